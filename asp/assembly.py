@@ -1,0 +1,147 @@
+"""An assembly folder: parts, holes, ground truths and demonstrations.
+
+An assembly is a folder (a name under ``data/`` or a path) holding:
+
+- ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role`` and optional ``start``
+  ``[x, y]`` [m] (where the part waits in the cell), ``[holes.<id>]`` with ``name``,
+  ``shape`` and ``position`` ``[x, y]`` [m] on the base plate;
+- ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
+  ``precedence_edge/2`` or ``must_precede/2``);
+- ``sizes.lp`` (optional): which part fits which hole (``part/1``, ``hole/1``,
+  ``fits/2``; closed world);
+- ``demos.txt`` (optional): demonstrated feasible sequences;
+- ``geometry.toml`` (optional): dimensions for the simulated cell.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from asp import PlannerError
+
+DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+_ID = re.compile(r"^[a-z][a-zA-Z0-9_]*$")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One part of an assembly; ``start`` is its waiting position [m] or None."""
+
+    id: str
+    name: str
+    role: str
+    start: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True)
+class Hole:
+    """One hole of the base plate; ``position`` [m] or None."""
+
+    id: str
+    name: str
+    shape: str
+    position: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """An assembly folder loaded from disk."""
+
+    folder: Path
+    name: str
+    parts: tuple[Part, ...]
+    holes: tuple[Hole, ...] = field(default_factory=tuple)
+
+    @property
+    def part_ids(self) -> list[str]:
+        return [p.id for p in self.parts]
+
+    @property
+    def hole_ids(self) -> list[str]:
+        return [h.id for h in self.holes]
+
+    def file(self, name: str) -> Path:
+        """Path of a file of the folder; PlannerError if it does not exist."""
+        path = self.folder / name
+        if not path.is_file():
+            raise PlannerError(f"{path}: no such file (assembly '{self.name}' has no {name})")
+        return path
+
+    def has_file(self, name: str) -> bool:
+        return (self.folder / name).is_file()
+
+
+def resolve_assembly_folder(name_or_path: str) -> Path:
+    """A name under ``data/`` or a path to a folder holding ``assembly.toml``."""
+    candidates = [Path(name_or_path), DATA_DIR / name_or_path]
+    for folder in candidates:
+        if (folder / "assembly.toml").is_file():
+            return folder.resolve()
+    known = sorted(p.parent.name for p in DATA_DIR.glob("*/assembly.toml"))
+    raise PlannerError(
+        f"assembly '{name_or_path}': expected a name under data/ ({', '.join(known)}) "
+        "or a folder holding assembly.toml"
+    )
+
+
+def _position(source: Path, table: str, key: str, value: object) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    if (
+        not isinstance(value, list)
+        or len(value) != 2
+        or not all(isinstance(v, (int, float)) for v in value)
+    ):
+        raise PlannerError(f"{source}: [{table}.{key}]: expected [x, y] in metres, got {value!r}")
+    return (float(value[0]), float(value[1]))
+
+
+def _table(source: Path, data: dict, table: str) -> dict[str, dict]:
+    entries = data.get(table, {})
+    if not isinstance(entries, dict):
+        raise PlannerError(f"{source}: [{table}] must be a table of ids")
+    for key, value in entries.items():
+        if not _ID.match(key):
+            raise PlannerError(
+                f"{source}: [{table}.{key}]: an id must be a lower-case ASP constant"
+            )
+        if not isinstance(value, dict):
+            raise PlannerError(f"{source}: [{table}.{key}] must be a table")
+    return entries
+
+
+def load_assembly(name_or_path: str) -> Assembly:
+    """Load an assembly folder; PlannerError naming the file and field on bad input."""
+    folder = resolve_assembly_folder(name_or_path)
+    source = folder / "assembly.toml"
+    try:
+        data = tomllib.loads(source.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise PlannerError(f"{source}: not valid TOML: {exc}") from None
+    parts = tuple(
+        Part(
+            id=key,
+            name=str(value.get("name", key)),
+            role=str(value.get("role", "part")),
+            start=_position(source, "parts", key, value.get("start")),
+        )
+        for key, value in _table(source, data, "parts").items()
+    )
+    if not parts:
+        raise PlannerError(f"{source}: expected at least one [parts.<id>] table")
+    holes = tuple(
+        Hole(
+            id=key,
+            name=str(value.get("name", key)),
+            shape=str(value.get("shape", "round")),
+            position=_position(source, "holes", key, value.get("position")),
+        )
+        for key, value in _table(source, data, "holes").items()
+    )
+    clash = {p.id for p in parts} & {h.id for h in holes}
+    if clash:
+        raise PlannerError(f"{source}: ids used for both a part and a hole: {sorted(clash)}")
+    return Assembly(folder=folder, name=str(data.get("name", folder.name)), parts=parts, holes=holes)

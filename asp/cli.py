@@ -1,0 +1,56 @@
+"""The planner's command line: ``./run.sh <subcommand> ...``.
+
+Each subcommand lives in its own module exposing ``main(argv) -> int``; they are
+imported lazily so that ``--help`` of one does not pay for the others. A
+:class:`asp.PlannerError` (bad input) is printed as ``error: ...`` with exit code 2.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "precedence": ("asp.precedence_cli", "learn/count/sample/evaluate/suggest precedence"),
+    "sizes": ("asp.sizes_cli", "learn/evaluate which part fits which hole"),
+    "assign": ("asp.assign_cli", "hole assignments from learned facts"),
+    "plan": ("asp.plan_cli", "complete assembly plans from learned facts"),
+    "session": ("asp.session", "the end-to-end learning session (planner + cells)"),
+    "view": ("asp.view", "open a session's Rerun recording"),
+    "bench": ("asp.bench", "benchmarks: precedence | sizes | session"),
+}
+
+
+def run_guarded(main, argv: list[str]) -> int:
+    """Run ``main(argv)``; a PlannerError becomes ``error: ...`` on stderr and exit 2."""
+    from asp import PlannerError
+
+    try:
+        return int(main(argv) or 0)
+    except PlannerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0] in ("-h", "--help"):
+        print("usage: ./run.sh SUBCOMMAND [ARGS...]\n")
+        for name, (_, text) in SUBCOMMANDS.items():
+            print(f"  {name:<11} {text}")
+        print("  executor    the simulated PyBullet cell (teach, trial, campaign, serve)")
+        return 0
+    name, rest = argv[0], argv[1:]
+    if name not in SUBCOMMANDS:
+        print(f"error: unknown subcommand '{name}'; expected one of: "
+              f"{', '.join([*SUBCOMMANDS, 'executor', 'test'])}", file=sys.stderr)
+        return 2
+    module = importlib.import_module(SUBCOMMANDS[name][0])
+    return run_guarded(module.main, rest)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# The one entry point of the project.
+#   ./run.sh                 set up .venv and run the main job (end-to-end Cranfield session)
+#   ./run.sh test [ARGS]     set up .venv and run the whole test suite (pytest ARGS)
+#   ./run.sh <subcommand>    run one command of the command line (each has --help)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+VENV="$ROOT/.venv"
+PY="$VENV/bin/python"
+STAMP="$VENV/.installed-$(sha1sum "$ROOT/pyproject.toml" | cut -c1-12)"
+
+setup() {
+    if [[ ! -x "$PY" ]]; then
+        python3 -m venv "$VENV" >&2
+    fi
+    if [[ ! -f "$STAMP" ]]; then
+        echo "run.sh: installing the project into $VENV (first run only)" >&2
+        "$PY" -m pip install --quiet --upgrade pip >&2
+        "$PY" -m pip install --quiet -e "$ROOT[test]" >&2
+        rm -f "$VENV"/.installed-*
+        touch "$STAMP"
+    fi
+}
+
+usage() {
+    cat <<'USAGE'
+usage: ./run.sh [SUBCOMMAND] [ARGS...]
+
+  (none)        end-to-end learning session on Cranfield (same as: session)
+  test          run the test suite
+  precedence    learn / count / sample / evaluate / suggest precedence constraints
+  sizes         learn / evaluate which part fits which hole (active exploration)
+  assign        hole assignments from learned facts
+  plan          complete assembly plans from learned facts
+  session       planner + cells over Zenoh: the whole learning session
+  view          open a session's Rerun recording
+  executor      the simulated PyBullet cell (teach, trial, campaign, serve)
+  bench         benchmarks: precedence | sizes | executor | session
+
+Every subcommand takes --help.
+USAGE
+}
+
+cd "$ROOT"
+cmd="${1:-session}"
+[[ $# -gt 0 ]] && shift
+case "$cmd" in
+    -h|--help|help) usage; exit 0 ;;
+esac
+setup
+export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
+case "$cmd" in
+    test)      exec "$PY" -m pytest "$@" ;;
+    executor)  exec "$PY" -m executor.cli "$@" ;;
+    bench)
+        if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -m executor.bench "$@"; fi
+        exec "$PY" -m asp.cli bench "$@" ;;
+    *)         exec "$PY" -m asp.cli "$cmd" "$@" ;;
+esac
