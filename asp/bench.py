@@ -1,0 +1,26 @@
+"""``./run.sh bench TOPIC``: benchmarks print their figures (medians, ratios).
+
+Each topic lives in its own module exposing ``main(argv) -> int``; ``bench executor``
+is routed by run.sh to ``executor.bench``.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+TOPICS: dict[str, str] = {
+    "precedence": "asp.bench_precedence",
+    "sizes": "asp.bench_sizes",
+    "session": "asp.bench_session",
+}
+
+
+def main(argv: list[str]) -> int:
+    if not argv or argv[0] in ("-h", "--help"):
+        print("usage: ./run.sh bench {precedence,sizes,executor,session} [--help]")
+        return 0
+    topic = argv[0]
+    if topic not in TOPICS:
+        print(f"error: unknown benchmark '{topic}'; expected one of: {', '.join([*TOPICS, 'executor'])}")
+        return 2
+    return int(importlib.import_module(TOPICS[topic]).main(argv[1:]) or 0)
