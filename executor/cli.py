@@ -1,0 +1,125 @@
+"""Command line of the simulated cell: ``teach``, ``trial``, ``campaign``, ``serve``.
+
+``./run.sh executor trial --part p1 --hole r1 --trials 3 --json`` prints
+``{"trials": [{"outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error",
+"duration_s", ...}, ...], "summary": {...}}``.  Bad input: ``error: ...`` and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+from collections.abc import Sequence
+
+from executor import ExecutorError
+
+
+def _teach(args: argparse.Namespace) -> int:
+    from executor.teach import teach_all
+
+    for path in teach_all(args.assembly):
+        print(f"wrote {path}")
+    return 0
+
+
+def _summary(results: list[dict]) -> dict:
+    """Counts and medians over the trials of one part-hole pair."""
+    outcomes = [r["outcome"] for r in results]
+    return {
+        "trials": len(results),
+        "fit": outcomes.count("fit"),
+        "no_fit": outcomes.count("no_fit"),
+        "fit_first_attempt": sum(1 for r in results if r["outcome"] == "fit" and r["attempts"] == 1),
+        "median_duration_s": statistics.median(r["duration_s"] for r in results),
+        "median_sim_steps_per_s": statistics.median(r["sim_steps_per_s"] for r in results),
+        "median_real_time_factor": statistics.median(r["real_time_factor"] for r in results),
+    }
+
+
+def _trial(args: argparse.Namespace) -> int:
+    from executor.trial import Cell
+
+    if args.trials < 1:
+        raise ExecutorError(f"--trials {args.trials}: expected a positive number of trials")
+    logger = None
+    if args.rrd:
+        from executor.rerun_log import AttemptLogger
+
+        logger = AttemptLogger.to_file(args.rrd)
+    cell = Cell(args.assembly, gui=args.gui, logger=logger)
+    try:
+        results = []
+        for k in range(args.trials):
+            result = cell.run_trial(args.part, args.hole, seed=args.seed + k, max_attempts=args.attempts)
+            results.append(result.to_json())
+            if not args.json:
+                r = results[-1]
+                print(
+                    f"{args.part}->{args.hole} seed {args.seed + k}: {r['outcome']} after {r['attempts']} "
+                    f"attempt(s); max |dF| {r['max_force_dev']:.1f} N, max |dM| {r['max_torque_dev']:.2f} Nm, "
+                    f"end error {1000 * r['end_error']:.1f} mm, {r['duration_s']:.2f} s wall "
+                    f"({r['real_time_factor']:.1f}x real time)"
+                )
+    finally:
+        cell.close()
+        if logger is not None:
+            logger.close()
+    summary = _summary(results)
+    if args.json:
+        print(json.dumps({"trials": results, "summary": summary}, indent=2))
+    else:
+        print(f"summary: {summary['fit']}/{summary['trials']} fit, median {summary['median_duration_s']:.2f} s wall")
+    return 0
+
+
+# Subcommands owned by sibling modules: ``executor.<name>.main(argv)``, imported lazily.
+_DELEGATED = {
+    "campaign": "Fig. 18: randomised executions of every part-hole pair (executor.campaign)",
+    "serve": "serve insertion requests over Zenoh (executor.serve)",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="executor", description="The simulated PyBullet assembly cell (paper 3).")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    teach = sub.add_parser("teach", help="record the scripted demonstrations (DMP + reference wrench)")
+    teach.add_argument("--assembly", default="cranfield", help="assembly folder under data/ (default: cranfield)")
+    teach.set_defaults(func=_teach)
+
+    trial = sub.add_parser("trial", help="insert one part into one hole, N randomised trials")
+    trial.add_argument("--part", required=True, help="part id, e.g. p1, p3, sh, tp")
+    trial.add_argument("--hole", required=True, help="hole id, e.g. r1, s1, br")
+    trial.add_argument("--trials", type=int, default=1, help="number of randomised trials (default 1)")
+    trial.add_argument("--seed", type=int, default=0, help="seed of the first trial; trial k uses seed+k")
+    trial.add_argument("--attempts", type=int, default=2, help="attempts per trial before 'no_fit' (default 2)")
+    trial.add_argument("--assembly", default="cranfield", help="assembly folder under data/ (default: cranfield)")
+    trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
+    trial.add_argument("--rrd", help="save a Rerun recording of every attempt to this file")
+    trial.add_argument("--json", action="store_true", help="print JSON instead of text")
+    trial.set_defaults(func=_trial)
+
+    for name, help_text in _DELEGATED.items():
+        sub.add_parser(name, help=help_text, add_help=False)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one subcommand; ExecutorError → ``error: ...`` on stderr and exit code 2."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        if argv and argv[0] in _DELEGATED:
+            import importlib
+
+            return int(importlib.import_module(f"executor.{argv[0]}").main(argv[1:]) or 0)
+        args = build_parser().parse_args(argv)
+        return int(args.func(args) or 0)
+    except ExecutorError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
