@@ -1,0 +1,113 @@
+"""Learning the must-precede relation from demonstrations (paper Algorithm 1).
+
+Each feasible sequence s gives its maximal relation C_s (s_i before s_j for i < j);
+the learned relation is the intersection of all C_s (paper eq. 1). It is computed on
+numpy boolean matrices, vectorised over demonstrations (and over trials in the
+evaluation). By paper eq. 10 it contains the true relation when every demonstration
+is feasible.
+
+Demonstrations can be wrong. :func:`pair_evidence` counts, per pair, the
+demonstrations that support and contradict it; :func:`suspects` flags a demonstration
+that alone removes constraints all the others support; ``min_support=K`` in
+:func:`learn_must_precede` drops a constraint only when at least K demonstrations
+contradict it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from asp import PlannerError
+from asp.demos import Demonstrations
+from asp.relation import Pair, Relation, close
+
+
+def positions(sequences: Sequence[Sequence[str]], parts: Sequence[str]) -> np.ndarray:
+    """``pos[d, i]``: the step (0-based) at which demonstration d places ``parts[i]``."""
+    index = {p: i for i, p in enumerate(parts)}
+    pos = np.empty((len(sequences), len(parts)), dtype=np.int16)
+    steps = np.arange(len(parts), dtype=np.int16)
+    for d, sequence in enumerate(sequences):
+        pos[d, [index[p] for p in sequence]] = steps
+    return pos
+
+
+def intersect_orders(pos: np.ndarray) -> np.ndarray:
+    """Algorithm 1 on positions ``pos[..., d, i]``: ``C[..., i, j]`` = i before j in every d.
+
+    Leading axes are batch axes (e.g. evaluation trials); with no demonstration the
+    result is all ones, as in the paper.
+    """
+    return np.all(pos[..., :, :, None] < pos[..., :, None, :], axis=-3)
+
+
+def precedence_support(pos: np.ndarray) -> np.ndarray:
+    """``support[i, j]``: how many demonstrations place i before j (int, shape (n, n)).
+
+    The number contradicting (i, j) is ``support[j, i]``.
+    """
+    return np.sum(pos[:, :, None] < pos[:, None, :], axis=0)
+
+
+def learn_must_precede(demos: Demonstrations, min_support: int = 1) -> Relation:
+    """The learned must-precede relation (transitively closed).
+
+    ``min_support=1`` is Algorithm 1 (intersection). With K > 1 a pair is kept while
+    fewer than K demonstrations contradict it and more support it than contradict it;
+    the kept pairs are then closed (ASP). PlannerError when they form a cycle.
+    """
+    if min_support < 1:
+        raise PlannerError(f"--min-support {min_support}: expected an integer >= 1")
+    pos = positions(demos.sequences, demos.parts)
+    if min_support == 1:
+        return Relation(demos.parts, intersect_orders(pos))
+    support = precedence_support(pos)
+    contradict = support.T
+    kept = (contradict < min_support) & (support > contradict)
+    return close(Relation(demos.parts, kept), source=f"demonstrations with --min-support {min_support}")
+
+
+@dataclass(frozen=True)
+class Suspect:
+    """A demonstration that alone removes constraints every other one supports."""
+
+    demo: int  # index into demos.sequences
+    origin: str  # file:line
+    removes: tuple[Pair, ...]
+
+
+def suspects(demos: Demonstrations, min_others: int = 2) -> list[Suspect]:
+    """Demonstrations that are the only ones contradicting some pair supported by all others.
+
+    Only reported when at least ``min_others`` other demonstrations agree (with one
+    other, every new demonstration would look suspicious).
+    """
+    count = len(demos.sequences)
+    if count - 1 < min_others:
+        return []
+    pos = positions(demos.sequences, demos.parts)
+    support = precedence_support(pos)
+    lone = support == count - 1  # all but one demonstration place i before j
+    found = []
+    for d in range(count):
+        reversed_here = pos[d][:, None] > pos[d][None, :]
+        rows, cols = np.nonzero(lone & reversed_here)
+        if rows.size:
+            pairs = tuple((demos.parts[i], demos.parts[j]) for i, j in zip(rows.tolist(), cols.tolist()))
+            found.append(Suspect(d, demos.origins[d], pairs))
+    return found
+
+
+def pair_evidence(demos: Demonstrations) -> list[dict[str, object]]:
+    """Per ordered pair seen both ways or one way: ``{"pair", "support", "contradict"}``."""
+    support = precedence_support(positions(demos.sequences, demos.parts))
+    n = len(demos.parts)
+    return [
+        {"pair": [demos.parts[i], demos.parts[j]], "support": int(support[i, j]), "contradict": int(support[j, i])}
+        for i in range(n)
+        for j in range(n)
+        if i != j and support[i, j] > 0
+    ]

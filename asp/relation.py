@@ -1,0 +1,143 @@
+"""A precedence relation over the parts of an assembly, and its ASP forms.
+
+:class:`Relation` holds a boolean matrix (``matrix[i, j]``: part ``parts[i]`` must be
+placed before ``parts[j]``, paper Fig. 2). Transitive closure and reduction are
+computed by the ASP encodings ``precedence_closure.lp`` and
+``precedence_reduction.lp``; the relation is written as ``part/1``,
+``must_precede/2`` (closure) and ``precedence_edge/2`` (reduction) facts.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import clingo
+import numpy as np
+
+from asp import PlannerError
+from asp.assembly import Assembly
+from asp.facts import atoms_by_name, fact, load_atoms
+
+Pair = tuple[str, str]
+
+
+def encoding_path(name: str) -> Path:
+    """Path of an encoding shipped in ``asp/encodings`` (found with importlib.resources)."""
+    resource = importlib.resources.files("asp") / "encodings" / name
+    return Path(str(resource))
+
+
+@dataclass(frozen=True, eq=False)
+class Relation:
+    """A precedence relation: ``matrix[i, j]`` is True when ``parts[i]`` precedes ``parts[j]``."""
+
+    parts: tuple[str, ...]
+    matrix: np.ndarray
+
+    @classmethod
+    def from_pairs(cls, parts: Sequence[str], pairs: Iterable[Pair]) -> Relation:
+        """Relation over ``parts`` holding exactly ``pairs``; PlannerError on an unknown id."""
+        index = {p: i for i, p in enumerate(parts)}
+        matrix = np.zeros((len(parts), len(parts)), dtype=bool)
+        for a, b in pairs:
+            for x in (a, b):
+                if x not in index:
+                    raise PlannerError(f"must_precede({a},{b}): '{x}' is not a part ({', '.join(parts)})")
+            matrix[index[a], index[b]] = True
+        return cls(tuple(parts), matrix)
+
+    def pairs(self) -> list[Pair]:
+        """The ordered pairs (a, b) with a before b, in part order."""
+        rows, cols = np.nonzero(self.matrix)
+        return [(self.parts[i], self.parts[j]) for i, j in zip(rows.tolist(), cols.tolist())]
+
+    def key(self) -> tuple[tuple[str, ...], bytes]:
+        """A hashable identity of the relation (for memoising counts)."""
+        return self.parts, np.packbits(self.matrix).tobytes()
+
+    def same_as(self, other: Relation) -> bool:
+        return self.parts == other.parts and bool(np.array_equal(self.matrix, other.matrix))
+
+    def admits(self, sequence: Sequence[str]) -> bool:
+        """Whether the sequence (all parts, each once) respects every pair."""
+        position = {p: i for i, p in enumerate(sequence)}
+        order = np.array([position[p] for p in self.parts])
+        return not bool(np.any(self.matrix & (order[:, None] > order[None, :])))
+
+    def matrix_text(self) -> str:
+        """The relation as a 0/1 matrix with row and column labels (paper Fig. 2)."""
+        width = max(len(p) for p in self.parts)
+        lines = [" " * width + " " + " ".join(f"{p:>{width}}" for p in self.parts)]
+        for name, row in zip(self.parts, self.matrix):
+            lines.append(f"{name:>{width}} " + " ".join(f"{int(v):>{width}}" for v in row))
+        return "\n".join(lines)
+
+
+def _solve(paths: Sequence[Path], facts: Iterable[clingo.Symbol]) -> list[clingo.Symbol]:
+    text = "".join(f"{atom}.\n" for atom in facts)
+    return load_atoms(paths, extra=text)
+
+
+def _relation_facts(relation: Relation, name: str) -> list[clingo.Symbol]:
+    return [fact("part", p) for p in relation.parts] + [fact(name, a, b) for a, b in relation.pairs()]
+
+
+def close(relation: Relation, source: str = "precedence constraints") -> Relation:
+    """Transitive closure by ``precedence_closure.lp``; PlannerError naming a cycle."""
+    atoms = _solve([encoding_path("precedence_closure.lp")], _relation_facts(relation, "must_precede"))
+    cycle = atoms_by_name(atoms, "cycle", 1)
+    if cycle:
+        raise PlannerError(
+            f"{source}: the constraints contain a cycle through {', '.join(c[0] for c in cycle)}; "
+            "expected an acyclic precedence relation"
+        )
+    return Relation.from_pairs(relation.parts, atoms_by_name(atoms, "must_precede", 2))
+
+
+def reduction(relation: Relation) -> list[Pair]:
+    """Transitive reduction (``precedence_edge`` pairs) of a closed acyclic relation."""
+    atoms = _solve([encoding_path("precedence_reduction.lp")], _relation_facts(relation, "must_precede"))
+    return [(a, b) for a, b in atoms_by_name(atoms, "precedence_edge", 2)]
+
+
+def precedence_facts(relation: Relation) -> list[clingo.Symbol]:
+    """``part/1``, ``must_precede/2`` (closure) and ``precedence_edge/2`` (reduction) facts."""
+    closed = close(relation)
+    return _relation_facts(closed, "must_precede") + [
+        fact("precedence_edge", a, b) for a, b in reduction(closed)
+    ]
+
+
+def load_relation(paths: Sequence[Path | str]) -> Relation:
+    """Read ``part/1`` with ``must_precede/2`` and/or ``precedence_edge/2`` facts; closed.
+
+    PlannerError when the files hold no ``part/1``, name an unknown part or hold a cycle.
+    """
+    names = ", ".join(str(p) for p in paths)
+    atoms = load_atoms([*paths, encoding_path("precedence_closure.lp")])
+    parts = [p for (p,) in atoms_by_name(atoms, "part", 1)]
+    if not parts:
+        raise PlannerError(f"{names}: expected part/1 facts naming the parts of the assembly")
+    pairs = atoms_by_name(atoms, "must_precede", 2)
+    unknown = sorted({x for pair in pairs for x in pair} - set(parts))
+    if unknown:
+        raise PlannerError(f"{names}: must_precede/precedence_edge name '{unknown[0]}', which is not a part/1")
+    relation = Relation.from_pairs(parts, pairs)
+    cycle = atoms_by_name(atoms, "cycle", 1)
+    if cycle:
+        raise PlannerError(f"{names}: the constraints contain a cycle through {', '.join(c[0] for c in cycle)}")
+    return relation
+
+
+def true_relation(assembly: Assembly) -> Relation:
+    """The assembly's true constraints (``precedence.lp``), closed, in assembly part order."""
+    relation = load_relation([assembly.file("precedence.lp")])
+    if set(relation.parts) != set(assembly.part_ids):
+        raise PlannerError(
+            f"{assembly.file('precedence.lp')}: part/1 facts {sorted(relation.parts)} differ from "
+            f"the parts of assembly.toml {sorted(assembly.part_ids)}"
+        )
+    return Relation.from_pairs(assembly.part_ids, relation.pairs())
