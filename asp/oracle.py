@@ -1,0 +1,126 @@
+"""Oracles answer "insert part P into hole H" with ``fit`` or ``no_fit`` (paper 2.2).
+
+Here the answers come from a ground truth (an assembly's ``sizes.lp``, paper Fig. 5,
+or any facts file of ``part/1``, ``hole/1``, ``fits/2``; closed world: a pair not
+listed does not fit). Later the simulated cell answers through Zenoh behind the same
+:class:`Oracle` protocol. A truth must be a biorder (Ferrers relation: sizes on one
+line), else the learner's reasoning by transitivity would be unsound.
+"""
+
+from __future__ import annotations
+
+import random
+import re
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Literal, Protocol
+
+from asp import PlannerError
+from asp.assembly import load_assembly
+from asp.facts import atoms_by_name, load_atoms
+
+Result = Literal["fit", "no_fit"]
+
+
+class Oracle(Protocol):
+    """Anything that can run one insertion experiment."""
+
+    def ask(self, part: str, hole: str) -> Result:
+        """Try to insert ``part`` into ``hole``: ``"fit"`` or ``"no_fit"``."""
+        ...
+
+
+def ferrers_violation(
+    parts: Sequence[str], holes: Sequence[str], fits: set[tuple[str, str]]
+) -> tuple[str, str, str, str] | None:
+    """``(p, h, q, k)`` with p fits h, q fits k, but p not k and q not h; None if a biorder."""
+    rows = {p: {h for h in holes if (p, h) in fits} for p in parts}
+    ordered = sorted(parts, key=lambda p: len(rows[p]))
+    for small, big in zip(ordered, ordered[1:]):
+        if not rows[small] <= rows[big]:
+            h = min(rows[small] - rows[big], key=holes.index)
+            k = min(rows[big] - rows[small], key=holes.index)
+            return small, h, big, k
+    return None
+
+
+class TruthOracle:
+    """Answers from a known part-hole relation (closed world), validated as a biorder.
+
+    ``parts`` and ``holes`` keep their order: it is the index order of the learner.
+    """
+
+    def __init__(
+        self, parts: Sequence[str], holes: Sequence[str], fits: Iterable[tuple[str, str]],
+        source: str = "truth",
+    ) -> None:
+        self.parts, self.holes = tuple(parts), tuple(holes)
+        self.fits = set(fits)
+        if not self.parts or not self.holes:
+            raise PlannerError(f"{source}: expected at least one part/1 and one hole/1")
+        for p, h in sorted(self.fits):
+            if p not in self.parts:
+                raise PlannerError(f"{source}: fits({p},{h}): '{p}' is not a declared part/1")
+            if h not in self.holes:
+                raise PlannerError(f"{source}: fits({p},{h}): '{h}' is not a declared hole/1")
+        bad = ferrers_violation(self.parts, self.holes, self.fits)
+        if bad:
+            p, h, q, k = bad
+            raise PlannerError(
+                f"{source}: not a biorder (sizes on one line): {p} fits {h} but not {k}, "
+                f"while {q} fits {k} but not {h}"
+            )
+
+    def ask(self, part: str, hole: str) -> Result:
+        if part not in self.parts or hole not in self.holes:
+            raise PlannerError(f"oracle: unknown pair ({part},{hole}); expected a part and a hole")
+        return "fit" if (part, hole) in self.fits else "no_fit"
+
+    @classmethod
+    def from_facts(cls, path: Path | str) -> TruthOracle:
+        """A truth facts file; index order = order of first mention in the file."""
+        path = Path(path)
+        atoms = load_atoms([path])
+        parts = [a for (a,) in atoms_by_name(atoms, "part", 1)]
+        holes = [a for (a,) in atoms_by_name(atoms, "hole", 1)]
+        text = re.sub(r"%.*", "", path.read_text(encoding="utf-8"))
+
+        def mention(name: str) -> int:
+            found = re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", text)
+            return found.start() if found else len(text)
+
+        parts.sort(key=mention)
+        holes.sort(key=mention)
+        fits = {(p, h) for p, h in atoms_by_name(atoms, "fits", 2)}
+        return cls(parts, holes, fits, source=str(path))
+
+    @classmethod
+    def from_assembly(cls, name_or_path: str) -> TruthOracle:
+        """An assembly's ``sizes.lp``, in the order of its ``assembly.toml``."""
+        assembly = load_assembly(name_or_path)
+        truth = cls.from_facts(assembly.file("sizes.lp"))
+        for kind, ids, known in (("part", truth.parts, assembly.part_ids),
+                                 ("hole", truth.holes, assembly.hole_ids)):
+            unknown = [i for i in ids if i not in known]
+            if unknown:
+                raise PlannerError(
+                    f"{assembly.folder / 'sizes.lp'}: {kind}(s) {unknown} are not in "
+                    f"{assembly.folder / 'assembly.toml'}"
+                )
+        parts = [p for p in assembly.part_ids if p in truth.parts]
+        holes = [h for h in assembly.hole_ids if h in truth.holes]
+        return cls(parts, holes, truth.fits, source=str(assembly.folder / "sizes.lp"))
+
+
+class NoisyOracle:
+    """Wraps an oracle and flips each answer with probability ``flip_probability``."""
+
+    def __init__(self, inner: Oracle, flip_probability: float, seed: int = 0) -> None:
+        self.inner, self.flip_probability = inner, flip_probability
+        self.rng = random.Random(seed)
+
+    def ask(self, part: str, hole: str) -> Result:
+        answer = self.inner.ask(part, hole)
+        if self.rng.random() < self.flip_probability:
+            return "no_fit" if answer == "fit" else "fit"
+        return answer

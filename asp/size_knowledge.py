@@ -1,0 +1,92 @@
+"""What the size learner knows: the closure of the smaller-than relation (paper 2.2).
+
+:class:`Knowledge` is an immutable snapshot read from one model of
+``sizes_closure.lp``: the smaller-than relation over parts ∪ holes, the part-hole pairs
+known to fit / not to fit (observed or entailed), the pairs still unknown, and the
+observations that lie on a cycle (noise). Policies written in Python receive it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import clingo
+
+Pair = tuple[str, str]
+"""A part-hole pair ``(part, hole)`` of ASP constants."""
+
+RESULTS: tuple[str, str] = ("fit", "no_fit")
+"""The two outcomes of an insertion experiment."""
+
+
+@dataclass(frozen=True)
+class Knowledge:
+    """The learner's knowledge after some experiments.
+
+    ``parts`` and ``holes`` are in index order (index 1 first); the pair sets hold
+    ``(part, hole)``; ``smaller`` holds ``(x, y)`` with x smaller than y, both parts or
+    holes; ``conflicts`` holds ``(part, hole, result)`` observations on a cycle.
+    """
+
+    parts: tuple[str, ...]
+    holes: tuple[str, ...]
+    smaller: frozenset[tuple[str, str]]
+    fits: frozenset[Pair]
+    no_fit: frozenset[Pair]
+    conflicts: frozenset[tuple[str, str, str]]
+
+    @property
+    def unknown(self) -> list[Pair]:
+        """Pairs neither known to fit nor known not to fit, in index order."""
+        return [
+            (p, h)
+            for p in self.parts
+            for h in self.holes
+            if (p, h) not in self.fits and (p, h) not in self.no_fit
+        ]
+
+    @property
+    def complete(self) -> bool:
+        """Every pair known and no conflict left."""
+        return not self.conflicts and not self.unknown
+
+    def result(self, part: str, hole: str) -> str | None:
+        """``"fit"``, ``"no_fit"`` or None when the pair is unknown (or in conflict: both)."""
+        fit, no_fit = (part, hole) in self.fits, (part, hole) in self.no_fit
+        if fit == no_fit:
+            return None
+        return "fit" if fit else "no_fit"
+
+    def matrix(self) -> list[list[int | None]]:
+        """Rows = parts, columns = holes: 1 fits, 0 does not fit, None unknown."""
+        code = {"fit": 1, "no_fit": 0, None: None}
+        return [[code[self.result(p, h)] for h in self.holes] for p in self.parts]
+
+    @classmethod
+    def from_symbols(
+        cls, parts: Sequence[str], holes: Sequence[str], symbols: Iterable[clingo.Symbol]
+    ) -> Knowledge:
+        """Read the shown atoms of a ``sizes_closure.lp`` model."""
+        smaller: set[tuple[str, str]] = set()
+        fits: set[Pair] = set()
+        no_fit: set[Pair] = set()
+        conflicts: set[tuple[str, str, str]] = set()
+        sets: dict[tuple[str, int], set] = {
+            ("smaller", 2): smaller,
+            ("fits", 2): fits,
+            ("no_fit", 2): no_fit,
+            ("in_conflict", 3): conflicts,
+        }
+        for symbol in symbols:
+            target = sets.get((symbol.name, len(symbol.arguments)))
+            if target is not None:
+                target.add(tuple(str(a) for a in symbol.arguments))
+        return cls(
+            parts=tuple(parts),
+            holes=tuple(holes),
+            smaller=frozenset(smaller),
+            fits=frozenset(fits),
+            no_fit=frozenset(no_fit),
+            conflicts=frozenset(conflicts),
+        )

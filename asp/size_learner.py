@@ -1,0 +1,237 @@
+"""The size-learning session (paper 2.2): which part fits which hole, by experiments.
+
+One :class:`SizeLearner` owns ONE long-lived ``clingo.Control``: the parts, holes,
+their index order, ``sizes_closure.lp`` and the policy's encoding are grounded once;
+every possible observation ``observed(P,H,R)`` is an ``#external`` switched with
+``assign_external``. Each decision is one solve of that ground program.
+
+The learner never proposes a pair whose result is entailed, and proposes a pair again
+only to re-test it: when an answer makes the closure cyclic (noise), the observations
+on the cycle are named and re-tested; per pair the majority of its answers is kept
+(a tie keeps the latest), so the kept relation never contradicts itself. It is done
+when every pair is known and no conflict is left.
+"""
+
+from __future__ import annotations
+
+import itertools
+import random
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from importlib.resources import as_file, files
+
+import clingo
+
+from asp import PlannerError
+from asp.facts import fact, format_facts
+from asp.oracle import Oracle
+from asp.size_knowledge import RESULTS, Knowledge, Pair
+from asp.size_policies import SelectionPolicy, get_policy
+
+_OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit)."
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """Experiment ``number`` (1-based) inserted ``part`` into ``hole``; ``retest`` if repeated."""
+
+    number: int
+    part: str
+    hole: str
+    result: str
+    retest: bool = False
+
+    def as_json(self) -> dict[str, str]:
+        return {"part": self.part, "hole": self.hole, "result": self.result}
+
+
+@dataclass(frozen=True)
+class SizeLearningResult:
+    """A finished session: the experiments in order and the final knowledge."""
+
+    policy: str
+    experiments: tuple[Experiment, ...]
+    knowledge: Knowledge
+
+    @property
+    def count(self) -> int:
+        """Number of experiments run, re-tests included."""
+        return len(self.experiments)
+
+    def facts(self) -> list[clingo.Symbol]:
+        """``part/1, hole/1, tried/4, smaller/2, fits/2, no_fit/2`` (DESIGN.md vocabulary)."""
+        k = self.knowledge
+        atoms = [fact("part", p) for p in k.parts] + [fact("hole", h) for h in k.holes]
+        atoms += [fact("tried", e.number, e.part, e.hole, e.result) for e in self.experiments]
+        atoms += [fact("smaller", x, y) for x, y in sorted(k.smaller)]
+        atoms += [fact("fits", p, h) for p, h in sorted(k.fits)]
+        atoms += [fact("no_fit", p, h) for p, h in sorted(k.no_fit)]
+        return atoms
+
+
+def encoding_path(name: str):
+    """Context manager giving the filesystem path of ``asp/encodings/<name>``."""
+    return as_file(files("asp") / "encodings" / name)
+
+
+class SizeLearner:
+    """Knowledge of one learning session and the choice of its next experiments."""
+
+    def __init__(
+        self,
+        parts: Sequence[str],
+        holes: Sequence[str],
+        policy: str | SelectionPolicy = "systematic",
+        seed: int = 0,
+        max_answers: int = 5,
+    ) -> None:
+        """``parts``/``holes`` in index order; ``max_answers`` caps the answers per pair."""
+        if len(set(parts) | set(holes)) != len(parts) + len(holes):
+            raise PlannerError("parts and holes need distinct ids")
+        self.parts, self.holes = tuple(parts), tuple(holes)
+        self.policy = get_policy(policy) if isinstance(policy, str) else policy
+        self.rng = random.Random(seed)
+        self.max_answers = max_answers
+        self.experiments: list[Experiment] = []
+        self.answers: dict[Pair, list[str]] = {}
+        self.retests: list[Pair] = []
+        self._ctl = clingo.Control(["--warn=none"])
+        self._ground(seed)
+        self._selected: Pair | None = None
+        self.knowledge = self._solve()
+
+    def _ground(self, seed: int) -> None:
+        atoms = [fact("part", p) for p in self.parts] + [fact("hole", h) for h in self.holes]
+        atoms += [fact("part_index", p, i) for i, p in enumerate(self.parts, 1)]
+        atoms += [fact("hole_index", h, j) for j, h in enumerate(self.holes, 1)]
+        if self.policy.session_facts is not None:
+            atoms += self.policy.session_facts(self.parts, self.holes, seed)
+        self._ctl.add("base", [], format_facts(atoms) + _OBSERVATIONS)
+        for name in ("sizes_closure.lp", self.policy.encoding):
+            if name is not None:
+                with encoding_path(name) as path:
+                    self._ctl.load(str(path))
+        self._ctl.ground([("base", [])])
+
+    def _solve(self) -> Knowledge:
+        """Solve the ground program under the current externals; remember ``select/2``."""
+        last: list[clingo.Symbol] = []
+        result = self._ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
+        if not result.satisfiable:
+            raise PlannerError(f"policy {self.policy.name}: no model for the current knowledge")
+        selected = [tuple(str(a) for a in s.arguments) for s in last if s.name == "select"]
+        self._selected = selected[0] if len(selected) == 1 else None
+        return Knowledge.from_symbols(self.parts, self.holes, last)
+
+    def _set_observation(self, pair: Pair, result: str | None) -> None:
+        for value in RESULTS:
+            atom = fact("observed", pair[0], pair[1], value)
+            self._ctl.assign_external(atom, value == result)
+
+    @staticmethod
+    def _kept(answers: list[str]) -> str:
+        """The majority answer; a tie keeps the latest."""
+        counts = {r: answers.count(r) for r in RESULTS}
+        if counts["fit"] == counts["no_fit"]:
+            return answers[-1]
+        return max(RESULTS, key=counts.__getitem__)
+
+    def next_experiment(self) -> Pair | None:
+        """The pair to try next (a pending re-test first); None when learning is done."""
+        if self.retests:
+            return self.retests[0]
+        if self.knowledge.complete:
+            return None
+        if self.policy.choose is not None:
+            pair = self.policy.choose(self.knowledge, self.rng)
+        else:
+            pair = self._selected
+        if pair is None or self.knowledge.result(*pair) is not None:
+            raise PlannerError(f"policy {self.policy.name} chose {pair}, not an unknown pair")
+        return pair
+
+    def record(self, part: str, hole: str, result: str) -> Experiment:
+        """Add one answer, update the closure, queue re-tests of conflicting observations."""
+        if result not in RESULTS or part not in self.parts or hole not in self.holes:
+            raise PlannerError(f"experiment ({part},{hole}) -> {result!r}: expected a known "
+                               f"part, hole and a result in {RESULTS}")
+        pair = (part, hole)
+        retest = pair in self.answers
+        if pair in self.retests:
+            self.retests.remove(pair)
+        experiment = Experiment(len(self.experiments) + 1, part, hole, result, retest)
+        self.experiments.append(experiment)
+        self.answers.setdefault(pair, []).append(result)
+        self._set_observation(pair, self._kept(self.answers[pair]))
+        self.knowledge = self._solve()
+        self._queue_retests()
+        return experiment
+
+    def conflicting_experiments(self) -> list[Experiment]:
+        """Experiments whose kept result lies on a cycle of the closure."""
+        kept = {(p, h, r) for p, h, r in self.knowledge.conflicts}
+        return [e for e in self.experiments if (e.part, e.hole, e.result) in kept]
+
+    def _queue_retests(self) -> None:
+        for p, h, _ in sorted(self.knowledge.conflicts):
+            if (p, h) in self.retests:
+                continue
+            if len(self.answers[(p, h)]) >= self.max_answers:
+                named = ", ".join(f"#{e.number} {e.part}->{e.hole} {e.result}"
+                                  for e in self.conflicting_experiments())
+                raise PlannerError(f"observations stay in conflict after {self.max_answers} "
+                                   f"answers per pair: {named}")
+            self.retests.append((p, h))
+
+    def next_batch(self, size: int) -> list[Pair]:
+        """Up to ``size`` pairs to try in parallel: no outcomes of some can entail another's.
+
+        Starts with :meth:`next_experiment`, then adds unknown pairs in index order whose
+        independence holds for every combination of outcomes (checked by solving).
+        """
+        first = self.next_experiment()
+        if first is None or self.retests:
+            return list(self.retests[:size]) if self.retests else []
+        batch = [first]
+        for pair in self.knowledge.unknown:
+            if len(batch) >= size:
+                break
+            if pair not in batch and self._independent([*batch, pair]):
+                batch.append(pair)
+        self.knowledge = self._solve()
+        return batch
+
+    def _independent(self, pairs: list[Pair]) -> bool:
+        """No outcomes of all but one pair entail (or contradict) the remaining pair."""
+        for index, target in enumerate(pairs):
+            others = pairs[:index] + pairs[index + 1:]
+            for outcomes in itertools.product(RESULTS, repeat=len(others)):
+                for pair, outcome in zip(others, outcomes):
+                    self._set_observation(pair, outcome)
+                knowledge = self._solve()
+                for pair in others:
+                    self._set_observation(pair, None)
+                if knowledge.conflicts or knowledge.result(*target) is not None:
+                    return False
+        return True
+
+    def result(self) -> SizeLearningResult:
+        return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge)
+
+
+def learn_sizes(
+    parts: Sequence[str],
+    holes: Sequence[str],
+    oracle: Oracle,
+    policy: str | SelectionPolicy = "systematic",
+    seed: int = 0,
+    on_experiment: Callable[[Experiment, Knowledge], None] | None = None,
+    max_answers: int = 5,
+) -> SizeLearningResult:
+    """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known."""
+    learner = SizeLearner(parts, holes, policy, seed, max_answers)
+    while (pair := learner.next_experiment()) is not None:
+        experiment = learner.record(*pair, oracle.ask(*pair))
+        if on_experiment is not None:
+            on_experiment(experiment, learner.knowledge)
+    return learner.result()
