@@ -1,0 +1,161 @@
+"""Reading Rerun recordings (``.rrd``) back: which entities they hold, and values.
+
+Rerun 0.41 dropped ``rr.dataframe``; this module uses the SDK's own chunk reader
+(``rerun.chunk.RrdReader``, in process, no extra dependency) instead of parsing the
+output of ``rerun rrd print``. Used by the tests and by ``./run.sh view RUN --print``.
+
+Entity paths are reported as Rerun prints them, with a leading ``/``
+(``/executor/c1/outcome``); Rerun's own ``/__properties`` entities are left out.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rerun.chunk import Chunk, RrdReader
+
+from executor import ExecutorError
+
+
+@dataclass
+class EntitySummary:
+    """One entity: logged rows (``static_rows`` of them static), components, timelines."""
+
+    path: str
+    rows: int = 0
+    static_rows: int = 0
+    components: set[str] = field(default_factory=set)
+    timelines: set[str] = field(default_factory=set)
+
+
+@dataclass
+class RecordingSummary:
+    """What one or more ``.rrd`` files hold."""
+
+    files: list[Path]
+    application_ids: set[str] = field(default_factory=set)
+    recording_ids: set[str] = field(default_factory=set)
+    blueprints: int = 0
+    entities: dict[str, EntitySummary] = field(default_factory=dict)
+
+    def under(self, prefix: str) -> dict[str, EntitySummary]:
+        """Entities at or below ``prefix`` (e.g. ``/executor/c1``)."""
+        prefix = "/" + prefix.strip("/")
+        return {
+            path: entity for path, entity in self.entities.items()
+            if path == prefix or path.startswith(prefix + "/")
+        }
+
+    def to_json(self) -> dict[str, Any]:
+        """``{"files", "application_ids", "recording_ids", "blueprints", "entities":
+        {path: {"rows", "static_rows", "components", "timelines"}}}``."""
+        return {
+            "files": [str(f) for f in self.files],
+            "application_ids": sorted(self.application_ids),
+            "recording_ids": sorted(self.recording_ids),
+            "blueprints": self.blueprints,
+            "entities": {
+                path: {
+                    "rows": e.rows, "static_rows": e.static_rows,
+                    "components": sorted(e.components), "timelines": sorted(e.timelines),
+                }
+                for path, e in sorted(self.entities.items())
+            },
+        }
+
+
+_CONTROL_COLUMN_PREFIX = "rerun.controls."
+
+
+def _reader(path: Path) -> RrdReader:
+    if not path.is_file():
+        raise ExecutorError(f"{path}: no such recording file (expected an .rrd file)")
+    return RrdReader(path)
+
+
+@contextmanager
+def _tolerating_unfinished_files() -> Iterator[None]:
+    """A file still being written (or from a killed process) has no footer yet; the
+    reader warns and falls back to a whole-file scan, which is what we want."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*no footer.*")
+        yield
+
+
+def _chunks(path: Path) -> Iterator[Chunk]:
+    """Every chunk of every recording store of the file (blueprints excluded)."""
+    reader = _reader(path)
+    with _tolerating_unfinished_files():
+        for store in reader.recordings():
+            yield from reader.stream(store=store)
+
+
+def read_recording(paths: Path | str | Sequence[Path | str]) -> RecordingSummary:
+    """Summarise ``.rrd`` files: entity paths with row counts, components, timelines."""
+    files = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]
+    summary = RecordingSummary(files=files)
+    for path in files:
+        reader = _reader(path)
+        with _tolerating_unfinished_files():
+            for store in reader.recordings():
+                summary.application_ids.add(store.application_id)
+                summary.recording_ids.add(store.recording_id)
+            summary.blueprints += len(reader.blueprints())
+        for chunk in _chunks(path):
+            if chunk.entity_path.startswith("/__"):
+                continue
+            entity = summary.entities.setdefault(chunk.entity_path, EntitySummary(chunk.entity_path))
+            entity.rows += chunk.num_rows
+            entity.static_rows += chunk.num_rows if chunk.is_static else 0
+            entity.timelines.update(chunk.timeline_names)
+            names = chunk.to_record_batch().schema.names
+            entity.components.update(
+                n for n in names
+                if ":" in n and not n.startswith(_CONTROL_COLUMN_PREFIX)
+            )
+    return summary
+
+
+def component_values(
+    paths: Path | str | Iterable[Path | str], entity: str, component: str
+) -> list[Any]:
+    """Every logged value of ``component`` (e.g. ``"TextLog:text"``, ``"Scalars:scalars"``)
+    of ``entity`` (e.g. ``/executor/c1/outcome``), one list item per row, in file order.
+
+    A row holds the component's batch: ``["fit ..."]`` for a text log line, ``[1.0]``
+    for one scalar, ``[fx, fy, fz]`` for three plotted series.
+    """
+    files = [paths] if isinstance(paths, (str, Path)) else list(paths)
+    wanted = "/" + entity.strip("/")
+    values: list[Any] = []
+    for path in files:
+        for chunk in _chunks(Path(path)):
+            if chunk.entity_path != wanted:
+                continue
+            batch = chunk.to_record_batch()
+            if component in batch.schema.names:
+                values.extend(batch.column(component).to_pylist())
+    return values
+
+
+def format_summary(summary: RecordingSummary) -> str:
+    """Human-readable listing: ids, then one line per entity (rows, components)."""
+    lines = [
+        f"files: {', '.join(str(f) for f in summary.files)}",
+        f"application ids: {', '.join(sorted(summary.application_ids)) or '-'}; "
+        f"recording ids: {', '.join(sorted(summary.recording_ids)) or '-'}; "
+        f"blueprints: {summary.blueprints}",
+        f"{len(summary.entities)} entity paths:",
+    ]
+    width = max((len(p) for p in summary.entities), default=0)
+    for path, entity in sorted(summary.entities.items()):
+        kind = ", ".join([*sorted(entity.timelines), *(["static"] if entity.static_rows else [])])
+        lines.append(
+            f"  {path:<{width}}  {entity.rows:>7} rows  [{kind}]  {', '.join(sorted(entity.components))}"
+        )
+    return "\n".join(lines)

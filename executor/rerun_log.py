@@ -1,0 +1,404 @@
+"""Rerun logging of the cell's insertion attempts (paper 3.2, Fig. 17).
+
+The :class:`~executor.trial.Cell` calls an :class:`AttemptLogger` while it executes:
+``log_scene`` once, then per attempt ``begin_attempt``, ``log_search_path``,
+``log_step`` at every control step and ``end_attempt``.
+
+Entities (all under ``executor/<cell-id>/``):
+
+=============================== ===================================================
+``scene/<name>``                static geometry (boxes, cylinders), ``static=True``
+``tool/tip``                    tool-tip position over ``sim_time`` [m]
+``tool/path``                   the attempt's tool path as a line strip [m]
+``search/path``                 the stochastic hole-search path [m]
+``wrench/force/{measured,desired}``   F_mes, F_des (x, y, z) over ``sim_time`` [N]
+``wrench/torque/{measured,desired}``  M_mes, M_des (x, y, z) over ``sim_time`` [Nm]
+``deviation/{force,torque}``    ‖F_mes − F_des‖ [N], ‖M_mes − M_des‖ [Nm] (eqs. 6, 7)
+``phase``                       DMP phase over ``sim_time`` (1 → 0 as in Ude et al.
+                                or 0 → 1, as the cell reports it)
+``by_phase/<attempt>/force_{measured,desired}``  force over timeline ``dmp_phase``
+                                (phase × 1000), one series per attempt: Fig. 17
+``outcome``                     text log, one line per attempt
+``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
+=============================== ===================================================
+
+Timelines: ``experiment`` (sequence: one per trial, or set by the caller),
+``sim_time`` (duration [s]; kept increasing across attempts even when the cell
+restarts its clock) and ``dmp_phase`` (sequence, phase × 1000).
+
+Steps are buffered and sent column-wise (``send_columns``) at ``end_attempt``, which
+keeps the per-step cost to a list append; samples closer than ``period_s`` in sim
+time are skipped so a long campaign stays small.
+"""
+
+from __future__ import annotations
+
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple, Protocol, Sequence
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from executor import ExecutorError
+
+APPLICATION_ID = "assembly_constraints"
+PHASE_SCALE = 1000
+"""The ``dmp_phase`` timeline holds round(phase × PHASE_SCALE)."""
+
+_AXIS_NAMES = {"force": ["Fx", "Fy", "Fz"], "torque": ["Mx", "My", "Mz"]}
+_MEASURED_COLORS = [[230, 60, 60], [60, 170, 60], [60, 90, 230]]
+_DESIRED_COLORS = [[250, 160, 160], [150, 220, 150], [150, 170, 250]]
+_TIME_TOLERANCE = 1e-9  # [s] float slack when comparing sim times
+_FIT_COLOR = [40, 180, 60]
+_NO_FIT_COLOR = [220, 50, 40]
+
+
+class SceneShape(NamedTuple):
+    """One static body of the scene; a plain tuple in this order works as well.
+
+    ``shape`` is ``"box"`` or ``"cylinder"``; ``half_extents`` [m] are the box's half
+    sizes, or ``(radius, radius, half_length)`` of a cylinder along its local z axis.
+    """
+
+    name: str
+    shape: str
+    half_extents: Sequence[float]
+    position: Sequence[float]
+    quat_xyzw: Sequence[float] = (0.0, 0.0, 0.0, 1.0)
+    color: Sequence[int] | None = None
+
+
+class Evidence(Protocol):
+    """What ``end_attempt`` reads (``executor.trial.AttemptEvidence`` satisfies it)."""
+
+    outcome: str
+    max_force_dev: float
+    max_torque_dev: float
+    end_error: float
+    duration_s: float
+    sim_time_s: float
+    jammed: bool
+    wiggles: int
+    phase_reached: float
+
+
+@dataclass
+class AttemptTrace:
+    """The buffered samples of one attempt (also kept for plots, e.g. Fig. 17).
+
+    Arrays have one row per logged step: ``sim_time`` [s] as the cell reported it,
+    ``phase`` (DMP phase), ``tool_pos`` [m], forces [N], torques [Nm].
+    """
+
+    part: str
+    hole: str
+    trial_seed: int
+    attempt: int
+    experiment: int
+    outcome: str = ""
+    sim_time: list[float] = field(default_factory=list)
+    phase: list[float] = field(default_factory=list)
+    tool_pos: list[np.ndarray] = field(default_factory=list)
+    force_mes: list[np.ndarray] = field(default_factory=list)
+    force_des: list[np.ndarray] = field(default_factory=list)
+    torque_mes: list[np.ndarray] = field(default_factory=list)
+    torque_des: list[np.ndarray] = field(default_factory=list)
+
+    @property
+    def key(self) -> str:
+        """Entity-path-safe name of the attempt, e.g. ``e0003_p1_r1_s7_a2``."""
+        return f"e{self.experiment:04d}_{self.part}_{self.hole}_s{self.trial_seed}_a{self.attempt}"
+
+    def array(self, name: str) -> np.ndarray:
+        """One buffered signal as an array (``(N,)`` or ``(N, 3)``)."""
+        return np.asarray(getattr(self, name), dtype=np.float64)
+
+
+class AttemptLogger:
+    """Logs a cell's attempts into one Rerun recording (explicit stream, not global).
+
+    ``AttemptLogger(cell_id="c1", rrd_path="runs/x/c1.rrd")`` opens a new stream of
+    application ``assembly_constraints`` with ``recording_id`` (random if None) saving
+    to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
+    existing ``rr.RecordingStream`` instead. Without either, data stays in memory
+    (``keep_traces`` then still gives the traces for plots).
+
+    ``period_s`` [s]: steps closer than this in sim time to the last kept one are
+    skipped. ``keep_traces``: keep every finished :class:`AttemptTrace` in ``traces``.
+    """
+
+    def __init__(
+        self,
+        cell_id: str = "c1",
+        *,
+        recording_id: str | None = None,
+        rrd_path: str | Path | None = None,
+        recording: rr.RecordingStream | None = None,
+        period_s: float = 0.005,
+        keep_traces: bool = False,
+        send_blueprint: bool = True,
+    ) -> None:
+        if recording is not None and rrd_path is not None:
+            raise ExecutorError("AttemptLogger: give rrd_path or recording, not both")
+        if period_s < 0:
+            raise ExecutorError(f"AttemptLogger: period_s must be >= 0 [s], got {period_s}")
+        self.cell_id = cell_id
+        self.root = f"executor/{cell_id}"
+        self.period_s = period_s
+        self.keep_traces = keep_traces
+        self.traces: list[AttemptTrace] = []
+        self._owns_stream = recording is None
+        if recording is None:
+            recording = rr.RecordingStream(
+                APPLICATION_ID, recording_id=recording_id or str(uuid.uuid4())
+            )
+            if rrd_path is not None:
+                Path(rrd_path).parent.mkdir(parents=True, exist_ok=True)
+                recording.save(str(rrd_path))
+            else:
+                recording.memory_recording()
+        self.rec = recording
+        self._experiment = 0
+        self._last_attempt: tuple[str, str, int, int] | None = None
+        self._styled: set[str] = set()  # entities whose static series style was sent
+        self._current: AttemptTrace | None = None
+        self._time_offset = 0.0  # [s] added to the cell's sim_time
+        self._last_time = 0.0  # [s] last logged (offset) sim time
+        if send_blueprint:
+            self.rec.send_blueprint(cell_blueprint([cell_id]))
+
+    @classmethod
+    def to_file(
+        cls, rrd_path: str | Path, cell_id: str = "c1", recording_id: str | None = None
+    ) -> AttemptLogger:
+        """A logger saving to ``rrd_path`` (parent folders are created)."""
+        return cls(cell_id, recording_id=recording_id, rrd_path=rrd_path)
+
+    # -- static geometry -------------------------------------------------------------
+
+    def log_scene(self, shapes: Sequence[SceneShape | tuple[Any, ...]]) -> None:
+        """Log static bodies once (``static=True``) under ``scene/<name>``."""
+        for raw in shapes:
+            shape = SceneShape(*raw)
+            half = np.asarray(shape.half_extents, dtype=np.float64)
+            quat = rr.Quaternion(xyzw=list(shape.quat_xyzw))
+            colors = [list(shape.color)] if shape.color is not None else None
+            if shape.shape == "box":
+                archetype: Any = rr.Boxes3D(
+                    half_sizes=[half], centers=[shape.position], quaternions=[quat],
+                    colors=colors, fill_mode="solid",
+                )
+            elif shape.shape == "cylinder":
+                archetype = rr.Cylinders3D(
+                    radii=[float(half[0])], lengths=[2.0 * float(half[2])],
+                    centers=[shape.position], quaternions=[quat], colors=colors,
+                    fill_mode="solid",
+                )
+            else:
+                raise ExecutorError(
+                    f"scene shape '{shape.name}': shape must be 'box' or 'cylinder', "
+                    f"got {shape.shape!r}"
+                )
+            self.rec.log(f"{self.root}/scene/{shape.name}", archetype, static=True)
+
+    # -- one attempt ---------------------------------------------------------------------
+
+    def begin_attempt(
+        self, part: str, hole: str, trial_seed: int, attempt: int, experiment: int | None = None
+    ) -> None:
+        """Start buffering an attempt; a new trial advances the ``experiment`` timeline.
+
+        A trial is new when (part, hole, seed) changes or ``attempt`` does not grow;
+        ``experiment`` (e.g. the planner's experiment number) overrides the counter.
+        """
+        previous = self._last_attempt
+        same_trial = (
+            previous is not None
+            and previous[:3] == (part, hole, trial_seed)
+            and attempt > previous[3]
+        )
+        if experiment is not None:
+            self._experiment = experiment
+        elif not same_trial:
+            self._experiment += 1
+        self._last_attempt = (part, hole, trial_seed, attempt)
+        self._current = AttemptTrace(part, hole, trial_seed, attempt, self._experiment)
+        self._set_time(self._last_time)
+
+    def log_step(
+        self,
+        sim_time: float,
+        phase: float,
+        tool_pos: np.ndarray,
+        force_mes: np.ndarray,
+        force_des: np.ndarray,
+        torque_mes: np.ndarray,
+        torque_des: np.ndarray,
+    ) -> None:
+        """Buffer one control step: sim time [s], DMP phase, tool tip [m], F [N], M [Nm]."""
+        trace = self._require_attempt("log_step")
+        if trace.sim_time:
+            if sim_time - trace.sim_time[-1] < self.period_s - _TIME_TOLERANCE:
+                return
+        elif sim_time + self._time_offset < self._last_time:
+            self._time_offset = self._last_time - sim_time
+        trace.sim_time.append(float(sim_time))
+        trace.phase.append(float(phase))
+        for name, value in (
+            ("tool_pos", tool_pos), ("force_mes", force_mes), ("force_des", force_des),
+            ("torque_mes", torque_mes), ("torque_des", torque_des),
+        ):
+            getattr(trace, name).append(np.array(value, dtype=np.float64))
+
+    def log_search_path(self, points: np.ndarray) -> None:
+        """Log the hole-search path ``points`` ``(N, 3)`` [m] at the current time."""
+        trace = self._require_attempt("log_search_path")
+        if trace.sim_time:
+            self._set_time(trace.sim_time[-1] + self._time_offset)
+        path = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        self.rec.log(
+            f"{self.root}/search/path", rr.LineStrips3D([path], colors=[[240, 180, 0]], radii=0.0005)
+        )
+
+    def end_attempt(self, evidence: Evidence) -> AttemptTrace:
+        """Send the buffered steps, the tool path and the outcome; returns the trace."""
+        trace = self._require_attempt("end_attempt")
+        trace.outcome = evidence.outcome
+        if trace.sim_time:
+            self._send_steps(trace)
+            self._last_time = trace.sim_time[-1] + self._time_offset
+        self._set_time(self._last_time)
+        color = _FIT_COLOR if evidence.outcome == "fit" else _NO_FIT_COLOR
+        if len(trace.tool_pos) >= 2:
+            self.rec.log(
+                f"{self.root}/tool/path",
+                rr.LineStrips3D([trace.array("tool_pos")], colors=[color], radii=0.0008),
+            )
+        self._log_outcome(trace, evidence)
+        if self.keep_traces:
+            self.traces.append(trace)
+        self._current = None
+        return trace
+
+    def close(self) -> None:
+        """Flush; disconnect the stream if this logger created it (finishes the file)."""
+        self.rec.flush()
+        if self._owns_stream:
+            self.rec.disconnect()
+
+    # -- internals -----------------------------------------------------------------
+
+    def _require_attempt(self, method: str) -> AttemptTrace:
+        if self._current is None:
+            raise ExecutorError(f"AttemptLogger.{method}: call begin_attempt first")
+        return self._current
+
+    def _set_time(self, sim_time: float) -> None:
+        self.rec.set_time("experiment", sequence=self._experiment)
+        self.rec.set_time("sim_time", duration=sim_time)
+
+    def _send_steps(self, trace: AttemptTrace) -> None:
+        times = trace.array("sim_time") + self._time_offset
+        count = len(times)
+        experiment = rr.TimeColumn("experiment", sequence=np.full(count, trace.experiment))
+        timed = [experiment, rr.TimeColumn("sim_time", duration=times)]
+        for quantity, measured, desired in (
+            ("force", "force_mes", "force_des"), ("torque", "torque_mes", "torque_des"),
+        ):
+            mes, des = trace.array(measured), trace.array(desired)
+            self._series(f"wrench/{quantity}/measured", timed, mes, quantity, "", _MEASURED_COLORS)
+            self._series(f"wrench/{quantity}/desired", timed, des, quantity, " des", _DESIRED_COLORS)
+            deviation = np.linalg.norm(mes - des, axis=1)
+            self.rec.send_columns(
+                f"{self.root}/deviation/{quantity}", indexes=timed,
+                columns=rr.Scalars.columns(scalars=deviation),
+            )
+        self.rec.send_columns(
+            f"{self.root}/phase", indexes=timed,
+            columns=rr.Scalars.columns(scalars=trace.array("phase")),
+        )
+        self.rec.send_columns(
+            f"{self.root}/tool/tip", indexes=timed,
+            columns=rr.Points3D.columns(positions=trace.array("tool_pos")).partition([1] * count),
+        )
+        by_phase = [
+            experiment,
+            rr.TimeColumn(
+                "dmp_phase", sequence=np.round(trace.array("phase") * PHASE_SCALE).astype(np.int64)
+            ),
+        ]
+        base = f"by_phase/{trace.key}"
+        self._series(f"{base}/force_measured", by_phase, trace.array("force_mes"), "force", "",
+                     _MEASURED_COLORS)
+        self._series(f"{base}/force_desired", by_phase, trace.array("force_des"), "force", " des",
+                     _DESIRED_COLORS)
+
+    def _series(
+        self, path: str, indexes: list[rr.TimeColumn], values: np.ndarray, quantity: str,
+        suffix: str, colors: list[list[int]],
+    ) -> None:
+        """Send an ``(N, 3)`` signal as three named plot series under ``path``."""
+        entity = f"{self.root}/{path}"
+        names = [name + suffix for name in _AXIS_NAMES[quantity]]
+        if entity not in self._styled:
+            self.rec.log(entity, rr.SeriesLines(names=names, colors=colors), static=True)
+            self._styled.add(entity)
+        self.rec.send_columns(entity, indexes=indexes, columns=rr.Scalars.columns(scalars=values))
+
+    def _log_outcome(self, trace: AttemptTrace, evidence: Evidence) -> None:
+        text = (
+            f"{trace.part}→{trace.hole} seed {trace.trial_seed} attempt {trace.attempt}: "
+            f"{evidence.outcome} (max ΔF {evidence.max_force_dev:.1f} N, "
+            f"max ΔM {evidence.max_torque_dev:.2f} Nm, end error "
+            f"{1000 * evidence.end_error:.1f} mm, phase {evidence.phase_reached:.2f}, "
+            f"jammed {evidence.jammed}, wiggles {evidence.wiggles}, "
+            f"{evidence.sim_time_s:.2f} s sim, {evidence.duration_s:.2f} s wall)"
+        )
+        level = "INFO" if evidence.outcome == "fit" else "WARN"
+        self.rec.log(f"{self.root}/outcome", rr.TextLog(text, level=level))
+        for name, value in (
+            ("fit", 1.0 if evidence.outcome == "fit" else 0.0),
+            ("max_force_dev", evidence.max_force_dev),
+            ("max_torque_dev", evidence.max_torque_dev),
+            ("end_error", evidence.end_error),
+            ("phase_reached", evidence.phase_reached),
+        ):
+            self.rec.log(f"{self.root}/result/{name}", rr.Scalars(float(value)))
+
+
+def cell_views(cell_id: str) -> rrb.Container:
+    """The views of one cell: 3D scene, force/torque plots, Fig. 17, outcome log."""
+    root = f"executor/{cell_id}"
+    return rrb.Horizontal(
+        rrb.Vertical(
+            rrb.Spatial3DView(
+                origin=root, name=f"{cell_id}: cell",
+                contents=["$origin/scene/**", "$origin/tool/**", "$origin/search/**"],
+            ),
+            rrb.TextLogView(origin=f"{root}/outcome", name=f"{cell_id}: outcomes"),
+            row_shares=[3, 1],
+        ),
+        rrb.Vertical(
+            rrb.TimeSeriesView(origin=f"{root}/wrench/force", name="force [N] over sim_time"),
+            rrb.TimeSeriesView(origin=f"{root}/wrench/torque", name="torque [Nm] over sim_time"),
+            rrb.TimeSeriesView(
+                origin=f"{root}/deviation", name="‖mes − des‖ (eqs. 6, 7) over sim_time"
+            ),
+            rrb.TimeSeriesView(
+                origin=f"{root}/by_phase", name="force [N] over DMP phase (timeline dmp_phase)"
+            ),
+        ),
+        column_shares=[1, 1],
+        name=cell_id,
+    )
+
+
+def cell_blueprint(cell_ids: Sequence[str], extra: Sequence[rrb.Container] = ()) -> rrb.Blueprint:
+    """A blueprint with one tab per cell (plus ``extra`` containers, e.g. the planner's)."""
+    tabs = [*extra, *(cell_views(cell_id) for cell_id in cell_ids)]
+    return rrb.Blueprint(
+        rrb.Tabs(*tabs), rrb.TimePanel(timeline="sim_time"), collapse_panels=False
+    )
