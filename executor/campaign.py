@@ -1,0 +1,296 @@
+"""``./run.sh executor campaign``: the paper's Fig. 18 robustness campaign, and more.
+
+Runs ``--trials`` (default 40) randomised executions of every fitting pair of the
+paper's Fig. 18 table (round peg ``p1`` and tight round peg ``tp`` in the small round
+``r1`` = H1, big round ``br`` = H3 and square ``s1`` = H4 holes; square peg ``p3`` in
+``br`` and ``s1``; shaft ``sh`` in ``br``) and of every non-fitting pair of parts
+{p1, p3, sh, tp} × holes {r1, s1, br} (``p3``→``r1``, ``sh``→``r1``, ``sh``→``s1``),
+which the paper did not run. Each trial is a fresh grasp error and hole-pose error
+(seeded), up to two attempts (paper 3.2).
+
+The trials are spread over ``--workers`` processes (default 2, the cores of this
+machine), each with its own DIRECT PyBullet cell. Trial ``i`` of pair ``k`` always uses
+seed ``S + k·N + i`` (N trials per pair), so the table does not depend on scheduling.
+
+Prints the table (1st-trial successes, successes after the 2nd trial, correct
+'no_fit' for non-fitting pairs); ``--json`` prints ``{"pairs": [...], "all_correct",
+"false_fits", ...}``; ``--plot DIR`` writes ``fig18_table.png``, ``fig17_forces.png``
+(measured vs desired force over DMP phase for a success ``p1``→``r1`` and a failure
+``p3``→``r1``, as in the paper) and ``fig17.rrd`` (those two trials in Rerun).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import multiprocessing
+import statistics
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from executor import ExecutorError
+
+FIG18_FITTING_PAIRS: tuple[tuple[str, str], ...] = (
+    ("p1", "r1"), ("p1", "br"), ("p1", "s1"),
+    ("tp", "r1"), ("tp", "br"), ("tp", "s1"),
+    ("p3", "br"), ("p3", "s1"),
+    ("sh", "br"),
+)
+"""The rows of the paper's Fig. 18, in its order (H1 = r1, H3 = br, H4 = s1)."""
+CAMPAIGN_PARTS = ("p1", "tp", "p3", "sh")
+CAMPAIGN_HOLES = ("r1", "br", "s1")
+PART_NAMES = {"p1": "round peg", "tp": "tight round peg", "p3": "square peg", "sh": "shaft"}
+HOLE_NAMES = {"r1": "H1 small round", "br": "H3 big round", "s1": "H4 square"}
+
+
+@dataclass(frozen=True)
+class CampaignPair:
+    """A part-hole pair of the campaign and whether the part truly fits."""
+
+    part: str
+    hole: str
+    fits: bool
+
+
+def campaign_pairs() -> list[CampaignPair]:
+    """Fig. 18's fitting pairs (paper order), then the non-fitting ones."""
+    fitting = [CampaignPair(p, h, True) for p, h in FIG18_FITTING_PAIRS]
+    others = [
+        CampaignPair(p, h, False)
+        for p in CAMPAIGN_PARTS for h in CAMPAIGN_HOLES
+        if (p, h) not in FIG18_FITTING_PAIRS
+    ]
+    return fitting + others
+
+
+def select_pairs(spec: str | None) -> list[CampaignPair]:
+    """All campaign pairs, or those named in ``spec`` ("p1:r1,p3:r1")."""
+    pairs = campaign_pairs()
+    if not spec:
+        return pairs
+    by_name = {f"{p.part}:{p.hole}": p for p in pairs}
+    chosen = []
+    for name in spec.split(","):
+        if name.strip() not in by_name:
+            raise ExecutorError(
+                f"--pairs: unknown pair '{name}'; expected PART:HOLE among {', '.join(by_name)}"
+            )
+        chosen.append(by_name[name.strip()])
+    return chosen
+
+
+class TrialRunner(Protocol):
+    """Runs one trial and returns ``TrialResult.to_json()`` (``outcome``, ``attempts``,
+    ``duration_s``, ...)."""
+
+    def __call__(self, part: str, hole: str, seed: int) -> dict[str, Any]: ...
+
+
+RunnerFactory = Callable[[], TrialRunner]
+"""Builds a runner inside a worker process (must be picklable: a module-level
+function or a ``functools.partial`` of one)."""
+
+
+class CellRunner:
+    """A :class:`executor.trial.Cell` in DIRECT mode, reused for every trial of a worker."""
+
+    def __init__(self, assembly: str) -> None:
+        from executor.trial import Cell
+
+        self.cell = Cell(assembly)
+
+    def __call__(self, part: str, hole: str, seed: int) -> dict[str, Any]:
+        return self.cell.run_trial(part, hole, seed=seed, max_attempts=2).to_json()
+
+
+@dataclass
+class PairStats:
+    """Counts over the trials of one pair (the columns of Fig. 18, plus ours)."""
+
+    part: str
+    hole: str
+    fits: bool
+    trials: int
+    first_trial: int
+    """fitting pair: reported 'fit' at the 1st attempt"""
+    after_second: int
+    """fitting pair: reported 'fit' within two attempts"""
+    correct: int
+    """'fit' for a fitting pair, 'no_fit' for a non-fitting one"""
+    false_fits: int
+    """non-fitting pair reported 'fit' (must stay 0)"""
+    median_duration_s: float
+    """median wall time of one trial [s]"""
+
+    @property
+    def correct_ratio(self) -> float:
+        return self.correct / self.trials if self.trials else 0.0
+
+
+def pair_stats(pair: CampaignPair, results: Sequence[dict[str, Any]]) -> PairStats:
+    """Fig. 18's counts for one pair from its trial results."""
+    fit = [r for r in results if r["outcome"] == "fit"]
+    first = sum(1 for r in fit if r["attempts"] == 1)
+    return PairStats(
+        part=pair.part, hole=pair.hole, fits=pair.fits, trials=len(results),
+        first_trial=first if pair.fits else 0,
+        after_second=len(fit) if pair.fits else 0,
+        correct=len(fit) if pair.fits else len(results) - len(fit),
+        false_fits=0 if pair.fits else len(fit),
+        median_duration_s=statistics.median(r["duration_s"] for r in results) if results else 0.0,
+    )
+
+
+# -- worker processes -------------------------------------------------------------------
+
+_RUNNER: TrialRunner | None = None
+
+
+def _init_worker(factory: RunnerFactory) -> None:
+    global _RUNNER
+    _RUNNER = factory()
+
+
+def _run_task(task: tuple[int, int, str, str, int]) -> tuple[int, int, dict[str, Any]]:
+    pair_index, trial_index, part, hole, seed = task
+    assert _RUNNER is not None, "worker not initialised"
+    return pair_index, trial_index, _RUNNER(part, hole, seed)
+
+
+def run_campaign(
+    pairs: Sequence[CampaignPair],
+    trials: int,
+    seed: int,
+    workers: int,
+    factory: RunnerFactory,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[list[dict[str, Any]]]:
+    """Results per pair (``trials`` dicts each, in seed order), run on ``workers``
+    processes (1: in this process). ``progress(done, total)`` after each trial."""
+    if trials < 1 or workers < 1:
+        raise ExecutorError(f"--trials {trials} / --workers {workers}: expected positive numbers")
+    # Trial-major order: every pair progresses together, so the pool stays balanced.
+    tasks = [
+        (k, i, pair.part, pair.hole, seed + k * trials + i)
+        for i in range(trials) for k, pair in enumerate(pairs)
+    ]
+    results: list[list[dict[str, Any]]] = [[{}] * trials for _ in pairs]
+
+    def store(done: int, item: tuple[int, int, dict[str, Any]]) -> None:
+        k, i, result = item
+        results[k][i] = result
+        if progress is not None:
+            progress(done, len(tasks))
+
+    if workers == 1:
+        _init_worker(factory)
+        for done, task in enumerate(tasks, 1):
+            store(done, _run_task(task))
+        return results
+    context = multiprocessing.get_context("spawn")
+    with context.Pool(workers, initializer=_init_worker, initargs=(factory,)) as pool:
+        for done, item in enumerate(pool.imap_unordered(_run_task, tasks, chunksize=1), 1):
+            store(done, item)
+    return results
+
+
+# -- report -----------------------------------------------------------------------------
+
+def format_table(stats: Sequence[PairStats]) -> str:
+    """The Fig. 18 table (fitting pairs) followed by the non-fitting pairs."""
+    header = (
+        f"{'object':<16} {'hole':<15} {'fits':<4} {'n':>3} {'1st trial':>9} "
+        f"{'after 2nd':>9} {'correct':>7} {'ratio %':>7} {'median s':>8}"
+    )
+    lines = [header, "-" * len(header)]
+    for s in stats:
+        first = f"{s.first_trial:>9}" if s.fits else f"{'-':>9}"
+        second = f"{s.after_second:>9}" if s.fits else f"{'-':>9}"
+        lines.append(
+            f"{PART_NAMES.get(s.part, s.part) + ' ' + s.part:<16} "
+            f"{HOLE_NAMES.get(s.hole, s.hole) + ' ' + s.hole:<15} {'yes' if s.fits else 'no':<4} "
+            f"{s.trials:>3} {first} {second} {s.correct:>7} {100 * s.correct_ratio:>7.1f} "
+            f"{s.median_duration_s:>8.2f}"
+        )
+    return "\n".join(lines)
+
+
+def campaign_report(
+    stats: Sequence[PairStats], trials: int, seed: int, workers: int, wall_s: float,
+    durations: Sequence[float],
+) -> dict[str, Any]:
+    """The ``--json`` document."""
+    return {
+        "trials_per_pair": trials,
+        "seed": seed,
+        "workers": workers,
+        "wall_s": wall_s,
+        "trial_wall_median_s": statistics.median(durations) if durations else 0.0,
+        "pairs": [asdict(s) | {"correct_ratio": s.correct_ratio} for s in stats],
+        "all_correct": all(s.correct == s.trials for s in stats),
+        "false_fits": sum(s.false_fits for s in stats),
+    }
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="executor campaign",
+        description="Fig. 18: randomised executions of every fitting pair of the paper's "
+        "table plus every non-fitting pair of {p1,tp,p3,sh} x {r1,br,s1}.",
+    )
+    parser.add_argument("--trials", type=int, default=40, help="executions per pair (default 40)")
+    parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
+    parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    parser.add_argument("--pairs", help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
+    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
+    return parser
+
+
+def main(argv: Sequence[str]) -> int:
+    """``executor campaign``; returns 0 when every outcome was correct, else 1."""
+    args = build_parser().parse_args(list(argv))
+    pairs = select_pairs(args.pairs)
+    start = time.perf_counter()
+    results = run_campaign(
+        pairs, args.trials, args.seed, args.workers,
+        functools.partial(CellRunner, args.assembly), progress=_progress_printer(),
+    )
+    wall_s = time.perf_counter() - start
+    stats = [pair_stats(pair, rs) for pair, rs in zip(pairs, results)]
+    durations = [r["duration_s"] for rs in results for r in rs]
+    report = campaign_report(stats, args.trials, args.seed, args.workers, wall_s, durations)
+    if args.plot:
+        from executor.campaign_plots import write_plots
+
+        report["plots"] = [str(p) for p in write_plots(Path(args.plot), stats, args.assembly, args.seed)]
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        print(format_table(stats))
+        print(
+            f"all correct: {report['all_correct']}; too-big parts reported fitting: "
+            f"{report['false_fits']}; {len(durations)} trials in {wall_s:.1f} s wall on "
+            f"{args.workers} worker(s), median {report['trial_wall_median_s']:.2f} s/trial"
+        )
+        for path in report.get("plots", []):
+            print(f"wrote {path}")
+    return 0 if report["all_correct"] else 1
+
+
+def _progress_printer() -> Callable[[int, int], None] | None:
+    """Progress on stderr when it is a terminal (``done/total trials``)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def show(done: int, total: int) -> None:
+        print(f"\rcampaign: {done}/{total} trials", end="" if done < total else "\n",
+              file=sys.stderr, flush=True)
+
+    return show
