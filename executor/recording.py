@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import pyarrow as pa
 from rerun.chunk import Chunk, RrdReader
 
 from executor import ExecutorError
@@ -121,14 +122,17 @@ def read_recording(paths: Path | str | Sequence[Path | str]) -> RecordingSummary
     return summary
 
 
-def component_values(
-    paths: Path | str | Iterable[Path | str], entity: str, component: str
+def column_values(
+    paths: Path | str | Iterable[Path | str], entity: str, column: str
 ) -> list[Any]:
-    """Every logged value of ``component`` (e.g. ``"TextLog:text"``, ``"Scalars:scalars"``)
-    of ``entity`` (e.g. ``/executor/c1/outcome``), one list item per row, in file order.
+    """Every row's value of ``column`` of ``entity`` (e.g. ``/executor/c1/outcome``), in
+    file order. ``column`` is a component (``"TextLog:text"``, ``"Scalars:scalars"``) or
+    a timeline (``"sim_time"`` → float [s], ``"experiment"`` → int, ``"log_time"`` →
+    int [ns since the epoch]).
 
-    A row holds the component's batch: ``["fit ..."]`` for a text log line, ``[1.0]``
-    for one scalar, ``[fx, fy, fz]`` for three plotted series.
+    A component row holds its batch: ``["fit ..."]`` for a text log line, ``[1.0]`` for
+    one scalar, ``[fx, fy, fz]`` for three plotted series. Rows of chunks lacking the
+    column (e.g. static style rows) are skipped.
     """
     files = [paths] if isinstance(paths, (str, Path)) else list(paths)
     wanted = "/" + entity.strip("/")
@@ -138,9 +142,19 @@ def component_values(
             if chunk.entity_path != wanted:
                 continue
             batch = chunk.to_record_batch()
-            if component in batch.schema.names:
-                values.extend(batch.column(component).to_pylist())
+            if column in batch.schema.names:
+                values.extend(_python_values(batch.column(column)))
     return values
+
+
+def _python_values(array: pa.Array) -> list[Any]:
+    """Arrow values as Python; durations as float seconds, timestamps as int ns
+    (Python's datetime types cannot hold nanoseconds)."""
+    if pa.types.is_duration(array.type):
+        return [None if v is None else v / 1e9 for v in array.cast(pa.int64()).to_pylist()]
+    if pa.types.is_timestamp(array.type):
+        return array.cast(pa.int64()).to_pylist()
+    return array.to_pylist()
 
 
 def format_summary(summary: RecordingSummary) -> str:

@@ -52,6 +52,7 @@ _AXIS_NAMES = {"force": ["Fx", "Fy", "Fz"], "torque": ["Mx", "My", "Mz"]}
 _MEASURED_COLORS = [[230, 60, 60], [60, 170, 60], [60, 90, 230]]
 _DESIRED_COLORS = [[250, 160, 160], [150, 220, 150], [150, 170, 250]]
 _TIME_TOLERANCE = 1e-9  # [s] float slack when comparing sim times
+_ATTEMPT_GAP_S = 0.001  # [s] between attempts when the cell restarts its clock
 _FIT_COLOR = [40, 180, 60]
 _NO_FIT_COLOR = [220, 50, 40]
 
@@ -106,6 +107,19 @@ class AttemptTrace:
     force_des: list[np.ndarray] = field(default_factory=list)
     torque_mes: list[np.ndarray] = field(default_factory=list)
     torque_des: list[np.ndarray] = field(default_factory=list)
+
+    def add(
+        self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
+        force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray,
+    ) -> None:
+        """Append one step (units as in the class docstring)."""
+        self.sim_time.append(float(sim_time))
+        self.phase.append(float(phase))
+        for name, value in (
+            ("tool_pos", tool_pos), ("force_mes", force_mes), ("force_des", force_des),
+            ("torque_mes", torque_mes), ("torque_des", torque_des),
+        ):
+            getattr(self, name).append(np.array(value, dtype=np.float64))
 
     @property
     def key(self) -> str:
@@ -167,6 +181,8 @@ class AttemptLogger:
         self._current: AttemptTrace | None = None
         self._time_offset = 0.0  # [s] added to the cell's sim_time
         self._last_time = 0.0  # [s] last logged (offset) sim time
+        self._sent_steps = False
+        self._skipped: tuple[Any, ...] | None = None  # last step not kept (yet)
         if send_blueprint:
             self.rec.send_blueprint(cell_blueprint([cell_id]))
 
@@ -226,6 +242,7 @@ class AttemptLogger:
             self._experiment += 1
         self._last_attempt = (part, hole, trial_seed, attempt)
         self._current = AttemptTrace(part, hole, trial_seed, attempt, self._experiment)
+        self._skipped = None
         self._set_time(self._last_time)
 
     def log_step(
@@ -238,20 +255,21 @@ class AttemptLogger:
         torque_mes: np.ndarray,
         torque_des: np.ndarray,
     ) -> None:
-        """Buffer one control step: sim time [s], DMP phase, tool tip [m], F [N], M [Nm]."""
+        """Buffer one control step: sim time [s], DMP phase, tool tip [m], F [N], M [Nm].
+
+        Steps within ``period_s`` of the last kept one are skipped, except the
+        attempt's final step, which ``end_attempt`` keeps.
+        """
         trace = self._require_attempt("log_step")
+        step = (sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des)
         if trace.sim_time:
             if sim_time - trace.sim_time[-1] < self.period_s - _TIME_TOLERANCE:
+                self._skipped = step
                 return
-        elif sim_time + self._time_offset < self._last_time:
-            self._time_offset = self._last_time - sim_time
-        trace.sim_time.append(float(sim_time))
-        trace.phase.append(float(phase))
-        for name, value in (
-            ("tool_pos", tool_pos), ("force_mes", force_mes), ("force_des", force_des),
-            ("torque_mes", torque_mes), ("torque_des", torque_des),
-        ):
-            getattr(trace, name).append(np.array(value, dtype=np.float64))
+        elif self._sent_steps and sim_time + self._time_offset <= self._last_time:
+            self._time_offset = self._last_time + _ATTEMPT_GAP_S - sim_time
+        trace.add(*step)
+        self._skipped = None
 
     def log_search_path(self, points: np.ndarray) -> None:
         """Log the hole-search path ``points`` ``(N, 3)`` [m] at the current time."""
@@ -267,9 +285,13 @@ class AttemptLogger:
         """Send the buffered steps, the tool path and the outcome; returns the trace."""
         trace = self._require_attempt("end_attempt")
         trace.outcome = evidence.outcome
+        if self._skipped is not None:
+            trace.add(*self._skipped)
+            self._skipped = None
         if trace.sim_time:
             self._send_steps(trace)
             self._last_time = trace.sim_time[-1] + self._time_offset
+            self._sent_steps = True
         self._set_time(self._last_time)
         color = _FIT_COLOR if evidence.outcome == "fit" else _NO_FIT_COLOR
         if len(trace.tool_pos) >= 2:

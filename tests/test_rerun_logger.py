@@ -1,0 +1,117 @@
+"""AttemptLogger writes a real .rrd that is read back: entities, timelines, values."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from executor import ExecutorError
+from executor.recording import column_values, format_summary, read_recording
+from executor.rerun_log import PHASE_SCALE, AttemptLogger
+
+
+@dataclass
+class Evidence:
+    outcome: str
+    max_force_dev: float = 4.0
+    max_torque_dev: float = 0.2
+    end_error: float = 0.0005
+    duration_s: float = 0.4
+    sim_time_s: float = 1.0
+    jammed: bool = False
+    wiggles: int = 0
+    phase_reached: float = 1.0
+
+
+def _attempt(logger: AttemptLogger, part: str, hole: str, seed: int, attempt: int,
+             outcome: str, steps: int = 1000) -> None:
+    """One synthetic attempt at 1 kHz whose clock restarts at 0 (as a cell may do)."""
+    logger.begin_attempt(part, hole, seed, attempt)
+    logger.log_search_path(np.array([[0.5, 0.0, 0.2], [0.501, 0.001, 0.2], [0.5, 0.002, 0.2]]))
+    for k in range(steps):
+        phase = k / (steps - 1)
+        logger.log_step(
+            k * 0.001, phase, np.array([0.5, 0.0, 0.2 - 0.02 * phase]),
+            np.array([0.0, 0.0, -10.0 * phase]), np.array([0.0, 0.0, -8.0 * phase]),
+            np.zeros(3), np.zeros(3),
+        )
+    logger.end_attempt(Evidence(outcome))
+
+
+def test_attempts_are_read_back(tmp_path: Path) -> None:
+    rrd = tmp_path / "c1.rrd"
+    logger = AttemptLogger("c1", recording_id="run-1", rrd_path=rrd, period_s=0.01)
+    logger.log_scene([
+        ("plate", "box", (0.1, 0.12, 0.01), (0.59, 0.0, 0.08)),
+        ("peg_p1", "cylinder", (0.006, 0.006, 0.025), (0.3, 0.1, 0.125), (0, 0, 0, 1), (200, 90, 40)),
+    ])
+    _attempt(logger, "p3", "r1", 7, 1, "no_fit")
+    _attempt(logger, "p3", "r1", 7, 2, "no_fit")
+    _attempt(logger, "p1", "r1", 8, 1, "fit")
+    logger.close()
+
+    summary = read_recording(rrd)
+    assert summary.application_ids == {"assembly_constraints"}
+    assert summary.recording_ids == {"run-1"}
+    assert summary.blueprints == 1
+    entities = summary.under("executor/c1")
+    for name in ("scene/plate", "scene/peg_p1", "tool/tip", "tool/path", "search/path",
+                 "wrench/force/measured", "wrench/force/desired", "wrench/torque/measured",
+                 "deviation/force", "phase", "outcome", "result/fit"):
+        assert f"/executor/c1/{name}" in entities, name
+    plate = entities["/executor/c1/scene/plate"]
+    assert plate.static_rows == plate.rows == 1 and "Boxes3D:half_sizes" in plate.components
+    # 1000 steps at 1 kHz kept every 10 ms plus the last: 101 rows per attempt, 3 attempts.
+    assert entities["/executor/c1/tool/tip"].rows == 303
+    assert entities["/executor/c1/outcome"].rows == 3
+    assert {"experiment", "sim_time"} <= entities["/executor/c1/wrench/force/measured"].timelines
+
+    texts = [row[0] for row in column_values(rrd, "executor/c1/outcome", "TextLog:text")]
+    assert texts[0].startswith("p3→r1 seed 7 attempt 1: no_fit")
+    assert texts[2].startswith("p1→r1 seed 8 attempt 1: fit")
+    assert column_values(rrd, "executor/c1/result/fit", "Scalars:scalars") == [[0.0], [0.0], [1.0]]
+    # Both attempts of trial 1 are experiment 1; the next trial is experiment 2.
+    assert column_values(rrd, "executor/c1/outcome", "experiment") == [1, 1, 2]
+    # The cell restarts its clock each attempt: the logged sim_time keeps increasing.
+    times = column_values(rrd, "executor/c1/tool/tip", "sim_time")
+    assert all(b > a for a, b in zip(times, times[1:]))
+    assert times[-1] == pytest.approx(3 * 0.999 + 2 * 0.001, abs=1e-6)
+    forces = column_values(rrd, "executor/c1/wrench/force/measured", "Scalars:scalars")
+    assert forces[-1] == pytest.approx([0.0, 0.0, -10.0])
+    deviation = column_values(rrd, "executor/c1/deviation/force", "Scalars:scalars")
+    assert deviation[-1] == pytest.approx([2.0])
+
+    # Fig. 17: one force series per attempt over the dmp_phase timeline.
+    by_phase = summary.under("executor/c1/by_phase")
+    assert len([p for p in by_phase if p.endswith("/force_measured")]) == 3
+    series = "/executor/c1/by_phase/e0002_p1_r1_s8_a1/force_measured"
+    phases = column_values(rrd, series, "dmp_phase")
+    assert (phases[0], phases[-1]) == (0, PHASE_SCALE)
+    assert "/executor/c1/by_phase" in format_summary(summary)
+
+
+def test_two_cells_in_one_process_share_a_recording(tmp_path: Path) -> None:
+    loggers = [AttemptLogger(cell, recording_id="shared", rrd_path=tmp_path / f"{cell}.rrd")
+               for cell in ("c1", "c2")]
+    _attempt(loggers[0], "p1", "br", 1, 1, "fit", steps=100)
+    _attempt(loggers[1], "sh", "r1", 2, 1, "no_fit", steps=100)
+    for logger in loggers:
+        logger.close()
+    summary = read_recording(sorted(tmp_path.glob("*.rrd")))
+    assert summary.recording_ids == {"shared"}
+    assert set(summary.under("executor")) >= {"/executor/c1/outcome", "/executor/c2/outcome"}
+    assert not any(p.startswith("/executor/c2") for p in read_recording(tmp_path / "c1.rrd").entities)
+
+
+def test_misuse_is_reported() -> None:
+    logger = AttemptLogger("c1")
+    with pytest.raises(ExecutorError, match="begin_attempt"):
+        logger.log_step(0.0, 0.0, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3))
+    with pytest.raises(ExecutorError, match="'box' or 'cylinder'"):
+        logger.log_scene([("x", "sphere", (1, 1, 1), (0, 0, 0))])
+    with pytest.raises(ExecutorError, match="no such recording"):
+        read_recording("/nonexistent/x.rrd")
+    logger.close()
