@@ -71,6 +71,7 @@ class RecordingSummary:
 
 
 _CONTROL_COLUMN_PREFIX = "rerun.controls."
+_VIEW_ORIGIN = "ViewBlueprint:space_origin"
 
 
 def _reader(path: Path) -> RrdReader:
@@ -145,6 +146,20 @@ def column_values(
             if column in batch.schema.names:
                 values.extend(_python_values(batch.column(column)))
     return values
+
+
+def blueprint_origins(path: Path | str) -> set[str]:
+    """Origins of the views in the blueprints of an ``.rrd`` / ``.rbl`` file
+    (e.g. ``{"executor/c1", "executor/c1/wrench/force", ...}``)."""
+    reader = _reader(Path(path))
+    origins: set[str] = set()
+    with _tolerating_unfinished_files():
+        for store in reader.blueprints():
+            for chunk in reader.stream(store=store):
+                batch = chunk.to_record_batch()
+                if _VIEW_ORIGIN in batch.schema.names:
+                    origins.update(v for row in batch.column(_VIEW_ORIGIN).to_pylist() for v in row or [])
+    return origins
 
 
 def _python_values(array: pa.Array) -> list[Any]:

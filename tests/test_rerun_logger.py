@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from executor import ExecutorError
-from executor.recording import column_values, format_summary, read_recording
+from executor.recording import blueprint_origins, column_values, format_summary, read_recording
 from executor.rerun_log import PHASE_SCALE, AttemptLogger
 
 
@@ -57,6 +57,7 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert summary.application_ids == {"assembly_constraints"}
     assert summary.recording_ids == {"run-1"}
     assert summary.blueprints == 1
+    assert {"executor/c1", "executor/c1/wrench/force", "executor/c1/by_phase"} <= blueprint_origins(rrd)
     entities = summary.under("executor/c1")
     for name in ("scene/plate", "scene/peg_p1", "tool/tip", "tool/path", "search/path",
                  "wrench/force/measured", "wrench/force/desired", "wrench/torque/measured",

@@ -1,0 +1,97 @@
+"""``./run.sh view RUN [--print] [--json]``: open a run's Rerun recording.
+
+RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: planner
+and cells log into one recording id) or a single ``.rrd`` file. With a display, the
+Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
+on the files plus ``RUN/view.rbl``, a blueprint with one tab per cell found in the
+recording (``executor.rerun_log.cell_blueprint``; other entities, e.g. the
+planner's, get the viewer's automatic views). Without a display (no ``DISPLAY`` /
+``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
+one line per entity path with its row count, timelines and components (``--json``: the
+same as JSON). A RUN without ``.rrd`` files is an error (exit code 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from asp import PlannerError
+
+
+def recording_files(run: Path) -> list[Path]:
+    """The ``.rrd`` files of RUN (a folder or one file); PlannerError if there are none."""
+    if run.is_file() and run.suffix == ".rrd":
+        return [run]
+    if not run.exists():
+        raise PlannerError(f"{run}: no such run folder or .rrd file")
+    files = sorted(run.glob("*.rrd")) if run.is_dir() else []
+    if not files:
+        raise PlannerError(f"{run}: holds no Rerun recording; expected RUN/*.rrd or an .rrd file")
+    return files
+
+
+def cell_ids(entity_paths: Sequence[str]) -> list[str]:
+    """Cell ids present in a recording: ``/executor/<cell-id>/...`` → ``<cell-id>``."""
+    ids = {p.split("/")[2] for p in entity_paths if p.startswith("/executor/") and p.count("/") >= 3}
+    return sorted(ids)
+
+
+def has_display() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def rerun_executable() -> str:
+    """The ``rerun`` CLI of this environment (the wheel installs it beside python)."""
+    beside = Path(sys.executable).parent / "rerun"
+    found = str(beside) if beside.is_file() else shutil.which("rerun")
+    if found is None:
+        raise PlannerError("no 'rerun' executable beside python or on PATH; install rerun-sdk")
+    return found
+
+
+def write_blueprint(folder: Path, cells: Sequence[str]) -> Path:
+    """``folder/view.rbl``: one tab per cell, automatic views for everything else."""
+    import rerun.blueprint as rrb
+
+    from executor.rerun_log import APPLICATION_ID, cell_views
+
+    path = folder / "view.rbl"
+    rrb.Blueprint(rrb.Tabs(*(cell_views(c) for c in cells)), auto_views=True).save(
+        APPLICATION_ID, str(path)
+    )
+    return path
+
+
+def main(argv: Sequence[str]) -> int:
+    parser = argparse.ArgumentParser(prog="view", description=__doc__.split("\n\n")[0])
+    parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
+    parser.add_argument("--print", action="store_true", help="print the contents, no viewer")
+    parser.add_argument("--json", action="store_true", help="print the contents as JSON")
+    args = parser.parse_args(list(argv))
+
+    from executor.recording import format_summary, read_recording
+
+    run = Path(args.run)
+    files = recording_files(run)
+    summary = read_recording(files)
+    if args.print or args.json or not has_display():
+        if not (args.print or args.json):
+            print("view: no display (DISPLAY/WAYLAND_DISPLAY unset); printing the recording",
+                  file=sys.stderr)
+        print(json.dumps(summary.to_json(), indent=2) if args.json else format_summary(summary))
+        return 0
+    cells = cell_ids(list(summary.entities))
+    blueprint = [write_blueprint(run if run.is_dir() else run.parent, cells)] if cells else []
+    subprocess.Popen(
+        [rerun_executable(), *map(str, files), *map(str, blueprint)],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+    )
+    print(f"view: opened {len(files)} recording file(s) in the Rerun viewer")
+    return 0
