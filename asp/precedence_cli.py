@@ -1,0 +1,187 @@
+"""``./run.sh precedence ...``: learn, count, enumerate, sample, evaluate, suggest.
+
+JSON keys are a contract (issue 2, section 5). Sequences are printed one per line,
+ids separated by spaces: the demonstrations format, so output can be fed back.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import sys
+from itertools import islice
+
+from asp import PlannerError
+from asp.assembly import load_assembly
+from asp.demos import Demonstrations, load_demos
+from asp.facts import write_facts
+from asp.linear_extensions import UniformSampler, count_linear_extensions, linear_extensions
+from asp.relation import Relation, load_relation, precedence_facts, reduction, true_relation
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="./run.sh precedence", description="Precedence constraints (paper 2.1, 4.1).")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    learn = commands.add_parser("learn", help="learn the must-precede relation from demonstrations (Algorithm 1)")
+    learn.add_argument("demos", nargs="?", help="demonstrations file (text, or demo/3 facts *.lp); default: the assembly's demos.txt")
+    learn.add_argument("--assembly", help="assembly name under data/ or folder (gives the parts)")
+    learn.add_argument("--out", help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
+    learn.add_argument("--dot", help="write the transitive-reduction graph as Graphviz DOT")
+    learn.add_argument("--png", help="draw the relation to a PNG file")
+    learn.add_argument("--min-support", type=int, default=1, metavar="K", help="drop a constraint only when >= K demonstrations contradict it (default 1: plain intersection)")
+    learn.add_argument("--evidence", action="store_true", help="add per-pair support/contradiction counts and suspect demonstrations (JSON keys evidence, suspects)")
+    learn.add_argument("--json", action="store_true", help="print JSON {parts, must_precede, reduction, admitted}")
+
+    for name, text in (("count", "count the sequences a relation admits (exact)"), ("enumerate", "print every admitted sequence (streaming)"), ("sample", "print uniformly random admitted sequences")):
+        sub = commands.add_parser(name, help=text)
+        sub.add_argument("facts", nargs="*", help="facts files with part/1 and must_precede/2 (or precedence_edge/2)")
+        sub.add_argument("--assembly", help="use the assembly's true constraints (precedence.lp)")
+        if name == "count":
+            sub.add_argument("--json", action="store_true", help='print JSON {"admitted": N}')
+        if name == "enumerate":
+            sub.add_argument("--limit", type=int, help="stop after this many sequences")
+        if name == "sample":
+            sub.add_argument("-n", type=int, default=1, help="number of sequences (default 1)")
+            sub.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+    evaluate = commands.add_parser("evaluate", help="the paper's evaluation (Figs. 12/13), or --guided demonstration")
+    evaluate.add_argument("--assembly", required=True, help="assembly with true constraints (precedence.lp)")
+    evaluate.add_argument("--m", default="5,7,10,15,20,30", help="numbers of demonstrations, comma separated")
+    evaluate.add_argument("--trials", type=int, default=1000, help="trials per m (default 1000)")
+    evaluate.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    evaluate.add_argument("--guided", action="store_true", help="demonstrations to the exact relation, guided vs random")
+    evaluate.add_argument("--json", action="store_true", help="print JSON")
+    evaluate.add_argument("--plot", help="write the Figs. 12/13 bar charts to this PNG file")
+
+    suggest = commands.add_parser("suggest", help="propose the next sequence to demonstrate")
+    suggest.add_argument("demos", help="demonstrations so far (made following earlier suggestions)")
+    suggest.add_argument("--assembly", help="assembly name or folder (gives the parts)")
+    suggest.add_argument("--seed", type=int, default=0, help="seed of the tie-breaking (default 0)")
+    suggest.add_argument("--json", action="store_true", help="print JSON {suggestion, undecided}")
+    return parser
+
+
+def _demonstrations(args: argparse.Namespace) -> Demonstrations:
+    assembly = load_assembly(args.assembly) if args.assembly else None
+    if args.demos is None:
+        if assembly is None:
+            raise PlannerError("learn: expected a demonstrations file or --assembly with demos.txt")
+        return load_demos(assembly.file("demos.txt"), assembly.part_ids)
+    return load_demos(args.demos, assembly.part_ids if assembly else None)
+
+
+def _relation(args: argparse.Namespace) -> Relation:
+    if bool(args.assembly) == bool(args.facts):
+        raise PlannerError(f"{args.command}: expected either --assembly A or facts files, not both or neither")
+    return true_relation(load_assembly(args.assembly)) if args.assembly else load_relation(args.facts)
+
+
+def _print_json(data: object) -> None:
+    print(json.dumps(data))
+
+
+def _learn(args: argparse.Namespace) -> None:
+    from asp.precedence import learn_must_precede, pair_evidence, suspects
+    from asp.precedence_graph import draw_png, to_dot
+
+    demos = _demonstrations(args)
+    relation = learn_must_precede(demos, args.min_support)
+    edges = reduction(relation)
+    flagged = suspects(demos)
+    for suspect in flagged:
+        pairs = " ".join(f"{a}<{b}" for a, b in suspect.removes)
+        print(f"warning: {suspect.origin}: this demonstration alone removes {pairs}, which all others support", file=sys.stderr)
+    if args.out:
+        write_facts(args.out, precedence_facts(relation), header=f"must-precede relation learned from {len(demos.sequences)} demonstrations")
+    if args.dot:
+        with open(args.dot, "w", encoding="utf-8") as out:
+            out.write(to_dot(relation, edges))
+    if args.png:
+        draw_png(relation, edges, args.png, title=f"learned from {len(demos.sequences)} demonstrations")
+    result: dict[str, object] = {
+        "parts": list(relation.parts),
+        "must_precede": [list(p) for p in relation.pairs()],
+        "reduction": [list(p) for p in edges],
+        "admitted": count_linear_extensions(relation),
+    }
+    if args.evidence:
+        result["evidence"] = pair_evidence(demos)
+        result["suspects"] = [{"line": s.origin, "removes": [list(p) for p in s.removes]} for s in flagged]
+    if args.json:
+        _print_json(result)
+        return
+    print(relation.matrix_text())
+    print("must_precede:", " ".join(f"{a}<{b}" for a, b in relation.pairs()))
+    print("reduction:   ", " ".join(f"{a}<{b}" for a, b in edges))
+    print("admitted:    ", result["admitted"])
+
+
+def _evaluate(args: argparse.Namespace) -> None:
+    progress = sys.stderr.isatty()
+    truth = true_relation(load_assembly(args.assembly))
+    if args.guided:
+        from asp.guidance import evaluate_guided
+
+        result = evaluate_guided(truth, args.trials, args.seed, progress)
+        if not args.json:
+            print(f"{args.trials} trials: guided mean {result['mean']:.2f} demonstrations to the exact relation, random {result['random_mean']:.2f}")
+            print("histogram (demonstrations: trials):", result["demos_to_exact"])
+    else:
+        from asp.precedence_eval import evaluate, plot
+
+        try:
+            ms = [int(m) for m in args.m.split(",")]
+        except ValueError:
+            raise PlannerError(f"--m {args.m}: expected comma-separated integers such as 5,7,10") from None
+        result = evaluate(truth, ms, args.trials, args.seed, progress)
+        if args.plot:
+            plot(result, args.plot)
+        if not args.json:
+            print(f"total admitted by the true constraints: {result['total']}")
+            for r in result["results"]:
+                print(f"m={r['m']:>3}: mean {r['mean']:8.1f} ({100 * r['mean'] / result['total']:5.1f} %)  P(all) {r['p_all']:.3f}  P(> half) {r['p_more_than_half']:.3f}")
+    if args.json:
+        _print_json(result)
+
+
+def _suggest(args: argparse.Namespace) -> None:
+    from asp.guidance import suggest
+
+    demos = load_demos(args.demos, load_assembly(args.assembly).part_ids if args.assembly else None)
+    guide, sequence = suggest(demos.parts, demos.sequences, args.seed)
+    undecided = Relation(demos.parts, guide.undecided()).pairs()
+    if args.json:
+        _print_json({"suggestion": sequence, "undecided": [list(p) for p in undecided]})
+    else:
+        print(" ".join(sequence))
+        print(f"# {len(undecided)} learned pairs still undecided; place at each step the earliest listed part that can be placed", file=sys.stderr)
+
+
+def main(argv: list[str]) -> int:
+    args = _parser().parse_args(argv)
+    if args.command == "learn":
+        _learn(args)
+    elif args.command == "count":
+        admitted = count_linear_extensions(_relation(args))
+        if args.json:
+            _print_json({"admitted": admitted})
+        else:
+            print(admitted)
+    elif args.command == "enumerate":
+        if args.limit is not None and args.limit < 0:
+            raise PlannerError(f"--limit {args.limit}: expected a non-negative integer")
+        for sequence in islice(linear_extensions(_relation(args)), args.limit):
+            print(" ".join(sequence))
+    elif args.command == "sample":
+        if args.n < 0:
+            raise PlannerError(f"-n {args.n}: expected a non-negative integer")
+        sampler, rng = UniformSampler(_relation(args)), random.Random(args.seed)
+        for _ in range(args.n):
+            print(" ".join(sampler.sample(rng)))
+    elif args.command == "evaluate":
+        _evaluate(args)
+    else:
+        _suggest(args)
+    return 0
