@@ -1,0 +1,121 @@
+"""``./run.sh bench executor [--quick] [--json]``: speed of the simulated cell (issue 6).
+
+1. Trial wall time: ``--trials`` (default 3; ``--quick`` 1) trials of every campaign
+   pair, fitting and non-fitting, one after the other in this process (one DIRECT
+   cell). A trial is search, insertion, detection and the 2nd attempt where there is
+   one; its wall time is the cell's ``duration_s``. Prints the median for the fitting
+   pairs (target < 1.5 s) and over all pairs (target < 2.5 s), the median sim steps
+   per second and real-time factor (target >= 3x).
+2. The whole campaign (``executor campaign``, 40 trials per pair; ``--quick`` 4) on
+   ``--workers`` processes (default 2): wall time (target < 15 min for 40 trials)
+   and whether every outcome was correct.
+
+Timings on a shared machine are noisy: medians are reported.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import statistics
+import time
+from collections.abc import Sequence
+from typing import Any
+
+from executor.campaign import CellRunner, campaign_pairs, pair_stats, run_campaign
+
+TARGET_FITTING_TRIAL_S = 1.5
+TARGET_ALL_TRIAL_S = 2.5
+TARGET_REAL_TIME_FACTOR = 3.0
+TARGET_CAMPAIGN_S = 15 * 60.0
+
+
+def trial_timing(assembly: str, trials: int, seed: int) -> dict[str, Any]:
+    """Medians over ``trials`` sequential trials of every campaign pair (one process)."""
+    pairs = campaign_pairs()
+    results = run_campaign(pairs, trials, seed, 1, functools.partial(CellRunner, assembly))
+    fitting = [r for pair, rs in zip(pairs, results) if pair.fits for r in rs]
+    every = [r for rs in results for r in rs]
+    return {
+        "trials": len(every),
+        "fitting_trial_median_s": statistics.median(r["duration_s"] for r in fitting),
+        "all_trial_median_s": statistics.median(r["duration_s"] for r in every),
+        "sim_steps_per_s_median": statistics.median(r["sim_steps_per_s"] for r in every),
+        "real_time_factor_median": statistics.median(r["real_time_factor"] for r in every),
+    }
+
+
+def campaign_timing(assembly: str, trials: int, seed: int, workers: int) -> dict[str, Any]:
+    """Wall time [s] and correctness of a whole campaign on ``workers`` processes."""
+    pairs = campaign_pairs()
+    start = time.perf_counter()
+    results = run_campaign(pairs, trials, seed, workers, functools.partial(CellRunner, assembly))
+    wall_s = time.perf_counter() - start
+    stats = [pair_stats(pair, rs) for pair, rs in zip(pairs, results)]
+    return {
+        "campaign_trials_per_pair": trials,
+        "campaign_workers": workers,
+        "campaign_wall_s": wall_s,
+        "campaign_all_correct": all(s.correct == s.trials for s in stats),
+        "campaign_false_fits": sum(s.false_fits for s in stats),
+    }
+
+
+def format_report(report: dict[str, Any]) -> str:
+    """Text lines with the targets of issue 4 section 6."""
+    def verdict(ok: bool) -> str:
+        return "ok" if ok else "MISSED"
+
+    lines = [
+        f"trial wall time, fitting pairs: median {report['fitting_trial_median_s']:.2f} s "
+        f"(target < {TARGET_FITTING_TRIAL_S} s: "
+        f"{verdict(report['fitting_trial_median_s'] < TARGET_FITTING_TRIAL_S)})",
+        f"trial wall time, all pairs:     median {report['all_trial_median_s']:.2f} s "
+        f"(target < {TARGET_ALL_TRIAL_S} s: "
+        f"{verdict(report['all_trial_median_s'] < TARGET_ALL_TRIAL_S)}; {report['trials']} trials)",
+        f"sim steps per second: median {report['sim_steps_per_s_median']:.0f}",
+        f"real-time factor: median {report['real_time_factor_median']:.1f}x "
+        f"(target >= {TARGET_REAL_TIME_FACTOR}x: "
+        f"{verdict(report['real_time_factor_median'] >= TARGET_REAL_TIME_FACTOR)})",
+    ]
+    if "campaign_wall_s" in report:
+        full = report["campaign_trials_per_pair"] == 40
+        target = (
+            f" (target < {TARGET_CAMPAIGN_S / 60:.0f} min: "
+            f"{verdict(report['campaign_wall_s'] < TARGET_CAMPAIGN_S)})" if full else ""
+        )
+        lines.append(
+            f"campaign, {report['campaign_trials_per_pair']} trials x {len(campaign_pairs())} pairs "
+            f"on {report['campaign_workers']} workers: {report['campaign_wall_s']:.1f} s wall"
+            f"{target}; all correct: {report['campaign_all_correct']}, "
+            f"too-big parts reported fitting: {report['campaign_false_fits']}"
+        )
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="bench executor", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="1 timed trial per pair and a 4-trial campaign")
+    parser.add_argument("--trials", type=int, help="timed trials per pair (default 3)")
+    parser.add_argument("--campaign-trials", type=int,
+                        help="campaign trials per pair (default 40; 0 skips the campaign)")
+    parser.add_argument("--workers", type=int, default=2, help="campaign workers (default 2)")
+    parser.add_argument("--seed", type=int, default=1000, help="base seed (default 1000)")
+    parser.add_argument("--assembly", default="cranfield")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    args = parser.parse_args(argv)
+    trials = args.trials or (1 if args.quick else 3)
+    campaign_trials = (
+        args.campaign_trials if args.campaign_trials is not None else 4 if args.quick else 40
+    )
+    report = trial_timing(args.assembly, trials, args.seed)
+    if campaign_trials > 0:
+        report |= campaign_timing(args.assembly, campaign_trials, args.seed, args.workers)
+    print(json.dumps(report, indent=2) if args.json else format_report(report))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
