@@ -72,13 +72,17 @@ def count_downset_paths(masks: Sequence[int]) -> int:
     return layer.get(full, 0)
 
 
+def exact_count(matrix: np.ndarray) -> int:
+    """Exact number of linear extensions of a boolean relation matrix (not memoised)."""
+    groups = components(matrix)
+    interleavings = factorial(len(matrix)) // prod(factorial(len(g)) for g in groups)
+    return interleavings * prod(count_downset_paths(_local_masks(matrix, g)) for g in groups)
+
+
 @lru_cache(maxsize=65536)
 def _count_cached(parts: tuple[str, ...], packed: bytes) -> int:
     n = len(parts)
-    matrix = np.unpackbits(np.frombuffer(packed, dtype=np.uint8), count=n * n).reshape(n, n).astype(bool)
-    groups = components(matrix)
-    interleavings = factorial(n) // prod(factorial(len(g)) for g in groups)
-    return interleavings * prod(count_downset_paths(_local_masks(matrix, g)) for g in groups)
+    return exact_count(np.unpackbits(np.frombuffer(packed, dtype=np.uint8), count=n * n).reshape(n, n).astype(bool))
 
 
 def count_linear_extensions(relation: Relation) -> int:

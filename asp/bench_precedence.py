@@ -1,0 +1,81 @@
+"""``./run.sh bench precedence``: timings of learning, counting and evaluation.
+
+Prints medians over repetitions and ratios measured in the same run:
+the full Cranfield evaluation (6 values of m x 1000 trials), exact counting against
+``networkx.all_topological_sorts`` on Cranfield, counting assemblies of 20, 30 and
+40 parts (a few chains plus free parts), and guided against random demonstration.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from collections.abc import Callable
+
+import networkx as nx
+import numpy as np
+
+from asp.assembly import load_assembly
+from asp.linear_extensions import exact_count
+from asp.precedence_eval import PAPER_M, evaluate
+from asp.relation import Relation, true_relation
+
+
+def median_seconds(work: Callable[[], object], repeat: int) -> float:
+    """Median wall-clock time of ``work()`` over ``repeat`` runs [s]."""
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        work()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def chains_and_free_parts(parts: int, chains: int = 3, chain_length: int = 5) -> Relation:
+    """``chains`` chains of ``chain_length`` parts each; the other parts are free."""
+    names = [f"q{i}" for i in range(parts)]
+    pairs = [
+        (names[c * chain_length + k], names[c * chain_length + k + 1])
+        for c in range(chains)
+        for k in range(chain_length - 1)
+    ]
+    relation = Relation.from_pairs(names, pairs)
+    closed = relation.matrix.copy()
+    for _ in range(chain_length):
+        closed |= (closed.astype(np.int32) @ closed.astype(np.int32)) > 0
+    return Relation(relation.parts, closed)
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="./run.sh bench precedence", description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5, help="repetitions per figure (median reported)")
+    parser.add_argument("--guided-trials", type=int, default=1000, help="trials of the guided evaluation")
+    args = parser.parse_args(argv)
+    truth = true_relation(load_assembly("cranfield"))
+
+    seconds = median_seconds(lambda: evaluate(truth, PAPER_M, 1000, seed=1), args.repeat)
+    print(f"Cranfield evaluation, 6 values of m x 1000 trials: {seconds:.3f} s (median of {args.repeat}; required < 1 s)")
+
+    graph = nx.DiGraph(truth.pairs())
+    graph.add_nodes_from(truth.parts)
+    ours = median_seconds(lambda: exact_count(truth.matrix), max(args.repeat, 21))
+    theirs = median_seconds(lambda: sum(1 for _ in nx.all_topological_sorts(graph)), args.repeat)
+    print(f"count Cranfield: ours {exact_count(truth.matrix)} in {1e3 * ours:.3f} ms, "
+          f"networkx.all_topological_sorts {sum(1 for _ in nx.all_topological_sorts(graph))} in {1e3 * theirs:.1f} ms: "
+          f"{theirs / ours:.0f}x faster (required >= 300x)")
+
+    for parts in (20, 30, 40):
+        relation = chains_and_free_parts(parts)
+        seconds = median_seconds(lambda: exact_count(relation.matrix), args.repeat)
+        print(f"count {parts} parts (3 chains of 5 + {parts - 15} free): {exact_count(relation.matrix)} in {1e3 * seconds:.3f} ms (required < 1 s)")
+
+    from asp.guidance import evaluate_guided
+
+    start = time.perf_counter()
+    guided = evaluate_guided(truth, args.guided_trials, seed=1)
+    seconds = time.perf_counter() - start
+    print(f"guided demonstration, {args.guided_trials} trials: mean {guided['mean']:.2f} demonstrations to the exact "
+          f"relation vs random {guided['random_mean']:.2f} ({guided['random_mean'] / guided['mean']:.1f}x fewer; "
+          f"required <= 4.5) in {seconds:.2f} s")
+    return 0
