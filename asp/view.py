@@ -4,7 +4,7 @@ RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: pla
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
 on the files plus ``RUN/view.rbl``, a blueprint with one tab per cell found in the
-recording (``executor.rerun_log.cell_blueprint``; other entities, e.g. the
+recording (``executor.rerun_blueprint.cell_views``; other entities, e.g. the
 planner's, get the viewer's automatic views). Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
@@ -60,7 +60,8 @@ def write_blueprint(folder: Path, cells: Sequence[str]) -> Path:
     """``folder/view.rbl``: one tab per cell, automatic views for everything else."""
     import rerun.blueprint as rrb
 
-    from executor.rerun_log import APPLICATION_ID, cell_views
+    from executor.rerun_blueprint import cell_views
+    from executor.rerun_log import APPLICATION_ID
 
     path = folder / "view.rbl"
     rrb.Blueprint(rrb.Tabs(*(cell_views(c) for c in cells)), auto_views=True).save(
