@@ -19,11 +19,10 @@ import argparse
 import functools
 import json
 import statistics
-import time
 from collections.abc import Sequence
 from typing import Any
 
-from executor.campaign import CellRunner, campaign_pairs, pair_stats, run_campaign
+from executor.campaign import CellRunner, campaign_pairs, run_campaign, timed_campaign
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5
@@ -48,17 +47,15 @@ def trial_timing(assembly: str, trials: int, seed: int) -> dict[str, Any]:
 
 def campaign_timing(assembly: str, trials: int, seed: int, workers: int) -> dict[str, Any]:
     """Wall time [s] and correctness of a whole campaign on ``workers`` processes."""
-    pairs = campaign_pairs()
-    start = time.perf_counter()
-    results = run_campaign(pairs, trials, seed, workers, functools.partial(CellRunner, assembly))
-    wall_s = time.perf_counter() - start
-    stats = [pair_stats(pair, rs) for pair, rs in zip(pairs, results)]
+    run = timed_campaign(
+        campaign_pairs(), trials, seed, workers, functools.partial(CellRunner, assembly)
+    )
     return {
         "campaign_trials_per_pair": trials,
         "campaign_workers": workers,
-        "campaign_wall_s": wall_s,
-        "campaign_all_correct": all(s.correct == s.trials for s in stats),
-        "campaign_false_fits": sum(s.false_fits for s in stats),
+        "campaign_wall_s": run.wall_s,
+        "campaign_all_correct": all(s.correct == s.trials for s in run.stats),
+        "campaign_false_fits": sum(s.false_fits for s in run.stats),
     }
 
 

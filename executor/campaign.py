@@ -199,6 +199,34 @@ def run_campaign(
     return results
 
 
+@dataclass
+class CampaignRun:
+    """A finished campaign: per-pair results (``TrialResult.to_json()`` dicts, seed
+    order), their Fig. 18 counts and the wall time [s]."""
+
+    pairs: list[CampaignPair]
+    results: list[list[dict[str, Any]]]
+    stats: list[PairStats]
+    wall_s: float
+
+    @property
+    def durations(self) -> list[float]:
+        """Wall time of every trial [s]."""
+        return [r["duration_s"] for rs in self.results for r in rs]
+
+
+def timed_campaign(
+    pairs: Sequence[CampaignPair], trials: int, seed: int, workers: int, factory: RunnerFactory,
+    progress: Callable[[int, int], None] | None = None,
+) -> CampaignRun:
+    """:func:`run_campaign` plus counts and wall time."""
+    start = time.perf_counter()
+    results = run_campaign(pairs, trials, seed, workers, factory, progress)
+    wall_s = time.perf_counter() - start
+    stats = [pair_stats(pair, rs) for pair, rs in zip(pairs, results)]
+    return CampaignRun(list(pairs), results, stats, wall_s)
+
+
 # -- report -----------------------------------------------------------------------------
 
 def format_table(stats: Sequence[PairStats]) -> str:
@@ -220,20 +248,18 @@ def format_table(stats: Sequence[PairStats]) -> str:
     return "\n".join(lines)
 
 
-def campaign_report(
-    stats: Sequence[PairStats], trials: int, seed: int, workers: int, wall_s: float,
-    durations: Sequence[float],
-) -> dict[str, Any]:
+def campaign_report(run: CampaignRun, seed: int, workers: int) -> dict[str, Any]:
     """The ``--json`` document."""
+    durations = run.durations
     return {
-        "trials_per_pair": trials,
+        "trials_per_pair": max((s.trials for s in run.stats), default=0),
         "seed": seed,
         "workers": workers,
-        "wall_s": wall_s,
+        "wall_s": run.wall_s,
         "trial_wall_median_s": statistics.median(durations) if durations else 0.0,
-        "pairs": [asdict(s) | {"correct_ratio": s.correct_ratio} for s in stats],
-        "all_correct": all(s.correct == s.trials for s in stats),
-        "false_fits": sum(s.false_fits for s in stats),
+        "pairs": [asdict(s) | {"correct_ratio": s.correct_ratio} for s in run.stats],
+        "all_correct": all(s.correct == s.trials for s in run.stats),
+        "false_fits": sum(s.false_fits for s in run.stats),
     }
 
 
@@ -256,27 +282,22 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
     args = build_parser().parse_args(list(argv))
-    pairs = select_pairs(args.pairs)
-    start = time.perf_counter()
-    results = run_campaign(
-        pairs, args.trials, args.seed, args.workers,
+    run = timed_campaign(
+        select_pairs(args.pairs), args.trials, args.seed, args.workers,
         functools.partial(CellRunner, args.assembly), progress=_progress_printer(),
     )
-    wall_s = time.perf_counter() - start
-    stats = [pair_stats(pair, rs) for pair, rs in zip(pairs, results)]
-    durations = [r["duration_s"] for rs in results for r in rs]
-    report = campaign_report(stats, args.trials, args.seed, args.workers, wall_s, durations)
+    report = campaign_report(run, args.seed, args.workers)
     if args.plot:
         from executor.campaign_plots import write_plots
 
-        report["plots"] = [str(p) for p in write_plots(Path(args.plot), stats, args.assembly, args.seed)]
+        report["plots"] = [str(p) for p in write_plots(Path(args.plot), run.stats, args.assembly, args.seed)]
     if args.json:
         print(json.dumps(report, indent=2))
     else:
-        print(format_table(stats))
+        print(format_table(run.stats))
         print(
             f"all correct: {report['all_correct']}; too-big parts reported fitting: "
-            f"{report['false_fits']}; {len(durations)} trials in {wall_s:.1f} s wall on "
+            f"{report['false_fits']}; {len(run.durations)} trials in {run.wall_s:.1f} s wall on "
             f"{args.workers} worker(s), median {report['trial_wall_median_s']:.2f} s/trial"
         )
         for path in report.get("plots", []):

@@ -34,9 +34,9 @@ time are skipped so a long campaign stays small.
 from __future__ import annotations
 
 import uuid
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from collections.abc import Sequence
 from typing import Any, NamedTuple, Protocol
 
 import numpy as np

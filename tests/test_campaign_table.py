@@ -12,6 +12,7 @@ import pytest
 
 from executor import ExecutorError
 from executor.campaign import (
+    CampaignRun,
     FIG18_FITTING_PAIRS,
     campaign_pairs,
     campaign_report,
@@ -74,9 +75,9 @@ def test_counts_seeds_and_two_workers_match_one() -> None:
     assert (p1_r1.trials, p1_r1.first_trial, p1_r1.after_second, p1_r1.correct) == (4, 3, 4, 4)
     sh_s1 = next(s for s in stats if (s.part, s.hole) == ("sh", "s1"))
     assert (sh_s1.correct, sh_s1.false_fits, sh_s1.first_trial) == (4, 0, 0)
-    report = campaign_report(stats, 4, 100, 2, 1.0, [0.5, 1.0, 2.0])
+    report = campaign_report(CampaignRun(pairs, serial, stats, 1.0), 100, 2)
     assert report["all_correct"] and report["false_fits"] == 0
-    assert report["trial_wall_median_s"] == 1.0
+    assert report["trials_per_pair"] == 4 and report["trial_wall_median_s"] == 0.004
     table = format_table(stats)
     assert "tight round peg tp" in table and "H4 square s1" in table
     assert len(table.splitlines()) == 2 + 12
@@ -88,7 +89,7 @@ def test_a_too_big_part_reported_fitting_is_counted() -> None:
                {"outcome": "no_fit", "attempts": 2, "duration_s": 2.0}]
     stats = pair_stats(pair, results)
     assert (stats.correct, stats.false_fits) == (1, 1)
-    assert not campaign_report([stats], 2, 0, 1, 1.0, [1.0, 2.0])["all_correct"]
+    assert not campaign_report(CampaignRun([pair], [results], [stats], 1.0), 0, 1)["all_correct"]
 
 
 def _trace(part: str, outcome: str, stop_at: float) -> AttemptTrace:
