@@ -66,12 +66,14 @@ def plot_fig17(success: AttemptTrace, failure: AttemptTrace, path: Path) -> Path
     failure (green), as in the paper's Fig. 17."""
     fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
     for axis, name, ax in zip(range(3), ("F_x", "F_y", "F_z"), axes):
-        ax.plot(success.array("phase"), success.array("force_des")[:, axis], ":", color="tab:blue",
-                label="desired")
-        ax.plot(success.array("phase"), success.array("force_mes")[:, axis], "-", color="tab:red",
-                label=f"success {success.part}→{success.hole}")
-        ax.plot(failure.array("phase"), failure.array("force_mes")[:, axis], "-", color="tab:green",
-                label=f"failure {failure.part}→{failure.hole}")
+        for trace, signal, style, color, label in (
+            (success, "force_des", ":", "tab:blue", "desired"),
+            (success, "force_mes", "-", "tab:red", f"success {success.part}→{success.hole}"),
+            (failure, "force_mes", "-", "tab:green", f"failure {failure.part}→{failure.hole}"),
+        ):
+            steps = trace.insertion()
+            ax.plot(trace.array("phase")[steps], trace.array(signal)[steps, axis], style,
+                    color=color, label=label)
         ax.set_ylabel(f"${name}$ [N]")
         ax.grid(alpha=0.3)
     axes[0].legend(loc="best", fontsize=8)

@@ -122,6 +122,12 @@ class AttemptTrace:
         ):
             getattr(self, name).append(np.array(value, dtype=np.float64))
 
+    def insertion(self) -> slice:
+        """The steps of the DMP insertion: from the first step with phase > 0 on (the
+        search before it runs at phase 0)."""
+        moving = np.flatnonzero(self.array("phase") > 0.0)
+        return slice(int(moving[0]) if len(moving) else len(self.phase), len(self.phase))
+
     @property
     def key(self) -> str:
         """Entity-path-safe name of the attempt, e.g. ``e0003_p1_r1_s7_a2``."""
@@ -347,17 +353,18 @@ class AttemptLogger:
             f"{self.root}/tool/tip", indexes=timed,
             columns=rr.Points3D.columns(positions=trace.array("tool_pos")).partition([1] * count),
         )
-        by_phase = [
-            experiment,
-            rr.TimeColumn(
-                "dmp_phase", sequence=np.round(trace.array("phase") * PHASE_SCALE).astype(np.int64)
-            ),
-        ]
-        base = f"by_phase/{trace.key}"
-        self._series(f"{base}/force_measured", by_phase, trace.array("force_mes"), "force", "",
-                     _MEASURED_COLORS)
-        self._series(f"{base}/force_desired", by_phase, trace.array("force_des"), "force", " des",
-                     _DESIRED_COLORS)
+        insertion = trace.insertion()
+        if insertion.stop > insertion.start:
+            phase = trace.array("phase")[insertion]
+            by_phase = [
+                rr.TimeColumn("experiment", sequence=np.full(len(phase), trace.experiment)),
+                rr.TimeColumn("dmp_phase", sequence=np.round(phase * PHASE_SCALE).astype(np.int64)),
+            ]
+            base = f"by_phase/{trace.key}"
+            self._series(f"{base}/force_measured", by_phase, trace.array("force_mes")[insertion],
+                         "force", "", _MEASURED_COLORS)
+            self._series(f"{base}/force_desired", by_phase, trace.array("force_des")[insertion],
+                         "force", " des", _DESIRED_COLORS)
 
     def _series(
         self, path: str, indexes: list[rr.TimeColumn], values: np.ndarray, quantity: str,

@@ -28,11 +28,13 @@ class Evidence:
 
 def _attempt(logger: AttemptLogger, part: str, hole: str, seed: int, attempt: int,
              outcome: str, steps: int = 1000) -> None:
-    """One synthetic attempt at 1 kHz whose clock restarts at 0 (as a cell may do)."""
+    """One synthetic attempt at 1 kHz whose clock restarts at 0 (as a cell may do): a
+    search at phase 0 for the first fifth of the steps, then the DMP (phase 0 → 1)."""
     logger.begin_attempt(part, hole, seed, attempt)
     logger.log_search_path(np.array([[0.5, 0.0, 0.2], [0.501, 0.001, 0.2], [0.5, 0.002, 0.2]]))
     for k in range(steps):
-        phase = k / (steps - 1)
+        search = steps // 5
+        phase = max(0.0, (k - search) / (steps - 1 - search))
         logger.log_step(
             k * 0.001, phase, np.array([0.5, 0.0, 0.2 - 0.02 * phase]),
             np.array([0.0, 0.0, -10.0 * phase]), np.array([0.0, 0.0, -8.0 * phase]),
@@ -90,7 +92,8 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert len([p for p in by_phase if p.endswith("/force_measured")]) == 3
     series = "/executor/c1/by_phase/e0002_p1_r1_s8_a1/force_measured"
     phases = column_values(rrd, series, "dmp_phase")
-    assert (phases[0], phases[-1]) == (0, PHASE_SCALE)
+    # The search (phase 0, steps 0..199) is left out: kept steps 210..990 and 999.
+    assert len(phases) == 80 and phases[0] > 0 and phases[-1] == PHASE_SCALE
     assert "/executor/c1/by_phase" in format_summary(summary)
 
 
