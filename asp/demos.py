@@ -110,7 +110,7 @@ def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations
         if step.number in steps:
             raise PlannerError(f"{where}: demonstration {demo} already places {steps[step.number]} at step {step.number}")
         steps[step.number] = str(part)
-    known = list(parts) if parts is not None else declared or None
+    known = list(parts) if parts is not None else None
     sequences, origins = [], []
     for demo, steps in sorted(by_demo.items(), key=lambda item: _demo_order(item[0])):
         where = f"{path}: demonstration {demo}"
@@ -124,6 +124,8 @@ def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations
         sequences.append(tuple(ids))
         origins.append(where)
     assert known is not None
+    if declared and set(declared) != set(known):
+        raise PlannerError(f"{path}: part/1 facts {' '.join(declared)} differ from the demonstrated parts {' '.join(known)}")
     return Demonstrations(tuple(known), tuple(sequences), tuple(origins))
 
 
