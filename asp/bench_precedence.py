@@ -14,12 +14,11 @@ import time
 from collections.abc import Callable
 
 import networkx as nx
-import numpy as np
 
 from asp.assembly import load_assembly
 from asp.linear_extensions import exact_count
 from asp.precedence_eval import PAPER_M, evaluate
-from asp.relation import Relation, true_relation
+from asp.relation import Relation, close, true_relation
 
 
 def median_seconds(work: Callable[[], object], repeat: int) -> float:
@@ -40,11 +39,7 @@ def chains_and_free_parts(parts: int, chains: int = 3, chain_length: int = 5) ->
         for c in range(chains)
         for k in range(chain_length - 1)
     ]
-    relation = Relation.from_pairs(names, pairs)
-    closed = relation.matrix.copy()
-    for _ in range(chain_length):
-        closed |= (closed.astype(np.int32) @ closed.astype(np.int32)) > 0
-    return Relation(relation.parts, closed)
+    return close(Relation.from_pairs(names, pairs))
 
 
 def main(argv: list[str]) -> int:

@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from asp import PlannerError
-from asp.linear_extensions import DownSets, down_sets, predecessor_masks
+from asp.linear_extensions import DownSets, down_sets
+from asp.poset_decomposition import predecessor_masks
 from asp.relation import Relation
 
 _INT64_LIMIT = 2**62

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from asp.extension_batches import ExtensionBatches, positions_of
-from asp.linear_extensions import predecessor_masks
+from asp.poset_decomposition import predecessor_masks, transitive_closure
 from asp.relation import Relation
 
 
@@ -42,13 +42,6 @@ def teacher_order(suggestion: Sequence[int], truth: Relation) -> list[int]:
         else:
             raise ValueError("the true relation has a cycle")
     return order
-
-
-def _closure(matrix: np.ndarray) -> np.ndarray:
-    closed = matrix.copy()
-    for _ in range(max(1, int(np.ceil(np.log2(max(2, len(matrix))))))):
-        closed |= (closed.astype(np.int32) @ closed.astype(np.int32)) > 0
-    return closed
 
 
 class Guide:
@@ -103,7 +96,7 @@ class Guide:
         position = np.empty(len(self.parts), dtype=np.int64)
         position[list(order)] = np.arange(len(self.parts))
         self.learned &= position[:, None] < position[None, :]
-        self.proven = _closure(self.proven) & self.learned
+        self.proven = transitive_closure(self.proven) & self.learned
         self.demonstrations += 1
         self._suggestion = None
 

@@ -1,12 +1,13 @@
 """The assembly sequences a precedence relation admits: count, enumerate, sample.
 
-A sequence is admitted when it is a linear extension of the relation. Counting is a
-dynamic programme over down-sets (sets of parts that can be in place together), with
-independent components (connected parts of the comparability graph) counted apart and
-combined by a multinomial: exact Python integers of any size, never enumerating.
-Sampling is exactly uniform: from a down-set S the next part x is drawn with
-probability completions(S + x) / completions(S), components are interleaved by a
-uniformly random shuffle. Enumeration streams sequences depth first.
+A sequence is admitted when it is a linear extension of the relation. Counting splits the
+relation into independent and consecutive groups (:mod:`asp.poset_decomposition`):
+independent groups combine by a multinomial, consecutive ones by a product, and each
+remaining prime group is counted by a dynamic programme over its down-sets (sets of
+parts that can be in place together): exact Python integers of any size, never
+enumerating. Sampling is exactly uniform: in a prime group the next part x is drawn
+from down-set S with probability completions(S + x) / completions(S); independent
+groups are interleaved by a uniformly random shuffle, consecutive ones concatenated. Enumeration streams sequences depth first.
 
 A relation with a cycle (or a part preceding itself) admits no sequence.
 """
@@ -21,38 +22,9 @@ from math import factorial, prod
 
 import numpy as np
 
+from asp import PlannerError
+from asp.poset_decomposition import Decomposition, decompose, predecessor_masks, transitive_closure
 from asp.relation import Relation
-
-
-def predecessor_masks(matrix: np.ndarray) -> tuple[int, ...]:
-    """Bit i of ``masks[j]`` is set when part i must precede part j."""
-    weights = [1 << i for i in range(matrix.shape[0])]
-    return tuple(sum(w for w, bit in zip(weights, column) if bit) for column in matrix.T.tolist())
-
-
-def components(matrix: np.ndarray) -> list[list[int]]:
-    """Connected components (lists of part indices) of the comparability graph."""
-    linked = (matrix | matrix.T).tolist()
-    seen: set[int] = set()
-    found = []
-    for start in range(len(linked)):
-        if start in seen:
-            continue
-        stack, members = [start], []
-        seen.add(start)
-        while stack:
-            i = stack.pop()
-            members.append(i)
-            for j, edge in enumerate(linked[i]):
-                if edge and j not in seen:
-                    seen.add(j)
-                    stack.append(j)
-        found.append(sorted(members))
-    return found
-
-
-def _local_masks(matrix: np.ndarray, members: Sequence[int]) -> tuple[int, ...]:
-    return predecessor_masks(matrix[np.ix_(members, members)])
 
 
 def count_downset_paths(masks: Sequence[int]) -> int:
@@ -72,11 +44,21 @@ def count_downset_paths(masks: Sequence[int]) -> int:
     return layer.get(full, 0)
 
 
+def _count(node: Decomposition) -> int:
+    if node.kind == "prime":
+        return count_downset_paths(node.masks)
+    counts = prod(_count(child) for child in node.children)
+    if node.kind == "series":
+        return counts
+    return counts * factorial(len(node.members)) // prod(factorial(len(c.members)) for c in node.children)
+
+
 def exact_count(matrix: np.ndarray) -> int:
     """Exact number of linear extensions of a boolean relation matrix (not memoised)."""
-    groups = components(matrix)
-    interleavings = factorial(len(matrix)) // prod(factorial(len(g)) for g in groups)
-    return interleavings * prod(count_downset_paths(_local_masks(matrix, g)) for g in groups)
+    closed = transitive_closure(matrix)
+    if np.any(np.diag(closed)):
+        return 0
+    return _count(decompose(closed))
 
 
 @lru_cache(maxsize=65536)
@@ -126,8 +108,6 @@ class DownSets:
 
 def down_sets(masks: Sequence[int], limit: int = 2_000_000) -> DownSets:
     """All down-sets of the poset given by predecessor masks (at most ``limit``)."""
-    from asp import PlannerError
-
     n = len(masks)
     states, index, frontier, edges = [0], {0: 0}, [0], []
     while frontier:
@@ -154,7 +134,7 @@ def down_sets(masks: Sequence[int], limit: int = 2_000_000) -> DownSets:
     return DownSets(tuple(masks), tuple(states), nxt, tuple(completions))
 
 
-def _sample_component(table: DownSets, rng: random.Random) -> list[int]:
+def _sample_prime(table: DownSets, rng: random.Random) -> list[int]:
     state, order = 0, []
     for _ in range(len(table.masks)):
         pick = rng.randrange(table.completions[state])
@@ -173,17 +153,28 @@ class UniformSampler:
     """Exactly uniform sampling of the sequences a relation admits (tables built once)."""
 
     def __init__(self, relation: Relation) -> None:
-        self.relation = relation
-        self.groups = components(relation.matrix)
-        self.tables = [down_sets(_local_masks(relation.matrix, g)) for g in self.groups]
-        if any(t.completions[0] == 0 for t in self.tables) or np.any(np.diag(relation.matrix)):
-            from asp import PlannerError
-
+        closed = transitive_closure(relation.matrix)
+        if np.any(np.diag(closed)):
             raise PlannerError("the relation admits no sequence (it has a cycle)")
+        self.relation = relation
+        self.root = decompose(closed)
+        self.tables = {node.members: down_sets(node.masks) for node in _primes(self.root)}
+
+    def _sample(self, node: Decomposition, rng: random.Random) -> list[int]:
+        if node.kind == "prime":
+            return [node.members[i] for i in _sample_prime(self.tables[node.members], rng)]
+        orders = [self._sample(child, rng) for child in node.children]
+        if node.kind == "series":
+            return [x for order in orders for x in order]
+        labels = [k for k, order in enumerate(orders) for _ in order]
+        rng.shuffle(labels)  # a uniformly random interleaving
+        streams = [iter(order) for order in orders]
+        return [next(streams[k]) for k in labels]
 
     def sample(self, rng: random.Random) -> tuple[str, ...]:
         """One sequence, uniformly among all admitted ones."""
-        orders = [iter([g[i] for i in _sample_component(t, rng)]) for g, t in zip(self.groups, self.tables)]
-        labels = [k for k, g in enumerate(self.groups) for _ in g]
-        rng.shuffle(labels)
-        return tuple(self.relation.parts[next(orders[k])] for k in labels)
+        return tuple(self.relation.parts[i] for i in self._sample(self.root, rng))
+
+
+def _primes(node: Decomposition) -> list[Decomposition]:
+    return [node] if node.kind == "prime" else [p for child in node.children for p in _primes(child)]
