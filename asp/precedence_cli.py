@@ -56,7 +56,7 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--plot", help="write the Figs. 12/13 bar charts to this PNG file")
 
     suggest = commands.add_parser("suggest", help="propose the next sequence to demonstrate")
-    suggest.add_argument("demos", help="demonstrations so far (made following earlier suggestions)")
+    suggest.add_argument("demos", nargs="?", help="demonstrations so far, made following earlier suggestions (none: the first suggestion; needs --assembly)")
     suggest.add_argument("--assembly", help="assembly name or folder (gives the parts)")
     suggest.add_argument("--seed", type=int, default=0, help="seed of the tie-breaking (default 0)")
     suggest.add_argument("--json", action="store_true", help="print JSON {suggestion, undecided}")
@@ -149,9 +149,12 @@ def _evaluate(args: argparse.Namespace) -> None:
 def _suggest(args: argparse.Namespace) -> None:
     from asp.guidance import suggest
 
-    demos = load_demos(args.demos, load_assembly(args.assembly).part_ids if args.assembly else None)
+    parts = load_assembly(args.assembly).part_ids if args.assembly else None
+    if args.demos is None and parts is None:
+        raise PlannerError("suggest: expected a demonstrations file or --assembly A (for the first suggestion)")
+    demos = load_demos(args.demos, parts) if args.demos else Demonstrations(tuple(parts or ()), (), ())
     guide, sequence = suggest(demos.parts, demos.sequences, args.seed)
-    undecided = Relation(demos.parts, guide.undecided()).pairs()
+    undecided = [(a, b) for a, b in Relation(demos.parts, guide.undecided()).pairs() if a != b]
     if args.json:
         _print_json({"suggestion": sequence, "undecided": [list(p) for p in undecided]})
     else:
