@@ -1,0 +1,58 @@
+"""On-line adaptation toward the reference wrench (paper 3.1/3.2, after Abu-Dakka 2015).
+
+A bounded mass-damper-spring admittance per axis shifts the commanded pose by δ:
+
+    M δ̈ + D δ̇ + K δ = ΔW,     ΔW = W_mes − W_des,     |δ| ≤ bound
+
+on the lateral forces (x, y → translation) and the tilting torques (x, y → rotation).
+The spring returns δ to the reference once the deviation is gone (a pure integrator
+ran away in the measurements of the notes).  The insertion axis z is left to the DMP and
+to phase stopping.  Integrated with semi-implicit Euler at the control rate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class AdmittanceParams:
+    """Translation: mass [kg], damping [N·s/m], stiffness [N/m], bound [m];
+    rotation: inertia [kg·m²], damping [Nm·s/rad], stiffness [Nm/rad], bound [rad].
+    Natural frequency ≈ 30 rad/s, critically damped."""
+
+    mass: float = 1.5
+    damping: float = 90.0
+    stiffness: float = 1350.0
+    bound: float = 0.002
+    inertia: float = 0.011
+    rot_damping: float = 0.66
+    rot_stiffness: float = 10.0
+    rot_bound: float = 0.035
+
+
+class Admittance:
+    """State δ = (dx, dy, rx, ry) with velocities; ``update`` returns the pose offset."""
+
+    def __init__(self, params: AdmittanceParams = AdmittanceParams()) -> None:
+        p = params
+        self.mass = np.array([p.mass, p.mass, p.inertia, p.inertia])
+        self.damping = np.array([p.damping, p.damping, p.rot_damping, p.rot_damping])
+        self.stiffness = np.array([p.stiffness, p.stiffness, p.rot_stiffness, p.rot_stiffness])
+        self.bound = np.array([p.bound, p.bound, p.rot_bound, p.rot_bound])
+        self.offset = np.zeros(4)
+        self.velocity = np.zeros(4)
+
+    def update(self, force_dev: np.ndarray, torque_dev: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Advance by ``dt`` [s] with the wrench deviation (world frame) [N, Nm]; returns
+        the translation offset (3,) [m] and the rotation vector offset (3,) [rad]."""
+        excitation = np.array([force_dev[0], force_dev[1], torque_dev[0], torque_dev[1]])
+        acc = (excitation - self.damping * self.velocity - self.stiffness * self.offset) / self.mass
+        self.velocity += acc * dt
+        self.offset += self.velocity * dt
+        clipped = np.clip(self.offset, -self.bound, self.bound)
+        self.velocity[clipped != self.offset] = 0.0
+        self.offset = clipped
+        return np.array([self.offset[0], self.offset[1], 0.0]), np.array([self.offset[2], self.offset[3], 0.0])

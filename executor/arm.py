@@ -1,0 +1,146 @@
+"""The arm as the controller sees it: joint state, the believed tool-tip pose, Jacobian,
+gravity/Coriolis torques and the wrist force/torque sensor.
+
+The part link's frame is the part's *real* tip.  The grasp is not repeatable: the robot
+believes the tip sits at ``real ∘ grasp_error⁻¹``, so every pose the controller reads or
+commands is the believed one, and the part really ends up offset and tilted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as pb
+
+from executor import ExecutorError
+
+N_JOINTS = 7
+# Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
+REST_POSTURE = np.array([0.0, 0.6, 0.0, -1.4, 0.0, 1.1, 0.0])
+TOOL_DOWN_QUAT_XYZW = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def quat_to_matrix(quat_xyzw: np.ndarray) -> np.ndarray:
+    """3×3 rotation matrix of a unit quaternion (x, y, z, w)."""
+    return np.array(pb.getMatrixFromQuaternion(list(quat_xyzw))).reshape(3, 3)
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """3-vector cross product (np.cross costs ~10 µs per call on 3-vectors)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def rotation_error(quat_des_xyzw: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
+    """Rotation vector [rad] (world frame) that turns ``quat_xyzw`` into ``quat_des_xyzw``."""
+    x1, y1, z1, w1 = quat_des_xyzw
+    x2, y2, z2, w2 = -quat_xyzw[0], -quat_xyzw[1], -quat_xyzw[2], quat_xyzw[3]
+    w = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2
+    v = np.array([
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ])
+    return 2.0 * v if w >= 0 else -2.0 * v
+
+
+@dataclass
+class ArmState:
+    """One reading: joints [rad, rad/s], believed tip pose/velocity [m, m/s, rad/s],
+    Jacobians (3×7 each) and the measured contact wrench at the tip (world frame) [N, Nm]."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    tip_pos: np.ndarray
+    tip_quat_xyzw: np.ndarray
+    tip_vel: np.ndarray
+    tip_omega: np.ndarray
+    jac_lin: np.ndarray
+    jac_ang: np.ndarray
+    force: np.ndarray
+    torque: np.ndarray
+
+
+class Arm:
+    """Reads and drives the ``kuka_iiwa`` + flange + part multibody in torque mode."""
+
+    def __init__(self, client: int, robot: int) -> None:
+        self.client, self.robot = client, robot
+        names = [pb.getJointInfo(robot, j, physicsClientId=client)[1].decode() for j in
+                 range(pb.getNumJoints(robot, physicsClientId=client))]
+        if "ft_sensor" not in names:
+            raise ExecutorError(f"robot body {robot}: no 'ft_sensor' joint (expected the generated arm URDF)")
+        self.sensor = names.index("ft_sensor")
+        self.joints = list(range(N_JOINTS))
+        pb.enableJointForceTorqueSensor(robot, self.sensor, True, physicsClientId=client)
+        self._zeros = [0.0] * N_JOINTS
+        self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+        self.tare = np.zeros(6)
+        self._wrench_filtered = np.zeros(6)
+
+    def set_grasp_error(self, offset: np.ndarray, quat_xyzw: np.ndarray) -> None:
+        """Real tip = believed tip ∘ (offset [m], rotation) in the believed tip frame."""
+        inv_pos, inv_quat = pb.invertTransform(list(offset), list(quat_xyzw))
+        self._inv_pos, self._inv_quat = np.array(inv_pos), np.array(inv_quat)
+        self.grasp_offset, self.grasp_quat_xyzw = np.array(offset), np.array(quat_xyzw)
+
+    def reset(self, q: np.ndarray) -> None:
+        """Teleport the joints to ``q`` [rad] at rest and switch the joint motors off."""
+        for j, qj in zip(self.joints, q):
+            pb.resetJointState(self.robot, j, float(qj), 0.0, physicsClientId=self.client)
+        pb.setJointMotorControlArray(self.robot, self.joints, pb.VELOCITY_CONTROL, forces=self._zeros,
+                                     physicsClientId=self.client)
+        self._wrench_filtered = np.zeros(6)
+
+    def inverse_kinematics(self, tip_pos: np.ndarray, tip_quat_xyzw: np.ndarray) -> np.ndarray:
+        """Joint angles [rad] putting the *believed* tip at the pose (a few IK iterations;
+        used only to place the arm before an attempt, never per control step)."""
+        real_pos, real_quat = pb.multiplyTransforms(list(tip_pos), list(tip_quat_xyzw),
+                                                    list(self.grasp_offset), list(self.grasp_quat_xyzw))
+        q = REST_POSTURE.copy()
+        for _ in range(4):
+            self.reset(q)
+            q = np.array(pb.calculateInverseKinematics(
+                self.robot, self.sensor, real_pos, real_quat, restPoses=list(REST_POSTURE),
+                maxNumIterations=200, residualThreshold=1e-6, physicsClientId=self.client)[:N_JOINTS])
+        self.reset(q)
+        return q
+
+    def read(self) -> ArmState:
+        """The current state; the wrench is tared and low-pass filtered (α = 0.1 per 1 ms step, τ ≈ 10 ms)."""
+        c, r = self.client, self.robot
+        js = pb.getJointStates(r, self.joints, physicsClientId=c)
+        q = np.array([j[0] for j in js])
+        qd = np.array([j[1] for j in js])
+        ls = pb.getLinkState(r, self.sensor, computeLinkVelocity=1, computeForwardKinematics=1,
+                             physicsClientId=c)
+        rot = quat_to_matrix(ls[5])
+        lever = rot @ self._inv_pos
+        tip_pos = np.array(ls[4]) + lever
+        tip_quat = np.array(pb.multiplyTransforms((0, 0, 0), ls[5], (0, 0, 0), self._inv_quat)[1])
+        omega = np.array(ls[7])
+        tip_vel = np.array(ls[6]) + cross(omega, lever)
+        jl, ja = pb.calculateJacobian(r, self.sensor, list(self._inv_pos), list(q), self._zeros, self._zeros,
+                                      physicsClientId=c)
+        raw = np.array(pb.getJointState(r, self.sensor, physicsClientId=c)[2]) - self.tare
+        self._wrench_filtered += 0.1 * (raw - self._wrench_filtered)
+        # The sensor gives the wrench of the flange on the part in the part frame; the
+        # contact wrench on the part is its negative (weight removed by the tare).
+        force = -(rot @ self._wrench_filtered[:3])
+        torque = -(rot @ self._wrench_filtered[3:]) - cross(lever, force)
+        return ArmState(q, qd, tip_pos, tip_quat, tip_vel, omega, np.array(jl), np.array(ja), force, torque)
+
+    def tare_sensor(self) -> None:
+        """Zero the F/T sensor (call at rest, out of contact): removes the part's weight."""
+        self.tare = np.array(pb.getJointState(self.robot, self.sensor, physicsClientId=self.client)[2])
+        self._wrench_filtered = np.zeros(6)
+
+    def gravity_coriolis(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """Joint torques [Nm] holding the arm against gravity and Coriolis forces."""
+        return np.array(pb.calculateInverseDynamics(self.robot, list(q), list(qd), self._zeros,
+                                                    physicsClientId=self.client))
+
+    def command(self, tau: np.ndarray) -> None:
+        """Apply joint torques [Nm] for the next step."""
+        pb.setJointMotorControlArray(self.robot, self.joints, pb.TORQUE_CONTROL, forces=list(tau),
+                                     physicsClientId=self.client)

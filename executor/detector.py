@@ -1,0 +1,60 @@
+"""Failure detection (paper 3.2): eqs. (6) and (7) and the goal check.
+
+    ‖F_mes − F_des‖ ≥ F_stop   (6)        ‖M_mes − M_des‖ ≥ M_stop   (7)
+    ‖p_end − p_goal‖ > goal_tolerance      (the trajectory was not completed)
+
+Thresholds come from margins measured with ``tests/../executor bench`` runs on every
+part-hole pair (README, "The simulated cell"): a fitting insertion, tight peg included,
+stays below ~13 N / 0.09 Nm deviation apart from short contact transients, a too-big
+part pressed by the 2000 N/m impedance reaches 20 N within 10 mm overtravel; a fitting
+insertion ends within 1 mm of p_goal, a blocked one ≥ 20 mm away.  One set of thresholds
+for all pairs.  A violation must persist ``persist_steps`` steps to count (contact
+transients when an edge catches last 1–5 ms).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Thresholds:
+    """F_stop [N], M_stop [Nm] (eqs. 6, 7), F_slow [N] (phase stopping scale), goal
+    tolerance [m], and how long a violation must persist [steps of 1 ms]."""
+
+    f_stop: float = 20.0
+    m_stop: float = 0.5
+    f_slow: float = 8.0
+    goal_tolerance: float = 0.005
+    persist_steps: int = 20
+
+
+class Detector:
+    """Tracks the wrench deviation of one attempt; ``violated`` after a sustained breach."""
+
+    def __init__(self, thresholds: Thresholds = Thresholds()) -> None:
+        self.thresholds = thresholds
+        self.max_force_dev = 0.0
+        self.max_torque_dev = 0.0
+        self._breach = 0
+
+    def update(self, force_dev: np.ndarray, torque_dev: np.ndarray) -> tuple[float, float, bool]:
+        """Add one sample of the deviations (3,) [N], (3,) [Nm]; returns their norms and
+        whether eq. (6) or (7) has held for ``persist_steps`` steps in a row."""
+        f, m = float(np.linalg.norm(force_dev)), float(np.linalg.norm(torque_dev))
+        self.max_force_dev = max(self.max_force_dev, f)
+        self.max_torque_dev = max(self.max_torque_dev, m)
+        th = self.thresholds
+        self._breach = self._breach + 1 if (f >= th.f_stop or m >= th.m_stop) else 0
+        return f, m, self._breach >= th.persist_steps
+
+    def clear(self) -> None:
+        """Forget a breach in progress (after the exception strategy)."""
+        self._breach = 0
+
+    def goal_reached(self, p_end: np.ndarray, p_goal: np.ndarray) -> tuple[bool, float]:
+        """The goal check: (‖p_end − p_goal‖ ≤ tolerance, the distance [m])."""
+        err = float(np.linalg.norm(np.asarray(p_end) - np.asarray(p_goal)))
+        return err <= self.thresholds.goal_tolerance, err

@@ -1,0 +1,170 @@
+"""The taught skill: a Cartesian DMP (movement-primitives, Ude et al. 2014) for the tip
+pose, a reference wrench as radial basis functions over the phase, and DMP phase
+stopping.
+
+Poses of a skill are in the *hole frame*: position relative to the hole centre on the
+plate top [m], orientation in the cell frame.  A skill is stored as JSON under
+``data/<assembly>/demonstrations/<shape>.json``.
+
+Phase stopping: the DMP is rolled out once per attempt (``open_loop``) over its own time
+t ∈ [0, τ]; during execution t advances by dt / (1 + ‖ΔF‖ / F_slow), so a large wrench
+deviation slows the reference (it never jumps: the rollout is a function of t only).
+The phase reported everywhere is t / τ ∈ [0, 1].
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from movement_primitives.dmp import CartesianDMP
+
+from executor import ExecutorError
+
+# Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
+ROLLOUT_DT = 0.002
+N_WEIGHTS = 12
+N_WRENCH_RBF = 20
+
+
+def xyzw_to_wxyz(quat_xyzw: np.ndarray) -> np.ndarray:
+    return np.roll(np.asarray(quat_xyzw, dtype=float), 1, axis=-1)
+
+
+def wxyz_to_xyzw(quat_wxyz: np.ndarray) -> np.ndarray:
+    return np.roll(np.asarray(quat_wxyz, dtype=float), -1, axis=-1)
+
+
+@dataclass
+class WrenchProfile:
+    """Reference wrench [N, Nm] (6 values) as normalised Gaussian RBFs over the phase."""
+
+    centres: np.ndarray
+    width: float
+    weights: np.ndarray  # (n_rbf, 6)
+
+    def _features(self, phase: np.ndarray) -> np.ndarray:
+        act = np.exp(-((np.atleast_1d(phase)[:, None] - self.centres[None, :]) ** 2) / (2 * self.width**2))
+        return act / act.sum(axis=1, keepdims=True)
+
+    @classmethod
+    def fit(cls, phase: np.ndarray, wrench: np.ndarray, n_rbf: int = N_WRENCH_RBF) -> WrenchProfile:
+        """Least-squares fit (lightly regularised) of (N,) phases and (N, 6) wrenches."""
+        centres = np.linspace(0.0, 1.0, n_rbf)
+        profile = cls(centres, 0.5 / (n_rbf - 1), np.zeros((n_rbf, 6)))
+        phi = profile._features(phase)
+        profile.weights = np.linalg.solve(phi.T @ phi + 1e-6 * np.eye(n_rbf), phi.T @ wrench)
+        return profile
+
+    def __call__(self, phase: float) -> np.ndarray:
+        return (self._features(np.array([phase])) @ self.weights)[0]
+
+
+@dataclass
+class Skill:
+    """A taught insertion: DMP weights, demo start/goal (hole frame), duration τ [s], the
+    expected end position p_goal [m] (hole frame, from the replay) and the wrench profile."""
+
+    shape: str
+    execution_time: float
+    weights: np.ndarray
+    demo_start: np.ndarray  # [x, y, z, qw, qx, qy, qz]
+    demo_goal: np.ndarray
+    end_position: np.ndarray
+    wrench: WrenchProfile
+
+    def make_dmp(self) -> CartesianDMP:
+        dmp = CartesianDMP(execution_time=self.execution_time, dt=ROLLOUT_DT, n_weights_per_dim=N_WEIGHTS)
+        dmp.set_weights(self.weights)
+        return dmp
+
+    def rollout(self, start_pos: np.ndarray, start_quat_xyzw: np.ndarray, goal_pos: np.ndarray,
+                goal_quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The DMP from a start to a goal pose (hole frame): times (N,) [s], positions
+        (N, 3) [m] and quaternions (N, 4) xyzw."""
+        dmp = self.make_dmp()
+        dmp.configure(start_y=np.concatenate([start_pos, xyzw_to_wxyz(start_quat_xyzw)]),
+                      goal_y=np.concatenate([goal_pos, xyzw_to_wxyz(goal_quat_xyzw)]))
+        t, y = dmp.open_loop()
+        return np.asarray(t), y[:, :3], wxyz_to_xyzw(y[:, 3:])
+
+    def to_json(self) -> dict:
+        return {
+            "shape": self.shape,
+            "execution_time": self.execution_time,
+            "weights": _rounded(self.weights),
+            "demo_start": _rounded(self.demo_start),
+            "demo_goal": _rounded(self.demo_goal),
+            "end_position": _rounded(self.end_position),
+            "wrench_centres": _rounded(self.wrench.centres),
+            "wrench_width": self.wrench.width,
+            "wrench_weights": _rounded(self.wrench.weights),
+        }
+
+    @classmethod
+    def from_json(cls, data: dict) -> Skill:
+        arr = {k: np.array(v, dtype=float) for k, v in data.items() if isinstance(v, list)}
+        return cls(data["shape"], float(data["execution_time"]), arr["weights"], arr["demo_start"],
+                   arr["demo_goal"], arr["end_position"],
+                   WrenchProfile(arr["wrench_centres"], float(data["wrench_width"]), arr["wrench_weights"]))
+
+
+def _rounded(a: np.ndarray) -> list:
+    return np.round(np.asarray(a, dtype=float), 9).tolist()
+
+
+def fit_dmp(times: np.ndarray, positions: np.ndarray, quats_xyzw: np.ndarray) -> np.ndarray:
+    """DMP weights imitating a demonstrated tip trajectory (hole frame)."""
+    dmp = CartesianDMP(execution_time=float(times[-1]), dt=ROLLOUT_DT, n_weights_per_dim=N_WEIGHTS)
+    dmp.imitate(times, np.hstack([positions, xyzw_to_wxyz(quats_xyzw)]))
+    return dmp.get_weights()
+
+
+def skill_path(folder: Path, shape: str) -> Path:
+    return folder / "demonstrations" / f"{shape}.json"
+
+
+def save_skill(folder: Path, skill: Skill) -> Path:
+    path = skill_path(folder, skill.shape)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(skill.to_json(), indent=1) + "\n")
+    return path
+
+
+def load_skill(folder: Path, shape: str) -> Skill:
+    """The stored skill of a part shape; ExecutorError if it was never taught."""
+    path = skill_path(folder, shape)
+    if not path.is_file():
+        raise ExecutorError(
+            f"part shape '{shape}': no demonstration at {path} (expected one; run ./run.sh executor teach)")
+    return Skill.from_json(json.loads(path.read_text()))
+
+
+class PhaseClock:
+    """DMP time with phase stopping: t advances by dt / (1 + ‖ΔF‖ / F_slow) [s]."""
+
+    def __init__(self, times: np.ndarray, positions: np.ndarray, quats_xyzw: np.ndarray, f_slow: float) -> None:
+        self.times, self.positions, self.quats, self.f_slow = times, positions, quats_xyzw, f_slow
+        self.t = 0.0
+        self.duration = float(times[-1])
+
+    @property
+    def phase(self) -> float:
+        return min(1.0, self.t / self.duration)
+
+    @property
+    def done(self) -> bool:
+        return self.t >= self.duration
+
+    def advance(self, dt: float, force_deviation: float) -> None:
+        self.t = min(self.duration, self.t + dt / (1.0 + force_deviation / self.f_slow))
+
+    def pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Desired position [m] and quaternion xyzw at the current DMP time."""
+        k = min(int(self.t / ROLLOUT_DT), len(self.times) - 2)
+        a = (self.t - self.times[k]) / (self.times[k + 1] - self.times[k])
+        pos = (1 - a) * self.positions[k] + a * self.positions[k + 1]
+        quat = (1 - a) * self.quats[k] + a * self.quats[k + 1]
+        return pos, quat / np.linalg.norm(quat)

@@ -1,0 +1,246 @@
+"""Geometry of the simulated cell: dimensions from ``geometry.toml``, positions from
+``assembly.toml``, and the generated assets (plate mesh, part URDFs, arm+tool URDF).
+
+The back plate is a static concave triangle mesh (PyBullet's trimesh has effectively no
+collision margin, so 0.1 mm clearances are real): one square boss per hole with a blind
+hole, round holes as 64-gons whose inradius is the hole radius, square holes exact.
+Parts are exact primitive shapes (cylinder with ``URDF_USE_IMPLICIT_CYLINDER``, box).
+``write_assets`` regenerates ``data/<assembly>/assets/`` byte-for-byte deterministically.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pybullet_data
+
+from executor import ExecutorError
+
+DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+
+
+@dataclass(frozen=True)
+class HoleSpec:
+    """A hole: ``kind`` "round" (``size`` = diameter [m]) or "square" (side [m])."""
+
+    id: str
+    kind: str
+    size: float
+    position: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class PartSpec:
+    """A graspable part: cross-section ``kind``/``size`` [m], ``length`` [m], ``mass`` [kg],
+    ``start`` on the tray [m], ``demo_hole`` where its shape's skill is taught."""
+
+    id: str
+    shape: str
+    kind: str
+    size: float
+    length: float
+    mass: float
+    start: tuple[float, float]
+    demo_hole: str
+
+
+@dataclass(frozen=True)
+class CellGeometry:
+    """Everything the scene needs; ``plate`` and ``gripper`` are the toml tables as is."""
+
+    folder: Path
+    plate: dict
+    gripper: dict
+    holes: dict[str, HoleSpec]
+    parts: dict[str, PartSpec]
+
+    @property
+    def assets(self) -> Path:
+        return self.folder / "assets"
+
+
+def _read_toml(path: Path) -> dict:
+    if not path.is_file():
+        raise ExecutorError(f"{path}: no such file (expected the assembly's {path.name})")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
+
+
+def load_geometry(assembly: str = "cranfield") -> CellGeometry:
+    """Read ``assembly.toml`` + ``geometry.toml`` of a folder under ``data/`` (or a path)."""
+    folder = Path(assembly) if Path(assembly).is_dir() else DATA_DIR / assembly
+    if not (folder / "assembly.toml").is_file():
+        raise ExecutorError(f"assembly '{assembly}': no assembly.toml in {folder} (expected a folder under data/)")
+    layout = _read_toml(folder / "assembly.toml")
+    geo = _read_toml(folder / "geometry.toml")
+    holes: dict[str, HoleSpec] = {}
+    for shape in geo.get("hole_shapes", {}).values():
+        for hid in shape["holes"]:
+            if hid not in layout.get("holes", {}):
+                raise ExecutorError(f"geometry.toml: hole '{hid}' is not a hole of assembly.toml")
+            x, y = layout["holes"][hid]["position"]
+            holes[hid] = HoleSpec(hid, shape["kind"], float(shape["size"]), (float(x), float(y)))
+    starts = {pid: p.get("start") for pid, p in layout.get("parts", {}).items()}
+    starts |= {pid: p["start"] for pid, p in geo.get("extra_parts", {}).items()}
+    parts: dict[str, PartSpec] = {}
+    for name, shape in geo.get("part_shapes", {}).items():
+        for pid in shape["parts"]:
+            if starts.get(pid) is None:
+                raise ExecutorError(f"geometry.toml: part '{pid}' has no start position (expected [x, y] in m)")
+            x, y = starts[pid]
+            parts[pid] = PartSpec(
+                pid, name, shape["kind"], float(shape["size"]), float(shape["length"]), float(shape["mass"]),
+                (float(x), float(y)), shape["demo_hole"],
+            )
+    return CellGeometry(folder, geo["plate"], geo["gripper"], holes, parts)
+
+
+def _ring(kind: str, half: float, n: int) -> np.ndarray:
+    """(n, 2) boundary points at angles 2πk/n [m]: a 64-gon of inradius ``half`` or a square
+    of half side ``half`` (its corners are among the points since n is a multiple of 8)."""
+    angles = 2.0 * np.pi * np.arange(n) / n
+    c, s = np.cos(angles), np.sin(angles)
+    if kind == "round":
+        radius = np.full(n, half / math.cos(math.pi / n))
+    else:
+        radius = half / np.maximum(np.abs(c), np.abs(s))
+    return np.stack([radius * c, radius * s], axis=1)
+
+
+def _boss_triangles(hole: HoleSpec, plate: dict) -> list[np.ndarray]:
+    """Triangles (3×3 vertex arrays [m], outward normals) of one boss with its through
+    hole (the plate under the boss is the hole's bottom)."""
+    n = int(plate["polygon_sides"])
+    if n % 8:
+        raise ExecutorError(f"geometry.toml: polygon_sides = {n}, expected a multiple of 8")
+    cx, cy = hole.position
+    top = float(plate["top_z"])
+    bottom = top - float(plate["tile_thickness"])
+    outer = _ring("square", float(plate["tile_size"]) / 2, n) + (cx, cy)
+    inner = _ring(hole.kind, hole.size / 2, n) + (cx, cy)
+
+    def v(ring: np.ndarray, k: int, z: float) -> np.ndarray:
+        x, y = ring[k % n]
+        return np.array([x, y, z])
+
+    tris: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []  # (a, b, c, wanted normal)
+    centre_top = np.array([cx, cy, top])
+    up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
+    for k in range(n):
+        o0, o1, i0, i1 = v(outer, k, top), v(outer, k + 1, top), v(inner, k, top), v(inner, k + 1, top)
+        tris += [(o0, o1, i1, up), (o0, i1, i0, up)]
+        f0, f1 = v(inner, k, bottom), v(inner, k + 1, bottom)
+        wall_in = centre_top - (i0 + i1) / 2
+        tris += [(i0, i1, f1, wall_in), (i0, f1, f0, wall_in)]
+        b0, b1 = v(outer, k, bottom), v(outer, k + 1, bottom)
+        wall_out = (o0 + o1) / 2 - centre_top
+        tris += [(o0, o1, b1, wall_out), (o0, b1, b0, wall_out)]
+        tris += [(b0, b1, f1, down), (b0, f1, f0, down)]
+    out = []
+    for a, b, c, wanted in tris:
+        if np.dot(np.cross(b - a, c - a), wanted) < 0:
+            b, c = c, b
+        out.append(np.array([a, b, c]))
+    return out
+
+
+def plate_obj_text(geometry: CellGeometry) -> str:
+    """Wavefront OBJ of all hole bosses, in the cell frame [m] (vertices rounded to 1 µm)."""
+    lines = ["# generated by executor/geometry.py from geometry.toml and assembly.toml"]
+    count = 0
+    for hid in sorted(geometry.holes):
+        lines.append(f"o boss_{hid}")
+        for tri in _boss_triangles(geometry.holes[hid], geometry.plate):
+            lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in tri]
+            lines.append(f"f {count + 1} {count + 2} {count + 3}")
+            count += 3
+    return "\n".join(lines) + "\n"
+
+
+def part_geometry_xml(part: PartSpec, z_centre: float, rgba: str) -> str:
+    """URDF ``<visual>`` + ``<collision>`` of a part whose axis is z, centred at ``z_centre`` [m]."""
+    if part.kind == "round":
+        shape = f'<cylinder radius="{part.size / 2:.6f}" length="{part.length:.6f}"/>'
+    else:
+        shape = f'<box size="{part.size:.6f} {part.size:.6f} {part.length:.6f}"/>'
+    origin = f'<origin xyz="0 0 {z_centre:.6f}" rpy="0 0 0"/>'
+    return (
+        f"    <visual>{origin}<geometry>{shape}</geometry>"
+        f'<material name="part"><color rgba="{rgba}"/></material></visual>\n'
+        f"    <collision>{origin}<geometry>{shape}</geometry></collision>\n"
+    )
+
+
+def _inertial_xml(mass: float, inertia: float, z: float) -> str:
+    return (
+        f'    <inertial><origin xyz="0 0 {z:.6f}" rpy="0 0 0"/><mass value="{mass:.6f}"/>'
+        f'<inertia ixx="{inertia:.6f}" ixy="0" ixz="0" iyy="{inertia:.6f}" iyz="0" izz="{inertia:.6f}"/></inertial>\n'
+    )
+
+
+def part_urdf_text(part: PartSpec) -> str:
+    """A free part lying on the tray (upright, frame at its bottom face centre)."""
+    inertia = part.mass * (part.size**2 + part.length**2) / 12
+    return (
+        f'<?xml version="1.0"?>\n<robot name="{part.shape}">\n  <link name="part">\n'
+        + _inertial_xml(part.mass, inertia, part.length / 2)
+        + part_geometry_xml(part, part.length / 2, "0.8 0.6 0.2 1")
+        + "  </link>\n</robot>\n"
+    )
+
+
+# The flange link is attached 45 mm beyond joint 7 (the iiwa's flange face).
+_FLANGE_OFFSET = 0.045
+
+
+def arm_urdf_text(part: PartSpec, gripper: dict) -> str:
+    """The pybullet_data ``kuka_iiwa`` with a flange (realistic inertia) and the held part.
+
+    Links appended after ``lbr_iiwa_link_7``: ``flange`` (fixed) and ``part`` (fixed joint
+    ``ft_sensor``: the wrist force/torque sensor).  The ``part`` link frame is at the
+    part's tip (the tool centre point), z along the part axis, pointing away from the arm.
+    Mesh paths point into the installed pybullet_data, so the text is written at run time.
+    """
+    source = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
+    text = source.read_text().replace('filename="meshes/', f'filename="{source.parent}/meshes/')
+    flange_len = float(gripper["flange_length"])
+    tip = flange_len + part.length - float(gripper["grasp_depth"])
+    inertia = part.mass * (part.size**2 + part.length**2) / 12
+    tool = (
+        '  <joint name="flange_joint" type="fixed"><parent link="lbr_iiwa_link_7"/><child link="flange"/>'
+        f'<origin xyz="0 0 {_FLANGE_OFFSET}" rpy="0 0 0"/></joint>\n'
+        '  <link name="flange">\n'
+        + _inertial_xml(float(gripper["flange_mass"]), float(gripper["flange_inertia"]), flange_len / 2)
+        + f'    <visual><origin xyz="0 0 {flange_len / 2:.6f}" rpy="0 0 0"/><geometry>'
+        f'<cylinder radius="0.03" length="{flange_len:.6f}"/></geometry>'
+        '<material name="gripper"><color rgba="0.3 0.3 0.35 1"/></material></visual>\n'
+        "  </link>\n"
+        '  <joint name="ft_sensor" type="fixed"><parent link="flange"/><child link="part"/>'
+        f'<origin xyz="0 0 {tip:.6f}" rpy="0 0 0"/></joint>\n'
+        '  <link name="part">\n'
+        + _inertial_xml(part.mass, inertia, -part.length / 2)
+        + part_geometry_xml(part, -part.length / 2, "0.8 0.6 0.2 1")
+        + "  </link>\n"
+    )
+    return text.replace("</robot>", tool + "</robot>")
+
+
+def write_assets(geometry: CellGeometry) -> list[Path]:
+    """(Re)generate ``assets/plate.obj`` and ``assets/part_<shape>.urdf``; returns the paths."""
+    geometry.assets.mkdir(parents=True, exist_ok=True)
+    written = []
+    plate = geometry.assets / "plate.obj"
+    plate.write_text(plate_obj_text(geometry))
+    written.append(plate)
+    for shape in sorted({p.shape for p in geometry.parts.values()}):
+        part = next(p for p in geometry.parts.values() if p.shape == shape)
+        path = geometry.assets / f"part_{shape}.urdf"
+        path.write_text(part_urdf_text(part))
+        written.append(path)
+    return written

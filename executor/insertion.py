@@ -1,0 +1,85 @@
+"""The insertion proper (paper 3.2 steps 2–4): the taught DMP from where the search ended
+to the goal, adapted on-line toward the reference wrench (admittance), slowed by phase
+stopping, monitored by eqs. (6)/(7), with the wiggle exception strategy on a breach and
+the goal check at the end."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as pb
+
+from executor.admittance import Admittance
+from executor.detector import Detector
+from executor.dmp import PhaseClock, Skill
+from executor.motion import Motion
+from executor.scene import TIME_STEP
+from executor.wiggle import wiggle
+
+# The insertion gives up when phase stopping has stretched it beyond this many τ.
+TIMEOUT_FACTOR = 3.0
+SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
+MAX_WIGGLES = 1  # exception strategy runs per attempt
+
+
+@dataclass
+class InsertionResult:
+    """``completed``: the DMP ran to its end without a lasting eq. (6)/(7) breach;
+    ``reached``: goal check passed; ``end_error`` ‖p_end − p_goal‖ [m]."""
+
+    completed: bool
+    reached: bool
+    end_error: float
+    jammed: bool
+    wiggles: int
+    phase_reached: float
+
+
+def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
+    """Quaternion (x, y, z, w) of a rotation vector [rad]."""
+    angle = float(np.linalg.norm(rotvec))
+    if angle < 1e-12:
+        return np.array([0.0, 0.0, 0.0, 1.0])
+    return np.concatenate([np.sin(angle / 2) * rotvec / angle, [math.cos(angle / 2)]])
+
+
+def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector, admittance: Admittance,
+           rim_radius: float, wiggle_enabled: bool = True) -> InsertionResult:
+    """Run the skill in the hole frame at ``hole_origin`` (hole centre on the plate top,
+    [m]) starting from the current tip pose."""
+    s = motion.controller.arm.read()
+    goal = skill.demo_goal
+    times, pos, quats = skill.rollout(s.tip_pos - hole_origin, s.tip_quat_xyzw, goal[:3],
+                                      np.roll(goal[3:], -1))
+    clock = PhaseClock(times, pos + hole_origin, quats, detector.thresholds.f_slow)
+    d_pos, d_rot = np.zeros(3), np.zeros(3)
+    wiggles, jammed, completed = 0, False, True
+    budget = int(TIMEOUT_FACTOR * clock.duration / TIME_STEP)
+    for _ in range(budget):
+        if clock.done:
+            break
+        pos_d, quat_d = clock.pose()
+        w_des = skill.wrench(clock.phase)
+        quat_cmd = np.array(pb.multiplyTransforms((0, 0, 0), rotvec_quat_xyzw(d_rot), (0, 0, 0), quat_d)[1])
+        s = motion.step(pos_d + d_pos, quat_cmd, phase=clock.phase, wrench_des=w_des)
+        f_dev, m_dev = s.force - w_des[:3], s.torque - w_des[3:]
+        f_norm, _, violated = detector.update(f_dev, m_dev)
+        d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
+        if violated:
+            jammed = True
+            if not wiggle_enabled or wiggles >= MAX_WIGGLES:
+                completed = False
+                break
+            wiggle(motion, pos_d + d_pos, quat_cmd, rim_radius, clock.phase, w_des)
+            wiggles += 1
+            detector.clear()
+            continue
+        clock.advance(TIME_STEP, f_norm)
+    else:
+        completed = False
+    pos_d, quat_d = clock.pose()
+    end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
+    reached, err = detector.goal_reached(end.tip_pos, hole_origin + skill.end_position)
+    return InsertionResult(completed, completed and reached, err, jammed, wiggles, clock.phase)

@@ -1,0 +1,131 @@
+"""The PyBullet world of the cell: floor, back plate with real holes, parts on the tray,
+and the arm holding one part.
+
+Physics: 1 kHz time step (torque control needs it), gravity, and
+``deterministicOverlappingPairs`` so that a seed replays bit for bit.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import pybullet as pb
+import pybullet_data
+
+from executor import ExecutorError
+from executor.geometry import CellGeometry, PartSpec, arm_urdf_text, write_assets
+
+TIME_STEP = 0.001  # [s]
+# Parked parts (the one in the hand) wait here, out of the way [m].
+_PARKED = (0.0, -2.0, 0.05)
+
+
+class Scene:
+    """A PyBullet client with the static cell; ``hold(part)`` puts a part in the hand."""
+
+    def __init__(self, geometry: CellGeometry, gui: bool = False) -> None:
+        self.geometry = geometry
+        self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
+        if self.client < 0:
+            raise ExecutorError("could not connect to PyBullet (GUI requested without a display?)")
+        pb.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=self.client)
+        pb.setTimeStep(TIME_STEP, physicsClientId=self.client)
+        pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
+        pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=self.client)
+        plate_obj = geometry.assets / "plate.obj"
+        if not plate_obj.is_file():
+            write_assets(geometry)
+        self.floor = pb.loadURDF("plane.urdf", physicsClientId=self.client)
+        self.plate = self._load_plate(plate_obj)
+        self.tray_parts = {
+            pid: pb.loadURDF(
+                str(geometry.assets / f"part_{spec.shape}.urdf"),
+                basePosition=(*spec.start, 0.0),
+                useFixedBase=True,
+                flags=pb.URDF_USE_IMPLICIT_CYLINDER,
+                physicsClientId=self.client,
+            )
+            for pid, spec in sorted(geometry.parts.items())
+        }
+        self._tmp = tempfile.TemporaryDirectory(prefix="executor-arm-")
+        self.robot: int | None = None
+        self.robot_shape: str | None = None
+        self.held: str | None = None
+
+    def _load_plate(self, plate_obj: Path) -> int:
+        """Static plate: a box under the bosses plus the concave trimesh of the bosses."""
+        plate = self.geometry.plate
+        boss_bottom = plate["top_z"] - plate["tile_thickness"]
+        (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
+        half = (sx / 2, sy / 2, boss_bottom / 2)
+        base_col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.client)
+        base_vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=(0.55, 0.6, 0.65, 1),
+                                        physicsClientId=self.client)
+        mesh_col = pb.createCollisionShape(pb.GEOM_MESH, fileName=str(plate_obj),
+                                           flags=pb.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=self.client)
+        mesh_vis = pb.createVisualShape(pb.GEOM_MESH, fileName=str(plate_obj), rgbaColor=(0.7, 0.72, 0.75, 1),
+                                        physicsClientId=self.client)
+        return pb.createMultiBody(
+            baseMass=0, baseCollisionShapeIndex=mesh_col, baseVisualShapeIndex=mesh_vis,
+            linkMasses=[0], linkCollisionShapeIndices=[base_col], linkVisualShapeIndices=[base_vis],
+            linkPositions=[(cx, cy, boss_bottom / 2)], linkOrientations=[(0, 0, 0, 1)],
+            linkInertialFramePositions=[(0, 0, 0)], linkInertialFrameOrientations=[(0, 0, 0, 1)],
+            linkParentIndices=[0], linkJointTypes=[pb.JOINT_FIXED], linkJointAxis=[(0, 0, 1)],
+            physicsClientId=self.client,
+        )
+
+    def hold(self, part: PartSpec) -> int:
+        """Put ``part`` in the gripper (reloading the arm if the part shape changes); the
+        tray copy is parked out of sight.  Returns the robot body id."""
+        if self.robot_shape != part.shape:
+            if self.robot is not None:
+                pb.removeBody(self.robot, physicsClientId=self.client)
+            urdf = Path(self._tmp.name) / f"arm_{part.shape}.urdf"
+            urdf.write_text(arm_urdf_text(part, self.geometry.gripper))
+            self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
+                                     flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
+                                     physicsClientId=self.client)
+            self.robot_shape = part.shape
+        self.release()
+        pb.resetBasePositionAndOrientation(self.tray_parts[part.id], _PARKED, (0, 0, 0, 1),
+                                           physicsClientId=self.client)
+        self.held = part.id
+        assert self.robot is not None
+        return self.robot
+
+    def release(self) -> None:
+        """The held part goes back to its start on the tray."""
+        if self.held is not None:
+            spec = self.geometry.parts[self.held]
+            pb.resetBasePositionAndOrientation(self.tray_parts[self.held], (*spec.start, 0.0), (0, 0, 0, 1),
+                                               physicsClientId=self.client)
+            self.held = None
+
+    def close(self) -> None:
+        if pb.isConnected(self.client):
+            pb.disconnect(self.client)
+        self._tmp.cleanup()
+
+
+def scene_shapes(geometry: CellGeometry) -> list[tuple]:
+    """Static bodies for the Rerun log: ``(name, "box"|"cylinder", half_extents [m],
+    position [m], quat_xyzw, rgb)``: the plate, each hole (as the cavity), the tray parts."""
+    plate = geometry.plate
+    boss_bottom = plate["top_z"] - plate["tile_thickness"]
+    (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
+    shapes: list[tuple] = [("plate", "box", (sx / 2, sy / 2, boss_bottom / 2), (cx, cy, boss_bottom / 2),
+                            (0, 0, 0, 1), (140, 150, 165))]
+    half_tile, half_thick = plate["tile_size"] / 2, plate["tile_thickness"] / 2
+    for hid, hole in sorted(geometry.holes.items()):
+        shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
+                       (*hole.position, plate["top_z"] - half_thick), (0, 0, 0, 1), (180, 185, 190)))
+        half_depth = plate["tile_thickness"] / 2
+        r = hole.size / 2
+        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (r, r, half_depth),
+                       (*hole.position, plate["top_z"] - half_depth), (0, 0, 0, 1), (40, 40, 40)))
+    for pid, part in sorted(geometry.parts.items()):
+        r = part.size / 2
+        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (r, r, part.length / 2),
+                       (*part.start, part.length / 2), (0, 0, 0, 1), (205, 155, 50)))
+    return shapes

@@ -1,0 +1,83 @@
+"""Stochastic hole search around the vision estimate (paper 3.2 step 1).
+
+The tip comes down on the estimate until it touches the plate (or drops straight into
+the hole), then slides over the surface under a light contact force along an
+Archimedean spiral whose start angle, direction and pitch are drawn at random.  The
+hole is found when the tip sinks ``sink_depth`` below the surface: a part that is too
+big never sinks, so the search gives up at ``max_radius`` and the insertion is tried at
+the estimate (and fails there).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from executor.motion import Motion
+from executor.scene import TIME_STEP
+
+
+@dataclass(frozen=True)
+class SearchParams:
+    """Approach speed [m/s], contact force that means "on the surface" [N], how far
+    below the surface the tip is pushed while sliding [m] (× 2000 N/m = contact force),
+    sink depth that means "in the hole" [m], spiral pitch [m] (± ``pitch_jitter``),
+    sliding speed [m/s], search radius [m] and time limit [s]."""
+
+    approach_speed: float = 0.02
+    contact_force: float = 2.0
+    press_depth: float = 0.0025
+    sink_depth: float = 0.0012
+    pitch: float = 0.0012
+    pitch_jitter: float = 0.2
+    speed: float = 0.025
+    max_radius: float = 0.0045
+    max_time: float = 1.6
+
+
+@dataclass
+class SearchResult:
+    """``found``: the tip sank into a hole at ``hole_xy`` [m]; ``path`` (N×3) [m]."""
+
+    found: bool
+    hole_xy: np.ndarray
+    surface_z: float
+    path: np.ndarray
+
+
+def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: float, quat_xyzw: np.ndarray,
+                rng: np.random.Generator, params: SearchParams = SearchParams()) -> SearchResult:
+    """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m]."""
+    p = params
+    path: list[np.ndarray] = []
+    target_z = surface_z - p.press_depth
+    # 1. Approach: straight down on the estimate.
+    z = start_z
+    while True:
+        z = max(target_z, z - p.approach_speed * TIME_STEP)
+        s = motion.step(np.array([est_xy[0], est_xy[1], z]), quat_xyzw)
+        if s.tip_pos[2] < surface_z - p.sink_depth:
+            return SearchResult(True, s.tip_pos[:2].copy(), surface_z, np.array([s.tip_pos]))
+        if s.force[2] > p.contact_force or (z == target_z and abs(s.tip_vel[2]) < 1e-3):
+            break
+    # 2. Spiral under contact: r = pitch·θ/2π, constant sliding speed.
+    angle0 = rng.uniform(0, 2 * math.pi)
+    direction = rng.choice([-1.0, 1.0])
+    pitch = p.pitch * (1 + rng.uniform(-p.pitch_jitter, p.pitch_jitter))
+    theta, elapsed = 0.0, 0.0
+    while elapsed < p.max_time:
+        radius = pitch * theta / (2 * math.pi)
+        if radius > p.max_radius:
+            break
+        theta += p.speed * TIME_STEP / max(radius, pitch / 2)
+        offset = radius * np.array([math.cos(angle0 + direction * theta), math.sin(angle0 + direction * theta)])
+        s = motion.step(np.array([est_xy[0] + offset[0], est_xy[1] + offset[1], target_z]), quat_xyzw)
+        elapsed += TIME_STEP
+        if motion.steps % 10 == 0:
+            path.append(s.tip_pos.copy())
+        if s.tip_pos[2] < surface_z - p.sink_depth:
+            path.append(s.tip_pos.copy())
+            return SearchResult(True, s.tip_pos[:2].copy(), surface_z, np.array(path))
+    return SearchResult(False, np.asarray(est_xy, dtype=float).copy(), surface_z, np.array(path).reshape(-1, 3))

@@ -1,0 +1,109 @@
+"""Scripted kinesthetic teaching (paper 3.1), one skill per part shape.
+
+Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path from
+4 mm above the hole of the shape's ``demo_hole`` (exactly aligned, perfect grasp) down to
+2 mm below the hole's bottom, i.e. pressing the part onto the bottom; the tip poses are
+recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
+executed by the impedance controller alone and the wrench it meets is recorded: the
+reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
+replay ends is p_goal.  ``./run.sh executor teach`` rebuilds
+``data/<assembly>/demonstrations/<shape>.json``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from executor.arm import TOOL_DOWN_QUAT_XYZW
+from executor.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
+from executor.geometry import write_assets
+from executor.motion import Motion
+from executor.scene import TIME_STEP
+from executor.trial import SETTLE_TIME, Cell
+
+DEMO_DURATION = 1.0  # [s]
+DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole
+DEMO_PRESS = 0.002  # [m] commanded beyond the hole bottom at the end
+
+
+def _min_jerk(s: np.ndarray) -> np.ndarray:
+    return 10 * s**3 - 15 * s**4 + 6 * s**5
+
+
+def _demonstrate(motion: Motion, origin: np.ndarray, bottom: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Guide the tip down into the hole; returns recorded times [s], positions (hole frame)
+    [m] and quaternions (xyzw)."""
+    quat = TOOL_DOWN_QUAT_XYZW
+    n = int(round(DEMO_DURATION / TIME_STEP))
+    z = DEMO_START_HEIGHT + (-(bottom + DEMO_PRESS) - DEMO_START_HEIGHT) * _min_jerk(np.linspace(0, 1, n))
+    times, positions, quats = [], [], []
+    for k in range(n):
+        s = motion.step(origin + np.array([0.0, 0.0, z[k]]), quat)
+        times.append(k * TIME_STEP)
+        positions.append(s.tip_pos - origin)
+        quats.append(s.tip_quat_xyzw)
+    return np.array(times), np.array(positions), np.array(quats)
+
+
+def _replay(motion: Motion, skill: Skill, origin: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Run the DMP without adaptation; returns phases, wrenches (N, 6) [N, Nm] and the
+    end position (hole frame) [m]."""
+    times, pos, quats = skill.rollout(skill.demo_start[:3], np.roll(skill.demo_start[3:], -1),
+                                      skill.demo_goal[:3], np.roll(skill.demo_goal[3:], -1))
+    clock = PhaseClock(times, pos + origin, quats, f_slow=1.0)
+    phases, wrenches = [], []
+    while not clock.done:
+        p, q = clock.pose()
+        s = motion.step(p, q, phase=clock.phase)
+        phases.append(clock.phase)
+        wrenches.append(np.concatenate([s.force, s.torque]))
+        clock.advance(TIME_STEP, 0.0)
+    p, q = clock.pose()
+    end = motion.hold(p, q, SETTLE_TIME)
+    return np.array(phases), np.array(wrenches), end.tip_pos - origin
+
+
+def teach_shape(cell: Cell, shape: str) -> Skill:
+    """Demonstrate, encode and replay the skill of one part shape."""
+    geometry = cell.geometry
+    part = next(p for pid, p in sorted(geometry.parts.items()) if p.shape == shape)
+    hole = geometry.holes[part.demo_hole]
+    origin = np.array([*hole.position, float(geometry.plate["top_z"])])
+    bottom = float(geometry.plate["tile_thickness"])
+    motion = cell.motion_for(part.id)
+    arm = motion.controller.arm
+    arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+    start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
+
+    def go_to_start() -> None:
+        arm.inverse_kinematics(start, TOOL_DOWN_QUAT_XYZW)
+        motion.hold(start, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
+        arm.tare_sensor()
+
+    go_to_start()
+    times, positions, quats = _demonstrate(motion, origin, bottom)
+    weights = fit_dmp(times, positions, quats)
+    skill = Skill(shape, float(times[-1]), weights,
+                  np.concatenate([positions[0], xyzw_to_wxyz(quats[0])]),
+                  np.concatenate([positions[-1], xyzw_to_wxyz(quats[-1])]),
+                  np.zeros(3), WrenchProfile.fit(np.zeros(1), np.zeros((1, 6))))
+    go_to_start()
+    phases, wrenches, end = _replay(motion, skill, origin)
+    skill.wrench = WrenchProfile.fit(phases, wrenches)
+    skill.end_position = end
+    cell.scene.release()
+    return skill
+
+
+def teach_all(assembly: str = "cranfield") -> list[Path]:
+    """Regenerate the assets and teach every part shape; returns the written files."""
+    cell = Cell(assembly)
+    try:
+        written = write_assets(cell.geometry)
+        for shape in sorted({p.shape for p in cell.geometry.parts.values()}):
+            written.append(save_skill(cell.geometry.folder, teach_shape(cell, shape)))
+    finally:
+        cell.close()
+    return written
