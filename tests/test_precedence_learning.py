@@ -42,6 +42,16 @@ def test_cranfield_demonstrations_learn_the_true_relation_exactly() -> None:
     assert count_linear_extensions(learned) == 5320
 
 
+def test_cranfield_demonstrations_hold_two_realizers_and_no_suspect() -> None:
+    cranfield = load_assembly("cranfield")
+    demos = load_demos(cranfield.file("demos.txt"), cranfield.part_ids)
+    assert suspects(demos) == []
+    by_line = {origin.rsplit(":", 1)[1]: s for origin, s in zip(demos.origins, demos.sequences)}
+    for lines in (("7", "9"), ("8", "10")):  # as the file's comment says
+        pair = Demonstrations(demos.parts, tuple(by_line[n] for n in lines), lines)
+        assert learn_must_precede(pair).same_as(true_relation(cranfield))
+
+
 @settings(max_examples=60, deadline=None)
 @given(poset_with_demos())
 def test_learned_contains_truth_admits_demos_and_only_feasible_sequences(case: tuple[Relation, list]) -> None:
