@@ -68,3 +68,15 @@ def test_every_subcommand_has_help(command: str) -> None:
 def test_count_needs_exactly_one_source() -> None:
     result = run_cli("precedence", "count")
     assert result.returncode == 2 and "expected either --assembly A or facts files" in result.stderr
+
+
+def test_learn_evidence_flags_a_wrong_demonstration_and_min_support_keeps_its_constraint(tmp_path: Path) -> None:
+    path = tmp_path / "demos.txt"
+    path.write_text("o r1 i1 r2 i2\no r2 i2 r1 i1\no r1 i1 r2 i2\no r2 i2 r1 i1\no i1 r1 r2 i2\n")
+    result = run_cli("precedence", "learn", str(path), "--json", "--evidence", "--min-support", "2")
+    data = json.loads(result.stdout)
+    assert set(data) == {"parts", "must_precede", "reduction", "admitted", "evidence", "suspects"}
+    assert data["suspects"] == [{"line": f"{path}:5", "removes": [["r1", "i1"]]}]
+    assert ["r1", "i1"] in data["must_precede"] and data["admitted"] == 6
+    assert {"pair": ["r1", "i1"], "support": 4, "contradict": 1} in data["evidence"]
+    assert f"warning: {path}:5:" in result.stderr
