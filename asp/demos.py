@@ -25,6 +25,7 @@ from asp.facts import atoms_by_name, fact, load_atoms
 
 _ID = re.compile(r"^[a-z][a-zA-Z0-9_]*$")
 _SEPARATOR = re.compile(r"[\s,]+")
+_CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
 
 
 @dataclass(frozen=True)
@@ -63,9 +64,10 @@ def _text(path: Path) -> str:
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise PlannerError(f"{path}:{line}: binary data, expected text (part ids separated by spaces or commas)") from None
-    if "\x00" in text:
-        line = text[: text.index("\x00")].count("\n") + 1
-        raise PlannerError(f"{path}:{line}: binary data (NUL byte), expected text (part ids separated by spaces or commas)")
+    control = _CONTROL.search(text)
+    if control:
+        line = text[: control.start()].count("\n") + 1
+        raise PlannerError(f"{path}:{line}: binary data (control character {control.group()!r}), expected text (part ids separated by spaces or commas)")
     return text
 
 

@@ -50,9 +50,10 @@ def test_binary_garbage_is_rejected_with_its_line(tmp_path: Path) -> None:
     path.write_bytes(b"a b c\n\xff\xfe\x00garbage\n")
     with pytest.raises(PlannerError, match=r"demos\.txt:2: binary data"):
         load_demos(path)
-    path.write_bytes(b"a b c\na\x00b c\n")
-    with pytest.raises(PlannerError, match=r"demos\.txt:2: binary data"):
-        load_demos(path)
+    for garbage in (b"a\x00b c", b"a \x01\x02 b c"):
+        path.write_bytes(b"a b c\n" + garbage + b"\n")
+        with pytest.raises(PlannerError, match=r"demos\.txt:2: binary data"):
+            load_demos(path)
 
 
 def test_demo_facts_round_trip(tmp_path: Path) -> None:
