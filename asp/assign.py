@@ -1,0 +1,161 @@
+"""Hole assignment (paper 2.2, end): the paper's greedy assignment and all feasible ones.
+
+Input are learned facts files in the DESIGN.md vocabulary: ``part/1``, ``hole/1``,
+``fits/2`` (and ``no_fit/2``, ``needs_hole/1``, ``must_precede/2``...). A part *needs a
+hole* when it has a ``fits/2`` or ``no_fit/2`` fact or a ``needs_hole/1`` fact
+(``asp/encodings/needs_hole.lp``); every other part (Cranfield: bp sp pd ph fp) is
+placed without a hole.
+
+- :func:`greedy_assignment`: the paper's greedy: the biggest unassigned part gets a free
+  hole big enough for it. Sizes come from the learned relation: a part is the bigger
+  the fewer holes it fits, a hole the bigger the more parts fit it. The part takes the
+  smallest free hole it fits (ties: lower id), which keeps the big holes for the big
+  parts. When the sizes are a biorder (what the size learner assumes, paper 2.2) this
+  finds an assignment whenever one exists.
+- :func:`all_assignments`: every feasible assignment, by ASP (``assignments.lp``).
+
+An assembly without an assignment raises :class:`UnsolvableAssembly` naming the part
+that gets no hole.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import clingo
+
+from asp import PlannerError
+from asp.facts import atoms_by_name, format_facts, load_atoms
+
+Assignment = dict[str, str]
+"""Part id -> hole id, for the parts that need a hole."""
+
+
+class UnsolvableAssembly(PlannerError):
+    """No feasible hole assignment; ``part`` is the part that gets no hole."""
+
+    def __init__(self, part: str, message: str) -> None:
+        super().__init__(message)
+        self.part = part
+
+
+@dataclass(frozen=True)
+class LearnedFacts:
+    """What the planner knows, read from learned facts files.
+
+    ``atoms`` are all atoms of the files plus ``needs_hole/1``; the other fields are the
+    same knowledge as Python values (ids as strings, sorted).
+    """
+
+    atoms: tuple[clingo.Symbol, ...]
+    parts: tuple[str, ...]
+    holes: tuple[str, ...]
+    fits: frozenset[tuple[str, str]]
+    needs_hole: tuple[str, ...]
+    must_precede: frozenset[tuple[str, str]]
+
+    def holes_of(self, part: str) -> list[str]:
+        """The holes ``part`` fits, sorted."""
+        return [hole for hole in self.holes if (part, hole) in self.fits]
+
+
+def encoding_text(name: str) -> str:
+    """The text of ``asp/encodings/<name>`` (found with importlib.resources)."""
+    return (resources.files("asp") / "encodings" / name).read_text(encoding="utf-8")
+
+
+def solve_encoding(
+    entry: str,
+    atoms: Sequence[clingo.Symbol],
+    arguments: Sequence[str],
+    on_model: Callable[[clingo.Model], None],
+) -> clingo.SolveResult:
+    """Ground the entry encoding with the atoms as facts, solve, call ``on_model``."""
+    ctl = clingo.Control(list(arguments))
+    with resources.as_file(resources.files("asp") / "encodings" / entry) as path:
+        ctl.load(str(path))
+    ctl.add("base", [], format_facts(atoms))
+    ctl.ground([("base", [])])
+    return ctl.solve(on_model=on_model)
+
+
+def _check_ids(facts: LearnedFacts, sources: str) -> None:
+    known_parts, known_holes = set(facts.parts), set(facts.holes)
+    for part, hole in sorted(facts.fits):
+        if part not in known_parts or hole not in known_holes:
+            raise PlannerError(
+                f"{sources}: fits({part},{hole}): expected a part/1 and a hole/1 "
+                f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
+            )
+    for first, then in sorted(facts.must_precede):
+        for part in (first, then):
+            if part not in known_parts:
+                raise PlannerError(
+                    f"{sources}: must_precede({first},{then}): {part} is not a part/1 "
+                    f"(parts: {' '.join(facts.parts)})"
+                )
+
+
+def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
+    """Read learned facts files; PlannerError on a file that does not parse or unknown ids."""
+    sources = ", ".join(str(p) for p in paths)
+    atoms = load_atoms(paths, extra=encoding_text("needs_hole.lp"))
+    facts = LearnedFacts(
+        atoms=tuple(atoms),
+        parts=tuple(p for (p,) in atoms_by_name(atoms, "part", 1)),
+        holes=tuple(h for (h,) in atoms_by_name(atoms, "hole", 1)),
+        fits=frozenset((p, h) for p, h in atoms_by_name(atoms, "fits", 2)),
+        needs_hole=tuple(p for (p,) in atoms_by_name(atoms, "needs_hole", 1)),
+        must_precede=frozenset((a, b) for a, b in atoms_by_name(atoms, "must_precede", 2)),
+    )
+    if not facts.parts:
+        raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
+    _check_ids(facts, sources)
+    return facts
+
+
+def greedy_assignment(facts: LearnedFacts) -> Assignment:
+    """The paper's greedy assignment; UnsolvableAssembly naming the part left without a hole."""
+    holes_of = {part: facts.holes_of(part) for part in facts.needs_hole}
+    parts_in = {hole: sum(hole in holes for holes in holes_of.values()) for hole in facts.holes}
+    biggest_first = sorted(facts.needs_hole, key=lambda part: (len(holes_of[part]), part))
+    assignment: Assignment = {}
+    taken_by: dict[str, str] = {}
+    for part in biggest_first:
+        free = [hole for hole in holes_of[part] if hole not in taken_by]
+        if not free:
+            raise UnsolvableAssembly(part, _no_hole_message(part, holes_of[part], taken_by))
+        hole = min(free, key=lambda h: (parts_in[h], h))
+        assignment[part] = hole
+        taken_by[hole] = part
+    return assignment
+
+
+def _no_hole_message(part: str, fitting: list[str], taken_by: dict[str, str]) -> str:
+    if not fitting:
+        return f"the assembly is not solvable: part {part} fits no hole"
+    taken = ", ".join(f"{hole} by {taken_by[hole]}" for hole in fitting)
+    return (
+        f"the assembly is not solvable: part {part} gets no hole; the holes it fits are "
+        f"taken by bigger parts ({taken})"
+    )
+
+
+def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:
+    """Every feasible assignment (at most ``limit``, 0 = all), sorted.
+
+    UnsolvableAssembly naming the part without a hole when there is none.
+    """
+    found: list[Assignment] = []
+
+    def keep(model: clingo.Model) -> None:
+        found.append(dict(atoms_by_name(model.symbols(shown=True), "assigned", 2)))
+
+    solve_encoding("assignments.lp", facts.atoms, [f"--models={limit}"], keep)
+    if not found:
+        # No assignment at all: the greedy one fails too and names the part.
+        return [greedy_assignment(facts)]
+    return sorted(found, key=lambda a: sorted(a.items()))
