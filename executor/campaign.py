@@ -22,13 +22,15 @@ Prints the table (1st-trial successes, successes after the 2nd trial, correct
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import json
 import multiprocessing
+import os
 import statistics
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -232,7 +234,7 @@ def timed_campaign(
 def format_table(stats: Sequence[PairStats]) -> str:
     """The Fig. 18 table (fitting pairs) followed by the non-fitting pairs."""
     header = (
-        f"{'object':<16} {'hole':<15} {'fits':<4} {'n':>3} {'1st trial':>9} "
+        f"{'object':<18} {'hole':<20} {'fits':<4} {'n':>3} {'1st trial':>9} "
         f"{'after 2nd':>9} {'correct':>7} {'ratio %':>7} {'median s':>8}"
     )
     lines = [header, "-" * len(header)]
@@ -240,8 +242,8 @@ def format_table(stats: Sequence[PairStats]) -> str:
         first = f"{s.first_trial:>9}" if s.fits else f"{'-':>9}"
         second = f"{s.after_second:>9}" if s.fits else f"{'-':>9}"
         lines.append(
-            f"{PART_NAMES.get(s.part, s.part) + ' ' + s.part:<16} "
-            f"{HOLE_NAMES.get(s.hole, s.hole) + ' ' + s.hole:<15} {'yes' if s.fits else 'no':<4} "
+            f"{PART_NAMES.get(s.part, s.part) + ' ' + s.part:<18} "
+            f"{HOLE_NAMES.get(s.hole, s.hole) + ' ' + s.hole:<20} {'yes' if s.fits else 'no':<4} "
             f"{s.trials:>3} {first} {second} {s.correct:>7} {100 * s.correct_ratio:>7.1f} "
             f"{s.median_duration_s:>8.2f}"
         )
@@ -282,15 +284,18 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
     args = build_parser().parse_args(list(argv))
-    run = timed_campaign(
-        select_pairs(args.pairs), args.trials, args.seed, args.workers,
-        functools.partial(CellRunner, args.assembly), progress=_progress_printer(),
-    )
-    report = campaign_report(run, args.seed, args.workers)
-    if args.plot:
-        from executor.campaign_plots import write_plots
+    pairs = select_pairs(args.pairs)
+    with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
+        run = timed_campaign(
+            pairs, args.trials, args.seed, args.workers,
+            functools.partial(CellRunner, args.assembly), progress=_progress_printer(),
+        )
+        report = campaign_report(run, args.seed, args.workers)
+        if args.plot:
+            from executor.campaign_plots import write_plots
 
-        report["plots"] = [str(p) for p in write_plots(Path(args.plot), run.stats, args.assembly, args.seed)]
+            plots = write_plots(Path(args.plot), run.stats, args.assembly, args.seed)
+            report["plots"] = [str(p) for p in plots]
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -303,6 +308,21 @@ def main(argv: Sequence[str]) -> int:
         for path in report.get("plots", []):
             print(f"wrote {path}")
     return 0 if report["all_correct"] else 1
+
+
+@contextlib.contextmanager
+def stdout_to_stderr() -> Iterator[None]:
+    """Send file descriptor 1 to stderr meanwhile (also for child processes started
+    meanwhile), so that C libraries' prints cannot mix into the table or the JSON."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def _progress_printer() -> Callable[[int, int], None] | None:
