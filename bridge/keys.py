@@ -1,0 +1,54 @@
+"""Every Zenoh key expression of the project, in one place.
+
+A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert`` and holds the
+liveliness token ``cell/<id>/alive`` while it is up; ``cell/<id>/ping`` echoes its payload. The planner discovers cells by
+subscribing to ``cell/*/alive``.
+"""
+
+from __future__ import annotations
+
+import re
+
+from bridge import BridgeError
+
+CELL_ID_PATTERN = r"^[a-z][a-z0-9_-]{0,31}$"
+"""A cell id: lower-case letter, then up to 31 of ``[a-z0-9_-]`` (one key chunk)."""
+
+ALIVE_PATTERN = "cell/*/alive"
+"""Liveliness key expression matching every cell's token."""
+
+_CELL_ID = re.compile(CELL_ID_PATTERN)
+_ALIVE_KEY = re.compile(r"^cell/([^/]+)/alive$")
+
+
+def check_cell_id(cell_id: str) -> str:
+    """Return ``cell_id`` if it is a valid cell id, else raise BridgeError."""
+    if not _CELL_ID.match(cell_id):
+        raise BridgeError(
+            f"cell id {cell_id!r}: expected a lower-case letter then up to 31 of [a-z0-9_-]"
+        )
+    return cell_id
+
+
+def insert_key(cell_id: str) -> str:
+    """Queryable key on which cell ``cell_id`` serves insertion experiments."""
+    return f"cell/{check_cell_id(cell_id)}/insert"
+
+
+def alive_key(cell_id: str) -> str:
+    """Liveliness token key held by cell ``cell_id`` while it serves."""
+    return f"cell/{check_cell_id(cell_id)}/alive"
+
+
+def ping_key(cell_id: str) -> str:
+    """Queryable key on which cell ``cell_id`` echoes the payload unread (diagnostics,
+    bare round-trip measurement)."""
+    return f"cell/{check_cell_id(cell_id)}/ping"
+
+
+def cell_of_alive_key(key: str) -> str | None:
+    """The cell id of a liveliness key ``cell/<id>/alive``; None for any other key."""
+    match = _ALIVE_KEY.match(key)
+    if match is None or not _CELL_ID.match(match.group(1)):
+        return None
+    return match.group(1)

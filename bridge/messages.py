@@ -1,0 +1,127 @@
+"""Typed, versioned JSON messages between the planner and the cells.
+
+Every message is a msgspec struct serialised as a JSON object with a ``kind`` tag and a
+protocol version ``v``. Payloads are size-capped (:data:`MAX_MESSAGE_BYTES`) and
+validated on receipt: types, identifier patterns, ranges and the version. Nothing in a
+message is ever executed; ids are matched against fixed patterns before use.
+
+- :class:`InsertRequest` (planner → cell): insert ``part`` into ``hole``;
+- :class:`InsertReply` (cell → planner): the outcome ``fit``/``no_fit`` and its evidence;
+- :class:`ErrorReply` (cell → planner): the request was refused, with a reason code.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Final, Literal
+
+import msgspec
+
+from bridge import BridgeError
+
+PROTOCOL_VERSION: Final = 1
+MAX_MESSAGE_BYTES: Final = 16 * 1024
+"""Largest accepted payload [bytes]; bigger messages are refused unread."""
+
+RequestId = Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z0-9_.:-]{1,128}$")]
+AspId = Annotated[str, msgspec.Meta(pattern=r"^[a-z][a-zA-Z0-9_]{0,63}$")]
+"""A part or hole id: a lower-case ASP constant."""
+CellId = Annotated[str, msgspec.Meta(pattern=r"^[a-z][a-z0-9_-]{0,31}$")]
+Seed = Annotated[int, msgspec.Meta(ge=0, lt=2**32)]
+NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
+Result = Literal["fit", "no_fit"]
+ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "failed"]
+
+
+class InsertRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
+                    tag_field="kind", tag="insert"):
+    """Insert ``part`` into ``hole``; ``id`` makes the request idempotent at the cell."""
+
+    id: RequestId
+    part: AspId
+    hole: AspId
+    seed: Seed = 0
+    retest: bool = False
+    v: int = PROTOCOL_VERSION
+
+
+class Evidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """What the cell measured during the insertion (None for the truth backend)."""
+
+    attempts: Annotated[int, msgspec.Meta(ge=0)]
+    max_force_dev: NonNegative
+    """Largest ‖F_mes − F_des‖ [N]."""
+    max_torque_dev: NonNegative
+    """Largest ‖M_mes − M_des‖ [N m]."""
+    end_error: NonNegative
+    """Distance of the final tool position from the goal [m]."""
+    duration_s: NonNegative
+    """Simulated duration of the attempts [s]."""
+
+
+class InsertReply(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
+                  tag_field="kind", tag="insert_reply"):
+    """The outcome of request ``id`` as observed by cell ``cell``."""
+
+    id: RequestId
+    cell: CellId
+    result: Result
+    evidence: Evidence | None = None
+    wall_s: NonNegative = 0.0
+    """Wall time the cell spent on the experiment [s]."""
+    v: int = PROTOCOL_VERSION
+
+
+class ErrorReply(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
+                 tag_field="kind", tag="error"):
+    """A refused request: ``code`` says why, ``error`` says what was expected."""
+
+    cell: CellId
+    code: ErrorCode
+    error: str
+    id: RequestId | None = None
+    v: int = PROTOCOL_VERSION
+
+
+class MessageError(BridgeError):
+    """A payload that is not a valid message; ``code`` is the ErrorReply code to send."""
+
+    def __init__(self, code: ErrorCode, text: str) -> None:
+        super().__init__(text)
+        self.code: ErrorCode = code
+
+
+_REQUEST_DECODER = msgspec.json.Decoder(InsertRequest)
+_REPLY_DECODER = msgspec.json.Decoder(InsertReply | ErrorReply)
+
+
+def encode(message: InsertRequest | InsertReply | ErrorReply) -> bytes:
+    """Serialise a message to JSON bytes; MessageError if it exceeds the size cap."""
+    data = msgspec.json.encode(message)
+    if len(data) > MAX_MESSAGE_BYTES:
+        raise MessageError("oversized", f"message of {len(data)} bytes exceeds the "
+                           f"{MAX_MESSAGE_BYTES}-byte cap")
+    return data
+
+
+def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
+    if len(payload) > MAX_MESSAGE_BYTES:
+        raise MessageError("oversized", f"{what} of {len(payload)} bytes exceeds the "
+                           f"{MAX_MESSAGE_BYTES}-byte cap")
+    try:
+        message = decoder.decode(payload)
+    except msgspec.DecodeError as exc:
+        raise MessageError("malformed", f"{what} is not valid: {exc}") from None
+    if message.v != PROTOCOL_VERSION:
+        raise MessageError("version", f"{what} has protocol version {message.v}; "
+                           f"expected {PROTOCOL_VERSION}")
+    return message
+
+
+def decode_request(payload: bytes) -> InsertRequest:
+    """Validate and decode an insert request; MessageError (with a code) if invalid."""
+    return _decode(_REQUEST_DECODER, payload, "insert request")
+
+
+def decode_reply(payload: bytes) -> InsertReply | ErrorReply:
+    """Validate and decode a cell's reply; MessageError if invalid."""
+    return _decode(_REPLY_DECODER, payload, "reply")

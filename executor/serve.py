@@ -1,0 +1,260 @@
+"""``./run.sh executor serve``: a cell node serving insertion experiments over Zenoh.
+
+The node declares the queryable ``cell/<id>/insert`` and the liveliness token
+``cell/<id>/alive`` (and ``cell/<id>/ping``, which echoes its payload unread), then
+serves until SIGTERM/SIGINT, which close the Zenoh session cleanly.
+
+- Every request is size-capped and validated (:mod:`bridge.messages`) in the Zenoh
+  thread; a malformed, oversized or wrong-version request gets an ErrorReply at once and
+  the cell keeps serving.
+- Valid requests run one at a time in the main thread. Results are idempotent by
+  request id: a repeated id gets the cached reply and never re-runs the experiment.
+- Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily);
+  ``truth`` answers from the assembly's ``sizes.lp`` without simulation, optionally
+  after ``--delay`` seconds, to measure the bridge and test the protocol quickly.
+
+One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
+``done <id> <result>``), flushed, so a supervisor can follow the node.
+"""
+
+from __future__ import annotations
+
+import argparse
+import queue
+import signal
+import sys
+import threading
+import time
+from collections import OrderedDict
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Protocol
+
+import zenoh
+
+from bridge import BridgeError
+from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
+from bridge.messages import (ErrorCode, ErrorReply, Evidence, InsertReply, InsertRequest,
+                             MessageError, Result, decode_request, encode)
+from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
+from executor import ExecutorError
+
+CACHE_SIZE = 100_000
+"""Replies kept for idempotency (oldest dropped first)."""
+
+
+class UnknownPair(ExecutorError):
+    """The request names a part or hole the cell does not have."""
+
+
+class Backend(Protocol):
+    """Runs one insertion experiment."""
+
+    def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        """The outcome and its evidence; ExecutorError for a bad part or hole."""
+        ...
+
+    def close(self) -> None: ...
+
+
+class TruthBackend:
+    """Answers from the assembly's ``sizes.lp`` (closed world), after ``delay_s`` [s]."""
+
+    def __init__(self, assembly: str, delay_s: float, cell_id: str,
+                 recording_id: str | None, rrd: Path | None) -> None:
+        from asp import PlannerError
+        from asp.oracle import TruthOracle
+
+        try:
+            self._truth = TruthOracle.from_assembly(assembly)
+        except PlannerError as exc:
+            raise ExecutorError(f"truth backend: {exc}") from None
+        self._delay_s = delay_s
+        self._log = None
+        if rrd is not None:
+            import rerun as rr
+
+            from executor.rerun_log import APPLICATION_ID
+
+            self._log = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
+            self._log.save(str(rrd))
+            self._entity = f"executor/{cell_id}/outcome"
+
+    def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        if request.part not in self._truth.parts or request.hole not in self._truth.holes:
+            raise UnknownPair(f"unknown pair ({request.part},{request.hole}); expected a part "
+                                f"of {self._truth.parts} and a hole of {self._truth.holes}")
+        if self._delay_s > 0:
+            time.sleep(self._delay_s)  # stands in for the duration of a real insertion
+        result: Result = "fit" if (request.part, request.hole) in self._truth.fits else "no_fit"
+        if self._log is not None:
+            import rerun as rr
+
+            self._log.log(self._entity, rr.TextLog(f"{request.part}->{request.hole}: {result}"))
+        return result, None
+
+    def close(self) -> None:
+        if self._log is not None:
+            self._log.flush()
+
+
+class SimBackend:
+    """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
+
+    def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
+                 rrd: Path | None) -> None:
+        from executor.rerun_log import AttemptLogger
+        from executor.trial import Cell
+
+        self._logger = (AttemptLogger(cell_id, recording_id=recording_id, rrd_path=rrd)
+                        if rrd is not None else None)
+        self._cell = Cell(assembly, gui=False, logger=self._logger)
+
+    def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        trial = self._cell.run_trial(request.part, request.hole, seed=request.seed).to_json()
+        evidence = Evidence(attempts=int(trial["attempts"]),
+                            max_force_dev=float(trial["max_force_dev"]),
+                            max_torque_dev=float(trial["max_torque_dev"]),
+                            end_error=float(trial["end_error"]),
+                            duration_s=float(trial["duration_s"]))
+        return trial["outcome"], evidence
+
+    def close(self) -> None:
+        self._cell.close()
+        if self._logger is not None:
+            self._logger.close()
+
+
+class CellNode:
+    """Validates requests (Zenoh thread) and runs them one at a time (:meth:`serve`)."""
+
+    def __init__(self, cell_id: str, backend: Backend) -> None:
+        self.cell_id = cell_id
+        self._backend = backend
+        self._work: queue.SimpleQueue[tuple[zenoh.Query, InsertRequest]] = queue.SimpleQueue()
+        self._replies: OrderedDict[str, bytes] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def _cached(self, request_id: str) -> bytes | None:
+        with self._lock:
+            return self._replies.get(request_id)
+
+    def _refuse(self, query: zenoh.Query, code: ErrorCode, text: str,
+                request_id: str | None = None) -> None:
+        print(f"refused {code}: {text}", flush=True)
+        reply = ErrorReply(cell=self.cell_id, code=code, error=text[:2000], id=request_id)
+        query.reply(query.key_expr, encode(reply))
+
+    def on_query(self, query: zenoh.Query) -> None:
+        """Zenoh-thread callback: refuse bad requests, answer repeats, queue new work."""
+        payload = query.payload.to_bytes() if query.payload is not None else b""
+        try:
+            request = decode_request(payload)
+        except MessageError as exc:
+            self._refuse(query, exc.code, str(exc))
+            return
+        cached = self._cached(request.id)
+        if cached is not None:
+            query.reply(query.key_expr, cached)
+            return
+        self._work.put((query, request))
+
+    def serve(self) -> None:
+        """Run queued requests until interrupted (by SIGTERM/SIGINT via SystemExit)."""
+        while True:
+            query, request = self._work.get()
+            cached = self._cached(request.id)
+            if cached is None:
+                cached = self._run(query, request)
+            if cached is not None:
+                query.reply(query.key_expr, cached)
+            query.drop()  # finalises the query: the planner need not wait for its timeout
+
+    def _run(self, query: zenoh.Query, request: InsertRequest) -> bytes | None:
+        print(f"start {request.id} {request.part} {request.hole}", flush=True)
+        started = time.perf_counter()
+        try:
+            result, evidence = self._backend.run(request)
+        except ExecutorError as exc:
+            code: ErrorCode = "unknown_id" if isinstance(exc, UnknownPair) else "failed"
+            self._refuse(query, code, str(exc), request.id)
+            return None
+        reply = encode(InsertReply(id=request.id, cell=self.cell_id, result=result,
+                                   evidence=evidence, wall_s=time.perf_counter() - started))
+        with self._lock:
+            self._replies[request.id] = reply
+            while len(self._replies) > CACHE_SIZE:
+                self._replies.popitem(last=False)
+        print(f"done {request.id} {result}", flush=True)
+        return reply
+
+
+def _echo(query: zenoh.Query) -> None:
+    query.reply(query.key_expr, query.payload.to_bytes() if query.payload is not None else b"")
+
+
+def _exit_on_signal(signum: int, _frame: object) -> None:
+    raise SystemExit(128 + signum)
+
+
+def _exit_when_stdin_closes() -> None:
+    """Lifeline: the supervisor holds our stdin; when it dies, stdin reaches EOF."""
+    sys.stdin.buffer.read()
+    signal.raise_signal(signal.SIGTERM)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="executor serve", description="Serve insertion experiments over Zenoh "
+        f"(default: listen on {DEFAULT_ENDPOINT}).")
+    parser.add_argument("--cell", default="c1", help="cell id (default c1)")
+    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
+                        help="sim: PyBullet cell; truth: answer from sizes.lp (default sim)")
+    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    parser.add_argument("--delay", type=float, default=0.0, metavar="S",
+                        help="truth backend: seconds each experiment takes (default 0)")
+    parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
+    parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
+    parser.add_argument("--lifeline", action="store_true",
+                        help="exit when standard input closes (set by a supervising session)")
+    add_endpoint_arguments(parser)
+    return parser
+
+
+def main(argv: Sequence[str]) -> int:
+    """Serve until SIGTERM/SIGINT; exit code 2 on bad options."""
+    args = build_parser().parse_args(list(argv))
+    try:
+        cell_id = check_cell_id(args.cell)
+    except BridgeError as exc:
+        raise ExecutorError(str(exc)) from None
+    if args.delay < 0:
+        raise ExecutorError(f"--delay {args.delay}: expected seconds >= 0")
+    listen = args.listen or ([] if args.connect or args.zenoh_config else [DEFAULT_ENDPOINT])
+    signal.signal(signal.SIGTERM, _exit_on_signal)
+    signal.signal(signal.SIGINT, _exit_on_signal)
+    backend: Backend = (TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
+                        if args.backend == "truth"
+                        else SimBackend(args.assembly, cell_id, args.recording_id, args.rrd))
+    node = CellNode(cell_id, backend)
+    try:
+        session = open_session(listen, args.connect, args.zenoh_config)
+    except BridgeError as exc:
+        backend.close()
+        raise ExecutorError(str(exc)) from None
+    try:
+        declared = (session.declare_queryable(insert_key(cell_id), node.on_query),
+                    session.declare_queryable(ping_key(cell_id), _echo),
+                    session.liveliness().declare_token(alive_key(cell_id)))
+        if args.lifeline:
+            threading.Thread(target=_exit_when_stdin_closes, daemon=True).start()
+        print(f"ready cell {cell_id} backend {args.backend} "
+              f"listen {listen} connect {args.connect}", flush=True)
+        node.serve()
+    except SystemExit:
+        print(f"stopping cell {cell_id} ({len(declared)} declarations closed)", flush=True)
+        pass
+    finally:
+        session.close()
+        backend.close()
+    return 0
