@@ -20,9 +20,9 @@ One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``
 from __future__ import annotations
 
 import argparse
+import os
 import queue
 import signal
-import sys
 import threading
 import time
 from collections import OrderedDict
@@ -199,7 +199,8 @@ def _exit_on_signal(signum: int, _frame: object) -> None:
 
 def _exit_when_stdin_closes() -> None:
     """Lifeline: the supervisor holds our stdin; when it dies, stdin reaches EOF."""
-    sys.stdin.buffer.read()
+    while os.read(0, 4096):  # raw read: no interpreter lock held at shutdown
+        pass
     signal.raise_signal(signal.SIGTERM)
 
 

@@ -1,0 +1,109 @@
+"""Cell co-processes: start ``executor serve`` nodes, follow their output, stop them.
+
+A session (or a test) starts its cells with :func:`start_cell`. Each cell runs with
+``--lifeline``: it holds our pipe on its stdin and exits when we die, so a killed
+planner leaves no cell behind. Output lines (``ready``, ``start <id> ...``,
+``done <id> ...``) are collected by a reader thread; :meth:`CellProcess.wait_for_line`
+waits for one with a deadline.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from asp import PlannerError
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+class CellProcess:
+    """One running ``executor serve`` process and the lines it printed."""
+
+    def __init__(self, cell_id: str, argv: Sequence[str]) -> None:
+        self.cell_id = cell_id
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
+        self.popen = subprocess.Popen(list(argv), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                      stderr=subprocess.STDOUT, env=env, cwd=ROOT, text=True)
+        self.lines: list[str] = []
+        self._eof = False
+        self._new = threading.Condition()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        assert self.popen.stdout is not None
+        for line in self.popen.stdout:
+            with self._new:
+                self.lines.append(line.rstrip("\n"))
+                self._new.notify_all()
+        with self._new:
+            self._eof = True
+            self._new.notify_all()
+
+    def wait_for_line(self, prefix: str, timeout: float, count: int = 1) -> str:
+        """Wait up to ``timeout`` [s] for the ``count``-th line starting with ``prefix``."""
+        deadline = time.monotonic() + timeout
+        with self._new:
+            while True:
+                found = [line for line in self.lines if line.startswith(prefix)]
+                if len(found) >= count:
+                    return found[count - 1]
+                remaining = deadline - time.monotonic()
+                if remaining <= 0 or self._eof:
+                    tail = "\n".join(self.lines[-20:])
+                    raise PlannerError(f"cell {self.cell_id}: no line '{prefix}...' within "
+                                       f"{timeout:.0f} s (exit code {self.popen.poll()}); "
+                                       f"last output:\n{tail}")
+                self._new.wait(remaining)
+
+    def stop(self, timeout: float = 10.0) -> int:
+        """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code."""
+        if self.popen.poll() is None:
+            self.popen.send_signal(signal.SIGTERM)
+            try:
+                return self.popen.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.popen.kill()
+        return self.popen.wait(timeout)
+
+    def kill(self) -> None:
+        """SIGKILL (as a crash would)."""
+        if self.popen.poll() is None:
+            self.popen.kill()
+        self.popen.wait(10.0)
+
+
+def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
+               listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
+               rrd: Path | None = None, recording_id: str | None = None) -> list[str]:
+    """The command line of one ``executor serve`` node, with ``--lifeline``."""
+    argv = [sys.executable, "-m", "executor.cli", "serve", "--cell", cell_id,
+            "--backend", backend, "--assembly", assembly, "--lifeline"]
+    argv += [arg for ep in listen for arg in ("--listen", ep)]
+    argv += [arg for ep in connect for arg in ("--connect", ep)]
+    if delay_s:
+        argv += ["--delay", str(delay_s)]
+    if rrd is not None:
+        argv += ["--rrd", str(rrd)]
+    if recording_id is not None:
+        argv += ["--recording-id", recording_id]
+    return argv
+
+
+def start_cell(cell_id: str, *, ready_timeout: float = 60.0, **options) -> CellProcess:
+    """Start a cell (options of :func:`serve_argv`) and wait until it prints ``ready``."""
+    cell = CellProcess(cell_id, serve_argv(cell_id, **options))
+    try:
+        cell.wait_for_line("ready", ready_timeout)
+    except PlannerError:
+        cell.kill()
+        raise
+    return cell

@@ -1,0 +1,112 @@
+"""Real cell processes on loopback (truth backend): refusals, idempotency, failover."""
+
+from __future__ import annotations
+
+import queue
+import signal
+from collections.abc import Iterator
+
+import pytest
+import zenoh
+
+from asp.cell_processes import CellProcess, start_cell
+from bridge.client import CellDirectory, CellPool, CellRefused, request_insert
+from bridge.messages import ErrorReply, InsertReply, InsertRequest, decode_reply
+from bridge.session import free_loopback_endpoint, open_session
+
+pytestmark = pytest.mark.timeout(60)
+
+
+@pytest.fixture
+def network() -> Iterator[tuple[str, zenoh.Session, CellDirectory, list[CellProcess]]]:
+    """A planner-side session listening on a free loopback port; cells are added by tests."""
+    endpoint = free_loopback_endpoint()
+    session = open_session(listen=[endpoint])
+    directory = CellDirectory(session)
+    cells: list[CellProcess] = []
+    try:
+        yield endpoint, session, directory, cells
+    finally:
+        for cell in cells:
+            cell.kill()
+        directory.close()
+        session.close()
+
+
+def raw_query(session: zenoh.Session, key: str, payload: bytes) -> InsertReply | ErrorReply:
+    box: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+    session.get(key, lambda reply: box.put(reply.ok.payload.to_bytes()), payload=payload,
+                timeout=10.0)
+    return decode_reply(box.get(timeout=15.0))
+
+
+def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    directory.wait_for(1, timeout=20)
+    bad = {
+        b"x" * 100_000: "oversized",
+        b"\xff\xfe not json": "malformed",
+        b'{"kind":"insert","id":"a1","part":"__import__","hole":"r1"}': "malformed",
+        b'{"kind":"insert","id":"a1","part":"p1","hole":"r1","v":99}': "version",
+    }
+    for payload, code in bad.items():
+        reply = raw_query(session, "cell/c1/insert", payload)
+        assert isinstance(reply, ErrorReply) and reply.code == code
+    with pytest.raises(CellRefused, match="unknown_id"):
+        request_insert(session, "c1", InsertRequest(id="u1", part="zz", hole="r1"), timeout=10)
+    assert request_insert(session, "c1", InsertRequest(id="ok1", part="sh", hole="br"), 10).result == "fit"
+    assert request_insert(session, "c1", InsertRequest(id="ok2", part="sh", hole="r1"), 10).result == "no_fit"
+    assert cells[0].popen.poll() is None
+
+
+def test_a_repeated_id_returns_the_cached_reply_without_rerunning(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.2))
+    directory.wait_for(1, timeout=20)
+    request = InsertRequest(id="same", part="p3", hole="s1")
+    first = request_insert(session, "c1", request, timeout=10)
+    again = request_insert(session, "c1", request, timeout=10)
+    assert first == again  # same wall_s: the experiment was not run again
+    cells[0].wait_for_line("done same", timeout=5)
+    assert sum(line.startswith("start same") for line in cells[0].lines) == 1
+
+
+def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    directory.wait_for(1, timeout=20)
+    gone: queue.SimpleQueue[str] = queue.SimpleQueue()
+    directory.listen(lambda cell, alive: None if alive else gone.put(cell))
+    cells[0].popen.send_signal(signal.SIGTERM)
+    assert cells[0].popen.wait(10) == 0
+    assert gone.get(timeout=10) == "c1"
+
+
+def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(network) -> None:
+    endpoint, session, directory, cells = network
+    for cell_id in ("c1", "c2"):
+        cells.append(start_cell(cell_id, backend="truth", connect=[endpoint], delay_s=0.3))
+    directory.wait_for(2, timeout=20)
+    pairs = [(p, h) for p in ("p1", "p3", "sh") for h in ("r1", "s1", "br")]
+    requests = [InsertRequest(id=f"r{i}", part=p, hole=h) for i, (p, h) in enumerate(pairs)]
+    delivered: list[tuple[str, str]] = []
+
+    def on_reply(request: InsertRequest, reply: InsertReply) -> None:
+        delivered.append((request.id, reply.cell))
+        if len(delivered) == 2:  # c1 is then busy with its next experiment
+            cells[0].wait_for_line("start", timeout=10, count=2)
+            cells[0].kill()
+
+    pool = CellPool(session, directory, timeout=20.0, wait_for_cell=20.0)
+    replies = pool.run(requests, on_reply)
+    assert sorted(replies) == sorted(r.id for r in requests)
+    assert len(delivered) == len(requests) == len({rid for rid, _ in delivered})
+    truth = {("p1", "r1"), ("p1", "s1"), ("p1", "br"), ("p3", "s1"), ("p3", "br"), ("sh", "br")}
+    for request in requests:
+        assert replies[request.id].result == ("fit" if (request.part, request.hole) in truth else "no_fit")
+    started_on_c1 = {line.split()[1] for line in cells[0].lines if line.startswith("start")}
+    finished_on_c1 = {rid for rid, cell in delivered if cell == "c1"}
+    lost = started_on_c1 - finished_on_c1
+    assert lost, "c1 was killed mid-experiment"
+    assert all(replies[rid].cell == "c2" for rid in lost)

@@ -1,0 +1,60 @@
+"""Messages of the bridge: round trip, validation, size cap, version (no network)."""
+
+from __future__ import annotations
+
+import msgspec
+import pytest
+
+from bridge.keys import alive_key, cell_of_alive_key, insert_key
+from bridge.messages import (MAX_MESSAGE_BYTES, ErrorReply, Evidence, InsertReply,
+                             InsertRequest, MessageError, decode_reply, decode_request, encode)
+from bridge import BridgeError
+
+
+def test_request_and_replies_round_trip() -> None:
+    request = InsertRequest(id="run-1:p1:r1:1", part="p1", hole="r1", seed=7)
+    assert decode_request(encode(request)) == request
+    reply = InsertReply(id=request.id, cell="c1", result="no_fit", wall_s=0.5,
+                        evidence=Evidence(attempts=2, max_force_dev=31.0, max_torque_dev=1.2,
+                                          end_error=0.004, duration_s=3.1))
+    assert decode_reply(encode(reply)) == reply
+    error = ErrorReply(cell="c1", code="malformed", error="bad")
+    assert decode_reply(encode(error)) == error
+
+
+@pytest.mark.parametrize("payload, code", [
+    (b"", "malformed"),
+    (b"{not json", "malformed"),
+    (b'{"kind":"insert","id":"a","part":"p1"}', "malformed"),
+    (b'{"kind":"insert","id":"a","part":"p1;import os","hole":"r1"}', "malformed"),
+    (b'{"kind":"insert","id":"a b","part":"p1","hole":"r1"}', "malformed"),
+    (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","seed":-1}', "malformed"),
+    (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","exec":"x"}', "malformed"),
+    (b'{"kind":"insert_reply","id":"a","cell":"c1","result":"fit"}', "malformed"),
+    (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","v":2}', "version"),
+    (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","pad":"' + b"x" * MAX_MESSAGE_BYTES + b'"}',
+     "oversized"),
+])
+def test_bad_requests_are_refused_with_a_code(payload: bytes, code: str) -> None:
+    with pytest.raises(MessageError) as caught:
+        decode_request(payload)
+    assert caught.value.code == code
+
+
+def test_reply_result_is_checked() -> None:
+    bad = msgspec.json.encode({"kind": "insert_reply", "id": "a", "cell": "c1", "result": "maybe"})
+    with pytest.raises(MessageError):
+        decode_reply(bad)
+
+
+def test_encode_refuses_oversized_messages() -> None:
+    with pytest.raises(MessageError, match="cap"):
+        encode(ErrorReply(cell="c1", code="failed", error="x" * MAX_MESSAGE_BYTES))
+
+
+def test_keys() -> None:
+    assert insert_key("c1") == "cell/c1/insert"
+    assert cell_of_alive_key(alive_key("cell-2")) == "cell-2"
+    assert cell_of_alive_key("cell/c1/insert") is None
+    with pytest.raises(BridgeError, match="cell id"):
+        insert_key("C/1")
