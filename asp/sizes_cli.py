@@ -1,0 +1,130 @@
+"""``./run.sh sizes learn|evaluate``: which part fits which hole (paper 2.2, 4.2).
+
+``learn`` runs one learning session against a truth oracle and prints the experiments
+(``--json``: the issue's contract), optionally writing the learned facts (``--out``).
+``evaluate`` counts the experiments a policy needs over relabelings of an assembly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from asp import PlannerError
+from asp.facts import write_facts
+from asp.oracle import NoisyOracle, Oracle, TruthOracle
+from asp.size_knowledge import Knowledge
+from asp.size_learner import Experiment, learn_sizes
+from asp.size_policies import get_policy, policy_names
+from asp.sizes_evaluate import evaluate_policy, percent, plot_comparison
+
+
+def _truth(args: argparse.Namespace) -> TruthOracle:
+    if args.truth:
+        return TruthOracle.from_facts(args.truth)
+    return TruthOracle.from_assembly(args.assembly)
+
+
+def _add_truth_options(parser: argparse.ArgumentParser) -> None:
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--assembly", metavar="A", help="assembly name under data/ or folder (uses its sizes.lp)")
+    source.add_argument("--truth", metavar="FILE.lp", help="truth facts: part/1, hole/1, fits/2 (closed world)")
+
+
+def _policy(name: str) -> str:
+    if name not in policy_names():
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(policy_names())}")
+    return name
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="./run.sh sizes", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    learn = sub.add_parser("learn", help="learn the relation from a truth by experiments")
+    _add_truth_options(learn)
+    learn.add_argument("--policy", type=_policy, default="heuristic", help="experiment selection (default heuristic)")
+    learn.add_argument("--seed", type=int, default=0, help="seed of random choices (default 0)")
+    learn.add_argument("--noise", type=float, default=0.0, metavar="P",
+                       help="probability that an answer is wrong (simulated noise; default 0)")
+    learn.add_argument("--out", metavar="FILE.lp", help="write learned facts (tried/4, smaller/2, fits/2, no_fit/2)")
+    learn.add_argument("--json", action="store_true", help="print JSON")
+    evaluate = sub.add_parser("evaluate", help="experiments needed over relabelings of parts and holes")
+    _add_truth_options(evaluate)
+    evaluate.add_argument("--policy", type=_policy, required=True)
+    evaluate.add_argument("--relabelings", default="all", metavar="all|N",
+                          help="every relabeling (default) or N random ones")
+    evaluate.add_argument("--seed", type=int, default=0)
+    evaluate.add_argument("--json", action="store_true", help="print JSON")
+    evaluate.add_argument("--plot", metavar="FILE.png", help="Fig. 19-style comparison plot")
+    evaluate.add_argument("--compare", default="random", metavar="P,...",
+                          help="policies drawn beside --policy in the plot (default random)")
+    return parser
+
+
+def _print_matrix(knowledge: Knowledge) -> None:
+    width = max(len(x) for x in (*knowledge.parts, *knowledge.holes)) + 1
+    print("part/hole".ljust(width + 2) + "".join(h.rjust(width) for h in knowledge.holes))
+    for part, row in zip(knowledge.parts, knowledge.matrix()):
+        cells = "".join(("?" if v is None else str(v)).rjust(width) for v in row)
+        print(part.ljust(width + 2) + cells)
+
+
+def _learn(args: argparse.Namespace) -> int:
+    truth = _truth(args)
+    if not 0.0 <= args.noise < 0.5:
+        raise PlannerError(f"--noise {args.noise}: expected a probability in [0, 0.5)")
+    oracle: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
+
+    def show(experiment: Experiment, _knowledge: Knowledge) -> None:
+        if not args.json:
+            note = " (re-test)" if experiment.retest else ""
+            print(f"{experiment.number:3d}: {experiment.part} -> {experiment.hole}: {experiment.result}{note}")
+
+    result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show)
+    if args.out:
+        write_facts(args.out, result.facts(), header=f"learned by `sizes learn --policy {args.policy}`")
+    if args.json:
+        print(json.dumps({
+            "policy": args.policy,
+            "experiments": [e.as_json() for e in result.experiments],
+            "count": result.count,
+            "fits": [[p, h] for p in truth.parts for h in truth.holes if (p, h) in result.knowledge.fits],
+        }))
+    else:
+        print(f"{result.count} experiments with policy {args.policy}; learned relation (1 = fits):")
+        _print_matrix(result.knowledge)
+    return 0
+
+
+def _evaluate(args: argparse.Namespace) -> int:
+    truth = _truth(args)
+    relabelings: str | int = args.relabelings
+    if relabelings != "all":
+        if not str(relabelings).isdigit() or int(relabelings) < 1:
+            raise PlannerError(f"--relabelings {relabelings}: expected 'all' or a positive integer")
+        relabelings = int(relabelings)
+    evaluation = evaluate_policy(truth, args.policy, relabelings, args.seed)
+    report = evaluation.as_json()
+    if args.plot:
+        others = [p for p in args.compare.split(",") if p and p != args.policy]
+        for name in others:
+            get_policy(name)
+        evaluations = [evaluation] + [evaluate_policy(truth, p, relabelings, args.seed) for p in others]
+        plot_comparison(evaluations, args.plot)
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print(f"policy {args.policy} over {report['cases']} relabelings: mean {report['mean']:.2f}, "
+              f"min {report['min']} ({percent(report['min_share'])}), "
+              f"max {report['max']} ({percent(report['max_share'])})")
+        print("histogram (experiments: cases): " + ", ".join(f"{n}: {c}" for n, c in report["histogram"].items()))
+        if args.plot:
+            print(f"plot written to {args.plot}", file=sys.stderr)
+    return 0
+
+
+def main(argv: list[str]) -> int:
+    args = _parser().parse_args(argv)
+    return _learn(args) if args.command == "learn" else _evaluate(args)
