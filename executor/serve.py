@@ -106,7 +106,8 @@ class SimBackend:
         from executor.rerun_log import AttemptLogger
         from executor.trial import Cell
 
-        self._logger = (AttemptLogger(cell_id, recording_id=recording_id, rrd_path=rrd)
+        self._logger = (AttemptLogger(cell_id, recording_id=recording_id, rrd_path=rrd,
+                                      send_blueprint=False)  # the planner sends it
                         if rrd is not None else None)
         self._cell = Cell(assembly, gui=False, logger=self._logger)
 

@@ -1,0 +1,247 @@
+"""``./run.sh session``: the end-to-end learning session, planner and cells over Zenoh.
+
+1. learns must-precede from the assembly's demonstrations (Algorithm 1);
+2. starts ``--cells N`` cell co-processes (``executor serve``) connected to the planner's
+   loopback endpoint (``--cells 0 --connect EP`` uses cells already on the network);
+3. learns which part fits which hole: the size learner's batches of mutually
+   non-entailing experiments run on all alive cells at once (:mod:`asp.zenoh_oracle`);
+   every finished experiment is journaled (fsynced) before the learner uses it;
+4. assigns holes (greedy) and computes complete plans, each run through the checker;
+5. writes ``RUN/learned.lp`` (DESIGN.md vocabulary), ``RUN/assignment.lp``,
+   ``RUN/session.json``, ``RUN/journal.jsonl`` and the Rerun recordings ``RUN/*.rrd``
+   (planner and cells in one recording id), and prints a summary (``--json``: the
+   contract ``{"run", "experiments", "fits", "must_precede", "plans", "matches_truth"}``).
+
+``--resume RUN`` continues a killed session: the journal is replayed into the learner,
+no finished experiment is run again. The sizes are learned over the parts and holes of
+the assembly's ``sizes.lp`` (Cranfield: pegs p1 p2 p3 p4 sh, holes r1 r2 s1 s2 br), or,
+without one, over the parts with role ``peg`` and all holes. ``matches_truth``: the
+learned part-hole relation equals ``sizes.lp`` and every true precedence constraint
+(``precedence.lp``) is learned, so every admitted sequence is feasible.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import time
+import uuid
+from contextlib import ExitStack
+from datetime import datetime, timezone
+from pathlib import Path
+
+from asp import PlannerError
+from asp.assembly import Assembly, load_assembly
+from asp.assign import greedy_assignment, load_learned_facts
+from asp.cell_processes import CellProcess, start_cell
+from asp.demos import demo_facts, load_demos
+from asp.facts import fact, write_facts
+from asp.journal import Journal
+from asp.oracle import TruthOracle
+from asp.plans import Plan, check_plan, plans
+from asp.precedence import learn_must_precede
+from asp.relation import Relation, precedence_facts, reduction, true_relation
+from asp.session_rerun import PlannerLog
+from asp.size_learner import SizeLearner, SizeLearningResult
+from asp.size_policies import policy_names
+from asp.zenoh_oracle import ZenohOracle
+from bridge import BridgeError
+from bridge.client import CellDirectory, CellPool
+from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
+
+SETTINGS = "session.json"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    parser.add_argument("--cells", type=int, default=1, help="cell co-processes to start (default 1)")
+    parser.add_argument("--policy", default="heuristic", choices=policy_names(),
+                        help="experiment selection policy (default heuristic)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the policy and the trials")
+    parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
+    parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
+    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
+                        help="cells started here: sim (PyBullet) or truth (sizes.lp, no simulation)")
+    parser.add_argument("--delay", type=float, default=0.0, metavar="S",
+                        help="truth backend: seconds each experiment takes (default 0)")
+    parser.add_argument("--timeout", type=float, default=120.0, metavar="S",
+                        help="one experiment at one cell before it is re-sent (default 120)")
+    parser.add_argument("--wait-for-cell", type=float, default=60.0, metavar="S",
+                        help="how long to wait while no cell is alive (default 60)")
+    parser.add_argument("--plans", type=int, default=5, metavar="K", help="plans to compute (default 5)")
+    parser.add_argument("--json", action="store_true", help="print the JSON result")
+    add_endpoint_arguments(parser)
+    return parser
+
+
+def _run_folder(args: argparse.Namespace) -> tuple[Path, dict]:
+    """The run folder and its settings (read back when resuming)."""
+    if args.resume is not None:
+        path = args.resume / SETTINGS
+        if not path.is_file():
+            raise PlannerError(f"--resume {args.resume}: expected a run folder holding {SETTINGS}")
+        settings = json.loads(path.read_text(encoding="utf-8"))
+        settings["starts"] = int(settings.get("starts", 1)) + 1
+        return args.resume, settings
+    run = args.out or Path("runs") / datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+    if (run / SETTINGS).exists():
+        raise PlannerError(f"--out {run}: already holds a session; use --resume {run} or another folder")
+    run.mkdir(parents=True, exist_ok=True)
+    settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed,
+                "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running"}
+    return run, settings
+
+
+def _save(run: Path, settings: dict) -> None:
+    tmp = run / (SETTINGS + ".tmp")
+    tmp.write_text(json.dumps(settings, indent=2) + "\n", encoding="utf-8")
+    tmp.replace(run / SETTINGS)
+
+
+def _sizes_domain(assembly: Assembly) -> tuple[list[str], list[str], TruthOracle | None]:
+    if assembly.has_file("sizes.lp"):
+        truth = TruthOracle.from_assembly(str(assembly.folder))
+        return list(truth.parts), list(truth.holes), truth
+    pegs = [p.id for p in assembly.parts if p.role == "peg"]
+    if not pegs or not assembly.holes:
+        raise PlannerError(f"assembly '{assembly.name}': no sizes.lp and no pegs/holes to learn")
+    return pegs, assembly.hole_ids, None
+
+
+def _endpoints(args: argparse.Namespace) -> tuple[list[str], list[str]]:
+    """(listen, connect) of the planner: it listens for its own cells, else connects."""
+    if args.cells > 0:
+        return args.listen or [free_loopback_endpoint()], args.connect
+    return args.listen, args.connect or ([] if args.zenoh_config else [DEFAULT_ENDPOINT])
+
+
+def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
+                 log: PlannerLog) -> SizeLearningResult:
+    def record(part: str, hole: str, result: str, cell: str) -> None:
+        experiment = learner.record(part, hole, result)
+        log.experiment(experiment.number, part, hole, result, cell, learner.knowledge)
+
+    for entry in list(journal.entries):
+        record(entry.part, entry.hole, entry.result, entry.cell)
+    while batch := learner.next_batch(max(1, oracle.alive_cells())):
+        before = len(journal.entries)
+        results = oracle.ask_batch(batch)
+        cells = {(e.part, e.hole): e.cell for e in journal.entries[before:]}
+        for (part, hole), result in zip(batch, results):
+            record(part, hole, result, cells[(part, hole)])
+    return learner.result()
+
+
+def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
+                   sizes: SizeLearningResult) -> list:
+    atoms = [fact("part", p) for p in assembly.part_ids] + [fact("hole", h) for h in assembly.hole_ids]
+    atoms += demos_atoms + precedence_facts(relation) + sizes.facts()
+    return list(dict.fromkeys(atoms))
+
+
+def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
+    facts = load_learned_facts([learned])
+    assignment = greedy_assignment(facts)
+    found = plans(facts, n=count)
+    for plan in found:
+        errors = check_plan(facts, plan.steps)
+        if errors:
+            raise PlannerError(f"plan {plan.as_json()} fails the checker: {errors}")
+    return assignment, found
+
+
+def run_session(args: argparse.Namespace) -> dict:
+    """Run (or resume) a session; returns the JSON result."""
+    started = time.perf_counter()
+    if args.cells < 0:
+        raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
+    run, settings = _run_folder(args)
+    assembly = load_assembly(settings["assembly"])
+    demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
+    relation = learn_must_precede(demos)
+    parts, holes, truth = _sizes_domain(assembly)
+    run_id = re.sub(r"[^A-Za-z0-9_-]", "-", settings["recording_id"])
+    listen, connect = _endpoints(args)
+    suffix = "" if settings["starts"] == 1 else f"-{settings['starts']}"
+    cell_ids = [f"c{k}" for k in range(1, args.cells + 1)]
+    _save(run, settings)
+    with ExitStack() as stack:
+        session = open_session(listen, connect, args.zenoh_config)
+        stack.callback(session.close)
+        directory = CellDirectory(session)
+        stack.callback(directory.close)
+        cells: list[CellProcess] = []
+        stack.callback(lambda: [cell.stop() for cell in cells])
+        for cell_id in cell_ids:
+            cells.append(start_cell(
+                cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
+                delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
+                recording_id=settings["recording_id"]))
+        try:
+            directory.wait_for(max(1, len(cell_ids)), timeout=args.wait_for_cell)
+        except BridgeError as exc:
+            raise PlannerError(f"cells: {exc}") from None
+        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
+        stack.callback(log.close)
+        log.precedence(relation.parts, reduction(relation))
+        journal = Journal(run)
+        stack.callback(journal.close)
+        pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell)
+        oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
+        learner = SizeLearner(parts, holes, settings["policy"], settings["seed"])
+        sizes = _learn_sizes(oracle, learner, journal, log)
+        learned = run / "learned.lp"
+        write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
+                    header=f"Learned by ./run.sh session on {assembly.name} ({run}).")
+        assignment, found = _plans(learned, args.plans)
+        write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
+                    header="The greedy hole assignment (paper 2.2) of learned.lp.")
+        log.assignment(assignment)
+    fits = sorted(sizes.knowledge.fits)
+    must_precede = relation.pairs()
+    matches = None
+    if truth is not None and assembly.has_file("precedence.lp"):
+        matches = set(fits) == truth.fits and set(true_relation(assembly).pairs()) <= set(must_precede)
+    result = {
+        "run": str(run),
+        "experiments": len(journal.entries),
+        "fits": [list(pair) for pair in fits],
+        "must_precede": [list(pair) for pair in must_precede],
+        "plans": [plan.as_json() for plan in found],
+        "matches_truth": matches,
+    }
+    settings.update(result, status="done", assignment=assignment, cells=cell_ids,
+                    journal=[{"part": e.part, "hole": e.hole, "result": e.result, "cell": e.cell,
+                              "retest": e.retest} for e in journal.entries],
+                    wall_s=round(time.perf_counter() - started, 3))
+    _save(run, settings)
+    return result
+
+
+def _summary(result: dict, run: Path) -> str:
+    settings = json.loads((run / SETTINGS).read_text(encoding="utf-8"))
+    cells: dict[str, int] = {}
+    for entry in settings["journal"]:
+        cells[entry["cell"]] = cells.get(entry["cell"], 0) + 1
+    plan = " ".join(f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+    return "\n".join([
+        f"run {result['run']}: {result['experiments']} experiments "
+        f"({', '.join(f'{c}: {n}' for c, n in sorted(cells.items()))}) in {settings['wall_s']:.1f} s",
+        "fits: " + " ".join(f"{p}->{h}" for p, h in result["fits"]),
+        f"must precede: {len(result['must_precede'])} pairs",
+        "assignment: " + " ".join(f"{p}->{h}" for p, h in settings["assignment"].items()),
+        f"plan 1 of {len(result['plans'])}: {plan}",
+        f"matches truth: {result['matches_truth']}",
+    ])
+
+
+def main(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        result = run_session(args)
+    except BridgeError as exc:
+        raise PlannerError(str(exc)) from None
+    print(json.dumps(result) if args.json else _summary(result, Path(result["run"])))
+    return 0

@@ -1,0 +1,104 @@
+"""The planner's Rerun log of a session (entities ``planner/...``).
+
+Planner and cells log into ONE recording id (application
+:data:`executor.rerun_log.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
+files opened together are one recording. The planner sends the blueprint: its views
+in a first tab, then one tab per cell (:func:`executor.rerun_blueprint.cell_blueprint`).
+
+=========================== ==========================================================
+``planner/knowledge``       part × hole matrix after every experiment (tensor: 1 fits,
+                            0 does not fit, -1 unknown), timeline ``experiment``
+``planner/experiments``     one text line per experiment (pair, result, cell)
+``planner/smaller``         smaller-than graph over parts ∪ holes (its transitive
+                            reduction), after every experiment
+``planner/precedence``      learned must-precede graph (transitive reduction), static
+``planner/assignment``      part → hole graph and a markdown table of the assignment
+=========================== ==========================================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from asp.size_knowledge import Knowledge
+from executor.rerun_blueprint import cell_blueprint
+from executor.rerun_log import APPLICATION_ID
+
+_PART_COLOR = [70, 130, 220]
+_HOLE_COLOR = [230, 150, 40]
+
+
+def planner_views() -> rrb.Container:
+    """The planner's tab: knowledge matrix, graphs, assignment, experiment log."""
+    return rrb.Horizontal(
+        rrb.Vertical(
+            rrb.TensorView(origin="planner/knowledge", name="knowledge (1 fit, 0 no fit, -1 unknown)"),
+            rrb.TextLogView(origin="planner/experiments", name="experiments"),
+        ),
+        rrb.Vertical(
+            rrb.GraphView(origin="planner/precedence", name="must precede"),
+            rrb.GraphView(origin="planner/smaller", name="smaller than"),
+        ),
+        rrb.Vertical(
+            rrb.GraphView(origin="planner/assignment", name="assignment"),
+            rrb.TextDocumentView(origin="planner/assignment", name="assignment table"),
+        ),
+        name="planner",
+    )
+
+
+def _reduction(pairs: Iterable[tuple[str, str]]) -> list[tuple[str, str]]:
+    """Pairs of a transitively closed relation that no third element connects."""
+    closed = set(pairs)
+    middle = {x for pair in closed for x in pair}
+    return sorted((a, b) for a, b in closed
+                  if not any((a, z) in closed and (z, b) in closed for z in middle - {a, b}))
+
+
+class PlannerLog:
+    """Logs the planner's entities into ``rrd`` under ``recording_id``."""
+
+    def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str]) -> None:
+        self.rec = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
+        self.rec.save(str(rrd))
+        self.rec.send_blueprint(cell_blueprint(cell_ids, extra=[planner_views()]))
+
+    def precedence(self, parts: Sequence[str], edges: Sequence[tuple[str, str]]) -> None:
+        """The learned must-precede relation as a directed graph (its reduction)."""
+        self.rec.log("planner/precedence", rr.GraphNodes(list(parts), labels=list(parts)), static=True)
+        self.rec.log("planner/precedence", rr.GraphEdges(list(edges), graph_type="directed"),
+                     static=True)
+
+    def experiment(self, number: int, part: str, hole: str, result: str, cell: str,
+                   knowledge: Knowledge) -> None:
+        """One finished experiment and the knowledge after it."""
+        self.rec.set_time("experiment", sequence=number)
+        self.rec.log("planner/experiments", rr.TextLog(f"#{number} {part} -> {hole}: {result} ({cell})"))
+        matrix = np.array([[-1 if v is None else v for v in row] for row in knowledge.matrix()],
+                          dtype=np.int8)
+        self.rec.log("planner/knowledge", rr.Tensor(matrix, dim_names=["part", "hole"]))
+        nodes = [*knowledge.parts, *knowledge.holes]
+        colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)
+        self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors))
+        self.rec.log("planner/smaller", rr.GraphEdges(_reduction(knowledge.smaller),
+                                                      graph_type="directed"))
+
+    def assignment(self, assignment: Mapping[str, str]) -> None:
+        """The hole assignment as a graph part → hole and a table."""
+        parts, holes = list(assignment), sorted(set(assignment.values()))
+        colors = [_PART_COLOR] * len(parts) + [_HOLE_COLOR] * len(holes)
+        self.rec.log("planner/assignment", rr.GraphNodes([*parts, *holes], labels=[*parts, *holes],
+                                                         colors=colors), static=True)
+        self.rec.log("planner/assignment", rr.GraphEdges(list(assignment.items()),
+                                                         graph_type="directed"), static=True)
+        table = "| part | hole |\n|---|---|\n" + "".join(f"| {p} | {h} |\n" for p, h in assignment.items())
+        self.rec.log("planner/assignment", rr.TextDocument(table, media_type="text/markdown"),
+                     static=True)
+
+    def close(self) -> None:
+        self.rec.flush()
