@@ -73,12 +73,20 @@ def solve_encoding(
     arguments: Sequence[str],
     on_model: Callable[[clingo.Model], None],
 ) -> clingo.SolveResult:
-    """Ground the entry encoding with the atoms as facts, solve, call ``on_model``."""
-    ctl = clingo.Control(list(arguments))
-    with resources.as_file(resources.files("asp") / "encodings" / entry) as path:
-        ctl.load(str(path))
-    ctl.add("base", [], format_facts(atoms))
-    ctl.ground([("base", [])])
+    """Ground the entry encoding with the atoms as facts, solve, call ``on_model``.
+
+    clingo's informational messages (e.g. a predicate without facts) are dropped; a
+    grounding error becomes a PlannerError quoting them.
+    """
+    messages: list[str] = []
+    ctl = clingo.Control(list(arguments), logger=lambda _code, msg: messages.append(msg.strip()))
+    try:
+        with resources.as_file(resources.files("asp") / "encodings" / entry) as path:
+            ctl.load(str(path))
+        ctl.add("base", [], format_facts(atoms))
+        ctl.ground([("base", [])])
+    except RuntimeError:
+        raise PlannerError(f"{entry} does not ground: " + "; ".join(messages)) from None
     return ctl.solve(on_model=on_model)
 
 
@@ -140,7 +148,7 @@ def _no_hole_message(part: str, fitting: list[str], taken_by: dict[str, str]) ->
     taken = ", ".join(f"{hole} by {taken_by[hole]}" for hole in fitting)
     return (
         f"the assembly is not solvable: part {part} gets no hole; the holes it fits are "
-        f"taken by bigger parts ({taken})"
+        f"taken by parts at least as big ({taken})"
     )
 
 

@@ -1,0 +1,161 @@
+"""Hole assignment: named ASP cases for assign.lp, the greedy assignment against brute
+force on random biorders, Cranfield, and the ``assign`` command."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+from clintest.assertion import Equals, Or, True_
+from clintest.quantifier import All, Exact
+from clintest.solver import Clingo
+from clintest.test import And, Assert
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from asp.assign import (
+    LearnedFacts,
+    UnsolvableAssembly,
+    all_assignments,
+    greedy_assignment,
+    load_learned_facts,
+)
+from asp.facts import fact, write_facts
+from asp.plans import check_assignment
+
+ROOT = Path(__file__).resolve().parent.parent
+ASSIGNMENTS_LP = str(ROOT / "asp" / "encodings" / "assignments.lp")
+CRANFIELD_SIZES = ROOT / "data" / "cranfield" / "sizes.lp"
+
+# name, facts, expected models (each the set of assigned/2 atoms); [] = unsatisfiable
+ASSIGN_CASES = [
+    ("one part one hole", "part(a). hole(h). fits(a,h).", [{"assigned(a,h)"}]),
+    ("nested sizes leave one choice",
+     "part(a;b). hole(h1;h2). fits(a,h1). fits(a,h2). fits(b,h2).",
+     [{"assigned(a,h1)", "assigned(b,h2)"}]),
+    ("equal parts swap holes",
+     "part(a;b). hole(h1;h2). fits(a,h1). fits(a,h2). fits(b,h1). fits(b,h2).",
+     [{"assigned(a,h1)", "assigned(b,h2)"}, {"assigned(a,h2)", "assigned(b,h1)"}]),
+    ("a part without sizes needs no hole", "part(a;x). hole(h). fits(a,h).",
+     [{"assigned(a,h)"}]),
+    ("spare hole", "part(a). hole(h1;h2). fits(a,h2). no_fit(a,h1).", [{"assigned(a,h2)"}]),
+    ("part fitting nothing is unsat", "part(a). hole(h). no_fit(a,h).", []),
+    ("declared needs_hole without sizes is unsat", "part(a). hole(h). needs_hole(a).", []),
+    ("two parts one hole is unsat",
+     "part(a;b). hole(h1;h2). fits(a,h1). fits(b,h1). no_fit(a,h2). no_fit(b,h2).", []),
+]
+
+
+@pytest.mark.parametrize("name,facts,expected", ASSIGN_CASES, ids=[c[0] for c in ASSIGN_CASES])
+def test_assign_encoding_named_cases(name: str, facts: str, expected: list[set[str]]) -> None:
+    test = Assert(Exact(len(expected)), True_())
+    if expected:
+        test = And(test, Assert(All(), Or(*(Equals(model) for model in expected))))
+    Clingo(arguments=["0"], program=facts, files=[ASSIGNMENTS_LP]).solve(test)
+    test.assert_()
+
+
+def _facts_file(tmp_path: Path, fits: dict[str, list[str]], holes: list[str]) -> Path:
+    atoms = [fact("part", p) for p in fits] + [fact("hole", h) for h in holes]
+    for part, fitting in fits.items():
+        atoms += [fact("fits" if h in fitting else "no_fit", part, h) for h in holes]
+    path = tmp_path / "learned.lp"
+    write_facts(path, atoms)
+    return path
+
+
+def _brute_force(facts: LearnedFacts) -> list[dict[str, str]]:
+    """Every injective part -> fitting hole map, by trying all hole permutations."""
+    parts = list(facts.needs_hole)
+    found = {
+        tuple(zip(parts, holes))
+        for holes in itertools.permutations(facts.holes, len(parts))
+        if all((p, h) in facts.fits for p, h in zip(parts, holes))
+    }
+    return sorted((dict(a) for a in found), key=lambda a: sorted(a.items()))
+
+
+def test_cranfield_assignments_are_all_feasible_ones_and_greedy_is_one() -> None:
+    facts = load_learned_facts([CRANFIELD_SIZES])
+    assignments = all_assignments(facts)
+    assert assignments == _brute_force(facts)
+    assert greedy_assignment(facts) in assignments
+    assert all(check_assignment(facts, a) == [] for a in assignments)
+
+
+biorders = st.integers(1, 5).flatmap(
+    lambda n_parts: st.tuples(
+        st.lists(st.integers(0, 6), min_size=n_parts, max_size=n_parts),
+        st.lists(st.integers(0, 6), min_size=1, max_size=5),
+    )
+)
+
+
+@settings(max_examples=40, deadline=None)
+@given(biorders)
+def test_greedy_solves_exactly_the_solvable_biorders(sizes: tuple[list[int], list[int]]) -> None:
+    """Sizes on a line (fits = part smaller than hole): greedy finds an assignment iff
+    one exists; when none does, the named part and the parts at least as big as it
+    outnumber the holes they fit."""
+    part_sizes, hole_sizes = sizes
+    parts = [f"p{i}" for i in range(len(part_sizes))]
+    holes = [f"h{i}" for i in range(len(hole_sizes))]
+    fits = {p: [h for h, hs in zip(holes, hole_sizes) if ps < hs] for p, ps in zip(parts, part_sizes)}
+    with tempfile.TemporaryDirectory() as tmp:
+        facts = load_learned_facts([_facts_file(Path(tmp), fits, holes)])
+    expected = _brute_force(facts)
+    try:
+        greedy = greedy_assignment(facts)
+    except UnsolvableAssembly as exc:
+        assert expected == []
+        at_least_as_big = [p for p in parts if set(fits[p]) <= set(fits[exc.part])]
+        assert len(at_least_as_big) > len(fits[exc.part])
+        with pytest.raises(UnsolvableAssembly):
+            all_assignments(facts)
+        return
+    assert check_assignment(facts, greedy) == []
+    assert all_assignments(facts) == expected
+
+
+def _assign(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "asp.cli", "assign", *args],
+        cwd=ROOT, capture_output=True, text=True, timeout=60,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
+
+
+def test_assign_command_json(tmp_path: Path) -> None:
+    greedy = json.loads(_assign(str(CRANFIELD_SIZES), "--json").stdout)
+    every = json.loads(_assign(str(CRANFIELD_SIZES), "--all", "--json").stdout)
+    facts = load_learned_facts([CRANFIELD_SIZES])
+    assert list(greedy) == ["assignments"] and len(greedy["assignments"]) == 1
+    assert greedy["assignments"][0] in every["assignments"]
+    assert every["assignments"] == all_assignments(facts)
+
+
+def test_assign_command_names_the_part_without_hole(tmp_path: Path) -> None:
+    path = _facts_file(tmp_path, {"a": ["h1", "h2"], "b": ["h2"], "c": ["h2"]}, ["h1", "h2"])
+    for extra in ([], ["--all"]):
+        done = _assign(str(path), "--json", *extra)
+        assert done.returncode == 3
+        report = json.loads(done.stdout)
+        assert report["assignments"] == [] and report["part"] in ("b", "c")
+        assert f"part {report['part']}" in done.stderr
+
+
+def test_assign_command_bad_input(tmp_path: Path) -> None:
+    broken = tmp_path / "broken.lp"
+    broken.write_text("part(a). fits(a,\n")
+    unknown = tmp_path / "unknown.lp"
+    unknown.write_text("part(a). hole(h). fits(a,zz).\n")
+    for path, word in ((broken, "parse"), (unknown, "zz")):
+        done = _assign(str(path))
+        assert done.returncode == 2 and word in done.stderr
+    assert _assign("--help").returncode == 0
