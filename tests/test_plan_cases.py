@@ -1,0 +1,145 @@
+"""Named ASP cases for plans.lp and the checker (check_plan.lp), and the plans of random
+small assemblies against brute force, every plan through the checker."""
+
+from __future__ import annotations
+
+import itertools
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from clintest.assertion import Equals, Or, True_
+from clintest.quantifier import All, Exact
+from clintest.solver import Clingo
+from clintest.test import And, Assert
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from asp.assign import UnsolvableAssembly, load_learned_facts
+from asp.facts import fact, write_facts
+from asp.plans import PlanStep, check_plan, plans
+
+ENCODINGS = Path(__file__).resolve().parent.parent / "asp" / "encodings"
+
+# name, facts, expected models (plan_step/3 and assigned/2 atoms); [] = unsatisfiable
+PLAN_CASES = [
+    ("precedence and a hole", "part(a;b). hole(h). fits(a,h). must_precede(a,b).",
+     [{"plan_step(1,a,h)", "plan_step(2,b,none)", "assigned(a,h)"}]),
+    ("no constraints, no holes", "part(a;b).",
+     [{"plan_step(1,a,none)", "plan_step(2,b,none)"},
+      {"plan_step(1,b,none)", "plan_step(2,a,none)"}]),
+    ("two holes, fixed order", "part(a;b). hole(h1;h2). fits(a,h1). fits(a,h2). must_precede(b,a).",
+     [{"plan_step(1,b,none)", "plan_step(2,a,h1)", "assigned(a,h1)"},
+      {"plan_step(1,b,none)", "plan_step(2,a,h2)", "assigned(a,h2)"}]),
+    ("chain not closed transitively",
+     "part(a;b;c). must_precede(c,b). must_precede(b,a).",
+     [{"plan_step(1,c,none)", "plan_step(2,b,none)", "plan_step(3,a,none)"}]),
+    ("cyclic precedence is unsat", "part(a;b). must_precede(a,b). must_precede(b,a).", []),
+    ("part without a hole is unsat", "part(a;b). hole(h). fits(a,h). fits(b,h).", []),
+]
+
+
+def _models_test(expected: list[set[str]]) -> Assert | And:
+    """Exactly the expected models (clingo never repeats a model)."""
+    test = Assert(Exact(len(expected)), True_())
+    if expected:
+        test = And(test, Assert(All(), Or(*(Equals(model) for model in expected))))
+    return test
+
+
+@pytest.mark.parametrize("name,facts,expected", PLAN_CASES, ids=[c[0] for c in PLAN_CASES])
+def test_plan_encoding_named_cases(name: str, facts: str, expected: list[set[str]]) -> None:
+    test = _models_test(expected)
+    Clingo(arguments=["0"], program=facts, files=[str(ENCODINGS / "plans.lp")]).solve(test)
+    test.assert_()
+
+
+CHECK_FACTS = "part(a;b;c). hole(h1;h2). fits(a,h1). fits(b,h1). fits(b,h2). must_precede(a,b).\n"
+# name, the plan or assignment, the errors the checker must derive (exactly)
+CHECK_CASES = [
+    ("valid plan", "plan_step(1,a,h1). plan_step(2,b,h2). plan_step(3,c,none).", set()),
+    ("valid assignment", "assigned(a,h1). assigned(b,h2).", set()),
+    ("wrong order", "plan_step(1,b,h2). plan_step(2,a,h1). plan_step(3,c,none).",
+     {"error(wrong_order(a,b))"}),
+    ("part missing", "plan_step(1,a,h1). plan_step(2,b,h2).", {"error(missing(c))"}),
+    ("part repeated", "plan_step(1,a,h1). plan_step(2,b,h2). plan_step(3,c,none). plan_step(4,c,none).",
+     {"error(repeated(c))", "error(bad_step(4))"}),
+    ("two parts at one step", "plan_step(1,a,h1). plan_step(1,c,none). plan_step(2,b,h2).",
+     {"error(step_twice(1))"}),
+    ("hole not fitting", "plan_step(1,a,h2). plan_step(2,b,h1). plan_step(3,c,none).",
+     {"error(not_fitting(a,h2))"}),
+    ("hole used twice", "plan_step(1,a,h1). plan_step(2,b,h1). plan_step(3,c,none).",
+     {"error(hole_twice(h1))"}),
+    ("part without its hole", "plan_step(1,a,none). plan_step(2,b,h2). plan_step(3,c,none).",
+     {"error(no_hole(a))"}),
+    ("unknown part", "plan_step(1,a,h1). plan_step(2,b,h2). plan_step(3,c,none). plan_step(4,x,none).",
+     {"error(unknown_part(x))", "error(bad_step(4))"}),
+    ("assignment misses a part", "assigned(a,h1).", {"error(no_hole(b))"}),
+    ("assignment gives two holes", "assigned(a,h1). assigned(b,h1). assigned(b,h2).",
+     {"error(two_holes(b))", "error(hole_twice(h1))"}),
+]
+
+
+@pytest.mark.parametrize("name,given,errors", CHECK_CASES, ids=[c[0] for c in CHECK_CASES])
+def test_checker_named_cases(name: str, given: str, errors: set[str]) -> None:
+    test = Assert(Exact(1), Equals(errors))
+    Clingo(program=CHECK_FACTS + given, files=[str(ENCODINGS / "check_plan.lp")]).solve(test)
+    test.assert_()
+
+
+def linear_extensions(parts: list[str], before: set[tuple[str, str]]) -> Iterator[tuple[str, ...]]:
+    """Every order of ``parts`` in which a comes before b for each (a, b) in ``before``."""
+    if not parts:
+        yield ()
+    for part in parts:
+        if not any((other, part) in before for other in parts):
+            rest = [other for other in parts if other != part]
+            for tail in linear_extensions(rest, before):
+                yield (part, *tail)
+
+
+assemblies = st.integers(1, 4).flatmap(
+    lambda n: st.tuples(
+        st.sets(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)).filter(lambda e: e[0] < e[1])),
+        st.lists(st.integers(0, 3), min_size=n, max_size=n),  # part sizes, 0 = needs no hole
+        st.lists(st.integers(1, 4), min_size=1, max_size=3),  # hole sizes
+    )
+)
+
+
+@settings(max_examples=30, deadline=None)
+@given(assemblies)
+def test_plans_are_exactly_the_brute_force_ones(case: tuple[set, list[int], list[int]]) -> None:
+    edges, part_sizes, hole_sizes = case
+    parts = [f"p{i}" for i in range(len(part_sizes))]
+    holes = [f"h{i}" for i in range(len(hole_sizes))]
+    before = {(parts[a], parts[b]) for a, b in edges}
+    fitting = {
+        p: [h for h, hs in zip(holes, hole_sizes) if ps < hs]
+        for p, ps in zip(parts, part_sizes) if ps > 0
+    }
+    atoms = [fact("part", p) for p in parts] + [fact("hole", h) for h in holes]
+    atoms += [fact("must_precede", a, b) for a, b in before]
+    atoms += [fact("fits" if h in fitting[p] else "no_fit", p, h) for p in fitting for h in holes]
+    with tempfile.TemporaryDirectory() as tmp:
+        write_facts(Path(tmp) / "learned.lp", atoms)
+        facts = load_learned_facts([Path(tmp) / "learned.lp"])
+    assignments = [
+        dict(zip(fitting, chosen))
+        for chosen in itertools.permutations(holes, len(fitting))
+        if all(h in fitting[p] for p, h in zip(fitting, chosen))
+    ]
+    expected = {
+        tuple(PlanStep(p, a.get(p)) for p in order)
+        for order in linear_extensions(parts, before)
+        for a in assignments
+    }
+    try:
+        found = plans(facts, 0)
+    except UnsolvableAssembly as exc:
+        assert not assignments and exc.part in fitting
+        return
+    assert {plan.steps for plan in found} == expected and len(found) == len(expected)
+    for plan in found:
+        assert check_plan(facts, plan.steps) == []
