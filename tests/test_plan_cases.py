@@ -35,6 +35,9 @@ PLAN_CASES = [
     ("chain not closed transitively",
      "part(a;b;c). must_precede(c,b). must_precede(b,a).",
      [{"plan_step(1,c,none)", "plan_step(2,b,none)", "plan_step(3,a,none)"}]),
+    ("two independent pairs", "part(a;b;c;d). must_precede(a,b). must_precede(c,d).",
+     [{f"plan_step({t},{p},none)" for t, p in enumerate(order, start=1)}
+      for order in ("abcd", "acbd", "acdb", "cabd", "cadb", "cdab")]),
     ("cyclic precedence is unsat", "part(a;b). must_precede(a,b). must_precede(b,a).", []),
     ("part without a hole is unsat", "part(a;b). hole(h). fits(a,h). fits(b,h).", []),
 ]
