@@ -1,0 +1,141 @@
+"""The session over Zenoh with real processes on loopback (truth backend, a few s each).
+
+- two cells, one SIGKILLed mid-experiment: the session completes with the right
+  relation and no experiment twice;
+- a planner SIGKILLed mid-session and resumed: no finished experiment is sent again;
+- learned.lp, session.json, journal and the shared Rerun recording are read back.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+from collections import Counter
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from asp.cell_processes import CellProcess, start_cell
+from asp.facts import atoms_by_name, load_atoms
+from asp.journal import read_journal
+from asp.oracle import TruthOracle
+from bridge.session import free_loopback_endpoint
+
+pytestmark = pytest.mark.timeout(90)
+ROOT = Path(__file__).resolve().parent.parent
+TRUTH = TruthOracle.from_assembly("cranfield")
+
+
+def session_argv(*args: str) -> list[str]:
+    return [sys.executable, "-m", "asp.cli", "session", "--backend", "truth", "--json", *args]
+
+
+def run_session(*args: str, timeout: float = 60) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    done = subprocess.run(session_argv(*args), cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=timeout)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+@pytest.fixture
+def cells() -> Iterator[list[CellProcess]]:
+    started: list[CellProcess] = []
+    try:
+        yield started
+    finally:
+        for cell in started:
+            cell.kill()
+
+
+def assert_learned_truth(result: dict, run: Path) -> None:
+    assert result["matches_truth"] is True
+    assert {tuple(pair) for pair in result["fits"]} == TRUTH.fits
+    journal = read_journal(run / "journal.jsonl")
+    assert len(journal) == result["experiments"]
+    assert len({e.id for e in journal}) == len(journal)
+    assert all(not e.retest for e in journal)
+    assert max(Counter((e.part, e.hole) for e in journal).values()) == 1
+    for entry in journal:
+        assert entry.result == TRUTH.ask(entry.part, entry.hole)
+    learned = load_atoms([run / "learned.lp"])
+    assert set(atoms_by_name(learned, "fits", 2)) == TRUTH.fits
+    assert len(atoms_by_name(learned, "tried", 4)) == len(journal)
+
+
+def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellProcess]) -> None:
+    endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
+    for cell_id, endpoint in zip(("c1", "c2"), endpoints):
+        cells.append(start_cell(cell_id, backend="truth", listen=[endpoint], delay_s=0.3))
+    run = tmp_path / "run"
+    connect = [arg for ep in endpoints for arg in ("--connect", ep)]
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    planner = subprocess.Popen(session_argv("--cells", "0", *connect, "--out", str(run),
+                                            "--policy", "best"),
+                               cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True)
+    try:
+        cells[0].wait_for_line("start", timeout=30, count=3)
+        cells[0].kill()
+        out, err = planner.communicate(timeout=60)
+    finally:
+        planner.kill()
+    assert planner.returncode == 0, err
+    result = json.loads(out)
+    assert_learned_truth(result, run)
+    journal = read_journal(run / "journal.jsonl")
+    killed_mid = cells[0].lines[-1].split()
+    assert killed_mid[0] == "start"  # c1 died during this experiment...
+    by_id = {e.id: e for e in journal}
+    assert by_id[killed_mid[1]].cell == "c2"  # ...which c2 then ran, once
+    assert {e.cell for e in journal} == {"c1", "c2"}
+
+
+def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[CellProcess]) -> None:
+    endpoint = free_loopback_endpoint()
+    cells.append(start_cell("c1", backend="truth", listen=[endpoint], delay_s=0.15))
+    run = tmp_path / "run"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    planner = subprocess.Popen(session_argv("--cells", "0", "--connect", endpoint, "--out", str(run)),
+                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        # one cell, batches of one: the 6th request leaves after the 5th was journaled
+        cells[0].wait_for_line("start", timeout=30, count=6)
+        planner.send_signal(signal.SIGKILL)
+        planner.wait(10)
+    finally:
+        planner.kill()
+    before = read_journal(run / "journal.jsonl")
+    assert 5 <= len(before) < 25
+    cells[0].kill()  # a fresh cell has no reply cache: a re-sent experiment would run again
+    cells.append(start_cell("c1", backend="truth", listen=[endpoint], delay_s=0.0))
+    result = run_session("--cells", "0", "--connect", endpoint, "--resume", str(run))
+    assert result["run"] == str(run)
+    assert_learned_truth(result, run)
+    after = read_journal(run / "journal.jsonl")
+    assert after[:len(before)] == before
+    rerun_ids = {line.split()[1] for line in cells[1].lines if line.startswith("start")}
+    assert rerun_ids == {e.id for e in after[len(before):]}
+    assert not rerun_ids & {e.id for e in before}
+
+
+def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path) -> None:
+    from executor.recording import read_recording
+
+    run = tmp_path / "run"
+    result = run_session("--cells", "2", "--out", str(run), "--policy", "best")
+    assert_learned_truth(result, run)
+    assert all(len(plan) == 10 for plan in result["plans"])
+    settings = json.loads((run / "session.json").read_text())
+    assert settings["status"] == "done" and set(settings["cells"]) == {"c1", "c2"}
+    summary = read_recording(sorted(run.glob("*.rrd")))
+    assert set(summary.recording_ids) == {settings["recording_id"]}
+    entities = set(summary.entities)
+    for entity in ("/planner/knowledge", "/planner/precedence", "/planner/smaller",
+                   "/planner/assignment", "/executor/c1/outcome", "/executor/c2/outcome"):
+        assert entity in entities
+    assert summary.entities["/planner/knowledge"].rows == result["experiments"]
