@@ -1,0 +1,145 @@
+"""Cranfield plans from its learned-facts equivalent (true precedence closed, Fig. 5
+sizes): plans, optimal plans against brute force over every plan, the ``plan`` command
+and the plain clingo command lines of the README. Every plan goes through the checker."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from asp.assembly import load_assembly
+from asp.assign import LearnedFacts, all_assignments, load_learned_facts
+from asp.facts import load_atoms, write_facts
+from asp.plans import PlanStep, check_plan, plans, travel_facts
+from test_plan_cases import linear_extensions
+
+ROOT = Path(__file__).resolve().parent.parent
+CRANFIELD = ROOT / "data" / "cranfield"
+CLOSURE = "must_precede(A,B) :- precedence_edge(A,B). must_precede(A,C) :- must_precede(A,B), precedence_edge(B,C)."
+
+
+@pytest.fixture(scope="module")
+def learned(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Cranfield's learned.lp as the learners would write it."""
+    path = tmp_path_factory.mktemp("cranfield") / "learned.lp"
+    atoms = load_atoms([CRANFIELD / "precedence.lp", CRANFIELD / "sizes.lp"], extra=CLOSURE)
+    write_facts(path, [a for a in atoms if a.name != "precedence_edge"])
+    return path
+
+
+@pytest.fixture(scope="module")
+def facts(learned: Path) -> LearnedFacts:
+    return load_learned_facts([learned])
+
+
+def test_cranfield_plans_are_valid_and_distinct(facts: LearnedFacts) -> None:
+    found = plans(facts, 40)
+    assert len({plan.steps for plan in found}) == 40
+    for plan in found:
+        assert [step.part for step in plan.steps].count("bp") == 1
+        assert check_plan(facts, plan.steps) == []
+
+
+def _brute_force_optimum(facts: LearnedFacts) -> tuple[int, set[tuple[PlanStep, ...]]]:
+    """Least total travel [mm] over every (order, assignment), straight from the
+    assembly's positions, and the plans that reach it."""
+    assembly = load_assembly("cranfield")
+    start = {part.id: part.start for part in assembly.parts}
+    at = {hole.id: hole.position for hole in assembly.holes}
+    site = tuple(sum(c) / len(at) for c in zip(*at.values()))
+
+    def leg(a: tuple[float, ...], b: tuple[float, ...]) -> int:
+        return round(1000.0 * math.dist(a, b))
+
+    best, winners = math.inf, set()
+    for assignment in all_assignments(facts):
+        goal = {p: at[assignment[p]] if p in assignment else site for p in facts.parts}
+        carry = sum(leg(start[p], goal[p]) for p in facts.parts)
+        for order in linear_extensions(list(facts.parts), set(facts.must_precede)):
+            tool, cost = (0.0, 0.0), carry
+            for part in order:
+                cost, tool = cost + leg(tool, start[part]), goal[part]
+            cost += leg(tool, (0.0, 0.0))
+            steps = tuple(PlanStep(p, assignment.get(p)) for p in order)
+            if cost < best:
+                best, winners = cost, {steps}
+            elif cost == best:
+                winners.add(steps)
+    return int(best), winners
+
+
+def test_cranfield_optimal_plans_match_brute_force(facts: LearnedFacts) -> None:
+    travel = travel_facts(load_assembly("cranfield"), facts)
+    found = plans(facts, 0, optimal=True, travel=travel)
+    best, winners = _brute_force_optimum(facts)
+    assert {plan.cost for plan in found} == {best}
+    assert {plan.steps for plan in found} == winners
+    for plan in found:
+        assert check_plan(facts, plan.steps) == []
+
+
+def _run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", *args], cwd=ROOT, capture_output=True, text=True, timeout=120,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
+
+
+def _steps(atoms: list[tuple[str, str, str]]) -> list[PlanStep]:
+    return [PlanStep(p, None if h == "none" else h) for _, p, h in sorted(atoms, key=lambda a: int(a[0]))]
+
+
+def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path) -> None:
+    done = _run("asp.cli", "plan", str(learned), "-n", "3", "--json")
+    report = json.loads(done.stdout)
+    assert done.returncode == 0 and list(report) == ["plans"] and len(report["plans"]) == 3
+    for plan in report["plans"]:
+        assert all(set(step) == {"part", "hole"} for step in plan)
+        assert check_plan(facts, [PlanStep(s["part"], s["hole"]) for s in plan]) == []
+    travel_file = tmp_path / "travel.lp"
+    done = _run("asp.cli", "plan", str(learned), "--optimal", "--assembly", "cranfield",
+                "--json", "--travel-out", str(travel_file))
+    report = json.loads(done.stdout)
+    assert report["cost"] == _brute_force_optimum(facts)[0] and len(report["plans"]) == 1
+    assert check_plan(facts, [PlanStep(s["part"], s["hole"]) for s in report["plans"][0]]) == []
+    # the same optimum from the plain clingo command line with the written travel facts
+    done = _run("clingo", str(ROOT / "asp/encodings/plans_optimal.lp"), str(learned),
+                str(travel_file), "--opt-mode=opt", "--configuration=crafty")
+    assert "OPTIMUM FOUND" in done.stdout
+    assert re.findall(r"^Optimization: (\d+)$", done.stdout, re.M)[-1] == str(report["cost"])
+
+
+def test_plan_command_errors(learned: Path, tmp_path: Path) -> None:
+    assert _run("asp.cli", "plan", "--help").returncode == 0
+    no_geometry = _run("asp.cli", "plan", str(learned), "--optimal")
+    assert no_geometry.returncode == 2 and "--assembly" in no_geometry.stderr
+    cyclic = tmp_path / "cyclic.lp"
+    cyclic.write_text("part(a;b). must_precede(a,b). must_precede(b,a).\n")
+    done = _run("asp.cli", "plan", str(cyclic))
+    assert done.returncode == 2 and "cycle through a b" in done.stderr
+    unsolvable = tmp_path / "unsolvable.lp"
+    unsolvable.write_text("part(a;b). hole(h). fits(a,h). no_fit(b,h).\n")
+    done = _run("asp.cli", "plan", str(unsolvable), "--json")
+    assert done.returncode == 3 and json.loads(done.stdout)["part"] == "b"
+
+
+def test_plain_clingo_answers_the_readme_questions(learned: Path, facts: LearnedFacts) -> None:
+    five = _run("clingo", str(ROOT / "asp/encodings/plans.lp"), str(learned), "5")
+    answers = [line for line in five.stdout.splitlines() if "plan_step(" in line]
+    assert len(answers) == 5
+    for answer in answers:
+        steps = _steps(re.findall(r"plan_step\((\d+),(\w+),(\w+)\)", answer))
+        assert check_plan(facts, steps) == []
+    brave = _run("clingo", str(ROOT / "asp/encodings/assignments.lp"), str(learned),
+                 "--enum-mode=brave")
+    last = [line for line in brave.stdout.splitlines() if "assigned(" in line][-1]
+    p3_holes = set(re.findall(r"assigned\(p3,(\w+)\)", last))
+    assert p3_holes == {a["p3"] for a in all_assignments(facts)}
+    assert p3_holes <= set(facts.holes_of("p3"))
