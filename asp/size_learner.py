@@ -18,13 +18,13 @@ import itertools
 import random
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from importlib.resources import as_file, files
 
 import clingo
 
 from asp import PlannerError
 from asp.facts import fact, format_facts
 from asp.oracle import Oracle
+from asp.relation import encoding_path
 from asp.size_knowledge import RESULTS, Knowledge, Pair
 from asp.size_policies import SelectionPolicy, get_policy
 
@@ -69,11 +69,6 @@ class SizeLearningResult:
         return atoms
 
 
-def encoding_path(name: str):
-    """Context manager giving the filesystem path of ``asp/encodings/<name>``."""
-    return as_file(files("asp") / "encodings" / name)
-
-
 class SizeLearner:
     """Knowledge of one learning session and the choice of its next experiments."""
 
@@ -109,8 +104,7 @@ class SizeLearner:
         self._ctl.add("base", [], format_facts(atoms) + _OBSERVATIONS)
         for name in ("sizes_closure.lp", self.policy.encoding):
             if name is not None:
-                with encoding_path(name) as path:
-                    self._ctl.load(str(path))
+                self._ctl.load(str(encoding_path(name)))
         self._ctl.ground([("base", [])])
 
     def _solve(self) -> Knowledge:
@@ -183,23 +177,28 @@ class SizeLearner:
                                    f"answers per pair: {named}")
             self.retests.append((p, h))
 
-    def next_batch(self, size: int) -> list[Pair]:
-        """Up to ``size`` pairs to try in parallel: no outcomes of some can entail another's.
+    def next_batch(self, size: int, pending: Sequence[Pair] = ()) -> list[Pair]:
+        """Up to ``size`` pairs to try in parallel, none of whose outcomes can entail another's.
 
-        Starts with :meth:`next_experiment`, then adds unknown pairs in index order whose
-        independence holds for every combination of outcomes (checked by solving).
+        ``pending`` are pairs already out at other cells: the new pairs must be
+        independent of them too. Pending re-tests come first; then the policy's choice
+        (if independent of ``pending``) and unknown pairs in index order, each kept when
+        no combination of outcomes of the others entails or contradicts it (checked by
+        solving with hypothetical observations).
         """
-        first = self.next_experiment()
-        if first is None or self.retests:
-            return list(self.retests[:size]) if self.retests else []
-        batch = [first]
-        for pair in self.knowledge.unknown:
-            if len(batch) >= size:
+        retests = [p for p in self.retests if p not in pending]
+        if retests:
+            return retests[:size]
+        if self.knowledge.complete:
+            return []
+        chosen: list[Pair] = []
+        for pair in [self.next_experiment(), *self.knowledge.unknown]:
+            if len(chosen) >= size:
                 break
-            if pair not in batch and self._independent([*batch, pair]):
-                batch.append(pair)
+            if pair not in chosen and pair not in pending and self._independent([*pending, *chosen, pair]):
+                chosen.append(pair)
         self.knowledge = self._solve()
-        return batch
+        return chosen
 
     def _independent(self, pairs: list[Pair]) -> bool:
         """No outcomes of all but one pair entail (or contradict) the remaining pair."""
@@ -210,10 +209,27 @@ class SizeLearner:
                     self._set_observation(pair, outcome)
                 knowledge = self._solve()
                 for pair in others:
-                    self._set_observation(pair, None)
+                    self._restore(pair)
                 if knowledge.conflicts or knowledge.result(*target) is not None:
                     return False
         return True
+
+    def _restore(self, pair: Pair) -> None:
+        """Set the external of ``pair`` back to its kept observation (or none)."""
+        answers = self.answers.get(pair)
+        self._set_observation(pair, self._kept(answers) if answers else None)
+
+    def reset(self, seed: int = 0) -> None:
+        """Forget all observations: a fresh session on the same ground program.
+
+        ``seed`` reseeds Python policies; ``session_facts`` (e.g. random priorities)
+        stay those of the seed given at construction.
+        """
+        for pair in self.answers:
+            self._set_observation(pair, None)
+        self.experiments, self.answers, self.retests = [], {}, []
+        self.rng = random.Random(seed)
+        self.knowledge = self._solve()
 
     def result(self) -> SizeLearningResult:
         return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge)
@@ -229,7 +245,15 @@ def learn_sizes(
     max_answers: int = 5,
 ) -> SizeLearningResult:
     """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known."""
-    learner = SizeLearner(parts, holes, policy, seed, max_answers)
+    return run_learner(SizeLearner(parts, holes, policy, seed, max_answers), oracle, on_experiment)
+
+
+def run_learner(
+    learner: SizeLearner,
+    oracle: Oracle,
+    on_experiment: Callable[[Experiment, Knowledge], None] | None = None,
+) -> SizeLearningResult:
+    """Ask ``oracle`` the learner's experiments, one at a time, until it is done."""
     while (pair := learner.next_experiment()) is not None:
         experiment = learner.record(*pair, oracle.ask(*pair))
         if on_experiment is not None:

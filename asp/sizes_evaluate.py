@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 from asp import PlannerError
 from asp.oracle import TruthOracle
-from asp.size_learner import learn_sizes
+from asp.size_learner import SizeLearner, run_learner
 from asp.size_policies import get_policy
 
 Matrix = tuple[tuple[bool, ...], ...]
@@ -76,14 +76,30 @@ def relabeled_matrices(truth: TruthOracle, relabelings: str | int, seed: int) ->
     return [tuple(tuple(fits[i][j] for j in col) for i in row) for row, col in orders]
 
 
+_LEARNERS: dict[tuple[str, int, int], SizeLearner] = {}
+"""Per worker process: one ground learner per (policy, parts, holes), reused by reset."""
+
+
 def count_experiments(task: tuple[Matrix, str, int]) -> int:
-    """Experiments ``policy`` needs to learn ``matrix`` (worker of the process pool)."""
+    """Experiments ``policy`` needs to learn ``matrix`` (worker of the process pool).
+
+    Deterministic policies reuse one ground program per shape (canonical names make
+    every case of a shape the same program); others get a fresh learner per seed.
+    """
     matrix, policy, seed = task
     parts = [f"q{i}" for i in range(1, len(matrix) + 1)]
     holes = [f"k{j}" for j in range(1, len(matrix[0]) + 1)]
     fits = {(p, h) for p, row in zip(parts, matrix) for h, f in zip(holes, row) if f}
     oracle = TruthOracle(parts, holes, fits)
-    result = learn_sizes(parts, holes, oracle, policy, seed)
+    key = (policy, len(parts), len(holes))
+    if get_policy(policy).deterministic and key in _LEARNERS:
+        learner = _LEARNERS[key]
+        learner.reset(seed)
+    else:
+        learner = SizeLearner(parts, holes, policy, seed)
+        if get_policy(policy).deterministic:
+            _LEARNERS[key] = learner
+    result = run_learner(learner, oracle)
     if result.knowledge.fits != frozenset(fits):
         raise PlannerError(f"policy {policy} learned a wrong relation for {matrix}")
     return result.count

@@ -1,0 +1,108 @@
+"""The size learner: exact relation, no entailed pair asked, conflicts, batches."""
+
+from __future__ import annotations
+
+import itertools
+
+import networkx as nx
+import pytest
+from hypothesis import assume, given, settings
+
+from asp import PlannerError
+from asp.oracle import TruthOracle
+from asp.size_learner import SizeLearner, learn_sizes
+from tests._sizes_helpers import CheckingOracle, biorders
+
+
+@pytest.mark.parametrize("policy", ["systematic", "random", "heuristic"])
+@settings(max_examples=12, deadline=None)
+@given(truth=biorders())
+def test_every_policy_learns_the_exact_relation_asking_no_entailed_pair(policy, truth) -> None:
+    oracle = CheckingOracle(truth)
+    result = learn_sizes(truth.parts, truth.holes, oracle, policy, seed=7, on_experiment=oracle.observe)
+    assert result.knowledge.fits == frozenset(truth.fits)
+    assert result.knowledge.complete
+    assert len(oracle.asked) == result.count <= len(truth.parts) * len(truth.holes)
+
+
+def test_cranfield_relation_is_learned_and_written_as_facts() -> None:
+    truth = TruthOracle.from_assembly("cranfield")
+    result = learn_sizes(truth.parts, truth.holes, truth, "heuristic")
+    assert result.knowledge.fits == frozenset(truth.fits)
+    names = {str(s) for s in result.facts()}
+    assert "fits(sh,br)" in names and "no_fit(sh,s1)" in names and "smaller(p1,p3)" in names
+    assert sum(1 for s in result.facts() if s.name == "tried") == result.count
+
+
+def _cycle_learner() -> SizeLearner:
+    """a < x < b < y observed, so a < y is entailed; then a late answer says a does not fit y."""
+    learner = SizeLearner(["a", "b"], ["x", "y"])
+    learner.record("a", "x", "fit")
+    learner.record("b", "x", "no_fit")
+    learner.record("b", "y", "fit")
+    assert learner.knowledge.result("a", "y") == "fit"
+    learner.record("a", "y", "no_fit")
+    return learner
+
+
+def test_a_cyclic_closure_names_the_conflicting_experiments_and_queues_retests() -> None:
+    learner = _cycle_learner()
+    assert [e.number for e in learner.conflicting_experiments()] == [1, 2, 3, 4]
+    assert sorted(learner.retests) == [("a", "x"), ("a", "y"), ("b", "x"), ("b", "y")]
+    assert learner.next_experiment() in learner.retests
+
+
+def test_retests_resolve_the_conflict_and_keep_a_consistent_relation() -> None:
+    learner = _cycle_learner()
+    truth = TruthOracle(["a", "b"], ["x", "y"], {("a", "x"), ("a", "y"), ("b", "y")})
+    while (pair := learner.next_experiment()) is not None:
+        learner.record(*pair, truth.ask(*pair))
+    assert not learner.knowledge.conflicts
+    assert learner.knowledge.fits == frozenset(truth.fits)
+    assert [e.retest for e in learner.experiments].count(True) >= 1
+
+
+def test_a_conflict_that_never_resolves_is_an_error_naming_experiments() -> None:
+    learner = _cycle_learner()
+    with pytest.raises(PlannerError, match=r"#4 a->y no_fit"):
+        for _ in range(20):
+            pair = learner.next_experiment()
+            # a liar that repeats whatever it said first
+            learner.record(*pair, learner.answers[pair][0])
+
+
+def _entails(graph: nx.DiGraph, pair: tuple[str, str]) -> bool:
+    part, hole = pair
+    return nx.has_path(graph, part, hole) or nx.has_path(graph, hole, part)
+
+
+@settings(max_examples=10, deadline=None)
+@given(truth=biorders(max_parts=5, max_holes=5))
+def test_a_batch_holds_pairs_no_outcomes_of_the_others_can_entail(truth) -> None:
+    learner = SizeLearner(truth.parts, truth.holes, "systematic")
+    for pair in learner.next_batch(2):  # learn a little first
+        learner.record(*pair, truth.ask(*pair))
+    batch = learner.next_batch(3)
+    assert bool(batch) == (not learner.knowledge.complete)
+    assume(batch)
+    assert len(set(batch)) == len(batch)
+    assert batch[0] == learner.next_experiment()
+    known = nx.DiGraph()
+    known.add_nodes_from([*truth.parts, *truth.holes])
+    known.add_edges_from(learner.knowledge.smaller)
+    for index, target in enumerate(batch):
+        assert learner.knowledge.result(*target) is None
+        others = batch[:index] + batch[index + 1:]
+        for outcomes in itertools.product([True, False], repeat=len(others)):
+            graph = known.copy()
+            graph.add_edges_from((p, h) if fit else (h, p) for (p, h), fit in zip(others, outcomes))
+            assert not _entails(graph, target)
+
+
+def test_a_batch_avoids_pairs_pending_at_other_cells() -> None:
+    learner = SizeLearner(["a", "b"], ["x", "y"])
+    learner.record("a", "x", "fit")
+    learner.record("b", "x", "no_fit")  # a < x < b
+    # (a,y) and (b,y) are not independent: a not fitting y entails b not fitting y
+    assert learner.next_batch(2) == [("a", "y")]
+    assert learner.next_batch(2, pending=[("a", "y")]) == []
