@@ -3,9 +3,9 @@
 RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: planner
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
-on the files plus ``RUN/view.rbl``, a blueprint with one tab per cell found in the
-recording (``executor.rerun_blueprint.cell_views``; other entities, e.g. the
-planner's, get the viewer's automatic views). Without a display (no ``DISPLAY`` /
+on the files plus ``RUN/view.rbl``, a blueprint with the planner's tab
+(``asp.session_rerun.planner_views``) when the recording has ``planner/...`` entities
+and one tab per cell found (``executor.rerun_blueprint.cell_views``). Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
 same as JSON). A RUN without ``.rrd`` files is an error (exit code 2).
@@ -56,17 +56,15 @@ def rerun_executable() -> str:
     return found
 
 
-def write_blueprint(folder: Path, cells: Sequence[str]) -> Path:
-    """``folder/view.rbl``: one tab per cell, automatic views for everything else."""
-    import rerun.blueprint as rrb
-
-    from executor.rerun_blueprint import cell_views
+def write_blueprint(folder: Path, cells: Sequence[str], planner: bool) -> Path:
+    """``folder/view.rbl``: the planner's tab (if ``planner``), then one tab per cell."""
+    from asp.session_rerun import planner_views
+    from executor.rerun_blueprint import cell_blueprint
     from executor.rerun_log import APPLICATION_ID
 
     path = folder / "view.rbl"
-    rrb.Blueprint(rrb.Tabs(*(cell_views(c) for c in cells)), auto_views=True).save(
-        APPLICATION_ID, str(path)
-    )
+    extra = [planner_views()] if planner else []
+    cell_blueprint(cells, extra=extra).save(APPLICATION_ID, str(path))
     return path
 
 
@@ -89,9 +87,10 @@ def main(argv: Sequence[str]) -> int:
         print(json.dumps(summary.to_json(), indent=2) if args.json else format_summary(summary))
         return 0
     cells = cell_ids(list(summary.entities))
-    blueprint = [write_blueprint(run if run.is_dir() else run.parent, cells)] if cells else []
+    planner = bool(summary.under("planner"))
+    blueprint = write_blueprint(run if run.is_dir() else run.parent, cells, planner)
     subprocess.Popen(
-        [rerun_executable(), *map(str, files), *map(str, blueprint)],
+        [rerun_executable(), *map(str, files), str(blueprint)],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
     )
     print(f"view: opened {len(files)} recording file(s) in the Rerun viewer")

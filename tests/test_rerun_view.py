@@ -60,13 +60,15 @@ def test_view_without_recording_exits_2(tmp_path: Path) -> None:
     assert missing.returncode == 2 and "no such run folder" in missing.stderr
 
 
-def test_blueprint_has_a_tab_per_cell(tmp_path: Path) -> None:
+def test_blueprint_has_the_planner_and_a_tab_per_cell(tmp_path: Path) -> None:
     paths = ["/executor/c1/outcome", "/executor/c2/scene/plate", "/planner/knowledge", "/executor"]
     assert cell_ids(paths) == ["c1", "c2"]
-    blueprint = write_blueprint(tmp_path, ["c1", "c2"])
+    blueprint = write_blueprint(tmp_path, ["c1", "c2"], planner=True)
     stores = RrdReader(blueprint).blueprints()
     assert [s.application_id for s in stores] == ["assembly_constraints"]
     origins = blueprint_origins(blueprint)
     for cell in ("c1", "c2"):
         assert {f"executor/{cell}", f"executor/{cell}/wrench/force", f"executor/{cell}/by_phase",
                 f"executor/{cell}/outcome"} <= origins
+    assert {"planner/knowledge", "planner/precedence"} <= origins
+    assert not any(o.startswith("planner") for o in blueprint_origins(write_blueprint(tmp_path, ["c1"], False)))
