@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import queue
 import signal
+import threading
 from collections.abc import Iterator
 
 import pytest
@@ -92,14 +93,15 @@ def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(net
     requests = [InsertRequest(id=f"r{i}", part=p, hole=h) for i, (p, h) in enumerate(pairs)]
     delivered: list[tuple[str, str]] = []
 
-    def on_reply(request: InsertRequest, reply: InsertReply) -> None:
-        delivered.append((request.id, reply.cell))
-        if len(delivered) == 2:  # c1 is then busy with its next experiment
-            cells[0].wait_for_line("start", timeout=10, count=2)
-            cells[0].kill()
+    def kill_c1_in_its_second_experiment() -> None:
+        cells[0].wait_for_line("start", timeout=30, count=2)
+        cells[0].kill()
 
+    killer = threading.Thread(target=kill_c1_in_its_second_experiment)
+    killer.start()
     pool = CellPool(session, directory, timeout=20.0, wait_for_cell=20.0)
-    replies = pool.run(requests, on_reply)
+    replies = pool.run(requests, lambda request, reply: delivered.append((request.id, reply.cell)))
+    killer.join(30)
     assert sorted(replies) == sorted(r.id for r in requests)
     assert len(delivered) == len(requests) == len({rid for rid, _ in delivered})
     truth = {("p1", "r1"), ("p1", "s1"), ("p1", "br"), ("p3", "s1"), ("p3", "br"), ("sh", "br")}
