@@ -53,7 +53,7 @@ ALPHA = 0.5
 EXACT_LIMIT = 400_000
 """Largest number of m×n biorders enumerated for the exact path (5×5 has 329 462)."""
 
-SAMPLES = 4096
+SAMPLES = 1024
 """Random linear extensions drawn per decision on the sampled path."""
 
 SCORE_DECIMALS = 9

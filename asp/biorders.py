@@ -98,15 +98,23 @@ def mask_bits(masks: np.ndarray, pairs: int) -> np.ndarray:
     return np.unpackbits(as_bytes, axis=1, count=pairs, bitorder="little").astype(bool)
 
 
+def line_keys(lines: np.ndarray) -> np.ndarray:
+    """One comparable key per boolean vector along the last axis (packed bytes, void dtype)."""
+    packed = np.ascontiguousarray(np.packbits(lines, axis=-1))
+    return packed.view(f"V{packed.shape[-1]}")[..., 0]
+
+
 def class_weights(fits: np.ndarray) -> np.ndarray:
     """∏ k! over classes of identical rows and of identical columns, per relation.
 
     ``fits`` has shape (relations, m, n); the result is float64.
     """
     log_weight = np.zeros(len(fits))
-    per_member = np.array([0.0] + [math.lgamma(k + 1) / k for k in range(1, max(fits.shape[1:], default=0) + 1)])
+    longest = max(fits.shape[1:], default=0)
+    per_member = np.array([0.0] + [math.lgamma(k + 1) / k for k in range(1, longest + 1)])
     for lines in (fits, fits.transpose(0, 2, 1)):
-        same = (lines[:, :, None, :] == lines[:, None, :, :]).all(axis=3).sum(axis=2)
+        keys = line_keys(lines)
+        same = (keys[:, :, None] == keys[:, None, :]).sum(axis=2)
         # a class of k lines contributes log(k!), i.e. log(k!)/k from each member
         log_weight += per_member[same].sum(axis=1)
     return np.exp(log_weight)
@@ -130,4 +138,5 @@ def sample_biorders(smaller: np.ndarray, m: int, n: int, samples: int, rng: np.r
     fits = (part_size < hole_size) | (
         (part_size == hole_size) & (height[:m, None] < height[None, m:])[None, :, :]
     )
-    return np.unique(fits.reshape(samples, m * n), axis=0).reshape(-1, m, n)
+    _, first = np.unique(line_keys(fits.reshape(samples, m * n)), return_index=True)
+    return fits[first]

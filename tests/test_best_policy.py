@@ -1,0 +1,57 @@
+"""The ``best`` policy: ASP and numpy paths agree; it learns any biorder, never asking a known pair."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from asp.best_policy import choose, choose_by_asp, knowledge_masks, possible_relations_asp
+from asp.biorders import all_biorders, consistent_index
+from asp.size_learner import SizeLearner
+from asp.size_policies import get_policy
+from tests.test_best_biorders import biorder_truths, closure_after
+
+
+@settings(max_examples=20, deadline=None)
+@given(truth=biorder_truths(3), data=st.data())
+def test_asp_path_enumerates_the_same_relations_and_chooses_the_same_pair(
+    truth: np.ndarray, data: st.DataObject
+) -> None:
+    m, n = truth.shape
+    observed = data.draw(st.lists(st.integers(0, m * n - 1), max_size=m * n // 2))
+    knowledge = closure_after(truth, observed).knowledge
+    if not knowledge.unknown:
+        return
+    masks, weights = possible_relations_asp(knowledge)
+    everything = all_biorders(m, n)
+    assert masks.tolist() == everything[consistent_index(everything, *knowledge_masks(knowledge))].tolist()
+    assert weights.min() >= 1.0
+    assert choose_by_asp(knowledge) == choose(knowledge, None)
+
+
+def run_best(truth: np.ndarray) -> tuple[SizeLearner, int]:
+    """Learn ``truth`` with ``best``; assert every proposed pair was unknown when proposed."""
+    m, n = truth.shape
+    learner = SizeLearner([f"q{i}" for i in range(m)], [f"k{j}" for j in range(n)], "best")
+    while (pair := learner.next_experiment()) is not None:
+        assert pair in learner.knowledge.unknown, f"{pair} was already entailed"
+        p, h = learner.parts.index(pair[0]), learner.holes.index(pair[1])
+        learner.record(*pair, "fit" if truth[p, h] else "no_fit")
+    return learner, len(learner.experiments)
+
+
+@settings(max_examples=4, deadline=None)
+@given(truth=biorder_truths(8))
+@example(truth=np.arange(8)[:, None] % 3 < np.arange(8)[None, :] % 4)
+def test_best_learns_the_exact_relation_of_random_biorders(truth: np.ndarray) -> None:
+    learner, count = run_best(truth)
+    m, n = truth.shape
+    learned = {(learner.parts.index(p), learner.holes.index(h)) for p, h in learner.knowledge.fits}
+    assert learned == set(zip(*np.nonzero(truth)))
+    assert count <= m * n
+
+
+def test_registry_entry_resolves_to_the_best_policy() -> None:
+    policy = get_policy("best")
+    assert policy.name == "best" and policy.choose is choose and policy.deterministic
