@@ -34,7 +34,7 @@ from pathlib import Path
 from asp import PlannerError
 from asp.assembly import Assembly, load_assembly
 from asp.assign import greedy_assignment, load_learned_facts
-from asp.cell_processes import CellProcess, start_cell
+from asp.cell_processes import CellProcess, serve_argv
 from asp.demos import demo_facts, load_demos
 from asp.facts import fact, write_facts
 from asp.journal import Journal
@@ -159,8 +159,6 @@ def run_session(args: argparse.Namespace) -> dict:
         raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
     run, settings = _run_folder(args)
     assembly = load_assembly(settings["assembly"])
-    demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
-    relation = learn_must_precede(demos)
     parts, holes, truth = _sizes_domain(assembly)
     run_id = re.sub(r"[^A-Za-z0-9_-]", "-", settings["recording_id"])
     listen, connect = _endpoints(args)
@@ -174,15 +172,20 @@ def run_session(args: argparse.Namespace) -> dict:
         stack.callback(directory.close)
         cells: list[CellProcess] = []
         stack.callback(lambda: [cell.stop() for cell in cells])
-        for cell_id in cell_ids:
-            cells.append(start_cell(
+        for cell_id in cell_ids:  # they start up in parallel with each other and with us
+            cells.append(CellProcess(cell_id, serve_argv(
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
-                recording_id=settings["recording_id"]))
+                recording_id=settings["recording_id"])))
+        demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
+        relation = learn_must_precede(demos)
+        for cell in cells:
+            cell.wait_for_line("ready", timeout=args.wait_for_cell)
         try:
             directory.wait_for(max(1, len(cell_ids)), timeout=args.wait_for_cell)
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
+        timings = {"cells_ready_s": time.perf_counter() - started}
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
@@ -192,6 +195,7 @@ def run_session(args: argparse.Namespace) -> dict:
         oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
         learner = SizeLearner(parts, holes, settings["policy"], settings["seed"])
         sizes = _learn_sizes(oracle, learner, journal, log)
+        timings["learned_s"] = time.perf_counter() - started
         learned = run / "learned.lp"
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
                     header=f"Learned by ./run.sh session on {assembly.name} ({run}).")
@@ -215,7 +219,8 @@ def run_session(args: argparse.Namespace) -> dict:
     settings.update(result, status="done", assignment=assignment, cells=cell_ids,
                     journal=[{"part": e.part, "hole": e.hole, "result": e.result, "cell": e.cell,
                               "retest": e.retest} for e in journal.entries],
-                    wall_s=round(time.perf_counter() - started, 3))
+                    wall_s=round(time.perf_counter() - started, 3),
+                    timings={k: round(v, 3) for k, v in timings.items()})
     _save(run, settings)
     return result
 
