@@ -1,0 +1,120 @@
+"""``./run.sh bench session``: the bridge's overhead and the session's wall time.
+
+1. Request/reply over Zenoh on loopback with a ``truth`` cell (no simulation): a
+   validated InsertRequest → InsertReply round trip (encode, size cap, decode and
+   validate on both sides, idempotency cache) beside a bare Zenoh query round trip of
+   the same payload to the cell's ``ping`` queryable, measured alternately in the same
+   run; medians [ms] and their ratio. Target: validated median < 1 ms.
+2. The Cranfield session (``sim`` backend) with 1 cell and with 2 cells: wall time [s]
+   of the whole command, experiments, and the ratio 2 cells / 1 cell (target ≤ 0.65;
+   on a shared 2-core machine the cells compete with everything else for the cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import queue
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from asp.cell_processes import ROOT, start_cell
+from bridge.client import CellDirectory, request_insert
+from bridge.keys import ping_key
+from bridge.messages import InsertRequest, encode
+from bridge.session import free_loopback_endpoint, open_session
+
+
+def _ms(values: list[float]) -> dict[str, float]:
+    ordered = sorted(values)
+    return {"median_ms": round(1000 * statistics.median(ordered), 4),
+            "p90_ms": round(1000 * ordered[int(0.9 * (len(ordered) - 1))], 4)}
+
+
+def round_trips(count: int) -> dict:
+    """Validated insert round trips vs bare queries, alternating, to one truth cell."""
+    endpoint = free_loopback_endpoint()
+    cell = start_cell("bench", backend="truth", listen=[endpoint])
+    session = open_session(connect=[endpoint])
+    try:
+        CellDirectory(session).wait_for(1, timeout=30)
+        replies: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+        validated: list[float] = []
+        bare: list[float] = []
+        for k in range(count + 20):  # the first 20 of each warm up
+            request = InsertRequest(id=f"bench-{k}", part="p3", hole="s1", seed=k)
+            payload = encode(request)
+            t0 = time.perf_counter()
+            session.get(ping_key("bench"), lambda reply: replies.put(reply.ok.payload.to_bytes()),
+                        payload=payload, timeout=10.0)
+            replies.get(timeout=15.0)
+            t1 = time.perf_counter()
+            request_insert(session, "bench", request, timeout=10.0)
+            t2 = time.perf_counter()
+            if k >= 20:
+                bare.append(t1 - t0)
+                validated.append(t2 - t1)
+        result = {"round_trips": count, "payload_bytes": len(payload),
+                  "validated": _ms(validated), "bare": _ms(bare)}
+        result["ratio"] = round(result["validated"]["median_ms"] / result["bare"]["median_ms"], 3)
+        return result
+    finally:
+        session.close()
+        cell.stop()
+
+
+def session_walls(cells: int, repeat: int, policy: str) -> dict:
+    """Wall time [s] of ``session --cells N`` (sim backend), ``repeat`` runs."""
+    walls: list[float] = []
+    experiments: list[int] = []
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    for _ in range(repeat):
+        with tempfile.TemporaryDirectory() as tmp:
+            argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells),
+                    "--policy", policy, "--out", str(Path(tmp) / "run"), "--json"]
+            t0 = time.perf_counter()
+            done = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True,
+                                  timeout=900)
+            walls.append(time.perf_counter() - t0)
+            if done.returncode != 0:
+                raise SystemExit(f"session --cells {cells} failed: {done.stderr.strip()}")
+            result = json.loads(done.stdout)
+            if not result["matches_truth"]:
+                raise SystemExit(f"session --cells {cells} learned a wrong relation")
+            experiments.append(result["experiments"])
+    return {"cells": cells, "walls_s": [round(w, 2) for w in walls],
+            "median_wall_s": round(statistics.median(walls), 2), "experiments": experiments}
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="bench session", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--round-trips", type=int, default=1000, help="per kind (default 1000)")
+    parser.add_argument("--repeat", type=int, default=1, help="sessions per cell count (default 1)")
+    parser.add_argument("--policy", default="best", help="session policy (default best)")
+    parser.add_argument("--skip-sessions", action="store_true", help="only the round trips")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    args = parser.parse_args(argv)
+    figures: dict = {"overhead": round_trips(args.round_trips)}
+    o = figures["overhead"]
+    if not args.json:
+        print(f"round trip over Zenoh on loopback ({o['round_trips']} each, "
+              f"{o['payload_bytes']} B): validated insert median {o['validated']['median_ms']:.3f} ms "
+              f"(p90 {o['validated']['p90_ms']:.3f}), bare query median {o['bare']['median_ms']:.3f} ms "
+              f"(p90 {o['bare']['p90_ms']:.3f}), ratio {o['ratio']:.2f}", flush=True)
+    if not args.skip_sessions:
+        one, two = (session_walls(n, args.repeat, args.policy) for n in (1, 2))
+        figures["sessions"] = [one, two]
+        figures["ratio_2_over_1"] = round(two["median_wall_s"] / one["median_wall_s"], 3)
+        if not args.json:
+            for s in (one, two):
+                print(f"Cranfield session, {s['cells']} cell(s), sim: median {s['median_wall_s']:.1f} s "
+                      f"wall (runs {s['walls_s']}, experiments {s['experiments']})")
+            print(f"ratio 2 cells / 1 cell: {figures['ratio_2_over_1']:.2f}")
+    if args.json:
+        print(json.dumps(figures, indent=2))
+    return 0
