@@ -1,0 +1,35 @@
+"""One real simulated insertion served over Zenoh by ``executor serve --backend sim``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from asp.cell_processes import start_cell
+from bridge.client import CellDirectory, request_insert
+from bridge.messages import InsertRequest
+from bridge.session import free_loopback_endpoint, open_session
+
+
+@pytest.mark.timeout(90)
+def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
+    from executor.recording import read_recording
+
+    endpoint = free_loopback_endpoint()
+    rrd = tmp_path / "c1.rrd"
+    cell = start_cell("c1", backend="sim", listen=[endpoint], rrd=rrd, recording_id="sim-test")
+    session = open_session(connect=[endpoint])
+    try:
+        CellDirectory(session).wait_for(1, timeout=30)
+        reply = request_insert(session, "c1", InsertRequest(id="s1", part="p1", hole="br", seed=3),
+                               timeout=60)
+        assert reply.result == "fit"
+        assert reply.evidence is not None and reply.evidence.attempts >= 1
+        assert reply.evidence.end_error < 0.01 and reply.evidence.duration_s > 0
+    finally:
+        session.close()
+        assert cell.stop() == 0
+    summary = read_recording([rrd])
+    assert set(summary.recording_ids) == {"sim-test"}
+    assert any(path.startswith("/executor/c1/wrench") for path in summary.entities)
