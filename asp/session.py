@@ -57,8 +57,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
     parser.add_argument("--cells", type=int, default=1, help="cell co-processes to start (default 1)")
-    parser.add_argument("--policy", default="heuristic", choices=policy_names(),
-                        help="experiment selection policy (default heuristic)")
+    parser.add_argument("--policy", default="best", choices=policy_names(),
+                        help="experiment selection policy (default best: fewest experiments)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the policy and the trials")
     parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
