@@ -10,7 +10,6 @@ waits for one with a deadline.
 from __future__ import annotations
 
 import os
-import queue
 import signal
 import subprocess
 import sys

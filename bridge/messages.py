@@ -32,8 +32,11 @@ Result = Literal["fit", "no_fit"]
 ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "failed"]
 
 
-class InsertRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
-                    tag_field="kind", tag="insert"):
+class _Message(msgspec.Struct, frozen=True, forbid_unknown_fields=True, tag_field="kind"):
+    """Base of the tagged messages: immutable, unknown fields refused."""
+
+
+class InsertRequest(_Message, tag="insert"):
     """Insert ``part`` into ``hole``; ``id`` makes the request idempotent at the cell."""
 
     id: RequestId
@@ -58,8 +61,7 @@ class Evidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """Simulated duration of the attempts [s]."""
 
 
-class InsertReply(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
-                  tag_field="kind", tag="insert_reply"):
+class InsertReply(_Message, tag="insert_reply"):
     """The outcome of request ``id`` as observed by cell ``cell``."""
 
     id: RequestId
@@ -71,8 +73,7 @@ class InsertReply(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
     v: int = PROTOCOL_VERSION
 
 
-class ErrorReply(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
-                 tag_field="kind", tag="error"):
+class ErrorReply(_Message, tag="error"):
     """A refused request: ``code`` says why, ``error`` says what was expected."""
 
     cell: CellId
