@@ -92,12 +92,13 @@ def solve_encoding(
 
 def _check_ids(facts: LearnedFacts, sources: str) -> None:
     known_parts, known_holes = set(facts.parts), set(facts.holes)
-    for part, hole in sorted(facts.fits):
-        if part not in known_parts or hole not in known_holes:
-            raise PlannerError(
-                f"{sources}: fits({part},{hole}): expected a part/1 and a hole/1 "
-                f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
-            )
+    for name in ("fits", "no_fit"):
+        for part, hole in atoms_by_name(facts.atoms, name, 2):
+            if part not in known_parts or hole not in known_holes:
+                raise PlannerError(
+                    f"{sources}: {name}({part},{hole}): expected a part/1 and a hole/1 "
+                    f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
+                )
     for first, then in sorted(facts.must_precede):
         for part in (first, then):
             if part not in known_parts:
