@@ -87,7 +87,7 @@ def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
 def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(network) -> None:
     endpoint, session, directory, cells = network
     for cell_id in ("c1", "c2"):
-        cells.append(start_cell(cell_id, backend="truth", connect=[endpoint], delay_s=0.3))
+        cells.append(start_cell(cell_id, backend="truth", connect=[endpoint], delay_s=0.5))
     directory.wait_for(2, timeout=20)
     pairs = [(p, h) for p in ("p1", "p3", "sh") for h in ("r1", "s1", "br")]
     requests = [InsertRequest(id=f"r{i}", part=p, hole=h) for i, (p, h) in enumerate(pairs)]
