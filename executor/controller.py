@@ -41,6 +41,12 @@ class ImpedanceController:
         self._steps = 0
         self._null_projector = np.eye(7)
 
+    def reset(self) -> None:
+        """Forget the cached null-space projector (call after teleporting the arm), so an
+        attempt does not depend on what ran before it."""
+        self._steps = 0
+        self._null_projector = np.eye(7)
+
     def step(self, pos_des: np.ndarray, quat_des_xyzw: np.ndarray,
              wrench_ff: np.ndarray | None = None) -> ArmState:
         """Read the arm, command the torques toward the desired pose (plus an optional

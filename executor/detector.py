@@ -14,6 +14,7 @@ transients when an edge catches last 1–5 ms).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,27 +33,37 @@ class Thresholds:
 
 
 class Detector:
-    """Tracks the wrench deviation of one attempt; ``violated`` after a sustained breach."""
+    """Tracks the wrench deviation of one attempt; ``violated`` after a sustained breach.
+
+    ``max_force_dev`` / ``max_torque_dev`` are the largest deviations *sustained* for
+    ``persist_steps`` steps (max over time of the window minimum): directly comparable
+    with F_stop and M_stop, blind to single-step contact spikes."""
 
     def __init__(self, thresholds: Thresholds = Thresholds()) -> None:
         self.thresholds = thresholds
         self.max_force_dev = 0.0
         self.max_torque_dev = 0.0
-        self._breach = 0
+        self._window = np.zeros((thresholds.persist_steps, 2))
+        self._count = 0
 
     def update(self, force_dev: np.ndarray, torque_dev: np.ndarray) -> tuple[float, float, bool]:
         """Add one sample of the deviations (3,) [N], (3,) [Nm]; returns their norms and
         whether eq. (6) or (7) has held for ``persist_steps`` steps in a row."""
-        f, m = float(np.linalg.norm(force_dev)), float(np.linalg.norm(torque_dev))
-        self.max_force_dev = max(self.max_force_dev, f)
-        self.max_torque_dev = max(self.max_torque_dev, m)
+        f = math.sqrt(force_dev[0] ** 2 + force_dev[1] ** 2 + force_dev[2] ** 2)
+        m = math.sqrt(torque_dev[0] ** 2 + torque_dev[1] ** 2 + torque_dev[2] ** 2)
         th = self.thresholds
-        self._breach = self._breach + 1 if (f >= th.f_stop or m >= th.m_stop) else 0
-        return f, m, self._breach >= th.persist_steps
+        self._window[self._count % th.persist_steps] = (f, m)
+        self._count += 1
+        if self._count < th.persist_steps:
+            return f, m, False
+        f_sustained, m_sustained = self._window.min(axis=0)
+        self.max_force_dev = max(self.max_force_dev, float(f_sustained))
+        self.max_torque_dev = max(self.max_torque_dev, float(m_sustained))
+        return f, m, bool(f_sustained >= th.f_stop or m_sustained >= th.m_stop)
 
     def clear(self) -> None:
-        """Forget a breach in progress (after the exception strategy)."""
-        self._breach = 0
+        """Forget the recent samples (after the exception strategy)."""
+        self._count = 0
 
     def goal_reached(self, p_end: np.ndarray, p_goal: np.ndarray) -> tuple[bool, float]:
         """The goal check: (‖p_end − p_goal‖ ≤ tolerance, the distance [m])."""

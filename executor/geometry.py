@@ -115,14 +115,16 @@ def _ring(kind: str, half: float, n: int) -> np.ndarray:
 
 def _boss_triangles(hole: HoleSpec, plate: dict) -> list[np.ndarray]:
     """Triangles (3×3 vertex arrays [m], outward normals) of one boss with its through
-    hole (the plate under the boss is the hole's bottom)."""
+    hole (the plate under the boss is the hole's bottom) and a 45° entry chamfer."""
     n = int(plate["polygon_sides"])
     if n % 8:
         raise ExecutorError(f"geometry.toml: polygon_sides = {n}, expected a multiple of 8")
     cx, cy = hole.position
     top = float(plate["top_z"])
     bottom = top - float(plate["tile_thickness"])
+    chamfer = float(plate["chamfer"])
     outer = _ring("square", float(plate["tile_size"]) / 2, n) + (cx, cy)
+    mouth = _ring(hole.kind, hole.size / 2 + chamfer, n) + (cx, cy)
     inner = _ring(hole.kind, hole.size / 2, n) + (cx, cy)
 
     def v(ring: np.ndarray, k: int, z: float) -> np.ndarray:
@@ -133,10 +135,14 @@ def _boss_triangles(hole: HoleSpec, plate: dict) -> list[np.ndarray]:
     centre_top = np.array([cx, cy, top])
     up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
     for k in range(n):
-        o0, o1, i0, i1 = v(outer, k, top), v(outer, k + 1, top), v(inner, k, top), v(inner, k + 1, top)
-        tris += [(o0, o1, i1, up), (o0, i1, i0, up)]
+        o0, o1, m0, m1 = v(outer, k, top), v(outer, k + 1, top), v(mouth, k, top), v(mouth, k + 1, top)
+        tris += [(o0, o1, m1, up), (o0, m1, m0, up)]
+        i0, i1 = v(inner, k, top - chamfer), v(inner, k + 1, top - chamfer)
+        slope = centre_top - (m0 + m1) / 2 + np.array([0.0, 0.0, np.linalg.norm(centre_top - (m0 + m1) / 2)])
+        tris += [(m0, m1, i1, slope), (m0, i1, i0, slope)]
         f0, f1 = v(inner, k, bottom), v(inner, k + 1, bottom)
         wall_in = centre_top - (i0 + i1) / 2
+        wall_in[2] = 0.0
         tris += [(i0, i1, f1, wall_in), (i0, f1, f0, wall_in)]
         b0, b1 = v(outer, k, bottom), v(outer, k + 1, bottom)
         wall_out = (o0 + o1) / 2 - centre_top

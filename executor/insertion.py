@@ -22,12 +22,14 @@ from executor.wiggle import wiggle
 TIMEOUT_FACTOR = 3.0
 SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
 MAX_WIGGLES = 1  # exception strategy runs per attempt
+JAM_DEPTH = 0.003  # [m] below the entry: a breach there is a jam, not a part on the surface
 
 
 @dataclass
 class InsertionResult:
-    """``completed``: the DMP ran to its end without a lasting eq. (6)/(7) breach;
-    ``reached``: goal check passed; ``end_error`` ‖p_end − p_goal‖ [m]."""
+    """``completed``: the DMP ran to its end without an unresolved eq. (6)/(7) breach;
+    ``reached``: goal check passed; ``end_error`` ‖p_end − p_goal‖ [m]; ``jammed``: a
+    breach happened inside the hole."""
 
     completed: bool
     reached: bool
@@ -46,9 +48,11 @@ def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
 
 
 def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector, admittance: Admittance,
-           rim_radius: float, wiggle_enabled: bool = True) -> InsertionResult:
+           gripper_lever: float, wiggle_enabled: bool = True) -> InsertionResult:
     """Run the skill in the hole frame at ``hole_origin`` (hole centre on the plate top,
-    [m]) starting from the current tip pose."""
+    [m]) starting from the current tip pose.  A breach with the tip inside the hole
+    (deeper than ``JAM_DEPTH``) is a jam: the wiggle runs once and the insertion goes on;
+    a breach with the part still on the plate surface ends the attempt."""
     s = motion.controller.arm.read()
     goal = skill.demo_goal
     times, pos, quats = skill.rollout(s.tip_pos - hole_origin, s.tip_quat_xyzw, goal[:3],
@@ -68,11 +72,11 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         f_norm, _, violated = detector.update(f_dev, m_dev)
         d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
         if violated:
-            jammed = True
-            if not wiggle_enabled or wiggles >= MAX_WIGGLES:
+            jammed = s.tip_pos[2] < hole_origin[2] - JAM_DEPTH
+            if not (jammed and wiggle_enabled and wiggles < MAX_WIGGLES):
                 completed = False
                 break
-            wiggle(motion, pos_d + d_pos, quat_cmd, rim_radius, clock.phase, w_des)
+            wiggle(motion, pos_d + d_pos, quat_cmd, gripper_lever, clock.phase, w_des)
             wiggles += 1
             detector.clear()
             continue

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from executor.admittance import Admittance
 from executor.motion import Motion
 from executor.scene import TIME_STEP
 
@@ -23,18 +24,22 @@ from executor.scene import TIME_STEP
 class SearchParams:
     """Approach speed [m/s], contact force that means "on the surface" [N], how far
     below the surface the tip is pushed while sliding [m] (× 2000 N/m = contact force),
-    sink depth that means "in the hole" [m], spiral pitch [m] (± ``pitch_jitter``),
-    sliding speed [m/s], search radius [m] and time limit [s]."""
+    sink depth that means "in the hole" [m], dip that pauses the spiral [m] and for how
+    long at most [s], spiral pitch [m] (± ``pitch_jitter``),
+    sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm)
+    and time limit [s]."""
 
     approach_speed: float = 0.02
     contact_force: float = 2.0
     press_depth: float = 0.0025
-    sink_depth: float = 0.0012
-    pitch: float = 0.0012
-    pitch_jitter: float = 0.2
-    speed: float = 0.025
-    max_radius: float = 0.0045
-    max_time: float = 1.6
+    sink_depth: float = 0.0005
+    dip_depth: float = 0.0001
+    dip_hold: float = 0.3
+    pitch: float = 0.0013
+    pitch_jitter: float = 0.15
+    speed: float = 0.04
+    max_radius: float = 0.0042
+    max_time: float = 2.2
 
 
 @dataclass
@@ -49,7 +54,12 @@ class SearchResult:
 
 def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: float, quat_xyzw: np.ndarray,
                 rng: np.random.Generator, params: SearchParams = SearchParams()) -> SearchResult:
-    """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m]."""
+    """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m].
+
+    While sliding, a dip of the tip (``dip_depth`` below the touched surface: an edge of
+    the part is over the hole) pauses the spiral for up to ``dip_hold``; meanwhile the
+    commanded position complies to the lateral contact force (admittance), so the part
+    slides down the hole's edge into it like into a chamfer."""
     p = params
     path: list[np.ndarray] = []
     target_z = surface_z - p.press_depth
@@ -62,22 +72,36 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
             return SearchResult(True, s.tip_pos[:2].copy(), surface_z, np.array([s.tip_pos]))
         if s.force[2] > p.contact_force or (z == target_z and abs(s.tip_vel[2]) < 1e-3):
             break
+    touched_z = float(s.tip_pos[2])
     # 2. Spiral under contact: r = pitch·θ/2π, constant sliding speed.
     angle0 = rng.uniform(0, 2 * math.pi)
     direction = rng.choice([-1.0, 1.0])
     pitch = p.pitch * (1 + rng.uniform(-p.pitch_jitter, p.pitch_jitter))
-    theta, elapsed = 0.0, 0.0
+    theta, elapsed, paused, may_pause = 0.0, 0.0, 0, True
+    comply = Admittance()
+    offset = np.zeros(2)
     while elapsed < p.max_time:
         radius = pitch * theta / (2 * math.pi)
         if radius > p.max_radius:
             break
-        theta += p.speed * TIME_STEP / max(radius, pitch / 2)
-        offset = radius * np.array([math.cos(angle0 + direction * theta), math.sin(angle0 + direction * theta)])
-        s = motion.step(np.array([est_xy[0] + offset[0], est_xy[1] + offset[1], target_z]), quat_xyzw)
+        dipped = s.tip_pos[2] < touched_z - p.dip_depth
+        if dipped and may_pause and paused < p.dip_hold / TIME_STEP:
+            paused += 1
+            shift = comply.update(s.force, np.zeros(3), TIME_STEP)[0][:2]
+        else:
+            may_pause = not dipped
+            paused = 0
+            comply = Admittance()
+            shift = np.zeros(2)
+            theta += p.speed * TIME_STEP / max(radius, pitch / 2)
+            angle = angle0 + direction * theta
+            offset = radius * np.array([math.cos(angle), math.sin(angle)])
+        xy = est_xy + offset + shift
+        s = motion.step(np.array([xy[0], xy[1], target_z]), quat_xyzw)
         elapsed += TIME_STEP
         if motion.steps % 10 == 0:
             path.append(s.tip_pos.copy())
-        if s.tip_pos[2] < surface_z - p.sink_depth:
+        if s.tip_pos[2] < touched_z - p.sink_depth:
             path.append(s.tip_pos.copy())
             return SearchResult(True, s.tip_pos[:2].copy(), surface_z, np.array(path))
     return SearchResult(False, np.asarray(est_xy, dtype=float).copy(), surface_z, np.array(path).reshape(-1, 3))

@@ -79,6 +79,7 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
 
     def go_to_start() -> None:
         arm.inverse_kinematics(start, TOOL_DOWN_QUAT_XYZW)
+        motion.controller.reset()
         motion.hold(start, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
         arm.tare_sensor()
 

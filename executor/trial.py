@@ -193,6 +193,7 @@ class Cell:
         quat = TOOL_DOWN_QUAT_XYZW
         approach = np.array([est_xy[0], est_xy[1], surface + APPROACH_HEIGHT])
         arm.inverse_kinematics(approach, quat)
+        motion.controller.reset()
         motion.hold(approach, quat, SETTLE_TIME)
         arm.tare_sensor()
         found = hole_search(motion, est_xy, surface, approach[2], quat,
@@ -201,8 +202,8 @@ class Cell:
             self.logger.log_search_path(found.path)
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
-        rim = spec.size / 2
-        result = insert(motion, skill, origin, detector, Admittance(), rim, wiggle_enabled)
+        lever = spec.length - float(self.geometry.gripper["grasp_depth"])
+        result = insert(motion, skill, origin, detector, Admittance(), lever, wiggle_enabled)
         self.scene.release()
         return AttemptEvidence(
             "fit" if result.reached else "no_fit", detector.max_force_dev, detector.max_torque_dev,

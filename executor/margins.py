@@ -1,0 +1,46 @@
+"""Measure the margins the detector thresholds are chosen from.
+
+``python -m executor.margins [--trials N] [--seed S]`` runs every part-hole pair of the
+cell with eqs. (6)/(7) switched off (F_stop = M_stop = ∞, so nothing is interrupted)
+and prints, per pair and over the trials, the largest sustained wrench deviation
+(the statistic eqs. 6 and 7 are tested on) and the end error ‖p_end − p_goal‖.
+Fitting pairs give the floor F_stop and M_stop must stay above; the end errors give the
+goal tolerance.  Too-big parts are stopped only by the insertion time-out here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+
+from executor.detector import Thresholds
+from executor.trial import AttemptSetup, Cell, trial_rng
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="executor.margins", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--trials", type=int, default=10, help="attempts per pair (default 10)")
+    parser.add_argument("--seed", type=int, default=0, help="first seed")
+    parser.add_argument("--pairs", help="comma-separated part:hole pairs (default: all)")
+    args = parser.parse_args(argv)
+    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf))
+    pairs = ([tuple(p.split(":")) for p in args.pairs.split(",")] if args.pairs else
+             [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)])
+    print(f"{'pair':8s} {'max dF [N]':>10s} {'max dM [Nm]':>11s} {'end error [mm] min..max':>24s}  found")
+    try:
+        for part, hole in pairs:
+            evidence = [cell.run_attempt(part, hole, AttemptSetup.draw(trial_rng(args.seed + k, part, hole)))
+                        for k in range(args.trials)]
+            errors = [1000 * e.end_error for e in evidence]
+            print(f"{part}:{hole:5s} {max(e.max_force_dev for e in evidence):10.2f} "
+                  f"{max(e.max_torque_dev for e in evidence):11.3f} {min(errors):11.2f} .. {max(errors):8.2f}  "
+                  f"{sum(e.hole_found for e in evidence)}/{len(evidence)}", flush=True)
+    finally:
+        cell.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
