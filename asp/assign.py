@@ -161,7 +161,7 @@ def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:
     found: list[Assignment] = []
 
     def keep(model: clingo.Model) -> None:
-        found.append(dict(atoms_by_name(model.symbols(shown=True), "assigned", 2)))
+        found.append({p: h for p, h in atoms_by_name(model.symbols(shown=True), "assigned", 2)})
 
     solve_encoding("assignments.lp", facts.atoms, [f"--models={limit}"], keep)
     if not found:

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 
+import clingo
+
 from asp import PlannerError
 from asp.assembly import load_assembly
 from asp.assign import UnsolvableAssembly, load_learned_facts
@@ -43,7 +45,7 @@ def main(argv: list[str]) -> int:
     if (args.optimal or args.travel_out) and not args.assembly:
         raise PlannerError("--optimal and --travel-out need --assembly (part and hole positions)")
     facts = load_learned_facts(args.facts)
-    travel = []
+    travel: list[clingo.Symbol] = []
     if args.optimal or args.travel_out:
         travel = travel_facts(load_assembly(args.assembly), facts, tuple(args.home))
     if args.travel_out:

@@ -103,9 +103,10 @@ def _parts_on_cycles(must_precede: frozenset[tuple[str, str]]) -> list[str]:
     after: dict[str, set[str]] = {}
     for first, then in must_precede:
         after.setdefault(first, set()).add(then)
-    on_cycle = []
+    on_cycle: list[str] = []
     for part in sorted(after):
-        reached, todo = set(), list(after[part])
+        reached: set[str] = set()
+        todo = list(after[part])
         while todo and part not in reached:
             nxt = todo.pop()
             if nxt not in reached:
@@ -146,17 +147,16 @@ def check_assignment(facts: LearnedFacts, assignment: Mapping[str, str]) -> list
 def _locations(
     assembly: Assembly, facts: LearnedFacts, home: tuple[float, float]
 ) -> dict[clingo.Symbol, tuple[float, float]]:
-    starts = {part.id: part.start for part in assembly.parts}
-    positions = {hole.id: hole.position for hole in assembly.holes}
-    missing = [p for p in facts.parts if starts.get(p) is None]
-    missing += [h for h in facts.holes if positions.get(h) is None]
+    starts = {part.id: part.start for part in assembly.parts if part.start is not None}
+    positions = {hole.id: hole.position for hole in assembly.holes if hole.position is not None}
+    missing = [p for p in facts.parts if p not in starts] + [h for h in facts.holes if h not in positions]
     if missing or not positions:
         raise PlannerError(
             f"assembly '{assembly.name}': optimal plans need a start [x, y] for every part "
             f"and a position for every hole; missing for: {' '.join(missing) or 'all holes'}"
         )
-    known = [pos for pos in positions.values() if pos is not None]
-    site = (sum(x for x, _ in known) / len(known), sum(y for _, y in known) / len(known))
+    xs, ys = zip(*positions.values())
+    site = (sum(xs) / len(xs), sum(ys) / len(ys))
     locations = {clingo.Function("home"): home, clingo.Function("site"): site}
     for part in facts.parts:
         locations[clingo.Function("start", [clingo.Function(part)])] = starts[part]

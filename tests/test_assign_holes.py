@@ -54,9 +54,9 @@ ASSIGN_CASES = [
 
 @pytest.mark.parametrize("name,facts,expected", ASSIGN_CASES, ids=[c[0] for c in ASSIGN_CASES])
 def test_assign_encoding_named_cases(name: str, facts: str, expected: list[set[str]]) -> None:
-    test = Assert(Exact(len(expected)), True_())
+    test: Assert | And = Assert(Exact(len(expected)), True_())
     if expected:
-        test = And(test, Assert(All(), Or(*(Equals(model) for model in expected))))
+        test = And(test, Assert(All(), Or(*(Equals(set(model)) for model in expected))))
     Clingo(arguments=["0"], program=facts, files=[ASSIGNMENTS_LP]).solve(test)
     test.assert_()
 

@@ -57,7 +57,7 @@ class PlanStepsEqual(Assertion):
 def test_plan_encoding_named_cases(name: str, facts: str, expected: list[set[str]]) -> None:
     """Exactly the expected plans (clingo never repeats a model, and a plan determines
     the sequence and the assignment that plans.lp also shows)."""
-    test = Assert(Exact(len(expected)), True_())
+    test: Assert | And = Assert(Exact(len(expected)), True_())
     if expected:
         test = And(test, Assert(All(), Or(*(PlanStepsEqual(model) for model in expected))))
     Clingo(arguments=["0"], program=facts, files=[str(ENCODINGS / "plans.lp")]).solve(test)
@@ -92,7 +92,7 @@ CHECK_CASES = [
 
 @pytest.mark.parametrize("name,given,errors", CHECK_CASES, ids=[c[0] for c in CHECK_CASES])
 def test_checker_named_cases(name: str, given: str, errors: set[str]) -> None:
-    test = Assert(Exact(1), Equals(errors))
+    test = Assert(Exact(1), Equals(set[clingo.Symbol | str](errors)))
     Clingo(program=CHECK_FACTS + given, files=[str(ENCODINGS / "check_plan.lp")]).solve(test)
     test.assert_()
 

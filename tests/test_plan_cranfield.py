@@ -51,19 +51,23 @@ def _brute_force_optimum(facts: LearnedFacts) -> tuple[int, set[tuple[PlanStep, 
     """Least total travel [mm] over every (order, assignment), straight from the
     assembly's positions, and the plans that reach it."""
     assembly = load_assembly("cranfield")
-    start = {part.id: part.start for part in assembly.parts}
-    at = {hole.id: hole.position for hole in assembly.holes}
+    start = {part.id: part.start for part in assembly.parts if part.start is not None}
+    at = {hole.id: hole.position for hole in assembly.holes if hole.position is not None}
     site = tuple(sum(c) / len(at) for c in zip(*at.values()))
 
     def leg(a: tuple[float, ...], b: tuple[float, ...]) -> int:
         return round(1000.0 * math.dist(a, b))
 
-    best, winners = math.inf, set()
+    best: float = math.inf
+    winners: set[tuple[PlanStep, ...]] = set()
     for assignment in all_assignments(facts):
-        goal = {p: at[assignment[p]] if p in assignment else site for p in facts.parts}
+        goal: dict[str, tuple[float, ...]] = {
+            p: at[assignment[p]] if p in assignment else site for p in facts.parts
+        }
         carry = sum(leg(start[p], goal[p]) for p in facts.parts)
         for order in linear_extensions(list(facts.parts), set(facts.must_precede)):
-            tool, cost = (0.0, 0.0), carry
+            tool: tuple[float, ...] = (0.0, 0.0)
+            cost = carry
             for part in order:
                 cost, tool = cost + leg(tool, start[part]), goal[part]
             cost += leg(tool, (0.0, 0.0))
