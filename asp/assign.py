@@ -13,6 +13,8 @@ placed without a hole.
   parts. When the sizes are a biorder (what the size learner assumes, paper 2.2) this
   finds an assignment whenever one exists.
 - :func:`all_assignments`: every feasible assignment, by ASP (``assignments.lp``).
+- :func:`feasible_assignment`: the greedy one, or ASP's first when greedy gets stuck on
+  sizes that are not a biorder although an assignment exists (``assign`` prints this).
 
 An assembly without an assignment raises :class:`UnsolvableAssembly` naming the part
 that gets no hole.
@@ -153,18 +155,39 @@ def _no_hole_message(part: str, fitting: list[str], taken_by: dict[str, str]) ->
     )
 
 
-def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:
-    """Every feasible assignment (at most ``limit``, 0 = all), sorted.
-
-    UnsolvableAssembly naming the part without a hole when there is none.
-    """
+def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
+    """Up to ``limit`` (0 = all) assignments of ``assignments.lp``, in clingo's order."""
     found: list[Assignment] = []
 
     def keep(model: clingo.Model) -> None:
         found.append({p: h for p, h in atoms_by_name(model.symbols(shown=True), "assigned", 2)})
 
     solve_encoding("assignments.lp", facts.atoms, [f"--models={limit}"], keep)
+    return found
+
+
+def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:
+    """Every feasible assignment (at most ``limit``, 0 = all), sorted.
+
+    UnsolvableAssembly naming the part without a hole when there is none.
+    """
+    found = _solve_assignments(facts, limit)
     if not found:
         # No assignment at all: the greedy one fails too and names the part.
         return [greedy_assignment(facts)]
     return sorted(found, key=lambda a: sorted(a.items()))
+
+
+def feasible_assignment(facts: LearnedFacts) -> Assignment:
+    """The greedy assignment; when greedy gets stuck although an assignment exists (the
+    sizes are not a biorder, e.g. a hand-written fits/2 table), the first one ASP finds.
+
+    UnsolvableAssembly (naming the part greedy could not place) only when none exists.
+    """
+    try:
+        return greedy_assignment(facts)
+    except UnsolvableAssembly:
+        found = _solve_assignments(facts, 1)
+        if not found:
+            raise
+        return found[0]

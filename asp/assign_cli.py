@@ -1,6 +1,7 @@
 """``./run.sh assign FACTS.lp ... [--all] [--json]``: hole assignments from learned facts.
 
-Prints the paper's greedy assignment, or with ``--all`` every feasible one (ASP).
+Prints the paper's greedy assignment (ASP's first one if greedy gets stuck on sizes that
+are not a biorder although an assignment exists), or with ``--all`` every feasible one.
 JSON: ``{"assignments": [{"p1": "r1", ...}, ...]}``. An unsolvable assembly exits with
 code 3 (bad input: 2) and names the part that gets no hole; with ``--json`` stdout also
 gets ``{"assignments": [], "error": "...", "part": "sh"}``.
@@ -12,7 +13,7 @@ import argparse
 import json
 import sys
 
-from asp.assign import UnsolvableAssembly, all_assignments, greedy_assignment, load_learned_facts
+from asp.assign import UnsolvableAssembly, all_assignments, feasible_assignment, load_learned_facts
 
 EXIT_UNSOLVABLE = 3
 """Exit code of a valid but unsolvable assembly (bad input exits with 2)."""
@@ -39,14 +40,15 @@ def main(argv: list[str]) -> int:
     parser = facts_parser(
         "./run.sh assign",
         "Hole assignments from learned facts: the paper's greedy one (biggest part first "
-        f"into the smallest free hole it fits), or every feasible one. Exit {EXIT_UNSOLVABLE}: "
+        "into the smallest free hole it fits; ASP's first one if greedy gets stuck on sizes "
+        f"that are not a biorder), or every feasible one. Exit {EXIT_UNSOLVABLE}: "
         "the assembly is not solvable (the part without a hole is named).",
     )
     parser.add_argument("--all", action="store_true", help="every feasible assignment (ASP)")
     args = parser.parse_args(argv)
     facts = load_learned_facts(args.facts)
     try:
-        assignments = all_assignments(facts) if args.all else [greedy_assignment(facts)]
+        assignments = all_assignments(facts) if args.all else [feasible_assignment(facts)]
     except UnsolvableAssembly as exc:
         return report_unsolvable(exc, "assignments", args.json)
     if args.json:

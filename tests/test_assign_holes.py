@@ -23,6 +23,7 @@ from asp.assign import (
     LearnedFacts,
     UnsolvableAssembly,
     all_assignments,
+    feasible_assignment,
     greedy_assignment,
     load_learned_facts,
 )
@@ -121,6 +122,40 @@ def test_greedy_solves_exactly_the_solvable_biorders(sizes: tuple[list[int], lis
         return
     assert check_assignment(facts, greedy) == []
     assert all_assignments(facts) == expected
+
+
+relations = st.tuples(st.integers(1, 4), st.integers(1, 4)).flatmap(
+    lambda size: st.lists(
+        st.lists(st.booleans(), min_size=size[1], max_size=size[1]), min_size=size[0], max_size=size[0]
+    )
+)
+
+
+@settings(max_examples=40, deadline=None)
+@given(relations)
+def test_feasible_assignment_exists_whenever_one_does(table: list[list[bool]]) -> None:
+    """Any fits/2 table, not only biorders: an assignment iff brute force finds one."""
+    holes = [f"h{i}" for i in range(len(table[0]))]
+    fits = {f"p{i}": [h for h, ok in zip(holes, row) if ok] for i, row in enumerate(table)}
+    with tempfile.TemporaryDirectory() as tmp:
+        facts = load_learned_facts([_facts_file(Path(tmp), fits, holes)])
+    expected = _brute_force(facts)
+    try:
+        assignment = feasible_assignment(facts)
+    except UnsolvableAssembly as exc:
+        assert expected == [] and exc.part in fits
+        return
+    assert assignment in expected and check_assignment(facts, assignment) == []
+
+
+def test_feasible_assignment_when_greedy_gets_stuck(tmp_path: Path) -> None:
+    """Not a biorder: greedy puts p0 into h2 and p1 into h1, leaving p2 nothing."""
+    fits = {"p0": ["h2", "h3"], "p1": ["h1", "h3"], "p2": ["h1", "h2"]}
+    facts = load_learned_facts([_facts_file(tmp_path, fits, ["h1", "h2", "h3"])])
+    with pytest.raises(UnsolvableAssembly):
+        greedy_assignment(facts)
+    assignment = feasible_assignment(facts)
+    assert assignment in _brute_force(facts) and check_assignment(facts, assignment) == []
 
 
 def _assign(*args: str) -> subprocess.CompletedProcess[str]:
