@@ -22,7 +22,7 @@ import clingo
 
 from asp import PlannerError
 from asp.assembly import Assembly
-from asp.assign import LearnedFacts, greedy_assignment, solve_encoding
+from asp.assign import LearnedFacts, feasible_assignment, solve_encoding
 from asp.facts import atoms_by_name, fact
 
 HOME: tuple[float, float] = (0.0, 0.0)
@@ -90,7 +90,7 @@ def plans(
         arguments += ["--opt-mode=optN", f"--configuration={OPTIMAL_CONFIGURATION}"]
     solve_encoding(entry, [*facts.atoms, *travel], arguments, keep)
     if not found:
-        greedy_assignment(facts)  # raises UnsolvableAssembly when no assignment exists
+        feasible_assignment(facts)  # raises UnsolvableAssembly when no assignment exists
         raise PlannerError(
             "no plan: no order of the parts respects must_precede, it has a cycle through "
             + " ".join(_parts_on_cycles(facts.must_precede))
