@@ -17,7 +17,7 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.assign import UnsolvableAssembly, load_learned_facts
+from asp.assign import LearnedFacts, UnsolvableAssembly, load_learned_facts
 from asp.facts import fact, write_facts
 from asp.plans import PlanStep, check_plan, plans
 
@@ -117,37 +117,47 @@ assemblies = st.integers(1, 4).flatmap(
 )
 
 
-@settings(max_examples=30, deadline=None)
-@given(assemblies)
-def test_plans_are_exactly_the_brute_force_ones(case: tuple[set, list[int], list[int]]) -> None:
+def random_facts(case: tuple[set, list[int], list[int]]) -> LearnedFacts:
+    """Learned facts of a drawn assembly: edges (i, j) i < j are must_precede, a part of
+    size 0 needs no hole, another fits the holes of a larger size."""
     edges, part_sizes, hole_sizes = case
     parts = [f"p{i}" for i in range(len(part_sizes))]
     holes = [f"h{i}" for i in range(len(hole_sizes))]
-    before = {(parts[a], parts[b]) for a, b in edges}
-    fitting = {
-        p: [h for h, hs in zip(holes, hole_sizes) if ps < hs]
-        for p, ps in zip(parts, part_sizes) if ps > 0
-    }
     atoms = [fact("part", p) for p in parts] + [fact("hole", h) for h in holes]
-    atoms += [fact("must_precede", a, b) for a, b in before]
-    atoms += [fact("fits" if h in fitting[p] else "no_fit", p, h) for p in fitting for h in holes]
+    atoms += [fact("must_precede", parts[a], parts[b]) for a, b in edges]
+    atoms += [
+        fact("fits" if ps < hs else "no_fit", p, h)
+        for p, ps in zip(parts, part_sizes) if ps > 0
+        for h, hs in zip(holes, hole_sizes)
+    ]
     with tempfile.TemporaryDirectory() as tmp:
         write_facts(Path(tmp) / "learned.lp", atoms)
-        facts = load_learned_facts([Path(tmp) / "learned.lp"])
-    assignments = [
-        dict(zip(fitting, chosen))
-        for chosen in itertools.permutations(holes, len(fitting))
-        if all(h in fitting[p] for p, h in zip(fitting, chosen))
+        return load_learned_facts([Path(tmp) / "learned.lp"])
+
+
+def brute_force_assignments(facts: LearnedFacts) -> list[dict[str, str]]:
+    """Every injective map of the parts that need a hole to holes they fit."""
+    return [
+        dict(zip(facts.needs_hole, chosen))
+        for chosen in itertools.permutations(facts.holes, len(facts.needs_hole))
+        if all((p, h) in facts.fits for p, h in zip(facts.needs_hole, chosen))
     ]
+
+
+@settings(max_examples=30, deadline=None)
+@given(assemblies)
+def test_plans_are_exactly_the_brute_force_ones(case: tuple[set, list[int], list[int]]) -> None:
+    facts = random_facts(case)
+    assignments = brute_force_assignments(facts)
     expected = {
         tuple(PlanStep(p, a.get(p)) for p in order)
-        for order in linear_extensions(parts, before)
+        for order in linear_extensions(list(facts.parts), set(facts.must_precede))
         for a in assignments
     }
     try:
         found = plans(facts, 0)
     except UnsolvableAssembly as exc:
-        assert not assignments and exc.part in fitting
+        assert not assignments and exc.part in facts.needs_hole
         return
     assert {plan.steps for plan in found} == expected and len(found) == len(expected)
     for plan in found:

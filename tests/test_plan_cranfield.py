@@ -1,6 +1,7 @@
 """Cranfield plans from its learned-facts equivalent (true precedence closed, Fig. 5
-sizes): plans, optimal plans against brute force over every plan, the ``plan`` command
-and the plain clingo command lines of the README. Every plan goes through the checker."""
+sizes): plans, optimal plans against brute force over every plan (also on random small
+cells), the ``plan`` command and the plain clingo command lines of the README. Every
+plan goes through the checker."""
 
 from __future__ import annotations
 
@@ -13,12 +14,14 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
-from asp.assembly import load_assembly
+from asp.assembly import Assembly, Hole, Part, load_assembly
 from asp.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.facts import load_atoms, write_facts
 from asp.plans import PlanStep, check_plan, plans, travel_facts
-from test_plan_cases import linear_extensions
+from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 
 ROOT = Path(__file__).resolve().parent.parent
 CRANFIELD = ROOT / "data" / "cranfield"
@@ -47,10 +50,11 @@ def test_cranfield_plans_are_valid_and_distinct(facts: LearnedFacts) -> None:
         assert check_plan(facts, plan.steps) == []
 
 
-def _brute_force_optimum(facts: LearnedFacts) -> tuple[int, set[tuple[PlanStep, ...]]]:
+def _brute_force_optimum(
+    facts: LearnedFacts, assembly: Assembly
+) -> tuple[int, set[tuple[PlanStep, ...]]]:
     """Least total travel [mm] over every (order, assignment), straight from the
-    assembly's positions, and the plans that reach it."""
-    assembly = load_assembly("cranfield")
+    assembly's positions (tool home at the origin), and the plans that reach it."""
     start = {part.id: part.start for part in assembly.parts if part.start is not None}
     at = {hole.id: hole.position for hole in assembly.holes if hole.position is not None}
     site = tuple(sum(c) / len(at) for c in zip(*at.values()))
@@ -60,7 +64,7 @@ def _brute_force_optimum(facts: LearnedFacts) -> tuple[int, set[tuple[PlanStep, 
 
     best: float = math.inf
     winners: set[tuple[PlanStep, ...]] = set()
-    for assignment in all_assignments(facts):
+    for assignment in brute_force_assignments(facts):
         goal: dict[str, tuple[float, ...]] = {
             p: at[assignment[p]] if p in assignment else site for p in facts.parts
         }
@@ -82,9 +86,29 @@ def _brute_force_optimum(facts: LearnedFacts) -> tuple[int, set[tuple[PlanStep, 
 def test_cranfield_optimal_plans_match_brute_force(facts: LearnedFacts) -> None:
     travel = travel_facts(load_assembly("cranfield"), facts)
     found = plans(facts, 0, optimal=True, travel=travel)
-    best, winners = _brute_force_optimum(facts)
+    best, winners = _brute_force_optimum(facts, load_assembly("cranfield"))
     assert {plan.cost for plan in found} == {best}
     assert {plan.steps for plan in found} == winners
+    for plan in found:
+        assert check_plan(facts, plan.steps) == []
+
+
+@settings(max_examples=20, deadline=None)
+@given(assemblies, st.lists(st.tuples(st.integers(0, 800), st.integers(-500, 500)), min_size=7, max_size=7))
+def test_optimal_plans_of_random_cells_match_brute_force(
+    case: tuple[set, list[int], list[int]], spots_mm: list[tuple[int, int]]
+) -> None:
+    facts = random_facts(case)
+    spots = [(x / 1000.0, y / 1000.0) for x, y in spots_mm]
+    cell = Assembly(
+        folder=ROOT, name="random cell",
+        parts=tuple(Part(p, p, "peg", spot) for p, spot in zip(facts.parts, spots)),
+        holes=tuple(Hole(h, h, "round", spot) for h, spot in zip(facts.holes, spots[4:])),
+    )
+    assume(brute_force_assignments(facts))
+    found = plans(facts, 0, optimal=True, travel=travel_facts(cell, facts))
+    best, winners = _brute_force_optimum(facts, cell)
+    assert {plan.cost for plan in found} == {best} and {plan.steps for plan in found} == winners
     for plan in found:
         assert check_plan(facts, plan.steps) == []
 
@@ -111,7 +135,7 @@ def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path) -
     done = _run("asp.cli", "plan", str(learned), "--optimal", "--assembly", "cranfield",
                 "--json", "--travel-out", str(travel_file))
     report = json.loads(done.stdout)
-    assert report["cost"] == _brute_force_optimum(facts)[0] and len(report["plans"]) == 1
+    assert report["cost"] == _brute_force_optimum(facts, load_assembly("cranfield"))[0] and len(report["plans"]) == 1
     assert check_plan(facts, [PlanStep(s["part"], s["hole"]) for s in report["plans"][0]]) == []
     # the same optimum from the plain clingo command line with the written travel facts
     done = _run("clingo", str(ROOT / "asp/encodings/plans_optimal.lp"), str(learned),
