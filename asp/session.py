@@ -119,19 +119,34 @@ def _endpoints(args: argparse.Namespace) -> tuple[list[str], list[str]]:
 
 def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
                  log: PlannerLog) -> SizeLearningResult:
+    """Replay the journal, then keep every alive cell busy until the learner is done.
+
+    Whenever a cell is free, the learner is asked for a batch as large as the running
+    experiments plus the free cells; only if the batch holds every running experiment
+    (so the new ones are independent of them) are its new pairs submitted; otherwise
+    the free cells wait for the running experiments to finish.
+    """
     def record(part: str, hole: str, result: str, cell: str) -> None:
         experiment = learner.record(part, hole, result)
         log.experiment(experiment.number, part, hole, result, cell, learner.knowledge)
 
     for entry in list(journal.entries):
         record(entry.part, entry.hole, entry.result, entry.cell)
-    while batch := learner.next_batch(max(1, oracle.alive_cells())):
-        before = len(journal.entries)
-        results = oracle.ask_batch(batch)
-        cells = {(e.part, e.hole): e.cell for e in journal.entries[before:]}
-        for (part, hole), result in zip(batch, results):
-            record(part, hole, result, cells[(part, hole)])
-    return learner.result()
+    running: list[tuple[str, str]] = []
+    while True:
+        free = max(1, oracle.alive_cells()) - len(running)
+        if free > 0:
+            batch = learner.next_batch(len(running) + free)
+            if not batch and not running:
+                return learner.result()
+            if set(running) <= set(batch):
+                for pair in batch:
+                    if pair not in running:
+                        oracle.submit(*pair)
+                        running.append(pair)
+        finished = oracle.next_result()
+        running.remove((finished.part, finished.hole))
+        record(finished.part, finished.hole, finished.result, finished.cell)
 
 
 def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
@@ -179,6 +194,15 @@ def run_session(args: argparse.Namespace) -> dict:
                 recording_id=settings["recording_id"])))
         demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
         relation = learn_must_precede(demos)
+        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
+        stack.callback(log.close)
+        log.precedence(relation.parts, reduction(relation))
+        journal = Journal(run)
+        stack.callback(journal.close)
+        pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell)
+        stack.callback(pool.close)
+        oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
+        learner = SizeLearner(parts, holes, settings["policy"], settings["seed"])
         for cell in cells:
             cell.wait_for_line("ready", timeout=args.wait_for_cell)
         try:
@@ -186,14 +210,6 @@ def run_session(args: argparse.Namespace) -> dict:
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
         timings = {"cells_ready_s": time.perf_counter() - started}
-        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
-        stack.callback(log.close)
-        log.precedence(relation.parts, reduction(relation))
-        journal = Journal(run)
-        stack.callback(journal.close)
-        pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell)
-        oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
-        learner = SizeLearner(parts, holes, settings["policy"], settings["seed"])
         sizes = _learn_sizes(oracle, learner, journal, log)
         timings["learned_s"] = time.perf_counter() - started
         learned = run / "learned.lp"

@@ -2,9 +2,9 @@
 
 - :class:`CellDirectory` follows the cells' liveliness tokens (``cell/*/alive``).
 - :func:`send_insert` sends one request asynchronously; :func:`request_insert` waits for it.
-- :class:`CellPool` runs a batch of requests over every alive cell at once: one request
-  per cell, a cell that dies (token gone) or times out has its request re-sent to another
-  cell (or the pool waits for one), and each request's outcome is delivered exactly once.
+- :class:`CellPool` keeps every alive cell busy with submitted requests: one request per
+  cell, a cell that dies (token gone) or times out has its request re-sent to another
+  cell (or the pool waits for one), and each request's reply is returned exactly once.
   Cells are idempotent by request id, so a re-sent request never runs twice on one cell.
 """
 
@@ -15,7 +15,7 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import zenoh
@@ -156,11 +156,13 @@ class _Sent:
 
 
 class CellPool:
-    """Runs batches of requests over every alive cell, with failover (see module doc).
+    """Keeps every alive cell busy with submitted requests, with failover (module doc).
 
-    ``timeout`` [s] bounds one attempt at one cell; ``wait_for_cell`` [s] bounds how long
-    a batch waits while no cell is alive; ``max_failures`` bounds the refused/failed
-    attempts of one request before the batch gives up.
+    :meth:`submit` queues a request (distinct ids); :meth:`next_reply` dispatches queued
+    requests to idle alive cells and returns the next finished request and its reply;
+    each submitted request is returned exactly once. ``timeout`` [s] bounds one attempt
+    at one cell; ``wait_for_cell`` [s] bounds a wait while no cell is alive;
+    ``max_failures`` bounds the failed attempts of one request. Close it when done.
     """
 
     def __init__(self, session: zenoh.Session, directory: CellDirectory, *,
@@ -171,88 +173,83 @@ class CellPool:
         self.wait_for_cell = wait_for_cell
         self.max_failures = max_failures
         self._attempts = itertools.count()
+        self._events: queue.SimpleQueue[tuple] = queue.SimpleQueue()
+        self._pending: deque[InsertRequest] = deque()
+        self._busy: dict[str, _Sent] = {}
+        self._slow: set[str] = set()
+        self._failures: dict[str, int] = {}
+        self._alive = directory.listen(self._on_change)
 
-    def run(self, requests: Iterable[InsertRequest],
-            on_reply: Callable[[InsertRequest, InsertReply], None]) -> dict[str, InsertReply]:
-        """Run the requests (distinct ids), each on one alive cell, until all have replies.
+    def _on_change(self, cell: str, alive: bool) -> None:
+        self._events.put(("cell", cell, alive))
 
-        ``on_reply`` is called once per request, in the calling thread, as soon as its
-        reply arrives. Raises BridgeError when no cell shows up for ``wait_for_cell`` s or
-        a request fails ``max_failures`` times.
-        """
-        events: queue.SimpleQueue[tuple] = queue.SimpleQueue()
+    @property
+    def unfinished(self) -> int:
+        """Submitted requests not yet returned by :meth:`next_reply`."""
+        return len(self._pending) + len(self._busy)
 
-        def on_change(cell: str, alive: bool) -> None:
-            events.put(("cell", cell, alive))
+    def submit(self, request: InsertRequest) -> None:
+        """Queue a request; it is sent as soon as a cell is idle."""
+        self._pending.append(request)
 
-        alive = self._directory.listen(on_change)
+    def close(self) -> None:
+        self._directory.unlisten(self._on_change)
+
+    def _dispatch(self) -> None:
+        idle = sorted(self._alive - self._busy.keys(), key=lambda c: (c in self._slow, c))
+        while self._pending and idle:
+            cell = idle.pop(0)
+            request = self._pending.popleft()
+            attempt = next(self._attempts)
+            cancel = send_insert(self._session, cell, request, self.timeout,
+                                 lambda outcome, c=cell, a=attempt: self._events.put(("outcome", c, a, outcome)))
+            self._busy[cell] = _Sent(attempt, request, cancel)
+
+    def _next_event(self) -> tuple:
+        if self._busy or self._alive:
+            return self._events.get()
         try:
-            return self._loop(deque(requests), alive, events, on_reply)
-        finally:
-            self._directory.unlisten(on_change)
+            return self._events.get(timeout=self.wait_for_cell)
+        except queue.Empty:
+            raise CellTimeout(f"no cell alive for {self.wait_for_cell:.0f} s; "
+                              f"{len(self._pending)} experiment(s) still to run") from None
 
-    def _loop(self, pending: deque[InsertRequest], alive: set[str], events: queue.SimpleQueue,
-              on_reply: Callable[[InsertRequest, InsertReply], None]) -> dict[str, InsertReply]:
-        done: dict[str, InsertReply] = {}
-        busy: dict[str, _Sent] = {}
-        slow: set[str] = set()
-        failures: dict[str, int] = {}
-        total = len(pending) + len(done)
-        no_cell_since: float | None = None
-        while len(done) < total:
-            idle = sorted(alive - busy.keys(), key=lambda c: (c in slow, c))
-            while pending and idle:
-                cell = idle.pop(0)
-                request = pending.popleft()
-                attempt = next(self._attempts)
-                cancel = send_insert(self._session, cell, request, self.timeout,
-                                     lambda outcome, c=cell, a=attempt: events.put(("outcome", c, a, outcome)))
-                busy[cell] = _Sent(attempt, request, cancel)
-            if not busy and not alive:
-                no_cell_since = no_cell_since or time.monotonic()
-                remaining = no_cell_since + self.wait_for_cell - time.monotonic()
-                if remaining <= 0:
-                    raise CellTimeout(f"no cell alive for {self.wait_for_cell:.0f} s; "
-                                      f"{len(pending)} experiment(s) still to run")
-                try:
-                    event = events.get(timeout=remaining)
-                except queue.Empty:
-                    continue
-            else:
-                no_cell_since = None
-                event = events.get()
+    def next_reply(self) -> tuple[InsertRequest, InsertReply]:
+        """The next finished request and its reply; BridgeError if none can finish."""
+        if not self.unfinished:
+            raise BridgeError("next_reply: no request submitted")
+        while True:
+            self._dispatch()
+            event = self._next_event()
             if event[0] == "cell":
-                _, cell, is_alive = event
-                if is_alive:
-                    alive.add(cell)
+                _, cell, alive = event
+                if alive:
+                    self._alive.add(cell)
                     continue
-                alive.discard(cell)
-                sent = busy.pop(cell, None)
-                if sent is not None:
+                self._alive.discard(cell)
+                sent = self._busy.pop(cell, None)
+                if sent is not None:  # it died mid-experiment: re-send elsewhere
                     sent.cancel.cancel()
-                    pending.appendleft(sent.request)
+                    self._pending.appendleft(sent.request)
                 continue
             _, cell, attempt, outcome = event
-            sent = busy.get(cell)
+            sent = self._busy.get(cell)
             if sent is None or sent.attempt != attempt:
                 continue  # a cancelled or superseded attempt
-            del busy[cell]
-            request = sent.request
+            del self._busy[cell]
             if isinstance(outcome, InsertReply):
-                slow.discard(cell)
-                if request.id not in done:
-                    done[request.id] = outcome
-                    on_reply(request, outcome)
-                continue
-            if isinstance(outcome, CellTimeout):
-                slow.add(cell)
-            elif isinstance(outcome, CellRefused) and outcome.reply.code != "failed":
-                raise outcome  # the request itself is bad: no cell will take it
-            else:
-                failures[request.id] = failures.get(request.id, 0) + 1
-                if failures[request.id] >= self.max_failures:
-                    raise BridgeError(f"request {request.id} ({request.part} into "
-                                      f"{request.hole}) failed {self.max_failures} times; "
-                                      f"last: {outcome}")
-            pending.appendleft(request)
-        return done
+                self._slow.discard(cell)
+                return sent.request, outcome
+            self._failed(cell, sent.request, outcome)
+
+    def _failed(self, cell: str, request: InsertRequest, outcome: BridgeError) -> None:
+        if isinstance(outcome, CellTimeout):
+            self._slow.add(cell)
+        elif isinstance(outcome, CellRefused) and outcome.reply.code != "failed":
+            raise outcome  # the request itself is bad: no cell will take it
+        else:
+            self._failures[request.id] = self._failures.get(request.id, 0) + 1
+            if self._failures[request.id] >= self.max_failures:
+                raise BridgeError(f"request {request.id} ({request.part} into {request.hole}) "
+                                  f"failed {self.max_failures} times; last: {outcome}")
+        self._pending.appendleft(request)

@@ -100,7 +100,14 @@ def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(net
     killer = threading.Thread(target=kill_c1_in_its_second_experiment)
     killer.start()
     pool = CellPool(session, directory, timeout=20.0, wait_for_cell=20.0)
-    replies = pool.run(requests, lambda request, reply: delivered.append((request.id, reply.cell)))
+    for request in requests:
+        pool.submit(request)
+    replies: dict[str, InsertReply] = {}
+    while pool.unfinished:
+        request, reply = pool.next_reply()
+        replies[request.id] = reply
+        delivered.append((request.id, reply.cell))
+    pool.close()
     killer.join(30)
     assert sorted(replies) == sorted(r.id for r in requests)
     assert len(delivered) == len(requests) == len({rid for rid, _ in delivered})
