@@ -3,9 +3,10 @@
 1. learns must-precede from the assembly's demonstrations (Algorithm 1);
 2. starts ``--cells N`` cell co-processes (``executor serve``) connected to the planner's
    loopback endpoint (``--cells 0 --connect EP`` uses cells already on the network);
-3. learns which part fits which hole: the size learner's batches of mutually
-   non-entailing experiments run on all alive cells at once (:mod:`asp.zenoh_oracle`);
-   every finished experiment is journaled (fsynced) before the learner uses it;
+3. learns which part fits which hole, keeping every alive cell busy with experiments
+   none of whose outcomes can entail another's (:func:`_learn_sizes`,
+   :mod:`asp.zenoh_oracle`); every finished experiment is journaled (fsynced) before
+   the learner uses it;
 4. assigns holes (greedy) and computes complete plans, each run through the checker;
 5. writes ``RUN/learned.lp`` (DESIGN.md vocabulary), ``RUN/assignment.lp``,
    ``RUN/session.json``, ``RUN/journal.jsonl`` and the Rerun recordings ``RUN/*.rrd``
