@@ -71,6 +71,11 @@ def _facts_file(tmp_path: Path, fits: dict[str, list[str]], holes: list[str]) ->
     return path
 
 
+def _learned(fits: dict[str, list[str]], holes: list[str]) -> LearnedFacts:
+    with tempfile.TemporaryDirectory() as tmp:
+        return load_learned_facts([_facts_file(Path(tmp), fits, holes)])
+
+
 def _brute_force(facts: LearnedFacts) -> list[dict[str, str]]:
     """Every injective part -> fitting hole map, by trying all hole permutations."""
     parts = list(facts.needs_hole)
@@ -108,8 +113,7 @@ def test_greedy_solves_exactly_the_solvable_biorders(sizes: tuple[list[int], lis
     parts = [f"p{i}" for i in range(len(part_sizes))]
     holes = [f"h{i}" for i in range(len(hole_sizes))]
     fits = {p: [h for h, hs in zip(holes, hole_sizes) if ps < hs] for p, ps in zip(parts, part_sizes)}
-    with tempfile.TemporaryDirectory() as tmp:
-        facts = load_learned_facts([_facts_file(Path(tmp), fits, holes)])
+    facts = _learned(fits, holes)
     expected = _brute_force(facts)
     try:
         greedy = greedy_assignment(facts)
@@ -137,8 +141,7 @@ def test_feasible_assignment_exists_whenever_one_does(table: list[list[bool]]) -
     """Any fits/2 table, not only biorders: an assignment iff brute force finds one."""
     holes = [f"h{i}" for i in range(len(table[0]))]
     fits = {f"p{i}": [h for h, ok in zip(holes, row) if ok] for i, row in enumerate(table)}
-    with tempfile.TemporaryDirectory() as tmp:
-        facts = load_learned_facts([_facts_file(Path(tmp), fits, holes)])
+    facts = _learned(fits, holes)
     expected = _brute_force(facts)
     try:
         assignment = feasible_assignment(facts)
@@ -148,10 +151,10 @@ def test_feasible_assignment_exists_whenever_one_does(table: list[list[bool]]) -
     assert assignment in expected and check_assignment(facts, assignment) == []
 
 
-def test_feasible_assignment_when_greedy_gets_stuck(tmp_path: Path) -> None:
+def test_feasible_assignment_when_greedy_gets_stuck() -> None:
     """Not a biorder: greedy puts p0 into h2 and p1 into h1, leaving p2 nothing."""
     fits = {"p0": ["h2", "h3"], "p1": ["h1", "h3"], "p2": ["h1", "h2"]}
-    facts = load_learned_facts([_facts_file(tmp_path, fits, ["h1", "h2", "h3"])])
+    facts = _learned(fits, ["h1", "h2", "h3"])
     with pytest.raises(UnsolvableAssembly):
         greedy_assignment(facts)
     assignment = feasible_assignment(facts)
