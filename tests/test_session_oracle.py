@@ -1,0 +1,46 @@
+"""ZenohOracle behind the size learner's Oracle protocol (learn_sizes), one truth cell."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from asp import PlannerError
+from asp.cell_processes import start_cell
+from asp.journal import Journal, read_journal
+from asp.oracle import TruthOracle
+from asp.size_learner import learn_sizes
+from asp.zenoh_oracle import ZenohOracle
+from bridge.client import CellDirectory, CellPool
+from bridge.session import free_loopback_endpoint, open_session
+
+
+@pytest.mark.timeout(60)
+def test_learn_sizes_through_the_zenoh_oracle(tmp_path: Path) -> None:
+    truth = TruthOracle.from_assembly("cranfield")
+    endpoint = free_loopback_endpoint()
+    cell = start_cell("c1", backend="truth", listen=[endpoint])
+    session = open_session(connect=[endpoint])
+    directory = CellDirectory(session)
+    pool = CellPool(session, directory, timeout=10.0, wait_for_cell=10.0)
+    journal = Journal(tmp_path)
+    try:
+        directory.wait_for(1, timeout=20)
+        oracle = ZenohOracle(pool, directory, journal, run_id="t", seed=1)
+        result = learn_sizes(truth.parts, truth.holes, oracle, policy="systematic")
+        assert result.knowledge.fits == truth.fits
+        oracle.submit("p1", "r1")
+        with pytest.raises(PlannerError, match="still running"):
+            oracle.ask("p2", "r1")
+        assert oracle.next_result().result == "fit"
+    finally:
+        journal.close()
+        pool.close()
+        directory.close()
+        session.close()
+        cell.stop()
+    entries = read_journal(tmp_path / "journal.jsonl")
+    assert [(e.part, e.hole, e.result) for e in entries[:-1]] == [
+        (e.part, e.hole, e.result) for e in result.experiments]
+    assert entries[-1].id == "t.p1.r1.2" and entries[-1].retest
