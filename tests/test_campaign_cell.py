@@ -1,0 +1,42 @@
+"""A real mini-campaign on the PyBullet cell: two worker processes, one fitting and one
+non-fitting pair, Fig. 17/18 written, the Fig. 17 recording read back."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from executor.recording import column_values, read_recording
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_mini_campaign_with_plots(tmp_path: Path) -> None:
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    done = subprocess.run(
+        [sys.executable, "-m", "executor.cli", "campaign", "--trials", "1", "--seed", "3",
+         "--pairs", "p1:br,p3:r1", "--workers", "2", "--json", "--plot", str(tmp_path)],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=240,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    report = json.loads(done.stdout)
+    assert report["all_correct"] and report["false_fits"] == 0 and report["workers"] == 2
+    rows = {(p["part"], p["hole"]): p for p in report["pairs"]}
+    assert rows[("p1", "br")]["after_second"] == 1 and rows[("p1", "br")]["fits"]
+    assert rows[("p3", "r1")]["correct"] == 1 and not rows[("p3", "r1")]["fits"]
+
+    for name in ("fig18_table.png", "fig17_forces.png"):
+        assert (tmp_path / name).read_bytes()[:4] == b"\x89PNG"
+    rrd = tmp_path / "fig17.rrd"
+    entities = read_recording(rrd).under("executor/fig17")
+    for name in ("scene", "tool/tip", "tool/path", "search/path", "wrench/force/measured",
+                 "wrench/force/desired", "deviation/force", "outcome"):
+        assert any(p.startswith(f"/executor/fig17/{name}") for p in entities), name
+    assert entities["/executor/fig17/tool/tip"].rows > 100
+    texts = [row[0] for row in column_values(rrd, "executor/fig17/outcome", "TextLog:text")]
+    assert any(t.startswith("p1→r1") and ": fit " in t for t in texts)
+    assert sum(1 for t in texts if t.startswith("p3→r1") and ": no_fit " in t) >= 1
+    assert any("/by_phase/" in p for p in entities), "Fig. 17 series over the DMP phase"
