@@ -122,11 +122,10 @@ class AttemptTrace:
         ):
             getattr(self, name).append(np.array(value, dtype=np.float64))
 
-    def insertion(self) -> slice:
-        """The steps of the DMP insertion: from the first step with phase > 0 on (the
-        search before it runs at phase 0)."""
-        moving = np.flatnonzero(self.array("phase") > 0.0)
-        return slice(int(moving[0]) if len(moving) else len(self.phase), len(self.phase))
+    def insertion(self) -> np.ndarray:
+        """Indices of the DMP insertion's steps (wiggles included): those logged with
+        phase > 0; search, settling and retreat are logged at phase 0."""
+        return np.flatnonzero(self.array("phase") > 0.0)
 
     @property
     def key(self) -> str:
@@ -354,7 +353,7 @@ class AttemptLogger:
             columns=rr.Points3D.columns(positions=trace.array("tool_pos")).partition([1] * count),
         )
         insertion = trace.insertion()
-        if insertion.stop > insertion.start:
+        if len(insertion):
             phase = trace.array("phase")[insertion]
             by_phase = [
                 rr.TimeColumn("experiment", sequence=np.full(len(phase), trace.experiment)),
