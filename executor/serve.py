@@ -132,7 +132,7 @@ class CellNode:
     def __init__(self, cell_id: str, backend: Backend) -> None:
         self.cell_id = cell_id
         self._backend = backend
-        self._work: queue.SimpleQueue[tuple[zenoh.Query, InsertRequest]] = queue.SimpleQueue()
+        self._work: queue.SimpleQueue[tuple[zenoh.Query, InsertRequest] | None] = queue.SimpleQueue()
         self._replies: OrderedDict[str, bytes] = OrderedDict()
         self._lock = threading.Lock()
 
@@ -160,10 +160,14 @@ class CellNode:
             return
         self._work.put((query, request))
 
+    def stop(self) -> None:
+        """Make :meth:`serve` return after the experiment in progress (any thread)."""
+        self._work.put(None)
+
     def serve(self) -> None:
-        """Run queued requests until interrupted (by SIGTERM/SIGINT via SystemExit)."""
-        while True:
-            query, request = self._work.get()
+        """Run queued requests until :meth:`stop` (or SIGTERM/SIGINT via SystemExit)."""
+        while (work := self._work.get()) is not None:
+            query, request = work
             cached = self._cached(request.id)
             if cached is None:
                 cached = self._run(query, request)
@@ -198,11 +202,11 @@ def _exit_on_signal(signum: int, _frame: object) -> None:
     raise SystemExit(128 + signum)
 
 
-def _exit_when_stdin_closes() -> None:
+def _stop_when_stdin_closes(node: CellNode) -> None:
     """Lifeline: the supervisor holds our stdin; when it dies, stdin reaches EOF."""
     while os.read(0, 4096):  # raw read: no interpreter lock held at shutdown
         pass
-    signal.raise_signal(signal.SIGTERM)
+    node.stop()  # no print: the supervisor that read our stdout may be gone
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -245,16 +249,16 @@ def main(argv: Sequence[str]) -> int:
         backend.close()
         raise ExecutorError(str(exc)) from None
     try:
-        declared = (session.declare_queryable(insert_key(cell_id), node.on_query),
+        declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # kept alive
                     session.declare_queryable(ping_key(cell_id), _echo),
                     session.liveliness().declare_token(alive_key(cell_id)))
         if args.lifeline:
-            threading.Thread(target=_exit_when_stdin_closes, daemon=True).start()
+            threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
         print(f"ready cell {cell_id} backend {args.backend} "
               f"listen {listen} connect {args.connect}", flush=True)
         node.serve()
     except SystemExit:
-        print(f"stopping cell {cell_id} ({len(declared)} declarations closed)", flush=True)
+        pass  # SIGTERM/SIGINT: close below
         pass
     finally:
         session.close()

@@ -13,6 +13,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
@@ -140,3 +141,41 @@ def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path) -> None
                    "/planner/assignment", "/executor/c1/outcome", "/executor/c2/outcome"):
         assert entity in entities
     assert summary.entities["/planner/knowledge"].rows == result["experiments"]
+
+
+def wait_until(condition, timeout: float, what: str) -> None:
+    """Poll ``condition`` every 50 ms until true; fail after ``timeout`` [s]."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.05)
+
+
+def test_cells_of_a_killed_planner_exit(tmp_path: Path) -> None:
+    run = tmp_path / "run"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    planner = subprocess.Popen(session_argv("--cells", "2", "--delay", "0.3", "--out", str(run)),
+                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    children: list[int] = []
+    try:
+        wait_until(lambda: (run / "journal.jsonl").is_file() and (run / "journal.jsonl").stat().st_size,
+                   30, "a first experiment")
+        children = [int(pid) for pid in subprocess.run(
+            ["ps", "-o", "pid=", "--ppid", str(planner.pid)], capture_output=True, text=True,
+            check=True).stdout.split()]
+        assert len(children) == 2
+        planner.kill()
+        planner.wait(10)
+        wait_until(lambda: not any(map(is_cell, children)), 15, "the cells to exit")
+    finally:
+        planner.kill()
+        for pid in filter(is_cell, children):
+            os.kill(pid, signal.SIGKILL)
+
+
+def is_cell(pid: int) -> bool:
+    """Whether process ``pid`` exists and is an ``executor.cli serve`` node."""
+    try:
+        return b"executor.cli" in Path(f"/proc/{pid}/cmdline").read_bytes()
+    except (FileNotFoundError, ProcessLookupError):
+        return False
