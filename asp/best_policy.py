@@ -20,8 +20,10 @@ Three paths compute the same rule:
 - sampled (numpy, larger instances such as 8×8 or 20×20): ``SAMPLES`` random linear
   extensions of the known smaller-than order, seeded by the knowledge state, stand in
   for the possible relations; an unknown pair the sample does not split scores 0;
-- ASP (``select_best.lp``): clingo enumerates the possible relations and their classes;
-  the reference path for small instances, used by the tests to check the numpy paths.
+- ASP (``select_best.lp``): clingo enumerates the possible relations and their classes
+  (part ``base``), then sums the weights per pair and selects (part ``split``); the
+  reference path for small instances (total weight < 2^31, e.g. 4×4), used by the tests
+  to check the numpy paths.
 """
 
 from __future__ import annotations
@@ -56,8 +58,12 @@ EXACT_LIMIT = 400_000
 SAMPLES = 1024
 """Random linear extensions drawn per decision on the sampled path."""
 
-SCORE_DECIMALS = 9
-"""Split shares are rounded so that float summation order cannot change a tie."""
+WEIGHT_SCALE = 1000
+"""Prior weights are the integers round(WEIGHT_SCALE · (∏ k!)^ALPHA): their sums are exact
+in float64 on the exact path (5×5: < 2^46) and equal clingo's ``#sum`` on the ASP path."""
+
+ASP_WEIGHT_LIMIT = 2**31 - 1
+"""clingo integers are 32 bit: the ASP path handles total weights up to this (4×4: ~10^8)."""
 
 
 def knowledge_masks(knowledge: Knowledge) -> tuple[int, int]:
@@ -88,12 +94,15 @@ def smaller_matrix(m: int, n: int, fit_mask: int, no_fit_mask: int) -> np.ndarra
     return order
 
 
+def prior_weights(fits: np.ndarray) -> np.ndarray:
+    """Integer-valued prior weight of each relation, ``fits`` of shape (relations, m, n)."""
+    return np.rint(WEIGHT_SCALE * class_weights(fits) ** ALPHA)
+
+
 def split_scores(fits: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Per column of ``fits`` (relations × candidate pairs): the smaller weight share of
-    the two outcomes (0..0.5), rounded to SCORE_DECIMALS."""
-    total = weights.sum()
+    """Per column of ``fits`` (relations × candidate pairs): the lighter of its two outcomes."""
     fit_weight = weights @ fits
-    return np.round(np.minimum(fit_weight, total - fit_weight) / total, SCORE_DECIMALS)
+    return np.minimum(fit_weight, weights.sum() - fit_weight)
 
 
 def pick(fits: np.ndarray, weights: np.ndarray, candidates: list[int]) -> int:
@@ -115,7 +124,7 @@ def choose_bit(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
     else:
         rng = np.random.default_rng([fit_mask, no_fit_mask, m, n])
         sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
-        fits, weights = sample.reshape(len(sample), m * n), class_weights(sample) ** ALPHA
+        fits, weights = sample.reshape(len(sample), m * n), prior_weights(sample)
     if len(fits) == 0:
         raise PlannerError("policy best: no biorder agrees with the knowledge (noise left?)")
     return pick(fits, weights, candidates)
@@ -125,7 +134,7 @@ def choose_bit(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
 def _prior_weights(m: int, n: int) -> np.ndarray:
     """Prior weight of every m×n biorder, aligned with :func:`all_biorders`."""
     masks = all_biorders(m, n)
-    return class_weights(mask_bits(masks, m * n).reshape(len(masks), m, n)) ** ALPHA
+    return prior_weights(mask_bits(masks, m * n).reshape(len(masks), m, n))
 
 
 def choose(knowledge: Knowledge, rng: random.Random) -> Pair:
@@ -136,8 +145,13 @@ def choose(knowledge: Knowledge, rng: random.Random) -> Pair:
     return knowledge.parts[bit // n], knowledge.holes[bit % n]
 
 
+def _encoding() -> str:
+    with as_file(files("asp") / "encodings" / "select_best.lp") as path:
+        return path.read_text(encoding="utf-8")
+
+
 def possible_relations_asp(knowledge: Knowledge) -> tuple[np.ndarray, np.ndarray]:
-    """ASP path: masks of the possible relations (sorted) and their prior weights."""
+    """ASP path, part ``base``: masks of the possible relations (sorted), prior weights."""
     parts, holes = knowledge.parts, knowledge.holes
     n = len(holes)
     atoms = [fact("part", p) for p in parts] + [fact("hole", h) for h in holes]
@@ -145,37 +159,52 @@ def possible_relations_asp(knowledge: Knowledge) -> tuple[np.ndarray, np.ndarray
     atoms += [fact("no_fit", p, h) for p, h in sorted(knowledge.no_fit)]
     atoms += [fact("unknown", p, h) for p, h in knowledge.unknown]
     ctl = clingo.Control(["--models=0", "--warn=none"])
-    ctl.add("base", [], format_facts(atoms))
-    with as_file(files("asp") / "encodings" / "select_best.lp") as path:
-        ctl.load(str(path))
+    ctl.add("base", [], format_facts(atoms) + _encoding())
     ctl.ground([("base", [])])
     found: dict[int, float] = {}
 
     def on_model(model: clingo.Model) -> None:
-        mask, log_weight = 0, 0.0
+        mask, orders = 0, 1
         for symbol in model.symbols(shown=True):
             args = [str(a) for a in symbol.arguments]
             if symbol.name == "rel":
                 mask |= 1 << (parts.index(args[0]) * n + holes.index(args[1]))
             else:
-                log_weight += math.lgamma(symbol.arguments[1].number + 1)
-        found[mask] = math.exp(ALPHA * log_weight)
+                orders *= math.factorial(symbol.arguments[1].number)
+        found[mask] = round(WEIGHT_SCALE * orders**ALPHA)
 
     ctl.solve(on_model=on_model)
     masks = np.array(sorted(found), dtype=np.uint64)
-    return masks, np.array([found[int(k)] for k in masks])
+    return masks, np.array([found[int(k)] for k in masks], dtype=np.float64)
 
 
 def choose_by_asp(knowledge: Knowledge) -> Pair:
-    """The same rule as :func:`choose`, over the relations clingo enumerates."""
-    n = len(knowledge.holes)
-    index = {(p, h): i * n + j for i, p in enumerate(knowledge.parts) for j, h in enumerate(knowledge.holes)}
-    candidates = [index[pair] for pair in knowledge.unknown]
-    if not candidates:
+    """The same rule as :func:`choose`, entirely in clingo: part ``base`` enumerates the
+    possible relations, part ``split`` sums their weights per pair and selects."""
+    if not knowledge.unknown:
         raise PlannerError("policy best: every pair is known, nothing to choose")
     masks, weights = possible_relations_asp(knowledge)
-    bit = pick(mask_bits(masks, len(index)), weights, candidates)
-    return knowledge.parts[bit // n], knowledge.holes[bit % n]
+    if weights.sum() > ASP_WEIGHT_LIMIT:
+        raise PlannerError(f"policy best: total weight {weights.sum():.0f} exceeds clingo's "
+                           f"integers ({ASP_WEIGHT_LIMIT}); use the numpy path")
+    parts, holes = knowledge.parts, knowledge.holes
+    n = len(holes)
+    atoms = [fact("unknown", p, h) for p, h in knowledge.unknown]
+    atoms += [fact("part_index", p, i) for i, p in enumerate(parts, 1)]
+    atoms += [fact("hole_index", h, j) for j, h in enumerate(holes, 1)]
+    for r, (mask, weight) in enumerate(zip(masks.tolist(), weights.tolist())):
+        atoms.append(fact("weight", r, int(weight)))
+        atoms += [fact("holds", r, parts[i // n], holes[i % n]) for i in range(len(parts) * n) if mask >> i & 1]
+    ctl = clingo.Control(["--warn=none"])
+    ctl.add("split", [], format_facts(atoms))
+    ctl.add("base", [], _encoding())
+    ctl.ground([("split", [])])
+    selected: list[Pair] = []
+    ctl.solve(on_model=lambda m: selected.extend(
+        (str(s.arguments[0]), str(s.arguments[1])) for s in m.symbols(shown=True) if s.name == "select"))
+    if len(selected) != 1:
+        raise PlannerError(f"policy best: the ASP split selected {selected}, expected one pair")
+    return selected[0]
 
 
 POLICY = SelectionPolicy(
