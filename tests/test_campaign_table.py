@@ -4,10 +4,10 @@ Fig. 18 counts, worker processes; and the figure writers on synthetic data."""
 from __future__ import annotations
 
 import functools
+import multiprocessing
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 
 from executor import ExecutorError
@@ -21,22 +21,22 @@ from executor.campaign import (
     run_campaign,
     select_pairs,
 )
-from executor.campaign_plots import plot_fig17, plot_fig18
-from executor.rerun_log import AttemptTrace
 
 
-def fake_runner(flaky_every: int) -> Any:
+def fake_runner(flaky_every: int, barrier: Any = None) -> Any:
     """A runner that fits exactly the truly fitting pairs; every ``flaky_every``-th
-    seed needs the 2nd attempt. Records the seed and the worker's pid; takes 40 ms
-    so that both worker processes get trials."""
+    seed needs the 2nd attempt. Records the seed and the worker's pid. With a
+    ``barrier``, workers start only once all are up, so each of them gets trials."""
     import os
     import time
 
+    if barrier is not None:
+        barrier.wait(timeout=60)
     fitting = set(FIG18_FITTING_PAIRS)
 
     def run(part: str, hole: str, seed: int) -> dict[str, Any]:
         fits = (part, hole) in fitting
-        time.sleep(0.04)
+        time.sleep(0.01)
         return {
             "outcome": "fit" if fits else "no_fit",
             "attempts": 2 if (not fits or seed % flaky_every == 0) else 1,
@@ -60,9 +60,11 @@ def test_pairs_are_fig18_rows_then_every_non_fitting_pair() -> None:
 
 def test_counts_seeds_and_two_workers_match_one() -> None:
     pairs = campaign_pairs()
-    factory = functools.partial(fake_runner, 4)
-    serial = run_campaign(pairs, trials=4, seed=100, workers=1, factory=factory)
-    parallel = run_campaign(pairs, trials=4, seed=100, workers=2, factory=factory)
+    serial = run_campaign(pairs, trials=4, seed=100, workers=1,
+                          factory=functools.partial(fake_runner, 4))
+    barrier = multiprocessing.get_context("spawn").Barrier(2)
+    parallel = run_campaign(pairs, trials=4, seed=100, workers=2,
+                            factory=functools.partial(fake_runner, 4, barrier))
     strip = lambda rs: [[{k: v for k, v in r.items() if k != "pid"} for r in row] for row in rs]
     assert strip(serial) == strip(parallel)
     assert len({r["pid"] for row in parallel for r in row}) == 2, "both workers did trials"
@@ -92,8 +94,12 @@ def test_a_too_big_part_reported_fitting_is_counted() -> None:
     assert not campaign_report(CampaignRun([pair], [results], [stats], 1.0), 0, 1)["all_correct"]
 
 
-def _trace(part: str, outcome: str, stop_at: float) -> AttemptTrace:
+def _trace(part: str, outcome: str, stop_at: float) -> Any:
+    from executor.rerun_log import AttemptTrace
+
     trace = AttemptTrace(part, "r1", 0, 1, 1, outcome)
+    import numpy as np
+
     for phase in np.linspace(0.0, stop_at, 50):
         trace.sim_time.append(float(phase))
         trace.phase.append(float(phase))
@@ -103,6 +109,9 @@ def _trace(part: str, outcome: str, stop_at: float) -> AttemptTrace:
 
 
 def test_figures_are_written(tmp_path: Path) -> None:
+    # Imported here: worker processes of the test above import this module.
+    from executor.campaign_plots import plot_fig17, plot_fig18
+
     pairs = campaign_pairs()[:3]
     stats = [pair_stats(p, [{"outcome": "fit", "attempts": 1, "duration_s": 1.0}]) for p in pairs]
     table = plot_fig18(stats, tmp_path / "fig18.png")
