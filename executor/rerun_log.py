@@ -14,10 +14,11 @@ Entities (all under ``executor/<cell-id>/``):
 ``wrench/force/{measured,desired}``   F_mes, F_des (x, y, z) over ``sim_time`` [N]
 ``wrench/torque/{measured,desired}``  M_mes, M_des (x, y, z) over ``sim_time`` [Nm]
 ``deviation/{force,torque}``    ‖F_mes − F_des‖ [N], ‖M_mes − M_des‖ [Nm] (eqs. 6, 7)
-``phase``                       DMP phase over ``sim_time`` (1 → 0 as in Ude et al.
-                                or 0 → 1, as the cell reports it)
+``phase``                       DMP phase over ``sim_time`` (0 → 1 during the
+                                insertion; 0 while searching or retreating)
 ``by_phase/<attempt>/force_{measured,desired}``  force over timeline ``dmp_phase``
-                                (phase × 1000), one series per attempt: Fig. 17
+                                (phase × 1000), one series per attempt, insertion
+                                steps only: Fig. 17
 ``outcome``                     text log, one line per attempt
 ``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
 =============================== ===================================================
