@@ -157,6 +157,24 @@ def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
     return list(dict.fromkeys(atoms))
 
 
+def _versus_truth(assembly: Assembly, truth: TruthOracle | None, fits: list[tuple[str, str]],
+                  must_precede: list[tuple[str, str]]) -> dict[str, bool | int | None]:
+    """The learned relations against the assembly's truths (None where unknown).
+
+    ``precedence_sound``: every true constraint was learned, so every sequence the
+    learned relation admits is feasible; ``precedence_extra``: learned pairs that the
+    truth does not require (orders the demonstrations happened not to vary).
+    """
+    versus: dict[str, bool | int | None] = {
+        "sizes_equal": None if truth is None else set(fits) == truth.fits,
+        "precedence_sound": None, "precedence_extra": None}
+    if assembly.has_file("precedence.lp"):
+        required = set(true_relation(assembly).pairs())
+        versus["precedence_sound"] = required <= set(must_precede)
+        versus["precedence_extra"] = len(set(must_precede) - required)
+    return versus
+
+
 def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
     facts = load_learned_facts([learned])
     assignment = greedy_assignment(facts)
@@ -222,9 +240,8 @@ def run_session(args: argparse.Namespace) -> dict:
         log.assignment(assignment)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
-    matches = None
-    if truth is not None and assembly.has_file("precedence.lp"):
-        matches = set(fits) == truth.fits and set(true_relation(assembly).pairs()) <= set(must_precede)
+    versus = _versus_truth(assembly, truth, fits, must_precede)
+    matches = None if None in versus.values() else versus["sizes_equal"] and versus["precedence_sound"]
     result = {
         "run": str(run),
         "experiments": len(journal.entries),
@@ -233,7 +250,7 @@ def run_session(args: argparse.Namespace) -> dict:
         "plans": [plan.as_json() for plan in found],
         "matches_truth": matches,
     }
-    settings.update(result, status="done", assignment=assignment, cells=cell_ids,
+    settings.update(result, status="done", truth=versus, assignment=assignment, cells=cell_ids,
                     journal=[{"part": e.part, "hole": e.hole, "result": e.result, "cell": e.cell,
                               "retest": e.retest} for e in journal.entries],
                     wall_s=round(time.perf_counter() - started, 3),
@@ -255,6 +272,9 @@ def _summary(result: dict, run: Path) -> str:
         f"must precede: {len(result['must_precede'])} pairs",
         "assignment: " + " ".join(f"{p}->{h}" for p, h in settings["assignment"].items()),
         f"plan 1 of {len(result['plans'])}: {plan}",
+        f"versus the truth: sizes equal {settings['truth']['sizes_equal']}, every true "
+        f"precedence learned {settings['truth']['precedence_sound']} "
+        f"({settings['truth']['precedence_extra']} pairs more than required); "
         f"matches truth: {result['matches_truth']}",
     ])
 
