@@ -90,6 +90,7 @@ class SizeLearner:
         self.experiments: list[Experiment] = []
         self.answers: dict[Pair, list[str]] = {}
         self.retests: list[Pair] = []
+        self._history: list[tuple[Knowledge, Pair | None, list[Pair]]] = []
         self._ctl = clingo.Control(["--warn=none"])
         self._ground(seed)
         self._selected: Pair | None = None
@@ -150,6 +151,7 @@ class SizeLearner:
             raise PlannerError(f"experiment ({part},{hole}) -> {result!r}: expected a known "
                                f"part, hole and a result in {RESULTS}")
         pair = (part, hole)
+        self._history.append((self.knowledge, self._selected, list(self.retests)))
         retest = pair in self.answers
         if pair in self.retests:
             self.retests.remove(pair)
@@ -219,6 +221,16 @@ class SizeLearner:
         answers = self.answers.get(pair)
         self._set_observation(pair, self._kept(answers) if answers else None)
 
+    def undo(self) -> None:
+        """Take back the last experiment (walks of a policy's decision tree use this)."""
+        last = self.experiments.pop()
+        pair = (last.part, last.hole)
+        self.answers[pair].pop()
+        if not self.answers[pair]:
+            del self.answers[pair]
+        self._restore(pair)
+        self.knowledge, self._selected, self.retests = self._history.pop()
+
     def reset(self, seed: int = 0) -> None:
         """Forget all observations: a fresh session on the same ground program.
 
@@ -227,7 +239,7 @@ class SizeLearner:
         """
         for pair in self.answers:
             self._set_observation(pair, None)
-        self.experiments, self.answers, self.retests = [], {}, []
+        self.experiments, self.answers, self.retests, self._history = [], {}, [], []
         self.rng = random.Random(seed)
         self.knowledge = self._solve()
 

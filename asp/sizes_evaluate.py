@@ -3,12 +3,14 @@
 A relabeling permutes the parts and the holes, i.e. their index order; the paper ran
 its learner on all 5!·5! = 14400 relabelings of Cranfield. The learner sees the truth
 only through the index order, so each run gets canonical names (``q1..``, ``k1..``)
-and the truth matrix in relabeled order. For a deterministic policy the number of
-experiments is a function of that matrix alone; identical rows or columns make many
-relabelings give the same matrix, so each distinct matrix is run once and counted
-with its multiplicity: the statistics are exactly those of running every relabeling.
+and the truth matrix in relabeled order. For a deterministic policy the experiments
+are a function of that matrix alone; identical rows or columns make many relabelings
+give the same matrix (900 distinct ones of 14400 for Cranfield), and runs share
+their decisions as long as their answers agree, so the policy's decision tree is
+walked once over the distinct matrices, each counted with its multiplicity: the
+statistics are exactly those of running every relabeling on its own.
 Non-deterministic policies (``random``) run every case, case i with seed
-``seed * 1_000_003 + i``. Runs are spread over the machine's cores.
+``seed * 1_000_003 + i``. Work is spread over the machine's cores.
 """
 
 from __future__ import annotations
@@ -76,49 +78,96 @@ def relabeled_matrices(truth: TruthOracle, relabelings: str | int, seed: int) ->
     return [tuple(tuple(fits[i][j] for j in col) for i in row) for row, col in orders]
 
 
+Task = tuple[str, int, tuple[tuple[str, str, str], ...], dict[Matrix, int]]
+"""A subtree of a deterministic policy's decision tree: (policy, seed, prefix of
+(part, hole, result) experiments, matrices reaching it with their multiplicities)."""
+
 _LEARNERS: dict[tuple[str, int, int], SizeLearner] = {}
-"""Per worker process: one ground learner per (policy, parts, holes), reused by reset."""
+"""Per process: one ground learner per (policy, parts, holes), reused by reset."""
+
+
+def _names(matrix: Matrix) -> tuple[list[str], list[str]]:
+    """Canonical part and hole names of a matrix's shape."""
+    return [f"q{i}" for i in range(1, len(matrix) + 1)], [f"k{j}" for j in range(1, len(matrix[0]) + 1)]
+
+
+def _learner(policy: str, matrix: Matrix, seed: int) -> SizeLearner:
+    """A fresh (reset) learner of the matrix's shape, reused for deterministic policies."""
+    parts, holes = _names(matrix)
+    key = (policy, len(parts), len(holes))
+    if not get_policy(policy).deterministic:
+        return SizeLearner(parts, holes, policy, seed)
+    if key not in _LEARNERS:
+        _LEARNERS[key] = SizeLearner(parts, holes, policy, seed)
+    learner = _LEARNERS[key]
+    learner.reset(seed)
+    return learner
+
+
+def _answer(matrix: Matrix, pair: tuple[str, str]) -> str:
+    """The truth of a canonical pair ``(q<i>, k<j>)``."""
+    return "fit" if matrix[int(pair[0][1:]) - 1][int(pair[1][1:]) - 1] else "no_fit"
 
 
 def count_experiments(task: tuple[Matrix, str, int]) -> int:
-    """Experiments ``policy`` needs to learn ``matrix`` (worker of the process pool).
-
-    Deterministic policies reuse one ground program per shape (canonical names make
-    every case of a shape the same program); others get a fresh learner per seed.
-    """
+    """Experiments a (random) policy needs to learn one matrix: one whole session."""
     matrix, policy, seed = task
-    parts = [f"q{i}" for i in range(1, len(matrix) + 1)]
-    holes = [f"k{j}" for j in range(1, len(matrix[0]) + 1)]
+    parts, holes = _names(matrix)
     fits = {(p, h) for p, row in zip(parts, matrix) for h, f in zip(holes, row) if f}
-    oracle = TruthOracle(parts, holes, fits)
-    key = (policy, len(parts), len(holes))
-    if get_policy(policy).deterministic and key in _LEARNERS:
-        learner = _LEARNERS[key]
-        learner.reset(seed)
-    else:
-        learner = SizeLearner(parts, holes, policy, seed)
-        if get_policy(policy).deterministic:
-            _LEARNERS[key] = learner
-    result = run_learner(learner, oracle)
+    result = run_learner(_learner(policy, matrix, seed), TruthOracle(parts, holes, fits))
     if result.knowledge.fits != frozenset(fits):
         raise PlannerError(f"policy {policy} learned a wrong relation for {matrix}")
     return result.count
 
 
-def _map(tasks: Sequence[tuple[Matrix, str, int]], processes: int) -> list[int]:
-    show = sys.stderr.isatty()
-    if processes <= 1 or len(tasks) < 50:
-        iterator = map(count_experiments, tasks)
-        pool = None
-    else:
+def _walk(learner: SizeLearner, group: dict[Matrix, int], histogram: Counter[int],
+          frontier: list | None = None, depth: int = 0) -> None:
+    """Walk the decision tree below the learner's state for the matrices of ``group``.
+
+    Each node is one decision; the matrices split by their answer to it. With
+    ``frontier``, nodes ``depth`` levels down are collected instead of walked.
+    """
+    pair = learner.next_experiment()
+    if pair is None:
+        histogram[len(learner.experiments)] += sum(group.values())
+        return
+    if frontier is not None and depth == 0:
+        prefix = tuple((e.part, e.hole, e.result) for e in learner.experiments)
+        frontier.append((prefix, group))
+        return
+    for result in ("fit", "no_fit"):
+        branch = {m: n for m, n in group.items() if _answer(m, pair) == result}
+        if branch:
+            learner.record(*pair, result)
+            _walk(learner, branch, histogram, frontier, depth - 1)
+            learner.undo()
+
+
+def walk_subtree(task: Task) -> Counter[int]:
+    """Histogram of experiment counts of one subtree (worker of the process pool)."""
+    policy, seed, prefix, group = task
+    learner = _learner(policy, next(iter(group)), seed)
+    for part, hole, result in prefix:
+        learner.record(part, hole, result)
+    histogram: Counter[int] = Counter()
+    _walk(learner, group, histogram)
+    return histogram
+
+
+def _pool_map(function, tasks: Sequence, processes: int, unit: str) -> list:
+    """``map`` over a process pool (serial for few tasks); a progress bar on a terminal."""
+    pool = None
+    if processes > 1 and len(tasks) > 1:
         pool = multiprocessing.get_context("fork").Pool(processes)
         chunk = max(1, min(64, len(tasks) // (processes * 8)))
-        iterator = pool.imap(count_experiments, tasks, chunksize=chunk)
+        iterator = pool.imap_unordered(function, tasks, chunksize=chunk)
+    else:
+        iterator = map(function, tasks)
     try:
-        if show:
+        if sys.stderr.isatty():
             from tqdm import tqdm
 
-            iterator = tqdm(iterator, total=len(tasks), unit="run", file=sys.stderr)
+            iterator = tqdm(iterator, total=len(tasks), unit=unit, file=sys.stderr)
         return list(iterator)
     finally:
         if pool is not None:
@@ -130,20 +179,33 @@ def evaluate_policy(
     truth: TruthOracle, policy: str, relabelings: str | int = "all", seed: int = 0,
     processes: int | None = None,
 ) -> Evaluation:
-    """Learn every relabeled truth with ``policy``; memoised for deterministic policies."""
+    """Learn every relabeled truth with ``policy``.
+
+    A deterministic policy's runs form a decision tree (a decision depends only on the
+    answers so far): it is walked once, each node solved once, the matrices splitting
+    by their answers; its top levels are cut into subtrees for the worker processes.
+    The histogram is exactly that of running every relabeling on its own.
+    """
     selection = get_policy(policy)
     matrices = relabeled_matrices(truth, relabelings, seed)
     processes = processes or min(2, multiprocessing.cpu_count())
     histogram: Counter[int] = Counter()
     if selection.deterministic:
-        multiplicity = Counter(matrices)
-        distinct = list(multiplicity)
-        counts = _map([(m, policy, seed) for m in distinct], processes)
-        for matrix, n in zip(distinct, counts):
-            histogram[n] += multiplicity[matrix]
+        group = dict(Counter(matrices))
+        frontier: list = []
+        depth = 0
+        while len(frontier) < 16 * processes and depth < 12:
+            frontier, histogram = [], Counter()
+            depth += 1
+            _walk(_learner(policy, matrices[0], seed), group, histogram, frontier, depth)
+            if not frontier:
+                break
+        tasks = [(policy, seed, prefix, sub) for prefix, sub in frontier]
+        for part in _pool_map(walk_subtree, tasks, processes, "subtree"):
+            histogram.update(part)
     else:
         tasks = [(m, policy, seed * 1_000_003 + i) for i, m in enumerate(matrices)]
-        histogram.update(_map(tasks, processes))
+        histogram.update(_pool_map(count_experiments, tasks, processes, "run"))
     return Evaluation(policy, dict(histogram))
 
 
