@@ -34,7 +34,7 @@ class ImpedanceController:
     """Tracks a tip pose with a Cartesian spring-damper; one ``step`` per physics step."""
 
     # The null-space projector changes slowly: recompute it every this many steps.
-    PROJECTOR_PERIOD = 10
+    PROJECTOR_PERIOD = 50
 
     def __init__(self, arm: Arm, client: int, gains: ImpedanceGains = ImpedanceGains()) -> None:
         self.arm, self.client, self.gains = arm, client, gains

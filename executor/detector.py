@@ -26,9 +26,9 @@ class Thresholds:
     tolerance [m], and how long a violation must persist [steps of 1 ms]."""
 
     f_stop: float = 20.0
-    m_stop: float = 0.5
+    m_stop: float = 3.0
     f_slow: float = 8.0
-    goal_tolerance: float = 0.005
+    goal_tolerance: float = 0.003
     persist_steps: int = 20
 
 

@@ -24,7 +24,7 @@ from movement_primitives.dmp import CartesianDMP
 from executor import ExecutorError
 
 # Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
-ROLLOUT_DT = 0.002
+ROLLOUT_DT = 0.005
 N_WEIGHTS = 12
 N_WRENCH_RBF = 20
 
@@ -60,6 +60,10 @@ class WrenchProfile:
 
     def __call__(self, phase: float) -> np.ndarray:
         return (self._features(np.array([phase])) @ self.weights)[0]
+
+    def tabulate(self, n: int = 501) -> np.ndarray:
+        """(n, 6) wrenches at phases 0, 1/(n−1), …, 1: a look-up table for the control loop."""
+        return self._features(np.linspace(0.0, 1.0, n)) @ self.weights
 
 
 @dataclass

@@ -28,8 +28,9 @@ JAM_DEPTH = 0.003  # [m] below the entry: a breach there is a jam, not a part on
 @dataclass
 class InsertionResult:
     """``completed``: the DMP ran to its end without an unresolved eq. (6)/(7) breach;
-    ``reached``: goal check passed; ``end_error`` ‖p_end − p_goal‖ [m]; ``jammed``: a
-    breach happened inside the hole."""
+    ``reached``: goal check passed where the execution ended (the success criterion:
+    an interrupted execution succeeds only if the part is already at its goal);
+    ``end_error`` ‖p_end − p_goal‖ [m]; ``jammed``: a breach happened inside the hole."""
 
     completed: bool
     reached: bool
@@ -52,7 +53,8 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     """Run the skill in the hole frame at ``hole_origin`` (hole centre on the plate top,
     [m]) starting from the current tip pose.  A breach with the tip inside the hole
     (deeper than ``JAM_DEPTH``) is a jam: the wiggle runs once and the insertion goes on;
-    a breach with the part still on the plate surface ends the attempt."""
+    a breach with the part still on the plate surface, or a second one, stops the
+    execution; the goal check then decides."""
     s = motion.controller.arm.read()
     goal = skill.demo_goal
     times, pos, quats = skill.rollout(s.tip_pos - hole_origin, s.tip_quat_xyzw, goal[:3],
@@ -61,18 +63,20 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     d_pos, d_rot = np.zeros(3), np.zeros(3)
     wiggles, jammed, completed = 0, False, True
     budget = int(TIMEOUT_FACTOR * clock.duration / TIME_STEP)
+    wrench_table = skill.wrench.tabulate()
+    last = len(wrench_table) - 1
     for _ in range(budget):
         if clock.done:
             break
         pos_d, quat_d = clock.pose()
-        w_des = skill.wrench(clock.phase)
+        w_des = wrench_table[int(clock.phase * last + 0.5)]
         quat_cmd = np.array(pb.multiplyTransforms((0, 0, 0), rotvec_quat_xyzw(d_rot), (0, 0, 0), quat_d)[1])
         s = motion.step(pos_d + d_pos, quat_cmd, phase=clock.phase, wrench_des=w_des)
         f_dev, m_dev = s.force - w_des[:3], s.torque - w_des[3:]
         f_norm, _, violated = detector.update(f_dev, m_dev)
         d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
         if violated:
-            jammed = s.tip_pos[2] < hole_origin[2] - JAM_DEPTH
+            jammed = jammed or s.tip_pos[2] < hole_origin[2] - JAM_DEPTH
             if not (jammed and wiggle_enabled and wiggles < MAX_WIGGLES):
                 completed = False
                 break
@@ -86,4 +90,4 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     pos_d, quat_d = clock.pose()
     end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
     reached, err = detector.goal_reached(end.tip_pos, hole_origin + skill.end_position)
-    return InsertionResult(completed, completed and reached, err, jammed, wiggles, clock.phase)
+    return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase)
