@@ -6,7 +6,8 @@
    the same payload to the cell's ``ping`` queryable, measured alternately in the same
    run; medians [ms] and their ratio. Target: validated median < 1 ms.
 2. The Cranfield session (``sim`` backend) with 1 cell and with 2 cells: wall time [s]
-   of the whole command, experiments, and the ratio 2 cells / 1 cell (target ≤ 0.65;
+   of the whole command, experiments, the share of the learning time the cells were busy
+   with experiments (1.0: never idle), and the ratio 2 cells / 1 cell (target ≤ 0.65;
    on a shared 2-core machine the cells compete with everything else for the cores).
 """
 
@@ -24,6 +25,7 @@ import time
 from pathlib import Path
 
 from asp.cell_processes import ROOT, start_cell
+from asp.journal import JOURNAL_NAME, read_journal
 from bridge.client import CellDirectory, request_insert
 from bridge.keys import ping_key
 from bridge.messages import InsertRequest, encode
@@ -72,6 +74,7 @@ def session_walls(cells: int, repeat: int, policy: str) -> dict:
     """Wall time [s] of ``session --cells N`` (sim backend), ``repeat`` runs."""
     walls: list[float] = []
     experiments: list[int] = []
+    busy: list[float] = []
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     for _ in range(repeat):
         with tempfile.TemporaryDirectory() as tmp:
@@ -87,8 +90,18 @@ def session_walls(cells: int, repeat: int, policy: str) -> dict:
             if not result["matches_truth"]:
                 raise SystemExit(f"session --cells {cells} learned a wrong relation")
             experiments.append(result["experiments"])
+            busy.append(cell_busy_fraction(Path(tmp) / "run" / JOURNAL_NAME, cells))
     return {"cells": cells, "walls_s": [round(w, 2) for w in walls],
-            "median_wall_s": round(statistics.median(walls), 2), "experiments": experiments}
+            "median_wall_s": round(statistics.median(walls), 2), "experiments": experiments,
+            "cell_busy": busy}
+
+
+def cell_busy_fraction(journal: Path, cells: int) -> float:
+    """Share of the learning span [first start, last end] the cells spent on experiments."""
+    entries = read_journal(journal)
+    start = min(e.time - e.wall_s for e in entries)
+    end = max(e.time for e in entries)
+    return round(sum(e.wall_s for e in entries) / (cells * (end - start)), 3)
 
 
 def main(argv: list[str]) -> int:
@@ -113,7 +126,8 @@ def main(argv: list[str]) -> int:
         if not args.json:
             for s in (one, two):
                 print(f"Cranfield session, {s['cells']} cell(s), sim: median {s['median_wall_s']:.1f} s "
-                      f"wall (runs {s['walls_s']}, experiments {s['experiments']})")
+                      f"wall (runs {s['walls_s']}, experiments {s['experiments']}, cells busy "
+                      f"{s['cell_busy']} of the learning time)")
             print(f"ratio 2 cells / 1 cell: {figures['ratio_2_over_1']:.2f}")
     if args.json:
         print(json.dumps(figures, indent=2))
