@@ -2,7 +2,8 @@
 
 The node declares the queryable ``cell/<id>/insert`` and the liveliness token
 ``cell/<id>/alive`` (and ``cell/<id>/ping``, which echoes its payload unread), then
-serves until SIGTERM/SIGINT, which close the Zenoh session cleanly.
+serves until SIGTERM/SIGINT (or, with ``--lifeline``, until its stdin closes: the
+supervising session died), then closes the Zenoh session cleanly.
 
 - Every request is size-capped and validated (:mod:`bridge.messages`) in the Zenoh
   thread; a malformed, oversized or wrong-version request gets an ErrorReply at once and
@@ -249,9 +250,9 @@ def main(argv: Sequence[str]) -> int:
         backend.close()
         raise ExecutorError(str(exc)) from None
     try:
-        declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # kept alive
-                    session.declare_queryable(ping_key(cell_id), _echo),
-                    session.liveliness().declare_token(alive_key(cell_id)))
+        _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
+                     session.declare_queryable(ping_key(cell_id), _echo),
+                     session.liveliness().declare_token(alive_key(cell_id)))
         if args.lifeline:
             threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
         print(f"ready cell {cell_id} backend {args.backend} "
@@ -259,7 +260,6 @@ def main(argv: Sequence[str]) -> int:
         node.serve()
     except SystemExit:
         pass  # SIGTERM/SIGINT: close below
-        pass
     finally:
         session.close()
         backend.close()
