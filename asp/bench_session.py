@@ -5,7 +5,8 @@
    validate on both sides, idempotency cache) beside a bare Zenoh query round trip of
    the same payload to the cell's ``ping`` queryable, measured alternately in the same
    run; medians [ms] and their ratio. Target: validated median < 1 ms.
-2. The Cranfield session (``sim`` backend) with 1 cell and with 2 cells: wall time [s]
+2. The Cranfield session (``sim`` backend, or ``--backend truth --delay S``: experiments
+   that take S seconds without using the cores) with 1 cell and with 2 cells: wall time [s]
    of the whole command, experiments, the share of the learning time the cells were busy
    with experiments (1.0: never idle), and the ratio 2 cells / 1 cell (target ≤ 0.65;
    on a shared 2-core machine the cells compete with everything else for the cores).
@@ -70,8 +71,8 @@ def round_trips(count: int) -> dict:
         cell.stop()
 
 
-def session_walls(cells: int, repeat: int, policy: str) -> dict:
-    """Wall time [s] of ``session --cells N`` (sim backend), ``repeat`` runs."""
+def session_walls(cells: int, repeat: int, policy: str, backend: str, delay_s: float) -> dict:
+    """Wall time [s] of ``session --cells N``, ``repeat`` runs."""
     walls: list[float] = []
     experiments: list[int] = []
     busy: list[float] = []
@@ -79,7 +80,8 @@ def session_walls(cells: int, repeat: int, policy: str) -> dict:
     for _ in range(repeat):
         with tempfile.TemporaryDirectory() as tmp:
             argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells),
-                    "--policy", policy, "--out", str(Path(tmp) / "run"), "--json"]
+                    "--policy", policy, "--out", str(Path(tmp) / "run"), "--json",
+                    "--backend", backend, "--delay", str(delay_s)]
             t0 = time.perf_counter()
             done = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True,
                                   timeout=900)
@@ -109,6 +111,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--round-trips", type=int, default=1000, help="per kind (default 1000)")
     parser.add_argument("--repeat", type=int, default=1, help="sessions per cell count (default 1)")
     parser.add_argument("--policy", default="best", help="session policy (default best)")
+    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
+                        help="cells of the sessions (default sim)")
+    parser.add_argument("--delay", type=float, default=0.0, metavar="S",
+                        help="truth backend: seconds per experiment, e.g. 2 to see the "
+                        "parallel speed-up without competing for the cores")
     parser.add_argument("--skip-sessions", action="store_true", help="only the round trips")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
@@ -120,12 +127,13 @@ def main(argv: list[str]) -> int:
               f"(p90 {o['validated']['p90_ms']:.3f}), bare query median {o['bare']['median_ms']:.3f} ms "
               f"(p90 {o['bare']['p90_ms']:.3f}), ratio {o['ratio']:.2f}", flush=True)
     if not args.skip_sessions:
-        one, two = (session_walls(n, args.repeat, args.policy) for n in (1, 2))
+        one, two = (session_walls(n, args.repeat, args.policy, args.backend, args.delay)
+                    for n in (1, 2))
         figures["sessions"] = [one, two]
         figures["ratio_2_over_1"] = round(two["median_wall_s"] / one["median_wall_s"], 3)
         if not args.json:
             for s in (one, two):
-                print(f"Cranfield session, {s['cells']} cell(s), sim: median {s['median_wall_s']:.1f} s "
+                print(f"Cranfield session, {s['cells']} cell(s), {args.backend}: median {s['median_wall_s']:.1f} s "
                       f"wall (runs {s['walls_s']}, experiments {s['experiments']}, cells busy "
                       f"{s['cell_busy']} of the learning time)")
             print(f"ratio 2 cells / 1 cell: {figures['ratio_2_over_1']:.2f}")
