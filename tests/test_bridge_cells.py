@@ -119,3 +119,28 @@ def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(net
     lost = started_on_c1 - finished_on_c1
     assert lost, "c1 was killed mid-experiment"
     assert all(replies[rid].cell == "c2" for rid in lost)
+
+
+def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.5))
+    directory.wait_for(1, timeout=20)
+
+    def replace_c1_in_its_second_experiment() -> None:
+        cells[0].wait_for_line("start", timeout=30, count=2)
+        cells[0].kill()
+        cells.append(start_cell("c2", backend="truth", connect=[endpoint]))
+
+    replacer = threading.Thread(target=replace_c1_in_its_second_experiment)
+    replacer.start()
+    pool = CellPool(session, directory, timeout=20.0, wait_for_cell=30.0)
+    requests = [InsertRequest(id=f"w{i}", part="p1", hole=h) for i, h in enumerate(("r1", "s1", "br"))]
+    for request in requests:
+        pool.submit(request)
+    cells_of = {}
+    while pool.unfinished:
+        request, reply = pool.next_reply()
+        cells_of[request.id] = reply.cell
+    pool.close()
+    replacer.join(30)
+    assert cells_of == {"w0": "c1", "w1": "c2", "w2": "c2"}
