@@ -3,7 +3,8 @@
 One JSON object a line: ``id`` (the request id), ``part``, ``hole``, ``result``
 (``fit``/``no_fit``), ``cell`` (who ran it), ``retest`` (true on a deliberate re-test of
 a pair already tried), ``evidence`` (the cell's measurements or null), ``wall_s`` (the
-cell's wall time [s]) and ``time`` (Unix time [s] it was journaled). Each line is
+cell's wall time [s]), ``time`` (Unix time [s] it was journaled) and ``experiment`` (its
+number in the order experiments were started: the Rerun timeline ``experiment``). Each line is
 flushed and fsynced before the result reaches the learner, so a session killed at any
 moment can be resumed (``session --resume RUN``) by replaying the journal: no finished
 experiment is run again. A torn last line (killed while writing) is ignored: its
@@ -36,6 +37,7 @@ class JournalEntry(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     evidence: Evidence | None = None
     wall_s: float = 0.0
     time: float = 0.0
+    experiment: int = 0
 
 
 _DECODER = msgspec.json.Decoder(JournalEntry)

@@ -127,12 +127,12 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
     (so the new ones are independent of them) are its new pairs submitted; otherwise
     the free cells wait for the running experiments to finish.
     """
-    def record(part: str, hole: str, result: str, cell: str) -> None:
-        experiment = learner.record(part, hole, result)
-        log.experiment(experiment.number, part, hole, result, cell, learner.knowledge)
+    def record(part: str, hole: str, result: str, cell: str, started: int) -> None:
+        learner.record(part, hole, result)
+        log.experiment(started, part, hole, result, cell, learner.knowledge)
 
     for entry in list(journal.entries):
-        record(entry.part, entry.hole, entry.result, entry.cell)
+        record(entry.part, entry.hole, entry.result, entry.cell, entry.experiment)
     running: list[tuple[str, str]] = []
     while True:
         free = max(1, oracle.alive_cells()) - len(running)
@@ -147,7 +147,7 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
                         running.append(pair)
         finished = oracle.next_result()
         running.remove((finished.part, finished.hole))
-        record(finished.part, finished.hole, finished.result, finished.cell)
+        record(finished.part, finished.hole, finished.result, finished.cell, finished.experiment)
 
 
 def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,

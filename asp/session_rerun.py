@@ -7,7 +7,9 @@ in a first tab, then one tab per cell (:func:`executor.rerun_blueprint.cell_blue
 
 =========================== ==========================================================
 ``planner/knowledge``       part × hole matrix after every experiment (tensor: 1 fits,
-                            0 does not fit, -1 unknown), timeline ``experiment``
+                            0 does not fit, -1 unknown), timeline ``experiment``: the
+                            number the experiment was started with, which the cell
+                            that ran it logs its attempts under
 ``planner/experiments``     one text line per experiment (pair, result, cell)
 ``planner/smaller``         smaller-than graph over parts ∪ holes (its transitive
                             reduction), after every experiment
@@ -76,7 +78,7 @@ class PlannerLog:
 
     def experiment(self, number: int, part: str, hole: str, result: str, cell: str,
                    knowledge: Knowledge) -> None:
-        """One finished experiment and the knowledge after it."""
+        """Experiment ``number`` (in start order) finished; the knowledge after it."""
         self.rec.set_time("experiment", sequence=number)
         self.rec.log("planner/experiments", rr.TextLog(f"#{number} {part} -> {hole}: {result} ({cell})"))
         matrix = np.array([[-1 if v is None else v for v in row] for row in knowledge.matrix()],

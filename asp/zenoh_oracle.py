@@ -38,6 +38,8 @@ class Finished:
     hole: str
     result: Result
     cell: str
+    experiment: int
+    """Its number in the order experiments were started (Rerun timeline ``experiment``)."""
 
 
 class ZenohOracle:
@@ -51,6 +53,7 @@ class ZenohOracle:
         self._run_id = run_id
         self._seed = seed
         self._asked: Counter[Pair] = Counter((e.part, e.hole) for e in journal.entries)
+        self._started = max((e.experiment for e in journal.entries), default=0)
 
     def alive_cells(self) -> int:
         """How many cells are alive now (how many experiments can run at once)."""
@@ -61,8 +64,10 @@ class ZenohOracle:
         self._asked[(part, hole)] += 1
         n = self._asked[(part, hole)]
         key = f"{self._run_id}.{part}.{hole}.{n}"
+        self._started += 1
         self._pool.submit(InsertRequest(id=key, part=part, hole=hole, retest=n > 1,
-                                        seed=zlib.crc32(f"{self._seed}.{key}".encode())))
+                                        seed=zlib.crc32(f"{self._seed}.{key}".encode()),
+                                        experiment=self._started))
 
     def next_result(self) -> Finished:
         """Wait for the next finished experiment, journal it durably, return it.
@@ -76,8 +81,9 @@ class ZenohOracle:
             raise PlannerError(f"experiments over Zenoh failed: {exc}") from None
         self._journal.append(JournalEntry(
             id=request.id, part=request.part, hole=request.hole, result=reply.result,
-            cell=reply.cell, retest=request.retest, evidence=reply.evidence, wall_s=reply.wall_s))
-        return Finished(request.part, request.hole, reply.result, reply.cell)
+            cell=reply.cell, retest=request.retest, evidence=reply.evidence, wall_s=reply.wall_s,
+            experiment=request.experiment))
+        return Finished(request.part, request.hole, reply.result, reply.cell, request.experiment)
 
     def ask(self, part: str, hole: str) -> Result:
         """One experiment, waited for (Oracle protocol); nothing else may be running."""

@@ -44,6 +44,8 @@ class InsertRequest(_Message, tag="insert"):
     hole: AspId
     seed: Seed = 0
     retest: bool = False
+    experiment: Annotated[int, msgspec.Meta(ge=0)] = 0
+    """The planner's experiment number (Rerun timeline ``experiment``); 0: none."""
     v: int = PROTOCOL_VERSION
 
 

@@ -91,6 +91,8 @@ class TruthBackend:
         if self._log is not None:
             import rerun as rr
 
+            if request.experiment:
+                self._log.set_time("experiment", sequence=request.experiment)
             self._log.log(self._entity, rr.TextLog(f"{request.part}->{request.hole}: {result}"))
         return result, None
 
@@ -99,20 +101,37 @@ class TruthBackend:
             self._log.flush()
 
 
+def _planner_numbered_logger() -> type:
+    """AttemptLogger that logs a trial under the planner's experiment number, if given."""
+    from executor.rerun_log import AttemptLogger
+
+    class PlannerNumbered(AttemptLogger):
+        planner_experiment: int | None = None
+
+        def begin_attempt(self, part: str, hole: str, trial_seed: int, attempt: int,
+                          experiment: int | None = None) -> None:
+            super().begin_attempt(part, hole, trial_seed, attempt,
+                                  experiment if experiment is not None else self.planner_experiment)
+
+    return PlannerNumbered
+
+
 class SimBackend:
     """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
                  rrd: Path | None) -> None:
-        from executor.rerun_log import AttemptLogger
         from executor.trial import Cell
 
-        self._logger = (AttemptLogger(cell_id, recording_id=recording_id, rrd_path=rrd,
-                                      send_blueprint=False)  # the planner sends it
+        _PlannerNumbered = _planner_numbered_logger()
+        self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd,
+                                         send_blueprint=False)  # the planner sends it
                         if rrd is not None else None)
         self._cell = Cell(assembly, gui=False, logger=self._logger)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        if self._logger is not None:
+            self._logger.planner_experiment = request.experiment or None
         trial = self._cell.run_trial(request.part, request.hole, seed=request.seed).to_json()
         evidence = Evidence(attempts=int(trial["attempts"]),
                             max_force_dev=float(trial["max_force_dev"]),

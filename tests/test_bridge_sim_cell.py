@@ -14,7 +14,7 @@ from bridge.session import free_loopback_endpoint, open_session
 
 @pytest.mark.timeout(90)
 def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
-    from executor.recording import read_recording
+    from executor.recording import column_values, read_recording
 
     endpoint = free_loopback_endpoint()
     rrd = tmp_path / "c1.rrd"
@@ -22,8 +22,8 @@ def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
     session = open_session(connect=[endpoint])
     try:
         CellDirectory(session).wait_for(1, timeout=30)
-        reply = request_insert(session, "c1", InsertRequest(id="s1", part="p1", hole="br", seed=3),
-                               timeout=60)
+        request = InsertRequest(id="s1", part="p1", hole="br", seed=3, experiment=7)
+        reply = request_insert(session, "c1", request, timeout=60)
         assert reply.result == "fit"
         assert reply.evidence is not None and reply.evidence.attempts >= 1
         assert reply.evidence.end_error < 0.01 and reply.evidence.duration_s > 0
@@ -33,3 +33,4 @@ def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
     summary = read_recording([rrd])
     assert set(summary.recording_ids) == {"sim-test"}
     assert any(path.startswith("/executor/c1/wrench") for path in summary.entities)
+    assert set(column_values([rrd], "/executor/c1/outcome", "experiment")) == {7}

@@ -126,7 +126,7 @@ def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[Ce
 
 
 def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path) -> None:
-    from executor.recording import read_recording
+    from executor.recording import column_values, read_recording
 
     run = tmp_path / "run"
     result = run_session("--cells", "2", "--out", str(run), "--policy", "best")
@@ -141,6 +141,11 @@ def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path) -> None
                    "/planner/assignment", "/executor/c1/outcome", "/executor/c2/outcome"):
         assert entity in entities
     assert summary.entities["/planner/knowledge"].rows == result["experiments"]
+    files = sorted(run.glob("*.rrd"))
+    numbers = set(range(1, result["experiments"] + 1))
+    assert set(column_values(files, "/planner/knowledge", "experiment")) == numbers
+    by_cells = [n for c in ("c1", "c2") for n in column_values(files, f"/executor/{c}/outcome", "experiment")]
+    assert sorted(by_cells) == sorted(numbers)  # each experiment logged once, by its cell
 
 
 def wait_until(condition, timeout: float, what: str) -> None:
