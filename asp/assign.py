@@ -92,8 +92,18 @@ def solve_encoding(
     return ctl.solve(on_model=on_model)
 
 
+RESERVED_IDS = frozenset({"none", "home", "site"})
+"""Constants of plan_step/3 (``none``) and of the travel cost (``home``, ``site``)."""
+
+
 def _check_ids(facts: LearnedFacts, sources: str) -> None:
     known_parts, known_holes = set(facts.parts), set(facts.holes)
+    reserved = sorted(known_holes & RESERVED_IDS)
+    if reserved:
+        raise PlannerError(
+            f"{sources}: hole({reserved[0]}): the ids {', '.join(sorted(RESERVED_IDS))} are "
+            "reserved for plans (no hole, tool home, assembly site); rename the hole"
+        )
     for name in ("fits", "no_fit"):
         for part, hole in atoms_by_name(facts.atoms, name, 2):
             if part not in known_parts or hole not in known_holes:

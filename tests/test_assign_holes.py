@@ -193,7 +193,9 @@ def test_assign_command_bad_input(tmp_path: Path) -> None:
     broken.write_text("part(a). fits(a,\n")
     unknown = tmp_path / "unknown.lp"
     unknown.write_text("part(a). hole(h). fits(a,zz).\n")
-    for path, word in ((broken, "parse"), (unknown, "zz")):
+    reserved = tmp_path / "reserved.lp"
+    reserved.write_text("part(a). hole(none). fits(a,none).\n")
+    for path, word in ((broken, "parse"), (unknown, "zz"), (reserved, "reserved")):
         done = _assign(str(path))
         assert done.returncode == 2 and word in done.stderr
     assert _assign("--help").returncode == 0
