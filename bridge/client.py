@@ -106,11 +106,14 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
     valid reply came within ``timeout`` [s] or the query was cancelled, or MessageError
     for a reply that does not validate. Returns a token that cancels the query.
     """
-    delivered = threading.Event()
+    lock = threading.Lock()
+    delivered = False
 
     def deliver(outcome: Outcome) -> None:
-        if not delivered.is_set():
-            delivered.set()
+        nonlocal delivered
+        with lock:  # replies and the query's end may come on different threads
+            first, delivered = not delivered, True
+        if first:
             on_outcome(outcome)
 
     def on_reply(reply: zenoh.Reply) -> None:
@@ -140,7 +143,10 @@ def request_insert(session: zenoh.Session, cell: str, request: InsertRequest,
     """Send ``request`` to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
     box: queue.SimpleQueue[Outcome] = queue.SimpleQueue()
     send_insert(session, cell, request, timeout, box.put)
-    outcome = box.get(timeout=timeout + 5.0)
+    try:
+        outcome = box.get(timeout=timeout + 5.0)  # Zenoh ends the query at its timeout
+    except queue.Empty:
+        raise CellTimeout(f"cell {cell}: query {request.id} never ended") from None
     if isinstance(outcome, BridgeError):
         raise outcome
     return outcome
