@@ -74,11 +74,13 @@ def solve_encoding(
     atoms: Sequence[clingo.Symbol],
     arguments: Sequence[str],
     on_model: Callable[[clingo.Model], None],
+    time_limit_s: float | None = None,
 ) -> clingo.SolveResult:
     """Ground the entry encoding with the atoms as facts, solve, call ``on_model``.
 
     clingo's informational messages (e.g. a predicate without facts) are dropped; a
-    grounding error becomes a PlannerError quoting them.
+    grounding error becomes a PlannerError quoting them. A search that does not finish
+    within ``time_limit_s`` [s] (None: no limit) is stopped with a PlannerError.
     """
     messages: list[str] = []
     ctl = clingo.Control(list(arguments), logger=lambda _code, msg: messages.append(msg.strip()))
@@ -89,7 +91,11 @@ def solve_encoding(
         ctl.ground([("base", [])])
     except RuntimeError:
         raise PlannerError(f"{entry} does not ground: " + "; ".join(messages)) from None
-    return ctl.solve(on_model=on_model)
+    with ctl.solve(on_model=on_model, async_=True) as handle:
+        if not handle.wait(time_limit_s):
+            handle.cancel()
+            raise PlannerError(f"{entry}: the search did not finish within {time_limit_s} s")
+        return handle.get()
 
 
 RESERVED_IDS = frozenset({"none", "home", "site"})

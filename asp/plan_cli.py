@@ -37,6 +37,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--assembly", metavar="A", help="assembly (name under data/ or folder) for positions")
     parser.add_argument("--home", type=float, nargs=2, default=HOME, metavar=("X", "Y"),
                         help="tool home [m] (default: 0 0, the cell origin)")
+    parser.add_argument("--time-limit", type=float, metavar="S",
+                        help="give up (exit 2) when the search takes longer than S seconds")
     parser.add_argument("--travel-out", metavar="FILE.lp",
                         help="also write the travel/3 facts (leg lengths [mm]) for plain clingo")
     args = parser.parse_args(argv)
@@ -51,7 +53,7 @@ def main(argv: list[str]) -> int:
     if args.travel_out:
         write_facts(args.travel_out, travel, header="travel(From,To,D): leg lengths [mm]")
     try:
-        found = plans(facts, args.n, optimal=args.optimal, travel=travel)
+        found = plans(facts, args.n, optimal=args.optimal, travel=travel, time_limit_s=args.time_limit)
     except UnsolvableAssembly as exc:
         return report_unsolvable(exc, "plans", args.json)
     if args.json:

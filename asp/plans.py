@@ -67,11 +67,13 @@ def plans(
     n: int = 1,
     optimal: bool = False,
     travel: Sequence[clingo.Symbol] = (),
+    time_limit_s: float | None = None,
 ) -> list[Plan]:
     """Up to ``n`` complete plans (0 = all); optimal ones need the ``travel`` facts.
 
     With ``optimal=True`` every plan returned has the least cost and clingo has proven
-    it. UnsolvableAssembly names the part without a hole; PlannerError when no order
+    it; PlannerError when that takes longer than ``time_limit_s`` [s] (None: no limit).
+    UnsolvableAssembly names the part without a hole; PlannerError when no order
     respects ``must_precede`` (a cycle).
     """
     if optimal and not travel:
@@ -88,7 +90,7 @@ def plans(
     if optimal:
         entry = "plans_optimal.lp"
         arguments += ["--opt-mode=optN", f"--configuration={OPTIMAL_CONFIGURATION}"]
-    solve_encoding(entry, [*facts.atoms, *travel], arguments, keep)
+    solve_encoding(entry, [*facts.atoms, *travel], arguments, keep, time_limit_s)
     if not found:
         feasible_assignment(facts)  # raises UnsolvableAssembly when no assignment exists
         raise PlannerError(

@@ -148,6 +148,9 @@ def test_plan_command_errors(learned: Path, tmp_path: Path) -> None:
     assert _run("asp.cli", "plan", "--help").returncode == 0
     no_geometry = _run("asp.cli", "plan", str(learned), "--optimal")
     assert no_geometry.returncode == 2 and "--assembly" in no_geometry.stderr
+    too_slow = _run("asp.cli", "plan", str(learned), "--optimal", "--assembly", "cranfield",
+                    "--time-limit", "0.001")
+    assert too_slow.returncode == 2 and "did not finish within 0.001 s" in too_slow.stderr
     cyclic = tmp_path / "cyclic.lp"
     cyclic.write_text("part(a;b). must_precede(a,b). must_precede(b,a).\n")
     done = _run("asp.cli", "plan", str(cyclic))
