@@ -1,0 +1,97 @@
+"""``./run.sh bench sizes``: time per decision of the size learner and evaluation time.
+
+For each size n×n (parts × holes) and policy, one learning session on a random biorder
+with ties (seeded) is timed decision by decision: a decision is choosing the next
+experiment and adding its answer, i.e. one solve of the session's ground program
+[ms]; grounding (once per session) is reported apart. Then ``sizes evaluate
+--relabelings all`` on Cranfield is timed for the heuristic (target < 2 min on 2 cores).
+Targets per decision: 5 ms at 5×5, 50 ms at 10×10, 500 ms at 20×20.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import statistics
+import time
+
+import numpy as np
+
+from asp.oracle import TruthOracle
+from asp.size_learner import SizeLearner
+from asp.sizes_evaluate import evaluate_policy
+
+TARGETS_MS = {5: 5.0, 10: 50.0, 20: 500.0}
+
+
+def random_biorder(n: int, seed: int) -> TruthOracle:
+    """n parts and n holes with sizes drawn from n//2 + 1 levels (ties likely)."""
+    rng = random.Random(seed)
+    parts, holes = [f"p{i}" for i in range(1, n + 1)], [f"h{j}" for j in range(1, n + 1)]
+    part_size = {p: rng.randint(0, n // 2) for p in parts}
+    hole_size = {h: rng.randint(0, n // 2) for h in holes}
+    fits = {(p, h) for p in parts for h in holes if part_size[p] < hole_size[h]}
+    return TruthOracle(parts, holes, fits)
+
+
+def time_decisions(n: int, policy: str, seed: int, max_decisions: int) -> dict:
+    """Ground time [s] and per-decision times [ms] of one session (first decisions)."""
+    truth = random_biorder(n, seed)
+    start = time.perf_counter()
+    learner = SizeLearner(truth.parts, truth.holes, policy, seed)
+    ground_s = time.perf_counter() - start
+    times_ms: list[float] = []
+    while len(times_ms) < max_decisions:
+        start = time.perf_counter()
+        pair = learner.next_experiment()
+        if pair is None:
+            break
+        learner.record(*pair, truth.ask(*pair))
+        times_ms.append(1e3 * (time.perf_counter() - start))
+    return {
+        "size": f"{n}x{n}",
+        "policy": policy,
+        "ground_s": round(ground_s, 3),
+        "decisions": len(times_ms),
+        "median_ms": round(statistics.median(times_ms), 2),
+        "p99_ms": round(float(np.percentile(times_ms, 99)), 2),
+        "target_ms": TARGETS_MS.get(n),
+    }
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sizes", default="5,10,20", help="n of the n×n instances (default 5,10,20)")
+    parser.add_argument("--policies", default="systematic,random,heuristic")
+    parser.add_argument("--decisions", type=int, default=60, help="decisions timed per session (default 60)")
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--evaluate", default="heuristic",
+                        help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    args = parser.parse_args(argv)
+    rows = [
+        time_decisions(int(n), policy, args.seed, args.decisions)
+        for n in args.sizes.split(",")
+        for policy in args.policies.split(",")
+    ]
+    report: dict = {"decisions": rows}
+    if args.evaluate:
+        start = time.perf_counter()
+        evaluation = evaluate_policy(TruthOracle.from_assembly("cranfield"), args.evaluate)
+        report["evaluate"] = {"policy": args.evaluate, "cases": evaluation.cases,
+                              "mean": round(evaluation.mean, 4),
+                              "seconds": round(time.perf_counter() - start, 1), "target_s": 120}
+    if args.json:
+        print(json.dumps(report))
+        return 0
+    print(f"{'size':>6} {'policy':>11} {'ground[s]':>9} {'n':>4} {'median[ms]':>10} {'p99[ms]':>8} {'target[ms]':>10}")
+    for r in rows:
+        print(f"{r['size']:>6} {r['policy']:>11} {r['ground_s']:>9.3f} {r['decisions']:>4} "
+              f"{r['median_ms']:>10.2f} {r['p99_ms']:>8.2f} {r['target_ms'] or '-':>10}")
+    if args.evaluate:
+        e = report["evaluate"]
+        print(f"sizes evaluate --policy {e['policy']} --relabelings all (Cranfield, {e['cases']} cases): "
+              f"{e['seconds']} s (target < {e['target_s']} s), mean {e['mean']:.2f}")
+    return 0

@@ -1,0 +1,90 @@
+"""``./run.sh sizes learn|evaluate``: JSON contract, facts output, bad input exits 2."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from asp.facts import atoms_by_name, load_atoms
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "asp.cli", "sizes", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+
+
+def test_learn_json_follows_the_contract_and_writes_facts(tmp_path: Path) -> None:
+    out = tmp_path / "learned.lp"
+    done = _run("learn", "--assembly", "cranfield", "--policy", "systematic", "--json", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert set(report) == {"policy", "experiments", "count", "fits"}
+    assert report["policy"] == "systematic"
+    assert report["count"] == len(report["experiments"]) == 25  # Fig. 5 in paper order: no entailment
+    assert set(report["experiments"][0]) == {"part", "hole", "result"}
+    assert ["sh", "br"] in report["fits"] and ["sh", "s1"] not in report["fits"] and len(report["fits"]) == 17
+    atoms = load_atoms([out])
+    assert len(atoms_by_name(atoms, "fits", 2)) == 17
+    assert len(atoms_by_name(atoms, "tried", 4)) == 25
+
+
+def test_learn_from_a_truth_file_keeps_its_order(tmp_path: Path) -> None:
+    truth = tmp_path / "truth.lp"
+    truth.write_text("part(big). part(small). hole(wide). hole(narrow).\n"
+                     "fits(small,wide). fits(small,narrow). fits(big,wide).\n")
+    report = json.loads(_run("learn", "--truth", str(truth), "--policy", "systematic", "--json").stdout)
+    assert report["experiments"][0] == {"part": "big", "hole": "wide", "result": "fit"}
+    assert sorted(map(tuple, report["fits"])) == [("big", "wide"), ("small", "narrow"), ("small", "wide")]
+
+
+def test_evaluate_json_follows_the_contract(tmp_path: Path) -> None:
+    plot = tmp_path / "fig19.png"
+    done = _run("evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "30",
+                "--json", "--plot", str(plot), "--compare", "random")
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert set(report) == {"policy", "cases", "mean", "min", "min_share", "max", "max_share", "histogram"}
+    assert report["cases"] == 30 == sum(report["histogram"].values())
+    assert 15 <= report["min"] <= report["mean"] <= report["max"] <= 25
+    assert report["histogram"][str(report["min"])] == round(report["min_share"] * 30)
+    assert plot.stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("part(a;b). hole(x;y). fits(a,x). fits(b,y).", "not a biorder"),
+        ("part(a). hole(x). fits(a,z).", "'z' is not a declared hole"),
+        ("part(a). hole(x). fits(c,x).", "'c' is not a declared part"),
+        ("part(a). hole(x) fits(a,x).", "does not parse"),
+        ("fits(a,x).", "expected at least one part/1"),
+    ],
+)
+def test_bad_truth_exits_2_with_a_clear_message(tmp_path: Path, text: str, message: str) -> None:
+    truth = tmp_path / "truth.lp"
+    truth.write_text(text + "\n")
+    done = _run("learn", "--truth", str(truth))
+    assert done.returncode == 2
+    assert message in done.stderr and str(truth) in done.stderr
+    assert "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["learn", "--assembly", "nowhere"],
+        ["learn", "--assembly", "cranfield", "--policy", "psychic"],
+        ["evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "many"],
+        ["learn", "--truth", "/nonexistent/truth.lp"],
+    ],
+)
+def test_bad_arguments_exit_2(args: list[str]) -> None:
+    done = _run(*args)
+    assert done.returncode == 2 and "Traceback" not in done.stderr and done.stderr.strip()
