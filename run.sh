@@ -51,7 +51,7 @@ setup
 export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
 case "$cmd" in
     test)      exec "$PY" -m pytest "$@" ;;
-    executor)  exec "$PY" -m executor.cli "$@" ;;
+    executor)  exec "$PY" -m executor "$@" ;;
     bench)
         if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -m executor.bench "$@"; fi
         exec "$PY" -m asp.cli bench "$@" ;;

@@ -84,7 +84,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None) -> list[str]:
     """The command line of one ``executor serve`` node, with ``--lifeline``."""
-    argv = [sys.executable, "-m", "executor.cli", "serve", "--cell", cell_id,
+    argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
     argv += [arg for ep in connect for arg in ("--connect", ep)]

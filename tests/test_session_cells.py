@@ -179,8 +179,8 @@ def test_cells_of_a_killed_planner_exit(tmp_path: Path) -> None:
 
 
 def is_cell(pid: int) -> bool:
-    """Whether process ``pid`` exists and is an ``executor.cli serve`` node."""
+    """Whether process ``pid`` exists and its command line reads ``executor serve``."""
     try:
-        return b"executor.cli" in Path(f"/proc/{pid}/cmdline").read_bytes()
+        return "executor serve" in Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
     except (FileNotFoundError, ProcessLookupError):
         return False
