@@ -17,9 +17,11 @@ Three paths compute the same rule:
 
 - exact (numpy): filter the enumeration of all m×n biorders (when there are at most
   ``EXACT_LIMIT``, e.g. 5×5) — ~ms per decision, memoised per knowledge state;
-- sampled (numpy, larger instances such as 8×8 or 20×20): ``SAMPLES`` random linear
-  extensions of the known smaller-than order, seeded by the knowledge state, stand in
-  for the possible relations; an unknown pair the sample does not split scores 0;
+- sampled (numpy, larger instances such as 8×8 or 20×20): the distinct biorders among
+  ``SAMPLES`` random integer size assignments that respect the known order (few size
+  levels are as likely as many, so identical parts and holes are common), seeded by
+  the knowledge state, stand in for the possible relations, weighted as above; an
+  unknown pair the sample does not split scores 0;
 - ASP (``select_best.lp``): clingo enumerates the possible relations and their classes
   (part ``base``), then sums the weights per pair and selects (part ``split``); the
   reference path for small instances (total weight < 2^31, e.g. 4×4), used by the tests
@@ -55,8 +57,8 @@ ALPHA = 0.5
 EXACT_LIMIT = 400_000
 """Largest number of m×n biorders enumerated for the exact path (5×5 has 329 462)."""
 
-SAMPLES = 1024
-"""Random linear extensions drawn per decision on the sampled path."""
+SAMPLES = 4096
+"""Random size assignments drawn per decision on the sampled path."""
 
 WEIGHT_SCALE = 1000
 """Prior weights are the integers round(WEIGHT_SCALE · (∏ k!)^ALPHA): their sums are exact

@@ -8,11 +8,11 @@ is set when part p (0-based index) fits hole h. Masks are ``numpy.uint64`` (m·n
 - :func:`all_biorders` enumerates every m×n biorder (5×5: 329 462, the poly-Bernoulli
   number B_5^(-5); :func:`biorder_count` gives the count without enumerating);
 - :func:`consistent_index` finds those agreeing with known fits and no-fits;
-- :func:`sample_biorders` draws biorders (boolean matrices) consistent with a strict
+- :func:`sample_biorders` draws biorders (boolean matrices) consistent with the known
   smaller-than closure, for instances too large to enumerate;
-- :func:`class_weights` gives each biorder (boolean matrix) ∏ k! over its classes of identical rows and
-  of identical columns: the number of orders of the parts and holes on the size line
-  that induce it (these weights sum to (m+n)!).
+- :func:`class_weights` gives each biorder (boolean matrix) ∏ k! over its classes of
+  identical rows and of identical columns: the number of orders of the parts and holes
+  on the size line that induce it (these weights sum to (m+n)!).
 """
 
 from __future__ import annotations
@@ -121,22 +121,28 @@ def class_weights(fits: np.ndarray) -> np.ndarray:
 
 
 def sample_biorders(smaller: np.ndarray, m: int, n: int, samples: int, rng: np.random.Generator) -> np.ndarray:
-    """Distinct biorders, shape (k, m, n), drawn consistent with a strict order on items.
+    """Distinct biorders, shape (k, m, n), drawn consistent with what is known.
 
     ``smaller[x, y]`` is True when item x is known smaller than item y (items: parts
-    0..m-1, then holes); it must be transitively closed and acyclic. Each draw gives
-    every item a uniform random size, lifts it to the largest size among the item and
-    everything below it, and breaks ties by the number of items below, which yields a
-    random linear extension (every one can occur); the biorder is "part below hole".
-    Works for any m, n (no bit masks).
+    0..m-1, then holes), transitively closed and acyclic; every entry is strict except
+    hole < part, which stands for a no-fit and allows equal sizes. Each draw picks a
+    number of size levels L uniform in 1..m+n, gives every item a uniform random level
+    below L, then, in an order compatible with ``smaller``, lifts each item to at least
+    the level of the items known smaller (one above, where strict). A part fits a hole
+    iff its level is lower, so ties (identical parts or holes) are common, and every
+    consistent biorder can occur. Works for any m, n (no bit masks).
     """
-    below = smaller.T | np.eye(m + n, dtype=bool)  # below[y, x]: x ≤ y
-    height = smaller.sum(axis=0)  # number of items below: increases along smaller
-    raw = rng.random((samples, m + n))
-    size = np.where(below[None, :, :], raw[:, None, :], -1.0).max(axis=2)
-    part_size, hole_size = size[:, :m, None], size[:, None, m:]
-    fits = (part_size < hole_size) | (
-        (part_size == hole_size) & (height[:m, None] < height[None, m:])[None, :, :]
-    )
+    items = m + n
+    strict = smaller.copy()
+    strict[m:, :m] = False
+    levels = np.floor(rng.random((samples, items)) * rng.integers(1, items + 1, size=(samples, 1)))
+    for item in np.argsort(smaller.sum(axis=0), kind="stable"):  # items below come first
+        above_strict = np.flatnonzero(strict[:, item])
+        if len(above_strict):
+            levels[:, item] = np.maximum(levels[:, item], levels[:, above_strict].max(axis=1) + 1)
+        at_least = np.flatnonzero(smaller[:, item] & ~strict[:, item])
+        if len(at_least):
+            levels[:, item] = np.maximum(levels[:, item], levels[:, at_least].max(axis=1))
+    fits = levels[:, :m, None] < levels[:, None, m:]
     _, first = np.unique(line_keys(fits.reshape(samples, m * n)), return_index=True)
     return fits[first]
