@@ -35,7 +35,7 @@ usage: ./run.sh [SUBCOMMAND] [ARGS...]
   session       planner + cells over Zenoh: the whole learning session
   view          open a session's Rerun recording
   executor      the simulated PyBullet cell (teach, trial, campaign, serve)
-  bench         benchmarks: precedence | sizes | executor | session
+  bench         benchmarks: precedence | sizes | plan | executor | session
 
 Every subcommand takes --help.
 USAGE

@@ -11,13 +11,14 @@ import importlib
 TOPICS: dict[str, str] = {
     "precedence": "asp.bench_precedence",
     "sizes": "asp.bench_sizes",
+    "plan": "asp.bench_plans",
     "session": "asp.bench_session",
 }
 
 
 def main(argv: list[str]) -> int:
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: ./run.sh bench {precedence,sizes,executor,session} [--help]")
+        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session} [--help]")
         return 0
     topic = argv[0]
     if topic not in TOPICS:

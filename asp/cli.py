@@ -17,7 +17,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "plan": ("asp.plan_cli", "complete assembly plans from learned facts"),
     "session": ("asp.session", "the end-to-end learning session (planner + cells)"),
     "view": ("asp.view", "open a session's Rerun recording"),
-    "bench": ("asp.bench", "benchmarks: precedence | sizes | session"),
+    "bench": ("asp.bench", "benchmarks: precedence | sizes | plan | executor | session"),
 }
 
 
