@@ -81,10 +81,10 @@ def knowledge_masks(knowledge: Knowledge) -> tuple[int, int]:
 
 
 def smaller_matrix(m: int, n: int, fit_mask: int, no_fit_mask: int) -> np.ndarray:
-    """Strict order on items (parts 0..m-1, then holes) from closed part-hole knowledge.
-
-    p < h for a fit, h < p for a no-fit; p < q when p fits a hole q does not (eq. 2);
-    h < k when a part does not fit h but fits k (eq. 3).
+    """The known smaller-than order on items (parts 0..m-1, then holes), from closed
+    part-hole knowledge: p < h for a fit; h < p for a no-fit (there: h ≤ p, equal sizes
+    allowed); p < q when p fits a hole q does not (eq. 2); h < k when a part does not
+    fit h but fits k (eq. 3).
     """
     bits = np.array([(fit_mask >> i) & 1 for i in range(m * n)], dtype=bool).reshape(m, n)
     nobits = np.array([(no_fit_mask >> i) & 1 for i in range(m * n)], dtype=bool).reshape(m, n)
