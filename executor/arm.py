@@ -46,8 +46,9 @@ def rotation_error(quat_des_xyzw: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarr
 
 @dataclass
 class ArmState:
-    """One reading: joints [rad, rad/s], believed tip pose/velocity [m, m/s, rad/s],
-    Jacobians (3×7 each) and the measured contact wrench at the tip (world frame) [N, Nm]."""
+    """One reading: joints [rad, rad/s], believed tip pose/velocity [m, m/s, rad/s], the
+    tip Jacobian (6×7: linear rows, then angular) and the measured contact wrench at the
+    tip (world frame) [N, Nm]."""
 
     q: np.ndarray
     qd: np.ndarray
@@ -55,8 +56,7 @@ class ArmState:
     tip_quat_xyzw: np.ndarray
     tip_vel: np.ndarray
     tip_omega: np.ndarray
-    jac_lin: np.ndarray
-    jac_ang: np.ndarray
+    jac: np.ndarray
     force: np.ndarray
     torque: np.ndarray
 
@@ -82,6 +82,7 @@ class Arm:
         """Real tip = believed tip ∘ (offset [m], rotation) in the believed tip frame."""
         inv_pos, inv_quat = pb.invertTransform(list(offset), list(quat_xyzw))
         self._inv_pos, self._inv_quat = np.array(inv_pos), np.array(inv_quat)
+        self._inv_pos_list = list(inv_pos)
         self.grasp_offset, self.grasp_quat_xyzw = np.array(offset), np.array(quat_xyzw)
 
     def reset(self, q: np.ndarray) -> None:
@@ -120,7 +121,7 @@ class Arm:
         tip_quat = np.array(pb.multiplyTransforms((0, 0, 0), ls[5], (0, 0, 0), self._inv_quat)[1])
         omega = np.array(ls[7])
         tip_vel = np.array(ls[6]) + cross(omega, lever)
-        jl, ja = pb.calculateJacobian(r, self.sensor, list(self._inv_pos), list(q), self._zeros, self._zeros,
+        jl, ja = pb.calculateJacobian(r, self.sensor, self._inv_pos_list, list(q), self._zeros, self._zeros,
                                       physicsClientId=c)
         raw = np.array(pb.getJointState(r, self.sensor, physicsClientId=c)[2]) - self.tare
         self._wrench_filtered += 0.1 * (raw - self._wrench_filtered)
@@ -128,7 +129,7 @@ class Arm:
         # contact wrench on the part is its negative (weight removed by the tare).
         force = -(rot @ self._wrench_filtered[:3])
         torque = -(rot @ self._wrench_filtered[3:]) - cross(lever, force)
-        return ArmState(q, qd, tip_pos, tip_quat, tip_vel, omega, np.array(jl), np.array(ja), force, torque)
+        return ArmState(q, qd, tip_pos, tip_quat, tip_vel, omega, np.array(jl + ja), force, torque)
 
     def tare_sensor(self) -> None:
         """Zero the F/T sensor (call at rest, out of contact): removes the part's weight."""

@@ -59,7 +59,7 @@ class ImpedanceController:
         if wrench_ff is not None:
             force = force + wrench_ff[:3]
             moment = moment + wrench_ff[3:]
-        jac = np.vstack([s.jac_lin, s.jac_ang])
+        jac = s.jac
         tau = jac.T @ np.concatenate([force, moment]) + self.arm.gravity_coriolis(s.q, s.qd)
         # Null-space posture: the posture torque projected through I − Jᵀ J⁺ᵀ.
         if self._steps % self.PROJECTOR_PERIOD == 0:

@@ -25,8 +25,8 @@ class Thresholds:
     """F_stop [N], M_stop [Nm] (eqs. 6, 7), F_slow [N] (phase stopping scale), goal
     tolerance [m], and how long a violation must persist [steps of 1 ms]."""
 
-    f_stop: float = 20.0
-    m_stop: float = 3.0
+    f_stop: float = 30.0
+    m_stop: float = 4.5
     f_slow: float = 8.0
     goal_tolerance: float = 0.003
     persist_steps: int = 20

@@ -58,9 +58,6 @@ class WrenchProfile:
         profile.weights = np.linalg.solve(phi.T @ phi + 1e-6 * np.eye(n_rbf), phi.T @ wrench)
         return profile
 
-    def __call__(self, phase: float) -> np.ndarray:
-        return (self._features(np.array([phase])) @ self.weights)[0]
-
     def tabulate(self, n: int = 501) -> np.ndarray:
         """(n, 6) wrenches at phases 0, 1/(n−1), …, 1: a look-up table for the control loop."""
         return self._features(np.linspace(0.0, 1.0, n)) @ self.weights

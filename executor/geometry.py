@@ -2,8 +2,9 @@
 ``assembly.toml``, and the generated assets (plate mesh, part URDFs, arm+tool URDF).
 
 The back plate is a static concave triangle mesh (PyBullet's trimesh has effectively no
-collision margin, so 0.1 mm clearances are real): one square boss per hole with a blind
-hole, round holes as 64-gons whose inradius is the hole radius, square holes exact.
+collision margin, so 0.1 mm clearances are real): one square boss per hole with a
+through hole (the plate under the boss is its bottom) and a 45° entry chamfer; round
+holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square holes exact.
 Parts are exact primitive shapes (cylinder with ``URDF_USE_IMPLICIT_CYLINDER``, box).
 ``write_assets`` regenerates ``data/<assembly>/assets/`` byte-for-byte deterministically.
 """
@@ -102,7 +103,7 @@ def load_geometry(assembly: str = "cranfield") -> CellGeometry:
 
 
 def _ring(kind: str, half: float, n: int) -> np.ndarray:
-    """(n, 2) boundary points at angles 2πk/n [m]: a 64-gon of inradius ``half`` or a square
+    """(n, 2) boundary points at angles 2πk/n [m]: an n-gon of inradius ``half`` or a square
     of half side ``half`` (its corners are among the points since n is a multiple of 8)."""
     angles = 2.0 * np.pi * np.arange(n) / n
     c, s = np.cos(angles), np.sin(angles)

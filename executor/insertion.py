@@ -30,7 +30,8 @@ class InsertionResult:
     """``completed``: the DMP ran to its end without an unresolved eq. (6)/(7) breach;
     ``reached``: goal check passed where the execution ended (the success criterion:
     an interrupted execution succeeds only if the part is already at its goal);
-    ``end_error`` ‖p_end − p_goal‖ [m]; ``jammed``: a breach happened inside the hole."""
+    ``end_error`` ‖p_end − p_goal‖ [m]; ``jammed``: a breach inside the hole, or the part
+    stuck in the hole at the end of the trajectory."""
 
     completed: bool
     reached: bool
@@ -54,7 +55,9 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     [m]) starting from the current tip pose.  A breach with the tip inside the hole
     (deeper than ``JAM_DEPTH``) is a jam: the wiggle runs once and the insertion goes on;
     a breach with the part still on the plate surface, or a second one, stops the
-    execution; the goal check then decides."""
+    execution; the goal check then decides.  A trajectory that ends with the part stuck
+    in the hole short of the goal (forces below the thresholds) is a jam as well: the
+    wiggle runs there, and the goal is checked again."""
     s = motion.controller.arm.read()
     goal = skill.demo_goal
     times, pos, quats = skill.rollout(s.tip_pos - hole_origin, s.tip_quat_xyzw, goal[:3],
@@ -89,5 +92,14 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         completed = False
     pos_d, quat_d = clock.pose()
     end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
-    reached, err = detector.goal_reached(end.tip_pos, hole_origin + skill.end_position)
+    # p_goal: where the adapted trajectory ends (the lateral admittance offset included).
+    p_goal = hole_origin + skill.end_position + d_pos
+    reached, err = detector.goal_reached(end.tip_pos, p_goal)
+    stalled = completed and not reached and end.tip_pos[2] < hole_origin[2] - JAM_DEPTH
+    jammed = jammed or stalled  # stuck in the hole below the thresholds: a jam too
+    if stalled and wiggle_enabled and wiggles < MAX_WIGGLES:
+        wiggle(motion, pos_d + d_pos, quat_d, gripper_lever, clock.phase, wrench_table[last])
+        wiggles += 1
+        end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME)
+        reached, err = detector.goal_reached(end.tip_pos, p_goal)
     return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase)

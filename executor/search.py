@@ -3,9 +3,9 @@
 The tip comes down on the estimate until it touches the plate (or drops straight into
 the hole), then slides over the surface under a light contact force along an
 Archimedean spiral whose start angle, direction and pitch are drawn at random.  The
-hole is found when the tip sinks ``sink_depth`` below the surface: a part that is too
-big never sinks, so the search gives up at ``max_radius`` and the insertion is tried at
-the estimate (and fails there).
+hole is found when the tip sinks into the hole's entry chamfer and, pushed down it,
+past it: a part that is too big never sinks, so the search gives up at ``max_radius``
+and the insertion is tried at the estimate (and fails there).
 """
 
 from __future__ import annotations
@@ -24,21 +24,24 @@ from executor.scene import TIME_STEP
 class SearchParams:
     """Approach speed [m/s], contact force that means "on the surface" [N], how far
     below the surface the tip is pushed while sliding [m] (× 2000 N/m = contact force),
-    sink depth that means "in the hole" [m], dip that pauses the spiral [m] and for how
-    long at most [s], spiral pitch [m] (± ``pitch_jitter``),
-    sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm)
+    sink depth that means "in the hole's chamfer" [m], depth that means "past the
+    chamfer" [m], dip that pauses the spiral [m] and for how long at most [s], spiral
+    pitch [m] (± ``pitch_jitter``),
+    sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm
+    + half a pitch)
     and time limit [s]."""
 
-    approach_speed: float = 0.02
+    approach_speed: float = 0.025
     contact_force: float = 2.0
     press_depth: float = 0.0025
     sink_depth: float = 0.0005
+    enter_depth: float = 0.0012
     dip_depth: float = 0.0001
     dip_hold: float = 0.3
-    pitch: float = 0.0013
-    pitch_jitter: float = 0.15
-    speed: float = 0.04
-    max_radius: float = 0.0042
+    pitch: float = 0.0012
+    pitch_jitter: float = 0.05
+    speed: float = 0.045
+    max_radius: float = 0.0046
     max_time: float = 2.2
 
 
@@ -52,14 +55,32 @@ class SearchResult:
     path: np.ndarray
 
 
+def _slide_in(motion: Motion, xy: np.ndarray, touched_z: float, quat_xyzw: np.ndarray, p: SearchParams,
+              path: list[np.ndarray]) -> np.ndarray:
+    """The part's edge is in the hole's chamfer: press harder (2 × press depth) with the
+    commanded position complying to the lateral force, until the tip is ``enter_depth``
+    below the surface (past the chamfer) or ``dip_hold`` is over.  Returns the tip
+    position [m]."""
+    comply = Admittance()
+    s = motion.controller.arm.read()
+    for _ in range(int(p.dip_hold / TIME_STEP)):
+        shift = comply.update(s.force, np.zeros(3), TIME_STEP)[0]
+        s = motion.step(np.array([xy[0] + shift[0], xy[1] + shift[1], touched_z - 2 * p.press_depth]), quat_xyzw)
+        if s.tip_pos[2] < touched_z - p.enter_depth:
+            break
+    path.append(s.tip_pos.copy())
+    return s.tip_pos
+
+
 def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: float, quat_xyzw: np.ndarray,
                 rng: np.random.Generator, params: SearchParams = SearchParams()) -> SearchResult:
     """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m].
 
     While sliding, a dip of the tip (``dip_depth`` below the touched surface: an edge of
     the part is over the hole) pauses the spiral for up to ``dip_hold``; meanwhile the
-    commanded position complies to the lateral contact force (admittance), so the part
-    slides down the hole's edge into it like into a chamfer."""
+    commanded position complies to the lateral contact force (admittance).  A sink of
+    ``sink_depth`` means the part is in the hole's chamfer: it is then pushed down the
+    chamfer into the hole (``_slide_in``) and the hole is found where it ends."""
     p = params
     path: list[np.ndarray] = []
     target_z = surface_z - p.press_depth
@@ -69,7 +90,8 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         z = max(target_z, z - p.approach_speed * TIME_STEP)
         s = motion.step(np.array([est_xy[0], est_xy[1], z]), quat_xyzw)
         if s.tip_pos[2] < surface_z - p.sink_depth:
-            return SearchResult(True, s.tip_pos[:2].copy(), surface_z, np.array([s.tip_pos]))
+            tip = _slide_in(motion, est_xy, surface_z, quat_xyzw, p, path)
+            return SearchResult(True, tip[:2].copy(), surface_z, np.array(path))
         if s.force[2] > p.contact_force or (z == target_z and abs(s.tip_vel[2]) < 1e-3):
             break
     touched_z = float(s.tip_pos[2])
@@ -102,6 +124,6 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         if motion.steps % 10 == 0:
             path.append(s.tip_pos.copy())
         if s.tip_pos[2] < touched_z - p.sink_depth:
-            path.append(s.tip_pos.copy())
-            return SearchResult(True, s.tip_pos[:2].copy(), surface_z, np.array(path))
+            tip = _slide_in(motion, xy, touched_z, quat_xyzw, p, path)
+            return SearchResult(True, tip[:2].copy(), surface_z, np.array(path))
     return SearchResult(False, np.asarray(est_xy, dtype=float).copy(), surface_z, np.array(path).reshape(-1, 3))

@@ -1,9 +1,9 @@
 """Scripted kinesthetic teaching (paper 3.1), one skill per part shape.
 
-Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path from
-4 mm above the hole of the shape's ``demo_hole`` (exactly aligned, perfect grasp) down to
-2 mm below the hole's bottom, i.e. pressing the part onto the bottom; the tip poses are
-recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
+Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path (0.8 s)
+from 2 mm inside the entrance of the shape's ``demo_hole`` (where the hole search leaves
+the part; exactly aligned, perfect grasp) down to 0.5 mm above the hole's bottom; the
+tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
 executed by the impedance controller alone and the wrench it meets is recorded: the
 reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
 replay ends is p_goal.  ``./run.sh executor teach`` rebuilds
@@ -23,9 +23,9 @@ from executor.motion import Motion
 from executor.scene import TIME_STEP
 from executor.trial import SETTLE_TIME, Cell
 
-DEMO_DURATION = 1.0  # [s]
+DEMO_DURATION = 0.8  # [s]
 DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole
-DEMO_PRESS = 0.002  # [m] commanded beyond the hole bottom at the end
+DEMO_CLEARANCE = 0.0005  # [m] left between the part and the hole bottom at the end
 
 
 def _min_jerk(s: np.ndarray) -> np.ndarray:
@@ -37,7 +37,7 @@ def _demonstrate(motion: Motion, origin: np.ndarray, bottom: float) -> tuple[np.
     [m] and quaternions (xyzw)."""
     quat = TOOL_DOWN_QUAT_XYZW
     n = int(round(DEMO_DURATION / TIME_STEP))
-    z = DEMO_START_HEIGHT + (-(bottom + DEMO_PRESS) - DEMO_START_HEIGHT) * _min_jerk(np.linspace(0, 1, n))
+    z = DEMO_START_HEIGHT + (-(bottom - DEMO_CLEARANCE) - DEMO_START_HEIGHT) * _min_jerk(np.linspace(0, 1, n))
     times, positions, quats = [], [], []
     for k in range(n):
         s = motion.step(origin + np.array([0.0, 0.0, z[k]]), quat)

@@ -37,8 +37,8 @@ GRASP_OFFSET_MAX = 0.001  # [m] lateral offset of the part in the hand
 GRASP_TILT_MAX = np.radians(1.0)  # [rad]
 VISION_SIGMA = 0.0015  # [m] per axis
 VISION_MAX = 0.003  # [m]
-APPROACH_HEIGHT = 0.004  # [m] above the plate where the search starts
-SETTLE_TIME = 0.03  # [s] at the approach pose before the F/T sensor is tared
+APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
+SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
 
 
 @dataclass
