@@ -142,8 +142,8 @@ class AttemptLogger:
     """Logs a cell's attempts into one Rerun recording (explicit stream, not global).
 
     ``AttemptLogger(cell_id="c1", rrd_path="runs/x/c1.rrd")`` opens a new stream of
-    application ``assembly_constraints`` with ``recording_id`` (random if None) saving
-    to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
+    ``application_id`` (default ``assembly_constraints``) with ``recording_id``
+    (random if None) saving to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
     existing ``rr.RecordingStream`` instead. Without either, data stays in memory
     (``keep_traces`` then still gives the traces for plots).
 
@@ -156,6 +156,7 @@ class AttemptLogger:
         cell_id: str = "c1",
         *,
         recording_id: str | None = None,
+        application_id: str = APPLICATION_ID,
         rrd_path: str | Path | None = None,
         recording: rr.RecordingStream | None = None,
         period_s: float = 0.005,
@@ -174,7 +175,7 @@ class AttemptLogger:
         self._owns_stream = recording is None
         if recording is None:
             recording = rr.RecordingStream(
-                APPLICATION_ID, recording_id=recording_id or str(uuid.uuid4())
+                application_id, recording_id=recording_id or str(uuid.uuid4())
             )
             if rrd_path is not None:
                 Path(rrd_path).parent.mkdir(parents=True, exist_ok=True)
