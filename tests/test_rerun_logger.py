@@ -119,3 +119,19 @@ def test_misuse_is_reported() -> None:
     with pytest.raises(ExecutorError, match="no such recording"):
         read_recording("/nonexistent/x.rrd")
     logger.close()
+
+
+def test_loggers_on_a_callers_stream(tmp_path: Path) -> None:
+    import rerun as rr
+
+    stream = rr.RecordingStream("assembly_constraints", recording_id="mine")
+    stream.save(str(tmp_path / "both.rrd"))
+    for cell in ("a", "b"):
+        logger = AttemptLogger(cell, recording=stream, send_blueprint=False)
+        _attempt(logger, "p1", "s1", 5, 1, "fit", steps=50)
+        logger.close()  # flushes, but leaves the caller's stream open
+    stream.log("planner/note", rr.TextLog("still open"))
+    stream.disconnect()
+    summary = read_recording(tmp_path / "both.rrd")
+    assert summary.blueprints == 0
+    assert {"/executor/a/outcome", "/executor/b/outcome", "/planner/note"} <= set(summary.entities)
