@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from asp.best_policy import choose, choose_by_asp, knowledge_masks, possible_relations_asp
+from asp.best_policy import choose, choose_bit, choose_by_asp, knowledge_masks, possible_relations_asp
 from asp.biorders import all_biorders, consistent_index
 from asp.size_learner import SizeLearner
 from asp.size_policies import get_policy
@@ -55,3 +55,14 @@ def test_best_learns_the_exact_relation_of_random_biorders(truth: np.ndarray) ->
 def test_registry_entry_resolves_to_the_best_policy() -> None:
     policy = get_policy("best")
     assert policy.name == "best" and policy.choose is choose and policy.deterministic
+
+
+def test_sampled_path_is_deterministic_and_picks_an_unknown_pair_at_20x20() -> None:
+    """Large instances: same knowledge, same choice (seeded by the knowledge), never a known pair."""
+    m = n = 20
+    truth = np.arange(m)[:, None] % 7 < np.arange(n)[None, :] % 5
+    learner = closure_after(truth, [0, 21, 42, 63, 84, 105, 399, 210])
+    fit, no_fit = knowledge_masks(learner.knowledge)
+    first = choose_bit.__wrapped__(m, n, fit, no_fit)
+    assert first == choose_bit.__wrapped__(m, n, fit, no_fit)
+    assert not ((fit | no_fit) >> first) & 1
