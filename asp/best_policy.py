@@ -40,12 +40,13 @@ import numpy as np
 
 from asp import PlannerError
 from asp.biorders import (
+    all_biorder_orders,
     all_biorders,
     biorder_count,
     class_weights,
     consistent_index,
-    mask_bits,
     sample_biorders,
+    weighted_bit_sums,
 )
 from asp.facts import fact, format_facts
 from asp.size_knowledge import Knowledge, Pair
@@ -96,21 +97,17 @@ def smaller_matrix(m: int, n: int, fit_mask: int, no_fit_mask: int) -> np.ndarra
     return order
 
 
-def prior_weights(fits: np.ndarray) -> np.ndarray:
-    """Integer-valued prior weight of each relation, ``fits`` of shape (relations, m, n)."""
-    return np.rint(WEIGHT_SCALE * class_weights(fits) ** ALPHA)
+def prior_weights(orders: np.ndarray) -> np.ndarray:
+    """Integer-valued prior weights round(WEIGHT_SCALE · orders^ALPHA), orders = ∏ k!."""
+    return np.rint(WEIGHT_SCALE * orders**ALPHA)
 
 
-def split_scores(fits: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Per column of ``fits`` (relations × candidate pairs): the lighter of its two outcomes."""
-    fit_weight = weights @ fits
-    return np.minimum(fit_weight, weights.sum() - fit_weight)
-
-
-def pick(fits: np.ndarray, weights: np.ndarray, candidates: list[int]) -> int:
-    """The candidate pair (flat index ``p*n + h``) of best split score; ties go to the
-    lowest index. ``fits`` has one row per possible relation, one column per pair."""
-    return candidates[int(np.argmax(split_scores(fits[:, candidates], weights)))]
+def pick(fit_weight: np.ndarray, total: float, candidates: list[int]) -> int:
+    """The candidate pair (flat index ``p*n + h``) whose lighter outcome weighs most;
+    ties go to the lowest index. ``fit_weight[i]``: weight of the relations where pair
+    i fits; ``total``: weight of all possible relations."""
+    lighter = np.minimum(fit_weight[candidates], total - fit_weight[candidates])
+    return candidates[int(np.argmax(lighter))]
 
 
 @lru_cache(maxsize=200_000)
@@ -120,23 +117,23 @@ def choose_bit(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
     if not candidates:
         raise PlannerError("policy best: every pair is known, nothing to choose")
     if biorder_count(m, n) <= EXACT_LIMIT:
-        everything = all_biorders(m, n)
-        keep = consistent_index(everything, fit_mask, no_fit_mask)
-        fits, weights = mask_bits(everything[keep], m * n), _prior_weights(m, n)[keep]
+        keep = consistent_index(all_biorders(m, n), fit_mask, no_fit_mask)
+        weights = _prior_weights(m, n)[keep]
+        fit_weight = weighted_bit_sums(all_biorders(m, n)[keep], weights, m * n)
     else:
         rng = np.random.default_rng([fit_mask, no_fit_mask, m, n])
         sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
-        fits, weights = sample.reshape(len(sample), m * n), prior_weights(sample)
-    if len(fits) == 0:
+        weights = prior_weights(class_weights(sample))
+        fit_weight = weights @ sample.reshape(len(sample), m * n)
+    if len(weights) == 0:
         raise PlannerError("policy best: no biorder agrees with the knowledge (noise left?)")
-    return pick(fits, weights, candidates)
+    return pick(fit_weight, weights.sum(), candidates)
 
 
 @lru_cache(maxsize=4)
 def _prior_weights(m: int, n: int) -> np.ndarray:
     """Prior weight of every m×n biorder, aligned with :func:`all_biorders`."""
-    masks = all_biorders(m, n)
-    return prior_weights(mask_bits(masks, m * n).reshape(len(masks), m, n))
+    return prior_weights(all_biorder_orders(m, n))
 
 
 def choose(knowledge: Knowledge, rng: random.Random) -> Pair:

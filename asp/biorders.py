@@ -6,8 +6,10 @@ allowed, paper 2.2, last paragraph). A relation is held as a bit mask: bit ``p*n
 is set when part p (0-based index) fits hole h. Masks are ``numpy.uint64`` (m·n ≤ 64).
 
 - :func:`all_biorders` enumerates every m×n biorder (5×5: 329 462, the poly-Bernoulli
-  number B_5^(-5); :func:`biorder_count` gives the count without enumerating);
+  number B_5^(-5); :func:`biorder_count` gives the count without enumerating) and
+  :func:`all_biorder_orders` their ∏ k!;
 - :func:`consistent_index` finds those agreeing with known fits and no-fits;
+  :func:`weighted_bit_sums` sums weights per pair over masks;
 - :func:`sample_biorders` draws biorders (boolean matrices) consistent with the known
   smaller-than closure, for instances too large to enumerate;
 - :func:`class_weights` gives each biorder (boolean matrix) ∏ k! over its classes of
@@ -61,16 +63,19 @@ def _ordered_partitions(n: int, max_blocks: int) -> Iterator[tuple[int, ...]]:
 
 
 @lru_cache(maxsize=4)
-def all_biorders(m: int, n: int) -> np.ndarray:
-    """Every m×n biorder as a sorted uint64 mask array (call only for small m, n).
+def _enumeration(m: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every m×n biorder (m, n ≥ 1) as sorted masks, with its ∏ k! (see :func:`class_weights`).
 
     Holes of equal columns form blocks 0..k-1 ordered by size; each part fits exactly
     the holes of the blocks ≥ its level t ∈ 0..k; two neighbouring blocks differ in
     their columns iff some part has the level between them, which makes the
-    enumeration free of duplicates.
+    enumeration free of duplicates. Parts of equal level are the classes of identical
+    rows, blocks the classes of identical columns.
     """
     weights = bit_weights(m, n)
-    chunks: list[np.ndarray] = [np.zeros(1, dtype=np.uint64)] if n == 0 or m == 0 else []
+    factorial = np.array([math.factorial(i) for i in range(max(m, n) + 1)], dtype=np.float64)
+    masks: list[np.ndarray] = []
+    orders: list[np.ndarray] = []
     by_blocks: dict[int, list[tuple[int, ...]]] = {}
     for blocks in _ordered_partitions(n, m + 1):
         by_blocks.setdefault(max(blocks) + 1, []).append(blocks)
@@ -78,12 +83,27 @@ def all_biorders(m: int, n: int) -> np.ndarray:
         levels = np.array(list(itertools.product(range(k + 1), repeat=m)), dtype=np.int64)
         hits_every_boundary = np.all([(levels == t).any(axis=1) for t in range(1, k)], axis=0)
         levels = levels[hits_every_boundary] if k > 1 else levels
+        row_orders = factorial[(levels[:, :, None] == np.arange(k + 1)).sum(axis=1)].prod(axis=1)
         for blocks in partitions:
             fits = levels[:, :, None] <= np.array(blocks)[None, None, :]
-            chunks.append((fits * weights).sum(axis=(1, 2), dtype=np.uint64))
-    masks = np.sort(np.concatenate(chunks))
-    masks.setflags(write=False)
-    return masks
+            masks.append((fits * weights).sum(axis=(1, 2), dtype=np.uint64))
+            orders.append(row_orders * factorial[np.bincount(blocks)].prod())
+    all_masks = np.concatenate(masks)
+    by_mask = np.argsort(all_masks)
+    result = all_masks[by_mask], np.concatenate(orders)[by_mask]
+    for array in result:
+        array.setflags(write=False)
+    return result
+
+
+def all_biorders(m: int, n: int) -> np.ndarray:
+    """Every m×n biorder as a sorted uint64 mask array (call only for small m, n)."""
+    return _enumeration(m, n)[0]
+
+
+def all_biorder_orders(m: int, n: int) -> np.ndarray:
+    """∏ k! of every biorder of :func:`all_biorders`, aligned (float64)."""
+    return _enumeration(m, n)[1]
 
 
 def consistent_index(masks: np.ndarray, fit_mask: int, no_fit_mask: int) -> np.ndarray:
@@ -102,6 +122,21 @@ def line_keys(lines: np.ndarray) -> np.ndarray:
     """One comparable key per boolean vector along the last axis (packed bytes, void dtype)."""
     packed = np.ascontiguousarray(np.packbits(lines, axis=-1))
     return packed.view(f"V{packed.shape[-1]}")[..., 0]
+
+
+def weighted_bit_sums(masks: np.ndarray, weights: np.ndarray, pairs: int) -> np.ndarray:
+    """Per bit i < pairs: the sum of the weights of the masks with bit i set.
+
+    Sums per byte value (one ``bincount`` per mask byte), then per bit: fast for many
+    masks, and exact for integer-valued weights whose total stays below 2^53.
+    """
+    as_bytes = np.ascontiguousarray(masks, dtype="<u8").view(np.uint8).reshape(-1, 8)
+    bits_of_byte = np.unpackbits(np.arange(256, dtype=np.uint8)[:, None], axis=1, bitorder="little")
+    per_byte = [
+        np.bincount(as_bytes[:, b], weights=weights, minlength=256) @ bits_of_byte
+        for b in range((pairs + 7) // 8)
+    ]
+    return np.concatenate(per_byte)[:pairs]
 
 
 def class_weights(fits: np.ndarray) -> np.ndarray:

@@ -12,12 +12,14 @@ from hypothesis import strategies as st
 
 from asp.best_policy import smaller_matrix
 from asp.biorders import (
+    all_biorder_orders,
     all_biorders,
     biorder_count,
     class_weights,
     consistent_index,
     mask_bits,
     sample_biorders,
+    weighted_bit_sums,
 )
 from asp.size_learner import SizeLearner
 
@@ -54,7 +56,15 @@ def test_enumeration_count_is_poly_bernoulli_and_duplicate_free(m: int, n: int) 
 def test_class_weights_count_the_orders_of_the_size_line(m: int, n: int) -> None:
     """Every order of the m+n items induces exactly one biorder."""
     masks = all_biorders(m, n)
-    assert class_weights(as_matrices(masks, m, n)).sum() == pytest.approx(math.factorial(m + n))
+    weights = class_weights(as_matrices(masks, m, n))
+    assert weights.sum() == pytest.approx(math.factorial(m + n))
+    assert np.allclose(all_biorder_orders(m, n), weights)
+
+
+def test_weighted_bit_sums_equal_the_sums_over_expanded_bits() -> None:
+    masks = all_biorders(4, 5)
+    weights = np.rint(1000 * np.sqrt(all_biorder_orders(4, 5)))
+    assert np.array_equal(weighted_bit_sums(masks, weights, 20), weights @ mask_bits(masks, 20))
 
 
 def biorder_truths(max_side: int) -> st.SearchStrategy[np.ndarray]:
