@@ -26,9 +26,6 @@ from functools import lru_cache
 
 import numpy as np
 
-ONE = np.uint64(1)
-
-
 def stirling2(n: int, k: int) -> int:
     """Stirling number of the second kind: partitions of n elements into k blocks."""
     return sum((-1) ** (k - j) * math.comb(k, j) * j**n for j in range(k + 1)) // math.factorial(k)
@@ -42,9 +39,9 @@ def biorder_count(m: int, n: int) -> int:
     )
 
 
-def bit_weights(m: int, n: int) -> np.ndarray:
+def pair_bits(m: int, n: int) -> np.ndarray:
     """(m, n) array of the mask bit of each part-hole pair."""
-    return (ONE << np.arange(m * n, dtype=np.uint64)).reshape(m, n)
+    return (np.uint64(1) << np.arange(m * n, dtype=np.uint64)).reshape(m, n)
 
 
 def _ordered_partitions(n: int, max_blocks: int) -> Iterator[tuple[int, ...]]:
@@ -72,7 +69,7 @@ def _enumeration(m: int, n: int) -> tuple[np.ndarray, np.ndarray]:
     enumeration free of duplicates. Parts of equal level are the classes of identical
     rows, blocks the classes of identical columns.
     """
-    weights = bit_weights(m, n)
+    bits = pair_bits(m, n)
     factorial = np.array([math.factorial(i) for i in range(max(m, n) + 1)], dtype=np.float64)
     masks: list[np.ndarray] = []
     orders: list[np.ndarray] = []
@@ -86,7 +83,7 @@ def _enumeration(m: int, n: int) -> tuple[np.ndarray, np.ndarray]:
         row_orders = factorial[(levels[:, :, None] == np.arange(k + 1)).sum(axis=1)].prod(axis=1)
         for blocks in partitions:
             fits = levels[:, :, None] <= np.array(blocks)[None, None, :]
-            masks.append((fits * weights).sum(axis=(1, 2), dtype=np.uint64))
+            masks.append((fits * bits).sum(axis=(1, 2), dtype=np.uint64))
             orders.append(row_orders * factorial[np.bincount(blocks)].prod())
     all_masks = np.concatenate(masks)
     by_mask = np.argsort(all_masks)
