@@ -17,7 +17,7 @@ from asp.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.size_knowledge import Knowledge
 from asp.size_learner import Experiment, learn_sizes
 from asp.size_policies import get_policy, policy_names
-from asp.sizes_evaluate import evaluate_policy, percent, plot_comparison
+from asp.sizes_evaluate import evaluate_policy, plot_comparison
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -117,8 +117,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         print(json.dumps(report))
     else:
         print(f"policy {args.policy} over {report['cases']} relabelings: mean {report['mean']:.2f}, "
-              f"min {report['min']} ({percent(report['min_share'])}), "
-              f"max {report['max']} ({percent(report['max_share'])})")
+              f"min {report['min']} ({100 * report['min_share']:.2f} %), "
+              f"max {report['max']} ({100 * report['max_share']:.2f} %)")
         print("histogram (experiments: cases): " + ", ".join(f"{n}: {c}" for n, c in report["histogram"].items()))
         if args.plot:
             print(f"plot written to {args.plot}", file=sys.stderr)

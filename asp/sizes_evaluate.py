@@ -16,7 +16,6 @@ Non-deterministic policies (``random``) run every case, case i with seed
 from __future__ import annotations
 
 import itertools
-import math
 import multiprocessing
 import random
 import sys
@@ -234,7 +233,3 @@ def plot_comparison(evaluations: Sequence[Evaluation], path: str) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
-
-
-def percent(share: float) -> str:
-    return f"{100 * share:.2f} %" if not math.isnan(share) else "n/a"
