@@ -3,13 +3,12 @@
     ‖F_mes − F_des‖ ≥ F_stop   (6)        ‖M_mes − M_des‖ ≥ M_stop   (7)
     ‖p_end − p_goal‖ > goal_tolerance      (the trajectory was not completed)
 
-Thresholds come from margins measured with ``tests/../executor bench`` runs on every
-part-hole pair (README, "The simulated cell"): a fitting insertion, tight peg included,
-stays below ~13 N / 0.09 Nm deviation apart from short contact transients, a too-big
-part pressed by the 2000 N/m impedance reaches 20 N within 10 mm overtravel; a fitting
-insertion ends within 1 mm of p_goal, a blocked one ≥ 20 mm away.  One set of thresholds
-for all pairs.  A violation must persist ``persist_steps`` steps to count (contact
-transients when an edge catches last 1–5 ms).
+Thresholds come from margins measured with ``python -m executor.margins`` (every
+part-hole pair, detection off; README, "The simulated cell"): fitting insertions stay
+below 3.9 N / 0.09 Nm sustained deviation (tight peg: 24.2 N / 2.6 Nm) and end within
+2.4 mm of p_goal; a too-big part pushed on by the 2000 N/m impedance passes 50 N and
+ends ≥ 24.7 mm away.  One set of thresholds for all pairs.  A violation must persist
+``persist_steps`` steps to count (contact transients when an edge catches last 1–5 ms).
 """
 
 from __future__ import annotations
