@@ -31,6 +31,8 @@ import statistics
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -194,10 +196,18 @@ def run_campaign(
         for done, task in enumerate(tasks, 1):
             store(done, _run_task(task))
         return results
-    context = multiprocessing.get_context("spawn")
-    with context.Pool(workers, initializer=_init_worker, initargs=(factory,)) as pool:
-        for done, item in enumerate(pool.imap_unordered(_run_task, tasks, chunksize=1), 1):
-            store(done, item)
+    with ProcessPoolExecutor(
+        workers, mp_context=multiprocessing.get_context("spawn"),
+        initializer=_init_worker, initargs=(factory,),
+    ) as pool:
+        futures = [pool.submit(_run_task, task) for task in tasks]
+        try:
+            for done, future in enumerate(as_completed(futures), 1):
+                store(done, future.result())
+        except BrokenProcessPool as exc:
+            raise ExecutorError(
+                f"campaign: a worker process died ({exc}); expected it to finish its trials"
+            ) from exc
     return results
 
 

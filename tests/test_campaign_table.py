@@ -119,3 +119,18 @@ def test_figures_are_written(tmp_path: Path) -> None:
     for image in (table, forces):
         assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert image.stat().st_size > 10_000
+
+
+def dying_runner() -> Any:
+    """A runner whose worker process dies at its first trial."""
+    import os
+
+    def run(part: str, hole: str, seed: int) -> dict[str, Any]:
+        os._exit(3)
+
+    return run
+
+
+def test_a_dead_worker_is_an_error_not_a_hang() -> None:
+    with pytest.raises(ExecutorError, match="worker process died"):
+        run_campaign(campaign_pairs()[:2], trials=1, seed=0, workers=2, factory=dying_runner)
