@@ -208,6 +208,9 @@ def run_campaign(
             raise ExecutorError(
                 f"campaign: a worker process died ({exc}); expected it to finish its trials"
             ) from exc
+        except BaseException:  # a failed trial or Ctrl-C: do not run the rest
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
     return results
 
 

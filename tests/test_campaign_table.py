@@ -134,3 +134,17 @@ def dying_runner() -> Any:
 def test_a_dead_worker_is_an_error_not_a_hang() -> None:
     with pytest.raises(ExecutorError, match="worker process died"):
         run_campaign(campaign_pairs()[:2], trials=1, seed=0, workers=2, factory=dying_runner)
+
+
+def failing_runner() -> Any:
+    """A runner whose trials raise an ExecutorError (e.g. a missing demonstration)."""
+
+    def run(part: str, hole: str, seed: int) -> dict[str, Any]:
+        raise ExecutorError(f"part '{part}' has no demonstration")
+
+    return run
+
+
+def test_a_failing_trial_stops_the_campaign() -> None:
+    with pytest.raises(ExecutorError, match="no demonstration"):
+        run_campaign(campaign_pairs(), trials=40, seed=0, workers=2, factory=failing_runner)
