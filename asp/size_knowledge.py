@@ -65,28 +65,31 @@ class Knowledge:
 
     @classmethod
     def from_symbols(
-        cls, parts: Sequence[str], holes: Sequence[str], symbols: Iterable[clingo.Symbol]
+        cls,
+        parts: Sequence[str],
+        holes: Sequence[str],
+        symbols: Iterable[clingo.Symbol],
+        decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] | None = None,
     ) -> Knowledge:
-        """Read the shown atoms of a ``sizes_closure.lp`` model."""
-        smaller: set[tuple[str, str]] = set()
-        fits: set[Pair] = set()
-        no_fit: set[Pair] = set()
-        conflicts: set[tuple[str, str, str]] = set()
-        sets: dict[tuple[str, int], set] = {
-            ("smaller", 2): smaller,
-            ("fits", 2): fits,
-            ("no_fit", 2): no_fit,
-            ("in_conflict", 3): conflicts,
-        }
+        """Read the shown atoms of a ``sizes_closure.lp`` model.
+
+        ``decoded`` caches ``symbol -> (name, argument strings)`` across calls (reading
+        arguments through clingo's API costs more than the solve on small instances).
+        """
+        decoded = {} if decoded is None else decoded
+        sets: dict[str, set] = {"smaller": set(), "fits": set(), "no_fit": set(), "in_conflict": set()}
         for symbol in symbols:
-            target = sets.get((symbol.name, len(symbol.arguments)))
+            entry = decoded.get(symbol)
+            if entry is None:
+                entry = decoded[symbol] = (symbol.name, tuple(str(a) for a in symbol.arguments))
+            target = sets.get(entry[0])
             if target is not None:
-                target.add(tuple(str(a) for a in symbol.arguments))
+                target.add(entry[1])
         return cls(
             parts=tuple(parts),
             holes=tuple(holes),
-            smaller=frozenset(smaller),
-            fits=frozenset(fits),
-            no_fit=frozenset(no_fit),
-            conflicts=frozenset(conflicts),
+            smaller=frozenset(sets["smaller"]),
+            fits=frozenset(sets["fits"]),
+            no_fit=frozenset(sets["no_fit"]),
+            conflicts=frozenset(sets["in_conflict"]),
         )

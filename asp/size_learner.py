@@ -92,7 +92,12 @@ class SizeLearner:
         self.retests: list[Pair] = []
         self._history: list[tuple[Knowledge, Pair | None, list[Pair]]] = []
         self._ctl = clingo.Control(["--warn=none"])
+        self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
         self._ground(seed)
+        self._literals = {
+            (p, h, r): self._ctl.symbolic_atoms[fact("observed", p, h, r)].literal
+            for p in self.parts for h in self.holes for r in RESULTS
+        }
         self._selected: Pair | None = None
         self.knowledge = self._solve()
 
@@ -114,14 +119,14 @@ class SizeLearner:
         result = self._ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
         if not result.satisfiable:
             raise PlannerError(f"policy {self.policy.name}: no model for the current knowledge")
-        selected = [tuple(str(a) for a in s.arguments) for s in last if s.name == "select"]
+        knowledge = Knowledge.from_symbols(self.parts, self.holes, last, self._decoded)
+        selected = [self._decoded[s][1] for s in last if self._decoded[s][0] == "select"]
         self._selected = selected[0] if len(selected) == 1 else None
-        return Knowledge.from_symbols(self.parts, self.holes, last)
+        return knowledge
 
     def _set_observation(self, pair: Pair, result: str | None) -> None:
         for value in RESULTS:
-            atom = fact("observed", pair[0], pair[1], value)
-            self._ctl.assign_external(atom, value == result)
+            self._ctl.assign_external(self._literals[(*pair, value)], value == result)
 
     @staticmethod
     def _kept(answers: list[str]) -> str:
