@@ -7,6 +7,8 @@ Physics: 1 kHz time step (torque control needs it), gravity, and
 
 from __future__ import annotations
 
+import os
+import sys
 import tempfile
 from pathlib import Path
 
@@ -26,6 +28,9 @@ class Scene:
 
     def __init__(self, geometry: CellGeometry, gui: bool = False) -> None:
         self.geometry = geometry
+        if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+            raise ExecutorError("--gui needs a display, but DISPLAY is not set (expected an X display; "
+                                "run without --gui for the DIRECT mode)")
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
         if self.client < 0:
             raise ExecutorError("could not connect to PyBullet (GUI requested without a display?)")
