@@ -88,3 +88,11 @@ def test_bad_truth_exits_2_with_a_clear_message(tmp_path: Path, text: str, messa
 def test_bad_arguments_exit_2(args: list[str]) -> None:
     done = _run(*args)
     assert done.returncode == 2 and "Traceback" not in done.stderr and done.stderr.strip()
+
+
+def test_assembly_sizes_with_an_undeclared_part_exits_2(tmp_path: Path) -> None:
+    (tmp_path / "assembly.toml").write_text('[parts.a]\nname = "a"\n[holes.x]\nname = "x"\n')
+    (tmp_path / "sizes.lp").write_text("part(a;ghost). hole(x). fits(a,x).\n")
+    done = _run("learn", "--assembly", str(tmp_path))
+    assert done.returncode == 2
+    assert "ghost" in done.stderr and "assembly.toml" in done.stderr
