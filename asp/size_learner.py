@@ -91,7 +91,7 @@ class SizeLearner:
         self.answers: dict[Pair, list[str]] = {}
         self.retests: list[Pair] = []
         self._history: list[tuple[Knowledge, Pair | None, list[Pair]]] = []
-        self._ctl = clingo.Control(["--warn=none"])
+        self._ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
         self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
         self._ground(seed)
         self._literals = {

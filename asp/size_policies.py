@@ -6,7 +6,7 @@ A policy tells the learner which unknown part-hole pair to try next. It is eithe
   long-lived ``clingo.Control`` beside ``sizes_closure.lp``; it reads ``unknown/2``,
   ``smaller/2``, ``fits/2``, ``no_fit/2``, ``part_index/2``, ``hole_index/2`` (1-based
   order) and whatever ``session_facts`` adds, and shows exactly one ``select(P,H)``
-  while some pair is unknown; or
+  while some pair is unknown (in the last model, if it optimises); or
 - a Python callable ``choose(knowledge, rng) -> (part, hole)`` over the current
   :class:`asp.size_knowledge.Knowledge` (it must return an unknown pair).
 
@@ -37,6 +37,8 @@ class SelectionPolicy:
 
     ``deterministic``: the chosen experiments depend only on the truth matrix in index
     order (not on names or the seed), so an evaluation may memoise per matrix.
+    ``solver_options``: clingo options of the learner's Control (e.g. an optimisation
+    strategy for an encoding that optimises; its last model is taken).
     """
 
     name: str
@@ -45,6 +47,7 @@ class SelectionPolicy:
     choose: Chooser | None = None
     session_facts: SessionFacts | None = None
     deterministic: bool = True
+    solver_options: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if (self.encoding is None) == (self.choose is None):
@@ -76,6 +79,7 @@ POLICIES: dict[str, SelectionPolicy | str] = {
         "heuristic",
         "the paper's template count with its tie-breaks (paper 2.2)",
         encoding="select_heuristic.lp",
+        solver_options=("--opt-strategy=usc",),
     ),
     "best": "asp.best_policy:POLICY",
 }
