@@ -38,13 +38,16 @@ import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NamedTuple, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import rerun as rr
 
 from executor import ExecutorError
 from executor.rerun_blueprint import cell_blueprint
+
+if TYPE_CHECKING:
+    from executor.trial import AttemptEvidence
 
 APPLICATION_ID = "assembly_constraints"
 PHASE_SCALE = 1000
@@ -72,20 +75,6 @@ class SceneShape(NamedTuple):
     position: Sequence[float]
     quat_xyzw: Sequence[float] = (0.0, 0.0, 0.0, 1.0)
     color: Sequence[int] | None = None
-
-
-class Evidence(Protocol):
-    """What ``end_attempt`` reads (``executor.trial.AttemptEvidence`` satisfies it)."""
-
-    outcome: str
-    max_force_dev: float
-    max_torque_dev: float
-    end_error: float
-    duration_s: float
-    sim_time_s: float
-    jammed: bool
-    wiggles: int
-    phase_reached: float
 
 
 @dataclass
@@ -289,7 +278,7 @@ class AttemptLogger:
             f"{self.root}/search/path", rr.LineStrips3D([path], colors=[[240, 180, 0]], radii=0.0005)
         )
 
-    def end_attempt(self, evidence: Evidence) -> AttemptTrace:
+    def end_attempt(self, evidence: AttemptEvidence) -> AttemptTrace:
         """Send the buffered steps, the tool path and the outcome; returns the trace."""
         trace = self._require_attempt("end_attempt")
         trace.outcome = evidence.outcome
@@ -379,7 +368,7 @@ class AttemptLogger:
             self._styled.add(entity)
         self.rec.send_columns(entity, indexes=indexes, columns=rr.Scalars.columns(scalars=values))
 
-    def _log_outcome(self, trace: AttemptTrace, evidence: Evidence) -> None:
+    def _log_outcome(self, trace: AttemptTrace, evidence: AttemptEvidence) -> None:
         text = (
             f"{trace.part}→{trace.hole} seed {trace.trial_seed} attempt {trace.attempt}: "
             f"{evidence.outcome} (max ΔF {evidence.max_force_dev:.1f} N, "
