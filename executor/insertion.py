@@ -79,7 +79,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         f_norm, _, violated = detector.update(f_dev, m_dev)
         d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
         if violated:
-            jammed = jammed or s.tip_pos[2] < hole_origin[2] - JAM_DEPTH
+            jammed = jammed or bool(s.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
             if not (jammed and wiggle_enabled and wiggles < MAX_WIGGLES):
                 completed = False
                 break
@@ -95,7 +95,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     # p_goal: where the adapted trajectory ends (the lateral admittance offset included).
     p_goal = hole_origin + skill.end_position + d_pos
     reached, err = detector.goal_reached(end.tip_pos, p_goal)
-    stalled = completed and not reached and end.tip_pos[2] < hole_origin[2] - JAM_DEPTH
+    stalled = completed and not reached and bool(end.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
     jammed = jammed or stalled  # stuck in the hole below the thresholds: a jam too
     if stalled and wiggle_enabled and wiggles < MAX_WIGGLES:
         wiggle(motion, pos_d + d_pos, quat_d, gripper_lever, clock.phase, wrench_table[last])

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
+
 import numpy as np
 import pybullet as pb
 import pytest
@@ -77,3 +80,4 @@ def test_tight_peg_jam_is_resolved_by_the_wiggle(cell):
     assert freed.jammed and freed.wiggles == 1
     assert freed.outcome == "fit"
     assert freed.end_error < cell.thresholds.goal_tolerance
+    json.dumps(dataclasses.asdict(freed))  # evidence goes out as JSON (bridge, CLI)
