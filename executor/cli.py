@@ -78,6 +78,7 @@ def _trial(args: argparse.Namespace) -> int:
 _DELEGATED = {
     "campaign": "Fig. 18: randomised executions of every part-hole pair (executor.campaign)",
     "serve": "serve insertion requests over Zenoh (executor.serve)",
+    "margins": "measure the wrench and end-error margins the thresholds come from (executor.margins)",
 }
 
 

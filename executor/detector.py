@@ -3,7 +3,7 @@
     ‖F_mes − F_des‖ ≥ F_stop   (6)        ‖M_mes − M_des‖ ≥ M_stop   (7)
     ‖p_end − p_goal‖ > goal_tolerance      (the trajectory was not completed)
 
-Thresholds come from margins measured with ``python -m executor.margins`` (every
+Thresholds come from margins measured with ``./run.sh executor margins`` (every
 part-hole pair, detection off; README, "The simulated cell"): fitting insertions stay
 below 3.9 N / 0.09 Nm sustained deviation (tight peg: 24.4 N / 2.8 Nm) and end within
 2.55 mm of p_goal; a too-big part pushed on by the 2000 N/m impedance passes 50 N and

@@ -1,6 +1,6 @@
 """Measure the margins the detector thresholds are chosen from.
 
-``python -m executor.margins [--trials N] [--seed S]`` runs every part-hole pair of the
+``./run.sh executor margins [--trials N] [--seed S] [--pairs P:H,...]`` runs every pair of the
 cell with eqs. (6)/(7) switched off (F_stop = M_stop = ∞, so nothing is interrupted)
 and prints, per pair and over the trials, the largest sustained wrench deviation
 (the statistic eqs. 6 and 7 are tested on) and the end error ‖p_end − p_goal‖.
@@ -20,7 +20,7 @@ from executor.trial import AttemptSetup, Cell, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="executor.margins", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="executor margins", description=__doc__.split("\n\n")[0])
     parser.add_argument("--trials", type=int, default=10, help="attempts per pair (default 10)")
     parser.add_argument("--seed", type=int, default=0, help="first seed")
     parser.add_argument("--pairs", help="comma-separated part:hole pairs (default: all)")
