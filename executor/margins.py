@@ -15,8 +15,20 @@ import math
 import sys
 from collections.abc import Sequence
 
+from executor import ExecutorError
 from executor.detector import Thresholds
 from executor.trial import AttemptSetup, Cell, trial_rng
+
+
+def _parse_pairs(text: str) -> list[tuple[str, str]]:
+    """``p1:r1,p3:s1`` → [("p1", "r1"), ("p3", "s1")]."""
+    pairs = []
+    for item in text.split(","):
+        part, sep, hole = item.partition(":")
+        if not (sep and part and hole) or ":" in hole:
+            raise ExecutorError(f"--pairs: '{item}' is not a pair (expected part:hole, e.g. p1:r1)")
+        pairs.append((part, hole))
+    return pairs
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -26,8 +38,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--pairs", help="comma-separated part:hole pairs (default: all)")
     args = parser.parse_args(argv)
     cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf))
-    pairs = ([tuple(p.split(":")) for p in args.pairs.split(",")] if args.pairs else
-             [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)])
+    pairs = _parse_pairs(args.pairs) if args.pairs else [
+        (p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     print(f"{'pair':8s} {'max dF [N]':>10s} {'max dM [Nm]':>11s} {'end error [mm] min..max':>24s}  found")
     try:
         for part, hole in pairs:
