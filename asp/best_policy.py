@@ -30,8 +30,10 @@ Three paths compute the same rule:
 
 from __future__ import annotations
 
+import itertools
 import math
 import random
+from collections.abc import Sequence
 from functools import lru_cache
 from importlib.resources import as_file, files
 
@@ -111,11 +113,11 @@ def pick(fit_weight: np.ndarray, total: float, candidates: list[int]) -> int:
 
 
 @lru_cache(maxsize=200_000)
-def choose_bit(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
-    """The chosen pair as flat index ``p*n + h`` for closed knowledge given by its masks."""
-    candidates = [i for i in range(m * n) if not ((fit_mask | no_fit_mask) >> i) & 1]
-    if not candidates:
-        raise PlannerError("policy best: every pair is known, nothing to choose")
+def split_weights(m: int, n: int, fit_mask: int, no_fit_mask: int) -> tuple[np.ndarray, float]:
+    """Per pair (flat index ``p*n + h``) the weight of the possible relations in which it
+    fits, and the total weight of the possible relations, for the knowledge given by its
+    masks (exact or sampled path; the masks may add hypothetical outcomes to closed
+    knowledge on the exact path)."""
     if biorder_count(m, n) <= EXACT_LIMIT:
         keep = consistent_index(all_biorders(m, n), fit_mask, no_fit_mask)
         weights = _prior_weights(m, n)[keep]
@@ -125,9 +127,19 @@ def choose_bit(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
         sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
         weights = prior_weights(class_weights(sample))
         fit_weight = weights @ sample.reshape(len(sample), m * n)
-    if len(weights) == 0:
+    return fit_weight, float(weights.sum())
+
+
+@lru_cache(maxsize=200_000)
+def choose_bit(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
+    """The chosen pair as flat index ``p*n + h`` for closed knowledge given by its masks."""
+    candidates = [i for i in range(m * n) if not ((fit_mask | no_fit_mask) >> i) & 1]
+    if not candidates:
+        raise PlannerError("policy best: every pair is known, nothing to choose")
+    fit_weight, total = split_weights(m, n, fit_mask, no_fit_mask)
+    if total == 0:
         raise PlannerError("policy best: no biorder agrees with the knowledge (noise left?)")
-    return pick(fit_weight, weights.sum(), candidates)
+    return pick(fit_weight, total, candidates)
 
 
 @lru_cache(maxsize=4)
@@ -142,6 +154,27 @@ def choose(knowledge: Knowledge, rng: random.Random) -> Pair:
     m, n = len(knowledge.parts), len(knowledge.holes)
     bit = choose_bit(m, n, *knowledge_masks(knowledge))
     return knowledge.parts[bit // n], knowledge.holes[bit % n]
+
+
+def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]:
+    """Unknown pairs not in ``pending`` (pairs out at other cells), best first to run
+    beside them: by the weight of the lighter outcome summed over the outcome
+    combinations of the pending pairs, i.e. the expected split once their results are
+    known too (without pending pairs, the split :func:`choose` maximises); ties go to
+    the lowest index. Scores only; whether a pair is independent of the others is the
+    learner's check.
+    """
+    m, n = len(knowledge.parts), len(knowledge.holes)
+    index = {(p, h): i * n + j for i, p in enumerate(knowledge.parts) for j, h in enumerate(knowledge.holes)}
+    fit_mask, no_fit_mask = knowledge_masks(knowledge)
+    bits = [1 << index[pair] for pair in pending]
+    score = np.zeros(m * n)
+    for outcomes in itertools.product((True, False), repeat=len(bits)):
+        fits = sum(bit for bit, fit in zip(bits, outcomes) if fit)
+        fit_weight, total = split_weights(m, n, fit_mask | fits, no_fit_mask | (sum(bits) - fits))
+        score += np.minimum(fit_weight, total - fit_weight)
+    candidates = [pair for pair in knowledge.unknown if pair not in pending]
+    return sorted(candidates, key=lambda pair: (-score[index[pair]], index[pair]))
 
 
 def _encoding() -> str:
@@ -210,4 +243,5 @@ POLICY = SelectionPolicy(
     "best",
     "most even split of the possible relations (biorders), weighted (prod k!)^(1/2)",
     choose=choose,
+    batch_rank=batch_rank,
 )

@@ -122,10 +122,9 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
                  log: PlannerLog) -> SizeLearningResult:
     """Replay the journal, then keep every alive cell busy until the learner is done.
 
-    Whenever a cell is free, the learner is asked for a batch as large as the running
-    experiments plus the free cells; only if the batch holds every running experiment
-    (so the new ones are independent of them) are its new pairs submitted; otherwise
-    the free cells wait for the running experiments to finish.
+    Whenever cells are free, the learner is asked for as many pairs as free cells,
+    independent of the running experiments and of each other, and they are submitted
+    at once; when there are none, the free cells wait for a running experiment to finish.
     """
     def record(part: str, hole: str, result: str, cell: str, started: int) -> None:
         learner.record(part, hole, result)
@@ -137,14 +136,12 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
     while True:
         free = max(1, oracle.alive_cells()) - len(running)
         if free > 0:
-            batch = learner.next_batch(len(running) + free)
+            batch = learner.next_batch(free, pending=running)
             if not batch and not running:
                 return learner.result()
-            if set(running) <= set(batch):
-                for pair in batch:
-                    if pair not in running:
-                        oracle.submit(*pair)
-                        running.append(pair)
+            for pair in batch:
+                oracle.submit(*pair)
+                running.append(pair)
         finished = oracle.next_result()
         running.remove((finished.part, finished.hole))
         record(finished.part, finished.hole, finished.result, finished.cell, finished.experiment)

@@ -188,24 +188,35 @@ class SizeLearner:
         """Up to ``size`` pairs to try in parallel, none of whose outcomes can entail another's.
 
         ``pending`` are pairs already out at other cells: the new pairs must be
-        independent of them too. Pending re-tests come first; then the policy's choice
-        (if independent of ``pending``) and unknown pairs in index order, each kept when
-        no combination of outcomes of the others entails or contradicts it (checked by
-        solving with hypothetical observations).
+        independent of them too. Pending re-tests come first. Otherwise pairs are added
+        one at a time, each the first of :meth:`_candidates` that no combination of
+        outcomes of the pending and already chosen pairs entails or contradicts, nor
+        its outcomes theirs (checked by solving with hypothetical observations).
         """
         retests = [p for p in self.retests if p not in pending]
         if retests:
             return retests[:size]
         if self.knowledge.complete:
             return []
+        choice = self.next_experiment()  # before hypothetical solves replace the selection
         chosen: list[Pair] = []
-        for pair in [self.next_experiment(), *self.knowledge.unknown]:
-            if len(chosen) >= size:
+        while len(chosen) < size:
+            out = [*pending, *chosen]
+            pair = next((p for p in self._candidates(choice, out) if self._independent([*out, p])), None)
+            if pair is None:
                 break
-            if pair not in chosen and pair not in pending and self._independent([*pending, *chosen, pair]):
-                chosen.append(pair)
+            chosen.append(pair)
         self.knowledge = self._solve()
         return chosen
+
+    def _candidates(self, choice: Pair, out: list[Pair]) -> list[Pair]:
+        """Unknown pairs not in ``out``, best first for a batch beside ``out``: the
+        policy's ``batch_rank`` given ``out`` if it has one (with nothing out, its
+        ``choice`` first), else its ``choice``, then index order."""
+        rank = self.policy.batch_rank
+        first = [choice] if rank is None or not out else []
+        rest = self.knowledge.unknown if rank is None else rank(self.knowledge, out)
+        return [p for p in dict.fromkeys([*first, *rest]) if p not in out]
 
     def _independent(self, pairs: list[Pair]) -> bool:
         """No outcomes of all but one pair entail (or contradict) the remaining pair."""

@@ -28,6 +28,7 @@ from asp.facts import fact
 from asp.size_knowledge import Knowledge, Pair
 
 Chooser = Callable[[Knowledge, random.Random], Pair]
+BatchRank = Callable[[Knowledge, Sequence[Pair]], list[Pair]]
 SessionFacts = Callable[[Sequence[str], Sequence[str], int], list[clingo.Symbol]]
 
 
@@ -39,6 +40,9 @@ class SelectionPolicy:
     order (not on names or the seed), so an evaluation may memoise per matrix.
     ``solver_options``: clingo options of the learner's Control (e.g. an optimisation
     strategy for an encoding that optimises; its last model is taken).
+    ``batch_rank(knowledge, pending)``: the unknown pairs not pending, best first to run
+    in parallel beside the pending ones (without it a batch takes the policy's choice,
+    then index order).
     """
 
     name: str
@@ -48,6 +52,7 @@ class SelectionPolicy:
     session_facts: SessionFacts | None = None
     deterministic: bool = True
     solver_options: tuple[str, ...] = ()
+    batch_rank: BatchRank | None = None
 
     def __post_init__(self) -> None:
         if (self.encoding is None) == (self.choose is None):
