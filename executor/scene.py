@@ -16,6 +16,7 @@ import pybullet as pb
 import pybullet_data
 
 from executor import ExecutorError
+from executor.arm import REST_POSTURE
 from executor.geometry import CellGeometry, PartSpec, arm_urdf_text, write_assets
 
 TIME_STEP = 0.001  # [s]
@@ -54,9 +55,34 @@ class Scene:
             for pid, spec in sorted(geometry.parts.items())
         }
         self._tmp = tempfile.TemporaryDirectory(prefix="executor-arm-")
+        # One arm per part shape, all loaded now in a fixed order and never removed:
+        # removing and reloading bodies made later trials differ from process to process.
+        shapes = sorted({p.shape for p in geometry.parts.values()})
+        # Where the arm of each part shape waits while another one works [m].
+        self._garages = {shape: (-3.0, 3.0 * k, 0.0) for k, shape in enumerate(shapes)}
+        self.robots: dict[str, int] = {}
+        for shape in shapes:
+            part = next(p for _, p in sorted(geometry.parts.items()) if p.shape == shape)
+            urdf = Path(self._tmp.name) / f"arm_{shape}.urdf"
+            urdf.write_text(arm_urdf_text(part, geometry.gripper))
+            self.robots[shape] = pb.loadURDF(
+                str(urdf), basePosition=self._garages[shape], useFixedBase=True,
+                flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=self.client)
+            self._park(shape)
         self.robot: int | None = None
         self.robot_shape: str | None = None
         self.held: str | None = None
+
+    def _park(self, shape: str) -> None:
+        """Move an arm to its garage, at rest, held by its joint motors."""
+        body = self.robots[shape]
+        pb.resetBasePositionAndOrientation(body, self._garages[shape], (0, 0, 0, 1),
+                                          physicsClientId=self.client)
+        joints = list(range(len(REST_POSTURE)))
+        for j, qj in zip(joints, REST_POSTURE):
+            pb.resetJointState(body, j, float(qj), 0.0, physicsClientId=self.client)
+        pb.setJointMotorControlArray(body, joints, pb.POSITION_CONTROL, targetPositions=list(REST_POSTURE),
+                                     forces=[300.0] * len(joints), physicsClientId=self.client)
 
     def _load_plate(self, plate_obj: Path) -> int:
         """Static plate: a box under the bosses plus the concave trimesh of the bosses."""
@@ -81,16 +107,14 @@ class Scene:
         )
 
     def hold(self, part: PartSpec) -> int:
-        """Put ``part`` in the gripper (reloading the arm if the part shape changes); the
-        tray copy is parked out of sight.  Returns the robot body id."""
+        """Put ``part`` in the gripper: the arm holding its shape comes to the cell (the
+        previous one goes to its garage); the tray copy is parked out of sight.  Returns
+        the robot body id."""
         if self.robot_shape != part.shape:
-            if self.robot is not None:
-                pb.removeBody(self.robot, physicsClientId=self.client)
-            urdf = Path(self._tmp.name) / f"arm_{part.shape}.urdf"
-            urdf.write_text(arm_urdf_text(part, self.geometry.gripper))
-            self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
-                                     flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
-                                     physicsClientId=self.client)
+            if self.robot_shape is not None:
+                self._park(self.robot_shape)
+            self.robot = self.robots[part.shape]
+            pb.resetBasePositionAndOrientation(self.robot, (0, 0, 0), (0, 0, 0, 1), physicsClientId=self.client)
             self.robot_shape = part.shape
         self.release()
         pb.resetBasePositionAndOrientation(self.tray_parts[part.id], _PARKED, (0, 0, 0, 1),

@@ -129,8 +129,8 @@ class Cell:
         self.logger = logger
         self.thresholds = thresholds
         self._skills: dict[str, Skill] = {}
+        self._motions: dict[str, Motion] = {}
         self._motion: Motion | None = None
-        self._shape: str | None = None
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
 
@@ -145,16 +145,18 @@ class Cell:
         return self._skills[shape]
 
     def motion_for(self, part: str) -> Motion:
-        """Put the part in the hand; the Motion driving the arm that holds it."""
-        shape = self.geometry.parts[part].shape
-        robot = self.scene.hold(self.geometry.parts[part])
-        if shape != self._shape or self._motion is None:  # a new arm body (ids may be reused)
-            arm = Arm(self.scene.client, robot)
-            steps = self._motion.steps if self._motion else 0
-            self._motion = Motion(ImpedanceController(arm, self.scene.client), self.logger)
-            self._motion.steps = steps
-            self._shape = shape
-        return self._motion
+        """Put the part in the hand; the Motion driving the arm that holds it (one arm
+        and Motion per part shape; the step count carries over, so sim time only grows)."""
+        spec = self.geometry.parts[part]
+        robot = self.scene.hold(spec)
+        motion = self._motions.get(spec.shape)
+        if motion is None:
+            motion = Motion(ImpedanceController(Arm(self.scene.client, robot), self.scene.client), self.logger)
+            self._motions[spec.shape] = motion
+        if self._motion is not None and motion is not self._motion:
+            motion.steps = self._motion.steps
+        self._motion = motion
+        return motion
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
         """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts."""
