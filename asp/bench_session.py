@@ -9,7 +9,9 @@
    that take S seconds without using the cores) with 1 cell and with 2 cells: wall time [s]
    of the whole command, experiments, the share of the learning time the cells were busy
    with experiments (1.0: never idle), and the ratio 2 cells / 1 cell (target ≤ 0.65;
-   on a shared 2-core machine the cells compete with everything else for the cores).
+   on a shared 2-core machine the cells compete with everything else for the cores, so
+   the sessions run in pairs, 1 cell then 2 cells back to back, and each pair's ratio
+   is reported beside the ratio of the medians).
 """
 
 from __future__ import annotations
@@ -71,31 +73,41 @@ def round_trips(count: int) -> dict:
         cell.stop()
 
 
-def session_walls(cells: int, repeat: int, policy: str, backend: str, delay_s: float) -> dict:
-    """Wall time [s] of ``session --cells N``, ``repeat`` runs."""
-    walls: list[float] = []
-    experiments: list[int] = []
-    busy: list[float] = []
+def session_run(cells: int, policy: str, backend: str, delay_s: float) -> dict:
+    """One ``session --cells N`` command: wall time [s], experiments, cell busy share."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
+    with tempfile.TemporaryDirectory() as tmp:
+        argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells),
+                "--policy", policy, "--out", str(Path(tmp) / "run"), "--json",
+                "--backend", backend, "--delay", str(delay_s)]
+        t0 = time.perf_counter()
+        done = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True, timeout=900)
+        wall = time.perf_counter() - t0
+        if done.returncode != 0:
+            raise SystemExit(f"session --cells {cells} failed: {done.stderr.strip()}")
+        result = json.loads(done.stdout)
+        if not result["matches_truth"]:
+            raise SystemExit(f"session --cells {cells} learned a wrong relation")
+        busy = cell_busy_fraction(Path(tmp) / "run" / JOURNAL_NAME, cells)
+    return {"wall_s": round(wall, 2), "experiments": result["experiments"], "cell_busy": busy}
+
+
+def session_walls(repeat: int, policy: str, backend: str, delay_s: float) -> dict:
+    """``repeat`` pairs of sessions, 1 cell then 2 cells back to back (both see about the
+    same load of a shared machine): per cell count the walls and their median, and the
+    ratio 2 cells / 1 cell of every pair and of the medians."""
+    runs: dict[int, list[dict]] = {1: [], 2: []}
     for _ in range(repeat):
-        with tempfile.TemporaryDirectory() as tmp:
-            argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells),
-                    "--policy", policy, "--out", str(Path(tmp) / "run"), "--json",
-                    "--backend", backend, "--delay", str(delay_s)]
-            t0 = time.perf_counter()
-            done = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True,
-                                  timeout=900)
-            walls.append(time.perf_counter() - t0)
-            if done.returncode != 0:
-                raise SystemExit(f"session --cells {cells} failed: {done.stderr.strip()}")
-            result = json.loads(done.stdout)
-            if not result["matches_truth"]:
-                raise SystemExit(f"session --cells {cells} learned a wrong relation")
-            experiments.append(result["experiments"])
-            busy.append(cell_busy_fraction(Path(tmp) / "run" / JOURNAL_NAME, cells))
-    return {"cells": cells, "walls_s": [round(w, 2) for w in walls],
-            "median_wall_s": round(statistics.median(walls), 2), "experiments": experiments,
-            "cell_busy": busy}
+        for cells in runs:
+            runs[cells].append(session_run(cells, policy, backend, delay_s))
+    sessions = [{"cells": cells, "walls_s": [r["wall_s"] for r in rs],
+                 "median_wall_s": round(statistics.median(r["wall_s"] for r in rs), 2),
+                 "experiments": [r["experiments"] for r in rs],
+                 "cell_busy": [r["cell_busy"] for r in rs]} for cells, rs in runs.items()]
+    pairs = [round(two["wall_s"] / one["wall_s"], 3) for one, two in zip(runs[1], runs[2])]
+    return {"sessions": sessions, "pair_ratios": pairs,
+            "median_pair_ratio": round(statistics.median(pairs), 3),
+            "ratio_2_over_1": round(sessions[1]["median_wall_s"] / sessions[0]["median_wall_s"], 3)}
 
 
 def cell_busy_fraction(journal: Path, cells: int) -> float:
@@ -109,7 +121,9 @@ def cell_busy_fraction(journal: Path, cells: int) -> float:
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="bench session", description=__doc__.split("\n\n")[0])
     parser.add_argument("--round-trips", type=int, default=1000, help="per kind (default 1000)")
-    parser.add_argument("--repeat", type=int, default=1, help="sessions per cell count (default 1)")
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="pairs of sessions, 1 cell then 2 cells back to back (default 1)")
+    parser.add_argument("--quick", action="store_true", help="100 round trips per kind")
     parser.add_argument("--policy", default="best", help="session policy (default best)")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="cells of the sessions (default sim)")
@@ -119,7 +133,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--skip-sessions", action="store_true", help="only the round trips")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
-    figures: dict = {"overhead": round_trips(args.round_trips)}
+    figures: dict = {"overhead": round_trips(100 if args.quick else args.round_trips)}
     o = figures["overhead"]
     if not args.json:
         print(f"round trip over Zenoh on loopback ({o['round_trips']} each, "
@@ -127,16 +141,14 @@ def main(argv: list[str]) -> int:
               f"(p90 {o['validated']['p90_ms']:.3f}), bare query median {o['bare']['median_ms']:.3f} ms "
               f"(p90 {o['bare']['p90_ms']:.3f}), ratio {o['ratio']:.2f}", flush=True)
     if not args.skip_sessions:
-        one, two = (session_walls(n, args.repeat, args.policy, args.backend, args.delay)
-                    for n in (1, 2))
-        figures["sessions"] = [one, two]
-        figures["ratio_2_over_1"] = round(two["median_wall_s"] / one["median_wall_s"], 3)
+        figures.update(session_walls(args.repeat, args.policy, args.backend, args.delay))
         if not args.json:
-            for s in (one, two):
+            for s in figures["sessions"]:
                 print(f"Cranfield session, {s['cells']} cell(s), {args.backend}: median {s['median_wall_s']:.1f} s "
                       f"wall (runs {s['walls_s']}, experiments {s['experiments']}, cells busy "
                       f"{s['cell_busy']} of the learning time)")
-            print(f"ratio 2 cells / 1 cell: {figures['ratio_2_over_1']:.2f}")
+            print(f"ratio 2 cells / 1 cell: {figures['ratio_2_over_1']:.2f} (of the medians); "
+                  f"per pair run back to back {figures['pair_ratios']}, median {figures['median_pair_ratio']:.2f}")
     if args.json:
         print(json.dumps(figures, indent=2))
     return 0
