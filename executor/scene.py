@@ -16,7 +16,6 @@ import pybullet as pb
 import pybullet_data
 
 from executor import ExecutorError
-from executor.arm import REST_POSTURE
 from executor.geometry import CellGeometry, PartSpec, arm_urdf_text, write_assets
 
 TIME_STEP = 0.001  # [s]
@@ -24,14 +23,26 @@ TIME_STEP = 0.001  # [s]
 _PARKED = (0.0, -2.0, 0.05)
 
 
-class Scene:
-    """A PyBullet client with the static cell; ``hold(part)`` puts a part in the hand."""
+def require_display() -> None:
+    """ExecutorError unless a GUI can open (PyBullet would exit the process instead)."""
+    if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+        raise ExecutorError("--gui needs a display, but DISPLAY is not set (expected an X display; "
+                            "run without --gui for the DIRECT mode)")
 
-    def __init__(self, geometry: CellGeometry, gui: bool = False) -> None:
+
+class Scene:
+    """A PyBullet client with the static cell and the arm for one part shape;
+    ``hold(part)`` puts a part of that shape in the hand.
+
+    One client per part shape: swapping arms inside one client (remove + load) made
+    later trials differ from process to process, and parked spare arms cost 25 % speed.
+    """
+
+    def __init__(self, geometry: CellGeometry, shape: str, gui: bool = False) -> None:
         self.geometry = geometry
-        if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
-            raise ExecutorError("--gui needs a display, but DISPLAY is not set (expected an X display; "
-                                "run without --gui for the DIRECT mode)")
+        self.shape = shape
+        if gui:
+            require_display()
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
         if self.client < 0:
             raise ExecutorError("could not connect to PyBullet (GUI requested without a display?)")
@@ -54,35 +65,14 @@ class Scene:
             )
             for pid, spec in sorted(geometry.parts.items())
         }
-        self._tmp = tempfile.TemporaryDirectory(prefix="executor-arm-")
-        # One arm per part shape, all loaded now in a fixed order and never removed:
-        # removing and reloading bodies made later trials differ from process to process.
-        shapes = sorted({p.shape for p in geometry.parts.values()})
-        # Where the arm of each part shape waits while another one works [m].
-        self._garages = {shape: (-3.0, 3.0 * k, 0.0) for k, shape in enumerate(shapes)}
-        self.robots: dict[str, int] = {}
-        for shape in shapes:
-            part = next(p for _, p in sorted(geometry.parts.items()) if p.shape == shape)
-            urdf = Path(self._tmp.name) / f"arm_{shape}.urdf"
+        part = next(p for _, p in sorted(geometry.parts.items()) if p.shape == shape)
+        with tempfile.TemporaryDirectory(prefix="executor-arm-") as tmp:
+            urdf = Path(tmp) / f"arm_{shape}.urdf"
             urdf.write_text(arm_urdf_text(part, geometry.gripper))
-            self.robots[shape] = pb.loadURDF(
-                str(urdf), basePosition=self._garages[shape], useFixedBase=True,
-                flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=self.client)
-            self._park(shape)
-        self.robot: int | None = None
-        self.robot_shape: str | None = None
+            self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
+                                     flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
+                                     physicsClientId=self.client)
         self.held: str | None = None
-
-    def _park(self, shape: str) -> None:
-        """Move an arm to its garage, at rest, held by its joint motors."""
-        body = self.robots[shape]
-        pb.resetBasePositionAndOrientation(body, self._garages[shape], (0, 0, 0, 1),
-                                          physicsClientId=self.client)
-        joints = list(range(len(REST_POSTURE)))
-        for j, qj in zip(joints, REST_POSTURE):
-            pb.resetJointState(body, j, float(qj), 0.0, physicsClientId=self.client)
-        pb.setJointMotorControlArray(body, joints, pb.POSITION_CONTROL, targetPositions=list(REST_POSTURE),
-                                     forces=[300.0] * len(joints), physicsClientId=self.client)
 
     def _load_plate(self, plate_obj: Path) -> int:
         """Static plate: a box under the bosses plus the concave trimesh of the bosses."""
@@ -107,20 +97,14 @@ class Scene:
         )
 
     def hold(self, part: PartSpec) -> int:
-        """Put ``part`` in the gripper: the arm holding its shape comes to the cell (the
-        previous one goes to its garage); the tray copy is parked out of sight.  Returns
-        the robot body id."""
-        if self.robot_shape != part.shape:
-            if self.robot_shape is not None:
-                self._park(self.robot_shape)
-            self.robot = self.robots[part.shape]
-            pb.resetBasePositionAndOrientation(self.robot, (0, 0, 0), (0, 0, 0, 1), physicsClientId=self.client)
-            self.robot_shape = part.shape
+        """Put ``part`` in the gripper; its tray copy is parked out of sight.  Returns the
+        robot body id."""
+        if part.shape != self.shape:
+            raise ExecutorError(f"part '{part.id}' has shape '{part.shape}', this arm holds '{self.shape}' parts")
         self.release()
         pb.resetBasePositionAndOrientation(self.tray_parts[part.id], _PARKED, (0, 0, 0, 1),
                                            physicsClientId=self.client)
         self.held = part.id
-        assert self.robot is not None
         return self.robot
 
     def release(self) -> None:
@@ -134,7 +118,6 @@ class Scene:
     def close(self) -> None:
         if pb.isConnected(self.client):
             pb.disconnect(self.client)
-        self._tmp.cleanup()
 
 
 def scene_shapes(geometry: CellGeometry) -> list[tuple]:

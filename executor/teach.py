@@ -94,6 +94,7 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     phases, wrenches, end = _replay(motion, skill, origin)
     skill.wrench = WrenchProfile.fit(phases, wrenches)
     skill.end_position = end
+    assert cell.scene is not None  # set by motion_for
     cell.scene.release()
     return skill
 

@@ -27,7 +27,7 @@ from executor.dmp import Skill, load_skill
 from executor.geometry import load_geometry
 from executor.insertion import insert, rotvec_quat_xyzw
 from executor.motion import Motion
-from executor.scene import TIME_STEP, Scene, scene_shapes
+from executor.scene import TIME_STEP, Scene, require_display, scene_shapes
 from executor.search import hole_search
 
 if TYPE_CHECKING:
@@ -125,12 +125,16 @@ class Cell:
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
                  thresholds: Thresholds = Thresholds()) -> None:
         self.geometry = load_geometry(assembly)
-        self.scene = Scene(self.geometry, gui=gui)
+        if gui:
+            require_display()
+        self.gui = gui
         self.logger = logger
         self.thresholds = thresholds
         self._skills: dict[str, Skill] = {}
+        self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
         self._motion: Motion | None = None
+        self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
 
@@ -145,17 +149,21 @@ class Cell:
         return self._skills[shape]
 
     def motion_for(self, part: str) -> Motion:
-        """Put the part in the hand; the Motion driving the arm that holds it (one arm
-        and Motion per part shape; the step count carries over, so sim time only grows)."""
+        """Put the part in the hand; the Motion driving the arm that holds it.  Each part
+        shape has its own PyBullet client, made on first use (with ``gui``, the first
+        one is the GUI); the step count carries over, so sim time only grows."""
         spec = self.geometry.parts[part]
-        robot = self.scene.hold(spec)
-        motion = self._motions.get(spec.shape)
-        if motion is None:
-            motion = Motion(ImpedanceController(Arm(self.scene.client, robot), self.scene.client), self.logger)
-            self._motions[spec.shape] = motion
+        scene = self._scenes.get(spec.shape)
+        if scene is None:
+            scene = Scene(self.geometry, spec.shape, gui=self.gui and not self._scenes)
+            self._scenes[spec.shape] = scene
+            arm = Arm(scene.client, scene.robot)
+            self._motions[spec.shape] = Motion(ImpedanceController(arm, scene.client), self.logger)
+        scene.hold(spec)
+        motion = self._motions[spec.shape]
         if self._motion is not None and motion is not self._motion:
             motion.steps = self._motion.steps
-        self._motion = motion
+        self._motion, self.scene = motion, scene
         return motion
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
@@ -206,7 +214,7 @@ class Cell:
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - float(self.geometry.gripper["grasp_depth"])
         result = insert(motion, skill, origin, detector, Admittance(), lever, wiggle_enabled)
-        self.scene.release()
+        self._scenes[spec.shape].release()
         return AttemptEvidence(
             "fit" if result.reached else "no_fit", detector.max_force_dev, detector.max_torque_dev,
             result.end_error, time.perf_counter() - wall0, (motion.steps - sim0) * TIME_STEP,
@@ -214,4 +222,5 @@ class Cell:
         )
 
     def close(self) -> None:
-        self.scene.close()
+        for scene in self._scenes.values():
+            scene.close()
