@@ -120,7 +120,8 @@ def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
 
 
 class Cell:
-    """The simulated cell: one PyBullet client, reused for many trials."""
+    """The simulated cell, reused for many trials: one DIRECT PyBullet client per part
+    shape (made on first use), so a trial depends on its seed only."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
                  thresholds: Thresholds = Thresholds()) -> None:
