@@ -24,14 +24,22 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 class CellProcess:
-    """One running ``executor serve`` process and the lines it printed."""
+    """One running ``executor serve`` process and the lines it printed.
+
+    A cell runs in its own process session, as a cell started by hand in another
+    terminal would: the kernel then schedules it beside the planner rather than inside
+    the planner's share of the cores (with autogroup scheduling, two cells in the
+    planner's session shared one core on a loaded machine). It still ends with the
+    planner: ``--lifeline`` makes it exit when its stdin closes.
+    """
 
     def __init__(self, cell_id: str, argv: Sequence[str]) -> None:
         self.cell_id = cell_id
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
         self.popen = subprocess.Popen(list(argv), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                      stderr=subprocess.STDOUT, env=env, cwd=ROOT, text=True)
+                                      stderr=subprocess.STDOUT, env=env, cwd=ROOT, text=True,
+                                      start_new_session=True)
         self.lines: list[str] = []
         self._eof = False
         self._new = threading.Condition()
