@@ -84,7 +84,6 @@ POLICIES: dict[str, SelectionPolicy | str] = {
         "heuristic",
         "the paper's template count with its tie-breaks (paper 2.2)",
         encoding="select_heuristic.lp",
-        solver_options=("--opt-strategy=usc",),
     ),
     "best": "asp.best_policy:POLICY",
 }
