@@ -64,7 +64,7 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="5,10,20", help="n of the n×n instances (default 5,10,20)")
-    parser.add_argument("--policies", default="systematic,random,heuristic")
+    parser.add_argument("--policies", default="systematic,random,heuristic,best")
     parser.add_argument("--decisions", type=int, default=60, help="decisions timed per session (default 60)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--evaluate", default="heuristic",

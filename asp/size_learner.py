@@ -91,6 +91,8 @@ class SizeLearner:
         self.answers: dict[Pair, list[str]] = {}
         self.retests: list[Pair] = []
         self._history: list[tuple[Knowledge, Pair | None, list[Pair]]] = []
+        if self.policy.prepare is not None:
+            self.policy.prepare(len(self.parts), len(self.holes))
         self._ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
         self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
         self._ground(seed)

@@ -43,6 +43,8 @@ class SelectionPolicy:
     ``batch_rank(knowledge, pending)``: the unknown pairs not pending, best first to run
     in parallel beside the pending ones (without it a batch takes the policy's choice,
     then index order).
+    ``prepare(m, n)``: one-time set-up for sessions of m parts × n holes (tables a
+    chooser needs), run when the learner is built, like the grounding of an encoding.
     """
 
     name: str
@@ -53,6 +55,7 @@ class SelectionPolicy:
     deterministic: bool = True
     solver_options: tuple[str, ...] = ()
     batch_rank: BatchRank | None = None
+    prepare: Callable[[int, int], None] | None = None
 
     def __post_init__(self) -> None:
         if (self.encoding is None) == (self.choose is None):
