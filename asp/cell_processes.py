@@ -66,10 +66,18 @@ class CellProcess:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0 or self._eof:
                     tail = "\n".join(self.lines[-20:])
-                    raise PlannerError(f"cell {self.cell_id}: no line '{prefix}...' within "
-                                       f"{timeout:.0f} s (exit code {self.popen.poll()}); "
-                                       f"last output:\n{tail}")
+                    why = (f"exited (code {self._exit_code()}) before printing"
+                           if self._eof else f"printed no")
+                    raise PlannerError(f"cell {self.cell_id}: {why} line '{prefix}...' "
+                                       f"(waited up to {timeout:.0f} s); last output:\n{tail}")
                 self._new.wait(remaining)
+
+    def _exit_code(self, timeout: float = 2.0) -> int | None:
+        """The exit code of a process whose output ended (None if it is still running)."""
+        try:
+            return self.popen.wait(timeout)
+        except subprocess.TimeoutExpired:
+            return None
 
     def stop(self, timeout: float = 10.0) -> int:
         """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code."""
