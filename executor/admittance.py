@@ -1,13 +1,17 @@
 """On-line adaptation toward the reference wrench (paper 3.1/3.2, after Abu-Dakka 2015).
 
-A bounded mass-damper-spring admittance per axis shifts the commanded pose by δ:
+A bounded mass-damper-spring admittance per axis, driven by a PI law of the wrench
+deviation (the paper's "admittance PI control law"), shifts the commanded pose by δ:
 
-    M δ̈ + D δ̇ + K δ = ΔW,     ΔW = W_mes − W_des,     |δ| ≤ bound
+    M δ̈ + D δ̇ + K δ = ΔW + K_i ∫ΔW dt,     ΔW = W_mes − W_des,     |δ| ≤ bound
 
 on the lateral forces (x, y → translation) and the tilting torques (x, y → rotation).
-The spring returns δ to the reference once the deviation is gone (a pure integrator
-ran away in the measurements of the notes).  The insertion axis z is left to the DMP and
-to phase stopping.  Integrated with semi-implicit Euler at the control rate.
+The proportional part answers at once; the integral part keeps adapting while a
+deviation persists (which is what DMP phase stopping gives it time to do). The spring
+returns δ to the reference once the integral has unwound (a pure integrator ran away in
+the measurements of the notes), and the integral is clamped to what holds δ at its
+bound (anti-windup). The insertion axis z is left to the DMP and to phase stopping.
+Integrated with semi-implicit Euler at the control rate.
 """
 
 from __future__ import annotations
@@ -21,7 +25,8 @@ import numpy as np
 class AdmittanceParams:
     """Translation: mass [kg], damping [N·s/m], stiffness [N/m], bound [m];
     rotation: inertia [kg·m²], damping [Nm·s/rad], stiffness [Nm/rad], bound [rad].
-    Natural frequency ≈ 30 rad/s, critically damped."""
+    Natural frequency ≈ 30 rad/s, critically damped; ``integral_gain`` K_i [1/s] of
+    the PI drive (time constant 1/K_i = 0.5 s)."""
 
     mass: float = 1.5
     damping: float = 90.0
@@ -31,6 +36,7 @@ class AdmittanceParams:
     rot_damping: float = 0.66
     rot_stiffness: float = 10.0
     rot_bound: float = 0.035
+    integral_gain: float = 2.0
 
 
 class Admittance:
@@ -42,13 +48,18 @@ class Admittance:
         self.damping = np.array([p.damping, p.damping, p.rot_damping, p.rot_damping])
         self.stiffness = np.array([p.stiffness, p.stiffness, p.rot_stiffness, p.rot_stiffness])
         self.bound = np.array([p.bound, p.bound, p.rot_bound, p.rot_bound])
+        self.integral_gain = p.integral_gain
+        self.integral_limit = self.stiffness * self.bound / p.integral_gain
         self.offset = np.zeros(4)
         self.velocity = np.zeros(4)
+        self.integral = np.zeros(4)
 
     def update(self, force_dev: np.ndarray, torque_dev: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Advance by ``dt`` [s] with the wrench deviation (world frame) [N, Nm]; returns
         the translation offset (3,) [m] and the rotation vector offset (3,) [rad]."""
-        excitation = np.array([force_dev[0], force_dev[1], torque_dev[0], torque_dev[1]])
+        error = np.array([force_dev[0], force_dev[1], torque_dev[0], torque_dev[1]])
+        self.integral = np.clip(self.integral + error * dt, -self.integral_limit, self.integral_limit)
+        excitation = error + self.integral_gain * self.integral
         acc = (excitation - self.damping * self.velocity - self.stiffness * self.offset) / self.mass
         self.velocity += acc * dt
         self.offset += self.velocity * dt
