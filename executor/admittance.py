@@ -7,10 +7,11 @@ deviation (the paper's "admittance PI control law"), shifts the commanded pose b
 
 on the lateral forces (x, y → translation) and the tilting torques (x, y → rotation).
 The proportional part answers at once; the integral part keeps adapting while a
-deviation persists (which is what DMP phase stopping gives it time to do). The spring
-returns δ to the reference once the integral has unwound (a pure integrator ran away in
-the measurements of the notes), and the integral is clamped to what holds δ at its
-bound (anti-windup). The insertion axis z is left to the DMP and to phase stopping.
+deviation persists (which is what DMP phase stopping gives it time to do) and holds
+the offset that cancelled it; in contact, the measured wrench unwinds the integral when
+the offset overshoots, and the spring then returns δ to the reference (a pure integrator
+driving the pose ran away in the measurements of the notes). The integral is clamped to
+what holds δ at its bound (anti-windup). The insertion axis z is left to the DMP and to phase stopping.
 Integrated with semi-implicit Euler at the control rate.
 """
 
