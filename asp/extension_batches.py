@@ -19,9 +19,14 @@ from asp.relation import Relation
 
 _INT64_LIMIT = 2**62
 
+GENERATORS: dict[str, str] = {
+    "uniform": "every feasible sequence equally likely (the paper's evaluation)",
+    "stepwise": "each step, a part whose predecessors are placed, uniformly (a naive demonstrator)",
+}
+
 
 class ExtensionBatches:
-    """Uniform sampling of a poset's sequences and counting of its refinements, in batches."""
+    """Random sampling of a poset's sequences and counting of its refinements, in batches."""
 
     def __init__(self, relation: Relation) -> None:
         self.relation = relation
@@ -34,8 +39,12 @@ class ExtensionBatches:
         self.total = total
         nxt = self.table.nxt
         completions = np.array(self.table.completions, dtype=np.int64)
-        self._completions = completions
-        self._cumulative = np.cumsum(np.where(nxt >= 0, completions[nxt], 0), axis=1)
+        # Per down-set, cumulative weights of the parts that can be placed next: the
+        # completions after placing them (uniform over sequences) or 1 each (stepwise).
+        self._cumulative = {
+            "uniform": np.cumsum(np.where(nxt >= 0, completions[nxt], 0), axis=1),
+            "stepwise": np.cumsum(nxt >= 0, axis=1),
+        }
         source, part = np.nonzero(nxt >= 0)
         target = nxt[source, part]
         order = np.lexsort((target, source))  # sources are grouped by layer already
@@ -51,14 +60,22 @@ class ExtensionBatches:
         starts = np.flatnonzero(np.r_[True, targets[1:] != targets[:-1]])
         return edges, starts, targets[starts]
 
-    def sample_orders(self, rng: np.random.Generator, count: int) -> np.ndarray:
-        """``count`` uniformly random sequences as part indices, shape (count, n)."""
+    def sample_orders(self, rng: np.random.Generator, count: int, generator: str = "uniform") -> np.ndarray:
+        """``count`` random feasible sequences as part indices, shape (count, n).
+
+        ``generator`` is a key of :data:`GENERATORS`: ``uniform`` draws every feasible
+        sequence with probability 1/total; ``stepwise`` places, at each step, one of the
+        currently placeable parts uniformly (sequences are then not equally likely).
+        """
+        if generator not in GENERATORS:
+            raise PlannerError(f"generator '{generator}': expected one of {', '.join(GENERATORS)}")
+        cumulative = self._cumulative[generator]
         n = len(self.relation.parts)
         state = np.zeros(count, dtype=np.int64)
         orders = np.empty((count, n), dtype=np.int16)
         for step in range(n):
-            pick = rng.integers(0, self._completions[state])
-            part = np.argmax(self._cumulative[state] > pick[:, None], axis=1)
+            pick = rng.integers(0, cumulative[state, -1])
+            part = np.argmax(cumulative[state] > pick[:, None], axis=1)
             orders[:, step] = part
             state = self.table.nxt[state, part]
         return orders

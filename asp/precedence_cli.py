@@ -15,6 +15,7 @@ from itertools import islice
 from asp import PlannerError
 from asp.assembly import load_assembly
 from asp.demos import Demonstrations, load_demos
+from asp.extension_batches import GENERATORS
 from asp.facts import write_facts
 from asp.linear_extensions import UniformSampler, count_linear_extensions, linear_extensions
 from asp.relation import Relation, load_relation, precedence_facts, reduction, true_relation
@@ -51,6 +52,8 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--m", default="5,7,10,15,20,30", help="numbers of demonstrations, comma separated")
     evaluate.add_argument("--trials", type=int, default=1000, help="trials per m (default 1000)")
     evaluate.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    evaluate.add_argument("--generator", choices=sorted(GENERATORS), default="uniform",
+                          help="random feasible sequences: uniform over all (the paper's; default) or stepwise (a placeable part uniformly each step)")
     evaluate.add_argument("--guided", action="store_true", help="demonstrations to the exact relation, guided vs random")
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", help="write the Figs. 12/13 bar charts to this PNG file")
@@ -124,6 +127,9 @@ def _evaluate(args: argparse.Namespace) -> None:
     if args.guided:
         from asp.guidance import evaluate_guided
 
+        if args.generator != "uniform":
+            raise PlannerError("--generator applies to the evaluation over m, not to --guided (its random baseline is uniform)")
+
         result = evaluate_guided(truth, args.trials, args.seed, progress)
         if not args.json:
             print(f"{args.trials} trials: guided mean {result['mean']:.2f} demonstrations to the exact relation, random {result['random_mean']:.2f}")
@@ -135,11 +141,11 @@ def _evaluate(args: argparse.Namespace) -> None:
             ms = [int(m) for m in args.m.split(",")]
         except ValueError:
             raise PlannerError(f"--m {args.m}: expected comma-separated integers such as 5,7,10") from None
-        result = evaluate(truth, ms, args.trials, args.seed, progress)
+        result = evaluate(truth, ms, args.trials, args.seed, progress, args.generator)
         if args.plot:
             plot(result, args.plot)
         if not args.json:
-            print(f"total admitted by the true constraints: {result['total']}")
+            print(f"total admitted by the true constraints: {result['total']} ({args.generator} demonstrations)")
             for r in result["results"]:
                 print(f"m={r['m']:>3}: mean {r['mean']:8.1f} ({100 * r['mean'] / result['total']:5.1f} %)  P(all) {r['p_all']:.3f}  P(> half) {r['p_more_than_half']:.3f}")
     if args.json:

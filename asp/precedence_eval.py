@@ -1,7 +1,7 @@
 """The paper's evaluation of Algorithm 1 (4.1, Figs. 12 and 13).
 
 For each number m of demonstrations, ``trials`` times: draw m feasible sequences
-uniformly from the true relation, learn the must-precede relation and count the
+from the true relation (uniformly by default; see ``GENERATORS``), learn the must-precede relation and count the
 sequences M it admits. Reported per m: the mean of M, P(M = all), P(M > all/2) and
 the distribution of M in bins of 200 sequences (key: the bin's lower bound; the key
 ``"all"`` holds M = all, the paper's last column). Probabilities are fractions of
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from asp import PlannerError
-from asp.extension_batches import ExtensionBatches, positions_of
+from asp.extension_batches import GENERATORS, ExtensionBatches, positions_of
 from asp.precedence import intersect_orders
 from asp.relation import Relation
 
@@ -34,17 +34,21 @@ def _histogram(admitted: np.ndarray, total: int) -> dict[str, float]:
     return histogram
 
 
-def evaluate(truth: Relation, ms: Sequence[int], trials: int, seed: int, progress: bool = False) -> dict[str, object]:
-    """``{"total": N, "results": [{"m", "mean", "p_all", "p_more_than_half", "histogram"}]}``."""
+def evaluate(
+    truth: Relation, ms: Sequence[int], trials: int, seed: int, progress: bool = False, generator: str = "uniform"
+) -> dict[str, object]:
+    """``{"total": N, "generator": g, "results": [{"m", "mean", "p_all", "p_more_than_half", "histogram"}]}``."""
     from tqdm import tqdm
 
     if trials < 1 or any(m < 1 for m in ms):
         raise PlannerError(f"--trials {trials} --m {','.join(map(str, ms))}: expected positive integers")
+    if generator not in GENERATORS:
+        raise PlannerError(f"--generator {generator}: expected one of {', '.join(GENERATORS)}")
     batches = ExtensionBatches(truth)
     rng = np.random.default_rng(seed)
     n, total, results = len(truth.parts), batches.total, []
     for m in tqdm(ms, desc="m", disable=not progress):
-        orders = batches.sample_orders(rng, trials * m).reshape(trials, m, n)
+        orders = batches.sample_orders(rng, trials * m, generator).reshape(trials, m, n)
         admitted = batches.count(intersect_orders(positions_of(orders)))
         results.append(
             {
@@ -55,7 +59,7 @@ def evaluate(truth: Relation, ms: Sequence[int], trials: int, seed: int, progres
                 "histogram": _histogram(admitted, total),
             }
         )
-    return {"total": total, "results": results}
+    return {"total": total, "generator": generator, "results": results}
 
 
 def plot(evaluation: dict, path: Path | str) -> None:

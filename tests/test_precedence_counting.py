@@ -95,3 +95,12 @@ def test_batched_sampler_is_uniform_and_batched_counts_are_exact() -> None:
     learned = intersect_orders(positions_of(batches.sample_orders(np.random.default_rng(4), 200 * 4).reshape(200, 4, 10)))
     expected = [count_linear_extensions(Relation(cranfield.parts, m)) for m in learned]
     assert batches.count(learned).tolist() == expected
+
+
+def test_stepwise_generator_picks_a_placeable_part_uniformly_at_each_step() -> None:
+    """a<b, c free: stepwise draws c first half the time (cab 1/2, abc 1/4, acb 1/4)."""
+    relation = Relation.from_pairs(("a", "b", "c"), [("a", "b")])
+    orders = ExtensionBatches(relation).sample_orders(np.random.default_rng(5), 8000, "stepwise")
+    draws = Counter("".join(relation.parts[i] for i in row) for row in orders.tolist())
+    assert set(draws) == {"abc", "acb", "cab"}
+    assert chisquare([draws["cab"], draws["abc"], draws["acb"]], [4000, 2000, 2000]).pvalue > 1e-3
