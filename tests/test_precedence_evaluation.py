@@ -19,8 +19,10 @@ def test_evaluation_reproduces_the_paper_within_sampling_error() -> None:
     assert sorted(by_m) == list(PAPER_M)
     assert by_m[7]["p_more_than_half"] > 0.5
     assert 0.72 <= by_m[10]["mean"] / 5320 <= 0.83
-    assert abs(by_m[20]["p_all"] - 0.72) <= 0.05
-    assert abs(by_m[30]["p_all"] - 0.94) <= 0.05
+    # four standard errors of a 1000-trial estimate: sqrt(p(1-p)/1000)
+    assert abs(by_m[20]["p_all"] - 0.72) <= 4 * (0.72 * 0.28 / 1000) ** 0.5
+    # the paper says 94 %; uniform sampling gives 0.917 +- 0.0006 (README, "Precedence")
+    assert abs(by_m[30]["p_all"] - 0.917) <= 4 * (0.917 * 0.083 / 1000) ** 0.5
     for r in result["results"]:
         assert abs(sum(r["histogram"].values()) - 1.0) < 1e-9
         assert r["histogram"]["all"] == r["p_all"]
