@@ -6,11 +6,18 @@ experiment and adding its answer, i.e. one solve of the session's ground program
 [ms]; grounding (once per session) is reported apart. Then ``sizes evaluate
 --relabelings all`` on Cranfield is timed for the heuristic (target < 2 min on 2 cores).
 Targets per decision: 5 ms at 5×5, 50 ms at 10×10, 500 ms at 20×20.
+
+With ``--noise P,...`` it measures robustness instead: for each flip probability,
+policy and ``--confirm`` K, ``--seeds`` N sessions on Cranfield (random relabeling and
+noise seed per session, as ``sizes evaluate --noise P --confirm K --relabelings N``):
+the share of sessions that learn a wrong relation and the experiments per session
+(mean, median; every physical experiment, re-tests included).
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import random
 import statistics
@@ -20,7 +27,10 @@ import numpy as np
 
 from asp.oracle import TruthOracle
 from asp.size_learner import SizeLearner
+from asp.size_policies import get_policy
 from asp.sizes_evaluate import evaluate_policy
+
+CRANFIELD = "cranfield"
 
 TARGETS_MS = {5: 5.0, 10: 50.0, 20: 500.0}
 
@@ -60,6 +70,37 @@ def time_decisions(n: int, policy: str, seed: int, max_decisions: int) -> dict:
     }
 
 
+def noise_rows(noises: list[float], policies: list[str], confirms: list[int], seeds: int,
+               seed: int) -> list[dict]:
+    """Wrong-relation share [%] and experiments per session for every setting (Cranfield)."""
+    truth = TruthOracle.from_assembly(CRANFIELD)
+    rows = []
+    for noise, policy, confirm in itertools.product(noises, policies, confirms):
+        evaluation = evaluate_policy(truth, policy, seeds, seed, confirm=confirm, noise=noise)
+        rows.append({"noise": noise, "policy": policy, "confirm": confirm, "sessions": evaluation.cases,
+                     "wrong_pct": round(100 * evaluation.wrong / evaluation.cases, 1),
+                     "mean": round(evaluation.mean, 2), "median": evaluation.median})
+    return rows
+
+
+def _print_noise(rows: list[dict]) -> None:
+    print(f"{'noise':>5} {'policy':>11} {'confirm':>7} {'sessions':>8} {'wrong[%]':>8} {'mean':>6} {'median':>6}")
+    for r in rows:
+        print(f"{r['noise']:>5} {r['policy']:>11} {r['confirm']:>7} {r['sessions']:>8} "
+              f"{r['wrong_pct']:>8.1f} {r['mean']:>6.2f} {r['median']:>6}")
+
+
+def _numbers(kind: type, text: str, low: float, high: float) -> list:
+    """A comma-separated list of numbers in [low, high); argparse error otherwise."""
+    try:
+        values = [kind(x) for x in text.split(",")]
+    except ValueError:
+        values = []
+    if not values or not all(low <= v < high for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated numbers in [{low}, {high})")
+    return values
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -69,8 +110,26 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--evaluate", default="heuristic",
                         help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
+    parser.add_argument("--noise", type=lambda t: _numbers(float, t, 0.0, 0.5), metavar="P,...",
+                        help="measure wrong relations and experiments under these flip probabilities "
+                             "instead of timing (Cranfield; with --confirm, --seeds, --policies)")
+    parser.add_argument("--confirm", type=lambda t: _numbers(int, t, 0, 100), default=[0], metavar="K,...",
+                        help="with --noise: the learner's confirm values (default 0)")
+    parser.add_argument("--seeds", type=int, default=30, metavar="N",
+                        help="with --noise: sessions per setting (default 30)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
+    if args.noise:
+        if args.seeds < 1:
+            parser.error(f"--seeds {args.seeds}: expected a positive number of sessions")
+        for name in args.policies.split(","):
+            get_policy(name)
+        noisy = noise_rows(args.noise, args.policies.split(","), args.confirm, args.seeds, args.seed)
+        if args.json:
+            print(json.dumps({"noise": noisy}))
+        else:
+            _print_noise(noisy)
+        return 0
     rows = [
         time_decisions(int(n), policy, args.seed, args.decisions)
         for n in args.sizes.split(",")
@@ -79,7 +138,7 @@ def main(argv: list[str]) -> int:
     report: dict = {"decisions": rows}
     if args.evaluate:
         start = time.perf_counter()
-        evaluation = evaluate_policy(TruthOracle.from_assembly("cranfield"), args.evaluate)
+        evaluation = evaluate_policy(TruthOracle.from_assembly(CRANFIELD), args.evaluate)
         report["evaluate"] = {"policy": args.evaluate, "cases": evaluation.cases,
                               "mean": round(evaluation.mean, 4),
                               "seconds": round(time.perf_counter() - start, 1), "target_s": 120}

@@ -10,6 +10,17 @@ only to re-test it: when an answer makes the closure cyclic (noise), the observa
 on the cycle are named and re-tested; per pair the majority of its answers is kept
 (a tie keeps the latest), so the kept relation never contradicts itself. It is done
 when every pair is known and no conflict is left.
+
+A wrong answer that other kept observations entail closes a cycle; one that is
+*essential* (its pair is unknown without it, ``sizes_essential.lp``) cannot be caught
+that way. With ``confirm`` K > 0, once every pair is known each essential observation is
+re-tested until its kept result *leads* the other by K+1 answers (noiseless: K extra
+answers). The lead is what the answers prove: with flips of probability q the odds of
+the kept result are ((1-q)/q)^lead, so fit, no_fit, fit is worth one answer, not two.
+Any pair asked more than once is re-tested at once (before unknown pairs) until it
+leads by K+1 or has ``max_answers`` answers (then its majority stands); if its kept
+result changes, the closure changes, the newly unknown pairs are asked and the
+essentials of the new closure are confirmed.
 """
 
 from __future__ import annotations
@@ -78,27 +89,38 @@ class SizeLearner:
         holes: Sequence[str],
         policy: str | SelectionPolicy = "systematic",
         seed: int = 0,
-        max_answers: int = 5,
+        max_answers: int | None = None,
+        confirm: int = 0,
     ) -> None:
-        """``parts``/``holes`` in index order; ``max_answers`` caps the answers per pair."""
+        """``parts``/``holes`` in index order; ``confirm`` K ≥ 0: each essential
+        observation's kept result must lead the other by K+1 answers (0: no confirmation);
+        ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more)."""
         if len(set(parts) | set(holes)) != len(parts) + len(holes):
             raise PlannerError("parts and holes need distinct ids")
+        if confirm < 0:
+            raise PlannerError(f"confirm {confirm}: expected a number of answers >= 0")
+        max_answers = max(5, 4 * confirm + 1) if max_answers is None else max_answers
+        if max_answers <= confirm:
+            raise PlannerError(f"max_answers {max_answers}: confirm {confirm} needs at least "
+                               f"{confirm + 1} answers per pair")
         self.parts, self.holes = tuple(parts), tuple(holes)
         self.policy = get_policy(policy) if isinstance(policy, str) else policy
         self.rng = random.Random(seed)
-        self.max_answers = max_answers
+        self.max_answers, self.confirm = max_answers, confirm
         self.experiments: list[Experiment] = []
         self.answers: dict[Pair, list[str]] = {}
         self.retests: list[Pair] = []
-        self._history: list[tuple[Knowledge, Pair | None, list[Pair]]] = []
+        self._essential: tuple[Pair, ...] = ()
+        self._history: list[tuple[Knowledge, Pair | None, list[Pair], tuple[Pair, ...]]] = []
         if self.policy.prepare is not None:
             self.policy.prepare(len(self.parts), len(self.holes))
         self._ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
         self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
         self._ground(seed)
+        self._pairs = [(p, h) for p in self.parts for h in self.holes]
         self._literals = {
-            (p, h, r): self._ctl.symbolic_atoms[fact("observed", p, h, r)].literal
-            for p in self.parts for h in self.holes for r in RESULTS
+            (*pair, r): self._ctl.symbolic_atoms[fact("observed", *pair, r)].literal
+            for pair in self._pairs for r in RESULTS
         }
         self._selected: Pair | None = None
         self.knowledge = self._solve()
@@ -110,13 +132,15 @@ class SizeLearner:
         if self.policy.session_facts is not None:
             atoms += self.policy.session_facts(self.parts, self.holes, seed)
         self._ctl.add("base", [], format_facts(atoms) + _OBSERVATIONS)
-        for name in ("sizes_closure.lp", self.policy.encoding):
+        essential = "sizes_essential.lp" if self.confirm else None
+        for name in ("sizes_closure.lp", essential, self.policy.encoding):
             if name is not None:
                 self._ctl.load(str(encoding_path(name)))
         self._ctl.ground([("base", [])])
 
     def _solve(self) -> Knowledge:
-        """Solve the ground program under the current externals; remember ``select/2``."""
+        """Solve the ground program under the current externals; remember ``select/2``
+        and ``essential/2`` (index order)."""
         last: list[clingo.Symbol] = []
         result = self._ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
         if not result.satisfiable:
@@ -124,6 +148,8 @@ class SizeLearner:
         knowledge = Knowledge.from_symbols(self.parts, self.holes, last, self._decoded)
         selected = [self._decoded[s][1] for s in last if self._decoded[s][0] == "select"]
         self._selected = selected[0] if len(selected) == 1 else None
+        essential = {self._decoded[s][1] for s in last if self._decoded[s][0] == "essential"}
+        self._essential = tuple(pair for pair in self._pairs if pair in essential)
         return knowledge
 
     def _set_observation(self, pair: Pair, result: str | None) -> None:
@@ -138,10 +164,32 @@ class SizeLearner:
             return answers[-1]
         return max(RESULTS, key=counts.__getitem__)
 
+    def lead(self, pair: Pair) -> int:
+        """Answers of ``pair`` agreeing with its kept result minus those disagreeing (0 if none)."""
+        answers = self.answers.get(pair, [])
+        return 2 * answers.count(self._kept(answers)) - len(answers) if answers else 0
+
+    def _unconfirmed(self, pair: Pair) -> bool:
+        """``pair`` leads by ``confirm`` answers or fewer and may still be re-tested."""
+        return self.lead(pair) <= self.confirm and len(self.answers.get(pair, [])) < self.max_answers
+
+    def essential(self) -> list[Pair]:
+        """Observed pairs that become unknown when their observation alone is removed
+        (index order; computed only with ``confirm`` > 0 and an acyclic closure)."""
+        return list(self._essential)
+
+    def _due_retests(self) -> list[Pair]:
+        """Queued re-tests (conflicts, re-tests to confirm), else (``confirm`` > 0, every
+        pair known) the unconfirmed essential observations."""
+        if self.retests or not self.confirm or not self.knowledge.complete:
+            return list(self.retests)
+        return [pair for pair in self._essential if self._unconfirmed(pair)]
+
     def next_experiment(self) -> Pair | None:
-        """The pair to try next (a pending re-test first); None when learning is done."""
-        if self.retests:
-            return self.retests[0]
+        """The pair to try next (a due re-test first); None when learning is done."""
+        due = self._due_retests()
+        if due:
+            return due[0]
         if self.knowledge.complete:
             return None
         if self.policy.choose is not None:
@@ -153,12 +201,12 @@ class SizeLearner:
         return pair
 
     def record(self, part: str, hole: str, result: str) -> Experiment:
-        """Add one answer, update the closure, queue re-tests of conflicting observations."""
+        """Add one answer, update the closure, queue re-tests (conflicts; unconfirmed re-tested pairs)."""
         if result not in RESULTS or part not in self.parts or hole not in self.holes:
             raise PlannerError(f"experiment ({part},{hole}) -> {result!r}: expected a known "
                                f"part, hole and a result in {RESULTS}")
         pair = (part, hole)
-        self._history.append((self.knowledge, self._selected, list(self.retests)))
+        self._history.append((self.knowledge, self._selected, list(self.retests), self._essential))
         retest = pair in self.answers
         if pair in self.retests:
             self.retests.remove(pair)
@@ -167,7 +215,7 @@ class SizeLearner:
         self.answers.setdefault(pair, []).append(result)
         self._set_observation(pair, self._kept(self.answers[pair]))
         self.knowledge = self._solve()
-        self._queue_retests()
+        self._queue_retests(pair)
         return experiment
 
     def conflicting_experiments(self) -> list[Experiment]:
@@ -175,7 +223,9 @@ class SizeLearner:
         kept = {(p, h, r) for p, h, r in self.knowledge.conflicts}
         return [e for e in self.experiments if (e.part, e.hole, e.result) in kept]
 
-    def _queue_retests(self) -> None:
+    def _queue_retests(self, recorded: Pair) -> None:
+        """Queue the observations on a cycle and, with ``confirm`` > 0, the ``recorded``
+        pair if it is a re-test still unconfirmed."""
         for p, h, _ in sorted(self.knowledge.conflicts):
             if (p, h) in self.retests:
                 continue
@@ -185,17 +235,21 @@ class SizeLearner:
                 raise PlannerError(f"observations stay in conflict after {self.max_answers} "
                                    f"answers per pair: {named}")
             self.retests.append((p, h))
+        if (self.confirm and len(self.answers[recorded]) > 1 and self._unconfirmed(recorded)
+                and recorded not in self.retests):
+            self.retests.append(recorded)
 
     def next_batch(self, size: int, pending: Sequence[Pair] = ()) -> list[Pair]:
         """Up to ``size`` pairs to try in parallel, none of whose outcomes can entail another's.
 
         ``pending`` are pairs already out at other cells: the new pairs must be
-        independent of them too. Pending re-tests come first. Otherwise pairs are added
-        one at a time, each the first of :meth:`_candidates` that no combination of
-        outcomes of the pending and already chosen pairs entails or contradicts, nor
-        its outcomes theirs (checked by solving with hypothetical observations).
+        independent of them too. Due re-tests (conflicts, ties, confirmations) not
+        pending come first. Otherwise pairs are added one at a time, each the first of
+        :meth:`_candidates` that no combination of outcomes of the pending and already
+        chosen pairs entails or contradicts, nor its outcomes theirs (checked by solving
+        with hypothetical observations).
         """
-        retests = [p for p in self.retests if p not in pending]
+        retests = [p for p in self._due_retests() if p not in pending]
         if retests:
             return retests[:size]
         if self.knowledge.complete:
@@ -247,7 +301,7 @@ class SizeLearner:
         if not self.answers[pair]:
             del self.answers[pair]
         self._restore(pair)
-        self.knowledge, self._selected, self.retests = self._history.pop()
+        self.knowledge, self._selected, self.retests, self._essential = self._history.pop()
 
     def reset(self, seed: int = 0) -> None:
         """Forget all observations: a fresh session on the same ground program.
@@ -272,10 +326,13 @@ def learn_sizes(
     policy: str | SelectionPolicy = "systematic",
     seed: int = 0,
     on_experiment: Callable[[Experiment, Knowledge], None] | None = None,
-    max_answers: int = 5,
+    max_answers: int | None = None,
+    confirm: int = 0,
 ) -> SizeLearningResult:
-    """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known."""
-    return run_learner(SizeLearner(parts, holes, policy, seed, max_answers), oracle, on_experiment)
+    """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known
+    (and, with ``confirm`` > 0, every essential observation confirmed; see :class:`SizeLearner`)."""
+    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm)
+    return run_learner(learner, oracle, on_experiment)
 
 
 def run_learner(

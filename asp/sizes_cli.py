@@ -3,6 +3,8 @@
 ``learn`` runs one learning session against a truth oracle and prints the experiments
 (``--json``: the issue's contract), optionally writing the learned facts (``--out``).
 ``evaluate`` counts the experiments a policy needs over relabelings of an assembly.
+Both take ``--noise P`` (answers flipped with probability P) and ``--confirm K`` (re-test
+each essential observation until its result leads by K+1 answers; see README "Noise").
 """
 
 from __future__ import annotations
@@ -38,6 +40,33 @@ def _policy(name: str) -> str:
     return name
 
 
+def _probability(text: str) -> float:
+    """A flip probability in [0, 0.5)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0.0 <= value < 0.5:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a probability in [0, 0.5)")
+    return value
+
+
+def _confirm(text: str) -> int:
+    """A number of answers K >= 0."""
+    if not text.isdigit():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer >= 0")
+    return int(text)
+
+
+def _add_noise_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--noise", type=_probability, default=0.0, metavar="P",
+                        help="probability that an answer is flipped (simulated noise; default 0)")
+    parser.add_argument("--confirm", type=_confirm, default=0, metavar="K",
+                        help="once every pair is known, re-test each essential observation (its pair "
+                             "unknown without it) until its result leads the other by K+1 answers "
+                             "(default 0: no confirmation)")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="./run.sh sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -45,9 +74,8 @@ def _parser() -> argparse.ArgumentParser:
     learn = sub.add_parser("learn", help="learn the relation from a truth by experiments")
     _add_truth_options(learn)
     learn.add_argument("--policy", type=_policy, default="heuristic", help="experiment selection (default heuristic)")
-    learn.add_argument("--seed", type=int, default=0, help="seed of random choices (default 0)")
-    learn.add_argument("--noise", type=float, default=0.0, metavar="P",
-                       help="probability that an answer is wrong (simulated noise; default 0)")
+    learn.add_argument("--seed", type=int, default=0, help="seed of random choices and noise (default 0)")
+    _add_noise_options(learn)
     learn.add_argument("--out", metavar="FILE.lp", help="write learned facts (tried/4, smaller/2, fits/2, no_fit/2)")
     learn.add_argument("--json", action="store_true", help="print JSON")
     evaluate = sub.add_parser("evaluate", help="experiments needed over relabelings of parts and holes")
@@ -55,7 +83,8 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--policy", type=_policy, required=True)
     evaluate.add_argument("--relabelings", default="all", metavar="all|N",
                           help="every relabeling (default) or N random ones")
-    evaluate.add_argument("--seed", type=int, default=0)
+    evaluate.add_argument("--seed", type=int, default=0, help="seed of relabelings, random choices, noise")
+    _add_noise_options(evaluate)
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", metavar="FILE.png", help="Fig. 19-style comparison plot")
     evaluate.add_argument("--compare", default="random", metavar="P,...",
@@ -73,8 +102,6 @@ def _print_matrix(knowledge: Knowledge) -> None:
 
 def _learn(args: argparse.Namespace) -> int:
     truth = _truth(args)
-    if not 0.0 <= args.noise < 0.5:
-        raise PlannerError(f"--noise {args.noise}: expected a probability in [0, 0.5)")
     oracle: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
 
     def show(experiment: Experiment, _knowledge: Knowledge) -> None:
@@ -82,7 +109,8 @@ def _learn(args: argparse.Namespace) -> int:
             note = " (re-test)" if experiment.retest else ""
             print(f"{experiment.number:3d}: {experiment.part} -> {experiment.hole}: {experiment.result}{note}")
 
-    result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show)
+    result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
+                         confirm=args.confirm)
     if args.out:
         write_facts(args.out, result.facts(), header=f"learned by `sizes learn --policy {args.policy}`")
     if args.json:
@@ -93,7 +121,9 @@ def _learn(args: argparse.Namespace) -> int:
             "fits": [[p, h] for p in truth.parts for h in truth.holes if (p, h) in result.knowledge.fits],
         }))
     else:
-        print(f"{result.count} experiments with policy {args.policy}; learned relation (1 = fits):")
+        retests = sum(e.retest for e in result.experiments)
+        print(f"{result.count} experiments ({retests} re-tests) with policy {args.policy}; "
+              "learned relation (1 = fits):")
         _print_matrix(result.knowledge)
     return 0
 
@@ -105,13 +135,15 @@ def _evaluate(args: argparse.Namespace) -> int:
         if not str(relabelings).isdigit() or int(relabelings) < 1:
             raise PlannerError(f"--relabelings {relabelings}: expected 'all' or a positive integer")
         relabelings = int(relabelings)
-    evaluation = evaluate_policy(truth, args.policy, relabelings, args.seed)
+    options = {"confirm": args.confirm, "noise": args.noise}
+    evaluation = evaluate_policy(truth, args.policy, relabelings, args.seed, **options)
     report = evaluation.as_json()
     if args.plot:
         others = [p for p in args.compare.split(",") if p and p != args.policy]
         for name in others:
             get_policy(name)
-        evaluations = [evaluation] + [evaluate_policy(truth, p, relabelings, args.seed) for p in others]
+        evaluations = [evaluation] + [evaluate_policy(truth, p, relabelings, args.seed, **options)
+                                      for p in others]
         plot_comparison(evaluations, args.plot)
     if args.json:
         print(json.dumps(report))
@@ -120,6 +152,9 @@ def _evaluate(args: argparse.Namespace) -> int:
               f"min {report['min']} ({100 * report['min_share']:.2f} %), "
               f"max {report['max']} ({100 * report['max_share']:.2f} %)")
         print("histogram (experiments: cases): " + ", ".join(f"{n}: {c}" for n, c in report["histogram"].items()))
+        if args.noise:
+            print(f"noise {args.noise}, confirm {args.confirm}: wrong relation in {report['wrong']} of "
+                  f"{report['cases']} cases ({100 * report['wrong_share']:.1f} %)")
         if args.plot:
             print(f"plot written to {args.plot}", file=sys.stderr)
     return 0

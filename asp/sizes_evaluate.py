@@ -10,7 +10,10 @@ their decisions as long as their answers agree, so the policy's decision tree is
 walked once over the distinct matrices, each counted with its multiplicity: the
 statistics are exactly those of running every relabeling on its own.
 Non-deterministic policies (``random``) run every case, case i with seed
-``seed * 1_000_003 + i``. Work is spread over the machine's cores.
+``seed * 1_000_003 + i``. With ``noise`` every case is a session of its own too, its
+answers flipped by a :class:`NoisyOracle` of the case's seed; the cases that end with
+a wrong relation (or give up on a conflict) are counted. ``confirm`` is the learner's
+(see :class:`asp.size_learner.SizeLearner`). Work is spread over the machine's cores.
 """
 
 from __future__ import annotations
@@ -18,13 +21,14 @@ from __future__ import annotations
 import itertools
 import multiprocessing
 import random
+import statistics
 import sys
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from asp import PlannerError
-from asp.oracle import TruthOracle
+from asp.oracle import NoisyOracle, TruthOracle
 from asp.size_learner import SizeLearner, run_learner
 from asp.size_policies import get_policy
 
@@ -34,10 +38,14 @@ Matrix = tuple[tuple[bool, ...], ...]
 
 @dataclass(frozen=True)
 class Evaluation:
-    """Number of experiments per case, as a histogram over all cases."""
+    """Number of experiments per case, as a histogram over all cases; ``wrong`` cases
+    ended with a wrong relation (only with ``noise``, the flip probability)."""
 
     policy: str
     histogram: dict[int, int]
+    noise: float = 0.0
+    confirm: int = 0
+    wrong: int = 0
 
     @property
     def cases(self) -> int:
@@ -47,9 +55,20 @@ class Evaluation:
     def mean(self) -> float:
         return sum(n * c for n, c in self.histogram.items()) / self.cases
 
+    @property
+    def median(self) -> float:
+        """Median number of experiments per case."""
+        counts = sorted(itertools.chain.from_iterable([n] * c for n, c in self.histogram.items()))
+        return statistics.median(counts)
+
     def as_json(self) -> dict:
-        """The issue's JSON contract; shares are fractions of all cases (0..1)."""
+        """The issue's JSON contract; shares are fractions of all cases (0..1). With noise
+        or confirm also ``noise``, ``confirm``, ``wrong`` (cases) and ``wrong_share``."""
         low, high = min(self.histogram), max(self.histogram)
+        extra = {} if not (self.noise or self.confirm) else {
+            "noise": self.noise, "confirm": self.confirm, "wrong": self.wrong,
+            "wrong_share": round(self.wrong / self.cases, 6),
+        }
         return {
             "policy": self.policy,
             "cases": self.cases,
@@ -59,6 +78,7 @@ class Evaluation:
             "max": high,
             "max_share": round(self.histogram[high] / self.cases, 6),
             "histogram": {str(n): self.histogram[n] for n in sorted(self.histogram)},
+            **extra,
         }
 
 
@@ -77,12 +97,15 @@ def relabeled_matrices(truth: TruthOracle, relabelings: str | int, seed: int) ->
     return [tuple(tuple(fits[i][j] for j in col) for i in row) for row, col in orders]
 
 
-Task = tuple[str, int, tuple[tuple[str, str, str], ...], dict[Matrix, int]]
-"""A subtree of a deterministic policy's decision tree: (policy, seed, prefix of
-(part, hole, result) experiments, matrices reaching it with their multiplicities)."""
+Task = tuple[str, int, int, tuple[tuple[str, str, str], ...], dict[Matrix, int]]
+"""A subtree of a deterministic policy's decision tree: (policy, seed, confirm, prefix
+of (part, hole, result) experiments, matrices reaching it with their multiplicities)."""
 
-_LEARNERS: dict[tuple[str, int, int], SizeLearner] = {}
-"""Per process: one ground learner per (policy, parts, holes), reused by reset."""
+Case = tuple[Matrix, str, int, int, float]
+"""One whole session: (truth matrix, policy, seed, confirm, noise)."""
+
+_LEARNERS: dict[tuple[str, int, int, int], SizeLearner] = {}
+"""Per process: one ground learner per (policy, parts, holes, confirm), reused by reset."""
 
 
 def _names(matrix: Matrix) -> tuple[list[str], list[str]]:
@@ -90,14 +113,14 @@ def _names(matrix: Matrix) -> tuple[list[str], list[str]]:
     return [f"q{i}" for i in range(1, len(matrix) + 1)], [f"k{j}" for j in range(1, len(matrix[0]) + 1)]
 
 
-def _learner(policy: str, matrix: Matrix, seed: int) -> SizeLearner:
+def _learner(policy: str, matrix: Matrix, seed: int, confirm: int) -> SizeLearner:
     """A fresh (reset) learner of the matrix's shape, reused for deterministic policies."""
     parts, holes = _names(matrix)
-    key = (policy, len(parts), len(holes))
+    key = (policy, len(parts), len(holes), confirm)
     if not get_policy(policy).deterministic:
-        return SizeLearner(parts, holes, policy, seed)
+        return SizeLearner(parts, holes, policy, seed, confirm=confirm)
     if key not in _LEARNERS:
-        _LEARNERS[key] = SizeLearner(parts, holes, policy, seed)
+        _LEARNERS[key] = SizeLearner(parts, holes, policy, seed, confirm=confirm)
     learner = _LEARNERS[key]
     learner.reset(seed)
     return learner
@@ -108,15 +131,27 @@ def _answer(matrix: Matrix, pair: tuple[str, str]) -> str:
     return "fit" if matrix[int(pair[0][1:]) - 1][int(pair[1][1:]) - 1] else "no_fit"
 
 
-def count_experiments(task: tuple[Matrix, str, int]) -> int:
-    """Experiments a (random) policy needs to learn one matrix: one whole session."""
-    matrix, policy, seed = task
+def run_case(case: Case) -> tuple[int, bool]:
+    """Experiments of one whole session and whether it ended with a wrong relation.
+
+    With noise, a session that gives up on a conflict counts as wrong (its experiments
+    so far counted); without noise a wrong relation is an error of the learner.
+    """
+    matrix, policy, seed, confirm, noise = case
     parts, holes = _names(matrix)
     fits = {(p, h) for p, row in zip(parts, matrix) for h, f in zip(holes, row) if f}
-    result = run_learner(_learner(policy, matrix, seed), TruthOracle(parts, holes, fits))
-    if result.knowledge.fits != frozenset(fits):
+    truth = TruthOracle(parts, holes, fits)
+    learner = _learner(policy, matrix, seed, confirm)
+    try:
+        result = run_learner(learner, NoisyOracle(truth, noise, seed) if noise else truth)
+    except PlannerError:
+        if not noise:
+            raise
+        return len(learner.experiments), True
+    wrong = result.knowledge.fits != frozenset(fits)
+    if wrong and not noise:
         raise PlannerError(f"policy {policy} learned a wrong relation for {matrix}")
-    return result.count
+    return result.count, wrong
 
 
 def _walk(learner: SizeLearner, group: dict[Matrix, int], histogram: Counter[int],
@@ -144,8 +179,8 @@ def _walk(learner: SizeLearner, group: dict[Matrix, int], histogram: Counter[int
 
 def walk_subtree(task: Task) -> Counter[int]:
     """Histogram of experiment counts of one subtree (worker of the process pool)."""
-    policy, seed, prefix, group = task
-    learner = _learner(policy, next(iter(group)), seed)
+    policy, seed, confirm, prefix, group = task
+    learner = _learner(policy, next(iter(group)), seed, confirm)
     for part, hole, result in prefix:
         learner.record(part, hole, result)
     histogram: Counter[int] = Counter()
@@ -176,36 +211,40 @@ def _pool_map(function, tasks: Sequence, processes: int, unit: str) -> list:
 
 def evaluate_policy(
     truth: TruthOracle, policy: str, relabelings: str | int = "all", seed: int = 0,
-    processes: int | None = None,
+    processes: int | None = None, confirm: int = 0, noise: float = 0.0,
 ) -> Evaluation:
-    """Learn every relabeled truth with ``policy``.
+    """Learn every relabeled truth with ``policy`` (learner option ``confirm``; answers
+    flipped with probability ``noise``).
 
-    A deterministic policy's runs form a decision tree (a decision depends only on the
-    answers so far): it is walked once, each node solved once, the matrices splitting
-    by their answers; its top levels are cut into subtrees for the worker processes.
-    The histogram is exactly that of running every relabeling on its own.
+    Without noise a deterministic policy's runs form a decision tree (a decision
+    depends only on the answers so far): it is walked once, each node solved once, the
+    matrices splitting by their answers; its top levels are cut into subtrees for the
+    worker processes. The histogram is exactly that of running every relabeling on its own.
     """
     selection = get_policy(policy)
     matrices = relabeled_matrices(truth, relabelings, seed)
     processes = processes or min(2, multiprocessing.cpu_count())
     histogram: Counter[int] = Counter()
-    if selection.deterministic:
+    wrong = 0
+    if selection.deterministic and not noise:
         group = dict(Counter(matrices))
         frontier: list = []
         depth = 0
         while len(frontier) < 16 * processes and depth < 12:
             frontier, histogram = [], Counter()
             depth += 1
-            _walk(_learner(policy, matrices[0], seed), group, histogram, frontier, depth)
+            _walk(_learner(policy, matrices[0], seed, confirm), group, histogram, frontier, depth)
             if not frontier:
                 break
-        tasks = [(policy, seed, prefix, sub) for prefix, sub in frontier]
+        tasks = [(policy, seed, confirm, prefix, sub) for prefix, sub in frontier]
         for part in _pool_map(walk_subtree, tasks, processes, "subtree"):
             histogram.update(part)
     else:
-        tasks = [(m, policy, seed * 1_000_003 + i) for i, m in enumerate(matrices)]
-        histogram.update(_pool_map(count_experiments, tasks, processes, "run"))
-    return Evaluation(policy, dict(histogram))
+        cases = [(m, policy, seed * 1_000_003 + i, confirm, noise) for i, m in enumerate(matrices)]
+        runs = _pool_map(run_case, cases, processes, "run")
+        histogram.update(count for count, _ in runs)
+        wrong = sum(bad for _, bad in runs)
+    return Evaluation(policy, dict(histogram), noise, confirm, wrong)
 
 
 def plot_comparison(evaluations: Sequence[Evaluation], path: str) -> None:
