@@ -61,6 +61,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--policy", default="best", choices=policy_names(),
                         help="experiment selection policy (default best: fewest experiments)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the policy and the trials")
+    parser.add_argument("--confirm", type=int, default=0, metavar="K",
+                        help="re-test each essential experiment until its result leads by K+1 answers "
+                             "(default 0: trust the cell's answer; see sizes learn --confirm)")
     parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
@@ -86,11 +89,13 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict]:
         settings = json.loads(path.read_text(encoding="utf-8"))
         settings["starts"] = int(settings.get("starts", 1)) + 1
         return args.resume, settings
+    if args.confirm < 0:
+        raise PlannerError(f"--confirm {args.confirm}: expected a number >= 0")
     run = args.out or Path("runs") / datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
     if (run / SETTINGS).exists():
         raise PlannerError(f"--out {run}: already holds a session; use --resume {run} or another folder")
     run.mkdir(parents=True, exist_ok=True)
-    settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed,
+    settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed, "confirm": args.confirm,
                 "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running"}
     return run, settings
 
@@ -218,7 +223,8 @@ def run_session(args: argparse.Namespace) -> dict:
         pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell)
         stack.callback(pool.close)
         oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
-        learner = SizeLearner(parts, holes, settings["policy"], settings["seed"])
+        learner = SizeLearner(parts, holes, settings["policy"], settings["seed"],
+                              confirm=int(settings.get("confirm", 0)))
         for cell in cells:
             cell.wait_for_line("ready", timeout=args.wait_for_cell)
         try:

@@ -184,3 +184,18 @@ def is_cell(pid: int) -> bool:
         return "executor serve" in Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
     except (FileNotFoundError, ProcessLookupError):
         return False
+
+
+def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path) -> None:
+    """--confirm 1 with truthful cells: one agreeing re-test per essential experiment."""
+    plain = run_session("--cells", "1", "--out", str(tmp_path / "plain"), "--policy", "systematic")
+    run = tmp_path / "confirmed"
+    result = run_session("--cells", "1", "--out", str(run), "--policy", "systematic", "--confirm", "1")
+    assert result["matches_truth"] is True
+    journal = read_journal(run / "journal.jsonl")
+    retests = [e for e in journal if e.retest]
+    assert len(journal) == result["experiments"] == plain["experiments"] + len(retests)
+    assert len(retests) == 15  # Cranfield's essential observations, for every policy
+    asked = Counter((e.part, e.hole) for e in journal)
+    assert all(asked[(e.part, e.hole)] == 2 for e in retests)
+    assert all(e.result == TRUTH.ask(e.part, e.hole) for e in journal)
