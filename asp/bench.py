@@ -13,12 +13,13 @@ TOPICS: dict[str, str] = {
     "sizes": "asp.bench_sizes",
     "plan": "asp.bench_plans",
     "session": "asp.bench_session",
+    "dominance": "asp.dominance",
 }
 
 
 def main(argv: list[str]) -> int:
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session} [--help]")
+        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session,dominance} [--help]")
         return 0
     topic = argv[0]
     if topic not in TOPICS:
