@@ -1,9 +1,14 @@
-"""Shared helpers of the size-learning tests: random biorders and a checking oracle."""
+"""Shared helpers of the size-learning tests: random biorders, a checking oracle, and
+policies walked over all biorders of a size (biorders as uint64 masks, bit p·n+h = fits)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+import numpy as np
 from hypothesis import strategies as st
 
+from asp.biorders import all_biorders
 from asp.oracle import TruthOracle
 from asp.size_knowledge import Knowledge
 
@@ -40,3 +45,42 @@ class CheckingOracle:
             assert self.knowledge.result(part, hole) is None, f"({part},{hole}) was entailed"
         self.asked.append((part, hole))
         return self.truth.ask(part, hole)
+
+
+Chooser = Callable[[int, int, int, int], int]
+"""(m, n, fit mask, no-fit mask of the known pairs) -> the pair (bit) to ask next."""
+
+
+def known_masks(possible: np.ndarray, pairs: int) -> tuple[int, int]:
+    """Pairs on which every possible relation agrees (the closure, complete for biorders)."""
+    every = int(np.bitwise_and.reduce(possible))
+    some = int(np.bitwise_or.reduce(possible))
+    return every, ((1 << pairs) - 1) & ~some
+
+
+def consistent(possible: np.ndarray, bit: int, answer: bool) -> np.ndarray:
+    """The possible biorders that give ``answer`` on the pair ``bit``."""
+    return possible[((possible >> np.uint64(bit)) & np.uint64(1)).astype(bool) == answer]
+
+
+def experiments_per_truth(m: int, n: int, chooser: Chooser) -> dict[int, int]:
+    """Experiments the policy needs for every m×n biorder (walking its decision tree)."""
+    needed: dict[int, int] = {}
+
+    def walk(possible: np.ndarray, depth: int) -> None:
+        if len(possible) == 1:
+            needed[int(possible[0])] = depth
+            return
+        bit = chooser(m, n, *known_masks(possible, m * n))
+        for answer in (True, False):
+            branch = consistent(possible, bit, answer)
+            assert 0 < len(branch) < len(possible), "chose a pair whose outcome was entailed"
+            walk(branch, depth + 1)
+
+    walk(all_biorders(m, n), 0)
+    return needed
+
+
+def systematic(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
+    """Lowest part index, then lowest hole index, among unknown pairs."""
+    return next(i for i in range(m * n) if not ((fit_mask | no_fit_mask) >> i) & 1)

@@ -8,47 +8,14 @@ i.e. beating systematic somewhere forces losing elsewhere.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
+from _sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
 from asp.best_policy import choose_bit
 from asp.biorders import all_biorders
 from asp.oracle import TruthOracle
 from asp.size_learner import learn_sizes
 from asp.sizes_evaluate import relabeled_matrices
-
-Chooser = Callable[[int, int, int, int], int]
-
-
-def known_masks(possible: np.ndarray, pairs: int) -> tuple[int, int]:
-    """Pairs on which every possible relation agrees (the closure, complete for biorders)."""
-    every = int(np.bitwise_and.reduce(possible))
-    some = int(np.bitwise_or.reduce(possible))
-    return every, ((1 << pairs) - 1) & ~some
-
-
-def experiments_per_truth(m: int, n: int, chooser: Chooser) -> dict[int, int]:
-    """Experiments the policy needs for every m×n biorder (walking its decision tree)."""
-    needed: dict[int, int] = {}
-
-    def walk(possible: np.ndarray, depth: int) -> None:
-        if len(possible) == 1:
-            needed[int(possible[0])] = depth
-            return
-        bit = chooser(m, n, *known_masks(possible, m * n))
-        fits = ((possible >> np.uint64(bit)) & np.uint64(1)).astype(bool)
-        assert 0 < fits.sum() < len(possible), "chose a pair whose outcome was entailed"
-        walk(possible[fits], depth + 1)
-        walk(possible[~fits], depth + 1)
-
-    walk(all_biorders(m, n), 0)
-    return needed
-
-
-def systematic(m: int, n: int, fit_mask: int, no_fit_mask: int) -> int:
-    """Lowest part index, then lowest hole index, among unknown pairs."""
-    return next(i for i in range(m * n) if not ((fit_mask | no_fit_mask) >> i) & 1)
 
 
 def test_best_needs_fewer_experiments_than_systematic_over_all_small_biorders() -> None:
@@ -65,7 +32,7 @@ def experiments_for(truth: int, m: int, n: int, chooser: Chooser) -> int:
     possible, count = all_biorders(m, n), 0
     while len(possible) > 1:
         bit = chooser(m, n, *known_masks(possible, m * n))
-        possible = possible[((possible >> np.uint64(bit)) & np.uint64(1)) == ((truth >> bit) & 1)]
+        possible = consistent(possible, bit, bool((truth >> bit) & 1))
         count += 1
     return count
 
