@@ -21,7 +21,7 @@ from pathlib import Path
 import clingo
 
 from asp import PlannerError
-from asp.assembly import Assembly, Hole, Part, load_assembly
+from bridge.assembly import Assembly, Hole, Part, load_assembly
 from asp.assign import LearnedFacts, load_learned_facts
 from asp.facts import fact, load_atoms, write_facts
 from asp.plans import plans, travel_facts

@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import networkx as nx
 
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.linear_extensions import exact_count
 from asp.precedence_eval import PAPER_M, evaluate
 from asp.relation import Relation, close, true_relation

@@ -22,12 +22,13 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
 
 
 def run_guarded(main, argv: list[str]) -> int:
-    """Run ``main(argv)``; a PlannerError becomes ``error: ...`` on stderr and exit 2."""
+    """Run ``main(argv)``; a PlannerError or BridgeError becomes ``error: ...`` on stderr and exit 2."""
     from asp import PlannerError
+    from bridge import BridgeError
 
     try:
         return int(main(argv) or 0)
-    except PlannerError as exc:
+    except (PlannerError, BridgeError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

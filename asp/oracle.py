@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from asp import PlannerError
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.facts import atoms_by_name, load_atoms
 
 Result = Literal["fit", "no_fit"]

@@ -12,7 +12,7 @@ import json
 import clingo
 
 from asp import PlannerError
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.assign import UnsolvableAssembly, load_learned_facts
 from asp.assign_cli import EXIT_UNSOLVABLE, facts_parser, report_unsolvable
 from asp.facts import write_facts

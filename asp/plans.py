@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from asp.assembly import Assembly
+from bridge.assembly import Assembly
 from asp.assign import LearnedFacts, feasible_assignment, solve_encoding
 from asp.facts import atoms_by_name, fact
 

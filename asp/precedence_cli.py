@@ -13,7 +13,7 @@ import sys
 from itertools import islice
 
 from asp import PlannerError
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.demos import Demonstrations, load_demos
 from asp.extension_batches import GENERATORS
 from asp.facts import write_facts

@@ -18,7 +18,7 @@ import clingo
 import numpy as np
 
 from asp import PlannerError
-from asp.assembly import Assembly
+from bridge.assembly import Assembly
 from asp.facts import atoms_by_name, fact, load_atoms
 
 Pair = tuple[str, str]

@@ -33,7 +33,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from asp import PlannerError
-from asp.assembly import Assembly, load_assembly
+from bridge.assembly import Assembly, load_assembly
 from asp.assign import greedy_assignment, load_learned_facts
 from asp.cell_processes import CellProcess, serve_argv
 from asp.demos import demo_facts, load_demos

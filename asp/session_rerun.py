@@ -1,9 +1,9 @@
 """The planner's Rerun log of a session (entities ``planner/...``).
 
 Planner and cells log into ONE recording id (application
-:data:`executor.rerun_log.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
+:data:`bridge.rerun_layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
 files opened together are one recording. The planner sends the blueprint: its views
-in a first tab, then one tab per cell (:func:`executor.rerun_blueprint.cell_blueprint`).
+in a first tab, then one tab per cell (:func:`bridge.rerun_layout.cell_blueprint`).
 
 =========================== ==========================================================
 ``planner/knowledge``       part × hole matrix after every experiment (tensor: 1 fits,
@@ -28,30 +28,10 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from asp.size_knowledge import Knowledge
-from executor.rerun_blueprint import cell_blueprint
-from executor.rerun_log import APPLICATION_ID
+from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]
-
-
-def planner_views() -> rrb.Container:
-    """The planner's tab: knowledge matrix, graphs, assignment, experiment log."""
-    return rrb.Horizontal(
-        rrb.Vertical(
-            rrb.TensorView(origin="planner/knowledge", name="knowledge (1 fit, 0 no fit, -1 unknown)"),
-            rrb.TextLogView(origin="planner/experiments", name="experiments"),
-        ),
-        rrb.Vertical(
-            rrb.GraphView(origin="planner/precedence", name="must precede"),
-            rrb.GraphView(origin="planner/smaller", name="smaller than"),
-        ),
-        rrb.Vertical(
-            rrb.GraphView(origin="planner/assignment", name="assignment"),
-            rrb.TextDocumentView(origin="planner/assignment", name="assignment table"),
-        ),
-        name="planner",
-    )
 
 
 def _reduction(pairs: Iterable[tuple[str, str]]) -> list[tuple[str, str]]:

@@ -13,6 +13,7 @@ import statistics
 import sys
 from collections.abc import Sequence
 
+from bridge import BridgeError
 from executor import ExecutorError
 
 
@@ -117,7 +118,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return int(importlib.import_module(f"executor.{argv[0]}").main(argv[1:]) or 0)
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
-    except ExecutorError as exc:
+    except (ExecutorError, BridgeError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import pybullet_data
 
+from bridge.assembly import load_assembly
 from executor import ExecutorError
 
-DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 
 
 @dataclass(frozen=True)
@@ -74,20 +74,22 @@ def _read_toml(path: Path) -> dict:
 
 
 def load_geometry(assembly: str = "cranfield") -> CellGeometry:
-    """Read ``assembly.toml`` + ``geometry.toml`` of a folder under ``data/`` (or a path)."""
-    folder = Path(assembly) if Path(assembly).is_dir() else DATA_DIR / assembly
-    if not (folder / "assembly.toml").is_file():
-        raise ExecutorError(f"assembly '{assembly}': no assembly.toml in {folder} (expected a folder under data/)")
-    layout = _read_toml(folder / "assembly.toml")
+    """Read ``assembly.toml`` (through :func:`bridge.assembly.load_assembly`) and
+    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path)."""
+    layout = load_assembly(assembly)
+    folder = layout.folder
     geo = _read_toml(folder / "geometry.toml")
+    positions = {hole.id: hole.position for hole in layout.holes}
     holes: dict[str, HoleSpec] = {}
     for shape in geo.get("hole_shapes", {}).values():
         for hid in shape["holes"]:
-            if hid not in layout.get("holes", {}):
+            if hid not in positions:
                 raise ExecutorError(f"geometry.toml: hole '{hid}' is not a hole of assembly.toml")
-            x, y = layout["holes"][hid]["position"]
-            holes[hid] = HoleSpec(hid, shape["kind"], float(shape["size"]), (float(x), float(y)))
-    starts = {pid: p.get("start") for pid, p in layout.get("parts", {}).items()}
+            position = positions[hid]
+            if position is None:
+                raise ExecutorError(f"assembly.toml: hole '{hid}' has no position (expected [x, y] in m)")
+            holes[hid] = HoleSpec(hid, shape["kind"], float(shape["size"]), position)
+    starts = {part.id: part.start for part in layout.parts}
     starts |= {pid: p["start"] for pid, p in geo.get("extra_parts", {}).items()}
     parts: dict[str, PartSpec] = {}
     for name, shape in geo.get("part_shapes", {}).items():
@@ -100,6 +102,14 @@ def load_geometry(assembly: str = "cranfield") -> CellGeometry:
                 (float(x), float(y)), shape["demo_hole"],
             )
     return CellGeometry(folder, geo["plate"], geo["gripper"], holes, parts)
+
+
+def passes(part: PartSpec, hole: HoleSpec) -> bool:
+    """Whether the part's cross-section passes the hole's (axis-aligned, no clearance needed
+    beyond a positive one): round in round d < D, round in square d < S, square in square
+    s < S, square in round s·√2 < D (its diagonal)."""
+    extent = part.size * math.sqrt(2.0) if part.kind == "square" and hole.kind == "round" else part.size
+    return extent < hole.size
 
 
 def _ring(kind: str, half: float, n: int) -> np.ndarray:

@@ -44,12 +44,11 @@ import numpy as np
 import rerun as rr
 
 from executor import ExecutorError
-from executor.rerun_blueprint import cell_blueprint
+from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, cell_root
 
 if TYPE_CHECKING:
     from executor.trial import AttemptEvidence
 
-APPLICATION_ID = "assembly_constraints"
 PHASE_SCALE = 1000
 """The ``dmp_phase`` timeline holds round(phase × PHASE_SCALE)."""
 
@@ -157,7 +156,7 @@ class AttemptLogger:
         if period_s < 0:
             raise ExecutorError(f"AttemptLogger: period_s must be >= 0 [s], got {period_s}")
         self.cell_id = cell_id
-        self.root = f"executor/{cell_id}"
+        self.root = cell_root(cell_id)
         self.period_s = period_s
         self.keep_traces = keep_traces
         self.traces: list[AttemptTrace] = []

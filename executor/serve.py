@@ -11,7 +11,7 @@ supervising session died), then closes the Zenoh session cleanly.
 - Valid requests run one at a time in the main thread. Results are idempotent by
   request id: a repeated id gets the cached reply and never re-runs the experiment.
 - Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily);
-  ``truth`` answers from the assembly's ``sizes.lp`` without simulation, optionally
+  ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly.
 
 One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
@@ -39,6 +39,7 @@ from bridge.messages import (ErrorCode, ErrorReply, Evidence, InsertReply, Inser
                              MessageError, Result, decode_request, encode)
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
 from executor import ExecutorError
+from executor.geometry import load_geometry, passes
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
@@ -59,35 +60,34 @@ class Backend(Protocol):
 
 
 class TruthBackend:
-    """Answers from the assembly's ``sizes.lp`` (closed world), after ``delay_s`` [s]."""
+    """Answers from the cell's geometry without simulation (a part passes a hole when its
+    cross-section does, :func:`executor.geometry.passes`), after ``delay_s`` [s]."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
                  recording_id: str | None, rrd: Path | None) -> None:
-        from asp import PlannerError
-        from asp.oracle import TruthOracle
-
         try:
-            self._truth = TruthOracle.from_assembly(assembly)
-        except PlannerError as exc:
+            self._geometry = load_geometry(assembly)
+        except BridgeError as exc:
             raise ExecutorError(f"truth backend: {exc}") from None
         self._delay_s = delay_s
         self._log = None
         if rrd is not None:
             import rerun as rr
 
-            from executor.rerun_log import APPLICATION_ID
+            from bridge.rerun_layout import APPLICATION_ID
 
             self._log = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
             self._log.save(str(rrd))
             self._entity = f"executor/{cell_id}/outcome"
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
-        if request.part not in self._truth.parts or request.hole not in self._truth.holes:
+        parts, holes = self._geometry.parts, self._geometry.holes
+        if request.part not in parts or request.hole not in holes:
             raise UnknownPair(f"unknown pair ({request.part},{request.hole}); expected a part "
-                                f"of {self._truth.parts} and a hole of {self._truth.holes}")
+                              f"of {tuple(parts)} and a hole of {tuple(holes)}")
         if self._delay_s > 0:
             time.sleep(self._delay_s)  # stands in for the duration of a real insertion
-        result: Result = "fit" if (request.part, request.hole) in self._truth.fits else "no_fit"
+        result: Result = "fit" if passes(parts[request.part], holes[request.hole]) else "no_fit"
         if self._log is not None:
             import rerun as rr
 
@@ -235,7 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
         f"(default: listen on {DEFAULT_ENDPOINT}).")
     parser.add_argument("--cell", default="c1", help="cell id (default c1)")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
-                        help="sim: PyBullet cell; truth: answer from sizes.lp (default sim)")
+                        help="sim: PyBullet cell; truth: answer from the geometry, no simulation (default sim)")
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
     parser.add_argument("--delay", type=float, default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")

@@ -10,7 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from executor.recording import column_values, read_recording
+from bridge.recordings import column_values, read_recording
 
 ROOT = Path(__file__).resolve().parent.parent
 

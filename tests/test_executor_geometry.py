@@ -6,23 +6,18 @@ import math
 import re
 from pathlib import Path
 
-from executor.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, plate_obj_text
+from executor.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def _passes(part: PartSpec, hole: HoleSpec) -> bool:
-    """Purely geometric: does the cross-section fit through the hole (aligned)?"""
-    width = part.size * (math.sqrt(2) if part.kind == "square" and hole.kind == "round" else 1.0)
-    return width < hole.size
-
-
 def test_sizes_make_fig5_true():
+    """The truth backend of the cell answers from these cross-sections: they must give sizes.lp."""
     geometry = load_geometry("cranfield")
     truth = set(re.findall(r"fits\((\w+),(\w+)\)", (ROOT / "data/cranfield/sizes.lp").read_text()))
     for pid in ("p1", "p2", "p3", "p4", "sh"):
         for hid, hole in geometry.holes.items():
-            assert _passes(geometry.parts[pid], hole) == ((pid, hid) in truth), (pid, hid)
+            assert passes(geometry.parts[pid], hole) == ((pid, hid) in truth), (pid, hid)
 
 
 def test_clearances():
@@ -39,3 +34,10 @@ def test_committed_assets_are_what_the_generator_makes():
     assert (geometry.assets / "plate.obj").read_text() == plate_obj_text(geometry)
     for part in geometry.parts.values():
         assert (geometry.assets / f"part_{part.shape}.urdf").read_text() == part_urdf_text(part)
+
+
+def test_a_square_peg_passes_a_round_hole_only_by_its_diagonal() -> None:
+    square = PartSpec("q", "q", "square", 0.010, 0.05, 0.05, (0.0, 0.0), "h")
+    assert passes(square, HoleSpec("h", "round", 0.0142, (0.0, 0.0)))  # diagonal 14.14 mm
+    assert not passes(square, HoleSpec("h", "round", 0.0141, (0.0, 0.0)))
+    assert passes(square, HoleSpec("h", "square", 0.0101, (0.0, 0.0)))

@@ -17,7 +17,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from asp.assembly import Assembly, Hole, Part, load_assembly
+from bridge.assembly import Assembly, Hole, Part, load_assembly
 from asp.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.facts import load_atoms, write_facts
 from asp.plans import PlanStep, check_plan, plans, travel_facts

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from _precedence_helpers import ROOT, run_cli
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.relation import load_relation, true_relation
 
 

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from scipy.stats import chisquare
 
 from _precedence_helpers import closed_relation, posets
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.extension_batches import ExtensionBatches, positions_of
 from asp.facts import fact
 from asp.linear_extensions import UniformSampler, count_linear_extensions, exact_count, linear_extensions

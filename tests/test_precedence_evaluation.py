@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 
 from _precedence_helpers import posets
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.guidance import Guide, evaluate_guided, suggest, teacher_order
 from asp.precedence_eval import PAPER_M, evaluate
 from asp.relation import Relation, true_relation

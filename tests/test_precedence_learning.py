@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 
 from _precedence_helpers import poset_with_demos
-from asp.assembly import load_assembly
+from bridge.assembly import load_assembly
 from asp.demos import Demonstrations, load_demos, parse_demos
 from asp.linear_extensions import count_linear_extensions, linear_extensions
 from asp.precedence import learn_must_precede, pair_evidence, suspects

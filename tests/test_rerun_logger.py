@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bridge import BridgeError
 from executor import ExecutorError
-from executor.recording import blueprint_origins, column_values, format_summary, read_recording
+from bridge.recordings import blueprint_origins, column_values, format_summary, read_recording
 from executor.rerun_log import PHASE_SCALE, AttemptLogger
 
 
@@ -116,7 +117,7 @@ def test_misuse_is_reported() -> None:
         logger.log_step(0.0, 0.0, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3))
     with pytest.raises(ExecutorError, match="'box' or 'cylinder'"):
         logger.log_scene([("x", "sphere", (1, 1, 1), (0, 0, 0))])
-    with pytest.raises(ExecutorError, match="no such recording"):
+    with pytest.raises(BridgeError, match="no such recording"):
         read_recording("/nonexistent/x.rrd")
     logger.close()
 

@@ -12,7 +12,7 @@ import numpy as np
 from rerun.chunk import RrdReader
 
 from asp.view import cell_ids, write_blueprint
-from executor.recording import blueprint_origins
+from bridge.recordings import blueprint_origins
 from executor.rerun_log import AttemptLogger
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -20,7 +20,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from asp import PlannerError
+from bridge import BridgeError
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 _ID = re.compile(r"^[a-z][a-zA-Z0-9_]*$")
@@ -64,10 +64,10 @@ class Assembly:
         return [h.id for h in self.holes]
 
     def file(self, name: str) -> Path:
-        """Path of a file of the folder; PlannerError if it does not exist."""
+        """Path of a file of the folder; BridgeError if it does not exist."""
         path = self.folder / name
         if not path.is_file():
-            raise PlannerError(f"{path}: no such file (assembly '{self.name}' has no {name})")
+            raise BridgeError(f"{path}: no such file (assembly '{self.name}' has no {name})")
         return path
 
     def has_file(self, name: str) -> bool:
@@ -81,7 +81,7 @@ def resolve_assembly_folder(name_or_path: str) -> Path:
         if (folder / "assembly.toml").is_file():
             return folder.resolve()
     known = sorted(p.parent.name for p in DATA_DIR.glob("*/assembly.toml"))
-    raise PlannerError(
+    raise BridgeError(
         f"assembly '{name_or_path}': expected a name under data/ ({', '.join(known)}) "
         "or a folder holding assembly.toml"
     )
@@ -95,32 +95,32 @@ def _position(source: Path, table: str, key: str, value: object) -> tuple[float,
         or len(value) != 2
         or not all(isinstance(v, (int, float)) for v in value)
     ):
-        raise PlannerError(f"{source}: [{table}.{key}]: expected [x, y] in metres, got {value!r}")
+        raise BridgeError(f"{source}: [{table}.{key}]: expected [x, y] in metres, got {value!r}")
     return (float(value[0]), float(value[1]))
 
 
 def _table(source: Path, data: dict, table: str) -> dict[str, dict]:
     entries = data.get(table, {})
     if not isinstance(entries, dict):
-        raise PlannerError(f"{source}: [{table}] must be a table of ids")
+        raise BridgeError(f"{source}: [{table}] must be a table of ids")
     for key, value in entries.items():
         if not _ID.match(key):
-            raise PlannerError(
+            raise BridgeError(
                 f"{source}: [{table}.{key}]: an id must be a lower-case ASP constant"
             )
         if not isinstance(value, dict):
-            raise PlannerError(f"{source}: [{table}.{key}] must be a table")
+            raise BridgeError(f"{source}: [{table}.{key}] must be a table")
     return entries
 
 
 def load_assembly(name_or_path: str) -> Assembly:
-    """Load an assembly folder; PlannerError naming the file and field on bad input."""
+    """Load an assembly folder; BridgeError naming the file and field on bad input."""
     folder = resolve_assembly_folder(name_or_path)
     source = folder / "assembly.toml"
     try:
         data = tomllib.loads(source.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise PlannerError(f"{source}: not valid TOML: {exc}") from None
+        raise BridgeError(f"{source}: not valid TOML: {exc}") from None
     parts = tuple(
         Part(
             id=key,
@@ -131,7 +131,7 @@ def load_assembly(name_or_path: str) -> Assembly:
         for key, value in _table(source, data, "parts").items()
     )
     if not parts:
-        raise PlannerError(f"{source}: expected at least one [parts.<id>] table")
+        raise BridgeError(f"{source}: expected at least one [parts.<id>] table")
     holes = tuple(
         Hole(
             id=key,
@@ -143,5 +143,5 @@ def load_assembly(name_or_path: str) -> Assembly:
     )
     clash = {p.id for p in parts} & {h.id for h in holes}
     if clash:
-        raise PlannerError(f"{source}: ids used for both a part and a hole: {sorted(clash)}")
+        raise BridgeError(f"{source}: ids used for both a part and a hole: {sorted(clash)}")
     return Assembly(folder=folder, name=str(data.get("name", folder.name)), parts=parts, holes=holes)

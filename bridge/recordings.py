@@ -20,7 +20,7 @@ from typing import Any
 import pyarrow as pa
 from rerun.chunk import Chunk, RrdReader
 
-from executor import ExecutorError
+from bridge import BridgeError
 
 
 @dataclass
@@ -76,7 +76,7 @@ _VIEW_ORIGIN = "ViewBlueprint:space_origin"
 
 def _reader(path: Path) -> RrdReader:
     if not path.is_file():
-        raise ExecutorError(f"{path}: no such recording file (expected an .rrd file)")
+        raise BridgeError(f"{path}: no such recording file (expected an .rrd file)")
     return RrdReader(path)
 
 

@@ -1,6 +1,9 @@
-"""The Rerun blueprint of the cell's entities (see :mod:`executor.rerun_log`).
+"""The Rerun layout both sides share: the application id, the entity roots and the blueprint.
 
-One tab per cell: the 3D scene (static geometry, tool path, search path) above the
+Planner and cells log into one recording id of application :data:`APPLICATION_ID`, the
+planner under ``planner/...``, cell ``<id>`` under ``executor/<id>/...``. The blueprint
+has the planner's tab (knowledge matrix, graphs, assignment, experiment log), then one
+tab per cell: the 3D scene (static geometry, tool path, search path) above the
 outcome log, next to force and torque (measured vs desired over ``sim_time``), the
 deviations of eqs. 6 and 7, and the force over the DMP phase (paper Fig. 17: switch
 the time panel to the ``dmp_phase`` timeline).
@@ -12,10 +15,37 @@ from collections.abc import Sequence
 
 import rerun.blueprint as rrb
 
+APPLICATION_ID = "assembly_constraints"
+PLANNER_ROOT = "planner"
+
+
+def cell_root(cell_id: str) -> str:
+    """Entity root of one cell's log: ``executor/<cell_id>``."""
+    return f"executor/{cell_id}"
+
+
+def planner_views() -> rrb.Container:
+    """The planner's tab: knowledge matrix, graphs, assignment, experiment log."""
+    return rrb.Horizontal(
+        rrb.Vertical(
+            rrb.TensorView(origin="planner/knowledge", name="knowledge (1 fit, 0 no fit, -1 unknown)"),
+            rrb.TextLogView(origin="planner/experiments", name="experiments"),
+        ),
+        rrb.Vertical(
+            rrb.GraphView(origin="planner/precedence", name="must precede"),
+            rrb.GraphView(origin="planner/smaller", name="smaller than"),
+        ),
+        rrb.Vertical(
+            rrb.GraphView(origin="planner/assignment", name="assignment"),
+            rrb.TextDocumentView(origin="planner/assignment", name="assignment table"),
+        ),
+        name="planner",
+    )
+
 
 def cell_views(cell_id: str) -> rrb.Container:
     """The views of one cell: 3D scene, force/torque plots, Fig. 17, outcome log."""
-    root = f"executor/{cell_id}"
+    root = cell_root(cell_id)
     return rrb.Horizontal(
         rrb.Vertical(
             rrb.Spatial3DView(
