@@ -21,11 +21,11 @@ from pathlib import Path
 import clingo
 
 from asp import PlannerError
-from bridge.assembly import Assembly, Hole, Part, load_assembly
 from asp.assign import LearnedFacts, load_learned_facts
 from asp.facts import fact, load_atoms, write_facts
 from asp.plans import plans, travel_facts
 from asp.relation import precedence_facts, true_relation
+from bridge.assembly import Assembly, Hole, Part, load_assembly
 
 
 def _learned(atoms: list[clingo.Symbol]) -> LearnedFacts:

@@ -15,10 +15,10 @@ from collections.abc import Callable
 
 import networkx as nx
 
-from bridge.assembly import load_assembly
 from asp.linear_extensions import exact_count
 from asp.precedence_eval import PAPER_M, evaluate
 from asp.relation import Relation, close, true_relation
+from bridge.assembly import load_assembly
 
 
 def median_seconds(work: Callable[[], object], repeat: int) -> float:

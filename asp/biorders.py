@@ -26,6 +26,7 @@ from functools import lru_cache
 
 import numpy as np
 
+
 def stirling2(n: int, k: int) -> int:
     """Stirling number of the second kind: partitions of n elements into k blocks."""
     return sum((-1) ** (k - j) * math.comb(k, j) * j**n for j in range(k + 1)) // math.factorial(k)

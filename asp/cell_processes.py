@@ -67,7 +67,7 @@ class CellProcess:
                 if remaining <= 0 or self._eof:
                     tail = "\n".join(self.lines[-20:])
                     why = (f"exited (code {self._exit_code()}) before printing"
-                           if self._eof else f"printed no")
+                           if self._eof else "printed no")
                     raise PlannerError(f"cell {self.cell_id}: {why} line '{prefix}...' "
                                        f"(waited up to {timeout:.0f} s); last output:\n{tail}")
                 self._new.wait(remaining)

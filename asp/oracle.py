@@ -16,8 +16,8 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from asp import PlannerError
-from bridge.assembly import load_assembly
 from asp.facts import atoms_by_name, load_atoms
+from bridge.assembly import load_assembly
 
 Result = Literal["fit", "no_fit"]
 

@@ -12,11 +12,11 @@ import json
 import clingo
 
 from asp import PlannerError
-from bridge.assembly import load_assembly
 from asp.assign import UnsolvableAssembly, load_learned_facts
 from asp.assign_cli import EXIT_UNSOLVABLE, facts_parser, report_unsolvable
 from asp.facts import write_facts
 from asp.plans import HOME, Plan, plans, travel_facts
+from bridge.assembly import load_assembly
 
 
 def _text(plan: Plan) -> str:

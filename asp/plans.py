@@ -21,9 +21,9 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from bridge.assembly import Assembly
 from asp.assign import LearnedFacts, feasible_assignment, solve_encoding
-from asp.facts import atoms_by_name, fact
+from asp.facts import fact
+from bridge.assembly import Assembly
 
 HOME: tuple[float, float] = (0.0, 0.0)
 """Default tool home [m]: the cell origin."""

@@ -13,12 +13,12 @@ import sys
 from itertools import islice
 
 from asp import PlannerError
-from bridge.assembly import load_assembly
 from asp.demos import Demonstrations, load_demos
 from asp.extension_batches import GENERATORS
 from asp.facts import write_facts
 from asp.linear_extensions import UniformSampler, count_linear_extensions, linear_extensions
 from asp.relation import Relation, load_relation, precedence_facts, reduction, true_relation
+from bridge.assembly import load_assembly
 
 
 def _parser() -> argparse.ArgumentParser:

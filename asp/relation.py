@@ -18,8 +18,8 @@ import clingo
 import numpy as np
 
 from asp import PlannerError
-from bridge.assembly import Assembly
 from asp.facts import atoms_by_name, fact, load_atoms
+from bridge.assembly import Assembly
 
 Pair = tuple[str, str]
 

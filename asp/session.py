@@ -29,11 +29,10 @@ import re
 import time
 import uuid
 from contextlib import ExitStack
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 from asp import PlannerError
-from bridge.assembly import Assembly, load_assembly
 from asp.assign import greedy_assignment, load_learned_facts
 from asp.cell_processes import CellProcess, serve_argv
 from asp.demos import demo_facts, load_demos
@@ -48,6 +47,7 @@ from asp.size_learner import SizeLearner, SizeLearningResult
 from asp.size_policies import policy_names
 from asp.zenoh_oracle import ZenohOracle
 from bridge import BridgeError
+from bridge.assembly import Assembly, load_assembly
 from bridge.client import CellDirectory, CellPool
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
@@ -91,7 +91,7 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict]:
         return args.resume, settings
     if args.confirm < 0:
         raise PlannerError(f"--confirm {args.confirm}: expected a number >= 0")
-    run = args.out or Path("runs") / datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+    run = args.out or Path("runs") / datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
     if (run / SETTINGS).exists():
         raise PlannerError(f"--out {run}: already holds a session; use --resume {run} or another folder")
     run.mkdir(parents=True, exist_ok=True)

@@ -25,7 +25,6 @@ from pathlib import Path
 
 import numpy as np
 import rerun as rr
-import rerun.blueprint as rrb
 
 from asp.size_knowledge import Knowledge
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views

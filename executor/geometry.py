@@ -23,7 +23,6 @@ from bridge.assembly import load_assembly
 from executor import ExecutorError
 
 
-
 @dataclass(frozen=True)
 class HoleSpec:
     """A hole: ``kind`` "round" (``size`` = diameter [m]) or "square" (side [m])."""

@@ -43,8 +43,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import rerun as rr
 
-from executor import ExecutorError
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, cell_root
+from executor import ExecutorError
 
 if TYPE_CHECKING:
     from executor.trial import AttemptEvidence

@@ -35,8 +35,17 @@ import zenoh
 
 from bridge import BridgeError
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
-from bridge.messages import (ErrorCode, ErrorReply, Evidence, InsertReply, InsertRequest,
-                             MessageError, Result, decode_request, encode)
+from bridge.messages import (
+    ErrorCode,
+    ErrorReply,
+    Evidence,
+    InsertReply,
+    InsertRequest,
+    MessageError,
+    Result,
+    decode_request,
+    encode,
+)
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
 from executor import ExecutorError
 from executor.geometry import load_geometry, passes

@@ -9,8 +9,8 @@ i.e. beating systematic somewhere forces losing elsewhere.
 from __future__ import annotations
 
 import numpy as np
-
 from _sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
+
 from asp.best_policy import choose_bit
 from asp.biorders import all_biorders
 from asp.oracle import TruthOracle

@@ -5,10 +5,19 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from bridge.keys import alive_key, cell_of_alive_key, insert_key
-from bridge.messages import (MAX_MESSAGE_BYTES, ErrorReply, Evidence, InsertReply,
-                             InsertRequest, MessageError, decode_reply, decode_request, encode)
 from bridge import BridgeError
+from bridge.keys import alive_key, cell_of_alive_key, insert_key
+from bridge.messages import (
+    MAX_MESSAGE_BYTES,
+    ErrorReply,
+    Evidence,
+    InsertReply,
+    InsertRequest,
+    MessageError,
+    decode_reply,
+    decode_request,
+    encode,
+)
 
 
 def test_request_and_replies_round_trip() -> None:

@@ -12,8 +12,8 @@ import pytest
 
 from executor import ExecutorError
 from executor.campaign import (
-    CampaignRun,
     FIG18_FITTING_PAIRS,
+    CampaignRun,
     campaign_pairs,
     campaign_report,
     format_table,

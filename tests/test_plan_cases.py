@@ -8,8 +8,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
 import clingo
+import pytest
 from clintest.assertion import Assertion, Equals, Or, True_
 from clintest.quantifier import All, Exact
 from clintest.solver import Clingo

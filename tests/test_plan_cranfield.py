@@ -16,12 +16,12 @@ from pathlib import Path
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 
-from bridge.assembly import Assembly, Hole, Part, load_assembly
 from asp.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.facts import load_atoms, write_facts
 from asp.plans import PlanStep, check_plan, plans, travel_facts
-from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
+from bridge.assembly import Assembly, Hole, Part, load_assembly
 
 ROOT = Path(__file__).resolve().parent.parent
 CRANFIELD = ROOT / "data" / "cranfield"

@@ -6,10 +6,10 @@ import json
 from pathlib import Path
 
 import pytest
-
 from _precedence_helpers import ROOT, run_cli
-from bridge.assembly import load_assembly
+
 from asp.relation import load_relation, true_relation
+from bridge.assembly import load_assembly
 
 
 def test_learn_json_facts_dot_png_and_count_of_the_facts(tmp_path: Path) -> None:

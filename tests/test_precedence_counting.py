@@ -8,16 +8,16 @@ from math import factorial
 
 import clingo
 import numpy as np
+from _precedence_helpers import closed_relation, posets
 from hypothesis import given, settings
 from scipy.stats import chisquare
 
-from _precedence_helpers import closed_relation, posets
-from bridge.assembly import load_assembly
 from asp.extension_batches import ExtensionBatches, positions_of
 from asp.facts import fact
 from asp.linear_extensions import UniformSampler, count_linear_extensions, exact_count, linear_extensions
 from asp.precedence import intersect_orders
 from asp.relation import Relation, encoding_path, true_relation
+from bridge.assembly import load_assembly
 
 
 def clingo_sequences(relation: Relation) -> set[tuple[str, ...]]:

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from _precedence_helpers import run_cli
+
 from asp import PlannerError
 from asp.demos import demo_facts, load_demos, parse_demos
 from asp.facts import write_facts

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+from _precedence_helpers import posets
 from hypothesis import given, settings
 
-from _precedence_helpers import posets
-from bridge.assembly import load_assembly
 from asp.guidance import Guide, evaluate_guided, suggest, teacher_order
 from asp.precedence_eval import PAPER_M, evaluate
 from asp.relation import Relation, true_relation
+from bridge.assembly import load_assembly
 
 
 def test_evaluation_reproduces_the_paper_within_sampling_error() -> None:

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+from _precedence_helpers import poset_with_demos
 from hypothesis import given, settings
 
-from _precedence_helpers import poset_with_demos
-from bridge.assembly import load_assembly
 from asp.demos import Demonstrations, load_demos, parse_demos
 from asp.linear_extensions import count_linear_extensions, linear_extensions
 from asp.precedence import learn_must_precede, pair_evidence, suspects
 from asp.relation import Relation, reduction, true_relation
+from bridge.assembly import load_assembly
 
 
 def test_battery_fig3_gives_fig4_and_the_five_listed_sequences() -> None:

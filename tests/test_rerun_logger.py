@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from bridge import BridgeError
-from executor import ExecutorError
 from bridge.recordings import blueprint_origins, column_values, format_summary, read_recording
+from executor import ExecutorError
 from executor.rerun_log import PHASE_SCALE, AttemptLogger
 
 

@@ -6,8 +6,8 @@ import random
 
 import numpy as np
 import pytest
-
 from _sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
+
 from asp.biorders import all_biorders
 from asp.dominance import (
     Relaxation,
