@@ -1,0 +1,53 @@
+"""Argument types both command lines share (argparse ``type=`` callables).
+
+A malformed value raises :class:`argparse.ArgumentTypeError`, which argparse turns into
+``error: argument --x: ...`` and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+from typing import TypeVar
+
+T = TypeVar("T")
+
+
+def comma_list(item: Callable[[str], T], what: str = "values") -> Callable[[str], list[T]]:
+    """An argparse type: ``"a,b,c"`` → ``[item("a"), item("b"), item("c")]``.
+
+    Empty items, and items ``item`` rejects (ValueError or ArgumentTypeError), are an
+    error naming the whole text and ``what`` was expected.
+    """
+
+    def parse(text: str) -> list[T]:
+        parts = [part.strip() for part in text.split(",")]
+        try:
+            if not all(parts):
+                raise ValueError(text)
+            return [item(part) for part in parts]
+        except (ValueError, argparse.ArgumentTypeError):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated {what}") from None
+
+    return parse
+
+
+def number_in(kind: Callable[[str], float], low: float, high: float) -> Callable[[str], float]:
+    """An item type: a finite number of ``kind`` in [low, high) (ValueError otherwise)."""
+
+    def parse(text: str) -> float:
+        value = kind(text)
+        if not (math.isfinite(value) and low <= value < high):
+            raise ValueError(text)
+        return value
+
+    return parse
+
+
+def part_hole_pair(text: str) -> tuple[str, str]:
+    """An item type: ``"p1:r1"`` → ``("p1", "r1")`` (ValueError otherwise)."""
+    part, sep, hole = text.partition(":")
+    if not (sep and part and hole) or ":" in hole:
+        raise ValueError(text)
+    return part, hole
