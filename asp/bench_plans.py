@@ -24,7 +24,7 @@ from asp import PlannerError
 from asp.assign import LearnedFacts, load_learned_facts
 from asp.facts import fact, load_atoms, write_facts
 from asp.plans import plans, travel_facts
-from asp.relation import precedence_facts, true_relation
+from asp.precedence.relation import precedence_facts, true_relation
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 
 

@@ -15,9 +15,9 @@ from collections.abc import Callable
 
 import networkx as nx
 
-from asp.linear_extensions import exact_count
-from asp.precedence_eval import PAPER_M, evaluate
-from asp.relation import Relation, close, true_relation
+from asp.precedence.count import exact_count
+from asp.precedence.evaluate import PAPER_M, evaluate
+from asp.precedence.relation import Relation, close, true_relation
 from bridge.assembly import load_assembly
 
 
@@ -65,7 +65,7 @@ def main(argv: list[str]) -> int:
         seconds = median_seconds(lambda: exact_count(relation.matrix), args.repeat)
         print(f"count {parts} parts (3 chains of 5 + {parts - 15} free): {exact_count(relation.matrix)} in {1e3 * seconds:.3f} ms (required < 1 s)")
 
-    from asp.guidance import evaluate_guided
+    from asp.precedence.guide import evaluate_guided
 
     start = time.perf_counter()
     guided = evaluate_guided(truth, args.guided_trials, seed=1)

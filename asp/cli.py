@@ -11,7 +11,7 @@ import importlib
 import sys
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "precedence": ("asp.precedence_cli", "learn/count/sample/evaluate/suggest precedence"),
+    "precedence": ("asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
     "sizes": ("asp.sizes_cli", "learn/evaluate which part fits which hole"),
     "assign": ("asp.assign_cli", "hole assignments from learned facts"),
     "plan": ("asp.plan_cli", "complete assembly plans from learned facts"),

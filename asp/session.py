@@ -35,13 +35,13 @@ from pathlib import Path
 from asp import PlannerError
 from asp.assign import greedy_assignment, load_learned_facts
 from asp.cell_processes import CellProcess, serve_argv
-from asp.demos import demo_facts, load_demos
 from asp.facts import fact, write_facts
 from asp.journal import Journal
 from asp.oracle import TruthOracle
 from asp.plans import Plan, check_plan, plans
-from asp.precedence import learn_must_precede
-from asp.relation import Relation, precedence_facts, reduction, true_relation
+from asp.precedence.demos import demo_facts, load_demos
+from asp.precedence.learn import learn_must_precede
+from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
 from asp.session_rerun import PlannerLog
 from asp.size_learner import SizeLearner, SizeLearningResult
 from asp.size_policies import policy_names

@@ -35,7 +35,7 @@ import clingo
 from asp import PlannerError
 from asp.facts import fact, format_facts
 from asp.oracle import Oracle
-from asp.relation import encoding_path
+from asp.precedence.relation import encoding_path
 from asp.size_knowledge import RESULTS, Knowledge, Pair
 from asp.size_policies import SelectionPolicy, get_policy
 

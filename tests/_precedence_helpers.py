@@ -11,7 +11,7 @@ import networkx as nx
 import numpy as np
 from hypothesis import strategies as st
 
-from asp.relation import Relation
+from asp.precedence.relation import Relation
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from _precedence_helpers import ROOT, run_cli
 
-from asp.relation import load_relation, true_relation
+from asp.precedence.relation import load_relation, true_relation
 from bridge.assembly import load_assembly
 
 

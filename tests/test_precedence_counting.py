@@ -12,11 +12,11 @@ from _precedence_helpers import closed_relation, posets
 from hypothesis import given, settings
 from scipy.stats import chisquare
 
-from asp.extension_batches import ExtensionBatches, positions_of
 from asp.facts import fact
-from asp.linear_extensions import UniformSampler, count_linear_extensions, exact_count, linear_extensions
-from asp.precedence import intersect_orders
-from asp.relation import Relation, encoding_path, true_relation
+from asp.precedence.batches import ExtensionBatches, positions_of
+from asp.precedence.count import UniformSampler, count_linear_extensions, exact_count, linear_extensions
+from asp.precedence.learn import intersect_orders
+from asp.precedence.relation import Relation, encoding_path, true_relation
 from bridge.assembly import load_assembly
 
 

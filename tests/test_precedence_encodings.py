@@ -7,7 +7,7 @@ from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
 
-from asp.relation import encoding_path
+from asp.precedence.relation import encoding_path
 
 
 def _solve(encoding: str, facts: str, test) -> None:

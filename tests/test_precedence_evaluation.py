@@ -6,9 +6,9 @@ import numpy as np
 from _precedence_helpers import posets
 from hypothesis import given, settings
 
-from asp.guidance import Guide, evaluate_guided, suggest, teacher_order
-from asp.precedence_eval import PAPER_M, evaluate
-from asp.relation import Relation, true_relation
+from asp.precedence.evaluate import PAPER_M, evaluate
+from asp.precedence.guide import Guide, evaluate_guided, suggest, teacher_order
+from asp.precedence.relation import Relation, true_relation
 from bridge.assembly import load_assembly
 
 

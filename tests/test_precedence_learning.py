@@ -6,10 +6,10 @@ import numpy as np
 from _precedence_helpers import poset_with_demos
 from hypothesis import given, settings
 
-from asp.demos import Demonstrations, load_demos, parse_demos
-from asp.linear_extensions import count_linear_extensions, linear_extensions
-from asp.precedence import learn_must_precede, pair_evidence, suspects
-from asp.relation import Relation, reduction, true_relation
+from asp.precedence.count import count_linear_extensions, linear_extensions
+from asp.precedence.demos import Demonstrations, load_demos, parse_demos
+from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
+from asp.precedence.relation import Relation, reduction, true_relation
 from bridge.assembly import load_assembly
 
 
@@ -90,7 +90,7 @@ def test_learned_relation_facts_are_queryable_by_plain_clingo(tmp_path) -> None:
     import sys
 
     from asp.facts import write_facts
-    from asp.relation import encoding_path, precedence_facts
+    from asp.precedence.relation import encoding_path, precedence_facts
 
     learned = learn_must_precede(parse_demos("o r2 i2 r1 i1\no r1 r2 i1 i2\n", "d.txt"))
     path = tmp_path / "learned.lp"

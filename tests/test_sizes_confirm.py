@@ -16,7 +16,7 @@ from asp import PlannerError
 from asp.bench_sizes import main as bench_main
 from asp.facts import fact, format_facts
 from asp.oracle import TruthOracle
-from asp.relation import encoding_path
+from asp.precedence.relation import encoding_path
 from asp.size_knowledge import Pair
 from asp.size_learner import SizeLearner, learn_sizes, run_learner
 from asp.size_policies import policy_names

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from asp.facts import fact, format_facts
-from asp.relation import encoding_path
+from asp.precedence.relation import encoding_path
 
 TWO_BY_TWO = "part(a;b). hole(x;y). part_index(a,1). part_index(b,2). hole_index(x,1). hole_index(y,2). "
 

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from asp.facts import fact, format_facts
 from asp.oracle import TruthOracle
-from asp.relation import encoding_path
+from asp.precedence.relation import encoding_path
 from asp.size_knowledge import Knowledge, Pair
 from asp.size_learner import SizeLearner
 from tests._sizes_helpers import biorders

@@ -24,9 +24,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from asp.extension_batches import ExtensionBatches, positions_of
-from asp.poset_decomposition import predecessor_masks, transitive_closure
-from asp.relation import Relation
+from asp.precedence.batches import ExtensionBatches, positions_of
+from asp.precedence.decompose import predecessor_masks, transitive_closure
+from asp.precedence.relation import Relation
 
 
 def teacher_order(suggestion: Sequence[int], truth: Relation) -> list[int]:

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from asp import PlannerError
-from asp.demos import Demonstrations
-from asp.relation import Pair, Relation, close
+from asp.precedence.demos import Demonstrations
+from asp.precedence.relation import Pair, Relation, close
 
 
 def positions(sequences: Sequence[Sequence[str]], parts: Sequence[str]) -> np.ndarray:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import networkx as nx
 
-from asp.relation import Pair, Relation
+from asp.precedence.relation import Pair, Relation
 
 
 def _graph(relation: Relation, reduction: list[Pair]) -> nx.DiGraph:

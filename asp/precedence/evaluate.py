@@ -6,7 +6,7 @@ sequences M it admits. Reported per m: the mean of M, P(M = all), P(M > all/2) a
 the distribution of M in bins of 200 sequences (key: the bin's lower bound; the key
 ``"all"`` holds M = all, the paper's last column). Probabilities are fractions of
 the trials. Sampling and counting are batched over trials
-(:class:`asp.extension_batches.ExtensionBatches`).
+(:class:`asp.precedence.batches.ExtensionBatches`).
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from asp import PlannerError
-from asp.extension_batches import GENERATORS, ExtensionBatches, positions_of
-from asp.precedence import intersect_orders
-from asp.relation import Relation
+from asp.precedence.batches import GENERATORS, ExtensionBatches, positions_of
+from asp.precedence.learn import intersect_orders
+from asp.precedence.relation import Relation
 
 BIN = 200  # width of a histogram bin [sequences], as in the paper
 PAPER_M = (5, 7, 10, 15, 20, 30)

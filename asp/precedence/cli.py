@@ -13,11 +13,11 @@ import sys
 from itertools import islice
 
 from asp import PlannerError
-from asp.demos import Demonstrations, load_demos
-from asp.extension_batches import GENERATORS
 from asp.facts import write_facts
-from asp.linear_extensions import UniformSampler, count_linear_extensions, linear_extensions
-from asp.relation import Relation, load_relation, precedence_facts, reduction, true_relation
+from asp.precedence.batches import GENERATORS
+from asp.precedence.count import UniformSampler, count_linear_extensions, linear_extensions
+from asp.precedence.demos import Demonstrations, load_demos
+from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from bridge.assembly import load_assembly
 
 
@@ -86,8 +86,8 @@ def _print_json(data: object) -> None:
 
 
 def _learn(args: argparse.Namespace) -> None:
-    from asp.precedence import learn_must_precede, pair_evidence, suspects
-    from asp.precedence_graph import draw_png, to_dot
+    from asp.precedence.draw import draw_png, to_dot
+    from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
 
     demos = _demonstrations(args)
     relation = learn_must_precede(demos, args.min_support)
@@ -125,7 +125,7 @@ def _evaluate(args: argparse.Namespace) -> None:
     progress = sys.stderr.isatty()
     truth = true_relation(load_assembly(args.assembly))
     if args.guided:
-        from asp.guidance import evaluate_guided
+        from asp.precedence.guide import evaluate_guided
 
         if args.generator != "uniform":
             raise PlannerError("--generator applies to the evaluation over m, not to --guided (its random baseline is uniform)")
@@ -135,7 +135,7 @@ def _evaluate(args: argparse.Namespace) -> None:
             print(f"{args.trials} trials: guided mean {result['mean']:.2f} demonstrations to the exact relation, random {result['random_mean']:.2f}")
             print("histogram (demonstrations: trials):", result["demos_to_exact"])
     else:
-        from asp.precedence_eval import evaluate, plot
+        from asp.precedence.evaluate import evaluate, plot
 
         try:
             ms = [int(m) for m in args.m.split(",")]
@@ -153,7 +153,7 @@ def _evaluate(args: argparse.Namespace) -> None:
 
 
 def _suggest(args: argparse.Namespace) -> None:
-    from asp.guidance import suggest
+    from asp.precedence.guide import suggest
 
     parts = load_assembly(args.assembly).part_ids if args.assembly else None
     if args.demos is None and parts is None:

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from asp import PlannerError
-from asp.linear_extensions import DownSets, down_sets
-from asp.poset_decomposition import predecessor_masks
-from asp.relation import Relation
+from asp.precedence.count import DownSets, down_sets
+from asp.precedence.decompose import predecessor_masks
+from asp.precedence.relation import Relation
 
 _INT64_LIMIT = 2**62
 
