@@ -25,10 +25,10 @@ import time
 
 import numpy as np
 
-from asp.oracle import TruthOracle
-from asp.size_learner import SizeLearner
-from asp.size_policies import get_policy
-from asp.sizes_evaluate import evaluate_policy
+from asp.sizes.evaluate import evaluate_policy
+from asp.sizes.learner import SizeLearner
+from asp.sizes.oracle import TruthOracle
+from asp.sizes.policies import get_policy
 
 CRANFIELD = "cranfield"
 

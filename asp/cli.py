@@ -12,7 +12,7 @@ import sys
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "precedence": ("asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
-    "sizes": ("asp.sizes_cli", "learn/evaluate which part fits which hole"),
+    "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
     "assign": ("asp.assign_cli", "hole assignments from learned facts"),
     "plan": ("asp.plan_cli", "complete assembly plans from learned facts"),
     "session": ("asp.session", "the end-to-end learning session (planner + cells)"),

@@ -47,9 +47,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from asp.biorders import all_biorders, mask_bits
-from asp.oracle import TruthOracle
-from asp.sizes_evaluate import relabeled_matrices
+from asp.sizes.biorders import all_biorders, mask_bits
+from asp.sizes.evaluate import relabeled_matrices
+from asp.sizes.oracle import TruthOracle
 
 INFEASIBLE = 1 << 40
 """Value of a state from which no policy meets every deadline."""

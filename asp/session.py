@@ -37,14 +37,14 @@ from asp.assign import greedy_assignment, load_learned_facts
 from asp.cell_processes import CellProcess, serve_argv
 from asp.facts import fact, write_facts
 from asp.journal import Journal
-from asp.oracle import TruthOracle
 from asp.plans import Plan, check_plan, plans
 from asp.precedence.demos import demo_facts, load_demos
 from asp.precedence.learn import learn_must_precede
 from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
 from asp.session_rerun import PlannerLog
-from asp.size_learner import SizeLearner, SizeLearningResult
-from asp.size_policies import policy_names
+from asp.sizes.learner import SizeLearner, SizeLearningResult
+from asp.sizes.oracle import TruthOracle
+from asp.sizes.policies import policy_names
 from asp.zenoh_oracle import ZenohOracle
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 
-from asp.size_knowledge import Knowledge
+from asp.sizes.knowledge import Knowledge
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
 
 _PART_COLOR = [70, 130, 220]

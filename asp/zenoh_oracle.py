@@ -1,6 +1,6 @@
 """The size learner's oracle over Zenoh: experiments run on every alive cell at once.
 
-:class:`ZenohOracle` satisfies :class:`asp.oracle.Oracle` (``ask(part, hole)``) and adds
+:class:`ZenohOracle` satisfies :class:`asp.sizes.oracle.Oracle` (``ask(part, hole)``) and adds
 a pipelined interface: :meth:`~ZenohOracle.submit` an experiment, get finished ones
 with :meth:`~ZenohOracle.next_result`. The session submits only experiments that the
 size learner put in one batch with everything still running (none of their outcomes
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 from asp import PlannerError
 from asp.journal import Journal, JournalEntry
-from asp.oracle import Result
+from asp.sizes.oracle import Result
 from bridge import BridgeError
 from bridge.client import CellDirectory, CellPool
 from bridge.messages import InsertRequest

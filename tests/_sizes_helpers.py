@@ -8,9 +8,9 @@ from collections.abc import Callable
 import numpy as np
 from hypothesis import strategies as st
 
-from asp.biorders import all_biorders
-from asp.oracle import TruthOracle
-from asp.size_knowledge import Knowledge
+from asp.sizes.biorders import all_biorders
+from asp.sizes.knowledge import Knowledge
+from asp.sizes.oracle import TruthOracle
 
 
 @st.composite

@@ -1,4 +1,4 @@
-"""Biorder enumeration, weights and sampling behind the ``best`` policy (asp/biorders.py)."""
+"""Biorder enumeration, weights and sampling behind the ``best`` policy (asp/sizes/biorders.py)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.best_policy import smaller_matrix
-from asp.biorders import (
+from asp.sizes.best import smaller_matrix
+from asp.sizes.biorders import (
     all_biorder_orders,
     all_biorders,
     biorder_count,
@@ -21,7 +21,7 @@ from asp.biorders import (
     sample_biorders,
     weighted_bit_sums,
 )
-from asp.size_learner import SizeLearner
+from asp.sizes.learner import SizeLearner
 
 
 def is_ferrers(fits: np.ndarray) -> bool:

@@ -6,10 +6,10 @@ import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from asp.best_policy import choose, choose_bit, choose_by_asp, knowledge_masks, possible_relations_asp
-from asp.biorders import all_biorders, consistent_index
-from asp.size_learner import SizeLearner
-from asp.size_policies import get_policy
+from asp.sizes.best import choose, choose_bit, choose_by_asp, knowledge_masks, possible_relations_asp
+from asp.sizes.biorders import all_biorders, consistent_index
+from asp.sizes.learner import SizeLearner
+from asp.sizes.policies import get_policy
 from tests.test_best_biorders import biorder_truths, closure_after
 
 

@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 from _sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
 
-from asp.best_policy import choose_bit
-from asp.biorders import all_biorders
-from asp.oracle import TruthOracle
-from asp.size_learner import learn_sizes
-from asp.sizes_evaluate import relabeled_matrices
+from asp.sizes.best import choose_bit
+from asp.sizes.biorders import all_biorders
+from asp.sizes.evaluate import relabeled_matrices
+from asp.sizes.learner import learn_sizes
+from asp.sizes.oracle import TruthOracle
 
 
 def test_best_needs_fewer_experiments_than_systematic_over_all_small_biorders() -> None:

@@ -16,11 +16,11 @@ import random
 
 import pytest
 
-from asp.best_policy import knowledge_masks
-from asp.biorders import all_biorders, consistent_index
-from asp.oracle import TruthOracle
-from asp.size_knowledge import Knowledge, Pair
-from asp.size_learner import SizeLearner
+from asp.sizes.best import knowledge_masks
+from asp.sizes.biorders import all_biorders, consistent_index
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.learner import SizeLearner
+from asp.sizes.oracle import TruthOracle
 from tests.test_session_cells import run_session
 
 TRUTH = TruthOracle.from_assembly("cranfield")

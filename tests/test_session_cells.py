@@ -23,7 +23,7 @@ import pytest
 from asp.cell_processes import CellProcess, start_cell
 from asp.facts import atoms_by_name, load_atoms
 from asp.journal import read_journal
-from asp.oracle import TruthOracle
+from asp.sizes.oracle import TruthOracle
 from bridge.session import free_loopback_endpoint
 
 pytestmark = pytest.mark.timeout(90)

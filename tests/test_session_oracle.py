@@ -9,8 +9,8 @@ import pytest
 from asp import PlannerError
 from asp.cell_processes import start_cell
 from asp.journal import Journal, read_journal
-from asp.oracle import TruthOracle
-from asp.size_learner import learn_sizes
+from asp.sizes.learner import learn_sizes
+from asp.sizes.oracle import TruthOracle
 from asp.zenoh_oracle import ZenohOracle
 from bridge.client import CellDirectory, CellPool
 from bridge.session import free_loopback_endpoint, open_session

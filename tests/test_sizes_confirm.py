@@ -15,11 +15,11 @@ from hypothesis import strategies as st
 from asp import PlannerError
 from asp.bench_sizes import main as bench_main
 from asp.facts import fact, format_facts
-from asp.oracle import TruthOracle
 from asp.precedence.relation import encoding_path
-from asp.size_knowledge import Pair
-from asp.size_learner import SizeLearner, learn_sizes, run_learner
-from asp.size_policies import policy_names
+from asp.sizes.knowledge import Pair
+from asp.sizes.learner import SizeLearner, learn_sizes, run_learner
+from asp.sizes.oracle import TruthOracle
+from asp.sizes.policies import policy_names
 from tests._sizes_helpers import biorders
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from _sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
 
-from asp.biorders import all_biorders
 from asp.dominance import (
     Relaxation,
     Search,
@@ -18,6 +17,7 @@ from asp.dominance import (
     reductions,
     systematic_counts,
 )
+from asp.sizes.biorders import all_biorders
 
 
 @pytest.mark.parametrize("m, n", [(2, 3), (3, 3), (2, 4), (4, 2)])

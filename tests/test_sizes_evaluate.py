@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from collections import Counter
 
-from asp.oracle import TruthOracle
-from asp.size_learner import learn_sizes
-from asp.sizes_evaluate import evaluate_policy, relabeled_matrices
+from asp.sizes.evaluate import evaluate_policy, relabeled_matrices
+from asp.sizes.learner import learn_sizes
+from asp.sizes.oracle import TruthOracle
 
 CRANFIELD = TruthOracle.from_assembly("cranfield")
 

@@ -7,10 +7,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from asp.facts import fact, format_facts
-from asp.oracle import TruthOracle
 from asp.precedence.relation import encoding_path
-from asp.size_knowledge import Knowledge, Pair
-from asp.size_learner import SizeLearner
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.learner import SizeLearner
+from asp.sizes.oracle import TruthOracle
 from tests._sizes_helpers import biorders
 
 

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import assume, given, settings
 
 from asp import PlannerError
-from asp.oracle import TruthOracle
-from asp.size_learner import SizeLearner, learn_sizes
+from asp.sizes.learner import SizeLearner, learn_sizes
+from asp.sizes.oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
 
 

@@ -13,7 +13,7 @@ Non-deterministic policies (``random``) run every case, case i with seed
 ``seed * 1_000_003 + i``. With ``noise`` every case is a session of its own too, its
 answers flipped by a :class:`NoisyOracle` of the case's seed; the cases that end with
 a wrong relation are counted. ``confirm`` is the learner's
-(see :class:`asp.size_learner.SizeLearner`). Work is spread over the machine's cores.
+(see :class:`asp.sizes.learner.SizeLearner`). Work is spread over the machine's cores.
 """
 
 from __future__ import annotations
@@ -28,9 +28,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from asp import PlannerError
-from asp.oracle import NoisyOracle, TruthOracle
-from asp.size_learner import SizeLearner, run_learner
-from asp.size_policies import get_policy
+from asp.sizes.learner import SizeLearner, run_learner
+from asp.sizes.oracle import NoisyOracle, TruthOracle
+from asp.sizes.policies import get_policy
 
 Matrix = tuple[tuple[bool, ...], ...]
 """Truth in index order: ``matrix[i][j]`` is True when part i+1 fits hole j+1."""

@@ -34,10 +34,10 @@ import clingo
 
 from asp import PlannerError
 from asp.facts import fact, format_facts
-from asp.oracle import Oracle
 from asp.precedence.relation import encoding_path
-from asp.size_knowledge import RESULTS, Knowledge, Pair
-from asp.size_policies import SelectionPolicy, get_policy
+from asp.sizes.knowledge import RESULTS, Knowledge, Pair
+from asp.sizes.oracle import Oracle
+from asp.sizes.policies import SelectionPolicy, get_policy
 
 _OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit)."
 

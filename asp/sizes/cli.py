@@ -15,11 +15,11 @@ import sys
 
 from asp import PlannerError
 from asp.facts import write_facts
-from asp.oracle import NoisyOracle, Oracle, TruthOracle
-from asp.size_knowledge import Knowledge
-from asp.size_learner import Experiment, learn_sizes
-from asp.size_policies import get_policy, policy_names
-from asp.sizes_evaluate import evaluate_policy, plot_comparison
+from asp.sizes.evaluate import evaluate_policy, plot_comparison
+from asp.sizes.knowledge import Knowledge
+from asp.sizes.learner import Experiment, learn_sizes
+from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
+from asp.sizes.policies import get_policy, policy_names
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:

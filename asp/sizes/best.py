@@ -41,7 +41,8 @@ import clingo
 import numpy as np
 
 from asp import PlannerError
-from asp.biorders import (
+from asp.facts import fact, format_facts
+from asp.sizes.biorders import (
     all_biorder_orders,
     all_biorders,
     biorder_count,
@@ -50,9 +51,8 @@ from asp.biorders import (
     sample_biorders,
     weighted_bit_sums,
 )
-from asp.facts import fact, format_facts
-from asp.size_knowledge import Knowledge, Pair
-from asp.size_policies import SelectionPolicy
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.policies import SelectionPolicy
 
 ALPHA = 0.5
 """Exponent of the prior weight ∏ k! of a relation (see the module docstring)."""

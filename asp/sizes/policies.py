@@ -8,7 +8,7 @@ A policy tells the learner which unknown part-hole pair to try next. It is eithe
   order) and whatever ``session_facts`` adds, and shows exactly one ``select(P,H)``
   while some pair is unknown (in the last model, if it optimises); or
 - a Python callable ``choose(knowledge, rng) -> (part, hole)`` over the current
-  :class:`asp.size_knowledge.Knowledge` (it must return an unknown pair).
+  :class:`asp.sizes.knowledge.Knowledge` (it must return an unknown pair).
 
 Registry entries are :class:`SelectionPolicy` objects or ``"module:attribute"`` strings
 naming one, imported on first use (so ``best`` lives in its own module).
@@ -25,7 +25,7 @@ import clingo
 
 from asp import PlannerError
 from asp.facts import fact
-from asp.size_knowledge import Knowledge, Pair
+from asp.sizes.knowledge import Knowledge, Pair
 
 Chooser = Callable[[Knowledge, random.Random], Pair]
 BatchRank = Callable[[Knowledge, Sequence[Pair]], list[Pair]]
@@ -88,7 +88,7 @@ POLICIES: dict[str, SelectionPolicy | str] = {
         "the paper's template count with its tie-breaks (paper 2.2)",
         encoding="select_heuristic.lp",
     ),
-    "best": "asp.best_policy:POLICY",
+    "best": "asp.sizes.best:POLICY",
 }
 
 
