@@ -1,7 +1,8 @@
 """The planner's command line: ``./run.sh <subcommand> ...``.
 
-Each subcommand lives in its own module exposing ``main(argv) -> int``; they are
-imported lazily so that ``--help`` of one does not pay for the others. A
+Each subcommand is a function ``main(argv) -> int`` of a module (``module:function``
+names another function); modules are imported lazily so that ``--help`` of one does not
+pay for the others. A
 :class:`asp.PlannerError` (bad input) is printed as ``error: ...`` with exit code 2.
 """
 
@@ -13,8 +14,8 @@ import sys
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "precedence": ("asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
     "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
-    "assign": ("asp.assign_cli", "hole assignments from learned facts"),
-    "plan": ("asp.plan_cli", "complete assembly plans from learned facts"),
+    "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
+    "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
     "session": ("asp.session", "the end-to-end learning session (planner + cells)"),
     "view": ("asp.view", "open a session's Rerun recording"),
     "bench": ("asp.bench", "benchmarks: precedence | sizes | plan | executor | session"),
@@ -49,8 +50,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: unknown subcommand '{name}'; expected one of: "
               f"{', '.join([*SUBCOMMANDS, 'executor', 'test'])}", file=sys.stderr)
         return 2
-    module = importlib.import_module(SUBCOMMANDS[name][0])
-    return run_guarded(module.main, rest)
+    module_name, _, function = SUBCOMMANDS[name][0].partition(":")
+    module = importlib.import_module(module_name)
+    return run_guarded(getattr(module, function or "main"), rest)
 
 
 if __name__ == "__main__":

@@ -33,11 +33,11 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from asp import PlannerError
-from asp.assign import greedy_assignment, load_learned_facts
+from asp.plans.assign import greedy_assignment, load_learned_facts
 from asp.cell_processes import CellProcess, serve_argv
 from asp.facts import fact, write_facts
 from asp.journal import Journal
-from asp.plans import Plan, check_plan, plans
+from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import demo_facts, load_demos
 from asp.precedence.learn import learn_must_precede
 from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation

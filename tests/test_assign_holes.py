@@ -19,7 +19,7 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.assign import (
+from asp.plans.assign import (
     LearnedFacts,
     UnsolvableAssembly,
     all_assignments,
@@ -28,7 +28,7 @@ from asp.assign import (
     load_learned_facts,
 )
 from asp.facts import fact, write_facts
-from asp.plans import check_assignment
+from asp.plans.plans import check_assignment
 
 ROOT = Path(__file__).resolve().parent.parent
 ASSIGNMENTS_LP = str(ROOT / "asp" / "encodings" / "assignments.lp")

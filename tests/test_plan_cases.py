@@ -17,9 +17,9 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.assign import LearnedFacts, UnsolvableAssembly, load_learned_facts
+from asp.plans.assign import LearnedFacts, UnsolvableAssembly, load_learned_facts
 from asp.facts import fact, write_facts
-from asp.plans import PlanStep, check_plan, plans
+from asp.plans.plans import PlanStep, check_plan, plans
 
 ENCODINGS = Path(__file__).resolve().parent.parent / "asp" / "encodings"
 

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from asp.assign import LearnedFacts, feasible_assignment, solve_encoding
 from asp.facts import fact
+from asp.plans.assign import LearnedFacts, feasible_assignment, solve_encoding
 from bridge.assembly import Assembly
 
 HOME: tuple[float, float] = (0.0, 0.0)
