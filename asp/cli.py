@@ -16,9 +16,9 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
     "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
     "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
-    "session": ("asp.session", "the end-to-end learning session (planner + cells)"),
-    "view": ("asp.view", "open a session's Rerun recording"),
-    "bench": ("asp.bench", "benchmarks: precedence | sizes | plan | executor | session"),
+    "session": ("asp.session.run", "the end-to-end learning session (planner + cells)"),
+    "view": ("asp.session.view", "open a session's Rerun recording"),
+    "bench": ("asp.bench.cli", "benchmarks: precedence | sizes | plan | executor | session"),
 }
 
 

@@ -19,6 +19,7 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from asp.facts import fact, write_facts
 from asp.plans.assign import (
     LearnedFacts,
     UnsolvableAssembly,
@@ -27,7 +28,6 @@ from asp.plans.assign import (
     greedy_assignment,
     load_learned_facts,
 )
-from asp.facts import fact, write_facts
 from asp.plans.plans import check_assignment
 
 ROOT = Path(__file__).resolve().parent.parent

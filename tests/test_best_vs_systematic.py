@@ -1,7 +1,7 @@
 """The ``best`` policy against ``systematic``: exhaustively on small instances, on Cranfield.
 
 Why no per-instance guarantee: exhaustive searches (``tests/test_sizes_dominance.py``,
-``asp/dominance.py``) show that on all m×n biorders of small sizes every policy never
+``asp/bench/dominance.py``) show that on all m×n biorders of small sizes every policy never
 worse than ``systematic`` on any instance needs exactly as many experiments in total,
 i.e. beating systematic somewhere forces losing elsewhere.
 """

@@ -10,7 +10,7 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from asp.cell_processes import CellProcess, start_cell
+from asp.session.cells import CellProcess, start_cell
 from bridge.client import CellDirectory, CellPool, CellRefused, request_insert
 from bridge.messages import ErrorReply, InsertReply, InsertRequest, decode_reply
 from bridge.session import free_loopback_endpoint, open_session

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from asp.cell_processes import start_cell
+from asp.session.cells import start_cell
 from bridge.client import CellDirectory, request_insert
 from bridge.messages import InsertRequest
 from bridge.session import free_loopback_endpoint, open_session

@@ -18,8 +18,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 
-from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.facts import load_atoms, write_facts
+from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 

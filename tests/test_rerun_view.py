@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from rerun.chunk import RrdReader
 
-from asp.view import cell_ids, write_blueprint
+from asp.session.view import cell_ids, write_blueprint
 from bridge.recordings import blueprint_origins
 from executor.rerun_log import AttemptLogger
 

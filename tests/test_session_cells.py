@@ -20,9 +20,9 @@ from pathlib import Path
 
 import pytest
 
-from asp.cell_processes import CellProcess, start_cell
 from asp.facts import atoms_by_name, load_atoms
-from asp.journal import read_journal
+from asp.session.cells import CellProcess, start_cell
+from asp.session.journal import read_journal
 from asp.sizes.oracle import TruthOracle
 from bridge.session import free_loopback_endpoint
 

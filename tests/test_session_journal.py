@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from asp import PlannerError
-from asp.journal import Journal, JournalEntry, read_journal
+from asp.session.journal import Journal, JournalEntry, read_journal
 
 
 def entry(k: int, retest: bool = False) -> JournalEntry:

@@ -7,11 +7,11 @@ from pathlib import Path
 import pytest
 
 from asp import PlannerError
-from asp.cell_processes import start_cell
-from asp.journal import Journal, read_journal
+from asp.session.cells import start_cell
+from asp.session.journal import Journal, read_journal
+from asp.session.oracle import ZenohOracle
 from asp.sizes.learner import learn_sizes
 from asp.sizes.oracle import TruthOracle
-from asp.zenoh_oracle import ZenohOracle
 from bridge.client import CellDirectory, CellPool
 from bridge.session import free_loopback_endpoint, open_session
 

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from asp import PlannerError
-from asp.bench_sizes import main as bench_main
+from asp.bench.sizes import main as bench_main
 from asp.facts import fact, format_facts
 from asp.precedence.relation import encoding_path
 from asp.sizes.knowledge import Pair

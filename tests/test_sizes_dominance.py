@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from _sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
 
-from asp.dominance import (
+from asp.bench.dominance import (
     Relaxation,
     Search,
     add_answer,

@@ -1,7 +1,7 @@
 """``./run.sh bench TOPIC``: benchmarks print their figures (medians, ratios).
 
 Each topic lives in its own module exposing ``main(argv) -> int``; ``bench executor``
-is routed by run.sh to ``executor.bench``.
+is routed by run.sh to the cell's benchmark.
 """
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ from __future__ import annotations
 import importlib
 
 TOPICS: dict[str, str] = {
-    "precedence": "asp.bench_precedence",
-    "sizes": "asp.bench_sizes",
-    "plan": "asp.bench_plans",
-    "session": "asp.bench_session",
-    "dominance": "asp.dominance",
+    "precedence": "asp.bench.precedence",
+    "sizes": "asp.bench.sizes",
+    "plan": "asp.bench.plans",
+    "session": "asp.bench.session",
+    "dominance": "asp.bench.dominance",
 }
 
 

@@ -5,7 +5,7 @@
    loopback endpoint (``--cells 0 --connect EP`` uses cells already on the network);
 3. learns which part fits which hole, keeping every alive cell busy with experiments
    none of whose outcomes can entail another's (:func:`_learn_sizes`,
-   :mod:`asp.zenoh_oracle`); every finished experiment is journaled (fsynced) before
+   :mod:`asp.session.oracle`); every finished experiment is journaled (fsynced) before
    the learner uses it;
 4. assigns holes (greedy) and computes complete plans, each run through the checker;
 5. writes ``RUN/learned.lp`` (DESIGN.md vocabulary), ``RUN/assignment.lp``,
@@ -33,19 +33,19 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from asp import PlannerError
-from asp.plans.assign import greedy_assignment, load_learned_facts
-from asp.cell_processes import CellProcess, serve_argv
 from asp.facts import fact, write_facts
-from asp.journal import Journal
+from asp.plans.assign import greedy_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import demo_facts, load_demos
 from asp.precedence.learn import learn_must_precede
 from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
-from asp.session_rerun import PlannerLog
+from asp.session.cells import CellProcess, serve_argv
+from asp.session.journal import Journal
+from asp.session.log import PlannerLog
+from asp.session.oracle import ZenohOracle
 from asp.sizes.learner import SizeLearner, SizeLearningResult
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import policy_names
-from asp.zenoh_oracle import ZenohOracle
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.client import CellDirectory, CellPool

@@ -21,7 +21,7 @@ from collections import Counter
 from dataclasses import dataclass
 
 from asp import PlannerError
-from asp.journal import Journal, JournalEntry
+from asp.session.journal import Journal, JournalEntry
 from asp.sizes.oracle import Result
 from bridge import BridgeError
 from bridge.client import CellDirectory, CellPool

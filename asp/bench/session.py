@@ -27,8 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from asp.cell_processes import ROOT, start_cell
-from asp.journal import JOURNAL_NAME, read_journal
+from asp.session.cells import ROOT, start_cell
+from asp.session.journal import JOURNAL_NAME, read_journal
 from bridge.client import CellDirectory, request_insert
 from bridge.keys import ping_key
 from bridge.messages import InsertRequest, encode
