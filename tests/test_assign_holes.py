@@ -19,7 +19,6 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.facts import fact, write_facts
 from asp.plans.assign import (
     LearnedFacts,
     UnsolvableAssembly,
@@ -29,9 +28,10 @@ from asp.plans.assign import (
     load_learned_facts,
 )
 from asp.plans.plans import check_assignment
+from asp.solve import encoding, fact, write_facts
 
 ROOT = Path(__file__).resolve().parent.parent
-ASSIGNMENTS_LP = str(ROOT / "asp" / "encodings" / "assignments.lp")
+ASSIGNMENTS_LP = str(encoding("assignments.lp"))
 CRANFIELD_SIZES = ROOT / "data" / "cranfield" / "sizes.lp"
 
 # name, facts, expected models (each the set of assigned/2 atoms); [] = unsatisfiable

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from importlib.resources import files
-
 import clingo
 import pytest
+from _best_reference import ENCODING as ENCODING_FILE
 
-ENCODING = (files("asp") / "encodings" / "select_best.lp").read_text(encoding="utf-8")
+ENCODING = ENCODING_FILE.read_text(encoding="utf-8")
 
 
 def answer_sets(part: str, facts: str) -> list[set[str]]:

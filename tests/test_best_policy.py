@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from _best_reference import choose_by_asp, possible_relations_asp
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from asp.sizes.best import choose, choose_bit, choose_by_asp, knowledge_masks, possible_relations_asp
+from asp.sizes.best import choose, choose_bit, knowledge_masks
 from asp.sizes.biorders import all_biorders, consistent_index
 from asp.sizes.learner import SizeLearner
 from asp.sizes.policies import get_policy

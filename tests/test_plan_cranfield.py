@@ -18,22 +18,21 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 
-from asp.facts import load_atoms, write_facts
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
+from asp.solve import load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 
 ROOT = Path(__file__).resolve().parent.parent
 CRANFIELD = ROOT / "data" / "cranfield"
-CLOSURE = "must_precede(A,B) :- precedence_edge(A,B). must_precede(A,C) :- must_precede(A,B), precedence_edge(B,C)."
 
 
 @pytest.fixture(scope="module")
 def learned(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Cranfield's learned.lp as the learners would write it."""
     path = tmp_path_factory.mktemp("cranfield") / "learned.lp"
-    atoms = load_atoms([CRANFIELD / "precedence.lp", CRANFIELD / "sizes.lp"], extra=CLOSURE)
-    write_facts(path, [a for a in atoms if a.name != "precedence_edge"])
+    closed = load_atoms([CRANFIELD / "precedence.lp"], encodings=["precedence_closure.lp"])
+    write_facts(path, [*closed, *load_atoms([CRANFIELD / "sizes.lp"])])
     return path
 
 

@@ -12,18 +12,18 @@ from _precedence_helpers import closed_relation, posets
 from hypothesis import given, settings
 from scipy.stats import chisquare
 
-from asp.facts import fact
 from asp.precedence.batches import ExtensionBatches, positions_of
 from asp.precedence.count import UniformSampler, count_linear_extensions, exact_count, linear_extensions
 from asp.precedence.learn import intersect_orders
-from asp.precedence.relation import Relation, encoding_path, true_relation
+from asp.precedence.relation import Relation, true_relation
+from asp.solve import encoding, fact
 from bridge.assembly import load_assembly
 
 
 def clingo_sequences(relation: Relation) -> set[tuple[str, ...]]:
     """Every model of sequence.lp, as a sequence of part ids."""
     ctl = clingo.Control(["0"])
-    ctl.load(str(encoding_path("sequence.lp")))
+    ctl.load(str(encoding("sequences.lp")))
     facts = [fact("part", p) for p in relation.parts] + [fact("must_precede", a, b) for a, b in relation.pairs()]
     ctl.add("base", [], "".join(f"{atom}.\n" for atom in facts))
     ctl.ground([("base", [])])

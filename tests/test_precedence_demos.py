@@ -8,8 +8,8 @@ import pytest
 from _precedence_helpers import run_cli
 
 from asp import PlannerError
-from asp.facts import write_facts
 from asp.precedence.demos import demo_facts, load_demos, parse_demos
+from asp.solve import write_facts
 
 
 def test_spaces_commas_comments_and_blank_lines_give_the_same_sequences() -> None:

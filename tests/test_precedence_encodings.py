@@ -7,11 +7,11 @@ from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
 
-from asp.precedence.relation import encoding_path
+from asp.solve import encoding
 
 
-def _solve(encoding: str, facts: str, test) -> None:
-    Clingo(["0"], program=facts, files=[str(encoding_path(encoding))]).solve(test)
+def _solve(name: str, facts: str, test) -> None:
+    Clingo(["0"], program=facts, files=[str(encoding(name))]).solve(test)
     test.assert_()
 
 
@@ -41,4 +41,4 @@ def test_sequence_enumerates_the_battery_relation_of_fig4() -> None:
         Assert(All(), Not(Contains("sequence_step(5,r1)"))),
         Assert(Exact(1), Contains("sequence_step(3,i2)")),
     )
-    _solve("sequence.lp", facts, test)
+    _solve("sequences.lp", facts, test)

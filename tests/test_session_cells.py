@@ -20,10 +20,10 @@ from pathlib import Path
 
 import pytest
 
-from asp.facts import atoms_by_name, load_atoms
 from asp.session.cells import CellProcess, start_cell
 from asp.session.journal import read_journal
 from asp.sizes.oracle import TruthOracle
+from asp.solve import atoms_by_name, load_atoms
 from bridge.session import free_loopback_endpoint
 
 pytestmark = pytest.mark.timeout(90)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from asp.facts import atoms_by_name, load_atoms
+from asp.solve import atoms_by_name, load_atoms
 
 ROOT = Path(__file__).resolve().parent.parent
 

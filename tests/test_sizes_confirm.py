@@ -14,12 +14,11 @@ from hypothesis import strategies as st
 
 from asp import PlannerError
 from asp.bench.sizes import main as bench_main
-from asp.facts import fact, format_facts
-from asp.precedence.relation import encoding_path
 from asp.sizes.knowledge import Pair
 from asp.sizes.learner import SizeLearner, learn_sizes, run_learner
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import policy_names
+from asp.solve import encoding, fact, format_facts
 from tests._sizes_helpers import biorders
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -63,7 +62,7 @@ def _unknown_without(truth: TruthOracle, observed: list[Pair], removed: Pair) ->
     atoms += [fact("observed", *pair, truth.ask(*pair)) for pair in observed if pair != removed]
     ctl = clingo.Control(["--warn=none"])
     ctl.add("base", [], format_facts(atoms))
-    ctl.load(str(encoding_path("sizes_closure.lp")))
+    ctl.load(str(encoding("sizes_closure.lp")))
     ctl.ground([("base", [])])
     with ctl.solve(yield_=True) as handle:
         model = next(iter(handle))

@@ -14,14 +14,13 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.facts import fact, format_facts
-from asp.precedence.relation import encoding_path
+from asp.solve import encoding, fact, format_facts
 
 TWO_BY_TWO = "part(a;b). hole(x;y). part_index(a,1). part_index(b,2). hole_index(x,1). hole_index(y,2). "
 
 
 def _solve(files: list[str], facts: str, test, arguments: list[str] | None = None) -> None:
-    paths = [str(encoding_path(f)) for f in files]
+    paths = [str(encoding(f)) for f in files]
     Clingo(["0", *(arguments or [])], program=facts, files=paths).solve(test)
     test.assert_()
 
@@ -29,7 +28,7 @@ def _solve(files: list[str], facts: str, test, arguments: list[str] | None = Non
 def _closure_model(facts: str) -> set[str]:
     models: list[set[str]] = []
     ctl = clingo.Control(["--warn=none"])
-    ctl.load(str(encoding_path("sizes_closure.lp")))
+    ctl.load(str(encoding("sizes_closure.lp")))
     ctl.add("base", [], facts)
     ctl.ground([("base", [])])
     ctl.solve(on_model=lambda m: models.append({str(s) for s in m.symbols(shown=True)}))
@@ -85,7 +84,7 @@ def test_require_consistent_makes_conflicts_unsat(case: str) -> None:
 
 def test_systematic_takes_lowest_part_then_lowest_hole() -> None:
     facts = TWO_BY_TWO + "tried(1,a,x,fit). tried(2,a,y,fit)."
-    _solve(["sizes_closure.lp", "select_systematic.lp"], facts, Assert(Exact(1), Contains("select(b,x)")))
+    _solve(["select_systematic.lp"], facts, Assert(Exact(1), Contains("select(b,x)")))
 
 
 def test_systematic_selects_nothing_once_all_is_known() -> None:
@@ -93,13 +92,13 @@ def test_systematic_selects_nothing_once_all_is_known() -> None:
     test = Assert(Exact(1), Equals({"smaller(a,x)", "smaller(a,y)", "smaller(x,b)", "smaller(y,b)",
                                     "smaller(a,b)", "fits(a,x)", "fits(a,y)", "no_fit(b,x)",
                                     "no_fit(b,y)"}))
-    _solve(["sizes_closure.lp", "select_systematic.lp"], facts, test)
+    _solve(["select_systematic.lp"], facts, test)
 
 
 def test_random_takes_the_least_priority_among_unknown_pairs() -> None:
     facts = TWO_BY_TWO + ("priority(a,x,2). priority(a,y,0). priority(b,x,3). priority(b,y,1). "
                           "tried(1,a,y,fit).")
-    _solve(["sizes_closure.lp", "select_random.lp"], facts, Assert(Exact(1), Contains("select(b,y)")))
+    _solve(["select_random.lp"], facts, Assert(Exact(1), Contains("select(b,y)")))
 
 
 def test_heuristic_prefers_the_template_of_fig7() -> None:
@@ -108,7 +107,7 @@ def test_heuristic_prefers_the_template_of_fig7() -> None:
     facts = ("part(a;b;c). hole(x;y;z). part_index(a,1). part_index(b,2). part_index(c,3). "
              "hole_index(x,1). hole_index(y,2). hole_index(z,3). "
              "tried(1,a,x,fit). tried(2,b,x,no_fit). tried(3,b,y,fit). tried(4,c,y,no_fit).")
-    _solve(["sizes_closure.lp", "select_heuristic.lp"], facts, Assert(Last(), Contains("select(b,z)")))
+    _solve(["select_heuristic.lp"], facts, Assert(Last(), Contains("select(b,z)")))
 
 
 OBSERVATIONS = st.lists(

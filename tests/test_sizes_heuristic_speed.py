@@ -6,11 +6,10 @@ import clingo
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asp.facts import fact, format_facts
-from asp.precedence.relation import encoding_path
 from asp.sizes.knowledge import Knowledge, Pair
 from asp.sizes.learner import SizeLearner
 from asp.sizes.oracle import TruthOracle
+from asp.solve import encoding, fact, format_facts
 from tests._sizes_helpers import biorders
 
 
@@ -55,8 +54,8 @@ def test_noisy_observations_give_one_model_with_the_best_scored_pair(
     atoms += [fact("observed", p, h, r) for (p, h), r in latest.items()]
     ctl = clingo.Control(["0", "--warn=none"])
     ctl.add("base", [], format_facts(atoms))
-    for name in ("sizes_closure.lp", "select_heuristic.lp"):
-        ctl.load(str(encoding_path(name)))
+    for name in ("select_heuristic.lp",):
+        ctl.load(str(encoding(name)))
     ctl.ground([("base", [])])
     models: list[list[clingo.Symbol]] = []
     ctl.solve(on_model=lambda m: models.append(m.symbols(shown=True)))

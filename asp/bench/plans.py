@@ -21,10 +21,10 @@ from pathlib import Path
 import clingo
 
 from asp import PlannerError
-from asp.facts import fact, load_atoms, write_facts
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import plans, travel_facts
 from asp.precedence.relation import precedence_facts, true_relation
+from asp.solve import fact, load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 
 

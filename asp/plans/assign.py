@@ -3,7 +3,7 @@
 Input are learned facts files in the DESIGN.md vocabulary: ``part/1``, ``hole/1``,
 ``fits/2`` (and ``no_fit/2``, ``needs_hole/1``, ``must_precede/2``...). A part *needs a
 hole* when it has a ``fits/2`` or ``no_fit/2`` fact or a ``needs_hole/1`` fact
-(``asp/encodings/needs_hole.lp``); every other part (Cranfield: bp sp pd ph fp) is
+(``asp/encodings/plans/needs_hole.lp``); every other part (Cranfield: bp sp pd ph fp) is
 placed without a hole.
 
 - :func:`greedy_assignment`: the paper's greedy: the biggest unassigned part gets a free
@@ -22,15 +22,14 @@ that gets no hole.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 
 import clingo
 
 from asp import PlannerError
-from asp.facts import atoms_by_name, format_facts, load_atoms
+from asp.solve import atoms_by_name, load_atoms, solve
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
@@ -64,40 +63,6 @@ class LearnedFacts:
         return [hole for hole in self.holes if (part, hole) in self.fits]
 
 
-def encoding_text(name: str) -> str:
-    """The text of ``asp/encodings/<name>`` (found with importlib.resources)."""
-    return (resources.files("asp") / "encodings" / name).read_text(encoding="utf-8")
-
-
-def solve_encoding(
-    entry: str,
-    atoms: Sequence[clingo.Symbol],
-    arguments: Sequence[str],
-    on_model: Callable[[clingo.Model], None],
-    time_limit_s: float | None = None,
-) -> clingo.SolveResult:
-    """Ground the entry encoding with the atoms as facts, solve, call ``on_model``.
-
-    clingo's informational messages (e.g. a predicate without facts) are dropped; a
-    grounding error becomes a PlannerError quoting them. A search that does not finish
-    within ``time_limit_s`` [s] (None: no limit) is stopped with a PlannerError.
-    """
-    messages: list[str] = []
-    ctl = clingo.Control(list(arguments), logger=lambda _code, msg: messages.append(msg.strip()))
-    try:
-        with resources.as_file(resources.files("asp") / "encodings" / entry) as path:
-            ctl.load(str(path))
-        ctl.add("base", [], format_facts(atoms))
-        ctl.ground([("base", [])])
-    except RuntimeError:
-        raise PlannerError(f"{entry} does not ground: " + "; ".join(messages)) from None
-    with ctl.solve(on_model=on_model, async_=True) as handle:
-        if not handle.wait(time_limit_s):
-            handle.cancel()
-            raise PlannerError(f"{entry}: the search did not finish within {time_limit_s} s")
-        return handle.get()
-
-
 RESERVED_IDS = frozenset({"none", "home", "site"})
 """Constants of plan_step/3 (``none``) and of the travel cost (``home``, ``site``)."""
 
@@ -129,7 +94,7 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
 def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
     """Read learned facts files; PlannerError on a file that does not parse or unknown ids."""
     sources = ", ".join(str(p) for p in paths)
-    atoms = load_atoms(paths, extra=encoding_text("needs_hole.lp"))
+    atoms = load_atoms(paths, encodings=["plans/needs_hole.lp"])
     facts = LearnedFacts(
         atoms=tuple(atoms),
         parts=tuple(p for (p,) in atoms_by_name(atoms, "part", 1)),
@@ -178,7 +143,7 @@ def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
     def keep(model: clingo.Model) -> None:
         found.append({p: h for p, h in atoms_by_name(model.symbols(shown=True), "assigned", 2)})
 
-    solve_encoding("assignments.lp", facts.atoms, [f"--models={limit}"], keep)
+    solve(["assignments.lp"], facts.atoms, [f"--models={limit}"], keep)
     return found
 
 

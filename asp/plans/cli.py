@@ -22,9 +22,9 @@ import sys
 import clingo
 
 from asp import PlannerError
-from asp.facts import write_facts
 from asp.plans.assign import UnsolvableAssembly, all_assignments, feasible_assignment, load_learned_facts
 from asp.plans.plans import HOME, Plan, plans, travel_facts
+from asp.solve import write_facts
 from bridge.assembly import load_assembly
 
 EXIT_UNSOLVABLE = 3

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from asp.facts import fact
-from asp.plans.assign import LearnedFacts, feasible_assignment, solve_encoding
+from asp.plans.assign import LearnedFacts, feasible_assignment
+from asp.solve import fact, solve
 from bridge.assembly import Assembly
 
 HOME: tuple[float, float] = (0.0, 0.0)
@@ -90,7 +90,7 @@ def plans(
     if optimal:
         entry = "plans_optimal.lp"
         arguments += ["--opt-mode=optN", f"--configuration={OPTIMAL_CONFIGURATION}"]
-    solve_encoding(entry, [*facts.atoms, *travel], arguments, keep, time_limit_s)
+    solve([entry], [*facts.atoms, *travel], arguments, keep, time_limit_s)
     if not found:
         feasible_assignment(facts)  # raises UnsolvableAssembly when no assignment exists
         raise PlannerError(
@@ -125,7 +125,7 @@ def _errors(facts: LearnedFacts, given: list[clingo.Symbol]) -> list[str]:
     def keep(model: clingo.Model) -> None:
         errors.extend(str(atom.arguments[0]) for atom in model.symbols(shown=True))
 
-    solve_encoding("check_plan.lp", [*facts.atoms, *given], [], keep)
+    solve(["check_plan.lp"], [*facts.atoms, *given], [], keep)
     return sorted(errors)
 
 

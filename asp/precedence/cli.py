@@ -13,11 +13,11 @@ import sys
 from itertools import islice
 
 from asp import PlannerError
-from asp.facts import write_facts
 from asp.precedence.batches import GENERATORS
 from asp.precedence.count import UniformSampler, count_linear_extensions, linear_extensions
 from asp.precedence.demos import Demonstrations, load_demos
 from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
+from asp.solve import write_facts
 from bridge.assembly import load_assembly
 
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import clingo
 
 from asp import PlannerError
-from asp.facts import atoms_by_name, fact, load_atoms
+from asp.solve import atoms_by_name, fact, load_atoms
 
 _ID = re.compile(r"^[a-z][a-zA-Z0-9_]*$")
 _SEPARATOR = re.compile(r"[\s,]+")

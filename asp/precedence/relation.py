@@ -9,7 +9,6 @@ computed by the ASP encodings ``precedence_closure.lp`` and
 
 from __future__ import annotations
 
-import importlib.resources
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,16 +17,10 @@ import clingo
 import numpy as np
 
 from asp import PlannerError
-from asp.facts import atoms_by_name, fact, load_atoms
+from asp.solve import atoms_by_name, fact, load_atoms
 from bridge.assembly import Assembly
 
 Pair = tuple[str, str]
-
-
-def encoding_path(name: str) -> Path:
-    """Path of an encoding shipped in ``asp/encodings`` (found with importlib.resources)."""
-    resource = importlib.resources.files("asp") / "encodings" / name
-    return Path(str(resource))
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,18 +69,13 @@ class Relation:
         return "\n".join(lines)
 
 
-def _solve(paths: Sequence[Path], facts: Iterable[clingo.Symbol]) -> list[clingo.Symbol]:
-    text = "".join(f"{atom}.\n" for atom in facts)
-    return load_atoms(paths, extra=text)
-
-
 def _relation_facts(relation: Relation, name: str) -> list[clingo.Symbol]:
     return [fact("part", p) for p in relation.parts] + [fact(name, a, b) for a, b in relation.pairs()]
 
 
 def close(relation: Relation, source: str = "precedence constraints") -> Relation:
     """Transitive closure by ``precedence_closure.lp``; PlannerError naming a cycle."""
-    atoms = _solve([encoding_path("precedence_closure.lp")], _relation_facts(relation, "must_precede"))
+    atoms = load_atoms([], encodings=["precedence_closure.lp"], extra=_relation_facts(relation, "must_precede"))
     cycle = atoms_by_name(atoms, "cycle", 1)
     if cycle:
         raise PlannerError(
@@ -99,7 +87,7 @@ def close(relation: Relation, source: str = "precedence constraints") -> Relatio
 
 def reduction(relation: Relation) -> list[Pair]:
     """Transitive reduction (``precedence_edge`` pairs) of a closed acyclic relation."""
-    atoms = _solve([encoding_path("precedence_reduction.lp")], _relation_facts(relation, "must_precede"))
+    atoms = load_atoms([], encodings=["precedence_reduction.lp"], extra=_relation_facts(relation, "must_precede"))
     return [(a, b) for a, b in atoms_by_name(atoms, "precedence_edge", 2)]
 
 
@@ -117,7 +105,7 @@ def load_relation(paths: Sequence[Path | str]) -> Relation:
     PlannerError when the files hold no ``part/1``, name an unknown part or hold a cycle.
     """
     names = ", ".join(str(p) for p in paths)
-    atoms = load_atoms([*paths, encoding_path("precedence_closure.lp")])
+    atoms = load_atoms(paths, encodings=["precedence_closure.lp"])
     parts = [p for (p,) in atoms_by_name(atoms, "part", 1)]
     if not parts:
         raise PlannerError(f"{names}: expected part/1 facts naming the parts of the assembly")

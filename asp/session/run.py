@@ -33,7 +33,6 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from asp import PlannerError
-from asp.facts import fact, write_facts
 from asp.plans.assign import greedy_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import demo_facts, load_demos
@@ -46,6 +45,7 @@ from asp.session.oracle import ZenohOracle
 from asp.sizes.learner import SizeLearner, SizeLearningResult
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import policy_names
+from asp.solve import fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.client import CellDirectory, CellPool

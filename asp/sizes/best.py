@@ -11,9 +11,10 @@ that prior); ties go to the lowest part, then hole index.
 
 ALPHA = 1/2 was chosen by measurement on all 14400 relabelings of Cranfield, where it
 is the only one of 0, 1/2, 1 whose worst case stayed at 20 for index-order and four
-random tie-break orders (README, "The ``best`` policy").
+random tie-break orders (docs/sizes.md, "The ``best`` policy").
 
-Three paths compute the same rule:
+Two paths compute the same rule (a third, in clingo, is the tests' reference:
+``tests/select_best.lp``):
 
 - exact (numpy): filter the enumeration of all m×n biorders (when there are at most
   ``EXACT_LIMIT``, e.g. 5×5) — ~ms per decision, memoised per knowledge state;
@@ -21,27 +22,19 @@ Three paths compute the same rule:
   ``SAMPLES`` random integer size assignments that respect the known order (few size
   levels are as likely as many, so identical parts and holes are common), seeded by
   the knowledge state, stand in for the possible relations, weighted as above; an
-  unknown pair the sample does not split scores 0;
-- ASP (``select_best.lp``): clingo enumerates the possible relations and their classes
-  (part ``base``), then sums the weights per pair and selects (part ``split``); the
-  reference path for small instances (total weight < 2^31, e.g. 4×4), used by the tests
-  to check the numpy paths.
+  unknown pair the sample does not split scores 0.
 """
 
 from __future__ import annotations
 
 import itertools
-import math
 import random
 from collections.abc import Sequence
 from functools import lru_cache
-from importlib.resources import as_file, files
 
-import clingo
 import numpy as np
 
 from asp import PlannerError
-from asp.facts import fact, format_facts
 from asp.sizes.biorders import (
     all_biorder_orders,
     all_biorders,
@@ -65,10 +58,7 @@ SAMPLES = 4096
 
 WEIGHT_SCALE = 1000
 """Prior weights are the integers round(WEIGHT_SCALE · (∏ k!)^ALPHA): their sums are exact
-in float64 on the exact path (5×5: < 2^46) and equal clingo's ``#sum`` on the ASP path."""
-
-ASP_WEIGHT_LIMIT = 2**31 - 1
-"""clingo integers are 32 bit: the ASP path handles total weights up to this (4×4: ~10^8)."""
+in float64 on the exact path (5×5: < 2^46) and equal clingo's ``#sum`` on the tests' ASP path."""
 
 
 def knowledge_masks(knowledge: Knowledge) -> tuple[int, int]:
@@ -175,68 +165,6 @@ def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]
         score += np.minimum(fit_weight, total - fit_weight)
     candidates = [pair for pair in knowledge.unknown if pair not in pending]
     return sorted(candidates, key=lambda pair: (-score[index[pair]], index[pair]))
-
-
-def _encoding() -> str:
-    with as_file(files("asp") / "encodings" / "select_best.lp") as path:
-        return path.read_text(encoding="utf-8")
-
-
-def possible_relations_asp(knowledge: Knowledge) -> tuple[np.ndarray, np.ndarray]:
-    """ASP path, part ``base``: masks of the possible relations (sorted), prior weights."""
-    parts, holes = knowledge.parts, knowledge.holes
-    n = len(holes)
-    atoms = [fact("part", p) for p in parts] + [fact("hole", h) for h in holes]
-    atoms += [fact("fits", p, h) for p, h in sorted(knowledge.fits)]
-    atoms += [fact("no_fit", p, h) for p, h in sorted(knowledge.no_fit)]
-    atoms += [fact("unknown", p, h) for p, h in knowledge.unknown]
-    ctl = clingo.Control(["--models=0", "--warn=none"])
-    ctl.add("base", [], format_facts(atoms) + _encoding())
-    ctl.ground([("base", [])])
-    found: dict[int, float] = {}
-
-    def on_model(model: clingo.Model) -> None:
-        mask, orders = 0, 1
-        for symbol in model.symbols(shown=True):
-            args = [str(a) for a in symbol.arguments]
-            if symbol.name == "rel":
-                mask |= 1 << (parts.index(args[0]) * n + holes.index(args[1]))
-            else:
-                orders *= math.factorial(symbol.arguments[1].number)
-        found[mask] = round(WEIGHT_SCALE * orders**ALPHA)
-
-    ctl.solve(on_model=on_model)
-    masks = np.array(sorted(found), dtype=np.uint64)
-    return masks, np.array([found[int(k)] for k in masks], dtype=np.float64)
-
-
-def choose_by_asp(knowledge: Knowledge) -> Pair:
-    """The same rule as :func:`choose`, entirely in clingo: part ``base`` enumerates the
-    possible relations, part ``split`` sums their weights per pair and selects."""
-    if not knowledge.unknown:
-        raise PlannerError("policy best: every pair is known, nothing to choose")
-    masks, weights = possible_relations_asp(knowledge)
-    if weights.sum() > ASP_WEIGHT_LIMIT:
-        raise PlannerError(f"policy best: total weight {weights.sum():.0f} exceeds clingo's "
-                           f"integers ({ASP_WEIGHT_LIMIT}); use the numpy path")
-    parts, holes = knowledge.parts, knowledge.holes
-    n = len(holes)
-    atoms = [fact("unknown", p, h) for p, h in knowledge.unknown]
-    atoms += [fact("part_index", p, i) for i, p in enumerate(parts, 1)]
-    atoms += [fact("hole_index", h, j) for j, h in enumerate(holes, 1)]
-    for r, (mask, weight) in enumerate(zip(masks.tolist(), weights.tolist())):
-        atoms.append(fact("weight", r, int(weight)))
-        atoms += [fact("holds", r, parts[i // n], holes[i % n]) for i in range(len(parts) * n) if mask >> i & 1]
-    ctl = clingo.Control(["--warn=none"])
-    ctl.add("split", [], format_facts(atoms))
-    ctl.add("base", [], _encoding())
-    ctl.ground([("split", [])])
-    selected: list[Pair] = []
-    ctl.solve(on_model=lambda m: selected.extend(
-        (str(s.arguments[0]), str(s.arguments[1])) for s in m.symbols(shown=True) if s.name == "select"))
-    if len(selected) != 1:
-        raise PlannerError(f"policy best: the ASP split selected {selected}, expected one pair")
-    return selected[0]
 
 
 def prepare(m: int, n: int) -> None:

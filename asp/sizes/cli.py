@@ -14,12 +14,12 @@ import json
 import sys
 
 from asp import PlannerError
-from asp.facts import write_facts
 from asp.sizes.evaluate import evaluate_policy, plot_comparison
 from asp.sizes.knowledge import Knowledge
 from asp.sizes.learner import Experiment, learn_sizes
 from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
+from asp.solve import write_facts
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:

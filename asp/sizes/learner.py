@@ -1,7 +1,8 @@
 """The size-learning session (paper 2.2): which part fits which hole, by experiments.
 
 One :class:`SizeLearner` owns ONE long-lived ``clingo.Control``: the parts, holes,
-their index order, ``sizes_closure.lp`` and the policy's encoding are grounded once;
+their index order and the policy's entry encoding (``select_<policy>.lp``, which includes
+the closure; ``sizes_closure.lp`` for a policy that chooses in Python) are grounded once;
 every possible observation ``observed(P,H,R)`` is an ``#external`` switched with
 ``assign_external``. Each decision is one solve of that ground program.
 
@@ -12,7 +13,7 @@ on the cycle are named and re-tested; per pair the majority of its answers is ke
 when every pair is known and no conflict is left.
 
 A wrong answer that other kept observations entail closes a cycle; one that is
-*essential* (its pair is unknown without it, ``sizes_essential.lp``) cannot be caught
+*essential* (its pair is unknown without it, ``sizes/essential.lp``) cannot be caught
 that way. With ``confirm`` K > 0, once every pair is known each essential observation is
 re-tested until its kept result *leads* the other by K+1 answers (noiseless: K extra
 answers). The lead is what the answers prove: with flips of probability q the odds of
@@ -33,11 +34,10 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from asp.facts import fact, format_facts
-from asp.precedence.relation import encoding_path
 from asp.sizes.knowledge import RESULTS, Knowledge, Pair
 from asp.sizes.oracle import Oracle
 from asp.sizes.policies import SelectionPolicy, get_policy
+from asp.solve import encoding, fact, format_facts
 
 _OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit)."
 
@@ -132,10 +132,9 @@ class SizeLearner:
         if self.policy.session_facts is not None:
             atoms += self.policy.session_facts(self.parts, self.holes, seed)
         self._ctl.add("base", [], format_facts(atoms) + _OBSERVATIONS)
-        essential = "sizes_essential.lp" if self.confirm else None
-        for name in ("sizes_closure.lp", essential, self.policy.encoding):
-            if name is not None:
-                self._ctl.load(str(encoding_path(name)))
+        names = [self.policy.encoding or "sizes_closure.lp"] + (["sizes/essential.lp"] if self.confirm else [])
+        for name in names:
+            self._ctl.load(str(encoding(name)))
         self._ctl.ground([("base", [])])
 
     def _solve(self) -> Knowledge:

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from asp import PlannerError
-from asp.facts import atoms_by_name, load_atoms
+from asp.solve import atoms_by_name, load_atoms
 from bridge.assembly import load_assembly
 
 Result = Literal["fit", "no_fit"]

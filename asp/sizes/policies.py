@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from asp.facts import fact
 from asp.sizes.knowledge import Knowledge, Pair
+from asp.solve import fact
 
 Chooser = Callable[[Knowledge, random.Random], Pair]
 BatchRank = Callable[[Knowledge, Sequence[Pair]], list[Pair]]
