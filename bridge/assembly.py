@@ -23,7 +23,9 @@ from pathlib import Path
 from bridge import BridgeError
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
-_ID = re.compile(r"^[a-z][a-zA-Z0-9_]*$")
+ID_PATTERN = r"^[a-z][a-zA-Z0-9_]{0,63}$"
+"""A part or hole id: a lower-case ASP constant of at most 64 characters."""
+_ID = re.compile(ID_PATTERN)
 
 
 @dataclass(frozen=True)
@@ -106,7 +108,7 @@ def _table(source: Path, data: dict, table: str) -> dict[str, dict]:
     for key, value in entries.items():
         if not _ID.match(key):
             raise BridgeError(
-                f"{source}: [{table}.{key}]: an id must be a lower-case ASP constant"
+                f"{source}: [{table}.{key}]: an id must be a lower-case ASP constant of at most 64 characters"
             )
         if not isinstance(value, dict):
             raise BridgeError(f"{source}: [{table}.{key}] must be a table")

@@ -14,14 +14,19 @@ from typing import TypeVar
 T = TypeVar("T")
 
 
-def comma_list(item: Callable[[str], T], what: str = "values") -> Callable[[str], list[T]]:
+def comma_list(
+    item: Callable[[str], T], what: str = "values", allow_empty: bool = False
+) -> Callable[[str], list[T]]:
     """An argparse type: ``"a,b,c"`` → ``[item("a"), item("b"), item("c")]``.
 
     Empty items, and items ``item`` rejects (ValueError or ArgumentTypeError), are an
-    error naming the whole text and ``what`` was expected.
+    error naming the whole text and ``what`` was expected; ``""`` is the empty list when
+    ``allow_empty``.
     """
 
     def parse(text: str) -> list[T]:
+        if allow_empty and not text.strip():
+            return []
         parts = [part.strip() for part in text.split(",")]
         try:
             if not all(parts):
@@ -43,6 +48,15 @@ def number_in(kind: Callable[[str], float], low: float, high: float) -> Callable
         return value
 
     return parse
+
+
+def size_pair(text: str) -> tuple[int, int]:
+    """An item type: ``"4x5"`` → ``(4, 5)``, both positive (ValueError otherwise)."""
+    m, sep, n = text.partition("x")
+    size = (int(m), int(n)) if sep else (0, 0)
+    if min(size) < 1:
+        raise ValueError(text)
+    return size
 
 
 def part_hole_pair(text: str) -> tuple[str, str]:

@@ -17,15 +17,17 @@ from typing import Annotated, Final, Literal
 import msgspec
 
 from bridge import BridgeError
+from bridge.assembly import ID_PATTERN
+from bridge.keys import CELL_ID_PATTERN
 
 PROTOCOL_VERSION: Final = 1
 MAX_MESSAGE_BYTES: Final = 16 * 1024
 """Largest accepted payload [bytes]; bigger messages are refused unread."""
 
 RequestId = Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z0-9_.:-]{1,128}$")]
-AspId = Annotated[str, msgspec.Meta(pattern=r"^[a-z][a-zA-Z0-9_]{0,63}$")]
+AspId = Annotated[str, msgspec.Meta(pattern=ID_PATTERN)]
 """A part or hole id: a lower-case ASP constant."""
-CellId = Annotated[str, msgspec.Meta(pattern=r"^[a-z][a-z0-9_-]{0,31}$")]
+CellId = Annotated[str, msgspec.Meta(pattern=CELL_ID_PATTERN)]
 Seed = Annotated[int, msgspec.Meta(ge=0, lt=2**32)]
 NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
 Result = Literal["fit", "no_fit"]

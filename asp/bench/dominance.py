@@ -50,6 +50,7 @@ import numpy as np
 from asp.sizes.biorders import all_biorders, mask_bits
 from asp.sizes.evaluate import relabeled_matrices
 from asp.sizes.oracle import TruthOracle
+from bridge.cli_types import comma_list, size_pair
 
 INFEASIBLE = 1 << 40
 """Value of a state from which no policy meets every deadline."""
@@ -483,6 +484,7 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="./run.sh bench dominance", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="2x3,3x2,2x4,3x3,3x4,4x3,2x5,5x2",
+                        type=comma_list(size_pair, "sizes such as 4x5", allow_empty=True),
                         help="m×n sizes, all biorders each ('' skips; 4x4 takes ~20 s)")
     parser.add_argument("--unconstrained", action="store_true",
                         help="also the unconstrained optimum (3x4: ~30 s; 4x4: too long)")
@@ -494,7 +496,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--target", type=float, default=18.8, help="mean to decide (default 18.8)")
     parser.add_argument("--cap", type=int, help="with --all-biorders: at most CAP experiments per Cranfield truth")
     args = parser.parse_args(argv)
-    sizes = [tuple(int(k) for k in size.split("x")) for size in args.sizes.split(",") if size]
+    sizes = args.sizes
     print(f"{'size':>5} {'biorders':>8} {'systematic':>10} {'never worse':>11} {'optimum':>8} "
           f"{'states':>8} {'s':>6}")
     for m, n in sizes:

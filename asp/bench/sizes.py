@@ -29,6 +29,7 @@ from asp.sizes.evaluate import evaluate_policy
 from asp.sizes.learner import SizeLearner
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import get_policy
+from bridge.cli_types import comma_list, number_in
 
 CRANFIELD = "cranfield"
 
@@ -90,30 +91,23 @@ def _print_noise(rows: list[dict]) -> None:
               f"{r['wrong_pct']:>8.1f} {r['mean']:>6.2f} {r['median']:>6}")
 
 
-def _numbers(kind: type, text: str, low: float, high: float) -> list:
-    """A comma-separated list of numbers in [low, high); argparse error otherwise."""
-    try:
-        values = [kind(x) for x in text.split(",")]
-    except ValueError:
-        values = []
-    if not values or not all(low <= v < high for v in values):
-        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated numbers in [{low}, {high})")
-    return values
-
-
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sizes", default="5,10,20", help="n of the n×n instances (default 5,10,20)")
-    parser.add_argument("--policies", default="systematic,random,heuristic,best")
+    parser.add_argument("--sizes", default="5,10,20", type=comma_list(number_in(int, 1, 1000), "sizes in [1, 1000)"),
+                        help="n of the n×n instances (default 5,10,20)")
+    parser.add_argument("--policies", default="systematic,random,heuristic,best", type=comma_list(str, "policy names"),
+                        help="policies to time (default systematic,random,heuristic,best)")
     parser.add_argument("--decisions", type=int, default=60, help="decisions timed per session (default 60)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--evaluate", default="heuristic",
                         help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
-    parser.add_argument("--noise", type=lambda t: _numbers(float, t, 0.0, 0.5), metavar="P,...",
+    parser.add_argument("--noise", type=comma_list(number_in(float, 0.0, 0.5), "probabilities in [0, 0.5)"),
+                        metavar="P,...",
                         help="measure wrong relations and experiments under these flip probabilities "
                              "instead of timing (Cranfield; with --confirm, --seeds, --policies)")
-    parser.add_argument("--confirm", type=lambda t: _numbers(int, t, 0, 100), default=[0], metavar="K,...",
+    parser.add_argument("--confirm", type=comma_list(number_in(int, 0, 100), "integers in [0, 100)"), default=[0],
+                        metavar="K,...",
                         help="with --noise: the learner's confirm values (default 0)")
     parser.add_argument("--seeds", type=int, default=30, metavar="N",
                         help="with --noise: sessions per setting (default 30)")
@@ -122,9 +116,9 @@ def main(argv: list[str]) -> int:
     if args.noise:
         if args.seeds < 1:
             parser.error(f"--seeds {args.seeds}: expected a positive number of sessions")
-        for name in args.policies.split(","):
+        for name in args.policies:
             get_policy(name)
-        noisy = noise_rows(args.noise, args.policies.split(","), args.confirm, args.seeds, args.seed)
+        noisy = noise_rows(args.noise, args.policies, args.confirm, args.seeds, args.seed)
         if args.json:
             print(json.dumps({"noise": noisy}))
         else:
@@ -132,8 +126,8 @@ def main(argv: list[str]) -> int:
         return 0
     rows = [
         time_decisions(int(n), policy, args.seed, args.decisions)
-        for n in args.sizes.split(",")
-        for policy in args.policies.split(",")
+        for n in args.sizes
+        for policy in args.policies
     ]
     report: dict = {"decisions": rows}
     if args.evaluate:

@@ -19,6 +19,7 @@ from asp.precedence.demos import Demonstrations, load_demos
 from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
+from bridge.cli_types import comma_list
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -49,7 +50,8 @@ def _parser() -> argparse.ArgumentParser:
 
     evaluate = commands.add_parser("evaluate", help="the paper's evaluation (Figs. 12/13), or --guided demonstration")
     evaluate.add_argument("--assembly", required=True, help="assembly with true constraints (precedence.lp)")
-    evaluate.add_argument("--m", default="5,7,10,15,20,30", help="numbers of demonstrations, comma separated")
+    evaluate.add_argument("--m", default="5,7,10,15,20,30", type=comma_list(int, "integers such as 5,7,10"),
+                          help="numbers of demonstrations, comma separated")
     evaluate.add_argument("--trials", type=int, default=1000, help="trials per m (default 1000)")
     evaluate.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     evaluate.add_argument("--generator", choices=sorted(GENERATORS), default="uniform",
@@ -137,11 +139,7 @@ def _evaluate(args: argparse.Namespace) -> None:
     else:
         from asp.precedence.evaluate import evaluate, plot
 
-        try:
-            ms = [int(m) for m in args.m.split(",")]
-        except ValueError:
-            raise PlannerError(f"--m {args.m}: expected comma-separated integers such as 5,7,10") from None
-        result = evaluate(truth, ms, args.trials, args.seed, progress, args.generator)
+        result = evaluate(truth, args.m, args.trials, args.seed, progress, args.generator)
         if args.plot:
             plot(result, args.plot)
         if not args.json:

@@ -22,8 +22,9 @@ import clingo
 
 from asp import PlannerError
 from asp.solve import atoms_by_name, fact, load_atoms
+from bridge.assembly import ID_PATTERN
 
-_ID = re.compile(r"^[a-z][a-zA-Z0-9_]*$")
+_ID = re.compile(ID_PATTERN)
 _SEPARATOR = re.compile(r"[\s,]+")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
 
@@ -41,7 +42,7 @@ def _check_sequence(where: str, ids: Sequence[str], parts: Sequence[str], parts_
     seen: set[str] = set()
     for part in ids:
         if not _ID.match(part):
-            raise PlannerError(f"{where}: '{part}' is not a part id (expected a lower-case ASP constant)")
+            raise PlannerError(f"{where}: '{part}' is not a part id (expected a lower-case ASP constant of at most 64 characters)")
         if part not in parts:
             raise PlannerError(f"{where}: unknown id '{part}'; expected one of {parts_origin}: {' '.join(parts)}")
         if part in seen:

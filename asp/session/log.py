@@ -20,25 +20,18 @@ in a first tab, then one tab per cell (:func:`bridge.rerun_layout.cell_blueprint
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 import rerun as rr
 
+from asp.precedence.relation import Relation, reduction
 from asp.sizes.knowledge import Knowledge
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]
-
-
-def _reduction(pairs: Iterable[tuple[str, str]]) -> list[tuple[str, str]]:
-    """Pairs of a transitively closed relation that no third element connects."""
-    closed = set(pairs)
-    middle = {x for pair in closed for x in pair}
-    return sorted((a, b) for a, b in closed
-                  if not any((a, z) in closed and (z, b) in closed for z in middle - {a, b}))
 
 
 class PlannerLog:
@@ -66,8 +59,8 @@ class PlannerLog:
         nodes = [*knowledge.parts, *knowledge.holes]
         colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)
         self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors))
-        self.rec.log("planner/smaller", rr.GraphEdges(_reduction(knowledge.smaller),
-                                                      graph_type="directed"))
+        edges = reduction(Relation.from_pairs(nodes, knowledge.smaller))
+        self.rec.log("planner/smaller", rr.GraphEdges(edges, graph_type="directed"))
 
     def assignment(self, assignment: Mapping[str, str]) -> None:
         """The hole assignment as a graph part → hole and a table."""

@@ -20,6 +20,7 @@ from asp.sizes.learner import Experiment, learn_sizes
 from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
 from asp.solve import write_facts
+from bridge.cli_types import comma_list
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -88,6 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", metavar="FILE.png", help="Fig. 19-style comparison plot")
     evaluate.add_argument("--compare", default="random", metavar="P,...",
+                          type=comma_list(str, "policy names", allow_empty=True),
                           help="policies drawn beside --policy in the plot (default random)")
     return parser
 
@@ -139,7 +141,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     evaluation = evaluate_policy(truth, args.policy, relabelings, args.seed, **options)
     report = evaluation.as_json()
     if args.plot:
-        others = [p for p in args.compare.split(",") if p and p != args.policy]
+        others = [p for p in args.compare if p != args.policy]
         for name in others:
             get_policy(name)
         evaluations = [evaluation] + [evaluate_policy(truth, p, relabelings, args.seed, **options)
