@@ -62,7 +62,7 @@ def load_atoms(
     except RuntimeError:
         raise PlannerError("facts do not ground: " + "; ".join(messages)) from None
     models: list[list[clingo.Symbol]] = []
-    ctl.solve(on_model=lambda m: models.append(m.symbols(shown=True)))
+    ctl.solve(on_model=lambda m: models.append(list(m.symbols(shown=True))))
     if len(models) != 1:
         names = ", ".join(str(p) for p in paths)
         raise PlannerError(f"{names}: expected facts with exactly one answer set, got {len(models)}")
@@ -78,6 +78,11 @@ def atoms_by_name(atoms: Iterable[clingo.Symbol], name: str, arity: int) -> list
         and atom.name == name
         and len(atom.arguments) == arity
     )
+
+
+def pairs_by_name(atoms: Iterable[clingo.Symbol], name: str) -> list[tuple[str, str]]:
+    """Arguments (as strings) of the atoms ``name/2``, sorted."""
+    return [(a, b) for a, b in atoms_by_name(atoms, name, 2)]
 
 
 def fact(name: str, *args: str | int) -> clingo.Symbol:

@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import queue
 import threading
@@ -118,7 +119,8 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
 
     def on_reply(reply: zenoh.Reply) -> None:
         if reply.ok is None:
-            deliver(CellTimeout(f"cell {cell}: query error: {reply.err.payload.to_string()}"))
+            error = reply.err.payload.to_string() if reply.err is not None else "no reply"
+            deliver(CellTimeout(f"cell {cell}: query error: {error}"))
             return
         try:
             message = decode_reply(reply.ok.payload.to_bytes())
@@ -208,8 +210,12 @@ class CellPool:
             request = self._pending.popleft()
             attempt = next(self._attempts)
             cancel = send_insert(self._session, cell, request, self.timeout,
-                                 lambda outcome, c=cell, a=attempt: self._events.put(("outcome", c, a, outcome)))
+                                 functools.partial(self._on_outcome, cell, attempt))
             self._busy[cell] = _Sent(attempt, request, cancel)
+
+    def _on_outcome(self, cell: str, attempt: int, outcome: Outcome) -> None:
+        """Called on a Zenoh thread with the outcome of ``attempt`` at ``cell``."""
+        self._events.put(("outcome", cell, attempt, outcome))
 
     def _next_event(self) -> tuple:
         if self._busy or self._alive:

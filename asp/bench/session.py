@@ -27,12 +27,22 @@ import tempfile
 import time
 from pathlib import Path
 
+import zenoh
+
+from asp import PlannerError
 from asp.session.cells import ROOT, start_cell
 from asp.session.journal import JOURNAL_NAME, read_journal
 from bridge.client import CellDirectory, request_insert
 from bridge.keys import ping_key
 from bridge.messages import InsertRequest, encode
 from bridge.session import free_loopback_endpoint, open_session
+
+
+def _payload(reply: zenoh.Reply) -> bytes:
+    """The payload of a ping's reply; an error reply is a failed benchmark."""
+    if reply.ok is None:
+        raise PlannerError(f"ping failed: {reply.err}")
+    return reply.ok.payload.to_bytes()
 
 
 def _ms(values: list[float]) -> dict[str, float]:
@@ -55,7 +65,7 @@ def round_trips(count: int) -> dict:
             request = InsertRequest(id=f"bench-{k}", part="p3", hole="s1", seed=k)
             payload = encode(request)
             t0 = time.perf_counter()
-            session.get(ping_key("bench"), lambda reply: replies.put(reply.ok.payload.to_bytes()),
+            session.get(ping_key("bench"), lambda reply: replies.put(_payload(reply)),
                         payload=payload, timeout=10.0)
             replies.get(timeout=15.0)
             t1 = time.perf_counter()
@@ -64,10 +74,9 @@ def round_trips(count: int) -> dict:
             if k >= 20:
                 bare.append(t1 - t0)
                 validated.append(t2 - t1)
-        result = {"round_trips": count, "payload_bytes": len(payload),
-                  "validated": _ms(validated), "bare": _ms(bare)}
-        result["ratio"] = round(result["validated"]["median_ms"] / result["bare"]["median_ms"], 3)
-        return result
+        timed, untimed = _ms(validated), _ms(bare)
+        return {"round_trips": count, "payload_bytes": len(payload), "validated": timed, "bare": untimed,
+                "ratio": round(timed["median_ms"] / untimed["median_ms"], 3)}
     finally:
         session.close()
         cell.stop()

@@ -29,7 +29,7 @@ from pathlib import Path
 import clingo
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, load_atoms, solve
+from asp.solve import atoms_by_name, load_atoms, pairs_by_name, solve
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
@@ -99,9 +99,9 @@ def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
         atoms=tuple(atoms),
         parts=tuple(p for (p,) in atoms_by_name(atoms, "part", 1)),
         holes=tuple(h for (h,) in atoms_by_name(atoms, "hole", 1)),
-        fits=frozenset((p, h) for p, h in atoms_by_name(atoms, "fits", 2)),
+        fits=frozenset(pairs_by_name(atoms, "fits")),
         needs_hole=tuple(p for (p,) in atoms_by_name(atoms, "needs_hole", 1)),
-        must_precede=frozenset((a, b) for a, b in atoms_by_name(atoms, "must_precede", 2)),
+        must_precede=frozenset(pairs_by_name(atoms, "must_precede")),
     )
     if not facts.parts:
         raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
@@ -141,7 +141,7 @@ def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
     found: list[Assignment] = []
 
     def keep(model: clingo.Model) -> None:
-        found.append({p: h for p, h in atoms_by_name(model.symbols(shown=True), "assigned", 2)})
+        found.append(dict(pairs_by_name(model.symbols(shown=True), "assigned")))
 
     solve(["assignments.lp"], facts.atoms, [f"--models={limit}"], keep)
     return found

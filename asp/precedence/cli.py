@@ -27,16 +27,23 @@ def _parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     learn = commands.add_parser("learn", help="learn the must-precede relation from demonstrations (Algorithm 1)")
-    learn.add_argument("demos", nargs="?", help="demonstrations file (text, or demo/3 facts *.lp); default: the assembly's demos.txt")
+    learn.add_argument("demos", nargs="?",
+                       help="demonstrations file (text, or demo/3 facts *.lp); default: the assembly's demos.txt")
     learn.add_argument("--assembly", help="assembly name under data/ or folder (gives the parts)")
     learn.add_argument("--out", help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
     learn.add_argument("--dot", help="write the transitive-reduction graph as Graphviz DOT")
     learn.add_argument("--png", help="draw the relation to a PNG file")
-    learn.add_argument("--min-support", type=int, default=1, metavar="K", help="drop a constraint only when >= K demonstrations contradict it (default 1: plain intersection)")
-    learn.add_argument("--evidence", action="store_true", help="add per-pair support/contradiction counts and suspect demonstrations (JSON keys evidence, suspects)")
+    learn.add_argument("--min-support", type=int, default=1, metavar="K",
+                       help="drop a constraint only when >= K demonstrations contradict it "
+                            "(default 1: plain intersection)")
+    learn.add_argument("--evidence", action="store_true",
+                       help="add per-pair support/contradiction counts and suspect demonstrations "
+                            "(JSON keys evidence, suspects)")
     learn.add_argument("--json", action="store_true", help="print JSON {parts, must_precede, reduction, admitted}")
 
-    for name, text in (("count", "count the sequences a relation admits (exact)"), ("enumerate", "print every admitted sequence (streaming)"), ("sample", "print uniformly random admitted sequences")):
+    for name, text in (("count", "count the sequences a relation admits (exact)"),
+                       ("enumerate", "print every admitted sequence (streaming)"),
+                       ("sample", "print uniformly random admitted sequences")):
         sub = commands.add_parser(name, help=text)
         sub.add_argument("facts", nargs="*", help="facts files with part/1 and must_precede/2 (or precedence_edge/2)")
         sub.add_argument("--assembly", help="use the assembly's true constraints (precedence.lp)")
@@ -55,13 +62,17 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--trials", type=int, default=1000, help="trials per m (default 1000)")
     evaluate.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     evaluate.add_argument("--generator", choices=sorted(GENERATORS), default="uniform",
-                          help="random feasible sequences: uniform over all (the paper's; default) or stepwise (a placeable part uniformly each step)")
-    evaluate.add_argument("--guided", action="store_true", help="demonstrations to the exact relation, guided vs random")
+                          help="random feasible sequences: uniform over all (the paper's; default) "
+                               "or stepwise (a placeable part uniformly each step)")
+    evaluate.add_argument("--guided", action="store_true",
+                          help="demonstrations to the exact relation, guided vs random")
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", help="write the Figs. 12/13 bar charts to this PNG file")
 
     suggest = commands.add_parser("suggest", help="propose the next sequence to demonstrate")
-    suggest.add_argument("demos", nargs="?", help="demonstrations so far, made following earlier suggestions (none: the first suggestion; needs --assembly)")
+    suggest.add_argument("demos", nargs="?",
+                         help="demonstrations so far, made following earlier suggestions "
+                              "(none: the first suggestion; needs --assembly)")
     suggest.add_argument("--assembly", help="assembly name or folder (gives the parts)")
     suggest.add_argument("--seed", type=int, default=0, help="seed of the tie-breaking (default 0)")
     suggest.add_argument("--json", action="store_true", help="print JSON {suggestion, undecided}")
@@ -97,9 +108,11 @@ def _learn(args: argparse.Namespace) -> None:
     flagged = suspects(demos)
     for suspect in flagged:
         pairs = " ".join(f"{a}<{b}" for a, b in suspect.removes)
-        print(f"warning: {suspect.origin}: this demonstration alone removes {pairs}, which all others support", file=sys.stderr)
+        print(f"warning: {suspect.origin}: this demonstration alone removes {pairs}, which all others support",
+              file=sys.stderr)
     if args.out:
-        write_facts(args.out, precedence_facts(relation), header=f"must-precede relation learned from {len(demos.sequences)} demonstrations")
+        header = f"must-precede relation learned from {len(demos.sequences)} demonstrations"
+        write_facts(args.out, precedence_facts(relation), header=header)
     if args.dot:
         with open(args.dot, "w", encoding="utf-8") as out:
             out.write(to_dot(relation, edges))
@@ -130,11 +143,13 @@ def _evaluate(args: argparse.Namespace) -> None:
         from asp.precedence.guide import evaluate_guided
 
         if args.generator != "uniform":
-            raise PlannerError("--generator applies to the evaluation over m, not to --guided (its random baseline is uniform)")
+            raise PlannerError("--generator applies to the evaluation over m, not to --guided "
+                               "(its random baseline is uniform)")
 
         result = evaluate_guided(truth, args.trials, args.seed, progress)
         if not args.json:
-            print(f"{args.trials} trials: guided mean {result['mean']:.2f} demonstrations to the exact relation, random {result['random_mean']:.2f}")
+            print(f"{args.trials} trials: guided mean {result['mean']:.2f} demonstrations to the exact relation, "
+                  f"random {result['random_mean']:.2f}")
             print("histogram (demonstrations: trials):", result["demos_to_exact"])
     else:
         from asp.precedence.evaluate import evaluate, plot
@@ -145,7 +160,9 @@ def _evaluate(args: argparse.Namespace) -> None:
         if not args.json:
             print(f"total admitted by the true constraints: {result['total']} ({args.generator} demonstrations)")
             for r in result["results"]:
-                print(f"m={r['m']:>3}: mean {r['mean']:8.1f} ({100 * r['mean'] / result['total']:5.1f} %)  P(all) {r['p_all']:.3f}  P(> half) {r['p_more_than_half']:.3f}")
+                share = 100 * r["mean"] / result["total"]
+                print(f"m={r['m']:>3}: mean {r['mean']:8.1f} ({share:5.1f} %)  P(all) {r['p_all']:.3f}  "
+                      f"P(> half) {r['p_more_than_half']:.3f}")
     if args.json:
         _print_json(result)
 
@@ -163,7 +180,8 @@ def _suggest(args: argparse.Namespace) -> None:
         _print_json({"suggestion": sequence, "undecided": [list(p) for p in undecided]})
     else:
         print(" ".join(sequence))
-        print(f"# {len(undecided)} learned pairs still undecided; place at each step the earliest listed part that can be placed", file=sys.stderr)
+        print(f"# {len(undecided)} learned pairs still undecided; place at each step the earliest listed part "
+              "that can be placed", file=sys.stderr)
 
 
 def main(argv: list[str]) -> int:

@@ -7,7 +7,8 @@ remaining prime group is counted by a dynamic programme over its down-sets (sets
 parts that can be in place together): exact Python integers of any size, never
 enumerating. Sampling is exactly uniform: in a prime group the next part x is drawn
 from down-set S with probability completions(S + x) / completions(S); independent
-groups are interleaved by a uniformly random shuffle, consecutive ones concatenated. Enumeration streams sequences depth first.
+groups are interleaved by a uniformly random shuffle, consecutive ones concatenated.
+Enumeration streams sequences depth first.
 
 A relation with a cycle (or a part preceding itself) admits no sequence.
 """

@@ -27,6 +27,7 @@ from bridge.assembly import ID_PATTERN
 _ID = re.compile(ID_PATTERN)
 _SEPARATOR = re.compile(r"[\s,]+")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
+_EXPECTED = "(part ids separated by spaces or commas)"
 
 
 @dataclass(frozen=True)
@@ -42,7 +43,8 @@ def _check_sequence(where: str, ids: Sequence[str], parts: Sequence[str], parts_
     seen: set[str] = set()
     for part in ids:
         if not _ID.match(part):
-            raise PlannerError(f"{where}: '{part}' is not a part id (expected a lower-case ASP constant of at most 64 characters)")
+            raise PlannerError(f"{where}: '{part}' is not a part id "
+                               "(expected a lower-case ASP constant of at most 64 characters)")
         if part not in parts:
             raise PlannerError(f"{where}: unknown id '{part}'; expected one of {parts_origin}: {' '.join(parts)}")
         if part in seen:
@@ -64,11 +66,12 @@ def _text(path: Path) -> str:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
-        raise PlannerError(f"{path}:{line}: binary data, expected text (part ids separated by spaces or commas)") from None
+        raise PlannerError(f"{path}:{line}: binary data, expected text {_EXPECTED}") from None
     control = _CONTROL.search(text)
     if control:
         line = text[: control.start()].count("\n") + 1
-        raise PlannerError(f"{path}:{line}: binary data (control character {control.group()!r}), expected text (part ids separated by spaces or commas)")
+        raise PlannerError(f"{path}:{line}: binary data (control character {control.group()!r}), "
+                           f"expected text {_EXPECTED}")
     return text
 
 
@@ -105,18 +108,19 @@ def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations
         raise PlannerError(f"{path}: expected demo(D,I,P) facts (demonstration D places part P at step I)")
     declared = [p for (p,) in atoms_by_name(atoms, "part", 1)]
     by_demo: dict[str, dict[int, str]] = {}
-    for demo, step, part in (a.arguments for a in atoms if a.match("demo", 3)):
-        where = f"{path}: demo({demo},{step},{part})"
+    for demo, step, symbol in (a.arguments for a in atoms if a.match("demo", 3)):
+        where = f"{path}: demo({demo},{step},{symbol})"
         if step.type != clingo.SymbolType.Number or step.number < 1:
             raise PlannerError(f"{where}: the step must be a positive integer")
         steps = by_demo.setdefault(str(demo), {})
         if step.number in steps:
-            raise PlannerError(f"{where}: demonstration {demo} already places {steps[step.number]} at step {step.number}")
-        steps[step.number] = str(part)
+            raise PlannerError(f"{where}: demonstration {demo} already places {steps[step.number]} "
+                               f"at step {step.number}")
+        steps[step.number] = str(symbol)
     known = list(parts) if parts is not None else None
     sequences, origins = [], []
-    for demo, steps in sorted(by_demo.items(), key=lambda item: _demo_order(item[0])):
-        where = f"{path}: demonstration {demo}"
+    for label, steps in sorted(by_demo.items(), key=lambda item: _demo_order(item[0])):
+        where = f"{path}: demonstration {label}"
         gaps = [i for i in range(1, max(steps) + 1) if i not in steps]
         if gaps:
             raise PlannerError(f"{where}: no part at step {gaps[0]}; expected steps 1..{max(steps)}")
@@ -128,7 +132,8 @@ def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations
         origins.append(where)
     assert known is not None
     if declared and set(declared) != set(known):
-        raise PlannerError(f"{path}: part/1 facts {' '.join(declared)} differ from the demonstrated parts {' '.join(known)}")
+        raise PlannerError(f"{path}: part/1 facts {' '.join(declared)} differ from the demonstrated parts "
+                           f"{' '.join(known)}")
     return Demonstrations(tuple(known), tuple(sequences), tuple(origins))
 
 

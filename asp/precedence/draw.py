@@ -70,7 +70,8 @@ def draw_png(relation: Relation, reduction: list[Pair], path: Path | str, title:
     layers = int(max(x for x, _ in position.values())) + 1
     figure, axis = plt.subplots(figsize=(2 + 1.6 * layers, 4))
     implied = [(a, b) for a, b, d in graph.edges(data=True) if not d["reduced"]]
-    nx.draw_networkx_edges(graph, position, edgelist=implied, edge_color="0.8", ax=axis, connectionstyle="arc3,rad=0.15")
+    nx.draw_networkx_edges(graph, position, edgelist=implied, edge_color="0.8", ax=axis,
+                           connectionstyle="arc3,rad=0.15")
     nx.draw_networkx_edges(graph, position, edgelist=reduction, edge_color="black", ax=axis, width=1.5)
     nx.draw_networkx_nodes(graph, position, node_color="white", edgecolors="black", node_size=700, ax=axis)
     nx.draw_networkx_labels(graph, position, ax=axis, font_size=9)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -36,7 +37,7 @@ def _histogram(admitted: np.ndarray, total: int) -> dict[str, float]:
 
 def evaluate(
     truth: Relation, ms: Sequence[int], trials: int, seed: int, progress: bool = False, generator: str = "uniform"
-) -> dict[str, object]:
+) -> dict[str, Any]:
     """``{"total": N, "generator": g, "results": [{"m", "mean", "p_all", "p_more_than_half", "histogram"}]}``."""
     from tqdm import tqdm
 

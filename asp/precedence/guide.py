@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import random
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -133,7 +134,7 @@ def random_demonstrations(batches: ExtensionBatches, trials: int, rng: np.random
     return needed
 
 
-def evaluate_guided(truth: Relation, trials: int, seed: int, progress: bool = False) -> dict[str, object]:
+def evaluate_guided(truth: Relation, trials: int, seed: int, progress: bool = False) -> dict[str, Any]:
     """``{"total", "demos_to_exact", "mean", "random_mean"}`` over ``trials`` simulated teachers.
 
     ``demos_to_exact`` maps a number of demonstrations to how many guided trials

@@ -17,7 +17,7 @@ import clingo
 import numpy as np
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, fact, load_atoms
+from asp.solve import atoms_by_name, fact, load_atoms, pairs_by_name
 from bridge.assembly import Assembly
 
 Pair = tuple[str, str]
@@ -82,13 +82,13 @@ def close(relation: Relation, source: str = "precedence constraints") -> Relatio
             f"{source}: the constraints contain a cycle through {', '.join(c[0] for c in cycle)}; "
             "expected an acyclic precedence relation"
         )
-    return Relation.from_pairs(relation.parts, atoms_by_name(atoms, "must_precede", 2))
+    return Relation.from_pairs(relation.parts, pairs_by_name(atoms, "must_precede"))
 
 
 def reduction(relation: Relation) -> list[Pair]:
     """Transitive reduction (``precedence_edge`` pairs) of a closed acyclic relation."""
     atoms = load_atoms([], encodings=["precedence_reduction.lp"], extra=_relation_facts(relation, "must_precede"))
-    return [(a, b) for a, b in atoms_by_name(atoms, "precedence_edge", 2)]
+    return pairs_by_name(atoms, "precedence_edge")
 
 
 def precedence_facts(relation: Relation) -> list[clingo.Symbol]:
@@ -109,7 +109,7 @@ def load_relation(paths: Sequence[Path | str]) -> Relation:
     parts = [p for (p,) in atoms_by_name(atoms, "part", 1)]
     if not parts:
         raise PlannerError(f"{names}: expected part/1 facts naming the parts of the assembly")
-    pairs = atoms_by_name(atoms, "must_precede", 2)
+    pairs = pairs_by_name(atoms, "must_precede")
     unknown = sorted({x for pair in pairs for x in pair} - set(parts))
     if unknown:
         raise PlannerError(f"{names}: must_precede/precedence_edge name '{unknown[0]}', which is not a part/1")

@@ -24,8 +24,9 @@ import random
 import statistics
 import sys
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from asp import PlannerError
 from asp.sizes.learner import SizeLearner, run_learner
@@ -85,6 +86,7 @@ class Evaluation:
 def relabeled_matrices(truth: TruthOracle, relabelings: str | int, seed: int) -> list[Matrix]:
     """The truth matrix under every relabeling (``"all"``) or ``N`` random ones."""
     rows, cols = range(len(truth.parts)), range(len(truth.holes))
+    orders: Iterable[tuple[tuple[int, ...], tuple[int, ...]]]
     if relabelings == "all":
         orders = itertools.product(itertools.permutations(rows), itertools.permutations(cols))
     else:
@@ -183,6 +185,7 @@ def walk_subtree(task: Task) -> Counter[int]:
 def _pool_map(function, tasks: Sequence, processes: int, unit: str) -> list:
     """``map`` over a process pool (serial for few tasks); a progress bar on a terminal."""
     pool = None
+    iterator: Iterator[Any]
     if processes > 1 and len(tasks) > 1:
         pool = multiprocessing.get_context("fork").Pool(processes)
         chunk = max(1, min(64, len(tasks) // (processes * 8)))

@@ -118,12 +118,22 @@ class SizeLearner:
         self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
         self._ground(seed)
         self._pairs = [(p, h) for p in self.parts for h in self.holes]
-        self._literals = {
-            (*pair, r): self._ctl.symbolic_atoms[fact("observed", *pair, r)].literal
-            for pair in self._pairs for r in RESULTS
-        }
+        self._literals = {(*pair, r): self._literal(fact("observed", *pair, r))
+                          for pair in self._pairs for r in RESULTS}
         self._selected: Pair | None = None
         self.knowledge = self._solve()
+
+    def _pair(self, symbol: clingo.Symbol) -> Pair:
+        """The (part, hole) arguments of a decoded ``select/2`` or ``essential/2`` atom."""
+        part, hole = self._decoded[symbol][1]
+        return part, hole
+
+    def _literal(self, atom: clingo.Symbol) -> int:
+        """The solver literal of a ground ``#external`` atom."""
+        found = self._ctl.symbolic_atoms[atom]
+        if found is None:
+            raise PlannerError(f"{atom}: not declared as an external of the learner's program")
+        return found.literal
 
     def _ground(self, seed: int) -> None:
         atoms = [fact("part", p) for p in self.parts] + [fact("hole", h) for h in self.holes]
@@ -145,9 +155,9 @@ class SizeLearner:
         if not result.satisfiable:
             raise PlannerError(f"policy {self.policy.name}: no model for the current knowledge")
         knowledge = Knowledge.from_symbols(self.parts, self.holes, last, self._decoded)
-        selected = [self._decoded[s][1] for s in last if self._decoded[s][0] == "select"]
+        selected = [self._pair(s) for s in last if self._decoded[s][0] == "select"]
         self._selected = selected[0] if len(selected) == 1 else None
-        essential = {self._decoded[s][1] for s in last if self._decoded[s][0] == "essential"}
+        essential = {self._pair(s) for s in last if self._decoded[s][0] == "essential"}
         self._essential = tuple(pair for pair in self._pairs if pair in essential)
         return knowledge
 
@@ -191,10 +201,7 @@ class SizeLearner:
             return due[0]
         if self.knowledge.complete:
             return None
-        if self.policy.choose is not None:
-            pair = self.policy.choose(self.knowledge, self.rng)
-        else:
-            pair = self._selected
+        pair: Pair | None = self.policy.choose(self.knowledge, self.rng) if self.policy.choose else self._selected
         if pair is None or self.knowledge.result(*pair) is not None:
             raise PlannerError(f"policy {self.policy.name} chose {pair}, not an unknown pair")
         return pair
@@ -264,12 +271,12 @@ class SizeLearner:
         self.knowledge = self._solve()
         return chosen
 
-    def _candidates(self, choice: Pair, out: list[Pair]) -> list[Pair]:
+    def _candidates(self, choice: Pair | None, out: list[Pair]) -> list[Pair]:
         """Unknown pairs not in ``out``, best first for a batch beside ``out``: the
         policy's ``batch_rank`` given ``out`` if it has one (with nothing out, its
         ``choice`` first), else its ``choice``, then index order."""
         rank = self.policy.batch_rank
-        first = [choice] if rank is None or not out else []
+        first = [choice] if choice is not None and (rank is None or not out) else []
         rest = self.knowledge.unknown if rank is None else rank(self.knowledge, out)
         return [p for p in dict.fromkeys([*first, *rest]) if p not in out]
 

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, load_atoms
+from asp.solve import atoms_by_name, load_atoms, pairs_by_name
 from bridge.assembly import load_assembly
 
 Result = Literal["fit", "no_fit"]
@@ -91,7 +91,7 @@ class TruthOracle:
 
         parts.sort(key=mention)
         holes.sort(key=mention)
-        fits = {(p, h) for p, h in atoms_by_name(atoms, "fits", 2)}
+        fits = set(pairs_by_name(atoms, "fits"))
         return cls(parts, holes, fits, source=str(path))
 
     @classmethod
