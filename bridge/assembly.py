@@ -29,22 +29,26 @@ _ID = re.compile(ID_PATTERN)
 
 
 @dataclass(frozen=True)
-class Part:
-    """One part of an assembly; ``start`` is its waiting position [m] or None."""
+class Item:
+    """A part or a hole: its id (an ASP constant) and a readable name."""
 
     id: str
     name: str
-    role: str
+
+
+@dataclass(frozen=True)
+class Part(Item):
+    """One part of an assembly; ``start`` is its waiting position [m] or None."""
+
+    role: str = "part"
     start: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
-class Hole:
+class Hole(Item):
     """One hole of the base plate; ``position`` [m] or None."""
 
-    id: str
-    name: str
-    shape: str
+    shape: str = "round"
     position: tuple[float, float] | None = None
 
 
@@ -124,23 +128,15 @@ def load_assembly(name_or_path: str) -> Assembly:
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise BridgeError(f"{source}: not valid TOML: {exc}") from None
     parts = tuple(
-        Part(
-            id=key,
-            name=str(value.get("name", key)),
-            role=str(value.get("role", "part")),
-            start=_position(source, "parts", key, value.get("start")),
-        )
+        Part(key, str(value.get("name", key)), str(value.get("role", "part")),
+             _position(source, "parts", key, value.get("start")))
         for key, value in _table(source, data, "parts").items()
     )
     if not parts:
         raise BridgeError(f"{source}: expected at least one [parts.<id>] table")
     holes = tuple(
-        Hole(
-            id=key,
-            name=str(value.get("name", key)),
-            shape=str(value.get("shape", "round")),
-            position=_position(source, "holes", key, value.get("position")),
-        )
+        Hole(key, str(value.get("name", key)), str(value.get("shape", "round")),
+             _position(source, "holes", key, value.get("position")))
         for key, value in _table(source, data, "holes").items()
     )
     clash = {p.id for p in parts} & {h.id for h in holes}
