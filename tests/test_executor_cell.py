@@ -6,7 +6,6 @@ import dataclasses
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pybullet as pb
@@ -64,14 +63,13 @@ def test_same_seed_same_trial(cell):
         fresh.close()
 
 
-def test_same_seed_same_trial_in_other_processes():
+def test_same_seed_same_trial_in_other_processes(root, cli_env):
     """Bit for bit across processes, also after the cell switched part shapes."""
     code = ("from executor.trial import Cell; c = Cell(); c.run_trial('p3', 'r1', 3); "
             "r = c.run_trial('tp', 'r1', 3).to_json(); "
             "print(repr((r['outcome'], r['max_force_dev'], r['max_torque_dev'], r['end_error'])))")
-    root = Path(__file__).resolve().parent.parent
     procs = [subprocess.Popen([sys.executable, "-c", code], cwd=root, stdout=subprocess.PIPE,
-                              stderr=subprocess.DEVNULL, text=True, env={"PYTHONPATH": str(root)})
+                              stderr=subprocess.DEVNULL, text=True, env=cli_env)
              for _ in range(3)]
     outputs = {p.communicate(timeout=120)[0] for p in procs}
     assert len(outputs) == 1 and "fit" in outputs.pop()

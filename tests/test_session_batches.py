@@ -21,7 +21,6 @@ from asp.biorders import all_biorders, consistent_index
 from asp.oracle import TruthOracle
 from asp.size_knowledge import Knowledge, Pair
 from asp.size_learner import SizeLearner
-from tests.test_session_cells import run_session
 
 TRUTH = TruthOracle.from_assembly("cranfield")
 BEST_TWO_CELLS = 21
@@ -85,7 +84,7 @@ def test_three_cells_keep_batches_independent_for_every_policy(policy: str) -> N
 
 
 @pytest.mark.timeout(90)
-def test_a_two_cell_session_needs_no_more_experiments_than_measured(tmp_path) -> None:
+def test_a_two_cell_session_needs_no_more_experiments_than_measured(tmp_path, run_session) -> None:
     result = run_session("--cells", "2", "--out", str(tmp_path / "run"))
     assert result["matches_truth"] is True
     assert result["experiments"] <= BEST_TWO_CELLS
