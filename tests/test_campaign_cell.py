@@ -7,7 +7,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from bridge.recordings import column_values, read_recording
+
+pytestmark = pytest.mark.slow  # real PyBullet campaigns, 10-15 s each
 
 
 def test_mini_campaign_with_plots(tmp_path: Path, run_executor) -> None:

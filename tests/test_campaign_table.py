@@ -58,6 +58,7 @@ def test_pairs_are_fig18_rows_then_every_non_fitting_pair() -> None:
         select_pairs("p9:r1")
 
 
+@pytest.mark.slow
 def test_counts_seeds_and_two_workers_match_one() -> None:
     pairs = campaign_pairs()
     serial = run_campaign(pairs, trials=4, seed=100, workers=1,
@@ -108,6 +109,7 @@ def _trace(part: str, outcome: str, stop_at: float) -> Any:
     return trace
 
 
+@pytest.mark.slow
 def test_figures_are_written(tmp_path: Path) -> None:
     # Imported here: worker processes of the test above import this module.
     from executor.campaign_plots import plot_fig17, plot_fig18

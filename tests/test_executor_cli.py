@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 import shutil
 
+import pytest
+
 
 def test_unknown_part_exits_2_naming_it(run_executor):
     proc = run_executor("trial", "--part", "zz", "--hole", "r1")
@@ -27,6 +29,7 @@ def test_part_without_demonstration_exits_2(tmp_path, root, run_executor):
     assert "no demonstration" in proc.stderr and "round_peg" in proc.stderr
 
 
+@pytest.mark.slow
 def test_trial_json_contract_and_rerun_file(tmp_path, run_executor):
     rrd = tmp_path / "trial.rrd"
     proc = run_executor("trial", "--part", "p4", "--hole", "s2", "--seed", "4", "--json", "--rrd", str(rrd))

@@ -114,6 +114,7 @@ def _steps(atoms: list[tuple[str, str, str]]) -> list[PlanStep]:
     return [PlanStep(p, None if h == "none" else h) for _, p, h in sorted(atoms, key=lambda a: int(a[0]))]
 
 
+@pytest.mark.slow
 def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path, run_cli, run_python) -> None:
     done = run_cli("plan", str(learned), "-n", "3", "--json")
     report = json.loads(done.stdout)

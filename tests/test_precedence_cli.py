@@ -11,6 +11,7 @@ from asp.relation import load_relation, true_relation
 from bridge.assembly import load_assembly
 
 
+@pytest.mark.slow
 def test_learn_json_facts_dot_png_and_count_of_the_facts(tmp_path: Path, root: Path, run_cli) -> None:
     out, dot, png = tmp_path / "learned.lp", tmp_path / "g.dot", tmp_path / "g.png"
     result = run_cli("precedence", "learn", str(root / "data/battery/demos.txt"), "--json",
@@ -38,6 +39,7 @@ def test_count_and_sample_from_the_assembly(root: Path, run_cli) -> None:
     assert all(truth.admits(line.split()) for line in lines)
 
 
+@pytest.mark.slow
 def test_evaluate_json_plot_and_guided_keys(tmp_path: Path, run_cli) -> None:
     plot = tmp_path / "fig12.png"
     result = run_cli("precedence", "evaluate", "--assembly", "cranfield", "--m", "5,20", "--trials", "200", "--json", "--plot", str(plot))

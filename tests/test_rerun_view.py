@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from rerun.chunk import RrdReader
 
 from asp.view import cell_ids, write_blueprint
@@ -26,6 +27,7 @@ def _run_folder(folder: Path) -> Path:
     return folder
 
 
+@pytest.mark.slow
 def test_view_prints_the_recording_without_display(tmp_path: Path, run_cli) -> None:
     run = _run_folder(tmp_path / "run")
     text = run_cli("view", str(run))
@@ -41,6 +43,7 @@ def test_view_prints_the_recording_without_display(tmp_path: Path, run_cli) -> N
     assert not any(p.startswith("/executor/c1") for p in data["entities"])
 
 
+@pytest.mark.slow
 def test_view_without_recording_exits_2(tmp_path: Path, run_cli) -> None:
     empty = run_cli("view", str(tmp_path), "--print")
     assert empty.returncode == 2 and "holds no Rerun recording" in empty.stderr

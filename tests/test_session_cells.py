@@ -26,7 +26,7 @@ from asp.journal import read_journal
 from asp.oracle import TruthOracle
 from bridge.session import free_loopback_endpoint
 
-pytestmark = pytest.mark.timeout(90)
+pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
 TRUTH = TruthOracle.from_assembly("cranfield")
 
 

@@ -6,7 +6,10 @@ import shutil
 import time
 from pathlib import Path
 
+import pytest
 
+
+@pytest.mark.slow
 def test_a_cell_dying_at_start_up_fails_the_session_at_once(tmp_path: Path, root: Path, run_cli) -> None:
     assembly = tmp_path / "no_geometry"
     shutil.copytree(root / "data" / "cranfield", assembly)

@@ -34,6 +34,7 @@ def test_learn_from_a_truth_file_keeps_its_order(tmp_path: Path, run_cli) -> Non
     assert sorted(map(tuple, report["fits"])) == [("big", "wide"), ("small", "narrow"), ("small", "wide")]
 
 
+@pytest.mark.slow
 def test_evaluate_json_follows_the_contract(tmp_path: Path, run_cli) -> None:
     plot = tmp_path / "fig19.png"
     done = run_cli("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "30",
