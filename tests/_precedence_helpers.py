@@ -35,7 +35,8 @@ def greedy_extension(relation: Relation, priority: list[int]) -> tuple[str, ...]
     n = len(relation.parts)
     placed: list[int] = []
     while len(placed) < n:
-        free = [x for x in range(n) if x not in placed and all(p in placed for p in np.flatnonzero(relation.matrix[:, x]))]
+        free = [x for x in range(n)
+                if x not in placed and all(p in placed for p in np.flatnonzero(relation.matrix[:, x]))]
         placed.append(max(free, key=lambda x: priority[x]))
     return tuple(relation.parts[i] for i in placed)
 

@@ -66,7 +66,9 @@ def test_counts_seeds_and_two_workers_match_one() -> None:
     barrier = multiprocessing.get_context("spawn").Barrier(2)
     parallel = run_campaign(pairs, trials=4, seed=100, workers=2,
                             factory=functools.partial(fake_runner, 4, barrier))
-    strip = lambda rs: [[{k: v for k, v in r.items() if k != "pid"} for r in row] for row in rs]
+    def strip(rows: list[list[dict[str, Any]]]) -> list[list[dict[str, Any]]]:
+        return [[{k: v for k, v in r.items() if k != "pid"} for r in row] for row in rows]
+
     assert strip(serial) == strip(parallel)
     assert len({r["pid"] for row in parallel for r in row}) == 2, "both workers did trials"
     seeds = [r["seed"] for row in serial for r in row]

@@ -62,8 +62,8 @@ def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellPro
         cells.append(start_cell(cell_id, backend="truth", listen=[endpoint], delay_s=0.5))
     run = tmp_path / "run"
     connect = [arg for ep in endpoints for arg in ("--connect", ep)]
-    planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run), "--policy", "best"),
-                               cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    argv = cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run), "--policy", "best")
+    planner = subprocess.Popen(argv, cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         cells[0].wait_for_line("start", timeout=30, count=3)
         cells[0].kill()
