@@ -1,19 +1,12 @@
-"""Shared helpers of the precedence tests: random posets, feasible sequences, CLI runs."""
+"""Shared helpers of the precedence tests: random posets, feasible sequences."""
 
 from __future__ import annotations
-
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import networkx as nx
 import numpy as np
 from hypothesis import strategies as st
 
 from asp.precedence.relation import Relation
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def closed_relation(parts: list[str], edges: list[tuple[int, int]]) -> Relation:
@@ -42,7 +35,8 @@ def greedy_extension(relation: Relation, priority: list[int]) -> tuple[str, ...]
     n = len(relation.parts)
     placed: list[int] = []
     while len(placed) < n:
-        free = [x for x in range(n) if x not in placed and all(p in placed for p in np.flatnonzero(relation.matrix[:, x]))]
+        free = [x for x in range(n)
+                if x not in placed and all(p in placed for p in np.flatnonzero(relation.matrix[:, x]))]
         placed.append(max(free, key=lambda x: priority[x]))
     return tuple(relation.parts[i] for i in placed)
 
@@ -55,8 +49,3 @@ def poset_with_demos(draw: st.DrawFn, max_parts: int = 7, max_demos: int = 6) ->
     priorities = draw(st.lists(st.permutations(range(n)), min_size=1, max_size=max_demos))
     return truth, [greedy_extension(truth, list(p)) for p in priorities]
 
-
-def run_cli(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
-    """``python -m asp.cli ARGS`` as a separate process (like ./run.sh)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.run([sys.executable, "-m", "asp.cli", *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=120)

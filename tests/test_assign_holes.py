@@ -5,9 +5,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import os
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
@@ -16,6 +13,7 @@ from clintest.assertion import Equals, Or, True_
 from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
+from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -30,7 +28,6 @@ from asp.plans.assign import (
 from asp.plans.plans import check_assignment
 from asp.solve import encoding, fact, write_facts
 
-ROOT = Path(__file__).resolve().parent.parent
 ASSIGNMENTS_LP = str(encoding("assignments.lp"))
 CRANFIELD_SIZES = ROOT / "data" / "cranfield" / "sizes.lp"
 
@@ -161,34 +158,26 @@ def test_feasible_assignment_when_greedy_gets_stuck() -> None:
     assert assignment in _brute_force(facts) and check_assignment(facts, assignment) == []
 
 
-def _assign(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "asp.cli", "assign", *args],
-        cwd=ROOT, capture_output=True, text=True, timeout=60,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )
-
-
-def test_assign_command_json(tmp_path: Path) -> None:
-    greedy = json.loads(_assign(str(CRANFIELD_SIZES), "--json").stdout)
-    every = json.loads(_assign(str(CRANFIELD_SIZES), "--all", "--json").stdout)
+def test_assign_command_json(tmp_path: Path, run_cli) -> None:
+    greedy = json.loads(run_cli("assign", str(CRANFIELD_SIZES), "--json").stdout)
+    every = json.loads(run_cli("assign", str(CRANFIELD_SIZES), "--all", "--json").stdout)
     facts = load_learned_facts([CRANFIELD_SIZES])
     assert list(greedy) == ["assignments"] and len(greedy["assignments"]) == 1
     assert greedy["assignments"][0] in every["assignments"]
     assert every["assignments"] == all_assignments(facts)
 
 
-def test_assign_command_names_the_part_without_hole(tmp_path: Path) -> None:
+def test_assign_command_names_the_part_without_hole(tmp_path: Path, run_cli) -> None:
     path = _facts_file(tmp_path, {"a": ["h1", "h2"], "b": ["h2"], "c": ["h2"]}, ["h1", "h2"])
     for extra in ([], ["--all"]):
-        done = _assign(str(path), "--json", *extra)
+        done = run_cli("assign", str(path), "--json", *extra)
         assert done.returncode == 3
         report = json.loads(done.stdout)
         assert report["assignments"] == [] and report["part"] in ("b", "c")
         assert f"part {report['part']}" in done.stderr
 
 
-def test_assign_command_bad_input(tmp_path: Path) -> None:
+def test_assign_command_bad_input(tmp_path: Path, run_cli) -> None:
     broken = tmp_path / "broken.lp"
     broken.write_text("part(a). fits(a,\n")
     unknown = tmp_path / "unknown.lp"
@@ -196,6 +185,6 @@ def test_assign_command_bad_input(tmp_path: Path) -> None:
     reserved = tmp_path / "reserved.lp"
     reserved.write_text("part(a). hole(none). fits(a,none).\n")
     for path, word in ((broken, "parse"), (unknown, "zz"), (reserved, "reserved")):
-        done = _assign(str(path))
+        done = run_cli("assign", str(path))
         assert done.returncode == 2 and word in done.stderr
-    assert _assign("--help").returncode == 0
+    assert run_cli("assign", "--help").returncode == 0

@@ -27,7 +27,8 @@ PARTS_2X2 = "part(a;b). hole(x;y). "
     "name,facts,count",
     [
         ("2x2 nothing known: all 14 biorders", PARTS_2X2 + "unknown((a;b),(x;y)).", 14),
-        ("2x2 a fits x: 8 relations, 7 without the crossing", PARTS_2X2 + "fits(a,x). unknown(a,y). unknown(b,(x;y)).", 7),
+        ("2x2 a fits x: 8 relations, 7 without the crossing",
+         PARTS_2X2 + "fits(a,x). unknown(a,y). unknown(b,(x;y)).", 7),
         ("crossing fits is not a biorder: unsat",
          PARTS_2X2 + "fits(a,x). no_fit(a,y). fits(b,y). no_fit(b,x).", 0),
         ("everything known: one relation", PARTS_2X2 + "fits(a,(x;y)). no_fit(b,(x;y)).", 1),

@@ -9,6 +9,7 @@ i.e. beating systematic somewhere forces losing elsewhere.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from _sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
 
 from asp.sizes.best import choose_bit
@@ -58,6 +59,7 @@ def learner_count(truth: np.ndarray, policy: str) -> int:
     return result.count
 
 
+@pytest.mark.slow
 def test_best_needs_fewer_experiments_than_systematic_on_random_8x8_biorders() -> None:
     """Sampled path: seeded random biorders with ties, 6..8 parts and holes, in total.
 

@@ -84,6 +84,7 @@ def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
     assert gone.get(timeout=10) == "c1"
 
 
+@pytest.mark.slow
 def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(network) -> None:
     endpoint, session, directory, cells = network
     for cell_id in ("c1", "c2"):

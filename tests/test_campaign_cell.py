@@ -5,23 +5,18 @@ are bitwise the same on one worker or two (seeds do not depend on scheduling).""
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
+
+import pytest
 
 from bridge.recordings import column_values, read_recording
 
-ROOT = Path(__file__).resolve().parent.parent
+pytestmark = pytest.mark.slow  # real PyBullet campaigns, 10-15 s each
 
 
-def test_mini_campaign_with_plots(tmp_path: Path) -> None:
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    done = subprocess.run(
-        [sys.executable, "-m", "executor.cli", "campaign", "--trials", "1", "--seed", "3",
-         "--pairs", "p1:br,p3:r1", "--workers", "2", "--json", "--plot", str(tmp_path)],
-        cwd=ROOT, env=env, capture_output=True, text=True, timeout=240,
-    )
+def test_mini_campaign_with_plots(tmp_path: Path, run_executor) -> None:
+    done = run_executor("campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1", "--workers", "2",
+                        "--json", "--plot", str(tmp_path), timeout=240)
     assert done.returncode == 0, done.stdout + done.stderr
     report = json.loads(done.stdout)
     assert report["all_correct"] and report["false_fits"] == 0 and report["workers"] == 2

@@ -58,6 +58,7 @@ def test_pairs_are_fig18_rows_then_every_non_fitting_pair() -> None:
         select_pairs("p9:r1")
 
 
+@pytest.mark.slow
 def test_counts_seeds_and_two_workers_match_one() -> None:
     pairs = campaign_pairs()
     serial = run_campaign(pairs, trials=4, seed=100, workers=1,
@@ -65,7 +66,9 @@ def test_counts_seeds_and_two_workers_match_one() -> None:
     barrier = multiprocessing.get_context("spawn").Barrier(2)
     parallel = run_campaign(pairs, trials=4, seed=100, workers=2,
                             factory=functools.partial(fake_runner, 4, barrier))
-    strip = lambda rs: [[{k: v for k, v in r.items() if k != "pid"} for r in row] for row in rs]
+    def strip(rows: list[list[dict[str, Any]]]) -> list[list[dict[str, Any]]]:
+        return [[{k: v for k, v in r.items() if k != "pid"} for r in row] for row in rows]
+
     assert strip(serial) == strip(parallel)
     assert len({r["pid"] for row in parallel for r in row}) == 2, "both workers did trials"
     seeds = [r["seed"] for row in serial for r in row]
@@ -108,6 +111,7 @@ def _trace(part: str, outcome: str, stop_at: float) -> Any:
     return trace
 
 
+@pytest.mark.slow
 def test_figures_are_written(tmp_path: Path) -> None:
     # Imported here: worker processes of the test above import this module.
     from executor.campaign_plots import plot_fig17, plot_fig18

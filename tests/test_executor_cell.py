@@ -6,7 +6,6 @@ import dataclasses
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pybullet as pb
@@ -41,6 +40,7 @@ def test_fitting_peg_goes_in_and_sits_at_the_goal(cell):
     assert result.max_force_dev < cell.thresholds.f_stop
 
 
+@pytest.mark.slow
 def test_too_big_peg_is_reported_not_fitting_after_two_attempts(cell):
     result = cell.run_trial("p3", "r1", seed=3)
     assert result.outcome == "no_fit"
@@ -52,6 +52,7 @@ def test_too_big_peg_is_reported_not_fitting_after_two_attempts(cell):
         assert not ev.jammed and ev.wiggles == 0  # blocked on the surface is no jam
 
 
+@pytest.mark.slow
 def test_same_seed_same_trial(cell):
     first = cell.run_trial("p2", "s2", seed=11).to_json()
     cell.run_trial("sh", "br", seed=5)  # something else in between
@@ -64,14 +65,14 @@ def test_same_seed_same_trial(cell):
         fresh.close()
 
 
-def test_same_seed_same_trial_in_other_processes():
+@pytest.mark.slow
+def test_same_seed_same_trial_in_other_processes(root, cli_env):
     """Bit for bit across processes, also after the cell switched part shapes."""
     code = ("from executor.trial import Cell; c = Cell(); c.run_trial('p3', 'r1', 3); "
             "r = c.run_trial('tp', 'r1', 3).to_json(); "
             "print(repr((r['outcome'], r['max_force_dev'], r['max_torque_dev'], r['end_error'])))")
-    root = Path(__file__).resolve().parent.parent
     procs = [subprocess.Popen([sys.executable, "-c", code], cwd=root, stdout=subprocess.PIPE,
-                              stderr=subprocess.DEVNULL, text=True, env={"PYTHONPATH": str(root)})
+                              stderr=subprocess.DEVNULL, text=True, env=cli_env)
              for _ in range(3)]
     outputs = {p.communicate(timeout=120)[0] for p in procs}
     assert len(outputs) == 1 and "fit" in outputs.pop()
@@ -88,6 +89,7 @@ def test_different_seeds_differ(cell):
 JAM = AttemptSetup(np.zeros(3), np.array([0.0, np.radians(4.0), 0.0]), np.zeros(2), search_seed=1)
 
 
+@pytest.mark.slow
 def test_tight_peg_jam_is_resolved_by_the_wiggle(cell):
     stuck = cell.run_attempt("tp", "r1", JAM, wiggle_enabled=False)
     assert stuck.jammed and stuck.outcome == "no_fit"

@@ -4,42 +4,35 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+import pytest
 
 
-def _run(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "executor.cli", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=timeout, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
-
-
-def test_unknown_part_exits_2_naming_it():
-    proc = _run("trial", "--part", "zz", "--hole", "r1")
+def test_unknown_part_exits_2_naming_it(run_executor):
+    proc = run_executor("trial", "--part", "zz", "--hole", "r1")
     assert proc.returncode == 2
     assert "unknown part 'zz'" in proc.stderr and "p1" in proc.stderr
     assert "Traceback" not in proc.stderr
 
 
-def test_unknown_hole_exits_2_naming_it():
-    proc = _run("trial", "--part", "p1", "--hole", "h9")
+def test_unknown_hole_exits_2_naming_it(run_executor):
+    proc = run_executor("trial", "--part", "p1", "--hole", "h9")
     assert proc.returncode == 2
     assert "unknown hole 'h9'" in proc.stderr
 
 
-def test_part_without_demonstration_exits_2(tmp_path):
+def test_part_without_demonstration_exits_2(tmp_path, root, run_executor):
     folder = tmp_path / "cell"
-    shutil.copytree(ROOT / "data" / "cranfield", folder, ignore=shutil.ignore_patterns("demonstrations"))
-    proc = _run("trial", "--part", "p1", "--hole", "r1", "--assembly", str(folder))
+    shutil.copytree(root / "data" / "cranfield", folder, ignore=shutil.ignore_patterns("demonstrations"))
+    proc = run_executor("trial", "--part", "p1", "--hole", "r1", "--assembly", str(folder))
     assert proc.returncode == 2
     assert "no demonstration" in proc.stderr and "round_peg" in proc.stderr
 
 
-def test_trial_json_contract_and_rerun_file(tmp_path):
+@pytest.mark.slow
+def test_trial_json_contract_and_rerun_file(tmp_path, run_executor):
     rrd = tmp_path / "trial.rrd"
-    proc = _run("trial", "--part", "p4", "--hole", "s2", "--seed", "4", "--json", "--rrd", str(rrd))
+    proc = run_executor("trial", "--part", "p4", "--hole", "s2", "--seed", "4", "--json", "--rrd", str(rrd))
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     trial = out["trials"][0]

@@ -4,17 +4,14 @@ from __future__ import annotations
 
 import math
 import re
-from pathlib import Path
 
 from executor.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
 
-ROOT = Path(__file__).resolve().parent.parent
 
-
-def test_sizes_make_fig5_true():
+def test_sizes_make_fig5_true(root):
     """The truth backend of the cell answers from these cross-sections: they must give sizes.lp."""
     geometry = load_geometry("cranfield")
-    truth = set(re.findall(r"fits\((\w+),(\w+)\)", (ROOT / "data/cranfield/sizes.lp").read_text()))
+    truth = set(re.findall(r"fits\((\w+),(\w+)\)", (root / "data/cranfield/sizes.lp").read_text()))
     for pid in ("p1", "p2", "p3", "p4", "sh"):
         for hid, hole in geometry.holes.items():
             assert passes(geometry.parts[pid], hole) == ((pid, hid) in truth), (pid, hid)

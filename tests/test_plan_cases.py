@@ -14,6 +14,7 @@ from clintest.assertion import Assertion, Equals, Or, True_
 from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
+from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -21,7 +22,7 @@ from asp.plans.assign import LearnedFacts, UnsolvableAssembly, load_learned_fact
 from asp.plans.plans import PlanStep, check_plan, plans
 from asp.solve import fact, write_facts
 
-ENCODINGS = Path(__file__).resolve().parent.parent / "asp" / "encodings"
+ENCODINGS = ROOT / "asp" / "encodings"
 
 # name, facts, expected models (their plan_step/3 atoms); [] = unsatisfiable
 PLAN_CASES = [

@@ -7,13 +7,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
@@ -23,7 +21,6 @@ from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
 from asp.solve import load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 
-ROOT = Path(__file__).resolve().parent.parent
 CRANFIELD = ROOT / "data" / "cranfield"
 
 
@@ -112,62 +109,56 @@ def test_optimal_plans_of_random_cells_match_brute_force(
         assert check_plan(facts, plan.steps) == []
 
 
-def _run(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", *args], cwd=ROOT, capture_output=True, text=True, timeout=120,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )
-
-
 def _steps(atoms: list[tuple[str, str, str]]) -> list[PlanStep]:
     return [PlanStep(p, None if h == "none" else h) for _, p, h in sorted(atoms, key=lambda a: int(a[0]))]
 
 
-def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path) -> None:
-    done = _run("asp.cli", "plan", str(learned), "-n", "3", "--json")
+@pytest.mark.slow
+def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path, run_cli, run_python) -> None:
+    done = run_cli("plan", str(learned), "-n", "3", "--json")
     report = json.loads(done.stdout)
     assert done.returncode == 0 and list(report) == ["plans"] and len(report["plans"]) == 3
     for plan in report["plans"]:
         assert all(set(step) == {"part", "hole"} for step in plan)
         assert check_plan(facts, [PlanStep(s["part"], s["hole"]) for s in plan]) == []
     travel_file = tmp_path / "travel.lp"
-    done = _run("asp.cli", "plan", str(learned), "--optimal", "--assembly", "cranfield",
+    done = run_cli("plan", str(learned), "--optimal", "--assembly", "cranfield",
                 "--json", "--travel-out", str(travel_file))
     report = json.loads(done.stdout)
     assert report["cost"] == _brute_force_optimum(facts, load_assembly("cranfield"))[0] and len(report["plans"]) == 1
     assert check_plan(facts, [PlanStep(s["part"], s["hole"]) for s in report["plans"][0]]) == []
     # the same optimum from the plain clingo command line with the written travel facts
-    done = _run("clingo", str(ROOT / "asp/encodings/plans_optimal.lp"), str(learned),
+    done = run_python("clingo", str(ROOT / "asp/encodings/plans_optimal.lp"), str(learned),
                 str(travel_file), "--opt-mode=opt", "--configuration=crafty")
     assert "OPTIMUM FOUND" in done.stdout
     assert re.findall(r"^Optimization: (\d+)$", done.stdout, re.M)[-1] == str(report["cost"])
 
 
-def test_plan_command_errors(learned: Path, tmp_path: Path) -> None:
-    assert _run("asp.cli", "plan", "--help").returncode == 0
-    no_geometry = _run("asp.cli", "plan", str(learned), "--optimal")
+def test_plan_command_errors(learned: Path, tmp_path: Path, run_cli) -> None:
+    assert run_cli("plan", "--help").returncode == 0
+    no_geometry = run_cli("plan", str(learned), "--optimal")
     assert no_geometry.returncode == 2 and "--assembly" in no_geometry.stderr
-    too_slow = _run("asp.cli", "plan", str(learned), "--optimal", "--assembly", "cranfield",
+    too_slow = run_cli("plan", str(learned), "--optimal", "--assembly", "cranfield",
                     "--time-limit", "0.001")
     assert too_slow.returncode == 2 and "did not finish within 0.001 s" in too_slow.stderr
     cyclic = tmp_path / "cyclic.lp"
     cyclic.write_text("part(a;b). must_precede(a,b). must_precede(b,a).\n")
-    done = _run("asp.cli", "plan", str(cyclic))
+    done = run_cli("plan", str(cyclic))
     assert done.returncode == 2 and "cycle through a b" in done.stderr
     unsolvable = tmp_path / "unsolvable.lp"
     unsolvable.write_text("part(a;b). hole(h). fits(a,h). no_fit(b,h).\n")
-    done = _run("asp.cli", "plan", str(unsolvable), "--json")
+    done = run_cli("plan", str(unsolvable), "--json")
     assert done.returncode == 3 and json.loads(done.stdout)["part"] == "b"
 
 
-def test_plain_clingo_answers_the_readme_questions(learned: Path, facts: LearnedFacts) -> None:
-    five = _run("clingo", str(ROOT / "asp/encodings/plans.lp"), str(learned), "5")
+def test_plain_clingo_answers_the_readme_questions(learned: Path, facts: LearnedFacts, run_python) -> None:
+    five = run_python("clingo", str(ROOT / "asp/encodings/plans.lp"), str(learned), "5")
     answers = [line for line in five.stdout.splitlines() if "plan_step(" in line]
     assert len(answers) == 5
     for answer in answers:
         steps = _steps(re.findall(r"plan_step\((\d+),(\w+),(\w+)\)", answer))
         assert check_plan(facts, steps) == []
-    brave = _run("clingo", str(ROOT / "asp/encodings/assignments.lp"), str(learned),
+    brave = run_python("clingo", str(ROOT / "asp/encodings/assignments.lp"), str(learned),
                  "--enum-mode=brave")
     last = [line for line in brave.stdout.splitlines() if "assigned(" in line][-1]
     p3_holes = set(re.findall(r"assigned\(p3,(\w+)\)", last))

@@ -55,7 +55,8 @@ def test_cranfield_admits_5320_and_battery_truth_6() -> None:
 def test_counts_are_exact_big_integers_with_components_factored() -> None:
     free = Relation(tuple(f"q{i}" for i in range(40)), np.zeros((40, 40), dtype=bool))
     assert count_linear_extensions(free) == factorial(40)
-    chains = closed_relation([f"q{i}" for i in range(30)], [(i, i + 1) for i in range(9)] + [(i, i + 1) for i in range(10, 19)])
+    chains = closed_relation([f"q{i}" for i in range(30)],
+                             [(i, i + 1) for i in range(9)] + [(i, i + 1) for i in range(10, 19)])
     assert exact_count(chains.matrix) == factorial(30) // (factorial(10) ** 2)
 
 
@@ -92,7 +93,8 @@ def test_batched_sampler_is_uniform_and_batched_counts_are_exact() -> None:
     assert chisquare(list(draws.values())).pvalue > 1e-3
     cranfield = true_relation(load_assembly("cranfield"))
     batches = ExtensionBatches(cranfield)
-    learned = intersect_orders(positions_of(batches.sample_orders(np.random.default_rng(4), 200 * 4).reshape(200, 4, 10)))
+    orders = batches.sample_orders(np.random.default_rng(4), 200 * 4).reshape(200, 4, 10)
+    learned = intersect_orders(positions_of(orders))
     expected = [count_linear_extensions(Relation(cranfield.parts, m)) for m in learned]
     assert batches.count(learned).tolist() == expected
 

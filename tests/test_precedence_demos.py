@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from _precedence_helpers import run_cli
 
 from asp import PlannerError
 from asp.precedence.demos import demo_facts, load_demos, parse_demos
@@ -85,7 +84,7 @@ def test_demo_facts_with_a_gap_or_a_repeat_are_rejected(tmp_path: Path) -> None:
         (b"\x89PNG\r\n\x1a\n\x00\x00", ":1: binary data"),
     ],
 )
-def test_cli_bad_input_exits_2_without_traceback(tmp_path: Path, content: bytes, message: str) -> None:
+def test_cli_bad_input_exits_2_without_traceback(tmp_path: Path, content: bytes, message: str, run_cli) -> None:
     path = tmp_path / "demos.txt"
     path.write_bytes(content)
     result = run_cli("precedence", "learn", str(path), "--assembly", "cranfield")

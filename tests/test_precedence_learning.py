@@ -85,18 +85,12 @@ def test_a_wrong_demonstration_is_flagged_and_min_support_keeps_the_constraint()
     assert evidence[("r1", "r2")] == (3, 2)
 
 
-def test_learned_relation_facts_are_queryable_by_plain_clingo(tmp_path) -> None:
-    import subprocess
-    import sys
-
+def test_learned_relation_facts_are_queryable_by_plain_clingo(tmp_path, run_python) -> None:
     from asp.precedence.relation import precedence_facts
     from asp.solve import encoding, write_facts
 
     learned = learn_must_precede(parse_demos("o r2 i2 r1 i1\no r1 r2 i1 i2\n", "d.txt"))
     path = tmp_path / "learned.lp"
     write_facts(path, precedence_facts(learned))
-    result = subprocess.run(
-        [sys.executable, "-m", "clingo", str(encoding("sequences.lp")), str(path), "0", "--quiet=2"],
-        capture_output=True, text=True, timeout=60,
-    )
+    result = run_python("clingo", str(encoding("sequences.lp")), str(path), "0", "--quiet=2", timeout=60)
     assert "Models       : 5" in result.stdout

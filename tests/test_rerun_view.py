@@ -3,26 +3,15 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from rerun.chunk import RrdReader
 
 from asp.session.view import cell_ids, write_blueprint
 from bridge.recordings import blueprint_origins
 from executor.rerun_log import AttemptLogger
-
-ROOT = Path(__file__).resolve().parent.parent
-
-
-def _view(*args: str) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    env["PYTHONPATH"] = str(ROOT)
-    return subprocess.run([sys.executable, "-m", "asp.cli", "view", *args], cwd=ROOT, env=env,
-                          capture_output=True, text=True, timeout=60)
 
 
 def _run_folder(folder: Path) -> Path:
@@ -38,25 +27,27 @@ def _run_folder(folder: Path) -> Path:
     return folder
 
 
-def test_view_prints_the_recording_without_display(tmp_path: Path) -> None:
+@pytest.mark.slow
+def test_view_prints_the_recording_without_display(tmp_path: Path, run_cli) -> None:
     run = _run_folder(tmp_path / "run")
-    text = _view(str(run))
+    text = run_cli("view", str(run))
     assert text.returncode == 0, text.stderr
     assert "no display" in text.stderr
     assert "/executor/c1/scene/plate" in text.stdout and "/executor/c2/scene/plate" in text.stdout
     assert "recording ids: run-7" in text.stdout
 
-    as_json = _view(str(run / "c2.rrd"), "--json")
+    as_json = run_cli("view", str(run / "c2.rrd"), "--json")
     data = json.loads(as_json.stdout)
     assert data["recording_ids"] == ["run-7"]
     assert data["entities"]["/executor/c2/scene/plate"]["static_rows"] == 1
     assert not any(p.startswith("/executor/c1") for p in data["entities"])
 
 
-def test_view_without_recording_exits_2(tmp_path: Path) -> None:
-    empty = _view(str(tmp_path), "--print")
+@pytest.mark.slow
+def test_view_without_recording_exits_2(tmp_path: Path, run_cli) -> None:
+    empty = run_cli("view", str(tmp_path), "--print")
     assert empty.returncode == 2 and "holds no Rerun recording" in empty.stderr
-    missing = _view(str(tmp_path / "nope"))
+    missing = run_cli("view", str(tmp_path / "nope"))
     assert missing.returncode == 2 and "no such run folder" in missing.stderr
 
 

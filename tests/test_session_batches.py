@@ -21,7 +21,6 @@ from asp.sizes.biorders import all_biorders, consistent_index
 from asp.sizes.knowledge import Knowledge, Pair
 from asp.sizes.learner import SizeLearner
 from asp.sizes.oracle import TruthOracle
-from tests.test_session_cells import run_session
 
 TRUTH = TruthOracle.from_assembly("cranfield")
 BEST_TWO_CELLS = 21
@@ -73,19 +72,21 @@ def relabelings(count: int) -> list[tuple[list[str], list[str]]]:
 
 
 @pytest.mark.parametrize("seed", range(3))
+@pytest.mark.slow
 def test_two_cells_with_best_need_few_experiments_and_never_waste_one(seed: int) -> None:
     counts = [parallel_session(parts, holes, 2, "best", seed) for parts, holes in relabelings(8)]
     assert max(counts) <= BEST_TWO_CELLS, counts
 
 
-@pytest.mark.parametrize("policy", ["systematic", "heuristic", "best"])
+@pytest.mark.parametrize("policy", ["systematic", pytest.param("heuristic", marks=pytest.mark.slow), "best"])
 def test_three_cells_keep_batches_independent_for_every_policy(policy: str) -> None:
     for parts, holes in relabelings(2):
         assert parallel_session(parts, holes, 3, policy, seed=1) <= 25
 
 
 @pytest.mark.timeout(90)
-def test_a_two_cell_session_needs_no_more_experiments_than_measured(tmp_path) -> None:
+@pytest.mark.slow
+def test_a_two_cell_session_needs_no_more_experiments_than_measured(tmp_path, run_session) -> None:
     result = run_session("--cells", "2", "--out", str(tmp_path / "run"))
     assert result["matches_truth"] is True
     assert result["experiments"] <= BEST_TWO_CELLS

@@ -12,13 +12,13 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import time
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from conftest import TRUTH_SESSION
 
 from asp.session.cells import CellProcess, start_cell
 from asp.session.journal import read_journal
@@ -26,21 +26,8 @@ from asp.sizes.oracle import TruthOracle
 from asp.solve import atoms_by_name, load_atoms
 from bridge.session import free_loopback_endpoint
 
-pytestmark = pytest.mark.timeout(90)
-ROOT = Path(__file__).resolve().parent.parent
+pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
 TRUTH = TruthOracle.from_assembly("cranfield")
-
-
-def session_argv(*args: str) -> list[str]:
-    return [sys.executable, "-m", "asp.cli", "session", "--backend", "truth", "--json", *args]
-
-
-def run_session(*args: str, timeout: float = 60) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    done = subprocess.run(session_argv(*args), cwd=ROOT, env=env, capture_output=True,
-                          text=True, timeout=timeout)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
 
 
 @pytest.fixture
@@ -68,17 +55,15 @@ def assert_learned_truth(result: dict, run: Path) -> None:
     assert len(atoms_by_name(learned, "tried", 4)) == len(journal)
 
 
-def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellProcess]) -> None:
+def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv,
+                                             cli_env: dict[str, str]) -> None:
     endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
     for cell_id, endpoint in zip(("c1", "c2"), endpoints):
         cells.append(start_cell(cell_id, backend="truth", listen=[endpoint], delay_s=0.5))
     run = tmp_path / "run"
     connect = [arg for ep in endpoints for arg in ("--connect", ep)]
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    planner = subprocess.Popen(session_argv("--cells", "0", *connect, "--out", str(run),
-                                            "--policy", "best"),
-                               cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
+    argv = cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run), "--policy", "best")
+    planner = subprocess.Popen(argv, cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         cells[0].wait_for_line("start", timeout=30, count=3)
         cells[0].kill()
@@ -97,13 +82,13 @@ def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellPro
     assert {e.cell for e in journal} == {"c1", "c2"}
 
 
-def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[CellProcess]) -> None:
+def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv,
+                                                 cli_env: dict[str, str], run_session) -> None:
     endpoint = free_loopback_endpoint()
     cells.append(start_cell("c1", backend="truth", listen=[endpoint], delay_s=0.15))
     run = tmp_path / "run"
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    planner = subprocess.Popen(session_argv("--cells", "0", "--connect", endpoint, "--out", str(run)),
-                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "0", "--connect", endpoint, "--out", str(run)),
+                               cwd=root, env=cli_env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         # one cell, batches of one: the 6th request leaves after the 5th was journaled
         cells[0].wait_for_line("start", timeout=30, count=6)
@@ -125,7 +110,7 @@ def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[Ce
     assert not rerun_ids & {e.id for e in before}
 
 
-def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path) -> None:
+def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path, run_session) -> None:
     from bridge.recordings import column_values, read_recording
 
     run = tmp_path / "run"
@@ -156,11 +141,10 @@ def wait_until(condition, timeout: float, what: str) -> None:
         time.sleep(0.05)
 
 
-def test_cells_of_a_killed_planner_exit(tmp_path: Path) -> None:
+def test_cells_of_a_killed_planner_exit(tmp_path: Path, root: Path, cli_argv, cli_env: dict[str, str]) -> None:
     run = tmp_path / "run"
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    planner = subprocess.Popen(session_argv("--cells", "2", "--delay", "0.3", "--out", str(run)),
-                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "2", "--delay", "0.3", "--out", str(run)),
+                               cwd=root, env=cli_env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     children: list[int] = []
     try:
         wait_until(lambda: (run / "journal.jsonl").is_file() and (run / "journal.jsonl").stat().st_size,
@@ -186,7 +170,7 @@ def is_cell(pid: int) -> bool:
         return False
 
 
-def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path) -> None:
+def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path, run_session) -> None:
     """--confirm 1 with truthful cells: one agreeing re-test per essential experiment."""
     plain = run_session("--cells", "1", "--out", str(tmp_path / "plain"), "--policy", "systematic")
     run = tmp_path / "confirmed"

@@ -3,24 +3,19 @@
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+import pytest
 
 
-def test_a_cell_dying_at_start_up_fails_the_session_at_once(tmp_path: Path) -> None:
+@pytest.mark.slow
+def test_a_cell_dying_at_start_up_fails_the_session_at_once(tmp_path: Path, root: Path, run_cli) -> None:
     assembly = tmp_path / "no_geometry"
-    shutil.copytree(ROOT / "data" / "cranfield", assembly)
+    shutil.copytree(root / "data" / "cranfield", assembly)
     (assembly / "geometry.toml").unlink()  # the sim cell cannot build its scene
     start = time.monotonic()
-    done = subprocess.run(
-        [sys.executable, "-m", "asp.cli", "session", "--assembly", str(assembly),
-         "--cells", "1", "--out", str(tmp_path / "run")],
-        cwd=ROOT, capture_output=True, text=True, timeout=50,
-    )
+    done = run_cli("session", "--assembly", str(assembly), "--cells", "1", "--out", str(tmp_path / "run"), timeout=50)
     assert done.returncode == 2
     assert "exited (code 2) before printing line 'ready" in done.stderr
     assert "geometry.toml" in done.stderr  # the cell's own message is passed on

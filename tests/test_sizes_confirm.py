@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import clingo
 import pytest
@@ -21,7 +18,6 @@ from asp.sizes.policies import policy_names
 from asp.solve import encoding, fact, format_facts
 from tests._sizes_helpers import biorders
 
-ROOT = Path(__file__).resolve().parent.parent
 CRANFIELD = TruthOracle.from_assembly("cranfield")
 
 
@@ -155,18 +151,13 @@ def test_bad_confirm_settings_are_errors() -> None:
         SizeLearner(["a"], ["x"], max_answers=2, confirm=2)
 
 
-def _cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "asp.cli", *args], cwd=ROOT, capture_output=True,
-                          text=True, timeout=120, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
-
-
-def test_cli_learn_and_evaluate_take_confirm_and_noise() -> None:
-    done = _cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--confirm", "1", "--json")
+def test_cli_learn_and_evaluate_take_confirm_and_noise(run_cli) -> None:
+    done = run_cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--confirm", "1", "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert set(report) == {"policy", "experiments", "count", "fits"}
     assert report["count"] == 25 + 15  # Cranfield's 15 essential observations, each re-tested once
-    done = _cli("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "6",
+    done = run_cli("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "6",
                 "--noise", "0.1", "--confirm", "1", "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
@@ -181,8 +172,8 @@ def test_cli_learn_and_evaluate_take_confirm_and_noise() -> None:
     ["bench", "sizes", "--noise", "0.1,x"],
     ["bench", "sizes", "--noise", "0.1", "--seeds", "0"],
 ])
-def test_bad_confirm_or_noise_exits_2(args: list[str]) -> None:
-    done = _cli(*args)
+def test_bad_confirm_or_noise_exits_2(args: list[str], run_cli) -> None:
+    done = run_cli(*args)
     assert done.returncode == 2 and "Traceback" not in done.stderr and done.stderr.strip()
 
 

@@ -69,6 +69,7 @@ def test_no_policy_beats_systematic_without_losing_somewhere(m: int, n: int, sys
     assert policy_counts(free).sum() == unconstrained
 
 
+@pytest.mark.slow
 def test_cranfield_alone_does_not_force_systematic() -> None:
     """A policy never worse than systematic on all 900 Cranfield truths, of mean ≤ 18.8.
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import clingo
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -32,6 +33,7 @@ def paper_choice(k: Knowledge) -> Pair:
     return max(unknown, key=key)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None)
 @given(biorders(max_parts=7, max_holes=7))
 def test_every_choice_of_a_session_is_the_best_scored_pair(truth: TruthOracle) -> None:

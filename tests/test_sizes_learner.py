@@ -14,7 +14,7 @@ from asp.sizes.oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
 
 
-@pytest.mark.parametrize("policy", ["systematic", "random", "heuristic"])
+@pytest.mark.parametrize("policy", ["systematic", "random", pytest.param("heuristic", marks=pytest.mark.slow)])
 @settings(max_examples=12, deadline=None)
 @given(truth=biorders())
 def test_every_policy_learns_the_exact_relation_asking_no_entailed_pair(policy, truth) -> None:

@@ -1,0 +1,119 @@
+"""Shared test infrastructure: the repository root, the one environment policy for
+child processes, and the runners of the command lines (as separate processes, like
+``./run.sh`` runs them).
+
+Fixtures (session-scoped but ``cli_env``, so hypothesis tests may use them too):
+
+- ``root`` → ``Path``: the repository root (also the constant ``ROOT``, for module-level paths);
+- ``run_cli(*args, cwd=None, input=None, timeout=120)``: ``python -m asp.cli ARGS``;
+- ``run_executor(*args, cwd=None, input=None, timeout=120)``: ``python -m executor ARGS``;
+- ``run_python(module, *args, cwd=None, input=None, timeout=120)``: ``python -m MODULE ARGS``
+  (e.g. ``clingo``);
+- ``run_session(*args, timeout=60)`` → ``dict``: ``session --backend truth --json ARGS`` (the
+  ``TRUTH_SESSION`` arguments), which must exit 0; its JSON result;
+- ``cli_argv(*args)`` → ``list[str]``: the argv of ``python -m asp.cli ARGS``, for ``Popen``;
+- ``cli_env`` → ``dict``: a fresh copy of the environment of every child process (``child_env()``).
+
+Each runner returns the ``subprocess.CompletedProcess`` (``capture_output=True, text=True``),
+run in ``cwd`` (default: the repository root) with ``child_env()``; a run longer than
+``timeout`` seconds raises ``subprocess.TimeoutExpired``. Tests that need a long-running
+process (``Popen``: cells, SIGKILL) start it themselves, with ``cwd=root, env=cli_env``.
+
+The environment policy lives here only: ``child_env()`` for children, and the autouse
+``_no_display`` for this process (so the viewer or a GUI never opens, also not from cells a
+test starts in-process).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Protocol
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+CLI_MODULE = "asp.cli"  # ./run.sh SUBCOMMAND
+EXECUTOR_MODULE = "executor"  # ./run.sh executor SUBCOMMAND
+DEFAULT_TIMEOUT = 120.0  # [s] per command line run
+TRUTH_SESSION = ("session", "--backend", "truth", "--json")  # a learning session with truthful cells
+# Unset for the whole test run and its children: no viewer or GUI ever opens.
+DISPLAY_VARIABLES = ("DISPLAY", "WAYLAND_DISPLAY")
+
+
+def child_env() -> dict[str, str]:
+    """The environment policy of every child process: this process's environment without
+    a display, and ``PYTHONPATH`` = the repository root (only)."""
+    env = {name: value for name, value in os.environ.items() if name not in DISPLAY_VARIABLES}
+    env["PYTHONPATH"] = str(ROOT)
+    return env
+
+
+def python_argv(module: str, *args: str) -> list[str]:
+    """The argv of ``python -m MODULE ARGS`` with this interpreter."""
+    return [sys.executable, "-m", module, *args]
+
+
+def python_module(module: str, *args: str, cwd: Path | str | None = None, input: str | None = None,
+                  timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]:
+    """``python -m MODULE ARGS`` as a separate process under the environment policy."""
+    return subprocess.run(python_argv(module, *args), cwd=ROOT if cwd is None else cwd, env=child_env(),
+                          input=input, capture_output=True, text=True, timeout=timeout)
+
+
+class Runner(Protocol):
+    def __call__(self, *args: str, cwd: Path | str | None = None, input: str | None = None,
+                 timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]: ...
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _no_display() -> Iterator[None]:
+    """No display for the tests themselves either (in-process code, cells they start)."""
+    with pytest.MonkeyPatch.context() as patch:
+        for name in DISPLAY_VARIABLES:
+            patch.delenv(name, raising=False)
+        yield
+
+
+@pytest.fixture(scope="session")
+def root() -> Path:
+    return ROOT
+
+
+@pytest.fixture
+def cli_env() -> dict[str, str]:
+    return child_env()
+
+
+@pytest.fixture(scope="session")
+def run_cli() -> Runner:
+    return functools.partial(python_module, CLI_MODULE)
+
+
+@pytest.fixture(scope="session")
+def run_executor() -> Runner:
+    return functools.partial(python_module, EXECUTOR_MODULE)
+
+
+@pytest.fixture(scope="session")
+def run_python() -> Callable[..., subprocess.CompletedProcess[str]]:
+    return python_module
+
+
+@pytest.fixture(scope="session")
+def run_session(run_cli: Runner) -> Callable[..., dict]:
+    def run(*args: str, timeout: float = 60) -> dict:
+        done = run_cli(*TRUTH_SESSION, *args, timeout=timeout)
+        assert done.returncode == 0, done.stderr
+        return json.loads(done.stdout)
+    return run
+
+
+@pytest.fixture(scope="session")
+def cli_argv() -> Callable[..., list[str]]:
+    return functools.partial(python_argv, CLI_MODULE)
