@@ -15,7 +15,7 @@ from executor.admittance import Admittance
 from executor.detector import Detector
 from executor.dmp import PhaseClock, Skill
 from executor.motion import Motion
-from executor.scene import TIME_STEP
+from executor.world.scene import TIME_STEP
 from executor.wiggle import wiggle
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.

@@ -7,9 +7,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from executor.arm import ArmState
+from executor.world.arm import ArmState
 from executor.controller import ImpedanceController
-from executor.scene import TIME_STEP
+from executor.world.scene import TIME_STEP
 
 if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger

@@ -17,7 +17,7 @@ import numpy as np
 
 from executor.admittance import Admittance
 from executor.motion import Motion
-from executor.scene import TIME_STEP
+from executor.world.scene import TIME_STEP
 
 
 @dataclass(frozen=True)

@@ -20,14 +20,14 @@ import numpy as np
 
 from executor import ExecutorError
 from executor.admittance import Admittance
-from executor.arm import TOOL_DOWN_QUAT_XYZW, Arm
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
 from executor.controller import ImpedanceController
 from executor.detector import Detector, Thresholds
 from executor.dmp import Skill, load_skill
-from executor.geometry import load_geometry
+from executor.world.geometry import load_geometry
 from executor.insertion import insert, rotvec_quat_xyzw
 from executor.motion import Motion
-from executor.scene import TIME_STEP, Scene, require_display, scene_shapes
+from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 from executor.search import hole_search
 
 if TYPE_CHECKING:

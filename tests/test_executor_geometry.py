@@ -6,7 +6,7 @@ import math
 import re
 from pathlib import Path
 
-from executor.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
+from executor.world.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
 
 ROOT = Path(__file__).resolve().parent.parent
 
