@@ -11,10 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from executor.admittance import Admittance
-from executor.detector import Detector
+from executor.control.admittance import Admittance
+from executor.control.detector import Detector
 from executor.dmp import PhaseClock, Skill
-from executor.motion import Motion
+from executor.control.motion import Motion
 from executor.world.scene import TIME_STEP
 from executor.wiggle import wiggle
 

@@ -16,7 +16,7 @@ import sys
 from collections.abc import Sequence
 
 from executor import ExecutorError
-from executor.detector import Thresholds
+from executor.control.detector import Thresholds
 from executor.trial import AttemptSetup, Cell, trial_rng
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW
 from executor.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
 from executor.world.geometry import write_assets
-from executor.motion import Motion
+from executor.control.motion import Motion
 from executor.world.scene import TIME_STEP
 from executor.trial import SETTLE_TIME, Cell
 

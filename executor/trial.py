@@ -19,14 +19,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from executor import ExecutorError
-from executor.admittance import Admittance
+from executor.control.admittance import Admittance
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
-from executor.controller import ImpedanceController
-from executor.detector import Detector, Thresholds
+from executor.control.controller import ImpedanceController
+from executor.control.detector import Detector, Thresholds
 from executor.dmp import Skill, load_skill
 from executor.world.geometry import load_geometry
 from executor.insertion import insert, rotvec_quat_xyzw
-from executor.motion import Motion
+from executor.control.motion import Motion
 from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 from executor.search import hole_search
 

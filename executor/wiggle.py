@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from executor.world.arm import cross, quat_to_matrix
-from executor.motion import Motion
+from executor.control.motion import Motion
 from executor.world.scene import TIME_STEP
 
 AMPLITUDE = 10.0  # [N]
