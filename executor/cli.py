@@ -18,7 +18,7 @@ from executor import ExecutorError
 
 
 def _teach(args: argparse.Namespace) -> int:
-    from executor.teach import teach_all
+    from executor.skills.teach import teach_all
 
     for path in teach_all(args.assembly):
         print(f"wrote {path}")

@@ -20,15 +20,15 @@ import numpy as np
 
 from executor import ExecutorError
 from executor.control.admittance import Admittance
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
 from executor.control.controller import ImpedanceController
 from executor.control.detector import Detector, Thresholds
-from executor.dmp import Skill, load_skill
-from executor.world.geometry import load_geometry
-from executor.insertion import insert, rotvec_quat_xyzw
 from executor.control.motion import Motion
+from executor.skills.dmp import Skill, load_skill
+from executor.skills.insertion import insert, rotvec_quat_xyzw
+from executor.skills.search import hole_search
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
+from executor.world.geometry import load_geometry
 from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
-from executor.search import hole_search
 
 if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger

@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from executor.world.arm import ArmState
 from executor.control.controller import ImpedanceController
+from executor.world.arm import ArmState
 from executor.world.scene import TIME_STEP
 
 if TYPE_CHECKING:

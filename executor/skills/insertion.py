@@ -13,10 +13,10 @@ import pybullet as pb
 
 from executor.control.admittance import Admittance
 from executor.control.detector import Detector
-from executor.dmp import PhaseClock, Skill
 from executor.control.motion import Motion
+from executor.skills.dmp import PhaseClock, Skill
+from executor.skills.wiggle import wiggle
 from executor.world.scene import TIME_STEP
-from executor.wiggle import wiggle
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.
 TIMEOUT_FACTOR = 3.0

@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from executor.world.arm import cross, quat_to_matrix
 from executor.control.motion import Motion
+from executor.world.arm import cross, quat_to_matrix
 from executor.world.scene import TIME_STEP
 
 AMPLITUDE = 10.0  # [N]
