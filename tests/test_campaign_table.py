@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from executor import ExecutorError
-from executor.campaign import (
+from executor.campaign.run import (
     FIG18_FITTING_PAIRS,
     CampaignRun,
     campaign_pairs,
@@ -110,7 +110,7 @@ def _trace(part: str, outcome: str, stop_at: float) -> Any:
 
 def test_figures_are_written(tmp_path: Path) -> None:
     # Imported here: worker processes of the test above import this module.
-    from executor.campaign_plots import plot_fig17, plot_fig18
+    from executor.campaign.plots import plot_fig17, plot_fig18
 
     pairs = campaign_pairs()[:3]
     stats = [pair_stats(p, [{"outcome": "fit", "attempts": 1, "duration_s": 1.0}]) for p in pairs]

@@ -305,7 +305,7 @@ def main(argv: Sequence[str]) -> int:
         )
         report = campaign_report(run, args.seed, args.workers)
         if args.plot:
-            from executor.campaign_plots import write_plots
+            from executor.campaign.plots import write_plots
 
             plots = write_plots(Path(args.plot), run.stats, args.assembly, args.seed)
             report["plots"] = [str(p) for p in plots]

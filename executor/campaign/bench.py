@@ -22,7 +22,7 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from executor.campaign import (
+from executor.campaign.run import (
     CellRunner,
     campaign_pairs,
     run_campaign,
