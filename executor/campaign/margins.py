@@ -17,7 +17,8 @@ from collections.abc import Sequence
 
 from executor import ExecutorError
 from executor.control.detector import Thresholds
-from executor.trial import AttemptSetup, Cell, trial_rng
+from executor.evidence import AttemptSetup
+from executor.trial import Cell, trial_rng
 
 
 def _parse_pairs(text: str) -> list[tuple[str, str]]:
