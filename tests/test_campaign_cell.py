@@ -46,7 +46,8 @@ def test_mini_campaign_with_plots(tmp_path: Path) -> None:
 def test_real_results_do_not_depend_on_scheduling() -> None:
     import functools
 
-    from executor.campaign.run import CellRunner, run_campaign, select_pairs, stdout_to_stderr
+    from executor.campaign.pairs import select_pairs
+    from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr
 
     pairs = select_pairs("tp:r1,sh:s1")
     factory = functools.partial(CellRunner, "cranfield")

@@ -11,16 +11,8 @@ from typing import Any
 import pytest
 
 from executor import ExecutorError
-from executor.campaign.run import (
-    FIG18_FITTING_PAIRS,
-    CampaignRun,
-    campaign_pairs,
-    campaign_report,
-    format_table,
-    pair_stats,
-    run_campaign,
-    select_pairs,
-)
+from executor.campaign.pairs import FIG18_FITTING_PAIRS, campaign_pairs, pair_stats, select_pairs
+from executor.campaign.run import CampaignRun, campaign_report, format_table, run_campaign
 
 
 def fake_runner(flaky_every: int, barrier: Any = None) -> Any:
