@@ -63,7 +63,8 @@ class Cell:
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
 
-    def _check(self, part: str, hole: str) -> Skill:
+    def check_pair(self, part: str, hole: str) -> Skill:
+        """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""
         if part not in self.geometry.parts:
             raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
@@ -93,7 +94,7 @@ class Cell:
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
         """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts."""
-        self._check(part, hole)
+        self.check_pair(part, hole)
         if max_attempts < 1:
             raise ExecutorError(f"max_attempts = {max_attempts}: expected at least 1")
         rng = trial_rng(seed, part, hole)
@@ -116,7 +117,7 @@ class Cell:
 
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
-        skill = self._check(part, hole)
+        skill = self.check_pair(part, hole)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps

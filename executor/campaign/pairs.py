@@ -8,11 +8,13 @@ the table.  Shared by the campaign (:mod:`executor.campaign.run`) and its figure
 
 from __future__ import annotations
 
+import argparse
 import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from bridge.cli_types import comma_list, part_hole_pair
 from executor import ExecutorError
 
 FIG18_FITTING_PAIRS: tuple[tuple[str, str], ...] = (
@@ -48,19 +50,30 @@ def campaign_pairs() -> list[CampaignPair]:
     return fitting + others
 
 
-def select_pairs(spec: str | None) -> list[CampaignPair]:
-    """All campaign pairs, or those named in ``spec`` ("p1:r1,p3:r1")."""
+PAIRS_ARGUMENT = comma_list(part_hole_pair, "PART:HOLE pairs such as p1:r1")
+"""The argparse ``type=`` of ``--pairs``: ``"p1:r1,p3:s1"`` → ``[("p1", "r1"), ("p3", "s1")]``."""
+
+
+def select_pairs(spec: str | Sequence[tuple[str, str]] | None) -> list[CampaignPair]:
+    """All campaign pairs, or those named in ``spec``: the parsed ``--pairs`` list
+    (``[("p1", "r1"), ("p3", "r1")]``) or its text (``"p1:r1,p3:r1"``)."""
     pairs = campaign_pairs()
     if not spec:
         return pairs
-    by_name = {f"{p.part}:{p.hole}": p for p in pairs}
+    if isinstance(spec, str):
+        try:
+            spec = PAIRS_ARGUMENT(spec)
+        except argparse.ArgumentTypeError as exc:
+            raise ExecutorError(f"--pairs: {exc}") from None
+    by_name = {(p.part, p.hole): p for p in pairs}
     chosen = []
-    for name in spec.split(","):
-        if name.strip() not in by_name:
+    for part, hole in spec:
+        if (part, hole) not in by_name:
             raise ExecutorError(
-                f"--pairs: unknown pair '{name}'; expected PART:HOLE among {', '.join(by_name)}"
+                f"--pairs: unknown pair '{part}:{hole}'; expected PART:HOLE among "
+                f"{', '.join(f'{p}:{h}' for p, h in by_name)}"
             )
-        chosen.append(by_name[name.strip()])
+        chosen.append(by_name[part, hole])
     return chosen
 
 

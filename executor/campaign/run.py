@@ -40,6 +40,7 @@ from typing import Any, Protocol
 from executor import ExecutorError
 from executor.campaign.pairs import (
     HOLE_NAMES,
+    PAIRS_ARGUMENT,
     PART_NAMES,
     CampaignPair,
     PairStats,
@@ -209,7 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--trials", type=int, default=40, help="executions per pair (default 40)")
     parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    parser.add_argument("--pairs", help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
+    parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
     parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
