@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import queue
 import threading
@@ -117,11 +118,13 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
             on_outcome(outcome)
 
     def on_reply(reply: zenoh.Reply) -> None:
-        if reply.ok is None:
-            deliver(CellTimeout(f"cell {cell}: query error: {reply.err.payload.to_string()}"))
+        ok, err = reply.ok, reply.err
+        if ok is None:
+            detail = err.payload.to_string() if err is not None else "neither a sample nor an error"
+            deliver(CellTimeout(f"cell {cell}: query error: {detail}"))
             return
         try:
-            message = decode_reply(reply.ok.payload.to_bytes())
+            message = decode_reply(ok.payload.to_bytes())
         except MessageError as exc:
             deliver(exc)
             return
@@ -208,8 +211,12 @@ class CellPool:
             request = self._pending.popleft()
             attempt = next(self._attempts)
             cancel = send_insert(self._session, cell, request, self.timeout,
-                                 lambda outcome, c=cell, a=attempt: self._events.put(("outcome", c, a, outcome)))
+                                 functools.partial(self._on_outcome, cell, attempt))
             self._busy[cell] = _Sent(attempt, request, cancel)
+
+    def _on_outcome(self, cell: str, attempt: int, outcome: Outcome) -> None:
+        """Zenoh thread: queue the outcome of ``attempt`` sent to ``cell``."""
+        self._events.put(("outcome", cell, attempt, outcome))
 
     def _next_event(self) -> tuple:
         if self._busy or self._alive:

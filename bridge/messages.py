@@ -36,7 +36,7 @@ class _Message(msgspec.Struct, frozen=True, forbid_unknown_fields=True, tag_fiel
     """Base of the tagged messages: immutable, unknown fields refused."""
 
 
-class InsertRequest(_Message, tag="insert"):
+class InsertRequest(_Message, tag="insert", frozen=True):
     """Insert ``part`` into ``hole``; ``id`` makes the request idempotent at the cell."""
 
     id: RequestId
@@ -63,7 +63,7 @@ class Evidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """Simulated duration of the attempts [s]."""
 
 
-class InsertReply(_Message, tag="insert_reply"):
+class InsertReply(_Message, tag="insert_reply", frozen=True):
     """The outcome of request ``id`` as observed by cell ``cell``."""
 
     id: RequestId
@@ -75,7 +75,7 @@ class InsertReply(_Message, tag="insert_reply"):
     v: int = PROTOCOL_VERSION
 
 
-class ErrorReply(_Message, tag="error"):
+class ErrorReply(_Message, tag="error", frozen=True):
     """A refused request: ``code`` says why, ``error`` says what was expected."""
 
     cell: CellId

@@ -89,5 +89,5 @@ class AttemptSetup:
         tilt_axis = rng.uniform(0, 2 * np.pi)
         tilt = GRASP_TILT_MAX * rng.uniform() * np.array([np.cos(tilt_axis), np.sin(tilt_axis), 0.0])
         vision = rng.normal(0.0, VISION_SIGMA, 2)
-        vision *= min(1.0, VISION_MAX / max(np.linalg.norm(vision), 1e-12))
+        vision *= min(1.0, VISION_MAX / max(float(np.linalg.norm(vision)), 1e-12))
         return cls(np.array([r * np.cos(a), r * np.sin(a), 0.0]), tilt, vision, int(rng.integers(2**31)))

@@ -48,13 +48,13 @@ class Cell:
     shape (made on first use), so a trial depends on its seed only."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 thresholds: Thresholds = Thresholds()) -> None:
+                 thresholds: Thresholds | None = None) -> None:
         self.geometry = load_geometry(assembly)
         if gui:
             require_display()
         self.gui = gui
         self.logger = logger
-        self.thresholds = thresholds
+        self.thresholds = Thresholds() if thresholds is None else thresholds
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
