@@ -1,4 +1,4 @@
-"""Command line of the simulated cell: ``teach``, ``trial``, ``campaign``, ``serve``.
+"""Command line of the simulated cell: ``teach``, ``trial``, ``campaign``, ``serve``, ``margins``.
 
 ``./run.sh executor trial --part p1 --hole r1 --trials 3 --json`` prints
 ``{"trials": [{"outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error",
