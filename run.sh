@@ -53,7 +53,7 @@ case "$cmd" in
     test)      exec "$PY" -m pytest "$@" ;;
     executor)  exec "$PY" -m executor "$@" ;;
     bench)
-        if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -m executor.bench "$@"; fi
+        if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -m executor.campaign.bench "$@"; fi
         exec "$PY" -m asp.cli bench "$@" ;;
     *)         exec "$PY" -m asp.cli "$cmd" "$@" ;;
 esac

@@ -118,12 +118,13 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
             on_outcome(outcome)
 
     def on_reply(reply: zenoh.Reply) -> None:
-        if reply.ok is None:
-            error = reply.err.payload.to_string() if reply.err is not None else "no reply"
-            deliver(CellTimeout(f"cell {cell}: query error: {error}"))
+        ok, err = reply.ok, reply.err
+        if ok is None:
+            detail = err.payload.to_string() if err is not None else "neither a sample nor an error"
+            deliver(CellTimeout(f"cell {cell}: query error: {detail}"))
             return
         try:
-            message = decode_reply(reply.ok.payload.to_bytes())
+            message = decode_reply(ok.payload.to_bytes())
         except MessageError as exc:
             deliver(exc)
             return
@@ -214,7 +215,7 @@ class CellPool:
             self._busy[cell] = _Sent(attempt, request, cancel)
 
     def _on_outcome(self, cell: str, attempt: int, outcome: Outcome) -> None:
-        """Called on a Zenoh thread with the outcome of ``attempt`` at ``cell``."""
+        """Zenoh thread: queue the outcome of ``attempt`` sent to ``cell``."""
         self._events.put(("outcome", cell, attempt, outcome))
 
     def _next_event(self) -> tuple:

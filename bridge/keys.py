@@ -1,8 +1,8 @@
 """Every Zenoh key expression of the project, in one place.
 
 A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert`` and holds the
-liveliness token ``cell/<id>/alive`` while it is up; ``cell/<id>/ping`` echoes its
-payload. The planner discovers cells by subscribing to ``cell/*/alive``.
+liveliness token ``cell/<id>/alive`` while it is up; ``cell/<id>/ping`` echoes its payload.
+The planner discovers cells by subscribing to ``cell/*/alive``.
 """
 
 from __future__ import annotations

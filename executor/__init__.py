@@ -3,6 +3,13 @@ impedance arm, hole search, DMP insertion with admittance and phase stopping, fa
 detection (eqs. 6, 7 and the goal check) and the wiggle exception strategy.
 
 Entry points: :class:`executor.trial.Cell` (``run_trial``) and ``python -m executor.cli``.
+Layers, each importing only those before it: :mod:`executor.world` (geometry, PyBullet
+scene, arm), :mod:`executor.control` (impedance controller, admittance, detector, motion
+stepper), :mod:`executor.skills` (DMP, hole search, insertion, wiggle, teaching), the
+records in :mod:`executor.evidence`, the Rerun log :mod:`executor.rerun_log`, the trial
+:mod:`executor.trial`, and on top :mod:`executor.campaign`, :mod:`executor.serve` and
+:mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`) drives a
+:class:`executor.trial.Cell` to record the skills the trial then uses.
 """
 
 

@@ -1,4 +1,4 @@
-"""Command line of the simulated cell: ``teach``, ``trial``, ``campaign``, ``serve``.
+"""Command line of the simulated cell: ``teach``, ``trial``, ``campaign``, ``serve``, ``margins``.
 
 ``./run.sh executor trial --part p1 --hole r1 --trials 3 --json`` prints
 ``{"trials": [{"outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error",
@@ -18,7 +18,7 @@ from executor import ExecutorError
 
 
 def _teach(args: argparse.Namespace) -> int:
-    from executor.teach import teach_all
+    from executor.skills.teach import teach_all
 
     for path in teach_all(args.assembly):
         print(f"wrote {path}")
@@ -75,11 +75,14 @@ def _trial(args: argparse.Namespace) -> int:
     return 0
 
 
-# Subcommands owned by sibling modules: ``executor.<name>.main(argv)``, imported lazily.
+# Subcommands owned by other modules: subcommand -> (module whose ``main(argv)`` runs it,
+# imported lazily; help text).
 _DELEGATED = {
-    "campaign": "Fig. 18: randomised executions of every part-hole pair (executor.campaign)",
-    "serve": "serve insertion requests over Zenoh (executor.serve)",
-    "margins": "measure the wrench and end-error margins the thresholds come from (executor.margins)",
+    "campaign": ("executor.campaign.run",
+                 "Fig. 18: randomised executions of every part-hole pair (executor.campaign.run)"),
+    "serve": ("executor.serve", "serve insertion requests over Zenoh (executor.serve)"),
+    "margins": ("executor.campaign.margins",
+                "measure the wrench and end-error margins the thresholds come from (executor.campaign.margins)"),
 }
 
 
@@ -103,7 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     trial.set_defaults(func=_trial)
 
-    for name, help_text in _DELEGATED.items():
+    for name, (_module, help_text) in _DELEGATED.items():
         sub.add_parser(name, help=help_text, add_help=False)
     return parser
 
@@ -115,7 +118,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if argv and argv[0] in _DELEGATED:
             import importlib
 
-            return int(importlib.import_module(f"executor.{argv[0]}").main(argv[1:]) or 0)
+            module, _help = _DELEGATED[argv[0]]
+            return int(importlib.import_module(module).main(argv[1:]) or 0)
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
     except (ExecutorError, BridgeError) as exc:

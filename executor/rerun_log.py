@@ -47,7 +47,7 @@ from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, cell_root
 from executor import ExecutorError
 
 if TYPE_CHECKING:
-    from executor.trial import AttemptEvidence
+    from executor.evidence import AttemptEvidence
 
 PHASE_SCALE = 1000
 """The ``dmp_phase`` timeline holds round(phase × PHASE_SCALE)."""

@@ -48,7 +48,7 @@ from bridge.messages import (
 )
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
 from executor import ExecutorError
-from executor.geometry import load_geometry, passes
+from executor.world.geometry import load_geometry, passes
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
@@ -70,7 +70,7 @@ class Backend(Protocol):
 
 class TruthBackend:
     """Answers from the cell's geometry without simulation (a part passes a hole when its
-    cross-section does, :func:`executor.geometry.passes`), after ``delay_s`` [s]."""
+    cross-section does, :func:`executor.world.geometry.passes`), after ``delay_s`` [s]."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
                  recording_id: str | None, rrd: Path | None) -> None:

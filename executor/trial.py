@@ -6,112 +6,36 @@ per axis, at most 3 mm off); the part is brought above the estimate, the hole is
 searched, the taught skill inserts it, the detector decides, and the part goes back to
 its start on the tray.  A failed attempt is repeated once; two failures mean "no_fit".
 The transfer between tray and plate is kinematic (joint-space, not simulated): only
-the force-controlled part of the task is.
+the force-controlled part of the task is.  The records it returns (the attempt's setup and
+evidence, the trial's result) are plain types in :mod:`executor.evidence`.
 """
 
 from __future__ import annotations
 
 import time
 import zlib
-from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from executor import ExecutorError
-from executor.admittance import Admittance
-from executor.arm import TOOL_DOWN_QUAT_XYZW, Arm
-from executor.controller import ImpedanceController
-from executor.detector import Detector, Thresholds
-from executor.dmp import Skill, load_skill
-from executor.geometry import load_geometry
-from executor.insertion import insert, rotvec_quat_xyzw
-from executor.motion import Motion
-from executor.scene import TIME_STEP, Scene, require_display, scene_shapes
-from executor.search import hole_search
+from executor.control.admittance import Admittance
+from executor.control.controller import ImpedanceController
+from executor.control.detector import Detector, Thresholds
+from executor.control.motion import Motion
+from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
+from executor.skills.dmp import Skill, load_skill
+from executor.skills.insertion import insert, rotvec_quat_xyzw
+from executor.skills.search import hole_search
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
+from executor.world.geometry import load_geometry
+from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
 if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger
 
-GRASP_OFFSET_MAX = 0.001  # [m] lateral offset of the part in the hand
-GRASP_TILT_MAX = np.radians(1.0)  # [rad]
-VISION_SIGMA = 0.0015  # [m] per axis
-VISION_MAX = 0.003  # [m]
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
 SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
-
-
-@dataclass
-class AttemptEvidence:
-    """What one attempt showed: outcome "fit"/"no_fit", max ‖F_mes − F_des‖ [N], max
-    ‖M_mes − M_des‖ [Nm], ‖p_end − p_goal‖ [m], wall time [s], simulated time [s], whether
-    eq. (6)/(7) fired (jam), exception-strategy runs, DMP phase reached (0..1)."""
-
-    outcome: str
-    max_force_dev: float
-    max_torque_dev: float
-    end_error: float
-    duration_s: float
-    sim_time_s: float
-    jammed: bool
-    wiggles: int
-    phase_reached: float
-    hole_found: bool = False
-
-
-@dataclass
-class TrialResult:
-    """A trial of up to ``max_attempts`` attempts; maxima over attempts, wall time [s] of all."""
-
-    part: str
-    hole: str
-    outcome: str
-    attempts: int
-    max_force_dev: float
-    max_torque_dev: float
-    end_error: float
-    duration_s: float
-    evidence: list[AttemptEvidence] = field(default_factory=list)
-
-    def to_json(self) -> dict:
-        """The contract keys plus sim time, steps per second and real-time factor."""
-        sim = sum(e.sim_time_s for e in self.evidence)
-        return {
-            "part": self.part,
-            "hole": self.hole,
-            "outcome": self.outcome,
-            "attempts": self.attempts,
-            "max_force_dev": self.max_force_dev,
-            "max_torque_dev": self.max_torque_dev,
-            "end_error": self.end_error,
-            "duration_s": self.duration_s,
-            "sim_time_s": sim,
-            "sim_steps_per_s": sim / TIME_STEP / self.duration_s if self.duration_s > 0 else 0.0,
-            "real_time_factor": sim / self.duration_s if self.duration_s > 0 else 0.0,
-            "evidence": [asdict(e) for e in self.evidence],
-        }
-
-
-@dataclass(frozen=True)
-class AttemptSetup:
-    """The random circumstances of one attempt: grasp offset [m] and tilt (rotation
-    vector [rad]) of the part in the hand, vision error of the hole estimate [m], seed
-    of the stochastic search."""
-
-    grasp_offset: np.ndarray
-    grasp_tilt: np.ndarray
-    vision_error: np.ndarray
-    search_seed: int = 0
-
-    @classmethod
-    def draw(cls, rng: np.random.Generator) -> AttemptSetup:
-        r = GRASP_OFFSET_MAX * np.sqrt(rng.uniform())
-        a = rng.uniform(0, 2 * np.pi)
-        tilt_axis = rng.uniform(0, 2 * np.pi)
-        tilt = GRASP_TILT_MAX * rng.uniform() * np.array([np.cos(tilt_axis), np.sin(tilt_axis), 0.0])
-        vision = rng.normal(0.0, VISION_SIGMA, 2)
-        vision *= min(1.0, VISION_MAX / max(np.linalg.norm(vision), 1e-12))
-        return cls(np.array([r * np.cos(a), r * np.sin(a), 0.0]), tilt, vision, int(rng.integers(2**31)))
 
 
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
@@ -124,13 +48,13 @@ class Cell:
     shape (made on first use), so a trial depends on its seed only."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 thresholds: Thresholds = Thresholds()) -> None:
+                 thresholds: Thresholds | None = None) -> None:
         self.geometry = load_geometry(assembly)
         if gui:
             require_display()
         self.gui = gui
         self.logger = logger
-        self.thresholds = thresholds
+        self.thresholds = Thresholds() if thresholds is None else thresholds
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
@@ -139,7 +63,8 @@ class Cell:
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
 
-    def _check(self, part: str, hole: str) -> Skill:
+    def check_pair(self, part: str, hole: str) -> Skill:
+        """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""
         if part not in self.geometry.parts:
             raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
@@ -169,7 +94,7 @@ class Cell:
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
         """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts."""
-        self._check(part, hole)
+        self.check_pair(part, hole)
         if max_attempts < 1:
             raise ExecutorError(f"max_attempts = {max_attempts}: expected at least 1")
         rng = trial_rng(seed, part, hole)
@@ -192,7 +117,7 @@ class Cell:
 
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
-        skill = self._check(part, hole)
+        skill = self.check_pair(part, hole)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps

@@ -41,7 +41,8 @@ def test_mini_campaign_with_plots(tmp_path: Path, run_executor) -> None:
 def test_real_results_do_not_depend_on_scheduling() -> None:
     import functools
 
-    from executor.campaign import CellRunner, run_campaign, select_pairs, stdout_to_stderr
+    from executor.campaign.pairs import select_pairs
+    from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr
 
     pairs = select_pairs("tp:r1,sh:s1")
     factory = functools.partial(CellRunner, "cranfield")

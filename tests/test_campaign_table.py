@@ -11,16 +11,8 @@ from typing import Any
 import pytest
 
 from executor import ExecutorError
-from executor.campaign import (
-    FIG18_FITTING_PAIRS,
-    CampaignRun,
-    campaign_pairs,
-    campaign_report,
-    format_table,
-    pair_stats,
-    run_campaign,
-    select_pairs,
-)
+from executor.campaign.pairs import FIG18_FITTING_PAIRS, campaign_pairs, pair_stats, select_pairs
+from executor.campaign.run import CampaignRun, campaign_report, format_table, run_campaign
 
 
 def fake_runner(flaky_every: int, barrier: Any = None) -> Any:
@@ -114,7 +106,7 @@ def _trace(part: str, outcome: str, stop_at: float) -> Any:
 @pytest.mark.slow
 def test_figures_are_written(tmp_path: Path) -> None:
     # Imported here: worker processes of the test above import this module.
-    from executor.campaign_plots import plot_fig17, plot_fig18
+    from executor.campaign.plots import plot_fig17, plot_fig18
 
     pairs = campaign_pairs()[:3]
     stats = [pair_stats(p, [{"outcome": "fit", "attempts": 1, "duration_s": 1.0}]) for p in pairs]

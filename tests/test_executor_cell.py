@@ -11,7 +11,8 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from executor.trial import AttemptSetup, Cell
+from executor.evidence import AttemptSetup
+from executor.trial import Cell
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import re
 
-from executor.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
+from executor.world.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
 
 
 def test_sizes_make_fig5_true(root):

@@ -16,12 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
-from executor.arm import TOOL_DOWN_QUAT_XYZW
-from executor.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
-from executor.geometry import write_assets
-from executor.motion import Motion
-from executor.scene import TIME_STEP
+from executor.control.motion import Motion
+from executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
 from executor.trial import SETTLE_TIME, Cell
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.world.geometry import write_assets
+from executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s]
 DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole

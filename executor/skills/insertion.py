@@ -11,12 +11,12 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from executor.admittance import Admittance
-from executor.detector import Detector
-from executor.dmp import PhaseClock, Skill
-from executor.motion import Motion
-from executor.scene import TIME_STEP
-from executor.wiggle import wiggle
+from executor.control.admittance import Admittance
+from executor.control.detector import Detector
+from executor.control.motion import Motion
+from executor.skills.dmp import PhaseClock, Skill
+from executor.skills.wiggle import wiggle
+from executor.world.scene import TIME_STEP
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.
 TIMEOUT_FACTOR = 3.0

@@ -3,26 +3,31 @@ step count, decimated logging).  Search, insertion and wiggle all move through i
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
-from executor.arm import ArmState
-from executor.controller import ImpedanceController
-from executor.scene import TIME_STEP
-
-if TYPE_CHECKING:
-    from executor.rerun_log import AttemptLogger
+from executor.control.controller import ImpedanceController
+from executor.world.arm import ArmState
+from executor.world.scene import TIME_STEP
 
 # Log every this many physics steps (10 ms of sim time).
 LOG_EVERY = 10
 _ZERO3 = np.zeros(3)
 
 
+class StepLogger(Protocol):
+    """What Motion logs into (:class:`executor.rerun_log.AttemptLogger` is one): sim time
+    [s], DMP phase, tool tip [m], measured and desired force [N] and torque [Nm]."""
+
+    def log_step(self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
+                 force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray) -> None: ...
+
+
 class Motion:
     """Steps the controller toward desired poses; counts sim time [s] and logs."""
 
-    def __init__(self, controller: ImpedanceController, logger: AttemptLogger | None = None) -> None:
+    def __init__(self, controller: ImpedanceController, logger: StepLogger | None = None) -> None:
         self.controller = controller
         self.logger = logger
         self.steps = 0

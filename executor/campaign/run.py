@@ -38,54 +38,15 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from executor import ExecutorError
-
-FIG18_FITTING_PAIRS: tuple[tuple[str, str], ...] = (
-    ("p1", "r1"), ("p1", "br"), ("p1", "s1"),
-    ("tp", "r1"), ("tp", "br"), ("tp", "s1"),
-    ("p3", "br"), ("p3", "s1"),
-    ("sh", "br"),
+from executor.campaign.pairs import (
+    HOLE_NAMES,
+    PAIRS_ARGUMENT,
+    PART_NAMES,
+    CampaignPair,
+    PairStats,
+    pair_stats,
+    select_pairs,
 )
-"""The rows of the paper's Fig. 18, in its order (H1 = r1, H3 = br, H4 = s1)."""
-CAMPAIGN_PARTS = ("p1", "tp", "p3", "sh")
-CAMPAIGN_HOLES = ("r1", "br", "s1")
-PART_NAMES = {"p1": "round peg", "tp": "tight round peg", "p3": "square peg", "sh": "shaft"}
-HOLE_NAMES = {"r1": "H1 small round", "br": "H3 big round", "s1": "H4 square"}
-
-
-@dataclass(frozen=True)
-class CampaignPair:
-    """A part-hole pair of the campaign and whether the part truly fits."""
-
-    part: str
-    hole: str
-    fits: bool
-
-
-def campaign_pairs() -> list[CampaignPair]:
-    """Fig. 18's fitting pairs (paper order), then the non-fitting ones."""
-    fitting = [CampaignPair(p, h, True) for p, h in FIG18_FITTING_PAIRS]
-    others = [
-        CampaignPair(p, h, False)
-        for p in CAMPAIGN_PARTS for h in CAMPAIGN_HOLES
-        if (p, h) not in FIG18_FITTING_PAIRS
-    ]
-    return fitting + others
-
-
-def select_pairs(spec: str | None) -> list[CampaignPair]:
-    """All campaign pairs, or those named in ``spec`` ("p1:r1,p3:r1")."""
-    pairs = campaign_pairs()
-    if not spec:
-        return pairs
-    by_name = {f"{p.part}:{p.hole}": p for p in pairs}
-    chosen = []
-    for name in spec.split(","):
-        if name.strip() not in by_name:
-            raise ExecutorError(
-                f"--pairs: unknown pair '{name}'; expected PART:HOLE among {', '.join(by_name)}"
-            )
-        chosen.append(by_name[name.strip()])
-    return chosen
 
 
 class TrialRunner(Protocol):
@@ -110,44 +71,6 @@ class CellRunner:
 
     def __call__(self, part: str, hole: str, seed: int) -> dict[str, Any]:
         return self.cell.run_trial(part, hole, seed=seed, max_attempts=2).to_json()
-
-
-@dataclass
-class PairStats:
-    """Counts over the trials of one pair (the columns of Fig. 18, plus ours)."""
-
-    part: str
-    hole: str
-    fits: bool
-    trials: int
-    first_trial: int
-    """fitting pair: reported 'fit' at the 1st attempt"""
-    after_second: int
-    """fitting pair: reported 'fit' within two attempts"""
-    correct: int
-    """'fit' for a fitting pair, 'no_fit' for a non-fitting one"""
-    false_fits: int
-    """non-fitting pair reported 'fit' (must stay 0)"""
-    median_duration_s: float
-    """median wall time of one trial [s]"""
-
-    @property
-    def correct_ratio(self) -> float:
-        return self.correct / self.trials if self.trials else 0.0
-
-
-def pair_stats(pair: CampaignPair, results: Sequence[dict[str, Any]]) -> PairStats:
-    """Fig. 18's counts for one pair from its trial results."""
-    fit = [r for r in results if r["outcome"] == "fit"]
-    first = sum(1 for r in fit if r["attempts"] == 1)
-    return PairStats(
-        part=pair.part, hole=pair.hole, fits=pair.fits, trials=len(results),
-        first_trial=first if pair.fits else 0,
-        after_second=len(fit) if pair.fits else 0,
-        correct=len(fit) if pair.fits else len(results) - len(fit),
-        false_fits=0 if pair.fits else len(fit),
-        median_duration_s=statistics.median(r["duration_s"] for r in results) if results else 0.0,
-    )
 
 
 # -- worker processes -------------------------------------------------------------------
@@ -287,7 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--trials", type=int, default=40, help="executions per pair (default 40)")
     parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    parser.add_argument("--pairs", help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
+    parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
     parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
@@ -305,7 +228,7 @@ def main(argv: Sequence[str]) -> int:
         )
         report = campaign_report(run, args.seed, args.workers)
         if args.plot:
-            from executor.campaign_plots import write_plots
+            from executor.campaign.plots import write_plots
 
             plots = write_plots(Path(args.plot), run.stats, args.assembly, args.seed)
             report["plots"] = [str(p) for p in plots]

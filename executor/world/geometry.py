@@ -93,9 +93,10 @@ def load_geometry(assembly: str = "cranfield") -> CellGeometry:
     parts: dict[str, PartSpec] = {}
     for name, shape in geo.get("part_shapes", {}).items():
         for pid in shape["parts"]:
-            if starts.get(pid) is None:
+            start = starts.get(pid)
+            if start is None:
                 raise ExecutorError(f"geometry.toml: part '{pid}' has no start position (expected [x, y] in m)")
-            x, y = starts[pid]
+            x, y = start
             parts[pid] = PartSpec(
                 pid, name, shape["kind"], float(shape["size"]), float(shape["length"]), float(shape["mass"]),
                 (float(x), float(y)), shape["demo_hole"],

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -21,10 +20,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from executor import ExecutorError  # noqa: E402
+from executor.campaign.pairs import HOLE_NAMES, PART_NAMES, PairStats  # noqa: E402
 from executor.rerun_log import AttemptLogger, AttemptTrace  # noqa: E402
-
-if TYPE_CHECKING:
-    from executor.campaign import PairStats
 
 FIG17_SUCCESS = ("p1", "r1")
 FIG17_FAILURE = ("p3", "r1")
@@ -87,8 +84,6 @@ def plot_fig17(success: AttemptTrace, failure: AttemptTrace, path: Path) -> Path
 
 def plot_fig18(stats: Sequence[PairStats], path: Path) -> Path:
     """The campaign table as an image (paper Fig. 18 plus the non-fitting pairs)."""
-    from executor.campaign import HOLE_NAMES, PART_NAMES
-
     columns = ["object", "hole", "fits", "executions", "1st trial", "after 2nd trial",
                "correct", "ratio %"]
     rows = [

@@ -16,7 +16,7 @@ import pybullet as pb
 import pybullet_data
 
 from executor import ExecutorError
-from executor.geometry import CellGeometry, PartSpec, arm_urdf_text, write_assets
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, write_assets
 
 TIME_STEP = 0.001  # [s]
 # Parked parts (the one in the hand) wait here, out of the way [m].

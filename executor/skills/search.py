@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from executor.admittance import Admittance
-from executor.motion import Motion
-from executor.scene import TIME_STEP
+from executor.control.admittance import Admittance
+from executor.control.motion import Motion
+from executor.world.scene import TIME_STEP
 
 
 @dataclass(frozen=True)

@@ -15,33 +15,24 @@ import math
 import sys
 from collections.abc import Sequence
 
-from executor import ExecutorError
-from executor.detector import Thresholds
-from executor.trial import AttemptSetup, Cell, trial_rng
-
-
-def _parse_pairs(text: str) -> list[tuple[str, str]]:
-    """``p1:r1,p3:s1`` → [("p1", "r1"), ("p3", "s1")]."""
-    pairs = []
-    for item in text.split(","):
-        part, sep, hole = item.partition(":")
-        if not (sep and part and hole) or ":" in hole:
-            raise ExecutorError(f"--pairs: '{item}' is not a pair (expected part:hole, e.g. p1:r1)")
-        pairs.append((part, hole))
-    return pairs
+from executor.campaign.pairs import PAIRS_ARGUMENT
+from executor.control.detector import Thresholds
+from executor.evidence import AttemptSetup
+from executor.trial import Cell, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="executor margins", description=__doc__.split("\n\n")[0])
     parser.add_argument("--trials", type=int, default=10, help="attempts per pair (default 10)")
     parser.add_argument("--seed", type=int, default=0, help="first seed")
-    parser.add_argument("--pairs", help="comma-separated part:hole pairs (default: all)")
+    parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     args = parser.parse_args(argv)
     cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf))
-    pairs = _parse_pairs(args.pairs) if args.pairs else [
-        (p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
-    print(f"{'pair':8s} {'max dF [N]':>10s} {'max dM [Nm]':>11s} {'end error [mm] min..max':>24s}  found")
+    pairs = args.pairs or [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     try:
+        for part, hole in pairs:  # an unknown part or hole is an error before any trial runs
+            cell.check_pair(part, hole)
+        print(f"{'pair':8s} {'max dF [N]':>10s} {'max dM [Nm]':>11s} {'end error [mm] min..max':>24s}  found")
         for part, hole in pairs:
             evidence = [cell.run_attempt(part, hole, AttemptSetup.draw(trial_rng(args.seed + k, part, hole)))
                         for k in range(args.trials)]

@@ -22,13 +22,8 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from executor.campaign import (
-    CellRunner,
-    campaign_pairs,
-    run_campaign,
-    stdout_to_stderr,
-    timed_campaign,
-)
+from executor.campaign.pairs import campaign_pairs
+from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5

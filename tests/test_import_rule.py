@@ -1,0 +1,102 @@
+"""The architecture, checked on the source: the planner (``asp``) and the cell (``executor``)
+meet only through ``bridge``, and no module imports itself back through others.
+
+Imports are read with :mod:`ast`, every one of them: module level, inside functions and
+under ``TYPE_CHECKING`` alike, so a lazy import cannot hide a crossing or a cycle.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import networkx as nx
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGES = ("asp", "executor", "bridge")
+FORBIDDEN = {"asp": {"executor"}, "executor": {"asp"}, "bridge": {"asp", "executor"}}
+
+
+def module_name(root: Path, path: Path) -> str:
+    """``asp/sizes/learner.py`` → ``asp.sizes.learner``; a package's ``__init__`` is the package."""
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports(root: Path, path: Path) -> list[tuple[int, str]]:
+    """(line, absolute module name) of every import of one file; relative ones are resolved."""
+    package = module_name(root, path).split(".")
+    if path.name != "__init__.py":
+        package = package[:-1]
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = package[: len(package) - node.level + 1] if node.level else []
+            module = ".".join([*base, *([node.module] if node.module else [])])
+            found.append((node.lineno, module))
+            found += [(node.lineno, f"{module}.{alias.name}") for alias in node.names]
+    return found
+
+
+def sources(root: Path) -> list[Path]:
+    return sorted(p for package in PACKAGES for p in (root / package).rglob("*.py"))
+
+
+def violations(root: Path) -> list[str]:
+    """``file:line imports X`` for every import that crosses the rule."""
+    bad = []
+    for path in sources(root):
+        side = path.relative_to(root).parts[0]
+        for line, name in imports(root, path):
+            if name.split(".")[0] in FORBIDDEN[side]:
+                bad.append(f"{path.relative_to(root)}:{line} imports {name}")
+    return sorted(set(bad))
+
+
+def import_graph(root: Path) -> nx.DiGraph:
+    """Module → module it imports, among the project's own modules."""
+    modules = {module_name(root, p): p for p in sources(root)}
+    graph = nx.DiGraph()
+    graph.add_nodes_from(modules)
+    for name, path in modules.items():
+        for _, imported in imports(root, path):
+            if imported in modules and imported != name and not name.startswith(imported + "."):
+                graph.add_edge(name, imported)
+    return graph
+
+
+def test_planner_and_cell_meet_only_through_the_bridge() -> None:
+    assert violations(ROOT) == []
+
+
+def test_the_rule_catches_a_planner_module_importing_the_cell(tmp_path: Path) -> None:
+    for package in PACKAGES:
+        (tmp_path / package).mkdir()
+        (tmp_path / package / "__init__.py").write_text("")
+    (tmp_path / "asp" / "planner.py").write_text("import executor\n")
+    (tmp_path / "executor" / "cell.py").write_text("def f():\n    from asp.solve import solve\n")
+    (tmp_path / "bridge" / "keys.py").write_text("from executor import ExecutorError\nfrom . import messages\n")
+    (tmp_path / "bridge" / "messages.py").write_text("from .keys import x\n")
+    assert violations(tmp_path) == [
+        "asp/planner.py:1 imports executor",
+        "bridge/keys.py:1 imports executor",
+        "bridge/keys.py:1 imports executor.ExecutorError",
+        "executor/cell.py:2 imports asp.solve",
+        "executor/cell.py:2 imports asp.solve.solve",
+    ]
+    cycles = [set(cycle) for cycle in nx.simple_cycles(import_graph(tmp_path))]
+    assert cycles == [{"bridge.keys", "bridge.messages"}]
+
+
+def test_no_import_cycle_among_the_project_modules() -> None:
+    cycles = sorted(sorted(cycle) for cycle in nx.simple_cycles(import_graph(ROOT)))
+    assert cycles == []
+
+
+def test_no_python_folder_holds_more_than_twelve_modules() -> None:
+    folders = {path.parent for path in sources(ROOT)}
+    crowded = {str(f.relative_to(ROOT)): n for f in folders
+               if (n := len([p for p in f.glob("*.py") if p.name != "__init__.py"])) > 12}
+    assert crowded == {}
