@@ -24,24 +24,28 @@ from executor import ExecutorError
 
 
 @dataclass(frozen=True)
-class HoleSpec:
-    """A hole: ``kind`` "round" (``size`` = diameter [m]) or "square" (side [m])."""
+class Section:
+    """A part's or a hole's cross-section: ``kind`` "round" (``size`` = diameter [m]) or
+    "square" (``size`` = side [m])."""
 
     id: str
     kind: str
     size: float
+
+
+@dataclass(frozen=True)
+class HoleSpec(Section):
+    """A hole of the plate at ``position`` [m]."""
+
     position: tuple[float, float]
 
 
 @dataclass(frozen=True)
-class PartSpec:
-    """A graspable part: cross-section ``kind``/``size`` [m], ``length`` [m], ``mass`` [kg],
+class PartSpec(Section):
+    """A graspable part of shape ``shape`` (its skill's name): ``length`` [m], ``mass`` [kg],
     ``start`` on the tray [m], ``demo_hole`` where its shape's skill is taught."""
 
-    id: str
     shape: str
-    kind: str
-    size: float
     length: float
     mass: float
     start: tuple[float, float]
@@ -98,8 +102,8 @@ def load_geometry(assembly: str = "cranfield") -> CellGeometry:
                 raise ExecutorError(f"geometry.toml: part '{pid}' has no start position (expected [x, y] in m)")
             x, y = start
             parts[pid] = PartSpec(
-                pid, name, shape["kind"], float(shape["size"]), float(shape["length"]), float(shape["mass"]),
-                (float(x), float(y)), shape["demo_hole"],
+                pid, shape["kind"], float(shape["size"]), shape=name, length=float(shape["length"]),
+                mass=float(shape["mass"]), start=(float(x), float(y)), demo_hole=shape["demo_hole"],
             )
     return CellGeometry(folder, geo["plate"], geo["gripper"], holes, parts)
 
