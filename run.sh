@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The one entry point of the project.
 #   ./run.sh                 set up .venv and run the main job (end-to-end Cranfield session)
-#   ./run.sh test [ARGS]     set up .venv and run the whole test suite (pytest ARGS)
+#   ./run.sh test [ARGS]     set up .venv, run the linters (ruff, mypy) and the test suite (pytest ARGS)
+#   ./run.sh lint            set up .venv and run the linters only
 #   ./run.sh <subcommand>    run one command of the command line (each has --help)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -22,12 +23,18 @@ setup() {
     fi
 }
 
+lint() {
+    "$VENV/bin/ruff" check --quiet asp executor bridge tests
+    "$VENV/bin/mypy" --no-error-summary
+}
+
 usage() {
     cat <<'USAGE'
 usage: ./run.sh [SUBCOMMAND] [ARGS...]
 
   (none)        end-to-end learning session on Cranfield (same as: session)
-  test          run the test suite
+  test          run the linters and the test suite (pytest options pass through, e.g. -m "not slow")
+  lint          run the linters (ruff, mypy)
   precedence    learn / count / sample / evaluate / suggest precedence constraints
   sizes         learn / evaluate which part fits which hole (active exploration)
   assign        hole assignments from learned facts
@@ -50,7 +57,8 @@ esac
 setup
 export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
 case "$cmd" in
-    test)      exec "$PY" -m pytest "$@" ;;
+    test)      lint; exec "$PY" -m pytest "$@" ;;
+    lint)      lint ;;
     executor)  exec "$PY" -m executor "$@" ;;
     bench)
         if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -m executor.campaign.bench "$@"; fi

@@ -43,12 +43,12 @@ def main(argv: list[str] | None = None) -> int:
         print("usage: ./run.sh SUBCOMMAND [ARGS...]\n")
         for name, (_, text) in SUBCOMMANDS.items():
             print(f"  {name:<11} {text}")
-        print("  executor    the simulated PyBullet cell (teach, trial, campaign, serve)")
+        print("  executor    the simulated PyBullet cell (teach, trial, campaign, serve, margins)")
         return 0
     name, rest = argv[0], argv[1:]
     if name not in SUBCOMMANDS:
         print(f"error: unknown subcommand '{name}'; expected one of: "
-              f"{', '.join([*SUBCOMMANDS, 'executor', 'test'])}", file=sys.stderr)
+              f"{', '.join([*SUBCOMMANDS, 'executor', 'test', 'lint'])}", file=sys.stderr)
         return 2
     module_name, _, function = SUBCOMMANDS[name][0].partition(":")
     module = importlib.import_module(module_name)

@@ -1,9 +1,15 @@
-"""Zenoh messaging shared by the planner and the cells (DESIGN.md, Bridge).
+"""What the planner and the cells share: Zenoh messaging, the assembly folder, the Rerun layout.
 
 - :mod:`bridge.keys`: every key expression (``cell/<id>/insert``, ``cell/<id>/alive``);
 - :mod:`bridge.messages`: typed, versioned JSON messages, validated on receipt;
 - :mod:`bridge.session`: opening Zenoh sessions (peer mode on loopback by default);
-- :mod:`bridge.client`: requests with id, timeout and failover; cell discovery.
+- :mod:`bridge.client`: requests with id, timeout and failover; cell discovery;
+- :mod:`bridge.assembly`: the assembly folder (``assembly.toml``) and its loader;
+- :mod:`bridge.rerun_layout`: the Rerun application id, entity roots and blueprint;
+- :mod:`bridge.recordings`: reading ``.rrd`` recordings back;
+- :mod:`bridge.cli_types`: argument types both command lines use.
+
+Nothing here imports the planner (``asp``) or the cell (``executor``).
 """
 
 

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import networkx as nx
 
-ROOT = Path(__file__).resolve().parent.parent
+from tests.conftest import ROOT
+
 PACKAGES = ("asp", "executor", "bridge")
 FORBIDDEN = {"asp": {"executor"}, "executor": {"asp"}, "bridge": {"asp", "executor"}}
 

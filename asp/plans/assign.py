@@ -1,6 +1,6 @@
 """Hole assignment (paper 2.2, end): the paper's greedy assignment and all feasible ones.
 
-Input are learned facts files in the DESIGN.md vocabulary: ``part/1``, ``hole/1``,
+Input are learned facts files in the project's vocabulary (docs/plans.md): ``part/1``, ``hole/1``,
 ``fits/2`` (and ``no_fit/2``, ``needs_hole/1``, ``must_precede/2``...). A part *needs a
 hole* when it has a ``fits/2`` or ``no_fit/2`` fact or a ``needs_hole/1`` fact
 (``asp/encodings/plans/needs_hole.lp``); every other part (Cranfield: bp sp pd ph fp) is

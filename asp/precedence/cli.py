@@ -1,6 +1,6 @@
 """``./run.sh precedence ...``: learn, count, enumerate, sample, evaluate, suggest.
 
-JSON keys are a contract (issue 2, section 5). Sequences are printed one per line,
+JSON keys are a contract (docs/cli.md). Sequences are printed one per line,
 ids separated by spaces: the demonstrations format, so output can be fed back.
 """
 

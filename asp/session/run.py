@@ -8,7 +8,7 @@
    :mod:`asp.session.oracle`); every finished experiment is journaled (fsynced) before
    the learner uses it;
 4. assigns holes (greedy) and computes complete plans, each run through the checker;
-5. writes ``RUN/learned.lp`` (DESIGN.md vocabulary), ``RUN/assignment.lp``,
+5. writes ``RUN/learned.lp`` (the project's facts vocabulary), ``RUN/assignment.lp``,
    ``RUN/session.json``, ``RUN/journal.jsonl`` and the Rerun recordings ``RUN/*.rrd``
    (planner and cells in one recording id), and prints a summary (``--json``: the
    contract ``{"run", "experiments", "fits", "must_precede", "plans", "matches_truth"}``).

@@ -1,10 +1,10 @@
 """``./run.sh sizes learn|evaluate``: which part fits which hole (paper 2.2, 4.2).
 
 ``learn`` runs one learning session against a truth oracle and prints the experiments
-(``--json``: the issue's contract), optionally writing the learned facts (``--out``).
+(``--json``: the contract of docs/cli.md), optionally writing the learned facts (``--out``).
 ``evaluate`` counts the experiments a policy needs over relabelings of an assembly.
 Both take ``--noise P`` (answers flipped with probability P) and ``--confirm K`` (re-test
-each essential observation until its result leads by K+1 answers; see README "Noise").
+each essential observation until its result leads by K+1 answers; docs/sizes.md, "Noise").
 """
 
 from __future__ import annotations

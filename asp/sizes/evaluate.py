@@ -63,7 +63,7 @@ class Evaluation:
         return statistics.median(counts)
 
     def as_json(self) -> dict:
-        """The issue's JSON contract; shares are fractions of all cases (0..1). With noise
+        """The JSON contract of ``sizes evaluate --json``; shares are fractions of all cases (0..1). With noise
         or confirm also ``noise``, ``confirm``, ``wrong`` (cases) and ``wrong_share``."""
         low, high = min(self.histogram), max(self.histogram)
         extra = {} if not (self.noise or self.confirm) else {

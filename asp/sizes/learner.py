@@ -70,7 +70,7 @@ class SizeLearningResult:
         return len(self.experiments)
 
     def facts(self) -> list[clingo.Symbol]:
-        """``part/1, hole/1, tried/4, smaller/2, fits/2, no_fit/2`` (DESIGN.md vocabulary)."""
+        """``part/1, hole/1, tried/4, smaller/2, fits/2, no_fit/2`` (the project's facts vocabulary)."""
         k = self.knowledge
         atoms = [fact("part", p) for p in k.parts] + [fact("hole", h) for h in k.holes]
         atoms += [fact("tried", e.number, e.part, e.hole, e.result) for e in self.experiments]

@@ -1,4 +1,4 @@
-"""``./run.sh bench executor [--quick] [--json]``: speed of the simulated cell (issue 6).
+"""``./run.sh bench executor [--quick] [--json]``: speed of the simulated cell.
 
 1. Trial wall time: ``--trials`` (default 3; ``--quick`` 1) trials of every campaign
    pair, fitting and non-fitting, one after the other in this process (one DIRECT
@@ -61,7 +61,7 @@ def campaign_timing(assembly: str, trials: int, seed: int, workers: int) -> dict
 
 
 def format_report(report: dict[str, Any]) -> str:
-    """Text lines with the targets of issue 4 section 6."""
+    """Text lines with the measured figures and their targets (docs/results.md)."""
     def verdict(ok: bool) -> str:
         return "ok" if ok else "MISSED"
 

@@ -4,10 +4,9 @@
     ‖p_end − p_goal‖ > goal_tolerance      (the trajectory was not completed)
 
 Thresholds come from margins measured with ``./run.sh executor margins`` (every
-part-hole pair, detection off; README, "The simulated cell"): fitting insertions stay
-below 3.9 N / 0.09 Nm sustained deviation (tight peg: 25.8 N / 2.9 Nm) and end within
-2.48 mm of p_goal; a too-big part pushed on by the 2000 N/m impedance passes 50 N and
-ends ≥ 24.7 mm away.  One set of thresholds for all pairs.  A violation must persist
+part-hole pair, detection off; the figures are in docs/results.md): fitting insertions
+stay well below them, a too-big part pushed on by the impedance passes them.  One set of
+thresholds for all pairs.  A violation must persist
 ``persist_steps`` steps to count (contact transients when an edge catches last 1–5 ms).
 """
 

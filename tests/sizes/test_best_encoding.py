@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import clingo
 import pytest
-from _best_reference import ENCODING as ENCODING_FILE
+
+from tests._best_reference import ENCODING as ENCODING_FILE
 
 ENCODING = ENCODING_FILE.read_text(encoding="utf-8")
 

@@ -14,13 +14,13 @@ from clintest.assertion import Assertion, Equals, Or, True_
 from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
-from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from asp.plans.assign import LearnedFacts, UnsolvableAssembly, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans
 from asp.solve import fact, write_facts
+from tests.conftest import ROOT
 
 ENCODINGS = ROOT / "asp" / "encodings"
 

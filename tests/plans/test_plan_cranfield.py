@@ -1,6 +1,6 @@
 """Cranfield plans from its learned-facts equivalent (true precedence closed, Fig. 5
 sizes): plans, optimal plans against brute force over every plan (also on random small
-cells), the ``plan`` command and the plain clingo command lines of the README. Every
+cells), the ``plan`` command and the plain clingo command lines of the docs. Every
 plan goes through the checker."""
 
 from __future__ import annotations
@@ -11,15 +11,15 @@ import re
 from pathlib import Path
 
 import pytest
-from conftest import ROOT
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-from test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
 from asp.solve import load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
+from tests.conftest import ROOT
+from tests.plans.test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 
 CRANFIELD = ROOT / "data" / "cranfield"
 

@@ -6,7 +6,6 @@ import random
 
 import numpy as np
 import pytest
-from _sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
 
 from asp.bench.dominance import (
     Relaxation,
@@ -18,6 +17,7 @@ from asp.bench.dominance import (
     systematic_counts,
 )
 from asp.sizes.biorders import all_biorders
+from tests._sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
 
 
 @pytest.mark.parametrize("m, n", [(2, 3), (3, 3), (2, 4), (4, 2)])

@@ -13,7 +13,6 @@ from clintest.assertion import Equals, Or, True_
 from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
-from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -27,6 +26,7 @@ from asp.plans.assign import (
 )
 from asp.plans.plans import check_assignment
 from asp.solve import encoding, fact, write_facts
+from tests.conftest import ROOT
 
 ASSIGNMENTS_LP = str(encoding("assignments.lp"))
 CRANFIELD_SIZES = ROOT / "data" / "cranfield" / "sizes.lp"

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from _precedence_helpers import poset_with_demos
 from hypothesis import given, settings
 
 from asp.precedence.count import count_linear_extensions, linear_extensions
@@ -11,6 +10,7 @@ from asp.precedence.demos import Demonstrations, load_demos, parse_demos
 from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
 from asp.precedence.relation import Relation, reduction, true_relation
 from bridge.assembly import load_assembly
+from tests._precedence_helpers import poset_with_demos
 
 
 def test_battery_fig3_gives_fig4_and_the_five_listed_sequences() -> None:

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
-from _precedence_helpers import posets
 from hypothesis import given, settings
 
 from asp.precedence.evaluate import PAPER_M, evaluate
 from asp.precedence.guide import Guide, evaluate_guided, suggest, teacher_order
 from asp.precedence.relation import Relation, true_relation
 from bridge.assembly import load_assembly
+from tests._precedence_helpers import posets
 
 
 def test_evaluation_reproduces_the_paper_within_sampling_error() -> None:
@@ -21,7 +21,7 @@ def test_evaluation_reproduces_the_paper_within_sampling_error() -> None:
     assert 0.72 <= by_m[10]["mean"] / 5320 <= 0.83
     # four standard errors of a 1000-trial estimate: sqrt(p(1-p)/1000)
     assert abs(by_m[20]["p_all"] - 0.72) <= 4 * (0.72 * 0.28 / 1000) ** 0.5
-    # the paper says 94 %; uniform sampling gives 0.917 +- 0.0006 (README, "Precedence")
+    # the paper says 94 %; uniform sampling gives 0.917 +- 0.0006 (docs/results.md)
     assert abs(by_m[30]["p_all"] - 0.917) <= 4 * (0.917 * 0.083 / 1000) ** 0.5
     for r in result["results"]:
         assert abs(sum(r["histogram"].values()) - 1.0) < 1e-9

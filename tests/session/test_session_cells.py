@@ -18,13 +18,13 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from conftest import TRUTH_SESSION
 
 from asp.session.cells import CellProcess, start_cell
 from asp.session.journal import read_journal
 from asp.sizes.oracle import TruthOracle
 from asp.solve import atoms_by_name, load_atoms
 from bridge.session import free_loopback_endpoint
+from tests.conftest import TRUTH_SESSION
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
 TRUTH = TruthOracle.from_assembly("cranfield")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from _best_reference import choose_by_asp, possible_relations_asp
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -11,7 +10,8 @@ from asp.sizes.best import choose, choose_bit, knowledge_masks
 from asp.sizes.biorders import all_biorders, consistent_index
 from asp.sizes.learner import SizeLearner
 from asp.sizes.policies import get_policy
-from tests.test_best_biorders import biorder_truths, closure_after
+from tests._best_reference import choose_by_asp, possible_relations_asp
+from tests.sizes.test_best_biorders import biorder_truths, closure_after
 
 
 @settings(max_examples=20, deadline=None)

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
 
 from asp.sizes.best import choose_bit
 from asp.sizes.biorders import all_biorders
 from asp.sizes.evaluate import relabeled_matrices
 from asp.sizes.learner import learn_sizes
 from asp.sizes.oracle import TruthOracle
+from tests._sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
 
 
 def test_best_needs_fewer_experiments_than_systematic_over_all_small_biorders() -> None:

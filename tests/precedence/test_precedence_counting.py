@@ -8,7 +8,6 @@ from math import factorial
 
 import clingo
 import numpy as np
-from _precedence_helpers import closed_relation, posets
 from hypothesis import given, settings
 from scipy.stats import chisquare
 
@@ -18,6 +17,7 @@ from asp.precedence.learn import intersect_orders
 from asp.precedence.relation import Relation, true_relation
 from asp.solve import encoding, fact
 from bridge.assembly import load_assembly
+from tests._precedence_helpers import closed_relation, posets
 
 
 def clingo_sequences(relation: Relation) -> set[tuple[str, ...]]:

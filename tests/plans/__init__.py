@@ -1,0 +1,1 @@
+"""Tests of hole assignment and plans (asp/plans)."""

@@ -1,0 +1,1 @@
+"""Tests of precedence constraints (asp/precedence)."""

@@ -1,0 +1,1 @@
+"""Tests of size learning and policies (asp/sizes)."""
