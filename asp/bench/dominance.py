@@ -16,10 +16,12 @@ policy stops, as a real one does, only when a single biorder of all m×n remains
 Every truth t has a *reduction* R(t): its pairs not entailed by its other pairs. They
 must all be asked, and every experiment is either one of them or *wasted* for t, so
 experiments(t) = |R(t)| + waste(t), and the deadline b(t) leaves t a slack
-b(t) − |R(t)| of waste. :class:`Search` computes the least total waste over
-(knowledge, depth) states, memoised, by a bounded depth-first search that stores
-proven lower bounds; an experiment wasted for a truth without slack left is pruned.
-Without deadlines it gives the unconstrained optimum.
+b(t) − |R(t)| of waste. The least total waste below a (knowledge, depth) state is
+the least, over the experiments wasted for no alive truth without slack left, of
+(its waste + the least waste below each answer); :class:`BranchAndBound` computes it
+by a memoised, bounded depth-first search that stores proven lower bounds (raised by
+iterative deepening when time-limited). :class:`Search` is that problem over a set of
+truths with per-truth deadlines; without deadlines it gives the unconstrained optimum.
 
 Relaxation for Cranfield. With T = the 900 distinct 5×5 Cranfield truths (14400
 relabelings, each truth 16 times, so means over T equal means over the 14400), the
@@ -43,7 +45,9 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from dataclasses import dataclass, field
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Generic, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -54,10 +58,6 @@ from bridge.cli_types import comma_list, size_pair
 
 INFEASIBLE = 1 << 40
 """Value of a state from which no policy meets every deadline."""
-
-State = tuple[int, int, int, int, tuple[int, ...]]
-"""(fit mask, no-fit mask, depth, bit set of the truths alive, their slack levels)."""
-
 
 def add_answer(fit: int, no_fit: int, m: int, n: int, bit: int, fits: bool) -> tuple[int, int]:
     """Closure of closed knowledge (fit, no_fit masks, bit p·n+h) plus one answer.
@@ -134,48 +134,81 @@ def bit_set(flags: np.ndarray) -> int:
     return int.from_bytes(np.packbits(flags, bitorder="little").tobytes(), "little")
 
 
-@dataclass
-class Search:
-    """Least total waste over policies meeting per-truth deadlines (see module docstring).
+Key = tuple[int, int, int]
+"""A state's memo key: (fit mask, no-fit mask, depth). The depth is part of it since the
+waste left to the truths alive depends on it (their deadlines count from the root)."""
 
-    ``truths`` are m×n biorder masks (uint64); ``slack[i]`` the waste truth i may have,
-    None for no deadline. ``states`` counts the expanded (knowledge, depth) states;
-    ``choice`` holds, per state key, the experiment (bit) of the last policy found.
+S = TypeVar("S")
+"""The state type of a problem."""
+
+
+@dataclass(slots=True)
+class Option(Generic[S]):
+    """One experiment at a state: its ``waste`` now, the states after it (one per answer)
+    and their ``parts`` (lower bounds, exact values once solved); ``lower`` = waste + Σ parts."""
+
+    bit: int
+    waste: int
+    children: list[S]
+    parts: list[int]
+    lower: int
+
+
+class BranchAndBound(ABC, Generic[S]):
+    """Least total waste below a state, by memoised depth-first branch and bound.
+
+    A problem supplies its states and four things: :meth:`key` (the memo key),
+    :meth:`settled` (nothing more to count below: value 0), :meth:`askable` (the unknown
+    experiments wasted for no alive truth without slack, with the waste they count) and
+    :meth:`children` (the states after an experiment, one per answer that matters). The
+    value of a state is min over askable experiments of (waste + Σ values of its
+    children), INFEASIBLE if none is askable.
+
+    ``memo[key]`` = (value, True) once proven exact, (lower bound, False) before;
+    ``choice[key]`` is the experiment (bit) of the last policy found within the bound;
+    ``states`` counts the expanded states. With ``first_only`` (:meth:`first_policy`) the
+    first policy within the bound is taken, and its values, not proven least, go to
+    ``found`` instead of ``memo``.
     """
 
-    m: int
-    n: int
-    truths: np.ndarray
-    slack: list[int | None]
-    states: int = 0
-    memo: dict[tuple[int, int, int], tuple[int, bool]] = field(default_factory=dict)
-    choice: dict[tuple[int, int, int], int] = field(default_factory=dict)
+    base = 0
+    """Experiments every policy asks (the counted reductions): the total is base + waste."""
 
-    def __post_init__(self) -> None:
-        pairs = self.m * self.n
-        reduced = reductions(self.truths, self.m, self.n)
-        self.base = int(np.bitwise_count(reduced).sum())
-        self.fit_sets = [bit_set(column) for column in mask_bits(self.truths, pairs).T]
-        self.reduced_sets = [bit_set(column) for column in mask_bits(reduced, pairs).T]
-        self.top = max((s for s in self.slack if s is not None), default=0)
-        slack = np.array([-1 if s is None else s for s in self.slack])
-        self.levels = tuple(bit_set(slack == k) for k in range(self.top + 1))
+    def __init__(self) -> None:
+        self.states = 0
+        self.memo: dict[Key, tuple[int, bool]] = {}
+        self.choice: dict[Key, int] = {}
+        self.found: dict[Key, int] = {}
         self.first_only = False
-        self.found: dict[tuple[int, int, int], int] = {}
 
-    def root(self) -> State:
-        return 0, 0, 0, (1 << len(self.truths)) - 1, self.levels
+    @abstractmethod
+    def root(self) -> S:
+        """The state before any experiment."""
+
+    @abstractmethod
+    def key(self, state: S) -> Key:
+        """The memo key of a state."""
+
+    @abstractmethod
+    def settled(self, state: S) -> bool:
+        """Whether nothing more is counted below the state (its value is 0)."""
+
+    @abstractmethod
+    def askable(self, state: S) -> list[tuple[int, int]]:
+        """(bit, counted waste) of each askable experiment, in bit order."""
+
+    @abstractmethod
+    def children(self, state: S, bit: int) -> list[S]:
+        """The states after asking ``bit``, one per answer of some alive truth that matters."""
 
     def least_total(self, bound: int | None = None) -> int:
-        """Least total experiments over the truths if ≤ ``bound`` (default: none), else a lower bound > it."""
-        if any(s is not None and s < 0 for s in self.slack):
-            return INFEASIBLE
+        """Least total if ≤ ``bound`` (default: none), else a lower bound > it."""
         limit = INFEASIBLE - 1 if bound is None else bound - self.base
-        return self.base + self.solve(*self.root(), limit)
+        return self.base + self.solve(self.root(), limit)
 
     def first_policy(self) -> int:
-        """Total experiments of the first policy found meeting every deadline (INFEASIBLE
-        if none), trying experiments of least bounded waste first; see ``choice``.
+        """Total of the first policy found (INFEASIBLE if none), trying experiments of
+        least bounded waste first; see ``choice``.
 
         Its values are kept apart from ``memo``, which holds proven bounds only.
         """
@@ -185,44 +218,70 @@ class Search:
         finally:
             self.first_only = False
 
-    def solve(self, fit: int, no_fit: int, depth: int, alive: int, levels: tuple[int, ...], bound: int) -> int:
-        """Least waste below this state if ≤ bound, else a lower bound > bound.
+    def lower_bound_within(self, seconds: float) -> tuple[int, bool]:
+        """Raise a proven lower bound of the least total by iterative deepening for about
+        ``seconds`` (checked between rounds); (bound, True) once it is the least total."""
+        start, root = time.perf_counter(), self.root()
+        bound = self.lower_bound(root)
+        while time.perf_counter() - start < seconds:
+            value = self.solve(root, bound)
+            if value <= bound:
+                return self.base + value, True
+            bound = value
+        return self.base + bound, False
 
-        ``alive`` is the bit set of the truths consistent with the knowledge,
-        ``levels[k]`` those of them with k wastes left (truths without deadline are in
-        none). With ``first_only`` the first policy within the bound is taken.
+    def lower_bound(self, state: S) -> int:
+        """Stored bound of a state, else the least waste of its next experiment (memoised).
+
+        A settled state costs nothing more; a state with no askable experiment (every
+        one wastes an alive truth without slack) is infeasible.
         """
-        if alive & (alive - 1) == 0:
+        if self.settled(state):
             return 0
-        key = (fit, no_fit, depth)
+        key = self.key(state)
+        known = self.memo.get(key)
+        if known is not None:
+            return known[0]
+        least = min((waste for _, waste in self.askable(state)), default=INFEASIBLE)
+        self.memo[key] = (least, False)
+        return least
+
+    def solve(self, state: S, bound: int) -> int:
+        """Least waste below ``state`` if ≤ bound, else a lower bound > bound.
+
+        Experiments are tried by increasing lower bound; a child is solved within what
+        the bound leaves after the waste and the other children's bounds, and an
+        experiment is dropped as soon as its total exceeds the bound. A policy found
+        lowers the bound to its total − 1, so later ones must be strictly better.
+        """
+        if self.settled(state):
+            return 0
+        key = self.key(state)
         known = self.memo.get(key)
         if known is not None and (known[1] or known[0] > bound):
             return known[0]
         if self.first_only and key in self.found:
             return self.found[key]
         self.states += 1
-        options = []
-        for bit in range(self.m * self.n):
-            if ((fit | no_fit) >> bit) & 1 or alive & ~self.reduced_sets[bit] & levels[0]:
-                continue
-            children = self.children((fit, no_fit, depth, alive, levels), bit)
-            waste = (alive & ~self.reduced_sets[bit]).bit_count()
-            parts = [self.lower_bound(*child) for child in children]
-            options.append([waste + sum(parts), waste, parts, children, bit])
-        options.sort(key=lambda option: option[0])
+        options: list[Option[S]] = []
+        for bit, waste in self.askable(state):
+            children = self.children(state, bit)
+            parts = [self.lower_bound(child) for child in children]
+            options.append(Option(bit, waste, children, parts, waste + sum(parts)))
+        options.sort(key=lambda option: option.lower)
         best = INFEASIBLE
         for option in options:
-            lower, waste, parts, children, bit = option
-            if lower > bound:
+            if option.lower > bound:
                 break
-            for i, child in enumerate(children):
-                parts[i] = self.solve(*child, bound - waste - sum(parts) + parts[i])
-                if waste + sum(parts) > bound:
+            parts = option.parts
+            for i, child in enumerate(option.children):
+                parts[i] = self.solve(child, bound - option.waste - sum(parts) + parts[i])
+                if option.waste + sum(parts) > bound:
                     break
-            option[0] = total = waste + sum(parts)
+            option.lower = total = option.waste + sum(parts)
             if total <= bound:
                 best, bound = total, total - 1
-                self.choice[key] = bit
+                self.choice[key] = option.bit
                 if self.first_only:
                     break
         if best < INFEASIBLE:
@@ -231,12 +290,68 @@ class Search:
             else:
                 self.memo[key] = (best, True)
             return best
-        lower = min((option[0] for option in options), default=INFEASIBLE)
+        lower = min((option.lower for option in options), default=INFEASIBLE)
         self.memo[key] = (lower, False)
         return lower
 
-    def children(self, state: State, bit: int) -> list[State]:
-        """The states after asking ``bit``, one per answer some alive truth gives."""
+
+class SearchState(NamedTuple):
+    """A state of :class:`Search`: the knowledge, the truths alive and their slack levels."""
+
+    fit: int
+    no_fit: int
+    depth: int
+    alive: int
+    """Bit set of the truths consistent with the knowledge."""
+    levels: tuple[int, ...]
+    """``levels[k]``: bit set of the alive truths with k wastes left (those without deadline in none)."""
+
+
+class Search(BranchAndBound[SearchState]):
+    """Least total waste over policies meeting per-truth deadlines (see module docstring).
+
+    ``truths`` are m×n biorder masks (uint64); ``slack[i]`` the waste truth i may have,
+    None for no deadline. Truths are bit sets (bit i = truth i) over the truth indices.
+    A state with one truth alive is settled: it asks that truth's reduction.
+    """
+
+    def __init__(self, m: int, n: int, truths: np.ndarray, slack: list[int | None]) -> None:
+        super().__init__()
+        self.m, self.n, self.truths, self.slack = m, n, truths, slack
+        pairs = m * n
+        reduced = reductions(truths, m, n)
+        self.base = int(np.bitwise_count(reduced).sum())
+        self.fit_sets = [bit_set(column) for column in mask_bits(truths, pairs).T]
+        self.reduced_sets = [bit_set(column) for column in mask_bits(reduced, pairs).T]
+        self.top = max((s for s in slack if s is not None), default=0)
+        levels = np.array([-1 if s is None else s for s in slack])
+        self.levels = tuple(bit_set(levels == k) for k in range(self.top + 1))
+
+    def root(self) -> SearchState:
+        return SearchState(0, 0, 0, (1 << len(self.truths)) - 1, self.levels)
+
+    def least_total(self, bound: int | None = None) -> int:
+        """Least total experiments over the truths if ≤ ``bound`` (default: none), else a
+        lower bound > it; INFEASIBLE at once if some deadline is below its reduction."""
+        if any(s is not None and s < 0 for s in self.slack):
+            return INFEASIBLE
+        return super().least_total(bound)
+
+    def key(self, state: SearchState) -> Key:
+        return state.fit, state.no_fit, state.depth
+
+    def settled(self, state: SearchState) -> bool:
+        return state.alive & (state.alive - 1) == 0
+
+    def askable(self, state: SearchState) -> list[tuple[int, int]]:
+        """Unknown pairs wasted for no truth without slack; waste = alive truths outside whose reduction they are."""
+        known, alive, tight = state.fit | state.no_fit, state.alive, state.levels[0]
+        return [(bit, (alive & ~self.reduced_sets[bit]).bit_count()) for bit in range(self.m * self.n)
+                if not (known >> bit) & 1 and not tight & ~self.reduced_sets[bit]]
+
+    def children(self, state: SearchState, bit: int) -> list[SearchState]:
+        """One state per answer some alive truth gives; the truths for which ``bit`` is
+        wasted move down one slack level (off the last one: out of every level)."""
         fit, no_fit, depth, alive, levels = state
         wasted = alive & ~self.reduced_sets[bit]
         result = []
@@ -246,27 +361,9 @@ class Search:
                     members & ((levels[k] & ~wasted) | (levels[k + 1] & wasted if k < self.top else 0))
                     for k in range(self.top + 1)
                 )
-                result.append((*add_answer(fit, no_fit, self.m, self.n, bit, answer), depth + 1, members, moved))
+                result.append(SearchState(*add_answer(fit, no_fit, self.m, self.n, bit, answer), depth + 1,
+                                          members, moved))
         return result
-
-    def lower_bound(self, fit: int, no_fit: int, depth: int, alive: int, levels: tuple[int, ...]) -> int:
-        """Stored bound of a state, else the least waste of its next experiment (memoised).
-
-        A state with one truth left costs nothing more (ask its reduction); a state
-        whose every experiment wastes a truth without slack is infeasible.
-        """
-        if alive & (alive - 1) == 0:
-            return 0
-        key = (fit, no_fit, depth)
-        known = self.memo.get(key)
-        if known is not None:
-            return known[0]
-        least = INFEASIBLE
-        for bit in range(self.m * self.n):
-            if not ((fit | no_fit) >> bit) & 1 and not levels[0] & ~self.reduced_sets[bit]:
-                least = min(least, (alive & ~self.reduced_sets[bit]).bit_count())
-        self.memo[key] = (least, False)
-        return least
 
 
 def policy_counts(search: Search, truths: np.ndarray | None = None) -> np.ndarray:
@@ -281,7 +378,7 @@ def policy_counts(search: Search, truths: np.ndarray | None = None) -> np.ndarra
     truths = search.truths if truths is None else truths
     reduced = reductions(search.truths, m, n).tolist()
     counts = np.zeros(len(truths), dtype=np.int64)
-    stack = [(0, 0, 0, np.arange(len(truths)), search.root()[3])]
+    stack = [(0, 0, 0, np.arange(len(truths)), search.root().alive)]
     while stack:
         fit, no_fit, depth, members, alive = stack.pop()
         known = fit | no_fit
@@ -302,11 +399,19 @@ def policy_counts(search: Search, truths: np.ndarray | None = None) -> np.ndarra
     return counts
 
 
-Node = tuple[int, int, int, np.ndarray, np.ndarray]
-"""(fit mask, no-fit mask, depth, indices of the constraining truths alive, their slack left)."""
+class RelaxationState(NamedTuple):
+    """A state of :class:`Relaxation`: the knowledge and the constraining biorders alive."""
+
+    fit: int
+    no_fit: int
+    depth: int
+    alive: np.ndarray
+    """Indices of the alive biorders that still constrain (counted, or able to overrun)."""
+    slack: np.ndarray
+    """Their waste left."""
 
 
-class Relaxation:
+class Relaxation(BranchAndBound[RelaxationState]):
     """Least counted waste of a policy never worse than systematic on *all* m×n biorders.
 
     ``slack`` (per biorder of ``all_biorders(m, n)``) is the waste allowed, ``counted``
@@ -320,6 +425,7 @@ class Relaxation:
     """
 
     def __init__(self, m: int, n: int, slack: np.ndarray, counted: np.ndarray) -> None:
+        super().__init__()
         self.m, self.n, self.full = m, n, (1 << (m * n)) - 1
         truths = all_biorders(m, n)
         reduced = reductions(truths, m, n)
@@ -328,78 +434,42 @@ class Relaxation:
         self.wasted = ~mask_bits(reduced, m * n)
         self.slack, self.counted = slack.astype(np.int64), counted
         self.base = int(np.bitwise_count(reduced[counted]).sum())
-        self.memo: dict[tuple[int, int, int], tuple[int, bool]] = {}
-        self.states = 0
 
-    def least_total(self, bound: int) -> int:
-        """Least counted total if ≤ ``bound``, else a lower bound > it."""
-        root = self.node(0, 0, 0, np.arange(len(self.slack)), self.slack)
-        return self.base + self.solve(root, bound - self.base)
+    def root(self) -> RelaxationState:
+        return self.state(0, 0, 0, np.arange(len(self.slack)), self.slack)
 
-    def node(self, fit: int, no_fit: int, depth: int, alive: np.ndarray, slack: np.ndarray) -> Node:
+    def state(self, fit: int, no_fit: int, depth: int, alive: np.ndarray, slack: np.ndarray) -> RelaxationState:
         """The state, without the biorders that can no longer overrun their deadline."""
         unknown = np.bitwise_count(self.outside[alive] & ~np.uint64(fit | no_fit)).astype(np.int64)
         keep = self.counted[alive] | (slack < unknown)
-        return fit, no_fit, depth, alive[keep], slack[keep]
+        return RelaxationState(fit, no_fit, depth, alive[keep], slack[keep])
 
-    def askable_waste(self, node: Node) -> tuple[np.ndarray, np.ndarray]:
-        """Per pair: askable (unknown, wastes no biorder without slack), counted waste."""
-        fit, no_fit, _, alive, slack = node
-        wasted = self.wasted[alive]
-        unknown = np.array([not ((fit | no_fit) >> q) & 1 for q in range(self.m * self.n)])
-        askable = unknown & ~(wasted & (slack == 0)[:, None]).any(axis=0)
-        return askable, (wasted & self.counted[alive][:, None]).sum(axis=0)
+    def key(self, state: RelaxationState) -> Key:
+        return state.fit, state.no_fit, state.depth
 
-    def lower_bound(self, node: Node) -> int:
-        """Stored bound, else the least counted waste of an askable experiment (memoised)."""
-        if not self.counted[node[3]].any() or node[0] | node[1] == self.full:
-            return 0
-        key = node[:3]
-        if key not in self.memo:
-            askable, waste = self.askable_waste(node)
-            self.memo[key] = (int(waste[askable].min()) if askable.any() else INFEASIBLE, False)
-        return self.memo[key][0]
+    def settled(self, state: RelaxationState) -> bool:
+        return not self.counted[state.alive].any() or state.fit | state.no_fit == self.full
 
-    def solve(self, node: Node, bound: int) -> int:
-        """Least counted waste below ``node`` if ≤ bound, else a lower bound > bound."""
-        fit, no_fit, depth, alive, slack = node
-        if not self.counted[alive].any() or fit | no_fit == self.full:
-            return 0
-        key = (fit, no_fit, depth)
-        known = self.memo.get(key)
-        if known is not None and (known[1] or known[0] > bound):
-            return known[0]
-        self.states += 1
-        askable, waste = self.askable_waste(node)
-        options = []
-        for bit in np.flatnonzero(askable).tolist():
-            fits, wasted = self.fits[alive, bit], self.wasted[alive, bit]
-            children = [
-                self.node(*add_answer(fit, no_fit, self.m, self.n, bit, answer), depth + 1,
-                          alive[side], slack[side] - wasted[side])
-                for answer, side in ((True, fits), (False, ~fits))
-                if self.counted[alive[side]].any()
-            ]
-            parts = [self.lower_bound(child) for child in children]
-            options.append([int(waste[bit]) + sum(parts), int(waste[bit]), parts, children])
-        options.sort(key=lambda option: option[0])
-        best = INFEASIBLE
-        for option in options:
-            lower, cost, parts, children = option
-            if lower > bound:
-                break
-            for i, child in enumerate(children):
-                parts[i] = self.solve(child, bound - cost - sum(parts) + parts[i])
-                if cost + sum(parts) > bound:
-                    break
-            option[0] = total = cost + sum(parts)
-            if total <= bound:
-                best, bound = total, total - 1
-        if best < INFEASIBLE:
-            self.memo[key] = (best, True)
-        else:
-            self.memo[key] = (min((option[0] for option in options), default=INFEASIBLE), False)
-        return self.memo[key][0]
+    def askable(self, state: RelaxationState) -> list[tuple[int, int]]:
+        """Unknown pairs wasted for no alive biorder without slack; waste = counted biorders it is wasted for."""
+        wasted = self.wasted[state.alive]
+        known = state.fit | state.no_fit
+        unknown = np.array([not (known >> q) & 1 for q in range(self.m * self.n)])
+        askable = unknown & ~(wasted & (state.slack == 0)[:, None]).any(axis=0)
+        waste = (wasted & self.counted[state.alive][:, None]).sum(axis=0)
+        return [(bit, int(waste[bit])) for bit in np.flatnonzero(askable).tolist()]
+
+    def children(self, state: RelaxationState, bit: int) -> list[RelaxationState]:
+        """One state per answer that leaves a counted biorder alive; the alive biorders for
+        which ``bit`` is wasted lose one slack."""
+        fit, no_fit, depth, alive, slack = state
+        fits, wasted = self.fits[alive, bit], self.wasted[alive, bit]
+        return [
+            self.state(*add_answer(fit, no_fit, self.m, self.n, bit, answer), depth + 1,
+                       alive[side], slack[side] - wasted[side])
+            for answer, side in ((True, fits), (False, ~fits))
+            if self.counted[alive[side]].any()
+        ]
 
 
 def cranfield_search() -> Search:
@@ -408,19 +478,6 @@ def cranfield_search() -> Search:
     truths = np.array(sorted(bit_set(np.ravel(matrix)) for matrix in matrices), dtype=np.uint64)
     slack = systematic_counts(truths, 5, 5) - np.bitwise_count(reductions(truths, 5, 5))
     return Search(5, 5, truths, slack.tolist())
-
-
-def lower_bound_within(search: Search, seconds: float) -> tuple[int, bool]:
-    """Raise a proven lower bound of the least total by iterative deepening for about
-    ``seconds`` (checked between rounds); (bound, True) once it is the least total."""
-    start, root = time.perf_counter(), search.root()
-    bound = search.lower_bound(*root)
-    while time.perf_counter() - start < seconds:
-        value = search.solve(*root, bound)
-        if value <= bound:
-            return search.base + value, True
-        bound = value
-    return search.base + bound, False
 
 
 def size_row(m: int, n: int, unconstrained: bool) -> dict:
@@ -455,7 +512,7 @@ def cranfield_report(seconds: float) -> dict:
              "seconds": round(time.perf_counter() - start, 1)}
     bound_search = cranfield_search()
     start = time.perf_counter()
-    bound, exact = lower_bound_within(bound_search, seconds)
+    bound, exact = bound_search.lower_bound_within(seconds)
     return {"truths": len(search.truths), "systematic": {"total": int(budget.sum()),
             "mean": round(float(budget.mean()), 4), "max": int(budget.max())},
             "never_worse_policy": found,

@@ -83,7 +83,7 @@ def test_cranfield_alone_does_not_force_systematic() -> None:
     assert counts.sum() == total <= 18.8 * 900 and (counts <= budget).all() and counts.max() <= 21
     biorders, reduced = all_biorders(5, 5), reductions(search.truths, 5, 5)
     for i in range(0, 900, 45):
-        truth, possible, alive, asked = int(search.truths[i]), biorders, search.root()[3], 0
+        truth, possible, alive, asked = int(search.truths[i]), biorders, search.root().alive, 0
         while len(possible) > 1:
             fit, no_fit = known_masks(possible, 25)
             if alive & (alive - 1):
