@@ -16,9 +16,10 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
+import msgspec
 import zenoh
 
 from bridge import BridgeError
@@ -37,6 +38,10 @@ class CellRefused(BridgeError):
         super().__init__(f"cell {reply.cell} refused request {reply.id}: "
                          f"{reply.code}: {reply.error}")
         self.reply = reply
+
+
+class CellConflict(BridgeError):
+    """One query got different replies (two processes answer for one cell id)."""
 
 
 Outcome = InsertReply | BridgeError
@@ -101,44 +106,63 @@ class CellDirectory:
 
 def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeout: float,
                 on_outcome: Callable[[Outcome], None]) -> zenoh.CancellationToken:
-    """Send ``request`` to ``cell``; ``on_outcome`` is called exactly once (Zenoh thread).
+    """Send ``request`` to ``cell``; ``on_outcome`` is called exactly once (Zenoh thread),
+    when the query ends (the cell finalises it after replying, or ``timeout`` [s] passes).
 
-    The outcome is the InsertReply, CellRefused for an ErrorReply, CellTimeout when no
-    valid reply came within ``timeout`` [s] or the query was cancelled, or MessageError
-    for a reply that does not validate. Returns a token that cancels the query.
+    The outcome is the InsertReply, or CellRefused for an ErrorReply, when every reply
+    that validates and echoes the request (its id, part and hole, from ``cell``) is that
+    same one; CellConflict when the query got different such replies; MessageError when
+    replies came but none validated or echoed the request; CellTimeout when none came or
+    the query was cancelled. Returns a token that cancels the query.
     """
     lock = threading.Lock()
-    delivered = False
-
-    def deliver(outcome: Outcome) -> None:
-        nonlocal delivered
-        with lock:  # replies and the query's end may come on different threads
-            first, delivered = not delivered, True
-        if first:
-            on_outcome(outcome)
+    answers: list[InsertReply | ErrorReply] = []
+    faults: list[BridgeError] = []
 
     def on_reply(reply: zenoh.Reply) -> None:
         ok, err = reply.ok, reply.err
-        if ok is None:
-            detail = err.payload.to_string() if err is not None else "neither a sample nor an error"
-            deliver(CellTimeout(f"cell {cell}: query error: {detail}"))
-            return
         try:
+            if ok is None:
+                detail = err.payload.to_string() if err is not None else "neither a sample nor an error"
+                raise CellTimeout(f"cell {cell}: query error: {detail}")
             message = decode_reply(ok.payload.to_bytes())
-        except MessageError as exc:
-            deliver(exc)
+            check_echo(message, cell, request)
+        except BridgeError as exc:
+            with lock:
+                faults.append(exc)
             return
-        deliver(message if isinstance(message, InsertReply) else CellRefused(message))
+        with lock:
+            answers.append(message)
 
     def on_end() -> None:
-        deliver(CellTimeout(f"cell {cell}: no reply to request {request.id} "
-                            f"within {timeout:.1f} s"))
+        with lock:
+            distinct = list(dict.fromkeys(answers))
+            fault = faults[0] if faults else None
+        if len(distinct) > 1:
+            on_outcome(CellConflict(f"cell {cell}: {len(distinct)} different replies to request {request.id}"))
+        elif distinct:
+            answer = distinct[0]
+            on_outcome(answer if isinstance(answer, InsertReply) else CellRefused(answer))
+        else:
+            on_outcome(fault or CellTimeout(f"cell {cell}: no reply to request {request.id} "
+                                            f"within {timeout:.1f} s"))
 
     cancel = zenoh.CancellationToken()
     session.get(insert_key(cell), zenoh.handlers.Callback(on_reply, on_end),
                 payload=encode(request), timeout=timeout, cancellation_token=cancel,
                 consolidation=zenoh.ConsolidationMode.NONE)
     return cancel
+
+
+def check_echo(message: InsertReply | ErrorReply, cell: str, request: InsertRequest) -> None:
+    """MessageError unless ``message`` comes from ``cell`` and answers ``request``."""
+    asked = (cell, request.id, request.part, request.hole)
+    if isinstance(message, InsertReply):
+        answered = (message.cell, message.id, message.part, message.hole)
+    else:
+        answered = (message.cell, message.id or request.id, request.part, request.hole)
+    if answered != asked:
+        raise MessageError("malformed", f"reply {answered} does not echo the request {asked}")
 
 
 def request_insert(session: zenoh.Session, cell: str, request: InsertRequest,
@@ -170,24 +194,36 @@ class CellPool:
     :meth:`submit` queues a request (distinct ids); :meth:`next_reply` dispatches queued
     requests to idle alive cells and returns the next finished request and its reply;
     each submitted request is returned exactly once. ``timeout`` [s] bounds one attempt
-    at one cell; ``wait_for_cell`` [s] bounds a wait while no cell is alive;
-    ``max_failures`` bounds the failed attempts of one request. Close it when done.
+    at one cell; ``wait_for_cell`` [s] bounds a wait while no usable cell is alive;
+    ``max_failures`` bounds the failed attempts of one request; a cell that misses
+    ``max_misses`` replies in a row is dropped for the rest of the pool's life. Only the
+    cells in ``allowed`` are used (None: any cell that shows a token). ``incidents``
+    lists what went wrong on the way (timeouts, conflicts, dropped cells). Close it when done.
     """
 
     def __init__(self, session: zenoh.Session, directory: CellDirectory, *,
-                 timeout: float = 60.0, wait_for_cell: float = 60.0, max_failures: int = 3) -> None:
+                 timeout: float = 60.0, wait_for_cell: float = 60.0, max_failures: int = 3,
+                 max_misses: int = 2, allowed: Collection[str] | None = None) -> None:
         self._session = session
         self._directory = directory
         self.timeout = timeout
         self.wait_for_cell = wait_for_cell
         self.max_failures = max_failures
+        self.max_misses = max_misses
+        self._allowed = None if allowed is None else frozenset(allowed)
         self._attempts = itertools.count()
         self._events: queue.SimpleQueue[tuple] = queue.SimpleQueue()
         self._pending: deque[InsertRequest] = deque()
         self._busy: dict[str, _Sent] = {}
         self._slow: set[str] = set()
         self._failures: dict[str, int] = {}
-        self._alive = directory.listen(self._on_change)
+        self._misses: dict[str, int] = {}
+        self._dropped: set[str] = set()
+        self.incidents: list[str] = []
+        self._alive = {cell for cell in directory.listen(self._on_change) if self._usable(cell)}
+
+    def _usable(self, cell: str) -> bool:
+        return (self._allowed is None or cell in self._allowed) and cell not in self._dropped
 
     def _on_change(self, cell: str, alive: bool) -> None:
         self._events.put(("cell", cell, alive))
@@ -210,7 +246,8 @@ class CellPool:
             cell = idle.pop(0)
             request = self._pending.popleft()
             attempt = next(self._attempts)
-            cancel = send_insert(self._session, cell, request, self.timeout,
+            sent = msgspec.structs.replace(request, timeout_s=self.timeout)  # the cell drops it after that
+            cancel = send_insert(self._session, cell, sent, self.timeout,
                                  functools.partial(self._on_outcome, cell, attempt))
             self._busy[cell] = _Sent(attempt, request, cancel)
 
@@ -237,7 +274,8 @@ class CellPool:
             if event[0] == "cell":
                 _, cell, alive = event
                 if alive:
-                    self._alive.add(cell)
+                    if self._usable(cell):
+                        self._alive.add(cell)
                     continue
                 self._alive.discard(cell)
                 sent = self._busy.pop(cell, None)
@@ -252,11 +290,20 @@ class CellPool:
             del self._busy[cell]
             if isinstance(outcome, InsertReply):
                 self._slow.discard(cell)
+                self._misses[cell] = 0
                 return sent.request, outcome
+            self.incidents.append(str(outcome))
             self._failed(cell, sent.request, outcome)
 
     def _failed(self, cell: str, request: InsertRequest, outcome: BridgeError) -> None:
         if isinstance(outcome, CellTimeout):
+            self._slow.add(cell)
+            self._misses[cell] = self._misses.get(cell, 0) + 1
+            if self._misses[cell] >= self.max_misses:
+                self._dropped.add(cell)
+                self._alive.discard(cell)
+                self.incidents.append(f"cell {cell} dropped after {self._misses[cell]} missed replies")
+        elif isinstance(outcome, CellRefused) and outcome.reply.code in ("busy", "expired"):
             self._slow.add(cell)
         elif isinstance(outcome, CellRefused) and outcome.reply.code != "failed":
             raise outcome  # the request itself is bad: no cell will take it

@@ -20,7 +20,8 @@ from bridge import BridgeError
 from bridge.assembly import ID_PATTERN
 from bridge.keys import CELL_ID_PATTERN
 
-PROTOCOL_VERSION: Final = 1
+PROTOCOL_VERSION: Final = 2
+"""2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``."""
 MAX_MESSAGE_BYTES: Final = 16 * 1024
 """Largest accepted payload [bytes]; bigger messages are refused unread."""
 
@@ -31,7 +32,11 @@ CellId = Annotated[str, msgspec.Meta(pattern=CELL_ID_PATTERN)]
 Seed = Annotated[int, msgspec.Meta(ge=0, lt=2**32)]
 NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
 Result = Literal["fit", "no_fit"]
-ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "failed"]
+ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "id_reused", "busy", "expired", "failed"]
+"""Why a request was refused: it is invalid (``malformed``, ``oversized``, ``version``), names an
+unknown part or hole (``unknown_id``), reuses the id of another request (``id_reused``); the cell's
+queue is full (``busy``) or the request waited past its ``timeout_s`` (``expired``); the experiment
+could not run (``failed``). Only the last three are worth sending again."""
 
 
 class _Message(msgspec.Struct, frozen=True, forbid_unknown_fields=True, tag_field="kind"):
@@ -48,6 +53,9 @@ class InsertRequest(_Message, tag="insert", frozen=True):
     retest: bool = False
     experiment: Annotated[int, msgspec.Meta(ge=0)] = 0
     """The planner's experiment number (Rerun timeline ``experiment``); 0: none."""
+    timeout_s: NonNegative = 0.0
+    """How long the planner waits for the reply [s]; a cell drops the request when it is
+    still queued after this long (its client has gone). 0: no limit."""
     v: int = PROTOCOL_VERSION
 
 
@@ -70,6 +78,9 @@ class InsertReply(_Message, tag="insert_reply", frozen=True):
 
     id: RequestId
     cell: CellId
+    part: AspId
+    hole: AspId
+    """``part`` and ``hole`` echo the request, so the planner can check what was answered."""
     result: Result
     evidence: Evidence | None = None
     wall_s: NonNegative = 0.0
@@ -114,7 +125,7 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
                            f"{MAX_MESSAGE_BYTES}-byte cap")
     try:
         message = decoder.decode(payload)
-    except msgspec.DecodeError as exc:
+    except (msgspec.DecodeError, UnicodeDecodeError) as exc:
         raise MessageError("malformed", f"{what} is not valid: {exc}") from None
     if message.v != PROTOCOL_VERSION:
         raise MessageError("version", f"{what} has protocol version {message.v}; "

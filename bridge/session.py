@@ -19,9 +19,14 @@ from pathlib import Path
 import zenoh
 
 from bridge import BridgeError
+from bridge.messages import MAX_MESSAGE_BYTES
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 """Where a cell listens and a planner connects when given no endpoint."""
+
+MAX_TRANSPORT_BYTES = 8 * MAX_MESSAGE_BYTES
+"""Zenoh refuses bigger messages before they reach Python (the application's own cap,
+:data:`bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
 
 _ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws|unixsock-stream)/\S+$")
 
@@ -60,6 +65,7 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
         config.insert_json5("mode", '"peer"')
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("listen/endpoints", "[]")
+    config.insert_json5("transport/link/rx/max_message_size", str(MAX_TRANSPORT_BYTES))
     if listen or config_file is None:
         config.insert_json5("listen/endpoints", json.dumps([check_endpoint(e) for e in listen]))
     if connect:

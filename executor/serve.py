@@ -28,6 +28,7 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
@@ -36,6 +37,7 @@ import zenoh
 from bridge import BridgeError
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
 from bridge.messages import (
+    MAX_MESSAGE_BYTES,
     ErrorCode,
     ErrorReply,
     Evidence,
@@ -52,6 +54,9 @@ from executor.world.geometry import load_geometry, passes
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
+
+QUEUE_SIZE = 16
+"""Requests that may wait for the cell; more are refused with ``busy``."""
 
 
 class UnknownPair(ExecutorError):
@@ -139,6 +144,10 @@ class SimBackend:
         self._cell = Cell(assembly, gui=False, logger=self._logger)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        try:
+            self._cell.check_pair(request.part, request.hole)
+        except ExecutorError as exc:
+            raise UnknownPair(str(exc)) from None
         if self._logger is not None:
             self._logger.planner_experiment = request.experiment or None
         trial = self._cell.run_trial(request.part, request.hole, seed=request.seed).to_json()
@@ -155,19 +164,43 @@ class SimBackend:
             self._logger.close()
 
 
-class CellNode:
-    """Validates requests (Zenoh thread) and runs them one at a time (:meth:`serve`)."""
+@dataclass(frozen=True)
+class _Work:
+    """A valid request waiting for the cell, and when it arrived (``time.monotonic`` [s])."""
 
-    def __init__(self, cell_id: str, backend: Backend) -> None:
+    query: zenoh.Query
+    request: InsertRequest
+    arrived: float
+
+
+class CellNode:
+    """Validates requests (Zenoh thread) and runs them one at a time (:meth:`serve`).
+
+    Replies are cached by request id together with the whole request: the same request
+    again gets the cached reply, the same id with anything else changed is refused
+    (``id_reused``). At most ``queue_size`` requests wait; beyond that a request is refused
+    (``busy``), and one that waited longer than its ``timeout_s`` is refused (``expired``)
+    instead of being run for a client that has gone.
+    """
+
+    def __init__(self, cell_id: str, backend: Backend, queue_size: int = QUEUE_SIZE) -> None:
         self.cell_id = cell_id
         self._backend = backend
-        self._work: queue.SimpleQueue[tuple[zenoh.Query, InsertRequest] | None] = queue.SimpleQueue()
-        self._replies: OrderedDict[str, bytes] = OrderedDict()
+        self._work: queue.Queue[_Work | None] = queue.Queue(maxsize=queue_size)
+        self._replies: OrderedDict[str, tuple[InsertRequest, bytes]] = OrderedDict()
         self._lock = threading.Lock()
 
-    def _cached(self, request_id: str) -> bytes | None:
+    def _cached(self, query: zenoh.Query, request: InsertRequest) -> bytes | None:
+        """The cached reply of this very request; refuses a reused id (then returns b"")."""
         with self._lock:
-            return self._replies.get(request_id)
+            cached = self._replies.get(request.id)
+        if cached is None:
+            return None
+        if cached[0] != request:
+            self._refuse(query, "id_reused", f"request id {request.id} was used for "
+                         f"({cached[0].part},{cached[0].hole}); expected a new id", request.id)
+            return b""
+        return cached[1]
 
     def _refuse(self, query: zenoh.Query, code: ErrorCode, text: str,
                 request_id: str | None = None) -> None:
@@ -183,11 +216,16 @@ class CellNode:
         except MessageError as exc:
             self._refuse(query, exc.code, str(exc))
             return
-        cached = self._cached(request.id)
+        cached = self._cached(query, request)
         if cached is not None:
-            query.reply(query.key_expr, cached)
+            if cached:
+                query.reply(query.key_expr, cached)
             return
-        self._work.put((query, request))
+        try:
+            self._work.put_nowait(_Work(query, request, time.monotonic()))
+        except queue.Full:
+            self._refuse(query, "busy", f"{self._work.maxsize} requests are waiting; send it again later",
+                         request.id)
 
     def stop(self) -> None:
         """Make :meth:`serve` return after the experiment in progress (any thread)."""
@@ -196,11 +234,15 @@ class CellNode:
     def serve(self) -> None:
         """Run queued requests until :meth:`stop` (or SIGTERM/SIGINT via SystemExit)."""
         while (work := self._work.get()) is not None:
-            query, request = work
-            cached = self._cached(request.id)
-            if cached is None:
+            query, request = work.query, work.request
+            waited = time.monotonic() - work.arrived
+            cached = self._cached(query, request)
+            if cached is None and request.timeout_s and waited > request.timeout_s:
+                self._refuse(query, "expired", f"request {request.id} waited {waited:.1f} s, "
+                             f"longer than its timeout_s {request.timeout_s:.1f} s", request.id)
+            elif cached is None:
                 cached = self._run(query, request)
-            if cached is not None:
+            if cached:
                 query.reply(query.key_expr, cached)
             query.drop()  # finalises the query: the planner need not wait for its timeout
 
@@ -213,10 +255,10 @@ class CellNode:
             code: ErrorCode = "unknown_id" if isinstance(exc, UnknownPair) else "failed"
             self._refuse(query, code, str(exc), request.id)
             return None
-        reply = encode(InsertReply(id=request.id, cell=self.cell_id, result=result,
-                                   evidence=evidence, wall_s=time.perf_counter() - started))
+        reply = encode(InsertReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole,
+                                   result=result, evidence=evidence, wall_s=time.perf_counter() - started))
         with self._lock:
-            self._replies[request.id] = reply
+            self._replies[request.id] = (request, reply)
             while len(self._replies) > CACHE_SIZE:
                 self._replies.popitem(last=False)
         print(f"done {request.id} {result}", flush=True)
@@ -224,7 +266,9 @@ class CellNode:
 
 
 def _echo(query: zenoh.Query) -> None:
-    query.reply(query.key_expr, query.payload.to_bytes() if query.payload is not None else b"")
+    """``cell/<id>/ping``: the payload back, unread; at most MAX_MESSAGE_BYTES of it."""
+    payload = query.payload.to_bytes() if query.payload is not None else b""
+    query.reply(query.key_expr, payload[:MAX_MESSAGE_BYTES])
 
 
 def _exit_on_signal(signum: int, _frame: object) -> None:

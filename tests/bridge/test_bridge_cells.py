@@ -5,15 +5,36 @@ from __future__ import annotations
 import queue
 import signal
 import threading
+import time
 from collections.abc import Iterator
 
 import pytest
 import zenoh
 
 from asp.session.cells import CellProcess, start_cell
-from bridge.client import CellDirectory, CellPool, CellRefused, request_insert
-from bridge.messages import ErrorReply, InsertReply, InsertRequest, decode_reply
+from bridge.client import (
+    CellConflict,
+    CellDirectory,
+    CellPool,
+    CellRefused,
+    CellTimeout,
+    check_echo,
+    request_insert,
+    send_insert,
+)
+from bridge.keys import alive_key
+from bridge.messages import (
+    MAX_MESSAGE_BYTES,
+    ErrorReply,
+    InsertReply,
+    InsertRequest,
+    MessageError,
+    decode_reply,
+    decode_request,
+    encode,
+)
 from bridge.session import free_loopback_endpoint, open_session
+from executor.serve import QUEUE_SIZE
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -145,3 +166,96 @@ def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
     pool.close()
     replacer.join(30)
     assert cells_of == {"w0": "c1", "w1": "c2", "w2": "c2"}
+
+
+def test_a_reused_id_with_another_pair_is_refused_not_answered_from_the_cache(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    directory.wait_for(1, timeout=20)
+    assert request_insert(session, "c1", InsertRequest(id="r", part="sh", hole="br"), 10).result == "fit"
+    with pytest.raises(CellRefused, match="id_reused"):
+        request_insert(session, "c1", InsertRequest(id="r", part="sh", hole="r1"), timeout=10)
+    bad_utf8 = b'{"kind":"insert","id":"u","part":"p1","hole":"r\xff1"}'
+    reply = raw_query(session, "cell/c1/insert", bad_utf8)
+    assert isinstance(reply, ErrorReply) and reply.code == "malformed"
+    echoed = raw_ping(session, "cell/c1/ping", b"x" * 100_000)
+    assert len(echoed) == MAX_MESSAGE_BYTES
+
+
+def raw_ping(session: zenoh.Session, key: str, payload: bytes) -> bytes:
+    box: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+    session.get(key, lambda reply: box.put(reply.ok.payload.to_bytes()), payload=payload, timeout=10.0)
+    return box.get(timeout=15.0)
+
+
+def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.3))
+    directory.wait_for(1, timeout=20)
+    outcomes: queue.SimpleQueue[object] = queue.SimpleQueue()
+    count = QUEUE_SIZE + 10
+    for k in range(count):  # all at once: one runs, QUEUE_SIZE wait, the rest are refused
+        send_insert(session, "c1", InsertRequest(id=f"q{k}", part="p1", hole="r1", timeout_s=0.5), 20.0,
+                    outcomes.put)
+    results = [outcomes.get(timeout=30) for _ in range(count)]
+    codes = sorted(r.reply.code for r in results if isinstance(r, CellRefused))
+    answered = [r for r in results if isinstance(r, InsertReply)]
+    assert codes.count("busy") >= 1, codes
+    assert codes.count("expired") >= 5, codes  # waited behind 0.3 s experiments longer than 0.5 s
+    assert 1 <= len(answered) <= 4, codes
+    assert sum(line.startswith("start q") for line in cells[0].lines) == len(answered)
+
+
+def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_taken(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    directory.wait_for(1, timeout=20)
+
+    def liar(query: zenoh.Query) -> None:  # a second process answering for c1: "fit", for p9
+        request = decode_request(query.payload.to_bytes())
+        query.reply(query.key_expr, encode(InsertReply(id=request.id, cell="c1", part="p9", hole=request.hole,
+                                                       result="fit")))
+
+    rogue = open_session(connect=[endpoint])
+    try:
+        declared = rogue.declare_queryable("cell/c1/insert", liar)
+        time.sleep(0.5)  # the declaration reaches the planner's session
+        with pytest.raises(MessageError, match="does not echo"):
+            check_echo(InsertReply(id="x", cell="c1", part="p9", hole="r1", result="fit"), "c1",
+                       InsertRequest(id="x", part="p1", hole="r1"))
+        reply = request_insert(session, "c1", InsertRequest(id="e1", part="sh", hole="r1"), timeout=10)
+        assert (reply.part, reply.hole, reply.result) == ("sh", "r1", "no_fit")  # the liar's echo is wrong
+
+        def contradicts(query: zenoh.Query) -> None:
+            request = decode_request(query.payload.to_bytes())
+            query.reply(query.key_expr, encode(InsertReply(id=request.id, cell="c1", part=request.part,
+                                                           hole=request.hole, result="fit")))
+
+        declared.undeclare()
+        declared = rogue.declare_queryable("cell/c1/insert", contradicts)
+        time.sleep(0.5)
+        with pytest.raises(CellConflict, match="2 different replies"):
+            request_insert(session, "c1", InsertRequest(id="e2", part="sh", hole="r1"), timeout=10)
+        declared.undeclare()
+    finally:
+        rogue.close()
+
+
+def test_a_token_with_nothing_behind_it_is_dropped_and_others_are_not_trusted(network) -> None:
+    endpoint, session, directory, cells = network
+    rogue = open_session(connect=[endpoint])
+    try:
+        tokens = [rogue.liveliness().declare_token(alive_key(cell)) for cell in ("c1", "evil")]
+        directory.wait_for(2, timeout=20)
+        pool = CellPool(session, directory, timeout=1.0, wait_for_cell=1.0, max_misses=2, allowed={"c1"})
+        pool.submit(InsertRequest(id="t1", part="p1", hole="r1"))
+        started = time.monotonic()
+        with pytest.raises(CellTimeout, match="no cell alive"):
+            pool.next_reply()
+        assert time.monotonic() - started < 6.0  # two missed replies, then wait_for_cell
+        assert "cell c1 dropped after 2 missed replies" in pool.incidents
+        assert not any("evil" in incident for incident in pool.incidents)
+        pool.close()
+        del tokens
+    finally:
+        rogue.close()

@@ -23,7 +23,7 @@ from bridge.messages import (
 def test_request_and_replies_round_trip() -> None:
     request = InsertRequest(id="run-1:p1:r1:1", part="p1", hole="r1", seed=7)
     assert decode_request(encode(request)) == request
-    reply = InsertReply(id=request.id, cell="c1", result="no_fit", wall_s=0.5,
+    reply = InsertReply(id=request.id, cell="c1", part="p1", hole="r1", result="no_fit", wall_s=0.5,
                         evidence=Evidence(attempts=2, max_force_dev=31.0, max_torque_dev=1.2,
                                           end_error=0.004, duration_s=3.1))
     assert decode_reply(encode(reply)) == reply
@@ -40,7 +40,8 @@ def test_request_and_replies_round_trip() -> None:
     (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","seed":-1}', "malformed"),
     (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","exec":"x"}', "malformed"),
     (b'{"kind":"insert_reply","id":"a","cell":"c1","result":"fit"}', "malformed"),
-    (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","v":2}', "version"),
+    (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","v":1}', "version"),
+    (b'{"kind":"insert","id":"a","part":"p1","hole":"r\xff1"}', "malformed"),
     (b'{"kind":"insert","id":"a","part":"p1","hole":"r1","pad":"' + b"x" * MAX_MESSAGE_BYTES + b'"}',
      "oversized"),
 ])
