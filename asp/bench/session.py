@@ -12,6 +12,12 @@
    on a shared 2-core machine the cells compete with everything else for the cores, so
    the sessions run in pairs, 1 cell then 2 cells back to back, and each pair's ratio
    is reported beside the ratio of the medians).
+3. ``--product N --cells 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
+   experiment takes ``--delay`` seconds without using the cores) on a generated N×N
+   product (:mod:`asp.bench.products`): wall time [s], speed-up against 1 cell,
+   experiments and their ratio to the 1-cell run, and duplicates (a request journaled
+   twice, or a pair run again though not a re-test; must be 0). Targets on 20×20: 8 cells
+   at least 4x faster than 1, with at most 10 % more experiments.
 """
 
 from __future__ import annotations
@@ -25,13 +31,16 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 import zenoh
 
 from asp import PlannerError
+from asp.bench.products import write_product
 from asp.session.cells import ROOT, start_cell
-from asp.session.journal import JOURNAL_NAME, read_journal
+from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from bridge.cli_types import comma_list, number_in
 from bridge.client import CellDirectory, request_insert
 from bridge.keys import ping_key
 from bridge.messages import InsertRequest, encode
@@ -82,11 +91,12 @@ def round_trips(count: int) -> dict:
         cell.stop()
 
 
-def session_run(cells: int, policy: str, backend: str, delay_s: float) -> dict:
-    """One ``session --cells N`` command: wall time [s], experiments, cell busy share."""
+def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly: str = "cranfield") -> dict:
+    """One ``session --cells N`` command: wall time [s], experiments, cell busy share,
+    duplicates (see the module doc)."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     with tempfile.TemporaryDirectory() as tmp:
-        argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells),
+        argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells), "--assembly", assembly,
                 "--policy", policy, "--out", str(Path(tmp) / "run"), "--json",
                 "--backend", backend, "--delay", str(delay_s)]
         t0 = time.perf_counter()
@@ -97,8 +107,30 @@ def session_run(cells: int, policy: str, backend: str, delay_s: float) -> dict:
         result = json.loads(done.stdout)
         if not result["matches_truth"]:
             raise SystemExit(f"session --cells {cells} learned a wrong relation")
-        busy = cell_busy_fraction(Path(tmp) / "run" / JOURNAL_NAME, cells)
-    return {"wall_s": round(wall, 2), "experiments": result["experiments"], "cell_busy": busy}
+        entries = read_journal(Path(tmp) / "run" / JOURNAL_NAME)
+        busy = cell_busy_fraction(entries, cells)
+    return {"wall_s": round(wall, 2), "experiments": result["experiments"], "cell_busy": busy,
+            "duplicates": duplicates(entries)}
+
+
+def duplicates(entries: list[JournalEntry]) -> int:
+    """Journal entries that repeat a request id, or a pair without being a re-test."""
+    ids = Counter(e.id for e in entries)
+    first_runs = Counter((e.part, e.hole) for e in entries if not e.retest)
+    return sum(n - 1 for n in ids.values()) + sum(n - 1 for n in first_runs.values())
+
+
+def load_runs(product: int, cell_counts: list[int], policy: str, delay_s: float, seed: int) -> dict:
+    """Sessions on a generated ``product``×``product`` assembly with each cell count."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp) / f"product{product}"
+        write_product(folder, product, seed)
+        runs = [{"cells": n, **session_run(n, policy, "truth", delay_s, str(folder))} for n in cell_counts]
+    base = runs[0]
+    for run in runs:
+        run["speedup"] = round(base["wall_s"] / run["wall_s"], 2)
+        run["experiments_ratio"] = round(run["experiments"] / base["experiments"], 3)
+    return {"product": f"{product}x{product}", "delay_s": delay_s, "seed": seed, "runs": runs}
 
 
 def session_walls(repeat: int, policy: str, backend: str, delay_s: float) -> dict:
@@ -119,9 +151,8 @@ def session_walls(repeat: int, policy: str, backend: str, delay_s: float) -> dic
             "ratio_2_over_1": round(sessions[1]["median_wall_s"] / sessions[0]["median_wall_s"], 3)}
 
 
-def cell_busy_fraction(journal: Path, cells: int) -> float:
+def cell_busy_fraction(entries: list[JournalEntry], cells: int) -> float:
     """Share of the learning span [first start, last end] the cells spent on experiments."""
-    entries = read_journal(journal)
     start = min(e.time - e.wall_s for e in entries)
     end = max(e.time for e in entries)
     return round(sum(e.wall_s for e in entries) / (cells * (end - start)), 3)
@@ -140,8 +171,15 @@ def main(argv: list[str]) -> int:
                         help="truth backend: seconds per experiment, e.g. 2 to see the "
                         "parallel speed-up without competing for the cores")
     parser.add_argument("--skip-sessions", action="store_true", help="only the round trips")
+    parser.add_argument("--product", type=int, metavar="N",
+                        help="load: sessions on a generated NxN product instead (truth cells, --delay)")
+    parser.add_argument("--cells", type=comma_list(number_in(int, 1, 65), "cell counts in [1, 64]"),
+                        default=[1, 2, 4, 8], metavar="N,...", help="with --product: cell counts (default 1,2,4,8)")
+    parser.add_argument("--seed", type=int, default=1, help="with --product: seed of the product (default 1)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
+    if args.product is not None:
+        return _load(args)
     figures: dict = {"overhead": round_trips(100 if args.quick else args.round_trips)}
     o = figures["overhead"]
     if not args.json:
@@ -160,4 +198,21 @@ def main(argv: list[str]) -> int:
                   f"per pair run back to back {figures['pair_ratios']}, median {figures['median_pair_ratio']:.2f}")
     if args.json:
         print(json.dumps(figures, indent=2))
+    return 0
+
+
+def _load(args: argparse.Namespace) -> int:
+    if args.product < 2:
+        raise PlannerError(f"--product {args.product}: expected an integer >= 2")
+    figures = load_runs(args.product, [int(n) for n in args.cells], args.policy, args.delay, args.seed)
+    if args.json:
+        print(json.dumps(figures, indent=2))
+        return 0
+    print(f"{figures['product']} product (seed {args.seed}), truth cells, {args.delay} s per experiment, "
+          f"policy {args.policy}")
+    print(f"{'cells':>5} {'wall [s]':>9} {'speed-up':>8} {'experiments':>11} {'ratio':>6} {'duplicates':>10} "
+          f"{'busy':>5}")
+    for r in figures["runs"]:
+        print(f"{r['cells']:>5} {r['wall_s']:>9.1f} {r['speedup']:>8.2f} {r['experiments']:>11} "
+              f"{r['experiments_ratio']:>6.3f} {r['duplicates']:>10} {r['cell_busy']:>5.2f}")
     return 0
