@@ -11,6 +11,8 @@ import math
 from collections.abc import Callable
 from typing import TypeVar
 
+from bridge import BridgeError
+
 T = TypeVar("T")
 
 
@@ -19,7 +21,7 @@ def comma_list(
 ) -> Callable[[str], list[T]]:
     """An argparse type: ``"a,b,c"`` → ``[item("a"), item("b"), item("c")]``.
 
-    Empty items, and items ``item`` rejects (ValueError or ArgumentTypeError), are an
+    Empty items, and items ``item`` rejects (ValueError, ArgumentTypeError, BridgeError), are an
     error naming the whole text and ``what`` was expected; ``""`` is the empty list when
     ``allow_empty``.
     """
@@ -32,7 +34,7 @@ def comma_list(
             if not all(parts):
                 raise ValueError(text)
             return [item(part) for part in parts]
-        except (ValueError, argparse.ArgumentTypeError):
+        except (ValueError, argparse.ArgumentTypeError, BridgeError):
             raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated {what}") from None
 
     return parse

@@ -3,7 +3,9 @@
 Without options a node is a Zenoh peer with multicast scouting off that listens only on
 the endpoints it is given (default :data:`DEFAULT_ENDPOINT`, loopback) and connects to
 the ones it is given. ``--zenoh-config FILE`` loads a full Zenoh config (JSON5) for a
-router or other hosts; ``--listen``/``--connect`` still override its endpoints. Nothing
+router, other hosts, TLS, authentication and access control (docs/session.md);
+``--listen``/``--connect`` still override its endpoints, and ``--connect`` without
+``--listen`` listens nowhere, whatever the file says. Nothing
 listens on a non-loopback address unless an option or the config file says so.
 """
 
@@ -66,7 +68,7 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("listen/endpoints", "[]")
     config.insert_json5("transport/link/rx/max_message_size", str(MAX_TRANSPORT_BYTES))
-    if listen or config_file is None:
+    if listen or connect or config_file is None:  # --connect alone: listen nowhere
         config.insert_json5("listen/endpoints", json.dumps([check_endpoint(e) for e in listen]))
     if connect:
         config.insert_json5("connect/endpoints", json.dumps([check_endpoint(e) for e in connect]))

@@ -98,7 +98,8 @@ class CellProcess:
 
 def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
-               rrd: Path | None = None, recording_id: str | None = None) -> list[str]:
+               rrd: Path | None = None, recording_id: str | None = None,
+               zenoh_config: Path | None = None) -> list[str]:
     """The command line of one ``executor serve`` node, with ``--lifeline``."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
@@ -110,6 +111,8 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
         argv += ["--rrd", str(rrd)]
     if recording_id is not None:
         argv += ["--recording-id", recording_id]
+    if zenoh_config is not None:
+        argv += ["--zenoh-config", str(zenoh_config)]
     return argv
 
 

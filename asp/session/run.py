@@ -48,7 +48,9 @@ from asp.sizes.policies import policy_names
 from asp.solve import fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
+from bridge.cli_types import comma_list
 from bridge.client import CellDirectory, CellPool
+from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
 SETTINGS = "session.json"
@@ -75,6 +77,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--wait-for-cell", type=float, default=60.0, metavar="S",
                         help="how long to wait while no cell is alive (default 60)")
     parser.add_argument("--plans", type=int, default=5, metavar="K", help="plans to compute (default 5)")
+    parser.add_argument("--allow-cells", type=comma_list(check_cell_id, "cell ids"), metavar="ID,...",
+                        help="with --cells 0: use only these cells (default: any cell that shows a token); "
+                             "a session that starts its cells uses only those")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     return parser
@@ -212,7 +217,7 @@ def run_session(args: argparse.Namespace) -> dict:
             cells.append(CellProcess(cell_id, serve_argv(
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
-                recording_id=settings["recording_id"])))
+                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config)))
         demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
         relation = learn_must_precede(demos)
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
@@ -220,7 +225,8 @@ def run_session(args: argparse.Namespace) -> dict:
         log.precedence(relation.parts, reduction(relation))
         journal = Journal(run)
         stack.callback(journal.close)
-        pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell)
+        allowed = cell_ids if args.cells > 0 else (args.allow_cells or None)  # by default only its own cells
+        pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell, allowed=allowed)
         stack.callback(pool.close)
         oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
         learner = SizeLearner(parts, holes, settings["policy"], settings["seed"],

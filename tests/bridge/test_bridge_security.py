@@ -1,0 +1,138 @@
+"""Cells on a shared network: mutual TLS and user/password authentication through
+``--zenoh-config`` files (the recipe of docs/session.md), with a throwaway CA.
+
+Real processes: an ``executor serve`` cell and this test's planner-side Zenoh session.
+A planner with a certificate signed by the CA is served; a peer without a certificate
+cannot join; a cell without the credentials cannot show itself to the planner.
+"""
+
+from __future__ import annotations
+
+import datetime
+import ipaddress
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from cryptography import x509
+from cryptography.hazmat.primitives import hashes, serialization
+from cryptography.hazmat.primitives.asymmetric import ec
+from cryptography.x509.oid import NameOID
+
+from asp.session.cells import CellProcess, start_cell
+from bridge.client import CellDirectory, CellTimeout, request_insert
+from bridge.messages import InsertRequest
+from bridge.session import free_loopback_endpoint, open_session
+
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(120)]
+
+
+def _name(common_name: str) -> x509.Name:
+    return x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, common_name)])
+
+
+def _write(folder: Path, stem: str, key: ec.EllipticCurvePrivateKey, cert: x509.Certificate) -> None:
+    (folder / f"{stem}.key").write_bytes(key.private_bytes(
+        serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()))
+    (folder / f"{stem}.pem").write_bytes(cert.public_bytes(serialization.Encoding.PEM))
+
+
+def make_certificates(folder: Path) -> None:
+    """``ca.pem`` and, signed by it, ``cell.{pem,key}`` and ``planner.{pem,key}`` for localhost."""
+    now = datetime.datetime.now(datetime.UTC)
+    valid = (now - datetime.timedelta(minutes=5), now + datetime.timedelta(days=1))
+    ca_key = ec.generate_private_key(ec.SECP256R1())
+    ca = (x509.CertificateBuilder().subject_name(_name("throwaway ca")).issuer_name(_name("throwaway ca"))
+          .public_key(ca_key.public_key()).serial_number(x509.random_serial_number())
+          .not_valid_before(valid[0]).not_valid_after(valid[1])
+          .add_extension(x509.BasicConstraints(ca=True, path_length=None), critical=True)
+          .sign(ca_key, hashes.SHA256()))
+    _write(folder, "ca", ca_key, ca)
+    names = x509.SubjectAlternativeName([x509.DNSName("localhost"), x509.IPAddress(ipaddress.ip_address("127.0.0.1"))])
+    for stem in ("cell", "planner"):
+        key = ec.generate_private_key(ec.SECP256R1())
+        cert = (x509.CertificateBuilder().subject_name(_name("localhost")).issuer_name(ca.subject)
+                .public_key(key.public_key()).serial_number(x509.random_serial_number())
+                .not_valid_before(valid[0]).not_valid_after(valid[1]).add_extension(names, critical=False)
+                .sign(ca_key, hashes.SHA256()))
+        _write(folder, stem, key, cert)
+
+
+def tls_config(folder: Path, side: str, endpoint: str, certificate: bool = True) -> Path:
+    """A JSON5 Zenoh config: the cell listens on ``endpoint``, the planner connects to it."""
+    direction = "listen" if side == "cell" else "connect"
+    own = (f'{direction}_private_key: "{folder}/{side}.key", {direction}_certificate: "{folder}/{side}.pem", '
+           "enable_mtls: true,") if certificate else ""
+    path = folder / f"{side}{'' if certificate else '-nocert'}.json5"
+    path.write_text(f"""{{
+  mode: "peer",
+  scouting: {{ multicast: {{ enabled: false }} }},
+  {direction}: {{ endpoints: ["{endpoint}"] }},
+  transport: {{ link: {{ tls: {{ root_ca_certificate: "{folder}/ca.pem", {own} }} }} }},
+}}
+""")
+    return path
+
+
+def userpwd_config(folder: Path, name: str, listen: str, user: str | None) -> Path:
+    """A JSON5 Zenoh config with user/password authentication (and the users' dictionary)."""
+    (folder / "users.txt").write_text("cell:s3cret\n")
+    auth = f'user: "{user}", password: "s3cret", ' if user else ""
+    path = folder / f"{name}.json5"
+    path.write_text(f"""{{
+  mode: "peer",
+  scouting: {{ multicast: {{ enabled: false }} }},
+  listen: {{ endpoints: [{f'"{listen}"' if listen else ""}] }},
+  transport: {{ auth: {{ usrpwd: {{ {auth}dictionary_file: "{folder}/users.txt" }} }} }},
+}}
+""")
+    return path
+
+
+@pytest.fixture
+def cells() -> Iterator[list[CellProcess]]:
+    started: list[CellProcess] = []
+    yield started
+    for cell in started:
+        cell.kill()
+
+
+def test_mutual_tls_serves_a_certified_planner_and_keeps_out_a_peer_without_certificate(
+        tmp_path: Path, cells: list[CellProcess]) -> None:
+    make_certificates(tmp_path)
+    endpoint = free_loopback_endpoint().replace("tcp/127.0.0.1", "tls/localhost")
+    cells.append(start_cell("c1", backend="truth", zenoh_config=tls_config(tmp_path, "cell", endpoint)))
+    for config, served in ((tls_config(tmp_path, "planner", endpoint), True),
+                           (tls_config(tmp_path, "planner", endpoint, certificate=False), False)):
+        session = open_session(config_file=config)
+        directory = CellDirectory(session)
+        try:
+            if served:
+                directory.wait_for(1, timeout=20)
+                assert request_insert(session, "c1", InsertRequest(id="tls1", part="sh", hole="br"), 10).result == "fit"
+            else:
+                with pytest.raises(CellTimeout):
+                    directory.wait_for(1, timeout=4)
+        finally:
+            directory.close()
+            session.close()
+
+
+def test_a_cell_without_the_credentials_cannot_show_itself_to_the_planner(
+        tmp_path: Path, cells: list[CellProcess]) -> None:
+    endpoint = free_loopback_endpoint()
+    session = open_session(config_file=userpwd_config(tmp_path, "planner", endpoint, user=None))
+    directory = CellDirectory(session)
+    try:
+        cells.append(start_cell("c1", backend="truth", connect=[endpoint],
+                                zenoh_config=userpwd_config(tmp_path, "cell", "", user="cell")))
+        cells.append(start_cell("evil", backend="truth", connect=[endpoint],
+                                zenoh_config=userpwd_config(tmp_path, "rogue", "", user=None)))
+        directory.wait_for(1, timeout=20)
+        assert request_insert(session, "c1", InsertRequest(id="auth1", part="p1", hole="r1"), 10).result == "fit"
+        with pytest.raises(CellTimeout):
+            directory.wait_for(2, timeout=4)
+        assert directory.alive() == {"c1"}
+    finally:
+        directory.close()
+        session.close()
