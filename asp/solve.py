@@ -7,7 +7,7 @@
   They are read by grounding them with clingo, so a file may also hold rules; what comes
   back is the set of atoms of the (unique) answer set (:func:`load_atoms`).
 - Facts are written from ``clingo.Symbol`` values, never by string formatting of terms
-  (:func:`fact`, :func:`format_facts`, :func:`write_facts`).
+  (:func:`fact`, :func:`format_facts`, :func:`write_facts`), and atomically.
 - :func:`solve` grounds encodings with facts and calls back on every model.
 """
 
@@ -20,6 +20,7 @@ from pathlib import Path
 import clingo
 
 from asp import PlannerError
+from bridge.files import write_atomic
 
 
 def encoding(name: str) -> Path:
@@ -100,8 +101,10 @@ def format_facts(atoms: Iterable[clingo.Symbol], header: str = "") -> str:
 
 
 def write_facts(path: Path | str, atoms: Iterable[clingo.Symbol], header: str = "") -> None:
-    """Write facts to ``path`` (see :func:`format_facts`)."""
-    Path(path).write_text(format_facts(atoms, header), encoding="utf-8")
+    """Write facts to ``path`` (see :func:`format_facts`), atomically: the old file stays
+    whole unless the new one is complete (:func:`bridge.files.write_atomic`; BridgeError
+    naming the path when it cannot be written)."""
+    write_atomic(path, format_facts(atoms, header))
 
 
 def solve(

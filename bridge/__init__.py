@@ -7,7 +7,8 @@
 - :mod:`bridge.assembly`: the assembly folder (``assembly.toml``) and its loader;
 - :mod:`bridge.rerun_layout`: the Rerun application id, entity roots and blueprint;
 - :mod:`bridge.recordings`: reading ``.rrd`` recordings back;
-- :mod:`bridge.cli_types`: argument types both command lines use.
+- :mod:`bridge.cli_types`: argument types both command lines use;
+- :mod:`bridge.files`: writing output files atomically, checking output paths.
 
 Nothing here imports the planner (``asp``) or the cell (``executor``).
 """

@@ -43,6 +43,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import rerun as rr
 
+from bridge import BridgeError
+from bridge.files import check_writable
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, cell_root
 from executor import ExecutorError
 
@@ -126,6 +128,18 @@ class AttemptTrace:
         return np.asarray(getattr(self, name), dtype=np.float64)
 
 
+def save_recording(recording: rr.RecordingStream, rrd_path: Path) -> None:
+    """Stream ``recording`` to the file ``rrd_path`` (written by the Rerun SDK, not
+    atomically); ExecutorError ``<path>: cannot write (<reason>)`` when it cannot be created."""
+    try:
+        check_writable(rrd_path)
+        recording.save(str(rrd_path))
+    except BridgeError as exc:
+        raise ExecutorError(str(exc)) from None
+    except RuntimeError as exc:  # the SDK's own check, e.g. a race with the one above
+        raise ExecutorError(f"{rrd_path}: cannot write ({exc})") from None
+
+
 class AttemptLogger:
     """Logs a cell's attempts into one Rerun recording (explicit stream, not global).
 
@@ -166,8 +180,7 @@ class AttemptLogger:
                 application_id, recording_id=recording_id or str(uuid.uuid4())
             )
             if rrd_path is not None:
-                Path(rrd_path).parent.mkdir(parents=True, exist_ok=True)
-                recording.save(str(rrd_path))
+                save_recording(recording, Path(rrd_path))
             else:
                 recording.memory_recording()
         self.rec = recording
@@ -186,7 +199,8 @@ class AttemptLogger:
     def to_file(
         cls, rrd_path: str | Path, cell_id: str = "c1", recording_id: str | None = None
     ) -> AttemptLogger:
-        """A logger saving to ``rrd_path`` (parent folders are created)."""
+        """A logger saving to ``rrd_path`` (its folder must exist; ExecutorError naming the
+        path if the file cannot be created)."""
         return cls(cell_id, recording_id=recording_id, rrd_path=rrd_path)
 
     # -- static geometry -------------------------------------------------------------

@@ -89,9 +89,10 @@ class TruthBackend:
             import rerun as rr
 
             from bridge.rerun_layout import APPLICATION_ID
+            from executor.rerun_log import save_recording
 
             self._log = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
-            self._log.save(str(rrd))
+            save_recording(self._log, rrd)
             self._entity = f"executor/{cell_id}/outcome"
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:

@@ -101,6 +101,7 @@ def _print_json(data: object) -> None:
 def _learn(args: argparse.Namespace) -> None:
     from asp.precedence.draw import draw_png, to_dot
     from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
+    from bridge.files import write_atomic
 
     demos = _demonstrations(args)
     relation = learn_must_precede(demos, args.min_support)
@@ -114,8 +115,7 @@ def _learn(args: argparse.Namespace) -> None:
         header = f"must-precede relation learned from {len(demos.sequences)} demonstrations"
         write_facts(args.out, precedence_facts(relation), header=header)
     if args.dot:
-        with open(args.dot, "w", encoding="utf-8") as out:
-            out.write(to_dot(relation, edges))
+        write_atomic(args.dot, to_dot(relation, edges))
     if args.png:
         draw_png(relation, edges, args.png, title=f"learned from {len(demos.sequences)} demonstrations")
     result: dict[str, object] = {
@@ -137,6 +137,10 @@ def _learn(args: argparse.Namespace) -> None:
 
 
 def _evaluate(args: argparse.Namespace) -> None:
+    from bridge.files import check_writable
+
+    if args.plot:
+        check_writable(args.plot)  # before the evaluation, which may take minutes
     progress = sys.stderr.isatty()
     truth = true_relation(load_assembly(args.assembly))
     if args.guided:

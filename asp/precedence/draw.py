@@ -12,6 +12,7 @@ from pathlib import Path
 import networkx as nx
 
 from asp.precedence.relation import Pair, Relation
+from bridge.files import write_figure
 
 
 def _graph(relation: Relation, reduction: list[Pair]) -> nx.DiGraph:
@@ -78,5 +79,7 @@ def draw_png(relation: Relation, reduction: list[Pair], path: Path | str, title:
     axis.set_title(title)
     axis.set_axis_off()
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    try:
+        write_figure(path, figure, dpi=120)
+    finally:
+        plt.close(figure)

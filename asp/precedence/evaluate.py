@@ -21,6 +21,7 @@ from asp import PlannerError
 from asp.precedence.batches import GENERATORS, ExtensionBatches, positions_of
 from asp.precedence.learn import intersect_orders
 from asp.precedence.relation import Relation
+from bridge.files import write_figure
 
 BIN = 200  # width of a histogram bin [sequences], as in the paper
 PAPER_M = (5, 7, 10, 15, 20, 30)
@@ -86,5 +87,7 @@ def plot(evaluation: dict, path: Path | str) -> None:
         axis.set_ylabel("probability")
         axis.legend()
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    try:
+        write_figure(path, figure, dpi=120)
+    finally:
+        plt.close(figure)

@@ -50,6 +50,7 @@ from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import comma_list
 from bridge.client import CellDirectory, CellPool
+from bridge.files import write_atomic
 from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
@@ -106,9 +107,7 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict]:
 
 
 def _save(run: Path, settings: dict) -> None:
-    tmp = run / (SETTINGS + ".tmp")
-    tmp.write_text(json.dumps(settings, indent=2) + "\n", encoding="utf-8")
-    tmp.replace(run / SETTINGS)
+    write_atomic(run / SETTINGS, json.dumps(settings, indent=2) + "\n")
 
 
 def _sizes_domain(assembly: Assembly) -> tuple[list[str], list[str], TruthOracle | None]:

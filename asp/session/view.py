@@ -58,9 +58,10 @@ def rerun_executable() -> str:
 
 def write_blueprint(folder: Path, cells: Sequence[str], planner: bool) -> Path:
     """``folder/view.rbl``: the planner's tab (if ``planner``), then one tab per cell."""
+    from bridge.files import check_writable
     from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
 
-    path = folder / "view.rbl"
+    path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
     extra = [planner_views()] if planner else []
     cell_blueprint(cells, extra=extra).save(APPLICATION_ID, str(path))
     return path

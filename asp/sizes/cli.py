@@ -131,6 +131,10 @@ def _learn(args: argparse.Namespace) -> int:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
+    from bridge.files import check_writable
+
+    if args.plot:
+        check_writable(args.plot)  # before the evaluation, which may take minutes
     truth = _truth(args)
     relabelings: str | int = args.relabelings
     if relabelings != "all":

@@ -32,6 +32,7 @@ from asp import PlannerError
 from asp.sizes.learner import SizeLearner, run_learner
 from asp.sizes.oracle import NoisyOracle, TruthOracle
 from asp.sizes.policies import get_policy
+from bridge.files import write_figure
 
 Matrix = tuple[tuple[bool, ...], ...]
 """Truth in index order: ``matrix[i][j]`` is True when part i+1 fits hole j+1."""
@@ -265,5 +266,7 @@ def plot_comparison(evaluations: Sequence[Evaluation], path: str) -> None:
     ax.set_title(f"Experiments needed over {evaluations[0].cases} relabelings")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        write_figure(path, fig, dpi=120)
+    finally:
+        plt.close(fig)

@@ -19,6 +19,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from bridge.files import make_folder, write_figure  # noqa: E402
 from executor import ExecutorError  # noqa: E402
 from executor.campaign.pairs import HOLE_NAMES, PART_NAMES, PairStats  # noqa: E402
 from executor.rerun_log import AttemptLogger, AttemptTrace  # noqa: E402
@@ -77,9 +78,10 @@ def plot_fig17(success: AttemptTrace, failure: AttemptTrace, path: Path) -> Path
     axes[-1].set_xlabel("DMP phase")
     fig.suptitle("Measured vs desired force over the DMP phase (paper Fig. 17)")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    try:
+        return write_figure(path, fig, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def plot_fig18(stats: Sequence[PairStats], path: Path) -> Path:
@@ -104,14 +106,16 @@ def plot_fig18(stats: Sequence[PairStats], path: Path) -> Path:
     table.scale(1, 1.3)
     ax.set_title("Success ratio of insertions (paper Fig. 18; non-fitting pairs added)")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    try:
+        return write_figure(path, fig, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def write_plots(folder: Path, stats: Sequence[PairStats], assembly: str, seed: int) -> list[Path]:
-    """Write Fig. 18 (table image), Fig. 17 (forces) and ``fig17.rrd`` into ``folder``."""
-    folder.mkdir(parents=True, exist_ok=True)
+    """Write Fig. 18 (table image), Fig. 17 (forces) and ``fig17.rrd`` into ``folder``
+(created if missing); the images are written atomically."""
+    make_folder(folder)
     rrd_path = folder / "fig17.rrd"
     success, failure = traced_trials(assembly, seed, rrd_path)
     return [

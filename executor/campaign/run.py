@@ -221,6 +221,10 @@ def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
     args = build_parser().parse_args(list(argv))
     pairs = select_pairs(args.pairs)
+    if args.plot:  # before the campaign, which takes minutes
+        from bridge.files import check_writable, make_folder
+
+        check_writable(make_folder(args.plot) / "fig18_table.png")
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.workers,

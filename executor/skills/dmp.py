@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from movement_primitives.dmp import CartesianDMP
 
+from bridge.files import make_folder, write_atomic
 from executor import ExecutorError
 
 # Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
@@ -128,10 +129,10 @@ def skill_path(folder: Path, shape: str) -> Path:
 
 
 def save_skill(folder: Path, skill: Skill) -> Path:
+    """Write the skill to ``<folder>/demonstrations/<shape>.json`` (atomically); returns the path."""
     path = skill_path(folder, skill.shape)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(skill.to_json(), indent=1) + "\n")
-    return path
+    make_folder(path.parent)
+    return write_atomic(path, json.dumps(skill.to_json(), indent=1) + "\n")
 
 
 def load_skill(folder: Path, shape: str) -> Skill:

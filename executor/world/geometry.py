@@ -20,6 +20,7 @@ import numpy as np
 import pybullet_data
 
 from bridge.assembly import load_assembly
+from bridge.files import make_folder, write_atomic
 from executor import ExecutorError
 
 
@@ -253,15 +254,11 @@ def arm_urdf_text(part: PartSpec, gripper: dict) -> str:
 
 
 def write_assets(geometry: CellGeometry) -> list[Path]:
-    """(Re)generate ``assets/plate.obj`` and ``assets/part_<shape>.urdf``; returns the paths."""
-    geometry.assets.mkdir(parents=True, exist_ok=True)
-    written = []
-    plate = geometry.assets / "plate.obj"
-    plate.write_text(plate_obj_text(geometry))
-    written.append(plate)
+    """(Re)generate ``assets/plate.obj`` and ``assets/part_<shape>.urdf`` (each written
+    atomically, so a cell starting meanwhile never loads half a file); returns the paths."""
+    make_folder(geometry.assets)
+    written = [write_atomic(geometry.assets / "plate.obj", plate_obj_text(geometry))]
     for shape in sorted({p.shape for p in geometry.parts.values()}):
         part = next(p for p in geometry.parts.values() if p.shape == shape)
-        path = geometry.assets / f"part_{shape}.urdf"
-        path.write_text(part_urdf_text(part))
-        written.append(path)
+        written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part)))
     return written

@@ -16,6 +16,7 @@ from executor.rerun_log import AttemptLogger
 
 def _run_folder(folder: Path) -> Path:
     """A run with two cells' recordings sharing one recording id."""
+    folder.mkdir()
     for cell in ("c1", "c2"):
         logger = AttemptLogger(cell, recording_id="run-7", rrd_path=folder / f"{cell}.rrd")
         logger.log_scene([("plate", "box", (0.1, 0.1, 0.01), (0.6, 0.0, 0.09))])

@@ -1,0 +1,67 @@
+"""Output files of the planner's command lines: written whole or not at all.
+
+A bad output path (missing folder, a directory, under a regular file) is one line
+``error: <path>: cannot write (<reason>)`` and exit code 2; a full disk (a child process
+limited by ``RLIMIT_FSIZE``) leaves the previous file whole and no temporary file behind.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests._files_helpers import leftovers, run_with_file_limit
+from tests.conftest import CLI_MODULE, ROOT
+
+CRANFIELD = ROOT / "data" / "cranfield"
+PLAN = ("plan", str(CRANFIELD / "precedence.lp"), str(CRANFIELD / "sizes.lp"), "--assembly", "cranfield")
+COMMANDS = {  # command line writing one file to OUT
+    "plan --travel-out": (*PLAN, "--travel-out", "OUT"),
+    "precedence learn --out": ("precedence", "learn", "--assembly", "cranfield", "--out", "OUT"),
+    "precedence learn --dot": ("precedence", "learn", "--assembly", "cranfield", "--dot", "OUT"),
+    "precedence learn --png": ("precedence", "learn", "--assembly", "cranfield", "--png", "OUT"),
+    "sizes learn --out": ("sizes", "learn", "--assembly", "cranfield", "--out", "OUT"),
+    "precedence evaluate --plot": ("precedence", "evaluate", "--assembly", "cranfield", "--m", "5",
+                                   "--trials", "2", "--plot", "OUT"),
+    "sizes evaluate --plot": ("sizes", "evaluate", "--assembly", "cranfield", "--policy", "best",
+                              "--relabelings", "2", "--plot", "OUT"),
+}
+BAD_PATHS = {"missing folder": ("missing/out", "No such file or directory"),
+             "a directory": ("folder", "Is a directory"),
+             "under a regular file": ("file/out", "Not a directory")}
+
+
+def _argv(command: str, out: Path) -> list[str]:
+    return [str(out) if arg == "OUT" else arg for arg in COMMANDS[command]]
+
+
+@pytest.mark.parametrize("bad", BAD_PATHS)
+@pytest.mark.parametrize("command", COMMANDS)
+def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_cli, command: str, bad: str) -> None:
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "file").write_text("a regular file\n")
+    name, reason = BAD_PATHS[bad]
+    out = tmp_path / name
+    done = run_cli(*_argv(command, out))
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == f"error: {out}: cannot write ({reason})\n"
+    assert (tmp_path / "file").read_text() == "a regular file\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "folder"]
+    assert list((tmp_path / "folder").iterdir()) == []
+
+
+@pytest.mark.parametrize("command", ["plan --travel-out", "precedence learn --out"])
+def test_full_disk_leaves_the_old_file_whole(tmp_path: Path, run_cli, command: str) -> None:
+    out = tmp_path / "facts.lp"
+    first = run_cli(*_argv(command, out))
+    assert first.returncode == 0, first.stderr
+    good = out.read_bytes()
+    assert len(good) > 600
+    done = run_with_file_limit([sys.executable, "-m", CLI_MODULE, *_argv(command, out)], limit=500)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.endswith(f"error: {out}: cannot write (File too large)\n")
+    assert "Traceback" not in done.stderr
+    assert out.read_bytes() == good
+    assert leftovers(tmp_path) == [] and [p.name for p in tmp_path.iterdir()] == ["facts.lp"]
