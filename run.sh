@@ -4,6 +4,8 @@
 #   ./run.sh test [ARGS]     set up .venv, run the linters (ruff, mypy) and the test suite (pytest ARGS)
 #   ./run.sh lint            set up .venv and run the linters only
 #   ./run.sh <subcommand>    run one command of the command line (each has --help)
+# Commands run in the caller's working directory, so relative paths (--out rel.lp, the
+# session's default runs/ folder) are relative to it; test and lint run in the repository.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 VENV="$ROOT/.venv"
@@ -48,7 +50,6 @@ Every subcommand takes --help.
 USAGE
 }
 
-cd "$ROOT"
 cmd="${1:-session}"
 [[ $# -gt 0 ]] && shift
 case "$cmd" in
@@ -56,12 +57,13 @@ case "$cmd" in
 esac
 setup
 export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
+# -P: the caller's folder is not put on sys.path (a folder named asp/ there cannot shadow ours).
 case "$cmd" in
-    test)      lint; exec "$PY" -m pytest "$@" ;;
-    lint)      lint ;;
-    executor)  exec "$PY" -m executor "$@" ;;
+    test)      cd "$ROOT"; lint; exec "$PY" -m pytest "$@" ;;
+    lint)      cd "$ROOT"; lint ;;
+    executor)  exec "$PY" -P -m executor "$@" ;;
     bench)
-        if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -m executor.campaign.bench "$@"; fi
-        exec "$PY" -m asp.cli bench "$@" ;;
-    *)         exec "$PY" -m asp.cli "$cmd" "$@" ;;
+        if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -P -m executor.campaign.bench "$@"; fi
+        exec "$PY" -P -m asp.cli bench "$@" ;;
+    *)         exec "$PY" -P -m asp.cli "$cmd" "$@" ;;
 esac

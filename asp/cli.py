@@ -23,14 +23,21 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
 
 
 def run_guarded(main, argv: list[str]) -> int:
-    """Run ``main(argv)``; a PlannerError or BridgeError becomes ``error: ...`` on stderr and exit 2."""
+    """Run ``main(argv)``; a PlannerError or BridgeError becomes one line ``error: ...`` on
+    stderr and exit 2. When stdout's reader goes away (``... | head -1``) the command stops
+    quietly with exit code 141 (:func:`bridge.cli_types.quiet_broken_pipe`)."""
     from asp import PlannerError
     from bridge import BridgeError
+    from bridge.cli_types import one_line, quiet_broken_pipe
 
     try:
-        return int(main(argv) or 0)
+        code = int(main(argv) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
+        return code
+    except BrokenPipeError:
+        return quiet_broken_pipe()
     except (PlannerError, BridgeError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {one_line(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

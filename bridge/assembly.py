@@ -15,17 +15,21 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
 
 from __future__ import annotations
 
+import math
 import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from bridge import BridgeError
+from bridge.inputs import shorten
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 ID_PATTERN = r"^[a-z][a-zA-Z0-9_]{0,63}$"
 """A part or hole id: a lower-case ASP constant of at most 64 characters."""
 _ID = re.compile(ID_PATTERN)
+MAX_COORDINATE = 100.0
+"""Positions ([x, y] of parts and holes, a tool home) are finite with |x|, |y| <= this [m]."""
 
 
 @dataclass(frozen=True)
@@ -99,9 +103,11 @@ def _position(source: Path, table: str, key: str, value: object) -> tuple[float,
     if (
         not isinstance(value, list)
         or len(value) != 2
-        or not all(isinstance(v, (int, float)) for v in value)
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        or not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE for v in value)
     ):
-        raise BridgeError(f"{source}: [{table}.{key}]: expected [x, y] in metres, got {value!r}")
+        raise BridgeError(f"{source}: [{table}.{key}]: expected [x, y] in metres, finite and within "
+                          f"±{MAX_COORDINATE:g}, got {shorten(repr(value))}")
     return (float(value[0]), float(value[1]))
 
 

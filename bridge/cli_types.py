@@ -1,19 +1,97 @@
-"""Argument types both command lines share (argparse ``type=`` callables).
+"""Argument types both command lines share (argparse ``type=`` callables), and their parser.
 
-A malformed value raises :class:`argparse.ArgumentTypeError`, which argparse turns into
-``error: argument --x: ...`` and exit code 2.
+A malformed value raises :class:`argparse.ArgumentTypeError`, which :class:`ArgumentParser`
+turns into one line ``error: PROG: argument --x: ...`` and exit code 2. Numbers are
+checked for finiteness and range (:func:`int_in`, :func:`non_negative_int`,
+:func:`finite_float`), so no NaN, infinity or absurd count reaches the code.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
+import sys
 from collections.abc import Callable
-from typing import TypeVar
+from typing import NoReturn, TypeVar
 
 from bridge import BridgeError
+from bridge.inputs import shorten
 
 T = TypeVar("T")
+
+MAX_SEED = 2**32 - 1
+"""Seeds are integers in [0, MAX_SEED] (numpy's generators take no negative seed)."""
+
+MAX_MESSAGE_CHARS = 300
+"""argparse's messages (which echo the value) are cut to this many characters."""
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """An argparse parser whose errors are one line on stderr, ``error: PROG: MESSAGE``,
+    with exit code 2 (argparse's default adds the usage lines; ``--help`` shows them).
+    Subparsers made by :meth:`add_subparsers` are of this class too."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"error: {self.prog}: {shorten(' '.join(message.split()), MAX_MESSAGE_CHARS)}\n")
+
+
+EXIT_BROKEN_PIPE = 141
+"""Exit code when stdout's reader went away (``... | head -1``): 128 + SIGPIPE, what a
+shell reports for ``yes | head -1``, so ``set -o pipefail`` scripts see the usual code."""
+
+
+def one_line(message: object, limit: int = 2000) -> str:
+    """An error message as one line (whitespace runs, newlines included, become one space),
+    cut to ``limit`` characters."""
+    return shorten(" ".join(str(message).split()), limit)
+
+
+def quiet_broken_pipe() -> int:
+    """After a BrokenPipeError on stdout: point stdout at devnull (so the interpreter's
+    final flush does not fail again) and return :data:`EXIT_BROKEN_PIPE` (the Python
+    documentation's recipe, "Note on SIGPIPE", with the shell's exit code)."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return EXIT_BROKEN_PIPE
+
+
+def int_in(low: int, high: int = sys.maxsize) -> Callable[[str], int]:
+    """An argparse type: an integer in [low, high] (``high`` default: no practical bound)."""
+    expected = f"an integer >= {low}" if high == sys.maxsize else f"an integer from {low} to {high}"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected {expected}")
+        return value
+
+    return parse
+
+
+def non_negative_int(text: str) -> int:
+    """An argparse type: an integer >= 0 (at most ``sys.maxsize``)."""
+    return int_in(0)(text)
+
+
+def finite_float(low: float, high: float, *, low_open: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite number in [low, high], or (low, high] when ``low_open``."""
+    expected = f"a finite number in {'(' if low_open else '['}{low:g}, {high:g}]"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and (low < value if low_open else low <= value) and value <= high):
+            raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected {expected}")
+        return value
+
+    return parse
 
 
 def comma_list(

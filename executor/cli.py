@@ -14,7 +14,13 @@ import sys
 from collections.abc import Sequence
 
 from bridge import BridgeError
+from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, one_line, quiet_broken_pipe
 from executor import ExecutorError
+
+MAX_TRIALS = 100_000
+"""``trial --trials N``: at most this many trials (trial k uses seed+k)."""
+MAX_ATTEMPTS = 10
+"""``trial --attempts``: at most this many attempts per trial."""
 
 
 def _teach(args: argparse.Namespace) -> int:
@@ -42,8 +48,6 @@ def _summary(results: list[dict]) -> dict:
 def _trial(args: argparse.Namespace) -> int:
     from executor.trial import Cell
 
-    if args.trials < 1:
-        raise ExecutorError(f"--trials {args.trials}: expected a positive number of trials")
     logger = None
     if args.rrd:
         from executor.rerun_log import AttemptLogger
@@ -87,7 +91,7 @@ _DELEGATED = {
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="executor", description="The simulated PyBullet assembly cell (paper 3).")
+    parser = ArgumentParser(prog="executor", description="The simulated PyBullet assembly cell (paper 3).")
     sub = parser.add_subparsers(dest="command", required=True)
 
     teach = sub.add_parser("teach", help="record the scripted demonstrations (DMP + reference wrench)")
@@ -97,9 +101,12 @@ def build_parser() -> argparse.ArgumentParser:
     trial = sub.add_parser("trial", help="insert one part into one hole, N randomised trials")
     trial.add_argument("--part", required=True, help="part id, e.g. p1, p3, sh, tp")
     trial.add_argument("--hole", required=True, help="hole id, e.g. r1, s1, br")
-    trial.add_argument("--trials", type=int, default=1, help="number of randomised trials (default 1)")
-    trial.add_argument("--seed", type=int, default=0, help="seed of the first trial; trial k uses seed+k")
-    trial.add_argument("--attempts", type=int, default=2, help="attempts per trial before 'no_fit' (default 2)")
+    trial.add_argument("--trials", type=int_in(1, MAX_TRIALS), default=1,
+                       help="number of randomised trials (default 1)")
+    trial.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
+                       help="seed of the first trial; trial k uses seed+k")
+    trial.add_argument("--attempts", type=int_in(1, MAX_ATTEMPTS), default=2,
+                       help="attempts per trial before 'no_fit' (default 2)")
     trial.add_argument("--assembly", default="cranfield", help="assembly folder under data/ (default: cranfield)")
     trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
     trial.add_argument("--rrd", help="save a Rerun recording of every attempt to this file")
@@ -112,18 +119,24 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one subcommand; ExecutorError → ``error: ...`` on stderr and exit code 2."""
+    """Run one subcommand; ExecutorError → one line ``error: ...`` on stderr and exit code 2;
+    a closed stdout (``... | head -1``) stops quietly with exit code 141."""
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         if argv and argv[0] in _DELEGATED:
             import importlib
 
             module, _help = _DELEGATED[argv[0]]
-            return int(importlib.import_module(module).main(argv[1:]) or 0)
-        args = build_parser().parse_args(argv)
-        return int(args.func(args) or 0)
+            code = int(importlib.import_module(module).main(argv[1:]) or 0)
+        else:
+            args = build_parser().parse_args(argv)
+            code = int(args.func(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
+        return code
+    except BrokenPipeError:
+        return quiet_broken_pipe()
     except (ExecutorError, BridgeError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {one_line(exc)}", file=sys.stderr)
         return 2
 
 

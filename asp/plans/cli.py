@@ -25,15 +25,22 @@ from asp import PlannerError
 from asp.plans.assign import UnsolvableAssembly, all_assignments, feasible_assignment, load_learned_facts
 from asp.plans.plans import HOME, Plan, plans, travel_facts
 from asp.solve import write_facts
-from bridge.assembly import load_assembly
+from bridge.assembly import MAX_COORDINATE, load_assembly
+from bridge.cli_types import ArgumentParser, finite_float, int_in
 
 EXIT_UNSOLVABLE = 3
 """Exit code of a valid but unsolvable assembly (bad input exits with 2)."""
 
+MAX_PLANS = 1_000_000
+"""``plan -n K``: at most this many plans (0 = all)."""
+
+MAX_TIME_LIMIT = 86_400.0
+"""``plan --time-limit S``: at most a day [s]."""
+
 
 def facts_parser(prog: str, description: str) -> argparse.ArgumentParser:
     """A parser taking learned facts files and ``--json`` (shared by assign and plan)."""
-    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser = ArgumentParser(prog=prog, description=description)
     parser.add_argument("facts", nargs="+", metavar="FACTS.lp",
                         help="learned facts files (part/1, hole/1, fits/2, must_precede/2, ...)")
     parser.add_argument("--json", action="store_true", help="print JSON on stdout")
@@ -85,19 +92,19 @@ def plan_main(argv: list[str]) -> int:
         "must_precede, each part that needs a hole in a distinct hole it fits. "
         f"Exit {EXIT_UNSOLVABLE}: the assembly is not solvable.",
     )
-    parser.add_argument("-n", type=int, default=1, metavar="K", help="how many plans (0 = all; default 1)")
+    parser.add_argument("-n", type=int_in(0, MAX_PLANS), default=1, metavar="K",
+                        help="how many plans (0 = all; default 1)")
     parser.add_argument("--optimal", action="store_true",
                         help="plans of least total tool travel [mm] (needs --assembly)")
     parser.add_argument("--assembly", metavar="A", help="assembly (name under data/ or folder) for positions")
-    parser.add_argument("--home", type=float, nargs=2, default=HOME, metavar=("X", "Y"),
+    parser.add_argument("--home", type=finite_float(-MAX_COORDINATE, MAX_COORDINATE), nargs=2, default=HOME,
+                        metavar=("X", "Y"),
                         help="tool home [m] (default: 0 0, the cell origin)")
-    parser.add_argument("--time-limit", type=float, metavar="S",
+    parser.add_argument("--time-limit", type=finite_float(0.0, MAX_TIME_LIMIT, low_open=True), metavar="S",
                         help="give up (exit 2) when the search takes longer than S seconds")
     parser.add_argument("--travel-out", metavar="FILE.lp",
                         help="also write the travel/3 facts (leg lengths [mm]) for plain clingo")
     args = parser.parse_args(argv)
-    if args.n < 0:
-        raise PlannerError(f"-n {args.n}: expected 0 (all) or a positive number of plans")
     if (args.optimal or args.travel_out) and not args.assembly:
         raise PlannerError("--optimal and --travel-out need --assembly (part and hole positions)")
     facts = load_learned_facts(args.facts)

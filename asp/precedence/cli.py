@@ -19,11 +19,11 @@ from asp.precedence.demos import Demonstrations, load_demos
 from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
-from bridge.cli_types import comma_list
+from bridge.cli_types import ArgumentParser, comma_list, non_negative_int
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="./run.sh precedence", description="Precedence constraints (paper 2.1, 4.1).")
+    parser = ArgumentParser(prog="./run.sh precedence", description="Precedence constraints (paper 2.1, 4.1).")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     learn = commands.add_parser("learn", help="learn the must-precede relation from demonstrations (Algorithm 1)")
@@ -50,9 +50,9 @@ def _parser() -> argparse.ArgumentParser:
         if name == "count":
             sub.add_argument("--json", action="store_true", help='print JSON {"admitted": N}')
         if name == "enumerate":
-            sub.add_argument("--limit", type=int, help="stop after this many sequences")
+            sub.add_argument("--limit", type=non_negative_int, help="stop after this many sequences")
         if name == "sample":
-            sub.add_argument("-n", type=int, default=1, help="number of sequences (default 1)")
+            sub.add_argument("-n", type=non_negative_int, default=1, help="number of sequences (default 1)")
             sub.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
 
     evaluate = commands.add_parser("evaluate", help="the paper's evaluation (Figs. 12/13), or --guided demonstration")
@@ -199,13 +199,9 @@ def main(argv: list[str]) -> int:
         else:
             print(admitted)
     elif args.command == "enumerate":
-        if args.limit is not None and args.limit < 0:
-            raise PlannerError(f"--limit {args.limit}: expected a non-negative integer")
         for sequence in islice(linear_extensions(_relation(args)), args.limit):
             print(" ".join(sequence))
     elif args.command == "sample":
-        if args.n < 0:
-            raise PlannerError(f"-n {args.n}: expected a non-negative integer")
         sampler, rng = UniformSampler(_relation(args)), random.Random(args.seed)
         for _ in range(args.n):
             print(" ".join(sampler.sample(rng)))

@@ -108,7 +108,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
     if delay_s:
         argv += ["--delay", str(delay_s)]
     if rrd is not None:
-        argv += ["--rrd", str(rrd)]
+        argv += ["--rrd", str(Path(rrd).absolute())]  # the cell runs in the repository, not our cwd
     if recording_id is not None:
         argv += ["--recording-id", recording_id]
     if zenoh_config is not None:

@@ -42,42 +42,47 @@ from asp.session.cells import CellProcess, serve_argv
 from asp.session.journal import Journal
 from asp.session.log import PlannerLog
 from asp.session.oracle import ZenohOracle
-from asp.sizes.learner import SizeLearner, SizeLearningResult
+from asp.sizes.learner import MAX_CONFIRM, SizeLearner, SizeLearningResult
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import policy_names
 from asp.solve import fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
-from bridge.cli_types import comma_list
+from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
 from bridge.files import write_atomic
 from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
 SETTINGS = "session.json"
+MAX_WAIT_S = 86_400.0
+"""--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
+MAX_PLANS = 1000
+"""--plans: at most this many plans (they are written to session.json)."""
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
     parser.add_argument("--cells", type=int, default=1, help="cell co-processes to start (default 1)")
     parser.add_argument("--policy", default="best", choices=policy_names(),
                         help="experiment selection policy (default best: fewest experiments)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the policy and the trials")
-    parser.add_argument("--confirm", type=int, default=0, metavar="K",
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the policy and the trials")
+    parser.add_argument("--confirm", type=int_in(0, MAX_CONFIRM), default=0, metavar="K",
                         help="re-test each essential experiment until its result leads by K+1 answers "
                              "(default 0: trust the cell's answer; see sizes learn --confirm)")
     parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="cells started here: sim (PyBullet) or truth (sizes.lp, no simulation)")
-    parser.add_argument("--delay", type=float, default=0.0, metavar="S",
+    parser.add_argument("--delay", type=finite_float(0.0, 3600.0), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
-    parser.add_argument("--timeout", type=float, default=120.0, metavar="S",
+    parser.add_argument("--timeout", type=finite_float(0.0, MAX_WAIT_S, low_open=True), default=120.0, metavar="S",
                         help="one experiment at one cell before it is re-sent (default 120)")
-    parser.add_argument("--wait-for-cell", type=float, default=60.0, metavar="S",
+    parser.add_argument("--wait-for-cell", type=finite_float(0.0, MAX_WAIT_S), default=60.0, metavar="S",
                         help="how long to wait while no cell is alive (default 60)")
-    parser.add_argument("--plans", type=int, default=5, metavar="K", help="plans to compute (default 5)")
+    parser.add_argument("--plans", type=int_in(1, MAX_PLANS), default=5, metavar="K",
+                        help="plans to compute (default 5)")
     parser.add_argument("--allow-cells", type=comma_list(check_cell_id, "cell ids"), metavar="ID,...",
                         help="with --cells 0: use only these cells (default: any cell that shows a token); "
                              "a session that starts its cells uses only those")

@@ -13,7 +13,6 @@ same as JSON). A RUN without ``.rrd`` files is an error (exit code 2).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shutil
@@ -23,6 +22,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from asp import PlannerError
+from bridge.cli_types import ArgumentParser
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -68,7 +68,7 @@ def write_blueprint(folder: Path, cells: Sequence[str], planner: bool) -> Path:
 
 
 def main(argv: Sequence[str]) -> int:
-    parser = argparse.ArgumentParser(prog="view", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="view", description=__doc__.split("\n\n")[0])
     parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
     parser.add_argument("--print", action="store_true", help="print the contents, no viewer")
     parser.add_argument("--json", action="store_true", help="print the contents as JSON")

@@ -16,11 +16,11 @@ import sys
 from asp import PlannerError
 from asp.sizes.evaluate import evaluate_policy, plot_comparison
 from asp.sizes.knowledge import Knowledge
-from asp.sizes.learner import Experiment, learn_sizes
+from asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
 from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
 from asp.solve import write_facts
-from bridge.cli_types import comma_list
+from bridge.cli_types import ArgumentParser, comma_list, int_in
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -52,24 +52,17 @@ def _probability(text: str) -> float:
     return value
 
 
-def _confirm(text: str) -> int:
-    """A number of answers K >= 0."""
-    if not text.isdigit():
-        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer >= 0")
-    return int(text)
-
-
 def _add_noise_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--noise", type=_probability, default=0.0, metavar="P",
                         help="probability that an answer is flipped (simulated noise; default 0)")
-    parser.add_argument("--confirm", type=_confirm, default=0, metavar="K",
+    parser.add_argument("--confirm", type=int_in(0, MAX_CONFIRM), default=0, metavar="K",
                         help="once every pair is known, re-test each essential observation (its pair "
                              "unknown without it) until its result leads the other by K+1 answers "
                              "(default 0: no confirmation)")
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="./run.sh sizes", description=__doc__,
+    parser = ArgumentParser(prog="./run.sh sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
     learn = sub.add_parser("learn", help="learn the relation from a truth by experiments")

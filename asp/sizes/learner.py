@@ -39,6 +39,10 @@ from asp.sizes.oracle import Oracle
 from asp.sizes.policies import SelectionPolicy, get_policy
 from asp.solve import encoding, fact, format_facts
 
+MAX_CONFIRM = 100
+"""``confirm`` K is at most this many answers (each essential observation is re-tested
+until its result leads by K+1, so K bounds the experiments)."""
+
 _OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit)."
 
 
@@ -97,8 +101,8 @@ class SizeLearner:
         ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more)."""
         if len(set(parts) | set(holes)) != len(parts) + len(holes):
             raise PlannerError("parts and holes need distinct ids")
-        if confirm < 0:
-            raise PlannerError(f"confirm {confirm}: expected a number of answers >= 0")
+        if not 0 <= confirm <= MAX_CONFIRM:
+            raise PlannerError(f"confirm {confirm}: expected a number of answers from 0 to {MAX_CONFIRM}")
         max_answers = max(5, 4 * confirm + 1) if max_answers is None else max_answers
         if max_answers <= confirm:
             raise PlannerError(f"max_answers {max_answers}: confirm {confirm} needs at least "

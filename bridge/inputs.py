@@ -1,0 +1,66 @@
+"""Reading input files under one set of rules, for the planner and the cell alike.
+
+- a file is read whole but never more than ``limit`` bytes (default :data:`MAX_INPUT_BYTES`);
+- a missing, unreadable (permissions, I/O error), non-regular or oversized file raises
+  the caller's error class with one line naming the path and what was expected;
+- :func:`shorten` cuts an echoed token to :data:`TOKEN_CHARS` characters, so a huge
+  token never makes a huge message.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+from bridge import BridgeError
+
+MAX_INPUT_BYTES = 10 * 1024 * 1024
+"""The largest input file read [bytes] (10 MiB): demonstrations, facts, assembly files."""
+
+TOKEN_CHARS = 40
+"""Echoed input tokens are cut to this many characters (with "…")."""
+
+
+def shorten(text: object, width: int = TOKEN_CHARS) -> str:
+    """``str(text)`` cut to ``width`` characters, the last being "…" when cut."""
+    text = str(text)
+    return text if len(text) <= width else text[: width - 1] + "…"
+
+
+def read_bytes(path: Path | str, what: str, *, limit: int = MAX_INPUT_BYTES,
+               error: type[Exception] = BridgeError) -> bytes:
+    """The bytes of the regular file ``path``, at most ``limit`` [bytes].
+
+    ``what`` names the file in messages (e.g. ``"facts file"``); every problem raises
+    ``error`` with one line: no such file, a directory or other non-regular file (a FIFO
+    would block), unreadable (``strerror``), larger than ``limit``.
+    """
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+        if stat.S_ISDIR(mode):
+            raise error(f"{path}: is a directory, expected a {what}")
+        if not stat.S_ISREG(mode):
+            raise error(f"{path}: not a regular file, expected a {what}")
+        with path.open("rb") as file:
+            data = file.read(limit + 1)
+    except FileNotFoundError:
+        raise error(f"{path}: no such {what}") from None
+    except OSError as exc:
+        reason = exc.strerror or os.strerror(exc.errno or 0) or type(exc).__name__
+        raise error(f"{path}: cannot read the {what}: {reason}") from None
+    if len(data) > limit:
+        raise error(f"{path}: larger than {limit} bytes; expected a {what} of at most {limit} bytes")
+    return data
+
+
+def read_text(path: Path | str, what: str, *, limit: int = MAX_INPUT_BYTES,
+              error: type[Exception] = BridgeError) -> str:
+    """:func:`read_bytes` decoded as UTF-8; binary data raises ``error`` naming file:line."""
+    data = read_bytes(path, what, limit=limit, error=error)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise error(f"{path}:{line}: binary data (not UTF-8 text), expected a {what}") from None

@@ -1,0 +1,151 @@
+"""A corpus of bad input for both command lines (repository level: it spans the packages).
+
+One row per case: ``(id, argv, setup, expected exit code, a word the message must hold)``.
+``argv`` starting with ``executor`` runs ``python -m executor``, else ``python -m asp.cli``;
+both run as separate processes in ``tmp_path``. ``setup`` is None, a dict of input files
+(name → text or bytes) or a callable ``setup(tmp_path)``. Every bad input must give one
+line ``error: ...`` on stderr holding the word, the exit code, and never a traceback.
+
+Rows expecting :data:`EXIT_BROKEN_PIPE` run as ``... | head -1``: stdout is closed after
+its first line, and stderr must stay empty.
+
+Unreadable files: ``chmod 000`` does not stop root (the tests may run as root), so under
+root the file is replaced by a symbolic link to ``/proc/self/mem``, a regular file whose
+read fails with an I/O error for every user (checked; the case is skipped otherwise).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from bridge.cli_types import EXIT_BROKEN_PIPE
+from tests.conftest import ROOT, child_env, python_argv
+
+CRANFIELD = ROOT / "data" / "cranfield"
+Setup = Callable[[Path], None] | dict[str, str | bytes] | None
+
+
+def unreadable(name: str, source: Path | None = None, text: str = "") -> Callable[[Path], None]:
+    """Setup: ``name`` (a copy of ``source``, else ``text``) made unreadable (see the module doc)."""
+
+    def setup(tmp: Path) -> None:
+        path = tmp / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.unlink(missing_ok=True)
+        if os.geteuid() == 0:
+            path.symlink_to("/proc/self/mem")
+        else:
+            path.write_bytes(source.read_bytes() if source else text.encode())
+            path.chmod(0)
+        try:
+            with path.open("rb") as file:
+                file.read(1)
+        except OSError:
+            return
+        pytest.skip(f"cannot make {name} unreadable here")
+
+    return setup
+
+
+def assembly(**files: str | bytes | Callable[[Path], None]) -> Callable[[Path], None]:
+    """Setup: a copy of data/cranfield in ``asm/`` (without assets), with ``files``
+    replaced (text, bytes, or a setup run with the copy's parent folder)."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(CRANFIELD, tmp / "asm", ignore=shutil.ignore_patterns("assets", "demonstrations"))
+        for name, content in files.items():
+            if callable(content):
+                content(tmp)
+            elif isinstance(content, bytes):
+                (tmp / "asm" / name).write_bytes(content)
+            else:
+                (tmp / "asm" / name).write_text(content)
+
+    return setup
+
+
+CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
+    # numeric options: finite, in range
+    ("trial-seed-negative", ("executor", "trial", "--part", "p1", "--hole", "r1", "--seed", "-1"), None, 2, "--seed"),
+    ("trial-trials-zero", ("executor", "trial", "--part", "p1", "--hole", "r1", "--trials", "0"), None, 2, "--trials"),
+    ("session-timeout-negative", ("session", "--timeout", "-1"), None, 2, "--timeout"),
+    ("session-timeout-nan", ("session", "--timeout", "nan"), None, 2, "finite"),
+    ("session-wait-negative", ("session", "--wait-for-cell", "-1"), None, 2, "--wait-for-cell"),
+    ("session-plans-negative", ("session", "--plans", "-1"), None, 2, "--plans"),
+    ("session-delay-nan", ("session", "--delay", "nan"), None, 2, "--delay"),
+    ("session-confirm-huge", ("session", "--confirm", "99999999999"), None, 2, "--confirm"),
+    ("session-seed-negative", ("session", "--seed", "-1"), None, 2, "--seed"),
+    ("sizes-confirm-huge", ("sizes", "learn", "--assembly", "cranfield", "--confirm", "99999999999"), None, 2,
+     "--confirm"),
+    ("enumerate-limit-float", ("precedence", "enumerate", "--assembly", "cranfield", "--limit", "1e23"), None, 2,
+     "--limit"),
+    ("enumerate-limit-huge", ("precedence", "enumerate", "--assembly", "cranfield", "--limit", "1" + "0" * 23),
+     None, 2, "--limit"),
+    ("sample-n-negative", ("precedence", "sample", "--assembly", "cranfield", "-n", "-1"), None, 2, "-n"),
+    ("plan-n-float", ("plan", "facts.lp", "-n", "1e20"), None, 2, "-n"),
+    ("plan-n-huge", ("plan", "facts.lp", "-n", "1" + "0" * 20), None, 2, "-n"),
+    ("plan-home-nan", ("plan", "facts.lp", "--optimal", "--assembly", "cranfield", "--home", "nan", "0"), None, 2,
+     "--home"),
+    ("plan-home-inf", ("plan", "facts.lp", "--optimal", "--assembly", "cranfield", "--home", "inf", "0"), None, 2,
+     "--home"),
+    ("plan-home-far", ("plan", "facts.lp", "--optimal", "--assembly", "cranfield", "--home", "1e12", "0"), None, 2,
+     "--home"),
+    ("plan-time-limit-negative", ("plan", "facts.lp", "--time-limit", "-1"), None, 2, "--time-limit"),
+    ("assembly-position-nan", ("plan", "facts.lp", "--optimal", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         "position = [0.55, -0.06]", "position = [nan, inf]", 1)}), 2, "finite"),
+    # a closed pipe: quiet, exit 141 like `yes | head -1`
+    ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
+    ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
+]
+
+
+def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
+    module, args = ("executor", argv[1:]) if argv[0] == "executor" else ("asp.cli", argv)
+    process = subprocess.Popen(python_argv(module, *args), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        if head:
+            assert process.stdout is not None
+            process.stdout.readline()
+            process.stdout.close()
+            code = process.wait(timeout=60)
+            assert process.stderr is not None
+            return code, process.stderr.read()
+        _out, err = process.communicate(timeout=60)
+        return process.returncode, err
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+
+
+@pytest.mark.slow  # one process per case: about 0.5 s each
+@pytest.mark.parametrize(("argv", "setup", "code", "word"), [case[1:] for case in CASES],
+                         ids=[case[0] for case in CASES])
+def test_bad_input_gives_one_line_error(argv: tuple[str, ...], setup: Setup, code: int, word: str,
+                                        tmp_path: Path) -> None:
+    (tmp_path / "facts.lp").write_text("part(p1). hole(r1). fits(p1,r1).\n")
+    if callable(setup):
+        setup(tmp_path)
+    elif setup:
+        for name, content in setup.items():
+            path = tmp_path / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    returncode, stderr = _run(argv, tmp_path, head=code == EXIT_BROKEN_PIPE)
+    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("pybullet build time")]
+    assert "Traceback" not in stderr, stderr[-3000:]
+    assert returncode == code, stderr[-3000:]
+    if code == EXIT_BROKEN_PIPE:
+        assert lines == [], stderr[-3000:]
+        return
+    assert len(lines) == 1 and lines[0].startswith("error: "), stderr[-3000:]
+    assert word in lines[0]
+    assert len(lines[0]) < 600, "an error message must not echo long input"
