@@ -183,3 +183,32 @@ def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path
     asked = Counter((e.part, e.hole) for e in journal)
     assert all(asked[(e.part, e.hole)] == 2 for e in retests)
     assert all(e.result == TRUTH.ask(e.part, e.hole) for e in journal)
+
+
+def test_a_rogue_cell_that_answers_fit_to_everything_is_never_used(tmp_path: Path, run_session) -> None:
+    """A local process declares ``cell/evil/alive`` and answers every request with "fit";
+    a session that started its own cell uses only that cell and learns the truth."""
+    from bridge.keys import alive_key
+    from bridge.messages import InsertReply, decode_request, encode
+    from bridge.session import open_session
+
+    endpoint = free_loopback_endpoint()
+    rogue = open_session(connect=[endpoint])
+    asked: list[str] = []
+
+    def always_fit(query) -> None:
+        request = decode_request(query.payload.to_bytes())
+        asked.append(request.id)
+        query.reply(query.key_expr, encode(InsertReply(id=request.id, cell="evil", part=request.part,
+                                                       hole=request.hole, result="fit")))
+
+    try:
+        handles = (rogue.declare_queryable("cell/evil/insert", always_fit),
+                   rogue.liveliness().declare_token(alive_key("evil")))
+        result = run_session("--listen", endpoint, "--out", str(tmp_path / "run"))
+        assert_learned_truth(result, tmp_path / "run")
+        assert asked == []
+        assert {e.cell for e in read_journal(tmp_path / "run" / "journal.jsonl")} == {"c1"}
+        del handles
+    finally:
+        rogue.close()
