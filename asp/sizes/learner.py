@@ -26,7 +26,6 @@ essentials of the new closure are confirmed.
 
 from __future__ import annotations
 
-import itertools
 import random
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -256,8 +255,7 @@ class SizeLearner:
         independent of them too. Due re-tests (conflicts, ties, confirmations) not
         pending come first. Otherwise pairs are added one at a time, each the first of
         :meth:`_candidates` that no combination of outcomes of the pending and already
-        chosen pairs entails or contradicts, nor its outcomes theirs (checked by solving
-        with hypothetical observations).
+        chosen pairs entails or contradicts, nor its outcomes theirs (:meth:`_independent`).
         """
         retests = [p for p in self._due_retests() if p not in pending]
         if retests:
@@ -272,7 +270,6 @@ class SizeLearner:
             if pair is None:
                 break
             chosen.append(pair)
-        self.knowledge = self._solve()
         return chosen
 
     def _candidates(self, choice: Pair | None, out: list[Pair]) -> list[Pair]:
@@ -285,17 +282,26 @@ class SizeLearner:
         return [p for p in dict.fromkeys([*first, *rest]) if p not in out]
 
     def _independent(self, pairs: list[Pair]) -> bool:
-        """No outcomes of all but one pair entail (or contradict) the remaining pair."""
-        for index, target in enumerate(pairs):
-            others = pairs[:index] + pairs[index + 1:]
-            for outcomes in itertools.product(RESULTS, repeat=len(others)):
-                for pair, outcome in zip(others, outcomes):
-                    self._set_observation(pair, outcome)
-                knowledge = self._solve()
-                for pair in others:
-                    self._restore(pair)
-                if knowledge.conflicts or knowledge.result(*target) is not None:
-                    return False
+        """No outcomes of all but one pair entail (or contradict) the remaining pair.
+
+        The closure is transitive over parts and holes (eqs. 2-5), so some outcomes of the
+        others entail ``(p, h)`` exactly when the graph of the known ``smaller/2`` edges
+        plus each other pair as an edge in either direction has a path from p to h or
+        from h to p (a shortest such walk is a simple path, which turns each pair one way
+        only). A contradiction is a cycle through some pair, i.e. the rest of the cycle
+        entails that pair: the same test. Linear in the graph per pair, where solving
+        every combination of outcomes was exponential in the batch size.
+        """
+        known: dict[str, set[str]] = {}
+        for smaller, bigger in self.knowledge.smaller:
+            known.setdefault(smaller, set()).add(bigger)
+        for index, (part, hole) in enumerate(pairs):
+            graph = {node: set(targets) for node, targets in known.items()}
+            for other_part, other_hole in pairs[:index] + pairs[index + 1:]:
+                graph.setdefault(other_part, set()).add(other_hole)
+                graph.setdefault(other_hole, set()).add(other_part)
+            if _reaches(graph, part, hole) or _reaches(graph, hole, part):
+                return False
         return True
 
     def _restore(self, pair: Pair) -> None:
@@ -327,6 +333,19 @@ class SizeLearner:
 
     def result(self) -> SizeLearningResult:
         return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge)
+
+
+def _reaches(graph: dict[str, set[str]], start: str, goal: str) -> bool:
+    """Whether ``goal`` can be reached from ``start`` along the graph's edges."""
+    seen, frontier = {start}, [start]
+    while frontier:
+        for node in graph.get(frontier.pop(), ()):
+            if node == goal:
+                return True
+            if node not in seen:
+                seen.add(node)
+                frontier.append(node)
+    return False
 
 
 def learn_sizes(
