@@ -171,7 +171,10 @@ class CellPool:
     requests to idle alive cells and returns the next finished request and its reply;
     each submitted request is returned exactly once. ``timeout`` [s] bounds one attempt
     at one cell; ``wait_for_cell`` [s] bounds a wait while no cell is alive;
-    ``max_failures`` bounds the failed attempts of one request. Close it when done.
+    ``max_failures`` bounds the failed attempts of one request. ``on_dispatch(cell,
+    request)``, if set, is called (in the thread of :meth:`next_reply`) just before each
+    request is sent to a cell, also when it is re-sent to another; an exception it raises
+    propagates from :meth:`next_reply` and the request is not sent. Close it when done.
     """
 
     def __init__(self, session: zenoh.Session, directory: CellDirectory, *,
@@ -188,6 +191,7 @@ class CellPool:
         self._slow: set[str] = set()
         self._failures: dict[str, int] = {}
         self._alive = directory.listen(self._on_change)
+        self.on_dispatch: Callable[[str, InsertRequest], None] | None = None
 
     def _on_change(self, cell: str, alive: bool) -> None:
         self._events.put(("cell", cell, alive))
@@ -207,8 +211,11 @@ class CellPool:
     def _dispatch(self) -> None:
         idle = sorted(self._alive - self._busy.keys(), key=lambda c: (c in self._slow, c))
         while self._pending and idle:
-            cell = idle.pop(0)
-            request = self._pending.popleft()
+            cell, request = idle[0], self._pending[0]
+            if self.on_dispatch is not None:
+                self.on_dispatch(cell, request)
+            idle.pop(0)
+            self._pending.popleft()
             attempt = next(self._attempts)
             cancel = send_insert(self._session, cell, request, self.timeout,
                                  functools.partial(self._on_outcome, cell, attempt))
