@@ -198,7 +198,11 @@ class CellPool:
     ``max_failures`` bounds the failed attempts of one request; a cell that misses
     ``max_misses`` replies in a row is dropped for the rest of the pool's life. Only the
     cells in ``allowed`` are used (None: any cell that shows a token). ``incidents``
-    lists what went wrong on the way (timeouts, conflicts, dropped cells). Close it when done.
+    lists what went wrong on the way (timeouts, conflicts, dropped cells).
+    ``on_dispatch(cell, request)``, if set, is called (in the thread of :meth:`next_reply`)
+    just before each request is sent to a cell, also when it is re-sent to another; an
+    exception it raises propagates from :meth:`next_reply` and the request is not sent.
+    Close it when done.
     """
 
     def __init__(self, session: zenoh.Session, directory: CellDirectory, *,
@@ -221,6 +225,7 @@ class CellPool:
         self._dropped: set[str] = set()
         self.incidents: list[str] = []
         self._alive = {cell for cell in directory.listen(self._on_change) if self._usable(cell)}
+        self.on_dispatch: Callable[[str, InsertRequest], None] | None = None
 
     def _usable(self, cell: str) -> bool:
         return (self._allowed is None or cell in self._allowed) and cell not in self._dropped
@@ -243,8 +248,11 @@ class CellPool:
     def _dispatch(self) -> None:
         idle = sorted(self._alive - self._busy.keys(), key=lambda c: (c in self._slow, c))
         while self._pending and idle:
-            cell = idle.pop(0)
-            request = self._pending.popleft()
+            cell, request = idle[0], self._pending[0]
+            if self.on_dispatch is not None:
+                self.on_dispatch(cell, request)
+            idle.pop(0)
+            self._pending.popleft()
             attempt = next(self._attempts)
             sent = msgspec.structs.replace(request, timeout_s=self.timeout)  # the cell drops it after that
             cancel = send_insert(self._session, cell, sent, self.timeout,

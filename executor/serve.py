@@ -248,7 +248,7 @@ class CellNode:
             query.drop()  # finalises the query: the planner need not wait for its timeout
 
     def _run(self, query: zenoh.Query, request: InsertRequest) -> bytes | None:
-        print(f"start {request.id} {request.part} {request.hole}", flush=True)
+        print(f"start {request.id} {request.part} {request.hole} {request.experiment}", flush=True)
         started = time.perf_counter()
         try:
             result, evidence = self._backend.run(request)

@@ -1,25 +1,40 @@
-"""``RUN/journal.jsonl``: every finished experiment, durable before it is used.
+"""``RUN/journal.jsonl``: every experiment started and finished, durable before it matters.
 
-One JSON object a line: ``id`` (the request id), ``part``, ``hole``, ``result``
-(``fit``/``no_fit``), ``cell`` (who ran it), ``retest`` (true on a deliberate re-test of
-a pair already tried), ``evidence`` (the cell's measurements or null), ``wall_s`` (the
-cell's wall time [s]), ``time`` (Unix time [s] it was journaled) and ``experiment`` (its
-number in the order experiments were started: the Rerun timeline ``experiment``). Each line is
-flushed and fsynced before the result reaches the learner, so a session killed at any
-moment can be resumed (``session --resume RUN``) by replaying the journal: no finished
-experiment is run again. A torn last line (killed while writing) is ignored: its
+One JSON object a line, of two kinds:
+
+- a finished experiment (:class:`JournalEntry`): ``id`` (the request id), ``part``,
+  ``hole``, ``result`` (``fit``/``no_fit``), ``cell`` (who ran it), ``retest`` (true on a
+  deliberate re-test of a pair already tried), ``evidence`` (the cell's measurements or
+  null), ``wall_s`` (the cell's wall time [s]), ``time`` (Unix time [s] it was journaled)
+  and ``experiment`` (its number in the order experiments were started: the Rerun
+  timeline ``experiment``);
+- an event (:class:`JournalEvent`, with an ``event`` key): ``started`` when the request
+  ``id`` with number ``experiment`` for ``part``, ``hole`` is sent to ``cell`` (again on
+  failover to another cell), ``abandoned`` when a resumed session finds an experiment
+  started but never finished (the planner died meanwhile): its number is never used
+  again, and the learner asks for the pair again, if still needed, under a new number.
+
+Each line is appended with one ``write`` of the whole line, then fsynced, before the
+request goes out or the result reaches the learner; so a session killed at any moment
+can be resumed (``session --resume RUN``) by replaying the journal: no finished
+experiment is run again and no experiment number is used twice. A failed append (full
+disk) cuts the file back to its last whole line and raises a PlannerError. A torn last
+line (a line without its newline: killed while writing) is ignored with a warning: its
 result was never used.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 import time
 from pathlib import Path
+from typing import Literal
 
 import msgspec
 
 from asp import PlannerError
+from bridge.files import os_reason
 from bridge.messages import AspId, Evidence, RequestId, Result
 
 JOURNAL_NAME = "journal.jsonl"
@@ -40,55 +55,144 @@ class JournalEntry(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     experiment: int = 0
 
 
-_DECODER = msgspec.json.Decoder(JournalEntry)
+class JournalEvent(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """Experiment ``experiment`` (request ``id``) ``started`` at ``cell``, or ``abandoned``."""
+
+    event: Literal["started", "abandoned"]
+    experiment: int
+    id: RequestId
+    part: AspId
+    hole: AspId
+    cell: str = ""
+    time: float = 0.0
 
 
-def read_journal(path: Path) -> list[JournalEntry]:
-    """The entries of a journal (none if it does not exist); PlannerError on a bad line.
+Record = JournalEntry | JournalEvent
 
-    Only the last line may be torn (then it is dropped); a bad line elsewhere means the
-    file was edited or corrupted and is reported with its line number.
-    """
+
+def _decode(line: bytes) -> Record:
+    data = msgspec.json.decode(line)
+    if isinstance(data, dict) and "event" in data:
+        return msgspec.convert(data, JournalEvent)
+    return msgspec.convert(data, JournalEntry)
+
+
+def _read(path: Path) -> tuple[list[Record], int | None]:
+    """The records of a journal and the number of its torn last line (None: none)."""
     if not path.is_file():
-        return []
-    lines = path.read_bytes().split(b"\n")
-    entries: list[JournalEntry] = []
-    for number, line in enumerate(lines, start=1):
+        return [], None
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise PlannerError(f"{path}: cannot read ({os_reason(exc)})") from None
+    lines = data.split(b"\n")
+    torn = len(lines) if lines[-1] else None  # the last line has no newline: a torn write
+    records: list[Record] = []
+    for number, line in enumerate(lines[:-1], start=1):
         if not line.strip():
             continue
         try:
-            entries.append(_DECODER.decode(line))
+            records.append(_decode(line))
         except msgspec.DecodeError as exc:
-            if number == len(lines):  # no newline after it: a torn write
-                break
             raise PlannerError(f"{path}:{number}: not a journal entry: {exc}") from None
-    return entries
+    return records, torn
+
+
+def _warn_torn(path: Path, torn: int | None) -> None:
+    if torn is not None:
+        print(f"warning: {path}:{torn}: ignoring a torn last line (the planner was killed while writing it)",
+              file=sys.stderr)
+
+
+def read_records(path: Path) -> list[Record]:
+    """Every record of a journal (none if it does not exist), in order; PlannerError on a
+    bad line. Only the last line may be torn (then it is dropped with a warning on
+    stderr); a bad line elsewhere means the file was edited or corrupted and is
+    reported with its line number."""
+    records, torn = _read(path)
+    _warn_torn(path, torn)
+    return records
+
+
+def read_journal(path: Path) -> list[JournalEntry]:
+    """The finished experiments of a journal, in order (see :func:`read_records`)."""
+    return [r for r in read_records(path) if isinstance(r, JournalEntry)]
 
 
 class Journal:
-    """Appends entries durably (write, flush, fsync) to ``RUN/journal.jsonl``."""
+    """Appends records durably (one write, fsync) to ``RUN/journal.jsonl``.
+
+    ``entries``: the finished experiments; ``events``: the started and abandoned ones.
+    """
 
     def __init__(self, run: Path) -> None:
         self.path = run / JOURNAL_NAME
-        self.entries = read_journal(self.path)
-        self._truncate_torn_tail()
-        self._file = self.path.open("ab")
+        records, torn = _read(self.path)
+        self.entries = [r for r in records if isinstance(r, JournalEntry)]
+        self.events = [r for r in records if isinstance(r, JournalEvent)]
+        try:
+            self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
+            if torn is not None:
+                _warn_torn(self.path, torn)
+                data = self.path.read_bytes()
+                os.ftruncate(self._fd, data.rfind(b"\n") + 1)
+        except OSError as exc:
+            raise PlannerError(f"{self.path}: cannot write ({os_reason(exc)})") from None
 
-    def _truncate_torn_tail(self) -> None:
-        if self.path.is_file():
-            data = self.path.read_bytes()
-            if data and not data.endswith(b"\n"):
-                with self.path.open("r+b") as file:
-                    file.truncate(data.rfind(b"\n") + 1)
+    @property
+    def highest_started(self) -> int:
+        """The highest experiment number ever started (finished, started or abandoned); 0: none."""
+        numbers = [e.experiment for e in self.entries] + [e.experiment for e in self.events]
+        return max(numbers, default=0)
+
+    def in_flight(self) -> list[JournalEvent]:
+        """Experiments started but neither finished nor abandoned (the last start of each)."""
+        closed = {e.experiment for e in self.entries}
+        closed |= {e.experiment for e in self.events if e.event == "abandoned"}
+        last = {e.experiment: e for e in self.events if e.event == "started" and e.experiment not in closed}
+        return [last[n] for n in sorted(last)]
+
+    def _write(self, record: Record) -> None:
+        """Append one line with one write and fsync it; on failure cut back to the last whole line."""
+        line = msgspec.json.encode(record) + b"\n"
+        size = os.fstat(self._fd).st_size
+        try:
+            view = memoryview(line)
+            while view:  # one write, unless the disk fills up in the middle (then the next one fails)
+                view = view[os.write(self._fd, view):]
+            os.fsync(self._fd)
+        except OSError as exc:
+            try:
+                os.ftruncate(self._fd, size)
+            except OSError:
+                pass  # the torn line is dropped when the journal is read again
+            raise PlannerError(f"{self.path}: cannot write ({os_reason(exc)})") from None
 
     def append(self, entry: JournalEntry) -> None:
-        """Write one entry and make it durable before returning."""
+        """Write one finished experiment and make it durable before returning."""
         if entry.time == 0.0:
             entry = msgspec.structs.replace(entry, time=time.time())
-        self._file.write(msgspec.json.encode(entry) + b"\n")
-        self._file.flush()
-        os.fsync(self._file.fileno())
+        self._write(entry)
         self.entries.append(entry)
 
+    def started(self, experiment: int, request_id: str, part: str, hole: str, cell: str) -> None:
+        """Record durably that experiment ``experiment`` goes to ``cell`` (before it is sent)."""
+        event = JournalEvent("started", experiment, request_id, part, hole, cell, time.time())
+        self._write(event)
+        self.events.append(event)
+
+    def abandon_in_flight(self) -> list[JournalEvent]:
+        """Record every experiment in flight (see :meth:`in_flight`) as abandoned; returns them."""
+        abandoned = []
+        for start in self.in_flight():
+            event = JournalEvent("abandoned", start.experiment, start.id, start.part, start.hole, start.cell,
+                                 time.time())
+            self._write(event)
+            self.events.append(event)
+            abandoned.append(event)
+        return abandoned
+
     def close(self) -> None:
-        self._file.close()
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1

@@ -8,10 +8,14 @@ can entail another's), so parallel work is never wasted. Underneath,
 :class:`bridge.client.CellPool` sends one request per alive cell and re-sends the
 request of a cell that dies mid-experiment to another cell (or waits for one).
 
-Request ids are ``<run>.<part>.<hole>.<n>`` for the n-th time the pair is asked in the
-run (n > 1: a deliberate re-test). Cells are idempotent by id, so a re-sent request
-never runs twice on a cell that finished it; every reply is journaled (fsynced)
-exactly once, before its result is returned.
+Request ids are ``<run>.<part>.<hole>.<n>`` for the n-th time the pair is started in
+the run (an experiment abandoned by a killed planner counts, so a resumed session never
+sends an old id again; ``retest`` marks a deliberate re-test of a pair already tried).
+Experiments are numbered in the order they are submitted, after the highest number the
+journal ever saw started. Each request is journaled as started (fsynced) just before it
+is sent to a cell. Cells are idempotent by id, so a re-sent request never runs twice on
+a cell that finished it; every reply is journaled (fsynced) exactly once, before its
+result is returned.
 """
 
 from __future__ import annotations
@@ -52,22 +56,30 @@ class ZenohOracle:
         self._journal = journal
         self._run_id = run_id
         self._seed = seed
-        self._asked: Counter[Pair] = Counter((e.part, e.hole) for e in journal.entries)
-        self._started = max((e.experiment for e in journal.entries), default=0)
+        self._tried: Counter[Pair] = Counter((e.part, e.hole) for e in journal.entries)
+        started = {(e.part, e.hole, e.experiment) for e in journal.events}
+        started |= {(e.part, e.hole, e.experiment or -k) for k, e in enumerate(journal.entries, start=1)}
+        self._asked: Counter[Pair] = Counter((part, hole) for part, hole, _ in started)
+        self._started = journal.highest_started
+        pool.on_dispatch = self._on_dispatch
 
     def alive_cells(self) -> int:
         """How many cells are alive now (how many experiments can run at once)."""
         return len(self._directory.alive())
 
     def submit(self, part: str, hole: str) -> None:
-        """Queue one experiment; it starts as soon as a cell is idle."""
+        """Queue one experiment under the next number; it starts as soon as a cell is idle."""
         self._asked[(part, hole)] += 1
-        n = self._asked[(part, hole)]
-        key = f"{self._run_id}.{part}.{hole}.{n}"
+        key = f"{self._run_id}.{part}.{hole}.{self._asked[(part, hole)]}"
+        retest = self._tried[(part, hole)] > 0
+        self._tried[(part, hole)] += 1
         self._started += 1
-        self._pool.submit(InsertRequest(id=key, part=part, hole=hole, retest=n > 1,
+        self._pool.submit(InsertRequest(id=key, part=part, hole=hole, retest=retest,
                                         seed=zlib.crc32(f"{self._seed}.{key}".encode()),
                                         experiment=self._started))
+
+    def _on_dispatch(self, cell: str, request: InsertRequest) -> None:
+        self._journal.started(request.experiment, request.id, request.part, request.hole, cell)
 
     def next_result(self) -> Finished:
         """Wait for the next finished experiment, journal it durably, return it.

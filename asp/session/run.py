@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import sys
 import time
 import uuid
 from contextlib import ExitStack
@@ -39,7 +40,8 @@ from asp.precedence.demos import demo_facts, load_demos
 from asp.precedence.learn import learn_must_precede
 from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
 from asp.session.cells import CellProcess, serve_argv
-from asp.session.journal import Journal
+from asp.session.folder import RunLock, lock_run_folder
+from asp.session.journal import JOURNAL_NAME, Journal
 from asp.session.log import PlannerLog
 from asp.session.oracle import ZenohOracle
 from asp.sizes.learner import MAX_CONFIRM, SizeLearner, SizeLearningResult
@@ -50,7 +52,7 @@ from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
-from bridge.files import write_atomic
+from bridge.files import make_folder, write_atomic
 from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
@@ -91,24 +93,46 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _run_folder(args: argparse.Namespace) -> tuple[Path, dict]:
-    """The run folder and its settings (read back when resuming)."""
+def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock]:
+    """The run folder, locked for this session (:mod:`asp.session.folder`), and its
+    settings (read back when resuming). ``--out`` creates the folder and refuses one
+    that holds a session (journaled experiments or a finished run); a folder left by a
+    start that failed before any experiment was journaled may be used again."""
     if args.resume is not None:
         path = args.resume / SETTINGS
         if not path.is_file():
             raise PlannerError(f"--resume {args.resume}: expected a run folder holding {SETTINGS}")
-        settings = json.loads(path.read_text(encoding="utf-8"))
+        lock = lock_run_folder(args.resume)
+        try:
+            settings = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            lock.release()
+            raise PlannerError(f"{path}: not the settings of a session ({exc})") from None
         settings["starts"] = int(settings.get("starts", 1)) + 1
-        return args.resume, settings
+        return args.resume, settings, lock
     if args.confirm < 0:
         raise PlannerError(f"--confirm {args.confirm}: expected a number >= 0")
     run = args.out or Path("runs") / datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-    if (run / SETTINGS).exists():
-        raise PlannerError(f"--out {run}: already holds a session; use --resume {run} or another folder")
-    run.mkdir(parents=True, exist_ok=True)
+    lock = lock_run_folder(make_folder(run))
+    if _holds_session(run):
+        lock.release()
+        raise PlannerError(f"--out {run}: already holds a session (its journal); "
+                           f"use --resume {run} or another folder")
     settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed, "confirm": args.confirm,
                 "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running"}
-    return run, settings
+    return run, settings, lock
+
+
+def _holds_session(run: Path) -> bool:
+    """Whether ``run`` holds a session to resume rather than overwrite: a journal with
+    at least one line, or settings with status ``done``."""
+    journal = run / JOURNAL_NAME
+    if journal.is_file() and journal.stat().st_size > 0:
+        return True
+    try:
+        return json.loads((run / SETTINGS).read_text(encoding="utf-8")).get("status") == "done"
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def _save(run: Path, settings: dict) -> None:
@@ -202,7 +226,16 @@ def run_session(args: argparse.Namespace) -> dict:
     started = time.perf_counter()
     if args.cells < 0:
         raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
-    run, settings = _run_folder(args)
+    run, settings, lock = _run_folder(args)
+    try:
+        return _run_locked(args, run, settings, started)
+    finally:
+        lock.release()
+
+
+def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: float) -> dict:
+    """:func:`run_session` in the locked run folder ``run``; ``started``: its
+    ``time.perf_counter()`` [s] at the start."""
     assembly = load_assembly(settings["assembly"])
     parts, holes, truth = _sizes_domain(assembly)
     run_id = re.sub(r"[^A-Za-z0-9_-]", "-", settings["recording_id"])
@@ -229,6 +262,12 @@ def run_session(args: argparse.Namespace) -> dict:
         log.precedence(relation.parts, reduction(relation))
         journal = Journal(run)
         stack.callback(journal.close)
+        abandoned = [event.experiment for event in journal.abandon_in_flight()]
+        if abandoned:
+            settings.setdefault("abandoned", []).extend(abandoned)
+            print(f"resume: experiment(s) {', '.join(map(str, abandoned))} were running when the session "
+                  "stopped; abandoned (their pairs are asked again, under new numbers, if still needed)",
+                  file=sys.stderr)
         allowed = cell_ids if args.cells > 0 else (args.allow_cells or None)  # by default only its own cells
         pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell, allowed=allowed)
         stack.callback(pool.close)

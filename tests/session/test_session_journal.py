@@ -1,13 +1,17 @@
-"""The session journal: durable lines, a torn last line dropped, corruption reported."""
+"""The session journal: durable lines, started/abandoned events, a torn last line dropped with a
+warning, a full disk leaving it whole, corruption reported."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
+import msgspec
 import pytest
 
 from asp import PlannerError
-from asp.session.journal import Journal, JournalEntry, read_journal
+from asp.session.journal import Journal, JournalEntry, read_journal, read_records
+from tests._files_helpers import run_with_file_limit
 
 
 def entry(k: int, retest: bool = False) -> JournalEntry:
@@ -40,3 +44,59 @@ def test_a_corrupted_line_inside_is_reported_with_its_number(tmp_path: Path) -> 
                     '{"id":"c","part":"p1","hole":"r1","result":"fit","cell":"c1"}\n')
     with pytest.raises(PlannerError, match="journal.jsonl:2"):
         read_journal(path)
+
+
+def test_a_last_line_without_its_newline_is_dropped_with_a_warning(tmp_path: Path, capsys) -> None:
+    journal = Journal(tmp_path)
+    journal.append(entry(1))
+    journal.close()
+    path = tmp_path / "journal.jsonl"
+    whole_but_unterminated = path.read_bytes().replace(b"r1.1", b"r1.2").rstrip(b"\n")
+    with path.open("ab") as file:
+        file.write(whole_but_unterminated)  # killed before the newline went out
+    assert [e.id for e in read_journal(path)] == ["run.p1.r1.1"]
+    assert capsys.readouterr().err == f"warning: {path}:2: ignoring a torn last line " \
+                                      "(the planner was killed while writing it)\n"
+    resumed = Journal(tmp_path)  # what is in memory is what is on disk
+    assert [e.id for e in resumed.entries] == ["run.p1.r1.1"]
+    resumed.close()
+    assert [e.id for e in read_journal(path)] == ["run.p1.r1.1"]
+
+
+def test_started_finished_abandoned(tmp_path: Path) -> None:
+    journal = Journal(tmp_path)
+    journal.started(1, "run.p1.r1.1", "p1", "r1", "c1")
+    journal.started(2, "run.p1.r2.1", "p1", "r2", "c2")
+    journal.append(msgspec.structs.replace(entry(1), experiment=1))
+    journal.started(3, "run.p2.r1.1", "p2", "r1", "c1")
+    journal.started(2, "run.p1.r2.1", "p1", "r2", "c1")  # c2 died: re-sent to c1
+    journal.close()
+    resumed = Journal(tmp_path)
+    assert resumed.highest_started == 3
+    assert [(e.experiment, e.cell) for e in resumed.in_flight()] == [(2, "c1"), (3, "c1")]
+    assert [e.experiment for e in resumed.abandon_in_flight()] == [2, 3]
+    assert resumed.in_flight() == [] and resumed.highest_started == 3
+    resumed.close()
+    records = read_records(tmp_path / "journal.jsonl")
+    assert [getattr(r, "event", "finished") for r in records] == [
+        "started", "started", "finished", "started", "started", "abandoned", "abandoned"]
+    assert [e.id for e in read_journal(tmp_path / "journal.jsonl")] == ["run.p1.r1.1"]
+
+
+def test_a_full_disk_keeps_the_journal_whole(tmp_path: Path) -> None:
+    journal = Journal(tmp_path)
+    journal.append(entry(1))
+    journal.close()
+    path = tmp_path / "journal.jsonl"
+    before = path.read_bytes()
+    program = ("import sys; from pathlib import Path; from asp import PlannerError\n"
+               "from asp.session.journal import Journal, JournalEntry\n"
+               "journal = Journal(Path(sys.argv[1]))\n"
+               "try:\n"
+               "    journal.append(JournalEntry(id='run.p1.r1.2', part='p1', hole='r1', result='fit',\n"
+               "                                cell='c1' * 200))\n"
+               "except PlannerError as exc:\n    print(exc)\n")
+    done = run_with_file_limit([sys.executable, "-c", program, str(tmp_path)], limit=len(before) + 100)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == f"{path}: cannot write (File too large)\n"
+    assert path.read_bytes() == before  # cut back to its last whole line
