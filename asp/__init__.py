@@ -5,6 +5,12 @@ hole by active exploration (paper 2.2), assigns holes and builds complete plans.
 """
 
 
+MAX_IDS = 64
+"""At most this many parts, and this many holes, in the planner's input (demonstrations,
+precedence and sizes facts, learned facts): the learners' matrices and searches are
+sized by them."""
+
+
 class PlannerError(Exception):
     """Base error of the planner: bad input or an unsolvable request.
 

@@ -14,13 +14,33 @@
 from __future__ import annotations
 
 import importlib.resources
-from collections.abc import Callable, Iterable, Sequence
+import re
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
 import clingo
 
-from asp import PlannerError
+from asp import MAX_IDS, PlannerError
+from bridge.assembly import ID_PATTERN
 from bridge.files import write_atomic
+from bridge.inputs import read_bytes, shorten
+
+_ID = re.compile(ID_PATTERN)
+_STRINGS_AND_COMMENTS = re.compile(r'"(?:\\.|[^"\\\n])*"|%\*.*?\*%|%[^\n]*', re.DOTALL)
+_NON_ASCII = re.compile(r"[^\x00-\x7f]")
+
+
+def _check_ascii(path: Path, text: str) -> None:
+    """PlannerError naming file:line at a non-ASCII character outside strings and comments.
+
+    Never valid ASP there, and clingo's own message would quote a piece of the character:
+    its Python logger then fails to decode it and the process aborts."""
+    code = _STRINGS_AND_COMMENTS.sub(lambda match: "\n" * match.group().count("\n"), text)
+    found = _NON_ASCII.search(code)
+    if found:
+        line = code[: found.start()].count("\n") + 1
+        raise PlannerError(f"{path}:{line}: character {found.group()!r} outside a string or comment; "
+                           "expected ASP facts (ASCII ids such as p1)")
 
 
 def encoding(name: str) -> Path:
@@ -32,28 +52,31 @@ def encoding(name: str) -> Path:
 
 
 def load_atoms(
-    paths: Sequence[Path | str], *, encodings: Sequence[str] = (), extra: Iterable[clingo.Symbol] = ()
+    paths: Sequence[Path | str], *, encodings: Sequence[str] = (), extra: Iterable[clingo.Symbol] = (),
+    shown_only: bool = True,
 ) -> list[clingo.Symbol]:
     """Ground the files with the named ``encodings`` (see :func:`encoding`) and ``extra``
-    facts, and return the shown atoms of the one answer set.
+    facts, and return the shown atoms of the one answer set (all its atoms when not
+    ``shown_only``: an encoding's ``#show`` then hides nothing from checks).
 
-    Raises PlannerError naming file:line when a file does not parse, does not exist,
-    or has no single answer set.
+    Raises PlannerError naming file:line when a file does not exist, cannot be read, is
+    larger than :data:`bridge.inputs.MAX_INPUT_BYTES`, does not parse, or has no single
+    answer set (clingo's messages are cut to one short line each).
     """
     messages: list[str] = []
     ctl = clingo.Control(["--models=2"], logger=lambda _code, msg: messages.append(msg.strip()))
     for path in paths:
         path = Path(path)
-        if not path.is_file():
-            raise PlannerError(f"{path}: no such facts file")
+        data = read_bytes(path, "facts file", error=PlannerError)
         try:
-            text = path.read_text(encoding="utf-8")
+            text = data.decode("utf-8")
         except UnicodeDecodeError:
             raise PlannerError(f"{path}: not a text file (expected ASP facts)") from None
+        _check_ascii(path, text)
         try:
             ctl.add("base", [], text.replace("\x00", ""))
         except RuntimeError:
-            detail = "; ".join(m.replace("<block>", str(path)) for m in messages) or "syntax error"
+            detail = "; ".join(shorten(m.replace("<block>", str(path)), 160) for m in messages[:2]) or "syntax error"
             raise PlannerError(f"{path}: does not parse as ASP facts: {detail}") from None
     for name in encodings:
         ctl.load(str(encoding(name)))
@@ -61,13 +84,38 @@ def load_atoms(
     try:
         ctl.ground([("base", [])])
     except RuntimeError:
-        raise PlannerError("facts do not ground: " + "; ".join(messages)) from None
+        raise PlannerError("facts do not ground: " + "; ".join(shorten(m, 160) for m in messages[:2])) from None
     models: list[list[clingo.Symbol]] = []
-    ctl.solve(on_model=lambda m: models.append(list(m.symbols(shown=True))))
+    ctl.solve(on_model=lambda m: models.append(list(m.symbols(shown=shown_only, atoms=not shown_only))))
     if len(models) != 1:
         names = ", ".join(str(p) for p in paths)
         raise PlannerError(f"{names}: expected facts with exactly one answer set, got {len(models)}")
     return models[0]
+
+
+def check_facts(atoms: Iterable[clingo.Symbol], signatures: Mapping[str, int], source: str) -> None:
+    """Check the atoms of the predicates named in ``signatures`` (name → arity), whose
+    arguments are all ids: PlannerError naming ``source`` and the atom when one has another
+    arity (e.g. ``must_precede/3``, expected ``must_precede/2``), an argument that is not an
+    id (a lower-case ASP constant such as ``p1``, not ``"ä"`` or ``3``), or when there are
+    more than :data:`asp.MAX_IDS` ``part/1`` or ``hole/1`` atoms."""
+    counts: dict[str, int] = {}
+    for atom in atoms:
+        if atom.type != clingo.SymbolType.Function or atom.name not in signatures:
+            continue
+        arity = signatures[atom.name]
+        if len(atom.arguments) != arity:
+            raise PlannerError(f"{source}: {shorten(atom, 60)}: {atom.name}/{len(atom.arguments)}, "
+                               f"expected {atom.name}/{arity}")
+        for argument in atom.arguments:
+            if (argument.type != clingo.SymbolType.Function or argument.arguments or not argument.positive
+                    or not _ID.match(argument.name)):
+                raise PlannerError(f"{source}: {shorten(atom, 60)}: '{shorten(argument)}' is not an id "
+                                   "(expected lower-case ASP constants such as p1)")
+        counts[atom.name] = counts.get(atom.name, 0) + 1
+    for name in ("part", "hole"):
+        if counts.get(name, 0) > MAX_IDS:
+            raise PlannerError(f"{source}: {counts[name]} {name}/1 facts; expected at most {MAX_IDS}")
 
 
 def atoms_by_name(atoms: Iterable[clingo.Symbol], name: str, arity: int) -> list[tuple[str, ...]]:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bridge import BridgeError
-from bridge.inputs import shorten
+from bridge.inputs import read_text, shorten
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 ID_PATTERN = r"^[a-z][a-zA-Z0-9_]{0,63}$"
@@ -130,8 +130,8 @@ def load_assembly(name_or_path: str) -> Assembly:
     folder = resolve_assembly_folder(name_or_path)
     source = folder / "assembly.toml"
     try:
-        data = tomllib.loads(source.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        data = tomllib.loads(read_text(source, "assembly file (TOML)"))
+    except tomllib.TOMLDecodeError as exc:
         raise BridgeError(f"{source}: not valid TOML: {exc}") from None
     parts = tuple(
         Part(key, str(value.get("name", key)), str(value.get("role", "part")),

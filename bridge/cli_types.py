@@ -130,6 +130,14 @@ def number_in(kind: Callable[[str], float], low: float, high: float) -> Callable
     return parse
 
 
+def png_path(text: str) -> str:
+    """An argparse type: a file path ending in ``.png`` (not a folder: matplotlib would
+    write ``FOLDER.png`` beside it)."""
+    if not text.lower().endswith(".png") or text.endswith(("/", "\\")):
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected a file path ending in .png")
+    return text
+
+
 def size_pair(text: str) -> tuple[int, int]:
     """An item type: ``"4x5"`` → ``(4, 5)``, both positive (ValueError otherwise)."""
     m, sep, n = text.partition("x")

@@ -21,6 +21,7 @@ import pyarrow as pa
 from rerun.chunk import Chunk, RrdReader
 
 from bridge import BridgeError
+from bridge.inputs import shorten
 
 
 @dataclass
@@ -75,9 +76,20 @@ _VIEW_ORIGIN = "ViewBlueprint:space_origin"
 
 
 def _reader(path: Path) -> RrdReader:
+    """A reader of one ``.rrd`` file; BridgeError naming the file when it is missing,
+    unreadable or not a Rerun recording (empty, garbage, another format)."""
     if not path.is_file():
         raise BridgeError(f"{path}: no such recording file (expected an .rrd file)")
-    return RrdReader(path)
+    try:
+        with path.open("rb") as file:
+            file.read(1)
+    except OSError as exc:
+        raise BridgeError(f"{path}: cannot read the recording: {exc.strerror or exc}") from None
+    try:
+        with _tolerating_unfinished_files():
+            return RrdReader(path)
+    except (RuntimeError, ValueError) as exc:
+        raise BridgeError(f"{path}: not a Rerun recording ({shorten(exc, 120)}); expected an .rrd file") from None
 
 
 @contextmanager
@@ -102,25 +114,33 @@ def read_recording(paths: Path | str | Sequence[Path | str]) -> RecordingSummary
     files = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]
     summary = RecordingSummary(files=files)
     for path in files:
-        reader = _reader(path)
-        with _tolerating_unfinished_files():
-            for store in reader.recordings():
-                summary.application_ids.add(store.application_id)
-                summary.recording_ids.add(store.recording_id)
-            summary.blueprints += len(reader.blueprints())
-        for chunk in _chunks(path):
-            if chunk.entity_path.startswith("/__"):
-                continue
-            entity = summary.entities.setdefault(chunk.entity_path, EntitySummary(chunk.entity_path))
-            entity.rows += chunk.num_rows
-            entity.static_rows += chunk.num_rows if chunk.is_static else 0
-            entity.timelines.update(chunk.timeline_names)
-            names = chunk.to_record_batch().schema.names
-            entity.components.update(
-                n for n in names
-                if ":" in n and not n.startswith(_CONTROL_COLUMN_PREFIX)
-            )
+        try:
+            _summarise(path, summary)
+        except RuntimeError as exc:  # a damaged file (e.g. cut in the middle of a message)
+            raise BridgeError(f"{path}: not a readable Rerun recording ({shorten(exc, 120)})") from None
     return summary
+
+
+def _summarise(path: Path, summary: RecordingSummary) -> None:
+    """Add what one ``.rrd`` file holds to ``summary``."""
+    reader = _reader(path)
+    with _tolerating_unfinished_files():
+        for store in reader.recordings():
+            summary.application_ids.add(store.application_id)
+            summary.recording_ids.add(store.recording_id)
+        summary.blueprints += len(reader.blueprints())
+    for chunk in _chunks(path):
+        if chunk.entity_path.startswith("/__"):
+            continue
+        entity = summary.entities.setdefault(chunk.entity_path, EntitySummary(chunk.entity_path))
+        entity.rows += chunk.num_rows
+        entity.static_rows += chunk.num_rows if chunk.is_static else 0
+        entity.timelines.update(chunk.timeline_names)
+        names = chunk.to_record_batch().schema.names
+        entity.components.update(
+            n for n in names
+            if ":" in n and not n.startswith(_CONTROL_COLUMN_PREFIX)
+        )
 
 
 def column_values(

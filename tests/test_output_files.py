@@ -28,9 +28,9 @@ COMMANDS = {  # command line writing one file to OUT
     "sizes evaluate --plot": ("sizes", "evaluate", "--assembly", "cranfield", "--policy", "best",
                               "--relabelings", "2", "--plot", "OUT"),
 }
-BAD_PATHS = {"missing folder": ("missing/out", "No such file or directory"),
-             "a directory": ("folder", "Is a directory"),
-             "under a regular file": ("file/out", "Not a directory")}
+BAD_PATHS = {"missing folder": ("missing/out.png", "No such file or directory"),  # .png: --png asks for it
+             "a directory": ("folder.png", "Is a directory"),
+             "under a regular file": ("file/out.png", "Not a directory")}
 
 
 def _argv(command: str, out: Path) -> list[str]:
@@ -40,7 +40,7 @@ def _argv(command: str, out: Path) -> list[str]:
 @pytest.mark.parametrize("bad", BAD_PATHS)
 @pytest.mark.parametrize("command", COMMANDS)
 def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_cli, command: str, bad: str) -> None:
-    (tmp_path / "folder").mkdir()
+    (tmp_path / "folder.png").mkdir()
     (tmp_path / "file").write_text("a regular file\n")
     name, reason = BAD_PATHS[bad]
     out = tmp_path / name
@@ -48,8 +48,8 @@ def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_cli, command: st
     assert done.returncode == 2, done.stderr
     assert done.stderr == f"error: {out}: cannot write ({reason})\n"
     assert (tmp_path / "file").read_text() == "a regular file\n"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "folder"]
-    assert list((tmp_path / "folder").iterdir()) == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "folder.png"]
+    assert list((tmp_path / "folder.png").iterdir()) == []
 
 
 @pytest.mark.parametrize("command", ["plan --travel-out", "precedence learn --out"])

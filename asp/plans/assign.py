@@ -24,12 +24,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
 
 import clingo
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, load_atoms, pairs_by_name, solve
+from asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name, solve
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
@@ -63,6 +64,10 @@ class LearnedFacts:
         return [hole for hole in self.holes if (part, hole) in self.fits]
 
 
+LEARNED_SIGNATURES = {"part": 1, "hole": 1, "fits": 2, "no_fit": 2, "needs_hole": 1,
+                      "must_precede": 2, "precedence_edge": 2}
+"""The predicates of learned facts the planner reads, with their arities (ids only)."""
+
 RESERVED_IDS = frozenset({"none", "home", "site"})
 """Constants of plan_step/3 (``none``) and of the travel cost (``home``, ``site``)."""
 
@@ -89,12 +94,31 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
                     f"{sources}: must_precede({first},{then}): {part} is not a part/1 "
                     f"(parts: {' '.join(facts.parts)})"
                 )
+    both = sorted(facts.fits & set(pairs_by_name(facts.atoms, "no_fit")))
+    if both:
+        part, hole = both[0]
+        raise PlannerError(f"{sources}: both fits({part},{hole}) and no_fit({part},{hole}); "
+                           "expected one result per part and hole")
+    successors: dict[str, set[str]] = {}
+    for first, then in facts.must_precede:
+        successors.setdefault(first, set()).add(then)
+    try:
+        TopologicalSorter(successors).prepare()
+    except CycleError as exc:
+        ring = list(reversed(exc.args[1]))[:-1]  # graphlib names each node's predecessor next
+        start = ring.index(min(ring))
+        cycle = " < ".join([*ring[start:], *ring[:start], ring[start]])
+        raise PlannerError(f"{sources}: must_precede has a cycle {cycle}; expected an acyclic precedence "
+                           "relation") from None
 
 
 def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
-    """Read learned facts files; PlannerError on a file that does not parse or unknown ids."""
+    """Read learned facts files; PlannerError on a file that does not parse, a predicate of
+    the wrong arity or with non-id arguments (:data:`LEARNED_SIGNATURES`), unknown ids,
+    a pair both fitting and not fitting, or a cycle of ``must_precede``."""
     sources = ", ".join(str(p) for p in paths)
     atoms = load_atoms(paths, encodings=["plans/needs_hole.lp"])
+    check_facts(atoms, LEARNED_SIGNATURES, sources)
     facts = LearnedFacts(
         atoms=tuple(atoms),
         parts=tuple(p for (p,) in atoms_by_name(atoms, "part", 1)),

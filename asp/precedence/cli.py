@@ -19,7 +19,7 @@ from asp.precedence.demos import Demonstrations, load_demos
 from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
-from bridge.cli_types import ArgumentParser, comma_list, non_negative_int
+from bridge.cli_types import ArgumentParser, comma_list, non_negative_int, png_path
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -32,7 +32,7 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--assembly", help="assembly name under data/ or folder (gives the parts)")
     learn.add_argument("--out", help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
     learn.add_argument("--dot", help="write the transitive-reduction graph as Graphviz DOT")
-    learn.add_argument("--png", help="draw the relation to a PNG file")
+    learn.add_argument("--png", type=png_path, help="draw the relation to a PNG file (FILE.png)")
     learn.add_argument("--min-support", type=int, default=1, metavar="K",
                        help="drop a constraint only when >= K demonstrations contradict it "
                             "(default 1: plain intersection)")

@@ -17,7 +17,7 @@ import clingo
 import numpy as np
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, fact, load_atoms, pairs_by_name
+from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name
 from bridge.assembly import Assembly
 
 Pair = tuple[str, str]
@@ -105,7 +105,8 @@ def load_relation(paths: Sequence[Path | str]) -> Relation:
     PlannerError when the files hold no ``part/1``, name an unknown part or hold a cycle.
     """
     names = ", ".join(str(p) for p in paths)
-    atoms = load_atoms(paths, encodings=["precedence_closure.lp"])
+    atoms = load_atoms(paths, encodings=["precedence_closure.lp"], shown_only=False)
+    check_facts(atoms, {"part": 1, "must_precede": 2, "precedence_edge": 2}, names)
     parts = [p for (p,) in atoms_by_name(atoms, "part", 1)]
     if not parts:
         raise PlannerError(f"{names}: expected part/1 facts naming the parts of the assembly")

@@ -53,6 +53,7 @@ from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
 from bridge.files import make_folder, write_atomic
+from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
@@ -104,10 +105,10 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock]:
             raise PlannerError(f"--resume {args.resume}: expected a run folder holding {SETTINGS}")
         lock = lock_run_folder(args.resume)
         try:
-            settings = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+            settings = _resume_settings(path)
+        except PlannerError:
             lock.release()
-            raise PlannerError(f"{path}: not the settings of a session ({exc})") from None
+            raise
         settings["starts"] = int(settings.get("starts", 1)) + 1
         return args.resume, settings, lock
     if args.confirm < 0:
@@ -133,6 +134,39 @@ def _holds_session(run: Path) -> bool:
         return json.loads((run / SETTINGS).read_text(encoding="utf-8")).get("status") == "done"
     except (OSError, ValueError, AttributeError):
         return False
+
+
+_SETTING_TYPES: dict[str, tuple[type, bool]] = {
+    "assembly": (str, True), "policy": (str, True), "seed": (int, True), "recording_id": (str, True),
+    "confirm": (int, False), "starts": (int, False)}
+"""The settings a resumed session reads back: key → (type, required)."""
+
+
+def _resume_settings(path: Path) -> dict:
+    """The settings of ``RUN/session.json``; PlannerError naming the file and the key when
+    it is unreadable, not a JSON object, lacks a key or holds a value of the wrong type or range."""
+    data = read_bytes(path, "session settings file", error=PlannerError)
+    try:
+        settings = json.loads(data)
+    except (ValueError, RecursionError) as exc:
+        raise PlannerError(f"{path}: not JSON ({shorten(exc, 80)}); expected the settings a session wrote") from None
+    if not isinstance(settings, dict):
+        raise PlannerError(f"{path}: a JSON {type(settings).__name__}; expected an object with the session's settings")
+    for key, (kind, required) in _SETTING_TYPES.items():
+        if key not in settings and not required:
+            continue
+        value = settings.get(key)
+        if not isinstance(value, kind) or isinstance(value, bool):
+            got = "nothing" if key not in settings else shorten(json.dumps(value))
+            raise PlannerError(f'{path}: "{key}": expected {"an integer" if kind is int else "a string"}, got {got}')
+    checks = [("policy", settings["policy"] in policy_names(), f"one of {', '.join(policy_names())}"),
+              ("seed", 0 <= settings["seed"] <= MAX_SEED, f"an integer from 0 to {MAX_SEED}"),
+              ("confirm", 0 <= settings.get("confirm", 0) <= MAX_CONFIRM, f"an integer from 0 to {MAX_CONFIRM}"),
+              ("starts", 1 <= settings.get("starts", 1) <= 1_000_000, "an integer >= 1")]
+    for key, ok, expected in checks:
+        if not ok:
+            raise PlannerError(f'{path}: "{key}": expected {expected}, got {shorten(json.dumps(settings[key]))}')
+    return settings
 
 
 def _save(run: Path, settings: dict) -> None:
@@ -192,19 +226,19 @@ def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
     return list(dict.fromkeys(atoms))
 
 
-def _versus_truth(assembly: Assembly, truth: TruthOracle | None, fits: list[tuple[str, str]],
+def _versus_truth(truth: TruthOracle | None, required: set[tuple[str, str]] | None, fits: list[tuple[str, str]],
                   must_precede: list[tuple[str, str]]) -> dict[str, bool | int | None]:
     """The learned relations against the assembly's truths (None where unknown).
 
     ``precedence_sound``: every true constraint was learned, so every sequence the
     learned relation admits is feasible; ``precedence_extra``: learned pairs that the
-    truth does not require (orders the demonstrations happened not to vary).
+    truth does not require (orders the demonstrations happened not to vary). ``required``:
+    the pairs of the assembly's ``precedence.lp`` (None without one).
     """
     versus: dict[str, bool | int | None] = {
         "sizes_equal": None if truth is None else set(fits) == truth.fits,
         "precedence_sound": None, "precedence_extra": None}
-    if assembly.has_file("precedence.lp"):
-        required = set(true_relation(assembly).pairs())
+    if required is not None:
         versus["precedence_sound"] = required <= set(must_precede)
         versus["precedence_extra"] = len(set(must_precede) - required)
     return versus
@@ -238,6 +272,10 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     ``time.perf_counter()`` [s] at the start."""
     assembly = load_assembly(settings["assembly"])
     parts, holes, truth = _sizes_domain(assembly)
+    # Every input file is read before any cell starts: bad input fails fast.
+    demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
+    relation = learn_must_precede(demos)
+    required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
     run_id = re.sub(r"[^A-Za-z0-9_-]", "-", settings["recording_id"])
     listen, connect = _endpoints(args)
     suffix = "" if settings["starts"] == 1 else f"-{settings['starts']}"
@@ -255,8 +293,6 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
                 recording_id=settings["recording_id"], zenoh_config=args.zenoh_config)))
-        demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
-        relation = learn_must_precede(demos)
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
@@ -292,7 +328,7 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         log.assignment(assignment)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
-    versus = _versus_truth(assembly, truth, fits, must_precede)
+    versus = _versus_truth(truth, required, fits, must_precede)
     matches = None if None in versus.values() else versus["sizes_equal"] and versus["precedence_sound"]
     result = {
         "run": str(run),

@@ -16,8 +16,9 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, load_atoms, pairs_by_name
+from asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name
 from bridge.assembly import load_assembly
+from bridge.inputs import read_text
 
 Result = Literal["fit", "no_fit"]
 
@@ -81,9 +82,10 @@ class TruthOracle:
         """A truth facts file; index order = order of first mention in the file."""
         path = Path(path)
         atoms = load_atoms([path])
+        check_facts(atoms, {"part": 1, "hole": 1, "fits": 2}, str(path))
         parts = [a for (a,) in atoms_by_name(atoms, "part", 1)]
         holes = [a for (a,) in atoms_by_name(atoms, "hole", 1)]
-        text = re.sub(r"%.*", "", path.read_text(encoding="utf-8"))
+        text = re.sub(r"%.*", "", read_text(path, "truth facts file", error=PlannerError))
 
         def mention(name: str) -> int:
             found = re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", text)

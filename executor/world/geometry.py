@@ -19,8 +19,9 @@ from pathlib import Path
 import numpy as np
 import pybullet_data
 
-from bridge.assembly import load_assembly
+from bridge.assembly import Assembly, load_assembly
 from bridge.files import make_folder, write_atomic
+from bridge.inputs import read_text, shorten
 from executor import ExecutorError
 
 
@@ -69,20 +70,58 @@ class CellGeometry:
 
 
 def _read_toml(path: Path) -> dict:
-    if not path.is_file():
-        raise ExecutorError(f"{path}: no such file (expected the assembly's {path.name})")
+    text = read_text(path, f"cell geometry file ({path.name}, TOML)", error=ExecutorError)
     try:
-        return tomllib.loads(path.read_text())
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
 
 
+_NUMBERS = {"plate": ("top_z", "tile_size", "tile_thickness", "chamfer", "polygon_sides", "base_thickness"),
+            "gripper": ("flange_mass", "flange_inertia", "flange_length", "grasp_depth")}
+_PAIRS = {"plate": ("base_size", "base_center")}
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _check_tables(path: Path, geo: dict) -> None:
+    """The [plate] and [gripper] keys the scene reads later: present, finite numbers
+    ([x, y] pairs for base_size, base_center); ExecutorError naming the key otherwise."""
+    for table in ("plate", "gripper"):
+        values = geo.get(table)
+        if not isinstance(values, dict):
+            raise ExecutorError(f"{path}: no [{table}] table; expected the tables of data/cranfield/geometry.toml")
+        for key in _NUMBERS[table]:
+            if not _is_number(values.get(key)):
+                raise ExecutorError(f"{path}: [{table}] {key}: expected a finite number, "
+                                    f"got {shorten(repr(values.get(key)))}")
+        for key in _PAIRS.get(table, ()):
+            value = values.get(key)
+            if not (isinstance(value, list) and len(value) == 2 and all(map(_is_number, value))):
+                raise ExecutorError(f"{path}: [{table}] {key}: expected [x, y] in m, got {shorten(repr(value))}")
+
+
 def load_geometry(assembly: str = "cranfield") -> CellGeometry:
     """Read ``assembly.toml`` (through :func:`bridge.assembly.load_assembly`) and
-    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path)."""
+    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path).
+    ExecutorError naming the file and key when a table or key is missing or malformed."""
     layout = load_assembly(assembly)
-    folder = layout.folder
-    geo = _read_toml(folder / "geometry.toml")
+    path = layout.folder / "geometry.toml"
+    geo = _read_toml(path)
+    _check_tables(path, geo)
+    try:
+        return _geometry(layout.folder, layout, geo)
+    except KeyError as exc:
+        raise ExecutorError(f"{path}: missing key {shorten(exc.args[0])!r} in a [hole_shapes.*], [part_shapes.*] "
+                            "or [extra_parts.*] table (see data/cranfield/geometry.toml)") from None
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise ExecutorError(f"{path}: a malformed table ({shorten(exc, 80)}); expected the tables of "
+                            "data/cranfield/geometry.toml") from None
+
+
+def _geometry(folder: Path, layout: Assembly, geo: dict) -> CellGeometry:
     positions = {hole.id: hole.position for hole in layout.holes}
     holes: dict[str, HoleSpec] = {}
     for shape in geo.get("hole_shapes", {}).values():

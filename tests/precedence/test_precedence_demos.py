@@ -66,8 +66,11 @@ def test_demo_facts_round_trip(tmp_path: Path) -> None:
 
 def test_demo_facts_with_a_gap_or_a_repeat_are_rejected(tmp_path: Path) -> None:
     path = tmp_path / "demos.lp"
-    path.write_text("demo(1,1,a). demo(1,3,b).\n")
+    path.write_text("part(a;b;c). demo(1,1,a). demo(1,3,b).\n")
     with pytest.raises(PlannerError, match=r"demonstration 1: no part at step 2"):
+        load_demos(path)
+    path.write_text("demo(1,1,a). demo(1,3,b).\n")  # two parts: no step 3
+    with pytest.raises(PlannerError, match=r"demo\(1,3,b\): the step must be an integer from 1 to 2"):
         load_demos(path)
     path.write_text("part(a;b). demo(1,1,a). demo(1,2,a).\n")
     with pytest.raises(PlannerError, match=r"demonstration 1: id 'a' is repeated"):
