@@ -59,7 +59,7 @@ setup
 export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
 # -P: the caller's folder is not put on sys.path (a folder named asp/ there cannot shadow ours).
 case "$cmd" in
-    test)      cd "$ROOT"; lint; exec "$PY" -m pytest "$@" ;;
+    test)      cd "$ROOT"; lint; exec "$PY" -m pytest -n 2 "$@" ;;  # two workers (xdist); -n 0: serially
     lint)      cd "$ROOT"; lint ;;
     executor)  exec "$PY" -P -m executor "$@" ;;
     bench)
