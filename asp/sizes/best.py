@@ -27,7 +27,6 @@ Two paths compute the same rule (a third, in clingo, is the tests' reference:
 
 from __future__ import annotations
 
-import itertools
 import random
 from collections.abc import Sequence
 from functools import lru_cache
@@ -41,6 +40,7 @@ from asp.sizes.biorders import (
     biorder_count,
     class_weights,
     consistent_index,
+    mask_bits,
     sample_biorders,
     weighted_bit_sums,
 )
@@ -146,23 +146,40 @@ def choose(knowledge: Knowledge, rng: random.Random) -> Pair:
     return knowledge.parts[bit // n], knowledge.holes[bit % n]
 
 
+def possible_relations(m: int, n: int, fit_mask: int, no_fit_mask: int) -> tuple[np.ndarray, np.ndarray]:
+    """The possible relations as a (k, m*n) boolean matrix (bit ``p*n + h``: p fits h) and
+    their prior weights: every consistent biorder on the exact path, the sample on the
+    sampled path (as :func:`split_weights`)."""
+    if biorder_count(m, n) <= EXACT_LIMIT:
+        keep = consistent_index(all_biorders(m, n), fit_mask, no_fit_mask)
+        return mask_bits(all_biorders(m, n)[keep], m * n), _prior_weights(m, n)[keep]
+    rng = np.random.default_rng([fit_mask, no_fit_mask, m, n])
+    sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
+    return sample.reshape(len(sample), m * n).astype(bool), prior_weights(class_weights(sample))
+
+
 def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]:
     """Unknown pairs not in ``pending`` (pairs out at other cells), best first to run
     beside them: by the weight of the lighter outcome summed over the outcome
     combinations of the pending pairs, i.e. the expected split once their results are
     known too (without pending pairs, the split :func:`choose` maximises); ties go to
-    the lowest index. Scores only; whether a pair is independent of the others is the
-    learner's check.
+    the lowest index. The possible relations are grouped by the outcomes they give the
+    pending pairs (one pass, however many pending pairs; on the sampled path one sample
+    serves every group). Scores only; whether a pair is independent of the others is
+    the learner's check.
     """
     m, n = len(knowledge.parts), len(knowledge.holes)
     index = {(p, h): i * n + j for i, p in enumerate(knowledge.parts) for j, h in enumerate(knowledge.holes)}
-    fit_mask, no_fit_mask = knowledge_masks(knowledge)
-    bits = [1 << index[pair] for pair in pending]
+    relations, weights = possible_relations(m, n, *knowledge_masks(knowledge))
+    groups = np.zeros(len(relations), dtype=np.int64)
+    if pending:
+        _, groups = np.unique(relations[:, [index[pair] for pair in pending]], axis=0, return_inverse=True)
+        groups = groups.reshape(-1)
     score = np.zeros(m * n)
-    for outcomes in itertools.product((True, False), repeat=len(bits)):
-        fits = sum(bit for bit, fit in zip(bits, outcomes) if fit)
-        fit_weight, total = split_weights(m, n, fit_mask | fits, no_fit_mask | (sum(bits) - fits))
-        score += np.minimum(fit_weight, total - fit_weight)
+    for group in range(int(groups.max(initial=0)) + 1):
+        chosen = groups == group
+        fit_weight = weights[chosen] @ relations[chosen]
+        score += np.minimum(fit_weight, weights[chosen].sum() - fit_weight)
     candidates = [pair for pair in knowledge.unknown if pair not in pending]
     return sorted(candidates, key=lambda pair: (-score[index[pair]], index[pair]))
 

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from asp.sizes.best import choose, choose_bit, knowledge_masks
+from asp.sizes.best import batch_rank, choose, choose_bit, knowledge_masks, split_weights
 from asp.sizes.biorders import all_biorders, consistent_index
 from asp.sizes.learner import SizeLearner
 from asp.sizes.policies import get_policy
@@ -67,3 +69,27 @@ def test_sampled_path_is_deterministic_and_picks_an_unknown_pair_at_20x20() -> N
     first = choose_bit.__wrapped__(m, n, fit, no_fit)
     assert first == choose_bit.__wrapped__(m, n, fit, no_fit)
     assert not ((fit | no_fit) >> first) & 1
+
+
+@settings(max_examples=20, deadline=None)
+@given(truth=biorder_truths(4), data=st.data())
+def test_batch_rank_is_the_lighter_outcome_summed_over_every_outcome_of_the_pending_pairs(
+    truth: np.ndarray, data: st.DataObject
+) -> None:
+    """The grouped one-pass ranking equals the sum over all 2^k outcome combinations of the
+    k pending pairs, each split computed on its own (the definition)."""
+    m, n = truth.shape
+    observed = data.draw(st.lists(st.integers(0, m * n - 1), max_size=m * n // 3))
+    knowledge = closure_after(truth, observed).knowledge
+    unknown = knowledge.unknown
+    pending = data.draw(st.lists(st.sampled_from(unknown), unique=True, max_size=3)) if unknown else []
+    index = {(p, h): i * n + j for i, p in enumerate(knowledge.parts) for j, h in enumerate(knowledge.holes)}
+    fit_mask, no_fit_mask = knowledge_masks(knowledge)
+    bits = [1 << index[pair] for pair in pending]
+    score = np.zeros(m * n)
+    for outcomes in itertools.product((True, False), repeat=len(bits)):
+        fits = sum(bit for bit, fit in zip(bits, outcomes) if fit)
+        fit_weight, total = split_weights(m, n, fit_mask | fits, no_fit_mask | (sum(bits) - fits))
+        score += np.minimum(fit_weight, total - fit_weight)
+    expected = sorted((pair for pair in unknown if pair not in pending), key=lambda p: (-score[index[p]], index[p]))
+    assert batch_rank(knowledge, pending) == expected
