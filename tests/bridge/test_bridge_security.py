@@ -3,7 +3,8 @@
 
 Real processes: an ``executor serve`` cell and this test's planner-side Zenoh session.
 A planner with a certificate signed by the CA is served; a peer without a certificate
-cannot join; a cell without the credentials cannot show itself to the planner.
+cannot join; a cell without the credentials cannot show itself to the planner, nor can a
+user with credentials whom the access-control rules do not allow.
 """
 
 from __future__ import annotations
@@ -130,6 +131,45 @@ def test_a_cell_without_the_credentials_cannot_show_itself_to_the_planner(
                                 zenoh_config=userpwd_config(tmp_path, "rogue", "", user=None)))
         directory.wait_for(1, timeout=20)
         assert request_insert(session, "c1", InsertRequest(id="auth1", part="p1", hole="r1"), 10).result == "fit"
+        with pytest.raises(CellTimeout):
+            directory.wait_for(2, timeout=4)
+        assert directory.alive() == {"c1"}
+    finally:
+        directory.close()
+        session.close()
+
+
+def test_access_control_lets_only_authorised_users_serve_cells(tmp_path: Path, cells: list[CellProcess]) -> None:
+    """Both users know a password; only ``cell`` may declare ``cell/**`` (the docs' rules)."""
+    endpoint = free_loopback_endpoint()
+    (tmp_path / "users.txt").write_text("cell:s3cret\nvisitor:s3cret\n")
+    rules = ('access_control: { enabled: true, default_permission: "deny", rules: [{ id: "cells", '
+             'permission: "allow", flows: ["ingress", "egress"], key_exprs: ["cell/**"], messages: ["query", '
+             '"reply", "declare_queryable", "liveliness_token", "declare_subscriber", "liveliness_query", '
+             '"declare_liveliness_subscriber"] }], subjects: [{ id: "cell-users", usernames: ["cell"] }], '
+             'policies: [{ rules: ["cells"], subjects: ["cell-users"] }] },')
+
+    def config(name: str, user: str, listen: str = "") -> Path:
+        path = tmp_path / f"{name}.json5"
+        path.write_text(f"""{{
+  mode: "peer",
+  scouting: {{ multicast: {{ enabled: false }} }},
+  listen: {{ endpoints: [{f'"{listen}"' if listen else ""}] }},
+  transport: {{ auth: {{ usrpwd: {{ user: "{user}", password: "s3cret",
+                                 dictionary_file: "{tmp_path}/users.txt" }} }} }},
+  {rules if listen else ""}
+}}
+""")
+        return path
+
+    session = open_session(config_file=config("planner", "cell", listen=endpoint))
+    directory = CellDirectory(session)
+    try:
+        cells.append(start_cell("c1", backend="truth", connect=[endpoint], zenoh_config=config("cell", "cell")))
+        cells.append(start_cell("visitor", backend="truth", connect=[endpoint],
+                                zenoh_config=config("visitor", "visitor")))
+        directory.wait_for(1, timeout=20)
+        assert request_insert(session, "c1", InsertRequest(id="acl1", part="p1", hole="r1"), 10).result == "fit"
         with pytest.raises(CellTimeout):
             directory.wait_for(2, timeout=4)
         assert directory.alive() == {"c1"}
