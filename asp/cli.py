@@ -28,20 +28,9 @@ def run_guarded(main, argv: list[str]) -> int:
     quietly with exit code 141 (:func:`bridge.cli_types.quiet_broken_pipe`)."""
     from asp import PlannerError
     from bridge import BridgeError
-    from bridge.cli_types import one_line, quiet_broken_pipe
+    from bridge.cli_types import run_command
 
-    try:
-        code = int(main(argv) or 0)
-        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
-        return code
-    except BrokenPipeError:
-        return quiet_broken_pipe()
-    except (PlannerError, BridgeError) as exc:
-        print(f"error: {one_line(exc)}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+    return run_command(lambda: int(main(argv) or 0), (PlannerError, BridgeError))
 
 
 def main(argv: list[str] | None = None) -> int:

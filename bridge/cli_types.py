@@ -57,6 +57,24 @@ def quiet_broken_pipe() -> int:
     return EXIT_BROKEN_PIPE
 
 
+def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...]) -> int:
+    """Run a command line's work and return its exit code: ``errors`` (bad input) become one
+    line ``error: ...`` on stderr and exit 2; a closed stdout (``... | head -1``) stops
+    quietly with :data:`EXIT_BROKEN_PIPE`; Ctrl-C exits 130."""
+    try:
+        code = command()
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
+        return code
+    except BrokenPipeError:
+        return quiet_broken_pipe()
+    except errors as exc:
+        print(f"error: {one_line(exc)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
 def int_in(low: int, high: int = sys.maxsize) -> Callable[[str], int]:
     """An argparse type: an integer in [low, high] (``high`` default: no practical bound)."""
     expected = f"an integer >= {low}" if high == sys.maxsize else f"an integer from {low} to {high}"

@@ -21,9 +21,12 @@ import io
 import os
 import tempfile
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING
 
 from bridge import BridgeError
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 def _current_umask() -> int:
@@ -85,19 +88,20 @@ def write_atomic(path: Path | str, data: bytes | str) -> Path:
     return path
 
 
-class Figure(Protocol):
-    """What :func:`write_figure` needs of a matplotlib figure."""
-
-    def savefig(self, fname: io.BytesIO, *, format: str, dpi: float) -> None: ...
-
-
 def write_figure(path: Path | str, figure: Figure, dpi: float = 120) -> Path:
-    """Render ``figure`` in memory in the format of the file name's suffix (default PNG)
-    at ``dpi`` [dots per inch], then :func:`write_atomic` it; returns the path."""
+    """Lay out ``figure`` (``tight_layout``), render it in memory in the format of the file
+    name's suffix (default PNG) at ``dpi`` [dots per inch], :func:`write_atomic` it and
+    close the figure, also when writing fails; returns the path."""
+    import matplotlib.pyplot as plt
+
     path = Path(path)
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format=path.suffix.lstrip(".").lower() or "png", dpi=dpi)
-    return write_atomic(path, buffer.getvalue())
+    try:
+        figure.tight_layout()
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format=path.suffix.lstrip(".").lower() or "png", dpi=dpi)
+        return write_atomic(path, buffer.getvalue())
+    finally:
+        plt.close(figure)
 
 
 def check_writable(path: Path | str) -> Path:

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 
 from bridge import BridgeError
-from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, one_line, quiet_broken_pipe
+from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, run_command
 from executor import ExecutorError
 
 MAX_TRIALS = 100_000
@@ -122,22 +122,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one subcommand; ExecutorError → one line ``error: ...`` on stderr and exit code 2;
     a closed stdout (``... | head -1``) stops quietly with exit code 141."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    try:
+
+    def dispatch() -> int:
         if argv and argv[0] in _DELEGATED:
             import importlib
 
             module, _help = _DELEGATED[argv[0]]
-            code = int(importlib.import_module(module).main(argv[1:]) or 0)
-        else:
-            args = build_parser().parse_args(argv)
-            code = int(args.func(args) or 0)
-        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
-        return code
-    except BrokenPipeError:
-        return quiet_broken_pipe()
-    except (ExecutorError, BridgeError) as exc:
-        print(f"error: {one_line(exc)}", file=sys.stderr)
-        return 2
+            return int(importlib.import_module(module).main(argv[1:]) or 0)
+        args = build_parser().parse_args(argv)
+        return int(args.func(args) or 0)
+
+    return run_command(dispatch, (ExecutorError, BridgeError))
 
 
 if __name__ == "__main__":

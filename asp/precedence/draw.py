@@ -78,8 +78,4 @@ def draw_png(relation: Relation, reduction: list[Pair], path: Path | str, title:
     nx.draw_networkx_labels(graph, position, ax=axis, font_size=9)
     axis.set_title(title)
     axis.set_axis_off()
-    figure.tight_layout()
-    try:
-        write_figure(path, figure, dpi=120)
-    finally:
-        plt.close(figure)
+    write_figure(path, figure, dpi=120)

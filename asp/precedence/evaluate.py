@@ -86,8 +86,4 @@ def plot(evaluation: dict, path: Path | str) -> None:
         axis.set_xlabel(f"M/100 (bins of {BIN}; total {evaluation['total']})")
         axis.set_ylabel("probability")
         axis.legend()
-    figure.tight_layout()
-    try:
-        write_figure(path, figure, dpi=120)
-    finally:
-        plt.close(figure)
+    write_figure(path, figure, dpi=120)

@@ -265,8 +265,4 @@ def plot_comparison(evaluations: Sequence[Evaluation], path: str) -> None:
     ax.set_xticks(xs)
     ax.set_title(f"Experiments needed over {evaluations[0].cases} relabelings")
     ax.legend()
-    fig.tight_layout()
-    try:
-        write_figure(path, fig, dpi=120)
-    finally:
-        plt.close(fig)
+    write_figure(path, fig, dpi=120)

@@ -77,11 +77,7 @@ def plot_fig17(success: AttemptTrace, failure: AttemptTrace, path: Path) -> Path
     axes[0].legend(loc="best", fontsize=8)
     axes[-1].set_xlabel("DMP phase")
     fig.suptitle("Measured vs desired force over the DMP phase (paper Fig. 17)")
-    fig.tight_layout()
-    try:
-        return write_figure(path, fig, dpi=120)
-    finally:
-        plt.close(fig)
+    return write_figure(path, fig, dpi=120)
 
 
 def plot_fig18(stats: Sequence[PairStats], path: Path) -> Path:
@@ -105,11 +101,7 @@ def plot_fig18(stats: Sequence[PairStats], path: Path) -> Path:
     table.set_fontsize(9)
     table.scale(1, 1.3)
     ax.set_title("Success ratio of insertions (paper Fig. 18; non-fitting pairs added)")
-    fig.tight_layout()
-    try:
-        return write_figure(path, fig, dpi=120)
-    finally:
-        plt.close(fig)
+    return write_figure(path, fig, dpi=120)
 
 
 def write_plots(folder: Path, stats: Sequence[PairStats], assembly: str, seed: int) -> list[Path]:
