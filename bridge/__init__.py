@@ -1,6 +1,6 @@
 """What the planner and the cells share: Zenoh messaging, the assembly folder, the Rerun layout.
 
-- :mod:`bridge.keys`: every key expression (``cell/<id>/insert``, ``cell/<id>/alive``);
+- :mod:`bridge.keys`: every key expression (``cell/<id>/insert``, ``cell/<id>/alive/<instance>``);
 - :mod:`bridge.messages`: typed, versioned JSON messages, validated on receipt;
 - :mod:`bridge.session`: opening Zenoh sessions (peer mode on loopback by default);
 - :mod:`bridge.client`: requests with id, timeout and failover; cell discovery;

@@ -51,24 +51,35 @@ Outcome = InsertReply | BridgeError
 class CellDirectory:
     """The set of alive cells, kept from liveliness tokens; listeners hear every change.
 
-    A listener ``(cell_id, alive)`` is called from a Zenoh thread; keep it short.
+    Each cell process holds a token with its own instance name, so two processes claiming
+    one cell id show as two tokens: such an id is *duplicated* and not alive (nothing is
+    sent to it) until only one of them is left. A listener ``(cell_id, alive)`` is called
+    from a Zenoh thread; keep it short.
     """
 
     def __init__(self, session: zenoh.Session) -> None:
         self._lock = threading.Condition()
+        self._instances: dict[str, set[str]] = {}
         self._alive: set[str] = set()
+        self.duplicated: set[str] = set()
+        """Cell ids claimed by more than one process at some time (never cleared)."""
         self._listeners: list[Callable[[str, bool], None]] = []
         self._subscriber = session.liveliness().declare_subscriber(
             ALIVE_PATTERN, self._on_sample, history=True)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
-        cell = cell_of_alive_key(str(sample.key_expr))
-        if cell is None:
+        parsed = cell_of_alive_key(str(sample.key_expr))
+        if parsed is None:
             return
-        alive = sample.kind == zenoh.SampleKind.PUT
+        cell, instance = parsed
         with self._lock:
+            instances = self._instances.setdefault(cell, set())
+            (instances.add if sample.kind == zenoh.SampleKind.PUT else instances.discard)(instance)
+            if len(instances) > 1:
+                self.duplicated.add(cell)
+            alive, was_alive = len(instances) == 1, cell in self._alive
             (self._alive.add if alive else self._alive.discard)(cell)
-            listeners = list(self._listeners)
+            listeners = list(self._listeners) if alive != was_alive else []
             self._lock.notify_all()
         for listener in listeners:
             listener(cell, alive)

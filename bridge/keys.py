@@ -1,8 +1,10 @@
 """Every Zenoh key expression of the project, in one place.
 
 A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert`` and holds the
-liveliness token ``cell/<id>/alive`` while it is up; ``cell/<id>/ping`` echoes its payload.
-The planner discovers cells by subscribing to ``cell/*/alive``.
+liveliness token ``cell/<id>/alive/<instance>`` while it is up (``<instance>``: a random
+name of the process, so two processes claiming one id show as two tokens);
+``cell/<id>/ping`` echoes its payload. The planner discovers cells by subscribing to
+``cell/*/alive/*``.
 """
 
 from __future__ import annotations
@@ -14,11 +16,11 @@ from bridge import BridgeError
 CELL_ID_PATTERN = r"^[a-z][a-z0-9_-]{0,31}$"
 """A cell id: lower-case letter, then up to 31 of ``[a-z0-9_-]`` (one key chunk)."""
 
-ALIVE_PATTERN = "cell/*/alive"
+ALIVE_PATTERN = "cell/*/alive/*"
 """Liveliness key expression matching every cell's token."""
 
 _CELL_ID = re.compile(CELL_ID_PATTERN)
-_ALIVE_KEY = re.compile(r"^cell/([^/]+)/alive$")
+_ALIVE_KEY = re.compile(r"^cell/([^/]+)/alive/([A-Za-z0-9_-]{1,64})$")
 
 
 def check_cell_id(cell_id: str) -> str:
@@ -35,9 +37,9 @@ def insert_key(cell_id: str) -> str:
     return f"cell/{check_cell_id(cell_id)}/insert"
 
 
-def alive_key(cell_id: str) -> str:
-    """Liveliness token key held by cell ``cell_id`` while it serves."""
-    return f"cell/{check_cell_id(cell_id)}/alive"
+def alive_key(cell_id: str, instance: str = "0") -> str:
+    """Liveliness token key held by the process ``instance`` of cell ``cell_id`` while it serves."""
+    return f"cell/{check_cell_id(cell_id)}/alive/{instance}"
 
 
 def ping_key(cell_id: str) -> str:
@@ -46,9 +48,9 @@ def ping_key(cell_id: str) -> str:
     return f"cell/{check_cell_id(cell_id)}/ping"
 
 
-def cell_of_alive_key(key: str) -> str | None:
-    """The cell id of a liveliness key ``cell/<id>/alive``; None for any other key."""
+def cell_of_alive_key(key: str) -> tuple[str, str] | None:
+    """(cell id, instance) of a liveliness key ``cell/<id>/alive/<instance>``; None for any other key."""
     match = _ALIVE_KEY.match(key)
     if match is None or not _CELL_ID.match(match.group(1)):
         return None
-    return match.group(1)
+    return match.group(1), match.group(2)

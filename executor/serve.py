@@ -1,7 +1,7 @@
 """``./run.sh executor serve``: a cell node serving insertion experiments over Zenoh.
 
 The node declares the queryable ``cell/<id>/insert`` and the liveliness token
-``cell/<id>/alive`` (and ``cell/<id>/ping``, which echoes its payload unread), then
+``cell/<id>/alive/<instance>`` (and ``cell/<id>/ping``, which echoes its payload unread), then
 serves until SIGTERM/SIGINT (or, with ``--lifeline``, until its stdin closes: the
 supervising session died), then closes the Zenoh session cleanly.
 
@@ -26,6 +26,7 @@ import queue
 import signal
 import threading
 import time
+import uuid
 from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -325,7 +326,7 @@ def main(argv: Sequence[str]) -> int:
     try:
         _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
                      session.declare_queryable(ping_key(cell_id), _echo),
-                     session.liveliness().declare_token(alive_key(cell_id)))
+                     session.liveliness().declare_token(alive_key(cell_id, uuid.uuid4().hex[:12])))
         if args.lifeline:
             threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
         print(f"ready cell {cell_id} backend {args.backend} "

@@ -259,3 +259,17 @@ def test_a_token_with_nothing_behind_it_is_dropped_and_others_are_not_trusted(ne
         del tokens
     finally:
         rogue.close()
+
+
+def test_two_processes_claiming_one_cell_id_are_not_used_until_one_is_gone(network) -> None:
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    directory.wait_for(1, timeout=20)
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    deadline = time.monotonic() + 20
+    while "c1" in directory.alive() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert directory.alive() == set() and directory.duplicated == {"c1"}
+    cells[0].kill()
+    directory.wait_for(1, timeout=20)  # one claimant left: usable again
+    assert request_insert(session, "c1", InsertRequest(id="d1", part="sh", hole="br"), 10).result == "fit"

@@ -64,7 +64,8 @@ def test_encode_refuses_oversized_messages() -> None:
 
 def test_keys() -> None:
     assert insert_key("c1") == "cell/c1/insert"
-    assert cell_of_alive_key(alive_key("cell-2")) == "cell-2"
+    assert cell_of_alive_key(alive_key("cell-2", "a1")) == ("cell-2", "a1")
+    assert cell_of_alive_key("cell/c1/alive") is None
     assert cell_of_alive_key("cell/c1/insert") is None
     with pytest.raises(BridgeError, match="cell id"):
         insert_key("C/1")
