@@ -37,6 +37,8 @@ from typing import Protocol
 
 import pytest
 
+from asp.session.cells import CellProcess
+
 ROOT = Path(__file__).resolve().parent.parent
 CLI_MODULE = "asp.cli"  # ./run.sh SUBCOMMAND
 EXECUTOR_MODULE = "executor"  # ./run.sh executor SUBCOMMAND
@@ -117,3 +119,14 @@ def run_session(run_cli: Runner) -> Callable[..., dict]:
 @pytest.fixture(scope="session")
 def cli_argv() -> Callable[..., list[str]]:
     return functools.partial(python_argv, CLI_MODULE)
+
+
+@pytest.fixture
+def cells() -> Iterator[list[CellProcess]]:
+    """Cell processes a test starts (append them); each is killed when the test ends."""
+    started: list[CellProcess] = []
+    try:
+        yield started
+    finally:
+        for cell in started:
+            cell.kill()

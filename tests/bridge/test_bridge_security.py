@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import datetime
 import ipaddress
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -75,9 +74,19 @@ def tls_config(folder: Path, side: str, endpoint: str, certificate: bool = True)
     return path
 
 
-def userpwd_config(folder: Path, name: str, listen: str, user: str | None) -> Path:
-    """A JSON5 Zenoh config with user/password authentication (and the users' dictionary)."""
-    (folder / "users.txt").write_text("cell:s3cret\n")
+ACCESS_RULES = (
+    'access_control: { enabled: true, default_permission: "deny", rules: [{ id: "cells", '
+    'permission: "allow", flows: ["ingress", "egress"], key_exprs: ["cell/**"], messages: ["query", '
+    '"reply", "declare_queryable", "liveliness_token", "declare_subscriber", "liveliness_query", '
+    '"declare_liveliness_subscriber"] }], subjects: [{ id: "cell-users", usernames: ["cell"] }], '
+    'policies: [{ rules: ["cells"], subjects: ["cell-users"] }] },')
+"""The access-control rules of docs/session.md: only user ``cell`` may use ``cell/**``."""
+
+
+def userpwd_config(folder: Path, name: str, listen: str, user: str | None, rules: str = "") -> Path:
+    """A JSON5 Zenoh config with user/password authentication against ``users.txt`` (users
+    ``cell`` and ``visitor``), and optional access-control ``rules``."""
+    (folder / "users.txt").write_text("cell:s3cret\nvisitor:s3cret\n")
     auth = f'user: "{user}", password: "s3cret", ' if user else ""
     path = folder / f"{name}.json5"
     path.write_text(f"""{{
@@ -85,17 +94,12 @@ def userpwd_config(folder: Path, name: str, listen: str, user: str | None) -> Pa
   scouting: {{ multicast: {{ enabled: false }} }},
   listen: {{ endpoints: [{f'"{listen}"' if listen else ""}] }},
   transport: {{ auth: {{ usrpwd: {{ {auth}dictionary_file: "{folder}/users.txt" }} }} }},
+  {rules}
 }}
 """)
     return path
 
 
-@pytest.fixture
-def cells() -> Iterator[list[CellProcess]]:
-    started: list[CellProcess] = []
-    yield started
-    for cell in started:
-        cell.kill()
 
 
 def test_mutual_tls_serves_a_certified_planner_and_keeps_out_a_peer_without_certificate(
@@ -142,32 +146,13 @@ def test_a_cell_without_the_credentials_cannot_show_itself_to_the_planner(
 def test_access_control_lets_only_authorised_users_serve_cells(tmp_path: Path, cells: list[CellProcess]) -> None:
     """Both users know a password; only ``cell`` may declare ``cell/**`` (the docs' rules)."""
     endpoint = free_loopback_endpoint()
-    (tmp_path / "users.txt").write_text("cell:s3cret\nvisitor:s3cret\n")
-    rules = ('access_control: { enabled: true, default_permission: "deny", rules: [{ id: "cells", '
-             'permission: "allow", flows: ["ingress", "egress"], key_exprs: ["cell/**"], messages: ["query", '
-             '"reply", "declare_queryable", "liveliness_token", "declare_subscriber", "liveliness_query", '
-             '"declare_liveliness_subscriber"] }], subjects: [{ id: "cell-users", usernames: ["cell"] }], '
-             'policies: [{ rules: ["cells"], subjects: ["cell-users"] }] },')
-
-    def config(name: str, user: str, listen: str = "") -> Path:
-        path = tmp_path / f"{name}.json5"
-        path.write_text(f"""{{
-  mode: "peer",
-  scouting: {{ multicast: {{ enabled: false }} }},
-  listen: {{ endpoints: [{f'"{listen}"' if listen else ""}] }},
-  transport: {{ auth: {{ usrpwd: {{ user: "{user}", password: "s3cret",
-                                 dictionary_file: "{tmp_path}/users.txt" }} }} }},
-  {rules if listen else ""}
-}}
-""")
-        return path
-
-    session = open_session(config_file=config("planner", "cell", listen=endpoint))
+    session = open_session(config_file=userpwd_config(tmp_path, "planner", endpoint, "cell", ACCESS_RULES))
     directory = CellDirectory(session)
     try:
-        cells.append(start_cell("c1", backend="truth", connect=[endpoint], zenoh_config=config("cell", "cell")))
+        cells.append(start_cell("c1", backend="truth", connect=[endpoint],
+                                zenoh_config=userpwd_config(tmp_path, "cell", "", "cell")))
         cells.append(start_cell("visitor", backend="truth", connect=[endpoint],
-                                zenoh_config=config("visitor", "visitor")))
+                                zenoh_config=userpwd_config(tmp_path, "visitor", "", "visitor")))
         directory.wait_for(1, timeout=20)
         assert request_insert(session, "c1", InsertRequest(id="acl1", part="p1", hole="r1"), 10).result == "fit"
         with pytest.raises(CellTimeout):

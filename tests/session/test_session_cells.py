@@ -14,7 +14,6 @@ import signal
 import subprocess
 import time
 from collections import Counter
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -30,14 +29,6 @@ pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over 
 TRUTH = TruthOracle.from_assembly("cranfield")
 
 
-@pytest.fixture
-def cells() -> Iterator[list[CellProcess]]:
-    started: list[CellProcess] = []
-    try:
-        yield started
-    finally:
-        for cell in started:
-            cell.kill()
 
 
 def assert_learned_truth(result: dict, run: Path) -> None:

@@ -11,7 +11,6 @@ import shutil
 import signal
 import subprocess
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -25,14 +24,6 @@ from tests.session.test_session_cells import assert_learned_truth
 pytestmark = pytest.mark.timeout(90)
 
 
-@pytest.fixture
-def cells() -> Iterator[list[CellProcess]]:
-    started: list[CellProcess] = []
-    try:
-        yield started
-    finally:
-        for cell in started:
-            cell.kill()
 
 
 def lock_is_free(run: Path) -> bool:
