@@ -317,7 +317,11 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
         timings = {"cells_ready_s": time.perf_counter() - started}
-        sizes = _learn_sizes(oracle, learner, journal, log)
+        try:
+            sizes = _learn_sizes(oracle, learner, journal, log)
+        finally:
+            for incident in pool.incidents:  # timeouts, conflicting replies, dropped cells
+                print(f"warning: {incident}", file=sys.stderr)
         timings["learned_s"] = time.perf_counter() - started
         learned = run / "learned.lp"
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
