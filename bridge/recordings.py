@@ -109,6 +109,12 @@ def _chunks(path: Path) -> Iterator[Chunk]:
             yield from reader.stream(store=store)
 
 
+def chunk_count(path: Path | str) -> int:
+    """How many chunks the recording stores of ``path`` hold (blueprints excluded): what
+    compaction (:mod:`bridge.recording_compaction`) brings down."""
+    return sum(1 for _ in _chunks(Path(path)))
+
+
 def read_recording(paths: Path | str | Sequence[Path | str]) -> RecordingSummary:
     """Summarise ``.rrd`` files: entity paths with row counts, components, timelines."""
     files = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]

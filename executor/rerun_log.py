@@ -45,6 +45,7 @@ import rerun as rr
 
 from bridge import BridgeError
 from bridge.files import check_writable
+from bridge.recording_compaction import compact_recording
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, cell_root
 from executor import ExecutorError
 
@@ -175,6 +176,7 @@ class AttemptLogger:
         self.keep_traces = keep_traces
         self.traces: list[AttemptTrace] = []
         self._owns_stream = recording is None
+        self._rrd_path = Path(rrd_path) if rrd_path is not None else None
         if recording is None:
             recording = rr.RecordingStream(
                 application_id, recording_id=recording_id or str(uuid.uuid4())
@@ -316,10 +318,13 @@ class AttemptLogger:
         return trace
 
     def close(self) -> None:
-        """Flush; disconnect the stream if this logger created it (finishes the file)."""
+        """Flush; if this logger created the stream, disconnect it (finishes the file) and
+        compact the file it wrote."""
         self.rec.flush()
         if self._owns_stream:
             self.rec.disconnect()
+            if self._rrd_path is not None:
+                compact_recording(self._rrd_path)
 
     # -- internals -----------------------------------------------------------------
 

@@ -28,6 +28,7 @@ import rerun as rr
 
 from asp.precedence.relation import Relation, reduction
 from asp.sizes.knowledge import Knowledge
+from bridge.recording_compaction import compact_recording
 from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
 
 _PART_COLOR = [70, 130, 220]
@@ -38,6 +39,7 @@ class PlannerLog:
     """Logs the planner's entities into ``rrd`` under ``recording_id``."""
 
     def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str]) -> None:
+        self.rrd = rrd
         self.rec = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
         self.rec.save(str(rrd))
         self.rec.send_blueprint(cell_blueprint(cell_ids, extra=[planner_views()]))
@@ -75,4 +77,7 @@ class PlannerLog:
                      static=True)
 
     def close(self) -> None:
+        """Finish the file and compact it."""
         self.rec.flush()
+        self.rec.disconnect()
+        compact_recording(self.rrd)
