@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import logging
 import os
+import stat
 import subprocess
 import sys
 import tempfile
@@ -46,6 +47,7 @@ def compact_recording(rrd_path: Path) -> bool:
             return False
         with tmp.open("rb") as handle:
             os.fsync(handle.fileno())
+        tmp.chmod(stat.S_IMODE(rrd_path.stat().st_mode))
         os.replace(tmp, rrd_path)
         return True
     except (OSError, subprocess.TimeoutExpired) as exc:

@@ -51,6 +51,7 @@ from executor import ExecutorError
 
 if TYPE_CHECKING:
     from executor.evidence import AttemptEvidence
+    from executor.rerun_arm import ArmRecorder
 
 PHASE_SCALE = 1000
 """The ``dmp_phase`` timeline holds round(phase × PHASE_SCALE)."""
@@ -100,12 +101,17 @@ class AttemptTrace:
     force_des: list[np.ndarray] = field(default_factory=list)
     torque_mes: list[np.ndarray] = field(default_factory=list)
     torque_des: list[np.ndarray] = field(default_factory=list)
+    arm_poses: list[np.ndarray] = field(default_factory=list)
 
     def add(
         self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
         force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray,
+        arm_pose: np.ndarray | None = None,
     ) -> None:
-        """Append one step (units as in the class docstring)."""
+        """Append one step (units as in the class docstring; ``arm_pose``: the arm's link
+        poses, see :meth:`executor.rerun_arm.ArmRecorder.sample`)."""
+        if arm_pose is not None:
+            self.arm_poses.append(arm_pose)
         self.sim_time.append(float(sim_time))
         self.phase.append(float(phase))
         for name, value in (
@@ -194,6 +200,9 @@ class AttemptLogger:
         self._last_time = 0.0  # [s] last logged (offset) sim time
         self._sent_steps = False
         self._skipped: tuple[Any, ...] | None = None  # last step not kept (yet)
+        self._arm: ArmRecorder | None = None
+        self._arm_static_sent = False
+        self._held: str | None = None
         if send_blueprint:
             self.rec.send_blueprint(cell_blueprint([cell_id]))
 
@@ -231,6 +240,15 @@ class AttemptLogger:
                     f"got {shape.shape!r}"
                 )
             self.rec.log(f"{self.root}/scene/{shape.name}", archetype, static=True)
+
+    def attach_arm(self, arm: ArmRecorder, held_part: str) -> None:
+        """From now on log ``arm``'s links at every kept step; log its geometry (the meshes
+        once per recording, the held part whenever it changes)."""
+        if arm is self._arm and held_part == self._held:
+            return
+        self._set_time(self._last_time)
+        arm.log_geometry(self.rec, self.root, held_part, with_static=not self._arm_static_sent)
+        self._arm, self._held, self._arm_static_sent = arm, held_part, True
 
     # -- one attempt ---------------------------------------------------------------------
 
@@ -273,7 +291,8 @@ class AttemptLogger:
         attempt's final step, which ``end_attempt`` keeps.
         """
         trace = self._require_attempt("log_step")
-        step = (sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des)
+        arm_pose = None if self._arm is None else self._arm.sample()
+        step = (sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des, arm_pose)
         if trace.sim_time:
             if sim_time - trace.sim_time[-1] < self.period_s - _TIME_TOLERANCE:
                 self._skipped = step
@@ -357,6 +376,8 @@ class AttemptLogger:
             f"{self.root}/phase", indexes=timed,
             columns=rr.Scalars.columns(scalars=trace.array("phase")),
         )
+        if self._arm is not None and len(trace.arm_poses) == count:
+            self._arm.send(self.rec, self.root, timed, np.stack(trace.arm_poses))
         self.rec.send_columns(
             f"{self.root}/tool/tip", indexes=timed,
             columns=rr.Points3D.columns(positions=trace.array("tool_pos")).partition([1] * count),

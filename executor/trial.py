@@ -24,6 +24,7 @@ from executor.control.controller import ImpedanceController
 from executor.control.detector import Detector, Thresholds
 from executor.control.motion import Motion
 from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
+from executor.rerun_arm import ArmRecorder
 from executor.skills.dmp import Skill, load_skill
 from executor.skills.insertion import insert, rotvec_quat_xyzw
 from executor.skills.search import hole_search
@@ -58,6 +59,7 @@ class Cell:
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
+        self._arms: dict[str, ArmRecorder] = {}  # for the Rerun log, one per part shape
         self._motion: Motion | None = None
         self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
@@ -86,6 +88,10 @@ class Cell:
             arm = Arm(scene.client, scene.robot)
             self._motions[spec.shape] = Motion(ImpedanceController(arm, scene.client), self.logger)
         scene.hold(spec)
+        if self.logger is not None:
+            if spec.shape not in self._arms:
+                self._arms[spec.shape] = ArmRecorder(scene.client, scene.robot)
+            self.logger.attach_arm(self._arms[spec.shape], part)
         motion = self._motions[spec.shape]
         if self._motion is not None and motion is not self._motion:
             motion.steps = self._motion.steps

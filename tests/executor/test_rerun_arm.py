@@ -1,0 +1,40 @@
+"""The arm in the cell's recording: every link's geometry, and link poses over sim_time
+that agree with the logged tool tip (the ``part`` link frame is the tool centre point)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bridge.recordings import column_values, read_recording
+from executor.rerun_log import AttemptLogger
+from executor.trial import Cell
+
+KUKA_LINKS = [f"lbr_iiwa_link_{k}" for k in range(1, 8)]
+
+
+@pytest.mark.slow
+def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) -> None:
+    rrd = tmp_path / "c1.rrd"
+    logger = AttemptLogger.to_file(rrd, "c1")
+    cell = Cell(logger=logger)
+    try:
+        cell.run_trial("p1", "r1", seed=3, max_attempts=1)
+    finally:
+        cell.close()
+        logger.close()
+    entities = read_recording(rrd).entities
+    for link in ["base", *KUKA_LINKS]:
+        visual = next(e for path, e in entities.items() if path.startswith(f"/executor/c1/arm/{link}/visual_"))
+        assert "Asset3D:blob" in visual.components and visual.static_rows == visual.rows
+    for link in [*KUKA_LINKS, "flange", "part"]:
+        assert "sim_time" in entities[f"/executor/c1/arm/{link}"].timelines
+
+    tip = np.array(column_values(rrd, "executor/c1/tool/tip", "Points3D:positions")).reshape(-1, 3)
+    part = np.array(column_values(rrd, "executor/c1/arm/part", "Transform3D:translation")).reshape(-1, 3)
+    link_7 = np.array(column_values(rrd, "executor/c1/arm/lbr_iiwa_link_7", "Transform3D:translation"))
+    assert len(part) == len(tip) > 100
+    assert np.max(np.linalg.norm(part - tip, axis=1)) < 1e-3
+    assert np.ptp(link_7.reshape(-1, 3)[:, 2]) > 0.01  # the wrist moves during the attempt
