@@ -250,6 +250,11 @@ class AttemptLogger:
         arm.log_geometry(self.rec, self.root, held_part, with_static=not self._arm_static_sent)
         self._arm, self._held, self._arm_static_sent = arm, held_part, True
 
+    def log_scene_mesh(self, name: str, mesh: Path, color: Sequence[int]) -> None:
+        """Log a static mesh file (``.obj``/``.stl``/``.glb``, world coordinates [m]) under
+        ``scene/<name>``, e.g. the plate's bosses with their holes."""
+        self.rec.log(f"{self.root}/scene/{name}", rr.Asset3D(path=mesh, albedo_factor=list(color)), static=True)
+
     # -- one attempt ---------------------------------------------------------------------
 
     def begin_attempt(

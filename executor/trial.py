@@ -29,13 +29,14 @@ from executor.skills.dmp import Skill, load_skill
 from executor.skills.insertion import insert, rotvec_quat_xyzw
 from executor.skills.search import hole_search
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
-from executor.world.geometry import load_geometry
+from executor.world.geometry import load_geometry, plate_mesh
 from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
 if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
+PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
 SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
 
 
@@ -64,6 +65,7 @@ class Cell:
         self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
+            logger.log_scene_mesh("plate_mesh", plate_mesh(self.geometry), PLATE_MESH_COLOR)
 
     def check_pair(self, part: str, hole: str) -> Skill:
         """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""

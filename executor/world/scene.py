@@ -16,7 +16,7 @@ import pybullet as pb
 import pybullet_data
 
 from executor import ExecutorError
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, write_assets
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, plate_mesh
 
 TIME_STEP = 0.001  # [s]
 # Parked parts (the one in the hand) wait here, out of the way [m].
@@ -50,9 +50,7 @@ class Scene:
         pb.setTimeStep(TIME_STEP, physicsClientId=self.client)
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=self.client)
-        plate_obj = geometry.assets / "plate.obj"
-        if not plate_obj.is_file():
-            write_assets(geometry)
+        plate_obj = plate_mesh(geometry)
         self.floor = pb.loadURDF("plane.urdf", physicsClientId=self.client)
         self.plate = self._load_plate(plate_obj)
         self.tray_parts = {

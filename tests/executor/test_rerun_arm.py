@@ -29,6 +29,7 @@ def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) ->
     for link in ["base", *KUKA_LINKS]:
         visual = next(e for path, e in entities.items() if path.startswith(f"/executor/c1/arm/{link}/visual_"))
         assert "Asset3D:blob" in visual.components and visual.static_rows == visual.rows
+    assert "Asset3D:blob" in entities["/executor/c1/scene/plate_mesh"].components
     for link in [*KUKA_LINKS, "flange", "part"]:
         assert "sim_time" in entities[f"/executor/c1/arm/{link}"].timelines
 
