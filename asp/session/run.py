@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import shutil
 import sys
 import time
 import uuid
@@ -94,11 +95,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock]:
-    """The run folder, locked for this session (:mod:`asp.session.folder`), and its
-    settings (read back when resuming). ``--out`` creates the folder and refuses one
-    that holds a session (journaled experiments or a finished run); a folder left by a
-    start that failed before any experiment was journaled may be used again."""
+def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock, bool]:
+    """The run folder, locked for this session (:mod:`asp.session.folder`), its settings
+    (read back when resuming) and whether this start created the folder. ``--out``
+    creates the folder and refuses one that holds a session (journaled experiments or a
+    finished run); a folder a failed start left (one that existed before) may be used again."""
     if args.resume is not None:
         path = args.resume / SETTINGS
         if not path.is_file():
@@ -110,10 +111,11 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock]:
             lock.release()
             raise
         settings["starts"] = int(settings.get("starts", 1)) + 1
-        return args.resume, settings, lock
+        return args.resume, settings, lock, False
     if args.confirm < 0:
         raise PlannerError(f"--confirm {args.confirm}: expected a number >= 0")
     run = args.out or Path("runs") / datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+    created = not run.exists()
     lock = lock_run_folder(make_folder(run))
     if _holds_session(run):
         lock.release()
@@ -121,7 +123,7 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock]:
                            f"use --resume {run} or another folder")
     settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed, "confirm": args.confirm,
                 "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running"}
-    return run, settings, lock
+    return run, settings, lock, created
 
 
 def _holds_session(run: Path) -> bool:
@@ -260,9 +262,13 @@ def run_session(args: argparse.Namespace) -> dict:
     started = time.perf_counter()
     if args.cells < 0:
         raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
-    run, settings, lock = _run_folder(args)
+    run, settings, lock, created = _run_folder(args)
     try:
         return _run_locked(args, run, settings, started)
+    except BaseException:
+        if created and not _holds_session(run):  # failed at start: no half-made run folder
+            shutil.rmtree(run, ignore_errors=True)
+        raise
     finally:
         lock.release()
 

@@ -126,16 +126,17 @@ def test_out_under_a_regular_file_is_one_line(tmp_path: Path, run_cli, parent: s
 
 
 @pytest.mark.slow
-def test_a_failed_start_blocks_nothing(tmp_path: Path, run_cli) -> None:
+def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, run_cli) -> None:
     run = tmp_path / "run"
     argv = (*TRUTH_SESSION, "--cells", "1", "--listen", "tcp/127.0.0.1:99999", "--out", str(run))
     failed = run_cli(*argv, timeout=30)
     assert failed.returncode == 2 and failed.stderr.startswith("error: cannot open a Zenoh session")
     assert failed.stderr.count("\n") == 1
-    assert lock_is_free(run)
-    again = run_cli(*argv, timeout=30)  # gets past the run folder: fails only for the endpoint again
+    assert not run.exists()  # the folder this start made is gone
+    run.mkdir()  # a folder the user made stays, and a failed start there blocks nothing
+    again = run_cli(*argv, timeout=30)
     assert again.returncode == 2 and again.stderr == failed.stderr
-    assert lock_is_free(run)
+    assert run.is_dir() and lock_is_free(run)
 
 
 @pytest.mark.slow
@@ -146,7 +147,7 @@ def test_a_normal_start_after_a_cell_died_at_start(tmp_path: Path, root: Path, r
     run = tmp_path / "run"
     failed = run_cli(*TRUTH_SESSION, "--assembly", str(broken), "--cells", "1", "--out", str(run), timeout=50)
     assert failed.returncode == 2 and "before printing line 'ready" in failed.stderr
-    assert lock_is_free(run)
+    assert not run.exists()
     result = run_session("--cells", "1", "--out", str(run))
     assert_learned_truth(result, run)
 
