@@ -141,7 +141,6 @@ def _evaluate(args: argparse.Namespace) -> None:
 
     if args.plot:
         check_writable(args.plot)  # before the evaluation, which may take minutes
-    progress = sys.stderr.isatty()
     truth = true_relation(load_assembly(args.assembly))
     if args.guided:
         from asp.precedence.guide import evaluate_guided
@@ -150,7 +149,7 @@ def _evaluate(args: argparse.Namespace) -> None:
             raise PlannerError("--generator applies to the evaluation over m, not to --guided "
                                "(its random baseline is uniform)")
 
-        result = evaluate_guided(truth, args.trials, args.seed, progress)
+        result = evaluate_guided(truth, args.trials, args.seed)
         if not args.json:
             print(f"{args.trials} trials: guided mean {result['mean']:.2f} demonstrations to the exact relation, "
                   f"random {result['random_mean']:.2f}")
@@ -158,7 +157,7 @@ def _evaluate(args: argparse.Namespace) -> None:
     else:
         from asp.precedence.evaluate import evaluate, plot
 
-        result = evaluate(truth, args.m, args.trials, args.seed, progress, args.generator)
+        result = evaluate(truth, args.m, args.trials, args.seed, args.generator)
         if args.plot:
             plot(result, args.plot)
         if not args.json:

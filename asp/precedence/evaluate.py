@@ -22,6 +22,7 @@ from asp.precedence.batches import GENERATORS, ExtensionBatches, positions_of
 from asp.precedence.learn import intersect_orders
 from asp.precedence.relation import Relation
 from bridge.files import write_figure
+from bridge.progress import progress
 
 BIN = 200  # width of a histogram bin [sequences], as in the paper
 PAPER_M = (5, 7, 10, 15, 20, 30)
@@ -37,10 +38,9 @@ def _histogram(admitted: np.ndarray, total: int) -> dict[str, float]:
 
 
 def evaluate(
-    truth: Relation, ms: Sequence[int], trials: int, seed: int, progress: bool = False, generator: str = "uniform"
+    truth: Relation, ms: Sequence[int], trials: int, seed: int, generator: str = "uniform"
 ) -> dict[str, Any]:
     """``{"total": N, "generator": g, "results": [{"m", "mean", "p_all", "p_more_than_half", "histogram"}]}``."""
-    from tqdm import tqdm
 
     if trials < 1 or any(m < 1 for m in ms):
         raise PlannerError(f"--trials {trials} --m {','.join(map(str, ms))}: expected positive integers")
@@ -49,7 +49,7 @@ def evaluate(
     batches = ExtensionBatches(truth)
     rng = np.random.default_rng(seed)
     n, total, results = len(truth.parts), batches.total, []
-    for m in tqdm(ms, desc="m", disable=not progress):
+    for m in progress(ms, desc="evaluate m", total=len(ms), unit="m"):
         orders = batches.sample_orders(rng, trials * m, generator).reshape(trials, m, n)
         admitted = batches.count(intersect_orders(positions_of(orders)))
         results.append(

@@ -28,6 +28,7 @@ import numpy as np
 from asp.precedence.batches import ExtensionBatches, positions_of
 from asp.precedence.decompose import predecessor_masks, transitive_closure
 from asp.precedence.relation import Relation
+from bridge.progress import progress
 
 
 def teacher_order(suggestion: Sequence[int], truth: Relation) -> list[int]:
@@ -134,18 +135,18 @@ def random_demonstrations(batches: ExtensionBatches, trials: int, rng: np.random
     return needed
 
 
-def evaluate_guided(truth: Relation, trials: int, seed: int, progress: bool = False) -> dict[str, Any]:
+def evaluate_guided(truth: Relation, trials: int, seed: int) -> dict[str, Any]:
     """``{"total", "demos_to_exact", "mean", "random_mean"}`` over ``trials`` simulated teachers.
 
     ``demos_to_exact`` maps a number of demonstrations to how many guided trials
     needed exactly that many; ``random_mean`` is measured in the same run with
     uniformly random feasible demonstrations.
     """
-    from tqdm import tqdm
 
     batches = ExtensionBatches(truth)
     rng = np.random.default_rng(seed)
-    guided = [guided_demonstrations(truth, seed * 1_000_003 + t) for t in tqdm(range(trials), disable=not progress)]
+    guided = [guided_demonstrations(truth, seed * 1_000_003 + t)
+              for t in progress(range(trials), desc="guided trials", total=trials)]
     histogram = np.bincount(guided)
     return {
         "total": batches.total,

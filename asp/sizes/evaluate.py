@@ -22,7 +22,6 @@ import itertools
 import multiprocessing
 import random
 import statistics
-import sys
 from collections import Counter
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -33,6 +32,7 @@ from asp.sizes.learner import SizeLearner, run_learner
 from asp.sizes.oracle import NoisyOracle, TruthOracle
 from asp.sizes.policies import get_policy
 from bridge.files import write_figure
+from bridge.progress import progress
 
 Matrix = tuple[tuple[bool, ...], ...]
 """Truth in index order: ``matrix[i][j]`` is True when part i+1 fits hole j+1."""
@@ -194,10 +194,7 @@ def _pool_map(function, tasks: Sequence, processes: int, unit: str) -> list:
     else:
         iterator = map(function, tasks)
     try:
-        if sys.stderr.isatty():
-            from tqdm import tqdm
-
-            iterator = tqdm(iterator, total=len(tasks), unit=unit, file=sys.stderr)
+        iterator = progress(iterator, desc="evaluate", total=len(tasks), unit=unit)
         return list(iterator)
     finally:
         if pool is not None:
