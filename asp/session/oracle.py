@@ -44,6 +44,10 @@ class Finished:
     cell: str
     experiment: int
     """Its number in the order experiments were started (Rerun timeline ``experiment``)."""
+    attempts: int | None = None
+    """Insertion attempts the cell made (None when it reported no evidence)."""
+    wall_s: float = 0.0
+    """The cell's wall-clock time for the experiment [s]."""
 
 
 class ZenohOracle:
@@ -95,7 +99,8 @@ class ZenohOracle:
             id=request.id, part=request.part, hole=request.hole, result=reply.result,
             cell=reply.cell, retest=request.retest, evidence=reply.evidence, wall_s=reply.wall_s,
             experiment=request.experiment))
-        return Finished(request.part, request.hole, reply.result, reply.cell, request.experiment)
+        return Finished(request.part, request.hole, reply.result, reply.cell, request.experiment,
+                        None if reply.evidence is None else reply.evidence.attempts, reply.wall_s)
 
     def ask(self, part: str, hole: str) -> Result:
         """One experiment, waited for (Oracle protocol); nothing else may be running."""

@@ -25,7 +25,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import re
+import shlex
 import shutil
 import sys
 import time
@@ -48,7 +50,7 @@ from asp.session.oracle import ZenohOracle
 from asp.sizes.learner import MAX_CONFIRM, SizeLearner, SizeLearningResult
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import policy_names
-from asp.solve import fact, write_facts
+from asp.solve import encoding, fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in
@@ -58,6 +60,7 @@ from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
+_LOG = logging.getLogger(__name__)
 SETTINGS = "session.json"
 MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
@@ -206,6 +209,9 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
 
     for entry in list(journal.entries):
         record(entry.part, entry.hole, entry.result, entry.cell, entry.experiment)
+    if journal.entries:
+        _LOG.info("resumed: %d experiments from the journal; %d pairs unknown",
+                  len(journal.entries), len(learner.knowledge.unknown))
     running: list[tuple[str, str]] = []
     while True:
         free = max(1, oracle.alive_cells()) - len(running)
@@ -219,6 +225,10 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
         finished = oracle.next_result()
         running.remove((finished.part, finished.hole))
         record(finished.part, finished.hole, finished.result, finished.cell, finished.experiment)
+        attempts = "" if finished.attempts is None else f"{finished.attempts} attempt(s), "
+        _LOG.info("experiment %d on %s: %s -> %s %s (%s%.1f s); %d pairs unknown", finished.experiment,
+                  finished.cell, finished.part, finished.hole, finished.result, attempts, finished.wall_s,
+                  len(learner.knowledge.unknown))
 
 
 def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
@@ -358,11 +368,16 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
 
 
 def _summary(result: dict, run: Path) -> str:
+    """The human ending of a session: what was learned, the files written, what to run next."""
     settings = json.loads((run / SETTINGS).read_text(encoding="utf-8"))
     cells: dict[str, int] = {}
     for entry in settings["journal"]:
         cells[entry["cell"]] = cells.get(entry["cell"], 0) + 1
     plan = " ".join(f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+    files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
+    python = shlex.quote(sys.executable)
+    learned = shlex.quote(str(run / "learned.lp"))
+    part = result["fits"][0][0] if result["fits"] else "p1"
     return "\n".join([
         f"run {result['run']}: {result['experiments']} experiments "
         f"({', '.join(f'{c}: {n}' for c, n in sorted(cells.items()))}) in {settings['wall_s']:.1f} s",
@@ -374,6 +389,13 @@ def _summary(result: dict, run: Path) -> str:
         f"precedence learned {settings['truth']['precedence_sound']} "
         f"({settings['truth']['precedence_extra']} pairs more than required); "
         f"matches truth: {result['matches_truth']}",
+        f"files written in {run}: {' '.join(files)}",
+        "next:",
+        *(f"  {label + ':':<24}{command}" for label, command in (
+            ("view the recording", f"./run.sh view {shlex.quote(str(run))}"),
+            (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
+            ("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5"),
+        )),
     ])
 
 

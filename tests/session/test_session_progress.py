@@ -1,0 +1,46 @@
+"""A session reports each finished experiment (INFO log lines) with the unknown pairs left."""
+
+from __future__ import annotations
+
+import logging
+import re
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from asp.session.run import main as session_main
+
+LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s\); (\d+) pairs unknown")
+
+
+@pytest.mark.timeout(90)
+def test_one_progress_line_per_experiment_down_to_no_unknown_pair(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture, capsys: pytest.CaptureFixture[str]) -> None:
+    caplog.set_level(logging.INFO, logger="asp.session.run")
+    assert session_main(["--backend", "truth", "--cells", "2", "--out", str(tmp_path / "run")]) == 0
+    lines = [LINE.fullmatch(r.getMessage()) for r in caplog.records if r.getMessage().startswith("experiment")]
+    assert lines and all(lines)
+    numbers = sorted(int(m.group(1)) for m in lines if m)
+    assert numbers == list(range(1, len(numbers) + 1))
+    unknown = [int(m.group(6)) for m in lines if m]
+    assert unknown[-1] == 0 and unknown == sorted(unknown, reverse=True)
+    assert {m.group(2) for m in lines if m} <= {"c1", "c2"}
+    assert f"{len(numbers)} experiments" in capsys.readouterr().out
+
+
+@pytest.mark.timeout(90)
+def test_the_summary_lists_the_files_and_next_commands_that_work(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    run = tmp_path / "run"
+    assert session_main(["--backend", "truth", "--out", str(run)]) == 0
+    out = capsys.readouterr().out
+    files = next(line for line in out.splitlines() if line.startswith("files written in"))
+    assert files.split(": ")[1].split() == sorted(p.name for p in run.iterdir() if not p.name.startswith("."))
+    commands = {line.split(":", 1)[0].strip(): line.split(":", 1)[1].strip()
+                for line in out.split("next:\n")[1].splitlines()}
+    assert commands["view the recording"] == f"./run.sh view {run}"
+    holes = subprocess.run(commands["holes p1 fits into"], shell=True, capture_output=True, text=True, timeout=60)
+    assert "br r1 r2 s1 s2" in holes.stdout
+    plans = subprocess.run(commands["five complete plans"], shell=True, capture_output=True, text=True, timeout=60)
+    assert "Models       : 5" in plans.stdout
