@@ -9,16 +9,21 @@ checked for finiteness and range (:func:`int_in`, :func:`non_negative_int`,
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import os
 import sys
 from collections.abc import Callable
-from typing import NoReturn, TypeVar
+from typing import Any, NoReturn, TypeVar
 
 from bridge import BridgeError
 from bridge.inputs import shorten
 
 T = TypeVar("T")
+
+PROGRAM = "assembly-constraints"
+"""The one console command (``pip install .`` puts it on PATH; ``./run.sh`` wraps it): every
+help page and error names it (:class:`ArgumentParser` puts it before a subcommand's name)."""
 
 MAX_SEED = 2**32 - 1
 """Seeds are integers in [0, MAX_SEED] (numpy's generators take no negative seed)."""
@@ -30,10 +35,35 @@ MAX_MESSAGE_CHARS = 300
 class ArgumentParser(argparse.ArgumentParser):
     """An argparse parser whose errors are one line on stderr, ``error: PROG: MESSAGE``,
     with exit code 2 (argparse's default adds the usage lines; ``--help`` shows them).
-    Subparsers made by :meth:`add_subparsers` are of this class too."""
+    ``prog`` is the subcommand (``"session"``, ``"executor serve"``): help pages and errors
+    show it after :data:`PROGRAM`. Subparsers made by :meth:`add_subparsers` are of this class too."""
+
+    def __init__(self, prog: str | None = None, **kwargs: Any) -> None:
+        if prog is not None and not prog.startswith(PROGRAM):
+            prog = f"{PROGRAM} {prog}"
+        super().__init__(prog=prog, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"error: {self.prog}: {shorten(' '.join(message.split()), MAX_MESSAGE_CHARS)}\n")
+
+
+class _OneLineFormatter(logging.Formatter):
+    """``warning: message``: the level in lower case, like the ``error:`` lines."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        return f"{record.levelname.lower()}: {one_line(record.getMessage())}"
+
+
+def configure_logging(level: int = logging.WARNING) -> None:
+    """Log to stderr, one line a record (``warning: ...``), from ``level`` up: the console
+    command's ``-v`` (INFO) and ``-q`` (ERROR). The handler is installed once per process;
+    a later call only changes the level."""
+    root = logging.getLogger()
+    if not any(isinstance(handler.formatter, _OneLineFormatter) for handler in root.handlers):
+        handler = logging.StreamHandler()
+        handler.setFormatter(_OneLineFormatter())
+        root.addHandler(handler)
+    root.setLevel(level)
 
 
 EXIT_BROKEN_PIPE = 141
