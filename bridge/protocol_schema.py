@@ -32,9 +32,17 @@ MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 
 
+def _plain(value: object) -> object:
+    """``value`` with the reStructuredText literals of docstrings (double backquotes) removed."""
+    if isinstance(value, dict):
+        return {k: v.replace("``", "") if k == "description" and isinstance(v, str) else _plain(v)
+                for k, v in value.items()}
+    return [_plain(v) for v in value] if isinstance(value, list) else value
+
+
 def schema(message: type[msgspec.Struct], direction: str) -> dict:
     """The JSON Schema (draft 2020-12) of one message type, self-contained (``$defs``)."""
-    generated = msgspec.json.schema(message)
+    generated: dict = _plain(msgspec.json.schema(message))  # type: ignore[assignment]
     name = generated["$ref"].rsplit("/", 1)[-1]
     defs = generated["$defs"]
     return {"$schema": DRAFT, "title": name,
