@@ -38,13 +38,16 @@ def subcommands() -> dict[str, tuple[str, str]]:
 
 def bench_main(argv: list[str]) -> int:
     """``bench TOPIC``: the planner's benchmarks, and the cell's under ``bench executor``."""
-    if argv[:1] == ["executor"]:
-        from executor.campaign.bench import main as cell_bench
+    from asp.bench.cli import TOPICS
 
-        return int(cell_bench(argv[1:]) or 0)
-    from asp.bench.cli import main as planner_bench
-
-    return planner_bench(argv)
+    topics = {**TOPICS, "executor": "executor.campaign.bench"}
+    parser = ArgumentParser(prog="bench", description="Benchmarks: each prints its figures (medians, ratios); "
+                            "docs/results.md lists the measured values and the commands.")
+    parser.add_argument("topic", choices=list(topics), metavar="TOPIC", help=f"one of: {', '.join(topics)}")
+    parser.add_argument("arguments", nargs=argparse.REMAINDER, metavar="ARGS",
+                        help="the benchmark's options (see bench TOPIC --help)")
+    args = parser.parse_args(argv)
+    return int(_entry(topics[args.topic])(args.arguments) or 0)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -36,6 +36,7 @@ from pathlib import Path
 import zenoh
 
 from bridge import BridgeError
+from bridge.cli_types import ArgumentParser, add_assembly_argument
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
 from bridge.messages import (
     MAX_MESSAGE_BYTES,
@@ -272,7 +273,7 @@ def _stop_when_stdin_closes(node: CellNode) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="executor serve", description="Serve insertion experiments over Zenoh "
         f"(default: listen on {DEFAULT_ENDPOINT}).")
     parser.add_argument("--cell", default="c1", help="cell id (default c1)")
@@ -281,7 +282,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "your class driving a real cell (docs/backends.md) (default sim)")
     parser.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
                         help="an option for a MODULE:CLASS backend, e.g. journal=runs/x/journal.jsonl (repeatable)")
-    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    add_assembly_argument(parser)
     parser.add_argument("--delay", type=float, default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
     parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
