@@ -43,10 +43,12 @@ def bench_main(argv: list[str]) -> int:
     topics = {**TOPICS, "executor": "executor.campaign.bench"}
     parser = ArgumentParser(prog="bench", description="Benchmarks: each prints its figures (medians, ratios); "
                             "docs/results.md lists the measured values and the commands.")
-    parser.add_argument("topic", choices=list(topics), metavar="TOPIC", help=f"one of: {', '.join(topics)}")
+    parser.add_argument("topic", nargs="?", choices=list(topics), metavar="TOPIC", help=f"one of: {', '.join(topics)}")
     parser.add_argument("arguments", nargs=argparse.REMAINDER, metavar="ARGS",
                         help="the benchmark's options (see bench TOPIC --help)")
     args = parser.parse_args(argv)
+    if args.topic is None:
+        parser.error(f"expected a benchmark, one of: {', '.join(topics)}")
     return int(_entry(topics[args.topic])(args.arguments) or 0)
 
 
