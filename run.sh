@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
-# The one entry point of the project.
+# The repository's wrapper around the console command `assembly-constraints` (the one
+# `pip install .` installs): it sets up .venv (editable, versions pinned by constraints.txt).
 #   ./run.sh                 set up .venv and run the main job (end-to-end Cranfield session)
 #   ./run.sh test [ARGS]     set up .venv, run the linters (ruff, mypy) and the test suite (pytest ARGS)
 #   ./run.sh lint            set up .venv and run the linters only
-#   ./run.sh <subcommand>    run one command of the command line (each has --help)
+#   ./run.sh <subcommand>    assembly-constraints <subcommand> (each has --help)
 # Commands run in the caller's working directory, so relative paths (--out rel.lp, the
 # session's default runs/ folder) are relative to it; test and lint run in the repository.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 VENV="$ROOT/.venv"
 PY="$VENV/bin/python"
-STAMP="$VENV/.installed-$(sha1sum "$ROOT/pyproject.toml" | cut -c1-12)"
+STAMP="$VENV/.installed-$(cat "$ROOT/pyproject.toml" "$ROOT/setup.py" "$ROOT/constraints.txt" | sha1sum | cut -c1-12)"
 
 setup() {
     if [[ ! -x "$PY" ]]; then
@@ -19,14 +20,14 @@ setup() {
     if [[ ! -f "$STAMP" ]]; then
         echo "run.sh: installing the project into $VENV (first run only)" >&2
         "$PY" -m pip install --quiet --upgrade pip >&2
-        "$PY" -m pip install --quiet -e "$ROOT[test]" >&2
+        "$PY" -m pip install --quiet -c "$ROOT/constraints.txt" -e "$ROOT[test]" >&2
         rm -f "$VENV"/.installed-*
         touch "$STAMP"
     fi
 }
 
 lint() {
-    "$VENV/bin/ruff" check --quiet asp executor bridge tests
+    "$VENV/bin/ruff" check --quiet
     "$VENV/bin/mypy" --no-error-summary
 }
 
@@ -34,26 +35,18 @@ usage() {
     cat <<'USAGE'
 usage: ./run.sh [SUBCOMMAND] [ARGS...]
 
-  (none)        end-to-end learning session on Cranfield (same as: session)
+The repository's wrapper around assembly-constraints (below); without a subcommand it
+runs a session. Two subcommands of its own:
   test          run the linters and the test suite (pytest options pass through, e.g. -m "not slow")
   lint          run the linters (ruff, mypy)
-  precedence    learn / count / sample / evaluate / suggest precedence constraints
-  sizes         learn / evaluate which part fits which hole (active exploration)
-  assign        hole assignments from learned facts
-  plan          complete assembly plans from learned facts
-  session       planner + cells over Zenoh: the whole learning session
-  view          open a session's Rerun recording
-  executor      the simulated PyBullet cell (teach, trial, campaign, serve)
-  bench         benchmarks: precedence | sizes | plan | executor | session
 
-Every subcommand takes --help.
 USAGE
 }
 
 cmd="${1:-session}"
 [[ $# -gt 0 ]] && shift
 case "$cmd" in
-    -h|--help|help) usage; exit 0 ;;
+    -h|--help|help) usage; setup; exec "$PY" -P -m assembly_constraints --help ;;
 esac
 setup
 export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
@@ -61,9 +54,5 @@ export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
 case "$cmd" in
     test)      cd "$ROOT"; lint; exec "$PY" -m pytest -n 2 "$@" ;;  # two workers (xdist); -n 0: serially
     lint)      cd "$ROOT"; lint ;;
-    executor)  exec "$PY" -P -m executor "$@" ;;
-    bench)
-        if [[ "${1:-}" == "executor" ]]; then shift; exec "$PY" -P -m executor.campaign.bench "$@"; fi
-        exec "$PY" -P -m asp.cli bench "$@" ;;
-    *)         exec "$PY" -P -m asp.cli "$cmd" "$@" ;;
+    *)         exec "$PY" -P -m assembly_constraints "$cmd" "$@" ;;
 esac

@@ -24,7 +24,11 @@ from pathlib import Path
 from bridge import BridgeError
 from bridge.inputs import read_text, shorten
 
-DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+_INSTALLED_ASSEMBLIES = Path(__file__).resolve().parent / "assemblies"
+DATA_DIR = (_INSTALLED_ASSEMBLIES if _INSTALLED_ASSEMBLIES.is_dir()
+            else Path(__file__).resolve().parent.parent / "data")
+"""The shipped assemblies: the repository's ``data/``, or in an installed copy its package
+data ``bridge/assemblies`` (``setup.py``), so ``--assembly cranfield`` works from any folder."""
 ID_PATTERN = r"^[a-z][a-zA-Z0-9_]{0,63}$"
 """A part or hole id: a lower-case ASP constant of at most 64 characters."""
 _ID = re.compile(ID_PATTERN)
@@ -85,14 +89,15 @@ class Assembly:
 
 
 def resolve_assembly_folder(name_or_path: str) -> Path:
-    """A name under ``data/`` or a path to a folder holding ``assembly.toml``."""
+    """A folder holding ``assembly.toml`` (relative to the working folder) or the name of a
+    shipped assembly (a folder of :data:`DATA_DIR`), in this order."""
     candidates = [Path(name_or_path), DATA_DIR / name_or_path]
     for folder in candidates:
         if (folder / "assembly.toml").is_file():
             return folder.resolve()
     known = sorted(p.parent.name for p in DATA_DIR.glob("*/assembly.toml"))
     raise BridgeError(
-        f"assembly '{name_or_path}': expected a name under data/ ({', '.join(known)}) "
+        f"assembly '{name_or_path}': expected a shipped assembly ({', '.join(known)}) "
         "or a folder holding assembly.toml"
     )
 

@@ -9,16 +9,22 @@ checked for finiteness and range (:func:`int_in`, :func:`non_negative_int`,
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import os
+import re
 import sys
 from collections.abc import Callable
-from typing import NoReturn, TypeVar
+from typing import Any, NoReturn, TypeVar
 
 from bridge import BridgeError
 from bridge.inputs import shorten
 
 T = TypeVar("T")
+
+PROGRAM = "assembly-constraints"
+"""The one console command (``pip install .`` puts it on PATH; ``./run.sh`` wraps it): every
+help page and error names it (:class:`ArgumentParser` puts it before a subcommand's name)."""
 
 MAX_SEED = 2**32 - 1
 """Seeds are integers in [0, MAX_SEED] (numpy's generators take no negative seed)."""
@@ -30,10 +36,66 @@ MAX_MESSAGE_CHARS = 300
 class ArgumentParser(argparse.ArgumentParser):
     """An argparse parser whose errors are one line on stderr, ``error: PROG: MESSAGE``,
     with exit code 2 (argparse's default adds the usage lines; ``--help`` shows them).
-    Subparsers made by :meth:`add_subparsers` are of this class too."""
+    ``prog`` is the subcommand (``"session"``, ``"executor serve"``): help pages and errors
+    show it after :data:`PROGRAM`. Subparsers made by :meth:`add_subparsers` are of this class too."""
+
+    def __init__(self, prog: str | None = None, **kwargs: Any) -> None:
+        if prog is not None and not prog.startswith(PROGRAM):
+            prog = f"{PROGRAM} {prog}"
+        for key in ("description", "epilog"):  # often a module's docstring
+            if kwargs.get(key):
+                kwargs[key] = plain_text(kwargs[key])
+        super().__init__(prog=prog, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"error: {self.prog}: {shorten(' '.join(message.split()), MAX_MESSAGE_CHARS)}\n")
+
+
+_ROLE = re.compile(r":(?:mod|class|func|meth|data|attr|exc):`~?([^`]+)`")
+
+
+def plain_text(text: str) -> str:
+    """A docstring as a help page shows it: reStructuredText literals (double backquotes)
+    and roles (``:mod:`x` ``) as plain text, the repository's ``./run.sh`` as the program."""
+    return _ROLE.sub(r"\1", text).replace("``", "").replace("./run.sh", PROGRAM)
+
+
+ASSEMBLY_HELP = "a shipped assembly's name (cranfield, battery) or a folder holding assembly.toml"
+"""The one meaning of ``--assembly`` on every help page."""
+
+
+def add_assembly_argument(parser: argparse._ActionsContainer, default: str | None = "cranfield", *,
+                          required: bool = False, purpose: str = "") -> None:
+    """Add ``--assembly`` with its one meaning (:data:`ASSEMBLY_HELP`); ``purpose`` says
+    what the command takes from it, ``default`` None: no default."""
+    tail = f" (default {default})" if default is not None else ""
+    parser.add_argument("--assembly", default=default, required=required, metavar="ASSEMBLY",
+                        help=f"{ASSEMBLY_HELP}{tail}" + (f"; {purpose}" if purpose else ""))
+
+
+class _OneLineFormatter(logging.Formatter):
+    """``warning: message``: the level in lower case, like the ``error:`` lines; progress
+    (INFO) and details (DEBUG) as the plain message."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        if record.levelno < logging.WARNING:
+            return one_line(record.getMessage())
+        return f"{record.levelname.lower()}: {one_line(record.getMessage())}"
+
+
+def configure_logging(level: int | None = None) -> None:
+    """Log to stderr, one line a record (``warning: ...``), from ``level`` up: the console
+    command's default INFO (progress), ``-v`` DEBUG and ``-q`` ERROR. The handler is
+    installed once per process (at WARNING when no level is given); a later call only
+    sets a given level."""
+    root = logging.getLogger()
+    if not any(isinstance(handler.formatter, _OneLineFormatter) for handler in root.handlers):
+        handler = logging.StreamHandler()
+        handler.setFormatter(_OneLineFormatter())
+        root.addHandler(handler)
+        root.setLevel(logging.WARNING)
+    if level is not None:
+        root.setLevel(level)
 
 
 EXIT_BROKEN_PIPE = 141
@@ -60,7 +122,9 @@ def quiet_broken_pipe() -> int:
 def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...]) -> int:
     """Run a command line's work and return its exit code: ``errors`` (bad input) become one
     line ``error: ...`` on stderr and exit 2; a closed stdout (``... | head -1``) stops
-    quietly with :data:`EXIT_BROKEN_PIPE`; Ctrl-C exits 130."""
+    quietly with :data:`EXIT_BROKEN_PIPE`; Ctrl-C exits 130. Log records go to stderr as
+    one line each (:func:`configure_logging`)."""
+    configure_logging()
     try:
         code = command()
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 
 from bridge import BridgeError
-from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, run_command
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
 from executor import ExecutorError
 
 MAX_TRIALS = 100_000
@@ -83,10 +83,10 @@ def _trial(args: argparse.Namespace) -> int:
 # imported lazily; help text).
 _DELEGATED = {
     "campaign": ("executor.campaign.run",
-                 "Fig. 18: randomised executions of every part-hole pair (executor.campaign.run)"),
-    "serve": ("executor.serve", "serve insertion requests over Zenoh (executor.serve)"),
+                 "Fig. 18: randomised executions of every part-hole pair"),
+    "serve": ("executor.serve", "serve insertion requests over Zenoh"),
     "margins": ("executor.campaign.margins",
-                "measure the wrench and end-error margins the thresholds come from (executor.campaign.margins)"),
+                "measure the wrench and end-error margins the thresholds come from"),
 }
 
 
@@ -95,7 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     teach = sub.add_parser("teach", help="record the scripted demonstrations (DMP + reference wrench)")
-    teach.add_argument("--assembly", default="cranfield", help="assembly folder under data/ (default: cranfield)")
+    add_assembly_argument(teach)
     teach.set_defaults(func=_teach)
 
     trial = sub.add_parser("trial", help="insert one part into one hole, N randomised trials")
@@ -107,7 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="seed of the first trial; trial k uses seed+k")
     trial.add_argument("--attempts", type=int_in(1, MAX_ATTEMPTS), default=2,
                        help="attempts per trial before 'no_fit' (default 2)")
-    trial.add_argument("--assembly", default="cranfield", help="assembly folder under data/ (default: cranfield)")
+    add_assembly_argument(trial)
     trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
     trial.add_argument("--rrd", help="save a Rerun recording of every attempt to this file")
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")

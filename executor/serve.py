@@ -12,7 +12,8 @@ supervising session died), then closes the Zenoh session cleanly.
   request id: a repeated id gets the cached reply and never re-runs the experiment.
 - Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily);
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
-  after ``--delay`` seconds, to measure the bridge and test the protocol quickly.
+  after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
+  ``MODULE:CLASS`` loads a user's backend (:mod:`executor.backends`), e.g. a real robot.
 
 One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
 ``done <id> <result>``), flushed, so a supervisor can follow the node.
@@ -31,11 +32,11 @@ from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
 
 import zenoh
 
 from bridge import BridgeError
+from bridge.cli_types import ArgumentParser, add_assembly_argument
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
 from bridge.messages import (
     MAX_MESSAGE_BYTES,
@@ -51,6 +52,7 @@ from bridge.messages import (
 )
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
 from executor import ExecutorError
+from executor.backends import Backend, CellContext, UnknownPair, backend_option, load_backend
 from executor.world.geometry import load_geometry, passes
 
 CACHE_SIZE = 100_000
@@ -58,20 +60,6 @@ CACHE_SIZE = 100_000
 
 QUEUE_SIZE = 16
 """Requests that may wait for the cell; more are refused with ``busy``."""
-
-
-class UnknownPair(ExecutorError):
-    """The request names a part or hole the cell does not have."""
-
-
-class Backend(Protocol):
-    """Runs one insertion experiment."""
-
-    def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
-        """The outcome and its evidence; ExecutorError for a bad part or hole."""
-        ...
-
-    def close(self) -> None: ...
 
 
 class TruthBackend:
@@ -285,13 +273,16 @@ def _stop_when_stdin_closes(node: CellNode) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="executor serve", description="Serve insertion experiments over Zenoh "
         f"(default: listen on {DEFAULT_ENDPOINT}).")
     parser.add_argument("--cell", default="c1", help="cell id (default c1)")
-    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
-                        help="sim: PyBullet cell; truth: answer from the geometry, no simulation (default sim)")
-    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    parser.add_argument("--backend", default="sim", metavar="{sim,truth,MODULE:CLASS}",
+                        help="sim: PyBullet cell; truth: answer from the geometry, no simulation; MODULE:CLASS: "
+                             "your class driving a real cell (docs/backends.md) (default sim)")
+    parser.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
+                        help="an option for a MODULE:CLASS backend, e.g. journal=runs/x/journal.jsonl (repeatable)")
+    add_assembly_argument(parser)
     parser.add_argument("--delay", type=float, default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
     parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
@@ -314,9 +305,14 @@ def main(argv: Sequence[str]) -> int:
     listen = args.listen or ([] if args.connect or args.zenoh_config else [DEFAULT_ENDPOINT])
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    backend: Backend = (TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
-                        if args.backend == "truth"
-                        else SimBackend(args.assembly, cell_id, args.recording_id, args.rrd))
+    backend: Backend
+    if args.backend == "truth":
+        backend = TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
+    elif args.backend == "sim":
+        backend = SimBackend(args.assembly, cell_id, args.recording_id, args.rrd)
+    else:
+        backend = load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
+                                                         dict(args.backend_option)))
     node = CellNode(cell_id, backend)
     try:
         session = open_session(listen, args.connect, args.zenoh_config)

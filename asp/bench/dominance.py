@@ -54,7 +54,7 @@ import numpy as np
 from asp.sizes.biorders import all_biorders, mask_bits
 from asp.sizes.evaluate import relabeled_matrices
 from asp.sizes.oracle import TruthOracle
-from bridge.cli_types import comma_list, size_pair
+from bridge.cli_types import ArgumentParser, comma_list, size_pair
 
 INFEASIBLE = 1 << 40
 """Value of a state from which no policy meets every deadline."""
@@ -538,7 +538,7 @@ def all_biorders_bound(target: int, cap: int | None = None) -> dict:
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="./run.sh bench dominance", description=__doc__,
+    parser = ArgumentParser(prog="bench dominance", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="2x3,3x2,2x4,3x3,3x4,4x3,2x5,5x2",
                         type=comma_list(size_pair, "sizes such as 4x5", allow_empty=True),

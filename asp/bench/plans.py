@@ -1,4 +1,4 @@
-"""Timing of optimal plans (``python -m asp.bench.plans``): Cranfield, and random cells.
+"""Timing of optimal plans (``./run.sh bench plan``): Cranfield, and random cells.
 
 Prints the CPU time [s] (this process, clingo included) to prove the least total tool
 travel and enumerate every optimal plan: the median of ``--repeat`` runs on Cranfield
@@ -10,7 +10,6 @@ ordered with probability 0.15, start and hole positions uniform in the cell.
 
 from __future__ import annotations
 
-import argparse
 import random
 import statistics
 import sys
@@ -26,6 +25,7 @@ from asp.plans.plans import plans, travel_facts
 from asp.precedence.relation import precedence_facts, true_relation
 from asp.solve import fact, load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
+from bridge.cli_types import ArgumentParser
 
 
 def _learned(atoms: list[clingo.Symbol]) -> LearnedFacts:
@@ -67,7 +67,7 @@ def _optimal_cpu_s(facts: LearnedFacts, cell: Assembly, time_limit_s: float) -> 
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="python -m asp.bench.plans", description=__doc__)
+    parser = ArgumentParser(prog="bench plan", description=__doc__)
     parser.add_argument("--repeat", type=int, default=5, help="Cranfield runs (default 5)")
     parser.add_argument("--parts", type=int, default=11, help="parts of a random cell (default 11)")
     parser.add_argument("--holes", type=int, default=6, help="holes of a random cell (default 6)")

@@ -40,7 +40,7 @@ from asp import PlannerError
 from asp.bench.products import write_product
 from asp.session.cells import ROOT, start_cell
 from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
-from bridge.cli_types import comma_list, number_in
+from bridge.cli_types import ArgumentParser, comma_list, number_in
 from bridge.client import CellDirectory, request_insert
 from bridge.keys import ping_key
 from bridge.messages import InsertRequest, encode
@@ -159,7 +159,7 @@ def cell_busy_fraction(entries: list[JournalEntry], cells: int) -> float:
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="bench session", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="bench session", description=__doc__.split("\n\n")[0])
     parser.add_argument("--round-trips", type=int, default=1000, help="per kind (default 1000)")
     parser.add_argument("--repeat", type=int, default=1,
                         help="pairs of sessions, 1 cell then 2 cells back to back (default 1)")

@@ -29,7 +29,7 @@ from asp.sizes.evaluate import evaluate_policy
 from asp.sizes.learner import SizeLearner
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import get_policy
-from bridge.cli_types import comma_list, number_in
+from bridge.cli_types import ArgumentParser, comma_list, number_in
 
 CRANFIELD = "cranfield"
 
@@ -92,14 +92,14 @@ def _print_noise(rows: list[dict]) -> None:
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
+    parser = ArgumentParser(prog="bench sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="5,10,20", type=comma_list(number_in(int, 1, 1000), "sizes in [1, 1000)"),
                         help="n of the n×n instances (default 5,10,20)")
     parser.add_argument("--policies", default="systematic,random,heuristic,best", type=comma_list(str, "policy names"),
                         help="policies to time (default systematic,random,heuristic,best)")
     parser.add_argument("--decisions", type=int, default=60, help="decisions timed per session (default 60)")
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seed", type=int, default=1, help="seed of the random choices (default 1)")
     parser.add_argument("--evaluate", default="heuristic",
                         help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
     parser.add_argument("--noise", type=comma_list(number_in(float, 0.0, 0.5), "probabilities in [0, 0.5)"),

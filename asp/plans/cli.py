@@ -26,7 +26,7 @@ from asp.plans.assign import UnsolvableAssembly, all_assignments, feasible_assig
 from asp.plans.plans import HOME, Plan, plans, travel_facts
 from asp.solve import write_facts
 from bridge.assembly import MAX_COORDINATE, load_assembly
-from bridge.cli_types import ArgumentParser, finite_float, int_in
+from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, int_in
 
 EXIT_UNSOLVABLE = 3
 """Exit code of a valid but unsolvable assembly (bad input exits with 2)."""
@@ -58,7 +58,7 @@ def report_unsolvable(exc: UnsolvableAssembly, key: str, as_json: bool) -> int:
 def assign_main(argv: list[str]) -> int:
     """``./run.sh assign``."""
     parser = facts_parser(
-        "./run.sh assign",
+        "assign",
         "Hole assignments from learned facts: the paper's greedy one (biggest part first "
         "into the smallest free hole it fits; ASP's first one if greedy gets stuck on sizes "
         f"that are not a biorder), or every feasible one. Exit {EXIT_UNSOLVABLE}: "
@@ -87,7 +87,7 @@ def _text(plan: Plan) -> str:
 def plan_main(argv: list[str]) -> int:
     """``./run.sh plan``."""
     parser = facts_parser(
-        "./run.sh plan",
+        "plan",
         "Complete assembly plans from learned facts: orders of all parts respecting "
         "must_precede, each part that needs a hole in a distinct hole it fits. "
         f"Exit {EXIT_UNSOLVABLE}: the assembly is not solvable.",
@@ -96,7 +96,7 @@ def plan_main(argv: list[str]) -> int:
                         help="how many plans (0 = all; default 1)")
     parser.add_argument("--optimal", action="store_true",
                         help="plans of least total tool travel [mm] (needs --assembly)")
-    parser.add_argument("--assembly", metavar="A", help="assembly (name under data/ or folder) for positions")
+    add_assembly_argument(parser, None, purpose="gives the positions for --optimal")
     parser.add_argument("--home", type=finite_float(-MAX_COORDINATE, MAX_COORDINATE), nargs=2, default=HOME,
                         metavar=("X", "Y"),
                         help="tool home [m] (default: 0 0, the cell origin)")

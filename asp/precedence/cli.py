@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import random
 import sys
 from itertools import islice
@@ -19,17 +20,19 @@ from asp.precedence.demos import Demonstrations, load_demos
 from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
-from bridge.cli_types import ArgumentParser, comma_list, non_negative_int, png_path
+from bridge.cli_types import ArgumentParser, add_assembly_argument, comma_list, non_negative_int, png_path
+
+LOG = logging.getLogger(__name__)
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = ArgumentParser(prog="./run.sh precedence", description="Precedence constraints (paper 2.1, 4.1).")
+    parser = ArgumentParser(prog="precedence", description="Precedence constraints (paper 2.1, 4.1).")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     learn = commands.add_parser("learn", help="learn the must-precede relation from demonstrations (Algorithm 1)")
     learn.add_argument("demos", nargs="?",
                        help="demonstrations file (text, or demo/3 facts *.lp); default: the assembly's demos.txt")
-    learn.add_argument("--assembly", help="assembly name under data/ or folder (gives the parts)")
+    add_assembly_argument(learn, None, purpose="gives the parts and the default demonstrations")
     learn.add_argument("--out", help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
     learn.add_argument("--dot", help="write the transitive-reduction graph as Graphviz DOT")
     learn.add_argument("--png", type=png_path, help="draw the relation to a PNG file (FILE.png)")
@@ -46,7 +49,7 @@ def _parser() -> argparse.ArgumentParser:
                        ("sample", "print uniformly random admitted sequences")):
         sub = commands.add_parser(name, help=text)
         sub.add_argument("facts", nargs="*", help="facts files with part/1 and must_precede/2 (or precedence_edge/2)")
-        sub.add_argument("--assembly", help="use the assembly's true constraints (precedence.lp)")
+        add_assembly_argument(sub, None, purpose="use its true constraints (precedence.lp)")
         if name == "count":
             sub.add_argument("--json", action="store_true", help='print JSON {"admitted": N}')
         if name == "enumerate":
@@ -56,7 +59,7 @@ def _parser() -> argparse.ArgumentParser:
             sub.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
 
     evaluate = commands.add_parser("evaluate", help="the paper's evaluation (Figs. 12/13), or --guided demonstration")
-    evaluate.add_argument("--assembly", required=True, help="assembly with true constraints (precedence.lp)")
+    add_assembly_argument(evaluate, None, required=True, purpose="one with true constraints (precedence.lp)")
     evaluate.add_argument("--m", default="5,7,10,15,20,30", type=comma_list(int, "integers such as 5,7,10"),
                           help="numbers of demonstrations, comma separated")
     evaluate.add_argument("--trials", type=int, default=1000, help="trials per m (default 1000)")
@@ -73,7 +76,7 @@ def _parser() -> argparse.ArgumentParser:
     suggest.add_argument("demos", nargs="?",
                          help="demonstrations so far, made following earlier suggestions "
                               "(none: the first suggestion; needs --assembly)")
-    suggest.add_argument("--assembly", help="assembly name or folder (gives the parts)")
+    add_assembly_argument(suggest, None, purpose="gives the parts and the default demonstrations")
     suggest.add_argument("--seed", type=int, default=0, help="seed of the tie-breaking (default 0)")
     suggest.add_argument("--json", action="store_true", help="print JSON {suggestion, undecided}")
     return parser
@@ -109,8 +112,7 @@ def _learn(args: argparse.Namespace) -> None:
     flagged = suspects(demos)
     for suspect in flagged:
         pairs = " ".join(f"{a}<{b}" for a, b in suspect.removes)
-        print(f"warning: {suspect.origin}: this demonstration alone removes {pairs}, which all others support",
-              file=sys.stderr)
+        LOG.warning("%s: this demonstration alone removes %s, which all others support", suspect.origin, pairs)
     if args.out:
         header = f"must-precede relation learned from {len(demos.sequences)} demonstrations"
         write_facts(args.out, precedence_facts(relation), header=header)
@@ -183,8 +185,8 @@ def _suggest(args: argparse.Namespace) -> None:
         _print_json({"suggestion": sequence, "undecided": [list(p) for p in undecided]})
     else:
         print(" ".join(sequence))
-        print(f"# {len(undecided)} learned pairs still undecided; place at each step the earliest listed part "
-              "that can be placed", file=sys.stderr)
+        LOG.info("%d learned pairs still undecided; place at each step the earliest listed part that can be placed",
+                 len(undecided))
 
 
 def main(argv: list[str]) -> int:

@@ -112,7 +112,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
     if recording_id is not None:
         argv += ["--recording-id", recording_id]
     if zenoh_config is not None:
-        argv += ["--zenoh-config", str(zenoh_config)]
+        argv += ["--zenoh-config", str(Path(zenoh_config).absolute())]
     return argv
 
 

@@ -53,14 +53,14 @@ from asp.sizes.policies import policy_names
 from asp.solve import encoding, fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
-from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
 from bridge.files import make_folder, write_atomic
 from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
-_LOG = logging.getLogger(__name__)
+LOG = logging.getLogger(__name__)
 SETTINGS = "session.json"
 MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
@@ -70,7 +70,7 @@ MAX_PLANS = 1000
 
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    add_assembly_argument(parser)
     parser.add_argument("--cells", type=int, default=1, help="cell co-processes to start (default 1)")
     parser.add_argument("--policy", default="best", choices=policy_names(),
                         help="experiment selection policy (default best: fewest experiments)")
@@ -210,7 +210,7 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
     for entry in list(journal.entries):
         record(entry.part, entry.hole, entry.result, entry.cell, entry.experiment)
     if journal.entries:
-        _LOG.info("resumed: %d experiments from the journal; %d pairs unknown",
+        LOG.info("resumed: %d experiments from the journal; %d pairs unknown",
                   len(journal.entries), len(learner.knowledge.unknown))
     running: list[tuple[str, str]] = []
     while True:
@@ -226,7 +226,7 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
         running.remove((finished.part, finished.hole))
         record(finished.part, finished.hole, finished.result, finished.cell, finished.experiment)
         attempts = "" if finished.attempts is None else f"{finished.attempts} attempt(s), "
-        _LOG.info("experiment %d on %s: %s -> %s %s (%s%.1f s); %d pairs unknown", finished.experiment,
+        LOG.info("experiment %d on %s: %s -> %s %s (%s%.1f s); %d pairs unknown", finished.experiment,
                   finished.cell, finished.part, finished.hole, finished.result, attempts, finished.wall_s,
                   len(learner.knowledge.unknown))
 
@@ -317,9 +317,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         abandoned = [event.experiment for event in journal.abandon_in_flight()]
         if abandoned:
             settings.setdefault("abandoned", []).extend(abandoned)
-            print(f"resume: experiment(s) {', '.join(map(str, abandoned))} were running when the session "
-                  "stopped; abandoned (their pairs are asked again, under new numbers, if still needed)",
-                  file=sys.stderr)
+            LOG.warning("resume: experiment(s) %s were running when the session stopped; abandoned (their pairs "
+                        "are asked again, under new numbers, if still needed)", ", ".join(map(str, abandoned)))
         allowed = cell_ids if args.cells > 0 else (args.allow_cells or None)  # by default only its own cells
         pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell, allowed=allowed)
         stack.callback(pool.close)
@@ -337,7 +336,7 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
             sizes = _learn_sizes(oracle, learner, journal, log)
         finally:
             for incident in pool.incidents:  # timeouts, conflicting replies, dropped cells
-                print(f"warning: {incident}", file=sys.stderr)
+                LOG.warning("%s", incident)
         timings["learned_s"] = time.perf_counter() - started
         learned = run / "learned.lp"
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),

@@ -20,7 +20,7 @@ from asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
 from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
 from asp.solve import write_facts
-from bridge.cli_types import ArgumentParser, comma_list, int_in
+from bridge.cli_types import ArgumentParser, add_assembly_argument, comma_list, int_in
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -31,14 +31,8 @@ def _truth(args: argparse.Namespace) -> TruthOracle:
 
 def _add_truth_options(parser: argparse.ArgumentParser) -> None:
     source = parser.add_mutually_exclusive_group(required=True)
-    source.add_argument("--assembly", metavar="A", help="assembly name under data/ or folder (uses its sizes.lp)")
+    add_assembly_argument(source, None, purpose="the truth is its sizes.lp")
     source.add_argument("--truth", metavar="FILE.lp", help="truth facts: part/1, hole/1, fits/2 (closed world)")
-
-
-def _policy(name: str) -> str:
-    if name not in policy_names():
-        raise argparse.ArgumentTypeError(f"expected one of {', '.join(policy_names())}")
-    return name
 
 
 def _probability(text: str) -> float:
@@ -62,19 +56,20 @@ def _add_noise_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = ArgumentParser(prog="./run.sh sizes", description=__doc__,
+    parser = ArgumentParser(prog="sizes", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
     learn = sub.add_parser("learn", help="learn the relation from a truth by experiments")
     _add_truth_options(learn)
-    learn.add_argument("--policy", type=_policy, default="heuristic", help="experiment selection (default heuristic)")
+    learn.add_argument("--policy", choices=policy_names(), default="heuristic",
+                       help="experiment selection (default heuristic)")
     learn.add_argument("--seed", type=int, default=0, help="seed of random choices and noise (default 0)")
     _add_noise_options(learn)
     learn.add_argument("--out", metavar="FILE.lp", help="write learned facts (tried/4, smaller/2, fits/2, no_fit/2)")
     learn.add_argument("--json", action="store_true", help="print JSON")
     evaluate = sub.add_parser("evaluate", help="experiments needed over relabelings of parts and holes")
     _add_truth_options(evaluate)
-    evaluate.add_argument("--policy", type=_policy, required=True)
+    evaluate.add_argument("--policy", choices=policy_names(), required=True, help="the policy to evaluate")
     evaluate.add_argument("--relabelings", default="all", metavar="all|N",
                           help="every relabeling (default) or N random ones")
     evaluate.add_argument("--seed", type=int, default=0, help="seed of relabelings, random choices, noise")

@@ -15,13 +15,13 @@ Timings on a shared machine are noisy: medians are reported.
 
 from __future__ import annotations
 
-import argparse
 import functools
 import json
 import statistics
 from collections.abc import Sequence
 from typing import Any
 
+from bridge.cli_types import ArgumentParser, add_assembly_argument
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
 
@@ -93,7 +93,7 @@ def format_report(report: dict[str, Any]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="bench executor", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="bench executor", description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
                         help="1 timed trial per pair and a 4-trial campaign")
     parser.add_argument("--trials", type=int, help="timed trials per pair (default 3)")
@@ -101,7 +101,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="campaign trials per pair (default 40; 0 skips the campaign)")
     parser.add_argument("--workers", type=int, default=2, help="campaign workers (default 2)")
     parser.add_argument("--seed", type=int, default=1000, help="base seed (default 1000)")
-    parser.add_argument("--assembly", default="cranfield")
+    add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
     trials = args.trials or (1 if args.quick else 3)

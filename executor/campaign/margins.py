@@ -10,11 +10,11 @@ goal tolerance.  Too-big parts are stopped only by the insertion time-out here.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from collections.abc import Sequence
 
+from bridge.cli_types import ArgumentParser
 from executor.campaign.pairs import PAIRS_ARGUMENT
 from executor.control.detector import Thresholds
 from executor.evidence import AttemptSetup
@@ -22,7 +22,7 @@ from executor.trial import Cell, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="executor margins", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="executor margins", description=__doc__.split("\n\n")[0])
     parser.add_argument("--trials", type=int, default=10, help="attempts per pair (default 10)")
     parser.add_argument("--seed", type=int, default=0, help="first seed")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")

@@ -37,6 +37,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from bridge.cli_types import ArgumentParser, add_assembly_argument
 from executor import ExecutorError
 from executor.campaign.pairs import (
     HOLE_NAMES,
@@ -202,7 +203,7 @@ def campaign_report(run: CampaignRun, seed: int, workers: int) -> dict[str, Any]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="executor campaign",
         description="Fig. 18: randomised executions of every fitting pair of the paper's "
         "table plus every non-fitting pair of {p1,tp,p3,sh} x {r1,br,s1}.",
@@ -211,7 +212,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
-    parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
+    add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
     parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
     return parser

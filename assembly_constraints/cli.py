@@ -1,0 +1,102 @@
+"""``assembly-constraints``: the one command line of the planner and the cell.
+
+``assembly-constraints [-v | -q] SUBCOMMAND [ARGS...]`` runs one subcommand; each takes
+``--help``. The planner's subcommands are those of :data:`asp.cli.SUBCOMMANDS`, the cell's
+are under ``executor`` (:mod:`executor.cli`), ``bench executor`` is the cell's benchmark,
+and ``protocol`` writes the published message schemas (:mod:`bridge.protocol_schema`).
+Modules are imported lazily, so ``--help`` of one subcommand does not pay for the others.
+
+Exit codes: 0 done, 1 a check failed, 2 bad input or usage (a missing subcommand too),
+3 an unsolvable assembly, 130 interrupted, 141 stdout closed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+from collections.abc import Callable, Sequence
+
+from assembly_constraints import __version__
+from bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
+
+CELL_SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "executor": ("executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve"),
+    "protocol": ("bridge.protocol_schema", "write or check the JSON Schema of every Zenoh message"),
+}
+"""Subcommands beside the planner's: name → (module whose ``main(argv)`` runs it, help)."""
+
+
+def subcommands() -> dict[str, tuple[str, str]]:
+    """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
+    from asp.cli import SUBCOMMANDS
+
+    return {**SUBCOMMANDS, "bench": ("assembly_constraints.cli:bench_main", SUBCOMMANDS["bench"][1]),
+            **CELL_SUBCOMMANDS}
+
+
+def bench_main(argv: list[str]) -> int:
+    """``bench TOPIC``: the planner's benchmarks, and the cell's under ``bench executor``."""
+    from asp.bench.cli import TOPICS
+
+    topics = {**TOPICS, "executor": "executor.campaign.bench"}
+    parser = ArgumentParser(prog="bench", description="Benchmarks: each prints its figures (medians, ratios); "
+                            "docs/results.md lists the measured values and the commands.")
+    parser.add_argument("topic", nargs="?", choices=list(topics), metavar="TOPIC", help=f"one of: {', '.join(topics)}")
+    parser.add_argument("arguments", nargs=argparse.REMAINDER, metavar="ARGS",
+                        help="the benchmark's options (see bench TOPIC --help)")
+    args = parser.parse_args(argv)
+    if args.topic is None:
+        parser.error(f"expected a benchmark, one of: {', '.join(topics)}")
+    return int(_entry(topics[args.topic])(args.arguments) or 0)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The top of the parser tree: global options and the subcommand's name; the
+    subcommand parses the rest of the arguments itself."""
+    commands = subcommands()
+    listing = "\n".join(f"  {name:<11} {text}" for name, (_, text) in commands.items())
+    parser = ArgumentParser(
+        prog=PROGRAM, formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Learn assembly constraints by demonstration and active exploration: precedence\n"
+                    "from demonstrated sequences, which part fits which hole from a robot cell's\n"
+                    "experiments, and complete assembly plans.",
+        epilog=f"subcommands (each takes --help):\n{listing}\n\n"
+               "exit codes: 0 done, 1 a check failed, 2 bad input or usage, 3 an unsolvable assembly")
+    parser.add_argument("--version", action="version", version=f"{PROGRAM} {__version__}",
+                        help="print the version and exit")
+    loudness = parser.add_mutually_exclusive_group()
+    loudness.add_argument("-v", "--verbose", action="store_true",
+                          help="also log details (log level DEBUG)")
+    loudness.add_argument("-q", "--quiet", action="store_true",
+                          help="log errors only: no progress, no warnings (log level ERROR)")
+    parser.add_argument("subcommand", nargs="?", choices=list(commands), metavar="SUBCOMMAND",
+                        help=f"one of: {', '.join(commands)}")
+    parser.add_argument("arguments", nargs=argparse.REMAINDER, metavar="ARGS",
+                        help="the subcommand's arguments (see SUBCOMMAND --help)")
+    return parser
+
+
+def _entry(target: str) -> Callable[[list[str]], int]:
+    module, _, function = target.partition(":")
+    return getattr(importlib.import_module(module), function or "main")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one subcommand; returns its exit code (see the module's docstring)."""
+    parser = build_parser()
+    args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
+    if args.subcommand is None:
+        parser.error(f"expected a subcommand, one of: {', '.join(subcommands())} (see --help)")
+    configure_logging(logging.DEBUG if args.verbose else logging.ERROR if args.quiet else logging.INFO)
+    target, _ = subcommands()[args.subcommand]
+    from asp import PlannerError
+    from bridge import BridgeError
+    from executor import ExecutorError
+
+    return run_command(lambda: int(_entry(target)(args.arguments) or 0), (PlannerError, ExecutorError, BridgeError))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

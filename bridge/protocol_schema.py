@@ -1,0 +1,97 @@
+"""``assembly-constraints protocol``: the JSON Schema of every Zenoh message, generated
+from the message types of :mod:`bridge.messages`.
+
+The schemas are published in ``docs/protocol/`` (one file a message, described in
+``docs/protocol.md``) for clients in any language; a test fails when the checked-in files
+and the types drift apart. ``protocol --out docs/protocol`` rewrites them, ``protocol
+--check docs/protocol`` exits 1 naming the files that differ, and without options the
+schemas are printed as one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+import msgspec
+
+from bridge.cli_types import ArgumentParser
+from bridge.files import make_folder, write_atomic
+from bridge.keys import ALIVE_PATTERN, CELL_ID_PATTERN
+from bridge.messages import MAX_MESSAGE_BYTES, PROTOCOL_VERSION, ErrorReply, InsertReply, InsertRequest
+
+MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
+    "insert_request": (InsertRequest, "planner → cell, a query on cell/<id>/insert"),
+    "insert_reply": (InsertReply, "cell → planner, the reply to an insert request"),
+    "error_reply": (ErrorReply, "cell → planner, a refused insert request"),
+}
+"""File stem → (message type, who sends it where)."""
+
+DRAFT = "https://json-schema.org/draft/2020-12/schema"
+
+
+def _plain(value: object) -> object:
+    """``value`` with the reStructuredText literals of docstrings (double backquotes) removed."""
+    if isinstance(value, dict):
+        return {k: v.replace("``", "") if k == "description" and isinstance(v, str) else _plain(v)
+                for k, v in value.items()}
+    return [_plain(v) for v in value] if isinstance(value, list) else value
+
+
+def schema(message: type[msgspec.Struct], direction: str) -> dict:
+    """The JSON Schema (draft 2020-12) of one message type, self-contained (``$defs``)."""
+    generated: dict = _plain(msgspec.json.schema(message))  # type: ignore[assignment]
+    name = generated["$ref"].rsplit("/", 1)[-1]
+    defs = generated["$defs"]
+    return {"$schema": DRAFT, "title": name,
+            "description": f"{defs[name].get('description', name)} ({direction}; protocol version "
+                           f"{PROTOCOL_VERSION}, at most {MAX_MESSAGE_BYTES} bytes of UTF-8 JSON)",
+            **{key: value for key, value in defs[name].items() if key not in ("title", "description")},
+            "$defs": {key: value for key, value in defs.items() if key != name}}
+
+
+def schemas() -> dict[str, str]:
+    """File name → text of every published schema (sorted keys, two-space indent, newline)."""
+    texts = {f"{stem}.schema.json": schema(message, direction) for stem, (message, direction) in MESSAGES.items()}
+    texts["protocol.json"] = {"protocol_version": PROTOCOL_VERSION, "max_message_bytes": MAX_MESSAGE_BYTES,
+                              "cell_id_pattern": CELL_ID_PATTERN, "alive_pattern": ALIVE_PATTERN,
+                              "keys": {"insert": "cell/<id>/insert", "ping": "cell/<id>/ping",
+                                       "alive": "cell/<id>/alive/<instance>"},
+                              "messages": {f"{stem}.schema.json": direction
+                                           for stem, (_, direction) in MESSAGES.items()}}
+    return {name: json.dumps(value, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
+            for name, value in texts.items()}
+
+
+def drift(folder: Path) -> list[str]:
+    """The files of ``folder`` that differ from the generated schemas (missing ones too)."""
+    return [name for name, text in schemas().items()
+            if not (folder / name).is_file() or (folder / name).read_text(encoding="utf-8") != text]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = ArgumentParser(prog="protocol", description="Write or check the JSON Schema of every Zenoh message "
+                            "(generated from the message types); without options, print them as one JSON object.")
+    what = parser.add_mutually_exclusive_group()
+    what.add_argument("--out", type=Path, metavar="DIR", help="write the schema files into this folder")
+    what.add_argument("--check", type=Path, metavar="DIR",
+                      help="exit 1 when the schema files in this folder differ from the message types")
+    return parser
+
+
+def main(argv: Sequence[str]) -> int:
+    args = build_parser().parse_args(list(argv))
+    if args.check is not None:
+        stale = drift(args.check)
+        for name in stale:
+            print(f"{args.check / name}: differs from the message types (regenerate: protocol --out {args.check})")
+        return 1 if stale else 0
+    if args.out is not None:
+        make_folder(args.out)
+        for name, text in schemas().items():
+            print(f"wrote {write_atomic(args.out / name, text)}")
+        return 0
+    print(json.dumps({name: json.loads(text) for name, text in schemas().items()}, indent=2, ensure_ascii=False))
+    return 0

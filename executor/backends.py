@@ -1,0 +1,96 @@
+"""What a cell's backend implements, and loading one by name (``serve --backend module:Class``).
+
+``executor serve`` answers the protocol (docs/protocol.md: validation, idempotency, queue,
+liveliness); a backend only runs experiments. A real cell plugs in its robot by writing a
+class with
+
+- ``__init__(self, context: CellContext)``: connect to the robot; raise
+  :class:`executor.ExecutorError` with a one-line message if it cannot (exit 2);
+- ``run(self, request: InsertRequest) -> tuple[Result, Evidence | None]``: insert
+  ``request.part`` into ``request.hole`` once and say ``"fit"`` or ``"no_fit"``, with
+  the measurements if there are any. Raise :class:`UnknownPair` for a part or hole the
+  cell does not have (the planner gets ``unknown_id``), :class:`executor.ExecutorError`
+  when the experiment could not run (``failed``, which the planner sends again);
+- ``close(self)``: release the robot.
+
+``run`` is called from one thread, one experiment at a time. Start it with
+``assembly-constraints executor serve --backend my_package.my_module:MyBackend
+--backend-option speed=0.2`` (the module must be importable: installed, or on
+``PYTHONPATH``). :class:`executor.replay.ReplayBackend` is a worked example; docs/backends.md
+describes the interface and docs/ros2.md how a backend reaches a ROS 2 robot.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+from bridge.inputs import shorten
+from bridge.messages import Evidence, InsertRequest, Result
+from executor import ExecutorError
+
+_SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
+
+
+class UnknownPair(ExecutorError):
+    """The request names a part or hole the cell does not have."""
+
+
+class Backend(Protocol):
+    """Runs one insertion experiment."""
+
+    def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        """The outcome and its evidence; ExecutorError for a bad part or hole."""
+        ...
+
+    def close(self) -> None: ...
+
+
+@dataclass(frozen=True)
+class CellContext:
+    """What ``executor serve`` tells a backend it loads: the cell's id, the assembly (a
+    shipped one's name or a folder), where to save a Rerun recording (None: none) under
+    which recording id, and the ``--backend-option KEY=VALUE`` pairs."""
+
+    cell_id: str
+    assembly: str
+    rrd: Path | None = None
+    recording_id: str | None = None
+    options: Mapping[str, str] = field(default_factory=dict)
+
+    def option(self, key: str) -> str:
+        """The value of ``--backend-option KEY=...``; ExecutorError when it was not given."""
+        if key not in self.options:
+            raise ExecutorError(f"this backend needs --backend-option {key}=...")
+        return self.options[key]
+
+
+def backend_option(text: str) -> tuple[str, str]:
+    """An argparse type: ``"key=value"`` → ``("key", "value")``."""
+    key, sep, value = text.partition("=")
+    if not (sep and re.fullmatch(r"[A-Za-z_][\w-]*", key)):
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected KEY=VALUE")
+    return key, value
+
+
+def load_backend(spec: str, context: CellContext) -> Backend:
+    """Import ``module:Class`` and construct it with ``context``; ExecutorError naming the
+    spec when the module or class is missing or the class lacks ``run``/``close``."""
+    match = _SPEC.match(spec)
+    if match is None:
+        raise ExecutorError(f"--backend {spec!r}: expected sim, truth or MODULE:CLASS")
+    module_name, class_name = match.groups()
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ExecutorError(f"--backend {spec}: cannot import {module_name} ({exc})") from None
+    factory = getattr(module, class_name, None)
+    if not isinstance(factory, type) or not all(callable(getattr(factory, m, None)) for m in ("run", "close")):
+        raise ExecutorError(f"--backend {spec}: expected a class {class_name} in {module_name} "
+                            "with the methods run(request) and close()")
+    return factory(context)
