@@ -5,8 +5,8 @@
 - :mod:`bridge.session`: opening Zenoh sessions (peer mode on loopback by default);
 - :mod:`bridge.client`: requests with id, timeout and failover; cell discovery;
 - :mod:`bridge.assembly`: the assembly folder (``assembly.toml``) and its loader;
-- :mod:`bridge.rerun_layout`: the Rerun application id, entity roots and blueprint;
-- :mod:`bridge.recordings`: reading ``.rrd`` recordings back;
+- :mod:`bridge.recording.layout`: the Rerun application id, entity roots and blueprint;
+- :mod:`bridge.recording.reader`: reading ``.rrd`` recordings back;
 - :mod:`bridge.cli_types`: argument types both command lines use;
 - :mod:`bridge.files`: writing output files atomically, checking output paths.
 

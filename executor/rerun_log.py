@@ -45,8 +45,8 @@ import rerun as rr
 
 from bridge import BridgeError
 from bridge.files import check_writable
-from bridge.recording_compaction import compact_recording
-from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, cell_root
+from bridge.recording.compaction import compact_recording
+from bridge.recording.layout import APPLICATION_ID, cell_blueprint, cell_root
 from executor import ExecutorError
 
 if TYPE_CHECKING:

@@ -77,7 +77,7 @@ class TruthBackend:
         if rrd is not None:
             import rerun as rr
 
-            from bridge.rerun_layout import APPLICATION_ID
+            from bridge.recording.layout import APPLICATION_ID
             from executor.rerun_log import save_recording
 
             self._log = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)

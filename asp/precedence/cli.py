@@ -10,7 +10,6 @@ import argparse
 import json
 import logging
 import random
-import sys
 from itertools import islice
 
 from asp import PlannerError

@@ -1,9 +1,9 @@
 """The planner's Rerun log of a session (entities ``planner/...``).
 
 Planner and cells log into ONE recording id (application
-:data:`bridge.rerun_layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
+:data:`bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
 files opened together are one recording. The planner sends the blueprint: its views
-in a first tab, then one tab per cell (:func:`bridge.rerun_layout.cell_blueprint`).
+in a first tab, then one tab per cell (:func:`bridge.recording.layout.cell_blueprint`).
 
 =========================== ==========================================================
 ``planner/knowledge``       part × hole matrix after every experiment (tensor: 1 fits,
@@ -28,8 +28,8 @@ import rerun as rr
 
 from asp.precedence.relation import Relation, reduction
 from asp.sizes.knowledge import Knowledge
-from bridge.recording_compaction import compact_recording
-from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
+from bridge.recording.compaction import compact_recording
+from bridge.recording.layout import APPLICATION_ID, cell_blueprint, planner_views
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]

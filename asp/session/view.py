@@ -4,8 +4,8 @@ RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: pla
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
 on the files plus ``RUN/view.rbl``, a blueprint with the planner's tab
-(``bridge.rerun_layout.planner_views``) when the recording has ``planner/...`` entities
-and one tab per cell found (``bridge.rerun_layout.cell_views``). Without a display (no ``DISPLAY`` /
+(``bridge.recording.layout.planner_views``) when the recording has ``planner/...`` entities
+and one tab per cell found (``bridge.recording.layout.cell_views``). Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
 same as JSON). A RUN without ``.rrd`` files is an error (exit code 2).
@@ -59,7 +59,7 @@ def rerun_executable() -> str:
 def write_blueprint(folder: Path, cells: Sequence[str], planner: bool) -> Path:
     """``folder/view.rbl``: the planner's tab (if ``planner``), then one tab per cell."""
     from bridge.files import check_writable
-    from bridge.rerun_layout import APPLICATION_ID, cell_blueprint, planner_views
+    from bridge.recording.layout import APPLICATION_ID, cell_blueprint, planner_views
 
     path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
     extra = [planner_views()] if planner else []
@@ -74,7 +74,7 @@ def main(argv: Sequence[str]) -> int:
     parser.add_argument("--json", action="store_true", help="print the contents as JSON")
     args = parser.parse_args(list(argv))
 
-    from bridge.recordings import format_summary, read_recording
+    from bridge.recording.reader import format_summary, read_recording
 
     run = Path(args.run)
     files = recording_files(run)

@@ -15,7 +15,7 @@ from bridge.session import free_loopback_endpoint, open_session
 @pytest.mark.timeout(90)
 @pytest.mark.slow
 def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
-    from bridge.recordings import column_values, read_recording
+    from bridge.recording.reader import column_values, read_recording
 
     endpoint = free_loopback_endpoint()
     rrd = tmp_path / "c1.rrd"

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from bridge.recordings import column_values, read_recording
+from bridge.recording.reader import column_values, read_recording
 
 pytestmark = pytest.mark.slow  # real PyBullet campaigns, 10-15 s each
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bridge.recordings import chunk_count, column_values
+from bridge.recording.reader import chunk_count, column_values
 from executor.evidence import AttemptEvidence
 from executor.rerun_log import AttemptLogger
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bridge.recordings import column_values, read_recording
+from bridge.recording.reader import column_values, read_recording
 from executor.rerun_log import AttemptLogger
 from executor.trial import Cell
 

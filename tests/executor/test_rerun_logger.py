@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from bridge import BridgeError
-from bridge.recordings import blueprint_origins, column_values, format_summary, read_recording
+from bridge.recording.reader import blueprint_origins, column_values, format_summary, read_recording
 from executor import ExecutorError
 from executor.rerun_log import PHASE_SCALE, AttemptLogger
 

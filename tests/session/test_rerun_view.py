@@ -10,7 +10,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from asp.session.view import cell_ids, write_blueprint
-from bridge.recordings import blueprint_origins
+from bridge.recording.reader import blueprint_origins
 from executor.rerun_log import AttemptLogger
 
 

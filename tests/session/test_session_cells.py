@@ -102,7 +102,7 @@ def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[Ce
 
 
 def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path, run_session) -> None:
-    from bridge.recordings import column_values, read_recording
+    from bridge.recording.reader import column_values, read_recording
 
     run = tmp_path / "run"
     result = run_session("--cells", "2", "--out", str(run), "--policy", "best")

@@ -111,7 +111,7 @@ def _chunks(path: Path) -> Iterator[Chunk]:
 
 def chunk_count(path: Path | str) -> int:
     """How many chunks the recording stores of ``path`` hold (blueprints excluded): what
-    compaction (:mod:`bridge.recording_compaction`) brings down."""
+    compaction (:mod:`bridge.recording.compaction`) brings down."""
     return sum(1 for _ in _chunks(Path(path)))
 
 
