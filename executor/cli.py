@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 from bridge import BridgeError
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
+from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 from executor import ExecutorError
 
 MAX_TRIALS = 100_000
@@ -46,13 +47,21 @@ def _summary(results: list[dict]) -> dict:
 
 
 def _trial(args: argparse.Namespace) -> int:
+    viewer = viewer_of(args)
+    with hosted_viewer(viewer) as live:
+        return _trials(args, live, viewer)
+
+
+def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
+    """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
+    with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
     from executor.trial import Cell
 
     logger = None
-    if args.rrd:
+    if args.rrd or live != NO_VIEWER:
         from executor.rerun_log import AttemptLogger
 
-        logger = AttemptLogger.to_file(args.rrd)
+        logger = AttemptLogger.to_file(args.rrd, viewer=live)
     cell = Cell(args.assembly, gui=args.gui, logger=logger)
     try:
         results = []
@@ -67,15 +76,17 @@ def _trial(args: argparse.Namespace) -> int:
                     f"end error {1000 * r['end_error']:.1f} mm, {r['duration_s']:.2f} s wall "
                     f"({r['real_time_factor']:.1f}x real time)"
                 )
+        summary = _summary(results)
+        if args.json:
+            print(json.dumps({"trials": results, "summary": summary}, indent=2), flush=True)
+        else:
+            print(f"summary: {summary['fit']}/{summary['trials']} fit, median {summary['median_duration_s']:.2f} s "
+                  "wall", flush=True)
+        keep_serving(viewer)
     finally:
         cell.close()
         if logger is not None:
             logger.close()
-    summary = _summary(results)
-    if args.json:
-        print(json.dumps({"trials": results, "summary": summary}, indent=2))
-    else:
-        print(f"summary: {summary['fit']}/{summary['trials']} fit, median {summary['median_duration_s']:.2f} s wall")
     return 0
 
 
@@ -109,7 +120,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="attempts per trial before 'no_fit' (default 2)")
     add_assembly_argument(trial)
     trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
-    trial.add_argument("--rrd", help="save a Rerun recording of every attempt to this file")
+    trial.add_argument("--save", "--rrd", dest="rrd", metavar="FILE",
+                       help="save a Rerun recording of every attempt to this .rrd file")
+    add_viewer_arguments(trial)
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     trial.set_defaults(func=_trial)
 

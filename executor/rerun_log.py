@@ -44,9 +44,9 @@ import numpy as np
 import rerun as rr
 
 from bridge import BridgeError
-from bridge.files import check_writable
 from bridge.recording.compaction import compact_recording
 from bridge.recording.layout import APPLICATION_ID, cell_blueprint, cell_root
+from bridge.recording.sinks import NO_VIEWER, Viewer, open_stream
 from executor import ExecutorError
 
 if TYPE_CHECKING:
@@ -135,12 +135,12 @@ class AttemptTrace:
         return np.asarray(getattr(self, name), dtype=np.float64)
 
 
-def save_recording(recording: rr.RecordingStream, rrd_path: Path) -> None:
-    """Stream ``recording`` to the file ``rrd_path`` (written by the Rerun SDK, not
-    atomically); ExecutorError ``<path>: cannot write (<reason>)`` when it cannot be created."""
+def open_recording(recording_id: str, rrd_path: Path | None, viewer: Viewer = NO_VIEWER,
+                   application_id: str = APPLICATION_ID) -> rr.RecordingStream:
+    """A stream of ``recording_id`` to the file ``rrd_path`` (written by the Rerun SDK) and to
+    ``viewer``; ExecutorError ``<path>: cannot write (<reason>)`` when the file cannot be created."""
     try:
-        check_writable(rrd_path)
-        recording.save(str(rrd_path))
+        return open_stream(application_id, recording_id, rrd_path, viewer)
     except BridgeError as exc:
         raise ExecutorError(str(exc)) from None
     except RuntimeError as exc:  # the SDK's own check, e.g. a race with the one above
@@ -154,7 +154,8 @@ class AttemptLogger:
     ``application_id`` (default ``assembly_constraints``) with ``recording_id``
     (random if None) saving to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
     existing ``rr.RecordingStream`` instead. Without either, data stays in memory
-    (``keep_traces`` then still gives the traces for plots).
+    (``keep_traces`` then still gives the traces for plots). ``viewer``: also stream
+    live to a Rerun viewer or serve it to a browser (:mod:`bridge.recording.sinks`).
 
     ``period_s`` [s]: steps closer than this in sim time to the last kept one are
     skipped. ``keep_traces``: keep every finished :class:`AttemptTrace` in ``traces``.
@@ -171,6 +172,7 @@ class AttemptLogger:
         period_s: float = 0.005,
         keep_traces: bool = False,
         send_blueprint: bool = True,
+        viewer: Viewer = NO_VIEWER,
     ) -> None:
         if recording is not None and rrd_path is not None:
             raise ExecutorError("AttemptLogger: give rrd_path or recording, not both")
@@ -184,13 +186,7 @@ class AttemptLogger:
         self._owns_stream = recording is None
         self._rrd_path = Path(rrd_path) if rrd_path is not None else None
         if recording is None:
-            recording = rr.RecordingStream(
-                application_id, recording_id=recording_id or str(uuid.uuid4())
-            )
-            if rrd_path is not None:
-                save_recording(recording, Path(rrd_path))
-            else:
-                recording.memory_recording()
+            recording = open_recording(recording_id or str(uuid.uuid4()), self._rrd_path, viewer, application_id)
         self.rec = recording
         self._experiment = 0
         self._last_attempt: tuple[str, str, int, int] | None = None
@@ -208,11 +204,12 @@ class AttemptLogger:
 
     @classmethod
     def to_file(
-        cls, rrd_path: str | Path, cell_id: str = "c1", recording_id: str | None = None
+        cls, rrd_path: str | Path | None, cell_id: str = "c1", recording_id: str | None = None,
+        viewer: Viewer = NO_VIEWER,
     ) -> AttemptLogger:
         """A logger saving to ``rrd_path`` (its folder must exist; ExecutorError naming the
-        path if the file cannot be created)."""
-        return cls(cell_id, recording_id=recording_id, rrd_path=rrd_path)
+        path if the file cannot be created) and streaming to ``viewer``."""
+        return cls(cell_id, recording_id=recording_id, rrd_path=rrd_path, viewer=viewer)
 
     # -- static geometry -------------------------------------------------------------
 

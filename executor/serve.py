@@ -50,6 +50,7 @@ from bridge.messages import (
     decode_request,
     encode,
 )
+from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
 from executor import ExecutorError
 from executor.backends import Backend, CellContext, UnknownPair, backend_option, load_backend
@@ -67,21 +68,17 @@ class TruthBackend:
     cross-section does, :func:`executor.world.geometry.passes`), after ``delay_s`` [s]."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
-                 recording_id: str | None, rrd: Path | None) -> None:
+                 recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER) -> None:
         try:
             self._geometry = load_geometry(assembly)
         except BridgeError as exc:
             raise ExecutorError(f"truth backend: {exc}") from None
         self._delay_s = delay_s
         self._log = None
-        if rrd is not None:
-            import rerun as rr
+        if rrd is not None or viewer != NO_VIEWER:
+            from executor.rerun_log import open_recording
 
-            from bridge.recording.layout import APPLICATION_ID
-            from executor.rerun_log import save_recording
-
-            self._log = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
-            save_recording(self._log, rrd)
+            self._log = open_recording(recording_id or str(uuid.uuid4()), rrd, viewer)
             self._entity = f"executor/{cell_id}/outcome"
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
@@ -124,13 +121,13 @@ class SimBackend:
     """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
-                 rrd: Path | None) -> None:
+                 rrd: Path | None, viewer: Viewer = NO_VIEWER) -> None:
         from executor.trial import Cell
 
         _PlannerNumbered = _planner_numbered_logger()
-        self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd,
+        self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd, viewer=viewer,
                                          send_blueprint=False)  # the planner sends it
-                        if rrd is not None else None)
+                        if rrd is not None or viewer != NO_VIEWER else None)
         self._cell = Cell(assembly, gui=False, logger=self._logger)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
@@ -287,6 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="truth backend: seconds each experiment takes (default 0)")
     parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
     parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
+    add_viewer_arguments(parser, serve=False)  # a cell serves for as long as it runs: stream to a viewer
     parser.add_argument("--lifeline", action="store_true",
                         help="exit when standard input closes (set by a supervising session)")
     add_endpoint_arguments(parser)
@@ -307,9 +305,9 @@ def main(argv: Sequence[str]) -> int:
     signal.signal(signal.SIGINT, _exit_on_signal)
     backend: Backend
     if args.backend == "truth":
-        backend = TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
+        backend = TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args))
     elif args.backend == "sim":
-        backend = SimBackend(args.assembly, cell_id, args.recording_id, args.rrd)
+        backend = SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args))
     else:
         backend = load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
                                                          dict(args.backend_option)))

@@ -99,8 +99,9 @@ class CellProcess:
 def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None,
-               zenoh_config: Path | None = None) -> list[str]:
-    """The command line of one ``executor serve`` node, with ``--lifeline``."""
+               zenoh_config: Path | None = None, viewer_url: str | None = None) -> list[str]:
+    """The command line of one ``executor serve`` node, with ``--lifeline``; ``viewer_url``:
+    a Rerun viewer or server the cell also streams its recording to."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
@@ -113,6 +114,8 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
         argv += ["--recording-id", recording_id]
     if zenoh_config is not None:
         argv += ["--zenoh-config", str(Path(zenoh_config).absolute())]
+    if viewer_url is not None:
+        argv += ["--rerun-connect", viewer_url]
     return argv
 
 

@@ -30,18 +30,18 @@ from asp.precedence.relation import Relation, reduction
 from asp.sizes.knowledge import Knowledge
 from bridge.recording.compaction import compact_recording
 from bridge.recording.layout import APPLICATION_ID, cell_blueprint, planner_views
+from bridge.recording.sinks import NO_VIEWER, Viewer, open_stream
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]
 
 
 class PlannerLog:
-    """Logs the planner's entities into ``rrd`` under ``recording_id``."""
+    """Logs the planner's entities into ``rrd`` under ``recording_id``, and live to ``viewer``."""
 
-    def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str]) -> None:
+    def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str], viewer: Viewer = NO_VIEWER) -> None:
         self.rrd = rrd
-        self.rec = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
-        self.rec.save(str(rrd))
+        self.rec = open_stream(APPLICATION_ID, recording_id, rrd, viewer)
         self.rec.send_blueprint(cell_blueprint(cell_ids, extra=[planner_views()]))
 
     def precedence(self, parts: Sequence[str], edges: Sequence[tuple[str, str]]) -> None:

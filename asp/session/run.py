@@ -58,6 +58,7 @@ from bridge.client import CellDirectory, CellPool
 from bridge.files import make_folder, write_atomic
 from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
+from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
 
 LOG = logging.getLogger(__name__)
@@ -95,6 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "a session that starts its cells uses only those")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
+    add_viewer_arguments(parser)
     return parser
 
 
@@ -267,14 +269,15 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
     return assignment, found
 
 
-def run_session(args: argparse.Namespace) -> dict:
-    """Run (or resume) a session; returns the JSON result."""
+def run_session(args: argparse.Namespace, viewer: Viewer = NO_VIEWER) -> dict:
+    """Run (or resume) a session; returns the JSON result. Planner and cells also stream
+    their recordings live to ``viewer``."""
     started = time.perf_counter()
     if args.cells < 0:
         raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
     run, settings, lock, created = _run_folder(args)
     try:
-        return _run_locked(args, run, settings, started)
+        return _run_locked(args, run, settings, started, viewer)
     except BaseException:
         if created and not _holds_session(run):  # failed at start: no half-made run folder
             shutil.rmtree(run, ignore_errors=True)
@@ -283,7 +286,7 @@ def run_session(args: argparse.Namespace) -> dict:
         lock.release()
 
 
-def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: float) -> dict:
+def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: float, viewer: Viewer) -> dict:
     """:func:`run_session` in the locked run folder ``run``; ``started``: its
     ``time.perf_counter()`` [s] at the start."""
     assembly = load_assembly(settings["assembly"])
@@ -308,8 +311,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
             cells.append(CellProcess(cell_id, serve_argv(
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
-                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config)))
-        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
+                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config, viewer_url=viewer.connect)))
+        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids, viewer)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
         journal = Journal(run)
@@ -400,9 +403,12 @@ def _summary(result: dict, run: Path) -> str:
 
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
+    viewer = viewer_of(args)
     try:
-        result = run_session(args)
+        with hosted_viewer(viewer) as live:
+            result = run_session(args, live)
+            print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
+            keep_serving(viewer)
     except BridgeError as exc:
         raise PlannerError(str(exc)) from None
-    print(json.dumps(result) if args.json else _summary(result, Path(result["run"])))
     return 0

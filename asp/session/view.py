@@ -8,7 +8,9 @@ on the files plus ``RUN/view.rbl``, a blueprint with the planner's tab
 and one tab per cell found (``bridge.recording.layout.cell_views``). Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
-same as JSON). A RUN without ``.rrd`` files is an error (exit code 2).
+same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
+free loopback ports; the address is logged; Ctrl-C stops). A RUN without ``.rrd`` files
+is an error (exit code 2).
 """
 
 from __future__ import annotations
@@ -72,6 +74,9 @@ def main(argv: Sequence[str]) -> int:
     parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
     parser.add_argument("--print", action="store_true", help="print the contents, no viewer")
     parser.add_argument("--json", action="store_true", help="print the contents as JSON")
+    parser.add_argument("--web", action="store_true",
+                        help="serve the recording to a web browser (for headless machines); the address to open "
+                             "is printed, Ctrl-C stops")
     args = parser.parse_args(list(argv))
 
     from bridge.recording.reader import format_summary, read_recording
@@ -79,7 +84,7 @@ def main(argv: Sequence[str]) -> int:
     run = Path(args.run)
     files = recording_files(run)
     summary = read_recording(files)
-    if args.print or args.json or not has_display():
+    if args.print or args.json or not (has_display() or args.web):
         if not (args.print or args.json):
             print("view: no display (DISPLAY/WAYLAND_DISPLAY unset); printing the recording",
                   file=sys.stderr)
@@ -88,6 +93,13 @@ def main(argv: Sequence[str]) -> int:
     cells = cell_ids(list(summary.entities))
     planner = bool(summary.under("planner"))
     blueprint = write_blueprint(run if run.is_dir() else run.parent, cells, planner)
+    if args.web:
+        from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
+
+        served = Viewer(serve=True)
+        with hosted_viewer(served, [*files, blueprint]):
+            keep_serving(served)
+        return 0
     subprocess.Popen(
         [rerun_executable(), *map(str, files), str(blueprint)],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,

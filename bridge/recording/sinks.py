@@ -1,0 +1,148 @@
+"""Where a recording goes: its file, and live to a Rerun viewer.
+
+Every command that records takes the options :func:`add_viewer_arguments` adds, the
+counterparts of the Rerun examples' ``--connect`` and ``--serve`` (named
+``--rerun-connect`` / ``--rerun-serve`` because ``--connect`` already names a Zenoh
+endpoint in ``session`` and ``executor serve``):
+
+- ``--rerun-connect [URL]``: also stream live to a running viewer (``rerun`` started on
+  this machine listens on :data:`DEFAULT_VIEWER_URL`);
+- ``--rerun-serve``: also host the recording for a web browser (headless machines): a
+  gRPC server and the web viewer on free loopback ports; the address is logged.
+
+:func:`open_stream` makes the stream with both sinks at once (file and viewer), so the
+file is the same whether or not someone watches; :func:`hosted_viewer` runs the web
+viewer (Rerun's own ``rerun --serve-web``) for as long as the command needs it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from urllib.parse import quote
+
+import rerun as rr
+
+from bridge import BridgeError
+from bridge.files import check_writable
+
+DEFAULT_VIEWER_URL = "rerun+http://127.0.0.1:9876/proxy"
+"""Where a Rerun viewer started on this machine listens for recordings."""
+_LOG = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Viewer:
+    """Live viewing of a recording: a viewer's URL to stream to, and/or a hosted web viewer."""
+
+    connect: str | None = None
+    serve: bool = False
+
+
+NO_VIEWER = Viewer()
+"""Nobody watches live: the recording goes to its file only."""
+
+
+def add_viewer_arguments(parser: argparse.ArgumentParser, serve: bool = True) -> None:
+    """Add ``--rerun-connect [URL]`` and (``serve``) ``--rerun-serve`` to ``parser``."""
+    parser.add_argument("--rerun-connect", nargs="?", const=DEFAULT_VIEWER_URL, metavar="URL",
+                        help=f"also stream the recording live to a running Rerun viewer (default {DEFAULT_VIEWER_URL})")
+    if serve:
+        parser.add_argument("--rerun-serve", action="store_true",
+                            help="also serve the recording to a web browser (for headless machines); "
+                                 "the address to open is printed, Ctrl-C stops")
+
+
+def viewer_of(args: argparse.Namespace) -> Viewer:
+    """The :class:`Viewer` the options of :func:`add_viewer_arguments` ask for."""
+    return Viewer(args.rerun_connect, getattr(args, "rerun_serve", False))
+
+
+def free_port() -> int:
+    """A TCP port free on the loopback interface now."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def open_stream(application_id: str, recording_id: str, rrd_path: Path | None,
+                viewer: Viewer = NO_VIEWER) -> rr.RecordingStream:
+    """A recording stream to ``rrd_path`` (checked writable first) and, if asked, live to
+    ``viewer.connect``; in memory when there is neither. BridgeError naming the file if it
+    cannot be written. (``viewer.serve`` is :func:`hosted_viewer`'s job.)"""
+    recording = rr.RecordingStream(application_id, recording_id=recording_id)
+    sinks: list[rr.FileSink | rr.GrpcSink] = []
+    if rrd_path is not None:
+        check_writable(rrd_path)
+        sinks.append(rr.FileSink(str(rrd_path)))
+    if viewer.connect:
+        sinks.append(rr.GrpcSink(viewer.connect))
+    if sinks:
+        recording.set_sinks(*sinks)
+    else:
+        recording.memory_recording()
+    return recording
+
+
+@contextmanager
+def hosted_viewer(viewer: Viewer, files: Sequence[Path] = ()) -> Iterator[Viewer]:
+    """With ``viewer.serve``: host a web viewer (Rerun's own ``rerun --serve-web``, a child
+    process on free loopback ports, showing ``files`` and whatever streams into it) while
+    the block runs, log its address, and give a :class:`Viewer` that streams to it.
+    Otherwise give ``viewer`` unchanged. BridgeError if the server does not come up."""
+    if not viewer.serve:
+        yield viewer
+        return
+    grpc_port, web_port = free_port(), free_port()
+    server_url = f"rerun+http://127.0.0.1:{grpc_port}/proxy"
+    server = subprocess.Popen(
+        [sys.executable, "-m", "rerun_cli", "--serve-web", "--bind", "127.0.0.1", "--port", str(grpc_port),
+         "--web-viewer-port", str(web_port), *map(str, files)],
+        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        _wait_for_port(grpc_port, server)
+        _LOG.info("web viewer: open http://127.0.0.1:%d/?url=%s", web_port, quote(server_url, safe=""))
+        yield Viewer(connect=server_url)
+    finally:
+        server.terminate()
+        try:
+            server.wait(SERVER_START_S)
+        except subprocess.TimeoutExpired:
+            server.kill()
+
+
+SERVER_START_S = 30.0
+"""Longest the web viewer's server may take to start or stop [s]."""
+
+
+def _wait_for_port(port: int, server: subprocess.Popen) -> None:
+    deadline = time.monotonic() + SERVER_START_S
+    while time.monotonic() < deadline:
+        if server.poll() is not None:
+            raise BridgeError(f"the Rerun web viewer exited at start (code {server.returncode})")
+        with socket.socket() as probe:
+            if probe.connect_ex(("127.0.0.1", port)) == 0:
+                return
+        time.sleep(0.1)
+    raise BridgeError(f"the Rerun web viewer did not start within {SERVER_START_S:g} s")
+
+
+def keep_serving(viewer: Viewer) -> None:
+    """With ``--rerun-serve``, keep the web viewer up once the work is done, until Ctrl-C
+    (which ends the command normally); returns at once otherwise."""
+    if not viewer.serve:
+        return
+    _LOG.info("done; still serving the recording to the web viewer (Ctrl-C to stop)")
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        return

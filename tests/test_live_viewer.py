@@ -1,0 +1,116 @@
+"""Live viewing: a trial or a session streams its recording to a running Rerun viewer (a
+headless ``rerun --save`` server stands in for one), or serves it to a web browser."""
+
+from __future__ import annotations
+
+import re
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+from bridge.recording.reader import column_values, read_recording
+from bridge.recording.sinks import free_port
+from tests.conftest import ROOT, child_env
+
+
+def _wait_for(path: Path, timeout: float = 30.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not path.exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
+
+
+@contextmanager
+def headless_viewer(live: Path) -> Iterator[str]:
+    """A Rerun server saving what streams into it to ``live``; yields its URL."""
+    port = free_port()
+    viewer = subprocess.Popen([sys.executable, "-m", "rerun_cli", "--port", str(port), "--save", str(live)],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=child_env())
+    try:
+        _wait_for(live)
+        yield f"rerun+http://127.0.0.1:{port}/proxy"
+        time.sleep(1.0)
+    finally:
+        viewer.send_signal(signal.SIGINT)
+        viewer.wait(20)
+
+
+@pytest.mark.slow
+def test_a_trial_streams_live_to_a_running_viewer(tmp_path: Path, run_executor) -> None:
+    live = tmp_path / "live.rrd"
+    with headless_viewer(live) as url:
+        done = run_executor("trial", "--part", "p1", "--hole", "r1", "--save", str(tmp_path / "c1.rrd"),
+                            "--rerun-connect", url)
+        assert done.returncode == 0, done.stderr
+    outcomes = column_values(live, "executor/c1/outcome", "TextLog:text")
+    assert len(outcomes) == 1 and "p1→r1" in outcomes[0][0]
+    assert "/executor/c1/arm/lbr_iiwa_link_4" in read_recording(live).entities
+    assert column_values(tmp_path / "c1.rrd", "executor/c1/outcome", "TextLog:text") == outcomes
+
+
+@pytest.mark.slow
+def test_a_trial_serves_its_recording_to_a_web_browser_until_ctrl_c(tmp_path: Path) -> None:
+    rrd = tmp_path / "c1.rrd"
+    trial = subprocess.Popen(
+        [sys.executable, "-m", "assembly_constraints", "executor", "trial", "--part", "p1", "--hole", "r1",
+         "--save", str(rrd), "--rerun-serve"],
+        cwd=ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert trial.stderr is not None
+        lines = []
+        for line in trial.stderr:
+            lines.append(line)
+            if "Ctrl-C to stop" in line:
+                break
+        address = next(m.group(0) for line in lines if (m := re.search(r"http://127\.0\.0\.1:\d+/\S*", line)))
+        with urllib.request.urlopen(address, timeout=10) as page:
+            assert page.status == 200 and b"<html" in page.read().lower()
+        trial.send_signal(signal.SIGINT)
+        out, _ = trial.communicate(timeout=30)
+    finally:
+        trial.kill()
+    assert trial.returncode == 0
+    assert "summary: 1/1 fit" in out
+    assert len(column_values(rrd, "executor/c1/outcome", "TextLog:text")) == 1
+
+
+@pytest.mark.slow
+def test_a_session_streams_planner_and_cells_live(tmp_path: Path, run_session) -> None:
+    live = tmp_path / "live.rrd"
+    with headless_viewer(live) as url:
+        result = run_session("--cells", "2", "--out", str(tmp_path / "run"), "--rerun-connect", url)
+    entities = read_recording(live).entities
+    assert "/planner/experiments" in entities
+    assert {"/executor/c1/outcome", "/executor/c2/outcome"} <= set(entities)
+    streamed = len(column_values(live, "planner/experiments", "TextLog:text"))
+    assert streamed == result["experiments"]
+
+
+@pytest.mark.slow
+def test_view_web_serves_a_run_folder_until_ctrl_c(tmp_path: Path, run_session) -> None:
+    run = tmp_path / "run"
+    run_session("--out", str(run))
+    view = subprocess.Popen([sys.executable, "-m", "assembly_constraints", "view", str(run), "--web"],
+                            cwd=ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert view.stderr is not None
+        address = None
+        for line in view.stderr:
+            if m := re.search(r"http://127\.0\.0\.1:\d+/\S*", line):
+                address = m.group(0)
+                break
+        assert address is not None
+        with urllib.request.urlopen(address, timeout=10) as page:
+            assert page.status == 200
+        view.send_signal(signal.SIGINT)
+        view.communicate(timeout=30)
+    finally:
+        view.kill()
+    assert view.returncode == 0
+    assert (run / "view.rbl").is_file()
