@@ -8,7 +8,8 @@
 - :mod:`bridge.recording.layout`: the Rerun application id, entity roots and blueprint;
 - :mod:`bridge.recording.reader`: reading ``.rrd`` recordings back;
 - :mod:`bridge.cli_types`: argument types both command lines use;
-- :mod:`bridge.files`: writing output files atomically, checking output paths.
+- :mod:`bridge.files`: writing output files atomically, checking output paths;
+- :mod:`bridge.protocol_schema`: the JSON Schemas of the messages, as published in ``docs/protocol/``.
 
 Nothing here imports the planner (``asp``) or the cell (``executor``).
 """

@@ -46,56 +46,54 @@ class _Message(msgspec.Struct, frozen=True, forbid_unknown_fields=True, tag_fiel
 class InsertRequest(_Message, tag="insert", frozen=True):
     """Insert ``part`` into ``hole``; ``id`` makes the request idempotent at the cell."""
 
-    id: RequestId
-    part: AspId
-    hole: AspId
-    seed: Seed = 0
-    retest: bool = False
-    experiment: Annotated[int, msgspec.Meta(ge=0)] = 0
-    """The planner's experiment number (Rerun timeline ``experiment``); 0: none."""
-    timeout_s: NonNegative = 0.0
-    """How long the planner waits for the reply [s]; a cell drops the request when it is
-    still queued after this long (its client has gone). 0: no limit."""
-    v: int = PROTOCOL_VERSION
+    id: Annotated[RequestId, msgspec.Meta(description="request id: the same request again gets the cached reply "
+                                          "and is never run twice; the same id with other fields is refused")]
+    part: Annotated[AspId, msgspec.Meta(description="the part to insert, e.g. p3")]
+    hole: Annotated[AspId, msgspec.Meta(description="the hole to insert it into, e.g. s1")]
+    seed: Annotated[Seed, msgspec.Meta(description="seed of a simulated cell's randomisation")] = 0
+    retest: Annotated[bool, msgspec.Meta(description="a deliberate re-test of a pair already tried")] = False
+    experiment: Annotated[int, msgspec.Meta(ge=0, description="the planner's experiment number (Rerun timeline "
+                                            "experiment); 0: none")] = 0
+    timeout_s: Annotated[NonNegative, msgspec.Meta(description="how long the planner waits for the reply [s]; a cell "
+                                                   "drops the request when it is still queued after this long "
+                                                   "(its client has gone); 0: no limit")] = 0.0
+    v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
 
 
 class Evidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """What the cell measured during the insertion (None for the truth backend)."""
 
-    attempts: Annotated[int, msgspec.Meta(ge=0)]
-    max_force_dev: NonNegative
-    """Largest ‖F_mes − F_des‖ [N]."""
-    max_torque_dev: NonNegative
-    """Largest ‖M_mes − M_des‖ [N m]."""
-    end_error: NonNegative
-    """Distance of the final tool position from the goal [m]."""
-    duration_s: NonNegative
-    """Simulated duration of the attempts [s]."""
+    attempts: Annotated[int, msgspec.Meta(ge=0, description="insertion attempts made")]
+    max_force_dev: Annotated[NonNegative, msgspec.Meta(description="largest |F_mes - F_des| [N]")]
+    max_torque_dev: Annotated[NonNegative, msgspec.Meta(description="largest |M_mes - M_des| [N m]")]
+    end_error: Annotated[NonNegative, msgspec.Meta(description="distance of the final tool position from the goal [m]")]
+    duration_s: Annotated[NonNegative, msgspec.Meta(description="duration of the attempts [s] (simulated time in "
+                                                    "the simulator)")]
 
 
 class InsertReply(_Message, tag="insert_reply", frozen=True):
     """The outcome of request ``id`` as observed by cell ``cell``."""
 
-    id: RequestId
-    cell: CellId
-    part: AspId
-    hole: AspId
-    """``part`` and ``hole`` echo the request, so the planner can check what was answered."""
-    result: Result
-    evidence: Evidence | None = None
-    wall_s: NonNegative = 0.0
-    """Wall time the cell spent on the experiment [s]."""
-    v: int = PROTOCOL_VERSION
+    id: Annotated[RequestId, msgspec.Meta(description="the request's id")]
+    cell: Annotated[CellId, msgspec.Meta(description="the cell that ran the experiment")]
+    part: Annotated[AspId, msgspec.Meta(description="the request's part, echoed")]
+    hole: Annotated[AspId, msgspec.Meta(description="the request's hole, echoed")]
+    result: Annotated[Result, msgspec.Meta(description="fit: the part went in; no_fit: it did not")]
+    evidence: Annotated[Evidence | None, msgspec.Meta(description="the cell's measurements, or null")] = None
+    wall_s: Annotated[NonNegative, msgspec.Meta(description="wall time the cell spent on the experiment [s]")] = 0.0
+    v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
 
 
 class ErrorReply(_Message, tag="error", frozen=True):
     """A refused request: ``code`` says why, ``error`` says what was expected."""
 
-    cell: CellId
-    code: ErrorCode
-    error: str
-    id: RequestId | None = None
-    v: int = PROTOCOL_VERSION
+    cell: Annotated[CellId, msgspec.Meta(description="the refusing cell")]
+    code: Annotated[ErrorCode, msgspec.Meta(description="why: malformed, oversized, version, unknown_id, id_reused "
+                                            "(do not send again); busy, expired, failed (worth sending again)")]
+    error: Annotated[str, msgspec.Meta(description="what was wrong and what was expected, one line")]
+    id: Annotated[RequestId | None, msgspec.Meta(description="the request's id; null when the payload could not "
+                                                 "be read")] = None
+    v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
 
 
 class MessageError(BridgeError):

@@ -7,8 +7,9 @@ Layers, each importing only those before it: :mod:`executor.world` (geometry, Py
 scene, arm), :mod:`executor.control` (impedance controller, admittance, detector, motion
 stepper), :mod:`executor.skills` (DMP, hole search, insertion, wiggle, teaching), the
 records in :mod:`executor.evidence`, the Rerun log :mod:`executor.rerun_log`, the trial
-:mod:`executor.trial`, and on top :mod:`executor.campaign`, :mod:`executor.serve` and
-:mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`) drives a
+:mod:`executor.trial`, and on top :mod:`executor.campaign`, :mod:`executor.serve` (with
+the backend interface :mod:`executor.backends` and the replay backend :mod:`executor.replay`)
+and :mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`) drives a
 :class:`executor.trial.Cell` to record the skills the trial then uses.
 """
 

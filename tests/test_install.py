@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -21,9 +22,11 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str,
     """The package installed (a wheel built from the repository, not editable) into a fresh
     folder; returns the console command and the environment that runs it (that folder on
     PYTHONPATH, the repository nowhere on it; the dependencies from this interpreter)."""
+    source = tmp_path_factory.mktemp("source") / "repository"  # pip builds in the tree: not in ours
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".*", "build", "runs", "*.egg-info", "__pycache__"))
     target = tmp_path_factory.mktemp("site")
     done = subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation",
-                           "--target", str(target), str(ROOT)],
+                           "--target", str(target), str(source)],
                           capture_output=True, text=True, timeout=180)
     assert done.returncode == 0, done.stderr
     env = {name: value for name, value in os.environ.items() if name not in DISPLAY_VARIABLES}
