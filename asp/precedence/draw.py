@@ -76,6 +76,11 @@ def draw_png(relation: Relation, reduction: list[Pair], path: Path | str, title:
     nx.draw_networkx_edges(graph, position, edgelist=reduction, edge_color="black", ax=axis, width=1.5)
     nx.draw_networkx_nodes(graph, position, node_color="white", edgecolors="black", node_size=700, ax=axis)
     nx.draw_networkx_labels(graph, position, ax=axis, font_size=9)
+    from matplotlib.lines import Line2D
+
+    axis.legend(handles=[Line2D([], [], color="black", linewidth=1.5, label="direct (transitive reduction)"),
+                         Line2D([], [], color="0.8", label="implied (transitive closure)")],
+                loc="lower right", fontsize=8, frameon=False)
     axis.set_title(title)
     axis.set_axis_off()
     write_figure(path, figure, dpi=120)

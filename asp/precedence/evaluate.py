@@ -61,11 +61,12 @@ def evaluate(
                 "histogram": _histogram(admitted, total),
             }
         )
-    return {"total": total, "generator": generator, "results": results}
+    return {"total": total, "generator": generator, "trials": trials, "results": results}
 
 
 def plot(evaluation: dict, path: Path | str) -> None:
-    """Bar charts as Figs. 12/13: P over M/100 in bins of 200; m <= 10 and m > 10 side by side."""
+    """Bar charts as Figs. 12/13: P over M/100 in bins of 200; m <= 10 and m > 10 side by
+    side, on one y scale, each titled with its figure and the trials per m."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -73,8 +74,12 @@ def plot(evaluation: dict, path: Path | str) -> None:
 
     results = evaluation["results"]
     panels = [group for group in ([r for r in results if r["m"] <= 10], [r for r in results if r["m"] > 10]) if group]
-    figure, axes = plt.subplots(1, len(panels), figsize=(7 * len(panels), 4), squeeze=False)
+    figure, axes = plt.subplots(1, len(panels), figsize=(7 * len(panels), 4.4), squeeze=False, sharey=True)
     for axis, group in zip(axes[0], panels):
+        figure_number, which = (12, "m ≤ 10") if group[0]["m"] <= 10 else (13, "m > 10")
+        axis.set_title(f"Fig. {figure_number}: admitted sequences after {which} demonstrations\n"
+                       f"({evaluation['trials']} trials per m, {evaluation['generator']} demonstrations)",
+                       fontsize=10)
         keys = list(group[0]["histogram"])
         labels = [f"{int(k) / 100:g}" if k != "all" else "all" for k in keys]
         width = 0.8 / len(group)

@@ -240,6 +240,15 @@ def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
     return list(dict.fromkeys(atoms))
 
 
+def _learned_header(assembly: Assembly, run: Path) -> str:
+    """The comment atop ``learned.lp``: where it comes from and what its ids name."""
+    lines = [f"Learned by a session on {assembly.name} ({run}).", "Parts:"]
+    lines += [f"  {part.id}: {part.name}" for part in assembly.parts]
+    lines += ["Holes:", *(f"  {hole.id}: {hole.name}" for hole in assembly.holes)]
+    lines += ["must_precede(A,B): A before B; fits(P,H) / no_fit(P,H): part P goes / does not go into hole H."]
+    return "\n".join(lines)
+
+
 def _versus_truth(truth: TruthOracle | None, required: set[tuple[str, str]] | None, fits: list[tuple[str, str]],
                   must_precede: list[tuple[str, str]]) -> dict[str, bool | int | None]:
     """The learned relations against the assembly's truths (None where unknown).
@@ -343,7 +352,7 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         timings["learned_s"] = time.perf_counter() - started
         learned = run / "learned.lp"
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
-                    header=f"Learned by ./run.sh session on {assembly.name} ({run}).")
+                    header=_learned_header(assembly, run))
         assignment, found = _plans(learned, args.plans)
         write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
                     header="The greedy hole assignment (paper 2.2) of learned.lp.")

@@ -260,6 +260,6 @@ def plot_comparison(evaluations: Sequence[Evaluation], path: str) -> None:
     ax.set_xlabel("number of experiments to learn the whole relation")
     ax.set_ylabel("share of relabelings [%]")
     ax.set_xticks(xs)
-    ax.set_title(f"Experiments needed over {evaluations[0].cases} relabelings")
+    ax.set_title(f"Fig. 19: experiments needed to learn the relation, over {evaluations[0].cases} relabelings")
     ax.legend()
     write_figure(path, fig, dpi=120)

@@ -45,7 +45,7 @@ def test_evaluate_json_plot_and_guided_keys(tmp_path: Path, run_cli) -> None:
     result = run_cli("precedence", "evaluate", "--assembly", "cranfield", "--m", "5,20", "--trials", "200", "--json",
                      "--plot", str(plot))
     data = json.loads(result.stdout)
-    assert set(data) == {"total", "generator", "results"} and data["generator"] == "uniform"
+    assert set(data) == {"total", "generator", "trials", "results"} and data["generator"] == "uniform"
     assert [set(r) for r in data["results"]] == [{"m", "mean", "p_all", "p_more_than_half", "histogram"}] * 2
     assert plot.read_bytes()[:4] == b"\x89PNG"
     guided = json.loads(

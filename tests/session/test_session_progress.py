@@ -44,3 +44,5 @@ def test_the_summary_lists_the_files_and_next_commands_that_work(
     assert "br r1 r2 s1 s2" in holes.stdout
     plans = subprocess.run(commands["five complete plans"], shell=True, capture_output=True, text=True, timeout=60)
     assert "Models       : 5" in plans.stdout
+    header = [line for line in (run / "learned.lp").read_text().splitlines() if line.startswith("%")]
+    assert "%   p1: round peg 1" in header and any(line.startswith("%   br: ") for line in header)
