@@ -53,7 +53,7 @@ from asp.sizes.policies import policy_names
 from asp.solve import encoding, fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
+from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
 from bridge.files import make_folder, write_atomic
 from bridge.inputs import read_bytes, shorten
@@ -378,6 +378,13 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     return result
 
 
+def _program() -> str:
+    """How to call this program again: the repository's ``run.sh`` (absolute, so it works
+    from any folder) in a checkout, else the installed console command."""
+    wrapper = Path(__file__).resolve().parents[2] / "run.sh"
+    return shlex.quote(str(wrapper)) if wrapper.is_file() else PROGRAM
+
+
 def _summary(result: dict, run: Path) -> str:
     """The human ending of a session: what was learned, the files written, what to run next."""
     settings = json.loads((run / SETTINGS).read_text(encoding="utf-8"))
@@ -403,7 +410,7 @@ def _summary(result: dict, run: Path) -> str:
         f"files written in {run}: {' '.join(files)}",
         "next:",
         *(f"  {label + ':':<24}{command}" for label, command in (
-            ("view the recording", f"./run.sh view {shlex.quote(str(run))}"),
+            ("view the recording", f"{_program()} view {shlex.quote(str(run))}"),
             (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
             ("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5"),
         )),

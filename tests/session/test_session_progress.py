@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from asp.session.run import main as session_main
+from tests.conftest import ROOT
 
 LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s\); (\d+) pairs unknown")
 
@@ -39,7 +40,7 @@ def test_the_summary_lists_the_files_and_next_commands_that_work(
     assert files.split(": ")[1].split() == sorted(p.name for p in run.iterdir() if not p.name.startswith("."))
     commands = {line.split(":", 1)[0].strip(): line.split(":", 1)[1].strip()
                 for line in out.split("next:\n")[1].splitlines()}
-    assert commands["view the recording"] == f"./run.sh view {run}"
+    assert commands["view the recording"] == f"{ROOT / 'run.sh'} view {run}"
     holes = subprocess.run(commands["holes p1 fits into"], shell=True, capture_output=True, text=True, timeout=60)
     assert "br r1 r2 s1 s2" in holes.stdout
     plans = subprocess.run(commands["five complete plans"], shell=True, capture_output=True, text=True, timeout=60)
