@@ -10,7 +10,6 @@ ordered with probability 0.15, start and hole positions uniform in the cell.
 
 from __future__ import annotations
 
-import argparse
 import random
 import statistics
 import sys
@@ -20,12 +19,13 @@ from pathlib import Path
 
 import clingo
 
-from asp import PlannerError
+from asp import MAX_IDS, PlannerError
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import plans, travel_facts
 from asp.precedence.relation import precedence_facts, true_relation
 from asp.solve import fact, load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
+from bridge.cli_types import ArgumentParser, finite_float, int_in
 
 
 def _learned(atoms: list[clingo.Symbol]) -> LearnedFacts:
@@ -67,12 +67,12 @@ def _optimal_cpu_s(facts: LearnedFacts, cell: Assembly, time_limit_s: float) -> 
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="python -m asp.bench.plans", description=__doc__)
-    parser.add_argument("--repeat", type=int, default=5, help="Cranfield runs (default 5)")
-    parser.add_argument("--parts", type=int, default=11, help="parts of a random cell (default 11)")
-    parser.add_argument("--holes", type=int, default=6, help="holes of a random cell (default 6)")
-    parser.add_argument("--cells", type=int, default=5, help="random cells, seeds 1.. (default 5)")
-    parser.add_argument("--time-limit", type=float, default=60.0, metavar="S",
+    parser = ArgumentParser(prog="./run.sh bench plan", description=__doc__)
+    parser.add_argument("--repeat", type=int_in(1, 1000), default=5, help="Cranfield runs (default 5)")
+    parser.add_argument("--parts", type=int_in(1, MAX_IDS), default=11, help="parts of a random cell (default 11)")
+    parser.add_argument("--holes", type=int_in(1, MAX_IDS), default=6, help="holes of a random cell (default 6)")
+    parser.add_argument("--cells", type=int_in(0, 1000), default=5, help="random cells, seeds 1.. (default 5)")
+    parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60.0, metavar="S",
                         help="give up on a cell after S seconds (default 60)")
     args = parser.parse_args(argv)
     cranfield = load_assembly("cranfield")

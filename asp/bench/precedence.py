@@ -8,7 +8,6 @@ the full Cranfield evaluation (6 values of m x 1000 trials), exact counting agai
 
 from __future__ import annotations
 
-import argparse
 import functools
 import statistics
 import time
@@ -20,6 +19,7 @@ from asp.precedence.count import exact_count
 from asp.precedence.evaluate import PAPER_M, evaluate
 from asp.precedence.relation import Relation, close, true_relation
 from bridge.assembly import load_assembly
+from bridge.cli_types import ArgumentParser, int_in
 
 
 def median_seconds(work: Callable[[], object], repeat: int) -> float:
@@ -44,9 +44,9 @@ def chains_and_free_parts(parts: int, chains: int = 3, chain_length: int = 5) ->
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="./run.sh bench precedence", description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5, help="repetitions per figure (median reported)")
-    parser.add_argument("--guided-trials", type=int, default=1000, help="trials of the guided evaluation")
+    parser = ArgumentParser(prog="./run.sh bench precedence", description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int_in(1, 1000), default=5, help="repetitions per figure (median reported)")
+    parser.add_argument("--guided-trials", type=int_in(1, 10**6), default=1000, help="trials of the guided evaluation")
     args = parser.parse_args(argv)
     truth = true_relation(load_assembly("cranfield"))
 

@@ -29,7 +29,7 @@ from asp.sizes.evaluate import evaluate_policy
 from asp.sizes.learner import SizeLearner
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import get_policy
-from bridge.cli_types import comma_list, number_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, int_in, number_in
 
 CRANFIELD = "cranfield"
 
@@ -92,14 +92,15 @@ def _print_noise(rows: list[dict]) -> None:
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = ArgumentParser(prog="./run.sh bench sizes", description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="5,10,20", type=comma_list(number_in(int, 1, 1000), "sizes in [1, 1000)"),
                         help="n of the n×n instances (default 5,10,20)")
     parser.add_argument("--policies", default="systematic,random,heuristic,best", type=comma_list(str, "policy names"),
                         help="policies to time (default systematic,random,heuristic,best)")
-    parser.add_argument("--decisions", type=int, default=60, help="decisions timed per session (default 60)")
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--decisions", type=int_in(1, 10**6), default=60,
+                        help="decisions timed per session (default 60)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1, help="seed (default 1)")
     parser.add_argument("--evaluate", default="heuristic",
                         help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
     parser.add_argument("--noise", type=comma_list(number_in(float, 0.0, 0.5), "probabilities in [0, 0.5)"),
@@ -109,13 +110,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--confirm", type=comma_list(number_in(int, 0, 100), "integers in [0, 100)"), default=[0],
                         metavar="K,...",
                         help="with --noise: the learner's confirm values (default 0)")
-    parser.add_argument("--seeds", type=int, default=30, metavar="N",
+    parser.add_argument("--seeds", type=int_in(1, 10**5), default=30, metavar="N",
                         help="with --noise: sessions per setting (default 30)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
     if args.noise:
-        if args.seeds < 1:
-            parser.error(f"--seeds {args.seeds}: expected a positive number of sessions")
         for name in args.policies:
             get_policy(name)
         noisy = noise_rows(args.noise, args.policies, args.confirm, args.seeds, args.seed)

@@ -131,8 +131,9 @@ def _holds_session(run: Path) -> bool:
     if journal.is_file() and journal.stat().st_size > 0:
         return True
     try:
-        return json.loads((run / SETTINGS).read_text(encoding="utf-8")).get("status") == "done"
-    except (OSError, ValueError, AttributeError):
+        return json.loads(read_bytes(run / SETTINGS, "session settings file", error=PlannerError)
+                          ).get("status") == "done"
+    except (PlannerError, ValueError, AttributeError):
         return False
 
 
@@ -280,8 +281,10 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     listen, connect = _endpoints(args)
     suffix = "" if settings["starts"] == 1 else f"-{settings['starts']}"
     cell_ids = [f"c{k}" for k in range(1, args.cells + 1)]
+    journal = Journal(run)
     _save(run, settings)
     with ExitStack() as stack:
+        stack.callback(journal.close)
         session = open_session(listen, connect, args.zenoh_config)
         stack.callback(session.close)
         directory = CellDirectory(session)
@@ -296,8 +299,6 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
-        journal = Journal(run)
-        stack.callback(journal.close)
         abandoned = [event.experiment for event in journal.abandon_in_flight()]
         if abandoned:
             settings.setdefault("abandoned", []).extend(abandoned)

@@ -37,6 +37,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor import ExecutorError
 from executor.campaign.pairs import (
     HOLE_NAMES,
@@ -202,14 +203,14 @@ def campaign_report(run: CampaignRun, seed: int, workers: int) -> dict[str, Any]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="executor campaign",
         description="Fig. 18: randomised executions of every fitting pair of the paper's "
         "table plus every non-fitting pair of {p1,tp,p3,sh} x {r1,br,s1}.",
     )
-    parser.add_argument("--trials", type=int, default=40, help="executions per pair (default 40)")
-    parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
-    parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    parser.add_argument("--trials", type=int_in(1, 10**5), default=40, help="executions per pair (default 40)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="base seed (default 0)")
+    parser.add_argument("--workers", type=int_in(1, 64), default=2, help="worker processes (default 2)")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
