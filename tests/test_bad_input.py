@@ -203,6 +203,15 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("bench-session-delay-negative", ("bench", "session", "--delay", "-1"), None, 2, "--delay"),
     ("bench-executor-workers-zero", ("bench", "executor", "--workers", "0"), None, 2, "--workers"),
     ("bench-executor-unknown-option", ("bench", "executor", "--bogus"), None, 2, "unrecognized"),
+    # demonstrations that say where a part went (part@hole)
+    ("learn-unknown-hole", ("precedence", "learn", "d.txt", "--assembly", "cranfield"),
+     {"d.txt": "bp p2@r2 p1@q9 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p1@q9': unknown hole"),
+    ("learn-hole-not-an-id", ("precedence", "learn", "d.txt"), {"d.txt": "a b@B c\n"}, 2, "d.txt:1: 'b@B'"),
+    ("learn-hole-twice", ("precedence", "learn", "d.txt"), {"d.txt": "a@x b@x c\n"}, 2, "already holds a"),
+    ("sizes-demos-base-plate-in-a-hole", ("sizes", "learn", "--assembly", "cranfield", "--demos", "d.txt"),
+     {"d.txt": "bp@r1 p2 p1 p3 p4 sp sh ph pd fp\n"}, 2, "bp@r1"),
+    ("session-demos-unknown-hole", ("session", "--demos", "d.txt"),
+     {"d.txt": "bp p2@r9 p1 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p2@r9'"),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
