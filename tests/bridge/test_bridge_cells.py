@@ -271,6 +271,7 @@ def _refusal(cell: CellProcess) -> str:
     return errors[0]
 
 
+@pytest.mark.slow  # two or three cell processes
 def test_a_second_process_on_a_served_cell_id_refuses_to_start(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
@@ -281,6 +282,7 @@ def test_a_second_process_on_a_served_cell_id_refuses_to_start(network) -> None:
     assert request_insert(session, "c1", InsertRequest(id="d1", part="sh", hole="br"), 10).result == "fit"
 
 
+@pytest.mark.slow  # two or three cell processes
 def test_two_processes_started_together_on_one_id_leave_exactly_one(network) -> None:
     endpoint, session, directory, cells = network
     cells += [CellProcess("c1", serve_argv("c1", backend="truth", connect=[endpoint])) for _ in range(2)]
@@ -293,6 +295,7 @@ def test_two_processes_started_together_on_one_id_leave_exactly_one(network) -> 
     assert request_insert(session, "c1", InsertRequest(id="d2", part="sh", hole="br"), 10).result == "fit"
 
 
+@pytest.mark.slow  # two or three cell processes
 def test_cells_on_one_id_that_meet_later_leave_the_older_serving(network) -> None:
     endpoint, session, directory, cells = network
     first, second = free_loopback_endpoint(), free_loopback_endpoint()
