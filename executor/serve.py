@@ -322,19 +322,22 @@ def main(argv: Sequence[str]) -> int:
     listen = cell_listen(args.listen, args.connect, args.zenoh_config)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    backend: Backend = (TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
-                        if args.backend == "truth"
-                        else SimBackend(args.assembly, cell_id, args.recording_id, args.rrd))
-    node = CellNode(cell_id, backend)
     try:
         session = open_session(listen, args.connect, args.zenoh_config)
     except BridgeError as exc:
-        backend.close()
         raise ExecutorError(str(exc)) from None
     claim: CellClaim | None = None
+    backend: Backend | None = None
     try:
-        claim = CellClaim(session, cell_id, on_lost=lambda _why: node.stop())
-        claim.check()
+        claim = CellClaim(session, cell_id)
+        claim.check()  # before the backend starts: a refused cell loads nothing
+        backend = (TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
+                   if args.backend == "truth"
+                   else SimBackend(args.assembly, cell_id, args.recording_id, args.rrd))
+        node = CellNode(cell_id, backend)
+        claim.on_lost = lambda _why: node.stop()
+        if claim.lost is not None:  # lost while the backend started
+            raise ClaimLost(claim.lost)
         _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
                      session.declare_queryable(ping_key(cell_id), _echo),
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
@@ -347,7 +350,8 @@ def main(argv: Sequence[str]) -> int:
         pass  # SIGTERM/SIGINT: close below
     finally:
         session.close()
-        backend.close()
+        if backend is not None:
+            backend.close()
     if claim is not None and claim.lost is not None:
         raise ClaimLost(claim.lost)
     return 0
