@@ -212,6 +212,11 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      {"d.txt": "bp@r1 p2 p1 p3 p4 sp sh ph pd fp\n"}, 2, "bp@r1"),
     ("session-demos-unknown-hole", ("session", "--demos", "d.txt"),
      {"d.txt": "bp p2@r9 p1 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p2@r9'"),
+    ("bench-sizes-demos-unknown-hole", ("bench", "sizes", "--demos", "d.txt", "--seeds", "1"),
+     {"d.txt": "bp p2@r9 p1 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p2@r9'"),
+    ("resume-demos-not-a-path", ("session", "--resume", "run"),
+     {"run/session.json": '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r", "demos": 7}'},
+     2, '"demos"'),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),

@@ -25,6 +25,7 @@ import statistics
 import subprocess
 import sys
 import time
+from importlib.metadata import version
 
 import zenoh
 
@@ -116,8 +117,9 @@ def main(argv: list[str]) -> int:
                      "median_delay_ms": round(statistics.median(delays), 1) if delays else None,
                      "max_delay_ms": round(max(delays), 1) if delays else None})
     if args.json:
-        print(json.dumps({"zenoh": zenoh.__version__ if hasattr(zenoh, "__version__") else None, "rows": rows}))
+        print(json.dumps({"zenoh": version("eclipse-zenoh"), "rows": rows}))
         return 0
+    print(f"eclipse-zenoh {version('eclipse-zenoh')}, {args.repeat} run(s) per topology")
     print(f"{'topology':<12} {'B sees A token':>14} {'B query reaches A':>17} {'delay median [ms]':>17} {'max':>7}")
     for r in rows:
         print(f"{r['topology']:<12} {r['token']:>10}/{r['runs']:<3} {r['query']:>13}/{r['runs']:<3} "
