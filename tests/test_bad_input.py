@@ -87,6 +87,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("session-timeout-negative", ("session", "--timeout", "-1"), None, 2, "--timeout"),
     ("session-timeout-nan", ("session", "--timeout", "nan"), None, 2, "finite"),
     ("session-wait-negative", ("session", "--wait-for-cell", "-1"), None, 2, "--wait-for-cell"),
+    ("session-cells-huge", ("session", "--cells", "100000"), None, 2, "--cells"),
     ("session-plans-negative", ("session", "--plans", "-1"), None, 2, "--plans"),
     ("session-delay-nan", ("session", "--delay", "nan"), None, 2, "--delay"),
     ("session-confirm-huge", ("session", "--confirm", "99999999999"), None, 2, "--confirm"),

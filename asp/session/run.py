@@ -62,6 +62,8 @@ from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopba
 SETTINGS = "session.json"
 MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
+MAX_CELLS = 64
+"""--cells: at most this many cell co-processes."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -69,7 +71,8 @@ MAX_PLANS = 1000
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
     parser.add_argument("--assembly", default="cranfield", help="assembly (default cranfield)")
-    parser.add_argument("--cells", type=int, default=1, help="cell co-processes to start (default 1)")
+    parser.add_argument("--cells", type=int_in(0, MAX_CELLS), default=1,
+                        help=f"cell co-processes to start, 0 to {MAX_CELLS} (default 1; 0: use cells on the network)")
     parser.add_argument("--policy", default="best", choices=policy_names(),
                         help="experiment selection policy (default best: fewest experiments)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the policy and the trials")
@@ -266,8 +269,6 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
 def run_session(args: argparse.Namespace) -> dict:
     """Run (or resume) a session; returns the JSON result."""
     started = time.perf_counter()
-    if args.cells < 0:
-        raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
     run, settings, lock = _run_folder(args)
     try:
         return _run_locked(args, run, settings, started)
