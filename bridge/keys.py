@@ -4,7 +4,9 @@ A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert`` and hold
 liveliness token ``cell/<id>/alive/<instance>`` while it is up (``<instance>``: a random
 name of the process, so two processes claiming one id show as two tokens);
 ``cell/<id>/ping`` echoes its payload. The planner discovers cells by subscribing to
-``cell/*/alive/*``.
+``cell/*/alive/*``. Before and while it serves, a cell process also holds the liveliness
+token ``cell/<id>/claim/<instance>`` and answers queries on that key with its age: cells
+claiming one id find each other there (:mod:`executor.claim`).
 """
 
 from __future__ import annotations
@@ -20,7 +22,9 @@ ALIVE_PATTERN = "cell/*/alive/*"
 """Liveliness key expression matching every cell's token."""
 
 _CELL_ID = re.compile(CELL_ID_PATTERN)
-_ALIVE_KEY = re.compile(r"^cell/([^/]+)/alive/([A-Za-z0-9_-]{1,64})$")
+_INSTANCE = r"([A-Za-z0-9_-]{1,64})"
+_ALIVE_KEY = re.compile(rf"^cell/([^/]+)/alive/{_INSTANCE}$")
+_CLAIM_KEY = re.compile(rf"^cell/([^/]+)/claim/{_INSTANCE}$")
 
 
 def check_cell_id(cell_id: str) -> str:
@@ -46,6 +50,22 @@ def ping_key(cell_id: str) -> str:
     """Queryable key on which cell ``cell_id`` echoes the payload unread (diagnostics,
     bare round-trip measurement)."""
     return f"cell/{check_cell_id(cell_id)}/ping"
+
+
+def claim_key(cell_id: str, instance: str) -> str:
+    """Liveliness token and queryable key of the process ``instance`` claiming cell ``cell_id``."""
+    return f"cell/{check_cell_id(cell_id)}/claim/{instance}"
+
+
+def claims_pattern(cell_id: str) -> str:
+    """Key expression matching the claims of every process on cell id ``cell_id``."""
+    return f"cell/{check_cell_id(cell_id)}/claim/*"
+
+
+def instance_of_claim_key(key: str, cell_id: str) -> str | None:
+    """The instance of a claim key ``cell/<cell_id>/claim/<instance>``; None for any other key."""
+    match = _CLAIM_KEY.match(key)
+    return match.group(2) if match is not None and match.group(1) == cell_id else None
 
 
 def cell_of_alive_key(key: str) -> tuple[str, str] | None:

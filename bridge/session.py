@@ -30,7 +30,11 @@ MAX_TRANSPORT_BYTES = 8 * MAX_MESSAGE_BYTES
 """Zenoh refuses bigger messages before they reach Python (the application's own cap,
 :data:`bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
 
+LOOPBACK_ANY_PORT = "tcp/127.0.0.1:0"
+"""A loopback listener on a port the system picks."""
+
 _ENDPOINT = re.compile(r"^(tcp|udp|tls|quic|ws|unixsock-stream)/\S+$")
+_LOOPBACK = re.compile(r"^[a-z-]+/(127\.\d+\.\d+\.\d+|localhost|\[::1\]):\d+$")
 
 
 def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
@@ -50,6 +54,19 @@ def check_endpoint(endpoint: str) -> str:
         raise BridgeError(f"endpoint {endpoint!r}: expected PROTO/ADDRESS:PORT, "
                           "e.g. tcp/127.0.0.1:7447")
     return endpoint
+
+
+def cell_listen(listen: Sequence[str], connect: Sequence[str], config_file: Path | None) -> list[str]:
+    """Where a cell listens: ``listen`` if given; else nowhere new with a config file (the
+    file says); else, when it connects only to loopback endpoints, a loopback port the
+    system picks (Zenoh's gossip then connects the cells of one planner to each other, so
+    a second process on one cell id is seen: :mod:`executor.claim`); else, connecting
+    elsewhere, nowhere; else :data:`DEFAULT_ENDPOINT`."""
+    if listen or config_file is not None:
+        return list(listen)
+    if connect:
+        return [LOOPBACK_ANY_PORT] if all(_LOOPBACK.match(e) for e in connect) else []
+    return [DEFAULT_ENDPOINT]
 
 
 def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),

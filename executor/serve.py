@@ -3,7 +3,10 @@
 The node declares the queryable ``cell/<id>/insert`` and the liveliness token
 ``cell/<id>/alive/<instance>`` (and ``cell/<id>/ping``, which echoes its payload unread), then
 serves until SIGTERM/SIGINT (or, with ``--lifeline``, until its stdin closes: the
-supervising session died), then closes the Zenoh session cleanly.
+supervising session died), then closes the Zenoh session cleanly. Before it declares
+anything else it claims its cell id (:mod:`executor.claim`): when another process already
+serves that id it exits with code 2 instead, and it stops the same way if it meets such a
+process later.
 
 - Every request is size-capped and validated (:mod:`bridge.messages`) in the Zenoh
   thread; a malformed, oversized or wrong-version request gets an ErrorReply at once and
@@ -36,7 +39,7 @@ from pathlib import Path
 import zenoh
 
 from bridge import BridgeError
-from bridge.cli_types import ArgumentParser, add_assembly_argument
+from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
 from bridge.messages import (
     MAX_MESSAGE_BYTES,
@@ -51,9 +54,10 @@ from bridge.messages import (
     encode,
 )
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
-from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
+from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from executor import ExecutorError
 from executor.backends import Backend, CellContext, UnknownPair, backend_option, load_backend
+from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
 
 CACHE_SIZE = 100_000
@@ -176,6 +180,7 @@ class CellNode:
         self._work: queue.Queue[_Work | None] = queue.Queue(maxsize=queue_size)
         self._replies: OrderedDict[str, tuple[InsertRequest, bytes]] = OrderedDict()
         self._lock = threading.Lock()
+        self._stopped = threading.Event()
 
     def _cached(self, query: zenoh.Query, request: InsertRequest) -> bytes | None:
         """The cached reply of this very request; refuses a reused id (then returns b"")."""
@@ -215,12 +220,16 @@ class CellNode:
                          request.id)
 
     def stop(self) -> None:
-        """Make :meth:`serve` return after the experiment in progress (any thread)."""
-        self._work.put(None)
+        """Make :meth:`serve` return after the experiment in progress (any thread; never blocks)."""
+        self._stopped.set()
+        try:
+            self._work.put_nowait(None)  # wakes serve() if it waits
+        except queue.Full:
+            pass  # serve() is busy and sees the flag next
 
     def serve(self) -> None:
         """Run queued requests until :meth:`stop` (or SIGTERM/SIGINT via SystemExit)."""
-        while (work := self._work.get()) is not None:
+        while not self._stopped.is_set() and (work := self._work.get()) is not None:
             query, request = work.query, work.request
             waited = time.monotonic() - work.arrived
             cached = self._cached(query, request)
@@ -280,7 +289,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
                         help="an option for a MODULE:CLASS backend, e.g. journal=runs/x/journal.jsonl (repeatable)")
     add_assembly_argument(parser)
-    parser.add_argument("--delay", type=float, default=0.0, metavar="S",
+    parser.add_argument("--delay", type=finite_float(0, 3600), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
     parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
     parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
@@ -291,36 +300,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
+    """The backend ``--backend`` names: the simulator, the geometry's truth or a user class."""
+    if args.backend == "truth":
+        return TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args))
+    if args.backend == "sim":
+        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args))
+    return load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
+                                                  dict(args.backend_option)))
+
+
 def main(argv: Sequence[str]) -> int:
-    """Serve until SIGTERM/SIGINT; exit code 2 on bad options."""
+    """Serve until SIGTERM/SIGINT; exit code 2 on bad options or when another process
+    serves this cell id (:mod:`executor.claim`)."""
     args = build_parser().parse_args(list(argv))
     try:
         cell_id = check_cell_id(args.cell)
     except BridgeError as exc:
         raise ExecutorError(str(exc)) from None
-    if args.delay < 0:
-        raise ExecutorError(f"--delay {args.delay}: expected seconds >= 0")
-    listen = args.listen or ([] if args.connect or args.zenoh_config else [DEFAULT_ENDPOINT])
+    listen = cell_listen(args.listen, args.connect, args.zenoh_config)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    backend: Backend
-    if args.backend == "truth":
-        backend = TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args))
-    elif args.backend == "sim":
-        backend = SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args))
-    else:
-        backend = load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
-                                                         dict(args.backend_option)))
-    node = CellNode(cell_id, backend)
     try:
         session = open_session(listen, args.connect, args.zenoh_config)
     except BridgeError as exc:
-        backend.close()
         raise ExecutorError(str(exc)) from None
+    claim: CellClaim | None = None
+    backend: Backend | None = None
     try:
+        claim = CellClaim(session, cell_id)
+        claim.check()  # before the backend starts: a refused cell loads nothing
+        backend = _backend(args, cell_id)
+        node = CellNode(cell_id, backend)
+        claim.on_lost = lambda _why: node.stop()
+        if claim.lost is not None:  # lost while the backend started
+            raise ClaimLost(claim.lost)
         _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
                      session.declare_queryable(ping_key(cell_id), _echo),
-                     session.liveliness().declare_token(alive_key(cell_id, uuid.uuid4().hex[:12])))
+                     session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
         if args.lifeline:
             threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
         print(f"ready cell {cell_id} backend {args.backend} "
@@ -330,5 +347,8 @@ def main(argv: Sequence[str]) -> int:
         pass  # SIGTERM/SIGINT: close below
     finally:
         session.close()
-        backend.close()
+        if backend is not None:
+            backend.close()
+    if claim is not None and claim.lost is not None:
+        raise ClaimLost(claim.lost)
     return 0

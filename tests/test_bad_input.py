@@ -1,7 +1,8 @@
 """A corpus of bad input for both command lines (repository level: it spans the packages).
 
 One row per case: ``(id, argv, setup, expected exit code, a word the message must hold)``.
-``argv`` starting with ``executor`` runs ``python -m executor``, else ``python -m asp.cli``;
+``argv`` starting with ``executor`` runs ``python -m executor``, ``bench executor`` runs
+``python -m executor.campaign.bench`` (as run.sh does), anything else ``python -m asp.cli``;
 both run as separate processes in ``tmp_path``. ``setup`` is None, a dict of input files
 (name → text or bytes) or a callable ``setup(tmp_path)``. Every bad input must give one
 line ``error: ...`` on stderr holding the word, the exit code, and never a traceback.
@@ -24,6 +25,7 @@ from pathlib import Path
 
 import pytest
 
+from asp.session.journal import MAX_JOURNAL_BYTES
 from bridge.cli_types import EXIT_BROKEN_PIPE
 from tests.conftest import ROOT, child_env, python_argv
 
@@ -70,6 +72,14 @@ def assembly(**files: str | bytes | Callable[[Path], None]) -> Callable[[Path], 
     return setup
 
 
+def huge_journal(run: Path) -> None:
+    """Setup: a run folder to resume whose journal is one byte over the bound (a sparse file)."""
+    run.mkdir()
+    (run / "session.json").write_text('{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}')
+    with (run / "journal.jsonl").open("wb") as file:
+        file.truncate(MAX_JOURNAL_BYTES + 1)
+
+
 CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     # numeric options: finite, in range
     ("trial-seed-negative", ("executor", "trial", "--part", "p1", "--hole", "r1", "--seed", "-1"), None, 2, "--seed"),
@@ -77,6 +87,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("session-timeout-negative", ("session", "--timeout", "-1"), None, 2, "--timeout"),
     ("session-timeout-nan", ("session", "--timeout", "nan"), None, 2, "finite"),
     ("session-wait-negative", ("session", "--wait-for-cell", "-1"), None, 2, "--wait-for-cell"),
+    ("session-cells-huge", ("session", "--cells", "100000"), None, 2, "--cells"),
     ("session-plans-negative", ("session", "--plans", "-1"), None, 2, "--plans"),
     ("session-delay-nan", ("session", "--delay", "nan"), None, 2, "--delay"),
     ("session-confirm-huge", ("session", "--confirm", "99999999999"), None, 2, "--confirm"),
@@ -138,6 +149,8 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("resume-bad-policy", ("session", "--resume", "run"),
      {"run/session.json": '{"assembly": "cranfield", "policy": 7, "seed": 0, "recording_id": "r"}'}, 2,
      '"policy"'),
+    ("resume-huge-journal", ("session", "--resume", "run"),
+     lambda tmp: huge_journal(tmp / "run"), 2, "larger than"),
     # recordings, cell geometry
     ("view-garbage", ("view", "g.rrd", "--print"), {"g.rrd": bytes(range(256)) * 8}, 2, "Rerun recording"),
     ("view-empty", ("view", "e.rrd", "--print"), {"e.rrd": b""}, 2, "Rerun recording"),
@@ -172,14 +185,56 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      "larger than"),
     ("learn-huge-token", ("precedence", "learn", "d.txt"), {"d.txt": "p" * 2**20 + " q\n"}, 2, "…"),
     ("suggest-too-many-demos", ("precedence", "suggest", "d.txt"), {"d.txt": "a b c\n" * 1001}, 2, "1000"),
+    # the cell's other commands and every benchmark: argparse errors are one line too
+    ("serve-delay-nan", ("executor", "serve", "--delay", "nan"), None, 2, "--delay"),
+    ("serve-unknown-option", ("executor", "serve", "--bogus"), None, 2, "unrecognized"),
+    ("serve-bad-cell-id", ("executor", "serve", "--cell", "C!"), None, 2, "cell id"),
+    ("campaign-trials-zero", ("executor", "campaign", "--trials", "0"), None, 2, "--trials"),
+    ("campaign-workers-huge", ("executor", "campaign", "--workers", "1e3"), None, 2, "--workers"),
+    ("margins-seed-negative", ("executor", "margins", "--seed", "-1"), None, 2, "--seed"),
+    ("margins-trials-missing", ("executor", "margins", "--trials"), None, 2, "--trials"),
+    ("bench-unknown", ("bench", "nosuch"), None, 2, "nosuch"),
+    ("bench-sizes-list", ("bench", "sizes", "--sizes", "3,y"), None, 2, "--sizes"),
+    ("bench-sizes-seeds-zero", ("bench", "sizes", "--noise", "0.1", "--seeds", "0"), None, 2, "--seeds"),
+    ("bench-dominance-seconds-nan", ("bench", "dominance", "--seconds", "nan"), None, 2, "--seconds"),
+    ("bench-dominance-sizes", ("bench", "dominance", "--sizes", "4y5"), None, 2, "--sizes"),
+    ("bench-plan-parts-huge", ("bench", "plan", "--parts", "100"), None, 2, "--parts"),
+    ("bench-precedence-repeat-zero", ("bench", "precedence", "--repeat", "0"), None, 2, "--repeat"),
+    ("bench-session-product-one", ("bench", "session", "--product", "1"), None, 2, "--product"),
+    ("bench-session-delay-negative", ("bench", "session", "--delay", "-1"), None, 2, "--delay"),
+    ("bench-executor-workers-zero", ("bench", "executor", "--workers", "0"), None, 2, "--workers"),
+    ("bench-executor-unknown-option", ("bench", "executor", "--bogus"), None, 2, "unrecognized"),
+    # demonstrations that say where a part went (part@hole)
+    ("learn-unknown-hole", ("precedence", "learn", "d.txt", "--assembly", "cranfield"),
+     {"d.txt": "bp p2@r2 p1@q9 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p1@q9': unknown hole"),
+    ("learn-hole-not-an-id", ("precedence", "learn", "d.txt"), {"d.txt": "a b@B c\n"}, 2, "d.txt:1: 'b@B'"),
+    ("learn-hole-twice", ("precedence", "learn", "d.txt"), {"d.txt": "a@x b@x c\n"}, 2, "already holds a"),
+    ("sizes-demos-base-plate-in-a-hole", ("sizes", "learn", "--assembly", "cranfield", "--demos", "d.txt"),
+     {"d.txt": "bp@r1 p2 p1 p3 p4 sp sh ph pd fp\n"}, 2, "bp@r1"),
+    ("session-demos-unknown-hole", ("session", "--demos", "d.txt"),
+     {"d.txt": "bp p2@r9 p1 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p2@r9'"),
+    ("bench-sizes-demos-unknown-hole", ("bench", "sizes", "--demos", "d.txt", "--seeds", "1"),
+     {"d.txt": "bp p2@r9 p1 p3 p4 sp sh ph pd fp\n"}, 2, "d.txt:1: 'p2@r9'"),
+    ("resume-demos-not-a-path", ("session", "--resume", "run"),
+     {"run/session.json": '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r", "demos": 7}'},
+     2, '"demos"'),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
 ]
 
 
+def _module(argv: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
+    """The module run.sh runs for ``argv``, and its arguments."""
+    if argv[0] == "executor":
+        return "executor", argv[1:]
+    if argv[:2] == ("bench", "executor"):
+        return "executor.campaign.bench", argv[2:]
+    return "asp.cli", argv
+
+
 def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
-    module, args = ("executor", argv[1:]) if argv[0] == "executor" else ("asp.cli", argv)
+    module, args = _module(argv)
     process = subprocess.Popen(python_argv(module, *args), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:

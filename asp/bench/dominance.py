@@ -54,7 +54,7 @@ import numpy as np
 from asp.sizes.biorders import all_biorders, mask_bits
 from asp.sizes.evaluate import relabeled_matrices
 from asp.sizes.oracle import TruthOracle
-from bridge.cli_types import ArgumentParser, comma_list, size_pair
+from bridge.cli_types import ArgumentParser, comma_list, finite_float, int_in, size_pair
 
 INFEASIBLE = 1 << 40
 """Value of a state from which no policy meets every deadline."""
@@ -539,19 +539,21 @@ def all_biorders_bound(target: int, cap: int | None = None) -> dict:
 
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench dominance", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="2x3,3x2,2x4,3x3,3x4,4x3,2x5,5x2",
                         type=comma_list(size_pair, "sizes such as 4x5", allow_empty=True),
                         help="m×n sizes, all biorders each ('' skips; 4x4 takes ~20 s)")
     parser.add_argument("--unconstrained", action="store_true",
                         help="also the unconstrained optimum (3x4: ~30 s; 4x4: too long)")
     parser.add_argument("--cranfield", action="store_true", help="the Cranfield relaxation")
-    parser.add_argument("--seconds", type=float, default=60,
+    parser.add_argument("--seconds", type=finite_float(0, 1e6, low_open=True), default=60,
                         help="time for the Cranfield lower bound (iterative deepening, default 60)")
     parser.add_argument("--all-biorders", action="store_true",
                         help="Cranfield total of policies never worse on all 5x5 biorders (long)")
-    parser.add_argument("--target", type=float, default=18.8, help="mean to decide (default 18.8)")
-    parser.add_argument("--cap", type=int, help="with --all-biorders: at most CAP experiments per Cranfield truth")
+    parser.add_argument("--target", type=finite_float(0, 1000, low_open=True), default=18.8,
+                        help="mean to decide (default 18.8)")
+    parser.add_argument("--cap", type=int_in(0, 10**6),
+                        help="with --all-biorders: at most CAP experiments per Cranfield truth")
     args = parser.parse_args(argv)
     sizes = args.sizes
     print(f"{'size':>5} {'biorders':>8} {'systematic':>10} {'never worse':>11} {'optimum':>8} "

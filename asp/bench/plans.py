@@ -19,13 +19,13 @@ from pathlib import Path
 
 import clingo
 
-from asp import PlannerError
+from asp import MAX_IDS, PlannerError
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import plans, travel_facts
 from asp.precedence.relation import precedence_facts, true_relation
 from asp.solve import fact, load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
-from bridge.cli_types import ArgumentParser
+from bridge.cli_types import ArgumentParser, finite_float, int_in
 
 
 def _learned(atoms: list[clingo.Symbol]) -> LearnedFacts:
@@ -68,11 +68,11 @@ def _optimal_cpu_s(facts: LearnedFacts, cell: Assembly, time_limit_s: float) -> 
 
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench plan", description=__doc__)
-    parser.add_argument("--repeat", type=int, default=5, help="Cranfield runs (default 5)")
-    parser.add_argument("--parts", type=int, default=11, help="parts of a random cell (default 11)")
-    parser.add_argument("--holes", type=int, default=6, help="holes of a random cell (default 6)")
-    parser.add_argument("--cells", type=int, default=5, help="random cells, seeds 1.. (default 5)")
-    parser.add_argument("--time-limit", type=float, default=60.0, metavar="S",
+    parser.add_argument("--repeat", type=int_in(1, 1000), default=5, help="Cranfield runs (default 5)")
+    parser.add_argument("--parts", type=int_in(1, MAX_IDS), default=11, help="parts of a random cell (default 11)")
+    parser.add_argument("--holes", type=int_in(1, MAX_IDS), default=6, help="holes of a random cell (default 6)")
+    parser.add_argument("--cells", type=int_in(0, 1000), default=5, help="random cells, seeds 1.. (default 5)")
+    parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60.0, metavar="S",
                         help="give up on a cell after S seconds (default 60)")
     args = parser.parse_args(argv)
     cranfield = load_assembly("cranfield")

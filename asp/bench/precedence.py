@@ -19,7 +19,7 @@ from asp.precedence.count import exact_count
 from asp.precedence.evaluate import PAPER_M, evaluate
 from asp.precedence.relation import Relation, close, true_relation
 from bridge.assembly import load_assembly
-from bridge.cli_types import ArgumentParser
+from bridge.cli_types import ArgumentParser, int_in
 
 
 def median_seconds(work: Callable[[], object], repeat: int) -> float:
@@ -45,8 +45,8 @@ def chains_and_free_parts(parts: int, chains: int = 3, chain_length: int = 5) ->
 
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench precedence", description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5, help="repetitions per figure (median reported)")
-    parser.add_argument("--guided-trials", type=int, default=1000, help="trials of the guided evaluation")
+    parser.add_argument("--repeat", type=int_in(1, 1000), default=5, help="repetitions per figure (median reported)")
+    parser.add_argument("--guided-trials", type=int_in(1, 10**6), default=1000, help="trials of the guided evaluation")
     args = parser.parse_args(argv)
     truth = true_relation(load_assembly("cranfield"))
 

@@ -36,11 +36,11 @@ from pathlib import Path
 
 import zenoh
 
-from asp import PlannerError
+from asp import MAX_IDS, PlannerError
 from asp.bench.products import write_product
 from asp.session.cells import ROOT, start_cell
 from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
-from bridge.cli_types import ArgumentParser, comma_list, number_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in, number_in
 from bridge.client import CellDirectory, request_insert
 from bridge.keys import ping_key
 from bridge.messages import InsertRequest, encode
@@ -160,22 +160,23 @@ def cell_busy_fraction(entries: list[JournalEntry], cells: int) -> float:
 
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench session", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--round-trips", type=int, default=1000, help="per kind (default 1000)")
-    parser.add_argument("--repeat", type=int, default=1,
+    parser.add_argument("--round-trips", type=int_in(1, 10**6), default=1000, help="per kind (default 1000)")
+    parser.add_argument("--repeat", type=int_in(1, 100), default=1,
                         help="pairs of sessions, 1 cell then 2 cells back to back (default 1)")
     parser.add_argument("--quick", action="store_true", help="100 round trips per kind")
     parser.add_argument("--policy", default="best", help="session policy (default best)")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="cells of the sessions (default sim)")
-    parser.add_argument("--delay", type=float, default=0.0, metavar="S",
+    parser.add_argument("--delay", type=finite_float(0, 3600), default=0.0, metavar="S",
                         help="truth backend: seconds per experiment, e.g. 2 to see the "
                         "parallel speed-up without competing for the cores")
     parser.add_argument("--skip-sessions", action="store_true", help="only the round trips")
-    parser.add_argument("--product", type=int, metavar="N",
+    parser.add_argument("--product", type=int_in(2, MAX_IDS), metavar="N",
                         help="load: sessions on a generated NxN product instead (truth cells, --delay)")
     parser.add_argument("--cells", type=comma_list(number_in(int, 1, 65), "cell counts in [1, 64]"),
                         default=[1, 2, 4, 8], metavar="N,...", help="with --product: cell counts (default 1,2,4,8)")
-    parser.add_argument("--seed", type=int, default=1, help="with --product: seed of the product (default 1)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1,
+                        help="with --product: seed of the product (default 1)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
     if args.product is not None:
@@ -202,8 +203,6 @@ def main(argv: list[str]) -> int:
 
 
 def _load(args: argparse.Namespace) -> int:
-    if args.product < 2:
-        raise PlannerError(f"--product {args.product}: expected an integer >= 2")
     figures = load_runs(args.product, [int(n) for n in args.cells], args.policy, args.delay, args.seed)
     if args.json:
         print(json.dumps(figures, indent=2))

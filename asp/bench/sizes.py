@@ -12,6 +12,12 @@ policy and ``--confirm`` K, ``--seeds`` N sessions on Cranfield (random relabeli
 noise seed per session, as ``sizes evaluate --noise P --confirm K --relabelings N``):
 the share of sessions that learn a wrong relation and the experiments per session
 (mean, median; every physical experiment, re-tests included).
+
+With ``--demos FILE`` it measures what demonstrations that say where each part went
+(``p1@r1``) save: for each policy, ``--seeds`` N sessions on Cranfield, session i on a
+random relabeling (index order of parts and holes, seed ``--seed`` + i, also the
+policy's seed), once from nothing and once from the demonstrated fits; the experiments
+per session (mean, median) of both and the mean saved.
 """
 
 from __future__ import annotations
@@ -25,11 +31,12 @@ import time
 
 import numpy as np
 
+from asp.sizes.cli import demonstrated_fits
 from asp.sizes.evaluate import evaluate_policy
-from asp.sizes.learner import SizeLearner
+from asp.sizes.learner import SizeLearner, learn_sizes
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import get_policy
-from bridge.cli_types import ArgumentParser, comma_list, number_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, int_in, number_in
 
 CRANFIELD = "cranfield"
 
@@ -84,6 +91,33 @@ def noise_rows(noises: list[float], policies: list[str], confirms: list[int], se
     return rows
 
 
+def demos_rows(demos: str, policies: list[str], seeds: int, seed: int) -> list[dict]:
+    """Experiments per Cranfield session without and with the fits ``demos`` show (module doc)."""
+    truth = TruthOracle.from_assembly(CRANFIELD)
+    demonstrated = demonstrated_fits(demos, CRANFIELD)
+    rows = []
+    for policy in policies:
+        counts: dict[str, list[int]] = {"without": [], "with": []}
+        for case in range(seed, seed + seeds):
+            rng = random.Random(case)
+            parts, holes = rng.sample(truth.parts, len(truth.parts)), rng.sample(truth.holes, len(truth.holes))
+            for kind, prior in (("without", []), ("with", demonstrated)):
+                counts[kind].append(learn_sizes(parts, holes, truth, policy, case, demonstrated=prior).count)
+        rows.append({"policy": policy, "sessions": seeds, "demonstrated": len(demonstrated),
+                     **{f"{k}_mean": round(statistics.mean(v), 2) for k, v in counts.items()},
+                     **{f"{k}_median": statistics.median(v) for k, v in counts.items()},
+                     "saved_mean": round(statistics.mean(counts["without"]) - statistics.mean(counts["with"]), 2)})
+    return rows
+
+
+def _print_demos(rows: list[dict]) -> None:
+    print(f"{'policy':>11} {'sessions':>8} {'fits shown':>10} {'mean without':>12} {'mean with':>9} "
+          f"{'median without':>14} {'median with':>11} {'saved (mean)':>12}")
+    for r in rows:
+        print(f"{r['policy']:>11} {r['sessions']:>8} {r['demonstrated']:>10} {r['without_mean']:>12.2f} "
+              f"{r['with_mean']:>9.2f} {r['without_median']:>14} {r['with_median']:>11} {r['saved_mean']:>12.2f}")
+
+
 def _print_noise(rows: list[dict]) -> None:
     print(f"{'noise':>5} {'policy':>11} {'confirm':>7} {'sessions':>8} {'wrong[%]':>8} {'mean':>6} {'median':>6}")
     for r in rows:
@@ -93,13 +127,14 @@ def _print_noise(rows: list[dict]) -> None:
 
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench sizes", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="5,10,20", type=comma_list(number_in(int, 1, 1000), "sizes in [1, 1000)"),
                         help="n of the n×n instances (default 5,10,20)")
     parser.add_argument("--policies", default="systematic,random,heuristic,best", type=comma_list(str, "policy names"),
                         help="policies to time (default systematic,random,heuristic,best)")
-    parser.add_argument("--decisions", type=int, default=60, help="decisions timed per session (default 60)")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the random choices (default 1)")
+    parser.add_argument("--decisions", type=int_in(1, 10**6), default=60,
+                        help="decisions timed per session (default 60)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1, help="seed (default 1)")
     parser.add_argument("--evaluate", default="heuristic",
                         help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
     parser.add_argument("--noise", type=comma_list(number_in(float, 0.0, 0.5), "probabilities in [0, 0.5)"),
@@ -109,15 +144,23 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--confirm", type=comma_list(number_in(int, 0, 100), "integers in [0, 100)"), default=[0],
                         metavar="K,...",
                         help="with --noise: the learner's confirm values (default 0)")
-    parser.add_argument("--seeds", type=int, default=30, metavar="N",
-                        help="with --noise: sessions per setting (default 30)")
+    parser.add_argument("--seeds", type=int_in(1, 10**5), default=30, metavar="N",
+                        help="with --noise or --demos: sessions per setting (default 30)")
+    parser.add_argument("--demos", metavar="FILE",
+                        help="measure the experiments saved by the fits these demonstrations show (p1@r1) "
+                             "instead of timing (Cranfield; with --seeds, --policies)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
+    for name in args.policies:
+        get_policy(name)
+    if args.demos:
+        saved = demos_rows(args.demos, args.policies, args.seeds, args.seed)
+        if args.json:
+            print(json.dumps({"demos": saved}))
+        else:
+            _print_demos(saved)
+        return 0
     if args.noise:
-        if args.seeds < 1:
-            parser.error(f"--seeds {args.seeds}: expected a positive number of sessions")
-        for name in args.policies:
-            get_policy(name)
         noisy = noise_rows(args.noise, args.policies, args.confirm, args.seeds, args.seed)
         if args.json:
             print(json.dumps({"noise": noisy}))

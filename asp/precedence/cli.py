@@ -86,8 +86,8 @@ def _demonstrations(args: argparse.Namespace) -> Demonstrations:
     if args.demos is None:
         if assembly is None:
             raise PlannerError("learn: expected a demonstrations file or --assembly with demos.txt")
-        return load_demos(assembly.file("demos.txt"), assembly.part_ids)
-    return load_demos(args.demos, assembly.part_ids if assembly else None)
+        return load_demos(assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
+    return load_demos(args.demos, *((assembly.part_ids, assembly.hole_ids) if assembly else (None, None)))
 
 
 def _relation(args: argparse.Namespace) -> Relation:

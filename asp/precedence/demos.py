@@ -3,12 +3,15 @@
 Text format (``demos.txt``): one sequence per line, part ids separated by spaces or
 commas; ``#`` starts a comment; blank lines are ignored. The parts are those of the
 assembly when one is given, otherwise the ids of the first sequence. Every sequence
-must name every part exactly once.
+must name every part exactly once. A part may say where it went: ``p1@r1`` (part p1
+placed in hole r1; paper 4.2, last paragraph): a fit seen in a demonstration, which the
+size learner starts from. The hole must be one of the assembly's holes when they are
+given, and one demonstration puts at most one part into a hole.
 
 The same data is accepted as ASP facts (a file ending in ``.lp``): ``demo(D,I,P)``,
-demonstration ``D`` places part ``P`` at position ``I`` (1-based), plus optional
-``part/1``. Every error raises :class:`asp.PlannerError` naming file:line (or the
-demonstration) and what was expected.
+demonstration ``D`` places part ``P`` at position ``I`` (1-based), or ``demo(D,I,P,H)``,
+into hole ``H``; plus optional ``part/1``. Every error raises :class:`asp.PlannerError`
+naming file:line (or the demonstration) and what was expected.
 
 Bounds: a file of at most :data:`bridge.inputs.MAX_INPUT_BYTES`, at most
 :data:`asp.MAX_IDS` parts and :data:`MAX_DEMONSTRATIONS` sequences; a step number of
@@ -40,11 +43,20 @@ MAX_DEMONSTRATIONS = 1000
 
 @dataclass(frozen=True)
 class Demonstrations:
-    """Sequences over ``parts``; ``origins[k]`` names where sequence k came from (file:line)."""
+    """Sequences over ``parts``; ``origins[k]`` names where sequence k came from (file:line);
+    ``holes[k][i]`` is the hole the i-th part of sequence k went into, or None (``holes``
+    empty: none said)."""
 
     parts: tuple[str, ...]
     sequences: tuple[tuple[str, ...], ...]
     origins: tuple[str, ...]
+    holes: tuple[tuple[str | None, ...], ...] = ()
+
+    def placements(self) -> list[tuple[str, str]]:
+        """Every (part, hole) some demonstration placed, in the order first seen."""
+        seen = [(part, hole) for sequence, holes in zip(self.sequences, self.holes)
+                for part, hole in zip(sequence, holes) if hole is not None]
+        return list(dict.fromkeys(seen))
 
 
 def _listed(ids: Sequence[str]) -> str:
@@ -74,6 +86,24 @@ def _check_sequence(where: str, ids: Sequence[str], parts: Sequence[str], parts_
         )
 
 
+def _check_holes(where: str, ids: Sequence[str], holes: Sequence[str | None], known: Sequence[str] | None) -> None:
+    """The holes of one sequence: ids, of the assembly's holes (``known``; None: any), each used once."""
+    used: dict[str, str] = {}
+    for part, hole in zip(ids, holes):
+        if hole is None:
+            continue
+        if not _ID.match(hole):
+            raise PlannerError(f"{where}: '{shorten(part)}@{shorten(hole)}': '{shorten(hole)}' is not a hole id "
+                               "(expected part@hole, a lower-case ASP constant after @)")
+        if known is not None and hole not in known:
+            raise PlannerError(f"{where}: '{part}@{shorten(hole)}': unknown hole '{shorten(hole)}'; expected one "
+                               f"of the assembly's holes: {_listed(known)}")
+        if hole in used:
+            raise PlannerError(f"{where}: '{part}@{hole}': hole {hole} already holds {used[hole]} in this "
+                               "demonstration; one part per hole")
+        used[hole] = part
+
+
 def _check_count(source: object, count: int) -> None:
     if count > MAX_DEMONSTRATIONS:
         raise PlannerError(f"{source}: more than {MAX_DEMONSTRATIONS} demonstrations; expected at most "
@@ -95,12 +125,15 @@ def _text(path: Path) -> str:
     return text
 
 
-def parse_demos(text: str, source: str, parts: Sequence[str] | None = None) -> Demonstrations:
+def parse_demos(text: str, source: str, parts: Sequence[str] | None = None,
+                holes: Sequence[str] | None = None) -> Demonstrations:
     """Parse demonstrations text; ``source`` names the file in messages.
 
     ``parts``: the assembly's part ids; None takes the ids of the first sequence.
+    ``holes``: the assembly's hole ids that ``part@hole`` may name; None: any id.
     """
     sequences: list[tuple[str, ...]] = []
+    placed: list[tuple[str | None, ...]] = []
     origins: list[str] = []
     known = tuple(parts) if parts is not None else None
     parts_origin = "the assembly's parts"
@@ -109,34 +142,40 @@ def parse_demos(text: str, source: str, parts: Sequence[str] | None = None) -> D
         if not line:
             continue
         where = f"{source}:{number}"
-        ids = [t for t in _SEPARATOR.split(line) if t]
-        if not ids:
+        tokens = [t.partition("@") for t in _SEPARATOR.split(line) if t]
+        if not tokens:
             raise PlannerError(f"{where}: only separators, expected a sequence {_EXPECTED}")
+        ids = [part for part, _at, _hole in tokens]
+        where_to = [hole if at else None for _part, at, hole in tokens]
         if known is None:
             _check_sequence(where, ids, ids, "the ids of the line")
             known, parts_origin = tuple(ids), f"the parts of the first sequence ({source}:{number})"
         _check_sequence(where, ids, known, parts_origin)
+        _check_holes(where, ids, where_to, holes)
         sequences.append(tuple(ids))
+        placed.append(tuple(where_to))
         origins.append(where)
         _check_count(source, len(sequences))
     if not sequences:
         raise PlannerError(f"{source}: empty, expected at least one sequence (part ids separated by spaces or commas)")
     assert known is not None
-    return Demonstrations(known, tuple(sequences), tuple(origins))
+    return Demonstrations(known, tuple(sequences), tuple(origins), tuple(placed))
 
 
-def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations:
+def _demos_from_facts(path: Path, parts: Sequence[str] | None, holes: Sequence[str] | None) -> Demonstrations:
     atoms = load_atoms([path])
-    if not any(a.match("demo", 3) for a in atoms):
-        raise PlannerError(f"{path}: expected demo(D,I,P) facts (demonstration D places part P at step I)")
+    demos = [a.arguments for a in atoms if a.match("demo", 3) or a.match("demo", 4)]
+    if not demos:
+        raise PlannerError(f"{path}: expected demo(D,I,P) facts (demonstration D places part P at step I) "
+                           "or demo(D,I,P,H) (into hole H)")
     declared = [p for (p,) in atoms_by_name(atoms, "part", 1)]
-    demos = [a.arguments for a in atoms if a.match("demo", 3)]
-    count = len(parts if parts is not None else declared or {str(symbol) for _, _, symbol in demos})
+    count = len(parts if parts is not None else declared or {str(args[2]) for args in demos})
     if count > MAX_IDS:
         raise PlannerError(f"{path}: {count} parts; expected at most {MAX_IDS}")
     by_demo: dict[str, dict[int, str]] = {}
-    for demo, step, symbol in demos:
-        where = f"{path}: demo({shorten(demo)},{shorten(step)},{shorten(symbol)})"
+    hole_of: dict[tuple[str, int], str] = {}
+    for demo, step, symbol, *hole in demos:
+        where = f"{path}: demo({','.join(shorten(a) for a in (demo, step, symbol, *hole))})"
         if step.type != clingo.SymbolType.Number or not 1 <= step.number <= count:
             raise PlannerError(f"{where}: the step must be an integer from 1 to {count} (the number of parts)")
         steps = by_demo.setdefault(str(demo), {})
@@ -145,8 +184,11 @@ def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations
             raise PlannerError(f"{where}: demonstration {demo} already places {steps[step.number]} "
                                f"at step {step.number}")
         steps[step.number] = str(symbol)
+        if hole:
+            _check_holes(where, [str(symbol)], [str(hole[0])], holes)
+            hole_of[(str(demo), step.number)] = str(hole[0])
     known = list(parts) if parts is not None else None
-    sequences, origins = [], []
+    sequences, origins, placed = [], [], []
     for label, steps in sorted(by_demo.items(), key=lambda item: _demo_order(item[0])):
         where = f"{path}: demonstration {label}"
         gaps = [i for i in range(1, max(steps) + 1) if i not in steps]
@@ -156,30 +198,38 @@ def _demos_from_facts(path: Path, parts: Sequence[str] | None) -> Demonstrations
         if known is None:
             known = ids
         _check_sequence(where, ids, known, "the parts")
+        where_to = [hole_of.get((label, i)) for i in range(1, max(steps) + 1)]
+        _check_holes(where, ids, where_to, holes)
         sequences.append(tuple(ids))
+        placed.append(tuple(where_to))
         origins.append(where)
     assert known is not None
     if declared and set(declared) != set(known):
         raise PlannerError(f"{path}: part/1 facts {_listed(declared)} differ from the demonstrated parts "
                            f"{_listed(known)}")
-    return Demonstrations(tuple(known), tuple(sequences), tuple(origins))
+    return Demonstrations(tuple(known), tuple(sequences), tuple(origins), tuple(placed))
 
 
 def _demo_order(name: str) -> tuple[int, int | str]:
     return (0, int(name)) if name.isdigit() else (1, name)
 
 
-def load_demos(path: Path | str, parts: Sequence[str] | None = None) -> Demonstrations:
-    """Read demonstrations from a text file or (``*.lp``) ``demo/3`` facts."""
+def load_demos(path: Path | str, parts: Sequence[str] | None = None,
+               holes: Sequence[str] | None = None) -> Demonstrations:
+    """Read demonstrations from a text file or (``*.lp``) ``demo/3``, ``demo/4`` facts;
+    ``parts``, ``holes``: the assembly's (see :func:`parse_demos`)."""
     path = Path(path)
     if path.suffix == ".lp":
-        return _demos_from_facts(path, parts)
-    return parse_demos(_text(path), str(path), parts)
+        return _demos_from_facts(path, parts, holes)
+    return parse_demos(_text(path), str(path), parts, holes)
 
 
 def demo_facts(demos: Demonstrations) -> list[clingo.Symbol]:
-    """``part/1`` and ``demo(D,I,P)`` facts (D and I 1-based) for the demonstrations."""
+    """``part/1`` and ``demo(D,I,P)`` facts (D and I 1-based) for the demonstrations,
+    ``demo(D,I,P,H)`` for a part placed into hole H."""
     atoms = [fact("part", p) for p in demos.parts]
     for d, sequence in enumerate(demos.sequences, start=1):
-        atoms += [fact("demo", d, i, p) for i, p in enumerate(sequence, start=1)]
+        holes = demos.holes[d - 1] if demos.holes else (None,) * len(sequence)
+        atoms += [fact("demo", d, i, p) if h is None else fact("demo", d, i, p, h)
+                  for i, (p, h) in enumerate(zip(sequence, holes), start=1)]
     return atoms

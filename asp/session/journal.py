@@ -21,6 +21,10 @@ experiment is run again and no experiment number is used twice. A failed append 
 disk) cuts the file back to its last whole line and raises a PlannerError. A torn last
 line (a line without its newline: killed while writing) is ignored with a warning: its
 result was never used.
+
+Bound: a journal holds at most :data:`MAX_JOURNAL_BYTES`. A bigger one is refused when
+read (``--resume``, ``bench``), and an append that would pass the bound is refused, so a
+session never writes a journal it could not read back.
 """
 
 from __future__ import annotations
@@ -35,9 +39,14 @@ import msgspec
 
 from asp import PlannerError
 from bridge.files import os_reason
+from bridge.inputs import read_bytes
 from bridge.messages import AspId, Evidence, RequestId, Result
 
 JOURNAL_NAME = "journal.jsonl"
+
+MAX_JOURNAL_BYTES = 64 * 1024 * 1024
+"""The largest journal read or written [bytes] (64 MiB; a finished experiment and its
+start take about 450 bytes, so over 100 000 experiments)."""
 
 
 class JournalEntry(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -77,14 +86,12 @@ def _decode(line: bytes) -> Record:
     return msgspec.convert(data, JournalEntry)
 
 
-def _read(path: Path) -> tuple[list[Record], int | None]:
-    """The records of a journal and the number of its torn last line (None: none)."""
-    if not path.is_file():
-        return [], None
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise PlannerError(f"{path}: cannot read ({os_reason(exc)})") from None
+def _read(path: Path, limit: int = MAX_JOURNAL_BYTES) -> tuple[list[Record], int | None, int]:
+    """The records of a journal, the number of its torn last line (None: none) and the
+    length of its whole lines [bytes]; PlannerError if it is unreadable or over ``limit``."""
+    if not path.exists():
+        return [], None, 0
+    data = read_bytes(path, "session journal", limit=limit, error=PlannerError)
     lines = data.split(b"\n")
     torn = len(lines) if lines[-1] else None  # the last line has no newline: a torn write
     records: list[Record] = []
@@ -95,7 +102,7 @@ def _read(path: Path) -> tuple[list[Record], int | None]:
             records.append(_decode(line))
         except msgspec.DecodeError as exc:
             raise PlannerError(f"{path}:{number}: not a journal entry: {exc}") from None
-    return records, torn
+    return records, torn, data.rfind(b"\n") + 1
 
 
 def _warn_torn(path: Path, torn: int | None) -> None:
@@ -109,7 +116,7 @@ def read_records(path: Path) -> list[Record]:
     bad line. Only the last line may be torn (then it is dropped with a warning on
     stderr); a bad line elsewhere means the file was edited or corrupted and is
     reported with its line number."""
-    records, torn = _read(path)
+    records, torn, _whole = _read(path)
     _warn_torn(path, torn)
     return records
 
@@ -120,22 +127,23 @@ def read_journal(path: Path) -> list[JournalEntry]:
 
 
 class Journal:
-    """Appends records durably (one write, fsync) to ``RUN/journal.jsonl``.
+    """Appends records durably (one write, fsync) to ``RUN/journal.jsonl``, at most
+    ``limit`` bytes in all.
 
     ``entries``: the finished experiments; ``events``: the started and abandoned ones.
     """
 
-    def __init__(self, run: Path) -> None:
+    def __init__(self, run: Path, limit: int = MAX_JOURNAL_BYTES) -> None:
         self.path = run / JOURNAL_NAME
-        records, torn = _read(self.path)
+        self.limit = limit
+        records, torn, whole = _read(self.path, limit)
         self.entries = [r for r in records if isinstance(r, JournalEntry)]
         self.events = [r for r in records if isinstance(r, JournalEvent)]
         try:
             self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
             if torn is not None:
                 _warn_torn(self.path, torn)
-                data = self.path.read_bytes()
-                os.ftruncate(self._fd, data.rfind(b"\n") + 1)
+                os.ftruncate(self._fd, whole)
         except OSError as exc:
             raise PlannerError(f"{self.path}: cannot write ({os_reason(exc)})") from None
 
@@ -156,6 +164,9 @@ class Journal:
         """Append one line with one write and fsync it; on failure cut back to the last whole line."""
         line = msgspec.json.encode(record) + b"\n"
         size = os.fstat(self._fd).st_size
+        if size + len(line) > self.limit:
+            raise PlannerError(f"{self.path}: full: a session journal holds at most {self.limit} bytes; "
+                               "the session stops here (what it learned so far is journaled)")
         try:
             view = memoryview(line)
             while view:  # one write, unless the disk fills up in the middle (then the next one fails)

@@ -1,6 +1,8 @@
 """``./run.sh session``: the end-to-end learning session, planner and cells over Zenoh.
 
-1. learns must-precede from the assembly's demonstrations (Algorithm 1);
+1. learns must-precede from the assembly's demonstrations (Algorithm 1; ``--demos FILE``
+   for others); parts they place into holes (``p1@r1``) are fits the size learner
+   starts from (paper 4.2, last paragraph);
 2. starts ``--cells N`` cell co-processes (``executor serve``) connected to the planner's
    loopback endpoint (``--cells 0 --connect EP`` uses cells already on the network);
 3. learns which part fits which hole, keeping every alive cell busy with experiments
@@ -65,6 +67,8 @@ LOG = logging.getLogger(__name__)
 SETTINGS = "session.json"
 MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
+MAX_CELLS = 64
+"""--cells: at most this many cell co-processes."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -72,13 +76,17 @@ MAX_PLANS = 1000
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
     add_assembly_argument(parser)
-    parser.add_argument("--cells", type=int, default=1, help="cell co-processes to start (default 1)")
+    parser.add_argument("--cells", type=int_in(0, MAX_CELLS), default=1,
+                        help=f"cell co-processes to start, 0 to {MAX_CELLS} (default 1; 0: use cells on the network)")
     parser.add_argument("--policy", default="best", choices=policy_names(),
                         help="experiment selection policy (default best: fewest experiments)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the policy and the trials")
     parser.add_argument("--confirm", type=int_in(0, MAX_CONFIRM), default=0, metavar="K",
                         help="re-test each essential experiment until its result leads by K+1 answers "
                              "(default 0: trust the cell's answer; see sizes learn --confirm)")
+    parser.add_argument("--demos", type=Path, metavar="FILE",
+                        help="demonstrations (default: the assembly's demos.txt); a part placed into a "
+                             "hole (p1@r1) is a fit the size learning starts from")
     parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
@@ -128,6 +136,8 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock, bool]:
                            f"use --resume {run} or another folder")
     settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed, "confirm": args.confirm,
                 "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running"}
+    if args.demos is not None:  # absolute: a resume may run from another folder
+        settings["demos"] = str(args.demos.absolute())
     return run, settings, lock, created
 
 
@@ -138,14 +148,15 @@ def _holds_session(run: Path) -> bool:
     if journal.is_file() and journal.stat().st_size > 0:
         return True
     try:
-        return json.loads((run / SETTINGS).read_text(encoding="utf-8")).get("status") == "done"
-    except (OSError, ValueError, AttributeError):
+        return json.loads(read_bytes(run / SETTINGS, "session settings file", error=PlannerError)
+                          ).get("status") == "done"
+    except (PlannerError, ValueError, AttributeError):
         return False
 
 
 _SETTING_TYPES: dict[str, tuple[type, bool]] = {
     "assembly": (str, True), "policy": (str, True), "seed": (int, True), "recording_id": (str, True),
-    "confirm": (int, False), "starts": (int, False)}
+    "confirm": (int, False), "starts": (int, False), "demos": (str, False)}
 """The settings a resumed session reads back: key → (type, required)."""
 
 
@@ -282,8 +293,6 @@ def run_session(args: argparse.Namespace, viewer: Viewer = NO_VIEWER) -> dict:
     """Run (or resume) a session; returns the JSON result. Planner and cells also stream
     their recordings live to ``viewer``."""
     started = time.perf_counter()
-    if args.cells < 0:
-        raise PlannerError(f"--cells {args.cells}: expected a number >= 0")
     run, settings, lock, created = _run_folder(args)
     try:
         return _run_locked(args, run, settings, started, viewer)
@@ -301,15 +310,19 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     assembly = load_assembly(settings["assembly"])
     parts, holes, truth = _sizes_domain(assembly)
     # Every input file is read before any cell starts: bad input fails fast.
-    demos = load_demos(assembly.file("demos.txt"), parts=assembly.part_ids)
+    demos = load_demos(settings.get("demos") or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
     relation = learn_must_precede(demos)
+    learner = SizeLearner(parts, holes, settings["policy"], settings["seed"],
+                          confirm=int(settings.get("confirm", 0)), demonstrated=demos.placements())
     required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
     run_id = re.sub(r"[^A-Za-z0-9_-]", "-", settings["recording_id"])
     listen, connect = _endpoints(args)
     suffix = "" if settings["starts"] == 1 else f"-{settings['starts']}"
     cell_ids = [f"c{k}" for k in range(1, args.cells + 1)]
+    journal = Journal(run)
     _save(run, settings)
     with ExitStack() as stack:
+        stack.callback(journal.close)
         session = open_session(listen, connect, args.zenoh_config)
         stack.callback(session.close)
         directory = CellDirectory(session)
@@ -324,8 +337,6 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids, viewer)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
-        journal = Journal(run)
-        stack.callback(journal.close)
         abandoned = [event.experiment for event in journal.abandon_in_flight()]
         if abandoned:
             settings.setdefault("abandoned", []).extend(abandoned)
@@ -335,8 +346,6 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell, allowed=allowed)
         stack.callback(pool.close)
         oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
-        learner = SizeLearner(parts, holes, settings["policy"], settings["seed"],
-                              confirm=int(settings.get("confirm", 0)))
         for cell in cells:
             cell.wait_for_line("ready", timeout=args.wait_for_cell)
         try:
@@ -368,6 +377,7 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         "must_precede": [list(pair) for pair in must_precede],
         "plans": [plan.as_json() for plan in found],
         "matches_truth": matches,
+        "demonstrated": [list(pair) for pair in sizes.demonstrated],
     }
     settings.update(result, status="done", truth=versus, assignment=assignment, cells=cell_ids,
                     journal=[{"part": e.part, "hole": e.hole, "result": e.result, "cell": e.cell,
@@ -399,7 +409,9 @@ def _summary(result: dict, run: Path) -> str:
     return "\n".join([
         f"run {result['run']}: {result['experiments']} experiments "
         f"({', '.join(f'{c}: {n}' for c, n in sorted(cells.items()))}) in {settings['wall_s']:.1f} s",
-        "fits: " + " ".join(f"{p}->{h}" for p, h in result["fits"]),
+        "fits: " + " ".join(f"{p}->{h}" for p, h in result["fits"])
+        + (f" (started from {len(result['demonstrated'])} seen in the demonstrations)"
+           if result["demonstrated"] else ""),
         f"must precede: {len(result['must_precede'])} pairs",
         "assignment: " + " ".join(f"{p}->{h}" for p, h in settings["assignment"].items()),
         f"plan 1 of {len(result['plans'])}: {plan}",

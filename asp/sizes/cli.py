@@ -1,7 +1,8 @@
 """``./run.sh sizes learn|evaluate``: which part fits which hole (paper 2.2, 4.2).
 
 ``learn`` runs one learning session against a truth oracle and prints the experiments
-(``--json``: the contract of docs/cli.md), optionally writing the learned facts (``--out``).
+(``--json``: the contract of docs/cli.md), optionally writing the learned facts (``--out``);
+``--demos FILE`` starts it from the fits the demonstrations show (``p1@r1``).
 ``evaluate`` counts the experiments a policy needs over relabelings of an assembly.
 Both take ``--noise P`` (answers flipped with probability P) and ``--confirm K`` (re-test
 each essential observation until its result leads by K+1 answers; docs/sizes.md, "Noise").
@@ -14,12 +15,14 @@ import json
 import sys
 
 from asp import PlannerError
+from asp.precedence.demos import load_demos
 from asp.sizes.evaluate import evaluate_policy, plot_comparison
 from asp.sizes.knowledge import Knowledge
 from asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
 from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
 from asp.solve import write_facts
+from bridge.assembly import load_assembly
 from bridge.cli_types import ArgumentParser, add_assembly_argument, comma_list, int_in
 
 
@@ -64,6 +67,8 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--policy", choices=policy_names(), default="heuristic",
                        help="experiment selection (default heuristic)")
     learn.add_argument("--seed", type=int, default=0, help="seed of random choices and noise (default 0)")
+    learn.add_argument("--demos", metavar="FILE",
+                       help="demonstrations; the parts they place into holes (p1@r1) are fits to start from")
     _add_noise_options(learn)
     learn.add_argument("--out", metavar="FILE.lp", help="write learned facts (tried/4, smaller/2, fits/2, no_fit/2)")
     learn.add_argument("--json", action="store_true", help="print JSON")
@@ -90,8 +95,17 @@ def _print_matrix(knowledge: Knowledge) -> None:
         print(part.ljust(width + 2) + cells)
 
 
+def demonstrated_fits(path: str, assembly: str | None) -> list[tuple[str, str]]:
+    """The (part, hole) placements of the demonstrations in ``path``, checked against the
+    parts and holes of ``assembly`` when given."""
+    folder = load_assembly(assembly) if assembly else None
+    demos = load_demos(path, folder.part_ids if folder else None, folder.hole_ids if folder else None)
+    return demos.placements()
+
+
 def _learn(args: argparse.Namespace) -> int:
     truth = _truth(args)
+    demonstrated = demonstrated_fits(args.demos, args.assembly) if args.demos else []
     oracle: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
 
     def show(experiment: Experiment, _knowledge: Knowledge) -> None:
@@ -99,8 +113,11 @@ def _learn(args: argparse.Namespace) -> int:
             note = " (re-test)" if experiment.retest else ""
             print(f"{experiment.number:3d}: {experiment.part} -> {experiment.hole}: {experiment.result}{note}")
 
+    if demonstrated and not args.json:
+        print(f"starting from {len(demonstrated)} fits seen in the demonstrations: "
+              + " ".join(f"{p}->{h}" for p, h in demonstrated))
     result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
-                         confirm=args.confirm)
+                         confirm=args.confirm, demonstrated=demonstrated)
     if args.out:
         write_facts(args.out, result.facts(), header=f"learned by `sizes learn --policy {args.policy}`")
     if args.json:
@@ -109,6 +126,7 @@ def _learn(args: argparse.Namespace) -> int:
             "experiments": [e.as_json() for e in result.experiments],
             "count": result.count,
             "fits": [[p, h] for p in truth.parts for h in truth.holes if (p, h) in result.knowledge.fits],
+            **({"demonstrated": [list(pair) for pair in result.demonstrated]} if args.demos else {}),
         }))
     else:
         retests = sum(e.retest for e in result.experiments)

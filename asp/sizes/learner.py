@@ -12,6 +12,11 @@ on the cycle are named and re-tested; per pair the majority of its answers is ke
 (a tie keeps the latest), so the kept relation never contradicts itself. It is done
 when every pair is known and no conflict is left.
 
+Demonstrations that say where a part went (``p1@r1``; paper 4.2, last paragraph) are
+fits seen before any experiment: ``demonstrated`` pairs start as one ``fit`` answer each,
+so the learner starts from their closure, never tries them unless a conflict names them,
+and counts no experiment for them.
+
 A wrong answer that other kept observations entail closes a cycle; one that is
 *essential* (its pair is unknown without it, ``sizes/essential.lp``) cannot be caught
 that way. With ``confirm`` K > 0, once every pair is known each essential observation is
@@ -72,10 +77,15 @@ class SizeLearningResult:
         """Number of experiments run, re-tests included."""
         return len(self.experiments)
 
+    demonstrated: tuple[Pair, ...] = ()
+    """Fits seen in demonstrations, which the learner started from."""
+
     def facts(self) -> list[clingo.Symbol]:
-        """``part/1, hole/1, tried/4, smaller/2, fits/2, no_fit/2`` (the project's facts vocabulary)."""
+        """``part/1, hole/1, demonstrated/2, tried/4, smaller/2, fits/2, no_fit/2`` (the
+        project's facts vocabulary)."""
         k = self.knowledge
         atoms = [fact("part", p) for p in k.parts] + [fact("hole", h) for h in k.holes]
+        atoms += [fact("demonstrated", p, h) for p, h in self.demonstrated]
         atoms += [fact("tried", e.number, e.part, e.hole, e.result) for e in self.experiments]
         atoms += [fact("smaller", x, y) for x, y in sorted(k.smaller)]
         atoms += [fact("fits", p, h) for p, h in sorted(k.fits)]
@@ -94,10 +104,12 @@ class SizeLearner:
         seed: int = 0,
         max_answers: int | None = None,
         confirm: int = 0,
+        demonstrated: Sequence[Pair] = (),
     ) -> None:
         """``parts``/``holes`` in index order; ``confirm`` K ≥ 0: each essential
         observation's kept result must lead the other by K+1 answers (0: no confirmation);
-        ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more)."""
+        ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more);
+        ``demonstrated``: (part, hole) pairs demonstrations placed, known to fit (module doc)."""
         if len(set(parts) | set(holes)) != len(parts) + len(holes):
             raise PlannerError("parts and holes need distinct ids")
         if not 0 <= confirm <= MAX_CONFIRM:
@@ -107,6 +119,11 @@ class SizeLearner:
             raise PlannerError(f"max_answers {max_answers}: confirm {confirm} needs at least "
                                f"{confirm + 1} answers per pair")
         self.parts, self.holes = tuple(parts), tuple(holes)
+        self.demonstrated = tuple(dict.fromkeys(demonstrated))
+        outside = [f"{p}@{h}" for p, h in self.demonstrated if p not in self.parts or h not in self.holes]
+        if outside:
+            raise PlannerError(f"demonstrated placement(s) {' '.join(outside[:5])}: expected a part of "
+                               f"{' '.join(self.parts)} and a hole of {' '.join(self.holes)}")
         self.policy = get_policy(policy) if isinstance(policy, str) else policy
         self.rng = random.Random(seed)
         self.max_answers, self.confirm = max_answers, confirm
@@ -124,6 +141,13 @@ class SizeLearner:
         self._literals = {(*pair, r): self._literal(fact("observed", *pair, r))
                           for pair in self._pairs for r in RESULTS}
         self._selected: Pair | None = None
+        self._start_from_demonstrations()
+
+    def _start_from_demonstrations(self) -> None:
+        """One ``fit`` answer per demonstrated pair, then the closure (fits alone close no cycle)."""
+        for pair in self.demonstrated:
+            self.answers[pair] = ["fit"]
+            self._set_observation(pair, "fit")
         self.knowledge = self._solve()
 
     def _pair(self, symbol: clingo.Symbol) -> Pair:
@@ -329,10 +353,10 @@ class SizeLearner:
             self._set_observation(pair, None)
         self.experiments, self.answers, self.retests, self._history = [], {}, [], []
         self.rng = random.Random(seed)
-        self.knowledge = self._solve()
+        self._start_from_demonstrations()
 
     def result(self) -> SizeLearningResult:
-        return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge)
+        return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge, self.demonstrated)
 
 
 def _reaches(graph: dict[str, set[str]], start: str, goal: str) -> bool:
@@ -357,10 +381,12 @@ def learn_sizes(
     on_experiment: Callable[[Experiment, Knowledge], None] | None = None,
     max_answers: int | None = None,
     confirm: int = 0,
+    demonstrated: Sequence[Pair] = (),
 ) -> SizeLearningResult:
     """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known
-    (and, with ``confirm`` > 0, every essential observation confirmed; see :class:`SizeLearner`)."""
-    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm)
+    (and, with ``confirm`` > 0, every essential observation confirmed), starting from the
+    fits ``demonstrated``; see :class:`SizeLearner`."""
+    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm, demonstrated)
     return run_learner(learner, oracle, on_experiment)
 
 

@@ -21,7 +21,9 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from bridge.cli_types import ArgumentParser, add_assembly_argument
+from bridge import BridgeError
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
+from executor import ExecutorError
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
 
@@ -96,11 +98,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = ArgumentParser(prog="bench executor", description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
                         help="1 timed trial per pair and a 4-trial campaign")
-    parser.add_argument("--trials", type=int, help="timed trials per pair (default 3)")
-    parser.add_argument("--campaign-trials", type=int,
+    parser.add_argument("--trials", type=int_in(1, 10**4), help="timed trials per pair (default 3)")
+    parser.add_argument("--campaign-trials", type=int_in(0, 10**5),
                         help="campaign trials per pair (default 40; 0 skips the campaign)")
-    parser.add_argument("--workers", type=int, default=2, help="campaign workers (default 2)")
-    parser.add_argument("--seed", type=int, default=1000, help="base seed (default 1000)")
+    parser.add_argument("--workers", type=int_in(1, 64), default=2, help="campaign workers (default 2)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1000, help="base seed (default 1000)")
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
@@ -117,4 +119,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run_command(main, (ExecutorError, BridgeError)))

@@ -14,7 +14,7 @@ import math
 import sys
 from collections.abc import Sequence
 
-from bridge.cli_types import ArgumentParser
+from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor.campaign.pairs import PAIRS_ARGUMENT
 from executor.control.detector import Thresholds
 from executor.evidence import AttemptSetup
@@ -23,8 +23,8 @@ from executor.trial import Cell, trial_rng
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = ArgumentParser(prog="executor margins", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--trials", type=int, default=10, help="attempts per pair (default 10)")
-    parser.add_argument("--seed", type=int, default=0, help="first seed")
+    parser.add_argument("--trials", type=int_in(1, 10**5), default=10, help="attempts per pair (default 10)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="first seed")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     args = parser.parse_args(argv)
     cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf))

@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from bridge.cli_types import ArgumentParser, add_assembly_argument
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
 from executor import ExecutorError
 from executor.campaign.pairs import (
     HOLE_NAMES,
@@ -208,9 +208,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Fig. 18: randomised executions of every fitting pair of the paper's "
         "table plus every non-fitting pair of {p1,tp,p3,sh} x {r1,br,s1}.",
     )
-    parser.add_argument("--trials", type=int, default=40, help="executions per pair (default 40)")
-    parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
-    parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    parser.add_argument("--trials", type=int_in(1, 10**5), default=40, help="executions per pair (default 40)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="base seed (default 0)")
+    parser.add_argument("--workers", type=int_in(1, 64), default=2, help="worker processes (default 2)")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")

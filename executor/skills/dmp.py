@@ -22,6 +22,7 @@ import numpy as np
 from movement_primitives.dmp import CartesianDMP
 
 from bridge.files import make_folder, write_atomic
+from bridge.inputs import read_text
 from executor import ExecutorError
 
 # Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
@@ -141,7 +142,12 @@ def load_skill(folder: Path, shape: str) -> Skill:
     if not path.is_file():
         raise ExecutorError(
             f"part shape '{shape}': no demonstration at {path} (expected one; run ./run.sh executor teach)")
-    return Skill.from_json(json.loads(path.read_text()))
+    text = read_text(path, "taught skill (JSON)", error=ExecutorError)
+    try:
+        return Skill.from_json(json.loads(text))
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ExecutorError(f"{path}: not a taught skill ({type(exc).__name__}: {str(exc)[:80]}); "
+                            "run ./run.sh executor teach") from None
 
 
 class PhaseClock:

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from asp.session.cells import CellProcess, start_cell
+from asp.session.cells import CellProcess, serve_argv, start_cell
 from bridge.client import (
     CellConflict,
     CellDirectory,
@@ -261,15 +261,70 @@ def test_a_token_with_nothing_behind_it_is_dropped_and_others_are_not_trusted(ne
         rogue.close()
 
 
-def test_two_processes_claiming_one_cell_id_are_not_used_until_one_is_gone(network) -> None:
+def _refusal(cell: CellProcess) -> str:
+    """The one line a cell that refused its id printed; asserts it exited with code 2 before ``ready``."""
+    assert cell.popen.wait(30) == 2
+    cell.wait_for_line("error:", 5)
+    assert not any(line.startswith("ready") for line in cell.lines), cell.lines
+    errors = [line for line in cell.lines if line.startswith("error:")]
+    assert len(errors) == 1 and len(cell.lines) == 1, cell.lines
+    return errors[0]
+
+
+@pytest.mark.slow  # two or three cell processes
+def test_a_second_process_on_a_served_cell_id_refuses_to_start(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
     directory.wait_for(1, timeout=20)
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
-    deadline = time.monotonic() + 20
-    while "c1" in directory.alive() and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert directory.alive() == set() and directory.duplicated == {"c1"}
-    cells[0].kill()
-    directory.wait_for(1, timeout=20)  # one claimant left: usable again
+    cells.append(CellProcess("c1", serve_argv("c1", backend="truth", connect=[endpoint])))
+    assert "error: cell id c1 is already served by another process" in _refusal(cells[1])
+    assert cells[0].popen.poll() is None and directory.duplicated == set()  # the planner never saw it
     assert request_insert(session, "c1", InsertRequest(id="d1", part="sh", hole="br"), 10).result == "fit"
+
+
+@pytest.mark.slow  # two or three cell processes
+def test_two_processes_started_together_on_one_id_leave_exactly_one(network) -> None:
+    endpoint, session, directory, cells = network
+    cells += [CellProcess("c1", serve_argv("c1", backend="truth", connect=[endpoint])) for _ in range(2)]
+    deadline = time.monotonic() + 40
+    while all(cell.popen.poll() is None for cell in cells) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    refused = [cell for cell in cells if cell.popen.poll() is not None]
+    assert len(refused) == 1 and "cell id c1" in _refusal(refused[0])
+    directory.wait_for(1, timeout=20)
+    assert request_insert(session, "c1", InsertRequest(id="d2", part="sh", hole="br"), 10).result == "fit"
+
+
+@pytest.mark.slow  # two or three cell processes
+def test_cells_on_one_id_that_meet_later_leave_the_older_serving(network) -> None:
+    endpoint, session, directory, cells = network
+    first, second = free_loopback_endpoint(), free_loopback_endpoint()
+    cells.append(start_cell("c1", backend="truth", listen=[first]))
+    cells.append(start_cell("c1", backend="truth", listen=[second]))  # apart: no peer connects them
+    late = open_session(connect=[first, second])  # a planner joins both: Zenoh's gossip connects them
+    try:
+        assert cells[1].popen.wait(30) == 2 and cells[0].popen.poll() is None
+        assert "error: cell id c1 is already served" in cells[1].wait_for_line("error:", 5)
+        assert request_insert(late, "c1", InsertRequest(id="d3", part="sh", hole="br"), 10).result == "fit"
+    finally:
+        late.close()
+
+
+def test_a_token_of_a_second_claimant_the_cells_cannot_see_makes_the_planner_wait(network) -> None:
+    """The planner's own guard: two tokens on one id (here a peer that listens nowhere, so
+    the cell cannot meet it) and that id gets nothing until one is gone."""
+    endpoint, session, directory, cells = network
+    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    directory.wait_for(1, timeout=20)
+    hidden = open_session(connect=[endpoint])
+    try:
+        token = hidden.liveliness().declare_token(alive_key("c1", "hidden"))
+        deadline = time.monotonic() + 20
+        while "c1" in directory.alive() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert directory.alive() == set() and directory.duplicated == {"c1"}
+        token.undeclare()
+        directory.wait_for(1, timeout=20)  # one claimant left: usable again
+        assert request_insert(session, "c1", InsertRequest(id="d4", part="sh", hole="br"), 10).result == "fit"
+    finally:
+        hidden.close()

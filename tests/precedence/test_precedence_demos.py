@@ -8,7 +8,8 @@ import pytest
 
 from asp import PlannerError
 from asp.precedence.demos import demo_facts, load_demos, parse_demos
-from asp.solve import write_facts
+from asp.solve import atoms_by_name, load_atoms, write_facts
+from bridge.assembly import load_assembly
 
 
 def test_spaces_commas_comments_and_blank_lines_give_the_same_sequences() -> None:
@@ -95,3 +96,51 @@ def test_cli_bad_input_exits_2_without_traceback(tmp_path: Path, content: bytes,
     assert result.stderr.startswith(f"error: {path}")
     assert message in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_placements_part_at_hole_are_read_from_text_and_facts_alike(tmp_path: Path) -> None:
+    demos = parse_demos("o r1@x i1\no, i1, r1@y  # another hole\n", "d.txt", holes=["x", "y"])
+    assert demos.sequences == (("o", "r1", "i1"), ("o", "i1", "r1"))
+    assert demos.holes == ((None, "x", None), (None, None, "y"))
+    assert demos.placements() == [("r1", "x"), ("r1", "y")]
+    path = tmp_path / "demos.lp"
+    write_facts(path, demo_facts(demos))
+    assert "demo(1,2,r1,x)." in path.read_text() and "demo(1,1,o)." in path.read_text()
+    again = load_demos(path, holes=["x", "y"])
+    assert (again.sequences, again.holes) == (demos.sequences, demos.holes)
+    assert parse_demos("o r1 i1\n", "d.txt").placements() == []
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("a b c\na b@z c\n", r"d\.txt:2: 'b@z': unknown hole 'z'; expected one of the assembly's holes: x y"),
+        ("a@X b c\n", r"d\.txt:1: 'a@X': 'X' is not a hole id"),
+        ("a@ b c\n", r"d\.txt:1: 'a@': '' is not a hole id"),
+        ("a@x@y b c\n", r"d\.txt:1: 'a@x@y': 'x@y' is not a hole id"),
+        ("a@x b@x c\n", r"d\.txt:1: 'b@x': hole x already holds a in this demonstration"),
+        ("@x a b c\n", r"d\.txt:1: '' is not a part id"),
+    ],
+)
+def test_a_bad_placement_names_file_line_and_the_hole(text: str, message: str) -> None:
+    with pytest.raises(PlannerError, match=message):
+        parse_demos(text, "d.txt", holes=["x", "y"])
+
+
+def test_a_bad_placement_in_facts_names_the_atom(tmp_path: Path) -> None:
+    path = tmp_path / "demos.lp"
+    for text, message in [("demo(1,1,a,z). demo(1,2,b).", r"demos\.lp: demo\(1,1,a,z\): 'a@z': unknown hole 'z'"),
+                          ("demo(1,1,a,3). demo(1,2,b).", r"'a@3': '3' is not a hole id"),
+                          ("demo(1,1,a,x). demo(1,1,a). demo(1,2,b).", r"already places a at step 1")]:
+        path.write_text(text + "\n")
+        with pytest.raises(PlannerError, match=message):
+            load_demos(path, holes=["x", "y"])
+
+
+def test_cranfield_annotated_demonstrations_are_demos_txt_with_nine_fits() -> None:
+    cranfield = load_assembly("cranfield")
+    plain = load_demos(cranfield.file("demos.txt"), cranfield.part_ids, cranfield.hole_ids)
+    annotated = load_demos(cranfield.folder / "demos_annotated.txt", cranfield.part_ids, cranfield.hole_ids)
+    assert annotated.sequences == plain.sequences and plain.placements() == []
+    truth = set(atoms_by_name(load_atoms([cranfield.file("sizes.lp")]), "fits", 2))
+    assert len(annotated.placements()) == 9 and set(annotated.placements()) <= truth

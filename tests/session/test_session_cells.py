@@ -23,7 +23,7 @@ from asp.session.journal import read_journal
 from asp.sizes.oracle import TruthOracle
 from asp.solve import atoms_by_name, load_atoms
 from bridge.session import free_loopback_endpoint
-from tests.conftest import TRUTH_SESSION
+from tests.conftest import ROOT, TRUTH_SESSION
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
 TRUTH = TruthOracle.from_assembly("cranfield")
@@ -174,6 +174,24 @@ def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path
     asked = Counter((e.part, e.hole) for e in journal)
     assert all(asked[(e.part, e.hole)] == 2 for e in retests)
     assert all(e.result == TRUTH.ask(e.part, e.hole) for e in journal)
+
+
+def test_a_session_starts_from_the_fits_its_demonstrations_show(tmp_path: Path, run_session) -> None:
+    from asp.sizes.learner import learn_sizes
+
+    demos = ROOT / "data" / "cranfield" / "demos_annotated.txt"
+    run = tmp_path / "run"
+    result = run_session("--cells", "1", "--out", str(run), "--demos", str(demos))
+    assert_learned_truth(result, run)
+    shown = {tuple(pair) for pair in result["demonstrated"]}
+    assert len(shown) == 9 and shown <= TRUTH.fits
+    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", demonstrated=list(shown))
+    assert result["experiments"] == alone.count < 19  # 19: best from nothing
+    assert not {(e.part, e.hole) for e in read_journal(run / "journal.jsonl")} & shown
+    learned = load_atoms([run / "learned.lp"])
+    assert set(atoms_by_name(learned, "demonstrated", 2)) == shown
+    assert len([a for a in learned if a.match("demo", 4)]) == 4 * 5  # 4 demonstrations, 5 pegs each
+    assert json.loads((run / "session.json").read_text())["demos"] == str(demos)
 
 
 def test_a_rogue_cell_that_answers_fit_to_everything_is_never_used(tmp_path: Path, run_session) -> None:

@@ -100,3 +100,17 @@ def test_a_full_disk_keeps_the_journal_whole(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert done.stdout == f"{path}: cannot write (File too large)\n"
     assert path.read_bytes() == before  # cut back to its last whole line
+
+
+def test_the_journal_is_bounded_when_written_and_when_read(tmp_path: Path) -> None:
+    journal = Journal(tmp_path, limit=1000)
+    with pytest.raises(PlannerError, match="full: a session journal holds at most 1000 bytes"):
+        for k in range(100):
+            journal.append(entry(k))
+    journal.close()
+    path = tmp_path / "journal.jsonl"
+    written = path.read_bytes()
+    assert 0 < len(written) <= 1000 and written.endswith(b"\n")  # whole lines, under the bound
+    assert len(read_journal(path)) == written.count(b"\n")
+    with pytest.raises(PlannerError, match="larger than 500 bytes"):
+        Journal(tmp_path, limit=500)

@@ -12,6 +12,7 @@ from asp import PlannerError
 from asp.sizes.learner import SizeLearner, learn_sizes
 from asp.sizes.oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
+from tests.conftest import ROOT
 
 
 @pytest.mark.parametrize("policy", ["systematic", "random", pytest.param("heuristic", marks=pytest.mark.slow)])
@@ -106,3 +107,37 @@ def test_a_batch_avoids_pairs_pending_at_other_cells() -> None:
     # (a,y) and (b,y) are not independent: a not fitting y entails b not fitting y
     assert learner.next_batch(2) == [("a", "y")]
     assert learner.next_batch(2, pending=[("a", "y")]) == []
+
+
+def test_the_learner_starts_from_demonstrated_fits_and_what_they_entail_with_experiments() -> None:
+    learner = SizeLearner(["a", "b"], ["x", "y"], demonstrated=[("a", "x")])
+    assert learner.knowledge.result("a", "x") == "fit" and learner.experiments == []
+    assert learner.next_experiment() != ("a", "x")
+    learner.record("b", "x", "no_fit")  # x < b, and a < x from the demonstration: a < b
+    learner.record("b", "y", "fit")  # a < x < b < y: a fits y, never asked
+    assert learner.knowledge.result("a", "y") == "fit" and learner.knowledge.complete
+    without = SizeLearner(["a", "b"], ["x", "y"])
+    without.record("b", "x", "no_fit")
+    without.record("b", "y", "fit")
+    assert without.knowledge.result("a", "y") is None  # the demonstration made the difference
+    names = {str(s) for s in learner.result().facts()}
+    assert "demonstrated(a,x)" in names and not any(s.startswith("tried(") and ",a,x," in s for s in names)
+    learner.reset()
+    assert learner.knowledge.result("a", "x") == "fit"  # a fresh session keeps what was demonstrated
+    with pytest.raises(PlannerError, match=r"demonstrated placement\(s\) a@z"):
+        SizeLearner(["a", "b"], ["x", "y"], demonstrated=[("a", "z")])
+
+
+@pytest.mark.parametrize("policy", ["systematic", "heuristic", "best"])
+def test_annotated_cranfield_demonstrations_save_experiments(policy: str) -> None:
+    from asp.sizes.cli import demonstrated_fits
+
+    truth = TruthOracle.from_assembly("cranfield")
+    shown = demonstrated_fits(str(ROOT / "data" / "cranfield" / "demos_annotated.txt"), "cranfield")
+    plain = learn_sizes(truth.parts, truth.holes, truth, policy)
+    oracle = CheckingOracle(truth)
+    annotated = learn_sizes(truth.parts, truth.holes, oracle, policy, on_experiment=oracle.observe,
+                            demonstrated=shown)
+    assert annotated.knowledge.fits == frozenset(truth.fits)
+    assert not set(oracle.asked) & set(shown)
+    assert annotated.count <= plain.count - 5
