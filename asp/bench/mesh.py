@@ -104,7 +104,7 @@ def one_run(topology: str) -> dict:
 
 
 def main(argv: list[str]) -> int:
-    parser = ArgumentParser(prog="./run.sh bench mesh", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="bench mesh", description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeat", type=int_in(1, 100), default=5, help="runs per topology (default 5)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
