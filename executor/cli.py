@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from bridge import BridgeError
 from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, run_command
 from executor import ExecutorError
+from executor.cell_options import add_cell_arguments
 
 MAX_TRIALS = 100_000
 """``trial --trials N``: at most this many trials (trial k uses seed+k)."""
@@ -46,6 +47,7 @@ def _summary(results: list[dict]) -> dict:
 
 
 def _trial(args: argparse.Namespace) -> int:
+    from executor.cell_options import cell_keywords
     from executor.trial import Cell
 
     logger = None
@@ -53,7 +55,7 @@ def _trial(args: argparse.Namespace) -> int:
         from executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger.to_file(args.rrd)
-    cell = Cell(args.assembly, gui=args.gui, logger=logger)
+    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
     try:
         results = []
         for k in range(args.trials):
@@ -111,6 +113,7 @@ def build_parser() -> argparse.ArgumentParser:
     trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
     trial.add_argument("--rrd", help="save a Rerun recording of every attempt to this file")
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
+    add_cell_arguments(trial)
     trial.set_defaults(func=_trial)
 
     for name, (_module, help_text) in _DELEGATED.items():

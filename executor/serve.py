@@ -10,7 +10,9 @@ supervising session died), then closes the Zenoh session cleanly.
   the cell keeps serving.
 - Valid requests run one at a time in the main thread. Results are idempotent by
   request id: a repeated id gets the cached reply and never re-runs the experiment.
-- Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily);
+- Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily)
+  with the execution layer and uncertainty of the options (``--layer``, ``--cell-seed``,
+  ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly.
 
@@ -31,7 +33,7 @@ from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
 import zenoh
 
@@ -51,6 +53,7 @@ from bridge.messages import (
 )
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, open_session
 from executor import ExecutorError
+from executor.cell_options import add_cell_arguments, cell_keywords
 from executor.world.geometry import load_geometry, passes
 
 CACHE_SIZE = 100_000
@@ -136,14 +139,17 @@ class SimBackend:
     """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
-                 rrd: Path | None) -> None:
+                 rrd: Path | None, **cell_keywords: Any) -> None:
+        """``cell_keywords``: the Cell's options (layer, perturbation, cell seed,
+        ``ilc_state``: the file its ILC corrections are loaded from and saved to,
+        atomically after every update, so a resumed session's cell starts from them)."""
         from executor.trial import Cell
 
         _PlannerNumbered = _planner_numbered_logger()
         self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd,
                                          send_blueprint=False)  # the planner sends it
                         if rrd is not None else None)
-        self._cell = Cell(assembly, gui=False, logger=self._logger)
+        self._cell = Cell(assembly, gui=False, logger=self._logger, **cell_keywords)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
         try:
@@ -298,6 +304,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
     parser.add_argument("--lifeline", action="store_true",
                         help="exit when standard input closes (set by a supervising session)")
+    parser.add_argument("--ilc-state", type=Path, metavar="FILE",
+                        help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
+                        "save them there after every update (a session passes <run>/<cell>-ilc.json)")
+    add_cell_arguments(parser)
     add_endpoint_arguments(parser)
     return parser
 
@@ -316,7 +326,8 @@ def main(argv: Sequence[str]) -> int:
     signal.signal(signal.SIGINT, _exit_on_signal)
     backend: Backend = (TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd)
                         if args.backend == "truth"
-                        else SimBackend(args.assembly, cell_id, args.recording_id, args.rrd))
+                        else SimBackend(args.assembly, cell_id, args.recording_id, args.rrd,
+                                        ilc_state=args.ilc_state, **cell_keywords(args)))
     node = CellNode(cell_id, backend)
     try:
         session = open_session(listen, args.connect, args.zenoh_config)

@@ -99,8 +99,10 @@ class CellProcess:
 def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None,
-               zenoh_config: Path | None = None) -> list[str]:
-    """The command line of one ``executor serve`` node, with ``--lifeline``."""
+               zenoh_config: Path | None = None, ilc_state: Path | None = None) -> list[str]:
+    """The command line of one ``executor serve`` node, with ``--lifeline``; ``ilc_state``:
+    the file the sim cell keeps its learned ILC corrections in (in the run folder, so a
+    resumed session's cell starts from them)."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
@@ -113,6 +115,8 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
         argv += ["--recording-id", recording_id]
     if zenoh_config is not None:
         argv += ["--zenoh-config", str(zenoh_config)]
+    if ilc_state is not None and backend == "sim":
+        argv += ["--ilc-state", str(Path(ilc_state).absolute())]
     return argv
 
 

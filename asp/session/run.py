@@ -292,7 +292,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
             cells.append(CellProcess(cell_id, serve_argv(
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
-                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config)))
+                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config,
+                ilc_state=run / f"{cell_id}-ilc.json")))
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
