@@ -71,12 +71,8 @@ class Cell:
         self.gui = gui
         self.logger = logger
         self.thresholds = Thresholds() if thresholds is None else thresholds
-        self.layer = layer_named(layer) if isinstance(layer, str) else layer
-        self.bias = CellBias(PerturbationModel() if perturbation is None else perturbation.check(), cell_seed)
-        self.ilc = Ilc()
         self.ilc_state = ilc_state
-        if ilc_state is not None:
-            self.ilc.load(ilc_state)
+        self.reset_state(layer=layer, perturbation=perturbation, cell_seed=cell_seed)
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
@@ -84,6 +80,16 @@ class Cell:
         self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
+
+    def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
+                    cell_seed: int = 0) -> None:
+        """Become another cell on the same PyBullet clients: this execution layer, new
+        systematic errors, the ILC corrections of ``ilc_state`` (if it exists) or none."""
+        self.layer = layer_named(layer) if isinstance(layer, str) else layer
+        self.bias = CellBias(PerturbationModel() if perturbation is None else perturbation.check(), cell_seed)
+        self.ilc = Ilc()
+        if self.ilc_state is not None:
+            self.ilc.load(self.ilc_state)
 
     def check_pair(self, part: str, hole: str) -> Skill:
         """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""

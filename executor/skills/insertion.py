@@ -60,7 +60,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
 
     The execution layer: ``admittance`` None is pure position control along the DMP;
     ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
-    ``feedforward`` (bins, 4) is a pose correction (dx, dy [m], rx, ry [rad]) over the
+    ``feedforward`` (bins, 5) is a pose correction (dx, dy, dz [m], rx, ry [rad]) over the
     phase added to the command (ILC, :mod:`executor.control.ilc`); ``record`` keeps the
     per-step wrench deviations and admittance offsets in ``result.trace`` for ILC.
 
@@ -80,16 +80,15 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     budget = int(TIMEOUT_FACTOR * clock.duration / TIME_STEP)
     wrench_table = skill.wrench.tabulate()
     last = len(wrench_table) - 1
-    ff = np.zeros((1, 4)) if feedforward is None else feedforward
+    ff = np.zeros((1, 5)) if feedforward is None else feedforward
     ff_last = len(ff) - 1
 
     def ff_at(phase: float) -> tuple[np.ndarray, np.ndarray]:
         c = ff[min(int(phase * len(ff)), ff_last)]
-        return np.array([c[0], c[1], 0.0]), np.array([c[2], c[3], 0.0])
+        return c[:3], np.array([c[3], c[4], 0.0])
 
     trace = ExecutionTrace() if record else None
-    bound_pos = np.array([OFFSET_BOUND[0], OFFSET_BOUND[1], 0.0])
-    bound_rot = np.array([OFFSET_BOUND[2], OFFSET_BOUND[3], 0.0])
+    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], 0.0])
     for _ in range(budget):
         if clock.done:
             break
@@ -108,7 +107,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
                 d_pos = np.clip(d_pos, -bound_pos - ff_pos, bound_pos - ff_pos)
                 d_rot = np.clip(d_rot, -bound_rot - ff_rot, bound_rot - ff_rot)
         if trace is not None:
-            trace.add(clock.phase, np.array([f_dev[0], f_dev[1], m_dev[0], m_dev[1]]))
+            trace.add(clock.phase, np.array([f_dev[0], f_dev[1], f_dev[2], m_dev[0], m_dev[1]]))
         if violated:
             jammed = jammed or bool(s.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
             if not (jammed and wiggle_enabled and wiggles < MAX_WIGGLES):
@@ -125,8 +124,9 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     ff_pos, _ = ff_at(clock.phase)
     pos_d = pos_d + ff_pos
     end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
-    # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets included).
-    p_goal = hole_origin + skill.end_position + d_pos + ff_pos
+    # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets
+    # included; not ILC's z, which only shapes the push, never where the part must end).
+    p_goal = hole_origin + skill.end_position + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])
     reached, err = detector.goal_reached(end.tip_pos, p_goal)
     stalled = completed and not reached and bool(end.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
     jammed = jammed or stalled  # stuck in the hole below the thresholds: a jam too

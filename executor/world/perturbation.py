@@ -42,8 +42,8 @@ class PerturbationModel:
     grasp_tilt_bias: float = 1.5
     grasp_tilt_random: float = 1.0
     vision_bias: float = 0.001
-    vision_sigma: float = 0.001
-    vision_max: float = 0.003
+    vision_sigma: float = 0.0015
+    vision_max: float = 0.006
     friction_min: float = 0.2
     friction_max: float = 0.5
     friction_jitter: float = 0.03
