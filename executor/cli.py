@@ -12,9 +12,10 @@ import json
 import statistics
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from bridge import BridgeError
-from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, run_command
+from bridge.cli_types import MAX_SEED, ArgumentParser, int_in, png_path, run_command
 from executor import ExecutorError
 from executor.cell_options import add_cell_arguments
 
@@ -51,10 +52,14 @@ def _trial(args: argparse.Namespace) -> int:
     from executor.trial import Cell
 
     logger = None
-    if args.rrd:
+    if args.plot:
+        from bridge.files import check_writable
+
+        check_writable(Path(args.plot))  # before the trials
+    if args.rrd or args.plot:
         from executor.rerun_log import AttemptLogger
 
-        logger = AttemptLogger.to_file(args.rrd)
+        logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot))
     cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
     try:
         results = []
@@ -74,6 +79,11 @@ def _trial(args: argparse.Namespace) -> int:
         if logger is not None:
             logger.close()
     summary = _summary(results)
+    if args.plot:
+        from executor.campaign.plots import first_attempts, plot_fig17
+
+        assert logger is not None
+        plot_fig17(*first_attempts(logger.traces), Path(args.plot))
     if args.json:
         print(json.dumps({"trials": results, "summary": summary}, indent=2))
     else:
@@ -112,6 +122,9 @@ def build_parser() -> argparse.ArgumentParser:
     trial.add_argument("--assembly", default="cranfield", help="assembly folder under data/ (default: cranfield)")
     trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
     trial.add_argument("--rrd", help="save a Rerun recording of every attempt to this file")
+    trial.add_argument("--plot", metavar="FILE", type=png_path,
+                       help="draw Fig. 17 (forces and torques over the DMP phase of the first successful "
+                       "and the first failed attempt, against their desired profiles) to this PNG")
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     add_cell_arguments(trial)
     trial.set_defaults(func=_trial)

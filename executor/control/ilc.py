@@ -142,7 +142,7 @@ class Ilc:
 
     def to_json(self) -> dict:
         return {"params": asdict(self.params), "keys": {
-            key: {"iterations": self.iterations[key], "correction": np.round(c, 9).tolist()}
+            key: {"iterations": self.iterations[key], "correction": c.tolist()}
             for key, c in sorted(self.corrections.items())}}
 
     def save(self, path: Path) -> None:
