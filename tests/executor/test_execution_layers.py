@@ -89,4 +89,4 @@ def test_ilc_update_learns_against_the_error_and_round_trips(tmp_path):
     other = Ilc()
     other.load(path)
     assert other.iterations == {"round_peg:r1": 2}
-    assert np.array_equal(other.correction("round_peg:r1")[0], again)  # exact: a resumed cell goes on as if never stopped
+    assert np.array_equal(other.correction("round_peg:r1")[0], again)  # exact: resumed as if never stopped
