@@ -90,3 +90,24 @@ def test_ilc_update_learns_against_the_error_and_round_trips(tmp_path):
     other.load(path)
     assert other.iterations == {"round_peg:r1": 2}
     assert np.array_equal(other.correction("round_peg:r1")[0], again)  # exact: resumed as if never stopped
+
+
+@pytest.mark.slow
+def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
+    """``executor serve --ilc-state``: the sim backend saves after a successful execution;
+    a restarted backend (a resumed session's cell) starts from the saved corrections."""
+    from bridge.messages import InsertRequest
+    from executor.serve import SimBackend
+
+    state = tmp_path / "c1-ilc.json"
+    backend = SimBackend("cranfield", "c1", None, None, ilc_state=state)
+    try:
+        result, _evidence = backend.run(InsertRequest(id="r1", part="p1", hole="r1", seed=3))
+    finally:
+        backend.close()
+    assert result == "fit"
+    restarted = SimBackend("cranfield", "c1", None, None, ilc_state=state)
+    try:
+        assert restarted._cell.ilc.iterations == {"round_peg:r1": 1}
+    finally:
+        restarted.close()
