@@ -111,3 +111,12 @@ def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
         assert restarted._cell.ilc.iterations == {"round_peg:r1": 1}
     finally:
         restarted.close()
+
+
+def test_a_corrupt_ilc_state_is_refused_naming_the_file(tmp_path):
+    from executor import ExecutorError
+
+    path = tmp_path / "c1-ilc.json"
+    path.write_text('{"keys": {"round_peg:r1": {"iterations": 1, "correction": [[0.0]]}}}')
+    with pytest.raises(ExecutorError, match="c1-ilc.json: not an ILC state"):
+        Ilc().load(path)
