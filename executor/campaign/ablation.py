@@ -19,7 +19,7 @@ and 95th percentile of the first attempt's maximal sustained force deviation [N]
 (the statistic of eq. 6), attempts rescued by the wiggle (fit after a wiggle), the
 median trial wall time [s].  For ILC, per execution index 1..E, the median maximal
 force deviation and the first-attempt share of the full layer, next to PI + phase
-stopping without ILC on the same executions.
+stopping without ILC on the same executions, also per pair (``by_pair``).
 """
 
 from __future__ import annotations
@@ -107,6 +107,13 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
     def per_execution(name: str) -> list[list[dict[str, Any]]]:
         return [[r for fit, i, r in by_variant[name] if fit and i == j] for j in range(executions)]
 
+    def pair_medians(name: str) -> dict[str, list[float]]:
+        """Median max force deviation per execution index, per fitting pair."""
+        return {f"{p.part}:{p.hole}": [statistics.median(_first_force(r) for r in rs) for rs in
+                                       [[r for fit, i, r in by_variant[name] if fit and i == j
+                                         and (r["part"], r["hole"]) == (p.part, p.hole)] for j in range(executions)]]
+                for p in pairs if p.fits}
+
     full, without = per_execution("full"), per_execution("pi_phase_stop")
     floor = [_first_force(r) for _, _, r in by_variant[FLOOR]]
     return {
@@ -119,6 +126,8 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
             "without_ilc_max_force_dev_median": [statistics.median(map(_first_force, rs)) for rs in without],
             "random_only_floor_max_force_dev_median": statistics.median(floor),
             "random_only_first_attempt": row(FLOOR)["fitting_first_attempt"],
+            "by_pair": pair_medians("full"),
+            "by_pair_without_ilc": pair_medians("pi_phase_stop"),
         },
     }
 
