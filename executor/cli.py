@@ -12,11 +12,13 @@ import json
 import statistics
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from bridge import BridgeError
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path, run_command
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 from executor import ExecutorError
+from executor.cell_options import add_cell_arguments
 
 MAX_TRIALS = 100_000
 """``trial --trials N``: at most this many trials (trial k uses seed+k)."""
@@ -55,14 +57,19 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
+    from executor.cell_options import cell_keywords
     from executor.trial import Cell
 
     logger = None
-    if args.rrd or live != NO_VIEWER:
+    if args.plot:
+        from bridge.files import check_writable
+
+        check_writable(Path(args.plot))  # before the trials
+    if args.rrd or args.plot or live != NO_VIEWER:
         from executor.rerun_log import AttemptLogger
 
-        logger = AttemptLogger.to_file(args.rrd, viewer=live)
-    cell = Cell(args.assembly, gui=args.gui, logger=logger)
+        logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
+    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
     try:
         results = []
         for k in range(args.trials):
@@ -77,6 +84,11 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
                     f"({r['real_time_factor']:.1f}x real time)"
                 )
         summary = _summary(results)
+        if args.plot:
+            from executor.campaign.plots import first_attempts, plot_fig17
+
+            assert logger is not None
+            plot_fig17(*first_attempts(logger.traces), Path(args.plot))
         if args.json:
             print(json.dumps({"trials": results, "summary": summary}, indent=2), flush=True)
         else:
@@ -123,7 +135,11 @@ def build_parser() -> argparse.ArgumentParser:
     trial.add_argument("--save", "--rrd", dest="rrd", metavar="FILE",
                        help="save a Rerun recording of every attempt to this .rrd file")
     add_viewer_arguments(trial)
+    trial.add_argument("--plot", metavar="FILE", type=png_path,
+                       help="draw Fig. 17 (forces and torques over the DMP phase of the first successful "
+                       "and the first failed attempt, against their desired profiles) to this PNG")
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
+    add_cell_arguments(trial)
     trial.set_defaults(func=_trial)
 
     for name, (_module, help_text) in _DELEGATED.items():

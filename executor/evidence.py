@@ -1,6 +1,6 @@
 """The plain records of the cell's experiments, shared by the trial (:mod:`executor.trial`),
 the Rerun log (:mod:`executor.rerun_log`) and the command lines: the random circumstances
-of one attempt (:class:`AttemptSetup`: grasp error [m, rad] and vision error [m]), what
+of one attempt (:class:`AttemptSetup`: grasp error [m, rad], vision error [m], friction), what
 one attempt showed (:class:`AttemptEvidence`: wrench deviations [N, Nm], end error [m],
 times [s]) and a whole trial (:class:`TrialResult`, with its ``--json`` form).  Kept apart
 from the trial so the logger can name them without importing the simulation.
@@ -13,11 +13,6 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from executor.world.scene import TIME_STEP
-
-GRASP_OFFSET_MAX = 0.001  # [m] lateral offset of the part in the hand
-GRASP_TILT_MAX = np.radians(1.0)  # [rad]
-VISION_SIGMA = 0.0015  # [m] per axis
-VISION_MAX = 0.003  # [m]
 
 
 @dataclass
@@ -36,6 +31,10 @@ class AttemptEvidence:
     wiggles: int
     phase_reached: float
     hole_found: bool = False
+    ilc_iteration: int = 0
+    """executions of this ILC key before this one (0: no correction yet, or ILC off)"""
+    ilc_correction_norm: float = 0.0
+    """RMS over the phase of the feed-forward correction used [m and rad, 4 axes]"""
 
 
 @dataclass
@@ -73,21 +72,13 @@ class TrialResult:
 
 @dataclass(frozen=True)
 class AttemptSetup:
-    """The random circumstances of one attempt: grasp offset [m] and tilt (rotation
-    vector [rad]) of the part in the hand, vision error of the hole estimate [m], seed
-    of the stochastic search."""
+    """The circumstances of one attempt, unknown to the robot: grasp offset [m] and tilt
+    (rotation vector [rad]) of the part in the hand, vision error of the hole estimate
+    [m], seed of the stochastic search, friction coefficient of the part in the hole
+    (None: the scene's own, 0.25).  Drawn by :class:`executor.world.perturbation.CellBias`."""
 
     grasp_offset: np.ndarray
     grasp_tilt: np.ndarray
     vision_error: np.ndarray
     search_seed: int = 0
-
-    @classmethod
-    def draw(cls, rng: np.random.Generator) -> AttemptSetup:
-        r = GRASP_OFFSET_MAX * np.sqrt(rng.uniform())
-        a = rng.uniform(0, 2 * np.pi)
-        tilt_axis = rng.uniform(0, 2 * np.pi)
-        tilt = GRASP_TILT_MAX * rng.uniform() * np.array([np.cos(tilt_axis), np.sin(tilt_axis), 0.0])
-        vision = rng.normal(0.0, VISION_SIGMA, 2)
-        vision *= min(1.0, VISION_MAX / max(float(np.linalg.norm(vision)), 1e-12))
-        return cls(np.array([r * np.cos(a), r * np.sin(a), 0.0]), tilt, vision, int(rng.integers(2**31)))
+    friction: float | None = None

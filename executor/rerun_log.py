@@ -21,11 +21,15 @@ Entities (all under ``executor/<cell-id>/``):
                                 steps only: Fig. 17
 ``outcome``                     text log, one line per attempt
 ``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
+``ilc/<shape>/<hole>/correction_norm``  size of the ILC correction after each update
+                                (mm and degrees, :func:`executor.control.ilc.correction_norm`)
+                                over timeline ``execution``
 =============================== ===================================================
 
 Timelines: ``experiment`` (sequence: one per trial, or set by the caller),
 ``sim_time`` (duration [s]; kept increasing across attempts even when the cell
-restarts its clock) and ``dmp_phase`` (sequence, phase × 1000).
+restarts its clock), ``dmp_phase`` (sequence, phase × 1000) and ``execution``
+(sequence: the ILC iteration of a part shape and hole).
 
 Steps are buffered and sent column-wise (``send_columns``) at ``end_attempt``, which
 keeps the per-step cost to a list append; samples closer than ``period_s`` in sim
@@ -337,6 +341,13 @@ class AttemptLogger:
             self.traces.append(trace)
         self._current = None
         return trace
+
+    def log_ilc(self, key: str, iteration: int, norm: float) -> None:
+        """After an ILC update: the size of the correction of ``key`` (part shape:hole)
+        over the ``execution`` timeline (the key's ILC iteration)."""
+        index = [rr.TimeColumn("execution", sequence=[iteration])]
+        self.rec.send_columns(f"{self.root}/ilc/{key.replace(':', '/')}/correction_norm", indexes=index,
+                              columns=rr.Scalars.columns(scalars=[norm]))
 
     def close(self) -> None:
         """Flush; if this logger created the stream, disconnect it (finishes the file) and

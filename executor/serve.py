@@ -13,7 +13,9 @@ process later.
   the cell keeps serving.
 - Valid requests run one at a time in the main thread. Results are idempotent by
   request id: a repeated id gets the cached reply and never re-runs the experiment.
-- Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily);
+- Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily)
+  with the execution layer and uncertainty of the options (``--layer``, ``--cell-seed``,
+  ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
   ``MODULE:CLASS`` loads a user's backend (:mod:`executor.backends`), e.g. a real robot.
@@ -35,6 +37,7 @@ from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import zenoh
 
@@ -57,6 +60,7 @@ from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, view
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from executor import ExecutorError
 from executor.backends import Backend, CellContext, UnknownPair, backend_option, load_backend
+from executor.cell_options import add_cell_arguments, cell_keywords
 from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
 
@@ -125,14 +129,18 @@ class SimBackend:
     """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
-                 rrd: Path | None, viewer: Viewer = NO_VIEWER) -> None:
+                 rrd: Path | None, viewer: Viewer = NO_VIEWER, **cell_keywords: Any) -> None:
+        """``viewer``: also stream the recording live; ``cell_keywords``: the Cell's options
+        (layer, perturbation, cell seed, ``ilc_state``: the file its ILC corrections are
+        loaded from and saved to, atomically after every update, so a resumed session's
+        cell starts from them)."""
         from executor.trial import Cell
 
         _PlannerNumbered = _planner_numbered_logger()
         self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd, viewer=viewer,
                                          send_blueprint=False)  # the planner sends it
                         if rrd is not None or viewer != NO_VIEWER else None)
-        self._cell = Cell(assembly, gui=False, logger=self._logger)
+        self._cell = Cell(assembly, gui=False, logger=self._logger, **cell_keywords)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
         try:
@@ -296,6 +304,10 @@ def build_parser() -> argparse.ArgumentParser:
     add_viewer_arguments(parser, serve=False)  # a cell serves for as long as it runs: stream to a viewer
     parser.add_argument("--lifeline", action="store_true",
                         help="exit when standard input closes (set by a supervising session)")
+    parser.add_argument("--ilc-state", type=Path, metavar="FILE",
+                        help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
+                        "save them there after every update (a session passes <run>/<cell>-ilc.json)")
+    add_cell_arguments(parser)
     add_endpoint_arguments(parser)
     return parser
 
@@ -305,7 +317,8 @@ def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
     if args.backend == "truth":
         return TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args))
     if args.backend == "sim":
-        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args))
+        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args),
+                          ilc_state=args.ilc_state, **cell_keywords(args))
     return load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
                                                   dict(args.backend_option)))
 

@@ -1,10 +1,14 @@
 """One insertion experiment: part P into hole H, up to two attempts (paper 3.2).
 
-Per attempt: a fresh non-repeatable grasp (≤ 1 mm lateral offset, ≤ 1° tilt of the part
-in the hand, unknown to the robot) and a fresh vision estimate of the hole (σ = 1.5 mm
-per axis, at most 3 mm off); the part is brought above the estimate, the hole is
-searched, the taught skill inserts it, the detector decides, and the part goes back to
-its start on the tray.  A failed attempt is repeated once; two failures mean "no_fit".
+Per attempt: a grasp of the part and a vision estimate of the hole, both off by errors
+unknown to the robot, and a friction of the hole (:mod:`executor.world.perturbation`:
+a systematic part per cell, a random part per attempt); the part is brought above the
+estimate, the hole is searched, the taught skill inserts it with the chosen execution
+layer (:class:`executor.control.ilc.ExecutionLayer`: admittance, phase stopping, ILC),
+the detector decides, and the part goes back to its start on the tray.  A failed attempt
+is repeated once; two failures mean "no_fit".  With ILC, each successful execution
+updates the correction of its (part shape, hole), kept for the cell's next executions
+(and saved to ``ilc_state`` if given).
 The transfer between tray and plate is kinematic (joint-space, not simulated): only
 the force-controlled part of the task is.  The records it returns (the attempt's setup and
 evidence, the trial's result) are plain types in :mod:`executor.evidence`.
@@ -19,9 +23,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from executor import ExecutorError
-from executor.control.admittance import Admittance
+from executor.control.admittance import Admittance, AdmittanceParams
 from executor.control.controller import ImpedanceController
 from executor.control.detector import Detector, Thresholds
+from executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
 from executor.control.motion import Motion
 from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from executor.rerun_arm import ArmRecorder
@@ -30,9 +35,12 @@ from executor.skills.insertion import insert, rotvec_quat_xyzw
 from executor.skills.search import hole_search
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
 from executor.world.geometry import load_geometry, plate_mesh
+from executor.world.perturbation import CellBias, PerturbationModel
 from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from executor.rerun_log import AttemptLogger
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
@@ -47,16 +55,26 @@ def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
 
 class Cell:
     """The simulated cell, reused for many trials: one DIRECT PyBullet client per part
-    shape (made on first use), so a trial depends on its seed only."""
+    shape (made on first use), so a trial depends on its seed, the cell seed and, with
+    ILC, on the executions before it (the learned corrections) only.
+
+    ``layer``: the execution layer (a name of :data:`executor.control.ilc.LAYERS` or one);
+    ``perturbation``/``cell_seed``: the cell's uncertainty and the seed of its systematic
+    part; ``ilc_state``: a JSON file the ILC corrections are read from (if it exists) and
+    saved to after every update."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 thresholds: Thresholds | None = None) -> None:
+                 thresholds: Thresholds | None = None, *, layer: str | ExecutionLayer = "full",
+                 perturbation: PerturbationModel | None = None, cell_seed: int = 0,
+                 ilc_state: Path | None = None) -> None:
         self.geometry = load_geometry(assembly)
         if gui:
             require_display()
         self.gui = gui
         self.logger = logger
         self.thresholds = Thresholds() if thresholds is None else thresholds
+        self.ilc_state = ilc_state
+        self.reset_state(layer=layer, perturbation=perturbation, cell_seed=cell_seed)
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
@@ -66,6 +84,16 @@ class Cell:
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
             logger.log_scene_mesh("plate_mesh", plate_mesh(self.geometry), PLATE_MESH_COLOR)
+
+    def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
+                    cell_seed: int = 0) -> None:
+        """Become another cell on the same PyBullet clients: this execution layer, new
+        systematic errors, the ILC corrections of ``ilc_state`` (if it exists) or none."""
+        self.layer = layer_named(layer) if isinstance(layer, str) else layer
+        self.bias = CellBias(PerturbationModel() if perturbation is None else perturbation.check(), cell_seed)
+        self.ilc = Ilc()
+        if self.ilc_state is not None:
+            self.ilc.load(self.ilc_state)
 
     def check_pair(self, part: str, hole: str) -> Skill:
         """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""
@@ -111,7 +139,7 @@ class Cell:
         for attempt in range(1, max_attempts + 1):
             if self.logger is not None:
                 self.logger.begin_attempt(part, hole, seed, attempt)
-            ev = self.run_attempt(part, hole, AttemptSetup.draw(rng))
+            ev = self.run_attempt(part, hole, self.draw_setup(rng, part, hole))
             if self.logger is not None:
                 self.logger.end_attempt(ev)
             evidence.append(ev)
@@ -123,6 +151,14 @@ class Cell:
             evidence[-1].end_error, time.perf_counter() - start, evidence,
         )
 
+    def draw_setup(self, rng: np.random.Generator, part: str, hole: str) -> AttemptSetup:
+        """The circumstances of one attempt: this cell's systematic errors plus random ones from ``rng``."""
+        return self.bias.draw(rng, self.geometry.parts[part].shape, hole)
+
+    def ilc_key(self, part: str, hole: str) -> str:
+        """ILC corrections are kept per (part shape, hole) (docs/decisions.md)."""
+        return f"{self.geometry.parts[part].shape}:{hole}"
+
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
         skill = self.check_pair(part, hole)
@@ -131,6 +167,10 @@ class Cell:
         sim0 = motion.steps
         arm = motion.controller.arm
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
+        layer = self.layer
+        key = self.ilc_key(part, hole)
+        correction, iteration = self.ilc.correction(key) if layer.ilc else (None, 0)
+        self._scenes[spec.shape].set_friction(setup.friction)
         arm.set_grasp_error(setup.grasp_offset, rotvec_quat_xyzw(setup.grasp_tilt))
         surface = float(self.geometry.plate["top_z"])
         est_xy = np.array(hole_spec.position) + setup.vision_error
@@ -147,12 +187,22 @@ class Cell:
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - float(self.geometry.gripper["grasp_depth"])
-        result = insert(motion, skill, origin, detector, Admittance(), lever, wiggle_enabled)
+        admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
+                      if layer.admittance else None)
+        result = insert(motion, skill, origin, detector, admittance, lever, wiggle_enabled,
+                        phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
         self._scenes[spec.shape].release()
+        if result.reached and result.trace is not None:
+            learned = self.ilc.update(key, result.trace)
+            if self.ilc_state is not None:
+                self.ilc.save(self.ilc_state)
+            if self.logger is not None:
+                self.logger.log_ilc(key, iteration + 1, correction_norm(learned))
         return AttemptEvidence(
             "fit" if result.reached else "no_fit", detector.max_force_dev, detector.max_torque_dev,
             result.end_error, time.perf_counter() - wall0, (motion.steps - sim0) * TIME_STEP,
             result.jammed, result.wiggles, result.phase_reached, found.found,
+            iteration, 0.0 if correction is None else correction_norm(correction),
         )
 
     def close(self) -> None:

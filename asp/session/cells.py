@@ -99,9 +99,12 @@ class CellProcess:
 def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None,
-               zenoh_config: Path | None = None, viewer_url: str | None = None) -> list[str]:
+               zenoh_config: Path | None = None, viewer_url: str | None = None,
+               ilc_state: Path | None = None) -> list[str]:
     """The command line of one ``executor serve`` node, with ``--lifeline``; ``viewer_url``:
-    a Rerun viewer or server the cell also streams its recording to."""
+    a Rerun viewer or server the cell also streams its recording to; ``ilc_state``: the
+    file the sim cell keeps its learned ILC corrections in (in the run folder, so a
+    resumed session's cell starts from them)."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
@@ -116,6 +119,8 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
         argv += ["--zenoh-config", str(Path(zenoh_config).absolute())]
     if viewer_url is not None:
         argv += ["--rerun-connect", viewer_url]
+    if ilc_state is not None and backend == "sim":
+        argv += ["--ilc-state", str(Path(ilc_state).absolute())]
     return argv
 
 

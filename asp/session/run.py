@@ -333,7 +333,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
             cells.append(CellProcess(cell_id, serve_argv(
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
-                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config, viewer_url=viewer.connect)))
+                recording_id=settings["recording_id"], zenoh_config=args.zenoh_config, viewer_url=viewer.connect,
+                ilc_state=run / f"{cell_id}-ilc.json")))
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids, viewer)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))

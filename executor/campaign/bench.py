@@ -1,4 +1,5 @@
-"""``./run.sh bench executor [--quick] [--json]``: speed of the simulated cell.
+"""``./run.sh bench executor [--quick] [--json]``: speed of the simulated cell
+(``--ablation``: the execution-layer ablation of :mod:`executor.campaign.ablation` instead).
 
 1. Trial wall time: ``--trials`` (default 3; ``--quick`` 1) trials of every campaign
    pair, fitting and non-fitting, one after the other in this process (one DIRECT
@@ -24,8 +25,10 @@ from typing import Any
 from bridge import BridgeError
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
 from executor import ExecutorError
+from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
+from executor.cell_options import add_cell_arguments, perturbation_from_args
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5
@@ -105,7 +108,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1000, help="base seed (default 1000)")
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.add_argument("--ablation", action="store_true",
+                        help="instead: every execution-layer variant on the same perturbations "
+                        "(executor.campaign.ablation; --trials per pair, default 40)")
+    parser.add_argument("--executions", type=int, default=5,
+                        help="--ablation: consecutive executions of a pair per cell (default 5)")
+    add_cell_arguments(parser, layer=False)
     args = parser.parse_args(argv)
+    if args.ablation:
+        with stdout_to_stderr():
+            ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.workers,
+                                    perturbation_from_args(args))
+        print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
+        return 0
     trials = args.trials or (1 if args.quick else 3)
     campaign_trials = (
         args.campaign_trials if args.campaign_trials is not None else 4 if args.quick else 40

@@ -3,7 +3,8 @@
 ``./run.sh executor margins [--trials N] [--seed S] [--pairs P:H,...]`` runs every pair of the
 cell with eqs. (6)/(7) switched off (F_stop = M_stop = ∞, so nothing is interrupted)
 and prints, per pair and over the trials, the largest sustained wrench deviation
-(the statistic eqs. 6 and 7 are tested on) and the end error ‖p_end − p_goal‖.
+(the statistic eqs. 6 and 7 are tested on) and the end error ‖p_end − p_goal‖, under
+the cell's uncertainty and execution layer (the same options as ``executor trial``).
 Fitting pairs give the floor F_stop and M_stop must stay above; the end errors give the
 goal tolerance.  Too-big parts are stopped only by the insertion time-out here.
 """
@@ -16,8 +17,8 @@ from collections.abc import Sequence
 
 from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor.campaign.pairs import PAIRS_ARGUMENT
+from executor.cell_options import add_cell_arguments, cell_keywords
 from executor.control.detector import Thresholds
-from executor.evidence import AttemptSetup
 from executor.trial import Cell, trial_rng
 
 
@@ -26,15 +27,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--trials", type=int_in(1, 10**5), default=10, help="attempts per pair (default 10)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="first seed")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
+    add_cell_arguments(parser)
     args = parser.parse_args(argv)
-    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf))
+    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf), **cell_keywords(args))
     pairs = args.pairs or [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     try:
         for part, hole in pairs:  # an unknown part or hole is an error before any trial runs
             cell.check_pair(part, hole)
         print(f"{'pair':8s} {'max dF [N]':>10s} {'max dM [Nm]':>11s} {'end error [mm] min..max':>24s}  found")
         for part, hole in pairs:
-            evidence = [cell.run_attempt(part, hole, AttemptSetup.draw(trial_rng(args.seed + k, part, hole)))
+            evidence = [cell.run_attempt(part, hole, cell.draw_setup(trial_rng(args.seed + k, part, hole), part, hole))
                         for k in range(args.trials)]
             errors = [1000 * e.end_error for e in evidence]
             print(f"{part}:{hole:5s} {max(e.max_force_dev for e in evidence):10.2f} "

@@ -2,9 +2,10 @@
 
 - ``fig18_table.png``: the campaign table as an image, like the paper's Fig. 18, with
   the non-fitting pairs added.
-- ``fig17_forces.png``: measured vs desired force over the DMP phase for a successful
-  round-peg insertion (``p1``→``r1``, red) and a failed square-peg one (``p3``→``r1``,
-  green), desired force blue dotted: the paper's Fig. 17. The traces come from two
+- ``fig17_forces.png``: measured vs desired forces and torques over the DMP phase for a
+  successful round-peg insertion (``p1``→``r1``, left) and a failed square-peg one
+  (``p3``→``r1``, right), each against its own part's desired profile (dotted): the
+  paper's Fig. 17 (``executor trial --plot FILE`` draws the same for its own trials). The traces come from two
   extra trials run here with an :class:`~executor.rerun_log.AttemptLogger`, which also
   saves them as ``fig17.rrd``.
 """
@@ -59,25 +60,47 @@ def traced_trials(assembly: str, seed: int, rrd_path: Path) -> tuple[AttemptTrac
     return found["success"], found["failure"]
 
 
-def plot_fig17(success: AttemptTrace, failure: AttemptTrace, path: Path) -> Path:
-    """Fx, Fy, Fz [N] over the DMP phase: desired (blue dotted), success (red),
-    failure (green), as in the paper's Fig. 17."""
-    fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
-    for axis, name, ax in zip(range(3), ("F_x", "F_y", "F_z"), axes):
-        for trace, signal, style, color, label in (
-            (success, "force_des", ":", "tab:blue", "desired"),
-            (success, "force_mes", "-", "tab:red", f"success {success.part}→{success.hole}"),
-            (failure, "force_mes", "-", "tab:green", f"failure {failure.part}→{failure.hole}"),
-        ):
-            steps = trace.insertion()
-            ax.plot(trace.array("phase")[steps], trace.array(signal)[steps, axis], style,
-                    color=color, label=label)
-        ax.set_ylabel(f"${name}$ [N]")
-        ax.grid(alpha=0.3)
-    axes[0].legend(loc="best", fontsize=8)
-    axes[-1].set_xlabel("DMP phase")
-    fig.suptitle("Measured vs desired force over the DMP phase (paper Fig. 17)")
+def plot_fig17(success: AttemptTrace | None, failure: AttemptTrace | None, path: Path) -> Path:
+    """Forces [N] (top) and torques [Nm] (bottom) over the DMP phase of a successful
+    (left) and a failed (right) attempt, measured (solid) against the desired profile of
+    the attempt's own part (dotted, same colour per axis), as in the paper's Fig. 17.
+    A missing attempt leaves its column with a note."""
+    fig, axes = plt.subplots(2, 2, figsize=(11, 6.5), sharex=True, squeeze=False)
+    colors = ("tab:red", "tab:green", "tab:blue")
+    for column, (label, trace) in enumerate((("success", success), ("failure", failure))):
+        top = axes[0][column]
+        if trace is None:
+            top.set_title(f"{label}: no such attempt in these trials")
+        else:
+            top.set_title(f"{label}: {PART_NAMES.get(trace.part, trace.part)} {trace.part} → "
+                          f"{trace.hole}, seed {trace.trial_seed}, attempt {trace.attempt} ({trace.outcome})",
+                          fontsize=9)
+        for row, (quantity, unit) in enumerate((("force", "N"), ("torque", "Nm"))):
+            ax = axes[row][column]
+            names = ("F_x", "F_y", "F_z") if quantity == "force" else ("M_x", "M_y", "M_z")
+            if trace is not None:
+                steps = trace.insertion()
+                phase = trace.array("phase")[steps]
+                for axis, (name, color) in enumerate(zip(names, colors)):
+                    ax.plot(phase, trace.array(f"{quantity}_mes")[steps, axis], "-", color=color,
+                            label=f"${name}$ measured")
+                    ax.plot(phase, trace.array(f"{quantity}_des")[steps, axis], ":", color=color,
+                            label=f"${name}$ desired")
+                ax.legend(loc="best", fontsize=7, ncol=2)
+            ax.set_ylabel(f"{quantity} [{unit}]")
+            ax.grid(alpha=0.3)
+    for ax in axes[1]:
+        ax.set_xlabel("DMP phase")
+    fig.suptitle("Measured vs desired force and torque over the DMP phase (paper Fig. 17)")
     return write_figure(path, fig, dpi=120)
+
+
+def first_attempts(traces: Sequence[AttemptTrace]) -> tuple[AttemptTrace | None, AttemptTrace | None]:
+    """The first fitting and the first failed attempt among ``traces`` that reached the insertion."""
+    def first(outcome: str) -> AttemptTrace | None:
+        return next((t for t in traces if t.outcome == outcome and len(t.insertion())), None)
+
+    return first("fit"), first("no_fit")
 
 
 def plot_fig18(stats: Sequence[PairStats], path: Path) -> Path:

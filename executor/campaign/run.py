@@ -8,9 +8,11 @@ paper's Fig. 18 table (round peg ``p1`` and tight round peg ``tp`` in the small 
 which the paper did not run. Each trial is a fresh grasp error and hole-pose error
 (seeded), up to two attempts (paper 3.2).
 
-The trials are spread over ``--workers`` processes (default 2, the cores of this
-machine), each with its own DIRECT PyBullet cell. Trial ``i`` of pair ``k`` always uses
-seed ``S + k·N + i`` (N trials per pair), so the table does not depend on scheduling.
+The pairs are spread over ``--workers`` processes (default 2, the cores of this
+machine), each with its own DIRECT PyBullet cell (the same cell seed: the same
+systematic errors); the trials of one pair run in order in one process (with ILC an
+execution learns from the ones before it). Trial ``i`` of pair ``k`` always uses seed
+``S + k·N + i`` (N trials per pair), so the table does not depend on scheduling.
 
 Prints the table (1st-trial successes, successes after the 2nd trial, correct
 'no_fit' for non-fitting pairs); ``--json`` prints ``{"pairs": [...], "all_correct",
@@ -48,6 +50,7 @@ from executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
+from executor.cell_options import add_cell_arguments, cell_keywords
 
 
 class TrialRunner(Protocol):
@@ -63,12 +66,13 @@ function or a ``functools.partial`` of one)."""
 
 
 class CellRunner:
-    """A :class:`executor.trial.Cell` in DIRECT mode, reused for every trial of a worker."""
+    """A :class:`executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
+    ``keywords``: the Cell's options (layer, perturbation, cell seed)."""
 
-    def __init__(self, assembly: str) -> None:
+    def __init__(self, assembly: str, **keywords: Any) -> None:
         from executor.trial import Cell
 
-        self.cell = Cell(assembly)
+        self.cell = Cell(assembly, **keywords)
 
     def __call__(self, part: str, hole: str, seed: int) -> dict[str, Any]:
         return self.cell.run_trial(part, hole, seed=seed, max_attempts=2).to_json()
@@ -84,10 +88,10 @@ def _init_worker(factory: RunnerFactory) -> None:
     _RUNNER = factory()
 
 
-def _run_task(task: tuple[int, int, str, str, int]) -> tuple[int, int, dict[str, Any]]:
-    pair_index, trial_index, part, hole, seed = task
+def _run_task(task: tuple[int, str, str, list[int]]) -> tuple[int, list[dict[str, Any]]]:
+    pair_index, part, hole, seeds = task
     assert _RUNNER is not None, "worker not initialised"
-    return pair_index, trial_index, _RUNNER(part, hole, seed)
+    return pair_index, [_RUNNER(part, hole, seed) for seed in seeds]
 
 
 def run_campaign(
@@ -99,21 +103,23 @@ def run_campaign(
     progress: Callable[[int, int], None] | None = None,
 ) -> list[list[dict[str, Any]]]:
     """Results per pair (``trials`` dicts each, in seed order), run on ``workers``
-    processes (1: in this process). ``progress(done, total)`` after each trial."""
+    processes (1: in this process). ``progress(done, total)`` after each pair.
+
+    The trials of one pair run in order in one process: with ILC, an execution depends
+    on the executions of the same pair before it (the learned correction), so the table
+    does not depend on scheduling."""
     if trials < 1 or workers < 1:
         raise ExecutorError(f"--trials {trials} / --workers {workers}: expected positive numbers")
-    # Trial-major order: every pair progresses together, so the pool stays balanced.
-    tasks = [
-        (k, i, pair.part, pair.hole, seed + k * trials + i)
-        for i in range(trials) for k, pair in enumerate(pairs)
-    ]
-    results: list[list[dict[str, Any]]] = [[{}] * trials for _ in pairs]
+    tasks = [(k, pair.part, pair.hole, [seed + k * trials + i for i in range(trials)])
+             for k, pair in enumerate(pairs)]
+    results: list[list[dict[str, Any]]] = [[] for _ in pairs]
+    total = len(tasks) * trials
 
-    def store(done: int, item: tuple[int, int, dict[str, Any]]) -> None:
-        k, i, result = item
-        results[k][i] = result
+    def store(done: int, item: tuple[int, list[dict[str, Any]]]) -> None:
+        k, pair_results = item
+        results[k] = pair_results
         if progress is not None:
-            progress(done, len(tasks))
+            progress(done * trials, total)
 
     if workers == 1:
         _init_worker(factory)
@@ -215,6 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
     parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
+    add_cell_arguments(parser)
     return parser
 
 
@@ -229,7 +236,7 @@ def main(argv: Sequence[str]) -> int:
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.workers,
-            functools.partial(CellRunner, args.assembly), progress=_progress_printer(),
+            functools.partial(CellRunner, args.assembly, **cell_keywords(args)), progress=_progress_printer(),
         )
         report = campaign_report(run, args.seed, args.workers)
         if args.plot:

@@ -27,7 +27,7 @@ class AdmittanceParams:
     """Translation: mass [kg], damping [N·s/m], stiffness [N/m], bound [m];
     rotation: inertia [kg·m²], damping [Nm·s/rad], stiffness [Nm/rad], bound [rad].
     Natural frequency ≈ 30 rad/s, critically damped; ``integral_gain`` K_i [1/s] of
-    the PI drive (time constant 1/K_i = 0.5 s)."""
+    the PI drive (time constant 1/K_i = 0.5 s; 0: P only, the integral stays 0)."""
 
     mass: float = 1.5
     damping: float = 90.0
@@ -50,7 +50,8 @@ class Admittance:
         self.stiffness = np.array([p.stiffness, p.stiffness, p.rot_stiffness, p.rot_stiffness])
         self.bound = np.array([p.bound, p.bound, p.rot_bound, p.rot_bound])
         self.integral_gain = p.integral_gain
-        self.integral_limit = self.stiffness * self.bound / p.integral_gain
+        # Anti-windup: no more integral than holds δ at its bound (none at all for P only).
+        self.integral_limit = self.stiffness * self.bound / p.integral_gain if p.integral_gain > 0 else np.zeros(4)
         self.offset = np.zeros(4)
         self.velocity = np.zeros(4)
         self.integral = np.zeros(4)

@@ -13,6 +13,7 @@ import pybullet as pb
 
 from executor.control.admittance import Admittance
 from executor.control.detector import Detector
+from executor.control.ilc import OFFSET_BOUND, ExecutionTrace
 from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill
 from executor.skills.wiggle import wiggle
@@ -39,6 +40,7 @@ class InsertionResult:
     jammed: bool
     wiggles: int
     phase_reached: float
+    trace: ExecutionTrace | None = None
 
 
 def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
@@ -49,10 +51,20 @@ def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
     return np.concatenate([np.sin(angle / 2) * rotvec / angle, [math.cos(angle / 2)]])
 
 
-def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector, admittance: Admittance,
-           gripper_lever: float, wiggle_enabled: bool = True) -> InsertionResult:
+def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
+           admittance: Admittance | None, gripper_lever: float, wiggle_enabled: bool = True, *,
+           phase_stopping: bool = True, feedforward: np.ndarray | None = None,
+           record: bool = False) -> InsertionResult:
     """Run the skill in the hole frame at ``hole_origin`` (hole centre on the plate top,
-    [m]) starting from the current tip pose.  A breach with the tip inside the hole
+    [m]) starting from the current tip pose.
+
+    The execution layer: ``admittance`` None is pure position control along the DMP;
+    ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
+    ``feedforward`` (bins, 5) is a pose correction (dx, dy, dz [m], rx, ry [rad]) over the
+    phase added to the command (ILC, :mod:`executor.control.ilc`); ``record`` keeps the
+    per-step wrench deviations and admittance offsets in ``result.trace`` for ILC.
+
+    A breach with the tip inside the hole
     (deeper than ``JAM_DEPTH``) is a jam: the wiggle runs once and the insertion goes on;
     a breach with the part still on the plate surface, or a second one, stops the
     execution; the goal check then decides.  A trajectory that ends with the part stuck
@@ -68,16 +80,34 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     budget = int(TIMEOUT_FACTOR * clock.duration / TIME_STEP)
     wrench_table = skill.wrench.tabulate()
     last = len(wrench_table) - 1
+    ff = np.zeros((1, 5)) if feedforward is None else feedforward
+    ff_last = len(ff) - 1
+
+    def ff_at(phase: float) -> tuple[np.ndarray, np.ndarray]:
+        c = ff[min(int(phase * len(ff)), ff_last)]
+        return c[:3], np.array([c[3], c[4], 0.0])
+
+    trace = ExecutionTrace() if record else None
+    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], 0.0])
     for _ in range(budget):
         if clock.done:
             break
         pos_d, quat_d = clock.pose()
+        ff_pos, ff_rot = ff_at(clock.phase)
+        pos_d = pos_d + ff_pos
+        quat_d = np.array(pb.multiplyTransforms((0, 0, 0), rotvec_quat_xyzw(ff_rot), (0, 0, 0), quat_d)[1])
         w_des = wrench_table[int(clock.phase * last + 0.5)]
         quat_cmd = np.array(pb.multiplyTransforms((0, 0, 0), rotvec_quat_xyzw(d_rot), (0, 0, 0), quat_d)[1])
         s = motion.step(pos_d + d_pos, quat_cmd, phase=clock.phase, wrench_des=w_des)
         f_dev, m_dev = s.force - w_des[:3], s.torque - w_des[3:]
         f_norm, _, violated = detector.update(f_dev, m_dev)
-        d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
+        if admittance is not None:
+            d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
+            if feedforward is not None:  # correction plus admittance stay within the admittance's bound
+                d_pos = np.clip(d_pos, -bound_pos - ff_pos, bound_pos - ff_pos)
+                d_rot = np.clip(d_rot, -bound_rot - ff_rot, bound_rot - ff_rot)
+        if trace is not None:
+            trace.add(clock.phase, np.array([f_dev[0], f_dev[1], f_dev[2], m_dev[0], m_dev[1]]))
         if violated:
             jammed = jammed or bool(s.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
             if not (jammed and wiggle_enabled and wiggles < MAX_WIGGLES):
@@ -87,13 +117,16 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
             wiggles += 1
             detector.clear()
             continue
-        clock.advance(TIME_STEP, f_norm)
+        clock.advance(TIME_STEP, f_norm if phase_stopping else 0.0)
     else:
         completed = False
     pos_d, quat_d = clock.pose()
+    ff_pos, _ = ff_at(clock.phase)
+    pos_d = pos_d + ff_pos
     end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
-    # p_goal: where the adapted trajectory ends (the lateral admittance offset included).
-    p_goal = hole_origin + skill.end_position + d_pos
+    # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets
+    # included; not ILC's z, which only shapes the push, never where the part must end).
+    p_goal = hole_origin + skill.end_position + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])
     reached, err = detector.goal_reached(end.tip_pos, p_goal)
     stalled = completed and not reached and bool(end.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
     jammed = jammed or stalled  # stuck in the hole below the thresholds: a jam too
@@ -102,4 +135,4 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         wiggles += 1
         end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME)
         reached, err = detector.goal_reached(end.tip_pos, p_goal)
-    return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase)
+    return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase, trace)

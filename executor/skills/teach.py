@@ -73,6 +73,8 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     origin = np.array([*hole.position, float(geometry.plate["top_z"])])
     bottom = float(geometry.plate["tile_thickness"])
     motion = cell.motion_for(part.id)
+    assert cell.scene is not None  # set by motion_for
+    cell.scene.set_friction(None)  # the teaching friction, whatever ran before
     arm = motion.controller.arm
     arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
@@ -94,7 +96,6 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     phases, wrenches, end = _replay(motion, skill, origin)
     skill.wrench = WrenchProfile.fit(phases, wrenches)
     skill.end_position = end
-    assert cell.scene is not None  # set by motion_for
     cell.scene.release()
     return skill
 

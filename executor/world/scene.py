@@ -19,6 +19,8 @@ from executor import ExecutorError
 from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, plate_mesh
 
 TIME_STEP = 0.001  # [s]
+PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
+TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
 # Parked parts (the one in the hand) wait here, out of the way [m].
 _PARKED = (0.0, -2.0, 0.05)
 
@@ -93,6 +95,13 @@ class Scene:
             linkParentIndices=[0], linkJointTypes=[pb.JOINT_FIXED], linkJointAxis=[(0, 0, 1)],
             physicsClientId=self.client,
         )
+
+    def set_friction(self, coefficient: float | None) -> None:
+        """Make the Coulomb friction coefficient between the held part and the plate
+        ``coefficient`` (None: the default, ``TEACH_FRICTION``).  Bullet multiplies the two
+        bodies' coefficients; the part keeps ``PART_FRICTION``, the plate gets the rest."""
+        mu = TEACH_FRICTION if coefficient is None else coefficient
+        pb.changeDynamics(self.plate, -1, lateralFriction=mu / PART_FRICTION, physicsClientId=self.client)
 
     def hold(self, part: PartSpec) -> int:
         """Put ``part`` in the gripper; its tray copy is parked out of sight.  Returns the

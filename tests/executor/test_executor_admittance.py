@@ -36,3 +36,12 @@ def test_the_integral_holds_the_offset_and_an_opposite_deviation_unwinds_it() ->
     held = run(adm, 0.0, 1.0)
     assert 0.5 * pushed < held <= pushed  # integral action: no deviation, offset kept
     assert run(adm, -1.0, 0.5) < 0.2 * pushed  # the opposite deviation brings it back
+
+
+def test_p_only_admittance_holds_no_integral() -> None:
+    """Integral gain 0 (the ``admittance_p`` layer): the offset settles at ΔF / K and
+    nothing is kept once the deviation is gone."""
+    params = AdmittanceParams(integral_gain=0.0)
+    adm = Admittance(params)
+    assert abs(run(adm, 1.0, 1.0) - 1.0 / params.stiffness) < 0.05 / params.stiffness
+    assert abs(run(adm, 0.0, 1.0)) < 0.05 / params.stiffness

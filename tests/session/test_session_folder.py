@@ -197,3 +197,14 @@ def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[Cel
     settings = json.loads((run / "session.json").read_text())
     assert settings["starts"] == 2 and sorted(settings["abandoned"]) == sorted(in_flight)
     assert len(read_journal(run / "journal.jsonl")) == result["experiments"]
+
+
+def test_a_sim_cell_keeps_its_ilc_state_in_the_run_folder(tmp_path: Path) -> None:
+    """The session gives each sim cell ``<run>/<cell>-ilc.json`` (a resume passes the same
+    path, so the cell reloads what it learned); the truth backend learns nothing."""
+    from asp.session.cells import serve_argv
+
+    state = tmp_path / "c1-ilc.json"
+    argv = serve_argv("c1", backend="sim", ilc_state=state)
+    assert argv[argv.index("--ilc-state") + 1] == str(state.absolute())
+    assert "--ilc-state" not in serve_argv("c1", backend="truth", ilc_state=state)

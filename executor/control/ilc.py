@@ -1,0 +1,174 @@
+"""Learning across executions: iterative learning control (paper 3.1, after Abu-Dakka et
+al. 2015 and Bristow et al. 2006), and the switchable execution layers it belongs to.
+
+A feed-forward pose correction c(φ) = (dx, dy, dz, rx, ry) over the DMP phase φ
+(``bins`` bins) is added to the commanded pose of the insertion: the axes the
+admittance adapts and the insertion axis z, where the largest systematic deviations
+are (a tilted tight peg wedges and pushes back; a hole with more friction than the
+teaching one brakes).  After an execution that reached its goal, with e(φ) the mean
+wrench deviation (Fx, Fy, Fz, Mx, My) in each bin:
+
+    c_{k+1}(φ) = clip( λ · smooth( c_k(φ) + L · S · e_k(φ) ), ±bound )
+
+S = diag(1/K_t, 1/K_t, 1/K_t, 1/K_r, 1/K_r) is the impedance controller's compliance (a pose
+offset of d changes the contact wrench by about K·d), L the learning gain (share of the
+error corrected per execution: in contact the systematic error shrinks by about 1 − L
+per execution), λ the forgetting factor (the Q filter: what is not confirmed again
+fades, so a one-off error does not stay), the z column faded out over the last 20 % of
+the phase (``Z_TAPER_FROM``: the end stays where it was taught) and ``smooth`` a moving average over
+``smoothing`` bins (no learning of contact noise).  The bound is the admittance's
+(2 mm, 0.035 rad), and the insertion bounds the sum of correction and admittance offset
+by it too (z by the translation bound): where a deviation cannot be removed by moving the part (a reference wrench
+taught in a tighter hole), the correction saturates instead of drifting.  The next
+execution so starts from what the previous ones learned about the systematic part of
+the error (habitual grasp tilt and offset, a hole's calibration bias); the random part
+stays for the on-line admittance.
+
+Failed executions do not update c (their error is an obstruction, not an offset).
+Corrections are keyed per (part shape, hole): docs/decisions.md says why.  The state
+is saved as JSON (:meth:`Ilc.save`, atomically) and read back by :meth:`Ilc.load`.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bridge.files import write_atomic
+from executor import ExecutorError
+from executor.control.admittance import AdmittanceParams
+from executor.control.controller import ImpedanceGains
+
+_A = AdmittanceParams()
+OFFSET_BOUND = np.array([_A.bound, _A.bound, _A.bound, _A.rot_bound, _A.rot_bound])
+"""Largest pose offset (dx, dy, dz [m], rx, ry [rad]) of correction plus admittance."""
+AXES = len(OFFSET_BOUND)
+Z_TAPER_FROM = 0.8
+"""From this phase on the z correction fades linearly to 0 at the end: ILC shapes the
+push along the way, never where the trajectory ends (the goal check stays the taught one)."""
+
+
+@dataclass(frozen=True)
+class ExecutionLayer:
+    """Which parts of the paper's execution layer run (the hole search, the wiggle and the
+    second attempt always do): the admittance (off: pure position control along the
+    DMP), its integral part (off: P only), DMP phase stopping, ILC."""
+
+    name: str
+    admittance: bool
+    integral: bool
+    phase_stopping: bool
+    ilc: bool
+
+
+LAYERS = {layer.name: layer for layer in (
+    ExecutionLayer("position", False, False, False, False),
+    ExecutionLayer("admittance_p", True, False, False, False),
+    ExecutionLayer("admittance_pi", True, True, False, False),
+    ExecutionLayer("pi_phase_stop", True, True, True, False),
+    ExecutionLayer("full", True, True, True, True),
+)}
+"""The variants of the ablation, from the least to the whole layer."""
+
+
+def layer_named(name: str) -> ExecutionLayer:
+    """The layer called ``name``; ExecutorError listing the known ones."""
+    if name not in LAYERS:
+        raise ExecutorError(f"unknown execution layer '{name}' (expected one of {', '.join(LAYERS)})")
+    return LAYERS[name]
+
+
+@dataclass(frozen=True)
+class IlcParams:
+    """Phase bins, learning gain L (dimensionless), forgetting factor λ (dimensionless,
+    per execution), smoothing window [bins]."""
+
+    bins: int = 50
+    learning_gain: float = 0.5
+    forgetting: float = 0.95
+    smoothing: int = 5
+
+
+@dataclass
+class ExecutionTrace:
+    """What one execution recorded per control step: phase (N,) and wrench deviation
+    (N, 5) (Fx, Fy, Fz [N], Mx, My [Nm])."""
+
+    phase: list[float] = field(default_factory=list)
+    error: list[np.ndarray] = field(default_factory=list)
+
+    def add(self, phase: float, error: np.ndarray) -> None:
+        self.phase.append(phase)
+        self.error.append(error)
+
+
+class Ilc:
+    """The corrections of one cell, per key, with how many executions taught each."""
+
+    def __init__(self, params: IlcParams = IlcParams(), gains: ImpedanceGains | None = None) -> None:
+        self.params = params
+        gains = ImpedanceGains() if gains is None else gains
+        centres = (np.arange(params.bins) + 0.5) / params.bins
+        self.z_taper = np.clip((1.0 - centres) / (1.0 - Z_TAPER_FROM), 0.0, 1.0)
+        self.gain = params.learning_gain / np.array([gains.k_trans] * 3 + [gains.k_rot] * 2)
+        self.corrections: dict[str, np.ndarray] = {}
+        self.iterations: dict[str, int] = {}
+
+    def correction(self, key: str) -> tuple[np.ndarray, int]:
+        """The (bins, 5) correction [m, m, m, rad, rad] of ``key`` and its iteration count."""
+        return self.corrections.get(key, np.zeros((self.params.bins, AXES))), self.iterations.get(key, 0)
+
+    def update(self, key: str, trace: ExecutionTrace) -> np.ndarray:
+        """Learn from one successful execution; returns the new correction."""
+        p = self.params
+        old, iteration = self.correction(key)
+        if not trace.phase:
+            return old
+        index = np.minimum((np.asarray(trace.phase) * p.bins).astype(int), p.bins - 1)
+        count = np.bincount(index, minlength=p.bins)[:, None]
+        sums = np.zeros((p.bins, AXES))
+        np.add.at(sums, index, self.gain * np.asarray(trace.error))
+        mean = np.divide(sums, count, out=np.zeros_like(sums), where=count > 0)
+        kernel = np.ones(p.smoothing) / p.smoothing
+        padded = np.pad(old + mean, ((p.smoothing // 2, p.smoothing - 1 - p.smoothing // 2), (0, 0)), mode="edge")
+        smooth = np.stack([np.convolve(padded[:, j], kernel, mode="valid") for j in range(AXES)], axis=1)
+        smooth[:, 2] *= self.z_taper
+        self.corrections[key] = np.clip(p.forgetting * smooth, -OFFSET_BOUND, OFFSET_BOUND)
+        self.iterations[key] = iteration + 1
+        return self.corrections[key]
+
+    def to_json(self) -> dict:
+        return {"params": asdict(self.params), "keys": {
+            key: {"iterations": self.iterations[key], "correction": c.tolist()}
+            for key, c in sorted(self.corrections.items())}}
+
+    def save(self, path: Path) -> None:
+        """Write the state to ``path`` atomically (JSON)."""
+        write_atomic(path, json.dumps(self.to_json()) + "\n")
+
+    def load(self, path: Path) -> None:
+        """Read the corrections saved at ``path`` (nothing if it does not exist);
+        ExecutorError naming the file if it is not such a state."""
+        if not path.is_file():
+            return
+        try:
+            keys = json.loads(path.read_text())["keys"]
+            for key, entry in keys.items():
+                correction = np.array(entry["correction"], dtype=float)
+                if correction.shape != (self.params.bins, AXES):
+                    raise ValueError(f"correction of {key}: shape {correction.shape}")
+                self.corrections[key], self.iterations[key] = correction, int(entry["iterations"])
+        except (ValueError, KeyError, TypeError) as exc:
+            raise ExecutorError(f"{path}: not an ILC state ({exc}); expected the JSON a cell saved") from None
+
+
+_NORM_UNITS = np.array([1000.0, 1000.0, 1000.0, np.degrees(1.0), np.degrees(1.0)])
+
+
+def correction_norm(correction: np.ndarray) -> float:
+    """Size of a correction: RMS over the phase of the norm of (dx, dy, dz [mm], rx, ry [°]),
+    so 1 means about a millimetre or a degree."""
+    return float(np.sqrt(np.mean(np.sum((correction * _NORM_UNITS) ** 2, axis=1))))

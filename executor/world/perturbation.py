@@ -1,0 +1,124 @@
+"""The uncertainty of a real cell (paper 3.1/3.2: "non-repeatable grasp configurations and
+errors in the estimated object poses"), stated and seeded.
+
+Every perturbation has a *systematic* part, drawn once per cell from its cell seed and
+the same in every execution (what a calibration leaves behind), and a *random* part,
+drawn per execution from the trial's random stream:
+
+- lateral grasp offset of the part in the hand [m]: a habitual offset per part shape
+  (≤ ``grasp_offset_bias``) plus a random one (≤ ``grasp_offset_random``);
+- tilt of the part in the hand [°]: habitual per part shape (≤ ``grasp_tilt_bias``)
+  plus random (≤ ``grasp_tilt_random``);
+- error of the hole's estimated position (vision) [m]: a calibration bias per hole
+  (≤ ``vision_bias``) plus a normal error (σ = ``vision_sigma`` per axis), the total
+  at most ``vision_max``;
+- friction coefficient of the part in the hole: per hole, uniform in
+  ``friction_min..friction_max``, plus at most ± ``friction_jitter`` per execution.
+
+Offsets and biases are uniform over a disc (lateral) of the given radius; tilts about a
+uniformly drawn horizontal axis with a uniform angle.  The robot knows none of them: the
+hole search and the force adaptation (and, for the systematic part, ILC) must cope.
+Magnitudes, defaults and reasons are in docs/cell.md.
+"""
+
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+from executor import ExecutorError
+from executor.evidence import AttemptSetup
+
+
+@dataclass(frozen=True)
+class PerturbationModel:
+    """Magnitudes of the cell's uncertainty: grasp offsets [m], grasp tilts [°], vision
+    errors [m], friction coefficients (Coulomb, part on hole wall, dimensionless)."""
+
+    grasp_offset_bias: float = 0.0005
+    grasp_offset_random: float = 0.001
+    grasp_tilt_bias: float = 1.5
+    grasp_tilt_random: float = 1.0
+    vision_bias: float = 0.001
+    vision_sigma: float = 0.0015
+    vision_max: float = 0.006
+    friction_min: float = 0.2
+    friction_max: float = 0.5
+    friction_jitter: float = 0.03
+
+    def random_only(self) -> PerturbationModel:
+        """The same random parts with every systematic part zero (friction: the middle of
+        its range): what no learning across executions can remove."""
+        mid = (self.friction_min + self.friction_max) / 2
+        return PerturbationModel(0.0, self.grasp_offset_random, 0.0, self.grasp_tilt_random, 0.0,
+                                 self.vision_sigma, self.vision_max, mid, mid, self.friction_jitter)
+
+    def check(self) -> PerturbationModel:
+        """ExecutorError naming the field unless every magnitude is ≥ 0 and the friction range ordered."""
+        for f in fields(self):
+            if not getattr(self, f.name) >= 0:
+                raise ExecutorError(f"perturbation {f.name} = {getattr(self, f.name)}: expected a number >= 0")
+        if self.friction_min > self.friction_max:
+            raise ExecutorError(f"perturbation friction_min {self.friction_min} > friction_max {self.friction_max}")
+        return self
+
+
+NO_PERTURBATION = PerturbationModel(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.25, 0.25, 0.0)
+"""A perfect cell: exact grasp, exact hole positions, the teaching friction (0.25)."""
+
+
+def _disc(rng: np.random.Generator, radius: float) -> np.ndarray:
+    """A point uniform over the disc of ``radius`` (x, y, 0)."""
+    r, a = radius * np.sqrt(rng.uniform()), rng.uniform(0, 2 * np.pi)
+    return np.array([r * np.cos(a), r * np.sin(a), 0.0])
+
+
+def _tilt(rng: np.random.Generator, max_deg: float) -> np.ndarray:
+    """A rotation vector [rad] about a uniform horizontal axis, angle uniform in 0..max."""
+    axis = rng.uniform(0, 2 * np.pi)
+    return np.radians(max_deg) * rng.uniform() * np.array([np.cos(axis), np.sin(axis), 0.0])
+
+
+@dataclass
+class CellBias:
+    """The systematic part of one cell: per part shape a grasp offset [m] and tilt
+    (rotation vector [rad]); per hole a vision bias [m] (x, y) and a friction coefficient.
+    Drawn lazily, each from its own stream of (cell seed, name), so it does not depend on
+    the order in which shapes and holes are first used."""
+
+    model: PerturbationModel
+    seed: int
+    grasp: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    holes: dict[str, tuple[np.ndarray, float]] = field(default_factory=dict)
+
+    def _rng(self, kind: str, name: str) -> np.random.Generator:
+        return np.random.default_rng([self.seed, zlib.crc32(kind.encode()), zlib.crc32(name.encode())])
+
+    def of_shape(self, shape: str) -> tuple[np.ndarray, np.ndarray]:
+        """Habitual grasp offset [m] and tilt [rad] of a part shape."""
+        if shape not in self.grasp:
+            rng = self._rng("grasp", shape)
+            self.grasp[shape] = (_disc(rng, self.model.grasp_offset_bias), _tilt(rng, self.model.grasp_tilt_bias))
+        return self.grasp[shape]
+
+    def of_hole(self, hole: str) -> tuple[np.ndarray, float]:
+        """Vision bias (x, y) [m] and friction coefficient of a hole."""
+        if hole not in self.holes:
+            rng = self._rng("hole", hole)
+            m = self.model
+            self.holes[hole] = (_disc(rng, m.vision_bias)[:2], float(rng.uniform(m.friction_min, m.friction_max)))
+        return self.holes[hole]
+
+    def draw(self, rng: np.random.Generator, shape: str, hole: str) -> AttemptSetup:
+        """One execution's circumstances: systematic + random parts (the random ones from ``rng``)."""
+        m = self.model
+        offset0, tilt0 = self.of_shape(shape)
+        vision0, friction0 = self.of_hole(hole)
+        offset = offset0 + _disc(rng, m.grasp_offset_random)
+        tilt = tilt0 + _tilt(rng, m.grasp_tilt_random)
+        vision = vision0 + rng.normal(0.0, m.vision_sigma, 2)
+        vision *= min(1.0, m.vision_max / max(float(np.linalg.norm(vision)), 1e-12))
+        friction = max(0.0, friction0 + float(rng.uniform(-m.friction_jitter, m.friction_jitter)))
+        return AttemptSetup(offset, tilt, vision, int(rng.integers(2**31)), friction)
