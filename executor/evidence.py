@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from executor.world.scene import TIME_STEP
+from executor.world import TIME_STEP
 
 
 @dataclass

@@ -1,5 +1,5 @@
 """``./run.sh bench executor [--quick] [--json]``: speed of the simulated cell
-(``--ablation``: the execution-layer ablation of :mod:`executor.campaign.ablation` instead).
+(``--ablation``: the ablation of the execution layers instead, see docs/results.md).
 
 1. Trial wall time: ``--trials`` (default 3; ``--quick`` 1) trials of every campaign
    pair, fitting and non-fitting, one after the other in this process (one DIRECT

@@ -34,13 +34,16 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from bridge.files import write_atomic
 from executor import ExecutorError
 from executor.control.admittance import AdmittanceParams
-from executor.control.controller import ImpedanceGains
+
+if TYPE_CHECKING:
+    from executor.control.controller import ImpedanceGains
 
 _A = AdmittanceParams()
 OFFSET_BOUND = np.array([_A.bound, _A.bound, _A.bound, _A.rot_bound, _A.rot_bound])
@@ -109,6 +112,8 @@ class Ilc:
     """The corrections of one cell, per key, with how many executions taught each."""
 
     def __init__(self, params: IlcParams = IlcParams(), gains: ImpedanceGains | None = None) -> None:
+        from executor.control.controller import ImpedanceGains  # here: the parser needs no PyBullet
+
         self.params = params
         gains = ImpedanceGains() if gains is None else gains
         centres = (np.arange(params.bins) + 0.5) / params.bins

@@ -16,9 +16,9 @@ import pybullet as pb
 import pybullet_data
 
 from executor import ExecutorError
+from executor.world import TIME_STEP
 from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, plate_mesh
 
-TIME_STEP = 0.001  # [s]
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
 # Parked parts (the one in the hand) wait here, out of the way [m].
