@@ -110,7 +110,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.add_argument("--ablation", action="store_true",
                         help="instead: every execution-layer variant on the same perturbations "
-                        "(executor.campaign.ablation; --trials per pair, default 40)")
+                        "(--trials per pair, default 40)")
     parser.add_argument("--executions", type=int, default=5,
                         help="--ablation: consecutive executions of a pair per cell (default 5)")
     add_cell_arguments(parser, layer=False)
