@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from bridge.progress import progress
 from executor import ExecutorError
 from executor.campaign.pairs import campaign_pairs
 from executor.control.ilc import LAYERS
@@ -79,10 +80,10 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
              for variant in variants for g, group in enumerate(groups) for pair in pairs
              if pair.fits or variant != FLOOR]
     if workers == 1:
-        outputs = [_run_group(task) for task in tasks]
+        outputs = [_run_group(task) for task in progress(tasks, desc="ablation", total=len(tasks), unit="group")]
     else:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-            outputs = list(pool.map(_run_group, tasks))
+            outputs = list(progress(pool.map(_run_group, tasks), desc="ablation", total=len(tasks), unit="group"))
     fits = {(p.part, p.hole): p.fits for p in pairs}
     by_variant: dict[str, list[tuple[bool, int, dict[str, Any]]]] = {v: [] for v in variants}
     for task, results in zip(tasks, outputs):

@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
+from bridge.progress import progress
 from executor import ExecutorError
 from executor.campaign.pairs import (
     HOLE_NAMES,
@@ -100,10 +101,9 @@ def run_campaign(
     seed: int,
     workers: int,
     factory: RunnerFactory,
-    progress: Callable[[int, int], None] | None = None,
 ) -> list[list[dict[str, Any]]]:
     """Results per pair (``trials`` dicts each, in seed order), run on ``workers``
-    processes (1: in this process). ``progress(done, total)`` after each pair.
+    processes (1: in this process), with a progress bar over the pairs on a terminal.
 
     The trials of one pair run in order in one process: with ILC, an execution depends
     on the executions of the same pair before it (the learned correction), so the table
@@ -113,18 +113,15 @@ def run_campaign(
     tasks = [(k, pair.part, pair.hole, [seed + k * trials + i for i in range(trials)])
              for k, pair in enumerate(pairs)]
     results: list[list[dict[str, Any]]] = [[] for _ in pairs]
-    total = len(tasks) * trials
 
-    def store(done: int, item: tuple[int, list[dict[str, Any]]]) -> None:
+    def store(item: tuple[int, list[dict[str, Any]]]) -> None:
         k, pair_results = item
         results[k] = pair_results
-        if progress is not None:
-            progress(done * trials, total)
 
     if workers == 1:
         _init_worker(factory)
-        for done, task in enumerate(tasks, 1):
-            store(done, _run_task(task))
+        for task in progress(tasks, desc="campaign", total=len(tasks), unit="pair"):
+            store(_run_task(task))
         return results
     with ProcessPoolExecutor(
         workers, mp_context=multiprocessing.get_context("spawn"),
@@ -132,8 +129,8 @@ def run_campaign(
     ) as pool:
         futures = [pool.submit(_run_task, task) for task in tasks]
         try:
-            for done, future in enumerate(as_completed(futures), 1):
-                store(done, future.result())
+            for future in progress(as_completed(futures), desc="campaign", total=len(futures), unit="pair"):
+                store(future.result())
         except BrokenProcessPool as exc:
             raise ExecutorError(
                 f"campaign: a worker process died ({exc}); expected it to finish its trials"
@@ -162,11 +159,10 @@ class CampaignRun:
 
 def timed_campaign(
     pairs: Sequence[CampaignPair], trials: int, seed: int, workers: int, factory: RunnerFactory,
-    progress: Callable[[int, int], None] | None = None,
 ) -> CampaignRun:
     """:func:`run_campaign` plus counts and wall time."""
     start = time.perf_counter()
-    results = run_campaign(pairs, trials, seed, workers, factory, progress)
+    results = run_campaign(pairs, trials, seed, workers, factory)
     wall_s = time.perf_counter() - start
     stats = [pair_stats(pair, rs) for pair, rs in zip(pairs, results)]
     return CampaignRun(list(pairs), results, stats, wall_s)
@@ -236,7 +232,7 @@ def main(argv: Sequence[str]) -> int:
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.workers,
-            functools.partial(CellRunner, args.assembly, **cell_keywords(args)), progress=_progress_printer(),
+            functools.partial(CellRunner, args.assembly, **cell_keywords(args)),
         )
         report = campaign_report(run, args.seed, args.workers)
         if args.plot:
@@ -273,13 +269,3 @@ def stdout_to_stderr() -> Iterator[None]:
         os.close(saved)
 
 
-def _progress_printer() -> Callable[[int, int], None] | None:
-    """Progress on stderr when it is a terminal (``done/total trials``)."""
-    if not sys.stderr.isatty():
-        return None
-
-    def show(done: int, total: int) -> None:
-        print(f"\rcampaign: {done}/{total} trials", end="" if done < total else "\n",
-              file=sys.stderr, flush=True)
-
-    return show

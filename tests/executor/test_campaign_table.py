@@ -100,6 +100,8 @@ def _trace(part: str, outcome: str, stop_at: float) -> Any:
         trace.phase.append(float(phase))
         trace.force_mes.append(np.array([0.0, 0.0, -5.0 * phase]))
         trace.force_des.append(np.array([0.0, 0.0, -4.0 * phase]))
+        trace.torque_mes.append(np.array([0.01 * phase, 0.0, 0.0]))
+        trace.torque_des.append(np.zeros(3))
     return trace
 
 
