@@ -79,6 +79,7 @@ class Assembler:
         self.placed: set[str] = set()
         self._screwed: dict[str, int] = {}
         self.blocked: set[str] = set()
+        self._pins: dict[str, np.ndarray] = {}  # hole -> where its peg went in, from the hole centre [m]
 
     def skill_of(self, part: str) -> str:
         """The step's skill: fixture, insert, insert_over or insert_socket."""
@@ -103,7 +104,8 @@ class Assembler:
         5 mm under the plate top, so no peg reaches its goal there."""
         spec = self.product.geometry.holes.get(hole)
         if spec is None:
-            raise ExecutorError(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.product.geometry.holes))})")
+            holes = ", ".join(sorted(self.product.geometry.holes))
+            raise ExecutorError(f"unknown hole '{hole}' (expected one of {holes})")
         plate = self.product.geometry.plate
         depth = float(plate["tile_thickness"]) - 0.005
         half = [spec.size / 2 - 0.0002, spec.size / 2 - 0.0002, depth / 2]
@@ -150,6 +152,7 @@ class Assembler:
         if ok:
             self.placed.add(part)
             self._screw(part)
+        world.rest()
         error = world.goal_error(part) if ok else float(np.linalg.norm(world.position(part) - world.goals[part]))
         return StepRecord(part, hole, skill, "fit" if ok else "no_fit", len(outcomes), time.perf_counter() - wall0,
                           max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
@@ -162,7 +165,8 @@ class Assembler:
         pos, quat = world.pose(part)
         grip = np.array(pb.multiplyTransforms(list(pos), list(quat), list(world.frames[part].grip), [0, 0, 0, 1])[0])
         carry(world.motion, grip)
-        return Grasp(world, part, setup.grasp_offset, setup.grasp_tilt)
+        flat = part in self.product.covers  # a flat part lies against the palm: no tilt
+        return Grasp(world, part, setup.grasp_offset, np.zeros(3) if flat else setup.grasp_tilt)
 
     def _goal_tcp(self, part: str, skill: str) -> np.ndarray:
         """Where the TCP is when the part is placed [m] (a head: in its part's socket now)."""
@@ -192,26 +196,35 @@ class Assembler:
         world, motion, p = self.world, self.world.motion, self.product
         goal = self._goal_tcp(part, skill)
         approach = self._approach(part, skill, goal)
-        if skill == "insert":
+        if skill == "insert_over":  # where the robot saw the pins go in, no search
+            approach[:2] += self._pins_offset(p.covers[part].over)
+        else:
             approach[:2] += setup.vision_error
         carry(motion, approach)
         motion.hold(approach, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
         world.arm.tare_sensor()
-        if skill == "insert":
-            assert hole is not None
-            spec = p.pegs[part]
-            found = hole_search(motion, approach[:2], p.top_z, approach[2], TOOL_DOWN_QUAT_XYZW,
-                                np.random.default_rng(setup.search_seed))
-            origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
-            skill_obj = self._skill(spec.shape)
+        if skill == "insert_over":
+            skill_obj, xy = self._skill(p.covers[part].skill), approach[:2]
         else:
-            name = p.covers[part].skill if skill == "insert_over" else p.heads[part].skill
-            skill_obj = self._skill(name)
-            origin = goal - skill_obj.end_position
+            # The hole search around the estimate, on the plate or on the socket's part.
+            surface = approach[2] - (APPROACH_HEIGHT if skill == "insert" else ABOVE_PINS)
+            found = hole_search(motion, approach[:2], surface, approach[2], TOOL_DOWN_QUAT_XYZW,
+                                np.random.default_rng(setup.search_seed))
+            xy = found.hole_xy
+            skill_obj = self._skill(p.pegs[part].shape if skill == "insert" else p.heads[part].skill)
+        origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])
         detector = Detector(self.thresholds)
         lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))
         result = insert(motion, skill_obj, origin, detector, Admittance(), lever, True)
+        if result.reached and hole is not None:
+            self._pins[hole] = motion.controller.arm.read().tip_pos[:2] - p.geometry.holes[hole].position
         return result.reached, detector.max_force_dev, detector.max_torque_dev
+
+    def _pins_offset(self, holes: tuple[str, ...]) -> np.ndarray:
+        """Mean offset [m] of the pins in ``holes`` from the hole centres, as the robot measured
+        them at the end of their insertions (zero where no pin is known)."""
+        seen = [self._pins[h] for h in holes if h in self._pins]
+        return np.mean(seen, axis=0) if seen else np.zeros(2)
 
     def _screw(self, part: str) -> None:
         """A head placed in its socket stays fixed to that part."""

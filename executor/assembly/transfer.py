@@ -13,8 +13,8 @@ from executor.world.arm import TOOL_DOWN_QUAT_XYZW
 from executor.world.scene import TIME_STEP
 
 SAFE_Z = 0.20  # [m] TCP height for carrying: above every part standing on the plate or the tray
-SPEED = 0.35  # [m/s] mean speed of a move
-SETTLE = 0.15  # [s] held at the end of a move
+SPEED = 0.6  # [m/s] mean speed of a move
+SETTLE = 0.08  # [s] held at the end of a move
 
 
 def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,

@@ -78,6 +78,7 @@ class AssemblyWorld:
         self.socket_offset: dict[str, np.ndarray] = {}
         self._build_heads()
         self.reset_tray()
+        self.rest()
         self._build_arm()
         self.motion = Motion(ImpedanceController(self.arm, c), logger)
         self.arm.inverse_kinematics(HOME, TOOL_DOWN_QUAT_XYZW)
@@ -163,6 +164,13 @@ class AssemblyWorld:
         plate = self.product.geometry.plate
         self.goals[part] = np.array([*self.product.geometry.holes[hole].position,
                                      self.product.top_z - float(plate["tile_thickness"])])
+
+    def rest(self) -> None:
+        """Put every part to sleep: a part at rest costs no contact computation until
+        something touches it (it then wakes).  Call with the gripper open."""
+        for frames in self.frames.values():
+            for state in (pb.ACTIVATION_STATE_ENABLE_SLEEPING, pb.ACTIVATION_STATE_SLEEP):
+                pb.changeDynamics(frames.body, -1, activationState=state, physicsClientId=self.client)
 
     def tray_position(self, part: str) -> np.ndarray:
         """Body position [m] of a part waiting on the tray; a head waits in no socket."""
