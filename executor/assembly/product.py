@@ -165,8 +165,9 @@ def _cover(cid: str, table: dict, geometry: CellGeometry, where: str) -> CoverSp
     if socket is not None:
         openings.append((float(socket[0]), float(socket[1]), float(socket[2])))
     half_t = thickness / 2
+    xmin, ymin, xmax, ymax = map(float, outline)
     boxes = [Box(((x0 + x1) / 2, (y0 + y1) / 2, half_t), ((x1 - x0) / 2, (y1 - y0) / 2, half_t))
-             for x0, y0, x1, y1 in rect_minus_squares(tuple(map(float, outline)), openings)]
+             for x0, y0, x1, y1 in rect_minus_squares((xmin, ymin, xmax, ymax), openings)]
     if socket is not None:  # the socket's floor
         floor = (thickness - float(socket[3])) / 2
         boxes.append(Box((float(socket[0]), float(socket[1]), floor), (socket[2] / 2, socket[2] / 2, floor)))
