@@ -42,6 +42,7 @@ usage: ./run.sh [SUBCOMMAND] [ARGS...]
   assign        hole assignments from learned facts
   plan          complete assembly plans from learned facts
   session       planner + cells over Zenoh: the whole learning session
+  assemble      execute a plan in a simulated cell (pick, move, place; monitored, re-planned)
   view          open a session's Rerun recording
   executor      the simulated PyBullet cell (teach, trial, campaign, serve)
   bench         benchmarks: precedence | sizes | plan | executor | session

@@ -143,7 +143,8 @@ class StepEvidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 
 class StepReply(_Message, tag="step_reply", frozen=True):
     """The outcome of step request ``id`` as observed by cell ``cell``; ``pose_errors_mm``:
-    distance [mm] of every placed part from its goal after the step."""
+    (part, distance [mm] from its goal) of every placed part after the step (pairs, so that a
+    reply stays hashable)."""
 
     id: RequestId
     cell: CellId
@@ -151,7 +152,7 @@ class StepReply(_Message, tag="step_reply", frozen=True):
     hole: AspId | None
     result: Result
     evidence: StepEvidence
-    pose_errors_mm: dict[AspId, NonNegative] = {}
+    pose_errors_mm: tuple[tuple[AspId, NonNegative], ...] = ()
     wall_s: NonNegative = 0.0
     v: int = PROTOCOL_VERSION
 

@@ -99,7 +99,7 @@ class CellProcess:
 def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None,
-               zenoh_config: Path | None = None) -> list[str]:
+               zenoh_config: Path | None = None, block_holes: Sequence[str] = ()) -> list[str]:
     """The command line of one ``executor serve`` node, with ``--lifeline``."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
@@ -113,6 +113,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
         argv += ["--recording-id", recording_id]
     if zenoh_config is not None:
         argv += ["--zenoh-config", str(zenoh_config)]
+    argv += [arg for hole in block_holes for arg in ("--block-hole", hole)]
     return argv
 
 
