@@ -27,7 +27,7 @@ import pybullet as pb
 from executor import ExecutorError
 from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
-from executor.assembly.transfer import carry, move_line
+from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
 from executor.assembly.world import AssemblyWorld
 from executor.control.admittance import Admittance
 from executor.control.detector import Detector, Thresholds
@@ -41,6 +41,8 @@ from executor.world.arm import TOOL_DOWN_QUAT_XYZW
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
 RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
+GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
+FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
 
 
 @dataclass
@@ -142,16 +144,18 @@ class Assembler:
                 if outcomes[-1][0]:
                     break
                 here = motion.controller.arm.read().tip_pos
-                move_line(motion, here + np.array([0.0, 0.0, 0.04]))
+                move_line(motion, here + np.array([0.0, 0.0, 0.04]), tolerance=VIA_TOLERANCE)
         ok = outcomes[-1][0]
         if not ok:  # back to the tray
             carry(motion, world.tray_position(part) + world.frames[part].tcp + np.array([0.0, 0.0, 0.002]))
         grasp.release()
         here = motion.controller.arm.read().tip_pos
-        move_line(motion, here + np.array([0.0, 0.0, RETREAT]))
+        move_line(motion, here + np.array([0.0, 0.0, RETREAT]), tolerance=VIA_TOLERANCE)
         if ok:
             self.placed.add(part)
             self._screw(part)
+            if skill == "insert":
+                world.lock(part)
         world.rest()
         error = world.goal_error(part) if ok else float(np.linalg.norm(world.position(part) - world.goals[part]))
         return StepRecord(part, hole, skill, "fit" if ok else "no_fit", len(outcomes), time.perf_counter() - wall0,
@@ -164,9 +168,10 @@ class Assembler:
         world.arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         pos, quat = world.pose(part)
         grip = np.array(pb.multiplyTransforms(list(pos), list(quat), list(world.frames[part].grip), [0, 0, 0, 1])[0])
-        carry(world.motion, grip)
-        flat = part in self.product.covers  # a flat part lies against the palm: no tilt
-        return Grasp(world, part, setup.grasp_offset, np.zeros(3) if flat else setup.grasp_tilt)
+        carry(world.motion, grip, tolerance=GRIP_TOLERANCE)
+        if part in self.product.covers:  # a flat part lies against the palm, centred by the fingers
+            return Grasp(world, part, FLAT_GRASP_OFFSET * setup.grasp_offset, np.zeros(3))
+        return Grasp(world, part, setup.grasp_offset, setup.grasp_tilt)
 
     def _goal_tcp(self, part: str, skill: str) -> np.ndarray:
         """Where the TCP is when the part is placed [m] (a head: in its part's socket now)."""

@@ -165,6 +165,18 @@ class AssemblyWorld:
         self.goals[part] = np.array([*self.product.geometry.holes[hole].position,
                                      self.product.top_z - float(plate["tile_thickness"])])
 
+    def lock(self, part: str) -> None:
+        """Lock a placed peg in its hole: fixed where it rests, its contacts with the plate
+        switched off (the hole holds it; contacts of a peg with the plate's triangle mesh
+        were the most expensive part of every later step)."""
+        c, body = self.client, self.frames[part].body
+        plate = self.frames[self.product.base.id].body
+        for link in range(-1, pb.getNumJoints(plate, physicsClientId=c)):
+            pb.setCollisionFilterPair(body, plate, -1, link, 0, physicsClientId=c)
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=c)
+        pb.createConstraint(body, -1, -1, -1, pb.JOINT_FIXED, (0, 0, 0), (0, 0, 0), pos,
+                            childFrameOrientation=quat, physicsClientId=c)
+
     def rest(self) -> None:
         """Put every part to sleep: a part at rest costs no contact computation until
         something touches it (it then wakes).  Call with the gripper open."""
