@@ -217,8 +217,14 @@ class AssemblyWorld:
         pb.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
 
     def goal_error(self, part: str) -> float:
-        """Distance [m] of the part's body origin from its goal."""
-        return float(np.linalg.norm(self.position(part) - self.goals[part]))
+        """Distance [m] of the part's body origin from its goal; a head's goal is the socket of
+        its part where that part is (a pendulum swings on its shaft, and its head with it)."""
+        head = self.product.heads.get(part)
+        if head is None:
+            return float(np.linalg.norm(self.position(part) - self.goals[part]))
+        pos, quat = self.pose(head.into)
+        socket = pb.multiplyTransforms(list(pos), list(quat), list(self.socket_offset[part]), _IDENTITY)[0]
+        return float(np.linalg.norm(self.position(part) - np.array(socket)))
 
     def close(self) -> None:
         if pb.isConnected(self.client):
