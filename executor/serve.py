@@ -291,7 +291,8 @@ class CellNode:
         if isinstance(request, StepRequest):
             result, step_evidence, errors = self._backend.run_step(request)
             return StepReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=result,
-                             evidence=step_evidence, pose_errors_mm=tuple(sorted(errors.items())), wall_s=time.perf_counter() - started)
+                             evidence=step_evidence, pose_errors_mm=tuple(sorted(errors.items())),
+                             wall_s=time.perf_counter() - started)
         outcome, evidence = self._backend.run(request)
         return InsertReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=outcome,
                            evidence=evidence, wall_s=time.perf_counter() - started, v=request.v)
