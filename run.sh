@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The one entry point of the project.
-#   ./run.sh                 set up .venv and run the main job (end-to-end Cranfield session)
+#   ./run.sh                 set up .venv and run the main job (Cranfield: learn, plan, assemble)
 #   ./run.sh test [ARGS]     set up .venv, run the linters (ruff, mypy) and the test suite (pytest ARGS)
 #   ./run.sh lint            set up .venv and run the linters only
 #   ./run.sh <subcommand>    run one command of the command line (each has --help)
@@ -34,7 +34,7 @@ usage() {
     cat <<'USAGE'
 usage: ./run.sh [SUBCOMMAND] [ARGS...]
 
-  (none)        end-to-end learning session on Cranfield (same as: session)
+  (none)        Cranfield end to end: learn, plan, assemble the first plan (same as: session --assemble)
   test          run the linters and the test suite (pytest options pass through, e.g. -m "not slow")
   lint          run the linters (ruff, mypy)
   precedence    learn / count / sample / evaluate / suggest precedence constraints
@@ -51,8 +51,9 @@ Every subcommand takes --help.
 USAGE
 }
 
-cmd="${1:-session}"
-[[ $# -gt 0 ]] && shift
+[[ $# -eq 0 ]] && set -- session --assemble
+cmd="$1"
+shift
 case "$cmd" in
     -h|--help|help) usage; exit 0 ;;
 esac

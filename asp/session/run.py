@@ -33,6 +33,8 @@ from contextlib import ExitStack
 from datetime import UTC, datetime
 from pathlib import Path
 
+import zenoh
+
 from asp import PlannerError
 from asp.plans.assign import greedy_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
@@ -60,6 +62,8 @@ from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopba
 SETTINGS = "session.json"
 MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
+EXIT_STOPPED = 3
+"""Exit code when ``--assemble`` could not finish the product."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -89,6 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--allow-cells", type=comma_list(check_cell_id, "cell ids"), metavar="ID,...",
                         help="with --cells 0: use only these cells (default: any cell that shows a token); "
                              "a session that starts its cells uses only those")
+    parser.add_argument("--assemble", action="store_true",
+                        help="then assemble the first plan in the first cell (./run.sh assemble); the JSON gains "
+                             "\"assembly\"")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     return parser
@@ -255,6 +262,24 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
     return assignment, found
 
 
+def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: Plan, seed: int,
+              args: argparse.Namespace) -> dict:
+    """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`); the report, with
+    ``"error"`` when the product could not be finished."""
+    from asp.assemble.driver import ZenohDriver
+    from asp.assemble.execute import AssemblyStopped, execute
+
+    if not cell_ids:
+        raise PlannerError("--assemble needs a cell of this session (--cells 1 or more)")
+    started = time.perf_counter()
+    try:
+        report = execute(load_learned_facts([learned]), plan, ZenohDriver(session, cell_ids[0], seed, args.timeout))
+    except AssemblyStopped as exc:
+        report = dict(exc.report, error=str(exc))
+    report["wall_s"] = round(time.perf_counter() - started, 3)
+    return report
+
+
 def run_session(args: argparse.Namespace) -> dict:
     """Run (or resume) a session; returns the JSON result."""
     started = time.perf_counter()
@@ -330,6 +355,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
                     header="The greedy hole assignment (paper 2.2) of learned.lp.")
         log.assignment(assignment)
+        assembly_report = (_assemble(session, cell_ids, learned, found[0], settings["seed"], args)
+                           if args.assemble else None)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
     versus = _versus_truth(truth, required, fits, must_precede)
@@ -342,6 +369,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         "plans": [plan.as_json() for plan in found],
         "matches_truth": matches,
     }
+    if assembly_report is not None:
+        result["assembly"] = assembly_report
     settings.update(result, status="done", truth=versus, assignment=assignment, cells=cell_ids,
                     journal=[{"part": e.part, "hole": e.hole, "result": e.result, "cell": e.cell,
                               "retest": e.retest} for e in journal.entries],
@@ -349,6 +378,13 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
                     timings={k: round(v, 3) for k, v in timings.items()})
     _save(run, settings)
     return result
+
+
+def _assembly_line(report: dict) -> str:
+    errors = report["final_pose_error_mm"]
+    worst = max(errors.values(), default=0.0)
+    return (f"assembly of plan 1: assembled {report['assembled']}, {len(report['steps'])} steps, "
+            f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
 
 
 def _summary(result: dict, run: Path) -> str:
@@ -368,6 +404,7 @@ def _summary(result: dict, run: Path) -> str:
         f"precedence learned {settings['truth']['precedence_sound']} "
         f"({settings['truth']['precedence_extra']} pairs more than required); "
         f"matches truth: {result['matches_truth']}",
+        *([_assembly_line(result["assembly"])] if "assembly" in result else []),
     ])
 
 
@@ -378,4 +415,8 @@ def main(argv: list[str]) -> int:
     except BridgeError as exc:
         raise PlannerError(str(exc)) from None
     print(json.dumps(result) if args.json else _summary(result, Path(result["run"])))
+    stopped = result.get("assembly", {}).get("error")
+    if stopped:
+        print(f"error: {stopped}", file=sys.stderr)
+        return EXIT_STOPPED
     return 0
