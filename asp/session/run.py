@@ -369,13 +369,14 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         "plans": [plan.as_json() for plan in found],
         "matches_truth": matches,
     }
-    if assembly_report is not None:
-        result["assembly"] = assembly_report
     settings.update(result, status="done", truth=versus, assignment=assignment, cells=cell_ids,
                     journal=[{"part": e.part, "hole": e.hole, "result": e.result, "cell": e.cell,
                               "retest": e.retest} for e in journal.entries],
                     wall_s=round(time.perf_counter() - started, 3),
                     timings={k: round(v, 3) for k, v in timings.items()})
+    if assembly_report is not None:
+        settings["assembly_run"] = assembly_report  # "assembly" in session.json names the assembly
+        result["assembly"] = assembly_report
     _save(run, settings)
     return result
 

@@ -81,3 +81,13 @@ def test_the_command_line_stops_with_exit_code_3(run_cli) -> None:
     assert done.returncode == 3, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] is False and "gets no hole" in done.stderr
+
+
+def test_a_session_learns_plans_and_assembles(run_session, tmp_path) -> None:
+    run = tmp_path / "run"
+    result = run_session("--assemble", "--out", str(run))
+    assert result["assembly"]["assembled"] is True
+    assert [s["part"] for s in result["assembly"]["steps"]] == [s["part"] for s in result["plans"][0]]
+    settings = json.loads((run / "session.json").read_text())
+    assert settings["assembly"] == "cranfield"  # the assembly's name stays (a resume reads it)
+    assert settings["assembly_run"] == result["assembly"]
