@@ -83,6 +83,7 @@ def test_the_command_line_stops_with_exit_code_3(run_cli) -> None:
     assert report["assembled"] is False and "gets no hole" in done.stderr
 
 
+@pytest.mark.slow
 def test_a_session_learns_plans_and_assembles(run_session, tmp_path) -> None:
     run = tmp_path / "run"
     result = run_session("--assemble", "--out", str(run))
