@@ -181,14 +181,17 @@ class SimBackend:
                                          send_blueprint=False)  # the planner sends it
                         if rrd is not None else None)
         self._cell = Cell(assembly, gui=False, logger=self._logger)
-        self._assembly, self._blocked = assembly, list(blocked)
+        self._assembly, self._blocked, self._cell_id = assembly, list(blocked), cell_id
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
         from executor.assembly.backend import AssemblyRunner, step_evidence
 
         if self._runner is None:  # the assembling world is made on the first step
-            self._runner = AssemblyRunner(self._assembly, self._blocked)
+            from executor.assembly.recording import AssemblyRecorder
+
+            recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
+            self._runner = AssemblyRunner(self._assembly, self._blocked, recorder)
         record, errors = self._runner.run_step(request)
         result: Result = "fit" if record.outcome == "fit" else "no_fit"
         return result, step_evidence(record), errors

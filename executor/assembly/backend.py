@@ -6,12 +6,15 @@ obstacle in every fresh world."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from bridge.messages import StepEvidence, StepRequest
 from executor import ExecutorError
 from executor.assembly.product import Product, load_product
 from executor.assembly.step import Assembler, StepRecord
-from executor.control.motion import StepLogger
+
+if TYPE_CHECKING:
+    from executor.assembly.recording import AssemblyRecorder
 
 
 def step_evidence(record: StepRecord) -> StepEvidence:
@@ -24,14 +27,14 @@ def step_evidence(record: StepRecord) -> StepEvidence:
 class AssemblyRunner:
     """One assembling world at a time, keyed by the plan run's id."""
 
-    def __init__(self, assembly: str, blocked: Sequence[str] = (), logger: StepLogger | None = None) -> None:
+    def __init__(self, assembly: str, blocked: Sequence[str] = (), recorder: AssemblyRecorder | None = None) -> None:
         self.product: Product = load_product(assembly)
         self.blocked = list(blocked)
         for hole in self.blocked:
             if hole not in self.product.geometry.holes:
                 raise ExecutorError(f"--block-hole {hole}: expected a hole of the plate "
                                     f"({', '.join(sorted(self.product.geometry.holes))})")
-        self.logger = logger
+        self.recorder = recorder
         self._run: str | None = None
         self._assembler: Assembler | None = None
 
@@ -39,7 +42,9 @@ class AssemblyRunner:
         """The world of plan run ``run`` (a fresh one for a new run)."""
         if self._assembler is None or run != self._run:
             self.close()
-            self._assembler = Assembler(self.product, self.logger)
+            self._assembler = Assembler(self.product, self.recorder)
+            if self.recorder is not None:
+                self.recorder.attach(self._assembler.world)
             for hole in self.blocked:
                 self._assembler.block_hole(hole)
             self._run = run
@@ -50,6 +55,10 @@ class AssemblyRunner:
         assembler = self.assembler(request.assembly)
         record = assembler.run_step(request.part, request.hole, request.seed)
         errors = assembler.pose_errors()
+        if self.recorder is not None:
+            self.recorder.log_plan_step(record.part, record.hole, record.outcome, record.attempts,
+                                        record.pose_error * 1000.0)
+            self.recorder.flush()
         return record, {part: errors[part] * 1000.0 for part in sorted(assembler.placed)}
 
     def close(self) -> None:

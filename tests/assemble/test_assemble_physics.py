@@ -7,6 +7,8 @@ import json
 
 import pytest
 
+from bridge.recordings import column_values, read_recording
+
 STEP_KEYS = {"part", "hole", "skill", "outcome", "attempts", "duration_s", "max_force_dev"}
 
 
@@ -24,11 +26,20 @@ def test_the_default_cranfield_plan_is_assembled_within_2_mm(run_cli) -> None:
 
 
 @pytest.mark.slow
-def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole(run_cli) -> None:
-    done = run_cli("assemble", "--assembly", "spare", "--block-hole", "r1", "--json", timeout=280)
+def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole(run_cli, tmp_path) -> None:
+    rrd = tmp_path / "a1.rrd"
+    done = run_cli("assemble", "--assembly", "spare", "--block-hole", "r1", "--rrd", str(rrd), "--json", timeout=280)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] is True and report["replans"]
     failed = [s for s in report["steps"] if s["outcome"] == "no_fit"]
     assert failed and all(s["hole"] == "r1" and s["attempts"] == 2 for s in failed)
     assert all(s["hole"] != "r1" for s in report["final_plan"])
+    # The recording: every part moving over sim_time, the arm, one line per plan step.
+    entities = read_recording(rrd).under("/executor/a1/assembly")
+    for part in ("bp", "p1", "p2", "p3"):
+        assert "sim_time" in entities[f"/executor/a1/assembly/parts/{part}"].timelines
+    assert entities["/executor/a1/assembly/arm"].rows > 10
+    lines = column_values(rrd, "/executor/a1/assembly/steps", "TextLog:text")
+    assert len(lines) == len(report["steps"]) and "no_fit" in " ".join(map(str, lines))
+    assert column_values(rrd, "/executor/a1/assembly/steps", "plan_step") == list(range(1, len(lines) + 1))
