@@ -114,6 +114,10 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
         plan = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in found[args.plan - 1]))
         lps = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
+    unknown = [hole for hole in args.block_hole if hole not in assembly.hole_ids]
+    if unknown:
+        raise PlannerError(f"--block-hole {unknown[0]}: expected a hole of {assembly.name} "
+                           f"({', '.join(assembly.hole_ids)})")
     facts = load_learned_facts(lps) if lps else truth_facts(assembly)
     if jsons:
         plan = read_plan_json(jsons[0], args.plan)

@@ -92,3 +92,14 @@ def test_a_session_learns_plans_and_assembles(run_session, tmp_path) -> None:
     settings = json.loads((run / "session.json").read_text())
     assert settings["assembly"] == "cranfield"  # the assembly's name stays (a resume reads it)
     assert settings["assembly_run"] == result["assembly"]
+
+
+@pytest.mark.parametrize("args, expected", [
+    (("--block-hole", "zz"), "--block-hole zz: expected a hole"),
+    (("missing.json",), "missing.json"),
+    (("--run", "."), "session.json"),
+])
+def test_bad_input_exits_2_with_one_line(run_cli, tmp_path, args, expected) -> None:
+    done = run_cli("assemble", "--backend", "truth", *args, cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    assert expected in done.stderr and len(done.stderr.strip().splitlines()) == 1
