@@ -36,12 +36,15 @@ from asp.session.cells import start_cell
 from asp.solve import fact
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, finite_float, int_in
+from bridge.client import CellDirectory
 from bridge.inputs import read_bytes
 from bridge.session import add_endpoint_arguments, free_loopback_endpoint, open_session
 
 EXIT_STOPPED = 3
 """Exit code when the product cannot be finished (bad input exits with 2)."""
 CELL_ID = "a1"
+CELL_START_S = 60.0
+"""How long the started cell may take to show its liveliness token [s]."""
 MAX_PLAN_INDEX = 1000
 
 
@@ -157,9 +160,12 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
     listen = args.listen or [free_loopback_endpoint()]
     session = open_session(listen, args.connect, args.zenoh_config)
     try:
+        directory = CellDirectory(session)
         cell = start_cell(CELL_ID, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                           rrd=args.rrd, zenoh_config=args.zenoh_config, block_holes=args.block_hole)
         try:
+            # Its queryables reach us with its liveliness token: a step sent before might find no one.
+            directory.wait_for(1, timeout=CELL_START_S)
             driver = ZenohDriver(session, CELL_ID, args.seed, args.timeout)
             try:
                 report, code = execute(facts, plan, driver), 0
@@ -167,6 +173,7 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
                 report, code = dict(exc.report, error=str(exc)), EXIT_STOPPED
         finally:
             cell.stop()
+            directory.close()
     finally:
         session.close()
     report["wall_s"] = round(time.perf_counter() - started, 3)

@@ -7,7 +7,10 @@ Per kind of part (the ``skill`` of the step's record):
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
 - ``insert_over``: a part with openings down over the pins standing in its holes, by the
-  same insertion skill, from above the pins to its resting height;
+  same insertion skill, from above the pins to its resting height, aimed at the holes'
+  centres without a search (a pin stands within half its hole's clearance of the centre,
+  closer than the robot's own reading of where it inserted it, which carries that peg's
+  unknown grasp offset; a spiral search fails on a long part tilting on the pin tops);
 - ``insert_socket``: a head into the socket of its part, wherever that part is; it stays
   fixed to it from then on (screwed).
 
@@ -81,7 +84,6 @@ class Assembler:
         self.placed: set[str] = set()
         self._screwed: dict[str, int] = {}
         self.blocked: set[str] = set()
-        self._pins: dict[str, np.ndarray] = {}  # hole -> where its peg went in, from the hole centre [m]
 
     def skill_of(self, part: str) -> str:
         """The step's skill: fixture, insert, insert_over or insert_socket."""
@@ -201,9 +203,7 @@ class Assembler:
         world, motion, p = self.world, self.world.motion, self.product
         goal = self._goal_tcp(part, skill)
         approach = self._approach(part, skill, goal)
-        if skill == "insert_over":  # where the robot saw the pins go in, no search
-            approach[:2] += self._pins_offset(p.covers[part].over)
-        else:
+        if skill != "insert_over":  # a cover is aimed at its holes' centres (module docstring)
             approach[:2] += setup.vision_error
         carry(motion, approach)
         motion.hold(approach, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
@@ -221,15 +221,7 @@ class Assembler:
         detector = Detector(self.thresholds)
         lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))
         result = insert(motion, skill_obj, origin, detector, Admittance(), lever, True)
-        if result.reached and hole is not None:
-            self._pins[hole] = motion.controller.arm.read().tip_pos[:2] - p.geometry.holes[hole].position
         return result.reached, detector.max_force_dev, detector.max_torque_dev
-
-    def _pins_offset(self, holes: tuple[str, ...]) -> np.ndarray:
-        """Mean offset [m] of the pins in ``holes`` from the hole centres, as the robot measured
-        them at the end of their insertions (zero where no pin is known)."""
-        seen = [self._pins[h] for h in holes if h in self._pins]
-        return np.mean(seen, axis=0) if seen else np.zeros(2)
 
     def _screw(self, part: str) -> None:
         """A head placed in its socket stays fixed to that part."""
