@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The repository's wrapper around the console command `assembly-constraints` (the one
 # `pip install .` installs): it sets up .venv (editable, versions pinned by constraints.txt).
-#   ./run.sh                 set up .venv and run the main job (end-to-end Cranfield session)
+#   ./run.sh                 set up .venv and run the main job (Cranfield: learn, plan, assemble)
 #   ./run.sh test [ARGS]     set up .venv, run the linters (ruff, mypy) and the test suite (pytest ARGS)
 #   ./run.sh lint            set up .venv and run the linters only
 #   ./run.sh <subcommand>    assembly-constraints <subcommand> (each has --help)
@@ -36,15 +36,17 @@ usage() {
 usage: ./run.sh [SUBCOMMAND] [ARGS...]
 
 The repository's wrapper around assembly-constraints (below); without a subcommand it
-runs a session. Two subcommands of its own:
+runs the main job: Cranfield end to end, learn, plan, assemble the first plan (same as
+session --assemble). Two subcommands of its own:
   test          run the linters and the test suite (pytest options pass through, e.g. -m "not slow")
   lint          run the linters (ruff, mypy)
 
 USAGE
 }
 
-cmd="${1:-session}"
-[[ $# -gt 0 ]] && shift
+[[ $# -eq 0 ]] && set -- session --assemble
+cmd="$1"
+shift
 case "$cmd" in
     -h|--help|help) usage; setup; exec "$PY" -P -m assembly_constraints --help ;;
 esac

@@ -17,6 +17,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
     "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
     "session": ("asp.session.run", "the end-to-end learning session (planner + cells)"),
+    "assemble": ("asp.assemble.cli", "execute a plan in a simulated cell, monitored and re-planned"),
     "view": ("asp.session.view", "open a session's Rerun recording"),
     "bench": ("asp.bench.cli", "benchmarks: precedence | sizes | plan | executor | session"),
 }

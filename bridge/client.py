@@ -1,7 +1,8 @@
 """The planner's side of the bridge: discovering cells and sending them experiments.
 
 - :class:`CellDirectory` follows the cells' liveliness tokens (``cell/*/alive``).
-- :func:`send_insert` sends one request asynchronously; :func:`request_insert` waits for it.
+- :func:`send_insert` sends one request asynchronously; :func:`request_insert` waits for it;
+  :func:`request_step` sends one plan step and waits for it.
 - :class:`CellPool` keeps every alive cell busy with submitted requests: one request per
   cell, a cell that dies (token gone) or times out has its request re-sent to another
   cell (or the pool waits for one), and each request's reply is returned exactly once.
@@ -23,8 +24,17 @@ import msgspec
 import zenoh
 
 from bridge import BridgeError
-from bridge.keys import ALIVE_PATTERN, cell_of_alive_key, insert_key
-from bridge.messages import ErrorReply, InsertReply, InsertRequest, MessageError, decode_reply, encode
+from bridge.keys import ALIVE_PATTERN, cell_of_alive_key, insert_key, step_key
+from bridge.messages import (
+    ErrorReply,
+    InsertReply,
+    InsertRequest,
+    MessageError,
+    StepReply,
+    StepRequest,
+    decode_reply,
+    encode,
+)
 
 
 class CellTimeout(BridgeError):
@@ -117,6 +127,12 @@ class CellDirectory:
 
 def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeout: float,
                 on_outcome: Callable[[Outcome], None]) -> zenoh.CancellationToken:
+    """Send ``request`` to ``cell`` (see :func:`_send`)."""
+    return _send(session, insert_key(cell), cell, request, timeout, on_outcome)  # type: ignore[arg-type]
+
+
+def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | StepRequest, timeout: float,
+          on_outcome: Callable[[InsertReply | StepReply | BridgeError], None]) -> zenoh.CancellationToken:
     """Send ``request`` to ``cell``; ``on_outcome`` is called exactly once (Zenoh thread),
     when the query ends (the cell finalises it after replying, or ``timeout`` [s] passes).
 
@@ -127,7 +143,7 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
     the query was cancelled. Returns a token that cancels the query.
     """
     lock = threading.Lock()
-    answers: list[InsertReply | ErrorReply] = []
+    answers: list[InsertReply | StepReply | ErrorReply] = []
     faults: list[BridgeError] = []
 
     def on_reply(reply: zenoh.Reply) -> None:
@@ -153,22 +169,26 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
             on_outcome(CellConflict(f"cell {cell}: {len(distinct)} different replies to request {request.id}"))
         elif distinct:
             answer = distinct[0]
-            on_outcome(answer if isinstance(answer, InsertReply) else CellRefused(answer))
+            on_outcome(CellRefused(answer) if isinstance(answer, ErrorReply) else answer)
         else:
             on_outcome(fault or CellTimeout(f"cell {cell}: no reply to request {request.id} "
                                             f"within {timeout:.1f} s"))
 
     cancel = zenoh.CancellationToken()
-    session.get(insert_key(cell), zenoh.handlers.Callback(on_reply, on_end),
+    session.get(key, zenoh.handlers.Callback(on_reply, on_end),
                 payload=encode(request), timeout=timeout, cancellation_token=cancel,
                 consolidation=zenoh.ConsolidationMode.NONE)
     return cancel
 
 
-def check_echo(message: InsertReply | ErrorReply, cell: str, request: InsertRequest) -> None:
-    """MessageError unless ``message`` comes from ``cell`` and answers ``request``."""
+def check_echo(message: InsertReply | StepReply | ErrorReply, cell: str,
+               request: InsertRequest | StepRequest) -> None:
+    """MessageError unless ``message`` comes from ``cell`` and answers ``request`` (a reply of
+    the request's kind)."""
     asked = (cell, request.id, request.part, request.hole)
-    if isinstance(message, InsertReply):
+    if isinstance(message, (InsertReply, StepReply)):
+        if isinstance(message, StepReply) != isinstance(request, StepRequest):
+            raise MessageError("malformed", f"a {type(message).__name__} does not answer a {type(request).__name__}")
         answered = (message.cell, message.id, message.part, message.hole)
     else:
         answered = (message.cell, message.id or request.id, request.part, request.hole)
@@ -187,6 +207,20 @@ def request_insert(session: zenoh.Session, cell: str, request: InsertRequest,
         raise CellTimeout(f"cell {cell}: query {request.id} never ended") from None
     if isinstance(outcome, BridgeError):
         raise outcome
+    return outcome
+
+
+def request_step(session: zenoh.Session, cell: str, request: StepRequest, timeout: float) -> StepReply:
+    """Send a plan step to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
+    box: queue.SimpleQueue[InsertReply | StepReply | BridgeError] = queue.SimpleQueue()
+    _send(session, step_key(cell), cell, request, timeout, box.put)
+    try:
+        outcome = box.get(timeout=timeout + 5.0)
+    except queue.Empty:
+        raise CellTimeout(f"cell {cell}: query {request.id} never ended") from None
+    if isinstance(outcome, BridgeError):
+        raise outcome
+    assert isinstance(outcome, StepReply)  # check_echo let only a StepReply through
     return outcome
 
 

@@ -1,6 +1,7 @@
 """Every Zenoh key expression of the project, in one place.
 
-A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert`` and holds the
+A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert``, plan steps on
+``cell/<id>/step`` (its world persists between steps), and holds the
 liveliness token ``cell/<id>/alive/<instance>`` while it is up (``<instance>``: a random
 name of the process, so two processes claiming one id show as two tokens);
 ``cell/<id>/ping`` echoes its payload. The planner discovers cells by subscribing to
@@ -39,6 +40,11 @@ def check_cell_id(cell_id: str) -> str:
 def insert_key(cell_id: str) -> str:
     """Queryable key on which cell ``cell_id`` serves insertion experiments."""
     return f"cell/{check_cell_id(cell_id)}/insert"
+
+
+def step_key(cell_id: str) -> str:
+    """Queryable key on which cell ``cell_id`` carries out plan steps."""
+    return f"cell/{check_cell_id(cell_id)}/step"
 
 
 def alive_key(cell_id: str, instance: str = "0") -> str:

@@ -7,7 +7,14 @@ message is ever executed; ids are matched against fixed patterns before use.
 
 - :class:`InsertRequest` (planner → cell): insert ``part`` into ``hole``;
 - :class:`InsertReply` (cell → planner): the outcome ``fit``/``no_fit`` and its evidence;
+- :class:`StepRequest` (planner → cell, since version 3): carry out one step of a plan in
+  the cell's persistent world (pick the part, place it, into ``hole`` if it has one);
+- :class:`StepReply` (cell → planner): the step's outcome, its evidence and how far every
+  placed part is from its goal;
 - :class:`ErrorReply` (cell → planner): the request was refused, with a reason code.
+
+Versions: 3 added the step messages; insert messages did not change, so a cell still
+serves a version-2 insert request and answers it as version 2.
 """
 
 from __future__ import annotations
@@ -20,8 +27,10 @@ from bridge import BridgeError
 from bridge.assembly import ID_PATTERN
 from bridge.keys import CELL_ID_PATTERN
 
-PROTOCOL_VERSION: Final = 2
-"""2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``."""
+PROTOCOL_VERSION: Final = 3
+"""2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``. 3: step request and reply."""
+INSERT_VERSIONS: Final = frozenset({2, 3})
+"""Versions of insert and error messages accepted (their form is the same in both)."""
 MAX_MESSAGE_BYTES: Final = 16 * 1024
 """Largest accepted payload [bytes]; bigger messages are refused unread."""
 
@@ -96,6 +105,56 @@ class ErrorReply(_Message, tag="error", frozen=True):
     v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
 
 
+class StepRequest(_Message, tag="step", frozen=True):
+    """Carry out step ``step`` of the plan run ``assembly``: pick ``part`` from the tray and
+    place it (into ``hole``, None for a part placed without a hole). The cell keeps one world
+    per ``assembly``; a new ``assembly`` starts from a fresh world (every part on the tray)."""
+
+    id: RequestId
+    assembly: RequestId
+    step: Annotated[int, msgspec.Meta(ge=1, le=10_000)]
+    part: AspId
+    hole: AspId | None = None
+    seed: Seed = 0
+    timeout_s: NonNegative = 0.0
+    """As :attr:`InsertRequest.timeout_s` [s]."""
+    v: int = PROTOCOL_VERSION
+
+
+class StepEvidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """What the cell measured during a plan step."""
+
+    skill: Annotated[str, msgspec.Meta(pattern=r"^[a-z_]{1,32}$")]
+    """How the part was placed: fixture, insert, insert_over, insert_socket, or truth."""
+    attempts: Annotated[int, msgspec.Meta(ge=0)]
+    max_force_dev: NonNegative
+    """Largest ‖F_mes − F_des‖ of the insertions [N]."""
+    max_torque_dev: NonNegative
+    """Largest ‖M_mes − M_des‖ [N m]."""
+    duration_s: NonNegative
+    """Wall time of the step [s]."""
+    sim_time_s: NonNegative
+    """Simulated time of the step [s]."""
+    pose_error_mm: NonNegative
+    """Distance of the part from its goal after the step [mm]."""
+
+
+class StepReply(_Message, tag="step_reply", frozen=True):
+    """The outcome of step request ``id`` as observed by cell ``cell``; ``pose_errors_mm``:
+    (part, distance [mm] from its goal) of every placed part after the step (pairs, so that a
+    reply stays hashable)."""
+
+    id: RequestId
+    cell: CellId
+    part: AspId
+    hole: AspId | None
+    result: Result
+    evidence: StepEvidence
+    pose_errors_mm: tuple[tuple[AspId, NonNegative], ...] = ()
+    wall_s: NonNegative = 0.0
+    v: int = PROTOCOL_VERSION
+
+
 class MessageError(BridgeError):
     """A payload that is not a valid message; ``code`` is the ErrorReply code to send."""
 
@@ -105,10 +164,11 @@ class MessageError(BridgeError):
 
 
 _REQUEST_DECODER = msgspec.json.Decoder(InsertRequest)
-_REPLY_DECODER = msgspec.json.Decoder(InsertReply | ErrorReply)
+_STEP_DECODER = msgspec.json.Decoder(StepRequest)
+_REPLY_DECODER = msgspec.json.Decoder(InsertReply | StepReply | ErrorReply)
 
 
-def encode(message: InsertRequest | InsertReply | ErrorReply) -> bytes:
+def encode(message: InsertRequest | InsertReply | StepRequest | StepReply | ErrorReply) -> bytes:
     """Serialise a message to JSON bytes; MessageError if it exceeds the size cap."""
     data = msgspec.json.encode(message)
     if len(data) > MAX_MESSAGE_BYTES:
@@ -125,9 +185,10 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
         message = decoder.decode(payload)
     except (msgspec.DecodeError, UnicodeDecodeError) as exc:
         raise MessageError("malformed", f"{what} is not valid: {exc}") from None
-    if message.v != PROTOCOL_VERSION:
+    accepted = {PROTOCOL_VERSION} if isinstance(message, (StepRequest, StepReply)) else INSERT_VERSIONS
+    if message.v not in accepted:
         raise MessageError("version", f"{what} has protocol version {message.v}; "
-                           f"expected {PROTOCOL_VERSION}")
+                           f"expected {' or '.join(map(str, sorted(accepted)))}")
     return message
 
 
@@ -136,6 +197,11 @@ def decode_request(payload: bytes) -> InsertRequest:
     return _decode(_REQUEST_DECODER, payload, "insert request")
 
 
-def decode_reply(payload: bytes) -> InsertReply | ErrorReply:
+def decode_step_request(payload: bytes) -> StepRequest:
+    """Validate and decode a step request; MessageError (with a code) if invalid."""
+    return _decode(_STEP_DECODER, payload, "step request")
+
+
+def decode_reply(payload: bytes) -> InsertReply | StepReply | ErrorReply:
     """Validate and decode a cell's reply; MessageError if invalid."""
     return _decode(_REPLY_DECODER, payload, "reply")

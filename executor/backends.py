@@ -11,6 +11,9 @@ class with
   the measurements if there are any. Raise :class:`UnknownPair` for a part or hole the
   cell does not have (the planner gets ``unknown_id``), :class:`executor.ExecutorError`
   when the experiment could not run (``failed``, which the planner sends again);
+- ``run_step(self, request: StepRequest) -> StepOutcome``: carry out one step of a plan
+  (``./run.sh assemble``), keeping the product between the steps of one plan run; a cell
+  that only learns may raise :class:`executor.ExecutorError` (the planner gets ``failed``);
 - ``close(self)``: release the robot.
 
 ``run`` is called from one thread, one experiment at a time. Start it with
@@ -31,7 +34,7 @@ from pathlib import Path
 from typing import Protocol
 
 from bridge.inputs import shorten
-from bridge.messages import Evidence, InsertRequest, Result
+from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
 from executor import ExecutorError
 
 _SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
@@ -41,11 +44,20 @@ class UnknownPair(ExecutorError):
     """The request names a part or hole the cell does not have."""
 
 
+StepOutcome = tuple[Result, StepEvidence, dict[str, float]]
+"""A plan step's outcome, its evidence and every placed part's distance from its goal [mm]."""
+
+
 class Backend(Protocol):
-    """Runs one insertion experiment."""
+    """Runs one insertion experiment or one plan step."""
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
         """The outcome and its evidence; ExecutorError for a bad part or hole."""
+        ...
+
+    def run_step(self, request: StepRequest) -> StepOutcome:
+        """The plan step's outcome (the cell keeps its world between the steps of one plan
+        run); ExecutorError for a bad part or hole, or when the cell cannot run plan steps."""
         ...
 
     def close(self) -> None: ...

@@ -26,9 +26,9 @@ import msgspec
 
 from bridge import BridgeError
 from bridge.inputs import read_bytes
-from bridge.messages import Evidence, InsertRequest, Result
+from bridge.messages import Evidence, InsertRequest, Result, StepRequest
 from executor import ExecutorError
-from executor.backends import CellContext, UnknownPair
+from executor.backends import CellContext, StepOutcome, UnknownPair
 
 Answer = tuple[Result, Evidence | None, float]
 """A recorded answer: the result, its evidence, the cell's wall time [s]."""
@@ -88,6 +88,11 @@ class ReplayBackend:
         if self._paced:
             time.sleep(wall_s)
         return result, evidence
+
+    def run_step(self, request: StepRequest) -> StepOutcome:
+        """A journal holds experiments, not assemblies: a plan step is refused (``failed``)."""
+        raise ExecutorError(f"the replay backend has no plan steps (step {request.step} of plan run "
+                            f"{request.assembly})")
 
     def close(self) -> None:
         """Nothing to release."""

@@ -19,6 +19,10 @@ process later.
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
   ``MODULE:CLASS`` loads a user's backend (:mod:`executor.backends`), e.g. a real robot.
+- Plan steps (``cell/<id>/step``, :class:`bridge.messages.StepRequest`) run in the same
+  queue: ``sim`` in the assembling world of :mod:`executor.assembly` (kept between the
+  steps of one plan run), ``truth`` from the geometry; ``--block-hole H`` puts an obstacle
+  in hole H (a fault to show the planner's recovery).
 
 One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
 ``done <id> <result>``), flushed, so a supervisor can follow the node.
@@ -34,16 +38,16 @@ import threading
 import time
 import uuid
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import zenoh
 
 from bridge import BridgeError
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
-from bridge.keys import alive_key, check_cell_id, insert_key, ping_key
+from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from bridge.messages import (
     MAX_MESSAGE_BYTES,
     ErrorCode,
@@ -53,16 +57,23 @@ from bridge.messages import (
     InsertRequest,
     MessageError,
     Result,
+    StepEvidence,
+    StepReply,
+    StepRequest,
     decode_request,
+    decode_step_request,
     encode,
 )
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from executor import ExecutorError
-from executor.backends import Backend, CellContext, UnknownPair, backend_option, load_backend
+from executor.backends import Backend, CellContext, StepOutcome, UnknownPair, backend_option, load_backend
 from executor.cell_options import add_cell_arguments, cell_keywords
 from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
+
+if TYPE_CHECKING:
+    from executor.assembly.backend import AssemblyRunner
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
@@ -76,12 +87,15 @@ class TruthBackend:
     cross-section does, :func:`executor.world.geometry.passes`), after ``delay_s`` [s]."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
-                 recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER) -> None:
+                 recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER,
+                 blocked: Sequence[str] = ()) -> None:
         try:
             self._geometry = load_geometry(assembly)
         except BridgeError as exc:
             raise ExecutorError(f"truth backend: {exc}") from None
         self._delay_s = delay_s
+        self._blocked = set(blocked)
+        self._placed: dict[str, dict[str, float]] = {}  # plan run -> placed parts
         self._log = None
         if rrd is not None or viewer != NO_VIEWER:
             from executor.rerun_log import open_recording
@@ -104,6 +118,22 @@ class TruthBackend:
                 self._log.set_time("experiment", sequence=request.experiment)
             self._log.log(self._entity, rr.TextLog(f"{request.part}->{request.hole}: {result}"))
         return result, None
+
+    def run_step(self, request: StepRequest) -> StepOutcome:
+        """A part with a hole fits when its cross-section passes and the hole is not blocked;
+        a part without one is always placed."""
+        placed = self._placed.setdefault(request.assembly, {})
+        parts, holes = self._geometry.parts, self._geometry.holes
+        if request.hole is not None and (request.part not in parts or request.hole not in holes):
+            raise UnknownPair(f"unknown pair ({request.part},{request.hole}); expected a part "
+                              f"of {tuple(parts)} and a hole of {tuple(holes)}")
+        ok = request.hole is None or (request.hole not in self._blocked
+                                      and passes(parts[request.part], holes[request.hole]))
+        if ok:
+            placed[request.part] = 0.0
+        evidence = StepEvidence(skill="truth", attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
+                                duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
+        return ("fit" if ok else "no_fit"), evidence, dict(placed)
 
     def close(self) -> None:
         if self._log is not None:
@@ -129,11 +159,12 @@ class SimBackend:
     """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
-                 rrd: Path | None, viewer: Viewer = NO_VIEWER, **cell_keywords: Any) -> None:
-        """``viewer``: also stream the recording live; ``cell_keywords``: the Cell's options
-        (layer, perturbation, cell seed, ``ilc_state``: the file its ILC corrections are
-        loaded from and saved to, atomically after every update, so a resumed session's
-        cell starts from them)."""
+                 rrd: Path | None, viewer: Viewer = NO_VIEWER, blocked: Sequence[str] = (),
+                 **cell_keywords: Any) -> None:
+        """``viewer``: also stream the recording live; ``blocked``: holes with an obstacle
+        for plan steps; ``cell_keywords``: the Cell's options (layer, perturbation, cell
+        seed, ``ilc_state``: the file its ILC corrections are loaded from and saved to,
+        atomically after every update, so a resumed session's cell starts from them)."""
         from executor.trial import Cell
 
         _PlannerNumbered = _planner_numbered_logger()
@@ -141,6 +172,20 @@ class SimBackend:
                                          send_blueprint=False)  # the planner sends it
                         if rrd is not None or viewer != NO_VIEWER else None)
         self._cell = Cell(assembly, gui=False, logger=self._logger, **cell_keywords)
+        self._assembly, self._blocked, self._cell_id = assembly, list(blocked), cell_id
+        self._runner: AssemblyRunner | None = None
+
+    def run_step(self, request: StepRequest) -> StepOutcome:
+        from executor.assembly.backend import AssemblyRunner, step_evidence
+
+        if self._runner is None:  # the assembling world is made on the first step
+            from executor.assembly.recording import AssemblyRecorder
+
+            recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
+            self._runner = AssemblyRunner(self._assembly, self._blocked, recorder)
+        record, errors = self._runner.run_step(request)
+        result: Result = "fit" if record.outcome == "fit" else "no_fit"
+        return result, step_evidence(record), errors
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
         try:
@@ -159,6 +204,8 @@ class SimBackend:
 
     def close(self) -> None:
         self._cell.close()
+        if self._runner is not None:
+            self._runner.close()
         if self._logger is not None:
             self._logger.close()
 
@@ -168,7 +215,7 @@ class _Work:
     """A valid request waiting for the cell, and when it arrived (``time.monotonic`` [s])."""
 
     query: zenoh.Query
-    request: InsertRequest
+    request: InsertRequest | StepRequest
     arrived: float
 
 
@@ -186,11 +233,11 @@ class CellNode:
         self.cell_id = cell_id
         self._backend = backend
         self._work: queue.Queue[_Work | None] = queue.Queue(maxsize=queue_size)
-        self._replies: OrderedDict[str, tuple[InsertRequest, bytes]] = OrderedDict()
+        self._replies: OrderedDict[str, tuple[InsertRequest | StepRequest, bytes]] = OrderedDict()
         self._lock = threading.Lock()
         self._stopped = threading.Event()
 
-    def _cached(self, query: zenoh.Query, request: InsertRequest) -> bytes | None:
+    def _cached(self, query: zenoh.Query, request: InsertRequest | StepRequest) -> bytes | None:
         """The cached reply of this very request; refuses a reused id (then returns b"")."""
         with self._lock:
             cached = self._replies.get(request.id)
@@ -209,10 +256,17 @@ class CellNode:
         query.reply(query.key_expr, encode(reply))
 
     def on_query(self, query: zenoh.Query) -> None:
-        """Zenoh-thread callback: refuse bad requests, answer repeats, queue new work."""
+        """Zenoh-thread callback of ``insert``: refuse bad requests, answer repeats, queue new work."""
+        self._accept(query, decode_request)
+
+    def on_step_query(self, query: zenoh.Query) -> None:
+        """Zenoh-thread callback of ``step``, as :meth:`on_query`."""
+        self._accept(query, decode_step_request)
+
+    def _accept(self, query: zenoh.Query, decode: Callable[[bytes], InsertRequest | StepRequest]) -> None:
         payload = query.payload.to_bytes() if query.payload is not None else b""
         try:
-            request = decode_request(payload)
+            request = decode(payload)
         except MessageError as exc:
             self._refuse(query, exc.code, str(exc))
             return
@@ -226,6 +280,17 @@ class CellNode:
         except queue.Full:
             self._refuse(query, "busy", f"{self._work.maxsize} requests are waiting; send it again later",
                          request.id)
+
+    def _answer(self, request: InsertRequest | StepRequest, started: float) -> InsertReply | StepReply:
+        """Run the request on the backend; the reply (an insert reply in the request's version)."""
+        if isinstance(request, StepRequest):
+            result, step_evidence, errors = self._backend.run_step(request)
+            return StepReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=result,
+                             evidence=step_evidence, pose_errors_mm=tuple(sorted(errors.items())),
+                             wall_s=time.perf_counter() - started)
+        outcome, evidence = self._backend.run(request)
+        return InsertReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=outcome,
+                           evidence=evidence, wall_s=time.perf_counter() - started, v=request.v)
 
     def stop(self) -> None:
         """Make :meth:`serve` return after the experiment in progress (any thread; never blocks)."""
@@ -250,17 +315,17 @@ class CellNode:
                 query.reply(query.key_expr, cached)
             query.drop()  # finalises the query: the planner need not wait for its timeout
 
-    def _run(self, query: zenoh.Query, request: InsertRequest) -> bytes | None:
-        print(f"start {request.id} {request.part} {request.hole} {request.experiment}", flush=True)
+    def _run(self, query: zenoh.Query, request: InsertRequest | StepRequest) -> bytes | None:
+        number = request.experiment if isinstance(request, InsertRequest) else f"step {request.step}"
+        print(f"start {request.id} {request.part} {request.hole} {number}", flush=True)
         started = time.perf_counter()
         try:
-            result, evidence = self._backend.run(request)
+            message = self._answer(request, started)
         except ExecutorError as exc:
             code: ErrorCode = "unknown_id" if isinstance(exc, UnknownPair) else "failed"
             self._refuse(query, code, str(exc), request.id)
             return None
-        reply = encode(InsertReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole,
-                                   result=result, evidence=evidence, wall_s=time.perf_counter() - started))
+        reply, result = encode(message), message.result
         with self._lock:
             self._replies[request.id] = (request, reply)
             while len(self._replies) > CACHE_SIZE:
@@ -302,6 +367,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
     parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
     add_viewer_arguments(parser, serve=False)  # a cell serves for as long as it runs: stream to a viewer
+    parser.add_argument("--block-hole", action="append", default=[], metavar="H",
+                        help="put an obstacle in hole H for plan steps (a fault injection; repeatable)")
     parser.add_argument("--lifeline", action="store_true",
                         help="exit when standard input closes (set by a supervising session)")
     parser.add_argument("--ilc-state", type=Path, metavar="FILE",
@@ -315,9 +382,10 @@ def build_parser() -> argparse.ArgumentParser:
 def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
     """The backend ``--backend`` names: the simulator, the geometry's truth or a user class."""
     if args.backend == "truth":
-        return TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args))
+        return TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args),
+                            args.block_hole)
     if args.backend == "sim":
-        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args),
+        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args), args.block_hole,
                           ilc_state=args.ilc_state, **cell_keywords(args))
     return load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
                                                   dict(args.backend_option)))
@@ -349,6 +417,7 @@ def main(argv: Sequence[str]) -> int:
         if claim.lost is not None:  # lost while the backend started
             raise ClaimLost(claim.lost)
         _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
+                     session.declare_queryable(step_key(cell_id), node.on_step_query),
                      session.declare_queryable(ping_key(cell_id), _echo),
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
         if args.lifeline:

@@ -68,8 +68,10 @@ def plans(
     optimal: bool = False,
     travel: Sequence[clingo.Symbol] = (),
     time_limit_s: float | None = None,
+    prefix: Sequence[PlanStep] = (),
 ) -> list[Plan]:
-    """Up to ``n`` complete plans (0 = all); optimal ones need the ``travel`` facts.
+    """Up to ``n`` complete plans (0 = all); optimal ones need the ``travel`` facts. With a
+    ``prefix`` (steps already done) only plans that begin with it (``plans/prefix.lp``).
 
     With ``optimal=True`` every plan returned has the least cost and clingo has proven
     it; PlannerError when that takes longer than ``time_limit_s`` [s] (None: no limit).
@@ -90,7 +92,9 @@ def plans(
     if optimal:
         entry = "plans_optimal.lp"
         arguments += ["--opt-mode=optN", f"--configuration={OPTIMAL_CONFIGURATION}"]
-    solve([entry], [*facts.atoms, *travel], arguments, keep, time_limit_s)
+    done = [fact("done", t, step.part, step.hole or "none") for t, step in enumerate(prefix, start=1)]
+    solve([entry, "plans/prefix.lp"] if prefix else [entry], [*facts.atoms, *travel, *done], arguments, keep,
+          time_limit_s)
     if not found:
         feasible_assignment(facts)  # raises UnsolvableAssembly when no assignment exists
         raise PlannerError(

@@ -100,11 +100,11 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None,
                zenoh_config: Path | None = None, viewer_url: str | None = None,
-               ilc_state: Path | None = None) -> list[str]:
+               ilc_state: Path | None = None, block_holes: Sequence[str] = ()) -> list[str]:
     """The command line of one ``executor serve`` node, with ``--lifeline``; ``viewer_url``:
     a Rerun viewer or server the cell also streams its recording to; ``ilc_state``: the
     file the sim cell keeps its learned ILC corrections in (in the run folder, so a
-    resumed session's cell starts from them)."""
+    resumed session's cell starts from them); ``block_holes``: holes with an obstacle."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
@@ -121,6 +121,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
         argv += ["--rerun-connect", viewer_url]
     if ilc_state is not None and backend == "sim":
         argv += ["--ilc-state", str(Path(ilc_state).absolute())]
+    argv += [arg for hole in block_holes for arg in ("--block-hole", hole)]
     return argv
 
 

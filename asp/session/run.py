@@ -38,6 +38,8 @@ from contextlib import ExitStack
 from datetime import UTC, datetime
 from pathlib import Path
 
+import zenoh
+
 from asp import PlannerError
 from asp.plans.assign import greedy_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
@@ -69,6 +71,8 @@ MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
 MAX_CELLS = 64
 """--cells: at most this many cell co-processes."""
+EXIT_STOPPED = 3
+"""Exit code when ``--assemble`` could not finish the product."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -102,6 +106,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--allow-cells", type=comma_list(check_cell_id, "cell ids"), metavar="ID,...",
                         help="with --cells 0: use only these cells (default: any cell that shows a token); "
                              "a session that starts its cells uses only those")
+    parser.add_argument("--assemble", action="store_true",
+                        help="then assemble the first plan in the first cell (./run.sh assemble); the JSON gains "
+                             "\"assembly\"")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     add_viewer_arguments(parser)
@@ -289,6 +296,24 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
     return assignment, found
 
 
+def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: Plan, seed: int,
+              args: argparse.Namespace) -> dict:
+    """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`); the report, with
+    ``"error"`` when the product could not be finished."""
+    from asp.assemble.driver import ZenohDriver
+    from asp.assemble.execute import AssemblyStopped, execute
+
+    if not cell_ids:
+        raise PlannerError("--assemble needs a cell of this session (--cells 1 or more)")
+    started = time.perf_counter()
+    try:
+        report = execute(load_learned_facts([learned]), plan, ZenohDriver(session, cell_ids[0], seed, args.timeout))
+    except AssemblyStopped as exc:
+        report = dict(exc.report, error=str(exc))
+    report["wall_s"] = round(time.perf_counter() - started, 3)
+    return report
+
+
 def run_session(args: argparse.Namespace, viewer: Viewer = NO_VIEWER) -> dict:
     """Run (or resume) a session; returns the JSON result. Planner and cells also stream
     their recordings live to ``viewer``."""
@@ -367,6 +392,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
                     header="The greedy hole assignment (paper 2.2) of learned.lp.")
         log.assignment(assignment)
+        assembly_report = (_assemble(session, cell_ids, learned, found[0], settings["seed"], args)
+                           if args.assemble else None)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
     versus = _versus_truth(truth, required, fits, must_precede)
@@ -385,6 +412,9 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
                               "retest": e.retest} for e in journal.entries],
                     wall_s=round(time.perf_counter() - started, 3),
                     timings={k: round(v, 3) for k, v in timings.items()})
+    if assembly_report is not None:
+        settings["assembly_run"] = assembly_report  # "assembly" in session.json names the assembly
+        result["assembly"] = assembly_report
     _save(run, settings)
     return result
 
@@ -394,6 +424,13 @@ def _program() -> str:
     from any folder) in a checkout, else the installed console command."""
     wrapper = Path(__file__).resolve().parents[2] / "run.sh"
     return shlex.quote(str(wrapper)) if wrapper.is_file() else PROGRAM
+
+
+def _assembly_line(report: dict) -> str:
+    errors = report["final_pose_error_mm"]
+    worst = max(errors.values(), default=0.0)
+    return (f"assembly of plan 1: assembled {report['assembled']}, {len(report['steps'])} steps, "
+            f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
 
 
 def _summary(result: dict, run: Path) -> str:
@@ -420,6 +457,7 @@ def _summary(result: dict, run: Path) -> str:
         f"precedence learned {settings['truth']['precedence_sound']} "
         f"({settings['truth']['precedence_extra']} pairs more than required); "
         f"matches truth: {result['matches_truth']}",
+        *([_assembly_line(result["assembly"])] if "assembly" in result else []),
         f"files written in {run}: {' '.join(files)}",
         "next:",
         *(f"  {label + ':':<24}{command}" for label, command in (
@@ -440,4 +478,8 @@ def main(argv: list[str]) -> int:
             keep_serving(viewer)
     except BridgeError as exc:
         raise PlannerError(str(exc)) from None
+    stopped = result.get("assembly", {}).get("error")
+    if stopped:
+        LOG.error("%s", stopped)
+        return EXIT_STOPPED
     return 0

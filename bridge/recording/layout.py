@@ -6,7 +6,8 @@ has the planner's tab (knowledge matrix, graphs, assignment, experiment log), th
 tab per cell: the 3D scene (static geometry, tool path, search path) above the
 outcome log, next to force and torque (measured vs desired over ``sim_time``), the
 deviations of eqs. 6 and 7, and the force over the DMP phase (paper Fig. 17: switch
-the time panel to the ``dmp_phase`` timeline).
+the time panel to the ``dmp_phase`` timeline); and one assembly tab per cell (the parts
+and the arm moving over ``sim_time``, the plan steps, the force).
 """
 
 from __future__ import annotations
@@ -22,6 +23,25 @@ PLANNER_ROOT = "planner"
 def cell_root(cell_id: str) -> str:
     """Entity root of one cell's log: ``executor/<cell_id>``."""
     return f"executor/{cell_id}"
+
+
+def assembly_root(cell_id: str) -> str:
+    """Entity root of a cell's assembly (plan execution): ``executor/<cell_id>/assembly``."""
+    return f"{cell_root(cell_id)}/assembly"
+
+
+def assembly_views(cell_id: str) -> rrb.Container:
+    """A cell's assembly tab: parts and arm in 3D, the plan steps, the measured force."""
+    root = assembly_root(cell_id)
+    return rrb.Horizontal(
+        rrb.Spatial3DView(origin=root, name=f"{cell_id}: assembly", contents=["$origin/parts/**", "$origin/arm"]),
+        rrb.Vertical(
+            rrb.TextLogView(origin=f"{root}/steps", name="plan steps (timeline plan_step)"),
+            rrb.TimeSeriesView(origin=f"{root}/force", name="force at the TCP [N] over sim_time"),
+        ),
+        column_shares=[2, 1],
+        name=f"{cell_id} assembly",
+    )
 
 
 def planner_views() -> rrb.Container:
@@ -72,7 +92,7 @@ def cell_views(cell_id: str) -> rrb.Container:
 
 def cell_blueprint(cell_ids: Sequence[str], extra: Sequence[rrb.Container] = ()) -> rrb.Blueprint:
     """A blueprint with one tab per cell (plus ``extra`` containers, e.g. the planner's)."""
-    tabs = [*extra, *(cell_views(cell_id) for cell_id in cell_ids)]
+    tabs = [*extra, *(cell_views(cell_id) for cell_id in cell_ids), *(assembly_views(c) for c in cell_ids)]
     return rrb.Blueprint(
         rrb.Tabs(*tabs), rrb.TimePanel(timeline="sim_time"), collapse_panels=False
     )

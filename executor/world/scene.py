@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import pybullet as pb
@@ -54,7 +55,7 @@ class Scene:
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=self.client)
         plate_obj = plate_mesh(geometry)
         self.floor = pb.loadURDF("plane.urdf", physicsClientId=self.client)
-        self.plate = self._load_plate(plate_obj)
+        self.plate = load_plate(self.client, geometry, plate_obj)
         self.tray_parts = {
             pid: pb.loadURDF(
                 str(geometry.assets / f"part_{spec.shape}.urdf"),
@@ -73,28 +74,6 @@ class Scene:
                                      flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                                      physicsClientId=self.client)
         self.held: str | None = None
-
-    def _load_plate(self, plate_obj: Path) -> int:
-        """Static plate: a box under the bosses plus the concave trimesh of the bosses."""
-        plate = self.geometry.plate
-        boss_bottom = plate["top_z"] - plate["tile_thickness"]
-        (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
-        half = (sx / 2, sy / 2, boss_bottom / 2)
-        base_col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.client)
-        base_vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=(0.55, 0.6, 0.65, 1),
-                                        physicsClientId=self.client)
-        mesh_col = pb.createCollisionShape(pb.GEOM_MESH, fileName=str(plate_obj),
-                                           flags=pb.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=self.client)
-        mesh_vis = pb.createVisualShape(pb.GEOM_MESH, fileName=str(plate_obj), rgbaColor=(0.7, 0.72, 0.75, 1),
-                                        physicsClientId=self.client)
-        return pb.createMultiBody(
-            baseMass=0, baseCollisionShapeIndex=mesh_col, baseVisualShapeIndex=mesh_vis,
-            linkMasses=[0], linkCollisionShapeIndices=[base_col], linkVisualShapeIndices=[base_vis],
-            linkPositions=[(cx, cy, boss_bottom / 2)], linkOrientations=[(0, 0, 0, 1)],
-            linkInertialFramePositions=[(0, 0, 0)], linkInertialFrameOrientations=[(0, 0, 0, 1)],
-            linkParentIndices=[0], linkJointTypes=[pb.JOINT_FIXED], linkJointAxis=[(0, 0, 1)],
-            physicsClientId=self.client,
-        )
 
     def set_friction(self, coefficient: float | None) -> None:
         """Make the Coulomb friction coefficient between the held part and the plate
@@ -125,6 +104,36 @@ class Scene:
     def close(self) -> None:
         if pb.isConnected(self.client):
             pb.disconnect(self.client)
+
+
+def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,
+               deck: Sequence[tuple[float, float, float, float]] = ()) -> int:
+    """Static plate: a box under the bosses plus the concave trimesh of the bosses, and
+    optionally ``deck`` boxes ([xmin, ymin, xmax, ymax] [m]) filling the space between the
+    bosses up to the plate top (a flat top for parts lying on the plate)."""
+    plate = geometry.plate
+    boss_bottom = plate["top_z"] - plate["tile_thickness"]
+    (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
+    boxes = [((sx / 2, sy / 2, boss_bottom / 2), (cx, cy, boss_bottom / 2), (0.55, 0.6, 0.65, 1))]
+    deck_half = plate["tile_thickness"] / 2
+    boxes += [(((x1 - x0) / 2, (y1 - y0) / 2, deck_half), ((x0 + x1) / 2, (y0 + y1) / 2, boss_bottom + deck_half),
+               (0.62, 0.66, 0.7, 1)) for x0, y0, x1, y1 in deck]
+    cols = [pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=client) for half, _, _ in boxes]
+    vis = [pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=rgba, physicsClientId=client)
+           for half, _, rgba in boxes]
+    mesh_col = pb.createCollisionShape(pb.GEOM_MESH, fileName=str(plate_obj),
+                                       flags=pb.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=client)
+    mesh_vis = pb.createVisualShape(pb.GEOM_MESH, fileName=str(plate_obj), rgbaColor=(0.7, 0.72, 0.75, 1),
+                                    physicsClientId=client)
+    n = len(boxes)
+    return pb.createMultiBody(
+        baseMass=0, baseCollisionShapeIndex=mesh_col, baseVisualShapeIndex=mesh_vis,
+        linkMasses=[0] * n, linkCollisionShapeIndices=cols, linkVisualShapeIndices=vis,
+        linkPositions=[centre for _, centre, _ in boxes], linkOrientations=[(0, 0, 0, 1)] * n,
+        linkInertialFramePositions=[(0, 0, 0)] * n, linkInertialFrameOrientations=[(0, 0, 0, 1)] * n,
+        linkParentIndices=[0] * n, linkJointTypes=[pb.JOINT_FIXED] * n, linkJointAxis=[(0, 0, 1)] * n,
+        physicsClientId=client,
+    )
 
 
 def scene_shapes(geometry: CellGeometry) -> list[tuple]:

@@ -69,3 +69,21 @@ def test_keys() -> None:
     assert cell_of_alive_key("cell/c1/insert") is None
     with pytest.raises(BridgeError, match="cell id"):
         insert_key("C/1")
+
+
+def test_step_messages_round_trip_and_need_version_3() -> None:
+    from bridge.messages import StepEvidence, StepReply, StepRequest, decode_step_request
+
+    request = StepRequest(id="run-7-2", assembly="run-7", step=2, part="sp", hole=None, seed=3)
+    assert decode_step_request(encode(request)) == request
+    reply = StepReply(id=request.id, cell="c1", part="sp", hole=None, result="fit",
+                      evidence=StepEvidence(skill="insert_over", attempts=1, max_force_dev=4.0, max_torque_dev=0.1,
+                                            duration_s=2.0, sim_time_s=5.0, pose_error_mm=1.2),
+                      pose_errors_mm=(("bp", 0.0), ("sp", 1.2)))
+    assert decode_reply(encode(reply)) == reply
+    hash(reply)  # a reply is compared and de-duplicated by the client
+    with pytest.raises(MessageError) as old:
+        decode_step_request(b'{"kind":"step","id":"a","assembly":"r","step":1,"part":"p1","v":2}')
+    assert old.value.code == "version"
+    # Insert messages did not change in version 3: a version-2 insert request is still served.
+    assert decode_request(b'{"kind":"insert","id":"a","part":"p1","hole":"r1","v":2}').v == 2

@@ -1,0 +1,189 @@
+"""``./run.sh assemble``: execute one plan step by step in a simulated cell, monitored.
+
+    ./run.sh assemble [--run RUN [--plan K] | PLAN.json [FACTS.lp ...] | FACTS.lp ...]
+                      [--assembly A] [--seed S] [--block-hole H] [--rrd FILE] [--json]
+
+The plan: plan K (default 1) of a session's run folder (``RUN/session.json``, facts
+``RUN/learned.lp``), a plan JSON file (``[{"part", "hole"}, ...]``, ``{"plan": [...]}`` or
+the ``{"plans": [...]}`` of ``plan --json``), or plan K of learned facts files; with none
+of these, plan K of the assembly's true facts (``sizes.lp``, ``precedence.lp``).
+Re-planning after a failed step uses the same facts.
+
+The planner starts one cell (``executor serve``) on loopback and sends it one step
+request per plan step over Zenoh (:mod:`asp.assemble.driver`); the cell keeps its world
+between steps.  JSON (``--json``): ``{"plan", "steps": [{"part", "hole", "skill",
+"outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled",
+"final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
+Exit code 3 when the product cannot be finished (e.g. no hole left for a part).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from asp import PlannerError
+from asp.assemble.driver import ZenohDriver
+from asp.assemble.execute import AssemblyStopped, execute
+from asp.plans.assign import LearnedFacts, load_learned_facts
+from asp.plans.plans import Plan, PlanStep, check_plan, plans
+from asp.precedence.relation import true_relation
+from asp.session.cells import start_cell
+from asp.solve import fact
+from bridge.assembly import Assembly, load_assembly
+from bridge.cli_types import MAX_SEED, ArgumentParser, finite_float, int_in
+from bridge.client import CellDirectory
+from bridge.inputs import read_bytes
+from bridge.session import add_endpoint_arguments, free_loopback_endpoint, open_session
+
+EXIT_STOPPED = 3
+"""Exit code when the product cannot be finished (bad input exits with 2)."""
+CELL_ID = "a1"
+CELL_START_S = 60.0
+"""How long the started cell may take to show its liveliness token [s]."""
+MAX_PLAN_INDEX = 1000
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = ArgumentParser(prog="assemble", description=__doc__.split("\n\n")[0])
+    parser.add_argument("inputs", nargs="*", type=Path, metavar="PLAN.json|FACTS.lp",
+                        help="a plan JSON file and/or learned facts files (default: the assembly's true facts)")
+    parser.add_argument("--run", type=Path, metavar="RUN", help="a session's run folder: its plans and learned facts")
+    parser.add_argument("--plan", type=int_in(1, MAX_PLAN_INDEX), default=1, metavar="K",
+                        help="which plan (1-based, default 1)")
+    parser.add_argument("--assembly", help="assembly (default: the run's, else cranfield)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the cell's random grasp, "
+                        "vision and search errors (default 0)")
+    parser.add_argument("--block-hole", action="append", default=[], metavar="H",
+                        help="put an obstacle in hole H (fault injection; repeatable)")
+    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
+                        help="the cell: sim (PyBullet, default) or truth (geometry rule, no simulation)")
+    parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
+                        help="one step at the cell (default 300)")
+    parser.add_argument("--rrd", type=Path, metavar="FILE", help="save the cell's Rerun recording to FILE")
+    parser.add_argument("--json", action="store_true", help="print the JSON result")
+    add_endpoint_arguments(parser)
+    return parser
+
+
+def truth_facts(assembly: Assembly) -> LearnedFacts:
+    """The assembly's true sizes and precedence as learned facts (``must_precede`` closed)."""
+    facts = load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
+    closed = true_relation(assembly).pairs()
+    return replace(facts, atoms=(*facts.atoms, *(fact("must_precede", a, b) for a, b in closed)),
+                   must_precede=frozenset(closed))
+
+
+def read_plan_json(path: Path, k: int) -> Plan:
+    """Plan ``k`` of a plan JSON file; PlannerError naming the file and what was expected."""
+    try:
+        data = json.loads(read_bytes(path, "plan file (JSON)", error=PlannerError))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise PlannerError(f"{path}: not valid JSON ({exc})") from None
+    if isinstance(data, dict):
+        many = data.get("plans")
+        data = data.get("plan") or (many[k - 1] if isinstance(many, list) and len(many) >= k else None)
+    ok = isinstance(data, list) and data and all(isinstance(s, dict) and isinstance(s.get("part"), str)
+                                                 and isinstance(s.get("hole", None), (str, type(None))) for s in data)
+    if not ok:
+        raise PlannerError(f"{path}: expected a plan [{{\"part\": P, \"hole\": H|null}}, ...], {{\"plan\": [...]}} "
+                           f"or {{\"plans\": [[...], ...]}} with at least {k} plan(s)")
+    return Plan(tuple(PlanStep(s["part"], s.get("hole")) for s in data))
+
+
+def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
+    """The assembly, the facts for re-planning and the plan to execute."""
+    jsons = [p for p in args.inputs if p.suffix == ".json"]
+    lps = [p for p in args.inputs if p.suffix != ".json"]
+    if len(jsons) > 1 or (args.run is not None and args.inputs):
+        raise PlannerError("expected --run RUN, or one PLAN.json with optional FACTS.lp files, or FACTS.lp files")
+    name = args.assembly
+    plan: Plan | None = None
+    if args.run is not None:
+        settings_path = args.run / "session.json"
+        try:
+            settings = json.loads(read_bytes(settings_path, "session settings (JSON)", error=PlannerError))
+            found = settings["plans"]
+            name = name or settings["assembly"]
+        except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError):
+            raise PlannerError(f"{settings_path}: expected the session.json of a finished session "
+                               "(with \"plans\" and \"assembly\")") from None
+        if not isinstance(found, list) or len(found) < args.plan:
+            raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {len(found)} plan(s)")
+        plan = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in found[args.plan - 1]))
+        lps = [args.run / "learned.lp"]
+    assembly = load_assembly(name or "cranfield")
+    unknown = [hole for hole in args.block_hole if hole not in assembly.hole_ids]
+    if unknown:
+        raise PlannerError(f"--block-hole {unknown[0]}: expected a hole of {assembly.name} "
+                           f"({', '.join(assembly.hole_ids)})")
+    facts = load_learned_facts(lps) if lps else truth_facts(assembly)
+    if jsons:
+        plan = read_plan_json(jsons[0], args.plan)
+    if plan is None:
+        found_plans = plans(facts, n=args.plan)
+        if len(found_plans) < args.plan:
+            raise PlannerError(f"--plan {args.plan}: the facts admit only {len(found_plans)} plan(s)")
+        plan = found_plans[args.plan - 1]
+    errors = check_plan(facts, plan.steps)
+    if errors:
+        raise PlannerError(f"the plan {' '.join(s.part for s in plan.steps)} is not valid for the facts: "
+                           + ", ".join(errors))
+    return assembly, facts, plan
+
+
+def _summary(report: dict) -> str:
+    lines = []
+    for k, step in enumerate(report["steps"], start=1):
+        lines.append(f"{k}: {step['part']}" + (f"->{step['hole']}" if step["hole"] else "")
+                     + f" {step['skill']}: {step['outcome']} ({step['attempts']} attempt(s), "
+                     f"{step['duration_s']:.1f} s, max force dev {step['max_force_dev']:.1f} N)")
+    for replan in report["replans"]:
+        lines.append(f"re-plan at step {replan['step']}: {replan['reason']}; new plan "
+                     + " ".join(s["part"] + (f"->{s['hole']}" if s["hole"] else "") for s in replan["plan"]))
+    errors = report["final_pose_error_mm"]
+    if errors:
+        worst = max(errors, key=lambda p: errors[p])
+        lines.append(f"pose errors: largest {errors[worst]:.2f} mm ({worst})")
+    lines.append(f"assembled: {report['assembled']} in {report['wall_s']:.1f} s")
+    return "\n".join(lines)
+
+
+def assemble(args: argparse.Namespace) -> tuple[dict, int]:
+    """Start the cell, run the plan; (report, exit code)."""
+    started = time.perf_counter()
+    assembly, facts, plan = resolve(args)
+    listen = args.listen or [free_loopback_endpoint()]
+    session = open_session(listen, args.connect, args.zenoh_config)
+    try:
+        directory = CellDirectory(session)
+        cell = start_cell(CELL_ID, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
+                          rrd=args.rrd, zenoh_config=args.zenoh_config, block_holes=args.block_hole)
+        try:
+            # Its queryables reach us with its liveliness token: a step sent before might find no one.
+            directory.wait_for(1, timeout=CELL_START_S)
+            driver = ZenohDriver(session, CELL_ID, args.seed, args.timeout)
+            try:
+                report, code = execute(facts, plan, driver), 0
+            except AssemblyStopped as exc:
+                report, code = dict(exc.report, error=str(exc)), EXIT_STOPPED
+        finally:
+            cell.stop()
+            directory.close()
+    finally:
+        session.close()
+    report["wall_s"] = round(time.perf_counter() - started, 3)
+    return report, code
+
+
+def main(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    report, code = assemble(args)
+    print(json.dumps(report) if args.json else _summary(report))
+    if code == EXIT_STOPPED:
+        print(f"error: {report['error']}", file=sys.stderr)
+    return code

@@ -1,0 +1,67 @@
+"""Plan steps served over Zenoh (``executor serve``): the :class:`Assembler` of the current
+plan run, kept between its steps; a request of another run (``assembly`` id) starts a
+fresh world with every part on the tray.  Holes blocked with ``--block-hole`` get their
+obstacle in every fresh world."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from bridge.messages import StepEvidence, StepRequest
+from executor import ExecutorError
+from executor.assembly.product import Product, load_product
+from executor.assembly.step import Assembler, StepRecord
+
+if TYPE_CHECKING:
+    from executor.assembly.recording import AssemblyRecorder
+
+
+def step_evidence(record: StepRecord) -> StepEvidence:
+    """The bridge form of a step record."""
+    return StepEvidence(skill=record.skill, attempts=record.attempts, max_force_dev=record.max_force_dev,
+                        max_torque_dev=record.max_torque_dev, duration_s=record.duration_s,
+                        sim_time_s=record.sim_time_s, pose_error_mm=record.pose_error * 1000.0)
+
+
+class AssemblyRunner:
+    """One assembling world at a time, keyed by the plan run's id."""
+
+    def __init__(self, assembly: str, blocked: Sequence[str] = (), recorder: AssemblyRecorder | None = None) -> None:
+        self.product: Product = load_product(assembly)
+        self.blocked = list(blocked)
+        for hole in self.blocked:
+            if hole not in self.product.geometry.holes:
+                raise ExecutorError(f"--block-hole {hole}: expected a hole of the plate "
+                                    f"({', '.join(sorted(self.product.geometry.holes))})")
+        self.recorder = recorder
+        self._run: str | None = None
+        self._assembler: Assembler | None = None
+
+    def assembler(self, run: str) -> Assembler:
+        """The world of plan run ``run`` (a fresh one for a new run)."""
+        if self._assembler is None or run != self._run:
+            self.close()
+            self._assembler = Assembler(self.product, self.recorder)
+            if self.recorder is not None:
+                self.recorder.attach(self._assembler.world)
+            for hole in self.blocked:
+                self._assembler.block_hole(hole)
+            self._run = run
+        return self._assembler
+
+    def run_step(self, request: StepRequest) -> tuple[StepRecord, dict[str, float]]:
+        """Carry out the step; the record and every placed part's distance from its goal [mm]."""
+        assembler = self.assembler(request.assembly)
+        record = assembler.run_step(request.part, request.hole, request.seed)
+        errors = assembler.pose_errors()
+        if self.recorder is not None:
+            self.recorder.log_plan_step(record.part, record.hole, record.outcome, record.attempts,
+                                        record.pose_error * 1000.0)
+            self.recorder.flush()
+        return record, {part: errors[part] * 1000.0 for part in sorted(assembler.placed)}
+
+    def close(self) -> None:
+        if self._assembler is not None:
+            self._assembler.close()
+            self._assembler = None

@@ -1,0 +1,62 @@
+"""The grasp: a fixed constraint between the gripper tool and the part, made at pick and
+released once the part is placed (it then rests on its own contacts).
+
+The constraint holds the part at its nominal grip pose composed with a random grasp
+error (≤ 1 mm lateral offset, ≤ 1° tilt, as in the single trials): the robot believes the
+nominal pose, so the skills meet a real, unknown error.  The back plate is a static
+(fixed-base) body: while held it is moved kinematically with the tool instead.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+
+from executor.assembly.world import AssemblyWorld
+from executor.skills.insertion import rotvec_quat_xyzw
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+
+GRASP_FORCE = 500.0  # [N] the constraint's maximum force
+
+
+class Grasp:
+    """A part in the gripper; :meth:`follow` moves a kinematic (base) part with the tool."""
+
+    def __init__(self, world: AssemblyWorld, part: str, offset: np.ndarray, tilt: np.ndarray) -> None:
+        self.world, self.part = world, part
+        frames = world.frames[part]
+        c = world.client
+        # Part body in the tool frame: tool at the grip point, pointing down; the grasp error on top.
+        tool_in_part = (list(frames.grip), list(TOOL_DOWN_QUAT_XYZW))
+        body_pos, body_quat = pb.invertTransform(*tool_in_part)
+        self.body_in_tool = pb.multiplyTransforms(list(offset), list(rotvec_quat_xyzw(tilt)), body_pos, body_quat)
+        self.kinematic = part == world.product.base.id
+        self.constraint: int | None = None
+        if not self.kinematic:
+            # Constraint frames are relative to the links' centres of mass.
+            tool_com = np.array(pb.getDynamicsInfo(world.robot, world.tool_link, physicsClientId=c)[3])
+            part_com = np.array(pb.getDynamicsInfo(frames.body, -1, physicsClientId=c)[3])
+            self.constraint = pb.createConstraint(
+                world.robot, world.tool_link, frames.body, -1, pb.JOINT_FIXED, (0, 0, 0),
+                parentFramePosition=list(np.array(self.body_in_tool[0]) - tool_com),
+                childFramePosition=list(-part_com),
+                parentFrameOrientation=self.body_in_tool[1], physicsClientId=c)
+            pb.changeConstraint(self.constraint, maxForce=GRASP_FORCE, physicsClientId=c)
+        # The believed TCP in the tool frame (nominal grasp): what the controller drives.
+        tcp_in_tool = pb.multiplyTransforms(body_pos, body_quat, list(frames.tcp), [0, 0, 0, 1])[0]
+        world.arm.set_grasp_error(-np.array(tcp_in_tool), np.array([0.0, 0.0, 0.0, 1.0]))
+
+    def follow(self) -> None:
+        """A kinematic part takes its place in the tool (call after each physics step)."""
+        if self.kinematic:
+            ls = pb.getLinkState(self.world.robot, self.world.tool_link, computeForwardKinematics=1,
+                                 physicsClientId=self.world.client)
+            pos, quat = pb.multiplyTransforms(ls[4], ls[5], *self.body_in_tool)
+            self.world.set_pose(self.part, np.array(pos), quat)
+
+    def release(self) -> None:
+        """Open the gripper: the part rests on its contacts; the TCP becomes the tool frame."""
+        if self.constraint is not None:
+            pb.removeConstraint(self.constraint, physicsClientId=self.world.client)
+            self.constraint = None
+        self.world.arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))

@@ -1,0 +1,108 @@
+"""Rerun recording of an assembly: every part and the arm moving over ``sim_time``, the plan
+steps on their own timeline ``plan_step``, the measured force.
+
+Entities (under ``executor/<cell-id>/assembly/``):
+
+=============================== ===================================================
+``parts/<id>``                  the part's pose (``Transform3D``) over ``sim_time``; its
+                                solid (boxes, cylinders in its frame) logged once, static
+``arm``                         the arm as a line strip through its link origins [m]
+``force``                       measured contact force at the TCP (x, y, z) [N]
+``steps``                       one text line per plan step (timelines ``plan_step``
+                                and ``sim_time``)
+=============================== ===================================================
+
+The recorder is the Motion's step logger (:class:`executor.control.motion.StepLogger`):
+it samples the world every ``period_s`` of simulated time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+import rerun as rr
+
+from bridge.recording.layout import assembly_root
+from executor.assembly.world import AssemblyWorld
+
+PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
+
+
+def _part_solids(world: AssemblyWorld, part: str) -> list[rr.AsComponents]:
+    """The part's solid in its body frame, as Rerun archetypes."""
+    p = world.product
+    color = [200, 150, 60]
+    if part == p.base.id:
+        plate = p.geometry.plate
+        (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
+        top = float(plate["top_z"])
+        return [rr.Boxes3D(half_sizes=[[sx / 2, sy / 2, top / 2]], centers=[[cx, cy, top / 2]],
+                           colors=[[150, 160, 175]], fill_mode="solid")]
+    if part in p.covers:
+        boxes = p.covers[part].boxes
+        return [rr.Boxes3D(half_sizes=[b.half for b in boxes], centers=[b.centre for b in boxes],
+                           colors=[[80, 130, 210]] * len(boxes), fill_mode="solid")]
+    if part in p.heads:
+        h = p.heads[part]
+        kind, size, length, color = h.kind, h.size, h.length, [210, 80, 80]
+    else:
+        s = p.pegs[part]
+        kind, size, length = s.kind, s.size, s.length
+    if kind == "round":
+        return [rr.Cylinders3D(radii=[size / 2], lengths=[length], centers=[[0, 0, length / 2]], colors=[color],
+                               fill_mode="solid")]
+    return [rr.Boxes3D(half_sizes=[[size / 2, size / 2, length / 2]], centers=[[0, 0, length / 2]], colors=[color],
+                       fill_mode="solid")]
+
+
+class AssemblyRecorder:
+    """Logs one assembling world into ``recording`` under the cell ``cell_id``."""
+
+    def __init__(self, recording: rr.RecordingStream, cell_id: str, period_s: float = PERIOD_S) -> None:
+        self.rec, self.root, self.period_s = recording, assembly_root(cell_id), period_s
+        self.world: AssemblyWorld | None = None
+        self._next = 0.0
+        self._offset = 0.0  # [s] sim time of the worlds before this one
+        self._step = 0
+
+    def attach(self, world: AssemblyWorld) -> None:
+        """Record ``world`` from now on (a new plan run: its sim time continues the last one's)."""
+        if self.world is not None:
+            self._offset = self._next
+        self.world = world
+        for part in world.product.parts:
+            for solid in _part_solids(world, part):
+                self.rec.log(f"{self.root}/parts/{part}", solid, static=True)
+
+    def log_step(self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
+                 force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray) -> None:
+        """Motion's step logger: a sample of every pose each ``period_s`` [s] of sim time."""
+        t = self._offset + sim_time
+        if self.world is None or t < self._next:
+            return
+        self._next = t + self.period_s
+        world, c = self.world, self.world.client
+        self.rec.set_time("sim_time", duration=t)
+        for part in world.frames:
+            pos, quat = world.pose(part)
+            self.rec.log(f"{self.root}/parts/{part}",
+                         rr.Transform3D(translation=pos, quaternion=rr.Quaternion(xyzw=list(quat))))
+        links = [pb.getBasePositionAndOrientation(world.robot, physicsClientId=c)[0]]
+        links += [pb.getLinkState(world.robot, k, physicsClientId=c)[4]
+                  for k in range(pb.getNumJoints(world.robot, physicsClientId=c))]
+        self.rec.log(f"{self.root}/arm", rr.LineStrips3D([links], radii=[0.02], colors=[[240, 120, 30]]))
+        self.rec.log(f"{self.root}/force", rr.Scalars(np.asarray(force_mes, dtype=float)))
+
+    def log_plan_step(self, part: str, hole: str | None, outcome: str, attempts: int, error_mm: float) -> None:
+        """One line per plan step on the ``plan_step`` timeline."""
+        self._step += 1
+        self.rec.set_time("plan_step", sequence=self._step)
+        self.rec.set_time("sim_time", duration=self._next)
+        into = f"->{hole}" if hole else ""
+        self.rec.log(f"{self.root}/steps", rr.TextLog(
+            f"step {self._step}: {part}{into}: {outcome} ({attempts} attempt(s), {error_mm:.2f} mm from its goal)",
+            level="INFO" if outcome == "fit" else "WARN"))
+        self.rec.reset_time()
+
+    def flush(self) -> None:
+        self.rec.flush()

@@ -1,0 +1,261 @@
+"""One plan step in the assembling cell: pick the part on the tray, carry it, place it.
+
+Per kind of part (the ``skill`` of the step's record):
+
+- ``fixture``: the back plate, carried kinematically into the fixture, whose locating pins
+  put it at its goal;
+- ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
+  then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
+- ``insert_over``: a part with openings down over the pins standing in its holes, by the
+  same insertion skill, from above the pins to its resting height, aimed at the holes'
+  centres without a search (a pin stands within half its hole's clearance of the centre,
+  closer than the robot's own reading of where it inserted it, which carries that peg's
+  unknown grasp offset; a spiral search fails on a long part tilting on the pin tops);
+- ``insert_socket``: a head into the socket of its part, wherever that part is; it stays
+  fixed to it from then on (screwed).
+
+A failed attempt (the goal check fails) lifts the part and tries again with a fresh
+vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
+``no_fit``.  Placed parts stay where they are.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as pb
+
+from executor import ExecutorError
+from executor.assembly.grasp import Grasp
+from executor.assembly.product import Product
+from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
+from executor.assembly.world import AssemblyWorld
+from executor.control.admittance import Admittance
+from executor.control.detector import Detector, Thresholds
+from executor.control.motion import StepLogger
+from executor.evidence import AttemptSetup
+from executor.skills.dmp import Skill, load_skill
+from executor.skills.insertion import insert
+from executor.skills.search import hole_search
+from executor.trial import APPROACH_HEIGHT, SETTLE_TIME, trial_rng
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.world.perturbation import CellBias, PerturbationModel
+
+ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
+RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
+GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
+ASSEMBLY_UNCERTAINTY = PerturbationModel(
+    grasp_offset_bias=0.0, grasp_offset_random=0.001, grasp_tilt_bias=0.0, grasp_tilt_random=1.0,
+    vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
+"""The assembling cell's uncertainty per execution: a grasp offset ≤ 1 mm and tilt ≤ 1°,
+a vision error σ 1.5 mm (≤ 3 mm), the teaching friction; random parts only (the single
+trials' systematic errors and ILC are not used when assembling yet)."""
+FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
+
+
+@dataclass
+class StepRecord:
+    """What one plan step did: ``outcome`` fit/no_fit, attempts, wall time [s], largest
+    force deviation [N] of the insertions, distance of the part from its goal [m] after
+    the step, simulated time [s], whether the hole search found the hole (pegs)."""
+
+    part: str
+    hole: str | None
+    skill: str
+    outcome: str
+    attempts: int
+    duration_s: float
+    max_force_dev: float
+    max_torque_dev: float
+    pose_error: float
+    sim_time_s: float
+
+    def to_json(self) -> dict:
+        return {"part": self.part, "hole": self.hole, "skill": self.skill, "outcome": self.outcome,
+                "attempts": self.attempts, "duration_s": self.duration_s, "max_force_dev": self.max_force_dev,
+                "max_torque_dev": self.max_torque_dev, "pose_error_mm": self.pose_error * 1000.0,
+                "sim_time_s": self.sim_time_s}
+
+
+class Assembler:
+    """The assembling cell: one :class:`AssemblyWorld` kept between steps."""
+
+    def __init__(self, product: Product, logger: StepLogger | None = None,
+                 thresholds: Thresholds | None = None) -> None:
+        self.product = product
+        self.world = AssemblyWorld(product, logger)
+        self.thresholds = Thresholds() if thresholds is None else thresholds
+        self._skills: dict[str, Skill] = {}
+        self.placed: set[str] = set()
+        self._screwed: dict[str, int] = {}
+        self.blocked: set[str] = set()
+        self._uncertainty = CellBias(ASSEMBLY_UNCERTAINTY, 0)
+
+    def skill_of(self, part: str) -> str:
+        """The step's skill: fixture, insert, insert_over or insert_socket."""
+        p = self.product
+        if part == p.base.id:
+            return "fixture"
+        if part in p.pegs:
+            return "insert"
+        if part in p.covers:
+            return "insert_over"
+        if part in p.heads:
+            return "insert_socket"
+        raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(p.parts)})")
+
+    def _skill(self, name: str) -> Skill:
+        if name not in self._skills:
+            self._skills[name] = load_skill(self.product.folder, name)
+        return self._skills[name]
+
+    def block_hole(self, hole: str) -> None:
+        """An obstacle in ``hole`` (a fault injection): a box filling it from the bottom up to
+        5 mm under the plate top, so no peg reaches its goal there."""
+        spec = self.product.geometry.holes.get(hole)
+        if spec is None:
+            holes = ", ".join(sorted(self.product.geometry.holes))
+            raise ExecutorError(f"unknown hole '{hole}' (expected one of {holes})")
+        plate = self.product.geometry.plate
+        depth = float(plate["tile_thickness"]) - 0.005
+        half = [spec.size / 2 - 0.0002, spec.size / 2 - 0.0002, depth / 2]
+        col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.world.client)
+        bottom = self.product.top_z - float(plate["tile_thickness"])
+        pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], physicsClientId=self.world.client)
+        self.blocked.add(hole)
+
+    def run_step(self, part: str, hole: str | None, seed: int, max_attempts: int = 2) -> StepRecord:
+        """Place ``part`` (into ``hole`` for a peg); ExecutorError for an unknown id, a peg
+        without a hole or a part already placed."""
+        skill = self.skill_of(part)
+        if skill == "insert" and hole not in self.product.geometry.holes:
+            raise ExecutorError(f"peg '{part}' needs a hole of the plate, got {hole!r}")
+        if part in self.placed:
+            raise ExecutorError(f"part '{part}' is already placed")
+        world, motion = self.world, self.world.motion
+        wall0, sim0 = time.perf_counter(), motion.steps
+        rng = trial_rng(seed, part, hole or "none")
+        if skill == "insert" and hole is not None:
+            world.set_peg_goal(part, hole)
+        setup = self._uncertainty.draw(rng, part, hole or part)
+        grasp = self._pick(part, setup)
+        if skill == "fixture":
+            carry(motion, world.frames[part].grip, grasp.follow)
+            world.set_pose(part, world.goals[part])  # the fixture's locating pins
+            outcomes = [(True, 0.0, 0.0)]
+        else:
+            outcomes = []
+            for attempt in range(max_attempts):
+                if attempt:
+                    setup = self._uncertainty.draw(rng, part, hole or part)
+                outcomes.append(self._insert(part, hole, skill, setup, grasp))
+                if outcomes[-1][0]:
+                    break
+                here = motion.controller.arm.read().tip_pos
+                move_line(motion, here + np.array([0.0, 0.0, 0.04]), tolerance=VIA_TOLERANCE)
+        ok = outcomes[-1][0]
+        if not ok:  # back to the tray
+            carry(motion, world.tray_position(part) + world.frames[part].tcp + np.array([0.0, 0.0, 0.002]))
+        grasp.release()
+        here = motion.controller.arm.read().tip_pos
+        move_line(motion, here + np.array([0.0, 0.0, RETREAT]), tolerance=VIA_TOLERANCE)
+        if ok:
+            self.placed.add(part)
+            self._screw(part)
+            if skill == "insert":
+                world.lock(part)
+        world.rest()
+        error = world.goal_error(part) if ok else float(np.linalg.norm(world.position(part) - world.goals[part]))
+        return StepRecord(part, hole, skill, "fit" if ok else "no_fit", len(outcomes), time.perf_counter() - wall0,
+                          max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
+                          (motion.steps - sim0) * 0.001)
+
+    def _pick(self, part: str, setup: AttemptSetup) -> Grasp:
+        """Carry the empty tool to the part's grip point and close the gripper."""
+        world = self.world
+        world.arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+        pos, quat = world.pose(part)
+        grip = np.array(pb.multiplyTransforms(list(pos), list(quat), list(world.frames[part].grip), [0, 0, 0, 1])[0])
+        carry(world.motion, grip, tolerance=GRIP_TOLERANCE)
+        if part in self.product.covers:  # a flat part lies against the palm, centred by the fingers
+            return Grasp(world, part, FLAT_GRASP_OFFSET * setup.grasp_offset, np.zeros(3))
+        return Grasp(world, part, setup.grasp_offset, setup.grasp_tilt)
+
+    def _goal_tcp(self, part: str, skill: str) -> np.ndarray:
+        """Where the TCP is when the part is placed [m] (a head: in its part's socket now)."""
+        world = self.world
+        if skill == "insert_socket":
+            into = self.product.heads[part].into
+            return world.position(into) + world.socket_offset[part] + world.frames[part].tcp
+        return world.goals[part] + world.frames[part].tcp
+
+    def _approach(self, part: str, skill: str, goal: np.ndarray) -> np.ndarray:
+        """Where the insertion starts [m]: above the hole (pegs), above the pin tops
+        (covers), above the socket (heads)."""
+        p = self.product
+        if skill == "insert":
+            return np.array([goal[0], goal[1], p.top_z + APPROACH_HEIGHT])
+        if skill == "insert_over":
+            plate = p.geometry.plate
+            pins_top = p.top_z + max(s.length for s in p.pegs.values()) - float(plate["tile_thickness"])
+            return np.array([goal[0], goal[1], pins_top + ABOVE_PINS])
+        head = p.heads[part]
+        cover = p.covers[head.into]
+        return np.array([goal[0], goal[1], self.world.position(head.into)[2] + cover.thickness + ABOVE_PINS])
+
+    def _insert(self, part: str, hole: str | None, skill: str, setup: AttemptSetup,
+                grasp: Grasp) -> tuple[bool, float, float]:
+        """One attempt from above the goal: (goal reached, max force dev [N], max torque dev [Nm])."""
+        world, motion, p = self.world, self.world.motion, self.product
+        goal = self._goal_tcp(part, skill)
+        approach = self._approach(part, skill, goal)
+        if skill != "insert_over":  # a cover is aimed at its holes' centres (module docstring)
+            approach[:2] += setup.vision_error
+        carry(motion, approach)
+        motion.hold(approach, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
+        world.arm.tare_sensor()
+        if skill == "insert_over":
+            skill_obj, xy = self._skill(p.covers[part].skill), approach[:2]
+        else:
+            # The hole search around the estimate, on the plate or on the socket's part.
+            surface = approach[2] - (APPROACH_HEIGHT if skill == "insert" else ABOVE_PINS)
+            found = hole_search(motion, approach[:2], surface, approach[2], TOOL_DOWN_QUAT_XYZW,
+                                np.random.default_rng(setup.search_seed))
+            xy = found.hole_xy
+            skill_obj = self._skill(p.pegs[part].shape if skill == "insert" else p.heads[part].skill)
+        origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])
+        detector = Detector(self.thresholds)
+        lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))
+        result = insert(motion, skill_obj, origin, detector, Admittance(), lever, True)
+        return result.reached, detector.max_force_dev, detector.max_torque_dev
+
+    def _screw(self, part: str) -> None:
+        """A head placed in its socket stays fixed to that part."""
+        head = self.product.heads.get(part)
+        if head is None:
+            return
+        world = self.world
+        into, me = world.frames[head.into].body, world.frames[part].body
+        pos, quat = world.pose(head.into)
+        mine = world.pose(part)
+        inv = pb.invertTransform(list(pos), list(quat))
+        rel_pos, rel_quat = pb.multiplyTransforms(*inv, list(mine[0]), list(mine[1]))
+        c = world.client
+        into_com = np.array(pb.getDynamicsInfo(into, -1, physicsClientId=c)[3])
+        my_com = np.array(pb.getDynamicsInfo(me, -1, physicsClientId=c)[3])
+        self._screwed[part] = pb.createConstraint(into, -1, me, -1, pb.JOINT_FIXED, (0, 0, 0),
+                                                  parentFramePosition=list(np.array(rel_pos) - into_com),
+                                                  childFramePosition=list(-my_com),
+                                                  parentFrameOrientation=rel_quat, physicsClientId=c)
+
+    def pose_errors(self) -> dict[str, float]:
+        """Distance of every part from its goal [m] (a peg without a goal: from its tray pose)."""
+        return {pid: self.world.goal_error(pid) if pid in self.world.goals else float("nan")
+                for pid in self.product.parts}
+
+    def close(self) -> None:
+        self.world.close()
+
+

@@ -1,0 +1,45 @@
+"""``./run.sh assemble`` in physics: the planner drives a simulated cell over Zenoh through
+a whole plan (real PyBullet, real Zenoh processes on loopback)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from bridge.recording.reader import column_values, read_recording
+
+STEP_KEYS = {"part", "hole", "skill", "outcome", "attempts", "duration_s", "max_force_dev"}
+
+
+@pytest.mark.slow
+def test_the_default_cranfield_plan_is_assembled_within_2_mm(run_cli) -> None:
+    done = run_cli("assemble", "--json", timeout=280)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True
+    assert len(report["steps"]) == 10 and all(STEP_KEYS <= set(s) for s in report["steps"])
+    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 10
+    errors = report["final_pose_error_mm"]
+    assert set(errors) == {"bp", "p1", "p2", "p3", "p4", "sh", "sp", "pd", "ph", "fp"}
+    assert max(errors.values()) < 2.0, errors
+
+
+@pytest.mark.slow
+def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole(run_cli, tmp_path) -> None:
+    rrd = tmp_path / "a1.rrd"
+    done = run_cli("assemble", "--assembly", "spare", "--block-hole", "r1", "--rrd", str(rrd), "--json", timeout=280)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True and report["replans"]
+    failed = [s for s in report["steps"] if s["outcome"] == "no_fit"]
+    assert failed and all(s["hole"] == "r1" and s["attempts"] == 2 for s in failed)
+    assert all(s["hole"] != "r1" for s in report["final_plan"])
+    # The recording: every part moving over sim_time, the arm, one line per plan step.
+    entities = read_recording(rrd).under("/executor/a1/assembly")
+    for part in ("bp", "p1", "p2", "p3"):
+        assert "sim_time" in entities[f"/executor/a1/assembly/parts/{part}"].timelines
+    assert entities["/executor/a1/assembly/arm"].rows > 10
+    lines = column_values(rrd, "/executor/a1/assembly/steps", "TextLog:text")
+    assert len(lines) == len(report["steps"]) and "no_fit" in " ".join(map(str, lines))
+    assert column_values(rrd, "/executor/a1/assembly/steps", "plan_step") == list(range(1, len(lines) + 1))

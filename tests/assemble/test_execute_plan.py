@@ -1,0 +1,105 @@
+"""The planner's side of plan execution (asp.assemble): the step loop, the no_fit
+observation of a failed step, re-planning from the current state, the stop with exit
+code 3; against a fake cell that answers from the true sizes and a set of blocked holes."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from asp.assemble.cli import truth_facts
+from asp.assemble.execute import AssemblyStopped, execute
+from asp.plans.plans import Plan, PlanStep, check_plan, plans
+from bridge.assembly import load_assembly
+from bridge.messages import StepEvidence, StepReply
+
+
+class FakeCell:
+    """Places a part when it fits the hole (true sizes) and the hole is not blocked."""
+
+    def __init__(self, fits: frozenset[tuple[str, str]], blocked: set[str]) -> None:
+        self.fits, self.blocked = fits, blocked
+        self.placed: dict[str, str | None] = {}
+        self.asked: list[tuple[int, str, str | None]] = []
+
+    def step(self, number: int, part: str, hole: str | None) -> StepReply:
+        self.asked.append((number, part, hole))
+        ok = hole is None or ((part, hole) in self.fits and hole not in self.blocked)
+        assert part not in self.placed, "a placed part was placed again"
+        if ok:
+            assert hole is None or hole not in self.placed.values(), "two parts in one hole"
+            self.placed[part] = hole
+        evidence = StepEvidence(skill="truth", attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
+                                duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
+        return StepReply(id=f"s{number}", cell="fake", part=part, hole=hole, result="fit" if ok else "no_fit",
+                         evidence=evidence, pose_errors_mm=tuple((p, 0.0) for p in sorted(self.placed)))
+
+
+def _run(assembly: str, blocked: set[str]) -> tuple[dict, FakeCell]:
+    facts = truth_facts(load_assembly(assembly))
+    cell = FakeCell(facts.fits, blocked)
+    return execute(facts, plans(facts, n=1)[0], cell), cell
+
+
+def test_the_default_cranfield_plan_is_executed_step_by_step() -> None:
+    report, cell = _run("cranfield", set())
+    assert report["assembled"] is True and report["replans"] == []
+    assert [s["part"] for s in report["steps"]] == [s["part"] for s in report["plan"]]
+    assert set(report["final_pose_error_mm"]) == set(cell.placed) and len(cell.placed) == 10
+    json.dumps(report)  # the report is JSON
+
+
+def test_a_blocked_hole_is_replanned_into_the_spare_hole() -> None:
+    report, cell = _run("spare", {"r1"})
+    assert report["assembled"] is True
+    assert report["replans"], "no re-plan recorded"
+    for replan in report["replans"]:
+        assert set(replan) == {"step", "reason", "plan"} and "no_fit" in replan["reason"]
+    # Placed parts stayed placed: every new plan begins with what was done before it.
+    facts = truth_facts(load_assembly("spare"))
+    final = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in report["final_plan"]))
+    assert check_plan(facts, final.steps) == []
+    assert "r1" not in cell.placed.values() and len(cell.placed) == 4
+    assert {o["fact"] for o in report["observations"]} <= {"no_fit(p1,r1)", "no_fit(p2,r1)"}
+
+
+@pytest.mark.parametrize("hole", ["r1", "s1", "br"])
+def test_cranfield_with_a_blocked_hole_stops_naming_the_part_without_a_hole(hole: str) -> None:
+    with pytest.raises(AssemblyStopped) as stopped:
+        _run("cranfield", {hole})
+    report = stopped.value.report
+    assert report["assembled"] is False
+    part = str(stopped.value).split("part ")[-1].split(" ")[0]
+    assert part in {"p1", "p2", "p3", "p4", "sh"}, str(stopped.value)
+    assert "placed parts stay where they are" in str(stopped.value)
+    assert report["observations"][-1]["fact"].endswith(f",{hole})")
+
+
+def test_the_command_line_stops_with_exit_code_3(run_cli) -> None:
+    done = run_cli("assemble", "--backend", "truth", "--block-hole", "s2", "--json", timeout=60)
+    assert done.returncode == 3, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is False and "gets no hole" in done.stderr
+
+
+@pytest.mark.slow
+def test_a_session_learns_plans_and_assembles(run_session, tmp_path) -> None:
+    run = tmp_path / "run"
+    result = run_session("--assemble", "--out", str(run))
+    assert result["assembly"]["assembled"] is True
+    assert [s["part"] for s in result["assembly"]["steps"]] == [s["part"] for s in result["plans"][0]]
+    settings = json.loads((run / "session.json").read_text())
+    assert settings["assembly"] == "cranfield"  # the assembly's name stays (a resume reads it)
+    assert settings["assembly_run"] == result["assembly"]
+
+
+@pytest.mark.parametrize("args, expected", [
+    (("--block-hole", "zz"), "--block-hole zz: expected a hole"),
+    (("missing.json",), "missing.json"),
+    (("--run", "."), "session.json"),
+])
+def test_bad_input_exits_2_with_one_line(run_cli, tmp_path, args, expected) -> None:
+    done = run_cli("assemble", "--backend", "truth", *args, cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    assert expected in done.stderr and len(done.stderr.strip().splitlines()) == 1
