@@ -20,12 +20,22 @@ import msgspec
 from bridge.cli_types import ArgumentParser
 from bridge.files import make_folder, write_atomic
 from bridge.keys import ALIVE_PATTERN, CELL_ID_PATTERN
-from bridge.messages import MAX_MESSAGE_BYTES, PROTOCOL_VERSION, ErrorReply, InsertReply, InsertRequest
+from bridge.messages import (
+    MAX_MESSAGE_BYTES,
+    PROTOCOL_VERSION,
+    ErrorReply,
+    InsertReply,
+    InsertRequest,
+    StepReply,
+    StepRequest,
+)
 
 MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
     "insert_request": (InsertRequest, "planner → cell, a query on cell/<id>/insert"),
     "insert_reply": (InsertReply, "cell → planner, the reply to an insert request"),
-    "error_reply": (ErrorReply, "cell → planner, a refused insert request"),
+    "error_reply": (ErrorReply, "cell → planner, a refused insert or step request"),
+    "step_request": (StepRequest, "planner → cell, a query on cell/<id>/step: one step of a plan"),
+    "step_reply": (StepReply, "cell → planner, the reply to a step request"),
 }
 """File stem → (message type, who sends it where)."""
 

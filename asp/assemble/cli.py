@@ -35,7 +35,7 @@ from asp.precedence.relation import true_relation
 from asp.session.cells import start_cell
 from asp.solve import fact
 from bridge.assembly import Assembly, load_assembly
-from bridge.cli_types import MAX_SEED, ArgumentParser, finite_float, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
 from bridge.client import CellDirectory
 from bridge.inputs import read_bytes
 from bridge.session import add_endpoint_arguments, free_loopback_endpoint, open_session
@@ -55,7 +55,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--run", type=Path, metavar="RUN", help="a session's run folder: its plans and learned facts")
     parser.add_argument("--plan", type=int_in(1, MAX_PLAN_INDEX), default=1, metavar="K",
                         help="which plan (1-based, default 1)")
-    parser.add_argument("--assembly", help="assembly (default: the run's, else cranfield)")
+    add_assembly_argument(parser, default=None, purpose="its parts, holes and geometry (default: the run's, "
+                                                        "else cranfield)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the cell's random grasp, "
                         "vision and search errors (default 0)")
     parser.add_argument("--block-hole", action="append", default=[], metavar="H",
@@ -64,7 +65,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="the cell: sim (PyBullet, default) or truth (geometry rule, no simulation)")
     parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell (default 300)")
-    parser.add_argument("--rrd", type=Path, metavar="FILE", help="save the cell's Rerun recording to FILE")
+    parser.add_argument("--save", "--rrd", dest="rrd", type=Path, metavar="FILE",
+                        help="save the cell's Rerun recording to this .rrd file")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     return parser

@@ -107,8 +107,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="with --cells 0: use only these cells (default: any cell that shows a token); "
                              "a session that starts its cells uses only those")
     parser.add_argument("--assemble", action="store_true",
-                        help="then assemble the first plan in the first cell (./run.sh assemble); the JSON gains "
-                             "\"assembly\"")
+                        help="then assemble the first plan in the first cell (as the assemble subcommand "
+                             "does); the JSON gains \"assembly\"")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     add_viewer_arguments(parser)
