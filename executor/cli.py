@@ -1,4 +1,4 @@
-"""Command line of the simulated cell: ``teach``, ``trial``, ``campaign``, ``serve``, ``margins``.
+"""Command line of the simulated cell: ``teach``, ``trial``, ``export``, ``campaign``, ``serve``, ``margins``.
 
 ``./run.sh executor trial --part p1 --hole r1 --trials 3 --json`` prints
 ``{"trials": [{"outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error",
@@ -102,6 +102,14 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     return 0
 
 
+def _export(args: argparse.Namespace) -> int:
+    from executor.assembly.export import export_cell
+
+    written = export_cell(args.assembly, args.out)
+    print(f"wrote {written[0]} and {len(written) - 1} mesh file(s) in {args.out / 'meshes'}")
+    return 0
+
+
 # Subcommands owned by other modules: subcommand -> (module whose ``main(argv)`` runs it,
 # imported lazily; help text).
 _DELEGATED = {
@@ -141,6 +149,11 @@ def build_parser() -> argparse.ArgumentParser:
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     add_cell_arguments(trial)
     trial.set_defaults(func=_trial)
+
+    export = sub.add_parser("export", help="write the assembling cell as URDF and meshes (arm, plate, every part)")
+    add_assembly_argument(export, purpose="the product whose cell is written")
+    export.add_argument("out", metavar="OUT", type=Path, help="folder to write cell.urdf and meshes/ into")
+    export.set_defaults(func=_export)
 
     for name, (_module, help_text) in _DELEGATED.items():
         sub.add_parser(name, help=help_text, add_help=False)

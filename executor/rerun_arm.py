@@ -24,6 +24,8 @@ import numpy as np
 import pybullet as pb
 import rerun as rr
 
+from executor.world.scene import link_frame
+
 _ARM_COLOR = [235, 120, 30]
 _TOOL_COLOR = [80, 80, 90]
 _PART_COLOR = [205, 155, 50]
@@ -68,9 +70,9 @@ class ArmRecorder:
                 rec.log(entity, pose, archetype, static=True)
         if not with_static:
             return
-        base_pos, base_quat = self._base_frame()
-        rec.log(f"{root}/arm/base", rr.Transform3D(translation=base_pos, quaternion=rr.Quaternion(xyzw=base_quat)),
-                static=True)
+        base_pos, base_quat = link_frame(self.client, self.robot, _BASE)
+        rec.log(f"{root}/arm/base", rr.Transform3D(translation=list(base_pos),
+                                                   quaternion=rr.Quaternion(xyzw=list(base_quat))), static=True)
 
     def send(self, rec: rr.RecordingStream, root: str, indexes: Sequence[rr.TimeColumn], poses: np.ndarray) -> None:
         """Send sampled poses ``(steps, links, 7)`` as one Transform3D column per link."""
@@ -79,14 +81,6 @@ class ArmRecorder:
                 f"{root}/arm/{self.names[link]}", indexes=indexes,
                 columns=rr.Transform3D.columns(translation=poses[:, column, :3], quaternion=poses[:, column, 3:]),
             )
-
-    def _base_frame(self) -> tuple[list[float], list[float]]:
-        """The base link's URDF frame (PyBullet reports the base's inertial frame)."""
-        pos, quat = pb.getBasePositionAndOrientation(self.robot, physicsClientId=self.client)
-        local_pos, local_quat = pb.getDynamicsInfo(self.robot, _BASE, physicsClientId=self.client)[3:5]
-        inv_pos, inv_quat = pb.invertTransform(local_pos, local_quat)
-        frame_pos, frame_quat = pb.multiplyTransforms(pos, quat, inv_pos, inv_quat)
-        return list(frame_pos), list(frame_quat)
 
 
 def _archetype(geom_type: int, dims: Sequence[float], mesh: bytes, color: list[int]) -> rr.AsComponents | None:

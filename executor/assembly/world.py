@@ -144,9 +144,11 @@ class AssemblyWorld:
         grasp_depth = float(gripper["grasp_depth"])
         tool = PartSpec("tool", "round", 0.02, shape="gripper", length=grasp_depth, mass=0.05, start=(0.0, 0.0),
                         demo_hole="")
+        self.arm_urdf = arm_urdf_text(tool, gripper)
+        """The arm's URDF text (absolute mesh paths), as loaded: :mod:`executor.assembly.export`."""
         with tempfile.TemporaryDirectory(prefix="executor-assembly-arm-") as tmp:
             urdf = Path(tmp) / "arm_gripper.urdf"
-            urdf.write_text(arm_urdf_text(tool, gripper))
+            urdf.write_text(self.arm_urdf)
             self.robot = pb.loadURDF(str(urdf), basePosition=(0, 0, 0), useFixedBase=True,
                                      flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                                      physicsClientId=self.client)

@@ -157,3 +157,17 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
         shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (r, r, part.length / 2),
                        (*part.start, part.length / 2), (0, 0, 0, 1), (205, 155, 50)))
     return shapes
+
+
+def link_frame(client: int, body: int, link: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """World pose (position [m], quaternion x y z w) of a link's URDF frame, where its
+    visual and collision shapes are placed; ``link`` -1 is the base, whose pose PyBullet
+    reports at the base's centre of mass instead."""
+    if link >= 0:
+        state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
+        return tuple(state[4]), tuple(state[5])
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    local_pos, local_quat = pb.getDynamicsInfo(body, -1, physicsClientId=client)[3:5]
+    inv_pos, inv_quat = pb.invertTransform(local_pos, local_quat)
+    frame_pos, frame_quat = pb.multiplyTransforms(pos, quat, inv_pos, inv_quat)
+    return tuple(frame_pos), tuple(frame_quat)
