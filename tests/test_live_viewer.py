@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -24,6 +25,13 @@ def _wait_for(path: Path, timeout: float = 30.0) -> None:
     deadline = time.monotonic() + timeout
     while not path.exists() and time.monotonic() < deadline:
         time.sleep(0.1)
+
+
+def assert_closed(address: str) -> None:
+    """Nobody serves ``address`` any more: the web viewer went with its command."""
+    port = int(re.search(r":(\d+)/", address).group(1))  # type: ignore[union-attr]
+    with socket.socket() as probe:
+        assert probe.connect_ex(("127.0.0.1", port)) != 0
 
 
 @contextmanager
@@ -77,6 +85,7 @@ def test_a_trial_serves_its_recording_to_a_web_browser_until_ctrl_c(tmp_path: Pa
         trial.kill()
     assert trial.returncode == 0
     assert "summary: 1/1 fit" in out
+    assert_closed(address)
     assert len(column_values(rrd, "executor/c1/outcome", "TextLog:text")) == 1
 
 
@@ -114,3 +123,4 @@ def test_view_web_serves_a_run_folder_until_ctrl_c(tmp_path: Path, run_session) 
         view.kill()
     assert view.returncode == 0
     assert (run / "view.rbl").is_file()
+    assert_closed(address)

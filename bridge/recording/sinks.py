@@ -18,7 +18,10 @@ viewer (Rerun's own ``rerun --serve-web``) for as long as the command needs it.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import os
+import signal
 import socket
 import subprocess
 import sys
@@ -112,11 +115,20 @@ def hosted_viewer(viewer: Viewer, files: Sequence[Path] = ()) -> Iterator[Viewer
         _LOG.info("web viewer: open http://127.0.0.1:%d/?url=%s", web_port, quote(server_url, safe=""))
         yield Viewer(connect=server_url)
     finally:
-        server.terminate()
-        try:
-            server.wait(SERVER_START_S)
-        except subprocess.TimeoutExpired:
-            server.kill()
+        _stop(server)
+
+
+def _stop(server: subprocess.Popen) -> None:
+    """Stop the server and its children: ``python -m rerun_cli`` runs the viewer binary as
+    a child, which a signal to the wrapper alone would leave running, so the whole process
+    group (its own session) gets SIGTERM, and SIGKILL for whatever is left."""
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(server.pid, signal.SIGTERM)
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        server.wait(SERVER_START_S / 3)
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(server.pid, signal.SIGKILL)
+    server.wait()
 
 
 SERVER_START_S = 30.0
