@@ -76,6 +76,7 @@ def test_cranfield_with_a_blocked_hole_stops_naming_the_part_without_a_hole(hole
     assert report["observations"][-1]["fact"].endswith(f",{hole})")
 
 
+@pytest.mark.slow
 def test_the_command_line_stops_with_exit_code_3(run_cli) -> None:
     done = run_cli("assemble", "--backend", "truth", "--block-hole", "s2", "--json", timeout=60)
     assert done.returncode == 3, done.stderr

@@ -82,6 +82,7 @@ def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> N
     assert cells[0].popen.poll() is None
 
 
+@pytest.mark.slow
 def test_a_repeated_id_returns_the_cached_reply_without_rerunning(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.2))
@@ -143,6 +144,7 @@ def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(net
     assert all(replies[rid].cell == "c2" for rid in lost)
 
 
+@pytest.mark.slow
 def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.5))
@@ -188,6 +190,7 @@ def raw_ping(session: zenoh.Session, key: str, payload: bytes) -> bytes:
     return box.get(timeout=15.0)
 
 
+@pytest.mark.slow
 def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.3))
@@ -206,6 +209,7 @@ def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(networ
     assert sum(line.startswith("start q") for line in cells[0].lines) == len(answered)
 
 
+@pytest.mark.slow
 def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_taken(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint]))

@@ -8,6 +8,7 @@ import shutil
 import pytest
 
 
+@pytest.mark.slow
 def test_unknown_part_exits_2_naming_it(run_executor):
     proc = run_executor("trial", "--part", "zz", "--hole", "r1")
     assert proc.returncode == 2
@@ -15,12 +16,14 @@ def test_unknown_part_exits_2_naming_it(run_executor):
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_unknown_hole_exits_2_naming_it(run_executor):
     proc = run_executor("trial", "--part", "p1", "--hole", "h9")
     assert proc.returncode == 2
     assert "unknown hole 'h9'" in proc.stderr
 
 
+@pytest.mark.slow
 def test_part_without_demonstration_exits_2(tmp_path, root, run_executor):
     folder = tmp_path / "cell"
     shutil.copytree(root / "data" / "cranfield", folder, ignore=shutil.ignore_patterns("demonstrations"))

@@ -29,6 +29,7 @@ def places(tmp_path: Path) -> Path:
     ("trial", "--part", "p1", "--hole", "r1"),
     ("serve", "--backend", "truth", "--listen", "tcp/127.0.0.1:0"),
 ])
+@pytest.mark.slow
 def test_unwritable_rrd_is_one_line_exit_2(places: Path, run_executor, command: tuple[str, ...],
                                            bad: str) -> None:
     name, reason = BAD_RRD[bad]

@@ -46,6 +46,7 @@ def test_a_bad_journal_line_is_named(tmp_path: Path) -> None:
         ReplayBackend(CellContext("c1", "cranfield", options={"journal": str(journal)}))
 
 
+@pytest.mark.slow
 def test_bad_backend_names_exit_2_with_one_line(run_executor, tmp_path: Path) -> None:
     for argv, expected in [(["--backend", "no_such_module:Backend"], "cannot import no_such_module"),
                            (["--backend", "executor.replay:Nope"], "expected a class Nope in executor.replay"),

@@ -78,7 +78,8 @@ def test_two_cells_with_best_need_few_experiments_and_never_waste_one(seed: int)
     assert max(counts) <= BEST_TWO_CELLS, counts
 
 
-@pytest.mark.parametrize("policy", ["systematic", pytest.param("heuristic", marks=pytest.mark.slow), "best"])
+@pytest.mark.parametrize("policy", ["systematic", pytest.param("heuristic", marks=pytest.mark.slow),
+                                    pytest.param("best", marks=pytest.mark.slow)])
 def test_three_cells_keep_batches_independent_for_every_policy(policy: str) -> None:
     for parts, holes in relabelings(2):
         assert parallel_session(parts, holes, 3, policy, seed=1) <= 25

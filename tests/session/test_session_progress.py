@@ -15,6 +15,7 @@ from tests.conftest import ROOT
 LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s\); (\d+) pairs unknown")
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(90)
 def test_one_progress_line_per_experiment_down_to_no_unknown_pair(
         tmp_path: Path, caplog: pytest.LogCaptureFixture, capsys: pytest.CaptureFixture[str]) -> None:
@@ -30,6 +31,7 @@ def test_one_progress_line_per_experiment_down_to_no_unknown_pair(
     assert f"{len(numbers)} experiments" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(90)
 def test_the_summary_lists_the_files_and_next_commands_that_work(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
