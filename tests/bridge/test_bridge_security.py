@@ -123,41 +123,36 @@ def test_mutual_tls_serves_a_certified_planner_and_keeps_out_a_peer_without_cert
             session.close()
 
 
-def test_a_cell_without_the_credentials_cannot_show_itself_to_the_planner(
-        tmp_path: Path, cells: list[CellProcess]) -> None:
-    endpoint = free_loopback_endpoint()
-    session = open_session(config_file=userpwd_config(tmp_path, "planner", endpoint, user=None))
+def _only_c1_is_served(cells: list[CellProcess], endpoint: str, planner: Path, cell: Path, other: str,
+                       other_config: Path, request_id: str) -> None:
+    """With the planner's Zenoh config ``planner``, cell ``c1`` (config ``cell``) answers;
+    cell ``other`` (config ``other_config``) never shows itself to the planner."""
+    session = open_session(config_file=planner)
     directory = CellDirectory(session)
     try:
-        cells.append(start_cell("c1", backend="truth", connect=[endpoint],
-                                zenoh_config=userpwd_config(tmp_path, "cell", "", user="cell")))
-        cells.append(start_cell("evil", backend="truth", connect=[endpoint],
-                                zenoh_config=userpwd_config(tmp_path, "rogue", "", user=None)))
+        cells.append(start_cell("c1", backend="truth", connect=[endpoint], zenoh_config=cell))
+        cells.append(start_cell(other, backend="truth", connect=[endpoint], zenoh_config=other_config))
         directory.wait_for(1, timeout=20)
-        assert request_insert(session, "c1", InsertRequest(id="auth1", part="p1", hole="r1"), 10).result == "fit"
+        assert request_insert(session, "c1", InsertRequest(id=request_id, part="p1", hole="r1"), 10).result == "fit"
         with pytest.raises(CellTimeout):
             directory.wait_for(2, timeout=4)
         assert directory.alive() == {"c1"}
     finally:
         directory.close()
         session.close()
+
+
+def test_a_cell_without_the_credentials_cannot_show_itself_to_the_planner(
+        tmp_path: Path, cells: list[CellProcess]) -> None:
+    endpoint = free_loopback_endpoint()
+    _only_c1_is_served(cells, endpoint, userpwd_config(tmp_path, "planner", endpoint, user=None),
+                       userpwd_config(tmp_path, "cell", "", user="cell"),
+                       "evil", userpwd_config(tmp_path, "rogue", "", user=None), "auth1")
 
 
 def test_access_control_lets_only_authorised_users_serve_cells(tmp_path: Path, cells: list[CellProcess]) -> None:
     """Both users know a password; only ``cell`` may declare ``cell/**`` (the docs' rules)."""
     endpoint = free_loopback_endpoint()
-    session = open_session(config_file=userpwd_config(tmp_path, "planner", endpoint, "cell", ACCESS_RULES))
-    directory = CellDirectory(session)
-    try:
-        cells.append(start_cell("c1", backend="truth", connect=[endpoint],
-                                zenoh_config=userpwd_config(tmp_path, "cell", "", "cell")))
-        cells.append(start_cell("visitor", backend="truth", connect=[endpoint],
-                                zenoh_config=userpwd_config(tmp_path, "visitor", "", "visitor")))
-        directory.wait_for(1, timeout=20)
-        assert request_insert(session, "c1", InsertRequest(id="acl1", part="p1", hole="r1"), 10).result == "fit"
-        with pytest.raises(CellTimeout):
-            directory.wait_for(2, timeout=4)
-        assert directory.alive() == {"c1"}
-    finally:
-        directory.close()
-        session.close()
+    _only_c1_is_served(cells, endpoint, userpwd_config(tmp_path, "planner", endpoint, "cell", ACCESS_RULES),
+                       userpwd_config(tmp_path, "cell", "", "cell"),
+                       "visitor", userpwd_config(tmp_path, "visitor", "", "visitor"), "acl1")
