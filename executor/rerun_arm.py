@@ -74,6 +74,13 @@ class ArmRecorder:
         rec.log(f"{root}/arm/base", rr.Transform3D(translation=list(base_pos),
                                                    quaternion=rr.Quaternion(xyzw=list(base_quat))), static=True)
 
+    def log_now(self, rec: rr.RecordingStream, root: str) -> None:
+        """Log every moving link's pose now, at the stream's current time (row by row, for
+        a logger that samples rather than buffers)."""
+        for row, link in zip(self.sample(), self.links):
+            rec.log(f"{root}/arm/{self.names[link]}",
+                    rr.Transform3D(translation=row[:3], quaternion=rr.Quaternion(xyzw=row[3:])))
+
     def send(self, rec: rr.RecordingStream, root: str, indexes: Sequence[rr.TimeColumn], poses: np.ndarray) -> None:
         """Send sampled poses ``(steps, links, 7)`` as one Transform3D column per link."""
         for column, link in enumerate(self.links):

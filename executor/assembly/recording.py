@@ -6,7 +6,8 @@ Entities (under ``executor/<cell-id>/assembly/``):
 =============================== ===================================================
 ``parts/<id>``                  the part's pose (``Transform3D``) over ``sim_time``; its
                                 solid (boxes, cylinders in its frame) logged once, static
-``arm``                         the arm as a line strip through its link origins [m]
+``arm/<link>``                  the arm's links (meshes, as in a cell's recording:
+                                :class:`executor.rerun_arm.ArmRecorder`) over ``sim_time``
 ``force``                       measured contact force at the TCP (x, y, z) [N]
 ``steps``                       one text line per plan step (timelines ``plan_step``
                                 and ``sim_time``)
@@ -19,11 +20,11 @@ it samples the world every ``period_s`` of simulated time.
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 import rerun as rr
 
 from bridge.recording.layout import assembly_root
 from executor.assembly.world import AssemblyWorld
+from executor.rerun_arm import ArmRecorder
 
 PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
 
@@ -61,6 +62,7 @@ class AssemblyRecorder:
     def __init__(self, recording: rr.RecordingStream, cell_id: str, period_s: float = PERIOD_S) -> None:
         self.rec, self.root, self.period_s = recording, assembly_root(cell_id), period_s
         self.world: AssemblyWorld | None = None
+        self._arm: ArmRecorder | None = None
         self._next = 0.0
         self._offset = 0.0  # [s] sim time of the worlds before this one
         self._step = 0
@@ -70,6 +72,8 @@ class AssemblyRecorder:
         if self.world is not None:
             self._offset = self._next
         self.world = world
+        self._arm = ArmRecorder(world.client, world.robot)
+        self._arm.log_geometry(self.rec, self.root, "gripper", with_static=True)
         for part in world.product.parts:
             for solid in _part_solids(world, part):
                 self.rec.log(f"{self.root}/parts/{part}", solid, static=True)
@@ -81,16 +85,14 @@ class AssemblyRecorder:
         if self.world is None or t < self._next:
             return
         self._next = t + self.period_s
-        world, c = self.world, self.world.client
+        world = self.world
         self.rec.set_time("sim_time", duration=t)
         for part in world.frames:
             pos, quat = world.pose(part)
             self.rec.log(f"{self.root}/parts/{part}",
                          rr.Transform3D(translation=pos, quaternion=rr.Quaternion(xyzw=list(quat))))
-        links = [pb.getBasePositionAndOrientation(world.robot, physicsClientId=c)[0]]
-        links += [pb.getLinkState(world.robot, k, physicsClientId=c)[4]
-                  for k in range(pb.getNumJoints(world.robot, physicsClientId=c))]
-        self.rec.log(f"{self.root}/arm", rr.LineStrips3D([links], radii=[0.02], colors=[[240, 120, 30]]))
+        if self._arm is not None:
+            self._arm.log_now(self.rec, self.root)
         self.rec.log(f"{self.root}/force", rr.Scalars(np.asarray(force_mes, dtype=float)))
 
     def log_plan_step(self, part: str, hole: str | None, outcome: str, attempts: int, error_mm: float) -> None:

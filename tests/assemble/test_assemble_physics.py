@@ -39,7 +39,8 @@ def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole(run_cli, tmp
     entities = read_recording(rrd).under("/executor/a1/assembly")
     for part in ("bp", "p1", "p2", "p3"):
         assert "sim_time" in entities[f"/executor/a1/assembly/parts/{part}"].timelines
-    assert entities["/executor/a1/assembly/arm"].rows > 10
+    assert entities["/executor/a1/assembly/arm/lbr_iiwa_link_4"].rows > 10
+    assert "Asset3D:blob" in entities["/executor/a1/assembly/arm/lbr_iiwa_link_4/visual_4"].components
     lines = column_values(rrd, "/executor/a1/assembly/steps", "TextLog:text")
     assert len(lines) == len(report["steps"]) and "no_fit" in " ".join(map(str, lines))
     assert column_values(rrd, "/executor/a1/assembly/steps", "plan_step") == list(range(1, len(lines) + 1))
