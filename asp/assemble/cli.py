@@ -27,24 +27,19 @@ from dataclasses import replace
 from pathlib import Path
 
 from asp import PlannerError
-from asp.assemble.driver import ZenohDriver
+from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import Plan, PlanStep, check_plan, plans
 from asp.precedence.relation import true_relation
-from asp.session.cells import start_cell
 from asp.solve import fact
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
-from bridge.client import CellDirectory
 from bridge.inputs import read_bytes
-from bridge.session import add_endpoint_arguments, free_loopback_endpoint, open_session
+from bridge.session import add_endpoint_arguments
 
 EXIT_STOPPED = 3
 """Exit code when the product cannot be finished (bad input exits with 2)."""
-CELL_ID = "a1"
-CELL_START_S = 60.0
-"""How long the started cell may take to show its liveliness token [s]."""
 MAX_PLAN_INDEX = 1000
 
 
@@ -159,25 +154,13 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
     """Start the cell, run the plan; (report, exit code)."""
     started = time.perf_counter()
     assembly, facts, plan = resolve(args)
-    listen = args.listen or [free_loopback_endpoint()]
-    session = open_session(listen, args.connect, args.zenoh_config)
-    try:
-        directory = CellDirectory(session)
-        cell = start_cell(CELL_ID, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
-                          rrd=args.rrd, zenoh_config=args.zenoh_config, block_holes=args.block_hole)
+    with assembling_cell(assembly.folder, args.seed, args.timeout, backend=args.backend,
+                         block_holes=args.block_hole, rrd=args.rrd, listen=args.listen, connect=args.connect,
+                         zenoh_config=args.zenoh_config) as driver:
         try:
-            # Its queryables reach us with its liveliness token: a step sent before might find no one.
-            directory.wait_for(1, timeout=CELL_START_S)
-            driver = ZenohDriver(session, CELL_ID, args.seed, args.timeout)
-            try:
-                report, code = execute(facts, plan, driver), 0
-            except AssemblyStopped as exc:
-                report, code = dict(exc.report, error=str(exc)), EXIT_STOPPED
-        finally:
-            cell.stop()
-            directory.close()
-    finally:
-        session.close()
+            report, code = execute(facts, plan, driver), 0
+        except AssemblyStopped as exc:
+            report, code = dict(exc.report, error=str(exc)), EXIT_STOPPED
     report["wall_s"] = round(time.perf_counter() - started, 3)
     return report, code
 

@@ -5,13 +5,22 @@ answers a repeated request from its cache and never runs the step twice)."""
 from __future__ import annotations
 
 import uuid
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
 
 import zenoh
 
 from asp import PlannerError
+from asp.session.cells import start_cell
 from bridge import BridgeError
-from bridge.client import CellTimeout, request_step
+from bridge.client import CellDirectory, CellTimeout, request_step
 from bridge.messages import StepReply, StepRequest
+from bridge.session import free_loopback_endpoint, open_session
+
+CELL_ID = "a1"
+CELL_START_S = 60.0
+"""How long a started cell may take to show its liveliness token [s]."""
 
 SEND_ATTEMPTS = 3
 """A step whose reply is lost is sent this many times in all."""
@@ -36,3 +45,27 @@ class ZenohDriver:
             except BridgeError as exc:
                 raise PlannerError(f"step {number} ({part}): {exc}") from None
         raise AssertionError("unreachable")
+
+
+@contextmanager
+def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backend: str = "sim",
+                    block_holes: Sequence[str] = (), rrd: Path | None = None, listen: Sequence[str] = (),
+                    connect: Sequence[str] = (), zenoh_config: Path | None = None) -> Iterator[ZenohDriver]:
+    """Start one cell (``executor serve``, a fresh world of ``assembly_folder``) on loopback and
+    yield a driver for one plan run in it; the cell is stopped on exit.  ``seed`` seeds the
+    cell's random errors, ``timeout_s`` bounds one step [s]."""
+    listen = list(listen) or [free_loopback_endpoint()]
+    session = open_session(listen, connect, zenoh_config)
+    try:
+        directory = CellDirectory(session)
+        cell = start_cell(CELL_ID, backend=backend, assembly=str(assembly_folder), connect=listen[:1],
+                          rrd=rrd, zenoh_config=zenoh_config, block_holes=list(block_holes))
+        try:
+            # Its queryables reach us with its liveliness token: a step sent before might find no one.
+            directory.wait_for(1, timeout=CELL_START_S)
+            yield ZenohDriver(session, CELL_ID, seed, timeout_s)
+        finally:
+            cell.stop()
+            directory.close()
+    finally:
+        session.close()
