@@ -50,18 +50,32 @@ def test_the_default_cranfield_plan_is_executed_step_by_step() -> None:
     json.dumps(report)  # the report is JSON
 
 
-def test_a_blocked_hole_is_replanned_into_the_spare_hole() -> None:
-    report, cell = _run("spare", {"r1"})
+@pytest.mark.parametrize("assembly, blocked, spare, parts", [
+    ("spare", "r1", "r3", 4),
+    ("graded", "h3", "h7", 7),  # the d 12.8 mm hole of the default plan; h7 is its spare
+    ("graded", "h1", "h7", 7),  # the thinnest peg's hole: a peg goes into a looser one
+])
+def test_a_blocked_hole_is_replanned_into_the_spare_hole(assembly: str, blocked: str, spare: str, parts: int) -> None:
+    report, cell = _run(assembly, {blocked})
     assert report["assembled"] is True
     assert report["replans"], "no re-plan recorded"
     for replan in report["replans"]:
         assert set(replan) == {"step", "reason", "plan"} and "no_fit" in replan["reason"]
     # Placed parts stayed placed: every new plan begins with what was done before it.
-    facts = truth_facts(load_assembly("spare"))
+    facts = truth_facts(load_assembly(assembly))
     final = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in report["final_plan"]))
     assert check_plan(facts, final.steps) == []
-    assert "r1" not in cell.placed.values() and len(cell.placed) == 4
-    assert {o["fact"] for o in report["observations"]} <= {"no_fit(p1,r1)", "no_fit(p2,r1)"}
+    assert blocked not in cell.placed.values() and spare in cell.placed.values() and len(cell.placed) == parts
+    assert all(o["fact"].endswith(f",{blocked})") for o in report["observations"])
+
+
+@pytest.mark.parametrize("hole", ["h4", "h5", "h6"])
+def test_the_graded_board_with_a_blocked_large_hole_stops(hole: str) -> None:
+    """p4..p6 have no alternative: the spare is smaller than their holes."""
+    with pytest.raises(AssemblyStopped) as stopped:
+        _run("graded", {hole})
+    assert "no complete assignment is left" in str(stopped.value) and stopped.value.report["assembled"] is False
+    assert str(stopped.value).split("not solvable: part ")[1][:2] in {"p4", "p5", "p6"}, str(stopped.value)
 
 
 @pytest.mark.parametrize("hole", ["r1", "s1", "br"])
