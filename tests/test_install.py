@@ -46,6 +46,9 @@ def test_the_installed_command_runs_a_session_from_a_folder_outside_the_reposito
     data_dir, asp_file = where.stdout.split()
     site = Path(env["PYTHONPATH"])
     assert Path(data_dir).is_relative_to(site) and Path(asp_file).is_relative_to(site)  # not the repository
+    def files(folder: Path) -> set[Path]:
+        return {f.relative_to(folder) for f in folder.rglob("*") if f.is_file()}
+    assert files(ROOT / "data") <= files(Path(data_dir))  # every shipped assembly, its assets and skills
     done = subprocess.run([str(command), "session", "--assembly", "cranfield", "--backend", "truth", "--json",
                            "--out", "my-run"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
