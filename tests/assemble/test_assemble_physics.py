@@ -44,3 +44,29 @@ def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole(run_cli, tmp
     lines = column_values(rrd, "/executor/a1/assembly/steps", "TextLog:text")
     assert len(lines) == len(report["steps"]) and "no_fit" in " ".join(map(str, lines))
     assert column_values(rrd, "/executor/a1/assembly/steps", "plan_step") == list(range(1, len(lines) + 1))
+
+
+@pytest.mark.slow
+def test_the_default_graded_board_plan_is_assembled_within_2_mm(run_cli) -> None:
+    done = run_cli("assemble", "--assembly", "graded", "--json", timeout=280)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True and report["replans"] == []
+    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 7
+    errors = report["final_pose_error_mm"]
+    assert set(errors) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6"}
+    assert max(errors.values()) < 2.0, errors
+
+
+@pytest.mark.slow
+def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_physics(run_cli) -> None:
+    """h1 blocked: p1 (d 10 mm) is re-planned into a d 12.8 mm hole, the loosest fit of any
+    complete assignment of the graded board, and still stands within 2 mm of its goal."""
+    done = run_cli("assemble", "--assembly", "graded", "--block-hole", "h1", "--json", timeout=280)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True and report["replans"]
+    assert [(s["part"], s["hole"]) for s in report["steps"] if s["outcome"] == "no_fit"] == [("p1", "h1")]
+    final = {s["part"]: s["hole"] for s in report["final_plan"]}
+    assert final["p1"] in {"h3", "h7"} and "h1" not in final.values()
+    assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
