@@ -10,7 +10,7 @@
 >>> run = api.read_run("runs/x")                              # its settings, journal, files
 
 Paths are relative to the working folder; an assembly is a shipped one's name
-(``cranfield``, ``battery``) or a folder holding ``assembly.toml``. Bad input raises
+(``cranfield``, ``battery``, ``spare``, ``graded``) or a folder holding ``assembly.toml``. Bad input raises
 :class:`asp.PlannerError` or :class:`bridge.BridgeError` with a one-line message naming
 the file or value. Documented in ``docs/api.md``.
 """

@@ -60,7 +60,7 @@ def plain_text(text: str) -> str:
     return _ROLE.sub(r"\1", text).replace("``", "").replace("./run.sh", PROGRAM)
 
 
-ASSEMBLY_HELP = "a shipped assembly's name (cranfield, battery) or a folder holding assembly.toml"
+ASSEMBLY_HELP = "a shipped assembly's name (cranfield, battery, spare, graded) or a folder holding assembly.toml"
 """The one meaning of ``--assembly`` on every help page."""
 
 
