@@ -52,16 +52,17 @@ def test_the_default_graded_board_plan_is_assembled_within_2_mm(run_cli) -> None
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] is True and report["replans"] == []
-    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 7
+    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 8
+    assert [s["skill"] for s in report["steps"]].count("insert_over") == 1  # the bar
     errors = report["final_pose_error_mm"]
-    assert set(errors) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6"}
+    assert set(errors) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6", "bar"}
     assert max(errors.values()) < 2.0, errors
 
 
 @pytest.mark.slow
 def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_physics(run_cli) -> None:
-    """h1 blocked: p1 (d 10 mm) is re-planned into a d 12.8 mm hole, the loosest fit of any
-    complete assignment of the graded board, and still stands within 2 mm of its goal."""
+    """h1 blocked: p1 (d 10 mm) is re-planned into the free d 12.8 mm hole, the loosest fit
+    of any complete assignment of the graded board, and still stands within 2 mm of its goal."""
     done = run_cli("assemble", "--assembly", "graded", "--block-hole", "h1", "--json", timeout=280)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)

@@ -52,8 +52,8 @@ def test_the_default_cranfield_plan_is_executed_step_by_step() -> None:
 
 @pytest.mark.parametrize("assembly, blocked, spare, parts", [
     ("spare", "r1", "r3", 4),
-    ("graded", "h3", "h7", 7),  # the d 12.8 mm hole of the default plan; h7 is its spare
-    ("graded", "h1", "h7", 7),  # the thinnest peg's hole: a peg goes into a looser one
+    ("graded", "h7", "h3", 8),  # a d 12.8 mm hole of the default plan; its twin h3 is free
+    ("graded", "h1", "h3", 8),  # the thinnest peg's hole: p1 goes into a looser one
 ])
 def test_a_blocked_hole_is_replanned_into_the_spare_hole(assembly: str, blocked: str, spare: str, parts: int) -> None:
     report, cell = _run(assembly, {blocked})
@@ -71,7 +71,7 @@ def test_a_blocked_hole_is_replanned_into_the_spare_hole(assembly: str, blocked:
 
 @pytest.mark.parametrize("hole", ["h4", "h5", "h6"])
 def test_the_graded_board_with_a_blocked_large_hole_stops(hole: str) -> None:
-    """p4..p6 have no alternative: the spare is smaller than their holes."""
+    """p4..p6 have no alternative: the free hole is smaller than theirs."""
     with pytest.raises(AssemblyStopped) as stopped:
         _run("graded", {hole})
     assert "no complete assignment is left" in str(stopped.value) and stopped.value.report["assembled"] is False
