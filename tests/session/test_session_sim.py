@@ -88,8 +88,9 @@ def test_a_killed_sim_session_resumes_with_its_cells_ilc_and_learns_cranfield_ex
     assert done.returncode == 0, done.stderr
     result = json.loads(done.stdout)
     assert_learned_truth(result, run)  # the exact Cranfield relation, every experiment right
-    after = _ilc_iterations(state)
     journal = read_journal(run / "journal.jsonl")
+    assert all(e.evidence is not None and e.evidence.attempts == 2 for e in journal if e.result == "no_fit")
+    after = _ilc_iterations(state)
     fits_after_resume = sum(e.result == "fit" for e in journal[finished_before:])
     assert fits_after_resume >= 1
     assert all(after[key] >= count for key, count in before.items())
