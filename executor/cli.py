@@ -15,10 +15,10 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from bridge import BridgeError
+from bridge.cell_options import add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path, run_command
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 from executor import ExecutorError
-from executor.cell_options import add_cell_arguments
 
 MAX_TRIALS = 100_000
 """``trial --trials N``: at most this many trials (trial k uses seed+k)."""

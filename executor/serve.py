@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 
 from bridge import BridgeError
+from bridge.cell_options import add_cell_arguments
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from bridge.messages import (
@@ -68,7 +69,7 @@ from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, view
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from executor import ExecutorError
 from executor.backends import Backend, CellContext, StepOutcome, UnknownPair, backend_option, load_backend
-from executor.cell_options import add_cell_arguments, cell_keywords
+from executor.cell_options import cell_keywords
 from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
 

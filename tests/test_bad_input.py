@@ -149,6 +149,9 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("resume-bad-policy", ("session", "--resume", "run"),
      {"run/session.json": '{"assembly": "cranfield", "policy": 7, "seed": 0, "recording_id": "r"}'}, 2,
      '"policy"'),
+    ("resume-bad-cell-options", ("session", "--resume", "run"),
+     {"run/session.json": '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r", '
+                          '"cell_options": ["--layer", "sideways"]}'}, 2, '"cell_options"'),
     ("resume-huge-journal", ("session", "--resume", "run"),
      lambda tmp: huge_journal(tmp / "run"), 2, "larger than"),
     # recordings, cell geometry

@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from asp import PlannerError
+from bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -100,11 +101,14 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
                listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
                rrd: Path | None = None, recording_id: str | None = None,
                zenoh_config: Path | None = None, viewer_url: str | None = None,
-               ilc_state: Path | None = None, block_holes: Sequence[str] = ()) -> list[str]:
+               ilc_state: Path | None = None, block_holes: Sequence[str] = (),
+               cell_options: Sequence[str] = (), cell_seed: int | None = None) -> list[str]:
     """The command line of one ``executor serve`` node, with ``--lifeline``; ``viewer_url``:
     a Rerun viewer or server the cell also streams its recording to; ``ilc_state``: the
     file the sim cell keeps its learned ILC corrections in (in the run folder, so a
-    resumed session's cell starts from them); ``block_holes``: holes with an obstacle."""
+    resumed session's cell starts from them); ``block_holes``: holes with an obstacle;
+    ``cell_options``: the sim cell's execution layer and uncertainty
+    (:func:`bridge.cell_options.cell_argv`), ``cell_seed``: the seed of its systematic errors."""
     argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
@@ -122,7 +126,18 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
     if ilc_state is not None and backend == "sim":
         argv += ["--ilc-state", str(Path(ilc_state).absolute())]
     argv += [arg for hole in block_holes for arg in ("--block-hole", hole)]
+    if backend == "sim":
+        argv += list(cell_options)
+        if cell_seed is not None:
+            argv += ["--cell-seed", str(cell_seed)]
     return argv
+
+
+def cell_seed(session_seed: int, number: int) -> int:
+    """The cell seed (systematic errors) of the session's cell ``c<number>`` (1, 2, ...):
+    the session seed plus ``number`` − 1 (modulo 2**32), so each cell of a session is
+    another cell, and the same cell again when the session is resumed."""
+    return (session_seed + number - 1) % (MAX_SEED + 1)
 
 
 def start_cell(cell_id: str, *, ready_timeout: float = 60.0, **options) -> CellProcess:

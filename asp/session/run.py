@@ -46,7 +46,7 @@ from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import demo_facts, load_demos
 from asp.precedence.learn import learn_must_precede
 from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
-from asp.session.cells import CellProcess, serve_argv
+from asp.session.cells import CellProcess, cell_seed, serve_argv
 from asp.session.folder import RunLock, lock_run_folder
 from asp.session.journal import JOURNAL_NAME, Journal
 from asp.session.log import PlannerLog
@@ -57,6 +57,7 @@ from asp.sizes.policies import policy_names
 from asp.solve import encoding, fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
+from bridge.cell_options import add_cell_arguments, cell_argv, parse_cell_argv
 from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
 from bridge.files import make_folder, write_atomic
@@ -112,6 +113,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     add_viewer_arguments(parser)
+    add_cell_arguments(parser, cell_seed=False)  # cell c<k>'s cell seed: --seed + k - 1 (asp.session.cells)
     return parser
 
 
@@ -142,7 +144,7 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock, bool]:
         raise PlannerError(f"--out {run}: already holds a session (its journal); "
                            f"use --resume {run} or another folder")
     settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed, "confirm": args.confirm,
-                "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running"}
+                "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running", "cell_options": cell_argv(args)}
     if args.demos is not None:  # absolute: a resume may run from another folder
         settings["demos"] = str(args.demos.absolute())
     return run, settings, lock, created
@@ -163,7 +165,7 @@ def _holds_session(run: Path) -> bool:
 
 _SETTING_TYPES: dict[str, tuple[type, bool]] = {
     "assembly": (str, True), "policy": (str, True), "seed": (int, True), "recording_id": (str, True),
-    "confirm": (int, False), "starts": (int, False), "demos": (str, False)}
+    "confirm": (int, False), "starts": (int, False), "demos": (str, False), "cell_options": (list, False)}
 """The settings a resumed session reads back: key → (type, required)."""
 
 
@@ -183,7 +185,8 @@ def _resume_settings(path: Path) -> dict:
         value = settings.get(key)
         if not isinstance(value, kind) or isinstance(value, bool):
             got = "nothing" if key not in settings else shorten(json.dumps(value))
-            raise PlannerError(f'{path}: "{key}": expected {"an integer" if kind is int else "a string"}, got {got}')
+            expected = {int: "an integer", str: "a string", list: "a list of the cell's options"}[kind]
+            raise PlannerError(f'{path}: "{key}": expected {expected}, got {got}')
     checks = [("policy", settings["policy"] in policy_names(), f"one of {', '.join(policy_names())}"),
               ("seed", 0 <= settings["seed"] <= MAX_SEED, f"an integer from 0 to {MAX_SEED}"),
               ("confirm", 0 <= settings.get("confirm", 0) <= MAX_CONFIRM, f"an integer from 0 to {MAX_CONFIRM}"),
@@ -191,6 +194,13 @@ def _resume_settings(path: Path) -> dict:
     for key, ok, expected in checks:
         if not ok:
             raise PlannerError(f'{path}: "{key}": expected {expected}, got {shorten(json.dumps(settings[key]))}')
+    try:
+        options = settings.get("cell_options", [])
+        if not all(isinstance(arg, str) for arg in options):
+            raise ValueError("not all strings")
+        parse_cell_argv(options)
+    except ValueError as exc:
+        raise PlannerError(f'{path}: "cell_options": {shorten(exc, 120)}; expected the options of a sim cell') from None
     return settings
 
 
@@ -354,12 +364,13 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         stack.callback(directory.close)
         cells: list[CellProcess] = []
         stack.callback(lambda: [cell.stop() for cell in cells])
-        for cell_id in cell_ids:  # they start up in parallel with each other and with us
+        for number, cell_id in enumerate(cell_ids, start=1):  # they start up in parallel with each other and us
             cells.append(CellProcess(cell_id, serve_argv(
                 cell_id, backend=args.backend, assembly=str(assembly.folder), connect=listen[:1],
                 delay_s=args.delay, rrd=run / f"{cell_id}{suffix}.rrd",
                 recording_id=settings["recording_id"], zenoh_config=args.zenoh_config, viewer_url=viewer.connect,
-                ilc_state=run / f"{cell_id}-ilc.json")))
+                ilc_state=run / f"{cell_id}-ilc.json", cell_options=settings.get("cell_options", []),
+                cell_seed=cell_seed(settings["seed"], number))))
         log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids, viewer)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))

@@ -23,12 +23,13 @@ from collections.abc import Sequence
 from typing import Any
 
 from bridge import BridgeError
+from bridge.cell_options import add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
 from executor import ExecutorError
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
-from executor.cell_options import add_cell_arguments, perturbation_from_args
+from executor.cell_options import perturbation_from_args
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5

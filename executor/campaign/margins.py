@@ -15,9 +15,10 @@ import math
 import sys
 from collections.abc import Sequence
 
+from bridge.cell_options import add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor.campaign.pairs import PAIRS_ARGUMENT
-from executor.cell_options import add_cell_arguments, cell_keywords
+from executor.cell_options import cell_keywords
 from executor.control.detector import Thresholds
 from executor.trial import Cell, trial_rng
 

@@ -39,6 +39,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from bridge.cell_options import add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
 from bridge.progress import progress
 from executor import ExecutorError
@@ -51,7 +52,7 @@ from executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from executor.cell_options import add_cell_arguments, cell_keywords
+from executor.cell_options import cell_keywords
 
 
 class TrialRunner(Protocol):

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from bridge.cell_options import LAYER_NAMES
 from bridge.files import write_atomic
 from executor import ExecutorError
 from executor.control.admittance import AdmittanceParams
@@ -67,13 +68,13 @@ class ExecutionLayer:
     ilc: bool
 
 
-LAYERS = {layer.name: layer for layer in (
-    ExecutionLayer("position", False, False, False, False),
-    ExecutionLayer("admittance_p", True, False, False, False),
-    ExecutionLayer("admittance_pi", True, True, False, False),
-    ExecutionLayer("pi_phase_stop", True, True, True, False),
-    ExecutionLayer("full", True, True, True, True),
-)}
+LAYERS = {name: ExecutionLayer(name, *switches) for name, switches in zip(LAYER_NAMES, (
+    (False, False, False, False),
+    (True, False, False, False),
+    (True, True, False, False),
+    (True, True, True, False),
+    (True, True, True, True),
+), strict=True)}
 """The variants of the ablation, from the least to the whole layer."""
 
 

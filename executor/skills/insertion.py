@@ -16,6 +16,7 @@ from executor.control.detector import Detector
 from executor.control.ilc import OFFSET_BOUND, ExecutionTrace
 from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill
+from executor.skills.search import SearchParams
 from executor.skills.wiggle import wiggle
 from executor.world.scene import TIME_STEP
 
@@ -23,7 +24,12 @@ from executor.world.scene import TIME_STEP
 TIMEOUT_FACTOR = 3.0
 SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
 MAX_WIGGLES = 1  # exception strategy runs per attempt
-JAM_DEPTH = 0.003  # [m] below the entry: a breach there is a jam, not a part on the surface
+JAM_DEPTH = SearchParams().sink_depth
+"""[m] below the entry: the part has sunk into the hole's entry chamfer (the search's
+criterion of "in the hole"), so a breach there is a jam, not a part on the surface.  A
+too-big part never gets there (measured: at most 0.08 mm below the entry when eq. (6)
+fires, with the default uncertainty); a tilted tight peg wedged in the chamfer is 1 mm
+deep."""
 
 
 @dataclass
@@ -64,8 +70,8 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     phase added to the command (ILC, :mod:`executor.control.ilc`); ``record`` keeps the
     per-step wrench deviations and admittance offsets in ``result.trace`` for ILC.
 
-    A breach with the tip inside the hole
-    (deeper than ``JAM_DEPTH``) is a jam: the wiggle runs once and the insertion goes on;
+    A breach with the tip sunk into the hole (deeper than ``JAM_DEPTH``: in the entry
+    chamfer or past it) is a jam: the wiggle runs once and the insertion goes on;
     a breach with the part still on the plate surface, or a second one, stops the
     execution; the goal check then decides.  A trajectory that ends with the part stuck
     in the hole short of the goal (forces below the thresholds) is a jam as well: the

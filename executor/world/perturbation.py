@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from bridge.cell_options import MAGNITUDES
 from executor import ExecutorError
 from executor.evidence import AttemptSetup
 
@@ -35,18 +36,19 @@ from executor.evidence import AttemptSetup
 @dataclass(frozen=True)
 class PerturbationModel:
     """Magnitudes of the cell's uncertainty: grasp offsets [m], grasp tilts [°], vision
-    errors [m], friction coefficients (Coulomb, part on hole wall, dimensionless)."""
+    errors [m], friction coefficients (Coulomb, part on hole wall, dimensionless); the
+    defaults are those of the cell's options (:data:`bridge.cell_options.MAGNITUDES`)."""
 
-    grasp_offset_bias: float = 0.0005
-    grasp_offset_random: float = 0.001
-    grasp_tilt_bias: float = 1.5
-    grasp_tilt_random: float = 1.0
-    vision_bias: float = 0.001
-    vision_sigma: float = 0.0015
-    vision_max: float = 0.006
-    friction_min: float = 0.2
-    friction_max: float = 0.5
-    friction_jitter: float = 0.03
+    grasp_offset_bias: float = MAGNITUDES["grasp_offset_bias"].default
+    grasp_offset_random: float = MAGNITUDES["grasp_offset_random"].default
+    grasp_tilt_bias: float = MAGNITUDES["grasp_tilt_bias"].default
+    grasp_tilt_random: float = MAGNITUDES["grasp_tilt_random"].default
+    vision_bias: float = MAGNITUDES["vision_bias"].default
+    vision_sigma: float = MAGNITUDES["vision_sigma"].default
+    vision_max: float = MAGNITUDES["vision_max"].default
+    friction_min: float = MAGNITUDES["friction_min"].default
+    friction_max: float = MAGNITUDES["friction_max"].default
+    friction_jitter: float = MAGNITUDES["friction_jitter"].default
 
     def random_only(self) -> PerturbationModel:
         """The same random parts with every systematic part zero (friction: the middle of
