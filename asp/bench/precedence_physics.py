@@ -28,6 +28,7 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import clingo
 
@@ -38,8 +39,10 @@ from asp.assemble.execute import StepDriver, step_json
 from asp.plans.plans import PlanStep, plans
 from asp.precedence.relation import Pair, Relation, reduction, true_relation
 from asp.solve import fact, solve
+from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
+from bridge.files import check_writable, write_atomic
 
 DriverFactory = Callable[[], AbstractContextManager[StepDriver]]
 """Starts a fresh cell for one sequence and yields its driver."""
@@ -208,6 +211,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell [s] (default 300)")
     parser.add_argument("--json", action="store_true", help="print the JSON result instead of the table")
+    parser.add_argument("--out", type=Path, metavar="FILE", help="also write the JSON result to FILE")
     return parser
 
 
@@ -219,7 +223,9 @@ def main(argv: list[str]) -> int:
         edges = args.edges or reduction(relation)
         holes = {s.part: s.hole for s in plans(truth_facts(assembly), 1)[0].steps}
         pending = list(edge_runs(relation, holes, edges))
-    except PlannerError as exc:
+        if args.out is not None:
+            check_writable(args.out)
+    except (PlannerError, BridgeError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 
@@ -228,5 +234,8 @@ def main(argv: list[str]) -> int:
 
     with ThreadPoolExecutor(args.jobs) as pool:
         runs = list(pool.map(lambda run: run_sequence(cell, run), pending))
-    print(json.dumps(report_json(assembly, args.seed, edges, runs)) if args.json else table(edges, runs))
+    report = report_json(assembly, args.seed, edges, runs)
+    if args.out is not None:
+        write_atomic(args.out, json.dumps(report, indent=1) + "\n")
+    print(json.dumps(report) if args.json else table(edges, runs))
     return 0 if all(c.completed for c in runs[1::2]) else 1
