@@ -43,6 +43,7 @@ from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.files import check_writable, write_atomic
+from bridge.progress import progress
 
 DriverFactory = Callable[[], AbstractContextManager[StepDriver]]
 """Starts a fresh cell for one sequence and yields its driver."""
@@ -233,7 +234,8 @@ def main(argv: list[str]) -> int:
         return assembling_cell(assembly.folder, args.seed, args.timeout)
 
     with ThreadPoolExecutor(args.jobs) as pool:
-        runs = list(pool.map(lambda run: run_sequence(cell, run), pending))
+        runs = list(progress(pool.map(lambda run: run_sequence(cell, run), pending), desc="sequences",
+                             total=len(pending)))
     report = report_json(assembly, args.seed, edges, runs)
     if args.out is not None:
         write_atomic(args.out, json.dumps(report, indent=1) + "\n")
