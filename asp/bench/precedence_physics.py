@@ -161,9 +161,10 @@ def _failure_text(run: SequenceRun) -> str:
     if failed > len(run.steps):
         return f"{failed}: error"
     step = run.steps[failed - 1]
-    worst = max(step["pose_errors_mm"].values(), default=0.0)
+    worst = max(step["pose_errors_mm"].values(), default=None)
+    placed = "none placed" if worst is None else f"worst placed {worst:.1f} mm"
     return (f"{failed}: {step['part']} {step['outcome']} ({step['attempts']} att., "
-            f"{step['max_force_dev']:.0f} N, {step['pose_error_mm']:.1f} mm; worst placed {worst:.1f} mm)")
+            f"{step['max_force_dev']:.0f} N, {step['pose_error_mm']:.1f} mm; {placed})")
 
 
 def table(edges: Sequence[Pair], runs: Sequence[SequenceRun]) -> str:
