@@ -55,7 +55,7 @@ class _Run:
                 "observations": self.observations, "final_plan": self.plan.as_json()}
 
 
-def _step_json(reply: StepReply) -> dict:
+def step_json(reply: StepReply) -> dict:
     e = reply.evidence
     return {"part": reply.part, "hole": reply.hole, "skill": e.skill, "outcome": reply.result,
             "attempts": e.attempts, "duration_s": round(e.duration_s, 3), "max_force_dev": round(e.max_force_dev, 3),
@@ -70,7 +70,7 @@ def execute(facts: LearnedFacts, plan: Plan, driver: StepDriver, max_replans: in
     while len(run.done) < len(run.plan.steps):
         step = run.plan.steps[len(run.done)]
         reply = driver.step(len(run.steps) + 1, step.part, step.hole)
-        run.steps.append(_step_json(reply))
+        run.steps.append(step_json(reply))
         run.errors_mm = {p: round(e, 3) for p, e in reply.pose_errors_mm}
         if reply.result == "fit":
             run.done.append(step)

@@ -16,7 +16,9 @@ Per kind of part (the ``skill`` of the step's record):
 
 A failed attempt (the goal check fails) lifts the part and tries again with a fresh
 vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
-``no_fit``.  Placed parts stay where they are.
+``no_fit``.  A part that reached its goal but does not stay there once let go (nothing
+holds it: :data:`STAY_TOLERANCE`) is ``no_fit`` too, left where it lies.  Placed parts
+stay where they are.
 """
 
 from __future__ import annotations
@@ -53,6 +55,11 @@ ASSEMBLY_UNCERTAINTY = PerturbationModel(
 a vision error σ 1.5 mm (≤ 3 mm), the teaching friction; random parts only (the single
 trials' systematic errors and ILC are not used when assembling yet)."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
+STAY_TOLERANCE = 0.005
+"""A part let go at its goal must still be within this distance of it after the tool's
+retreat [m] (placed parts are within 2 mm); else the step is ``no_fit`` and the part is
+left where it lies (e.g. a peg let go in a hole of a plate that is not in its fixture
+falls: the insertion itself met no resistance to tell it)."""
 
 
 @dataclass
@@ -161,6 +168,8 @@ class Assembler:
         grasp.release()
         here = motion.controller.arm.read().tip_pos
         move_line(motion, here + np.array([0.0, 0.0, RETREAT]), tolerance=VIA_TOLERANCE)
+        if ok and world.goal_error(part) > STAY_TOLERANCE:  # let go, it did not stay: nothing holds it there
+            ok = False
         if ok:
             self.placed.add(part)
             self._screw(part)
