@@ -16,12 +16,13 @@ TOPICS: dict[str, str] = {
     "session": "asp.bench.session",
     "dominance": "asp.bench.dominance",
     "mesh": "asp.bench.mesh",
+    "assemble": "asp.bench.assemble_plans",
 }
 
 
 def main(argv: list[str]) -> int:
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session,dominance,mesh} [--help]")
+        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session,dominance,mesh,assemble} [--help]")
         return 0
     topic = argv[0]
     if topic not in TOPICS:
