@@ -13,11 +13,11 @@ the relation admits (:class:`asp.precedence.count.UniformSampler`, as
 every plan passes the checker.  Plan k runs in a cell of its own started for it
 (``executor serve``, a fresh world) whose random errors have seed S + k.
 
-Prints per plan: the plan, assembled, re-plans, the worst final pose error of any part
-[mm] and the wall time [s] (cell start-up included); then the summary: plans assembled,
-plans with every part within :data:`TOLERANCE_MM`, the worst pose error and the median
-wall time.  Exit code 1 when a plan is not assembled or a part ends farther than the
-tolerance, else 0.
+Prints per plan (to stderr with ``--json``), as it finishes: the plan, assembled,
+re-plans, the worst final pose error of any part [mm] and the wall time [s] (cell
+start-up included); then the summary: plans assembled, plans with every part within
+:data:`TOLERANCE_MM`, the worst pose error and the median wall time.  Exit code 1
+when a plan is not assembled or a part ends farther than the tolerance, else 0.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import argparse
 import json
 import random
 import statistics
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -166,8 +167,7 @@ def main(argv: list[str]) -> int:
 
     def one(k: int) -> None:
         reports[k] = run_plan(assembly, facts, drawn[k], args.seed + k + 1, args.timeout, args.backend)
-        if not args.json:
-            print(_row(k + 1, reports[k]), flush=True)
+        print(_row(k + 1, reports[k]), file=sys.stderr if args.json else sys.stdout, flush=True)
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         list(pool.map(one, range(len(drawn))))
