@@ -17,13 +17,14 @@ TOPICS: dict[str, str] = {
     "dominance": "asp.bench.dominance",
     "mesh": "asp.bench.mesh",
     "precedence-physics": "asp.bench.precedence_physics",
+    "assemble": "asp.bench.assemble_plans",
 }
 
 
 def main(argv: list[str]) -> int:
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session,dominance,mesh,precedence-physics} "
-              "[--help]")
+        print("usage: ./run.sh bench {precedence,sizes,plan,executor,session,dominance,mesh,assemble,"
+              "precedence-physics} [--help]")
         return 0
     topic = argv[0]
     if topic not in TOPICS:
