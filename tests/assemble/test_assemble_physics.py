@@ -47,19 +47,6 @@ def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole(run_cli, tmp
 
 
 @pytest.mark.slow
-def test_the_default_graded_board_plan_is_assembled_within_2_mm(run_cli) -> None:
-    done = run_cli("assemble", "--assembly", "graded", "--json", timeout=280)
-    assert done.returncode == 0, done.stderr
-    report = json.loads(done.stdout)
-    assert report["assembled"] is True and report["replans"] == []
-    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 8
-    assert [s["skill"] for s in report["steps"]].count("insert_over") == 1  # the bar
-    errors = report["final_pose_error_mm"]
-    assert set(errors) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6", "bar"}
-    assert max(errors.values()) < 2.0, errors
-
-
-@pytest.mark.slow
 def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_physics(run_cli) -> None:
     """h1 blocked: p1 (d 10 mm) is re-planned into the free d 12.8 mm hole, the loosest fit
     of any complete assignment of the graded board, and still stands within 2 mm of its goal."""
@@ -70,4 +57,6 @@ def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_
     assert [(s["part"], s["hole"]) for s in report["steps"] if s["outcome"] == "no_fit"] == [("p1", "h1")]
     final = {s["part"]: s["hole"] for s in report["final_plan"]}
     assert final["p1"] in {"h3", "h7"} and "h1" not in final.values()
+    assert [s["skill"] for s in report["steps"]].count("insert_over") == 1  # the bar
+    assert set(report["final_pose_error_mm"]) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6", "bar"}
     assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]

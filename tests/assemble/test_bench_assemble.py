@@ -57,19 +57,3 @@ def test_two_drawn_plans_run_in_two_truth_cells_at_once(run_cli) -> None:
     assert [r["seed"] for r in result["plans"]] == [6, 7]
     assert result["summary"]["assembled"] == 2
     assert all(len(r["steps"]) == 10 for r in result["plans"])
-
-
-@pytest.mark.slow
-def test_an_order_unlike_the_default_plan_is_assembled_in_physics(run_cli) -> None:
-    """Seed 6 draws ph bp p4->s2 p3->s1 p1->r1 p2->r2 sh->br sp pd fp: the head screwed
-    on before the back plate is in, the separator before the pendulum, other holes than
-    the default plan's (bp p3->s2 p4->s1 sh->br ph pd p2->r2 sp p1->r1 fp)."""
-    done = run_cli("bench", "assemble", "--plans", "1", "--seed", "6", "--json", timeout=280)
-    assert done.returncode == 0, done.stderr
-    result = json.loads(done.stdout)
-    (report,) = result["plans"]
-    assert [s["part"] for s in report["plan"]] == ["ph", "bp", "p4", "p3", "p1", "p2", "sh", "sp", "pd", "fp"]
-    assert report["assembled"] is True and report["replans"] == []
-    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 10
-    errors = report["final_pose_error_mm"]
-    assert len(errors) == 10 and max(errors.values()) <= 2.0, errors
