@@ -7,6 +7,7 @@ import pytest
 
 from asp import PlannerError
 from asp.assemble.cli import build_parser, cell_options
+from asp.bench.assemble_plans import build_parser as bench_parser
 from asp.session.cells import serve_argv
 from executor.serve import build_parser as serve_parser
 
@@ -30,3 +31,9 @@ def test_by_default_the_assembling_cell_gets_no_cell_options() -> None:
 def test_a_cell_option_without_uncertainty_cell_is_refused(option: list[str]) -> None:
     with pytest.raises(PlannerError, match="need --uncertainty cell"):
         cell_options(build_parser().parse_args(option))
+
+
+def test_bench_assemble_passes_the_same_cell_options() -> None:
+    args = bench_parser().parse_args(["--uncertainty", "cell", "--cell-seed", "2", "--layer", "admittance_p"])
+    served = serve_parser().parse_args(cell_options(args))
+    assert (served.uncertainty, served.cell_seed, served.layer) == ("cell", 2, "admittance_p")
