@@ -58,6 +58,19 @@ def add_cell_arguments(parser: argparse.ArgumentParser, *, layer: bool = True, c
                            metavar="X", help=f"{m.help} (default {m.default})")
 
 
+ASSEMBLY_UNCERTAINTIES = ("random", "cell")
+"""The uncertainty of the assembling cell's plan steps: ``random`` (the default) its own
+random-only model, no ILC; ``cell`` the cell's model of the options (systematic part from
+the cell seed) with its execution layer and ILC (docs/assembly.md)."""
+
+
+def add_assembly_uncertainty_argument(parser: argparse.ArgumentParser) -> None:
+    """``--uncertainty {random,cell}`` of the assembling cell (plan steps)."""
+    parser.add_argument("--uncertainty", choices=ASSEMBLY_UNCERTAINTIES, default=ASSEMBLY_UNCERTAINTIES[0],
+                        help="plan steps: random = the assembling cell's own random errors only, no ILC; cell = "
+                        "the cell's uncertainty (--cell-seed, magnitudes) with its --layer and ILC (default random)")
+
+
 def cell_argv(args: argparse.Namespace) -> list[str]:
     """The ``--layer`` and ``--<magnitude>`` options of ``args`` (parsed with
     :func:`add_cell_arguments`) as command-line arguments of ``executor serve``."""

@@ -22,7 +22,8 @@ process later.
 - Plan steps (``cell/<id>/step``, :class:`bridge.messages.StepRequest`) run in the same
   queue: ``sim`` in the assembling world of :mod:`executor.assembly` (kept between the
   steps of one plan run), ``truth`` from the geometry; ``--block-hole H`` puts an obstacle
-  in hole H (a fault to show the planner's recovery).
+  in hole H (a fault to show the planner's recovery); ``--uncertainty cell`` gives the
+  plan steps the cell's uncertainty, layer and ILC (default ``random``: their own errors).
 
 One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
 ``done <id> <result>``), flushed, so a supervisor can follow the node.
@@ -46,7 +47,7 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 
 from bridge import BridgeError
-from bridge.cell_options import add_cell_arguments
+from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from bridge.messages import (
@@ -161,11 +162,13 @@ class SimBackend:
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
                  rrd: Path | None, viewer: Viewer = NO_VIEWER, blocked: Sequence[str] = (),
-                 **cell_keywords: Any) -> None:
+                 uncertainty: str = "random", **cell_keywords: Any) -> None:
         """``viewer``: also stream the recording live; ``blocked``: holes with an obstacle
-        for plan steps; ``cell_keywords``: the Cell's options (layer, perturbation, cell
-        seed, ``ilc_state``: the file its ILC corrections are loaded from and saved to,
-        atomically after every update, so a resumed session's cell starts from them)."""
+        for plan steps; ``uncertainty``: ``cell`` gives plan steps the Cell's uncertainty
+        (its systematic errors), layer and an ILC, ``random`` their own; ``cell_keywords``:
+        the Cell's options (layer, perturbation, cell seed, ``ilc_state``: the file its ILC
+        corrections are loaded from and saved to, atomically after every update, so a
+        resumed session's cell starts from them)."""
         from executor.trial import Cell
 
         _PlannerNumbered = _planner_numbered_logger()
@@ -174,6 +177,7 @@ class SimBackend:
                         if rrd is not None or viewer != NO_VIEWER else None)
         self._cell = Cell(assembly, gui=False, logger=self._logger, **cell_keywords)
         self._assembly, self._blocked, self._cell_id = assembly, list(blocked), cell_id
+        self._cell_uncertainty = uncertainty == "cell"
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
@@ -183,7 +187,10 @@ class SimBackend:
             from executor.assembly.recording import AssemblyRecorder
 
             recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
-            self._runner = AssemblyRunner(self._assembly, self._blocked, recorder)
+            cell = self._cell
+            self._runner = (AssemblyRunner(self._assembly, self._blocked, recorder, uncertainty=cell.bias,
+                                           layer=cell.layer)
+                            if self._cell_uncertainty else AssemblyRunner(self._assembly, self._blocked, recorder))
         record, errors = self._runner.run_step(request)
         result: Result = "fit" if record.outcome == "fit" else "no_fit"
         return result, step_evidence(record), errors
@@ -376,6 +383,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
                         "save them there after every update (a session passes <run>/<cell>-ilc.json)")
     add_cell_arguments(parser)
+    add_assembly_uncertainty_argument(parser)
     add_endpoint_arguments(parser)
     return parser
 
@@ -387,7 +395,7 @@ def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
                             args.block_hole)
     if args.backend == "sim":
         return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args), args.block_hole,
-                          ilc_state=args.ilc_state, **cell_keywords(args))
+                          uncertainty=args.uncertainty, ilc_state=args.ilc_state, **cell_keywords(args))
     return load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
                                                   dict(args.backend_option)))
 

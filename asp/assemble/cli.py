@@ -2,6 +2,7 @@
 
     ./run.sh assemble [--run RUN [--plan K] | PLAN.json [FACTS.lp ...] | FACTS.lp ...]
                       [--assembly A] [--seed S] [--block-hole H] [--rrd FILE] [--json]
+                      [--uncertainty {random,cell} [--cell-seed C] [--layer L] [--<magnitude> X ...]]
 
 The plan: plan K (default 1) of a session's run folder (``RUN/session.json``, facts
 ``RUN/learned.lp``), a plan JSON file (``[{"part", "hole"}, ...]``, ``{"plan": [...]}`` or
@@ -15,6 +16,11 @@ between steps.  JSON (``--json``): ``{"plan", "steps": [{"part", "hole", "skill"
 "outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled",
 "final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
 Exit code 3 when the product cannot be finished (e.g. no hole left for a part).
+
+``--uncertainty cell`` gives the plan steps the uncertainty of a single-trial cell (the
+magnitudes' options, systematic part from ``--cell-seed``), its execution layer
+``--layer`` and, with ``full``, ILC (docs/assembly.md); the default ``random`` is the
+assembling cell's own random errors, and then those options must keep their defaults.
 """
 
 from __future__ import annotations
@@ -34,6 +40,7 @@ from asp.plans.plans import Plan, PlanStep, check_plan, plans
 from asp.precedence.relation import true_relation
 from asp.solve import fact
 from bridge.assembly import Assembly, load_assembly
+from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
 from bridge.inputs import read_bytes
 from bridge.session import add_endpoint_arguments
@@ -63,8 +70,21 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--save", "--rrd", dest="rrd", type=Path, metavar="FILE",
                         help="save the cell's Rerun recording to this .rrd file")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
+    add_assembly_uncertainty_argument(parser)
+    add_cell_arguments(parser)
     add_endpoint_arguments(parser)
     return parser
+
+
+def cell_options(args: argparse.Namespace) -> list[str]:
+    """The sim cell's options for ``--uncertainty cell`` (none for ``random``); PlannerError
+    if a cell option was changed without it (it would have no effect)."""
+    if args.uncertainty == "cell":
+        return ["--uncertainty", "cell", *cell_argv(args), "--cell-seed", str(args.cell_seed)]
+    defaults = build_parser().parse_args([])
+    if cell_argv(args) != cell_argv(defaults) or args.cell_seed != defaults.cell_seed:
+        raise PlannerError("--layer, --cell-seed and the uncertainty magnitudes need --uncertainty cell")
+    return []
 
 
 def truth_facts(assembly: Assembly) -> LearnedFacts:
@@ -156,7 +176,7 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
     assembly, facts, plan = resolve(args)
     with assembling_cell(assembly.folder, args.seed, args.timeout, backend=args.backend,
                          block_holes=args.block_hole, rrd=args.rrd, listen=args.listen, connect=args.connect,
-                         zenoh_config=args.zenoh_config) as driver:
+                         zenoh_config=args.zenoh_config, cell_options=cell_options(args)) as driver:
         try:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:

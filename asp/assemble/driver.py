@@ -50,16 +50,19 @@ class ZenohDriver:
 @contextmanager
 def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backend: str = "sim",
                     block_holes: Sequence[str] = (), rrd: Path | None = None, listen: Sequence[str] = (),
-                    connect: Sequence[str] = (), zenoh_config: Path | None = None) -> Iterator[ZenohDriver]:
+                    connect: Sequence[str] = (), zenoh_config: Path | None = None,
+                    cell_options: Sequence[str] = ()) -> Iterator[ZenohDriver]:
     """Start one cell (``executor serve``, a fresh world of ``assembly_folder``) on loopback and
     yield a driver for one plan run in it; the cell is stopped on exit.  ``seed`` seeds the
-    cell's random errors, ``timeout_s`` bounds one step [s]."""
+    cell's random errors, ``timeout_s`` bounds one step [s], ``cell_options`` are more
+    options of a sim cell (:func:`asp.assemble.cli.cell_options`: uncertainty, layer, cell seed)."""
     listen = list(listen) or [free_loopback_endpoint()]
     session = open_session(listen, connect, zenoh_config)
     try:
         directory = CellDirectory(session)
         cell = start_cell(CELL_ID, backend=backend, assembly=str(assembly_folder), connect=listen[:1],
-                          rrd=rrd, zenoh_config=zenoh_config, block_holes=list(block_holes))
+                          rrd=rrd, zenoh_config=zenoh_config, block_holes=list(block_holes),
+                           cell_options=list(cell_options))
         try:
             # Its queryables reach us with its liveliness token: a step sent before might find no one.
             directory.wait_for(1, timeout=CELL_START_S)

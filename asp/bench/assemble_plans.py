@@ -3,6 +3,7 @@ assembled in a fresh simulated cell with monitoring and re-planning.
 
     ./run.sh bench assemble --plans N --seed S [--run RUN | FACTS.lp ...] [--assembly A]
                             [--jobs J] [--backend sim|truth] [--timeout S] [--json]
+                            [--uncertainty random|cell [--cell-seed C] [--layer L] [--<magnitude> X ...]]
 
 The relation and the sizes: the learned facts of a session's run folder
 (``RUN/learned.lp``) or of facts files, else the assembly's true ones (``precedence.lp``,
@@ -11,7 +12,9 @@ the relation admits (:class:`asp.precedence.count.UniformSampler`, as
 ``precedence sample``) with a hole assignment drawn uniformly among the feasible ones
 (at most :data:`ASSIGNMENT_LIMIT`; Cranfield has 4), both from ``random.Random(S)``;
 every plan passes the checker.  Plan k runs in a cell of its own started for it
-(``executor serve``, a fresh world) whose random errors have seed S + k.
+(``executor serve``, a fresh world) whose random errors have seed S + k; with
+``--uncertainty cell`` every cell has the cell options' uncertainty and layer
+(:func:`asp.assemble.cli.cell_options`, the same cell seed for all).
 
 Prints per plan (to stderr with ``--json``), as it finishes: the plan, assembled,
 re-plans, the worst final pose error of any part [mm] and the wall time [s] (cell
@@ -32,7 +35,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from asp import PlannerError
-from asp.assemble.cli import truth_facts
+from asp.assemble.cli import cell_options, truth_facts
 from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
@@ -40,6 +43,7 @@ from asp.plans.plans import Plan, PlanStep, check_plan
 from asp.precedence.count import UniformSampler
 from asp.precedence.relation import Relation
 from bridge.assembly import Assembly, load_assembly
+from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
 from bridge.inputs import read_bytes
 
@@ -75,13 +79,15 @@ def plan_text(steps: list[dict]) -> str:
 
 
 def run_plan(assembly: Assembly, facts: LearnedFacts, plan: Plan, seed: int, timeout_s: float,
-             backend: str = "sim") -> dict:
+             backend: str = "sim", cell_options: list[str] | None = None) -> dict:
     """Assemble ``plan`` in a fresh cell (random errors seeded with ``seed``); the
-    execution report with ``wall_s`` [s] and ``error`` (null, or why it stopped)."""
+    execution report with ``wall_s`` [s] and ``error`` (null, or why it stopped);
+    ``cell_options``: more options of the sim cell."""
     started = time.perf_counter()
     error = None
     try:
-        with assembling_cell(assembly.folder, seed, timeout_s, backend=backend) as driver:
+        with assembling_cell(assembly.folder, seed, timeout_s, backend=backend,
+                             cell_options=cell_options or []) as driver:
             report = execute(facts, plan, driver)
     except AssemblyStopped as exc:
         report, error = exc.report, str(exc)
@@ -156,17 +162,20 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell [s] (default 300)")
     parser.add_argument("--json", action="store_true", help="print JSON {\"plans\": [report, ...], \"summary\"}")
+    add_assembly_uncertainty_argument(parser)
+    add_cell_arguments(parser)
     return parser
 
 
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     assembly, facts = _facts(args)
+    options = cell_options(args)
     drawn = draw_plans(facts, args.plans, args.seed)
     reports: list[dict] = [{}] * len(drawn)
 
     def one(k: int) -> None:
-        reports[k] = run_plan(assembly, facts, drawn[k], args.seed + k + 1, args.timeout, args.backend)
+        reports[k] = run_plan(assembly, facts, drawn[k], args.seed + k + 1, args.timeout, args.backend, options)
         print(_row(k + 1, reports[k]), file=sys.stderr if args.json else sys.stdout, flush=True)
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:

@@ -1,7 +1,9 @@
 """Plan steps served over Zenoh (``executor serve``): the :class:`Assembler` of the current
 plan run, kept between its steps; a request of another run (``assembly`` id) starts a
 fresh world with every part on the tray.  Holes blocked with ``--block-hole`` get their
-obstacle in every fresh world."""
+obstacle in every fresh world.  With ``--uncertainty cell`` every world gets the cell's
+uncertainty and execution layer, and the ILC corrections are kept across the plan runs
+this cell serves (in memory: not saved)."""
 
 from __future__ import annotations
 
@@ -11,10 +13,12 @@ from typing import TYPE_CHECKING
 from bridge.messages import StepEvidence, StepRequest
 from executor import ExecutorError
 from executor.assembly.product import Product, load_product
-from executor.assembly.step import Assembler, StepRecord
+from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord
+from executor.control.ilc import ExecutionLayer, Ilc
 
 if TYPE_CHECKING:
     from executor.assembly.recording import AssemblyRecorder
+    from executor.world.perturbation import CellBias
 
 
 def step_evidence(record: StepRecord) -> StepEvidence:
@@ -27,8 +31,13 @@ def step_evidence(record: StepRecord) -> StepEvidence:
 class AssemblyRunner:
     """One assembling world at a time, keyed by the plan run's id."""
 
-    def __init__(self, assembly: str, blocked: Sequence[str] = (), recorder: AssemblyRecorder | None = None) -> None:
+    def __init__(self, assembly: str, blocked: Sequence[str] = (), recorder: AssemblyRecorder | None = None, *,
+                 uncertainty: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER) -> None:
+        """``uncertainty``/``layer``: the cell's (``--uncertainty cell``), else the assembling
+        cell's own (:class:`Assembler`); with an ILC layer one :class:`Ilc` serves every run."""
         self.product: Product = load_product(assembly)
+        self.uncertainty, self.layer = uncertainty, layer
+        self.ilc = Ilc() if layer.ilc else None
         self.blocked = list(blocked)
         for hole in self.blocked:
             if hole not in self.product.geometry.holes:
@@ -42,7 +51,8 @@ class AssemblyRunner:
         """The world of plan run ``run`` (a fresh one for a new run)."""
         if self._assembler is None or run != self._run:
             self.close()
-            self._assembler = Assembler(self.product, self.recorder)
+            self._assembler = Assembler(self.product, self.recorder, uncertainty=self.uncertainty,
+                                        layer=self.layer, ilc=self.ilc)
             if self.recorder is not None:
                 self.recorder.attach(self._assembler.world)
             for hole in self.blocked:

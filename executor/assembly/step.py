@@ -19,6 +19,12 @@ vision estimate; after ``max_attempts`` the part is put back on the tray and the
 ``no_fit``.  A part that reached its goal but does not stay there once let go (nothing
 holds it: :data:`STAY_TOLERANCE`) is ``no_fit`` too, left where it lies.  Placed parts
 stay where they are.
+
+The uncertainty and the execution layer: by default :data:`ASSEMBLY_UNCERTAINTY` and the
+layer ``pi_phase_stop`` (admittance PI and phase stopping, no ILC); a cell with
+``--uncertainty cell`` gives its own :class:`CellBias` (systematic errors per part shape
+and per hole from its cell seed), its layer, and an :class:`Ilc` keyed as in the single
+trials, (part shape, hole), a cover or head being its own shape and hole.
 """
 
 from __future__ import annotations
@@ -34,8 +40,9 @@ from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
 from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
 from executor.assembly.world import AssemblyWorld
-from executor.control.admittance import Admittance
+from executor.control.admittance import Admittance, AdmittanceParams
 from executor.control.detector import Detector, Thresholds
+from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from executor.control.motion import StepLogger
 from executor.evidence import AttemptSetup
 from executor.skills.dmp import Skill, load_skill
@@ -44,6 +51,7 @@ from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, SETTLE_TIME, trial_rng
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW
 from executor.world.perturbation import CellBias, PerturbationModel
+from executor.world.scene import PART_FRICTION
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
 RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
@@ -52,8 +60,10 @@ ASSEMBLY_UNCERTAINTY = PerturbationModel(
     grasp_offset_bias=0.0, grasp_offset_random=0.001, grasp_tilt_bias=0.0, grasp_tilt_random=1.0,
     vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
 """The assembling cell's uncertainty per execution: a grasp offset ≤ 1 mm and tilt ≤ 1°,
-a vision error σ 1.5 mm (≤ 3 mm), the teaching friction; random parts only (the single
-trials' systematic errors and ILC are not used when assembling yet)."""
+a vision error σ 1.5 mm (≤ 3 mm), the teaching friction; random parts only (the cell's
+systematic errors and ILC are used with ``--uncertainty cell``)."""
+DEFAULT_LAYER = LAYERS["pi_phase_stop"]
+"""The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
 STAY_TOLERANCE = 0.005
 """A part let go at its goal must still be within this distance of it after the tool's
@@ -90,7 +100,13 @@ class Assembler:
     """The assembling cell: one :class:`AssemblyWorld` kept between steps."""
 
     def __init__(self, product: Product, logger: StepLogger | None = None,
-                 thresholds: Thresholds | None = None) -> None:
+                 thresholds: Thresholds | None = None, *, uncertainty: CellBias | None = None,
+                 layer: ExecutionLayer = DEFAULT_LAYER, ilc: Ilc | None = None) -> None:
+        """``uncertainty``: the errors of each execution (default :data:`ASSEMBLY_UNCERTAINTY`);
+        ``layer``: the insertion's execution layer; ``ilc``: the corrections its ILC uses and
+        updates (kept by the caller, e.g. across plan runs; required when ``layer.ilc``)."""
+        if layer.ilc and ilc is None:
+            raise ExecutorError(f"execution layer '{layer.name}' needs an ILC state")
         self.product = product
         self.world = AssemblyWorld(product, logger)
         self.thresholds = Thresholds() if thresholds is None else thresholds
@@ -98,7 +114,8 @@ class Assembler:
         self.placed: set[str] = set()
         self._screwed: dict[str, int] = {}
         self.blocked: set[str] = set()
-        self._uncertainty = CellBias(ASSEMBLY_UNCERTAINTY, 0)
+        self._uncertainty = CellBias(ASSEMBLY_UNCERTAINTY, 0) if uncertainty is None else uncertainty
+        self.layer, self.ilc = layer, ilc
 
     def skill_of(self, part: str) -> str:
         """The step's skill: fixture, insert, insert_over or insert_socket."""
@@ -112,6 +129,11 @@ class Assembler:
         if part in p.heads:
             return "insert_socket"
         raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(p.parts)})")
+
+    def shape_of(self, part: str) -> str:
+        """The part's shape for its systematic grasp error and ILC key: a peg's shape, else the part itself."""
+        peg = self.product.pegs.get(part)
+        return part if peg is None else peg.shape
 
     def _skill(self, name: str) -> Skill:
         if name not in self._skills:
@@ -146,7 +168,7 @@ class Assembler:
         rng = trial_rng(seed, part, hole or "none")
         if skill == "insert" and hole is not None:
             world.set_peg_goal(part, hole)
-        setup = self._uncertainty.draw(rng, part, hole or part)
+        setup = self._uncertainty.draw(rng, self.shape_of(part), hole or part)
         grasp = self._pick(part, setup)
         if skill == "fixture":
             carry(motion, world.frames[part].grip, grasp.follow)
@@ -156,7 +178,7 @@ class Assembler:
             outcomes = []
             for attempt in range(max_attempts):
                 if attempt:
-                    setup = self._uncertainty.draw(rng, part, hole or part)
+                    setup = self._uncertainty.draw(rng, self.shape_of(part), hole or part)
                 outcomes.append(self._insert(part, hole, skill, setup, grasp))
                 if outcomes[-1][0]:
                     break
@@ -237,7 +259,18 @@ class Assembler:
         origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])
         detector = Detector(self.thresholds)
         lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))
-        result = insert(motion, skill_obj, origin, detector, Admittance(), lever, True)
+        layer, key = self.layer, f"{self.shape_of(part)}:{hole or part}"
+        correction = self.ilc.correction(key)[0] if layer.ilc and self.ilc is not None else None
+        admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
+                      if layer.admittance else None)
+        plate = world.frames[p.base.id].body
+        if skill == "insert" and setup.friction is not None:  # the hole's friction: Bullet multiplies the two
+            pb.changeDynamics(plate, -1, lateralFriction=setup.friction / PART_FRICTION, physicsClientId=world.client)
+        result = insert(motion, skill_obj, origin, detector, admittance, lever, True,
+                        phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
+        pb.changeDynamics(plate, -1, lateralFriction=PART_FRICTION, physicsClientId=world.client)
+        if result.reached and result.trace is not None and self.ilc is not None:
+            self.ilc.update(key, result.trace)
         return result.reached, detector.max_force_dev, detector.max_torque_dev
 
     def _screw(self, part: str) -> None:

@@ -60,3 +60,15 @@ def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_
     assert [s["skill"] for s in report["steps"]].count("insert_over") == 1  # the bar
     assert set(report["final_pose_error_mm"]) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6", "bar"}
     assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
+
+
+@pytest.mark.slow
+def test_the_spare_plan_is_assembled_with_the_cells_uncertainty_and_ilc_layer(run_cli) -> None:
+    """``--uncertainty cell``: systematic grasp and vision errors from cell seed 3, the hole's
+    friction, the full layer (ILC); still assembled, every part within 2 mm."""
+    done = run_cli("assemble", "--assembly", "spare", "--uncertainty", "cell", "--cell-seed", "3", "--json",
+                   timeout=280)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True
+    assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
