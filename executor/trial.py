@@ -24,7 +24,7 @@ import numpy as np
 
 from executor import ExecutorError
 from executor.control.admittance import Admittance, AdmittanceParams
-from executor.control.controller import ImpedanceController
+from executor.control.controller import POSITION_CONTROL_GAINS, ImpedanceController
 from executor.control.detector import Detector, Thresholds
 from executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
 from executor.control.motion import Motion
@@ -189,8 +189,14 @@ class Cell:
         lever = spec.length - float(self.geometry.gripper["grasp_depth"])
         admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
                       if layer.admittance else None)
-        result = insert(motion, skill, origin, detector, admittance, lever, wiggle_enabled,
-                        phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
+        compliant = motion.controller.gains
+        if layer.stiff:  # the insertion only: the search, the approach and the release stay compliant
+            motion.controller.gains = POSITION_CONTROL_GAINS
+        try:
+            result = insert(motion, skill, origin, detector, admittance, lever, wiggle_enabled,
+                            phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
+        finally:
+            motion.controller.gains = compliant
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

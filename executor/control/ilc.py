@@ -59,21 +59,24 @@ push along the way, never where the trajectory ends (the goal check stays the ta
 class ExecutionLayer:
     """Which parts of the paper's execution layer run (the hole search, the wiggle and the
     second attempt always do): the admittance (off: pure position control along the
-    DMP), its integral part (off: P only), DMP phase stopping, ILC."""
+    DMP), its integral part (off: P only), DMP phase stopping, ILC; ``stiff`` tracks the
+    insertion with :data:`executor.control.controller.POSITION_CONTROL_GAINS` (an
+    industrial arm's position control) instead of the compliant impedance."""
 
     name: str
     admittance: bool
     integral: bool
     phase_stopping: bool
     ilc: bool
+    stiff: bool
 
 
 LAYERS = {name: ExecutionLayer(name, *switches) for name, switches in zip(LAYER_NAMES, (
-    (False, False, False, False),
-    (True, False, False, False),
-    (True, True, False, False),
-    (True, True, True, False),
-    (True, True, True, True),
+    (False, False, False, False, True),
+    (True, False, False, False, False),
+    (True, True, False, False, False),
+    (True, True, True, False, False),
+    (True, True, True, True, False),
 ), strict=True)}
 """The variants of the ablation, from the least to the whole layer."""
 

@@ -8,6 +8,8 @@ import json
 import numpy as np
 import pytest
 
+from executor.control.controller import POSITION_CONTROL_GAINS, ImpedanceGains
+from executor.control.detector import Thresholds
 from executor.control.ilc import LAYERS, ExecutionTrace, Ilc
 from executor.evidence import AttemptSetup
 from executor.trial import Cell
@@ -30,12 +32,21 @@ def cell():
 @pytest.mark.slow
 def test_every_layer_switch_changes_the_execution(cell):
     """The same attempt under each layer: the wrench it meets differs from the layer
-    below; with ILC, the second execution differs from the first."""
+    below; with ILC, the second execution differs from the first.  Pure position control
+    tracks stiffly (an industrial arm's servo): the tilted tight peg wedges past F_stop
+    and does not fit, where every adapting layer fits it; the search and the release
+    stay on the compliant impedance."""
     seen = {}
+    controller = cell.motion_for("tp").controller
     for name in LAYERS:
         cell.reset_state(layer=name, perturbation=NO_PERTURBATION)
         seen[name] = cell.run_attempt("tp", "r1", TILTED)
-        assert seen[name].outcome == "fit"
+        assert controller.gains == ImpedanceGains()
+    assert [name for name, layer in LAYERS.items() if layer.stiff] == ["position"]
+    assert POSITION_CONTROL_GAINS.k_trans >= 10 * ImpedanceGains().k_trans
+    assert POSITION_CONTROL_GAINS.k_rot >= 10 * ImpedanceGains().k_rot
+    assert seen["position"].outcome == "no_fit" and seen["position"].max_force_dev >= Thresholds().f_stop
+    assert all(seen[name].outcome == "fit" for name in list(LAYERS)[1:])
     names = list(LAYERS)
     for lower, upper in zip(names, names[1:-1]):
         a, b = seen[lower], seen[upper]
