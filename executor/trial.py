@@ -23,15 +23,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from executor import ExecutorError
-from executor.control.admittance import Admittance, AdmittanceParams
-from executor.control.controller import POSITION_CONTROL_GAINS, ImpedanceController
+from executor.control.controller import ImpedanceController
 from executor.control.detector import Detector, Thresholds
 from executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
 from executor.control.motion import Motion
 from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from executor.rerun_arm import ArmRecorder
 from executor.skills.dmp import Skill, load_skill
-from executor.skills.insertion import insert, rotvec_quat_xyzw
+from executor.skills.insertion import insert_in_layer, rotvec_quat_xyzw
 from executor.skills.search import hole_search
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
 from executor.world.geometry import load_geometry, plate_mesh
@@ -187,16 +186,7 @@ class Cell:
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - float(self.geometry.gripper["grasp_depth"])
-        admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
-                      if layer.admittance else None)
-        compliant = motion.controller.gains
-        if layer.stiff:  # the insertion only: the search, the approach and the release stay compliant
-            motion.controller.gains = POSITION_CONTROL_GAINS
-        try:
-            result = insert(motion, skill, origin, detector, admittance, lever, wiggle_enabled,
-                            phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
-        finally:
-            motion.controller.gains = compliant
+        result = insert_in_layer(motion, skill, origin, detector, layer, lever, wiggle_enabled, correction)
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

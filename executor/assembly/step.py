@@ -40,13 +40,12 @@ from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
 from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
 from executor.assembly.world import AssemblyWorld
-from executor.control.admittance import Admittance, AdmittanceParams
 from executor.control.detector import Detector, Thresholds
 from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from executor.control.motion import StepLogger
 from executor.evidence import AttemptSetup
 from executor.skills.dmp import Skill, load_skill
-from executor.skills.insertion import insert
+from executor.skills.insertion import insert_in_layer
 from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, SETTLE_TIME, trial_rng
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW
@@ -261,13 +260,10 @@ class Assembler:
         lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))
         layer, key = self.layer, f"{self.shape_of(part)}:{hole or part}"
         correction = self.ilc.correction(key)[0] if layer.ilc and self.ilc is not None else None
-        admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
-                      if layer.admittance else None)
         plate = world.frames[p.base.id].body
         if skill == "insert" and setup.friction is not None:  # the hole's friction: Bullet multiplies the two
             pb.changeDynamics(plate, -1, lateralFriction=setup.friction / PART_FRICTION, physicsClientId=world.client)
-        result = insert(motion, skill_obj, origin, detector, admittance, lever, True,
-                        phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
+        result = insert_in_layer(motion, skill_obj, origin, detector, layer, lever, True, correction)
         pb.changeDynamics(plate, -1, lateralFriction=PART_FRICTION, physicsClientId=world.client)
         if result.reached and result.trace is not None and self.ilc is not None:
             self.ilc.update(key, result.trace)

@@ -11,9 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from executor.control.admittance import Admittance
+from executor.control.admittance import Admittance, AdmittanceParams
+from executor.control.controller import POSITION_CONTROL_GAINS
 from executor.control.detector import Detector
-from executor.control.ilc import OFFSET_BOUND, ExecutionTrace
+from executor.control.ilc import OFFSET_BOUND, ExecutionLayer, ExecutionTrace
 from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill
 from executor.skills.search import SearchParams
@@ -142,3 +143,23 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME)
         reached, err = detector.goal_reached(end.tip_pos, p_goal)
     return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase, trace)
+
+
+def insert_in_layer(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
+                    layer: ExecutionLayer, gripper_lever: float, wiggle_enabled: bool = True,
+                    correction: np.ndarray | None = None) -> InsertionResult:
+    """:func:`insert` under an execution layer: its admittance (P or PI, none for pure
+    position control), phase stopping, the ILC ``correction`` and recording; with
+    ``layer.stiff`` the insertion tracks with :data:`POSITION_CONTROL_GAINS` and the
+    controller's own gains come back after (the search and the release stay compliant)."""
+    admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
+                  if layer.admittance else None)
+    controller = motion.controller
+    compliant = controller.gains
+    if layer.stiff:
+        controller.gains = POSITION_CONTROL_GAINS
+    try:
+        return insert(motion, skill, hole_origin, detector, admittance, gripper_lever, wiggle_enabled,
+                      phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
+    finally:
+        controller.gains = compliant
