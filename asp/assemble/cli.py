@@ -95,6 +95,20 @@ def truth_facts(assembly: Assembly) -> LearnedFacts:
                    must_precede=frozenset(closed))
 
 
+def read_session_settings(run: Path, *required: str) -> dict:
+    """The ``session.json`` of run folder ``run``; PlannerError naming the file and the
+    ``required`` keys when it cannot be read or lacks one."""
+    path = run / "session.json"
+    try:
+        settings = json.loads(read_bytes(path, "session settings (JSON)", error=PlannerError))
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        settings = None
+    if not isinstance(settings, dict) or any(key not in settings for key in required):
+        keys = " and ".join(f'"{key}"' for key in required)
+        raise PlannerError(f"{path}: expected the session.json of a finished session (with {keys})")
+    return settings
+
+
 def read_plan_json(path: Path, k: int) -> Plan:
     """Plan ``k`` of a plan JSON file; PlannerError naming the file and what was expected."""
     try:
@@ -121,14 +135,9 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
     name = args.assembly
     plan: Plan | None = None
     if args.run is not None:
-        settings_path = args.run / "session.json"
-        try:
-            settings = json.loads(read_bytes(settings_path, "session settings (JSON)", error=PlannerError))
-            found = settings["plans"]
-            name = name or settings["assembly"]
-        except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError):
-            raise PlannerError(f"{settings_path}: expected the session.json of a finished session "
-                               "(with \"plans\" and \"assembly\")") from None
+        settings = read_session_settings(args.run, "plans", "assembly")
+        settings_path, found = args.run / "session.json", settings["plans"]
+        name = name or settings["assembly"]
         if not isinstance(found, list) or len(found) < args.plan:
             raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {len(found)} plan(s)")
         plan = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in found[args.plan - 1]))

@@ -35,7 +35,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from asp import PlannerError
-from asp.assemble.cli import cell_options, truth_facts
+from asp.assemble.cli import cell_options, read_session_settings, truth_facts
 from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
@@ -45,7 +45,6 @@ from asp.precedence.relation import Relation
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
-from bridge.inputs import read_bytes
 
 ASSIGNMENT_LIMIT = 10_000
 """A plan's assignment is drawn among at most this many feasible ones (clingo's first)."""
@@ -134,12 +133,7 @@ def _facts(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts]:
     name = args.assembly
     paths = list(args.facts)
     if args.run is not None:
-        settings_path = args.run / "session.json"
-        try:
-            settings = json.loads(read_bytes(settings_path, "session settings (JSON)", error=PlannerError))
-            name = name or settings["assembly"]
-        except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError):
-            raise PlannerError(f"{settings_path}: expected the session.json of a session (with \"assembly\")") from None
+        name = name or read_session_settings(args.run, "assembly")["assembly"]
         paths = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
     return assembly, load_learned_facts(paths) if paths else truth_facts(assembly)
