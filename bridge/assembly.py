@@ -3,8 +3,12 @@
 An assembly is a folder (a name under ``data/`` or a path) holding:
 
 - ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role`` and optional ``start``
-  ``[x, y]`` [m] (where the part waits in the cell), ``[holes.<id>]`` with ``name``,
-  ``shape`` and ``position`` ``[x, y]`` [m] on the base plate;
+  ``[x, y]`` [m] (where the part waits in the cell), ``shape`` (a peg's cross-section:
+  ``round``, ``square`` or ``rect``) and ``section`` (pegs of one section are scaled
+  copies of one cross-section; default: the shape, a rect peg's own id);
+  ``[holes.<id>]`` with ``name``, ``shape`` and ``position`` ``[x, y]`` [m] on the base
+  plate; an optional ``[sizes]`` table with ``model`` (the size model the product
+  declares: ``line``, ``sections`` or ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
   ``precedence_edge/2`` or ``must_precede/2``);
 - ``sizes.lp`` (optional): which part fits which hole (``part/1``, ``hole/1``,
@@ -44,12 +48,23 @@ class Item:
     name: str
 
 
+SHAPES = ("round", "square", "rect")
+"""Cross-sections of pegs and holes."""
+
+SIZE_MODELS = ("line", "sections", "pairs")
+"""The size models a product may declare (``[sizes] model``; docs/sizes.md)."""
+
+
 @dataclass(frozen=True)
 class Part(Item):
-    """One part of an assembly; ``start`` is its waiting position [m] or None."""
+    """One part of an assembly; ``start`` is its waiting position [m] or None; ``shape``
+    its cross-section (None: not stated) and ``section`` the label shared by parts that
+    are scaled copies of one cross-section (None: not stated)."""
 
     role: str = "part"
     start: tuple[float, float] | None = None
+    shape: str | None = None
+    section: str | None = None
 
 
 @dataclass(frozen=True)
@@ -68,6 +83,12 @@ class Assembly:
     name: str
     parts: tuple[Part, ...]
     holes: tuple[Hole, ...] = field(default_factory=tuple)
+    size_model: str | None = None
+    """The size model the product declares (``[sizes] model``), None when it declares none."""
+
+    def sections(self) -> dict[str, str]:
+        """Part id -> section, for the parts whose cross-section is stated."""
+        return {p.id: p.section for p in self.parts if p.section is not None}
 
     @property
     def part_ids(self) -> list[str]:
@@ -140,7 +161,7 @@ def load_assembly(name_or_path: str) -> Assembly:
         raise BridgeError(f"{source}: not valid TOML: {exc}") from None
     parts = tuple(
         Part(key, str(value.get("name", key)), str(value.get("role", "part")),
-             _position(source, "parts", key, value.get("start")))
+             _position(source, "parts", key, value.get("start")), *_section(source, key, value))
         for key, value in _table(source, data, "parts").items()
     )
     if not parts:
@@ -153,4 +174,36 @@ def load_assembly(name_or_path: str) -> Assembly:
     clash = {p.id for p in parts} & {h.id for h in holes}
     if clash:
         raise BridgeError(f"{source}: ids used for both a part and a hole: {sorted(clash)}")
-    return Assembly(folder=folder, name=str(data.get("name", folder.name)), parts=parts, holes=holes)
+    return Assembly(folder=folder, name=str(data.get("name", folder.name)), parts=parts, holes=holes,
+                    size_model=_size_model(source, data))
+
+
+def _choice(source: Path, table: str, key: str, value: object, choices: tuple[str, ...]) -> str:
+    if not isinstance(value, str) or value not in choices:
+        raise BridgeError(f"{source}: [{table}] {key}: expected one of {', '.join(choices)}, "
+                          f"got {shorten(repr(value))}")
+    return value
+
+
+def _section(source: Path, key: str, value: dict) -> tuple[str | None, str | None]:
+    """(shape, section) of ``[parts.<key>]``; the section defaults to the shape, and to
+    the part's own id for a rect (rectangles of other aspect ratios are not on one line)."""
+    shape = value.get("shape")
+    if shape is not None:
+        shape = _choice(source, f"parts.{key}", "shape", shape, SHAPES)
+    section = value.get("section")
+    if section is not None and (not isinstance(section, str) or not _ID.match(section)):
+        raise BridgeError(f"{source}: [parts.{key}] section: expected a lower-case ASP constant "
+                          f"of at most 64 characters, got {shorten(repr(section))}")
+    if section is None and shape is not None:
+        section = key if shape == "rect" else shape
+    return shape, section
+
+
+def _size_model(source: Path, data: dict) -> str | None:
+    table = data.get("sizes")
+    if table is None:
+        return None
+    if not isinstance(table, dict) or set(table) - {"model"}:
+        raise BridgeError(f"{source}: [sizes]: expected a table with the key model")
+    return _choice(source, "sizes", "model", table.get("model"), SIZE_MODELS)

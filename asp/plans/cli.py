@@ -51,7 +51,7 @@ def report_unsolvable(exc: UnsolvableAssembly, key: str, as_json: bool) -> int:
     """Print why the assembly is unsolvable (stderr; JSON with an empty ``key`` list)."""
     print(f"error: {exc}", file=sys.stderr)
     if as_json:
-        print(json.dumps({key: [], "error": str(exc), "part": exc.part}))
+        print(json.dumps({key: [], "error": str(exc), "part": exc.part, "parts": list(exc.parts)}))
     return EXIT_UNSOLVABLE
 
 
