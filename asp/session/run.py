@@ -482,6 +482,8 @@ def _summary(result: dict, run: Path) -> str:
         "fits: " + " ".join(f"{p}->{h}" for p, h in result["fits"])
         + (f" (started from {len(result['demonstrated'])} seen in the demonstrations)"
            if result["demonstrated"] else ""),
+        f"assumes: {result['assumption']}",
+        *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
         "assignment: " + " ".join(f"{p}->{h}" for p, h in settings["assignment"].items()),
         f"plan 1 of {len(result['plans'])}: {plan}",
