@@ -206,3 +206,12 @@ def test_a_contradicted_line_moves_to_sections_then_learns_the_truth() -> None:
     assert result.model.name == "sections" and len(result.model_changes) == 1
     assert "contradict size model line; now sections" in result.model_changes[0]
     assert result.knowledge.fits == frozenset(truth.fits)
+
+
+@pytest.mark.parametrize("policy", policy_names())
+def test_under_pairs_every_policy_tries_every_pair_and_learns_the_truth(policy: str) -> None:
+    truth, sections = _example(2)
+    result = learn_sizes(truth.parts, truth.holes, truth, policy, model=build_model("pairs", truth.parts, sections))
+    assert result.knowledge.fits == frozenset(truth.fits)
+    assert result.count == len(truth.parts) * len(truth.holes)
+    assert len({(e.part, e.hole) for e in result.experiments}) == result.count
