@@ -2,7 +2,8 @@
 impedance arm, hole search, DMP insertion with admittance and phase stopping, failure
 detection (eqs. 6, 7 and the goal check) and the wiggle exception strategy.
 
-Entry points: :class:`executor.trial.Cell` (``run_trial``) and ``python -m executor.cli``.
+Entry points: :class:`executor.trial.Cell` (``run_trial``) and the ``executor`` subcommand
+of the command line (:mod:`executor.cli`).
 Layers, each importing only those before it: :mod:`executor.world` (geometry, PyBullet
 scene, arm), :mod:`executor.control` (impedance controller, admittance, detector, motion
 stepper), :mod:`executor.skills` (DMP, hole search, insertion, wiggle, teaching), the

@@ -177,5 +177,3 @@ def main(argv: Sequence[str] | None = None) -> int:
     return run_command(dispatch, (ExecutorError, BridgeError))
 
 
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,9 +1,8 @@
 """A corpus of bad input for both command lines (repository level: it spans the packages).
 
 One row per case: ``(id, argv, setup, expected exit code, a word the message must hold)``.
-``argv`` starting with ``executor`` runs ``python -m executor``, ``bench executor`` runs
-``python -m executor.campaign.bench`` (as run.sh does), anything else ``python -m asp.cli``;
-both run as separate processes in ``tmp_path``. ``setup`` is None, a dict of input files
+``argv`` runs the one command line, ``python -m assembly_constraints`` (as ``./run.sh``
+does), as a separate process in ``tmp_path``. ``setup`` is None, a dict of input files
 (name → text or bytes) or a callable ``setup(tmp_path)``. Every bad input must give one
 line ``error: ...`` on stderr holding the word, the exit code, and never a traceback.
 
@@ -27,7 +26,7 @@ import pytest
 
 from asp.session.journal import MAX_JOURNAL_BYTES
 from bridge.cli_types import EXIT_BROKEN_PIPE
-from tests.conftest import ROOT, child_env, python_argv
+from tests.conftest import CLI_MODULE, ROOT, child_env, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
 Setup = Callable[[Path], None] | dict[str, str | bytes] | None
@@ -227,18 +226,8 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
 ]
 
 
-def _module(argv: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
-    """The module run.sh runs for ``argv``, and its arguments."""
-    if argv[0] == "executor":
-        return "executor", argv[1:]
-    if argv[:2] == ("bench", "executor"):
-        return "executor.campaign.bench", argv[2:]
-    return "asp.cli", argv
-
-
 def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
-    module, args = _module(argv)
-    process = subprocess.Popen(python_argv(module, *args), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
+    process = subprocess.Popen(python_argv(CLI_MODULE, *argv), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         if head:
