@@ -7,8 +7,9 @@ under ``executor`` (:mod:`executor.cli`), the benchmarks of both under ``bench``
 (:mod:`bridge.protocol_schema`). The tests run this same command line.
 Modules are imported lazily, so ``--help`` of one subcommand does not pay for the others.
 
-Exit codes: 0 done, 1 a check failed, 2 bad input or usage (a missing subcommand too),
-3 an unsolvable assembly, 130 interrupted, 141 stdout closed.
+Exit codes (:mod:`bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
+missing subcommand too; every :class:`bridge.errors.ToolError`), 3 an unsolvable
+assembly, 130 interrupted, 141 stdout closed.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from collections.abc import Callable, Sequence
 
 from assembly_constraints import __version__
 from bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
+from bridge.errors import ToolError
 
 BENCHMARKS: dict[str, str] = {
     "precedence": "asp.bench.precedence",
@@ -104,11 +106,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(f"expected a subcommand, one of: {', '.join(SUBCOMMANDS)} (see --help)")
     configure_logging(logging.DEBUG if args.verbose else logging.ERROR if args.quiet else logging.INFO)
     target, _ = SUBCOMMANDS[args.subcommand]
-    from asp import PlannerError
-    from bridge import BridgeError
-    from executor import ExecutorError
-
-    return run_command(lambda: int(_entry(target)(args.arguments) or 0), (PlannerError, ExecutorError, BridgeError))
+    return run_command(lambda: int(_entry(target)(args.arguments) or 0), (ToolError,))
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any, NoReturn, TypeVar
 
 from bridge import BridgeError
+from bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED
 from bridge.inputs import shorten
 
 T = TypeVar("T")
@@ -98,9 +99,6 @@ def configure_logging(level: int | None = None) -> None:
         root.setLevel(level)
 
 
-EXIT_BROKEN_PIPE = 141
-"""Exit code when stdout's reader went away (``... | head -1``): 128 + SIGPIPE, what a
-shell reports for ``yes | head -1``, so ``set -o pipefail`` scripts see the usual code."""
 
 
 def one_line(message: object, limit: int = 2000) -> str:
@@ -133,10 +131,10 @@ def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...])
         return quiet_broken_pipe()
     except errors as exc:
         print(f"error: {one_line(exc)}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 def int_in(low: int, high: int = sys.maxsize) -> Callable[[str], int]:

@@ -15,7 +15,10 @@ and :mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`)
 """
 
 
-class ExecutorError(Exception):
+from bridge.errors import ToolError
+
+
+class ExecutorError(ToolError):
     """Base error of the executor: a bad part/hole id, a missing demonstration, bad data.
 
     The message names the bad value and what was expected; the command line prints

@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 
 from asp.session.journal import MAX_JOURNAL_BYTES
-from bridge.cli_types import EXIT_BROKEN_PIPE
+from bridge.errors import EXIT_BROKEN_PIPE
 from tests.conftest import CLI_MODULE, ROOT, child_env, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"

@@ -43,7 +43,6 @@ bound of the Cranfield total of every policy never worse than systematic on ever
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -584,6 +583,3 @@ def main(argv: list[str]) -> int:
               f"{result}{bound['states']} states, {bound['seconds']} s)")
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

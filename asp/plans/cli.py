@@ -27,9 +27,7 @@ from asp.plans.plans import HOME, Plan, plans, travel_facts
 from asp.solve import write_facts
 from bridge.assembly import MAX_COORDINATE, load_assembly
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, int_in
-
-EXIT_UNSOLVABLE = 3
-"""Exit code of a valid but unsolvable assembly (bad input exits with 2)."""
+from bridge.errors import EXIT_UNSOLVABLE
 
 MAX_PLANS = 1_000_000
 """``plan -n K``: at most this many plans (0 = all)."""

@@ -62,6 +62,7 @@ from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_cell_arguments, cell_argv, parse_cell_argv
 from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
+from bridge.errors import EXIT_UNSOLVABLE
 from bridge.files import make_folder, write_atomic
 from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
@@ -74,8 +75,6 @@ MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
 MAX_CELLS = 64
 """--cells: at most this many cell co-processes."""
-EXIT_STOPPED = 3
-"""Exit code when ``--assemble`` could not finish the product."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -505,15 +504,12 @@ def _summary(result: dict, run: Path) -> str:
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     viewer = viewer_of(args)
-    try:
-        with hosted_viewer(viewer) as live:
-            result = run_session(args, live)
-            print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
-            keep_serving(viewer)
-    except BridgeError as exc:
-        raise PlannerError(str(exc)) from None
+    with hosted_viewer(viewer) as live:
+        result = run_session(args, live)
+        print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
+        keep_serving(viewer)
     stopped = result.get("assembly", {}).get("error")
     if stopped:
         LOG.error("%s", stopped)
-        return EXIT_STOPPED
+        return EXIT_UNSOLVABLE
     return 0

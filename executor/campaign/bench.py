@@ -22,10 +22,8 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from bridge import BridgeError
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
-from executor import ExecutorError
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
@@ -133,6 +131,3 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(json.dumps(report, indent=2) if args.json else format_report(report))
     return 0
 
-
-if __name__ == "__main__":
-    raise SystemExit(run_command(main, (ExecutorError, BridgeError)))
