@@ -137,6 +137,24 @@ def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...])
         return EXIT_INTERRUPTED
 
 
+MAX_JOBS = 64
+"""``--jobs``: at most this many processes or cells at once."""
+
+
+def default_jobs() -> int:
+    """The machine's cores (those this process may use), at most :data:`MAX_JOBS`."""
+    return max(1, min(MAX_JOBS, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                      else os.cpu_count() or 1))
+
+
+def add_jobs_argument(parser: argparse._ActionsContainer, what: str) -> None:
+    """``--jobs N``: how many ``what`` run at once (default: the machine's cores). Results
+    do not depend on N (each unit of work has its own seed and its own process or cell)."""
+    parser.add_argument("--jobs", type=int_in(1, MAX_JOBS), default=default_jobs(), metavar="N",
+                        help=f"{what} at once (default: the machine's cores, here {default_jobs()}); "
+                             "the results do not depend on it")
+
+
 def int_in(low: int, high: int = sys.maxsize) -> Callable[[str], int]:
     """An argparse type: an integer in [low, high] (``high`` default: no practical bound)."""
     expected = f"an integer >= {low}" if high == sys.maxsize else f"an integer from {low} to {high}"

@@ -192,7 +192,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("serve-unknown-option", ("executor", "serve", "--bogus"), None, 2, "unrecognized"),
     ("serve-bad-cell-id", ("executor", "serve", "--cell", "C!"), None, 2, "cell id"),
     ("campaign-trials-zero", ("executor", "campaign", "--trials", "0"), None, 2, "--trials"),
-    ("campaign-workers-huge", ("executor", "campaign", "--workers", "1e3"), None, 2, "--workers"),
+    ("campaign-jobs-huge", ("executor", "campaign", "--jobs", "1e3"), None, 2, "--jobs"),
     ("margins-seed-negative", ("executor", "margins", "--seed", "-1"), None, 2, "--seed"),
     ("margins-trials-missing", ("executor", "margins", "--trials"), None, 2, "--trials"),
     ("bench-unknown", ("bench", "nosuch"), None, 2, "nosuch"),
@@ -204,7 +204,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("bench-precedence-repeat-zero", ("bench", "precedence", "--repeat", "0"), None, 2, "--repeat"),
     ("bench-session-product-one", ("bench", "session", "--product", "1"), None, 2, "--product"),
     ("bench-session-delay-negative", ("bench", "session", "--delay", "-1"), None, 2, "--delay"),
-    ("bench-executor-workers-zero", ("bench", "executor", "--workers", "0"), None, 2, "--workers"),
+    ("bench-executor-jobs-zero", ("bench", "executor", "--jobs", "0"), None, 2, "--jobs"),
     ("bench-executor-unknown-option", ("bench", "executor", "--bogus"), None, 2, "unrecognized"),
     # demonstrations that say where a part went (part@hole)
     ("learn-unknown-hole", ("precedence", "learn", "d.txt", "--assembly", "cranfield"),
