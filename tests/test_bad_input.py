@@ -198,7 +198,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("bench-unknown", ("bench", "nosuch"), None, 2, "nosuch"),
     ("bench-sizes-list", ("bench", "sizes", "--sizes", "3,y"), None, 2, "--sizes"),
     ("bench-sizes-seeds-zero", ("bench", "sizes", "--noise", "0.1", "--seeds", "0"), None, 2, "--seeds"),
-    ("bench-dominance-seconds-nan", ("bench", "dominance", "--seconds", "nan"), None, 2, "--seconds"),
+    ("bench-dominance-time-limit-nan", ("bench", "dominance", "--time-limit", "nan"), None, 2, "--time-limit"),
     ("bench-dominance-sizes", ("bench", "dominance", "--sizes", "4y5"), None, 2, "--sizes"),
     ("bench-plan-parts-huge", ("bench", "plan", "--parts", "100"), None, 2, "--parts"),
     ("bench-precedence-repeat-zero", ("bench", "precedence", "--repeat", "0"), None, 2, "--repeat"),

@@ -545,7 +545,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--unconstrained", action="store_true",
                         help="also the unconstrained optimum (3x4: ~30 s; 4x4: too long)")
     parser.add_argument("--cranfield", action="store_true", help="the Cranfield relaxation")
-    parser.add_argument("--seconds", type=finite_float(0, 1e6, low_open=True), default=60,
+    parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60,
                         help="time for the Cranfield lower bound (iterative deepening, default 60)")
     parser.add_argument("--all-biorders", action="store_true",
                         help="Cranfield total of policies never worse on all 5x5 biorders (long)")
@@ -562,7 +562,7 @@ def main(argv: list[str]) -> int:
         print(f"{row['size']:>5} {row['biorders']:>8} {row['systematic']:>10} {row['never_worse']:>11} "
               f"{row.get('optimum', '-'):>8} {row['states']:>8} {row['seconds']:>6}", flush=True)
     if args.cranfield:
-        report = cranfield_report(args.seconds)
+        report = cranfield_report(args.time_limit)
         system, found, least = report["systematic"], report["never_worse_policy"], report["least_total"]
         print(f"\nCranfield, {report['truths']} distinct truths (each 16 of the 14400 relabelings):")
         print(f"  systematic: total {system['total']}, mean {system['mean']}, max {system['max']}")

@@ -110,7 +110,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--ablation", action="store_true",
                         help="instead: every execution-layer variant on the same perturbations "
                         "(--trials per pair, default 40)")
-    parser.add_argument("--executions", type=int, default=5,
+    parser.add_argument("--executions", type=int_in(1, 10**5), default=5,
                         help="--ablation: consecutive executions of a pair per cell (default 5)")
     add_cell_arguments(parser, layer=False)
     args = parser.parse_args(argv)
