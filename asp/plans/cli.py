@@ -90,8 +90,8 @@ def plan_main(argv: list[str]) -> int:
         "must_precede, each part that needs a hole in a distinct hole it fits. "
         f"Exit {EXIT_UNSOLVABLE}: the assembly is not solvable.",
     )
-    parser.add_argument("-n", type=int_in(0, MAX_PLANS), default=1, metavar="K",
-                        help="how many plans (0 = all; default 1)")
+    parser.add_argument("-n", "--plans", dest="n", type=int_in(0, MAX_PLANS), default=1, metavar="K",
+                        help="how many plans (0 = all; default 1; as session --plans)")
     parser.add_argument("--optimal", action="store_true",
                         help="plans of least total tool travel [mm] (needs --assembly)")
     add_assembly_argument(parser, None, purpose="gives the positions for --optimal")
