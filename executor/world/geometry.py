@@ -6,7 +6,8 @@ collision margin, so 0.1 mm clearances are real): one square boss per hole with 
 through hole (the plate under the boss is its bottom) and a 45° entry chamfer; round
 holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square holes exact.
 Parts are exact primitive shapes (cylinder with ``URDF_USE_IMPLICIT_CYLINDER``, box).
-``write_assets`` regenerates ``data/<assembly>/assets/`` byte-for-byte deterministically.
+``write_assets`` regenerates ``data/<assembly>/assets/`` deterministically (the URDFs byte
+for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 """
 
 from __future__ import annotations
