@@ -179,6 +179,11 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("assign-non-ascii", ("assign", "f.lp"), {"f.lp": "part(\u00e4). hole(r1).\n"}, 2, "outside a string"),
     ("learn-png-folder", ("precedence", "learn", "--assembly", "cranfield", "--png", "pictures"),
      lambda tmp: (tmp / "pictures").mkdir(), 2, ".png"),
+    # output paths that are special files: written through or refused, never replaced
+    ("learn-out-full-disk", ("precedence", "learn", "--assembly", "cranfield", "--out", "full"),
+     lambda tmp: (tmp / "full").symlink_to("/dev/full"), 2, "full: cannot write (No space left on device)"),
+    ("learn-out-fifo-no-reader", ("precedence", "learn", "--assembly", "cranfield", "--out", "pipe"),
+     lambda tmp: os.mkfifo(tmp / "pipe"), 2, "pipe: cannot write (a FIFO with no reader)"),
     # bounds
     ("learn-huge-step", ("precedence", "learn", "d.lp"), {"d.lp": "demo(1,1,bp). demo(1,2147483647,p1)."}, 2,
      "step"),

@@ -7,6 +7,7 @@ limited by ``RLIMIT_FSIZE``) leaves the previous file whole and no temporary fil
 
 from __future__ import annotations
 
+import stat
 import sys
 from pathlib import Path
 
@@ -65,3 +66,21 @@ def test_full_disk_leaves_the_old_file_whole(tmp_path: Path, run_cli, command: s
     assert "Traceback" not in done.stderr
     assert out.read_bytes() == good
     assert leftovers(tmp_path) == [] and [p.name for p in tmp_path.iterdir()] == ["facts.lp"]
+
+
+@pytest.mark.parametrize("command", ["plan --travel-out", "precedence learn --out"])
+def test_a_device_is_written_through_never_replaced(tmp_path: Path, run_cli, command: str) -> None:
+    """``--out /dev/null`` discards the output (exit 0), ``/dev/full`` is a full disk (exit
+    2); both stay devices. Links to them, so that a writer that replaced the path would
+    replace the link, never the machine's ``/dev/null``."""
+    null, full = tmp_path / "null", tmp_path / "full"
+    null.symlink_to("/dev/null")
+    full.symlink_to("/dev/full")
+    done = run_cli(*_argv(command, null))
+    assert done.returncode == 0, done.stderr
+    done = run_cli(*_argv(command, full))
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.splitlines() == [f"error: {full}: cannot write (No space left on device)"]
+    assert null.resolve() == Path("/dev/null") and full.resolve() == Path("/dev/full")
+    assert stat.S_ISCHR(null.stat().st_mode) and stat.S_ISCHR(full.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full", "null"]
