@@ -303,11 +303,3 @@ def write_assets(geometry: CellGeometry) -> list[Path]:
         written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part)))
     return written
 
-
-def plate_mesh(geometry: CellGeometry) -> Path:
-    """``assets/plate.obj`` (the bosses with their holes, world coordinates [m]), generated
-    with the other assets first if it is missing."""
-    path = geometry.assets / "plate.obj"
-    if not path.is_file():
-        write_assets(geometry)
-    return path
