@@ -8,13 +8,14 @@ limited by ``RLIMIT_FSIZE``) leaves the previous file whole and no temporary fil
 from __future__ import annotations
 
 import stat
+import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
 from tests._files_helpers import leftovers, run_with_file_limit
-from tests.conftest import CLI_MODULE, ROOT
+from tests.conftest import CLI_MODULE, ROOT, child_env
 
 CRANFIELD = ROOT / "data" / "cranfield"
 PLAN = ("plan", str(CRANFIELD / "precedence.lp"), str(CRANFIELD / "sizes.lp"), "--assembly", "cranfield")
@@ -84,3 +85,15 @@ def test_a_device_is_written_through_never_replaced(tmp_path: Path, run_cli, com
     assert null.resolve() == Path("/dev/null") and full.resolve() == Path("/dev/full")
     assert stat.S_ISCHR(null.stat().st_mode) and stat.S_ISCHR(full.stat().st_mode)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full", "null"]
+
+
+@pytest.mark.parametrize("argv", [("precedence", "count", "--assembly", "cranfield"),
+                                  ("precedence", "enumerate", "--assembly", "cranfield"),
+                                  ("executor", "trial", "--part", "p1", "--hole", "r1")])
+def test_stdout_on_a_full_disk_is_one_line_exit_2(argv: tuple[str, ...]) -> None:
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "assembly_constraints", *argv], cwd=ROOT, env=child_env(),
+                              stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
+    lines = [line for line in done.stderr.splitlines() if not line.startswith("pybullet build time")]
+    assert done.returncode == 2, done.stderr
+    assert lines == ["error: stdout: cannot write (No space left on device)"], done.stderr
