@@ -97,3 +97,17 @@ def test_stdout_on_a_full_disk_is_one_line_exit_2(argv: tuple[str, ...]) -> None
     lines = [line for line in done.stderr.splitlines() if not line.startswith("pybullet build time")]
     assert done.returncode == 2, done.stderr
     assert lines == ["error: stdout: cannot write (No space left on device)"], done.stderr
+
+
+@pytest.mark.slow
+def test_a_recording_that_hits_a_full_disk_is_one_line_exit_2(tmp_path: Path) -> None:
+    """A session whose planner.rrd outgrows the disk (60 kB files): the facts are written,
+    then ``error: RUN/planner.rrd: cannot write (...)`` is the last line (after the Rerun
+    SDK's own report of the failed write, with the system's reason), exit 2, no traceback."""
+    run = tmp_path / "run"
+    done = run_with_file_limit([sys.executable, "-m", CLI_MODULE, "session", "--backend", "truth", "--out", str(run)],
+                               limit=60_000, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.splitlines()[-1].startswith(f"error: {run / 'planner.rrd'}: cannot write ("), done.stderr
+    assert "Traceback" not in done.stderr
+    assert (run / "learned.lp").is_file()
