@@ -51,10 +51,10 @@ def whole_length(path: Path) -> int | None:
             if len(head) < MESSAGE_HEADER.size:
                 return offset
             kind, length = MESSAGE_HEADER.unpack(head)
-            if kind == 0:  # the end message: finished
-                return None
             if offset + MESSAGE_HEADER.size + length > size:
-                return offset
+                return offset  # cut inside this message (the end message too)
+            if kind == 0:  # the whole end message: finished
+                return None
             offset += MESSAGE_HEADER.size + length
     return None
 

@@ -72,3 +72,16 @@ def test_a_file_torn_inside_its_stream_header_is_still_refused(tmp_path: Path, r
     rrd.write_bytes(recording[:6])
     with pytest.raises(BridgeError, match="c1.rrd: not a"):
         read_recording(rrd)
+
+
+@pytest.mark.slow
+def test_a_file_torn_inside_its_end_message_keeps_every_entity(tmp_path: Path, recording: bytes, caplog) -> None:
+    offset, length = _last_message(recording)
+    end = offset + 16 + length  # the end message (its footer data) starts here
+    rrd = tmp_path / "c1.rrd"
+    rrd.write_bytes(recording[: end + 100])
+    whole = tmp_path / "whole.rrd"
+    whole.write_bytes(recording)
+    with caplog.at_level("WARNING"):
+        assert set(read_recording(rrd).entities) == set(read_recording(whole).entities)
+    assert any(f"{rrd}: torn tail" in r.getMessage() for r in caplog.records)
