@@ -65,5 +65,5 @@ def current_assets(geometry: CellGeometry) -> Path:
     try:
         regenerate_assets(geometry)
     except BridgeError as exc:
-        raise ExecutorError(f"{exc}; the assets there are stale and were not used") from None
+        raise ExecutorError(f"{exc}; the generated assets there are missing or stale, not used") from None
     return folder
