@@ -138,16 +138,15 @@ class _GuardedStdout:
         self._stream = stream
 
     def write(self, text: str) -> int:
-        try:
-            return self._stream.write(text)
-        except BrokenPipeError:
-            raise
-        except OSError as exc:
-            raise StdoutError(f"stdout: cannot write ({exc.strerror or exc})") from None
+        return self._guarded(self._stream.write, text)
 
     def flush(self) -> None:
+        self._guarded(self._stream.flush)
+
+    @staticmethod
+    def _guarded(function: Callable[..., Any], *args: Any) -> Any:
         try:
-            self._stream.flush()
+            return function(*args)
         except BrokenPipeError:
             raise
         except OSError as exc:
