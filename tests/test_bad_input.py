@@ -71,6 +71,12 @@ def assembly(**files: str | bytes | Callable[[Path], None]) -> Callable[[Path], 
     return setup
 
 
+def geometry(old: str, new: str) -> Callable[[Path], None]:
+    """Setup: the Cranfield copy of :func:`assembly` with ``old`` replaced by ``new`` in
+    its ``geometry.toml``."""
+    return assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(old, new, 1)})
+
+
 def huge_journal(run: Path) -> None:
     """Setup: a run folder to resume whose journal is one byte over the bound (a sparse file)."""
     run.mkdir()
@@ -160,6 +166,17 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      assembly(**{"geometry.toml": bytes(range(256))}), 2, "geometry.toml"),
     ("trial-geometry-missing-keys", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"geometry.toml": "[plate]\ntop_z = 0.1\n"}), 2, "tile_size"),
+    ("trial-polygon-sides-huge", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry("polygon_sides = 24", "polygon_sides = 8000000"), 2,
+     "[plate] polygon_sides: expected an integer multiple of 8 in 8 .. 256, got 8000000"),
+    ("trial-size-string", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry("size = 0.0120           # diameter [m]", 'size = "12"'), 2, "[part_shapes.round_peg] size"),
+    ("trial-peg-half-a-metre", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry("size = 0.0187", "size = 0.5"), 2, "[part_shapes.shaft] size: expected a number in (0, 0.1] m"),
+    ("trial-kind-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of round, square"),
+    ("teach-demo-hole-unknown", ("executor", "teach", "--assembly", "asm"),
+     geometry('demo_hole = "br"', 'demo_hole = "zz"'), 2, "[part_shapes.shaft] demo_hole"),
     # learned facts: arity, ids, cycles, contradictions
     ("assign-arity", ("assign", "f.lp"), {"f.lp": "part(a). hole(r1). fits(a,r1,x).\n"}, 2, "fits/2"),
     ("plan-arity", ("plan", "f.lp"), {"f.lp": "part(a;b). must_precede(a,b,c).\n"}, 2, "must_precede/2"),
@@ -178,6 +195,11 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("assign-non-ascii", ("assign", "f.lp"), {"f.lp": "part(\u00e4). hole(r1).\n"}, 2, "outside a string"),
     ("learn-png-folder", ("precedence", "learn", "--assembly", "cranfield", "--png", "pictures"),
      lambda tmp: (tmp / "pictures").mkdir(), 2, ".png"),
+    # output paths that are special files: written through or refused, never replaced
+    ("learn-out-full-disk", ("precedence", "learn", "--assembly", "cranfield", "--out", "full"),
+     lambda tmp: (tmp / "full").symlink_to("/dev/full"), 2, "full: cannot write (No space left on device)"),
+    ("learn-out-fifo-no-reader", ("precedence", "learn", "--assembly", "cranfield", "--out", "pipe"),
+     lambda tmp: os.mkfifo(tmp / "pipe"), 2, "pipe: cannot write (a FIFO with no reader)"),
     # bounds
     ("learn-huge-step", ("precedence", "learn", "d.lp"), {"d.lp": "demo(1,1,bp). demo(1,2147483647,p1)."}, 2,
      "step"),
