@@ -29,7 +29,6 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 from asp import PlannerError
@@ -37,8 +36,6 @@ from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import Plan, PlanStep, check_plan, plans
-from asp.precedence.relation import true_relation
-from asp.solve import fact
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
@@ -89,10 +86,7 @@ def cell_options(args: argparse.Namespace) -> list[str]:
 
 def truth_facts(assembly: Assembly) -> LearnedFacts:
     """The assembly's true sizes and precedence as learned facts (``must_precede`` closed)."""
-    facts = load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
-    closed = true_relation(assembly).pairs()
-    return replace(facts, atoms=(*facts.atoms, *(fact("must_precede", a, b) for a, b in closed)),
-                   must_precede=frozenset(closed))
+    return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
 
 
 def read_session_settings(run: Path, *required: str) -> dict:

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
+from asp.precedence.relation import load_relation
 from asp.solve import load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 from tests.conftest import ROOT
@@ -164,3 +165,39 @@ def test_plain_clingo_answers_the_readme_questions(learned: Path, facts: Learned
     p3_holes = set(re.findall(r"assigned\(p3,(\w+)\)", last))
     assert p3_holes == {a["p3"] for a in all_assignments(facts)}
     assert p3_holes <= set(facts.holes_of("p3"))
+
+
+@pytest.mark.parametrize("name", ["cranfield", "spare", "graded"])
+def test_plans_of_shipped_files_respect_their_precedence_edges(name: str) -> None:
+    """A shipped precedence.lp holds only precedence_edge/2 (the reduction): plans read
+    its transitive closure, so every plan is a sequence the true constraints admit."""
+    folder = ROOT / "data" / name
+    truth = load_relation([folder / "precedence.lp"])
+    facts = load_learned_facts([folder / "sizes.lp", folder / "precedence.lp"])
+    assert facts.must_precede == frozenset(truth.pairs())
+    for plan in plans(facts, 30):
+        assert truth.admits([step.part for step in plan.steps])
+        assert check_plan(facts, plan.steps) == []
+    wrong = tuple(reversed(plans(facts, 1)[0].steps))
+    assert any(error.startswith("wrong_order(") for error in check_plan(facts, wrong))
+
+
+def test_plan_command_reads_precedence_edges_and_mixed_forms(tmp_path: Path, run_cli) -> None:
+    truth = load_relation([CRANFIELD / "precedence.lp"])
+    done = run_cli("plan", str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"), "-n", "20", "--json")
+    assert done.returncode == 0, done.stderr
+    for plan in json.loads(done.stdout)["plans"]:
+        assert truth.admits([step["part"] for step in plan])
+    mixed = tmp_path / "mixed.lp"
+    mixed.write_text("part(a;b;c). must_precede(a,b). precedence_edge(b,c).\n")
+    done = run_cli("plan", str(mixed), "-n", "0", "--json")
+    assert done.returncode == 0, done.stderr
+    assert [[step["part"] for step in plan] for plan in json.loads(done.stdout)["plans"]] == [["a", "b", "c"]]
+    cyclic = tmp_path / "cyclic_edges.lp"
+    cyclic.write_text("part(a;b). must_precede(a,b). precedence_edge(b,a).\n")
+    done = run_cli("plan", str(cyclic))
+    assert done.returncode == 2 and "has a cycle a < b < a" in done.stderr
+    unknown = tmp_path / "unknown.lp"
+    unknown.write_text("part(a;b). precedence_edge(a,zz).\n")
+    done = run_cli("plan", str(unknown))
+    assert done.returncode == 2 and "precedence_edge(a,zz): zz is not a part/1" in done.stderr
