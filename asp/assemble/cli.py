@@ -34,8 +34,9 @@ from pathlib import Path
 from asp import PlannerError
 from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
+from asp.assemble.inputs import check_facts_product, check_plan_product, plan_of_json, read_plan_json
 from asp.plans.assign import LearnedFacts, load_learned_facts
-from asp.plans.plans import Plan, PlanStep, check_plan, plans
+from asp.plans.plans import Plan, plans
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
@@ -84,6 +85,11 @@ def cell_options(args: argparse.Namespace) -> list[str]:
     return []
 
 
+def truth_sources(assembly: Assembly) -> str:
+    """The assembly's true facts files, as messages name them."""
+    return f"{assembly.file('sizes.lp')}, {assembly.file('precedence.lp')}"
+
+
 def truth_facts(assembly: Assembly) -> LearnedFacts:
     """The assembly's true sizes and precedence as learned facts (``must_precede`` closed)."""
     return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
@@ -103,23 +109,6 @@ def read_session_settings(run: Path, *required: str) -> dict:
     return settings
 
 
-def read_plan_json(path: Path, k: int) -> Plan:
-    """Plan ``k`` of a plan JSON file; PlannerError naming the file and what was expected."""
-    try:
-        data = json.loads(read_bytes(path, "plan file (JSON)", error=PlannerError))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise PlannerError(f"{path}: not valid JSON ({exc})") from None
-    if isinstance(data, dict):
-        many = data.get("plans")
-        data = data.get("plan") or (many[k - 1] if isinstance(many, list) and len(many) >= k else None)
-    ok = isinstance(data, list) and data and all(isinstance(s, dict) and isinstance(s.get("part"), str)
-                                                 and isinstance(s.get("hole", None), (str, type(None))) for s in data)
-    if not ok:
-        raise PlannerError(f"{path}: expected a plan [{{\"part\": P, \"hole\": H|null}}, ...], {{\"plan\": [...]}} "
-                           f"or {{\"plans\": [[...], ...]}} with at least {k} plan(s)")
-    return Plan(tuple(PlanStep(s["part"], s.get("hole")) for s in data))
-
-
 def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
     """The assembly, the facts for re-planning and the plan to execute."""
     jsons = [p for p in args.inputs if p.suffix == ".json"]
@@ -128,13 +117,16 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
         raise PlannerError("expected --run RUN, or one PLAN.json with optional FACTS.lp files, or FACTS.lp files")
     name = args.assembly
     plan: Plan | None = None
+    plan_source = ""
     if args.run is not None:
         settings = read_session_settings(args.run, "plans", "assembly")
         settings_path, found = args.run / "session.json", settings["plans"]
         name = name or settings["assembly"]
         if not isinstance(found, list) or len(found) < args.plan:
-            raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {len(found)} plan(s)")
-        plan = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in found[args.plan - 1]))
+            count = len(found) if isinstance(found, list) else 0
+            raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {count} plan(s)")
+        plan_source = f"{settings_path}: plans[{args.plan}]"
+        plan = plan_of_json(found[args.plan - 1], plan_source)
         lps = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
     unknown = [hole for hole in args.block_hole if hole not in assembly.hole_ids]
@@ -142,17 +134,16 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
         raise PlannerError(f"--block-hole {unknown[0]}: expected a hole of {assembly.name} "
                            f"({', '.join(assembly.hole_ids)})")
     facts = load_learned_facts(lps) if lps else truth_facts(assembly)
+    check_facts_product(assembly, facts, ", ".join(map(str, lps)) or truth_sources(assembly))
     if jsons:
+        plan_source = str(jsons[0])
         plan = read_plan_json(jsons[0], args.plan)
     if plan is None:
         found_plans = plans(facts, n=args.plan)
         if len(found_plans) < args.plan:
             raise PlannerError(f"--plan {args.plan}: the facts admit only {len(found_plans)} plan(s)")
-        plan = found_plans[args.plan - 1]
-    errors = check_plan(facts, plan.steps)
-    if errors:
-        raise PlannerError(f"the plan {' '.join(s.part for s in plan.steps)} is not valid for the facts: "
-                           + ", ".join(errors))
+        plan_source, plan = f"plan {args.plan} of the facts", found_plans[args.plan - 1]
+    check_plan_product(facts, plan, plan_source)
     return assembly, facts, plan
 
 

@@ -10,6 +10,7 @@ import math
 import re
 from pathlib import Path
 
+import clingo
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -201,3 +202,15 @@ def test_plan_command_reads_precedence_edges_and_mixed_forms(tmp_path: Path, run
     unknown.write_text("part(a;b). precedence_edge(a,zz).\n")
     done = run_cli("plan", str(unknown))
     assert done.returncode == 2 and "precedence_edge(a,zz): zz is not a part/1" in done.stderr
+
+
+def test_ids_reach_clingo_as_symbols_never_as_program_text(facts: LearnedFacts) -> None:
+    """An id holding ASP syntax is one constant: it adds no facts (the checker refuses the
+    unknown hole) and no rules (the interval is never ground)."""
+    plan = plans(facts, 1)[0]
+    injected = [PlanStep(s.part, "r3). hole(zz). fits(p1,zz") if s.part == "p1" else s for s in plan.steps]
+    assert any("p1" in error for error in check_plan(facts, injected))
+    bomb = [PlanStep(s.part, "r3). bomb(1..50000000") if s.part == "p1" else s for s in plan.steps]
+    assert any("p1" in error for error in check_plan(facts, bomb))
+    atoms = load_atoms([], extra=[clingo.Function("part", [clingo.Function("a). part(b")])])
+    assert [str(atom.arguments[0].name) for atom in atoms] == ["a). part(b"]
