@@ -98,6 +98,15 @@ def _part(old: str, new: str) -> Callable[[list[dict]], object]:
     return lambda steps: [step.update(part=new) for step in steps if step["part"] == old]
 
 
+SETTINGS = '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}'
+JOURNAL_LINE = '{{"id":"{id}","part":"{part}","hole":"{hole}","result":"{result}","cell":"c1"{extra}}}\n'
+
+
+def resume(*lines: str, settings: str = SETTINGS) -> dict[str, str | bytes]:
+    """Setup: a run folder ``run`` to resume with these journal lines."""
+    return {"run/session.json": settings, "run/journal.jsonl": "".join(lines)}
+
+
 def huge_journal(run: Path) -> None:
     """Setup: a run folder to resume whose journal is one byte over the bound (a sparse file)."""
     run.mkdir()
@@ -293,6 +302,25 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      "precedence_edge(a,zz): zz is not a part/1"),
     ("assembly-keyword-id", ("plan", "facts.lp", "--optimal", "--assembly", "asm"),
      assembly(**{"assembly.toml": "[parts.not]\nname = 'x'\n"}), 2, "[parts.not]"),
+    # a journal that contradicts itself, or names what the assembly does not have
+    ("resume-journal-contradiction", ("session", "--resume", "run"),
+     resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=""),
+            JOURNAL_LINE.format(id="b", part="p1", hole="br", result="no_fit", extra="")), 2,
+     "journal.jsonl:2: p1,br no_fit after fit on line 1, without the retest marker"),
+    ("resume-journal-duplicated-line", ("session", "--resume", "run"),
+     resume(*[JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra="")] * 2), 2,
+     "journal.jsonl:2: a second result of request a"),
+    ("resume-journal-negative-experiment", ("session", "--resume", "run"),
+     resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=',"experiment":-3')), 2,
+     "journal.jsonl:1"),
+    ("resume-journal-unknown-part", ("session", "--resume", "run"),
+     resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=""),
+            JOURNAL_LINE.format(id="b", part="zz", hole="br", result="fit", extra="")), 2,
+     "journal.jsonl:2: (zz,br): expected a part of"),
+    ("resume-recording-id-long", ("session", "--resume", "run"),
+     resume(settings=SETTINGS.replace('"r"', '"' + "r" * 200 + '"')), 2, '"recording_id": expected 1 to 64'),
+    ("resume-starts-at-bound", ("session", "--resume", "run"),
+     resume(settings=SETTINGS.replace("}", ', "starts": 1000000}')), 2, '"starts": expected an integer from 1'),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
