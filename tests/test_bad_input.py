@@ -321,6 +321,18 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      resume(settings=SETTINGS.replace('"r"', '"' + "r" * 200 + '"')), 2, '"recording_id": expected 1 to 64'),
     ("resume-starts-at-bound", ("session", "--resume", "run"),
      resume(settings=SETTINGS.replace("}", ', "starts": 1000000}')), 2, '"starts": expected an integer from 1'),
+    # numbers written with ASCII digits only; list items once
+    ("sample-seed-fullwidth", ("precedence", "sample", "--assembly", "cranfield", "--seed", "\uff15"), None, 2,
+     "--seed"),
+    ("sample-n-underscore", ("precedence", "sample", "--assembly", "cranfield", "-n", "1_0"), None, 2, "-n"),
+    ("session-seed-fullwidth", ("session", "--seed", "\uff15"), None, 2, "--seed"),
+    ("plan-time-limit-underscore", ("plan", "facts.lp", "--time-limit", "1_0"), None, 2, "--time-limit"),
+    ("bench-sizes-noise-fullwidth", ("bench", "sizes", "--noise", "0.\uff11"), None, 2, "--noise"),
+    ("bench-executor-executions-underscore", ("bench", "executor", "--executions", "1_0"), None, 2,
+     "--executions"),
+    ("bench-precedence-physics-edge-twice", ("bench", "precedence-physics", "--edges", "bp-p1,bp-p1"), None, 2,
+     "'bp-p1' is given twice"),
+    ("session-allow-cells-twice", ("session", "--allow-cells", "c1,c1"), None, 2, "given twice"),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),

@@ -24,7 +24,7 @@ from typing import Any
 
 from bridge import BridgeError
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, run_command
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, integer, run_command
 from executor import ExecutorError
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
@@ -112,7 +112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--ablation", action="store_true",
                         help="instead: every execution-layer variant on the same perturbations "
                         "(--trials per pair, default 40)")
-    parser.add_argument("--executions", type=int, default=5,
+    parser.add_argument("--executions", type=integer, default=5,
                         help="--ablation: consecutive executions of a pair per cell (default 5)")
     add_cell_arguments(parser, layer=False)
     args = parser.parse_args(argv)

@@ -105,3 +105,17 @@ def test_ids_that_break_clingo_are_malformed(bad: str) -> None:
             decode_step_request(payload)
         assert refused.value.code == "malformed"
     assert decode_step_request(step).part == "p1" and decode_step_request(step.replace(b'"p1"', b'"nots"'))
+
+
+def test_a_key_given_twice_is_malformed() -> None:
+    """msgspec keeps the last of two equal keys: a message with one is refused instead, so
+    that a reader of the first one never sees another request than the cell runs."""
+    from bridge.messages import decode_step_request
+
+    step = b'{"kind":"step","id":"a","assembly":"r","step":1,"part":"p1","hole":"r1","hole":"br"}'
+    with pytest.raises(MessageError, match="the key 'hole' appears twice") as refused:
+        decode_step_request(step)
+    assert refused.value.code == "malformed"
+    with pytest.raises(MessageError, match="'part' appears twice"):
+        decode_request(b'{"kind":"insert","id":"a","part":"p1","hole":"r1","part":"p2"}')
+    assert decode_request(b'{"kind":"insert","id":"a","part":"p1","hole":"r1"}').part == "p1"
