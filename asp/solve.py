@@ -28,6 +28,7 @@ from bridge.assembly import is_id
 from bridge.files import write_atomic
 from bridge.inputs import read_bytes, shorten
 
+_CONSTANT = re.compile(r"_*[a-z][A-Za-z0-9_']*")
 _STRINGS_AND_COMMENTS = re.compile(r'"(?:\\.|[^"\\\n])*"|%\*.*?\*%|%[^\n]*', re.DOTALL)
 _NON_ASCII = re.compile(r"[^\x00-\x7f]")
 
@@ -152,10 +153,27 @@ def add_facts(ctl: clingo.Control, atoms: Iterable[clingo.Symbol]) -> None:
             backend.add_rule([backend.add_atom(atom)])
 
 
+def _unprintable(symbol: clingo.Symbol) -> str | None:
+    """The first name in ``symbol`` that is no ASP constant (clingo prints a function's name
+    as it is, so such a name would become program text), else None."""
+    if symbol.type != clingo.SymbolType.Function:
+        return None  # numbers, #inf/#sup, and strings (printed quoted and escaped)
+    if symbol.name and (symbol.name == "not" or not _CONSTANT.fullmatch(symbol.name)):
+        return symbol.name
+    return next((name for name in map(_unprintable, symbol.arguments) if name is not None), None)
+
+
 def format_facts(atoms: Iterable[clingo.Symbol], header: str = "") -> str:
-    """Facts as program text, one per line, after an optional ``%`` comment header."""
+    """Facts as program text, one per line, after an optional ``%`` comment header;
+    PlannerError for a symbol with a name that is no ASP constant (it would not read back
+    as the same fact)."""
     lines = [f"% {line}" if line else "%" for line in header.splitlines()]
-    lines += [f"{atom}." for atom in atoms]
+    for atom in atoms:
+        bad = _unprintable(atom)
+        if bad is not None:
+            raise PlannerError(f"cannot write the fact {shorten(repr(str(atom)), 60)}: {shorten(repr(bad))} is not "
+                               "an ASP constant")
+        lines.append(f"{atom}.")
     return "\n".join(lines) + "\n"
 
 

@@ -15,6 +15,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from asp import PlannerError
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
 from asp.precedence.relation import load_relation
@@ -214,3 +215,15 @@ def test_ids_reach_clingo_as_symbols_never_as_program_text(facts: LearnedFacts) 
     assert any("p1" in error for error in check_plan(facts, bomb))
     atoms = load_atoms([], extra=[clingo.Function("part", [clingo.Function("a). part(b")])])
     assert [str(atom.arguments[0].name) for atom in atoms] == ["a). part(b"]
+
+
+def test_a_fact_that_would_not_read_back_is_never_written(tmp_path: Path) -> None:
+    path = tmp_path / "facts.lp"
+    with pytest.raises(PlannerError, match="is not an ASP constant"):
+        write_facts(path, [clingo.Function("hole", [clingo.Function("r3). bomb(1..5")])])
+    with pytest.raises(PlannerError, match="'not' is not an ASP constant"):
+        write_facts(path, [clingo.Function("part", [clingo.Function("not")])])
+    assert not path.exists()
+    write_facts(path, [clingo.Function("label", [clingo.String('a "quoted" ). string')]),
+                       clingo.Function("n", [clingo.Number(-3)])])
+    assert [str(atom) for atom in load_atoms([path])] == ['label("a \\"quoted\\" ). string")', "n(-3)"]
