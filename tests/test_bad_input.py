@@ -302,6 +302,12 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      "precedence_edge(a,zz): zz is not a part/1"),
     ("assembly-keyword-id", ("plan", "facts.lp", "--optimal", "--assembly", "asm"),
      assembly(**{"assembly.toml": "[parts.not]\nname = 'x'\n"}), 2, "[parts.not]"),
+    ("assemble-run-assembly-wrong-type", ("assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": 7, "plans": []}'}, 2, '"assembly": expected a string, got 7'),
+    ("bench-assemble-run-assembly-wrong-type", ("bench", "assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": ["x"], "plans": []}'}, 2, '"assembly": expected a string'),
+    ("assemble-run-plans-wrong-type", ("assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": "cranfield", "plans": {"a": 1}}'}, 2, '"plans": expected a list'),
     # a journal that contradicts itself, or names what the assembly does not have
     ("resume-journal-contradiction", ("session", "--resume", "run"),
      resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=""),

@@ -40,7 +40,7 @@ from asp.plans.plans import Plan, plans
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
-from bridge.inputs import read_bytes
+from bridge.inputs import read_bytes, shorten
 from bridge.session import add_endpoint_arguments
 
 EXIT_STOPPED = 3
@@ -95,17 +95,27 @@ def truth_facts(assembly: Assembly) -> LearnedFacts:
     return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
 
 
+_SESSION_TYPES: dict[str, tuple[type, str]] = {"assembly": (str, "a string"), "plans": (list, "a list of plans")}
+"""The types of the ``session.json`` keys ``assemble`` and ``bench assemble`` read."""
+
+
 def read_session_settings(run: Path, *required: str) -> dict:
     """The ``session.json`` of run folder ``run``; PlannerError naming the file and the
-    ``required`` keys when it cannot be read or lacks one."""
+    ``required`` keys when it cannot be read or lacks one, or naming the key when it has
+    the wrong type (``assembly`` a string, ``plans`` a list)."""
     path = run / "session.json"
     try:
         settings = json.loads(read_bytes(path, "session settings (JSON)", error=PlannerError))
-    except (json.JSONDecodeError, UnicodeDecodeError):
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError):
         settings = None
     if not isinstance(settings, dict) or any(key not in settings for key in required):
         keys = " and ".join(f'"{key}"' for key in required)
         raise PlannerError(f"{path}: expected the session.json of a finished session (with {keys})")
+    for key in required:
+        kind, expected = _SESSION_TYPES.get(key, (object, ""))
+        if not isinstance(settings[key], kind):
+            raise PlannerError(f'{path}: "{key}": expected {expected}, got '
+                               f"{shorten(json.dumps(settings[key], ensure_ascii=True))}")
     return settings
 
 
@@ -122,9 +132,8 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
         settings = read_session_settings(args.run, "plans", "assembly")
         settings_path, found = args.run / "session.json", settings["plans"]
         name = name or settings["assembly"]
-        if not isinstance(found, list) or len(found) < args.plan:
-            count = len(found) if isinstance(found, list) else 0
-            raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {count} plan(s)")
+        if len(found) < args.plan:
+            raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {len(found)} plan(s)")
         plan_source = f"{settings_path}: plans[{args.plan}]"
         plan = plan_of_json(found[args.plan - 1], plan_source)
         lps = [args.run / "learned.lp"]
