@@ -21,8 +21,9 @@ from bridge.session import free_loopback_endpoint, open_session
 
 
 @contextmanager
-def one_cell(backend: str) -> Iterator[zenoh.Session]:
-    """A cell ``c1`` of Cranfield with ``backend``, and a planner's session connected to it."""
+def one_cell(backend: str, stop_s: float = 30.0) -> Iterator[zenoh.Session]:
+    """A cell ``c1`` of Cranfield with ``backend``, and a planner's session connected to it;
+    the cell must stop cleanly within ``stop_s`` [s] afterwards."""
     endpoint = free_loopback_endpoint()
     cell = start_cell("c1", backend=backend, listen=[endpoint])
     session = open_session(connect=[endpoint])
@@ -31,7 +32,7 @@ def one_cell(backend: str) -> Iterator[zenoh.Session]:
         yield session
     finally:
         session.close()
-        assert cell.stop(timeout=30) == 0
+        assert cell.stop(timeout=stop_s) == 0
 
 
 def step(session: zenoh.Session, run: str, number: int, part: str, hole: str | None) -> StepReply:
@@ -71,7 +72,7 @@ def test_truth_cell_builds_one_product_at_a_time_and_refuses_what_is_not_the_pro
 @pytest.mark.slow
 @pytest.mark.timeout(300)
 def test_sim_cell_keeps_its_world_when_another_run_is_refused() -> None:
-    with one_cell("sim") as session:
+    with one_cell("sim", stop_s=120.0) as session:  # closing the world is slow on a loaded machine
         assert step(session, "a", 1, "bp", None).result == "fit"
         assert refused(session, "b", 1, "p1", "r1") == "run_active"
         assert refused(session, "a", 2, "p3", None) == "invalid_step"
