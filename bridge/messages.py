@@ -19,13 +19,13 @@ serves a version-2 insert request and answers it as version 2.
 
 from __future__ import annotations
 
-import json
 from typing import Annotated, Final, Literal
 
 import msgspec
 
 from bridge import BridgeError
 from bridge.assembly import ID_PATTERN
+from bridge.inputs import duplicate_key
 from bridge.keys import CELL_ID_PATTERN
 
 PROTOCOL_VERSION: Final = 3
@@ -185,21 +185,6 @@ def encode(message: InsertRequest | InsertReply | StepRequest | StepReply | Erro
     return data
 
 
-def _key_twice(payload: bytes) -> str | None:
-    """A key that appears twice in one JSON object of ``payload`` (msgspec keeps the last
-    one silently), else None; ``payload`` already decoded as a message, so it is valid
-    JSON of a bounded size and depth."""
-    twice: list[str] = []
-
-    def pairs(items: list[tuple[str, object]]) -> dict[str, object]:
-        keys = [key for key, _value in items]
-        twice.extend(key for k, key in enumerate(keys) if key in keys[:k])
-        return dict(items)
-
-    json.loads(payload, object_pairs_hook=pairs)
-    return twice[0] if twice else None
-
-
 def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
     if len(payload) > MAX_MESSAGE_BYTES:
         raise MessageError("oversized", f"{what} of {len(payload)} bytes exceeds the "
@@ -208,7 +193,7 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
         message = decoder.decode(payload)
     except (msgspec.DecodeError, UnicodeDecodeError) as exc:
         raise MessageError("malformed", f"{what} is not valid: {exc}") from None
-    twice = _key_twice(payload)
+    twice = duplicate_key(payload)
     if twice is not None:
         raise MessageError("malformed", f"{what} is not valid: the key {twice!r} appears twice in one object; "
                            "expected each key once")

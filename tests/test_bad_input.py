@@ -271,6 +271,8 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      plan_file("p.json", _part("bp", "bp\n")), 2, "step 1: part"),
     ("assemble-plan-unknown-key", ("assemble", "p.json", "--backend", "truth"),
      {"p.json": '[{"part": "bp", "hole": null, "holes": "r1"}]'}, 2, "p.json: step 1: expected"),
+    ("assemble-plan-key-twice", ("assemble", "p.json", "--backend", "truth"),
+     {"p.json": '[{"part": "bp", "hole": null, "hole": "r1"}]'}, 2, "p.json: the key 'hole' appears twice"),
     ("assemble-plan-deep-nesting", ("assemble", "p.json", "--backend", "truth"),
      {"p.json": "[" * 100_000 + "]" * 100_000}, 2, "nested too deeply"),
     ("assemble-plan-k-of-one", ("assemble", "p.json", "--plan", "5", "--backend", "truth"),

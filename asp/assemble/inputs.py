@@ -24,7 +24,7 @@ from asp import PlannerError
 from asp.plans.assign import LearnedFacts
 from asp.plans.plans import Plan, PlanStep, check_plan
 from bridge.assembly import Assembly, is_id
-from bridge.inputs import read_bytes, shorten
+from bridge.inputs import duplicate_key, read_bytes, shorten
 
 _STEP_KEYS = frozenset({"part", "hole"})
 
@@ -53,12 +53,16 @@ def read_plan_json(path: Path, k: int) -> Plan:
     """Plan ``k`` (1-based) of a plan JSON file: a plan, ``{"plan": plan}`` or the
     ``{"plans": [plan, ...]}`` of ``plan --json``; PlannerError naming the file (and the
     step) when it is not one of these, or holds fewer than ``k`` plans."""
+    text = read_bytes(path, "plan file (JSON)", error=PlannerError)
     try:
-        data = json.loads(read_bytes(path, "plan file (JSON)", error=PlannerError))
+        data, twice = json.loads(text), duplicate_key(text)
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise PlannerError(f"{path}: not valid JSON ({shorten(exc, 80)})") from None
     except RecursionError:
         raise PlannerError(f"{path}: nested too deeply; expected a plan JSON file") from None
+    if twice is not None:
+        raise PlannerError(f"{path}: the key {shorten(repr(twice))} appears twice in one object; expected each "
+                           "key once")
     if isinstance(data, dict) and set(data) - {"cost"} in ({"plan"}, {"plans"}):
         many = data.get("plans")
         if many is not None:

@@ -47,7 +47,7 @@ import msgspec
 
 from asp import PlannerError
 from bridge.files import os_reason
-from bridge.inputs import read_bytes
+from bridge.inputs import duplicate_key, read_bytes
 from bridge.messages import AspId, Evidence, RequestId, Result
 
 JOURNAL_NAME = "journal.jsonl"
@@ -161,10 +161,13 @@ def _read(path: Path, limit: int = MAX_JOURNAL_BYTES) -> _Contents:
             continue
         try:
             record = _decode(line)
+            twice = duplicate_key(line)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
             raise PlannerError(f"{path}:{number}: not a journal entry: {exc}") from None
         except RecursionError:
             raise PlannerError(f"{path}:{number}: not a journal entry: nested too deeply") from None
+        if twice is not None:
+            raise PlannerError(f"{path}:{number}: not a journal entry: the key {twice!r} appears twice")
         consistency.check(record, number)
         consistency.add(record, number)
         records.append((number, record))

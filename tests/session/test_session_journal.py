@@ -133,6 +133,8 @@ LINE = '{{"id":"{id}","part":"{part}","hole":"{hole}","result":"{result}","cell"
     ([LINE.format(id="a", part="p1", hole="br", result="fit", extra=',"experiment":99999999999999999999')],
      "journal.jsonl:1: not a journal entry"),
     (["[" * 100_000 + "]" * 100_000 + "\n"], "journal.jsonl:1: not a journal entry"),
+    ([LINE.format(id="a", part="p1", hole="br", result="fit", extra=',"result":"no_fit"')],
+     "journal.jsonl:1: not a journal entry: the key 'result' appears twice"),
 ])
 def test_a_journal_that_contradicts_itself_is_refused_naming_the_line(tmp_path: Path, lines: list[str],
                                                                      expected: str) -> None:
