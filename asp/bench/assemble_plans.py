@@ -35,9 +35,10 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from asp import PlannerError
-from asp.assemble.cli import cell_options, read_session_settings, truth_facts
+from asp.assemble.cli import cell_options, read_session_settings, truth_facts, truth_sources
 from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
+from asp.assemble.inputs import check_facts_product
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import Plan, PlanStep, check_plan
 from asp.precedence.count import UniformSampler
@@ -136,7 +137,9 @@ def _facts(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts]:
         name = name or read_session_settings(args.run, "assembly")["assembly"]
         paths = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
-    return assembly, load_learned_facts(paths) if paths else truth_facts(assembly)
+    facts = load_learned_facts(paths) if paths else truth_facts(assembly)
+    check_facts_product(assembly, facts, ", ".join(map(str, paths)) or truth_sources(assembly))
+    return assembly, facts
 
 
 def build_parser() -> argparse.ArgumentParser:

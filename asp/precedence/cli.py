@@ -28,6 +28,7 @@ from bridge.cli_types import (
     non_negative_int,
     number_in,
     png_path,
+    strict_int,
 )
 
 LOG = logging.getLogger(__name__)
@@ -69,7 +70,7 @@ def _parser() -> argparse.ArgumentParser:
     evaluate = commands.add_parser("evaluate", help="the paper's evaluation (Figs. 12/13), or --guided demonstration")
     add_assembly_argument(evaluate, None, required=True, purpose="one with true constraints (precedence.lp)")
     evaluate.add_argument("--demonstrations", default="5,7,10,15,20,30", metavar="M,...",
-                          type=comma_list(number_in(int, 1, 10**6), "positive integers such as 5,7,10"),
+                          type=comma_list(number_in(strict_int, 1, 10**6), "positive integers such as 5,7,10"),
                           help="numbers m of demonstrations per trial, comma separated (default 5,7,10,15,20,30)")
     evaluate.add_argument("--trials", type=int_in(1, 10**8), default=1000, help="trials per m (default 1000)")
     evaluate.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="random seed (default 0)")

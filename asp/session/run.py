@@ -166,6 +166,12 @@ def _holds_session(run: Path) -> bool:
         return False
 
 
+MAX_STARTS = 1_000_000
+"""The most starts (the first and its resumes) a run folder records."""
+MAX_RECORDING_ID = 64
+"""The longest recording id [characters]: the cells' request ids are built from it."""
+_RECORDING_ID = re.compile(rf"[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}")
+
 _SETTING_TYPES: dict[str, tuple[type, bool]] = {
     "assembly": (str, True), "policy": (str, True), "seed": (int, True), "recording_id": (str, True),
     "confirm": (int, False), "starts": (int, False), "demos": (str, False), "cell_options": (list, False),
@@ -195,7 +201,10 @@ def _resume_settings(path: Path) -> dict:
               ("model", settings.get("model") in (None, *MODELS), f"null or one of {', '.join(MODELS)}"),
               ("seed", 0 <= settings["seed"] <= MAX_SEED, f"an integer from 0 to {MAX_SEED}"),
               ("confirm", 0 <= settings.get("confirm", 0) <= MAX_CONFIRM, f"an integer from 0 to {MAX_CONFIRM}"),
-              ("starts", 1 <= settings.get("starts", 1) <= 1_000_000, "an integer >= 1")]
+              ("starts", 1 <= settings.get("starts", 1) < MAX_STARTS,
+               f"an integer from 1 to {MAX_STARTS - 1} (a resume adds one)"),
+              ("recording_id", _RECORDING_ID.fullmatch(settings["recording_id"]) is not None,
+               f"1 to {MAX_RECORDING_ID} letters, digits, '_' or '-' (a session writes a UUID)")]
     for key, ok, expected in checks:
         if not ok:
             raise PlannerError(f'{path}: "{key}": expected {expected}, got {shorten(json.dumps(settings[key]))}')
@@ -369,6 +378,11 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     suffix = "" if settings["starts"] == 1 else f"-{settings['starts']}"
     cell_ids = [f"c{k}" for k in range(1, args.cells + 1)]
     journal = Journal(run)
+    try:
+        journal.check_ids(parts, holes)
+    except PlannerError:
+        journal.close()
+        raise
     _save(run, settings)
     with ExitStack() as stack:
         stack.callback(journal.close)
