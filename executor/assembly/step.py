@@ -57,10 +57,12 @@ RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
 ASSEMBLY_UNCERTAINTY = PerturbationModel(
     grasp_offset_bias=0.0, grasp_offset_random=0.001, grasp_tilt_bias=0.0, grasp_tilt_random=1.0,
-    vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
+    vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, vision_yaw_bias=0.0, vision_yaw_sigma=0.5,
+    vision_yaw_max=1.0, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
 """The assembling cell's uncertainty per execution: a grasp offset ≤ 1 mm and tilt ≤ 1°,
-a vision error σ 1.5 mm (≤ 3 mm), the teaching friction; random parts only (the cell's
-systematic errors and ILC are used with ``--uncertainty cell``)."""
+a vision error σ 1.5 mm (≤ 3 mm), a rect hole's yaw error σ 0.5° (≤ 1°), the teaching
+friction; random parts only (the cell's systematic errors and ILC are used with
+``--uncertainty cell``)."""
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)

@@ -203,6 +203,7 @@ def _geometry(folder: Path, layout: Assembly, geo: dict) -> CellGeometry:
 def _cross_check(layout: Assembly, holes: dict[str, HoleSpec], parts: dict[str, PartSpec]) -> None:
     """The ``shape`` of each part and hole in ``assembly.toml`` (where given) is the
     ``kind`` of its cross-section in ``geometry.toml``; ExecutorError naming it otherwise."""
+    declared: list[tuple[str, str, str | None, Section | None]]
     declared = [(part.id, "part", part.shape, parts.get(part.id)) for part in layout.parts]
     declared += [(hole.id, "hole", hole.shape, holes.get(hole.id)) for hole in layout.holes]
     for item, what, shape, spec in declared:
