@@ -24,6 +24,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import clingo
 import numpy as np
 import pybullet_data
 
@@ -229,6 +230,32 @@ def passes(part: Section, hole: Section) -> bool:
         return part.size < short_side
     a, b = part.sides
     return a < long_side and b < short_side
+
+
+def sizes_lp_text(assembly: str) -> str:
+    """The ``sizes.lp`` of an assembly folder as its geometry makes it: ``part/1`` for each
+    part of ``assembly.toml`` with a cross-section (``[part_shapes.*]``), ``hole/1`` for
+    each hole, ``fits/2`` for every pair that :func:`passes` (closed world), as clingo
+    symbols in the order of ``assembly.toml``, one line per part."""
+    geometry, layout = load_geometry(assembly), load_assembly(assembly)
+    pegs = [part.id for part in layout.parts if part.id in geometry.parts]
+    holes = [hole.id for hole in layout.holes if hole.id in geometry.holes]
+
+    def facts(symbols: list[clingo.Symbol]) -> str:
+        return " ".join(f"{symbol}." for symbol in symbols)
+
+    lines = [f"% {geometry.folder.name}: which part fits which hole (closed world), generated from geometry.toml",
+             "% by executor.world.geometry.passes; do not edit, regenerate with",
+             f"% ./run.sh executor sizes --assembly {geometry.folder.name} --out "
+             f"data/{geometry.folder.name}/sizes.lp",
+             facts([clingo.Function("part", [clingo.Function(pid)]) for pid in pegs]),
+             facts([clingo.Function("hole", [clingo.Function(hid)]) for hid in holes])]
+    for pid in pegs:
+        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid in holes
+                if passes(geometry.parts[pid], geometry.holes[hid])]
+        if fits:
+            lines.append(facts(fits))
+    return "\n".join(lines) + "\n"
 
 
 def _ring(kind: str, half: float, n: int, half_y: float = 0.0) -> np.ndarray:
