@@ -30,7 +30,7 @@ from executor.control.motion import Motion
 from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from executor.rerun_arm import ArmRecorder
 from executor.skills.dmp import Skill, load_skill
-from executor.skills.insertion import insert_in_layer, rotvec_quat_xyzw
+from executor.skills.insertion import insert_in_layer, needs_yaw_compliance, rotvec_quat_xyzw
 from executor.skills.search import hole_search
 from executor.world.arm import Arm, aligned_yaw, tool_quat
 from executor.world.geometry import load_geometry, plate_mesh
@@ -189,7 +189,7 @@ class Cell:
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - float(self.geometry.gripper["grasp_depth"])
         result = insert_in_layer(motion, skill, origin, detector, layer, lever, wiggle_enabled, correction,
-                                 yaw=yaw)
+                                 yaw=yaw, yaw_compliant=needs_yaw_compliance(spec.kind, hole_spec.kind))
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

@@ -99,7 +99,8 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         return c[:3], np.array([c[3], c[4], 0.0])
 
     trace = ExecutionTrace() if record else None
-    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], 0.0])
+    yaw_bound = admittance.bound[4] if admittance is not None and admittance.yaw else 0.0
+    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], yaw_bound])
     for _ in range(budget):
         if clock.done:
             break
@@ -149,15 +150,26 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase, trace)
 
 
+def needs_yaw_compliance(part_kind: str, hole_kind: str) -> bool:
+    """Whether the insertion corrects the part's yaw: a square or rect part in a rect hole,
+    whose yaw the vision estimates with an error (a round part has no yaw to correct; a
+    square hole's yaw is known, as it always was)."""
+    return hole_kind == "rect" and part_kind != "round"
+
+
 def insert_in_layer(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
                     layer: ExecutionLayer, gripper_lever: float, wiggle_enabled: bool = True,
-                    correction: np.ndarray | None = None, yaw: float = 0.0) -> InsertionResult:
+                    correction: np.ndarray | None = None, yaw: float = 0.0,
+                    yaw_compliant: bool = False) -> InsertionResult:
     """:func:`insert` under an execution layer: its admittance (P or PI, none for pure
     position control), phase stopping, the ILC ``correction`` and recording; with
     ``layer.stiff`` the insertion tracks with :data:`POSITION_CONTROL_GAINS` and the
     controller's own gains come back after (the search and the release stay compliant);
-    ``yaw`` [rad]: the hole frame's (:func:`insert`)."""
-    admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
+    ``yaw`` [rad]: the hole frame's (:func:`insert`); ``yaw_compliant``: the admittance
+    also turns the part about the tool axis (a part aligned to a rect hole's estimated
+    yaw, :func:`needs_yaw_compliance`)."""
+    admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0),
+                             yaw=yaw_compliant)
                   if layer.admittance else None)
     controller = motion.controller
     compliant = controller.gains
