@@ -161,6 +161,21 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      assembly(**{"geometry.toml": bytes(range(256))}), 2, "geometry.toml"),
     ("trial-geometry-missing-keys", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"geometry.toml": "[plate]\ntop_z = 0.1\n"}), 2, "tile_size"),
+    ("trial-geometry-rect-short-side-first", ("executor", "trial", "--part", "p3", "--hole", "s1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "square"\nsize = 0.0133', 'kind = "rect"\nsize = [0.010, 0.0133]', 1)}), 2, "a >= b"),
+    ("trial-geometry-unknown-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "round"', 'kind = "oval"', 1)}), 2, "oval"),
+    ("trial-part-shape-against-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "square"', 1)}), 2, "kind"),
+    ("assembly-part-shape-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape"),
+    ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2, "section"),
     # learned facts: arity, ids, cycles, contradictions
     ("assign-arity", ("assign", "f.lp"), {"f.lp": "part(a). hole(r1). fits(a,r1,x).\n"}, 2, "fits/2"),
     ("plan-arity", ("plan", "f.lp"), {"f.lp": "part(a;b). must_precede(a,b,c).\n"}, 2, "must_precede/2"),
