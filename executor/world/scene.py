@@ -7,6 +7,7 @@ Physics: 1 kHz time step (torque control needs it), gravity, and
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import tempfile
@@ -146,15 +147,16 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
                             (0, 0, 0, 1), (140, 150, 165))]
     half_tile, half_thick = plate["tile_size"] / 2, plate["tile_thickness"] / 2
     for hid, hole in sorted(geometry.holes.items()):
+        turned = (0.0, 0.0, math.sin(hole.yaw / 2), math.cos(hole.yaw / 2))  # the boss turns with its hole
         shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
-                       (*hole.position, plate["top_z"] - half_thick), (0, 0, 0, 1), (180, 185, 190)))
+                       (*hole.position, plate["top_z"] - half_thick), turned, (180, 185, 190)))
         half_depth = plate["tile_thickness"] / 2
-        r = hole.size / 2
-        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (r, r, half_depth),
-                       (*hole.position, plate["top_z"] - half_depth), (0, 0, 0, 1), (40, 40, 40)))
+        a, b = hole.sides
+        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (a / 2, b / 2, half_depth),
+                       (*hole.position, plate["top_z"] - half_depth), turned, (40, 40, 40)))
     for pid, part in sorted(geometry.parts.items()):
-        r = part.size / 2
-        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (r, r, part.length / 2),
+        a, b = part.sides
+        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (a / 2, b / 2, part.length / 2),
                        (*part.start, part.length / 2), (0, 0, 0, 1), (205, 155, 50)))
     return shapes
 

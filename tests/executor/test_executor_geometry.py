@@ -38,7 +38,14 @@ def test_every_shipped_product_with_geometry_is_listed() -> None:
     assert {"cranfield", "spare", "graded"} <= set(WITH_GEOMETRY)
 
 
-@pytest.mark.parametrize("assembly", WITH_GEOMETRY)
+NOT_A_BIORDER = {"taskboard"}
+"""Products whose true sizes are no one size line: the truth loader refuses them until the
+size model of issue 18 accepts them (then these xfails fail, strict, and go)."""
+
+
+@pytest.mark.parametrize("assembly", [
+    pytest.param(a, marks=pytest.mark.xfail(strict=True, reason="TruthOracle refuses a truth that is not a biorder"))
+    if a in NOT_A_BIORDER else a for a in WITH_GEOMETRY])
 def test_the_geometry_rule_gives_sizes_lp(assembly: str) -> None:
     """The truth cells answer from the cross-sections, the session checks against sizes.lp."""
     geometry = load_geometry(assembly)
