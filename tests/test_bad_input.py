@@ -30,6 +30,7 @@ from bridge.cli_types import EXIT_BROKEN_PIPE
 from tests.conftest import ROOT, child_env, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
+TASKBOARD = ROOT / "data" / "taskboard"
 Setup = Callable[[Path], None] | dict[str, str | bytes] | None
 
 
@@ -51,6 +52,17 @@ def unreadable(name: str, source: Path | None = None, text: str = "") -> Callabl
         except OSError:
             return
         pytest.skip(f"cannot make {name} unreadable here")
+
+    return setup
+
+
+def taskboard(**files: str) -> Callable[[Path], None]:
+    """Setup: a copy of data/taskboard in ``asm/`` (without its assets), with ``files`` replaced."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(TASKBOARD, tmp / "asm", ignore=shutil.ignore_patterns("assets"))
+        for name, content in files.items():
+            (tmp / "asm" / name).write_text(content)
 
     return setup
 
@@ -173,6 +185,9 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("assembly-part-shape-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
          'role = "peg"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape"),
+    ("section-of-unlike-parts", ("executor", "trial", "--part", "rect8", "--hole", "slot8", "--assembly", "asm"),
+     taskboard(**{"assembly.toml": (TASKBOARD / "assembly.toml").read_text().replace(
+         'shape = "rect"\n', 'shape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
     ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
          'role = "peg"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2, "section"),

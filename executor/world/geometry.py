@@ -203,7 +203,9 @@ def _geometry(folder: Path, layout: Assembly, geo: dict) -> CellGeometry:
 
 def _cross_check(layout: Assembly, holes: dict[str, HoleSpec], parts: dict[str, PartSpec]) -> None:
     """The ``shape`` of each part and hole in ``assembly.toml`` (where given) is the
-    ``kind`` of its cross-section in ``geometry.toml``; ExecutorError naming it otherwise."""
+    ``kind`` of its cross-section in ``geometry.toml``, and the parts of one ``section``
+    are scaled copies of one cross-section (one aspect ratio b/a, all round or none);
+    ExecutorError naming them otherwise."""
     declared: list[tuple[str, str, str | None, Section | None]]
     declared = [(part.id, "part", part.shape, parts.get(part.id)) for part in layout.parts]
     declared += [(hole.id, "hole", hole.shape, holes.get(hole.id)) for hole in layout.holes]
@@ -211,6 +213,23 @@ def _cross_check(layout: Assembly, holes: dict[str, HoleSpec], parts: dict[str, 
         if shape is not None and spec is not None and spec.kind != shape:
             raise ExecutorError(f"{layout.folder / 'assembly.toml'}: {what} '{item}' has shape \"{shape}\" but "
                                 f"geometry.toml gives it kind \"{spec.kind}\"")
+    first: dict[str, PartSpec] = {}
+    for part in layout.parts:
+        spec = parts.get(part.id)
+        if part.section is None or spec is None:
+            continue
+        other = first.setdefault(part.section, spec)
+        if (other.kind == "round") != (spec.kind == "round") or not math.isclose(
+                spec.sides[1] / spec.sides[0], other.sides[1] / other.sides[0], rel_tol=1e-9):
+            raise ExecutorError(f"{layout.folder / 'assembly.toml'}: parts '{other.id}' and '{part.id}' share section "
+                                f"\"{part.section}\" but are no scaled copies of one cross-section "
+                                f"({_describe(other)} and {_describe(spec)} in geometry.toml)")
+
+
+def _describe(section: Section) -> str:
+    """``round d 12 mm``, ``square 4 mm``, ``rect 16 x 10 mm``."""
+    a, b = (1000 * side for side in section.sides)
+    return {"round": f"round d {a:g} mm", "square": f"square {a:g} mm"}.get(section.kind, f"rect {a:g} x {b:g} mm")
 
 
 def passes(part: Section, hole: Section) -> bool:
