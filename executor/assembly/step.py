@@ -29,7 +29,6 @@ trials, (part shape, hole), a cover or head being its own shape and hole.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 
@@ -49,7 +48,7 @@ from executor.skills.dmp import Skill, load_skill
 from executor.skills.insertion import insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, SETTLE_TIME, trial_rng
-from executor.world.arm import aligned_yaw, tool_quat
+from executor.world.arm import aligned_yaw, tool_quat, yaw_quat
 from executor.world.perturbation import CellBias, PerturbationModel
 from executor.world.scene import PART_FRICTION
 
@@ -155,8 +154,8 @@ class Assembler:
         half = [a / 2 - 0.0002, b / 2 - 0.0002, depth / 2]
         col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.world.client)
         bottom = self.product.top_z - float(plate["tile_thickness"])
-        turned = [0.0, 0.0, math.sin(spec.yaw / 2), math.cos(spec.yaw / 2)]
-        pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], turned, physicsClientId=self.world.client)
+        pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], yaw_quat(spec.yaw),
+                           physicsClientId=self.world.client)
         self.blocked.add(hole)
 
     def run_step(self, part: str, hole: str | None, seed: int, max_attempts: int = 2) -> StepRecord:

@@ -29,6 +29,11 @@ def tool_quat(yaw: float) -> np.ndarray:
     return np.array([math.cos(yaw / 2), math.sin(yaw / 2), 0.0, 0.0])
 
 
+def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
+    """The rotation by ``yaw`` [rad] about z (xyzw): a turned hole's or boss's orientation."""
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
 def turn_z(vectors: np.ndarray, yaw: float) -> np.ndarray:
     """Vectors (..., 3) turned by ``yaw`` [rad] about z (returned unchanged at yaw 0)."""
     if yaw == 0.0:

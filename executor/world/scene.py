@@ -7,7 +7,6 @@ Physics: 1 kHz time step (torque control needs it), gravity, and
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 import tempfile
@@ -19,6 +18,7 @@ import pybullet_data
 
 from executor import ExecutorError
 from executor.world import TIME_STEP
+from executor.world.arm import yaw_quat
 from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, plate_mesh
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
@@ -147,7 +147,7 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
                             (0, 0, 0, 1), (140, 150, 165))]
     half_tile, half_thick = plate["tile_size"] / 2, plate["tile_thickness"] / 2
     for hid, hole in sorted(geometry.holes.items()):
-        turned = (0.0, 0.0, math.sin(hole.yaw / 2), math.cos(hole.yaw / 2))  # the boss turns with its hole
+        turned = yaw_quat(hole.yaw)  # the boss turns with its hole
         shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
                        (*hole.position, plate["top_z"] - half_thick), turned, (180, 185, 190)))
         half_depth = plate["tile_thickness"] / 2
