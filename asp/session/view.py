@@ -3,9 +3,10 @@
 RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: planner
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
-on the files plus ``RUN/view.rbl``, a blueprint with the planner's tab
-(``bridge.recording.layout.planner_views``) when the recording has ``planner/...`` entities
-and one tab per cell found (``bridge.recording.layout.cell_views``). Without a display (no ``DISPLAY`` /
+on the files plus ``RUN/view.rbl``, the blueprint of what the recording holds
+(``bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
+entities, one tab per cell that tried insertions (its Fig. 17 view on the cell's first
+fitting attempt), one assembly tab per cell that assembled. Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
@@ -22,9 +23,13 @@ import subprocess
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from asp import PlannerError
 from bridge.cli_types import ArgumentParser
+
+if TYPE_CHECKING:
+    from bridge.recording.layout import Contents
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -37,12 +42,6 @@ def recording_files(run: Path) -> list[Path]:
     if not files:
         raise PlannerError(f"{run}: holds no Rerun recording; expected RUN/*.rrd or an .rrd file")
     return files
-
-
-def cell_ids(entity_paths: Sequence[str]) -> list[str]:
-    """Cell ids present in a recording: ``/executor/<cell-id>/...`` → ``<cell-id>``."""
-    ids = {p.split("/")[2] for p in entity_paths if p.startswith("/executor/") and p.count("/") >= 3}
-    return sorted(ids)
 
 
 def has_display() -> bool:
@@ -58,14 +57,13 @@ def rerun_executable() -> str:
     return found
 
 
-def write_blueprint(folder: Path, cells: Sequence[str], planner: bool) -> Path:
-    """``folder/view.rbl``: the planner's tab (if ``planner``), then one tab per cell."""
+def write_blueprint(folder: Path, contents: Contents) -> Path:
+    """``folder/view.rbl``: the blueprint of a recording holding ``contents``."""
     from bridge.files import check_writable
-    from bridge.recording.layout import APPLICATION_ID, cell_blueprint, planner_views
+    from bridge.recording.layout import APPLICATION_ID, blueprint
 
     path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
-    extra = [planner_views()] if planner else []
-    cell_blueprint(cells, extra=extra).save(APPLICATION_ID, str(path))
+    blueprint(contents).save(APPLICATION_ID, str(path))
     return path
 
 
@@ -79,6 +77,7 @@ def main(argv: Sequence[str]) -> int:
                              "is printed, Ctrl-C stops")
     args = parser.parse_args(list(argv))
 
+    from bridge.recording.layout import Contents
     from bridge.recording.reader import format_summary, read_recording
 
     run = Path(args.run)
@@ -90,9 +89,7 @@ def main(argv: Sequence[str]) -> int:
                   file=sys.stderr)
         print(json.dumps(summary.to_json(), indent=2) if args.json else format_summary(summary))
         return 0
-    cells = cell_ids(list(summary.entities))
-    planner = bool(summary.under("planner"))
-    blueprint = write_blueprint(run if run.is_dir() else run.parent, cells, planner)
+    blueprint = write_blueprint(run if run.is_dir() else run.parent, Contents.of(summary.entities))
     if args.web:
         from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
 
