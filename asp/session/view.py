@@ -10,8 +10,9 @@ fitting attempt), one assembly tab per cell that assembled. Without a display (n
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
-free loopback ports; the address is logged; Ctrl-C stops). A RUN without ``.rrd`` files
-is an error (exit code 2).
+free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
+picture of every tab, rendered by the web viewer in a headless Chromium
+(:mod:`asp.session.screenshot`). A RUN without ``.rrd`` files is an error (exit code 2).
 """
 
 from __future__ import annotations
@@ -72,6 +73,9 @@ def main(argv: Sequence[str]) -> int:
     parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
     parser.add_argument("--print", action="store_true", help="print the contents, no viewer")
     parser.add_argument("--json", action="store_true", help="print the contents as JSON")
+    parser.add_argument("--screenshot", type=Path, metavar="DIR",
+                        help="render every tab in a headless Chromium (Rerun's web viewer), write DIR/<k>-<tab>.png; "
+                             "needs chromium on PATH, takes a few minutes")
     parser.add_argument("--web", action="store_true",
                         help="serve the recording to a web browser (for headless machines); the address to open "
                              "is printed, Ctrl-C stops")
@@ -83,13 +87,21 @@ def main(argv: Sequence[str]) -> int:
     run = Path(args.run)
     files = recording_files(run)
     summary = read_recording(files)
+    contents = Contents.of(summary.entities)
+    if args.screenshot:
+        from asp.session.screenshot import take_screenshots
+
+        recording_id = min(summary.recording_ids, default="view")
+        for picture in take_screenshots(files, contents, recording_id, args.screenshot):
+            print(picture)
+        return 0
     if args.print or args.json or not (has_display() or args.web):
         if not (args.print or args.json):
             print("view: no display (DISPLAY/WAYLAND_DISPLAY unset); printing the recording",
                   file=sys.stderr)
         print(json.dumps(summary.to_json(), indent=2) if args.json else format_summary(summary))
         return 0
-    blueprint = write_blueprint(run if run.is_dir() else run.parent, Contents.of(summary.entities))
+    blueprint = write_blueprint(run if run.is_dir() else run.parent, contents)
     if args.web:
         from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
 

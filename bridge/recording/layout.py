@@ -23,8 +23,11 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Literal
 
 import rerun.blueprint as rrb
+
+PlayState = Literal["paused", "playing", "following"]
 
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
@@ -33,7 +36,7 @@ SESSION_TIMELINE = "log_time"
 SIM_TIMELINE = "sim_time"
 """A cell's simulated time [s], increasing across its attempts."""
 
-CELL_EYE = rrb.EyeControls3D(position=(1.45, -1.05, 0.95), look_target=(0.4, 0.15, 0.15), eye_up=(0.0, 0.0, 1.0))
+CELL_EYE = rrb.EyeControls3D(position=(1.1, -0.75, 0.65), look_target=(0.42, 0.12, 0.12), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
 the tray around y = 0.4 m (``executor.world``); all three in view."""
 
@@ -179,9 +182,16 @@ def assembly_views(cell_id: str) -> rrb.Container:
     )
 
 
-def blueprint(contents: Contents) -> rrb.Blueprint:
+def tab_names(contents: Contents) -> list[str]:
+    """The names of the tabs of ``contents``' blueprint, in order."""
+    return [*(["planner"] if contents.planner else []), *contents.cells,
+            *(f"{cell} assembly" for cell in contents.assembly_cells)]
+
+
+def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = "paused") -> rrb.Blueprint:
     """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
-    an assembly tab per assembling cell; opened paused on :attr:`Contents.timeline`."""
+    an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
+    :attr:`Contents.timeline`, ``play_state`` ``paused``, ``playing`` or ``following``."""
     chosen = dict(contents.fig17)
     tabs = [
         *([planner_views()] if contents.planner else []),
@@ -189,5 +199,6 @@ def blueprint(contents: Contents) -> rrb.Blueprint:
         *(assembly_views(cell) for cell in contents.assembly_cells),
     ]
     return rrb.Blueprint(
-        rrb.Tabs(*tabs), rrb.TimePanel(timeline=contents.timeline, play_state="paused"), collapse_panels=False
+        rrb.Tabs(*tabs, active_tab=active_tab), rrb.TimePanel(timeline=contents.timeline, play_state=play_state),
+        collapse_panels=False,
     )
