@@ -21,7 +21,8 @@ cell, and an assembly tab for the cell that assembles.
                             (:mod:`asp.session.layered`: smallest on top)
 ``planner/precedence``      learned must-precede graph (transitive reduction), static,
                             laid out by levels (first parts on top)
-``planner/assignment``      part → hole graph and a markdown table of the assignment
+``planner/assignment``      part → hole graph (parts above their holes) and a markdown
+                            table of the assignment
 =========================== ==========================================================
 """
 
@@ -82,11 +83,12 @@ class PlannerLog:
         self.rec.log("planner/smaller", rr.GraphEdges(edges, graph_type="directed"))
 
     def assignment(self, assignment: Mapping[str, str]) -> None:
-        """The hole assignment as a graph part → hole and a table."""
+        """The hole assignment as a graph part → hole (parts above their holes) and a table."""
         parts, holes = list(assignment), sorted(set(assignment.values()))
         colors = [_PART_COLOR] * len(parts) + [_HOLE_COLOR] * len(holes)
-        self.rec.log("planner/assignment", rr.GraphNodes([*parts, *holes], labels=[*parts, *holes],
-                                                         colors=colors), static=True)
+        nodes = [*parts, *holes]
+        self.rec.log("planner/assignment", rr.GraphNodes(nodes, labels=nodes, colors=colors, positions=positions(
+            nodes, list(assignment.items()))), static=True)
         self.rec.log("planner/assignment", rr.GraphEdges(list(assignment.items()),
                                                          graph_type="directed"), static=True)
         table = "| part | hole |\n|---|---|\n" + "".join(f"| {p} | {h} |\n" for p, h in assignment.items())

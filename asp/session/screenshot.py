@@ -5,9 +5,9 @@ and opened in a headless Chromium (:mod:`asp.session.browser`). The viewer needs
 seconds to load and render on a software rasteriser; a picture is taken once two in a row,
 :data:`POLL_S` apart, are the same. Then, for each tab, a blueprint that shows that tab
 (``rrb.Tabs(active_tab=k)``) is streamed to the viewer and the tab is pictured once it has
-settled. The blueprints sent here follow the newest data (``play_state="following"``), so
-every tab is pictured at the end of the recording: the last experiment's knowledge, the
-whole plots. ``DIR/<k>-<tab>.png``, k from 1.
+settled. The blueprints follow the newest data (:func:`bridge.recording.layout.blueprint`),
+so every tab is pictured at the end of the recording: the last experiment's knowledge,
+the whole plots. ``DIR/<k>-<tab>.png``, k from 1.
 """
 
 from __future__ import annotations
@@ -46,12 +46,12 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
         assert served.page is not None and served.connect is not None
         stream = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
         stream.set_sinks(rr.GrpcSink(served.connect))
-        stream.send_blueprint(blueprint(contents, active_tab=0, play_state="following"))
+        stream.send_blueprint(blueprint(contents))
         browser.open(served.page)
         picture = _settled(browser, LOAD_TIMEOUT_S, b"")
         for number, name in enumerate(names):
             if number:
-                stream.send_blueprint(blueprint(contents, active_tab=number, play_state="following"))
+                stream.send_blueprint(blueprint(contents, active_tab=number))
                 picture = _settled(browser, TAB_TIMEOUT_S, picture)
             path = folder / f"{number + 1}-{re.sub(r'[^A-Za-z0-9]+', '-', name).strip('-')}.png"
             path.write_bytes(picture)

@@ -15,19 +15,21 @@ blueprint shows is logged on the timeline the blueprint opens on: a session's op
 :data:`SESSION_TIMELINE` (``log_time``, the wall clock, on which the planner and every
 cell log: the knowledge changes when an experiment ends, beside the arm that ran it), a
 single trial's and an assembly's on ``sim_time``. The paper's Fig. 17 (force against the
-DMP phase) is drawn as a 2D plot of one chosen attempt, visible on every timeline. The
-viewer opens paused (``play_state``); the blueprint cannot set the time it opens at.
+DMP phase) is drawn as a 2D plot of one chosen attempt, visible on every timeline.
+
+A blueprint cannot set the time the viewer opens at (the time panel has no cursor field).
+Opened paused, the viewer sits at the start of the timeline, where the planner has logged
+nothing yet; so the blueprints follow the newest data (``play_state="following"``): a
+finished recording opens at its end (the last experiment's knowledge, the whole plots),
+a live one keeps up with it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Literal
 
 import rerun.blueprint as rrb
-
-PlayState = Literal["paused", "playing", "following"]
 
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
@@ -36,9 +38,9 @@ SESSION_TIMELINE = "log_time"
 SIM_TIMELINE = "sim_time"
 """A cell's simulated time [s], increasing across its attempts."""
 
-CELL_EYE = rrb.EyeControls3D(position=(1.1, -0.75, 0.65), look_target=(0.42, 0.12, 0.12), eye_up=(0.0, 0.0, 1.0))
+CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
-the tray around y = 0.4 m (``executor.world``); all three in view."""
+the tray around y = 0.4 m (``executor.world``): seen from beyond the tray, all three in view."""
 
 
 def cell_root(cell_id: str) -> str:
@@ -130,9 +132,13 @@ def planner_views() -> rrb.Container:
     )
 
 
+_WHOLE = rrb.TimeRange(start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite())
+
+
 def _plot(origin: str, name: str, legend: bool = True) -> rrb.TimeSeriesView:
-    """A plot with its legend in the top-left corner (hidden when ``legend`` is False)."""
-    return rrb.TimeSeriesView(origin=origin, name=name,
+    """A plot of the whole timeline (not a window around the time cursor) with its legend
+    in the top-left corner (hidden when ``legend`` is False)."""
+    return rrb.TimeSeriesView(origin=origin, name=name, axis_x=rrb.TimeAxis(view_range=_WHOLE),
                               plot_legend=rrb.PlotLegend(corner="LeftTop", visible=legend))
 
 
@@ -188,10 +194,10 @@ def tab_names(contents: Contents) -> list[str]:
             *(f"{cell} assembly" for cell in contents.assembly_cells)]
 
 
-def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = "paused") -> rrb.Blueprint:
+def blueprint(contents: Contents, active_tab: int = 0) -> rrb.Blueprint:
     """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
     an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
-    :attr:`Contents.timeline`, ``play_state`` ``paused``, ``playing`` or ``following``."""
+    :attr:`Contents.timeline`, following the newest data."""
     chosen = dict(contents.fig17)
     tabs = [
         *([planner_views()] if contents.planner else []),
@@ -199,6 +205,6 @@ def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = "
         *(assembly_views(cell) for cell in contents.assembly_cells),
     ]
     return rrb.Blueprint(
-        rrb.Tabs(*tabs, active_tab=active_tab), rrb.TimePanel(timeline=contents.timeline, play_state=play_state),
+        rrb.Tabs(*tabs, active_tab=active_tab), rrb.TimePanel(timeline=contents.timeline, play_state="following"),
         collapse_panels=False,
     )

@@ -191,7 +191,7 @@ class ViewSummary:
 @dataclass
 class BlueprintSummary:
     """The views of a blueprint, the names of its tabs in order and the time panel's fields
-    (``{"timeline": "sim_time", "play_state": 1}``; play state 1 is paused)."""
+    (``{"timeline": "sim_time", "play_state": 3}``; play state 1 paused, 2 playing, 3 following)."""
 
     views: list[ViewSummary] = field(default_factory=list)
     tabs: list[str] = field(default_factory=list)

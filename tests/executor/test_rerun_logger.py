@@ -105,7 +105,7 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
 
     # The single trial's blueprint: one tab, paused on sim_time, the arm in the 3D view.
     layout = read_blueprint(rrd)
-    assert layout.time_panel == {"timeline": "sim_time", "play_state": 1} and layout.tabs == ["c1"]
+    assert layout.time_panel == {"timeline": "sim_time", "play_state": 3} and layout.tabs == ["c1"]
     cell_3d = next(v for v in layout.views if v.kind == "3D")
     assert "$origin/arm/**" in cell_3d.contents and "position" in cell_3d.properties["EyeControls3D"]
 

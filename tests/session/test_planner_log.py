@@ -30,6 +30,7 @@ def test_knowledge_matrix_keeps_its_range_and_labels_to_the_last_experiment(tmp_
     log.experiment(1, "p1", "r1", "fit", "c1", _knowledge({("p1", "r1")}, set()))
     every = {("p1", "r1"), ("p1", "r2"), ("p2", "r2")}
     log.experiment(2, "p2", "r1", "no_fit", "c1", _knowledge(every, {("p2", "r1")}))
+    log.assignment({"p1": "r1", "p2": "r2"})
     log.close()
 
     assert column_values(rrd, "planner/knowledge", "experiment") == [1, 2]
@@ -46,9 +47,12 @@ def test_knowledge_matrix_keeps_its_range_and_labels_to_the_last_experiment(tmp_
     xy = dict(zip(nodes, column_values(rrd, "planner/precedence", "GraphNodes:positions")[0]))
     assert [xy[n][1] for n in ("bp", "p1", "p2", "fp")] == pytest.approx([0, SPACING[1], SPACING[1], 2 * SPACING[1]])
     assert xy["p1"][0] != xy["p2"][0]
+    nodes = column_values(rrd, "planner/assignment", "GraphNodes:node_ids")[0]
+    rows = dict(zip(nodes, column_values(rrd, "planner/assignment", "GraphNodes:positions")[0]))
+    assert {n: rows[n][1] for n in nodes} == {"p1": 0, "p2": 0, "r1": SPACING[1], "r2": SPACING[1]}
 
     layout = read_blueprint(rrd)
-    assert layout.time_panel == {"timeline": "log_time", "play_state": 1}
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
     assert layout.tabs == ["planner", "c1", "c1 assembly"]
     graphs = [v for v in layout.views if v.kind == "Graph"]
     assert graphs and all(v.properties["ForceManyBody"] == {"enabled": False} for v in graphs)

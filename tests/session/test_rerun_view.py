@@ -10,7 +10,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from asp.session.view import write_blueprint
-from bridge.recording.layout import Contents
+from bridge.recording.layout import Contents, tab_names
 from bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from executor.rerun_log import AttemptLogger
 
@@ -78,8 +78,8 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
     assert contents == Contents(planner=True, cells=("c1", "c2"), assembly_cells=("c1",),
                                 fig17=(("c1", "fit/e0002_p2_r2_s0_a1"),))
     layout = read_blueprint(write_blueprint(tmp_path, contents))
-    assert layout.tabs == ["planner", "c1", "c2", "c1 assembly"]
-    assert layout.time_panel == {"timeline": "log_time", "play_state": 1}
+    assert layout.tabs == ["planner", "c1", "c2", "c1 assembly"] == tab_names(contents)
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
     fig17 = [v for v in layout.views if v.origin == "executor/c1/by_phase"]
     assert fig17[0].contents == ["$origin/fit/e0002_p2_r2_s0_a1/**"] and "e0002_p2_r2_s0_a1" in fig17[0].name
     spatial = [v for v in layout.views if v.kind == "3D"]
