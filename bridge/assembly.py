@@ -33,9 +33,17 @@ DATA_DIR = (_INSTALLED_ASSEMBLIES if _INSTALLED_ASSEMBLIES.is_dir()
             else Path(__file__).resolve().parent.parent / "data")
 """The shipped assemblies: the repository's ``data/``, or in an installed copy its package
 data ``bridge/assemblies`` (``setup.py``), so ``--assembly cranfield`` works from any folder."""
-ID_PATTERN = r"^[a-z][a-zA-Z0-9_]{0,63}$"
-"""A part or hole id: a lower-case ASP constant of at most 64 characters."""
+ID_PATTERN = r"^(?!not$)[a-z][a-zA-Z0-9_]{0,63}$(?!\n)"
+"""A part or hole id: an ASP constant of at most 64 ASCII characters, a lower-case letter
+first, not the keyword ``not`` (clingo's only lower-case keyword). ``(?!\n)`` keeps a
+trailing newline out (Python's ``$`` would match before it); the pattern means the same
+in Python and in JSON Schema (ECMA 262)."""
 _ID = re.compile(ID_PATTERN)
+
+
+def is_id(value: object) -> bool:
+    """Whether ``value`` is a part or hole id (:data:`ID_PATTERN`)."""
+    return isinstance(value, str) and _ID.match(value) is not None
 MAX_COORDINATE = 100.0
 """Positions ([x, y] of parts and holes, a tool home) are finite with |x|, |y| <= this [m]."""
 
@@ -142,7 +150,7 @@ def _table(source: Path, data: dict, table: str) -> dict[str, dict]:
     if not isinstance(entries, dict):
         raise BridgeError(f"{source}: [{table}] must be a table of ids")
     for key, value in entries.items():
-        if not _ID.match(key):
+        if not is_id(key):
             raise BridgeError(
                 f"{source}: [{table}.{key}]: an id must be a lower-case ASP constant of at most 64 characters"
             )

@@ -14,11 +14,9 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from bridge import BridgeError
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path, run_command
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
-from executor import ExecutorError
 
 MAX_TRIALS = 100_000
 """``trial --trials N``: at most this many trials (trial k uses seed+k)."""
@@ -161,21 +159,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one subcommand; ExecutorError → one line ``error: ...`` on stderr and exit code 2;
-    a closed stdout (``... | head -1``) stops quietly with exit code 141."""
+    """Run one subcommand of the cell (the command line's ``executor`` subcommand, which
+    reports errors and exit codes)."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in _DELEGATED:
+        import importlib
 
-    def dispatch() -> int:
-        if argv and argv[0] in _DELEGATED:
-            import importlib
-
-            module, _help = _DELEGATED[argv[0]]
-            return int(importlib.import_module(module).main(argv[1:]) or 0)
-        args = build_parser().parse_args(argv)
-        return int(args.func(args) or 0)
-
-    return run_command(dispatch, (ExecutorError, BridgeError))
+        module, _help = _DELEGATED[argv[0]]
+        return int(importlib.import_module(module).main(argv[1:]) or 0)
+    args = build_parser().parse_args(argv)
+    return int(args.func(args) or 0)
 
 
-if __name__ == "__main__":
-    sys.exit(main())

@@ -33,7 +33,8 @@ from executor.skills.dmp import Skill, load_skill
 from executor.skills.insertion import insert_in_layer, rotvec_quat_xyzw
 from executor.skills.search import hole_search
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
-from executor.world.geometry import load_geometry, plate_mesh
+from executor.world.assets import current_assets
+from executor.world.geometry import load_geometry
 from executor.world.perturbation import CellBias, PerturbationModel
 from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
@@ -82,7 +83,7 @@ class Cell:
         self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
-            logger.log_scene_mesh("plate_mesh", plate_mesh(self.geometry), PLATE_MESH_COLOR)
+            logger.log_scene_mesh("plate_mesh", current_assets(self.geometry) / "plate.obj", PLATE_MESH_COLOR)
 
     def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
                     cell_seed: int = 0) -> None:

@@ -46,7 +46,7 @@ from asp.sizes.learner import SizeLearner, learn_sizes
 from asp.sizes.models import MODELS, model_for
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import get_policy
-from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, int_in, number_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, int_in, number_in, strict_float, strict_int
 
 CRANFIELD = "cranfield"
 
@@ -165,7 +165,8 @@ def _print_noise(rows: list[dict]) -> None:
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench sizes", description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sizes", default="5,10,20", type=comma_list(number_in(int, 1, 1000), "sizes in [1, 1000)"),
+    parser.add_argument("--sizes", default="5,10,20",
+                        type=comma_list(number_in(strict_int, 1, 1000), "sizes in [1, 1000)"),
                         help="n of the n×n instances (default 5,10,20)")
     parser.add_argument("--policies", default="systematic,random,heuristic,best", type=comma_list(str, "policy names"),
                         help="policies to time (default systematic,random,heuristic,best)")
@@ -174,11 +175,12 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1, help="seed (default 1)")
     parser.add_argument("--evaluate", default="heuristic",
                         help="policy whose all-relabelings evaluation of Cranfield is timed ('' skips)")
-    parser.add_argument("--noise", type=comma_list(number_in(float, 0.0, 0.5), "probabilities in [0, 0.5)"),
+    parser.add_argument("--noise", type=comma_list(number_in(strict_float, 0.0, 0.5), "probabilities in [0, 0.5)"),
                         metavar="P,...",
                         help="measure wrong relations and experiments under these flip probabilities "
                              "instead of timing (Cranfield; with --confirm, --seeds, --policies)")
-    parser.add_argument("--confirm", type=comma_list(number_in(int, 0, 100), "integers in [0, 100)"), default=[0],
+    parser.add_argument("--confirm", type=comma_list(number_in(strict_int, 0, 100), "integers in [0, 100)"),
+                        default=[0],
                         metavar="K,...",
                         help="with --noise: the learner's confirm values (default 0)")
     parser.add_argument("--seeds", type=int_in(1, 10**5), default=30, metavar="N",

@@ -26,13 +26,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
 
 import clingo
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name, solve
+from asp.precedence.relation import closed_precedence
+from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name, solve
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
@@ -92,48 +92,37 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
                     f"{sources}: {name}({part},{hole}): expected a part/1 and a hole/1 "
                     f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
                 )
-    for first, then in sorted(facts.must_precede):
-        for part in (first, then):
-            if part not in known_parts:
-                raise PlannerError(
-                    f"{sources}: must_precede({first},{then}): {part} is not a part/1 "
-                    f"(parts: {' '.join(facts.parts)})"
-                )
     both = sorted(facts.fits & set(pairs_by_name(facts.atoms, "no_fit")))
     if both:
         part, hole = both[0]
         raise PlannerError(f"{sources}: both fits({part},{hole}) and no_fit({part},{hole}); "
                            "expected one result per part and hole")
-    successors: dict[str, set[str]] = {}
-    for first, then in facts.must_precede:
-        successors.setdefault(first, set()).add(then)
-    try:
-        TopologicalSorter(successors).prepare()
-    except CycleError as exc:
-        ring = list(reversed(exc.args[1]))[:-1]  # graphlib names each node's predecessor next
-        start = ring.index(min(ring))
-        cycle = " < ".join([*ring[start:], *ring[:start], ring[start]])
-        raise PlannerError(f"{sources}: must_precede has a cycle {cycle}; expected an acyclic precedence "
-                           "relation") from None
 
 
 def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
     """Read learned facts files; PlannerError on a file that does not parse, a predicate of
     the wrong arity or with non-id arguments (:data:`LEARNED_SIGNATURES`), unknown ids,
-    a pair both fitting and not fitting, or a cycle of ``must_precede``."""
+    a pair both fitting and not fitting, or a precedence cycle.
+
+    Precedence is read in both forms, ``must_precede/2`` and ``precedence_edge/2``, and
+    closed (:func:`asp.precedence.relation.closed_precedence`): ``must_precede`` and the
+    ``must_precede/2`` atoms hold the closure."""
     sources = ", ".join(str(p) for p in paths)
     atoms = load_atoms(paths, encodings=["plans/needs_hole.lp"])
     check_facts(atoms, LEARNED_SIGNATURES, sources)
+    if not atoms_by_name(atoms, "part", 1):
+        raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
+    must_precede = closed_precedence(atoms, sources)
+    atoms = [atom for atom in atoms if not atom.match("must_precede", 2)]
+    atoms += [fact("must_precede", first, then) for first, then in sorted(must_precede)]
     facts = LearnedFacts(
         atoms=tuple(atoms),
         parts=tuple(p for (p,) in atoms_by_name(atoms, "part", 1)),
         holes=tuple(h for (h,) in atoms_by_name(atoms, "hole", 1)),
         fits=frozenset(pairs_by_name(atoms, "fits")),
         needs_hole=tuple(p for (p,) in atoms_by_name(atoms, "needs_hole", 1)),
-        must_precede=frozenset(pairs_by_name(atoms, "must_precede")),
+        must_precede=must_precede,
     )
-    if not facts.parts:
-        raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
     _check_ids(facts, sources)
     return facts
 

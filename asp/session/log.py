@@ -39,7 +39,7 @@ from asp.session.layered import positions
 from asp.sizes.knowledge import Knowledge
 from bridge.recording.compaction import compact_recording
 from bridge.recording.layout import APPLICATION_ID, Contents, blueprint
-from bridge.recording.sinks import NO_VIEWER, Viewer, open_stream
+from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]
@@ -96,9 +96,8 @@ class PlannerLog:
                      static=True)
 
     def close(self) -> None:
-        """Finish the file and compact it."""
-        self.rec.flush()
-        self.rec.disconnect()
+        """Finish the file and compact it; BridgeError naming it if it could not be written."""
+        finish_stream(self.rec, self.rrd)
         compact_recording(self.rrd)
 
 

@@ -62,6 +62,7 @@ from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_cell_arguments, cell_argv, parse_cell_argv
 from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
+from bridge.errors import EXIT_UNSOLVABLE
 from bridge.files import make_folder, write_atomic
 from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
@@ -74,8 +75,6 @@ MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
 MAX_CELLS = 64
 """--cells: at most this many cell co-processes."""
-EXIT_STOPPED = 3
-"""Exit code when ``--assemble`` could not finish the product."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -167,6 +166,12 @@ def _holds_session(run: Path) -> bool:
         return False
 
 
+MAX_STARTS = 1_000_000
+"""The most starts (the first and its resumes) a run folder records."""
+MAX_RECORDING_ID = 64
+"""The longest recording id [characters]: the cells' request ids are built from it."""
+_RECORDING_ID = re.compile(rf"[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}")
+
 _SETTING_TYPES: dict[str, tuple[type, bool]] = {
     "assembly": (str, True), "policy": (str, True), "seed": (int, True), "recording_id": (str, True),
     "confirm": (int, False), "starts": (int, False), "demos": (str, False), "cell_options": (list, False),
@@ -196,7 +201,10 @@ def _resume_settings(path: Path) -> dict:
               ("model", settings.get("model") in (None, *MODELS), f"null or one of {', '.join(MODELS)}"),
               ("seed", 0 <= settings["seed"] <= MAX_SEED, f"an integer from 0 to {MAX_SEED}"),
               ("confirm", 0 <= settings.get("confirm", 0) <= MAX_CONFIRM, f"an integer from 0 to {MAX_CONFIRM}"),
-              ("starts", 1 <= settings.get("starts", 1) <= 1_000_000, "an integer >= 1")]
+              ("starts", 1 <= settings.get("starts", 1) < MAX_STARTS,
+               f"an integer from 1 to {MAX_STARTS - 1} (a resume adds one)"),
+              ("recording_id", _RECORDING_ID.fullmatch(settings["recording_id"]) is not None,
+               f"1 to {MAX_RECORDING_ID} letters, digits, '_' or '-' (a session writes a UUID)")]
     for key, ok, expected in checks:
         if not ok:
             raise PlannerError(f'{path}: "{key}": expected {expected}, got {shorten(json.dumps(settings[key]))}')
@@ -370,6 +378,11 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     suffix = "" if settings["starts"] == 1 else f"-{settings['starts']}"
     cell_ids = [f"c{k}" for k in range(1, args.cells + 1)]
     journal = Journal(run)
+    try:
+        journal.check_ids(parts, holes)
+    except PlannerError:
+        journal.close()
+        raise
     _save(run, settings)
     with ExitStack() as stack:
         stack.callback(journal.close)
@@ -506,15 +519,12 @@ def _summary(result: dict, run: Path) -> str:
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     viewer = viewer_of(args)
-    try:
-        with hosted_viewer(viewer) as live:
-            result = run_session(args, live)
-            print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
-            keep_serving(viewer)
-    except BridgeError as exc:
-        raise PlannerError(str(exc)) from None
+    with hosted_viewer(viewer) as live:
+        result = run_session(args, live)
+        print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
+        keep_serving(viewer)
     stopped = result.get("assembly", {}).get("error")
     if stopped:
         LOG.error("%s", stopped)
-        return EXIT_STOPPED
+        return EXIT_UNSOLVABLE
     return 0

@@ -24,7 +24,7 @@ from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
-from bridge.cli_types import ArgumentParser, add_assembly_argument, comma_list, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -79,7 +79,8 @@ def _parser() -> argparse.ArgumentParser:
     _add_truth_options(learn)
     learn.add_argument("--policy", choices=policy_names(), default="heuristic",
                        help="experiment selection (default heuristic)")
-    learn.add_argument("--seed", type=int, default=0, help="seed of random choices and noise (default 0)")
+    learn.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
+                       help="seed of random choices and noise (default 0)")
     add_model_option(learn)
     learn.add_argument("--demos", metavar="FILE",
                        help="demonstrations; the parts they place into holes (p1@r1) are fits to start from")
@@ -91,7 +92,8 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--policy", choices=policy_names(), required=True, help="the policy to evaluate")
     evaluate.add_argument("--relabelings", default="all", metavar="all|N",
                           help="every relabeling (default) or N random ones")
-    evaluate.add_argument("--seed", type=int, default=0, help="seed of relabelings, random choices, noise")
+    evaluate.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
+                          help="seed of relabelings, random choices, noise")
     _add_noise_options(evaluate)
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", metavar="FILE.png", help="Fig. 19-style comparison plot")

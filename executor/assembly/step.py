@@ -30,6 +30,7 @@ trials, (part shape, hole), a cover or head being its own shape and hole.
 from __future__ import annotations
 
 import time
+from collections.abc import Collection
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +41,7 @@ from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
 from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
 from executor.assembly.world import AssemblyWorld
+from executor.backends import check_step
 from executor.control.detector import Detector, Thresholds
 from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from executor.control.motion import StepLogger
@@ -93,6 +95,11 @@ class StepRecord:
                 "attempts": self.attempts, "duration_s": self.duration_s, "max_force_dev": self.max_force_dev,
                 "max_torque_dev": self.max_torque_dev, "pose_error_mm": self.pose_error * 1000.0,
                 "sim_time_s": self.sim_time_s}
+
+
+def check_product_step(product: Product, part: str, hole: str | None, placed: Collection[str]) -> None:
+    """:func:`executor.backends.check_step` against ``product``, with ``placed`` parts."""
+    check_step(part, hole, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes, placed=placed)
 
 
 class Assembler:
@@ -155,13 +162,11 @@ class Assembler:
         self.blocked.add(hole)
 
     def run_step(self, part: str, hole: str | None, seed: int, max_attempts: int = 2) -> StepRecord:
-        """Place ``part`` (into ``hole`` for a peg); ExecutorError for an unknown id, a peg
-        without a hole or a part already placed."""
+        """Place ``part`` (into ``hole`` for a peg); UnknownPair for an unknown id,
+        InvalidStep for a step the product does not allow (:func:`check_step`), before
+        anything moves."""
+        check_product_step(self.product, part, hole, self.placed)
         skill = self.skill_of(part)
-        if skill == "insert" and hole not in self.product.geometry.holes:
-            raise ExecutorError(f"peg '{part}' needs a hole of the plate, got {hole!r}")
-        if part in self.placed:
-            raise ExecutorError(f"part '{part}' is already placed")
         world, motion = self.world, self.world.motion
         wall0, sim0 = time.perf_counter(), motion.steps
         rng = trial_rng(seed, part, hole or "none")

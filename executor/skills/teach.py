@@ -20,7 +20,7 @@ from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
 from executor.trial import SETTLE_TIME, Cell
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW
-from executor.world.geometry import write_assets
+from executor.world.assets import regenerate_assets
 from executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s]
@@ -104,7 +104,7 @@ def teach_all(assembly: str = "cranfield") -> list[Path]:
     """Regenerate the assets and teach every part shape; returns the written files."""
     cell = Cell(assembly)
     try:
-        written = write_assets(cell.geometry)
+        written = regenerate_assets(cell.geometry)
         for shape in sorted({p.shape for p in cell.geometry.parts.values()}):
             written.append(save_skill(cell.geometry.folder, teach_shape(cell, shape)))
     finally:

@@ -6,7 +6,8 @@ collision margin, so 0.1 mm clearances are real): one square boss per hole with 
 through hole (the plate under the boss is its bottom) and a 45° entry chamfer; round
 holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square holes exact.
 Parts are exact primitive shapes (cylinder with ``URDF_USE_IMPLICIT_CYLINDER``, box).
-``write_assets`` regenerates ``data/<assembly>/assets/`` byte-for-byte deterministically.
+``write_assets`` regenerates ``data/<assembly>/assets/`` deterministically (the URDFs byte
+for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 """
 
 from __future__ import annotations
@@ -21,8 +22,9 @@ import pybullet_data
 
 from bridge.assembly import Assembly, load_assembly
 from bridge.files import make_folder, write_atomic
-from bridge.inputs import read_text, shorten
+from bridge.inputs import read_text
 from executor import ExecutorError
+from executor.world.validation import check_geometry
 
 
 @dataclass(frozen=True)
@@ -77,70 +79,30 @@ def _read_toml(path: Path) -> dict:
         raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
 
 
-_NUMBERS = {"plate": ("top_z", "tile_size", "tile_thickness", "chamfer", "polygon_sides", "base_thickness"),
-            "gripper": ("flange_mass", "flange_inertia", "flange_length", "grasp_depth")}
-_PAIRS = {"plate": ("base_size", "base_center")}
-
-
-def _is_number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-def _check_tables(path: Path, geo: dict) -> None:
-    """The [plate] and [gripper] keys the scene reads later: present, finite numbers
-    ([x, y] pairs for base_size, base_center); ExecutorError naming the key otherwise."""
-    for table in ("plate", "gripper"):
-        values = geo.get(table)
-        if not isinstance(values, dict):
-            raise ExecutorError(f"{path}: no [{table}] table; expected the tables of data/cranfield/geometry.toml")
-        for key in _NUMBERS[table]:
-            if not _is_number(values.get(key)):
-                raise ExecutorError(f"{path}: [{table}] {key}: expected a finite number, "
-                                    f"got {shorten(repr(values.get(key)))}")
-        for key in _PAIRS.get(table, ()):
-            value = values.get(key)
-            if not (isinstance(value, list) and len(value) == 2 and all(map(_is_number, value))):
-                raise ExecutorError(f"{path}: [{table}] {key}: expected [x, y] in m, got {shorten(repr(value))}")
-
-
 def load_geometry(assembly: str = "cranfield") -> CellGeometry:
     """Read ``assembly.toml`` (through :func:`bridge.assembly.load_assembly`) and
-    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path).
-    ExecutorError naming the file and key when a table or key is missing or malformed."""
+    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path), checked
+    as a whole first (:func:`executor.world.validation.check_geometry`: ExecutorError
+    naming the file, table and key)."""
     layout = load_assembly(assembly)
     path = layout.folder / "geometry.toml"
     geo = _read_toml(path)
-    _check_tables(path, geo)
-    try:
-        return _geometry(layout.folder, layout, geo)
-    except KeyError as exc:
-        raise ExecutorError(f"{path}: missing key {shorten(exc.args[0])!r} in a [hole_shapes.*], [part_shapes.*] "
-                            "or [extra_parts.*] table (see data/cranfield/geometry.toml)") from None
-    except (TypeError, ValueError, AttributeError) as exc:
-        raise ExecutorError(f"{path}: a malformed table ({shorten(exc, 80)}); expected the tables of "
-                            "data/cranfield/geometry.toml") from None
+    check_geometry(path, geo, layout)
+    return _geometry(layout.folder, layout, geo)
 
 
 def _geometry(folder: Path, layout: Assembly, geo: dict) -> CellGeometry:
-    positions = {hole.id: hole.position for hole in layout.holes}
+    positions = {hole.id: hole.position for hole in layout.holes if hole.position is not None}
     holes: dict[str, HoleSpec] = {}
     for shape in geo.get("hole_shapes", {}).values():
         for hid in shape["holes"]:
-            if hid not in positions:
-                raise ExecutorError(f"geometry.toml: hole '{hid}' is not a hole of assembly.toml")
-            position = positions[hid]
-            if position is None:
-                raise ExecutorError(f"assembly.toml: hole '{hid}' has no position (expected [x, y] in m)")
-            holes[hid] = HoleSpec(hid, shape["kind"], float(shape["size"]), position)
-    starts = {part.id: part.start for part in layout.parts}
+            holes[hid] = HoleSpec(hid, shape["kind"], float(shape["size"]), positions[hid])
+    starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: p["start"] for pid, p in geo.get("extra_parts", {}).items()}
     parts: dict[str, PartSpec] = {}
     for name, shape in geo.get("part_shapes", {}).items():
         for pid in shape["parts"]:
-            start = starts.get(pid)
-            if start is None:
-                raise ExecutorError(f"geometry.toml: part '{pid}' has no start position (expected [x, y] in m)")
-            x, y = start
+            x, y = starts[pid]
             parts[pid] = PartSpec(
                 pid, shape["kind"], float(shape["size"]), shape=name, length=float(shape["length"]),
                 mass=float(shape["mass"]), start=(float(x), float(y)), demo_hole=shape["demo_hole"],
@@ -172,8 +134,6 @@ def _boss_triangles(hole: HoleSpec, plate: dict) -> list[np.ndarray]:
     """Triangles (3×3 vertex arrays [m], outward normals) of one boss with its through
     hole (the plate under the boss is the hole's bottom) and a 45° entry chamfer."""
     n = int(plate["polygon_sides"])
-    if n % 8:
-        raise ExecutorError(f"geometry.toml: polygon_sides = {n}, expected a multiple of 8")
     cx, cy = hole.position
     top = float(plate["top_z"])
     bottom = top - float(plate["tile_thickness"])
@@ -302,11 +262,3 @@ def write_assets(geometry: CellGeometry) -> list[Path]:
         written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part)))
     return written
 
-
-def plate_mesh(geometry: CellGeometry) -> Path:
-    """``assets/plate.obj`` (the bosses with their holes, world coordinates [m]), generated
-    with the other assets first if it is missing."""
-    path = geometry.assets / "plate.obj"
-    if not path.is_file():
-        write_assets(geometry)
-    return path

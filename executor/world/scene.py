@@ -18,7 +18,8 @@ import pybullet_data
 
 from executor import ExecutorError
 from executor.world import TIME_STEP
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, plate_mesh
+from executor.world.assets import current_assets
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -53,7 +54,7 @@ class Scene:
         pb.setTimeStep(TIME_STEP, physicsClientId=self.client)
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=self.client)
-        plate_obj = plate_mesh(geometry)
+        plate_obj = current_assets(geometry) / "plate.obj"
         self.floor = pb.loadURDF("plane.urdf", physicsClientId=self.client)
         self.plate = load_plate(self.client, geometry, plate_obj)
         self.tray_parts = {

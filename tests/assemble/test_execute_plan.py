@@ -12,8 +12,10 @@ import pytest
 from asp.assemble.cli import truth_facts
 from asp.assemble.execute import AssemblyStopped, execute
 from asp.plans.plans import Plan, PlanStep, check_plan, plans
+from asp.precedence.relation import true_relation
 from bridge.assembly import load_assembly
 from bridge.messages import StepEvidence, StepReply
+from tests.conftest import ROOT
 
 
 class FakeCell:
@@ -120,3 +122,17 @@ def test_bad_input_exits_2_with_one_line(run_cli, tmp_path, args, expected) -> N
     done = run_cli("assemble", "--backend", "truth", *args, cwd=tmp_path)
     assert done.returncode == 2, done.stderr
     assert expected in done.stderr and len(done.stderr.strip().splitlines()) == 1
+
+
+def test_assemble_and_bench_of_facts_files_respect_precedence_edges(run_cli) -> None:
+    """The shipped precedence.lp holds precedence_edge/2 only: assemble and bench assemble
+    of the facts files follow its closure."""
+    files = [str(ROOT / "data" / "cranfield" / name) for name in ("sizes.lp", "precedence.lp")]
+    truth = true_relation(load_assembly("cranfield"))
+    done = run_cli("assemble", *files, "--backend", "truth", "--json", timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert truth.admits([step["part"] for step in json.loads(done.stdout)["steps"]])
+    done = run_cli("bench", "assemble", *files, "--plans", "3", "--backend", "truth", "--json", timeout=60)
+    assert done.returncode == 0, done.stderr
+    for report in json.loads(done.stdout)["plans"]:
+        assert truth.admits([step["part"] for step in report["steps"]])

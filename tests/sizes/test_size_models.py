@@ -215,3 +215,18 @@ def test_under_pairs_every_policy_tries_every_pair_and_learns_the_truth(policy: 
     assert result.knowledge.fits == frozenset(truth.fits)
     assert result.count == len(truth.parts) * len(truth.holes)
     assert len({(e.part, e.hole) for e in result.experiments}) == result.count
+
+
+@settings(max_examples=30, deadline=None)
+@given(products(max_pegs=5, max_holes=5), st.sampled_from(policy_names()), st.integers(2, 4))
+def test_parallel_batches_under_sections_never_conflict_and_learn_exactly(product, policy: str, cells: int) -> None:
+    """Pairs handed out together are independent on their section's line: answered in
+    any order they never contradict each other, and the relation is learned exactly."""
+    truth, sections = product
+    learner = SizeLearner(truth.parts, truth.holes, policy, model=model_for(truth.parts, None, None, sections))
+    while batch := learner.next_batch(cells):
+        for pair in reversed(batch):
+            learner.record(*pair, truth.ask(*pair))
+            assert not learner.knowledge.conflicts
+    assert learner.knowledge.fits == frozenset(truth.fits)
+    assert not any(e.retest for e in learner.experiments)
