@@ -2,13 +2,14 @@
 
 An assembly is a folder (a name under ``data/`` or a path) holding:
 
-- ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role`` and optional ``start``
-  ``[x, y]`` [m] (where the part waits in the cell), ``shape`` (a peg's cross-section:
-  ``round``, ``square`` or ``rect``) and ``section`` (pegs of one section are scaled
-  copies of one cross-section; default: the shape, a rect peg's own id);
-  ``[holes.<id>]`` with ``name``, ``shape`` and ``position`` ``[x, y]`` [m] on the base
-  plate; an optional ``[sizes]`` table with ``model`` (the size model the product
-  declares: ``line``, ``sections`` or ``pairs``, docs/sizes.md);
+- ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role``, optional ``start``
+  ``[x, y]`` [m] (where the part waits in the cell), optional ``shape`` (its cross-section
+  kind, :data:`SHAPES`) and, for a rect part, optional ``section`` (a label: parts of one
+  section are scaled copies of one cross-section; default the shape for round and
+  square, the part's own id for rect); ``[holes.<id>]`` with ``name``, ``shape`` (default
+  round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
+  table with ``model`` (the size model the product declares: ``line``, ``sections`` or
+  ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
   ``precedence_edge/2`` or ``must_precede/2``);
 - ``sizes.lp`` (optional): which part fits which hole (``part/1``, ``hole/1``,
@@ -44,6 +45,8 @@ _ID = re.compile(ID_PATTERN)
 def is_id(value: object) -> bool:
     """Whether ``value`` is a part or hole id (:data:`ID_PATTERN`)."""
     return isinstance(value, str) and _ID.match(value) is not None
+
+
 MAX_COORDINATE = 100.0
 """Positions ([x, y] of parts and holes, a tool home) are finite with |x|, |y| <= this [m]."""
 
@@ -57,7 +60,7 @@ class Item:
 
 
 SHAPES = ("round", "square", "rect")
-"""Cross-sections of pegs and holes."""
+"""The cross-section kinds of a part's or hole's ``shape`` (``kind`` in ``geometry.toml``)."""
 
 SIZE_MODELS = ("line", "sections", "pairs")
 """The size models a product may declare (``[sizes] model``; docs/sizes.md)."""
@@ -66,8 +69,8 @@ SIZE_MODELS = ("line", "sections", "pairs")
 @dataclass(frozen=True)
 class Part(Item):
     """One part of an assembly; ``start`` is its waiting position [m] or None; ``shape``
-    its cross-section (None: not stated) and ``section`` the label shared by parts that
-    are scaled copies of one cross-section (None: not stated)."""
+    its cross-section kind (one of :data:`SHAPES`, None when the file gives none) and
+    ``section`` the label of its cross-section (None without a shape)."""
 
     role: str = "part"
     start: tuple[float, float] | None = None
@@ -145,6 +148,29 @@ def _position(source: Path, table: str, key: str, value: object) -> tuple[float,
     return (float(value[0]), float(value[1]))
 
 
+def _shape(source: Path, table: str, key: str, value: object) -> str:
+    if value not in SHAPES:
+        raise BridgeError(f"{source}: [{table}.{key}] shape: expected one of {', '.join(SHAPES)}, "
+                          f"got {shorten(repr(value))}")
+    return str(value)
+
+
+def _part(source: Path, key: str, value: dict) -> Part:
+    """One ``[parts.<id>]`` table; ``section`` only for a rect part (an id-like label)."""
+    shape = None if value.get("shape") is None else _shape(source, "parts", key, value["shape"])
+    section = value.get("section")
+    if section is not None and shape != "rect":
+        raise BridgeError(f"{source}: [parts.{key}] section: only a part of shape \"rect\" has one "
+                          f"(a {shape or 'part without a shape'} is its own section)")
+    if section is not None and not (isinstance(section, str) and _ID.match(section)):
+        raise BridgeError(f"{source}: [parts.{key}] section: expected a lower-case ASP constant, "
+                          f"got {shorten(repr(section))}")
+    if shape is not None and section is None:
+        section = key if shape == "rect" else shape
+    return Part(key, str(value.get("name", key)), str(value.get("role", "part")),
+                _position(source, "parts", key, value.get("start")), shape, section)
+
+
 def _table(source: Path, data: dict, table: str) -> dict[str, dict]:
     entries = data.get(table, {})
     if not isinstance(entries, dict):
@@ -167,15 +193,11 @@ def load_assembly(name_or_path: str) -> Assembly:
         data = tomllib.loads(read_text(source, "assembly file (TOML)"))
     except tomllib.TOMLDecodeError as exc:
         raise BridgeError(f"{source}: not valid TOML: {exc}") from None
-    parts = tuple(
-        Part(key, str(value.get("name", key)), str(value.get("role", "part")),
-             _position(source, "parts", key, value.get("start")), *_section(source, key, value))
-        for key, value in _table(source, data, "parts").items()
-    )
+    parts = tuple(_part(source, key, value) for key, value in _table(source, data, "parts").items())
     if not parts:
         raise BridgeError(f"{source}: expected at least one [parts.<id>] table")
     holes = tuple(
-        Hole(key, str(value.get("name", key)), str(value.get("shape", "round")),
+        Hole(key, str(value.get("name", key)), _shape(source, "holes", key, value.get("shape", "round")),
              _position(source, "holes", key, value.get("position")))
         for key, value in _table(source, data, "holes").items()
     )
@@ -191,21 +213,6 @@ def _choice(source: Path, table: str, key: str, value: object, choices: tuple[st
         raise BridgeError(f"{source}: [{table}] {key}: expected one of {', '.join(choices)}, "
                           f"got {shorten(repr(value))}")
     return value
-
-
-def _section(source: Path, key: str, value: dict) -> tuple[str | None, str | None]:
-    """(shape, section) of ``[parts.<key>]``; the section defaults to the shape, and to
-    the part's own id for a rect (rectangles of other aspect ratios are not on one line)."""
-    shape = value.get("shape")
-    if shape is not None:
-        shape = _choice(source, f"parts.{key}", "shape", shape, SHAPES)
-    section = value.get("section")
-    if section is not None and (not isinstance(section, str) or not _ID.match(section)):
-        raise BridgeError(f"{source}: [parts.{key}] section: expected a lower-case ASP constant "
-                          f"of at most 64 characters, got {shorten(repr(section))}")
-    if section is None and shape is not None:
-        section = key if shape == "rect" else shape
-    return shape, section
 
 
 def _size_model(source: Path, data: dict) -> str | None:

@@ -1,4 +1,5 @@
-"""Command line of the simulated cell: ``teach``, ``trial``, ``export``, ``campaign``, ``serve``, ``margins``.
+"""Command line of the simulated cell: ``teach``, ``trial``, ``sizes``, ``export``, ``campaign``, ``serve``,
+``margins``.
 
 ``./run.sh executor trial --part p1 --hole r1 --trials 3 --json`` prints
 ``{"trials": [{"outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error",
@@ -16,6 +17,7 @@ from pathlib import Path
 
 from bridge.cell_options import add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path
+from bridge.files import write_atomic
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 
 MAX_TRIALS = 100_000
@@ -100,6 +102,19 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     return 0
 
 
+def _sizes(args: argparse.Namespace) -> int:
+    """Print or write the sizes.lp of ``geometry.toml`` (:func:`executor.world.geometry.sizes_lp_text`)."""
+    from executor.world.geometry import sizes_lp_text
+
+    text = sizes_lp_text(args.assembly)
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        write_atomic(args.out, text)
+        print(f"wrote {args.out}")
+    return 0
+
+
 def _export(args: argparse.Namespace) -> int:
     from executor.assembly.export import export_cell
 
@@ -147,6 +162,11 @@ def build_parser() -> argparse.ArgumentParser:
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     add_cell_arguments(trial)
     trial.set_defaults(func=_trial)
+
+    sizes = sub.add_parser("sizes", help="write the sizes.lp (which part fits which hole) that the geometry makes")
+    add_assembly_argument(sizes, purpose="the product whose fits are derived from geometry.toml")
+    sizes.add_argument("--out", metavar="FILE", type=Path, help="write it to FILE (default: print it)")
+    sizes.set_defaults(func=_sizes)
 
     export = sub.add_parser("export", help="write the assembling cell as URDF and meshes (arm, plate, every part)")
     add_assembly_argument(export, purpose="the product whose cell is written")

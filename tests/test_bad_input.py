@@ -32,6 +32,7 @@ from tests.conftest import CLI_MODULE, ROOT, child_env, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
 TRUTH = (str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"))
+TASKBOARD = ROOT / "data" / "taskboard"
 Setup = Callable[[Path], None] | dict[str, str | bytes] | None
 
 
@@ -53,6 +54,17 @@ def unreadable(name: str, source: Path | None = None, text: str = "") -> Callabl
         except OSError:
             return
         pytest.skip(f"cannot make {name} unreadable here")
+
+    return setup
+
+
+def taskboard(**files: str) -> Callable[[Path], None]:
+    """Setup: a copy of data/taskboard in ``asm/`` (without its assets), with ``files`` replaced."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(TASKBOARD, tmp / "asm", ignore=shutil.ignore_patterns("assets"))
+        for name, content in files.items():
+            (tmp / "asm" / name).write_text(content)
 
     return setup
 
@@ -209,9 +221,27 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("trial-peg-half-a-metre", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      geometry("size = 0.0187", "size = 0.5"), 2, "[part_shapes.shaft] size: expected a number in (0, 0.1] m"),
     ("trial-kind-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
-     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of round, square"),
+     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of rect, round, square"),
     ("teach-demo-hole-unknown", ("executor", "teach", "--assembly", "asm"),
      geometry('demo_hole = "br"', 'demo_hole = "zz"'), 2, "[part_shapes.shaft] demo_hole"),
+    ("trial-geometry-rect-short-side-first", ("executor", "trial", "--part", "p3", "--hole", "s1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "square"\nsize = 0.0133', 'kind = "rect"\nsize = [0.010, 0.0133]', 1)}), 2, "a >= b"),
+    ("trial-geometry-unknown-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "round"', 'kind = "oval"', 1)}), 2, "oval"),
+    ("trial-part-shape-against-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "square"', 1)}), 2, "kind"),
+    ("assembly-part-shape-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape"),
+    ("section-of-unlike-parts", ("executor", "trial", "--part", "rect8", "--hole", "slot8", "--assembly", "asm"),
+     taskboard(**{"assembly.toml": (TASKBOARD / "assembly.toml").read_text().replace(
+         'shape = "rect"\n', 'shape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
+    ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2, "section"),
     # learned facts: arity, ids, cycles, contradictions
     ("assign-arity", ("assign", "f.lp"), {"f.lp": "part(a). hole(r1). fits(a,r1,x).\n"}, 2, "fits/2"),
     ("plan-arity", ("plan", "f.lp"), {"f.lp": "part(a;b). must_precede(a,b,c).\n"}, 2, "must_precede/2"),

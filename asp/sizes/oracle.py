@@ -92,43 +92,46 @@ class TruthOracle:
     def from_facts(cls, path: Path | str) -> TruthOracle:
         """A truth facts file (``part/1``, ``hole/1``, ``fits/2``, optional ``section/2``, the
         parts' cross-sections); index order = order of first mention in the file."""
-        path = Path(path)
-        atoms = load_atoms([path])
-        check_facts(atoms, {"part": 1, "hole": 1, "fits": 2, "section": 2}, str(path))
-        parts = [a for (a,) in atoms_by_name(atoms, "part", 1)]
-        holes = [a for (a,) in atoms_by_name(atoms, "hole", 1)]
-        text = re.sub(r"%.*", "", read_text(path, "truth facts file", error=PlannerError))
-
-        def mention(name: str) -> int:
-            found = re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", text)
-            return found.start() if found else len(text)
-
-        parts.sort(key=mention)
-        holes.sort(key=mention)
-        fits = set(pairs_by_name(atoms, "fits"))
-        sections = dict(pairs_by_name(atoms, "section")) or None
-        return cls(parts, holes, fits, source=str(path), sections=sections)
+        parts, holes, fits, sections = _read_truth(Path(path))
+        return cls(parts, holes, fits, source=str(path), sections=sections or None)
 
     @classmethod
     def from_assembly(cls, name_or_path: str) -> TruthOracle:
         """An assembly's ``sizes.lp``, in the order of its ``assembly.toml``."""
         assembly = load_assembly(name_or_path)
-        truth = cls.from_facts(assembly.file("sizes.lp"))
-        for kind, ids, known in (("part", truth.parts, assembly.part_ids),
-                                 ("hole", truth.holes, assembly.hole_ids)):
+        truth_parts, truth_holes, fits, _ = _read_truth(assembly.file("sizes.lp"))
+        for kind, ids, known in (("part", truth_parts, assembly.part_ids),
+                                 ("hole", truth_holes, assembly.hole_ids)):
             unknown = [i for i in ids if i not in known]
             if unknown:
                 raise PlannerError(
                     f"{assembly.folder / 'sizes.lp'}: {kind}(s) {unknown} are not in "
                     f"{assembly.folder / 'assembly.toml'}"
                 )
-        parts = [p for p in assembly.part_ids if p in truth.parts]
-        holes = [h for h in assembly.hole_ids if h in truth.holes]
+        parts = [p for p in assembly.part_ids if p in truth_parts]
+        holes = [h for h in assembly.hole_ids if h in truth_holes]
         declared = assembly.sections()
         sections = None if assembly.size_model == "line" else {p: declared.get(p, "line") for p in parts}
-        found = cls(parts, holes, truth.fits, source=str(assembly.folder / "sizes.lp"), sections=sections)
+        found = cls(parts, holes, fits, source=str(assembly.folder / "sizes.lp"), sections=sections)
         found.declared_sections, found.declared_model = declared, assembly.size_model
         return found
+
+
+def _read_truth(path: Path) -> tuple[list[str], list[str], set[tuple[str, str]], dict[str, str]]:
+    """Parts and holes (in order of first mention), fits and ``section/2`` of a truth file."""
+    atoms = load_atoms([path])
+    check_facts(atoms, {"part": 1, "hole": 1, "fits": 2, "section": 2}, str(path))
+    parts = [a for (a,) in atoms_by_name(atoms, "part", 1)]
+    holes = [a for (a,) in atoms_by_name(atoms, "hole", 1)]
+    text = re.sub(r"%.*", "", read_text(path, "truth facts file", error=PlannerError))
+
+    def mention(name: str) -> int:
+        found = re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", text)
+        return found.start() if found else len(text)
+
+    parts.sort(key=mention)
+    holes.sort(key=mention)
+    return parts, holes, set(pairs_by_name(atoms, "fits")), dict(pairs_by_name(atoms, "section"))
 
 
 class NoisyOracle:
