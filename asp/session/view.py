@@ -1,11 +1,11 @@
-"""``./run.sh view RUN [--print] [--json]``: open a run's Rerun recording.
+"""``./run.sh view RUN [--print] [--json] [--web] [--screenshot DIR]``: open a run's Rerun recording.
 
 RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: planner
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
 on the files plus ``RUN/view.rbl``, the blueprint of what the recording holds
 (``bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
-entities, one tab per cell that tried insertions (its Fig. 17 view on the cell's first
+entities, one tab per cell that logged more than an assembly (its Fig. 17 view on its first
 fitting attempt), one assembly tab per cell that assembled. Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the

@@ -3,8 +3,8 @@
 Planner and cells log into one recording id of application :data:`APPLICATION_ID`, the
 planner under ``planner/...``, cell ``<id>`` under ``executor/<id>/...``. A blueprint is
 made for what a recording holds (:class:`Contents`): the planner's tab when the planner
-logged, one tab per cell that logged insertions, one assembly tab per cell that executed a
-plan, nothing else.
+logged, one tab per cell that logged more than an assembly, one assembly tab per cell that
+executed a plan, nothing else.
 
 Rerun 0.41 has one time panel for the whole viewer: its timeline (``TimePanel(timeline=)``)
 is the x axis of every plot and the time of every other view; no view or tab has a
@@ -34,7 +34,7 @@ import rerun.blueprint as rrb
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
 SESSION_TIMELINE = "log_time"
-"""Wall-clock timeline [ns since the epoch] every entity of a session carries."""
+"""Wall-clock timeline [ns since the epoch] every time-varying entity of a session carries."""
 SIM_TIMELINE = "sim_time"
 """A cell's simulated time [s], increasing across its attempts."""
 
