@@ -9,16 +9,19 @@ Entities (all under ``executor/<cell-id>/``):
 =============================== ===================================================
 ``scene/<name>``                static geometry (boxes, cylinders), ``static=True``
 ``tool/tip``                    tool-tip position over ``sim_time`` [m]
-``tool/path``                   the attempt's tool path as a line strip [m]
+``tool/force``                  F_mes as an arrow at the tool tip (:data:`FORCE_ARROW_M_PER_N`)
+``tool/path``                   the attempt's tool path as a line strip [m] (green fit, red no fit)
 ``search/path``                 the stochastic hole-search path [m]
 ``wrench/force/{measured,desired}``   F_mes, F_des (x, y, z) over ``sim_time`` [N]
 ``wrench/torque/{measured,desired}``  M_mes, M_des (x, y, z) over ``sim_time`` [Nm]
-``deviation/{force,torque}``    ‖F_mes − F_des‖ [N], ‖M_mes − M_des‖ [Nm] (eqs. 6, 7)
+``deviation/{force,torque}/<key>``    ‖F_mes − F_des‖ [N], ‖M_mes − M_des‖ [Nm] (eqs. 6, 7),
+                                one series per attempt (:attr:`AttemptTrace.key`),
+                                green when it fitted, red when not
 ``phase``                       DMP phase over ``sim_time`` (0 → 1 during the
                                 insertion; 0 while searching or retreating)
-``by_phase/<attempt>/force_{measured,desired}``  force over timeline ``dmp_phase``
-                                (phase × 1000), one series per attempt, insertion
-                                steps only: Fig. 17
+``by_phase/<outcome>/<key>``    Fig. 17: F_des and F_mes of the insertion against the DMP
+                                phase 0..1, a 2D plot logged when the attempt ends
+                                (:func:`executor.rerun_plots.log_fig17`)
 ``outcome``                     text log, one line per attempt
 ``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
 ``ilc/<shape>/<hole>/correction_norm``  size of the ILC correction after each update
@@ -28,8 +31,9 @@ Entities (all under ``executor/<cell-id>/``):
 
 Timelines: ``experiment`` (sequence: one per trial, or set by the caller),
 ``sim_time`` (duration [s]; kept increasing across attempts even when the cell
-restarts its clock), ``dmp_phase`` (sequence, phase × 1000) and ``execution``
-(sequence: the ILC iteration of a part shape and hole).
+restarts its clock), ``log_time`` (the wall clock when each step ran, the timeline a
+session's planner logs on too) and ``execution`` (sequence: the ILC iteration of a part
+shape and hole).
 
 Steps are buffered and sent column-wise (``send_columns``) at ``end_attempt``, which
 keeps the per-step cost to a list append; samples closer than ``period_s`` in sim
@@ -38,6 +42,7 @@ time are skipped so a long campaign stays small.
 
 from __future__ import annotations
 
+import time
 import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -48,24 +53,20 @@ import numpy as np
 import rerun as rr
 
 from bridge.recording.compaction import compact_recording
-from bridge.recording.layout import APPLICATION_ID, cell_blueprint, cell_root
+from bridge.recording.layout import APPLICATION_ID, SESSION_TIMELINE, Contents, blueprint, cell_root, fig17_path
 from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 from executor import ExecutorError
+from executor.rerun_plots import AXIS_NAMES, DESIRED_COLORS, MEASURED_COLORS, log_fig17, outcome_color
 
 if TYPE_CHECKING:
     from executor.evidence import AttemptEvidence
     from executor.rerun_arm import ArmRecorder
 
-PHASE_SCALE = 1000
-"""The ``dmp_phase`` timeline holds round(phase × PHASE_SCALE)."""
+FORCE_ARROW_M_PER_N = 0.004
+"""Length of the force arrow at the tool [m] per newton of F_mes."""
 
-_AXIS_NAMES = {"force": ["Fx", "Fy", "Fz"], "torque": ["Mx", "My", "Mz"]}
-_MEASURED_COLORS = [[230, 60, 60], [60, 170, 60], [60, 90, 230]]
-_DESIRED_COLORS = [[250, 160, 160], [150, 220, 150], [150, 170, 250]]
 _TIME_TOLERANCE = 1e-9  # [s] float slack when comparing sim times
 _ATTEMPT_GAP_S = 0.001  # [s] between attempts when the cell restarts its clock
-_FIT_COLOR = [40, 180, 60]
-_NO_FIT_COLOR = [220, 50, 40]
 
 
 class SceneShape(NamedTuple):
@@ -88,7 +89,8 @@ class AttemptTrace:
     """The buffered samples of one attempt (also kept for plots, e.g. Fig. 17).
 
     Arrays have one row per logged step: ``sim_time`` [s] as the cell reported it,
-    ``phase`` (DMP phase), ``tool_pos`` [m], forces [N], torques [Nm].
+    ``wall_time`` [s since the epoch], ``phase`` (DMP phase), ``tool_pos`` [m], forces [N],
+    torques [Nm].
     """
 
     part: str
@@ -98,6 +100,7 @@ class AttemptTrace:
     experiment: int
     outcome: str = ""
     sim_time: list[float] = field(default_factory=list)
+    wall_time: list[float] = field(default_factory=list)
     phase: list[float] = field(default_factory=list)
     tool_pos: list[np.ndarray] = field(default_factory=list)
     force_mes: list[np.ndarray] = field(default_factory=list)
@@ -109,13 +112,15 @@ class AttemptTrace:
     def add(
         self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
         force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray,
-        arm_pose: np.ndarray | None = None,
+        arm_pose: np.ndarray | None = None, wall_time: float | None = None,
     ) -> None:
         """Append one step (units as in the class docstring; ``arm_pose``: the arm's link
-        poses, see :meth:`executor.rerun_arm.ArmRecorder.sample`)."""
+        poses, see :meth:`executor.rerun_arm.ArmRecorder.sample`; ``wall_time``: now when
+        None)."""
         if arm_pose is not None:
             self.arm_poses.append(arm_pose)
         self.sim_time.append(float(sim_time))
+        self.wall_time.append(time.time() if wall_time is None else wall_time)
         self.phase.append(float(phase))
         for name, value in (
             ("tool_pos", tool_pos), ("force_mes", force_mes), ("force_des", force_des),
@@ -201,7 +206,7 @@ class AttemptLogger:
         self._arm_static_sent = False
         self._held: str | None = None
         if send_blueprint:
-            self.rec.send_blueprint(cell_blueprint([cell_id]))
+            self.rec.send_blueprint(blueprint(Contents(cells=(cell_id,))))
 
     @classmethod
     def to_file(
@@ -295,7 +300,7 @@ class AttemptLogger:
         """
         trace = self._require_attempt("log_step")
         arm_pose = None if self._arm is None else self._arm.sample()
-        step = (sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des, arm_pose)
+        step = (sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des, arm_pose, time.time())
         if trace.sim_time:
             if sim_time - trace.sim_time[-1] < self.period_s - _TIME_TOLERANCE:
                 self._skipped = step
@@ -327,7 +332,12 @@ class AttemptLogger:
             self._last_time = trace.sim_time[-1] + self._time_offset
             self._sent_steps = True
         self._set_time(self._last_time)
-        color = _FIT_COLOR if evidence.outcome == "fit" else _NO_FIT_COLOR
+        color = outcome_color(evidence.outcome)
+        insertion = trace.insertion()
+        if len(insertion):
+            log_fig17(self.rec, fig17_path(self.cell_id, f"{trace.outcome}/{trace.key}"),
+                      trace.array("phase")[insertion], trace.array("force_mes")[insertion],
+                      trace.array("force_des")[insertion])
         if len(trace.tool_pos) >= 2:
             self.rec.log(
                 f"{self.root}/tool/path",
@@ -371,40 +381,35 @@ class AttemptLogger:
         times = trace.array("sim_time") + self._time_offset
         count = len(times)
         experiment = rr.TimeColumn("experiment", sequence=np.full(count, trace.experiment))
-        timed = [experiment, rr.TimeColumn("sim_time", duration=times)]
+        timed = [experiment, rr.TimeColumn("sim_time", duration=times),
+                 rr.TimeColumn(SESSION_TIMELINE, timestamp=trace.array("wall_time"))]
+        label = f"{trace.part}→{trace.hole} s{trace.trial_seed} a{trace.attempt} {trace.outcome}"
         for quantity, measured, desired in (
             ("force", "force_mes", "force_des"), ("torque", "torque_mes", "torque_des"),
         ):
             mes, des = trace.array(measured), trace.array(desired)
-            self._series(f"wrench/{quantity}/measured", timed, mes, quantity, "", _MEASURED_COLORS)
-            self._series(f"wrench/{quantity}/desired", timed, des, quantity, " des", _DESIRED_COLORS)
-            deviation = np.linalg.norm(mes - des, axis=1)
-            self.rec.send_columns(
-                f"{self.root}/deviation/{quantity}", indexes=timed,
-                columns=rr.Scalars.columns(scalars=deviation),
-            )
+            self._series(f"wrench/{quantity}/measured", timed, mes, quantity, "", MEASURED_COLORS)
+            self._series(f"wrench/{quantity}/desired", timed, des, quantity, " des", DESIRED_COLORS)
+            entity = f"{self.root}/deviation/{quantity}/{trace.key}"
+            self.rec.log(entity, rr.SeriesLines(names=[label], colors=[outcome_color(trace.outcome)]), static=True)
+            self.rec.send_columns(entity, indexes=timed,
+                                  columns=rr.Scalars.columns(scalars=np.linalg.norm(mes - des, axis=1)))
         self.rec.send_columns(
             f"{self.root}/phase", indexes=timed,
             columns=rr.Scalars.columns(scalars=trace.array("phase")),
         )
         if self._arm is not None and len(trace.arm_poses) == count:
             self._arm.send(self.rec, self.root, timed, np.stack(trace.arm_poses))
+        tip = trace.array("tool_pos")
         self.rec.send_columns(
             f"{self.root}/tool/tip", indexes=timed,
-            columns=rr.Points3D.columns(positions=trace.array("tool_pos")).partition([1] * count),
+            columns=rr.Points3D.columns(positions=tip).partition([1] * count),
         )
-        insertion = trace.insertion()
-        if len(insertion):
-            phase = trace.array("phase")[insertion]
-            by_phase = [
-                rr.TimeColumn("experiment", sequence=np.full(len(phase), trace.experiment)),
-                rr.TimeColumn("dmp_phase", sequence=np.round(phase * PHASE_SCALE).astype(np.int64)),
-            ]
-            base = f"by_phase/{trace.key}"
-            self._series(f"{base}/force_measured", by_phase, trace.array("force_mes")[insertion],
-                         "force", "", _MEASURED_COLORS)
-            self._series(f"{base}/force_desired", by_phase, trace.array("force_des")[insertion],
-                         "force", " des", _DESIRED_COLORS)
+        self.rec.send_columns(
+            f"{self.root}/tool/force", indexes=timed,
+            columns=rr.Arrows3D.columns(origins=tip, vectors=trace.array("force_mes") * FORCE_ARROW_M_PER_N)
+            .partition([1] * count),
+        )
 
     def _series(
         self, path: str, indexes: list[rr.TimeColumn], values: np.ndarray, quantity: str,
@@ -412,7 +417,8 @@ class AttemptLogger:
     ) -> None:
         """Send an ``(N, 3)`` signal as three named plot series under ``path``."""
         entity = f"{self.root}/{path}"
-        names = [name + suffix for name in _AXIS_NAMES[quantity]]
+        unit = "N" if quantity == "force" else "Nm"
+        names = [f"{name}{suffix} [{unit}]" for name in AXIS_NAMES[quantity]]
         if entity not in self._styled:
             self.rec.log(entity, rr.SeriesLines(names=names, colors=colors), static=True)
             self._styled.add(entity)

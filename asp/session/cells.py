@@ -80,8 +80,11 @@ class CellProcess:
         except subprocess.TimeoutExpired:
             return None
 
-    def stop(self, timeout: float = 10.0) -> int:
-        """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code."""
+    def stop(self, timeout: float = 60.0) -> int:
+        """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code. A cell
+        compacts its recording before it exits (:mod:`bridge.recording.compaction`), which
+        on a loaded machine takes tens of seconds; killed earlier, it leaves the file
+        uncompacted."""
         if self.popen.poll() is None:
             self.popen.send_signal(signal.SIGTERM)
             try:

@@ -400,7 +400,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
                 recording_id=settings["recording_id"], zenoh_config=args.zenoh_config, viewer_url=viewer.connect,
                 ilc_state=run / f"{cell_id}-ilc.json", cell_options=settings.get("cell_options", []),
                 cell_seed=cell_seed(settings["seed"], number))))
-        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids, viewer)
+        log = PlannerLog(run / f"planner{suffix}.rrd", settings["recording_id"], cell_ids, viewer,
+                         assembling=cell_ids[:1] if args.assemble else ())
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
         abandoned = [event.experiment for event in journal.abandon_in_flight()]

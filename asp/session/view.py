@@ -1,16 +1,18 @@
-"""``./run.sh view RUN [--print] [--json]``: open a run's Rerun recording.
+"""``./run.sh view RUN [--print] [--json] [--web] [--screenshot DIR]``: open a run's Rerun recording.
 
 RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: planner
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
-on the files plus ``RUN/view.rbl``, a blueprint with the planner's tab
-(``bridge.recording.layout.planner_views``) when the recording has ``planner/...`` entities
-and one tab per cell found (``bridge.recording.layout.cell_views``). Without a display (no ``DISPLAY`` /
+on the files plus ``RUN/view.rbl``, the blueprint of what the recording holds
+(``bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
+entities, one tab per cell that logged more than an assembly (its Fig. 17 view on its first
+fitting attempt), one assembly tab per cell that assembled. Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
 one line per entity path with its row count, timelines and components (``--json``: the
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
-free loopback ports; the address is logged; Ctrl-C stops). A RUN without ``.rrd`` files
-is an error (exit code 2).
+free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
+picture of every tab, rendered by the web viewer in a headless Chromium
+(:mod:`asp.session.screenshot`). A RUN without ``.rrd`` files is an error (exit code 2).
 """
 
 from __future__ import annotations
@@ -22,9 +24,13 @@ import subprocess
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from asp import PlannerError
 from bridge.cli_types import ArgumentParser
+
+if TYPE_CHECKING:
+    from bridge.recording.layout import Contents
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -37,12 +43,6 @@ def recording_files(run: Path) -> list[Path]:
     if not files:
         raise PlannerError(f"{run}: holds no Rerun recording; expected RUN/*.rrd or an .rrd file")
     return files
-
-
-def cell_ids(entity_paths: Sequence[str]) -> list[str]:
-    """Cell ids present in a recording: ``/executor/<cell-id>/...`` → ``<cell-id>``."""
-    ids = {p.split("/")[2] for p in entity_paths if p.startswith("/executor/") and p.count("/") >= 3}
-    return sorted(ids)
 
 
 def has_display() -> bool:
@@ -58,14 +58,13 @@ def rerun_executable() -> str:
     return found
 
 
-def write_blueprint(folder: Path, cells: Sequence[str], planner: bool) -> Path:
-    """``folder/view.rbl``: the planner's tab (if ``planner``), then one tab per cell."""
+def write_blueprint(folder: Path, contents: Contents) -> Path:
+    """``folder/view.rbl``: the blueprint of a recording holding ``contents``."""
     from bridge.files import check_writable
-    from bridge.recording.layout import APPLICATION_ID, cell_blueprint, planner_views
+    from bridge.recording.layout import APPLICATION_ID, blueprint
 
     path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
-    extra = [planner_views()] if planner else []
-    cell_blueprint(cells, extra=extra).save(APPLICATION_ID, str(path))
+    blueprint(contents).save(APPLICATION_ID, str(path))
     return path
 
 
@@ -74,25 +73,35 @@ def main(argv: Sequence[str]) -> int:
     parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
     parser.add_argument("--print", action="store_true", help="print the contents, no viewer")
     parser.add_argument("--json", action="store_true", help="print the contents as JSON")
+    parser.add_argument("--screenshot", type=Path, metavar="DIR",
+                        help="render every tab in a headless Chromium (Rerun's web viewer), write DIR/<k>-<tab>.png; "
+                             "needs chromium on PATH, takes a few minutes")
     parser.add_argument("--web", action="store_true",
                         help="serve the recording to a web browser (for headless machines); the address to open "
                              "is printed, Ctrl-C stops")
     args = parser.parse_args(list(argv))
 
+    from bridge.recording.layout import Contents
     from bridge.recording.reader import format_summary, read_recording
 
     run = Path(args.run)
     files = recording_files(run)
     summary = read_recording(files)
+    contents = Contents.of(summary.entities)
+    if args.screenshot:
+        from asp.session.screenshot import take_screenshots
+
+        recording_id = min(summary.recording_ids, default="view")
+        for picture in take_screenshots(files, contents, recording_id, args.screenshot):
+            print(picture)
+        return 0
     if args.print or args.json or not (has_display() or args.web):
         if not (args.print or args.json):
             print("view: no display (DISPLAY/WAYLAND_DISPLAY unset); printing the recording",
                   file=sys.stderr)
         print(json.dumps(summary.to_json(), indent=2) if args.json else format_summary(summary))
         return 0
-    cells = cell_ids(list(summary.entities))
-    planner = bool(summary.under("planner"))
-    blueprint = write_blueprint(run if run.is_dir() else run.parent, cells, planner)
+    blueprint = write_blueprint(run if run.is_dir() else run.parent, contents)
     if args.web:
         from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
 

@@ -1,23 +1,46 @@
-"""The Rerun layout both sides share: the application id, the entity roots and the blueprint.
+"""The Rerun layout both sides share: the application id, the entity roots and the blueprints.
 
 Planner and cells log into one recording id of application :data:`APPLICATION_ID`, the
-planner under ``planner/...``, cell ``<id>`` under ``executor/<id>/...``. The blueprint
-has the planner's tab (knowledge matrix, graphs, assignment, experiment log), then one
-tab per cell: the 3D scene (static geometry, tool path, search path) above the
-outcome log, next to force and torque (measured vs desired over ``sim_time``), the
-deviations of eqs. 6 and 7, and the force over the DMP phase (paper Fig. 17: switch
-the time panel to the ``dmp_phase`` timeline); and one assembly tab per cell (the parts
-and the arm moving over ``sim_time``, the plan steps, the force).
+planner under ``planner/...``, cell ``<id>`` under ``executor/<id>/...``. A blueprint is
+made for what a recording holds (:class:`Contents`): the planner's tab when the planner
+logged, one tab per cell that logged more than an assembly, one assembly tab per cell that
+executed a plan, nothing else.
+
+Rerun 0.41 has one time panel for the whole viewer: its timeline (``TimePanel(timeline=)``)
+is the x axis of every plot and the time of every other view; no view or tab has a
+timeline of its own (``TimePanelBlueprint``'s fields: ``state``, ``timeline``,
+``playback_speed``, ``fps``, ``play_state``, ``loop_mode``, ``time_selection``; the views
+take ``time_ranges`` on a timeline but are drawn at the panel's). So every entity a
+blueprint shows is logged on the timeline the blueprint opens on: a session's opens on
+:data:`SESSION_TIMELINE` (``log_time``, the wall clock, on which the planner and every
+cell log: the knowledge changes when an experiment ends, beside the arm that ran it), a
+single trial's and an assembly's on ``sim_time``. The paper's Fig. 17 (force against the
+DMP phase) is drawn as a 2D plot of one chosen attempt, visible on every timeline.
+
+A blueprint cannot set the time the viewer opens at (the time panel has no cursor field).
+Opened paused, the viewer sits at the start of the timeline, where the planner has logged
+nothing yet; so the blueprints follow the newest data (``play_state="following"``): a
+finished recording opens at its end (the last experiment's knowledge, the whole plots),
+a live one keeps up with it.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable
+from dataclasses import dataclass
 
 import rerun.blueprint as rrb
 
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
+SESSION_TIMELINE = "log_time"
+"""Wall-clock timeline [ns since the epoch] every time-varying entity of a session carries."""
+SIM_TIMELINE = "sim_time"
+"""A cell's simulated time [s], increasing across its attempts."""
+
+CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
+"""The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
+the tray around y = 0.4 m (``executor.world``): seen from beyond the tray, all three in view."""
 
 
 def cell_root(cell_id: str) -> str:
@@ -30,69 +53,158 @@ def assembly_root(cell_id: str) -> str:
     return f"{cell_root(cell_id)}/assembly"
 
 
-def assembly_views(cell_id: str) -> rrb.Container:
-    """A cell's assembly tab: parts and arm in 3D, the plan steps, the measured force."""
-    root = assembly_root(cell_id)
-    return rrb.Horizontal(
-        rrb.Spatial3DView(origin=root, name=f"{cell_id}: assembly", contents=["$origin/parts/**", "$origin/arm"]),
-        rrb.Vertical(
-            rrb.TextLogView(origin=f"{root}/steps", name="plan steps (timeline plan_step)"),
-            rrb.TimeSeriesView(origin=f"{root}/force", name="force at the TCP [N] over sim_time"),
-        ),
-        column_shares=[2, 1],
-        name=f"{cell_id} assembly",
+def fig17_path(cell_id: str, attempt: str) -> str:
+    """Entity of one attempt's Fig. 17 plot: ``executor/<cell>/by_phase/<attempt>``, where
+    ``attempt`` is ``<outcome>/<key>`` (``fit/e0003_p1_r1_s7_a1``)."""
+    return f"{cell_root(cell_id)}/by_phase/{attempt}"
+
+
+@dataclass(frozen=True)
+class Contents:
+    """What a recording holds, as far as its blueprint is concerned.
+
+    ``planner``: the planner logged (a session); ``cells``: cells that logged anything but an assembly;
+    ``assembly_cells``: cells that executed a plan; ``fig17``: ``(cell, attempt)`` pairs,
+    the attempt (``<outcome>/<key>``, :func:`fig17_path`) whose Fig. 17 plot the cell's tab
+    shows (every attempt's when the cell has none here).
+    """
+
+    planner: bool = False
+    cells: tuple[str, ...] = ()
+    assembly_cells: tuple[str, ...] = ()
+    fig17: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def timeline(self) -> str:
+        """The timeline the viewer opens on: ``log_time`` for a session, else ``sim_time``."""
+        return SESSION_TIMELINE if self.planner else SIM_TIMELINE
+
+    @classmethod
+    def of(cls, entity_paths: Iterable[str]) -> Contents:
+        """The contents of a recording from its entity paths (``/executor/c1/outcome``, ...);
+        each cell's Fig. 17 shows its first fitting attempt, else its first attempt."""
+        paths = sorted(p.strip("/") for p in entity_paths)
+        cells = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and p.count("/") >= 2
+                        and p.split("/")[2] != "assembly"})
+        assembly = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and "/assembly/" in p})
+        chosen = []
+        for cell in cells:
+            prefix = f"{cell_root(cell)}/by_phase/"
+            attempts = {"/".join(p[len(prefix):].split("/")[:2]) for p in paths if p.startswith(prefix)}
+            by_key = sorted((a for a in attempts if a.count("/") == 1), key=lambda a: a.split("/")[1])
+            first = [a for a in by_key if a.startswith("fit/")][:1] or by_key[:1]
+            chosen += [(cell, attempt) for attempt in first]
+        return cls(any(p.startswith(f"{PLANNER_ROOT}/") for p in paths), tuple(cells), tuple(assembly), tuple(chosen))
+
+
+def _graph(origin: str, name: str) -> rrb.GraphView:
+    """A graph view that keeps the logged node positions (every layout force off)."""
+    forces = rrb.archetypes
+    return rrb.GraphView(
+        origin=origin, name=name,
+        force_link=forces.ForceLink(enabled=False), force_many_body=forces.ForceManyBody(enabled=False),
+        force_position=forces.ForcePosition(enabled=False),
+        force_collision_radius=forces.ForceCollisionRadius(enabled=False),
+        force_center=forces.ForceCenter(enabled=False),
     )
 
 
 def planner_views() -> rrb.Container:
-    """The planner's tab: knowledge matrix, graphs, assignment, experiment log."""
+    """The planner's tab: knowledge matrix and table, experiment log, layered graphs, assignment."""
     return rrb.Horizontal(
         rrb.Vertical(
-            rrb.TensorView(origin="planner/knowledge", name="knowledge (1 fit, 0 no fit, -1 unknown)"),
-            rrb.TextLogView(origin="planner/experiments", name="experiments"),
+            rrb.TensorView(origin=f"{PLANNER_ROOT}/knowledge", name="knowledge: -1 unknown, 0 no fit, 1 fit",
+                           view_fit="fill"),
+            rrb.TextDocumentView(origin=f"{PLANNER_ROOT}/knowledge_table", name="knowledge: part × hole"),
+            rrb.TextLogView(origin=f"{PLANNER_ROOT}/experiments", name="experiments"),
+            row_shares=[2, 2, 1],
         ),
         rrb.Vertical(
-            rrb.GraphView(origin="planner/precedence", name="must precede"),
-            rrb.GraphView(origin="planner/smaller", name="smaller than"),
+            _graph(f"{PLANNER_ROOT}/precedence", "must precede (reduction, by levels)"),
+            _graph(f"{PLANNER_ROOT}/smaller", "smaller than (reduction, by levels)"),
         ),
         rrb.Vertical(
-            rrb.GraphView(origin="planner/assignment", name="assignment"),
-            rrb.TextDocumentView(origin="planner/assignment", name="assignment table"),
+            _graph(f"{PLANNER_ROOT}/assignment", "assignment part → hole"),
+            rrb.TextDocumentView(origin=f"{PLANNER_ROOT}/assignment", name="assignment table"),
         ),
+        column_shares=[2, 2, 1],
         name="planner",
     )
 
 
-def cell_views(cell_id: str) -> rrb.Container:
-    """The views of one cell: 3D scene, force/torque plots, Fig. 17, outcome log."""
+_WHOLE = rrb.TimeRange(start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite())
+
+
+def _plot(origin: str, name: str, legend: bool = True) -> rrb.TimeSeriesView:
+    """A plot of the whole timeline (not a window around the time cursor) with its legend
+    in the top-left corner (hidden when ``legend`` is False)."""
+    return rrb.TimeSeriesView(origin=origin, name=name, axis_x=rrb.TimeAxis(view_range=_WHOLE),
+                              plot_legend=rrb.PlotLegend(corner="LeftTop", visible=legend))
+
+
+def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
+    """A cell's tab: the 3D cell (arm, scene, tool path and force, search path) above the
+    Fig. 17 plot of attempt ``fig17`` (``<outcome>/<key>``, :func:`fig17_path`; None:
+    every attempt) and
+    the outcome log; force, torque and the deviations of eqs. 6 and 7 per attempt."""
     root = cell_root(cell_id)
+    attempt = fig17.replace("/", " ") if fig17 else "every attempt"
     return rrb.Horizontal(
         rrb.Vertical(
             rrb.Spatial3DView(
                 origin=root, name=f"{cell_id}: cell",
-                contents=["$origin/scene/**", "$origin/tool/**", "$origin/search/**"],
+                contents=["$origin/scene/**", "$origin/arm/**", "$origin/tool/**", "$origin/search/**"],
+                eye_controls=CELL_EYE,
             ),
+            rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
+                              name=f"Fig. 17 {attempt}: F_des (pale), F_mes [N] over DMP phase 0..1"),
             rrb.TextLogView(origin=f"{root}/outcome", name=f"{cell_id}: outcomes"),
-            row_shares=[3, 1],
+            row_shares=[3, 2, 1],
         ),
         rrb.Vertical(
-            rrb.TimeSeriesView(origin=f"{root}/wrench/force", name="force [N] over sim_time"),
-            rrb.TimeSeriesView(origin=f"{root}/wrench/torque", name="torque [Nm] over sim_time"),
-            rrb.TimeSeriesView(
-                origin=f"{root}/deviation", name="‖mes − des‖ (eqs. 6, 7) over sim_time"
-            ),
-            rrb.TimeSeriesView(
-                origin=f"{root}/by_phase", name="force [N] over DMP phase (timeline dmp_phase)"
-            ),
+            _plot(f"{root}/wrench/force", "force F_mes, F_des [N]"),
+            _plot(f"{root}/wrench/torque", "torque M_mes, M_des [Nm]"),
+            _plot(f"{root}/deviation/force", "‖F_mes − F_des‖ [N] per attempt: green fit, red no fit", legend=False),
+            _plot(f"{root}/deviation/torque", "‖M_mes − M_des‖ [Nm] per attempt: green fit, red no fit",
+                  legend=False),
         ),
         column_shares=[1, 1],
         name=cell_id,
     )
 
 
-def cell_blueprint(cell_ids: Sequence[str], extra: Sequence[rrb.Container] = ()) -> rrb.Blueprint:
-    """A blueprint with one tab per cell (plus ``extra`` containers, e.g. the planner's)."""
-    tabs = [*extra, *(cell_views(cell_id) for cell_id in cell_ids), *(assembly_views(c) for c in cell_ids)]
+def assembly_views(cell_id: str) -> rrb.Container:
+    """A cell's assembly tab: parts and arm in 3D, the plan steps, the measured force."""
+    root = assembly_root(cell_id)
+    return rrb.Horizontal(
+        rrb.Spatial3DView(origin=root, name=f"{cell_id}: assembly", contents=["$origin/parts/**", "$origin/arm/**"],
+                          eye_controls=CELL_EYE),
+        rrb.Vertical(
+            rrb.TextLogView(origin=f"{root}/steps", name="plan steps"),
+            _plot(f"{root}/force", "force at the TCP Fx, Fy, Fz [N]"),
+        ),
+        column_shares=[2, 1],
+        name=f"{cell_id} assembly",
+    )
+
+
+def tab_names(contents: Contents) -> list[str]:
+    """The names of the tabs of ``contents``' blueprint, in order."""
+    return [*(["planner"] if contents.planner else []), *contents.cells,
+            *(f"{cell} assembly" for cell in contents.assembly_cells)]
+
+
+def blueprint(contents: Contents, active_tab: int = 0) -> rrb.Blueprint:
+    """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
+    an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
+    :attr:`Contents.timeline`, following the newest data."""
+    chosen = dict(contents.fig17)
+    tabs = [
+        *([planner_views()] if contents.planner else []),
+        *(cell_views(cell, chosen.get(cell)) for cell in contents.cells),
+        *(assembly_views(cell) for cell in contents.assembly_cells),
+    ]
     return rrb.Blueprint(
-        rrb.Tabs(*tabs), rrb.TimePanel(timeline="sim_time"), collapse_panels=False
+        rrb.Tabs(*tabs, active_tab=active_tab), rrb.TimePanel(timeline=contents.timeline, play_state="following"),
+        collapse_panels=False,
     )

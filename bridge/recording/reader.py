@@ -76,6 +76,7 @@ class RecordingSummary:
 
 _CONTROL_COLUMN_PREFIX = "rerun.controls."
 _VIEW_ORIGIN = "ViewBlueprint:space_origin"
+_TABS_KIND = 1  # ContainerBlueprint:container_kind of rrb.Tabs
 
 
 @contextmanager
@@ -182,17 +183,71 @@ def column_values(
     return values
 
 
-def blueprint_origins(path: Path | str) -> set[str]:
-    """Origins of the views in the blueprints of an ``.rrd`` / ``.rbl`` file
-    (e.g. ``{"executor/c1", "executor/c1/wrench/force", ...}``)."""
-    origins: set[str] = set()
+@dataclass
+class ViewSummary:
+    """One view of a blueprint: its class (``Spatial3DView``, ``TimeSeriesView``, ...),
+    display name, origin (without the leading ``/``), contents queries and the view's
+    properties by archetype (``{"EyeControls3D": {"position": [...], ...}}``)."""
+
+    kind: str = ""
+    name: str = ""
+    origin: str = ""
+    contents: list[str] = field(default_factory=list)
+    properties: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+@dataclass
+class BlueprintSummary:
+    """The views of a blueprint, the names of its tabs in order and the time panel's fields
+    (``{"timeline": "sim_time", "play_state": 3}``; play state 1 paused, 2 playing, 3 following)."""
+
+    views: list[ViewSummary] = field(default_factory=list)
+    tabs: list[str] = field(default_factory=list)
+    time_panel: dict[str, Any] = field(default_factory=dict)
+
+
+def read_blueprint(path: Path | str) -> BlueprintSummary:
+    """The last blueprint of an ``.rrd`` / ``.rbl`` file (the one the viewer shows)."""
+    summary = BlueprintSummary()
     with _open(Path(path)) as reader, _tolerating_unfinished_files():
-        for store in reader.blueprints():
-            for chunk in reader.stream(store=store):
-                batch = chunk.to_record_batch()
-                if _VIEW_ORIGIN in batch.schema.names:
-                    origins.update(v for row in batch.column(_VIEW_ORIGIN).to_pylist() for v in row or [])
-    return origins
+        stores = reader.blueprints()
+        chunks = list(reader.stream(store=stores[-1])) if stores else []
+    views: dict[str, ViewSummary] = {}
+    containers: dict[str, dict[str, Any]] = {}
+    for chunk in chunks:
+        batch = chunk.to_record_batch()
+        row = {name: column.to_pylist()[-1] for name, column in zip(batch.schema.names, batch.columns) if ":" in name}
+        parts = chunk.entity_path.strip("/").split("/")
+        if parts[0] == "time_panel":
+            summary.time_panel.update({n.split(":")[1]: _single(v) for n, v in row.items()})
+        elif parts[0] == "container":
+            containers["/".join(parts)] = {n.split(":")[1]: v if n.endswith(":contents") else _single(v)
+                                           for n, v in row.items()}
+        elif parts[0] == "view" and len(parts) >= 2:
+            view = views.setdefault(parts[1], ViewSummary())
+            if len(parts) == 2:
+                view.kind = _single(row.get("ViewBlueprint:class_identifier"))
+                view.name = _single(row.get("ViewBlueprint:display_name"))
+                view.origin = str(_single(row.get(_VIEW_ORIGIN)) or "").strip("/")
+            elif parts[2] == "ViewContents":
+                view.contents = list(row.get("ViewContents:query") or [])
+            else:
+                view.properties[parts[2]] = {n.split(":")[1]: _single(v) for n, v in row.items()}
+    summary.views = list(views.values())
+    tabs = next((c for c in containers.values() if c.get("container_kind") == _TABS_KIND), {})
+    summary.tabs = [containers.get(child, {}).get("display_name", child) for child in tabs.get("contents") or []]
+    return summary
+
+
+def _single(value: Any) -> Any:
+    """A component row's one value (rows hold batches)."""
+    return value[0] if isinstance(value, list) and len(value) == 1 else value
+
+
+def blueprint_origins(path: Path | str) -> set[str]:
+    """Origins of the views in the last blueprint of an ``.rrd`` / ``.rbl`` file
+    (e.g. ``{"executor/c1", "executor/c1/wrench/force", ...}``)."""
+    return {view.origin for view in read_blueprint(path).views}
 
 
 def _python_values(array: pa.Array) -> list[Any]:

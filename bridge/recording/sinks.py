@@ -44,10 +44,12 @@ _LOG = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class Viewer:
-    """Live viewing of a recording: a viewer's URL to stream to, and/or a hosted web viewer."""
+    """Live viewing of a recording: a viewer's URL to stream to, and/or a hosted web viewer;
+    ``page``: the address a browser opens to see it (set by :func:`hosted_viewer`)."""
 
     connect: str | None = None
     serve: bool = False
+    page: str | None = None
 
 
 NO_VIEWER = Viewer()
@@ -141,8 +143,9 @@ def hosted_viewer(viewer: Viewer, files: Sequence[Path] = ()) -> Iterator[Viewer
         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     try:
         _wait_for_port(grpc_port, server)
-        _LOG.info("web viewer: open http://127.0.0.1:%d/?url=%s", web_port, quote(server_url, safe=""))
-        yield Viewer(connect=server_url)
+        page = f"http://127.0.0.1:{web_port}/?url={quote(server_url, safe='')}"
+        _LOG.info("web viewer: open %s", page)
+        yield Viewer(connect=server_url, page=page)
     finally:
         _stop(server)
 

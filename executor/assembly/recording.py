@@ -8,7 +8,7 @@ Entities (under ``executor/<cell-id>/assembly/``):
                                 solid (boxes, cylinders in its frame) logged once, static
 ``arm/<link>``                  the arm's links (meshes, as in a cell's recording:
                                 :class:`executor.rerun_arm.ArmRecorder`) over ``sim_time``
-``force``                       measured contact force at the TCP (x, y, z) [N]
+``force``                       measured contact force at the TCP (series Fx, Fy, Fz [N])
 ``steps``                       one text line per plan step (timelines ``plan_step``
                                 and ``sim_time``)
 =============================== ===================================================
@@ -25,6 +25,7 @@ import rerun as rr
 from bridge.recording.layout import assembly_root
 from executor.assembly.world import AssemblyWorld
 from executor.rerun_arm import ArmRecorder
+from executor.rerun_plots import AXIS_NAMES, MEASURED_COLORS
 
 PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
 
@@ -77,6 +78,8 @@ class AssemblyRecorder:
         for part in world.product.parts:
             for solid in _part_solids(world, part):
                 self.rec.log(f"{self.root}/parts/{part}", solid, static=True)
+        self.rec.log(f"{self.root}/force", rr.SeriesLines(names=[f"{n} [N]" for n in AXIS_NAMES["force"]],
+                                                         colors=MEASURED_COLORS), static=True)
 
     def log_step(self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
                  force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray) -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 import rerun as rr
 
 from bridge.recording.compaction import compact_recording
-from bridge.recording.layout import APPLICATION_ID, cell_blueprint
+from bridge.recording.layout import APPLICATION_ID, Contents, blueprint
 from bridge.recording.reader import blueprint_origins, chunk_count, column_values, read_recording
 
 
@@ -15,7 +15,7 @@ def _many_chunk_recording(path: Path, rows: int = 60) -> None:
     """A recording flushed after every row, as a slow writer makes it."""
     rec = rr.RecordingStream(APPLICATION_ID, recording_id="compaction-test")
     rec.save(str(path))
-    rec.send_blueprint(cell_blueprint(["c1"]))
+    rec.send_blueprint(blueprint(Contents(cells=("c1",))))
     for k in range(rows):
         rec.set_time("experiment", sequence=k)
         rec.log("executor/c1/result/max_force_dev", rr.Scalars(float(k)))

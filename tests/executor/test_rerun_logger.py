@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from bridge import BridgeError
-from bridge.recording.reader import blueprint_origins, column_values, format_summary, read_recording
+from bridge.recording.reader import blueprint_origins, column_values, format_summary, read_blueprint, read_recording
 from executor import ExecutorError
-from executor.rerun_log import PHASE_SCALE, AttemptLogger
+from executor.rerun_log import AttemptLogger
+from executor.rerun_plots import WIDTH
 
 
 @dataclass
@@ -62,16 +63,16 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert summary.blueprints == 1
     assert {"executor/c1", "executor/c1/wrench/force", "executor/c1/by_phase"} <= blueprint_origins(rrd)
     entities = summary.under("executor/c1")
-    for name in ("scene/plate", "scene/peg_p1", "tool/tip", "tool/path", "search/path",
+    for name in ("scene/plate", "scene/peg_p1", "tool/tip", "tool/force", "tool/path", "search/path",
                  "wrench/force/measured", "wrench/force/desired", "wrench/torque/measured",
-                 "deviation/force", "phase", "outcome", "result/fit"):
+                 "deviation/force/e0002_p1_r1_s8_a1", "phase", "outcome", "result/fit"):
         assert f"/executor/c1/{name}" in entities, name
     plate = entities["/executor/c1/scene/plate"]
     assert plate.static_rows == plate.rows == 1 and "Boxes3D:half_sizes" in plate.components
     # 1000 steps at 1 kHz kept every 10 ms plus the last: 101 rows per attempt, 3 attempts.
     assert entities["/executor/c1/tool/tip"].rows == 303
     assert entities["/executor/c1/outcome"].rows == 3
-    assert {"experiment", "sim_time"} <= entities["/executor/c1/wrench/force/measured"].timelines
+    assert {"experiment", "sim_time", "log_time"} <= entities["/executor/c1/wrench/force/measured"].timelines
 
     texts = [row[0] for row in column_values(rrd, "executor/c1/outcome", "TextLog:text")]
     assert texts[0].startswith("p3→r1 seed 7 attempt 1: no_fit")
@@ -85,17 +86,28 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert times[-1] == pytest.approx(3 * 0.999 + 2 * 0.001, abs=1e-6)
     forces = column_values(rrd, "executor/c1/wrench/force/measured", "Scalars:scalars")
     assert forces[-1] == pytest.approx([0.0, 0.0, -10.0])
-    deviation = column_values(rrd, "executor/c1/deviation/force", "Scalars:scalars")
-    assert deviation[-1] == pytest.approx([2.0])
+    # One deviation series per attempt, coloured by its outcome (green fit, red no fit).
+    deviation = "executor/c1/deviation/force/e0002_p1_r1_s8_a1"
+    assert column_values(rrd, deviation, "Scalars:scalars")[-1] == pytest.approx([2.0])
+    assert column_values(rrd, deviation, "SeriesLines:colors") != column_values(
+        rrd, "executor/c1/deviation/force/e0001_p3_r1_s7_a1", "SeriesLines:colors")
+    assert column_values(rrd, deviation, "SeriesLines:names") == [["p1→r1 s8 a1 fit"]]
+    wall = column_values(rrd, "executor/c1/tool/tip", "log_time")
+    assert all(b >= a for a, b in zip(wall, wall[1:]))
 
-    # Fig. 17: one force series per attempt over the dmp_phase timeline.
+    # Fig. 17: a 2D plot per attempt, x the DMP phase 0..1 (WIDTH units), the search left out.
     by_phase = summary.under("executor/c1/by_phase")
-    assert len([p for p in by_phase if p.endswith("/force_measured")]) == 3
-    series = "/executor/c1/by_phase/e0002_p1_r1_s8_a1/force_measured"
-    phases = column_values(rrd, series, "dmp_phase")
-    # The search (phase 0, steps 0..199) is left out: kept steps 210..990 and 999.
-    assert len(phases) == 80 and phases[0] > 0 and phases[-1] == PHASE_SCALE
+    assert len([p for p in by_phase if p.endswith("/measured")]) == 3
+    strips = column_values(rrd, "executor/c1/by_phase/fit/e0002_p1_r1_s8_a1/measured", "LineStrips2D:strips")
+    x = [point[0] for point in strips[0][2]]  # Fz
+    assert 0 < x[0] < 5 and x[-1] == pytest.approx(WIDTH)
     assert "/executor/c1/by_phase" in format_summary(summary)
+
+    # The single trial's blueprint: one tab, paused on sim_time, the arm in the 3D view.
+    layout = read_blueprint(rrd)
+    assert layout.time_panel == {"timeline": "sim_time", "play_state": 3} and layout.tabs == ["c1"]
+    cell_3d = next(v for v in layout.views if v.kind == "3D")
+    assert "$origin/arm/**" in cell_3d.contents and "position" in cell_3d.properties["EyeControls3D"]
 
 
 def test_two_cells_in_one_process_share_a_recording(tmp_path: Path) -> None:

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from asp.session.view import cell_ids, write_blueprint
-from bridge.recording.reader import blueprint_origins
+from asp.session.view import write_blueprint
+from bridge.recording.layout import Contents, tab_names
+from bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from executor.rerun_log import AttemptLogger
 
 
@@ -52,15 +53,37 @@ def test_view_without_recording_exits_2(tmp_path: Path, run_cli) -> None:
     assert missing.returncode == 2 and "no such run folder" in missing.stderr
 
 
-def test_blueprint_has_the_planner_and_a_tab_per_cell(tmp_path: Path) -> None:
-    paths = ["/executor/c1/outcome", "/executor/c2/scene/plate", "/planner/knowledge", "/executor"]
-    assert cell_ids(paths) == ["c1", "c2"]
-    blueprint = write_blueprint(tmp_path, ["c1", "c2"], planner=True)
+def test_blueprint_has_a_tab_per_cell_of_a_real_recording(tmp_path: Path) -> None:
+    run = _run_folder(tmp_path / "run")
+    contents = Contents.of(read_recording(sorted(run.glob("*.rrd"))).entities)
+    assert contents == Contents(cells=("c1", "c2"))  # no planner, no assembly, no insertion
+    blueprint = write_blueprint(run, contents)
     stores = RrdReader(blueprint).blueprints()
     assert [s.application_id for s in stores] == ["assembly_constraints"]
     origins = blueprint_origins(blueprint)
     for cell in ("c1", "c2"):
         assert {f"executor/{cell}", f"executor/{cell}/wrench/force", f"executor/{cell}/by_phase",
                 f"executor/{cell}/outcome"} <= origins
-    assert {"planner/knowledge", "planner/precedence"} <= origins
-    assert not any(o.startswith("planner") for o in blueprint_origins(write_blueprint(tmp_path, ["c1"], False)))
+    assert not any(o.startswith("planner") for o in origins)
+    layout = read_blueprint(blueprint)
+    assert layout.tabs == ["c1", "c2"] and layout.time_panel["timeline"] == "sim_time"
+
+
+def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> None:
+    attempts = "/executor/c1/by_phase/{}/measured"
+    paths = ["/planner/knowledge", "/executor/c1/outcome", "/executor/c1/assembly/force", "/executor/c2/outcome",
+             attempts.format("no_fit/e0001_p3_r1_s0_a1"), attempts.format("fit/e0003_p1_r1_s0_a1"),
+             attempts.format("fit/e0002_p2_r2_s0_a1"), "/executor"]
+    contents = Contents.of(paths)
+    assert contents == Contents(planner=True, cells=("c1", "c2"), assembly_cells=("c1",),
+                                fig17=(("c1", "fit/e0002_p2_r2_s0_a1"),))
+    layout = read_blueprint(write_blueprint(tmp_path, contents))
+    assert layout.tabs == ["planner", "c1", "c2", "c1 assembly"] == tab_names(contents)
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
+    fig17 = [v for v in layout.views if v.origin == "executor/c1/by_phase"]
+    assert fig17[0].contents == ["$origin/fit/e0002_p2_r2_s0_a1/**"] and "e0002_p2_r2_s0_a1" in fig17[0].name
+    spatial = [v for v in layout.views if v.kind == "3D"]
+    assert {v.origin for v in spatial} == {"executor/c1", "executor/c2", "executor/c1/assembly"}
+    assert all("$origin/arm/**" in v.contents and "EyeControls3D" in v.properties for v in spatial)
+    assert {"planner/knowledge", "planner/knowledge_table", "planner/precedence"} <= blueprint_origins(
+        tmp_path / "view.rbl")
