@@ -69,3 +69,15 @@ def test_line_on_the_mixed_product_is_refused_before_any_cell_starts(run_cli, tm
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "size model line puts parts of 2 cross-sections" in done.stderr
     assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.slow
+def test_a_session_learns_the_task_board_and_assigns_each_peg_a_hole_it_fits(run_session, tmp_path) -> None:
+    """NIST task board 1's pegs (data/taskboard): round, square and three rect aspect
+    ratios, no one size line; learned under the sections model, against its sizes.lp."""
+    result = run_session("--assembly", "taskboard", "--out", str(tmp_path / "run"), timeout=120)
+    assert result["matches_truth"] is True and result["model"] == "sections"
+    assert result["experiments"] < 64  # the round pegs' line spares experiments
+    steps = {step["part"]: step["hole"] for step in result["plans"][0] if step["hole"]}
+    assert len(steps) == 8 and len(set(steps.values())) == 8
+    assert all([p, h] in result["fits"] for p, h in steps.items())
