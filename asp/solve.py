@@ -8,6 +8,9 @@
   back is the set of atoms of the (unique) answer set (:func:`load_atoms`).
 - Facts are written from ``clingo.Symbol`` values, never by string formatting of terms
   (:func:`fact`, :func:`format_facts`, :func:`write_facts`), and atomically.
+- Facts reach clingo as symbols through its backend (:func:`add_facts`), never as
+  program text: an id read from a file or a message is one constant whatever its
+  characters, so it cannot add rules or facts of its own.
 - :func:`solve` grounds encodings with facts and calls back on every model.
 """
 
@@ -21,11 +24,11 @@ from pathlib import Path
 import clingo
 
 from asp import MAX_IDS, PlannerError
-from bridge.assembly import ID_PATTERN
+from bridge.assembly import is_id
 from bridge.files import write_atomic
 from bridge.inputs import read_bytes, shorten
 
-_ID = re.compile(ID_PATTERN)
+_CONSTANT = re.compile(r"_*[a-z][A-Za-z0-9_']*")
 _STRINGS_AND_COMMENTS = re.compile(r'"(?:\\.|[^"\\\n])*"|%\*.*?\*%|%[^\n]*', re.DOTALL)
 _NON_ASCII = re.compile(r"[^\x00-\x7f]")
 
@@ -80,7 +83,7 @@ def load_atoms(
             raise PlannerError(f"{path}: does not parse as ASP facts: {detail}") from None
     for name in encodings:
         ctl.load(str(encoding(name)))
-    ctl.add("base", [], format_facts(extra))
+    add_facts(ctl, extra)
     try:
         ctl.ground([("base", [])])
     except RuntimeError:
@@ -109,7 +112,7 @@ def check_facts(atoms: Iterable[clingo.Symbol], signatures: Mapping[str, int], s
                                f"expected {atom.name}/{arity}")
         for argument in atom.arguments:
             if (argument.type != clingo.SymbolType.Function or argument.arguments or not argument.positive
-                    or not _ID.match(argument.name)):
+                    or not is_id(argument.name)):
                 raise PlannerError(f"{source}: {shorten(atom, 60)}: '{shorten(argument)}' is not an id "
                                    "(expected lower-case ASP constants such as p1)")
         counts[atom.name] = counts.get(atom.name, 0) + 1
@@ -141,10 +144,36 @@ def fact(name: str, *args: str | int) -> clingo.Symbol:
     )
 
 
+def add_facts(ctl: clingo.Control, atoms: Iterable[clingo.Symbol]) -> None:
+    """Add the atoms to ``ctl`` as facts through its backend, before grounding: the
+    grounder sees them like facts of the program, but no symbol is ever parsed as
+    program text."""
+    with ctl.backend() as backend:
+        for atom in atoms:
+            backend.add_rule([backend.add_atom(atom)])
+
+
+def _unprintable(symbol: clingo.Symbol) -> str | None:
+    """The first name in ``symbol`` that is no ASP constant (clingo prints a function's name
+    as it is, so such a name would become program text), else None."""
+    if symbol.type != clingo.SymbolType.Function:
+        return None  # numbers, #inf/#sup, and strings (printed quoted and escaped)
+    if symbol.name and (symbol.name == "not" or not _CONSTANT.fullmatch(symbol.name)):
+        return symbol.name
+    return next((name for name in map(_unprintable, symbol.arguments) if name is not None), None)
+
+
 def format_facts(atoms: Iterable[clingo.Symbol], header: str = "") -> str:
-    """Facts as program text, one per line, after an optional ``%`` comment header."""
+    """Facts as program text, one per line, after an optional ``%`` comment header;
+    PlannerError for a symbol with a name that is no ASP constant (it would not read back
+    as the same fact)."""
     lines = [f"% {line}" if line else "%" for line in header.splitlines()]
-    lines += [f"{atom}." for atom in atoms]
+    for atom in atoms:
+        bad = _unprintable(atom)
+        if bad is not None:
+            raise PlannerError(f"cannot write the fact {shorten(repr(str(atom)), 60)}: {shorten(repr(bad))} is not "
+                               "an ASP constant")
+        lines.append(f"{atom}.")
     return "\n".join(lines) + "\n"
 
 
@@ -174,7 +203,7 @@ def solve(
     try:
         for name in encodings:
             ctl.load(str(encoding(name)))
-        ctl.add("base", [], format_facts(atoms))
+        add_facts(ctl, atoms)
         ctl.ground([("base", [])])
     except RuntimeError:
         raise PlannerError(f"{names} does not ground: " + "; ".join(messages)) from None

@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any, NoReturn, TypeVar
 
 from bridge import BridgeError
+from bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED
 from bridge.inputs import shorten
 
 T = TypeVar("T")
@@ -98,9 +99,6 @@ def configure_logging(level: int | None = None) -> None:
         root.setLevel(level)
 
 
-EXIT_BROKEN_PIPE = 141
-"""Exit code when stdout's reader went away (``... | head -1``): 128 + SIGPIPE, what a
-shell reports for ``yes | head -1``, so ``set -o pipefail`` scripts see the usual code."""
 
 
 def one_line(message: object, limit: int = 2000) -> str:
@@ -175,24 +173,74 @@ def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...])
     except StdoutError as exc:
         _stdout_to_devnull()
         print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
     except errors as exc:
         print(f"error: {one_line(exc)}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     finally:
         sys.stdout = stdout
 
 
+MAX_JOBS = 64
+"""``--jobs``: at most this many processes or cells at once."""
+
+
+def default_jobs() -> int:
+    """The machine's cores (those this process may use), at most :data:`MAX_JOBS`."""
+    return max(1, min(MAX_JOBS, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                      else os.cpu_count() or 1))
+
+
+def add_jobs_argument(parser: argparse._ActionsContainer, what: str) -> None:
+    """``--jobs N``: how many ``what`` run at once (default: the machine's cores). Results
+    do not depend on N (each unit of work has its own seed and its own process or cell)."""
+    parser.add_argument("--jobs", type=int_in(1, MAX_JOBS), default=default_jobs(), metavar="N",
+                        help=f"{what} at once (default: the machine's cores, here {default_jobs()}); "
+                             "the results do not depend on it")
+
+
+_INTEGER = re.compile(r"[+-]?[0-9]+")
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:inf|infinity|nan)",
+                      re.IGNORECASE)
+
+
+def strict_int(text: str) -> int:
+    """An item type: an integer written with ASCII digits and an optional sign, nothing
+    else (``int`` alone also takes ``1_0``, ``５`` and surrounding blanks); ValueError otherwise."""
+    if not _INTEGER.fullmatch(text):
+        raise ValueError(text)
+    return int(text)
+
+
+def strict_float(text: str) -> float:
+    """An item type: a decimal number with ASCII digits (``1``, ``-0.5``, ``2e-3``; also
+    ``inf`` and ``nan``, for the caller's range check to name); ValueError for ``1_0``,
+    ``５`` and the like, which ``float`` alone takes."""
+    if not _DECIMAL.fullmatch(text):
+        raise ValueError(text)
+    return float(text)
+
+
+def integer(text: str) -> int:
+    """An argparse type: any integer, written as :func:`strict_int` takes it."""
+    try:
+        return strict_int(text)
+    except ValueError:
+        expected = "expected an integer (ASCII digits, optional sign)"
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: {expected}") from None
+
+
 def int_in(low: int, high: int = sys.maxsize) -> Callable[[str], int]:
-    """An argparse type: an integer in [low, high] (``high`` default: no practical bound)."""
+    """An argparse type: an integer in [low, high] (``high`` default: no practical bound),
+    written as :func:`strict_int` takes it."""
     expected = f"an integer >= {low}" if high == sys.maxsize else f"an integer from {low} to {high}"
 
     def parse(text: str) -> int:
         try:
-            value = int(text)
+            value = strict_int(text)
         except ValueError:
             value = None
         if value is None or not low <= value <= high:
@@ -208,12 +256,13 @@ def non_negative_int(text: str) -> int:
 
 
 def finite_float(low: float, high: float, *, low_open: bool = False) -> Callable[[str], float]:
-    """An argparse type: a finite number in [low, high], or (low, high] when ``low_open``."""
+    """An argparse type: a finite number in [low, high], or (low, high] when ``low_open``,
+    written as :func:`strict_float` takes it."""
     expected = f"a finite number in {'(' if low_open else '['}{low:g}, {high:g}]"
 
     def parse(text: str) -> float:
         try:
-            value = float(text)
+            value = strict_float(text)
         except ValueError:
             value = math.nan
         if not (math.isfinite(value) and (low < value if low_open else low <= value) and value <= high):
@@ -228,9 +277,9 @@ def comma_list(
 ) -> Callable[[str], list[T]]:
     """An argparse type: ``"a,b,c"`` → ``[item("a"), item("b"), item("c")]``.
 
-    Empty items, and items ``item`` rejects (ValueError, ArgumentTypeError, BridgeError), are an
-    error naming the whole text and ``what`` was expected; ``""`` is the empty list when
-    ``allow_empty``.
+    Empty items, items ``item`` rejects (ValueError, ArgumentTypeError, BridgeError) and an
+    item given twice (``bp-p1,bp-p1`` would run it twice) are an error naming the whole text
+    and ``what`` was expected; ``""`` is the empty list when ``allow_empty``.
     """
 
     def parse(text: str) -> list[T]:
@@ -240,9 +289,14 @@ def comma_list(
         try:
             if not all(parts):
                 raise ValueError(text)
-            return [item(part) for part in parts]
+            values = [item(part) for part in parts]
         except (ValueError, argparse.ArgumentTypeError, BridgeError):
-            raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated {what}") from None
+            raise argparse.ArgumentTypeError(f"{shorten(text, 200)!r}: expected comma-separated {what}") from None
+        twice = next((part for k, part in enumerate(parts) if values[k] in values[:k]), None)
+        if twice is not None:
+            raise argparse.ArgumentTypeError(f"{shorten(text, 200)!r}: {shorten(twice)!r} is given twice; expected "
+                                             f"comma-separated {what}, each once")
+        return values
 
     return parse
 
@@ -270,7 +324,7 @@ def png_path(text: str) -> str:
 def size_pair(text: str) -> tuple[int, int]:
     """An item type: ``"4x5"`` → ``(4, 5)``, both positive (ValueError otherwise)."""
     m, sep, n = text.partition("x")
-    size = (int(m), int(n)) if sep else (0, 0)
+    size = (strict_int(m), strict_int(n)) if sep else (0, 0)
     if min(size) < 1:
         raise ValueError(text)
     return size

@@ -3,12 +3,15 @@
 - a file is read whole but never more than ``limit`` bytes (default :data:`MAX_INPUT_BYTES`);
 - a missing, unreadable (permissions, I/O error), non-regular or oversized file raises
   the caller's error class with one line naming the path and what was expected;
+- :func:`duplicate_key` finds a key given twice in one JSON object (Python's ``json`` and
+  msgspec both keep the last silently), so a reader can refuse it;
 - :func:`shorten` cuts an echoed token to :data:`TOKEN_CHARS` characters, so a huge
   token never makes a huge message.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import stat
 from pathlib import Path
@@ -26,6 +29,21 @@ def shorten(text: object, width: int = TOKEN_CHARS) -> str:
     """``str(text)`` cut to ``width`` characters, the last being "…" when cut."""
     text = str(text)
     return text if len(text) <= width else text[: width - 1] + "…"
+
+
+def duplicate_key(data: bytes | str) -> str | None:
+    """A key that appears twice in one object of the JSON ``data``, else None. ``data``
+    must be valid JSON (ValueError otherwise; RecursionError when nested too deeply):
+    call it after the reader accepted the document."""
+    twice: list[str] = []
+
+    def pairs(items: list[tuple[str, object]]) -> dict[str, object]:
+        keys = [key for key, _value in items]
+        twice.extend(key for k, key in enumerate(keys) if key in keys[:k])
+        return dict(items)
+
+    json.loads(data, object_pairs_hook=pairs)
+    return twice[0] if twice else None
 
 
 def read_bytes(path: Path | str, what: str, *, limit: int = MAX_INPUT_BYTES,

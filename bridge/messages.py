@@ -25,6 +25,7 @@ import msgspec
 
 from bridge import BridgeError
 from bridge.assembly import ID_PATTERN
+from bridge.inputs import duplicate_key
 from bridge.keys import CELL_ID_PATTERN
 
 PROTOCOL_VERSION: Final = 3
@@ -41,11 +42,15 @@ CellId = Annotated[str, msgspec.Meta(pattern=CELL_ID_PATTERN)]
 Seed = Annotated[int, msgspec.Meta(ge=0, lt=2**32)]
 NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
 Result = Literal["fit", "no_fit"]
-ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "id_reused", "busy", "expired", "failed"]
+ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "id_reused", "invalid_step", "busy",
+                    "expired", "failed", "run_active"]
 """Why a request was refused: it is invalid (``malformed``, ``oversized``, ``version``), names an
-unknown part or hole (``unknown_id``), reuses the id of another request (``id_reused``); the cell's
-queue is full (``busy``) or the request waited past its ``timeout_s`` (``expired``); the experiment
-could not run (``failed``). Only the last three are worth sending again."""
+unknown part or hole (``unknown_id``), reuses the id of another request (``id_reused``), is a
+plan step the product does not allow (``invalid_step``: a peg without a hole, a part placed
+twice); the cell's queue is full (``busy``), the request waited past its ``timeout_s``
+(``expired``), the experiment could not run (``failed``), or the step belongs to another plan
+run while the cell's world holds an unfinished one (``run_active``). Only the last four are
+worth sending again."""
 
 
 class _Message(msgspec.Struct, frozen=True, forbid_unknown_fields=True, tag_field="kind"):
@@ -97,8 +102,9 @@ class ErrorReply(_Message, tag="error", frozen=True):
     """A refused request: ``code`` says why, ``error`` says what was expected."""
 
     cell: Annotated[CellId, msgspec.Meta(description="the refusing cell")]
-    code: Annotated[ErrorCode, msgspec.Meta(description="why: malformed, oversized, version, unknown_id, id_reused "
-                                            "(do not send again); busy, expired, failed (worth sending again)")]
+    code: Annotated[ErrorCode, msgspec.Meta(description="why: malformed, oversized, version, unknown_id, id_reused, "
+                                            "invalid_step (do not send again); busy, expired, failed, run_active "
+                                            "(worth sending again)")]
     error: Annotated[str, msgspec.Meta(description="what was wrong and what was expected, one line")]
     id: Annotated[RequestId | None, msgspec.Meta(description="the request's id; null when the payload could not "
                                                  "be read")] = None
@@ -108,7 +114,9 @@ class ErrorReply(_Message, tag="error", frozen=True):
 class StepRequest(_Message, tag="step", frozen=True):
     """Carry out step ``step`` of the plan run ``assembly``: pick ``part`` from the tray and
     place it (into ``hole``, None for a part placed without a hole). The cell keeps one world
-    per ``assembly``; a new ``assembly`` starts from a fresh world (every part on the tray)."""
+    for one ``assembly`` at a time; a new ``assembly`` starts from a fresh world (every part on
+    the tray) once the current one's product is complete, and is refused (``run_active``)
+    before."""
 
     id: RequestId
     assembly: RequestId
@@ -185,6 +193,10 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
         message = decoder.decode(payload)
     except (msgspec.DecodeError, UnicodeDecodeError) as exc:
         raise MessageError("malformed", f"{what} is not valid: {exc}") from None
+    twice = duplicate_key(payload)
+    if twice is not None:
+        raise MessageError("malformed", f"{what} is not valid: the key {twice!r} appears twice in one object; "
+                           "expected each key once")
     accepted = {PROTOCOL_VERSION} if isinstance(message, (StepRequest, StepReply)) else INSERT_VERSIONS
     if message.v not in accepted:
         raise MessageError("version", f"{what} has protocol version {message.v}; "

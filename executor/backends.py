@@ -12,8 +12,11 @@ class with
   cell does not have (the planner gets ``unknown_id``), :class:`executor.ExecutorError`
   when the experiment could not run (``failed``, which the planner sends again);
 - ``run_step(self, request: StepRequest) -> StepOutcome``: carry out one step of a plan
-  (``./run.sh assemble``), keeping the product between the steps of one plan run; a cell
-  that only learns may raise :class:`executor.ExecutorError` (the planner gets ``failed``);
+  (``./run.sh assemble``), keeping the product between the steps of one plan run, one
+  run at a time (:func:`check_run`: :class:`RunActive`, the planner gets ``run_active``);
+  a step the product does not allow raises :class:`InvalidStep` (``invalid_step``, see
+  :func:`check_step`) before anything moves; a cell that only learns may raise
+  :class:`executor.ExecutorError` (the planner gets ``failed``);
 - ``close(self)``: release the robot.
 
 ``run`` is called from one thread, one experiment at a time. Start it with
@@ -28,7 +31,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import re
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
@@ -42,6 +45,41 @@ _SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
 
 class UnknownPair(ExecutorError):
     """The request names a part or hole the cell does not have."""
+
+
+class InvalidStep(ExecutorError):
+    """A plan step the product does not allow: a peg without a hole of the plate, a hole
+    for a part placed without one, a part already placed."""
+
+
+class RunActive(ExecutorError):
+    """A plan step of another run while the cell's world holds an unfinished run."""
+
+
+def check_step(part: str, hole: str | None, *, parts: Collection[str], pegs: Collection[str],
+               holes: Collection[str], placed: Collection[str]) -> None:
+    """Refuse a step before anything moves: UnknownPair for a part not of the product
+    (``parts``), InvalidStep for a peg (``pegs``) without a hole of ``holes``, a hole for
+    another part, or a part already ``placed``."""
+    if part not in parts:
+        raise UnknownPair(f"unknown part '{part}' (expected one of {', '.join(sorted(parts))})")
+    if part in pegs and hole not in holes:
+        raise InvalidStep(f"peg '{part}' needs a hole of the plate ({', '.join(sorted(holes))}), got {hole!r}")
+    if part not in pegs and hole is not None:
+        raise InvalidStep(f"part '{part}' is placed without a hole, got hole '{hole}'")
+    if part in placed:
+        raise InvalidStep(f"part '{part}' is already placed")
+
+
+def check_run(current: str | None, run: str, parts: Collection[str], placed: Collection[str]) -> None:
+    """RunActive when a step of plan run ``run`` comes while the world belongs to run
+    ``current`` (None: no run yet) and its product is unfinished (a part of ``parts`` is
+    not ``placed``): a cell's world holds one product, another run must wait until it is
+    complete (or the cell restarts); the refused step changes nothing."""
+    if current is not None and run != current and not set(parts) <= set(placed):
+        raise RunActive(f"plan run {current} holds the cell's world ({len(set(placed) & set(parts))} of "
+                        f"{len(parts)} parts placed); a step of run {run} waits until that product is "
+                        "complete or the cell restarts")
 
 
 StepOutcome = tuple[Result, StepEvidence, dict[str, float]]

@@ -47,7 +47,6 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import rerun as rr
 
-from bridge import BridgeError
 from bridge.recording.compaction import compact_recording
 from bridge.recording.layout import APPLICATION_ID, cell_blueprint, cell_root
 from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
@@ -145,8 +144,6 @@ def open_recording(recording_id: str, rrd_path: Path | None, viewer: Viewer = NO
     ``viewer``; ExecutorError ``<path>: cannot write (<reason>)`` when the file cannot be created."""
     try:
         return open_stream(application_id, recording_id, rrd_path, viewer)
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
     except RuntimeError as exc:  # the SDK's own check, e.g. a race with the one above
         raise ExecutorError(f"{rrd_path}: cannot write ({exc})") from None
 

@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING, Any
 import zenoh
 
 from bridge import BridgeError
+from bridge.assembly import load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
@@ -69,7 +70,18 @@ from bridge.messages import (
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from executor import ExecutorError
-from executor.backends import Backend, CellContext, StepOutcome, UnknownPair, backend_option, load_backend
+from executor.backends import (
+    Backend,
+    CellContext,
+    InvalidStep,
+    RunActive,
+    StepOutcome,
+    UnknownPair,
+    backend_option,
+    check_run,
+    check_step,
+    load_backend,
+)
 from executor.cell_options import cell_keywords
 from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
@@ -93,11 +105,14 @@ class TruthBackend:
                  blocked: Sequence[str] = ()) -> None:
         try:
             self._geometry = load_geometry(assembly)
+            assembly_of = load_assembly(assembly)
         except BridgeError as exc:
             raise ExecutorError(f"truth backend: {exc}") from None
         self._delay_s = delay_s
         self._blocked = set(blocked)
-        self._placed: dict[str, dict[str, float]] = {}  # plan run -> placed parts
+        self._parts = tuple(assembly_of.part_ids)
+        self._run: str | None = None  # the plan run whose product is being built
+        self._placed: dict[str, float] = {}  # its placed parts
         self._log = None
         if rrd is not None or viewer != NO_VIEWER:
             from executor.rerun_log import open_recording
@@ -122,13 +137,18 @@ class TruthBackend:
         return result, None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
-        """A part with a hole fits when its cross-section passes and the hole is not blocked;
-        a part without one is always placed."""
-        placed = self._placed.setdefault(request.assembly, {})
+        """A peg fits when its cross-section passes the hole and the hole is not blocked;
+        another part of the product is always placed. One plan run at a time; a step of
+        another run, or one the product does not allow, is refused before anything changes
+        (:func:`executor.backends.check_run`, :func:`executor.backends.check_step`)."""
         parts, holes = self._geometry.parts, self._geometry.holes
-        if request.hole is not None and (request.part not in parts or request.hole not in holes):
-            raise UnknownPair(f"unknown pair ({request.part},{request.hole}); expected a part "
-                              f"of {tuple(parts)} and a hole of {tuple(holes)}")
+        check_run(self._run, request.assembly, self._parts, self._placed)
+        fresh = request.assembly != self._run
+        check_step(request.part, request.hole, parts=self._parts, pegs=parts, holes=holes,
+                   placed=() if fresh else self._placed)
+        if fresh:
+            self._run, self._placed = request.assembly, {}
+        placed = self._placed
         ok = request.hole is None or (request.hole not in self._blocked
                                       and passes(parts[request.part], holes[request.hole]))
         if ok:
@@ -330,7 +350,9 @@ class CellNode:
         try:
             message = self._answer(request, started)
         except ExecutorError as exc:
-            code: ErrorCode = "unknown_id" if isinstance(exc, UnknownPair) else "failed"
+            code: ErrorCode = ("unknown_id" if isinstance(exc, UnknownPair) else "invalid_step"
+                               if isinstance(exc, InvalidStep) else "run_active" if isinstance(exc, RunActive)
+                               else "failed")
             self._refuse(query, code, str(exc), request.id)
             return None
         reply, result = encode(message), message.result
@@ -404,17 +426,11 @@ def main(argv: Sequence[str]) -> int:
     """Serve until SIGTERM/SIGINT; exit code 2 on bad options or when another process
     serves this cell id (:mod:`executor.claim`)."""
     args = build_parser().parse_args(list(argv))
-    try:
-        cell_id = check_cell_id(args.cell)
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
+    cell_id = check_cell_id(args.cell)
     listen = cell_listen(args.listen, args.connect, args.zenoh_config)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    try:
-        session = open_session(listen, args.connect, args.zenoh_config)
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
+    session = open_session(listen, args.connect, args.zenoh_config)
     claim: CellClaim | None = None
     backend: Backend | None = None
     try:

@@ -1,9 +1,8 @@
 """A corpus of bad input for both command lines (repository level: it spans the packages).
 
 One row per case: ``(id, argv, setup, expected exit code, a word the message must hold)``.
-``argv`` starting with ``executor`` runs ``python -m executor``, ``bench executor`` runs
-``python -m executor.campaign.bench`` (as run.sh does), anything else ``python -m asp.cli``;
-both run as separate processes in ``tmp_path``. ``setup`` is None, a dict of input files
+``argv`` runs the one command line, ``python -m assembly_constraints`` (as ``./run.sh``
+does), as a separate process in ``tmp_path``. ``setup`` is None, a dict of input files
 (name → text or bytes) or a callable ``setup(tmp_path)``. Every bad input must give one
 line ``error: ...`` on stderr holding the word, the exit code, and never a traceback.
 
@@ -17,6 +16,7 @@ read fails with an I/O error for every user (checked; the case is skipped otherw
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -26,10 +26,13 @@ from pathlib import Path
 import pytest
 
 from asp.session.journal import MAX_JOURNAL_BYTES
-from bridge.cli_types import EXIT_BROKEN_PIPE
-from tests.conftest import ROOT, child_env, python_argv
+from bridge.assembly import load_assembly
+from bridge.errors import EXIT_BROKEN_PIPE
+from tests.conftest import CLI_MODULE, ROOT, child_env, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
+TRUTH = (str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"))
+TASKBOARD = ROOT / "data" / "taskboard"
 Setup = Callable[[Path], None] | dict[str, str | bytes] | None
 
 
@@ -55,6 +58,17 @@ def unreadable(name: str, source: Path | None = None, text: str = "") -> Callabl
     return setup
 
 
+def taskboard(**files: str) -> Callable[[Path], None]:
+    """Setup: a copy of data/taskboard in ``asm/`` (without its assets), with ``files`` replaced."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(TASKBOARD, tmp / "asm", ignore=shutil.ignore_patterns("assets"))
+        for name, content in files.items():
+            (tmp / "asm" / name).write_text(content)
+
+    return setup
+
+
 def assembly(**files: str | bytes | Callable[[Path], None]) -> Callable[[Path], None]:
     """Setup: a copy of data/cranfield in ``asm/`` (without assets), with ``files``
     replaced (text, bytes, or a setup run with the copy's parent folder)."""
@@ -76,6 +90,38 @@ def geometry(old: str, new: str) -> Callable[[Path], None]:
     """Setup: the Cranfield copy of :func:`assembly` with ``old`` replaced by ``new`` in
     its ``geometry.toml``."""
     return assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(old, new, 1)})
+
+
+def plan_file(name: str, change: Callable[[list[dict]], object]) -> Callable[[Path], None]:
+    """Setup: ``name`` holding Cranfield's first plan (real clingo, true facts) as ``plan
+    --json`` prints it, after ``change`` edited its list of steps in place."""
+
+    def setup(tmp: Path) -> None:
+        from asp.assemble.cli import truth_facts
+        from asp.plans.plans import plans
+
+        steps = plans(truth_facts(load_assembly("cranfield")))[0].as_json()
+        change(steps)
+        (tmp / name).write_text(json.dumps({"plans": [steps]}))
+
+    return setup
+
+
+def _hole_of(part: str, hole: str | None) -> Callable[[list[dict]], object]:
+    return lambda steps: [step.update(hole=hole) for step in steps if step["part"] == part]
+
+
+def _part(old: str, new: str) -> Callable[[list[dict]], object]:
+    return lambda steps: [step.update(part=new) for step in steps if step["part"] == old]
+
+
+SETTINGS = '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}'
+JOURNAL_LINE = '{{"id":"{id}","part":"{part}","hole":"{hole}","result":"{result}","cell":"c1"{extra}}}\n'
+
+
+def resume(*lines: str, settings: str = SETTINGS) -> dict[str, str | bytes]:
+    """Setup: a run folder ``run`` to resume with these journal lines."""
+    return {"run/session.json": settings, "run/journal.jsonl": "".join(lines)}
 
 
 def huge_journal(run: Path) -> None:
@@ -175,9 +221,27 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("trial-peg-half-a-metre", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      geometry("size = 0.0187", "size = 0.5"), 2, "[part_shapes.shaft] size: expected a number in (0, 0.1] m"),
     ("trial-kind-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
-     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of round, square"),
+     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of rect, round, square"),
     ("teach-demo-hole-unknown", ("executor", "teach", "--assembly", "asm"),
      geometry('demo_hole = "br"', 'demo_hole = "zz"'), 2, "[part_shapes.shaft] demo_hole"),
+    ("trial-geometry-rect-short-side-first", ("executor", "trial", "--part", "p3", "--hole", "s1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "square"\nsize = 0.0133', 'kind = "rect"\nsize = [0.010, 0.0133]', 1)}), 2, "a >= b"),
+    ("trial-geometry-unknown-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "round"', 'kind = "oval"', 1)}), 2, "oval"),
+    ("trial-part-shape-against-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "square"', 1)}), 2, "kind"),
+    ("assembly-part-shape-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape"),
+    ("section-of-unlike-parts", ("executor", "trial", "--part", "rect8", "--hole", "slot8", "--assembly", "asm"),
+     taskboard(**{"assembly.toml": (TASKBOARD / "assembly.toml").read_text().replace(
+         'shape = "rect"\n', 'shape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
+    ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2, "section"),
     # learned facts: arity, ids, cycles, contradictions
     ("assign-arity", ("assign", "f.lp"), {"f.lp": "part(a). hole(r1). fits(a,r1,x).\n"}, 2, "fits/2"),
     ("plan-arity", ("plan", "f.lp"), {"f.lp": "part(a;b). must_precede(a,b,c).\n"}, 2, "must_precede/2"),
@@ -215,19 +279,19 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("serve-unknown-option", ("executor", "serve", "--bogus"), None, 2, "unrecognized"),
     ("serve-bad-cell-id", ("executor", "serve", "--cell", "C!"), None, 2, "cell id"),
     ("campaign-trials-zero", ("executor", "campaign", "--trials", "0"), None, 2, "--trials"),
-    ("campaign-workers-huge", ("executor", "campaign", "--workers", "1e3"), None, 2, "--workers"),
+    ("campaign-jobs-huge", ("executor", "campaign", "--jobs", "1e3"), None, 2, "--jobs"),
     ("margins-seed-negative", ("executor", "margins", "--seed", "-1"), None, 2, "--seed"),
     ("margins-trials-missing", ("executor", "margins", "--trials"), None, 2, "--trials"),
     ("bench-unknown", ("bench", "nosuch"), None, 2, "nosuch"),
     ("bench-sizes-list", ("bench", "sizes", "--sizes", "3,y"), None, 2, "--sizes"),
     ("bench-sizes-seeds-zero", ("bench", "sizes", "--noise", "0.1", "--seeds", "0"), None, 2, "--seeds"),
-    ("bench-dominance-seconds-nan", ("bench", "dominance", "--seconds", "nan"), None, 2, "--seconds"),
+    ("bench-dominance-time-limit-nan", ("bench", "dominance", "--time-limit", "nan"), None, 2, "--time-limit"),
     ("bench-dominance-sizes", ("bench", "dominance", "--sizes", "4y5"), None, 2, "--sizes"),
     ("bench-plan-parts-huge", ("bench", "plan", "--parts", "100"), None, 2, "--parts"),
     ("bench-precedence-repeat-zero", ("bench", "precedence", "--repeat", "0"), None, 2, "--repeat"),
     ("bench-session-product-one", ("bench", "session", "--product", "1"), None, 2, "--product"),
     ("bench-session-delay-negative", ("bench", "session", "--delay", "-1"), None, 2, "--delay"),
-    ("bench-executor-workers-zero", ("bench", "executor", "--workers", "0"), None, 2, "--workers"),
+    ("bench-executor-jobs-zero", ("bench", "executor", "--jobs", "0"), None, 2, "--jobs"),
     ("bench-executor-unknown-option", ("bench", "executor", "--bogus"), None, 2, "unrecognized"),
     # demonstrations that say where a part went (part@hole)
     ("learn-unknown-hole", ("precedence", "learn", "d.txt", "--assembly", "cranfield"),
@@ -243,24 +307,99 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("resume-demos-not-a-path", ("session", "--resume", "run"),
      {"run/session.json": '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r", "demos": 7}'},
      2, '"demos"'),
+    # plans and facts against the product: ids reach clingo as symbols, never as program text
+    ("assemble-plan-injected-fact", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", _hole_of("p1", "r3). hole(zz). fits(p1,zz")), 2, "p.json: plans[1]: step 9: hole"),
+    ("assemble-plan-injected-interval", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", _hole_of("p1", "r3). bomb(1..50000000")), 2, "p.json: plans[1]: step 9: hole"),
+    ("assemble-plan-keyword-id", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", _hole_of("p1", "not")), 2, "step 9: hole \"not\" is not an id"),
+    ("assemble-plan-non-ascii-id", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", _part("p1", "p\u00e91")), 2, "step 9: part"),
+    ("assemble-plan-surrogate-id", ("assemble", "p.json", "--backend", "truth"),
+     {"p.json": '[{"part": "bp", "hole": null}, {"part": "p\\ud800", "hole": "r1"}]'}, 2, "step 2: part"),
+    ("assemble-plan-trailing-newline-id", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", _part("bp", "bp\n")), 2, "step 1: part"),
+    ("assemble-plan-unknown-key", ("assemble", "p.json", "--backend", "truth"),
+     {"p.json": '[{"part": "bp", "hole": null, "holes": "r1"}]'}, 2, "p.json: step 1: expected"),
+    ("assemble-plan-key-twice", ("assemble", "p.json", "--backend", "truth"),
+     {"p.json": '[{"part": "bp", "hole": null, "hole": "r1"}]'}, 2, "p.json: the key 'hole' appears twice"),
+    ("assemble-plan-deep-nesting", ("assemble", "p.json", "--backend", "truth"),
+     {"p.json": "[" * 100_000 + "]" * 100_000}, 2, "nested too deeply"),
+    ("assemble-plan-k-of-one", ("assemble", "p.json", "--plan", "5", "--backend", "truth"),
+     plan_file("p.json", lambda steps: None), 2, "--plan 5, but the file holds 1 plan(s)"),
+    ("assemble-plan-subset", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", lambda steps: steps.__delitem__(slice(2, None))), 2, "p.json: the plan: missing("),
+    ("assemble-plan-unknown-part", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", lambda steps: steps.append({"part": "zz", "hole": None})), 2,
+     "step 11 (zz): unknown_part(zz)"),
+    ("assemble-plan-none-part", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", lambda steps: steps.insert(0, {"part": "none", "hole": None})), 2,
+     "step 1 (none): unknown_part(none)"),
+    ("assemble-plan-peg-without-hole", ("assemble", "p.json", "--backend", "truth"),
+     plan_file("p.json", _hole_of("p1", None)), 2, "step 9 (p1): no_hole(p1)"),
+    ("assemble-facts-subset", ("assemble", "f.lp", "--backend", "truth"),
+     {"f.lp": "part(bp;p1). hole(r1). fits(p1,r1).\n"}, 2, "f.lp: the facts are not of the product"),
+    ("assemble-facts-peg-unknown-sizes", ("assemble", "f.lp", "--backend", "truth"),
+     {"f.lp": "part(bp;p1;p2;p3;p4;sh;sp;pd;ph;fp). hole(r1;r2;s1;s2;br). fits(p1,r1). fits(p2,r2). "
+              "fits(p3,s1). fits(p4,s2).\n"}, 2, "peg sh of"),
+    ("assemble-facts-of-another-assembly", ("assemble", *(str(ROOT / "data" / "graded" / name)
+                                                           for name in ("sizes.lp", "precedence.lp")),
+                                            "--backend", "truth"), None, 2, "not of the product"),
+    ("bench-assemble-facts-subset", ("bench", "assemble", "f.lp", "--backend", "truth", "--plans", "1"),
+     {"f.lp": "part(bp;p1). hole(r1). fits(p1,r1).\n"}, 2, "f.lp: the facts are not of the product"),
+    ("assemble-run-plan-wrong-types", ("assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": "cranfield", "plans": [[{"part": 7, "hole": [1]}]]}',
+      "run/learned.lp": "part(bp).\n"}, 2, "session.json: plans[1]: step 1: part 7"),
+    ("plan-precedence-edge-unknown-part", ("plan", "f.lp"), {"f.lp": "part(a;b). precedence_edge(a,zz).\n"}, 2,
+     "precedence_edge(a,zz): zz is not a part/1"),
+    ("assembly-keyword-id", ("plan", "facts.lp", "--optimal", "--assembly", "asm"),
+     assembly(**{"assembly.toml": "[parts.not]\nname = 'x'\n"}), 2, "[parts.not]"),
+    ("assemble-run-assembly-wrong-type", ("assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": 7, "plans": []}'}, 2, '"assembly": expected a string, got 7'),
+    ("bench-assemble-run-assembly-wrong-type", ("bench", "assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": ["x"], "plans": []}'}, 2, '"assembly": expected a string'),
+    ("assemble-run-plans-wrong-type", ("assemble", "--run", "run", "--backend", "truth"),
+     {"run/session.json": '{"assembly": "cranfield", "plans": {"a": 1}}'}, 2, '"plans": expected a list'),
+    # a journal that contradicts itself, or names what the assembly does not have
+    ("resume-journal-contradiction", ("session", "--resume", "run"),
+     resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=""),
+            JOURNAL_LINE.format(id="b", part="p1", hole="br", result="no_fit", extra="")), 2,
+     "journal.jsonl:2: p1,br no_fit after fit on line 1, without the retest marker"),
+    ("resume-journal-duplicated-line", ("session", "--resume", "run"),
+     resume(*[JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra="")] * 2), 2,
+     "journal.jsonl:2: a second result of request a"),
+    ("resume-journal-negative-experiment", ("session", "--resume", "run"),
+     resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=',"experiment":-3')), 2,
+     "journal.jsonl:1"),
+    ("resume-journal-unknown-part", ("session", "--resume", "run"),
+     resume(JOURNAL_LINE.format(id="a", part="p1", hole="br", result="fit", extra=""),
+            JOURNAL_LINE.format(id="b", part="zz", hole="br", result="fit", extra="")), 2,
+     "journal.jsonl:2: (zz,br): expected a part of"),
+    ("resume-recording-id-long", ("session", "--resume", "run"),
+     resume(settings=SETTINGS.replace('"r"', '"' + "r" * 200 + '"')), 2, '"recording_id": expected 1 to 64'),
+    ("resume-starts-at-bound", ("session", "--resume", "run"),
+     resume(settings=SETTINGS.replace("}", ', "starts": 1000000}')), 2, '"starts": expected an integer from 1'),
+    # numbers written with ASCII digits only; list items once
+    ("sample-seed-fullwidth", ("precedence", "sample", "--assembly", "cranfield", "--seed", "\uff15"), None, 2,
+     "--seed"),
+    ("sample-n-underscore", ("precedence", "sample", "--assembly", "cranfield", "-n", "1_0"), None, 2, "-n"),
+    ("session-seed-fullwidth", ("session", "--seed", "\uff15"), None, 2, "--seed"),
+    ("plan-time-limit-underscore", ("plan", "facts.lp", "--time-limit", "1_0"), None, 2, "--time-limit"),
+    ("bench-sizes-noise-fullwidth", ("bench", "sizes", "--noise", "0.\uff11"), None, 2, "--noise"),
+    ("bench-executor-executions-underscore", ("bench", "executor", "--executions", "1_0"), None, 2,
+     "--executions"),
+    ("bench-precedence-physics-edge-twice", ("bench", "precedence-physics", "--edges", "bp-p1,bp-p1"), None, 2,
+     "'bp-p1' is given twice"),
+    ("session-allow-cells-twice", ("session", "--allow-cells", "c1,c1"), None, 2, "given twice"),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
 ]
 
 
-def _module(argv: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
-    """The module run.sh runs for ``argv``, and its arguments."""
-    if argv[0] == "executor":
-        return "executor", argv[1:]
-    if argv[:2] == ("bench", "executor"):
-        return "executor.campaign.bench", argv[2:]
-    return "asp.cli", argv
-
-
 def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
-    module, args = _module(argv)
-    process = subprocess.Popen(python_argv(module, *args), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
+    process = subprocess.Popen(python_argv(CLI_MODULE, *argv), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         if head:

@@ -25,7 +25,7 @@ COMMANDS = {  # command line writing one file to OUT
     "precedence learn --dot": ("precedence", "learn", "--assembly", "cranfield", "--dot", "OUT"),
     "precedence learn --png": ("precedence", "learn", "--assembly", "cranfield", "--png", "OUT"),
     "sizes learn --out": ("sizes", "learn", "--assembly", "cranfield", "--out", "OUT"),
-    "precedence evaluate --plot": ("precedence", "evaluate", "--assembly", "cranfield", "--m", "5",
+    "precedence evaluate --plot": ("precedence", "evaluate", "--assembly", "cranfield", "--demonstrations", "5",
                                    "--trials", "2", "--plot", "OUT"),
     "sizes evaluate --plot": ("sizes", "evaluate", "--assembly", "cranfield", "--policy", "best",
                               "--relabelings", "2", "--plot", "OUT"),

@@ -29,24 +29,21 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 from asp import PlannerError
 from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
+from asp.assemble.inputs import check_facts_product, check_plan_product, plan_of_json, read_plan_json
 from asp.plans.assign import LearnedFacts, load_learned_facts
-from asp.plans.plans import Plan, PlanStep, check_plan, plans
-from asp.precedence.relation import true_relation
-from asp.solve import fact
+from asp.plans.plans import Plan, plans
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
-from bridge.inputs import read_bytes
+from bridge.errors import EXIT_UNSOLVABLE
+from bridge.inputs import read_bytes, shorten
 from bridge.session import add_endpoint_arguments
 
-EXIT_STOPPED = 3
-"""Exit code when the product cannot be finished (bad input exits with 2)."""
 MAX_PLAN_INDEX = 1000
 
 
@@ -87,43 +84,38 @@ def cell_options(args: argparse.Namespace) -> list[str]:
     return []
 
 
+def truth_sources(assembly: Assembly) -> str:
+    """The assembly's true facts files, as messages name them."""
+    return f"{assembly.file('sizes.lp')}, {assembly.file('precedence.lp')}"
+
+
 def truth_facts(assembly: Assembly) -> LearnedFacts:
     """The assembly's true sizes and precedence as learned facts (``must_precede`` closed)."""
-    facts = load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
-    closed = true_relation(assembly).pairs()
-    return replace(facts, atoms=(*facts.atoms, *(fact("must_precede", a, b) for a, b in closed)),
-                   must_precede=frozenset(closed))
+    return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
+
+
+_SESSION_TYPES: dict[str, tuple[type, str]] = {"assembly": (str, "a string"), "plans": (list, "a list of plans")}
+"""The types of the ``session.json`` keys ``assemble`` and ``bench assemble`` read."""
 
 
 def read_session_settings(run: Path, *required: str) -> dict:
     """The ``session.json`` of run folder ``run``; PlannerError naming the file and the
-    ``required`` keys when it cannot be read or lacks one."""
+    ``required`` keys when it cannot be read or lacks one, or naming the key when it has
+    the wrong type (``assembly`` a string, ``plans`` a list)."""
     path = run / "session.json"
     try:
         settings = json.loads(read_bytes(path, "session settings (JSON)", error=PlannerError))
-    except (json.JSONDecodeError, UnicodeDecodeError):
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError):
         settings = None
     if not isinstance(settings, dict) or any(key not in settings for key in required):
         keys = " and ".join(f'"{key}"' for key in required)
         raise PlannerError(f"{path}: expected the session.json of a finished session (with {keys})")
+    for key in required:
+        kind, expected = _SESSION_TYPES.get(key, (object, ""))
+        if not isinstance(settings[key], kind):
+            raise PlannerError(f'{path}: "{key}": expected {expected}, got '
+                               f"{shorten(json.dumps(settings[key], ensure_ascii=True))}")
     return settings
-
-
-def read_plan_json(path: Path, k: int) -> Plan:
-    """Plan ``k`` of a plan JSON file; PlannerError naming the file and what was expected."""
-    try:
-        data = json.loads(read_bytes(path, "plan file (JSON)", error=PlannerError))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise PlannerError(f"{path}: not valid JSON ({exc})") from None
-    if isinstance(data, dict):
-        many = data.get("plans")
-        data = data.get("plan") or (many[k - 1] if isinstance(many, list) and len(many) >= k else None)
-    ok = isinstance(data, list) and data and all(isinstance(s, dict) and isinstance(s.get("part"), str)
-                                                 and isinstance(s.get("hole", None), (str, type(None))) for s in data)
-    if not ok:
-        raise PlannerError(f"{path}: expected a plan [{{\"part\": P, \"hole\": H|null}}, ...], {{\"plan\": [...]}} "
-                           f"or {{\"plans\": [[...], ...]}} with at least {k} plan(s)")
-    return Plan(tuple(PlanStep(s["part"], s.get("hole")) for s in data))
 
 
 def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
@@ -134,13 +126,15 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
         raise PlannerError("expected --run RUN, or one PLAN.json with optional FACTS.lp files, or FACTS.lp files")
     name = args.assembly
     plan: Plan | None = None
+    plan_source = ""
     if args.run is not None:
         settings = read_session_settings(args.run, "plans", "assembly")
         settings_path, found = args.run / "session.json", settings["plans"]
         name = name or settings["assembly"]
-        if not isinstance(found, list) or len(found) < args.plan:
+        if len(found) < args.plan:
             raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {len(found)} plan(s)")
-        plan = Plan(tuple(PlanStep(s["part"], s["hole"]) for s in found[args.plan - 1]))
+        plan_source = f"{settings_path}: plans[{args.plan}]"
+        plan = plan_of_json(found[args.plan - 1], plan_source)
         lps = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
     unknown = [hole for hole in args.block_hole if hole not in assembly.hole_ids]
@@ -148,17 +142,16 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
         raise PlannerError(f"--block-hole {unknown[0]}: expected a hole of {assembly.name} "
                            f"({', '.join(assembly.hole_ids)})")
     facts = load_learned_facts(lps) if lps else truth_facts(assembly)
+    check_facts_product(assembly, facts, ", ".join(map(str, lps)) or truth_sources(assembly))
     if jsons:
+        plan_source = str(jsons[0])
         plan = read_plan_json(jsons[0], args.plan)
     if plan is None:
         found_plans = plans(facts, n=args.plan)
         if len(found_plans) < args.plan:
             raise PlannerError(f"--plan {args.plan}: the facts admit only {len(found_plans)} plan(s)")
-        plan = found_plans[args.plan - 1]
-    errors = check_plan(facts, plan.steps)
-    if errors:
-        raise PlannerError(f"the plan {' '.join(s.part for s in plan.steps)} is not valid for the facts: "
-                           + ", ".join(errors))
+        plan_source, plan = f"plan {args.plan} of the facts", found_plans[args.plan - 1]
+    check_plan_product(facts, plan, plan_source)
     return assembly, facts, plan
 
 
@@ -189,7 +182,7 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
         try:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:
-            report, code = dict(exc.report, error=str(exc)), EXIT_STOPPED
+            report, code = dict(exc.report, error=str(exc)), EXIT_UNSOLVABLE
     report["wall_s"] = round(time.perf_counter() - started, 3)
     return report, code
 
@@ -198,6 +191,6 @@ def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     report, code = assemble(args)
     print(json.dumps(report) if args.json else _summary(report))
-    if code == EXIT_STOPPED:
+    if code == EXIT_UNSOLVABLE:
         print(f"error: {report['error']}", file=sys.stderr)
     return code

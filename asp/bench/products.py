@@ -18,6 +18,7 @@ import random
 import tomllib
 from pathlib import Path
 
+from asp.solve import fact, write_facts
 from bridge.assembly import DATA_DIR
 
 _TEMPLATE = DATA_DIR / "cranfield" / "geometry.toml"
@@ -68,11 +69,11 @@ def write_product(folder: Path, n: int, seed: int) -> dict[str, list[str]]:
                                                            "size": round(peg_size[peg], 6), "length": 0.05,
                                                            "mass": 0.05, "demo_hole": demo_hole}))
     (folder / "geometry.toml").write_text("".join(geometry), encoding="utf-8")
-    fits = [f"fits({p},{h})." for p in sorted(pegs) for h in sorted(holes)
+    parts = [fact("part", peg) for peg in sorted(pegs)]
+    fits = [fact("fits", p, h) for p in sorted(pegs) for h in sorted(holes)
             if round(peg_size[p], 6) < round(hole_size[h], 6)]
-    (folder / "sizes.lp").write_text(f"part({';'.join(sorted(pegs))}).\nhole({';'.join(sorted(holes))}).\n"
-                                     + "\n".join(fits) + "\n", encoding="utf-8")
-    (folder / "precedence.lp").write_text(f"part({';'.join(sorted(pegs))}).\n", encoding="utf-8")
+    write_facts(folder / "sizes.lp", [*parts, *(fact("hole", hole) for hole in sorted(holes)), *fits])
+    write_facts(folder / "precedence.lp", parts, header="No precedence constraints: any order.")
     orders = [rng.sample(pegs, n) for _ in range(2)]
     (folder / "demos.txt").write_text("".join(" ".join(order) + "\n" for order in orders), encoding="utf-8")
     return {"parts": sorted(pegs), "holes": sorted(holes)}

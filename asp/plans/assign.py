@@ -16,32 +16,37 @@ placed without a hole.
 - :func:`feasible_assignment`: the greedy one, or ASP's first when greedy gets stuck on
   sizes that are not a biorder although an assignment exists (``assign`` prints this).
 
-An assembly without an assignment raises :class:`UnsolvableAssembly` naming the part
-that gets no hole.
+An assembly without an assignment raises :class:`UnsolvableAssembly` naming a set of
+parts that fit fewer holes than they are (Hall's condition; :func:`hall_violation`),
+found from a maximum matching; "not solvable" is never said while a matching of every
+part exists.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
 
 import clingo
 
 from asp import PlannerError
-from asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name, solve
+from asp.precedence.relation import closed_precedence
+from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name, solve
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
 
 
 class UnsolvableAssembly(PlannerError):
-    """No feasible hole assignment; ``part`` is the part that gets no hole."""
+    """No feasible hole assignment. ``parts`` are parts that together fit fewer holes
+    than they are (Hall's condition fails for them; the witness a maximum matching
+    gives); ``part`` is the first of them."""
 
-    def __init__(self, part: str, message: str) -> None:
+    def __init__(self, parts: Sequence[str], message: str) -> None:
         super().__init__(message)
-        self.part = part
+        self.parts = tuple(parts)
+        self.part = self.parts[0]
 
 
 @dataclass(frozen=True)
@@ -87,48 +92,37 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
                     f"{sources}: {name}({part},{hole}): expected a part/1 and a hole/1 "
                     f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
                 )
-    for first, then in sorted(facts.must_precede):
-        for part in (first, then):
-            if part not in known_parts:
-                raise PlannerError(
-                    f"{sources}: must_precede({first},{then}): {part} is not a part/1 "
-                    f"(parts: {' '.join(facts.parts)})"
-                )
     both = sorted(facts.fits & set(pairs_by_name(facts.atoms, "no_fit")))
     if both:
         part, hole = both[0]
         raise PlannerError(f"{sources}: both fits({part},{hole}) and no_fit({part},{hole}); "
                            "expected one result per part and hole")
-    successors: dict[str, set[str]] = {}
-    for first, then in facts.must_precede:
-        successors.setdefault(first, set()).add(then)
-    try:
-        TopologicalSorter(successors).prepare()
-    except CycleError as exc:
-        ring = list(reversed(exc.args[1]))[:-1]  # graphlib names each node's predecessor next
-        start = ring.index(min(ring))
-        cycle = " < ".join([*ring[start:], *ring[:start], ring[start]])
-        raise PlannerError(f"{sources}: must_precede has a cycle {cycle}; expected an acyclic precedence "
-                           "relation") from None
 
 
 def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
     """Read learned facts files; PlannerError on a file that does not parse, a predicate of
     the wrong arity or with non-id arguments (:data:`LEARNED_SIGNATURES`), unknown ids,
-    a pair both fitting and not fitting, or a cycle of ``must_precede``."""
+    a pair both fitting and not fitting, or a precedence cycle.
+
+    Precedence is read in both forms, ``must_precede/2`` and ``precedence_edge/2``, and
+    closed (:func:`asp.precedence.relation.closed_precedence`): ``must_precede`` and the
+    ``must_precede/2`` atoms hold the closure."""
     sources = ", ".join(str(p) for p in paths)
     atoms = load_atoms(paths, encodings=["plans/needs_hole.lp"])
     check_facts(atoms, LEARNED_SIGNATURES, sources)
+    if not atoms_by_name(atoms, "part", 1):
+        raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
+    must_precede = closed_precedence(atoms, sources)
+    atoms = [atom for atom in atoms if not atom.match("must_precede", 2)]
+    atoms += [fact("must_precede", first, then) for first, then in sorted(must_precede)]
     facts = LearnedFacts(
         atoms=tuple(atoms),
         parts=tuple(p for (p,) in atoms_by_name(atoms, "part", 1)),
         holes=tuple(h for (h,) in atoms_by_name(atoms, "hole", 1)),
         fits=frozenset(pairs_by_name(atoms, "fits")),
         needs_hole=tuple(p for (p,) in atoms_by_name(atoms, "needs_hole", 1)),
-        must_precede=frozenset(pairs_by_name(atoms, "must_precede")),
+        must_precede=must_precede,
     )
-    if not facts.parts:
-        raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
     _check_ids(facts, sources)
     return facts
 
@@ -143,7 +137,7 @@ def greedy_assignment(facts: LearnedFacts) -> Assignment:
     for part in biggest_first:
         free = [hole for hole in holes_of[part] if hole not in taken_by]
         if not free:
-            raise UnsolvableAssembly(part, _no_hole_message(part, holes_of[part], taken_by))
+            raise UnsolvableAssembly([part], _no_hole_message(part, holes_of[part], taken_by))
         hole = min(free, key=lambda h: (parts_in[h], h))
         assignment[part] = hole
         taken_by[hole] = part
@@ -160,6 +154,53 @@ def _no_hole_message(part: str, fitting: list[str], taken_by: dict[str, str]) ->
     )
 
 
+def maximum_matching(facts: LearnedFacts) -> Assignment:
+    """A largest set of parts with distinct holes they fit (augmenting paths, Kuhn's
+    algorithm; parts in id order, holes in the facts' order)."""
+    holes_of = {part: facts.holes_of(part) for part in sorted(facts.needs_hole)}
+    owner: dict[str, str] = {}
+
+    def augment(part: str, seen: set[str]) -> bool:
+        for hole in holes_of[part]:
+            if hole not in seen:
+                seen.add(hole)
+                if hole not in owner or augment(owner[hole], seen):
+                    owner[hole] = part
+                    return True
+        return False
+
+    for part in holes_of:
+        augment(part, set())
+    return {part: hole for hole, part in owner.items()}
+
+
+def hall_violation(facts: LearnedFacts, matching: Assignment) -> tuple[list[str], list[str]]:
+    """For a maximum ``matching`` that leaves a part out: parts S and the holes N(S) they
+    fit, with |N(S)| < |S| (König: the parts reachable from an unmatched part along
+    alternating paths; every hole they reach is matched, to another part of S)."""
+    unmatched = sorted(p for p in facts.needs_hole if p not in matching)
+    owner = {hole: part for part, hole in matching.items()}
+    parts, holes, frontier = {unmatched[0]}, set(), [unmatched[0]]
+    while frontier:
+        for hole in facts.holes_of(frontier.pop()):
+            if hole not in holes:
+                holes.add(hole)
+                if owner[hole] not in parts:
+                    parts.add(owner[hole])
+                    frontier.append(owner[hole])
+    return sorted(parts), [h for h in facts.holes if h in holes]
+
+
+def _unsolvable(facts: LearnedFacts, matching: Assignment) -> UnsolvableAssembly:
+    """The error for facts whose maximum ``matching`` leaves a part without a hole."""
+    parts, holes = hall_violation(facts, matching)
+    if not holes:
+        return UnsolvableAssembly(parts, f"the assembly is not solvable: part {parts[0]} fits no hole")
+    return UnsolvableAssembly(parts, f"the assembly is not solvable: parts {' '.join(parts)} fit only "
+                                     f"{len(holes)} hole(s) between them ({' '.join(holes)}): fewer holes "
+                                     "than parts")
+
+
 def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
     """Up to ``limit`` (0 = all) assignments of ``assignments.lp``, in clingo's order."""
     found: list[Assignment] = []
@@ -171,28 +212,31 @@ def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
     return found
 
 
+def _require_complete_matching(facts: LearnedFacts) -> None:
+    """UnsolvableAssembly naming a Hall violator when no complete assignment exists."""
+    matching = maximum_matching(facts)
+    if len(matching) < len(facts.needs_hole):
+        raise _unsolvable(facts, matching)
+
+
 def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:
     """Every feasible assignment (at most ``limit``, 0 = all), sorted.
 
-    UnsolvableAssembly naming the part without a hole when there is none.
+    UnsolvableAssembly naming parts with fewer holes than parts when there is none.
     """
-    found = _solve_assignments(facts, limit)
-    if not found:
-        # No assignment at all: the greedy one fails too and names the part.
-        return [greedy_assignment(facts)]
-    return sorted(found, key=lambda a: sorted(a.items()))
+    _require_complete_matching(facts)
+    return sorted(_solve_assignments(facts, limit), key=lambda a: sorted(a.items()))
 
 
 def feasible_assignment(facts: LearnedFacts) -> Assignment:
-    """The greedy assignment; when greedy gets stuck although an assignment exists (the
-    sizes are not a biorder, e.g. a hand-written fits/2 table), the first one ASP finds.
+    """The paper's greedy assignment; when greedy gets stuck although an assignment
+    exists (the relation is not one biorder: parts of several cross-sections, a
+    hand-written fits/2 table), the first one ASP finds.
 
-    UnsolvableAssembly (naming the part greedy could not place) only when none exists.
+    UnsolvableAssembly naming parts with fewer holes than parts only when none exists.
     """
     try:
         return greedy_assignment(facts)
     except UnsolvableAssembly:
-        found = _solve_assignments(facts, 1)
-        if not found:
-            raise
-        return found[0]
+        _require_complete_matching(facts)
+        return _solve_assignments(facts, 1)[0]

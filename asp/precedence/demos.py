@@ -29,10 +29,9 @@ import clingo
 
 from asp import MAX_IDS, PlannerError
 from asp.solve import atoms_by_name, fact, load_atoms
-from bridge.assembly import ID_PATTERN
+from bridge.assembly import is_id
 from bridge.inputs import read_bytes, shorten
 
-_ID = re.compile(ID_PATTERN)
 _SEPARATOR = re.compile(r"[\s,]+")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
 _EXPECTED = "(part ids separated by spaces or commas)"
@@ -69,7 +68,7 @@ def _check_sequence(where: str, ids: Sequence[str], parts: Sequence[str], parts_
         raise PlannerError(f"{where}: {len(ids)} ids; expected at most {MAX_IDS} parts")
     seen: set[str] = set()
     for part in ids:
-        if not _ID.match(part):
+        if not is_id(part):
             raise PlannerError(f"{where}: '{shorten(part)}' is not a part id "
                                "(expected a lower-case ASP constant of at most 64 characters)")
         if part not in parts:
@@ -92,7 +91,7 @@ def _check_holes(where: str, ids: Sequence[str], holes: Sequence[str | None], kn
     for part, hole in zip(ids, holes):
         if hole is None:
             continue
-        if not _ID.match(hole):
+        if not is_id(hole):
             raise PlannerError(f"{where}: '{shorten(part)}@{shorten(hole)}': '{shorten(hole)}' is not a hole id "
                                "(expected part@hole, a lower-case ASP constant after @)")
         if known is not None and hole not in known:

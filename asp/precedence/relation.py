@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
 
 import clingo
@@ -119,6 +120,37 @@ def load_relation(paths: Sequence[Path | str]) -> Relation:
     if cycle:
         raise PlannerError(f"{names}: the constraints contain a cycle through {', '.join(c[0] for c in cycle)}")
     return relation
+
+
+def closed_precedence(atoms: Sequence[clingo.Symbol], source: str) -> frozenset[Pair]:
+    """The precedence of checked facts atoms (:func:`asp.solve.check_facts`) in both forms,
+    ``must_precede/2`` and ``precedence_edge/2`` (a reduction, as every shipped
+    ``precedence.lp`` has it), transitively closed.
+
+    PlannerError naming ``source`` and the atom when a pair names an id that is not a
+    ``part/1``, or naming the cycle (``a < b < a``) when the pairs have one.
+    """
+    parts = [p for (p,) in atoms_by_name(atoms, "part", 1)]
+    pairs: list[Pair] = []
+    for name in ("must_precede", "precedence_edge"):
+        for first, then in pairs_by_name(atoms, name):
+            unknown = next((x for x in (first, then) if x not in parts), None)
+            if unknown is not None:
+                raise PlannerError(f"{source}: {name}({first},{then}): {unknown} is not a part/1 "
+                                   f"(parts: {' '.join(parts)})")
+            pairs.append((first, then))
+    successors: dict[str, set[str]] = {}
+    for first, then in pairs:
+        successors.setdefault(first, set()).add(then)
+    try:
+        TopologicalSorter(successors).prepare()
+    except CycleError as exc:
+        ring = list(reversed(exc.args[1]))[:-1]  # graphlib names each node's predecessor next
+        start = ring.index(min(ring))
+        cycle = " < ".join([*ring[start:], *ring[:start], ring[start]])
+        raise PlannerError(f"{source}: must_precede has a cycle {cycle}; expected an acyclic precedence "
+                           "relation") from None
+    return frozenset(close(Relation.from_pairs(parts, pairs), source).pairs())
 
 
 def true_relation(assembly: Assembly) -> Relation:

@@ -1,9 +1,12 @@
 """Plan steps served over Zenoh (``executor serve``): the :class:`Assembler` of the current
-plan run, kept between its steps; a request of another run (``assembly`` id) starts a
-fresh world with every part on the tray.  Holes blocked with ``--block-hole`` get their
-obstacle in every fresh world.  With ``--uncertainty cell`` every world gets the cell's
-uncertainty and execution layer, and the ILC corrections are kept across the plan runs
-this cell serves (in memory: not saved)."""
+plan run, kept between its steps. One run at a time: a step of another run (``assembly``
+id) is refused (:class:`executor.backends.RunActive`) while the current run's product is
+unfinished, and starts a fresh world with every part on the tray once it is complete. A
+refused step (another run, or one the product does not allow) changes nothing. Holes
+blocked with ``--block-hole`` get their obstacle in every fresh world. With
+``--uncertainty cell`` every world gets the cell's uncertainty and execution layer, and
+the ILC corrections are kept across the plan runs this cell serves (in memory: not
+saved)."""
 
 from __future__ import annotations
 
@@ -13,7 +16,8 @@ from typing import TYPE_CHECKING
 from bridge.messages import StepEvidence, StepRequest
 from executor import ExecutorError
 from executor.assembly.product import Product, load_product
-from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord
+from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
+from executor.backends import check_run
 from executor.control.ilc import ExecutionLayer, Ilc
 
 if TYPE_CHECKING:
@@ -61,7 +65,14 @@ class AssemblyRunner:
         return self._assembler
 
     def run_step(self, request: StepRequest) -> tuple[StepRecord, dict[str, float]]:
-        """Carry out the step; the record and every placed part's distance from its goal [mm]."""
+        """Carry out the step; the record and every placed part's distance from its goal [mm].
+
+        RunActive, UnknownPair or InvalidStep before anything moves: a step of another run
+        while this one is unfinished, or a step the product does not allow."""
+        current = None if self._assembler is None else self._run
+        placed = set() if self._assembler is None else self._assembler.placed
+        check_run(current, request.assembly, self.product.parts, placed)
+        check_product_step(self.product, request.part, request.hole, placed if request.assembly == current else ())
         assembler = self.assembler(request.assembly)
         record = assembler.run_step(request.part, request.hole, request.seed)
         errors = assembler.pose_errors()

@@ -20,7 +20,7 @@ from executor import ExecutorError
 from executor.assembly.product import Product, rect_minus_squares
 from executor.control.controller import ImpedanceController
 from executor.control.motion import Motion, StepLogger
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import PartSpec, arm_urdf_text
 from executor.world.scene import TIME_STEP, load_plate
@@ -193,7 +193,7 @@ class AssemblyWorld:
     def settle(self, duration: float) -> None:
         """Hold the arm where it is for ``duration`` [s] (parts come to rest)."""
         s = self.arm.read()
-        self.motion.hold(s.tip_pos, TOOL_DOWN_QUAT_XYZW, duration)
+        self.motion.hold(s.tip_pos, tool_quat(self.motion.tool_yaw), duration)
 
     def _com(self, part: str) -> tuple[float, float, float]:
         """The body's centre of mass in its frame [m] (PyBullet's base pose is the COM's)."""

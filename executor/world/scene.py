@@ -18,6 +18,7 @@ import pybullet_data
 
 from executor import ExecutorError
 from executor.world import TIME_STEP
+from executor.world.arm import yaw_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text
 
@@ -147,15 +148,16 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
                             (0, 0, 0, 1), (140, 150, 165))]
     half_tile, half_thick = plate["tile_size"] / 2, plate["tile_thickness"] / 2
     for hid, hole in sorted(geometry.holes.items()):
+        turned = yaw_quat(hole.yaw)  # the boss turns with its hole
         shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
-                       (*hole.position, plate["top_z"] - half_thick), (0, 0, 0, 1), (180, 185, 190)))
+                       (*hole.position, plate["top_z"] - half_thick), turned, (180, 185, 190)))
         half_depth = plate["tile_thickness"] / 2
-        r = hole.size / 2
-        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (r, r, half_depth),
-                       (*hole.position, plate["top_z"] - half_depth), (0, 0, 0, 1), (40, 40, 40)))
+        a, b = hole.sides
+        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (a / 2, b / 2, half_depth),
+                       (*hole.position, plate["top_z"] - half_depth), turned, (40, 40, 40)))
     for pid, part in sorted(geometry.parts.items()):
-        r = part.size / 2
-        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (r, r, part.length / 2),
+        a, b = part.sides
+        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (a / 2, b / 2, part.length / 2),
                        (*part.start, part.length / 2), (0, 0, 0, 1), (205, 155, 50)))
     return shapes
 

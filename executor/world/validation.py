@@ -21,7 +21,8 @@ from bridge.assembly import MAX_COORDINATE, Assembly
 from bridge.inputs import shorten
 from executor import ExecutorError
 
-KINDS = frozenset({"round", "square"})  # cross-sections: "round" size = diameter, "square" size = side
+KINDS = frozenset({"round", "square", "rect"})
+"""Cross-sections: "round" size = diameter, "square" size = side, "rect" size = [a, b] (a >= b)."""
 # Bosses of neighbouring holes may touch (Cranfield's do), not overlap: up to rounding [m].
 TOUCH_TOLERANCE = 1e-6
 
@@ -72,6 +73,22 @@ class Pair:
 
 
 @dataclass(frozen=True)
+class SectionSize:
+    """A cross-section's size: one number (a diameter or side) or, for a rect, ``[a, b]``
+    with a ≥ b (the long side a along x), each accepted by ``item``."""
+
+    item: Real
+
+    def accepts(self, value: object) -> bool:
+        if isinstance(value, list):
+            return len(value) == 2 and all(map(self.item.accepts, value)) and value[0] >= value[1]
+        return self.item.accepts(value)
+
+    def expected(self) -> str:
+        return f"{self.item.expected()}, or for a rect [a, b] with a >= b, each such a number"
+
+
+@dataclass(frozen=True)
 class OneOf:
     """One of ``choices`` (strings)."""
 
@@ -107,9 +124,10 @@ class Text:
         return "an id"
 
 
-Rule = Real | Count | Pair | OneOf | Ids | Text
+Rule = Real | Count | Pair | SectionSize | OneOf | Ids | Text
 COORDINATE = Real(-MAX_COORDINATE, MAX_COORDINATE)
-SECTION_SIZE = Real(0.0, 0.1)  # a diameter or side the gripper's fingers can hold [m]
+SECTION_SIZE = SectionSize(Real(0.0, 0.1))  # sides or a diameter the gripper's fingers can hold [m]
+YAW = Real(-360.0, 360.0, "degrees")  # a hole's optional yaw
 
 PLATE: dict[str, Rule] = {
     "top_z": Real(0.0, 1.0), "tile_size": Real(0.0, 0.5), "tile_thickness": Real(0.0, 0.2),
@@ -175,12 +193,15 @@ def check_geometry(path: Path, geo: Mapping[str, object], layout: Assembly) -> N
         raise ExecutorError(f"{path}: [extra_parts]: expected tables [extra_parts.<id>], got {shorten(repr(extras))}")
     for pid, table in extras.items():
         _check_keys(path, f"extra_parts.{pid}", table, EXTRA_PART)
+    for group, tables in (("hole_shapes", holes), ("part_shapes", parts)):
+        for name, table in tables.items():
+            _check_section(path, f"{group}.{name}", table)
     chamfer, tile = plate["chamfer"], plate["tile_size"]
     if chamfer >= plate["tile_thickness"]:
         raise _fail(path, "plate", "chamfer", f"less than tile_thickness ({plate['tile_thickness']:g} m)", chamfer)
     hole_ids = {hid for table in holes.values() for hid in table["holes"]}
     for name, table in holes.items():
-        if table["size"] + 2 * chamfer >= tile:
+        if _long_side(table["size"]) + 2 * chamfer >= tile:
             raise _fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {tile:g} m boss "
                         f"(size + 2 chamfer < tile_size)", table["size"])
     for name, table in parts.items():
@@ -192,7 +213,8 @@ def check_geometry(path: Path, geo: Mapping[str, object], layout: Assembly) -> N
                         f"longer than [gripper] grasp_depth ({gripper['grasp_depth']:g} m)", table["length"])
     _check_references(path, layout, holes, parts, extras)
     positions = {h.id: h.position for h in layout.holes if h.id in hole_ids and h.position is not None}
-    _check_bosses(path, tile, positions)
+    turned = {hid for table in holes.values() if table.get("yaw", 0.0) for hid in table["holes"]}
+    _check_bosses(path, tile, positions, turned)
 
 
 def _check_references(path: Path, layout: Assembly, holes: dict[str, dict], parts: dict[str, dict],
@@ -214,11 +236,34 @@ def _check_references(path: Path, layout: Assembly, holes: dict[str, dict], part
                             f"[extra_parts] ({pid} is neither)", pid)
 
 
-def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]]) -> None:
-    """No two square bosses (side ``tile`` [m], around the holes at ``positions``) overlap."""
+def _check_section(path: Path, table_name: str, table: dict) -> None:
+    """A rect's size is ``[a, b]``, any other kind's one number; a hole's ``yaw`` [°] is finite."""
+    rect, size = table["kind"] == "rect", table["size"]
+    if rect != isinstance(size, list):
+        expected = ("[a, b] in m with a >= b > 0 (the long side a along x) for a rect" if rect
+                    else f"one number (the {'diameter' if table['kind'] == 'round' else 'side'}) for a {table['kind']}")
+        raise _fail(path, table_name, "size", expected, size)
+    if "yaw" in table and not YAW.accepts(table["yaw"]):
+        raise _fail(path, table_name, "yaw", YAW.expected(), table["yaw"])
+
+
+def _long_side(size: float | list[float]) -> float:
+    """A checked size's largest extent along a side of its boss [m] (a rect's a)."""
+    return float(size[0]) if isinstance(size, list) else float(size)
+
+
+def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]],
+                  turned: set[str]) -> None:
+    """No two square bosses (side ``tile`` [m], around the holes at ``positions``) overlap.
+    A boss of a ``turned`` hole is turned with it: two bosses whose centres are closer than
+    ``tile`` overlap whatever their yaws (their inscribed circles do)."""
     ordered = sorted(positions.items())
     for k, (a, (xa, ya)) in enumerate(ordered):
         for b, (xb, yb) in ordered[k + 1:]:
-            if abs(xa - xb) < tile - TOUCH_TOLERANCE and abs(ya - yb) < tile - TOUCH_TOLERANCE:
+            if a in turned or b in turned:
+                overlap = math.hypot(xa - xb, ya - yb) < tile - TOUCH_TOLERANCE
+            else:
+                overlap = abs(xa - xb) < tile - TOUCH_TOLERANCE and abs(ya - yb) < tile - TOUCH_TOLERANCE
+            if overlap:
                 raise ExecutorError(f"{path}: [plate] tile_size: expected bosses that do not overlap, got holes "
                                     f"{a} at ({xa:g}, {ya:g}) and {b} at ({xb:g}, {yb:g}) m closer than {tile:g} m")

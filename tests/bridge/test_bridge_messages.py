@@ -87,3 +87,35 @@ def test_step_messages_round_trip_and_need_version_3() -> None:
     assert old.value.code == "version"
     # Insert messages did not change in version 3: a version-2 insert request is still served.
     assert decode_request(b'{"kind":"insert","id":"a","part":"p1","hole":"r1","v":2}').v == 2
+
+
+@pytest.mark.parametrize("bad", ["not", "p1\n", "p\u00e91", "p\\ud800", "P1", "1p", "_p", "p" * 65])
+def test_ids_that_break_clingo_are_malformed(bad: str) -> None:
+    """An id is an ASCII ASP constant: not the keyword ``not``, no trailing newline, no
+    non-ASCII letter (clingo panics on one), no lone surrogate."""
+    from bridge.messages import decode_step_request
+
+    step = msgspec.json.encode({"kind": "step", "id": "a", "assembly": "r", "step": 1, "part": "p1", "hole": "r1"})
+    for field in ("part", "hole"):
+        payload = step.replace(f'"{field}":"{"p1" if field == "part" else "r1"}"'.encode(),
+                               f'"{field}":"'.encode() + bad.encode("utf-8", "surrogatepass")
+                               .replace(b"\n", b"\\n") + b'"')
+        assert payload != step
+        with pytest.raises(MessageError) as refused:
+            decode_step_request(payload)
+        assert refused.value.code == "malformed"
+    assert decode_step_request(step).part == "p1" and decode_step_request(step.replace(b'"p1"', b'"nots"'))
+
+
+def test_a_key_given_twice_is_malformed() -> None:
+    """msgspec keeps the last of two equal keys: a message with one is refused instead, so
+    that a reader of the first one never sees another request than the cell runs."""
+    from bridge.messages import decode_step_request
+
+    step = b'{"kind":"step","id":"a","assembly":"r","step":1,"part":"p1","hole":"r1","hole":"br"}'
+    with pytest.raises(MessageError, match="the key 'hole' appears twice") as refused:
+        decode_step_request(step)
+    assert refused.value.code == "malformed"
+    with pytest.raises(MessageError, match="'part' appears twice"):
+        decode_request(b'{"kind":"insert","id":"a","part":"p1","hole":"r1","part":"p2"}')
+    assert decode_request(b'{"kind":"insert","id":"a","part":"p1","hole":"r1"}').part == "p1"

@@ -18,11 +18,11 @@ pytestmark = pytest.mark.slow  # real PyBullet campaigns, 10-15 s each
 
 
 def test_mini_campaign_with_plots(tmp_path: Path, run_executor) -> None:
-    done = run_executor("campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1", "--workers", "2",
+    done = run_executor("campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1", "--jobs", "2",
                         "--json", "--plot", str(tmp_path), timeout=240)
     assert done.returncode == 0, done.stdout + done.stderr
     report = json.loads(done.stdout)
-    assert report["all_correct"] and report["false_fits"] == 0 and report["workers"] == 2
+    assert report["all_correct"] and report["false_fits"] == 0 and report["jobs"] == 2
     rows = {(p["part"], p["hole"]): p for p in report["pairs"]}
     assert rows[("p1", "br")]["after_second"] == 1 and rows[("p1", "br")]["fits"]
     assert rows[("p3", "r1")]["correct"] == 1 and not rows[("p3", "r1")]["fits"]

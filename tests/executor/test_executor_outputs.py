@@ -48,7 +48,7 @@ def test_unwritable_rrd_is_one_line_exit_2(places: Path, run_executor, command: 
 def test_campaign_plot_folder_is_checked_before_the_campaign(places: Path, run_executor, name: str,
                                                             reason: str) -> None:
     folder = places / name
-    done = run_executor("campaign", "--trials", "1", "--pairs", "p1:r1", "--workers", "1", "--plot", str(folder),
+    done = run_executor("campaign", "--trials", "1", "--pairs", "p1:r1", "--jobs", "1", "--plot", str(folder),
                         timeout=30)
     assert done.returncode == 2, done.stderr
     assert done.stderr.splitlines()[-1] == f"error: {folder}: cannot create the folder ({reason})"

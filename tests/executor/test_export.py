@@ -14,7 +14,7 @@ import pytest
 from executor.assembly.export import export_cell
 from executor.assembly.product import load_product
 from tests._files_helpers import leftovers, run_with_file_limit
-from tests.conftest import EXECUTOR_MODULE
+from tests.conftest import CLI_MODULE
 
 
 @pytest.mark.slow
@@ -46,7 +46,7 @@ def test_a_full_disk_leaves_no_torn_file(tmp_path: Path) -> None:
     copy of it), no temporary file left."""
     export_cell("cranfield", tmp_path / "whole")
     out = tmp_path / "out"
-    done = run_with_file_limit([sys.executable, "-m", EXECUTOR_MODULE, "export", str(out)], limit=120_000)
+    done = run_with_file_limit([sys.executable, "-m", CLI_MODULE, "executor", "export", str(out)], limit=120_000)
     assert done.returncode == 2, done.stderr
     assert done.stderr.splitlines()[-1].endswith(": cannot write (File too large)"), done.stderr
     assert "Traceback" not in done.stderr

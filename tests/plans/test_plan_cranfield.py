@@ -10,12 +10,15 @@ import math
 import re
 from pathlib import Path
 
+import clingo
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from asp import PlannerError
 from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
+from asp.precedence.relation import load_relation
 from asp.solve import load_atoms, write_facts
 from bridge.assembly import Assembly, Hole, Part, load_assembly
 from tests.conftest import ROOT
@@ -164,3 +167,63 @@ def test_plain_clingo_answers_the_readme_questions(learned: Path, facts: Learned
     p3_holes = set(re.findall(r"assigned\(p3,(\w+)\)", last))
     assert p3_holes == {a["p3"] for a in all_assignments(facts)}
     assert p3_holes <= set(facts.holes_of("p3"))
+
+
+@pytest.mark.parametrize("name", ["cranfield", "spare", "graded"])
+def test_plans_of_shipped_files_respect_their_precedence_edges(name: str) -> None:
+    """A shipped precedence.lp holds only precedence_edge/2 (the reduction): plans read
+    its transitive closure, so every plan is a sequence the true constraints admit."""
+    folder = ROOT / "data" / name
+    truth = load_relation([folder / "precedence.lp"])
+    facts = load_learned_facts([folder / "sizes.lp", folder / "precedence.lp"])
+    assert facts.must_precede == frozenset(truth.pairs())
+    for plan in plans(facts, 30):
+        assert truth.admits([step.part for step in plan.steps])
+        assert check_plan(facts, plan.steps) == []
+    wrong = tuple(reversed(plans(facts, 1)[0].steps))
+    assert any(error.startswith("wrong_order(") for error in check_plan(facts, wrong))
+
+
+def test_plan_command_reads_precedence_edges_and_mixed_forms(tmp_path: Path, run_cli) -> None:
+    truth = load_relation([CRANFIELD / "precedence.lp"])
+    done = run_cli("plan", str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"), "-n", "20", "--json")
+    assert done.returncode == 0, done.stderr
+    for plan in json.loads(done.stdout)["plans"]:
+        assert truth.admits([step["part"] for step in plan])
+    mixed = tmp_path / "mixed.lp"
+    mixed.write_text("part(a;b;c). must_precede(a,b). precedence_edge(b,c).\n")
+    done = run_cli("plan", str(mixed), "-n", "0", "--json")
+    assert done.returncode == 0, done.stderr
+    assert [[step["part"] for step in plan] for plan in json.loads(done.stdout)["plans"]] == [["a", "b", "c"]]
+    cyclic = tmp_path / "cyclic_edges.lp"
+    cyclic.write_text("part(a;b). must_precede(a,b). precedence_edge(b,a).\n")
+    done = run_cli("plan", str(cyclic))
+    assert done.returncode == 2 and "has a cycle a < b < a" in done.stderr
+    unknown = tmp_path / "unknown.lp"
+    unknown.write_text("part(a;b). precedence_edge(a,zz).\n")
+    done = run_cli("plan", str(unknown))
+    assert done.returncode == 2 and "precedence_edge(a,zz): zz is not a part/1" in done.stderr
+
+
+def test_ids_reach_clingo_as_symbols_never_as_program_text(facts: LearnedFacts) -> None:
+    """An id holding ASP syntax is one constant: it adds no facts (the checker refuses the
+    unknown hole) and no rules (the interval is never ground)."""
+    plan = plans(facts, 1)[0]
+    injected = [PlanStep(s.part, "r3). hole(zz). fits(p1,zz") if s.part == "p1" else s for s in plan.steps]
+    assert any("p1" in error for error in check_plan(facts, injected))
+    bomb = [PlanStep(s.part, "r3). bomb(1..50000000") if s.part == "p1" else s for s in plan.steps]
+    assert any("p1" in error for error in check_plan(facts, bomb))
+    atoms = load_atoms([], extra=[clingo.Function("part", [clingo.Function("a). part(b")])])
+    assert [str(atom.arguments[0].name) for atom in atoms] == ["a). part(b"]
+
+
+def test_a_fact_that_would_not_read_back_is_never_written(tmp_path: Path) -> None:
+    path = tmp_path / "facts.lp"
+    with pytest.raises(PlannerError, match="is not an ASP constant"):
+        write_facts(path, [clingo.Function("hole", [clingo.Function("r3). bomb(1..5")])])
+    with pytest.raises(PlannerError, match="'not' is not an ASP constant"):
+        write_facts(path, [clingo.Function("part", [clingo.Function("not")])])
+    assert not path.exists()
+    write_facts(path, [clingo.Function("label", [clingo.String('a "quoted" ). string')]),
+                       clingo.Function("n", [clingo.Number(-3)])])
+    assert [str(atom) for atom in load_atoms([path])] == ['label("a \\"quoted\\" ). string")', "n(-3)"]
