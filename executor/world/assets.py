@@ -2,16 +2,20 @@
 
 ``<assembly>/assets/`` (plate mesh, part URDFs) is generated from ``geometry.toml`` and
 ``assembly.toml`` by :func:`executor.world.geometry.write_assets`. The folder records the
-SHA-256 of those two files it was made from (``assets/sources.sha256``, written after the
-assets, so an interrupted regeneration is regenerated again). :func:`current_assets`,
-called before a cell loads any asset, regenerates the folder when a generated file is
-missing or the digest differs: an edited hole is never simulated with its old mesh. When
-the folder cannot be written (a read-only install), the error names the file.
+SHA-256 of the values it was made from (``assets/sources.sha256``: the ``[plate]`` table,
+every hole and part as loaded, as canonical JSON; comments and the keys the assets do
+not use leave it unchanged), written after the assets, so an interrupted regeneration is
+regenerated again. :func:`current_assets`, called before a cell loads any asset,
+regenerates the folder when a generated file is missing or the digest differs: an edited
+hole is never simulated with its old mesh. When the folder cannot be written (a
+read-only install), the error names the file.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
+import json
 import logging
 from pathlib import Path
 
@@ -21,19 +25,18 @@ from executor import ExecutorError
 from executor.world.geometry import CellGeometry, write_assets
 
 STAMP = "sources.sha256"
-SOURCES = ("assembly.toml", "geometry.toml")
 
 logger = logging.getLogger(__name__)
 
 
 def sources_digest(geometry: CellGeometry) -> str:
-    """Hex SHA-256 over the names and bytes of the assembly folder's :data:`SOURCES`."""
-    digest = hashlib.sha256()
-    for name in SOURCES:
-        data = (geometry.folder / name).read_bytes()
-        digest.update(f"{name}\0{len(data)}\0".encode())
-        digest.update(data)
-    return digest.hexdigest()
+    """Hex SHA-256 of the canonical JSON of what the assets are generated from: the
+    ``[plate]`` table and every hole and part (their dataclass fields). The values come
+    from decimal text, so the digest is the same on every machine."""
+    inputs = {"plate": geometry.plate,
+              "holes": [dataclasses.asdict(h) for _, h in sorted(geometry.holes.items())],
+              "parts": [dataclasses.asdict(p) for _, p in sorted(geometry.parts.items())]}
+    return hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def _generated_names(geometry: CellGeometry) -> list[str]:
@@ -61,7 +64,8 @@ def current_assets(geometry: CellGeometry) -> Path:
     if recorded == expected and all((folder / name).is_file() for name in _generated_names(geometry)):
         return folder
     if recorded is not None:  # a first generation (no stamp yet) is no news
-        logger.warning("%s: stale (made from another %s or incomplete); regenerating", folder, " or ".join(SOURCES))
+        logger.warning("%s: stale (made from other values of geometry.toml or assembly.toml, or incomplete); "
+                       "regenerating", folder)
     try:
         regenerate_assets(geometry)
     except BridgeError as exc:

@@ -1,6 +1,6 @@
-"""Generated assets follow their sources: ``<assembly>/assets/`` records the digest of
-``geometry.toml`` and ``assembly.toml`` it was made from, and a cell regenerates assets
-that no longer match before it uses them; the shipped ones match."""
+"""Generated assets follow their sources: ``<assembly>/assets/`` records the digest of the
+``geometry.toml`` and ``assembly.toml`` values it was made from, and a cell regenerates
+assets that no longer match before it uses them; the shipped ones match."""
 
 from __future__ import annotations
 
@@ -52,6 +52,17 @@ def test_stale_assets_are_regenerated_before_use(cranfield: Path) -> None:
     (geometry.assets / "part_shaft.urdf").unlink()  # a generated file missing: made again
     current_assets(geometry)
     assert (geometry.assets / "part_shaft.urdf").is_file()
+
+
+def test_an_edit_the_assets_do_not_depend_on_keeps_them(cranfield: Path) -> None:
+    layout = cranfield / "assembly.toml"
+    layout.write_text(layout.read_text().replace('name = "round peg 1"', 'name = "renamed"', 1) + "# a comment\n")
+    stamp = cranfield / "assets" / STAMP
+    before = stamp.stat().st_mtime_ns
+    geometry = load_geometry(str(cranfield))
+    assert stamp.read_text() == sources_digest(geometry) + "\n"
+    current_assets(geometry)
+    assert stamp.stat().st_mtime_ns == before  # not regenerated
 
 
 def test_assets_that_cannot_be_regenerated_are_refused_naming_the_file(cranfield: Path) -> None:

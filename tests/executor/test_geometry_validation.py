@@ -113,13 +113,14 @@ VALUES = st.one_of(st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow
 @settings(max_examples=60, deadline=None)
 @given(key=st.sampled_from(NUMERIC_KEYS), value=VALUES)
 def test_any_value_of_a_key_loads_or_is_refused_in_one_line(key: tuple[str, str], value: object) -> None:
-    """Whatever a [plate] or [gripper] key holds, the loader gives a geometry or one
-    ExecutorError naming the key, never another exception."""
-
+    """Whatever a [plate] or [gripper] key holds, the check passes or raises one
+    ExecutorError of one line naming the file and a table (the key itself, or the key a
+    cross check relates it to: a smaller tile_size refuses the hole that no longer fits),
+    never another exception."""
     geo = tomllib.loads(ORIGINAL)
     geo[key[0]][key[1]] = value
-
+    path = CRANFIELD / "geometry.toml"
     try:
-        check_geometry(CRANFIELD / "geometry.toml", geo, load_assembly("cranfield"))
+        check_geometry(path, geo, load_assembly("cranfield"))
     except ExecutorError as exc:
-        assert f"[{key[0]}]" in str(exc) and "\n" not in str(exc)
+        assert str(exc).startswith(f"{path}: [") and "\n" not in str(exc), str(exc)
