@@ -232,16 +232,17 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
          'kind = "round"', 'kind = "oval"', 1)}), 2, "oval"),
     ("trial-part-shape-against-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
-         'role = "peg"', 'role = "peg"\nshape = "square"', 1)}), 2, "kind"),
+         'role = "peg"\nshape = "round"', 'role = "peg"\nshape = "square"', 1)}), 2, "kind"),
     ("assembly-part-shape-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
-         'role = "peg"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape"),
+         'role = "peg"\nshape = "round"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape: expected one of"),
     ("section-of-unlike-parts", ("executor", "trial", "--part", "rect8", "--hole", "slot8", "--assembly", "asm"),
      taskboard(**{"assembly.toml": (TASKBOARD / "assembly.toml").read_text().replace(
          'shape = "rect"\n', 'shape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
     ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
-         'role = "peg"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2, "section"),
+         'role = "peg"\nshape = "round"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2,
+     "section: only a part of shape"),
     # learned facts: arity, ids, cycles, contradictions
     ("assign-arity", ("assign", "f.lp"), {"f.lp": "part(a). hole(r1). fits(a,r1,x).\n"}, 2, "fits/2"),
     ("plan-arity", ("plan", "f.lp"), {"f.lp": "part(a;b). must_precede(a,b,c).\n"}, 2, "must_precede/2"),
