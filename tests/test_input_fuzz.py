@@ -1,7 +1,8 @@
 """Fuzzing the readers of the planner's input files with hypothesis: the demonstrations
-reader (text and ``demo/3`` facts), the learned facts reader, the plan JSON reader and
-the session journal reader, and the product description loader (``assembly.toml``). Whatever the bytes, a
-reader returns valid data or raises :class:`asp.PlannerError` with a short message: never
+reader (text and ``demo/3`` facts), the learned facts reader, the plan JSON reader, the
+session journal reader and the product description loader (``assembly.toml``). Whatever
+the bytes, a reader returns valid data or raises its package's error
+(:class:`asp.PlannerError`, :class:`bridge.BridgeError`) with a short message: never
 another exception, never unbounded work (each example has a deadline)."""
 
 from __future__ import annotations
