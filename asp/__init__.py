@@ -4,6 +4,7 @@ Learns precedence constraints from demonstrations (paper 2.1), which part fits w
 hole by active exploration (paper 2.2), assigns holes and builds complete plans.
 """
 
+from bridge.errors import ToolError
 
 MAX_IDS = 64
 """At most this many parts, and this many holes, in the planner's input (demonstrations,
@@ -11,7 +12,7 @@ precedence and sizes facts, learned facts): the learners' matrices and searches 
 sized by them."""
 
 
-class PlannerError(Exception):
+class PlannerError(ToolError):
     """Base error of the planner: bad input or an unsolvable request.
 
     The message names the bad value (file:line or field) and what was expected; the

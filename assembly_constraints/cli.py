@@ -1,13 +1,15 @@
 """``assembly-constraints``: the one command line of the planner and the cell.
 
 ``assembly-constraints [-v | -q] SUBCOMMAND [ARGS...]`` runs one subcommand; each takes
-``--help``. The planner's subcommands are those of :data:`asp.cli.SUBCOMMANDS`, the cell's
-are under ``executor`` (:mod:`executor.cli`), ``bench executor`` is the cell's benchmark,
-and ``protocol`` writes the published message schemas (:mod:`bridge.protocol_schema`).
+``--help``. :data:`SUBCOMMANDS` is the one registry: the planner's subcommands, the cell's
+under ``executor`` (:mod:`executor.cli`), the benchmarks of both under ``bench``
+(:data:`BENCHMARKS`), and ``protocol``, which writes the published message schemas
+(:mod:`bridge.protocol_schema`). The tests run this same command line.
 Modules are imported lazily, so ``--help`` of one subcommand does not pay for the others.
 
-Exit codes: 0 done, 1 a check failed, 2 bad input or usage (a missing subcommand too),
-3 an unsolvable assembly, 130 interrupted, 141 stdout closed.
+Exit codes (:mod:`bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
+missing subcommand too; every :class:`bridge.errors.ToolError`), 3 an unsolvable
+assembly, 130 interrupted, 141 stdout closed.
 """
 
 from __future__ import annotations
@@ -20,42 +22,55 @@ from collections.abc import Callable, Sequence
 
 from assembly_constraints import __version__
 from bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
+from bridge.errors import ToolError
 
-CELL_SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "executor": ("executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve"),
+BENCHMARKS: dict[str, str] = {
+    "precedence": "asp.bench.precedence",
+    "sizes": "asp.bench.sizes",
+    "plan": "asp.bench.plans",
+    "session": "asp.bench.session",
+    "dominance": "asp.bench.dominance",
+    "mesh": "asp.bench.mesh",
+    "precedence-physics": "asp.bench.precedence_physics",
+    "assemble": "asp.bench.assemble_plans",
+    "executor": "executor.campaign.bench",
+    "physics": "executor.campaign.physics",
+}
+"""``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""
+
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "precedence": ("asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
+    "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
+    "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
+    "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
+    "session": ("asp.session.run", "the end-to-end learning session (planner + cells)"),
+    "assemble": ("asp.assemble.cli", "execute a plan in a simulated cell, monitored and re-planned"),
+    "view": ("asp.session.view", "open a session's Rerun recording"),
+    "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
+    "executor": ("executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
     "protocol": ("bridge.protocol_schema", "write or check the JSON Schema of every Zenoh message"),
 }
-"""Subcommands beside the planner's: name → (module whose ``main(argv)`` runs it, help)."""
-
-
-def subcommands() -> dict[str, tuple[str, str]]:
-    """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
-    from asp.cli import SUBCOMMANDS
-
-    return {**SUBCOMMANDS, "bench": ("assembly_constraints.cli:bench_main", SUBCOMMANDS["bench"][1]),
-            **CELL_SUBCOMMANDS}
+"""Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
 
 
 def bench_main(argv: list[str]) -> int:
-    """``bench TOPIC``: the planner's benchmarks, and the cell's under ``bench executor``."""
-    from asp.bench.cli import TOPICS
-
-    topics = {**TOPICS, "executor": "executor.campaign.bench"}
+    """``bench TOPIC``: the planner's and the cell's benchmarks (:data:`BENCHMARKS`)."""
     parser = ArgumentParser(prog="bench", description="Benchmarks: each prints its figures (medians, ratios); "
                             "docs/results.md lists the measured values and the commands.")
-    parser.add_argument("topic", nargs="?", choices=list(topics), metavar="TOPIC", help=f"one of: {', '.join(topics)}")
+    parser.add_argument("topic", nargs="?", choices=list(BENCHMARKS), metavar="TOPIC",
+                        help=f"one of: {', '.join(BENCHMARKS)}")
     parser.add_argument("arguments", nargs=argparse.REMAINDER, metavar="ARGS",
                         help="the benchmark's options (see bench TOPIC --help)")
     args = parser.parse_args(argv)
     if args.topic is None:
-        parser.error(f"expected a benchmark, one of: {', '.join(topics)}")
-    return int(_entry(topics[args.topic])(args.arguments) or 0)
+        parser.error(f"expected a benchmark, one of: {', '.join(BENCHMARKS)}")
+    return int(_entry(BENCHMARKS[args.topic])(args.arguments) or 0)
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The top of the parser tree: global options and the subcommand's name; the
     subcommand parses the rest of the arguments itself."""
-    commands = subcommands()
+    commands = SUBCOMMANDS
     listing = "\n".join(f"  {name:<11} {text}" for name, (_, text) in commands.items())
     parser = ArgumentParser(
         prog=PROGRAM, formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -88,14 +103,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
     if args.subcommand is None:
-        parser.error(f"expected a subcommand, one of: {', '.join(subcommands())} (see --help)")
+        parser.error(f"expected a subcommand, one of: {', '.join(SUBCOMMANDS)} (see --help)")
     configure_logging(logging.DEBUG if args.verbose else logging.ERROR if args.quiet else logging.INFO)
-    target, _ = subcommands()[args.subcommand]
-    from asp import PlannerError
-    from bridge import BridgeError
-    from executor import ExecutorError
-
-    return run_command(lambda: int(_entry(target)(args.arguments) or 0), (PlannerError, ExecutorError, BridgeError))
+    target, _ = SUBCOMMANDS[args.subcommand]
+    return run_command(lambda: int(_entry(target)(args.arguments) or 0), (ToolError,))
 
 
 if __name__ == "__main__":

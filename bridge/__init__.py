@@ -15,7 +15,10 @@ Nothing here imports the planner (``asp``) or the cell (``executor``).
 """
 
 
-class BridgeError(Exception):
+from bridge.errors import ToolError
+
+
+class BridgeError(ToolError):
     """Base error of the bridge: a bad message, a bad endpoint or config, a lost cell.
 
     The message names the bad value and what was expected.

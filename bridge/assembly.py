@@ -2,9 +2,14 @@
 
 An assembly is a folder (a name under ``data/`` or a path) holding:
 
-- ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role`` and optional ``start``
-  ``[x, y]`` [m] (where the part waits in the cell), ``[holes.<id>]`` with ``name``,
-  ``shape`` and ``position`` ``[x, y]`` [m] on the base plate;
+- ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role``, optional ``start``
+  ``[x, y]`` [m] (where the part waits in the cell), optional ``shape`` (its cross-section
+  kind, :data:`SHAPES`) and, for a rect part, optional ``section`` (a label: parts of one
+  section are scaled copies of one cross-section; default the shape for round and
+  square, the part's own id for rect); ``[holes.<id>]`` with ``name``, ``shape`` (default
+  round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
+  table with ``model`` (the size model the product declares: ``line``, ``sections`` or
+  ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
   ``precedence_edge/2`` or ``must_precede/2``);
 - ``sizes.lp`` (optional): which part fits which hole (``part/1``, ``hole/1``,
@@ -40,6 +45,8 @@ _ID = re.compile(ID_PATTERN)
 def is_id(value: object) -> bool:
     """Whether ``value`` is a part or hole id (:data:`ID_PATTERN`)."""
     return isinstance(value, str) and _ID.match(value) is not None
+
+
 MAX_COORDINATE = 100.0
 """Positions ([x, y] of parts and holes, a tool home) are finite with |x|, |y| <= this [m]."""
 
@@ -52,12 +59,23 @@ class Item:
     name: str
 
 
+SHAPES = ("round", "square", "rect")
+"""The cross-section kinds of a part's or hole's ``shape`` (``kind`` in ``geometry.toml``)."""
+
+SIZE_MODELS = ("line", "sections", "pairs")
+"""The size models a product may declare (``[sizes] model``; docs/sizes.md)."""
+
+
 @dataclass(frozen=True)
 class Part(Item):
-    """One part of an assembly; ``start`` is its waiting position [m] or None."""
+    """One part of an assembly; ``start`` is its waiting position [m] or None; ``shape``
+    its cross-section kind (one of :data:`SHAPES`, None when the file gives none) and
+    ``section`` the label of its cross-section (None without a shape)."""
 
     role: str = "part"
     start: tuple[float, float] | None = None
+    shape: str | None = None
+    section: str | None = None
 
 
 @dataclass(frozen=True)
@@ -76,6 +94,12 @@ class Assembly:
     name: str
     parts: tuple[Part, ...]
     holes: tuple[Hole, ...] = field(default_factory=tuple)
+    size_model: str | None = None
+    """The size model the product declares (``[sizes] model``), None when it declares none."""
+
+    def sections(self) -> dict[str, str]:
+        """Part id -> section, for the parts whose cross-section is stated."""
+        return {p.id: p.section for p in self.parts if p.section is not None}
 
     @property
     def part_ids(self) -> list[str]:
@@ -124,6 +148,29 @@ def _position(source: Path, table: str, key: str, value: object) -> tuple[float,
     return (float(value[0]), float(value[1]))
 
 
+def _shape(source: Path, table: str, key: str, value: object) -> str:
+    if value not in SHAPES:
+        raise BridgeError(f"{source}: [{table}.{key}] shape: expected one of {', '.join(SHAPES)}, "
+                          f"got {shorten(repr(value))}")
+    return str(value)
+
+
+def _part(source: Path, key: str, value: dict) -> Part:
+    """One ``[parts.<id>]`` table; ``section`` only for a rect part (an id-like label)."""
+    shape = None if value.get("shape") is None else _shape(source, "parts", key, value["shape"])
+    section = value.get("section")
+    if section is not None and shape != "rect":
+        raise BridgeError(f"{source}: [parts.{key}] section: only a part of shape \"rect\" has one "
+                          f"(a {shape or 'part without a shape'} is its own section)")
+    if section is not None and not (isinstance(section, str) and _ID.match(section)):
+        raise BridgeError(f"{source}: [parts.{key}] section: expected a lower-case ASP constant, "
+                          f"got {shorten(repr(section))}")
+    if shape is not None and section is None:
+        section = key if shape == "rect" else shape
+    return Part(key, str(value.get("name", key)), str(value.get("role", "part")),
+                _position(source, "parts", key, value.get("start")), shape, section)
+
+
 def _table(source: Path, data: dict, table: str) -> dict[str, dict]:
     entries = data.get(table, {})
     if not isinstance(entries, dict):
@@ -146,19 +193,32 @@ def load_assembly(name_or_path: str) -> Assembly:
         data = tomllib.loads(read_text(source, "assembly file (TOML)"))
     except tomllib.TOMLDecodeError as exc:
         raise BridgeError(f"{source}: not valid TOML: {exc}") from None
-    parts = tuple(
-        Part(key, str(value.get("name", key)), str(value.get("role", "part")),
-             _position(source, "parts", key, value.get("start")))
-        for key, value in _table(source, data, "parts").items()
-    )
+    parts = tuple(_part(source, key, value) for key, value in _table(source, data, "parts").items())
     if not parts:
         raise BridgeError(f"{source}: expected at least one [parts.<id>] table")
     holes = tuple(
-        Hole(key, str(value.get("name", key)), str(value.get("shape", "round")),
+        Hole(key, str(value.get("name", key)), _shape(source, "holes", key, value.get("shape", "round")),
              _position(source, "holes", key, value.get("position")))
         for key, value in _table(source, data, "holes").items()
     )
     clash = {p.id for p in parts} & {h.id for h in holes}
     if clash:
         raise BridgeError(f"{source}: ids used for both a part and a hole: {sorted(clash)}")
-    return Assembly(folder=folder, name=str(data.get("name", folder.name)), parts=parts, holes=holes)
+    return Assembly(folder=folder, name=str(data.get("name", folder.name)), parts=parts, holes=holes,
+                    size_model=_size_model(source, data))
+
+
+def _choice(source: Path, table: str, key: str, value: object, choices: tuple[str, ...]) -> str:
+    if not isinstance(value, str) or value not in choices:
+        raise BridgeError(f"{source}: [{table}] {key}: expected one of {', '.join(choices)}, "
+                          f"got {shorten(repr(value))}")
+    return value
+
+
+def _size_model(source: Path, data: dict) -> str | None:
+    table = data.get("sizes")
+    if table is None:
+        return None
+    if not isinstance(table, dict) or set(table) - {"model"}:
+        raise BridgeError(f"{source}: [sizes]: expected a table with the key model")
+    return _choice(source, "sizes", "model", table.get("model"), SIZE_MODELS)

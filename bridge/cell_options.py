@@ -35,6 +35,10 @@ MAGNITUDES = {
     "vision_bias": Magnitude(0.001, 0.02, "calibration bias of each hole's estimated position, at most [m]"),
     "vision_sigma": Magnitude(0.0015, 0.02, "per-execution vision error, standard deviation per axis [m]"),
     "vision_max": Magnitude(0.006, 0.05, "total vision error, at most [m]"),
+    "vision_yaw_bias": Magnitude(0.5, 20.0, "calibration bias of each rect hole's estimated yaw, at most [deg]"),
+    "vision_yaw_sigma": Magnitude(0.5, 20.0, "per-execution error of a rect hole's estimated yaw, "
+                                  "standard deviation [deg]"),
+    "vision_yaw_max": Magnitude(2.0, 45.0, "total error of a rect hole's estimated yaw, at most [deg]"),
     "friction_min": Magnitude(0.2, 2.0, "friction coefficient of a hole, lower end of its range"),
     "friction_max": Magnitude(0.5, 2.0, "friction coefficient of a hole, upper end of its range"),
     "friction_jitter": Magnitude(0.03, 1.0, "per-execution change of a hole's friction coefficient, at most"),

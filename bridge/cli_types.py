@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any, NoReturn, TypeVar
 
 from bridge import BridgeError
+from bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED
 from bridge.inputs import shorten
 
 T = TypeVar("T")
@@ -98,9 +99,6 @@ def configure_logging(level: int | None = None) -> None:
         root.setLevel(level)
 
 
-EXIT_BROKEN_PIPE = 141
-"""Exit code when stdout's reader went away (``... | head -1``): 128 + SIGPIPE, what a
-shell reports for ``yes | head -1``, so ``set -o pipefail`` scripts see the usual code."""
 
 
 def one_line(message: object, limit: int = 2000) -> str:
@@ -109,34 +107,99 @@ def one_line(message: object, limit: int = 2000) -> str:
     return shorten(" ".join(str(message).split()), limit)
 
 
-def quiet_broken_pipe() -> int:
-    """After a BrokenPipeError on stdout: point stdout at devnull (so the interpreter's
-    final flush does not fail again) and return :data:`EXIT_BROKEN_PIPE` (the Python
-    documentation's recipe, "Note on SIGPIPE", with the shell's exit code)."""
+def _stdout_to_devnull() -> None:
+    """Point stdout's file descriptor at devnull, so the interpreter's final flush of
+    what is still buffered cannot fail again."""
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, sys.stdout.fileno())
     os.close(devnull)
+
+
+def quiet_broken_pipe() -> int:
+    """After a BrokenPipeError on stdout: point stdout at devnull and return
+    :data:`EXIT_BROKEN_PIPE` (the Python documentation's recipe, "Note on SIGPIPE", with
+    the shell's exit code)."""
+    _stdout_to_devnull()
     return EXIT_BROKEN_PIPE
+
+
+class StdoutError(Exception):
+    """Writing stdout failed for another reason than a closed pipe (``> /dev/full``, a full
+    disk, ``ulimit -f``)."""
+
+
+class _GuardedStdout:
+    """sys.stdout as is, except that a failed write or flush raises :class:`StdoutError`
+    (a BrokenPipeError stays one: a closed pipe is quiet, see :func:`run_command`)."""
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        return self._guarded(self._stream.write, text)
+
+    def flush(self) -> None:
+        self._guarded(self._stream.flush)
+
+    @staticmethod
+    def _guarded(function: Callable[..., Any], *args: Any) -> Any:
+        try:
+            return function(*args)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise StdoutError(f"stdout: cannot write ({exc.strerror or exc})") from None
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
 
 
 def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...]) -> int:
     """Run a command line's work and return its exit code: ``errors`` (bad input) become one
     line ``error: ...`` on stderr and exit 2; a closed stdout (``... | head -1``) stops
-    quietly with :data:`EXIT_BROKEN_PIPE`; Ctrl-C exits 130. Log records go to stderr as
-    one line each (:func:`configure_logging`)."""
+    quietly with :data:`EXIT_BROKEN_PIPE`; stdout that cannot be written (``> /dev/full``)
+    is ``error: stdout: cannot write (<reason>)``, exit 2; Ctrl-C exits 130. Log records
+    go to stderr as one line each (:func:`configure_logging`)."""
     configure_logging()
+    stdout = sys.stdout
+    if not isinstance(stdout, _GuardedStdout):
+        sys.stdout = _GuardedStdout(stdout)
     try:
         code = command()
-        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
+        sys.stdout.flush()  # a closed pipe or a full disk shows here, not in the interpreter's last flush
         return code
     except BrokenPipeError:
         return quiet_broken_pipe()
+    except StdoutError as exc:
+        _stdout_to_devnull()
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except errors as exc:
         print(f"error: {one_line(exc)}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    finally:
+        sys.stdout = stdout
+
+
+MAX_JOBS = 64
+"""``--jobs``: at most this many processes or cells at once."""
+
+
+def default_jobs() -> int:
+    """The machine's cores (those this process may use), at most :data:`MAX_JOBS`."""
+    return max(1, min(MAX_JOBS, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                      else os.cpu_count() or 1))
+
+
+def add_jobs_argument(parser: argparse._ActionsContainer, what: str) -> None:
+    """``--jobs N``: how many ``what`` run at once (default: the machine's cores). Results
+    do not depend on N (each unit of work has its own seed and its own process or cell)."""
+    parser.add_argument("--jobs", type=int_in(1, MAX_JOBS), default=default_jobs(), metavar="N",
+                        help=f"{what} at once (default: the machine's cores, here {default_jobs()}); "
+                             "the results do not depend on it")
 
 
 _INTEGER = re.compile(r"[+-]?[0-9]+")

@@ -3,7 +3,10 @@
 - :func:`write_atomic` writes a file through a temporary file in the same folder
   (write, flush, fsync, ``os.replace``, fsync of the folder): a reader sees the old
   content or the new, never a part; after a failure (full disk, no permission, missing
-  folder) the old file is unchanged and no temporary file is left behind.
+  folder) the old file is unchanged and no temporary file is left behind. A path that
+  names a character device or a FIFO (``/dev/null``, ``/dev/stdout``, a named pipe) is
+  written through, never replaced; a FIFO without a reader, a socket or a block device
+  is refused.
 - :func:`write_figure` renders a matplotlib figure into memory and writes it with
   :func:`write_atomic`.
 - :func:`check_writable` checks, before a long run, that a file which a library writes
@@ -17,8 +20,10 @@ operating system's reason, e.g. ``runs/x/learned.lp: cannot write (No space left
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import os
+import stat
 import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -51,6 +56,29 @@ def _fsync_folder(folder: Path) -> None:
         os.close(fd)
 
 
+def _write_through(path: Path, mode: int, payload: bytes) -> Path:
+    """Write ``payload`` into the special file ``path`` (of ``st_mode`` ``mode``) in place:
+    a character device or a FIFO with a reader; BridgeError for anything else."""
+    if not (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
+        kind = "a block device" if stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "a special file"
+        raise BridgeError(f"{path}: cannot write ({kind}; expected a regular file, a character device or a FIFO)")
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK)  # a FIFO without a reader fails at once (ENXIO)
+    except OSError as exc:
+        reason = "a FIFO with no reader" if exc.errno == errno.ENXIO and stat.S_ISFIFO(mode) else os_reason(exc)
+        raise BridgeError(f"{path}: cannot write ({reason})") from None
+    try:
+        os.set_blocking(fd, True)
+        view = memoryview(payload)
+        while view:
+            view = view[os.write(fd, view):]
+    except OSError as exc:
+        raise BridgeError(f"{path}: cannot write ({os_reason(exc)})") from None
+    finally:
+        os.close(fd)
+    return path
+
+
 def write_atomic(path: Path | str, data: bytes | str) -> Path:
     """Replace ``path`` by ``data`` (``str``: UTF-8) atomically and durably; returns the path.
 
@@ -60,9 +88,16 @@ def write_atomic(path: Path | str, data: bytes | str) -> Path:
     would give it, an existing one keeps its mode. Raises BridgeError ``<path>: cannot
     write (<reason>)`` on any OSError (missing folder, ``path`` a directory, no
     permission, full disk); the old file then stays whole and the temporary is removed.
+    A character device or a FIFO is written through in place (no atomicity to have), a
+    FIFO without a reader, a socket or a block device refused: a special file is never
+    replaced.
     """
     path = Path(path)
     payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    with contextlib.suppress(OSError):  # missing, or unreadable: the rename below reports it
+        mode = path.stat().st_mode
+        if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+            return _write_through(path, mode, payload)
     folder = path.parent
     temporary: str | None = None
     try:

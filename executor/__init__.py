@@ -2,7 +2,8 @@
 impedance arm, hole search, DMP insertion with admittance and phase stopping, failure
 detection (eqs. 6, 7 and the goal check) and the wiggle exception strategy.
 
-Entry points: :class:`executor.trial.Cell` (``run_trial``) and ``python -m executor.cli``.
+Entry points: :class:`executor.trial.Cell` (``run_trial``) and the ``executor`` subcommand
+of the command line (:mod:`executor.cli`).
 Layers, each importing only those before it: :mod:`executor.world` (geometry, PyBullet
 scene, arm), :mod:`executor.control` (impedance controller, admittance, detector, motion
 stepper), :mod:`executor.skills` (DMP, hole search, insertion, wiggle, teaching), the
@@ -14,7 +15,10 @@ and :mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`)
 """
 
 
-class ExecutorError(Exception):
+from bridge.errors import ToolError
+
+
+class ExecutorError(ToolError):
     """Base error of the executor: a bad part/hole id, a missing demonstration, bad data.
 
     The message names the bad value and what was expected; the command line prints

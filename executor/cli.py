@@ -1,4 +1,5 @@
-"""Command line of the simulated cell: ``teach``, ``trial``, ``export``, ``campaign``, ``serve``, ``margins``.
+"""Command line of the simulated cell: ``teach``, ``trial``, ``sizes``, ``export``, ``campaign``, ``serve``,
+``margins``.
 
 ``./run.sh executor trial --part p1 --hole r1 --trials 3 --json`` prints
 ``{"trials": [{"outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error",
@@ -14,11 +15,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from bridge import BridgeError
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path, run_command
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path
+from bridge.files import write_atomic
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
-from executor import ExecutorError
 
 MAX_TRIALS = 100_000
 """``trial --trials N``: at most this many trials (trial k uses seed+k)."""
@@ -102,6 +102,19 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     return 0
 
 
+def _sizes(args: argparse.Namespace) -> int:
+    """Print or write the sizes.lp of ``geometry.toml`` (:func:`executor.world.geometry.sizes_lp_text`)."""
+    from executor.world.geometry import sizes_lp_text
+
+    text = sizes_lp_text(args.assembly)
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        write_atomic(args.out, text)
+        print(f"wrote {args.out}")
+    return 0
+
+
 def _export(args: argparse.Namespace) -> int:
     from executor.assembly.export import export_cell
 
@@ -150,6 +163,11 @@ def build_parser() -> argparse.ArgumentParser:
     add_cell_arguments(trial)
     trial.set_defaults(func=_trial)
 
+    sizes = sub.add_parser("sizes", help="write the sizes.lp (which part fits which hole) that the geometry makes")
+    add_assembly_argument(sizes, purpose="the product whose fits are derived from geometry.toml")
+    sizes.add_argument("--out", metavar="FILE", type=Path, help="write it to FILE (default: print it)")
+    sizes.set_defaults(func=_sizes)
+
     export = sub.add_parser("export", help="write the assembling cell as URDF and meshes (arm, plate, every part)")
     add_assembly_argument(export, purpose="the product whose cell is written")
     export.add_argument("out", metavar="OUT", type=Path, help="folder to write cell.urdf and meshes/ into")
@@ -161,21 +179,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one subcommand; ExecutorError → one line ``error: ...`` on stderr and exit code 2;
-    a closed stdout (``... | head -1``) stops quietly with exit code 141."""
+    """Run one subcommand of the cell (the command line's ``executor`` subcommand, which
+    reports errors and exit codes)."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in _DELEGATED:
+        import importlib
 
-    def dispatch() -> int:
-        if argv and argv[0] in _DELEGATED:
-            import importlib
-
-            module, _help = _DELEGATED[argv[0]]
-            return int(importlib.import_module(module).main(argv[1:]) or 0)
-        args = build_parser().parse_args(argv)
-        return int(args.func(args) or 0)
-
-    return run_command(dispatch, (ExecutorError, BridgeError))
+        module, _help = _DELEGATED[argv[0]]
+        return int(importlib.import_module(module).main(argv[1:]) or 0)
+    args = build_parser().parse_args(argv)
+    return int(args.func(args) or 0)
 
 
-if __name__ == "__main__":
-    sys.exit(main())

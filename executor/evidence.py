@@ -75,10 +75,12 @@ class AttemptSetup:
     """The circumstances of one attempt, unknown to the robot: grasp offset [m] and tilt
     (rotation vector [rad]) of the part in the hand, vision error of the hole estimate
     [m], seed of the stochastic search, friction coefficient of the part in the hole
-    (None: the scene's own, 0.25).  Drawn by :class:`executor.world.perturbation.CellBias`."""
+    (None: the scene's own, 0.25), error of the hole's estimated yaw [rad] (0 but for a
+    rect hole).  Drawn by :class:`executor.world.perturbation.CellBias`."""
 
     grasp_offset: np.ndarray
     grasp_tilt: np.ndarray
     vision_error: np.ndarray
     search_seed: int = 0
     friction: float | None = None
+    vision_yaw: float = 0.0

@@ -24,7 +24,6 @@ from collections import defaultdict
 
 import msgspec
 
-from bridge import BridgeError
 from bridge.inputs import read_bytes
 from bridge.messages import Evidence, InsertRequest, Result, StepRequest
 from executor import ExecutorError
@@ -36,10 +35,7 @@ Answer = tuple[Result, Evidence | None, float]
 
 def read_answers(path: str) -> dict[tuple[str, str], list[Answer]]:
     """(part, hole) → its recorded answers in journal order; ExecutorError naming file:line."""
-    try:
-        data = read_bytes(path, "session journal")
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
+    data = read_bytes(path, "session journal")
     lines = data.split(b"\n")
     answers: dict[tuple[str, str], list[Answer]] = defaultdict(list)
     for number, line in enumerate(lines[:-1], start=1):  # lines[-1]: empty, or a torn last line

@@ -47,10 +47,9 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import rerun as rr
 
-from bridge import BridgeError
 from bridge.recording.compaction import compact_recording
 from bridge.recording.layout import APPLICATION_ID, cell_blueprint, cell_root
-from bridge.recording.sinks import NO_VIEWER, Viewer, open_stream
+from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 from executor import ExecutorError
 
 if TYPE_CHECKING:
@@ -145,8 +144,6 @@ def open_recording(recording_id: str, rrd_path: Path | None, viewer: Viewer = NO
     ``viewer``; ExecutorError ``<path>: cannot write (<reason>)`` when the file cannot be created."""
     try:
         return open_stream(application_id, recording_id, rrd_path, viewer)
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
     except RuntimeError as exc:  # the SDK's own check, e.g. a race with the one above
         raise ExecutorError(f"{rrd_path}: cannot write ({exc})") from None
 
@@ -350,13 +347,14 @@ class AttemptLogger:
                               columns=rr.Scalars.columns(scalars=[norm]))
 
     def close(self) -> None:
-        """Flush; if this logger created the stream, disconnect it (finishes the file) and
-        compact the file it wrote."""
-        self.rec.flush()
-        if self._owns_stream:
-            self.rec.disconnect()
-            if self._rrd_path is not None:
-                compact_recording(self._rrd_path)
+        """Flush; if this logger created the stream, finish it (BridgeError naming the file
+        if it could not be written) and compact the file it wrote."""
+        if not self._owns_stream:
+            self.rec.flush()
+            return
+        finish_stream(self.rec, self._rrd_path)
+        if self._rrd_path is not None:
+            compact_recording(self._rrd_path)
 
     # -- internals -----------------------------------------------------------------
 

@@ -426,17 +426,11 @@ def main(argv: Sequence[str]) -> int:
     """Serve until SIGTERM/SIGINT; exit code 2 on bad options or when another process
     serves this cell id (:mod:`executor.claim`)."""
     args = build_parser().parse_args(list(argv))
-    try:
-        cell_id = check_cell_id(args.cell)
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
+    cell_id = check_cell_id(args.cell)
     listen = cell_listen(args.listen, args.connect, args.zenoh_config)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    try:
-        session = open_session(listen, args.connect, args.zenoh_config)
-    except BridgeError as exc:
-        raise ExecutorError(str(exc)) from None
+    session = open_session(listen, args.connect, args.zenoh_config)
     claim: CellClaim | None = None
     backend: Backend | None = None
     try:

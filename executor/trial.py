@@ -30,10 +30,11 @@ from executor.control.motion import Motion
 from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from executor.rerun_arm import ArmRecorder
 from executor.skills.dmp import Skill, load_skill
-from executor.skills.insertion import insert_in_layer, rotvec_quat_xyzw
+from executor.skills.insertion import insert_in_layer, needs_yaw_compliance, rotvec_quat_xyzw
 from executor.skills.search import hole_search
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
-from executor.world.geometry import load_geometry, plate_mesh
+from executor.world.arm import Arm, aligned_yaw, tool_quat
+from executor.world.assets import current_assets
+from executor.world.geometry import load_geometry
 from executor.world.perturbation import CellBias, PerturbationModel
 from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
@@ -82,7 +83,7 @@ class Cell:
         self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
-            logger.log_scene_mesh("plate_mesh", plate_mesh(self.geometry), PLATE_MESH_COLOR)
+            logger.log_scene_mesh("plate_mesh", current_assets(self.geometry) / "plate.obj", PLATE_MESH_COLOR)
 
     def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
                     cell_seed: int = 0) -> None:
@@ -151,8 +152,9 @@ class Cell:
         )
 
     def draw_setup(self, rng: np.random.Generator, part: str, hole: str) -> AttemptSetup:
-        """The circumstances of one attempt: this cell's systematic errors plus random ones from ``rng``."""
-        return self.bias.draw(rng, self.geometry.parts[part].shape, hole)
+        """The circumstances of one attempt: this cell's systematic errors plus random ones
+        from ``rng`` (with a yaw error of the estimate for a rect hole)."""
+        return self.bias.draw(rng, self.geometry.parts[part].shape, hole, self.geometry.holes[hole].kind == "rect")
 
     def ilc_key(self, part: str, hole: str) -> str:
         """ILC corrections are kept per (part shape, hole) (docs/decisions.md)."""
@@ -173,7 +175,8 @@ class Cell:
         arm.set_grasp_error(setup.grasp_offset, rotvec_quat_xyzw(setup.grasp_tilt))
         surface = float(self.geometry.plate["top_z"])
         est_xy = np.array(hole_spec.position) + setup.vision_error
-        quat = TOOL_DOWN_QUAT_XYZW
+        yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + setup.vision_yaw)
+        quat = tool_quat(yaw)
         approach = np.array([est_xy[0], est_xy[1], surface + APPROACH_HEIGHT])
         arm.inverse_kinematics(approach, quat)
         motion.controller.reset()
@@ -186,7 +189,8 @@ class Cell:
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - float(self.geometry.gripper["grasp_depth"])
-        result = insert_in_layer(motion, skill, origin, detector, layer, lever, wiggle_enabled, correction)
+        result = insert_in_layer(motion, skill, origin, detector, layer, lever, wiggle_enabled, correction,
+                                 yaw=yaw, yaw_compliant=needs_yaw_compliance(spec.kind, hole_spec.kind))
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

@@ -5,13 +5,13 @@ child processes, and the runners of the command lines (as separate processes, li
 Fixtures (session-scoped but ``cli_env``, so hypothesis tests may use them too):
 
 - ``root`` → ``Path``: the repository root (also the constant ``ROOT``, for module-level paths);
-- ``run_cli(*args, cwd=None, input=None, timeout=120)``: ``python -m asp.cli ARGS``;
-- ``run_executor(*args, cwd=None, input=None, timeout=120)``: ``python -m executor ARGS``;
+- ``run_cli(*args, cwd=None, input=None, timeout=120)``: ``python -m assembly_constraints ARGS``;
+- ``run_executor(*args, cwd=None, input=None, timeout=120)``: the same with ``executor ARGS``;
 - ``run_python(module, *args, cwd=None, input=None, timeout=120)``: ``python -m MODULE ARGS``
   (e.g. ``clingo``);
 - ``run_session(*args, timeout=60)`` → ``dict``: ``session --backend truth --json ARGS`` (the
   ``TRUTH_SESSION`` arguments), which must exit 0; its JSON result;
-- ``cli_argv(*args)`` → ``list[str]``: the argv of ``python -m asp.cli ARGS``, for ``Popen``;
+- ``cli_argv(*args)`` → ``list[str]``: the argv of ``python -m assembly_constraints ARGS``, for ``Popen``;
 - ``cli_env`` → ``dict``: a fresh copy of the environment of every child process (``child_env()``).
 
 Each runner returns the ``subprocess.CompletedProcess`` (``capture_output=True, text=True``),
@@ -40,8 +40,7 @@ import pytest
 from asp.session.cells import CellProcess
 
 ROOT = Path(__file__).resolve().parent.parent
-CLI_MODULE = "asp.cli"  # ./run.sh SUBCOMMAND
-EXECUTOR_MODULE = "executor"  # ./run.sh executor SUBCOMMAND
+CLI_MODULE = "assembly_constraints"  # ./run.sh SUBCOMMAND: the one command line
 DEFAULT_TIMEOUT = 120.0  # [s] per command line run
 TRUTH_SESSION = ("session", "--backend", "truth", "--json")  # a learning session with truthful cells
 # Unset for the whole test run and its children: no viewer or GUI ever opens.
@@ -99,7 +98,7 @@ def run_cli() -> Runner:
 
 @pytest.fixture(scope="session")
 def run_executor() -> Runner:
-    return functools.partial(python_module, EXECUTOR_MODULE)
+    return functools.partial(python_module, CLI_MODULE, "executor")
 
 
 @pytest.fixture(scope="session")

@@ -1,9 +1,8 @@
 """A corpus of bad input for both command lines (repository level: it spans the packages).
 
 One row per case: ``(id, argv, setup, expected exit code, a word the message must hold)``.
-``argv`` starting with ``executor`` runs ``python -m executor``, ``bench executor`` runs
-``python -m executor.campaign.bench`` (as run.sh does), anything else ``python -m asp.cli``;
-both run as separate processes in ``tmp_path``. ``setup`` is None, a dict of input files
+``argv`` runs the one command line, ``python -m assembly_constraints`` (as ``./run.sh``
+does), as a separate process in ``tmp_path``. ``setup`` is None, a dict of input files
 (name → text or bytes) or a callable ``setup(tmp_path)``. Every bad input must give one
 line ``error: ...`` on stderr holding the word, the exit code, and never a traceback.
 
@@ -28,11 +27,12 @@ import pytest
 
 from asp.session.journal import MAX_JOURNAL_BYTES
 from bridge.assembly import load_assembly
-from bridge.cli_types import EXIT_BROKEN_PIPE
-from tests.conftest import ROOT, child_env, python_argv
+from bridge.errors import EXIT_BROKEN_PIPE
+from tests.conftest import CLI_MODULE, ROOT, child_env, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
 TRUTH = (str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"))
+TASKBOARD = ROOT / "data" / "taskboard"
 Setup = Callable[[Path], None] | dict[str, str | bytes] | None
 
 
@@ -58,6 +58,17 @@ def unreadable(name: str, source: Path | None = None, text: str = "") -> Callabl
     return setup
 
 
+def taskboard(**files: str) -> Callable[[Path], None]:
+    """Setup: a copy of data/taskboard in ``asm/`` (without its assets), with ``files`` replaced."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(TASKBOARD, tmp / "asm", ignore=shutil.ignore_patterns("assets"))
+        for name, content in files.items():
+            (tmp / "asm" / name).write_text(content)
+
+    return setup
+
+
 def assembly(**files: str | bytes | Callable[[Path], None]) -> Callable[[Path], None]:
     """Setup: a copy of data/cranfield in ``asm/`` (without assets), with ``files``
     replaced (text, bytes, or a setup run with the copy's parent folder)."""
@@ -73,6 +84,12 @@ def assembly(**files: str | bytes | Callable[[Path], None]) -> Callable[[Path], 
                 (tmp / "asm" / name).write_text(content)
 
     return setup
+
+
+def geometry(old: str, new: str) -> Callable[[Path], None]:
+    """Setup: the Cranfield copy of :func:`assembly` with ``old`` replaced by ``new`` in
+    its ``geometry.toml``."""
+    return assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(old, new, 1)})
 
 
 def plan_file(name: str, change: Callable[[list[dict]], object]) -> Callable[[Path], None]:
@@ -196,6 +213,35 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      assembly(**{"geometry.toml": bytes(range(256))}), 2, "geometry.toml"),
     ("trial-geometry-missing-keys", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"geometry.toml": "[plate]\ntop_z = 0.1\n"}), 2, "tile_size"),
+    ("trial-polygon-sides-huge", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry("polygon_sides = 24", "polygon_sides = 8000000"), 2,
+     "[plate] polygon_sides: expected an integer multiple of 8 in 8 .. 256, got 8000000"),
+    ("trial-size-string", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry("size = 0.0120           # diameter [m]", 'size = "12"'), 2, "[part_shapes.round_peg] size"),
+    ("trial-peg-half-a-metre", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry("size = 0.0187", "size = 0.5"), 2, "[part_shapes.shaft] size: expected a number in (0, 0.1] m"),
+    ("trial-kind-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of rect, round, square"),
+    ("teach-demo-hole-unknown", ("executor", "teach", "--assembly", "asm"),
+     geometry('demo_hole = "br"', 'demo_hole = "zz"'), 2, "[part_shapes.shaft] demo_hole"),
+    ("trial-geometry-rect-short-side-first", ("executor", "trial", "--part", "p3", "--hole", "s1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "square"\nsize = 0.0133', 'kind = "rect"\nsize = [0.010, 0.0133]', 1)}), 2, "a >= b"),
+    ("trial-geometry-unknown-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(
+         'kind = "round"', 'kind = "oval"', 1)}), 2, "oval"),
+    ("trial-part-shape-against-kind", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "square"', 1)}), 2, "kind"),
+    ("assembly-part-shape-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape"),
+    ("section-of-unlike-parts", ("executor", "trial", "--part", "rect8", "--hole", "slot8", "--assembly", "asm"),
+     taskboard(**{"assembly.toml": (TASKBOARD / "assembly.toml").read_text().replace(
+         'shape = "rect"\n', 'shape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
+    ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
+     assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
+         'role = "peg"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2, "section"),
     # learned facts: arity, ids, cycles, contradictions
     ("assign-arity", ("assign", "f.lp"), {"f.lp": "part(a). hole(r1). fits(a,r1,x).\n"}, 2, "fits/2"),
     ("plan-arity", ("plan", "f.lp"), {"f.lp": "part(a;b). must_precede(a,b,c).\n"}, 2, "must_precede/2"),
@@ -214,6 +260,11 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("assign-non-ascii", ("assign", "f.lp"), {"f.lp": "part(\u00e4). hole(r1).\n"}, 2, "outside a string"),
     ("learn-png-folder", ("precedence", "learn", "--assembly", "cranfield", "--png", "pictures"),
      lambda tmp: (tmp / "pictures").mkdir(), 2, ".png"),
+    # output paths that are special files: written through or refused, never replaced
+    ("learn-out-full-disk", ("precedence", "learn", "--assembly", "cranfield", "--out", "full"),
+     lambda tmp: (tmp / "full").symlink_to("/dev/full"), 2, "full: cannot write (No space left on device)"),
+    ("learn-out-fifo-no-reader", ("precedence", "learn", "--assembly", "cranfield", "--out", "pipe"),
+     lambda tmp: os.mkfifo(tmp / "pipe"), 2, "pipe: cannot write (a FIFO with no reader)"),
     # bounds
     ("learn-huge-step", ("precedence", "learn", "d.lp"), {"d.lp": "demo(1,1,bp). demo(1,2147483647,p1)."}, 2,
      "step"),
@@ -228,19 +279,19 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("serve-unknown-option", ("executor", "serve", "--bogus"), None, 2, "unrecognized"),
     ("serve-bad-cell-id", ("executor", "serve", "--cell", "C!"), None, 2, "cell id"),
     ("campaign-trials-zero", ("executor", "campaign", "--trials", "0"), None, 2, "--trials"),
-    ("campaign-workers-huge", ("executor", "campaign", "--workers", "1e3"), None, 2, "--workers"),
+    ("campaign-jobs-huge", ("executor", "campaign", "--jobs", "1e3"), None, 2, "--jobs"),
     ("margins-seed-negative", ("executor", "margins", "--seed", "-1"), None, 2, "--seed"),
     ("margins-trials-missing", ("executor", "margins", "--trials"), None, 2, "--trials"),
     ("bench-unknown", ("bench", "nosuch"), None, 2, "nosuch"),
     ("bench-sizes-list", ("bench", "sizes", "--sizes", "3,y"), None, 2, "--sizes"),
     ("bench-sizes-seeds-zero", ("bench", "sizes", "--noise", "0.1", "--seeds", "0"), None, 2, "--seeds"),
-    ("bench-dominance-seconds-nan", ("bench", "dominance", "--seconds", "nan"), None, 2, "--seconds"),
+    ("bench-dominance-time-limit-nan", ("bench", "dominance", "--time-limit", "nan"), None, 2, "--time-limit"),
     ("bench-dominance-sizes", ("bench", "dominance", "--sizes", "4y5"), None, 2, "--sizes"),
     ("bench-plan-parts-huge", ("bench", "plan", "--parts", "100"), None, 2, "--parts"),
     ("bench-precedence-repeat-zero", ("bench", "precedence", "--repeat", "0"), None, 2, "--repeat"),
     ("bench-session-product-one", ("bench", "session", "--product", "1"), None, 2, "--product"),
     ("bench-session-delay-negative", ("bench", "session", "--delay", "-1"), None, 2, "--delay"),
-    ("bench-executor-workers-zero", ("bench", "executor", "--workers", "0"), None, 2, "--workers"),
+    ("bench-executor-jobs-zero", ("bench", "executor", "--jobs", "0"), None, 2, "--jobs"),
     ("bench-executor-unknown-option", ("bench", "executor", "--bogus"), None, 2, "unrecognized"),
     # demonstrations that say where a part went (part@hole)
     ("learn-unknown-hole", ("precedence", "learn", "d.txt", "--assembly", "cranfield"),
@@ -347,18 +398,8 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
 ]
 
 
-def _module(argv: tuple[str, ...]) -> tuple[str, tuple[str, ...]]:
-    """The module run.sh runs for ``argv``, and its arguments."""
-    if argv[0] == "executor":
-        return "executor", argv[1:]
-    if argv[:2] == ("bench", "executor"):
-        return "executor.campaign.bench", argv[2:]
-    return "asp.cli", argv
-
-
 def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
-    module, args = _module(argv)
-    process = subprocess.Popen(python_argv(module, *args), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
+    process = subprocess.Popen(python_argv(CLI_MODULE, *argv), cwd=tmp, env=child_env(), stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         if head:

@@ -104,3 +104,15 @@ def test_no_python_folder_holds_more_than_twelve_modules() -> None:
     crowded = {str(f.relative_to(ROOT)): n for f in folders
                if (n := len([p for p in f.glob("*.py") if p.name != "__init__.py"])) > 12}
     assert crowded == {}
+
+
+def test_every_layer_error_shares_the_one_root() -> None:
+    """Callers catch one layer's errors or all of them; none is converted into another."""
+    from asp import PlannerError
+    from bridge import BridgeError
+    from bridge.errors import ToolError
+    from executor import ExecutorError
+
+    assert all(issubclass(error, ToolError) for error in (PlannerError, BridgeError, ExecutorError))
+    assert not any(issubclass(a, b) for a in (PlannerError, BridgeError, ExecutorError)
+                   for b in (PlannerError, BridgeError, ExecutorError) if a is not b)

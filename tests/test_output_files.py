@@ -7,13 +7,15 @@ limited by ``RLIMIT_FSIZE``) leaves the previous file whole and no temporary fil
 
 from __future__ import annotations
 
+import stat
+import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
 from tests._files_helpers import leftovers, run_with_file_limit
-from tests.conftest import CLI_MODULE, ROOT
+from tests.conftest import CLI_MODULE, ROOT, child_env
 
 CRANFIELD = ROOT / "data" / "cranfield"
 PLAN = ("plan", str(CRANFIELD / "precedence.lp"), str(CRANFIELD / "sizes.lp"), "--assembly", "cranfield")
@@ -23,7 +25,7 @@ COMMANDS = {  # command line writing one file to OUT
     "precedence learn --dot": ("precedence", "learn", "--assembly", "cranfield", "--dot", "OUT"),
     "precedence learn --png": ("precedence", "learn", "--assembly", "cranfield", "--png", "OUT"),
     "sizes learn --out": ("sizes", "learn", "--assembly", "cranfield", "--out", "OUT"),
-    "precedence evaluate --plot": ("precedence", "evaluate", "--assembly", "cranfield", "--m", "5",
+    "precedence evaluate --plot": ("precedence", "evaluate", "--assembly", "cranfield", "--demonstrations", "5",
                                    "--trials", "2", "--plot", "OUT"),
     "sizes evaluate --plot": ("sizes", "evaluate", "--assembly", "cranfield", "--policy", "best",
                               "--relabelings", "2", "--plot", "OUT"),
@@ -65,3 +67,47 @@ def test_full_disk_leaves_the_old_file_whole(tmp_path: Path, run_cli, command: s
     assert "Traceback" not in done.stderr
     assert out.read_bytes() == good
     assert leftovers(tmp_path) == [] and [p.name for p in tmp_path.iterdir()] == ["facts.lp"]
+
+
+@pytest.mark.parametrize("command", ["plan --travel-out", "precedence learn --out"])
+def test_a_device_is_written_through_never_replaced(tmp_path: Path, run_cli, command: str) -> None:
+    """``--out /dev/null`` discards the output (exit 0), ``/dev/full`` is a full disk (exit
+    2); both stay devices. Links to them, so that a writer that replaced the path would
+    replace the link, never the machine's ``/dev/null``."""
+    null, full = tmp_path / "null", tmp_path / "full"
+    null.symlink_to("/dev/null")
+    full.symlink_to("/dev/full")
+    done = run_cli(*_argv(command, null))
+    assert done.returncode == 0, done.stderr
+    done = run_cli(*_argv(command, full))
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.splitlines() == [f"error: {full}: cannot write (No space left on device)"]
+    assert null.resolve() == Path("/dev/null") and full.resolve() == Path("/dev/full")
+    assert stat.S_ISCHR(null.stat().st_mode) and stat.S_ISCHR(full.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full", "null"]
+
+
+@pytest.mark.parametrize("argv", [("precedence", "count", "--assembly", "cranfield"),
+                                  ("precedence", "enumerate", "--assembly", "cranfield"),
+                                  ("executor", "trial", "--part", "p1", "--hole", "r1")])
+def test_stdout_on_a_full_disk_is_one_line_exit_2(argv: tuple[str, ...]) -> None:
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "assembly_constraints", *argv], cwd=ROOT, env=child_env(),
+                              stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
+    lines = [line for line in done.stderr.splitlines() if not line.startswith("pybullet build time")]
+    assert done.returncode == 2, done.stderr
+    assert lines == ["error: stdout: cannot write (No space left on device)"], done.stderr
+
+
+@pytest.mark.slow
+def test_a_recording_that_hits_a_full_disk_is_one_line_exit_2(tmp_path: Path) -> None:
+    """A session whose planner.rrd outgrows the disk (60 kB files): the facts are written,
+    then ``error: RUN/planner.rrd: cannot write (...)`` is the last line (after the Rerun
+    SDK's own report of the failed write, with the system's reason), exit 2, no traceback."""
+    run = tmp_path / "run"
+    done = run_with_file_limit([sys.executable, "-m", CLI_MODULE, "session", "--backend", "truth", "--out", str(run)],
+                               limit=60_000, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.splitlines()[-1].startswith(f"error: {run / 'planner.rrd'}: cannot write ("), done.stderr
+    assert "Traceback" not in done.stderr
+    assert (run / "learned.lp").is_file()

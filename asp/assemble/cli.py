@@ -40,11 +40,10 @@ from asp.plans.plans import Plan, plans
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
+from bridge.errors import EXIT_UNSOLVABLE
 from bridge.inputs import read_bytes, shorten
 from bridge.session import add_endpoint_arguments
 
-EXIT_STOPPED = 3
-"""Exit code when the product cannot be finished (bad input exits with 2)."""
 MAX_PLAN_INDEX = 1000
 
 
@@ -183,7 +182,7 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
         try:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:
-            report, code = dict(exc.report, error=str(exc)), EXIT_STOPPED
+            report, code = dict(exc.report, error=str(exc)), EXIT_UNSOLVABLE
     report["wall_s"] = round(time.perf_counter() - started, 3)
     return report, code
 
@@ -192,6 +191,6 @@ def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     report, code = assemble(args)
     print(json.dumps(report) if args.json else _summary(report))
-    if code == EXIT_STOPPED:
+    if code == EXIT_UNSOLVABLE:
         print(f"error: {report['error']}", file=sys.stderr)
     return code

@@ -45,7 +45,7 @@ from asp.precedence.count import UniformSampler
 from asp.precedence.relation import Relation
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, finite_float, int_in
 
 ASSIGNMENT_LIMIT = 10_000
 """A plan's assignment is drawn among at most this many feasible ones (clingo's first)."""
@@ -153,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="plans to draw and assemble (default 20)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED - 10_000), default=0,
                         help="seed of the draw; plan k's cell has seed S + k (default 0)")
-    parser.add_argument("--jobs", type=int_in(1, 64), default=1, metavar="J", help="cells at once (default 1)")
+    add_jobs_argument(parser, "cells")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="the cells: sim (PyBullet, default) or truth (geometry rule, no simulation)")
     parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",

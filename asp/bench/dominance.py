@@ -43,7 +43,6 @@ bound of the Cranfield total of every policy never worse than systematic on ever
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -546,7 +545,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--unconstrained", action="store_true",
                         help="also the unconstrained optimum (3x4: ~30 s; 4x4: too long)")
     parser.add_argument("--cranfield", action="store_true", help="the Cranfield relaxation")
-    parser.add_argument("--seconds", type=finite_float(0, 1e6, low_open=True), default=60,
+    parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60,
                         help="time for the Cranfield lower bound (iterative deepening, default 60)")
     parser.add_argument("--all-biorders", action="store_true",
                         help="Cranfield total of policies never worse on all 5x5 biorders (long)")
@@ -563,7 +562,7 @@ def main(argv: list[str]) -> int:
         print(f"{row['size']:>5} {row['biorders']:>8} {row['systematic']:>10} {row['never_worse']:>11} "
               f"{row.get('optimum', '-'):>8} {row['states']:>8} {row['seconds']:>6}", flush=True)
     if args.cranfield:
-        report = cranfield_report(args.seconds)
+        report = cranfield_report(args.time_limit)
         system, found, least = report["systematic"], report["never_worse_policy"], report["least_total"]
         print(f"\nCranfield, {report['truths']} distinct truths (each 16 of the 14400 relabelings):")
         print(f"  systematic: total {system['total']}, mean {system['mean']}, max {system['max']}")
@@ -584,6 +583,3 @@ def main(argv: list[str]) -> int:
               f"{result}{bound['states']} states, {bound['seconds']} s)")
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import random
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -84,6 +83,3 @@ def main(argv: list[str]) -> int:
         print(f"cell {seed} ({args.parts} parts, {args.holes} holes): {cpu:.3f} s CPU ({outcome})")
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

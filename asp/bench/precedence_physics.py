@@ -41,7 +41,15 @@ from asp.precedence.relation import Pair, Relation, reduction, true_relation
 from asp.solve import fact, solve
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
+from bridge.cli_types import (
+    MAX_SEED,
+    ArgumentParser,
+    add_assembly_argument,
+    add_jobs_argument,
+    comma_list,
+    finite_float,
+    int_in,
+)
 from bridge.files import check_writable, write_atomic
 from bridge.progress import progress
 
@@ -209,7 +217,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="only these cover edges (default: all)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
                         help="seed of the cells' random grasp, vision and search errors (default 0)")
-    parser.add_argument("--jobs", type=int_in(1, 8), default=1, metavar="N", help="cells run at once (default 1)")
+    add_jobs_argument(parser, "cells")
     parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell [s] (default 300)")
     parser.add_argument("--json", action="store_true", help="print the JSON result instead of the table")

@@ -96,7 +96,7 @@ def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly:
     duplicates (see the module doc)."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     with tempfile.TemporaryDirectory() as tmp:
-        argv = [sys.executable, "-m", "asp.cli", "session", "--cells", str(cells), "--assembly", assembly,
+        argv = [sys.executable, "-m", "assembly_constraints", "session", "--cells", str(cells), "--assembly", assembly,
                 "--policy", policy, "--out", str(Path(tmp) / "run"), "--json",
                 "--backend", backend, "--delay", str(delay_s)]
         t0 = time.perf_counter()

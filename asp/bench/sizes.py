@@ -13,6 +13,14 @@ noise seed per session, as ``sizes evaluate --noise P --confirm K --relabelings 
 the share of sessions that learn a wrong relation and the experiments per session
 (mean, median; every physical experiment, re-tests included).
 
+With ``--products A,...`` it counts experiments instead: for each product (a shipped
+assembly or a folder with ``sizes.lp``) and policy, the experiments a session needs
+under the product's size model (``--model`` overrides it; ``random``: the mean over
+``--seeds`` seeds), next to |parts| × |holes| (trying every pair) and the information
+bound of the model: log2 of the number of relations it allows (a policy needs at least
+that many experiments on average over relations drawn uniformly, each answer being one
+bit).
+
 With ``--demos FILE`` it measures what demonstrations that say where each part went
 (``p1@r1``) save: for each policy, ``--seeds`` N sessions on Cranfield, session i on a
 random relabeling (index order of parts and holes, seed ``--seed`` + i, also the
@@ -31,9 +39,11 @@ import time
 
 import numpy as np
 
+from asp import PlannerError
 from asp.sizes.cli import demonstrated_fits
 from asp.sizes.evaluate import evaluate_policy
 from asp.sizes.learner import SizeLearner, learn_sizes
+from asp.sizes.models import MODELS, model_for
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import get_policy
 from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, int_in, number_in, strict_float, strict_int
@@ -110,6 +120,33 @@ def demos_rows(demos: str, policies: list[str], seeds: int, seed: int) -> list[d
     return rows
 
 
+def product_rows(products: list[str], policies: list[str], model: str | None, seeds: int, seed: int) -> list[dict]:
+    """Experiments per policy for each product, with |parts| × |holes| and the bound [bit]."""
+    rows = []
+    for product in products:
+        truth = TruthOracle.from_assembly(product)
+        size_model = model_for(truth.parts, model, truth.declared_model, truth.declared_sections)
+        row: dict = {"product": product, "model": size_model.name, "parts": len(truth.parts),
+                     "holes": len(truth.holes), "pairs": len(truth.parts) * len(truth.holes),
+                     "bound_bits": round(size_model.information_bits(len(truth.holes)), 2)}
+        for policy in policies:
+            runs = range(seed, seed + (seeds if not get_policy(policy).deterministic else 1))
+            results = [learn_sizes(truth.parts, truth.holes, truth, policy, case, model=size_model) for case in runs]
+            if any(r.knowledge.fits != frozenset(truth.fits) for r in results):
+                raise PlannerError(f"bench sizes: policy {policy} learned a wrong relation of {product}")
+            row[policy] = round(statistics.mean(r.count for r in results), 2)
+        rows.append(row)
+    return rows
+
+
+def _print_products(rows: list[dict], policies: list[str]) -> None:
+    print(f"{'product':>12} {'model':>9} {'parts x holes':>13} {'bound[bit]':>10} "
+          + " ".join(f"{p:>10}" for p in policies))
+    for r in rows:
+        print(f"{r['product']:>12} {r['model']:>9} {str(r['parts']) + ' x ' + str(r['holes']):>13} "
+              f"{r['bound_bits']:>10.2f} " + " ".join(f"{r[p]:>10}" for p in policies))
+
+
 def _print_demos(rows: list[dict]) -> None:
     print(f"{'policy':>11} {'sessions':>8} {'fits shown':>10} {'mean without':>12} {'mean with':>9} "
           f"{'median without':>14} {'median with':>11} {'saved (mean)':>12}")
@@ -151,10 +188,22 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--demos", metavar="FILE",
                         help="measure the experiments saved by the fits these demonstrations show (p1@r1) "
                              "instead of timing (Cranfield; with --seeds, --policies)")
+    parser.add_argument("--products", type=comma_list(str, "assembly names or folders"), metavar="A,...",
+                        help="count experiments per policy on these products instead of timing "
+                             "(with --policies, --model, --seeds)")
+    parser.add_argument("--model", choices=MODELS, default=None,
+                        help="with --products: the size model (default: each product's own)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
     for name in args.policies:
         get_policy(name)
+    if args.products:
+        counted = product_rows(args.products, args.policies, args.model, args.seeds, args.seed)
+        if args.json:
+            print(json.dumps({"products": counted}))
+        else:
+            _print_products(counted, args.policies)
+        return 0
     if args.demos:
         saved = demos_rows(args.demos, args.policies, args.seeds, args.seed)
         if args.json:

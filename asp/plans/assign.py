@@ -16,8 +16,10 @@ placed without a hole.
 - :func:`feasible_assignment`: the greedy one, or ASP's first when greedy gets stuck on
   sizes that are not a biorder although an assignment exists (``assign`` prints this).
 
-An assembly without an assignment raises :class:`UnsolvableAssembly` naming the part
-that gets no hole.
+An assembly without an assignment raises :class:`UnsolvableAssembly` naming a set of
+parts that fit fewer holes than they are (Hall's condition; :func:`hall_violation`),
+found from a maximum matching; "not solvable" is never said while a matching of every
+part exists.
 """
 
 from __future__ import annotations
@@ -37,11 +39,14 @@ Assignment = dict[str, str]
 
 
 class UnsolvableAssembly(PlannerError):
-    """No feasible hole assignment; ``part`` is the part that gets no hole."""
+    """No feasible hole assignment. ``parts`` are parts that together fit fewer holes
+    than they are (Hall's condition fails for them; the witness a maximum matching
+    gives); ``part`` is the first of them."""
 
-    def __init__(self, part: str, message: str) -> None:
+    def __init__(self, parts: Sequence[str], message: str) -> None:
         super().__init__(message)
-        self.part = part
+        self.parts = tuple(parts)
+        self.part = self.parts[0]
 
 
 @dataclass(frozen=True)
@@ -132,7 +137,7 @@ def greedy_assignment(facts: LearnedFacts) -> Assignment:
     for part in biggest_first:
         free = [hole for hole in holes_of[part] if hole not in taken_by]
         if not free:
-            raise UnsolvableAssembly(part, _no_hole_message(part, holes_of[part], taken_by))
+            raise UnsolvableAssembly([part], _no_hole_message(part, holes_of[part], taken_by))
         hole = min(free, key=lambda h: (parts_in[h], h))
         assignment[part] = hole
         taken_by[hole] = part
@@ -149,6 +154,53 @@ def _no_hole_message(part: str, fitting: list[str], taken_by: dict[str, str]) ->
     )
 
 
+def maximum_matching(facts: LearnedFacts) -> Assignment:
+    """A largest set of parts with distinct holes they fit (augmenting paths, Kuhn's
+    algorithm; parts in id order, holes in the facts' order)."""
+    holes_of = {part: facts.holes_of(part) for part in sorted(facts.needs_hole)}
+    owner: dict[str, str] = {}
+
+    def augment(part: str, seen: set[str]) -> bool:
+        for hole in holes_of[part]:
+            if hole not in seen:
+                seen.add(hole)
+                if hole not in owner or augment(owner[hole], seen):
+                    owner[hole] = part
+                    return True
+        return False
+
+    for part in holes_of:
+        augment(part, set())
+    return {part: hole for hole, part in owner.items()}
+
+
+def hall_violation(facts: LearnedFacts, matching: Assignment) -> tuple[list[str], list[str]]:
+    """For a maximum ``matching`` that leaves a part out: parts S and the holes N(S) they
+    fit, with |N(S)| < |S| (König: the parts reachable from an unmatched part along
+    alternating paths; every hole they reach is matched, to another part of S)."""
+    unmatched = sorted(p for p in facts.needs_hole if p not in matching)
+    owner = {hole: part for part, hole in matching.items()}
+    parts, holes, frontier = {unmatched[0]}, set(), [unmatched[0]]
+    while frontier:
+        for hole in facts.holes_of(frontier.pop()):
+            if hole not in holes:
+                holes.add(hole)
+                if owner[hole] not in parts:
+                    parts.add(owner[hole])
+                    frontier.append(owner[hole])
+    return sorted(parts), [h for h in facts.holes if h in holes]
+
+
+def _unsolvable(facts: LearnedFacts, matching: Assignment) -> UnsolvableAssembly:
+    """The error for facts whose maximum ``matching`` leaves a part without a hole."""
+    parts, holes = hall_violation(facts, matching)
+    if not holes:
+        return UnsolvableAssembly(parts, f"the assembly is not solvable: part {parts[0]} fits no hole")
+    return UnsolvableAssembly(parts, f"the assembly is not solvable: parts {' '.join(parts)} fit only "
+                                     f"{len(holes)} hole(s) between them ({' '.join(holes)}): fewer holes "
+                                     "than parts")
+
+
 def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
     """Up to ``limit`` (0 = all) assignments of ``assignments.lp``, in clingo's order."""
     found: list[Assignment] = []
@@ -160,28 +212,31 @@ def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
     return found
 
 
+def _require_complete_matching(facts: LearnedFacts) -> None:
+    """UnsolvableAssembly naming a Hall violator when no complete assignment exists."""
+    matching = maximum_matching(facts)
+    if len(matching) < len(facts.needs_hole):
+        raise _unsolvable(facts, matching)
+
+
 def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:
     """Every feasible assignment (at most ``limit``, 0 = all), sorted.
 
-    UnsolvableAssembly naming the part without a hole when there is none.
+    UnsolvableAssembly naming parts with fewer holes than parts when there is none.
     """
-    found = _solve_assignments(facts, limit)
-    if not found:
-        # No assignment at all: the greedy one fails too and names the part.
-        return [greedy_assignment(facts)]
-    return sorted(found, key=lambda a: sorted(a.items()))
+    _require_complete_matching(facts)
+    return sorted(_solve_assignments(facts, limit), key=lambda a: sorted(a.items()))
 
 
 def feasible_assignment(facts: LearnedFacts) -> Assignment:
-    """The greedy assignment; when greedy gets stuck although an assignment exists (the
-    sizes are not a biorder, e.g. a hand-written fits/2 table), the first one ASP finds.
+    """The paper's greedy assignment; when greedy gets stuck although an assignment
+    exists (the relation is not one biorder: parts of several cross-sections, a
+    hand-written fits/2 table), the first one ASP finds.
 
-    UnsolvableAssembly (naming the part greedy could not place) only when none exists.
+    UnsolvableAssembly naming parts with fewer holes than parts only when none exists.
     """
     try:
         return greedy_assignment(facts)
     except UnsolvableAssembly:
-        found = _solve_assignments(facts, 1)
-        if not found:
-            raise
-        return found[0]
+        _require_complete_matching(facts)
+        return _solve_assignments(facts, 1)[0]

@@ -27,9 +27,7 @@ from asp.plans.plans import HOME, Plan, plans, travel_facts
 from asp.solve import write_facts
 from bridge.assembly import MAX_COORDINATE, load_assembly
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, int_in
-
-EXIT_UNSOLVABLE = 3
-"""Exit code of a valid but unsolvable assembly (bad input exits with 2)."""
+from bridge.errors import EXIT_UNSOLVABLE
 
 MAX_PLANS = 1_000_000
 """``plan -n K``: at most this many plans (0 = all)."""
@@ -51,7 +49,7 @@ def report_unsolvable(exc: UnsolvableAssembly, key: str, as_json: bool) -> int:
     """Print why the assembly is unsolvable (stderr; JSON with an empty ``key`` list)."""
     print(f"error: {exc}", file=sys.stderr)
     if as_json:
-        print(json.dumps({key: [], "error": str(exc), "part": exc.part}))
+        print(json.dumps({key: [], "error": str(exc), "part": exc.part, "parts": list(exc.parts)}))
     return EXIT_UNSOLVABLE
 
 
@@ -92,8 +90,8 @@ def plan_main(argv: list[str]) -> int:
         "must_precede, each part that needs a hole in a distinct hole it fits. "
         f"Exit {EXIT_UNSOLVABLE}: the assembly is not solvable.",
     )
-    parser.add_argument("-n", type=int_in(0, MAX_PLANS), default=1, metavar="K",
-                        help="how many plans (0 = all; default 1)")
+    parser.add_argument("-n", "--plans", dest="n", type=int_in(0, MAX_PLANS), default=1, metavar="K",
+                        help="how many plans (0 = all; default 1; as session --plans)")
     parser.add_argument("--optimal", action="store_true",
                         help="plans of least total tool travel [mm] (needs --assembly)")
     add_assembly_argument(parser, None, purpose="gives the positions for --optimal")

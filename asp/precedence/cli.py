@@ -20,11 +20,13 @@ from asp.precedence.relation import Relation, load_relation, precedence_facts, r
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
 from bridge.cli_types import (
+    MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
     comma_list,
-    integer,
+    int_in,
     non_negative_int,
+    number_in,
     png_path,
     strict_int,
 )
@@ -43,7 +45,7 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--out", help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
     learn.add_argument("--dot", help="write the transitive-reduction graph as Graphviz DOT")
     learn.add_argument("--png", type=png_path, help="draw the relation to a PNG file (FILE.png)")
-    learn.add_argument("--min-support", type=integer, default=1, metavar="K",
+    learn.add_argument("--min-support", type=int_in(1, 10**6), default=1, metavar="K",
                        help="drop a constraint only when >= K demonstrations contradict it "
                             "(default 1: plain intersection)")
     learn.add_argument("--evidence", action="store_true",
@@ -63,14 +65,15 @@ def _parser() -> argparse.ArgumentParser:
             sub.add_argument("--limit", type=non_negative_int, help="stop after this many sequences")
         if name == "sample":
             sub.add_argument("-n", type=non_negative_int, default=1, help="number of sequences (default 1)")
-            sub.add_argument("--seed", type=integer, default=0, help="random seed (default 0)")
+            sub.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="random seed (default 0)")
 
     evaluate = commands.add_parser("evaluate", help="the paper's evaluation (Figs. 12/13), or --guided demonstration")
     add_assembly_argument(evaluate, None, required=True, purpose="one with true constraints (precedence.lp)")
-    evaluate.add_argument("--m", default="5,7,10,15,20,30", type=comma_list(strict_int, "integers such as 5,7,10"),
-                          help="numbers of demonstrations, comma separated")
-    evaluate.add_argument("--trials", type=integer, default=1000, help="trials per m (default 1000)")
-    evaluate.add_argument("--seed", type=integer, default=0, help="random seed (default 0)")
+    evaluate.add_argument("--demonstrations", default="5,7,10,15,20,30", metavar="M,...",
+                          type=comma_list(number_in(strict_int, 1, 10**6), "positive integers such as 5,7,10"),
+                          help="numbers m of demonstrations per trial, comma separated (default 5,7,10,15,20,30)")
+    evaluate.add_argument("--trials", type=int_in(1, 10**8), default=1000, help="trials per m (default 1000)")
+    evaluate.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="random seed (default 0)")
     evaluate.add_argument("--generator", choices=sorted(GENERATORS), default="uniform",
                           help="random feasible sequences: uniform over all (the paper's; default) "
                                "or stepwise (a placeable part uniformly each step)")
@@ -84,7 +87,7 @@ def _parser() -> argparse.ArgumentParser:
                          help="demonstrations so far, made following earlier suggestions "
                               "(none: the first suggestion; needs --assembly)")
     add_assembly_argument(suggest, None, purpose="gives the parts and the default demonstrations")
-    suggest.add_argument("--seed", type=integer, default=0, help="seed of the tie-breaking (default 0)")
+    suggest.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the tie-breaking (default 0)")
     suggest.add_argument("--json", action="store_true", help="print JSON {suggestion, undecided}")
     return parser
 
@@ -166,7 +169,7 @@ def _evaluate(args: argparse.Namespace) -> None:
     else:
         from asp.precedence.evaluate import evaluate, plot
 
-        result = evaluate(truth, args.m, args.trials, args.seed, args.generator)
+        result = evaluate(truth, args.demonstrations, args.trials, args.seed, args.generator)
         if args.plot:
             plot(result, args.plot)
         if not args.json:

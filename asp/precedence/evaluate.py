@@ -43,7 +43,7 @@ def evaluate(
     """``{"total": N, "generator": g, "results": [{"m", "mean", "p_all", "p_more_than_half", "histogram"}]}``."""
 
     if trials < 1 or any(m < 1 for m in ms):
-        raise PlannerError(f"--trials {trials} --m {','.join(map(str, ms))}: expected positive integers")
+        raise PlannerError(f"--trials {trials} --demonstrations {','.join(map(str, ms))}: expected positive integers")
     if generator not in GENERATORS:
         raise PlannerError(f"--generator {generator}: expected one of {', '.join(GENERATORS)}")
     batches = ExtensionBatches(truth)

@@ -111,7 +111,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
     resumed session's cell starts from them); ``block_holes``: holes with an obstacle;
     ``cell_options``: the sim cell's execution layer and uncertainty
     (:func:`bridge.cell_options.cell_argv`), ``cell_seed``: the seed of its systematic errors."""
-    argv = [sys.executable, "-m", "executor", "serve", "--cell", cell_id,
+    argv = [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]
     argv += [arg for ep in connect for arg in ("--connect", ep)]

@@ -30,7 +30,7 @@ from asp.precedence.relation import Relation, reduction
 from asp.sizes.knowledge import Knowledge
 from bridge.recording.compaction import compact_recording
 from bridge.recording.layout import APPLICATION_ID, cell_blueprint, planner_views
-from bridge.recording.sinks import NO_VIEWER, Viewer, open_stream
+from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]
@@ -77,7 +77,6 @@ class PlannerLog:
                      static=True)
 
     def close(self) -> None:
-        """Finish the file and compact it."""
-        self.rec.flush()
-        self.rec.disconnect()
+        """Finish the file and compact it; BridgeError naming it if it could not be written."""
+        finish_stream(self.rec, self.rrd)
         compact_recording(self.rrd)

@@ -9,7 +9,7 @@
    none of whose outcomes can entail another's (:func:`_learn_sizes`,
    :mod:`asp.session.oracle`); every finished experiment is journaled (fsynced) before
    the learner uses it;
-4. assigns holes (greedy) and computes complete plans, each run through the checker;
+4. assigns holes (the paper's greedy rule, else a matching) and computes complete plans, each run through the checker;
 5. writes ``RUN/learned.lp`` (the project's facts vocabulary), ``RUN/assignment.lp``,
    ``RUN/session.json``, ``RUN/journal.jsonl`` and the Rerun recordings ``RUN/*.rrd``
    (planner and cells in one recording id), and prints a summary (``--json``: the
@@ -41,7 +41,7 @@ from pathlib import Path
 import zenoh
 
 from asp import PlannerError
-from asp.plans.assign import greedy_assignment, load_learned_facts
+from asp.plans.assign import feasible_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import demo_facts, load_demos
 from asp.precedence.learn import learn_must_precede
@@ -51,7 +51,9 @@ from asp.session.folder import RunLock, lock_run_folder
 from asp.session.journal import JOURNAL_NAME, Journal
 from asp.session.log import PlannerLog
 from asp.session.oracle import ZenohOracle
+from asp.sizes.cli import add_model_option
 from asp.sizes.learner import MAX_CONFIRM, SizeLearner, SizeLearningResult
+from asp.sizes.models import MODELS, SizeModel, model_for
 from asp.sizes.oracle import TruthOracle
 from asp.sizes.policies import policy_names
 from asp.solve import encoding, fact, write_facts
@@ -60,6 +62,7 @@ from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_cell_arguments, cell_argv, parse_cell_argv
 from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.client import CellDirectory, CellPool
+from bridge.errors import EXIT_UNSOLVABLE
 from bridge.files import make_folder, write_atomic
 from bridge.inputs import read_bytes, shorten
 from bridge.keys import check_cell_id
@@ -72,8 +75,6 @@ MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
 MAX_CELLS = 64
 """--cells: at most this many cell co-processes."""
-EXIT_STOPPED = 3
-"""Exit code when ``--assemble`` could not finish the product."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -86,6 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--policy", default="best", choices=policy_names(),
                         help="experiment selection policy (default best: fewest experiments)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the policy and the trials")
+    add_model_option(parser)
     parser.add_argument("--confirm", type=int_in(0, MAX_CONFIRM), default=0, metavar="K",
                         help="re-test each essential experiment until its result leads by K+1 answers "
                              "(default 0: trust the cell's answer; see sizes learn --confirm)")
@@ -143,7 +145,8 @@ def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock, bool]:
         lock.release()
         raise PlannerError(f"--out {run}: already holds a session (its journal); "
                            f"use --resume {run} or another folder")
-    settings = {"assembly": args.assembly, "policy": args.policy, "seed": args.seed, "confirm": args.confirm,
+    settings = {"assembly": args.assembly, "policy": args.policy, "model": args.model, "seed": args.seed,
+                "confirm": args.confirm,
                 "recording_id": str(uuid.uuid4()), "starts": 1, "status": "running", "cell_options": cell_argv(args)}
     if args.demos is not None:  # absolute: a resume may run from another folder
         settings["demos"] = str(args.demos.absolute())
@@ -171,7 +174,8 @@ _RECORDING_ID = re.compile(rf"[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}")
 
 _SETTING_TYPES: dict[str, tuple[type, bool]] = {
     "assembly": (str, True), "policy": (str, True), "seed": (int, True), "recording_id": (str, True),
-    "confirm": (int, False), "starts": (int, False), "demos": (str, False), "cell_options": (list, False)}
+    "confirm": (int, False), "starts": (int, False), "demos": (str, False), "cell_options": (list, False),
+    "model": (str, False)}
 """The settings a resumed session reads back: key → (type, required)."""
 
 
@@ -186,7 +190,7 @@ def _resume_settings(path: Path) -> dict:
     if not isinstance(settings, dict):
         raise PlannerError(f"{path}: a JSON {type(settings).__name__}; expected an object with the session's settings")
     for key, (kind, required) in _SETTING_TYPES.items():
-        if key not in settings and not required:
+        if (key not in settings or (key == "model" and settings[key] is None)) and not required:
             continue
         value = settings.get(key)
         if not isinstance(value, kind) or isinstance(value, bool):
@@ -194,6 +198,7 @@ def _resume_settings(path: Path) -> dict:
             expected = {int: "an integer", str: "a string", list: "a list of the cell's options"}[kind]
             raise PlannerError(f'{path}: "{key}": expected {expected}, got {got}')
     checks = [("policy", settings["policy"] in policy_names(), f"one of {', '.join(policy_names())}"),
+              ("model", settings.get("model") in (None, *MODELS), f"null or one of {', '.join(MODELS)}"),
               ("seed", 0 <= settings["seed"] <= MAX_SEED, f"an integer from 0 to {MAX_SEED}"),
               ("confirm", 0 <= settings.get("confirm", 0) <= MAX_CONFIRM, f"an integer from 0 to {MAX_CONFIRM}"),
               ("starts", 1 <= settings.get("starts", 1) < MAX_STARTS,
@@ -217,14 +222,20 @@ def _save(run: Path, settings: dict) -> None:
     write_atomic(run / SETTINGS, json.dumps(settings, indent=2) + "\n")
 
 
-def _sizes_domain(assembly: Assembly) -> tuple[list[str], list[str], TruthOracle | None]:
+def _sizes_domain(assembly: Assembly, requested_model: str | None
+                  ) -> tuple[list[str], list[str], TruthOracle | None, SizeModel]:
+    """Parts and holes to learn, the truth (``sizes.lp``, if the product has one) and the
+    size model of the run (refused before any cell starts when it is unsound for the product)."""
     if assembly.has_file("sizes.lp"):
-        truth = TruthOracle.from_assembly(str(assembly.folder))
-        return list(truth.parts), list(truth.holes), truth
-    pegs = [p.id for p in assembly.parts if p.role == "peg"]
-    if not pegs or not assembly.holes:
-        raise PlannerError(f"assembly '{assembly.name}': no sizes.lp and no pegs/holes to learn")
-    return pegs, assembly.hole_ids, None
+        known = TruthOracle.from_assembly(str(assembly.folder))
+        truth: TruthOracle | None = known
+        parts, holes = list(known.parts), list(known.holes)
+    else:
+        truth, parts, holes = None, [p.id for p in assembly.parts if p.role == "peg"], assembly.hole_ids
+        if not parts or not holes:
+            raise PlannerError(f"assembly '{assembly.name}': no sizes.lp and no pegs/holes to learn")
+    model = model_for(parts, requested_model, assembly.size_model, assembly.sections())
+    return parts, holes, truth, model
 
 
 def _endpoints(args: argparse.Namespace) -> tuple[list[str], list[str]]:
@@ -277,9 +288,11 @@ def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
     return list(dict.fromkeys(atoms))
 
 
-def _learned_header(assembly: Assembly, run: Path) -> str:
-    """The comment atop ``learned.lp``: where it comes from and what its ids name."""
-    lines = [f"Learned by a session on {assembly.name} ({run}).", "Parts:"]
+def _learned_header(assembly: Assembly, run: Path, sizes: SizeLearningResult) -> str:
+    """The comment atop ``learned.lp``: where it comes from, what it assumes, what its ids name."""
+    lines = [f"Learned by a session on {assembly.name} ({run}).", f"Assumes: {sizes.model.assumption()}."]
+    lines += [f"Model changed: {change}." for change in sizes.model_changes]
+    lines += ["Parts:"]
     lines += [f"  {part.id}: {part.name}" for part in assembly.parts]
     lines += ["Holes:", *(f"  {hole.id}: {hole.name}" for hole in assembly.holes)]
     lines += ["must_precede(A,B): A before B; fits(P,H) / no_fit(P,H): part P goes / does not go into hole H."]
@@ -306,7 +319,7 @@ def _versus_truth(truth: TruthOracle | None, required: set[tuple[str, str]] | No
 
 def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
     facts = load_learned_facts([learned])
-    assignment = greedy_assignment(facts)
+    assignment = feasible_assignment(facts)
     found = plans(facts, n=count)
     for plan in found:
         errors = check_plan(facts, plan.steps)
@@ -352,12 +365,13 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     """:func:`run_session` in the locked run folder ``run``; ``started``: its
     ``time.perf_counter()`` [s] at the start."""
     assembly = load_assembly(settings["assembly"])
-    parts, holes, truth = _sizes_domain(assembly)
+    parts, holes, truth, model = _sizes_domain(assembly, settings.get("model"))
+    LOG.info("assumes: %s", model.assumption())
     # Every input file is read before any cell starts: bad input fails fast.
     demos = load_demos(settings.get("demos") or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
     relation = learn_must_precede(demos)
     learner = SizeLearner(parts, holes, settings["policy"], settings["seed"],
-                          confirm=int(settings.get("confirm", 0)), demonstrated=demos.placements())
+                          confirm=int(settings.get("confirm", 0)), demonstrated=demos.placements(), model=model)
     required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
     run_id = re.sub(r"[^A-Za-z0-9_-]", "-", settings["recording_id"])
     listen, connect = _endpoints(args)
@@ -411,11 +425,14 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
                 LOG.warning("%s", incident)
         timings["learned_s"] = time.perf_counter() - started
         learned = run / "learned.lp"
+        for change in sizes.model_changes:
+            LOG.warning("model changed: %s", change)
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
-                    header=_learned_header(assembly, run))
+                    header=_learned_header(assembly, run, sizes))
         assignment, found = _plans(learned, args.plans)
         write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
-                    header="The greedy hole assignment (paper 2.2) of learned.lp.")
+                    header="A hole assignment of learned.lp (the paper's greedy one when it finds one, "
+                           "else a matching; paper 2.2).")
         log.assignment(assignment)
         assembly_report = (_assemble(session, cell_ids, learned, found[0], settings["seed"], args)
                            if args.assemble else None)
@@ -430,6 +447,9 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         "must_precede": [list(pair) for pair in must_precede],
         "plans": [plan.as_json() for plan in found],
         "matches_truth": matches,
+        "model": sizes.model.name,
+        "assumption": sizes.model.assumption(),
+        "model_changes": list(sizes.model_changes),
         "demonstrated": [list(pair) for pair in sizes.demonstrated],
     }
     settings.update(result, status="done", truth=versus, assignment=assignment, cells=cell_ids,
@@ -475,6 +495,8 @@ def _summary(result: dict, run: Path) -> str:
         "fits: " + " ".join(f"{p}->{h}" for p, h in result["fits"])
         + (f" (started from {len(result['demonstrated'])} seen in the demonstrations)"
            if result["demonstrated"] else ""),
+        f"assumes: {result['assumption']}",
+        *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
         "assignment: " + " ".join(f"{p}->{h}" for p, h in settings["assignment"].items()),
         f"plan 1 of {len(result['plans'])}: {plan}",
@@ -496,15 +518,12 @@ def _summary(result: dict, run: Path) -> str:
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     viewer = viewer_of(args)
-    try:
-        with hosted_viewer(viewer) as live:
-            result = run_session(args, live)
-            print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
-            keep_serving(viewer)
-    except BridgeError as exc:
-        raise PlannerError(str(exc)) from None
+    with hosted_viewer(viewer) as live:
+        result = run_session(args, live)
+        print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
+        keep_serving(viewer)
     stopped = result.get("assembly", {}).get("error")
     if stopped:
         LOG.error("%s", stopped)
-        return EXIT_STOPPED
+        return EXIT_UNSOLVABLE
     return 0

@@ -2,9 +2,11 @@
 
 With sizes on one line (paper 2.2, last paragraph) the relations still possible after
 some experiments are exactly the biorders that contain every known fit and no known
-no-fit. Each gets the prior weight ``(∏ k!)**ALPHA`` over its classes of k identical
-parts (rows) and k identical holes (columns): ∏ k! counts the orders of parts and
-holes on the size line inducing the relation (ALPHA = 1: sizes drawn independently;
+no-fit; under a model of several lines (:mod:`asp.sizes.models`) they are the products
+of such biorders, one per section, and each section is weighed on its own. Each
+biorder gets the prior weight ``(∏ k!)**ALPHA`` over its classes of k identical parts
+(rows) and k identical holes (columns): ∏ k! counts the orders of parts and holes
+on the size line inducing the relation (ALPHA = 1: sizes drawn independently;
 ALPHA = 0: every relation equally likely). The policy tries the unknown pair whose
 outcomes split the total weight most evenly (the most informative experiment under
 that prior); ties go to the lowest part, then hole index.
@@ -138,12 +140,47 @@ def _prior_weights(m: int, n: int) -> np.ndarray:
     return prior_weights(all_biorder_orders(m, n))
 
 
+def section_knowledge(knowledge: Knowledge) -> list[Knowledge]:
+    """The knowledge of each section's parts (with every hole), in the parts' order.
+
+    The size model's relations are independent across sections, so the possible
+    relations are products of each section's possible biorders: an experiment splits
+    the weight of its own section only, and its split is best compared as a share of
+    that section's total weight.
+    """
+    groups: dict[str, list[str]] = {}
+    for part in knowledge.parts:
+        groups.setdefault(knowledge.section_of(part), []).append(part)
+    if len(groups) == 1:
+        return [knowledge]
+    return [knowledge.restricted(parts) for parts in groups.values()]
+
+
 def choose(knowledge: Knowledge, rng: random.Random) -> Pair:
-    """The registry's chooser: the unknown pair of most even weighted split (numpy paths)."""
+    """The registry's chooser: the unknown pair of most even weighted split (numpy paths),
+    per section as a share of the section's weight (:func:`section_knowledge`)."""
     del rng  # deterministic: the choice depends on the knowledge in index order only
-    m, n = len(knowledge.parts), len(knowledge.holes)
-    bit = choose_bit(m, n, *knowledge_masks(knowledge))
-    return knowledge.parts[bit // n], knowledge.holes[bit % n]
+    sections = section_knowledge(knowledge)
+    if len(sections) == 1:
+        m, n = len(knowledge.parts), len(knowledge.holes)
+        bit = choose_bit(m, n, *knowledge_masks(knowledge))
+        return knowledge.parts[bit // n], knowledge.holes[bit % n]
+    order = {pair: i for i, pair in enumerate((p, h) for p in knowledge.parts for h in knowledge.holes)}
+    scored: list[tuple[float, int, Pair]] = []
+    for sub in sections:
+        m, n = len(sub.parts), len(sub.holes)
+        fit_mask, no_fit_mask = knowledge_masks(sub)
+        if not sub.unknown:
+            continue
+        fit_weight, total = split_weights(m, n, fit_mask, no_fit_mask)
+        if total == 0:
+            raise PlannerError("policy best: no biorder agrees with the knowledge (noise left?)")
+        for part, hole in sub.unknown:
+            w = float(fit_weight[sub.parts.index(part) * n + sub.holes.index(hole)])
+            scored.append((-min(w, total - w) / total, order[(part, hole)], (part, hole)))
+    if not scored:
+        raise PlannerError("policy best: every pair is known, nothing to choose")
+    return min(scored)[2]
 
 
 def possible_relations(m: int, n: int, fit_mask: int, no_fit_mask: int) -> tuple[np.ndarray, np.ndarray]:
@@ -162,26 +199,32 @@ def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]
     """Unknown pairs not in ``pending`` (pairs out at other cells), best first to run
     beside them: by the weight of the lighter outcome summed over the outcome
     combinations of the pending pairs, i.e. the expected split once their results are
-    known too (without pending pairs, the split :func:`choose` maximises); ties go to
-    the lowest index. The possible relations are grouped by the outcomes they give the
-    pending pairs (one pass, however many pending pairs; on the sampled path one sample
-    serves every group). Scores only; whether a pair is independent of the others is
-    the learner's check.
+    known too (without pending pairs, the split :func:`choose` maximises), as a share of
+    the pair's section weight; ties go to the lowest index. The possible relations are
+    grouped by the outcomes they give the pending pairs of the section (one pass,
+    however many pending pairs; on the sampled path one sample serves every group).
+    Scores only; whether a pair is independent of the others is the learner's check.
     """
-    m, n = len(knowledge.parts), len(knowledge.holes)
-    index = {(p, h): i * n + j for i, p in enumerate(knowledge.parts) for j, h in enumerate(knowledge.holes)}
-    relations, weights = possible_relations(m, n, *knowledge_masks(knowledge))
-    groups = np.zeros(len(relations), dtype=np.int64)
-    if pending:
-        _, groups = np.unique(relations[:, [index[pair] for pair in pending]], axis=0, return_inverse=True)
-        groups = groups.reshape(-1)
-    score = np.zeros(m * n)
-    for group in range(int(groups.max(initial=0)) + 1):
-        chosen = groups == group
-        fit_weight = weights[chosen] @ relations[chosen]
-        score += np.minimum(fit_weight, weights[chosen].sum() - fit_weight)
+    order = {pair: i for i, pair in enumerate((p, h) for p in knowledge.parts for h in knowledge.holes)}
+    share: dict[Pair, float] = {}
+    for sub in section_knowledge(knowledge):
+        m, n = len(sub.parts), len(sub.holes)
+        index = {(p, h): i * n + j for i, p in enumerate(sub.parts) for j, h in enumerate(sub.holes)}
+        relations, weights = possible_relations(m, n, *knowledge_masks(sub))
+        mine = [pair for pair in pending if pair in index]
+        groups = np.zeros(len(relations), dtype=np.int64)
+        if mine:
+            _, groups = np.unique(relations[:, [index[pair] for pair in mine]], axis=0, return_inverse=True)
+            groups = groups.reshape(-1)
+        score = np.zeros(m * n)
+        for group in range(int(groups.max(initial=0)) + 1):
+            chosen = groups == group
+            fit_weight = weights[chosen] @ relations[chosen]
+            score += np.minimum(fit_weight, weights[chosen].sum() - fit_weight)
+        total = float(weights.sum()) or 1.0
+        share.update({pair: float(score[index[pair]]) / total for pair in sub.unknown})
     candidates = [pair for pair in knowledge.unknown if pair not in pending]
-    return sorted(candidates, key=lambda pair: (-score[index[pair]], index[pair]))
+    return sorted(candidates, key=lambda pair: (-share[pair], order[pair]))
 
 
 def prepare(m: int, n: int) -> None:

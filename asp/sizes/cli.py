@@ -19,11 +19,12 @@ from asp.precedence.demos import load_demos
 from asp.sizes.evaluate import evaluate_policy, plot_comparison
 from asp.sizes.knowledge import Knowledge
 from asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
+from asp.sizes.models import MODELS, SizeModel, model_for
 from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
 from asp.sizes.policies import get_policy, policy_names
 from asp.solve import write_facts
 from bridge.assembly import load_assembly
-from bridge.cli_types import ArgumentParser, add_assembly_argument, comma_list, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -49,6 +50,18 @@ def _probability(text: str) -> float:
     return value
 
 
+def add_model_option(parser: argparse.ArgumentParser) -> None:
+    """``--model``: the size model (default: the product's declared one, else sections)."""
+    parser.add_argument("--model", choices=MODELS, default=None,
+                        help="size model: line (the paper's one size line), sections (one line per "
+                             "cross-section), pairs (nothing entailed); default: the product's [sizes] "
+                             "model, else sections (docs/sizes.md)")
+
+
+def _model(args: argparse.Namespace, truth: TruthOracle) -> SizeModel:
+    return model_for(truth.parts, args.model, truth.declared_model, truth.declared_sections)
+
+
 def _add_noise_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--noise", type=_probability, default=0.0, metavar="P",
                         help="probability that an answer is flipped (simulated noise; default 0)")
@@ -66,7 +79,9 @@ def _parser() -> argparse.ArgumentParser:
     _add_truth_options(learn)
     learn.add_argument("--policy", choices=policy_names(), default="heuristic",
                        help="experiment selection (default heuristic)")
-    learn.add_argument("--seed", type=int, default=0, help="seed of random choices and noise (default 0)")
+    learn.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
+                       help="seed of random choices and noise (default 0)")
+    add_model_option(learn)
     learn.add_argument("--demos", metavar="FILE",
                        help="demonstrations; the parts they place into holes (p1@r1) are fits to start from")
     _add_noise_options(learn)
@@ -77,7 +92,8 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--policy", choices=policy_names(), required=True, help="the policy to evaluate")
     evaluate.add_argument("--relabelings", default="all", metavar="all|N",
                           help="every relabeling (default) or N random ones")
-    evaluate.add_argument("--seed", type=int, default=0, help="seed of relabelings, random choices, noise")
+    evaluate.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
+                          help="seed of relabelings, random choices, noise")
     _add_noise_options(evaluate)
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", metavar="FILE.png", help="Fig. 19-style comparison plot")
@@ -105,8 +121,11 @@ def demonstrated_fits(path: str, assembly: str | None) -> list[tuple[str, str]]:
 
 def _learn(args: argparse.Namespace) -> int:
     truth = _truth(args)
+    model = _model(args, truth)
     demonstrated = demonstrated_fits(args.demos, args.assembly) if args.demos else []
     oracle: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
+    if not args.json:
+        print(f"assumes: {model.assumption()}")
 
     def show(experiment: Experiment, _knowledge: Knowledge) -> None:
         if not args.json:
@@ -117,12 +136,19 @@ def _learn(args: argparse.Namespace) -> int:
         print(f"starting from {len(demonstrated)} fits seen in the demonstrations: "
               + " ".join(f"{p}->{h}" for p, h in demonstrated))
     result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
-                         confirm=args.confirm, demonstrated=demonstrated)
+                         confirm=args.confirm, demonstrated=demonstrated, model=model)
+    if not args.json:
+        for change in result.model_changes:
+            print(f"model changed: {change}")
     if args.out:
-        write_facts(args.out, result.facts(), header=f"learned by `sizes learn --policy {args.policy}`")
+        write_facts(args.out, result.facts(), header=f"learned by `sizes learn --policy {args.policy}`\n"
+                                                      f"assumes: {result.model.assumption()}")
     if args.json:
         print(json.dumps({
             "policy": args.policy,
+            "model": result.model.name,
+            "assumption": result.model.assumption(),
+            "model_changes": list(result.model_changes),
             "experiments": [e.as_json() for e in result.experiments],
             "count": result.count,
             "fits": [[p, h] for p in truth.parts for h in truth.holes if (p, h) in result.knowledge.fits],

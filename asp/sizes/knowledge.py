@@ -1,9 +1,10 @@
 """What the size learner knows: the closure of the smaller-than relation (paper 2.2).
 
 :class:`Knowledge` is an immutable snapshot read from one model of
-``sizes_closure.lp``: the smaller-than relation over parts ∪ holes, the part-hole pairs
-known to fit / not to fit (observed or entailed), the pairs still unknown, and the
-observations that lie on a cycle (noise). Policies written in Python receive it.
+``sizes_closure.lp``: the smaller-than relation on each section's size line, the
+part-hole pairs known to fit / not to fit (observed or entailed), the pairs still
+unknown, and the observations that lie on a cycle (noise, or a model the observations
+contradict). Policies written in Python receive it.
 """
 
 from __future__ import annotations
@@ -26,7 +27,10 @@ class Knowledge:
 
     ``parts`` and ``holes`` are in index order (index 1 first); the pair sets hold
     ``(part, hole)``; ``smaller`` holds ``(x, y)`` with x smaller than y, both parts or
-    holes; ``conflicts`` holds ``(part, hole, result)`` observations on a cycle.
+    holes (``smaller/2`` of the closure); ``lines`` holds ``(section, x, y)``: x smaller
+    than y on that section's size line; ``sections`` maps each part to its section
+    (empty: every part on one line); ``conflicts`` holds ``(part, hole, result)``
+    observations on a cycle.
     """
 
     parts: tuple[str, ...]
@@ -35,6 +39,24 @@ class Knowledge:
     fits: frozenset[Pair]
     no_fit: frozenset[Pair]
     conflicts: frozenset[tuple[str, str, str]]
+    lines: frozenset[tuple[str, str, str]] = frozenset()
+    sections: tuple[tuple[str, str], ...] = ()
+
+    def section_of(self, part: str) -> str:
+        """The section whose size line ``part`` lies on ("line" when none is given)."""
+        return dict(self.sections).get(part, "line")
+
+    def restricted(self, parts: Sequence[str]) -> Knowledge:
+        """The knowledge of ``parts`` (one section's parts) and every hole, in index order."""
+        keep = set(parts)
+        return Knowledge(
+            parts=tuple(p for p in self.parts if p in keep), holes=self.holes,
+            smaller=frozenset((x, y) for x, y in self.smaller if x in keep or y in keep),
+            fits=frozenset(pair for pair in self.fits if pair[0] in keep),
+            no_fit=frozenset(pair for pair in self.no_fit if pair[0] in keep),
+            conflicts=frozenset(c for c in self.conflicts if c[0] in keep),
+            lines=frozenset(e for e in self.lines if e[1] in keep or e[2] in keep),
+            sections=tuple((p, s) for p, s in self.sections if p in keep))
 
     @property
     def unknown(self) -> list[Pair]:
@@ -70,6 +92,7 @@ class Knowledge:
         holes: Sequence[str],
         symbols: Iterable[clingo.Symbol],
         decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] | None = None,
+        sections: Sequence[tuple[str, str]] = (),
     ) -> Knowledge:
         """Read the shown atoms of a ``sizes_closure.lp`` model.
 
@@ -77,7 +100,7 @@ class Knowledge:
         arguments through clingo's API costs more than the solve on small instances).
         """
         decoded = {} if decoded is None else decoded
-        sets: dict[str, set] = {"smaller": set(), "fits": set(), "no_fit": set(), "in_conflict": set()}
+        sets: dict[str, set] = {"smaller": set(), "fits": set(), "no_fit": set(), "in_conflict": set(), "lt": set()}
         for symbol in symbols:
             entry = decoded.get(symbol)
             if entry is None:
@@ -92,4 +115,6 @@ class Knowledge:
             fits=frozenset(sets["fits"]),
             no_fit=frozenset(sets["no_fit"]),
             conflicts=frozenset(sets["in_conflict"]),
+            lines=frozenset(sets["lt"]),
+            sections=tuple(sections),
         )

@@ -12,6 +12,14 @@ on the cycle are named and re-tested; per pair the majority of its answers is ke
 (a tie keeps the latest), so the kept relation never contradicts itself. It is done
 when every pair is known and no conflict is left.
 
+What is entailed follows the size model (:mod:`asp.sizes.models`; default ``line``, the
+paper's): ``section(P,S)`` facts put each part on a section's size line. Observations
+that contradict the model cannot be noise once re-tests reproduce them: when every
+observation on a cycle has been answered at least twice with one result (or a pair
+reached ``max_answers``), the learner names them in one line, moves to the next weaker
+model (``line`` -> ``sections`` -> ``pairs``), re-grounds, and asks the pairs the
+weaker model no longer entails. ``model_changes`` lists the moves.
+
 Demonstrations that say where a part went (``p1@r1``; paper 4.2, last paragraph) are
 fits seen before any experiment: ``demonstrated`` pairs start as one ``fit`` answer each,
 so the learner starts from their closure, never tries them unless a conflict names them,
@@ -39,6 +47,7 @@ import clingo
 
 from asp import PlannerError
 from asp.sizes.knowledge import RESULTS, Knowledge, Pair
+from asp.sizes.models import SizeModel, build_model, weaker
 from asp.sizes.oracle import Oracle
 from asp.sizes.policies import SelectionPolicy, get_policy
 from asp.solve import encoding, fact, format_facts
@@ -47,7 +56,7 @@ MAX_CONFIRM = 100
 """``confirm`` K is at most this many answers (each essential observation is re-tested
 until its result leads by K+1, so K bounds the experiments)."""
 
-_OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit)."
+_OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit). #show lt/3."
 
 
 @dataclass(frozen=True)
@@ -71,6 +80,7 @@ class SizeLearningResult:
     policy: str
     experiments: tuple[Experiment, ...]
     knowledge: Knowledge
+    model: SizeModel
 
     @property
     def count(self) -> int:
@@ -80,11 +90,16 @@ class SizeLearningResult:
     demonstrated: tuple[Pair, ...] = ()
     """Fits seen in demonstrations, which the learner started from."""
 
+    model_changes: tuple[str, ...] = ()
+    """One line per move to a weaker model: the contradicting observations and the models."""
+
     def facts(self) -> list[clingo.Symbol]:
-        """``part/1, hole/1, demonstrated/2, tried/4, smaller/2, fits/2, no_fit/2`` (the
-        project's facts vocabulary)."""
+        """``part/1, hole/1, size_model/1, section/2, demonstrated/2, tried/4, smaller/2,
+        fits/2, no_fit/2`` (the project's facts vocabulary)."""
         k = self.knowledge
         atoms = [fact("part", p) for p in k.parts] + [fact("hole", h) for h in k.holes]
+        atoms += [fact("size_model", self.model.name)]
+        atoms += [fact("section", p, s) for p, s in self.model.sections.items()]
         atoms += [fact("demonstrated", p, h) for p, h in self.demonstrated]
         atoms += [fact("tried", e.number, e.part, e.hole, e.result) for e in self.experiments]
         atoms += [fact("smaller", x, y) for x, y in sorted(k.smaller)]
@@ -105,11 +120,13 @@ class SizeLearner:
         max_answers: int | None = None,
         confirm: int = 0,
         demonstrated: Sequence[Pair] = (),
+        model: SizeModel | None = None,
     ) -> None:
         """``parts``/``holes`` in index order; ``confirm`` K ≥ 0: each essential
         observation's kept result must lead the other by K+1 answers (0: no confirmation);
         ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more);
-        ``demonstrated``: (part, hole) pairs demonstrations placed, known to fit (module doc)."""
+        ``demonstrated``: (part, hole) pairs demonstrations placed, known to fit (module doc);
+        ``model``: the size model over ``parts`` (default: the paper's ``line``)."""
         if len(set(parts) | set(holes)) != len(parts) + len(holes):
             raise PlannerError("parts and holes need distinct ids")
         if not 0 <= confirm <= MAX_CONFIRM:
@@ -125,6 +142,11 @@ class SizeLearner:
             raise PlannerError(f"demonstrated placement(s) {' '.join(outside[:5])}: expected a part of "
                                f"{' '.join(self.parts)} and a hole of {' '.join(self.holes)}")
         self.policy = get_policy(policy) if isinstance(policy, str) else policy
+        self.model = self._initial_model = build_model("line", self.parts) if model is None else model
+        if set(self.model.sections) != set(self.parts):
+            raise PlannerError("size model: expected a section for every part and no other")
+        self.model_changes: list[str] = []
+        self.seed = seed
         self.rng = random.Random(seed)
         self.max_answers, self.confirm = max_answers, confirm
         self.experiments: list[Experiment] = []
@@ -132,16 +154,22 @@ class SizeLearner:
         self.retests: list[Pair] = []
         self._essential: tuple[Pair, ...] = ()
         self._history: list[tuple[Knowledge, Pair | None, list[Pair], tuple[Pair, ...]]] = []
-        if self.policy.prepare is not None:
-            self.policy.prepare(len(self.parts), len(self.holes))
-        self._ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
-        self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
-        self._ground(seed)
         self._pairs = [(p, h) for p in self.parts for h in self.holes]
-        self._literals = {(*pair, r): self._literal(fact("observed", *pair, r))
-                          for pair in self._pairs for r in RESULTS}
+        self._build_control()
         self._selected: Pair | None = None
         self._start_from_demonstrations()
+
+    def _build_control(self) -> None:
+        """Ground the learner's one Control for the current model (again only when the
+        model is weakened)."""
+        if self.policy.prepare is not None:
+            for size in sorted({len(parts) for parts in self.model.groups().values()}):
+                self.policy.prepare(size, len(self.holes))
+        self._ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
+        self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
+        self._ground(self.seed)
+        self._literals = {(*pair, r): self._literal(fact("observed", *pair, r))
+                          for pair in self._pairs for r in RESULTS}
 
     def _start_from_demonstrations(self) -> None:
         """One ``fit`` answer per demonstrated pair, then the closure (fits alone close no cycle)."""
@@ -166,6 +194,7 @@ class SizeLearner:
         atoms = [fact("part", p) for p in self.parts] + [fact("hole", h) for h in self.holes]
         atoms += [fact("part_index", p, i) for i, p in enumerate(self.parts, 1)]
         atoms += [fact("hole_index", h, j) for j, h in enumerate(self.holes, 1)]
+        atoms += [fact("section", p, section) for p, section in self.model.sections.items()]
         if self.policy.session_facts is not None:
             atoms += self.policy.session_facts(self.parts, self.holes, seed)
         self._ctl.add("base", [], format_facts(atoms) + _OBSERVATIONS)
@@ -181,7 +210,8 @@ class SizeLearner:
         result = self._ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
         if not result.satisfiable:
             raise PlannerError(f"policy {self.policy.name}: no model for the current knowledge")
-        knowledge = Knowledge.from_symbols(self.parts, self.holes, last, self._decoded)
+        knowledge = Knowledge.from_symbols(self.parts, self.holes, last, self._decoded,
+                                           tuple(self.model.sections.items()))
         selected = [self._pair(s) for s in last if self._decoded[s][0] == "select"]
         self._selected = selected[0] if len(selected) == 1 else None
         essential = {self._pair(s) for s in last if self._decoded[s][0] == "essential"}
@@ -251,6 +281,33 @@ class SizeLearner:
         self._queue_retests(pair)
         return experiment
 
+    def _contradicts_model(self) -> bool:
+        """The observations on a cycle are no noise: each pair on it answered at least
+        twice with one result, or one pair ``max_answers`` times."""
+        pairs = {(p, h) for p, h, _ in self.knowledge.conflicts}
+        if not pairs:
+            return False
+        answers = [self.answers[pair] for pair in pairs]
+        reproduced = all(len(a) >= 2 and len(set(a)) == 1 for a in answers)
+        return reproduced or any(len(a) >= self.max_answers for a in answers)
+
+    def _weaken(self) -> None:
+        """Move to the next weaker model, re-ground and re-apply every kept answer;
+        PlannerError when no weaker model is left (the kept answers contradict themselves)."""
+        named = ", ".join(f"{p}->{h} {r}" for p, h, r in sorted(self.knowledge.conflicts))
+        following = weaker(self.model)
+        if following is None:
+            raise PlannerError(f"observations stay in conflict under size model {self.model.name}: {named}")
+        change = f"observations {named} contradict size model {self.model.name}; now {following.name}"
+        self.model_changes.append(change)
+        self.model = following
+        self._build_control()
+        for pair, answers in self.answers.items():
+            self._set_observation(pair, self._kept(answers))
+        self.retests = [pair for pair in self.retests if pair in self.answers and len(set(self.answers[pair])) > 1]
+        self._history.clear()
+        self.knowledge = self._solve()
+
     def conflicting_experiments(self) -> list[Experiment]:
         """Experiments whose kept result lies on a cycle of the closure."""
         kept = {(p, h, r) for p, h, r in self.knowledge.conflicts}
@@ -259,15 +316,11 @@ class SizeLearner:
     def _queue_retests(self, recorded: Pair) -> None:
         """Queue the observations on a cycle and, with ``confirm`` > 0, the ``recorded``
         pair if it is a re-test still unconfirmed."""
+        while self._contradicts_model():
+            self._weaken()
         for p, h, _ in sorted(self.knowledge.conflicts):
-            if (p, h) in self.retests:
-                continue
-            if len(self.answers[(p, h)]) >= self.max_answers:
-                named = ", ".join(f"#{e.number} {e.part}->{e.hole} {e.result}"
-                                  for e in self.conflicting_experiments())
-                raise PlannerError(f"observations stay in conflict after {self.max_answers} "
-                                   f"answers per pair: {named}")
-            self.retests.append((p, h))
+            if (p, h) not in self.retests:
+                self.retests.append((p, h))
         if (self.confirm and len(self.answers[recorded]) > 1 and self._unconfirmed(recorded)
                 and recorded not in self.retests):
             self.retests.append(recorded)
@@ -308,7 +361,8 @@ class SizeLearner:
     def _independent(self, pairs: list[Pair]) -> bool:
         """No outcomes of all but one pair entail (or contradict) the remaining pair.
 
-        The closure is transitive over parts and holes (eqs. 2-5), so some outcomes of the
+        The closure is transitive over the parts and holes of one section's line
+        (eqs. 2-5; pairs of other sections are unrelated), so some outcomes of the
         others entail ``(p, h)`` exactly when the graph of the known ``smaller/2`` edges
         plus each other pair as an edge in either direction has a path from p to h or
         from h to p (a shortest such walk is a simple path, which turns each pair one way
@@ -316,12 +370,16 @@ class SizeLearner:
         entails that pair: the same test. Linear in the graph per pair, where solving
         every combination of outcomes was exponential in the batch size.
         """
-        known: dict[str, set[str]] = {}
-        for smaller, bigger in self.knowledge.smaller:
-            known.setdefault(smaller, set()).add(bigger)
+        known: dict[str, dict[str, set[str]]] = {}
+        for section, smaller, bigger in self.knowledge.lines:
+            known.setdefault(section, {}).setdefault(smaller, set()).add(bigger)
+        section_of = self.model.sections
         for index, (part, hole) in enumerate(pairs):
-            graph = {node: set(targets) for node, targets in known.items()}
+            line = section_of[part]
+            graph = {node: set(targets) for node, targets in known.get(line, {}).items()}
             for other_part, other_hole in pairs[:index] + pairs[index + 1:]:
+                if section_of[other_part] != line:
+                    continue
                 graph.setdefault(other_part, set()).add(other_hole)
                 graph.setdefault(other_hole, set()).add(other_part)
             if _reaches(graph, part, hole) or _reaches(graph, hole, part):
@@ -335,6 +393,8 @@ class SizeLearner:
 
     def undo(self) -> None:
         """Take back the last experiment (walks of a policy's decision tree use this)."""
+        if not self._history:
+            raise PlannerError("undo: nothing to take back (a model change forgets the history)")
         last = self.experiments.pop()
         pair = (last.part, last.hole)
         self.answers[pair].pop()
@@ -347,16 +407,20 @@ class SizeLearner:
         """Forget all observations: a fresh session on the same ground program.
 
         ``seed`` reseeds Python policies; ``session_facts`` (e.g. random priorities)
-        stay those of the seed given at construction.
+        stay those of the seed given at construction; a weakened model is restored.
         """
         for pair in self.answers:
             self._set_observation(pair, None)
+        if self.model != self._initial_model:
+            self.model, self.model_changes = self._initial_model, []
+            self._build_control()
         self.experiments, self.answers, self.retests, self._history = [], {}, [], []
         self.rng = random.Random(seed)
         self._start_from_demonstrations()
 
     def result(self) -> SizeLearningResult:
-        return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge, self.demonstrated)
+        return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge, self.model,
+                                  self.demonstrated, tuple(self.model_changes))
 
 
 def _reaches(graph: dict[str, set[str]], start: str, goal: str) -> bool:
@@ -382,11 +446,12 @@ def learn_sizes(
     max_answers: int | None = None,
     confirm: int = 0,
     demonstrated: Sequence[Pair] = (),
+    model: SizeModel | None = None,
 ) -> SizeLearningResult:
     """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known
     (and, with ``confirm`` > 0, every essential observation confirmed), starting from the
-    fits ``demonstrated``; see :class:`SizeLearner`."""
-    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm, demonstrated)
+    fits ``demonstrated``, under the size ``model``; see :class:`SizeLearner`."""
+    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm, demonstrated, model)
     return run_learner(learner, oracle, on_experiment)
 
 

@@ -3,15 +3,16 @@
 Here the answers come from a ground truth (an assembly's ``sizes.lp``, paper Fig. 5,
 or any facts file of ``part/1``, ``hole/1``, ``fits/2``; closed world: a pair not
 listed does not fit). Later the simulated cell answers through Zenoh behind the same
-:class:`Oracle` protocol. A truth must be a biorder (Ferrers relation: sizes on one
-line), else the learner's reasoning by transitivity would be unsound.
+:class:`Oracle` protocol. A truth must be one the size model allows: within each
+section (a line of the model, :mod:`asp.sizes.models`) a biorder (Ferrers relation),
+else the learner's reasoning by transitivity would be unsound for it.
 """
 
 from __future__ import annotations
 
 import random
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Literal, Protocol
 
@@ -46,17 +47,22 @@ def ferrers_violation(
 
 
 class TruthOracle:
-    """Answers from a known part-hole relation (closed world), validated as a biorder.
+    """Answers from a known part-hole relation (closed world), validated as a biorder on
+    each section's parts (``sections``: part -> section; None: all parts on one line).
 
     ``parts`` and ``holes`` keep their order: it is the index order of the learner.
     """
 
     def __init__(
         self, parts: Sequence[str], holes: Sequence[str], fits: Iterable[tuple[str, str]],
-        source: str = "truth",
+        source: str = "truth", sections: Mapping[str, str] | None = None,
     ) -> None:
         self.parts, self.holes = tuple(parts), tuple(holes)
         self.fits = set(fits)
+        self.declared_sections: dict[str, str] = dict(sections or {})
+        """The parts' sections stated by the truth's source (its product or section/2 facts)."""
+        self.declared_model: str | None = None
+        """The size model the truth's product declares, if any."""
         if not self.parts or not self.holes:
             raise PlannerError(f"{source}: expected at least one part/1 and one hole/1")
         for p, h in sorted(self.fits):
@@ -64,13 +70,18 @@ class TruthOracle:
                 raise PlannerError(f"{source}: fits({p},{h}): '{p}' is not a declared part/1")
             if h not in self.holes:
                 raise PlannerError(f"{source}: fits({p},{h}): '{h}' is not a declared hole/1")
-        bad = ferrers_violation(self.parts, self.holes, self.fits)
-        if bad:
-            p, h, q, k = bad
-            raise PlannerError(
-                f"{source}: not a biorder (sizes on one line): {p} fits {h} but not {k}, "
-                f"while {q} fits {k} but not {h}"
-            )
+        groups: dict[str, list[str]] = {}
+        for part in self.parts:
+            groups.setdefault("line" if sections is None else sections.get(part, "line"), []).append(part)
+        for section, members in groups.items():
+            bad = ferrers_violation(members, self.holes, self.fits)
+            if bad:
+                p, h, q, k = bad
+                line = "sizes on one line" if sections is None else f"one size line for section {section}"
+                raise PlannerError(
+                    f"{source}: not a biorder ({line}): {p} fits {h} but not {k}, "
+                    f"while {q} fits {k} but not {h}"
+                )
 
     def ask(self, part: str, hole: str) -> Result:
         if part not in self.parts or hole not in self.holes:
@@ -79,39 +90,48 @@ class TruthOracle:
 
     @classmethod
     def from_facts(cls, path: Path | str) -> TruthOracle:
-        """A truth facts file; index order = order of first mention in the file."""
-        path = Path(path)
-        atoms = load_atoms([path])
-        check_facts(atoms, {"part": 1, "hole": 1, "fits": 2}, str(path))
-        parts = [a for (a,) in atoms_by_name(atoms, "part", 1)]
-        holes = [a for (a,) in atoms_by_name(atoms, "hole", 1)]
-        text = re.sub(r"%.*", "", read_text(path, "truth facts file", error=PlannerError))
-
-        def mention(name: str) -> int:
-            found = re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", text)
-            return found.start() if found else len(text)
-
-        parts.sort(key=mention)
-        holes.sort(key=mention)
-        fits = set(pairs_by_name(atoms, "fits"))
-        return cls(parts, holes, fits, source=str(path))
+        """A truth facts file (``part/1``, ``hole/1``, ``fits/2``, optional ``section/2``, the
+        parts' cross-sections); index order = order of first mention in the file."""
+        parts, holes, fits, sections = _read_truth(Path(path))
+        return cls(parts, holes, fits, source=str(path), sections=sections or None)
 
     @classmethod
     def from_assembly(cls, name_or_path: str) -> TruthOracle:
         """An assembly's ``sizes.lp``, in the order of its ``assembly.toml``."""
         assembly = load_assembly(name_or_path)
-        truth = cls.from_facts(assembly.file("sizes.lp"))
-        for kind, ids, known in (("part", truth.parts, assembly.part_ids),
-                                 ("hole", truth.holes, assembly.hole_ids)):
+        truth_parts, truth_holes, fits, _ = _read_truth(assembly.file("sizes.lp"))
+        for kind, ids, known in (("part", truth_parts, assembly.part_ids),
+                                 ("hole", truth_holes, assembly.hole_ids)):
             unknown = [i for i in ids if i not in known]
             if unknown:
                 raise PlannerError(
                     f"{assembly.folder / 'sizes.lp'}: {kind}(s) {unknown} are not in "
                     f"{assembly.folder / 'assembly.toml'}"
                 )
-        parts = [p for p in assembly.part_ids if p in truth.parts]
-        holes = [h for h in assembly.hole_ids if h in truth.holes]
-        return cls(parts, holes, truth.fits, source=str(assembly.folder / "sizes.lp"))
+        parts = [p for p in assembly.part_ids if p in truth_parts]
+        holes = [h for h in assembly.hole_ids if h in truth_holes]
+        declared = assembly.sections()
+        sections = None if assembly.size_model == "line" else {p: declared.get(p, "line") for p in parts}
+        found = cls(parts, holes, fits, source=str(assembly.folder / "sizes.lp"), sections=sections)
+        found.declared_sections, found.declared_model = declared, assembly.size_model
+        return found
+
+
+def _read_truth(path: Path) -> tuple[list[str], list[str], set[tuple[str, str]], dict[str, str]]:
+    """Parts and holes (in order of first mention), fits and ``section/2`` of a truth file."""
+    atoms = load_atoms([path])
+    check_facts(atoms, {"part": 1, "hole": 1, "fits": 2, "section": 2}, str(path))
+    parts = [a for (a,) in atoms_by_name(atoms, "part", 1)]
+    holes = [a for (a,) in atoms_by_name(atoms, "hole", 1)]
+    text = re.sub(r"%.*", "", read_text(path, "truth facts file", error=PlannerError))
+
+    def mention(name: str) -> int:
+        found = re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", text)
+        return found.start() if found else len(text)
+
+    parts.sort(key=mention)
+    holes.sort(key=mention)
+    return parts, holes, set(pairs_by_name(atoms, "fits")), dict(pairs_by_name(atoms, "section"))
 
 
 class NoisyOracle:

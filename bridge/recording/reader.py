@@ -3,6 +3,8 @@
 Rerun 0.41 dropped ``rr.dataframe``; this module uses the SDK's own chunk reader
 (``rerun.chunk.RrdReader``, in process, no extra dependency) instead of parsing the
 output of ``rerun rrd print``. Used by the tests and by ``./run.sh view RUN --print``.
+A file with a torn tail (its writer died mid-message) is read up to its last whole
+message, with a warning (:mod:`bridge.recording.torn`).
 
 Entity paths are reported as Rerun prints them, with a leading ``/``
 (``/executor/c1/outcome``); Rerun's own ``/__properties`` entities are left out.
@@ -22,6 +24,7 @@ from rerun.chunk import Chunk, RrdReader
 
 from bridge import BridgeError
 from bridge.inputs import shorten
+from bridge.recording.torn import readable
 
 
 @dataclass
@@ -75,9 +78,11 @@ _CONTROL_COLUMN_PREFIX = "rerun.controls."
 _VIEW_ORIGIN = "ViewBlueprint:space_origin"
 
 
-def _reader(path: Path) -> RrdReader:
-    """A reader of one ``.rrd`` file; BridgeError naming the file when it is missing,
-    unreadable or not a Rerun recording (empty, garbage, another format)."""
+@contextmanager
+def _open(path: Path) -> Iterator[RrdReader]:
+    """A reader of one ``.rrd`` file (of its whole messages when its tail is torn, with a
+    warning: :mod:`bridge.recording.torn`); BridgeError naming the file when it is
+    missing, unreadable or not a Rerun recording (empty, garbage, another format)."""
     if not path.is_file():
         raise BridgeError(f"{path}: no such recording file (expected an .rrd file)")
     try:
@@ -85,11 +90,13 @@ def _reader(path: Path) -> RrdReader:
             file.read(1)
     except OSError as exc:
         raise BridgeError(f"{path}: cannot read the recording: {exc.strerror or exc}") from None
-    try:
-        with _tolerating_unfinished_files():
-            return RrdReader(path)
-    except (RuntimeError, ValueError) as exc:
-        raise BridgeError(f"{path}: not a Rerun recording ({shorten(exc, 120)}); expected an .rrd file") from None
+    with readable(path) as source:
+        try:
+            with _tolerating_unfinished_files():
+                reader = RrdReader(source)
+        except (RuntimeError, ValueError) as exc:
+            raise BridgeError(f"{path}: not a Rerun recording ({shorten(exc, 120)}); expected an .rrd file") from None
+        yield reader
 
 
 @contextmanager
@@ -101,9 +108,8 @@ def _tolerating_unfinished_files() -> Iterator[None]:
         yield
 
 
-def _chunks(path: Path) -> Iterator[Chunk]:
+def _chunks(reader: RrdReader) -> Iterator[Chunk]:
     """Every chunk of every recording store of the file (blueprints excluded)."""
-    reader = _reader(path)
     with _tolerating_unfinished_files():
         for store in reader.recordings():
             yield from reader.stream(store=store)
@@ -112,7 +118,8 @@ def _chunks(path: Path) -> Iterator[Chunk]:
 def chunk_count(path: Path | str) -> int:
     """How many chunks the recording stores of ``path`` hold (blueprints excluded): what
     compaction (:mod:`bridge.recording.compaction`) brings down."""
-    return sum(1 for _ in _chunks(Path(path)))
+    with _open(Path(path)) as reader:
+        return sum(1 for _ in _chunks(reader))
 
 
 def read_recording(paths: Path | str | Sequence[Path | str]) -> RecordingSummary:
@@ -121,21 +128,21 @@ def read_recording(paths: Path | str | Sequence[Path | str]) -> RecordingSummary
     summary = RecordingSummary(files=files)
     for path in files:
         try:
-            _summarise(path, summary)
-        except RuntimeError as exc:  # a damaged file (e.g. cut in the middle of a message)
+            with _open(path) as reader:
+                _summarise(reader, summary)
+        except RuntimeError as exc:  # damaged inside (a torn tail is read up to its last whole message)
             raise BridgeError(f"{path}: not a readable Rerun recording ({shorten(exc, 120)})") from None
     return summary
 
 
-def _summarise(path: Path, summary: RecordingSummary) -> None:
+def _summarise(reader: RrdReader, summary: RecordingSummary) -> None:
     """Add what one ``.rrd`` file holds to ``summary``."""
-    reader = _reader(path)
     with _tolerating_unfinished_files():
         for store in reader.recordings():
             summary.application_ids.add(store.application_id)
             summary.recording_ids.add(store.recording_id)
         summary.blueprints += len(reader.blueprints())
-    for chunk in _chunks(path):
+    for chunk in _chunks(reader):
         if chunk.entity_path.startswith("/__"):
             continue
         entity = summary.entities.setdefault(chunk.entity_path, EntitySummary(chunk.entity_path))
@@ -165,21 +172,21 @@ def column_values(
     wanted = "/" + entity.strip("/")
     values: list[Any] = []
     for path in files:
-        for chunk in _chunks(Path(path)):
-            if chunk.entity_path != wanted:
-                continue
-            batch = chunk.to_record_batch()
-            if column in batch.schema.names:
-                values.extend(_python_values(batch.column(column)))
+        with _open(Path(path)) as reader:
+            for chunk in _chunks(reader):
+                if chunk.entity_path != wanted:
+                    continue
+                batch = chunk.to_record_batch()
+                if column in batch.schema.names:
+                    values.extend(_python_values(batch.column(column)))
     return values
 
 
 def blueprint_origins(path: Path | str) -> set[str]:
     """Origins of the views in the blueprints of an ``.rrd`` / ``.rbl`` file
     (e.g. ``{"executor/c1", "executor/c1/wrench/force", ...}``)."""
-    reader = _reader(Path(path))
     origins: set[str] = set()
-    with _tolerating_unfinished_files():
+    with _open(Path(path)) as reader, _tolerating_unfinished_files():
         for store in reader.blueprints():
             for chunk in reader.stream(store=store):
                 batch = chunk.to_record_batch()

@@ -95,6 +95,35 @@ def open_stream(application_id: str, recording_id: str, rrd_path: Path | None,
     return recording
 
 
+def finish_stream(recording: rr.RecordingStream, rrd_path: Path | None) -> None:
+    """Flush ``recording`` and disconnect it (finishes its file). BridgeError ``<rrd>:
+    cannot write (...)`` when Rerun's file writer stopped before (a full disk, ``ulimit
+    -f``: the SDK does not say which), instead of the SDK's RuntimeError."""
+    try:
+        recording.flush()
+    except RuntimeError as exc:
+        with _stderr_silenced():  # the SDK logs the dead sink once more when it is replaced
+            recording.memory_recording()
+        raise BridgeError(f"{rrd_path}: cannot write (the recording's file writer stopped: {exc}; "
+                          "a full disk?)") from None
+    recording.disconnect()
+
+
+@contextmanager
+def _stderr_silenced() -> Iterator[None]:
+    """File descriptor 2 (where the SDK's native code logs) pointed at devnull meanwhile."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+
+
 @contextmanager
 def hosted_viewer(viewer: Viewer, files: Sequence[Path] = ()) -> Iterator[Viewer]:
     """With ``viewer.serve``: host a web viewer (Rerun's own ``rerun --serve-web``, a child

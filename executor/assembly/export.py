@@ -17,13 +17,14 @@ Units: metres, kilograms, radians (URDF's).
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import pybullet as pb
 
 from bridge.files import make_folder, write_atomic
+from bridge.inputs import read_bytes
+from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.world import AssemblyWorld
 from executor.world.scene import link_frame
@@ -48,16 +49,15 @@ def export_cell(assembly: str, out: Path) -> list[Path]:
 
 
 def _mesh(source: str, meshes: Path, written: list[Path]) -> str:
-    """Copy a mesh (with its ``.mtl`` if any) into ``meshes``; its path relative to the URDF."""
+    """Copy a mesh (with its ``.mtl`` if any) into ``meshes``, each file atomically (a full
+    disk leaves no torn copy); its path relative to the URDF."""
     path = Path(source)
     target = meshes / path.name
-    if not target.exists():
-        shutil.copyfile(path, target)
-        written.append(target)
+    if target not in written:
         material = path.with_suffix(".mtl")
-        if material.is_file():
-            shutil.copyfile(material, meshes / material.name)
-            written.append(meshes / material.name)
+        for original in [path, *([material] if material.is_file() else [])]:
+            data = read_bytes(original, "mesh file", error=ExecutorError)
+            written.append(write_atomic(meshes / original.name, data))
     return f"meshes/{path.name}"
 
 

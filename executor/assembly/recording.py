@@ -45,14 +45,14 @@ def _part_solids(world: AssemblyWorld, part: str) -> list[rr.AsComponents]:
                            colors=[[80, 130, 210]] * len(boxes), fill_mode="solid")]
     if part in p.heads:
         h = p.heads[part]
-        kind, size, length, color = h.kind, h.size, h.length, [210, 80, 80]
+        kind, (a, b), length, color = h.kind, (h.size, h.size), h.length, [210, 80, 80]
     else:
         s = p.pegs[part]
-        kind, size, length = s.kind, s.size, s.length
+        kind, (a, b), length = s.kind, s.sides, s.length
     if kind == "round":
-        return [rr.Cylinders3D(radii=[size / 2], lengths=[length], centers=[[0, 0, length / 2]], colors=[color],
+        return [rr.Cylinders3D(radii=[a / 2], lengths=[length], centers=[[0, 0, length / 2]], colors=[color],
                                fill_mode="solid")]
-    return [rr.Boxes3D(half_sizes=[[size / 2, size / 2, length / 2]], centers=[[0, 0, length / 2]], colors=[color],
+    return [rr.Boxes3D(half_sizes=[[a / 2, b / 2, length / 2]], centers=[[0, 0, length / 2]], colors=[color],
                        fill_mode="solid")]
 
 

@@ -47,10 +47,10 @@ from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from executor.control.motion import StepLogger
 from executor.evidence import AttemptSetup
 from executor.skills.dmp import Skill, load_skill
-from executor.skills.insertion import insert_in_layer
+from executor.skills.insertion import insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, SETTLE_TIME, trial_rng
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.world.arm import aligned_yaw, tool_quat, yaw_quat
 from executor.world.perturbation import CellBias, PerturbationModel
 from executor.world.scene import PART_FRICTION
 
@@ -59,10 +59,12 @@ RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
 ASSEMBLY_UNCERTAINTY = PerturbationModel(
     grasp_offset_bias=0.0, grasp_offset_random=0.001, grasp_tilt_bias=0.0, grasp_tilt_random=1.0,
-    vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
+    vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, vision_yaw_bias=0.0, vision_yaw_sigma=0.5,
+    vision_yaw_max=1.0, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
 """The assembling cell's uncertainty per execution: a grasp offset ≤ 1 mm and tilt ≤ 1°,
-a vision error σ 1.5 mm (≤ 3 mm), the teaching friction; random parts only (the cell's
-systematic errors and ILC are used with ``--uncertainty cell``)."""
+a vision error σ 1.5 mm (≤ 3 mm), a rect hole's yaw error σ 0.5° (≤ 1°), the teaching
+friction; random parts only (the cell's systematic errors and ILC are used with
+``--uncertainty cell``)."""
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
@@ -155,10 +157,12 @@ class Assembler:
             raise ExecutorError(f"unknown hole '{hole}' (expected one of {holes})")
         plate = self.product.geometry.plate
         depth = float(plate["tile_thickness"]) - 0.005
-        half = [spec.size / 2 - 0.0002, spec.size / 2 - 0.0002, depth / 2]
+        a, b = spec.sides
+        half = [a / 2 - 0.0002, b / 2 - 0.0002, depth / 2]
         col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.world.client)
         bottom = self.product.top_z - float(plate["tile_thickness"])
-        pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], physicsClientId=self.world.client)
+        pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], yaw_quat(spec.yaw),
+                           physicsClientId=self.world.client)
         self.blocked.add(hole)
 
     def run_step(self, part: str, hole: str | None, seed: int, max_attempts: int = 2) -> StepRecord:
@@ -172,7 +176,7 @@ class Assembler:
         rng = trial_rng(seed, part, hole or "none")
         if skill == "insert" and hole is not None:
             world.set_peg_goal(part, hole)
-        setup = self._uncertainty.draw(rng, self.shape_of(part), hole or part)
+        setup = self._draw(rng, part, hole)
         grasp = self._pick(part, setup)
         if skill == "fixture":
             carry(motion, world.frames[part].grip, grasp.follow)
@@ -182,7 +186,7 @@ class Assembler:
             outcomes = []
             for attempt in range(max_attempts):
                 if attempt:
-                    setup = self._uncertainty.draw(rng, self.shape_of(part), hole or part)
+                    setup = self._draw(rng, part, hole)
                 outcomes.append(self._insert(part, hole, skill, setup, grasp))
                 if outcomes[-1][0]:
                     break
@@ -207,13 +211,28 @@ class Assembler:
                           max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
                           (motion.steps - sim0) * 0.001)
 
+    def _draw(self, rng: np.random.Generator, part: str, hole: str | None) -> AttemptSetup:
+        """One execution's errors: of the part's shape and its hole (a cover or head: of
+        itself), with a yaw error of the estimate for a peg's rect hole."""
+        oriented = hole is not None and self.product.geometry.holes[hole].kind == "rect"
+        return self._uncertainty.draw(rng, self.shape_of(part), hole or part, oriented)
+
+    def _yaw(self, part: str, hole: str | None, setup: AttemptSetup) -> float:
+        """The tool yaw [rad] a peg is inserted with: aligned to its hole's estimated yaw
+        (0 for other parts and round pegs or holes)."""
+        peg = self.product.pegs.get(part)
+        if peg is None or hole is None:
+            return 0.0
+        spec = self.product.geometry.holes[hole]
+        return aligned_yaw(peg.kind, spec.kind, spec.yaw + setup.vision_yaw)
+
     def _pick(self, part: str, setup: AttemptSetup) -> Grasp:
         """Carry the empty tool to the part's grip point and close the gripper."""
         world = self.world
         world.arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         pos, quat = world.pose(part)
         grip = np.array(pb.multiplyTransforms(list(pos), list(quat), list(world.frames[part].grip), [0, 0, 0, 1])[0])
-        carry(world.motion, grip, tolerance=GRIP_TOLERANCE)
+        carry(world.motion, grip, tolerance=GRIP_TOLERANCE, yaw=0.0)  # the parts lie on the tray unturned
         if part in self.product.covers:  # a flat part lies against the palm, centred by the fingers
             return Grasp(world, part, FLAT_GRASP_OFFSET * setup.grasp_offset, np.zeros(3))
         return Grasp(world, part, setup.grasp_offset, setup.grasp_tilt)
@@ -248,15 +267,17 @@ class Assembler:
         approach = self._approach(part, skill, goal)
         if skill != "insert_over":  # a cover is aimed at its holes' centres (module docstring)
             approach[:2] += setup.vision_error
-        carry(motion, approach)
-        motion.hold(approach, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
+        yaw = self._yaw(part, hole, setup)
+        quat = tool_quat(yaw)
+        carry(motion, approach, yaw=yaw)
+        motion.hold(approach, quat, SETTLE_TIME)
         world.arm.tare_sensor()
         if skill == "insert_over":
             skill_obj, xy = self._skill(p.covers[part].skill), approach[:2]
         else:
             # The hole search around the estimate, on the plate or on the socket's part.
             surface = approach[2] - (APPROACH_HEIGHT if skill == "insert" else ABOVE_PINS)
-            found = hole_search(motion, approach[:2], surface, approach[2], TOOL_DOWN_QUAT_XYZW,
+            found = hole_search(motion, approach[:2], surface, approach[2], quat,
                                 np.random.default_rng(setup.search_seed))
             xy = found.hole_xy
             skill_obj = self._skill(p.pegs[part].shape if skill == "insert" else p.heads[part].skill)
@@ -268,7 +289,10 @@ class Assembler:
         plate = world.frames[p.base.id].body
         if skill == "insert" and setup.friction is not None:  # the hole's friction: Bullet multiplies the two
             pb.changeDynamics(plate, -1, lateralFriction=setup.friction / PART_FRICTION, physicsClientId=world.client)
-        result = insert_in_layer(motion, skill_obj, origin, detector, layer, lever, True, correction)
+        compliant = skill == "insert" and hole is not None and needs_yaw_compliance(
+            p.pegs[part].kind, p.geometry.holes[hole].kind)
+        result = insert_in_layer(motion, skill_obj, origin, detector, layer, lever, True, correction, yaw=yaw,
+                                 yaw_compliant=compliant)
         pb.changeDynamics(plate, -1, lateralFriction=PART_FRICTION, physicsClientId=world.client)
         if result.reached and result.trace is not None and self.ilc is not None:
             self.ilc.update(key, result.trace)

@@ -2,7 +2,9 @@
 and down, each a straight line with a minimum-jerk time law, tracked by the impedance
 controller (the arm and the held part are simulated all along).  Moves use twice the
 controller's damping (the insertion gains are lightly damped: a 0.5 m move rang for
-about a second); the gains are restored after each move."""
+about a second); the gains are restored after each move.  The tool points down, turned
+about z by a yaw that a move changes with the same time law (a part aligned to a rect
+hole's estimated yaw; ``Motion.tool_yaw`` is where it stands)."""
 
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from executor.control.motion import Motion
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.world.arm import tool_quat
 from executor.world.scene import TIME_STEP
 
 DAMPING_FACTOR = 2.0
@@ -25,27 +27,31 @@ VIA_TOLERANCE = 0.01  # [m] at the corners of a carry
 
 
 def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,
-              speed: float = SPEED, settle: float = SETTLE, tolerance: float = TOLERANCE) -> None:
-    """The TCP in a straight line to ``goal`` [m], tool pointing down; then held until it is
-    within ``tolerance`` [m] at rest (speed below ``tolerance`` per 0.1 s), or ``settle`` [s] has passed."""
+              speed: float = SPEED, settle: float = SETTLE, tolerance: float = TOLERANCE,
+              yaw: float | None = None) -> None:
+    """The TCP in a straight line to ``goal`` [m], tool pointing down and turning to ``yaw``
+    [rad] (None: keeping its yaw); then held until it is within ``tolerance`` [m] at rest
+    (speed below ``tolerance`` per 0.1 s), or ``settle`` [s] has passed."""
     controller = motion.controller
     gains = controller.gains
     controller.gains = replace(gains, d_trans=DAMPING_FACTOR * gains.d_trans, d_rot=DAMPING_FACTOR * gains.d_rot)
     try:
-        _track(motion, goal, after_step, speed, settle, tolerance)
+        _track(motion, goal, after_step, speed, settle, tolerance, motion.tool_yaw if yaw is None else yaw)
     finally:
         controller.gains = gains
 
 
 def _track(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None, speed: float, settle: float,
-           tolerance: float) -> None:
+           tolerance: float, yaw: float) -> None:
     start = motion.controller.arm.read().tip_pos
+    yaw0 = motion.tool_yaw
     distance = float(np.linalg.norm(goal - start))
     n = max(1, int(distance / speed / TIME_STEP))
     for k in range(1, n + settle_steps(settle) + 1):
         s = min(1.0, k / n)
         blend = 10 * s**3 - 15 * s**4 + 6 * s**5
-        state = motion.step(start + blend * (goal - start), TOOL_DOWN_QUAT_XYZW)
+        motion.tool_yaw = yaw0 + blend * (yaw - yaw0)
+        state = motion.step(start + blend * (goal - start), tool_quat(motion.tool_yaw))
         if after_step is not None:
             after_step()
         at_rest = np.linalg.norm(state.tip_vel) < 10 * tolerance
@@ -58,12 +64,12 @@ def settle_steps(duration: float) -> int:
 
 
 def carry(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,
-          safe_z: float = SAFE_Z, tolerance: float = TOLERANCE) -> None:
-    """Lift to ``safe_z``, move across above ``goal``, go down to it [m] (slowly, until
-    within ``tolerance`` [m])."""
+          safe_z: float = SAFE_Z, tolerance: float = TOLERANCE, yaw: float = 0.0) -> None:
+    """Lift to ``safe_z``, move across above ``goal`` turning the tool to ``yaw`` [rad], go
+    down to it [m] (slowly, until within ``tolerance`` [m])."""
     here = motion.controller.arm.read().tip_pos
     high = max(safe_z, float(goal[2]), float(here[2]))
     if here[2] < high - 1e-3:
         move_line(motion, np.array([here[0], here[1], high]), after_step, tolerance=VIA_TOLERANCE)
-    move_line(motion, np.array([goal[0], goal[1], high]), after_step, tolerance=VIA_TOLERANCE)
+    move_line(motion, np.array([goal[0], goal[1], high]), after_step, tolerance=VIA_TOLERANCE, yaw=yaw)
     move_line(motion, goal, after_step, speed=DESCENT_SPEED, tolerance=tolerance)

@@ -20,8 +20,9 @@ from executor import ExecutorError
 from executor.assembly.product import Product, rect_minus_squares
 from executor.control.controller import ImpedanceController
 from executor.control.motion import Motion, StepLogger
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm
-from executor.world.geometry import PartSpec, arm_urdf_text, write_assets
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
+from executor.world.assets import current_assets
+from executor.world.geometry import PartSpec, arm_urdf_text
 from executor.world.scene import TIME_STEP, load_plate
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
@@ -65,9 +66,7 @@ class AssemblyWorld:
         pb.setTimeStep(TIME_STEP, physicsClientId=c)
         pb.setGravity(0, 0, -9.81, physicsClientId=c)
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
-        plate_obj = geometry.assets / "plate.obj"
-        if not plate_obj.is_file():
-            write_assets(geometry)
+        current_assets(geometry)
         self.floor = pb.loadURDF("plane.urdf", physicsClientId=c)
         self.frames: dict[str, PartFrames] = {}
         self.goals: dict[str, np.ndarray] = {}  # body position [m] of each part in the product
@@ -194,7 +193,7 @@ class AssemblyWorld:
     def settle(self, duration: float) -> None:
         """Hold the arm where it is for ``duration`` [s] (parts come to rest)."""
         s = self.arm.read()
-        self.motion.hold(s.tip_pos, TOOL_DOWN_QUAT_XYZW, duration)
+        self.motion.hold(s.tip_pos, tool_quat(self.motion.tool_yaw), duration)
 
     def _com(self, part: str) -> tuple[float, float, float]:
         """The body's centre of mass in its frame [m] (PyBullet's base pose is the COM's)."""

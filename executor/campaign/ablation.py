@@ -95,7 +95,7 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
                  model: PerturbationModel) -> dict[str, Any]:
     """The ablation table (see the module text) as a JSON-ready dict."""
     if trials < 1 or executions < 1 or workers < 1:
-        raise ExecutorError(f"--trials {trials} / --executions {executions} / --workers {workers}: "
+        raise ExecutorError(f"--trials {trials} / --executions {executions} / --jobs {workers}: "
                             "expected positive numbers")
     pairs = campaign_pairs()
     groups = [list(range(g * executions, min(trials, (g + 1) * executions)))

@@ -8,7 +8,7 @@
    pairs (target < 1.5 s) and over all pairs (target < 2.5 s), the median sim steps
    per second and real-time factor (target >= 3x).
 2. The whole campaign (``executor campaign``, 40 trials per pair; ``--quick`` 4) on
-   ``--workers`` processes (default 2): wall time (target < 15 min for 40 trials)
+   ``--jobs`` processes (default: the machine's cores): wall time (target < 15 min for 40 trials)
    and whether every outcome was correct.
 
 Timings on a shared machine are noisy: medians are reported.
@@ -22,10 +22,8 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from bridge import BridgeError
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, integer, run_command
-from executor import ExecutorError
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
@@ -59,7 +57,7 @@ def campaign_timing(assembly: str, trials: int, seed: int, workers: int) -> dict
     )
     return {
         "campaign_trials_per_pair": trials,
-        "campaign_workers": workers,
+        "campaign_jobs": workers,
         "campaign_wall_s": run.wall_s,
         "campaign_all_correct": all(s.correct == s.trials for s in run.stats),
         "campaign_false_fits": sum(s.false_fits for s in run.stats),
@@ -91,7 +89,7 @@ def format_report(report: dict[str, Any]) -> str:
         )
         lines.append(
             f"campaign, {report['campaign_trials_per_pair']} trials x {len(campaign_pairs())} pairs "
-            f"on {report['campaign_workers']} workers: {report['campaign_wall_s']:.1f} s wall"
+            f"on {report['campaign_jobs']} jobs: {report['campaign_wall_s']:.1f} s wall"
             f"{target}; all correct: {report['campaign_all_correct']}, "
             f"too-big parts reported fitting: {report['campaign_false_fits']}"
         )
@@ -105,20 +103,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--trials", type=int_in(1, 10**4), help="timed trials per pair (default 3)")
     parser.add_argument("--campaign-trials", type=int_in(0, 10**5),
                         help="campaign trials per pair (default 40; 0 skips the campaign)")
-    parser.add_argument("--workers", type=int_in(1, 64), default=2, help="campaign workers (default 2)")
+    add_jobs_argument(parser, "campaign (or ablation) worker processes")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1000, help="base seed (default 1000)")
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.add_argument("--ablation", action="store_true",
                         help="instead: every execution-layer variant on the same perturbations "
                         "(--trials per pair, default 40)")
-    parser.add_argument("--executions", type=integer, default=5,
+    parser.add_argument("--executions", type=int_in(1, 10**5), default=5,
                         help="--ablation: consecutive executions of a pair per cell (default 5)")
     add_cell_arguments(parser, layer=False)
     args = parser.parse_args(argv)
     if args.ablation:
         with stdout_to_stderr():
-            ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.workers,
+            ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.jobs,
                                     perturbation_from_args(args))
         print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
         return 0
@@ -129,10 +127,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     with stdout_to_stderr():  # keep PyBullet's banner out of the report
         report = trial_timing(args.assembly, trials, args.seed)
         if campaign_trials > 0:
-            report |= campaign_timing(args.assembly, campaign_trials, args.seed, args.workers)
+            report |= campaign_timing(args.assembly, campaign_trials, args.seed, args.jobs)
     print(json.dumps(report, indent=2) if args.json else format_report(report))
     return 0
 
-
-if __name__ == "__main__":
-    raise SystemExit(run_command(main, (ExecutorError, BridgeError)))

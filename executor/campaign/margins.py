@@ -12,7 +12,6 @@ goal tolerance.  Too-big parts are stopped only by the insertion time-out here.
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Sequence
 
 from bridge.cell_options import add_cell_arguments
@@ -47,6 +46,3 @@ def main(argv: Sequence[str] | None = None) -> int:
         cell.close()
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -8,7 +8,7 @@ paper's Fig. 18 table (round peg ``p1`` and tight round peg ``tp`` in the small 
 which the paper did not run. Each trial is a fresh grasp error and hole-pose error
 (seeded), up to two attempts (paper 3.2).
 
-The pairs are spread over ``--workers`` processes (default 2, the cores of this
+The pairs are spread over ``--jobs`` processes (default: the cores of this
 machine), each with its own DIRECT PyBullet cell (the same cell seed: the same
 systematic errors); the trials of one pair run in order in one process (with ILC an
 execution learns from the ones before it). Trial ``i`` of pair ``k`` always uses seed
@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
 from bridge.progress import progress
 from executor import ExecutorError
 from executor.campaign.pairs import (
@@ -110,7 +110,7 @@ def run_campaign(
     on the executions of the same pair before it (the learned correction), so the table
     does not depend on scheduling."""
     if trials < 1 or workers < 1:
-        raise ExecutorError(f"--trials {trials} / --workers {workers}: expected positive numbers")
+        raise ExecutorError(f"--trials {trials} / --jobs {workers}: expected positive numbers")
     tasks = [(k, pair.part, pair.hole, [seed + k * trials + i for i in range(trials)])
              for k, pair in enumerate(pairs)]
     results: list[list[dict[str, Any]]] = [[] for _ in pairs]
@@ -196,7 +196,7 @@ def campaign_report(run: CampaignRun, seed: int, workers: int) -> dict[str, Any]
     return {
         "trials_per_pair": max((s.trials for s in run.stats), default=0),
         "seed": seed,
-        "workers": workers,
+        "jobs": workers,
         "wall_s": run.wall_s,
         "trial_wall_median_s": statistics.median(durations) if durations else 0.0,
         "pairs": [asdict(s) | {"correct_ratio": s.correct_ratio} for s in run.stats],
@@ -213,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--trials", type=int_in(1, 10**5), default=40, help="executions per pair (default 40)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="base seed (default 0)")
-    parser.add_argument("--workers", type=int_in(1, 64), default=2, help="worker processes (default 2)")
+    add_jobs_argument(parser, "worker processes")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
@@ -232,10 +232,10 @@ def main(argv: Sequence[str]) -> int:
         check_writable(make_folder(args.plot) / "fig18_table.png")
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
-            pairs, args.trials, args.seed, args.workers,
+            pairs, args.trials, args.seed, args.jobs,
             functools.partial(CellRunner, args.assembly, **cell_keywords(args)),
         )
-        report = campaign_report(run, args.seed, args.workers)
+        report = campaign_report(run, args.seed, args.jobs)
         if args.plot:
             from executor.campaign.plots import write_plots
 
@@ -248,7 +248,7 @@ def main(argv: Sequence[str]) -> int:
         print(
             f"all correct: {report['all_correct']}; too-big parts reported fitting: "
             f"{report['false_fits']}; {len(run.durations)} trials in {run.wall_s:.1f} s wall on "
-            f"{args.workers} worker(s), median {report['trial_wall_median_s']:.2f} s/trial"
+            f"{args.jobs} worker(s), median {report['trial_wall_median_s']:.2f} s/trial"
         )
         for path in report.get("plots", []):
             print(f"wrote {path}")

@@ -5,7 +5,10 @@ deviation (the paper's "admittance PI control law"), shifts the commanded pose b
 
     M δ̈ + D δ̇ + K δ = ΔW + K_i ∫ΔW dt,     ΔW = W_mes − W_des,     |δ| ≤ bound
 
-on the lateral forces (x, y → translation) and the tilting torques (x, y → rotation).
+on the lateral forces (x, y → translation) and the tilting torques (x, y → rotation),
+and for a part that must be aligned in yaw (a rect part or hole) on the torque about the
+tool axis too (z → rotation about z, ``yaw_bound``): the walls of a slot turn the part
+toward the slot's real yaw when vision got it wrong.
 The proportional part answers at once; the integral part keeps adapting while a
 deviation persists (which is what DMP phase stopping gives it time to do) and holds
 the offset that cancelled it; in contact, the measured wrench unwinds the integral when
@@ -27,7 +30,9 @@ class AdmittanceParams:
     """Translation: mass [kg], damping [N·s/m], stiffness [N/m], bound [m];
     rotation: inertia [kg·m²], damping [Nm·s/rad], stiffness [Nm/rad], bound [rad].
     Natural frequency ≈ 30 rad/s, critically damped; ``integral_gain`` K_i [1/s] of
-    the PI drive (time constant 1/K_i = 0.5 s; 0: P only, the integral stays 0)."""
+    the PI drive (time constant 1/K_i = 0.5 s; 0: P only, the integral stays 0); the yaw
+    axis has the rotation's inertia, damping and stiffness and its own bound [rad] (4°:
+    twice the cell's largest yaw error of the vision, ``--vision-yaw-max``)."""
 
     mass: float = 1.5
     damping: float = 90.0
@@ -38,28 +43,35 @@ class AdmittanceParams:
     rot_stiffness: float = 10.0
     rot_bound: float = 0.035
     integral_gain: float = 2.0
+    yaw_bound: float = 0.07
 
 
 class Admittance:
-    """State δ = (dx, dy, rx, ry) with velocities; ``update`` returns the pose offset."""
+    """State δ = (dx, dy, rx, ry) with velocities, and rz with ``yaw``; ``update`` returns
+    the pose offset."""
 
-    def __init__(self, params: AdmittanceParams = AdmittanceParams()) -> None:
+    def __init__(self, params: AdmittanceParams = AdmittanceParams(), yaw: bool = False) -> None:
         p = params
-        self.mass = np.array([p.mass, p.mass, p.inertia, p.inertia])
-        self.damping = np.array([p.damping, p.damping, p.rot_damping, p.rot_damping])
-        self.stiffness = np.array([p.stiffness, p.stiffness, p.rot_stiffness, p.rot_stiffness])
-        self.bound = np.array([p.bound, p.bound, p.rot_bound, p.rot_bound])
+        self.yaw = yaw
+        axes = slice(0, 5 if yaw else 4)
+        self.mass = np.array([p.mass, p.mass, p.inertia, p.inertia, p.inertia])[axes]
+        self.damping = np.array([p.damping, p.damping, p.rot_damping, p.rot_damping, p.rot_damping])[axes]
+        self.stiffness = np.array([p.stiffness, p.stiffness, p.rot_stiffness, p.rot_stiffness, p.rot_stiffness])[axes]
+        self.bound = np.array([p.bound, p.bound, p.rot_bound, p.rot_bound, p.yaw_bound])[axes]
         self.integral_gain = p.integral_gain
+        n = len(self.mass)
         # Anti-windup: no more integral than holds δ at its bound (none at all for P only).
-        self.integral_limit = self.stiffness * self.bound / p.integral_gain if p.integral_gain > 0 else np.zeros(4)
-        self.offset = np.zeros(4)
-        self.velocity = np.zeros(4)
-        self.integral = np.zeros(4)
+        self.integral_limit = self.stiffness * self.bound / p.integral_gain if p.integral_gain > 0 else np.zeros(n)
+        self.offset = np.zeros(n)
+        self.velocity = np.zeros(n)
+        self.integral = np.zeros(n)
 
     def update(self, force_dev: np.ndarray, torque_dev: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Advance by ``dt`` [s] with the wrench deviation (world frame) [N, Nm]; returns
         the translation offset (3,) [m] and the rotation vector offset (3,) [rad]."""
         error = np.array([force_dev[0], force_dev[1], torque_dev[0], torque_dev[1]])
+        if self.yaw:
+            error = np.append(error, torque_dev[2])
         self.integral = np.clip(self.integral + error * dt, -self.integral_limit, self.integral_limit)
         excitation = error + self.integral_gain * self.integral
         acc = (excitation - self.damping * self.velocity - self.stiffness * self.offset) / self.mass
@@ -68,4 +80,5 @@ class Admittance:
         clipped = np.clip(self.offset, -self.bound, self.bound)
         self.velocity[clipped != self.offset] = 0.0
         self.offset = clipped
-        return np.array([self.offset[0], self.offset[1], 0.0]), np.array([self.offset[2], self.offset[3], 0.0])
+        yaw = self.offset[4] if self.yaw else 0.0
+        return np.array([self.offset[0], self.offset[1], 0.0]), np.array([self.offset[2], self.offset[3], yaw])

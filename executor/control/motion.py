@@ -31,6 +31,9 @@ class Motion:
         self.controller = controller
         self.logger = logger
         self.steps = 0
+        self.tool_yaw = 0.0
+        """[rad] the yaw of the pointing-down tool the transfers last commanded
+        (:mod:`executor.assembly.transfer`): where their next move turns it from."""
 
     @property
     def sim_time(self) -> float:

@@ -19,6 +19,7 @@ from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill
 from executor.skills.search import SearchParams
 from executor.skills.wiggle import wiggle
+from executor.world.arm import turn_quats_z, turn_z
 from executor.world.scene import TIME_STEP
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.
@@ -61,9 +62,11 @@ def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
 def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
            admittance: Admittance | None, gripper_lever: float, wiggle_enabled: bool = True, *,
            phase_stopping: bool = True, feedforward: np.ndarray | None = None,
-           record: bool = False) -> InsertionResult:
+           record: bool = False, yaw: float = 0.0) -> InsertionResult:
     """Run the skill in the hole frame at ``hole_origin`` (hole centre on the plate top,
-    [m]) starting from the current tip pose.
+    [m]), turned by ``yaw`` [rad] about z (the tool yaw aligned to the hole's estimated
+    yaw; the skill's poses and reference wrench are in the frame it was taught in),
+    starting from the current tip pose.
 
     The execution layer: ``admittance`` None is pure position control along the DMP;
     ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
@@ -79,13 +82,14 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     wiggle runs there, and the goal is checked again."""
     s = motion.controller.arm.read()
     goal = skill.demo_goal
-    times, pos, quats = skill.rollout(s.tip_pos - hole_origin, s.tip_quat_xyzw, goal[:3],
-                                      np.roll(goal[3:], -1))
-    clock = PhaseClock(times, pos + hole_origin, quats, detector.thresholds.f_slow)
+    times, pos, quats = skill.rollout(turn_z(s.tip_pos - hole_origin, -yaw), turn_quats_z(s.tip_quat_xyzw, -yaw),
+                                      goal[:3], np.roll(goal[3:], -1))
+    clock = PhaseClock(times, turn_z(pos, yaw) + hole_origin, turn_quats_z(quats, yaw), detector.thresholds.f_slow)
     d_pos, d_rot = np.zeros(3), np.zeros(3)
     wiggles, jammed, completed = 0, False, True
     budget = int(TIMEOUT_FACTOR * clock.duration / TIME_STEP)
-    wrench_table = skill.wrench.tabulate()
+    taught = skill.wrench.tabulate()
+    wrench_table = np.concatenate([turn_z(taught[:, :3], yaw), turn_z(taught[:, 3:], yaw)], axis=1)
     last = len(wrench_table) - 1
     ff = np.zeros((1, 5)) if feedforward is None else feedforward
     ff_last = len(ff) - 1
@@ -95,7 +99,8 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         return c[:3], np.array([c[3], c[4], 0.0])
 
     trace = ExecutionTrace() if record else None
-    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], 0.0])
+    yaw_bound = admittance.bound[4] if admittance is not None and admittance.yaw else 0.0
+    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], yaw_bound])
     for _ in range(budget):
         if clock.done:
             break
@@ -133,7 +138,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
     # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets
     # included; not ILC's z, which only shapes the push, never where the part must end).
-    p_goal = hole_origin + skill.end_position + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])
+    p_goal = hole_origin + turn_z(skill.end_position, yaw) + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])
     reached, err = detector.goal_reached(end.tip_pos, p_goal)
     stalled = completed and not reached and bool(end.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
     jammed = jammed or stalled  # stuck in the hole below the thresholds: a jam too
@@ -145,14 +150,26 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase, trace)
 
 
+def needs_yaw_compliance(part_kind: str, hole_kind: str) -> bool:
+    """Whether the insertion corrects the part's yaw: a square or rect part in a rect hole,
+    whose yaw the vision estimates with an error (a round part has no yaw to correct; a
+    square hole's yaw is known, as it always was)."""
+    return hole_kind == "rect" and part_kind != "round"
+
+
 def insert_in_layer(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
                     layer: ExecutionLayer, gripper_lever: float, wiggle_enabled: bool = True,
-                    correction: np.ndarray | None = None) -> InsertionResult:
+                    correction: np.ndarray | None = None, yaw: float = 0.0,
+                    yaw_compliant: bool = False) -> InsertionResult:
     """:func:`insert` under an execution layer: its admittance (P or PI, none for pure
     position control), phase stopping, the ILC ``correction`` and recording; with
     ``layer.stiff`` the insertion tracks with :data:`POSITION_CONTROL_GAINS` and the
-    controller's own gains come back after (the search and the release stay compliant)."""
-    admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0))
+    controller's own gains come back after (the search and the release stay compliant);
+    ``yaw`` [rad]: the hole frame's (:func:`insert`); ``yaw_compliant``: the admittance
+    also turns the part about the tool axis (a part aligned to a rect hole's estimated
+    yaw, :func:`needs_yaw_compliance`)."""
+    admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0),
+                             yaw=yaw_compliant)
                   if layer.admittance else None)
     controller = motion.controller
     compliant = controller.gains
@@ -160,6 +177,6 @@ def insert_in_layer(motion: Motion, skill: Skill, hole_origin: np.ndarray, detec
         controller.gains = POSITION_CONTROL_GAINS
     try:
         return insert(motion, skill, hole_origin, detector, admittance, gripper_lever, wiggle_enabled,
-                      phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc)
+                      phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc, yaw=yaw)
     finally:
         controller.gains = compliant

@@ -2,11 +2,12 @@
 
 Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path (0.8 s)
 from 2 mm inside the entrance of the shape's ``demo_hole`` (where the hole search leaves
-the part; exactly aligned, perfect grasp) down to 0.5 mm above the hole's bottom; the
+the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom; the
 tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
 executed by the impedance controller alone and the wrench it meets is recorded: the
 reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
-replay ends is p_goal.  ``./run.sh executor teach`` rebuilds
+replay ends is p_goal.  Poses, wrenches and p_goal are stored in the hole's frame (turned
+by the hole's yaw), so the skill runs in a hole of any yaw.  ``./run.sh executor teach`` rebuilds
 ``data/<assembly>/demonstrations/<shape>.json``.
 """
 
@@ -19,8 +20,8 @@ import numpy as np
 from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
 from executor.trial import SETTLE_TIME, Cell
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW
-from executor.world.geometry import write_assets
+from executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
+from executor.world.assets import regenerate_assets
 from executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s]
@@ -32,37 +33,40 @@ def _min_jerk(s: np.ndarray) -> np.ndarray:
     return 10 * s**3 - 15 * s**4 + 6 * s**5
 
 
-def _demonstrate(motion: Motion, origin: np.ndarray, bottom: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Guide the tip down into the hole; returns recorded times [s], positions (hole frame)
-    [m] and quaternions (xyzw)."""
-    quat = TOOL_DOWN_QUAT_XYZW
+def _demonstrate(motion: Motion, origin: np.ndarray, bottom: float,
+                 yaw: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Guide the tip down into the hole, the tool turned by ``yaw`` [rad] (the hole's);
+    returns recorded times [s], positions [m] and quaternions (xyzw) in the hole frame
+    (turned by ``yaw``)."""
+    quat = tool_quat(yaw)
     n = int(round(DEMO_DURATION / TIME_STEP))
     z = DEMO_START_HEIGHT + (-(bottom - DEMO_CLEARANCE) - DEMO_START_HEIGHT) * _min_jerk(np.linspace(0, 1, n))
     times, positions, quats = [], [], []
     for k in range(n):
         s = motion.step(origin + np.array([0.0, 0.0, z[k]]), quat)
         times.append(k * TIME_STEP)
-        positions.append(s.tip_pos - origin)
-        quats.append(s.tip_quat_xyzw)
+        positions.append(turn_z(s.tip_pos - origin, -yaw))
+        quats.append(turn_quats_z(s.tip_quat_xyzw, -yaw))
     return np.array(times), np.array(positions), np.array(quats)
 
 
-def _replay(motion: Motion, skill: Skill, origin: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Run the DMP without adaptation; returns phases, wrenches (N, 6) [N, Nm] and the
-    end position (hole frame) [m]."""
+def _replay(motion: Motion, skill: Skill, origin: np.ndarray,
+            yaw: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Run the DMP without adaptation in the hole frame turned by ``yaw`` [rad]; returns
+    phases, wrenches (N, 6) [N, Nm] and the end position [m], in the hole frame."""
     times, pos, quats = skill.rollout(skill.demo_start[:3], np.roll(skill.demo_start[3:], -1),
                                       skill.demo_goal[:3], np.roll(skill.demo_goal[3:], -1))
-    clock = PhaseClock(times, pos + origin, quats, f_slow=1.0)
+    clock = PhaseClock(times, turn_z(pos, yaw) + origin, turn_quats_z(quats, yaw), f_slow=1.0)
     phases, wrenches = [], []
     while not clock.done:
         p, q = clock.pose()
         s = motion.step(p, q, phase=clock.phase)
         phases.append(clock.phase)
-        wrenches.append(np.concatenate([s.force, s.torque]))
+        wrenches.append(np.concatenate([turn_z(s.force, -yaw), turn_z(s.torque, -yaw)]))
         clock.advance(TIME_STEP, 0.0)
     p, q = clock.pose()
     end = motion.hold(p, q, SETTLE_TIME)
-    return np.array(phases), np.array(wrenches), end.tip_pos - origin
+    return np.array(phases), np.array(wrenches), turn_z(end.tip_pos - origin, -yaw)
 
 
 def teach_shape(cell: Cell, shape: str) -> Skill:
@@ -78,22 +82,24 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     arm = motion.controller.arm
     arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
+    yaw = aligned_yaw(part.kind, hole.kind, hole.yaw)
+    quat = tool_quat(yaw)
 
     def go_to_start() -> None:
-        arm.inverse_kinematics(start, TOOL_DOWN_QUAT_XYZW)
+        arm.inverse_kinematics(start, quat)
         motion.controller.reset()
-        motion.hold(start, TOOL_DOWN_QUAT_XYZW, SETTLE_TIME)
+        motion.hold(start, quat, SETTLE_TIME)
         arm.tare_sensor()
 
     go_to_start()
-    times, positions, quats = _demonstrate(motion, origin, bottom)
+    times, positions, quats = _demonstrate(motion, origin, bottom, yaw)
     weights = fit_dmp(times, positions, quats)
     skill = Skill(shape, float(times[-1]), weights,
                   np.concatenate([positions[0], xyzw_to_wxyz(quats[0])]),
                   np.concatenate([positions[-1], xyzw_to_wxyz(quats[-1])]),
                   np.zeros(3), WrenchProfile.fit(np.zeros(1), np.zeros((1, 6))))
     go_to_start()
-    phases, wrenches, end = _replay(motion, skill, origin)
+    phases, wrenches, end = _replay(motion, skill, origin, yaw)
     skill.wrench = WrenchProfile.fit(phases, wrenches)
     skill.end_position = end
     cell.scene.release()
@@ -104,7 +110,7 @@ def teach_all(assembly: str = "cranfield") -> list[Path]:
     """Regenerate the assets and teach every part shape; returns the written files."""
     cell = Cell(assembly)
     try:
-        written = write_assets(cell.geometry)
+        written = regenerate_assets(cell.geometry)
         for shape in sorted({p.shape for p in cell.geometry.parts.values()}):
             written.append(save_skill(cell.geometry.folder, teach_shape(cell, shape)))
     finally:

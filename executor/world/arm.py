@@ -8,6 +8,7 @@ commands is the believed one, and the part really ends up offset and tilted.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +20,51 @@ N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
 REST_POSTURE = np.array([0.0, 0.6, 0.0, -1.4, 0.0, 1.1, 0.0])
 TOOL_DOWN_QUAT_XYZW = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def tool_quat(yaw: float) -> np.ndarray:
+    """The tool pointing down, turned by ``yaw`` [rad] about the world z axis (xyzw):
+    Rz(yaw) · :data:`TOOL_DOWN_QUAT_XYZW`, so the held part's x axis points at angle
+    ``yaw``; exactly :data:`TOOL_DOWN_QUAT_XYZW` at yaw 0."""
+    return np.array([math.cos(yaw / 2), math.sin(yaw / 2), 0.0, 0.0])
+
+
+def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
+    """The rotation by ``yaw`` [rad] about z (xyzw): a turned hole's or boss's orientation."""
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
+def turn_z(vectors: np.ndarray, yaw: float) -> np.ndarray:
+    """Vectors (..., 3) turned by ``yaw`` [rad] about z (returned unchanged at yaw 0)."""
+    if yaw == 0.0:
+        return vectors
+    c, s = math.cos(yaw), math.sin(yaw)
+    out = np.array(vectors, dtype=float)
+    out[..., 0] = c * vectors[..., 0] - s * vectors[..., 1]
+    out[..., 1] = s * vectors[..., 0] + c * vectors[..., 1]
+    return out
+
+
+def turn_quats_z(quats_xyzw: np.ndarray, yaw: float) -> np.ndarray:
+    """Orientations (..., 4) xyzw turned by ``yaw`` [rad] about the world z axis:
+    Rz(yaw) · q (returned unchanged at yaw 0)."""
+    if yaw == 0.0:
+        return quats_xyzw
+    s, c = math.sin(yaw / 2), math.cos(yaw / 2)
+    x, y, z, w = (quats_xyzw[..., k] for k in range(4))
+    return np.stack([c * x - s * y, c * y + s * x, c * z + s * w, c * w - s * z], axis=-1)
+
+
+def aligned_yaw(part_kind: str, hole_kind: str, yaw: float) -> float:
+    """The tool yaw [rad] that puts a part of ``part_kind`` along a hole of ``hole_kind``
+    whose x axis is at ``yaw`` [rad]: 0 when either is round (nothing to align), else
+    ``yaw`` reduced by the symmetry of the pair (a quarter turn when either is square,
+    a half turn for rect in rect) into the half period around 0, the smallest turn of the
+    wrist."""
+    if "round" in (part_kind, hole_kind):
+        return 0.0
+    period = math.pi / 2 if "square" in (part_kind, hole_kind) else math.pi
+    return yaw - period * round(yaw / period)
 
 
 def quat_to_matrix(quat_xyzw: np.ndarray) -> np.ndarray:

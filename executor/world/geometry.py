@@ -4,48 +4,68 @@
 The back plate is a static concave triangle mesh (PyBullet's trimesh has effectively no
 collision margin, so 0.1 mm clearances are real): one square boss per hole with a
 through hole (the plate under the boss is its bottom) and a 45° entry chamfer; round
-holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square holes exact.
-Parts are exact primitive shapes (cylinder with ``URDF_USE_IMPLICIT_CYLINDER``, box).
-``write_assets`` regenerates ``data/<assembly>/assets/`` byte-for-byte deterministically.
+holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square and
+rectangular holes exact; a hole with a yaw has its whole boss turned by it about the
+hole's centre.  Parts are exact primitive shapes (cylinder with
+``URDF_USE_IMPLICIT_CYLINDER``, box).
+
+Cross-sections (``kind``): ``round`` (``size`` = diameter), ``square`` (``size`` = side)
+and ``rect`` (``size = [a, b]``, a ≥ b: the long side a along the part's or hole's x
+axis), all in m; a hole's ``yaw`` [°] turns its x axis about z (counter-clockwise from
+the cell's x axis).  :func:`passes` compares aligned cross-sections: the skills turn
+the part to the hole's (measured) yaw, so the yaw never changes whether a part fits.
+``write_assets`` regenerates ``data/<assembly>/assets/`` deterministically (the URDFs byte
+for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 """
 
 from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
+import clingo
 import numpy as np
 import pybullet_data
 
 from bridge.assembly import Assembly, load_assembly
 from bridge.files import make_folder, write_atomic
-from bridge.inputs import read_text, shorten
+from bridge.inputs import read_text
 from executor import ExecutorError
+from executor.world.validation import check_geometry
 
 
 @dataclass(frozen=True)
 class Section:
-    """A part's or a hole's cross-section: ``kind`` "round" (``size`` = diameter [m]) or
-    "square" (``size`` = side [m])."""
+    """A part's or a hole's cross-section: ``kind`` "round" (``size`` = diameter [m]),
+    "square" (``size`` = side [m]) or "rect" (``size`` = long side a along x [m],
+    ``width`` = short side b along y [m]; 0 means ``size``: round and square)."""
 
     id: str
     kind: str
     size: float
+    width: float = field(default=0.0, kw_only=True)
+
+    @property
+    def sides(self) -> tuple[float, float]:
+        """(a, b) [m]: the extents along x and y (a round section: its diameter twice)."""
+        return self.size, self.width if self.width > 0 else self.size
 
 
 @dataclass(frozen=True)
 class HoleSpec(Section):
-    """A hole of the plate at ``position`` [m]."""
+    """A hole of the plate at ``position`` [m], its x axis turned by ``yaw`` [rad] about z."""
 
     position: tuple[float, float]
+    yaw: float = 0.0
 
 
 @dataclass(frozen=True)
 class PartSpec(Section):
     """A graspable part of shape ``shape`` (its skill's name): ``length`` [m], ``mass`` [kg],
-    ``start`` on the tray [m], ``demo_hole`` where its shape's skill is taught."""
+    ``start`` on the tray [m], ``demo_hole`` where its shape's skill is taught (a rect
+    part's long side is along the tool's x axis when held)."""
 
     shape: str
     length: float
@@ -77,110 +97,169 @@ def _read_toml(path: Path) -> dict:
         raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
 
 
-_NUMBERS = {"plate": ("top_z", "tile_size", "tile_thickness", "chamfer", "polygon_sides", "base_thickness"),
-            "gripper": ("flange_mass", "flange_inertia", "flange_length", "grasp_depth")}
-_PAIRS = {"plate": ("base_size", "base_center")}
-
-
-def _is_number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-def _check_tables(path: Path, geo: dict) -> None:
-    """The [plate] and [gripper] keys the scene reads later: present, finite numbers
-    ([x, y] pairs for base_size, base_center); ExecutorError naming the key otherwise."""
-    for table in ("plate", "gripper"):
-        values = geo.get(table)
-        if not isinstance(values, dict):
-            raise ExecutorError(f"{path}: no [{table}] table; expected the tables of data/cranfield/geometry.toml")
-        for key in _NUMBERS[table]:
-            if not _is_number(values.get(key)):
-                raise ExecutorError(f"{path}: [{table}] {key}: expected a finite number, "
-                                    f"got {shorten(repr(values.get(key)))}")
-        for key in _PAIRS.get(table, ()):
-            value = values.get(key)
-            if not (isinstance(value, list) and len(value) == 2 and all(map(_is_number, value))):
-                raise ExecutorError(f"{path}: [{table}] {key}: expected [x, y] in m, got {shorten(repr(value))}")
-
-
 def load_geometry(assembly: str = "cranfield") -> CellGeometry:
     """Read ``assembly.toml`` (through :func:`bridge.assembly.load_assembly`) and
-    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path).
-    ExecutorError naming the file and key when a table or key is missing or malformed."""
+    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path), checked
+    as a whole first (:func:`executor.world.validation.check_geometry`: ExecutorError
+    naming the file, table and key)."""
     layout = load_assembly(assembly)
     path = layout.folder / "geometry.toml"
     geo = _read_toml(path)
-    _check_tables(path, geo)
-    try:
-        return _geometry(layout.folder, layout, geo)
-    except KeyError as exc:
-        raise ExecutorError(f"{path}: missing key {shorten(exc.args[0])!r} in a [hole_shapes.*], [part_shapes.*] "
-                            "or [extra_parts.*] table (see data/cranfield/geometry.toml)") from None
-    except (TypeError, ValueError, AttributeError) as exc:
-        raise ExecutorError(f"{path}: a malformed table ({shorten(exc, 80)}); expected the tables of "
-                            "data/cranfield/geometry.toml") from None
+    check_geometry(path, geo, layout)
+    return _geometry(layout.folder, layout, geo)
+
+
+def section_of(shape: dict) -> tuple[str, float, float]:
+    """``kind``, size and width [m] of a checked ``[hole_shapes.*]`` or ``[part_shapes.*]``
+    table (:func:`executor.world.validation.check_geometry`): a rect ``[a, b]`` gives a
+    and b, any other kind its one size and width 0."""
+    kind, size = shape["kind"], shape["size"]
+    if kind == "rect":
+        return kind, float(size[0]), float(size[1])
+    return kind, float(size), 0.0
+
+
+def _yaw(shape: dict) -> float:
+    """A checked hole table's ``yaw`` [°] (default 0), in rad."""
+    return math.radians(shape.get("yaw", 0.0))
 
 
 def _geometry(folder: Path, layout: Assembly, geo: dict) -> CellGeometry:
-    positions = {hole.id: hole.position for hole in layout.holes}
+    positions = {hole.id: hole.position for hole in layout.holes if hole.position is not None}
     holes: dict[str, HoleSpec] = {}
     for shape in geo.get("hole_shapes", {}).values():
+        kind, size, width = section_of(shape)
+        yaw = _yaw(shape)
         for hid in shape["holes"]:
-            if hid not in positions:
-                raise ExecutorError(f"geometry.toml: hole '{hid}' is not a hole of assembly.toml")
-            position = positions[hid]
-            if position is None:
-                raise ExecutorError(f"assembly.toml: hole '{hid}' has no position (expected [x, y] in m)")
-            holes[hid] = HoleSpec(hid, shape["kind"], float(shape["size"]), position)
-    starts = {part.id: part.start for part in layout.parts}
+            holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=yaw, width=width)
+    starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: p["start"] for pid, p in geo.get("extra_parts", {}).items()}
     parts: dict[str, PartSpec] = {}
     for name, shape in geo.get("part_shapes", {}).items():
+        kind, size, width = section_of(shape)
         for pid in shape["parts"]:
-            start = starts.get(pid)
-            if start is None:
-                raise ExecutorError(f"geometry.toml: part '{pid}' has no start position (expected [x, y] in m)")
-            x, y = start
+            x, y = starts[pid]
             parts[pid] = PartSpec(
-                pid, shape["kind"], float(shape["size"]), shape=name, length=float(shape["length"]),
-                mass=float(shape["mass"]), start=(float(x), float(y)), demo_hole=shape["demo_hole"],
+                pid, kind, size, shape=name, length=float(shape["length"]),
+                mass=float(shape["mass"]), start=(float(x), float(y)), demo_hole=shape["demo_hole"], width=width,
             )
+    _cross_check(layout, holes, parts)
     return CellGeometry(folder, geo["plate"], geo["gripper"], holes, parts)
 
 
-def passes(part: PartSpec, hole: HoleSpec) -> bool:
-    """Whether the part's cross-section passes the hole's (axis-aligned, no clearance needed
-    beyond a positive one): round in round d < D, round in square d < S, square in square
-    s < S, square in round s·√2 < D (its diagonal)."""
-    extent = part.size * math.sqrt(2.0) if part.kind == "square" and hole.kind == "round" else part.size
-    return extent < hole.size
+def _cross_check(layout: Assembly, holes: dict[str, HoleSpec], parts: dict[str, PartSpec]) -> None:
+    """The ``shape`` of each part and hole in ``assembly.toml`` (where given) is the
+    ``kind`` of its cross-section in ``geometry.toml``, and the parts of one ``section``
+    are scaled copies of one cross-section (one aspect ratio b/a, all round or none);
+    ExecutorError naming them otherwise."""
+    declared: list[tuple[str, str, str | None, Section | None]]
+    declared = [(part.id, "part", part.shape, parts.get(part.id)) for part in layout.parts]
+    declared += [(hole.id, "hole", hole.shape, holes.get(hole.id)) for hole in layout.holes]
+    for item, what, shape, spec in declared:
+        if shape is not None and spec is not None and spec.kind != shape:
+            raise ExecutorError(f"{layout.folder / 'assembly.toml'}: {what} '{item}' has shape \"{shape}\" but "
+                                f"geometry.toml gives it kind \"{spec.kind}\"")
+    first: dict[str, PartSpec] = {}
+    for part in layout.parts:
+        spec = parts.get(part.id)
+        if part.section is None or spec is None:
+            continue
+        other = first.setdefault(part.section, spec)
+        if (other.kind == "round") != (spec.kind == "round") or not math.isclose(
+                spec.sides[1] / spec.sides[0], other.sides[1] / other.sides[0], rel_tol=1e-9):
+            raise ExecutorError(f"{layout.folder / 'assembly.toml'}: parts '{other.id}' and '{part.id}' share section "
+                                f"\"{part.section}\" but are no scaled copies of one cross-section "
+                                f"({_describe(other)} and {_describe(spec)} in geometry.toml)")
 
 
-def _ring(kind: str, half: float, n: int) -> np.ndarray:
-    """(n, 2) boundary points at angles 2πk/n [m]: an n-gon of inradius ``half`` or a square
-    of half side ``half`` (its corners are among the points since n is a multiple of 8)."""
+def _describe(section: Section) -> str:
+    """``round d 12 mm``, ``square 4 mm``, ``rect 16 x 10 mm``."""
+    a, b = (1000 * side for side in section.sides)
+    return {"round": f"round d {a:g} mm", "square": f"square {a:g} mm"}.get(section.kind, f"rect {a:g} x {b:g} mm")
+
+
+def passes(part: Section, hole: Section) -> bool:
+    """Whether the part's cross-section passes the hole's, aligned (the skill turns the
+    part to the hole's yaw; no clearance needed beyond a positive one): round in round
+    d < D; a square or rect a × b in round by its diagonal √(a² + b²) < D; round in a
+    square or rect by its short side d < B; a square or rect in a square or rect long
+    side along long side, a < A and b < B (a square is a rect with a = b)."""
+    if hole.kind == "round":
+        if part.kind == "round":
+            return part.size < hole.size
+        if part.kind == "square":
+            return part.size * math.sqrt(2.0) < hole.size
+        return math.hypot(*part.sides) < hole.size
+    long_side, short_side = hole.sides
+    if part.kind == "round":
+        return part.size < short_side
+    a, b = part.sides
+    return a < long_side and b < short_side
+
+
+def sizes_lp_text(assembly: str) -> str:
+    """The ``sizes.lp`` of an assembly folder as its geometry makes it: ``part/1`` for each
+    part of ``assembly.toml`` with a cross-section (``[part_shapes.*]``), ``hole/1`` for
+    each hole, ``fits/2`` for every pair that :func:`passes` (closed world), as clingo
+    symbols in the order of ``assembly.toml``, one line per part."""
+    geometry, layout = load_geometry(assembly), load_assembly(assembly)
+    pegs = [part.id for part in layout.parts if part.id in geometry.parts]
+    holes = [hole.id for hole in layout.holes if hole.id in geometry.holes]
+
+    def facts(symbols: list[clingo.Symbol]) -> str:
+        return " ".join(f"{symbol}." for symbol in symbols)
+
+    lines = [f"% {geometry.folder.name}: which part fits which hole (closed world), generated from geometry.toml",
+             "% by executor.world.geometry.passes; do not edit, regenerate with",
+             f"% ./run.sh executor sizes --assembly {geometry.folder.name} --out "
+             f"data/{geometry.folder.name}/sizes.lp",
+             facts([clingo.Function("part", [clingo.Function(pid)]) for pid in pegs]),
+             facts([clingo.Function("hole", [clingo.Function(hid)]) for hid in holes])]
+    for pid in pegs:
+        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid in holes
+                if passes(geometry.parts[pid], geometry.holes[hid])]
+        if fits:
+            lines.append(facts(fits))
+    return "\n".join(lines) + "\n"
+
+
+def _ring(kind: str, half: float, n: int, half_y: float = 0.0) -> np.ndarray:
+    """(n, 2) boundary points [m]: an n-gon of inradius ``half`` at angles 2πk/n, a square
+    of half side ``half`` at those angles (its corners are among the points since n is a
+    multiple of 8), or (rect) that square ring scaled to half sides ``half`` × ``half_y``,
+    so its corners have the same indices and its points the same order as the boss's."""
     angles = 2.0 * np.pi * np.arange(n) / n
     c, s = np.cos(angles), np.sin(angles)
     if kind == "round":
         radius = np.full(n, half / math.cos(math.pi / n))
+    elif kind == "rect":
+        unit = 1.0 / np.maximum(np.abs(c), np.abs(s))
+        return np.stack([half * unit * c, half_y * unit * s], axis=1)
     else:
         radius = half / np.maximum(np.abs(c), np.abs(s))
     return np.stack([radius * c, radius * s], axis=1)
+
+
+def _turned(ring: np.ndarray, yaw: float) -> np.ndarray:
+    """``ring`` (n, 2) [m] turned by ``yaw`` [rad] about the origin (unchanged at yaw 0)."""
+    if yaw == 0.0:
+        return ring
+    c, s = math.cos(yaw), math.sin(yaw)
+    return ring @ np.array([[c, s], [-s, c]])
 
 
 def _boss_triangles(hole: HoleSpec, plate: dict) -> list[np.ndarray]:
     """Triangles (3×3 vertex arrays [m], outward normals) of one boss with its through
     hole (the plate under the boss is the hole's bottom) and a 45° entry chamfer."""
     n = int(plate["polygon_sides"])
-    if n % 8:
-        raise ExecutorError(f"geometry.toml: polygon_sides = {n}, expected a multiple of 8")
     cx, cy = hole.position
     top = float(plate["top_z"])
     bottom = top - float(plate["tile_thickness"])
     chamfer = float(plate["chamfer"])
-    outer = _ring("square", float(plate["tile_size"]) / 2, n) + (cx, cy)
-    mouth = _ring(hole.kind, hole.size / 2 + chamfer, n) + (cx, cy)
-    inner = _ring(hole.kind, hole.size / 2, n) + (cx, cy)
+    half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
+    outer = _turned(_ring("square", float(plate["tile_size"]) / 2, n), hole.yaw) + (cx, cy)
+    mouth = _turned(_ring(hole.kind, half_a + chamfer, n, half_b + chamfer), hole.yaw) + (cx, cy)
+    inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw) + (cx, cy)
 
     def v(ring: np.ndarray, k: int, z: float) -> np.ndarray:
         x, y = ring[k % n]
@@ -229,7 +308,8 @@ def part_geometry_xml(part: PartSpec, z_centre: float, rgba: str) -> str:
     if part.kind == "round":
         shape = f'<cylinder radius="{part.size / 2:.6f}" length="{part.length:.6f}"/>'
     else:
-        shape = f'<box size="{part.size:.6f} {part.size:.6f} {part.length:.6f}"/>'
+        a, b = part.sides
+        shape = f'<box size="{a:.6f} {b:.6f} {part.length:.6f}"/>'
     origin = f'<origin xyz="0 0 {z_centre:.6f}" rpy="0 0 0"/>'
     return (
         f"    <visual>{origin}<geometry>{shape}</geometry>"
@@ -302,11 +382,3 @@ def write_assets(geometry: CellGeometry) -> list[Path]:
         written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part)))
     return written
 
-
-def plate_mesh(geometry: CellGeometry) -> Path:
-    """``assets/plate.obj`` (the bosses with their holes, world coordinates [m]), generated
-    with the other assets first if it is missing."""
-    path = geometry.assets / "plate.obj"
-    if not path.is_file():
-        write_assets(geometry)
-    return path

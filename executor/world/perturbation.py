@@ -12,6 +12,11 @@ drawn per execution from the trial's random stream:
 - error of the hole's estimated position (vision) [m]: a calibration bias per hole
   (≤ ``vision_bias``) plus a normal error (σ = ``vision_sigma`` per axis), the total
   at most ``vision_max``;
+- error of a rect hole's estimated yaw (vision) [°], the same model: a calibration bias
+  per hole (uniform, ≤ ``vision_yaw_bias``) plus a normal error (σ =
+  ``vision_yaw_sigma``), the total at most ``vision_yaw_max``; drawn from streams of
+  their own (the hole's, and one seeded by the attempt's search seed), so the draws of
+  round and square holes are those of a cell without yaw errors;
 - friction coefficient of the part in the hole: per hole, uniform in
   ``friction_min..friction_max``, plus at most ± ``friction_jitter`` per execution.
 
@@ -23,6 +28,7 @@ Magnitudes, defaults and reasons are in docs/cell.md.
 
 from __future__ import annotations
 
+import math
 import zlib
 from dataclasses import dataclass, field, fields
 
@@ -36,7 +42,7 @@ from executor.evidence import AttemptSetup
 @dataclass(frozen=True)
 class PerturbationModel:
     """Magnitudes of the cell's uncertainty: grasp offsets [m], grasp tilts [°], vision
-    errors [m], friction coefficients (Coulomb, part on hole wall, dimensionless); the
+    errors [m], vision yaw errors [°], friction coefficients (Coulomb, part on hole wall, dimensionless); the
     defaults are those of the cell's options (:data:`bridge.cell_options.MAGNITUDES`)."""
 
     grasp_offset_bias: float = MAGNITUDES["grasp_offset_bias"].default
@@ -46,6 +52,9 @@ class PerturbationModel:
     vision_bias: float = MAGNITUDES["vision_bias"].default
     vision_sigma: float = MAGNITUDES["vision_sigma"].default
     vision_max: float = MAGNITUDES["vision_max"].default
+    vision_yaw_bias: float = MAGNITUDES["vision_yaw_bias"].default
+    vision_yaw_sigma: float = MAGNITUDES["vision_yaw_sigma"].default
+    vision_yaw_max: float = MAGNITUDES["vision_yaw_max"].default
     friction_min: float = MAGNITUDES["friction_min"].default
     friction_max: float = MAGNITUDES["friction_max"].default
     friction_jitter: float = MAGNITUDES["friction_jitter"].default
@@ -55,7 +64,8 @@ class PerturbationModel:
         its range): what no learning across executions can remove."""
         mid = (self.friction_min + self.friction_max) / 2
         return PerturbationModel(0.0, self.grasp_offset_random, 0.0, self.grasp_tilt_random, 0.0,
-                                 self.vision_sigma, self.vision_max, mid, mid, self.friction_jitter)
+                                 self.vision_sigma, self.vision_max, 0.0, self.vision_yaw_sigma,
+                                 self.vision_yaw_max, mid, mid, self.friction_jitter)
 
     def check(self) -> PerturbationModel:
         """ExecutorError naming the field unless every magnitude is ≥ 0 and the friction range ordered."""
@@ -67,7 +77,7 @@ class PerturbationModel:
         return self
 
 
-NO_PERTURBATION = PerturbationModel(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.25, 0.25, 0.0)
+NO_PERTURBATION = PerturbationModel(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.25, 0.25, 0.0)
 """A perfect cell: exact grasp, exact hole positions, the teaching friction (0.25)."""
 
 
@@ -86,7 +96,8 @@ def _tilt(rng: np.random.Generator, max_deg: float) -> np.ndarray:
 @dataclass
 class CellBias:
     """The systematic part of one cell: per part shape a grasp offset [m] and tilt
-    (rotation vector [rad]); per hole a vision bias [m] (x, y) and a friction coefficient.
+    (rotation vector [rad]); per hole a vision bias [m] (x, y) and a friction coefficient,
+    and per rect hole a yaw bias [rad].
     Drawn lazily, each from its own stream of (cell seed, name), so it does not depend on
     the order in which shapes and holes are first used."""
 
@@ -94,6 +105,7 @@ class CellBias:
     seed: int
     grasp: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     holes: dict[str, tuple[np.ndarray, float]] = field(default_factory=dict)
+    yaws: dict[str, float] = field(default_factory=dict)
 
     def _rng(self, kind: str, name: str) -> np.random.Generator:
         return np.random.default_rng([self.seed, zlib.crc32(kind.encode()), zlib.crc32(name.encode())])
@@ -113,8 +125,18 @@ class CellBias:
             self.holes[hole] = (_disc(rng, m.vision_bias)[:2], float(rng.uniform(m.friction_min, m.friction_max)))
         return self.holes[hole]
 
-    def draw(self, rng: np.random.Generator, shape: str, hole: str) -> AttemptSetup:
-        """One execution's circumstances: systematic + random parts (the random ones from ``rng``)."""
+    def yaw_of_hole(self, hole: str) -> float:
+        """Vision yaw bias of a rect hole [rad], uniform in ± ``vision_yaw_bias``."""
+        if hole not in self.yaws:
+            bias = self.model.vision_yaw_bias
+            self.yaws[hole] = math.radians(float(self._rng("hole_yaw", hole).uniform(-bias, bias)))
+        return self.yaws[hole]
+
+    def draw(self, rng: np.random.Generator, shape: str, hole: str, oriented: bool = False) -> AttemptSetup:
+        """One execution's circumstances: systematic + random parts (the random ones from
+        ``rng``); ``oriented``: the hole's yaw is estimated too (a rect hole), with an error
+        from a stream of its own (the hole's bias, then a stream of the search seed), so
+        ``rng`` is drawn from the same way either way."""
         m = self.model
         offset0, tilt0 = self.of_shape(shape)
         vision0, friction0 = self.of_hole(hole)
@@ -123,4 +145,11 @@ class CellBias:
         vision = vision0 + rng.normal(0.0, m.vision_sigma, 2)
         vision *= min(1.0, m.vision_max / max(float(np.linalg.norm(vision)), 1e-12))
         friction = max(0.0, friction0 + float(rng.uniform(-m.friction_jitter, m.friction_jitter)))
-        return AttemptSetup(offset, tilt, vision, int(rng.integers(2**31)), friction)
+        search_seed = int(rng.integers(2**31))
+        yaw = 0.0
+        if oriented:
+            stream = np.random.default_rng([search_seed, zlib.crc32(b"vision_yaw")])
+            noise = float(stream.normal(0.0, m.vision_yaw_sigma))
+            limit = math.radians(m.vision_yaw_max)
+            yaw = float(np.clip(self.yaw_of_hole(hole) + math.radians(noise), -limit, limit))
+        return AttemptSetup(offset, tilt, vision, search_seed, friction, yaw)

@@ -18,7 +18,9 @@ import pybullet_data
 
 from executor import ExecutorError
 from executor.world import TIME_STEP
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, plate_mesh
+from executor.world.arm import yaw_quat
+from executor.world.assets import current_assets
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -53,7 +55,7 @@ class Scene:
         pb.setTimeStep(TIME_STEP, physicsClientId=self.client)
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=self.client)
-        plate_obj = plate_mesh(geometry)
+        plate_obj = current_assets(geometry) / "plate.obj"
         self.floor = pb.loadURDF("plane.urdf", physicsClientId=self.client)
         self.plate = load_plate(self.client, geometry, plate_obj)
         self.tray_parts = {
@@ -146,15 +148,16 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
                             (0, 0, 0, 1), (140, 150, 165))]
     half_tile, half_thick = plate["tile_size"] / 2, plate["tile_thickness"] / 2
     for hid, hole in sorted(geometry.holes.items()):
+        turned = yaw_quat(hole.yaw)  # the boss turns with its hole
         shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
-                       (*hole.position, plate["top_z"] - half_thick), (0, 0, 0, 1), (180, 185, 190)))
+                       (*hole.position, plate["top_z"] - half_thick), turned, (180, 185, 190)))
         half_depth = plate["tile_thickness"] / 2
-        r = hole.size / 2
-        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (r, r, half_depth),
-                       (*hole.position, plate["top_z"] - half_depth), (0, 0, 0, 1), (40, 40, 40)))
+        a, b = hole.sides
+        shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (a / 2, b / 2, half_depth),
+                       (*hole.position, plate["top_z"] - half_depth), turned, (40, 40, 40)))
     for pid, part in sorted(geometry.parts.items()):
-        r = part.size / 2
-        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (r, r, part.length / 2),
+        a, b = part.sides
+        shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (a / 2, b / 2, part.length / 2),
                        (*part.start, part.length / 2), (0, 0, 0, 1), (205, 155, 50)))
     return shapes
 

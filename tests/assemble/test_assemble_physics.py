@@ -72,3 +72,18 @@ def test_the_spare_plan_is_assembled_with_the_cells_uncertainty_and_ilc_layer(ru
     report = json.loads(done.stdout)
     assert report["assembled"] is True
     assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
+
+
+@pytest.mark.slow
+def test_the_taskboard_is_assembled_each_peg_in_its_own_hole_within_2_mm(run_cli, root) -> None:
+    """The NIST task board's eight pegs (four of them square or rect, three slots turned)
+    by the hand-written plan of examples/taskboard-plan.json: every step in physics."""
+    plan = root / "examples" / "taskboard-plan.json"
+    done = run_cli("assemble", "--assembly", "taskboard", str(plan), "--json", timeout=400)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True and not report["replans"]
+    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 9
+    errors = report["final_pose_error_mm"]
+    assert set(errors) == {"base", "round4", "round8", "round12", "round16", "rect4", "rect8", "rect12", "rect16"}
+    assert max(errors.values()) < 2.0, errors

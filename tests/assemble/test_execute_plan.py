@@ -5,6 +5,7 @@ code 3; against a fake cell that answers from the true sizes and a set of blocke
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -77,7 +78,8 @@ def test_the_graded_board_with_a_blocked_large_hole_stops(hole: str) -> None:
     with pytest.raises(AssemblyStopped) as stopped:
         _run("graded", {hole})
     assert "no complete assignment is left" in str(stopped.value) and stopped.value.report["assembled"] is False
-    assert str(stopped.value).split("not solvable: part ")[1][:2] in {"p4", "p5", "p6"}, str(stopped.value)
+    named = re.search(r"not solvable: parts? (.*?) fit", str(stopped.value)).group(1).split()
+    assert named and set(named) <= {"p4", "p5", "p6"}, str(stopped.value)
 
 
 @pytest.mark.parametrize("hole", ["r1", "s1", "br"])
@@ -97,7 +99,7 @@ def test_the_command_line_stops_with_exit_code_3(run_cli) -> None:
     done = run_cli("assemble", "--backend", "truth", "--block-hole", "s2", "--json", timeout=60)
     assert done.returncode == 3, done.stderr
     report = json.loads(done.stdout)
-    assert report["assembled"] is False and "gets no hole" in done.stderr
+    assert report["assembled"] is False and "fewer holes than parts" in done.stderr
 
 
 @pytest.mark.slow

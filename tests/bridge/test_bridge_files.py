@@ -92,3 +92,54 @@ def test_make_folder(tmp_path: Path) -> None:
         make_folder(tmp_path / "file")
     with pytest.raises(BridgeError, match=r"file/x: cannot create the folder \(Not a directory\)$"):
         make_folder(tmp_path / "file" / "x")
+
+
+def _device(folder: Path, name: str, minor: int) -> Path:
+    """A character device ``folder/name`` like ``/dev/<name>`` (major 1, ``minor``): made
+    with mknod as root, else a symbolic link to it. Never the machine's own path: a broken
+    writer would replace ``/dev/null`` itself."""
+    path = folder / name
+    if os.geteuid() == 0:
+        os.mknod(path, stat.S_IFCHR | 0o666, os.makedev(1, minor))
+    else:
+        path.symlink_to(Path("/dev") / name)
+    return path
+
+
+def test_a_character_device_is_written_through_never_replaced(tmp_path: Path) -> None:
+    null, full = _device(tmp_path, "null", 3), _device(tmp_path, "full", 7)
+    assert write_atomic(null, "a.\n") == null
+    assert stat.S_ISCHR(null.stat().st_mode)
+    with pytest.raises(BridgeError) as error:
+        write_atomic(full, "a.\n")
+    assert str(error.value) == f"{full}: cannot write (No space left on device)"
+    assert stat.S_ISCHR(full.stat().st_mode)
+    assert leftovers(null.parent) == []
+
+
+def test_a_fifo_is_written_through_to_its_reader_and_refused_without_one(tmp_path: Path) -> None:
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    with pytest.raises(BridgeError) as error:  # nobody reads: refused at once, never blocks
+        write_atomic(fifo, "a.\n")
+    assert str(error.value) == f"{fifo}: cannot write (a FIFO with no reader)"
+    reader = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK)
+    try:
+        write_atomic(fifo, "a.\nb.\n")
+        assert os.read(reader, 100) == b"a.\nb.\n"
+    finally:
+        os.close(reader)
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
+
+
+def test_a_socket_is_refused_and_kept(tmp_path: Path) -> None:
+    import socket
+
+    path = tmp_path / "sock"
+    with socket.socket(socket.AF_UNIX) as server:
+        server.bind(str(path))
+        with pytest.raises(BridgeError) as error:
+            write_atomic(path, "a.\n")
+    assert str(error.value) == f"{path}: cannot write (a socket; expected a regular file, a character device or a FIFO)"
+    assert stat.S_ISSOCK(path.stat().st_mode)

@@ -13,6 +13,7 @@ import pytest
 
 from executor.evidence import AttemptSetup
 from executor.trial import Cell
+from tests._tolerances import END_BOUND, FORCE_BOUND, TORQUE_BOUND
 
 
 @pytest.fixture(scope="module")
@@ -69,15 +70,20 @@ def test_same_seed_same_trial(cell):
 
 @pytest.mark.slow
 def test_same_seed_same_trial_in_other_processes(root, cli_env):
-    """Bit for bit across processes, also after the cell switched part shapes."""
-    code = ("from executor.trial import Cell; c = Cell(); c.run_trial('p3', 'r1', 3); "
+    """The same outcome across processes, also after the cell switched part shapes; the
+    figures within the bounds another process (maybe another CPU) may move them by."""
+    code = ("import json; from executor.trial import Cell; c = Cell(); c.run_trial('p3', 'r1', 3); "
             "r = c.run_trial('tp', 'r1', 3).to_json(); "
-            "print(repr((r['outcome'], r['max_force_dev'], r['max_torque_dev'], r['end_error'])))")
+            "print(json.dumps([r['outcome'], r['attempts'], r['max_force_dev'], r['max_torque_dev'], r['end_error']]))")
     procs = [subprocess.Popen([sys.executable, "-c", code], cwd=root, stdout=subprocess.PIPE,
                               stderr=subprocess.DEVNULL, text=True, env=cli_env)
              for _ in range(3)]
-    outputs = {p.communicate(timeout=120)[0] for p in procs}
-    assert len(outputs) == 1 and "fit" in outputs.pop()
+    runs = [json.loads(p.communicate(timeout=120)[0]) for p in procs]
+    assert all(run[:2] == ["fit", 1] for run in runs), runs
+    figures = np.array([run[2:] for run in runs])
+    # The tight peg's 0.1 mm-clearance contact: force and torque within the thresholds'
+    # margins, the end within the clearance (tests/_tolerances.py).
+    assert np.all(np.ptp(figures, axis=0) < [FORCE_BOUND, TORQUE_BOUND, END_BOUND]), figures
 
 
 def test_different_seeds_differ(cell):

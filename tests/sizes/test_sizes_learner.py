@@ -63,13 +63,20 @@ def test_retests_resolve_the_conflict_and_keep_a_consistent_relation() -> None:
     assert [e.retest for e in learner.experiments].count(True) >= 1
 
 
-def test_a_conflict_that_never_resolves_is_an_error_naming_experiments() -> None:
+def test_reproduced_conflicting_observations_move_to_a_weaker_model_and_learn_the_truth() -> None:
+    # a fits x and b fits y only: not a biorder, so the line model is wrong, and re-tests
+    # that reproduce every answer on the cycle are no noise.
     learner = _cycle_learner()
-    with pytest.raises(PlannerError, match=r"#4 a->y no_fit"):
-        for _ in range(20):
-            pair = learner.next_experiment()
-            # a liar that repeats whatever it said first
-            learner.record(*pair, learner.answers[pair][0])
+    truth = TruthOracle(["a", "b"], ["x", "y"], {("a", "x"), ("b", "y")},
+                        sections={"a": "a", "b": "b"})
+    while (pair := learner.next_experiment()) is not None:
+        learner.record(*pair, truth.ask(*pair))
+    result = learner.result()
+    assert result.model.name == "pairs"
+    assert result.model_changes == ("observations a->x fit, a->y no_fit, b->x no_fit, b->y fit "
+                                    "contradict size model line; now pairs",)
+    assert learner.knowledge.fits == frozenset(truth.fits) and not learner.knowledge.conflicts
+    assert "size_model(pairs)" in {str(s) for s in result.facts()}
 
 
 def _entails(graph: nx.DiGraph, pair: tuple[str, str]) -> bool:

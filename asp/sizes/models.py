@@ -1,0 +1,127 @@
+"""Size models: which part-hole relations the size learner considers possible.
+
+The learner entails an outcome only when every relation of its model that agrees with
+the observations agrees on it (docs/sizes.md, "Size models"). A model puts each part on
+the size line of a *section* (``section(P,S)`` facts for ``sizes/closure.lp``); the
+relations it allows are those whose rows of each section form a biorder (Ferrers
+relation), independently across sections. Three models, strongest first:
+
+- ``line``: one section for all parts (the paper's eqs. 2-5, sizes on one line);
+- ``sections``: one line per cross-section of the product description: pegs with the
+  same ``section`` are scaled copies of one cross-section, and whether such a peg
+  passes a hole is monotone in its scale (round in round or square, square in round
+  by its diagonal, one rectangle's aspect in any hole), so each section is a line;
+- ``pairs``: every part its own section: nothing is entailed, every pair is tried.
+
+A model is weakened along this order when observations contradict it
+(:func:`weaker`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from asp import PlannerError
+from asp.sizes.biorders import biorder_count
+
+MODELS = ("line", "sections", "pairs")
+"""The size models, strongest first."""
+
+LINE_SECTION = "line"
+"""The one section of the ``line`` model (and of parts with no declared section)."""
+
+
+@dataclass(frozen=True)
+class SizeModel:
+    """A model applied to a product: its ``name`` and the section of each part.
+
+    ``sections`` maps every part to the section whose size line it lies on; ``declared``
+    is the product's own sections (what ``sections`` uses), kept so that a weaker model
+    can be derived and the summary can say what ``line`` merges.
+    """
+
+    name: str
+    sections: Mapping[str, str]
+    declared: Mapping[str, str]
+
+    def groups(self) -> dict[str, list[str]]:
+        """Section -> its parts, in the parts' order."""
+        found: dict[str, list[str]] = {}
+        for part, section in self.sections.items():
+            found.setdefault(section, []).append(part)
+        return found
+
+    def assumption(self) -> str:
+        """One line saying what the model assumes, printed and written beside the results."""
+        if self.name == "pairs":
+            return "size model pairs: no two pairs related, every pair is tried"
+        groups = self.groups()
+        if self.name == "line":
+            kinds = len(set(self.declared.values()))
+            merged = f" (the product declares {kinds} cross-sections)" if kinds > 1 else ""
+            return f"size model line: every part and hole on one size line{merged}"
+        lines = "; ".join(f"{'no cross-section stated' if section == LINE_SECTION else section}: {' '.join(parts)}"
+                          for section, parts in groups.items())
+        return f"size model sections: one size line per cross-section ({lines})"
+
+    def information_bits(self, holes: int) -> float:
+        """log2 of the number of relations the model allows with ``holes`` holes [bit]:
+        the sum over sections of log2 B(m_S, n), B the poly-Bernoulli number."""
+        return sum(math.log2(biorder_count(len(parts), holes)) for parts in self.groups().values())
+
+
+def build_model(name: str, parts: Sequence[str], declared: Mapping[str, str] | None = None) -> SizeModel:
+    """The model ``name`` for ``parts``; ``declared`` maps parts to the product's sections
+    (a part missing from it gets :data:`LINE_SECTION`: no cross-section stated)."""
+    if name not in MODELS:
+        raise PlannerError(f"size model '{name}': expected one of {', '.join(MODELS)}")
+    own = {part: (declared or {}).get(part, LINE_SECTION) for part in parts}
+    if name == "line":
+        sections = dict.fromkeys(parts, LINE_SECTION)
+    elif name == "sections":
+        sections = own
+    else:
+        sections = {part: f"of_{part}" for part in parts}
+    return SizeModel(name, sections, own)
+
+
+def weaker(model: SizeModel) -> SizeModel | None:
+    """The next weaker model (``line`` -> ``sections`` -> ``pairs``; ``sections`` of a
+    product with one declared section is ``line`` itself, so it goes to ``pairs``), or
+    None for ``pairs``."""
+    parts = list(model.sections)
+    if model.name == "line" and len(set(model.declared.values())) > 1:
+        return build_model("sections", parts, model.declared)
+    if model.name in ("line", "sections"):
+        return build_model("pairs", parts, model.declared)
+    return None
+
+
+def check_line_allowed(model: SizeModel, declared_by_product: bool) -> None:
+    """Refuse ``line`` on parts of several declared cross-sections unless the product
+    itself declares the line (the explicit override, which the summary repeats)."""
+    if model.name != "line" or declared_by_product:
+        return
+    groups: dict[str, list[str]] = {}
+    for part, section in model.declared.items():
+        groups.setdefault(section, []).append(part)
+    if len(groups) > 1:
+        listed = "; ".join(f"{section}: {' '.join(parts)}" for section, parts in groups.items())
+        raise PlannerError(
+            f"size model line puts parts of {len(groups)} cross-sections ({listed}) on one size "
+            "line, which can entail fits that do not exist; use --model sections, or declare "
+            "[sizes] model = \"line\" in the product's assembly.toml when its sizes are known to lie on one line"
+        )
+
+
+def model_for(parts: Sequence[str], requested: str | None, declared_model: str | None,
+              declared_sections: Mapping[str, str]) -> SizeModel:
+    """The model a run uses: ``requested`` (a command-line choice), else the product's
+    ``declared_model``, else ``sections``; ``line`` on parts of several declared
+    cross-sections only when the product declares it (:func:`check_line_allowed`)."""
+    name = requested or declared_model or "sections"
+    model = build_model(name, parts, declared_sections)
+    check_line_allowed(model, declared_by_product=declared_model == "line")
+    return model

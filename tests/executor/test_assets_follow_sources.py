@@ -1,0 +1,75 @@
+"""Generated assets follow their sources: ``<assembly>/assets/`` records the digest of
+``geometry.toml`` and ``assembly.toml`` it was made from, and a cell regenerates assets
+that no longer match before it uses them; the shipped ones match."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from bridge.assembly import DATA_DIR
+from executor.world.assets import STAMP, current_assets, sources_digest
+from executor.world.geometry import load_geometry, plate_obj_text
+from tests._tolerances import assert_same_asset
+
+WITH_ASSETS = sorted(p.parent.parent.name for p in DATA_DIR.glob("*/assets/plate.obj"))
+# s1 from 13.3 mm to 10 mm: the 12 mm square peg p3 no longer passes.
+NARROW_S1 = ('[hole_shapes.square]\nholes = ["s1", "s2"]',
+             '[hole_shapes.narrow]\nholes = ["s1"]\nkind = "square"\nsize = 0.010\n\n'
+             '[hole_shapes.square]\nholes = ["s2"]')
+
+
+@pytest.fixture
+def cranfield(tmp_path: Path) -> Path:
+    """A copy of data/cranfield with its assets."""
+    return Path(shutil.copytree(DATA_DIR / "cranfield", tmp_path / "asm"))
+
+
+def _narrow_s1(folder: Path) -> None:
+    path = folder / "geometry.toml"
+    text = path.read_text()
+    assert NARROW_S1[0] in text
+    path.write_text(text.replace(*NARROW_S1))
+
+
+@pytest.mark.parametrize("assembly", WITH_ASSETS)
+def test_the_shipped_assets_match_their_sources(assembly: str) -> None:
+    geometry = load_geometry(assembly)
+    assert (geometry.assets / STAMP).read_text() == sources_digest(geometry) + "\n"
+    assert_same_asset((geometry.assets / "plate.obj").read_text(), plate_obj_text(geometry))
+
+
+def test_stale_assets_are_regenerated_before_use(cranfield: Path) -> None:
+    _narrow_s1(cranfield)
+    geometry = load_geometry(str(cranfield))
+    assert (geometry.assets / STAMP).read_text() != sources_digest(geometry) + "\n"
+    assert current_assets(geometry) == geometry.assets
+    assert (geometry.assets / STAMP).read_text() == sources_digest(geometry) + "\n"
+    assert_same_asset((geometry.assets / "plate.obj").read_text(), plate_obj_text(geometry))
+    (geometry.assets / "part_shaft.urdf").unlink()  # a generated file missing: made again
+    current_assets(geometry)
+    assert (geometry.assets / "part_shaft.urdf").is_file()
+
+
+def test_assets_that_cannot_be_regenerated_are_refused_naming_the_file(cranfield: Path) -> None:
+    from executor import ExecutorError
+
+    _narrow_s1(cranfield)
+    (cranfield / "assets" / "plate.obj").unlink()
+    (cranfield / "assets" / "plate.obj").mkdir()  # cannot be replaced by a file
+    with pytest.raises(ExecutorError, match=r"assets/plate\.obj: cannot write \(Is a directory\)"):
+        current_assets(load_geometry(str(cranfield)))
+
+
+@pytest.mark.slow
+def test_a_trial_after_editing_a_hole_sees_the_edit(cranfield: Path, run_executor) -> None:
+    first = run_executor("trial", "--part", "p3", "--hole", "s1", "--assembly", str(cranfield), "--json")
+    assert first.returncode == 0, first.stderr
+    assert json.loads(first.stdout)["trials"][0]["outcome"] == "fit"
+    _narrow_s1(cranfield)
+    done = run_executor("trial", "--part", "p3", "--hole", "s1", "--assembly", str(cranfield), "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["trials"][0]["outcome"] == "no_fit"

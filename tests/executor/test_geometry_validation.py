@@ -1,0 +1,122 @@
+"""``geometry.toml`` is checked as a whole before the cell builds anything: types, ranges,
+kinds, references and overlaps, each refused in one line ``<file>: [<table>] <key>:
+expected ..., got ...`` (executor/world/validation.py)."""
+
+from __future__ import annotations
+
+import shutil
+import tomllib
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from bridge.assembly import DATA_DIR, load_assembly
+from executor import ExecutorError
+from executor.world.geometry import load_geometry
+from executor.world.validation import GRIPPER, PLATE, check_geometry
+
+CRANFIELD = DATA_DIR / "cranfield"
+ORIGINAL = (CRANFIELD / "geometry.toml").read_text()
+
+# (id, text of data/cranfield/geometry.toml, its replacement, the expected end of the message)
+CASES = [
+    ("sides-huge", "polygon_sides = 24", "polygon_sides = 8000000",
+     "[plate] polygon_sides: expected an integer multiple of 8 in 8 .. 256, got 8000000"),
+    ("sides-zero", "polygon_sides = 24", "polygon_sides = 0", "[plate] polygon_sides: expected"),
+    ("sides-negative", "polygon_sides = 24", "polygon_sides = -8", "got -8"),
+    ("sides-not-multiple-of-8", "polygon_sides = 24", "polygon_sides = 25", "got 25"),
+    ("sides-float", "polygon_sides = 24", "polygon_sides = 24.0", "got 24.0"),
+    ("sides-boolean", "polygon_sides = 24", "polygon_sides = true", "got True"),
+    ("top-z-zero", "top_z = 0.10", "top_z = 0.0", "[plate] top_z: expected a number in (0, 1] m, got 0.0"),
+    ("tile-negative", "tile_size = 0.04", "tile_size = -0.04", "[plate] tile_size: expected a number in"),
+    ("chamfer-zero", "chamfer = 0.0008", "chamfer = 0", "[plate] chamfer: expected a number in (0, 0.01] m, got 0"),
+    ("chamfer-deeper-than-the-hole", "tile_thickness = 0.025", "tile_thickness = 0.0005",
+     "[plate] chamfer: expected less than tile_thickness (0.0005 m), got 0.0008"),
+    ("base-size-zero", "base_size = [0.20, 0.24]", "base_size = [0.0, 0.24]", "[plate] base_size: expected [x, y]"),
+    ("base-size-string", "base_size = [0.20, 0.24]", 'base_size = ["0.2", 0.24]', "got ['0.2', 0.24]"),
+    ("grasp-depth-negative", "grasp_depth = 0.02", "grasp_depth = -0.02", "[gripper] grasp_depth: expected"),
+    ("grasp-deeper-than-the-part", "grasp_depth = 0.02", "grasp_depth = 0.06",
+     "[part_shapes.round_peg] length: expected longer than [gripper] grasp_depth (0.06 m), got 0.05"),
+    ("flange-mass-zero", "flange_mass = 1.0", "flange_mass = 0.0",
+     "[gripper] flange_mass: expected a number in (0, 20] kg"),
+    ("size-string", 'kind = "round"\nsize = 0.0133', 'kind = "round"\nsize = "13.3"',
+     "[hole_shapes.round_small] size: expected a number in (0, 0.1] m, got '13.3'"),
+    ("size-boolean", 'kind = "square"\nsize = 0.0133', 'kind = "square"\nsize = true',
+     "[hole_shapes.square] size: expected a number in (0, 0.1] m, got True"),
+    ("size-zero", "size = 0.0200", "size = 0.0", "[hole_shapes.round_big] size: expected"),
+    ("hole-wider-than-its-boss", "size = 0.0200", "size = 0.04",
+     "[hole_shapes.round_big] size: expected a hole and its chamfer inside the 0.04 m boss"),
+    ("peg-half-a-metre", "size = 0.0187", "size = 0.5",
+     "[part_shapes.shaft] size: expected a number in (0, 0.1] m, got 0.5"),
+    ("mass-negative", "mass = 0.06", "mass = -0.06", "[part_shapes.square_peg] mass: expected a number in (0, 10] kg"),
+    ("length-zero", "length = 0.05           # [m]", "length = 0", "[part_shapes.round_peg] length: expected"),
+    ("kind-unknown", 'kind = "round"\nsize = 0.0187', 'kind = "hexagon"\nsize = 0.0187',
+     "[part_shapes.shaft] kind: expected one of round, square, got 'hexagon'"),
+    ("kind-number", 'holes = ["br"]\nkind = "round"', 'holes = ["br"]\nkind = 1',
+     "[hole_shapes.round_big] kind: expected one of round, square, got 1"),
+    ("demo-hole-unknown", 'demo_hole = "br"', 'demo_hole = "zz"',
+     "[part_shapes.shaft] demo_hole: expected a hole of [hole_shapes.*] (br, r1, r2, s1, s2), got 'zz'"),
+    ("hole-twice", 'holes = ["br"]', 'holes = ["br", "r1"]',
+     "[hole_shapes.round_big] holes: expected ids not already in [hole_shapes.round_small], got 'r1'"),
+    ("hole-unknown", 'holes = ["br"]', 'holes = ["br", "q9"]',
+     "[hole_shapes.round_big] holes: expected holes of assembly.toml with a position (q9 is not a hole there)"),
+    ("part-unknown", 'parts = ["sh"]', 'parts = ["sh", "zz"]',
+     "[part_shapes.shaft] parts: expected parts of assembly.toml with a start, or of [extra_parts] (zz is neither)"),
+    ("holes-not-a-list", 'holes = ["br"]', 'holes = "br"', "[hole_shapes.round_big] holes: expected a non-empty list"),
+    ("size-missing", 'size = 0.0200           # diameter [m]', "", "[hole_shapes.round_big] size: expected a number"),
+    ("extra-start-nan", "start = [0.25, 0.46]", "start = [nan, 0.46]", "[extra_parts.tp] start: expected [x, y]"),
+]
+
+
+def _folder(tmp_path: Path, text: str) -> Path:
+    skip = shutil.ignore_patterns("assets", "demonstrations")
+    folder = Path(shutil.copytree(CRANFIELD, tmp_path / "asm", ignore=skip))
+    (folder / "geometry.toml").write_text(text)
+    return folder
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_a_bad_value_is_refused_naming_file_table_and_key(tmp_path: Path, old: str, new: str, message: str) -> None:
+    assert ORIGINAL.count(old) >= 1, old
+    folder = _folder(tmp_path, ORIGINAL.replace(old, new, 1))
+    with pytest.raises(ExecutorError) as error:
+        load_geometry(str(folder))
+    text = str(error.value)
+    assert text.startswith(f"{folder / 'geometry.toml'}: ") and message in text, text
+    assert "\n" not in text and len(text) < 300
+
+
+def test_two_holes_at_one_position_are_refused(tmp_path: Path) -> None:
+    folder = _folder(tmp_path, ORIGINAL)
+    layout = folder / "assembly.toml"
+    layout.write_text(layout.read_text().replace("position = [0.63, -0.06]", "position = [0.55, -0.06]", 1))
+    with pytest.raises(ExecutorError, match=r"geometry.toml: \[plate\] tile_size: expected bosses that do not "
+                                            r"overlap, got holes r1 at \(0.55, -0.06\) and s1 at \(0.55, -0.06\)"):
+        load_geometry(str(folder))
+
+
+@pytest.mark.parametrize("assembly", ["cranfield", "spare", "graded"])
+def test_the_shipped_geometries_pass(assembly: str) -> None:
+    assert load_geometry(assembly).parts
+
+
+NUMERIC_KEYS = [("plate", key) for key in PLATE] + [("gripper", key) for key in GRIPPER]
+VALUES = st.one_of(st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow_infinity=True), st.booleans(),
+                   st.text(max_size=5), st.lists(st.floats(-1, 1), max_size=3))
+
+
+@settings(max_examples=60, deadline=None)
+@given(key=st.sampled_from(NUMERIC_KEYS), value=VALUES)
+def test_any_value_of_a_key_loads_or_is_refused_in_one_line(key: tuple[str, str], value: object) -> None:
+    """Whatever a [plate] or [gripper] key holds, the loader gives a geometry or one
+    ExecutorError naming the key, never another exception."""
+
+    geo = tomllib.loads(ORIGINAL)
+    geo[key[0]][key[1]] = value
+
+    try:
+        check_geometry(CRANFIELD / "geometry.toml", geo, load_assembly("cranfield"))
+    except ExecutorError as exc:
+        assert f"[{key[0]}]" in str(exc) and "\n" not in str(exc)

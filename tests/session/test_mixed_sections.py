@@ -1,0 +1,71 @@
+"""A new product of round and square pegs, learned by whole sessions with truth cells.
+
+The product (made here, as a user would describe it, with no ``sizes.lp``): a base
+plate with four holes (round 14.5 mm, square 13.5 mm, round 10.5 mm, square 9.5 mm)
+and four pegs (round 14 mm, square 13 mm, round 10 mm, square 9 mm). Each peg fits
+the hole of its own kind and number, so a complete assignment exists; the relation is
+not one biorder (the square 13 mm peg's diagonal is 18.4 mm), so one size line would
+entail fits that do not exist. The truth cells answer from the cross-sections.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+PEGS = {"pa": ("round", 0.014), "pb": ("square", 0.013), "pc": ("round", 0.010), "pd": ("square", 0.009)}
+HOLES = {"ha": ("round", 0.0145), "hb": ("square", 0.0135), "hc": ("round", 0.0105), "hd": ("square", 0.0095)}
+
+
+def _product(folder: Path) -> Path:
+    """Write the product's ``assembly.toml``, ``geometry.toml`` and ``demos.txt``."""
+    folder.mkdir()
+    assembly = ['name = "mixed pegs"', "", "[parts.bp]", 'name = "base plate"', 'role = "base"',
+                "start = [0.30, -0.40]"]
+    for k, (part, (kind, _)) in enumerate(PEGS.items()):
+        assembly += ["", f"[parts.{part}]", f'name = "{kind} peg {part}"', 'role = "peg"', f'shape = "{kind}"',
+                     f"start = [{0.25 + 0.05 * k:.2f}, 0.40]"]
+    for k, (hole, (kind, _)) in enumerate(HOLES.items()):
+        assembly += ["", f"[holes.{hole}]", f'name = "{kind} hole {hole}"', f'shape = "{kind}"',
+                     f"position = [{0.55 + 0.06 * (k % 2):.2f}, {-0.05 + 0.1 * (k // 2):.2f}]"]
+    (folder / "assembly.toml").write_text("\n".join(assembly) + "\n")
+    geometry = ["[plate]", "top_z = 0.10", "tile_size = 0.04", "tile_thickness = 0.025", "chamfer = 0.0008",
+                "polygon_sides = 24", "base_size = [0.20, 0.24]", "base_center = [0.58, 0.0]",
+                "base_thickness = 0.02"]
+    for hole, (kind, size) in HOLES.items():
+        geometry += ["", f"[hole_shapes.{hole}]", f'holes = ["{hole}"]', f'kind = "{kind}"', f"size = {size}"]
+    for part, (kind, size) in PEGS.items():
+        geometry += ["", f"[part_shapes.{part}]", f'parts = ["{part}"]', f'kind = "{kind}"', f"size = {size}",
+                     "length = 0.05", "mass = 0.05", f'demo_hole = "h{part[1]}"']
+    geometry += ["", "[gripper]", "flange_mass = 1.0", "flange_inertia = 0.004", "flange_length = 0.06",
+                 "grasp_depth = 0.02"]
+    (folder / "geometry.toml").write_text("\n".join(geometry) + "\n")
+    (folder / "demos.txt").write_text("bp pa pb pc pd\nbp pd pc pb pa\n")
+    return folder
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("policy", ["best", "systematic", "heuristic", "random"])
+def test_a_session_learns_the_mixed_product_exactly_and_assigns_every_peg(run_session, tmp_path, policy) -> None:
+    product = _product(tmp_path / "mixed")
+    result = run_session("--assembly", str(product), "--policy", policy, "--out", str(tmp_path / "run"))
+    assert result["model"] == "sections" and not result["model_changes"]
+    assert result["assumption"] == ("size model sections: one size line per cross-section "
+                                    "(round: pa pc; square: pb pd)")
+    assert {tuple(pair) for pair in result["fits"]} == {("pa", "ha"), ("pb", "hb"), ("pc", "ha"), ("pc", "hb"),
+                                                        ("pc", "hc"), ("pd", "ha"), ("pd", "hb"), ("pd", "hd")}
+    steps = {step["part"]: step["hole"] for step in result["plans"][0] if step["hole"]}
+    assert len(set(steps.values())) == 4 and all([p, h] in result["fits"] for p, h in steps.items())
+    learned = (tmp_path / "run" / "learned.lp").read_text()
+    assert "size_model(sections)." in learned and "section(pb,square)." in learned
+    assert "% Assumes: size model sections" in learned
+
+
+def test_line_on_the_mixed_product_is_refused_before_any_cell_starts(run_cli, tmp_path) -> None:
+    product = _product(tmp_path / "mixed")
+    done = run_cli("session", "--backend", "truth", "--assembly", str(product), "--model", "line",
+                   "--out", str(tmp_path / "run"), timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "size model line puts parts of 2 cross-sections" in done.stderr
+    assert not (tmp_path / "run").exists()
