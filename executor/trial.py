@@ -45,7 +45,7 @@ if TYPE_CHECKING:
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
 PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
-SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
+APPROACH_SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
 
 
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
@@ -180,7 +180,7 @@ class Cell:
         approach = np.array([est_xy[0], est_xy[1], surface + APPROACH_HEIGHT])
         arm.inverse_kinematics(approach, quat)
         motion.controller.reset()
-        motion.hold(approach, quat, SETTLE_TIME)
+        motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         arm.tare_sensor()
         found = hole_search(motion, est_xy, surface, approach[2], quat,
                             np.random.default_rng(setup.search_seed))

@@ -97,7 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
-                        help="cells started here: sim (PyBullet) or truth (sizes.lp, no simulation)")
+                        help="cells started here: sim (PyBullet) or truth (answers from the geometry's "
+                             "cross-sections, no simulation)")
     parser.add_argument("--delay", type=finite_float(0.0, 3600.0), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
     parser.add_argument("--timeout", type=finite_float(0.0, MAX_WAIT_S, low_open=True), default=120.0, metavar="S",

@@ -49,7 +49,7 @@ from executor.evidence import AttemptSetup
 from executor.skills.dmp import Skill, load_skill
 from executor.skills.insertion import insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
-from executor.trial import APPROACH_HEIGHT, SETTLE_TIME, trial_rng
+from executor.trial import APPROACH_HEIGHT, APPROACH_SETTLE_TIME, trial_rng
 from executor.world.arm import aligned_yaw, tool_quat, yaw_quat
 from executor.world.perturbation import CellBias, PerturbationModel
 from executor.world.scene import PART_FRICTION
@@ -270,7 +270,7 @@ class Assembler:
         yaw = self._yaw(part, hole, setup)
         quat = tool_quat(yaw)
         carry(motion, approach, yaw=yaw)
-        motion.hold(approach, quat, SETTLE_TIME)
+        motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         world.arm.tare_sensor()
         if skill == "insert_over":
             skill_obj, xy = self._skill(p.covers[part].skill), approach[:2]

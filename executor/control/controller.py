@@ -35,7 +35,7 @@ POSITION_CONTROL_GAINS = ImpedanceGains(k_trans=20000.0, d_trans=580.0, k_rot=60
 stiffness seen at the tool is of the order of 10⁴–10⁵ N/m, hundreds of Nm/rad and more).
 D_t = 2·√(K_t·m) with the lightest effective tip mass of the arm at the plate, m ≈ 4.2 kg
 (4.2–10.3 kg: critically damped to ζ ≈ 0.64); D_r gives ζ ≈ 0.37 about the tilt axes
-(effective inertia ≈ 0.19–0.30 kg·m², today's ratio) and stays below 2·I/Δt = 10 Nm·s/rad,
+(effective inertia ≈ 0.19–0.30 kg·m² over the arm's poses at the plate) and stays below 2·I/Δt = 10 Nm·s/rad,
 where the explicit 1 ms step becomes unstable about the tool axis (I ≈ 0.005 kg·m²).
 docs/cell.md ("Execution layers") says why."""
 

@@ -24,7 +24,7 @@ from executor.world.scene import TIME_STEP
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.
 TIMEOUT_FACTOR = 3.0
-SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
+END_SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
 MAX_WIGGLES = 1  # exception strategy runs per attempt
 JAM_DEPTH = SearchParams().sink_depth
 """[m] below the entry: the part has sunk into the hole's entry chamfer (the search's
@@ -135,7 +135,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     pos_d, quat_d = clock.pose()
     ff_pos, _ = ff_at(clock.phase)
     pos_d = pos_d + ff_pos
-    end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME) if completed else motion.controller.arm.read()
+    end = motion.hold(pos_d + d_pos, quat_d, END_SETTLE_TIME) if completed else motion.controller.arm.read()
     # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets
     # included; not ILC's z, which only shapes the push, never where the part must end).
     p_goal = hole_origin + turn_z(skill.end_position, yaw) + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])
@@ -145,7 +145,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     if stalled and wiggle_enabled and wiggles < MAX_WIGGLES:
         wiggle(motion, pos_d + d_pos, quat_d, gripper_lever, clock.phase, wrench_table[last])
         wiggles += 1
-        end = motion.hold(pos_d + d_pos, quat_d, SETTLE_TIME)
+        end = motion.hold(pos_d + d_pos, quat_d, END_SETTLE_TIME)
         reached, err = detector.goal_reached(end.tip_pos, p_goal)
     return InsertionResult(completed, reached, err, jammed, wiggles, clock.phase, trace)
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
-from executor.trial import SETTLE_TIME, Cell
+from executor.trial import APPROACH_SETTLE_TIME, Cell
 from executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
 from executor.world.assets import regenerate_assets
 from executor.world.scene import TIME_STEP
@@ -65,7 +65,7 @@ def _replay(motion: Motion, skill: Skill, origin: np.ndarray,
         wrenches.append(np.concatenate([turn_z(s.force, -yaw), turn_z(s.torque, -yaw)]))
         clock.advance(TIME_STEP, 0.0)
     p, q = clock.pose()
-    end = motion.hold(p, q, SETTLE_TIME)
+    end = motion.hold(p, q, APPROACH_SETTLE_TIME)
     return np.array(phases), np.array(wrenches), turn_z(end.tip_pos - origin, -yaw)
 
 
@@ -88,7 +88,7 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     def go_to_start() -> None:
         arm.inverse_kinematics(start, quat)
         motion.controller.reset()
-        motion.hold(start, quat, SETTLE_TIME)
+        motion.hold(start, quat, APPROACH_SETTLE_TIME)
         arm.tare_sensor()
 
     go_to_start()

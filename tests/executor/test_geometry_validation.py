@@ -21,6 +21,9 @@ CRANFIELD = DATA_DIR / "cranfield"
 ORIGINAL = (CRANFIELD / "geometry.toml").read_text()
 
 # (id, text of data/cranfield/geometry.toml, its replacement, the expected end of the message)
+SIZE = "a number in (0, 0.1] m, or for a rect [a, b] with a >= b, each such a number"
+"""What a cross-section's size must be."""
+
 CASES = [
     ("sides-huge", "polygon_sides = 24", "polygon_sides = 8000000",
      "[plate] polygon_sides: expected an integer multiple of 8 in 8 .. 256, got 8000000"),
@@ -42,20 +45,20 @@ CASES = [
     ("flange-mass-zero", "flange_mass = 1.0", "flange_mass = 0.0",
      "[gripper] flange_mass: expected a number in (0, 20] kg"),
     ("size-string", 'kind = "round"\nsize = 0.0133', 'kind = "round"\nsize = "13.3"',
-     "[hole_shapes.round_small] size: expected a number in (0, 0.1] m, got '13.3'"),
+     f"[hole_shapes.round_small] size: expected {SIZE}, got '13.3'"),
     ("size-boolean", 'kind = "square"\nsize = 0.0133', 'kind = "square"\nsize = true',
-     "[hole_shapes.square] size: expected a number in (0, 0.1] m, got True"),
+     f"[hole_shapes.square] size: expected {SIZE}, got True"),
     ("size-zero", "size = 0.0200", "size = 0.0", "[hole_shapes.round_big] size: expected"),
     ("hole-wider-than-its-boss", "size = 0.0200", "size = 0.04",
      "[hole_shapes.round_big] size: expected a hole and its chamfer inside the 0.04 m boss"),
     ("peg-half-a-metre", "size = 0.0187", "size = 0.5",
-     "[part_shapes.shaft] size: expected a number in (0, 0.1] m, got 0.5"),
+     f"[part_shapes.shaft] size: expected {SIZE}, got 0.5"),
     ("mass-negative", "mass = 0.06", "mass = -0.06", "[part_shapes.square_peg] mass: expected a number in (0, 10] kg"),
     ("length-zero", "length = 0.05           # [m]", "length = 0", "[part_shapes.round_peg] length: expected"),
     ("kind-unknown", 'kind = "round"\nsize = 0.0187', 'kind = "hexagon"\nsize = 0.0187',
-     "[part_shapes.shaft] kind: expected one of round, square, got 'hexagon'"),
+     "[part_shapes.shaft] kind: expected one of rect, round, square, got 'hexagon'"),
     ("kind-number", 'holes = ["br"]\nkind = "round"', 'holes = ["br"]\nkind = 1',
-     "[hole_shapes.round_big] kind: expected one of round, square, got 1"),
+     "[hole_shapes.round_big] kind: expected one of rect, round, square, got 1"),
     ("demo-hole-unknown", 'demo_hole = "br"', 'demo_hole = "zz"',
      "[part_shapes.shaft] demo_hole: expected a hole of [hole_shapes.*] (br, r1, r2, s1, s2), got 'zz'"),
     ("hole-twice", 'holes = ["br"]', 'holes = ["br", "r1"]',

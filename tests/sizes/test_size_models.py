@@ -26,20 +26,26 @@ from asp.sizes.policies import policy_names
 from asp.solve import fact
 from executor.world.geometry import HoleSpec, PartSpec, passes
 
-Section = tuple[str, float]
-"""(kind, size [m]) of a peg's or a hole's cross-section."""
+Section = tuple[str, float, float]
+"""(kind, size [m], width [m]) of a peg's or a hole's cross-section: a rect is size x width
+(size >= width), round and square have width 0."""
 
 
-def _truth(pegs: list[Section], holes: list[Section]) -> tuple[TruthOracle, dict[str, str]]:
-    """The relation the cross-sections give, and each peg's section (its kind)."""
+def _truth(pegs: list[Section], holes: list[Section],
+           sections: list[str] | None = None) -> tuple[TruthOracle, dict[str, str]]:
+    """The relation the cross-sections give, and each peg's section (default: its kind,
+    a rect its own id; ``sections`` gives them, as a product's ``section`` labels do)."""
     part_ids = [f"p{i}" for i in range(1, len(pegs) + 1)]
     hole_ids = [f"h{j}" for j in range(1, len(holes) + 1)]
-    specs = [PartSpec(p, kind, size, shape=kind, length=0.05, mass=0.05, start=(0.0, 0.0), demo_hole="h1")
-             for p, (kind, size) in zip(part_ids, pegs)]
-    hole_specs = [HoleSpec(h, kind, size, position=(0.0, 0.0)) for h, (kind, size) in zip(hole_ids, holes)]
+    specs = [PartSpec(p, kind, size, shape=kind, length=0.05, mass=0.05, start=(0.0, 0.0), demo_hole="h1",
+                      width=width) for p, (kind, size, width) in zip(part_ids, pegs)]
+    hole_specs = [HoleSpec(h, kind, size, position=(0.0, 0.0), width=width)
+                  for h, (kind, size, width) in zip(hole_ids, holes)]
     fits = {(p.id, h.id) for p in specs for h in hole_specs if passes(p, h)}
-    sections = {p: kind for p, (kind, _) in zip(part_ids, pegs)}
-    return TruthOracle(part_ids, hole_ids, fits, sections=sections), sections
+    if sections is None:
+        sections = [p if kind == "rect" else kind for p, (kind, _, _) in zip(part_ids, pegs)]
+    by_part = dict(zip(part_ids, sections))
+    return TruthOracle(part_ids, hole_ids, fits, sections=by_part), by_part
 
 
 def _example(pairs: int) -> tuple[TruthOracle, dict[str, str]]:
@@ -49,8 +55,8 @@ def _example(pairs: int) -> tuple[TruthOracle, dict[str, str]]:
     holes: list[Section] = []
     for k in range(pairs):
         for kind, size in (("round", 0.014 - 0.004 * k), ("square", 0.013 - 0.004 * k)):
-            pegs.append((kind, size))
-            holes.append((kind, size + 0.0005))
+            pegs.append((kind, size, 0.0))
+            holes.append((kind, size + 0.0005, 0.0))
     return _truth(pegs, holes)
 
 
@@ -107,16 +113,29 @@ def _facts(parts: list[str] | tuple[str, ...], holes: list[str] | tuple[str, ...
     return LearnedFacts(tuple(atoms), tuple(parts), tuple(holes), frozenset(fits), tuple(parts), frozenset())
 
 
-sections_strategy = st.sampled_from(["round", "square"])
-sizes_mm = st.integers(8, 16)
+@st.composite
+def cross_section(draw, clearance: float = 0.0) -> Section:
+    """Round, square or rect, sides 8..16 mm in 1 mm steps (ties likely), plus ``clearance`` [m]."""
+    kind = draw(st.sampled_from(["round", "square", "rect"]))
+    size = draw(st.integers(8, 16)) / 1000
+    width = draw(st.integers(4, int(size * 1000))) / 1000 if kind == "rect" else 0.0
+    return kind, size + clearance, width + clearance if width else 0.0
 
 
 @st.composite
 def products(draw, max_pegs: int = 5, max_holes: int = 5) -> tuple[TruthOracle, dict[str, str]]:
-    """Random pegs and holes, round or square, sizes 8..16 mm in 1 mm steps (ties likely)."""
-    pegs = draw(st.lists(st.tuples(sections_strategy, sizes_mm), min_size=1, max_size=max_pegs))
-    holes = draw(st.lists(st.tuples(sections_strategy, sizes_mm), min_size=1, max_size=max_holes))
-    return _truth([(k, s / 1000) for k, s in pegs], [(k, s / 1000 + 0.0004) for k, s in holes])
+    """Random pegs and holes, round, square or rect; rect pegs of one aspect ratio share a
+    section (they are scaled copies), others are their own."""
+    pegs = draw(st.lists(cross_section(), min_size=1, max_size=max_pegs))
+    holes = draw(st.lists(cross_section(0.0004), min_size=1, max_size=max_holes))
+    sections = [f"rect_{round(1000 * size)}_{round(1000 * width)}" if kind == "rect" and draw(st.booleans())
+                else kind if kind != "rect" else f"own{i}" for i, (kind, size, width) in enumerate(pegs)]
+    # a shared label only for rects of one aspect ratio
+    by_aspect: dict[float, str] = {}
+    for i, (kind, size, width) in enumerate(pegs):
+        if kind == "rect" and not sections[i].startswith("own"):
+            sections[i] = by_aspect.setdefault(round(size / width, 9), sections[i])
+    return _truth(pegs, holes, sections)
 
 
 @settings(max_examples=60, deadline=None)
