@@ -1,7 +1,8 @@
 """Fuzzing the readers of the planner's input files with hypothesis: the demonstrations
-reader (text and ``demo/3`` facts), the learned facts reader, the plan JSON reader and
-the session journal reader. Whatever the bytes, a
-reader returns valid data or raises :class:`asp.PlannerError` with a short message: never
+reader (text and ``demo/3`` facts), the learned facts reader, the plan JSON reader, the
+session journal reader and the product description loader (``assembly.toml``). Whatever
+the bytes, a reader returns valid data or raises its package's error
+(:class:`asp.PlannerError`, :class:`bridge.BridgeError`) with a short message: never
 another exception, never unbounded work (each example has a deadline)."""
 
 from __future__ import annotations
@@ -19,7 +20,8 @@ from asp.plans.assign import load_learned_facts
 from asp.precedence.demos import MAX_DEMONSTRATIONS, load_demos
 from asp.session.journal import read_journal
 from asp.solve import load_atoms, pairs_by_name
-from bridge.assembly import ID_PATTERN
+from bridge import BridgeError
+from bridge.assembly import ID_PATTERN, load_assembly
 
 FUZZ = settings(max_examples=100, deadline=2000, suppress_health_check=[HealthCheck.too_slow])
 ID = re.compile(ID_PATTERN)
@@ -130,3 +132,25 @@ def test_journal_reader_returns_a_consistent_journal_or_an_error_naming_the_line
     for entry in entries:
         assert entry.experiment >= 0 and ((entry.part, entry.hole) not in first or entry.retest)
         first.add((entry.part, entry.hole))
+
+
+ASSEMBLY_FRAGMENTS = [
+    "[parts.a]\n", "[parts.not]\n", "[parts.P1]\n", "[holes.h1]\n", "[holes.h1]\n", "[parts]\n", 'name = "x"\n',
+    'role = "peg"\n', "start = [0.1, 0.2]\n", "start = [1e999, 0]\n", 'start = "x"\n', "position = [0, 0]\n",
+    "shape = 3\n", "name = 5\n", "[parts.a.b]\n", "x = 1\n", "[[parts]]\n", "parts = 1\n", "holes = []\n", "=\n",
+    '"\n', "[" * 50 + "\n", 'role = ["peg"]\n', '[parts."p\\u00e91"]\n', '[parts."a\\n"]\n',
+]
+
+
+@FUZZ
+@given(text=st.one_of(st.text(max_size=200), st.lists(st.sampled_from(ASSEMBLY_FRAGMENTS), max_size=20).map("".join)))
+def test_product_description_loader_returns_an_assembly_of_ids_or_bridge_error(text: str) -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        _file(folder, "assembly.toml", text.encode("utf-8", "surrogatepass"))
+        try:
+            assembly = load_assembly(folder)
+        except BridgeError as exc:
+            assert len(str(exc)) < MAX_MESSAGE + len(folder) * 2
+            return
+    ids = [*assembly.part_ids, *assembly.hole_ids]
+    assert all(ID.match(x) for x in ids) and len(set(assembly.part_ids)) == len(assembly.part_ids)

@@ -21,7 +21,9 @@ from pathlib import Path
 from asp import PlannerError
 from bridge.cli_types import MAX_SEED
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
+"""The folder holding the packages (the repository, or site-packages when installed): the
+cells get it on their PYTHONPATH and run in it."""
 
 
 class CellProcess:
