@@ -50,7 +50,7 @@ from asp.sizes.knowledge import RESULTS, Knowledge, Pair
 from asp.sizes.models import SizeModel, build_model, weaker
 from asp.sizes.oracle import Oracle
 from asp.sizes.policies import SelectionPolicy, get_policy
-from asp.solve import encoding, fact, format_facts
+from asp.solve import add_facts, encoding, fact
 
 MAX_CONFIRM = 100
 """``confirm`` K is at most this many answers (each essential observation is re-tested
@@ -197,7 +197,8 @@ class SizeLearner:
         atoms += [fact("section", p, section) for p, section in self.model.sections.items()]
         if self.policy.session_facts is not None:
             atoms += self.policy.session_facts(self.parts, self.holes, seed)
-        self._ctl.add("base", [], format_facts(atoms) + _OBSERVATIONS)
+        add_facts(self._ctl, atoms)
+        self._ctl.add("base", [], _OBSERVATIONS)
         names = [self.policy.encoding or "sizes_closure.lp"] + (["sizes/essential.lp"] if self.confirm else [])
         for name in names:
             self._ctl.load(str(encoding(name)))
