@@ -24,7 +24,7 @@ def _results(value: Any) -> Any:
 @pytest.mark.slow
 @pytest.mark.parametrize("argv", [
     ("bench", "assemble", "--plans", "3", "--backend", "truth", "--seed", "4"),
-    ("executor", "campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1,sh:s1"),
+    ("executor", "campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1"),
 ])
 def test_one_and_two_jobs_give_the_same_json(run_cli, argv: tuple[str, ...]) -> None:
     reports = []

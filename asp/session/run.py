@@ -367,7 +367,6 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
     ``time.perf_counter()`` [s] at the start."""
     assembly = load_assembly(settings["assembly"])
     parts, holes, truth, model = _sizes_domain(assembly, settings.get("model"))
-    LOG.info("assumes: %s", model.assumption())
     # Every input file is read before any cell starts: bad input fails fast.
     demos = load_demos(settings.get("demos") or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
     relation = learn_must_precede(demos)
@@ -420,6 +419,7 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
         timings = {"cells_ready_s": time.perf_counter() - started}
+        LOG.info("assumes: %s", model.assumption())  # once every input was checked and the cells are up
         try:
             sizes = _learn_sizes(oracle, learner, journal, log)
         finally:

@@ -46,7 +46,7 @@ def _product(folder: Path) -> Path:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("policy", ["best", "systematic", "heuristic", "random"])
+@pytest.mark.parametrize("policy", ["best", "heuristic"])  # every policy in process: tests/sizes
 def test_a_session_learns_the_mixed_product_exactly_and_assigns_every_peg(run_session, tmp_path, policy) -> None:
     product = _product(tmp_path / "mixed")
     result = run_session("--assembly", str(product), "--policy", policy, "--out", str(tmp_path / "run"))
