@@ -388,6 +388,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      resume(settings=SETTINGS.replace('"r"', '"' + "r" * 200 + '"')), 2, '"recording_id": expected 1 to 64'),
     ("resume-starts-at-bound", ("session", "--resume", "run"),
      resume(settings=SETTINGS.replace("}", ', "starts": 1000000}')), 2, '"starts": expected an integer from 1'),
+    ("export-out-empty", ("executor", "export", ""), None, 2, "OUT: expected a path, got the empty string"),
     # the sim cell's ILC state: refused when the cell starts, never at its first insertion
     ("serve-ilc-state-nan", ("executor", "serve", "--ilc-state", "s.json"), {"s.json": ilc_state("NaN")}, 2,
      's.json: "keys" "round_peg:r1" correction[0][0]: expected a number within ±0.002 m, got NaN'),
