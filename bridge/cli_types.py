@@ -15,6 +15,7 @@ import os
 import re
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
 from bridge import BridgeError
@@ -319,6 +320,14 @@ def png_path(text: str) -> str:
     if not text.lower().endswith(".png") or text.endswith(("/", "\\")):
         raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected a file path ending in .png")
     return text
+
+
+def nonempty_path(text: str) -> Path:
+    """An argparse type: a path, not the empty string (``Path("")`` is the current folder,
+    so an empty ``$VAR`` would silently write there)."""
+    if not text:
+        raise argparse.ArgumentTypeError("expected a path, got the empty string")
+    return Path(text)
 
 
 def size_pair(text: str) -> tuple[int, int]:

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, png_path
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, nonempty_path, png_path
 from bridge.files import write_atomic
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 
@@ -170,7 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     export = sub.add_parser("export", help="write the assembling cell as URDF and meshes (arm, plate, every part)")
     add_assembly_argument(export, purpose="the product whose cell is written")
-    export.add_argument("out", metavar="OUT", type=Path, help="folder to write cell.urdf and meshes/ into")
+    export.add_argument("out", metavar="OUT", type=nonempty_path, help="folder to write cell.urdf and meshes/ into")
     export.set_defaults(func=_export)
 
     for name, (_module, help_text) in _DELEGATED.items():

@@ -423,10 +423,14 @@ def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
 
 
 def main(argv: Sequence[str]) -> int:
-    """Serve until SIGTERM/SIGINT; exit code 2 on bad options or when another process
+    """Serve until SIGTERM/SIGINT; exit code 2 on bad options, a damaged ``--ilc-state`` or when another process
     serves this cell id (:mod:`executor.claim`)."""
     args = build_parser().parse_args(list(argv))
     cell_id = check_cell_id(args.cell)
+    if args.backend == "sim" and args.ilc_state is not None:
+        from executor.control.ilc import read_state
+
+        read_state(args.ilc_state)  # a damaged state is refused here, before the session opens
     listen = cell_listen(args.listen, args.connect, args.zenoh_config)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)

@@ -115,6 +115,13 @@ def _part(old: str, new: str) -> Callable[[list[dict]], object]:
     return lambda steps: [step.update(part=new) for step in steps if step["part"] == old]
 
 
+def ilc_state(value: object = 0.0, iterations: object = 1) -> str:
+    """An ILC state file of ``executor serve --ilc-state`` (50 bins) whose corrections all
+    hold ``value`` (JSON text, e.g. ``NaN``) and whose key was taught ``iterations`` times."""
+    rows = ", ".join([f"[{value}, 0, 0, 0, 0]"] * 50)
+    return f'{{"keys": {{"round_peg:r1": {{"iterations": {iterations}, "correction": [{rows}]}}}}}}'
+
+
 SETTINGS = '{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}'
 JOURNAL_LINE = '{{"id":"{id}","part":"{part}","hole":"{hole}","result":"{result}","cell":"c1"{extra}}}\n'
 
@@ -347,6 +354,16 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("assemble-facts-of-another-assembly", ("assemble", *(str(ROOT / "data" / "graded" / name)
                                                            for name in ("sizes.lp", "precedence.lp")),
                                             "--backend", "truth"), None, 2, "not of the product"),
+    ("assemble-uncertainty-cell-truth", ("assemble", "--backend", "truth", "--uncertainty", "cell"), None, 2,
+     "--uncertainty cell has no effect with --backend truth"),
+    ("assemble-layer-truth", ("assemble", "--backend", "truth", "--layer", "position"), None, 2,
+     "--layer has no effect with --backend truth"),
+    ("bench-assemble-uncertainty-cell-truth", ("bench", "assemble", "--backend", "truth", "--plans", "1",
+                                               "--uncertainty", "cell", "--grasp-tilt-bias", "2"), None, 2,
+     "--uncertainty cell has no effect with --backend truth"),
+    ("bench-assemble-magnitude-truth", ("bench", "assemble", "--backend", "truth", "--plans", "1",
+                                        "--vision-bias", "0.002"), None, 2,
+     "--vision-bias has no effect with --backend truth"),
     ("bench-assemble-facts-subset", ("bench", "assemble", "f.lp", "--backend", "truth", "--plans", "1"),
      {"f.lp": "part(bp;p1). hole(r1). fits(p1,r1).\n"}, 2, "f.lp: the facts are not of the product"),
     ("assemble-run-plan-wrong-types", ("assemble", "--run", "run", "--backend", "truth"),
@@ -381,6 +398,20 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      resume(settings=SETTINGS.replace('"r"', '"' + "r" * 200 + '"')), 2, '"recording_id": expected 1 to 64'),
     ("resume-starts-at-bound", ("session", "--resume", "run"),
      resume(settings=SETTINGS.replace("}", ', "starts": 1000000}')), 2, '"starts": expected an integer from 1'),
+    ("export-out-empty", ("executor", "export", ""), None, 2, "OUT: expected a path, got the empty string"),
+    # the sim cell's ILC state: refused when the cell starts, never at its first insertion
+    ("serve-ilc-state-nan", ("executor", "serve", "--ilc-state", "s.json"), {"s.json": ilc_state("NaN")}, 2,
+     's.json: "keys" "round_peg:r1" correction[0][0]: expected a number within ±0.002 m, got NaN'),
+    ("serve-ilc-state-huge", ("executor", "serve", "--ilc-state", "s.json"), {"s.json": ilc_state("1e300")}, 2,
+     'correction[0][0]: expected a number within ±0.002 m, got 1e+300'),
+    ("serve-ilc-state-string", ("executor", "serve", "--ilc-state", "s.json"), {"s.json": ilc_state('"0"')}, 2,
+     "correction[0][0]"),
+    ("serve-ilc-state-fractional-iterations", ("executor", "serve", "--ilc-state", "s.json"),
+     {"s.json": ilc_state(iterations="1.5")}, 2, '"round_peg:r1" iterations: expected an integer'),
+    ("serve-ilc-state-keys-list", ("executor", "serve", "--ilc-state", "s.json"), {"s.json": '{"keys": []}'}, 2,
+     's.json: "keys": expected an object'),
+    ("serve-ilc-state-deep-nesting", ("executor", "serve", "--ilc-state", "s.json"),
+     {"s.json": '{"keys": ' + "[" * 100_000 + "]" * 100_000 + "}"}, 2, "s.json: nested too deeply"),
     # numbers written with ASCII digits only; list items once
     ("sample-seed-fullwidth", ("precedence", "sample", "--assembly", "cranfield", "--seed", "\uff15"), None, 2,
      "--seed"),

@@ -38,7 +38,7 @@ from asp.assemble.inputs import check_facts_product, check_plan_product, plan_of
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import Plan, plans
 from bridge.assembly import Assembly, load_assembly
-from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
+from bridge.cell_options import MAGNITUDES, add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
 from bridge.errors import EXIT_UNSOLVABLE
 from bridge.inputs import read_bytes, shorten
@@ -75,12 +75,21 @@ def build_parser() -> argparse.ArgumentParser:
 
 def cell_options(args: argparse.Namespace) -> list[str]:
     """The sim cell's options for ``--uncertainty cell`` (none for ``random``); PlannerError
-    if a cell option was changed without it (it would have no effect)."""
+    naming the option if one was given where it would have no effect: with ``--backend
+    truth`` (the geometry rule simulates nothing), or a cell option without
+    ``--uncertainty cell``."""
+    defaults = build_parser().parse_args([])
+    changed = [f"--{name.replace('_', '-')}" for name in ("layer", "cell_seed", *MAGNITUDES)
+               if getattr(args, name) != getattr(defaults, name)]
+    if args.backend == "truth" and (args.uncertainty == "cell" or changed):
+        option = "--uncertainty cell" if args.uncertainty == "cell" else changed[0]
+        raise PlannerError(f"{option} has no effect with --backend truth (the geometry rule simulates nothing); "
+                           "drop it or use --backend sim")
     if args.uncertainty == "cell":
         return ["--uncertainty", "cell", *cell_argv(args), "--cell-seed", str(args.cell_seed)]
-    defaults = build_parser().parse_args([])
-    if cell_argv(args) != cell_argv(defaults) or args.cell_seed != defaults.cell_seed:
-        raise PlannerError("--layer, --cell-seed and the uncertainty magnitudes need --uncertainty cell")
+    if changed:
+        raise PlannerError(f"{changed[0]}: --layer, --cell-seed and the uncertainty magnitudes need "
+                           "--uncertainty cell")
     return []
 
 
@@ -175,10 +184,11 @@ def _summary(report: dict) -> str:
 def assemble(args: argparse.Namespace) -> tuple[dict, int]:
     """Start the cell, run the plan; (report, exit code)."""
     started = time.perf_counter()
+    options = cell_options(args)
     assembly, facts, plan = resolve(args)
     with assembling_cell(assembly.folder, args.seed, args.timeout, backend=args.backend,
                          block_holes=args.block_hole, rrd=args.rrd, listen=args.listen, connect=args.connect,
-                         zenoh_config=args.zenoh_config, cell_options=cell_options(args)) as driver:
+                         zenoh_config=args.zenoh_config, cell_options=options) as driver:
         try:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:

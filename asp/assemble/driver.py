@@ -12,9 +12,10 @@ from pathlib import Path
 import zenoh
 
 from asp import PlannerError
-from asp.session.cells import start_cell
+from asp.session.cells import CellProcess, start_cell
 from bridge import BridgeError
 from bridge.client import CellDirectory, CellTimeout, request_step
+from bridge.inputs import shorten
 from bridge.messages import StepReply, StepRequest
 from bridge.session import free_loopback_endpoint, open_session
 
@@ -27,10 +28,14 @@ SEND_ATTEMPTS = 3
 
 
 class ZenohDriver:
-    """Sends the steps of one plan run (a fresh world at the cell) to cell ``cell``."""
+    """Sends the steps of one plan run (a fresh world at the cell) to cell ``cell``;
+    ``process``: the cell's process if this planner started it, so a cell that died is
+    reported as exited (with its exit code) rather than as one that did not reply."""
 
-    def __init__(self, session: zenoh.Session, cell: str, seed: int, timeout_s: float) -> None:
+    def __init__(self, session: zenoh.Session, cell: str, seed: int, timeout_s: float,
+                 process: CellProcess | None = None) -> None:
         self.session, self.cell, self.seed, self.timeout_s = session, cell, seed, timeout_s
+        self.process = process
         self.run_id = uuid.uuid4().hex[:16]
 
     def step(self, number: int, part: str, hole: str | None) -> StepReply:
@@ -40,11 +45,24 @@ class ZenohDriver:
             try:
                 return request_step(self.session, self.cell, request, self.timeout_s)
             except CellTimeout as exc:
+                self._check_alive(number, part)
                 if attempt == SEND_ATTEMPTS:
                     raise PlannerError(f"step {number} ({part}): {exc}; gave up after {attempt} sends") from None
             except BridgeError as exc:
                 raise PlannerError(f"step {number} ({part}): {exc}") from None
         raise AssertionError("unreachable")
+
+    def _check_alive(self, number: int, part: str) -> None:
+        """PlannerError naming the exit code if the cell process this planner started has
+        ended (a reply then never comes: sending again is pointless)."""
+        if self.process is None:
+            return
+        code = self.process.exit_code(timeout=1.0)
+        if code is not None:
+            last = self.process.last_line()
+            output = f"; its last output: {shorten(last, 200)}" if last else ""
+            raise PlannerError(f"step {number} ({part}): cell {self.cell} exited (code {code}) during the step"
+                               f"{output}")
 
 
 @contextmanager
@@ -66,7 +84,7 @@ def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backe
         try:
             # Its queryables reach us with its liveliness token: a step sent before might find no one.
             directory.wait_for(1, timeout=CELL_START_S)
-            yield ZenohDriver(session, CELL_ID, seed, timeout_s)
+            yield ZenohDriver(session, CELL_ID, seed, timeout_s, cell)
         finally:
             cell.stop()
             directory.close()

@@ -166,8 +166,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
-    assembly, facts = _facts(args)
     options = cell_options(args)
+    assembly, facts = _facts(args)
     drawn = draw_plans(facts, args.plans, args.seed)
     reports: list[dict] = [{}] * len(drawn)
 

@@ -69,18 +69,24 @@ class CellProcess:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0 or self._eof:
                     tail = "\n".join(self.lines[-20:])
-                    why = (f"exited (code {self._exit_code()}) before printing"
+                    why = (f"exited (code {self.exit_code()}) before printing"
                            if self._eof else "printed no")
                     raise PlannerError(f"cell {self.cell_id}: {why} line '{prefix}...' "
                                        f"(waited up to {timeout:.0f} s); last output:\n{tail}")
                 self._new.wait(remaining)
 
-    def _exit_code(self, timeout: float = 2.0) -> int | None:
-        """The exit code of a process whose output ended (None if it is still running)."""
+    def exit_code(self, timeout: float = 2.0) -> int | None:
+        """The exit code of the process, waiting up to ``timeout`` [s] for it to end
+        (None if it is still running then)."""
         try:
             return self.popen.wait(timeout)
         except subprocess.TimeoutExpired:
             return None
+
+    def last_line(self) -> str | None:
+        """The last non-blank line the process printed (None if none)."""
+        with self._new:
+            return next((line for line in reversed(self.lines) if line.strip()), None)
 
     def stop(self, timeout: float = 60.0) -> int:
         """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code. A cell

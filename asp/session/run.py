@@ -330,17 +330,19 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
 
 
 def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: Plan, seed: int,
-              args: argparse.Namespace) -> dict:
-    """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`); the report, with
-    ``"error"`` when the product could not be finished."""
+              args: argparse.Namespace, process: CellProcess | None) -> dict:
+    """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`; ``process``: its
+    process if the session started it); the report, with ``"error"`` when the product
+    could not be finished."""
     from asp.assemble.driver import ZenohDriver
     from asp.assemble.execute import AssemblyStopped, execute
 
     if not cell_ids:
         raise PlannerError("--assemble needs a cell of this session (--cells 1 or more)")
     started = time.perf_counter()
+    driver = ZenohDriver(session, cell_ids[0], seed, args.timeout, process)
     try:
-        report = execute(load_learned_facts([learned]), plan, ZenohDriver(session, cell_ids[0], seed, args.timeout))
+        report = execute(load_learned_facts([learned]), plan, driver)
     except AssemblyStopped as exc:
         report = dict(exc.report, error=str(exc))
     report["wall_s"] = round(time.perf_counter() - started, 3)
@@ -436,8 +438,8 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
                     header="A hole assignment of learned.lp (the paper's greedy one when it finds one, "
                            "else a matching; paper 2.2).")
         log.assignment(assignment)
-        assembly_report = (_assemble(session, cell_ids, learned, found[0], settings["seed"], args)
-                           if args.assemble else None)
+        assembly_report = (_assemble(session, cell_ids, learned, found[0], settings["seed"], args,
+                                     cells[0] if cells else None) if args.assemble else None)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
     versus = _versus_truth(truth, required, fits, must_precede)

@@ -32,6 +32,7 @@ is saved as JSON (:meth:`Ilc.save`, atomically) and read back by :meth:`Ilc.load
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -40,6 +41,7 @@ import numpy as np
 
 from bridge.cell_options import LAYER_NAMES
 from bridge.files import write_atomic
+from bridge.inputs import duplicate_key, read_bytes, shorten
 from executor import ExecutorError
 from executor.control.admittance import AdmittanceParams
 
@@ -160,18 +162,83 @@ class Ilc:
 
     def load(self, path: Path) -> None:
         """Read the corrections saved at ``path`` (nothing if it does not exist);
-        ExecutorError naming the file if it is not such a state."""
-        if not path.is_file():
-            return
-        try:
-            keys = json.loads(path.read_text())["keys"]
-            for key, entry in keys.items():
-                correction = np.array(entry["correction"], dtype=float)
-                if correction.shape != (self.params.bins, AXES):
-                    raise ValueError(f"correction of {key}: shape {correction.shape}")
-                self.corrections[key], self.iterations[key] = correction, int(entry["iterations"])
-        except (ValueError, KeyError, TypeError) as exc:
-            raise ExecutorError(f"{path}: not an ILC state ({exc}); expected the JSON a cell saved") from None
+        ExecutorError naming the file and the key if it is not such a state
+        (:func:`read_state`)."""
+        corrections, iterations = read_state(path, self.params)
+        self.corrections.update(corrections)
+        self.iterations.update(iterations)
+
+
+MAX_ITERATIONS = 2**31 - 1
+"""The largest iteration count of a key an ILC state file may hold."""
+MAX_KEY_CHARS = 200
+"""The longest key (``shape:hole``) an ILC state file may hold."""
+
+
+def read_state(path: Path, params: IlcParams = IlcParams()) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """The corrections and iteration counts by key of the ILC state saved at ``path``
+    (both empty if it does not exist), as :meth:`Ilc.save` writes it for ``params``.
+
+    ExecutorError, one line naming the file and the key, unless it is a JSON object
+    ``{"params": ..., "keys": {"<shape>:<hole>": {"iterations": N, "correction": C}}}``
+    with ``params`` those of the cell (if given), each N an integer in 0 ..
+    :data:`MAX_ITERATIONS` and each C a (bins, 5) list of finite numbers within
+    ±:data:`OFFSET_BOUND` per axis (what an update can produce).  Checked when the cell
+    starts, so a damaged file is refused there, never at the first insertion."""
+    if not path.exists():
+        return {}, {}
+    data = read_bytes(path, "ILC state file (JSON)", error=ExecutorError)
+    try:
+        state = json.loads(data)
+        twice = duplicate_key(data)
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ExecutorError(f"{path}: not valid JSON ({shorten(exc, 80)}); expected the ILC state a cell saved") \
+            from None
+    except RecursionError:
+        raise ExecutorError(f"{path}: nested too deeply; expected the ILC state a cell saved") from None
+
+    def refuse(where: str, expected: str) -> ExecutorError:
+        return ExecutorError(f"{path}: {where}: expected {expected} (the ILC state a cell saved)")
+
+    if twice is not None:
+        raise refuse(f"the key {shorten(repr(twice))}", "each key once in one object")
+    if not isinstance(state, dict) or not set(state) <= {"params", "keys"} or "keys" not in state:
+        raise refuse("the file", 'an object {"params": {...}, "keys": {...}}')
+    if "params" in state and state["params"] != asdict(params):
+        raise refuse('"params"', f"this cell's {json.dumps(asdict(params))}")
+    keys = state["keys"]
+    if not isinstance(keys, dict):
+        raise refuse('"keys"', 'an object {"<shape>:<hole>": {"iterations": N, "correction": [...]}}')
+    corrections: dict[str, np.ndarray] = {}
+    iterations: dict[str, int] = {}
+    for key, entry in keys.items():
+        where = f'"keys" {shorten(json.dumps(key, ensure_ascii=True))}'
+        shape, _colon, hole = key.partition(":")
+        if len(key) > MAX_KEY_CHARS or not shape or not hole:
+            raise refuse(where, f'a key "<shape>:<hole>" of at most {MAX_KEY_CHARS} characters')
+        if not isinstance(entry, dict) or set(entry) != {"iterations", "correction"}:
+            raise refuse(where, '{"iterations": N, "correction": [...]}')
+        count = entry["iterations"]
+        if type(count) is not int or not 0 <= count <= MAX_ITERATIONS:
+            raise refuse(f"{where} iterations", f"an integer in 0 .. {MAX_ITERATIONS}, got "
+                         f"{shorten(json.dumps(count, ensure_ascii=True))}")
+        corrections[key], iterations[key] = _correction(entry["correction"], params.bins, refuse, where), count
+    return corrections, iterations
+
+
+def _correction(rows: object, bins: int, refuse: Callable[[str, str], ExecutorError], where: str) -> np.ndarray:
+    """The (bins, 5) correction array of the JSON ``rows``; ``refuse(where, expected)``
+    raised naming the first bad row or value."""
+    if not isinstance(rows, list) or len(rows) != bins:
+        raise refuse(f"{where} correction", f"a list of {bins} rows (one per phase bin)")
+    for k, row in enumerate(rows):
+        if not isinstance(row, list) or len(row) != AXES:
+            raise refuse(f"{where} correction[{k}]", f"a row of {AXES} numbers (dx, dy, dz [m], rx, ry [rad])")
+        for axis, (value, bound) in enumerate(zip(row, OFFSET_BOUND, strict=True)):
+            if type(value) not in (int, float) or not abs(value) <= bound:
+                raise refuse(f"{where} correction[{k}][{axis}]", f"a number within ±{bound:g} "
+                             f"{'m' if axis < 3 else 'rad'}, got {shorten(json.dumps(value, ensure_ascii=True))}")
+    return np.array(rows, dtype=float)
 
 
 _NORM_UNITS = np.array([1000.0, 1000.0, 1000.0, np.degrees(1.0), np.degrees(1.0)])

@@ -1,7 +1,11 @@
 """``assemble --uncertainty cell``: the cell's options reach ``executor serve`` (no physics),
-and are refused without ``--uncertainty cell``, where they would have no effect."""
+and are refused where they would have no effect: without ``--uncertainty cell``, or with
+``--backend truth``."""
 
 from __future__ import annotations
+
+from argparse import ArgumentParser
+from collections.abc import Callable
 
 import pytest
 
@@ -37,3 +41,14 @@ def test_bench_assemble_passes_the_same_cell_options() -> None:
     args = bench_parser().parse_args(["--uncertainty", "cell", "--cell-seed", "2", "--layer", "admittance_p"])
     served = serve_parser().parse_args(cell_options(args))
     assert (served.uncertainty, served.cell_seed, served.layer) == ("cell", 2, "admittance_p")
+
+
+@pytest.mark.parametrize("parser", [build_parser, bench_parser], ids=["assemble", "bench-assemble"])
+@pytest.mark.parametrize(("option", "named"), [(["--uncertainty", "cell"], "--uncertainty cell"),
+                                               (["--uncertainty", "cell", "--layer", "position"], "--uncertainty cell"),
+                                               (["--cell-seed", "1"], "--cell-seed"),
+                                               (["--friction-max", "0.6"], "--friction-max")])
+def test_a_cell_option_with_the_truth_backend_is_refused_naming_both(parser: Callable[[], ArgumentParser],
+                                                                      option: list[str], named: str) -> None:
+    with pytest.raises(PlannerError, match=f"^{named} has no effect with --backend truth"):
+        cell_options(parser().parse_args(["--backend", "truth", *option]))

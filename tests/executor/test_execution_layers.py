@@ -161,5 +161,5 @@ def test_a_corrupt_ilc_state_is_refused_naming_the_file(tmp_path):
 
     path = tmp_path / "c1-ilc.json"
     path.write_text('{"keys": {"round_peg:r1": {"iterations": 1, "correction": [[0.0]]}}}')
-    with pytest.raises(ExecutorError, match="c1-ilc.json: not an ILC state"):
+    with pytest.raises(ExecutorError, match='c1-ilc.json: "keys" "round_peg:r1" correction: expected a list of 50'):
         Ilc().load(path)

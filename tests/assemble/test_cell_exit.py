@@ -1,0 +1,42 @@
+"""A cell that dies during a plan step is reported as exited, with its exit code, not as
+a cell that did not reply in time (the planner started it and knows its process)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from asp import PlannerError
+from asp.assemble.driver import assembling_cell
+from bridge.assembly import load_assembly
+
+CRASHING_BACKEND = '''
+import os
+
+
+class Crash:
+    """A cell backend that exits with code 7 at its first plan step."""
+
+    def __init__(self, context):
+        pass
+
+    def run(self, request):
+        os._exit(7)
+
+    def run_step(self, request):
+        os._exit(7)
+
+    def close(self):
+        pass
+'''
+
+
+@pytest.mark.slow  # starts a cell process
+def test_a_cell_that_dies_at_step_one_is_reported_as_exited(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "crashing_cell.py").write_text(CRASHING_BACKEND)
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")])))
+    with assembling_cell(load_assembly("cranfield").folder, 0, 20.0, backend="crashing_cell:Crash") as driver:
+        with pytest.raises(PlannerError, match=r"^step 1 \(bp\): cell a1 exited \(code 7\) during the step"):
+            driver.step(1, "bp", None)
