@@ -89,7 +89,8 @@ def test_a_device_is_written_through_never_replaced(tmp_path: Path, run_cli, com
 
 @pytest.mark.parametrize("argv", [("precedence", "count", "--assembly", "cranfield"),
                                   ("precedence", "enumerate", "--assembly", "cranfield"),
-                                  ("executor", "trial", "--part", "p1", "--hole", "r1")])
+                                  pytest.param(("executor", "trial", "--part", "p1", "--hole", "r1"),
+                                               marks=pytest.mark.slow)])
 def test_stdout_on_a_full_disk_is_one_line_exit_2(argv: tuple[str, ...]) -> None:
     with open("/dev/full", "w") as full:
         done = subprocess.run([sys.executable, "-m", "assembly_constraints", *argv], cwd=ROOT, env=child_env(),

@@ -124,6 +124,7 @@ def test_bad_input_exits_2_with_one_line(run_cli, tmp_path, args, expected) -> N
     assert expected in done.stderr and len(done.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_assemble_and_bench_of_facts_files_respect_precedence_edges(run_cli) -> None:
     """The shipped precedence.lp holds precedence_edge/2 only: assemble and bench assemble
     of the facts files follow its closure."""

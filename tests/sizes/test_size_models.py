@@ -236,7 +236,7 @@ def test_under_pairs_every_policy_tries_every_pair_and_learns_the_truth(policy: 
     assert len({(e.part, e.hole) for e in result.experiments}) == result.count
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=15, deadline=None)
 @given(products(max_pegs=5, max_holes=5), st.sampled_from(policy_names()), st.integers(2, 4))
 def test_parallel_batches_under_sections_never_conflict_and_learn_exactly(product, policy: str, cells: int) -> None:
     """Pairs handed out together are independent on their section's line: answered in
