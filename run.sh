@@ -54,7 +54,9 @@ setup
 export PYTHONPATH="$ROOT${PYTHONPATH:+:$PYTHONPATH}"
 # -P: the caller's folder is not put on sys.path (a folder named asp/ there cannot shadow ours).
 case "$cmd" in
-    test)      cd "$ROOT"; lint; exec "$PY" -m pytest -n 2 "$@" ;;  # two workers (xdist); -n 0: serially
+    # Bytecode caches on for the tests (an environment may turn them off): pytest then
+    # rewrites each test module's asserts once, not at every collection in every worker.
+    test)      cd "$ROOT"; lint; unset PYTHONDONTWRITEBYTECODE; exec "$PY" -m pytest -n 2 "$@" ;;  # two workers (xdist); -n 0: serially
     lint)      cd "$ROOT"; lint ;;
     *)         exec "$PY" -P -m assembly_constraints "$cmd" "$@" ;;
 esac

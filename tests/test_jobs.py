@@ -35,6 +35,7 @@ def test_one_and_two_jobs_give_the_same_json(run_cli, argv: tuple[str, ...]) -> 
     assert _results(reports[0]) == _results(reports[1])
 
 
+@pytest.mark.slow
 def test_jobs_defaults_to_the_cores_and_is_bounded(run_cli) -> None:
     done = run_cli("executor", "campaign", "--help")
     assert "--jobs N" in done.stdout and "default: the machine's" in " ".join(done.stdout.split())

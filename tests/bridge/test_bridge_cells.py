@@ -62,6 +62,7 @@ def raw_query(session: zenoh.Session, key: str, payload: bytes) -> InsertReply |
     return decode_reply(box.get(timeout=15.0))
 
 
+@pytest.mark.slow
 def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
@@ -95,6 +96,7 @@ def test_a_repeated_id_returns_the_cached_reply_without_rerunning(network) -> No
     assert sum(line.startswith("start same") for line in cells[0].lines) == 1
 
 
+@pytest.mark.slow
 def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
@@ -170,6 +172,7 @@ def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
     assert cells_of == {"w0": "c1", "w1": "c2", "w2": "c2"}
 
 
+@pytest.mark.slow
 def test_a_reused_id_with_another_pair_is_refused_not_answered_from_the_cache(network) -> None:
     endpoint, session, directory, cells = network
     cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
@@ -314,6 +317,7 @@ def test_cells_on_one_id_that_meet_later_leave_the_older_serving(network) -> Non
         late.close()
 
 
+@pytest.mark.slow
 def test_a_token_of_a_second_claimant_the_cells_cannot_see_makes_the_planner_wait(network) -> None:
     """The planner's own guard: two tokens on one id (here a peer that listens nowhere, so
     the cell cannot meet it) and that id gets nothing until one is gone."""

@@ -49,6 +49,7 @@ def refused(session: zenoh.Session, run: str, number: int, part: str, hole: str 
 
 
 @pytest.mark.timeout(120)
+@pytest.mark.slow
 def test_truth_cell_builds_one_product_at_a_time_and_refuses_what_is_not_the_product() -> None:
     plan = plans(truth_facts(load_assembly("cranfield")))[0].steps
     with one_cell("truth") as session:

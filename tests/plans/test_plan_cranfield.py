@@ -137,6 +137,7 @@ def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path, r
     assert re.findall(r"^Optimization: (\d+)$", done.stdout, re.M)[-1] == str(report["cost"])
 
 
+@pytest.mark.slow
 def test_plan_command_errors(learned: Path, tmp_path: Path, run_cli) -> None:
     assert run_cli("plan", "--help").returncode == 0
     no_geometry = run_cli("plan", str(learned), "--optimal")
@@ -184,6 +185,7 @@ def test_plans_of_shipped_files_respect_their_precedence_edges(name: str) -> Non
     assert any(error.startswith("wrong_order(") for error in check_plan(facts, wrong))
 
 
+@pytest.mark.slow
 def test_plan_command_reads_precedence_edges_and_mixed_forms(tmp_path: Path, run_cli) -> None:
     truth = load_relation([CRANFIELD / "precedence.lp"])
     done = run_cli("plan", str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"), "-n", "20", "--json")

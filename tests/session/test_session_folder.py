@@ -100,6 +100,7 @@ def test_resume_of_a_running_session_is_refused_before_any_cell(tmp_path: Path, 
     assert json.loads((run / "session.json").read_text())["starts"] == 1
 
 
+@pytest.mark.slow
 def test_out_on_a_folder_with_a_journal_is_refused(tmp_path: Path, run_cli) -> None:
     run = tmp_path / "run"
     run.mkdir()

@@ -178,6 +178,7 @@ def test_a_journal_of_other_ids_is_refused_naming_the_line(tmp_path: Path) -> No
     LINE.format(id="b", part="p1", hole="br", result="no_fit", extra=""),  # a contradiction
     LINE.format(id="b", part="zz", hole="br", result="fit", extra=""),  # not a part of the assembly
 ])
+@pytest.mark.slow
 def test_a_refused_resume_starts_no_cell_and_changes_nothing(tmp_path: Path, run_cli, second: str) -> None:
     run = tmp_path / "run"
     run.mkdir()

@@ -17,6 +17,7 @@ from bridge.session import free_loopback_endpoint, open_session
 
 
 @pytest.mark.timeout(60)
+@pytest.mark.slow
 def test_learn_sizes_through_the_zenoh_oracle(tmp_path: Path) -> None:
     truth = TruthOracle.from_assembly("cranfield")
     endpoint = free_loopback_endpoint()

@@ -78,6 +78,7 @@ def test_essentials_are_the_observations_whose_pair_is_unknown_without_them(trut
     assert learner.essential() == expected
 
 
+@pytest.mark.slow
 def test_confirm_1_undoes_a_lie_on_an_essential_pair_that_confirm_0_keeps() -> None:
     truth_fits = frozenset(CRANFIELD.fits)
     for pair in _final_essentials(CRANFIELD):
@@ -151,6 +152,7 @@ def test_bad_confirm_settings_are_errors() -> None:
         SizeLearner(["a"], ["x"], max_answers=2, confirm=2)
 
 
+@pytest.mark.slow
 def test_cli_learn_and_evaluate_take_confirm_and_noise(run_cli) -> None:
     done = run_cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--confirm", "1", "--json")
     assert done.returncode == 0, done.stderr

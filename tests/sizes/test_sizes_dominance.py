@@ -56,6 +56,7 @@ def test_systematic_counts_match_a_replay_over_all_biorders() -> None:
 @pytest.mark.parametrize("m, n, systematic_total, unconstrained", [
     (2, 3, 260, 258), (3, 2, 260, 258), (2, 4, 1082, 1070), (3, 3, 1876, 1832),
 ])
+@pytest.mark.slow
 def test_no_policy_beats_systematic_without_losing_somewhere(m: int, n: int, systematic_total: int,
                                                              unconstrained: int) -> None:
     """Least total over policies never worse than systematic on any m×n biorder = systematic's."""

@@ -46,6 +46,7 @@ def test_every_choice_of_a_session_is_the_best_scored_pair(truth: TruthOracle) -
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4), st.sampled_from(["fit", "no_fit"])),
                 max_size=14))
+@pytest.mark.slow
 def test_noisy_observations_give_one_model_with_the_best_scored_pair(
         observations: list[tuple[int, int, str]]) -> None:
     parts, holes = [f"p{i}" for i in range(1, 6)], [f"h{j}" for j in range(1, 6)]
