@@ -10,6 +10,7 @@ entail fits that do not exist. The truth cells answer from the cross-sections.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -81,3 +82,16 @@ def test_a_session_learns_the_task_board_and_assigns_each_peg_a_hole_it_fits(run
     steps = {step["part"]: step["hole"] for step in result["plans"][0] if step["hole"]}
     assert len(steps) == 8 and len(set(steps.values())) == 8
     assert all([p, h] in result["fits"] for p, h in steps.items())
+
+
+@pytest.mark.slow
+def test_the_task_board_is_learned_through_physics_and_assembled_within_2_mm(run_cli, tmp_path) -> None:
+    """Sim cells learn the board exactly (its sizes.lp) and the first plan is assembled."""
+    done = run_cli("session", "--assembly", "taskboard", "--cells", "2", "--assemble", "--json",
+                   "--out", str(tmp_path / "run"), timeout=900)
+    assert done.returncode == 0, done.stderr[-2000:]
+    result = json.loads(done.stdout)
+    assert result["matches_truth"] is True and result["model"] == "sections"
+    report = result["assembly"]
+    assert report["assembled"] is True
+    assert max(report["final_pose_error_mm"].values()) <= 2.0
