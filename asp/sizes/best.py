@@ -47,6 +47,7 @@ from asp.sizes.biorders import (
     weighted_bit_sums,
 )
 from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.models import group_by_section
 from asp.sizes.policies import SelectionPolicy
 
 ALPHA = 0.5
@@ -148,9 +149,7 @@ def section_knowledge(knowledge: Knowledge) -> list[Knowledge]:
     the weight of its own section only, and its split is best compared as a share of
     that section's total weight.
     """
-    groups: dict[str, list[str]] = {}
-    for part in knowledge.parts:
-        groups.setdefault(knowledge.section_of(part), []).append(part)
+    groups = group_by_section({part: knowledge.section_of(part) for part in knowledge.parts})
     if len(groups) == 1:
         return [knowledge]
     return [knowledge.restricted(parts) for parts in groups.values()]

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import clingo
 
+from asp.sizes.models import LINE_SECTION
+
 Pair = tuple[str, str]
 """A part-hole pair ``(part, hole)`` of ASP constants."""
 
@@ -43,8 +45,8 @@ class Knowledge:
     sections: tuple[tuple[str, str], ...] = ()
 
     def section_of(self, part: str) -> str:
-        """The section whose size line ``part`` lies on ("line" when none is given)."""
-        return dict(self.sections).get(part, "line")
+        """The section whose size line ``part`` lies on (:data:`LINE_SECTION` when none is given)."""
+        return dict(self.sections).get(part, LINE_SECTION)
 
     def restricted(self, parts: Sequence[str]) -> Knowledge:
         """The knowledge of ``parts`` (one section's parts) and every hole, in index order."""

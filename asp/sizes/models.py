@@ -25,12 +25,21 @@ from dataclasses import dataclass
 
 from asp import PlannerError
 from asp.sizes.biorders import biorder_count
+from bridge.assembly import SIZE_MODELS
 
-MODELS = ("line", "sections", "pairs")
-"""The size models, strongest first."""
+MODELS = SIZE_MODELS
+"""The size models, strongest first (the names a product may declare)."""
 
 LINE_SECTION = "line"
 """The one section of the ``line`` model (and of parts with no declared section)."""
+
+
+def group_by_section(sections: Mapping[str, str]) -> dict[str, list[str]]:
+    """Section -> its parts, in the order of ``sections`` (part -> section)."""
+    found: dict[str, list[str]] = {}
+    for part, section in sections.items():
+        found.setdefault(section, []).append(part)
+    return found
 
 
 @dataclass(frozen=True)
@@ -48,10 +57,7 @@ class SizeModel:
 
     def groups(self) -> dict[str, list[str]]:
         """Section -> its parts, in the parts' order."""
-        found: dict[str, list[str]] = {}
-        for part, section in self.sections.items():
-            found.setdefault(section, []).append(part)
-        return found
+        return group_by_section(self.sections)
 
     def assumption(self) -> str:
         """One line saying what the model assumes, printed and written beside the results."""
@@ -104,9 +110,7 @@ def check_line_allowed(model: SizeModel, declared_by_product: bool) -> None:
     itself declares the line (the explicit override, which the summary repeats)."""
     if model.name != "line" or declared_by_product:
         return
-    groups: dict[str, list[str]] = {}
-    for part, section in model.declared.items():
-        groups.setdefault(section, []).append(part)
+    groups = group_by_section(model.declared)
     if len(groups) > 1:
         listed = "; ".join(f"{section}: {' '.join(parts)}" for section, parts in groups.items())
         raise PlannerError(

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from asp import PlannerError
+from asp.sizes.models import LINE_SECTION, group_by_section
 from asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name
 from bridge.assembly import load_assembly
 from bridge.inputs import read_text
@@ -70,10 +71,9 @@ class TruthOracle:
                 raise PlannerError(f"{source}: fits({p},{h}): '{p}' is not a declared part/1")
             if h not in self.holes:
                 raise PlannerError(f"{source}: fits({p},{h}): '{h}' is not a declared hole/1")
-        groups: dict[str, list[str]] = {}
-        for part in self.parts:
-            groups.setdefault("line" if sections is None else sections.get(part, "line"), []).append(part)
-        for section, members in groups.items():
+        for section, members in group_by_section(
+                {part: LINE_SECTION if sections is None else sections.get(part, LINE_SECTION)
+                 for part in self.parts}).items():
             bad = ferrers_violation(members, self.holes, self.fits)
             if bad:
                 p, h, q, k = bad
@@ -111,7 +111,7 @@ class TruthOracle:
         parts = [p for p in assembly.part_ids if p in truth_parts]
         holes = [h for h in assembly.hole_ids if h in truth_holes]
         declared = assembly.sections()
-        sections = None if assembly.size_model == "line" else {p: declared.get(p, "line") for p in parts}
+        sections = None if assembly.size_model == "line" else {p: declared.get(p, LINE_SECTION) for p in parts}
         found = cls(parts, holes, fits, source=str(assembly.folder / "sizes.lp"), sections=sections)
         found.declared_sections, found.declared_model = declared, assembly.size_model
         return found
