@@ -15,16 +15,30 @@ import networkx as nx
 from tests.conftest import ROOT
 
 PACKAGES = ("asp", "executor", "bridge", "assembly_constraints")
-FORBIDDEN = {"asp": {"executor", "assembly_constraints"}, "executor": {"asp", "assembly_constraints"},
-             "bridge": {"asp", "executor", "assembly_constraints"}, "assembly_constraints": set()}
+"""The repository's folders; the first three are installed as ``assembly_constraints.<folder>``."""
+FRONT = "assembly_constraints"
+FORBIDDEN = {"asp": {"executor", FRONT}, "executor": {"asp", FRONT}, "bridge": {"asp", "executor", FRONT}, FRONT: set()}
 """``assembly_constraints`` is the front (console command, Python API): it may use every
 side, and no side uses it."""
 
 
 def module_name(root: Path, path: Path) -> str:
-    """``asp/sizes/learner.py`` → ``asp.sizes.learner``; a package's ``__init__`` is the package."""
+    """``asp/sizes/learner.py`` → ``assembly_constraints.asp.sizes.learner`` (its installed
+    name); a package's ``__init__`` is the package."""
     parts = list(path.relative_to(root).with_suffix("").parts)
+    if parts[0] != FRONT:
+        parts.insert(0, FRONT)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def side_of(name: str) -> str:
+    """The folder a module name belongs to: ``assembly_constraints.asp.solve`` → ``asp``,
+    ``assembly_constraints.cli`` → the front; a bare ``asp...`` name (never installed) counts
+    as its folder, so it is caught as well."""
+    parts = name.split(".")
+    if parts[0] == FRONT:
+        return parts[1] if len(parts) > 1 and parts[1] in PACKAGES[:3] else FRONT
+    return parts[0]
 
 
 def imports(root: Path, path: Path) -> list[tuple[int, str]]:
@@ -45,7 +59,10 @@ def imports(root: Path, path: Path) -> list[tuple[int, str]]:
 
 
 def sources(root: Path) -> list[Path]:
-    return sorted(p for package in PACKAGES if (root / package).is_dir() for p in (root / package).rglob("*.py"))
+    """Every module of the four folders, once: not through the front's links to the layers."""
+    return sorted(p for package in PACKAGES if (root / package).is_dir() for p in (root / package).rglob("*.py")
+                  if not any((root / Path(*p.relative_to(root).parts[:n])).is_symlink()
+                             for n in range(1, len(p.relative_to(root).parts))))
 
 
 def violations(root: Path) -> list[str]:
@@ -54,7 +71,7 @@ def violations(root: Path) -> list[str]:
     for path in sources(root):
         side = path.relative_to(root).parts[0]
         for line, name in imports(root, path):
-            if name.split(".")[0] in FORBIDDEN[side]:
+            if side_of(name) in FORBIDDEN[side]:
                 bad.append(f"{path.relative_to(root)}:{line} imports {name}")
     return sorted(set(bad))
 
@@ -80,18 +97,26 @@ def test_the_rule_catches_a_planner_module_importing_the_cell(tmp_path: Path) ->
         (tmp_path / package).mkdir()
         (tmp_path / package / "__init__.py").write_text("")
     (tmp_path / "asp" / "planner.py").write_text("import executor\n")
-    (tmp_path / "executor" / "cell.py").write_text("def f():\n    from asp.solve import solve\n")
-    (tmp_path / "bridge" / "keys.py").write_text("from executor import ExecutorError\nfrom . import messages\n")
+    (tmp_path / "executor" / "cell.py").write_text("def f():\n    from assembly_constraints.asp.solve import solve\n")
+    (tmp_path / "bridge" / "keys.py").write_text("from assembly_constraints.executor import ExecutorError\n"
+                                                 "from . import messages\n")
     (tmp_path / "bridge" / "messages.py").write_text("from .keys import x\n")
     assert violations(tmp_path) == [
         "asp/planner.py:1 imports executor",
-        "bridge/keys.py:1 imports executor",
-        "bridge/keys.py:1 imports executor.ExecutorError",
-        "executor/cell.py:2 imports asp.solve",
-        "executor/cell.py:2 imports asp.solve.solve",
+        "bridge/keys.py:1 imports assembly_constraints.executor",
+        "bridge/keys.py:1 imports assembly_constraints.executor.ExecutorError",
+        "executor/cell.py:2 imports assembly_constraints.asp.solve",
+        "executor/cell.py:2 imports assembly_constraints.asp.solve.solve",
     ]
     cycles = [set(cycle) for cycle in nx.simple_cycles(import_graph(tmp_path))]
-    assert cycles == [{"bridge.keys", "bridge.messages"}]
+    assert cycles == [{"assembly_constraints.bridge.keys", "assembly_constraints.bridge.messages"}]
+
+
+def test_no_module_imports_a_layer_outside_the_namespace() -> None:
+    """Installed, only ``assembly_constraints`` exists: a bare ``import bridge`` would fail there."""
+    bare = [f"{path.relative_to(ROOT)}:{line} imports {name}" for path in sources(ROOT)
+            for line, name in imports(ROOT, path) if name.split(".")[0] in PACKAGES[:3]]
+    assert bare == []
 
 
 def test_no_import_cycle_among_the_project_modules() -> None:
@@ -108,10 +133,10 @@ def test_no_python_folder_holds_more_than_twelve_modules() -> None:
 
 def test_every_layer_error_shares_the_one_root() -> None:
     """Callers catch one layer's errors or all of them; none is converted into another."""
-    from asp import PlannerError
-    from bridge import BridgeError
-    from bridge.errors import ToolError
-    from executor import ExecutorError
+    from assembly_constraints.asp import PlannerError
+    from assembly_constraints.bridge import BridgeError
+    from assembly_constraints.bridge.errors import ToolError
+    from assembly_constraints.executor import ExecutorError
 
     assert all(issubclass(error, ToolError) for error in (PlannerError, BridgeError, ExecutorError))
     assert not any(issubclass(a, b) for a in (PlannerError, BridgeError, ExecutorError)

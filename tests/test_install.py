@@ -41,8 +41,9 @@ def test_the_installed_command_runs_a_session_from_a_folder_outside_the_reposito
     version = subprocess.run([str(command), "--version"], cwd=tmp_path, env=env, capture_output=True, text=True,
                              timeout=60)
     assert version.returncode == 0 and version.stdout.startswith(f"{PROGRAM} "), version.stderr
-    where = subprocess.run([sys.executable, "-c", "import bridge.assembly as a, asp; print(a.DATA_DIR); "
-                            "print(asp.__file__)"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
+    where = subprocess.run([sys.executable, "-c", "import assembly_constraints.bridge.assembly as a; "
+                            "import assembly_constraints.asp as asp; print(a.DATA_DIR); print(asp.__file__)"],
+                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
     data_dir, asp_file = where.stdout.split()
     site = Path(env["PYTHONPATH"])
     assert Path(data_dir).is_relative_to(site) and Path(asp_file).is_relative_to(site)  # not the repository
@@ -55,3 +56,15 @@ def test_the_installed_command_runs_a_session_from_a_folder_outside_the_reposito
     assert json.loads(done.stdout)["matches_truth"] is True
     run = tmp_path / "my-run"  # relative to the caller's folder
     assert {"learned.lp", "journal.jsonl", "session.json", "planner.rrd", "c1.rrd"} <= {p.name for p in run.iterdir()}
+
+
+@pytest.mark.slow
+def test_the_installed_package_adds_exactly_one_top_level_name(installed: tuple[Path, dict[str, str]]) -> None:
+    """Nothing of ours stands beside other packages: ``asp``, ``bridge`` and ``executor`` are
+    inside ``assembly_constraints``, as real folders (not links back to a checkout)."""
+    site = Path(installed[1]["PYTHONPATH"])
+    names = {p.name for p in site.iterdir()
+             if p.name not in {"bin", "__pycache__"} and not p.name.endswith(".dist-info")}
+    assert names == {"assembly_constraints"}
+    layers = [site / "assembly_constraints" / layer for layer in ("asp", "bridge", "executor")]
+    assert all(layer.is_dir() and not layer.is_symlink() and (layer / "__init__.py").is_file() for layer in layers)
