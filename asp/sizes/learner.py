@@ -368,8 +368,8 @@ class SizeLearner:
         plus each other pair as an edge in either direction has a path from p to h or
         from h to p (a shortest such walk is a simple path, which turns each pair one way
         only). A contradiction is a cycle through some pair, i.e. the rest of the cycle
-        entails that pair: the same test. Linear in the graph per pair, where solving
-        every combination of outcomes was exponential in the batch size.
+        entails that pair: the same test. Linear in the graph per pair (solving every
+        combination of the others' outcomes instead would be exponential in the batch size).
         """
         known: dict[str, dict[str, set[str]]] = {}
         for section, smaller, bigger in self.knowledge.lines:

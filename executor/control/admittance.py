@@ -12,9 +12,10 @@ toward the slot's real yaw when vision got it wrong.
 The proportional part answers at once; the integral part keeps adapting while a
 deviation persists (which is what DMP phase stopping gives it time to do) and holds
 the offset that cancelled it; in contact, the measured wrench unwinds the integral when
-the offset overshoots, and the spring then returns δ to the reference (a pure integrator
-driving the pose ran away in the measurements of the notes). The integral is clamped to
-what holds δ at its bound (anti-windup). The insertion axis z is left to the DMP and to phase stopping.
+the offset overshoots, and the spring then returns δ to the reference (without the
+spring, a pure integrator keeps the offset it reached and drives the pose away once the
+contact that caused it is gone). The integral is clamped to what holds δ at its bound
+(anti-windup). The insertion axis z is left to the DMP and to phase stopping.
 Integrated with semi-implicit Euler at the control rate.
 """
 
