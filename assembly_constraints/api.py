@@ -11,7 +11,7 @@
 
 Paths are relative to the working folder; an assembly is a shipped one's name
 (``cranfield``, ``battery``, ``spare``, ``graded``) or a folder holding ``assembly.toml``. Bad input raises
-:class:`asp.PlannerError` or :class:`bridge.BridgeError` with a one-line message naming
+:class:`assembly_constraints.asp.PlannerError` or :class:`assembly_constraints.bridge.BridgeError` with a one-line message naming
 the file or value. Documented in ``docs/api.md``.
 """
 
@@ -23,19 +23,19 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal, TypedDict
 
-from asp import PlannerError
-from asp.plans.assign import load_learned_facts
-from asp.plans.plans import Plan, check_plan, plans
-from asp.precedence.demos import load_demos
-from asp.precedence.learn import learn_must_precede
-from asp.precedence.relation import Relation, precedence_facts
-from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
-from asp.sizes.learner import Experiment, SizeLearningResult
-from asp.sizes.learner import learn_sizes as _learn_sizes
-from asp.sizes.oracle import Oracle, TruthOracle
-from asp.solve import write_facts as _write_facts
-from bridge.assembly import load_assembly
-from bridge.inputs import read_bytes
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.plans.assign import load_learned_facts
+from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
+from assembly_constraints.asp.precedence.demos import load_demos
+from assembly_constraints.asp.precedence.learn import learn_must_precede
+from assembly_constraints.asp.precedence.relation import Relation, precedence_facts
+from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from assembly_constraints.asp.sizes.learner import Experiment, SizeLearningResult
+from assembly_constraints.asp.sizes.learner import learn_sizes as _learn_sizes
+from assembly_constraints.asp.sizes.truth_oracle import Oracle, TruthOracle
+from assembly_constraints.asp.solve import write_facts as _write_facts
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.inputs import read_bytes
 
 Result = Literal["fit", "no_fit"]
 """The outcome of one insertion experiment."""
@@ -66,7 +66,7 @@ def truth_oracle(assembly: str | Path = "cranfield") -> TruthOracle:
 
 
 class _CallableOracle:
-    """An :class:`asp.sizes.oracle.Oracle` around a function ``(part, hole) -> result``."""
+    """An :class:`assembly_constraints.asp.sizes.truth_oracle.Oracle` around a function ``(part, hole) -> result``."""
 
     def __init__(self, ask: Callable[[str, str], Result]) -> None:
         self._ask = ask
@@ -108,7 +108,7 @@ def write_facts(path: str | Path, precedence: Relation | None = None,
 def plan(facts: Sequence[str | Path], n: int = 1) -> list[Plan]:
     """Up to ``n`` complete plans (0: all) from learned facts files: a hole for every part
     that needs one and an order respecting ``must_precede``; each checked by the
-    independent plan checker. :class:`asp.plans.assign.UnsolvableAssembly` names a part
+    independent plan checker. :class:`assembly_constraints.asp.plans.assign.UnsolvableAssembly` names a part
     without a hole."""
     learned = load_learned_facts([Path(f) for f in facts])
     found = plans(learned, n=n)
@@ -140,8 +140,8 @@ def run_session(assembly: str | Path = "cranfield", *, out: str | Path | None = 
     reachable at the Zenoh endpoints ``connect``; learns the sizes, plans, and writes the
     run folder ``out`` (default ``runs/<UTC time>``). ``timeout_s`` [s]: one experiment at
     one cell before it is sent again."""
-    from asp.session.run import build_parser
-    from asp.session.run import run_session as run
+    from assembly_constraints.asp.session.run import build_parser
+    from assembly_constraints.asp.session.run import run_session as run
 
     args = build_parser().parse_args([])
     overrides = {"assembly": str(assembly), "out": None if out is None else Path(out), "backend": backend,

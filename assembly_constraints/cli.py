@@ -2,13 +2,13 @@
 
 ``assembly-constraints [-v | -q] SUBCOMMAND [ARGS...]`` runs one subcommand; each takes
 ``--help``. :data:`SUBCOMMANDS` is the one registry: the planner's subcommands, the cell's
-under ``executor`` (:mod:`executor.cli`), the benchmarks of both under ``bench``
+under ``executor`` (:mod:`assembly_constraints.executor.cli`), the benchmarks of both under ``bench``
 (:data:`BENCHMARKS`), and ``protocol``, which writes the published message schemas
-(:mod:`bridge.protocol_schema`). The tests run this same command line.
+(:mod:`assembly_constraints.bridge.protocol_schema`). The tests run this same command line.
 Modules are imported lazily, so ``--help`` of one subcommand does not pay for the others.
 
-Exit codes (:mod:`bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
-missing subcommand too; every :class:`bridge.errors.ToolError`), 3 an unsolvable
+Exit codes (:mod:`assembly_constraints.bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
+missing subcommand too; every :class:`assembly_constraints.bridge.errors.ToolError`), 3 an unsolvable
 assembly, 130 interrupted, 141 stdout closed.
 """
 
@@ -21,34 +21,34 @@ import sys
 from collections.abc import Callable, Sequence
 
 from assembly_constraints import __version__
-from bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
-from bridge.errors import ToolError
+from assembly_constraints.bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
+from assembly_constraints.bridge.errors import ToolError
 
 BENCHMARKS: dict[str, str] = {
-    "precedence": "asp.bench.precedence",
-    "sizes": "asp.bench.sizes",
-    "plan": "asp.bench.plans",
-    "session": "asp.bench.session",
-    "dominance": "asp.bench.dominance",
-    "mesh": "asp.bench.mesh",
-    "precedence-physics": "asp.bench.precedence_physics",
-    "assemble": "asp.bench.assemble_plans",
-    "executor": "executor.campaign.bench",
-    "physics": "executor.campaign.physics",
+    "precedence": "assembly_constraints.asp.bench.precedence",
+    "sizes": "assembly_constraints.asp.bench.sizes",
+    "plan": "assembly_constraints.asp.bench.plans",
+    "session": "assembly_constraints.asp.bench.session",
+    "dominance": "assembly_constraints.asp.bench.dominance",
+    "mesh": "assembly_constraints.asp.bench.mesh",
+    "precedence-physics": "assembly_constraints.asp.bench.precedence_physics",
+    "assemble": "assembly_constraints.asp.bench.assemble_plans",
+    "executor": "assembly_constraints.executor.campaign.bench",
+    "physics": "assembly_constraints.executor.campaign.physics",
 }
 """``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "precedence": ("asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
-    "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
-    "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
-    "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
-    "session": ("asp.session.run", "the end-to-end learning session (planner + cells)"),
-    "assemble": ("asp.assemble.cli", "execute a plan in a simulated cell, monitored and re-planned"),
-    "view": ("asp.session.view", "open a session's Rerun recording"),
+    "precedence": ("assembly_constraints.asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
+    "sizes": ("assembly_constraints.asp.sizes.cli", "learn/evaluate which part fits which hole"),
+    "assign": ("assembly_constraints.asp.plans.cli:assign_main", "hole assignments from learned facts"),
+    "plan": ("assembly_constraints.asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
+    "session": ("assembly_constraints.asp.session.run", "the end-to-end learning session (planner + cells)"),
+    "assemble": ("assembly_constraints.asp.assemble.cli", "execute a plan in a simulated cell, monitored and re-planned"),
+    "view": ("assembly_constraints.asp.session.view", "open a session's Rerun recording"),
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
-    "executor": ("executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
-    "protocol": ("bridge.protocol_schema", "write or check the JSON Schema of every Zenoh message"),
+    "executor": ("assembly_constraints.executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
+    "protocol": ("assembly_constraints.bridge.protocol_schema", "write or check the JSON Schema of every Zenoh message"),
 }
 """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
 

@@ -26,8 +26,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bridge import BridgeError
-from bridge.inputs import read_text, shorten
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.inputs import read_text, shorten
 
 _INSTALLED_ASSEMBLIES = Path(__file__).resolve().parent / "assemblies"
 DATA_DIR = (_INSTALLED_ASSEMBLIES if _INSTALLED_ASSEMBLIES.is_dir()

@@ -2,7 +2,7 @@
 ``campaign``, ``serve``, ``bench executor``) and the session that starts cells: the
 execution layer (``--layer``), the seed of the cell's systematic errors (``--cell-seed``)
 and one option per magnitude of the cell's uncertainty (the fields of
-:class:`executor.world.perturbation.PerturbationModel`, whose defaults are the ones
+:class:`assembly_constraints.executor.world.perturbation.PerturbationModel`, whose defaults are the ones
 here; units and reasons in docs/cell.md).  Here in ``bridge`` so the planner can pass
 them on to ``executor serve`` without importing the cell."""
 
@@ -11,10 +11,10 @@ from __future__ import annotations
 import argparse
 from dataclasses import dataclass
 
-from bridge.cli_types import MAX_SEED, finite_float, int_in
+from assembly_constraints.bridge.cli_types import MAX_SEED, finite_float, int_in
 
 LAYER_NAMES = ("position", "admittance_p", "admittance_pi", "pi_phase_stop", "full")
-"""The execution layers (:data:`executor.control.ilc.LAYERS`), from the least to the whole."""
+"""The execution layers (:data:`assembly_constraints.executor.control.ilc.LAYERS`), from the least to the whole."""
 DEFAULT_LAYER = "full"
 
 

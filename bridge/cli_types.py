@@ -18,9 +18,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
-from bridge import BridgeError
-from bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED
-from bridge.inputs import shorten
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED
+from assembly_constraints.bridge.inputs import shorten
 
 T = TypeVar("T")
 

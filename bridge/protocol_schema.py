@@ -1,5 +1,5 @@
 """``assembly-constraints protocol``: the JSON Schema of every Zenoh message, generated
-from the message types of :mod:`bridge.messages`.
+from the message types of :mod:`assembly_constraints.bridge.messages`.
 
 The schemas are published in ``docs/protocol/`` (one file a message, described in
 ``docs/protocol.md``) for clients in any language; a test fails when the checked-in files
@@ -17,10 +17,10 @@ from pathlib import Path
 
 import msgspec
 
-from bridge.cli_types import ArgumentParser
-from bridge.files import make_folder, write_atomic
-from bridge.keys import ALIVE_PATTERN, CELL_ID_PATTERN
-from bridge.messages import (
+from assembly_constraints.bridge.cli_types import ArgumentParser
+from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.keys import ALIVE_PATTERN, CELL_ID_PATTERN
+from assembly_constraints.bridge.messages import (
     MAX_MESSAGE_BYTES,
     PROTOCOL_VERSION,
     ErrorReply,

@@ -20,15 +20,15 @@ from pathlib import Path
 
 import zenoh
 
-from bridge import BridgeError
-from bridge.messages import MAX_MESSAGE_BYTES
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.messages import MAX_MESSAGE_BYTES
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 """Where a cell listens and a planner connects when given no endpoint."""
 
 MAX_TRANSPORT_BYTES = 8 * MAX_MESSAGE_BYTES
 """Zenoh refuses bigger messages before they reach Python (the application's own cap,
-:data:`bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
+:data:`assembly_constraints.bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
 
 LOOPBACK_ANY_PORT = "tcp/127.0.0.1:0"
 """A loopback listener on a port the system picks."""
@@ -60,7 +60,7 @@ def cell_listen(listen: Sequence[str], connect: Sequence[str], config_file: Path
     """Where a cell listens: ``listen`` if given; else nowhere new with a config file (the
     file says); else, when it connects only to loopback endpoints, a loopback port the
     system picks (Zenoh's gossip then connects the cells of one planner to each other, so
-    a second process on one cell id is seen: :mod:`executor.claim`); else, connecting
+    a second process on one cell id is seen: :mod:`assembly_constraints.executor.claim`); else, connecting
     elsewhere, nowhere; else :data:`DEFAULT_ENDPOINT`."""
     if listen or config_file is not None:
         return list(listen)

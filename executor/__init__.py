@@ -2,20 +2,20 @@
 impedance arm, hole search, DMP insertion with admittance and phase stopping, failure
 detection (eqs. 6, 7 and the goal check) and the wiggle exception strategy.
 
-Entry points: :class:`executor.trial.Cell` (``run_trial``) and the ``executor`` subcommand
-of the command line (:mod:`executor.cli`).
-Layers, each importing only those before it: :mod:`executor.world` (geometry, PyBullet
-scene, arm), :mod:`executor.control` (impedance controller, admittance, detector, motion
-stepper), :mod:`executor.skills` (DMP, hole search, insertion, wiggle, teaching), the
-records in :mod:`executor.evidence`, the Rerun log :mod:`executor.rerun_log`, the trial
-:mod:`executor.trial`, and on top :mod:`executor.campaign`, :mod:`executor.serve` (with
-the backend interface :mod:`executor.backends` and the replay backend :mod:`executor.replay`)
-and :mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`) drives a
-:class:`executor.trial.Cell` to record the skills the trial then uses.
+Entry points: :class:`assembly_constraints.executor.trial.Cell` (``run_trial``) and the ``executor`` subcommand
+of the command line (:mod:`assembly_constraints.executor.cli`).
+Layers, each importing only those before it: :mod:`assembly_constraints.executor.world` (geometry, PyBullet
+scene, arm), :mod:`assembly_constraints.executor.control` (impedance controller, admittance, detector, motion
+stepper), :mod:`assembly_constraints.executor.skills` (DMP, hole search, insertion, wiggle, teaching), the
+records in :mod:`assembly_constraints.executor.evidence`, the Rerun log :mod:`assembly_constraints.executor.rerun_log`, the trial
+:mod:`assembly_constraints.executor.trial`, and on top :mod:`assembly_constraints.executor.campaign`, :mod:`assembly_constraints.executor.serve` (with
+the backend interface :mod:`assembly_constraints.executor.backend_plugin` and the replay backend :mod:`assembly_constraints.executor.replay`)
+and :mod:`assembly_constraints.executor.cli`.  One exception: teaching (:mod:`assembly_constraints.executor.skills.teach`) drives a
+:class:`assembly_constraints.executor.trial.Cell` to record the skills the trial then uses.
 """
 
 
-from bridge.errors import ToolError
+from assembly_constraints.bridge.errors import ToolError
 
 
 class ExecutorError(ToolError):

@@ -1,13 +1,13 @@
-"""The cell's options (:mod:`bridge.cell_options`: ``--layer``, ``--cell-seed``, one per
-magnitude of the uncertainty) turned into what a :class:`executor.trial.Cell` takes."""
+"""The cell's options (:mod:`assembly_constraints.bridge.cell_options`: ``--layer``, ``--cell-seed``, one per
+magnitude of the uncertainty) turned into what a :class:`assembly_constraints.executor.trial.Cell` takes."""
 
 from __future__ import annotations
 
 import argparse
 from typing import Any
 
-from bridge.cell_options import MAGNITUDES
-from executor.world.perturbation import PerturbationModel
+from assembly_constraints.bridge.cell_options import MAGNITUDES
+from assembly_constraints.executor.world.perturbation import PerturbationModel
 
 
 def perturbation_from_args(args: argparse.Namespace) -> PerturbationModel:
@@ -16,7 +16,7 @@ def perturbation_from_args(args: argparse.Namespace) -> PerturbationModel:
 
 
 def cell_keywords(args: argparse.Namespace) -> dict[str, Any]:
-    """Keyword arguments of :class:`executor.trial.Cell` from the options."""
+    """Keyword arguments of :class:`assembly_constraints.executor.trial.Cell` from the options."""
     keywords: dict[str, Any] = {"perturbation": perturbation_from_args(args), "cell_seed": args.cell_seed}
     if hasattr(args, "layer"):
         keywords["layer"] = args.layer

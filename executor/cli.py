@@ -15,10 +15,24 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, nonempty_path, png_path
-from bridge.files import write_atomic
-from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
+from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    ArgumentParser,
+    add_assembly_argument,
+    int_in,
+    nonempty_path,
+    png_path,
+)
+from assembly_constraints.bridge.files import write_atomic
+from assembly_constraints.bridge.recording.sinks import (
+    NO_VIEWER,
+    Viewer,
+    add_viewer_arguments,
+    hosted_viewer,
+    keep_serving,
+    viewer_of,
+)
 
 MAX_TRIALS = 100_000
 """``trial --trials N``: at most this many trials (trial k uses seed+k)."""
@@ -27,7 +41,7 @@ MAX_ATTEMPTS = 10
 
 
 def _teach(args: argparse.Namespace) -> int:
-    from executor.skills.teach import teach_all
+    from assembly_constraints.executor.skills.teach import teach_all
 
     for path in teach_all(args.assembly):
         print(f"wrote {path}")
@@ -57,16 +71,16 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from executor.cell_options import cell_keywords
-    from executor.trial import Cell
+    from assembly_constraints.executor.cell_options import cell_keywords
+    from assembly_constraints.executor.trial import Cell
 
     logger = None
     if args.plot:
-        from bridge.files import check_writable
+        from assembly_constraints.bridge.files import check_writable
 
         check_writable(Path(args.plot))  # before the trials
     if args.rrd or args.plot or live != NO_VIEWER:
-        from executor.rerun_log import AttemptLogger
+        from assembly_constraints.executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
     cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
@@ -85,7 +99,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
                 )
         summary = _summary(results)
         if args.plot:
-            from executor.campaign.plots import first_attempts, plot_fig17
+            from assembly_constraints.executor.campaign.plots import first_attempts, plot_fig17
 
             assert logger is not None
             plot_fig17(*first_attempts(logger.traces), Path(args.plot))
@@ -103,8 +117,8 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
 
 
 def _sizes(args: argparse.Namespace) -> int:
-    """Print or write the sizes.lp of ``geometry.toml`` (:func:`executor.world.geometry.sizes_lp_text`)."""
-    from executor.world.geometry import sizes_lp_text
+    """Print or write the sizes.lp of ``geometry.toml`` (:func:`assembly_constraints.executor.world.geometry.sizes_lp_text`)."""
+    from assembly_constraints.executor.world.geometry import sizes_lp_text
 
     text = sizes_lp_text(args.assembly)
     if args.out is None:
@@ -116,7 +130,7 @@ def _sizes(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from executor.assembly.export import export_cell
+    from assembly_constraints.executor.assembly.export import export_cell
 
     written = export_cell(args.assembly, args.out)
     print(f"wrote {written[0]} and {len(written) - 1} mesh file(s) in {args.out / 'meshes'}")
@@ -126,10 +140,10 @@ def _export(args: argparse.Namespace) -> int:
 # Subcommands owned by other modules: subcommand -> (module whose ``main(argv)`` runs it,
 # imported lazily; help text).
 _DELEGATED = {
-    "campaign": ("executor.campaign.run",
+    "campaign": ("assembly_constraints.executor.campaign.run",
                  "Fig. 18: randomised executions of every part-hole pair"),
-    "serve": ("executor.serve", "serve insertion requests over Zenoh"),
-    "margins": ("executor.campaign.margins",
+    "serve": ("assembly_constraints.executor.serve", "serve insertion requests over Zenoh"),
+    "margins": ("assembly_constraints.executor.campaign.margins",
                 "measure the wrench and end-error margins the thresholds come from"),
 }
 

@@ -24,7 +24,7 @@ import numpy as np
 import pybullet as pb
 import rerun as rr
 
-from executor.world.scene import link_frame
+from assembly_constraints.executor.world.scene import link_frame
 
 _ARM_COLOR = [235, 120, 30]
 _TOOL_COLOR = [80, 80, 90]

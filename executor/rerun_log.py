@@ -1,6 +1,6 @@
 """Rerun logging of the cell's insertion attempts (paper 3.2, Fig. 17).
 
-The :class:`~executor.trial.Cell` calls an :class:`AttemptLogger` while it executes:
+The :class:`~assembly_constraints.executor.trial.Cell` calls an :class:`AttemptLogger` while it executes:
 ``log_scene`` once, then per attempt ``begin_attempt``, ``log_search_path``,
 ``log_step`` at every control step and ``end_attempt``.
 
@@ -21,11 +21,11 @@ Entities (all under ``executor/<cell-id>/``):
                                 insertion; 0 while searching or retreating)
 ``by_phase/<outcome>/<key>``    Fig. 17: F_des and F_mes of the insertion against the DMP
                                 phase 0..1, a 2D plot logged when the attempt ends
-                                (:func:`executor.rerun_plots.log_fig17`)
+                                (:func:`assembly_constraints.executor.rerun_plots.log_fig17`)
 ``outcome``                     text log, one line per attempt
 ``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
 ``ilc/<shape>/<hole>/correction_norm``  size of the ILC correction after each update
-                                (mm and degrees, :func:`executor.control.ilc.correction_norm`)
+                                (mm and degrees, :func:`assembly_constraints.executor.control.ilc.correction_norm`)
                                 over timeline ``execution``
 =============================== ===================================================
 
@@ -52,15 +52,28 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import rerun as rr
 
-from bridge.recording.compaction import compact_recording
-from bridge.recording.layout import APPLICATION_ID, SESSION_TIMELINE, Contents, blueprint, cell_root, fig17_path
-from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
-from executor import ExecutorError
-from executor.rerun_plots import AXIS_NAMES, DESIRED_COLORS, MEASURED_COLORS, log_fig17, outcome_color
+from assembly_constraints.bridge.recording.compaction import compact_recording
+from assembly_constraints.bridge.recording.layout import (
+    APPLICATION_ID,
+    SESSION_TIMELINE,
+    Contents,
+    blueprint,
+    cell_root,
+    fig17_path,
+)
+from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.rerun_plots import (
+    AXIS_NAMES,
+    DESIRED_COLORS,
+    MEASURED_COLORS,
+    log_fig17,
+    outcome_color,
+)
 
 if TYPE_CHECKING:
-    from executor.evidence import AttemptEvidence
-    from executor.rerun_arm import ArmRecorder
+    from assembly_constraints.executor.evidence import AttemptEvidence
+    from assembly_constraints.executor.rerun_arm import ArmRecorder
 
 FORCE_ARROW_M_PER_N = 0.004
 """Length of the force arrow at the tool [m] per newton of F_mes."""
@@ -115,7 +128,7 @@ class AttemptTrace:
         arm_pose: np.ndarray | None = None, wall_time: float | None = None,
     ) -> None:
         """Append one step (units as in the class docstring; ``arm_pose``: the arm's link
-        poses, see :meth:`executor.rerun_arm.ArmRecorder.sample`; ``wall_time``: now when
+        poses, see :meth:`assembly_constraints.executor.rerun_arm.ArmRecorder.sample`; ``wall_time``: now when
         None)."""
         if arm_pose is not None:
             self.arm_poses.append(arm_pose)
@@ -161,7 +174,7 @@ class AttemptLogger:
     (random if None) saving to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
     existing ``rr.RecordingStream`` instead. Without either, data stays in memory
     (``keep_traces`` then still gives the traces for plots). ``viewer``: also stream
-    live to a Rerun viewer or serve it to a browser (:mod:`bridge.recording.sinks`).
+    live to a Rerun viewer or serve it to a browser (:mod:`assembly_constraints.bridge.recording.sinks`).
 
     ``period_s`` [s]: steps closer than this in sim time to the last kept one are
     skipped. ``keep_traces``: keep every finished :class:`AttemptTrace` in ``traces``.

@@ -4,23 +4,23 @@ The node declares the queryable ``cell/<id>/insert`` and the liveliness token
 ``cell/<id>/alive/<instance>`` (and ``cell/<id>/ping``, which echoes its payload unread), then
 serves until SIGTERM/SIGINT (or, with ``--lifeline``, until its stdin closes: the
 supervising session died), then closes the Zenoh session cleanly. Before it declares
-anything else it claims its cell id (:mod:`executor.claim`): when another process already
+anything else it claims its cell id (:mod:`assembly_constraints.executor.claim`): when another process already
 serves that id it exits with code 2 instead, and it stops the same way if it meets such a
 process later.
 
-- Every request is size-capped and validated (:mod:`bridge.messages`) in the Zenoh
+- Every request is size-capped and validated (:mod:`assembly_constraints.bridge.messages`) in the Zenoh
   thread; a malformed, oversized or wrong-version request gets an ErrorReply at once and
   the cell keeps serving.
 - Valid requests run one at a time in the main thread. Results are idempotent by
   request id: a repeated id gets the cached reply and never re-runs the experiment.
-- Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily)
+- Backends: ``sim`` runs the PyBullet :class:`assembly_constraints.executor.trial.Cell` (imported lazily)
   with the execution layer and uncertainty of the options (``--layer``, ``--cell-seed``,
   ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
-  ``MODULE:CLASS`` loads a user's backend (:mod:`executor.backends`), e.g. a real robot.
-- Plan steps (``cell/<id>/step``, :class:`bridge.messages.StepRequest`) run in the same
-  queue: ``sim`` in the assembling world of :mod:`executor.assembly` (kept between the
+  ``MODULE:CLASS`` loads a user's backend (:mod:`assembly_constraints.executor.backend_plugin`), e.g. a real robot.
+- Plan steps (``cell/<id>/step``, :class:`assembly_constraints.bridge.messages.StepRequest`) run in the same
+  queue: ``sim`` in the assembling world of :mod:`assembly_constraints.executor.assembly` (kept between the
   steps of one plan run), ``truth`` from the geometry; ``--block-hole H`` puts an obstacle
   in hole H (a fault to show the planner's recovery); ``--uncertainty cell`` gives the
   plan steps the cell's uncertainty, layer and ILC (default ``random``: their own errors).
@@ -46,12 +46,12 @@ from typing import TYPE_CHECKING, Any
 
 import zenoh
 
-from bridge import BridgeError
-from bridge.assembly import load_assembly
-from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
-from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
-from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
-from bridge.messages import (
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
+from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
+from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
+from assembly_constraints.bridge.messages import (
     MAX_MESSAGE_BYTES,
     ErrorCode,
     ErrorReply,
@@ -67,10 +67,10 @@ from bridge.messages import (
     decode_step_request,
     encode,
 )
-from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
-from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
-from executor import ExecutorError
-from executor.backends import (
+from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
+from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.backend_plugin import (
     Backend,
     CellContext,
     InvalidStep,
@@ -82,12 +82,12 @@ from executor.backends import (
     check_step,
     load_backend,
 )
-from executor.cell_options import cell_keywords
-from executor.claim import CellClaim, ClaimLost
-from executor.world.geometry import load_geometry, passes
+from assembly_constraints.executor.cell_options import cell_keywords
+from assembly_constraints.executor.claim import CellClaim, ClaimLost
+from assembly_constraints.executor.world.geometry import load_geometry, passes
 
 if TYPE_CHECKING:
-    from executor.assembly.backend import AssemblyRunner
+    from assembly_constraints.executor.assembly.step_backend import AssemblyRunner
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
@@ -98,7 +98,7 @@ QUEUE_SIZE = 16
 
 class TruthBackend:
     """Answers from the cell's geometry without simulation (a part passes a hole when its
-    cross-section does, :func:`executor.world.geometry.passes`), after ``delay_s`` [s]."""
+    cross-section does, :func:`assembly_constraints.executor.world.geometry.passes`), after ``delay_s`` [s]."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
                  recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER,
@@ -115,7 +115,7 @@ class TruthBackend:
         self._placed: dict[str, float] = {}  # its placed parts
         self._log = None
         if rrd is not None or viewer != NO_VIEWER:
-            from executor.rerun_log import open_recording
+            from assembly_constraints.executor.rerun_log import open_recording
 
             self._log = open_recording(recording_id or str(uuid.uuid4()), rrd, viewer)
             self._entity = f"executor/{cell_id}/outcome"
@@ -140,7 +140,7 @@ class TruthBackend:
         """A peg fits when its cross-section passes the hole and the hole is not blocked;
         another part of the product is always placed. One plan run at a time; a step of
         another run, or one the product does not allow, is refused before anything changes
-        (:func:`executor.backends.check_run`, :func:`executor.backends.check_step`)."""
+        (:func:`assembly_constraints.executor.backend_plugin.check_run`, :func:`assembly_constraints.executor.backend_plugin.check_step`)."""
         parts, holes = self._geometry.parts, self._geometry.holes
         check_run(self._run, request.assembly, self._parts, self._placed)
         fresh = request.assembly != self._run
@@ -164,7 +164,7 @@ class TruthBackend:
 
 def _planner_numbered_logger() -> type:
     """AttemptLogger that logs a trial under the planner's experiment number, if given."""
-    from executor.rerun_log import AttemptLogger
+    from assembly_constraints.executor.rerun_log import AttemptLogger
 
     class PlannerNumbered(AttemptLogger):
         planner_experiment: int | None = None
@@ -189,7 +189,7 @@ class SimBackend:
         the Cell's options (layer, perturbation, cell seed, ``ilc_state``: the file its ILC
         corrections are loaded from and saved to, atomically after every update, so a
         resumed session's cell starts from them)."""
-        from executor.trial import Cell
+        from assembly_constraints.executor.trial import Cell
 
         _PlannerNumbered = _planner_numbered_logger()
         self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd, viewer=viewer,
@@ -201,10 +201,10 @@ class SimBackend:
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
-        from executor.assembly.backend import AssemblyRunner, step_evidence
+        from assembly_constraints.executor.assembly.step_backend import AssemblyRunner, step_evidence
 
         if self._runner is None:  # the assembling world is made on the first step
-            from executor.assembly.recording import AssemblyRecorder
+            from assembly_constraints.executor.assembly.recording import AssemblyRecorder
 
             recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
             cell = self._cell
@@ -424,11 +424,11 @@ def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
 
 def main(argv: Sequence[str]) -> int:
     """Serve until SIGTERM/SIGINT; exit code 2 on bad options, a damaged ``--ilc-state`` or when another process
-    serves this cell id (:mod:`executor.claim`)."""
+    serves this cell id (:mod:`assembly_constraints.executor.claim`)."""
     args = build_parser().parse_args(list(argv))
     cell_id = check_cell_id(args.cell)
     if args.backend == "sim" and args.ilc_state is not None:
-        from executor.control.ilc import read_state
+        from assembly_constraints.executor.control.ilc import read_state
 
         read_state(args.ilc_state)  # a damaged state is refused here, before the session opens
     listen = cell_listen(args.listen, args.connect, args.zenoh_config)

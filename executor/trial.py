@@ -1,17 +1,17 @@
 """One insertion experiment: part P into hole H, up to two attempts (paper 3.2).
 
 Per attempt: a grasp of the part and a vision estimate of the hole, both off by errors
-unknown to the robot, and a friction of the hole (:mod:`executor.world.perturbation`:
+unknown to the robot, and a friction of the hole (:mod:`assembly_constraints.executor.world.perturbation`:
 a systematic part per cell, a random part per attempt); the part is brought above the
 estimate, the hole is searched, the taught skill inserts it with the chosen execution
-layer (:class:`executor.control.ilc.ExecutionLayer`: admittance, phase stopping, ILC),
+layer (:class:`assembly_constraints.executor.control.ilc.ExecutionLayer`: admittance, phase stopping, ILC),
 the detector decides, and the part goes back to its start on the tray.  A failed attempt
 is repeated once; two failures mean "no_fit".  With ILC, each successful execution
 updates the correction of its (part shape, hole), kept for the cell's next executions
 (and saved to ``ilc_state`` if given).
 The transfer between tray and plate is kinematic (joint-space, not simulated): only
 the force-controlled part of the task is.  The records it returns (the attempt's setup and
-evidence, the trial's result) are plain types in :mod:`executor.evidence`.
+evidence, the trial's result) are plain types in :mod:`assembly_constraints.executor.evidence`.
 """
 
 from __future__ import annotations
@@ -22,26 +22,26 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from executor import ExecutorError
-from executor.control.controller import ImpedanceController
-from executor.control.detector import Detector, Thresholds
-from executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
-from executor.control.motion import Motion
-from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
-from executor.rerun_arm import ArmRecorder
-from executor.skills.dmp import Skill, load_skill
-from executor.skills.insertion import insert_in_layer, needs_yaw_compliance, rotvec_quat_xyzw
-from executor.skills.search import hole_search
-from executor.world.arm import Arm, aligned_yaw, tool_quat
-from executor.world.assets import current_assets
-from executor.world.geometry import load_geometry
-from executor.world.perturbation import CellBias, PerturbationModel
-from executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.control.controller import ImpedanceController
+from assembly_constraints.executor.control.detector import Detector, Thresholds
+from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
+from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
+from assembly_constraints.executor.rerun_arm import ArmRecorder
+from assembly_constraints.executor.skills.dmp import Skill, load_skill
+from assembly_constraints.executor.skills.insertion import insert_in_layer, needs_yaw_compliance, rotvec_quat_xyzw
+from assembly_constraints.executor.skills.search import hole_search
+from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
+from assembly_constraints.executor.world.assets import current_assets
+from assembly_constraints.executor.world.geometry import load_geometry
+from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from executor.rerun_log import AttemptLogger
+    from assembly_constraints.executor.rerun_log import AttemptLogger
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
 PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
@@ -58,7 +58,7 @@ class Cell:
     shape (made on first use), so a trial depends on its seed, the cell seed and, with
     ILC, on the executions before it (the learned corrections) only.
 
-    ``layer``: the execution layer (a name of :data:`executor.control.ilc.LAYERS` or one);
+    ``layer``: the execution layer (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
     ``perturbation``/``cell_seed``: the cell's uncertainty and the seed of its systematic
     part; ``ilc_state``: a JSON file the ILC corrections are read from (if it exists) and
     saved to after every update."""

@@ -18,14 +18,14 @@ from pathlib import Path
 
 import pytest
 
+from assembly_constraints.bridge.cli_types import ASSEMBLY_HELP, PROGRAM
 from assembly_constraints.cli import main
-from bridge.cli_types import ASSEMBLY_HELP, PROGRAM
 from tests.conftest import child_env
 
 MARKUP = re.compile(r"``|`|:mod:|:class:|:func:|\.\/run\.sh|\b(?:asp|executor|bridge)\.[a-z_]+\b|\w+\.py\b")
 """Documentation markup, the wrapper's name, and module names a user never types (a
-``MODULE:CLASS`` example such as ``executor.replay:ReplayBackend`` is allowed below)."""
-ALLOWED = ("executor.replay:ReplayBackend",)
+``MODULE:CLASS`` example such as ``assembly_constraints.executor.replay:ReplayBackend`` is allowed below)."""
+ALLOWED = ("assembly_constraints.executor.replay:ReplayBackend",)
 
 
 class _Captured(Exception):

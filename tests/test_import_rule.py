@@ -22,7 +22,7 @@ side, and no side uses it."""
 
 
 def module_name(root: Path, path: Path) -> str:
-    """``asp/sizes/learner.py`` → ``asp.sizes.learner``; a package's ``__init__`` is the package."""
+    """``asp/sizes/learner.py`` → ``assembly_constraints.asp.sizes.learner``; a package's ``__init__`` is the package."""
     parts = list(path.relative_to(root).with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
@@ -80,18 +80,18 @@ def test_the_rule_catches_a_planner_module_importing_the_cell(tmp_path: Path) ->
         (tmp_path / package).mkdir()
         (tmp_path / package / "__init__.py").write_text("")
     (tmp_path / "asp" / "planner.py").write_text("import executor\n")
-    (tmp_path / "executor" / "cell.py").write_text("def f():\n    from asp.solve import solve\n")
-    (tmp_path / "bridge" / "keys.py").write_text("from executor import ExecutorError\nfrom . import messages\n")
+    (tmp_path / "executor" / "cell.py").write_text("def f():\n    from assembly_constraints.asp.solve import solve\n")
+    (tmp_path / "bridge" / "keys.py").write_text("from assembly_constraints.executor import ExecutorError\nfrom . import messages\n")
     (tmp_path / "bridge" / "messages.py").write_text("from .keys import x\n")
     assert violations(tmp_path) == [
         "asp/planner.py:1 imports executor",
         "bridge/keys.py:1 imports executor",
-        "bridge/keys.py:1 imports executor.ExecutorError",
-        "executor/cell.py:2 imports asp.solve",
-        "executor/cell.py:2 imports asp.solve.solve",
+        "bridge/keys.py:1 imports assembly_constraints.executor.ExecutorError",
+        "executor/cell.py:2 imports assembly_constraints.asp.solve",
+        "executor/cell.py:2 imports assembly_constraints.asp.solve.solve",
     ]
     cycles = [set(cycle) for cycle in nx.simple_cycles(import_graph(tmp_path))]
-    assert cycles == [{"bridge.keys", "bridge.messages"}]
+    assert cycles == [{"assembly_constraints.bridge.keys", "assembly_constraints.bridge.messages"}]
 
 
 def test_no_import_cycle_among_the_project_modules() -> None:
@@ -108,10 +108,10 @@ def test_no_python_folder_holds_more_than_twelve_modules() -> None:
 
 def test_every_layer_error_shares_the_one_root() -> None:
     """Callers catch one layer's errors or all of them; none is converted into another."""
-    from asp import PlannerError
-    from bridge import BridgeError
-    from bridge.errors import ToolError
-    from executor import ExecutorError
+    from assembly_constraints.asp import PlannerError
+    from assembly_constraints.bridge import BridgeError
+    from assembly_constraints.bridge.errors import ToolError
+    from assembly_constraints.executor import ExecutorError
 
     assert all(issubclass(error, ToolError) for error in (PlannerError, BridgeError, ExecutorError))
     assert not any(issubclass(a, b) for a in (PlannerError, BridgeError, ExecutorError)

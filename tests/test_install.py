@@ -41,8 +41,8 @@ def test_the_installed_command_runs_a_session_from_a_folder_outside_the_reposito
     version = subprocess.run([str(command), "--version"], cwd=tmp_path, env=env, capture_output=True, text=True,
                              timeout=60)
     assert version.returncode == 0 and version.stdout.startswith(f"{PROGRAM} "), version.stderr
-    where = subprocess.run([sys.executable, "-c", "import bridge.assembly as a, asp; print(a.DATA_DIR); "
-                            "print(asp.__file__)"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
+    where = subprocess.run([sys.executable, "-c", "import assembly_constraints.bridge.assembly as a, asp; print(a.DATA_DIR); "
+                            "print(assembly_constraints.asp.__file__)"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
     data_dir, asp_file = where.stdout.split()
     site = Path(env["PYTHONPATH"])
     assert Path(data_dir).is_relative_to(site) and Path(asp_file).is_relative_to(site)  # not the repository

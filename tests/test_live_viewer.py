@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from bridge.recording.reader import column_values, read_recording
-from bridge.recording.sinks import free_port
+from assembly_constraints.bridge.recording.reader import column_values, read_recording
+from assembly_constraints.bridge.recording.sinks import free_port
 from tests.conftest import ROOT, child_env
 
 

@@ -11,7 +11,7 @@ of these, plan K of the assembly's true facts (``sizes.lp``, ``precedence.lp``).
 Re-planning after a failed step uses the same facts.
 
 The planner starts one cell (``executor serve``) on loopback and sends it one step
-request per plan step over Zenoh (:mod:`asp.assemble.driver`); the cell keeps its world
+request per plan step over Zenoh (:mod:`assembly_constraints.asp.assemble.driver`); the cell keeps its world
 between steps.  JSON (``--json``): ``{"plan", "steps": [{"part", "hole", "skill",
 "outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled",
 "final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
@@ -31,18 +31,28 @@ import sys
 import time
 from pathlib import Path
 
-from asp import PlannerError
-from asp.assemble.driver import assembling_cell
-from asp.assemble.execute import AssemblyStopped, execute
-from asp.assemble.inputs import check_facts_product, check_plan_product, plan_of_json, read_plan_json
-from asp.plans.assign import LearnedFacts, load_learned_facts
-from asp.plans.plans import Plan, plans
-from bridge.assembly import Assembly, load_assembly
-from bridge.cell_options import MAGNITUDES, add_assembly_uncertainty_argument, add_cell_arguments, cell_argv
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
-from bridge.errors import EXIT_UNSOLVABLE
-from bridge.inputs import read_bytes, shorten
-from bridge.session import add_endpoint_arguments
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.assemble.driver import assembling_cell
+from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
+from assembly_constraints.asp.assemble.inputs import (
+    check_facts_product,
+    check_plan_product,
+    plan_of_json,
+    read_plan_json,
+)
+from assembly_constraints.asp.plans.assign import LearnedFacts, load_learned_facts
+from assembly_constraints.asp.plans.plans import Plan, plans
+from assembly_constraints.bridge.assembly import Assembly, load_assembly
+from assembly_constraints.bridge.cell_options import (
+    MAGNITUDES,
+    add_assembly_uncertainty_argument,
+    add_cell_arguments,
+    cell_argv,
+)
+from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
+from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
+from assembly_constraints.bridge.inputs import read_bytes, shorten
+from assembly_constraints.bridge.session import add_endpoint_arguments
 
 MAX_PLAN_INDEX = 1000
 

@@ -1,4 +1,4 @@
-"""The planner's end of plan execution over Zenoh: one :class:`bridge.messages.StepRequest`
+"""The planner's end of plan execution over Zenoh: one :class:`assembly_constraints.bridge.messages.StepRequest`
 per step to one cell, waited for (a lost reply is sent again under the same id: the cell
 answers a repeated request from its cache and never runs the step twice)."""
 
@@ -11,13 +11,13 @@ from pathlib import Path
 
 import zenoh
 
-from asp import PlannerError
-from asp.session.cells import CellProcess, start_cell
-from bridge import BridgeError
-from bridge.client import CellDirectory, CellTimeout, request_step
-from bridge.inputs import shorten
-from bridge.messages import StepReply, StepRequest
-from bridge.session import free_loopback_endpoint, open_session
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.session.cells import CellProcess, start_cell
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_step
+from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.messages import StepReply, StepRequest
+from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
 
 CELL_ID = "a1"
 CELL_START_S = 60.0
@@ -73,7 +73,7 @@ def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backe
     """Start one cell (``executor serve``, a fresh world of ``assembly_folder``) on loopback and
     yield a driver for one plan run in it; the cell is stopped on exit.  ``seed`` seeds the
     cell's random errors, ``timeout_s`` bounds one step [s], ``cell_options`` are more
-    options of a sim cell (:func:`asp.assemble.cli.cell_options`: uncertainty, layer, cell seed)."""
+    options of a sim cell (:func:`assembly_constraints.asp.assemble.cli.cell_options`: uncertainty, layer, cell seed)."""
     listen = list(listen) or [free_loopback_endpoint()]
     session = open_session(listen, connect, zenoh_config)
     try:

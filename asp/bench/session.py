@@ -14,7 +14,7 @@
    is reported beside the ratio of the medians).
 3. ``--product N --cells 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
    experiment takes ``--delay`` seconds without using the cores) on a generated N×N
-   product (:mod:`asp.bench.products`): wall time [s], speed-up against 1 cell,
+   product (:mod:`assembly_constraints.asp.bench.products`): wall time [s], speed-up against 1 cell,
    experiments and their ratio to the 1-cell run, and duplicates (a request journaled
    twice, or a pair run again though not a re-test; must be 0). Targets on 20×20: 8 cells
    at least 4x faster than 1, with at most 10 % more experiments.
@@ -36,15 +36,15 @@ from pathlib import Path
 
 import zenoh
 
-from asp import MAX_IDS, PlannerError
-from asp.bench.products import write_product
-from asp.session.cells import ROOT, start_cell
-from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
-from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in, number_in
-from bridge.client import CellDirectory, request_insert
-from bridge.keys import ping_key
-from bridge.messages import InsertRequest, encode
-from bridge.session import free_loopback_endpoint, open_session
+from assembly_constraints.asp import MAX_IDS, PlannerError
+from assembly_constraints.asp.bench.products import write_product
+from assembly_constraints.asp.session.cells import ROOT, start_cell
+from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in, number_in
+from assembly_constraints.bridge.client import CellDirectory, request_insert
+from assembly_constraints.bridge.keys import ping_key
+from assembly_constraints.bridge.messages import InsertRequest, encode
+from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
 
 
 def _payload(reply: zenoh.Reply) -> bytes:

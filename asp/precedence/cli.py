@@ -12,14 +12,20 @@ import logging
 import random
 from itertools import islice
 
-from asp import PlannerError
-from asp.precedence.batches import GENERATORS
-from asp.precedence.count import UniformSampler, count_linear_extensions, linear_extensions
-from asp.precedence.demos import Demonstrations, load_demos
-from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
-from asp.solve import write_facts
-from bridge.assembly import load_assembly
-from bridge.cli_types import (
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.precedence.batches import GENERATORS
+from assembly_constraints.asp.precedence.count import UniformSampler, count_linear_extensions, linear_extensions
+from assembly_constraints.asp.precedence.demos import Demonstrations, load_demos
+from assembly_constraints.asp.precedence.relation import (
+    Relation,
+    load_relation,
+    precedence_facts,
+    reduction,
+    true_relation,
+)
+from assembly_constraints.asp.solve import write_facts
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -112,9 +118,9 @@ def _print_json(data: object) -> None:
 
 
 def _learn(args: argparse.Namespace) -> None:
-    from asp.precedence.draw import draw_png, to_dot
-    from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
-    from bridge.files import write_atomic
+    from assembly_constraints.asp.precedence.draw import draw_png, to_dot
+    from assembly_constraints.asp.precedence.learn import learn_must_precede, pair_evidence, suspects
+    from assembly_constraints.bridge.files import write_atomic
 
     demos = _demonstrations(args)
     relation = learn_must_precede(demos, args.min_support)
@@ -149,13 +155,13 @@ def _learn(args: argparse.Namespace) -> None:
 
 
 def _evaluate(args: argparse.Namespace) -> None:
-    from bridge.files import check_writable
+    from assembly_constraints.bridge.files import check_writable
 
     if args.plot:
         check_writable(args.plot)  # before the evaluation, which may take minutes
     truth = true_relation(load_assembly(args.assembly))
     if args.guided:
-        from asp.precedence.guide import evaluate_guided
+        from assembly_constraints.asp.precedence.guide import evaluate_guided
 
         if args.generator != "uniform":
             raise PlannerError("--generator applies to the evaluation over m, not to --guided "
@@ -167,7 +173,7 @@ def _evaluate(args: argparse.Namespace) -> None:
                   f"random {result['random_mean']:.2f}")
             print("histogram (demonstrations: trials):", result["demos_to_exact"])
     else:
-        from asp.precedence.evaluate import evaluate, plot
+        from assembly_constraints.asp.precedence.evaluate import evaluate, plot
 
         result = evaluate(truth, args.demonstrations, args.trials, args.seed, args.generator)
         if args.plot:
@@ -183,7 +189,7 @@ def _evaluate(args: argparse.Namespace) -> None:
 
 
 def _suggest(args: argparse.Namespace) -> None:
-    from asp.precedence.guide import suggest
+    from assembly_constraints.asp.precedence.guide import suggest
 
     parts = load_assembly(args.assembly).part_ids if args.assembly else None
     if args.demos is None and parts is None:

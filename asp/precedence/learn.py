@@ -20,9 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asp import PlannerError
-from asp.precedence.demos import Demonstrations
-from asp.precedence.relation import Pair, Relation, close
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.precedence.demos import Demonstrations
+from assembly_constraints.asp.precedence.relation import Pair, Relation, close
 
 
 def positions(sequences: Sequence[Sequence[str]], parts: Sequence[str]) -> np.ndarray:

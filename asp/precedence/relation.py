@@ -17,9 +17,9 @@ from pathlib import Path
 import clingo
 import numpy as np
 
-from asp import PlannerError
-from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name
-from bridge.assembly import Assembly
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name
+from assembly_constraints.bridge.assembly import Assembly
 
 Pair = tuple[str, str]
 
@@ -123,7 +123,7 @@ def load_relation(paths: Sequence[Path | str]) -> Relation:
 
 
 def closed_precedence(atoms: Sequence[clingo.Symbol], source: str) -> frozenset[Pair]:
-    """The precedence of checked facts atoms (:func:`asp.solve.check_facts`) in both forms,
+    """The precedence of checked facts atoms (:func:`assembly_constraints.asp.solve.check_facts`) in both forms,
     ``must_precede/2`` and ``precedence_edge/2`` (a reduction, as every shipped
     ``precedence.lp`` has it), transitively closed.
 

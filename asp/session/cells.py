@@ -18,8 +18,8 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from asp import PlannerError
-from bridge.cli_types import MAX_SEED
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parents[2]
 """The folder holding the packages (the repository, or site-packages when installed): the
@@ -90,7 +90,7 @@ class CellProcess:
 
     def stop(self, timeout: float = 60.0) -> int:
         """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code. A cell
-        compacts its recording before it exits (:mod:`bridge.recording.compaction`), which
+        compacts its recording before it exits (:mod:`assembly_constraints.bridge.recording.compaction`), which
         on a loaded machine takes tens of seconds; killed earlier, it leaves the file
         uncompacted."""
         if self.popen.poll() is None:
@@ -119,7 +119,7 @@ def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
     file the sim cell keeps its learned ILC corrections in (in the run folder, so a
     resumed session's cell starts from them); ``block_holes``: holes with an obstacle;
     ``cell_options``: the sim cell's execution layer and uncertainty
-    (:func:`bridge.cell_options.cell_argv`), ``cell_seed``: the seed of its systematic errors."""
+    (:func:`assembly_constraints.bridge.cell_options.cell_argv`), ``cell_seed``: the seed of its systematic errors."""
     argv = [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--cell", cell_id,
             "--backend", backend, "--assembly", assembly, "--lifeline"]
     argv += [arg for ep in listen for arg in ("--listen", ep)]

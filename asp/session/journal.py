@@ -45,10 +45,10 @@ from typing import Annotated, Literal
 
 import msgspec
 
-from asp import PlannerError
-from bridge.files import os_reason
-from bridge.inputs import duplicate_key, read_bytes
-from bridge.messages import AspId, Evidence, RequestId, Result
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.bridge.files import os_reason
+from assembly_constraints.bridge.inputs import duplicate_key, read_bytes
+from assembly_constraints.bridge.messages import AspId, Evidence, RequestId, Result
 
 JOURNAL_NAME = "journal.jsonl"
 

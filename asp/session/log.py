@@ -1,9 +1,9 @@
 """The planner's Rerun log of a session (entities ``planner/...``).
 
 Planner and cells log into ONE recording id (application
-:data:`bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
+:data:`assembly_constraints.bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
 files opened together are one recording. The planner sends the session's blueprint
-(:func:`bridge.recording.layout.blueprint`): its views in a first tab, then one tab per
+(:func:`assembly_constraints.bridge.recording.layout.blueprint`): its views in a first tab, then one tab per
 cell, and an assembly tab for the cell that assembles.
 
 =========================== ==========================================================
@@ -18,7 +18,7 @@ cell, and an assembly tab for the cell that assembles.
 ``planner/experiments``     one text line per experiment (pair, result, cell)
 ``planner/smaller``         smaller-than graph over parts ∪ holes (its transitive
                             reduction), after every experiment, laid out by levels
-                            (:mod:`asp.session.layered`: smallest on top)
+                            (:mod:`assembly_constraints.asp.session.layered`: smallest on top)
 ``planner/precedence``      learned must-precede graph (transitive reduction), static,
                             laid out by levels (first parts on top)
 ``planner/assignment``      part → hole graph (parts above their holes) and a markdown
@@ -34,12 +34,12 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 
-from asp.precedence.relation import Relation, reduction
-from asp.session.layered import positions
-from asp.sizes.knowledge import Knowledge
-from bridge.recording.compaction import compact_recording
-from bridge.recording.layout import APPLICATION_ID, Contents, blueprint
-from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
+from assembly_constraints.asp.precedence.relation import Relation, reduction
+from assembly_constraints.asp.session.layered import positions
+from assembly_constraints.asp.sizes.knowledge import Knowledge
+from assembly_constraints.bridge.recording.compaction import compact_recording
+from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, blueprint
+from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]

@@ -7,7 +7,7 @@
    loopback endpoint (``--cells 0 --connect EP`` uses cells already on the network);
 3. learns which part fits which hole, keeping every alive cell busy with experiments
    none of whose outcomes can entail another's (:func:`_learn_sizes`,
-   :mod:`asp.session.oracle`); every finished experiment is journaled (fsynced) before
+   :mod:`assembly_constraints.asp.session.zenoh_oracle`); every finished experiment is journaled (fsynced) before
    the learner uses it;
 4. assigns holes (the paper's greedy rule, else a matching) and computes complete plans, each run through the checker;
 5. writes ``RUN/learned.lp`` (the project's facts vocabulary), ``RUN/assignment.lp``,
@@ -40,34 +40,54 @@ from pathlib import Path
 
 import zenoh
 
-from asp import PlannerError
-from asp.plans.assign import feasible_assignment, load_learned_facts
-from asp.plans.plans import Plan, check_plan, plans
-from asp.precedence.demos import demo_facts, load_demos
-from asp.precedence.learn import learn_must_precede
-from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
-from asp.session.cells import CellProcess, cell_seed, serve_argv
-from asp.session.folder import RunLock, lock_run_folder
-from asp.session.journal import JOURNAL_NAME, Journal
-from asp.session.log import PlannerLog
-from asp.session.oracle import ZenohOracle
-from asp.sizes.cli import add_model_option
-from asp.sizes.learner import MAX_CONFIRM, SizeLearner, SizeLearningResult
-from asp.sizes.models import MODELS, SizeModel, model_for
-from asp.sizes.oracle import TruthOracle
-from asp.sizes.policies import policy_names
-from asp.solve import encoding, fact, write_facts
-from bridge import BridgeError
-from bridge.assembly import Assembly, load_assembly
-from bridge.cell_options import add_cell_arguments, cell_argv, parse_cell_argv
-from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
-from bridge.client import CellDirectory, CellPool
-from bridge.errors import EXIT_UNSOLVABLE
-from bridge.files import make_folder, write_atomic
-from bridge.inputs import read_bytes, shorten
-from bridge.keys import check_cell_id
-from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
-from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, free_loopback_endpoint, open_session
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.plans.assign import feasible_assignment, load_learned_facts
+from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
+from assembly_constraints.asp.precedence.demos import demo_facts, load_demos
+from assembly_constraints.asp.precedence.learn import learn_must_precede
+from assembly_constraints.asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
+from assembly_constraints.asp.session.cells import CellProcess, cell_seed, serve_argv
+from assembly_constraints.asp.session.folder import RunLock, lock_run_folder
+from assembly_constraints.asp.session.journal import JOURNAL_NAME, Journal
+from assembly_constraints.asp.session.log import PlannerLog
+from assembly_constraints.asp.session.zenoh_oracle import ZenohOracle
+from assembly_constraints.asp.sizes.cli import add_model_option
+from assembly_constraints.asp.sizes.learner import MAX_CONFIRM, SizeLearner, SizeLearningResult
+from assembly_constraints.asp.sizes.models import MODELS, SizeModel, model_for
+from assembly_constraints.asp.sizes.policies import policy_names
+from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from assembly_constraints.asp.solve import encoding, fact, write_facts
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.assembly import Assembly, load_assembly
+from assembly_constraints.bridge.cell_options import add_cell_arguments, cell_argv, parse_cell_argv
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    PROGRAM,
+    ArgumentParser,
+    add_assembly_argument,
+    comma_list,
+    finite_float,
+    int_in,
+)
+from assembly_constraints.bridge.client import CellDirectory, CellPool
+from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
+from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.inputs import read_bytes, shorten
+from assembly_constraints.bridge.keys import check_cell_id
+from assembly_constraints.bridge.recording.sinks import (
+    NO_VIEWER,
+    Viewer,
+    add_viewer_arguments,
+    hosted_viewer,
+    keep_serving,
+    viewer_of,
+)
+from assembly_constraints.bridge.session import (
+    DEFAULT_ENDPOINT,
+    add_endpoint_arguments,
+    free_loopback_endpoint,
+    open_session,
+)
 
 LOG = logging.getLogger(__name__)
 SETTINGS = "session.json"
@@ -116,12 +136,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_endpoint_arguments(parser)
     add_viewer_arguments(parser)
-    add_cell_arguments(parser, cell_seed=False)  # cell c<k>'s cell seed: --seed + k - 1 (asp.session.cells)
+    add_cell_arguments(parser, cell_seed=False)  # cell c<k>'s cell seed: --seed + k - 1 (assembly_constraints.asp.session.cells)
     return parser
 
 
 def _run_folder(args: argparse.Namespace) -> tuple[Path, dict, RunLock, bool]:
-    """The run folder, locked for this session (:mod:`asp.session.folder`), its settings
+    """The run folder, locked for this session (:mod:`assembly_constraints.asp.session.folder`), its settings
     (read back when resuming) and whether this start created the folder. ``--out``
     creates the folder and refuses one that holds a session (journaled experiments or a
     finished run); a folder a failed start left (one that existed before) may be used again."""
@@ -331,11 +351,11 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
 
 def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: Plan, seed: int,
               args: argparse.Namespace, process: CellProcess | None) -> dict:
-    """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`; ``process``: its
+    """Execute ``plan`` in the session's first cell (:mod:`assembly_constraints.asp.assemble`; ``process``: its
     process if the session started it); the report, with ``"error"`` when the product
     could not be finished."""
-    from asp.assemble.driver import ZenohDriver
-    from asp.assemble.execute import AssemblyStopped, execute
+    from assembly_constraints.asp.assemble.driver import ZenohDriver
+    from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
 
     if not cell_ids:
         raise PlannerError("--assemble needs a cell of this session (--cells 1 or more)")

@@ -1,12 +1,12 @@
 """``./run.sh view RUN --screenshot DIR``: a picture of every tab of a recording, taken in a real browser.
 
-The recording is served to Rerun's web viewer (:func:`bridge.recording.sinks.hosted_viewer`)
-and opened in a headless Chromium (:mod:`asp.session.browser`). The viewer needs tens of
+The recording is served to Rerun's web viewer (:func:`assembly_constraints.bridge.recording.sinks.hosted_viewer`)
+and opened in a headless Chromium (:mod:`assembly_constraints.asp.session.browser`). The viewer needs tens of
 seconds to load and render on a software rasteriser; a picture is taken once two in a row,
 :data:`POLL_S` apart, are the same. Then, for each tab, a blueprint that shows that tab
 (``rrb.Tabs(active_tab=k)``) is streamed to the viewer and the tab is pictured once it has
 settled (or, after :data:`TAB_TIMEOUT_S`, as it is then, with a warning). The blueprints
-follow the newest data (:func:`bridge.recording.layout.blueprint`), so every tab is
+follow the newest data (:func:`assembly_constraints.bridge.recording.layout.blueprint`), so every tab is
 pictured at the end of the recording: the last experiment's knowledge, the whole plots. ``DIR/<k>-<tab>.png``, k from 1.
 """
 
@@ -20,10 +20,10 @@ from pathlib import Path
 
 import rerun as rr
 
-from asp import PlannerError
-from asp.session.browser import Browser, find_chromium
-from bridge.recording.layout import APPLICATION_ID, Contents, blueprint, tab_names
-from bridge.recording.sinks import Viewer, hosted_viewer
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.session.browser import Browser, find_chromium
+from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, blueprint, tab_names
+from assembly_constraints.bridge.recording.sinks import Viewer, hosted_viewer
 
 POLL_S = 5.0
 """Time between two pictures while waiting for the page to settle [s]."""
@@ -36,7 +36,7 @@ _LOG = logging.getLogger(__name__)
 
 def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: str, folder: Path) -> list[Path]:
     """Write one PNG per tab of ``contents``' blueprint into ``folder`` (created); PlannerError
-    when there is no Chromium (:data:`asp.session.browser.NAMES`) or the page never settles."""
+    when there is no Chromium (:data:`assembly_constraints.asp.session.browser.NAMES`) or the page never settles."""
     chromium = find_chromium()
     if chromium is None:
         raise PlannerError("--screenshot needs a Chromium on PATH (chromium, chromium-browser or google-chrome; "

@@ -4,7 +4,7 @@ RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: pla
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
 on the files plus ``RUN/view.rbl``, the blueprint of what the recording holds
-(``bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
+(``assembly_constraints.bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
 entities, one tab per cell that logged more than an assembly (its Fig. 17 view on its first
 fitting attempt), one assembly tab per cell that assembled. Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
@@ -12,7 +12,7 @@ one line per entity path with its row count, timelines and components (``--json`
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
 free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
 picture of every tab, rendered by the web viewer in a headless Chromium
-(:mod:`asp.session.screenshot`). A RUN without ``.rrd`` files is an error (exit code 2).
+(:mod:`assembly_constraints.asp.session.screenshot`). A RUN without ``.rrd`` files is an error (exit code 2).
 """
 
 from __future__ import annotations
@@ -26,11 +26,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from asp import PlannerError
-from bridge.cli_types import ArgumentParser
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.bridge.cli_types import ArgumentParser
 
 if TYPE_CHECKING:
-    from bridge.recording.layout import Contents
+    from assembly_constraints.bridge.recording.layout import Contents
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -60,8 +60,8 @@ def rerun_executable() -> str:
 
 def write_blueprint(folder: Path, contents: Contents) -> Path:
     """``folder/view.rbl``: the blueprint of a recording holding ``contents``."""
-    from bridge.files import check_writable
-    from bridge.recording.layout import APPLICATION_ID, blueprint
+    from assembly_constraints.bridge.files import check_writable
+    from assembly_constraints.bridge.recording.layout import APPLICATION_ID, blueprint
 
     path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
     blueprint(contents).save(APPLICATION_ID, str(path))
@@ -81,15 +81,15 @@ def main(argv: Sequence[str]) -> int:
                              "is printed, Ctrl-C stops")
     args = parser.parse_args(list(argv))
 
-    from bridge.recording.layout import Contents
-    from bridge.recording.reader import format_summary, read_recording
+    from assembly_constraints.bridge.recording.layout import Contents
+    from assembly_constraints.bridge.recording.reader import format_summary, read_recording
 
     run = Path(args.run)
     files = recording_files(run)
     summary = read_recording(files)
     contents = Contents.of(summary.entities)
     if args.screenshot:
-        from asp.session.screenshot import take_screenshots
+        from assembly_constraints.asp.session.screenshot import take_screenshots
 
         recording_id = min(summary.recording_ids, default="view")
         for picture in take_screenshots(files, contents, recording_id, args.screenshot):
@@ -103,7 +103,7 @@ def main(argv: Sequence[str]) -> int:
         return 0
     blueprint = write_blueprint(run if run.is_dir() else run.parent, contents)
     if args.web:
-        from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
+        from assembly_constraints.bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
 
         served = Viewer(serve=True)
         with hosted_viewer(served, [*files, blueprint]):

@@ -14,17 +14,17 @@ import argparse
 import json
 import sys
 
-from asp import PlannerError
-from asp.precedence.demos import load_demos
-from asp.sizes.evaluate import evaluate_policy, plot_comparison
-from asp.sizes.knowledge import Knowledge
-from asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
-from asp.sizes.models import MODELS, SizeModel, model_for
-from asp.sizes.oracle import NoisyOracle, Oracle, TruthOracle
-from asp.sizes.policies import get_policy, policy_names
-from asp.solve import write_facts
-from bridge.assembly import load_assembly
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.precedence.demos import load_demos
+from assembly_constraints.asp.sizes.evaluate import evaluate_policy, plot_comparison
+from assembly_constraints.asp.sizes.knowledge import Knowledge
+from assembly_constraints.asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
+from assembly_constraints.asp.sizes.models import MODELS, SizeModel, model_for
+from assembly_constraints.asp.sizes.policies import get_policy, policy_names
+from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, Oracle, TruthOracle
+from assembly_constraints.asp.solve import write_facts
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -163,7 +163,7 @@ def _learn(args: argparse.Namespace) -> int:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
-    from bridge.files import check_writable
+    from assembly_constraints.bridge.files import check_writable
 
     if args.plot:
         check_writable(args.plot)  # before the evaluation, which may take minutes

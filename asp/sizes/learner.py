@@ -12,7 +12,7 @@ on the cycle are named and re-tested; per pair the majority of its answers is ke
 (a tie keeps the latest), so the kept relation never contradicts itself. It is done
 when every pair is known and no conflict is left.
 
-What is entailed follows the size model (:mod:`asp.sizes.models`; default ``line``, the
+What is entailed follows the size model (:mod:`assembly_constraints.asp.sizes.models`; default ``line``, the
 paper's): ``section(P,S)`` facts put each part on a section's size line. Observations
 that contradict the model cannot be noise once re-tests reproduce them: when every
 observation on a cycle has been answered at least twice with one result (or a pair
@@ -45,12 +45,12 @@ from dataclasses import dataclass
 
 import clingo
 
-from asp import PlannerError
-from asp.sizes.knowledge import RESULTS, Knowledge, Pair
-from asp.sizes.models import SizeModel, build_model, weaker
-from asp.sizes.oracle import Oracle
-from asp.sizes.policies import SelectionPolicy, get_policy
-from asp.solve import add_facts, encoding, fact
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.sizes.knowledge import RESULTS, Knowledge, Pair
+from assembly_constraints.asp.sizes.models import SizeModel, build_model, weaker
+from assembly_constraints.asp.sizes.policies import SelectionPolicy, get_policy
+from assembly_constraints.asp.sizes.truth_oracle import Oracle
+from assembly_constraints.asp.solve import add_facts, encoding, fact
 
 MAX_CONFIRM = 100
 """``confirm`` K is at most this many answers (each essential observation is re-tested

@@ -40,7 +40,7 @@ SIM_TIMELINE = "sim_time"
 
 CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
-the tray around y = 0.4 m (``executor.world``): seen from beyond the tray, all three in view."""
+the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
 
 
 def cell_root(cell_id: str) -> str:

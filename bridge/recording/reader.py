@@ -4,7 +4,7 @@ Rerun 0.41 dropped ``rr.dataframe``; this module uses the SDK's own chunk reader
 (``rerun.chunk.RrdReader``, in process, no extra dependency) instead of parsing the
 output of ``rerun rrd print``. Used by the tests and by ``./run.sh view RUN --print``.
 A file with a torn tail (its writer died mid-message) is read up to its last whole
-message, with a warning (:mod:`bridge.recording.torn`).
+message, with a warning (:mod:`assembly_constraints.bridge.recording.torn`).
 
 Entity paths are reported as Rerun prints them, with a leading ``/``
 (``/executor/c1/outcome``); Rerun's own ``/__properties`` entities are left out.
@@ -22,9 +22,9 @@ from typing import Any
 import pyarrow as pa
 from rerun.chunk import Chunk, RrdReader
 
-from bridge import BridgeError
-from bridge.inputs import shorten
-from bridge.recording.torn import readable
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.recording.torn import readable
 
 
 @dataclass
@@ -82,7 +82,7 @@ _TABS_KIND = 1  # ContainerBlueprint:container_kind of rrb.Tabs
 @contextmanager
 def _open(path: Path) -> Iterator[RrdReader]:
     """A reader of one ``.rrd`` file (of its whole messages when its tail is torn, with a
-    warning: :mod:`bridge.recording.torn`); BridgeError naming the file when it is
+    warning: :mod:`assembly_constraints.bridge.recording.torn`); BridgeError naming the file when it is
     missing, unreadable or not a Rerun recording (empty, garbage, another format)."""
     if not path.is_file():
         raise BridgeError(f"{path}: no such recording file (expected an .rrd file)")
@@ -118,7 +118,7 @@ def _chunks(reader: RrdReader) -> Iterator[Chunk]:
 
 def chunk_count(path: Path | str) -> int:
     """How many chunks the recording stores of ``path`` hold (blueprints excluded): what
-    compaction (:mod:`bridge.recording.compaction`) brings down."""
+    compaction (:mod:`assembly_constraints.bridge.recording.compaction`) brings down."""
     with _open(Path(path)) as reader:
         return sum(1 for _ in _chunks(reader))
 

@@ -34,8 +34,8 @@ from urllib.parse import quote
 
 import rerun as rr
 
-from bridge import BridgeError
-from bridge.files import check_writable
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.files import check_writable
 
 DEFAULT_VIEWER_URL = "rerun+http://127.0.0.1:9876/proxy"
 """Where a Rerun viewer started on this machine listens for recordings."""

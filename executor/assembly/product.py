@@ -1,5 +1,5 @@
 """The whole product as the assembling cell sees it: the cell geometry of
-:mod:`executor.world.geometry` (plate, holes, pegs) plus the ``[base]``, ``[covers.*]``
+:mod:`assembly_constraints.executor.world.geometry` (plate, holes, pegs) plus the ``[base]``, ``[covers.*]``
 and ``[heads.*]`` tables of ``geometry.toml`` (documented in ``docs/geometry.md``).
 
 Every part gets a tray pose (where it waits), a goal pose (where the product has it),
@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from bridge.inputs import shorten
-from executor import ExecutorError
-from executor.world.geometry import CellGeometry, PartSpec, load_geometry
+from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, load_geometry
 
 Vec3 = tuple[float, float, float]
 
@@ -182,7 +182,7 @@ def load_product(assembly: str = "cranfield") -> Product:
     """The product of an assembly folder; ExecutorError naming the table and key when the
     ``[base]``, ``[covers.*]`` or ``[heads.*]`` tables are missing or malformed, or a part of
     ``assembly.toml`` has no geometry."""
-    from executor.world.geometry import _read_toml  # one reader of the file
+    from assembly_constraints.executor.world.geometry import _read_toml  # one reader of the file
 
     geometry = load_geometry(assembly)
     path = geometry.folder / "geometry.toml"
@@ -194,7 +194,7 @@ def load_product(assembly: str = "cranfield") -> Product:
     base_spec = BaseSpec(base["part"], _pair(base, "tray", where), _pair(base, "grip", where),
                          _number(base, "mass", where))
     covers = {cid: _cover(cid, t, geometry, f"{path}: [covers.{cid}]") for cid, t in geo.get("covers", {}).items()}
-    from bridge.assembly import load_assembly
+    from assembly_constraints.bridge.assembly import load_assembly
 
     layout = load_assembly(assembly)
     starts = {p.id: p.start for p in layout.parts}

@@ -7,13 +7,13 @@ Entities (under ``executor/<cell-id>/assembly/``):
 ``parts/<id>``                  the part's pose (``Transform3D``) over ``sim_time``; its
                                 solid (boxes, cylinders in its frame) logged once, static
 ``arm/<link>``                  the arm's links (meshes, as in a cell's recording:
-                                :class:`executor.rerun_arm.ArmRecorder`) over ``sim_time``
+                                :class:`assembly_constraints.executor.rerun_arm.ArmRecorder`) over ``sim_time``
 ``force``                       measured contact force at the TCP (series Fx, Fy, Fz [N])
 ``steps``                       one text line per plan step (timelines ``plan_step``
                                 and ``sim_time``)
 =============================== ===================================================
 
-The recorder is the Motion's step logger (:class:`executor.control.motion.StepLogger`):
+The recorder is the Motion's step logger (:class:`assembly_constraints.executor.control.motion.StepLogger`):
 it samples the world every ``period_s`` of simulated time.
 """
 
@@ -22,10 +22,10 @@ from __future__ import annotations
 import numpy as np
 import rerun as rr
 
-from bridge.recording.layout import assembly_root
-from executor.assembly.world import AssemblyWorld
-from executor.rerun_arm import ArmRecorder
-from executor.rerun_plots import AXIS_NAMES, MEASURED_COLORS
+from assembly_constraints.bridge.recording.layout import assembly_root
+from assembly_constraints.executor.assembly.world import AssemblyWorld
+from assembly_constraints.executor.rerun_arm import ArmRecorder
+from assembly_constraints.executor.rerun_plots import AXIS_NAMES, MEASURED_COLORS
 
 PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
 

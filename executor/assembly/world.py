@@ -2,7 +2,7 @@
 kinematically while carried), every other part as a free rigid body on the tray, and the
 arm with a gripper tool (the wrist force/torque sensor between flange and tool).
 
-The tool link has no collisions: the gripper is a grasp constraint (:mod:`executor.assembly.grasp`),
+The tool link has no collisions: the gripper is a grasp constraint (:mod:`assembly_constraints.executor.assembly.grasp`),
 not simulated fingers.  The world persists between plan steps: placed parts stay placed.
 """
 
@@ -16,14 +16,14 @@ import numpy as np
 import pybullet as pb
 import pybullet_data
 
-from executor import ExecutorError
-from executor.assembly.product import Product, rect_minus_squares
-from executor.control.controller import ImpedanceController
-from executor.control.motion import Motion, StepLogger
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
-from executor.world.assets import current_assets
-from executor.world.geometry import PartSpec, arm_urdf_text
-from executor.world.scene import TIME_STEP, load_plate
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.assembly.product import Product, rect_minus_squares
+from assembly_constraints.executor.control.controller import ImpedanceController
+from assembly_constraints.executor.control.motion import Motion, StepLogger
+from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
+from assembly_constraints.executor.world.assets import current_assets
+from assembly_constraints.executor.world.geometry import PartSpec, arm_urdf_text
+from assembly_constraints.executor.world.scene import TIME_STEP, load_plate
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -144,7 +144,7 @@ class AssemblyWorld:
         tool = PartSpec("tool", "round", 0.02, shape="gripper", length=grasp_depth, mass=0.05, start=(0.0, 0.0),
                         demo_hole="")
         self.arm_urdf = arm_urdf_text(tool, gripper)
-        """The arm's URDF text (absolute mesh paths), as loaded: :mod:`executor.assembly.export`."""
+        """The arm's URDF text (absolute mesh paths), as loaded: :mod:`assembly_constraints.executor.assembly.export`."""
         with tempfile.TemporaryDirectory(prefix="executor-assembly-arm-") as tmp:
             urdf = Path(tmp) / "arm_gripper.urdf"
             urdf.write_text(self.arm_urdf)

@@ -22,12 +22,18 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
-from executor.campaign.ablation import format_ablation, run_ablation
-from executor.campaign.pairs import campaign_pairs
-from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
-from executor.cell_options import perturbation_from_args
+from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    ArgumentParser,
+    add_assembly_argument,
+    add_jobs_argument,
+    int_in,
+)
+from assembly_constraints.executor.campaign.ablation import format_ablation, run_ablation
+from assembly_constraints.executor.campaign.pairs import campaign_pairs
+from assembly_constraints.executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
+from assembly_constraints.executor.cell_options import perturbation_from_args
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5

@@ -14,12 +14,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
-from executor.campaign.pairs import PAIRS_ARGUMENT
-from executor.cell_options import cell_keywords
-from executor.control.detector import Thresholds
-from executor.trial import Cell, trial_rng
+from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, int_in
+from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT
+from assembly_constraints.executor.cell_options import cell_keywords
+from assembly_constraints.executor.control.detector import Thresholds
+from assembly_constraints.executor.trial import Cell, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:

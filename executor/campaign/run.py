@@ -39,11 +39,17 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from bridge.cell_options import add_cell_arguments
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
-from bridge.progress import progress
-from executor import ExecutorError
-from executor.campaign.pairs import (
+from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    ArgumentParser,
+    add_assembly_argument,
+    add_jobs_argument,
+    int_in,
+)
+from assembly_constraints.bridge.progress import progress
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.campaign.pairs import (
     HOLE_NAMES,
     PAIRS_ARGUMENT,
     PART_NAMES,
@@ -52,7 +58,7 @@ from executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from executor.cell_options import cell_keywords
+from assembly_constraints.executor.cell_options import cell_keywords
 
 
 class TrialRunner(Protocol):
@@ -68,11 +74,11 @@ function or a ``functools.partial`` of one)."""
 
 
 class CellRunner:
-    """A :class:`executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
+    """A :class:`assembly_constraints.executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
     ``keywords``: the Cell's options (layer, perturbation, cell seed)."""
 
     def __init__(self, assembly: str, **keywords: Any) -> None:
-        from executor.trial import Cell
+        from assembly_constraints.executor.trial import Cell
 
         self.cell = Cell(assembly, **keywords)
 
@@ -227,7 +233,7 @@ def main(argv: Sequence[str]) -> int:
     args = build_parser().parse_args(list(argv))
     pairs = select_pairs(args.pairs)
     if args.plot:  # before the campaign, which takes minutes
-        from bridge.files import check_writable, make_folder
+        from assembly_constraints.bridge.files import check_writable, make_folder
 
         check_writable(make_folder(args.plot) / "fig18_table.png")
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
@@ -237,7 +243,7 @@ def main(argv: Sequence[str]) -> int:
         )
         report = campaign_report(run, args.seed, args.jobs)
         if args.plot:
-            from executor.campaign.plots import write_plots
+            from assembly_constraints.executor.campaign.plots import write_plots
 
             plots = write_plots(Path(args.plot), run.stats, args.assembly, args.seed)
             report["plots"] = [str(p) for p in plots]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from executor.world.arm import REST_POSTURE, Arm, ArmState, rotation_error
+from assembly_constraints.executor.world.arm import REST_POSTURE, Arm, ArmState, rotation_error
 
 
 @dataclass(frozen=True)

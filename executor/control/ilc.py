@@ -39,14 +39,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bridge.cell_options import LAYER_NAMES
-from bridge.files import write_atomic
-from bridge.inputs import duplicate_key, read_bytes, shorten
-from executor import ExecutorError
-from executor.control.admittance import AdmittanceParams
+from assembly_constraints.bridge.cell_options import LAYER_NAMES
+from assembly_constraints.bridge.files import write_atomic
+from assembly_constraints.bridge.inputs import duplicate_key, read_bytes, shorten
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.control.admittance import AdmittanceParams
 
 if TYPE_CHECKING:
-    from executor.control.controller import ImpedanceGains
+    from assembly_constraints.executor.control.controller import ImpedanceGains
 
 _A = AdmittanceParams()
 OFFSET_BOUND = np.array([_A.bound, _A.bound, _A.bound, _A.rot_bound, _A.rot_bound])
@@ -62,7 +62,7 @@ class ExecutionLayer:
     """Which parts of the paper's execution layer run (the hole search, the wiggle and the
     second attempt always do): the admittance (off: pure position control along the
     DMP), its integral part (off: P only), DMP phase stopping, ILC; ``stiff`` tracks the
-    insertion with :data:`executor.control.controller.POSITION_CONTROL_GAINS` (an
+    insertion with :data:`assembly_constraints.executor.control.controller.POSITION_CONTROL_GAINS` (an
     industrial arm's position control) instead of the compliant impedance."""
 
     name: str
@@ -118,7 +118,9 @@ class Ilc:
     """The corrections of one cell, per key, with how many executions taught each."""
 
     def __init__(self, params: IlcParams = IlcParams(), gains: ImpedanceGains | None = None) -> None:
-        from executor.control.controller import ImpedanceGains  # here: the parser needs no PyBullet
+        from assembly_constraints.executor.control.controller import (
+            ImpedanceGains,  # here: the parser needs no PyBullet
+        )
 
         self.params = params
         gains = ImpedanceGains() if gains is None else gains

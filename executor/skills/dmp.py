@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 from movement_primitives.dmp import CartesianDMP
 
-from bridge.files import make_folder, write_atomic
-from bridge.inputs import read_text
-from executor import ExecutorError
+from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.inputs import read_text
+from assembly_constraints.executor import ExecutorError
 
 # Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
 ROLLOUT_DT = 0.005

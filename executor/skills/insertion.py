@@ -11,16 +11,16 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from executor.control.admittance import Admittance, AdmittanceParams
-from executor.control.controller import POSITION_CONTROL_GAINS
-from executor.control.detector import Detector
-from executor.control.ilc import OFFSET_BOUND, ExecutionLayer, ExecutionTrace
-from executor.control.motion import Motion
-from executor.skills.dmp import PhaseClock, Skill
-from executor.skills.search import SearchParams
-from executor.skills.wiggle import wiggle
-from executor.world.arm import turn_quats_z, turn_z
-from executor.world.scene import TIME_STEP
+from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
+from assembly_constraints.executor.control.controller import POSITION_CONTROL_GAINS
+from assembly_constraints.executor.control.detector import Detector
+from assembly_constraints.executor.control.ilc import OFFSET_BOUND, ExecutionLayer, ExecutionTrace
+from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.skills.dmp import PhaseClock, Skill
+from assembly_constraints.executor.skills.search import SearchParams
+from assembly_constraints.executor.skills.wiggle import wiggle
+from assembly_constraints.executor.world.arm import turn_quats_z, turn_z
+from assembly_constraints.executor.world.scene import TIME_STEP
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.
 TIMEOUT_FACTOR = 3.0
@@ -71,7 +71,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     The execution layer: ``admittance`` None is pure position control along the DMP;
     ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
     ``feedforward`` (bins, 5) is a pose correction (dx, dy, dz [m], rx, ry [rad]) over the
-    phase added to the command (ILC, :mod:`executor.control.ilc`); ``record`` keeps the
+    phase added to the command (ILC, :mod:`assembly_constraints.executor.control.ilc`); ``record`` keeps the
     per-step wrench deviations and admittance offsets in ``result.trace`` for ILC.
 
     A breach with the tip sunk into the hole (deeper than ``JAM_DEPTH``: in the entry

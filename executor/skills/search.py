@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from executor.control.admittance import Admittance
-from executor.control.motion import Motion
-from executor.world.scene import TIME_STEP
+from assembly_constraints.executor.control.admittance import Admittance
+from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.world.scene import TIME_STEP
 
 
 @dataclass(frozen=True)

@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from executor.control.motion import Motion
-from executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
-from executor.trial import APPROACH_SETTLE_TIME, Cell
-from executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
-from executor.world.assets import regenerate_assets
-from executor.world.scene import TIME_STEP
+from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
+from assembly_constraints.executor.trial import APPROACH_SETTLE_TIME, Cell
+from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
+from assembly_constraints.executor.world.assets import regenerate_assets
+from assembly_constraints.executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s]
 DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole

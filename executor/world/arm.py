@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from executor import ExecutorError
+from assembly_constraints.executor import ExecutorError
 
 N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].

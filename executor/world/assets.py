@@ -1,7 +1,7 @@
 """Generated assets that follow their sources.
 
 ``<assembly>/assets/`` (plate mesh, part URDFs) is generated from ``geometry.toml`` and
-``assembly.toml`` by :func:`executor.world.geometry.write_assets`. The folder records the
+``assembly.toml`` by :func:`assembly_constraints.executor.world.geometry.write_assets`. The folder records the
 SHA-256 of the values it was made from (``assets/sources.sha256``: the ``[plate]`` table,
 every hole and part as loaded, as canonical JSON; comments and the keys the assets do
 not use leave it unchanged), written after the assets, so an interrupted regeneration is
@@ -19,10 +19,10 @@ import json
 import logging
 from pathlib import Path
 
-from bridge import BridgeError
-from bridge.files import write_atomic
-from executor import ExecutorError
-from executor.world.geometry import CellGeometry, write_assets
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.files import write_atomic
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.world.geometry import CellGeometry, write_assets
 
 STAMP = "sources.sha256"
 

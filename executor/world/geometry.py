@@ -29,11 +29,11 @@ import clingo
 import numpy as np
 import pybullet_data
 
-from bridge.assembly import Assembly, load_assembly
-from bridge.files import make_folder, write_atomic
-from bridge.inputs import read_text
-from executor import ExecutorError
-from executor.world.validation import check_geometry
+from assembly_constraints.bridge.assembly import Assembly, load_assembly
+from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.inputs import read_text
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.world.validation import check_geometry
 
 
 @dataclass(frozen=True)
@@ -98,9 +98,9 @@ def _read_toml(path: Path) -> dict:
 
 
 def load_geometry(assembly: str = "cranfield") -> CellGeometry:
-    """Read ``assembly.toml`` (through :func:`bridge.assembly.load_assembly`) and
+    """Read ``assembly.toml`` (through :func:`assembly_constraints.bridge.assembly.load_assembly`) and
     ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path), checked
-    as a whole first (:func:`executor.world.validation.check_geometry`: ExecutorError
+    as a whole first (:func:`assembly_constraints.executor.world.validation.check_geometry`: ExecutorError
     naming the file, table and key)."""
     layout = load_assembly(assembly)
     path = layout.folder / "geometry.toml"
@@ -111,7 +111,7 @@ def load_geometry(assembly: str = "cranfield") -> CellGeometry:
 
 def section_of(shape: dict) -> tuple[str, float, float]:
     """``kind``, size and width [m] of a checked ``[hole_shapes.*]`` or ``[part_shapes.*]``
-    table (:func:`executor.world.validation.check_geometry`): a rect ``[a, b]`` gives a
+    table (:func:`assembly_constraints.executor.world.validation.check_geometry`): a rect ``[a, b]`` gives a
     and b, any other kind its one size and width 0."""
     kind, size = shape["kind"], shape["size"]
     if kind == "rect":
@@ -210,7 +210,7 @@ def sizes_lp_text(assembly: str) -> str:
         return " ".join(f"{symbol}." for symbol in symbols)
 
     lines = [f"% {geometry.folder.name}: which part fits which hole (closed world), generated from geometry.toml",
-             "% by executor.world.geometry.passes; do not edit, regenerate with",
+             "% by assembly_constraints.executor.world.geometry.passes; do not edit, regenerate with",
              f"% ./run.sh executor sizes --assembly {geometry.folder.name} --out "
              f"data/{geometry.folder.name}/sizes.lp",
              facts([clingo.Function("part", [clingo.Function(pid)]) for pid in pegs]),

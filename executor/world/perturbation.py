@@ -34,16 +34,16 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from bridge.cell_options import MAGNITUDES
-from executor import ExecutorError
-from executor.evidence import AttemptSetup
+from assembly_constraints.bridge.cell_options import MAGNITUDES
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.evidence import AttemptSetup
 
 
 @dataclass(frozen=True)
 class PerturbationModel:
     """Magnitudes of the cell's uncertainty: grasp offsets [m], grasp tilts [°], vision
     errors [m], vision yaw errors [°], friction coefficients (Coulomb, part on hole wall, dimensionless); the
-    defaults are those of the cell's options (:data:`bridge.cell_options.MAGNITUDES`)."""
+    defaults are those of the cell's options (:data:`assembly_constraints.bridge.cell_options.MAGNITUDES`)."""
 
     grasp_offset_bias: float = MAGNITUDES["grasp_offset_bias"].default
     grasp_offset_random: float = MAGNITUDES["grasp_offset_random"].default

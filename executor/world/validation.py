@@ -17,9 +17,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from bridge.assembly import MAX_COORDINATE, Assembly
-from bridge.inputs import shorten
-from executor import ExecutorError
+from assembly_constraints.bridge.assembly import MAX_COORDINATE, Assembly
+from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.executor import ExecutorError
 
 KINDS = frozenset({"round", "square", "rect"})
 """Cross-sections: "round" size = diameter, "square" size = side, "rect" size = [a, b] (a >= b)."""

@@ -9,11 +9,11 @@ from collections.abc import Callable
 
 import pytest
 
-from asp import PlannerError
-from asp.assemble.cli import build_parser, cell_options
-from asp.bench.assemble_plans import build_parser as bench_parser
-from asp.session.cells import serve_argv
-from executor.serve import build_parser as serve_parser
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.assemble.cli import build_parser, cell_options
+from assembly_constraints.asp.bench.assemble_plans import build_parser as bench_parser
+from assembly_constraints.asp.session.cells import serve_argv
+from assembly_constraints.executor.serve import build_parser as serve_parser
 
 
 def test_the_cell_options_reach_the_assembling_cell() -> None:

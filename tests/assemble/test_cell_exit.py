@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from asp import PlannerError
-from asp.assemble.driver import assembling_cell
-from bridge.assembly import load_assembly
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.assemble.driver import assembling_cell
+from assembly_constraints.bridge.assembly import load_assembly
 
 CRASHING_BACKEND = '''
 import os

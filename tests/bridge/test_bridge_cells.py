@@ -11,8 +11,8 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from asp.session.cells import CellProcess, serve_argv, start_cell
-from bridge.client import (
+from assembly_constraints.asp.session.cells import CellProcess, serve_argv, start_cell
+from assembly_constraints.bridge.client import (
     CellConflict,
     CellDirectory,
     CellPool,
@@ -22,8 +22,8 @@ from bridge.client import (
     request_insert,
     send_insert,
 )
-from bridge.keys import alive_key
-from bridge.messages import (
+from assembly_constraints.bridge.keys import alive_key
+from assembly_constraints.bridge.messages import (
     MAX_MESSAGE_BYTES,
     ErrorReply,
     InsertReply,
@@ -33,8 +33,8 @@ from bridge.messages import (
     decode_request,
     encode,
 )
-from bridge.session import free_loopback_endpoint, open_session
-from executor.serve import QUEUE_SIZE
+from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from assembly_constraints.executor.serve import QUEUE_SIZE
 
 pytestmark = pytest.mark.timeout(60)
 

@@ -19,10 +19,10 @@ from cryptography.hazmat.primitives import hashes, serialization
 from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import NameOID
 
-from asp.session.cells import CellProcess, start_cell
-from bridge.client import CellDirectory, CellTimeout, request_insert
-from bridge.messages import InsertRequest
-from bridge.session import free_loopback_endpoint, open_session
+from assembly_constraints.asp.session.cells import CellProcess, start_cell
+from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_insert
+from assembly_constraints.bridge.messages import InsertRequest
+from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(120)]
 

@@ -7,7 +7,7 @@ import logging
 
 import pytest
 
-from bridge.progress import progress
+from assembly_constraints.bridge.progress import progress
 
 
 class Terminal(io.StringIO):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from executor.campaign.ablation import format_ablation, variant_row
+from assembly_constraints.executor.campaign.ablation import format_ablation, variant_row
 
 
 def _trial(outcome: str, attempts: list[tuple[str, float, int]]) -> dict:

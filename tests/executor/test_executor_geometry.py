@@ -9,9 +9,16 @@ import re
 
 import pytest
 
-from asp.sizes.oracle import TruthOracle
-from bridge.assembly import DATA_DIR
-from executor.world.geometry import HoleSpec, PartSpec, load_geometry, part_urdf_text, passes, plate_obj_text
+from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from assembly_constraints.bridge.assembly import DATA_DIR
+from assembly_constraints.executor.world.geometry import (
+    HoleSpec,
+    PartSpec,
+    load_geometry,
+    part_urdf_text,
+    passes,
+    plate_obj_text,
+)
 from tests._tolerances import assert_same_asset
 
 WITH_GEOMETRY = sorted(p.parent.name for p in DATA_DIR.glob("*/geometry.toml"))

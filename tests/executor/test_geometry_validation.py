@@ -12,10 +12,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bridge.assembly import DATA_DIR, load_assembly
-from executor import ExecutorError
-from executor.world.geometry import load_geometry
-from executor.world.validation import GRIPPER, PLATE, check_geometry
+from assembly_constraints.bridge.assembly import DATA_DIR, load_assembly
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.world.geometry import load_geometry
+from assembly_constraints.executor.world.validation import GRIPPER, PLATE, check_geometry
 
 CRANFIELD = DATA_DIR / "cranfield"
 ORIGINAL = (CRANFIELD / "geometry.toml").read_text()

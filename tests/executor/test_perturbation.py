@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from executor import ExecutorError
-from executor.trial import trial_rng
-from executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.trial import trial_rng
+from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
 
 MODEL = PerturbationModel()
 

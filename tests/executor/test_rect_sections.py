@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from bridge.assembly import load_assembly
-from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quats_z, turn_z
-from executor.world.geometry import (
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quats_z, turn_z
+from assembly_constraints.executor.world.geometry import (
     HoleSpec,
     PartSpec,
     load_geometry,
@@ -21,7 +21,7 @@ from executor.world.geometry import (
     plate_obj_text,
     sizes_lp_text,
 )
-from executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
 
 
 def _peg(kind: str, a: float, b: float = 0.0) -> PartSpec:

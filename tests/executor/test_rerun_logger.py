@@ -8,11 +8,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bridge import BridgeError
-from bridge.recording.reader import blueprint_origins, column_values, format_summary, read_blueprint, read_recording
-from executor import ExecutorError
-from executor.rerun_log import AttemptLogger
-from executor.rerun_plots import WIDTH
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.recording.reader import (
+    blueprint_origins,
+    column_values,
+    format_summary,
+    read_blueprint,
+    read_recording,
+)
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.rerun_log import AttemptLogger
+from assembly_constraints.executor.rerun_plots import WIDTH
 
 
 @dataclass

@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from asp.session.layered import SPACING, levels, positions
-from asp.session.log import PlannerLog
-from asp.sizes.knowledge import Knowledge
-from bridge.recording.reader import column_values, read_blueprint, read_recording
+from assembly_constraints.asp.session.layered import SPACING, levels, positions
+from assembly_constraints.asp.session.log import PlannerLog
+from assembly_constraints.asp.sizes.knowledge import Knowledge
+from assembly_constraints.bridge.recording.reader import column_values, read_blueprint, read_recording
 
 PARTS, HOLES = ("p1", "p2"), ("r1", "r2")
 

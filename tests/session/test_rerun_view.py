@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from asp.session.view import write_blueprint
-from bridge.recording.layout import Contents, tab_names
-from bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
-from executor.rerun_log import AttemptLogger
+from assembly_constraints.asp.session.view import write_blueprint
+from assembly_constraints.bridge.recording.layout import Contents, tab_names
+from assembly_constraints.bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
+from assembly_constraints.executor.rerun_log import AttemptLogger
 
 
 def _run_folder(folder: Path) -> Path:

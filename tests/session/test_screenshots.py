@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from asp.session.browser import find_chromium
-from asp.session.screenshot import take_screenshots
-from bridge.recording.layout import Contents
-from bridge.recording.reader import read_recording
-from executor.rerun_log import AttemptLogger
+from assembly_constraints.asp.session.browser import find_chromium
+from assembly_constraints.asp.session.screenshot import take_screenshots
+from assembly_constraints.bridge.recording.layout import Contents
+from assembly_constraints.bridge.recording.reader import read_recording
+from assembly_constraints.executor.rerun_log import AttemptLogger
 
 pytestmark = [
     pytest.mark.slow,

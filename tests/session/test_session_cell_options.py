@@ -3,9 +3,9 @@ starts, and gives each cell its own cell seed derived from the session seed."""
 
 from __future__ import annotations
 
-from asp.session.cells import cell_seed, serve_argv
-from asp.session.run import build_parser
-from bridge.cell_options import cell_argv
+from assembly_constraints.asp.session.cells import cell_seed, serve_argv
+from assembly_constraints.asp.session.run import build_parser
+from assembly_constraints.bridge.cell_options import cell_argv
 
 
 def _value(argv: list[str], option: str) -> str:

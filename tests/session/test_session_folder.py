@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from asp.session.cells import CellProcess, start_cell
-from asp.session.journal import JournalEntry, JournalEvent, read_journal, read_records
-from bridge.session import free_loopback_endpoint
+from assembly_constraints.asp.session.cells import CellProcess, start_cell
+from assembly_constraints.asp.session.journal import JournalEntry, JournalEvent, read_journal, read_records
+from assembly_constraints.bridge.session import free_loopback_endpoint
 from tests.conftest import TRUTH_SESSION
 from tests.session.test_session_cells import assert_learned_truth
 
@@ -203,7 +203,7 @@ def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[Cel
 def test_a_sim_cell_keeps_its_ilc_state_in_the_run_folder(tmp_path: Path) -> None:
     """The session gives each sim cell ``<run>/<cell>-ilc.json`` (a resume passes the same
     path, so the cell reloads what it learned); the truth backend learns nothing."""
-    from asp.session.cells import serve_argv
+    from assembly_constraints.asp.session.cells import serve_argv
 
     state = tmp_path / "c1-ilc.json"
     argv = serve_argv("c1", backend="sim", ilc_state=state)

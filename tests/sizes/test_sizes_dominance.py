@@ -7,7 +7,7 @@ import random
 import numpy as np
 import pytest
 
-from asp.bench.dominance import (
+from assembly_constraints.asp.bench.dominance import (
     Relaxation,
     Search,
     add_answer,
@@ -16,7 +16,7 @@ from asp.bench.dominance import (
     reductions,
     systematic_counts,
 )
-from asp.sizes.biorders import all_biorders
+from assembly_constraints.asp.sizes.biorders import all_biorders
 from tests._sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
 
 

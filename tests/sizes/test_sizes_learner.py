@@ -8,9 +8,9 @@ import networkx as nx
 import pytest
 from hypothesis import assume, given, settings
 
-from asp import PlannerError
-from asp.sizes.learner import SizeLearner, learn_sizes
-from asp.sizes.oracle import TruthOracle
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
+from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
 from tests.conftest import ROOT
 
@@ -137,7 +137,7 @@ def test_the_learner_starts_from_demonstrated_fits_and_what_they_entail_with_exp
 
 @pytest.mark.parametrize("policy", ["systematic", "heuristic", "best"])
 def test_annotated_cranfield_demonstrations_save_experiments(policy: str) -> None:
-    from asp.sizes.cli import demonstrated_fits
+    from assembly_constraints.asp.sizes.cli import demonstrated_fits
 
     truth = TruthOracle.from_assembly("cranfield")
     shown = demonstrated_fits(str(ROOT / "data" / "cranfield" / "demos_annotated.txt"), "cranfield")
