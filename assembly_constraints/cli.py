@@ -48,6 +48,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "view": ("asp.session.view", "open a session's Rerun recording"),
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
     "executor": ("executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
+    "import": ("executor.cad.cli", "a product from its CAD (STEP or meshes): holes, sections, geometric precedence"),
     "protocol": ("bridge.protocol_schema", "write or check the JSON Schema of every Zenoh message"),
 }
 """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
