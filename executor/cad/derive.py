@@ -138,7 +138,7 @@ def _hole_fit(part: CadPart, base: CadPart, axis: np.ndarray) -> HoleFit | None:
     chamfer = 0.0
     if probe:
         top = classify(min(probe, key=lambda loop: loop.area), hole=True)
-        chamfer = max(0.0, (top.b - hole.b) / 2 - _ENTRY_PROBE)
+        chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
     return HoleFit(part.id, hole, classify(own[0], hole=False), (float(hole.centre[0]), float(hole.centre[1])),
                    entry, entry - float(along.min()), chamfer,
                    classify(around[1], hole=False) if len(around) > 1 else None)

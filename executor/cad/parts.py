@@ -99,9 +99,10 @@ def check_parts(parts: list[CadPart], units: str) -> None:
             raise ExecutorError(f"{part.source}: part id '{part.id}' also given by {seen[part.id]}")
         seen[part.id] = part.source
         if not part.mesh.is_watertight:
-            edges = trimesh.grouping.group_rows(part.mesh.edges_sorted, require_count=1)
-            raise ExecutorError(f"{part.source}: part '{part.id}' is an open mesh ({len(edges)} boundary edges; "
-                                "expected a closed solid)")
+            _, uses = np.unique(part.mesh.edges_sorted, axis=0, return_counts=True)
+            raise ExecutorError(f"{part.source}: part '{part.id}' is an open mesh ({int(np.sum(uses == 1))} boundary "
+                                f"edges, {int(np.sum(uses > 2))} edges of more than two faces; expected a closed "
+                                "manifold solid)")
         if part.mesh.volume <= 0:
             part.mesh.invert()
     extents = {p.id: float(np.max(p.mesh.extents)) for p in parts}
