@@ -6,8 +6,9 @@ The assembling world (:class:`executor.assembly.world.AssemblyWorld`) is built, 
 is put at its goal pose (each peg turned to its hole's yaw, in the first hole by id it passes
 (:func:`executor.world.geometry.passes`) among those still free, smallest hole first), and
 each part's shapes are read back from PyBullet (boxes, grown by :data:`JOIN` in a part
-of several shapes; cylinders as 256-gons whose corners lie on the circle; meshes) and joined by an exact boolean union (manifold3d)
-into one solid. Written as ``OUT/<part>.obj`` in metres (10 digits: STL's single precision would
+of several shapes; cylinders as 256-gons whose corners lie on the circle; meshes) and
+joined by an exact boolean union (manifold3d) into one solid; the base is its plate's
+block minus the hole cavities. Written as ``OUT/<part>.obj`` in metres (10 digits: STL's single precision would
 merge the union's nearby vertices), with ``OUT/import.toml`` naming
 the base, every part's tray and the heads fixed to their parts.
 """
@@ -50,6 +51,7 @@ def _shape(geom_type: int, dims: tuple[float, ...], mesh_file: str, grow: float)
     if geom_type == pb.GEOM_CYLINDER:
         return trimesh.creation.cylinder(radius=dims[1], height=dims[0], sections=CYLINDER_SECTIONS)
     mesh = trimesh.load(mesh_file, force="mesh")
+    assert isinstance(mesh, trimesh.Trimesh), mesh_file
     mesh.apply_scale(dims)
     return mesh
 

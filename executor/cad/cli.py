@@ -27,7 +27,7 @@ from bridge.inputs import read_text, shorten
 from executor import ExecutorError
 from executor.cad.derive import Derived, derive
 from executor.cad.parts import UNITS, CadPart, check_parts, load_source
-from executor.cad.write import Settings, hole_ids, simulable, write_folder
+from executor.cad.write import Settings, write_folder
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
 """Default trays: the parts in a row from this point [m], this far apart along x [m]."""
@@ -89,7 +89,9 @@ def _config(path: Path | None, parts: list[CadPart]) -> tuple[Settings, dict[str
 
 
 def _mm(value: float) -> str:
-    return f"{1000 * value:.3f}"
+    """Metres as millimetres with 3 decimals (no "-0.000")."""
+    millimetres = 1000 * value
+    return f"{millimetres if abs(millimetres) >= 5e-4 else 0.0:.3f}"
 
 
 def _describe(kind: str, a: float, b: float) -> str:
@@ -103,16 +105,17 @@ def report(derived: Derived) -> list[str]:
         lines.append(f"part {pid}: insertion axis {_reverse(derived.axis[pid])} (leaves along "
                      f"{derived.axis[pid]}); free in the assembled product along "
                      f"{', '.join(derived.free(pid)) or 'none'}")
-    holes = hole_ids(derived)
-    for pid, fit in sorted(derived.holes.items(), key=lambda item: holes[item[0]]):
-        ca, cb = fit.clearance
-        clearance = f"{_mm(ca)}" if fit.hole.kind == "round" and fit.section.kind == "round" else \
-            f"{_mm(ca)} x {_mm(cb)}"
+    for hid, fit in derived.holes.items():
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
-        lines.append(f"hole {holes[pid]} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm holds {pid}: hole "
-                     f"{_describe(fit.hole.kind, fit.hole.a, fit.hole.b)}{yaw}, part "
-                     f"{_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance {clearance} mm, "
-                     f"depth {_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm")
+        held = "empty"
+        if fit.part is not None and fit.section is not None:
+            ca, cb = fit.clearance
+            clearance = _mm(ca) if fit.hole.kind == fit.section.kind == "round" else f"{_mm(ca)} x {_mm(cb)}"
+            held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
+                    f"{clearance} mm)")
+        lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
+                     f"{_reverse(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
+                     f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     lines.append("geometric precedence (A before B): " + (" ".join(f"{a}->{b}" for a, b in sorted(derived.edges))
                                                           or "none"))
@@ -123,16 +126,17 @@ def _reverse(direction: str) -> str:
     return ("-" if direction[0] == "+" else "+") + direction[1]
 
 
-def run_import(source: Path, out: Path, units: str, config: Path | None) -> tuple[Derived, list[str], float]:
-    """Read, check, derive and write; returns what was derived, what was assumed and the
-    seconds taken."""
+def run_import(source: Path, out: Path, units: str, config: Path | None
+               ) -> tuple[Derived, list[str], str | None, float]:
+    """Read, check, derive and write; returns what was derived, what was assumed, why
+    there is no geometry.toml (None: there is) and the seconds taken."""
     started = time.perf_counter()
     parts = load_source(source, units)
     check_parts(parts, units)
     settings, fixed, assumed = _config(config, parts)
     derived = derive(parts, settings.base, fixed)
-    write_folder(derived, settings, source.stem, out)
-    return derived, assumed, time.perf_counter() - started
+    _, why = write_folder(derived, settings, source.stem, out)
+    return derived, assumed, why, time.perf_counter() - started
 
 
 def main(argv: list[str]) -> int:
@@ -148,12 +152,11 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
-    derived, assumed, seconds = run_import(args.source, args.out, args.units, args.config)
+    derived, assumed, why, seconds = run_import(args.source, args.out, args.units, args.config)
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(assumed))
     for line in report(derived):
         print(line)
-    why = simulable(derived)
     print(f"wrote {args.out}: assembly.toml, sizes.lp, geometric_precedence.lp"
           + (", geometry.toml" if why is None else f" (no geometry.toml: {why})"))
     print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {seconds:.2f} s")

@@ -11,11 +11,12 @@ precedence**: A must precede B when B blocks A's path out along A's axis, and th
 precedes every part touching it. Parts fixed to another (a head screwed into its lever)
 move with it: neither blocks the other.
 
-A part is **in a hole** when the base's slice at the middle of the part's depth in the
-base (perpendicular to the axis) has a loop around the part's slice: that loop is the
-hole; its cross-section, the part's, their clearance, the hole's entry (the base's
-highest point around it along the axis), depth (entry to the part's deepest point) and
-entry chamfer (the loop's growth just below the entry, taken as 45°) are measured.
+**Holes** are the inner loops of the base's slices perpendicular to the axes, at the middle
+of each part's depth in the base (or, with no part reaching into it, at the base's middle
+along z). A part is in the hole whose loop holds its slice's centre. Measured: both
+cross-sections, their clearance, the hole's entry (the base's highest point around it
+along the axis), depth (entry to the first face down its centre line, or through the
+base), entry chamfer (the loop's growth just below the entry, taken as 45°).
 """
 
 from __future__ import annotations
@@ -23,32 +24,45 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import trimesh
 
 from executor import ExecutorError
 from executor.cad.parts import CadPart
-from executor.cad.sections import Shape2D, classify, frame_of, slice_loops
+from executor.cad.sections import Loop, Shape2D, classify, frame_of, slice_loops
 from executor.cad.sweep import DIRECTIONS, Sweeper
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
+_SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
 
 
 @dataclass(frozen=True)
 class HoleFit:
-    """A part in a hole of the base: the hole's and the part's sections, measured."""
+    """A hole of the base (``id`` h1, h2, ... by position) entered against ``axis`` (the
+    removal direction of the parts in it), with its measured section, the part standing in
+    it (None: an empty hole) and that part's section."""
 
-    part: str
+    id: str
+    axis: str
     hole: Shape2D
-    section: Shape2D
-    position: tuple[float, float]
+    centre: tuple[float, float, float]
     entry: float
     depth: float
     chamfer: float
     outer: Shape2D | None
     """The loop of the base around the hole at mid-depth (a boss), None when there is none."""
+    part: str | None = None
+    section: Shape2D | None = None
+
+    @property
+    def position(self) -> tuple[float, float]:
+        """The hole's centre in the cell's x, y [m]."""
+        return self.centre[0], self.centre[1]
 
     @property
     def clearance(self) -> tuple[float, float]:
-        """Hole minus part along a and b [m] (round: the diameters)."""
+        """Hole minus part along a and b [m] (round: the diameters); zeros without a part."""
+        if self.section is None:
+            return 0.0, 0.0
         return self.hole.a - self.section.a, self.hole.b - self.section.b
 
 
@@ -69,6 +83,11 @@ class Derived:
 
     def free(self, part: str) -> list[str]:
         return [d for d in DIRECTIONS if not self.blockers[(part, d)]]
+
+    @property
+    def hole_of(self) -> dict[str, HoleFit]:
+        """Part → the hole it stands in."""
+        return {fit.part: fit for fit in self.holes.values() if fit.part is not None}
 
 
 def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str]) -> Derived:
@@ -104,41 +123,95 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str]) -> Derived
     for pid, direction in result.axis.items():
         result.edges |= {(pid, other) for other in result.blockers[(pid, direction)] if other != base}
     result.edges |= {(base, pid) for pid in result.axis if sweeper.touching(base, pid)}
-    for pid, direction in result.axis.items():
-        fit = _hole_fit(by_id[pid], by_id[base], np.array(DIRECTIONS[direction]))
-        if fit is not None:
-            result.holes[pid] = fit
+    result.holes = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis)], result.axis)
     result.queries = sweeper.queries
     return result
 
 
-def _hole_fit(part: CadPart, base: CadPart, axis: np.ndarray) -> HoleFit | None:
-    """The hole of ``base`` that ``part`` occupies along ``axis``, None when it is in none."""
-    along = part.mesh.vertices @ axis
-    base_along = base.mesh.vertices @ axis
+def _first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> float | None:
+    """Distance [m] along the unit ``direction`` from ``origin`` to the first triangle of
+    ``mesh`` (Möller-Trumbore over all triangles), None when the ray meets none."""
+    a, b, c = (mesh.triangles[:, k] for k in range(3))
+    e1, e2 = b - a, c - a
+    p = np.cross(direction, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > 1e-15
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    t_vec = origin - a
+    u = np.einsum("ij,ij->i", t_vec, p) * inv
+    q = np.cross(t_vec, e1)
+    v = (q @ direction) * inv
+    t = np.einsum("ij,ij->i", e2, q) * inv
+    hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-9)
+    return float(t[hit].min()) if np.any(hit) else None
+
+
+def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
+    """The level [m] in the middle of the part's depth inside the base along ``axis`` and
+    the part's one loop there; None when the part does not reach into the base or its
+    slice there is not one loop."""
+    along, base_along = part.mesh.vertices @ axis, base.mesh.vertices @ axis
     low, high = max(along.min(), base_along.min()), min(along.max(), base_along.max())
     if high - low <= 1e-6:
         return None
-    level = (low + high) / 2
+    level = float(low + high) / 2
     own = slice_loops(part.mesh, axis, level)
-    if len(own) != 1:
-        return None
-    centre = own[0].centre
-    around = sorted((loop for loop in slice_loops(base.mesh, axis, level) if loop.contains(centre)),
-                    key=lambda loop: loop.area)
-    if not around:
-        return None
-    hole = classify(around[0], hole=True)
+    return (level, own[0]) if len(own) == 1 else None
+
+
+def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> dict[str, HoleFit]:
+    """Every hole of the base (an inner loop of its slices, at the levels of the parts in
+    it, or at its middle along +z), with the part in it where one is."""
+    slices: dict[tuple[str, float], list[tuple[CadPart, Loop]]] = {}
+    for part in parts:
+        found = _part_slice(part, base, np.array(DIRECTIONS[axes[part.id]]))
+        if found is not None:
+            slices.setdefault((axes[part.id], round(found[0], 7)), []).append((part, found[1]))
+    if not slices:
+        z = base.mesh.vertices[:, 2]
+        slices[("+z", round(float(z.min() + z.max()) / 2, 7))] = []
+    fits: list[HoleFit] = []
+    for (name, level), members in sorted(slices.items()):
+        axis = np.array(DIRECTIONS[name])
+        loops = slice_loops(base.mesh, axis, level)
+        for loop in loops:
+            around = sorted((o for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)),
+                            key=lambda o: o.area)
+            if len(around) % 2 == 0:
+                continue  # an outline, not a hole
+            frame = frame_of(axis)
+            centre = frame.T @ loop.centre + axis * level
+            if any(f.axis == name and np.linalg.norm(np.array(f.centre) - centre - axis * np.dot(
+                    np.array(f.centre) - centre, axis)) < _SAME_HOLE for f in fits):
+                continue
+            occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
+            fits.append(_measure(base, name, loop, level, around[0] if around else None, occupant))
+    fits.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
+    return {f"h{k}": HoleFit(f"h{k}", *_fields(f)) for k, f in enumerate(fits, start=1)}
+
+
+def _fields(fit: HoleFit) -> tuple:
+    return (fit.axis, fit.hole, fit.centre, fit.entry, fit.depth, fit.chamfer, fit.outer, fit.part, fit.section)
+
+
+def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
+             occupant: tuple[CadPart, Loop] | None) -> HoleFit:
+    """Section, entry, depth (to the first face of the base down the hole's centre line;
+    through the base when there is none) and chamfer of the hole ``loop``."""
+    axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
-    reach = max(hole.a, hole.b)
+    hole = classify(loop, hole=True)
+    base_along = base.mesh.vertices @ axis
     radial = base.mesh.vertices @ frame.T - hole.centre
-    near = np.linalg.norm(radial, axis=1) <= reach
-    entry = float(base_along[near].max())
-    probe = [loop for loop in slice_loops(base.mesh, axis, entry - _ENTRY_PROBE) if loop.contains(centre)]
+    entry = float(base_along[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)].max())
+    centre = frame.T @ hole.centre + axis * level
+    bottom = _first_hit(base.mesh, centre, -axis)
+    depth = entry - (level - bottom if bottom is not None else float(base_along.min()))
+    probe = [o for o in slice_loops(base.mesh, axis, entry - _ENTRY_PROBE) if o.contains(hole.centre)]
     chamfer = 0.0
     if probe:
-        top = classify(min(probe, key=lambda loop: loop.area), hole=True)
+        top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
-    return HoleFit(part.id, hole, classify(own[0], hole=False), (float(hole.centre[0]), float(hole.centre[1])),
-                   entry, entry - float(along.min()), chamfer,
-                   classify(around[1], hole=False) if len(around) > 1 else None)
+    part, section = (None, None) if occupant is None else (occupant[0].id, classify(occupant[1], hole=False))
+    return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
+                   None if outer is None else classify(outer, hole=False), part, section)

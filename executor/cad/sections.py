@@ -52,7 +52,7 @@ class Loop:
         return np.array([np.sum((x + np.roll(x, -1)) * cross), np.sum((y + np.roll(y, -1)) * cross)]) / (6 * signed)
 
     def contains(self, point: np.ndarray) -> bool:
-        return bool(PolygonPath(self.points).contains_point(point))
+        return bool(PolygonPath(self.points).contains_point((float(point[0]), float(point[1]))))
 
 
 @dataclass(frozen=True)

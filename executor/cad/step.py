@@ -9,6 +9,7 @@ converts to metres. A leaf without a name is named after its parent and position
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -22,10 +23,10 @@ _MM = 1e-3
 def load_step(path: Path) -> list[CadPart]:
     """The leaves of the STEP assembly at ``path`` as parts; ExecutorError naming the file
     when it is not a readable STEP file or holds no solid."""
+    from OCP.collections import Sequence_TDF_Label
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPCAFControl import STEPCAFControl_Reader
     from OCP.TCollection import TCollection_ExtendedString
-    from OCP.collections import Sequence_TDF_Label
     from OCP.TDocStd import TDocStd_Document
     from OCP.XCAFDoc import XCAFDoc_DocumentTool
 
@@ -37,7 +38,7 @@ def load_step(path: Path) -> list[CadPart]:
     tool = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
     roots = Sequence_TDF_Label()
     tool.GetFreeShapes(roots)
-    leaves: list[tuple[str, object]] = []
+    leaves: list[tuple[str, Any]] = []
     for k in range(1, roots.Length() + 1):
         _collect(tool, roots.Value(k), None, _name(roots.Value(k)) or path.stem, leaves)
     if not leaves:
@@ -46,16 +47,16 @@ def load_step(path: Path) -> list[CadPart]:
             for name, shape in leaves]
 
 
-def _name(label: object) -> str:
+def _name(label: Any) -> str:
     from OCP.TDataStd import TDataStd_Name
 
     attribute = TDataStd_Name()
-    if label.FindAttribute(TDataStd_Name.GetID_s(), attribute):  # type: ignore[attr-defined]
+    if label.FindAttribute(TDataStd_Name.GetID_s(), attribute):
         return attribute.Get().ToExtString()
     return ""
 
 
-def _collect(tool: object, label: object, location: object, name: str, leaves: list[tuple[str, object]]) -> None:
+def _collect(tool: object, label: Any, location: Any, name: str, leaves: list[tuple[str, Any]]) -> None:
     """Append ``(name, located shape)`` for every leaf under ``label``; ``location`` is the
     placement of ``label`` in the product (None at a root)."""
     from OCP.collections import Sequence_TDF_Label
@@ -78,7 +79,7 @@ def _collect(tool: object, label: object, location: object, name: str, leaves: l
     leaves.append((name, shape.Located(here.Multiplied(shape.Location()))))
 
 
-def _mesh(shape: object, source: str) -> trimesh.Trimesh:
+def _mesh(shape: Any, source: str) -> trimesh.Trimesh:
     """The shape's faces tessellated (:data:`STEP_DEFLECTION`) into one mesh [m]."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepMesh import BRepMesh_IncrementalMesh

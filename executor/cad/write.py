@@ -2,14 +2,15 @@
 
 - ``assembly.toml``: every part (the base with role ``base``, a part in a hole with role
   ``peg`` and its section's kind as ``shape``, any other ``part``) with its tray ``start``,
-  every hole (``h1``, ``h2``, ... by position) with its kind and position;
+  every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
   (:func:`executor.world.geometry.passes`), closed world;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly, the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's primitives (plate with bosses, pegs) when the
   product is one (every part but the base a peg standing in a hole along +z, the holes'
-  entries at one height with one depth); left out otherwise, and the report says why.
+  entries at one height with one depth) and the cell's loader accepts it; left out
+  otherwise, and the report says why.
 """
 
 from __future__ import annotations
@@ -21,14 +22,17 @@ from pathlib import Path
 import clingo
 import networkx as nx
 
+from bridge.errors import ToolError
 from bridge.files import make_folder, write_atomic
 from executor.cad.derive import Derived, HoleFit
-from executor.world.geometry import Section, passes
+from executor.world.geometry import Section, load_geometry, passes
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
 GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02}
 """The simulated gripper of every imported product (Cranfield's)."""
+MIN_CHAMFER = 1e-4
+"""The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
 _LEVEL = 1e-5  # holes whose entries or depths differ by more [m] are no one plate
 
 
@@ -39,12 +43,6 @@ class Settings:
     base: str
     trays: dict[str, tuple[float, float]]
     names: dict[str, str]
-
-
-def hole_ids(derived: Derived) -> dict[str, str]:
-    """Part → its hole's id, ``h1``... in order of position (x, then y)."""
-    ordered = sorted(derived.holes.values(), key=lambda fit: (round(fit.position[0], 6), round(fit.position[1], 6)))
-    return {fit.part: f"h{k}" for k, fit in enumerate(ordered, start=1)}
 
 
 def section(name: str, shape_kind: str, a: float, b: float) -> Section:
@@ -65,23 +63,27 @@ def _symbols(symbols: list[clingo.Symbol]) -> str:
 
 
 def assembly_text(derived: Derived, settings: Settings, title: str) -> str:
-    holes = hole_ids(derived)
+    pegs = derived.hole_of
     lines = [f"# Imported from {title} by ./run.sh import: parts in the CAD frame (the cell frame) [m].",
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):
-        role = "base" if pid == derived.base else "peg" if pid in derived.holes else "part"
+        role = "base" if pid == derived.base else "peg" if pid in pegs else "part"
         lines += [f"[parts.{pid}]", f"name = {json.dumps(settings.names.get(pid, derived.parts[pid].name))}",
                   f'role = "{role}"']
         x, y = settings.trays[pid]
         lines.append(f"start = [{_q(x)}, {_q(y)}]")
-        if pid in derived.holes and derived.holes[pid].section.kind != "other":
-            lines.append(f'shape = "{derived.holes[pid].section.kind}"')
+        if _section_kind(pegs.get(pid)) not in (None, "other"):
+            lines.append(f'shape = "{_section_kind(pegs.get(pid))}"')
         lines.append("")
-    for pid, hid in sorted(holes.items(), key=lambda item: int(item[1][1:])):
-        fit = derived.holes[pid]
-        lines += [f"[holes.{hid}]", f'name = "hole of {pid}"', f'shape = "{_kind(fit.hole.kind)}"',
+    for hid, fit in derived.holes.items():
+        name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
+        lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{_kind(fit.hole.kind)}"',
                   f"position = [{_q(fit.position[0])}, {_q(fit.position[1])}]", ""]
     return "\n".join(lines)
+
+
+def _section_kind(fit: HoleFit | None) -> str | None:
+    return None if fit is None or fit.section is None else fit.section.kind
 
 
 def _kind(kind: str) -> str:
@@ -90,19 +92,15 @@ def _kind(kind: str) -> str:
 
 
 def sizes_text(derived: Derived) -> str:
-    holes = hole_ids(derived)
-    pegs = [pid for pid in sorted(derived.holes) if derived.holes[pid].section.kind != "other"]
-    ordered = sorted(holes.items(), key=lambda item: int(item[1][1:]))
+    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
+            if fit.section is not None and fit.section.kind != "other"}
+    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in pegs]),
-             _symbols([clingo.Function("hole", [clingo.Function(h)]) for _, h in ordered])]
-    for pid in pegs:
-        peg = derived.holes[pid].section
-        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for owner, hid in ordered
-                if derived.holes[owner].hole.kind != "other" and passes(
-                    section(pid, peg.kind, peg.a, peg.b),
-                    section(hid, derived.holes[owner].hole.kind, derived.holes[owner].hole.a,
-                            derived.holes[owner].hole.b))]
+             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in holes])]
+    for pid, peg in pegs.items():
+        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, hole in holes.items()
+                if passes(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))]
         if fits:
             lines.append(_symbols(fits))
     return "\n".join(lines) + "\n"
@@ -123,17 +121,18 @@ def precedence_text(derived: Derived) -> str:
 
 def simulable(derived: Derived) -> str | None:
     """Why the product is not one the simulated cell builds from primitives, None when it is."""
+    pegs = derived.hole_of
     for pid in sorted(derived.parts):
         if pid == derived.base:
             continue
-        fit = derived.holes.get(pid)
-        if fit is None:
+        if pid not in pegs:
             return f"part '{pid}' stands in no hole of the base"
         if derived.axis[pid] != "+z":
             return f"part '{pid}' goes in along {derived.axis[pid]}, not from above"
-        if "other" in (fit.section.kind, fit.hole.kind):
-            return f"part '{pid}' or its hole has a cross-section other than round, square or rect"
     fits = list(derived.holes.values())
+    for fit in fits:
+        if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
+            return f"hole {fit.id} is not entered from above with a round, square or rect section"
     if not fits:
         return "no part stands in a hole of the base"
     for what, values in (("entry", [f.entry for f in fits]), ("depth", [f.depth for f in fits])):
@@ -145,29 +144,29 @@ def simulable(derived: Derived) -> str | None:
 def geometry_text(derived: Derived, settings: Settings) -> str:
     """``geometry.toml`` of a :func:`simulable` product."""
     fits = list(derived.holes.values())
-    holes = hole_ids(derived)
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = fits[0].entry, fits[0].depth
     tile = _tile(fits)
     lines = ["# The simulated cell's primitives measured from the CAD by ./run.sh import [m].", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
-             f"chamfer = {_q(max(f.chamfer for f in fits))}", "polygon_sides = 24",
+             f"chamfer = {_q(max(MIN_CHAMFER, *(f.chamfer for f in fits)))}  # [m] at least MIN_CHAMFER",
+             "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(max(top - depth - z0, 1e-3))}", ""]
-    for pid, fit in sorted(derived.holes.items()):
-        hid = holes[pid]
+    for hid, fit in derived.holes.items():
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', f'kind = "{fit.hole.kind}"',
                   f"size = {_size(fit.hole.kind, fit.hole.a, fit.hole.b)}"]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         lines.append("")
-    for pid, fit in sorted(derived.holes.items()):
-        mesh = derived.parts[pid].mesh
-        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', f'kind = "{fit.section.kind}"',
-                  f"size = {_size(fit.section.kind, fit.section.a, fit.section.b)}",
+    for pid, fit in sorted(derived.hole_of.items()):
+        mesh, peg = derived.parts[pid].mesh, fit.section
+        assert peg is not None
+        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', f'kind = "{peg.kind}"',
+                  f"size = {_size(peg.kind, peg.a, peg.b)}",
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
-                  f'demo_hole = "{holes[pid]}"', ""]
+                  f'demo_hole = "{fit.id}"', ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
               "[base]", f'part = "{derived.base}"',
               f"tray = [{_q(settings.trays[derived.base][0])}, {_q(settings.trays[derived.base][1])}]",
@@ -186,15 +185,24 @@ def _tile(fits: list[HoleFit]) -> float:
     return tile if tile > widest else widest + 0.004
 
 
-def write_folder(derived: Derived, settings: Settings, title: str, out: Path) -> list[Path]:
-    """Write the files of the module docstring into ``out``; returns them."""
+def write_folder(derived: Derived, settings: Settings, title: str, out: Path) -> tuple[list[Path], str | None]:
+    """Write the files of the module docstring into ``out``; returns them and why there
+    is no ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
     make_folder(out)
     written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
                write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
     geometry = out / "geometry.toml"
-    if simulable(derived) is None:
-        written.append(write_atomic(geometry, geometry_text(derived, settings)))
-    elif geometry.exists():
+    if geometry.exists():
         geometry.unlink()
-    return written
+    why = simulable(derived)
+    if why is None:
+        write_atomic(geometry, geometry_text(derived, settings))
+        try:
+            load_geometry(str(out))
+        except ToolError as exc:
+            geometry.unlink()
+            why = f"the cell refuses its primitives ({exc})"
+        else:
+            written.append(geometry)
+    return written, why
