@@ -132,7 +132,9 @@ def _check_overlaps(parts: list[CadPart]) -> None:
             if np.any(high - low <= 0):
                 continue
             common = trimesh.boolean.intersection([a.mesh, b.mesh], engine="manifold")
-            if len(common.faces) and common.volume > OVERLAP_VOLUME:
+            with np.errstate(divide="ignore", invalid="ignore"):  # an empty intersection has no centre
+                volume = float(common.volume) if len(common.faces) else 0.0
+            if volume > OVERLAP_VOLUME:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
-                                    f"{common.volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
+                                    f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
                                     "that at most touch)")

@@ -18,6 +18,7 @@ from __future__ import annotations
 import fcl
 import numpy as np
 import trimesh
+from scipy.spatial import ConvexHull
 
 TOUCH = 1e-5
 """Contacts at most this deep [m] are touching, not colliding (10 µm: below every
@@ -38,23 +39,23 @@ def _bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
     return fcl.CollisionObject(model, fcl.Transform())
 
 
-def _convex(vertices: np.ndarray, faces: list[list[int]]) -> fcl.CollisionObject:
-    flat = np.concatenate([[len(face), *face] for face in faces]).astype(np.int32)
-    return fcl.CollisionObject(fcl.Convex(np.asarray(vertices, dtype=float), len(faces), flat), fcl.Transform())
+def _convex(vertices: np.ndarray, count: int, flat: np.ndarray) -> fcl.CollisionObject:
+    """A convex piece of ``count`` faces given as fcl's flat list (size, indices...)."""
+    return fcl.CollisionObject(fcl.Convex(np.asarray(vertices, dtype=float), count, flat), fcl.Transform())
 
 
-_PRISM_FACES = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
+_PRISM_FACES = np.array([3, 0, 2, 1, 3, 3, 4, 5, 4, 0, 1, 4, 3, 4, 1, 2, 5, 4, 4, 2, 0, 3, 5], dtype=np.int32)
+"""A triangle (0 1 2) and its translate (3 4 5): two triangles and three quads."""
 
 
 def swept_pieces(mesh: trimesh.Trimesh, shift: np.ndarray) -> list[fcl.CollisionObject]:
     """Convex pieces whose union's boundary contains the sweep of ``mesh`` by ``shift`` [m]."""
     if mesh.is_convex:
-        hull = trimesh.convex.convex_hull(np.vstack([mesh.vertices, mesh.vertices + shift]))
-        return [_convex(hull.vertices, hull.faces.tolist())]
-    pieces = []
-    for triangle in mesh.triangles:
-        pieces.append(_convex(np.vstack([triangle, triangle + shift]), _PRISM_FACES))
-    return pieces
+        points = np.vstack([mesh.vertices, mesh.vertices + shift])
+        hull = ConvexHull(points)
+        flat = np.hstack([np.full((len(hull.simplices), 1), 3), hull.simplices]).astype(np.int32).ravel()
+        return [_convex(points, len(hull.simplices), flat)]
+    return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in mesh.triangles]
 
 
 class Sweeper:
@@ -96,10 +97,15 @@ class Sweeper:
 
     @staticmethod
     def _meets(pieces: list[fcl.CollisionObject], fixed: fcl.CollisionObject) -> bool:
-        request = fcl.CollisionRequest(num_max_contacts=_MAX_CONTACTS, enable_contact=True)
+        """Whether a piece meets ``fixed`` deeper than :data:`TOUCH`: a first query without
+        contacts, the contacts' depths only for the pieces that meet at all."""
+        first = fcl.CollisionRequest()
+        deep = fcl.CollisionRequest(num_max_contacts=_MAX_CONTACTS, enable_contact=True)
         for piece in pieces:
+            if not fcl.collide(piece, fixed, first, fcl.CollisionResult()):
+                continue
             result = fcl.CollisionResult()
-            if fcl.collide(piece, fixed, request, result) and any(
-                    contact.penetration_depth > TOUCH for contact in result.contacts):
+            fcl.collide(piece, fixed, deep, result)
+            if any(contact.penetration_depth > TOUCH for contact in result.contacts):
                 return True
         return False
