@@ -57,9 +57,10 @@ def _shape(geom_type: int, dims: tuple[float, ...], mesh_file: str, grow: float)
 
 
 def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
-    """The base as one solid: the plate's box from the floor to its top minus the hole
-    cavities (each boss's square minus the boss mesh), the same solid as the cell's boss
-    mesh, deck and box under them, without their shared faces."""
+    """The base as one solid: the plate's box from the floor to its top minus the cavities
+    (the deck's axis-aligned square around each hole minus the boss mesh), the same solid
+    as the cell's boss mesh, deck and box under them, without their shared faces. A turned
+    boss leaves the corners of its square open, as in the cell."""
     geometry = world.product.geometry
     plate = geometry.plate
     top, tile, depth = float(plate["top_z"]), float(plate["tile_size"]), float(plate["tile_thickness"])
@@ -69,7 +70,6 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
     tiles = []
     for hole in geometry.holes.values():
         square = trimesh.creation.box((tile, tile, depth))
-        square.apply_transform(trimesh.transformations.rotation_matrix(hole.yaw, (0, 0, 1)))
         square.apply_translation((*hole.position, top - depth / 2))
         tiles.append(square)
     bosses = trimesh.load(geometry.assets / "plate.obj", force="mesh")

@@ -116,6 +116,10 @@ def report(derived: Derived) -> list[str]:
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
                      f"{_reverse(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
+    for pocket in derived.pockets:
+        lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
+                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: no round, "
+                     "square or rect section, no hole")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     lines.append("geometric precedence (A before B): " + (" ".join(f"{a}->{b}" for a, b in sorted(derived.edges))
                                                           or "none"))

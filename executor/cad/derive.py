@@ -16,7 +16,8 @@ of each part's depth in the base (or, with no part reaching into it, at the base
 along z). A part is in the hole whose loop holds its slice's centre. Measured: both
 cross-sections, their clearance, the hole's entry (the base's highest point around it
 along the axis), depth (entry to the first face down its centre line, or through the
-base), entry chamfer (the loop's growth just below the entry, taken as 45°).
+base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
+loop that is no round, square or rect section is a pocket, reported but no hole.
 """
 
 from __future__ import annotations
@@ -79,6 +80,8 @@ class Derived:
     stages: list[list[str]] = field(default_factory=list)
     edges: set[tuple[str, str]] = field(default_factory=set)
     holes: dict[str, HoleFit] = field(default_factory=dict)
+    pockets: list[HoleFit] = field(default_factory=list)
+    """Empty inner loops of the base that are no round, square or rect section: not holes."""
     queries: int = 0
 
     def free(self, part: str) -> list[str]:
@@ -123,7 +126,10 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str]) -> Derived
     for pid, direction in result.axis.items():
         result.edges |= {(pid, other) for other in result.blockers[(pid, direction)] if other != base}
     result.edges |= {(base, pid) for pid in result.axis if sweeper.touching(base, pid)}
-    result.holes = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis)], result.axis)
+    found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis)], result.axis)
+    result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "other"]
+    holes = [fit for fit in found if fit not in result.pockets]
+    result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.queries = sweeper.queries
     return result
 
@@ -159,9 +165,9 @@ def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, 
     return (level, own[0]) if len(own) == 1 else None
 
 
-def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> dict[str, HoleFit]:
-    """Every hole of the base (an inner loop of its slices, at the levels of the parts in
-    it, or at its middle along +z), with the part in it where one is."""
+def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> list[HoleFit]:
+    """Every inner loop of the base's slices (at the levels of the parts in it, or at its
+    middle along +z), with the part in it where one is, in order of position."""
     slices: dict[tuple[str, float], list[tuple[CadPart, Loop]]] = {}
     for part in parts:
         found = _part_slice(part, base, np.array(DIRECTIONS[axes[part.id]]))
@@ -187,7 +193,7 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> dict[st
             occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
             fits.append(_measure(base, name, loop, level, around[0] if around else None, occupant))
     fits.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
-    return {f"h{k}": HoleFit(f"h{k}", *_fields(f)) for k, f in enumerate(fits, start=1)}
+    return fits
 
 
 def _fields(fit: HoleFit) -> tuple:
