@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import clingo
@@ -35,18 +36,28 @@ def _fits(path: Path) -> set[tuple[str, str]]:
             for s in [s.symbol]}
 
 
-def _imported(tmp: Path, product: str) -> tuple[Derived, Path]:
-    meshes = tmp / "meshes"
-    subprocess.run([sys.executable, "-P", "-m", "assembly_constraints", "-q", "executor", "export", "--assembled",
-                    "--assembly", product, str(meshes)], check=True, cwd=Path(__file__).parents[2])
-    derived, _, _, _ = run_import(meshes, tmp / "out", "m", meshes / "import.toml")
-    return derived, tmp / "out"
+@pytest.fixture(scope="module")
+def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], tuple[Derived, Path]]:
+    """A product exported in the assembled pose (``executor export --assembled``) and
+    imported, once per product for the module."""
+    done: dict[str, tuple[Derived, Path]] = {}
+
+    def get(product: str) -> tuple[Derived, Path]:
+        if product not in done:
+            tmp = tmp_path_factory.mktemp(product)
+            assert main(["-q", "executor", "export", "--assembled", "--assembly", product, str(tmp / "meshes")]) == 0
+            derived, _, _, _ = run_import(tmp / "meshes", tmp / "out", "m", tmp / "meshes" / "import.toml")
+            done[product] = derived, tmp / "out"
+        return done[product]
+
+    return get
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("product", PRODUCTS)
-def test_round_trip_gives_back_holes_sizes_and_fits(tmp_path: Path, product: str) -> None:
-    derived, out = _imported(tmp_path, product)
+def test_round_trip_gives_back_holes_sizes_and_fits(imported: Callable[[str], tuple[Derived, Path]],
+                                                    product: str) -> None:
+    derived, out = imported(product)
     geometry = load_geometry(product)
     renamed: dict[str, str] = {}
     assert len(derived.holes) == len(geometry.holes)
@@ -72,8 +83,9 @@ def test_round_trip_gives_back_holes_sizes_and_fits(tmp_path: Path, product: str
 
 
 @pytest.mark.slow
-def test_cranfield_geometric_precedence_against_the_physics(tmp_path: Path) -> None:
-    derived, _ = _imported(tmp_path, "cranfield")
+def test_cranfield_geometric_precedence_against_the_physics(
+        imported: Callable[[str], tuple[Derived, Path]]) -> None:
+    derived, _ = imported("cranfield")
     assert ENFORCED - {("sh", "pd")} <= derived.edges
     assert not derived.edges & NOT_ENFORCED
     # The pendulum's opening is the big hole plus 0.5 mm: the shaft (1.3 mm less than the
