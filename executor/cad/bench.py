@@ -7,7 +7,9 @@ covers, one lying on the first row, the other on it, each with openings for the 
 (which pass through both). Written as STL files in mm, then imported
 (:func:`executor.cad.cli.run_import`) ``--repeat`` times. Prints the median wall and CPU
 time of the import, the collision queries and the edges found; exit code 1 when the
-median wall time exceeds ``--target``.
+median CPU time (the process's, all its threads: what one core would need) exceeds
+``--target``. The wall time is printed too: on a shared machine it also counts the
+waits for a core.
 """
 
 from __future__ import annotations
@@ -78,7 +80,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--parts", type=int_in(4, 200), default=20, help="parts of the product (default 20)")
     parser.add_argument("--repeat", type=int_in(1, 100), default=3, help="imports to take the median of (default 3)")
     parser.add_argument("--target", type=number_in(float, 0.0, 3600.0), default=10.0,
-                        help="the median wall time's bound [s] (default 10)")
+                        help="the median CPU time's bound [s] (default 10)")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="bench-import-") as tmp:
         source = Path(tmp) / "cad"
@@ -94,5 +96,5 @@ def main(argv: list[str]) -> int:
     print(f"{len(derived.parts)} parts, {len(derived.holes)} holes, {derived.queries} collision queries, "
           f"{len(derived.edges)} geometric edges, stages {len(derived.stages)}")
     print(f"import + geometric precedence: median {wall:.2f} s wall, {cpu:.2f} s CPU over {args.repeat} run(s) "
-          f"(target {args.target:g} s wall)" + ("" if why is None else f"; no geometry.toml: {why}"))
-    return 0 if wall <= args.target else 1
+          f"(target {args.target:g} s CPU)" + ("" if why is None else f"; no geometry.toml: {why}"))
+    return 0 if cpu <= args.target else 1
