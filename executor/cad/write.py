@@ -5,6 +5,8 @@
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
   (:func:`executor.world.geometry.passes`), closed world;
+- ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
+  section in each hole's, the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly, the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's primitives (plate with bosses, pegs) when the
@@ -25,7 +27,7 @@ import networkx as nx
 from bridge.errors import ToolError
 from bridge.files import make_folder, write_atomic
 from executor.cad.derive import Derived, HoleFit
-from executor.world.geometry import Section, load_geometry, passes
+from executor.world.geometry import Section, load_geometry, margin, passes
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -103,6 +105,23 @@ def sizes_text(derived: Derived) -> str:
                 if passes(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))]
         if fits:
             lines.append(_symbols(fits))
+    return "\n".join(lines) + "\n"
+
+
+def nominal_text(derived: Derived) -> str:
+    """``nominal_margin(P,H,M)``: the room [µm, rounded] the peg's nominal section has in
+    the hole's (:func:`executor.world.geometry.margin`; negative: it does not pass)."""
+    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
+            if fit.section is not None and fit.section.kind != "other"}
+    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    lines = ["% The nominal room of every peg in every hole [um] (negative: it does not pass), by ./run.sh import;",
+             "% the input of sizes learn --prior cad."]
+    for pid, peg in pegs.items():
+        lines.append(_symbols([clingo.Function("nominal_margin", [
+            clingo.Function(pid), clingo.Function(hid),
+            clingo.Number(round(1e6 * margin(section(pid, peg.kind, peg.a, peg.b),
+                                             section(hid, hole.kind, hole.a, hole.b))))])
+            for hid, hole in holes.items()]))
     return "\n".join(lines) + "\n"
 
 
@@ -191,6 +210,7 @@ def write_folder(derived: Derived, settings: Settings, title: str, out: Path) ->
     make_folder(out)
     written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
+               write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
                write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
     geometry = out / "geometry.toml"
     if geometry.exists():

@@ -41,3 +41,40 @@ def test_a_demonstration_breaking_the_prior_is_wrong(tmp_path: Path, capsys: pyt
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"error: {demos}:2: a wrong demonstration: it breaks the geometric precedence a<c of {prior} "
                    "(the CAD admits no such order)"]
+
+
+def _sizes_folder(tmp_path: Path) -> Path:
+    """Two round pegs (d 10, 12 mm) and two round holes (d 10.3, 12.05 mm), as import writes them."""
+    (tmp_path / "assembly.toml").write_text(
+        "name = 't'\n[parts.a]\nname = 'a'\nshape = 'round'\n[parts.b]\nname = 'b'\nshape = 'round'\n"
+        "[holes.h1]\nname = 'h1'\n[holes.h2]\nname = 'h2'\n")
+    (tmp_path / "sizes.lp").write_text("part(a;b). hole(h1;h2). fits(a,h1). fits(a,h2). fits(b,h2).\n")
+    (tmp_path / "nominal_sizes.lp").write_text(
+        "nominal_margin(a,h1,300). nominal_margin(a,h2,2050). nominal_margin(b,h1,-1700). nominal_margin(b,h2,50).\n")
+    return tmp_path
+
+
+def test_the_cad_prior_leaves_the_pairs_within_the_tolerance(tmp_path: Path, capsys: pytest.CaptureFixture[str]
+                                                              ) -> None:
+    folder = _sizes_folder(tmp_path)
+    without = _sizes(capsys, "--assembly", str(folder), "--model", "pairs")
+    prior = _sizes(capsys, "--assembly", str(folder), "--model", "pairs", "--prior", "cad", "--tolerance", "0.0001")
+    assert sorted(map(tuple, prior["prior"])) == [("a", "h1", "fit"), ("a", "h2", "fit"), ("b", "h1", "no_fit")]
+    assert [(e["part"], e["hole"]) for e in prior["experiments"]] == [("b", "h2")]  # 50 µm: within 0.1 mm
+    assert without["count"] == 4 and prior["count"] == 1
+    assert sorted(map(tuple, prior["fits"])) == sorted(map(tuple, without["fits"])) == [
+        ("a", "h1"), ("a", "h2"), ("b", "h2")]
+
+
+def _sizes(capsys: pytest.CaptureFixture[str], *argv: str) -> dict:
+    assert main(["sizes", "learn", *argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_the_cad_prior_needs_its_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = _sizes_folder(tmp_path)
+    (folder / "nominal_sizes.lp").write_text("nominal_margin(a,h1,wide).\n")
+    assert main(["sizes", "learn", "--assembly", str(folder), "--prior", "cad"]) == 2
+    assert "expected nominal_margin(Part,Hole,Micrometres) facts only" in capsys.readouterr().err
+    assert main(["sizes", "learn", "--assembly", str(folder), "--tolerance", "0.001"]) == 2
+    assert "--tolerance applies to --prior cad only" in capsys.readouterr().err
