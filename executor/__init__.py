@@ -10,7 +10,8 @@ stepper), :mod:`executor.skills` (DMP, hole search, insertion, wiggle, teaching)
 records in :mod:`executor.evidence`, the Rerun log :mod:`executor.rerun_log`, the trial
 :mod:`executor.trial`, and on top :mod:`executor.campaign`, :mod:`executor.serve` (with
 the backend interface :mod:`executor.backends` and the replay backend :mod:`executor.replay`)
-and :mod:`executor.cli`.  One exception: teaching (:mod:`executor.skills.teach`) drives a
+and :mod:`executor.cli`; beside them :mod:`executor.cad`, a product from its CAD (on
+:mod:`executor.world` and :mod:`executor.assembly`).  One exception: teaching (:mod:`executor.skills.teach`) drives a
 :class:`executor.trial.Cell` to record the skills the trial then uses.
 """
 
