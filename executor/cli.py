@@ -180,7 +180,7 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("out", metavar="OUT", type=nonempty_path, help="folder to write cell.urdf and meshes/ into")
     export.add_argument("--assembled", action="store_true",
                         help="instead: one closed mesh per part in the assembled pose (OUT/<part>.obj, m) and "
-                             "OUT/import.toml, the input of ./run.sh import")
+                             "OUT/import.toml, the input of the import subcommand")
     export.set_defaults(func=_export)
 
     for name, (_module, help_text) in _DELEGATED.items():

@@ -50,8 +50,8 @@ def _parser() -> argparse.ArgumentParser:
                             "(default 1: plain intersection)")
     learn.add_argument("--prior", metavar="FILE",
                        help="a precedence the demonstrations refine (part/1, must_precede/2: the "
-                            "geometric_precedence.lp of ./run.sh import); a demonstration breaking it is an error; "
-                            "without demonstrations the prior alone is the relation")
+                            "geometric_precedence.lp the import subcommand writes); a demonstration breaking it "
+                            "is an error; without demonstrations the prior alone is the relation")
     learn.add_argument("--evidence", action="store_true",
                        help="add per-pair support/contradiction counts and suspect demonstrations "
                             "(JSON keys evidence, suspects)")

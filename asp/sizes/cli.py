@@ -84,7 +84,7 @@ def _parser() -> argparse.ArgumentParser:
     add_model_option(learn)
     learn.add_argument("--prior", choices=["cad"],
                        help="cad: start from the outcomes the nominal cross-sections decide beyond --tolerance "
-                            "(the assembly's nominal_sizes.lp, written by ./run.sh import)")
+                            "(the assembly's nominal_sizes.lp, written by the import subcommand)")
     learn.add_argument("--tolerance", type=number_in(float, 0.0, 0.1), default=0.0, metavar="T",
                        help="with --prior cad: margins within T [m] of zero are left to the experiments (default 0)")
     learn.add_argument("--demos", metavar="FILE",

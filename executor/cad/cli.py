@@ -26,7 +26,8 @@ from bridge.cli_types import ArgumentParser
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
 from executor.cad.derive import Derived, derive
-from executor.cad.parts import UNITS, CadPart, check_parts, load_source
+from executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
+from executor.cad.step import load_step
 from executor.cad.write import Settings, write_folder
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
@@ -128,6 +129,15 @@ def report(derived: Derived) -> list[str]:
 
 def _reverse(direction: str) -> str:
     return ("-" if direction[0] == "+" else "+") + direction[1]
+
+
+def load_source(source: Path, units: str) -> list[CadPart]:
+    """The parts of a mesh folder or a STEP file (``units`` applies to meshes only)."""
+    if source.is_dir():
+        return load_meshes(source, units)
+    if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
+        return load_step(source)
+    raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
 
 
 def run_import(source: Path, out: Path, units: str, config: Path | None

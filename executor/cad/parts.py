@@ -80,17 +80,6 @@ def load_meshes(folder: Path, units: str) -> list[CadPart]:
     return parts
 
 
-def load_source(source: Path, units: str) -> list[CadPart]:
-    """The parts of a mesh folder or a STEP file (``units`` applies to meshes only)."""
-    if source.is_dir():
-        return load_meshes(source, units)
-    if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
-        from executor.cad.step import load_step
-
-        return load_step(source)
-    raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
-
-
 def check_parts(parts: list[CadPart], units: str) -> None:
     """The checks of the module docstring, in that order; ExecutorError naming the part."""
     seen: dict[str, str] = {}

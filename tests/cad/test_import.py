@@ -106,7 +106,8 @@ def test_a_step_assembly_made_by_build123d(tmp_path: Path) -> None:
         "peg = Pos(-20, 0, 10) * Cylinder(6.0, 30); peg.label = 'round peg'\n"
         "rect = Pos(20, 0, 10) * Rot(0, 0, 30) * Box(12, 8, 30); rect.label = 'rect peg'\n"
         "cap = Pos(20, 0, 27) * Box(20, 20, 4); cap.label = 'cap'\n"
-        f"export_step(Compound(label='product', children=[plate, peg, rect, cap]), {str(tmp_path / 'p.step')!r})\n")
+        f"export_step(Compound(label='product', children=[plate, peg, rect, cap]), {str(tmp_path / 'p.step')!r})\n"
+        f"export_step(Compound(label='pegs', children=[plate, peg, rect]), {str(tmp_path / 'pegs.step')!r})\n")
     subprocess.run([sys.executable, str(script)], check=True)
     derived, _, _, _ = run_import(tmp_path / "p.step", tmp_path / "out", "mm", None)
     assert derived.base == "plate"
@@ -123,6 +124,16 @@ def test_a_step_assembly_made_by_build123d(tmp_path: Path) -> None:
     empty = derived.holes["h2"]
     assert (empty.part, empty.hole.kind, empty.depth) == (None, "square", pytest.approx(0.015, abs=SIZE_BOUND))
     assert _fits(tmp_path / "out" / "sizes.lp") == {("round_peg", "h1"), ("rect_peg", "h3")}
+    # Without the cap the product is one of primitives: the cell's loader takes its geometry,
+    # and the nominal sections decide every pair the learner would otherwise try.
+    assert main(["import", str(tmp_path / "pegs.step"), "--out", str(tmp_path / "pegs")]) == 0
+    geometry = load_geometry(str(tmp_path / "pegs"))
+    assert (geometry.holes["h3"].kind, math.degrees(geometry.holes["h3"].yaw)) == ("rect", pytest.approx(30.0))
+    assert geometry.parts["rect_peg"].sides == pytest.approx((0.012, 0.008), abs=SIZE_BOUND)
+    for prior in ([], ["--prior", "cad", "--tolerance", "0.0005"]):
+        assert main(["sizes", "learn", "--assembly", str(tmp_path / "pegs"), *prior, "--out",
+                     str(tmp_path / "learned.lp")]) == 0
+        assert _fits(tmp_path / "learned.lp") == _fits(tmp_path / "pegs" / "sizes.lp")
 
 
 def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
