@@ -161,6 +161,15 @@ def _learn(args: argparse.Namespace) -> int:
               f"{len(truth.parts) * len(truth.holes)} pairs: " + " ".join(f"{p}->{h} {r}" for (p, h), r in prior))
     result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
                          confirm=args.confirm, demonstrated=demonstrated, model=model, prior=prior)
+    saved = None
+    if args.prior:
+        # The same session without the prior, against the same truth (and noise seed):
+        # what the prior saved is the difference.
+        again: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
+        saved = learn_sizes(truth.parts, truth.holes, again, args.policy, args.seed, confirm=args.confirm,
+                            demonstrated=demonstrated, model=model).count - result.count
+        if not args.json:
+            print(f"the CAD prior saved {saved} experiments (same policy, seed and truth without it)")
     if not args.json:
         for change in result.model_changes:
             print(f"model changed: {change}")
@@ -177,7 +186,7 @@ def _learn(args: argparse.Namespace) -> int:
             "count": result.count,
             "fits": [[p, h] for p in truth.parts for h in truth.holes if (p, h) in result.knowledge.fits],
             **({"demonstrated": [list(pair) for pair in result.demonstrated]} if args.demos else {}),
-            **({"prior": [[p, h, r] for (p, h), r in result.prior]} if args.prior else {}),
+            **({"prior": [[p, h, r] for (p, h), r in result.prior], "saved": saved} if args.prior else {}),
         }))
     else:
         retests = sum(e.retest for e in result.experiments)

@@ -61,7 +61,7 @@ def test_the_cad_prior_leaves_the_pairs_within_the_tolerance(tmp_path: Path, cap
     prior = _sizes(capsys, "--assembly", str(folder), "--model", "pairs", "--prior", "cad", "--tolerance", "0.0001")
     assert sorted(map(tuple, prior["prior"])) == [("a", "h1", "fit"), ("a", "h2", "fit"), ("b", "h1", "no_fit")]
     assert [(e["part"], e["hole"]) for e in prior["experiments"]] == [("b", "h2")]  # 50 µm: within 0.1 mm
-    assert without["count"] == 4 and prior["count"] == 1
+    assert without["count"] == 4 and prior["count"] == 1 and prior["saved"] == 3
     assert sorted(map(tuple, prior["fits"])) == sorted(map(tuple, without["fits"])) == [
         ("a", "h1"), ("a", "h2"), ("b", "h2")]
 
