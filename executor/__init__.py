@@ -10,7 +10,8 @@ stepper), :mod:`assembly_constraints.executor.skills` (DMP, hole search, inserti
 records in :mod:`assembly_constraints.executor.evidence`, the Rerun log :mod:`assembly_constraints.executor.rerun_log`, the trial
 :mod:`assembly_constraints.executor.trial`, and on top :mod:`assembly_constraints.executor.campaign`, :mod:`assembly_constraints.executor.serve` (with
 the backend interface :mod:`assembly_constraints.executor.backend_plugin` and the replay backend :mod:`assembly_constraints.executor.replay`)
-and :mod:`assembly_constraints.executor.cli`.  One exception: teaching (:mod:`assembly_constraints.executor.skills.teach`) drives a
+and :mod:`assembly_constraints.executor.cli`; beside them :mod:`assembly_constraints.executor.cad`, a product from its CAD (on
+:mod:`assembly_constraints.executor.world` and :mod:`assembly_constraints.executor.assembly`).  One exception: teaching (:mod:`assembly_constraints.executor.skills.teach`) drives a
 :class:`assembly_constraints.executor.trial.Cell` to record the skills the trial then uses.
 """
 
