@@ -35,6 +35,7 @@ BENCHMARKS: dict[str, str] = {
     "assemble": "assembly_constraints.asp.bench.assemble_plans",
     "executor": "assembly_constraints.executor.campaign.bench",
     "physics": "assembly_constraints.executor.campaign.physics",
+    "import": "assembly_constraints.executor.cad.bench",
 }
 """``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""
 
@@ -50,6 +51,8 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
     "executor": ("assembly_constraints.executor.cli",
                  "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
+    "import": ("assembly_constraints.executor.cad.cli",
+               "a product from its CAD (STEP or meshes): holes, sections, geometric precedence"),
     "protocol": ("assembly_constraints.bridge.protocol_schema",
                  "write or check the JSON Schema of every Zenoh message"),
 }

@@ -9,8 +9,9 @@ PyBullet scene, arm), ``control`` (impedance controller, admittance, detector, m
 stepper), ``skills`` (DMP, hole search, insertion, wiggle, teaching), the records in
 ``evidence``, the Rerun log ``rerun_log``, the trial ``trial``, and on top ``campaign``,
 ``serve`` (with the backend interface ``backend_plugin`` and the replay backend ``replay``)
-and ``cli``.  One exception: teaching (``skills.teach``) drives a ``trial.Cell`` to record
-the skills the trial then uses.
+and ``cli``; beside them ``cad``, a product from its CAD (on ``world`` and ``assembly``).
+One exception: teaching (``skills.teach``) drives a ``trial.Cell`` to record the skills
+the trial then uses.
 """
 
 

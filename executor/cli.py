@@ -133,6 +133,13 @@ def _sizes(args: argparse.Namespace) -> int:
 def _export(args: argparse.Namespace) -> int:
     from assembly_constraints.executor.assembly.export import export_cell
 
+    if args.assembled:
+        from assembly_constraints.executor.cad.assembled import write_assembled
+
+        files = write_assembled(args.assembly, args.out)
+        print(f"wrote {len(files) - 1} part mesh(es) in the assembled pose and import.toml in {args.out}")
+        return 0
+
     written = export_cell(args.assembly, args.out)
     print(f"wrote {written[0]} and {len(written) - 1} mesh file(s) in {args.out / 'meshes'}")
     return 0
@@ -186,6 +193,9 @@ def build_parser() -> argparse.ArgumentParser:
     export = sub.add_parser("export", help="write the assembling cell as URDF and meshes (arm, plate, every part)")
     add_assembly_argument(export, purpose="the product whose cell is written")
     export.add_argument("out", metavar="OUT", type=nonempty_path, help="folder to write cell.urdf and meshes/ into")
+    export.add_argument("--assembled", action="store_true",
+                        help="instead: one closed mesh per part in the assembled pose (OUT/<part>.obj, m) and "
+                             "OUT/import.toml, the input of the import subcommand")
     export.set_defaults(func=_export)
 
     for name, (_module, help_text) in _DELEGATED.items():

@@ -54,6 +54,10 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--min-support", type=int_in(1, 10**6), default=1, metavar="K",
                        help="drop a constraint only when >= K demonstrations contradict it "
                             "(default 1: plain intersection)")
+    learn.add_argument("--prior", metavar="FILE",
+                       help="a precedence the demonstrations refine (part/1, must_precede/2: the "
+                            "geometric_precedence.lp the import subcommand writes); a demonstration breaking it "
+                            "is an error; without demonstrations the prior alone is the relation")
     learn.add_argument("--evidence", action="store_true",
                        help="add per-pair support/contradiction counts and suspect demonstrations "
                             "(JSON keys evidence, suspects)")
@@ -98,9 +102,11 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _demonstrations(args: argparse.Namespace) -> Demonstrations:
+def _demonstrations(args: argparse.Namespace, prior: Relation | None = None) -> Demonstrations:
     assembly = load_assembly(args.assembly) if args.assembly else None
     if args.demos is None:
+        if prior is not None and (assembly is None or not assembly.has_file("demos.txt")):
+            return Demonstrations(prior.parts, (), ())
         if assembly is None:
             raise PlannerError("learn: expected a demonstrations file or --assembly with demos.txt")
         return load_demos(assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
@@ -122,8 +128,16 @@ def _learn(args: argparse.Namespace) -> None:
     from assembly_constraints.asp.precedence.learn import learn_must_precede, pair_evidence, suspects
     from assembly_constraints.bridge.files import write_atomic
 
-    demos = _demonstrations(args)
-    relation = learn_must_precede(demos, args.min_support)
+    prior = load_relation([args.prior]) if args.prior else None
+    demos = _demonstrations(args, prior)
+    if prior is None:
+        relation = learn_must_precede(demos, args.min_support)
+    else:
+        from assembly_constraints.asp.precedence.learn import learn_with_prior
+
+        relation = learn_with_prior(demos, prior, args.prior, args.min_support)
+        LOG.info("%d demonstration(s) refine the prior %s (%d pairs)", len(demos.sequences), args.prior,
+                 int(prior.matrix.sum()))
     edges = reduction(relation)
     flagged = suspects(demos)
     for suspect in flagged:

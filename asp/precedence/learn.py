@@ -111,3 +111,36 @@ def pair_evidence(demos: Demonstrations) -> list[dict[str, object]]:
         for j in range(n)
         if i != j and support[i, j] > 0
     ]
+
+
+def check_prior(demos: Demonstrations, prior: Relation, source: str) -> None:
+    """Every demonstration respects every pair of ``prior`` (the geometric precedence of
+    ``import``: what the CAD decides); PlannerError naming the first demonstration that
+    breaks one (file:line) and the pairs it breaks, and when the prior's parts are not the
+    demonstrations'."""
+    if set(prior.parts) != set(demos.parts):
+        raise PlannerError(f"{source}: the prior's parts ({', '.join(sorted(prior.parts))}) are not the "
+                           f"demonstrations' ({', '.join(sorted(demos.parts))})")
+    index = {p: i for i, p in enumerate(prior.parts)}
+    rows, cols = np.nonzero(prior.matrix)
+    for sequence, origin in zip(demos.sequences, demos.origins):
+        step = np.empty(len(prior.parts), dtype=np.int64)
+        step[[index[p] for p in sequence]] = np.arange(len(sequence))
+        broken = [(prior.parts[i], prior.parts[j]) for i, j in zip(rows.tolist(), cols.tolist()) if step[i] > step[j]]
+        if broken:
+            pairs = " ".join(f"{a}<{b}" for a, b in broken)
+            raise PlannerError(f"{origin}: a wrong demonstration: it breaks the geometric precedence {pairs} "
+                               f"of {source} (the CAD admits no such order)")
+
+
+def learn_with_prior(demos: Demonstrations, prior: Relation, source: str, min_support: int = 1) -> Relation:
+    """Algorithm 1 with the geometric ``prior``: the demonstrations are checked against it
+    (:func:`check_prior`); the learned relation is theirs joined with the prior (closed),
+    so it contains every geometric pair, and it is the prior alone without demonstrations."""
+    check_prior(demos, prior, source)
+    order = [prior.parts.index(p) for p in demos.parts]
+    aligned = Relation(demos.parts, prior.matrix[np.ix_(order, order)])
+    if not demos.sequences:
+        return aligned
+    learned = learn_must_precede(demos, min_support)
+    return close(Relation(demos.parts, learned.matrix | aligned.matrix), source=f"demonstrations and {source}")

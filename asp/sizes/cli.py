@@ -24,7 +24,14 @@ from assembly_constraints.asp.sizes.policies import get_policy, policy_names
 from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, Oracle, TruthOracle
 from assembly_constraints.asp.solve import write_facts
 from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    ArgumentParser,
+    add_assembly_argument,
+    comma_list,
+    int_in,
+    number_in,
+)
 
 
 def _truth(args: argparse.Namespace) -> TruthOracle:
@@ -82,6 +89,11 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
                        help="seed of random choices and noise (default 0)")
     add_model_option(learn)
+    learn.add_argument("--prior", choices=["cad"],
+                       help="cad: start from the outcomes the nominal cross-sections decide beyond --tolerance "
+                            "(the assembly's nominal_sizes.lp, written by the import subcommand)")
+    learn.add_argument("--tolerance", type=number_in(float, 0.0, 0.1), default=0.0, metavar="T",
+                       help="with --prior cad: margins within T [m] of zero are left to the experiments (default 0)")
     learn.add_argument("--demos", metavar="FILE",
                        help="demonstrations; the parts they place into holes (p1@r1) are fits to start from")
     _add_noise_options(learn)
@@ -119,10 +131,26 @@ def demonstrated_fits(path: str, assembly: str | None) -> list[tuple[str, str]]:
     return demos.placements()
 
 
+def _cad_prior(args: argparse.Namespace, truth: TruthOracle) -> list[tuple[tuple[str, str], str]]:
+    """The outcomes ``--prior cad`` decides (none without it); PlannerError without an
+    assembly folder holding nominal_sizes.lp."""
+    if args.prior is None:
+        if args.tolerance:
+            raise PlannerError("--tolerance applies to --prior cad only")
+        return []
+    from assembly_constraints.asp.sizes.cad_prior import NOMINAL_FILE, decided, nominal_margins
+
+    if not args.assembly:
+        raise PlannerError(f"--prior cad: expected --assembly A with {NOMINAL_FILE} (./run.sh import writes it)")
+    margins = nominal_margins(load_assembly(args.assembly).file(NOMINAL_FILE))
+    return decided(margins, args.tolerance, truth.parts, truth.holes)
+
+
 def _learn(args: argparse.Namespace) -> int:
     truth = _truth(args)
     model = _model(args, truth)
     demonstrated = demonstrated_fits(args.demos, args.assembly) if args.demos else []
+    prior = _cad_prior(args, truth)
     oracle: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
     if not args.json:
         print(f"assumes: {model.assumption()}")
@@ -135,8 +163,20 @@ def _learn(args: argparse.Namespace) -> int:
     if demonstrated and not args.json:
         print(f"starting from {len(demonstrated)} fits seen in the demonstrations: "
               + " ".join(f"{p}->{h}" for p, h in demonstrated))
+    if prior and not args.json:
+        print(f"the CAD prior (tolerance {1000 * args.tolerance:g} mm) decides {len(prior)} of "
+              f"{len(truth.parts) * len(truth.holes)} pairs: " + " ".join(f"{p}->{h} {r}" for (p, h), r in prior))
     result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
-                         confirm=args.confirm, demonstrated=demonstrated, model=model)
+                         confirm=args.confirm, demonstrated=demonstrated, model=model, prior=prior)
+    saved = None
+    if args.prior:
+        # The same session without the prior, against the same truth (and noise seed):
+        # what the prior saved is the difference.
+        again: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
+        saved = learn_sizes(truth.parts, truth.holes, again, args.policy, args.seed, confirm=args.confirm,
+                            demonstrated=demonstrated, model=model).count - result.count
+        if not args.json:
+            print(f"the CAD prior saved {saved} experiments (same policy, seed and truth without it)")
     if not args.json:
         for change in result.model_changes:
             print(f"model changed: {change}")
@@ -153,6 +193,7 @@ def _learn(args: argparse.Namespace) -> int:
             "count": result.count,
             "fits": [[p, h] for p in truth.parts for h in truth.holes if (p, h) in result.knowledge.fits],
             **({"demonstrated": [list(pair) for pair in result.demonstrated]} if args.demos else {}),
+            **({"prior": [[p, h, r] for (p, h), r in result.prior], "saved": saved} if args.prior else {}),
         }))
     else:
         retests = sum(e.retest for e in result.experiments)

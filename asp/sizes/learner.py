@@ -20,6 +20,10 @@ reached ``max_answers``), the learner names them in one line, moves to the next 
 model (``line`` -> ``sections`` -> ``pairs``), re-grounds, and asks the pairs the
 weaker model no longer entails. ``model_changes`` lists the moves.
 
+A prior from the nominal CAD (``prior``: pairs and results the nominal cross-sections
+decide beyond a tolerance, :mod:`assembly_constraints.asp.sizes.cad_prior`) starts the same way: one answer
+each, no experiment, re-tested only when a conflict names them.
+
 Demonstrations that say where a part went (``p1@r1``; paper 4.2, last paragraph) are
 fits seen before any experiment: ``demonstrated`` pairs start as one ``fit`` answer each,
 so the learner starts from their closure, never tries them unless a conflict names them,
@@ -90,6 +94,9 @@ class SizeLearningResult:
     demonstrated: tuple[Pair, ...] = ()
     """Fits seen in demonstrations, which the learner started from."""
 
+    prior: tuple[tuple[Pair, str], ...] = ()
+    """Outcomes a prior decided (the nominal CAD), which the learner started from."""
+
     model_changes: tuple[str, ...] = ()
     """One line per move to a weaker model: the contradicting observations and the models."""
 
@@ -121,12 +128,14 @@ class SizeLearner:
         confirm: int = 0,
         demonstrated: Sequence[Pair] = (),
         model: SizeModel | None = None,
+        prior: Sequence[tuple[Pair, str]] = (),
     ) -> None:
         """``parts``/``holes`` in index order; ``confirm`` K ≥ 0: each essential
         observation's kept result must lead the other by K+1 answers (0: no confirmation);
         ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more);
         ``demonstrated``: (part, hole) pairs demonstrations placed, known to fit (module doc);
-        ``model``: the size model over ``parts`` (default: the paper's ``line``)."""
+        ``model``: the size model over ``parts`` (default: the paper's ``line``);
+        ``prior``: ((part, hole), result) outcomes known before any experiment."""
         if len(set(parts) | set(holes)) != len(parts) + len(holes):
             raise PlannerError("parts and holes need distinct ids")
         if not 0 <= confirm <= MAX_CONFIRM:
@@ -141,6 +150,12 @@ class SizeLearner:
         if outside:
             raise PlannerError(f"demonstrated placement(s) {' '.join(outside[:5])}: expected a part of "
                                f"{' '.join(self.parts)} and a hole of {' '.join(self.holes)}")
+        self.prior = tuple(dict.fromkeys((pair, result) for pair, result in prior))
+        unknown = [f"{p}->{h} {r}" for (p, h), r in self.prior
+                   if p not in self.parts or h not in self.holes or r not in RESULTS]
+        if unknown:
+            raise PlannerError(f"prior outcome(s) {' '.join(unknown[:5])}: expected a part of {' '.join(self.parts)}, "
+                               f"a hole of {' '.join(self.holes)} and a result in {RESULTS}")
         self.policy = get_policy(policy) if isinstance(policy, str) else policy
         self.model = self._initial_model = build_model("line", self.parts) if model is None else model
         if set(self.model.sections) != set(self.parts):
@@ -172,10 +187,11 @@ class SizeLearner:
                           for pair in self._pairs for r in RESULTS}
 
     def _start_from_demonstrations(self) -> None:
-        """One ``fit`` answer per demonstrated pair, then the closure (fits alone close no cycle)."""
-        for pair in self.demonstrated:
-            self.answers[pair] = ["fit"]
-            self._set_observation(pair, "fit")
+        """One ``fit`` answer per demonstrated pair and one per prior outcome, then the
+        closure; a prior that contradicts the model is weakened away as any observation."""
+        for pair, result in [*((pair, "fit") for pair in self.demonstrated), *self.prior]:
+            self.answers[pair] = [result]
+            self._set_observation(pair, result)
         self.knowledge = self._solve()
 
     def _pair(self, symbol: clingo.Symbol) -> Pair:
@@ -421,7 +437,7 @@ class SizeLearner:
 
     def result(self) -> SizeLearningResult:
         return SizeLearningResult(self.policy.name, tuple(self.experiments), self.knowledge, self.model,
-                                  self.demonstrated, tuple(self.model_changes))
+                                  self.demonstrated, self.prior, tuple(self.model_changes))
 
 
 def _reaches(graph: dict[str, set[str]], start: str, goal: str) -> bool:
@@ -448,11 +464,12 @@ def learn_sizes(
     confirm: int = 0,
     demonstrated: Sequence[Pair] = (),
     model: SizeModel | None = None,
+    prior: Sequence[tuple[Pair, str]] = (),
 ) -> SizeLearningResult:
     """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known
     (and, with ``confirm`` > 0, every essential observation confirmed), starting from the
     fits ``demonstrated``, under the size ``model``; see :class:`SizeLearner`."""
-    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm, demonstrated, model)
+    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm, demonstrated, model, prior)
     return run_learner(learner, oracle, on_experiment)
 
 

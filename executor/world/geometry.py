@@ -178,23 +178,29 @@ def _describe(section: Section) -> str:
     return {"round": f"round d {a:g} mm", "square": f"square {a:g} mm"}.get(section.kind, f"rect {a:g} x {b:g} mm")
 
 
-def passes(part: Section, hole: Section) -> bool:
-    """Whether the part's cross-section passes the hole's, aligned (the skill turns the
-    part to the hole's yaw; no clearance needed beyond a positive one): round in round
-    d < D; a square or rect a × b in round by its diagonal √(a² + b²) < D; round in a
-    square or rect by its short side d < B; a square or rect in a square or rect long
-    side along long side, a < A and b < B (a square is a rect with a = b)."""
+def margin(part: Section, hole: Section) -> float:
+    """How much room the part's cross-section has in the hole's, aligned [m] (negative: it
+    does not pass; the skill turns the part to the hole's yaw): round in round D - d; a
+    square or rect a × b in round D - √(a² + b²); round in a square or rect B - d (its short
+    side); a square or rect in a square or rect, long side along long side, min(A - a, B - b)
+    (a square is a rect with a = b)."""
     if hole.kind == "round":
         if part.kind == "round":
-            return part.size < hole.size
+            return hole.size - part.size
         if part.kind == "square":
-            return part.size * math.sqrt(2.0) < hole.size
-        return math.hypot(*part.sides) < hole.size
+            return hole.size - part.size * math.sqrt(2.0)
+        return hole.size - math.hypot(*part.sides)
     long_side, short_side = hole.sides
     if part.kind == "round":
-        return part.size < short_side
+        return short_side - part.size
     a, b = part.sides
-    return a < long_side and b < short_side
+    return min(long_side - a, short_side - b)
+
+
+def passes(part: Section, hole: Section) -> bool:
+    """Whether the part's cross-section passes the hole's, aligned: a positive
+    :func:`margin` (no clearance needed beyond a positive one)."""
+    return margin(part, hole) > 0
 
 
 def sizes_lp_text(assembly: str) -> str:

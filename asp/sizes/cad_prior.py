@@ -1,0 +1,60 @@
+"""The size prior from nominal CAD dimensions (``sizes learn --prior cad --tolerance T``).
+
+``import`` writes ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of
+part P's nominal cross-section in hole H's (negative: it does not pass). Real parts are
+made within a tolerance, so only margins beyond it decide: M > T is a fit, M < -T a
+no-fit, |M| <= T is left to the experiments. The decided outcomes start the learner as
+answers (:class:`assembly_constraints.asp.sizes.learner.SizeLearner`'s ``prior``), so its closure entails
+more and it tries fewer pairs; it still learns from what it observes, and an
+observation that contradicts the prior is a conflict re-tested like any other.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import clingo
+
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.sizes.knowledge import Pair
+from assembly_constraints.asp.solve import load_atoms
+from assembly_constraints.bridge.assembly import is_id
+from assembly_constraints.bridge.inputs import shorten
+
+NOMINAL_FILE = "nominal_sizes.lp"
+
+
+def nominal_margins(path: Path) -> dict[Pair, int]:
+    """(part, hole) -> margin [µm] of ``path``; PlannerError naming the file when it holds
+    other facts or none."""
+    margins: dict[Pair, int] = {}
+    for atom in load_atoms([path], shown_only=False):
+        arguments = atom.arguments if atom.type == clingo.SymbolType.Function else []
+        if (atom.name != "nominal_margin" or len(arguments) != 3 or not all(is_id(str(a)) for a in arguments[:2])
+                or arguments[2].type != clingo.SymbolType.Number):
+            raise PlannerError(f"{path}: {shorten(atom, 60)}: expected nominal_margin(Part,Hole,Micrometres) "
+                               "facts only (a part and hole id, an integer)")
+        margins[(str(arguments[0]), str(arguments[1]))] = arguments[2].number
+    if not margins:
+        raise PlannerError(f"{path}: no nominal_margin/3 facts (expected the file ./run.sh import writes)")
+    return margins
+
+
+def decided(margins: dict[Pair, int], tolerance: float, parts: tuple[str, ...], holes: tuple[str, ...]
+            ) -> list[tuple[Pair, str]]:
+    """The outcomes the margins decide beyond ``tolerance`` [m], in part then hole order;
+    PlannerError when the margins miss a pair of ``parts`` × ``holes``."""
+    missing = [f"{p}->{h}" for p in parts for h in holes if (p, h) not in margins]
+    if missing:
+        raise PlannerError(f"{NOMINAL_FILE}: no nominal margin for {' '.join(missing[:5])} (expected every part "
+                           "and hole of sizes.lp)")
+    bound = 1e6 * tolerance
+    outcomes = []
+    for part in parts:
+        for hole in holes:
+            value = margins[(part, hole)]
+            if value > bound:
+                outcomes.append(((part, hole), "fit"))
+            elif value < -bound:
+                outcomes.append(((part, hole), "no_fit"))
+    return outcomes

@@ -1,0 +1,177 @@
+"""``import SOURCE --out DIR``: a product from its CAD as an assembly folder.
+
+SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assembled pose
+(``--units``). ``--config FILE`` is an optional TOML file::
+
+    base = "plate"            # the fixture part (default: the part of largest volume)
+    [parts.peg1]
+    tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: a row)
+    name = "round peg"
+    fixed_to = "lever"        # moves with that part (screwed, glued): neither blocks the other
+
+It prints what it assumes, each part's insertion axis and free directions, each hole
+with both cross-sections and the clearance, the disassembly stages, the geometric
+precedence and the collision queries; bad CAD or a bad file: one line, exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+import tomllib
+from pathlib import Path
+
+from assembly_constraints.bridge.cli_types import ArgumentParser
+from assembly_constraints.bridge.inputs import read_text, shorten
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.cad.derive import Derived, derive
+from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
+from assembly_constraints.executor.cad.step import load_step
+from assembly_constraints.executor.cad.write import Settings, write_folder
+
+TRAY_ROW = ((0.25, 0.40), 0.05)
+"""Default trays: the parts in a row from this point [m], this far apart along x [m]."""
+BASE_TRAY = (0.30, -0.40)
+"""Default tray of the base [m]."""
+
+
+def _config(path: Path | None, parts: list[CadPart]) -> tuple[Settings, dict[str, str], list[str]]:
+    """The settings of ``--config`` (checked: one line naming the file and key), the
+    fixed-to map, and what was assumed for lack of them."""
+    ids = {p.id for p in parts}
+    data: dict = {}
+    if path is not None:
+        try:
+            data = tomllib.loads(read_text(path, "import settings (TOML)", error=ExecutorError))
+        except tomllib.TOMLDecodeError as exc:
+            raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
+    assumed: list[str] = []
+    base = data.get("base")
+    if base is None:
+        base = max(parts, key=lambda p: p.mesh.volume).id
+        assumed.append(f"base {base} (the largest part; set base = \"<id>\")")
+    elif base not in ids:
+        raise ExecutorError(f"{path}: base: expected a part id ({', '.join(sorted(ids))}), got {shorten(repr(base))}")
+    tables = data.get("parts", {})
+    if not isinstance(tables, dict):
+        raise ExecutorError(f"{path}: [parts]: expected tables [parts.<id>]")
+    trays: dict[str, tuple[float, float]] = {}
+    names: dict[str, str] = {}
+    fixed: dict[str, str] = {}
+    for pid, table in tables.items():
+        if pid not in ids or not isinstance(table, dict):
+            raise ExecutorError(f"{path}: [parts.{pid}]: expected a table of a part of the CAD "
+                                f"({', '.join(sorted(ids))})")
+        tray = table.get("tray")
+        if tray is not None:
+            if not (isinstance(tray, list) and len(tray) == 2 and all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in tray)):
+                raise ExecutorError(f"{path}: [parts.{pid}] tray: expected [x, y] in m, got {shorten(repr(tray))}")
+            trays[pid] = (float(tray[0]), float(tray[1]))
+        if "name" in table:
+            names[pid] = str(table["name"])
+        host = table.get("fixed_to")
+        if host is not None:
+            if host not in ids or host in (pid, base):
+                raise ExecutorError(f"{path}: [parts.{pid}] fixed_to: expected another part than it and the base, "
+                                    f"got {shorten(repr(host))}")
+            fixed[pid] = host
+    missing = [p.id for p in parts if p.id not in trays]
+    (x, y), step = TRAY_ROW
+    row = [pid for pid in sorted(missing) if pid != base]
+    for k, pid in enumerate(row):
+        trays[pid] = (x + step * k, y)
+    if base in missing:
+        trays[base] = BASE_TRAY
+    if missing:
+        assumed.append(f"trays of {', '.join(sorted(missing))} in a row (set [parts.<id>] tray)")
+    return Settings(base, trays, names), fixed, assumed
+
+
+def _mm(value: float) -> str:
+    """Metres as millimetres with 3 decimals (no "-0.000")."""
+    millimetres = 1000 * value
+    return f"{millimetres if abs(millimetres) >= 5e-4 else 0.0:.3f}"
+
+
+def _describe(kind: str, a: float, b: float) -> str:
+    return f"round d {_mm(a)}" if kind == "round" else f"{kind} {_mm(a)} x {_mm(b)}"
+
+
+def report(derived: Derived) -> list[str]:
+    """The lines ``import`` prints about what it derived."""
+    lines = []
+    for pid in sorted(derived.axis):
+        lines.append(f"part {pid}: insertion axis {_reverse(derived.axis[pid])} (leaves along "
+                     f"{derived.axis[pid]}); free in the assembled product along "
+                     f"{', '.join(derived.free(pid)) or 'none'}")
+    for hid, fit in derived.holes.items():
+        yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
+        held = "empty"
+        if fit.part is not None and fit.section is not None:
+            ca, cb = fit.clearance
+            clearance = _mm(ca) if fit.hole.kind == fit.section.kind == "round" else f"{_mm(ca)} x {_mm(cb)}"
+            held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
+                    f"{clearance} mm)")
+        lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
+                     f"{_reverse(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
+                     f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
+    for pocket in derived.pockets:
+        lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
+                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: no round, "
+                     "square or rect section, no hole")
+    lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
+    lines.append("geometric precedence (A before B): " + (" ".join(f"{a}->{b}" for a, b in sorted(derived.edges))
+                                                          or "none"))
+    return lines
+
+
+def _reverse(direction: str) -> str:
+    return ("-" if direction[0] == "+" else "+") + direction[1]
+
+
+def load_source(source: Path, units: str) -> list[CadPart]:
+    """The parts of a mesh folder or a STEP file (``units`` applies to meshes only)."""
+    if source.is_dir():
+        return load_meshes(source, units)
+    if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
+        return load_step(source)
+    raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
+
+
+def run_import(source: Path, out: Path, units: str, config: Path | None
+               ) -> tuple[Derived, list[str], str | None, float]:
+    """Read, check, derive and write; returns what was derived, what was assumed, why
+    there is no geometry.toml (None: there is) and the seconds taken."""
+    started = time.perf_counter()
+    parts = load_source(source, units)
+    check_parts(parts, units)
+    settings, fixed, assumed = _config(config, parts)
+    derived = derive(parts, settings.base, fixed)
+    _, why = write_folder(derived, settings, source.stem, out)
+    return derived, assumed, why, time.perf_counter() - started
+
+
+def main(argv: list[str]) -> int:
+    parser = ArgumentParser(prog="import", description="A product from its CAD (STEP, or STL/OBJ meshes in the "
+                            "assembled pose) as an assembly folder: assembly.toml, sizes.lp, "
+                            "geometric_precedence.lp, geometry.toml where the product is made of primitives.",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("source", type=Path, metavar="SOURCE", help="a STEP file or a folder of *.stl/*.obj meshes")
+    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="the assembly folder to write")
+    parser.add_argument("--units", choices=list(UNITS), default="mm",
+                        help="length unit of mesh files (default mm; a STEP file states its own)")
+    parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to")
+    args = parser.parse_args(argv)
+    if not args.source.exists():
+        raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
+    derived, assumed, why, seconds = run_import(args.source, args.out, args.units, args.config)
+    units = "the STEP file's" if args.source.is_file() else args.units
+    print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(assumed))
+    for line in report(derived):
+        print(line)
+    print(f"wrote {args.out}: assembly.toml, sizes.lp, geometric_precedence.lp"
+          + (", geometry.toml" if why is None else f" (no geometry.toml: {why})"))
+    print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {seconds:.2f} s")
+    return 0

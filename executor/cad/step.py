@@ -1,0 +1,119 @@
+"""STEP assemblies through Open CASCADE (``OCP``, the cadquery-ocp wheels): one part per
+leaf of the assembly tree with its name and its placement (the product of the locations
+on the path from the root), tessellated to a closed triangle mesh [m].
+
+Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
+converts to metres. A leaf without a name is named after its parent and position.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart, part_id
+
+_MM = 1e-3
+
+
+def load_step(path: Path) -> list[CadPart]:
+    """The leaves of the STEP assembly at ``path`` as parts; ExecutorError naming the file
+    when it is not a readable STEP file or holds no solid."""
+    from OCP.collections import Sequence_TDF_Label
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPCAFControl import STEPCAFControl_Reader
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+    document = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+    reader = STEPCAFControl_Reader()
+    reader.SetNameMode(True)
+    if reader.ReadFile(str(path)) != IFSelect_RetDone or not reader.Transfer(document):
+        raise ExecutorError(f"{path}: not a readable STEP file")
+    tool = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
+    roots = Sequence_TDF_Label()
+    tool.GetFreeShapes(roots)
+    leaves: list[tuple[str, Any]] = []
+    for k in range(1, roots.Length() + 1):
+        _collect(tool, roots.Value(k), None, _name(roots.Value(k)) or path.stem, leaves)
+    if not leaves:
+        raise ExecutorError(f"{path}: no solid parts in the STEP file")
+    return [CadPart(part_id(name, f"{path}#{name}"), name, _mesh(shape, f"{path}#{name}"), f"{path}#{name}")
+            for name, shape in leaves]
+
+
+def _name(label: Any) -> str:
+    from OCP.TDataStd import TDataStd_Name
+
+    attribute = TDataStd_Name()
+    if label.FindAttribute(TDataStd_Name.GetID_s(), attribute):
+        return attribute.Get().ToExtString()
+    return ""
+
+
+def _collect(tool: object, label: Any, location: Any, name: str, leaves: list[tuple[str, Any]]) -> None:
+    """Append ``(name, located shape)`` for every leaf under ``label``; ``location`` is the
+    placement of ``label`` in the product (None at a root)."""
+    from OCP.collections import Sequence_TDF_Label
+    from OCP.TDF import TDF_Label
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.XCAFDoc import XCAFDoc_ShapeTool
+
+    here = location if location is not None else TopLoc_Location()
+    referred = TDF_Label()
+    definition = referred if XCAFDoc_ShapeTool.GetReferredShape_s(label, referred) else label
+    if XCAFDoc_ShapeTool.IsAssembly_s(definition):
+        children = Sequence_TDF_Label()
+        XCAFDoc_ShapeTool.GetComponents_s(definition, children, False)
+        for k in range(1, children.Length() + 1):
+            child = children.Value(k)
+            placement = here.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(child))
+            _collect(tool, child, placement, _name(child) or _name(definition) or f"{name}_{k}", leaves)
+        return
+    shape = XCAFDoc_ShapeTool.GetShape_s(definition)
+    leaves.append((name, shape.Located(here.Multiplied(shape.Location()))))
+
+
+def _mesh(shape: Any, source: str) -> trimesh.Trimesh:
+    """The shape's faces tessellated (:data:`STEP_DEFLECTION`) into one mesh [m]."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS
+
+    BRepMesh_IncrementalMesh(shape, STEP_DEFLECTION / _MM, False, 0.1, True)
+    vertices: list[np.ndarray] = []
+    faces: list[np.ndarray] = []
+    count = 0
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        face = TopoDS.Face(explorer.Current())
+        location = TopLoc_Location()
+        triangulation = BRep_Tool.Triangulation_s(face, location)
+        explorer.Next()
+        if triangulation is None:
+            continue
+        transform = location.Transformation()
+        points = []
+        for i in range(1, triangulation.NbNodes() + 1):
+            p = triangulation.Node(i).Transformed(transform)
+            points.append((p.X(), p.Y(), p.Z()))
+        triangles = np.array([triangulation.Triangle(i).Get() for i in range(1, triangulation.NbTriangles() + 1)])
+        triangles = triangles - 1
+        if face.Orientation() == TopAbs_REVERSED:
+            triangles = triangles[:, ::-1]
+        vertices.append(np.array(points) * _MM)
+        faces.append(triangles + count)
+        count += len(points)
+    if not faces:
+        raise ExecutorError(f"{source}: the part has no faces to tessellate")
+    mesh = trimesh.Trimesh(np.vstack(vertices), np.vstack(faces), process=True)
+    mesh.merge_vertices(digits_vertex=9)
+    return mesh

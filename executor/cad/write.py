@@ -1,0 +1,228 @@
+"""The assembly folder of an imported product, in the vocabulary every command reads.
+
+- ``assembly.toml``: every part (the base with role ``base``, a part in a hole with role
+  ``peg`` and its section's kind as ``shape``, any other ``part``) with its tray ``start``,
+  every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
+- ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
+  (:func:`assembly_constraints.executor.world.geometry.passes`), closed world;
+- ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
+  section in each hole's, the input of ``sizes learn --prior cad``;
+- ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
+  from the disassembly, the input of ``precedence learn --prior`` and ``precedence count``;
+- ``geometry.toml``: the simulated cell's primitives (plate with bosses, pegs) when the
+  product is one (every part but the base a peg standing in a hole along +z, the holes'
+  entries at one height with one depth) and the cell's loader accepts it; left out
+  otherwise, and the report says why.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import clingo
+import networkx as nx
+
+from assembly_constraints.bridge.errors import ToolError
+from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
+
+DENSITY = 2700.0
+"""Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
+GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02}
+"""The simulated gripper of every imported product (Cranfield's)."""
+MIN_CHAMFER = 1e-4
+"""The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
+_LEVEL = 1e-5  # holes whose entries or depths differ by more [m] are no one plate
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What the import file states: the ``base`` part, the ``trays`` [m], part ``names``."""
+
+    base: str
+    trays: dict[str, tuple[float, float]]
+    names: dict[str, str]
+
+
+def section(name: str, shape_kind: str, a: float, b: float) -> Section:
+    return Section(name, shape_kind, a, width=b if shape_kind == "rect" else 0.0)
+
+
+def _q(value: float) -> float:
+    """Metres rounded to 0.1 µm (a printed tessellation is no finer)."""
+    return round(value, 7)
+
+
+def _size(kind: str, a: float, b: float) -> str:
+    return f"[{_q(a)}, {_q(b)}]" if kind == "rect" else f"{_q(a)}"
+
+
+def _symbols(symbols: list[clingo.Symbol]) -> str:
+    return " ".join(f"{symbol}." for symbol in symbols)
+
+
+def assembly_text(derived: Derived, settings: Settings, title: str) -> str:
+    pegs = derived.hole_of
+    lines = [f"# Imported from {title} by ./run.sh import: parts in the CAD frame (the cell frame) [m].",
+             f"name = {json.dumps(title)}", ""]
+    for pid in sorted(derived.parts):
+        role = "base" if pid == derived.base else "peg" if pid in pegs else "part"
+        lines += [f"[parts.{pid}]", f"name = {json.dumps(settings.names.get(pid, derived.parts[pid].name))}",
+                  f'role = "{role}"']
+        x, y = settings.trays[pid]
+        lines.append(f"start = [{_q(x)}, {_q(y)}]")
+        if _section_kind(pegs.get(pid)) not in (None, "other"):
+            lines.append(f'shape = "{_section_kind(pegs.get(pid))}"')
+        lines.append("")
+    for hid, fit in derived.holes.items():
+        name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
+        lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{_kind(fit.hole.kind)}"',
+                  f"position = [{_q(fit.position[0])}, {_q(fit.position[1])}]", ""]
+    return "\n".join(lines)
+
+
+def _section_kind(fit: HoleFit | None) -> str | None:
+    return None if fit is None or fit.section is None else fit.section.kind
+
+
+def _kind(kind: str) -> str:
+    """An ``other`` hole is stated as round in assembly.toml (its shape is only a label there)."""
+    return kind if kind != "other" else "round"
+
+
+def sizes_text(derived: Derived) -> str:
+    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
+            if fit.section is not None and fit.section.kind != "other"}
+    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
+             _symbols([clingo.Function("part", [clingo.Function(p)]) for p in pegs]),
+             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in holes])]
+    for pid, peg in pegs.items():
+        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, hole in holes.items()
+                if passes(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))]
+        if fits:
+            lines.append(_symbols(fits))
+    return "\n".join(lines) + "\n"
+
+
+def nominal_text(derived: Derived) -> str:
+    """``nominal_margin(P,H,M)``: the room [µm, rounded] the peg's nominal section has in
+    the hole's (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not pass)."""
+    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
+            if fit.section is not None and fit.section.kind != "other"}
+    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    lines = ["% The nominal room of every peg in every hole [um] (negative: it does not pass), by ./run.sh import;",
+             "% the input of sizes learn --prior cad."]
+    for pid, peg in pegs.items():
+        lines.append(_symbols([clingo.Function("nominal_margin", [
+            clingo.Function(pid), clingo.Function(hid),
+            clingo.Number(round(1e6 * margin(section(pid, peg.kind, peg.a, peg.b),
+                                             section(hid, hole.kind, hole.a, hole.b))))])
+            for hid, hole in holes.items()]))
+    return "\n".join(lines) + "\n"
+
+
+def precedence_text(derived: Derived) -> str:
+    graph = nx.DiGraph()
+    graph.add_nodes_from(derived.parts)
+    graph.add_edges_from(derived.edges)
+    closure = sorted(nx.transitive_closure_dag(graph).edges)
+    lines = ["% Geometric precedence by disassembly (./run.sh import): must_precede(A,B) when B blocks A's",
+             "% straight way out along A's insertion axis, or A is the base and B touches it; transitively closed.",
+             _symbols([clingo.Function("part", [clingo.Function(p)]) for p in sorted(derived.parts)])]
+    lines += [_symbols([clingo.Function("must_precede", [clingo.Function(a), clingo.Function(b)])])
+              for a, b in closure]
+    return "\n".join(lines) + "\n"
+
+
+def simulable(derived: Derived) -> str | None:
+    """Why the product is not one the simulated cell builds from primitives, None when it is."""
+    pegs = derived.hole_of
+    for pid in sorted(derived.parts):
+        if pid == derived.base:
+            continue
+        if pid not in pegs:
+            return f"part '{pid}' stands in no hole of the base"
+        if derived.axis[pid] != "+z":
+            return f"part '{pid}' goes in along {derived.axis[pid]}, not from above"
+    fits = list(derived.holes.values())
+    for fit in fits:
+        if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
+            return f"hole {fit.id} is not entered from above with a round, square or rect section"
+    if not fits:
+        return "no part stands in a hole of the base"
+    for what, values in (("entry", [f.entry for f in fits]), ("depth", [f.depth for f in fits])):
+        if max(values) - min(values) > _LEVEL:
+            return f"the holes' {what} differs by {1000 * (max(values) - min(values)):.3g} mm (one plate has one)"
+    return None
+
+
+def geometry_text(derived: Derived, settings: Settings) -> str:
+    """``geometry.toml`` of a :func:`simulable` product."""
+    fits = list(derived.holes.values())
+    base = derived.parts[derived.base].mesh
+    (x0, y0, z0), (x1, y1, _) = base.bounds
+    top, depth = fits[0].entry, fits[0].depth
+    tile = _tile(fits)
+    lines = ["# The simulated cell's primitives measured from the CAD by ./run.sh import [m].", "",
+             "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
+             f"chamfer = {_q(max(MIN_CHAMFER, *(f.chamfer for f in fits)))}  # [m] at least MIN_CHAMFER",
+             "polygon_sides = 24",
+             f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
+             f"base_thickness = {_q(max(top - depth - z0, 1e-3))}", ""]
+    for hid, fit in derived.holes.items():
+        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', f'kind = "{fit.hole.kind}"',
+                  f"size = {_size(fit.hole.kind, fit.hole.a, fit.hole.b)}"]
+        if fit.hole.yaw:
+            lines.append(f"yaw = {fit.hole.yaw:.6g}")
+        lines.append("")
+    for pid, fit in sorted(derived.hole_of.items()):
+        mesh, peg = derived.parts[pid].mesh, fit.section
+        assert peg is not None
+        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', f'kind = "{peg.kind}"',
+                  f"size = {_size(peg.kind, peg.a, peg.b)}",
+                  f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
+                  f'demo_hole = "{fit.id}"', ""]
+    lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
+              "[base]", f'part = "{derived.base}"',
+              f"tray = [{_q(settings.trays[derived.base][0])}, {_q(settings.trays[derived.base][1])}]",
+              "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}", ""]
+    return "\n".join(lines)
+
+
+def _tile(fits: list[HoleFit]) -> float:
+    """The side of the square boss around every hole [m]: the measured boss when the base
+    has one around each hole, else the largest square the holes' spacing leaves room for."""
+    bosses = [f.outer.b for f in fits if f.outer is not None and f.outer.kind in ("square", "rect")]
+    spacing = min((max(abs(a.position[0] - b.position[0]), abs(a.position[1] - b.position[1]))
+                   for i, a in enumerate(fits) for b in fits[i + 1:]), default=0.04)
+    widest = max(max(f.hole.a, f.hole.b) + 2 * f.chamfer for f in fits)
+    tile = min([*bosses, spacing, 0.04])
+    return tile if tile > widest else widest + 0.004
+
+
+def write_folder(derived: Derived, settings: Settings, title: str, out: Path) -> tuple[list[Path], str | None]:
+    """Write the files of the module docstring into ``out``; returns them and why there
+    is no ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
+    make_folder(out)
+    written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title)),
+               write_atomic(out / "sizes.lp", sizes_text(derived)),
+               write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
+               write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
+    geometry = out / "geometry.toml"
+    if geometry.exists():
+        geometry.unlink()
+    why = simulable(derived)
+    if why is None:
+        write_atomic(geometry, geometry_text(derived, settings))
+        try:
+            load_geometry(str(out))
+        except ToolError as exc:
+            geometry.unlink()
+            why = f"the cell refuses its primitives ({exc})"
+        else:
+            written.append(geometry)
+    return written, why
