@@ -33,7 +33,7 @@ def test_a_changed_type_shows_as_drift(tmp_path: Path, capsys: pytest.CaptureFix
     (tmp_path / "insert_request.schema.json").write_text(json.dumps(edited))
     capsys.readouterr()
     assert main(["--check", str(tmp_path)]) == 1
-    assert "insert_request.schema.json: differs from the message types" in capsys.readouterr().out
+    assert "insert_request.schema.json: differs from the types" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("message", [
