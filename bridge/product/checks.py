@@ -102,15 +102,15 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
             why = "has no position there" if entry is not None else "is not a hole there"
             raise fail(path, f"hole_shapes.{name}", "holes", f"holes of assembly.toml with a position ({hid} {why})",
                         hid)
+    for pid in geo.extra_parts:
+        if pid in layout.parts:
+            raise fail(path, f"extra_parts.{pid}", "start", "a part that is not in assembly.toml (this one is)",
+                        pid)
     starts = {pid for pid, part in layout.parts.items() if part.start is not None} | set(geo.extra_parts)
     for pid, name in pegs.items():
         if pid not in starts:
             raise fail(path, f"part_shapes.{name}", "parts", "parts of assembly.toml with a start, or of "
                         f"[extra_parts] ({pid} is neither)", pid)
-    for pid in geo.extra_parts:
-        if pid in layout.parts:
-            raise fail(path, f"extra_parts.{pid}", "start", "a part that is not in assembly.toml (this one is)",
-                        pid)
     positions = {hid: layout.holes[hid].position for hid in holes}
     turned = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.yaw for hid in hole_shape.holes}
     _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items() if p is not None}, turned)
