@@ -16,6 +16,9 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
   ``fits/2``; closed world);
 - ``demos.txt`` (optional): demonstrated feasible sequences;
 - ``geometry.toml`` (optional): dimensions for the simulated cell.
+
+``assembly.toml`` and ``geometry.toml`` are decoded and checked as a whole by
+:mod:`bridge.product`; :func:`load_assembly` gives the planner's view of the result.
 """
 
 from __future__ import annotations
