@@ -75,7 +75,7 @@ def _read(path: Path, what: str) -> dict[str, Any]:
     except tomllib.TOMLDecodeError as exc:
         raise BridgeError(f"{path}: not valid TOML ({exc})") from None
     except RecursionError:
-        raise BridgeError(f"{path}: nested too deeply; expected the tables of docs/geometry.md") from None
+        raise BridgeError(f"{path}: nested too deeply; expected a {what}") from None
 
 
 _MISSING = object()

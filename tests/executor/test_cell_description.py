@@ -50,6 +50,7 @@ def test_an_override_changes_only_its_keys(tmp_path: Path) -> None:
     ("[admittance]\nbound = nan\n", "[admittance] bound: expected a number in (0, 0.5] (m or rad), got nan"),
     ("thresholds = 3\n", "[thresholds]: expected a table with the keys f_stop"),
     ("[ilc\n", "not valid TOML"),
+    ("x = " + "[" * 100000 + "]" * 100000 + "\n", "nested too deeply; expected a cell description (TOML)"),
 ])
 def test_a_bad_override_is_refused_in_one_line(tmp_path: Path, text: str, message: str) -> None:
     path = tmp_path / "cell.toml"
