@@ -72,7 +72,7 @@ def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
     for name, table in geometry.part_shapes.items():
         if gripper.grasp_depth >= table.length:
             raise fail(path, f"part_shapes.{name}", "length",
-                        f"longer than [gripper] grasp_depth ({gripper.grasp_depth:g} m)", table.length)
+                       f"longer than [gripper] grasp_depth ({gripper.grasp_depth:g} m)", table.length)
 
 
 def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
@@ -89,11 +89,11 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     for name, hole_shape in geo.hole_shapes.items():
         if _sides(hole_shape.size)[0] + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
-                        "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
+                       "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():
         if part_shape.demo_hole not in holes:
             raise fail(path, f"part_shapes.{name}", "demo_hole",
-                        f"a hole of [hole_shapes.*] ({', '.join(sorted(holes))})", part_shape.demo_hole)
+                       f"a hole of [hole_shapes.*] ({', '.join(sorted(holes))})", part_shape.demo_hole)
     if geo.gripper is not None:
         check_grasp(path, geo, geo.gripper)
     for hid, name in holes.items():
@@ -101,16 +101,16 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
         if entry is None or entry.position is None:
             why = "has no position there" if entry is not None else "is not a hole there"
             raise fail(path, f"hole_shapes.{name}", "holes", f"holes of assembly.toml with a position ({hid} {why})",
-                        hid)
+                       hid)
     for pid in geo.extra_parts:
         if pid in layout.parts:
             raise fail(path, f"extra_parts.{pid}", "start", "a part that is not in assembly.toml (this one is)",
-                        pid)
+                       pid)
     starts = {pid for pid, part in layout.parts.items() if part.start is not None} | set(geo.extra_parts)
     for pid, name in pegs.items():
         if pid not in starts:
             raise fail(path, f"part_shapes.{name}", "parts", "parts of assembly.toml with a start, or of "
-                        f"[extra_parts] ({pid} is neither)", pid)
+                       f"[extra_parts] ({pid} is neither)", pid)
     positions = {hid: layout.holes[hid].position for hid in holes}
     turned = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.yaw for hid in hole_shape.holes}
     _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items() if p is not None}, turned)
@@ -184,10 +184,10 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         xmin, ymin, xmax, ymax = cover.outline
         if not (xmin < xmax and ymin < ymax):
             raise fail(path, table, "outline", "[xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax",
-                        cover.outline)
+                       cover.outline)
         if cover.socket is not None and not (0 < cover.socket[2] and 0 < cover.socket[3] < cover.thickness):
             raise fail(path, table, "socket", f"[x, y, side, depth] with side > 0 and 0 < depth < thickness "
-                        f"({cover.thickness:g} m)", cover.socket)
+                       f"({cover.thickness:g} m)", cover.socket)
         if cover.skill not in geo.part_shapes:
             raise fail(path, table, "skill", f"a part shape of [part_shapes.*] ({', '.join(skills)})", cover.skill)
     for hid, head in geo.heads.items():
@@ -196,7 +196,7 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         if cover_of is None or cover_of.socket is None:
             with_socket = sorted(c for c, t in geo.covers.items() if t.socket is not None)
             raise fail(path, table, "into", f"a cover with a socket ({', '.join(with_socket) or 'none'})",
-                        head.into)
+                       head.into)
         if head.skill not in geo.part_shapes:
             raise fail(path, table, "skill", f"a part shape of [part_shapes.*] ({', '.join(skills)})", head.skill)
         part = layout.parts.get(hid)
