@@ -194,7 +194,7 @@ def _translated(path: Path, data: dict[str, Any], kind: type, message: str) -> B
         bad = [key for key in entries if not is_id(key)] if isinstance(entries, dict) else []
         table = ".".join(names)
         return fail(path, table, "a table name", _expected(msgspec.inspect.type_info(Id)),
-                     bad[0] if bad else entries)
+                    bad[0] if bad else entries)
     segments = _segments(at, data, root)
     while segments and isinstance(segments[-1], int):  # a bad item: name its list
         segments.pop()
