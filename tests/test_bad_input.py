@@ -245,7 +245,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
          'role = "peg"\nshape = "round"', 'role = "peg"\nshape = "hex"', 1)}), 2, "shape: expected one of"),
     ("section-of-unlike-parts", ("executor", "trial", "--part", "rect8", "--hole", "slot8", "--assembly", "asm"),
      taskboard(**{"assembly.toml": (TASKBOARD / "assembly.toml").read_text().replace(
-         'shape = "rect"\n', 'shape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
+         'role = "peg"\nshape = "rect"\n', 'role = "peg"\nshape = "rect"\nsection = "slab"\n')}), 2, "scaled copies"),
     ("assembly-section-without-rect", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"assembly.toml": (CRANFIELD / "assembly.toml").read_text().replace(
          'role = "peg"\nshape = "round"', 'role = "peg"\nshape = "round"\nsection = "a"', 1)}), 2,

@@ -29,7 +29,7 @@ from typing import Any, TypeVar
 import msgspec
 
 from bridge import BridgeError
-from bridge.inputs import read_text
+from bridge.inputs import read_text, shorten
 from bridge.product.checks import check_assembly, check_geometry, check_grasp, fail, where
 from bridge.product.tables import (
     DEFAULT_COVER_CLEARANCE,
@@ -192,9 +192,9 @@ def _translated(path: Path, data: dict[str, Any], kind: type, message: str) -> B
         names = [s for s in _segments(outer, data, root) if not isinstance(s, int)]
         entries = _value_at(data, names)
         bad = [key for key in entries if not is_id(key)] if isinstance(entries, dict) else []
-        table = ".".join(names)
-        return fail(path, table, "a table name", _expected(msgspec.inspect.type_info(Id)),
-                    bad[0] if bad else entries)
+        table, key = ".".join(names), bad[0] if bad else "..."
+        return BridgeError(f"{path}: [{table}.{shorten(key)}]: expected a table name that is "
+                           f"{_expected(msgspec.inspect.type_info(Id))}, got {shorten(repr(key))}")
     segments = _segments(at, data, root)
     while segments and isinstance(segments[-1], int):  # a bad item: name its list
         segments.pop()

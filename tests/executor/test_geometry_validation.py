@@ -82,7 +82,7 @@ CASES = [
     ("unknown-key", "[plate]\n", "[plate]\ncolour = 3\n", "[plate] colour: unknown key; expected one of top_z"),
     ("unknown-table", "[base]\n", "[fixture]\nx = 1\n\n[base]\n", "fixture: unknown table or key"),
     ("table-name-not-an-id", "[part_shapes.shaft]", "[part_shapes.Shaft]",
-     "[part_shapes] a table name: expected an id (a lower-case ASP constant"),
+     "[part_shapes.Shaft]: expected a table name that is an id (a lower-case ASP constant"),
     ("cover-mass-zero", "mass = 0.05             # [kg]\ngrip", "mass = 0             # [kg]\ngrip",
      "[covers.sp] mass: expected a number in (0, 10] kg, got 0"),
     ("cover-mass-missing", "mass = 0.05             # [kg]\ngrip", "grip",
