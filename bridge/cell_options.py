@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass
+from pathlib import Path
 
 from assembly_constraints.bridge.cli_types import MAX_SEED, finite_float, int_in
 
@@ -60,6 +61,14 @@ def add_cell_arguments(parser: argparse.ArgumentParser, *, layer: bool = True, c
     for name, m in MAGNITUDES.items():
         group.add_argument(f"--{name.replace('_', '-')}", type=finite_float(0.0, m.high), default=m.default,
                            metavar="X", help=f"{m.help} (default {m.default})")
+
+
+def add_cell_description_argument(parser: argparse.ArgumentParser) -> None:
+    """``--cell-description FILE``: the cell's gripper, gains, thresholds, admittance and
+    ILC parameters overridden by a TOML file (docs/cell.md)."""
+    parser.add_argument("--cell-description", type=Path, metavar="FILE",
+                        help="TOML file overriding the cell's gripper, gains, thresholds, admittance or ILC "
+                        "parameters (docs/cell.md; default: the built-in description)")
 
 
 ASSEMBLY_UNCERTAINTIES = ("random", "cell")

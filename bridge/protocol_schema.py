@@ -1,11 +1,14 @@
 """``assembly-constraints protocol``: the JSON Schema of every Zenoh message, generated
-from the message types of :mod:`assembly_constraints.bridge.messages`.
+from the message types of :mod:`assembly_constraints.bridge.messages`, and of the product description files
+(``assembly.toml``, ``geometry.toml`` as decoded TOML), generated from the structs of
+:mod:`assembly_constraints.bridge.product`.
 
-The schemas are published in ``docs/protocol/`` (one file a message, described in
-``docs/protocol.md``) for clients in any language; a test fails when the checked-in files
-and the types drift apart. ``protocol --out docs/protocol`` rewrites them, ``protocol
---check docs/protocol`` exits 1 naming the files that differ, and without options the
-schemas are printed as one JSON object.
+The schemas are published in ``docs/protocol/`` (one file a message or product file,
+described in ``docs/protocol.md`` and ``docs/geometry.md``) for clients and editors in
+any language; a test fails when the checked-in files and the types drift apart.
+``protocol --out docs/protocol`` rewrites them, ``protocol --check docs/protocol`` exits 1
+naming the files that differ, and without options the schemas are printed as one JSON
+object.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from assembly_constraints.bridge.messages import (
     StepReply,
     StepRequest,
 )
+from assembly_constraints.bridge.product import AssemblyFile, GeometryFile
 
 MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
     "insert_request": (InsertRequest, "planner → cell, a query on cell/<id>/insert"),
@@ -38,6 +42,11 @@ MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
     "step_reply": (StepReply, "cell → planner, the reply to a step request"),
 }
 """File stem → (message type, who sends it where)."""
+PRODUCT_FILES: dict[str, tuple[type[msgspec.Struct], str]] = {
+    "assembly": (AssemblyFile, "assembly.toml of a product folder: parts, holes, the declared size model"),
+    "geometry": (GeometryFile, "geometry.toml of a product folder: the cell geometry, base, covers and heads"),
+}
+"""File stem → (struct of the decoded TOML, what the file is)."""
 
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 
@@ -52,12 +61,17 @@ def _plain(value: object) -> object:
 
 def schema(message: type[msgspec.Struct], direction: str) -> dict:
     """The JSON Schema (draft 2020-12) of one message type, self-contained (``$defs``)."""
-    generated: dict = _plain(msgspec.json.schema(message))  # type: ignore[assignment]
+    return _schema(message, f"{direction}; protocol version {PROTOCOL_VERSION}, at most {MAX_MESSAGE_BYTES} "
+                   "bytes of UTF-8 JSON")
+
+
+def _schema(kind: type[msgspec.Struct], context: str) -> dict:
+    """The self-contained JSON Schema of ``kind``, its description followed by ``context``."""
+    generated: dict = _plain(msgspec.json.schema(kind))  # type: ignore[assignment]
     name = generated["$ref"].rsplit("/", 1)[-1]
     defs = generated["$defs"]
     return {"$schema": DRAFT, "title": name,
-            "description": f"{defs[name].get('description', name)} ({direction}; protocol version "
-                           f"{PROTOCOL_VERSION}, at most {MAX_MESSAGE_BYTES} bytes of UTF-8 JSON)",
+            "description": f"{defs[name].get('description', name)} ({context})",
             **{key: value for key, value in defs[name].items() if key not in ("title", "description")},
             "$defs": {key: value for key, value in defs.items() if key != name}}
 
@@ -65,6 +79,8 @@ def schema(message: type[msgspec.Struct], direction: str) -> dict:
 def schemas() -> dict[str, str]:
     """File name → text of every published schema (sorted keys, two-space indent, newline)."""
     texts = {f"{stem}.schema.json": schema(message, direction) for stem, (message, direction) in MESSAGES.items()}
+    texts |= {f"{stem}.schema.json": _schema(kind, f"{what}; TOML, here as the JSON of its decoded tables")
+              for stem, (kind, what) in PRODUCT_FILES.items()}
     texts["protocol.json"] = {"protocol_version": PROTOCOL_VERSION, "max_message_bytes": MAX_MESSAGE_BYTES,
                               "cell_id_pattern": CELL_ID_PATTERN, "alive_pattern": ALIVE_PATTERN,
                               "keys": {"insert": "cell/<id>/insert", "ping": "cell/<id>/ping",
@@ -83,11 +99,12 @@ def drift(folder: Path) -> list[str]:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="protocol", description="Write or check the JSON Schema of every Zenoh message "
-                            "(generated from the message types); without options, print them as one JSON object.")
+                            "and product description file (generated from their types); without options, print "
+                            "them as one JSON object.")
     what = parser.add_mutually_exclusive_group()
     what.add_argument("--out", type=Path, metavar="DIR", help="write the schema files into this folder")
     what.add_argument("--check", type=Path, metavar="DIR",
-                      help="exit 1 when the schema files in this folder differ from the message types")
+                      help="exit 1 when the schema files in this folder differ from the types")
     return parser
 
 
@@ -96,7 +113,7 @@ def main(argv: Sequence[str]) -> int:
     if args.check is not None:
         stale = drift(args.check)
         for name in stale:
-            print(f"{args.check / name}: differs from the message types (regenerate: protocol --out {args.check})")
+            print(f"{args.check / name}: differs from the types (regenerate: protocol --out {args.check})")
         return 1 if stale else 0
     if args.out is not None:
         make_folder(args.out)

@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cell_options import add_cell_arguments, add_cell_description_argument
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -74,6 +74,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     from assembly_constraints.executor.cell_options import cell_keywords
     from assembly_constraints.executor.trial import Cell
 
+    keywords = cell_keywords(args)  # the cell description checked before anything is written
     logger = None
     if args.plot:
         from assembly_constraints.bridge.files import check_writable
@@ -83,7 +84,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
         from assembly_constraints.executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
-    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
+    cell = Cell(args.assembly, gui=args.gui, logger=logger, **keywords)
     try:
         results = []
         for k in range(args.trials):
@@ -132,6 +133,7 @@ def _sizes(args: argparse.Namespace) -> int:
 
 def _export(args: argparse.Namespace) -> int:
     from assembly_constraints.executor.assembly.export import export_cell
+    from assembly_constraints.executor.cell_description import load_cell_description
 
     if args.assembled:
         from assembly_constraints.executor.cad.assembled import write_assembled
@@ -140,7 +142,7 @@ def _export(args: argparse.Namespace) -> int:
         print(f"wrote {len(files) - 1} part mesh(es) in the assembled pose and import.toml in {args.out}")
         return 0
 
-    written = export_cell(args.assembly, args.out)
+    written = export_cell(args.assembly, args.out, load_cell_description(args.cell_description))
     print(f"wrote {written[0]} and {len(written) - 1} mesh file(s) in {args.out / 'meshes'}")
     return 0
 
@@ -183,6 +185,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "and the first failed attempt, against their desired profiles) to this PNG")
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     add_cell_arguments(trial)
+    add_cell_description_argument(trial)
     trial.set_defaults(func=_trial)
 
     sizes = sub.add_parser("sizes", help="write the sizes.lp (which part fits which hole) that the geometry makes")
@@ -196,6 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--assembled", action="store_true",
                         help="instead: one closed mesh per part in the assembled pose (OUT/<part>.obj, m) and "
                              "OUT/import.toml, the input of the import subcommand")
+    add_cell_description_argument(export)
     export.set_defaults(func=_export)
 
     for name, (_module, help_text) in _DELEGATED.items():

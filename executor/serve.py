@@ -48,7 +48,11 @@ import zenoh
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
+from assembly_constraints.bridge.cell_options import (
+    add_assembly_uncertainty_argument,
+    add_cell_arguments,
+    add_cell_description_argument,
+)
 from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
 from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from assembly_constraints.bridge.messages import (
@@ -406,6 +410,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
                         "save them there after every update (a session passes <run>/<cell>-ilc.json)")
     add_cell_arguments(parser)
+    add_cell_description_argument(parser)
     add_assembly_uncertainty_argument(parser)
     add_endpoint_arguments(parser)
     return parser
@@ -428,10 +433,13 @@ def main(argv: Sequence[str]) -> int:
     serves this cell id (:mod:`assembly_constraints.executor.claim`)."""
     args = build_parser().parse_args(list(argv))
     cell_id = check_cell_id(args.cell)
-    if args.backend == "sim" and args.ilc_state is not None:
-        from assembly_constraints.executor.control.ilc import read_state
+    if args.backend == "sim":  # a bad cell description or a damaged state is refused here, before the session opens
+        from assembly_constraints.executor.cell_description import load_cell_description
+        from assembly_constraints.executor.control.ilc import offset_bound, read_state
 
-        read_state(args.ilc_state)  # a damaged state is refused here, before the session opens
+        description = load_cell_description(args.cell_description)
+        if args.ilc_state is not None:
+            read_state(args.ilc_state, description.ilc, offset_bound(description.admittance))
     listen = cell_listen(args.listen, args.connect, args.zenoh_config)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)

@@ -23,8 +23,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.controller import ImpedanceController
-from assembly_constraints.executor.control.detector import Detector, Thresholds
+from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
 from assembly_constraints.executor.control.motion import Motion
 from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
@@ -61,18 +62,20 @@ class Cell:
     ``layer``: the execution layer (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
     ``perturbation``/``cell_seed``: the cell's uncertainty and the seed of its systematic
     part; ``ilc_state``: a JSON file the ILC corrections are read from (if it exists) and
-    saved to after every update."""
+    saved to after every update; ``description``: the cell's gripper, gains, thresholds,
+    admittance and ILC parameters (default :class:`CellDescription`)."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 thresholds: Thresholds | None = None, *, layer: str | ExecutionLayer = "full",
-                 perturbation: PerturbationModel | None = None, cell_seed: int = 0,
-                 ilc_state: Path | None = None) -> None:
-        self.geometry = load_geometry(assembly)
+                 *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
+                 cell_seed: int = 0, ilc_state: Path | None = None,
+                 description: CellDescription | None = None) -> None:
+        self.description = CellDescription() if description is None else description
+        self.geometry = load_geometry(assembly, self.description)
         if gui:
             require_display()
         self.gui = gui
         self.logger = logger
-        self.thresholds = Thresholds() if thresholds is None else thresholds
+        self.thresholds = self.description.thresholds
         self.ilc_state = ilc_state
         self.reset_state(layer=layer, perturbation=perturbation, cell_seed=cell_seed)
         self._skills: dict[str, Skill] = {}
@@ -91,7 +94,8 @@ class Cell:
         systematic errors, the ILC corrections of ``ilc_state`` (if it exists) or none."""
         self.layer = layer_named(layer) if isinstance(layer, str) else layer
         self.bias = CellBias(PerturbationModel() if perturbation is None else perturbation.check(), cell_seed)
-        self.ilc = Ilc()
+        d = self.description
+        self.ilc = Ilc(d.ilc, d.gains, d.admittance)
         if self.ilc_state is not None:
             self.ilc.load(self.ilc_state)
 
@@ -116,7 +120,8 @@ class Cell:
             scene = Scene(self.geometry, spec.shape, gui=self.gui and not self._scenes)
             self._scenes[spec.shape] = scene
             arm = Arm(scene.client, scene.robot)
-            self._motions[spec.shape] = Motion(ImpedanceController(arm, scene.client), self.logger)
+            self._motions[spec.shape] = Motion(ImpedanceController(arm, scene.client, self.description.gains),
+                                               self.logger)
         scene.hold(spec)
         if self.logger is not None:
             if spec.shape not in self._arms:
@@ -173,7 +178,7 @@ class Cell:
         correction, iteration = self.ilc.correction(key) if layer.ilc else (None, 0)
         self._scenes[spec.shape].set_friction(setup.friction)
         arm.set_grasp_error(setup.grasp_offset, rotvec_quat_xyzw(setup.grasp_tilt))
-        surface = float(self.geometry.plate["top_z"])
+        surface = self.geometry.plate.top_z
         est_xy = np.array(hole_spec.position) + setup.vision_error
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + setup.vision_yaw)
         quat = tool_quat(yaw)
@@ -188,9 +193,10 @@ class Cell:
             self.logger.log_search_path(found.path)
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
-        lever = spec.length - float(self.geometry.gripper["grasp_depth"])
-        result = insert_in_layer(motion, skill, origin, detector, layer, lever, wiggle_enabled, correction,
-                                 yaw=yaw, yaw_compliant=needs_yaw_compliance(spec.kind, hole_spec.kind))
+        lever = spec.length - self.geometry.gripper.grasp_depth
+        result = insert_in_layer(motion, skill, origin, detector, layer, lever, description=self.description,
+                                 wiggle_enabled=wiggle_enabled, correction=correction, yaw=yaw,
+                                 yaw_compliant=needs_yaw_compliance(spec.kind, hole_spec.kind))
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

@@ -59,7 +59,7 @@ def write_product(folder: Path, n: int, seed: int) -> dict[str, list[str]]:
                                                                  -0.1 + 0.04 * (k // columns)]}))
     (folder / "assembly.toml").write_text("".join(layout), encoding="utf-8")
     template = tomllib.loads(_TEMPLATE.read_text(encoding="utf-8"))
-    geometry = [_toml_table("plate", template["plate"]), _toml_table("gripper", template["gripper"])]
+    geometry = [_toml_table("plate", template["plate"])]
     for hole in sorted(holes):
         geometry.append(_toml_table(f"hole_shapes.{hole}", {"holes": [hole], "kind": "round",
                                                             "size": round(hole_size[hole], 6)}))

@@ -27,15 +27,20 @@ from assembly_constraints.bridge.inputs import read_bytes
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.assembly.product import load_product
 from assembly_constraints.executor.assembly.world import AssemblyWorld
+from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.world.scene import link_frame
 
 _BASE = -1
 
 
-def export_cell(assembly: str, out: Path) -> list[Path]:
-    """Write ``out/cell.urdf`` and ``out/meshes/*`` for ``assembly``; returns the files."""
+def export_cell(assembly: str, out: Path, description: CellDescription | None = None) -> list[Path]:
+    """Write ``out/cell.urdf`` and ``out/meshes/*`` for ``assembly`` with the gripper of
+    the cell ``description`` (default :class:`CellDescription`) unless the product has its
+    own; returns the files."""
+    description = CellDescription() if description is None else description
+    product = load_product(assembly, description)
     meshes = make_folder(Path(out) / "meshes")
-    world = AssemblyWorld(load_product(assembly))
+    world = AssemblyWorld(product, gains=description.gains)
     try:
         written: list[Path] = []
         arm = _arm_links(world, meshes, written)

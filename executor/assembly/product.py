@@ -11,14 +11,14 @@ upright, so quaternions are the identity.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.product import Cover
 from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, load_geometry
 
 Vec3 = tuple[float, float, float]
@@ -93,7 +93,7 @@ class Product:
 
     @property
     def top_z(self) -> float:
-        return float(self.geometry.plate["top_z"])
+        return self.geometry.plate.top_z
 
     @property
     def parts(self) -> list[str]:
@@ -132,86 +132,43 @@ def rect_minus_squares(outline: tuple[float, float, float, float],
     return rects
 
 
-def _pair(table: dict, key: str, where: str) -> tuple[float, float]:
-    value = table.get(key)
-    if not (isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value)):
-        raise ExecutorError(f"{where}: {key}: expected [x, y] in m, got {shorten(repr(value))}")
-    return float(value[0]), float(value[1])
-
-
-def _number(table: dict, key: str, where: str, default: float | None = None) -> float:
-    value = table.get(key, default)
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value < 0:
-        raise ExecutorError(f"{where}: {key}: expected a number >= 0, got {shorten(repr(value))}")
-    return float(value)
-
-
-def _cover(cid: str, table: dict, geometry: CellGeometry, where: str) -> CoverSpec:
-    over = table.get("over")
-    if not (isinstance(over, list) and over and all(h in geometry.holes for h in over)):
-        raise ExecutorError(f"{where}: over: expected a list of holes of the plate "
-                            f"({', '.join(sorted(geometry.holes))}), got {shorten(repr(over))}")
-    outline = table.get("outline")
-    if not (isinstance(outline, list) and len(outline) == 4 and outline[0] < outline[2] and outline[1] < outline[3]):
-        raise ExecutorError(f"{where}: outline: expected [xmin, ymin, xmax, ymax] in m, got {shorten(repr(outline))}")
-    thickness = _number(table, "thickness", where)
-    clearance = _number(table, "clearance", where, 0.003)
-    centre = np.mean([geometry.holes[h].position for h in over], axis=0)
-    openings = [(*(np.array(geometry.holes[h].position) - centre), geometry.holes[h].size + clearance)
-                for h in over]
-    socket = table.get("socket")
-    if socket is not None and not (isinstance(socket, list) and len(socket) == 4):
-        raise ExecutorError(f"{where}: socket: expected [x, y, side, depth] in m, got {shorten(repr(socket))}")
+def _cover(cid: str, table: Cover, geometry: CellGeometry) -> CoverSpec:
+    """A checked ``[covers.<id>]`` table (:mod:`assembly_constraints.bridge.product`): its solid is the outline
+    minus square openings (each hole's size + clearance, and the socket)."""
+    centre = np.mean([geometry.holes[h].position for h in table.over], axis=0)
+    openings = [(*(np.array(geometry.holes[h].position) - centre), geometry.holes[h].size + table.clearance)
+                for h in table.over]
+    socket = None if table.socket is None else (table.socket[0], table.socket[1], table.socket[2], table.socket[3])
     if socket is not None:
-        openings.append((float(socket[0]), float(socket[1]), float(socket[2])))
-    half_t = thickness / 2
-    xmin, ymin, xmax, ymax = map(float, outline)
+        openings.append(socket[:3])
+    half_t = table.thickness / 2
+    xmin, ymin, xmax, ymax = table.outline
     boxes = [Box(((x0 + x1) / 2, (y0 + y1) / 2, half_t), ((x1 - x0) / 2, (y1 - y0) / 2, half_t))
              for x0, y0, x1, y1 in rect_minus_squares((xmin, ymin, xmax, ymax), openings)]
     if socket is not None:  # the socket's floor
-        floor = (thickness - float(socket[3])) / 2
-        boxes.append(Box((float(socket[0]), float(socket[1]), floor), (socket[2] / 2, socket[2] / 2, floor)))
-    return CoverSpec(cid, tuple(over), tuple(boxes), thickness, _number(table, "bottom", where, 0.0),
-                     _number(table, "mass", where), _pair(table, "grip", where), _pair(table, "tray", where),
-                     str(table.get("skill", "")),
-                     None if socket is None else (float(socket[0]), float(socket[1]), float(socket[2]),
-                                                  float(socket[3])))
+        floor = (table.thickness - socket[3]) / 2
+        boxes.append(Box((socket[0], socket[1], floor), (socket[2] / 2, socket[2] / 2, floor)))
+    return CoverSpec(cid, tuple(table.over), tuple(boxes), table.thickness, table.bottom, table.mass,
+                     (table.grip[0], table.grip[1]), (table.tray[0], table.tray[1]), table.skill, socket)
 
 
-def load_product(assembly: str = "cranfield") -> Product:
-    """The product of an assembly folder; ExecutorError naming the table and key when the
-    ``[base]``, ``[covers.*]`` or ``[heads.*]`` tables are missing or malformed, or a part of
-    ``assembly.toml`` has no geometry."""
-    from assembly_constraints.executor.world.geometry import _read_toml  # one reader of the file
-
-    geometry = load_geometry(assembly)
-    path = geometry.folder / "geometry.toml"
-    geo = _read_toml(path)
-    base = geo.get("base")
-    if not isinstance(base, dict) or not isinstance(base.get("part"), str):
-        raise ExecutorError(f"{path}: no [base] table with part = \"<id>\" (see docs/geometry.md)")
-    where = f"{path}: [base]"
-    base_spec = BaseSpec(base["part"], _pair(base, "tray", where), _pair(base, "grip", where),
-                         _number(base, "mass", where))
-    covers = {cid: _cover(cid, t, geometry, f"{path}: [covers.{cid}]") for cid, t in geo.get("covers", {}).items()}
-    from assembly_constraints.bridge.assembly import load_assembly
-
-    layout = load_assembly(assembly)
-    starts = {p.id: p.start for p in layout.parts}
+def load_product(assembly: str = "cranfield", description: CellDescription | None = None) -> Product:
+    """The product of an assembly folder with the gripper of the cell ``description``
+    unless ``geometry.toml`` has its own (:func:`assembly_constraints.executor.world.geometry.load_geometry`:
+    the whole description checked); ExecutorError when it has no ``[base]`` table."""
+    geometry = load_geometry(assembly, description)
+    tables, path = geometry.tables, geometry.folder / "geometry.toml"
+    if tables.base is None:
+        raise ExecutorError(f"{path}: no [base] table with part = \"<id>\"; expected the whole product "
+                            "(see docs/geometry.md)")
+    base = BaseSpec(tables.base.part, (tables.base.tray[0], tables.base.tray[1]),
+                    (tables.base.grip[0], tables.base.grip[1]), tables.base.mass)
+    covers = {cid: _cover(cid, table, geometry) for cid, table in tables.covers.items()}
+    starts = {p.id: p.start for p in geometry.layout.parts}
     heads: dict[str, HeadSpec] = {}
-    for hid, t in geo.get("heads", {}).items():
-        where = f"{path}: [heads.{hid}]"
-        if t.get("into") not in covers or covers[t["into"]].socket is None:
-            raise ExecutorError(f"{where}: into: expected a cover with a socket, got {shorten(repr(t.get('into')))}")
-        start = starts.get(hid)
-        if start is None:
-            raise ExecutorError(f"{where}: part '{hid}' has no start in assembly.toml")
-        heads[hid] = HeadSpec(hid, t["into"], str(t.get("kind", "round")), _number(t, "size", where),
-                              _number(t, "length", where), _number(t, "mass", where), start, str(t.get("skill", "")))
+    for hid, head in tables.heads.items():
+        start = starts[hid]
+        assert start is not None  # the loader checked that every head has a start
+        heads[hid] = HeadSpec(hid, head.into, head.kind, head.size, head.length, head.mass, start, head.skill)
     pegs = {pid: spec for pid, spec in geometry.parts.items() if pid in starts}
-    product = Product(geometry, base_spec, pegs, covers, heads)
-    missing = sorted(set(starts) - set(product.parts))
-    if missing:
-        raise ExecutorError(f"{path}: part(s) {', '.join(missing)} of assembly.toml have no geometry "
-                            "(expected a [part_shapes.*], [covers.*], [heads.*] or [base] entry)")
-    return product
+    return Product(geometry, base, pegs, covers, heads)

@@ -36,8 +36,8 @@ def _part_solids(world: AssemblyWorld, part: str) -> list[rr.AsComponents]:
     color = [200, 150, 60]
     if part == p.base.id:
         plate = p.geometry.plate
-        (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
-        top = float(plate["top_z"])
+        (sx, sy), (cx, cy) = plate.base_size, plate.base_center
+        top = plate.top_z
         return [rr.Boxes3D(half_sizes=[[sx / 2, sy / 2, top / 2]], centers=[[cx, cy, top / 2]],
                            colors=[[150, 160, 175]], fill_mode="solid")]
     if part in p.covers:

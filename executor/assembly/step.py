@@ -42,7 +42,8 @@ from assembly_constraints.executor.assembly.product import Product
 from assembly_constraints.executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
 from assembly_constraints.executor.assembly.world import AssemblyWorld
 from assembly_constraints.executor.backend_plugin import check_step
-from assembly_constraints.executor.control.detector import Detector, Thresholds
+from assembly_constraints.executor.cell_description import CellDescription
+from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from assembly_constraints.executor.control.motion import StepLogger
 from assembly_constraints.executor.evidence import AttemptSetup
@@ -107,17 +108,19 @@ def check_product_step(product: Product, part: str, hole: str | None, placed: Co
 class Assembler:
     """The assembling cell: one :class:`AssemblyWorld` kept between steps."""
 
-    def __init__(self, product: Product, logger: StepLogger | None = None,
-                 thresholds: Thresholds | None = None, *, uncertainty: CellBias | None = None,
-                 layer: ExecutionLayer = DEFAULT_LAYER, ilc: Ilc | None = None) -> None:
-        """``uncertainty``: the errors of each execution (default :data:`ASSEMBLY_UNCERTAINTY`);
-        ``layer``: the insertion's execution layer; ``ilc``: the corrections its ILC uses and
-        updates (kept by the caller, e.g. across plan runs; required when ``layer.ilc``)."""
+    def __init__(self, product: Product, logger: StepLogger | None = None, *, description: CellDescription,
+                 uncertainty: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER,
+                 ilc: Ilc | None = None) -> None:
+        """``description``: the cell's gains, thresholds and admittance (the product was
+        loaded with its gripper); ``uncertainty``: the errors of each execution (default
+        :data:`ASSEMBLY_UNCERTAINTY`); ``layer``: the insertion's execution layer; ``ilc``:
+        the corrections its ILC uses and updates (kept by the caller, e.g. across plan
+        runs; required when ``layer.ilc``)."""
         if layer.ilc and ilc is None:
             raise ExecutorError(f"execution layer '{layer.name}' needs an ILC state")
-        self.product = product
-        self.world = AssemblyWorld(product, logger)
-        self.thresholds = Thresholds() if thresholds is None else thresholds
+        self.product, self.description = product, description
+        self.world = AssemblyWorld(product, logger, gains=description.gains)
+        self.thresholds = description.thresholds
         self._skills: dict[str, Skill] = {}
         self.placed: set[str] = set()
         self._screwed: dict[str, int] = {}
@@ -156,11 +159,11 @@ class Assembler:
             holes = ", ".join(sorted(self.product.geometry.holes))
             raise ExecutorError(f"unknown hole '{hole}' (expected one of {holes})")
         plate = self.product.geometry.plate
-        depth = float(plate["tile_thickness"]) - 0.005
+        depth = plate.tile_thickness - 0.005
         a, b = spec.sides
         half = [a / 2 - 0.0002, b / 2 - 0.0002, depth / 2]
         col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.world.client)
-        bottom = self.product.top_z - float(plate["tile_thickness"])
+        bottom = self.product.top_z - plate.tile_thickness
         pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], yaw_quat(spec.yaw),
                            physicsClientId=self.world.client)
         self.blocked.add(hole)
@@ -253,7 +256,7 @@ class Assembler:
             return np.array([goal[0], goal[1], p.top_z + APPROACH_HEIGHT])
         if skill == "insert_over":
             plate = p.geometry.plate
-            pins_top = p.top_z + max(s.length for s in p.pegs.values()) - float(plate["tile_thickness"])
+            pins_top = p.top_z + max(s.length for s in p.pegs.values()) - plate.tile_thickness
             return np.array([goal[0], goal[1], pins_top + ABOVE_PINS])
         head = p.heads[part]
         cover = p.covers[head.into]
@@ -291,8 +294,8 @@ class Assembler:
             pb.changeDynamics(plate, -1, lateralFriction=setup.friction / PART_FRICTION, physicsClientId=world.client)
         compliant = skill == "insert" and hole is not None and needs_yaw_compliance(
             p.pegs[part].kind, p.geometry.holes[hole].kind)
-        result = insert_in_layer(motion, skill_obj, origin, detector, layer, lever, True, correction, yaw=yaw,
-                                 yaw_compliant=compliant)
+        result = insert_in_layer(motion, skill_obj, origin, detector, layer, lever, description=self.description,
+                                 correction=correction, yaw=yaw, yaw_compliant=compliant)
         pb.changeDynamics(plate, -1, lateralFriction=PART_FRICTION, physicsClientId=world.client)
         if result.reached and result.trace is not None and self.ilc is not None:
             self.ilc.update(key, result.trace)

@@ -18,6 +18,7 @@ from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.assembly.product import Product, load_product
 from assembly_constraints.executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
 from assembly_constraints.executor.backend_plugin import check_run
+from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc
 
 if TYPE_CHECKING:
@@ -36,12 +37,16 @@ class AssemblyRunner:
     """One assembling world at a time, keyed by the plan run's id."""
 
     def __init__(self, assembly: str, blocked: Sequence[str] = (), recorder: AssemblyRecorder | None = None, *,
-                 uncertainty: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER) -> None:
+                 uncertainty: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER,
+                 description: CellDescription | None = None) -> None:
         """``uncertainty``/``layer``: the cell's (``--uncertainty cell``), else the assembling
-        cell's own (:class:`Assembler`); with an ILC layer one :class:`Ilc` serves every run."""
-        self.product: Product = load_product(assembly)
+        cell's own (:class:`Assembler`); with an ILC layer one :class:`Ilc` serves every run;
+        ``description``: the cell's gripper, gains, thresholds, admittance and ILC
+        parameters (default :class:`CellDescription`)."""
+        self.description = d = CellDescription() if description is None else description
+        self.product: Product = load_product(assembly, d)
         self.uncertainty, self.layer = uncertainty, layer
-        self.ilc = Ilc() if layer.ilc else None
+        self.ilc = Ilc(d.ilc, d.gains, d.admittance) if layer.ilc else None
         self.blocked = list(blocked)
         for hole in self.blocked:
             if hole not in self.product.geometry.holes:
@@ -55,7 +60,8 @@ class AssemblyRunner:
         """The world of plan run ``run`` (a fresh one for a new run)."""
         if self._assembler is None or run != self._run:
             self.close()
-            self._assembler = Assembler(self.product, self.recorder, uncertainty=self.uncertainty,
+            self._assembler = Assembler(self.product, self.recorder, description=self.description,
+                                        uncertainty=self.uncertainty,
                                         layer=self.layer, ilc=self.ilc)
             if self.recorder is not None:
                 self.recorder.attach(self._assembler.world)

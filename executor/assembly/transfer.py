@@ -9,8 +9,8 @@ hole's estimated yaw; ``Motion.tool_yaw`` is where it stands)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 
+import msgspec
 import numpy as np
 
 from assembly_constraints.executor.control.motion import Motion
@@ -34,7 +34,8 @@ def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] |
     (speed below ``tolerance`` per 0.1 s), or ``settle`` [s] has passed."""
     controller = motion.controller
     gains = controller.gains
-    controller.gains = replace(gains, d_trans=DAMPING_FACTOR * gains.d_trans, d_rot=DAMPING_FACTOR * gains.d_rot)
+    controller.gains = msgspec.structs.replace(gains, d_trans=DAMPING_FACTOR * gains.d_trans,
+                                               d_rot=DAMPING_FACTOR * gains.d_rot)
     try:
         _track(motion, goal, after_step, speed, settle, tolerance, motion.tool_yaw if yaw is None else yaw)
     finally:

@@ -20,6 +20,7 @@ import pybullet_data
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.assembly.product import Product, rect_minus_squares
 from assembly_constraints.executor.control.controller import ImpedanceController
+from assembly_constraints.executor.control.gains import ImpedanceGains
 from assembly_constraints.executor.control.motion import Motion, StepLogger
 from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
@@ -56,7 +57,8 @@ def _compound(client: int, boxes: list[tuple[tuple, tuple]], mass: float, rgba: 
 class AssemblyWorld:
     """The cell of :class:`Product` ``product``: bodies, frames, goal and current poses."""
 
-    def __init__(self, product: Product, logger: StepLogger | None = None) -> None:
+    def __init__(self, product: Product, logger: StepLogger | None = None, *, gains: ImpedanceGains) -> None:
+        """``gains``: the controller's (the cell description's compliant impedance)."""
         self.product = product
         geometry = product.geometry
         self.client = pb.connect(pb.DIRECT)
@@ -80,7 +82,7 @@ class AssemblyWorld:
         self.reset_tray()
         self.rest()
         self._build_arm()
-        self.motion = Motion(ImpedanceController(self.arm, c), logger)
+        self.motion = Motion(ImpedanceController(self.arm, c, gains), logger)
         self.arm.inverse_kinematics(HOME, TOOL_DOWN_QUAT_XYZW)
         self.motion.controller.reset()
         self.settle(0.2)
@@ -88,8 +90,8 @@ class AssemblyWorld:
     # --- building -------------------------------------------------------------------
     def _build_base(self) -> None:
         p, plate = self.product, self.product.geometry.plate
-        tiles = [(*h.position, float(plate["tile_size"])) for h in p.geometry.holes.values()]
-        (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
+        tiles = [(*h.position, plate.tile_size) for h in p.geometry.holes.values()]
+        (sx, sy), (cx, cy) = plate.base_size, plate.base_center
         deck = rect_minus_squares((cx - sx / 2, cy - sy / 2, cx + sx / 2, cy + sy / 2), tiles)
         body = load_plate(self.client, p.geometry, p.geometry.assets / "plate.obj", deck)
         grip_xy = np.array([cx, cy]) + p.base.grip
@@ -98,7 +100,7 @@ class AssemblyWorld:
         self._tray[p.base.id] = np.array([p.base.tray[0] - cx, p.base.tray[1] - cy, 0.0])
 
     def _build_pegs(self) -> None:
-        grasp_depth = float(self.product.geometry.gripper["grasp_depth"])
+        grasp_depth = self.product.geometry.gripper.grasp_depth
         for pid, spec in sorted(self.product.pegs.items()):
             body = pb.loadURDF(str(self.product.geometry.assets / f"part_{spec.shape}.urdf"),
                                basePosition=(*spec.start, 0.0), flags=pb.URDF_USE_IMPLICIT_CYLINDER,
@@ -131,7 +133,7 @@ class AssemblyWorld:
                                            rgbaColor=(0.8, 0.3, 0.3, 1), physicsClientId=c)
             body = pb.createMultiBody(baseMass=head.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
                                       baseInertialFramePosition=[0, 0, half], physicsClientId=c)
-            grip = min(float(self.product.geometry.gripper["grasp_depth"]), head.length / 2)
+            grip = min(self.product.geometry.gripper.grasp_depth, head.length / 2)
             self.frames[hid] = PartFrames(body, np.array([0.0, 0.0, head.length - grip]), np.zeros(3))
             self._tray[hid] = np.array([*head.start, 0.0])
             sx, sy, _, depth = self.product.covers[head.into].socket or (0.0, 0.0, 0.0, 0.0)
@@ -141,7 +143,7 @@ class AssemblyWorld:
 
     def _build_arm(self) -> None:
         gripper = self.product.geometry.gripper
-        grasp_depth = float(gripper["grasp_depth"])
+        grasp_depth = gripper.grasp_depth
         tool = PartSpec("tool", "round", 0.02, shape="gripper", length=grasp_depth, mass=0.05, start=(0.0, 0.0),
                         demo_hole="")
         self.arm_urdf = arm_urdf_text(tool, gripper)
@@ -166,7 +168,7 @@ class AssemblyWorld:
         """A peg's goal: standing on the bottom of ``hole``."""
         plate = self.product.geometry.plate
         self.goals[part] = np.array([*self.product.geometry.holes[hole].position,
-                                     self.product.top_z - float(plate["tile_thickness"])])
+                                     self.product.top_z - plate.tile_thickness])
 
     def lock(self, part: str) -> None:
         """Lock a placed peg in its hole: fixed where it rests, its contacts with the plate

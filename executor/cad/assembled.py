@@ -22,6 +22,7 @@ import trimesh
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.executor.assembly.product import load_product
 from assembly_constraints.executor.assembly.world import AssemblyWorld
+from assembly_constraints.executor.cell_description import load_cell_description
 from assembly_constraints.executor.world.geometry import passes
 from assembly_constraints.executor.world.scene import link_frame
 
@@ -63,8 +64,8 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
     boss leaves the corners of its square open, as in the cell."""
     geometry = world.product.geometry
     plate = geometry.plate
-    top, tile, depth = float(plate["top_z"]), float(plate["tile_size"]), float(plate["tile_thickness"])
-    (sx, sy), (cx, cy) = plate["base_size"], plate["base_center"]
+    top, tile, depth = plate.top_z, plate.tile_size, plate.tile_thickness
+    (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     block = trimesh.creation.box((sx, sy, top))
     block.apply_translation((cx, cy, top / 2))
     tiles = []
@@ -83,7 +84,7 @@ def part_meshes(assembly: str) -> tuple[dict[str, trimesh.Trimesh], str, dict[st
     """Every part's closed mesh in the assembled pose [m], the base's id, the trays [m]
     (the base's: its plate's centre) and the heads' parts."""
     product = load_product(assembly)
-    world = AssemblyWorld(product)
+    world = AssemblyWorld(product, gains=load_cell_description(None).gains)
     try:
         turns: dict[str, tuple[float, ...]] = {}
         for pid, hole in _peg_holes(world).items():

@@ -37,7 +37,7 @@ import numpy as np
 from assembly_constraints.bridge.progress import progress
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.campaign.pairs import campaign_pairs
-from assembly_constraints.executor.control.detector import Thresholds
+from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.ilc import LAYERS
 from assembly_constraints.executor.world.perturbation import PerturbationModel
 
@@ -68,11 +68,10 @@ def _first_force(result: dict[str, Any]) -> float:
     return float(result["evidence"][0]["max_force_dev"])
 
 
-def variant_row(name: str, rows: Sequence[tuple[bool, int, dict[str, Any]]],
-                f_stop: float = Thresholds().f_stop) -> dict[str, Any]:
+def variant_row(name: str, rows: Sequence[tuple[bool, int, dict[str, Any]]], f_stop: float) -> dict[str, Any]:
     """One variant's line of the table from its trials' JSON (``rows``: whether the pair
     fits, execution index, the trial).  ``force_past_stop``: the share of all attempts on
-    fitting pairs whose sustained force deviation reached F_stop (eq. 6), the wiggle's
+    fitting pairs whose sustained force deviation reached ``f_stop`` [N] (eq. 6), the wiggle's
     and the retry's work included: how often this layer let the contact forces grow to
     where the cell would stop."""
     fitting = [r for fit, _, r in rows if fit]
@@ -127,16 +126,17 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
 
     full, without = per_execution("full"), per_execution("pi_phase_stop")
     floor = [_first_force(r) for _, _, r in by_variant[FLOOR]]
+    f_stop = CellDescription().thresholds.f_stop  # the cells of the ablation have the built-in description
     return {
         "trials": trials, "seed": seed, "executions_per_cell": executions, "perturbation": asdict(model),
-        "variants": [variant_row(name, by_variant[name]) for name in LAYERS],
+        "variants": [variant_row(name, by_variant[name], f_stop) for name in LAYERS],
         "ilc": {
             "executions": list(range(1, executions + 1)),
             "max_force_dev_median": [statistics.median(map(_first_force, rs)) for rs in full],
             "first_attempt": [sum(r["outcome"] == "fit" and r["attempts"] == 1 for r in rs) / len(rs) for rs in full],
             "without_ilc_max_force_dev_median": [statistics.median(map(_first_force, rs)) for rs in without],
             "random_only_floor_max_force_dev_median": statistics.median(floor),
-            "random_only_first_attempt": variant_row(FLOOR, by_variant[FLOOR])["fitting_first_attempt"],
+            "random_only_first_attempt": variant_row(FLOOR, by_variant[FLOOR], f_stop)["fitting_first_attempt"],
             "by_pair": pair_medians("full"),
             "by_pair_without_ilc": pair_medians("pi_phase_stop"),
         },

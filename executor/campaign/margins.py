@@ -14,11 +14,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+import msgspec
+
+from assembly_constraints.bridge.cell_options import add_cell_arguments, add_cell_description_argument
 from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT
 from assembly_constraints.executor.cell_options import cell_keywords
-from assembly_constraints.executor.control.detector import Thresholds
 from assembly_constraints.executor.trial import Cell, trial_rng
 
 
@@ -28,8 +29,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="first seed")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     add_cell_arguments(parser)
+    add_cell_description_argument(parser)
     args = parser.parse_args(argv)
-    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf), **cell_keywords(args))
+    keywords = cell_keywords(args)
+    described = keywords["description"]
+    keywords["description"] = msgspec.structs.replace(described, thresholds=msgspec.structs.replace(
+        described.thresholds, f_stop=math.inf, m_stop=math.inf))
+    cell = Cell(**keywords)
     pairs = args.pairs or [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     try:
         for part, hole in pairs:  # an unknown part or hole is an error before any trial runs

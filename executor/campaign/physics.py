@@ -68,8 +68,8 @@ def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, 
     try:
         scene.hold(spec)
         arm = Arm(scene.client, scene.robot)
-        top = float(geometry.plate["top_z"])
-        depth = float(geometry.plate["tile_thickness"])
+        top = geometry.plate.top_z
+        depth = geometry.plate.tile_thickness
         center = np.array([*hole_spec.position, top])
         _hold(scene, arm, center + [0.0, 0.0, 0.03])
         for _ in range(200):

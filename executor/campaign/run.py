@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cell_options import add_cell_arguments, add_cell_description_argument
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -75,7 +75,7 @@ function or a ``functools.partial`` of one)."""
 
 class CellRunner:
     """A :class:`assembly_constraints.executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
-    ``keywords``: the Cell's options (layer, perturbation, cell seed)."""
+    ``keywords``: the Cell's options (layer, perturbation, cell seed, description)."""
 
     def __init__(self, assembly: str, **keywords: Any) -> None:
         from assembly_constraints.executor.trial import Cell
@@ -225,6 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
     parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
     add_cell_arguments(parser)
+    add_cell_description_argument(parser)
     return parser
 
 
@@ -232,6 +233,7 @@ def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
     args = build_parser().parse_args(list(argv))
     pairs = select_pairs(args.pairs)
+    keywords = cell_keywords(args)  # the cell description checked before anything is written
     if args.plot:  # before the campaign, which takes minutes
         from assembly_constraints.bridge.files import check_writable, make_folder
 
@@ -239,7 +241,7 @@ def main(argv: Sequence[str]) -> int:
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.jobs,
-            functools.partial(CellRunner, args.assembly, **cell_keywords(args)),
+            functools.partial(CellRunner, args.assembly, **keywords),
         )
         report = campaign_report(run, args.seed, args.jobs)
         if args.plot:

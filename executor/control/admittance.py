@@ -21,13 +21,16 @@ Integrated with semi-implicit Euler at the control rate.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import Annotated
 
+import msgspec
 import numpy as np
 
+Positive = Annotated[float, msgspec.Meta(gt=0.0, le=1e6, description="a number in (0, 1e6]")]
+Bound = Annotated[float, msgspec.Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] (m or rad)")]
 
-@dataclass(frozen=True)
-class AdmittanceParams:
+
+class AdmittanceParams(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """Translation: mass [kg], damping [N·s/m], stiffness [N/m], bound [m];
     rotation: inertia [kg·m²], damping [Nm·s/rad], stiffness [Nm/rad], bound [rad].
     Natural frequency ≈ 30 rad/s, critically damped; ``integral_gain`` K_i [1/s] of
@@ -35,23 +38,23 @@ class AdmittanceParams:
     axis has the rotation's inertia, damping and stiffness and its own bound [rad] (4°:
     twice the cell's largest yaw error of the vision, ``--vision-yaw-max``)."""
 
-    mass: float = 1.5
-    damping: float = 90.0
-    stiffness: float = 1350.0
-    bound: float = 0.002
-    inertia: float = 0.011
-    rot_damping: float = 0.66
-    rot_stiffness: float = 10.0
-    rot_bound: float = 0.035
-    integral_gain: float = 2.0
-    yaw_bound: float = 0.07
+    mass: Positive = 1.5
+    damping: Positive = 90.0
+    stiffness: Positive = 1350.0
+    bound: Bound = 0.002
+    inertia: Positive = 0.011
+    rot_damping: Positive = 0.66
+    rot_stiffness: Positive = 10.0
+    rot_bound: Bound = 0.035
+    integral_gain: Annotated[float, msgspec.Meta(ge=0.0, le=1000.0, description="a number in [0, 1000] 1/s")] = 2.0
+    yaw_bound: Bound = 0.07
 
 
 class Admittance:
     """State δ = (dx, dy, rx, ry) with velocities, and rz with ``yaw``; ``update`` returns
     the pose offset."""
 
-    def __init__(self, params: AdmittanceParams = AdmittanceParams(), yaw: bool = False) -> None:
+    def __init__(self, params: AdmittanceParams, yaw: bool = False) -> None:
         p = params
         self.yaw = yaw
         axes = slice(0, 5 if yaw else 4)

@@ -9,35 +9,12 @@ K_t × overtravel (20 N per 10 mm), soft enough to be safe, stiff enough to inse
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pybullet as pb
 
+from assembly_constraints.executor.control.gains import ImpedanceGains
 from assembly_constraints.executor.world.arm import REST_POSTURE, Arm, ArmState, rotation_error
 
-
-@dataclass(frozen=True)
-class ImpedanceGains:
-    """Stiffness and damping: translation [N/m, N·s/m], rotation [Nm/rad, Nm·s/rad],
-    null-space posture [Nm/rad, Nm·s/rad]."""
-
-    k_trans: float = 2000.0
-    d_trans: float = 90.0
-    k_rot: float = 60.0
-    d_rot: float = 2.5
-    k_null: float = 2.0
-    d_null: float = 0.3
-
-
-POSITION_CONTROL_GAINS = ImpedanceGains(k_trans=20000.0, d_trans=580.0, k_rot=600.0, d_rot=8.0)
-"""Stiff tracking: what pure position control is on an industrial arm (a joint servo whose
-stiffness seen at the tool is of the order of 10⁴–10⁵ N/m, hundreds of Nm/rad and more).
-D_t = 2·√(K_t·m) with the lightest effective tip mass of the arm at the plate, m ≈ 4.2 kg
-(4.2–10.3 kg: critically damped to ζ ≈ 0.64); D_r gives ζ ≈ 0.37 about the tilt axes
-(effective inertia ≈ 0.19–0.30 kg·m² over the arm's poses at the plate) and stays below 2·I/Δt = 10 Nm·s/rad,
-where the explicit 1 ms step becomes unstable about the tool axis (I ≈ 0.005 kg·m²).
-docs/cell.md ("Execution layers") says why."""
 
 class ImpedanceController:
     """Tracks a tip pose with a Cartesian spring-damper; one ``step`` per physics step."""
@@ -45,7 +22,7 @@ class ImpedanceController:
     # The null-space projector changes slowly: recompute it every this many steps.
     PROJECTOR_PERIOD = 50
 
-    def __init__(self, arm: Arm, client: int, gains: ImpedanceGains = ImpedanceGains()) -> None:
+    def __init__(self, arm: Arm, client: int, gains: ImpedanceGains) -> None:
         self.arm, self.client, self.gains = arm, client, gains
         self._steps = 0
         self._null_projector = np.eye(7)

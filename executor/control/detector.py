@@ -13,21 +13,22 @@ thresholds for all pairs.  A violation must persist
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import Annotated
 
+import msgspec
 import numpy as np
 
 
-@dataclass(frozen=True)
-class Thresholds:
+class Thresholds(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """F_stop [N], M_stop [Nm] (eqs. 6, 7), F_slow [N] (phase stopping scale), goal
-    tolerance [m], and how long a violation must persist [steps of 1 ms]."""
+    tolerance [m], and how long a violation must persist [steps of 1 ms]. A file may not
+    switch detection off; ``executor margins`` does (infinite thresholds) in code."""
 
-    f_stop: float = 30.0
-    m_stop: float = 4.5
-    f_slow: float = 8.0
-    goal_tolerance: float = 0.003
-    persist_steps: int = 20
+    f_stop: Annotated[float, msgspec.Meta(gt=0.0, le=1000.0, description="a number in (0, 1000] N")] = 30.0
+    m_stop: Annotated[float, msgspec.Meta(gt=0.0, le=100.0, description="a number in (0, 100] Nm")] = 4.5
+    f_slow: Annotated[float, msgspec.Meta(gt=0.0, le=1000.0, description="a number in (0, 1000] N")] = 8.0
+    goal_tolerance: Annotated[float, msgspec.Meta(gt=0.0, le=0.05, description="a number in (0, 0.05] m")] = 0.003
+    persist_steps: Annotated[int, msgspec.Meta(ge=1, le=10000, description="an integer in 1 .. 10000")] = 20
 
 
 class Detector:
@@ -37,7 +38,7 @@ class Detector:
     ``persist_steps`` steps (max over time of the window minimum): directly comparable
     with F_stop and M_stop, blind to single-step contact spikes."""
 
-    def __init__(self, thresholds: Thresholds = Thresholds()) -> None:
+    def __init__(self, thresholds: Thresholds) -> None:
         self.thresholds = thresholds
         self.max_force_dev = 0.0
         self.max_torque_dev = 0.0

@@ -33,10 +33,11 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated
 
+import msgspec
 import numpy as np
 
 from assembly_constraints.bridge.cell_options import LAYER_NAMES
@@ -46,12 +47,17 @@ from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.control.admittance import AdmittanceParams
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.control.controller import ImpedanceGains
+    from assembly_constraints.executor.control.gains import ImpedanceGains
 
-_A = AdmittanceParams()
-OFFSET_BOUND = np.array([_A.bound, _A.bound, _A.bound, _A.rot_bound, _A.rot_bound])
-"""Largest pose offset (dx, dy, dz [m], rx, ry [rad]) of correction plus admittance."""
-AXES = len(OFFSET_BOUND)
+AXES = 5
+"""The corrected axes: dx, dy, dz [m], rx, ry [rad]."""
+
+
+def offset_bound(admittance: AdmittanceParams) -> np.ndarray:
+    """Largest pose offset (dx, dy, dz [m], rx, ry [rad]) of correction plus admittance:
+    the admittance's bounds (z by the translation bound)."""
+    return np.array([admittance.bound] * 3 + [admittance.rot_bound] * 2)
+
 Z_TAPER_FROM = 0.8
 """From this phase on the z correction fades linearly to 0 at the end: ILC shapes the
 push along the way, never where the trajectory ends (the goal check stays the taught one)."""
@@ -62,7 +68,7 @@ class ExecutionLayer:
     """Which parts of the paper's execution layer run (the hole search, the wiggle and the
     second attempt always do): the admittance (off: pure position control along the
     DMP), its integral part (off: P only), DMP phase stopping, ILC; ``stiff`` tracks the
-    insertion with :data:`assembly_constraints.executor.control.controller.POSITION_CONTROL_GAINS` (an
+    insertion with the cell description's ``position_gains`` (an
     industrial arm's position control) instead of the compliant impedance."""
 
     name: str
@@ -90,15 +96,14 @@ def layer_named(name: str) -> ExecutionLayer:
     return LAYERS[name]
 
 
-@dataclass(frozen=True)
-class IlcParams:
+class IlcParams(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """Phase bins, learning gain L (dimensionless), forgetting factor λ (dimensionless,
-    per execution), smoothing window [bins]."""
+    per execution), smoothing window [bins] (at most the bins)."""
 
-    bins: int = 50
-    learning_gain: float = 0.5
-    forgetting: float = 0.95
-    smoothing: int = 5
+    bins: Annotated[int, msgspec.Meta(ge=1, le=10000, description="an integer in 1 .. 10000")] = 50
+    learning_gain: Annotated[float, msgspec.Meta(gt=0.0, le=1.0, description="a number in (0, 1]")] = 0.5
+    forgetting: Annotated[float, msgspec.Meta(gt=0.0, le=1.0, description="a number in (0, 1]")] = 0.95
+    smoothing: Annotated[int, msgspec.Meta(ge=1, le=10000, description="an integer in 1 .. 10000")] = 5
 
 
 @dataclass
@@ -117,13 +122,11 @@ class ExecutionTrace:
 class Ilc:
     """The corrections of one cell, per key, with how many executions taught each."""
 
-    def __init__(self, params: IlcParams = IlcParams(), gains: ImpedanceGains | None = None) -> None:
-        from assembly_constraints.executor.control.controller import (
-            ImpedanceGains,  # here: the parser needs no PyBullet
-        )
-
+    def __init__(self, params: IlcParams, gains: ImpedanceGains, admittance: AdmittanceParams) -> None:
+        """``gains``: the controller's (its compliance S); ``admittance``: whose bounds
+        bound the corrections (:func:`offset_bound`)."""
         self.params = params
-        gains = ImpedanceGains() if gains is None else gains
+        self.bound = offset_bound(admittance)
         centres = (np.arange(params.bins) + 0.5) / params.bins
         self.z_taper = np.clip((1.0 - centres) / (1.0 - Z_TAPER_FROM), 0.0, 1.0)
         self.gain = params.learning_gain / np.array([gains.k_trans] * 3 + [gains.k_rot] * 2)
@@ -149,12 +152,12 @@ class Ilc:
         padded = np.pad(old + mean, ((p.smoothing // 2, p.smoothing - 1 - p.smoothing // 2), (0, 0)), mode="edge")
         smooth = np.stack([np.convolve(padded[:, j], kernel, mode="valid") for j in range(AXES)], axis=1)
         smooth[:, 2] *= self.z_taper
-        self.corrections[key] = np.clip(p.forgetting * smooth, -OFFSET_BOUND, OFFSET_BOUND)
+        self.corrections[key] = np.clip(p.forgetting * smooth, -self.bound, self.bound)
         self.iterations[key] = iteration + 1
         return self.corrections[key]
 
     def to_json(self) -> dict:
-        return {"params": asdict(self.params), "keys": {
+        return {"params": msgspec.structs.asdict(self.params), "keys": {
             key: {"iterations": self.iterations[key], "correction": c.tolist()}
             for key, c in sorted(self.corrections.items())}}
 
@@ -166,7 +169,7 @@ class Ilc:
         """Read the corrections saved at ``path`` (nothing if it does not exist);
         ExecutorError naming the file and the key if it is not such a state
         (:func:`read_state`)."""
-        corrections, iterations = read_state(path, self.params)
+        corrections, iterations = read_state(path, self.params, self.bound)
         self.corrections.update(corrections)
         self.iterations.update(iterations)
 
@@ -177,7 +180,7 @@ MAX_KEY_CHARS = 200
 """The longest key (``shape:hole``) an ILC state file may hold."""
 
 
-def read_state(path: Path, params: IlcParams = IlcParams()) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+def read_state(path: Path, params: IlcParams, bound: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, int]]:
     """The corrections and iteration counts by key of the ILC state saved at ``path``
     (both empty if it does not exist), as :meth:`Ilc.save` writes it for ``params``.
 
@@ -185,7 +188,7 @@ def read_state(path: Path, params: IlcParams = IlcParams()) -> tuple[dict[str, n
     ``{"params": ..., "keys": {"<shape>:<hole>": {"iterations": N, "correction": C}}}``
     with ``params`` those of the cell (if given), each N an integer in 0 ..
     :data:`MAX_ITERATIONS` and each C a (bins, 5) list of finite numbers within
-    ±:data:`OFFSET_BOUND` per axis (what an update can produce).  Checked when the cell
+    ±``bound`` per axis (:func:`offset_bound`: what an update can produce).  Checked when the cell
     starts, so a damaged file is refused there, never at the first insertion."""
     if not path.exists():
         return {}, {}
@@ -206,8 +209,8 @@ def read_state(path: Path, params: IlcParams = IlcParams()) -> tuple[dict[str, n
         raise refuse(f"the key {shorten(repr(twice))}", "each key once in one object")
     if not isinstance(state, dict) or not set(state) <= {"params", "keys"} or "keys" not in state:
         raise refuse("the file", 'an object {"params": {...}, "keys": {...}}')
-    if "params" in state and state["params"] != asdict(params):
-        raise refuse('"params"', f"this cell's {json.dumps(asdict(params))}")
+    if "params" in state and state["params"] != msgspec.structs.asdict(params):
+        raise refuse('"params"', f"this cell's {json.dumps(msgspec.structs.asdict(params))}")
     keys = state["keys"]
     if not isinstance(keys, dict):
         raise refuse('"keys"', 'an object {"<shape>:<hole>": {"iterations": N, "correction": [...]}}')
@@ -224,11 +227,12 @@ def read_state(path: Path, params: IlcParams = IlcParams()) -> tuple[dict[str, n
         if type(count) is not int or not 0 <= count <= MAX_ITERATIONS:
             raise refuse(f"{where} iterations", f"an integer in 0 .. {MAX_ITERATIONS}, got "
                          f"{shorten(json.dumps(count, ensure_ascii=True))}")
-        corrections[key], iterations[key] = _correction(entry["correction"], params.bins, refuse, where), count
+        corrections[key], iterations[key] = _correction(entry["correction"], params.bins, bound, refuse, where), count
     return corrections, iterations
 
 
-def _correction(rows: object, bins: int, refuse: Callable[[str, str], ExecutorError], where: str) -> np.ndarray:
+def _correction(rows: object, bins: int, bound: np.ndarray, refuse: Callable[[str, str], ExecutorError],
+                where: str) -> np.ndarray:
     """The (bins, 5) correction array of the JSON ``rows``; ``refuse(where, expected)``
     raised naming the first bad row or value."""
     if not isinstance(rows, list) or len(rows) != bins:
@@ -236,9 +240,9 @@ def _correction(rows: object, bins: int, refuse: Callable[[str, str], ExecutorEr
     for k, row in enumerate(rows):
         if not isinstance(row, list) or len(row) != AXES:
             raise refuse(f"{where} correction[{k}]", f"a row of {AXES} numbers (dx, dy, dz [m], rx, ry [rad])")
-        for axis, (value, bound) in enumerate(zip(row, OFFSET_BOUND, strict=True)):
-            if type(value) not in (int, float) or not abs(value) <= bound:
-                raise refuse(f"{where} correction[{k}][{axis}]", f"a number within ±{bound:g} "
+        for axis, (value, limit) in enumerate(zip(row, bound, strict=True)):
+            if type(value) not in (int, float) or not abs(value) <= limit:
+                raise refuse(f"{where} correction[{k}][{axis}]", f"a number within ±{limit:g} "
                              f"{'m' if axis < 3 else 'rad'}, got {shorten(json.dumps(value, ensure_ascii=True))}")
     return np.array(rows, dtype=float)
 

@@ -8,16 +8,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import msgspec
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
-from assembly_constraints.executor.control.controller import POSITION_CONTROL_GAINS
+from assembly_constraints.executor.cell_description import CellDescription
+from assembly_constraints.executor.control.admittance import Admittance
 from assembly_constraints.executor.control.detector import Detector
-from assembly_constraints.executor.control.ilc import OFFSET_BOUND, ExecutionLayer, ExecutionTrace
+from assembly_constraints.executor.control.ilc import ExecutionLayer, ExecutionTrace
 from assembly_constraints.executor.control.motion import Motion
 from assembly_constraints.executor.skills.dmp import PhaseClock, Skill
-from assembly_constraints.executor.skills.search import SearchParams
+from assembly_constraints.executor.skills.search import SINK_DEPTH
 from assembly_constraints.executor.skills.wiggle import wiggle
 from assembly_constraints.executor.world.arm import turn_quats_z, turn_z
 from assembly_constraints.executor.world.scene import TIME_STEP
@@ -26,7 +27,7 @@ from assembly_constraints.executor.world.scene import TIME_STEP
 TIMEOUT_FACTOR = 3.0
 END_SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
 MAX_WIGGLES = 1  # exception strategy runs per attempt
-JAM_DEPTH = SearchParams().sink_depth
+JAM_DEPTH = SINK_DEPTH
 """[m] below the entry: the part has sunk into the hole's entry chamfer (the search's
 criterion of "in the hole"), so a breach there is a jam, not a part on the surface.  A
 too-big part never gets there (measured: at most 0.08 mm below the entry when eq. (6)
@@ -99,8 +100,9 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
         return c[:3], np.array([c[3], c[4], 0.0])
 
     trace = ExecutionTrace() if record else None
-    yaw_bound = admittance.bound[4] if admittance is not None and admittance.yaw else 0.0
-    bound_pos, bound_rot = OFFSET_BOUND[:3], np.array([OFFSET_BOUND[3], OFFSET_BOUND[4], yaw_bound])
+    if admittance is not None:  # its translation bound for z too, no yaw bound unless it turns the part
+        bound_pos = np.full(3, admittance.bound[0])
+        bound_rot = np.array([admittance.bound[2], admittance.bound[3], admittance.bound[4] if admittance.yaw else 0.0])
     for _ in range(budget):
         if clock.done:
             break
@@ -158,23 +160,24 @@ def needs_yaw_compliance(part_kind: str, hole_kind: str) -> bool:
 
 
 def insert_in_layer(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
-                    layer: ExecutionLayer, gripper_lever: float, wiggle_enabled: bool = True,
-                    correction: np.ndarray | None = None, yaw: float = 0.0,
+                    layer: ExecutionLayer, gripper_lever: float, *, description: CellDescription,
+                    wiggle_enabled: bool = True, correction: np.ndarray | None = None, yaw: float = 0.0,
                     yaw_compliant: bool = False) -> InsertionResult:
     """:func:`insert` under an execution layer: its admittance (P or PI, none for pure
-    position control), phase stopping, the ILC ``correction`` and recording; with
-    ``layer.stiff`` the insertion tracks with :data:`POSITION_CONTROL_GAINS` and the
-    controller's own gains come back after (the search and the release stay compliant);
+    position control) with the admittance of the cell ``description``, phase stopping,
+    the ILC ``correction`` and recording; with ``layer.stiff`` the insertion tracks with
+    the description's ``position_gains`` and the controller's own gains come back after
+    (the search and the release stay compliant);
     ``yaw`` [rad]: the hole frame's (:func:`insert`); ``yaw_compliant``: the admittance
     also turns the part about the tool axis (a part aligned to a rect hole's estimated
     yaw, :func:`needs_yaw_compliance`)."""
-    admittance = (Admittance(AdmittanceParams() if layer.integral else AdmittanceParams(integral_gain=0.0),
-                             yaw=yaw_compliant)
-                  if layer.admittance else None)
+    params = description.admittance if layer.integral else msgspec.structs.replace(description.admittance,
+                                                                                      integral_gain=0.0)
+    admittance = Admittance(params, yaw=yaw_compliant) if layer.admittance else None
     controller = motion.controller
     compliant = controller.gains
     if layer.stiff:
-        controller.gains = POSITION_CONTROL_GAINS
+        controller.gains = description.position_gains
     try:
         return insert(motion, skill, hole_origin, detector, admittance, gripper_lever, wiggle_enabled,
                       phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc, yaw=yaw)

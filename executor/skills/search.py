@@ -15,9 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from assembly_constraints.executor.control.admittance import Admittance
+from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
 from assembly_constraints.executor.control.motion import Motion
 from assembly_constraints.executor.world.scene import TIME_STEP
+
+SINK_DEPTH = 0.0005
+"""[m] below the surface: the tip is in a hole's entry chamfer."""
 
 
 @dataclass(frozen=True)
@@ -34,7 +37,7 @@ class SearchParams:
     approach_speed: float = 0.025
     contact_force: float = 2.0
     press_depth: float = 0.0025
-    sink_depth: float = 0.0005
+    sink_depth: float = SINK_DEPTH
     enter_depth: float = 0.0012
     dip_depth: float = 0.0001
     dip_hold: float = 0.3
@@ -61,7 +64,7 @@ def _slide_in(motion: Motion, xy: np.ndarray, touched_z: float, quat_xyzw: np.nd
     commanded position complying to the lateral force, until the tip is ``enter_depth``
     below the surface (past the chamfer) or ``dip_hold`` is over.  Returns the tip
     position [m]."""
-    comply = Admittance()
+    comply = Admittance(AdmittanceParams())
     s = motion.controller.arm.read()
     for _ in range(int(p.dip_hold / TIME_STEP)):
         shift = comply.update(s.force, np.zeros(3), TIME_STEP)[0]
@@ -100,7 +103,7 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
     direction = rng.choice([-1.0, 1.0])
     pitch = p.pitch * (1 + rng.uniform(-p.pitch_jitter, p.pitch_jitter))
     theta, elapsed, paused, may_pause = 0.0, 0.0, 0, True
-    comply = Admittance()
+    comply = Admittance(AdmittanceParams())
     offset = np.zeros(2)
     while elapsed < p.max_time:
         radius = pitch * theta / (2 * math.pi)
@@ -113,7 +116,7 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         else:
             may_pause = not dipped
             paused = 0
-            comply = Admittance()
+            comply = Admittance(AdmittanceParams())
             shift = np.zeros(2)
             theta += p.speed * TIME_STEP / max(radius, pitch / 2)
             angle = angle0 + direction * theta

@@ -74,8 +74,8 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     geometry = cell.geometry
     part = next(p for pid, p in sorted(geometry.parts.items()) if p.shape == shape)
     hole = geometry.holes[part.demo_hole]
-    origin = np.array([*hole.position, float(geometry.plate["top_z"])])
-    bottom = float(geometry.plate["tile_thickness"])
+    origin = np.array([*hole.position, geometry.plate.top_z])
+    bottom = geometry.plate.tile_thickness
     motion = cell.motion_for(part.id)
     assert cell.scene is not None  # set by motion_for
     cell.scene.set_friction(None)  # the teaching friction, whatever ran before

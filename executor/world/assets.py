@@ -19,6 +19,8 @@ import json
 import logging
 from pathlib import Path
 
+import msgspec
+
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.files import write_atomic
 from assembly_constraints.executor import ExecutorError
@@ -33,7 +35,7 @@ def sources_digest(geometry: CellGeometry) -> str:
     """Hex SHA-256 of the canonical JSON of what the assets are generated from: the
     ``[plate]`` table and every hole and part (their dataclass fields). The values come
     from decimal text, so the digest is the same on every machine."""
-    inputs = {"plate": geometry.plate,
+    inputs = {"plate": msgspec.structs.asdict(geometry.plate),
               "holes": [dataclasses.asdict(h) for _, h in sorted(geometry.holes.items())],
               "parts": [dataclasses.asdict(p) for _, p in sorted(geometry.parts.items())]}
     return hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()

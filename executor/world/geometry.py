@@ -21,7 +21,6 @@ for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,11 +28,19 @@ import clingo
 import numpy as np
 import pybullet_data
 
-from assembly_constraints.bridge.assembly import Assembly, load_assembly
+from assembly_constraints.bridge.assembly import Assembly, assembly_of, resolve_assembly_folder
 from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.inputs import read_text
+from assembly_constraints.bridge.product import (
+    GeometryFile,
+    Gripper,
+    HoleShape,
+    PartShape,
+    Plate,
+    check_grasp,
+    load_product_description,
+)
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.world.validation import check_geometry
+from assembly_constraints.executor.cell_description import CellDescription
 
 
 @dataclass(frozen=True)
@@ -76,106 +83,71 @@ class PartSpec(Section):
 
 @dataclass(frozen=True)
 class CellGeometry:
-    """Everything the scene needs; ``plate`` and ``gripper`` are the toml tables as is."""
+    """Everything the scene needs: the ``[plate]``, the gripper in use (the product's
+    ``[gripper]`` or the cell description's), the holes and parts by id, the decoded
+    ``geometry.toml`` (``tables``: the product's base, covers and heads) and the parts and
+    holes of ``assembly.toml`` (``layout``)."""
 
     folder: Path
-    plate: dict
-    gripper: dict
+    plate: Plate
+    gripper: Gripper
     holes: dict[str, HoleSpec]
     parts: dict[str, PartSpec]
+    tables: GeometryFile
+    layout: Assembly
 
     @property
     def assets(self) -> Path:
         return self.folder / "assets"
 
 
-def _read_toml(path: Path) -> dict:
-    text = read_text(path, f"cell geometry file ({path.name}, TOML)", error=ExecutorError)
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
+def load_geometry(assembly: str = "cranfield", description: CellDescription | None = None) -> CellGeometry:
+    """The cell geometry of an assembly folder (a name under ``data/`` or a path): its
+    product description (:func:`assembly_constraints.bridge.product.load_product_description`, checked as a
+    whole) with the gripper of ``geometry.toml`` or else of the cell ``description``
+    (default :class:`assembly_constraints.executor.cell_description.CellDescription`); BridgeError naming the
+    file, table and key."""
+    folder = resolve_assembly_folder(assembly)
+    product = load_product_description(folder)
+    path = folder / "geometry.toml"
+    if product.geometry is None:
+        raise ExecutorError(f"{path}: no such file; expected the cell geometry of assembly '{assembly}' "
+                            "(docs/geometry.md)")
+    geo = product.geometry
+    gripper = geo.gripper
+    if gripper is None:
+        gripper = (CellDescription() if description is None else description).gripper
+        check_grasp(path, geo, gripper)
+    return _geometry(folder, assembly_of(product), geo, gripper)
 
 
-def load_geometry(assembly: str = "cranfield") -> CellGeometry:
-    """Read ``assembly.toml`` (through :func:`assembly_constraints.bridge.assembly.load_assembly`) and
-    ``geometry.toml`` of an assembly folder (a name under ``data/`` or a path), checked
-    as a whole first (:func:`assembly_constraints.executor.world.validation.check_geometry`: ExecutorError
-    naming the file, table and key)."""
-    layout = load_assembly(assembly)
-    path = layout.folder / "geometry.toml"
-    geo = _read_toml(path)
-    check_geometry(path, geo, layout)
-    return _geometry(layout.folder, layout, geo)
+def _section(shape: HoleShape | PartShape) -> tuple[str, float, float]:
+    """``kind``, size and width [m] of a shape table: a rect ``[a, b]`` gives a and b, any
+    other kind its one size and width 0."""
+    if isinstance(shape.size, list):
+        return shape.kind, float(shape.size[0]), float(shape.size[1])
+    return shape.kind, float(shape.size), 0.0
 
 
-def section_of(shape: dict) -> tuple[str, float, float]:
-    """``kind``, size and width [m] of a checked ``[hole_shapes.*]`` or ``[part_shapes.*]``
-    table (:func:`assembly_constraints.executor.world.validation.check_geometry`): a rect ``[a, b]`` gives a
-    and b, any other kind its one size and width 0."""
-    kind, size = shape["kind"], shape["size"]
-    if kind == "rect":
-        return kind, float(size[0]), float(size[1])
-    return kind, float(size), 0.0
-
-
-def _yaw(shape: dict) -> float:
-    """A checked hole table's ``yaw`` [°] (default 0), in rad."""
-    return math.radians(shape.get("yaw", 0.0))
-
-
-def _geometry(folder: Path, layout: Assembly, geo: dict) -> CellGeometry:
+def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Gripper) -> CellGeometry:
     positions = {hole.id: hole.position for hole in layout.holes if hole.position is not None}
     holes: dict[str, HoleSpec] = {}
-    for shape in geo.get("hole_shapes", {}).values():
-        kind, size, width = section_of(shape)
-        yaw = _yaw(shape)
-        for hid in shape["holes"]:
-            holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=yaw, width=width)
+    for hole_shape in geo.hole_shapes.values():
+        kind, size, width = _section(hole_shape)
+        for hid in hole_shape.holes:
+            holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
-    starts |= {pid: p["start"] for pid, p in geo.get("extra_parts", {}).items()}
+    starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
-    for name, shape in geo.get("part_shapes", {}).items():
-        kind, size, width = section_of(shape)
-        for pid in shape["parts"]:
+    for name, part_shape in geo.part_shapes.items():
+        kind, size, width = _section(part_shape)
+        for pid in part_shape.parts:
             x, y = starts[pid]
             parts[pid] = PartSpec(
-                pid, kind, size, shape=name, length=float(shape["length"]),
-                mass=float(shape["mass"]), start=(float(x), float(y)), demo_hole=shape["demo_hole"], width=width,
+                pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
+                start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width,
             )
-    _cross_check(layout, holes, parts)
-    return CellGeometry(folder, geo["plate"], geo["gripper"], holes, parts)
-
-
-def _cross_check(layout: Assembly, holes: dict[str, HoleSpec], parts: dict[str, PartSpec]) -> None:
-    """The ``shape`` of each part and hole in ``assembly.toml`` (where given) is the
-    ``kind`` of its cross-section in ``geometry.toml``, and the parts of one ``section``
-    are scaled copies of one cross-section (one aspect ratio b/a, all round or none);
-    ExecutorError naming them otherwise."""
-    declared: list[tuple[str, str, str | None, Section | None]]
-    declared = [(part.id, "part", part.shape, parts.get(part.id)) for part in layout.parts]
-    declared += [(hole.id, "hole", hole.shape, holes.get(hole.id)) for hole in layout.holes]
-    for item, what, shape, spec in declared:
-        if shape is not None and spec is not None and spec.kind != shape:
-            raise ExecutorError(f"{layout.folder / 'assembly.toml'}: {what} '{item}' has shape \"{shape}\" but "
-                                f"geometry.toml gives it kind \"{spec.kind}\"")
-    first: dict[str, PartSpec] = {}
-    for part in layout.parts:
-        spec = parts.get(part.id)
-        if part.section is None or spec is None:
-            continue
-        other = first.setdefault(part.section, spec)
-        if (other.kind == "round") != (spec.kind == "round") or not math.isclose(
-                spec.sides[1] / spec.sides[0], other.sides[1] / other.sides[0], rel_tol=1e-9):
-            raise ExecutorError(f"{layout.folder / 'assembly.toml'}: parts '{other.id}' and '{part.id}' share section "
-                                f"\"{part.section}\" but are no scaled copies of one cross-section "
-                                f"({_describe(other)} and {_describe(spec)} in geometry.toml)")
-
-
-def _describe(section: Section) -> str:
-    """``round d 12 mm``, ``square 4 mm``, ``rect 16 x 10 mm``."""
-    a, b = (1000 * side for side in section.sides)
-    return {"round": f"round d {a:g} mm", "square": f"square {a:g} mm"}.get(section.kind, f"rect {a:g} x {b:g} mm")
+    return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
 
 def margin(part: Section, hole: Section) -> float:
@@ -208,7 +180,8 @@ def sizes_lp_text(assembly: str) -> str:
     part of ``assembly.toml`` with a cross-section (``[part_shapes.*]``), ``hole/1`` for
     each hole, ``fits/2`` for every pair that :func:`passes` (closed world), as clingo
     symbols in the order of ``assembly.toml``, one line per part."""
-    geometry, layout = load_geometry(assembly), load_assembly(assembly)
+    geometry = load_geometry(assembly)
+    layout = geometry.layout
     pegs = [part.id for part in layout.parts if part.id in geometry.parts]
     holes = [hole.id for hole in layout.holes if hole.id in geometry.holes]
 
@@ -254,16 +227,16 @@ def _turned(ring: np.ndarray, yaw: float) -> np.ndarray:
     return ring @ np.array([[c, s], [-s, c]])
 
 
-def _boss_triangles(hole: HoleSpec, plate: dict) -> list[np.ndarray]:
+def _boss_triangles(hole: HoleSpec, plate: Plate) -> list[np.ndarray]:
     """Triangles (3×3 vertex arrays [m], outward normals) of one boss with its through
     hole (the plate under the boss is the hole's bottom) and a 45° entry chamfer."""
-    n = int(plate["polygon_sides"])
+    n = plate.polygon_sides
     cx, cy = hole.position
-    top = float(plate["top_z"])
-    bottom = top - float(plate["tile_thickness"])
-    chamfer = float(plate["chamfer"])
+    top = plate.top_z
+    bottom = top - plate.tile_thickness
+    chamfer = plate.chamfer
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
-    outer = _turned(_ring("square", float(plate["tile_size"]) / 2, n), hole.yaw) + (cx, cy)
+    outer = _turned(_ring("square", plate.tile_size / 2, n), hole.yaw) + (cx, cy)
     mouth = _turned(_ring(hole.kind, half_a + chamfer, n, half_b + chamfer), hole.yaw) + (cx, cy)
     inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw) + (cx, cy)
 
@@ -346,7 +319,7 @@ def part_urdf_text(part: PartSpec) -> str:
 _FLANGE_OFFSET = 0.045
 
 
-def arm_urdf_text(part: PartSpec, gripper: dict) -> str:
+def arm_urdf_text(part: PartSpec, gripper: Gripper) -> str:
     """The pybullet_data ``kuka_iiwa`` with a flange (realistic inertia) and the held part.
 
     Links appended after ``lbr_iiwa_link_7``: ``flange`` (fixed) and ``part`` (fixed joint
@@ -356,14 +329,14 @@ def arm_urdf_text(part: PartSpec, gripper: dict) -> str:
     """
     source = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
     text = source.read_text().replace('filename="meshes/', f'filename="{source.parent}/meshes/')
-    flange_len = float(gripper["flange_length"])
-    tip = flange_len + part.length - float(gripper["grasp_depth"])
+    flange_len = gripper.flange_length
+    tip = flange_len + part.length - gripper.grasp_depth
     inertia = part.mass * (part.size**2 + part.length**2) / 12
     tool = (
         '  <joint name="flange_joint" type="fixed"><parent link="lbr_iiwa_link_7"/><child link="flange"/>'
         f'<origin xyz="0 0 {_FLANGE_OFFSET}" rpy="0 0 0"/></joint>\n'
         '  <link name="flange">\n'
-        + _inertial_xml(float(gripper["flange_mass"]), float(gripper["flange_inertia"]), flange_len / 2)
+        + _inertial_xml(gripper.flange_mass, gripper.flange_inertia, flange_len / 2)
         + f'    <visual><origin xyz="0 0 {flange_len / 2:.6f}" rpy="0 0 0"/><geometry>'
         f'<cylinder radius="0.03" length="{flange_len:.6f}"/></geometry>'
         '<material name="gripper"><color rgba="0.3 0.3 0.35 1"/></material></visual>\n'

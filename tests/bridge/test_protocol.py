@@ -14,6 +14,7 @@ import pytest
 
 from assembly_constraints.asp.session.cells import CellProcess, start_cell
 from assembly_constraints.bridge.messages import ErrorReply, Evidence, InsertReply, InsertRequest, encode
+from assembly_constraints.bridge.product import ID_PATTERN
 from assembly_constraints.bridge.protocol_schema import MESSAGES, drift, main, schemas
 from assembly_constraints.bridge.session import free_loopback_endpoint
 from tests.conftest import ROOT, child_env
@@ -33,7 +34,7 @@ def test_a_changed_type_shows_as_drift(tmp_path: Path, capsys: pytest.CaptureFix
     (tmp_path / "insert_request.schema.json").write_text(json.dumps(edited))
     capsys.readouterr()
     assert main(["--check", str(tmp_path)]) == 1
-    assert "insert_request.schema.json: differs from the message types" in capsys.readouterr().out
+    assert "insert_request.schema.json: differs from the types" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("message", [
@@ -77,3 +78,16 @@ def test_the_third_party_client_talks_to_a_real_cell(cells: list[CellProcess], t
     assert code == 0 and reply["result"] == "no_fit"
     code, reply = client("p3", "zz")
     assert code == 1 and reply["kind"] == "error" and reply["code"] == "unknown_id"
+
+
+@pytest.mark.parametrize("stem", ["assembly", "geometry"])
+def test_the_published_product_schemas_are_strict(stem: str) -> None:
+    """Every table of the product files refuses unknown keys in the schema as the loader
+    does, and ids carry the loader's pattern."""
+    published = json.loads((PUBLISHED / f"{stem}.schema.json").read_text())
+    tables = [published, *published["$defs"].values()]
+    assert tables and all(table.get("additionalProperties") is False for table in tables if "properties" in table)
+    text = json.dumps(published)
+    assert json.dumps(ID_PATTERN) in text
+    required = {"assembly": ["parts"], "geometry": ["plate"]}[stem]
+    assert published["required"] == required

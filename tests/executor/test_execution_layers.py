@@ -9,8 +9,9 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assembly_constraints.executor.control.controller import POSITION_CONTROL_GAINS, ImpedanceGains
+from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.detector import Thresholds
+from assembly_constraints.executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionTrace, Ilc
 from assembly_constraints.executor.evidence import AttemptSetup
 from assembly_constraints.executor.skills.insertion import rotvec_quat_xyzw
@@ -23,6 +24,12 @@ TILTED = AttemptSetup(np.zeros(3), np.array([np.radians(2.0), 0.0, 0.0]), np.zer
 # The systematic part only (a 2.5° habitual tilt): every execution of a pair meets the same errors.
 SYSTEMATIC_ONLY = PerturbationModel(grasp_offset_random=0.0, grasp_tilt_bias=2.5, grasp_tilt_random=0.0,
                                     vision_sigma=0.0, friction_jitter=0.0)
+
+
+def _ilc() -> Ilc:
+    """An ILC with the default cell description's parameters, gains and bounds."""
+    d = CellDescription()
+    return Ilc(d.ilc, d.gains, d.admittance)
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +75,7 @@ def test_stiff_tracking_settles_at_the_cell_time_step(cell):
     the plate settle to 5 % within 150 ms, with less than 20 % overshoot."""
     motion = cell.motion_for("tp")
     controller = motion.controller
-    start = np.array([*cell.geometry.holes["r1"].position[:2], float(cell.geometry.plate["top_z"]) + 0.02])
+    start = np.array([*cell.geometry.holes["r1"].position[:2], cell.geometry.plate.top_z + 0.02])
     steps = {0: (np.array([1e-3, 0, 0]), np.zeros(3)), 2: (np.array([0, 0, 1e-3]), np.zeros(3)),
              3: (np.zeros(3), np.radians([1.0, 0, 0])), 5: (np.zeros(3), np.radians([0, 0, 1.0]))}
     try:
@@ -118,7 +125,7 @@ def test_ilc_converges_on_a_repeated_pair(cell, tmp_path):
 
 
 def test_ilc_update_learns_against_the_error_and_round_trips(tmp_path):
-    ilc = Ilc()
+    ilc = _ilc()
     trace = ExecutionTrace()
     for k in range(1000):  # a constant +2 N lateral x deviation and +0.1 Nm about y
         trace.add(k / 1000, np.array([2.0, 0.0, 0.0, 0.0, 0.1]))
@@ -129,7 +136,7 @@ def test_ilc_update_learns_against_the_error_and_round_trips(tmp_path):
     assert np.all(again[:, 0] > learned[:, 0])  # the error persisted: learns further
     path = tmp_path / "ilc.json"
     ilc.save(path)
-    other = Ilc()
+    other = _ilc()
     other.load(path)
     assert other.iterations == {"round_peg:r1": 2}
     assert np.array_equal(other.correction("round_peg:r1")[0], again)  # exact: resumed as if never stopped
@@ -162,4 +169,4 @@ def test_a_corrupt_ilc_state_is_refused_naming_the_file(tmp_path):
     path = tmp_path / "c1-ilc.json"
     path.write_text('{"keys": {"round_peg:r1": {"iterations": 1, "correction": [[0.0]]}}}')
     with pytest.raises(ExecutorError, match='c1-ilc.json: "keys" "round_peg:r1" correction: expected a list of 50'):
-        Ilc().load(path)
+        _ilc().load(path)

@@ -30,7 +30,7 @@ def test_a_persisting_deviation_is_integrated_beyond_the_proportional_answer() -
 
 
 def test_the_integral_holds_the_offset_and_an_opposite_deviation_unwinds_it() -> None:
-    adm = Admittance()
+    adm = Admittance(AdmittanceParams())
     pushed = run(adm, 1.0, 0.5)
     assert pushed > 0
     held = run(adm, 0.0, 1.0)

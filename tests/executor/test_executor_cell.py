@@ -39,7 +39,7 @@ def test_fitting_peg_goes_in_and_sits_at_the_goal(cell):
     assert result.end_error < cell.thresholds.goal_tolerance
     # Ground truth: the peg tip is really inside the hole, near its bottom.
     tip_z = pb.getLinkState(cell.scene.robot, 8, computeForwardKinematics=1, physicsClientId=cell.scene.client)[4][2]
-    assert tip_z < cell.geometry.plate["top_z"] - 0.02
+    assert tip_z < cell.geometry.plate.top_z - 0.02
     assert result.max_force_dev < cell.thresholds.f_stop
 
 

@@ -1,6 +1,6 @@
 """``geometry.toml`` is checked as a whole before the cell builds anything: types, ranges,
 kinds, references and overlaps, each refused in one line ``<file>: [<table>] <key>:
-expected ..., got ...`` (executor/world/validation.py)."""
+expected ..., got ...`` (bridge/product.py)."""
 
 from __future__ import annotations
 
@@ -12,13 +12,22 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.bridge.assembly import DATA_DIR, load_assembly
-from assembly_constraints.executor import ExecutorError
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.assembly import DATA_DIR
+from assembly_constraints.bridge.errors import ToolError
+from assembly_constraints.bridge.product import Gripper, Plate, product_from_tables
 from assembly_constraints.executor.world.geometry import load_geometry
-from assembly_constraints.executor.world.validation import GRIPPER, PLATE, check_geometry
 
 CRANFIELD = DATA_DIR / "cranfield"
-ORIGINAL = (CRANFIELD / "geometry.toml").read_text()
+GRIPPER_TABLE = """[gripper]
+flange_mass = 1.0
+flange_inertia = 0.004
+flange_length = 0.06
+grasp_depth = 0.02
+
+"""
+ORIGINAL = (CRANFIELD / "geometry.toml").read_text().replace("[base]", GRIPPER_TABLE + "[base]", 1)
+"""Cranfield's geometry with its own [gripper] (a product may override the cell's)."""
 
 # (id, text of data/cranfield/geometry.toml, its replacement, the expected end of the message)
 SIZE = "a number in (0, 0.1] m, or for a rect [a, b] with a >= b, each such a number"
@@ -70,6 +79,34 @@ CASES = [
     ("holes-not-a-list", 'holes = ["br"]', 'holes = "br"', "[hole_shapes.round_big] holes: expected a non-empty list"),
     ("size-missing", 'size = 0.0200           # diameter [m]', "", "[hole_shapes.round_big] size: expected a number"),
     ("extra-start-nan", "start = [0.25, 0.46]", "start = [nan, 0.46]", "[extra_parts.tp] start: expected [x, y]"),
+    ("unknown-key", "[plate]\n", "[plate]\ncolour = 3\n", "[plate] colour: unknown key; expected one of top_z"),
+    ("unknown-table", "[base]\n", "[fixture]\nx = 1\n\n[base]\n", "fixture: unknown table or key"),
+    ("table-name-not-an-id", "[part_shapes.shaft]", "[part_shapes.Shaft]",
+     "[part_shapes.Shaft]: expected a table name that is an id (a lower-case ASP constant"),
+    ("cover-mass-zero", "mass = 0.05             # [kg]\ngrip", "mass = 0             # [kg]\ngrip",
+     "[covers.sp] mass: expected a number in (0, 10] kg, got 0"),
+    ("cover-mass-missing", "mass = 0.05             # [kg]\ngrip", "grip",
+     "[covers.sp] mass: expected a number in (0, 10] kg, got nothing (a required key)"),
+    ("cover-over-unknown", 'over = ["s1", "s2"]', 'over = ["s1", "zz"]', "[covers.sp] over: expected holes of "
+     "[hole_shapes.*] (br, r1, r2, s1, s2), got 'zz'"),
+    ("cover-outline-inverted", "outline = [-0.015, -0.08, 0.015, 0.08]", "outline = [0.015, -0.08, -0.015, 0.08]",
+     "[covers.sp] outline: expected [xmin, ymin, xmax, ymax] with xmin < xmax"),
+    ("cover-skill-unknown", 'skill = "square_peg"', 'skill = "zz"', "[covers.sp] skill: expected a part shape"),
+    ("cover-not-a-part", "[covers.sp]", "[covers.zz]", "[covers.zz]: expected a part of assembly.toml, got 'zz'"),
+    ("socket-deeper-than-cover", "socket = [-0.075, 0.0, 0.0115, 0.008]", "socket = [-0.075, 0.0, 0.0115, 0.02]",
+     "[covers.pd] socket: expected [x, y, side, depth] with side > 0 and 0 < depth < thickness"),
+    ("head-kind-unknown", 'into = "pd"\nkind = "round"', 'into = "pd"\nkind = "rect"',
+     "[heads.ph] kind: expected one of round, square, got 'rect'"),
+    ("head-into-no-socket", 'into = "pd"', 'into = "fp"', "[heads.ph] into: expected a cover with a socket (pd)"),
+    ("head-size-zero", "size = 0.010 ", "size = 0.0 ", "[heads.ph] size: expected a number in (0, 0.1] m, got 0.0"),
+    ("base-part-unknown", 'part = "bp"', 'part = "zz"', "[base] part: expected a part of assembly.toml"),
+    ("base-mass-negative", "mass = 2.0 ", "mass = -2.0 ", "[base] mass: expected a number in (0, 50] kg, got -2.0"),
+    ("part-with-two-geometries", 'parts = ["sh"]', 'parts = ["sh", "sp"]',
+     "part sp of assembly.toml has more than one geometry ([part_shapes.*] and [covers.*])"),
+    ("extra-part-of-assembly", "[extra_parts.tp]", "[extra_parts.p1]", "[extra_parts.p1] start: expected a part "
+     "that is not in assembly.toml"),
+    ("gripper-unknown-key", "grasp_depth = 0.02", "grasp_depth = 0.02\ngrasp_force = 5",
+     "[gripper] grasp_force: unknown key"),
 ]
 
 
@@ -84,7 +121,7 @@ def _folder(tmp_path: Path, text: str) -> Path:
 def test_a_bad_value_is_refused_naming_file_table_and_key(tmp_path: Path, old: str, new: str, message: str) -> None:
     assert ORIGINAL.count(old) >= 1, old
     folder = _folder(tmp_path, ORIGINAL.replace(old, new, 1))
-    with pytest.raises(ExecutorError) as error:
+    with pytest.raises(ToolError) as error:
         load_geometry(str(folder))
     text = str(error.value)
     assert text.startswith(f"{folder / 'geometry.toml'}: ") and message in text, text
@@ -95,17 +132,24 @@ def test_two_holes_at_one_position_are_refused(tmp_path: Path) -> None:
     folder = _folder(tmp_path, ORIGINAL)
     layout = folder / "assembly.toml"
     layout.write_text(layout.read_text().replace("position = [0.63, -0.06]", "position = [0.55, -0.06]", 1))
-    with pytest.raises(ExecutorError, match=r"geometry.toml: \[plate\] tile_size: expected bosses that do not "
+    with pytest.raises(BridgeError, match=r"geometry.toml: \[plate\] tile_size: expected bosses that do not "
                                             r"overlap, got holes r1 at \(0.55, -0.06\) and s1 at \(0.55, -0.06\)"):
         load_geometry(str(folder))
 
 
-@pytest.mark.parametrize("assembly", ["cranfield", "spare", "graded"])
+@pytest.mark.parametrize("assembly", ["cranfield", "spare", "graded", "taskboard"])
 def test_the_shipped_geometries_pass(assembly: str) -> None:
     assert load_geometry(assembly).parts
 
 
-NUMERIC_KEYS = [("plate", key) for key in PLATE] + [("gripper", key) for key in GRIPPER]
+def test_the_product_gripper_wins_over_the_cell_one(tmp_path: Path) -> None:
+    folder = _folder(tmp_path, ORIGINAL.replace("flange_length = 0.06", "flange_length = 0.08", 1))
+    assert load_geometry(str(folder)).gripper.flange_length == 0.08
+    assert load_geometry("cranfield").gripper.flange_length == 0.06  # the cell description's
+
+
+NUMERIC_KEYS = [("plate", key) for key in Plate.__struct_fields__] + [
+    ("gripper", key) for key in Gripper.__struct_fields__]
 VALUES = st.one_of(st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow_infinity=True), st.booleans(),
                    st.text(max_size=5), st.lists(st.floats(-1, 1), max_size=3))
 
@@ -114,13 +158,14 @@ VALUES = st.one_of(st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow
 @given(key=st.sampled_from(NUMERIC_KEYS), value=VALUES)
 def test_any_value_of_a_key_loads_or_is_refused_in_one_line(key: tuple[str, str], value: object) -> None:
     """Whatever a [plate] or [gripper] key holds, the check passes or raises one
-    ExecutorError of one line naming the file and a table (the key itself, or the key a
+    BridgeError of one line naming the file and a table (the key itself, or the key a
     cross check relates it to: a smaller tile_size refuses the hole that no longer fits),
     never another exception."""
     geo = tomllib.loads(ORIGINAL)
     geo[key[0]][key[1]] = value
     path = CRANFIELD / "geometry.toml"
+    layout = tomllib.loads((CRANFIELD / "assembly.toml").read_text())
     try:
-        check_geometry(path, geo, load_assembly("cranfield"))
-    except ExecutorError as exc:
+        product_from_tables(CRANFIELD, layout, geo)
+    except BridgeError as exc:
         assert str(exc).startswith(f"{path}: [") and "\n" not in str(exc), str(exc)

@@ -80,8 +80,8 @@ def test_the_mesh_of_a_turned_rect_hole_has_its_sides_and_yaw(hole: str) -> None
     geometry = load_geometry("taskboard")
     spec, plate = geometry.holes[hole], geometry.plate
     a, b = spec.sides
-    tile, chamfer = float(plate["tile_size"]), float(plate["chamfer"])
-    top, bottom = float(plate["top_z"]), float(plate["top_z"]) - float(plate["tile_thickness"])
+    tile, chamfer = plate.tile_size, plate.chamfer
+    top, bottom = plate.top_z, plate.top_z - plate.tile_thickness
     vertices = _boss_vertices(plate_obj_text(geometry), hole)
     local = turn_z(vertices - np.array([*spec.position, 0.0]), -spec.yaw)  # in the hole's frame
     boss = np.max(np.abs(local[:, :2]), axis=1) > tile / 2 - 1e-5

@@ -1,0 +1,234 @@
+"""The checks of a product description that one struct cannot make (:mod:`assembly_constraints.bridge.product`):
+references between tables, a rect's ``[a, b]``, a chamfer inside its boss, bosses that do
+not overlap, a grasp shorter than the part, the shapes of ``assembly.toml`` against the
+kinds of ``geometry.toml``, the base, covers and heads against the parts. Every failure
+is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a BridgeError)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.product.tables import (
+    TOUCH_TOLERANCE,
+    AssemblyFile,
+    GeometryFile,
+    Gripper,
+    HoleShape,
+    PartShape,
+)
+
+
+def where(table: str, key: str) -> str:
+    """``[table] key``, ``[table]`` or ``key``."""
+    return " ".join(([f"[{table}]"] if table else []) + ([key] if key else []))
+
+
+def fail(path: Path, table: str, key: str, expected: str, value: object) -> BridgeError:
+    """``<path>: [<table>] <key>: expected <expected>, got <value>`` (the value shortened)."""
+    return BridgeError(f"{path}: {where(table, key)}: expected {expected}, got {shorten(repr(value))}")
+
+# ---- the checks between tables ----
+
+def _sides(size: float | list[float]) -> tuple[float, float]:
+    """(a, b) [m] of a decoded section size: a rect's ``[a, b]``, else the size twice."""
+    return (size[0], size[1]) if isinstance(size, list) else (size, size)
+
+
+def check_assembly(path: Path, layout: AssemblyFile) -> None:
+    """A ``section`` only for a rect part; no id both a part and a hole."""
+    for pid, part in layout.parts.items():
+        if part.section is not None and part.shape != "rect":
+            raise BridgeError(f"{path}: [parts.{pid}] section: only a part of shape \"rect\" has one "
+                              f"(a {part.shape or 'part without a shape'} is its own section)")
+    clash = set(layout.parts) & set(layout.holes)
+    if clash:
+        raise BridgeError(f"{path}: ids used for both a part and a hole: {sorted(clash)}")
+
+
+def _members(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[str, PartShape]) -> dict[str, str]:
+    """Member id -> shape name; each id in one shape table once."""
+    owner: dict[str, str] = {}
+    for name, table in tables.items():
+        members = table.holes if isinstance(table, HoleShape) else table.parts
+        key = "holes" if isinstance(table, HoleShape) else "parts"
+        for member in members:
+            if member in owner:
+                raise fail(path, f"{group}.{name}", key, f"ids not already in [{group}.{owner[member]}]", member)
+            owner[member] = name
+    return owner
+
+
+def _check_sections(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[str, PartShape]) -> None:
+    """A rect's size is ``[a, b]`` with a >= b, any other kind's one number."""
+    for name, table in tables.items():
+        rect, size = table.kind == "rect", table.size
+        if rect != isinstance(size, list):
+            expected = ("[a, b] in m with a >= b > 0 (the long side a along x) for a rect" if rect
+                        else f"one number (the {'diameter' if table.kind == 'round' else 'side'}) for a {table.kind}")
+            raise fail(path, f"{group}.{name}", "size", expected, size)
+        if isinstance(size, list) and size[0] < size[1]:
+            raise fail(path, f"{group}.{name}", "size", "[a, b] with a >= b (the long side a along x)", size)
+
+
+def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
+    """Every peg is longer than the part of it inside ``gripper``'s fingers."""
+    for name, table in geometry.part_shapes.items():
+        if gripper.grasp_depth >= table.length:
+            raise fail(path, f"part_shapes.{name}", "length",
+                       f"longer than [gripper] grasp_depth ({gripper.grasp_depth:g} m)", table.length)
+
+
+def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
+    """``geometry.toml`` (decoded) against itself and ``layout``: shape members, sections,
+    chamfer, bosses, the product's grasp (with its own gripper), references, kinds, the
+    base, covers and heads."""
+    plate = geo.plate
+    holes = _members(path, "hole_shapes", geo.hole_shapes)
+    pegs = _members(path, "part_shapes", geo.part_shapes)
+    _check_sections(path, "hole_shapes", geo.hole_shapes)
+    _check_sections(path, "part_shapes", geo.part_shapes)
+    if plate.chamfer >= plate.tile_thickness:
+        raise fail(path, "plate", "chamfer", f"less than tile_thickness ({plate.tile_thickness:g} m)", plate.chamfer)
+    for name, hole_shape in geo.hole_shapes.items():
+        if _sides(hole_shape.size)[0] + 2 * plate.chamfer >= plate.tile_size:
+            raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
+                       "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
+    for name, part_shape in geo.part_shapes.items():
+        if part_shape.demo_hole not in holes:
+            raise fail(path, f"part_shapes.{name}", "demo_hole",
+                       f"a hole of [hole_shapes.*] ({', '.join(sorted(holes))})", part_shape.demo_hole)
+    if geo.gripper is not None:
+        check_grasp(path, geo, geo.gripper)
+    for hid, name in holes.items():
+        entry = layout.holes.get(hid)
+        if entry is None or entry.position is None:
+            why = "has no position there" if entry is not None else "is not a hole there"
+            raise fail(path, f"hole_shapes.{name}", "holes", f"holes of assembly.toml with a position ({hid} {why})",
+                       hid)
+    for pid in geo.extra_parts:
+        if pid in layout.parts:
+            raise fail(path, f"extra_parts.{pid}", "start", "a part that is not in assembly.toml (this one is)",
+                       pid)
+    starts = {pid for pid, part in layout.parts.items() if part.start is not None} | set(geo.extra_parts)
+    for pid, name in pegs.items():
+        if pid not in starts:
+            raise fail(path, f"part_shapes.{name}", "parts", "parts of assembly.toml with a start, or of "
+                       f"[extra_parts] ({pid} is neither)", pid)
+    positions = {hid: layout.holes[hid].position for hid in holes}
+    turned = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.yaw for hid in hole_shape.holes}
+    _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items() if p is not None}, turned)
+    _check_kinds(path, geo, layout)
+    _check_product(path, geo, layout, holes)
+
+
+def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]], turned: set[str]) -> None:
+    """No two square bosses (side ``tile`` [m], around the holes at ``positions``) overlap.
+    A boss of a ``turned`` hole is turned with it: two bosses whose centres are closer than
+    ``tile`` overlap whatever their yaws (their inscribed circles do)."""
+    ordered = sorted(positions.items())
+    for k, (a, (xa, ya)) in enumerate(ordered):
+        for b, (xb, yb) in ordered[k + 1:]:
+            if a in turned or b in turned:
+                overlap = math.hypot(xa - xb, ya - yb) < tile - TOUCH_TOLERANCE
+            else:
+                overlap = abs(xa - xb) < tile - TOUCH_TOLERANCE and abs(ya - yb) < tile - TOUCH_TOLERANCE
+            if overlap:
+                raise BridgeError(f"{path}: [plate] tile_size: expected bosses that do not overlap, got holes "
+                                  f"{a} at ({xa:g}, {ya:g}) and {b} at ({xb:g}, {yb:g}) m closer than {tile:g} m")
+
+
+def _describe(kind: str, size: float | list[float]) -> str:
+    """``round d 12 mm``, ``square 4 mm``, ``rect 16 x 10 mm``."""
+    a, b = (1000 * side for side in _sides(size))
+    return {"round": f"round d {a:g} mm", "square": f"square {a:g} mm"}.get(kind, f"rect {a:g} x {b:g} mm")
+
+
+def _check_kinds(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
+    """The ``shape`` of each part and hole in ``assembly.toml`` (where given) is the
+    ``kind`` of its cross-section in ``geometry.toml``, and the parts of one ``section``
+    are scaled copies of one cross-section (one aspect ratio b/a, all round or none)."""
+    source = path.parent / "assembly.toml"
+    part_shape = {pid: shape for shape in geo.part_shapes.values() for pid in shape.parts}
+    hole_shape = {hid: shape for shape in geo.hole_shapes.values() for hid in shape.holes}
+    declared: list[tuple[str, str, str | None, HoleShape | PartShape | None]]
+    declared = [(pid, "part", part.shape, part_shape.get(pid)) for pid, part in layout.parts.items()]
+    declared += [(hid, "hole", hole.shape, hole_shape.get(hid)) for hid, hole in layout.holes.items()]
+    for item, what, shape, spec in declared:
+        if shape is not None and spec is not None and spec.kind != shape:
+            raise BridgeError(f"{source}: {what} '{item}' has shape \"{shape}\" but geometry.toml gives it kind "
+                              f"\"{spec.kind}\"")
+    first: dict[str, tuple[str, PartShape]] = {}
+    for pid, part in layout.parts.items():
+        spec = part_shape.get(pid)
+        if part.shape is None or spec is None:
+            continue
+        section = part.section or (pid if part.shape == "rect" else part.shape)
+        other_id, other = first.setdefault(section, (pid, spec))
+        (a, b), (oa, ob) = _sides(spec.size), _sides(other.size)
+        if (other.kind == "round") != (spec.kind == "round") or not math.isclose(b / a, ob / oa, rel_tol=1e-9):
+            raise BridgeError(f"{source}: parts '{other_id}' and '{pid}' share section \"{section}\" but are no "
+                              f"scaled copies of one cross-section ({_describe(other.kind, other.size)} and "
+                              f"{_describe(spec.kind, spec.size)} in geometry.toml)")
+
+
+def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: Mapping[str, str]) -> None:
+    """The base, covers and heads name parts of ``assembly.toml``, holes of the plate, part
+    shapes (their skills) and covers with a socket; with a ``[base]``, every part of
+    ``assembly.toml`` has exactly one geometry."""
+    skills = sorted(geo.part_shapes)
+    pegs = {pid for shape in geo.part_shapes.values() for pid in shape.parts}
+    for cid, cover in geo.covers.items():
+        table = f"covers.{cid}"
+        for hid in cover.over:
+            if hid not in holes:
+                raise fail(path, table, "over", f"holes of [hole_shapes.*] ({', '.join(sorted(holes))})", hid)
+        if len(set(cover.over)) != len(cover.over):
+            raise fail(path, table, "over", "distinct holes", cover.over)
+        xmin, ymin, xmax, ymax = cover.outline
+        if not (xmin < xmax and ymin < ymax):
+            raise fail(path, table, "outline", "[xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax",
+                       cover.outline)
+        if cover.socket is not None and not (0 < cover.socket[2] and 0 < cover.socket[3] < cover.thickness):
+            raise fail(path, table, "socket", f"[x, y, side, depth] with side > 0 and 0 < depth < thickness "
+                       f"({cover.thickness:g} m)", cover.socket)
+        if cover.skill not in geo.part_shapes:
+            raise fail(path, table, "skill", f"a part shape of [part_shapes.*] ({', '.join(skills)})", cover.skill)
+    for hid, head in geo.heads.items():
+        table = f"heads.{hid}"
+        cover_of = geo.covers.get(head.into)
+        if cover_of is None or cover_of.socket is None:
+            with_socket = sorted(c for c, t in geo.covers.items() if t.socket is not None)
+            raise fail(path, table, "into", f"a cover with a socket ({', '.join(with_socket) or 'none'})",
+                       head.into)
+        if head.skill not in geo.part_shapes:
+            raise fail(path, table, "skill", f"a part shape of [part_shapes.*] ({', '.join(skills)})", head.skill)
+        part = layout.parts.get(hid)
+        if part is None or part.start is None:
+            raise fail(path, table, "", "a part of assembly.toml with a start", hid)
+    for cid in geo.covers:
+        if cid not in layout.parts:
+            raise fail(path, f"covers.{cid}", "", "a part of assembly.toml", cid)
+    if geo.base is None:
+        return
+    if geo.base.part not in layout.parts:
+        raise fail(path, "base", "part", f"a part of assembly.toml ({', '.join(layout.parts)})", geo.base.part)
+    owners: dict[str, list[str]] = {pid: [] for pid in layout.parts}
+    for pid in pegs:
+        owners.get(pid, []).append("[part_shapes.*]")
+    for pid in geo.covers:
+        owners[pid].append("[covers.*]")
+    for pid in geo.heads:
+        owners[pid].append("[heads.*]")
+    owners[geo.base.part].append("[base]")
+    missing = sorted(pid for pid, tables in owners.items() if not tables)
+    if missing:
+        raise BridgeError(f"{path}: part(s) {', '.join(missing)} of assembly.toml have no geometry "
+                          "(expected a [part_shapes.*], [covers.*], [heads.*] or [base] entry)")
+    twice = sorted(pid for pid, tables in owners.items() if len(tables) > 1)
+    if twice:
+        raise BridgeError(f"{path}: part {twice[0]} of assembly.toml has more than one geometry "
+                          f"({' and '.join(owners[twice[0]])}); expected one")

@@ -1,0 +1,228 @@
+"""The structs of the product description (:mod:`assembly_constraints.bridge.product`): ``assembly.toml``
+(:class:`AssemblyFile`) and ``geometry.toml`` (:class:`GeometryFile`) as decoded TOML,
+their ranges and units in the types' descriptions (the error messages and the published
+JSON Schema say the same). Units: lengths and positions [m], masses [kg], inertia
+[kg m^2], yaw [degrees].
+
+Pairs and quadruples are lists of fixed length, not tuples: msgspec 0.22 corrupts memory
+when a union holds a constrained float and a tuple of them (docs/decisions.md).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated, Literal
+
+import msgspec
+from msgspec import Meta
+
+ID_PATTERN = r"^(?!not$)[a-z][a-zA-Z0-9_]{0,63}$(?!\n)"
+"""A part or hole id: an ASP constant of at most 64 ASCII characters, a lower-case letter
+first, not the keyword ``not`` (clingo's only lower-case keyword). ``(?!\n)`` keeps a
+trailing newline out (Python's ``$`` would match before it); the pattern means the same
+in Python and in JSON Schema (ECMA 262)."""
+_ID = re.compile(ID_PATTERN)
+
+
+def is_id(value: object) -> bool:
+    """Whether ``value`` is a part or hole id (:data:`ID_PATTERN`)."""
+    return isinstance(value, str) and _ID.match(value) is not None
+
+
+MAX_COORDINATE = 100.0
+"""Positions ([x, y] of parts and holes, a tool home) are finite with |x|, |y| <= this [m]."""
+SHAPES = ("round", "square", "rect")
+"""The cross-section kinds of a part's or hole's ``shape`` (``kind`` in ``geometry.toml``)."""
+SIZE_MODELS = ("line", "sections", "pairs")
+"""The size models a product may declare (``[sizes] model``; docs/sizes.md)."""
+TOUCH_TOLERANCE = 1e-6
+"""Bosses of neighbouring holes may touch (Cranfield's do), not overlap: up to rounding [m]."""
+DEFAULT_COVER_CLEARANCE = 0.003
+"""A cover's openings are its holes' sizes plus this when the file gives no ``clearance`` [m]."""
+
+Id = Annotated[str, Meta(pattern=ID_PATTERN, description="an id (a lower-case ASP constant of at most 64 "
+                         "characters, not 'not')")]
+Ids = Annotated[list[Id], Meta(min_length=1, max_length=1000, description="a non-empty list of distinct ids")]
+Text = Annotated[str, Meta(min_length=1, max_length=200, description="a non-empty text of at most 200 characters")]
+Kind = Literal["round", "square", "rect"]
+Coordinate = Annotated[float, Meta(ge=-MAX_COORDINATE, le=MAX_COORDINATE,
+                                   description="a number in [-100, 100] m")]
+XY = Annotated[list[Coordinate], Meta(min_length=2, max_length=2,
+                                      description="[x, y] in metres, finite and within ±100")]
+Offset = Annotated[float, Meta(ge=-1.0, le=1.0, description="a number in [-1, 1] m")]
+OffsetXY = Annotated[list[Offset], Meta(min_length=2, max_length=2, description="[x, y], each in [-1, 1] m")]
+Side = Annotated[float, Meta(gt=0.0, le=0.1, description="a number in (0, 0.1] m")]
+SectionSize = Side | Annotated[list[Side], Meta(min_length=2, max_length=2, description="for a rect [a, b] with "
+                                                "a >= b, each such a number")]
+Length = Annotated[float, Meta(gt=0.0, le=0.3, description="a number in (0, 0.3] m")]
+Mass = Annotated[float, Meta(gt=0.0, le=10.0, description="a number in (0, 10] kg")]
+Yaw = Annotated[float, Meta(gt=-360.0, le=360.0, description="a number in (-360, 360] degrees")]
+
+
+class Table(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """A table of a product file: unknown keys are refused."""
+
+
+# ---- assembly.toml ----
+
+class PartEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[parts.<id>]``: a readable ``name``, a ``role``, where the part waits (``start``
+    [m]), its cross-section kind (``shape``) and, for a rect part, its ``section`` label
+    (parts of one section are scaled copies of one cross-section)."""
+
+    name: Text | None = None
+    role: Text = "part"
+    start: XY | None = None
+    shape: Kind | None = None
+    section: Id | None = None
+
+
+class HoleEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[holes.<id>]``: a readable ``name``, its cross-section kind, its ``position`` [m]
+    on the base plate."""
+
+    name: Text | None = None
+    shape: Kind = "round"
+    position: XY | None = None
+
+
+class SizesTable(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[sizes]``: the size model the product declares (docs/sizes.md)."""
+
+    model: Literal["line", "sections", "pairs"]
+
+
+class AssemblyFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``assembly.toml``: the parts (at least one), the holes, the declared size model."""
+
+    parts: Annotated[dict[Id, PartEntry], Meta(min_length=1)]
+    name: Text | None = None
+    holes: dict[Id, HoleEntry] = {}
+    sizes: SizesTable | None = None
+
+
+# ---- geometry.toml ----
+
+class Plate(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[plate]``: the bosses' top face height, side and thickness (= hole depth), the
+    entry chamfer [m], the sides of a round hole's polygon, the plate under the bosses."""
+
+    top_z: Annotated[float, Meta(gt=0.0, le=1.0, description="a number in (0, 1] m")]
+    tile_size: Annotated[float, Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] m")]
+    tile_thickness: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
+    chamfer: Annotated[float, Meta(gt=0.0, le=0.01, description="a number in (0, 0.01] m")]
+    polygon_sides: Annotated[int, Meta(ge=8, le=256, multiple_of=8,
+                                       description="an integer multiple of 8 in 8 .. 256")]
+    base_thickness: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
+    base_size: Annotated[list[Annotated[float, Meta(gt=0.0, le=2.0)]],
+                         Meta(min_length=2, max_length=2, description="[x, y], each a number in (0, 2] m")]
+    base_center: XY
+
+
+class Gripper(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[gripper]``: flange + F/T sensor + gripper mass [kg] and inertia [kg m^2], flange
+    face to the fingertips [m], part length inside the fingers [m]."""
+
+    flange_mass: Annotated[float, Meta(gt=0.0, le=20.0, description="a number in (0, 20] kg")]
+    flange_inertia: Annotated[float, Meta(gt=0.0, le=1.0, description="a number in (0, 1] kg m^2")]
+    flange_length: Annotated[float, Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] m")]
+    grasp_depth: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
+
+
+class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[hole_shapes.<name>]``: holes of one cross-section; ``size`` a diameter or side
+    [m], for a rect ``[a, b]`` (a along the hole's x axis, turned by ``yaw`` [degrees])."""
+
+    holes: Ids
+    kind: Kind
+    size: SectionSize
+    yaw: Yaw = 0.0
+
+
+class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[part_shapes.<name>]``: pegs of one cross-section (the name is their skill's);
+    ``length`` [m], ``mass`` [kg], the hole its demonstration is taught in."""
+
+    parts: Ids
+    kind: Kind
+    size: SectionSize
+    length: Length
+    mass: Mass
+    demo_hole: Id
+
+
+class ExtraPart(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[extra_parts.<id>]``: a part of the cell that is not in ``assembly.toml``."""
+
+    start: XY
+    name: Text | None = None
+
+
+class Base(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[base]``: the part carrying the plate, where its ``base_center`` waits (``tray``
+    [m]), its grip point from ``base_center`` [m], its mass [kg]."""
+
+    part: Id
+    tray: XY
+    grip: OffsetXY
+    mass: Annotated[float, Meta(gt=0.0, le=50.0, description="a number in (0, 50] kg")]
+
+
+class Cover(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[covers.<id>]``: a part whose openings go down over the pins in the holes
+    ``over``; ``outline`` [xmin, ymin, xmax, ymax] [m] around their centre, ``socket``
+    ``[x, y, side, depth]`` [m] an optional blind opening for a head, ``skill`` the part
+    shape whose taught motion places it."""
+
+    over: Ids
+    outline: Annotated[list[Offset], Meta(min_length=4, max_length=4,
+                                          description="[xmin, ymin, xmax, ymax], each in [-1, 1] m")]
+    thickness: Annotated[float, Meta(gt=0.0, le=0.1, description="a number in (0, 0.1] m")]
+    mass: Mass
+    grip: OffsetXY
+    tray: XY
+    skill: Id
+    bottom: Annotated[float, Meta(ge=0.0, le=0.5, description="a number in [0, 0.5] m")] = 0.0
+    clearance: Annotated[float, Meta(ge=0.0, le=0.02, description="a number in [0, 0.02] m")] = \
+        DEFAULT_COVER_CLEARANCE
+    socket: Annotated[list[Offset], Meta(min_length=4, max_length=4,
+                                         description="[x, y, side, depth] in m")] | None = None
+    name: Text | None = None
+
+
+class Head(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[heads.<id>]``: a part going into the socket of cover ``into``; round (``size``
+    a diameter) or square (a side) [m], ``length`` [m], ``mass`` [kg]."""
+
+    into: Id
+    size: Side
+    length: Length
+    mass: Mass
+    skill: Id
+    kind: Literal["round", "square"] = "round"
+    name: Text | None = None
+
+
+class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``geometry.toml``: the plate, the cross-sections of holes and pegs, the cell's extra
+    parts, an optional gripper (else the cell description's), the product's base, covers
+    and heads."""
+
+    plate: Plate
+    hole_shapes: dict[Id, HoleShape] = {}
+    part_shapes: dict[Id, PartShape] = {}
+    extra_parts: dict[Id, ExtraPart] = {}
+    gripper: Gripper | None = None
+    base: Base | None = None
+    covers: dict[Id, Cover] = {}
+    heads: dict[Id, Head] = {}
+
+
+class ProductDescription(msgspec.Struct, frozen=True, kw_only=True):
+    """A product folder as decoded and checked: ``geometry`` None when it has no
+    ``geometry.toml`` (a planner-only product)."""
+
+    folder: Path
+    assembly: AssemblyFile
+    geometry: GeometryFile | None
