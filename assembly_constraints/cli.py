@@ -43,7 +43,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
     "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
     "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
-    "session": ("asp.session.run", "the end-to-end learning session (planner + cells)"),
+    "session": ("asp.session.cli", "the end-to-end learning session (planner + cells)"),
     "assemble": ("asp.assemble.cli", "execute a plan in a simulated cell, monitored and re-planned"),
     "view": ("asp.session.view", "open a session's Rerun recording"),
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),

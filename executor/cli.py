@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from bridge.cell_options import add_cell_arguments
+from bridge.cell_arguments import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, nonempty_path, png_path
 from bridge.files import write_atomic
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
@@ -57,7 +57,7 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from executor.cell_options import cell_keywords
+    from executor.cell_settings import cell_keywords
     from executor.trial import Cell
 
     logger = None
@@ -69,7 +69,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
         from executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
-    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
+    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(cell_settings_of(args)))
     try:
         results = []
         for k in range(args.trials):

@@ -48,8 +48,10 @@ import zenoh
 
 from bridge import BridgeError
 from bridge.assembly import load_assembly
-from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
+from bridge.cell_arguments import add_assembly_uncertainty_argument, add_cell_arguments, cell_settings_of
+from bridge.cell_settings import ServeSettings, decode_settings
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
+from bridge.inputs import read_bytes
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from bridge.messages import (
     MAX_MESSAGE_BYTES,
@@ -67,7 +69,7 @@ from bridge.messages import (
     decode_step_request,
     encode,
 )
-from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
+from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from executor import ExecutorError
 from executor.backends import (
@@ -82,7 +84,7 @@ from executor.backends import (
     check_step,
     load_backend,
 )
-from executor.cell_options import cell_keywords
+from executor.cell_settings import cell_keywords
 from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
 
@@ -381,10 +383,15 @@ def _stop_when_stdin_closes(node: CellNode) -> None:
     node.stop()  # no print: the supervisor that read our stdout may be gone
 
 
+SETTINGS_HELP = ("the cell's settings as one document: a JSON object (ServeSettings, docs/cell.md), or a file "
+                 "holding one; instead of the other options (a session starts its cells so)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(
         prog="executor serve", description="Serve insertion experiments over Zenoh "
         f"(default: listen on {DEFAULT_ENDPOINT}).")
+    parser.add_argument("--settings", metavar="JSON|FILE", help=SETTINGS_HELP)
     parser.add_argument("--cell", default="c1", help="cell id (default c1)")
     parser.add_argument("--backend", default="sim", metavar="{sim,truth,MODULE:CLASS}",
                         help="sim: PyBullet cell; truth: answer from the geometry, no simulation; MODULE:CLASS: "
@@ -410,37 +417,72 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
-    """The backend ``--backend`` names: the simulator, the geometry's truth or a user class."""
-    if args.backend == "truth":
-        return TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args),
-                            args.block_hole)
-    if args.backend == "sim":
-        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args), args.block_hole,
-                          uncertainty=args.uncertainty, ilc_state=args.ilc_state, **cell_keywords(args))
-    return load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
-                                                  dict(args.backend_option)))
+def _optional(path: Path | None) -> str | None:
+    return None if path is None else str(path)
+
+
+def serve_settings_of(args: argparse.Namespace) -> ServeSettings:
+    """The settings the options give: the ``--settings`` document, or the other options
+    (the same struct); BridgeError when both are given or the document is not one."""
+    settings = ServeSettings(
+        cell_id=args.cell, backend=args.backend, backend_options=dict(args.backend_option), assembly=args.assembly,
+        delay_s=args.delay, rrd=_optional(args.rrd), recording_id=args.recording_id, viewer_url=args.rerun_connect,
+        ilc_state=_optional(args.ilc_state), block_holes=tuple(args.block_hole), lifeline=args.lifeline,
+        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=_optional(args.zenoh_config),
+        cell=cell_settings_of(args))
+    if args.settings is None:
+        return settings
+    if settings != ServeSettings():
+        raise BridgeError("--settings: expected the cell's settings either as one document or as options, not both")
+    document = args.settings
+    if document.lstrip().startswith("{"):
+        return decode_settings(document, ServeSettings, "--settings")
+    return decode_settings(read_bytes(document, "cell settings file (JSON)"), ServeSettings, document)
+
+
+def _backend(settings: ServeSettings) -> Backend:
+    """The backend ``settings.backend`` names: the simulator, the geometry's truth or a user class."""
+    rrd = None if settings.rrd is None else Path(settings.rrd)
+    viewer = Viewer(settings.viewer_url)
+    if settings.backend == "truth":
+        return TruthBackend(settings.assembly, settings.delay_s, settings.cell_id, settings.recording_id, rrd, viewer,
+                            settings.block_holes)
+    if settings.backend == "sim":
+        return SimBackend(settings.assembly, settings.cell_id, settings.recording_id, rrd, viewer,
+                          settings.block_holes, uncertainty=settings.cell.uncertainty,
+                          ilc_state=None if settings.ilc_state is None else Path(settings.ilc_state),
+                          **cell_keywords(settings.cell))
+    return load_backend(settings.backend, CellContext(settings.cell_id, settings.assembly, rrd,
+                                                      settings.recording_id, settings.backend_options))
 
 
 def main(argv: Sequence[str]) -> int:
-    """Serve until SIGTERM/SIGINT; exit code 2 on bad options, a damaged ``--ilc-state`` or when another process
-    serves this cell id (:mod:`executor.claim`)."""
-    args = build_parser().parse_args(list(argv))
-    cell_id = check_cell_id(args.cell)
-    if args.backend == "sim" and args.ilc_state is not None:
-        from executor.control.ilc import read_state
+    """``executor serve``: the settings of the options, then :func:`serve`."""
+    return serve(serve_settings_of(build_parser().parse_args(list(argv))))
 
-        read_state(args.ilc_state)  # a damaged state is refused here, before the session opens
-    listen = cell_listen(args.listen, args.connect, args.zenoh_config)
+
+def serve(settings: ServeSettings) -> int:
+    """Serve until SIGTERM/SIGINT; exit code 2 on bad settings, a damaged ``ilc_state`` or when another process
+    serves this cell id (:mod:`executor.claim`)."""
+    cell_id = check_cell_id(settings.cell_id)
+    zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
+    if settings.backend == "sim":
+        cell_keywords(settings.cell)  # bad cell settings are refused here, before the session opens
+        if settings.ilc_state is not None:
+            from executor.control.ilc import read_state
+
+            read_state(Path(settings.ilc_state))  # so is a damaged state
+    listen = cell_listen(settings.listen, settings.connect, zenoh_config)
+    connect = list(settings.connect)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    session = open_session(listen, args.connect, args.zenoh_config)
+    session = open_session(listen, connect, zenoh_config)
     claim: CellClaim | None = None
     backend: Backend | None = None
     try:
         claim = CellClaim(session, cell_id)
         claim.check()  # before the backend starts: a refused cell loads nothing
-        backend = _backend(args, cell_id)
+        backend = _backend(settings)
         node = CellNode(cell_id, backend)
         claim.on_lost = lambda _why: node.stop()
         if claim.lost is not None:  # lost while the backend started
@@ -449,10 +491,10 @@ def main(argv: Sequence[str]) -> int:
                      session.declare_queryable(step_key(cell_id), node.on_step_query),
                      session.declare_queryable(ping_key(cell_id), _echo),
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
-        if args.lifeline:
+        if settings.lifeline:
             threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
-        print(f"ready cell {cell_id} backend {args.backend} "
-              f"listen {listen} connect {args.connect}", flush=True)
+        print(f"ready cell {cell_id} backend {settings.backend} "
+              f"listen {listen} connect {connect}", flush=True)
         node.serve()
     except SystemExit:
         pass  # SIGTERM/SIGINT: close below

@@ -22,12 +22,12 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from bridge.cell_options import add_cell_arguments
+from bridge.cell_arguments import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
-from executor.cell_options import perturbation_from_args
+from executor.cell_settings import perturbation_of
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5
@@ -117,7 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.ablation:
         with stdout_to_stderr():
             ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.jobs,
-                                    perturbation_from_args(args))
+                                    perturbation_of(cell_settings_of(args).magnitudes))
         print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
         return 0
     trials = args.trials or (1 if args.quick else 3)

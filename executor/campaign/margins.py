@@ -14,10 +14,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from bridge.cell_options import add_cell_arguments
+from bridge.cell_arguments import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor.campaign.pairs import PAIRS_ARGUMENT
-from executor.cell_options import cell_keywords
+from executor.cell_settings import cell_keywords
 from executor.control.detector import Thresholds
 from executor.trial import Cell, trial_rng
 
@@ -29,7 +29,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     add_cell_arguments(parser)
     args = parser.parse_args(argv)
-    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf), **cell_keywords(args))
+    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf), **cell_keywords(cell_settings_of(args)))
     pairs = args.pairs or [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     try:
         for part, hole in pairs:  # an unknown part or hole is an error before any trial runs

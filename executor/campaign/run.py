@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from bridge.cell_options import add_cell_arguments
+from bridge.cell_arguments import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
 from bridge.progress import progress
 from executor import ExecutorError
@@ -52,7 +52,7 @@ from executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from executor.cell_options import cell_keywords
+from executor.cell_settings import cell_keywords
 
 
 class TrialRunner(Protocol):
@@ -233,7 +233,7 @@ def main(argv: Sequence[str]) -> int:
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.jobs,
-            functools.partial(CellRunner, args.assembly, **cell_keywords(args)),
+            functools.partial(CellRunner, args.assembly, **cell_keywords(cell_settings_of(args))),
         )
         report = campaign_report(run, args.seed, args.jobs)
         if args.plot:

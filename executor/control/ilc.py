@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bridge.cell_options import LAYER_NAMES
+from bridge.cell_settings import LAYER_NAMES
 from bridge.files import write_atomic
 from bridge.inputs import duplicate_key, read_bytes, shorten
 from executor import ExecutorError
