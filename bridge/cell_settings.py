@@ -4,18 +4,22 @@ with (:class:`ServeSettings`, ``executor serve --settings DOC``).
 
 Here in ``bridge`` because both sides use them: the planner builds the document for each
 cell it starts, the cell decodes it. The command-line options that build the same
-structs by hand are in :mod:`bridge.cell_arguments`. Units and reasons of the
-magnitudes in docs/cell.md.
+structs by hand (:func:`add_cell_arguments`, :func:`cell_settings_of`) are here too,
+shared by the cell's commands (``executor trial``, ``campaign``, ``serve``, ``bench
+executor``) and the planner's commands that start cells (``session``, ``assemble``).
+Units and reasons of the magnitudes in docs/cell.md.
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, TypeVar
+import argparse
+import re
+from typing import Annotated, Any, Literal, TypeVar
 
 import msgspec
 
 from bridge import BridgeError
-from bridge.cli_types import MAX_SEED
+from bridge.cli_types import MAX_SEED, finite_float, int_in
 from bridge.inputs import shorten
 
 Layer = Literal["position", "admittance_p", "admittance_pi", "pi_phase_stop", "full"]
@@ -133,12 +137,16 @@ def encode_settings(settings: msgspec.Struct) -> str:
 
 def validation_text(exc: msgspec.ValidationError) -> str:
     """msgspec's ``Expected `int`, got `str` - at `$.cell.cell_seed``` as ``"cell.cell_seed":
-    expected `int`, got `str```: the field first, as the project's messages put it."""
+    expected `int`, got `str```, and ``Object missing required field `x``` as ``"x":
+    missing (a required field)``: the field first, as the project's messages put it."""
     message, sep, where = str(exc).rpartition(" - at `")
     if not sep:
-        return str(exc)
+        message, where = str(exc), "$"
     field = where.rstrip("`").removeprefix("$").removeprefix(".")
-    return f'"{field}": {message[:1].lower()}{message[1:]}'
+    missing = re.fullmatch(r"Object missing required field `(.+)`", message)
+    if missing:
+        return f'"{".".join(filter(None, (field, missing.group(1))))}": missing (a required field)'
+    return f'"{field}": {message[:1].lower()}{message[1:]}' if field else message
 
 
 def decode_settings(data: bytes | str, kind: type[_T], source: str) -> _T:
@@ -151,3 +159,54 @@ def decode_settings(data: bytes | str, kind: type[_T], source: str) -> _T:
     except msgspec.DecodeError as exc:
         raise BridgeError(f"{source}: not JSON ({shorten(exc, 80)}); expected the {kind.__name__} "
                           "document") from None
+
+
+def _option(name: str) -> str:
+    return f"--{name.replace('_', '-')}"
+
+
+def add_cell_arguments(parser: argparse.ArgumentParser, *, layer: bool = True, cell_seed: bool = True) -> None:
+    """``--layer`` (unless ``layer`` is False), ``--cell-seed`` (unless ``cell_seed`` is
+    False) and the ``--<magnitude>`` options, in one argument group."""
+    group = parser.add_argument_group("execution layer and uncertainty of the cell (docs/cell.md)")
+    if layer:
+        group.add_argument("--layer", choices=LAYER_NAMES, default=DEFAULT_LAYER,
+                           help="execution layer: pure position control along the DMP, admittance P, "
+                           f"admittance PI, PI + phase stopping, all + ILC (default {DEFAULT_LAYER})")
+    if cell_seed:
+        group.add_argument("--cell-seed", type=int_in(0, MAX_SEED), default=0,
+                           help="seed of the cell's systematic errors (default 0)")
+    for field in MAGNITUDE_FIELDS:
+        meta = field.type.__metadata__[0]
+        group.add_argument(_option(field.name), type=finite_float(0.0, meta.le), default=field.default,
+                           metavar="X", help=f"{meta.description} (default {field.default})")
+
+
+def add_assembly_uncertainty_argument(parser: argparse.ArgumentParser) -> None:
+    """``--uncertainty {random,cell}`` of the assembling cell (plan steps)."""
+    parser.add_argument("--uncertainty", choices=ASSEMBLY_UNCERTAINTIES, default=ASSEMBLY_UNCERTAINTIES[0],
+                        help="plan steps: random = the assembling cell's own random errors only, no ILC; cell = "
+                        "the cell's uncertainty (--cell-seed, magnitudes) with its --layer and ILC (default random)")
+
+
+def cell_settings_of(args: argparse.Namespace, **fixed: Any) -> CellSettings:
+    """The cell settings the options of :func:`add_cell_arguments` (and
+    :func:`add_assembly_uncertainty_argument`) give; an option a parser lacks keeps its
+    default, ``fixed`` sets fields the command decides (e.g. a session's cell seed)."""
+    values: dict[str, Any] = {name: getattr(args, name) for name in ("layer", "cell_seed", "uncertainty")
+                              if hasattr(args, name)}
+    try:
+        magnitudes = msgspec.convert({field.name: getattr(args, field.name) for field in MAGNITUDE_FIELDS},
+                                     Magnitudes)
+    except msgspec.ValidationError as exc:  # the options are each in range; their combination is not
+        raise BridgeError(f"the cell's uncertainty: {exc}") from None
+    return CellSettings(**{**values, "magnitudes": magnitudes, **fixed})
+
+
+def changed_cell_options(settings: CellSettings) -> list[str]:
+    """The options (``--layer``, ``--cell-seed``, ``--<magnitude>``) whose values in
+    ``settings`` are not the defaults, in the order of the help page."""
+    changed = [_option(name) for name in ("layer", "cell_seed")
+               if getattr(settings, name) != getattr(DEFAULT_CELL, name)]
+    return changed + [_option(field.name) for field in MAGNITUDE_FIELDS
+                      if getattr(settings.magnitudes, field.name) != field.default]

@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from bridge.cell_arguments import add_cell_arguments, cell_settings_of
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, nonempty_path, png_path
 from bridge.files import write_atomic
 from bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, hosted_viewer, keep_serving, viewer_of

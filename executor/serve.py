@@ -48,8 +48,13 @@ import zenoh
 
 from bridge import BridgeError
 from bridge.assembly import load_assembly
-from bridge.cell_arguments import add_assembly_uncertainty_argument, add_cell_arguments, cell_settings_of
-from bridge.cell_settings import ServeSettings, decode_settings
+from bridge.cell_settings import (
+    ServeSettings,
+    add_assembly_uncertainty_argument,
+    add_cell_arguments,
+    cell_settings_of,
+    decode_settings,
+)
 from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
 from bridge.inputs import read_bytes
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key

@@ -42,7 +42,7 @@ from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import Plan, plans
 from asp.session.settings import SESSION_FILE, SessionFile, read_session_file
 from bridge.assembly import Assembly, load_assembly
-from bridge.cell_arguments import add_assembly_uncertainty_argument, add_cell_arguments, cell_settings_of
+from bridge.cell_settings import add_assembly_uncertainty_argument, add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
 from bridge.errors import EXIT_UNSOLVABLE
 from bridge.session import add_endpoint_arguments

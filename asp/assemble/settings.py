@@ -8,8 +8,7 @@ from typing import Annotated, Literal
 from msgspec import Meta, Struct
 
 from asp import PlannerError
-from bridge.cell_arguments import changed_cell_options
-from bridge.cell_settings import DEFAULT_CELL, CellSettings, Seed
+from bridge.cell_settings import DEFAULT_CELL, CellSettings, Seed, changed_cell_options
 
 MAX_PLAN_INDEX = 1000
 MAX_STEP_S = 86_400.0

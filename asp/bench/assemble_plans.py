@@ -45,8 +45,13 @@ from asp.plans.plans import Plan, PlanStep, check_plan
 from asp.precedence.count import UniformSampler
 from asp.precedence.relation import Relation
 from bridge.assembly import Assembly, load_assembly
-from bridge.cell_arguments import add_assembly_uncertainty_argument, add_cell_arguments, cell_settings_of
-from bridge.cell_settings import DEFAULT_CELL, CellSettings
+from bridge.cell_settings import (
+    DEFAULT_CELL,
+    CellSettings,
+    add_assembly_uncertainty_argument,
+    add_cell_arguments,
+    cell_settings_of,
+)
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, finite_float, int_in
 
 ASSIGNMENT_LIMIT = 10_000

@@ -44,14 +44,20 @@ class CellProcess:
     terminal would: the kernel then schedules it beside the planner rather than inside
     the planner's share of the cores (with autogroup scheduling, two cells in the
     planner's session shared one core on a loaded machine). It still ends with the
-    planner: ``--lifeline`` makes it exit when its stdin closes.
+    planner: ``lifeline`` makes it exit when its stdin closes.
     """
+
+    @staticmethod
+    def command(settings: ServeSettings) -> list[str]:
+        """The command line of the cell: ``executor serve --settings JSON``, the settings
+        with ``lifeline`` set and their files' paths absolute."""
+        started = _absolute(msgspec.structs.replace(settings, lifeline=True))
+        return [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--settings",
+                encode_settings(started)]
 
     def __init__(self, settings: ServeSettings) -> None:
         self.cell_id = settings.cell_id
-        self.settings = _absolute(msgspec.structs.replace(settings, lifeline=True))
-        argv = [sys.executable, "-m", "assembly_constraints", "executor", "serve",
-                "--settings", encode_settings(self.settings)]
+        argv = self.command(settings)
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
         self.popen = subprocess.Popen(argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,

@@ -23,7 +23,7 @@ from asp.sizes.cli import add_model_option
 from asp.sizes.learner import MAX_CONFIRM
 from asp.sizes.policies import policy_names
 from asp.solve import encoding
-from bridge.cell_arguments import add_cell_arguments, cell_settings_of
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
 from bridge.errors import EXIT_UNSOLVABLE
 from bridge.keys import check_cell_id

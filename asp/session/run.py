@@ -265,6 +265,23 @@ def run_session(settings: SessionSettings, viewer: Viewer = NO_VIEWER) -> dict:
         lock.release()
 
 
+def session_cell(settings: SessionSettings, record: SessionFile, run: Path, number: int, connect: list[str],
+                 viewer_url: str | None) -> ServeSettings:
+    """The settings of the session's cell ``c<number>`` (1, 2, ...) connecting to
+    ``connect``: its recording ``RUN/c<k>[-<start>].rrd`` in the run's recording id, its
+    cell seed (:func:`asp.session.cells.cell_seed`) and, for a sim cell, its ILC
+    corrections kept in ``RUN/c<k>-ilc.json`` (a resume passes the same file, so the
+    cell reloads what it learned)."""
+    cell_id = f"c{number}"
+    suffix = "" if record.starts == 1 else f"-{record.starts}"
+    return ServeSettings(
+        cell_id=cell_id, backend=settings.backend, assembly=str(load_assembly(record.assembly).folder),
+        connect=tuple(connect), delay_s=settings.delay_s, rrd=str(run / f"{cell_id}{suffix}.rrd"),
+        recording_id=record.recording_id, zenoh_config=settings.zenoh_config, viewer_url=viewer_url,
+        ilc_state=str(run / f"{cell_id}-ilc.json") if settings.backend == "sim" else None,
+        cell=msgspec.structs.replace(record.cell, cell_seed=cell_seed(record.cell.cell_seed, number)))
+
+
 def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, started: float,
                 viewer: Viewer) -> dict:
     """:func:`run_session` in the locked run folder ``run`` whose ``session.json`` is
@@ -298,14 +315,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         stack.callback(directory.close)
         cells: list[CellProcess] = []
         stack.callback(lambda: [cell.stop() for cell in cells])
-        for number, cell_id in enumerate(cell_ids, start=1):  # they start up in parallel with each other and us
-            sim = settings.backend == "sim"
-            cells.append(CellProcess(ServeSettings(
-                cell_id=cell_id, backend=settings.backend, assembly=str(assembly.folder), connect=tuple(listen[:1]),
-                delay_s=settings.delay_s, rrd=str(run / f"{cell_id}{suffix}.rrd"), recording_id=record.recording_id,
-                zenoh_config=settings.zenoh_config, viewer_url=viewer.connect,
-                ilc_state=str(run / f"{cell_id}-ilc.json") if sim else None,
-                cell=msgspec.structs.replace(record.cell, cell_seed=cell_seed(record.cell.cell_seed, number)))))
+        for number in range(1, settings.cells + 1):  # they start up in parallel with each other and us
+            cells.append(CellProcess(session_cell(settings, record, run, number, listen[:1], viewer.connect)))
         log = PlannerLog(run / f"planner{suffix}.rrd", record.recording_id, cell_ids, viewer,
                          assembling=cell_ids[:1] if settings.assemble else ())
         stack.callback(log.close)

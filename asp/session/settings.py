@@ -198,10 +198,14 @@ def read_session_file(run: Path) -> SessionFile:
         raise PlannerError(f"{path}: not JSON ({shorten(exc, 80)}); expected the settings a session wrote") from None
     if not isinstance(raw, dict):
         raise PlannerError(f"{path}: a JSON {type(raw).__name__}; expected an object with the session's settings")
+    old = "format" not in raw
     try:
-        return msgspec.convert(raw if "format" in raw else _from_format_1(raw), SessionFile)
+        return msgspec.convert(_from_format_1(raw) if old else raw, SessionFile)
     except msgspec.ValidationError as exc:
-        raise PlannerError(f"{path}: {shorten(validation_text(exc), 200)}") from None
+        text = validation_text(exc)
+        if old and text.startswith('"cell.'):
+            text = f'"cell_options" (format 1, read as "cell"): {text}'
+        raise PlannerError(f"{path}: {shorten(text, 200)}") from None
     except ValueError as exc:  # format 1's cell options
         raise PlannerError(f"{path}: {shorten(exc, 200)}") from None
 

@@ -22,7 +22,7 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from bridge.cell_arguments import add_cell_arguments, cell_settings_of
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from bridge.cell_arguments import add_cell_arguments, cell_settings_of
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor.campaign.pairs import PAIRS_ARGUMENT
 from executor.cell_settings import cell_keywords

@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from bridge.cell_arguments import add_cell_arguments, cell_settings_of
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, int_in
 from bridge.progress import progress
 from executor import ExecutorError

@@ -14,8 +14,7 @@ from asp.assemble.cli import assembly_settings, build_parser
 from asp.assemble.settings import assembling_cell_settings
 from asp.bench.assemble_plans import build_parser as bench_parser
 from asp.session.cells import CellProcess
-from bridge.cell_arguments import cell_settings_of
-from bridge.cell_settings import DEFAULT_CELL, ServeSettings
+from bridge.cell_settings import DEFAULT_CELL, ServeSettings, cell_settings_of
 from executor.serve import build_parser as serve_parser
 from executor.serve import serve_settings_of
 
