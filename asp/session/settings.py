@@ -97,17 +97,18 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     connect: tuple[str, ...] = ()
     zenoh_config: str | None = None
 
-    def __post_init__(self) -> None:
-        _check_choices(self.policy, self.model)
-
 
 def checked(settings: SessionSettings) -> SessionSettings:
-    """``settings`` if every field is in its range (a struct built in Python is not
-    checked as a decoded one is); PlannerError naming the field otherwise."""
+    """``settings`` if every field is in its range and the policy and model are known (a
+    struct built in Python is not checked as a decoded one is); PlannerError naming the
+    field otherwise."""
     try:
+        _check_choices(settings.policy, settings.model)
         return msgspec.convert(msgspec.to_builtins(settings), SessionSettings)
     except msgspec.ValidationError as exc:
         raise PlannerError(f"session settings: {validation_text(exc)}") from None
+    except ValueError as exc:
+        raise PlannerError(f"session settings: {exc}") from None
 
 
 class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
