@@ -14,8 +14,8 @@ process later.
 - Valid requests run one at a time in the main thread. Results are idempotent by
   request id: a repeated id gets the cached reply and never re-runs the experiment.
 - Backends: ``sim`` runs the PyBullet :class:`executor.trial.Cell` (imported lazily)
-  with the execution layer and uncertainty of the options (``--layer``, ``--cell-seed``,
-  ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
+  with the execution layer and uncertainty of its cell settings (``--layer``,
+  ``--cell-seed``, ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
   ``MODULE:CLASS`` loads a user's backend (:mod:`executor.backends`), e.g. a real robot.
@@ -24,6 +24,10 @@ process later.
   steps of one plan run), ``truth`` from the geometry; ``--block-hole H`` puts an obstacle
   in hole H (a fault to show the planner's recovery); ``--uncertainty cell`` gives the
   plan steps the cell's uncertainty, layer and ILC (default ``random``: their own errors).
+
+Its settings are one :class:`bridge.cell_settings.ServeSettings`: ``--settings JSON|FILE``
+(how a session starts its cells) or the options below, which build the same struct; the
+node takes only the struct (:func:`serve`).
 
 One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
 ``done <id> <result>``), flushed, so a supervisor can follow the node.
