@@ -191,7 +191,7 @@ def read_session_file(run: Path) -> SessionFile:
     field, and what was expected, when it is missing, not JSON or not one a session writes."""
     path = run / SESSION_FILE
     if not path.is_file():
-        raise PlannerError(f"{run}: expected a run folder holding {SESSION_FILE}")
+        raise PlannerError(f"{run}: not a run folder (expected {SESSION_FILE} in it)")
     data = read_bytes(path, "session settings file (JSON)", error=PlannerError)
     try:
         raw = json.loads(data)
