@@ -59,7 +59,7 @@ from bridge.cell_settings import (
     cell_settings_of,
     decode_settings,
 )
-from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
+from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, path_setting
 from bridge.inputs import read_bytes
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from bridge.messages import (
@@ -426,18 +426,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _optional(path: Path | None) -> str | None:
-    return None if path is None else str(path)
-
-
 def serve_settings_of(args: argparse.Namespace) -> ServeSettings:
     """The settings the options give: the ``--settings`` document, or the other options
     (the same struct); BridgeError when both are given or the document is not one."""
     settings = ServeSettings(
         cell_id=args.cell, backend=args.backend, backend_options=dict(args.backend_option), assembly=args.assembly,
-        delay_s=args.delay, rrd=_optional(args.rrd), recording_id=args.recording_id, viewer_url=args.rerun_connect,
-        ilc_state=_optional(args.ilc_state), block_holes=tuple(args.block_hole), lifeline=args.lifeline,
-        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=_optional(args.zenoh_config),
+        delay_s=args.delay, rrd=path_setting(args.rrd), recording_id=args.recording_id, viewer_url=args.rerun_connect,
+        ilc_state=path_setting(args.ilc_state), block_holes=tuple(args.block_hole), lifeline=args.lifeline,
+        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config),
         cell=cell_settings_of(args))
     if args.settings is None:
         return settings

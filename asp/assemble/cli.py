@@ -43,7 +43,7 @@ from asp.plans.plans import Plan, plans
 from asp.session.settings import SESSION_FILE, SessionFile, read_session_file
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_settings import add_assembly_uncertainty_argument, add_cell_arguments, cell_settings_of
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in, path_setting
 from bridge.errors import EXIT_UNSOLVABLE
 from bridge.session import add_endpoint_arguments
 
@@ -74,17 +74,13 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _optional(path: Path | None) -> str | None:
-    return None if path is None else str(path)
-
-
 def assembly_settings(args: argparse.Namespace) -> AssemblySettings:
     """The settings the options of :func:`build_parser` give."""
     return AssemblySettings(
-        inputs=tuple(map(str, args.inputs)), run=_optional(args.run), plan=args.plan, assembly=args.assembly,
+        inputs=tuple(map(str, args.inputs)), run=path_setting(args.run), plan=args.plan, assembly=args.assembly,
         seed=args.seed, block_holes=tuple(args.block_hole), backend=args.backend, timeout_s=args.timeout,
-        rrd=_optional(args.rrd), cell=cell_settings_of(args), listen=tuple(args.listen),
-        connect=tuple(args.connect), zenoh_config=_optional(args.zenoh_config))
+        rrd=path_setting(args.rrd), cell=cell_settings_of(args), listen=tuple(args.listen),
+        connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config))
 
 
 def truth_sources(assembly: Assembly) -> str:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import logging
 import shlex
 import sys
 from pathlib import Path
@@ -17,21 +16,27 @@ from pathlib import Path
 from msgspec import UNSET
 
 from asp.session.cells import ROOT
-from asp.session.run import run_session
+from asp.session.run import LOG, run_session
 from asp.session.settings import MAX_CELLS, MAX_PLANS, MAX_WAIT_S, SessionSettings, read_session_file
 from asp.sizes.cli import add_model_option
 from asp.sizes.learner import MAX_CONFIRM
 from asp.sizes.policies import policy_names
 from asp.solve import encoding
 from bridge.cell_settings import add_cell_arguments, cell_settings_of
-from bridge.cli_types import MAX_SEED, PROGRAM, ArgumentParser, add_assembly_argument, comma_list, finite_float, int_in
+from bridge.cli_types import (
+    MAX_SEED,
+    PROGRAM,
+    ArgumentParser,
+    add_assembly_argument,
+    comma_list,
+    finite_float,
+    int_in,
+    path_setting,
+)
 from bridge.errors import EXIT_UNSOLVABLE
 from bridge.keys import check_cell_id
 from bridge.recording.sinks import add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
 from bridge.session import add_endpoint_arguments
-
-LOG = logging.getLogger("asp.session.run")
-"""The session's log (its progress is logged there too)."""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -75,19 +80,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _optional(path: Path | None) -> str | None:
-    return None if path is None else str(path)
-
-
 def session_settings(args: argparse.Namespace) -> SessionSettings:
     """The settings the options of :func:`build_parser` give; the cells' first cell seed is ``--seed``."""
     return SessionSettings(
         assembly=args.assembly, policy=args.policy, model=args.model, seed=args.seed, confirm=args.confirm,
-        demos=_optional(args.demos), cell=cell_settings_of(args, cell_seed=args.seed), out=_optional(args.out),
-        resume=_optional(args.resume), cells=args.cells, backend=args.backend, delay_s=args.delay,
+        demos=path_setting(args.demos), cell=cell_settings_of(args, cell_seed=args.seed), out=path_setting(args.out),
+        resume=path_setting(args.resume), cells=args.cells, backend=args.backend, delay_s=args.delay,
         timeout_s=args.timeout, wait_for_cell_s=args.wait_for_cell, plans=args.plans,
         allow_cells=None if args.allow_cells is None else tuple(args.allow_cells), assemble=args.assemble,
-        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=_optional(args.zenoh_config))
+        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config))
 
 
 def _program() -> str:
