@@ -57,8 +57,7 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from executor.cell_settings import cell_keywords
-    from executor.trial import Cell
+    from executor.trial import Cell, cell_keywords
 
     logger = None
     if args.plot:

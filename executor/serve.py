@@ -46,13 +46,15 @@ from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import zenoh
 
 from bridge import BridgeError
 from bridge.assembly import load_assembly
 from bridge.cell_settings import (
+    DEFAULT_CELL,
+    CellSettings,
     ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
@@ -93,7 +95,6 @@ from executor.backends import (
     check_step,
     load_backend,
 )
-from executor.cell_settings import cell_keywords
 from executor.claim import CellClaim, ClaimLost
 from executor.world.geometry import load_geometry, passes
 
@@ -193,22 +194,22 @@ class SimBackend:
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
                  rrd: Path | None, viewer: Viewer = NO_VIEWER, blocked: Sequence[str] = (),
-                 uncertainty: str = "random", **cell_keywords: Any) -> None:
+                 cell: CellSettings = DEFAULT_CELL, ilc_state: Path | None = None) -> None:
         """``viewer``: also stream the recording live; ``blocked``: holes with an obstacle
-        for plan steps; ``uncertainty``: ``cell`` gives plan steps the Cell's uncertainty
-        (its systematic errors), layer and an ILC, ``random`` their own; ``cell_keywords``:
-        the Cell's options (layer, perturbation, cell seed, ``ilc_state``: the file its ILC
-        corrections are loaded from and saved to, atomically after every update, so a
-        resumed session's cell starts from them)."""
-        from executor.trial import Cell
+        for plan steps; ``cell``: the Cell's settings (layer, uncertainty, cell seed; with
+        ``uncertainty`` ``cell`` plan steps get the Cell's uncertainty (its systematic
+        errors), layer and an ILC, with ``random`` their own); ``ilc_state``: the file its
+        ILC corrections are loaded from and saved to, atomically after every update, so a
+        resumed session's cell starts from them."""
+        from executor.trial import Cell, cell_keywords
 
         _PlannerNumbered = _planner_numbered_logger()
         self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd, viewer=viewer,
                                          send_blueprint=False)  # the planner sends it
                         if rrd is not None or viewer != NO_VIEWER else None)
-        self._cell = Cell(assembly, gui=False, logger=self._logger, **cell_keywords)
+        self._cell = Cell(assembly, gui=False, logger=self._logger, ilc_state=ilc_state, **cell_keywords(cell))
         self._assembly, self._blocked, self._cell_id = assembly, list(blocked), cell_id
-        self._cell_uncertainty = uncertainty == "cell"
+        self._cell_uncertainty = cell.uncertainty == "cell"
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
@@ -454,9 +455,8 @@ def _backend(settings: ServeSettings) -> Backend:
                             settings.block_holes)
     if settings.backend == "sim":
         return SimBackend(settings.assembly, settings.cell_id, settings.recording_id, rrd, viewer,
-                          settings.block_holes, uncertainty=settings.cell.uncertainty,
-                          ilc_state=None if settings.ilc_state is None else Path(settings.ilc_state),
-                          **cell_keywords(settings.cell))
+                          settings.block_holes, settings.cell,
+                          None if settings.ilc_state is None else Path(settings.ilc_state))
     return load_backend(settings.backend, CellContext(settings.cell_id, settings.assembly, rrd,
                                                       settings.recording_id, settings.backend_options))
 
@@ -472,6 +472,8 @@ def serve(settings: ServeSettings) -> int:
     cell_id = check_cell_id(settings.cell_id)
     zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
     if settings.backend == "sim":
+        from executor.trial import cell_keywords
+
         cell_keywords(settings.cell)  # bad cell settings are refused here, before the session opens
         if settings.ilc_state is not None:
             from executor.control.ilc import read_state

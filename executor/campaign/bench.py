@@ -27,7 +27,7 @@ from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, ad
 from executor.campaign.ablation import format_ablation, run_ablation
 from executor.campaign.pairs import campaign_pairs
 from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
-from executor.cell_settings import perturbation_of
+from executor.world.perturbation import PerturbationModel
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5
@@ -117,7 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.ablation:
         with stdout_to_stderr():
             ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.jobs,
-                                    perturbation_of(cell_settings_of(args).magnitudes))
+                                    PerturbationModel.of(cell_settings_of(args).magnitudes))
         print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
         return 0
     trials = args.trials or (1 if args.quick else 3)

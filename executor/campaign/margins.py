@@ -17,9 +17,8 @@ from collections.abc import Sequence
 from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from executor.campaign.pairs import PAIRS_ARGUMENT
-from executor.cell_settings import cell_keywords
 from executor.control.detector import Thresholds
-from executor.trial import Cell, trial_rng
+from executor.trial import Cell, cell_keywords, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -52,7 +52,7 @@ from executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from executor.cell_settings import cell_keywords
+from executor.trial import cell_keywords
 
 
 class TrialRunner(Protocol):

@@ -32,6 +32,7 @@ import math
 import zlib
 from dataclasses import dataclass, field, fields
 
+import msgspec
 import numpy as np
 
 from bridge.cell_settings import Magnitudes
@@ -60,6 +61,11 @@ class PerturbationModel:
     friction_min: float = _DEFAULT.friction_min
     friction_max: float = _DEFAULT.friction_max
     friction_jitter: float = _DEFAULT.friction_jitter
+
+    @classmethod
+    def of(cls, magnitudes: Magnitudes) -> PerturbationModel:
+        """The model of the cell settings' magnitudes; ExecutorError if inconsistent."""
+        return cls(**msgspec.structs.asdict(magnitudes)).check()
 
     def random_only(self) -> PerturbationModel:
         """The same random parts with every systematic part zero (friction: the middle of
