@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -71,8 +71,7 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from assembly_constraints.executor.cell_options import cell_keywords
-    from assembly_constraints.executor.trial import Cell
+    from assembly_constraints.executor.trial import Cell, cell_keywords
 
     logger = None
     if args.plot:
@@ -83,7 +82,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
         from assembly_constraints.executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
-    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(args))
+    cell = Cell(args.assembly, gui=args.gui, logger=logger, **cell_keywords(cell_settings_of(args)))
     try:
         results = []
         for k in range(args.trials):

@@ -18,10 +18,11 @@ from __future__ import annotations
 
 import time
 import zlib
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from assembly_constraints.bridge.cell_settings import CellSettings
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.control.controller import ImpedanceController
 from assembly_constraints.executor.control.detector import Detector, Thresholds
@@ -51,6 +52,16 @@ APPROACH_SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
     """The random stream of one trial: same seed, part and hole → same trial."""
     return np.random.default_rng([seed, zlib.crc32(part.encode()), zlib.crc32(hole.encode())])
+
+
+def cell_keywords(settings: CellSettings) -> dict[str, Any]:
+    """Keyword arguments of :class:`Cell` from the cell settings; ExecutorError when they
+    name a cell description file (the cell does not read one yet) or inconsistent magnitudes."""
+    if settings.description is not None:
+        raise ExecutorError(f"cell description {settings.description}: this cell does not read description "
+                            "files yet; expected none (null)")
+    return {"layer": settings.layer, "perturbation": PerturbationModel.of(settings.magnitudes),
+            "cell_seed": settings.cell_seed}
 
 
 class Cell:

@@ -14,12 +14,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT
-from assembly_constraints.executor.cell_options import cell_keywords
 from assembly_constraints.executor.control.detector import Thresholds
-from assembly_constraints.executor.trial import Cell, trial_rng
+from assembly_constraints.executor.trial import Cell, cell_keywords, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -29,7 +28,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     add_cell_arguments(parser)
     args = parser.parse_args(argv)
-    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf), **cell_keywords(args))
+    cell = Cell(thresholds=Thresholds(f_stop=math.inf, m_stop=math.inf), **cell_keywords(cell_settings_of(args)))
     pairs = args.pairs or [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     try:
         for part, hole in pairs:  # an unknown part or hole is an error before any trial runs

@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -58,7 +58,7 @@ from assembly_constraints.executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from assembly_constraints.executor.cell_options import cell_keywords
+from assembly_constraints.executor.trial import cell_keywords
 
 
 class TrialRunner(Protocol):
@@ -239,7 +239,7 @@ def main(argv: Sequence[str]) -> int:
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.jobs,
-            functools.partial(CellRunner, args.assembly, **cell_keywords(args)),
+            functools.partial(CellRunner, args.assembly, **cell_keywords(cell_settings_of(args))),
         )
         report = campaign_report(run, args.seed, args.jobs)
         if args.plot:
