@@ -17,11 +17,12 @@ with a one-line message naming the file or value. Documented in ``docs/api.md``.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal, TypedDict
+
+from msgspec import UNSET
 
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.plans.assign import load_learned_facts
@@ -30,19 +31,20 @@ from assembly_constraints.asp.precedence.demos import load_demos
 from assembly_constraints.asp.precedence.learn import learn_must_precede
 from assembly_constraints.asp.precedence.relation import Relation, precedence_facts
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from assembly_constraints.asp.session.settings import SessionFile, SessionSettings, read_session_file
 from assembly_constraints.asp.sizes.learner import Experiment, SizeLearningResult
 from assembly_constraints.asp.sizes.learner import learn_sizes as _learn_sizes
 from assembly_constraints.asp.sizes.truth_oracle import Oracle, TruthOracle
 from assembly_constraints.asp.solve import write_facts as _write_facts
 from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.inputs import read_bytes
+from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
 
 Result = Literal["fit", "no_fit"]
 """The outcome of one insertion experiment."""
 
-__all__ = ["Experiment", "JournalEntry", "Plan", "PlannerError", "Relation", "Result", "RunFolder", "SessionResult",
-           "SizeLearningResult", "learn_precedence", "learn_sizes", "plan", "read_run", "run_session",
-           "truth_oracle", "write_facts"]
+__all__ = ["CellSettings", "Experiment", "JournalEntry", "Magnitudes", "Plan", "PlannerError", "Relation", "Result",
+           "RunFolder", "SessionFile", "SessionResult", "SizeLearningResult", "learn_precedence", "learn_sizes",
+           "plan", "read_run", "run_session", "truth_oracle", "write_facts"]
 
 
 def learn_precedence(assembly: str | Path = "cranfield", demos: str | Path | None = None,
@@ -133,36 +135,37 @@ class SessionResult(TypedDict):
 def run_session(assembly: str | Path = "cranfield", *, out: str | Path | None = None,
                 backend: Literal["sim", "truth"] = "sim", cells: int = 1, policy: str = "best", seed: int = 0,
                 confirm: int = 0, timeout_s: float = 120.0, plans: int = 5,
-                connect: Sequence[str] = ()) -> SessionResult:
+                connect: Sequence[str] = (), cell: CellSettings | None = None) -> SessionResult:
     """A whole learning session (``assembly-constraints session``): learns precedence from
     the demonstrations, starts ``cells`` cell processes (``backend`` ``sim``: PyBullet,
     ``truth``: answers from the geometry, fast) or, with ``cells=0``, uses the cells
     reachable at the Zenoh endpoints ``connect``; learns the sizes, plans, and writes the
     run folder ``out`` (default ``runs/<UTC time>``). ``timeout_s`` [s]: one experiment at
-    one cell before it is sent again."""
-    from assembly_constraints.asp.session.run import build_parser
+    one cell before it is sent again. ``cell``: the simulated cells' execution layer and
+    uncertainty (default: the defaults, cell seed ``seed``); cell ``c<k>`` has cell seed
+    ``cell.cell_seed + k - 1``. PlannerError naming the setting when one is out of range."""
     from assembly_constraints.asp.session.run import run_session as run
 
-    args = build_parser().parse_args([])
-    overrides = {"assembly": str(assembly), "out": None if out is None else Path(out), "backend": backend,
-                 "cells": cells, "policy": policy, "seed": seed, "confirm": confirm, "timeout": timeout_s,
-                 "plans": plans, "connect": list(connect)}
-    vars(args).update(overrides)
-    return SessionResult(**run(args))  # type: ignore[typeddict-item]
+    settings = SessionSettings(assembly=str(assembly), out=None if out is None else str(out), backend=backend,
+                               cells=cells, policy=policy, seed=seed, confirm=confirm, timeout_s=timeout_s,
+                               plans=plans, connect=tuple(connect),
+                               cell=CellSettings(cell_seed=seed) if cell is None else cell)
+    return SessionResult(**run(settings))  # type: ignore[typeddict-item]
 
 
 @dataclass(frozen=True)
 class RunFolder:
     """A session's run folder, read back.
 
-    ``settings``: ``session.json`` (assembly, policy, seed, status, the result and
-    timings); ``experiments``: the finished experiments of ``journal.jsonl`` in order
-    (part, hole, result, cell, evidence, wall time); ``learned``: ``learned.lp`` (None
-    until the session finished); ``recordings``: the Rerun recordings ``*.rrd``.
+    ``settings``: ``session.json`` (:class:`assembly_constraints.asp.session.settings.SessionFile`: assembly,
+    policy, seed, the cells' settings, status, and once done the result and timings);
+    ``experiments``: the finished experiments of ``journal.jsonl`` in order (part, hole,
+    result, cell, evidence, wall time); ``learned``: ``learned.lp`` (None until the
+    session finished); ``recordings``: the Rerun recordings ``*.rrd``.
     """
 
     path: Path
-    settings: dict
+    settings: SessionFile
     experiments: list[JournalEntry]
     learned: Path | None
     recordings: list[Path]
@@ -170,19 +173,14 @@ class RunFolder:
     @property
     def fits(self) -> list[tuple[str, str]]:
         """The pairs found to fit (empty until the session finished)."""
-        return [(p, h) for p, h in self.settings.get("fits", [])]
+        return [] if self.settings.fits is UNSET else list(self.settings.fits)
 
 
 def read_run(folder: str | Path) -> RunFolder:
-    """Read a run folder written by a session; PlannerError when it holds no ``session.json``."""
+    """Read a run folder written by a session; PlannerError naming the file and the field
+    when it holds no ``session.json`` or one a session did not write."""
     path = Path(folder)
-    settings_file = path / "session.json"
-    if not settings_file.is_file():
-        raise PlannerError(f"{path}: not a run folder (expected {settings_file.name} in it)")
-    try:
-        settings = json.loads(read_bytes(settings_file, "session settings file", error=PlannerError))
-    except ValueError as exc:
-        raise PlannerError(f"{settings_file}: not JSON ({exc})") from None
+    settings = read_session_file(path)
     learned = path / "learned.lp"
     return RunFolder(path=path, settings=settings, experiments=read_journal(path / JOURNAL_NAME),
                      learned=learned if learned.is_file() else None, recordings=sorted(path.glob("*.rrd")))

@@ -44,7 +44,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "sizes": ("assembly_constraints.asp.sizes.cli", "learn/evaluate which part fits which hole"),
     "assign": ("assembly_constraints.asp.plans.cli:assign_main", "hole assignments from learned facts"),
     "plan": ("assembly_constraints.asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
-    "session": ("assembly_constraints.asp.session.run", "the end-to-end learning session (planner + cells)"),
+    "session": ("assembly_constraints.asp.session.cli", "the end-to-end learning session (planner + cells)"),
     "assemble": ("assembly_constraints.asp.assemble.cli",
                  "execute a plan in a simulated cell, monitored and re-planned"),
     "view": ("assembly_constraints.asp.session.view", "open a session's Rerun recording"),

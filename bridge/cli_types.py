@@ -85,6 +85,11 @@ class _OneLineFormatter(logging.Formatter):
         return f"{record.levelname.lower()}: {one_line(record.getMessage())}"
 
 
+def path_setting(path: Path | None) -> str | None:
+    """A parsed path option as a settings struct holds it (a string; None stays None)."""
+    return None if path is None else str(path)
+
+
 def configure_logging(level: int | None = None) -> None:
     """Log to stderr, one line a record (``warning: ...``), from ``level`` up: the console
     command's default INFO (progress), ``-v`` DEBUG and ``-q`` ERROR. The handler is

@@ -15,7 +15,11 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments, add_cell_description_argument
+from assembly_constraints.bridge.cell_settings import (
+    add_cell_arguments,
+    add_cell_description_argument,
+    cell_settings_of,
+)
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -71,10 +75,9 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from assembly_constraints.executor.cell_options import cell_keywords
-    from assembly_constraints.executor.trial import Cell
+    from assembly_constraints.executor.trial import Cell, cell_keywords
 
-    keywords = cell_keywords(args)  # the cell description checked before anything is written
+    keywords = cell_keywords(cell_settings_of(args))  # the cell description checked before anything is written
     logger = None
     if args.plot:
         from assembly_constraints.bridge.files import check_writable
@@ -185,7 +188,6 @@ def build_parser() -> argparse.ArgumentParser:
                        "and the first failed attempt, against their desired profiles) to this PNG")
     trial.add_argument("--json", action="store_true", help="print JSON instead of text")
     add_cell_arguments(trial)
-    add_cell_description_argument(trial)
     trial.set_defaults(func=_trial)
 
     sizes = sub.add_parser("sizes", help="write the sizes.lp (which part fits which hole) that the geometry makes")

@@ -14,8 +14,8 @@ process later.
 - Valid requests run one at a time in the main thread. Results are idempotent by
   request id: a repeated id gets the cached reply and never re-runs the experiment.
 - Backends: ``sim`` runs the PyBullet :class:`assembly_constraints.executor.trial.Cell` (imported lazily)
-  with the execution layer and uncertainty of the options (``--layer``, ``--cell-seed``,
-  ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
+  with the execution layer and uncertainty of its cell settings (``--layer``,
+  ``--cell-seed``, ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
   ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
   ``MODULE:CLASS`` loads a user's backend (:mod:`assembly_constraints.executor.backend_plugin`), e.g. a real robot.
@@ -24,6 +24,10 @@ process later.
   steps of one plan run), ``truth`` from the geometry; ``--block-hole H`` puts an obstacle
   in hole H (a fault to show the planner's recovery); ``--uncertainty cell`` gives the
   plan steps the cell's uncertainty, layer and ILC (default ``random``: their own errors).
+
+Its settings are one :class:`assembly_constraints.bridge.cell_settings.ServeSettings`: ``--settings JSON|FILE``
+(how a session starts its cells) or the options below, which build the same struct; the
+node takes only the struct (:func:`serve`).
 
 One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
 ``done <id> <result>``), flushed, so a supervisor can follow the node.
@@ -42,18 +46,23 @@ from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import zenoh
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_options import (
+from assembly_constraints.bridge.cell_settings import (
+    DEFAULT_CELL,
+    CellSettings,
+    ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
-    add_cell_description_argument,
+    cell_settings_of,
+    decode_settings,
 )
-from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float
+from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, path_setting
+from assembly_constraints.bridge.inputs import read_bytes
 from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from assembly_constraints.bridge.messages import (
     MAX_MESSAGE_BYTES,
@@ -71,7 +80,7 @@ from assembly_constraints.bridge.messages import (
     decode_step_request,
     encode,
 )
-from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments, viewer_of
+from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments
 from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.backend_plugin import (
@@ -86,7 +95,6 @@ from assembly_constraints.executor.backend_plugin import (
     check_step,
     load_backend,
 )
-from assembly_constraints.executor.cell_options import cell_keywords
 from assembly_constraints.executor.claim import CellClaim, ClaimLost
 from assembly_constraints.executor.world.geometry import load_geometry, passes
 
@@ -187,22 +195,22 @@ class SimBackend:
 
     def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
                  rrd: Path | None, viewer: Viewer = NO_VIEWER, blocked: Sequence[str] = (),
-                 uncertainty: str = "random", **cell_keywords: Any) -> None:
+                 cell: CellSettings = DEFAULT_CELL, ilc_state: Path | None = None) -> None:
         """``viewer``: also stream the recording live; ``blocked``: holes with an obstacle
-        for plan steps; ``uncertainty``: ``cell`` gives plan steps the Cell's uncertainty
-        (its systematic errors), layer and an ILC, ``random`` their own; ``cell_keywords``:
-        the Cell's options (layer, perturbation, cell seed, ``ilc_state``: the file its ILC
-        corrections are loaded from and saved to, atomically after every update, so a
-        resumed session's cell starts from them)."""
-        from assembly_constraints.executor.trial import Cell
+        for plan steps; ``cell``: the Cell's settings (layer, uncertainty, cell seed; with
+        ``uncertainty`` ``cell`` plan steps get the Cell's uncertainty (its systematic
+        errors), layer and an ILC, with ``random`` their own); ``ilc_state``: the file its
+        ILC corrections are loaded from and saved to, atomically after every update, so a
+        resumed session's cell starts from them."""
+        from assembly_constraints.executor.trial import Cell, cell_keywords
 
         _PlannerNumbered = _planner_numbered_logger()
         self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd, viewer=viewer,
                                          send_blueprint=False)  # the planner sends it
                         if rrd is not None or viewer != NO_VIEWER else None)
-        self._cell = Cell(assembly, gui=False, logger=self._logger, **cell_keywords)
+        self._cell = Cell(assembly, gui=False, logger=self._logger, ilc_state=ilc_state, **cell_keywords(cell))
         self._assembly, self._blocked, self._cell_id = assembly, list(blocked), cell_id
-        self._cell_uncertainty = uncertainty == "cell"
+        self._cell_uncertainty = cell.uncertainty == "cell"
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
@@ -386,10 +394,15 @@ def _stop_when_stdin_closes(node: CellNode) -> None:
     node.stop()  # no print: the supervisor that read our stdout may be gone
 
 
+SETTINGS_HELP = ("the cell's settings as one document: a JSON object (ServeSettings, docs/cell.md), or a file "
+                 "holding one; instead of the other options (a session starts its cells so)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(
         prog="executor serve", description="Serve insertion experiments over Zenoh "
         f"(default: listen on {DEFAULT_ENDPOINT}).")
+    parser.add_argument("--settings", metavar="JSON|FILE", help=SETTINGS_HELP)
     parser.add_argument("--cell", default="c1", help="cell id (default c1)")
     parser.add_argument("--backend", default="sim", metavar="{sim,truth,MODULE:CLASS}",
                         help="sim: PyBullet cell; truth: answer from the geometry, no simulation; MODULE:CLASS: "
@@ -410,46 +423,76 @@ def build_parser() -> argparse.ArgumentParser:
                         help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
                         "save them there after every update (a session passes <run>/<cell>-ilc.json)")
     add_cell_arguments(parser)
-    add_cell_description_argument(parser)
     add_assembly_uncertainty_argument(parser)
     add_endpoint_arguments(parser)
     return parser
 
 
-def _backend(args: argparse.Namespace, cell_id: str) -> Backend:
-    """The backend ``--backend`` names: the simulator, the geometry's truth or a user class."""
-    if args.backend == "truth":
-        return TruthBackend(args.assembly, args.delay, cell_id, args.recording_id, args.rrd, viewer_of(args),
-                            args.block_hole)
-    if args.backend == "sim":
-        return SimBackend(args.assembly, cell_id, args.recording_id, args.rrd, viewer_of(args), args.block_hole,
-                          uncertainty=args.uncertainty, ilc_state=args.ilc_state, **cell_keywords(args))
-    return load_backend(args.backend, CellContext(cell_id, args.assembly, args.rrd, args.recording_id,
-                                                  dict(args.backend_option)))
+def serve_settings_of(args: argparse.Namespace) -> ServeSettings:
+    """The settings the options give: the ``--settings`` document, or the other options
+    (the same struct); BridgeError when both are given or the document is not one."""
+    settings = ServeSettings(
+        cell_id=args.cell, backend=args.backend, backend_options=dict(args.backend_option), assembly=args.assembly,
+        delay_s=args.delay, rrd=path_setting(args.rrd), recording_id=args.recording_id, viewer_url=args.rerun_connect,
+        ilc_state=path_setting(args.ilc_state), block_holes=tuple(args.block_hole), lifeline=args.lifeline,
+        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config),
+        cell=cell_settings_of(args))
+    if args.settings is None:
+        return settings
+    if settings != ServeSettings():
+        raise BridgeError("--settings: expected the cell's settings either as one document or as options, not both")
+    document = args.settings
+    if document.lstrip().startswith("{"):
+        return decode_settings(document, ServeSettings, "--settings")
+    return decode_settings(read_bytes(document, "cell settings file (JSON)"), ServeSettings, document)
+
+
+def _backend(settings: ServeSettings) -> Backend:
+    """The backend ``settings.backend`` names: the simulator, the geometry's truth or a user class."""
+    rrd = None if settings.rrd is None else Path(settings.rrd)
+    viewer = Viewer(settings.viewer_url)
+    if settings.backend == "truth":
+        return TruthBackend(settings.assembly, settings.delay_s, settings.cell_id, settings.recording_id, rrd, viewer,
+                            settings.block_holes)
+    if settings.backend == "sim":
+        return SimBackend(settings.assembly, settings.cell_id, settings.recording_id, rrd, viewer,
+                          settings.block_holes, settings.cell,
+                          None if settings.ilc_state is None else Path(settings.ilc_state))
+    return load_backend(settings.backend, CellContext(settings.cell_id, settings.assembly, rrd,
+                                                      settings.recording_id, settings.backend_options))
 
 
 def main(argv: Sequence[str]) -> int:
-    """Serve until SIGTERM/SIGINT; exit code 2 on bad options, a damaged ``--ilc-state`` or when another process
-    serves this cell id (:mod:`assembly_constraints.executor.claim`)."""
-    args = build_parser().parse_args(list(argv))
-    cell_id = check_cell_id(args.cell)
-    if args.backend == "sim":  # a bad cell description or a damaged state is refused here, before the session opens
-        from assembly_constraints.executor.cell_description import load_cell_description
-        from assembly_constraints.executor.control.ilc import offset_bound, read_state
+    """``executor serve``: the settings of the options, then :func:`serve`."""
+    return serve(serve_settings_of(build_parser().parse_args(list(argv))))
 
-        description = load_cell_description(args.cell_description)
-        if args.ilc_state is not None:
-            read_state(args.ilc_state, description.ilc, offset_bound(description.admittance))
-    listen = cell_listen(args.listen, args.connect, args.zenoh_config)
+
+def serve(settings: ServeSettings) -> int:
+    """Serve until SIGTERM/SIGINT; exit code 2 on bad settings, a damaged ``ilc_state`` or when another process
+    serves this cell id (:mod:`assembly_constraints.executor.claim`)."""
+    cell_id = check_cell_id(settings.cell_id)
+    zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
+    if settings.backend == "sim":
+        from assembly_constraints.executor.trial import cell_keywords
+
+        # Bad cell settings or description are refused here, before the session opens.
+        description = cell_keywords(settings.cell)["description"]
+        if settings.ilc_state is not None:
+            from assembly_constraints.executor.control.ilc import offset_bound, read_state
+
+            # So is a damaged state.
+            read_state(Path(settings.ilc_state), description.ilc, offset_bound(description.admittance))
+    listen = cell_listen(settings.listen, settings.connect, zenoh_config)
+    connect = list(settings.connect)
     signal.signal(signal.SIGTERM, _exit_on_signal)
     signal.signal(signal.SIGINT, _exit_on_signal)
-    session = open_session(listen, args.connect, args.zenoh_config)
+    session = open_session(listen, connect, zenoh_config)
     claim: CellClaim | None = None
     backend: Backend | None = None
     try:
         claim = CellClaim(session, cell_id)
         claim.check()  # before the backend starts: a refused cell loads nothing
-        backend = _backend(args, cell_id)
+        backend = _backend(settings)
         node = CellNode(cell_id, backend)
         claim.on_lost = lambda _why: node.stop()
         if claim.lost is not None:  # lost while the backend started
@@ -458,10 +501,10 @@ def main(argv: Sequence[str]) -> int:
                      session.declare_queryable(step_key(cell_id), node.on_step_query),
                      session.declare_queryable(ping_key(cell_id), _echo),
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
-        if args.lifeline:
+        if settings.lifeline:
             threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
-        print(f"ready cell {cell_id} backend {args.backend} "
-              f"listen {listen} connect {args.connect}", flush=True)
+        print(f"ready cell {cell_id} backend {settings.backend} "
+              f"listen {listen} connect {connect}", flush=True)
         node.serve()
     except SystemExit:
         pass  # SIGTERM/SIGINT: close below

@@ -18,12 +18,14 @@ from __future__ import annotations
 
 import time
 import zlib
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from assembly_constraints.bridge.cell_settings import CellSettings
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cell_description import CellDescription
+from assembly_constraints.executor.cell_description import CellDescription, load_cell_description
 from assembly_constraints.executor.control.controller import ImpedanceController
 from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
@@ -40,8 +42,6 @@ from assembly_constraints.executor.world.perturbation import CellBias, Perturbat
 from assembly_constraints.executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
 if TYPE_CHECKING:
-    from pathlib import Path
-
     from assembly_constraints.executor.rerun_log import AttemptLogger
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
@@ -52,6 +52,14 @@ APPROACH_SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
     """The random stream of one trial: same seed, part and hole → same trial."""
     return np.random.default_rng([seed, zlib.crc32(part.encode()), zlib.crc32(hole.encode())])
+
+
+def cell_keywords(settings: CellSettings) -> dict[str, Any]:
+    """Keyword arguments of :class:`Cell` from the cell settings, the cell description file
+    they name read and checked here (BridgeError naming the file, table and key)."""
+    description = None if settings.description is None else Path(settings.description)
+    return {"layer": settings.layer, "perturbation": PerturbationModel.of(settings.magnitudes),
+            "cell_seed": settings.cell_seed, "description": load_cell_description(description)}
 
 
 class Cell:

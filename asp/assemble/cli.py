@@ -31,6 +31,8 @@ import sys
 import time
 from pathlib import Path
 
+from msgspec import UNSET
+
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.assemble.driver import assembling_cell
 from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
@@ -40,21 +42,31 @@ from assembly_constraints.asp.assemble.inputs import (
     plan_of_json,
     read_plan_json,
 )
+from assembly_constraints.asp.assemble.settings import (
+    MAX_PLAN_INDEX,
+    MAX_STEP_S,
+    AssemblySettings,
+    assembling_cell_settings,
+)
 from assembly_constraints.asp.plans.assign import LearnedFacts, load_learned_facts
 from assembly_constraints.asp.plans.plans import Plan, plans
+from assembly_constraints.asp.session.settings import SESSION_FILE, SessionFile, read_session_file
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_options import (
-    MAGNITUDES,
+from assembly_constraints.bridge.cell_settings import (
     add_assembly_uncertainty_argument,
     add_cell_arguments,
-    cell_argv,
+    cell_settings_of,
 )
-from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, finite_float, int_in
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    ArgumentParser,
+    add_assembly_argument,
+    finite_float,
+    int_in,
+    path_setting,
+)
 from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
-from assembly_constraints.bridge.inputs import read_bytes, shorten
 from assembly_constraints.bridge.session import add_endpoint_arguments
-
-MAX_PLAN_INDEX = 1000
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -72,7 +84,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="put an obstacle in hole H (fault injection; repeatable)")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="the cell: sim (PyBullet, default) or truth (geometry rule, no simulation)")
-    parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
+    parser.add_argument("--timeout", type=finite_float(0.0, MAX_STEP_S, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell (default 300)")
     parser.add_argument("--save", "--rrd", dest="rrd", type=Path, metavar="FILE",
                         help="save the cell's Rerun recording to this .rrd file")
@@ -83,24 +95,13 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def cell_options(args: argparse.Namespace) -> list[str]:
-    """The sim cell's options for ``--uncertainty cell`` (none for ``random``); PlannerError
-    naming the option if one was given where it would have no effect: with ``--backend
-    truth`` (the geometry rule simulates nothing), or a cell option without
-    ``--uncertainty cell``."""
-    defaults = build_parser().parse_args([])
-    changed = [f"--{name.replace('_', '-')}" for name in ("layer", "cell_seed", *MAGNITUDES)
-               if getattr(args, name) != getattr(defaults, name)]
-    if args.backend == "truth" and (args.uncertainty == "cell" or changed):
-        option = "--uncertainty cell" if args.uncertainty == "cell" else changed[0]
-        raise PlannerError(f"{option} has no effect with --backend truth (the geometry rule simulates nothing); "
-                           "drop it or use --backend sim")
-    if args.uncertainty == "cell":
-        return ["--uncertainty", "cell", *cell_argv(args), "--cell-seed", str(args.cell_seed)]
-    if changed:
-        raise PlannerError(f"{changed[0]}: --layer, --cell-seed and the uncertainty magnitudes need "
-                           "--uncertainty cell")
-    return []
+def assembly_settings(args: argparse.Namespace) -> AssemblySettings:
+    """The settings the options of :func:`build_parser` give."""
+    return AssemblySettings(
+        inputs=tuple(map(str, args.inputs)), run=path_setting(args.run), plan=args.plan, assembly=args.assembly,
+        seed=args.seed, block_holes=tuple(args.block_hole), backend=args.backend, timeout_s=args.timeout,
+        rrd=path_setting(args.rrd), cell=cell_settings_of(args), listen=tuple(args.listen),
+        connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config))
 
 
 def truth_sources(assembly: Assembly) -> str:
@@ -113,50 +114,37 @@ def truth_facts(assembly: Assembly) -> LearnedFacts:
     return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
 
 
-_SESSION_TYPES: dict[str, tuple[type, str]] = {"assembly": (str, "a string"), "plans": (list, "a list of plans")}
-"""The types of the ``session.json`` keys ``assemble`` and ``bench assemble`` read."""
+def session_plans(run: Path) -> tuple[SessionFile, list[list[dict[str, str | None]]]]:
+    """The ``session.json`` of run folder ``run`` and its plans; PlannerError naming the
+    file when it is not that of a finished session."""
+    record = read_session_file(run)
+    if record.plans is UNSET:
+        raise PlannerError(f'{run / SESSION_FILE}: expected the session.json of a finished session (with "plans")')
+    return record, record.plans
 
 
-def read_session_settings(run: Path, *required: str) -> dict:
-    """The ``session.json`` of run folder ``run``; PlannerError naming the file and the
-    ``required`` keys when it cannot be read or lacks one, or naming the key when it has
-    the wrong type (``assembly`` a string, ``plans`` a list)."""
-    path = run / "session.json"
-    try:
-        settings = json.loads(read_bytes(path, "session settings (JSON)", error=PlannerError))
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError):
-        settings = None
-    if not isinstance(settings, dict) or any(key not in settings for key in required):
-        keys = " and ".join(f'"{key}"' for key in required)
-        raise PlannerError(f"{path}: expected the session.json of a finished session (with {keys})")
-    for key in required:
-        kind, expected = _SESSION_TYPES.get(key, (object, ""))
-        if not isinstance(settings[key], kind):
-            raise PlannerError(f'{path}: "{key}": expected {expected}, got '
-                               f"{shorten(json.dumps(settings[key], ensure_ascii=True))}")
-    return settings
-
-
-def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
+def resolve(settings: AssemblySettings) -> tuple[Assembly, LearnedFacts, Plan]:
     """The assembly, the facts for re-planning and the plan to execute."""
-    jsons = [p for p in args.inputs if p.suffix == ".json"]
-    lps = [p for p in args.inputs if p.suffix != ".json"]
-    if len(jsons) > 1 or (args.run is not None and args.inputs):
+    inputs = [Path(p) for p in settings.inputs]
+    jsons = [p for p in inputs if p.suffix == ".json"]
+    lps = [p for p in inputs if p.suffix != ".json"]
+    if len(jsons) > 1 or (settings.run is not None and inputs):
         raise PlannerError("expected --run RUN, or one PLAN.json with optional FACTS.lp files, or FACTS.lp files")
-    name = args.assembly
+    name = settings.assembly
+    index = settings.plan
     plan: Plan | None = None
     plan_source = ""
-    if args.run is not None:
-        settings = read_session_settings(args.run, "plans", "assembly")
-        settings_path, found = args.run / "session.json", settings["plans"]
-        name = name or settings["assembly"]
-        if len(found) < args.plan:
-            raise PlannerError(f"{settings_path}: --plan {args.plan}, but the run has {len(found)} plan(s)")
-        plan_source = f"{settings_path}: plans[{args.plan}]"
-        plan = plan_of_json(found[args.plan - 1], plan_source)
-        lps = [args.run / "learned.lp"]
+    if settings.run is not None:
+        run = Path(settings.run)
+        record, found = session_plans(run)
+        name = name or record.assembly
+        if len(found) < index:
+            raise PlannerError(f"{run / SESSION_FILE}: --plan {index}, but the run has {len(found)} plan(s)")
+        plan_source = f"{run / SESSION_FILE}: plans[{index}]"
+        plan = plan_of_json(found[index - 1], plan_source)
+        lps = [run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
-    unknown = [hole for hole in args.block_hole if hole not in assembly.hole_ids]
+    unknown = [hole for hole in settings.block_holes if hole not in assembly.hole_ids]
     if unknown:
         raise PlannerError(f"--block-hole {unknown[0]}: expected a hole of {assembly.name} "
                            f"({', '.join(assembly.hole_ids)})")
@@ -164,12 +152,12 @@ def resolve(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts, Plan]:
     check_facts_product(assembly, facts, ", ".join(map(str, lps)) or truth_sources(assembly))
     if jsons:
         plan_source = str(jsons[0])
-        plan = read_plan_json(jsons[0], args.plan)
+        plan = read_plan_json(jsons[0], index)
     if plan is None:
-        found_plans = plans(facts, n=args.plan)
-        if len(found_plans) < args.plan:
-            raise PlannerError(f"--plan {args.plan}: the facts admit only {len(found_plans)} plan(s)")
-        plan_source, plan = f"plan {args.plan} of the facts", found_plans[args.plan - 1]
+        found_plans = plans(facts, n=index)
+        if len(found_plans) < index:
+            raise PlannerError(f"--plan {index}: the facts admit only {len(found_plans)} plan(s)")
+        plan_source, plan = f"plan {index} of the facts", found_plans[index - 1]
     check_plan_product(facts, plan, plan_source)
     return assembly, facts, plan
 
@@ -191,14 +179,14 @@ def _summary(report: dict) -> str:
     return "\n".join(lines)
 
 
-def assemble(args: argparse.Namespace) -> tuple[dict, int]:
+def assemble(settings: AssemblySettings) -> tuple[dict, int]:
     """Start the cell, run the plan; (report, exit code)."""
     started = time.perf_counter()
-    options = cell_options(args)
-    assembly, facts, plan = resolve(args)
-    with assembling_cell(assembly.folder, args.seed, args.timeout, backend=args.backend,
-                         block_holes=args.block_hole, rrd=args.rrd, listen=args.listen, connect=args.connect,
-                         zenoh_config=args.zenoh_config, cell_options=options) as driver:
+    cell = assembling_cell_settings(settings.cell, settings.backend)
+    assembly, facts, plan = resolve(settings)
+    with assembling_cell(assembly.folder, settings.seed, settings.timeout_s, backend=settings.backend,
+                         block_holes=settings.block_holes, rrd=settings.rrd, listen=settings.listen,
+                         connect=settings.connect, zenoh_config=settings.zenoh_config, cell=cell) as driver:
         try:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:
@@ -209,7 +197,7 @@ def assemble(args: argparse.Namespace) -> tuple[dict, int]:
 
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
-    report, code = assemble(args)
+    report, code = assemble(assembly_settings(args))
     print(json.dumps(report) if args.json else _summary(report))
     if code == EXIT_UNSOLVABLE:
         print(f"error: {report['error']}", file=sys.stderr)

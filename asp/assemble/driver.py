@@ -14,6 +14,7 @@ import zenoh
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.session.cells import CellProcess, start_cell
 from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, CellSettings, ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_step
 from assembly_constraints.bridge.inputs import shorten
 from assembly_constraints.bridge.messages import StepReply, StepRequest
@@ -67,27 +68,27 @@ class ZenohDriver:
 
 @contextmanager
 def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backend: str = "sim",
-                    block_holes: Sequence[str] = (), rrd: Path | None = None, listen: Sequence[str] = (),
-                    connect: Sequence[str] = (), zenoh_config: Path | None = None,
-                    cell_options: Sequence[str] = ()) -> Iterator[ZenohDriver]:
+                    block_holes: Sequence[str] = (), rrd: str | None = None, listen: Sequence[str] = (),
+                    connect: Sequence[str] = (), zenoh_config: str | None = None,
+                    cell: CellSettings = DEFAULT_CELL) -> Iterator[ZenohDriver]:
     """Start one cell (``executor serve``, a fresh world of ``assembly_folder``) on loopback and
     yield a driver for one plan run in it; the cell is stopped on exit.  ``seed`` seeds the
-    cell's random errors, ``timeout_s`` bounds one step [s], ``cell_options`` are more
-    options of a sim cell
-    (:func:`assembly_constraints.asp.assemble.cli.cell_options`: uncertainty, layer, cell seed)."""
+    cell's random errors, ``timeout_s`` bounds one step [s], ``cell``: the sim cell's
+    settings (:func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`:
+    uncertainty, layer, cell seed)."""
     listen = list(listen) or [free_loopback_endpoint()]
-    session = open_session(listen, connect, zenoh_config)
+    session = open_session(listen, connect, None if zenoh_config is None else Path(zenoh_config))
     try:
         directory = CellDirectory(session)
-        cell = start_cell(CELL_ID, backend=backend, assembly=str(assembly_folder), connect=listen[:1],
-                          rrd=rrd, zenoh_config=zenoh_config, block_holes=list(block_holes),
-                           cell_options=list(cell_options))
+        process = start_cell(ServeSettings(cell_id=CELL_ID, backend=backend, assembly=str(assembly_folder),
+                                           connect=tuple(listen[:1]), rrd=rrd, zenoh_config=zenoh_config,
+                                           block_holes=tuple(block_holes), cell=cell))
         try:
             # Its queryables reach us with its liveliness token: a step sent before might find no one.
             directory.wait_for(1, timeout=CELL_START_S)
-            yield ZenohDriver(session, CELL_ID, seed, timeout_s, cell)
+            yield ZenohDriver(session, CELL_ID, seed, timeout_s, process)
         finally:
-            cell.stop()
+            process.stop()
             directory.close()
     finally:
         session.close()

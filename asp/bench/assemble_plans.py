@@ -14,7 +14,7 @@ the relation admits (:class:`assembly_constraints.asp.precedence.count.UniformSa
 every plan passes the checker.  Plan k runs in a cell of its own started for it
 (``executor serve``, a fresh world) whose random errors have seed S + k; with
 ``--uncertainty cell`` every cell has the cell options' uncertainty and layer
-(:func:`assembly_constraints.asp.assemble.cli.cell_options`, the same cell seed for all).
+(:func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`, the same cell seed for all).
 
 Prints per plan (to stderr with ``--json``), as it finishes: the plan, assembled,
 re-plans, the worst final pose error of any part [mm] and the wall time [s] (cell
@@ -35,16 +35,23 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.cli import cell_options, read_session_settings, truth_facts, truth_sources
+from assembly_constraints.asp.assemble.cli import session_plans, truth_facts, truth_sources
 from assembly_constraints.asp.assemble.driver import assembling_cell
 from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
 from assembly_constraints.asp.assemble.inputs import check_facts_product
+from assembly_constraints.asp.assemble.settings import MAX_STEP_S, assembling_cell_settings
 from assembly_constraints.asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
 from assembly_constraints.asp.plans.plans import Plan, PlanStep, check_plan
 from assembly_constraints.asp.precedence.count import UniformSampler
 from assembly_constraints.asp.precedence.relation import Relation
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
+from assembly_constraints.bridge.cell_settings import (
+    DEFAULT_CELL,
+    CellSettings,
+    add_assembly_uncertainty_argument,
+    add_cell_arguments,
+    cell_settings_of,
+)
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -86,15 +93,15 @@ def plan_text(steps: list[dict]) -> str:
 
 
 def run_plan(assembly: Assembly, facts: LearnedFacts, plan: Plan, seed: int, timeout_s: float,
-             backend: str = "sim", cell_options: list[str] | None = None) -> dict:
+             backend: str = "sim", cell: CellSettings = DEFAULT_CELL) -> dict:
     """Assemble ``plan`` in a fresh cell (random errors seeded with ``seed``); the
     execution report with ``wall_s`` [s] and ``error`` (null, or why it stopped);
-    ``cell_options``: more options of the sim cell."""
+    ``cell``: the sim cell's settings."""
     started = time.perf_counter()
     error = None
     try:
         with assembling_cell(assembly.folder, seed, timeout_s, backend=backend,
-                             cell_options=cell_options or []) as driver:
+                             cell=cell) as driver:
             report = execute(facts, plan, driver)
     except AssemblyStopped as exc:
         report, error = exc.report, str(exc)
@@ -141,7 +148,7 @@ def _facts(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts]:
     name = args.assembly
     paths = list(args.facts)
     if args.run is not None:
-        name = name or read_session_settings(args.run, "assembly")["assembly"]
+        name = name or session_plans(args.run)[0].assembly
         paths = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
     facts = load_learned_facts(paths) if paths else truth_facts(assembly)
@@ -163,7 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_jobs_argument(parser, "cells")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="the cells: sim (PyBullet, default) or truth (geometry rule, no simulation)")
-    parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
+    parser.add_argument("--timeout", type=finite_float(0.0, MAX_STEP_S, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell [s] (default 300)")
     parser.add_argument("--json", action="store_true", help="print JSON {\"plans\": [report, ...], \"summary\"}")
     add_assembly_uncertainty_argument(parser)
@@ -173,13 +180,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
-    options = cell_options(args)
+    cell = assembling_cell_settings(cell_settings_of(args), args.backend)
     assembly, facts = _facts(args)
     drawn = draw_plans(facts, args.plans, args.seed)
     reports: list[dict] = [{}] * len(drawn)
 
     def one(k: int) -> None:
-        reports[k] = run_plan(assembly, facts, drawn[k], args.seed + k + 1, args.timeout, args.backend, options)
+        reports[k] = run_plan(assembly, facts, drawn[k], args.seed + k + 1, args.timeout, args.backend, cell)
         print(_row(k + 1, reports[k]), file=sys.stderr if args.json else sys.stdout, flush=True)
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:

@@ -545,8 +545,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--unconstrained", action="store_true",
                         help="also the unconstrained optimum (3x4: ~30 s; 4x4: too long)")
     parser.add_argument("--cranfield", action="store_true", help="the Cranfield relaxation")
-    parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60,
-                        help="time for the Cranfield lower bound (iterative deepening, default 60)")
+    parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60, metavar="S",
+                        help="the search for the Cranfield lower bound (iterative deepening) gives up after "
+                             "S seconds (default 60)")
     parser.add_argument("--all-biorders", action="store_true",
                         help="Cranfield total of policies never worse on all 5x5 biorders (long)")
     parser.add_argument("--target", type=finite_float(0, 1000, low_open=True), default=18.8,

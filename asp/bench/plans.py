@@ -70,7 +70,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--repeat", type=int_in(1, 1000), default=5, help="Cranfield runs (default 5)")
     parser.add_argument("--parts", type=int_in(1, MAX_IDS), default=11, help="parts of a random cell (default 11)")
     parser.add_argument("--holes", type=int_in(1, MAX_IDS), default=6, help="holes of a random cell (default 6)")
-    parser.add_argument("--cells", type=int_in(0, 1000), default=5, help="random cells, seeds 1.. (default 5)")
+    parser.add_argument("--products", type=int_in(0, 1000), default=5,
+                        help="random products (a cell layout each), seeds 1.. (default 5)")
     parser.add_argument("--time-limit", type=finite_float(0, 1e6, low_open=True), default=60.0, metavar="S",
                         help="give up on a cell after S seconds (default 60)")
     args = parser.parse_args(argv)
@@ -78,7 +79,7 @@ def main(argv: list[str]) -> int:
     facts = _learned([*precedence_facts(true_relation(cranfield)), *load_atoms([cranfield.file("sizes.lp")])])
     runs = [_optimal_cpu_s(facts, cranfield, args.time_limit) for _ in range(args.repeat)]
     print(f"cranfield: median {statistics.median(cpu for cpu, _ in runs):.3f} s CPU ({runs[0][1]})")
-    for seed in range(1, args.cells + 1):
+    for seed in range(1, args.products + 1):
         cpu, outcome = _optimal_cpu_s(*random_cell(args.parts, args.holes, seed), args.time_limit)
         print(f"cell {seed} ({args.parts} parts, {args.holes} holes): {cpu:.3f} s CPU ({outcome})")
     return 0

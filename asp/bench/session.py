@@ -12,7 +12,7 @@
    on a shared 2-core machine the cells compete with everything else for the cores, so
    the sessions run in pairs, 1 cell then 2 cells back to back, and each pair's ratio
    is reported beside the ratio of the medians).
-3. ``--product N --cells 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
+3. ``--product N --cell-counts 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
    experiment takes ``--delay`` seconds without using the cores) on a generated N×N
    product (:mod:`assembly_constraints.asp.bench.products`): wall time [s], speed-up against 1 cell,
    experiments and their ratio to the 1-cell run, and duplicates (a request journaled
@@ -40,6 +40,9 @@ from assembly_constraints.asp import MAX_IDS, PlannerError
 from assembly_constraints.asp.bench.products import write_product
 from assembly_constraints.asp.session.cells import ROOT, start_cell
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from assembly_constraints.asp.session.settings import MAX_CELLS
+from assembly_constraints.asp.sizes.policies import policy_names
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in, number_in
 from assembly_constraints.bridge.client import CellDirectory, request_insert
 from assembly_constraints.bridge.keys import ping_key
@@ -63,7 +66,7 @@ def _ms(values: list[float]) -> dict[str, float]:
 def round_trips(count: int) -> dict:
     """Validated insert round trips vs bare queries, alternating, to one truth cell."""
     endpoint = free_loopback_endpoint()
-    cell = start_cell("bench", backend="truth", listen=[endpoint])
+    cell = start_cell(ServeSettings(cell_id="bench", backend="truth", listen=(endpoint,)))
     session = open_session(connect=[endpoint])
     try:
         CellDirectory(session).wait_for(1, timeout=30)
@@ -164,7 +167,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--repeat", type=int_in(1, 100), default=1,
                         help="pairs of sessions, 1 cell then 2 cells back to back (default 1)")
     parser.add_argument("--quick", action="store_true", help="100 round trips per kind")
-    parser.add_argument("--policy", default="best", help="session policy (default best)")
+    parser.add_argument("--policy", default="best", choices=policy_names(), help="session policy (default best)")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="cells of the sessions (default sim)")
     parser.add_argument("--delay", type=finite_float(0, 3600), default=0.0, metavar="S",
@@ -173,8 +176,10 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--skip-sessions", action="store_true", help="only the round trips")
     parser.add_argument("--product", type=int_in(2, MAX_IDS), metavar="N",
                         help="load: sessions on a generated NxN product instead (truth cells, --delay)")
-    parser.add_argument("--cells", type=comma_list(number_in(int, 1, 65), "cell counts in [1, 64]"),
-                        default=[1, 2, 4, 8], metavar="N,...", help="with --product: cell counts (default 1,2,4,8)")
+    parser.add_argument("--cell-counts", type=comma_list(number_in(int, 1, MAX_CELLS + 1),
+                                                         f"cell counts in [1, {MAX_CELLS}]"),
+                        default=[1, 2, 4, 8], metavar="N,...",
+                        help="with --product: one session per count, as session --cells N (default 1,2,4,8)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1,
                         help="with --product: seed of the product (default 1)")
     parser.add_argument("--json", action="store_true", help="print JSON")
@@ -203,7 +208,7 @@ def main(argv: list[str]) -> int:
 
 
 def _load(args: argparse.Namespace) -> int:
-    figures = load_runs(args.product, [int(n) for n in args.cells], args.policy, args.delay, args.seed)
+    figures = load_runs(args.product, [int(n) for n in args.cell_counts], args.policy, args.delay, args.seed)
     if args.json:
         print(json.dumps(figures, indent=2))
         return 0

@@ -1,7 +1,8 @@
 """Cell co-processes: start ``executor serve`` nodes, follow their output, stop them.
 
-A session (or a test) starts its cells with :func:`start_cell`. Each cell runs with
-``--lifeline``: it holds our pipe on its stdin and exits when we die, so a killed
+A session (or a test) starts its cells with :func:`start_cell`, each with its settings as
+one document (:class:`assembly_constraints.bridge.cell_settings.ServeSettings`). Each cell runs with
+``lifeline`` set: it holds our pipe on its stdin and exits when we die, so a killed
 planner leaves no cell behind. Output lines (``ready``, ``start <id> ...``,
 ``done <id> ...``) are collected by a reader thread; :meth:`CellProcess.wait_for_line`
 waits for one with a deadline.
@@ -15,10 +16,12 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Sequence
 from pathlib import Path
 
+import msgspec
+
 from assembly_constraints.asp import PlannerError
+from assembly_constraints.bridge.cell_settings import ServeSettings, encode_settings
 from assembly_constraints.bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -26,21 +29,38 @@ ROOT = Path(__file__).resolve().parents[2]
 cells get it on their PYTHONPATH and run in it."""
 
 
+def _absolute(settings: ServeSettings) -> ServeSettings:
+    """``settings`` with its files' paths absolute: the cell runs in :data:`ROOT`, not our folder."""
+    paths = {name: str(Path(value).absolute()) for name in ("rrd", "ilc_state", "zenoh_config")
+             if (value := getattr(settings, name)) is not None}
+    return msgspec.structs.replace(settings, **paths)
+
+
 class CellProcess:
-    """One running ``executor serve`` process and the lines it printed.
+    """One running ``executor serve`` process, started with ``settings`` as its one
+    document (``--settings JSON``, with ``lifeline`` set), and the lines it printed.
 
     A cell runs in its own process session, as a cell started by hand in another
     terminal would: the kernel then schedules it beside the planner rather than inside
     the planner's share of the cores (with autogroup scheduling, two cells in the
     planner's session shared one core on a loaded machine). It still ends with the
-    planner: ``--lifeline`` makes it exit when its stdin closes.
+    planner: ``lifeline`` makes it exit when its stdin closes.
     """
 
-    def __init__(self, cell_id: str, argv: Sequence[str]) -> None:
-        self.cell_id = cell_id
+    @staticmethod
+    def command(settings: ServeSettings) -> list[str]:
+        """The command line of the cell: ``executor serve --settings JSON``, the settings
+        with ``lifeline`` set and their files' paths absolute."""
+        started = _absolute(msgspec.structs.replace(settings, lifeline=True))
+        return [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--settings",
+                encode_settings(started)]
+
+    def __init__(self, settings: ServeSettings) -> None:
+        self.cell_id = settings.cell_id
+        argv = self.command(settings)
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
-        self.popen = subprocess.Popen(list(argv), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+        self.popen = subprocess.Popen(argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                       stderr=subprocess.STDOUT, env=env, cwd=ROOT, text=True,
                                       start_new_session=True)
         self.lines: list[str] = []
@@ -108,52 +128,16 @@ class CellProcess:
         self.popen.wait(10.0)
 
 
-def serve_argv(cell_id: str, *, backend: str, assembly: str = "cranfield",
-               listen: Sequence[str] = (), connect: Sequence[str] = (), delay_s: float = 0.0,
-               rrd: Path | None = None, recording_id: str | None = None,
-               zenoh_config: Path | None = None, viewer_url: str | None = None,
-               ilc_state: Path | None = None, block_holes: Sequence[str] = (),
-               cell_options: Sequence[str] = (), cell_seed: int | None = None) -> list[str]:
-    """The command line of one ``executor serve`` node, with ``--lifeline``; ``viewer_url``:
-    a Rerun viewer or server the cell also streams its recording to; ``ilc_state``: the
-    file the sim cell keeps its learned ILC corrections in (in the run folder, so a
-    resumed session's cell starts from them); ``block_holes``: holes with an obstacle;
-    ``cell_options``: the sim cell's execution layer and uncertainty
-    (:func:`assembly_constraints.bridge.cell_options.cell_argv`), ``cell_seed``: the seed of its systematic errors."""
-    argv = [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--cell", cell_id,
-            "--backend", backend, "--assembly", assembly, "--lifeline"]
-    argv += [arg for ep in listen for arg in ("--listen", ep)]
-    argv += [arg for ep in connect for arg in ("--connect", ep)]
-    if delay_s:
-        argv += ["--delay", str(delay_s)]
-    if rrd is not None:
-        argv += ["--rrd", str(Path(rrd).absolute())]  # the cell runs in the repository, not our cwd
-    if recording_id is not None:
-        argv += ["--recording-id", recording_id]
-    if zenoh_config is not None:
-        argv += ["--zenoh-config", str(Path(zenoh_config).absolute())]
-    if viewer_url is not None:
-        argv += ["--rerun-connect", viewer_url]
-    if ilc_state is not None and backend == "sim":
-        argv += ["--ilc-state", str(Path(ilc_state).absolute())]
-    argv += [arg for hole in block_holes for arg in ("--block-hole", hole)]
-    if backend == "sim":
-        argv += list(cell_options)
-        if cell_seed is not None:
-            argv += ["--cell-seed", str(cell_seed)]
-    return argv
-
-
-def cell_seed(session_seed: int, number: int) -> int:
+def cell_seed(first: int, number: int) -> int:
     """The cell seed (systematic errors) of the session's cell ``c<number>`` (1, 2, ...):
-    the session seed plus ``number`` − 1 (modulo 2**32), so each cell of a session is
+    the session's first cell seed plus ``number`` − 1 (modulo 2**32), so each cell of a session is
     another cell, and the same cell again when the session is resumed."""
-    return (session_seed + number - 1) % (MAX_SEED + 1)
+    return (first + number - 1) % (MAX_SEED + 1)
 
 
-def start_cell(cell_id: str, *, ready_timeout: float = 60.0, **options) -> CellProcess:
-    """Start a cell (options of :func:`serve_argv`) and wait until it prints ``ready``."""
-    cell = CellProcess(cell_id, serve_argv(cell_id, **options))
+def start_cell(settings: ServeSettings, *, ready_timeout: float = 60.0) -> CellProcess:
+    """Start a cell and wait until it prints ``ready``."""
+    cell = CellProcess(settings)
     try:
         cell.wait_for_line("ready", ready_timeout)
     except PlannerError:

@@ -22,7 +22,7 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -33,7 +33,7 @@ from assembly_constraints.bridge.cli_types import (
 from assembly_constraints.executor.campaign.ablation import format_ablation, run_ablation
 from assembly_constraints.executor.campaign.pairs import campaign_pairs
 from assembly_constraints.executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
-from assembly_constraints.executor.cell_options import perturbation_from_args
+from assembly_constraints.executor.world.perturbation import PerturbationModel
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5
@@ -123,7 +123,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.ablation:
         with stdout_to_stderr():
             ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.jobs,
-                                    perturbation_from_args(args))
+                                    PerturbationModel.of(cell_settings_of(args).magnitudes))
         print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
         return 0
     trials = args.trials or (1 if args.quick else 3)

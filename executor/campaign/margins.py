@@ -16,11 +16,10 @@ from collections.abc import Sequence
 
 import msgspec
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments, add_cell_description_argument
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT
-from assembly_constraints.executor.cell_options import cell_keywords
-from assembly_constraints.executor.trial import Cell, trial_rng
+from assembly_constraints.executor.trial import Cell, cell_keywords, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -29,9 +28,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="first seed")
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     add_cell_arguments(parser)
-    add_cell_description_argument(parser)
     args = parser.parse_args(argv)
-    keywords = cell_keywords(args)
+    keywords = cell_keywords(cell_settings_of(args))
     described = keywords["description"]
     keywords["description"] = msgspec.structs.replace(described, thresholds=msgspec.structs.replace(
         described.thresholds, f_stop=math.inf, m_stop=math.inf))

@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from assembly_constraints.bridge.cell_options import add_cell_arguments, add_cell_description_argument
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -58,7 +58,7 @@ from assembly_constraints.executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from assembly_constraints.executor.cell_options import cell_keywords
+from assembly_constraints.executor.trial import cell_keywords
 
 
 class TrialRunner(Protocol):
@@ -75,7 +75,7 @@ function or a ``functools.partial`` of one)."""
 
 class CellRunner:
     """A :class:`assembly_constraints.executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
-    ``keywords``: the Cell's options (layer, perturbation, cell seed, description)."""
+    ``keywords``: the Cell's options (layer, perturbation, cell seed)."""
 
     def __init__(self, assembly: str, **keywords: Any) -> None:
         from assembly_constraints.executor.trial import Cell
@@ -225,7 +225,6 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
     parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
     add_cell_arguments(parser)
-    add_cell_description_argument(parser)
     return parser
 
 
@@ -233,7 +232,7 @@ def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
     args = build_parser().parse_args(list(argv))
     pairs = select_pairs(args.pairs)
-    keywords = cell_keywords(args)  # the cell description checked before anything is written
+    keywords = cell_keywords(cell_settings_of(args))  # the cell description checked before anything is written
     if args.plot:  # before the campaign, which takes minutes
         from assembly_constraints.bridge.files import check_writable, make_folder
 

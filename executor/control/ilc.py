@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Annotated
 import msgspec
 import numpy as np
 
-from assembly_constraints.bridge.cell_options import LAYER_NAMES
+from assembly_constraints.bridge.cell_settings import LAYER_NAMES
 from assembly_constraints.bridge.files import write_atomic
 from assembly_constraints.bridge.inputs import duplicate_key, read_bytes, shorten
 from assembly_constraints.executor import ExecutorError

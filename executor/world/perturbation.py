@@ -32,32 +32,40 @@ import math
 import zlib
 from dataclasses import dataclass, field, fields
 
+import msgspec
 import numpy as np
 
-from assembly_constraints.bridge.cell_options import MAGNITUDES
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.evidence import AttemptSetup
+
+_DEFAULT = Magnitudes()
 
 
 @dataclass(frozen=True)
 class PerturbationModel:
     """Magnitudes of the cell's uncertainty: grasp offsets [m], grasp tilts [°], vision
     errors [m], vision yaw errors [°], friction coefficients (Coulomb, part on hole wall, dimensionless); the
-    defaults are those of the cell's options (:data:`assembly_constraints.bridge.cell_options.MAGNITUDES`)."""
+    defaults are those of the cell's options (:class:`assembly_constraints.bridge.cell_settings.Magnitudes`)."""
 
-    grasp_offset_bias: float = MAGNITUDES["grasp_offset_bias"].default
-    grasp_offset_random: float = MAGNITUDES["grasp_offset_random"].default
-    grasp_tilt_bias: float = MAGNITUDES["grasp_tilt_bias"].default
-    grasp_tilt_random: float = MAGNITUDES["grasp_tilt_random"].default
-    vision_bias: float = MAGNITUDES["vision_bias"].default
-    vision_sigma: float = MAGNITUDES["vision_sigma"].default
-    vision_max: float = MAGNITUDES["vision_max"].default
-    vision_yaw_bias: float = MAGNITUDES["vision_yaw_bias"].default
-    vision_yaw_sigma: float = MAGNITUDES["vision_yaw_sigma"].default
-    vision_yaw_max: float = MAGNITUDES["vision_yaw_max"].default
-    friction_min: float = MAGNITUDES["friction_min"].default
-    friction_max: float = MAGNITUDES["friction_max"].default
-    friction_jitter: float = MAGNITUDES["friction_jitter"].default
+    grasp_offset_bias: float = _DEFAULT.grasp_offset_bias
+    grasp_offset_random: float = _DEFAULT.grasp_offset_random
+    grasp_tilt_bias: float = _DEFAULT.grasp_tilt_bias
+    grasp_tilt_random: float = _DEFAULT.grasp_tilt_random
+    vision_bias: float = _DEFAULT.vision_bias
+    vision_sigma: float = _DEFAULT.vision_sigma
+    vision_max: float = _DEFAULT.vision_max
+    vision_yaw_bias: float = _DEFAULT.vision_yaw_bias
+    vision_yaw_sigma: float = _DEFAULT.vision_yaw_sigma
+    vision_yaw_max: float = _DEFAULT.vision_yaw_max
+    friction_min: float = _DEFAULT.friction_min
+    friction_max: float = _DEFAULT.friction_max
+    friction_jitter: float = _DEFAULT.friction_jitter
+
+    @classmethod
+    def of(cls, magnitudes: Magnitudes) -> PerturbationModel:
+        """The model of the cell settings' magnitudes; ExecutorError if inconsistent."""
+        return cls(**msgspec.structs.asdict(magnitudes)).check()
 
     def random_only(self) -> PerturbationModel:
         """The same random parts with every systematic part zero (friction: the middle of

@@ -1,6 +1,6 @@
-"""``assemble --uncertainty cell``: the cell's options reach ``executor serve`` (no physics),
-and are refused where they would have no effect: without ``--uncertainty cell``, or with
-``--backend truth``."""
+"""``assemble --uncertainty cell``: the cell's options reach the assembling cell's settings
+document (no physics), and are refused where they would have no effect: without
+``--uncertainty cell``, or with ``--backend truth``."""
 
 from __future__ import annotations
 
@@ -10,37 +10,44 @@ from collections.abc import Callable
 import pytest
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.cli import build_parser, cell_options
+from assembly_constraints.asp.assemble.cli import assembly_settings, build_parser
+from assembly_constraints.asp.assemble.settings import assembling_cell_settings
 from assembly_constraints.asp.bench.assemble_plans import build_parser as bench_parser
-from assembly_constraints.asp.session.cells import serve_argv
+from assembly_constraints.asp.session.cells import CellProcess
+from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, ServeSettings, cell_settings_of
 from assembly_constraints.executor.serve import build_parser as serve_parser
+from assembly_constraints.executor.serve import serve_settings_of
+
+
+def _checked(parser: ArgumentParser, argv: list[str]):
+    args = parser.parse_args(argv)
+    return assembling_cell_settings(cell_settings_of(args), args.backend)
 
 
 def test_the_cell_options_reach_the_assembling_cell() -> None:
-    args = build_parser().parse_args(["--uncertainty", "cell", "--cell-seed", "3", "--layer", "position",
-                                      "--grasp-tilt-bias", "2.5"])
-    argv = serve_argv("a1", backend="sim", cell_options=cell_options(args))
-    served = serve_parser().parse_args(argv[argv.index("serve") + 1:])
+    settings = assembly_settings(build_parser().parse_args(["--uncertainty", "cell", "--cell-seed", "3", "--layer",
+                                                            "position", "--grasp-tilt-bias", "2.5"]))
+    cell = assembling_cell_settings(settings.cell, settings.backend)
+    argv = CellProcess.command(ServeSettings(cell_id="a1", cell=cell))
+    served = serve_settings_of(serve_parser().parse_args(argv[argv.index("serve") + 1:])).cell
     assert (served.uncertainty, served.cell_seed, served.layer) == ("cell", 3, "position")
-    assert served.grasp_tilt_bias == 2.5 and served.vision_sigma == 0.0015  # the defaults are passed too
+    assert served.magnitudes.grasp_tilt_bias == 2.5 and served.magnitudes.vision_sigma == 0.0015
 
 
-def test_by_default_the_assembling_cell_gets_no_cell_options() -> None:
-    args = build_parser().parse_args([])
-    assert cell_options(args) == []
-    assert serve_parser().parse_args(["--cell", "a1"]).uncertainty == "random"
+def test_by_default_the_assembling_cell_gets_the_default_cell() -> None:
+    assert _checked(build_parser(), []) == DEFAULT_CELL
+    assert serve_settings_of(serve_parser().parse_args(["--cell", "a1"])).cell.uncertainty == "random"
 
 
 @pytest.mark.parametrize("option", [["--layer", "position"], ["--cell-seed", "1"], ["--vision-bias", "0.002"]])
 def test_a_cell_option_without_uncertainty_cell_is_refused(option: list[str]) -> None:
     with pytest.raises(PlannerError, match="need --uncertainty cell"):
-        cell_options(build_parser().parse_args(option))
+        _checked(build_parser(), option)
 
 
-def test_bench_assemble_passes_the_same_cell_options() -> None:
-    args = bench_parser().parse_args(["--uncertainty", "cell", "--cell-seed", "2", "--layer", "admittance_p"])
-    served = serve_parser().parse_args(cell_options(args))
-    assert (served.uncertainty, served.cell_seed, served.layer) == ("cell", 2, "admittance_p")
+def test_bench_assemble_passes_the_same_cell_settings() -> None:
+    cell = _checked(bench_parser(), ["--uncertainty", "cell", "--cell-seed", "2", "--layer", "admittance_p"])
+    assert (cell.uncertainty, cell.cell_seed, cell.layer) == ("cell", 2, "admittance_p")
 
 
 @pytest.mark.parametrize("parser", [build_parser, bench_parser], ids=["assemble", "bench-assemble"])
@@ -51,4 +58,4 @@ def test_bench_assemble_passes_the_same_cell_options() -> None:
 def test_a_cell_option_with_the_truth_backend_is_refused_naming_both(parser: Callable[[], ArgumentParser],
                                                                       option: list[str], named: str) -> None:
     with pytest.raises(PlannerError, match=f"^{named} has no effect with --backend truth"):
-        cell_options(parser().parse_args(["--backend", "truth", *option]))
+        _checked(parser(), ["--backend", "truth", *option])

@@ -11,7 +11,8 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from assembly_constraints.asp.session.cells import CellProcess, serve_argv, start_cell
+from assembly_constraints.asp.session.cells import CellProcess, start_cell
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import (
     CellConflict,
     CellDirectory,
@@ -43,7 +44,7 @@ pytestmark = pytest.mark.timeout(60)
 def network() -> Iterator[tuple[str, zenoh.Session, CellDirectory, list[CellProcess]]]:
     """A planner-side session listening on a free loopback port; cells are added by tests."""
     endpoint = free_loopback_endpoint()
-    session = open_session(listen=[endpoint])
+    session = open_session(listen=(endpoint,))
     directory = CellDirectory(session)
     cells: list[CellProcess] = []
     try:
@@ -65,7 +66,7 @@ def raw_query(session: zenoh.Session, key: str, payload: bytes) -> InsertReply |
 @pytest.mark.slow
 def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     directory.wait_for(1, timeout=20)
     bad = {
         b"x" * 100_000: "oversized",
@@ -86,7 +87,7 @@ def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> N
 @pytest.mark.slow
 def test_a_repeated_id_returns_the_cached_reply_without_rerunning(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.2))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,), delay_s=0.2)))
     directory.wait_for(1, timeout=20)
     request = InsertRequest(id="same", part="p3", hole="s1")
     first = request_insert(session, "c1", request, timeout=10)
@@ -99,7 +100,7 @@ def test_a_repeated_id_returns_the_cached_reply_without_rerunning(network) -> No
 @pytest.mark.slow
 def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     directory.wait_for(1, timeout=20)
     gone: queue.SimpleQueue[str] = queue.SimpleQueue()
     directory.listen(lambda cell, alive: None if alive else gone.put(cell))
@@ -112,7 +113,7 @@ def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
 def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(network) -> None:
     endpoint, session, directory, cells = network
     for cell_id in ("c1", "c2"):
-        cells.append(start_cell(cell_id, backend="truth", connect=[endpoint], delay_s=0.5))
+        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", connect=(endpoint,), delay_s=0.5)))
     directory.wait_for(2, timeout=20)
     pairs = [(p, h) for p in ("p1", "p3", "sh") for h in ("r1", "s1", "br")]
     requests = [InsertRequest(id=f"r{i}", part=p, hole=h) for i, (p, h) in enumerate(pairs)]
@@ -149,13 +150,13 @@ def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(net
 @pytest.mark.slow
 def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.5))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,), delay_s=0.5)))
     directory.wait_for(1, timeout=20)
 
     def replace_c1_in_its_second_experiment() -> None:
         cells[0].wait_for_line("start", timeout=30, count=2)
         cells[0].kill()
-        cells.append(start_cell("c2", backend="truth", connect=[endpoint]))
+        cells.append(start_cell(ServeSettings(cell_id="c2", backend="truth", connect=(endpoint,))))
 
     replacer = threading.Thread(target=replace_c1_in_its_second_experiment)
     replacer.start()
@@ -175,7 +176,7 @@ def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
 @pytest.mark.slow
 def test_a_reused_id_with_another_pair_is_refused_not_answered_from_the_cache(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     directory.wait_for(1, timeout=20)
     assert request_insert(session, "c1", InsertRequest(id="r", part="sh", hole="br"), 10).result == "fit"
     with pytest.raises(CellRefused, match="id_reused"):
@@ -196,7 +197,7 @@ def raw_ping(session: zenoh.Session, key: str, payload: bytes) -> bytes:
 @pytest.mark.slow
 def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint], delay_s=0.3))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,), delay_s=0.3)))
     directory.wait_for(1, timeout=20)
     outcomes: queue.SimpleQueue[object] = queue.SimpleQueue()
     count = QUEUE_SIZE + 10
@@ -215,7 +216,7 @@ def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(networ
 @pytest.mark.slow
 def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_taken(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     directory.wait_for(1, timeout=20)
 
     def liar(query: zenoh.Query) -> None:  # a second process answering for c1: "fit", for p9
@@ -223,7 +224,7 @@ def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_
         query.reply(query.key_expr, encode(InsertReply(id=request.id, cell="c1", part="p9", hole=request.hole,
                                                        result="fit")))
 
-    rogue = open_session(connect=[endpoint])
+    rogue = open_session(connect=(endpoint,))
     try:
         declared = rogue.declare_queryable("cell/c1/insert", liar)
         time.sleep(0.5)  # the declaration reaches the planner's session
@@ -250,7 +251,7 @@ def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_
 
 def test_a_token_with_nothing_behind_it_is_dropped_and_others_are_not_trusted(network) -> None:
     endpoint, session, directory, cells = network
-    rogue = open_session(connect=[endpoint])
+    rogue = open_session(connect=(endpoint,))
     try:
         tokens = [rogue.liveliness().declare_token(alive_key(cell)) for cell in ("c1", "evil")]
         directory.wait_for(2, timeout=20)
@@ -281,9 +282,9 @@ def _refusal(cell: CellProcess) -> str:
 @pytest.mark.slow  # two or three cell processes
 def test_a_second_process_on_a_served_cell_id_refuses_to_start(network) -> None:
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     directory.wait_for(1, timeout=20)
-    cells.append(CellProcess("c1", serve_argv("c1", backend="truth", connect=[endpoint])))
+    cells.append(CellProcess(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     assert "error: cell id c1 is already served by another process" in _refusal(cells[1])
     assert cells[0].popen.poll() is None and directory.duplicated == set()  # the planner never saw it
     assert request_insert(session, "c1", InsertRequest(id="d1", part="sh", hole="br"), 10).result == "fit"
@@ -292,7 +293,7 @@ def test_a_second_process_on_a_served_cell_id_refuses_to_start(network) -> None:
 @pytest.mark.slow  # two or three cell processes
 def test_two_processes_started_together_on_one_id_leave_exactly_one(network) -> None:
     endpoint, session, directory, cells = network
-    cells += [CellProcess("c1", serve_argv("c1", backend="truth", connect=[endpoint])) for _ in range(2)]
+    cells += [CellProcess(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))) for _ in range(2)]
     deadline = time.monotonic() + 40
     while all(cell.popen.poll() is None for cell in cells) and time.monotonic() < deadline:
         time.sleep(0.1)
@@ -306,8 +307,9 @@ def test_two_processes_started_together_on_one_id_leave_exactly_one(network) -> 
 def test_cells_on_one_id_that_meet_later_leave_the_older_serving(network) -> None:
     endpoint, session, directory, cells = network
     first, second = free_loopback_endpoint(), free_loopback_endpoint()
-    cells.append(start_cell("c1", backend="truth", listen=[first]))
-    cells.append(start_cell("c1", backend="truth", listen=[second]))  # apart: no peer connects them
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(first,))))
+    # apart: no peer connects them
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(second,))))
     late = open_session(connect=[first, second])  # a planner joins both: Zenoh's gossip connects them
     try:
         assert cells[1].popen.wait(30) == 2 and cells[0].popen.poll() is None
@@ -322,9 +324,9 @@ def test_a_token_of_a_second_claimant_the_cells_cannot_see_makes_the_planner_wai
     """The planner's own guard: two tokens on one id (here a peer that listens nowhere, so
     the cell cannot meet it) and that id gets nothing until one is gone."""
     endpoint, session, directory, cells = network
-    cells.append(start_cell("c1", backend="truth", connect=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
     directory.wait_for(1, timeout=20)
-    hidden = open_session(connect=[endpoint])
+    hidden = open_session(connect=(endpoint,))
     try:
         token = hidden.liveliness().declare_token(alive_key("c1", "hidden"))
         deadline = time.monotonic() + 20

@@ -20,6 +20,7 @@ from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import NameOID
 
 from assembly_constraints.asp.session.cells import CellProcess, start_cell
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_insert
 from assembly_constraints.bridge.messages import InsertRequest
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
@@ -106,7 +107,8 @@ def test_mutual_tls_serves_a_certified_planner_and_keeps_out_a_peer_without_cert
         tmp_path: Path, cells: list[CellProcess]) -> None:
     make_certificates(tmp_path)
     endpoint = free_loopback_endpoint().replace("tcp/127.0.0.1", "tls/localhost")
-    cells.append(start_cell("c1", backend="truth", zenoh_config=tls_config(tmp_path, "cell", endpoint)))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth",
+                                          zenoh_config=str(tls_config(tmp_path, "cell", endpoint)))))
     for config, served in ((tls_config(tmp_path, "planner", endpoint), True),
                            (tls_config(tmp_path, "planner", endpoint, certificate=False), False)):
         session = open_session(config_file=config)
@@ -130,8 +132,10 @@ def _only_c1_is_served(cells: list[CellProcess], endpoint: str, planner: Path, c
     session = open_session(config_file=planner)
     directory = CellDirectory(session)
     try:
-        cells.append(start_cell("c1", backend="truth", connect=[endpoint], zenoh_config=cell))
-        cells.append(start_cell(other, backend="truth", connect=[endpoint], zenoh_config=other_config))
+        cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,),
+                                              zenoh_config=str(cell))))
+        cells.append(start_cell(ServeSettings(cell_id=other, backend="truth", connect=(endpoint,),
+                                              zenoh_config=str(other_config))))
         directory.wait_for(1, timeout=20)
         assert request_insert(session, "c1", InsertRequest(id=request_id, part="p1", hole="r1"), 10).result == "fit"
         with pytest.raises(CellTimeout):

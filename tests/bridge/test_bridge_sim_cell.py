@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from assembly_constraints.asp.session.cells import start_cell
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, request_insert
 from assembly_constraints.bridge.messages import InsertRequest
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
@@ -19,8 +20,9 @@ def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
 
     endpoint = free_loopback_endpoint()
     rrd = tmp_path / "c1.rrd"
-    cell = start_cell("c1", backend="sim", listen=[endpoint], rrd=rrd, recording_id="sim-test")
-    session = open_session(connect=[endpoint])
+    cell = start_cell(ServeSettings(cell_id="c1", backend="sim", listen=(endpoint,), rrd=str(rrd),
+                                    recording_id="sim-test"))
+    session = open_session(connect=(endpoint,))
     try:
         CellDirectory(session).wait_for(1, timeout=30)
         request = InsertRequest(id="s1", part="p1", hole="br", seed=3, experiment=7)

@@ -15,6 +15,7 @@ from assembly_constraints.asp.assemble.cli import truth_facts
 from assembly_constraints.asp.plans.plans import plans
 from assembly_constraints.asp.session.cells import start_cell
 from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellRefused, request_step
 from assembly_constraints.bridge.messages import StepReply, StepRequest
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
@@ -25,8 +26,8 @@ def one_cell(backend: str, stop_s: float = 30.0) -> Iterator[zenoh.Session]:
     """A cell ``c1`` of Cranfield with ``backend``, and a planner's session connected to it;
     the cell must stop cleanly within ``stop_s`` [s] afterwards."""
     endpoint = free_loopback_endpoint()
-    cell = start_cell("c1", backend=backend, listen=[endpoint])
-    session = open_session(connect=[endpoint])
+    cell = start_cell(ServeSettings(cell_id="c1", backend=backend, listen=(endpoint,)))
+    session = open_session(connect=(endpoint,))
     try:
         CellDirectory(session).wait_for(1, timeout=30)
         yield session

@@ -13,6 +13,7 @@ import msgspec
 import pytest
 
 from assembly_constraints.asp.session.cells import CellProcess, start_cell
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.messages import ErrorReply, Evidence, InsertReply, InsertRequest, encode
 from assembly_constraints.bridge.product import ID_PATTERN
 from assembly_constraints.bridge.protocol_schema import MESSAGES, drift, main, schemas
@@ -63,7 +64,7 @@ def test_the_third_party_client_imports_only_zenoh_and_the_standard_library() ->
 @pytest.mark.slow
 def test_the_third_party_client_talks_to_a_real_cell(cells: list[CellProcess], tmp_path: Path) -> None:
     endpoint = free_loopback_endpoint()
-    cells.append(start_cell("c1", backend="truth", listen=[endpoint]))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,))))
 
     def client(part: str, hole: str) -> tuple[int, dict]:
         done = subprocess.run([sys.executable, "-I", str(CLIENT), endpoint, part, hole], cwd=tmp_path,

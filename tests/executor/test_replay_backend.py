@@ -4,12 +4,12 @@ backend (assembly_constraints.executor.replay) answers from a recorded session's
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import pytest
 
 from assembly_constraints.asp.session.cells import CellProcess
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.messages import InsertRequest
 from assembly_constraints.bridge.session import free_loopback_endpoint
 from assembly_constraints.executor import ExecutorError
@@ -61,10 +61,8 @@ def test_a_session_against_a_replay_cell_repeats_the_recorded_session(
         run_session, cells: list[CellProcess], tmp_path: Path) -> None:
     recorded = run_session("--out", str(tmp_path / "recorded"))
     endpoint = free_loopback_endpoint()
-    cell = CellProcess("c1", [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--cell", "c1",
-                              "--backend", REPLAY,
-                              "--backend-option", f"journal={tmp_path / 'recorded' / 'journal.jsonl'}",
-                              "--listen", endpoint, "--lifeline"])
+    cell = CellProcess(ServeSettings(cell_id="c1", backend=REPLAY, listen=(endpoint,),
+                                     backend_options={"journal": str(tmp_path / "recorded" / "journal.jsonl")}))
     cells.append(cell)
     cell.wait_for_line("ready", timeout=60)
     replayed = run_session("--cells", "0", "--connect", endpoint, "--out", str(tmp_path / "replayed"))

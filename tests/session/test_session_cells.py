@@ -22,6 +22,7 @@ from assembly_constraints.asp.session.cells import CellProcess, start_cell
 from assembly_constraints.asp.session.journal import read_journal
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.asp.solve import atoms_by_name, load_atoms
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.session import free_loopback_endpoint
 from tests.conftest import ROOT, TRUTH_SESSION
 
@@ -50,7 +51,7 @@ def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellPro
                                              cli_env: dict[str, str]) -> None:
     endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
     for cell_id, endpoint in zip(("c1", "c2"), endpoints):
-        cells.append(start_cell(cell_id, backend="truth", listen=[endpoint], delay_s=0.5))
+        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", listen=(endpoint,), delay_s=0.5)))
     run = tmp_path / "run"
     connect = [arg for ep in endpoints for arg in ("--connect", ep)]
     argv = cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run), "--policy", "best")
@@ -76,7 +77,7 @@ def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellPro
 def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv,
                                                  cli_env: dict[str, str], run_session) -> None:
     endpoint = free_loopback_endpoint()
-    cells.append(start_cell("c1", backend="truth", listen=[endpoint], delay_s=0.15))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,), delay_s=0.15)))
     run = tmp_path / "run"
     planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "0", "--connect", endpoint, "--out", str(run)),
                                cwd=root, env=cli_env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -90,7 +91,7 @@ def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[Ce
     before = read_journal(run / "journal.jsonl")
     assert 5 <= len(before) < 25
     cells[0].kill()  # a fresh cell has no reply cache: a re-sent experiment would run again
-    cells.append(start_cell("c1", backend="truth", listen=[endpoint], delay_s=0.0))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,), delay_s=0.0)))
     result = run_session("--cells", "0", "--connect", endpoint, "--resume", str(run))
     assert result["run"] == str(run)
     assert_learned_truth(result, run)
@@ -202,7 +203,7 @@ def test_a_rogue_cell_that_answers_fit_to_everything_is_never_used(tmp_path: Pat
     from assembly_constraints.bridge.session import open_session
 
     endpoint = free_loopback_endpoint()
-    rogue = open_session(connect=[endpoint])
+    rogue = open_session(connect=(endpoint,))
     asked: list[str] = []
 
     def always_fit(query) -> None:

@@ -17,6 +17,7 @@ import pytest
 
 from assembly_constraints.asp.session.cells import CellProcess, start_cell
 from assembly_constraints.asp.session.journal import JournalEntry, JournalEvent, read_journal, read_records
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.session import free_loopback_endpoint
 from tests.conftest import TRUTH_SESSION
 from tests.session.test_session_cells import assert_learned_truth
@@ -81,7 +82,7 @@ def test_resume_of_a_running_session_is_refused_before_any_cell(tmp_path: Path, 
                                                                 root: Path, cli_argv, cli_env: dict[str, str],
                                                                 run_cli) -> None:
     endpoint = free_loopback_endpoint()
-    cells.append(start_cell("c1", backend="truth", listen=[endpoint], delay_s=0.2))
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,), delay_s=0.2)))
     run = tmp_path / "run"
     planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "0", "--connect", endpoint, "--out", str(run)),
                                cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -158,7 +159,7 @@ def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[Cel
                                                  cli_env: dict[str, str], run_session) -> None:
     endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
     for cell_id, endpoint in zip(("c1", "c2"), endpoints):
-        cells.append(start_cell(cell_id, backend="truth", listen=[endpoint], delay_s=0.3))
+        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", listen=(endpoint,), delay_s=0.3)))
     connect = [arg for ep in endpoints for arg in ("--connect", ep)]
     run = tmp_path / "run"
     planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run)),
@@ -198,14 +199,3 @@ def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[Cel
     settings = json.loads((run / "session.json").read_text())
     assert settings["starts"] == 2 and sorted(settings["abandoned"]) == sorted(in_flight)
     assert len(read_journal(run / "journal.jsonl")) == result["experiments"]
-
-
-def test_a_sim_cell_keeps_its_ilc_state_in_the_run_folder(tmp_path: Path) -> None:
-    """The session gives each sim cell ``<run>/<cell>-ilc.json`` (a resume passes the same
-    path, so the cell reloads what it learned); the truth backend learns nothing."""
-    from assembly_constraints.asp.session.cells import serve_argv
-
-    state = tmp_path / "c1-ilc.json"
-    argv = serve_argv("c1", backend="sim", ilc_state=state)
-    assert argv[argv.index("--ilc-state") + 1] == str(state.absolute())
-    assert "--ilc-state" not in serve_argv("c1", backend="truth", ilc_state=state)

@@ -12,6 +12,7 @@ from assembly_constraints.asp.session.journal import Journal, read_journal
 from assembly_constraints.asp.session.zenoh_oracle import ZenohOracle
 from assembly_constraints.asp.sizes.learner import learn_sizes
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellPool
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
 
@@ -21,8 +22,8 @@ from assembly_constraints.bridge.session import free_loopback_endpoint, open_ses
 def test_learn_sizes_through_the_zenoh_oracle(tmp_path: Path) -> None:
     truth = TruthOracle.from_assembly("cranfield")
     endpoint = free_loopback_endpoint()
-    cell = start_cell("c1", backend="truth", listen=[endpoint])
-    session = open_session(connect=[endpoint])
+    cell = start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,)))
+    session = open_session(connect=(endpoint,))
     directory = CellDirectory(session)
     pool = CellPool(session, directory, timeout=10.0, wait_for_cell=10.0)
     journal = Journal(tmp_path)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.run import main as session_main
+from assembly_constraints.asp.session.cli import main as session_main
 from tests.conftest import ROOT
 
 LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s\); (\d+) pairs unknown")

@@ -54,9 +54,8 @@ def test_a_sim_session_runs_with_the_layer_and_uncertainty_it_was_given(tmp_path
     assert done.returncode == 0, done.stderr
     result = json.loads(done.stdout)
     assert result["matches_truth"] is True
-    options = json.loads((run / "session.json").read_text())["cell_options"]
-    assert options[options.index("--layer") + 1] == "pi_phase_stop"
-    assert float(options[options.index("--vision-sigma") + 1]) == 0.001
+    cell = json.loads((run / "session.json").read_text())["cell"]
+    assert cell["layer"] == "pi_phase_stop" and cell["magnitudes"]["vision_sigma"] == 0.001
     assert not (run / "c1-ilc.json").exists()
 
 

@@ -1,0 +1,163 @@
+"""``./run.sh session``: the end-to-end learning session, planner and cells over Zenoh.
+
+The command line of :mod:`assembly_constraints.asp.session.run`: the options become one
+:class:`assembly_constraints.asp.session.settings.SessionSettings` (:func:`session_settings`), the session
+runs from it, and a summary (or, with ``--json``, the result) is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+from pathlib import Path
+
+from msgspec import UNSET
+
+from assembly_constraints.asp.session.cells import ROOT
+from assembly_constraints.asp.session.run import LOG, run_session
+from assembly_constraints.asp.session.settings import (
+    MAX_CELLS,
+    MAX_PLANS,
+    MAX_WAIT_S,
+    SessionSettings,
+    read_session_file,
+)
+from assembly_constraints.asp.sizes.cli import add_model_option
+from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
+from assembly_constraints.asp.sizes.policies import policy_names
+from assembly_constraints.asp.solve import encoding
+from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
+from assembly_constraints.bridge.cli_types import (
+    MAX_SEED,
+    PROGRAM,
+    ArgumentParser,
+    add_assembly_argument,
+    comma_list,
+    finite_float,
+    int_in,
+    path_setting,
+)
+from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
+from assembly_constraints.bridge.keys import check_cell_id
+from assembly_constraints.bridge.recording.sinks import add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
+from assembly_constraints.bridge.session import add_endpoint_arguments
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = ArgumentParser(prog="session", description=__doc__.split("\n\n")[0])
+    add_assembly_argument(parser)
+    parser.add_argument("--cells", type=int_in(0, MAX_CELLS), default=1,
+                        help=f"cell co-processes to start, 0 to {MAX_CELLS} (default 1; 0: use cells on the network)")
+    parser.add_argument("--policy", default="best", choices=policy_names(),
+                        help="experiment selection policy (default best: fewest experiments)")
+    parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the policy and the trials")
+    add_model_option(parser)
+    parser.add_argument("--confirm", type=int_in(0, MAX_CONFIRM), default=0, metavar="K",
+                        help="re-test each essential experiment until its result leads by K+1 answers "
+                             "(default 0: trust the cell's answer; see sizes learn --confirm)")
+    parser.add_argument("--demos", type=Path, metavar="FILE",
+                        help="demonstrations (default: the assembly's demos.txt); a part placed into a "
+                             "hole (p1@r1) is a fit the size learning starts from")
+    parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
+    parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
+    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
+                        help="cells started here: sim (PyBullet) or truth (answers from the geometry's "
+                             "cross-sections, no simulation)")
+    parser.add_argument("--delay", type=finite_float(0.0, 3600.0), default=0.0, metavar="S",
+                        help="truth backend: seconds each experiment takes (default 0)")
+    parser.add_argument("--timeout", type=finite_float(0.0, MAX_WAIT_S, low_open=True), default=120.0, metavar="S",
+                        help="one experiment at one cell before it is re-sent (default 120)")
+    parser.add_argument("--wait-for-cell", type=finite_float(0.0, MAX_WAIT_S), default=60.0, metavar="S",
+                        help="how long to wait while no cell is alive (default 60)")
+    parser.add_argument("--plans", type=int_in(1, MAX_PLANS), default=5, metavar="K",
+                        help="plans to compute (default 5)")
+    parser.add_argument("--allow-cells", type=comma_list(check_cell_id, "cell ids"), metavar="ID,...",
+                        help="with --cells 0: use only these cells (default: any cell that shows a token); "
+                             "a session that starts its cells uses only those")
+    parser.add_argument("--assemble", action="store_true",
+                        help="then assemble the first plan in the first cell (as the assemble subcommand "
+                             "does); the JSON gains \"assembly\"")
+    parser.add_argument("--json", action="store_true", help="print the JSON result")
+    add_endpoint_arguments(parser)
+    add_viewer_arguments(parser)
+    add_cell_arguments(parser, cell_seed=False)  # cell c<k>'s cell seed: --seed + k - 1 (session_settings)
+    return parser
+
+
+def session_settings(args: argparse.Namespace) -> SessionSettings:
+    """The settings the options of :func:`build_parser` give; the cells' first cell seed is ``--seed``."""
+    return SessionSettings(
+        assembly=args.assembly, policy=args.policy, model=args.model, seed=args.seed, confirm=args.confirm,
+        demos=path_setting(args.demos), cell=cell_settings_of(args, cell_seed=args.seed), out=path_setting(args.out),
+        resume=path_setting(args.resume), cells=args.cells, backend=args.backend, delay_s=args.delay,
+        timeout_s=args.timeout, wait_for_cell_s=args.wait_for_cell, plans=args.plans,
+        allow_cells=None if args.allow_cells is None else tuple(args.allow_cells), assemble=args.assemble,
+        listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config))
+
+
+def _program() -> str:
+    """How to call this program again: the repository's ``run.sh`` (absolute, so it works
+    from any folder) in a checkout, else the installed console command."""
+    wrapper = ROOT / "run.sh"
+    return shlex.quote(str(wrapper)) if wrapper.is_file() else PROGRAM
+
+
+def _assembly_line(report: dict) -> str:
+    errors = report["final_pose_error_mm"]
+    worst = max(errors.values(), default=0.0)
+    return (f"assembly of plan 1: assembled {report['assembled']}, {len(report['steps'])} steps, "
+            f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
+
+
+def _summary(result: dict, run: Path) -> str:
+    """The human ending of a session: what was learned, the files written, what to run next."""
+    settings = read_session_file(run)
+    assert settings.journal is not UNSET and settings.truth is not UNSET and settings.assignment is not UNSET
+    cells: dict[str, int] = {}
+    for entry in settings.journal:
+        cells[entry["cell"]] = cells.get(entry["cell"], 0) + 1
+    plan = " ".join(f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+    files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
+    python = shlex.quote(sys.executable)
+    learned = shlex.quote(str(run / "learned.lp"))
+    part = result["fits"][0][0] if result["fits"] else "p1"
+    return "\n".join([
+        f"run {result['run']}: {result['experiments']} experiments "
+        f"({', '.join(f'{c}: {n}' for c, n in sorted(cells.items()))}) in {settings.wall_s:.1f} s",
+        "fits: " + " ".join(f"{p}->{h}" for p, h in result["fits"])
+        + (f" (started from {len(result['demonstrated'])} seen in the demonstrations)"
+           if result["demonstrated"] else ""),
+        f"assumes: {result['assumption']}",
+        *(f"model changed: {change}" for change in result["model_changes"]),
+        f"must precede: {len(result['must_precede'])} pairs",
+        "assignment: " + " ".join(f"{p}->{h}" for p, h in settings.assignment.items()),
+        f"plan 1 of {len(result['plans'])}: {plan}",
+        f"versus the truth: sizes equal {settings.truth['sizes_equal']}, every true "
+        f"precedence learned {settings.truth['precedence_sound']} "
+        f"({settings.truth['precedence_extra']} pairs more than required); "
+        f"matches truth: {result['matches_truth']}",
+        *([_assembly_line(result["assembly"])] if "assembly" in result else []),
+        f"files written in {run}: {' '.join(files)}",
+        "next:",
+        *(f"  {label + ':':<24}{command}" for label, command in (
+            ("view the recording", f"{_program()} view {shlex.quote(str(run))}"),
+            (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
+            ("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5"),
+        )),
+    ])
+
+
+def main(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    viewer = viewer_of(args)
+    with hosted_viewer(viewer) as live:
+        result = run_session(session_settings(args), live)
+        print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
+        keep_serving(viewer)
+    stopped = result.get("assembly", {}).get("error")
+    if stopped:
+        LOG.error("%s", stopped)
+        return EXIT_UNSOLVABLE
+    return 0

@@ -1,0 +1,222 @@
+"""The settings of a learning session, and ``RUN/session.json``, their encoding.
+
+:class:`SessionSettings` is one start of a session, built once at the edge (the command
+line, :mod:`assembly_constraints.asp.session.cli`, or :func:`assembly_constraints.api.run_session`).
+:class:`SessionFile` is ``session.json``: the settings that stay with the run folder
+(assembly, policy, model, seed, confirmations, demonstrations, the cells' settings), the
+recording id and the count of starts, and, once the session is done, its result.
+:func:`read_session_file` is its one decoder: a resume, ``assemble --run``, ``bench
+assemble``, the summary and :func:`assembly_constraints.api.read_run` read it.
+
+A folder written before the settings were typed (``"cell_options"``: the cell's options
+as command-line arguments, no ``"format"``) is decoded too: its options are read as the
+fields of :class:`assembly_constraints.bridge.cell_settings.CellSettings`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import msgspec
+from msgspec import UNSET, Meta, UnsetType
+
+from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
+from assembly_constraints.asp.sizes.models import MODELS
+from assembly_constraints.asp.sizes.policies import policy_names
+from assembly_constraints.bridge.cell_settings import (
+    DEFAULT_CELL,
+    MAGNITUDE_FIELDS,
+    CellSettings,
+    Seed,
+    validation_text,
+)
+from assembly_constraints.bridge.files import write_atomic
+from assembly_constraints.bridge.inputs import read_bytes, shorten
+
+SESSION_FILE = "session.json"
+SESSION_FORMAT = 2
+"""The format ``session.json`` is written in (1: the untyped one, without ``"format"``)."""
+MAX_WAIT_S = 86_400.0
+"""``timeout_s``, ``wait_for_cell_s``: at most a day [s]; ``delay_s`` at most an hour."""
+MAX_CELLS = 64
+"""``cells``: at most this many cell co-processes."""
+MAX_PLANS = 1000
+"""``plans``: at most this many plans (they are written to session.json)."""
+MAX_STARTS = 1_000_000
+"""The most starts (the first and its resumes) a run folder records."""
+MAX_RECORDING_ID = 64
+"""The longest recording id [characters]: the cells' request ids are built from it."""
+
+RecordingId = Annotated[str, Meta(pattern=rf"^[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}$")]
+Confirm = Annotated[int, Meta(ge=0, le=MAX_CONFIRM)]
+
+
+def _check_choices(policy: str, model: str | None) -> None:
+    """ValueError (msgspec reports it with the struct's path) unless ``policy`` and ``model`` are known."""
+    if policy not in policy_names():
+        raise ValueError(f"policy {policy!r}: expected one of {', '.join(policy_names())}")
+    if model is not None and model not in MODELS:
+        raise ValueError(f"model {model!r}: expected null or one of {', '.join(MODELS)}")
+
+
+class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """One start of a session.
+
+    What is learned: ``assembly`` (a shipped one's name or a folder), ``policy``,
+    ``model`` (None: the product's, else ``sections``), ``seed`` (of the policy and the
+    trials), ``confirm`` K (re-tests until a result leads by K+1), ``demos`` (a file;
+    None: the assembly's ``demos.txt``), ``cell``: the simulated cells' settings, cell
+    ``c<k>`` with cell seed ``cell.cell_seed + k - 1`` (the command line sets
+    ``cell.cell_seed`` to ``seed``). These are kept in ``session.json``; a resume takes
+    them from there and ignores its own.
+
+    How: ``out`` (None: ``runs/<UTC time>``) or ``resume`` (a run folder); ``cells``
+    co-processes to start (0: use cells on the network, only ``allow_cells`` if given)
+    with ``backend`` (``truth``: each experiment takes ``delay_s`` [s]); ``timeout_s`` [s]
+    one experiment at one cell before it is sent again; ``wait_for_cell_s`` [s] while no
+    cell is alive; ``plans``: how many to compute; ``assemble``: then assemble plan 1 in
+    the first cell; ``listen``, ``connect``, ``zenoh_config``: the planner's Zenoh
+    endpoints and config file.
+    """
+
+    assembly: str = "cranfield"
+    policy: str = "best"
+    model: str | None = None
+    seed: Seed = 0
+    confirm: Confirm = 0
+    demos: str | None = None
+    cell: CellSettings = DEFAULT_CELL
+    out: str | None = None
+    resume: str | None = None
+    cells: Annotated[int, Meta(ge=0, le=MAX_CELLS)] = 1
+    backend: Literal["sim", "truth"] = "sim"
+    delay_s: Annotated[float, Meta(ge=0.0, le=3600.0)] = 0.0
+    timeout_s: Annotated[float, Meta(gt=0.0, le=MAX_WAIT_S)] = 120.0
+    wait_for_cell_s: Annotated[float, Meta(ge=0.0, le=MAX_WAIT_S)] = 60.0
+    plans: Annotated[int, Meta(ge=1, le=MAX_PLANS)] = 5
+    allow_cells: tuple[str, ...] | None = None
+    assemble: bool = False
+    listen: tuple[str, ...] = ()
+    connect: tuple[str, ...] = ()
+    zenoh_config: str | None = None
+
+
+def checked(settings: SessionSettings) -> SessionSettings:
+    """``settings`` if every field is in its range and the policy and model are known (a
+    struct built in Python is not checked as a decoded one is); PlannerError naming the
+    field otherwise."""
+    try:
+        _check_choices(settings.policy, settings.model)
+        return msgspec.convert(msgspec.to_builtins(settings), SessionSettings)
+    except msgspec.ValidationError as exc:
+        raise PlannerError(f"session settings: {validation_text(exc)}") from None
+    except ValueError as exc:
+        raise PlannerError(f"session settings: {exc}") from None
+
+
+class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
+    """``RUN/session.json``: the settings kept with the run folder (see
+    :class:`SessionSettings`), its Rerun ``recording_id``, how many times it was
+    started, ``status`` and the experiments abandoned by resumes; once ``done``, the
+    result (the ``session --json`` contract: ``run``, ``experiments``, ``fits``,
+    ``must_precede``, ``plans``, ``matches_truth``, and more: the size model used and
+    what it assumes, the truth comparison, the assignment, the cells, the journal,
+    wall time [s] and timings [s], the assembly run). Fields not yet known are absent."""
+
+    format: int = SESSION_FORMAT
+    assembly: str
+    policy: str
+    model: str | None = None
+    seed: Seed
+    confirm: Confirm = 0
+    demos: str | None = None
+    cell: CellSettings = DEFAULT_CELL
+    recording_id: RecordingId
+    starts: Annotated[int, Meta(ge=1, lt=MAX_STARTS)] = 1
+    status: Literal["running", "done"] = "running"
+    abandoned: list[int] = []
+    run: str | UnsetType = UNSET
+    experiments: int | UnsetType = UNSET
+    fits: list[tuple[str, str]] | UnsetType = UNSET
+    must_precede: list[tuple[str, str]] | UnsetType = UNSET
+    plans: list[list[dict[str, str | None]]] | UnsetType = UNSET
+    matches_truth: bool | None | UnsetType = UNSET
+    assumption: str | UnsetType = UNSET
+    model_changes: list[str] | UnsetType = UNSET
+    demonstrated: list[tuple[str, str]] | UnsetType = UNSET
+    truth: dict[str, bool | int | None] | UnsetType = UNSET
+    assignment: dict[str, str] | UnsetType = UNSET
+    cells: list[str] | UnsetType = UNSET
+    journal: list[dict[str, Any]] | UnsetType = UNSET
+    wall_s: float | UnsetType = UNSET
+    timings: dict[str, float] | UnsetType = UNSET
+    assembly_run: dict[str, Any] | UnsetType = UNSET
+
+    def __post_init__(self) -> None:
+        if self.format != SESSION_FORMAT:
+            raise ValueError(f"format {self.format}: expected {SESSION_FORMAT} (written by another version; "
+                             "start a new session)")
+        _check_choices(self.policy, self.model)
+
+
+def new_session_file(settings: SessionSettings, recording_id: str) -> SessionFile:
+    """The ``session.json`` of a new run folder."""
+    return SessionFile(assembly=settings.assembly, policy=settings.policy, model=settings.model, seed=settings.seed,
+                       confirm=settings.confirm, demos=settings.demos, cell=settings.cell, recording_id=recording_id)
+
+
+def _from_format_1(data: dict[str, Any]) -> dict[str, Any]:
+    """A ``session.json`` of format 1 as format 2: its ``"cell_options"`` (``["--layer",
+    L, "--<magnitude>", "X", ...]``) become ``"cell"``, whose cell seed was the session
+    seed; ValueError naming an option that is none of the cell's."""
+    options = data.pop("cell_options", [])
+    if not isinstance(options, list) or len(options) % 2 or not all(isinstance(arg, str) for arg in options):
+        raise ValueError(f'"cell_options" {shorten(json.dumps(options), 80)}: expected pairs of an option '
+                         "and its value")
+    magnitudes = {field.name for field in MAGNITUDE_FIELDS}
+    cell: dict[str, Any] = {"cell_seed": data.get("seed", 0), "magnitudes": {}}
+    for option, value in zip(options[::2], options[1::2], strict=True):
+        name = option.removeprefix("--").replace("-", "_")
+        if name == "layer":
+            cell["layer"] = value
+        elif name in magnitudes:
+            try:
+                cell["magnitudes"][name] = float(value)
+            except ValueError:
+                raise ValueError(f'"cell_options": {option} {shorten(value, 40)}: expected a number') from None
+        else:
+            raise ValueError(f'"cell_options": {shorten(option, 40)}: expected --layer or a magnitude of the cell')
+    return {**data, "format": SESSION_FORMAT, "cell": cell}
+
+
+def read_session_file(run: Path) -> SessionFile:
+    """The ``session.json`` of run folder ``run``; PlannerError naming the file and the
+    field, and what was expected, when it is missing, not JSON or not one a session writes."""
+    path = run / SESSION_FILE
+    if not path.is_file():
+        raise PlannerError(f"{run}: not a run folder (expected {SESSION_FILE} in it)")
+    data = read_bytes(path, "session settings file (JSON)", error=PlannerError)
+    try:
+        raw = json.loads(data)
+    except (ValueError, RecursionError) as exc:
+        raise PlannerError(f"{path}: not JSON ({shorten(exc, 80)}); expected the settings a session wrote") from None
+    if not isinstance(raw, dict):
+        raise PlannerError(f"{path}: a JSON {type(raw).__name__}; expected an object with the session's settings")
+    old = "format" not in raw
+    try:
+        return msgspec.convert(_from_format_1(raw) if old else raw, SessionFile)
+    except msgspec.ValidationError as exc:
+        text = validation_text(exc)
+        if old and text.startswith('"cell.'):
+            text = f'"cell_options" (format 1, read as "cell"): {text}'
+        raise PlannerError(f"{path}: {shorten(text, 200)}") from None
+    except ValueError as exc:  # format 1's cell options
+        raise PlannerError(f"{path}: {shorten(exc, 200)}") from None
+
+
+def write_session_file(run: Path, record: SessionFile) -> None:
+    """Write ``run/session.json`` atomically (indented, the fields not yet known left out)."""
+    write_atomic(run / SESSION_FILE, msgspec.json.format(msgspec.json.encode(record), indent=2).decode() + "\n")
