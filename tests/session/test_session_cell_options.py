@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from assembly_constraints.asp.session.cells import CellProcess, cell_seed
 from assembly_constraints.asp.session.cli import build_parser, session_settings
 from assembly_constraints.asp.session.run import session_cell
@@ -43,3 +45,16 @@ def test_the_cell_reads_back_the_document_the_session_wrote(tmp_path: Path) -> N
     assert argv[argv.index("serve") + 1:][0] == "--settings" and len(argv[argv.index("serve") + 1:]) == 2
     read = serve_settings_of(serve_parser().parse_args(argv[argv.index("serve") + 1:]))
     assert read.cell == settings.cell and read.lifeline and read.rrd == str(Path("relative-run/c2.rrd").absolute())
+
+
+def test_a_cell_description_reaches_every_cell_by_its_absolute_path(tmp_path: Path,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """``session --cell-description FILE`` (relative to the caller) is in every cell's
+    settings as an absolute path, and the cell builds its Cell with that file's values."""
+    from assembly_constraints.executor.trial import cell_keywords
+
+    (tmp_path / "cell.toml").write_text("[thresholds]\nf_stop = 7.5\n")
+    monkeypatch.chdir(tmp_path)
+    first, second = _cells(["--cell-description", "cell.toml"], tmp_path)
+    assert first.cell.description == second.cell.description == str(tmp_path / "cell.toml")
+    assert cell_keywords(first.cell)["description"].thresholds.f_stop == 7.5
