@@ -109,8 +109,12 @@ def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly:
             raise SystemExit(f"session --cells {cells} learned a wrong relation")
         entries = read_journal(Path(tmp) / "run" / JOURNAL_NAME)
         busy = cell_busy_fraction(entries, cells)
+        timings = json.loads((Path(tmp) / "run" / "session.json").read_text(encoding="utf-8"))["timings"]
     return {"wall_s": round(wall, 2), "experiments": result["experiments"], "cell_busy": busy,
-            "duplicates": duplicates(entries)}
+            "duplicates": duplicates(entries),
+            "learning_s": round(timings["learned_s"] - timings["cells_ready_s"], 2),
+            "planning_s": timings["planning_s"],
+            "planning_ms_per_experiment": round(1000 * timings["planning_s"] / result["experiments"], 1)}
 
 
 def duplicates(entries: list[JournalEntry]) -> int:
@@ -129,6 +133,7 @@ def load_runs(product: int, cell_counts: list[int], policy: str, delay_s: float,
     base = runs[0]
     for run in runs:
         run["speedup"] = round(base["wall_s"] / run["wall_s"], 2)
+        run["learning_speedup"] = round(base["learning_s"] / run["learning_s"], 2)
         run["experiments_ratio"] = round(run["experiments"] / base["experiments"], 3)
     return {"product": f"{product}x{product}", "delay_s": delay_s, "seed": seed, "runs": runs}
 
@@ -209,9 +214,10 @@ def _load(args: argparse.Namespace) -> int:
         return 0
     print(f"{figures['product']} product (seed {args.seed}), truth cells, {args.delay} s per experiment, "
           f"policy {args.policy}")
-    print(f"{'cells':>5} {'wall [s]':>9} {'speed-up':>8} {'experiments':>11} {'ratio':>6} {'duplicates':>10} "
-          f"{'busy':>5}")
+    print(f"{'cells':>5} {'wall [s]':>9} {'speed-up':>8} {'learning [s]':>12} {'speed-up':>8} {'experiments':>11} "
+          f"{'ratio':>6} {'duplicates':>10} {'busy':>5} {'planning/exp [ms]':>17}")
     for r in figures["runs"]:
-        print(f"{r['cells']:>5} {r['wall_s']:>9.1f} {r['speedup']:>8.2f} {r['experiments']:>11} "
-              f"{r['experiments_ratio']:>6.3f} {r['duplicates']:>10} {r['cell_busy']:>5.2f}")
+        print(f"{r['cells']:>5} {r['wall_s']:>9.1f} {r['speedup']:>8.2f} {r['learning_s']:>12.1f} "
+              f"{r['learning_speedup']:>8.2f} {r['experiments']:>11} {r['experiments_ratio']:>6.3f} "
+              f"{r['duplicates']:>10} {r['cell_busy']:>5.2f} {r['planning_ms_per_experiment']:>17.1f}")
     return 0

@@ -56,6 +56,9 @@ class PlannerLog:
         self.rec = open_stream(APPLICATION_ID, recording_id, rrd, viewer)
         self.rec.send_blueprint(blueprint(Contents(planner=True, cells=tuple(cell_ids),
                                                    assembly_cells=tuple(assembling))))
+        self._smaller: tuple[Knowledge, list[tuple[str, str]], list[tuple[float, float]]] | None = None
+        """The last knowledge logged, the reduction of its smaller-than graph and the graph's
+        layout: experiments recorded together share one knowledge, laid out once."""
 
     def precedence(self, parts: Sequence[str], edges: Sequence[tuple[str, str]]) -> None:
         """The learned must-precede relation as a directed graph (its reduction), by levels."""
@@ -77,9 +80,11 @@ class PlannerLog:
                      rr.TextDocument(_knowledge_table(knowledge, matrix, (part, hole)), media_type="text/markdown"))
         nodes = [*knowledge.parts, *knowledge.holes]
         colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)
-        edges = reduction(Relation.from_pairs(nodes, knowledge.smaller))
-        self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors,
-                                                      positions=positions(nodes, edges)))
+        if self._smaller is None or self._smaller[0] is not knowledge:
+            reduced = reduction(Relation.from_pairs(nodes, knowledge.smaller))
+            self._smaller = knowledge, reduced, positions(nodes, reduced)
+        _, edges, layout = self._smaller
+        self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors, positions=layout))
         self.rec.log("planner/smaller", rr.GraphEdges(edges, graph_type="directed"))
 
     def assignment(self, assignment: Mapping[str, str]) -> None:
