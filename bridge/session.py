@@ -70,8 +70,9 @@ def cell_listen(listen: Sequence[str], connect: Sequence[str], config_file: Path
 
 
 def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
-                config_file: Path | None = None) -> zenoh.Config:
-    """A Zenoh config: the file if given, else a loopback peer; endpoints override it."""
+                config_file: Path | None = None, mode: str | None = None) -> zenoh.Config:
+    """A Zenoh config: the file if given, else a loopback peer; endpoints and ``mode``
+    (``peer``, ``client``, ``router``) override it."""
     if config_file is not None:
         if not config_file.is_file():
             raise BridgeError(f"{config_file}: no such Zenoh config file")
@@ -85,6 +86,8 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("listen/endpoints", "[]")
     config.insert_json5("transport/link/rx/max_message_size", str(MAX_TRANSPORT_BYTES))
+    if mode is not None:
+        config.insert_json5("mode", json.dumps(mode))
     if listen or connect or config_file is None:  # --connect alone: listen nowhere
         config.insert_json5("listen/endpoints", json.dumps([check_endpoint(e) for e in listen]))
     if connect:
@@ -93,12 +96,13 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
 
 
 def open_session(listen: Sequence[str] = (), connect: Sequence[str] = (),
-                 config_file: Path | None = None) -> zenoh.Session:
-    """Open a Zenoh session (~0.5 s); BridgeError if an endpoint cannot be used.
+                 config_file: Path | None = None, mode: str | None = None) -> zenoh.Session:
+    """Open a Zenoh session (~0.5 s; see :func:`make_config`); BridgeError if an endpoint
+    cannot be used.
 
     Close it (``with`` or ``.close()``): an open session keeps the process alive.
     """
-    config = make_config(listen, connect, config_file)
+    config = make_config(listen, connect, config_file, mode)
     try:
         return zenoh.open(config)
     except zenoh.ZError as exc:

@@ -234,19 +234,21 @@ def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]
         weighted = (relations * weights[:, None] if biorder_count(m, n) <= EXACT_LIMIT
                     else _weighted_sample(m, n, *masks))
         mine = [index[pair] for pair in pending if pair in index]
-        score = np.zeros(m * n)
-        if len(relations):
-            groups = np.zeros(len(relations), dtype=np.int64)
-            if mine:
+        columns = np.array([index[pair] for pair in sub.unknown], dtype=np.int64)  # only unknown pairs score
+        score = np.zeros(len(columns))
+        if len(relations) and len(columns):
+            if len(mine) < 63:  # the outcomes of the pending pairs as the bits of one integer
+                groups = relations[:, mine].astype(np.int64) @ (np.int64(1) << np.arange(len(mine), dtype=np.int64))
+            else:
                 groups = np.unique(relations[:, mine], axis=0, return_inverse=True)[1].reshape(-1)
             # the relations sorted by group, each group's rows summed in one pass
             by_group = np.argsort(groups, kind="stable")
             starts = np.flatnonzero(np.r_[True, np.diff(groups[by_group]) != 0])
-            fit_weight = np.add.reduceat(weighted[by_group], starts, axis=0)
+            fit_weight = np.add.reduceat(weighted[np.ix_(by_group, columns)], starts, axis=0)
             group_weight = np.add.reduceat(weights[by_group], starts)
             score = np.minimum(fit_weight, group_weight[:, None] - fit_weight).sum(axis=0)
         total = float(weights.sum()) or 1.0
-        share.update({pair: float(score[index[pair]]) / total for pair in sub.unknown})
+        share.update({pair: float(value) / total for pair, value in zip(sub.unknown, score)})
     candidates = [pair for pair in knowledge.unknown if pair not in pending]
     return sorted(candidates, key=lambda pair: (-share[pair], order[pair]))
 
