@@ -17,12 +17,19 @@ import itertools
 import os
 import shutil
 import subprocess
+import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from asp import PlannerError
+from asp.session.cells import CellProcess, serve_argv
 
 ROUTER_PORT = 7447
 """The port the router listens on in the router namespace."""
+
+CLIENT_CONFIG = '{ mode: "client", scouting: { multicast: { enabled: false } } }\n'
+"""The Zenoh config of a planner or cell that reaches the others only through the router:
+a client of it (two peers that listen nowhere never meet through a router)."""
 
 _SERIAL = itertools.count(1)
 
@@ -103,6 +110,29 @@ class Hosts:
     def argv(self, namespace: str, argv: Sequence[str]) -> list[str]:
         """``argv`` run inside ``namespace``."""
         return ["ip", "netns", "exec", namespace, *argv]
+
+    def start_fleet(self, client_config: Path, *, backend: str = "truth", delay_s: float = 0.0,
+                    assembly: str = "cranfield", ready_timeout: float = 60.0) -> list[CellProcess]:
+        """Start ``./run.sh router`` in the router namespace and cell ``c<k>`` in cell
+        namespace k, a Zenoh client (``client_config``, e.g. :data:`CLIENT_CONFIG`) of the
+        router only; returns the router's and the cells' processes once each printed
+        ``ready`` (stop them; on a failure here they are killed)."""
+        router = [sys.executable, "-m", "assembly_constraints", "router",
+                  *(f"--listen={endpoint}" for endpoint in self.router_endpoints())]
+        started = [CellProcess("router", self.argv(self.router, router))]
+        try:
+            started[0].wait_for_line("ready", timeout=ready_timeout)
+            for k, namespace in enumerate(self.cells, start=1):
+                argv = serve_argv(f"c{k}", backend=backend, assembly=assembly, connect=[self.cell_endpoint(k)],
+                                  delay_s=delay_s, zenoh_config=client_config)
+                started.append(CellProcess(f"c{k}", self.argv(namespace, argv)))
+            for process in started[1:]:
+                process.wait_for_line("ready", timeout=ready_timeout)
+        except BaseException:
+            for process in started:
+                process.kill()
+            raise
+        return started
 
     def cut(self, k: int) -> None:
         """Take cell namespace ``k``'s only link down."""

@@ -8,63 +8,49 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from asp.session.cells import CellProcess, serve_argv
-from asp.session.hosts import Hosts, unavailable
+from asp.session.cells import CellProcess
+from asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
 from asp.session.journal import read_journal
 from asp.sizes.oracle import TruthOracle
-from tests.conftest import CLI_MODULE, TRUTH_SESSION
+from tests.conftest import TRUTH_SESSION
 
 pytestmark = [pytest.mark.timeout(150), pytest.mark.slow]  # real namespaces and processes, 15-40 s
 TRUTH = TruthOracle.from_assembly("cranfield")
-WHY_NOT = unavailable()
-CLIENT_CONFIG = '{ mode: "client", scouting: { multicast: { enabled: false } } }\n'
-"""Planner and cells reach each other only through the router: Zenoh clients of it (two
-peers that listen nowhere never meet through a router)."""
 
 
 @pytest.fixture
 def hosts() -> Iterator[Hosts]:
-    if WHY_NOT is not None:
-        pytest.skip(WHY_NOT)
+    why_not = unavailable()
+    if why_not is not None:
+        pytest.skip(why_not)
     with Hosts(2) as made:
         yield made
 
 
 @pytest.fixture
-def processes() -> Iterator[list[CellProcess]]:
-    """Router and cell processes a test starts; killed when it ends."""
-    started: list[CellProcess] = []
+def client(tmp_path: Path) -> Path:
+    path = tmp_path / "client.json5"
+    path.write_text(CLIENT_CONFIG, encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def fleet(hosts: Hosts, client: Path) -> Iterator[list[CellProcess]]:
+    """The router and cells c1, c2 (truth, 0.3 s per experiment), each in its namespace."""
+    started = hosts.start_fleet(client, delay_s=0.3)
     yield started
     for process in started:
         process.kill()
 
 
-def start_fleet(hosts: Hosts, processes: list[CellProcess], client: Path, delay_s: float) -> None:
-    """The router in the router namespace, cell c<k> in cell namespace k, each a Zenoh
-    client (config file ``client``) of the router only."""
-    router = [sys.executable, "-m", CLI_MODULE, "router", *(f"--listen={ep}" for ep in hosts.router_endpoints())]
-    processes.append(CellProcess("router", hosts.argv(hosts.router, router)))
-    processes[-1].wait_for_line("ready", timeout=60)
-    for k, namespace in enumerate(hosts.cells, start=1):
-        argv = serve_argv(f"c{k}", backend="truth", connect=[hosts.cell_endpoint(k)], delay_s=delay_s,
-                          zenoh_config=client)
-        processes.append(CellProcess(f"c{k}", hosts.argv(namespace, argv)))
-    for cell in processes[1:]:
-        cell.wait_for_line("ready", timeout=60)
-
-
 def test_a_cell_whose_link_is_cut_is_dropped_and_the_session_finishes(
-        tmp_path: Path, hosts: Hosts, processes: list[CellProcess], root: Path, cli_argv, cli_env) -> None:
-    client = tmp_path / "client.json5"
-    client.write_text(CLIENT_CONFIG, encoding="utf-8")
-    start_fleet(hosts, processes, client, delay_s=0.3)
+        tmp_path: Path, hosts: Hosts, fleet: list[CellProcess], client: Path, root: Path, cli_argv, cli_env) -> None:
     run = tmp_path / "run"
     argv = cli_argv(*TRUTH_SESSION, "--cells", "0", "--zenoh-config", str(client),
                     "--connect", hosts.router_endpoints()[0],
