@@ -56,7 +56,7 @@ class CellConflict(BridgeError):
 
 
 class CellCrashed(BridgeError):
-    """Every cell the pool may use has ended (crashed, or dropped), work is left to do."""
+    """Every cell the pool may use has crashed, and work is left to do."""
 
 
 def describe_exit(code: int) -> str:
@@ -263,10 +263,12 @@ class CellPool:
     ``max_misses`` replies in a row is dropped for the rest of the pool's life. Only the
     cells in ``allowed`` are used (None: any cell that shows a token). ``exit_status(cell)``
     gives the exit status of a cell's process when this planner started it and it has
-    ended (None otherwise): such a cell is *crashed*, its request is sent to another
-    cell at once, it is never used again, and when every allowed cell has ended the pool
-    fails with :class:`CellCrashed` naming them instead of waiting. ``incidents`` lists what
-    went wrong on the way (timeouts, conflicts, crashed and dropped cells).
+    ended (None otherwise; it may wait a moment for a process whose links just closed, and
+    is asked only when a cell's token goes or an attempt fails): such a cell is *crashed*,
+    its request is sent to another cell at once, it is never used again, and when every
+    allowed cell has crashed the pool fails with :class:`CellCrashed` naming them instead
+    of waiting. ``incidents`` lists what went wrong on the way (timeouts, conflicts,
+    crashed and dropped cells).
     ``on_dispatch(cell, request)``, if set, is called (in the thread of :meth:`next_reply`)
     just before each request is sent to a cell, also when it is re-sent to another; an
     exception it raises propagates from :meth:`next_reply` and the request is not sent.
@@ -348,10 +350,11 @@ class CellPool:
                 return None
         if self._busy or self._alive:
             return self._events.get()
-        crashed = "; ".join(f"cell {cell} {how}" for cell, how in sorted(self.crashed.items()))
-        if self._allowed is not None and self._allowed <= self._dropped:
-            raise CellCrashed(f"{crashed or 'every cell dropped'}; no other cell left, "
-                              f"{len(self._pending)} experiment(s) still to run")
+        for cell in sorted((self._allowed or set()) - self._dropped):
+            self._ended(cell)  # a crash seen only now: its links closed before its process was reaped
+        crashed = "; ".join(f"cell {cell} crashed ({how})" for cell, how in sorted(self.crashed.items()))
+        if self._allowed is not None and self._allowed <= self.crashed.keys():
+            raise CellCrashed(f"{crashed}; no other cell left, {len(self._pending)} experiment(s) still to run")
         try:
             return self._events.get(timeout=self.wait_for_cell)
         except queue.Empty:

@@ -83,11 +83,6 @@ class CellProcess:
         except subprocess.TimeoutExpired:
             return None
 
-    def ended(self) -> int | None:
-        """The exit status if the process has ended (negative: the signal that killed
-        it), else None; never waits."""
-        return self.popen.poll()
-
     def last_line(self) -> str | None:
         """The last non-blank line the process printed (None if none)."""
         with self._new:

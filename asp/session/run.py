@@ -75,6 +75,10 @@ MAX_WAIT_S = 86_400.0
 """--timeout, --wait-for-cell: at most a day [s]; --delay at most an hour."""
 MAX_CELLS = 64
 """--cells: at most this many cell co-processes."""
+CRASH_WAIT_S = 2.0
+"""How long the pool waits for a started cell's process to end when its links just closed
+or it missed a reply [s]: the peer sees the sockets close a moment before the process can
+be reaped."""
 MAX_PLANS = 1000
 """--plans: at most this many plans (they are written to session.json)."""
 
@@ -433,7 +437,7 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         allowed = cell_ids if args.cells > 0 else (args.allow_cells or None)  # by default only its own cells
         processes = {cell.cell_id: cell for cell in cells}
         pool = CellPool(session, directory, timeout=args.timeout, wait_for_cell=args.wait_for_cell, allowed=allowed,
-                        exit_status=lambda cell: processes[cell].ended() if cell in processes else None)
+                        exit_status=lambda cell: processes[cell].exit_code(CRASH_WAIT_S) if cell in processes else None)
         stack.callback(pool.close)
         oracle = ZenohOracle(pool, directory, journal, run_id, settings["seed"])
         for cell in cells:
