@@ -46,6 +46,7 @@ from asp.precedence.relation import Relation
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_options import add_assembly_uncertainty_argument, add_cell_arguments
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, add_jobs_argument, finite_float, int_in
+from bridge.progress import progress
 
 ASSIGNMENT_LIMIT = 10_000
 """A plan's assignment is drawn among at most this many feasible ones (clingo's first)."""
@@ -176,7 +177,7 @@ def main(argv: list[str]) -> int:
         print(_row(k + 1, reports[k]), file=sys.stderr if args.json else sys.stdout, flush=True)
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        list(pool.map(one, range(len(drawn))))
+        list(progress(pool.map(one, range(len(drawn))), desc="plans", total=len(drawn), unit="plan"))
     result = summary(reports)
     if args.json:
         print(json.dumps({"plans": reports, "summary": result}))
