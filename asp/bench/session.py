@@ -14,10 +14,17 @@
    is reported beside the ratio of the medians).
 3. ``--product N --cells 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
    experiment takes ``--delay`` seconds without using the cores) on a generated N×N
-   product (:mod:`asp.bench.products`): wall time [s], speed-up against 1 cell,
-   experiments and their ratio to the 1-cell run, and duplicates (a request journaled
-   twice, or a pair run again though not a re-test; must be 0). Targets on 20×20: 8 cells
-   at least 4x faster than 1, with at most 10 % more experiments.
+   product (:mod:`asp.bench.products`): wall time [s] of the whole command, the learning
+   time [s] (from the cells being ready to the last result, ``session.json`` timings), the
+   speed-up of each against 1 cell, experiments and their ratio to the 1-cell run,
+   duplicates (a request journaled twice, or a pair run again though not a re-test; must
+   be 0) and the planner's time per experiment [ms] (recording results and choosing the
+   next ones). Targets on 20×20 at ``--delay 0.5``: 8 cells at least 6x faster than 1,
+   with at most 10 % more experiments.
+4. ``--hosts K``: the Cranfield session with K cells on loopback (started by the session),
+   then with K cells in K network namespaces joined only through ``./run.sh router``
+   (:mod:`asp.session.hosts`; needs root): each run's figures and the ratio of their
+   learning times.
 """
 
 from __future__ import annotations
