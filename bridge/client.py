@@ -295,6 +295,8 @@ class CellPool:
         self._misses: dict[str, int] = {}
         self._dropped: set[str] = set()
         self._exit_status = exit_status
+        self._gone: set[str] = set()
+        """Cells whose token disappeared (since last seen alive)."""
         self.crashed: dict[str, str] = {}
         """Cells whose process ended: cell id -> how (``killed by signal SIGKILL``)."""
         self.incidents: list[str] = []
@@ -350,7 +352,7 @@ class CellPool:
                 return None
         if self._busy or self._alive:
             return self._events.get()
-        for cell in sorted((self._allowed or set()) - self._dropped):
+        for cell in sorted(self._gone - self._dropped):
             self._ended(cell)  # a crash seen only now: its links closed before its process was reaped
         crashed = "; ".join(f"cell {cell} crashed ({how})" for cell, how in sorted(self.crashed.items()))
         if self._allowed is not None and self._allowed <= self.crashed.keys():
@@ -401,9 +403,11 @@ class CellPool:
             if event[0] == "cell":
                 _, cell, alive = event
                 if alive:
+                    self._gone.discard(cell)
                     if self._usable(cell):
                         self._alive.add(cell)
                     continue
+                self._gone.add(cell)
                 self._ended(cell)
                 self._alive.discard(cell)
                 sent = self._busy.pop(cell, None)
