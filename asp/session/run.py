@@ -260,7 +260,8 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
     Every experiment that finished meanwhile is taken and recorded with one closure
     solve (:meth:`SizeLearner.record_all`) before the next batch is planned, so with many
     cells the planner plans once per few results rather than once per result; the
-    Rerun log of the results is written after the next batch has started.
+    Rerun log of the results is queued (:class:`PlannerLog` writes it in its own thread)
+    after the next batch has started.
     ``timings["planning_s"]`` adds up the time spent recording and choosing [s].
     """
     def record(finished: list[Finished]) -> None:
