@@ -49,6 +49,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
     "executor": ("assembly_constraints.executor.cli", "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
     "protocol": ("assembly_constraints.bridge.protocol_schema", "write or check the JSON Schema of every Zenoh message"),
+    "router": ("assembly_constraints.bridge.session:router_main", "a Zenoh router (router mode of eclipse-zenoh) for cells on other hosts"),
 }
 """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
 
