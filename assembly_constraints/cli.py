@@ -55,6 +55,8 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
                "a product from its CAD (STEP or meshes): holes, sections, geometric precedence"),
     "protocol": ("assembly_constraints.bridge.protocol_schema",
                  "write or check the JSON Schema of every Zenoh message"),
+    "router": ("assembly_constraints.bridge.session:router_main",
+               "a Zenoh router (router mode of eclipse-zenoh) for cells on other hosts"),
 }
 """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""
 

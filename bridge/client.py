@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import itertools
 import queue
+import signal
 import threading
 import time
 from collections import deque
@@ -52,6 +53,20 @@ class CellRefused(BridgeError):
 
 class CellConflict(BridgeError):
     """One query got different replies (two processes answer for one cell id)."""
+
+
+class CellCrashed(BridgeError):
+    """Every cell the pool may use has crashed, and work is left to do."""
+
+
+def describe_exit(code: int) -> str:
+    """A process's exit status in words: ``killed by signal SIGKILL``, ``exited with code 1``."""
+    if code < 0:
+        try:
+            return f"killed by signal {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exited with code {code}"
 
 
 Outcome = InsertReply | BridgeError
@@ -145,6 +160,7 @@ def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | 
     lock = threading.Lock()
     answers: list[InsertReply | StepReply | ErrorReply] = []
     faults: list[BridgeError] = []
+    sent = time.monotonic()
 
     def on_reply(reply: zenoh.Reply) -> None:
         ok, err = reply.ok, reply.err
@@ -171,8 +187,11 @@ def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | 
             answer = distinct[0]
             on_outcome(CellRefused(answer) if isinstance(answer, ErrorReply) else answer)
         else:
-            on_outcome(fault or CellTimeout(f"cell {cell}: no reply to request {request.id} "
-                                            f"within {timeout:.1f} s"))
+            waited = time.monotonic() - sent
+            # Zenoh also ends a query early when the cell's session goes away
+            ended = (f"within {timeout:.1f} s" if waited >= 0.9 * timeout
+                     else f"(the query ended after {waited:.1f} s of the {timeout:.1f} s allowed)")
+            on_outcome(fault or CellTimeout(f"cell {cell}: no reply to request {request.id} {ended}"))
 
     cancel = zenoh.CancellationToken()
     session.get(key, zenoh.handlers.Callback(on_reply, on_end),
@@ -242,8 +261,14 @@ class CellPool:
     at one cell; ``wait_for_cell`` [s] bounds a wait while no usable cell is alive;
     ``max_failures`` bounds the failed attempts of one request; a cell that misses
     ``max_misses`` replies in a row is dropped for the rest of the pool's life. Only the
-    cells in ``allowed`` are used (None: any cell that shows a token). ``incidents``
-    lists what went wrong on the way (timeouts, conflicts, dropped cells).
+    cells in ``allowed`` are used (None: any cell that shows a token). ``exit_status(cell)``
+    gives the exit status of a cell's process when this planner started it and it has
+    ended (None otherwise; it may wait a moment for a process whose links just closed, and
+    is asked only when a cell's token goes or an attempt fails): such a cell is *crashed*,
+    its request is sent to another cell at once, it is never used again, and when every
+    allowed cell has crashed the pool fails with :class:`CellCrashed` naming them instead
+    of waiting. ``incidents`` lists what went wrong on the way (timeouts, conflicts,
+    crashed and dropped cells).
     ``on_dispatch(cell, request)``, if set, is called (in the thread of :meth:`next_reply`)
     just before each request is sent to a cell, also when it is re-sent to another; an
     exception it raises propagates from :meth:`next_reply` and the request is not sent.
@@ -252,7 +277,8 @@ class CellPool:
 
     def __init__(self, session: zenoh.Session, directory: CellDirectory, *,
                  timeout: float = 60.0, wait_for_cell: float = 60.0, max_failures: int = 3,
-                 max_misses: int = 2, allowed: Collection[str] | None = None) -> None:
+                 max_misses: int = 2, allowed: Collection[str] | None = None,
+                 exit_status: Callable[[str], int | None] | None = None) -> None:
         self._session = session
         self._directory = directory
         self.timeout = timeout
@@ -268,6 +294,11 @@ class CellPool:
         self._failures: dict[str, int] = {}
         self._misses: dict[str, int] = {}
         self._dropped: set[str] = set()
+        self._exit_status = exit_status
+        self._gone: set[str] = set()
+        """Cells whose token disappeared (since last seen alive)."""
+        self.crashed: dict[str, str] = {}
+        """Cells whose process ended: cell id -> how (``killed by signal SIGKILL``)."""
         self.incidents: list[str] = []
         self._alive = {cell for cell in directory.listen(self._on_change) if self._usable(cell)}
         self.on_dispatch: Callable[[str, InsertRequest], None] | None = None
@@ -290,6 +321,10 @@ class CellPool:
     def close(self) -> None:
         self._directory.unlisten(self._on_change)
 
+    def dispatch(self) -> None:
+        """Send queued requests to the idle alive cells now (:meth:`next_reply` does too)."""
+        self._dispatch()
+
     def _dispatch(self) -> None:
         idle = sorted(self._alive - self._busy.keys(), key=lambda c: (c in self._slow, c))
         while self._pending and idle:
@@ -308,28 +343,72 @@ class CellPool:
         """Zenoh thread: queue the outcome of ``attempt`` sent to ``cell``."""
         self._events.put(("outcome", cell, attempt, outcome))
 
-    def _next_event(self) -> tuple:
+    def _next_event(self, wait: bool) -> tuple | None:
+        """The next event; without ``wait``, None when none has come yet."""
+        if not wait:
+            try:
+                return self._events.get_nowait()
+            except queue.Empty:
+                return None
         if self._busy or self._alive:
             return self._events.get()
+        for cell in sorted(self._gone - self._dropped):
+            self._ended(cell)  # a crash seen only now: its links closed before its process was reaped
+        crashed = "; ".join(f"cell {cell} crashed ({how})" for cell, how in sorted(self.crashed.items()))
+        if self._allowed is not None and self._allowed <= self.crashed.keys():
+            raise CellCrashed(f"{crashed}; no other cell left, {len(self._pending)} experiment(s) still to run")
         try:
             return self._events.get(timeout=self.wait_for_cell)
         except queue.Empty:
-            raise CellTimeout(f"no cell alive for {self.wait_for_cell:.0f} s; "
+            raise CellTimeout(f"no cell alive for {self.wait_for_cell:.0f} s"
+                              f"{f' ({crashed})' if crashed else ''}; "
                               f"{len(self._pending)} experiment(s) still to run") from None
+
+    def _ended(self, cell: str) -> bool:
+        """Whether ``cell``'s process (one this planner started) has ended; the first time,
+        it is dropped and named in :attr:`crashed` and the incidents."""
+        if cell in self.crashed:
+            return True
+        code = None if self._exit_status is None else self._exit_status(cell)
+        if code is None:
+            return False
+        self.crashed[cell] = describe_exit(code)
+        self._dropped.add(cell)
+        self._alive.discard(cell)
+        running = self._busy.get(cell)
+        during = "" if running is None else (f" during request {running.request.id} ({running.request.part} "
+                                             f"into {running.request.hole}), sent again to another cell")
+        self.incidents.append(f"cell {cell} crashed ({self.crashed[cell]}){during}")
+        return True
 
     def next_reply(self) -> tuple[InsertRequest, InsertReply]:
         """The next finished request and its reply; BridgeError if none can finish."""
         if not self.unfinished:
             raise BridgeError("next_reply: no request submitted")
+        found = self._next_reply(wait=True)
+        assert found is not None  # waiting ends with a reply or an error
+        return found
+
+    def finished_reply(self) -> tuple[InsertRequest, InsertReply] | None:
+        """A request that has already finished and its reply, without waiting (None if
+        none has); what came in meanwhile (cells, failures) is handled as by :meth:`next_reply`."""
+        return self._next_reply(wait=False) if self.unfinished else None
+
+    def _next_reply(self, wait: bool) -> tuple[InsertRequest, InsertReply] | None:
         while True:
             self._dispatch()
-            event = self._next_event()
+            event = self._next_event(wait)
+            if event is None:
+                return None
             if event[0] == "cell":
                 _, cell, alive = event
                 if alive:
+                    self._gone.discard(cell)
                     if self._usable(cell):
                         self._alive.add(cell)
                     continue
+                self._gone.add(cell)
+                self._ended(cell)
                 self._alive.discard(cell)
                 sent = self._busy.pop(cell, None)
                 if sent is not None:  # it died mid-experiment: re-send elsewhere
@@ -340,11 +419,16 @@ class CellPool:
             sent = self._busy.get(cell)
             if sent is None or sent.attempt != attempt:
                 continue  # a cancelled or superseded attempt
-            del self._busy[cell]
             if isinstance(outcome, InsertReply):
+                del self._busy[cell]
                 self._slow.discard(cell)
                 self._misses[cell] = 0
                 return sent.request, outcome
+            if self._ended(cell):  # no reply because the process is gone: not a miss
+                del self._busy[cell]
+                self._pending.appendleft(sent.request)
+                continue
+            del self._busy[cell]
             self.incidents.append(str(outcome))
             self._failed(cell, sent.request, outcome)
 

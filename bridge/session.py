@@ -7,6 +7,7 @@ router, other hosts, TLS, authentication and access control (docs/session.md);
 ``--listen``/``--connect`` still override its endpoints, and ``--connect`` without
 ``--listen`` listens nowhere, whatever the file says. Nothing
 listens on a non-loopback address unless an option or the config file says so.
+:func:`router_main` is ``./run.sh router``, a session in router mode.
 """
 
 from __future__ import annotations
@@ -14,13 +15,16 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import signal
 import socket
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
 import zenoh
 
 from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.cli_types import ArgumentParser
 from assembly_constraints.bridge.messages import MAX_MESSAGE_BYTES
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
@@ -70,8 +74,9 @@ def cell_listen(listen: Sequence[str], connect: Sequence[str], config_file: Path
 
 
 def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
-                config_file: Path | None = None) -> zenoh.Config:
-    """A Zenoh config: the file if given, else a loopback peer; endpoints override it."""
+                config_file: Path | None = None, mode: str | None = None) -> zenoh.Config:
+    """A Zenoh config: the file if given, else a loopback peer; endpoints and ``mode``
+    (``peer``, ``client``, ``router``) override it."""
     if config_file is not None:
         if not config_file.is_file():
             raise BridgeError(f"{config_file}: no such Zenoh config file")
@@ -85,6 +90,8 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("listen/endpoints", "[]")
     config.insert_json5("transport/link/rx/max_message_size", str(MAX_TRANSPORT_BYTES))
+    if mode is not None:
+        config.insert_json5("mode", json.dumps(mode))
     if listen or connect or config_file is None:  # --connect alone: listen nowhere
         config.insert_json5("listen/endpoints", json.dumps([check_endpoint(e) for e in listen]))
     if connect:
@@ -93,12 +100,13 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
 
 
 def open_session(listen: Sequence[str] = (), connect: Sequence[str] = (),
-                 config_file: Path | None = None) -> zenoh.Session:
-    """Open a Zenoh session (~0.5 s); BridgeError if an endpoint cannot be used.
+                 config_file: Path | None = None, mode: str | None = None) -> zenoh.Session:
+    """Open a Zenoh session (~0.5 s; see :func:`make_config`); BridgeError if an endpoint
+    cannot be used.
 
     Close it (``with`` or ``.close()``): an open session keeps the process alive.
     """
-    config = make_config(listen, connect, config_file)
+    config = make_config(listen, connect, config_file, mode)
     try:
         return zenoh.open(config)
     except zenoh.ZError as exc:
@@ -112,3 +120,48 @@ def free_loopback_endpoint() -> str:
         sock.bind(("127.0.0.1", 0))
         port = sock.getsockname()[1]
     return f"tcp/127.0.0.1:{port}"
+
+
+def _exit_on_signal(signum: int, _frame: object) -> None:
+    raise SystemExit(128 + signum)
+
+
+def router_main(argv: Sequence[str]) -> int:
+    """``./run.sh router``: the Zenoh router that joins a planner and cells on other hosts.
+
+    eclipse-zenoh's router daemon ``zenohd`` is not in the eclipse-zenoh Python wheel, and no
+    package of the registries this project installs from provides it, so the router is a
+    Zenoh session in *router mode* opened through the eclipse-zenoh Python API: the same
+    routing code as ``zenohd`` (it routes liveliness tokens, queries and replies between the
+    sessions connected to it), without ``zenohd``'s plugins (REST, storages) or its command
+    line. It prints ``ready router <zid> listen <endpoints>`` once it listens and runs until
+    SIGTERM or SIGINT (exit 0).
+
+    By default it listens on :data:`assembly_constraints.bridge.session.DEFAULT_ENDPOINT` (loopback); cells and
+    planners on other hosts need an endpoint on an address they can reach
+    (``--listen tcp/192.0.2.10:7447``), and a ``--zenoh-config`` file for TLS,
+    authentication and access control (``docs/session.md``; its ``mode`` is set to router).
+    Planner and cells then connect to it (``--connect tcp/192.0.2.10:7447``).
+    """
+    parser = ArgumentParser(prog="router", description="The Zenoh router (router mode of eclipse-zenoh) that "
+                                                       "joins a planner and cells on other hosts.")
+    parser.add_argument("--listen", action="append", default=[], metavar="EP",
+                        help=f"endpoint to listen on (repeatable; default {DEFAULT_ENDPOINT}, "
+                             "or those of --zenoh-config)")
+    parser.add_argument("--zenoh-config", type=Path, metavar="FILE",
+                        help="a Zenoh JSON5 config file (TLS, authentication, access control)")
+    args = parser.parse_args(list(argv))
+    listen = args.listen or ([] if args.zenoh_config else [DEFAULT_ENDPOINT])
+    signal.signal(signal.SIGTERM, _exit_on_signal)
+    signal.signal(signal.SIGINT, _exit_on_signal)
+    session = open_session(listen, (), args.zenoh_config, mode="router")
+    try:
+        where = " ".join(listen) or f"as in {args.zenoh_config}"
+        print(f"ready router {session.zid()} listen {where}", flush=True)
+        while True:
+            time.sleep(3600.0)
+    except SystemExit:
+        pass  # SIGTERM/SIGINT: close below
+    finally:
+        session.close()
+    return 0

@@ -60,6 +60,7 @@ from assembly_constraints.bridge.cli_types import (
     finite_float,
     int_in,
 )
+from assembly_constraints.bridge.progress import progress
 
 ASSIGNMENT_LIMIT = 10_000
 """A plan's assignment is drawn among at most this many feasible ones (clingo's first)."""
@@ -190,7 +191,7 @@ def main(argv: list[str]) -> int:
         print(_row(k + 1, reports[k]), file=sys.stderr if args.json else sys.stdout, flush=True)
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        list(pool.map(one, range(len(drawn))))
+        list(progress(pool.map(one, range(len(drawn))), desc="plans", total=len(drawn), unit="plan"))
     result = summary(reports)
     if args.json:
         print(json.dumps({"plans": reports, "summary": result}))

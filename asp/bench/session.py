@@ -14,10 +14,17 @@
    is reported beside the ratio of the medians).
 3. ``--product N --cell-counts 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
    experiment takes ``--delay`` seconds without using the cores) on a generated N×N
-   product (:mod:`assembly_constraints.asp.bench.products`): wall time [s], speed-up against 1 cell,
-   experiments and their ratio to the 1-cell run, and duplicates (a request journaled
-   twice, or a pair run again though not a re-test; must be 0). Targets on 20×20: 8 cells
-   at least 4x faster than 1, with at most 10 % more experiments.
+   product (:mod:`assembly_constraints.asp.bench.products`): wall time [s] of the whole command, the learning
+   time [s] (from the cells being ready to the last result, ``session.json`` timings), the
+   speed-up of each against 1 cell, experiments and their ratio to the 1-cell run,
+   duplicates (a request journaled twice, or a pair run again though not a re-test; must
+   be 0) and the planner's time per experiment [ms] (recording results and choosing the
+   next ones). Targets on 20×20 at ``--delay 0.5``: 8 cells at least 6x faster than 1,
+   with at most 10 % more experiments.
+4. ``--hosts K``: the Cranfield session with K cells on loopback (started by the session),
+   then with K cells in K network namespaces joined only through ``./run.sh router``
+   (:mod:`assembly_constraints.asp.session.hosts`; needs root): each run's figures and the ratio of their
+   learning times.
 """
 
 from __future__ import annotations
@@ -39,6 +46,7 @@ import zenoh
 from assembly_constraints.asp import MAX_IDS, PlannerError
 from assembly_constraints.asp.bench.products import write_product
 from assembly_constraints.asp.session.cells import ROOT, start_cell
+from assembly_constraints.asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
 from assembly_constraints.asp.session.settings import MAX_CELLS
 from assembly_constraints.asp.sizes.policies import policy_names
@@ -48,6 +56,9 @@ from assembly_constraints.bridge.client import CellDirectory, request_insert
 from assembly_constraints.bridge.keys import ping_key
 from assembly_constraints.bridge.messages import InsertRequest, encode
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+
+MAX_HOSTS = 16
+"""--hosts: at most this many cell namespaces."""
 
 
 def _payload(reply: zenoh.Reply) -> bytes:
@@ -94,14 +105,23 @@ def round_trips(count: int) -> dict:
         cell.stop()
 
 
-def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly: str = "cranfield") -> dict:
+def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly: str = "cranfield",
+                hosts: Hosts | None = None, client_config: Path | None = None) -> dict:
     """One ``session --cells N`` command: wall time [s], experiments, cell busy share,
-    duplicates (see the module doc)."""
+    duplicates, learning and planning time (see the module doc). With ``hosts``, the
+    planner runs in the router namespace and uses the N cells already started in the cell
+    namespaces (:meth:`Hosts.start_fleet`, Zenoh clients by ``client_config``) instead."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     with tempfile.TemporaryDirectory() as tmp:
-        argv = [sys.executable, "-m", "assembly_constraints", "session", "--cells", str(cells), "--assembly", assembly,
+        argv = [sys.executable, "-m", "assembly_constraints", "session", "--assembly", assembly,
                 "--policy", policy, "--out", str(Path(tmp) / "run"), "--json",
                 "--backend", backend, "--delay", str(delay_s)]
+        if hosts is None:
+            argv += ["--cells", str(cells)]
+        else:
+            argv = hosts.argv(hosts.router, [*argv, "--cells", "0", "--zenoh-config", str(client_config),
+                                             "--connect", hosts.router_endpoints()[0],
+                                             "--allow-cells", ",".join(f"c{k}" for k in range(1, cells + 1))])
         t0 = time.perf_counter()
         done = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True, timeout=900)
         wall = time.perf_counter() - t0
@@ -112,8 +132,33 @@ def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly:
             raise SystemExit(f"session --cells {cells} learned a wrong relation")
         entries = read_journal(Path(tmp) / "run" / JOURNAL_NAME)
         busy = cell_busy_fraction(entries, cells)
+        timings = json.loads((Path(tmp) / "run" / "session.json").read_text(encoding="utf-8"))["timings"]
     return {"wall_s": round(wall, 2), "experiments": result["experiments"], "cell_busy": busy,
-            "duplicates": duplicates(entries)}
+            "duplicates": duplicates(entries),
+            "learning_s": round(timings["learned_s"] - timings["cells_ready_s"], 2),
+            "planning_s": timings["planning_s"],
+            "planning_ms_per_experiment": round(1000 * timings["planning_s"] / result["experiments"], 1)}
+
+
+def hosts_runs(count: int, policy: str, backend: str, delay_s: float) -> dict:
+    """The Cranfield session with ``count`` cells on loopback (started by the session), then
+    with ``count`` cells in network namespaces of their own joined through the router
+    (:mod:`assembly_constraints.asp.session.hosts`): each run's figures and the ratio of the learning times."""
+    why_not = unavailable()
+    if why_not is not None:
+        raise PlannerError(f"--hosts: {why_not}")
+    loopback = session_run(count, policy, backend, delay_s)
+    with tempfile.TemporaryDirectory() as tmp, Hosts(count) as hosts:
+        client = Path(tmp) / "client.json5"
+        client.write_text(CLIENT_CONFIG, encoding="utf-8")
+        fleet = hosts.start_fleet(client, backend=backend, delay_s=delay_s)
+        try:
+            namespaces = session_run(count, policy, backend, delay_s, hosts=hosts, client_config=client)
+        finally:
+            for process in fleet:
+                process.stop()
+    return {"hosts": count, "backend": backend, "delay_s": delay_s, "loopback": loopback, "namespaces": namespaces,
+            "learning_ratio": round(namespaces["learning_s"] / loopback["learning_s"], 3)}
 
 
 def duplicates(entries: list[JournalEntry]) -> int:
@@ -132,6 +177,7 @@ def load_runs(product: int, cell_counts: list[int], policy: str, delay_s: float,
     base = runs[0]
     for run in runs:
         run["speedup"] = round(base["wall_s"] / run["wall_s"], 2)
+        run["learning_speedup"] = round(base["learning_s"] / run["learning_s"], 2)
         run["experiments_ratio"] = round(run["experiments"] / base["experiments"], 3)
     return {"product": f"{product}x{product}", "delay_s": delay_s, "seed": seed, "runs": runs}
 
@@ -182,10 +228,15 @@ def main(argv: list[str]) -> int:
                         help="with --product: one session per count, as session --cells N (default 1,2,4,8)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=1,
                         help="with --product: seed of the product (default 1)")
+    parser.add_argument("--hosts", type=int_in(1, MAX_HOSTS), metavar="K",
+                        help="the Cranfield session with K cells in K network namespaces joined through "
+                             "the router, next to K cells on loopback (needs root)")
     parser.add_argument("--json", action="store_true", help="print JSON")
     args = parser.parse_args(argv)
     if args.product is not None:
         return _load(args)
+    if args.hosts is not None:
+        return _hosts(args)
     figures: dict = {"overhead": round_trips(100 if args.quick else args.round_trips)}
     o = figures["overhead"]
     if not args.json:
@@ -214,9 +265,25 @@ def _load(args: argparse.Namespace) -> int:
         return 0
     print(f"{figures['product']} product (seed {args.seed}), truth cells, {args.delay} s per experiment, "
           f"policy {args.policy}")
-    print(f"{'cells':>5} {'wall [s]':>9} {'speed-up':>8} {'experiments':>11} {'ratio':>6} {'duplicates':>10} "
-          f"{'busy':>5}")
+    print(f"{'cells':>5} {'wall [s]':>9} {'speed-up':>8} {'learning [s]':>12} {'speed-up':>8} {'experiments':>11} "
+          f"{'ratio':>6} {'duplicates':>10} {'busy':>5} {'planning/exp [ms]':>17}")
     for r in figures["runs"]:
-        print(f"{r['cells']:>5} {r['wall_s']:>9.1f} {r['speedup']:>8.2f} {r['experiments']:>11} "
-              f"{r['experiments_ratio']:>6.3f} {r['duplicates']:>10} {r['cell_busy']:>5.2f}")
+        print(f"{r['cells']:>5} {r['wall_s']:>9.1f} {r['speedup']:>8.2f} {r['learning_s']:>12.1f} "
+              f"{r['learning_speedup']:>8.2f} {r['experiments']:>11} {r['experiments_ratio']:>6.3f} "
+              f"{r['duplicates']:>10} {r['cell_busy']:>5.2f} {r['planning_ms_per_experiment']:>17.1f}")
+    return 0
+
+
+def _hosts(args: argparse.Namespace) -> int:
+    figures = hosts_runs(args.hosts, args.policy, args.backend, args.delay)
+    if args.json:
+        print(json.dumps(figures, indent=2))
+        return 0
+    print(f"Cranfield session, {args.hosts} {args.backend} cell(s), {args.delay} s per experiment, "
+          f"policy {args.policy}")
+    for where in ("loopback", "namespaces"):
+        r = figures[where]
+        print(f"{where:>10}: learning {r['learning_s']:.1f} s, wall {r['wall_s']:.1f} s, {r['experiments']} "
+              f"experiments, cells busy {r['cell_busy']:.2f}, duplicates {r['duplicates']}")
+    print(f"learning time, namespaces / loopback: {figures['learning_ratio']:.2f}")
     return 0

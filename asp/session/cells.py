@@ -16,6 +16,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import msgspec
@@ -36,28 +37,19 @@ def _absolute(settings: ServeSettings) -> ServeSettings:
     return msgspec.structs.replace(settings, **paths)
 
 
-class CellProcess:
-    """One running ``executor serve`` process, started with ``settings`` as its one
-    document (``--settings JSON``, with ``lifeline`` set), and the lines it printed.
+class LineProcess:
+    """One running co-process of the planner (a cell, a router), started from the
+    repository with ``argv``, and the lines it printed; ``name`` says what it is in errors
+    (``cell c1``, ``router``).
 
-    A cell runs in its own process session, as a cell started by hand in another
+    It runs in its own process session, as a process started by hand in another
     terminal would: the kernel then schedules it beside the planner rather than inside
     the planner's share of the cores (with autogroup scheduling, two cells in the
-    planner's session shared one core on a loaded machine). It still ends with the
-    planner: ``lifeline`` makes it exit when its stdin closes.
+    planner's session shared one core on a loaded machine).
     """
 
-    @staticmethod
-    def command(settings: ServeSettings) -> list[str]:
-        """The command line of the cell: ``executor serve --settings JSON``, the settings
-        with ``lifeline`` set and their files' paths absolute."""
-        started = _absolute(msgspec.structs.replace(settings, lifeline=True))
-        return [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--settings",
-                encode_settings(started)]
-
-    def __init__(self, settings: ServeSettings) -> None:
-        self.cell_id = settings.cell_id
-        argv = self.command(settings)
+    def __init__(self, name: str, argv: Sequence[str]) -> None:
+        self.name = name
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]))
         self.popen = subprocess.Popen(argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -91,7 +83,7 @@ class CellProcess:
                     tail = "\n".join(self.lines[-20:])
                     why = (f"exited (code {self.exit_code()}) before printing"
                            if self._eof else "printed no")
-                    raise PlannerError(f"cell {self.cell_id}: {why} line '{prefix}...' "
+                    raise PlannerError(f"{self.name}: {why} line '{prefix}...' "
                                        f"(waited up to {timeout:.0f} s); last output:\n{tail}")
                 self._new.wait(remaining)
 
@@ -126,6 +118,24 @@ class CellProcess:
         if self.popen.poll() is None:
             self.popen.kill()
         self.popen.wait(10.0)
+
+
+class CellProcess(LineProcess):
+    """One running ``executor serve`` process, started with ``settings`` as its one
+    document (``--settings JSON``, with ``lifeline`` set: it ends with the planner, when
+    its stdin closes), run under ``prefix`` if given (e.g. ``ip netns exec NS``)."""
+
+    @staticmethod
+    def command(settings: ServeSettings) -> list[str]:
+        """The command line of the cell: ``executor serve --settings JSON``, the settings
+        with ``lifeline`` set and their files' paths absolute."""
+        started = _absolute(msgspec.structs.replace(settings, lifeline=True))
+        return [sys.executable, "-m", "assembly_constraints", "executor", "serve", "--settings",
+                encode_settings(started)]
+
+    def __init__(self, settings: ServeSettings, prefix: Sequence[str] = ()) -> None:
+        super().__init__(f"cell {settings.cell_id}", [*prefix, *self.command(settings)])
+        self.cell_id = settings.cell_id
 
 
 def cell_seed(first: int, number: int) -> int:

@@ -28,6 +28,8 @@ cell, and an assembly tab for the cell that assembles.
 
 from __future__ import annotations
 
+import queue
+import threading
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -56,6 +58,13 @@ class PlannerLog:
         self.rec = open_stream(APPLICATION_ID, recording_id, rrd, viewer)
         self.rec.send_blueprint(blueprint(Contents(planner=True, cells=tuple(cell_ids),
                                                    assembly_cells=tuple(assembling))))
+        self._smaller: tuple[Knowledge, list[tuple[str, str]], list[tuple[float, float]]] | None = None
+        """The last knowledge logged, the reduction of its smaller-than graph and the graph's
+        layout: experiments recorded together share one knowledge, laid out once."""
+        self._experiments: queue.SimpleQueue[tuple[int, str, str, str, str, Knowledge] | None] = queue.SimpleQueue()
+        self._failure: BaseException | None = None
+        self._writer = threading.Thread(target=self._write_experiments, name="planner-log", daemon=True)
+        self._writer.start()
 
     def precedence(self, parts: Sequence[str], edges: Sequence[tuple[str, str]]) -> None:
         """The learned must-precede relation as a directed graph (its reduction), by levels."""
@@ -66,7 +75,26 @@ class PlannerLog:
 
     def experiment(self, number: int, part: str, hole: str, result: str, cell: str,
                    knowledge: Knowledge) -> None:
-        """Experiment ``number`` (in start order) finished; the knowledge after it."""
+        """Experiment ``number`` (in start order) finished; the knowledge after it. Queued:
+        the log's own thread writes it (reducing and laying out the smaller-than graph takes
+        longer than the planner may wait while cells finish); :meth:`close` waits for it
+        and raises what went wrong there."""
+        if self._failure is not None:
+            raise self._failure
+        self._experiments.put((number, part, hole, result, cell, knowledge))
+
+    def _write_experiments(self) -> None:
+        """The log's thread: write queued experiments in order until :meth:`close`; the
+        first failure stops the writing and is kept for the planner's thread."""
+        while (item := self._experiments.get()) is not None:
+            if self._failure is None:
+                try:
+                    self._write_experiment(*item)
+                except BaseException as exc:  # handed to the planner's thread, raised there
+                    self._failure = exc
+
+    def _write_experiment(self, number: int, part: str, hole: str, result: str, cell: str,
+                          knowledge: Knowledge) -> None:
         self.rec.set_time("experiment", sequence=number)
         self.rec.log("planner/experiments", rr.TextLog(f"#{number} {part} -> {hole}: {result} ({cell})"))
         matrix = np.array([[-1 if v is None else v for v in row] for row in knowledge.matrix()],
@@ -77,9 +105,11 @@ class PlannerLog:
                      rr.TextDocument(_knowledge_table(knowledge, matrix, (part, hole)), media_type="text/markdown"))
         nodes = [*knowledge.parts, *knowledge.holes]
         colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)
-        edges = reduction(Relation.from_pairs(nodes, knowledge.smaller))
-        self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors,
-                                                      positions=positions(nodes, edges)))
+        if self._smaller is None or self._smaller[0] is not knowledge:
+            reduced = reduction(Relation.from_pairs(nodes, knowledge.smaller))
+            self._smaller = knowledge, reduced, positions(nodes, reduced)
+        _, edges, layout = self._smaller
+        self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors, positions=layout))
         self.rec.log("planner/smaller", rr.GraphEdges(edges, graph_type="directed"))
 
     def assignment(self, assignment: Mapping[str, str]) -> None:
@@ -96,9 +126,14 @@ class PlannerLog:
                      static=True)
 
     def close(self) -> None:
-        """Finish the file and compact it; BridgeError naming it if it could not be written."""
+        """Write what is queued, finish the file and compact it; BridgeError naming it if it
+        could not be written (or what the log's thread raised)."""
+        self._experiments.put(None)
+        self._writer.join()
         finish_stream(self.rec, self.rrd)
         compact_recording(self.rrd)
+        if self._failure is not None:
+            raise self._failure
 
 
 def _knowledge_table(knowledge: Knowledge, matrix: np.ndarray, pair: tuple[str, str]) -> str:

@@ -57,7 +57,7 @@ from assembly_constraints.asp.session.settings import (
     read_session_file,
     write_session_file,
 )
-from assembly_constraints.asp.session.zenoh_oracle import ZenohOracle
+from assembly_constraints.asp.session.zenoh_oracle import Finished, ZenohOracle
 from assembly_constraints.asp.sizes.learner import SizeLearner, SizeLearningResult
 from assembly_constraints.asp.sizes.models import SizeModel, model_for
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
@@ -74,6 +74,10 @@ LOG = logging.getLogger(__name__)
 RESULT_KEYS = ("run", "experiments", "fits", "must_precede", "plans", "matches_truth", "model", "assumption",
                "model_changes", "demonstrated")
 """What :func:`run_session` returns (``session --json``), in this order, as ``session.json`` holds them."""
+CRASH_WAIT_S = 2.0
+"""How long the pool waits for a started cell's process to end when its links just closed
+or it missed a reply [s]: the peer sees the sockets close a moment before the process can
+be reaped."""
 
 
 def _run_folder(settings: SessionSettings) -> tuple[Path, SessionFile, RunLock, bool]:
@@ -146,39 +150,60 @@ def _endpoints(settings: SessionSettings) -> tuple[list[str], list[str]]:
 
 
 def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
-                 log: PlannerLog) -> SizeLearningResult:
+                 log: PlannerLog, timings: dict[str, float]) -> SizeLearningResult:
     """Replay the journal, then keep every alive cell busy until the learner is done.
 
     Whenever cells are free, the learner is asked for as many pairs as free cells,
-    independent of the running experiments and of each other, and they are submitted
-    at once; when there are none, the free cells wait for a running experiment to finish.
+    independent of the running experiments and of each other, and they are started at
+    once; when there are none, the free cells wait for a running experiment to finish.
+    Every experiment that finished meanwhile is taken and recorded with one closure
+    solve (:meth:`SizeLearner.record_all`) before the next batch is planned, so with many
+    cells the planner plans once per few results rather than once per result; the
+    Rerun log of the results is queued (:class:`PlannerLog` writes it in its own thread)
+    after the next batch has started.
+    ``timings["planning_s"]`` adds up the time spent recording and choosing [s].
     """
-    def record(part: str, hole: str, result: str, cell: str, started: int) -> None:
-        learner.record(part, hole, result)
-        log.experiment(started, part, hole, result, cell, learner.knowledge)
+    def record(finished: list[Finished]) -> None:
+        started = time.perf_counter()
+        learner.record_all([(f.part, f.hole, f.result) for f in finished])
+        timings["planning_s"] += time.perf_counter() - started
 
-    for entry in list(journal.entries):
-        record(entry.part, entry.hole, entry.result, entry.cell, entry.experiment)
+    def write_log(finished: list[Finished]) -> None:
+        for f in finished:
+            log.experiment(f.experiment, f.part, f.hole, f.result, f.cell, learner.knowledge)
+            attempts = "" if f.attempts is None else f"{f.attempts} attempt(s), "
+            LOG.info("experiment %d on %s: %s -> %s %s (%s%.1f s); %d pairs unknown", f.experiment, f.cell,
+                      f.part, f.hole, f.result, attempts, f.wall_s, len(learner.knowledge.unknown))
+
+    timings.setdefault("planning_s", 0.0)
+    for entry in journal.entries:  # one by one: the log shows the knowledge after each
+        record([Finished(entry.part, entry.hole, entry.result, entry.cell, entry.experiment)])
+        log.experiment(entry.experiment, entry.part, entry.hole, entry.result, entry.cell, learner.knowledge)
     if journal.entries:
         LOG.info("resumed: %d experiments from the journal; %d pairs unknown",
                   len(journal.entries), len(learner.knowledge.unknown))
+    done: list[Finished] = []
     running: list[tuple[str, str]] = []
     while True:
         free = max(1, oracle.alive_cells()) - len(running)
         if free > 0:
+            started = time.perf_counter()
             batch = learner.next_batch(free, pending=running)
+            timings["planning_s"] += time.perf_counter() - started
             if not batch and not running:
+                write_log(done)
                 return learner.result()
             for pair in batch:
                 oracle.submit(*pair)
                 running.append(pair)
-        finished = oracle.next_result()
-        running.remove((finished.part, finished.hole))
-        record(finished.part, finished.hole, finished.result, finished.cell, finished.experiment)
-        attempts = "" if finished.attempts is None else f"{finished.attempts} attempt(s), "
-        LOG.info("experiment %d on %s: %s -> %s %s (%s%.1f s); %d pairs unknown", finished.experiment,
-                  finished.cell, finished.part, finished.hole, finished.result, attempts, finished.wall_s,
-                  len(learner.knowledge.unknown))
+            oracle.dispatch()
+        write_log(done)
+        done = [oracle.next_result()]
+        while (more := oracle.finished_result()) is not None:
+            done.append(more)
+        for f in done:
+            running.remove((f.part, f.hole))
+        record(done)
 
 
 def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
@@ -328,8 +353,10 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
                         "are asked again, under new numbers, if still needed)", ", ".join(map(str, abandoned)))
         # by default only its own cells
         allowed = cell_ids if settings.cells > 0 else (list(settings.allow_cells or ()) or None)
+        processes = {cell.cell_id: cell for cell in cells}
         pool = CellPool(session, directory, timeout=settings.timeout_s, wait_for_cell=settings.wait_for_cell_s,
-                        allowed=allowed)
+                        allowed=allowed,
+                        exit_status=lambda cell: processes[cell].exit_code(CRASH_WAIT_S) if cell in processes else None)
         stack.callback(pool.close)
         oracle = ZenohOracle(pool, directory, journal, run_id, record.seed)
         for cell in cells:
@@ -341,7 +368,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         timings = {"cells_ready_s": time.perf_counter() - started}
         LOG.info("assumes: %s", model.assumption())  # once every input was checked and the cells are up
         try:
-            sizes = _learn_sizes(oracle, learner, journal, log)
+            sizes = _learn_sizes(oracle, learner, journal, log, timings)
         finally:
             for incident in pool.incidents:  # timeouts, conflicting replies, dropped cells
                 LOG.warning("%s", incident)

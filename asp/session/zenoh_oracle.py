@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import zlib
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from assembly_constraints.asp import PlannerError
@@ -29,7 +30,7 @@ from assembly_constraints.asp.session.journal import Journal, JournalEntry
 from assembly_constraints.asp.sizes.truth_oracle import Result
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.client import CellDirectory, CellPool
-from assembly_constraints.bridge.messages import InsertRequest
+from assembly_constraints.bridge.messages import InsertReply, InsertRequest
 
 Pair = tuple[str, str]
 
@@ -82,6 +83,11 @@ class ZenohOracle:
                                         seed=zlib.crc32(f"{self._seed}.{key}".encode()),
                                         experiment=self._started))
 
+    def dispatch(self) -> None:
+        """Start the submitted experiments on the idle cells now, before other work of the
+        planner's thread (:meth:`next_result` would start them too)."""
+        self._pool.dispatch()
+
     def _on_dispatch(self, cell: str, request: InsertRequest) -> None:
         self._journal.started(request.experiment, request.id, request.part, request.hole, cell)
 
@@ -91,10 +97,23 @@ class ZenohOracle:
         PlannerError when the cells cannot finish the submitted experiments (no cell for
         the wait limit, or a request refused by every cell).
         """
+        finished = self._finish(self._pool.next_reply)
+        assert finished is not None  # next_reply waits until one finishes or raises
+        return finished
+
+    def finished_result(self) -> Finished | None:
+        """An experiment that has already finished, journaled, without waiting (None if
+        none has): the session takes every one of them before it plans again."""
+        return self._finish(self._pool.finished_reply)
+
+    def _finish(self, reply_of: Callable[[], tuple[InsertRequest, InsertReply] | None]) -> Finished | None:
         try:
-            request, reply = self._pool.next_reply()
+            found = reply_of()
         except BridgeError as exc:
             raise PlannerError(f"experiments over Zenoh failed: {exc}") from None
+        if found is None:
+            return None
+        request, reply = found
         self._journal.append(JournalEntry(
             id=request.id, part=request.part, hole=request.hole, result=reply.result,
             cell=reply.cell, retest=request.retest, evidence=reply.evidence, wall_s=reply.wall_s,

@@ -116,11 +116,33 @@ def split_weights(m: int, n: int, fit_mask: int, no_fit_mask: int) -> tuple[np.n
         weights = _prior_weights(m, n)[keep]
         fit_weight = weighted_bit_sums(all_biorders(m, n)[keep], weights, m * n)
     else:
-        rng = np.random.default_rng([fit_mask, no_fit_mask, m, n])
-        sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
-        weights = prior_weights(class_weights(sample))
-        fit_weight = weights @ sample.reshape(len(sample), m * n)
+        weights = _sampled(m, n, fit_mask, no_fit_mask)[1]
+        fit_weight = _weighted_sample(m, n, fit_mask, no_fit_mask).sum(axis=0)
     return fit_weight, float(weights.sum())
+
+
+@lru_cache(maxsize=16)
+def _sampled(m: int, n: int, fit_mask: int, no_fit_mask: int) -> tuple[np.ndarray, np.ndarray]:
+    """The sampled path's stand-in for the possible relations: a (k, m*n) boolean matrix
+    (bit ``p*n + h``: p fits h) and the prior weights, drawn with a generator seeded by
+    the knowledge, so the same knowledge always gets the same sample (drawn once: a
+    decision and the batch ranking beside it share it; read-only)."""
+    rng = np.random.default_rng([fit_mask, no_fit_mask, m, n])
+    sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
+    relations, weights = sample.reshape(len(sample), m * n), prior_weights(class_weights(sample))
+    for array in (relations, weights):
+        array.setflags(write=False)
+    return relations, weights
+
+
+@lru_cache(maxsize=4)
+def _weighted_sample(m: int, n: int, fit_mask: int, no_fit_mask: int) -> np.ndarray:
+    """The rows of :func:`_sampled`, each multiplied by its weight (float64, read-only):
+    the decision and every batch ranking beside it sum them."""
+    relations, weights = _sampled(m, n, fit_mask, no_fit_mask)
+    weighted = relations * weights[:, None]
+    weighted.setflags(write=False)
+    return weighted
 
 
 @lru_cache(maxsize=200_000)
@@ -189,9 +211,7 @@ def possible_relations(m: int, n: int, fit_mask: int, no_fit_mask: int) -> tuple
     if biorder_count(m, n) <= EXACT_LIMIT:
         keep = consistent_index(all_biorders(m, n), fit_mask, no_fit_mask)
         return mask_bits(all_biorders(m, n)[keep], m * n), _prior_weights(m, n)[keep]
-    rng = np.random.default_rng([fit_mask, no_fit_mask, m, n])
-    sample = sample_biorders(smaller_matrix(m, n, fit_mask, no_fit_mask), m, n, SAMPLES, rng)
-    return sample.reshape(len(sample), m * n).astype(bool), prior_weights(class_weights(sample))
+    return _sampled(m, n, fit_mask, no_fit_mask)
 
 
 def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]:
@@ -209,19 +229,26 @@ def batch_rank(knowledge: Knowledge, pending: Sequence[Pair] = ()) -> list[Pair]
     for sub in section_knowledge(knowledge):
         m, n = len(sub.parts), len(sub.holes)
         index = {(p, h): i * n + j for i, p in enumerate(sub.parts) for j, h in enumerate(sub.holes)}
-        relations, weights = possible_relations(m, n, *knowledge_masks(sub))
-        mine = [pair for pair in pending if pair in index]
-        groups = np.zeros(len(relations), dtype=np.int64)
-        if mine:
-            _, groups = np.unique(relations[:, [index[pair] for pair in mine]], axis=0, return_inverse=True)
-            groups = groups.reshape(-1)
-        score = np.zeros(m * n)
-        for group in range(int(groups.max(initial=0)) + 1):
-            chosen = groups == group
-            fit_weight = weights[chosen] @ relations[chosen]
-            score += np.minimum(fit_weight, weights[chosen].sum() - fit_weight)
+        masks = knowledge_masks(sub)
+        relations, weights = possible_relations(m, n, *masks)
+        weighted = (relations * weights[:, None] if biorder_count(m, n) <= EXACT_LIMIT
+                    else _weighted_sample(m, n, *masks))
+        mine = [index[pair] for pair in pending if pair in index]
+        columns = np.array([index[pair] for pair in sub.unknown], dtype=np.int64)  # only unknown pairs score
+        score = np.zeros(len(columns))
+        if len(relations) and len(columns):
+            if len(mine) < 63:  # the outcomes of the pending pairs as the bits of one integer
+                groups = relations[:, mine].astype(np.int64) @ (np.int64(1) << np.arange(len(mine), dtype=np.int64))
+            else:
+                groups = np.unique(relations[:, mine], axis=0, return_inverse=True)[1].reshape(-1)
+            # the relations sorted by group, each group's rows summed in one pass
+            by_group = np.argsort(groups, kind="stable")
+            starts = np.flatnonzero(np.r_[True, np.diff(groups[by_group]) != 0])
+            fit_weight = np.add.reduceat(weighted[np.ix_(by_group, columns)], starts, axis=0)
+            group_weight = np.add.reduceat(weights[by_group], starts)
+            score = np.minimum(fit_weight, group_weight[:, None] - fit_weight).sum(axis=0)
         total = float(weights.sum()) or 1.0
-        share.update({pair: float(score[index[pair]]) / total for pair in sub.unknown})
+        share.update({pair: float(value) / total for pair, value in zip(sub.unknown, score)})
     candidates = [pair for pair in knowledge.unknown if pair not in pending]
     return sorted(candidates, key=lambda pair: (-share[pair], order[pair]))
 

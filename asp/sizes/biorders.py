@@ -32,6 +32,7 @@ def stirling2(n: int, k: int) -> int:
     return sum((-1) ** (k - j) * math.comb(k, j) * j**n for j in range(k + 1)) // math.factorial(k)
 
 
+@lru_cache(maxsize=1024)
 def biorder_count(m: int, n: int) -> int:
     """Number of m×n biorders: the poly-Bernoulli number B_m^(-n) (Kaneko's formula)."""
     return sum(
@@ -138,16 +139,18 @@ def weighted_bit_sums(masks: np.ndarray, weights: np.ndarray, pairs: int) -> np.
 
 
 def class_weights(fits: np.ndarray) -> np.ndarray:
-    """∏ k! over classes of identical rows and of identical columns, per relation.
+    """∏ k! over classes of identical rows and of identical columns, per biorder.
 
-    ``fits`` has shape (relations, m, n); the result is float64.
+    ``fits`` has shape (relations, m, n), each a biorder; the result is float64. The
+    rows of a biorder form a chain under inclusion (so do its columns), so two rows are
+    identical exactly when they hold as many fits: classes are found by counting.
     """
     log_weight = np.zeros(len(fits))
     longest = max(fits.shape[1:], default=0)
     per_member = np.array([0.0] + [math.lgamma(k + 1) / k for k in range(1, longest + 1)])
-    for lines in (fits, fits.transpose(0, 2, 1)):
-        keys = line_keys(lines)
-        same = (keys[:, :, None] == keys[:, None, :]).sum(axis=2)
+    for axis in (2, 1):
+        counts = fits.sum(axis=axis, dtype=np.int32)
+        same = (counts[:, :, None] == counts[:, None, :]).sum(axis=2)
         # a class of k lines contributes log(k!), i.e. log(k!)/k from each member
         log_weight += per_member[same].sum(axis=1)
     return np.exp(log_weight)

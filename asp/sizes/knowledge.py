@@ -102,14 +102,28 @@ class Knowledge:
         arguments through clingo's API costs more than the solve on small instances).
         """
         decoded = {} if decoded is None else decoded
-        sets: dict[str, set] = {"smaller": set(), "fits": set(), "no_fit": set(), "in_conflict": set(), "lt": set()}
+        entries = []
         for symbol in symbols:
             entry = decoded.get(symbol)
             if entry is None:
                 entry = decoded[symbol] = (symbol.name, tuple(str(a) for a in symbol.arguments))
-            target = sets.get(entry[0])
+            entries.append(entry)
+        return cls.from_entries(parts, holes, entries, sections)
+
+    @classmethod
+    def from_entries(
+        cls,
+        parts: Sequence[str],
+        holes: Sequence[str],
+        entries: Iterable[tuple[str, tuple[str, ...]]],
+        sections: Sequence[tuple[str, str]] = (),
+    ) -> Knowledge:
+        """:meth:`from_symbols` of atoms already decoded as ``(name, argument strings)``."""
+        sets: dict[str, set] = {"smaller": set(), "fits": set(), "no_fit": set(), "in_conflict": set(), "lt": set()}
+        for name, arguments in entries:
+            target = sets.get(name)
             if target is not None:
-                target.add(entry[1])
+                target.add(arguments)
         return cls(
             parts=tuple(parts),
             holes=tuple(holes),

@@ -44,7 +44,7 @@ essentials of the new closure are confirmed.
 from __future__ import annotations
 
 import random
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
 import clingo
@@ -194,10 +194,13 @@ class SizeLearner:
             self._set_observation(pair, result)
         self.knowledge = self._solve()
 
-    def _pair(self, symbol: clingo.Symbol) -> Pair:
-        """The (part, hole) arguments of a decoded ``select/2`` or ``essential/2`` atom."""
-        part, hole = self._decoded[symbol][1]
-        return part, hole
+    def _decode(self, symbol: clingo.Symbol) -> tuple[str, tuple[str, ...]]:
+        """``(name, argument strings)`` of a shown atom, cached (reading arguments through
+        clingo's API costs more than a solve on small instances)."""
+        entry = self._decoded.get(symbol)
+        if entry is None:
+            entry = self._decoded[symbol] = (symbol.name, tuple(str(a) for a in symbol.arguments))
+        return entry
 
     def _literal(self, atom: clingo.Symbol) -> int:
         """The solver literal of a ground ``#external`` atom."""
@@ -227,11 +230,11 @@ class SizeLearner:
         result = self._ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
         if not result.satisfiable:
             raise PlannerError(f"policy {self.policy.name}: no model for the current knowledge")
-        knowledge = Knowledge.from_symbols(self.parts, self.holes, last, self._decoded,
-                                           tuple(self.model.sections.items()))
-        selected = [self._pair(s) for s in last if self._decoded[s][0] == "select"]
+        entries = [self._decode(symbol) for symbol in last]
+        knowledge = Knowledge.from_entries(self.parts, self.holes, entries, tuple(self.model.sections.items()))
+        selected = [(args[0], args[1]) for name, args in entries if name == "select"]
         self._selected = selected[0] if len(selected) == 1 else None
-        essential = {self._pair(s) for s in last if self._decoded[s][0] == "essential"}
+        essential = {(args[0], args[1]) for name, args in entries if name == "essential"}
         self._essential = tuple(pair for pair in self._pairs if pair in essential)
         return knowledge
 
@@ -282,11 +285,38 @@ class SizeLearner:
 
     def record(self, part: str, hole: str, result: str) -> Experiment:
         """Add one answer, update the closure, queue re-tests (conflicts; unconfirmed re-tested pairs)."""
+        self._check_answer(part, hole, result)
+        self._history.append((self.knowledge, self._selected, list(self.retests), self._essential))
+        experiment = self._add_answer(part, hole, result)
+        self.knowledge = self._solve()
+        self._queue_retests((part, hole))
+        return experiment
+
+    def record_all(self, results: Sequence[tuple[str, str, str]]) -> list[Experiment]:
+        """:meth:`record` for experiments that finished together: every answer is added
+        in the order given, then the closure is solved once (the same closure as recording
+        them one by one: it depends only on each pair's kept answer) and re-tests are
+        queued; a conflict is judged on the state after all of them. :meth:`undo` cannot
+        take back a batch of more than one."""
+        if len(results) == 1:
+            return [self.record(*results[0])]
+        for answer in results:
+            self._check_answer(*answer)
+        self._history.clear()
+        recorded = [self._add_answer(*answer) for answer in results]
+        self.knowledge = self._solve()
+        for experiment in recorded:
+            self._queue_retests((experiment.part, experiment.hole))
+        return recorded
+
+    def _check_answer(self, part: str, hole: str, result: str) -> None:
         if result not in RESULTS or part not in self.parts or hole not in self.holes:
             raise PlannerError(f"experiment ({part},{hole}) -> {result!r}: expected a known "
                                f"part, hole and a result in {RESULTS}")
+
+    def _add_answer(self, part: str, hole: str, result: str) -> Experiment:
+        """Append the experiment and its answer; switch the pair's external to its kept answer."""
         pair = (part, hole)
-        self._history.append((self.knowledge, self._selected, list(self.retests), self._essential))
         retest = pair in self.answers
         if pair in self.retests:
             self.retests.remove(pair)
@@ -294,8 +324,6 @@ class SizeLearner:
         self.experiments.append(experiment)
         self.answers.setdefault(pair, []).append(result)
         self._set_observation(pair, self._kept(self.answers[pair]))
-        self.knowledge = self._solve()
-        self._queue_retests(pair)
         return experiment
 
     def _contradicts_model(self) -> bool:
@@ -356,7 +384,9 @@ class SizeLearner:
             return retests[:size]
         if self.knowledge.complete:
             return []
-        choice = self.next_experiment()  # before hypothetical solves replace the selection
+        # the policy's own choice leads a batch beside nothing (a ranking beside pending pairs
+        # replaces it); taken before hypothetical solves replace the selection
+        choice = self.next_experiment() if self.policy.batch_rank is None or not pending else None
         chosen: list[Pair] = []
         while len(chosen) < size:
             out = [*pending, *chosen]
@@ -366,14 +396,20 @@ class SizeLearner:
             chosen.append(pair)
         return chosen
 
-    def _candidates(self, choice: Pair | None, out: list[Pair]) -> list[Pair]:
+    def _candidates(self, choice: Pair | None, out: list[Pair]) -> Iterator[Pair]:
         """Unknown pairs not in ``out``, best first for a batch beside ``out``: the
         policy's ``batch_rank`` given ``out`` if it has one (with nothing out, its
-        ``choice`` first), else its ``choice``, then index order."""
+        ``choice`` first), else its ``choice``, then index order. Lazy: the ranking is
+        computed only when the first candidate is not taken."""
         rank = self.policy.batch_rank
-        first = [choice] if choice is not None and (rank is None or not out) else []
-        rest = self.knowledge.unknown if rank is None else rank(self.knowledge, out)
-        return [p for p in dict.fromkeys([*first, *rest]) if p not in out]
+        seen = set(out)
+        if choice is not None and (rank is None or not out) and choice not in seen:
+            seen.add(choice)
+            yield choice
+        for pair in self.knowledge.unknown if rank is None else rank(self.knowledge, out):
+            if pair not in seen:
+                seen.add(pair)
+                yield pair
 
     def _independent(self, pairs: list[Pair]) -> bool:
         """No outcomes of all but one pair entail (or contradict) the remaining pair.
@@ -411,7 +447,8 @@ class SizeLearner:
     def undo(self) -> None:
         """Take back the last experiment (walks of a policy's decision tree use this)."""
         if not self._history:
-            raise PlannerError("undo: nothing to take back (a model change forgets the history)")
+            raise PlannerError("undo: nothing to take back (a model change or a batch recorded "
+                               "at once forgets the history)")
         last = self.experiments.pop()
         pair = (last.part, last.hole)
         self.answers[pair].pop()

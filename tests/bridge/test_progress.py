@@ -2,8 +2,16 @@
 
 from __future__ import annotations
 
+import fcntl
 import io
+import json
 import logging
+import os
+import pty
+import struct
+import subprocess
+import termios
+from pathlib import Path
 
 import pytest
 
@@ -27,3 +35,43 @@ def test_a_bar_only_on_a_terminal_that_wants_info(tty: bool, level: int, drawn: 
     assert list(progress(iter(range(5)), desc="trials", total=5)) == [0, 1, 2, 3, 4]
     assert ("trials: 100%" in stream.getvalue()) is drawn
     assert drawn or stream.getvalue() == ""
+
+
+def run_with_stderr(argv: list[str], tty: bool, cwd: Path, env: dict[str, str]) -> tuple[str, str]:
+    """Run ``argv`` with stdout a pipe and stderr a pseudo-terminal (``tty``) or a pipe;
+    (stdout, stderr) as text."""
+    if not tty:
+        done = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
+        return done.stdout, done.stderr
+    leader, follower = pty.openpty()
+    # a terminal 120 columns wide (a new pseudo-terminal has none: a bar of no width)
+    fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 120, 0, 0))
+    with subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=follower, text=True) as process:
+        os.close(follower)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:  # the terminal closed with the process
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        out = process.stdout.read() if process.stdout else ""
+        process.wait(120)
+    os.close(leader)
+    return out, b"".join(chunks).decode(errors="replace")
+
+
+@pytest.mark.slow  # two truth-cell assemblies, ~10 s
+@pytest.mark.timeout(180)
+@pytest.mark.parametrize("tty", [True, False])
+def test_bench_assemble_draws_a_bar_on_a_terminal_stderr_only_and_never_in_its_json(
+        tty: bool, root: Path, cli_argv, cli_env: dict[str, str]) -> None:
+    out, err = run_with_stderr(cli_argv("bench", "assemble", "--backend", "truth", "--plans", "2", "--jobs", "2",
+                                        "--json"), tty, root, cli_env)
+    assert out, err
+    report = json.loads(out)
+    assert len(report["plans"]) == 2
+    assert ("plans: 100%" in err) is tty
+    assert "100%" not in out

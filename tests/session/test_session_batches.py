@@ -40,9 +40,12 @@ def independent(knowledge: Knowledge, pairs: list[Pair]) -> bool:
     return True
 
 
-def parallel_session(parts: list[str], holes: list[str], cells: int, policy: str, seed: int) -> int:
+def parallel_session(parts: list[str], holes: list[str], cells: int, policy: str, seed: int,
+                     together: bool = False) -> int:
     """Learn with ``cells`` simulated cells finishing in a seeded random order; returns
-    the number of experiments, asserting every batch is independent of what runs."""
+    the number of experiments, asserting every batch is independent of what runs.
+    ``together``: a random number of the running experiments finish at once and are
+    recorded with one solve (``record_all``), as a session takes them."""
     learner = SizeLearner(parts, holes, policy)
     rng = random.Random(seed)
     running: list[Pair] = []
@@ -56,8 +59,14 @@ def parallel_session(parts: list[str], holes: list[str], cells: int, policy: str
         if not running:
             break
         assert independent(learner.knowledge, running), running
-        pair = running.pop(rng.randrange(len(running)))
-        learner.record(*pair, TRUTH.ask(*pair))
+        if together:
+            rng.shuffle(running)
+            count = rng.randint(1, len(running))
+            finished, running = running[:count], running[count:]
+            learner.record_all([(*pair, TRUTH.ask(*pair)) for pair in finished])
+        else:
+            pair = running.pop(rng.randrange(len(running)))
+            learner.record(*pair, TRUTH.ask(*pair))
     assert learner.knowledge.fits == TRUTH.fits
     return len(asked)
 
@@ -83,6 +92,13 @@ def test_two_cells_with_best_need_few_experiments_and_never_waste_one(seed: int)
 def test_three_cells_keep_batches_independent_for_every_policy(policy: str) -> None:
     for parts, holes in relabelings(2):
         assert parallel_session(parts, holes, 3, policy, seed=1) <= 25
+
+
+@pytest.mark.parametrize("policy", ["systematic", pytest.param("best", marks=pytest.mark.slow)])
+def test_experiments_that_finish_together_are_recorded_at_once_and_batches_stay_independent(policy: str) -> None:
+    counts = [parallel_session(parts, holes, 4, policy, seed, together=True)
+              for seed, (parts, holes) in enumerate(relabelings(2))]
+    assert max(counts) <= 25, counts
 
 
 @pytest.mark.timeout(90)

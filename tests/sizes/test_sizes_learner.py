@@ -7,6 +7,7 @@ import itertools
 import networkx as nx
 import pytest
 from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
@@ -105,6 +106,37 @@ def test_a_batch_holds_pairs_no_outcomes_of_the_others_can_entail(truth) -> None
             graph = known.copy()
             graph.add_edges_from((p, h) if fit else (h, p) for (p, h), fit in zip(others, outcomes))
             assert not _entails(graph, target)
+
+
+@settings(max_examples=15, deadline=None)
+@given(truth=biorders(max_parts=4, max_holes=4), data=st.data())
+def test_answers_recorded_at_once_give_the_closure_of_recording_them_one_by_one(truth, data) -> None:
+    """record_all: the same knowledge and experiments as record, in the order given, with
+    noise too (a flipped answer is a conflict either way)."""
+    pairs = [(p, h) for p in truth.parts for h in truth.holes]
+    chosen = data.draw(st.lists(st.sampled_from(pairs), min_size=1, max_size=6))
+    flips = data.draw(st.lists(st.booleans(), min_size=len(chosen), max_size=len(chosen)))
+    answers = [(p, h, {"fit": "no_fit", "no_fit": "fit"}[truth.ask(p, h)] if flip else truth.ask(p, h))
+               for (p, h), flip in zip(chosen, flips)]
+    one_by_one, at_once = (SizeLearner(truth.parts, truth.holes, "systematic") for _ in range(2))
+    for answer in answers:
+        one_by_one.record(*answer)
+    recorded = at_once.record_all(answers)
+    assert recorded == one_by_one.experiments == at_once.experiments
+    assert at_once.answers == one_by_one.answers
+    assert at_once.knowledge.fits == one_by_one.knowledge.fits
+    assert at_once.knowledge.no_fit == one_by_one.knowledge.no_fit
+    assert at_once.knowledge.conflicts == one_by_one.knowledge.conflicts
+
+
+def test_a_batch_recorded_at_once_cannot_be_undone_but_a_single_record_can() -> None:
+    learner = SizeLearner(["a", "b"], ["x", "y"])
+    learner.record_all([("a", "x", "fit"), ("b", "x", "no_fit")])
+    with pytest.raises(PlannerError, match="nothing to take back"):
+        learner.undo()
+    learner.record_all([("a", "y", "fit")])
+    learner.undo()
+    assert len(learner.experiments) == 2 and learner.knowledge.result("a", "y") is None
 
 
 def test_a_batch_avoids_pairs_pending_at_other_cells() -> None:
