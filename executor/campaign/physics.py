@@ -10,7 +10,9 @@ b. **contact**: the same with the part pushed into a hole it fits, against the h
    wall and bottom (the motors aim 2 mm below the bottom and one clearance sideways):
    the cost of the peg-in-hole contact itself;
 c. **trial**: whole trials (search, insertion, detection, the second attempt where there
-   is one) of the part in that hole, ``Cell.run_trial``: simulated steps over wall time.
+   is one) of the part in that hole, ``Cell.run_trial``: simulated steps over wall time,
+   each in a fresh cell whose PyBullet scene and taught skill are loaded before the clock
+   starts (a cell is made once and runs many trials: its making is no part of a trial).
 
 It prints the three and the ratio c/b (time per step of a trial over that of the
 contact physics: 1 would be a free controller). ``--baseline S`` compares the trial's
@@ -87,9 +89,12 @@ def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, 
 
 
 def trial_rate(assembly: str, part: str, hole: str, seed: int) -> float:
-    """Simulated steps per wall second of one whole trial (a fresh cell)."""
+    """Simulated steps per wall second of one whole trial in a fresh cell whose scene and
+    skill are loaded before the clock starts (what every trial after a cell's first costs)."""
     cell = Cell(assembly)
     try:
+        cell.check_pair(part, hole)
+        cell.motion_for(part)
         result = cell.run_trial(part, hole, seed)
     finally:
         cell.close()

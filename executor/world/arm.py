@@ -169,8 +169,9 @@ class Arm:
         lever = rot @ self._inv_pos
         tip_pos = np.array(ls[4]) + lever
         tip_quat = np.array(pb.multiplyTransforms(_ORIGIN, ls[5], _ORIGIN, self._inv_quat)[1])
+        (vx, vy, vz), (wx, wy, wz), (lx, ly, lz) = ls[6], ls[7], lever.tolist()
         omega = np.array(ls[7])
-        tip_vel = np.array(ls[6]) + cross(omega, lever)
+        tip_vel = np.array([vx + (wy * lz - wz * ly), vy + (wz * lx - wx * lz), vz + (wx * ly - wy * lx)])
         jl, ja = pb.calculateJacobian(r, self.sensor, self._inv_pos_list, q_list, self._zeros, self._zeros,
                                       physicsClientId=c)
         filtered = self._wrench_filtered
