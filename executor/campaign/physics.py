@@ -15,9 +15,10 @@ c. **trial**: whole trials (search, insertion, detection, the second attempt whe
    starts (a cell is made once and runs many trials: its making is no part of a trial).
 
 It prints the three and the ratio c/b (time per step of a trial over that of the
-contact physics: 1 would be a free controller). ``--baseline S`` compares the trial's
-steps per second with a kept figure S (docs/results.md) and says when it fell by more
-than a third (exit code 1).
+contact physics: 1 would be a free controller), by wall time and by this process's CPU
+time (on a machine shared with other work, the CPU figures do not count the waiting).
+``--baseline S`` compares the trial's steps per second (wall) with a kept figure S
+(docs/results.md) and says when it fell by more than a third (exit code 1).
 """
 
 from __future__ import annotations
@@ -54,16 +55,17 @@ def _hold(scene: Scene, arm: Arm, tip: np.ndarray) -> None:
                                  forces=[300.0] * len(arm.joints), physicsClientId=scene.client)
 
 
-def _steps_per_s(client: int, steps: int) -> float:
-    start = time.perf_counter()
+def _steps_per_s(client: int, steps: int) -> tuple[float, float]:
+    """Steps per second of wall time and of this process's CPU time."""
+    wall, cpu = time.perf_counter(), time.process_time()
     for _ in range(steps):
         pb.stepSimulation(physicsClientId=client)
-    return steps / (time.perf_counter() - start)
+    return steps / (time.perf_counter() - wall), steps / (time.process_time() - cpu)
 
 
 def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, Any]:
-    """Steps per second of (a) the bare scene and (b) the part in contact with the hole,
-    and the contact points the part has with the plate in (b)."""
+    """Steps per second (wall, CPU) of (a) the bare scene and (b) the part in contact with
+    the hole, and the contact points the part has with the plate in (b)."""
     geometry = load_geometry(assembly)
     spec, hole_spec = geometry.parts[part], geometry.holes[hole]
     scene = Scene(geometry, spec.shape)
@@ -88,17 +90,20 @@ def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, 
     return {"bare": bare, "contact": contact, "contact_points": contacts}
 
 
-def trial_rate(assembly: str, part: str, hole: str, seed: int) -> float:
+def trial_rate(assembly: str, part: str, hole: str, seed: int) -> tuple[float, float]:
     """Simulated steps per wall second of one whole trial in a fresh cell whose scene and
     skill are loaded before the clock starts (what every trial after a cell's first costs)."""
     cell = Cell(assembly)
     try:
         cell.check_pair(part, hole)
         cell.motion_for(part)
+        cpu = time.process_time()
         result = cell.run_trial(part, hole, seed)
+        cpu = time.process_time() - cpu
     finally:
         cell.close()
-    return sum(e.sim_time_s for e in result.evidence) / TIME_STEP / result.duration_s
+    steps = sum(e.sim_time_s for e in result.evidence) / TIME_STEP
+    return steps / result.duration_s, steps / cpu
 
 
 def main(argv: list[str]) -> int:
@@ -123,15 +128,20 @@ def main(argv: list[str]) -> int:
     with stdout_to_stderr():
         runs = [physics_rates(args.assembly, args.part, args.hole, args.steps) for _ in range(args.repeats)]
         trials = [trial_rate(args.assembly, args.part, args.hole, args.seed + k) for k in range(args.repeats)]
-    bare = statistics.median(r["bare"] for r in runs)
-    contact = statistics.median(r["contact"] for r in runs)
-    trial = statistics.median(trials)
+    bare, contact = (statistics.median(r[key][0] for r in runs) for key in ("bare", "contact"))
+    trial = statistics.median(t[0] for t in trials)
+    cpu_contact = statistics.median(r["contact"][1] for r in runs)
+    cpu_trial = statistics.median(t[1] for t in trials)
     report: dict[str, Any] = {
         "assembly": args.assembly, "part": args.part, "hole": args.hole, "repeats": args.repeats,
         "bare_steps_per_s": round(bare), "contact_steps_per_s": round(contact), "trial_steps_per_s": round(trial),
         "contact_points": min(r["contact_points"] for r in runs),
         "ratio_trial_over_contact": round(contact / trial, 2),
         "trial_real_time_factor": round(trial * TIME_STEP, 2),
+        # Per CPU second of this process: what a loaded machine's waiting does not change.
+        "cpu_bare_steps_per_s": round(statistics.median(r["bare"][1] for r in runs)),
+        "cpu_contact_steps_per_s": round(cpu_contact), "cpu_trial_steps_per_s": round(cpu_trial),
+        "cpu_ratio_trial_over_contact": round(cpu_contact / cpu_trial, 2),
     }
     regressed = False
     if args.baseline is not None:
@@ -149,6 +159,8 @@ def main(argv: list[str]) -> int:
         print(f"  c. whole trial:                         {report['trial_steps_per_s']:>8}  "
               f"(real-time factor {report['trial_real_time_factor']})")
         print(f"  ratio c/b (time per step, trial over contact physics): {report['ratio_trial_over_contact']}")
+        print(f"  per CPU second: a {report['cpu_bare_steps_per_s']}, b {report['cpu_contact_steps_per_s']}, "
+              f"c {report['cpu_trial_steps_per_s']}, ratio c/b {report['cpu_ratio_trial_over_contact']}")
         if args.baseline is not None:
             verdict = "fell by more than a third" if regressed else "within a third"
             print(f"  trial versus the kept {args.baseline:.0f} steps/s: {report['ratio_to_baseline']} ({verdict})")
