@@ -92,8 +92,9 @@ def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, 
 
 
 def trial_rate(assembly: str, part: str, hole: str, seed: int) -> tuple[float, float]:
-    """Simulated steps per wall second of one whole trial in a fresh cell whose scene and
-    skill are loaded before the clock starts (what every trial after a cell's first costs)."""
+    """Simulated steps per wall second and per CPU second of one whole trial, in a fresh
+    cell whose scene and skill are loaded before the clocks start (what every trial after
+    a cell's first costs)."""
     cell = Cell(assembly)
     try:
         cell.check_pair(part, hole)

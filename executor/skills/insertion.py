@@ -26,7 +26,7 @@ from executor.world.scene import TIME_STEP
 TIMEOUT_FACTOR = 3.0
 END_SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
 MAX_WIGGLES = 1  # exception strategy runs per attempt
-_ORIGIN = (0.0, 0.0, 0.0)
+_ORIGIN = (0.0, 0.0, 0.0)  # the zero translation of the rotations composed with multiplyTransforms
 JAM_DEPTH = SearchParams().sink_depth
 """[m] below the entry: the part has sunk into the hole's entry chamfer (the search's
 criterion of "in the hole"), so a breach there is a jam, not a part on the surface.  A
