@@ -19,6 +19,8 @@ from assembly_constraints.executor.control.admittance import Admittance
 from assembly_constraints.executor.control.motion import Motion
 from assembly_constraints.executor.world.scene import TIME_STEP
 
+_NO_SHIFT = np.zeros(2)
+
 
 @dataclass(frozen=True)
 class SearchParams:
@@ -113,8 +115,8 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         else:
             may_pause = not dipped
             paused = 0
-            comply = Admittance()
-            shift = np.zeros(2)
+            comply.reset()
+            shift = _NO_SHIFT
             theta += p.speed * TIME_STEP / max(radius, pitch / 2)
             angle = angle0 + direction * theta
             offset = radius * np.array([math.cos(angle), math.sin(angle)])
