@@ -26,6 +26,7 @@ class ImpedanceController:
         self.arm, self.client, self.gains = arm, client, gains
         self._steps = 0
         self._null_projector = np.eye(7)
+        self._wrench = np.zeros(6)  # the commanded tip wrench [N, Nm], rewritten every step
 
     def reset(self) -> None:
         """Forget the cached null-space projector (call after teleporting the arm), so an
@@ -40,13 +41,13 @@ class ImpedanceController:
         Returns the state read *before* the step."""
         g = self.gains
         s = self.arm.read()
-        force = g.k_trans * (pos_des - s.tip_pos) - g.d_trans * s.tip_vel
-        moment = g.k_rot * rotation_error(quat_des_xyzw, s.tip_quat_xyzw) - g.d_rot * s.tip_omega
+        wrench = self._wrench
+        wrench[:3] = g.k_trans * (pos_des - s.tip_pos) - g.d_trans * s.tip_vel
+        wrench[3:] = g.k_rot * rotation_error(quat_des_xyzw, s.tip_quat_xyzw) - g.d_rot * s.tip_omega
         if wrench_ff is not None:
-            force = force + wrench_ff[:3]
-            moment = moment + wrench_ff[3:]
+            wrench += wrench_ff
         jac = s.jac
-        tau = jac.T @ np.concatenate([force, moment]) + self.arm.gravity_coriolis(s.q, s.qd)
+        tau = jac.T @ wrench + self.arm.gravity_coriolis(s.q, s.qd)
         # Null-space posture: the posture torque projected through I − Jᵀ J⁺ᵀ.
         if self._steps % self.PROJECTOR_PERIOD == 0:
             self._null_projector = np.eye(7) - jac.T @ np.linalg.pinv(jac).T

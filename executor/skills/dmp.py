@@ -15,8 +15,10 @@ The phase reported everywhere is t / τ ∈ [0, 1].
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from movement_primitives.dmp import CartesianDMP
@@ -65,6 +67,38 @@ class WrenchProfile:
         return self._features(np.linspace(0.0, 1.0, n)) @ self.weights
 
 
+class _MemoForcingTerm:
+    """A DMP forcing term that remembers its values: the forcing term and the phase are
+    functions of the DMP time only (not of the start or goal), and every rollout of a
+    skill integrates over the same times, so its rollouts after the first compute none
+    of them again (the same numbers; a rollout costs a third)."""
+
+    def __init__(self, term: Any) -> None:
+        self.term = term
+        self._forces: dict[Any, np.ndarray] = {}
+        self._phases: dict[Any, Any] = {}
+
+    @staticmethod
+    def _key(x: Any) -> Any:
+        return x if isinstance(x, float) else np.asarray(x).tobytes()
+
+    def forcing_term(self, z: Any) -> np.ndarray:
+        key = self._key(z)
+        value = self._forces.get(key)
+        if value is None:
+            value = self._forces[key] = self.term.forcing_term(z)
+        return value.copy()
+
+    def phase(self, t: Any) -> Any:
+        key = self._key(t)
+        if key not in self._phases:
+            self._phases[key] = self.term.phase(t)
+        return self._phases[key]
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.term, name)
+
+
 @dataclass
 class Skill:
     """A taught insertion: DMP weights, demo start/goal (hole frame), duration τ [s], the
@@ -77,17 +111,26 @@ class Skill:
     demo_goal: np.ndarray
     end_position: np.ndarray
     wrench: WrenchProfile
+    _dmp: CartesianDMP | None = field(default=None, init=False, repr=False, compare=False)
 
     def make_dmp(self) -> CartesianDMP:
         dmp = CartesianDMP(execution_time=self.execution_time, dt=ROLLOUT_DT, n_weights_per_dim=N_WEIGHTS)
         dmp.set_weights(self.weights)
         return dmp
 
+    def _rollout_dmp(self) -> CartesianDMP:
+        """The skill's DMP for rollouts, made once, its forcing terms remembered."""
+        if self._dmp is None:
+            self._dmp = self.make_dmp()
+            self._dmp.forcing_term_pos = _MemoForcingTerm(self._dmp.forcing_term_pos)
+            self._dmp.forcing_term_rot = _MemoForcingTerm(self._dmp.forcing_term_rot)
+        return self._dmp
+
     def rollout(self, start_pos: np.ndarray, start_quat_xyzw: np.ndarray, goal_pos: np.ndarray,
                 goal_quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The DMP from a start to a goal pose (hole frame): times (N,) [s], positions
         (N, 3) [m] and quaternions (N, 4) xyzw."""
-        dmp = self.make_dmp()
+        dmp = self._rollout_dmp()
         dmp.configure(start_y=np.concatenate([start_pos, xyzw_to_wxyz(start_quat_xyzw)]),
                       goal_y=np.concatenate([goal_pos, xyzw_to_wxyz(goal_quat_xyzw)]))
         t, y = dmp.open_loop()
@@ -175,4 +218,4 @@ class PhaseClock:
         a = (self.t - self.times[k]) / (self.times[k + 1] - self.times[k])
         pos = (1 - a) * self.positions[k] + a * self.positions[k + 1]
         quat = (1 - a) * self.quats[k] + a * self.quats[k + 1]
-        return pos, quat / np.linalg.norm(quat)
+        return pos, quat / math.sqrt(quat.dot(quat))  # ‖quat‖ as np.linalg.norm computes it

@@ -27,6 +27,7 @@ from assembly_constraints.executor.world.scene import TIME_STEP
 TIMEOUT_FACTOR = 3.0
 END_SETTLE_TIME = 0.05  # [s] held at the end before p_end is read
 MAX_WIGGLES = 1  # exception strategy runs per attempt
+_ORIGIN = (0.0, 0.0, 0.0)  # the zero translation of the rotations composed with multiplyTransforms
 JAM_DEPTH = SINK_DEPTH
 """[m] below the entry: the part has sunk into the hole's entry chamfer (the search's
 criterion of "in the hole"), so a breach there is a jam, not a part on the surface.  A
@@ -54,10 +55,11 @@ class InsertionResult:
 
 def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
     """Quaternion (x, y, z, w) of a rotation vector [rad]."""
-    angle = float(np.linalg.norm(rotvec))
+    angle = math.sqrt(rotvec.dot(rotvec))  # ‖rotvec‖ as np.linalg.norm computes it, without its overhead
     if angle < 1e-12:
         return np.array([0.0, 0.0, 0.0, 1.0])
-    return np.concatenate([np.sin(angle / 2) * rotvec / angle, [math.cos(angle / 2)]])
+    x, y, z = (np.sin(angle / 2) * rotvec / angle).tolist()
+    return np.array([x, y, z, math.cos(angle / 2)])
 
 
 def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
@@ -94,32 +96,41 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     last = len(wrench_table) - 1
     ff = np.zeros((1, 5)) if feedforward is None else feedforward
     ff_last = len(ff) - 1
-
-    def ff_at(phase: float) -> tuple[np.ndarray, np.ndarray]:
-        c = ff[min(int(phase * len(ff)), ff_last)]
-        return c[:3], np.array([c[3], c[4], 0.0])
-
-    trace = ExecutionTrace() if record else None
     if admittance is not None:  # its translation bound for z too, no yaw bound unless it turns the part
         bound_pos = np.full(3, admittance.bound[0])
         bound_rot = np.array([admittance.bound[2], admittance.bound[3], admittance.bound[4] if admittance.yaw else 0.0])
+    else:  # no admittance offsets to keep in range
+        bound_pos, bound_rot = np.zeros(3), np.zeros(3)
+    # Per phase bin of the correction, made once instead of every step: its position (3,)
+    # [m], its rotation as a quaternion (x, y, z, w), and the range left to the
+    # admittance's offsets (position [m], rotation vector [rad]: low, high).
+    ff_bins: list[tuple[np.ndarray, list[float], tuple[np.ndarray, ...]]] = []
+    for c in ff:
+        ff_pos, ff_rot = c[:3], np.array([c[3], c[4], 0.0])
+        room = (-bound_pos - ff_pos, bound_pos - ff_pos, -bound_rot - ff_rot, bound_rot - ff_rot)
+        ff_bins.append((ff_pos, rotvec_quat_xyzw(ff_rot).tolist(), room))
+
+    def ff_at(phase: float) -> tuple[np.ndarray, list[float], tuple[np.ndarray, ...]]:
+        return ff_bins[min(int(phase * len(ff)), ff_last)]
+
+    trace = ExecutionTrace() if record else None
     for _ in range(budget):
         if clock.done:
             break
         pos_d, quat_d = clock.pose()
-        ff_pos, ff_rot = ff_at(clock.phase)
+        ff_pos, ff_quat, (pos_low, pos_high, rot_low, rot_high) = ff_at(clock.phase)
         pos_d = pos_d + ff_pos
-        quat_d = np.array(pb.multiplyTransforms((0, 0, 0), rotvec_quat_xyzw(ff_rot), (0, 0, 0), quat_d)[1])
+        quat_d = np.array(pb.multiplyTransforms(_ORIGIN, ff_quat, _ORIGIN, quat_d)[1])
         w_des = wrench_table[int(clock.phase * last + 0.5)]
-        quat_cmd = np.array(pb.multiplyTransforms((0, 0, 0), rotvec_quat_xyzw(d_rot), (0, 0, 0), quat_d)[1])
+        quat_cmd = np.array(pb.multiplyTransforms(_ORIGIN, rotvec_quat_xyzw(d_rot), _ORIGIN, quat_d)[1])
         s = motion.step(pos_d + d_pos, quat_cmd, phase=clock.phase, wrench_des=w_des)
         f_dev, m_dev = s.force - w_des[:3], s.torque - w_des[3:]
         f_norm, _, violated = detector.update(f_dev, m_dev)
         if admittance is not None:
             d_pos, d_rot = admittance.update(f_dev, m_dev, TIME_STEP)
             if feedforward is not None:  # correction plus admittance stay within the admittance's bound
-                d_pos = np.clip(d_pos, -bound_pos - ff_pos, bound_pos - ff_pos)
-                d_rot = np.clip(d_rot, -bound_rot - ff_rot, bound_rot - ff_rot)
+                d_pos = np.minimum(np.maximum(d_pos, pos_low), pos_high)  # np.clip, without its overhead
+                d_rot = np.minimum(np.maximum(d_rot, rot_low), rot_high)
         if trace is not None:
             trace.add(clock.phase, np.array([f_dev[0], f_dev[1], f_dev[2], m_dev[0], m_dev[1]]))
         if violated:
@@ -135,7 +146,7 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     else:
         completed = False
     pos_d, quat_d = clock.pose()
-    ff_pos, _ = ff_at(clock.phase)
+    ff_pos = ff_at(clock.phase)[0]
     pos_d = pos_d + ff_pos
     end = motion.hold(pos_d + d_pos, quat_d, END_SETTLE_TIME) if completed else motion.controller.arm.read()
     # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets

@@ -21,6 +21,7 @@ from assembly_constraints.executor.world.scene import TIME_STEP
 
 SINK_DEPTH = 0.0005
 """[m] below the surface: the tip is in a hole's entry chamfer."""
+_NO_SHIFT = np.zeros(2)
 
 
 @dataclass(frozen=True)
@@ -116,8 +117,8 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         else:
             may_pause = not dipped
             paused = 0
-            comply = Admittance(AdmittanceParams())
-            shift = np.zeros(2)
+            comply.reset()
+            shift = _NO_SHIFT
             theta += p.speed * TIME_STEP / max(radius, pitch / 2)
             angle = angle0 + direction * theta
             offset = radius * np.array([math.cos(angle), math.sin(angle)])

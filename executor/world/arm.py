@@ -20,6 +20,7 @@ N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
 REST_POSTURE = np.array([0.0, 0.6, 0.0, -1.4, 0.0, 1.1, 0.0])
 TOOL_DOWN_QUAT_XYZW = np.array([1.0, 0.0, 0.0, 0.0])
+_ORIGIN = (0.0, 0.0, 0.0)
 
 
 def tool_quat(yaw: float) -> np.ndarray:
@@ -90,7 +91,7 @@ def rotation_error(quat_des_xyzw: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarr
     return 2.0 * v if w >= 0 else -2.0 * v
 
 
-@dataclass
+@dataclass(slots=True)
 class ArmState:
     """One reading: joints [rad, rad/s], believed tip pose/velocity [m, m/s, rad/s], the
     tip Jacobian (6×7: linear rows, then angular) and the measured contact wrench at the
@@ -118,6 +119,7 @@ class Arm:
             raise ExecutorError(f"robot body {robot}: no 'ft_sensor' joint (expected the generated arm URDF)")
         self.sensor = names.index("ft_sensor")
         self.joints = list(range(N_JOINTS))
+        self._read_joints = [*self.joints, self.sensor]  # one getJointStates per read
         pb.enableJointForceTorqueSensor(robot, self.sensor, True, physicsClientId=client)
         self._zeros = [0.0] * N_JOINTS
         self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
@@ -127,7 +129,7 @@ class Arm:
     def set_grasp_error(self, offset: np.ndarray, quat_xyzw: np.ndarray) -> None:
         """Real tip = believed tip ∘ (offset [m], rotation) in the believed tip frame."""
         inv_pos, inv_quat = pb.invertTransform(list(offset), list(quat_xyzw))
-        self._inv_pos, self._inv_quat = np.array(inv_pos), np.array(inv_quat)
+        self._inv_pos, self._inv_quat = np.array(inv_pos), tuple(inv_quat)
         self._inv_pos_list = list(inv_pos)
         self.grasp_offset, self.grasp_quat_xyzw = np.array(offset), np.array(quat_xyzw)
 
@@ -154,28 +156,32 @@ class Arm:
         return q
 
     def read(self) -> ArmState:
-        """The current state; the wrench is tared and low-pass filtered (α = 0.1 per 1 ms step, τ ≈ 10 ms)."""
+        """The current state; the wrench is tared and low-pass filtered (α = 0.1 per 1 ms step, τ ≈ 10 ms).
+
+        Called once per control step: four PyBullet queries (the joints and the sensor
+        in one ``getJointStates``, the sensor link's pose and velocity, the Jacobian)."""
         c, r = self.client, self.robot
-        js = pb.getJointStates(r, self.joints, physicsClientId=c)
-        q = np.array([j[0] for j in js])
-        qd = np.array([j[1] for j in js])
+        js = pb.getJointStates(r, self._read_joints, physicsClientId=c)
+        q_list = [j[0] for j in js[:N_JOINTS]]
         ls = pb.getLinkState(r, self.sensor, computeLinkVelocity=1, computeForwardKinematics=1,
                              physicsClientId=c)
-        rot = quat_to_matrix(ls[5])
+        rot = np.array(pb.getMatrixFromQuaternion(ls[5])).reshape(3, 3)
         lever = rot @ self._inv_pos
         tip_pos = np.array(ls[4]) + lever
-        tip_quat = np.array(pb.multiplyTransforms((0, 0, 0), ls[5], (0, 0, 0), self._inv_quat)[1])
+        tip_quat = np.array(pb.multiplyTransforms(_ORIGIN, ls[5], _ORIGIN, self._inv_quat)[1])
+        (vx, vy, vz), (wx, wy, wz), (lx, ly, lz) = ls[6], ls[7], lever.tolist()
         omega = np.array(ls[7])
-        tip_vel = np.array(ls[6]) + cross(omega, lever)
-        jl, ja = pb.calculateJacobian(r, self.sensor, self._inv_pos_list, list(q), self._zeros, self._zeros,
+        tip_vel = np.array([vx + (wy * lz - wz * ly), vy + (wz * lx - wx * lz), vz + (wx * ly - wy * lx)])
+        jl, ja = pb.calculateJacobian(r, self.sensor, self._inv_pos_list, q_list, self._zeros, self._zeros,
                                       physicsClientId=c)
-        raw = np.array(pb.getJointState(r, self.sensor, physicsClientId=c)[2]) - self.tare
-        self._wrench_filtered += 0.1 * (raw - self._wrench_filtered)
+        filtered = self._wrench_filtered
+        filtered += 0.1 * ((np.array(js[N_JOINTS][2]) - self.tare) - filtered)
         # The sensor gives the wrench of the flange on the part in the part frame; the
         # contact wrench on the part is its negative (weight removed by the tare).
-        force = -(rot @ self._wrench_filtered[:3])
-        torque = -(rot @ self._wrench_filtered[3:]) - cross(lever, force)
-        return ArmState(q, qd, tip_pos, tip_quat, tip_vel, omega, np.array(jl + ja), force, torque)
+        force = -(rot @ filtered[:3])
+        torque = -(rot @ filtered[3:]) - cross(lever, force)
+        return ArmState(np.array(q_list), np.array([j[1] for j in js[:N_JOINTS]]), tip_pos, tip_quat, tip_vel,
+                        omega, np.array(jl + ja), force, torque)
 
     def tare_sensor(self) -> None:
         """Zero the F/T sensor (call at rest, out of contact): removes the part's weight."""
@@ -184,10 +190,10 @@ class Arm:
 
     def gravity_coriolis(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """Joint torques [Nm] holding the arm against gravity and Coriolis forces."""
-        return np.array(pb.calculateInverseDynamics(self.robot, list(q), list(qd), self._zeros,
+        return np.array(pb.calculateInverseDynamics(self.robot, q.tolist(), qd.tolist(), self._zeros,
                                                     physicsClientId=self.client))
 
     def command(self, tau: np.ndarray) -> None:
         """Apply joint torques [Nm] for the next step."""
-        pb.setJointMotorControlArray(self.robot, self.joints, pb.TORQUE_CONTROL, forces=list(tau),
+        pb.setJointMotorControlArray(self.robot, self.joints, pb.TORQUE_CONTROL, forces=tau.tolist(),
                                      physicsClientId=self.client)

@@ -16,6 +16,9 @@ def test_bench_physics_measures_bare_contact_and_trial_steps(run_cli) -> None:
     assert report["bare_steps_per_s"] > report["contact_steps_per_s"] > 0 and report["trial_steps_per_s"] > 0
     assert report["ratio_trial_over_contact"] == pytest.approx(
         report["contact_steps_per_s"] / report["trial_steps_per_s"], rel=0.01)
+    assert report["cpu_contact_steps_per_s"] > 0 and report["cpu_trial_steps_per_s"] > 0
+    assert report["cpu_ratio_trial_over_contact"] == pytest.approx(
+        report["cpu_contact_steps_per_s"] / report["cpu_trial_steps_per_s"], rel=0.01)
     assert report["regressed"] is True
 
 

@@ -1,0 +1,88 @@
+"""The control loop's fast paths compute what the plain computations do: the arm's one
+batched reading against PyBullet's own velocities, a skill's remembered DMP forcing terms
+against a fresh DMP, an admittance after ``reset`` against a new one, the detector's
+window against its definition (max over time of the window minimum). Within one process,
+so the comparisons are exact where the claim is "the same numbers"."""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+import pytest
+
+from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
+from assembly_constraints.executor.control.detector import Detector, Thresholds
+from assembly_constraints.executor.skills.dmp import load_skill, xyzw_to_wxyz
+from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.world.geometry import load_geometry
+
+
+@pytest.fixture(scope="module")
+def cell():
+    c = Cell()
+    c.run_trial("p1", "r1", 3)  # the arm ends holding the part in its hole
+    yield c
+    c.close()
+
+
+def test_one_batched_reading_gives_what_separate_queries_give(cell: Cell) -> None:
+    """``Arm.read`` takes q, q̇ and the sensor's wrench from one query: they must be the
+    joints' and the sensor's own (a shuffled index breaks it), and the angular rows of
+    the Jacobian times q̇ the link's angular velocity."""
+    motion = cell.motion_for("p1")
+    arm = motion.controller.arm
+    arm.set_grasp_error(np.array([0.0008, -0.0005, 0.0]), np.array([0.0, 0.01, 0.0, 1.0]) / np.hypot(0.01, 1.0))
+    motion.hold(arm.read().tip_pos + [0.0, 0.0, 0.01], np.array([1.0, 0.0, 0.0, 0.0]), 0.02)  # moving up
+    arm.tare = np.zeros(6)
+    arm.reset(arm.read().q)  # at rest now: the filtered wrench starts from zero
+    pb.stepSimulation(physicsClientId=arm.client)
+    state = arm.read()
+    joints = pb.getJointStates(arm.robot, arm.joints, physicsClientId=arm.client)
+    assert np.array_equal(state.q, [j[0] for j in joints]) and np.array_equal(state.qd, [j[1] for j in joints])
+    sensor = np.array(pb.getJointState(arm.robot, arm.sensor, physicsClientId=arm.client)[2])
+    link_quat = pb.getLinkState(arm.robot, arm.sensor, computeForwardKinematics=1, physicsClientId=arm.client)[5]
+    rot = np.array(pb.getMatrixFromQuaternion(link_quat)).reshape(3, 3)
+    assert np.allclose(state.force, -(rot @ (0.1 * sensor[:3])), atol=1e-12)  # one filter step from zero
+    assert np.allclose(state.jac[3:] @ state.qd, state.tip_omega, atol=1e-9)
+
+
+def test_remembered_forcing_terms_give_the_rollout_of_a_fresh_dmp() -> None:
+    skill = load_skill(load_geometry("cranfield").folder, "round_peg")
+    goal = skill.demo_goal
+    for start in (np.array([0.0, 0.0, 0.003]), np.array([0.0004, -0.0002, 0.0031]), np.array([0.0, 0.0, 0.003])):
+        quat = np.array([1.0, 0.0, 0.0, 0.0])
+        times, pos, quats = skill.rollout(start, quat, goal[:3], np.roll(goal[3:], -1))
+        fresh = skill.make_dmp()
+        fresh.configure(start_y=np.concatenate([start, xyzw_to_wxyz(quat)]), goal_y=goal)
+        t_ref, y_ref = fresh.open_loop()
+        assert np.array_equal(times, t_ref)
+        assert np.array_equal(pos, y_ref[:, :3])
+        assert np.array_equal(xyzw_to_wxyz(quats), y_ref[:, 3:])
+
+
+def test_a_reset_admittance_answers_as_a_new_one() -> None:
+    used = Admittance(AdmittanceParams(), yaw=True)
+    for _ in range(300):
+        used.update(np.array([5.0, -3.0, 1.0]), np.array([0.2, 0.1, 0.05]), 0.001)
+    assert np.abs(used.offset).max() > 0
+    used.reset()
+    new = Admittance(AdmittanceParams(), yaw=True)
+    for k in range(200):
+        force, torque = np.array([np.sin(k / 9), 2.0, 0.0]), np.array([0.1, -0.1 * np.cos(k / 7), 0.3])
+        assert all(np.array_equal(a, b) for a, b in zip(used.update(force, torque, 0.001),
+                                                        new.update(force, torque, 0.001)))
+    assert np.array_equal(used.integral, new.integral) and np.array_equal(used.velocity, new.velocity)
+
+
+def test_the_detector_keeps_the_largest_sustained_deviation() -> None:
+    thresholds = Thresholds(persist_steps=5)
+    detector = Detector(thresholds)
+    rng = np.random.default_rng(4)
+    forces = rng.uniform(0.0, 40.0, 60)
+    fired = []
+    for f in forces:
+        fired.append(detector.update(np.array([f, 0.0, 0.0]), np.zeros(3))[2])
+    windows = np.lib.stride_tricks.sliding_window_view(forces, 5).min(axis=1)
+    assert detector.max_force_dev == pytest.approx(windows.max(), abs=1e-12)
+    assert fired[4:] == [bool(w >= thresholds.f_stop) for w in windows]
+    assert not any(fired[:4])
