@@ -10,7 +10,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from asp.session.view import write_blueprint
-from bridge.recording.layout import Contents, tab_names
+from bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names
 from bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from executor.rerun_log import AttemptLogger
 
@@ -85,5 +85,43 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
     spatial = [v for v in layout.views if v.kind == "3D"]
     assert {v.origin for v in spatial} == {"executor/c1", "executor/c2", "executor/c1/assembly"}
     assert all("$origin/arm/**" in v.contents and "EyeControls3D" in v.properties for v in spatial)
+    for cell in ("c1", "c2"):  # the tool tip's trail: the last TRAIL_S up to the cursor, the whole experiment
+        cell_view = next(v for v in spatial if v.origin == f"executor/{cell}")
+        ranges = {r["timeline"]: r["range"] for r in cell_view.overrides[f"executor/{cell}/tool/tip"][
+            "VisibleTimeRanges:ranges"]}
+        second = round(TRAIL_S * 1e9)
+        assert ranges == {"sim_time": {"start": -second, "end": 0}, "log_time": {"start": -second, "end": 0},
+                          "experiment": {"start": 0, "end": 0}}
+        assert set(cell_view.overrides) == {f"executor/{cell}/tool/tip"}
     assert {"planner/knowledge", "planner/knowledge_table", "planner/precedence"} <= blueprint_origins(
         tmp_path / "view.rbl")
+
+
+@pytest.mark.parametrize(("text", "point", "viewer_time"), [
+    ("experiment=1", TimePoint("experiment", 1), 1), ("sim_time=2.5", TimePoint("sim_time", 2.5), 2_500_000_000),
+    ("log_time=1764633600", TimePoint("log_time", 1764633600), 1764633600 * 10**9)])
+def test_a_time_point_is_parsed_with_its_timeline_kind(text: str, point: TimePoint, viewer_time: int) -> None:
+    assert TimePoint.parse(text) == point and point.viewer_time == viewer_time
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("experiment", "expected TIMELINE=VALUE"), ("frame=3", "expected TIMELINE=VALUE"),
+    ("experiment=1.5", "sequence timeline, expected a whole number"), ("sim_time=x", "a number of seconds"),
+    ("sim_time=-1", "finite time >= 0"), ("sim_time=nan", "finite time >= 0")])
+def test_a_bad_time_point_says_what_is_expected(text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        TimePoint.parse(text)
+
+
+@pytest.mark.slow
+def test_view_at_needs_a_timeline_of_the_recording(tmp_path: Path, run_cli) -> None:
+    run = _run_folder(tmp_path / "run")
+    missing = run_cli("view", str(run), "--screenshot", str(tmp_path / "shots"), "--at", "plan_step=1")
+    assert missing.returncode == 2 and missing.stderr.splitlines() == [
+        f"error: --at plan_step=1: {run} has no timeline 'plan_step'; it has none"]  # its attempt never ended
+    malformed = run_cli("view", str(run), "--at", "experiment=first")
+    assert malformed.returncode == 2
+    assert "experiment is a sequence timeline, expected a whole number" in malformed.stderr
+    alone = run_cli("view", str(run), "--at", "experiment=1")
+    assert alone.returncode == 2 and "--at: only with --screenshot DIR" in alone.stderr
+    assert not (tmp_path / "shots").exists()
