@@ -36,8 +36,9 @@ from bridge.recording.sinks import Viewer, hosted_viewer
 
 POLL_S = 5.0
 """Time between two pictures while waiting for the page to settle [s]."""
-LOAD_TIMEOUT_S = 300.0
-"""Longest the web viewer may take to load the recording and settle [s]."""
+LOAD_TIMEOUT_S = 600.0
+"""Longest the web viewer may take to load the recording and settle [s] (measured: 85 s
+for a Cranfield session on two cores; several minutes when other work loads them)."""
 TAB_TIMEOUT_S = 180.0
 """Longest a tab may take to settle once its blueprint is sent [s]."""
 PLAY_STATE_PAUSED = 1
@@ -63,15 +64,17 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
         assert served.page is not None and served.connect is not None
         stream = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id)
         stream.set_sinks(rr.GrpcSink(served.connect))
-        stream.send_blueprint(blueprint(contents))
-        browser.open(served.page)
-        picture = _settled(browser, LOAD_TIMEOUT_S, b"")
-        if picture is None:
-            raise PlannerError(f"the web viewer did not load and settle within {LOAD_TIMEOUT_S:g} s")
-        picture = _picture_tabs(browser, stream, contents, folder, picture, None, written)
-        for point in at:
-            picture = _picture_tabs(browser, stream, contents, folder, picture, point, written)
-        stream.disconnect()
+        try:  # disconnected before the server stops, else the SDK logs the broken connection
+            stream.send_blueprint(blueprint(contents))
+            browser.open(served.page)
+            picture = _settled(browser, LOAD_TIMEOUT_S, b"")
+            if picture is None:
+                raise PlannerError(f"the web viewer did not load and settle within {LOAD_TIMEOUT_S:g} s")
+            picture = _picture_tabs(browser, stream, contents, folder, picture, None, written)
+            for point in at:
+                picture = _picture_tabs(browser, stream, contents, folder, picture, point, written)
+        finally:
+            stream.disconnect()
     return written
 
 

@@ -3,8 +3,8 @@
 Planner and cells log into one recording id of application :data:`APPLICATION_ID`, the
 planner under ``planner/...``, cell ``<id>`` under ``executor/<id>/...``. A blueprint is
 made for what a recording holds (:class:`Contents`): the planner's tab when the planner
-logged, one tab per cell that logged more than an assembly, one assembly tab per cell that
-executed a plan, nothing else.
+logged, one tab per cell that logged more than its scene and an assembly, one assembly tab
+per cell that executed a plan, nothing else.
 
 Rerun 0.41 has one time panel for the whole viewer: its timeline (``TimePanel(timeline=)``)
 is the x axis of every plot and the time of every other view; no view or tab has a
@@ -114,7 +114,8 @@ def fig17_path(cell_id: str, attempt: str) -> str:
 class Contents:
     """What a recording holds, as far as its blueprint is concerned.
 
-    ``planner``: the planner logged (a session); ``cells``: cells that logged anything but an assembly;
+    ``planner``: the planner logged (a session); ``cells``: cells that logged more than their
+    static scene and an assembly (attempts, or a truth cell's outcomes);
     ``assembly_cells``: cells that executed a plan; ``fig17``: ``(cell, attempt)`` pairs,
     the attempt (``<outcome>/<key>``, :func:`fig17_path`) whose Fig. 17 plot the cell's tab
     shows (every attempt's when the cell has none here).
@@ -136,7 +137,7 @@ class Contents:
         each cell's Fig. 17 shows its first fitting attempt, else its first attempt."""
         paths = sorted(p.strip("/") for p in entity_paths)
         cells = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and p.count("/") >= 2
-                        and p.split("/")[2] != "assembly"})
+                        and p.split("/")[2] not in ("assembly", "scene")})
         assembly = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and "/assembly/" in p})
         chosen = []
         for cell in cells:
