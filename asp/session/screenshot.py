@@ -2,10 +2,11 @@
 
 The recording is served to Rerun's web viewer (:func:`bridge.recording.sinks.hosted_viewer`)
 and opened in a headless Chromium (:mod:`asp.session.browser`). The viewer needs tens of
-seconds to load and render on a software rasteriser; a picture is taken once two in a row,
-:data:`POLL_S` apart, are the same. Then, for each tab, a blueprint that shows that tab
-(``rrb.Tabs(active_tab=k)``) is streamed to the viewer and the tab is pictured once it has
-settled (or, after :data:`TAB_TIMEOUT_S`, as it is then, with a warning).
+seconds to load and render on a software rasteriser; the first picture is taken once two
+in a row, :data:`POLL_S` apart, are the same and the viewer's state has not changed
+between them (all data has arrived), later ones once two in a row are the same. Then,
+for each tab, a blueprint that shows that tab (``rrb.Tabs(active_tab=k)``) is streamed to
+the viewer and the tab is pictured once it has settled (or, after :data:`TAB_TIMEOUT_S`, as it is then, with a warning).
 
 First every tab is pictured at the end of the recording (the blueprints follow the newest
 data, :func:`bridge.recording.layout.blueprint`): ``DIR/<k>-<tab>.png``, k from 1. Then,
@@ -67,7 +68,7 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
         try:  # disconnected before the server stops, else the SDK logs the broken connection
             stream.send_blueprint(blueprint(contents))
             browser.open(served.page)
-            picture = _settled(browser, LOAD_TIMEOUT_S, b"")
+            picture = _settled(browser, LOAD_TIMEOUT_S, b"", loading=True)
             if picture is None:
                 raise PlannerError(f"the web viewer did not load and settle within {LOAD_TIMEOUT_S:g} s")
             picture = _picture_tabs(browser, stream, contents, folder, picture, None, written)
@@ -141,15 +142,20 @@ def _bytes_field(number: int, value: bytes) -> bytes:
     return _varint(number << 3 | 2) + _varint(len(value)) + value
 
 
-def _settled(browser: Browser, timeout_s: float, previous: bytes) -> bytes | None:
+def _settled(browser: Browser, timeout_s: float, previous: bytes, loading: bool = False) -> bytes | None:
     """A picture of the page once it differs from ``previous`` and two in a row agree
-    (``previous`` empty: once two agree); None if that does not happen within ``timeout_s`` [s]."""
+    (``previous`` empty: once two agree); ``loading``: and so do two reports of the
+    viewer's state between them (``window._handle.viewer_state()``: its recordings, their
+    timelines' ranges, the views; it changes while data still arrives, which a picture need
+    not show when the data lands in another tab, and a recording's own blueprint arriving
+    late would replace the one sent). None if that does not happen within ``timeout_s`` [s]."""
     deadline = time.monotonic() + timeout_s
-    last = b""
+    last: tuple[bytes, list[int]] = (b"", [])
     while time.monotonic() < deadline:
         time.sleep(POLL_S)
-        picture = browser.screenshot()
-        if picture == last and picture != previous:
-            return picture
-        last = picture
+        state = browser.evaluate("Array.from(window._handle?.viewer_state?.() ?? [])") if loading else [0]
+        now = (browser.screenshot(), state)
+        if now == last and now[1] and now[0] != previous:
+            return now[0]
+        last = now
     return None
