@@ -81,17 +81,18 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
 
 def _picture_tabs(browser: Browser, stream: rr.RecordingStream, contents: Contents, folder: Path,
                   shown: bytes, point: TimePoint | None, written: list[Path]) -> bytes:
-    """Picture every tab, following the newest data (``point`` None; tab 1 is ``shown``
-    already) or paused at ``point``; append the files to ``written``; the last picture."""
+    """Picture every tab, following the newest data (``point`` None; ``shown`` is what the
+    page shows now) or paused at ``point``; append the files to ``written``; the last picture."""
     picture = shown
     for number, name in enumerate(tab_names(contents)):
-        if number or point is not None:
-            stream.send_blueprint(blueprint(contents, number, "following" if point is None else "paused",
-                                            None if point is None else point.timeline))
-            picture = _settled(browser, TAB_TIMEOUT_S, picture) or _unsettled(browser, name)
-            if point is not None:  # once the blueprint is shown: it sets the time panel when it arrives
-                _move_cursor(browser, point)
-                picture = _settled(browser, TAB_TIMEOUT_S, b"") or _unsettled(browser, name)
+        stream.send_blueprint(blueprint(contents, number, "following" if point is None else "paused",
+                                        None if point is None else point.timeline))
+        # the first tab at the end may look as it did under the recording's own blueprint
+        before = b"" if number == 0 and point is None else picture
+        picture = _settled(browser, TAB_TIMEOUT_S, before) or _unsettled(browser, name)
+        if point is not None:  # once the blueprint is shown: it sets the time panel when it arrives
+            _move_cursor(browser, point)
+            picture = _settled(browser, TAB_TIMEOUT_S, b"") or _unsettled(browser, name)
         suffix = "" if point is None else f"-{point}"
         path = folder / f"{number + 1}-{re.sub(r'[^A-Za-z0-9.]+', '-', name + suffix).strip('-')}.png"
         path.write_bytes(picture)
