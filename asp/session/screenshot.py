@@ -38,8 +38,9 @@ from bridge.recording.sinks import Viewer, hosted_viewer
 POLL_S = 5.0
 """Time between two pictures while waiting for the page to settle [s]."""
 LOAD_TIMEOUT_S = 600.0
-"""Longest the web viewer may take to load the recording and settle [s] (measured: 85 s
-for a Cranfield session on two cores; several minutes when other work loads them)."""
+"""Longest the web viewer may take to load the recording and settle [s] (measured on two
+cores: 85 s for a Cranfield session's planner file alone; several minutes for the whole
+session when other work loads the cores, one run beyond 300 s)."""
 TAB_TIMEOUT_S = 180.0
 """Longest a tab may take to settle once its blueprint is sent [s]."""
 PLAY_STATE_PAUSED = 1
