@@ -54,14 +54,6 @@ class PlannerLog:
                  assembling: Sequence[str] = ()) -> None:
         self.rrd = rrd
         self.rec = open_stream(APPLICATION_ID, recording_id, rrd, viewer)
-        self.show(cell_ids, assembling)
-
-    def show(self, cell_ids: Sequence[str], assembling: Sequence[str] = ()) -> None:
-        """Send the session's blueprint: the planner's tab, a tab per cell of ``cell_ids``, an
-        assembly tab per cell of ``assembling``. The session sends it at the start for the
-        cells it starts (live viewing), and at the end for the cells that ran experiments and
-        the cell that executed a plan, so the recording's own blueprint (the last one sent)
-        has tabs only for what was logged."""
         self.rec.send_blueprint(blueprint(Contents(planner=True, cells=tuple(cell_ids),
                                                    assembly_cells=tuple(assembling))))
 

@@ -440,8 +440,6 @@ def _run_locked(args: argparse.Namespace, run: Path, settings: dict, started: fl
         log.assignment(assignment)
         assembly_report = (_assemble(session, cell_ids, learned, found[0], settings["seed"], args,
                                      cells[0] if cells else None) if args.assemble else None)
-        log.show(sorted({entry.cell for entry in journal.entries}),
-                 cell_ids[:1] if assembly_report and assembly_report["steps"] else ())
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
     versus = _versus_truth(truth, required, fits, must_precede)

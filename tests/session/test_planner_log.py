@@ -64,15 +64,3 @@ def test_levels_are_longest_paths_and_cycles_go_below() -> None:
     assert levels("xyz", [("x", "y"), ("y", "x")]) == {"x": 1, "y": 1, "z": 0}
     row = positions("abc", [("a", "c"), ("b", "c")])
     assert row[2] == pytest.approx((0.0, SPACING[1])) and row[0][1] == row[1][1] == 0.0
-
-
-def test_the_blueprint_sent_last_has_tabs_only_for_what_was_logged(tmp_path: Path) -> None:
-    """At the start the session expects two cells and an assembly; at the end only c2 ran
-    experiments and nothing was assembled: the recording's blueprint (the last sent, read
-    after compaction) shows the planner and c2."""
-    rrd = tmp_path / "planner.rrd"
-    log = PlannerLog(rrd, "run-2", ["c1", "c2"], assembling=["c1"])
-    log.experiment(1, "p1", "r1", "fit", "c2", _knowledge({("p1", "r1")}, set()))
-    log.show(["c2"])
-    log.close()
-    assert read_blueprint(rrd).tabs == ["planner", "c2"]
