@@ -90,11 +90,21 @@ def path_setting(path: Path | None) -> str | None:
     return None if path is None else str(path)
 
 
+NATIVE_LOG_FILTER = "warn,re_log_encoding::rrd::file_sink=off,re_log_encoding::rrd::encoder=off"
+"""``RUST_LOG`` of the Rerun SDK's native code unless the user sets it: its default level
+(warnings and errors), without the file writer's own report of a failed write ("Failed to
+write log stream to ...: ... (os error 28)", "encoder couldn't be finished"), since the
+command reports that as its one error line (:func:`assembly_constraints.bridge.recording.sinks.finish_stream`)."""
+
+
 def configure_logging(level: int | None = None) -> None:
     """Log to stderr, one line a record (``warning: ...``), from ``level`` up: the console
     command's default INFO (progress), ``-v`` DEBUG and ``-q`` ERROR. The handler is
     installed once per process (at WARNING when no level is given); a later call only
-    sets a given level."""
+    sets a given level. Sets ``RUST_LOG`` to :data:`NATIVE_LOG_FILTER` when unset, which
+    the Rerun SDK reads when it is imported (later: the subcommands import it lazily), and
+    which the cells this process starts inherit."""
+    os.environ.setdefault("RUST_LOG", NATIVE_LOG_FILTER)
     root = logging.getLogger()
     if not any(isinstance(handler.formatter, _OneLineFormatter) for handler in root.handlers):
         handler = logging.StreamHandler()

@@ -8,7 +8,7 @@ Entities (all under ``executor/<cell-id>/``):
 
 =============================== ===================================================
 ``scene/<name>``                static geometry (boxes, cylinders), ``static=True``
-``tool/tip``                    tool-tip position over ``sim_time`` [m]
+``tool/tip``                    tool-tip position over ``sim_time`` [m] (a point of :data:`TIP_RADIUS_M`)
 ``tool/force``                  F_mes as an arrow at the tool tip (:data:`FORCE_ARROW_M_PER_N`)
 ``tool/path``                   the attempt's tool path as a line strip [m] (green fit, red no fit)
 ``search/path``                 the stochastic hole-search path [m]
@@ -77,6 +77,9 @@ if TYPE_CHECKING:
 
 FORCE_ARROW_M_PER_N = 0.004
 """Length of the force arrow at the tool [m] per newton of F_mes."""
+TIP_RADIUS_M = 0.002
+"""Radius of the tool tip's point [m]; the 3D view draws the tip over the last second as
+its trail (:data:`assembly_constraints.bridge.recording.layout.TRAIL_S`)."""
 
 _TIME_TOLERANCE = 1e-9  # [s] float slack when comparing sim times
 _ATTEMPT_GAP_S = 0.001  # [s] between attempts when the cell restarts its clock
@@ -416,7 +419,7 @@ class AttemptLogger:
         tip = trace.array("tool_pos")
         self.rec.send_columns(
             f"{self.root}/tool/tip", indexes=timed,
-            columns=rr.Points3D.columns(positions=tip).partition([1] * count),
+            columns=rr.Points3D.columns(positions=tip, radii=np.full(count, TIP_RADIUS_M)).partition([1] * count),
         )
         self.rec.send_columns(
             f"{self.root}/tool/force", indexes=timed,

@@ -7,6 +7,7 @@ limited by ``RLIMIT_FSIZE``) leaves the previous file whole and no temporary fil
 
 from __future__ import annotations
 
+import shutil
 import stat
 import subprocess
 import sys
@@ -100,15 +101,54 @@ def test_stdout_on_a_full_disk_is_one_line_exit_2(argv: tuple[str, ...]) -> None
     assert lines == ["error: stdout: cannot write (No space left on device)"], done.stderr
 
 
+def _rerun_lines(stderr: str) -> list[str]:
+    """Lines of the Rerun SDK's native logger (``... ERROR re_log_encoding::...: ... (os error 28)``)."""
+    return [line for line in stderr.splitlines() if "re_log_encoding" in line or "os error" in line
+            or "re_sdk" in line]
+
+
 @pytest.mark.slow
-def test_a_recording_that_hits_a_full_disk_is_one_line_exit_2(tmp_path: Path) -> None:
-    """A session whose planner.rrd outgrows the disk (60 kB files): the facts are written,
-    then ``error: RUN/planner.rrd: cannot write (...)`` is the last line (after the Rerun
-    SDK's own report of the failed write, with the system's reason), exit 2, no traceback."""
+def test_a_recording_that_outgrows_the_file_size_limit_is_one_line_exit_2(tmp_path: Path) -> None:
+    """A session whose planner.rrd outgrows the limit on file sizes (60 kB): the facts are
+    written, then ``error: RUN/planner.rrd: cannot write (File too large: ...)`` is the last
+    line, without the Rerun SDK's own report of the failed write; exit 2, no traceback."""
     run = tmp_path / "run"
     done = run_with_file_limit([sys.executable, "-m", CLI_MODULE, "session", "--backend", "truth", "--out", str(run)],
                                limit=60_000, timeout=120)
     assert done.returncode == 2, done.stderr
-    assert done.stderr.splitlines()[-1].startswith(f"error: {run / 'planner.rrd'}: cannot write ("), done.stderr
-    assert "Traceback" not in done.stderr
+    assert done.stderr.splitlines()[-1].startswith(
+        f"error: {run / 'planner.rrd'}: cannot write (File too large: files are limited to 60000 bytes"), done.stderr
+    assert "Traceback" not in done.stderr and not _rerun_lines(done.stderr), done.stderr
     assert (run / "learned.lp").is_file()
+
+
+def _private_tmpfs_works() -> bool:
+    """Whether this process may mount a tmpfs in a mount namespace of its own (root, or
+    CAP_SYS_ADMIN, and ``unshare`` from util-linux)."""
+    if shutil.which("unshare") is None:
+        return False
+    probe = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c",
+                            "mount -t tmpfs -o size=64k tmpfs /mnt"], capture_output=True, timeout=30, check=False)
+    return probe.returncode == 0
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not _private_tmpfs_works(), reason="cannot mount a tmpfs in a private mount namespace "
+                    "(needs root or CAP_SYS_ADMIN and util-linux's unshare)")
+def test_a_recording_on_a_full_filesystem_is_one_line_exit_2(tmp_path: Path) -> None:
+    """A session on a real filesystem that fills up (a 128 KiB tmpfs, mounted in a mount
+    namespace of the child's own, gone with it): its last line is ``error:
+    RUN/planner.rrd: cannot write (No space left on device; ...)``, and no line of the
+    Rerun SDK's native logger ("os error 28") shows; exit 2, no traceback."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    run = disk / "run"
+    mount = 'mount -t tmpfs -o size=128k tmpfs "$0" && exec "$@"'
+    done = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c", mount, str(disk),
+                           sys.executable, "-m", CLI_MODULE, "session", "--backend", "truth", "--out", str(run)],
+                          cwd=ROOT, env=child_env(), capture_output=True, text=True, timeout=120, check=False)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.splitlines()[-1].startswith(
+        f"error: {run / 'planner.rrd'}: cannot write (No space left on device; "), done.stderr
+    assert "Traceback" not in done.stderr and not _rerun_lines(done.stderr), done.stderr
+    assert list(disk.iterdir()) == []  # the session wrote into the tmpfs, not into the folder below it

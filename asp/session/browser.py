@@ -81,9 +81,16 @@ class Browser:
         """The page as PNG bytes."""
         return base64.b64decode(self.command("Page.captureScreenshot", format="png")["data"])
 
-    def evaluate(self, expression: str) -> Any:
-        """The value of a JavaScript ``expression`` in the page."""
-        return self.command("Runtime.evaluate", expression=expression, returnByValue=True)["result"].get("value")
+    def evaluate(self, expression: str, await_promise: bool = False) -> Any:
+        """The value of a JavaScript ``expression`` in the page (``await_promise``: the value
+        the promise it gives resolves to); PlannerError naming the exception it throws."""
+        answer = self.command("Runtime.evaluate", expression=expression, returnByValue=True,
+                              awaitPromise=await_promise)
+        if "exceptionDetails" in answer:
+            details = answer["exceptionDetails"]
+            raise PlannerError(f"chromium: {expression[:60]}: "
+                               f"{details.get('exception', {}).get('description', details.get('text'))}")
+        return answer["result"].get("value")
 
     def command(self, method: str, **params: Any) -> dict[str, Any]:
         """Send one protocol command (to the page once :meth:`open` attached) and wait for

@@ -12,11 +12,14 @@ one line per entity path with its row count, timelines and components (``--json`
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
 free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
 picture of every tab, rendered by the web viewer in a headless Chromium
-(:mod:`assembly_constraints.asp.session.screenshot`). A RUN without ``.rrd`` files is an error (exit code 2).
+(:mod:`assembly_constraints.asp.session.screenshot`), at the end of the recording and, for each ``--at
+TIMELINE=VALUE`` (``experiment=1``), paused at that time. A RUN without ``.rrd`` files is
+an error (exit code 2).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import shutil
@@ -30,7 +33,7 @@ from assembly_constraints.asp import PlannerError
 from assembly_constraints.bridge.cli_types import ArgumentParser
 
 if TYPE_CHECKING:
-    from assembly_constraints.bridge.recording.layout import Contents
+    from assembly_constraints.bridge.recording.layout import Contents, TimePoint
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -68,6 +71,16 @@ def write_blueprint(folder: Path, contents: Contents) -> Path:
     return path
 
 
+def _time_point(text: str) -> TimePoint:
+    """``--at``'s value as a :class:`assembly_constraints.bridge.recording.layout.TimePoint`."""
+    from assembly_constraints.bridge.recording.layout import TimePoint
+
+    try:
+        return TimePoint.parse(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def main(argv: Sequence[str]) -> int:
     parser = ArgumentParser(prog="view", description=__doc__.split("\n\n")[0])
     parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
@@ -76,6 +89,9 @@ def main(argv: Sequence[str]) -> int:
     parser.add_argument("--screenshot", type=Path, metavar="DIR",
                         help="render every tab in a headless Chromium (Rerun's web viewer), write DIR/<k>-<tab>.png; "
                              "needs chromium on PATH, takes a few minutes")
+    parser.add_argument("--at", type=_time_point, action="append", default=[], metavar="TIMELINE=VALUE",
+                        help="with --screenshot: also picture every tab paused at this time (experiment=1, "
+                             "sim_time=2.5 [s]); repeatable")
     parser.add_argument("--web", action="store_true",
                         help="serve the recording to a web browser (for headless machines); the address to open "
                              "is printed, Ctrl-C stops")
@@ -88,11 +104,18 @@ def main(argv: Sequence[str]) -> int:
     files = recording_files(run)
     summary = read_recording(files)
     contents = Contents.of(summary.entities)
+    if args.at and not args.screenshot:
+        parser.error("--at: only with --screenshot DIR")
+    timelines = set().union(*(entity.timelines for entity in summary.entities.values()))
+    for point in args.at:
+        if point.timeline not in timelines:
+            raise PlannerError(f"--at {point}: {run} has no timeline {point.timeline!r}; "
+                               f"it has {', '.join(sorted(timelines)) or 'none'}")
     if args.screenshot:
         from assembly_constraints.asp.session.screenshot import take_screenshots
 
         recording_id = min(summary.recording_ids, default="view")
-        for picture in take_screenshots(files, contents, recording_id, args.screenshot):
+        for picture in take_screenshots(files, contents, recording_id, args.screenshot, args.at):
             print(picture)
         return 0
     if args.print or args.json or not (has_display() or args.web):

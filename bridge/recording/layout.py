@@ -3,8 +3,8 @@
 Planner and cells log into one recording id of application :data:`APPLICATION_ID`, the
 planner under ``planner/...``, cell ``<id>`` under ``executor/<id>/...``. A blueprint is
 made for what a recording holds (:class:`Contents`): the planner's tab when the planner
-logged, one tab per cell that logged more than an assembly, one assembly tab per cell that
-executed a plan, nothing else.
+logged, one tab per cell that logged more than its scene and an assembly, one assembly tab
+per cell that executed a plan, nothing else.
 
 Rerun 0.41 has one time panel for the whole viewer: its timeline (``TimePanel(timeline=)``)
 is the x axis of every plot and the time of every other view; no view or tab has a
@@ -21,13 +21,19 @@ A blueprint cannot set the time the viewer opens at (the time panel has no curso
 Opened paused, the viewer sits at the start of the timeline, where the planner has logged
 nothing yet; so the blueprints follow the newest data (``play_state="following"``): a
 finished recording opens at its end (the last experiment's knowledge, the whole plots),
-a live one keeps up with it.
+a live one keeps up with it. A running viewer's cursor is moved through Rerun's viewer
+control instead (:class:`TimePoint`, ``view --screenshot --at``).
+
+A view's ``time_ranges`` and per-entity overrides do take effect: the cell's 3D view
+draws the tool tip over the last :data:`TRAIL_S` of each timeline, a trail of the
+recent tool path behind the tip, while every other entity is drawn at the cursor.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Literal
 
 import rerun.blueprint as rrb
 
@@ -37,10 +43,55 @@ SESSION_TIMELINE = "log_time"
 """Wall-clock timeline [ns since the epoch] every time-varying entity of a session carries."""
 SIM_TIMELINE = "sim_time"
 """A cell's simulated time [s], increasing across its attempts."""
+TIMELINE_KINDS = {"experiment": "sequence", "plan_step": "sequence", "execution": "sequence",
+                  SIM_TIMELINE: "duration", SESSION_TIMELINE: "timestamp"}
+"""Every timeline the planner and the cells log on, and its kind: ``sequence`` (a count),
+``duration`` [s] or ``timestamp`` [s since the epoch]."""
+TRAIL_S = 1.0
+"""Length of the tool tip's trail in the cell's 3D view [s of sim time, or of wall time on ``log_time``]."""
 
 CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
 the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
+
+
+@dataclass(frozen=True)
+class TimePoint:
+    """A time on one of :data:`TIMELINE_KINDS`: ``value`` a count (sequence), or seconds
+    (duration, timestamp since the epoch)."""
+
+    timeline: str
+    value: float
+
+    @classmethod
+    def parse(cls, text: str) -> TimePoint:
+        """``TIMELINE=VALUE`` (``experiment=1``, ``sim_time=2.5``); ValueError saying what is
+        expected otherwise."""
+        timeline, equals, value = text.partition("=")
+        kind = TIMELINE_KINDS.get(timeline.strip())
+        if not equals or kind is None:
+            raise ValueError(f"{text!r}: expected TIMELINE=VALUE with TIMELINE one of {', '.join(TIMELINE_KINDS)}")
+        try:
+            number = int(value) if kind == "sequence" else float(value)
+        except ValueError:
+            expected = "a whole number" if kind == "sequence" else "a number of seconds"
+            raise ValueError(f"{text!r}: {timeline.strip()} is a {kind} timeline, expected {expected}") from None
+        if number < 0 or number != number or number in (float("inf"), float("-inf")):
+            raise ValueError(f"{text!r}: expected a finite time >= 0")
+        return cls(timeline.strip(), number)
+
+    @property
+    def kind(self) -> str:
+        """``sequence``, ``duration`` or ``timestamp`` (:data:`TIMELINE_KINDS`)."""
+        return TIMELINE_KINDS[self.timeline]
+
+    @property
+    def viewer_time(self) -> int:
+        """The time as the viewer counts it: the sequence number, else nanoseconds."""
+        return int(self.value) if self.kind == "sequence" else round(self.value * 1e9)
+
+    def __str__(self) -> str:
+        return f"{self.timeline}={self.value:g}"
 
 
 def cell_root(cell_id: str) -> str:
@@ -63,7 +114,8 @@ def fig17_path(cell_id: str, attempt: str) -> str:
 class Contents:
     """What a recording holds, as far as its blueprint is concerned.
 
-    ``planner``: the planner logged (a session); ``cells``: cells that logged anything but an assembly;
+    ``planner``: the planner logged (a session); ``cells``: cells that logged more than their
+    static scene and an assembly (attempts, or a truth cell's outcomes);
     ``assembly_cells``: cells that executed a plan; ``fig17``: ``(cell, attempt)`` pairs,
     the attempt (``<outcome>/<key>``, :func:`fig17_path`) whose Fig. 17 plot the cell's tab
     shows (every attempt's when the cell has none here).
@@ -85,7 +137,7 @@ class Contents:
         each cell's Fig. 17 shows its first fitting attempt, else its first attempt."""
         paths = sorted(p.strip("/") for p in entity_paths)
         cells = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and p.count("/") >= 2
-                        and p.split("/")[2] != "assembly"})
+                        and p.split("/")[2] not in ("assembly", "scene")})
         assembly = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and "/assembly/" in p})
         chosen = []
         for cell in cells:
@@ -142,11 +194,22 @@ def _plot(origin: str, name: str, legend: bool = True) -> rrb.TimeSeriesView:
                               plot_legend=rrb.PlotLegend(corner="LeftTop", visible=legend))
 
 
+def _trail() -> rrb.VisibleTimeRanges:
+    """The last :data:`TRAIL_S` up to the cursor, on the cell's timelines that advance with
+    its steps (``sim_time``, ``log_time``); the whole experiment on ``experiment``."""
+    recent = [rrb.VisibleTimeRange(timeline, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-TRAIL_S),
+                                   end=rrb.TimeRangeBoundary.cursor_relative())
+              for timeline in (SIM_TIMELINE, SESSION_TIMELINE)]
+    experiment = rrb.VisibleTimeRange("experiment", start=rrb.TimeRangeBoundary.cursor_relative(),
+                                      end=rrb.TimeRangeBoundary.cursor_relative())
+    return rrb.VisibleTimeRanges([*recent, experiment])
+
+
 def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
-    """A cell's tab: the 3D cell (arm, scene, tool path and force, search path) above the
-    Fig. 17 plot of attempt ``fig17`` (``<outcome>/<key>``, :func:`fig17_path`; None:
-    every attempt) and
-    the outcome log; force, torque and the deviations of eqs. 6 and 7 per attempt."""
+    """A cell's tab: the 3D cell (arm, scene, tool tip with its trail (:func:`_trail`) and
+    force, the attempt's tool path, search path) above the Fig. 17 plot of attempt ``fig17``
+    (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) and the outcome log;
+    force, torque and the deviations of eqs. 6 and 7 per attempt."""
     root = cell_root(cell_id)
     attempt = fig17.replace("/", " ") if fig17 else "every attempt"
     return rrb.Horizontal(
@@ -154,7 +217,7 @@ def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
             rrb.Spatial3DView(
                 origin=root, name=f"{cell_id}: cell",
                 contents=["$origin/scene/**", "$origin/arm/**", "$origin/tool/**", "$origin/search/**"],
-                eye_controls=CELL_EYE,
+                eye_controls=CELL_EYE, overrides={f"/{root}/tool/tip": _trail()},
             ),
             rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
                               name=f"Fig. 17 {attempt}: F_des (pale), F_mes [N] over DMP phase 0..1"),
@@ -194,10 +257,12 @@ def tab_names(contents: Contents) -> list[str]:
             *(f"{cell} assembly" for cell in contents.assembly_cells)]
 
 
-def blueprint(contents: Contents, active_tab: int = 0) -> rrb.Blueprint:
+def blueprint(contents: Contents, active_tab: int = 0, play_state: Literal["following", "paused"] = "following",
+              timeline: str | None = None) -> rrb.Blueprint:
     """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
     an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
-    :attr:`Contents.timeline`, following the newest data."""
+    ``timeline`` (default :attr:`Contents.timeline`), following the newest data
+    (``play_state="paused"``: the cursor stays where it is)."""
     chosen = dict(contents.fig17)
     tabs = [
         *([planner_views()] if contents.planner else []),
@@ -205,6 +270,7 @@ def blueprint(contents: Contents, active_tab: int = 0) -> rrb.Blueprint:
         *(assembly_views(cell) for cell in contents.assembly_cells),
     ]
     return rrb.Blueprint(
-        rrb.Tabs(*tabs, active_tab=active_tab), rrb.TimePanel(timeline=contents.timeline, play_state="following"),
+        rrb.Tabs(*tabs, active_tab=active_tab),
+        rrb.TimePanel(timeline=timeline or contents.timeline, play_state=play_state),
         collapse_panels=False,
     )

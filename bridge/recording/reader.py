@@ -186,14 +186,16 @@ def column_values(
 @dataclass
 class ViewSummary:
     """One view of a blueprint: its class (``Spatial3DView``, ``TimeSeriesView``, ...),
-    display name, origin (without the leading ``/``), contents queries and the view's
-    properties by archetype (``{"EyeControls3D": {"position": [...], ...}}``)."""
+    display name, origin (without the leading ``/``), contents queries, the view's
+    properties by archetype (``{"EyeControls3D": {"position": [...], ...}}``) and its
+    per-entity overrides by entity path (``{"executor/c1/tool/tip": {"VisibleTimeRanges:ranges": [...]}}``)."""
 
     kind: str = ""
     name: str = ""
     origin: str = ""
     contents: list[str] = field(default_factory=list)
     properties: dict[str, dict[str, Any]] = field(default_factory=dict)
+    overrides: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 @dataclass
@@ -229,6 +231,9 @@ def read_blueprint(path: Path | str) -> BlueprintSummary:
                 view.kind = _single(row.get("ViewBlueprint:class_identifier"))
                 view.name = _single(row.get("ViewBlueprint:display_name"))
                 view.origin = str(_single(row.get(_VIEW_ORIGIN)) or "").strip("/")
+            elif parts[2:4] == ["ViewContents", "overrides"]:
+                entity = "/".join(parts[4:-1] if parts[-1] == "visualizers" else parts[4:])
+                view.overrides.setdefault(entity, {}).update({n: _single(v) for n, v in row.items()})
             elif parts[2] == "ViewContents":
                 view.contents = list(row.get("ViewContents:query") or [])
             else:

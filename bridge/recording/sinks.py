@@ -19,12 +19,15 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import logging
 import os
+import resource
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -99,16 +102,40 @@ def open_stream(application_id: str, recording_id: str, rrd_path: Path | None,
 
 def finish_stream(recording: rr.RecordingStream, rrd_path: Path | None) -> None:
     """Flush ``recording`` and disconnect it (finishes its file). BridgeError ``<rrd>:
-    cannot write (...)`` when Rerun's file writer stopped before (a full disk, ``ulimit
-    -f``: the SDK does not say which), instead of the SDK's RuntimeError."""
+    cannot write (<reason>; ...)`` when Rerun's file writer stopped before, instead of the
+    SDK's RuntimeError, which does not say why: the reason is what :func:`write_failure`
+    finds now."""
     try:
         recording.flush()
     except RuntimeError as exc:
         with _stderr_silenced():  # the SDK logs the dead sink once more when it is replaced
             recording.memory_recording()
-        raise BridgeError(f"{rrd_path}: cannot write (the recording's file writer stopped: {exc}; "
-                          "a full disk?)") from None
+        reason = write_failure(rrd_path) if rrd_path is not None else ""
+        raise BridgeError(f"{rrd_path}: cannot write ({reason + '; ' if reason else ''}"
+                          f"the recording's file writer stopped: {exc})") from None
     recording.disconnect()
+
+
+PROBE_BYTES = 4096
+"""Size of the block :func:`write_failure` writes to find out whether the disk is full [bytes]."""
+
+
+def write_failure(path: Path) -> str:
+    """Why ``path`` cannot grow now, as the system says it: what writing and syncing
+    :data:`PROBE_BYTES` to a temporary file beside it fails with (``No space left on
+    device``), else ``File too large`` with the process's file size limit when one is set
+    (``ulimit -f``); "" when neither applies."""
+    try:
+        with tempfile.TemporaryFile(dir=path.parent) as probe:
+            probe.write(bytes(PROBE_BYTES))
+            probe.flush()
+            os.fsync(probe.fileno())
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    if limit != resource.RLIM_INFINITY:
+        return f"{os.strerror(errno.EFBIG)}: files are limited to {limit} bytes (ulimit -f)"
+    return ""
 
 
 @contextmanager

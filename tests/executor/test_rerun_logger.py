@@ -17,7 +17,7 @@ from assembly_constraints.bridge.recording.reader import (
     read_recording,
 )
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.rerun_log import AttemptLogger
+from assembly_constraints.executor.rerun_log import TIP_RADIUS_M, AttemptLogger
 from assembly_constraints.executor.rerun_plots import WIDTH
 
 
@@ -100,6 +100,8 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert column_values(rrd, deviation, "SeriesLines:names") == [["p1→r1 s8 a1 fit"]]
     wall = column_values(rrd, "executor/c1/tool/tip", "log_time")
     assert all(b >= a for a, b in zip(wall, wall[1:]))
+    radii = [radius for row in column_values(rrd, "executor/c1/tool/tip", "Points3D:radii") for radius in row]
+    assert len(radii) == len(times) and radii == pytest.approx([TIP_RADIUS_M] * len(times))  # the trail's points
 
     # Fig. 17: a 2D plot per attempt, x the DMP phase 0..1 (WIDTH units), the search left out.
     by_phase = summary.under("executor/c1/by_phase")

@@ -10,8 +10,9 @@ import pytest
 from rerun.chunk import RrdReader
 
 from assembly_constraints.asp.session.view import write_blueprint
-from assembly_constraints.bridge.recording.layout import Contents, tab_names
+from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names
 from assembly_constraints.bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
+from assembly_constraints.executor.evidence import AttemptEvidence
 from assembly_constraints.executor.rerun_log import AttemptLogger
 
 
@@ -25,6 +26,9 @@ def _run_folder(folder: Path) -> Path:
         for k in range(20):
             logger.log_step(0.01 * k, k / 19, np.array([0.6, 0.0, 0.2]), np.zeros(3), np.zeros(3),
                             np.zeros(3), np.zeros(3))
+        logger.end_attempt(AttemptEvidence(outcome="fit", max_force_dev=0.0, max_torque_dev=0.0, end_error=0.0,
+                                           duration_s=0.2, sim_time_s=0.19, jammed=False, wiggles=0,
+                                           phase_reached=1.0))
         logger.close()
     return folder
 
@@ -56,7 +60,8 @@ def test_view_without_recording_exits_2(tmp_path: Path, run_cli) -> None:
 def test_blueprint_has_a_tab_per_cell_of_a_real_recording(tmp_path: Path) -> None:
     run = _run_folder(tmp_path / "run")
     contents = Contents.of(read_recording(sorted(run.glob("*.rrd"))).entities)
-    assert contents == Contents(cells=("c1", "c2"))  # no planner, no assembly, no insertion
+    assert contents == Contents(cells=("c1", "c2"), fig17=(("c1", "fit/e0001_p1_r1_s3_a1"),
+                                                            ("c2", "fit/e0001_p1_r1_s3_a1")))  # no planner, no assembly
     blueprint = write_blueprint(run, contents)
     stores = RrdReader(blueprint).blueprints()
     assert [s.application_id for s in stores] == ["assembly_constraints"]
@@ -72,18 +77,57 @@ def test_blueprint_has_a_tab_per_cell_of_a_real_recording(tmp_path: Path) -> Non
 def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> None:
     attempts = "/executor/c1/by_phase/{}/measured"
     paths = ["/planner/knowledge", "/executor/c1/outcome", "/executor/c1/assembly/force", "/executor/c2/outcome",
+             "/executor/a1/scene/plate", "/executor/a1/assembly/force",  # a1 only assembled: no cell tab
              attempts.format("no_fit/e0001_p3_r1_s0_a1"), attempts.format("fit/e0003_p1_r1_s0_a1"),
              attempts.format("fit/e0002_p2_r2_s0_a1"), "/executor"]
     contents = Contents.of(paths)
-    assert contents == Contents(planner=True, cells=("c1", "c2"), assembly_cells=("c1",),
+    assert contents == Contents(planner=True, cells=("c1", "c2"), assembly_cells=("a1", "c1"),
                                 fig17=(("c1", "fit/e0002_p2_r2_s0_a1"),))
     layout = read_blueprint(write_blueprint(tmp_path, contents))
-    assert layout.tabs == ["planner", "c1", "c2", "c1 assembly"] == tab_names(contents)
+    assert layout.tabs == ["planner", "c1", "c2", "a1 assembly", "c1 assembly"] == tab_names(contents)
     assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
     fig17 = [v for v in layout.views if v.origin == "executor/c1/by_phase"]
     assert fig17[0].contents == ["$origin/fit/e0002_p2_r2_s0_a1/**"] and "e0002_p2_r2_s0_a1" in fig17[0].name
     spatial = [v for v in layout.views if v.kind == "3D"]
-    assert {v.origin for v in spatial} == {"executor/c1", "executor/c2", "executor/c1/assembly"}
+    assert {v.origin for v in spatial} == {"executor/c1", "executor/c2", "executor/a1/assembly", "executor/c1/assembly"}
     assert all("$origin/arm/**" in v.contents and "EyeControls3D" in v.properties for v in spatial)
+    for cell in ("c1", "c2"):  # the tool tip's trail: the last TRAIL_S up to the cursor, the whole experiment
+        cell_view = next(v for v in spatial if v.origin == f"executor/{cell}")
+        ranges = {r["timeline"]: r["range"] for r in cell_view.overrides[f"executor/{cell}/tool/tip"][
+            "VisibleTimeRanges:ranges"]}
+        second = round(TRAIL_S * 1e9)
+        assert ranges == {"sim_time": {"start": -second, "end": 0}, "log_time": {"start": -second, "end": 0},
+                          "experiment": {"start": 0, "end": 0}}
+        assert set(cell_view.overrides) == {f"executor/{cell}/tool/tip"}
     assert {"planner/knowledge", "planner/knowledge_table", "planner/precedence"} <= blueprint_origins(
         tmp_path / "view.rbl")
+
+
+@pytest.mark.parametrize(("text", "point", "viewer_time"), [
+    ("experiment=1", TimePoint("experiment", 1), 1), ("sim_time=2.5", TimePoint("sim_time", 2.5), 2_500_000_000),
+    ("log_time=1764633600", TimePoint("log_time", 1764633600), 1764633600 * 10**9)])
+def test_a_time_point_is_parsed_with_its_timeline_kind(text: str, point: TimePoint, viewer_time: int) -> None:
+    assert TimePoint.parse(text) == point and point.viewer_time == viewer_time
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("experiment", "expected TIMELINE=VALUE"), ("frame=3", "expected TIMELINE=VALUE"),
+    ("experiment=1.5", "sequence timeline, expected a whole number"), ("sim_time=x", "a number of seconds"),
+    ("sim_time=-1", "finite time >= 0"), ("sim_time=nan", "finite time >= 0")])
+def test_a_bad_time_point_says_what_is_expected(text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        TimePoint.parse(text)
+
+
+@pytest.mark.slow
+def test_view_at_needs_a_timeline_of_the_recording(tmp_path: Path, run_cli) -> None:
+    run = _run_folder(tmp_path / "run")
+    missing = run_cli("view", str(run), "--screenshot", str(tmp_path / "shots"), "--at", "plan_step=1")
+    assert missing.returncode == 2 and missing.stderr.splitlines() == [
+        f"error: --at plan_step=1: {run} has no timeline 'plan_step'; it has experiment, log_time, sim_time"]
+    malformed = run_cli("view", str(run), "--at", "experiment=first")
+    assert malformed.returncode == 2
+    assert "experiment is a sequence timeline, expected a whole number" in malformed.stderr
+    alone = run_cli("view", str(run), "--at", "experiment=1")
+    assert alone.returncode == 2 and "--at: only with --screenshot DIR" in alone.stderr
+    assert not (tmp_path / "shots").exists()

@@ -14,7 +14,7 @@ from PIL import Image
 
 from assembly_constraints.asp.session.browser import find_chromium
 from assembly_constraints.asp.session.screenshot import take_screenshots
-from assembly_constraints.bridge.recording.layout import Contents
+from assembly_constraints.bridge.recording.layout import Contents, TimePoint
 from assembly_constraints.bridge.recording.reader import read_recording
 from assembly_constraints.executor.rerun_log import AttemptLogger
 
@@ -29,21 +29,23 @@ def test_every_tab_is_rendered_and_not_blank(tmp_path: Path) -> None:
     rrd = tmp_path / "c1.rrd"
     logger = AttemptLogger("c1", recording_id="shots", rrd_path=rrd)
     logger.log_scene([("plate", "box", (0.1, 0.12, 0.0375), (0.59, 0.0, 0.0375), (0, 0, 0, 1), (150, 160, 175))])
-    logger.begin_attempt("p1", "r1", 1, 1)
-    for k in range(300):
-        phase = k / 299
-        logger.log_step(0.002 * k, phase, np.array([0.55, -0.06, 0.2 - 0.1 * phase]),
-                        np.array([0.0, 0.0, -10.0 * phase]), np.array([0.0, 0.0, -9.0 * phase]),
-                        np.zeros(3), np.zeros(3))
-    logger.end_attempt(_Fit())
+    for experiment, force in ((1, 10.0), (2, 40.0)):
+        logger.begin_attempt("p1", "r1", experiment, 1, experiment=experiment)
+        for k in range(300):
+            phase = k / 299
+            logger.log_step(0.002 * k, phase, np.array([0.55, -0.06, 0.2 - 0.1 * phase]),
+                            np.array([0.0, 0.0, -force * phase]), np.array([0.0, 0.0, -9.0 * phase]),
+                            np.zeros(3), np.zeros(3))
+        logger.end_attempt(_Fit())
     logger.close()
 
     contents = Contents.of(read_recording(rrd).entities)
-    pictures = take_screenshots([rrd], contents, "shots", tmp_path / "shots")
-    assert [p.name for p in pictures] == ["1-c1.png"]
-    pixels = np.asarray(Image.open(pictures[0]).convert("RGB"), dtype=np.float64)
-    assert pixels.shape[:2] == (1000, 1600)
-    assert pixels.std() > 10, "a blank picture"
+    pictures = take_screenshots([rrd], contents, "shots", tmp_path / "shots", at=[TimePoint("experiment", 1)])
+    assert [p.name for p in pictures] == ["1-c1.png", "1-c1-experiment-1.png"]
+    end, first = (np.asarray(Image.open(p).convert("RGB"), dtype=np.float64) for p in pictures)
+    assert end.shape[:2] == first.shape[:2] == (1000, 1600)
+    assert end.std() > 10 and first.std() > 10, "a blank picture"
+    assert np.abs(end - first).mean() > 1.0, "the picture at experiment 1 is the one at the end"
 
 
 class _Fit:
