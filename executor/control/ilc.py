@@ -79,13 +79,14 @@ class ExecutionLayer:
     stiff: bool
 
 
-LAYERS = {name: ExecutionLayer(name, *switches) for name, switches in zip(LAYER_NAMES, (
-    (False, False, False, False, True),
-    (True, False, False, False, False),
-    (True, True, False, False, False),
-    (True, True, True, False, False),
-    (True, True, True, True, False),
-), strict=True)}
+_POSITION, _ADMITTANCE_P, _ADMITTANCE_PI, _PI_PHASE_STOP, _FULL = LAYER_NAMES
+LAYERS = {layer.name: layer for layer in (
+    ExecutionLayer(_POSITION, admittance=False, integral=False, phase_stopping=False, ilc=False, stiff=True),
+    ExecutionLayer(_ADMITTANCE_P, admittance=True, integral=False, phase_stopping=False, ilc=False, stiff=False),
+    ExecutionLayer(_ADMITTANCE_PI, admittance=True, integral=True, phase_stopping=False, ilc=False, stiff=False),
+    ExecutionLayer(_PI_PHASE_STOP, admittance=True, integral=True, phase_stopping=True, ilc=False, stiff=False),
+    ExecutionLayer(_FULL, admittance=True, integral=True, phase_stopping=True, ilc=True, stiff=False),
+)}
 """The variants of the ablation, from the least to the whole layer."""
 
 
