@@ -47,7 +47,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "session": ("assembly_constraints.asp.session.cli", "the end-to-end learning session (planner + cells)"),
     "assemble": ("assembly_constraints.asp.assemble.cli",
                  "execute a plan in a simulated cell, monitored and re-planned"),
-    "view": ("assembly_constraints.asp.session.view", "open a session's Rerun recording"),
+    "view": ("assembly_constraints.asp.view.cli", "open a session's Rerun recording"),
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
     "executor": ("assembly_constraints.executor.cli",
                  "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),

@@ -11,18 +11,27 @@ demonstrations that support and contradict it; :func:`suspects` flags a demonstr
 that alone removes constraints all the others support; ``min_support=K`` in
 :func:`learn_must_precede` drops a constraint only when at least K demonstrations
 contradict it.
+
+A product imported from its CAD carries its geometric precedence
+(``geometric_precedence.lp``): :func:`learn_for_assembly` uses it as the prior the
+demonstrations refine, or alone where the product has none.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.demos import Demonstrations
-from assembly_constraints.asp.precedence.relation import Pair, Relation, close
+from assembly_constraints.asp.precedence.demos import Demonstrations, load_demos
+from assembly_constraints.asp.precedence.relation import Pair, Relation, close, load_relation
+from assembly_constraints.bridge.assembly import Assembly
+
+GEOMETRIC_PRIOR = "geometric_precedence.lp"
+"""The file of an assembly folder holding the precedence its geometry forces (``import``)."""
 
 
 def positions(sequences: Sequence[Sequence[str]], parts: Sequence[str]) -> np.ndarray:
@@ -144,3 +153,21 @@ def learn_with_prior(demos: Demonstrations, prior: Relation, source: str, min_su
         return aligned
     learned = learn_must_precede(demos, min_support)
     return close(Relation(demos.parts, learned.matrix | aligned.matrix), source=f"demonstrations and {source}")
+
+
+def learn_for_assembly(assembly: Assembly,
+                       demos_file: Path | None = None) -> tuple[Demonstrations, Relation, Path | None]:
+    """The demonstrations of ``assembly`` (``demos_file``, else its ``demos.txt``), the
+    must-precede relation learned from them and the geometric prior used, if any: with a
+    :data:`GEOMETRIC_PRIOR` file in the folder the demonstrations refine it
+    (:func:`learn_with_prior`; one that breaks it is an error naming its line), and
+    without demonstrations it alone is the relation."""
+    prior_file = assembly.file(GEOMETRIC_PRIOR) if assembly.has_file(GEOMETRIC_PRIOR) else None
+    if prior_file is None:
+        demos = load_demos(demos_file or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
+        return demos, learn_must_precede(demos), None
+    if demos_file is None and not assembly.has_file("demos.txt"):
+        demos = Demonstrations(tuple(assembly.part_ids), (), ())
+    else:
+        demos = load_demos(demos_file or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
+    return demos, learn_with_prior(demos, load_relation([prior_file]), str(prior_file)), prior_file

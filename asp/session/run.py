@@ -40,8 +40,8 @@ import zenoh
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.plans.assign import feasible_assignment, load_learned_facts
 from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
-from assembly_constraints.asp.precedence.demos import demo_facts, load_demos
-from assembly_constraints.asp.precedence.learn import learn_must_precede
+from assembly_constraints.asp.precedence.demos import demo_facts
+from assembly_constraints.asp.precedence.learn import learn_for_assembly
 from assembly_constraints.asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
 from assembly_constraints.asp.session.cells import CellProcess, cell_seed
 from assembly_constraints.asp.session.folder import RunLock, lock_run_folder
@@ -315,8 +315,9 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     assembly = load_assembly(record.assembly)
     parts, holes, truth, model = _sizes_domain(assembly, record.model)
     # Every input file is read before any cell starts: bad input fails fast.
-    demos = load_demos(record.demos or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
-    relation = learn_must_precede(demos)
+    demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
+    if prior is not None:
+        LOG.info("precedence: the geometric prior %s refined by %d demonstration(s)", prior, len(demos.sequences))
     learner = SizeLearner(parts, holes, record.policy, record.seed,
                           confirm=record.confirm, demonstrated=demos.placements(), model=model)
     required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from assembly_constraints.asp.session.view import write_blueprint
+from assembly_constraints.asp.view.cli import write_blueprint
 from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names
 from assembly_constraints.bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from assembly_constraints.executor.evidence import AttemptEvidence

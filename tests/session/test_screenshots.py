@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from assembly_constraints.asp.session.browser import find_chromium
-from assembly_constraints.asp.session.screenshot import take_screenshots
+from assembly_constraints.asp.view.browser import find_chromium
+from assembly_constraints.asp.view.screenshot import take_screenshots
 from assembly_constraints.bridge.recording.layout import Contents, TimePoint
 from assembly_constraints.bridge.recording.reader import read_recording
 from assembly_constraints.executor.rerun_log import AttemptLogger

@@ -11,7 +11,7 @@ from collections.abc import Callable
 import pytest
 from rerun.experimental import ViewerClient
 
-from assembly_constraints.asp.session.screenshot import set_time_request
+from assembly_constraints.asp.view.screenshot import set_time_request
 from assembly_constraints.bridge.recording.layout import TimePoint
 
 _PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n"

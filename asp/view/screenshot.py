@@ -1,7 +1,7 @@
 """``./run.sh view RUN --screenshot DIR [--at TIMELINE=VALUE]``: every tab of a recording pictured in a browser.
 
 The recording is served to Rerun's web viewer (:func:`assembly_constraints.bridge.recording.sinks.hosted_viewer`)
-and opened in a headless Chromium (:mod:`assembly_constraints.asp.session.browser`). The viewer needs tens of
+and opened in a headless Chromium (:mod:`assembly_constraints.asp.view.browser`). The viewer needs tens of
 seconds to load and render on a software rasteriser; the first picture is taken once two
 in a row, :data:`POLL_S` apart, are the same and the viewer's state has not changed
 between them (all data has arrived), later ones once two in a row are the same. Then,
@@ -31,7 +31,7 @@ from pathlib import Path
 import rerun as rr
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.browser import Browser, find_chromium
+from assembly_constraints.asp.view.browser import Browser, find_chromium
 from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, TimePoint, blueprint, tab_names
 from assembly_constraints.bridge.recording.sinks import Viewer, hosted_viewer
 
@@ -52,7 +52,7 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
                      at: Sequence[TimePoint] = ()) -> list[Path]:
     """Write one PNG per tab of ``contents``' blueprint into ``folder`` (created), at the end
     of the recording and paused at each of ``at``; PlannerError when there is no Chromium
-    (:data:`assembly_constraints.asp.session.browser.NAMES`), the page never settles or does not take the time."""
+    (:data:`assembly_constraints.asp.view.browser.NAMES`), the page never settles or does not take the time."""
     chromium = find_chromium()
     if chromium is None:
         raise PlannerError("--screenshot needs a Chromium on PATH (chromium, chromium-browser or google-chrome; "

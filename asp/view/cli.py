@@ -12,7 +12,7 @@ one line per entity path with its row count, timelines and components (``--json`
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
 free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
 picture of every tab, rendered by the web viewer in a headless Chromium
-(:mod:`assembly_constraints.asp.session.screenshot`), at the end of the recording and, for each ``--at
+(:mod:`assembly_constraints.asp.view.screenshot`), at the end of the recording and, for each ``--at
 TIMELINE=VALUE`` (``experiment=1``), paused at that time. A RUN without ``.rrd`` files is
 an error (exit code 2).
 """
@@ -112,7 +112,7 @@ def main(argv: Sequence[str]) -> int:
             raise PlannerError(f"--at {point}: {run} has no timeline {point.timeline!r}; "
                                f"it has {', '.join(sorted(timelines)) or 'none'}")
     if args.screenshot:
-        from assembly_constraints.asp.session.screenshot import take_screenshots
+        from assembly_constraints.asp.view.screenshot import take_screenshots
 
         recording_id = min(summary.recording_ids, default="view")
         for picture in take_screenshots(files, contents, recording_id, args.screenshot, args.at):
