@@ -78,3 +78,25 @@ def test_the_cad_prior_needs_its_file(tmp_path: Path, capsys: pytest.CaptureFixt
     assert "expected nominal_margin(Part,Hole,Micrometres) facts only" in capsys.readouterr().err
     assert main(["sizes", "learn", "--assembly", str(folder), "--tolerance", "0.001"]) == 2
     assert "--tolerance applies to --prior cad only" in capsys.readouterr().err
+
+
+def test_an_assembly_folder_s_own_geometric_precedence_is_the_session_s_prior(tmp_path: Path) -> None:
+    """:func:`learn_for_assembly` (what a session learns its precedence with): the folder's
+    ``geometric_precedence.lp`` alone without demonstrations, refined by its ``demos.txt``,
+    and a demonstration that breaks it refused naming its line."""
+    from assembly_constraints.asp import PlannerError
+    from assembly_constraints.asp.precedence.learn import GEOMETRIC_PRIOR, learn_for_assembly
+    from assembly_constraints.bridge.assembly import load_assembly
+
+    (tmp_path / GEOMETRIC_PRIOR).write_text(PRIOR)
+    (tmp_path / "assembly.toml").write_text("name = 't'\n" + "".join(
+        f"[parts.{p}]\nname = '{p}'\n" for p in ("base", "a", "b", "c")))
+    demos, alone, prior = learn_for_assembly(load_assembly(str(tmp_path)))
+    assert prior == tmp_path / GEOMETRIC_PRIOR and demos.sequences == ()
+    assert set(alone.pairs()) == {("base", "a"), ("base", "b"), ("base", "c"), ("a", "c")}
+    (tmp_path / "demos.txt").write_text("base a b c\nbase b a c\n")
+    _, refined, _ = learn_for_assembly(load_assembly(str(tmp_path)))
+    assert set(alone.pairs()) < set(refined.pairs()) and ("b", "c") in set(refined.pairs())
+    (tmp_path / "demos.txt").write_text("base a b c\nbase c a b\n")
+    with pytest.raises(PlannerError, match="demos.txt:2"):
+        learn_for_assembly(load_assembly(str(tmp_path)))
