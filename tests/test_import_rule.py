@@ -8,6 +8,7 @@ under ``TYPE_CHECKING`` alike, so a lazy import cannot hide a crossing or a cycl
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import networkx as nx
@@ -41,8 +42,10 @@ def side_of(name: str) -> str:
     return parts[0]
 
 
+@functools.cache
 def imports(root: Path, path: Path) -> list[tuple[int, str]]:
-    """(line, absolute module name) of every import of one file; relative ones are resolved."""
+    """(line, absolute module name) of every import of one file; relative ones are resolved
+    (parsed once per file for all the tests of the module)."""
     package = module_name(root, path).split(".")
     if path.name != "__init__.py":
         package = package[:-1]

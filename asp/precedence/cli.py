@@ -126,8 +126,11 @@ def _print_json(data: object) -> None:
 def _learn(args: argparse.Namespace) -> None:
     from assembly_constraints.asp.precedence.draw import draw_png, to_dot
     from assembly_constraints.asp.precedence.learn import learn_must_precede, pair_evidence, suspects
-    from assembly_constraints.bridge.files import write_atomic
+    from assembly_constraints.bridge.files import check_writable, write_atomic
 
+    for path in (args.out, args.dot, args.png):  # before the learning and the drawing
+        if path:
+            check_writable(path)
     prior = load_relation([args.prior]) if args.prior else None
     demos = _demonstrations(args, prior)
     if prior is None:

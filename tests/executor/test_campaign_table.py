@@ -129,6 +129,7 @@ def dying_runner() -> Any:
     return run
 
 
+@pytest.mark.slow
 def test_a_dead_worker_is_an_error_not_a_hang() -> None:
     with pytest.raises(ExecutorError, match="worker process died"):
         run_campaign(campaign_pairs()[:2], trials=1, seed=0, workers=2, factory=dying_runner)
@@ -143,6 +144,7 @@ def failing_runner() -> Any:
     return run
 
 
+@pytest.mark.slow
 def test_a_failing_trial_stops_the_campaign() -> None:
     with pytest.raises(ExecutorError, match="no demonstration"):
         run_campaign(campaign_pairs(), trials=40, seed=0, workers=2, factory=failing_runner)

@@ -43,6 +43,7 @@ def test_unwritable_rrd_is_one_line_exit_2(places: Path, run_executor, command: 
     assert sorted(p.name for p in places.iterdir()) == ["file", "folder"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, reason", [("file", "a file of that name exists"),
                                           ("file/plots", "Not a directory")])
 def test_campaign_plot_folder_is_checked_before_the_campaign(places: Path, run_executor, name: str,

@@ -28,6 +28,7 @@ def _log_attempts(rrd: Path) -> None:
     logger.close()
 
 
+@pytest.mark.slow
 def test_the_cell_logger_compacts_its_file_when_it_closes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     compacted = tmp_path / "compacted.rrd"
     _log_attempts(compacted)
