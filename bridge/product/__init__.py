@@ -11,7 +11,8 @@ same), then checks (:mod:`assembly_constraints.bridge.product.checks`) what one 
 between tables (a hole's position, a part's start, a ``demo_hole``, a cover's holes, a
 head's cover), a rect's size ``[a, b]`` with ``a >= b``, a chamfer inside its boss,
 bosses that do not overlap, a grasp shorter than the part, the shapes of
-``assembly.toml`` against the kinds of ``geometry.toml``.
+``assembly.toml`` against the kinds of ``geometry.toml``, a part's mesh against the
+digest of its file and its convex pieces against that mesh.
 
 Every failure is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a
 :class:`assembly_constraints.bridge.BridgeError`, exit 2). Units: lengths and positions [m], masses [kg],
@@ -32,6 +33,7 @@ from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.bridge.product.checks import check_assembly, check_geometry, check_grasp, fail, where
 from assembly_constraints.bridge.product.tables import (
+    CONVEX_HEADER,
     DEFAULT_COVER_CLEARANCE,
     ID_PATTERN,
     MAX_COORDINATE,
@@ -47,6 +49,7 @@ from assembly_constraints.bridge.product.tables import (
     HoleEntry,
     HoleShape,
     Id,
+    Mesh,
     PartEntry,
     PartShape,
     Plate,
@@ -55,10 +58,10 @@ from assembly_constraints.bridge.product.tables import (
     is_id,
 )
 
-__all__ = ["DEFAULT_COVER_CLEARANCE", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS", "AssemblyFile", "Base",
-           "Cover", "ExtraPart", "GeometryFile", "Gripper", "Head", "HoleEntry", "HoleShape", "PartEntry", "PartShape",
-           "Plate", "ProductDescription", "SizesTable", "check_grasp", "decode_toml_file", "is_id",
-           "load_product_description", "product_from_tables"]
+__all__ = ["CONVEX_HEADER", "DEFAULT_COVER_CLEARANCE", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS",
+           "AssemblyFile", "Base", "Cover", "ExtraPart", "GeometryFile", "Gripper", "Head", "HoleEntry", "HoleShape",
+           "Mesh", "PartEntry", "PartShape", "Plate", "ProductDescription", "SizesTable", "check_grasp",
+           "decode_toml_file", "is_id", "load_product_description", "product_from_tables"]
 
 _T = TypeVar("_T")
 # ---- reading and translating errors ----

@@ -1,25 +1,32 @@
 """The checks of a product description that one struct cannot make (:mod:`assembly_constraints.bridge.product`):
 references between tables, a rect's ``[a, b]``, a chamfer inside its boss, bosses that do
 not overlap, a grasp shorter than the part, the shapes of ``assembly.toml`` against the
-kinds of ``geometry.toml``, the base, covers and heads against the parts. Every failure
+kinds of ``geometry.toml``, the base, covers and heads against the parts, a part's mesh
+against its file (by SHA-256) and its convex pieces against that mesh. Every failure
 is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a BridgeError)."""
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Mapping
 from pathlib import Path
 
 from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.inputs import read_bytes, shorten
 from assembly_constraints.bridge.product.tables import (
+    CONVEX_HEADER,
     TOUCH_TOLERANCE,
     AssemblyFile,
     GeometryFile,
     Gripper,
     HoleShape,
+    Mesh,
     PartShape,
 )
+
+MAX_MESH_BYTES = 256 * 1024 * 1024
+"""The largest mesh file read [bytes] (256 MiB: a base tessellated to 1 µm)."""
 
 
 def where(table: str, key: str) -> str:
@@ -85,7 +92,7 @@ def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
 def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     """``geometry.toml`` (decoded) against itself and ``layout``: shape members, sections,
     chamfer, bosses, the product's grasp (with its own gripper), references, kinds, the
-    base, covers and heads."""
+    base, covers and heads, the meshes."""
     plate = geo.plate
     holes = _members(path, "hole_shapes", geo.hole_shapes)
     pegs = _members(path, "part_shapes", geo.part_shapes)
@@ -123,6 +130,42 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items() if p is not None}, turned)
     _check_kinds(path, geo, layout)
     _check_product(path, geo, layout, holes)
+    meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]
+    meshes.append(("base", None if geo.base is None else geo.base.mesh, False))
+    for table, mesh, moving in meshes:
+        if mesh is not None:
+            _check_mesh(path, table, mesh, moving)
+
+
+def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
+    """A part's ``mesh``: its ``file`` is there and has the stated ``sha256``; a moving
+    part has ``convex`` pieces made from that file as it is (their header names its
+    digest), the base none (it is a static concave mesh)."""
+    folder = path.parent
+    try:
+        digest = hashlib.sha256(read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)).hexdigest()
+    except BridgeError as exc:
+        raise BridgeError(f"{path}: [{table}] mesh.file: {exc}") from None
+    if digest != mesh.sha256:
+        raise fail(path, table, "mesh.sha256", f"the SHA-256 of {mesh.file} ({digest}: the file changed since "
+                   "geometry.toml was written; import the product again)", mesh.sha256)
+    if not moving:
+        if mesh.convex is not None:
+            raise fail(path, table, "mesh.convex", "no convex pieces (the base is simulated as its static concave "
+                       "mesh)", mesh.convex)
+        return
+    if mesh.convex is None:
+        raise BridgeError(f"{path}: [{table}] mesh.convex: expected the convex pieces of {mesh.file} (an .obj file "
+                          "in the folder; a moving part collides as them), got nothing (a required key)")
+    try:
+        text = read_bytes(folder / mesh.convex, "convex pieces file (OBJ)", limit=MAX_MESH_BYTES)
+    except BridgeError as exc:
+        raise BridgeError(f"{path}: [{table}] mesh.convex: {exc}") from None
+    first = text.split(b"\n", 1)[0].decode("utf-8", "replace").strip()
+    expected = CONVEX_HEADER.format(file=mesh.file, sha256=digest)
+    if first != expected:
+        raise fail(path, table, "mesh.convex", f"pieces made from {mesh.file} as it is (first line of "
+                   f"{mesh.convex} {expected!r}; stale pieces: import the product again)", first)
 
 
 def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]], turned: set[str]) -> None:

@@ -142,7 +142,8 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[part_shapes.<name>]``: pegs of one cross-section (the name is their skill's);
-    ``length`` [m], ``mass`` [kg], the hole its demonstration is taught in."""
+    ``length`` [m], ``mass`` [kg], the hole its demonstration is taught in, and ``mesh``
+    when they are simulated from their own mesh rather than as a cylinder or box."""
 
     parts: Ids
     kind: Kind
@@ -150,6 +151,31 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     length: Length
     mass: Mass
     demo_hole: Id
+    mesh: Mesh | None = None
+
+
+MESH_FILE_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*(/[A-Za-z0-9_-][A-Za-z0-9_.-]*)*\.obj$(?!\n)"
+"""A mesh file of a product: a relative path inside its assembly folder (no component
+starting with ``.``, so no ``..``), ending in ``.obj``."""
+MeshFile = Annotated[str, Meta(pattern=MESH_FILE_PATTERN, max_length=200, description="a path of an .obj file inside "
+                               "the assembly folder (relative, '/' between names, none starting with '.')")]
+Sha256 = Annotated[str, Meta(pattern=r"^[0-9a-f]{64}$(?!\n)", description="a SHA-256 digest (64 lower-case hex "
+                             "digits)")]
+CONVEX_HEADER = "# convex pieces of {file} sha256 {sha256}"
+"""The first line of a ``convex`` file: the mesh (its path and digest) it was made from."""
+
+
+class Mesh(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``mesh`` of a ``[part_shapes.<name>]`` or of the ``[base]``: the part simulated from
+    its own closed triangle mesh ``file`` (Wavefront OBJ, metres, in the part frame: a
+    peg's origin at the centre of its section at its bottom, z its axis upwards, x its
+    section's long side; the base's is the cell frame), the ``sha256`` of that file, and
+    for a moving part ``convex``: the convex pieces it collides as (one OBJ object each,
+    first line :data:`CONVEX_HEADER` naming the mesh they were made from)."""
+
+    file: MeshFile
+    sha256: Sha256
+    convex: MeshFile | None = None
 
 
 class ExtraPart(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
@@ -161,12 +187,14 @@ class ExtraPart(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 class Base(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[base]``: the part carrying the plate, where its ``base_center`` waits (``tray``
-    [m]), its grip point from ``base_center`` [m], its mass [kg]."""
+    [m]), its grip point from ``base_center`` [m], its mass [kg], and ``mesh`` when it is
+    simulated from its own mesh (a static concave one) rather than as the ``[plate]``."""
 
     part: Id
     tray: XY
     grip: OffsetXY
     mass: Annotated[float, Meta(gt=0.0, le=50.0, description="a number in (0, 50] kg")]
+    mesh: Mesh | None = None
 
 
 class Cover(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

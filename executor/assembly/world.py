@@ -102,9 +102,10 @@ class AssemblyWorld:
     def _build_pegs(self) -> None:
         grasp_depth = self.product.geometry.gripper.grasp_depth
         for pid, spec in sorted(self.product.pegs.items()):
+            # A mesh peg's inertia is its mesh's (in the URDF); PyBullet's own would be its pieces' box.
+            flags = pb.URDF_USE_IMPLICIT_CYLINDER | (pb.URDF_USE_INERTIA_FROM_FILE if spec.mesh is not None else 0)
             body = pb.loadURDF(str(self.product.geometry.assets / f"part_{spec.shape}.urdf"),
-                               basePosition=(*spec.start, 0.0), flags=pb.URDF_USE_IMPLICIT_CYLINDER,
-                               physicsClientId=self.client)
+                               basePosition=(*spec.start, 0.0), flags=flags, physicsClientId=self.client)
             self.frames[pid] = PartFrames(body, np.array([0.0, 0.0, spec.length - grasp_depth]), np.zeros(3))
             self._tray[pid] = np.array([*spec.start, 0.0])
 

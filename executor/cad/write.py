@@ -9,10 +9,11 @@
   section in each hole's, the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly, the input of ``precedence learn --prior`` and ``precedence count``;
-- ``geometry.toml``: the simulated cell's primitives (plate with bosses, pegs) when the
-  product is one (every part but the base a peg standing in a hole along +z, the holes'
-  entries at one height with one depth) and the cell's loader accepts it; left out
-  otherwise, and the report says why.
+- ``geometry.toml``: the simulated cell's product when every part but the base is a peg
+  standing in a hole along +z and the holes' entries are at one height with one depth
+  (and the cell's loader accepts it; left out otherwise, and the report says why): the
+  plate and pegs as primitives where they are ones, else as their own meshes with convex
+  pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,14 @@ import networkx as nx
 
 from assembly_constraints.bridge.errors import ToolError
 from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.product import Mesh
+from assembly_constraints.executor.cad.convex import (
+    MESH_FOLDER,
+    base_is_primitive,
+    peg_frame,
+    peg_is_primitive,
+    write_mesh,
+)
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
 from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
 
@@ -160,8 +169,31 @@ def simulable(derived: Derived) -> str | None:
     return None
 
 
-def geometry_text(derived: Derived, settings: Settings) -> str:
-    """``geometry.toml`` of a :func:`simulable` product."""
+def _mesh_entry(mesh: Mesh) -> str:
+    convex = "" if mesh.convex is None else f', convex = "{mesh.convex}"'
+    return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
+
+
+def write_meshes(derived: Derived, out: Path) -> tuple[dict[str, Mesh], list[Path]]:
+    """The meshes of the parts of a :func:`simulable` product that are no primitive,
+    written into ``out`` (the base in the cell frame, a peg in its part frame); returns
+    their ``mesh`` entries by part and the files written."""
+    meshes: dict[str, Mesh] = {}
+    written: list[Path] = []
+    if not base_is_primitive(derived):
+        meshes[derived.base], files = write_mesh(out, derived.base, derived.parts[derived.base].mesh, moving=False)
+        written += files
+    for pid, fit in sorted(derived.hole_of.items()):
+        mesh = derived.parts[pid].mesh
+        if not peg_is_primitive(fit, mesh):
+            meshes[pid], files = write_mesh(out, pid, mesh.copy().apply_transform(peg_frame(fit, mesh)), moving=True)
+            written += files
+    return meshes, written
+
+
+def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh]) -> str:
+    """``geometry.toml`` of a :func:`simulable` product, the parts in ``meshes`` as their
+    own meshes."""
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
@@ -185,11 +217,12 @@ def geometry_text(derived: Derived, settings: Settings) -> str:
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', f'kind = "{peg.kind}"',
                   f"size = {_size(peg.kind, peg.a, peg.b)}",
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
-                  f'demo_hole = "{fit.id}"', ""]
+                  f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
               "[base]", f'part = "{derived.base}"',
               f"tray = [{_q(settings.trays[derived.base][0])}, {_q(settings.trays[derived.base][1])}]",
-              "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}", ""]
+              "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}",
+              *([_mesh_entry(meshes[derived.base])] if derived.base in meshes else []), ""]
     return "\n".join(lines)
 
 
@@ -216,13 +249,18 @@ def write_folder(derived: Derived, settings: Settings, title: str, out: Path) ->
     if geometry.exists():
         geometry.unlink()
     why = simulable(derived)
+    mesh_files: list[Path] = []
     if why is None:
-        write_atomic(geometry, geometry_text(derived, settings))
+        meshes, mesh_files = write_meshes(derived, out)
+        write_atomic(geometry, geometry_text(derived, settings, meshes))
         try:
             load_geometry(str(out))
         except ToolError as exc:
             geometry.unlink()
-            why = f"the cell refuses its primitives ({exc})"
+            why = f"the cell refuses its geometry ({exc})"
         else:
-            written.append(geometry)
+            written += [*mesh_files, geometry]
+    for stale in sorted((out / MESH_FOLDER).glob("*.obj")):  # meshes of an earlier import, or of a refused one
+        if why is not None or stale not in mesh_files:
+            stale.unlink()
     return written, why

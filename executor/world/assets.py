@@ -1,14 +1,16 @@
 """Generated assets that follow their sources.
 
-``<assembly>/assets/`` (plate mesh, part URDFs) is generated from ``geometry.toml`` and
-``assembly.toml`` by :func:`assembly_constraints.executor.world.geometry.write_assets`. The folder records the
+``<assembly>/assets/`` (plate mesh, part URDFs, a mesh part's eroded convex pieces) is
+generated from ``geometry.toml`` and ``assembly.toml`` by
+:func:`assembly_constraints.executor.world.geometry.write_assets`. The folder records the
 SHA-256 of the values it was made from (``assets/sources.sha256``: the ``[plate]`` table,
-every hole and part as loaded, as canonical JSON; comments and the keys the assets do
-not use leave it unchanged), written after the assets, so an interrupted regeneration is
-regenerated again. :func:`current_assets`, called before a cell loads any asset,
-regenerates the folder when a generated file is missing or the digest differs: an edited
-hole is never simulated with its old mesh. When the folder cannot be written (a
-read-only install), the error names the file.
+every hole and part as loaded, as canonical JSON, a part's or the base's ``mesh`` with the
+digest of its file; comments and the keys the assets do not use leave it unchanged),
+written after the assets, so an interrupted regeneration is regenerated again.
+:func:`current_assets`, called before a cell loads any asset, regenerates the folder
+when a generated file is missing or the digest differs: an edited hole is never simulated
+with its old mesh. When the folder cannot be written (a read-only install), the error
+names the file.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ import msgspec
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.files import write_atomic
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.world.geometry import CellGeometry, write_assets
+from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, convex_asset_name, write_assets
 
 STAMP = "sources.sha256"
 
@@ -33,16 +35,28 @@ logger = logging.getLogger(__name__)
 
 def sources_digest(geometry: CellGeometry) -> str:
     """Hex SHA-256 of the canonical JSON of what the assets are generated from: the
-    ``[plate]`` table and every hole and part (their dataclass fields). The values come
-    from decimal text, so the digest is the same on every machine."""
-    inputs = {"plate": msgspec.structs.asdict(geometry.plate),
-              "holes": [dataclasses.asdict(h) for _, h in sorted(geometry.holes.items())],
-              "parts": [dataclasses.asdict(p) for _, p in sorted(geometry.parts.items())]}
+    ``[plate]`` table, every hole and part (their dataclass fields; a part's ``mesh`` and
+    the base's only where there is one, so a product of primitives keeps its digest). The
+    values come from decimal text, and a mesh is named by its file's SHA-256 (the loader
+    checked it), so the digest is the same on every machine and in every folder."""
+    inputs: dict[str, object] = {"plate": msgspec.structs.asdict(geometry.plate),
+                                 "holes": [dataclasses.asdict(h) for _, h in sorted(geometry.holes.items())],
+                                 "parts": [_part_fields(p) for _, p in sorted(geometry.parts.items())]}
+    base = geometry.tables.base
+    if base is not None and base.mesh is not None:
+        inputs["base_mesh"] = msgspec.structs.asdict(base.mesh)
     return hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()
 
 
+def _part_fields(part: PartSpec) -> dict[str, object]:
+    fields = {key: value for key, value in dataclasses.asdict(part).items() if key != "mesh"}
+    return fields if part.mesh is None else fields | {"mesh": msgspec.structs.asdict(part.mesh)}
+
+
 def _generated_names(geometry: CellGeometry) -> list[str]:
-    return ["plate.obj", *sorted({f"part_{p.shape}.urdf" for p in geometry.parts.values()})]
+    shapes = {p.shape: p for p in geometry.parts.values()}
+    return ["plate.obj", *sorted(f"part_{s}.urdf" for s in shapes),
+            *sorted(convex_asset_name(p) for p in shapes.values() if p.mesh is not None)]
 
 
 def regenerate_assets(geometry: CellGeometry) -> list[Path]:

@@ -7,7 +7,9 @@ through hole (the plate under the boss is its bottom) and a 45° entry chamfer; 
 holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square and
 rectangular holes exact; a hole with a yaw has its whole boss turned by it about the
 hole's centre.  Parts are exact primitive shapes (cylinder with
-``URDF_USE_IMPLICIT_CYLINDER``, box).
+``URDF_USE_IMPLICIT_CYLINDER``, box), or, with a ``mesh``, their own mesh colliding as its
+convex pieces (:mod:`assembly_constraints.executor.world.meshes`); a base with a ``mesh``
+is that mesh as a static concave triangle mesh instead of the plate.
 
 Cross-sections (``kind``): ``round`` (``size`` = diameter), ``square`` (``size`` = side)
 and ``rect`` (``size = [a, b]``, a ≥ b: the long side a along the part's or hole's x
@@ -34,6 +36,7 @@ from assembly_constraints.bridge.product import (
     GeometryFile,
     Gripper,
     HoleShape,
+    Mesh,
     PartShape,
     Plate,
     check_grasp,
@@ -41,6 +44,7 @@ from assembly_constraints.bridge.product import (
 )
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cell_description import CellDescription
+from assembly_constraints.executor.world.meshes import MeshInertia, eroded_pieces_text, mesh_inertia
 
 
 @dataclass(frozen=True)
@@ -72,13 +76,15 @@ class HoleSpec(Section):
 class PartSpec(Section):
     """A graspable part of shape ``shape`` (its skill's name): ``length`` [m], ``mass`` [kg],
     ``start`` on the tray [m], ``demo_hole`` where its shape's skill is taught (a rect
-    part's long side is along the tool's x axis when held)."""
+    part's long side is along the tool's x axis when held), ``mesh`` when it is simulated
+    from its own mesh (paths inside the assembly folder)."""
 
     shape: str
     length: float
     mass: float
     start: tuple[float, float]
     demo_hole: str
+    mesh: Mesh | None = field(default=None, kw_only=True)
 
 
 @dataclass(frozen=True)
@@ -99,6 +105,12 @@ class CellGeometry:
     @property
     def assets(self) -> Path:
         return self.folder / "assets"
+
+    @property
+    def base_mesh(self) -> Path | None:
+        """The base's own mesh file (the cell frame [m]) when it is simulated from it, else None."""
+        base = self.tables.base
+        return None if base is None or base.mesh is None else self.folder / base.mesh.file
 
 
 def load_geometry(assembly: str = "cranfield", description: CellDescription | None = None) -> CellGeometry:
@@ -145,7 +157,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             x, y = starts[pid]
             parts[pid] = PartSpec(
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
-                start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width,
+                start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
             )
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
@@ -282,8 +294,46 @@ def plate_obj_text(geometry: CellGeometry) -> str:
     return "\n".join(lines) + "\n"
 
 
-def part_geometry_xml(part: PartSpec, z_centre: float, rgba: str) -> str:
-    """URDF ``<visual>`` + ``<collision>`` of a part whose axis is z, centred at ``z_centre`` [m]."""
+@dataclass(frozen=True)
+class MeshFiles:
+    """A mesh part in a URDF: its ``visual`` mesh and the ``collision`` asset (its eroded
+    convex pieces), as the URDF names them, and its mass properties."""
+
+    visual: str
+    collision: str
+    inertia: MeshInertia
+
+
+def convex_asset_name(part: PartSpec) -> str:
+    """The file name in ``assets/`` of a mesh part shape's eroded convex pieces."""
+    return f"part_{part.shape}.convex.obj"
+
+
+def mesh_files(geometry: CellGeometry, part: PartSpec, *, absolute: bool) -> MeshFiles | None:
+    """The files of a mesh part (None for a primitive one): relative to ``assets/`` (a URDF
+    written there) or ``absolute`` (one written elsewhere)."""
+    if part.mesh is None:
+        return None
+    visual = geometry.folder / part.mesh.file
+    collision = geometry.assets / convex_asset_name(part)
+    names = (str(visual), str(collision)) if absolute else (f"../{part.mesh.file}", collision.name)
+    return MeshFiles(*names, mesh_inertia(visual, part.mass))
+
+
+_FLIP = np.diag([1.0, -1.0, -1.0])  # a half turn about x: the held part's frame, z pointing away from the arm
+
+
+def part_geometry_xml(part: PartSpec, z_centre: float, rgba: str, files: MeshFiles | None = None,
+                      flip: bool = False) -> str:
+    """URDF ``<visual>`` + ``<collision>`` of a part whose axis is z, centred at ``z_centre``
+    [m]; a mesh part's (``files``) at the link origin, turned half about x when ``flip``."""
+    if files is not None:
+        origin = f'<origin xyz="0 0 0" rpy="{np.pi if flip else 0.0:.15g} 0 0"/>'
+        return (
+            f'    <visual>{origin}<geometry><mesh filename="{files.visual}"/></geometry>'
+            f'<material name="part"><color rgba="{rgba}"/></material></visual>\n'
+            f'    <collision>{origin}<geometry><mesh filename="{files.collision}"/></geometry></collision>\n'
+        )
     if part.kind == "round":
         shape = f'<cylinder radius="{part.size / 2:.6f}" length="{part.length:.6f}"/>'
     else:
@@ -304,13 +354,35 @@ def _inertial_xml(mass: float, inertia: float, z: float) -> str:
     )
 
 
-def part_urdf_text(part: PartSpec) -> str:
-    """A free part lying on the tray (upright, frame at its bottom face centre)."""
+def _mesh_inertial_xml(inertia: MeshInertia, flip: bool) -> str:
+    """``<inertial>`` of a mesh part: its centre of mass and full inertia tensor, in the
+    link frame (turned half about x when ``flip``)."""
+    turn = _FLIP if flip else np.eye(3)
+    (x, y, z), i = turn @ inertia.com, turn @ inertia.inertia @ turn.T
+    return (
+        f'    <inertial><origin xyz="{x:.9g} {y:.9g} {z:.9g}" rpy="0 0 0"/><mass value="{inertia.mass:.9g}"/>'
+        f'<inertia ixx="{i[0, 0]:.9g}" ixy="{i[0, 1]:.9g}" ixz="{i[0, 2]:.9g}" iyy="{i[1, 1]:.9g}" '
+        f'iyz="{i[1, 2]:.9g}" izz="{i[2, 2]:.9g}"/></inertial>\n'
+    )
+
+
+def _part_link_xml(part: PartSpec, files: MeshFiles | None, held: bool) -> str:
+    """Inertial, visual and collision of a part upright on the tray (link frame at its
+    bottom face centre) or ``held`` (frame at its tip, z pointing away from the arm)."""
+    rgba = "0.8 0.6 0.2 1"
+    if files is not None:
+        return _mesh_inertial_xml(files.inertia, held) + part_geometry_xml(part, 0.0, rgba, files, held)
     inertia = part.mass * (part.size**2 + part.length**2) / 12
+    centre = -part.length / 2 if held else part.length / 2
+    return _inertial_xml(part.mass, inertia, centre) + part_geometry_xml(part, centre, rgba)
+
+
+def part_urdf_text(part: PartSpec, files: MeshFiles | None = None) -> str:
+    """A free part lying on the tray (upright, frame at its bottom face centre); a mesh
+    part needs its ``files`` (:func:`mesh_files`)."""
     return (
         f'<?xml version="1.0"?>\n<robot name="{part.shape}">\n  <link name="part">\n'
-        + _inertial_xml(part.mass, inertia, part.length / 2)
-        + part_geometry_xml(part, part.length / 2, "0.8 0.6 0.2 1")
+        + _part_link_xml(part, files, held=False)
         + "  </link>\n</robot>\n"
     )
 
@@ -319,19 +391,19 @@ def part_urdf_text(part: PartSpec) -> str:
 _FLANGE_OFFSET = 0.045
 
 
-def arm_urdf_text(part: PartSpec, gripper: Gripper) -> str:
+def arm_urdf_text(part: PartSpec, gripper: Gripper, files: MeshFiles | None = None) -> str:
     """The pybullet_data ``kuka_iiwa`` with a flange (realistic inertia) and the held part.
 
     Links appended after ``lbr_iiwa_link_7``: ``flange`` (fixed) and ``part`` (fixed joint
     ``ft_sensor``: the wrist force/torque sensor).  The ``part`` link frame is at the
     part's tip (the tool centre point), z along the part axis, pointing away from the arm.
-    Mesh paths point into the installed pybullet_data, so the text is written at run time.
+    Mesh paths point into the installed pybullet_data, so the text is written at run time;
+    a mesh part needs its ``files`` with absolute paths (:func:`mesh_files`).
     """
     source = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
     text = source.read_text().replace('filename="meshes/', f'filename="{source.parent}/meshes/')
     flange_len = gripper.flange_length
     tip = flange_len + part.length - gripper.grasp_depth
-    inertia = part.mass * (part.size**2 + part.length**2) / 12
     tool = (
         '  <joint name="flange_joint" type="fixed"><parent link="lbr_iiwa_link_7"/><child link="flange"/>'
         f'<origin xyz="0 0 {_FLANGE_OFFSET}" rpy="0 0 0"/></joint>\n'
@@ -344,20 +416,24 @@ def arm_urdf_text(part: PartSpec, gripper: Gripper) -> str:
         '  <joint name="ft_sensor" type="fixed"><parent link="flange"/><child link="part"/>'
         f'<origin xyz="0 0 {tip:.6f}" rpy="0 0 0"/></joint>\n'
         '  <link name="part">\n'
-        + _inertial_xml(part.mass, inertia, -part.length / 2)
-        + part_geometry_xml(part, -part.length / 2, "0.8 0.6 0.2 1")
+        + _part_link_xml(part, files, held=True)
         + "  </link>\n"
     )
     return text.replace("</robot>", tool + "</robot>")
 
 
 def write_assets(geometry: CellGeometry) -> list[Path]:
-    """(Re)generate ``assets/plate.obj`` and ``assets/part_<shape>.urdf`` (each written
-    atomically, so a cell starting meanwhile never loads half a file); returns the paths."""
+    """(Re)generate ``assets/plate.obj``, ``assets/part_<shape>.urdf`` and, for a mesh part
+    shape, its eroded convex pieces (each written atomically, so a cell starting meanwhile
+    never loads half a file); returns the paths."""
     make_folder(geometry.assets)
     written = [write_atomic(geometry.assets / "plate.obj", plate_obj_text(geometry))]
     for shape in sorted({p.shape for p in geometry.parts.values()}):
         part = next(p for p in geometry.parts.values() if p.shape == shape)
-        written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part)))
+        if part.mesh is not None and part.mesh.convex is not None:
+            written.append(write_atomic(geometry.assets / convex_asset_name(part),
+                                        eroded_pieces_text(geometry.folder / part.mesh.convex, f"part '{part.id}'")))
+        files = mesh_files(geometry, part, absolute=False)
+        written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part, files)))
     return written
 

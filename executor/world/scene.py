@@ -20,7 +20,7 @@ from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.world import TIME_STEP
 from assembly_constraints.executor.world.arm import yaw_quat
 from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text
+from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -71,7 +71,7 @@ class Scene:
         part = next(p for _, p in sorted(geometry.parts.items()) if p.shape == shape)
         with tempfile.TemporaryDirectory(prefix="executor-arm-") as tmp:
             urdf = Path(tmp) / f"arm_{shape}.urdf"
-            urdf.write_text(arm_urdf_text(part, geometry.gripper))
+            urdf.write_text(arm_urdf_text(part, geometry.gripper, mesh_files(geometry, part, absolute=True)))
             self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
                                      flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                                      physicsClientId=self.client)
@@ -112,7 +112,17 @@ def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,
                deck: Sequence[tuple[float, float, float, float]] = ()) -> int:
     """Static plate: a box under the bosses plus the concave trimesh of the bosses, and
     optionally ``deck`` boxes ([xmin, ymin, xmax, ymax] [m]) filling the space between the
-    bosses up to the plate top (a flat top for parts lying on the plate)."""
+    bosses up to the plate top (a flat top for parts lying on the plate); a base with its
+    own mesh is that mesh alone, a static concave trimesh in the cell frame (no deck
+    needed: its top is its own)."""
+    base_mesh = geometry.base_mesh
+    if base_mesh is not None:
+        col = pb.createCollisionShape(pb.GEOM_MESH, fileName=str(base_mesh), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+                                      physicsClientId=client)
+        vis = pb.createVisualShape(pb.GEOM_MESH, fileName=str(base_mesh), rgbaColor=(0.7, 0.72, 0.75, 1),
+                                   physicsClientId=client)
+        return pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                                  physicsClientId=client)
     plate = geometry.plate
     boss_bottom = plate.top_z - plate.tile_thickness
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center

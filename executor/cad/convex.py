@@ -1,0 +1,103 @@
+"""Parts the simulated cell builds from their own meshes, decided and written at import.
+
+A peg is a **primitive** when its mesh's volume is within :data:`PRIMITIVE_TOLERANCE` of
+the prism of its cross-section over its length (a cylinder or a box: the cell builds it
+as one); the base is one when its volume is within that of its bounding box less its
+holes (cross-section times depth: the cell's plate). Any other part is written as its
+own mesh (``meshes/<id>.obj``, Wavefront OBJ [m]): a peg in its part frame (origin at the
+centre of its section at its bottom, z up its axis, x along its section's long side),
+the base in the cell frame. A moving part also gets its convex pieces
+(``meshes/<id>.convex.obj``, one OBJ object each, the first line naming the mesh and its
+SHA-256): its convex hull when the hull's volume is within :data:`CONVEX_TOLERANCE` of
+the mesh's, else a convex decomposition by CoACD (seed 0, so an import is repeatable).
+The decomposition is made here, never when a cell starts.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import coacd
+import numpy as np
+import trimesh
+
+from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.product import CONVEX_HEADER, Mesh
+from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.world.meshes import obj_text
+
+PRIMITIVE_TOLERANCE = 0.01
+"""A part is the primitive its sections describe when their volumes differ by less than
+this fraction of the part's."""
+CONVEX_TOLERANCE = 1e-3
+"""A part is convex (one piece, its hull) when its hull is larger by less than this fraction."""
+DECOMPOSITION_THRESHOLD = 0.05
+"""CoACD's concavity threshold (its default): the largest concavity left in a piece,
+relative to the part's size."""
+MESH_FOLDER = "meshes"
+
+
+def _area(kind: str, a: float, b: float) -> float:
+    """The area [m²] of a section: round of diameter a, square of side a, rect a × b."""
+    return math.pi * a * a / 4 if kind == "round" else a * (a if kind == "square" else b)
+
+
+def _is_close(volume: float, primitive: float) -> bool:
+    return abs(volume - primitive) < PRIMITIVE_TOLERANCE * volume
+
+
+def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
+    """Whether the peg in ``fit`` is the prism of its section over its length along z."""
+    assert fit.section is not None  # a peg has a section
+    section = fit.section
+    return _is_close(mesh.volume, _area(section.kind, section.a, section.b) * float(mesh.extents[2]))
+
+
+def base_is_primitive(derived: Derived) -> bool:
+    """Whether the base is its bounding box less its holes (each its section times its depth)."""
+    mesh = derived.parts[derived.base].mesh
+    holes = sum(_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
+    return _is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
+
+
+def peg_frame(fit: HoleFit, mesh: trimesh.Trimesh) -> np.ndarray:
+    """The 4 × 4 transform from the cell frame to the peg's part frame (module docstring)."""
+    assert fit.section is not None  # a peg has a section
+    x, y = fit.section.centre
+    yaw = math.radians(fit.section.yaw) if fit.section.kind != "round" else 0.0
+    turn = trimesh.transformations.rotation_matrix(-yaw, (0, 0, 1))
+    shift = trimesh.transformations.translation_matrix((-x, -y, -float(mesh.bounds[0][2])))
+    return turn @ shift
+
+
+def convex_pieces(mesh: trimesh.Trimesh) -> list[trimesh.Trimesh]:
+    """The convex pieces of a closed mesh: its hull when it is convex, else CoACD's."""
+    hull = mesh.convex_hull
+    if hull.volume < (1 + CONVEX_TOLERANCE) * mesh.volume:
+        return [hull]
+    coacd.set_log_level("error")
+    pieces = coacd.run_coacd(coacd.Mesh(mesh.vertices, mesh.faces), threshold=DECOMPOSITION_THRESHOLD, seed=0)
+    return [trimesh.Trimesh(vertices, faces) for vertices, faces in pieces]
+
+
+def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, moving: bool) -> tuple[Mesh, list[Path]]:
+    """Write ``mesh`` (already in its part frame [m]) as ``meshes/<pid>.obj`` in the
+    assembly ``folder`` and, for a ``moving`` part, its convex pieces; returns the
+    ``mesh`` entry of ``geometry.toml`` and the paths written."""
+    make_folder(folder / MESH_FOLDER)
+    name = f"{MESH_FOLDER}/{pid}.obj"
+    frame = "its part frame" if moving else "the cell frame"
+    text = obj_text([(pid, mesh.vertices, mesh.faces)], f"# {pid}: its closed mesh [m] in {frame}, by ./run.sh import")
+    written = [write_atomic(folder / name, text)]
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    if not moving:
+        return Mesh(file=name, sha256=digest), written
+    # The pieces of the mesh as written (0.1 µm), so that they are pieces of that file.
+    exact = trimesh.load(folder / name, force="mesh")
+    assert isinstance(exact, trimesh.Trimesh)  # the closed mesh just written
+    convex = f"{MESH_FOLDER}/{pid}.convex.obj"
+    pieces = [(f"{pid}_{k + 1}", piece.vertices, piece.faces) for k, piece in enumerate(convex_pieces(exact))]
+    written.append(write_atomic(folder / convex, obj_text(pieces, CONVEX_HEADER.format(file=name, sha256=digest))))
+    return Mesh(file=name, sha256=digest, convex=convex), written

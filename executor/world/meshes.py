@@ -1,0 +1,118 @@
+"""Parts simulated from their own meshes (a ``mesh`` of ``[part_shapes.*]`` or ``[base]``,
+docs/geometry.md): the OBJ files of their convex pieces, the pieces as the cell loads
+them, and mass and inertia from the mesh.
+
+A moving part collides as the convex pieces of its ``convex`` file (one OBJ object each,
+made at import time). PyBullet's URDF importer makes one convex hull of each object and
+inflates every hull by :data:`URDF_HULL_MARGIN` (measured: a 10 mm box rests 1.0 mm above
+the floor; ``changeDynamics(collisionMargin=...)`` does not reach a URDF link's hulls).
+So the generated asset is each piece eroded by that margin (its faces moved inwards),
+which the margin then adds back: the piece as it is, its edges rounded by 1 mm (as the
+cell's primitive shapes' edges act). A piece thinner than twice the margin has no eroded
+form and is refused. The base is a static concave triangle mesh (no margin).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from scipy.optimize import linprog
+from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
+
+from assembly_constraints.executor import ExecutorError
+
+URDF_HULL_MARGIN = 0.001
+"""How much PyBullet's URDF importer inflates each convex hull of a link [m]."""
+
+
+def obj_text(objects: Sequence[tuple[str, np.ndarray, np.ndarray]], header: str) -> str:
+    """Wavefront OBJ of named triangle meshes ``(name, vertices (n, 3) [m], faces (m, 3))``,
+    one ``o`` object each, after the comment line ``header``; vertices to 0.1 µm."""
+    lines = [header]
+    base = 1
+    for name, vertices, faces in objects:
+        lines.append(f"o {name}")
+        lines += [f"v {x:.7f} {y:.7f} {z:.7f}" for x, y, z in vertices]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces]
+        base += len(vertices)
+    return "\n".join(lines) + "\n"
+
+
+def read_objects(path: Path) -> list[np.ndarray]:
+    """The vertices [m] of each ``o`` object of an OBJ file (vertices before the first
+    ``o`` are an object of their own); ExecutorError naming the file and line."""
+    objects: list[list[list[float]]] = [[]]
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ExecutorError(f"{path}: cannot read the convex pieces ({exc})") from None
+    for number, line in enumerate(lines, 1):
+        words = line.split()
+        if words[:1] == ["o"]:
+            objects.append([])
+        elif words[:1] == ["v"]:
+            try:
+                objects[-1].append([float(w) for w in words[1:4]])
+            except ValueError:
+                raise ExecutorError(f"{path}:{number}: expected a vertex 'v x y z' in metres, got {line!r}") from None
+    pieces = [np.array(o) for o in objects if o]
+    if not pieces:
+        raise ExecutorError(f"{path}: no vertices; expected the convex pieces of a part, one OBJ object each")
+    return pieces
+
+
+def eroded(vertices: np.ndarray, margin: float) -> trimesh.Trimesh | None:
+    """The convex hull of ``vertices`` [m] with every face moved inwards by ``margin``
+    [m]; None when nothing is left (the hull is thinner than twice the margin)."""
+    try:
+        hull = ConvexHull(vertices)
+    except QhullError:
+        return None  # flat or degenerate: no volume to erode
+    normals, offsets = hull.equations[:, :3], hull.equations[:, 3] + margin  # inside: n.x + d <= 0
+    # The centre of the largest ball inside the eroded hull (Chebyshev centre): a strictly
+    # interior point for the intersection, and its radius says whether anything is left.
+    res = linprog(c=[0, 0, 0, -1], A_ub=np.hstack([normals, np.ones((len(normals), 1))]), b_ub=-offsets,
+                  bounds=[(None, None)] * 3 + [(0, None)])
+    if not res.success or res.x[3] <= 1e-7:
+        return None
+    corners = HalfspaceIntersection(np.hstack([normals, offsets[:, None]]), res.x[:3]).intersections
+    return trimesh.convex.convex_hull(corners)
+
+
+def eroded_pieces_text(convex: Path, what: str) -> str:
+    """The asset a URDF collides as: every piece of the ``convex`` file eroded by
+    :data:`URDF_HULL_MARGIN`; ExecutorError naming ``what`` (the part) and the piece when
+    one is too thin."""
+    objects = []
+    for k, vertices in enumerate(read_objects(convex)):
+        piece = eroded(vertices, URDF_HULL_MARGIN)
+        if piece is None:
+            raise ExecutorError(f"{convex}: convex piece {k + 1} of {what} is thinner than "
+                                f"{2000 * URDF_HULL_MARGIN:g} mm (the cell's hull margin twice); expected pieces "
+                                "the simulated cell can collide as")
+        objects.append((f"piece{k + 1}", piece.vertices, piece.faces))
+    return obj_text(objects, f"# generated from {convex.name}: each piece eroded by {URDF_HULL_MARGIN} m, "
+                             "the URDF hull margin that PyBullet adds back")
+
+
+@dataclass(frozen=True)
+class MeshInertia:
+    """A part's ``com`` [m] in its frame and ``inertia`` [kg m^2] about it (3 x 3, the
+    part frame's axes), for ``mass`` [kg] spread uniformly over its mesh."""
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+
+
+def mesh_inertia(path: Path, mass: float) -> MeshInertia:
+    """Centre of mass and inertia of the closed mesh in ``path`` [m] for ``mass`` [kg]."""
+    mesh = trimesh.load(path, force="mesh")
+    if not isinstance(mesh, trimesh.Trimesh) or not mesh.is_volume:
+        raise ExecutorError(f"{path}: not a closed mesh with a volume; expected the part's own closed mesh [m]")
+    mesh.density = mass / mesh.volume
+    return MeshInertia(mass, np.array(mesh.center_mass), np.array(mesh.moment_inertia))
