@@ -205,6 +205,8 @@ def _translated(path: Path, data: dict[str, Any], kind: type, message: str) -> B
     unknown = re.match(r"Object contains unknown field `(.+)`$", what)
     if unknown:
         parent = _unwrap(_info_at(root, segments))
+        if isinstance(parent, msgspec.inspect.UnionType):  # an optional table (``mesh``): its table's keys
+            parent = next((t for t in parent.types if isinstance(t, msgspec.inspect.StructType)), parent)
         keys = [f.encode_name for f in parent.fields] if isinstance(parent, msgspec.inspect.StructType) else []
         table, key = ".".join(map(str, segments)), unknown[1]
         return BridgeError(f"{path}: [{table}] {key}: unknown key; expected one of {', '.join(keys)}"
