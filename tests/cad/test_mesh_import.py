@@ -1,0 +1,101 @@
+"""``import`` writes a part that is no primitive as its own mesh (with convex pieces for a
+moving part) and keeps primitives where a part is one; a STEP product made with
+build123d holding a flanged peg and a base with a stop on it is imported, taught and
+assembled by ``assemble`` in the simulated cell within 2 mm."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from assembly_constraints.bridge.product import CONVEX_HEADER
+from assembly_constraints.cli import main
+from assembly_constraints.executor.world.geometry import load_geometry
+from assembly_constraints.executor.world.meshes import read_objects
+
+POSE_BOUND_MM = 2.0
+"""An assembled part is within this of its goal [mm] (the bar of the assembling cell)."""
+
+
+def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
+    mesh = trimesh.creation.box(extents)
+    mesh.apply_translation(centre)
+    return mesh
+
+
+def _plate(folder: Path, peg: trimesh.Trimesh) -> None:
+    """A 100 x 100 x 20 mm plate with a 10.5 mm square hole 15 mm deep and ``peg`` [mm]."""
+    folder.mkdir()
+    plate = trimesh.boolean.difference([_box((100, 100, 20), (0, 0, 0)), _box((10.5, 10.5, 15), (0, 0, 2.5 + 1e-3))],
+                                       engine="manifold")
+    plate.export(folder / "plate.stl")
+    peg.export(folder / "peg.stl")
+
+
+def test_a_primitive_peg_stays_a_primitive(tmp_path: Path) -> None:
+    _plate(tmp_path / "cad", _box((10, 10, 30), (0, 0, 10)))
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    geometry = load_geometry(str(tmp_path / "out"))
+    assert geometry.parts["peg"].mesh is None and geometry.base_mesh is None
+    assert not (tmp_path / "out" / "meshes").exists()
+
+
+@pytest.mark.slow
+def test_a_flanged_peg_is_its_own_mesh_and_its_convex_pieces(tmp_path: Path) -> None:
+    flanged = trimesh.boolean.union([_box((10, 10, 30), (0, 0, 10)), _box((16, 16, 4), (0, 0, 23))], engine="manifold")
+    _plate(tmp_path / "cad", flanged)
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    geometry = load_geometry(str(tmp_path / "out"))
+    mesh = geometry.parts["peg"].mesh
+    assert mesh is not None and mesh.convex is not None and geometry.base_mesh is None
+    assert geometry.parts["peg"].sides == pytest.approx((0.01, 0.01), abs=1e-6)  # the section in the hole
+    own = trimesh.load(tmp_path / "out" / mesh.file, force="mesh")
+    # The part frame: the section's centre at the peg's bottom, z up its axis.
+    assert np.allclose(own.bounds, [[-0.008, -0.008, 0.0], [0.008, 0.008, 0.030]], atol=1e-6), own.bounds
+    pieces = read_objects(tmp_path / "out" / mesh.convex)
+    assert len(pieces) >= 2  # not one convex hull: that would fill the space under the flange
+    header = (tmp_path / "out" / mesh.convex).read_text().splitlines()[0]
+    assert header == CONVEX_HEADER.format(file=mesh.file, sha256=mesh.sha256)
+
+
+MAKE_STEP = """from build123d import Axis, Box, Compound, Cylinder, Pos, chamfer, export_step
+plate = Box(100, 60, 20) - Pos(-20, 0, 2.5) * Cylinder(6.65, 15)
+top = plate.faces().sort_by(Axis.Z)[-1]
+plate = chamfer([edge for wire in top.inner_wires() for edge in wire.edges()], length=0.8)
+plate = plate + Pos(40, 0, 15) * Box(10, 60, 10)  # a stop on the plate: no longer the cell's plate
+at = Pos(550, 0, 10)  # [mm]: where the simulated arm reaches
+plate = at * plate
+peg = at * (Pos(-20, 0, 10) * Cylinder(6.0, 30) + Pos(-20, 0, 23) * Cylinder(10, 4))
+plate.label, peg.label = "plate", "flange peg"
+export_step(Compound(label="flange", children=[plate, peg]), {out!r})
+"""
+"""A 100 x 60 x 20 mm plate with a 13.3 mm round hole 15 mm deep (0.8 mm chamfer) and a
+10 mm stop, and a 12 mm peg with a 20 mm flange 4 mm thick on top, in the assembled pose."""
+
+
+@pytest.mark.slow
+def test_a_step_product_with_a_flanged_peg_is_assembled_in_the_simulated_cell(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    script = tmp_path / "make.py"
+    script.write_text(MAKE_STEP.format(out=str(tmp_path / "flange.step")))
+    subprocess.run([sys.executable, str(script)], check=True)
+    out = tmp_path / "flange"
+    assert main(["import", str(tmp_path / "flange.step"), "--out", str(out)]) == 0
+    assert "geometry.toml" in capsys.readouterr().out
+    geometry = load_geometry(str(out))
+    assert geometry.base_mesh == out / "meshes" / "plate.obj"  # the stop: no plate of primitives
+    assert geometry.parts["flange_peg"].mesh is not None
+    assert main(["-q", "executor", "teach", "--assembly", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["assemble", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
+                 "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["assembled"] is True
+    assert [step["part"] for step in result["steps"]] == ["plate", "flange_peg"]
+    assert result["final_pose_error_mm"]["flange_peg"] < POSE_BOUND_MM, result
