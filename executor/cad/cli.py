@@ -25,6 +25,7 @@ from pathlib import Path
 from assembly_constraints.bridge.cli_types import ArgumentParser
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.cad.convex import MESH_FOLDER
 from assembly_constraints.executor.cad.derive import Derived, derive
 from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
 from assembly_constraints.executor.cad.step import load_step
@@ -171,7 +172,10 @@ def main(argv: list[str]) -> int:
     print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(assumed))
     for line in report(derived):
         print(line)
+    meshes = sorted(p.name.removesuffix(".obj") for p in (args.out / MESH_FOLDER).glob("*.obj")
+                    if not p.name.endswith(".convex.obj"))
     print(f"wrote {args.out}: assembly.toml, sizes.lp, geometric_precedence.lp"
-          + (", geometry.toml" if why is None else f" (no geometry.toml: {why})"))
+          + (", geometry.toml" if why is None else f" (no geometry.toml: {why})")
+          + (f"; simulated from their own meshes ({MESH_FOLDER}/): {', '.join(meshes)}" if meshes else ""))
     print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {seconds:.2f} s")
     return 0

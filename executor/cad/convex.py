@@ -22,6 +22,7 @@ import hashlib
 import math
 from pathlib import Path
 
+import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print a symbol, std::bad_cast)
 import coacd
 import numpy as np
 import trimesh

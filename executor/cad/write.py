@@ -199,7 +199,8 @@ def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh])
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = fits[0].entry, fits[0].depth
     tile = _tile(fits)
-    lines = ["# The simulated cell's primitives measured from the CAD by ./run.sh import [m].", "",
+    lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
+             "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
              f"chamfer = {_q(max(MIN_CHAMFER, *(f.chamfer for f in fits)))}  # [m] at least MIN_CHAMFER",
              "polygon_sides = 24",

@@ -64,6 +64,16 @@ def test_a_flanged_peg_is_its_own_mesh_and_its_convex_pieces(tmp_path: Path) -> 
     assert header == CONVEX_HEADER.format(file=mesh.file, sha256=mesh.sha256)
 
 
+@pytest.mark.slow
+def test_clingo_still_prints_symbols_after_the_decomposition_is_loaded() -> None:
+    # CoACD's library loaded before clingo's makes printing a clingo symbol throw std::bad_cast.
+    code = ("import assembly_constraints.executor.cad.convex, clingo; "
+            "print(clingo.Function('a', [clingo.Number(1)]))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False,
+                          cwd=Path(__file__).resolve().parents[2])
+    assert (done.returncode, done.stdout.strip()) == (0, "a(1)"), done.stderr
+
+
 MAKE_STEP = """from build123d import Axis, Box, Compound, Cylinder, Pos, chamfer, export_step
 plate = Box(100, 60, 20) - Pos(-20, 0, 2.5) * Cylinder(6.65, 15)
 top = plate.faces().sort_by(Axis.Z)[-1]
