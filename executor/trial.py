@@ -94,7 +94,8 @@ class Cell:
         self.scene: Scene | None = None  # the client of the part in the hand
         if logger is not None:
             logger.log_scene(scene_shapes(self.geometry))
-            logger.log_scene_mesh("plate_mesh", current_assets(self.geometry) / "plate.obj", PLATE_MESH_COLOR)
+            plate_obj = current_assets(self.geometry) / "plate.obj"
+            logger.log_scene_mesh("plate_mesh", self.geometry.base_mesh or plate_obj, PLATE_MESH_COLOR)
 
     def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
                     cell_seed: int = 0) -> None:
