@@ -61,8 +61,13 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
     """The base as one solid: the plate's box from the floor to its top minus the cavities
     (the deck's axis-aligned square around each hole minus the boss mesh), the same solid
     as the cell's boss mesh, deck and box under them, without their shared faces. A turned
-    boss leaves the corners of its square open, as in the cell."""
+    boss leaves the corners of its square open, as in the cell. A base with its own mesh
+    is that mesh."""
     geometry = world.product.geometry
+    if geometry.base_mesh is not None:
+        own = trimesh.load(geometry.base_mesh, force="mesh")
+        assert isinstance(own, trimesh.Trimesh)  # the loader checked the file
+        return own
     plate = geometry.plate
     top, tile, depth = plate.top_z, plate.tile_size, plate.tile_thickness
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center

@@ -19,6 +19,7 @@ from assembly_constraints.bridge.product import CONVEX_HEADER
 from assembly_constraints.cli import main
 from assembly_constraints.executor.assembly.product import load_product
 from assembly_constraints.executor.assembly.world import AssemblyWorld
+from assembly_constraints.executor.cad.assembled import part_meshes
 from assembly_constraints.executor.cell_description import load_cell_description
 from assembly_constraints.executor.world.geometry import load_geometry
 from assembly_constraints.executor.world.meshes import obj_text
@@ -198,3 +199,17 @@ def test_mesh_parts_rest_where_they_should_in_the_cell(product: Path) -> None:
         assert abs(quat[3]) > np.cos(np.radians(1.0) / 2), quat  # tilted by less than 1 degree
     finally:
         world.close()
+
+
+@pytest.mark.slow
+def test_the_assembled_export_of_mesh_parts_is_their_meshes(product: Path) -> None:
+    """``executor export --assembled`` (the meshes import reads) gives a mesh base as its
+    mesh and a mesh peg as its mesh, placed in its hole."""
+    meshes, base, _, _ = part_meshes(str(product))
+    plate = trimesh.load(product / "meshes" / "plate.obj", force="mesh")
+    peg = trimesh.load(product / "meshes" / "peg.obj", force="mesh")
+    assert base == "plate"
+    assert meshes["plate"].volume == pytest.approx(plate.volume, rel=1e-9)
+    assert meshes["peg"].volume == pytest.approx(peg.volume, rel=1e-6)
+    assert np.allclose(meshes["peg"].bounds[0], [HOLE[0] - 0.008, HOLE[1] - 0.008, 0.005], atol=1e-6)
+
