@@ -208,7 +208,7 @@ def test_the_assembled_export_of_mesh_parts_is_their_meshes(product: Path) -> No
     meshes, base, _, _ = part_meshes(str(product))
     plate = trimesh.load(product / "meshes" / "plate.obj", force="mesh")
     peg = trimesh.load(product / "meshes" / "peg.obj", force="mesh")
-    assert base == "plate"
+    assert base == "plate" and isinstance(plate, trimesh.Trimesh) and isinstance(peg, trimesh.Trimesh)
     assert meshes["plate"].volume == pytest.approx(plate.volume, rel=1e-9)
     assert meshes["peg"].volume == pytest.approx(peg.volume, rel=1e-6)
     assert np.allclose(meshes["peg"].bounds[0], [HOLE[0] - 0.008, HOLE[1] - 0.008, 0.005], atol=1e-6)
