@@ -239,8 +239,9 @@ def _tile(fits: list[HoleFit]) -> float:
 
 
 def write_folder(derived: Derived, settings: Settings, title: str, out: Path) -> tuple[list[Path], str | None]:
-    """Write the files of the module docstring into ``out``; returns them and why there
-    is no ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
+    """Write the files of the module docstring into ``out`` (removing the ``meshes/*.obj``
+    an earlier import left that this one does not use); returns them and why there is no
+    ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
     make_folder(out)
     written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
