@@ -21,6 +21,7 @@ from assembly_constraints.executor.assembly.product import load_product
 from assembly_constraints.executor.assembly.world import AssemblyWorld
 from assembly_constraints.executor.cad.assembled import part_meshes
 from assembly_constraints.executor.cell_description import load_cell_description
+from assembly_constraints.executor.world.assets import sources_digest
 from assembly_constraints.executor.world.geometry import load_geometry
 from assembly_constraints.executor.world.meshes import obj_text
 
@@ -145,6 +146,20 @@ def test_stale_convex_pieces_are_refused(product: Path) -> None:
     message = _refusal(product)
     assert "[part_shapes.peg] mesh.convex: expected pieces made from meshes/peg.obj as it is" in message
     assert "stale pieces: import the product again" in message
+
+
+def test_the_generated_assets_follow_an_edited_mesh(product: Path) -> None:
+    """The mesh digests are among the assets' sources: a mesh edited (and its entry and
+    pieces made again) makes the assets stale, so the cell regenerates them."""
+    before = sources_digest(load_geometry(str(product)))
+    path = product / "meshes" / "peg.obj"
+    old = hashlib.sha256(path.read_bytes()).hexdigest()
+    path.write_text(path.read_text() + "# edited\n")
+    new = hashlib.sha256(path.read_bytes()).hexdigest()
+    _edit(product, old, new)
+    pieces = product / "meshes" / "peg.convex.obj"
+    pieces.write_text(pieces.read_text().replace(old, new, 1))
+    assert sources_digest(load_geometry(str(product))) != before
 
 
 @pytest.mark.parametrize(("old", "new", "expected"), [
