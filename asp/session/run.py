@@ -43,7 +43,7 @@ from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
 from assembly_constraints.asp.precedence.demos import demo_facts
 from assembly_constraints.asp.precedence.learn import learn_for_assembly
 from assembly_constraints.asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
-from assembly_constraints.asp.session.cells import CellProcess, cell_seed
+from assembly_constraints.asp.session.cells import CellProcess, cell_seed, stop_all
 from assembly_constraints.asp.session.folder import RunLock, lock_run_folder
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, Journal
 from assembly_constraints.asp.session.log import PlannerLog
@@ -340,7 +340,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         directory = CellDirectory(session)
         stack.callback(directory.close)
         cells: list[CellProcess] = []
-        stack.callback(lambda: [cell.stop() for cell in cells])
+        stack.callback(lambda: stop_all(cells))
         for number in range(1, settings.cells + 1):  # they start up in parallel with each other and us
             cells.append(CellProcess(session_cell(settings, record, run, number, listen[:1], viewer.connect)))
         log = PlannerLog(run / f"planner{suffix}.rrd", record.recording_id, cell_ids, viewer,
