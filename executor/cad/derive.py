@@ -28,8 +28,8 @@ import numpy as np
 import trimesh
 
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.parts import CadPart
-from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, frame_of, slice_loops
+from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart
+from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
 from assembly_constraints.executor.cad.sweep import DIRECTIONS, Sweeper
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
@@ -206,7 +206,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     through the base when there is none) and chamfer of the hole ``loop``."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
-    hole = classify(loop, hole=True)
+    hole = exact_round(classify(loop, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
     base_along = base.mesh.vertices @ axis
     radial = base.mesh.vertices @ frame.T - hole.centre
     entry = float(base_along[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)].max())
@@ -218,6 +218,8 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     if probe:
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
-    part, section = (None, None) if occupant is None else (occupant[0].id, classify(occupant[1], hole=False))
+    part, section = (None, None) if occupant is None else (
+        occupant[0].id, exact_round(classify(occupant[1], hole=False), occupant[0].cylinders, axis, level,
+                                    STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)
