@@ -102,6 +102,7 @@ def test_an_assembly_folder_s_own_geometric_precedence_is_the_session_s_prior(tm
         learn_for_assembly(load_assembly(str(tmp_path)))
 
 
+@pytest.mark.slow  # the first session command of a process imports the session's stack (zenoh, rerun)
 def test_a_session_refuses_a_tolerance_without_the_prior(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     folder = _sizes_folder(tmp_path)
     argv = ["session", "--backend", "truth", "--assembly", str(folder), "--out", str(tmp_path / "runs")]
