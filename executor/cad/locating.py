@@ -12,7 +12,9 @@ must-precede pair cannot say. Parts fixed to another move with it (one body: its
 members' locators together, less the members).
 
 This is a model of the process, not a consequence of the geometry: the straight paths
-stay free whatever the order (docs/import.md, Limits). A locating pair that contradicts
+stay free whatever the order, and the cell may well succeed (Cranfield's shaft through
+the pendulum placed first failed at one seed of three; docs/results.md). It errs to the
+safe side: a superfluous pair removes sequences, never admits one. A locating pair that contradicts
 the blocking precedence (the geometry forces the other order) is dropped and reported.
 """
 
