@@ -46,8 +46,8 @@ def _m(high: float, description: str) -> msgspec.Meta:
 
 
 class Magnitudes(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """The magnitudes of a simulated cell's uncertainty (the fields of
-    :class:`assembly_constraints.executor.world.perturbation.PerturbationModel`, whose defaults are these).
+    """The magnitudes of a simulated cell's uncertainty
+    (:mod:`assembly_constraints.executor.world.perturbation` draws the errors from them).
     Each field's description gives its unit; ``executor trial`` and friends offer one
     ``--<field>`` option per field."""
 
@@ -70,6 +70,10 @@ class Magnitudes(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_field
                                               "at most")] = 0.03
 
     def __post_init__(self) -> None:
+        # decoding checks each field's range; a struct built in code is checked here
+        for name in self.__struct_fields__:
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"{name} = {getattr(self, name)}: expected a number >= 0")
         if self.friction_min > self.friction_max:
             raise ValueError(f"friction_min {self.friction_min} > friction_max {self.friction_max}; "
                              "expected an ordered range")

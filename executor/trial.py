@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from assembly_constraints.bridge.cell_settings import CellSettings
+from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cell_description import CellDescription, load_cell_description
 from assembly_constraints.executor.control.controller import ImpedanceController
@@ -38,7 +38,7 @@ from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
 from assembly_constraints.executor.world.geometry import load_geometry
-from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor.world.perturbation import CellBias
 from assembly_constraints.executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
 
 if TYPE_CHECKING:
@@ -58,7 +58,7 @@ def cell_keywords(settings: CellSettings) -> dict[str, Any]:
     """Keyword arguments of :class:`Cell` from the cell settings, the cell description file
     they name read and checked here (BridgeError naming the file, table and key)."""
     description = None if settings.description is None else Path(settings.description)
-    return {"layer": settings.layer, "perturbation": PerturbationModel.of(settings.magnitudes),
+    return {"layer": settings.layer, "perturbation": settings.magnitudes,
             "cell_seed": settings.cell_seed, "description": load_cell_description(description)}
 
 
@@ -74,7 +74,7 @@ class Cell:
     admittance and ILC parameters (default :class:`CellDescription`)."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
+                 *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
                  cell_seed: int = 0, ilc_state: Path | None = None,
                  description: CellDescription | None = None) -> None:
         self.description = CellDescription() if description is None else description
@@ -97,12 +97,12 @@ class Cell:
             plate_obj = current_assets(self.geometry) / "plate.obj"
             logger.log_scene_mesh("plate_mesh", self.geometry.base_mesh or plate_obj, PLATE_MESH_COLOR)
 
-    def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: PerturbationModel | None = None,
+    def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
                     cell_seed: int = 0) -> None:
         """Become another cell on the same PyBullet clients: this execution layer, new
         systematic errors, the ILC corrections of ``ilc_state`` (if it exists) or none."""
         self.layer = layer_named(layer) if isinstance(layer, str) else layer
-        self.bias = CellBias(PerturbationModel() if perturbation is None else perturbation.check(), cell_seed)
+        self.bias = CellBias(Magnitudes() if perturbation is None else perturbation, cell_seed)
         d = self.description
         self.ilc = Ilc(d.ilc, d.gains, d.admittance)
         if self.ilc_state is not None:

@@ -45,7 +45,7 @@ import zenoh
 
 from assembly_constraints.asp import MAX_IDS, PlannerError
 from assembly_constraints.asp.bench.products import write_product
-from assembly_constraints.asp.session.cells import ROOT, start_cell
+from assembly_constraints.asp.session.cells import ROOT, start_cell, stop_all
 from assembly_constraints.asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
 from assembly_constraints.asp.session.settings import MAX_CELLS
@@ -155,8 +155,7 @@ def hosts_runs(count: int, policy: str, backend: str, delay_s: float) -> dict:
         try:
             namespaces = session_run(count, policy, backend, delay_s, hosts=hosts, client_config=client)
         finally:
-            for process in fleet:
-                process.stop()
+            stop_all(fleet)
     return {"hosts": count, "backend": backend, "delay_s": delay_s, "loopback": loopback, "namespaces": namespaces,
             "learning_ratio": round(namespaces["learning_s"] / loopback["learning_s"], 3)}
 

@@ -26,6 +26,10 @@ from assembly_constraints.bridge.cell_settings import ServeSettings, encode_sett
 from assembly_constraints.bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parents[2]
+
+STOP_S = 60.0
+"""How long [s] a stopped process may take to exit (a cell compacts its recording
+first) before it is killed."""
 """The folder holding the packages (the repository, or site-packages when installed): the
 cells get it on their PYTHONPATH and run in it."""
 
@@ -100,24 +104,37 @@ class LineProcess:
         with self._new:
             return next((line for line in reversed(self.lines) if line.strip()), None)
 
-    def stop(self, timeout: float = 60.0) -> int:
+    def stop(self, timeout: float = STOP_S) -> int:
         """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code. A cell
         compacts its recording before it exits (:mod:`assembly_constraints.bridge.recording.compaction`), which
         on a loaded machine takes tens of seconds; killed earlier, it leaves the file
         uncompacted."""
-        if self.popen.poll() is None:
-            self.popen.send_signal(signal.SIGTERM)
-            try:
-                return self.popen.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self.popen.kill()
-        return self.popen.wait(timeout)
+        return stop_all([self], timeout)[0]
 
     def kill(self) -> None:
         """SIGKILL (as a crash would)."""
         if self.popen.poll() is None:
             self.popen.kill()
         self.popen.wait(10.0)
+
+
+def stop_all(processes: Sequence[LineProcess], timeout: float = STOP_S) -> list[int]:
+    """:meth:`LineProcess.stop` for several processes at once: SIGTERM to every one
+    still running, then each waited for until ``timeout`` [s] after the signals (SIGKILL
+    then); their exit codes. They compact their recordings side by side instead of one
+    after the other."""
+    running = [p for p in processes if p.popen.poll() is None]
+    for process in running:
+        process.popen.send_signal(signal.SIGTERM)
+    deadline = time.monotonic() + timeout
+    codes = []
+    for process in processes:
+        try:
+            codes.append(process.popen.wait(max(0.0, deadline - time.monotonic())))
+        except subprocess.TimeoutExpired:
+            process.popen.kill()
+            codes.append(process.popen.wait(timeout))
+    return codes
 
 
 class CellProcess(LineProcess):

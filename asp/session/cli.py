@@ -22,9 +22,10 @@ from assembly_constraints.asp.session.settings import (
     MAX_PLANS,
     MAX_WAIT_S,
     SessionSettings,
+    prior_statement,
     read_session_file,
 )
-from assembly_constraints.asp.sizes.cli import add_model_option
+from assembly_constraints.asp.sizes.cli import add_model_option, add_prior_options, check_prior_options
 from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
 from assembly_constraints.asp.sizes.policies import policy_names
 from assembly_constraints.asp.solve import encoding
@@ -54,6 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="experiment selection policy (default best: fewest experiments)")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="seed of the policy and the trials")
     add_model_option(parser)
+    add_prior_options(parser)
     parser.add_argument("--confirm", type=int_in(0, MAX_CONFIRM), default=0, metavar="K",
                         help="re-test each essential experiment until its result leads by K+1 answers "
                              "(default 0: trust the cell's answer; see sizes learn --confirm)")
@@ -87,9 +89,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def session_settings(args: argparse.Namespace) -> SessionSettings:
-    """The settings the options of :func:`build_parser` give; the cells' first cell seed is ``--seed``."""
+    """The settings the options of :func:`build_parser` give; the cells' first cell seed is
+    ``--seed``. PlannerError for ``--tolerance`` without ``--prior cad``."""
+    check_prior_options(args)
     return SessionSettings(
         assembly=args.assembly, policy=args.policy, model=args.model, seed=args.seed, confirm=args.confirm,
+        size_prior=args.prior, tolerance_m=args.tolerance,
         demos=path_setting(args.demos), cell=cell_settings_of(args, cell_seed=args.seed), out=path_setting(args.out),
         resume=path_setting(args.resume), cells=args.cells, backend=args.backend, delay_s=args.delay,
         timeout_s=args.timeout, wait_for_cell_s=args.wait_for_cell, plans=args.plans,
@@ -130,6 +135,7 @@ def _summary(result: dict, run: Path) -> str:
         + (f" (started from {len(result['demonstrated'])} seen in the demonstrations)"
            if result["demonstrated"] else ""),
         f"assumes: {result['assumption']}",
+        *([] if settings.prior is UNSET or settings.prior is None else [f"assumes: {prior_statement(settings.prior)}"]),
         *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
         "assignment: " + " ".join(f"{p}->{h}" for p, h in settings.assignment.items()),

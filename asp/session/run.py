@@ -6,7 +6,8 @@ and cells over Zenoh, from its settings (:class:`assembly_constraints.asp.sessio
    starts from (paper 4.2, last paragraph);
 2. starts ``--cells N`` cell co-processes (``executor serve``) connected to the planner's
    loopback endpoint (``--cells 0 --connect EP`` uses cells already on the network);
-3. learns which part fits which hole, keeping every alive cell busy with experiments
+3. learns which part fits which hole (``--prior cad``: starting from the outcomes the
+   nominal sections of an imported product decide), keeping every alive cell busy with experiments
    none of whose outcomes can entail another's (:func:`_learn_sizes`,
    :mod:`assembly_constraints.asp.session.zenoh_oracle`); every finished experiment is journaled (fsynced) before
    the learner uses it;
@@ -43,21 +44,24 @@ from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
 from assembly_constraints.asp.precedence.demos import demo_facts
 from assembly_constraints.asp.precedence.learn import learn_for_assembly
 from assembly_constraints.asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
-from assembly_constraints.asp.session.cells import CellProcess, cell_seed
+from assembly_constraints.asp.session.cells import CellProcess, cell_seed, stop_all
 from assembly_constraints.asp.session.folder import RunLock, lock_run_folder
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, Journal
 from assembly_constraints.asp.session.log import PlannerLog
 from assembly_constraints.asp.session.settings import (
     MAX_STARTS,
     SESSION_FILE,
+    DecidedPrior,
     SessionFile,
     SessionSettings,
     checked,
     new_session_file,
+    prior_statement,
     read_session_file,
     write_session_file,
 )
 from assembly_constraints.asp.session.zenoh_oracle import Finished, ZenohOracle
+from assembly_constraints.asp.sizes.cad_prior import cad_prior
 from assembly_constraints.asp.sizes.learner import SizeLearner, SizeLearningResult
 from assembly_constraints.asp.sizes.models import SizeModel, model_for
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
@@ -72,7 +76,7 @@ from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, free_loopback_
 
 LOG = logging.getLogger(__name__)
 RESULT_KEYS = ("run", "experiments", "fits", "must_precede", "plans", "matches_truth", "model", "assumption",
-               "model_changes", "demonstrated")
+               "prior", "model_changes", "demonstrated")
 """What :func:`run_session` returns (``session --json``), in this order, as ``session.json`` holds them."""
 CRASH_WAIT_S = 2.0
 """How long the pool waits for a started cell's process to end when its links just closed
@@ -213,9 +217,11 @@ def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
     return list(dict.fromkeys(atoms))
 
 
-def _learned_header(assembly: Assembly, run: Path, sizes: SizeLearningResult) -> str:
-    """The comment atop ``learned.lp``: where it comes from, what it assumes, what its ids name."""
+def _learned_header(assembly: Assembly, run: Path, sizes: SizeLearningResult, prior: str | None) -> str:
+    """The comment atop ``learned.lp``: where it comes from, what it assumes (``prior``:
+    the size prior's statement, if any), what its ids name."""
     lines = [f"Learned by a session on {assembly.name} ({run}).", f"Assumes: {sizes.model.assumption()}."]
+    lines += [] if prior is None else [f"Assumes: {prior}."]
     lines += [f"Model changed: {change}." for change in sizes.model_changes]
     lines += ["Parts:"]
     lines += [f"  {part.id}: {part.name}" for part in assembly.parts]
@@ -314,12 +320,18 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     ``time.perf_counter()`` [s] at the start."""
     assembly = load_assembly(record.assembly)
     parts, holes, truth, model = _sizes_domain(assembly, record.model)
+    decided = ([] if record.size_prior is None
+               else cad_prior(assembly, record.tolerance_m, tuple(parts), tuple(holes)))
+    record.prior = None if record.size_prior is None else DecidedPrior(
+        kind=record.size_prior, tolerance_m=record.tolerance_m, pairs=len(parts) * len(holes),
+        decided=[(p, h, result) for (p, h), result in decided])
+    stated_prior = None if record.prior is None else prior_statement(record.prior)
     # Every input file is read before any cell starts: bad input fails fast.
     demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
     if prior is not None:
         LOG.info("precedence: the geometric prior %s refined by %d demonstration(s)", prior, len(demos.sequences))
     learner = SizeLearner(parts, holes, record.policy, record.seed,
-                          confirm=record.confirm, demonstrated=demos.placements(), model=model)
+                          confirm=record.confirm, demonstrated=demos.placements(), model=model, prior=decided)
     required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
     run_id = record.recording_id
     listen, connect = _endpoints(settings)
@@ -340,7 +352,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         directory = CellDirectory(session)
         stack.callback(directory.close)
         cells: list[CellProcess] = []
-        stack.callback(lambda: [cell.stop() for cell in cells])
+        stack.callback(lambda: stop_all(cells))
         for number in range(1, settings.cells + 1):  # they start up in parallel with each other and us
             cells.append(CellProcess(session_cell(settings, record, run, number, listen[:1], viewer.connect)))
         log = PlannerLog(run / f"planner{suffix}.rrd", record.recording_id, cell_ids, viewer,
@@ -368,6 +380,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             raise PlannerError(f"cells: {exc}") from None
         timings = {"cells_ready_s": time.perf_counter() - started}
         LOG.info("assumes: %s", model.assumption())  # once every input was checked and the cells are up
+        if stated_prior is not None:
+            LOG.info("assumes: %s", stated_prior)
         try:
             sizes = _learn_sizes(oracle, learner, journal, log, timings)
         finally:
@@ -378,7 +392,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         for change in sizes.model_changes:
             LOG.warning("model changed: %s", change)
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
-                    header=_learned_header(assembly, run, sizes))
+                    header=_learned_header(assembly, run, sizes, stated_prior))
         assignment, found = _plans(learned, settings.plans)
         write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
                     header="A hole assignment of learned.lp (the paper's greedy one when it finds one, "

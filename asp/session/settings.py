@@ -3,8 +3,8 @@
 :class:`SessionSettings` is one start of a session, built once at the edge (the command
 line, :mod:`assembly_constraints.asp.session.cli`, or :func:`assembly_constraints.api.run_session`).
 :class:`SessionFile` is ``session.json``: the settings that stay with the run folder
-(assembly, policy, model, seed, confirmations, demonstrations, the cells' settings), the
-recording id and the count of starts, and, once the session is done, its result.
+(assembly, policy, model, seed, confirmations, demonstrations, the cells' settings, the
+size prior), the recording id and the count of starts, and, once the session is done, its result.
 :func:`read_session_file` is its one decoder: a resume, ``assemble --run``, ``bench
 assemble``, the summary and :func:`assembly_constraints.api.read_run` read it.
 
@@ -23,9 +23,11 @@ import msgspec
 from msgspec import UNSET, Meta, UnsetType
 
 from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.sizes.cad_prior import MAX_TOLERANCE_M, prior_text
 from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
 from assembly_constraints.asp.sizes.models import MODELS
 from assembly_constraints.asp.sizes.policies import policy_names
+from assembly_constraints.asp.sizes.truth_oracle import Result
 from assembly_constraints.bridge.cell_settings import (
     DEFAULT_CELL,
     MAGNITUDE_FIELDS,
@@ -52,14 +54,18 @@ MAX_RECORDING_ID = 64
 
 RecordingId = Annotated[str, Meta(pattern=rf"^[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}$")]
 Confirm = Annotated[int, Meta(ge=0, le=MAX_CONFIRM)]
+Tolerance = Annotated[float, Meta(ge=0.0, le=MAX_TOLERANCE_M)]
 
 
-def _check_choices(policy: str, model: str | None) -> None:
-    """ValueError (msgspec reports it with the struct's path) unless ``policy`` and ``model`` are known."""
+def _check_choices(policy: str, model: str | None, size_prior: str | None, tolerance_m: float) -> None:
+    """ValueError (msgspec reports it with the struct's path) unless ``policy`` and ``model``
+    are known and a tolerance comes with a prior."""
     if policy not in policy_names():
         raise ValueError(f"policy {policy!r}: expected one of {', '.join(policy_names())}")
     if model is not None and model not in MODELS:
         raise ValueError(f"model {model!r}: expected null or one of {', '.join(MODELS)}")
+    if size_prior is None and tolerance_m:
+        raise ValueError(f"tolerance_m {tolerance_m:g}: applies to size_prior \"cad\" only (expected 0 without it)")
 
 
 class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
@@ -70,8 +76,10 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     trials), ``confirm`` K (re-tests until a result leads by K+1), ``demos`` (a file;
     None: the assembly's ``demos.txt``), ``cell``: the simulated cells' settings, cell
     ``c<k>`` with cell seed ``cell.cell_seed + k - 1`` (the command line sets
-    ``cell.cell_seed`` to ``seed``). These are kept in ``session.json``; a resume takes
-    them from there and ignores its own.
+    ``cell.cell_seed`` to ``seed``), ``size_prior`` (``cad``: the learner starts from the
+    outcomes the assembly's nominal sections decide beyond ``tolerance_m`` [m],
+    :mod:`assembly_constraints.asp.sizes.cad_prior`; None: no prior). These are kept in
+    ``session.json``; a resume takes them from there and ignores its own.
 
     How: ``out`` (None: ``runs/<UTC time>``) or ``resume`` (a run folder); ``cells``
     co-processes to start (0: use cells on the network, only ``allow_cells`` if given)
@@ -89,6 +97,8 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     confirm: Confirm = 0
     demos: str | None = None
     cell: CellSettings = DEFAULT_CELL
+    size_prior: Literal["cad"] | None = None
+    tolerance_m: Tolerance = 0.0
     out: str | None = None
     resume: str | None = None
     cells: Annotated[int, Meta(ge=0, le=MAX_CELLS)] = 1
@@ -109,12 +119,23 @@ def checked(settings: SessionSettings) -> SessionSettings:
     struct built in Python is not checked as a decoded one is); PlannerError naming the
     field otherwise."""
     try:
-        _check_choices(settings.policy, settings.model)
+        _check_choices(settings.policy, settings.model, settings.size_prior, settings.tolerance_m)
         return msgspec.convert(msgspec.to_builtins(settings), SessionSettings)
     except msgspec.ValidationError as exc:
         raise PlannerError(f"session settings: {validation_text(exc)}") from None
     except ValueError as exc:
         raise PlannerError(f"session settings: {exc}") from None
+
+
+class DecidedPrior(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """What a session's size prior decided: its ``kind`` (``cad``), ``tolerance_m`` [m],
+    the ``pairs`` it was over (parts × holes learned) and the outcomes it ``decided``
+    ([part, hole, result])."""
+
+    kind: Literal["cad"]
+    tolerance_m: Tolerance
+    pairs: Annotated[int, Meta(ge=0)]
+    decided: list[tuple[str, str, Result]]
 
 
 class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
@@ -123,7 +144,8 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     started, ``status`` and the experiments abandoned by resumes; once ``done``, the
     result (the ``session --json`` contract: ``run``, ``experiments``, ``fits``,
     ``must_precede``, ``plans``, ``matches_truth``, and more: the size model used and
-    what it assumes, the truth comparison, the assignment, the cells, the journal,
+    what it assumes, what the size prior decided (``prior``, set at each start; None
+    without one), the truth comparison, the assignment, the cells, the journal,
     wall time [s] and timings [s], the assembly run). Fields not yet known are absent."""
 
     format: int = SESSION_FORMAT
@@ -134,6 +156,8 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     confirm: Confirm = 0
     demos: str | None = None
     cell: CellSettings = DEFAULT_CELL
+    size_prior: Literal["cad"] | None = None
+    tolerance_m: Tolerance = 0.0
     recording_id: RecordingId
     starts: Annotated[int, Meta(ge=1, lt=MAX_STARTS)] = 1
     status: Literal["running", "done"] = "running"
@@ -145,6 +169,7 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     plans: list[list[dict[str, str | None]]] | UnsetType = UNSET
     matches_truth: bool | None | UnsetType = UNSET
     assumption: str | UnsetType = UNSET
+    prior: DecidedPrior | None | UnsetType = UNSET
     model_changes: list[str] | UnsetType = UNSET
     demonstrated: list[tuple[str, str]] | UnsetType = UNSET
     truth: dict[str, bool | int | None] | UnsetType = UNSET
@@ -159,13 +184,19 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
         if self.format != SESSION_FORMAT:
             raise ValueError(f"format {self.format}: expected {SESSION_FORMAT} (written by another version; "
                              "start a new session)")
-        _check_choices(self.policy, self.model)
+        _check_choices(self.policy, self.model, self.size_prior, self.tolerance_m)
+
+
+def prior_statement(prior: DecidedPrior) -> str:
+    """The line a run prints (and ``learned.lp`` keeps) as the assumption its size prior makes."""
+    return prior_text([((p, h), result) for p, h, result in prior.decided], prior.tolerance_m, prior.pairs)
 
 
 def new_session_file(settings: SessionSettings, recording_id: str) -> SessionFile:
     """The ``session.json`` of a new run folder."""
     return SessionFile(assembly=settings.assembly, policy=settings.policy, model=settings.model, seed=settings.seed,
-                       confirm=settings.confirm, demos=settings.demos, cell=settings.cell, recording_id=recording_id)
+                       confirm=settings.confirm, demos=settings.demos, cell=settings.cell,
+                       size_prior=settings.size_prior, tolerance_m=settings.tolerance_m, recording_id=recording_id)
 
 
 def _from_format_1(data: dict[str, Any]) -> dict[str, Any]:

@@ -11,17 +11,21 @@ observation that contradicts the prior is a conflict re-tested like any other.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import clingo
 
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.sizes.knowledge import Pair
+from assembly_constraints.asp.sizes.truth_oracle import Result
 from assembly_constraints.asp.solve import load_atoms
-from assembly_constraints.bridge.assembly import is_id
+from assembly_constraints.bridge.assembly import Assembly, is_id
 from assembly_constraints.bridge.inputs import shorten
 
 NOMINAL_FILE = "nominal_sizes.lp"
+MAX_TOLERANCE_M = 0.1
+"""The largest tolerance a prior takes [m]."""
 
 
 def nominal_margins(path: Path) -> dict[Pair, int]:
@@ -41,7 +45,7 @@ def nominal_margins(path: Path) -> dict[Pair, int]:
 
 
 def decided(margins: dict[Pair, int], tolerance: float, parts: tuple[str, ...], holes: tuple[str, ...]
-            ) -> list[tuple[Pair, str]]:
+            ) -> list[tuple[Pair, Result]]:
     """The outcomes the margins decide beyond ``tolerance`` [m], in part then hole order;
     PlannerError when the margins miss a pair of ``parts`` × ``holes``."""
     missing = [f"{p}->{h}" for p in parts for h in holes if (p, h) not in margins]
@@ -49,7 +53,7 @@ def decided(margins: dict[Pair, int], tolerance: float, parts: tuple[str, ...], 
         raise PlannerError(f"{NOMINAL_FILE}: no nominal margin for {' '.join(missing[:5])} (expected every part "
                            "and hole of sizes.lp)")
     bound = 1e6 * tolerance
-    outcomes = []
+    outcomes: list[tuple[Pair, Result]] = []
     for part in parts:
         for hole in holes:
             value = margins[(part, hole)]
@@ -58,3 +62,21 @@ def decided(margins: dict[Pair, int], tolerance: float, parts: tuple[str, ...], 
             elif value < -bound:
                 outcomes.append(((part, hole), "no_fit"))
     return outcomes
+
+
+def cad_prior(assembly: Assembly, tolerance: float, parts: tuple[str, ...], holes: tuple[str, ...]
+              ) -> list[tuple[Pair, Result]]:
+    """The outcomes the nominal sections of ``assembly`` (its ``nominal_sizes.lp``) decide
+    beyond ``tolerance`` [m] over ``parts`` × ``holes`` (:func:`decided`); PlannerError
+    naming the folder when it has no such file."""
+    if not assembly.has_file(NOMINAL_FILE):
+        raise PlannerError(f"--prior cad: {assembly.folder}: no {NOMINAL_FILE} (expected an assembly folder "
+                           "./run.sh import wrote)")
+    return decided(nominal_margins(assembly.file(NOMINAL_FILE)), tolerance, parts, holes)
+
+
+def prior_text(prior: Sequence[tuple[Pair, str]], tolerance: float, pairs: int) -> str:
+    """The line that states the prior a run assumes: its tolerance [m shown as mm], how
+    many of ``pairs`` pairs it decides, and which."""
+    return (f"the CAD prior (tolerance {1000 * tolerance:g} mm) decides {len(prior)} of {pairs} pairs"
+            + (": " + " ".join(f"{p}->{h} {r}" for (p, h), r in prior) if prior else ""))

@@ -16,12 +16,13 @@ import sys
 
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.precedence.demos import load_demos
+from assembly_constraints.asp.sizes.cad_prior import MAX_TOLERANCE_M, NOMINAL_FILE, cad_prior, prior_text
 from assembly_constraints.asp.sizes.evaluate import evaluate_policy, plot_comparison
 from assembly_constraints.asp.sizes.knowledge import Knowledge
 from assembly_constraints.asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
 from assembly_constraints.asp.sizes.models import MODELS, SizeModel, model_for
 from assembly_constraints.asp.sizes.policies import get_policy, policy_names
-from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, Oracle, TruthOracle
+from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, Oracle, Result, TruthOracle
 from assembly_constraints.asp.solve import write_facts
 from assembly_constraints.bridge.assembly import load_assembly
 from assembly_constraints.bridge.cli_types import (
@@ -65,6 +66,22 @@ def add_model_option(parser: argparse.ArgumentParser) -> None:
                              "model, else sections (docs/sizes.md)")
 
 
+def add_prior_options(parser: argparse.ArgumentParser) -> None:
+    """``--prior cad`` and ``--tolerance T`` [m]: the size prior from the nominal CAD
+    (:mod:`assembly_constraints.asp.sizes.cad_prior`); :func:`check_prior_options` refuses a tolerance alone."""
+    parser.add_argument("--prior", choices=["cad"],
+                        help="cad: start from the outcomes the nominal cross-sections decide beyond --tolerance "
+                             "(the assembly's nominal_sizes.lp, written by the import subcommand)")
+    parser.add_argument("--tolerance", type=number_in(float, 0.0, MAX_TOLERANCE_M), default=0.0, metavar="T",
+                        help="with --prior cad: margins within T [m] of zero are left to the experiments (default 0)")
+
+
+def check_prior_options(args: argparse.Namespace) -> None:
+    """PlannerError when ``--tolerance`` is given without ``--prior cad``."""
+    if args.prior is None and args.tolerance:
+        raise PlannerError("--tolerance applies to --prior cad only")
+
+
 def _model(args: argparse.Namespace, truth: TruthOracle) -> SizeModel:
     return model_for(truth.parts, args.model, truth.declared_model, truth.declared_sections)
 
@@ -89,11 +106,7 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--seed", type=int_in(0, MAX_SEED), default=0,
                        help="seed of random choices and noise (default 0)")
     add_model_option(learn)
-    learn.add_argument("--prior", choices=["cad"],
-                       help="cad: start from the outcomes the nominal cross-sections decide beyond --tolerance "
-                            "(the assembly's nominal_sizes.lp, written by the import subcommand)")
-    learn.add_argument("--tolerance", type=number_in(float, 0.0, 0.1), default=0.0, metavar="T",
-                       help="with --prior cad: margins within T [m] of zero are left to the experiments (default 0)")
+    add_prior_options(learn)
     learn.add_argument("--demos", metavar="FILE",
                        help="demonstrations; the parts they place into holes (p1@r1) are fits to start from")
     _add_noise_options(learn)
@@ -131,19 +144,15 @@ def demonstrated_fits(path: str, assembly: str | None) -> list[tuple[str, str]]:
     return demos.placements()
 
 
-def _cad_prior(args: argparse.Namespace, truth: TruthOracle) -> list[tuple[tuple[str, str], str]]:
+def _cad_prior(args: argparse.Namespace, truth: TruthOracle) -> list[tuple[tuple[str, str], Result]]:
     """The outcomes ``--prior cad`` decides (none without it); PlannerError without an
     assembly folder holding nominal_sizes.lp."""
+    check_prior_options(args)
     if args.prior is None:
-        if args.tolerance:
-            raise PlannerError("--tolerance applies to --prior cad only")
         return []
-    from assembly_constraints.asp.sizes.cad_prior import NOMINAL_FILE, decided, nominal_margins
-
     if not args.assembly:
         raise PlannerError(f"--prior cad: expected --assembly A with {NOMINAL_FILE} (./run.sh import writes it)")
-    margins = nominal_margins(load_assembly(args.assembly).file(NOMINAL_FILE))
-    return decided(margins, args.tolerance, truth.parts, truth.holes)
+    return cad_prior(load_assembly(args.assembly), args.tolerance, truth.parts, truth.holes)
 
 
 def _learn(args: argparse.Namespace) -> int:
@@ -164,8 +173,7 @@ def _learn(args: argparse.Namespace) -> int:
         print(f"starting from {len(demonstrated)} fits seen in the demonstrations: "
               + " ".join(f"{p}->{h}" for p, h in demonstrated))
     if prior and not args.json:
-        print(f"the CAD prior (tolerance {1000 * args.tolerance:g} mm) decides {len(prior)} of "
-              f"{len(truth.parts) * len(truth.holes)} pairs: " + " ".join(f"{p}->{h} {r}" for (p, h), r in prior))
+        print(prior_text(prior, args.tolerance, len(truth.parts) * len(truth.holes)))
     result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
                          confirm=args.confirm, demonstrated=demonstrated, model=model, prior=prior)
     saved = None

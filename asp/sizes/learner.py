@@ -1,10 +1,17 @@
 """The size-learning session (paper 2.2): which part fits which hole, by experiments.
 
-One :class:`SizeLearner` owns ONE long-lived ``clingo.Control``: the parts, holes,
-their index order and the policy's entry encoding (``select_<policy>.lp``, which includes
-the closure; ``sizes_closure.lp`` for a policy that chooses in Python) are grounded once;
-every possible observation ``observed(P,H,R)`` is an ``#external`` switched with
-``assign_external``. Each decision is one solve of that ground program.
+Each decision is one solve of the policy's entry encoding (``select_<policy>.lp``, which
+includes the closure; ``sizes_closure.lp`` for a policy that chooses in Python) over the
+parts, holes, their index order, the policy's session facts and the kept observations
+``observed(P,H,R)``, in one of two ways by the size of the product:
+
+- up to ``GROUND_ONCE_PAIRS`` part-hole pairs, ONE long-lived ``clingo.Control`` is
+  grounded once with every possible observation as an ``#external`` switched by
+  ``assign_external``: a decision is one solve (0.2 ms at 5×5);
+- above, each decision grounds a fresh ``Control`` with the kept observations as facts:
+  the closure is then stratified and derived by the grounder alone, while a program with
+  every possible observation external grounds every closure rule over every triple and
+  solves through their positive loops (at 20×20 three times the time; docs/decisions.md).
 
 The learner never proposes a pair whose result is entailed, and proposes a pair again
 only to re-test it: when an answer makes the closure cyclic (noise), the observations
@@ -17,7 +24,7 @@ paper's): ``section(P,S)`` facts put each part on a section's size line. Observa
 that contradict the model cannot be noise once re-tests reproduce them: when every
 observation on a cycle has been answered at least twice with one result (or a pair
 reached ``max_answers``), the learner names them in one line, moves to the next weaker
-model (``line`` -> ``sections`` -> ``pairs``), re-grounds, and asks the pairs the
+model (``line`` -> ``sections`` -> ``pairs``) and asks the pairs the
 weaker model no longer entails. ``model_changes`` lists the moves.
 
 A prior from the nominal CAD (``prior``: pairs and results the nominal cross-sections
@@ -56,11 +63,17 @@ from assembly_constraints.asp.sizes.policies import SelectionPolicy, get_policy
 from assembly_constraints.asp.sizes.truth_oracle import Oracle
 from assembly_constraints.asp.solve import add_facts, encoding, fact
 
+GROUND_ONCE_PAIRS = 100
+"""Products of at most this many part-hole pairs are grounded once with the observations
+as externals, larger ones per decision with the observations as facts (module doc; the
+two cost the same at 10×10, measured with ``./run.sh bench sizes``)."""
+
 MAX_CONFIRM = 100
 """``confirm`` K is at most this many answers (each essential observation is re-tested
 until its result leads by K+1, so K bounds the experiments)."""
 
-_OBSERVATIONS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit). #show lt/3."
+_EXTERNALS = "#external observed(P,H,R) : part(P), hole(H), R=(fit;no_fit)."
+_SHOW_LINES = "#show lt/3."
 
 
 @dataclass(frozen=True)
@@ -170,21 +183,43 @@ class SizeLearner:
         self._essential: tuple[Pair, ...] = ()
         self._history: list[tuple[Knowledge, Pair | None, list[Pair], tuple[Pair, ...]]] = []
         self._pairs = [(p, h) for p in self.parts for h in self.holes]
-        self._build_control()
+        self._prepare_model()
         self._selected: Pair | None = None
         self._start_from_demonstrations()
 
-    def _build_control(self) -> None:
-        """Ground the learner's one Control for the current model (again only when the
-        model is weakened)."""
+    def _prepare_model(self) -> None:
+        """Prepare the policy and the facts every solve shares for the current model
+        (again only when the model is weakened)."""
         if self.policy.prepare is not None:
             for size in sorted({len(parts) for parts in self.model.groups().values()}):
                 self.policy.prepare(size, len(self.holes))
-        self._ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
+        self._static = self._static_facts(self.seed)
+        self._observed: dict[Pair, str] = {}
         self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
-        self._ground(self.seed)
-        self._literals = {(*pair, r): self._literal(fact("observed", *pair, r))
-                          for pair in self._pairs for r in RESULTS}
+        self._ctl: clingo.Control | None = None
+        if len(self._pairs) <= GROUND_ONCE_PAIRS:
+            self._ctl = self._grounded([], _EXTERNALS)
+            self._literals = {(*pair, r): self._literal(fact("observed", *pair, r))
+                              for pair in self._pairs for r in RESULTS}
+
+    def _grounded(self, observed: list[clingo.Symbol], rules: str = "") -> clingo.Control:
+        """A Control grounded on the shared facts, the ``observed`` facts, the learner's
+        own ``rules`` and the policy's encodings."""
+        ctl = clingo.Control(["--warn=none", *self.policy.solver_options])
+        add_facts(ctl, [*self._static, *observed])
+        ctl.add("base", [], rules + _SHOW_LINES)
+        for name in [self.policy.encoding or "sizes_closure.lp"] + (["sizes/essential.lp"] if self.confirm else []):
+            ctl.load(str(encoding(name)))
+        ctl.ground([("base", [])])
+        return ctl
+
+    def _literal(self, atom: clingo.Symbol) -> int:
+        """The solver literal of a ground ``#external`` atom."""
+        assert self._ctl is not None
+        found = self._ctl.symbolic_atoms[atom]
+        if found is None:
+            raise PlannerError(f"{atom}: not declared as an external of the learner's program")
+        return found.literal
 
     def _start_from_demonstrations(self) -> None:
         """One ``fit`` answer per demonstrated pair and one per prior outcome, then the
@@ -202,32 +237,24 @@ class SizeLearner:
             entry = self._decoded[symbol] = (symbol.name, tuple(str(a) for a in symbol.arguments))
         return entry
 
-    def _literal(self, atom: clingo.Symbol) -> int:
-        """The solver literal of a ground ``#external`` atom."""
-        found = self._ctl.symbolic_atoms[atom]
-        if found is None:
-            raise PlannerError(f"{atom}: not declared as an external of the learner's program")
-        return found.literal
-
-    def _ground(self, seed: int) -> None:
+    def _static_facts(self, seed: int) -> list[clingo.Symbol]:
+        """The parts, holes, their index order, sections and the policy's session facts."""
         atoms = [fact("part", p) for p in self.parts] + [fact("hole", h) for h in self.holes]
         atoms += [fact("part_index", p, i) for i, p in enumerate(self.parts, 1)]
         atoms += [fact("hole_index", h, j) for j, h in enumerate(self.holes, 1)]
         atoms += [fact("section", p, section) for p, section in self.model.sections.items()]
         if self.policy.session_facts is not None:
             atoms += self.policy.session_facts(self.parts, self.holes, seed)
-        add_facts(self._ctl, atoms)
-        self._ctl.add("base", [], _OBSERVATIONS)
-        names = [self.policy.encoding or "sizes_closure.lp"] + (["sizes/essential.lp"] if self.confirm else [])
-        for name in names:
-            self._ctl.load(str(encoding(name)))
-        self._ctl.ground([("base", [])])
+        return atoms
 
     def _solve(self) -> Knowledge:
-        """Solve the ground program under the current externals; remember ``select/2``
-        and ``essential/2`` (index order)."""
+        """Solve the policy's program on the kept observations; remember
+        ``select/2`` and ``essential/2`` (index order)."""
+        ctl = self._ctl
+        if ctl is None:
+            ctl = self._grounded([fact("observed", p, h, r) for (p, h), r in self._observed.items()])
         last: list[clingo.Symbol] = []
-        result = self._ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
+        result = ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
         if not result.satisfiable:
             raise PlannerError(f"policy {self.policy.name}: no model for the current knowledge")
         entries = [self._decode(symbol) for symbol in last]
@@ -239,8 +266,14 @@ class SizeLearner:
         return knowledge
 
     def _set_observation(self, pair: Pair, result: str | None) -> None:
-        for value in RESULTS:
-            self._ctl.assign_external(self._literals[(*pair, value)], value == result)
+        """Make ``result`` the kept observation of ``pair`` (None: no observation)."""
+        if result is None:
+            self._observed.pop(pair, None)
+        else:
+            self._observed[pair] = result
+        if self._ctl is not None:
+            for value in RESULTS:
+                self._ctl.assign_external(self._literals[(*pair, value)], value == result)
 
     @staticmethod
     def _kept(answers: list[str]) -> str:
@@ -337,7 +370,7 @@ class SizeLearner:
         return reproduced or any(len(a) >= self.max_answers for a in answers)
 
     def _weaken(self) -> None:
-        """Move to the next weaker model, re-ground and re-apply every kept answer;
+        """Move to the next weaker model and re-apply every kept answer;
         PlannerError when no weaker model is left (the kept answers contradict themselves)."""
         named = ", ".join(f"{p}->{h} {r}" for p, h, r in sorted(self.knowledge.conflicts))
         following = weaker(self.model)
@@ -346,7 +379,7 @@ class SizeLearner:
         change = f"observations {named} contradict size model {self.model.name}; now {following.name}"
         self.model_changes.append(change)
         self.model = following
-        self._build_control()
+        self._prepare_model()
         for pair, answers in self.answers.items():
             self._set_observation(pair, self._kept(answers))
         self.retests = [pair for pair in self.retests if pair in self.answers and len(set(self.answers[pair])) > 1]
@@ -440,7 +473,7 @@ class SizeLearner:
         return True
 
     def _restore(self, pair: Pair) -> None:
-        """Set the external of ``pair`` back to its kept observation (or none)."""
+        """Set ``pair`` back to its kept observation (or none)."""
         answers = self.answers.get(pair)
         self._set_observation(pair, self._kept(answers) if answers else None)
 
@@ -458,7 +491,7 @@ class SizeLearner:
         self.knowledge, self._selected, self.retests, self._essential = self._history.pop()
 
     def reset(self, seed: int = 0) -> None:
-        """Forget all observations: a fresh session on the same ground program.
+        """Forget all observations: a fresh session on the same product and policy.
 
         ``seed`` reseeds Python policies; ``session_facts`` (e.g. random priorities)
         stay those of the seed given at construction; a weakened model is restored.
@@ -467,7 +500,7 @@ class SizeLearner:
             self._set_observation(pair, None)
         if self.model != self._initial_model:
             self.model, self.model_changes = self._initial_model, []
-            self._build_control()
+            self._prepare_model()
         self.experiments, self.answers, self.retests, self._history = [], {}, [], []
         self.rng = random.Random(seed)
         self._start_from_demonstrations()

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.assembly.grasp import Grasp
 from assembly_constraints.executor.assembly.product import Product
@@ -52,13 +53,13 @@ from assembly_constraints.executor.skills.insertion import insert_in_layer, need
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.trial import APPROACH_HEIGHT, APPROACH_SETTLE_TIME, trial_rng
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, yaw_quat
-from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor.world.perturbation import CellBias
 from assembly_constraints.executor.world.scene import PART_FRICTION
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
 RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
-ASSEMBLY_UNCERTAINTY = PerturbationModel(
+ASSEMBLY_UNCERTAINTY = Magnitudes(
     grasp_offset_bias=0.0, grasp_offset_random=0.001, grasp_tilt_bias=0.0, grasp_tilt_random=1.0,
     vision_bias=0.0, vision_sigma=0.0015, vision_max=0.003, vision_yaw_bias=0.0, vision_yaw_sigma=0.5,
     vision_yaw_max=1.0, friction_min=0.25, friction_max=0.25, friction_jitter=0.0)

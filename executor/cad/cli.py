@@ -11,7 +11,9 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 
 It prints what it assumes, each part's insertion axis and free directions, each hole
 with both cross-sections and the clearance, the disassembly stages, the geometric
-precedence and the collision queries; bad CAD or a bad file: one line, exit code 2.
+precedence with each pair's reason (``--locating-reach R``: the locating rule's reach [m],
+:mod:`assembly_constraints.executor.cad.locating`; 0: off) and the collision queries; bad
+CAD or a bad file: one line, exit code 2.
 """
 
 from __future__ import annotations
@@ -22,11 +24,12 @@ import time
 import tomllib
 from pathlib import Path
 
-from assembly_constraints.bridge.cli_types import ArgumentParser
+from assembly_constraints.bridge.cli_types import ArgumentParser, number_in
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import MESH_FOLDER
 from assembly_constraints.executor.cad.derive import Derived, derive
+from assembly_constraints.executor.cad.locating import LOCATING_REACH, MAX_REACH
 from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
 from assembly_constraints.executor.cad.step import load_step
 from assembly_constraints.executor.cad.write import Settings, write_folder
@@ -123,8 +126,13 @@ def report(derived: Derived) -> list[str]:
                      f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: no round, "
                      "square or rect section, no hole")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
-    lines.append("geometric precedence (A before B): " + (" ".join(f"{a}->{b}" for a, b in sorted(derived.edges))
-                                                          or "none"))
+    for pid, by_direction in sorted(derived.located.items()):
+        lines.append(f"part {pid} sideways within {_mm(derived.reach)} mm: " + "; ".join(
+            f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items()))
+    for locator, pid in sorted(derived.dropped):
+        lines.append(f"locating pair {locator}->{pid} dropped: the blocking needs {pid} before {locator}")
+    lines.append("geometric precedence (A before B): " + (" ".join(
+        f"{a}->{b} ({reason})" for (a, b), reason in sorted(derived.reasons.items())) or "none"))
     return lines
 
 
@@ -141,15 +149,18 @@ def load_source(source: Path, units: str) -> list[CadPart]:
     raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
 
 
-def run_import(source: Path, out: Path, units: str, config: Path | None
+def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH
                ) -> tuple[Derived, list[str], str | None, float]:
-    """Read, check, derive and write; returns what was derived, what was assumed, why
-    there is no geometry.toml (None: there is) and the seconds taken."""
+    """Read, check, derive (``reach`` [m]: the locating rule's, 0: off) and write; returns
+    what was derived, what was assumed, why there is no geometry.toml (None: there is)
+    and the seconds taken."""
     started = time.perf_counter()
     parts = load_source(source, units)
     check_parts(parts, units)
     settings, fixed, assumed = _config(config, parts)
-    derived = derive(parts, settings.base, fixed)
+    assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
+                   "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
+    derived = derive(parts, settings.base, fixed, reach)
     _, why = write_folder(derived, settings, source.stem, out)
     return derived, assumed, why, time.perf_counter() - started
 
@@ -164,10 +175,13 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
     parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to")
+    parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
+                        metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
+                                          f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
     args = parser.parse_args(argv)
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
-    derived, assumed, why, seconds = run_import(args.source, args.out, args.units, args.config)
+    derived, assumed, why, seconds = run_import(args.source, args.out, args.units, args.config, args.locating_reach)
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(assumed))
     for line in report(derived):

@@ -9,7 +9,9 @@ parts still in place leaves along the first such direction: its **insertion axis
 reverse. A part that no stage frees never comes out (an error naming it). **Geometric
 precedence**: A must precede B when B blocks A's path out along A's axis, and the base
 precedes every part touching it. Parts fixed to another (a head screwed into its lever)
-move with it: neither blocks the other.
+move with it: neither blocks the other. The **locating rule**
+(:mod:`assembly_constraints.executor.cad.locating`, a stated assumption, off with reach 0)
+adds Y before X when Y alone keeps X from moving sideways.
 
 **Holes** are the inner loops of the base's slices perpendicular to the axes, at the middle
 of each part's depth in the base (or, with no part reaching into it, at the base's middle
@@ -28,8 +30,9 @@ import numpy as np
 import trimesh
 
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.parts import CadPart
-from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, frame_of, slice_loops
+from assembly_constraints.executor.cad.locating import LOCATING_REACH, locating_pairs, locators
+from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart
+from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
 from assembly_constraints.executor.cad.sweep import DIRECTIONS, Sweeper
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
@@ -71,7 +74,12 @@ class HoleFit:
 class Derived:
     """Everything :func:`derive` finds; ``free`` the directions each part leaves the whole
     product along, ``axis`` its insertion axis (the name of the removal direction),
-    ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs."""
+    ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs and
+    ``reasons`` why each holds (``blocks``: B blocks A's way out; ``base``: the base
+    precedes the parts touching it; ``locates``: the locating rule,
+    :mod:`assembly_constraints.executor.cad.locating`), ``located`` each moving body's
+    locators per direction across its axis, ``dropped`` the locating pairs the blocking
+    contradicts, ``reach`` the locating reach [m] (0: the rule is off)."""
 
     base: str
     parts: dict[str, CadPart]
@@ -79,6 +87,10 @@ class Derived:
     axis: dict[str, str] = field(default_factory=dict)
     stages: list[list[str]] = field(default_factory=list)
     edges: set[tuple[str, str]] = field(default_factory=set)
+    reasons: dict[tuple[str, str], str] = field(default_factory=dict)
+    located: dict[str, dict[str, set[str]]] = field(default_factory=dict)
+    dropped: set[tuple[str, str]] = field(default_factory=set)
+    reach: float = 0.0
     holes: dict[str, HoleFit] = field(default_factory=dict)
     pockets: list[HoleFit] = field(default_factory=list)
     """Empty inner loops of the base that are no round, square or rect section: not holes."""
@@ -93,12 +105,12 @@ class Derived:
         return {fit.part: fit for fit in self.holes.values() if fit.part is not None}
 
 
-def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str]) -> Derived:
+def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH) -> Derived:
     """Axes, stages, precedence and holes of ``parts`` with ``base`` the fixture;
-    ``fixed_to`` maps a part to the part it moves with. ExecutorError naming the parts that
-    never come out."""
+    ``fixed_to`` maps a part to the part it moves with; ``reach`` [m]: the locating rule's
+    (0: off). ExecutorError naming the parts that never come out."""
     by_id = {p.id: p for p in parts}
-    result = Derived(base, by_id)
+    result = Derived(base, by_id, reach=reach)
     sweeper = Sweeper({p.id: p.mesh for p in parts})
     lower = np.min([p.mesh.bounds[0] for p in parts], axis=0)
     upper = np.max([p.mesh.bounds[1] for p in parts], axis=0)
@@ -124,8 +136,14 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str]) -> Derived
         result.stages.append(stage)
         remaining -= set(stage)
     for pid, direction in result.axis.items():
-        result.edges |= {(pid, other) for other in result.blockers[(pid, direction)] if other != base}
-    result.edges |= {(base, pid) for pid in result.axis if sweeper.touching(base, pid)}
+        result.reasons |= {(pid, other): "blocks" for other in result.blockers[(pid, direction)] if other != base}
+    result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
+    if reach > 0:
+        result.located = {pid: locators(sweeper, group[pid], result.axis[pid], reach)
+                          for pid in result.axis if pid not in fixed_to}
+        kept, result.dropped = locating_pairs(result.located, base, set(result.reasons))
+        result.reasons |= {pair: "locates" for pair in kept if pair not in result.reasons}
+    result.edges = set(result.reasons)
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis)], result.axis)
     result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "other"]
     holes = [fit for fit in found if fit not in result.pockets]
@@ -206,7 +224,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     through the base when there is none) and chamfer of the hole ``loop``."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
-    hole = classify(loop, hole=True)
+    hole = exact_round(classify(loop, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
     base_along = base.mesh.vertices @ axis
     radial = base.mesh.vertices @ frame.T - hole.centre
     entry = float(base_along[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)].max())
@@ -218,6 +236,8 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     if probe:
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
-    part, section = (None, None) if occupant is None else (occupant[0].id, classify(occupant[1], hole=False))
+    part, section = (None, None) if occupant is None else (
+        occupant[0].id, exact_round(classify(occupant[1], hole=False), occupant[0].cylinders, axis, level,
+                                    STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)

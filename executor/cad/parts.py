@@ -42,14 +42,26 @@ STEP_DEFLECTION = 1e-6
 
 
 @dataclass(frozen=True)
+class Cylinder:
+    """A cylindrical face of a part's B-rep: a ``point`` (3,) [m] on its axis, the axis
+    ``direction`` (3,) (unit) and the ``radius`` [m], in the cell frame."""
+
+    point: np.ndarray
+    direction: np.ndarray
+    radius: float
+
+
+@dataclass(frozen=True)
 class CadPart:
     """One part in the assembled pose: ``id`` (an ASP constant), the ``name`` the source
-    gives, its closed ``mesh`` [m] in the cell frame, and ``source`` (file, or file#name)."""
+    gives, its closed ``mesh`` [m] in the cell frame, ``source`` (file, or file#name) and
+    the ``cylinders`` of its B-rep (a STEP part's; none for a mesh)."""
 
     id: str
     name: str
     mesh: trimesh.Trimesh
     source: str
+    cylinders: tuple[Cylinder, ...] = ()
 
 
 def part_id(name: str, source: str) -> str:

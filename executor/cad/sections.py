@@ -12,7 +12,9 @@ A loop is classified as
 
 Sizes are what a fit depends on: a part's round section is its circumscribed circle (its
 widest), a hole's its inscribed circle (its narrowest), so a polygonal hole's size is its
-inradius and a tessellated cylinder's is within the tessellation's deflection.
+inradius and a tessellated cylinder's is within the tessellation's deflection. Where the
+part's B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
+diameter instead.
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ import numpy as np
 import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
+
+from assembly_constraints.executor.cad.parts import Cylinder
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
@@ -143,3 +147,26 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
             a = b = (a + b) / 2
         return Shape2D("square" if square else "rect", a, b, round(yaw, 6), centre)
     return Shape2D("other", a, b, math.degrees(angle), centre)
+
+
+ON_AXIS = 1e-6
+"""A B-rep cylinder's axis within this [m] of a round loop's centre is the loop's."""
+
+
+def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarray, level: float,
+                tolerance: float) -> Shape2D:
+    """``shape`` with the diameter of the B-rep cylinder it tessellates, if it is round and
+    one of ``cylinders`` is parallel to ``axis``, on the loop's centre (``level`` [m] along
+    the axis) and within ``tolerance`` [m] of its radius; else ``shape`` unchanged."""
+    if shape.kind != "round":
+        return shape
+    axis = np.asarray(axis, dtype=float)
+    centre = frame_of(axis).T @ shape.centre + axis * level
+    for cylinder in cylinders:
+        off = centre - cylinder.point
+        if (abs(abs(float(cylinder.direction @ axis)) - 1.0) < 1e-9
+                and np.linalg.norm(off - (off @ cylinder.direction) * cylinder.direction) < ON_AXIS
+                and abs(2 * cylinder.radius - shape.a) <= 2 * tolerance):
+            d = 2 * cylinder.radius
+            return Shape2D("round", d, d, 0.0, shape.centre)
+    return shape

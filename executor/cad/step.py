@@ -1,6 +1,8 @@
 """STEP assemblies through Open CASCADE (``OCP``, the cadquery-ocp wheels): one part per
 leaf of the assembly tree with its name and its placement (the product of the locations
-on the path from the root), tessellated to a closed triangle mesh [m].
+on the path from the root), tessellated to a closed triangle mesh [m], with the cylindrical faces of its B-rep (axis
+and radius, exact where the tessellation is within :data:`STEP_DEFLECTION` of them; planar
+faces tessellate exactly).
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
 converts to metres. A leaf without a name is named after its parent and position.
@@ -15,7 +17,7 @@ import numpy as np
 import trimesh
 
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart, part_id
+from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart, Cylinder, part_id
 
 _MM = 1e-3
 
@@ -43,8 +45,8 @@ def load_step(path: Path) -> list[CadPart]:
         _collect(tool, roots.Value(k), None, _name(roots.Value(k)) or path.stem, leaves)
     if not leaves:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
-    return [CadPart(part_id(name, f"{path}#{name}"), name, _mesh(shape, f"{path}#{name}"), f"{path}#{name}")
-            for name, shape in leaves]
+    return [CadPart(part_id(name, f"{path}#{name}"), name, _mesh(shape, f"{path}#{name}"), f"{path}#{name}",
+                    _cylinders(shape)) for name, shape in leaves]
 
 
 def _name(label: Any) -> str:
@@ -117,3 +119,30 @@ def _mesh(shape: Any, source: str) -> trimesh.Trimesh:
     mesh = trimesh.Trimesh(np.vstack(vertices), np.vstack(faces), process=True)
     mesh.merge_vertices(digits_vertex=9)
     return mesh
+
+
+def _cylinders(shape: Any) -> tuple[Cylinder, ...]:
+    """The cylindrical faces of the located ``shape`` (one per distinct axis and radius) [m]."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.GeomAbs import GeomAbs_Cylinder
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    found: dict[tuple[float, ...], Cylinder] = {}
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        surface = BRepAdaptor_Surface(TopoDS.Face(explorer.Current()))  # with the face's location
+        explorer.Next()
+        if surface.GetType() != GeomAbs_Cylinder:
+            continue
+        cylinder = surface.Cylinder()
+        axis = cylinder.Axis()
+        point, direction = axis.Location(), axis.Direction()
+        cyl = Cylinder(np.array([point.X(), point.Y(), point.Z()]) * _MM,
+                       np.array([direction.X(), direction.Y(), direction.Z()]), cylinder.Radius() * _MM)
+        # faces of one cylinder split by seams share axis and radius: keep one
+        key = (*np.round(cyl.direction * np.sign(cyl.direction @ (1.0, 2.0, 3.0)), 9), round(cyl.radius, 9),
+               *np.round(np.cross(cyl.point, cyl.direction), 9))
+        found.setdefault(key, cyl)
+    return tuple(found.values())

@@ -8,7 +8,8 @@
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's, the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
-  from the disassembly, the input of ``precedence learn --prior`` and ``precedence count``;
+  from the disassembly and the locating rule, each direct pair's reason in a comment
+  (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product when every part but the base is a peg
   standing in a hole along +z and the holes' entries are at one height with one depth
   (and the cell's loader accepts it; left out otherwise, and the report says why): the
@@ -134,13 +135,25 @@ def nominal_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
+REASONS = {
+    "blocks": "B blocks A's straight way out along A's insertion axis",
+    "base": "A is the base and B touches it",
+    "locates": "A alone keeps B from moving sideways (the locating rule, an assumption of the import)",
+}
+"""Why a pair of ``geometric_precedence.lp`` holds, as its comments say."""
+
+
 def precedence_text(derived: Derived) -> str:
+    """``geometric_precedence.lp``: its pairs with their reasons (comments), ``part/1`` and
+    the closed ``must_precede/2``."""
     graph = nx.DiGraph()
     graph.add_nodes_from(derived.parts)
     graph.add_edges_from(derived.edges)
     closure = sorted(nx.transitive_closure_dag(graph).edges)
-    lines = ["% Geometric precedence by disassembly (./run.sh import): must_precede(A,B) when B blocks A's",
-             "% straight way out along A's insertion axis, or A is the base and B touches it; transitively closed.",
+    used = [reason for reason in REASONS if reason in derived.reasons.values()]
+    lines = ["% Geometric precedence by disassembly (./run.sh import), transitively closed: must_precede(A,B) when",
+             *(f"% {reason}: {REASONS[reason]}" + (";" if k + 1 < len(used) else ".") for k, reason in enumerate(used)),
+             *(f"% {a}->{b}: {reason}" for (a, b), reason in sorted(derived.reasons.items())),
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in sorted(derived.parts)])]
     lines += [_symbols([clingo.Function("must_precede", [clingo.Function(a), clingo.Function(b)])])
               for a, b in closure]

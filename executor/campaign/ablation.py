@@ -9,7 +9,7 @@ consecutive executions (default 5) in one cell, group ``g`` with cell seed ``S +
 (its systematic errors) and execution ``j`` with trial seed ``S + g·E + j`` (its random
 errors), so with ILC execution ``j`` learns from executions ``0..j−1`` of that pair in
 that cell.  A last run, PI + phase stopping with the systematic errors set to zero
-(:meth:`assembly_constraints.executor.world.perturbation.PerturbationModel.random_only`), gives the force
+(:func:`assembly_constraints.executor.world.perturbation.random_only`), gives the force
 deviation the random part alone leaves: the floor no learning across executions can go
 below.
 
@@ -34,12 +34,13 @@ from typing import Any
 
 import numpy as np
 
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.bridge.progress import progress
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.campaign.pairs import campaign_pairs
 from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.ilc import LAYERS
-from assembly_constraints.executor.world.perturbation import PerturbationModel
+from assembly_constraints.executor.world.perturbation import random_only
 
 FLOOR = "random_only"
 """The extra run: PI + phase stopping with only the random part of the perturbations."""
@@ -47,7 +48,7 @@ FLOOR = "random_only"
 _CELL: Any = None  # the worker's Cell (reused: one PyBullet client per part shape)
 
 
-def _run_group(task: tuple[str, str, int, str, str, list[int], PerturbationModel]) -> list[dict[str, Any]]:
+def _run_group(task: tuple[str, str, int, str, str, list[int], Magnitudes]) -> list[dict[str, Any]]:
     """One group: consecutive executions of one pair in a fresh cell state (cell seed)."""
     from assembly_constraints.executor.trial import Cell
 
@@ -56,7 +57,7 @@ def _run_group(task: tuple[str, str, int, str, str, list[int], PerturbationModel
     if _CELL is None:
         _CELL = Cell(assembly)
     _CELL.reset_state(layer="pi_phase_stop" if variant == FLOOR else variant,
-                      perturbation=model.random_only() if variant == FLOOR else model, cell_seed=cell_seed)
+                      perturbation=random_only(model) if variant == FLOOR else model, cell_seed=cell_seed)
     return [_CELL.run_trial(part, hole, seed).to_json() for seed in seeds]
 
 
@@ -91,7 +92,7 @@ def variant_row(name: str, rows: Sequence[tuple[bool, int, dict[str, Any]]], f_s
 
 
 def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers: int,
-                 model: PerturbationModel) -> dict[str, Any]:
+                 model: Magnitudes) -> dict[str, Any]:
     """The ablation table (see the module text) as a JSON-ready dict."""
     if trials < 1 or executions < 1 or workers < 1:
         raise ExecutorError(f"--trials {trials} / --executions {executions} / --jobs {workers}: "

@@ -33,7 +33,6 @@ from assembly_constraints.bridge.cli_types import (
 from assembly_constraints.executor.campaign.ablation import format_ablation, run_ablation
 from assembly_constraints.executor.campaign.pairs import campaign_pairs
 from assembly_constraints.executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
-from assembly_constraints.executor.world.perturbation import PerturbationModel
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5
@@ -123,7 +122,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.ablation:
         with stdout_to_stderr():
             ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.jobs,
-                                    PerturbationModel.of(cell_settings_of(args).magnitudes))
+                                    cell_settings_of(args).magnitudes)
         print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
         return 0
     trials = args.trials or (1 if args.quick else 3)

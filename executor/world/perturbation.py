@@ -30,62 +30,27 @@ from __future__ import annotations
 
 import math
 import zlib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import msgspec
 import numpy as np
 
 from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.evidence import AttemptSetup
 
-_DEFAULT = Magnitudes()
+
+def random_only(model: Magnitudes) -> Magnitudes:
+    """The same random parts with every systematic part zero (friction: the middle of its
+    range): what no learning across executions can remove."""
+    mid = (model.friction_min + model.friction_max) / 2
+    return msgspec.structs.replace(model, grasp_offset_bias=0.0, grasp_tilt_bias=0.0, vision_bias=0.0,
+                                   vision_yaw_bias=0.0, friction_min=mid, friction_max=mid)
 
 
-@dataclass(frozen=True)
-class PerturbationModel:
-    """Magnitudes of the cell's uncertainty: grasp offsets [m], grasp tilts [°], vision
-    errors [m], vision yaw errors [°], friction coefficients (Coulomb, part on hole wall, dimensionless); the
-    defaults are those of the cell's options (:class:`assembly_constraints.bridge.cell_settings.Magnitudes`)."""
-
-    grasp_offset_bias: float = _DEFAULT.grasp_offset_bias
-    grasp_offset_random: float = _DEFAULT.grasp_offset_random
-    grasp_tilt_bias: float = _DEFAULT.grasp_tilt_bias
-    grasp_tilt_random: float = _DEFAULT.grasp_tilt_random
-    vision_bias: float = _DEFAULT.vision_bias
-    vision_sigma: float = _DEFAULT.vision_sigma
-    vision_max: float = _DEFAULT.vision_max
-    vision_yaw_bias: float = _DEFAULT.vision_yaw_bias
-    vision_yaw_sigma: float = _DEFAULT.vision_yaw_sigma
-    vision_yaw_max: float = _DEFAULT.vision_yaw_max
-    friction_min: float = _DEFAULT.friction_min
-    friction_max: float = _DEFAULT.friction_max
-    friction_jitter: float = _DEFAULT.friction_jitter
-
-    @classmethod
-    def of(cls, magnitudes: Magnitudes) -> PerturbationModel:
-        """The model of the cell settings' magnitudes; ExecutorError if inconsistent."""
-        return cls(**msgspec.structs.asdict(magnitudes)).check()
-
-    def random_only(self) -> PerturbationModel:
-        """The same random parts with every systematic part zero (friction: the middle of
-        its range): what no learning across executions can remove."""
-        mid = (self.friction_min + self.friction_max) / 2
-        return PerturbationModel(0.0, self.grasp_offset_random, 0.0, self.grasp_tilt_random, 0.0,
-                                 self.vision_sigma, self.vision_max, 0.0, self.vision_yaw_sigma,
-                                 self.vision_yaw_max, mid, mid, self.friction_jitter)
-
-    def check(self) -> PerturbationModel:
-        """ExecutorError naming the field unless every magnitude is ≥ 0 and the friction range ordered."""
-        for f in fields(self):
-            if not getattr(self, f.name) >= 0:
-                raise ExecutorError(f"perturbation {f.name} = {getattr(self, f.name)}: expected a number >= 0")
-        if self.friction_min > self.friction_max:
-            raise ExecutorError(f"perturbation friction_min {self.friction_min} > friction_max {self.friction_max}")
-        return self
-
-
-NO_PERTURBATION = PerturbationModel(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.25, 0.25, 0.0)
+NO_PERTURBATION = Magnitudes(grasp_offset_bias=0.0, grasp_offset_random=0.0, grasp_tilt_bias=0.0,
+                             grasp_tilt_random=0.0, vision_bias=0.0, vision_sigma=0.0, vision_max=0.0,
+                             vision_yaw_bias=0.0, vision_yaw_sigma=0.0, vision_yaw_max=0.0,
+                             friction_min=0.25, friction_max=0.25, friction_jitter=0.0)
 """A perfect cell: exact grasp, exact hole positions, the teaching friction (0.25)."""
 
 
@@ -109,7 +74,7 @@ class CellBias:
     Drawn lazily, each from its own stream of (cell seed, name), so it does not depend on
     the order in which shapes and holes are first used."""
 
-    model: PerturbationModel
+    model: Magnitudes
     seed: int
     grasp: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     holes: dict[str, tuple[np.ndarray, float]] = field(default_factory=dict)

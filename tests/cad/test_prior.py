@@ -100,3 +100,16 @@ def test_an_assembly_folder_s_own_geometric_precedence_is_the_session_s_prior(tm
     (tmp_path / "demos.txt").write_text("base a b c\nbase c a b\n")
     with pytest.raises(PlannerError, match="demos.txt:2"):
         learn_for_assembly(load_assembly(str(tmp_path)))
+
+
+@pytest.mark.slow  # the first session command of a process imports the session's stack (zenoh, rerun)
+def test_a_session_refuses_a_tolerance_without_the_prior(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = _sizes_folder(tmp_path)
+    argv = ["session", "--backend", "truth", "--assembly", str(folder), "--out", str(tmp_path / "runs")]
+    assert main([*argv, "--tolerance", "0.001"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == ["error: --tolerance applies to --prior cad only"]
+    (folder / "nominal_sizes.lp").unlink()
+    assert main([*argv, "--prior", "cad"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"error: --prior cad: {folder}: no nominal_sizes.lp (expected an assembly folder ./run.sh import wrote)"]
+    assert not (tmp_path / "runs").exists()

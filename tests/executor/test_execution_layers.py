@@ -9,6 +9,7 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.detector import Thresholds
 from assembly_constraints.executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
@@ -17,13 +18,13 @@ from assembly_constraints.executor.evidence import AttemptSetup
 from assembly_constraints.executor.skills.insertion import rotvec_quat_xyzw
 from assembly_constraints.executor.trial import Cell
 from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, rotation_error
-from assembly_constraints.executor.world.perturbation import NO_PERTURBATION, PerturbationModel
+from assembly_constraints.executor.world.perturbation import NO_PERTURBATION
 
 # The tight peg tilted 2° in the hand, otherwise exact: it touches the walls all the way down.
 TILTED = AttemptSetup(np.zeros(3), np.array([np.radians(2.0), 0.0, 0.0]), np.zeros(2), search_seed=1)
 # The systematic part only (a 2.5° habitual tilt): every execution of a pair meets the same errors.
-SYSTEMATIC_ONLY = PerturbationModel(grasp_offset_random=0.0, grasp_tilt_bias=2.5, grasp_tilt_random=0.0,
-                                    vision_sigma=0.0, friction_jitter=0.0)
+SYSTEMATIC_ONLY = Magnitudes(grasp_offset_random=0.0, grasp_tilt_bias=2.5, grasp_tilt_random=0.0,
+                             vision_sigma=0.0, friction_jitter=0.0)
 
 
 def _ilc() -> Ilc:

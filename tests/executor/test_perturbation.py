@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from assembly_constraints.executor import ExecutorError
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor.trial import trial_rng
-from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor.world.perturbation import CellBias, random_only
 
-MODEL = PerturbationModel()
+MODEL = Magnitudes()
 
 
 def _draws(cell_seed: int, n: int = 50, shape: str = "round_peg", hole: str = "r1") -> list:
@@ -52,11 +52,11 @@ def test_systematic_part_is_the_same_in_every_execution_and_independent_of_use_o
 
 
 def test_random_only_has_no_systematic_part() -> None:
-    bias = CellBias(MODEL.random_only(), 7)
+    bias = CellBias(random_only(MODEL), 7)
     assert not np.any(bias.of_shape("round_peg")[1]) and not np.any(bias.of_hole("r1")[0])
     assert bias.of_hole("r1")[1] == bias.of_hole("s1")[1]
 
 
 def test_a_negative_magnitude_is_refused_naming_it() -> None:
-    with pytest.raises(ExecutorError, match="grasp_tilt_bias"):
-        PerturbationModel(grasp_tilt_bias=-1.0).check()
+    with pytest.raises(ValueError, match="grasp_tilt_bias"):
+        Magnitudes(grasp_tilt_bias=-1.0)

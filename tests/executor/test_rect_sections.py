@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quats_z, turn_z
 from assembly_constraints.executor.world.geometry import (
     HoleSpec,
@@ -21,7 +22,7 @@ from assembly_constraints.executor.world.geometry import (
     plate_obj_text,
     sizes_lp_text,
 )
-from assembly_constraints.executor.world.perturbation import CellBias, PerturbationModel
+from assembly_constraints.executor.world.perturbation import CellBias
 
 
 def _peg(kind: str, a: float, b: float = 0.0) -> PartSpec:
@@ -120,7 +121,7 @@ def test_the_tool_yaw_aligns_the_part_by_the_pairs_symmetry() -> None:
 
 
 def test_the_yaw_error_of_the_vision_is_bias_plus_noise_and_leaves_the_other_draws_alone() -> None:
-    model = PerturbationModel()
+    model = Magnitudes()
     bias = CellBias(model, 3)
     limit = math.radians(model.vision_yaw_max)
     yaws = []

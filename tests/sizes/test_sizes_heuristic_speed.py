@@ -66,3 +66,15 @@ def test_noisy_observations_give_one_model_with_the_best_scored_pair(
     knowledge = Knowledge.from_symbols(parts, holes, models[0])
     selected = [(str(s.arguments[0]), str(s.arguments[1])) for s in models[0] if s.name == "select"]
     assert selected == ([paper_choice(knowledge)] if knowledge.unknown else [])
+
+
+def test_the_heuristic_scores_products_of_more_than_thirty_one_ids() -> None:
+    # 2**B for the gain bits would wrap at B = 31 and above: 16 parts and 16 holes reach it
+    parts, holes = [f"p{i}" for i in range(1, 17)], [f"h{j}" for j in range(1, 17)]
+    sizes = {name: (7 * k) % 17 for k, name in enumerate(parts + holes)}
+    truth = TruthOracle(parts, holes, [(p, h) for p in parts for h in holes if sizes[p] < sizes[h]])
+    learner = SizeLearner(parts, holes, "heuristic")
+    for _ in range(4):
+        pair = learner.next_experiment()
+        assert pair is not None and pair == paper_choice(learner.knowledge)
+        learner.record(*pair, truth.ask(*pair))

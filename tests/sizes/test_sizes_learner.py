@@ -10,7 +10,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp.sizes import learner as learner_module
 from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
+from assembly_constraints.asp.sizes.models import build_model
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
 from tests.conftest import ROOT
@@ -180,3 +182,25 @@ def test_annotated_cranfield_demonstrations_save_experiments(policy: str) -> Non
     assert annotated.knowledge.fits == frozenset(truth.fits)
     assert not set(oracle.asked) & set(shown)
     assert annotated.count <= plain.count - 5
+
+
+@pytest.mark.parametrize("policy", ["systematic", pytest.param("heuristic", marks=pytest.mark.slow)])
+def test_grounding_once_and_per_decision_make_the_same_session(policy, monkeypatch) -> None:
+    # 8 parts on two sections, 6 holes, one wrong answer confirmed away: both ways the learner solves
+    parts, holes = [f"p{i}" for i in range(1, 9)], [f"h{j}" for j in range(1, 7)]
+    sizes = {name: (5 * k) % 11 for k, name in enumerate(parts + holes)}
+    fits = {(p, h) for p in parts for h in holes if sizes[p] < sizes[h]}
+    model = build_model("sections", parts, {p: "round" if i % 2 else "square" for i, p in enumerate(parts)})
+    sessions = []
+    for limit in (0, 10_000):
+        monkeypatch.setattr(learner_module, "GROUND_ONCE_PAIRS", limit)
+        learner = SizeLearner(parts, holes, policy, confirm=1, model=model)
+        flipped = False
+        while (pair := learner.next_experiment()) is not None:
+            result = "fit" if pair in fits else "no_fit"
+            if not flipped and len(learner.experiments) == 4:
+                result, flipped = ("no_fit" if result == "fit" else "fit"), True
+            learner.record(*pair, result)
+        sessions.append(([(e.part, e.hole, e.result) for e in learner.experiments], learner.knowledge.fits))
+    assert sessions[0] == sessions[1]
+    assert sessions[0][1] == frozenset(fits)

@@ -1,0 +1,67 @@
+"""The locating rule of ``import`` (executor/cad/locating.py) on small products of boxes:
+a washer on a plate that only a peg through it locates goes after the peg; one located
+by two pegs gets no pair; a pair the blocking contradicts (a bolt's head over the washer)
+is dropped; reach 0 turns the rule off."""
+
+from __future__ import annotations
+
+import pytest
+import trimesh
+
+from assembly_constraints.executor.cad.derive import derive
+from assembly_constraints.executor.cad.parts import CadPart
+
+MM = 1e-3
+
+
+def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
+    """A box [m] from extents and centre [mm]."""
+    mesh = trimesh.creation.box([MM * e for e in extents])
+    mesh.apply_translation([MM * c for c in centre])
+    return mesh
+
+
+def _part(pid: str, mesh: trimesh.Trimesh) -> CadPart:
+    return CadPart(pid, pid, mesh, f"{pid}.stl")
+
+
+def _product(pegs: list[float], head: bool = False) -> list[CadPart]:
+    """A 100 x 100 x 20 mm plate (top at z 10 mm) with a 10.5 mm square hole 15 mm deep at
+    each x of ``pegs`` [mm], a 10 mm square peg standing 25 mm out of each (with ``head``: a 20 mm
+    square head on top, a bolt), and a 4 mm washer lying on the plate over all of them,
+    its openings 12 mm square (1 mm of play a side)."""
+    plate = trimesh.boolean.difference([_box((100, 100, 20), (0, 0, 0)),
+                                        *(_box((10.5, 10.5, 16), (x, 0, 3)) for x in pegs)], engine="manifold")
+    parts = [_part("plate", plate)]
+    for k, x in enumerate(pegs):
+        peg = _box((10, 10, 40), (x, 0, 15))
+        if head:
+            peg = trimesh.boolean.union([peg, _box((20, 20, 4), (x, 0, 37))], engine="manifold")
+        parts.append(_part(f"peg{k}", peg))
+    washer = trimesh.boolean.difference([_box((90, 30, 4), (0, 0, 12)),
+                                         *(_box((12, 12, 10), (x, 0, 12)) for x in pegs)], engine="manifold")
+    return [*parts, _part("washer", washer)]
+
+
+def test_a_part_only_a_peg_locates_goes_after_the_peg() -> None:
+    derived = derive(_product([0.0]), "plate", {})
+    assert derived.reasons == {("plate", "peg0"): "base", ("plate", "washer"): "base", ("peg0", "washer"): "locates"}
+    assert derived.located["washer"] == {"+x": {"peg0"}, "-x": {"peg0"}, "+y": {"peg0"}, "-y": {"peg0"}}
+    assert not derived.dropped
+    assert derive(_product([0.0]), "plate", {}, reach=0.0).reasons == {
+        ("plate", "peg0"): "base", ("plate", "washer"): "base"}
+    # Moved 0.5 mm the washer meets nothing: its 1 mm of play is beyond that reach.
+    assert ("peg0", "washer") not in derive(_product([0.0]), "plate", {}, reach=0.5 * MM).edges
+
+
+def test_a_part_two_pegs_locate_gets_no_pair() -> None:
+    derived = derive(_product([-20.0, 20.0]), "plate", {})
+    assert derived.located["washer"]["+x"] == {"peg0", "peg1"}
+    assert {pair for pair, reason in derived.reasons.items() if reason == "locates"} == set()
+
+
+@pytest.mark.parametrize("reach", [1.5 * MM, 3 * MM])
+def test_a_locating_pair_the_blocking_contradicts_is_dropped(reach: float) -> None:
+    derived = derive(_product([0.0], head=True), "plate", {}, reach)
+    assert derived.reasons[("washer", "peg0")] == "blocks"  # the bolt's head lies over the washer
+    assert derived.dropped == {("peg0", "washer")} and ("peg0", "washer") not in derived.edges
