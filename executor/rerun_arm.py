@@ -52,9 +52,10 @@ class ArmRecorder:
                                   physicsClientId=self.client)
         return np.array([[*s[4], *s[5]] for s in states], dtype=np.float64)
 
-    def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str, with_static: bool) -> None:
-        """Log the held part's geometry at the current time and, ``with_static``, every
-        other link's geometry and the fixed base's pose (once per recording is enough)."""
+    def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str | None, with_static: bool) -> None:
+        """Log the held part's geometry at the current time (None: the hand is empty, nothing
+        is logged for it) and, ``with_static``, every other link's geometry and the fixed
+        base's pose (once per recording is enough)."""
         for k, visual in enumerate(self._visuals):
             link, geom_type, dims, mesh = visual[1], visual[2], visual[3], visual[4]
             entity = f"{root}/arm/{self.names[link]}/visual_{k}"
@@ -65,7 +66,8 @@ class ArmRecorder:
             if archetype is None:
                 continue
             if is_part:
-                rec.log(entity, pose, archetype, rr.TextDocument(held_part))
+                if held_part is not None:
+                    rec.log(entity, pose, archetype, rr.TextDocument(held_part))
             elif with_static:
                 rec.log(entity, pose, archetype, static=True)
         if not with_static:

@@ -60,6 +60,7 @@ from assembly_constraints.bridge.recording.layout import (
     blueprint,
     cell_root,
     fig17_path,
+    opening,
 )
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 from assembly_constraints.executor import ExecutorError
@@ -222,7 +223,8 @@ class AttemptLogger:
         self._arm_static_sent = False
         self._held: str | None = None
         if send_blueprint:
-            self.rec.send_blueprint(blueprint(Contents(cells=(cell_id,))))
+            live = viewer.connect is not None
+            self.rec.send_blueprint(blueprint(Contents(cells=(cell_id,)), play_state=opening(live)))
 
     @classmethod
     def to_file(
@@ -268,6 +270,15 @@ class AttemptLogger:
         self._set_time(self._last_time)
         arm.log_geometry(self.rec, self.root, held_part, with_static=not self._arm_static_sent)
         self._arm, self._held, self._arm_static_sent = arm, held_part, True
+
+    def log_arm_at_rest(self, arm: ArmRecorder) -> None:
+        """The arm as it stands before its first move, its hand empty, at the current time
+        (``sim_time`` 0 and ``experiment`` 0 before any attempt): a viewer opened at the
+        start of a timeline shows it in place instead of its links piled at the origin."""
+        self._set_time(self._last_time)
+        arm.log_geometry(self.rec, self.root, None, with_static=not self._arm_static_sent)
+        arm.log_now(self.rec, self.root)
+        self._arm_static_sent = True
 
     def log_scene_mesh(self, name: str, mesh: Path, color: Sequence[int]) -> None:
         """Log a static mesh file (``.obj``/``.stl``/``.glb``, world coordinates [m]) under

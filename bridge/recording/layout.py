@@ -18,24 +18,31 @@ single trial's and an assembly's on ``sim_time``. The paper's Fig. 17 (force aga
 DMP phase) is drawn as a 2D plot of one chosen attempt, visible on every timeline.
 
 A blueprint cannot set the time the viewer opens at (the time panel has no cursor field).
-Opened paused, the viewer sits at the start of the timeline, where the planner has logged
-nothing yet; so the blueprints follow the newest data (``play_state="following"``): a
-finished recording opens at its end (the last experiment's knowledge, the whole plots),
-a live one keeps up with it. A running viewer's cursor is moved through Rerun's viewer
-control instead (:class:`TimePoint`, ``view --screenshot --at``).
+Opened ``paused``, the viewer sits at the start of the timeline and a time the user picks
+stays; so the start is made meaningful: the planner logs the knowledge learning starts
+from (the demonstrated fits, every other pair unknown) as ``experiment`` 0 when it starts,
+and a cell logs its arm at rest with its scene at ``sim_time`` 0 when it starts. Recording
+files and ``view.rbl`` open paused (:data:`OPENS`); a stream watched live follows the newest
+data (``play_state="following"``). A running viewer's cursor is moved through Rerun's
+viewer control instead (:class:`TimePoint`, ``view --screenshot --at``).
 
-A view's ``time_ranges`` and per-entity overrides do take effect: the cell's 3D view
-draws the tool tip over the last :data:`TRAIL_S` of each timeline, a trail of the
-recent tool path behind the tip, while every other entity is drawn at the cursor.
+A view's ``time_ranges`` and per-entity overrides do take effect: the cell's 3D views
+draw the tool tip over the last :data:`TRAIL_S` of each timeline, a trail of the recent
+tool path behind the tip, while every other entity is drawn at the cursor; the cell's
+close-up follows the tip (``EyeControls3D(tracking_entity=)``), where that trail is
+centimetres wide rather than a pixel.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Literal
 
 import rerun.blueprint as rrb
+
+from assembly_constraints.bridge.files import check_writable
 
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
@@ -53,6 +60,12 @@ TRAIL_S = 1.0
 CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
 the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
+CLOSE_UP_OFFSET_M = (0.12, 0.09, 0.07)
+"""Where the close-up's camera sits relative to the tool tip it follows [m]: 0.17 m away,
+from the tray's side and above, so a 0.1 m neighbourhood of the tip fills the view."""
+PlayState = Literal["following", "paused"]
+OPENS: PlayState = "paused"
+"""How a recording file or ``view.rbl`` opens: paused at the start of its timeline."""
 
 
 @dataclass(frozen=True)
@@ -205,24 +218,37 @@ def _trail() -> rrb.VisibleTimeRanges:
     return rrb.VisibleTimeRanges([*recent, experiment])
 
 
+def _cell_3d(root: str, name: str, eye: rrb.EyeControls3D) -> rrb.Spatial3DView:
+    """A 3D view of the cell under ``root`` (scene, arm, tool with the tip's trail, search
+    path) seen through ``eye``."""
+    return rrb.Spatial3DView(
+        origin=root, name=name,
+        contents=["$origin/scene/**", "$origin/arm/**", "$origin/tool/**", "$origin/search/**"],
+        eye_controls=eye, overrides={f"/{root}/tool/tip": _trail()},
+    )
+
+
 def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
     """A cell's tab: the 3D cell (arm, scene, tool tip with its trail (:func:`_trail`) and
-    force, the attempt's tool path, search path) above the Fig. 17 plot of attempt ``fig17``
-    (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) and the outcome log;
+    force, the attempt's tool path, search path) above a close-up of the same that follows
+    the tool tip (:data:`CLOSE_UP_OFFSET_M`); the Fig. 17 plot of attempt ``fig17``
+    (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) above the outcome log;
     force, torque and the deviations of eqs. 6 and 7 per attempt."""
     root = cell_root(cell_id)
     attempt = fig17.replace("/", " ") if fig17 else "every attempt"
+    tip = f"/{root}/tool/tip"
+    close_up = rrb.EyeControls3D(position=CLOSE_UP_OFFSET_M, look_target=(0.0, 0.0, 0.0), eye_up=(0.0, 0.0, 1.0),
+                                 tracking_entity=tip)
     return rrb.Horizontal(
         rrb.Vertical(
-            rrb.Spatial3DView(
-                origin=root, name=f"{cell_id}: cell",
-                contents=["$origin/scene/**", "$origin/arm/**", "$origin/tool/**", "$origin/search/**"],
-                eye_controls=CELL_EYE, overrides={f"/{root}/tool/tip": _trail()},
-            ),
+            _cell_3d(root, f"{cell_id}: cell", CELL_EYE),
+            _cell_3d(root, f"{cell_id}: tool close-up (follows the tip; trail {TRAIL_S:g} s)", close_up),
+        ),
+        rrb.Vertical(
             rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
                               name=f"Fig. 17 {attempt}: F_des (pale), F_mes [N] over DMP phase 0..1"),
             rrb.TextLogView(origin=f"{root}/outcome", name=f"{cell_id}: outcomes"),
-            row_shares=[3, 2, 1],
+            row_shares=[2, 1],
         ),
         rrb.Vertical(
             _plot(f"{root}/wrench/force", "force F_mes, F_des [N]"),
@@ -231,7 +257,7 @@ def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
             _plot(f"{root}/deviation/torque", "‖M_mes − M_des‖ [Nm] per attempt: green fit, red no fit",
                   legend=False),
         ),
-        column_shares=[1, 1],
+        column_shares=[3, 2, 3],
         name=cell_id,
     )
 
@@ -257,12 +283,12 @@ def tab_names(contents: Contents) -> list[str]:
             *(f"{cell} assembly" for cell in contents.assembly_cells)]
 
 
-def blueprint(contents: Contents, active_tab: int = 0, play_state: Literal["following", "paused"] = "following",
+def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = OPENS,
               timeline: str | None = None) -> rrb.Blueprint:
     """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
     an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
-    ``timeline`` (default :attr:`Contents.timeline`), following the newest data
-    (``play_state="paused"``: the cursor stays where it is)."""
+    ``timeline`` (default :attr:`Contents.timeline`), paused (the cursor stays where it is:
+    at the start of the timeline when the viewer opens) or ``"following"`` the newest data."""
     chosen = dict(contents.fig17)
     tabs = [
         *([planner_views()] if contents.planner else []),
@@ -274,3 +300,17 @@ def blueprint(contents: Contents, active_tab: int = 0, play_state: Literal["foll
         rrb.TimePanel(timeline=timeline or contents.timeline, play_state=play_state),
         collapse_panels=False,
     )
+
+
+def opening(live: bool) -> PlayState:
+    """How a stream's own blueprint opens: following the newest data when someone watches it
+    live (``live``), else :data:`OPENS`."""
+    return "following" if live else OPENS
+
+
+def write_blueprint(folder: Path, contents: Contents) -> Path:
+    """``folder/view.rbl``: the blueprint of a recording holding ``contents``, opening
+    paused; BridgeError naming the file when it cannot be written."""
+    path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
+    blueprint(contents).save(APPLICATION_ID, str(path))
+    return path

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from assembly_constraints.asp.view.cli import write_blueprint
-from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names
+from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names, write_blueprint
 from assembly_constraints.bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from assembly_constraints.executor.evidence import AttemptEvidence
 from assembly_constraints.executor.rerun_log import AttemptLogger
@@ -85,7 +84,7 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
                                 fig17=(("c1", "fit/e0002_p2_r2_s0_a1"),))
     layout = read_blueprint(write_blueprint(tmp_path, contents))
     assert layout.tabs == ["planner", "c1", "c2", "a1 assembly", "c1 assembly"] == tab_names(contents)
-    assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 1}  # paused: opens at the start
     fig17 = [v for v in layout.views if v.origin == "executor/c1/by_phase"]
     assert fig17[0].contents == ["$origin/fit/e0002_p2_r2_s0_a1/**"] and "e0002_p2_r2_s0_a1" in fig17[0].name
     spatial = [v for v in layout.views if v.kind == "3D"]
