@@ -8,7 +8,9 @@ the world pose of each link frame (one ``getLinkStates`` call, ~15 µs).  Entiti
 ================================ ==========================================================
 ``<link>``                       the link frame's pose (Transform3D) over ``sim_time`` [m]
 ``<link>/visual_<k>``            the link's geometry in its frame: a mesh (``Asset3D``,
-                                 static) or a box/cylinder (the flange, the held part)
+                                 static) or a box/cylinder (the flange)
+``part/held``                    the held part's solid in the ``part`` frame (its tip), from
+                                 the time it is taken (the cell tab's close-up follows it)
 ================================ ==========================================================
 
 The base link never moves and is logged once.  The held part's geometry is logged at the
@@ -24,6 +26,7 @@ import numpy as np
 import pybullet as pb
 import rerun as rr
 
+from assembly_constraints.bridge.recording.layout import HELD_PART
 from assembly_constraints.executor.world.scene import link_frame
 
 _ARM_COLOR = [235, 120, 30]
@@ -58,9 +61,9 @@ class ArmRecorder:
         base's pose (once per recording is enough)."""
         for k, visual in enumerate(self._visuals):
             link, geom_type, dims, mesh = visual[1], visual[2], visual[3], visual[4]
-            entity = f"{root}/arm/{self.names[link]}/visual_{k}"
+            is_part = self.names[link] == "part"  # one visual: the part's solid (arm_urdf_text)
+            entity = f"{root}/{HELD_PART}" if is_part else f"{root}/arm/{self.names[link]}/visual_{k}"
             pose = rr.Transform3D(translation=list(visual[5]), quaternion=rr.Quaternion(xyzw=list(visual[6])))
-            is_part = self.names[link] == "part"
             color = _PART_COLOR if is_part else _ARM_COLOR if geom_type == pb.GEOM_MESH else _TOOL_COLOR
             archetype = _archetype(geom_type, dims, mesh, color)
             if archetype is None:

@@ -29,8 +29,8 @@ viewer control instead (:class:`TimePoint`, ``view --screenshot --at``).
 A view's ``time_ranges`` and per-entity overrides do take effect: the cell's 3D views
 draw the tool tip over the last :data:`TRAIL_S` of each timeline, a trail of the recent
 tool path behind the tip, while every other entity is drawn at the cursor; the cell's
-close-up follows the tip (``EyeControls3D(tracking_entity=)``), where that trail is
-centimetres wide rather than a pixel.
+close-up follows the held part (``EyeControls3D(tracking_entity=)``), whose tip is the
+tool tip, where that trail is centimetres wide rather than a pixel.
 """
 
 from __future__ import annotations
@@ -60,9 +60,14 @@ TRAIL_S = 1.0
 CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
 the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
+HELD_PART = "arm/part/held"
+"""Entity of the part in the hand, below a cell's root (``executor.rerun_arm``)."""
+CLOSE_UP_TARGET_M = (0.59, 0.0, 0.1)
+"""Where the close-up looks before a part is taken [m]: over the plate's centre."""
 CLOSE_UP_OFFSET_M = (0.12, 0.09, 0.07)
-"""Where the close-up's camera sits relative to the tool tip it follows [m]: 0.17 m away,
-from the tray's side and above, so a 0.1 m neighbourhood of the tip fills the view."""
+"""The direction the close-up looks from [m], from the tray's side and above. The viewer
+sets its distance when it starts following the held part: 1.5 times the radius of the
+part's bounding sphere (Rerun 0.41's ``eye.rs``), a few centimetres for Cranfield's pegs."""
 PlayState = Literal["following", "paused"]
 OPENS: PlayState = "paused"
 """How a recording file or ``view.rbl`` opens: paused at the start of its timeline."""
@@ -128,7 +133,8 @@ class Contents:
     """What a recording holds, as far as its blueprint is concerned.
 
     ``planner``: the planner logged (a session); ``cells``: cells that logged more than their
-    static scene and an assembly (attempts, or a truth cell's outcomes);
+    static scene, their arm and an assembly (attempts, or a truth cell's outcomes; the arm
+    alone is the one at rest every simulated cell logs when it starts);
     ``assembly_cells``: cells that executed a plan; ``fig17``: ``(cell, attempt)`` pairs,
     the attempt (``<outcome>/<key>``, :func:`fig17_path`) whose Fig. 17 plot the cell's tab
     shows (every attempt's when the cell has none here).
@@ -150,7 +156,7 @@ class Contents:
         each cell's Fig. 17 shows its first fitting attempt, else its first attempt."""
         paths = sorted(p.strip("/") for p in entity_paths)
         cells = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and p.count("/") >= 2
-                        and p.split("/")[2] not in ("assembly", "scene")})
+                        and p.split("/")[2] not in ("assembly", "scene", "arm")})
         assembly = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and "/assembly/" in p})
         chosen = []
         for cell in cells:
@@ -231,18 +237,19 @@ def _cell_3d(root: str, name: str, eye: rrb.EyeControls3D) -> rrb.Spatial3DView:
 def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
     """A cell's tab: the 3D cell (arm, scene, tool tip with its trail (:func:`_trail`) and
     force, the attempt's tool path, search path) above a close-up of the same that follows
-    the tool tip (:data:`CLOSE_UP_OFFSET_M`); the Fig. 17 plot of attempt ``fig17``
+    the held part, whose tip is the tool tip (:data:`HELD_PART`, :data:`CLOSE_UP_OFFSET_M`;
+    over the plate, :data:`CLOSE_UP_TARGET_M`, before a part is taken); the Fig. 17 plot of attempt ``fig17``
     (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) above the outcome log;
     force, torque and the deviations of eqs. 6 and 7 per attempt."""
     root = cell_root(cell_id)
     attempt = fig17.replace("/", " ") if fig17 else "every attempt"
-    tip = f"/{root}/tool/tip"
-    close_up = rrb.EyeControls3D(position=CLOSE_UP_OFFSET_M, look_target=(0.0, 0.0, 0.0), eye_up=(0.0, 0.0, 1.0),
-                                 tracking_entity=tip)
+    eye = tuple(t + d for t, d in zip(CLOSE_UP_TARGET_M, CLOSE_UP_OFFSET_M))
+    close_up = rrb.EyeControls3D(position=eye, look_target=CLOSE_UP_TARGET_M, eye_up=(0.0, 0.0, 1.0),
+                                 tracking_entity=f"/{root}/{HELD_PART}")
     return rrb.Horizontal(
         rrb.Vertical(
             _cell_3d(root, f"{cell_id}: cell", CELL_EYE),
-            _cell_3d(root, f"{cell_id}: tool close-up (follows the tip; trail {TRAIL_S:g} s)", close_up),
+            _cell_3d(root, f"{cell_id}: close-up following the held part (tip trail {TRAIL_S:g} s)", close_up),
         ),
         rrb.Vertical(
             rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
@@ -298,7 +305,7 @@ def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = O
     return rrb.Blueprint(
         rrb.Tabs(*tabs, active_tab=active_tab),
         rrb.TimePanel(timeline=timeline or contents.timeline, play_state=play_state),
-        collapse_panels=False,
+        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),  # the views get the room
     )
 
 
