@@ -55,10 +55,12 @@ class ArmRecorder:
                                   physicsClientId=self.client)
         return np.array([[*s[4], *s[5]] for s in states], dtype=np.float64)
 
-    def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str | None, with_static: bool) -> None:
+    def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str | None, with_static: bool,
+                     static: bool = True) -> None:
         """Log the held part's geometry at the current time (None: the hand is empty, nothing
         is logged for it) and, ``with_static``, every other link's geometry and the fixed
-        base's pose (once per recording is enough)."""
+        base's pose: static (once per recording is enough), or at the current time when not
+        ``static`` (nothing is drawn before it: no links piled at the origin before they move)."""
         for k, visual in enumerate(self._visuals):
             link, geom_type, dims, mesh = visual[1], visual[2], visual[3], visual[4]
             is_part = self.names[link] == "part"  # one visual: the part's solid (arm_urdf_text)
@@ -72,12 +74,12 @@ class ArmRecorder:
                 if held_part is not None:
                     rec.log(entity, pose, archetype, rr.TextDocument(held_part))
             elif with_static:
-                rec.log(entity, pose, archetype, static=True)
+                rec.log(entity, pose, archetype, static=static)
         if not with_static:
             return
         base_pos, base_quat = link_frame(self.client, self.robot, _BASE)
         rec.log(f"{root}/arm/base", rr.Transform3D(translation=list(base_pos),
-                                                   quaternion=rr.Quaternion(xyzw=list(base_quat))), static=True)
+                                                   quaternion=rr.Quaternion(xyzw=list(base_quat))), static=static)
 
     def log_now(self, rec: rr.RecordingStream, root: str) -> None:
         """Log every moving link's pose now, at the stream's current time (row by row, for
