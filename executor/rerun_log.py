@@ -273,10 +273,12 @@ class AttemptLogger:
 
     def log_arm_at_rest(self, arm: ArmRecorder) -> None:
         """The arm as it stands before its first move, its hand empty, at the current time
-        (``sim_time`` 0 and ``experiment`` 0 before any attempt): a viewer opened at the
-        start of a timeline shows it in place instead of its links piled at the origin."""
+        (``sim_time`` 0 and ``experiment`` 0 before any attempt, ``log_time`` now): its
+        meshes and link poses, both logged now rather than the meshes static, so a viewer
+        shows the arm in place from then on and nothing of it before (on ``log_time``, before
+        the cell started), never its links piled at the origin."""
         self._set_time(self._last_time)
-        arm.log_geometry(self.rec, self.root, None, with_static=not self._arm_static_sent)
+        arm.log_geometry(self.rec, self.root, None, with_static=not self._arm_static_sent, static=False)
         arm.log_now(self.rec, self.root)
         self._arm_static_sent = True
 

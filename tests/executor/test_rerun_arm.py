@@ -26,9 +26,11 @@ def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) ->
         cell.close()
         logger.close()
     entities = read_recording(rrd).entities
-    for link in ["base", *KUKA_LINKS]:
-        visual = next(e for path, e in entities.items() if path.startswith(f"/executor/c1/arm/{link}/visual_"))
-        assert "Asset3D:blob" in visual.components and visual.static_rows == visual.rows
+    for link in ["base", *KUKA_LINKS]:  # each mesh logged once, with the arm at rest
+        path, visual = next((p, e) for p, e in entities.items() if p.startswith(f"/executor/c1/arm/{link}/visual_"))
+        assert "Asset3D:blob" in visual.components and not visual.static_rows
+        assert len(column_values(rrd, path, "Asset3D:media_type")) == 1
+        assert set(column_values(rrd, path, "experiment")) == {0} and set(column_values(rrd, path, "sim_time")) == {0}
     assert "Asset3D:blob" in entities["/executor/c1/scene/plate_mesh"].components
     for link in [*KUKA_LINKS, "flange", "part"]:
         assert "sim_time" in entities[f"/executor/c1/arm/{link}"].timelines
