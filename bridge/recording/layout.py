@@ -18,10 +18,11 @@ single trial's and an assembly's on ``sim_time``. The paper's Fig. 17 (force aga
 DMP phase) is drawn as a 2D plot of one chosen attempt, visible on every timeline.
 
 A blueprint cannot set the time the viewer opens at (the time panel has no cursor field).
-Opened ``paused``, the viewer sits at the start of the timeline and a time the user picks
-stays; so the start is made meaningful: the planner logs the knowledge learning starts
-from (the demonstrated fits, every other pair unknown) as ``experiment`` 0 when it starts,
-and a cell logs its arm at rest with its scene at ``sim_time`` 0 when it starts. Recording
+Opened ``paused``, the viewer keeps the cursor where the first data it receives starts and
+a time the user picks stays; so the starts are made meaningful: the planner logs the
+knowledge learning starts from (the demonstrated fits, every other pair unknown) as
+``experiment`` 0 when it starts, and a simulated cell logs its arm at rest with its scene
+at ``sim_time`` 0 when it starts (docs/recordings.md: what a user sees). Recording
 files and ``view.rbl`` open paused (:data:`OPENS`); a stream watched live follows the newest
 data (``play_state="following"``). A running viewer's cursor is moved through Rerun's
 viewer control instead (:class:`TimePoint`, ``view --screenshot --at``).
