@@ -65,10 +65,11 @@ HELD_PART = "arm/part/held"
 """Entity of the part in the hand, below a cell's root (``executor.rerun_arm``)."""
 CLOSE_UP_TARGET_M = (0.59, 0.0, 0.1)
 """Where the close-up looks before a part is taken [m]: over the plate's centre."""
-CLOSE_UP_OFFSET_M = (0.12, 0.09, 0.07)
-"""The direction the close-up looks from [m], from the tray's side and above. The viewer
-sets its distance when it starts following the held part: 1.5 times the radius of the
-part's bounding sphere (Rerun 0.41's ``eye.rs``), a few centimetres for Cranfield's pegs."""
+CLOSE_UP_OFFSET_M = (0.07, 0.05, 0.12)
+"""The direction the close-up looks from [m]: from the tray's side, 54° above the horizontal,
+so a search path on a boss top is seen from above. The viewer sets its distance when it
+starts following the held part: 1.5 times the radius of the part's bounding sphere (Rerun
+0.41's ``eye.rs``), a few centimetres for Cranfield's pegs."""
 PlayState = Literal["following", "paused"]
 OPENS: PlayState = "paused"
 """How a recording file or ``view.rbl`` opens: paused at the start of its timeline."""
