@@ -56,11 +56,13 @@ class ArmRecorder:
         return np.array([[*s[4], *s[5]] for s in states], dtype=np.float64)
 
     def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str | None, with_static: bool,
-                     static: bool = True) -> None:
-        """Log the held part's geometry at the current time (None: the hand is empty, nothing
-        is logged for it) and, ``with_static``, every other link's geometry and the fixed
-        base's pose: static (once per recording is enough), or at the current time when not
-        ``static`` (nothing is drawn before it: no links piled at the origin before they move)."""
+                     static: bool = True, at: Sequence[rr.TimeColumn] | None = None) -> None:
+        """Log the held part's geometry (None: the hand is empty, nothing is logged for it)
+        and, ``with_static``, every other link's geometry and the fixed base's pose. The held
+        part at the current time, the rest ``static`` (once per recording is enough) or, when
+        not, at the current time too; with ``at`` (one-row time columns: one instant on each
+        timeline, ``log_time`` included), everything as rows at that instant. Not static,
+        nothing is drawn before it (no links piled at the origin before the arm is there)."""
         for k, visual in enumerate(self._visuals):
             link, geom_type, dims, mesh = visual[1], visual[2], visual[3], visual[4]
             is_part = self.names[link] == "part"  # one visual: the part's solid (arm_urdf_text)
@@ -72,14 +74,14 @@ class ArmRecorder:
                 continue
             if is_part:
                 if held_part is not None:
-                    rec.log(entity, pose, archetype, rr.TextDocument(held_part))
+                    _log_row(rec, entity, [pose, archetype, rr.TextDocument(held_part)], at, static=False)
             elif with_static:
-                rec.log(entity, pose, archetype, static=static)
+                _log_row(rec, entity, [pose, archetype], at, static)
         if not with_static:
             return
         base_pos, base_quat = link_frame(self.client, self.robot, _BASE)
-        rec.log(f"{root}/arm/base", rr.Transform3D(translation=list(base_pos),
-                                                   quaternion=rr.Quaternion(xyzw=list(base_quat))), static=static)
+        _log_row(rec, f"{root}/arm/base", [rr.Transform3D(translation=list(base_pos),
+                                                          quaternion=rr.Quaternion(xyzw=list(base_quat)))], at, static)
 
     def log_now(self, rec: rr.RecordingStream, root: str) -> None:
         """Log every moving link's pose now, at the stream's current time (row by row, for
@@ -95,6 +97,19 @@ class ArmRecorder:
                 f"{root}/arm/{self.names[link]}", indexes=indexes,
                 columns=rr.Transform3D.columns(translation=poses[:, column, :3], quaternion=poses[:, column, 3:]),
             )
+
+
+def _log_row(rec: rr.RecordingStream, entity: str, parts: Sequence[rr.AsComponents],
+             at: Sequence[rr.TimeColumn] | None, static: bool) -> None:
+    """Log ``parts`` on ``entity`` as one row: at the instant ``at`` (one-row time columns,
+    sent column-wise, so ``log_time`` is that instant too rather than the moment of the
+    call), else ``static`` or at the stream's current time."""
+    if at is None:
+        rec.log(entity, *parts, static=static)
+        return
+    batches = [batch for part in parts for batch in part.as_component_batches()]
+    rec.send_columns(entity, indexes=at, columns=[batch.partition([len(batch.as_arrow_array())])
+                                                  for batch in batches])
 
 
 def _archetype(geom_type: int, dims: Sequence[float], mesh: bytes, color: list[int]) -> rr.AsComponents | None:

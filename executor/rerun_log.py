@@ -274,12 +274,14 @@ class AttemptLogger:
     def log_arm_at_rest(self, arm: ArmRecorder) -> None:
         """The arm as it stands before its first move, its hand empty, at the current time
         (``sim_time`` 0 and ``experiment`` 0 before any attempt, ``log_time`` now): its
-        meshes and link poses, both logged now rather than the meshes static, so a viewer
-        shows the arm in place from then on and nothing of it before (on ``log_time``, before
-        the cell started), never its links piled at the origin."""
-        self._set_time(self._last_time)
-        arm.log_geometry(self.rec, self.root, None, with_static=not self._arm_static_sent, static=False)
-        arm.log_now(self.rec, self.root)
+        meshes and link poses, all at that one instant rather than the meshes static, so a
+        viewer shows the whole arm in place from then on and nothing of it before (on
+        ``log_time``, before the cell started), never its links piled at the origin."""
+        at = [rr.TimeColumn("experiment", sequence=[self._experiment]),
+              rr.TimeColumn("sim_time", duration=[self._last_time]),
+              rr.TimeColumn(SESSION_TIMELINE, timestamp=[time.time()])]
+        arm.log_geometry(self.rec, self.root, None, with_static=not self._arm_static_sent, at=at)
+        arm.send(self.rec, self.root, at, arm.sample()[np.newaxis])
         self._arm_static_sent = True
 
     def log_scene_mesh(self, name: str, mesh: Path, color: Sequence[int]) -> None:

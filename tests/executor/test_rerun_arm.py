@@ -39,6 +39,11 @@ def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) ->
     # sim_time 0), its hand empty: the held part's geometry comes with the attempt.
     for link in [*KUKA_LINKS, "flange", "part"]:
         assert column_values(rrd, f"executor/c1/arm/{link}", "experiment")[:2] == [0, 1], link
+    # ... all of it at one instant on log_time too: a viewer opened there shows the whole arm
+    at_rest = {column_values(rrd, f"executor/c1/arm/{link}", "log_time")[0] for link in [*KUKA_LINKS, "part"]}
+    at_rest |= {column_values(rrd, p, "log_time")[0] for p in entities if p.startswith("/executor/c1/arm/lbr")
+                and "/visual_" in p}
+    assert len(at_rest) == 1
     assert column_values(rrd, "executor/c1/arm/part", "sim_time")[0] == 0
     assert column_values(rrd, "executor/c1/arm/part/held", "experiment") == [1]
     assert "TextDocument:text" in entities["/executor/c1/arm/part/held"].components  # names the part
