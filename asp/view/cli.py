@@ -12,7 +12,7 @@ one line per entity path with its row count, timelines and components (``--json`
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
 free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
 picture of every tab, rendered by the web viewer in a headless Chromium
-(:mod:`assembly_constraints.asp.view.screenshot`), at the end of the recording and, for each ``--at
+(:mod:`assembly_constraints.asp.view.screenshot`), as the viewer opens the recording and, for each ``--at
 TIMELINE=VALUE`` (``experiment=1``), paused at that time. A RUN without ``.rrd`` files is
 an error (exit code 2).
 """

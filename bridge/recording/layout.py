@@ -297,7 +297,8 @@ def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = O
     """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
     an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
     ``timeline`` (default :attr:`Contents.timeline`), paused (the cursor stays where it is:
-    at the start of the timeline when the viewer opens) or ``"following"`` the newest data."""
+    where the first data it received starts when the viewer opens) or ``"following"`` the
+    newest data."""
     chosen = dict(contents.fig17)
     tabs = [
         *([planner_views()] if contents.planner else []),
