@@ -8,7 +8,9 @@ the world pose of each link frame (one ``getLinkStates`` call, ~15 µs).  Entiti
 ================================ ==========================================================
 ``<link>``                       the link frame's pose (Transform3D) over ``sim_time`` [m]
 ``<link>/visual_<k>``            the link's geometry in its frame: a mesh (``Asset3D``,
-                                 static) or a box/cylinder (the flange, the held part)
+                                 static) or a box/cylinder (the flange)
+``part/held``                    the held part's solid in the ``part`` frame (its tip), from
+                                 the time it is taken (the cell tab's close-up follows it)
 ================================ ==========================================================
 
 The base link never moves and is logged once.  The held part's geometry is logged at the
@@ -24,6 +26,7 @@ import numpy as np
 import pybullet as pb
 import rerun as rr
 
+from assembly_constraints.bridge.recording.layout import HELD_PART
 from assembly_constraints.executor.world.scene import link_frame
 
 _ARM_COLOR = [235, 120, 30]
@@ -52,27 +55,33 @@ class ArmRecorder:
                                   physicsClientId=self.client)
         return np.array([[*s[4], *s[5]] for s in states], dtype=np.float64)
 
-    def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str, with_static: bool) -> None:
-        """Log the held part's geometry at the current time and, ``with_static``, every
-        other link's geometry and the fixed base's pose (once per recording is enough)."""
+    def log_geometry(self, rec: rr.RecordingStream, root: str, held_part: str | None, with_static: bool,
+                     static: bool = True, at: Sequence[rr.TimeColumn] | None = None) -> None:
+        """Log the held part's geometry (None: the hand is empty, nothing is logged for it)
+        and, ``with_static``, every other link's geometry and the fixed base's pose. The held
+        part at the current time, the rest ``static`` (once per recording is enough) or, when
+        not, at the current time too; with ``at`` (one-row time columns: one instant on each
+        timeline, ``log_time`` included), everything as rows at that instant. Not static,
+        nothing is drawn before it (no links piled at the origin before the arm is there)."""
         for k, visual in enumerate(self._visuals):
             link, geom_type, dims, mesh = visual[1], visual[2], visual[3], visual[4]
-            entity = f"{root}/arm/{self.names[link]}/visual_{k}"
+            is_part = self.names[link] == "part"  # one visual: the part's solid (arm_urdf_text)
+            entity = f"{root}/{HELD_PART}" if is_part else f"{root}/arm/{self.names[link]}/visual_{k}"
             pose = rr.Transform3D(translation=list(visual[5]), quaternion=rr.Quaternion(xyzw=list(visual[6])))
-            is_part = self.names[link] == "part"
             color = _PART_COLOR if is_part else _ARM_COLOR if geom_type == pb.GEOM_MESH else _TOOL_COLOR
             archetype = _archetype(geom_type, dims, mesh, color)
             if archetype is None:
                 continue
             if is_part:
-                rec.log(entity, pose, archetype, rr.TextDocument(held_part))
+                if held_part is not None:
+                    _log_row(rec, entity, [pose, archetype, rr.TextDocument(held_part)], at, static=False)
             elif with_static:
-                rec.log(entity, pose, archetype, static=True)
+                _log_row(rec, entity, [pose, archetype], at, static)
         if not with_static:
             return
         base_pos, base_quat = link_frame(self.client, self.robot, _BASE)
-        rec.log(f"{root}/arm/base", rr.Transform3D(translation=list(base_pos),
-                                                   quaternion=rr.Quaternion(xyzw=list(base_quat))), static=True)
+        _log_row(rec, f"{root}/arm/base", [rr.Transform3D(translation=list(base_pos),
+                                                          quaternion=rr.Quaternion(xyzw=list(base_quat)))], at, static)
 
     def log_now(self, rec: rr.RecordingStream, root: str) -> None:
         """Log every moving link's pose now, at the stream's current time (row by row, for
@@ -88,6 +97,19 @@ class ArmRecorder:
                 f"{root}/arm/{self.names[link]}", indexes=indexes,
                 columns=rr.Transform3D.columns(translation=poses[:, column, :3], quaternion=poses[:, column, 3:]),
             )
+
+
+def _log_row(rec: rr.RecordingStream, entity: str, parts: Sequence[rr.AsComponents],
+             at: Sequence[rr.TimeColumn] | None, static: bool) -> None:
+    """Log ``parts`` on ``entity`` as one row: at the instant ``at`` (one-row time columns,
+    sent column-wise, so ``log_time`` is that instant too rather than the moment of the
+    call), else ``static`` or at the stream's current time."""
+    if at is None:
+        rec.log(entity, *parts, static=static)
+        return
+    batches = [batch for part in parts for batch in part.as_component_batches()]
+    rec.send_columns(entity, indexes=at, columns=[batch.partition([len(batch.as_arrow_array())])
+                                                  for batch in batches])
 
 
 def _archetype(geom_type: int, dims: Sequence[float], mesh: bytes, color: list[int]) -> rr.AsComponents | None:

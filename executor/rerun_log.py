@@ -60,6 +60,7 @@ from assembly_constraints.bridge.recording.layout import (
     blueprint,
     cell_root,
     fig17_path,
+    opening,
 )
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 from assembly_constraints.executor import ExecutorError
@@ -222,7 +223,8 @@ class AttemptLogger:
         self._arm_static_sent = False
         self._held: str | None = None
         if send_blueprint:
-            self.rec.send_blueprint(blueprint(Contents(cells=(cell_id,))))
+            live = viewer.connect is not None
+            self.rec.send_blueprint(blueprint(Contents(cells=(cell_id,)), play_state=opening(live)))
 
     @classmethod
     def to_file(
@@ -268,6 +270,19 @@ class AttemptLogger:
         self._set_time(self._last_time)
         arm.log_geometry(self.rec, self.root, held_part, with_static=not self._arm_static_sent)
         self._arm, self._held, self._arm_static_sent = arm, held_part, True
+
+    def log_arm_at_rest(self, arm: ArmRecorder) -> None:
+        """The arm as it stands before its first move, its hand empty, at the current time
+        (``sim_time`` 0 and ``experiment`` 0 before any attempt, ``log_time`` now): its
+        meshes and link poses, all at that one instant rather than the meshes static, so a
+        viewer shows the whole arm in place from then on and nothing of it before (on
+        ``log_time``, before the cell started), never its links piled at the origin."""
+        at = [rr.TimeColumn("experiment", sequence=[self._experiment]),
+              rr.TimeColumn("sim_time", duration=[self._last_time]),
+              rr.TimeColumn(SESSION_TIMELINE, timestamp=[time.time()])]
+        arm.log_geometry(self.rec, self.root, None, with_static=not self._arm_static_sent, at=at)
+        arm.send(self.rec, self.root, at, arm.sample()[np.newaxis])
+        self._arm_static_sent = True
 
     def log_scene_mesh(self, name: str, mesh: Path, color: Sequence[int]) -> None:
         """Log a static mesh file (``.obj``/``.stl``/``.glb``, world coordinates [m]) under

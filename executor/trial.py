@@ -96,6 +96,7 @@ class Cell:
             logger.log_scene(scene_shapes(self.geometry))
             plate_obj = current_assets(self.geometry) / "plate.obj"
             logger.log_scene_mesh("plate_mesh", self.geometry.base_mesh or plate_obj, PLATE_MESH_COLOR)
+            logger.log_arm_at_rest(self._arm_of(min(self.geometry.parts.items())[1].shape))
 
     def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
                     cell_seed: int = 0) -> None:
@@ -124,23 +125,32 @@ class Cell:
         shape has its own PyBullet client, made on first use (with ``gui``, the first
         one is the GUI); the step count carries over, so sim time only grows."""
         spec = self.geometry.parts[part]
-        scene = self._scenes.get(spec.shape)
-        if scene is None:
-            scene = Scene(self.geometry, spec.shape, gui=self.gui and not self._scenes)
-            self._scenes[spec.shape] = scene
-            arm = Arm(scene.client, scene.robot)
-            self._motions[spec.shape] = Motion(ImpedanceController(arm, scene.client, self.description.gains),
-                                               self.logger)
+        scene = self._scene_of(spec.shape)
         scene.hold(spec)
         if self.logger is not None:
-            if spec.shape not in self._arms:
-                self._arms[spec.shape] = ArmRecorder(scene.client, scene.robot)
-            self.logger.attach_arm(self._arms[spec.shape], part)
+            self.logger.attach_arm(self._arm_of(spec.shape), part)
         motion = self._motions[spec.shape]
         if self._motion is not None and motion is not self._motion:
             motion.steps = self._motion.steps
         self._motion, self.scene = motion, scene
         return motion
+
+    def _scene_of(self, shape: str) -> Scene:
+        """The PyBullet client of ``shape``'s arm, made (with its Motion) on first use."""
+        scene = self._scenes.get(shape)
+        if scene is None:
+            scene = Scene(self.geometry, shape, gui=self.gui and not self._scenes)
+            self._scenes[shape] = scene
+            arm = Arm(scene.client, scene.robot)
+            self._motions[shape] = Motion(ImpedanceController(arm, scene.client, self.description.gains), self.logger)
+        return scene
+
+    def _arm_of(self, shape: str) -> ArmRecorder:
+        """The Rerun recorder of ``shape``'s arm (its client made on first use)."""
+        if shape not in self._arms:
+            scene = self._scene_of(shape)
+            self._arms[shape] = ArmRecorder(scene.client, scene.robot)
+        return self._arms[shape]
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
         """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts."""

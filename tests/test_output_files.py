@@ -136,14 +136,16 @@ def _private_tmpfs_works() -> bool:
 @pytest.mark.skipif(not _private_tmpfs_works(), reason="cannot mount a tmpfs in a private mount namespace "
                     "(needs root or CAP_SYS_ADMIN and util-linux's unshare)")
 def test_a_recording_on_a_full_filesystem_is_one_line_exit_2(tmp_path: Path) -> None:
-    """A session on a real filesystem that fills up (a 128 KiB tmpfs, mounted in a mount
-    namespace of the child's own, gone with it): its last line is ``error:
+    """A session on a real filesystem that fills up (a 64 KiB tmpfs, mounted in a mount
+    namespace of the child's own, gone with it; smaller than the planner's blueprint alone,
+    about 200 kB, so the planner's own first writes fail whichever process writes first):
+    its last line is ``error:
     RUN/planner.rrd: cannot write (No space left on device; ...)``, and no line of the
     Rerun SDK's native logger ("os error 28") shows; exit 2, no traceback."""
     disk = tmp_path / "disk"
     disk.mkdir()
     run = disk / "run"
-    mount = 'mount -t tmpfs -o size=128k tmpfs "$0" && exec "$@"'
+    mount = 'mount -t tmpfs -o size=64k tmpfs "$0" && exec "$@"'
     done = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c", mount, str(disk),
                            sys.executable, "-m", CLI_MODULE, "session", "--backend", "truth", "--out", str(run)],
                           cwd=ROOT, env=child_env(), capture_output=True, text=True, timeout=120, check=False)

@@ -3,11 +3,16 @@
 Planner and cells log into ONE recording id (application
 :data:`assembly_constraints.bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
 files opened together are one recording. The planner sends the session's blueprint
-(:func:`assembly_constraints.bridge.recording.layout.blueprint`): its views in a first tab, then one tab per
-cell, and an assembly tab for the cell that assembles.
+(:func:`assembly_constraints.bridge.recording.layout.blueprint`) with what is certain when
+it starts: its views in a first tab, then one tab per cell it starts (whether a cell will
+assemble is not known yet; the session writes ``RUN/view.rbl`` from what was recorded
+when it ends). The knowledge learning starts from is logged as experiment 0, so a viewer
+opened paused at the start of a timeline shows it.
 
 =========================== ==========================================================
-``planner/knowledge``       part × hole matrix after every experiment (tensor: 1 fits,
+``planner/knowledge``       part × hole matrix at the start (experiment 0: the
+                            demonstrated fits and their closure, the rest unknown)
+                            and after every experiment (tensor: 1 fits,
                             0 does not fit, -1 unknown; value range -1..1, its
                             dimensions named with the part and hole ids in order),
                             timelines ``experiment`` (the number the experiment was
@@ -40,7 +45,7 @@ from assembly_constraints.asp.precedence.relation import Relation, reduction
 from assembly_constraints.asp.session.layered import positions
 from assembly_constraints.asp.sizes.knowledge import Knowledge
 from assembly_constraints.bridge.recording.compaction import compact_recording
-from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, blueprint
+from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, blueprint, opening
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 
 _PART_COLOR = [70, 130, 220]
@@ -49,20 +54,23 @@ _CELL_TEXT = {1: "fit", 0: "no fit", -1: "?"}
 
 
 class PlannerLog:
-    """Logs the planner's entities into ``rrd`` under ``recording_id``, and live to ``viewer``;
-    ``assembling``: the cells that will execute a plan (their assembly tabs)."""
+    """Logs the planner's entities into ``rrd`` under ``recording_id``, and live to
+    ``viewer``, starting with ``start``, the knowledge before any experiment (experiment 0);
+    its blueprint has a tab for the planner and for each of ``cell_ids``."""
 
-    def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str], viewer: Viewer = NO_VIEWER,
-                 assembling: Sequence[str] = ()) -> None:
+    def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str], start: Knowledge,
+                 viewer: Viewer = NO_VIEWER) -> None:
         self.rrd = rrd
         self.rec = open_stream(APPLICATION_ID, recording_id, rrd, viewer)
-        self.rec.send_blueprint(blueprint(Contents(planner=True, cells=tuple(cell_ids),
-                                                   assembly_cells=tuple(assembling))))
+        self.rec.send_blueprint(blueprint(Contents(planner=True, cells=tuple(cell_ids)),
+                                          play_state=opening(viewer.connect is not None)))
         self._smaller: tuple[Knowledge, list[tuple[str, str]], list[tuple[float, float]]] | None = None
         """The last knowledge logged, the reduction of its smaller-than graph and the graph's
         layout: experiments recorded together share one knowledge, laid out once."""
         self._experiments: queue.SimpleQueue[tuple[int, str, str, str, str, Knowledge] | None] = queue.SimpleQueue()
         self._failure: BaseException | None = None
+        known = " ".join(f"{p}->{h}" for p, h in sorted(start.fits)) or "none"
+        self._write_knowledge(0, f"#0 start: fits known {known}; {len(start.unknown)} pairs unknown", start, None)
         self._writer = threading.Thread(target=self._write_experiments, name="planner-log", daemon=True)
         self._writer.start()
 
@@ -95,14 +103,19 @@ class PlannerLog:
 
     def _write_experiment(self, number: int, part: str, hole: str, result: str, cell: str,
                           knowledge: Knowledge) -> None:
+        self._write_knowledge(number, f"#{number} {part} -> {hole}: {result} ({cell})", knowledge, (part, hole))
+
+    def _write_knowledge(self, number: int, line: str, knowledge: Knowledge, pair: tuple[str, str] | None) -> None:
+        """At experiment ``number`` (and now on ``log_time``): ``line`` in the experiment log,
+        ``knowledge`` as matrix, table (``pair`` in bold) and smaller-than graph."""
         self.rec.set_time("experiment", sequence=number)
-        self.rec.log("planner/experiments", rr.TextLog(f"#{number} {part} -> {hole}: {result} ({cell})"))
+        self.rec.log("planner/experiments", rr.TextLog(line))
         matrix = np.array([[-1 if v is None else v for v in row] for row in knowledge.matrix()],
                           dtype=np.int8)
         dims = [f"part: {' '.join(knowledge.parts)}", f"hole: {' '.join(knowledge.holes)}"]
         self.rec.log("planner/knowledge", rr.Tensor(matrix, dim_names=dims, value_range=(-1, 1)))
         self.rec.log("planner/knowledge_table",
-                     rr.TextDocument(_knowledge_table(knowledge, matrix, (part, hole)), media_type="text/markdown"))
+                     rr.TextDocument(_knowledge_table(knowledge, matrix, pair), media_type="text/markdown"))
         nodes = [*knowledge.parts, *knowledge.holes]
         colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)
         if self._smaller is None or self._smaller[0] is not knowledge:
@@ -136,8 +149,8 @@ class PlannerLog:
             raise self._failure
 
 
-def _knowledge_table(knowledge: Knowledge, matrix: np.ndarray, pair: tuple[str, str]) -> str:
-    """``matrix`` (1 fit, 0 no fit, -1 unknown) as a markdown table, ``pair`` in bold."""
+def _knowledge_table(knowledge: Knowledge, matrix: np.ndarray, pair: tuple[str, str] | None) -> str:
+    """``matrix`` (1 fit, 0 no fit, -1 unknown) as a markdown table, ``pair`` (if any) in bold."""
     lines = ["| part | " + " | ".join(knowledge.holes) + " |", "|---" * (len(knowledge.holes) + 1) + "|"]
     for part, row in zip(knowledge.parts, matrix):
         cells = [_CELL_TEXT[int(v)] for v in row]

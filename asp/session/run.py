@@ -13,8 +13,9 @@ and cells over Zenoh, from its settings (:class:`assembly_constraints.asp.sessio
    the learner uses it;
 4. assigns holes (the paper's greedy rule, else a matching) and computes complete plans, each run through the checker;
 5. writes ``RUN/learned.lp`` (the project's facts vocabulary), ``RUN/assignment.lp``,
-   ``RUN/session.json``, ``RUN/journal.jsonl`` and the Rerun recordings ``RUN/*.rrd``
-   (planner and cells in one recording id), and prints a summary (``--json``: the
+   ``RUN/session.json``, ``RUN/journal.jsonl``, the Rerun recordings ``RUN/*.rrd``
+   (planner and cells in one recording id) and their blueprint ``RUN/view.rbl``
+   (:func:`view_blueprint`), and prints a summary (``--json``: the
    contract ``{"run", "experiments", "fits", "must_precede", "plans", "matches_truth"}``).
 
 ``--resume RUN`` continues a killed session: the journal is replayed into the learner,
@@ -71,6 +72,8 @@ from assembly_constraints.bridge.assembly import Assembly, load_assembly
 from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellPool
 from assembly_constraints.bridge.files import make_folder
+from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
+from assembly_constraints.bridge.recording.reader import read_recording
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
 from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, free_loopback_endpoint, open_session
 
@@ -279,6 +282,14 @@ def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: 
     return report
 
 
+def view_blueprint(run: Path) -> Path:
+    """``RUN/view.rbl``, the blueprint of what ``RUN/*.rrd`` hold once every writer closed
+    its file (:meth:`assembly_constraints.bridge.recording.layout.Contents.of`): an assembly tab
+    only for a cell that assembled, each cell's Fig. 17 on its first fitting attempt."""
+    summary = read_recording(sorted(run.glob("*.rrd")))
+    return write_blueprint(run, Contents.of(summary.entities))
+
+
 def run_session(settings: SessionSettings, viewer: Viewer = NO_VIEWER) -> dict:
     """Run (or resume) a session; returns the JSON result. Planner and cells also stream
     their recordings live to ``viewer``. PlannerError naming the field when a setting is
@@ -355,8 +366,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         stack.callback(lambda: stop_all(cells))
         for number in range(1, settings.cells + 1):  # they start up in parallel with each other and us
             cells.append(CellProcess(session_cell(settings, record, run, number, listen[:1], viewer.connect)))
-        log = PlannerLog(run / f"planner{suffix}.rrd", record.recording_id, cell_ids, viewer,
-                         assembling=cell_ids[:1] if settings.assemble else ())
+        log = PlannerLog(run / f"planner{suffix}.rrd", record.recording_id, cell_ids, learner.knowledge, viewer)
         stack.callback(log.close)
         log.precedence(relation.parts, reduction(relation))
         abandoned = [event.experiment for event in journal.abandon_in_flight()]
@@ -400,6 +410,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         log.assignment(assignment)
         assembly_report = (_assemble(session, cell_ids, learned, found[0], record.seed, settings.timeout_s,
                                      cells[0] if cells else None) if settings.assemble else None)
+    view_blueprint(run)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
     versus = _versus_truth(truth, required, fits, must_precede)

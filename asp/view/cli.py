@@ -12,7 +12,7 @@ one line per entity path with its row count, timelines and components (``--json`
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
 free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
 picture of every tab, rendered by the web viewer in a headless Chromium
-(:mod:`assembly_constraints.asp.view.screenshot`), at the end of the recording and, for each ``--at
+(:mod:`assembly_constraints.asp.view.screenshot`), as the viewer opens the recording and, for each ``--at
 TIMELINE=VALUE`` (``experiment=1``), paused at that time. A RUN without ``.rrd`` files is
 an error (exit code 2).
 """
@@ -33,7 +33,7 @@ from assembly_constraints.asp import PlannerError
 from assembly_constraints.bridge.cli_types import ArgumentParser
 
 if TYPE_CHECKING:
-    from assembly_constraints.bridge.recording.layout import Contents, TimePoint
+    from assembly_constraints.bridge.recording.layout import TimePoint
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -59,16 +59,6 @@ def rerun_executable() -> str:
     if found is None:
         raise PlannerError("no 'rerun' executable beside python or on PATH; install rerun-sdk")
     return found
-
-
-def write_blueprint(folder: Path, contents: Contents) -> Path:
-    """``folder/view.rbl``: the blueprint of a recording holding ``contents``."""
-    from assembly_constraints.bridge.files import check_writable
-    from assembly_constraints.bridge.recording.layout import APPLICATION_ID, blueprint
-
-    path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
-    blueprint(contents).save(APPLICATION_ID, str(path))
-    return path
 
 
 def _time_point(text: str) -> TimePoint:
@@ -97,7 +87,7 @@ def main(argv: Sequence[str]) -> int:
                              "is printed, Ctrl-C stops")
     args = parser.parse_args(list(argv))
 
-    from assembly_constraints.bridge.recording.layout import Contents
+    from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
     from assembly_constraints.bridge.recording.reader import format_summary, read_recording
 
     run = Path(args.run)

@@ -8,9 +8,10 @@ between them (all data has arrived), later ones once two in a row are the same. 
 for each tab, a blueprint that shows that tab (``rrb.Tabs(active_tab=k)``) is streamed to
 the viewer and the tab is pictured once it has settled (or, after :data:`TAB_TIMEOUT_S`, as it is then, with a warning).
 
-First every tab is pictured at the end of the recording (the blueprints follow the newest
-data, :func:`assembly_constraints.bridge.recording.layout.blueprint`): ``DIR/<k>-<tab>.png``, k from 1. Then,
-for each ``--at`` time, the viewer is paused with its cursor there and every tab is
+First every tab is pictured as the viewer opens the recording: paused where it placed the
+cursor when the data arrived, the blueprint of ``view.rbl``
+(:func:`assembly_constraints.bridge.recording.layout.blueprint`): ``DIR/<k>-<tab>.png``, k from 1.
+Then, for each ``--at`` time, the viewer is paused with its cursor there and every tab is
 pictured again: ``DIR/<k>-<tab>-<timeline>-<value>.png``. A blueprint cannot place the
 cursor; the page's viewer handle (``window._handle``, set by the page ``rerun
 --serve-web`` serves) takes the viewer-control request Rerun's ``ViewerClient.set_time``
@@ -50,8 +51,8 @@ _LOG = logging.getLogger(__name__)
 
 def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: str, folder: Path,
                      at: Sequence[TimePoint] = ()) -> list[Path]:
-    """Write one PNG per tab of ``contents``' blueprint into ``folder`` (created), at the end
-    of the recording and paused at each of ``at``; PlannerError when there is no Chromium
+    """Write one PNG per tab of ``contents``' blueprint into ``folder`` (created), as the
+    viewer opens the recording and paused at each of ``at``; PlannerError when there is no Chromium
     (:data:`assembly_constraints.asp.view.browser.NAMES`), the page never settles or does not take the time."""
     chromium = find_chromium()
     if chromium is None:
@@ -82,13 +83,13 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
 
 def _picture_tabs(browser: Browser, stream: rr.RecordingStream, contents: Contents, folder: Path,
                   shown: bytes, point: TimePoint | None, written: list[Path]) -> bytes:
-    """Picture every tab, following the newest data (``point`` None; ``shown`` is what the
-    page shows now) or paused at ``point``; append the files to ``written``; the last picture."""
+    """Picture every tab paused, the cursor where the viewer placed it on opening (``point``
+    None; ``shown`` is what the page shows now) or at ``point``; append the files to
+    ``written``; the last picture."""
     picture = shown
     for number, name in enumerate(tab_names(contents)):
-        stream.send_blueprint(blueprint(contents, number, "following" if point is None else "paused",
-                                        None if point is None else point.timeline))
-        # the first tab at the end may look as it did under the recording's own blueprint
+        stream.send_blueprint(blueprint(contents, number, timeline=None if point is None else point.timeline))
+        # the first tab as opened may look as it did under the recording's own blueprint
         before = b"" if number == 0 and point is None else picture
         picture = _settled(browser, TAB_TIMEOUT_S, before) or _unsettled(browser, name)
         if point is not None:  # once the blueprint is shown: it sets the time panel when it arrives

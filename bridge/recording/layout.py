@@ -18,24 +18,32 @@ single trial's and an assembly's on ``sim_time``. The paper's Fig. 17 (force aga
 DMP phase) is drawn as a 2D plot of one chosen attempt, visible on every timeline.
 
 A blueprint cannot set the time the viewer opens at (the time panel has no cursor field).
-Opened paused, the viewer sits at the start of the timeline, where the planner has logged
-nothing yet; so the blueprints follow the newest data (``play_state="following"``): a
-finished recording opens at its end (the last experiment's knowledge, the whole plots),
-a live one keeps up with it. A running viewer's cursor is moved through Rerun's viewer
-control instead (:class:`TimePoint`, ``view --screenshot --at``).
+Opened ``paused``, the viewer keeps the cursor where the first data it receives starts and
+a time the user picks stays; so the starts are made meaningful: the planner logs the
+knowledge learning starts from (the demonstrated fits, every other pair unknown) as
+``experiment`` 0 when it starts, and a simulated cell logs its arm at rest with its scene
+at ``sim_time`` 0 when it starts (docs/recordings.md: what a user sees). Recording
+files and ``view.rbl`` open paused (:data:`OPENS`); a stream watched live follows the newest
+data (``play_state="following"``). A running viewer's cursor is moved through Rerun's
+viewer control instead (:class:`TimePoint`, ``view --screenshot --at``).
 
-A view's ``time_ranges`` and per-entity overrides do take effect: the cell's 3D view
-draws the tool tip over the last :data:`TRAIL_S` of each timeline, a trail of the
-recent tool path behind the tip, while every other entity is drawn at the cursor.
+A view's ``time_ranges`` and per-entity overrides do take effect: the cell's 3D views
+draw the tool tip over the last :data:`TRAIL_S` of each timeline, a trail of the recent
+tool path behind the tip, while every other entity is drawn at the cursor; the cell's
+close-up follows the held part (``EyeControls3D(tracking_entity=)``), whose tip is the
+tool tip, where that trail is centimetres wide rather than a pixel.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Literal
 
 import rerun.blueprint as rrb
+
+from assembly_constraints.bridge.files import check_writable
 
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
@@ -53,6 +61,18 @@ TRAIL_S = 1.0
 CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
 the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
+HELD_PART = "arm/part/held"
+"""Entity of the part in the hand, below a cell's root (``executor.rerun_arm``)."""
+CLOSE_UP_TARGET_M = (0.59, 0.0, 0.1)
+"""Where the close-up looks before a part is taken [m]: over the plate's centre."""
+CLOSE_UP_OFFSET_M = (0.07, 0.05, 0.12)
+"""The direction the close-up looks from [m]: from the tray's side, 54° above the horizontal,
+so a search path on a boss top is seen from above. The viewer sets its distance when it
+starts following the held part: 1.5 times the radius of the part's bounding sphere (Rerun
+0.41's ``eye.rs``), a few centimetres for Cranfield's pegs."""
+PlayState = Literal["following", "paused"]
+OPENS: PlayState = "paused"
+"""How a recording file or ``view.rbl`` opens: paused at the start of its timeline."""
 
 
 @dataclass(frozen=True)
@@ -115,7 +135,8 @@ class Contents:
     """What a recording holds, as far as its blueprint is concerned.
 
     ``planner``: the planner logged (a session); ``cells``: cells that logged more than their
-    static scene and an assembly (attempts, or a truth cell's outcomes);
+    static scene, their arm and an assembly (attempts, or a truth cell's outcomes; the arm
+    alone is the one at rest every simulated cell logs when it starts);
     ``assembly_cells``: cells that executed a plan; ``fig17``: ``(cell, attempt)`` pairs,
     the attempt (``<outcome>/<key>``, :func:`fig17_path`) whose Fig. 17 plot the cell's tab
     shows (every attempt's when the cell has none here).
@@ -137,7 +158,7 @@ class Contents:
         each cell's Fig. 17 shows its first fitting attempt, else its first attempt."""
         paths = sorted(p.strip("/") for p in entity_paths)
         cells = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and p.count("/") >= 2
-                        and p.split("/")[2] not in ("assembly", "scene")})
+                        and p.split("/")[2] not in ("assembly", "scene", "arm")})
         assembly = sorted({p.split("/")[1] for p in paths if p.startswith("executor/") and "/assembly/" in p})
         chosen = []
         for cell in cells:
@@ -205,24 +226,38 @@ def _trail() -> rrb.VisibleTimeRanges:
     return rrb.VisibleTimeRanges([*recent, experiment])
 
 
+def _cell_3d(root: str, name: str, eye: rrb.EyeControls3D) -> rrb.Spatial3DView:
+    """A 3D view of the cell under ``root`` (scene, arm, tool with the tip's trail, search
+    path) seen through ``eye``."""
+    return rrb.Spatial3DView(
+        origin=root, name=name,
+        contents=["$origin/scene/**", "$origin/arm/**", "$origin/tool/**", "$origin/search/**"],
+        eye_controls=eye, overrides={f"/{root}/tool/tip": _trail()},
+    )
+
+
 def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
     """A cell's tab: the 3D cell (arm, scene, tool tip with its trail (:func:`_trail`) and
-    force, the attempt's tool path, search path) above the Fig. 17 plot of attempt ``fig17``
-    (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) and the outcome log;
+    force, the attempt's tool path, search path) above a close-up of the same that follows
+    the held part, whose tip is the tool tip (:data:`HELD_PART`, :data:`CLOSE_UP_OFFSET_M`;
+    over the plate, :data:`CLOSE_UP_TARGET_M`, before a part is taken); the Fig. 17 plot of attempt ``fig17``
+    (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) above the outcome log;
     force, torque and the deviations of eqs. 6 and 7 per attempt."""
     root = cell_root(cell_id)
     attempt = fig17.replace("/", " ") if fig17 else "every attempt"
+    eye = tuple(t + d for t, d in zip(CLOSE_UP_TARGET_M, CLOSE_UP_OFFSET_M))
+    close_up = rrb.EyeControls3D(position=eye, look_target=CLOSE_UP_TARGET_M, eye_up=(0.0, 0.0, 1.0),
+                                 tracking_entity=f"/{root}/{HELD_PART}")
     return rrb.Horizontal(
         rrb.Vertical(
-            rrb.Spatial3DView(
-                origin=root, name=f"{cell_id}: cell",
-                contents=["$origin/scene/**", "$origin/arm/**", "$origin/tool/**", "$origin/search/**"],
-                eye_controls=CELL_EYE, overrides={f"/{root}/tool/tip": _trail()},
-            ),
+            _cell_3d(root, f"{cell_id}: cell", CELL_EYE),
+            _cell_3d(root, f"{cell_id}: close-up following the held part (tip trail {TRAIL_S:g} s)", close_up),
+        ),
+        rrb.Vertical(
             rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
                               name=f"Fig. 17 {attempt}: F_des (pale), F_mes [N] over DMP phase 0..1"),
             rrb.TextLogView(origin=f"{root}/outcome", name=f"{cell_id}: outcomes"),
-            row_shares=[3, 2, 1],
+            row_shares=[2, 1],
         ),
         rrb.Vertical(
             _plot(f"{root}/wrench/force", "force F_mes, F_des [N]"),
@@ -231,7 +266,7 @@ def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
             _plot(f"{root}/deviation/torque", "‖M_mes − M_des‖ [Nm] per attempt: green fit, red no fit",
                   legend=False),
         ),
-        column_shares=[1, 1],
+        column_shares=[3, 2, 3],
         name=cell_id,
     )
 
@@ -257,12 +292,13 @@ def tab_names(contents: Contents) -> list[str]:
             *(f"{cell} assembly" for cell in contents.assembly_cells)]
 
 
-def blueprint(contents: Contents, active_tab: int = 0, play_state: Literal["following", "paused"] = "following",
+def blueprint(contents: Contents, active_tab: int = 0, play_state: PlayState = OPENS,
               timeline: str | None = None) -> rrb.Blueprint:
     """The blueprint of a recording holding ``contents``: the planner's tab, a tab per cell,
     an assembly tab per assembling cell (:func:`tab_names`), tab ``active_tab`` shown; on
-    ``timeline`` (default :attr:`Contents.timeline`), following the newest data
-    (``play_state="paused"``: the cursor stays where it is)."""
+    ``timeline`` (default :attr:`Contents.timeline`), paused (the cursor stays where it is:
+    where the first data it received starts when the viewer opens) or ``"following"`` the
+    newest data."""
     chosen = dict(contents.fig17)
     tabs = [
         *([planner_views()] if contents.planner else []),
@@ -272,5 +308,19 @@ def blueprint(contents: Contents, active_tab: int = 0, play_state: Literal["foll
     return rrb.Blueprint(
         rrb.Tabs(*tabs, active_tab=active_tab),
         rrb.TimePanel(timeline=timeline or contents.timeline, play_state=play_state),
-        collapse_panels=False,
+        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),  # the views get the room
     )
+
+
+def opening(live: bool) -> PlayState:
+    """How a stream's own blueprint opens: following the newest data when someone watches it
+    live (``live``), else :data:`OPENS`."""
+    return "following" if live else OPENS
+
+
+def write_blueprint(folder: Path, contents: Contents) -> Path:
+    """``folder/view.rbl``: the blueprint of a recording holding ``contents``, opening
+    paused; BridgeError naming the file when it cannot be written."""
+    path = check_writable(folder / "view.rbl")  # written by the Rerun SDK itself
+    blueprint(contents).save(APPLICATION_ID, str(path))
+    return path

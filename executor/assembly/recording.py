@@ -5,16 +5,21 @@ Entities (under ``executor/<cell-id>/assembly/``):
 
 =============================== ===================================================
 ``parts/<id>``                  the part's pose (``Transform3D``) over ``sim_time``; its
-                                solid (boxes, cylinders in its frame) logged once, static
+                                solid (boxes, cylinders in its frame) logged when the
+                                world is attached
 ``arm/<link>``                  the arm's links (meshes, as in a cell's recording:
-                                :class:`assembly_constraints.executor.rerun_arm.ArmRecorder`) over ``sim_time``
+                                :class:`assembly_constraints.executor.rerun_arm.ArmRecorder`) over ``sim_time``,
+                                their geometry logged when the world is attached
 ``force``                       measured contact force at the TCP (series Fx, Fy, Fz [N])
 ``steps``                       one text line per plan step (timelines ``plan_step``
                                 and ``sim_time``)
 =============================== ===================================================
 
 The recorder is the Motion's step logger (:class:`assembly_constraints.executor.control.motion.StepLogger`):
-it samples the world every ``period_s`` of simulated time.
+it samples the world every ``period_s`` of simulated time. The solids and meshes are logged
+at the time the world is attached with the poses then, not static: in a session's
+recording the assembly comes after learning, and before it nothing of it is drawn (static
+solids would stand at the origin until their first pose).
 """
 
 from __future__ import annotations
@@ -74,12 +79,23 @@ class AssemblyRecorder:
             self._offset = self._next
         self.world = world
         self._arm = ArmRecorder(world.client, world.robot)
-        self._arm.log_geometry(self.rec, self.root, "gripper", with_static=True)
+        self.rec.set_time("sim_time", duration=self._offset)
+        self._arm.log_geometry(self.rec, self.root, "gripper", with_static=True, static=False)
         for part in world.product.parts:
             for solid in _part_solids(world, part):
-                self.rec.log(f"{self.root}/parts/{part}", solid, static=True)
+                self.rec.log(f"{self.root}/parts/{part}", solid)
+        self._log_poses()
         self.rec.log(f"{self.root}/force", rr.SeriesLines(names=[f"{n} [N]" for n in AXIS_NAMES["force"]],
                                                          colors=MEASURED_COLORS), static=True)
+
+    def _log_poses(self) -> None:
+        """Every part's and the arm's pose now, at the stream's current time."""
+        assert self.world is not None and self._arm is not None
+        for part in self.world.frames:
+            pos, quat = self.world.pose(part)
+            self.rec.log(f"{self.root}/parts/{part}",
+                         rr.Transform3D(translation=pos, quaternion=rr.Quaternion(xyzw=list(quat))))
+        self._arm.log_now(self.rec, self.root)
 
     def log_step(self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
                  force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray) -> None:
@@ -88,14 +104,8 @@ class AssemblyRecorder:
         if self.world is None or t < self._next:
             return
         self._next = t + self.period_s
-        world = self.world
         self.rec.set_time("sim_time", duration=t)
-        for part in world.frames:
-            pos, quat = world.pose(part)
-            self.rec.log(f"{self.root}/parts/{part}",
-                         rr.Transform3D(translation=pos, quaternion=rr.Quaternion(xyzw=list(quat))))
-        if self._arm is not None:
-            self._arm.log_now(self.rec, self.root)
+        self._log_poses()
         self.rec.log(f"{self.root}/force", rr.Scalars(np.asarray(force_mes, dtype=float)))
 
     def log_plan_step(self, part: str, hole: str | None, outcome: str, attempts: int, error_mm: float) -> None:

@@ -26,16 +26,32 @@ def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) ->
         cell.close()
         logger.close()
     entities = read_recording(rrd).entities
-    for link in ["base", *KUKA_LINKS]:
-        visual = next(e for path, e in entities.items() if path.startswith(f"/executor/c1/arm/{link}/visual_"))
-        assert "Asset3D:blob" in visual.components and visual.static_rows == visual.rows
+    for link in ["base", *KUKA_LINKS]:  # each mesh logged once, with the arm at rest
+        path, visual = next((p, e) for p, e in entities.items() if p.startswith(f"/executor/c1/arm/{link}/visual_"))
+        assert "Asset3D:blob" in visual.components and not visual.static_rows
+        assert len(column_values(rrd, path, "Asset3D:media_type")) == 1
+        assert set(column_values(rrd, path, "experiment")) == {0} and set(column_values(rrd, path, "sim_time")) == {0}
     assert "Asset3D:blob" in entities["/executor/c1/scene/plate_mesh"].components
     for link in [*KUKA_LINKS, "flange", "part"]:
         assert "sim_time" in entities[f"/executor/c1/arm/{link}"].timelines
 
+    # The arm at rest is logged with the scene, before the first attempt (experiment 0,
+    # sim_time 0), its hand empty: the held part's geometry comes with the attempt.
+    for link in [*KUKA_LINKS, "flange", "part"]:
+        assert column_values(rrd, f"executor/c1/arm/{link}", "experiment")[:2] == [0, 1], link
+    # ... all of it at one instant on log_time too: a viewer opened there shows the whole arm
+    at_rest = {column_values(rrd, f"executor/c1/arm/{link}", "log_time")[0] for link in [*KUKA_LINKS, "part"]}
+    at_rest |= {column_values(rrd, p, "log_time")[0] for p in entities if p.startswith("/executor/c1/arm/lbr")
+                and "/visual_" in p}
+    assert len(at_rest) == 1
+    assert column_values(rrd, "executor/c1/arm/part", "sim_time")[0] == 0
+    assert column_values(rrd, "executor/c1/arm/part/held", "experiment") == [1]
+    assert "TextDocument:text" in entities["/executor/c1/arm/part/held"].components  # names the part
     tip = np.array(column_values(rrd, "executor/c1/tool/tip", "Points3D:positions")).reshape(-1, 3)
-    part = np.array(column_values(rrd, "executor/c1/arm/part", "Transform3D:translation")).reshape(-1, 3)
+    rest, *moving = column_values(rrd, "executor/c1/arm/part", "Transform3D:translation")
+    part = np.array(moving).reshape(-1, 3)
     link_7 = np.array(column_values(rrd, "executor/c1/arm/lbr_iiwa_link_7", "Transform3D:translation"))
     assert len(part) == len(tip) > 100
+    assert np.linalg.norm(np.reshape(rest, 3) - part[0]) > 0.1  # upright as loaded, not yet over the hole
     assert np.max(np.linalg.norm(part - tip, axis=1)) < 1e-3
     assert np.ptp(link_7.reshape(-1, 3)[:, 2]) > 0.01  # the wrist moves during the attempt

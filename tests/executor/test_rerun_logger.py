@@ -111,11 +111,17 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert 0 < x[0] < 5 and x[-1] == pytest.approx(WIDTH)
     assert "/executor/c1/by_phase" in format_summary(summary)
 
-    # The single trial's blueprint: one tab, paused on sim_time, the arm in the 3D view.
+    # The single trial's blueprint: one tab, paused on sim_time, the arm in the 3D views:
+    # the whole cell from a set camera, and a close-up that follows the held part.
     layout = read_blueprint(rrd)
-    assert layout.time_panel == {"timeline": "sim_time", "play_state": 3} and layout.tabs == ["c1"]
-    cell_3d = next(v for v in layout.views if v.kind == "3D")
+    assert layout.time_panel == {"timeline": "sim_time", "play_state": 1} and layout.tabs == ["c1"]
+    spatial = sorted((v for v in layout.views if v.kind == "3D"), key=lambda v: "close-up" in v.name)
+    assert len(spatial) == 2
+    cell_3d, close_up = spatial
     assert "$origin/arm/**" in cell_3d.contents and "position" in cell_3d.properties["EyeControls3D"]
+    assert "tracking_entity" not in cell_3d.properties["EyeControls3D"]
+    assert close_up.contents == cell_3d.contents and set(close_up.overrides) == {"executor/c1/tool/tip"}
+    assert close_up.properties["EyeControls3D"]["tracking_entity"] == "/executor/c1/arm/part/held"
 
 
 def test_two_cells_in_one_process_share_a_recording(tmp_path: Path) -> None:

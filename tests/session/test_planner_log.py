@@ -25,7 +25,7 @@ def _knowledge(fits: set[tuple[str, str]], no_fit: set[tuple[str, str]]) -> Know
 
 def test_knowledge_matrix_keeps_its_range_and_labels_to_the_last_experiment(tmp_path: Path) -> None:
     rrd = tmp_path / "planner.rrd"
-    log = PlannerLog(rrd, "run-1", ["c1"], assembling=["c1"])
+    log = PlannerLog(rrd, "run-1", ["c1"], _knowledge({("p1", "r2")}, set()))  # demonstrated: p1 fits r2
     log.precedence(["bp", "p1", "p2", "fp"], [("bp", "p1"), ("bp", "p2"), ("p1", "fp"), ("p2", "fp")])
     log.experiment(1, "p1", "r1", "fit", "c1", _knowledge({("p1", "r1")}, set()))
     every = {("p1", "r1"), ("p1", "r2"), ("p2", "r2")}
@@ -33,15 +33,21 @@ def test_knowledge_matrix_keeps_its_range_and_labels_to_the_last_experiment(tmp_
     log.assignment({"p1": "r1", "p2": "r2"})
     log.close()
 
-    assert column_values(rrd, "planner/knowledge", "experiment") == [1, 2]
-    assert len(column_values(rrd, "planner/knowledge", "log_time")) == 2
-    assert column_values(rrd, "planner/knowledge", "Tensor:value_range") == [[[-1.0, 1.0]]] * 2
+    # experiment 0: the knowledge learning starts from, logged when the log opens
+    assert column_values(rrd, "planner/knowledge", "experiment") == [0, 1, 2]
+    starts = column_values(rrd, "planner/knowledge", "log_time")
+    assert len(starts) == 3 and starts == sorted(starts)
+    assert column_values(rrd, "planner/knowledge", "Tensor:value_range") == [[[-1.0, 1.0]]] * 3
     tensors = column_values(rrd, "planner/knowledge", "Tensor:data")
     assert [d["names"] for d in tensors[-1]] == [["part: p1 p2", "hole: r1 r2"]]
+    assert np.array(tensors[0][0]["buffer"]).reshape(2, 2).tolist() == [[-1, 1], [-1, -1]]
     assert np.array(tensors[-1][0]["buffer"]).reshape(2, 2).tolist() == [[1, 1], [0, 1]]
     tables = [row[0] for row in column_values(rrd, "planner/knowledge_table", "TextDocument:text")]
-    assert tables[0].splitlines()[:3] == ["| part | r1 | r2 |", "|---|---|---|", "| p1 | **fit** | ? |"]
+    assert tables[0].splitlines()[2:] == ["| p1 | ? | fit |", "| p2 | ? | ? |"]  # no experiment's pair in bold
+    assert tables[1].splitlines()[:3] == ["| part | r1 | r2 |", "|---|---|---|", "| p1 | **fit** | ? |"]
     assert tables[-1].splitlines()[3] == "| p2 | **no fit** | fit |"
+    lines = [row[0] for row in column_values(rrd, "planner/experiments", "TextLog:text")]
+    assert lines[0] == "#0 start: fits known p1->r2; 3 pairs unknown"
 
     nodes = column_values(rrd, "planner/precedence", "GraphNodes:node_ids")[0]
     xy = dict(zip(nodes, column_values(rrd, "planner/precedence", "GraphNodes:positions")[0]))
@@ -52,8 +58,8 @@ def test_knowledge_matrix_keeps_its_range_and_labels_to_the_last_experiment(tmp_
     assert {n: rows[n][1] for n in nodes} == {"p1": 0, "p2": 0, "r1": SPACING[1], "r2": SPACING[1]}
 
     layout = read_blueprint(rrd)
-    assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
-    assert layout.tabs == ["planner", "c1", "c1 assembly"]
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 1}  # paused: at the start when opened
+    assert layout.tabs == ["planner", "c1"]  # whether c1 will assemble is not known when the planner starts
     graphs = [v for v in layout.views if v.kind == "Graph"]
     assert graphs and all(v.properties["ForceManyBody"] == {"enabled": False} for v in graphs)
     assert {"/planner/knowledge", "/planner/smaller"} <= set(read_recording(rrd).entities)

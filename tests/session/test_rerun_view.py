@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import rerun as rr
 from rerun.chunk import RrdReader
 
-from assembly_constraints.asp.view.cli import write_blueprint
-from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names
+from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names, write_blueprint
 from assembly_constraints.bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from assembly_constraints.executor.evidence import AttemptEvidence
 from assembly_constraints.executor.rerun_log import AttemptLogger
@@ -77,7 +77,8 @@ def test_blueprint_has_a_tab_per_cell_of_a_real_recording(tmp_path: Path) -> Non
 def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> None:
     attempts = "/executor/c1/by_phase/{}/measured"
     paths = ["/planner/knowledge", "/executor/c1/outcome", "/executor/c1/assembly/force", "/executor/c2/outcome",
-             "/executor/a1/scene/plate", "/executor/a1/assembly/force",  # a1 only assembled: no cell tab
+             "/executor/a1/scene/plate", "/executor/a1/arm/base", "/executor/a1/arm/lbr_iiwa_link_1",
+             "/executor/a1/assembly/force",  # a1 only stood at rest and assembled: no cell tab
              attempts.format("no_fit/e0001_p3_r1_s0_a1"), attempts.format("fit/e0003_p1_r1_s0_a1"),
              attempts.format("fit/e0002_p2_r2_s0_a1"), "/executor"]
     contents = Contents.of(paths)
@@ -85,7 +86,7 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
                                 fig17=(("c1", "fit/e0002_p2_r2_s0_a1"),))
     layout = read_blueprint(write_blueprint(tmp_path, contents))
     assert layout.tabs == ["planner", "c1", "c2", "a1 assembly", "c1 assembly"] == tab_names(contents)
-    assert layout.time_panel == {"timeline": "log_time", "play_state": 3}
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 1}  # paused: opens at the start
     fig17 = [v for v in layout.views if v.origin == "executor/c1/by_phase"]
     assert fig17[0].contents == ["$origin/fit/e0002_p2_r2_s0_a1/**"] and "e0002_p2_r2_s0_a1" in fig17[0].name
     spatial = [v for v in layout.views if v.kind == "3D"]
@@ -101,6 +102,38 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
         assert set(cell_view.overrides) == {f"executor/{cell}/tool/tip"}
     assert {"planner/knowledge", "planner/knowledge_table", "planner/precedence"} <= blueprint_origins(
         tmp_path / "view.rbl")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("assemble", [True, False])
+def test_a_session_opens_with_an_assembly_tab_only_when_it_recorded_one(tmp_path: Path, run_session,
+                                                                        assemble: bool) -> None:
+    """Truth cells answer the plan's steps from the product's truth and record no assembly:
+    with ``--assemble`` the session's report has an assembly, its recording none."""
+    run = tmp_path / "run"
+    result = run_session("--cells", "1", "--out", str(run), *(["--assemble"] if assemble else []))
+    assert ("assembly" in result) == assemble and (not assemble or result["assembly"]["assembled"])
+    files = sorted(run.glob("*.rrd"))
+    assert [f.name for f in files] == ["c1.rrd", "planner.rrd"]
+    assert not any("/assembly/" in path for path in read_recording(files).entities)
+    for opened in (run / "view.rbl", run / "planner.rrd"):  # the session's own view, the planner's own blueprint
+        layout = read_blueprint(opened)
+        assert layout.tabs == ["planner", "c1"], opened
+        assert layout.time_panel == {"timeline": "log_time", "play_state": 1}, opened
+
+
+def test_the_view_blueprint_of_a_session_that_assembled_has_its_assembly_tab(tmp_path: Path) -> None:
+    """The session's ``view.rbl`` comes from the entities its files hold: a cell that logged
+    an assembly gets its tab, without the planner having announced it."""
+    from assembly_constraints.asp.session.run import view_blueprint
+
+    run = _run_folder(tmp_path / "run")
+    logger = AttemptLogger("c1", recording_id="run-7", rrd_path=run / "c1-assembly.rrd", send_blueprint=False)
+    logger.rec.log("executor/c1/assembly/steps", rr.TextLog("p1 -> r1: fit"))
+    logger.close()
+    layout = read_blueprint(view_blueprint(run))
+    assert layout.tabs == ["c1", "c2", "c1 assembly"]
+    assert layout.time_panel == {"timeline": "sim_time", "play_state": 1}
 
 
 @pytest.mark.parametrize(("text", "point", "viewer_time"), [

@@ -42,10 +42,10 @@ def test_every_tab_is_rendered_and_not_blank(tmp_path: Path) -> None:
     contents = Contents.of(read_recording(rrd).entities)
     pictures = take_screenshots([rrd], contents, "shots", tmp_path / "shots", at=[TimePoint("experiment", 1)])
     assert [p.name for p in pictures] == ["1-c1.png", "1-c1-experiment-1.png"]
-    end, first = (np.asarray(Image.open(p).convert("RGB"), dtype=np.float64) for p in pictures)
-    assert end.shape[:2] == first.shape[:2] == (1000, 1600)
-    assert end.std() > 10 and first.std() > 10, "a blank picture"
-    assert np.abs(end - first).mean() > 1.0, "the picture at experiment 1 is the one at the end"
+    opened, first = (np.asarray(Image.open(p).convert("RGB"), dtype=np.float64) for p in pictures)
+    assert opened.shape[:2] == first.shape[:2] == (1000, 1600)
+    assert opened.std() > 10 and first.std() > 10, "a blank picture"
+    assert np.abs(opened - first).mean() > 1.0, "the picture at experiment 1 is the one as opened"
 
 
 class _Fit:

@@ -117,10 +117,10 @@ def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path, run_ses
     for entity in ("/planner/knowledge", "/planner/precedence", "/planner/smaller",
                    "/planner/assignment", "/executor/c1/outcome", "/executor/c2/outcome"):
         assert entity in entities
-    assert summary.entities["/planner/knowledge"].rows == result["experiments"]
+    assert summary.entities["/planner/knowledge"].rows == result["experiments"] + 1  # and the start, experiment 0
     files = sorted(run.glob("*.rrd"))
     numbers = set(range(1, result["experiments"] + 1))
-    assert set(column_values(files, "/planner/knowledge", "experiment")) == numbers
+    assert set(column_values(files, "/planner/knowledge", "experiment")) == numbers | {0}
     by_cells = [n for c in ("c1", "c2") for n in column_values(files, f"/executor/{c}/outcome", "experiment")]
     assert sorted(by_cells) == sorted(numbers)  # each experiment logged once, by its cell
 
