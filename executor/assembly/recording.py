@@ -117,7 +117,8 @@ class AssemblyRecorder:
         self.rec.log(f"{self.root}/steps", rr.TextLog(
             f"step {self._step}: {part}{into}: {outcome} ({attempts} attempt(s), {error_mm:.2f} mm from its goal)",
             level="INFO" if outcome == "fit" else "WARN"))
-        self.rec.reset_time()
+        # only the step's own timeline ends here: the others (a session's experiment) go on
+        self.rec.disable_timeline("plan_step")
 
     def flush(self) -> None:
         self.rec.flush()

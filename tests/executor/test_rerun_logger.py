@@ -162,3 +162,20 @@ def test_loggers_on_a_callers_stream(tmp_path: Path) -> None:
     summary = read_recording(tmp_path / "both.rrd")
     assert summary.blueprints == 0
     assert {"/executor/a/outcome", "/executor/b/outcome", "/planner/note"} <= set(summary.entities)
+
+
+def test_the_plan_steps_of_a_session_keep_its_experiment_timeline(tmp_path: Path) -> None:
+    import rerun as rr
+
+    from assembly_constraints.executor.assembly.recording import AssemblyRecorder
+
+    stream = rr.RecordingStream("assembly_constraints", recording_id="steps")
+    stream.save(str(tmp_path / "steps.rrd"))
+    stream.set_time("experiment", sequence=19)  # a session's cell assembles after its last experiment
+    recorder = AssemblyRecorder(stream, "c1")
+    for part in ("p1", "p2"):
+        recorder.log_plan_step(part, "r1", "fit", 1, 0.5)
+    stream.disconnect()
+    rrd = tmp_path / "steps.rrd"
+    assert column_values(rrd, "/executor/c1/assembly/steps", "plan_step") == [1, 2]
+    assert column_values(rrd, "/executor/c1/assembly/steps", "experiment") == [19, 19]
