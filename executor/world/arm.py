@@ -169,7 +169,9 @@ class Arm:
         lever = rot @ self._inv_pos
         tip_pos = np.array(ls[4]) + lever
         tip_quat = np.array(pb.multiplyTransforms(_ORIGIN, ls[5], _ORIGIN, self._inv_quat)[1])
-        (vx, vy, vz), (wx, wy, wz), (lx, ly, lz) = ls[6], ls[7], lever.tolist()
+        # ls[6] is the velocity of the link's centre of mass (ls[0]), not of its frame
+        # (ls[4]): carry it to the believed tip with ω × (tip − COM).
+        (vx, vy, vz), (wx, wy, wz), (lx, ly, lz) = ls[6], ls[7], (tip_pos - ls[0]).tolist()
         omega = np.array(ls[7])
         tip_vel = np.array([vx + (wy * lz - wz * ly), vy + (wz * lx - wx * lz), vz + (wx * ly - wy * lx)])
         jl, ja = pb.calculateJacobian(r, self.sensor, self._inv_pos_list, q_list, self._zeros, self._zeros,
