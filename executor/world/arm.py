@@ -158,6 +158,9 @@ class Arm:
     def read(self) -> ArmState:
         """The current state; the wrench is tared and low-pass filtered (α = 0.1 per 1 ms step, τ ≈ 10 ms).
 
+        Position, velocity, angular velocity and Jacobian all refer to the believed tip;
+        the torque to the point the same lever away from the part's centre of mass, about
+        which the sensor measures (docs/cell.md, "Which point PyBullet's quantities refer to").
         Called once per control step: four PyBullet queries (the joints and the sensor
         in one ``getJointStates``, the sensor link's pose and velocity, the Jacobian)."""
         c, r = self.client, self.robot

@@ -79,9 +79,11 @@ def test_tip_position_velocity_and_jacobian_refer_to_one_point(cell: Cell) -> No
     finite_difference = (pos[1:] - pos[:-1]) / TIME_STEP
     assert np.abs(finite_difference - vel[1:]).max() < 1e-3  # [m/s]
     assert np.linalg.norm(omega, axis=1).max() * 0.025 > 0.02  # the COM's velocity would be off by > 20 mm/s
-    for s in states[::30]:
-        assert np.allclose(s.jac[:3] @ s.qd, s.tip_vel, atol=1e-9)
-        assert np.allclose(s.jac[3:] @ s.qd, s.tip_omega, atol=1e-9)
+    # J q̇ is the same kinematics as PyBullet's link state, which differs from it by up to
+    # 1e-7 m/s here (1e-15 rad/s for ω).
+    jac_vel = np.array([s.jac @ s.qd for s in states])
+    assert np.abs(jac_vel[:, :3] - vel).max() < 1e-6  # [m/s]
+    assert np.abs(jac_vel[:, 3:] - omega).max() < 1e-9  # [rad/s]
 
 
 def test_remembered_forcing_terms_give_the_rollout_of_a_fresh_dmp() -> None:
