@@ -158,6 +158,9 @@ class Arm:
     def read(self) -> ArmState:
         """The current state; the wrench is tared and low-pass filtered (α = 0.1 per 1 ms step, τ ≈ 10 ms).
 
+        Position, velocity, angular velocity and Jacobian all refer to the believed tip;
+        the torque to the point the same lever away from the part's centre of mass, about
+        which the sensor measures (docs/cell.md, "Which point PyBullet's quantities refer to").
         Called once per control step: four PyBullet queries (the joints and the sensor
         in one ``getJointStates``, the sensor link's pose and velocity, the Jacobian)."""
         c, r = self.client, self.robot
@@ -169,7 +172,9 @@ class Arm:
         lever = rot @ self._inv_pos
         tip_pos = np.array(ls[4]) + lever
         tip_quat = np.array(pb.multiplyTransforms(_ORIGIN, ls[5], _ORIGIN, self._inv_quat)[1])
-        (vx, vy, vz), (wx, wy, wz), (lx, ly, lz) = ls[6], ls[7], lever.tolist()
+        # ls[6] is the velocity of the link's centre of mass (ls[0]), not of its frame
+        # (ls[4]): carry it to the believed tip with ω × (tip − COM).
+        (vx, vy, vz), (wx, wy, wz), (lx, ly, lz) = ls[6], ls[7], (tip_pos - ls[0]).tolist()
         omega = np.array(ls[7])
         tip_vel = np.array([vx + (wy * lz - wz * ly), vy + (wz * lx - wx * lz), vz + (wx * ly - wy * lx)])
         jl, ja = pb.calculateJacobian(r, self.sensor, self._inv_pos_list, q_list, self._zeros, self._zeros,
