@@ -10,6 +10,7 @@ waits for one with a deadline.
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import subprocess
@@ -26,6 +27,8 @@ from assembly_constraints.bridge.cell_settings import ServeSettings, encode_sett
 from assembly_constraints.bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parents[2]
+
+LOG = logging.getLogger(__name__)
 
 STOP_S = 60.0
 """How long [s] a stopped process may take to exit (a cell compacts its recording
@@ -132,6 +135,8 @@ def stop_all(processes: Sequence[LineProcess], timeout: float = STOP_S) -> list[
         try:
             codes.append(process.popen.wait(max(0.0, deadline - time.monotonic())))
         except subprocess.TimeoutExpired:
+            LOG.warning("%s did not exit within %.0f s of SIGTERM; killed (its recording stays uncompacted)",
+                        process.name, timeout)
             process.popen.kill()
             codes.append(process.popen.wait(timeout))
     return codes
