@@ -158,8 +158,8 @@ def router_main(argv: Sequence[str]) -> int:
     try:
         where = " ".join(listen) or f"as in {args.zenoh_config}"
         print(f"ready router {session.zid()} listen {where}", flush=True)
-        while True:
-            time.sleep(3600.0)
+        while True:  # short sleeps: a signal one of Zenoh's threads takes runs its handler here only then
+            time.sleep(0.2)
     except SystemExit:
         pass  # SIGTERM/SIGINT: close below
     finally:

@@ -107,6 +107,9 @@ CACHE_SIZE = 100_000
 QUEUE_SIZE = 16
 """Requests that may wait for the cell; more are refused with ``busy``."""
 
+SIGNAL_POLL_S = 0.2
+"""The longest the cell's main thread waits for work before it looks at signals [s]."""
+
 
 class TruthBackend:
     """Answers from the cell's geometry without simulation (a part passes a hole when its
@@ -342,8 +345,19 @@ class CellNode:
             pass  # serve() is busy and sees the flag next
 
     def serve(self) -> None:
-        """Run queued requests until :meth:`stop` (or SIGTERM/SIGINT via SystemExit)."""
-        while not self._stopped.is_set() and (work := self._work.get()) is not None:
+        """Run queued requests until :meth:`stop` (or SIGTERM/SIGINT via SystemExit).
+
+        The wait for work wakes every :data:`SIGNAL_POLL_S`: a signal sent to the process may
+        be taken by one of Zenoh's threads, and Python runs its handler only when the main
+        thread next runs; blocked without a timeout, the cell would wait out its
+        supervisor's SIGTERM until it is killed."""
+        while not self._stopped.is_set():
+            try:
+                work = self._work.get(timeout=SIGNAL_POLL_S)
+            except queue.Empty:
+                continue
+            if work is None:
+                break
             query, request = work.query, work.request
             waited = time.monotonic() - work.arrived
             cached = self._cached(query, request)
