@@ -27,14 +27,14 @@ from assembly_constraints.bridge.cell_settings import ServeSettings, encode_sett
 from assembly_constraints.bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parents[2]
+"""The folder holding the packages (the repository, or site-packages when installed): the
+cells get it on their PYTHONPATH and run in it."""
 
 LOG = logging.getLogger(__name__)
 
 STOP_S = 60.0
 """How long [s] a stopped process may take to exit (a cell compacts its recording
 first) before it is killed."""
-"""The folder holding the packages (the repository, or site-packages when installed): the
-cells get it on their PYTHONPATH and run in it."""
 
 
 def _absolute(settings: ServeSettings) -> ServeSettings:

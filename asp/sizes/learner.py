@@ -194,7 +194,6 @@ class SizeLearner:
             for size in sorted({len(parts) for parts in self.model.groups().values()}):
                 self.policy.prepare(size, len(self.holes))
         self._static = self._static_facts(self.seed)
-        self._observed: dict[Pair, str] = {}
         self._decoded: dict[clingo.Symbol, tuple[str, tuple[str, ...]]] = {}
         self._ctl: clingo.Control | None = None
         if len(self._pairs) <= GROUND_ONCE_PAIRS:
@@ -252,7 +251,8 @@ class SizeLearner:
         ``select/2`` and ``essential/2`` (index order)."""
         ctl = self._ctl
         if ctl is None:
-            ctl = self._grounded([fact("observed", p, h, r) for (p, h), r in self._observed.items()])
+            ctl = self._grounded([fact("observed", p, h, self._kept(answers))
+                                  for (p, h), answers in self.answers.items() if answers])
         last: list[clingo.Symbol] = []
         result = ctl.solve(on_model=lambda m: last.__setitem__(slice(None), m.symbols(shown=True)))
         if not result.satisfiable:
@@ -266,11 +266,8 @@ class SizeLearner:
         return knowledge
 
     def _set_observation(self, pair: Pair, result: str | None) -> None:
-        """Make ``result`` the kept observation of ``pair`` (None: no observation)."""
-        if result is None:
-            self._observed.pop(pair, None)
-        else:
-            self._observed[pair] = result
+        """Switch the externals of ``pair`` to ``result`` (None: no observation) in a program
+        grounded once; a program grounded per decision reads the kept answers instead."""
         if self._ctl is not None:
             for value in RESULTS:
                 self._ctl.assign_external(self._literals[(*pair, value)], value == result)
