@@ -1,8 +1,8 @@
 """STEP assemblies through Open CASCADE (``OCP``, the cadquery-ocp wheels): one part per
 leaf of the assembly tree with its name and its placement (the product of the locations
-on the path from the root), tessellated to a closed triangle mesh [m], with the cylindrical faces of its B-rep (axis
-and radius, exact where the tessellation is within :data:`STEP_DEFLECTION` of them; planar
-faces tessellate exactly).
+on the path from the root), tessellated to a closed triangle mesh [m], with the
+cylindrical faces of its B-rep (axis and radius, exact where the tessellation is within
+:data:`STEP_DEFLECTION` of them; planar faces tessellate exactly).
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
 converts to metres. A leaf without a name is named after its parent and position.
@@ -122,14 +122,15 @@ def _mesh(shape: Any, source: str) -> trimesh.Trimesh:
 
 
 def _cylinders(shape: Any) -> tuple[Cylinder, ...]:
-    """The cylindrical faces of the located ``shape`` (one per distinct axis and radius) [m]."""
+    """The cylindrical faces of the located ``shape`` [m] (a cylinder split by seams
+    appears once per face)."""
     from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.GeomAbs import GeomAbs_Cylinder
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    found: dict[tuple[float, ...], Cylinder] = {}
+    found: list[Cylinder] = []
     explorer = TopExp_Explorer(shape, TopAbs_FACE)
     while explorer.More():
         surface = BRepAdaptor_Surface(TopoDS.Face(explorer.Current()))  # with the face's location
@@ -139,10 +140,6 @@ def _cylinders(shape: Any) -> tuple[Cylinder, ...]:
         cylinder = surface.Cylinder()
         axis = cylinder.Axis()
         point, direction = axis.Location(), axis.Direction()
-        cyl = Cylinder(np.array([point.X(), point.Y(), point.Z()]) * _MM,
-                       np.array([direction.X(), direction.Y(), direction.Z()]), cylinder.Radius() * _MM)
-        # faces of one cylinder split by seams share axis and radius: keep one
-        key = (*np.round(cyl.direction * np.sign(cyl.direction @ (1.0, 2.0, 3.0)), 9), round(cyl.radius, 9),
-               *np.round(np.cross(cyl.point, cyl.direction), 9))
-        found.setdefault(key, cyl)
-    return tuple(found.values())
+        found.append(Cylinder(np.array([point.X(), point.Y(), point.Z()]) * _MM,
+                              np.array([direction.X(), direction.Y(), direction.Z()]), cylinder.Radius() * _MM))
+    return tuple(found)
