@@ -30,6 +30,11 @@ from assembly_constraints.bridge.messages import MAX_MESSAGE_BYTES
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 """Where a cell listens and a planner connects when given no endpoint."""
 
+SIGNAL_POLL_S = 0.2
+"""The longest a Zenoh process's main thread waits (for work, or idle) before it looks at
+signals [s]: a signal sent to the process may be taken by one of Zenoh's threads, and
+Python runs its handler only when the main thread next runs."""
+
 MAX_TRANSPORT_BYTES = 8 * MAX_MESSAGE_BYTES
 """Zenoh refuses bigger messages before they reach Python (the application's own cap,
 :data:`assembly_constraints.bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
@@ -158,8 +163,8 @@ def router_main(argv: Sequence[str]) -> int:
     try:
         where = " ".join(listen) or f"as in {args.zenoh_config}"
         print(f"ready router {session.zid()} listen {where}", flush=True)
-        while True:  # short sleeps: a signal one of Zenoh's threads takes runs its handler here only then
-            time.sleep(0.2)
+        while True:
+            time.sleep(SIGNAL_POLL_S)
     except SystemExit:
         pass  # SIGTERM/SIGINT: close below
     finally:

@@ -81,7 +81,13 @@ from assembly_constraints.bridge.messages import (
     encode,
 )
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, add_viewer_arguments
-from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments, cell_listen, open_session
+from assembly_constraints.bridge.session import (
+    DEFAULT_ENDPOINT,
+    SIGNAL_POLL_S,
+    add_endpoint_arguments,
+    cell_listen,
+    open_session,
+)
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.backend_plugin import (
     Backend,
@@ -106,9 +112,6 @@ CACHE_SIZE = 100_000
 
 QUEUE_SIZE = 16
 """Requests that may wait for the cell; more are refused with ``busy``."""
-
-SIGNAL_POLL_S = 0.2
-"""The longest the cell's main thread waits for work before it looks at signals [s]."""
 
 
 class TruthBackend:
@@ -347,10 +350,8 @@ class CellNode:
     def serve(self) -> None:
         """Run queued requests until :meth:`stop` (or SIGTERM/SIGINT via SystemExit).
 
-        The wait for work wakes every :data:`SIGNAL_POLL_S`: a signal sent to the process may
-        be taken by one of Zenoh's threads, and Python runs its handler only when the main
-        thread next runs; blocked without a timeout, the cell would wait out its
-        supervisor's SIGTERM until it is killed."""
+        The wait for work wakes every :data:`SIGNAL_POLL_S`; blocked without a timeout, the
+        cell would wait out a SIGTERM one of Zenoh's threads took until it is killed."""
         while not self._stopped.is_set():
             try:
                 work = self._work.get(timeout=SIGNAL_POLL_S)
