@@ -27,6 +27,7 @@ import pybullet as pb
 import rerun as rr
 
 from assembly_constraints.bridge.recording.layout import HELD_PART
+from assembly_constraints.bridge.recording.rows import log_row
 from assembly_constraints.executor.world.scene import link_frame
 
 _ARM_COLOR = [235, 120, 30]
@@ -74,13 +75,13 @@ class ArmRecorder:
                 continue
             if is_part:
                 if held_part is not None:
-                    _log_row(rec, entity, [pose, archetype, rr.TextDocument(held_part)], at, static=False)
+                    log_row(rec, entity, [pose, archetype, rr.TextDocument(held_part)], at, static=False)
             elif with_static:
-                _log_row(rec, entity, [pose, archetype], at, static)
+                log_row(rec, entity, [pose, archetype], at, static)
         if not with_static:
             return
         base_pos, base_quat = link_frame(self.client, self.robot, _BASE)
-        _log_row(rec, f"{root}/arm/base", [rr.Transform3D(translation=list(base_pos),
+        log_row(rec, f"{root}/arm/base", [rr.Transform3D(translation=list(base_pos),
                                                           quaternion=rr.Quaternion(xyzw=list(base_quat)))], at, static)
 
     def log_now(self, rec: rr.RecordingStream, root: str) -> None:
@@ -97,19 +98,6 @@ class ArmRecorder:
                 f"{root}/arm/{self.names[link]}", indexes=indexes,
                 columns=rr.Transform3D.columns(translation=poses[:, column, :3], quaternion=poses[:, column, 3:]),
             )
-
-
-def _log_row(rec: rr.RecordingStream, entity: str, parts: Sequence[rr.AsComponents],
-             at: Sequence[rr.TimeColumn] | None, static: bool) -> None:
-    """Log ``parts`` on ``entity`` as one row: at the instant ``at`` (one-row time columns,
-    sent column-wise, so ``log_time`` is that instant too rather than the moment of the
-    call), else ``static`` or at the stream's current time."""
-    if at is None:
-        rec.log(entity, *parts, static=static)
-        return
-    batches = [batch for part in parts for batch in part.as_component_batches()]
-    rec.send_columns(entity, indexes=at, columns=[batch.partition([len(batch.as_arrow_array())])
-                                                  for batch in batches])
 
 
 def _archetype(geom_type: int, dims: Sequence[float], mesh: bytes, color: list[int]) -> rr.AsComponents | None:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import queue
 import threading
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -45,7 +46,8 @@ from assembly_constraints.asp.precedence.relation import Relation, reduction
 from assembly_constraints.asp.session.layered import positions
 from assembly_constraints.asp.sizes.knowledge import Knowledge
 from assembly_constraints.bridge.recording.compaction import compact_recording
-from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, blueprint, opening
+from assembly_constraints.bridge.recording.layout import APPLICATION_ID, SESSION_TIMELINE, Contents, blueprint, opening
+from assembly_constraints.bridge.recording.rows import log_row
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
 
 _PART_COLOR = [70, 130, 220]
@@ -106,24 +108,26 @@ class PlannerLog:
         self._write_knowledge(number, f"#{number} {part} -> {hole}: {result} ({cell})", knowledge, (part, hole))
 
     def _write_knowledge(self, number: int, line: str, knowledge: Knowledge, pair: tuple[str, str] | None) -> None:
-        """At experiment ``number`` (and now on ``log_time``): ``line`` in the experiment log,
-        ``knowledge`` as matrix, table (``pair`` in bold) and smaller-than graph."""
-        self.rec.set_time("experiment", sequence=number)
-        self.rec.log("planner/experiments", rr.TextLog(line))
+        """At experiment ``number`` and one instant of ``log_time`` (now): ``line`` in the
+        experiment log, ``knowledge`` as matrix, table (``pair`` in bold) and smaller-than
+        graph. One instant, so that a viewer paused where this experiment's rows start shows
+        all of them."""
         matrix = np.array([[-1 if v is None else v for v in row] for row in knowledge.matrix()],
                           dtype=np.int8)
         dims = [f"part: {' '.join(knowledge.parts)}", f"hole: {' '.join(knowledge.holes)}"]
-        self.rec.log("planner/knowledge", rr.Tensor(matrix, dim_names=dims, value_range=(-1, 1)))
-        self.rec.log("planner/knowledge_table",
-                     rr.TextDocument(_knowledge_table(knowledge, matrix, pair), media_type="text/markdown"))
         nodes = [*knowledge.parts, *knowledge.holes]
         colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)
         if self._smaller is None or self._smaller[0] is not knowledge:
             reduced = reduction(Relation.from_pairs(nodes, knowledge.smaller))
             self._smaller = knowledge, reduced, positions(nodes, reduced)
         _, edges, layout = self._smaller
-        self.rec.log("planner/smaller", rr.GraphNodes(nodes, labels=nodes, colors=colors, positions=layout))
-        self.rec.log("planner/smaller", rr.GraphEdges(edges, graph_type="directed"))
+        at = [rr.TimeColumn("experiment", sequence=[number]), rr.TimeColumn(SESSION_TIMELINE, timestamp=[time.time()])]
+        log_row(self.rec, "planner/experiments", [rr.TextLog(line)], at)
+        log_row(self.rec, "planner/knowledge", [rr.Tensor(matrix, dim_names=dims, value_range=(-1, 1))], at)
+        log_row(self.rec, "planner/knowledge_table",
+                [rr.TextDocument(_knowledge_table(knowledge, matrix, pair), media_type="text/markdown")], at)
+        log_row(self.rec, "planner/smaller", [rr.GraphNodes(nodes, labels=nodes, colors=colors, positions=layout),
+                                              rr.GraphEdges(edges, graph_type="directed")], at)
 
     def assignment(self, assignment: Mapping[str, str]) -> None:
         """The hole assignment as a graph part → hole (parts above their holes) and a table."""

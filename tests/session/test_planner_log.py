@@ -37,6 +37,9 @@ def test_knowledge_matrix_keeps_its_range_and_labels_to_the_last_experiment(tmp_
     assert column_values(rrd, "planner/knowledge", "experiment") == [0, 1, 2]
     starts = column_values(rrd, "planner/knowledge", "log_time")
     assert len(starts) == 3 and starts == sorted(starts)
+    for entity in ("planner/experiments", "planner/knowledge_table", "planner/smaller"):
+        # each experiment's rows at one instant: paused where one starts, the viewer draws them all
+        assert column_values(rrd, entity, "log_time") == starts, entity
     assert column_values(rrd, "planner/knowledge", "Tensor:value_range") == [[[-1.0, 1.0]]] * 3
     tensors = column_values(rrd, "planner/knowledge", "Tensor:data")
     assert [d["names"] for d in tensors[-1]] == [["part: p1 p2", "hole: r1 r2"]]
