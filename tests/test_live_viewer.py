@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge.recording.reader import column_values, read_recording
+from assembly_constraints.bridge.recording.reader import column_values, read_blueprint, read_recording
 from assembly_constraints.bridge.recording.sinks import free_port
 from tests.conftest import ROOT, child_env
 
@@ -99,6 +99,9 @@ def test_a_session_streams_planner_and_cells_live(tmp_path: Path, run_session) -
     assert {"/executor/c1/outcome", "/executor/c2/outcome"} <= set(entities)
     streamed = len(column_values(live, "planner/experiments", "TextLog:text"))
     assert streamed == result["experiments"] + 1  # and the start, experiment 0
+    layout = read_blueprint(live)  # the live viewer's blueprint, following the newest data
+    assert layout.tabs == ["planner", "c1", "c2"] and layout.time_panel["play_state"] == 3
+    assert read_recording(tmp_path / "run" / "planner.rrd").blueprints == 0  # the folder's is view.rbl
 
 
 @pytest.mark.slow

@@ -2,12 +2,14 @@
 
 Planner and cells log into ONE recording id (application
 :data:`assembly_constraints.bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
-files opened together are one recording. The planner sends the session's blueprint
-(:func:`assembly_constraints.bridge.recording.layout.blueprint`) with what is certain when
-it starts: its views in a first tab, then one tab per cell it starts (whether a cell will
-assemble is not known yet; the session writes ``RUN/view.rbl`` from what was recorded
-when it ends). The knowledge learning starts from is logged as experiment 0, so a viewer
-opened paused at the start of a timeline shows it.
+files opened together are one recording. Their blueprint is ``RUN/view.rbl``, which the
+session writes from what was recorded when it ends; the planner's file holds none (a
+viewer opening the folder would take whichever it read last). A viewer watching live gets
+the session's blueprint (:func:`assembly_constraints.bridge.recording.layout.blueprint`)
+with what is certain when it starts: the planner's views in a first tab, then one tab per
+cell it starts (whether a cell will assemble is not known yet). The knowledge learning
+starts from is logged as experiment 0, so a viewer opened paused at the start of a
+timeline shows it.
 
 =========================== ==========================================================
 ``planner/knowledge``       part × hole matrix at the start (experiment 0: the
@@ -48,7 +50,13 @@ from assembly_constraints.asp.sizes.knowledge import Knowledge
 from assembly_constraints.bridge.recording.compaction import compact_recording
 from assembly_constraints.bridge.recording.layout import APPLICATION_ID, SESSION_TIMELINE, Contents, blueprint, opening
 from assembly_constraints.bridge.recording.rows import log_row
-from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
+from assembly_constraints.bridge.recording.sinks import (
+    NO_VIEWER,
+    Viewer,
+    finish_stream,
+    open_stream,
+    send_live_blueprint,
+)
 
 _PART_COLOR = [70, 130, 220]
 _HOLE_COLOR = [230, 150, 40]
@@ -58,14 +66,14 @@ _CELL_TEXT = {1: "fit", 0: "no fit", -1: "?"}
 class PlannerLog:
     """Logs the planner's entities into ``rrd`` under ``recording_id``, and live to
     ``viewer``, starting with ``start``, the knowledge before any experiment (experiment 0);
-    its blueprint has a tab for the planner and for each of ``cell_ids``."""
+    ``viewer`` gets a blueprint with a tab for the planner and for each of ``cell_ids``."""
 
     def __init__(self, rrd: Path, recording_id: str, cell_ids: Sequence[str], start: Knowledge,
                  viewer: Viewer = NO_VIEWER) -> None:
         self.rrd = rrd
         self.rec = open_stream(APPLICATION_ID, recording_id, rrd, viewer)
-        self.rec.send_blueprint(blueprint(Contents(planner=True, cells=tuple(cell_ids)),
-                                          play_state=opening(viewer.connect is not None)))
+        send_live_blueprint(APPLICATION_ID, recording_id, viewer,
+                            blueprint(Contents(planner=True, cells=tuple(cell_ids)), play_state=opening(live=True)))
         self._smaller: tuple[Knowledge, list[tuple[str, str]], list[tuple[float, float]]] | None = None
         """The last knowledge logged, the reduction of its smaller-than graph and the graph's
         layout: experiments recorded together share one knowledge, laid out once."""

@@ -36,6 +36,7 @@ from pathlib import Path
 from urllib.parse import quote
 
 import rerun as rr
+import rerun.blueprint as rrb
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.files import check_writable
@@ -98,6 +99,21 @@ def open_stream(application_id: str, recording_id: str, rrd_path: Path | None,
     else:
         recording.memory_recording()
     return recording
+
+
+def send_live_blueprint(application_id: str, recording_id: str, viewer: Viewer,
+                        layout: rrb.BlueprintLike) -> None:
+    """Send ``layout`` to the live viewer ``viewer.connect`` only (no file): a recording
+    whose folder gets its blueprint when it ends (``view.rbl``) keeps none in its own file,
+    since a viewer opening the folder takes whichever of the two it reads last (measured
+    with rerun 0.41: a session's files in name order showed the file's)."""
+    if viewer.connect is None:
+        return
+    stream = rr.RecordingStream(application_id, recording_id=recording_id)
+    stream.set_sinks(rr.GrpcSink(viewer.connect))
+    stream.send_blueprint(layout)
+    stream.flush()
+    stream.disconnect()
 
 
 def finish_stream(recording: rr.RecordingStream, rrd_path: Path | None) -> None:

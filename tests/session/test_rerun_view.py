@@ -116,10 +116,10 @@ def test_a_session_opens_with_an_assembly_tab_only_when_it_recorded_one(tmp_path
     files = sorted(run.glob("*.rrd"))
     assert [f.name for f in files] == ["c1.rrd", "planner.rrd"]
     assert not any("/assembly/" in path for path in read_recording(files).entities)
-    for opened in (run / "view.rbl", run / "planner.rrd"):  # the session's own view, the planner's own blueprint
-        layout = read_blueprint(opened)
-        assert layout.tabs == ["planner", "c1"], opened
-        assert layout.time_panel == {"timeline": "log_time", "play_state": 1}, opened
+    layout = read_blueprint(run / "view.rbl")  # the folder's one blueprint: no file of it holds another
+    assert layout.tabs == ["planner", "c1"]
+    assert layout.time_panel == {"timeline": "log_time", "play_state": 1}
+    assert read_recording(files).blueprints == 0
 
 
 def test_the_view_blueprint_of_a_session_that_assembled_has_its_assembly_tab(tmp_path: Path) -> None:
