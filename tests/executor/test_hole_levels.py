@@ -4,7 +4,8 @@ own entries, floors where a hole is shallower than its boss, the plate under the
 at the deepest bottom); in physics, with the skills taught at the plate's level (the
 shipped ones, taught in r1 and s1), a fitting peg inserted to the bottom of each, a
 too-big one refused on the raised boss, skills taught in the raised and the deeper hole
-against the shipped ones, and the assembling cell's goals at each hole's bottom."""
+against the shipped ones, and the assembling cell's goals at each hole's bottom; the
+assembled export, made for the plate's level only, refuses the product."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import pytest
 import trimesh
 
 from assembly_constraints.bridge.assembly import DATA_DIR
+from assembly_constraints.cli import main
 from assembly_constraints.executor.assembly.product import load_product
 from assembly_constraints.executor.assembly.step import Assembler
 from assembly_constraints.executor.cell_description import CellDescription
@@ -110,6 +112,17 @@ def test_the_bosses_stand_to_their_entries_with_a_floor_where_shallower(product:
             assert floor.size == 0 and hole.bottom_z == base
         else:
             assert floor.size and floor == pytest.approx(hole.bottom_z, abs=1e-6), hid
+
+
+def test_the_assembled_export_refuses_holes_at_their_own_levels(product: Path, tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    """``executor export --assembled`` builds the base's solid at the plate's level only:
+    it refuses (one line, exit 2) rather than write a base without r2's raise and s2's depth."""
+    assert main(["-q", "executor", "export", "--assembled", "--assembly", str(product), str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: {product / 'geometry.toml'}: holes r2, s2 have their own top_z or depth; the base's solid "
+                   "is exported only for holes at the plate's level"]
+    assert not list((tmp_path / "out").glob("*.obj"))
 
 
 @pytest.mark.slow
