@@ -186,18 +186,18 @@ class Cell:
 
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
-        skill = self.check_pair(part, hole)
+        spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
+        skill = self.check_pair(part, hole).deeper(self.geometry.deeper_than_taught(spec, hole_spec))
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps
         arm = motion.controller.arm
-        spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
         layer = self.layer
         key = self.ilc_key(part, hole)
         correction, iteration = self.ilc.correction(key) if layer.ilc else (None, 0)
         self._scenes[spec.shape].set_friction(setup.friction)
         arm.set_grasp_error(setup.grasp_offset, rotvec_quat_xyzw(setup.grasp_tilt))
-        surface = self.geometry.plate.top_z
+        surface = hole_spec.top_z
         est_xy = np.array(hole_spec.position) + setup.vision_error
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + setup.vision_yaw)
         quat = tool_quat(yaw)

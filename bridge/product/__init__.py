@@ -10,7 +10,8 @@ descriptions, so the JSON Schema ``protocol --out`` publishes, docs/protocol/, s
 same), then checks (:mod:`assembly_constraints.bridge.product.checks`) what one struct cannot: references
 between tables (a hole's position, a part's start, a ``demo_hole``, a cover's holes, a
 head's cover), a rect's size ``[a, b]`` with ``a >= b``, a chamfer inside its boss,
-bosses that do not overlap, a grasp shorter than the part, the shapes of
+every hole deeper than its chamfer (a hole at its own level with its bottom above the
+floor), bosses that do not overlap, a grasp shorter than the part, the shapes of
 ``assembly.toml`` against the kinds of ``geometry.toml``, a part's mesh against the
 digest of its file and its convex pieces against that mesh.
 
@@ -31,7 +32,14 @@ import msgspec
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.inputs import read_text, shorten
-from assembly_constraints.bridge.product.checks import check_assembly, check_geometry, check_grasp, fail, where
+from assembly_constraints.bridge.product.checks import (
+    check_assembly,
+    check_geometry,
+    check_grasp,
+    fail,
+    hole_level,
+    where,
+)
 from assembly_constraints.bridge.product.tables import (
     CONVEX_HEADER,
     DEFAULT_COVER_CLEARANCE,
@@ -61,7 +69,7 @@ from assembly_constraints.bridge.product.tables import (
 __all__ = ["CONVEX_HEADER", "DEFAULT_COVER_CLEARANCE", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS",
            "AssemblyFile", "Base", "Cover", "ExtraPart", "GeometryFile", "Gripper", "Head", "HoleEntry", "HoleShape",
            "Mesh", "PartEntry", "PartShape", "Plate", "ProductDescription", "SizesTable", "check_grasp",
-           "decode_toml_file", "is_id", "load_product_description", "product_from_tables"]
+           "decode_toml_file", "hole_level", "is_id", "load_product_description", "product_from_tables"]
 
 _T = TypeVar("_T")
 # ---- reading and translating errors ----

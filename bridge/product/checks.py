@@ -1,9 +1,10 @@
 """The checks of a product description that one struct cannot make (:mod:`assembly_constraints.bridge.product`):
-references between tables, a rect's ``[a, b]``, a chamfer inside its boss, bosses that do
-not overlap, a grasp shorter than the part, the shapes of ``assembly.toml`` against the
-kinds of ``geometry.toml``, the base, covers and heads against the parts, a part's mesh
-against its file (by SHA-256) and its convex pieces against that mesh. Every failure
-is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a BridgeError)."""
+references between tables, a rect's ``[a, b]``, a chamfer inside its boss, every hole
+deeper than its chamfer (a hole at its own level with its bottom above the floor), bosses
+that do not overlap, a grasp shorter than the part, the shapes of ``assembly.toml``
+against the kinds of ``geometry.toml``, the base, covers and heads against the parts, a
+part's mesh against its file (by SHA-256) and its convex pieces against that mesh. Every
+failure is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a BridgeError)."""
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from assembly_constraints.bridge.product.tables import (
     HoleShape,
     Mesh,
     PartShape,
+    Plate,
 )
 
 MAX_MESH_BYTES = 256 * 1024 * 1024
@@ -81,6 +83,32 @@ def _check_sections(path: Path, group: str, tables: Mapping[str, HoleShape] | Ma
             raise fail(path, f"{group}.{name}", "size", "[a, b] with a >= b (the long side a along x)", size)
 
 
+def hole_level(plate: Plate, shape: HoleShape) -> tuple[float, float]:
+    """(entry height, depth) [m] of the holes of ``shape``: its own ``top_z`` and
+    ``depth``, else the plate's ``top_z`` and ``tile_thickness``."""
+    return (plate.top_z if shape.top_z is None else shape.top_z,
+            plate.tile_thickness if shape.depth is None else shape.depth)
+
+
+def _check_levels(path: Path, plate: Plate, shapes: Mapping[str, HoleShape]) -> None:
+    """The holes at the plate's level and each shape with its own are deeper than the
+    entry chamfer; a shape's own level has its bottom above the floor (z = 0)."""
+    if plate.chamfer >= plate.tile_thickness:
+        raise fail(path, "plate", "chamfer", f"less than tile_thickness ({plate.tile_thickness:g} m)", plate.chamfer)
+    for name, shape in shapes.items():
+        top, depth = hole_level(plate, shape)
+        table = f"hole_shapes.{name}"
+        if shape.depth is not None and plate.chamfer >= depth:
+            raise fail(path, table, "depth", f"more than the [plate] chamfer ({plate.chamfer:g} m)", depth)
+        if depth < top or (shape.top_z is None and shape.depth is None):
+            continue
+        if shape.depth is not None:
+            raise fail(path, table, "depth", f"less than the entry height ({top:g} m: the bottom above the floor)",
+                       depth)
+        raise fail(path, table, "top_z", f"more than the depth ({depth:g} m, the [plate] tile_thickness: the "
+                   "bottom above the floor)", top)
+
+
 def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
     """Every peg is longer than the part of it inside ``gripper``'s fingers."""
     for name, table in geometry.part_shapes.items():
@@ -98,8 +126,7 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     pegs = _members(path, "part_shapes", geo.part_shapes)
     _check_sections(path, "hole_shapes", geo.hole_shapes)
     _check_sections(path, "part_shapes", geo.part_shapes)
-    if plate.chamfer >= plate.tile_thickness:
-        raise fail(path, "plate", "chamfer", f"less than tile_thickness ({plate.tile_thickness:g} m)", plate.chamfer)
+    _check_levels(path, plate, geo.hole_shapes)
     for name, hole_shape in geo.hole_shapes.items():
         if _sides(hole_shape.size)[0] + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "

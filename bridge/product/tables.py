@@ -104,13 +104,18 @@ class AssemblyFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True)
 
 # ---- geometry.toml ----
 
-class Plate(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """``[plate]``: the bosses' top face height, side and thickness (= hole depth), the
-    entry chamfer [m], the sides of a round hole's polygon, the plate under the bosses."""
+EntryHeight = Annotated[float, Meta(gt=0.0, le=1.0, description="a number in (0, 1] m")]
+HoleDepth = Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
 
-    top_z: Annotated[float, Meta(gt=0.0, le=1.0, description="a number in (0, 1] m")]
+
+class Plate(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[plate]``: the bosses' top face height (the hole entries), side and thickness (=
+    the hole depth), each hole's unless its shape gives its own, the entry chamfer [m],
+    the sides of a round hole's polygon, the plate under the bosses."""
+
+    top_z: EntryHeight
     tile_size: Annotated[float, Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] m")]
-    tile_thickness: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
+    tile_thickness: HoleDepth
     chamfer: Annotated[float, Meta(gt=0.0, le=0.01, description="a number in (0, 0.01] m")]
     polygon_sides: Annotated[int, Meta(ge=8, le=256, multiple_of=8,
                                        description="an integer multiple of 8 in 8 .. 256")]
@@ -132,12 +137,16 @@ class Gripper(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[hole_shapes.<name>]``: holes of one cross-section; ``size`` a diameter or side
-    [m], for a rect ``[a, b]`` (a along the hole's x axis, turned by ``yaw`` [degrees])."""
+    [m], for a rect ``[a, b]`` (a along the hole's x axis, turned by ``yaw`` [degrees]);
+    ``top_z`` the height of their entry and ``depth`` from the entry to their bottom [m],
+    where they differ from the plate's ``top_z`` and ``tile_thickness``."""
 
     holes: Ids
     kind: Kind
     size: SectionSize
     yaw: Yaw = 0.0
+    top_z: EntryHeight | None = None
+    depth: HoleDepth | None = None
 
 
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -154,18 +154,16 @@ class Assembler:
 
     def block_hole(self, hole: str) -> None:
         """An obstacle in ``hole`` (a fault injection): a box filling it from the bottom up to
-        5 mm under the plate top, so no peg reaches its goal there."""
+        5 mm under its entry, so no peg reaches its goal there."""
         spec = self.product.geometry.holes.get(hole)
         if spec is None:
             holes = ", ".join(sorted(self.product.geometry.holes))
             raise ExecutorError(f"unknown hole '{hole}' (expected one of {holes})")
-        plate = self.product.geometry.plate
-        depth = plate.tile_thickness - 0.005
+        depth = spec.depth - 0.005
         a, b = spec.sides
         half = [a / 2 - 0.0002, b / 2 - 0.0002, depth / 2]
         col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=self.world.client)
-        bottom = self.product.top_z - plate.tile_thickness
-        pb.createMultiBody(0, col, -1, [*spec.position, bottom + depth / 2], yaw_quat(spec.yaw),
+        pb.createMultiBody(0, col, -1, [*spec.position, spec.bottom_z + depth / 2], yaw_quat(spec.yaw),
                            physicsClientId=self.world.client)
         self.blocked.add(hole)
 
@@ -249,15 +247,17 @@ class Assembler:
             return world.position(into) + world.socket_offset[part] + world.frames[part].tcp
         return world.goals[part] + world.frames[part].tcp
 
-    def _approach(self, part: str, skill: str, goal: np.ndarray) -> np.ndarray:
-        """Where the insertion starts [m]: above the hole (pegs), above the pin tops
-        (covers), above the socket (heads)."""
+    def _approach(self, part: str, hole: str | None, skill: str, goal: np.ndarray) -> np.ndarray:
+        """Where the insertion starts [m]: above the entry of ``hole`` (pegs), above the pin
+        tops (covers: the longest peg standing in the highest of its holes), above the
+        socket (heads)."""
         p = self.product
-        if skill == "insert":
-            return np.array([goal[0], goal[1], p.top_z + APPROACH_HEIGHT])
+        if skill == "insert" and hole is not None:
+            return np.array([goal[0], goal[1], p.geometry.holes[hole].top_z + APPROACH_HEIGHT])
         if skill == "insert_over":
-            plate = p.geometry.plate
-            pins_top = p.top_z + max(s.length for s in p.pegs.values()) - plate.tile_thickness
+            longest = max(s.length for s in p.pegs.values())
+            holes = [p.geometry.holes[h] for h in p.covers[part].over]
+            pins_top = max(h.top_z + longest - h.depth for h in holes)
             return np.array([goal[0], goal[1], pins_top + ABOVE_PINS])
         head = p.heads[part]
         cover = p.covers[head.into]
@@ -268,7 +268,7 @@ class Assembler:
         """One attempt from above the goal: (goal reached, max force dev [N], max torque dev [Nm])."""
         world, motion, p = self.world, self.world.motion, self.product
         goal = self._goal_tcp(part, skill)
-        approach = self._approach(part, skill, goal)
+        approach = self._approach(part, hole, skill, goal)
         if skill != "insert_over":  # a cover is aimed at its holes' centres (module docstring)
             approach[:2] += setup.vision_error
         yaw = self._yaw(part, hole, setup)
@@ -284,7 +284,11 @@ class Assembler:
             found = hole_search(motion, approach[:2], surface, approach[2], quat,
                                 np.random.default_rng(setup.search_seed))
             xy = found.hole_xy
-            skill_obj = self._skill(p.pegs[part].shape if skill == "insert" else p.heads[part].skill)
+            if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
+                peg = p.pegs[part]
+                skill_obj = self._skill(peg.shape).deeper(p.geometry.deeper_than_taught(peg, p.geometry.holes[hole]))
+            else:
+                skill_obj = self._skill(p.heads[part].skill)
         origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])
         detector = Detector(self.thresholds)
         lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))

@@ -167,9 +167,8 @@ class AssemblyWorld:
 
     def set_peg_goal(self, part: str, hole: str) -> None:
         """A peg's goal: standing on the bottom of ``hole``."""
-        plate = self.product.geometry.plate
-        self.goals[part] = np.array([*self.product.geometry.holes[hole].position,
-                                     self.product.top_z - plate.tile_thickness])
+        spec = self.product.geometry.holes[hole]
+        self.goals[part] = np.array([*spec.position, spec.bottom_z])
 
     def lock(self, part: str) -> None:
         """Lock a placed peg in its hole: fixed where it rests, its contacts with the plate

@@ -20,6 +20,7 @@ import pybullet as pb
 import trimesh
 
 from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.assembly.product import load_product
 from assembly_constraints.executor.assembly.world import AssemblyWorld
 from assembly_constraints.executor.cell_description import load_cell_description
@@ -62,7 +63,7 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
     (the deck's axis-aligned square around each hole minus the boss mesh), the same solid
     as the cell's boss mesh, deck and box under them, without their shared faces. A turned
     boss leaves the corners of its square open, as in the cell. A base with its own mesh
-    is that mesh."""
+    is that mesh; ExecutorError for a plate with holes at their own levels (not made)."""
     geometry = world.product.geometry
     if geometry.base_mesh is not None:
         own = trimesh.load(geometry.base_mesh, force="mesh")
@@ -70,6 +71,10 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
         return own
     plate = geometry.plate
     top, tile, depth = plate.top_z, plate.tile_size, plate.tile_thickness
+    levelled = sorted(h.id for h in geometry.holes.values() if (h.top_z, h.depth) != (top, depth))
+    if levelled:
+        raise ExecutorError(f"{geometry.folder / 'geometry.toml'}: holes {', '.join(levelled)} have their own top_z or "
+                            "depth; the base's solid is exported only for holes at the plate's level")
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     block = trimesh.creation.box((sx, sy, top))
     block.apply_translation((cx, cy, top / 2))

@@ -205,11 +205,17 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> list[Ho
                 continue  # an outline, not a hole
             frame = frame_of(axis)
             centre = frame.T @ loop.centre + axis * level
-            if any(f.axis == name and np.linalg.norm(np.array(f.centre) - centre - axis * np.dot(
-                    np.array(f.centre) - centre, axis)) < _SAME_HOLE for f in fits):
-                continue
             occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
-            fits.append(_measure(base, name, loop, level, around[0] if around else None, occupant))
+            same = [k for k, f in enumerate(fits) if f.axis == name and np.linalg.norm(
+                np.array(f.centre) - centre - axis * np.dot(np.array(f.centre) - centre, axis)) < _SAME_HOLE]
+            if same and (occupant is None or fits[same[0]].part is not None):
+                continue
+            # a hole met empty at another part's level (a shallower one beside a deeper) is its occupant's
+            fit = _measure(base, name, loop, level, around[0] if around else None, occupant)
+            if same:
+                fits[same[0]] = fit
+            else:
+                fits.append(fit)
     fits.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     return fits
 

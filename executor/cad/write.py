@@ -11,10 +11,11 @@
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product when every part but the base is a peg
-  standing in a hole along +z and the holes' entries are at one height with one depth
-  (and the cell's loader accepts it; left out otherwise, and the report says why): the
-  plate and pegs as primitives where they are ones, else as their own meshes with convex
-  pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`).
+  standing in a hole along +z (and the cell's loader accepts it; left out otherwise, and
+  the report says why): the plate at the entry height and depth most holes share, a hole
+  at another one with its own ``top_z`` and ``depth``, the plate and pegs as primitives
+  where they are ones, else as their own meshes with convex pieces (``meshes/``,
+  :mod:`assembly_constraints.executor.cad.convex`).
 """
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "
 """The simulated gripper of every imported product (Cranfield's)."""
 MIN_CHAMFER = 1e-4
 """The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
-_LEVEL = 1e-5  # holes whose entries or depths differ by more [m] are no one plate
+_LEVEL = 1e-5
+"""A hole whose entry or depth differs by more than this from the plate's [m] states its own."""
 
 
 @dataclass(frozen=True)
@@ -176,9 +178,6 @@ def simulable(derived: Derived) -> str | None:
             return f"hole {fit.id} is not entered from above with a round, square or rect section"
     if not fits:
         return "no part stands in a hole of the base"
-    for what, values in (("entry", [f.entry for f in fits]), ("depth", [f.depth for f in fits])):
-        if max(values) - min(values) > _LEVEL:
-            return f"the holes' {what} differs by {1000 * (max(values) - min(values)):.3g} mm (one plate has one)"
     return None
 
 
@@ -210,7 +209,7 @@ def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh])
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
-    top, depth = fits[0].entry, fits[0].depth
+    top, depth = _plate_level(fits)
     tile = _tile(fits)
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
              "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
@@ -224,6 +223,10 @@ def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh])
                   f"size = {_size(fit.hole.kind, fit.hole.a, fit.hole.b)}"]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
+        if abs(fit.entry - top) > _LEVEL:
+            lines.append(f"top_z = {_q(fit.entry)}")
+        if abs(fit.depth - depth) > _LEVEL:
+            lines.append(f"depth = {_q(fit.depth)}")
         lines.append("")
     for pid, fit in sorted(derived.hole_of.items()):
         mesh, peg = derived.parts[pid].mesh, fit.section
@@ -238,6 +241,17 @@ def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh])
               "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}",
               *([_mesh_entry(meshes[derived.base])] if derived.base in meshes else []), ""]
     return "\n".join(lines)
+
+
+def _plate_level(fits: list[HoleFit]) -> tuple[float, float]:
+    """The plate's ``top_z`` and ``tile_thickness`` [m]: the entry and depth most holes
+    share (the first hole's among equally many), so that only the others state their own."""
+    levels = [(f.entry, f.depth) for f in fits]
+
+    def sharing(level: tuple[float, float]) -> int:
+        return sum(abs(e - level[0]) <= _LEVEL and abs(d - level[1]) <= _LEVEL for e, d in levels)
+
+    return max(levels, key=sharing)
 
 
 def _tile(fits: list[HoleFit]) -> float:

@@ -73,9 +73,8 @@ def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, 
     try:
         scene.hold(spec)
         arm = Arm(scene.client, scene.robot)
-        top = geometry.plate.top_z
-        depth = geometry.plate.tile_thickness
-        center = np.array([*hole_spec.position, top])
+        depth = hole_spec.depth
+        center = np.array([*hole_spec.position, hole_spec.top_z])
         _hold(scene, arm, center + [0.0, 0.0, 0.03])
         for _ in range(200):
             pb.stepSimulation(physicsClientId=scene.client)

@@ -126,6 +126,20 @@ class Skill:
             self._dmp.forcing_term_rot = _MemoForcingTerm(self._dmp.forcing_term_rot)
         return self._dmp
 
+    def deeper(self, offset: float) -> Skill:
+        """This skill in a hole ``offset`` [m] deeper than the one it was taught in
+        (negative: shallower): the same DMP weights, duration and reference wrench over the
+        phase, its goal and expected end position ``offset`` lower. The hole frame's origin
+        is the entry, so a skill moves with the entry's height as it is; only the depth
+        needs this. ``self`` itself at offset 0."""
+        if offset == 0.0:
+            return self
+        down = np.array([0.0, 0.0, offset])
+        moved = Skill(self.shape, self.execution_time, self.weights, self.demo_start,
+                      self.demo_goal - np.concatenate([down, np.zeros(4)]), self.end_position - down, self.wrench)
+        moved._dmp = self._rollout_dmp()  # its remembered forcing terms do not depend on the goal
+        return moved
+
     def rollout(self, start_pos: np.ndarray, start_quat_xyzw: np.ndarray, goal_pos: np.ndarray,
                 goal_quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The DMP from a start to a goal pose (hole frame): times (N,) [s], positions

@@ -6,9 +6,11 @@ the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) dow
 tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
 executed by the impedance controller alone and the wrench it meets is recorded: the
 reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
-replay ends is p_goal.  Poses, wrenches and p_goal are stored in the hole's frame (turned
-by the hole's yaw), so the skill runs in a hole of any yaw.  ``./run.sh executor teach`` rebuilds
-``data/<assembly>/demonstrations/<shape>.json``.
+replay ends is p_goal.  Poses, wrenches and p_goal are stored in the hole's frame (its
+origin at the centre of the hole's entry, at the hole's own height, turned by the hole's
+yaw), so the skill runs in a hole of any yaw and at any height; in a hole of another depth
+its goal moves with the bottom (:meth:`assembly_constraints.executor.skills.dmp.Skill.deeper`).
+``./run.sh executor teach`` rebuilds ``data/<assembly>/demonstrations/<shape>.json``.
 """
 
 from __future__ import annotations
@@ -74,8 +76,8 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     geometry = cell.geometry
     part = next(p for pid, p in sorted(geometry.parts.items()) if p.shape == shape)
     hole = geometry.holes[part.demo_hole]
-    origin = np.array([*hole.position, geometry.plate.top_z])
-    bottom = geometry.plate.tile_thickness
+    origin = np.array([*hole.position, hole.top_z])
+    bottom = hole.depth
     motion = cell.motion_for(part.id)
     assert cell.scene is not None  # set by motion_for
     cell.scene.set_friction(None)  # the teaching friction, whatever ran before

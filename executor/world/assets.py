@@ -4,9 +4,10 @@
 generated from ``geometry.toml`` and ``assembly.toml`` by
 :func:`assembly_constraints.executor.world.geometry.write_assets`. The folder records the
 SHA-256 of the values it was made from (``assets/sources.sha256``: the ``[plate]`` table,
-every hole and part as loaded, as canonical JSON, a part's or the base's ``mesh`` with the
-digest of its file; comments and the keys the assets do not use leave it unchanged),
-written after the assets, so an interrupted regeneration is regenerated again.
+every hole (its entry height and depth where they are its own) and part as loaded, as
+canonical JSON, a part's or the base's ``mesh`` with the digest of its file; comments and
+the keys the assets do not use leave it unchanged), written after the assets, so an
+interrupted regeneration is regenerated again.
 :func:`current_assets`, called before a cell loads any asset, regenerates the folder
 when a generated file is missing or the digest differs: an edited hole is never simulated
 with its old mesh. When the folder cannot be written (a read-only install), the error
@@ -25,8 +26,15 @@ import msgspec
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.files import write_atomic
+from assembly_constraints.bridge.product import Plate
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, convex_asset_name, write_assets
+from assembly_constraints.executor.world.geometry import (
+    CellGeometry,
+    HoleSpec,
+    PartSpec,
+    convex_asset_name,
+    write_assets,
+)
 
 STAMP = "sources.sha256"
 
@@ -35,17 +43,28 @@ logger = logging.getLogger(__name__)
 
 def sources_digest(geometry: CellGeometry) -> str:
     """Hex SHA-256 of the canonical JSON of what the assets are generated from: the
-    ``[plate]`` table, every hole and part (their dataclass fields; a part's ``mesh`` and
-    the base's only where there is one, so a product of primitives keeps its digest). The
-    values come from decimal text, and a mesh is named by its file's SHA-256 (the loader
-    checked it), so the digest is the same on every machine and in every folder."""
+    ``[plate]`` table, every hole and part (their dataclass fields; a hole's level where it
+    is not the plate's, a part's ``mesh`` and the base's only where there is one, so a
+    product of primitives at one level keeps its digest). The values come from decimal
+    text, and a mesh is named by its file's SHA-256 (the loader checked it), so the digest
+    is the same on every machine and in every folder."""
     inputs: dict[str, object] = {"plate": msgspec.structs.asdict(geometry.plate),
-                                 "holes": [dataclasses.asdict(h) for _, h in sorted(geometry.holes.items())],
+                                 "holes": [_hole_fields(h, geometry.plate) for _, h in sorted(geometry.holes.items())],
                                  "parts": [_part_fields(p) for _, p in sorted(geometry.parts.items())]}
     base = geometry.tables.base
     if base is not None and base.mesh is not None:
         inputs["base_mesh"] = msgspec.structs.asdict(base.mesh)
     return hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
+    """A hole's fields, its entry height and depth only where they are not the plate's (so
+    a product whose holes are all at the plate's level keeps its digest)."""
+    fields = dataclasses.asdict(hole)
+    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness)):
+        if fields[key] == default:
+            del fields[key]
+    return fields
 
 
 def _part_fields(part: PartSpec) -> dict[str, object]:

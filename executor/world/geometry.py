@@ -2,8 +2,11 @@
 ``assembly.toml``, and the generated assets (plate mesh, part URDFs, arm+tool URDF).
 
 The back plate is a static concave triangle mesh (PyBullet's trimesh has effectively no
-collision margin, so 0.1 mm clearances are real): one square boss per hole with a
-through hole (the plate under the boss is its bottom) and a 45° entry chamfer; round
+collision margin, so 0.1 mm clearances are real): one square boss per hole, from the
+plate under the bosses (:attr:`CellGeometry.base_top`) up to the hole's entry (the
+plate's ``top_z`` or the hole's own), with a 45° entry chamfer and the hole down to its
+bottom (the plate's ``tile_thickness`` or its own ``depth`` below the entry): through the
+boss when the bottom is the plate's top, else onto a floor of the boss; round
 holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square and
 rectangular holes exact; a hole with a yaw has its whole boss turned by it about the
 hole's centre.  Parts are exact primitive shapes (cylinder with
@@ -40,11 +43,16 @@ from assembly_constraints.bridge.product import (
     PartShape,
     Plate,
     check_grasp,
+    hole_level,
     load_product_description,
 )
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.world.meshes import MeshInertia, eroded_pieces_text, mesh_inertia
+
+FLOOR_MIN = 1e-6
+"""A hole whose bottom is less than this above the plate under the bosses goes through its
+boss onto the plate [m] (the mesh is printed to 1 µm): no floor thinner than that."""
 
 
 @dataclass(frozen=True)
@@ -66,10 +74,18 @@ class Section:
 
 @dataclass(frozen=True)
 class HoleSpec(Section):
-    """A hole of the plate at ``position`` [m], its x axis turned by ``yaw`` [rad] about z."""
+    """A hole of the plate at ``position`` [m], its x axis turned by ``yaw`` [rad] about z,
+    its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry."""
 
     position: tuple[float, float]
     yaw: float = 0.0
+    top_z: float = field(kw_only=True)
+    depth: float = field(kw_only=True)
+
+    @property
+    def bottom_z(self) -> float:
+        """Height of the hole's bottom [m]."""
+        return self.top_z - self.depth
 
 
 @dataclass(frozen=True)
@@ -105,6 +121,25 @@ class CellGeometry:
     @property
     def assets(self) -> Path:
         return self.folder / "assets"
+
+    @property
+    def base_top(self) -> float:
+        """Height of the plate under the bosses [m]: the bottom of a hole at the plate's
+        level (``top_z - tile_thickness``), or of the deepest hole where that is lower; a
+        hole whose bottom is above it has a floor in its boss."""
+        default = self.plate.top_z - self.plate.tile_thickness
+        return min([default, *(hole.bottom_z for hole in self.holes.values())])
+
+    @property
+    def sunk_by(self) -> float:
+        """How far [m] the plate under the bosses lies below the bottom of a hole at the
+        plate's level (0.0 exactly when no hole is deeper)."""
+        return self.plate.top_z - self.plate.tile_thickness - self.base_top
+
+    def deeper_than_taught(self, part: PartSpec, hole: HoleSpec) -> float:
+        """How much deeper [m] ``hole`` is than the hole ``part``'s skill is taught in (its
+        shape's ``demo_hole``; negative: shallower)."""
+        return hole.depth - self.holes[part.demo_hole].depth
 
     @property
     def base_mesh(self) -> Path | None:
@@ -146,8 +181,10 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
     holes: dict[str, HoleSpec] = {}
     for hole_shape in geo.hole_shapes.values():
         kind, size, width = _section(hole_shape)
+        top, depth = hole_level(geo.plate, hole_shape)
         for hid in hole_shape.holes:
-            holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width)
+            holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
+                                  top_z=top, depth=depth)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -239,13 +276,15 @@ def _turned(ring: np.ndarray, yaw: float) -> np.ndarray:
     return ring @ np.array([[c, s], [-s, c]])
 
 
-def _boss_triangles(hole: HoleSpec, plate: Plate) -> list[np.ndarray]:
-    """Triangles (3×3 vertex arrays [m], outward normals) of one boss with its through
-    hole (the plate under the boss is the hole's bottom) and a 45° entry chamfer."""
+def _boss_triangles(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarray]:
+    """Triangles (3×3 vertex arrays [m], outward normals) of one boss standing on the
+    plate under the bosses (its top at ``base`` [m]) up to the hole's entry, with a 45°
+    entry chamfer and the hole down to its bottom: through the boss (the plate is the
+    bottom) when the bottom is at ``base``, else onto a floor of the boss."""
     n = plate.polygon_sides
     cx, cy = hole.position
-    top = plate.top_z
-    bottom = top - plate.tile_thickness
+    top = hole.top_z
+    floor = hole.bottom_z if hole.bottom_z - base >= FLOOR_MIN else None
     chamfer = plate.chamfer
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
     outer = _turned(_ring("square", plate.tile_size / 2, n), hole.yaw) + (cx, cy)
@@ -265,14 +304,17 @@ def _boss_triangles(hole: HoleSpec, plate: Plate) -> list[np.ndarray]:
         i0, i1 = v(inner, k, top - chamfer), v(inner, k + 1, top - chamfer)
         slope = centre_top - (m0 + m1) / 2 + np.array([0.0, 0.0, np.linalg.norm(centre_top - (m0 + m1) / 2)])
         tris += [(m0, m1, i1, slope), (m0, i1, i0, slope)]
-        f0, f1 = v(inner, k, bottom), v(inner, k + 1, bottom)
+        f0, f1 = v(inner, k, base if floor is None else floor), v(inner, k + 1, base if floor is None else floor)
         wall_in = centre_top - (i0 + i1) / 2
         wall_in[2] = 0.0
         tris += [(i0, i1, f1, wall_in), (i0, f1, f0, wall_in)]
-        b0, b1 = v(outer, k, bottom), v(outer, k + 1, bottom)
+        b0, b1 = v(outer, k, base), v(outer, k + 1, base)
         wall_out = (o0 + o1) / 2 - centre_top
         tris += [(o0, o1, b1, wall_out), (o0, b1, b0, wall_out)]
-        tris += [(b0, b1, f1, down), (b0, f1, f0, down)]
+        if floor is None:  # an open ring on the plate, which is the hole's bottom
+            tris += [(b0, b1, f1, down), (b0, f1, f0, down)]
+        else:  # the boss's floor inside the hole, its solid bottom on the plate
+            tris += [(np.array([cx, cy, floor]), f0, f1, up), (np.array([cx, cy, base]), b0, b1, down)]
     out = []
     for a, b, c, wanted in tris:
         if np.dot(np.cross(b - a, c - a), wanted) < 0:
@@ -287,7 +329,7 @@ def plate_obj_text(geometry: CellGeometry) -> str:
     count = 0
     for hid in sorted(geometry.holes):
         lines.append(f"o boss_{hid}")
-        for tri in _boss_triangles(geometry.holes[hid], geometry.plate):
+        for tri in _boss_triangles(geometry.holes[hid], geometry.plate, geometry.base_top):
             lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in tri]
             lines.append(f"f {count + 1} {count + 2} {count + 3}")
             count += 3

@@ -112,7 +112,8 @@ def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,
                deck: Sequence[tuple[float, float, float, float]] = ()) -> int:
     """Static plate: a box under the bosses plus the concave trimesh of the bosses, and
     optionally ``deck`` boxes ([xmin, ymin, xmax, ymax] [m]) filling the space between the
-    bosses up to the plate top (a flat top for parts lying on the plate); a base with its
+    bosses up to the plate's ``top_z`` (a flat top for parts lying on the plate; a hole
+    at its own level has its boss standing out of it or sunk into it); a base with its
     own mesh is that mesh alone, a static concave trimesh in the cell frame (no deck
     needed: its top is its own)."""
     base_mesh = geometry.base_mesh
@@ -124,10 +125,10 @@ def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,
         return pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
                                   physicsClientId=client)
     plate = geometry.plate
-    boss_bottom = plate.top_z - plate.tile_thickness
+    boss_bottom = geometry.base_top
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     boxes = [((sx / 2, sy / 2, boss_bottom / 2), (cx, cy, boss_bottom / 2), (0.55, 0.6, 0.65, 1))]
-    deck_half = plate.tile_thickness / 2
+    deck_half = (plate.tile_thickness + geometry.sunk_by) / 2
     boxes += [(((x1 - x0) / 2, (y1 - y0) / 2, deck_half), ((x0 + x1) / 2, (y0 + y1) / 2, boss_bottom + deck_half),
                (0.62, 0.66, 0.7, 1)) for x0, y0, x1, y1 in deck]
     cols = [pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=client) for half, _, _ in boxes]
@@ -152,19 +153,20 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
     """Static bodies for the Rerun log: ``(name, "box"|"cylinder", half_extents [m],
     position [m], quat_xyzw, rgb)``: the plate, each hole (as the cavity), the tray parts."""
     plate = geometry.plate
-    boss_bottom = plate.top_z - plate.tile_thickness
+    boss_bottom = geometry.base_top
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     shapes: list[tuple] = [("plate", "box", (sx / 2, sy / 2, boss_bottom / 2), (cx, cy, boss_bottom / 2),
                             (0, 0, 0, 1), (140, 150, 165))]
-    half_tile, half_thick = plate.tile_size / 2, plate.tile_thickness / 2
+    half_tile = plate.tile_size / 2
     for hid, hole in sorted(geometry.holes.items()):
         turned = yaw_quat(hole.yaw)  # the boss turns with its hole
+        half_thick = (hole.depth + (hole.bottom_z - boss_bottom)) / 2  # its depth and floor
         shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
-                       (*hole.position, plate.top_z - half_thick), turned, (180, 185, 190)))
-        half_depth = plate.tile_thickness / 2
+                       (*hole.position, hole.top_z - half_thick), turned, (180, 185, 190)))
+        half_depth = hole.depth / 2
         a, b = hole.sides
         shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (a / 2, b / 2, half_depth),
-                       (*hole.position, plate.top_z - half_depth), turned, (40, 40, 40)))
+                       (*hole.position, hole.top_z - half_depth), turned, (40, 40, 40)))
     for pid, part in sorted(geometry.parts.items()):
         a, b = part.sides
         shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (a / 2, b / 2, part.length / 2),

@@ -12,8 +12,8 @@ import pytest
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.bridge.assembly import DATA_DIR
 from assembly_constraints.executor.world.geometry import (
-    HoleSpec,
     PartSpec,
+    Section,
     load_geometry,
     part_urdf_text,
     passes,
@@ -92,6 +92,6 @@ def test_committed_assets_are_what_the_generator_makes(assembly: str) -> None:
 
 def test_a_square_peg_passes_a_round_hole_only_by_its_diagonal() -> None:
     square = PartSpec("q", "square", 0.010, shape="q", length=0.05, mass=0.05, start=(0.0, 0.0), demo_hole="h")
-    assert passes(square, HoleSpec("h", "round", 0.0142, (0.0, 0.0)))  # diagonal 14.14 mm
-    assert not passes(square, HoleSpec("h", "round", 0.0141, (0.0, 0.0)))
-    assert passes(square, HoleSpec("h", "square", 0.0101, (0.0, 0.0)))
+    assert passes(square, Section("h", "round", 0.0142))  # diagonal 14.14 mm
+    assert not passes(square, Section("h", "round", 0.0141))
+    assert passes(square, Section("h", "square", 0.0101))

@@ -66,6 +66,18 @@ CASES = [
     ("length-zero", "length = 0.05           # [m]", "length = 0", "[part_shapes.round_peg] length: expected"),
     ("kind-unknown", 'kind = "round"\nsize = 0.0187', 'kind = "hexagon"\nsize = 0.0187',
      "[part_shapes.shaft] kind: expected one of rect, round, square, got 'hexagon'"),
+    ("hole-top-z-text", 'holes = ["br"]', 'holes = ["br"]\ntop_z = "0.11"',
+     "[hole_shapes.round_big] top_z: expected a number in (0, 1] m, got '0.11'"),
+    ("hole-depth-zero", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.0',
+     "[hole_shapes.round_big] depth: expected a number in (0, 0.2] m, got 0.0"),
+    ("hole-depth-within-the-chamfer", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.0005',
+     "[hole_shapes.round_big] depth: expected more than the [plate] chamfer (0.0008 m), got 0.0005"),
+    ("hole-bottom-under-the-floor", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.1',
+     "[hole_shapes.round_big] depth: expected less than the entry height (0.1 m: the bottom above the floor), "
+     "got 0.1"),
+    ("hole-entry-under-the-plate-depth", 'holes = ["br"]', 'holes = ["br"]\ntop_z = 0.02',
+     "[hole_shapes.round_big] top_z: expected more than the depth (0.025 m, the [plate] tile_thickness: the bottom "
+     "above the floor), got 0.02"),
     ("kind-number", 'holes = ["br"]\nkind = "round"', 'holes = ["br"]\nkind = 1',
      "[hole_shapes.round_big] kind: expected one of rect, round, square, got 1"),
     ("demo-hole-unknown", 'demo_hole = "br"', 'demo_hole = "zz"',
@@ -149,7 +161,8 @@ def test_the_product_gripper_wins_over_the_cell_one(tmp_path: Path) -> None:
 
 
 NUMERIC_KEYS = [("plate", key) for key in Plate.__struct_fields__] + [
-    ("gripper", key) for key in Gripper.__struct_fields__]
+    ("gripper", key) for key in Gripper.__struct_fields__] + [("hole_shapes.round_big", "top_z"),
+                                                              ("hole_shapes.round_big", "depth")]
 VALUES = st.one_of(st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow_infinity=True), st.booleans(),
                    st.text(max_size=5), st.lists(st.floats(-1, 1), max_size=3))
 
@@ -157,12 +170,15 @@ VALUES = st.one_of(st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow
 @settings(max_examples=60, deadline=None)
 @given(key=st.sampled_from(NUMERIC_KEYS), value=VALUES)
 def test_any_value_of_a_key_loads_or_is_refused_in_one_line(key: tuple[str, str], value: object) -> None:
-    """Whatever a [plate] or [gripper] key holds, the check passes or raises one
-    BridgeError of one line naming the file and a table (the key itself, or the key a
-    cross check relates it to: a smaller tile_size refuses the hole that no longer fits),
-    never another exception."""
+    """Whatever a [plate] or [gripper] key or a hole's own level holds, the check passes or
+    raises one BridgeError of one line naming the file and a table (the key itself, or the
+    key a cross check relates it to: a smaller tile_size refuses the hole that no longer
+    fits), never another exception."""
     geo = tomllib.loads(ORIGINAL)
-    geo[key[0]][key[1]] = value
+    table = geo
+    for name in key[0].split("."):
+        table = table[name]
+    table[key[1]] = value
     path = CRANFIELD / "geometry.toml"
     layout = tomllib.loads((CRANFIELD / "assembly.toml").read_text())
     try:

@@ -30,7 +30,7 @@ def _peg(kind: str, a: float, b: float = 0.0) -> PartSpec:
 
 
 def _hole(kind: str, a: float, b: float = 0.0, yaw: float = 0.0) -> HoleSpec:
-    return HoleSpec("h", kind, a, (0.0, 0.0), yaw=yaw, width=b)
+    return HoleSpec("h", kind, a, (0.0, 0.0), yaw=yaw, width=b, top_z=0.1, depth=0.025)
 
 
 def test_a_rect_passes_a_rect_when_aligned_long_side_along_long_side() -> None:

@@ -24,7 +24,8 @@ from assembly_constraints.asp.sizes.models import build_model, model_for
 from assembly_constraints.asp.sizes.policies import policy_names
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle, ferrers_violation
 from assembly_constraints.asp.solve import fact
-from assembly_constraints.executor.world.geometry import HoleSpec, PartSpec, passes
+from assembly_constraints.executor.world.geometry import PartSpec, passes
+from assembly_constraints.executor.world.geometry import Section as CrossSection
 
 Section = tuple[str, float, float]
 """(kind, size [m], width [m]) of a peg's or a hole's cross-section: a rect is size x width
@@ -39,7 +40,7 @@ def _truth(pegs: list[Section], holes: list[Section],
     hole_ids = [f"h{j}" for j in range(1, len(holes) + 1)]
     specs = [PartSpec(p, kind, size, shape=kind, length=0.05, mass=0.05, start=(0.0, 0.0), demo_hole="h1",
                       width=width) for p, (kind, size, width) in zip(part_ids, pegs)]
-    hole_specs = [HoleSpec(h, kind, size, position=(0.0, 0.0), width=width)
+    hole_specs = [CrossSection(h, kind, size, width=width)
                   for h, (kind, size, width) in zip(hole_ids, holes)]
     fits = {(p.id, h.id) for p in specs for h in hole_specs if passes(p, h)}
     if sections is None:
