@@ -1,12 +1,17 @@
 """Parts the simulated cell builds from their own meshes, decided and written at import.
 
-A peg is a **primitive** when its mesh's volume is within :data:`PRIMITIVE_TOLERANCE` of
-the prism of its cross-section over its length (a cylinder or a box: the cell builds it
-as one); the base is one when its volume is within that of its bounding box less its
-holes (cross-section times depth: the cell's plate). Any other part is written as its
-own mesh (``meshes/<id>.obj``, Wavefront OBJ [m]): a peg in its part frame (origin at the
-centre of its section at its bottom, z up its axis, x along its section's long side),
-the base in the cell frame. A moving part also gets its convex pieces
+A peg or a head is a **primitive** when its mesh's volume is within
+:data:`PRIMITIVE_TOLERANCE` of the prism of its cross-section over its length (a cylinder
+or a box: the cell builds it as one; a head's box has the cell's axes); a cover when the
+symmetric difference of its mesh and the cell's cover (its outline less square openings
+of its holes' sizes plus its clearance, and its socket) is within that of its volume;
+the base when its volume is within that of its bounding box less its holes (cross-section
+times depth: the cell's plate). Any other part is written as its own mesh
+(``meshes/<id>.obj``, Wavefront OBJ [m]): a peg in its part frame (origin at the centre of
+its section at its bottom, z up its axis, x along its section's long side), a cover in its
+frame (origin at the centre of the holes it goes over at its bottom, the cell's axes), a
+head in its (the centre of its section at its bottom, the cell's axes), the base in the
+cell frame. A moving part also gets its convex pieces
 (``meshes/<id>.convex.obj``, one OBJ object each, the first line naming the mesh and its
 SHA-256): its convex hull when the hull's volume is within :data:`CONVEX_TOLERANCE` of
 the mesh's, else a convex decomposition by CoACD (seed 0, so an import is repeatable),
@@ -20,6 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print a symbol, std::bad_cast)
@@ -29,7 +35,9 @@ import trimesh
 
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.product import CONVEX_HEADER, Mesh
+from assembly_constraints.executor.assembly.product import Box
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.cad.sections import Shape2D
 from assembly_constraints.executor.world.meshes import obj_text
 
 PRIMITIVE_TOLERANCE = 0.01
@@ -43,14 +51,17 @@ relative to the part's size."""
 PIECE_VERTICES = 64
 """The most vertices a convex piece keeps (the 12 mm shaft of the tests then within 0.06 mm)."""
 MESH_FOLDER = "meshes"
+YAW_TOLERANCE = 0.01
+"""A square section within this of the cell's axes [°] is not turned."""
 
 
-def _area(kind: str, a: float, b: float) -> float:
+def section_area(kind: str, a: float, b: float) -> float:
     """The area [m²] of a section: round of diameter a, square of side a, rect a × b."""
     return math.pi * a * a / 4 if kind == "round" else a * (a if kind == "square" else b)
 
 
-def _is_close(volume: float, primitive: float) -> bool:
+def is_close(volume: float, primitive: float) -> bool:
+    """Whether a part's ``volume`` and its primitive's [m³] differ by less than :data:`PRIMITIVE_TOLERANCE` of it."""
     return abs(volume - primitive) < PRIMITIVE_TOLERANCE * volume
 
 
@@ -58,14 +69,38 @@ def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
     """Whether the peg in ``fit`` is the prism of its section over its length along z."""
     assert fit.section is not None  # a peg has a section
     section = fit.section
-    return _is_close(mesh.volume, _area(section.kind, section.a, section.b) * float(mesh.extents[2]))
+    return is_close(mesh.volume, section_area(section.kind, section.a, section.b) * float(mesh.extents[2]))
 
 
 def base_is_primitive(derived: Derived) -> bool:
     """Whether the base is its bounding box less its holes (each its section times its depth)."""
     mesh = derived.parts[derived.base].mesh
-    holes = sum(_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
-    return _is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
+    holes = sum(section_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
+    return is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
+
+
+def cover_is_primitive(mesh: trimesh.Trimesh, boxes: Sequence[Box]) -> bool:
+    """Whether a cover's ``mesh`` (in its frame) is the cell's solid of ``boxes`` (its
+    outline less square openings: :func:`assembly_constraints.executor.assembly.product.cover_spec`):
+    their symmetric difference is less than :data:`PRIMITIVE_TOLERANCE` of the mesh's
+    volume. The boxes are disjoint, so it is both volumes less twice the mesh's
+    intersections with each box (exact booleans, manifold3d)."""
+    solid = sum(8 * float(np.prod(box.half)) for box in boxes)
+    common = 0.0
+    for box in boxes:
+        piece = trimesh.creation.box(2 * np.asarray(box.half))
+        piece.apply_translation(box.centre)
+        inside = trimesh.boolean.intersection([mesh, piece], engine="manifold")
+        common += float(inside.volume) if len(inside.faces) else 0.0
+    return bool(mesh.volume + solid - 2 * common < PRIMITIVE_TOLERANCE * mesh.volume)
+
+
+def head_is_primitive(section: Shape2D, mesh: trimesh.Trimesh) -> bool:
+    """Whether a head is the cylinder or box of its ``section`` over its length along z with
+    the cell's axes (the cell's head box is not turned: a square head with a yaw is none)."""
+    turned = section.kind != "round" and abs(section.yaw) > YAW_TOLERANCE
+    return not turned and is_close(mesh.volume, section_area(section.kind, section.a, section.b)
+                                   * float(mesh.extents[2]))
 
 
 def peg_frame(fit: HoleFit, mesh: trimesh.Trimesh) -> np.ndarray:

@@ -20,11 +20,13 @@
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import clingo
 import networkx as nx
+import numpy as np
+import trimesh
 
 from assembly_constraints.bridge.errors import ToolError
 from assembly_constraints.bridge.files import make_folder, write_atomic
@@ -36,6 +38,7 @@ from assembly_constraints.executor.cad.convex import (
     peg_is_primitive,
     write_mesh,
 )
+from assembly_constraints.executor.cad.covers import Mapped, map_parts
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
 from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
 
@@ -62,8 +65,8 @@ def section(name: str, shape_kind: str, a: float, b: float) -> Section:
 
 
 def _q(value: float) -> float:
-    """Metres rounded to 0.1 µm (a printed tessellation is no finer)."""
-    return round(value, 7)
+    """Metres rounded to 0.1 µm (a printed tessellation is no finer), never -0.0."""
+    return round(value, 7) + 0.0
 
 
 def _size(kind: str, a: float, b: float) -> str:
@@ -74,12 +77,14 @@ def _symbols(symbols: list[clingo.Symbol]) -> str:
     return " ".join(f"{symbol}." for symbol in symbols)
 
 
-def assembly_text(derived: Derived, settings: Settings, title: str) -> str:
+def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[str, str]) -> str:
+    """``assembly.toml``: the parts with their ``roles`` (base, peg, else the given one or
+    ``part``) and trays, the holes."""
     pegs = derived.hole_of
     lines = [f"# Imported from {title} by ./run.sh import: parts in the CAD frame (the cell frame) [m].",
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):
-        role = "base" if pid == derived.base else "peg" if pid in pegs else "part"
+        role = "base" if pid == derived.base else "peg" if pid in pegs else roles.get(pid, "part")
         lines += [f"[parts.{pid}]", f"name = {json.dumps(settings.names.get(pid, derived.parts[pid].name))}",
                   f'role = "{role}"']
         x, y = settings.trays[pid]
@@ -161,24 +166,66 @@ def precedence_text(derived: Derived) -> str:
 
 
 def simulable(derived: Derived) -> str | None:
-    """Why the product is not one the simulated cell builds from primitives, None when it is."""
-    pegs = derived.hole_of
-    for pid in sorted(derived.parts):
-        if pid == derived.base:
-            continue
-        if pid not in pegs:
-            return f"part '{pid}' stands in no hole of the base"
+    """Why the product's base and pegs are not ones the simulated cell builds, None when
+    they are (its other parts: :func:`assembly_constraints.executor.cad.covers.map_parts`)."""
+    for pid in sorted(derived.hole_of):
         if derived.axis[pid] != "+z":
-            return f"part '{pid}' goes in along {derived.axis[pid]}, not from above"
+            return f"part '{pid}' goes in along {_reverse(derived.axis[pid])}, not from above"
     fits = list(derived.holes.values())
     for fit in fits:
         if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
             return f"hole {fit.id} is not entered from above with a round, square or rect section"
-    if not fits:
+    if not fits or not derived.hole_of:
         return "no part stands in a hole of the base"
     for what, values in (("entry", [f.entry for f in fits]), ("depth", [f.depth for f in fits])):
         if max(values) - min(values) > _LEVEL:
             return f"the holes' {what} differs by {1000 * (max(values) - min(values)):.3g} mm (one plate has one)"
+    return None
+
+
+def _reverse(direction: str) -> str:
+    return ("-" if direction[0] == "+" else "+") + direction[1]
+
+
+def map_product(derived: Derived, settings: Settings) -> Mapped:
+    """The covers and heads of a product whose base and pegs the cell builds
+    (:func:`simulable`), with ``why`` the cell builds none: the first reason of
+    :func:`simulable`, :func:`assembly_constraints.executor.cad.covers.map_parts`, or two
+    parts overlapping on the tray."""
+    why = simulable(derived)
+    if why is not None:
+        return Mapped({}, {}, why)
+    mapped = map_parts(derived, next(iter(derived.holes.values())).entry)
+    return mapped if mapped.why is not None else replace(mapped, why=_tray_overlap(derived, mapped, settings))
+
+
+def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
+    """Each part's transform (4 × 4) from the cell frame to its part frame (the base's: its
+    bounding box's centre at its plate's ``base_center``)."""
+    frames = {pid: peg_frame(fit, derived.parts[pid].mesh) for pid, fit in derived.hole_of.items()}
+    (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
+    origins = {pid: fit.origin for pid, fit in mapped.covers.items()} | {pid: fit.origin for pid, fit in
+                                                                         mapped.heads.items()}
+    origins[derived.base] = ((x0 + x1) / 2, (y0 + y1) / 2, 0.0)
+    return frames | {pid: trimesh.transformations.translation_matrix(np.negative(origin))
+                     for pid, origin in origins.items()}
+
+
+def _tray_overlap(derived: Derived, mapped: Mapped, settings: Settings) -> str | None:
+    """Why two parts overlap where they wait (their footprints: bounding boxes of their
+    meshes in their part frames at their trays), None when none do."""
+    frames = _frames(derived, mapped)
+    boxes = {}
+    for pid, frame in frames.items():
+        lower, upper = trimesh.bounds.corners(derived.parts[pid].mesh.bounds) @ frame[:3, :3].T, None
+        upper = (lower + frame[:3, 3]).max(axis=0)[:2] + settings.trays[pid]
+        boxes[pid] = ((lower + frame[:3, 3]).min(axis=0)[:2] + settings.trays[pid], upper)
+    ids = sorted(boxes)
+    for k, a in enumerate(ids):
+        for b in ids[k + 1:]:
+            if np.all(np.minimum(boxes[a][1], boxes[b][1]) - np.maximum(boxes[a][0], boxes[b][0]) > _LEVEL):
+                return (f"parts '{a}' and '{b}' overlap where they wait on the tray (set [parts.<id>] tray in the "
+                        "import settings)")
     return None
 
 
@@ -187,26 +234,29 @@ def _mesh_entry(mesh: Mesh) -> str:
     return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
 
 
-def write_meshes(derived: Derived, out: Path) -> tuple[dict[str, Mesh], list[Path]]:
-    """The meshes of the parts of a :func:`simulable` product that are no primitive,
-    written into ``out`` (the base in the cell frame, a peg in its part frame); returns
-    their ``mesh`` entries by part and the files written."""
+def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str, Mesh], list[Path]]:
+    """The meshes of the parts of a mapped product that are no primitive, written into
+    ``out`` (the base in the cell frame, the others in their part frames); returns their
+    ``mesh`` entries by part and the files written."""
     meshes: dict[str, Mesh] = {}
     written: list[Path] = []
     if not base_is_primitive(derived):
         meshes[derived.base], files = write_mesh(out, derived.base, derived.parts[derived.base].mesh, moving=False)
         written += files
-    for pid, fit in sorted(derived.hole_of.items()):
-        mesh = derived.parts[pid].mesh
-        if not peg_is_primitive(fit, mesh):
-            meshes[pid], files = write_mesh(out, pid, mesh.copy().apply_transform(peg_frame(fit, mesh)), moving=True)
-            written += files
+    frames = _frames(derived, mapped)
+    moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
+    moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
+    moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
+    for pid in sorted(moving):
+        mesh = derived.parts[pid].mesh.copy().apply_transform(frames[pid])
+        meshes[pid], files = write_mesh(out, pid, mesh, moving=True)
+        written += files
     return meshes, written
 
 
-def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh]) -> str:
-    """``geometry.toml`` of a :func:`simulable` product, the parts in ``meshes`` as their
-    own meshes."""
+def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh]) -> str:
+    """``geometry.toml`` of a mapped product (:func:`map_product`), the parts in ``meshes``
+    as their own meshes."""
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
@@ -233,11 +283,29 @@ def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh])
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
-              "[base]", f'part = "{derived.base}"',
-              f"tray = [{_q(settings.trays[derived.base][0])}, {_q(settings.trays[derived.base][1])}]",
+              "[base]", f'part = "{derived.base}"', f"tray = {_numbers(settings.trays[derived.base])}",
               "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}",
               *([_mesh_entry(meshes[derived.base])] if derived.base in meshes else []), ""]
+    for cid, cover in sorted(mapped.covers.items()):
+        lines += [f"[covers.{cid}]", f"name = {json.dumps(settings.names.get(cid, derived.parts[cid].name))}",
+                  f"over = {json.dumps(list(cover.over))}", f"outline = {_numbers(cover.outline)}",
+                  f"thickness = {_q(cover.thickness)}", f"bottom = {_q(max(cover.bottom, 0.0))}",
+                  f"clearance = {_q(cover.clearance)}", f"mass = {_q(derived.parts[cid].mesh.volume * DENSITY)}",
+                  f"grip = {_numbers(cover.grip)}", f"tray = {_numbers(settings.trays[cid])}",
+                  f'skill = "{cover.skill}"',
+                  *([f"socket = {_numbers(cover.socket)}"] if cover.socket else []),
+                  *([_mesh_entry(meshes[cid])] if cid in meshes else []), ""]
+    for hid, head in sorted(mapped.heads.items()):
+        lines += [f"[heads.{hid}]", f"name = {json.dumps(settings.names.get(hid, derived.parts[hid].name))}",
+                  f'into = "{head.into}"', f'kind = "{head.section.kind}"', f"size = {_q(head.section.a)}",
+                  f"length = {_q(head.length)}", f"mass = {_q(derived.parts[hid].mesh.volume * DENSITY)}",
+                  f'skill = "{head.skill}"', *([_mesh_entry(meshes[hid])] if hid in meshes else []), ""]
     return "\n".join(lines)
+
+
+def _numbers(values: tuple[float, ...]) -> str:
+    """A TOML list of lengths [m] to 0.1 µm."""
+    return f"[{', '.join(str(_q(v)) for v in values)}]"
 
 
 def _tile(fits: list[HoleFit]) -> float:
@@ -251,23 +319,25 @@ def _tile(fits: list[HoleFit]) -> float:
     return tile if tile > widest else widest + 0.004
 
 
-def write_folder(derived: Derived, settings: Settings, title: str, out: Path) -> tuple[list[Path], str | None]:
+def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: str, out: Path
+                 ) -> tuple[list[Path], str | None]:
     """Write the files of the module docstring into ``out`` (removing the ``meshes/*.obj``
     an earlier import left that this one does not use); returns them and why there is no
     ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
     make_folder(out)
-    written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title)),
+    roles = {pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
+    written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title, roles)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
                write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
                write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
     geometry = out / "geometry.toml"
     if geometry.exists():
         geometry.unlink()
-    why = simulable(derived)
+    why = mapped.why
     mesh_files: list[Path] = []
     if why is None:
-        meshes, mesh_files = write_meshes(derived, out)
-        write_atomic(geometry, geometry_text(derived, settings, meshes))
+        meshes, mesh_files = write_meshes(derived, mapped, out)
+        write_atomic(geometry, geometry_text(derived, mapped, settings, meshes))
         try:
             load_geometry(str(out))
         except ToolError as exc:

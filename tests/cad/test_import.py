@@ -48,7 +48,7 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], tuple[
         if product not in done:
             tmp = tmp_path_factory.mktemp(product)
             assert main(["-q", "executor", "export", "--assembled", "--assembly", product, str(tmp / "meshes")]) == 0
-            derived, _, _, _ = run_import(tmp / "meshes", tmp / "out", "m", tmp / "meshes" / "import.toml")
+            derived = run_import(tmp / "meshes", tmp / "out", "m", tmp / "meshes" / "import.toml").derived
             done[product] = derived, tmp / "out"
         return done[product]
 
@@ -116,7 +116,7 @@ def test_a_step_assembly_made_by_build123d(tmp_path: Path) -> None:
         f"export_step(Compound(label='product', children=[plate, peg, rect, cap]), {str(tmp_path / 'p.step')!r})\n"
         f"export_step(Compound(label='pegs', children=[plate, peg, rect]), {str(tmp_path / 'pegs.step')!r})\n")
     subprocess.run([sys.executable, str(script)], check=True)
-    derived, _, _, _ = run_import(tmp_path / "p.step", tmp_path / "out", "mm", None)
+    derived = run_import(tmp_path / "p.step", tmp_path / "out", "mm", None).derived
     assert derived.base == "plate"
     round_fit, rect_fit = derived.hole_of["round_peg"], derived.hole_of["rect_peg"]
     assert round_fit.section is not None and rect_fit.section is not None
