@@ -109,13 +109,30 @@ class Product:
         return np.mean([self.geometry.holes[h].position for h in cover.over], axis=0)
 
 
+SAME_EDGE = 1e-6
+"""Edges of a cover's openings closer than this [m] are one edge (1 µm)."""
+MAX_COVER_BOXES = 16
+"""The most boxes a cover's solid may have: PyBullet keeps the first 16 shapes of a compound
+body made by ``createCollisionShapeArray`` and drops the others (measured: a ball fell through
+the 26th box of 30); a cover that needs more is simulated from its own mesh."""
+
+
+def _edges(values: list[float]) -> list[float]:
+    """``values`` sorted, each within :data:`SAME_EDGE` of the last kept one dropped."""
+    kept: list[float] = []
+    for value in sorted(values):
+        if not kept or value - kept[-1] > SAME_EDGE:
+            kept.append(value)
+    return kept
+
+
 def rect_minus_squares(outline: tuple[float, float, float, float],
                        squares: list[tuple[float, float, float]]) -> list[tuple[float, float, float, float]]:
     """Rectangles [xmin, ymin, xmax, ymax] covering ``outline`` minus the axis-aligned
-    squares (centre x, y, side) [m]: the cells of the grid their edges make, merged
-    along x row by row."""
-    xs = sorted({outline[0], outline[2], *(c - s / 2 for c, _, s in squares), *(c + s / 2 for c, _, s in squares)})
-    ys = sorted({outline[1], outline[3], *(c - s / 2 for _, c, s in squares), *(c + s / 2 for _, c, s in squares)})
+    squares (centre x, y, side) [m]: the cells of the grid their edges make (edges within
+    :data:`SAME_EDGE` of each other taken as one: no sliver cells), merged along x row by row."""
+    xs = _edges([outline[0], outline[2], *(c - s / 2 for c, _, s in squares), *(c + s / 2 for c, _, s in squares)])
+    ys = _edges([outline[1], outline[3], *(c - s / 2 for _, c, s in squares), *(c + s / 2 for _, c, s in squares)])
     xs = [x for x in xs if outline[0] <= x <= outline[2]]
     ys = [y for y in ys if outline[1] <= y <= outline[3]]
 
@@ -171,6 +188,11 @@ def load_product(assembly: str = "cranfield", description: CellDescription | Non
     base = BaseSpec(tables.base.part, (tables.base.tray[0], tables.base.tray[1]),
                     (tables.base.grip[0], tables.base.grip[1]), tables.base.mass)
     covers = {cid: cover_spec(cid, table, geometry.holes) for cid, table in tables.covers.items()}
+    for cid, cover in covers.items():
+        if len(cover.boxes) > MAX_COVER_BOXES:
+            raise ExecutorError(f"{path}: [covers.{cid}] over: expected a cover whose outline less its openings is at "
+                                f"most {MAX_COVER_BOXES} boxes (the cell's compound bodies hold no more), got "
+                                f"{len(cover.boxes)}; give it a mesh (docs/geometry.md)")
     starts = {p.id: p.start for p in geometry.layout.parts}
     heads: dict[str, HeadSpec] = {}
     for hid, head in tables.heads.items():

@@ -38,7 +38,7 @@ from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull, QhullError
 
 from assembly_constraints.bridge.product import Cover
-from assembly_constraints.executor.assembly.product import cover_spec
+from assembly_constraints.executor.assembly.product import MAX_COVER_BOXES, cover_spec
 from assembly_constraints.executor.cad.convex import cover_is_primitive, head_is_primitive, section_area
 from assembly_constraints.executor.cad.derive import Derived, first_hit
 from assembly_constraints.executor.cad.parts import STEP_DEFLECTION
@@ -334,4 +334,4 @@ def _with_primitive(derived: Derived, fit: CoverFit) -> CoverFit:
     mesh = derived.parts[fit.id].mesh.copy()
     mesh.apply_translation(-np.asarray(fit.origin))
     boxes = cover_spec(fit.id, table, hole_specs(derived)).boxes
-    return replace(fit, primitive=cover_is_primitive(mesh, boxes))
+    return replace(fit, primitive=len(boxes) <= MAX_COVER_BOXES and cover_is_primitive(mesh, boxes))

@@ -31,12 +31,19 @@ DIRECTIONS: dict[str, tuple[float, float, float]] = {
 _MAX_CONTACTS = 100_000
 
 
-def _bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
+def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
+    """The triangles of ``mesh`` as an fcl object (its BVH)."""
     model = fcl.BVHModel()
     model.beginModel(len(mesh.vertices), len(mesh.faces))
     model.addSubModel(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32))
     model.endModel()
     return fcl.CollisionObject(model, fcl.Transform())
+
+
+def convex_object(hull: trimesh.Trimesh) -> fcl.CollisionObject:
+    """A convex mesh as an fcl convex shape (GJK/EPA against other objects)."""
+    flat = np.hstack([np.full((len(hull.faces), 1), 3), hull.faces]).astype(np.int32).ravel()
+    return _convex(hull.vertices, len(hull.faces), flat)
 
 
 def _convex(vertices: np.ndarray, count: int, flat: np.ndarray) -> fcl.CollisionObject:
@@ -63,7 +70,7 @@ class Sweeper:
 
     def __init__(self, meshes: dict[str, trimesh.Trimesh]) -> None:
         self.meshes = meshes
-        self._objects = {pid: _bvh(mesh) for pid, mesh in meshes.items()}
+        self._objects = {pid: bvh(mesh) for pid, mesh in meshes.items()}
         self.queries = 0
         """Narrow-phase queries made so far."""
 

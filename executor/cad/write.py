@@ -33,6 +33,7 @@ from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.product import Mesh
 from assembly_constraints.executor.cad.convex import (
     MESH_FOLDER,
+    NEAR,
     base_is_primitive,
     peg_frame,
     peg_is_primitive,
@@ -234,22 +235,31 @@ def _mesh_entry(mesh: Mesh) -> str:
     return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
 
 
-def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str, Mesh], list[Path]]:
+def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str, Mesh], list[Path]] | str:
     """The meshes of the parts of a mapped product that are no primitive, written into
-    ``out`` (the base in the cell frame, the others in their part frames); returns their
-    ``mesh`` entries by part and the files written."""
+    ``out`` (the base in the cell frame, the others in their part frames with their convex
+    pieces); returns their ``mesh`` entries by part and the files written, or why a part
+    has no pieces that fit (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
     written: list[Path] = []
     if not base_is_primitive(derived):
-        meshes[derived.base], files = write_mesh(out, derived.base, derived.parts[derived.base].mesh, moving=False)
+        done = write_mesh(out, derived.base, derived.parts[derived.base].mesh, None)
+        assert not isinstance(done, str)  # the base has no pieces
+        meshes[derived.base], files = done
         written += files
     frames = _frames(derived, mapped)
     moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
     moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
     moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
     for pid in sorted(moving):
-        mesh = derived.parts[pid].mesh.copy().apply_transform(frames[pid])
-        meshes[pid], files = write_mesh(out, pid, mesh, moving=True)
+        mesh = derived.parts[pid].mesh
+        near = {other: part.mesh.copy().apply_transform(frames[pid]) for other, part in derived.parts.items()
+                if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
+                                           - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
+        done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), near)
+        if isinstance(done, str):
+            return done
+        meshes[pid], files = done
         written += files
     return meshes, written
 
@@ -335,8 +345,11 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
         geometry.unlink()
     why = mapped.why
     mesh_files: list[Path] = []
-    if why is None:
-        meshes, mesh_files = write_meshes(derived, mapped, out)
+    made = write_meshes(derived, mapped, out) if why is None else None
+    if isinstance(made, str):
+        why = made
+    elif made is not None:
+        meshes, mesh_files = made
         write_atomic(geometry, geometry_text(derived, mapped, settings, meshes))
         try:
             load_geometry(str(out))
