@@ -27,6 +27,7 @@ from assembly_constraints.executor.cad.write import DENSITY
 from assembly_constraints.executor.cell_description import load_cell_description
 from assembly_constraints.executor.world.meshes import read_objects
 from tests.cad.test_import import _fits
+from tests.cad.test_mesh_import import _box
 from tests.conftest import ROOT, Runner
 
 SIZE_BOUND = 5e-5
@@ -100,12 +101,6 @@ def test_the_imported_cranfield_is_learned_and_assembled_in_the_cell(
 
 def _solid(mesh: trimesh.Trimesh, *cuts: trimesh.Trimesh) -> trimesh.Trimesh:
     return trimesh.boolean.difference([mesh, *cuts], engine="manifold") if cuts else mesh
-
-
-def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
-    mesh = trimesh.creation.box(extents)
-    mesh.apply_translation(centre)
-    return mesh
 
 
 def _cylinder(radius: float, height: float, centre: tuple[float, float, float]) -> trimesh.Trimesh:
