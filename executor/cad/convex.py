@@ -217,16 +217,18 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
     return kept, float(max(0.0, np.max(_beyond(kept, points))))
 
 
-def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimesh.Trimesh] | None
-               ) -> tuple[Mesh, list[Path]] | str:
-    """Write ``mesh`` (already in its part frame [m]) as ``meshes/<pid>.obj`` in the
-    assembly ``folder`` and, for a moving part (``neighbours``: the parts near it, in its
-    frame; None for the base), its convex pieces (:func:`fitting_pieces`); returns the
-    ``mesh`` entry of ``geometry.toml`` and the paths written, or why no pieces fit."""
+def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
+               neighbours: dict[str, trimesh.Trimesh] | None) -> tuple[Mesh, list[Path]] | str:
+    """Write ``mesh`` (already in its part frame [m]; ``made``: how, for its header) as
+    ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
+    (``neighbours``: the parts near it, in its frame; None for the base), its convex
+    pieces (:func:`fitting_pieces`); returns the ``mesh`` entry of ``geometry.toml`` and
+    the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
     frame = "the cell frame" if neighbours is None else "its part frame"
-    text = obj_text([(pid, mesh.vertices, mesh.faces)], f"# {pid}: its closed mesh [m] in {frame}, by ./run.sh import")
+    text = obj_text([(pid, mesh.vertices, mesh.faces)],
+                    f"# {pid}: its closed mesh [m] in {frame}, {made}, by ./run.sh import")
     written = [write_atomic(folder / name, text)]
     digest = hashlib.sha256(text.encode()).hexdigest()
     if neighbours is None:

@@ -50,6 +50,9 @@ GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "
 MIN_CHAMFER = 1e-4
 """The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
 _LEVEL = 1e-5  # holes whose entries or depths differ by more [m] are no one plate
+CELL_DEFLECTION = 1e-5
+"""The largest distance [m] of a STEP base's faces from the triangles the cell collides
+with (its own mesh is measured at :data:`assembly_constraints.executor.cad.parts.STEP_DEFLECTION`)."""
 
 
 @dataclass(frozen=True)
@@ -124,21 +127,42 @@ def sizes_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
-def nominal_text(derived: Derived) -> str:
-    """``nominal_margin(P,H,M)``: the room [µm, rounded] the peg's nominal section has in
-    the hole's (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not pass)."""
+def margins(derived: Derived) -> dict[str, dict[str, float]]:
+    """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
+    (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not
+    pass), sections ``other`` left out."""
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
             if fit.section is not None and fit.section.kind != "other"}
     holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    return {pid: {hid: margin(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))
+                  for hid, hole in holes.items()} for pid, peg in pegs.items()}
+
+
+def nominal_text(derived: Derived) -> str:
+    """``nominal_margin(P,H,M)``: the room [µm, rounded] of each peg in each hole (:func:`margins`)."""
     lines = ["% The nominal room of every peg in every hole [um] (negative: it does not pass), by ./run.sh import;",
              "% the input of sizes learn --prior cad."]
-    for pid, peg in pegs.items():
+    for pid, rooms in margins(derived).items():
         lines.append(_symbols([clingo.Function("nominal_margin", [
-            clingo.Function(pid), clingo.Function(hid),
-            clingo.Number(round(1e6 * margin(section(pid, peg.kind, peg.a, peg.b),
-                                             section(hid, hole.kind, hole.a, hole.b))))])
-            for hid, hole in holes.items()]))
+            clingo.Function(pid), clingo.Function(hid), clingo.Number(round(1e6 * room))])
+            for hid, room in rooms.items()]))
     return "\n".join(lines) + "\n"
+
+
+def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
+    """The base's mesh as the cell simulates it and a line saying how it was made: a STEP
+    base tessellated again to :data:`CELL_DEFLECTION` (or a tenth of the least room of a
+    peg that fits a hole, if that is less), else the mesh the import measured."""
+    base = derived.parts[derived.base]
+    rooms = [room for holes in margins(derived).values() for room in holes.values() if room > 0]
+    deflection = min([CELL_DEFLECTION, *(room / 10 for room in rooms)])
+    coarse = None if base.remesh is None else base.remesh(deflection)
+    if coarse is None or not coarse.is_watertight:
+        return base.mesh, "as measured"
+    if coarse.volume < 0:
+        coarse.invert()
+    return coarse, (f"tessellated to {1e6 * deflection:.3g} um for the cell: a round hole's polygon has its corners on "
+                    "the circle, its sides within that of it")
 
 
 REASONS = {
@@ -243,7 +267,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str,
     meshes: dict[str, Mesh] = {}
     written: list[Path] = []
     if not base_is_primitive(derived):
-        done = write_mesh(out, derived.base, derived.parts[derived.base].mesh, None)
+        done = write_mesh(out, derived.base, *cell_base(derived), None)
         assert not isinstance(done, str)  # the base has no pieces
         meshes[derived.base], files = done
         written += files
@@ -256,7 +280,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str,
         near = {other: part.mesh.copy().apply_transform(frames[pid]) for other, part in derived.parts.items()
                 if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
-        done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), near)
+        done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near)
         if isinstance(done, str):
             return done
         meshes[pid], files = done
