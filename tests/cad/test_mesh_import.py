@@ -15,9 +15,9 @@ import pytest
 import trimesh
 
 from assembly_constraints.bridge.product import CONVEX_HEADER
+from assembly_constraints.cli import main
 from assembly_constraints.executor.cad.sections import edge_distance, slice_loops
 from assembly_constraints.executor.cad.write import CELL_DEFLECTION
-from assembly_constraints.cli import main
 from assembly_constraints.executor.world.geometry import load_geometry
 from assembly_constraints.executor.world.meshes import read_objects
 
