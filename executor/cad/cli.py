@@ -34,6 +34,7 @@ from assembly_constraints.executor.cad.derive import Derived, derive
 from assembly_constraints.executor.cad.locating import LOCATING_REACH, MAX_REACH
 from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
 from assembly_constraints.executor.cad.step import load_step
+from assembly_constraints.executor.cad.sweep import opposite
 from assembly_constraints.executor.cad.write import Settings, map_product, write_folder
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
@@ -109,7 +110,7 @@ def report(derived: Derived) -> list[str]:
     """The lines ``import`` prints about what it derived."""
     lines = []
     for pid in sorted(derived.axis):
-        lines.append(f"part {pid}: insertion axis {_reverse(derived.axis[pid])} (leaves along "
+        lines.append(f"part {pid}: insertion axis {opposite(derived.axis[pid])} (leaves along "
                      f"{derived.axis[pid]}); free in the assembled product along "
                      f"{', '.join(derived.free(pid)) or 'none'}")
     for hid, fit in derived.holes.items():
@@ -121,7 +122,7 @@ def report(derived: Derived) -> list[str]:
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
                     f"{clearance} mm)")
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
-                     f"{_reverse(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
+                     f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
     for pocket in derived.pockets:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
@@ -157,9 +158,6 @@ def mapped_report(mapped: Mapped) -> list[str]:
                      + ("a cylinder or box" if head.primitive else "no cylinder or box: its own mesh"))
     return lines
 
-
-def _reverse(direction: str) -> str:
-    return ("-" if direction[0] == "+" else "+") + direction[1]
 
 
 def load_source(source: Path, units: str) -> list[CadPart]:

@@ -43,6 +43,7 @@ from assembly_constraints.executor.cad.convex import cover_is_primitive, head_is
 from assembly_constraints.executor.cad.derive import Derived, first_hit
 from assembly_constraints.executor.cad.parts import STEP_DEFLECTION
 from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, edge_distance, exact_round, slice_loops
+from assembly_constraints.executor.cad.sweep import opposite
 from assembly_constraints.executor.world.geometry import HoleSpec
 
 PROBE = 1e-5
@@ -216,7 +217,7 @@ def map_parts(derived: Derived, top: float) -> Mapped:
     others = [pid for pid in derived.parts if pid != derived.base and pid not in derived.hole_of]
     for pid in sorted(others, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p)):
         if derived.axis[pid] != "+z":
-            return Mapped(covers, heads, f"part '{pid}' goes in along {_reverse(derived.axis[pid])}, not from above")
+            return Mapped(covers, heads, f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above")
         pins = _pins(derived, pid)
         head = None if pins else _head(derived, pid, covers)
         if isinstance(head, str):
@@ -237,9 +238,6 @@ def map_parts(derived: Derived, top: float) -> Mapped:
         covers[head.into] = found
     return Mapped(covers, heads)
 
-
-def _reverse(direction: str) -> str:
-    return ("-" if direction[0] == "+" else "+") + direction[1]
 
 
 def _head(derived: Derived, pid: str, covers: dict[str, CoverFit]) -> HeadFit | str | None:

@@ -28,6 +28,11 @@ DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
 }
 """The removal directions tried, in order of preference (the cell inserts from above)."""
+
+
+def opposite(direction: str) -> str:
+    """The name of the direction opposite ``direction`` (a removal direction's insertion axis)."""
+    return ("-" if direction[0] == "+" else "+") + direction[1]
 _MAX_CONTACTS = 100_000
 
 

@@ -1,7 +1,7 @@
 """The assembly folder of an imported product, in the vocabulary every command reads.
 
 - ``assembly.toml``: every part (the base with role ``base``, a part in a hole with role
-  ``peg`` and its section's kind as ``shape``, any other ``part``) with its tray ``start``,
+  ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
   (:func:`assembly_constraints.executor.world.geometry.passes`), closed world;
@@ -11,10 +11,12 @@
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product when every part but the base is a peg
-  standing in a hole along +z and the holes' entries are at one height with one depth
-  (and the cell's loader accepts it; left out otherwise, and the report says why): the
-  plate and pegs as primitives where they are ones, else as their own meshes with convex
-  pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`).
+  standing in a hole along +z, a cover or a head (:mod:`assembly_constraints.executor.cad.covers`),
+  the holes' entries are at one height with one depth, and no two parts overlap where
+  they wait (and the cell's loader accepts it; left out otherwise, and the report says
+  why): the plate, pegs, covers and heads as primitives where they are ones, else as
+  their own meshes with convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`;
+  a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from assembly_constraints.executor.cad.convex import (
 )
 from assembly_constraints.executor.cad.covers import Mapped, map_parts
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.cad.sweep import opposite
 from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
 
 DENSITY = 2700.0
@@ -195,7 +198,7 @@ def simulable(derived: Derived) -> str | None:
     they are (its other parts: :func:`assembly_constraints.executor.cad.covers.map_parts`)."""
     for pid in sorted(derived.hole_of):
         if derived.axis[pid] != "+z":
-            return f"part '{pid}' goes in along {_reverse(derived.axis[pid])}, not from above"
+            return f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"
     fits = list(derived.holes.values())
     for fit in fits:
         if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
@@ -207,9 +210,6 @@ def simulable(derived: Derived) -> str | None:
             return f"the holes' {what} differs by {1000 * (max(values) - min(values)):.3g} mm (one plate has one)"
     return None
 
-
-def _reverse(direction: str) -> str:
-    return ("-" if direction[0] == "+" else "+") + direction[1]
 
 
 def map_product(derived: Derived, settings: Settings) -> Mapped:
@@ -239,12 +239,10 @@ def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
 def _tray_overlap(derived: Derived, mapped: Mapped, settings: Settings) -> str | None:
     """Why two parts overlap where they wait (their footprints: bounding boxes of their
     meshes in their part frames at their trays), None when none do."""
-    frames = _frames(derived, mapped)
     boxes = {}
-    for pid, frame in frames.items():
-        lower, upper = trimesh.bounds.corners(derived.parts[pid].mesh.bounds) @ frame[:3, :3].T, None
-        upper = (lower + frame[:3, 3]).max(axis=0)[:2] + settings.trays[pid]
-        boxes[pid] = ((lower + frame[:3, 3]).min(axis=0)[:2] + settings.trays[pid], upper)
+    for pid, frame in _frames(derived, mapped).items():
+        corners = trimesh.transform_points(trimesh.bounds.corners(derived.parts[pid].mesh.bounds), frame)[:, :2]
+        boxes[pid] = (corners.min(axis=0) + settings.trays[pid], corners.max(axis=0) + settings.trays[pid])
     ids = sorted(boxes)
     for k, a in enumerate(ids):
         for b in ids[k + 1:]:
