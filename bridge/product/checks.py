@@ -158,6 +158,8 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     _check_kinds(path, geo, layout)
     _check_product(path, geo, layout, holes)
     meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]
+    meshes += [(f"covers.{cid}", cover.mesh, True) for cid, cover in geo.covers.items()]
+    meshes += [(f"heads.{hid}", head.mesh, True) for hid, head in geo.heads.items()]
     meshes.append(("base", None if geo.base is None else geo.base.mesh, False))
     for table, mesh, moving in meshes:
         if mesh is not None:

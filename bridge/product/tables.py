@@ -175,12 +175,14 @@ CONVEX_HEADER = "# convex pieces of {file} sha256 {sha256}"
 
 
 class Mesh(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """``mesh`` of a ``[part_shapes.<name>]`` or of the ``[base]``: the part simulated from
-    its own closed triangle mesh ``file`` (Wavefront OBJ, metres, in the part frame: a
-    peg's origin at the centre of its section at its bottom, z its axis upwards, x its
-    section's long side; the base's is the cell frame), the ``sha256`` of that file, and
-    for a moving part ``convex``: the convex pieces it collides as (one OBJ object each,
-    first line :data:`CONVEX_HEADER` naming the mesh they were made from)."""
+    """``mesh`` of a ``[part_shapes.<name>]``, ``[covers.<id>]``, ``[heads.<id>]`` or of the
+    ``[base]``: the part simulated from its own closed triangle mesh ``file`` (Wavefront
+    OBJ, metres, in the part frame: a peg's origin at the centre of its section at its
+    bottom, z its axis upwards, x its section's long side; a cover's at the centre of the
+    holes it goes over at its bottom face, a head's at the centre of its section at its
+    bottom, both with the cell's axes; the base's is the cell frame), the ``sha256`` of that
+    file, and for a moving part ``convex``: the convex pieces it collides as (one OBJ object
+    each, first line :data:`CONVEX_HEADER` naming the mesh they were made from)."""
 
     file: MeshFile
     sha256: Sha256
@@ -210,7 +212,9 @@ class Cover(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[covers.<id>]``: a part whose openings go down over the pins in the holes
     ``over``; ``outline`` [xmin, ymin, xmax, ymax] [m] around their centre, ``socket``
     ``[x, y, side, depth]`` [m] an optional blind opening for a head, ``skill`` the part
-    shape whose taught motion places it."""
+    shape whose taught motion places it, ``mesh`` when it is simulated from its own mesh
+    rather than as the outline less square openings (``outline`` and ``clearance`` then
+    describe it, the mesh is its solid)."""
 
     over: Ids
     outline: Annotated[list[Offset], Meta(min_length=4, max_length=4,
@@ -226,11 +230,13 @@ class Cover(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     socket: Annotated[list[Offset], Meta(min_length=4, max_length=4,
                                          description="[x, y, side, depth] in m")] | None = None
     name: Text | None = None
+    mesh: Mesh | None = None
 
 
 class Head(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[heads.<id>]``: a part going into the socket of cover ``into``; round (``size``
-    a diameter) or square (a side) [m], ``length`` [m], ``mass`` [kg]."""
+    a diameter) or square (a side) [m], ``length`` [m], ``mass`` [kg], ``mesh`` when it is
+    simulated from its own mesh rather than as a cylinder or box."""
 
     into: Id
     size: Side
@@ -239,6 +245,7 @@ class Head(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     skill: Id
     kind: Literal["round", "square"] = "round"
     name: Text | None = None
+    mesh: Mesh | None = None
 
 
 class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -4,22 +4,23 @@ and ``[heads.*]`` tables of ``geometry.toml`` (documented in ``docs/geometry.md`
 
 Every part gets a tray pose (where it waits), a goal pose (where the product has it),
 a grip point and the tool-centre point (TCP) the insertion skill drives: a peg's bottom
-centre, a cover's bottom at the centre of its first opening, a head's bottom centre.
+centre, a cover's bottom at the centre of the holes it goes over, a head's bottom centre.
 Poses are ``(position [m], quat_xyzw)`` of the part's body frame; all parts stand
 upright, so quaternions are the identity.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from assembly_constraints.bridge.product import Cover
+from assembly_constraints.bridge.product import Cover, Mesh
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, load_geometry
+from assembly_constraints.executor.world.geometry import CellGeometry, HoleSpec, PartSpec, load_geometry
 
 Vec3 = tuple[float, float, float]
 
@@ -36,8 +37,9 @@ class Box:
 class CoverSpec:
     """A part with openings going down over the pins in ``over`` (holes of the plate):
     ``boxes`` (its solid, in its body frame: origin = the centre of those holes, bottom
-    face at z = 0), ``bottom`` above the plate top when placed [m], ``grip`` on its top
-    [m], ``tray`` origin [m], ``skill`` name, optional ``socket`` (x, y, side, depth [m])."""
+    face at z = 0; none when it is its own ``mesh``, in that frame), ``bottom`` above the
+    plate top when placed [m], ``grip`` on its top [m], ``tray`` origin [m], ``skill``
+    name, optional ``socket`` (x, y, side, depth [m])."""
 
     id: str
     over: tuple[str, ...]
@@ -49,11 +51,13 @@ class CoverSpec:
     tray: tuple[float, float]
     skill: str
     socket: tuple[float, float, float, float] | None
+    mesh: Mesh | None = None
 
 
 @dataclass(frozen=True)
 class HeadSpec:
-    """A part going into the socket of cover ``into`` (round or square cross-section)."""
+    """A part going into the socket of cover ``into`` (round or square cross-section), a
+    cylinder or box unless it is its own ``mesh`` (frame at its bottom centre)."""
 
     id: str
     into: str
@@ -63,6 +67,7 @@ class HeadSpec:
     mass: float
     start: tuple[float, float]
     skill: str
+    mesh: Mesh | None = None
 
 
 @dataclass(frozen=True)
@@ -104,13 +109,30 @@ class Product:
         return np.mean([self.geometry.holes[h].position for h in cover.over], axis=0)
 
 
+SAME_EDGE = 1e-6
+"""Edges of a cover's openings closer than this [m] are one edge (1 µm)."""
+MAX_COVER_BOXES = 16
+"""The most boxes a cover's solid may have: PyBullet keeps the first 16 shapes of a compound
+body made by ``createCollisionShapeArray`` and drops the others (measured: a ball fell through
+the 26th box of 30); a cover that needs more is simulated from its own mesh."""
+
+
+def _edges(values: list[float]) -> list[float]:
+    """``values`` sorted, each within :data:`SAME_EDGE` of the last kept one dropped."""
+    kept: list[float] = []
+    for value in sorted(values):
+        if not kept or value - kept[-1] > SAME_EDGE:
+            kept.append(value)
+    return kept
+
+
 def rect_minus_squares(outline: tuple[float, float, float, float],
                        squares: list[tuple[float, float, float]]) -> list[tuple[float, float, float, float]]:
     """Rectangles [xmin, ymin, xmax, ymax] covering ``outline`` minus the axis-aligned
-    squares (centre x, y, side) [m]: the cells of the grid their edges make, merged
-    along x row by row."""
-    xs = sorted({outline[0], outline[2], *(c - s / 2 for c, _, s in squares), *(c + s / 2 for c, _, s in squares)})
-    ys = sorted({outline[1], outline[3], *(c - s / 2 for _, c, s in squares), *(c + s / 2 for _, c, s in squares)})
+    squares (centre x, y, side) [m]: the cells of the grid their edges make (edges within
+    :data:`SAME_EDGE` of each other taken as one: no sliver cells), merged along x row by row."""
+    xs = _edges([outline[0], outline[2], *(c - s / 2 for c, _, s in squares), *(c + s / 2 for c, _, s in squares)])
+    ys = _edges([outline[1], outline[3], *(c - s / 2 for _, c, s in squares), *(c + s / 2 for _, c, s in squares)])
     xs = [x for x in xs if outline[0] <= x <= outline[2]]
     ys = [y for y in ys if outline[1] <= y <= outline[3]]
 
@@ -132,24 +154,26 @@ def rect_minus_squares(outline: tuple[float, float, float, float],
     return rects
 
 
-def _cover(cid: str, table: Cover, geometry: CellGeometry) -> CoverSpec:
-    """A checked ``[covers.<id>]`` table (:mod:`assembly_constraints.bridge.product`): its solid is the outline
-    minus square openings (each hole's size + clearance, and the socket)."""
-    centre = np.mean([geometry.holes[h].position for h in table.over], axis=0)
-    openings = [(*(np.array(geometry.holes[h].position) - centre), geometry.holes[h].size + table.clearance)
-                for h in table.over]
+def cover_spec(cid: str, table: Cover, holes: Mapping[str, HoleSpec]) -> CoverSpec:
+    """A checked ``[covers.<id>]`` table (:mod:`assembly_constraints.bridge.product`) over
+    the plate's ``holes``: its solid is the outline minus square openings (each hole's size
+    + clearance, and the socket), or its own mesh."""
+    centre = np.mean([holes[h].position for h in table.over], axis=0)
     socket = None if table.socket is None else (table.socket[0], table.socket[1], table.socket[2], table.socket[3])
-    if socket is not None:
-        openings.append(socket[:3])
-    half_t = table.thickness / 2
-    xmin, ymin, xmax, ymax = table.outline
-    boxes = [Box(((x0 + x1) / 2, (y0 + y1) / 2, half_t), ((x1 - x0) / 2, (y1 - y0) / 2, half_t))
-             for x0, y0, x1, y1 in rect_minus_squares((xmin, ymin, xmax, ymax), openings)]
-    if socket is not None:  # the socket's floor
-        floor = (table.thickness - socket[3]) / 2
-        boxes.append(Box((socket[0], socket[1], floor), (socket[2] / 2, socket[2] / 2, floor)))
+    boxes: list[Box] = []
+    if table.mesh is None:
+        openings = [(*(np.array(holes[h].position) - centre), holes[h].size + table.clearance) for h in table.over]
+        if socket is not None:
+            openings.append(socket[:3])
+        half_t = table.thickness / 2
+        xmin, ymin, xmax, ymax = table.outline
+        boxes = [Box(((x0 + x1) / 2, (y0 + y1) / 2, half_t), ((x1 - x0) / 2, (y1 - y0) / 2, half_t))
+                 for x0, y0, x1, y1 in rect_minus_squares((xmin, ymin, xmax, ymax), openings)]
+        if socket is not None:  # the socket's floor
+            floor = (table.thickness - socket[3]) / 2
+            boxes.append(Box((socket[0], socket[1], floor), (socket[2] / 2, socket[2] / 2, floor)))
     return CoverSpec(cid, tuple(table.over), tuple(boxes), table.thickness, table.bottom, table.mass,
-                     (table.grip[0], table.grip[1]), (table.tray[0], table.tray[1]), table.skill, socket)
+                     (table.grip[0], table.grip[1]), (table.tray[0], table.tray[1]), table.skill, socket, table.mesh)
 
 
 def load_product(assembly: str = "cranfield", description: CellDescription | None = None) -> Product:
@@ -163,12 +187,18 @@ def load_product(assembly: str = "cranfield", description: CellDescription | Non
                             "(see docs/geometry.md)")
     base = BaseSpec(tables.base.part, (tables.base.tray[0], tables.base.tray[1]),
                     (tables.base.grip[0], tables.base.grip[1]), tables.base.mass)
-    covers = {cid: _cover(cid, table, geometry) for cid, table in tables.covers.items()}
+    covers = {cid: cover_spec(cid, table, geometry.holes) for cid, table in tables.covers.items()}
+    for cid, cover in covers.items():
+        if len(cover.boxes) > MAX_COVER_BOXES:
+            raise ExecutorError(f"{path}: [covers.{cid}] over: expected a cover whose outline less its openings is at "
+                                f"most {MAX_COVER_BOXES} boxes (the cell's compound bodies hold no more), got "
+                                f"{len(cover.boxes)}; give it a mesh (docs/geometry.md)")
     starts = {p.id: p.start for p in geometry.layout.parts}
     heads: dict[str, HeadSpec] = {}
     for hid, head in tables.heads.items():
         start = starts[hid]
         assert start is not None  # the loader checked that every head has a start
-        heads[hid] = HeadSpec(hid, head.into, head.kind, head.size, head.length, head.mass, start, head.skill)
+        heads[hid] = HeadSpec(hid, head.into, head.kind, head.size, head.length, head.mass, start, head.skill,
+                              head.mesh)
     pegs = {pid: spec for pid, spec in geometry.parts.items() if pid in starts}
     return Product(geometry, base, pegs, covers, heads)

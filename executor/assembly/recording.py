@@ -5,8 +5,8 @@ Entities (under ``executor/<cell-id>/assembly/``):
 
 =============================== ===================================================
 ``parts/<id>``                  the part's pose (``Transform3D``) over ``sim_time``; its
-                                solid (boxes, cylinders in its frame) logged when the
-                                world is attached
+                                solid (boxes, cylinders or its own mesh, in its frame)
+                                logged when the world is attached
 ``arm/<link>``                  the arm's links (meshes, as in a cell's recording:
                                 :class:`assembly_constraints.executor.rerun_arm.ArmRecorder`) over ``sim_time``,
                                 their geometry logged when the world is attached
@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 import rerun as rr
+import trimesh
 
 from assembly_constraints.bridge.recording.layout import assembly_root
 from assembly_constraints.executor.assembly.world import AssemblyWorld
@@ -36,9 +37,17 @@ PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
 
 
 def _part_solids(world: AssemblyWorld, part: str) -> list[rr.AsComponents]:
-    """The part's solid in its body frame, as Rerun archetypes."""
+    """The part's solid in its body frame, as Rerun archetypes: a peg, cover or head with
+    its own mesh as that mesh, the others as their boxes and cylinders."""
     p = world.product
     color = [200, 150, 60]
+    own = p.pegs[part].mesh if part in p.pegs else p.covers[part].mesh if part in p.covers else \
+        p.heads[part].mesh if part in p.heads else None
+    if own is not None:
+        mesh = trimesh.load(p.folder / own.file, force="mesh")
+        assert isinstance(mesh, trimesh.Trimesh)  # the loader checked the file
+        return [rr.Mesh3D(vertex_positions=mesh.vertices, triangle_indices=mesh.faces,
+                          albedo_factor=[80, 130, 210] if part in p.covers else color)]
     if part == p.base.id:
         plate = p.geometry.plate
         (sx, sy), (cx, cy) = plate.base_size, plate.base_center

@@ -18,13 +18,13 @@ import pybullet as pb
 import pybullet_data
 
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.product import Product, rect_minus_squares
+from assembly_constraints.executor.assembly.product import HeadSpec, Product, rect_minus_squares
 from assembly_constraints.executor.control.controller import ImpedanceController
 from assembly_constraints.executor.control.gains import ImpedanceGains
 from assembly_constraints.executor.control.motion import Motion, StepLogger
 from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import PartSpec, arm_urdf_text
+from assembly_constraints.executor.world.geometry import PartSpec, arm_urdf_text, product_bodies
 from assembly_constraints.executor.world.scene import TIME_STEP, load_plate
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
@@ -52,6 +52,25 @@ def _compound(client: int, boxes: list[tuple[tuple, tuple]], mass: float, rgba: 
     com = np.mean(centres, axis=0)
     return pb.createMultiBody(baseMass=mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
                               baseInertialFramePosition=list(com), physicsClientId=client)
+
+
+def _head_body(client: int, head: HeadSpec) -> int:
+    """A free cylinder or box (the head's section over its length), its frame at its bottom centre."""
+    half = head.length / 2
+    if head.kind == "round":
+        col = pb.createCollisionShape(pb.GEOM_CYLINDER, radius=head.size / 2, height=head.length,
+                                      collisionFramePosition=[0, 0, half], physicsClientId=client)
+        vis = pb.createVisualShape(pb.GEOM_CYLINDER, radius=head.size / 2, length=head.length,
+                                   visualFramePosition=[0, 0, half], rgbaColor=(0.8, 0.3, 0.3, 1),
+                                   physicsClientId=client)
+    else:
+        ext = [head.size / 2, head.size / 2, half]
+        col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=ext, collisionFramePosition=[0, 0, half],
+                                      physicsClientId=client)
+        vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=ext, visualFramePosition=[0, 0, half],
+                                   rgbaColor=(0.8, 0.3, 0.3, 1), physicsClientId=client)
+    return pb.createMultiBody(baseMass=head.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                              baseInertialFramePosition=[0, 0, half], physicsClientId=client)
 
 
 class AssemblyWorld:
@@ -109,9 +128,17 @@ class AssemblyWorld:
             self.frames[pid] = PartFrames(body, np.array([0.0, 0.0, spec.length - grasp_depth]), np.zeros(3))
             self._tray[pid] = np.array([*spec.start, 0.0])
 
+    def _mesh_body(self, pid: str) -> int:
+        """A cover or head simulated from its own mesh: its generated URDF (the mesh's
+        inertia, its convex pieces), at the origin."""
+        stem = product_bodies(self.product.geometry)[pid].stem
+        return pb.loadURDF(str(self.product.geometry.assets / f"{stem}.urdf"), flags=pb.URDF_USE_INERTIA_FROM_FILE,
+                           physicsClientId=self.client)
+
     def _build_covers(self) -> None:
         for cid, cover in sorted(self.product.covers.items()):
-            body = _compound(self.client, [(b.centre, b.half) for b in cover.boxes], cover.mass, (0.3, 0.5, 0.8, 1))
+            body = (self._mesh_body(cid) if cover.mesh is not None else
+                    _compound(self.client, [(b.centre, b.half) for b in cover.boxes], cover.mass, (0.3, 0.5, 0.8, 1)))
             self.frames[cid] = PartFrames(body, np.array([*cover.grip, cover.thickness]), np.zeros(3))
             self.goals[cid] = np.array([*self.product.over_centre(cover), self.product.top_z + cover.bottom])
             self._tray[cid] = np.array([*cover.tray, 0.0])
@@ -119,21 +146,7 @@ class AssemblyWorld:
     def _build_heads(self) -> None:
         c = self.client
         for hid, head in sorted(self.product.heads.items()):
-            half = head.length / 2
-            if head.kind == "round":
-                col = pb.createCollisionShape(pb.GEOM_CYLINDER, radius=head.size / 2, height=head.length,
-                                              collisionFramePosition=[0, 0, half], physicsClientId=c)
-                vis = pb.createVisualShape(pb.GEOM_CYLINDER, radius=head.size / 2, length=head.length,
-                                           visualFramePosition=[0, 0, half], rgbaColor=(0.8, 0.3, 0.3, 1),
-                                           physicsClientId=c)
-            else:
-                ext = [head.size / 2, head.size / 2, half]
-                col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=ext, collisionFramePosition=[0, 0, half],
-                                              physicsClientId=c)
-                vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=ext, visualFramePosition=[0, 0, half],
-                                           rgbaColor=(0.8, 0.3, 0.3, 1), physicsClientId=c)
-            body = pb.createMultiBody(baseMass=head.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
-                                      baseInertialFramePosition=[0, 0, half], physicsClientId=c)
+            body = self._mesh_body(hid) if head.mesh is not None else _head_body(c, head)
             grip = min(self.product.geometry.gripper.grasp_depth, head.length / 2)
             self.frames[hid] = PartFrames(body, np.array([0.0, 0.0, head.length - grip]), np.zeros(3))
             self._tray[hid] = np.array([*head.start, 0.0])

@@ -7,7 +7,7 @@ is put at its goal pose (each peg turned to its hole's yaw, in the first hole by
 (:func:`assembly_constraints.executor.world.geometry.passes`) among those still free, smallest hole first), and
 each part's shapes are read back from PyBullet (boxes, grown by :data:`JOIN` in a part
 of several shapes; cylinders as 256-gons whose corners lie on the circle; meshes) and
-joined by an exact boolean union (manifold3d) into one solid; the base is its plate's
+joined by an exact boolean union (manifold3d, in double precision) into one solid; the base is its plate's
 block minus the hole cavities. Written as ``OUT/<part>.obj`` in metres (10 digits: STL's single precision would
 merge the union's nearby vertices), with ``OUT/import.toml`` naming
 the base, every part's tray and the heads fixed to their parts.
@@ -15,6 +15,9 @@ the base, every part's tray and the heads fixed to their parts.
 
 from __future__ import annotations
 
+from functools import reduce
+
+import manifold3d
 import numpy as np
 import pybullet as pb
 import trimesh
@@ -28,10 +31,12 @@ from assembly_constraints.executor.world.geometry import passes
 from assembly_constraints.executor.world.scene import link_frame
 
 CYLINDER_SECTIONS = 256
-JOIN = 5e-5
+JOIN = 1e-6
 """Boxes of a part of several shapes are grown by this [m] a side along x and y (never in
-height: a peg stands on them), so that boxes meeting
-along an edge overlap and their union is a manifold solid."""
+height: a peg stands on them), so that boxes meeting along an edge overlap and their union
+is a manifold solid; a cover's outline and openings come out this much larger and smaller."""
+SNAP = 9
+"""Decimals [m] the vertices of a part of several shapes are rounded to before their union (1 nm)."""
 
 
 def _peg_holes(world: AssemblyWorld) -> dict[str, str]:
@@ -56,6 +61,26 @@ def _shape(geom_type: int, dims: tuple[float, ...], mesh_file: str, grow: float)
     assert isinstance(mesh, trimesh.Trimesh), mesh_file
     mesh.apply_scale(dims)
     return mesh
+
+
+def _matrix(pos: tuple[float, ...], quat_xyzw: tuple[float, ...]) -> np.ndarray:
+    """The 4 × 4 transform of a pose (position [m], quaternion xyzw)."""
+    matrix = np.eye(4)
+    matrix[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat_xyzw)).reshape(3, 3)
+    matrix[:3, 3] = pos
+    return matrix
+
+
+def _union(pieces: list[trimesh.Trimesh]) -> trimesh.Trimesh:
+    """The exact union of closed meshes in double precision (trimesh's booleans hand manifold3d
+    single precision vertices, with which boxes grown by :data:`JOIN` joined into a solid with
+    edges of four faces), their vertices first rounded to :data:`SNAP` (faces meant to be
+    one plane may be an ulp apart, slivers the union would keep)."""
+    solids = [manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.round(np.asarray(p.vertices), SNAP),
+                                                    tri_verts=np.asarray(p.faces, dtype=np.uint64)))
+              for p in pieces]
+    joined = reduce(lambda a, b: a + b, solids).to_mesh64()
+    return trimesh.Trimesh(np.asarray(joined.vert_properties)[:, :3], np.asarray(joined.tri_verts), process=False)
 
 
 def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
@@ -107,19 +132,15 @@ def part_meshes(assembly: str) -> tuple[dict[str, trimesh.Trimesh], str, dict[st
             if pid == product.base.id:
                 continue
             visuals = pb.getVisualShapeData(frames.body, physicsClientId=world.client)
+            links = {visual[1] for visual in visuals}
+            assert len(links) == 1, f"part {pid} has shapes on links {links}; expected one body"
             grow = JOIN if len(visuals) > 1 else 0.0
-            pieces = []
+            pieces = []  # in the link's frame, exact as given (poses read back are single precision)
             for visual in visuals:
-                link, geom_type, dims, mesh_file = visual[1], visual[2], visual[3], visual[4].decode()
-                frame = link_frame(world.client, frames.body, link)
-                pos, quat = pb.multiplyTransforms(*frame, visual[5], visual[6])
-                piece = _shape(geom_type, dims, mesh_file, grow)
-                matrix = np.eye(4)
-                matrix[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
-                matrix[:3, 3] = pos
-                piece.apply_transform(matrix)
-                pieces.append(piece)
-            meshes[pid] = pieces[0] if len(pieces) == 1 else trimesh.boolean.union(pieces, engine="manifold")
+                geom_type, dims, mesh_file = visual[2], visual[3], visual[4].decode()
+                pieces.append(_shape(geom_type, dims, mesh_file, grow).apply_transform(_matrix(visual[5], visual[6])))
+            solid = pieces[0] if len(pieces) == 1 else _union(pieces)
+            meshes[pid] = solid.apply_transform(_matrix(*link_frame(world.client, frames.body, links.pop())))
         trays = {pid: (float(world.tray_position(pid)[0]), float(world.tray_position(pid)[1]))
                  for pid in world.frames}
         trays[product.base.id] = product.base.tray

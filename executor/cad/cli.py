@@ -22,17 +22,20 @@ import argparse
 import math
 import time
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
 from assembly_constraints.bridge.cli_types import ArgumentParser, number_in
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import MESH_FOLDER
+from assembly_constraints.executor.cad.covers import Mapped
 from assembly_constraints.executor.cad.derive import Derived, derive
 from assembly_constraints.executor.cad.locating import LOCATING_REACH, MAX_REACH
 from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
 from assembly_constraints.executor.cad.step import load_step
-from assembly_constraints.executor.cad.write import Settings, write_folder
+from assembly_constraints.executor.cad.sweep import opposite
+from assembly_constraints.executor.cad.write import Settings, map_product, write_folder
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
 """Default trays: the parts in a row from this point [m], this far apart along x [m]."""
@@ -107,7 +110,7 @@ def report(derived: Derived) -> list[str]:
     """The lines ``import`` prints about what it derived."""
     lines = []
     for pid in sorted(derived.axis):
-        lines.append(f"part {pid}: insertion axis {_reverse(derived.axis[pid])} (leaves along "
+        lines.append(f"part {pid}: insertion axis {opposite(derived.axis[pid])} (leaves along "
                      f"{derived.axis[pid]}); free in the assembled product along "
                      f"{', '.join(derived.free(pid)) or 'none'}")
     for hid, fit in derived.holes.items():
@@ -119,7 +122,7 @@ def report(derived: Derived) -> list[str]:
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
                     f"{clearance} mm)")
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
-                     f"{_reverse(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
+                     f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
     for pocket in derived.pockets:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
@@ -136,8 +139,25 @@ def report(derived: Derived) -> list[str]:
     return lines
 
 
-def _reverse(direction: str) -> str:
-    return ("-" if direction[0] == "+" else "+") + direction[1]
+def mapped_report(mapped: Mapped) -> list[str]:
+    """The lines ``import`` prints about the covers and heads it found."""
+    lines = []
+    for cid, cover in sorted(mapped.covers.items()):
+        x0, y0, x1, y1 = cover.outline
+        socket = "" if cover.socket is None else (f", socket {_mm(cover.socket[2])} mm {_mm(cover.socket[3])} deep at "
+                                                  f"({_mm(cover.socket[0])}, {_mm(cover.socket[1])}) mm")
+        lines.append(f"cover {cid} over {' '.join(cover.over)} on {' '.join(cover.on)}: {_mm(x1 - x0)} x "
+                     f"{_mm(y1 - y0)} x {_mm(cover.thickness)} mm, {_mm(cover.bottom)} mm above the plate top, "
+                     f"openings {_mm(cover.clearance)} mm over their holes{socket}; grip ({_mm(cover.grip[0])}, "
+                     f"{_mm(cover.grip[1])}) mm, skill {cover.skill}; "
+                     + ("the cell's cover" if cover.primitive else "no cell's cover: its own mesh"))
+    for hid, head in sorted(mapped.heads.items()):
+        section = head.section
+        lines.append(f"head {hid} into {head.into}: {_describe(section.kind, section.a, section.b)} x "
+                     f"{_mm(head.length)} mm, skill {head.skill}; "
+                     + ("a cylinder or box" if head.primitive else "no cylinder or box: its own mesh"))
+    return lines
+
 
 
 def load_source(source: Path, units: str) -> list[CadPart]:
@@ -149,11 +169,22 @@ def load_source(source: Path, units: str) -> list[CadPart]:
     raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
 
 
-def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH
-               ) -> tuple[Derived, list[str], str | None, float]:
-    """Read, check, derive (``reach`` [m]: the locating rule's, 0: off) and write; returns
-    what was derived, what was assumed, why there is no geometry.toml (None: there is)
-    and the seconds taken."""
+@dataclass(frozen=True)
+class Imported:
+    """What :func:`run_import` found: the ``derived`` geometry, the ``mapped`` covers and
+    heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is) and
+    the ``seconds`` taken."""
+
+    derived: Derived
+    mapped: Mapped
+    assumed: list[str]
+    why: str | None
+    seconds: float
+
+
+def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH) -> Imported:
+    """Read, check, derive (``reach`` [m]: the locating rule's, 0: off), map the covers and
+    heads, and write."""
     started = time.perf_counter()
     parts = load_source(source, units)
     check_parts(parts, units)
@@ -161,8 +192,9 @@ def run_import(source: Path, out: Path, units: str, config: Path | None, reach: 
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
-    _, why = write_folder(derived, settings, source.stem, out)
-    return derived, assumed, why, time.perf_counter() - started
+    mapped = map_product(derived, settings)
+    _, why = write_folder(derived, mapped, settings, source.stem, out)
+    return Imported(derived, mapped, assumed, why, time.perf_counter() - started)
 
 
 def main(argv: list[str]) -> int:
@@ -181,15 +213,16 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
-    derived, assumed, why, seconds = run_import(args.source, args.out, args.units, args.config, args.locating_reach)
+    done = run_import(args.source, args.out, args.units, args.config, args.locating_reach)
+    derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
-    print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(assumed))
-    for line in report(derived):
+    print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(done.assumed))
+    for line in report(derived) + mapped_report(done.mapped):
         print(line)
     meshes = sorted(p.name.removesuffix(".obj") for p in (args.out / MESH_FOLDER).glob("*.obj")
                     if not p.name.endswith(".convex.obj"))
     print(f"wrote {args.out}: assembly.toml, sizes.lp, geometric_precedence.lp"
           + (", geometry.toml" if why is None else f" (no geometry.toml: {why})")
           + (f"; simulated from their own meshes ({MESH_FOLDER}/): {', '.join(meshes)}" if meshes else ""))
-    print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {seconds:.2f} s")
+    print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {done.seconds:.2f} s")
     return 0

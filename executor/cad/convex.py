@@ -1,56 +1,81 @@
 """Parts the simulated cell builds from their own meshes, decided and written at import.
 
-A peg is a **primitive** when its mesh's volume is within :data:`PRIMITIVE_TOLERANCE` of
-the prism of its cross-section over its length (a cylinder or a box: the cell builds it
-as one); the base is one when its volume is within that of its bounding box less its
-holes (cross-section times depth: the cell's plate). Any other part is written as its
-own mesh (``meshes/<id>.obj``, Wavefront OBJ [m]): a peg in its part frame (origin at the
-centre of its section at its bottom, z up its axis, x along its section's long side),
-the base in the cell frame. A moving part also gets its convex pieces
+A peg or a head is a **primitive** when its mesh's volume is within
+:data:`PRIMITIVE_TOLERANCE` of the prism of its cross-section over its length (a cylinder
+or a box: the cell builds it as one; a head's box has the cell's axes); a cover when the
+symmetric difference of its mesh and the cell's cover (its outline less square openings
+of its holes' sizes plus its clearance, and its socket) is within that of its volume;
+the base when its volume is within that of its bounding box less its holes (cross-section
+times depth: the cell's plate). Any other part is written as its own mesh
+(``meshes/<id>.obj``, Wavefront OBJ [m]): a peg in its part frame (origin at the centre of
+its section at its bottom, z up its axis, x along its section's long side), a cover in its
+frame (origin at the centre of the holes it goes over at its bottom, the cell's axes), a
+head in its (the centre of its section at its bottom, the cell's axes), the base in the
+cell frame. A moving part also gets its convex pieces
 (``meshes/<id>.convex.obj``, one OBJ object each, the first line naming the mesh and its
 SHA-256): its convex hull when the hull's volume is within :data:`CONVEX_TOLERANCE` of
 the mesh's, else a convex decomposition by CoACD (seed 0, so an import is repeatable),
 each piece cut down to at most :data:`PIECE_VERTICES` of its vertices (the cell's contact
 cost grows with them: a 900-vertex piece ran 40 steps/s, a 32-vertex one 270), each next
 one the farthest beyond the hull of those kept; the file's second line states how far the dropped vertices
-reach beyond the kept pieces' face planes. The decomposition is made here, never when a cell starts.
+reach beyond the kept pieces' face planes. The pieces must fit where the part is: they
+must leave each part near it (:data:`NEAR`: a cover's pins and head, a head's cover, a
+peg's base) :data:`ROOM_KEPT` of the room its mesh leaves it, and overlap none it touches
+(measured with python-fcl in the assembled pose), each piece at least 2 mm thick (the
+cell's hull margin twice: :mod:`assembly_constraints.executor.world.meshes`); CoACD's
+:data:`THRESHOLDS` are tried in turn until they do (the third line names the threshold and the least room left), and
+a part whose pieces never do is named and gets none. The decomposition is made here,
+never when a cell starts.
 """
 
 from __future__ import annotations
 
 import hashlib
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print a symbol, std::bad_cast)
 import coacd
+import fcl
 import numpy as np
 import trimesh
 
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.product import CONVEX_HEADER, Mesh
+from assembly_constraints.executor.assembly.product import Box
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
-from assembly_constraints.executor.world.meshes import obj_text
+from assembly_constraints.executor.cad.sections import Shape2D
+from assembly_constraints.executor.cad.sweep import TOUCH, bvh, convex_object
+from assembly_constraints.executor.world.meshes import URDF_HULL_MARGIN, eroded, obj_text
 
 PRIMITIVE_TOLERANCE = 0.01
 """A part is the primitive its sections describe when their volumes differ by less than
 this fraction of the part's."""
 CONVEX_TOLERANCE = 1e-3
 """A part is convex (one piece, its hull) when its hull is larger by less than this fraction."""
-DECOMPOSITION_THRESHOLD = 0.05
-"""CoACD's concavity threshold (its default): the largest concavity left in a piece,
-relative to the part's size."""
+THRESHOLDS = (0.05, 0.03, 0.02, 0.01)
+"""CoACD's concavity thresholds (the largest concavity left in a piece, relative to the
+part's size) tried in turn, its default first, until the pieces fit (:data:`ROOM_KEPT`)."""
+ROOM_KEPT = 0.5
+"""A part's convex pieces must leave each part near it at least this share of the room
+its mesh leaves it in the assembled pose (a hull bridging an opening would fill it)."""
+NEAR = 0.002
+"""The parts whose bounding boxes come this close [m] to a part's are its neighbours."""
 PIECE_VERTICES = 64
 """The most vertices a convex piece keeps (the 12 mm shaft of the tests then within 0.06 mm)."""
 MESH_FOLDER = "meshes"
+YAW_TOLERANCE = 0.01
+"""A square section within this of the cell's axes [°] is not turned."""
 
 
-def _area(kind: str, a: float, b: float) -> float:
+def section_area(kind: str, a: float, b: float) -> float:
     """The area [m²] of a section: round of diameter a, square of side a, rect a × b."""
     return math.pi * a * a / 4 if kind == "round" else a * (a if kind == "square" else b)
 
 
-def _is_close(volume: float, primitive: float) -> bool:
+def is_close(volume: float, primitive: float) -> bool:
+    """Whether a part's ``volume`` and its primitive's [m³] differ by less than :data:`PRIMITIVE_TOLERANCE` of it."""
     return abs(volume - primitive) < PRIMITIVE_TOLERANCE * volume
 
 
@@ -58,14 +83,38 @@ def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
     """Whether the peg in ``fit`` is the prism of its section over its length along z."""
     assert fit.section is not None  # a peg has a section
     section = fit.section
-    return _is_close(mesh.volume, _area(section.kind, section.a, section.b) * float(mesh.extents[2]))
+    return is_close(mesh.volume, section_area(section.kind, section.a, section.b) * float(mesh.extents[2]))
 
 
 def base_is_primitive(derived: Derived) -> bool:
     """Whether the base is its bounding box less its holes (each its section times its depth)."""
     mesh = derived.parts[derived.base].mesh
-    holes = sum(_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
-    return _is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
+    holes = sum(section_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
+    return is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
+
+
+def cover_is_primitive(mesh: trimesh.Trimesh, boxes: Sequence[Box]) -> bool:
+    """Whether a cover's ``mesh`` (in its frame) is the cell's solid of ``boxes`` (its
+    outline less square openings: :func:`assembly_constraints.executor.assembly.product.cover_spec`):
+    their symmetric difference is less than :data:`PRIMITIVE_TOLERANCE` of the mesh's
+    volume. The boxes are disjoint, so it is both volumes less twice the mesh's
+    intersections with each box (exact booleans, manifold3d)."""
+    solid = sum(8 * float(np.prod(box.half)) for box in boxes)
+    common = 0.0
+    for box in boxes:
+        piece = trimesh.creation.box(2 * np.asarray(box.half))
+        piece.apply_translation(box.centre)
+        inside = trimesh.boolean.intersection([mesh, piece], engine="manifold")
+        common += float(inside.volume) if len(inside.faces) else 0.0
+    return bool(mesh.volume + solid - 2 * common < PRIMITIVE_TOLERANCE * mesh.volume)
+
+
+def head_is_primitive(section: Shape2D, mesh: trimesh.Trimesh) -> bool:
+    """Whether a head is the cylinder or box of its ``section`` over its length along z with
+    the cell's axes (the cell's head box is not turned: a square head with a yaw is none)."""
+    turned = section.kind != "round" and abs(section.yaw) > YAW_TOLERANCE
+    return not turned and is_close(mesh.volume, section_area(section.kind, section.a, section.b)
+                                   * float(mesh.extents[2]))
 
 
 def peg_frame(fit: HoleFit, mesh: trimesh.Trimesh) -> np.ndarray:
@@ -78,14 +127,66 @@ def peg_frame(fit: HoleFit, mesh: trimesh.Trimesh) -> np.ndarray:
     return turn @ shift
 
 
-def convex_pieces(mesh: trimesh.Trimesh) -> list[trimesh.Trimesh]:
-    """The convex pieces of a closed mesh: its hull when it is convex, else CoACD's."""
-    hull = mesh.convex_hull
-    if hull.volume < (1 + CONVEX_TOLERANCE) * mesh.volume:
-        return [hull]
+def _decomposed(mesh: trimesh.Trimesh, threshold: float) -> list[trimesh.Trimesh]:
+    """CoACD's convex pieces of a closed mesh at a concavity ``threshold``, each cut to
+    :data:`PIECE_VERTICES` (:func:`reduced`)."""
     coacd.set_log_level("error")
-    pieces = coacd.run_coacd(coacd.Mesh(mesh.vertices, mesh.faces), threshold=DECOMPOSITION_THRESHOLD, seed=0)
+    pieces = coacd.run_coacd(coacd.Mesh(mesh.vertices, mesh.faces), threshold=threshold, seed=0)
     return [trimesh.convex.convex_hull(vertices) for vertices, _ in pieces]
+
+
+def _room(pieces: list[fcl.CollisionObject], other: fcl.CollisionObject) -> float:
+    """The least distance [m] between ``pieces`` and ``other``; where they overlap, minus
+    the deepest overlap."""
+    room = math.inf
+    for piece in pieces:
+        found = fcl.CollisionResult()
+        if fcl.collide(piece, other, fcl.CollisionRequest(num_max_contacts=100, enable_contact=True), found):
+            room = min(room, -max((c.penetration_depth for c in found.contacts), default=0.0))
+        else:
+            room = min(room, fcl.distance(piece, other, fcl.DistanceRequest(), fcl.DistanceResult()))
+    return room
+
+
+def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimesh.Trimesh]
+                   ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+    """The convex pieces of part ``pid``'s closed mesh (module docstring; each with how far
+    its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
+    parts near it in the assembled pose, in its frame); or why no decomposition leaves
+    each of them :data:`ROOM_KEPT` of the room the mesh leaves it (touching: none
+    deeper than :data:`assembly_constraints.executor.cad.sweep.TOUCH`) with every piece
+    at least twice the cell's hull margin thick."""
+    others = {name: bvh(other) for name, other in sorted(neighbours.items())}
+    own = bvh(mesh)
+    rooms = {name: fcl.distance(own, other, fcl.DistanceRequest(), fcl.DistanceResult())
+             for name, other in others.items()}
+    hull = mesh.convex_hull
+    convex = hull.volume < (1 + CONVEX_TOLERANCE) * mesh.volume
+    left: dict[str, float] = {}
+    short: list[str] = []
+    for threshold in (0.0,) if convex else THRESHOLDS:
+        kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold))]
+        if any(eroded(piece.vertices, URDF_HULL_MARGIN) is None for piece, _ in kept):
+            continue  # a piece the cell cannot collide as
+        objects = [convex_object(piece) for piece, _ in kept]
+        left = {name: _room(objects, other) for name, other in others.items()}
+        short = [name for name in others if left[name] < ROOM_KEPT * rooms[name] - TOUCH]
+        if not short:
+            kind = "its hull" if convex else f"CoACD at threshold {threshold:g}"
+            apart = [name for name in rooms if rooms[name] > TOUCH]
+            touching = f"; they overlap none of the parts they touch ({' '.join(sorted(set(rooms) - set(apart)))})"
+            if not apart:
+                return kept, kind + (touching if rooms else "")
+            name = min(apart, key=lambda n: left[n] / rooms[n])
+            return kept, (f"{kind}; they leave {name} {1e3 * left[name]:.3f} of {1e3 * rooms[name]:.3f} mm"
+                          + (touching if len(apart) < len(rooms) else ""))
+    tried = f"CoACD's thresholds {', '.join(f'{t:g}' for t in THRESHOLDS)}"
+    if not short:
+        return (f"part '{pid}' has no convex pieces the cell can collide as ({tried}: each gave a piece thinner than "
+                f"{2000 * URDF_HULL_MARGIN:g} mm, the cell's hull margin twice)")
+    name = min(short, key=lambda n: left[n] - ROOM_KEPT * rooms[n])
+    return (f"the convex pieces of part '{pid}' leave '{name}' {1e3 * left[name]:.3f} mm of the "
+            f"{1e3 * rooms[name]:.3f} mm its mesh leaves it ({tried}; expected at least {ROOM_KEPT:.0%})")
 
 
 def _beyond(hull: trimesh.Trimesh, points: np.ndarray) -> np.ndarray:
@@ -116,25 +217,33 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
     return kept, float(max(0.0, np.max(_beyond(kept, points))))
 
 
-def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, moving: bool) -> tuple[Mesh, list[Path]]:
-    """Write ``mesh`` (already in its part frame [m]) as ``meshes/<pid>.obj`` in the
-    assembly ``folder`` and, for a ``moving`` part, its convex pieces; returns the
-    ``mesh`` entry of ``geometry.toml`` and the paths written."""
+def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
+               neighbours: dict[str, trimesh.Trimesh] | None) -> tuple[Mesh, list[Path]] | str:
+    """Write ``mesh`` (already in its part frame [m]; ``made``: how, for its header) as
+    ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
+    (``neighbours``: the parts near it, in its frame; None for the base), its convex
+    pieces (:func:`fitting_pieces`); returns the ``mesh`` entry of ``geometry.toml`` and
+    the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
-    frame = "its part frame" if moving else "the cell frame"
-    text = obj_text([(pid, mesh.vertices, mesh.faces)], f"# {pid}: its closed mesh [m] in {frame}, by ./run.sh import")
+    frame = "the cell frame" if neighbours is None else "its part frame"
+    text = obj_text([(pid, mesh.vertices, mesh.faces)],
+                    f"# {pid}: its closed mesh [m] in {frame}, {made}, by ./run.sh import")
     written = [write_atomic(folder / name, text)]
     digest = hashlib.sha256(text.encode()).hexdigest()
-    if not moving:
+    if neighbours is None:
         return Mesh(file=name, sha256=digest), written
     # The pieces of the mesh as written (0.1 µm), so that they are pieces of that file.
     exact = trimesh.load(folder / name, force="mesh")
     assert isinstance(exact, trimesh.Trimesh)  # the closed mesh just written
+    found = fitting_pieces(pid, exact, neighbours)
+    if isinstance(found, str):
+        return found
+    kept, made = found
     convex = f"{MESH_FOLDER}/{pid}.convex.obj"
-    kept = [reduced(piece) for piece in convex_pieces(exact)]
     pieces = [(f"{pid}_{k + 1}", piece.vertices, piece.faces) for k, (piece, _) in enumerate(kept)]
     header = (CONVEX_HEADER.format(file=name, sha256=digest) + f"\n# {len(kept)} piece(s) of at most {PIECE_VERTICES} "
-              f"vertices; the dropped vertices reach {1e6 * max(d for _, d in kept):.1f} um beyond their face planes")
+              f"vertices; the dropped vertices reach {1e6 * max(d for _, d in kept):.1f} um beyond their face planes"
+              f"\n# {made}")
     written.append(write_atomic(folder / convex, obj_text(pieces, header)))
     return Mesh(file=name, sha256=digest, convex=convex), written

@@ -152,7 +152,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     return result
 
 
-def _first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> float | None:
+def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> float | None:
     """Distance [m] along the unit ``direction`` from ``origin`` to the first triangle of
     ``mesh`` (Möller-Trumbore over all triangles), None when the ray meets none."""
     a, b, c = (mesh.triangles[:, k] for k in range(3))
@@ -235,7 +235,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     radial = base.mesh.vertices @ frame.T - hole.centre
     entry = float(base_along[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)].max())
     centre = frame.T @ hole.centre + axis * level
-    bottom = _first_hit(base.mesh, centre, -axis)
+    bottom = first_hit(base.mesh, centre, -axis)
     depth = entry - (level - bottom if bottom is not None else float(base_along.min()))
     probe = [o for o in slice_loops(base.mesh, axis, entry - _ENTRY_PROBE) if o.contains(hole.centre)]
     chamfer = 0.0

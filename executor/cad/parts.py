@@ -15,6 +15,7 @@ stated units, and parts that overlap (intersection volume above :data:`OVERLAP_V
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -54,14 +55,16 @@ class Cylinder:
 @dataclass(frozen=True)
 class CadPart:
     """One part in the assembled pose: ``id`` (an ASP constant), the ``name`` the source
-    gives, its closed ``mesh`` [m] in the cell frame, ``source`` (file, or file#name) and
-    the ``cylinders`` of its B-rep (a STEP part's; none for a mesh)."""
+    gives, its closed ``mesh`` [m] in the cell frame, ``source`` (file, or file#name), the
+    ``cylinders`` of its B-rep and ``remesh``, its B-rep tessellated again to a given
+    linear deflection [m] (a STEP part's; none for a mesh)."""
 
     id: str
     name: str
     mesh: trimesh.Trimesh
     source: str
     cylinders: tuple[Cylinder, ...] = ()
+    remesh: Callable[[float], trimesh.Trimesh] | None = None
 
 
 def part_id(name: str, source: str) -> str:

@@ -118,7 +118,7 @@ def _min_rectangle(points: np.ndarray) -> tuple[float, float, float]:
     return (w, h, angle) if w >= h else (h, w, angle + math.pi / 2)
 
 
-def _edge_distance(points: np.ndarray, centre: np.ndarray) -> float:
+def edge_distance(points: np.ndarray, centre: np.ndarray) -> float:
     """The smallest distance [m] from ``centre`` to the loop's edges."""
     start, end = points, np.roll(points, -1, axis=0)
     edge = end - start
@@ -133,7 +133,7 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
     outer = float(radii.max())
     if (len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
             and loop.area >= 0.98 * math.pi * outer ** 2):
-        d = 2 * (_edge_distance(points, centre) if hole else outer)
+        d = 2 * (edge_distance(points, centre) if hole else outer)
         return Shape2D("round", d, d, 0.0, centre)
     a, b, angle = _min_rectangle(points)
     if loop.area >= 0.995 * a * b:

@@ -2,7 +2,8 @@
 leaf of the assembly tree with its name and its placement (the product of the locations
 on the path from the root), tessellated to a closed triangle mesh [m], with the
 cylindrical faces of its B-rep (axis and radius, exact where the tessellation is within
-:data:`STEP_DEFLECTION` of them; planar faces tessellate exactly).
+:data:`STEP_DEFLECTION` of them; planar faces tessellate exactly), and the means to
+tessellate it again more coarsely (``CadPart.remesh``: the simulated cell's base).
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
 converts to metres. A leaf without a name is named after its parent and position.
@@ -10,6 +11,7 @@ converts to metres. A leaf without a name is named after its parent and position
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +22,11 @@ from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart, Cylinder, part_id
 
 _MM = 1e-3
+FINE_ANGLE = 0.1
+"""The angular deflection of the tessellation the import measures on [rad]."""
+COARSE_ANGLE = 0.5
+"""The angular deflection of a part tessellated again for the cell [rad]: loose enough
+that the linear deflection decides how many sides a round hole gets."""
 
 
 def load_step(path: Path) -> list[CadPart]:
@@ -46,7 +53,8 @@ def load_step(path: Path) -> list[CadPart]:
     if not leaves:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
     return [CadPart(part_id(name, f"{path}#{name}"), name, _mesh(shape, f"{path}#{name}"), f"{path}#{name}",
-                    _cylinders(shape)) for name, shape in leaves]
+                    _cylinders(shape), functools.partial(_mesh, shape, f"{path}#{name}", angle=COARSE_ANGLE))
+            for name, shape in leaves]
 
 
 def _name(label: Any) -> str:
@@ -81,16 +89,20 @@ def _collect(tool: object, label: Any, location: Any, name: str, leaves: list[tu
     leaves.append((name, shape.Located(here.Multiplied(shape.Location()))))
 
 
-def _mesh(shape: Any, source: str) -> trimesh.Trimesh:
-    """The shape's faces tessellated (:data:`STEP_DEFLECTION`) into one mesh [m]."""
+def _mesh(shape: Any, source: str, deflection: float = STEP_DEFLECTION, angle: float = FINE_ANGLE) -> trimesh.Trimesh:
+    """The shape's faces tessellated into one mesh [m]: no point of a face farther than
+    ``deflection`` [m] from its triangles, no two normals of one triangle's corners more
+    than ``angle`` [rad] apart (the triangles' corners lie on the faces)."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.BRepTools import BRepTools
     from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopLoc import TopLoc_Location
     from OCP.TopoDS import TopoDS
 
-    BRepMesh_IncrementalMesh(shape, STEP_DEFLECTION / _MM, False, 0.1, True)
+    BRepTools.Clean_s(shape)  # a coarser tessellation replaces an earlier one (it would only refine it)
+    BRepMesh_IncrementalMesh(shape, deflection / _MM, False, angle, True)
     vertices: list[np.ndarray] = []
     faces: list[np.ndarray] = []
     count = 0

@@ -28,15 +28,27 @@ DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
 }
 """The removal directions tried, in order of preference (the cell inserts from above)."""
+
+
+def opposite(direction: str) -> str:
+    """The name of the direction opposite ``direction`` (a removal direction's insertion axis)."""
+    return ("-" if direction[0] == "+" else "+") + direction[1]
 _MAX_CONTACTS = 100_000
 
 
-def _bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
+def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
+    """The triangles of ``mesh`` as an fcl object (its BVH)."""
     model = fcl.BVHModel()
     model.beginModel(len(mesh.vertices), len(mesh.faces))
     model.addSubModel(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32))
     model.endModel()
     return fcl.CollisionObject(model, fcl.Transform())
+
+
+def convex_object(hull: trimesh.Trimesh) -> fcl.CollisionObject:
+    """A convex mesh as an fcl convex shape (GJK/EPA against other objects)."""
+    flat = np.hstack([np.full((len(hull.faces), 1), 3), hull.faces]).astype(np.int32).ravel()
+    return _convex(hull.vertices, len(hull.faces), flat)
 
 
 def _convex(vertices: np.ndarray, count: int, flat: np.ndarray) -> fcl.CollisionObject:
@@ -63,7 +75,7 @@ class Sweeper:
 
     def __init__(self, meshes: dict[str, trimesh.Trimesh]) -> None:
         self.meshes = meshes
-        self._objects = {pid: _bvh(mesh) for pid, mesh in meshes.items()}
+        self._objects = {pid: bvh(mesh) for pid, mesh in meshes.items()}
         self.queries = 0
         """Narrow-phase queries made so far."""
 

@@ -1,7 +1,7 @@
 """The assembly folder of an imported product, in the vocabulary every command reads.
 
 - ``assembly.toml``: every part (the base with role ``base``, a part in a hole with role
-  ``peg`` and its section's kind as ``shape``, any other ``part``) with its tray ``start``,
+  ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
   (:func:`assembly_constraints.executor.world.geometry.passes`), closed world;
@@ -11,33 +11,40 @@
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product when every part but the base is a peg
-  standing in a hole along +z (and the cell's loader accepts it; left out otherwise, and
-  the report says why): the plate at the entry height and depth most holes share, a hole
-  at another one with its own ``top_z`` and ``depth``, the plate and pegs as primitives
-  where they are ones, else as their own meshes with convex pieces (``meshes/``,
-  :mod:`assembly_constraints.executor.cad.convex`).
+  standing in a hole along +z, a cover or a head (:mod:`assembly_constraints.executor.cad.covers`),
+  and no two parts overlap where they wait (and the cell's loader accepts it; left out
+  otherwise, and the report says why): the plate at the entry height and depth most
+  holes share, a hole at another one with its own ``top_z`` and ``depth``, the plate,
+  pegs, covers and heads as primitives where they are ones, else as their own meshes with
+  convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`; a STEP base
+  tessellated again to :data:`CELL_DEFLECTION` for the cell).
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import clingo
 import networkx as nx
+import numpy as np
+import trimesh
 
 from assembly_constraints.bridge.errors import ToolError
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.product import Mesh
 from assembly_constraints.executor.cad.convex import (
     MESH_FOLDER,
+    NEAR,
     base_is_primitive,
     peg_frame,
     peg_is_primitive,
     write_mesh,
 )
+from assembly_constraints.executor.cad.covers import Mapped, map_parts
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.cad.sweep import opposite
 from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
 
 DENSITY = 2700.0
@@ -48,6 +55,9 @@ MIN_CHAMFER = 1e-4
 """The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
 _LEVEL = 1e-5
 """A hole whose entry or depth differs by more than this from the plate's [m] states its own."""
+CELL_DEFLECTION = 1e-5
+"""The largest distance [m] of a STEP base's faces from the triangles the cell collides
+with (its own mesh is measured at :data:`assembly_constraints.executor.cad.parts.STEP_DEFLECTION`)."""
 
 
 @dataclass(frozen=True)
@@ -64,8 +74,8 @@ def section(name: str, shape_kind: str, a: float, b: float) -> Section:
 
 
 def _q(value: float) -> float:
-    """Metres rounded to 0.1 µm (a printed tessellation is no finer)."""
-    return round(value, 7)
+    """Metres rounded to 0.1 µm (a printed tessellation is no finer), never -0.0."""
+    return round(value, 7) + 0.0
 
 
 def _size(kind: str, a: float, b: float) -> str:
@@ -76,12 +86,14 @@ def _symbols(symbols: list[clingo.Symbol]) -> str:
     return " ".join(f"{symbol}." for symbol in symbols)
 
 
-def assembly_text(derived: Derived, settings: Settings, title: str) -> str:
+def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[str, str]) -> str:
+    """``assembly.toml``: the parts with their ``roles`` (base, peg, else the given one or
+    ``part``) and trays, the holes."""
     pegs = derived.hole_of
     lines = [f"# Imported from {title} by ./run.sh import: parts in the CAD frame (the cell frame) [m].",
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):
-        role = "base" if pid == derived.base else "peg" if pid in pegs else "part"
+        role = "base" if pid == derived.base else "peg" if pid in pegs else roles.get(pid, "part")
         lines += [f"[parts.{pid}]", f"name = {json.dumps(settings.names.get(pid, derived.parts[pid].name))}",
                   f'role = "{role}"']
         x, y = settings.trays[pid]
@@ -120,21 +132,42 @@ def sizes_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
-def nominal_text(derived: Derived) -> str:
-    """``nominal_margin(P,H,M)``: the room [µm, rounded] the peg's nominal section has in
-    the hole's (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not pass)."""
+def margins(derived: Derived) -> dict[str, dict[str, float]]:
+    """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
+    (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not
+    pass), sections ``other`` left out."""
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
             if fit.section is not None and fit.section.kind != "other"}
     holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    return {pid: {hid: margin(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))
+                  for hid, hole in holes.items()} for pid, peg in pegs.items()}
+
+
+def nominal_text(derived: Derived) -> str:
+    """``nominal_margin(P,H,M)``: the room [µm, rounded] of each peg in each hole (:func:`margins`)."""
     lines = ["% The nominal room of every peg in every hole [um] (negative: it does not pass), by ./run.sh import;",
              "% the input of sizes learn --prior cad."]
-    for pid, peg in pegs.items():
+    for pid, rooms in margins(derived).items():
         lines.append(_symbols([clingo.Function("nominal_margin", [
-            clingo.Function(pid), clingo.Function(hid),
-            clingo.Number(round(1e6 * margin(section(pid, peg.kind, peg.a, peg.b),
-                                             section(hid, hole.kind, hole.a, hole.b))))])
-            for hid, hole in holes.items()]))
+            clingo.Function(pid), clingo.Function(hid), clingo.Number(round(1e6 * room))])
+            for hid, room in rooms.items()]))
     return "\n".join(lines) + "\n"
+
+
+def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
+    """The base's mesh as the cell simulates it and a line saying how it was made: a STEP
+    base tessellated again to :data:`CELL_DEFLECTION` (or a tenth of the least room of a
+    peg that fits a hole, if that is less), else the mesh the import measured."""
+    base = derived.parts[derived.base]
+    rooms = [room for holes in margins(derived).values() for room in holes.values() if room > 0]
+    deflection = min([CELL_DEFLECTION, *(room / 10 for room in rooms)])
+    coarse = None if base.remesh is None else base.remesh(deflection)
+    if coarse is None or not coarse.is_watertight:
+        return base.mesh, "as measured"
+    if coarse.volume < 0:
+        coarse.invert()
+    return coarse, (f"tessellated to {1e6 * deflection:.3g} um for the cell: a round hole's polygon has its corners on "
+                    "the circle, its sides within that of it")
 
 
 REASONS = {
@@ -163,21 +196,58 @@ def precedence_text(derived: Derived) -> str:
 
 
 def simulable(derived: Derived) -> str | None:
-    """Why the product is not one the simulated cell builds from primitives, None when it is."""
-    pegs = derived.hole_of
-    for pid in sorted(derived.parts):
-        if pid == derived.base:
-            continue
-        if pid not in pegs:
-            return f"part '{pid}' stands in no hole of the base"
+    """Why the product's base and pegs are not ones the simulated cell builds, None when
+    they are (its other parts: :func:`assembly_constraints.executor.cad.covers.map_parts`)."""
+    for pid in sorted(derived.hole_of):
         if derived.axis[pid] != "+z":
-            return f"part '{pid}' goes in along {derived.axis[pid]}, not from above"
+            return f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"
     fits = list(derived.holes.values())
     for fit in fits:
         if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
             return f"hole {fit.id} is not entered from above with a round, square or rect section"
-    if not fits:
+    if not fits or not derived.hole_of:
         return "no part stands in a hole of the base"
+    return None
+
+
+
+def map_product(derived: Derived, settings: Settings) -> Mapped:
+    """The covers and heads of a product whose base and pegs the cell builds
+    (:func:`simulable`), with ``why`` the cell builds none: the first reason of
+    :func:`simulable`, :func:`assembly_constraints.executor.cad.covers.map_parts`, or two
+    parts overlapping on the tray."""
+    why = simulable(derived)
+    if why is not None:
+        return Mapped({}, {}, why)
+    mapped = map_parts(derived, _plate_level(list(derived.holes.values()))[0])
+    return mapped if mapped.why is not None else replace(mapped, why=_tray_overlap(derived, mapped, settings))
+
+
+def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
+    """Each part's transform (4 × 4) from the cell frame to its part frame (the base's: its
+    bounding box's centre at its plate's ``base_center``)."""
+    frames = {pid: peg_frame(fit, derived.parts[pid].mesh) for pid, fit in derived.hole_of.items()}
+    (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
+    origins = {pid: fit.origin for pid, fit in mapped.covers.items()} | {pid: fit.origin for pid, fit in
+                                                                         mapped.heads.items()}
+    origins[derived.base] = ((x0 + x1) / 2, (y0 + y1) / 2, 0.0)
+    return frames | {pid: trimesh.transformations.translation_matrix(np.negative(origin))
+                     for pid, origin in origins.items()}
+
+
+def _tray_overlap(derived: Derived, mapped: Mapped, settings: Settings) -> str | None:
+    """Why two parts overlap where they wait (their footprints: bounding boxes of their
+    meshes in their part frames at their trays), None when none do."""
+    boxes = {}
+    for pid, frame in _frames(derived, mapped).items():
+        corners = trimesh.transform_points(trimesh.bounds.corners(derived.parts[pid].mesh.bounds), frame)[:, :2]
+        boxes[pid] = (corners.min(axis=0) + settings.trays[pid], corners.max(axis=0) + settings.trays[pid])
+    ids = sorted(boxes)
+    for k, a in enumerate(ids):
+        for b in ids[k + 1:]:
+            if np.all(np.minimum(boxes[a][1], boxes[b][1]) - np.maximum(boxes[a][0], boxes[b][0]) > _LEVEL):
+                return (f"parts '{a}' and '{b}' overlap where they wait on the tray (set [parts.<id>] tray in the "
+                        "import settings)")
     return None
 
 
@@ -186,26 +256,38 @@ def _mesh_entry(mesh: Mesh) -> str:
     return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
 
 
-def write_meshes(derived: Derived, out: Path) -> tuple[dict[str, Mesh], list[Path]]:
-    """The meshes of the parts of a :func:`simulable` product that are no primitive,
-    written into ``out`` (the base in the cell frame, a peg in its part frame); returns
-    their ``mesh`` entries by part and the files written."""
+def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str, Mesh], list[Path]] | str:
+    """The meshes of the parts of a mapped product that are no primitive, written into
+    ``out`` (the base in the cell frame, the others in their part frames with their convex
+    pieces); returns their ``mesh`` entries by part and the files written, or why a part
+    has no pieces that fit (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
     written: list[Path] = []
     if not base_is_primitive(derived):
-        meshes[derived.base], files = write_mesh(out, derived.base, derived.parts[derived.base].mesh, moving=False)
+        done = write_mesh(out, derived.base, *cell_base(derived), None)
+        assert not isinstance(done, str)  # the base has no pieces
+        meshes[derived.base], files = done
         written += files
-    for pid, fit in sorted(derived.hole_of.items()):
+    frames = _frames(derived, mapped)
+    moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
+    moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
+    moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
+    for pid in sorted(moving):
         mesh = derived.parts[pid].mesh
-        if not peg_is_primitive(fit, mesh):
-            meshes[pid], files = write_mesh(out, pid, mesh.copy().apply_transform(peg_frame(fit, mesh)), moving=True)
-            written += files
+        near = {other: part.mesh.copy().apply_transform(frames[pid]) for other, part in derived.parts.items()
+                if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
+                                           - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
+        done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near)
+        if isinstance(done, str):
+            return done
+        meshes[pid], files = done
+        written += files
     return meshes, written
 
 
-def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh]) -> str:
-    """``geometry.toml`` of a :func:`simulable` product, the parts in ``meshes`` as their
-    own meshes."""
+def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh]) -> str:
+    """``geometry.toml`` of a mapped product (:func:`map_product`), the parts in ``meshes``
+    as their own meshes."""
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
@@ -236,10 +318,23 @@ def geometry_text(derived: Derived, settings: Settings, meshes: dict[str, Mesh])
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
-              "[base]", f'part = "{derived.base}"',
-              f"tray = [{_q(settings.trays[derived.base][0])}, {_q(settings.trays[derived.base][1])}]",
+              "[base]", f'part = "{derived.base}"', f"tray = {_numbers(settings.trays[derived.base])}",
               "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}",
               *([_mesh_entry(meshes[derived.base])] if derived.base in meshes else []), ""]
+    for cid, cover in sorted(mapped.covers.items()):
+        lines += [f"[covers.{cid}]", f"name = {json.dumps(settings.names.get(cid, derived.parts[cid].name))}",
+                  f"over = {json.dumps(list(cover.over))}", f"outline = {_numbers(cover.outline)}",
+                  f"thickness = {_q(cover.thickness)}", f"bottom = {_q(max(cover.bottom, 0.0))}",
+                  f"clearance = {_q(cover.clearance)}", f"mass = {_q(derived.parts[cid].mesh.volume * DENSITY)}",
+                  f"grip = {_numbers(cover.grip)}", f"tray = {_numbers(settings.trays[cid])}",
+                  f'skill = "{cover.skill}"',
+                  *([f"socket = {_numbers(cover.socket)}"] if cover.socket else []),
+                  *([_mesh_entry(meshes[cid])] if cid in meshes else []), ""]
+    for hid, head in sorted(mapped.heads.items()):
+        lines += [f"[heads.{hid}]", f"name = {json.dumps(settings.names.get(hid, derived.parts[hid].name))}",
+                  f'into = "{head.into}"', f'kind = "{head.section.kind}"', f"size = {_q(head.section.a)}",
+                  f"length = {_q(head.length)}", f"mass = {_q(derived.parts[hid].mesh.volume * DENSITY)}",
+                  f'skill = "{head.skill}"', *([_mesh_entry(meshes[hid])] if hid in meshes else []), ""]
     return "\n".join(lines)
 
 
@@ -254,6 +349,11 @@ def _plate_level(fits: list[HoleFit]) -> tuple[float, float]:
     return max(levels, key=sharing)
 
 
+def _numbers(values: tuple[float, ...]) -> str:
+    """A TOML list of lengths [m] to 0.1 µm."""
+    return f"[{', '.join(str(_q(v)) for v in values)}]"
+
+
 def _tile(fits: list[HoleFit]) -> float:
     """The side of the square boss around every hole [m]: the measured boss when the base
     has one around each hole, else the largest square the holes' spacing leaves room for."""
@@ -265,23 +365,28 @@ def _tile(fits: list[HoleFit]) -> float:
     return tile if tile > widest else widest + 0.004
 
 
-def write_folder(derived: Derived, settings: Settings, title: str, out: Path) -> tuple[list[Path], str | None]:
+def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: str, out: Path
+                 ) -> tuple[list[Path], str | None]:
     """Write the files of the module docstring into ``out`` (removing the ``meshes/*.obj``
     an earlier import left that this one does not use); returns them and why there is no
     ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
     make_folder(out)
-    written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title)),
+    roles = {pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
+    written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title, roles)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
                write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
                write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
     geometry = out / "geometry.toml"
     if geometry.exists():
         geometry.unlink()
-    why = simulable(derived)
+    why = mapped.why
     mesh_files: list[Path] = []
-    if why is None:
-        meshes, mesh_files = write_meshes(derived, out)
-        write_atomic(geometry, geometry_text(derived, settings, meshes))
+    made = write_meshes(derived, mapped, out) if why is None else None
+    if isinstance(made, str):
+        why = made
+    elif made is not None:
+        meshes, mesh_files = made
+        write_atomic(geometry, geometry_text(derived, mapped, settings, meshes))
         try:
             load_geometry(str(out))
         except ToolError as exc:

@@ -1,13 +1,14 @@
 """Generated assets that follow their sources.
 
-``<assembly>/assets/`` (plate mesh, part URDFs, a mesh part's eroded convex pieces) is
+``<assembly>/assets/`` (plate mesh, part URDFs, a mesh part's eroded convex pieces, the URDF of a
+cover or head simulated from its mesh) is
 generated from ``geometry.toml`` and ``assembly.toml`` by
 :func:`assembly_constraints.executor.world.geometry.write_assets`. The folder records the
 SHA-256 of the values it was made from (``assets/sources.sha256``: the ``[plate]`` table,
 every hole (its entry height and depth where they are its own) and part as loaded, as
-canonical JSON, a part's or the base's ``mesh`` with the digest of its file; comments and
-the keys the assets do not use leave it unchanged), written after the assets, so an
-interrupted regeneration is regenerated again.
+canonical JSON, a part's, cover's, head's or the base's ``mesh`` with the digest of its
+file; comments and the keys the assets do not use leave it unchanged), written after the
+assets, so an interrupted regeneration is regenerated again.
 :func:`current_assets`, called before a cell loads any asset, regenerates the folder
 when a generated file is missing or the digest differs: an edited hole is never simulated
 with its old mesh. When the folder cannot be written (a read-only install), the error
@@ -32,7 +33,8 @@ from assembly_constraints.executor.world.geometry import (
     CellGeometry,
     HoleSpec,
     PartSpec,
-    convex_asset_name,
+    peg_body,
+    product_bodies,
     write_assets,
 )
 
@@ -44,16 +46,21 @@ logger = logging.getLogger(__name__)
 def sources_digest(geometry: CellGeometry) -> str:
     """Hex SHA-256 of the canonical JSON of what the assets are generated from: the
     ``[plate]`` table, every hole and part (their dataclass fields; a hole's level where it
-    is not the plate's, a part's ``mesh`` and the base's only where there is one, so a
-    product of primitives at one level keeps its digest). The values come from decimal
-    text, and a mesh is named by its file's SHA-256 (the loader checked it), so the digest
-    is the same on every machine and in every folder."""
+    is not the plate's, a part's ``mesh``, the base's and the ``mesh`` and ``mass`` of
+    covers and heads only where there is one, so a product of primitives at one level keeps
+    its digest). The values come from decimal text, and a mesh is named by its file's
+    SHA-256 (the loader checked it), so the digest is the same on every machine and in
+    every folder."""
     inputs: dict[str, object] = {"plate": msgspec.structs.asdict(geometry.plate),
                                  "holes": [_hole_fields(h, geometry.plate) for _, h in sorted(geometry.holes.items())],
                                  "parts": [_part_fields(p) for _, p in sorted(geometry.parts.items())]}
     base = geometry.tables.base
     if base is not None and base.mesh is not None:
         inputs["base_mesh"] = msgspec.structs.asdict(base.mesh)
+    bodies = product_bodies(geometry)
+    if bodies:
+        inputs["meshes"] = {pid: {"mesh": msgspec.structs.asdict(body.mesh), "mass": body.mass}
+                            for pid, body in bodies.items()}
     return hashlib.sha256(json.dumps(inputs, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -74,8 +81,10 @@ def _part_fields(part: PartSpec) -> dict[str, object]:
 
 def _generated_names(geometry: CellGeometry) -> list[str]:
     shapes = {p.shape: p for p in geometry.parts.values()}
-    return ["plate.obj", *sorted(f"part_{s}.urdf" for s in shapes),
-            *sorted(convex_asset_name(p) for p in shapes.values() if p.mesh is not None)]
+    bodies = [body for body in map(peg_body, shapes.values()) if body is not None]
+    others = list(product_bodies(geometry).values())
+    return ["plate.obj", *sorted(f"part_{s}.urdf" for s in shapes), *sorted(f"{b.stem}.urdf" for b in others),
+            *sorted(body.convex_asset for body in bodies + others)]
 
 
 def regenerate_assets(geometry: CellGeometry) -> list[Path]:

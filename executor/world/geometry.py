@@ -48,7 +48,14 @@ from assembly_constraints.bridge.product import (
 )
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.world.meshes import MeshInertia, eroded_pieces_text, mesh_inertia
+from assembly_constraints.executor.world.meshes import (
+    MeshBody,
+    MeshFiles,
+    eroded_pieces_text,
+    mesh_inertia,
+    mesh_link_xml,
+    mesh_urdf_text,
+)
 
 FLOOR_MIN = 1e-6
 """A hole whose bottom is less than this above the plate under the bosses goes through its
@@ -336,46 +343,38 @@ def plate_obj_text(geometry: CellGeometry) -> str:
     return "\n".join(lines) + "\n"
 
 
-@dataclass(frozen=True)
-class MeshFiles:
-    """A mesh part in a URDF: its ``visual`` mesh and the ``collision`` asset (its eroded
-    convex pieces), as the URDF names them, and its mass properties."""
-
-    visual: str
-    collision: str
-    inertia: MeshInertia
+PART_RGBA = "0.8 0.6 0.2 1"
+"""The colour of the pegs, covers and heads in the generated URDFs."""
 
 
-def convex_asset_name(part: PartSpec) -> str:
-    """The file name in ``assets/`` of a mesh part shape's eroded convex pieces."""
-    return f"part_{part.shape}.convex.obj"
+def peg_body(part: PartSpec) -> MeshBody | None:
+    """A peg's shape simulated from its own mesh (None for a cylinder or box)."""
+    return None if part.mesh is None else MeshBody(f"part_{part.shape}", part.mesh, part.mass, f"part '{part.id}'")
 
 
-def mesh_files(geometry: CellGeometry, part: PartSpec, *, absolute: bool) -> MeshFiles | None:
+def product_bodies(geometry: CellGeometry) -> dict[str, MeshBody]:
+    """The covers and heads simulated from their own meshes, by part id."""
+    tables = geometry.tables
+    bodies = {cid: MeshBody(f"cover_{cid}", cover.mesh, cover.mass, f"cover '{cid}'")
+              for cid, cover in sorted(tables.covers.items()) if cover.mesh is not None}
+    return bodies | {hid: MeshBody(f"head_{hid}", head.mesh, head.mass, f"head '{hid}'")
+                     for hid, head in sorted(tables.heads.items()) if head.mesh is not None}
+
+
+def mesh_files(geometry: CellGeometry, body: MeshBody | None, *, absolute: bool) -> MeshFiles | None:
     """The files of a mesh part (None for a primitive one): relative to ``assets/`` (a URDF
     written there) or ``absolute`` (one written elsewhere)."""
-    if part.mesh is None:
+    if body is None:
         return None
-    visual = geometry.folder / part.mesh.file
-    collision = geometry.assets / convex_asset_name(part)
-    names = (str(visual), str(collision)) if absolute else (f"../{part.mesh.file}", collision.name)
-    return MeshFiles(*names, mesh_inertia(visual, part.mass))
+    visual = geometry.folder / body.mesh.file
+    collision = geometry.assets / body.convex_asset
+    names = (str(visual), str(collision)) if absolute else (f"../{body.mesh.file}", collision.name)
+    return MeshFiles(*names, mesh_inertia(visual, body.mass))
 
 
-_FLIP = np.diag([1.0, -1.0, -1.0])  # a half turn about x: the held part's frame, z pointing away from the arm
-
-
-def part_geometry_xml(part: PartSpec, z_centre: float, rgba: str, files: MeshFiles | None = None,
-                      flip: bool = False) -> str:
-    """URDF ``<visual>`` + ``<collision>`` of a part whose axis is z, centred at ``z_centre``
-    [m]; a mesh part's (``files``) at the link origin, turned half about x when ``flip``."""
-    if files is not None:
-        origin = f'<origin xyz="0 0 0" rpy="{np.pi if flip else 0.0:.15g} 0 0"/>'
-        return (
-            f'    <visual>{origin}<geometry><mesh filename="{files.visual}"/></geometry>'
-            f'<material name="part"><color rgba="{rgba}"/></material></visual>\n'
-            f'    <collision>{origin}<geometry><mesh filename="{files.collision}"/></geometry></collision>\n'
-        )
+def part_geometry_xml(part: PartSpec, z_centre: float, rgba: str) -> str:
+    """URDF ``<visual>`` + ``<collision>`` of a cylinder or box part whose axis is z,
+    centred at ``z_centre`` [m]."""
     if part.kind == "round":
         shape = f'<cylinder radius="{part.size / 2:.6f}" length="{part.length:.6f}"/>'
     else:
@@ -396,27 +395,14 @@ def _inertial_xml(mass: float, inertia: float, z: float) -> str:
     )
 
 
-def _mesh_inertial_xml(inertia: MeshInertia, flip: bool) -> str:
-    """``<inertial>`` of a mesh part: its centre of mass and full inertia tensor, in the
-    link frame (turned half about x when ``flip``)."""
-    turn = _FLIP if flip else np.eye(3)
-    (x, y, z), i = turn @ inertia.com, turn @ inertia.inertia @ turn.T
-    return (
-        f'    <inertial><origin xyz="{x:.9g} {y:.9g} {z:.9g}" rpy="0 0 0"/><mass value="{inertia.mass:.9g}"/>'
-        f'<inertia ixx="{i[0, 0]:.9g}" ixy="{i[0, 1]:.9g}" ixz="{i[0, 2]:.9g}" iyy="{i[1, 1]:.9g}" '
-        f'iyz="{i[1, 2]:.9g}" izz="{i[2, 2]:.9g}"/></inertial>\n'
-    )
-
-
 def _part_link_xml(part: PartSpec, files: MeshFiles | None, held: bool) -> str:
     """Inertial, visual and collision of a part upright on the tray (link frame at its
     bottom face centre) or ``held`` (frame at its tip, z pointing away from the arm)."""
-    rgba = "0.8 0.6 0.2 1"
     if files is not None:
-        return _mesh_inertial_xml(files.inertia, held) + part_geometry_xml(part, 0.0, rgba, files, held)
+        return mesh_link_xml(files, PART_RGBA, held)
     inertia = part.mass * (part.size**2 + part.length**2) / 12
     centre = -part.length / 2 if held else part.length / 2
-    return _inertial_xml(part.mass, inertia, centre) + part_geometry_xml(part, centre, rgba)
+    return _inertial_xml(part.mass, inertia, centre) + part_geometry_xml(part, centre, PART_RGBA)
 
 
 def part_urdf_text(part: PartSpec, files: MeshFiles | None = None) -> str:
@@ -465,17 +451,25 @@ def arm_urdf_text(part: PartSpec, gripper: Gripper, files: MeshFiles | None = No
 
 
 def write_assets(geometry: CellGeometry) -> list[Path]:
-    """(Re)generate ``assets/plate.obj``, ``assets/part_<shape>.urdf`` and, for a mesh part
-    shape, its eroded convex pieces (each written atomically, so a cell starting meanwhile
-    never loads half a file); returns the paths."""
+    """(Re)generate ``assets/plate.obj``, ``assets/part_<shape>.urdf``, for a part shape,
+    cover or head simulated from its own mesh its eroded convex pieces, and for such a
+    cover or head its URDF (``cover_<id>.urdf``, ``head_<id>.urdf``), each written
+    atomically (a cell starting meanwhile never loads half a file); returns the paths."""
     make_folder(geometry.assets)
     written = [write_atomic(geometry.assets / "plate.obj", plate_obj_text(geometry))]
-    for shape in sorted({p.shape for p in geometry.parts.values()}):
-        part = next(p for p in geometry.parts.values() if p.shape == shape)
-        if part.mesh is not None and part.mesh.convex is not None:
-            written.append(write_atomic(geometry.assets / convex_asset_name(part),
-                                        eroded_pieces_text(geometry.folder / part.mesh.convex, f"part '{part.id}'")))
-        files = mesh_files(geometry, part, absolute=False)
+    pegs: dict[str, PartSpec] = {}
+    for part in geometry.parts.values():
+        pegs.setdefault(part.shape, part)
+    others = product_bodies(geometry)
+    for body in [peg_body(part) for _, part in sorted(pegs.items())] + list(others.values()):
+        if body is not None and body.mesh.convex is not None:
+            written.append(write_atomic(geometry.assets / body.convex_asset,
+                                        eroded_pieces_text(geometry.folder / body.mesh.convex, body.what)))
+    for shape, part in sorted(pegs.items()):
+        files = mesh_files(geometry, peg_body(part), absolute=False)
         written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part, files)))
+    for body in others.values():
+        files = mesh_files(geometry, body, absolute=False)
+        assert files is not None  # a body of its own mesh
+        written.append(write_atomic(geometry.assets / f"{body.stem}.urdf", mesh_urdf_text(body.stem, files, PART_RGBA)))
     return written
-

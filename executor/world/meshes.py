@@ -1,6 +1,7 @@
-"""Parts simulated from their own meshes (a ``mesh`` of ``[part_shapes.*]`` or ``[base]``,
-docs/geometry.md): the OBJ files of their convex pieces, the pieces as the cell loads
-them, and mass and inertia from the mesh.
+"""Parts simulated from their own meshes (a ``mesh`` of ``[part_shapes.*]``, ``[covers.*]``,
+``[heads.*]`` or ``[base]``, docs/geometry.md): the OBJ files of their convex pieces, the
+pieces as the cell loads them, mass and inertia from the mesh, and the URDF link of such
+a part (:class:`MeshBody`, :func:`mesh_link_xml`).
 
 A moving part collides as the convex pieces of its ``convex`` file (one OBJ object each,
 made at import time). PyBullet's URDF importer makes one convex hull of each object and
@@ -23,6 +24,7 @@ import trimesh
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
+from assembly_constraints.bridge.product import Mesh
 from assembly_constraints.executor import ExecutorError
 
 URDF_HULL_MARGIN = 0.001
@@ -116,3 +118,56 @@ def mesh_inertia(path: Path, mass: float) -> MeshInertia:
         raise ExecutorError(f"{path}: not a closed mesh with a volume; expected the part's own closed mesh [m]")
     mesh.density = mass / mesh.volume
     return MeshInertia(mass, np.array(mesh.center_mass), np.array(mesh.moment_inertia))
+
+
+@dataclass(frozen=True)
+class MeshBody:
+    """A moving part simulated from its own ``mesh`` (a peg shape's, a cover's or a
+    head's): ``stem`` of its generated assets (``<stem>.urdf``, ``<stem>.convex.obj``), its
+    ``mass`` [kg], and ``what`` names it in messages."""
+
+    stem: str
+    mesh: Mesh
+    mass: float
+    what: str
+
+    @property
+    def convex_asset(self) -> str:
+        """The file name in ``assets/`` of its eroded convex pieces."""
+        return f"{self.stem}.convex.obj"
+
+
+@dataclass(frozen=True)
+class MeshFiles:
+    """A mesh part in a URDF: its ``visual`` mesh and the ``collision`` asset (its eroded
+    convex pieces), as the URDF names them, and its mass properties."""
+
+    visual: str
+    collision: str
+    inertia: MeshInertia
+
+
+_FLIP = np.diag([1.0, -1.0, -1.0])  # a half turn about x: the held part's frame, z pointing away from the arm
+
+
+def mesh_link_xml(files: MeshFiles, rgba: str, flip: bool) -> str:
+    """URDF ``<inertial>``, ``<visual>`` and ``<collision>`` of a mesh part (``files``) at
+    the link origin: its centre of mass and full inertia tensor, its mesh and its pieces,
+    turned half about x when ``flip``."""
+    turn = _FLIP if flip else np.eye(3)
+    (x, y, z), i = turn @ files.inertia.com, turn @ files.inertia.inertia @ turn.T
+    origin = f'<origin xyz="0 0 0" rpy="{np.pi if flip else 0.0:.15g} 0 0"/>'
+    return (
+        f'    <inertial><origin xyz="{x:.9g} {y:.9g} {z:.9g}" rpy="0 0 0"/><mass value="{files.inertia.mass:.9g}"/>'
+        f'<inertia ixx="{i[0, 0]:.9g}" ixy="{i[0, 1]:.9g}" ixz="{i[0, 2]:.9g}" iyy="{i[1, 1]:.9g}" '
+        f'iyz="{i[1, 2]:.9g}" izz="{i[2, 2]:.9g}"/></inertial>\n'
+        f'    <visual>{origin}<geometry><mesh filename="{files.visual}"/></geometry>'
+        f'<material name="part"><color rgba="{rgba}"/></material></visual>\n'
+        f'    <collision>{origin}<geometry><mesh filename="{files.collision}"/></geometry></collision>\n'
+    )
+
+
+def mesh_urdf_text(name: str, files: MeshFiles, rgba: str) -> str:
+    """A free mesh part (robot ``name``), its frame the part frame of its mesh."""
+    return (f'<?xml version="1.0"?>\n<robot name="{name}">\n  <link name="part">\n'
+            + mesh_link_xml(files, rgba, flip=False) + "  </link>\n</robot>\n")

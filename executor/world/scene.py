@@ -20,7 +20,7 @@ from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.world import TIME_STEP
 from assembly_constraints.executor.world.arm import yaw_quat
 from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files
+from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files, peg_body
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -71,7 +71,7 @@ class Scene:
         part = next(p for _, p in sorted(geometry.parts.items()) if p.shape == shape)
         with tempfile.TemporaryDirectory(prefix="executor-arm-") as tmp:
             urdf = Path(tmp) / f"arm_{shape}.urdf"
-            urdf.write_text(arm_urdf_text(part, geometry.gripper, mesh_files(geometry, part, absolute=True)))
+            urdf.write_text(arm_urdf_text(part, geometry.gripper, mesh_files(geometry, peg_body(part), absolute=True)))
             self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
                                      flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                                      physicsClientId=self.client)

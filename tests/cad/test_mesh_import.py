@@ -16,6 +16,8 @@ import trimesh
 
 from assembly_constraints.bridge.product import CONVEX_HEADER
 from assembly_constraints.cli import main
+from assembly_constraints.executor.cad.sections import edge_distance, slice_loops
+from assembly_constraints.executor.cad.write import CELL_DEFLECTION
 from assembly_constraints.executor.world.geometry import load_geometry
 from assembly_constraints.executor.world.meshes import read_objects
 
@@ -101,6 +103,13 @@ def test_a_step_product_with_a_flanged_peg_is_assembled_in_the_simulated_cell(
     geometry = load_geometry(str(out))
     assert geometry.base_mesh == out / "meshes" / "plate.obj"  # the stop: no plate of primitives
     assert geometry.parts["flange_peg"].mesh is not None
+    # The cell's plate is tessellated to CELL_DEFLECTION: the hole's polygon within it of its circle.
+    hole = geometry.holes["h1"]
+    loops = slice_loops(trimesh.load(geometry.base_mesh, force="mesh"), np.array([0.0, 0.0, 1.0]), 0.0125)
+    wall = min(loops, key=lambda loop: loop.area)
+    corners = np.linalg.norm(wall.points - hole.position, axis=1)
+    assert hole.size / 2 - CELL_DEFLECTION <= edge_distance(wall.points, np.array(hole.position)) < hole.size / 2
+    assert corners.max() <= hole.size / 2 + 1e-7 and len(wall.points) < 200  # the measured mesh's has 514
     assert main(["-q", "executor", "teach", "--assembly", str(out)]) == 0
     capsys.readouterr()
     assert main(["assemble", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
