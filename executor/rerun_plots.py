@@ -19,21 +19,20 @@ from collections.abc import Sequence
 import numpy as np
 import rerun as rr
 
+from assembly_constraints.bridge.recording.layout import FIG17_HEIGHT as HEIGHT
+from assembly_constraints.bridge.recording.layout import FIG17_MARGIN
+from assembly_constraints.bridge.recording.layout import FIG17_WIDTH as WIDTH
+
 AXIS_NAMES = {"force": ["Fx", "Fy", "Fz"], "torque": ["Mx", "My", "Mz"]}
 MEASURED_COLORS = [[230, 60, 60], [60, 170, 60], [60, 90, 230]]
 DESIRED_COLORS = [[250, 170, 170], [160, 225, 160], [160, 180, 250]]
 FIT_COLOR = [40, 180, 60]
 NO_FIT_COLOR = [220, 50, 40]
-WIDTH = 100.0
-"""Plot units from phase 0 to phase 1."""
-HEIGHT = 60.0
-"""Plot units from −|F|max to +|F|max."""
 GROWTH_ROWS = 8
 """Rows an attempt's growing plots are sent as, at most (the last one whole): the data they
 take is about ``(GROWTH_ROWS + 1) / 2`` times that of the whole plot alone."""
 _AXES_COLOR = [150, 150, 150]
 _LINE_RADIUS = 0.35  # plot units
-_KEY_Y = -HEIGHT / 2 - 7.0  # the colour key's line, above the plot (2D views: y points down)
 
 
 def outcome_color(outcome: str) -> list[int]:
@@ -73,12 +72,14 @@ def send_fig17(rec: rr.RecordingStream, entity: str, indexes: Sequence[rr.TimeCo
     rec.send_columns(f"{entity}/axes", indexes=indexes, columns=rr.LineStrips2D.columns(
         strips=axes * rows, colors=[_AXES_COLOR] * (len(axes) * rows), radii=[_LINE_RADIUS / 2] * (len(axes) * rows))
         .partition([len(axes)] * rows))
-    # The labels sit outside the data: phase below the plot, |F| left of the y axis, the key above.
-    ticks = [[0.0, half + 5.0], [WIDTH / 2, half + 5.0], [WIDTH, half + 5.0], [-12.0, -half], [-12.0, half],
-             *([WIDTH * (0.5 + 0.12 * k), _KEY_Y] for k in range(4))]
-    labels = [["phase 0", "0.5", "1", f"+{span:.1f} N", f"−{span:.1f} N", *AXIS_NAMES["force"], "pale: des"]
+    # The labels (drawn below their points) sit outside the data, in the view's margin
+    # (FIG17_MARGIN): the phase below the plot, |F| left of the force axis, the key above.
+    below, left, above = half + 2.0, -0.8 * FIG17_MARGIN, -half - 0.9 * FIG17_MARGIN
+    ticks = [[0.0, below], [WIDTH / 2, below], [WIDTH, below], [left, -half - 4.0], [left, half - 4.0],
+             *([WIDTH * x, above] for x in (0.05, 0.2, 0.35, 0.7))]
+    labels = [["phase 0", "0.5", "1", f"+{span:.1f} N", f"−{span:.1f} N", *AXIS_NAMES["force"], "F_des: pale"]
               for span in spans]
-    colors = [_AXES_COLOR] * 5 + MEASURED_COLORS + [DESIRED_COLORS[2]]
+    colors = [_AXES_COLOR] * 5 + MEASURED_COLORS + [_AXES_COLOR]
     rec.send_columns(f"{entity}/ticks", indexes=indexes, columns=rr.Points2D.columns(
         positions=ticks * rows, labels=[label for row in labels for label in row], colors=colors * rows,
         radii=[0.6] * (len(ticks) * rows)).partition([len(ticks)] * rows))

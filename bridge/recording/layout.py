@@ -79,6 +79,13 @@ CLOSE_UP_OFFSET_M = (0.07, 0.05, 0.12)
 so a search path on a boss top is seen from above. The viewer sets its distance when it
 starts following the held part: 1.5 times the radius of the part's bounding sphere (Rerun
 0.41's ``eye.rs``), a few centimetres for Cranfield's pegs."""
+FIG17_WIDTH = 80.0
+"""Fig. 17's plot units from phase 0 to phase 1 (``executor.rerun_plots`` draws it)."""
+FIG17_HEIGHT = 80.0
+"""Fig. 17's plot units from −|F|max to +|F|max."""
+FIG17_MARGIN = 14.0
+"""Plot units around Fig. 17's axes where its labels are: the phase below, |F|max left of the
+force axis, the colour key above (the view shows them all, whatever its size)."""
 PlayState = Literal["following", "paused"]
 OPENS: PlayState = "paused"
 """How a recording file or ``view.rbl`` opens: paused at the start of its timeline."""
@@ -280,12 +287,15 @@ def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
             _cell_3d(root, f"{cell_id}: cell", CELL_EYE),
             rrb.Horizontal(
                 _cell_3d(root, f"{cell_id}: close-up on the held part", close_up),
-                _tool_3d(root, f"{cell_id}: tool, trail {TRAIL_S:g} s, part see-through", close_up),
+                _tool_3d(root, f"{cell_id}: tool, part see-through", close_up),
             ),
         ),
         rrb.Vertical(
             rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
-                              name=f"Fig. 17 {attempt}: F_des (pale), F_mes [N] over DMP phase 0..1"),
+                              name=f"Fig. 17 {attempt}: F_mes, F_des [N] over DMP phase",
+                              visual_bounds=rrb.VisualBounds2D(
+                                  x_range=[-1.6 * FIG17_MARGIN, FIG17_WIDTH + FIG17_MARGIN / 2],
+                                  y_range=[-FIG17_HEIGHT / 2 - FIG17_MARGIN, FIG17_HEIGHT / 2 + FIG17_MARGIN])),
             rrb.TextLogView(origin=f"{root}/outcome", name=f"{cell_id}: outcomes"),
             row_shares=[2, 1],
         ),
