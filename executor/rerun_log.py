@@ -11,10 +11,11 @@ Entities (all under ``executor/<cell-id>/``):
 ``scene/hole_rims``             the holes' rims at the plate's top [m], ``static=True``
 ``tool/tip``                    tool-tip position over ``sim_time`` [m] (a point of :data:`TIP_RADIUS_UI`)
 ``tool/force``                  F_mes as an arrow at the tool tip (:data:`FORCE_ARROW_M_PER_N`)
-``tool/path``                   the attempt's tool path up to then as a line strip [m]: grey at a few
-                                times while the attempt runs, the whole path green (fit) or red
-                                (no fit) when it ends
-``search/path``                 the stochastic hole-search path [m]
+``tool/path``                   the attempt's tool path up to then as a line strip [m]: none at its
+                                first step, grey at a few times while the attempt runs, the whole
+                                path green (fit) or red (no fit) when it ends
+``search/path``                 the stochastic hole-search path [m], from the step its search
+                                ended at (none before it in the attempt)
 ``wrench/force/{measured,desired}``   F_mes, F_des (x, y, z) over ``sim_time`` [N]
 ``wrench/torque/{measured,desired}``  M_mes, M_des (x, y, z) over ``sim_time`` [Nm]
 ``deviation/{force,torque}/<key>``    ‖F_mes − F_des‖ [N], ‖M_mes − M_des‖ [Nm] (eqs. 6, 7),
@@ -41,8 +42,8 @@ shape and hole).
 
 Steps are buffered and sent column-wise (``send_columns``) at ``end_attempt``, which
 keeps the per-step cost to a list append; samples closer than ``period_s`` in sim
-time are skipped so a long campaign stays small. The growing tool path and Fig. 17 are
-sent then too, each row at the times of the step it ends with
+time are skipped so a long campaign stays small. The search path, the growing tool path
+and Fig. 17 are sent then too, each row at the times of the step it ends with
 (:func:`assembly_constraints.executor.rerun_plots.growth_ends`: at most
 :data:`assembly_constraints.executor.rerun_plots.GROWTH_ROWS` rows an attempt).
 """
@@ -97,6 +98,7 @@ FORCE_COLOR = [200, 30, 160]
 PATH_COLOR = [110, 110, 120]
 """The tool path's colour while its attempt runs (its outcome is not known yet)."""
 RIM_COLOR = [60, 60, 60]
+SEARCH_COLOR = [240, 180, 0]
 PATH_RADIUS_UI = 1.0
 """Radius of the tool path's and the search path's lines [UI points]."""
 FORCE_RADIUS_UI = 1.5
@@ -145,6 +147,9 @@ class AttemptTrace:
     torque_mes: list[np.ndarray] = field(default_factory=list)
     torque_des: list[np.ndarray] = field(default_factory=list)
     arm_poses: list[np.ndarray] = field(default_factory=list)
+    search_path: np.ndarray | None = None
+    search_step: int = 0
+    """The hole-search path ``(N, 3)`` [m] and the step it was logged at (when the search ended)."""
 
     def add(
         self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
@@ -368,14 +373,11 @@ class AttemptLogger:
         self._skipped = None
 
     def log_search_path(self, points: np.ndarray) -> None:
-        """Log the hole-search path ``points`` ``(N, 3)`` [m] at the current time."""
+        """Buffer the hole-search path ``points`` ``(N, 3)`` [m] the search just ran: it is
+        sent with the steps, at the time of the last one logged so far."""
         trace = self._require_attempt("log_search_path")
-        if trace.sim_time:
-            self._set_time(trace.sim_time[-1] + self._time_offset)
-        path = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        self.rec.log(
-            f"{self.root}/search/path", rr.LineStrips3D([path], colors=[[240, 180, 0]], radii=-PATH_RADIUS_UI)
-        )
+        trace.search_path = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        trace.search_step = max(len(trace.sim_time) - 1, 0)
 
     def end_attempt(self, evidence: AttemptEvidence) -> AttemptTrace:
         """Send the buffered steps, the tool path and the outcome; returns the trace."""
@@ -386,6 +388,7 @@ class AttemptLogger:
             self._skipped = None
         if trace.sim_time:
             self._send_steps(trace)
+            self._send_paths(trace)
             self._last_time = trace.sim_time[-1] + self._time_offset
             self._sent_steps = True
         self._set_time(self._last_time)
@@ -395,8 +398,6 @@ class AttemptLogger:
             send_fig17(self.rec, fig17_path(self.cell_id, f"{trace.outcome}/{trace.key}"),
                        self._indexes(trace, insertion[ends - 1]), ends, trace.array("phase")[insertion],
                        trace.array("force_mes")[insertion], trace.array("force_des")[insertion])
-        if len(trace.tool_pos) >= 2:
-            self._send_tool_path(trace)
         self._log_outcome(trace, evidence)
         if self.keep_traces:
             self.traces.append(trace)
@@ -440,15 +441,28 @@ class AttemptLogger:
         return [rr.TimeColumn("experiment", sequence=np.full(len(times), trace.experiment)),
                 rr.TimeColumn("sim_time", duration=times), rr.TimeColumn(SESSION_TIMELINE, timestamp=wall)]
 
-    def _send_tool_path(self, trace: AttemptTrace) -> None:
-        """The attempt's tool path growing (:func:`growth_ends`), each row the path up to
-        its time: grey while the attempt runs, the whole path in the outcome's colour."""
+    def _send_paths(self, trace: AttemptTrace) -> None:
+        """The attempt's tool path and search path, each starting empty at its first step (the
+        previous attempt's are not drawn in this one): the tool path growing
+        (:func:`growth_ends`), each row the path up to its time, grey while the attempt runs
+        and whole in the outcome's colour at its last step; the search path from the step
+        the search ended at."""
         tip = trace.array("tool_pos")
-        ends = growth_ends(len(tip))
-        colors = [PATH_COLOR] * (len(ends) - 1) + [outcome_color(trace.outcome)]
-        self.rec.send_columns(f"{self.root}/tool/path", indexes=self._indexes(trace, ends - 1),
-                              columns=rr.LineStrips3D.columns(strips=[tip[:end] for end in ends], colors=colors,
-                                                              radii=np.full(len(ends), -PATH_RADIUS_UI)))
+        ends = growth_ends(len(tip)) if len(tip) >= 2 else np.zeros(0, dtype=np.int64)
+        colors = [PATH_COLOR] * (len(ends) - 1) + [outcome_color(trace.outcome)] * min(len(ends), 1)
+        self._send_strips("tool/path", trace, [0, *(ends - 1)], [tip[:end] for end in ends], colors)
+        search = [] if trace.search_path is None else [trace.search_path]
+        self._send_strips("search/path", trace, sorted({0, trace.search_step}), search, [SEARCH_COLOR] * len(search))
+
+    def _send_strips(self, path: str, trace: AttemptTrace, rows: Sequence[int], strips: Sequence[np.ndarray],
+                     colors: Sequence[Sequence[int]]) -> None:
+        """Lines under ``path`` at the times of ``trace``'s steps ``rows``: none at the first
+        row when there are more rows than ``strips``, then one strip a row."""
+        empty = len(rows) - len(strips)
+        self.rec.send_columns(f"{self.root}/{path}", indexes=self._indexes(trace, np.array(rows, dtype=np.int64)),
+                              columns=rr.LineStrips3D.columns(strips=strips, colors=colors,
+                                                              radii=np.full(len(strips), -PATH_RADIUS_UI))
+                              .partition([0] * empty + [1] * len(strips)))
 
     def _send_steps(self, trace: AttemptTrace) -> None:
         timed = self._indexes(trace)

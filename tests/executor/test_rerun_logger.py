@@ -218,9 +218,32 @@ def test_the_plots_of_an_attempt_grow_with_it(tmp_path: Path) -> None:
     assert f"+{span:.1f} N" in column_values(rrd, f"{fig17}/ticks", "Points2D:labels")[row]
     paths = column_values(rrd, "executor/c1/tool/path", "LineStrips3D:strips")
     path_times = column_values(rrd, "executor/c1/tool/path", "sim_time")
-    assert [len(strip[0]) for strip in paths] == list(growth_ends(len(times))) and path_times[-1] == times[-1]
+    assert paths[0] == [] and path_times[0] == times[0]  # the previous attempt's path is not drawn in this one
+    assert [len(strip[0]) for strip in paths[1:]] == list(growth_ends(len(times))) and path_times[-1] == times[-1]
     colors = column_values(rrd, "executor/c1/tool/path", "LineStrips3D:colors")
     grey, green = (int.from_bytes(bytes([*c, 255]), "big") for c in (PATH_COLOR, FIT_COLOR))
-    assert colors == [[grey]] * (len(paths) - 1) + [[green]]  # the outcome's colour once it is known
+    assert colors == [[]] + [[grey]] * (len(paths) - 2) + [[green]]  # the outcome's colour once it is known
     at = max(k for k, t in enumerate(path_times) if t <= inside)
     assert len(paths[at][0]) == times.index(path_times[at]) + 1  # the path up to that step
+
+
+def test_an_attempt_shows_its_own_search_path(tmp_path: Path) -> None:
+    """The search path appears when the search ends; before, in the same attempt, none (not
+    the previous attempt's)."""
+    rrd = tmp_path / "c1.rrd"
+    logger = AttemptLogger("c1", recording_id="search", rrd_path=rrd, period_s=0.01)
+    for attempt in (1, 2):
+        logger.begin_attempt("p1", "r1", 8, attempt)
+        for k in range(100):
+            if k == 40:  # the search ran during the first 40 steps
+                logger.log_search_path(np.array([[0.5, 0.0, 0.1], [0.501, 0.0, 0.1], [0.501, 0.001, 0.1]]) * attempt)
+            logger.log_step(0.01 * k, 0.0, np.array([0.5, 0.0, 0.1]), np.zeros(3), np.zeros(3), np.zeros(3),
+                            np.zeros(3))
+        logger.end_attempt(Evidence("no_fit"))
+    logger.close()
+    steps = column_values(rrd, "executor/c1/phase", "sim_time")
+    rows = sorted(zip(column_values(rrd, "executor/c1/search/path", "sim_time"),
+                      column_values(rrd, "executor/c1/search/path", "LineStrips3D:strips")), key=lambda row: row[0])
+    assert [(time, len(strips)) for time, strips in rows] == [
+        (steps[0], 0), (steps[39], 1), (steps[100], 0), (steps[139], 1)]  # each search ended after step 40
+    assert rows[3][1][0][1] == pytest.approx([1.002, 0.0, 0.2])  # the second attempt's own path
