@@ -380,7 +380,8 @@ class AttemptLogger:
         trace.search_step = max(len(trace.sim_time) - 1, 0)
 
     def end_attempt(self, evidence: AttemptEvidence) -> AttemptTrace:
-        """Send the buffered steps, the tool path and the outcome; returns the trace."""
+        """Send the buffered steps, the search and tool paths, Fig. 17 and the outcome;
+        returns the trace."""
         trace = self._require_attempt("end_attempt")
         trace.outcome = evidence.outcome
         if self._skipped is not None:

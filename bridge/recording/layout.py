@@ -65,6 +65,7 @@ the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from b
 HELD_PART = "arm/part/held"
 """Entity of the part in the hand, below a cell's root (``executor.rerun_arm``)."""
 HELD_PART_COLOR = (205, 155, 50)
+"""The held part's colour (RGB): solid in the cell's views, see-through in the tool view."""
 HELD_PART_SOLIDS = (rr.Asset3D, rr.Cylinders3D, rr.Boxes3D)
 """The archetypes the held part may be drawn with (a mesh, a round or a square part)."""
 SEE_THROUGH_ALPHA = 80
