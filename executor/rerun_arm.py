@@ -14,7 +14,9 @@ the world pose of each link frame (one ``getLinkStates`` call, ~15 µs).  Entiti
 ================================ ==========================================================
 
 The base link never moves and is logged once.  The held part's geometry is logged at the
-time it is taken (a cell holding parts of several shapes shows the right one at each time).
+time it is taken, with the archetypes of the other kinds cleared (a viewer draws each
+archetype's latest values, so a square peg held before a round one would stay drawn
+around it): a cell holding parts of several shapes shows the right one at each time.
 """
 
 from __future__ import annotations
@@ -26,13 +28,12 @@ import numpy as np
 import pybullet as pb
 import rerun as rr
 
-from assembly_constraints.bridge.recording.layout import HELD_PART
+from assembly_constraints.bridge.recording.layout import HELD_PART, HELD_PART_COLOR, HELD_PART_SOLIDS
 from assembly_constraints.bridge.recording.rows import log_row
 from assembly_constraints.executor.world.scene import link_frame
 
 _ARM_COLOR = [235, 120, 30]
 _TOOL_COLOR = [80, 80, 90]
-_PART_COLOR = [205, 155, 50]
 _BASE = -1
 
 
@@ -69,13 +70,14 @@ class ArmRecorder:
             is_part = self.names[link] == "part"  # one visual: the part's solid (arm_urdf_text)
             entity = f"{root}/{HELD_PART}" if is_part else f"{root}/arm/{self.names[link]}/visual_{k}"
             pose = rr.Transform3D(translation=list(visual[5]), quaternion=rr.Quaternion(xyzw=list(visual[6])))
-            color = _PART_COLOR if is_part else _ARM_COLOR if geom_type == pb.GEOM_MESH else _TOOL_COLOR
+            color = list(HELD_PART_COLOR) if is_part else _ARM_COLOR if geom_type == pb.GEOM_MESH else _TOOL_COLOR
             archetype = _archetype(geom_type, dims, mesh, color)
             if archetype is None:
                 continue
             if is_part:
-                if held_part is not None:
-                    log_row(rec, entity, [pose, archetype, rr.TextDocument(held_part)], at, static=False)
+                if held_part is not None:  # the other kinds cleared: a box held before is no longer drawn
+                    others = [kind.cleared() for kind in HELD_PART_SOLIDS if not isinstance(archetype, kind)]
+                    log_row(rec, entity, [pose, archetype, *others, rr.TextDocument(held_part)], at, static=False)
             elif with_static:
                 log_row(rec, entity, [pose, archetype], at, static)
         if not with_static:

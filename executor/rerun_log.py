@@ -8,10 +8,14 @@ Entities (all under ``executor/<cell-id>/``):
 
 =============================== ===================================================
 ``scene/<name>``                static geometry (boxes, cylinders), ``static=True``
-``tool/tip``                    tool-tip position over ``sim_time`` [m] (a point of :data:`TIP_RADIUS_M`)
+``scene/hole_rims``             the holes' rims at the plate's top [m], ``static=True``
+``tool/tip``                    tool-tip position over ``sim_time`` [m] (a point of :data:`TIP_RADIUS_UI`)
 ``tool/force``                  F_mes as an arrow at the tool tip (:data:`FORCE_ARROW_M_PER_N`)
-``tool/path``                   the attempt's tool path as a line strip [m] (green fit, red no fit)
-``search/path``                 the stochastic hole-search path [m]
+``tool/path``                   the attempt's tool path up to then as a line strip [m]: none at its
+                                first step, grey at a few times while the attempt runs, the whole
+                                path green (fit) or red (no fit) when it ends
+``search/path``                 the stochastic hole-search path [m], from the step its search
+                                ended at (none before it in the attempt)
 ``wrench/force/{measured,desired}``   F_mes, F_des (x, y, z) over ``sim_time`` [N]
 ``wrench/torque/{measured,desired}``  M_mes, M_des (x, y, z) over ``sim_time`` [Nm]
 ``deviation/{force,torque}/<key>``    ‖F_mes − F_des‖ [N], ‖M_mes − M_des‖ [Nm] (eqs. 6, 7),
@@ -20,8 +24,9 @@ Entities (all under ``executor/<cell-id>/``):
 ``phase``                       DMP phase over ``sim_time`` (0 → 1 during the
                                 insertion; 0 while searching or retreating)
 ``by_phase/<outcome>/<key>``    Fig. 17: F_des and F_mes of the insertion against the DMP
-                                phase 0..1, a 2D plot logged when the attempt ends
-                                (:func:`assembly_constraints.executor.rerun_plots.log_fig17`)
+                                phase 0..1, a 2D plot growing with the insertion: the part up
+                                to then at a few times during it, whole at its last step
+                                (:func:`assembly_constraints.executor.rerun_plots.send_fig17`)
 ``outcome``                     text log, one line per attempt
 ``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
 ``ilc/<shape>/<hole>/correction_norm``  size of the ILC correction after each update
@@ -37,7 +42,10 @@ shape and hole).
 
 Steps are buffered and sent column-wise (``send_columns``) at ``end_attempt``, which
 keeps the per-step cost to a list append; samples closer than ``period_s`` in sim
-time are skipped so a long campaign stays small.
+time are skipped so a long campaign stays small. The search path, the growing tool path
+and Fig. 17 are sent then too, each row at the times of the step it ends with
+(:func:`assembly_constraints.executor.rerun_plots.growth_ends`: at most
+:data:`assembly_constraints.executor.rerun_plots.GROWTH_ROWS` rows an attempt).
 """
 
 from __future__ import annotations
@@ -55,6 +63,7 @@ import rerun as rr
 from assembly_constraints.bridge.recording.compaction import compact_recording
 from assembly_constraints.bridge.recording.layout import (
     APPLICATION_ID,
+    HOLE_RIMS,
     SESSION_TIMELINE,
     Contents,
     blueprint,
@@ -68,8 +77,9 @@ from assembly_constraints.executor.rerun_plots import (
     AXIS_NAMES,
     DESIRED_COLORS,
     MEASURED_COLORS,
-    log_fig17,
+    growth_ends,
     outcome_color,
+    send_fig17,
 )
 
 if TYPE_CHECKING:
@@ -78,9 +88,21 @@ if TYPE_CHECKING:
 
 FORCE_ARROW_M_PER_N = 0.004
 """Length of the force arrow at the tool [m] per newton of F_mes."""
-TIP_RADIUS_M = 0.002
-"""Radius of the tool tip's point [m]; the 3D view draws the tip over the last second as
-its trail (:data:`assembly_constraints.bridge.recording.layout.TRAIL_S`)."""
+TIP_RADIUS_UI = 2.0
+"""Radius of the tool tip's point [UI points: pixels at 100 % UI scaling, whatever the zoom];
+the 3D views draw the tip over the last second as its trail
+(:data:`assembly_constraints.bridge.recording.layout.TRAIL_S`): a line of dots a few pixels
+wide, in the cell's overview and in the close-ups alike."""
+TIP_COLOR = [30, 110, 230]
+FORCE_COLOR = [200, 30, 160]
+PATH_COLOR = [110, 110, 120]
+"""The tool path's colour while its attempt runs (its outcome is not known yet)."""
+RIM_COLOR = [60, 60, 60]
+SEARCH_COLOR = [240, 180, 0]
+PATH_RADIUS_UI = 1.0
+"""Radius of the tool path's and the search path's lines [UI points]."""
+FORCE_RADIUS_UI = 1.5
+"""Radius of the force arrow's shaft [UI points]."""
 
 _TIME_TOLERANCE = 1e-9  # [s] float slack when comparing sim times
 _ATTEMPT_GAP_S = 0.001  # [s] between attempts when the cell restarts its clock
@@ -125,6 +147,9 @@ class AttemptTrace:
     torque_mes: list[np.ndarray] = field(default_factory=list)
     torque_des: list[np.ndarray] = field(default_factory=list)
     arm_poses: list[np.ndarray] = field(default_factory=list)
+    search_path: np.ndarray | None = None
+    search_step: int = 0
+    """The hole-search path ``(N, 3)`` [m] and the step it was logged at (when the search ended)."""
 
     def add(
         self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
@@ -213,7 +238,7 @@ class AttemptLogger:
         self.rec = recording
         self._experiment = 0
         self._last_attempt: tuple[str, str, int, int] | None = None
-        self._styled: set[str] = set()  # entities whose static series style was sent
+        self._styled: set[str] = set()  # entities whose static style was sent
         self._current: AttemptTrace | None = None
         self._time_offset = 0.0  # [s] added to the cell's sim_time
         self._last_time = 0.0  # [s] last logged (offset) sim time
@@ -289,6 +314,12 @@ class AttemptLogger:
         ``scene/<name>``, e.g. the plate's bosses with their holes."""
         self.rec.log(f"{self.root}/scene/{name}", rr.Asset3D(path=mesh, albedo_factor=list(color)), static=True)
 
+    def log_hole_rims(self, rims: Sequence[np.ndarray]) -> None:
+        """Log the holes' rims (closed lines ``(K, 3)`` [m]) static under ``scene/hole_rims``,
+        where the tool view shows them without the plate (:data:`HOLE_RIMS`)."""
+        self.rec.log(f"{self.root}/{HOLE_RIMS}", rr.LineStrips3D(list(rims), colors=[RIM_COLOR], radii=-PATH_RADIUS_UI),
+                     static=True)
+
     # -- one attempt ---------------------------------------------------------------------
 
     def begin_attempt(
@@ -342,17 +373,15 @@ class AttemptLogger:
         self._skipped = None
 
     def log_search_path(self, points: np.ndarray) -> None:
-        """Log the hole-search path ``points`` ``(N, 3)`` [m] at the current time."""
+        """Buffer the hole-search path ``points`` ``(N, 3)`` [m] the search just ran: it is
+        sent with the steps, at the time of the last one logged so far."""
         trace = self._require_attempt("log_search_path")
-        if trace.sim_time:
-            self._set_time(trace.sim_time[-1] + self._time_offset)
-        path = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        self.rec.log(
-            f"{self.root}/search/path", rr.LineStrips3D([path], colors=[[240, 180, 0]], radii=0.0005)
-        )
+        trace.search_path = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        trace.search_step = max(len(trace.sim_time) - 1, 0)
 
     def end_attempt(self, evidence: AttemptEvidence) -> AttemptTrace:
-        """Send the buffered steps, the tool path and the outcome; returns the trace."""
+        """Send the buffered steps, the search and tool paths, Fig. 17 and the outcome;
+        returns the trace."""
         trace = self._require_attempt("end_attempt")
         trace.outcome = evidence.outcome
         if self._skipped is not None:
@@ -360,20 +389,16 @@ class AttemptLogger:
             self._skipped = None
         if trace.sim_time:
             self._send_steps(trace)
+            self._send_paths(trace)
             self._last_time = trace.sim_time[-1] + self._time_offset
             self._sent_steps = True
         self._set_time(self._last_time)
-        color = outcome_color(evidence.outcome)
         insertion = trace.insertion()
         if len(insertion):
-            log_fig17(self.rec, fig17_path(self.cell_id, f"{trace.outcome}/{trace.key}"),
-                      trace.array("phase")[insertion], trace.array("force_mes")[insertion],
-                      trace.array("force_des")[insertion])
-        if len(trace.tool_pos) >= 2:
-            self.rec.log(
-                f"{self.root}/tool/path",
-                rr.LineStrips3D([trace.array("tool_pos")], colors=[color], radii=0.0008),
-            )
+            ends = growth_ends(len(insertion))
+            send_fig17(self.rec, fig17_path(self.cell_id, f"{trace.outcome}/{trace.key}"),
+                       self._indexes(trace, insertion[ends - 1]), ends, trace.array("phase")[insertion],
+                       trace.array("force_mes")[insertion], trace.array("force_des")[insertion])
         self._log_outcome(trace, evidence)
         if self.keep_traces:
             self.traces.append(trace)
@@ -408,12 +433,41 @@ class AttemptLogger:
         self.rec.set_time("experiment", sequence=self._experiment)
         self.rec.set_time("sim_time", duration=sim_time)
 
+    def _indexes(self, trace: AttemptTrace, rows: np.ndarray | None = None) -> list[rr.TimeColumn]:
+        """The times of ``trace``'s steps ``rows`` (every step when None) on ``experiment``,
+        ``sim_time`` (the logged, increasing one) and ``log_time``."""
+        times, wall = trace.array("sim_time") + self._time_offset, trace.array("wall_time")
+        if rows is not None:
+            times, wall = times[rows], wall[rows]
+        return [rr.TimeColumn("experiment", sequence=np.full(len(times), trace.experiment)),
+                rr.TimeColumn("sim_time", duration=times), rr.TimeColumn(SESSION_TIMELINE, timestamp=wall)]
+
+    def _send_paths(self, trace: AttemptTrace) -> None:
+        """The attempt's tool path and search path, each starting empty at its first step (the
+        previous attempt's are not drawn in this one): the tool path growing
+        (:func:`growth_ends`), each row the path up to its time, grey while the attempt runs
+        and whole in the outcome's colour at its last step; the search path from the step
+        the search ended at."""
+        tip = trace.array("tool_pos")
+        ends = growth_ends(len(tip)) if len(tip) >= 2 else np.zeros(0, dtype=np.int64)
+        colors = [PATH_COLOR] * (len(ends) - 1) + [outcome_color(trace.outcome)] * min(len(ends), 1)
+        self._send_strips("tool/path", trace, [0, *(ends - 1)], [tip[:end] for end in ends], colors)
+        search = [] if trace.search_path is None else [trace.search_path]
+        self._send_strips("search/path", trace, sorted({0, trace.search_step}), search, [SEARCH_COLOR] * len(search))
+
+    def _send_strips(self, path: str, trace: AttemptTrace, rows: Sequence[int], strips: Sequence[np.ndarray],
+                     colors: Sequence[Sequence[int]]) -> None:
+        """Lines under ``path`` at the times of ``trace``'s steps ``rows``: none at the first
+        row when there are more rows than ``strips``, then one strip a row."""
+        empty = len(rows) - len(strips)
+        self.rec.send_columns(f"{self.root}/{path}", indexes=self._indexes(trace, np.array(rows, dtype=np.int64)),
+                              columns=rr.LineStrips3D.columns(strips=strips, colors=colors,
+                                                              radii=np.full(len(strips), -PATH_RADIUS_UI))
+                              .partition([0] * empty + [1] * len(strips)))
+
     def _send_steps(self, trace: AttemptTrace) -> None:
-        times = trace.array("sim_time") + self._time_offset
-        count = len(times)
-        experiment = rr.TimeColumn("experiment", sequence=np.full(count, trace.experiment))
-        timed = [experiment, rr.TimeColumn("sim_time", duration=times),
-                 rr.TimeColumn(SESSION_TIMELINE, timestamp=trace.array("wall_time"))]
+        timed = self._indexes(trace)
+        count = len(trace.sim_time)
         label = f"{trace.part}→{trace.hole} s{trace.trial_seed} a{trace.attempt} {trace.outcome}"
         for quantity, measured, desired in (
             ("force", "force_mes", "force_des"), ("torque", "torque_mes", "torque_des"),
@@ -432,15 +486,22 @@ class AttemptLogger:
         if self._arm is not None and len(trace.arm_poses) == count:
             self._arm.send(self.rec, self.root, timed, np.stack(trace.arm_poses))
         tip = trace.array("tool_pos")
-        self.rec.send_columns(
-            f"{self.root}/tool/tip", indexes=timed,
-            columns=rr.Points3D.columns(positions=tip, radii=np.full(count, TIP_RADIUS_M)).partition([1] * count),
-        )
+        self._style("tool/tip", rr.Points3D.from_fields(radii=-TIP_RADIUS_UI, colors=TIP_COLOR))
+        self.rec.send_columns(f"{self.root}/tool/tip", indexes=timed,
+                              columns=rr.Points3D.columns(positions=tip).partition([1] * count))
+        self._style("tool/force", rr.Arrows3D.from_fields(radii=-FORCE_RADIUS_UI, colors=FORCE_COLOR))
         self.rec.send_columns(
             f"{self.root}/tool/force", indexes=timed,
             columns=rr.Arrows3D.columns(origins=tip, vectors=trace.array("force_mes") * FORCE_ARROW_M_PER_N)
             .partition([1] * count),
         )
+
+    def _style(self, path: str, style: rr.AsComponents) -> None:
+        """Log ``style`` (colours, radii) on ``path`` static, once per recording."""
+        entity = f"{self.root}/{path}"
+        if entity not in self._styled:
+            self.rec.log(entity, style, static=True)
+            self._styled.add(entity)
 
     def _series(
         self, path: str, indexes: list[rr.TimeColumn], values: np.ndarray, quantity: str,
@@ -450,9 +511,7 @@ class AttemptLogger:
         entity = f"{self.root}/{path}"
         unit = "N" if quantity == "force" else "Nm"
         names = [f"{name}{suffix} [{unit}]" for name in AXIS_NAMES[quantity]]
-        if entity not in self._styled:
-            self.rec.log(entity, rr.SeriesLines(names=names, colors=colors), static=True)
-            self._styled.add(entity)
+        self._style(path, rr.SeriesLines(names=names, colors=colors))
         self.rec.send_columns(entity, indexes=indexes, columns=rr.Scalars.columns(scalars=values))
 
     def _log_outcome(self, trace: AttemptTrace, evidence: AttemptEvidence) -> None:

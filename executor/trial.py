@@ -39,7 +39,7 @@ from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
 from assembly_constraints.executor.world.geometry import load_geometry
 from assembly_constraints.executor.world.perturbation import CellBias
-from assembly_constraints.executor.world.scene import TIME_STEP, Scene, require_display, scene_shapes
+from assembly_constraints.executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes
 
 if TYPE_CHECKING:
     from assembly_constraints.executor.rerun_log import AttemptLogger
@@ -96,6 +96,7 @@ class Cell:
             logger.log_scene(scene_shapes(self.geometry))
             plate_obj = current_assets(self.geometry) / "plate.obj"
             logger.log_scene_mesh("plate_mesh", self.geometry.base_mesh or plate_obj, PLATE_MESH_COLOR)
+            logger.log_hole_rims(hole_rims(self.geometry))
             logger.log_arm_at_rest(self._arm_of(min(self.geometry.parts.items())[1].shape))
 
     def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,

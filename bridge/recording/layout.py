@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+import rerun as rr
 import rerun.blueprint as rrb
 
 from assembly_constraints.bridge.files import check_writable
@@ -63,6 +64,15 @@ CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15,
 the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
 HELD_PART = "arm/part/held"
 """Entity of the part in the hand, below a cell's root (``executor.rerun_arm``)."""
+HELD_PART_COLOR = (205, 155, 50)
+"""The held part's colour (RGB): solid in the cell's views, see-through in the tool view."""
+HELD_PART_SOLIDS = (rr.Asset3D, rr.Cylinders3D, rr.Boxes3D)
+"""The archetypes the held part may be drawn with (a mesh, a round or a square part)."""
+SEE_THROUGH_ALPHA = 80
+"""Opacity (of 255) of the held part in the tool view: the tool path inside it shows."""
+HOLE_RIMS = "scene/hole_rims"
+"""Entity of the holes' rims at the plate's top, below a cell's root: where the tool view
+shows the holes without the plate that would hide the tip in them."""
 CLOSE_UP_TARGET_M = (0.59, 0.0, 0.1)
 """Where the close-up looks before a part is taken [m]: over the plate's centre."""
 CLOSE_UP_OFFSET_M = (0.07, 0.05, 0.12)
@@ -70,6 +80,13 @@ CLOSE_UP_OFFSET_M = (0.07, 0.05, 0.12)
 so a search path on a boss top is seen from above. The viewer sets its distance when it
 starts following the held part: 1.5 times the radius of the part's bounding sphere (Rerun
 0.41's ``eye.rs``), a few centimetres for Cranfield's pegs."""
+FIG17_WIDTH = 80.0
+"""Fig. 17's plot units from phase 0 to phase 1 (``executor.rerun_plots`` draws it)."""
+FIG17_HEIGHT = 80.0
+"""Fig. 17's plot units from −|F|max to +|F|max."""
+FIG17_MARGIN = 14.0
+"""Plot units around Fig. 17's axes where its labels are: the phase below, |F|max left of the
+force axis, the colour key above (the view shows them all, whatever its size)."""
 PlayState = Literal["following", "paused"]
 OPENS: PlayState = "paused"
 """How a recording file or ``view.rbl`` opens: paused at the start of its timeline."""
@@ -236,13 +253,31 @@ def _cell_3d(root: str, name: str, eye: rrb.EyeControls3D) -> rrb.Spatial3DView:
     )
 
 
+def _tool_3d(root: str, name: str, eye: rrb.EyeControls3D) -> rrb.Spatial3DView:
+    """The tool alone under ``root`` seen through ``eye``: the tip with its trail, the force
+    arrow, the tool and search paths, the holes' rims and the held part see-through
+    (:data:`SEE_THROUGH_ALPHA`); the arm, the plate and the solid part, which hide the tip
+    inside the part and the hole, are left out."""
+    see_through = [*HELD_PART_COLOR, SEE_THROUGH_ALPHA]
+    solids = [solid.visualizer() for solid in (  # one per kind of HELD_PART_SOLIDS
+        rr.Asset3D.from_fields(albedo_factor=see_through), rr.Cylinders3D.from_fields(colors=[see_through]),
+        rr.Boxes3D.from_fields(colors=[see_through]))]
+    return rrb.Spatial3DView(
+        origin=root, name=name,
+        contents=["$origin/tool/**", "$origin/search/**", f"$origin/{HOLE_RIMS}", f"$origin/{HELD_PART}"],
+        eye_controls=eye, overrides={f"/{root}/tool/tip": _trail(), f"/{root}/{HELD_PART}": solids},
+    )
+
+
 def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
     """A cell's tab: the 3D cell (arm, scene, tool tip with its trail (:func:`_trail`) and
     force, the attempt's tool path, search path) above a close-up of the same that follows
     the held part, whose tip is the tool tip (:data:`HELD_PART`, :data:`CLOSE_UP_OFFSET_M`;
-    over the plate, :data:`CLOSE_UP_TARGET_M`, before a part is taken); the Fig. 17 plot of attempt ``fig17``
+    over the plate, :data:`CLOSE_UP_TARGET_M`, before a part is taken), beside it the tool
+    alone through the same camera (:func:`_tool_3d`); the Fig. 17 plot of attempt ``fig17``
     (``<outcome>/<key>``, :func:`fig17_path`; None: every attempt) above the outcome log;
-    force, torque and the deviations of eqs. 6 and 7 per attempt."""
+    force, torque and the deviations of eqs. 6 and 7 per attempt, their colours named in
+    the titles (a legend covers the plot's data: Rerun draws it inside, in a corner)."""
     root = cell_root(cell_id)
     attempt = fig17.replace("/", " ") if fig17 else "every attempt"
     eye = tuple(t + d for t, d in zip(CLOSE_UP_TARGET_M, CLOSE_UP_OFFSET_M))
@@ -251,17 +286,23 @@ def cell_views(cell_id: str, fig17: str | None = None) -> rrb.Container:
     return rrb.Horizontal(
         rrb.Vertical(
             _cell_3d(root, f"{cell_id}: cell", CELL_EYE),
-            _cell_3d(root, f"{cell_id}: close-up following the held part (tip trail {TRAIL_S:g} s)", close_up),
+            rrb.Horizontal(
+                _cell_3d(root, f"{cell_id}: close-up on the held part", close_up),
+                _tool_3d(root, f"{cell_id}: tool, part see-through", close_up),
+            ),
         ),
         rrb.Vertical(
             rrb.Spatial2DView(origin=f"{root}/by_phase", contents=[f"$origin/{fig17}/**" if fig17 else "$origin/**"],
-                              name=f"Fig. 17 {attempt}: F_des (pale), F_mes [N] over DMP phase 0..1"),
+                              name=f"Fig. 17 {attempt}: F_mes, F_des [N] over DMP phase",
+                              visual_bounds=rrb.VisualBounds2D(
+                                  x_range=[-1.6 * FIG17_MARGIN, FIG17_WIDTH + FIG17_MARGIN / 2],
+                                  y_range=[-FIG17_HEIGHT / 2 - FIG17_MARGIN, FIG17_HEIGHT / 2 + FIG17_MARGIN])),
             rrb.TextLogView(origin=f"{root}/outcome", name=f"{cell_id}: outcomes"),
             row_shares=[2, 1],
         ),
         rrb.Vertical(
-            _plot(f"{root}/wrench/force", "force F_mes, F_des [N]"),
-            _plot(f"{root}/wrench/torque", "torque M_mes, M_des [Nm]"),
+            _plot(f"{root}/wrench/force", "force [N]: Fx red, Fy green, Fz blue; F_des pale", legend=False),
+            _plot(f"{root}/wrench/torque", "torque [Nm]: Mx red, My green, Mz blue; M_des pale", legend=False),
             _plot(f"{root}/deviation/force", "‖F_mes − F_des‖ [N] per attempt: green fit, red no fit", legend=False),
             _plot(f"{root}/deviation/torque", "‖M_mes − M_des‖ [Nm] per attempt: green fit, red no fit",
                   legend=False),

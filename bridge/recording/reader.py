@@ -77,6 +77,7 @@ class RecordingSummary:
 _CONTROL_COLUMN_PREFIX = "rerun.controls."
 _VIEW_ORIGIN = "ViewBlueprint:space_origin"
 _TABS_KIND = 1  # ContainerBlueprint:container_kind of rrb.Tabs
+_VISUALIZER_TYPE = "VisualizerInstruction:visualizer_type"  # its overrides name their archetype anyway
 
 
 @contextmanager
@@ -188,7 +189,8 @@ class ViewSummary:
     """One view of a blueprint: its class (``Spatial3DView``, ``TimeSeriesView``, ...),
     display name, origin (without the leading ``/``), contents queries, the view's
     properties by archetype (``{"EyeControls3D": {"position": [...], ...}}``) and its
-    per-entity overrides by entity path (``{"executor/c1/tool/tip": {"VisibleTimeRanges:ranges": [...]}}``)."""
+    per-entity overrides by entity path (``{"executor/c1/tool/tip": {"VisibleTimeRanges:ranges": [...]}}``;
+    a visualizer's component overrides under their archetype's name, ``"Cylinders3D:colors"``)."""
 
     kind: str = ""
     name: str = ""
@@ -232,8 +234,10 @@ def read_blueprint(path: Path | str) -> BlueprintSummary:
                 view.name = _single(row.get("ViewBlueprint:display_name"))
                 view.origin = str(_single(row.get(_VIEW_ORIGIN)) or "").strip("/")
             elif parts[2:4] == ["ViewContents", "overrides"]:
-                entity = "/".join(parts[4:-1] if parts[-1] == "visualizers" else parts[4:])
-                view.overrides.setdefault(entity, {}).update({n: _single(v) for n, v in row.items()})
+                # .../overrides/<entity>/visualizers[/<instruction id>]: one entity's overrides
+                end = parts.index("visualizers", 4) if "visualizers" in parts[4:] else len(parts)
+                view.overrides.setdefault("/".join(parts[4:end]), {}).update(
+                    {n: _single(v) for n, v in row.items() if n != _VISUALIZER_TYPE})
             elif parts[2] == "ViewContents":
                 view.contents = list(row.get("ViewContents:query") or [])
             else:

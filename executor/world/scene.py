@@ -13,12 +13,13 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
 import pybullet as pb
 import pybullet_data
 
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.world import TIME_STEP
-from assembly_constraints.executor.world.arm import yaw_quat
+from assembly_constraints.executor.world.arm import turn_z, yaw_quat
 from assembly_constraints.executor.world.assets import current_assets
 from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files, peg_body
 
@@ -172,6 +173,23 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
         shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (a / 2, b / 2, part.length / 2),
                        (*part.start, part.length / 2), (0, 0, 0, 1), (205, 155, 50)))
     return shapes
+
+
+def hole_rims(geometry: CellGeometry, segments: int = 48) -> list[np.ndarray]:
+    """Each hole's rim at the plate's top as a closed line ``(K, 3)`` [m]: a circle of the
+    hole's diameter, or its rectangle turned by its yaw."""
+    top = geometry.plate.top_z
+    rims = []
+    for _hid, hole in sorted(geometry.holes.items()):
+        a, b = hole.sides
+        if hole.kind == "round":
+            angle = np.linspace(0.0, 2.0 * np.pi, segments + 1)
+            outline = np.column_stack([a / 2 * np.cos(angle), b / 2 * np.sin(angle), np.zeros(segments + 1)])
+        else:
+            corners = [(1, 1), (-1, 1), (-1, -1), (1, -1), (1, 1)]
+            outline = np.array([[sx * a / 2, sy * b / 2, 0.0] for sx, sy in corners])
+        rims.append(turn_z(outline, hole.yaw) + np.array([*hole.position, top]))
+    return rims
 
 
 def link_frame(client: int, body: int, link: int) -> tuple[tuple[float, ...], tuple[float, ...]]:

@@ -47,6 +47,11 @@ def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) ->
     assert column_values(rrd, "executor/c1/arm/part", "sim_time")[0] == 0
     assert column_values(rrd, "executor/c1/arm/part/held", "experiment") == [1]
     assert "TextDocument:text" in entities["/executor/c1/arm/part/held"].components  # names the part
+    # A viewer draws each archetype's latest values: the round peg's row clears a square
+    # part's box and a mesh part's mesh, which would otherwise stay drawn around it.
+    held = "executor/c1/arm/part/held"
+    assert column_values(rrd, held, "Cylinders3D:radii") == [[pytest.approx(cell.geometry.parts["p1"].size / 2)]]
+    assert column_values(rrd, held, "Boxes3D:half_sizes") == [[]] and column_values(rrd, held, "Asset3D:blob") == [[]]
     tip = np.array(column_values(rrd, "executor/c1/tool/tip", "Points3D:positions")).reshape(-1, 3)
     rest, *moving = column_values(rrd, "executor/c1/arm/part", "Transform3D:translation")
     part = np.array(moving).reshape(-1, 3)
@@ -55,3 +60,23 @@ def test_a_trial_recording_shows_the_arm_moving_with_the_tool(tmp_path: Path) ->
     assert np.linalg.norm(np.reshape(rest, 3) - part[0]) > 0.1  # upright as loaded, not yet over the hole
     assert np.max(np.linalg.norm(part - tip, axis=1)) < 1e-3
     assert np.ptp(link_7.reshape(-1, 3)[:, 2]) > 0.01  # the wrist moves during the attempt
+
+
+def test_the_hole_rims_lie_on_the_plate_around_each_hole(tmp_path: Path) -> None:
+    """The tool view shows the holes by their rims (the plate would hide the tip in them)."""
+    rrd = tmp_path / "c1.rrd"
+    logger = AttemptLogger.to_file(rrd, "c1")
+    cell = Cell(logger=logger)
+    cell.close()
+    logger.close()
+    holes = sorted(cell.geometry.holes.items())
+    (rims,) = column_values(rrd, "executor/c1/scene/hole_rims", "LineStrips3D:strips")
+    assert len(rims) == len(holes) == 5
+    for rim, (hid, hole) in zip(rims, holes):
+        points = np.array(rim)
+        assert np.allclose(points[0], points[-1]), hid  # closed
+        assert np.allclose(points[:, 2], cell.geometry.plate.top_z, atol=1e-6), hid
+        reach = np.linalg.norm(points[:, :2] - hole.position, axis=1)  # [m] from the hole's axis
+        a, b = hole.sides
+        expected = a / 2 if hole.kind == "round" else np.hypot(a, b) / 2  # the circle, or the corners
+        assert reach.max() == pytest.approx(expected, abs=1e-6), hid  # stored as float32

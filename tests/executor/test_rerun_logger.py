@@ -17,8 +17,8 @@ from assembly_constraints.bridge.recording.reader import (
     read_recording,
 )
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.rerun_log import TIP_RADIUS_M, AttemptLogger
-from assembly_constraints.executor.rerun_plots import WIDTH
+from assembly_constraints.executor.rerun_log import PATH_COLOR, TIP_RADIUS_UI, AttemptLogger
+from assembly_constraints.executor.rerun_plots import FIT_COLOR, GROWTH_ROWS, HEIGHT, WIDTH, growth_ends
 
 
 @dataclass
@@ -75,8 +75,10 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
         assert f"/executor/c1/{name}" in entities, name
     plate = entities["/executor/c1/scene/plate"]
     assert plate.static_rows == plate.rows == 1 and "Boxes3D:half_sizes" in plate.components
-    # 1000 steps at 1 kHz kept every 10 ms plus the last: 101 rows per attempt, 3 attempts.
-    assert entities["/executor/c1/tool/tip"].rows == 303
+    # 1000 steps at 1 kHz kept every 10 ms plus the last: 101 rows per attempt, 3 attempts
+    # (and the points' style, static).
+    tip = entities["/executor/c1/tool/tip"]
+    assert tip.rows - tip.static_rows == 303 and tip.static_rows == 1
     assert entities["/executor/c1/outcome"].rows == 3
     assert {"experiment", "sim_time", "log_time"} <= entities["/executor/c1/wrench/force/measured"].timelines
 
@@ -100,28 +102,36 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
     assert column_values(rrd, deviation, "SeriesLines:names") == [["p1→r1 s8 a1 fit"]]
     wall = column_values(rrd, "executor/c1/tool/tip", "log_time")
     assert all(b >= a for a, b in zip(wall, wall[1:]))
-    radii = [radius for row in column_values(rrd, "executor/c1/tool/tip", "Points3D:radii") for radius in row]
-    assert len(radii) == len(times) and radii == pytest.approx([TIP_RADIUS_M] * len(times))  # the trail's points
+    # the trail's points: a few pixels in every view (negative radii are UI points)
+    assert column_values(rrd, "executor/c1/tool/tip", "Points3D:radii") == [[-TIP_RADIUS_UI]]
 
     # Fig. 17: a 2D plot per attempt, x the DMP phase 0..1 (WIDTH units), the search left out.
     by_phase = summary.under("executor/c1/by_phase")
     assert len([p for p in by_phase if p.endswith("/measured")]) == 3
     strips = column_values(rrd, "executor/c1/by_phase/fit/e0002_p1_r1_s8_a1/measured", "LineStrips2D:strips")
-    x = [point[0] for point in strips[0][2]]  # Fz
+    x = [point[0] for point in strips[-1][2]]  # Fz, whole
     assert 0 < x[0] < 5 and x[-1] == pytest.approx(WIDTH)
     assert "/executor/c1/by_phase" in format_summary(summary)
 
     # The single trial's blueprint: one tab, paused on sim_time, the arm in the 3D views:
-    # the whole cell from a set camera, and a close-up that follows the held part.
+    # the whole cell from a set camera, a close-up that follows the held part, and the tool
+    # alone through the same camera, the held part see-through, nothing else to hide the tip.
     layout = read_blueprint(rrd)
     assert layout.time_panel == {"timeline": "sim_time", "play_state": 1} and layout.tabs == ["c1"]
-    spatial = sorted((v for v in layout.views if v.kind == "3D"), key=lambda v: "close-up" in v.name)
-    assert len(spatial) == 2
-    cell_3d, close_up = spatial
+    cell_3d, close_up, tool = (next(v for v in layout.views if v.kind == "3D" and name in v.name)
+                               for name in ("cell", "close-up", "tool"))
     assert "$origin/arm/**" in cell_3d.contents and "position" in cell_3d.properties["EyeControls3D"]
     assert "tracking_entity" not in cell_3d.properties["EyeControls3D"]
     assert close_up.contents == cell_3d.contents and set(close_up.overrides) == {"executor/c1/tool/tip"}
     assert close_up.properties["EyeControls3D"]["tracking_entity"] == "/executor/c1/arm/part/held"
+    assert tool.properties["EyeControls3D"] == close_up.properties["EyeControls3D"]
+    assert sorted(tool.contents) == ["$origin/arm/part/held", "$origin/scene/hole_rims", "$origin/search/**",
+                                     "$origin/tool/**"]
+    assert tool.overrides["executor/c1/tool/tip"] == close_up.overrides["executor/c1/tool/tip"]  # the trail
+    held = tool.overrides["executor/c1/arm/part/held"]
+    assert len(held["ActiveVisualizers:instruction_ids"]) == 3  # a mesh, a round or a square part
+    for component in ("Asset3D:albedo_factor", "Cylinders3D:colors", "Boxes3D:colors"):
+        assert 0 < held[component] & 0xFF < 255, component  # RGBA: see-through
 
 
 def test_two_cells_in_one_process_share_a_recording(tmp_path: Path) -> None:
@@ -179,3 +189,61 @@ def test_the_plan_steps_of_a_session_keep_its_experiment_timeline(tmp_path: Path
     rrd = tmp_path / "steps.rrd"
     assert column_values(rrd, "/executor/c1/assembly/steps", "plan_step") == [1, 2]
     assert column_values(rrd, "/executor/c1/assembly/steps", "experiment") == [19, 19]
+
+
+def test_the_plots_of_an_attempt_grow_with_it(tmp_path: Path) -> None:
+    """Fig. 17 and the tool path, read back at a time inside the attempt: the latest row
+    before it holds the attempt up to then, drawn to the scale of what was measured so far."""
+    rrd = tmp_path / "c1.rrd"
+    logger = AttemptLogger("c1", recording_id="grow", rrd_path=rrd, period_s=0.01)
+    _attempt(logger, "p1", "r1", 8, 1, "fit")
+    logger.close()
+    fig17 = "executor/c1/by_phase/fit/e0001_p1_r1_s8_a1"
+    times = column_values(rrd, "executor/c1/phase", "sim_time")
+    phase = [row[0] for row in column_values(rrd, "executor/c1/phase", "Scalars:scalars")]
+    insertion = [t for t, p in zip(times, phase) if p > 0]
+    rows = column_values(rrd, f"{fig17}/measured", "sim_time")
+    assert len(rows) == len(growth_ends(len(insertion))) == GROWTH_ROWS and rows == sorted(rows)
+    assert rows[-1] == insertion[-1] and rows[0] > insertion[0]  # whole at the insertion's last step
+    for name in ("desired", "axes", "ticks"):
+        assert column_values(rrd, f"{fig17}/{name}", "sim_time") == rows, name
+    inside = (insertion[0] + insertion[-1]) / 2  # [s] a viewer paused in the middle of the insertion
+    row = max(k for k, t in enumerate(rows) if t <= inside)
+    assert 0 < row < len(rows) - 1
+    fz = column_values(rrd, f"{fig17}/measured", "LineStrips2D:strips")[row][2]
+    shown = phase[times.index(rows[row])]  # the phase at the row's time
+    assert fz[-1][0] == pytest.approx(shown * WIDTH) and shown < 0.6  # up to then, not beyond
+    span = 10.0 * shown  # [N] the largest |F| measured so far: |F_mes| = 10 N × phase
+    assert fz[-1][1] == pytest.approx(HEIGHT / 2)  # Fz = −span at the bottom of the plot (2D y points down)
+    assert f"+{span:.1f} N" in column_values(rrd, f"{fig17}/ticks", "Points2D:labels")[row]
+    paths = column_values(rrd, "executor/c1/tool/path", "LineStrips3D:strips")
+    path_times = column_values(rrd, "executor/c1/tool/path", "sim_time")
+    assert paths[0] == [] and path_times[0] == times[0]  # the previous attempt's path is not drawn in this one
+    assert [len(strip[0]) for strip in paths[1:]] == list(growth_ends(len(times))) and path_times[-1] == times[-1]
+    colors = column_values(rrd, "executor/c1/tool/path", "LineStrips3D:colors")
+    grey, green = (int.from_bytes(bytes([*c, 255]), "big") for c in (PATH_COLOR, FIT_COLOR))
+    assert colors == [[]] + [[grey]] * (len(paths) - 2) + [[green]]  # the outcome's colour once it is known
+    at = max(k for k, t in enumerate(path_times) if t <= inside)
+    assert len(paths[at][0]) == times.index(path_times[at]) + 1  # the path up to that step
+
+
+def test_an_attempt_shows_its_own_search_path(tmp_path: Path) -> None:
+    """The search path appears when the search ends; before, in the same attempt, none (not
+    the previous attempt's)."""
+    rrd = tmp_path / "c1.rrd"
+    logger = AttemptLogger("c1", recording_id="search", rrd_path=rrd, period_s=0.01)
+    for attempt in (1, 2):
+        logger.begin_attempt("p1", "r1", 8, attempt)
+        for k in range(100):
+            if k == 40:  # the search ran during the first 40 steps
+                logger.log_search_path(np.array([[0.5, 0.0, 0.1], [0.501, 0.0, 0.1], [0.501, 0.001, 0.1]]) * attempt)
+            logger.log_step(0.01 * k, 0.0, np.array([0.5, 0.0, 0.1]), np.zeros(3), np.zeros(3), np.zeros(3),
+                            np.zeros(3))
+        logger.end_attempt(Evidence("no_fit"))
+    logger.close()
+    steps = column_values(rrd, "executor/c1/phase", "sim_time")
+    rows = sorted(zip(column_values(rrd, "executor/c1/search/path", "sim_time"),
+                      column_values(rrd, "executor/c1/search/path", "LineStrips3D:strips")), key=lambda row: row[0])
+    assert [(time, len(strips)) for time, strips in rows] == [
+        (steps[0], 0), (steps[39], 1), (steps[100], 0), (steps[139], 1)]  # each search ended after step 40
+    assert rows[3][1][0][1] == pytest.approx([1.002, 0.0, 0.2])  # the second attempt's own path

@@ -91,15 +91,19 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
     assert fig17[0].contents == ["$origin/fit/e0002_p2_r2_s0_a1/**"] and "e0002_p2_r2_s0_a1" in fig17[0].name
     spatial = [v for v in layout.views if v.kind == "3D"]
     assert {v.origin for v in spatial} == {"executor/c1", "executor/c2", "executor/a1/assembly", "executor/c1/assembly"}
-    assert all("$origin/arm/**" in v.contents and "EyeControls3D" in v.properties for v in spatial)
+    assert all("EyeControls3D" in v.properties for v in spatial)
+    assert all("$origin/arm/**" in v.contents for v in spatial if "tool" not in v.name)  # the tool view: no arm
+    second = round(TRAIL_S * 1e9)
     for cell in ("c1", "c2"):  # the tool tip's trail: the last TRAIL_S up to the cursor, the whole experiment
-        cell_view = next(v for v in spatial if v.origin == f"executor/{cell}")
-        ranges = {r["timeline"]: r["range"] for r in cell_view.overrides[f"executor/{cell}/tool/tip"][
-            "VisibleTimeRanges:ranges"]}
-        second = round(TRAIL_S * 1e9)
-        assert ranges == {"sim_time": {"start": -second, "end": 0}, "log_time": {"start": -second, "end": 0},
-                          "experiment": {"start": 0, "end": 0}}
-        assert set(cell_view.overrides) == {f"executor/{cell}/tool/tip"}
+        cell_views = [v for v in spatial if v.origin == f"executor/{cell}"]
+        assert len(cell_views) == 3  # the cell, its close-up, the tool path
+        for view in cell_views:
+            ranges = {r["timeline"]: r["range"] for r in view.overrides[f"executor/{cell}/tool/tip"][
+                "VisibleTimeRanges:ranges"]}
+            assert ranges == {"sim_time": {"start": -second, "end": 0}, "log_time": {"start": -second, "end": 0},
+                              "experiment": {"start": 0, "end": 0}}, view.name
+            see_through = {f"executor/{cell}/arm/part/held"} if "tool" in view.name else set()
+            assert set(view.overrides) == {f"executor/{cell}/tool/tip"} | see_through, view.name
     assert {"planner/knowledge", "planner/knowledge_table", "planner/precedence"} <= blueprint_origins(
         tmp_path / "view.rbl")
 
