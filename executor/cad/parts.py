@@ -134,25 +134,33 @@ def triangles_in(path: Path) -> int:
     """The triangles of a mesh file, counted without building the mesh: a binary STL's
     count (its header's, when the file's size matches it), an ASCII STL's ``endfacet``
     records, an OBJ's faces (a face of n corners is n - 2 triangles)."""
+    binary = _binary_stl(path)
+    if binary is not None:
+        return binary
     with path.open("rb") as file:
-        head = file.read(_STL_HEADER)
         if path.suffix.lower() == ".stl":
-            count = int.from_bytes(head[80:], "little")
-            if len(head) == _STL_HEADER and path.stat().st_size == _STL_HEADER + _STL_TRIANGLE * count:
-                return count
-            return _occurrences(head, file, b"endfacet")
-        file.seek(0)
+            return _occurrences(file, b"endfacet")
         return sum(max(len(line.split()) - 3, 0) for line in file if line[:2] in (b"f ", b"f\t"))
 
 
-def _occurrences(head: bytes, file: BinaryIO, word: bytes) -> int:
-    """How often ``word`` occurs in ``head`` followed by the rest of ``file`` (read in blocks)."""
-    count, carry, block = 0, b"", head
-    while block:
+def _binary_stl(path: Path) -> int | None:
+    """The triangles a binary STL's header states, None when ``path`` is no STL or its
+    size does not match that count (an ASCII STL, whose first line may look alike)."""
+    if path.suffix.lower() != ".stl":
+        return None
+    with path.open("rb") as file:
+        head = file.read(_STL_HEADER)
+    count = int.from_bytes(head[80:], "little")
+    return count if len(head) == _STL_HEADER and path.stat().st_size == _STL_HEADER + _STL_TRIANGLE * count else None
+
+
+def _occurrences(file: BinaryIO, word: bytes) -> int:
+    """How often ``word`` occurs in the rest of ``file`` (read in blocks)."""
+    count, carry = 0, b""
+    while block := file.read(1 << 20):
         text = carry + block
         count += text.count(word)
         carry = text[-(len(word) - 1):]  # too short to hold a whole word: none is counted twice
-        block = file.read(1 << 20)
     return count
 
 
@@ -160,9 +168,8 @@ def _non_finite(path: Path, mesh: trimesh.Trimesh) -> str:
     """Where ``path`` first states a coordinate that is not finite: ``file:line`` of a
     text file's vertex, else the binary STL's triangle (``mesh`` read unprocessed)."""
     keyword = b"v" if path.suffix.lower() == ".obj" else b"vertex"
-    with path.open("rb") as file:
-        if path.suffix.lower() == ".obj" or file.read(5).lower() == b"solid":
-            file.seek(0)
+    if _binary_stl(path) is None:
+        with path.open("rb") as file:
             for number, line in enumerate(file, 1):
                 words = line.split()
                 if words[:1] == [keyword] and not all(math.isfinite(_number(w)) for w in words[1:4]):
@@ -216,12 +223,15 @@ def _make_solid(part: CadPart, units: str) -> None:
                             f"edges, {int(np.sum(uses > 2))} edges of more than two faces; one from "
                             f"({', '.join(f'{v:.6g}' for v in start)}) to ({', '.join(f'{v:.6g}' for v in end)}) "
                             f"{units}; expected a closed manifold solid)")
-    if not mesh.is_winding_consistent:
-        if mesh.body_count > 1:
-            raise ExecutorError(f"{part.source}: part '{part.id}' is a closed mesh of {mesh.body_count} shells whose "
-                                "triangles are wound inconsistently (expected each edge run in opposite directions by "
-                                "its two triangles: which shells are cavities is not known)")
+    if not mesh.is_winding_consistent and mesh.body_count == 1:
         trimesh.repair.fix_winding(mesh)
+    if not mesh.is_winding_consistent:
+        why = ("which shells are cavities is not known" if mesh.body_count > 1 else
+               "no winding makes it so: a surface with one side")
+        raise ExecutorError(f"{part.source}: part '{part.id}' is a closed mesh of {mesh.body_count} "
+                            f"shell{'s' if mesh.body_count > 1 else ''} whose "
+                            "triangles are wound inconsistently (expected each edge run in opposite directions by its "
+                            f"two triangles; {why})")
     if mesh.volume < 0:
         mesh.invert()
     if not mesh.is_volume:

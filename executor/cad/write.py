@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -69,6 +70,8 @@ MANIFEST = ".import-manifest.json"
 "title": the product's name, "files": {path relative to the folder: SHA-256 of its content}}``."""
 PRODUCT_FILES = ("assembly.toml", "sizes.lp", "nominal_sizes.lp", "geometric_precedence.lp", "geometry.toml")
 """The product's files an import writes (``geometry.toml`` only where the cell builds the product)."""
+_MESH_NAME = re.compile(rf"{MESH_FOLDER}/[a-z][a-z0-9_]*(\.convex)?\.obj")
+"""The name of a mesh file an import writes, relative to the folder (a part id is an ASP constant)."""
 CELL_DEFLECTION = 1e-5
 """The largest distance [m] of a STEP base's faces from the triangles the cell collides
 with (its own mesh is measured at :data:`assembly_constraints.executor.cad.parts.STEP_DEFLECTION`)."""
@@ -400,9 +403,10 @@ def _manifest(out: Path) -> dict[str, str]:
         files = json.loads(read_text(path, "import manifest (JSON)", error=ExecutorError)).get("files")
     except (ValueError, AttributeError):  # not JSON, or not an object
         files = None
-    if not isinstance(files, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in files.items()):
-        raise ExecutorError(f"{path}: not an import manifest (expected JSON with \"files\": {{path: sha256}}); "
-                            "--replace replaces it")
+    if not isinstance(files, dict) or not all(isinstance(name, str) and (name in PRODUCT_FILES or _MESH_NAME.fullmatch(
+            name)) and isinstance(digest, str) for name, digest in files.items()):
+        raise ExecutorError(f"{path}: not an import manifest (expected JSON with \"files\": {{path: sha256}} of the "
+                            "files import writes); --replace replaces it")
     return files
 
 

@@ -10,6 +10,8 @@ a product or a file it did not write unless given ``--replace``.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import subprocess
 import sys
 from collections.abc import Callable
@@ -261,3 +263,17 @@ def test_a_corrupted_step_record_is_refused_naming_it(step_file: Path, tmp_path:
             assert (code, out) == (2, ""), err
             assert err.startswith(f"error: {bad.name}:{line}: record #") and err.count("\n") == 1, err
             assert not (tmp_path / "out").exists()
+
+
+def test_a_manifest_listing_other_files_is_refused(tmp_path: Path) -> None:
+    _box((10, 10, 40), (0, 0, 10)).export(_plate(tmp_path / "cad") and tmp_path / "cad" / "peg.stl")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(out)]) == 0
+    victim = tmp_path / "victim.txt"
+    victim.write_text("not the import's\n")
+    manifest = json.loads((out / ".import-manifest.json").read_text())
+    manifest["files"]["../victim.txt"] = hashlib.sha256(victim.read_bytes()).hexdigest()
+    (out / ".import-manifest.json").write_text(json.dumps(manifest))
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(out)]) == 2
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(out), "--replace"]) == 0
+    assert victim.read_text() == "not the import's\n"
