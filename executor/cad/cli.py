@@ -13,7 +13,10 @@ It prints what it assumes, each part's insertion axis and free directions, each 
 with both cross-sections and the clearance, the disassembly stages, the geometric
 precedence with each pair's reason (``--locating-reach R``: the locating rule's reach [m],
 :mod:`assembly_constraints.executor.cad.locating`; 0: off) and the collision queries; bad
-CAD or a bad file: one line, exit code 2.
+CAD or a bad file: one line, exit code 2. ``--max-triangles N`` bounds the parts'
+triangles together; the folder's ``.import-manifest.json`` lists the files an import
+wrote, the only ones a later import replaces or removes (``--replace``: also a product it
+did not write, :func:`assembly_constraints.executor.cad.write.claim_folder`).
 """
 
 from __future__ import annotations
