@@ -128,17 +128,18 @@ def _failure(path: Path, reader: Any) -> str | None:
 
 
 def _record(path: Path, model: Any, number: int) -> str:
-    """``file:line: record #N KEYWORD`` of the model's entity ``number``: the record that
-    the reader maps to it among those starting a line of the file (``file: entity N`` if
-    none does)."""
+    """``file:line: record #N KEYWORD`` of the model's entity ``number``: the record at
+    that position among those starting a line of the file (the model numbers them in
+    the file's order), checked with the reader's own map of labels (``file: entity N``
+    when they disagree, e.g. records sharing a line)."""
     starts = []
     with path.open("rb") as file:
         for line, text in enumerate(file, 1):
             found = re.match(rb"\s*#(\d+)\s*=\s*\(?\s*([A-Za-z0-9_]*)", text)  # a complex record: its first type
             if found:
                 starts.append((line, found.group(1).decode(), found.group(2).decode()))
-    ordered = starts[number - 1: number] if number <= len(starts) else []  # records are numbered in file order
-    for line, ident, keyword in ordered + starts:
+    if number <= len(starts):
+        line, ident, keyword = starts[number - 1]
         if model.NextNumberForLabel(f"#{ident}", 0, True) == number:
             return f"{path}:{line}: record #{ident} {keyword}".rstrip()
     return f"{path}: entity {number}"
