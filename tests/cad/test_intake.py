@@ -44,6 +44,12 @@ def _plate(folder: Path) -> trimesh.Trimesh:
     return _box((10, 10, 40), (0, 0, 10))
 
 
+def _product(folder: Path, peg: trimesh.Trimesh | None = None, name: str = "peg.stl") -> None:
+    """``folder``: the plate (:func:`_plate`) and ``peg`` (default the square one) as ``name``."""
+    square = _plate(folder)
+    (square if peg is None else peg).export(folder / name)
+
+
 def _tapered_peg() -> trimesh.Trimesh:
     """A 10 mm square peg whose top 10 mm narrow to 6 mm: convex, no prism (its own mesh) [mm]."""
     corners = [(x * s, y * s, z) for s, z in ((5, -10), (5, 20), (3, 30)) for x, y in ((-1, -1), (1, -1), (1, 1),
@@ -129,7 +135,7 @@ def _two_shells_wound_inconsistently(tmp: Path) -> None:
 
 
 def _foreign_product(tmp: Path) -> None:
-    _box((10, 10, 40), (0, 0, 10)).export(_plate(tmp / "cad") and tmp / "cad" / "peg.stl")
+    _product(tmp / "cad")
     (tmp / "out").mkdir()
     (tmp / "out" / "assembly.toml").write_text('name = "mine"\n')
 
@@ -187,8 +193,8 @@ def test_the_crack_is_located_in_the_files_units(tmp_path: Path, capsys: pytest.
 
 
 def test_import_keeps_the_users_files_and_removes_only_its_own(tmp_path: Path) -> None:
-    _tapered_peg().export(_plate(tmp_path / "tapered") and tmp_path / "tapered" / "peg.stl")
-    _box((10, 10, 40), (0, 0, 10)).export(_plate(tmp_path / "square") and tmp_path / "square" / "peg.stl")
+    _product(tmp_path / "tapered", _tapered_peg())
+    _product(tmp_path / "square")
     out = tmp_path / "out"
     (out / "meshes").mkdir(parents=True)
     mine = {out / "meshes" / "fixture.obj": b"# the user's own mesh\n", out / "notes.txt": b"mine\n"}
@@ -210,7 +216,7 @@ def test_import_keeps_the_users_files_and_removes_only_its_own(tmp_path: Path) -
 
 def test_a_source_mesh_in_the_out_folder_is_never_overwritten(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    _tapered_peg().export(_plate(out / "meshes") and out / "meshes" / "peg.obj")
+    _product(out / "meshes", _tapered_peg(), "peg.obj")
     before = (out / "meshes" / "peg.obj").read_bytes()
     assert main(["-q", "import", str(out / "meshes"), "--out", str(out)]) == 2
     assert (out / "meshes" / "peg.obj").read_bytes() == before
@@ -266,7 +272,7 @@ def test_a_corrupted_step_record_is_refused_naming_it(step_file: Path, tmp_path:
 
 
 def test_a_manifest_listing_other_files_is_refused(tmp_path: Path) -> None:
-    _box((10, 10, 40), (0, 0, 10)).export(_plate(tmp_path / "cad") and tmp_path / "cad" / "peg.stl")
+    _product(tmp_path / "cad")
     out = tmp_path / "out"
     assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(out)]) == 0
     victim = tmp_path / "victim.txt"
