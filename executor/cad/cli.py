@@ -226,7 +226,7 @@ def main(argv: list[str]) -> int:
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
     parser.add_argument("--max-triangles", type=int_in(1), default=MAX_TRIANGLES, metavar="N",
-                        help=f"the most triangles the parts may have together (default {MAX_TRIANGLES}: about 1.5 kB "
+                        help=f"the most triangles the parts may have together (default {MAX_TRIANGLES}: about 1.9 kB "
                              "of memory each)")
     parser.add_argument("--replace", action="store_true",
                         help=f"replace the product in DIR even where import did not write it (DIR/{MANIFEST} lists "

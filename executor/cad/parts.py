@@ -51,8 +51,8 @@ STEP_DEFLECTION = 1e-6
 """Tessellation of STEP faces: largest distance of a triangle from its surface [m]."""
 MAX_TRIANGLES = 1_000_000
 """The most triangles of a product's parts together (``import --max-triangles`` sets
-another bound): the import holds about 1.5 kB per triangle (290k triangles: 0.53 GB peak),
-so 1 million stay under 2 GB."""
+another bound): the import's peak memory grows by about 1.9 kB per triangle (a plate and
+a peg of 290k triangles: 0.53 GB, of 416k: 0.76 GB), so 1 million stay near 1.9 GB."""
 _STL_HEADER = 84
 """A binary STL's bytes before its triangles (an 80-byte header, then the count, uint32)."""
 _STL_TRIANGLE = 50
@@ -126,7 +126,7 @@ def count_triangles(source: str, count: int, total: int, bound: int) -> int:
     if total + count > bound:
         before = f" (with the {total} before it, {total + count})" if total else ""
         raise ExecutorError(f"{source}: {count} triangles{before}, beyond the bound of {bound} for a product "
-                            "(the import holds about 1.5 kB per triangle; --max-triangles N raises it)")
+                            "(the import needs about 1.9 kB of memory per triangle; --max-triangles N raises it)")
     return total + count
 
 
