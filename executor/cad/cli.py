@@ -243,8 +243,9 @@ def main(argv: list[str]) -> int:
         print(line)
     meshes = sorted(p.name.removesuffix(".obj") for p in done.written
                     if p.parent.name == MESH_FOLDER and not p.name.endswith(".convex.obj"))
-    print(f"wrote {args.out}: assembly.toml, sizes.lp, geometric_precedence.lp"
+    print(f"wrote {args.out}: assembly.toml, sizes.lp, nominal_sizes.lp, geometric_precedence.lp"
           + (", geometry.toml" if why is None else f" (no geometry.toml: {why})")
-          + (f"; simulated from their own meshes ({MESH_FOLDER}/): {', '.join(meshes)}" if meshes else ""))
+          + (f"; simulated from their own meshes ({MESH_FOLDER}/): {', '.join(meshes)}" if meshes else "")
+          + f"; the files it wrote listed in {MANIFEST}")
     print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {done.seconds:.2f} s")
     return 0
