@@ -54,15 +54,18 @@ class ArgumentParser(argparse.ArgumentParser):
 
 
 _ROLE = re.compile(r":(?:mod|class|func|meth|data|attr|exc):`~?([^`]+)`")
+_STRONG = re.compile(r"\*\*([^*]+)\*\*")
 
 
 def plain_text(text: str) -> str:
-    """A docstring as a help page shows it: reStructuredText literals (double backquotes)
-    and roles (``:mod:`x` ``) as plain text, the repository's ``./run.sh`` as the program."""
-    return _ROLE.sub(r"\1", text).replace("``", "").replace("./run.sh", PROGRAM)
+    """A docstring as a help page shows it: reStructuredText literals (double backquotes),
+    roles (``:mod:`x` ``) and strong emphasis (``**x**``) as plain text, the repository's
+    ``./run.sh`` as the program."""
+    return _STRONG.sub(r"\1", _ROLE.sub(r"\1", text)).replace("``", "").replace("./run.sh", PROGRAM)
 
 
-ASSEMBLY_HELP = "a shipped assembly's name (cranfield, battery, spare, graded) or a folder holding assembly.toml"
+ASSEMBLY_HELP = ("a shipped assembly's name (cranfield, battery, spare, graded, taskboard) or a folder holding "
+                 "assembly.toml")
 """The one meaning of ``--assembly`` on every help page."""
 
 
