@@ -16,7 +16,8 @@ TOP_FILES = ("run.sh", "setup.py", "pyproject.toml", "constraints.txt", "CHANGEL
 
 # A repository path in prose or code spans: a top-level folder and what follows it, not part of
 # a longer path or an entity path (``/executor/c1/...``), nor a placeholder (``data/<name>``).
-REPO_PATH = re.compile(r"(?<![\w/.$<{-])(?<!\]\()((?:%s)/[\w./-]*)" % "|".join(TOP_FOLDERS))
+FOLDERS = "|".join(TOP_FOLDERS)
+REPO_PATH = re.compile(rf"(?<![\w/.$<{{-])(?<!\]\()((?:{FOLDERS})/[\w./-]*)")
 WRITTEN_BY_EXAMPLES = {"data/myproduct"}  # ``import --out data/myproduct``: the docs' examples create it
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 HEADING = re.compile(r"^(#+)\s+(.*?)\s*$", re.MULTILINE)
