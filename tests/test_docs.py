@@ -1,5 +1,5 @@
-"""The reference docs against the checkout: every repository path and every relative link
-they name exists (a link's ``#anchor`` too), and they describe the present, not how it came
+"""The reference docs against the checkout: every repository path they (and the data
+files' comments) name and every relative link exists (a link's ``#anchor`` too), and they describe the present, not how it came
 about (no dated history, no process words; history is ``CHANGELOG.md``'s)."""
 
 from __future__ import annotations
@@ -31,6 +31,13 @@ def pages() -> list[Path]:
     return sorted([ROOT / "README.md", ROOT / "CHANGELOG.md", *ROOT.glob("docs/**/*.md"), *ROOT.glob("data/*/*.md")])
 
 
+def described_files() -> list[Path]:
+    """The pages and the data files whose comments name repository paths (``geometry.toml``
+    names the code that reads it)."""
+    data = [f for suffix in ("toml", "lp", "txt") for f in ROOT.glob(f"data/*/*.{suffix}")]
+    return sorted([*pages(), *data])
+
+
 def anchor(heading: str) -> str:
     """GitHub's anchor of a heading: lower case, punctuation dropped, spaces as hyphens."""
     text = re.sub(r"[`*_]", "", heading).strip().lower()
@@ -52,7 +59,7 @@ def test_the_path_pattern_finds_paths_and_skips_entity_paths_and_placeholders() 
     assert named_paths(text) == {"executor/cad/", "docs/results.md", "data/"}
 
 
-@pytest.mark.parametrize("page", pages(), ids=lambda p: str(p.relative_to(ROOT)))
+@pytest.mark.parametrize("page", described_files(), ids=lambda p: str(p.relative_to(ROOT)))
 def test_every_repository_path_a_page_names_exists(page: Path) -> None:
     text = page.read_text(encoding="utf-8")
     missing = sorted(p for p in named_paths(text) if not (ROOT / p).exists()
