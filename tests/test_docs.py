@@ -1,6 +1,7 @@
 """The reference docs against the checkout: every repository path they (and the data
-files' comments) name and every relative link exists (a link's ``#anchor`` too), and they describe the present, not how it came
-about (no dated history, no process words; history is ``CHANGELOG.md``'s)."""
+files' comments) name and every relative link exists (a link's ``#anchor`` too), and they
+describe the present, not how it came about (no dated history, no process words; history
+is ``CHANGELOG.md``'s)."""
 
 from __future__ import annotations
 
