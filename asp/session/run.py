@@ -300,8 +300,6 @@ def run_session(settings: SessionSettings, viewer: Viewer = NO_VIEWER) -> dict:
     settings = checked(settings)
     run, record, lock, created = _run_folder(settings)
     try:
-        if settings.resume is not None:
-            settings = _resumed(settings, record, run)
         return _run_locked(settings, run, record, started, viewer)
     except BaseException:
         if created and not _holds_session(run):  # failed at start: no half-made run folder
@@ -311,19 +309,19 @@ def run_session(settings: SessionSettings, viewer: Viewer = NO_VIEWER) -> dict:
         lock.release()
 
 
-def _resumed(settings: SessionSettings, record: SessionFile, run: Path) -> SessionSettings:
+def _resumed(settings: SessionSettings, record: SessionFile, run: Path) -> tuple[SessionSettings, list[str]]:
     """The settings a resume of ``run`` runs with: what its ``session.json`` (``record``)
-    keeps wins over ``settings`` (:func:`resumed_settings`); warns about the options it
-    ignores, and about a folder that kept no backend (written before it was kept)."""
+    keeps wins over ``settings`` (:func:`resumed_settings`); and the warnings to give once
+    the resume is checked: the options it ignores, a folder that kept no backend (written
+    before it was kept)."""
     unrecorded = record.backend is None
     settings, ignored = resumed_settings(settings, record)
-    if unrecorded:
-        LOG.warning("resume: %s keeps no backend, delay or product digest (written by an older version): resuming "
-                    "with --backend %s --delay %g and the product as it is now", run / SESSION_FILE,
-                    settings.backend, settings.delay_s)
+    warnings = [f"resume: {run / SESSION_FILE} keeps no backend, delay or product digest (written by an older "
+                f"version): resuming with --backend {settings.backend} --delay {settings.delay_s:g} and the "
+                "product as it is now"] if unrecorded else []
     if ignored:
-        LOG.warning("resume: ignoring %s (a resume keeps the settings of %s)", ", ".join(ignored), run / SESSION_FILE)
-    return settings
+        warnings.append(f"resume: ignoring {', '.join(ignored)} (a resume keeps the settings of {run / SESSION_FILE})")
+    return settings, warnings
 
 
 def _check_product(settings: SessionSettings, record: SessionFile, assembly: Assembly, run: Path) -> None:
@@ -371,8 +369,9 @@ def session_cell(settings: SessionSettings, record: SessionFile, run: Path, numb
 def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, started: float,
                 viewer: Viewer) -> dict:
     """:func:`run_session` in the locked run folder ``run`` whose ``session.json`` is
-    ``record`` (what is learned comes from there); ``started``: its
-    ``time.perf_counter()`` [s] at the start."""
+    ``record`` (what is learned comes from there, and the cells' backend on a resume);
+    ``started``: its ``time.perf_counter()`` [s] at the start."""
+    settings, warnings = _resumed(settings, record, run) if settings.resume is not None else (settings, [])
     assembly = load_assembly(record.assembly)
     _check_product(settings, record, assembly, run)
     parts, holes, truth, model = _sizes_domain(assembly, record.model)
@@ -400,6 +399,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     except PlannerError:
         journal.close()
         raise
+    for warning in warnings:
+        LOG.warning("%s", warning)
     if settings.resume is not None:
         LOG.info("%s", _resume_line(settings, record, run, journal))
     write_session_file(run, record)
