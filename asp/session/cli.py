@@ -116,6 +116,16 @@ def _assembly_line(report: dict) -> str:
             f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
 
 
+def _versus_line(truth: dict[str, bool | int | None], matches: bool | None) -> str:
+    """The summary's comparison with the product's truths, saying which cannot be made."""
+    sizes = "unknown (no sizes.lp)" if truth["sizes_equal"] is None else truth["sizes_equal"]
+    precedence = ("unknown (no precedence.lp)" if truth["precedence_sound"] is None
+                  else f"{truth['precedence_sound']} ({truth['precedence_extra']} pairs more than required)")
+    verdict = "unknown" if matches is None else matches
+    return (f"versus the truth: sizes equal {sizes}, every true precedence learned {precedence}; "
+            f"matches truth: {verdict}")
+
+
 def _summary(result: dict, run: Path) -> str:
     """The human ending of a session: what was learned, the files written, what to run next."""
     settings = read_session_file(run)
@@ -142,10 +152,7 @@ def _summary(result: dict, run: Path) -> str:
         f"must precede: {len(result['must_precede'])} pairs",
         "assignment: " + (" ".join(f"{p}->{h}" for p, h in settings.assignment.items()) or "none"),
         plan,
-        f"versus the truth: sizes equal {settings.truth['sizes_equal']}, every true "
-        f"precedence learned {settings.truth['precedence_sound']} "
-        f"({settings.truth['precedence_extra']} pairs more than required); "
-        f"matches truth: {result['matches_truth']}",
+        _versus_line(settings.truth, result["matches_truth"]),
         *([_assembly_line(result["assembly"])] if "assembly" in result else []),
         f"files written in {run}: {' '.join(files)}",
         "next:",
