@@ -15,7 +15,8 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
 - ``sizes.lp`` (optional): which part fits which hole (``part/1``, ``hole/1``,
   ``fits/2``; closed world);
 - ``demos.txt`` (optional): demonstrated feasible sequences;
-- ``geometry.toml`` (optional): dimensions for the simulated cell.
+- ``geometry.toml`` (optional): the cell's dimensions and cross-sections (the simulated
+  and the ``truth`` cells need it; the planner alone does not).
 
 ``assembly.toml`` and ``geometry.toml`` are decoded and checked as a whole by
 :mod:`assembly_constraints.bridge.product`; :func:`load_assembly` gives the planner's view of the result.

@@ -65,6 +65,7 @@ from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_a
 from assembly_constraints.bridge.inputs import read_bytes
 from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from assembly_constraints.bridge.messages import (
+    MAX_ERROR_CHARS,
     MAX_MESSAGE_BYTES,
     ErrorCode,
     ErrorReply,
@@ -299,7 +300,7 @@ class CellNode:
     def _refuse(self, query: zenoh.Query, code: ErrorCode, text: str,
                 request_id: str | None = None) -> None:
         print(f"refused {code}: {text}", flush=True)
-        reply = ErrorReply(cell=self.cell_id, code=code, error=text[:2000], id=request_id)
+        reply = ErrorReply(cell=self.cell_id, code=code, error=text[:MAX_ERROR_CHARS], id=request_id)
         query.reply(query.key_expr, encode(reply))
 
     def on_query(self, query: zenoh.Query) -> None:

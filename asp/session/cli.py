@@ -116,6 +116,16 @@ def _assembly_line(report: dict) -> str:
             f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
 
 
+def _versus_line(truth: dict[str, bool | int | None], matches: bool | None) -> str:
+    """The summary's comparison with the product's truths, saying which cannot be made."""
+    sizes = "unknown (no sizes.lp)" if truth["sizes_equal"] is None else truth["sizes_equal"]
+    precedence = ("unknown (no precedence.lp)" if truth["precedence_sound"] is None
+                  else f"{truth['precedence_sound']} ({truth['precedence_extra']} pairs more than required)")
+    verdict = "unknown" if matches is None else matches
+    return (f"versus the truth: sizes equal {sizes}, every true precedence learned {precedence}; "
+            f"matches truth: {verdict}")
+
+
 def _summary(result: dict, run: Path) -> str:
     """The human ending of a session: what was learned, the files written, what to run next."""
     settings = read_session_file(run)
@@ -123,7 +133,9 @@ def _summary(result: dict, run: Path) -> str:
     cells: dict[str, int] = {}
     for entry in settings.journal:
         cells[entry["cell"]] = cells.get(entry["cell"], 0) + 1
-    plan = " ".join(f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+    plan = (f"plan 1 of {len(result['plans'])}: " + " ".join(
+        f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+        if result["plans"] else f"no plan: {result['error']}")
     files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
     python = shlex.quote(sys.executable)
     learned = shlex.quote(str(run / "learned.lp"))
@@ -138,19 +150,17 @@ def _summary(result: dict, run: Path) -> str:
         *([] if settings.prior is UNSET or settings.prior is None else [f"assumes: {prior_statement(settings.prior)}"]),
         *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
-        "assignment: " + " ".join(f"{p}->{h}" for p, h in settings.assignment.items()),
-        f"plan 1 of {len(result['plans'])}: {plan}",
-        f"versus the truth: sizes equal {settings.truth['sizes_equal']}, every true "
-        f"precedence learned {settings.truth['precedence_sound']} "
-        f"({settings.truth['precedence_extra']} pairs more than required); "
-        f"matches truth: {result['matches_truth']}",
+        "assignment: " + (" ".join(f"{p}->{h}" for p, h in settings.assignment.items()) or "none"),
+        plan,
+        _versus_line(settings.truth, result["matches_truth"]),
         *([_assembly_line(result["assembly"])] if "assembly" in result else []),
         f"files written in {run}: {' '.join(files)}",
         "next:",
-        *(f"  {label + ':':<24}{command}" for label, command in (
+        *(f"  {(label + ':').ljust(23)} {command}" for label, command in (
             ("view the recording", f"{_program()} view {shlex.quote(str(run))}"),
             (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
-            ("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5"),
+            *([("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5")]
+              if result["plans"] else []),
         )),
     ])
 
@@ -162,7 +172,7 @@ def main(argv: list[str]) -> int:
         result = run_session(session_settings(args), live)
         print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
         keep_serving(viewer)
-    stopped = result.get("assembly", {}).get("error")
+    stopped = result.get("error") or result.get("assembly", {}).get("error")
     if stopped:
         LOG.error("%s", stopped)
         return EXIT_UNSOLVABLE

@@ -17,7 +17,9 @@ from typing import Annotated, Literal
 import msgspec
 from msgspec import Meta
 
-ID_PATTERN = r"^(?!not$)[a-z][a-zA-Z0-9_]{0,63}$(?!\n)"
+MAX_ID_CHARS = 64
+"""The longest part or hole id [characters]."""
+ID_PATTERN = rf"^(?!not$)[a-z][a-zA-Z0-9_]{{0,{MAX_ID_CHARS - 1}}}$(?!\n)"
 """A part or hole id: an ASP constant of at most 64 ASCII characters, a lower-case letter
 first, not the keyword ``not`` (clingo's only lower-case keyword). ``(?!\n)`` keeps a
 trailing newline out (Python's ``$`` would match before it); the pattern means the same
