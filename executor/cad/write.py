@@ -98,7 +98,7 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
                   f'role = "{role}"']
         x, y = settings.trays[pid]
         lines.append(f"start = [{_q(x)}, {_q(y)}]")
-        if _section_kind(pegs.get(pid)) not in (None, "other"):
+        if _section_kind(pegs.get(pid)) not in (None, "polygon"):
             lines.append(f'shape = "{_section_kind(pegs.get(pid))}"')
         lines.append("")
     for hid, fit in derived.holes.items():
@@ -114,13 +114,13 @@ def _section_kind(fit: HoleFit | None) -> str | None:
 
 def _kind(kind: str) -> str:
     """An ``other`` hole is stated as round in assembly.toml (its shape is only a label there)."""
-    return kind if kind != "other" else "round"
+    return kind if kind != "polygon" else "round"
 
 
 def sizes_text(derived: Derived) -> str:
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
-            if fit.section is not None and fit.section.kind != "other"}
-    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+            if fit.section is not None and fit.section.kind != "polygon"}
+    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "polygon"}
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in pegs]),
              _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in holes])]
@@ -135,10 +135,10 @@ def sizes_text(derived: Derived) -> str:
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
     (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not
-    pass), sections ``other`` left out."""
+    pass), sections ``polygon`` left out."""
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
-            if fit.section is not None and fit.section.kind != "other"}
-    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+            if fit.section is not None and fit.section.kind != "polygon"}
+    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "polygon"}
     return {pid: {hid: margin(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))
                   for hid, hole in holes.items()} for pid, peg in pegs.items()}
 
@@ -203,7 +203,7 @@ def simulable(derived: Derived) -> str | None:
             return f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"
     fits = list(derived.holes.values())
     for fit in fits:
-        if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
+        if fit.axis != "+z" or "polygon" in (fit.hole.kind, _section_kind(fit)):
             return f"hole {fit.id} is not entered from above with a round, square or rect section"
     if not fits or not derived.hole_of:
         return "no part stands in a hole of the base"
