@@ -62,13 +62,6 @@ class HoleFit:
         """The hole's centre in the cell's x, y [m]."""
         return self.centre[0], self.centre[1]
 
-    @property
-    def clearance(self) -> tuple[float, float]:
-        """Hole minus part along a and b [m] (round: the diameters); zeros without a part."""
-        if self.section is None:
-            return 0.0, 0.0
-        return self.hole.a - self.section.a, self.hole.b - self.section.b
-
 
 @dataclass
 class Derived:

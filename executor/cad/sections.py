@@ -33,8 +33,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import trimesh
 import shapely
+import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
 
@@ -77,20 +77,21 @@ class Loop:
         return bool(PolygonPath(self.points).contains_point((float(point[0]), float(point[1]))))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Shape2D:
     """A classified loop: ``kind`` (round, square, rect, polygon), ``a`` ≥ ``b`` [m] (a
     round section: its diameter twice; a polygon: its minimum-area rectangle's sides),
-    ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]), ``centre`` (2,) [m] in the
-    slice's frame, ``outline`` (n, 2) [m] the loop's points about the centre, ``corner``
-    [m] the corner radius a rect's missing area gives (0: sharp)."""
+    ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]; a polygon: 0, its outline
+    holds its turn), ``centre`` (2,) [m] in the slice's frame, ``outline`` (n, 2) [m] the
+    loop's points about the centre, ``corner`` [m] the corner radius a rect's missing
+    area gives (0: sharp)."""
 
     kind: str
     a: float
     b: float
     yaw: float
     centre: np.ndarray
-    outline: np.ndarray = field(compare=False, repr=False, kw_only=True)
+    outline: np.ndarray = field(repr=False, kw_only=True)
     corner: float = field(default=0.0, kw_only=True)
 
 
@@ -207,7 +208,7 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
             a = b = (a + b) / 2
         return Shape2D("square" if square else "rect", a, b, round(yaw, 6), centre, outline=outline,
                        corner=corner if corner > ON_SIDE else 0.0)
-    return Shape2D("polygon", a, b, math.degrees(angle), centre, outline=outline)
+    return Shape2D("polygon", a, b, 0.0, centre, outline=outline)
 
 
 ON_AXIS = 1e-6

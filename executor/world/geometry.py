@@ -25,6 +25,7 @@ for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,7 @@ from pathlib import Path
 import clingo
 import numpy as np
 import pybullet_data
+import shapely
 
 from assembly_constraints.bridge.assembly import Assembly, assembly_of, resolve_assembly_folder
 from assembly_constraints.bridge.files import make_folder, write_atomic
@@ -56,6 +58,7 @@ from assembly_constraints.executor.world.meshes import (
     mesh_link_xml,
     mesh_urdf_text,
 )
+from assembly_constraints.executor.world.polygon_fit import PolygonFit, circle, polygon, polygon_fit, round_fit
 
 FLOOR_MIN = 1e-6
 """A hole whose bottom is less than this above the plate under the bosses goes through its
@@ -65,13 +68,16 @@ boss onto the plate [m] (the mesh is printed to 1 µm): no floor thinner than th
 @dataclass(frozen=True)
 class Section:
     """A part's or a hole's cross-section: ``kind`` "round" (``size`` = diameter [m]),
-    "square" (``size`` = side [m]) or "rect" (``size`` = long side a along x [m],
-    ``width`` = short side b along y [m]; 0 means ``size``: round and square)."""
+    "square" (``size`` = side [m]), "rect" (``size`` = long side a along x [m],
+    ``width`` = short side b along y [m]; 0 means ``size``: round and square) or
+    "polygon" (``outline`` its points (x, y) [m] in its own frame, ``size`` and ``width``
+    its extents along x and y)."""
 
     id: str
     kind: str
     size: float
     width: float = field(default=0.0, kw_only=True)
+    outline: tuple[tuple[float, float], ...] = field(default=(), kw_only=True)
 
     @property
     def sides(self) -> tuple[float, float]:
@@ -176,11 +182,16 @@ def load_geometry(assembly: str = "cranfield", description: CellDescription | No
 
 
 def _section(shape: HoleShape | PartShape) -> tuple[str, float, float]:
-    """``kind``, size and width [m] of a shape table: a rect ``[a, b]`` gives a and b, any
-    other kind its one size and width 0."""
+    """``kind``, size and width [m] of a shape table: a rect's or polygon's ``[a, b]``
+    gives a and b, any other kind its one size and width 0."""
     if isinstance(shape.size, list):
         return shape.kind, float(shape.size[0]), float(shape.size[1])
     return shape.kind, float(shape.size), 0.0
+
+
+def _outline(shape: HoleShape | PartShape) -> tuple[tuple[float, float], ...]:
+    """A polygon's outline points [m] (empty for the other kinds)."""
+    return () if shape.outline is None else tuple((float(x), float(y)) for x, y in shape.outline)
 
 
 def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Gripper) -> CellGeometry:
@@ -191,7 +202,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
         top, depth = hole_level(geo.plate, hole_shape)
         for hid in hole_shape.holes:
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
-                                  top_z=top, depth=depth)
+                                  top_z=top, depth=depth, outline=_outline(hole_shape))
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -202,6 +213,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             parts[pid] = PartSpec(
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
+                outline=_outline(part_shape),
             )
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
@@ -211,7 +223,12 @@ def margin(part: Section, hole: Section) -> float:
     does not pass; the skill turns the part to the hole's yaw): round in round D - d; a
     square or rect a × b in round D - √(a² + b²); round in a square or rect B - d (its short
     side); a square or rect in a square or rect, long side along long side, min(A - a, B - b)
-    (a square is a rect with a = b)."""
+    (a square is a rect with a = b); with a polygon on either side twice the room of
+    :func:`section_fit` (the largest uniform offset of the part that passes, at the yaw
+    and shift the polygon relation finds), which agrees with these rules on their kinds
+    (a rect held along the hole's long side)."""
+    if "polygon" in (part.kind, hole.kind):
+        return section_fit(part, hole).margin
     if hole.kind == "round":
         if part.kind == "round":
             return hole.size - part.size
@@ -229,6 +246,43 @@ def passes(part: Section, hole: Section) -> bool:
     """Whether the part's cross-section passes the hole's, aligned: a positive
     :func:`margin` (no clearance needed beyond a positive one)."""
     return margin(part, hole) > 0
+
+
+def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
+    """The section as a polygon in its own frame [m]: a polygon's outline, a square's or
+    rect's exact rectangle, a round one's 256-gon around the circle for a ``peg`` (it holds
+    the part), inside it for a hole. ValueError naming the section when its outline is no
+    simple polygon."""
+    if section.kind == "polygon":
+        return polygon(np.array(section.outline), f"the section of '{section.id}'")
+    if section.kind == "round":
+        return circle(section.size / 2, outside=peg)
+    a, b = section.sides
+    return shapely.box(-a / 2, -b / 2, a / 2, b / 2)
+
+
+def section_fit(part: Section, hole: Section) -> PolygonFit:
+    """How the part's section sits in the hole's (:mod:`assembly_constraints.executor.world.polygon_fit`):
+    the room [m], the part's yaw [°] and offset [m] in the hole's frame; a round side's
+    closed forms, the search otherwise; the exact rules of :func:`margin` (room half the
+    margin, yaw 0, centred) when neither side is a polygon."""
+    return _section_fit(_key(part), _key(hole))
+
+
+def _key(section: Section) -> Section:
+    """The section without its id (pairs of equal sections share one answer)."""
+    return Section("", section.kind, section.size, width=section.width, outline=section.outline)
+
+
+@functools.lru_cache(maxsize=4096)
+def _section_fit(part: Section, hole: Section) -> PolygonFit:
+    if "polygon" not in (part.kind, hole.kind):
+        return PolygonFit(margin(part, hole) / 2, 0.0, (0.0, 0.0))
+    if hole.kind == "round":
+        return round_fit(outline_polygon(part, peg=True), None, hole_diameter=hole.size)
+    if part.kind == "round":
+        return round_fit(None, outline_polygon(hole, peg=False), peg_diameter=part.size)
+    return polygon_fit(outline_polygon(part, peg=True), outline_polygon(hole, peg=False))
 
 
 def sizes_lp_text(assembly: str) -> str:
