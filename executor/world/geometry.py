@@ -269,6 +269,19 @@ def section_fit(part: Section, hole: Section) -> PolygonFit:
     return _section_fit(_key(part), _key(hole))
 
 
+def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
+    """The part's yaw [rad] in the hole's frame and its origin's offset (x, y) [m] from the
+    hole's position in the cell's axes where the polygon relation passes it (:func:`section_fit`);
+    (0, 0) for pairs of round, square and rect sections (the skill aligns those itself,
+    :func:`assembly_constraints.executor.world.arm.aligned_yaw`)."""
+    if "polygon" not in (part.kind, hole.kind):
+        return 0.0, np.zeros(2)
+    found = section_fit(part, hole)
+    c, s = math.cos(hole.yaw), math.sin(hole.yaw)
+    x, y = found.offset
+    return math.radians(found.yaw), np.array([c * x - s * y, s * x + c * y])
+
+
 def _key(section: Section) -> Section:
     """The section without its id (pairs of equal sections share one answer)."""
     return Section("", section.kind, section.size, width=section.width, outline=section.outline)

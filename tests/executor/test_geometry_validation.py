@@ -29,6 +29,10 @@ grasp_depth = 0.02
 ORIGINAL = (CRANFIELD / "geometry.toml").read_text().replace("[base]", GRIPPER_TABLE + "[base]", 1)
 """Cranfield's geometry with its own [gripper] (a product may override the cell's)."""
 
+ROUND_HOLE = 'kind = "round"\nsize = 0.0133'
+TRIANGLE = "[[-0.005, -0.005], [0.005, -0.005], [-0.005, 0.005]]"
+"""A polygon section's outline [m]."""
+
 # (id, text of data/cranfield/geometry.toml, its replacement, the expected end of the message)
 SIZE = "a number in (0, 0.1] m, or for a rect [a, b] with a >= b, each such a number"
 """What a cross-section's size must be."""
@@ -119,6 +123,24 @@ CASES = [
      "that is not in assembly.toml"),
     ("gripper-unknown-key", "grasp_depth = 0.02", "grasp_depth = 0.02\ngrasp_force = 5",
      "[gripper] grasp_force: unknown key"),
+    ("polygon-without-outline", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]',
+     "[hole_shapes.round_small] outline: expected an outline [[x, y], ...] in m (a polygon's section), got None"),
+    ("outline-of-a-round", ROUND_HOLE, ROUND_HOLE + f"\noutline = {TRIANGLE}",
+     "[hole_shapes.round_small] outline: expected an outline [[x, y], ...] for a polygon, none for a round"),
+    ("outline-crossing", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]\n'
+     "outline = [[0.0, 0.0], [0.01, 0.01], [0.01, 0.0], [0.0, 0.01]]",
+     "[hole_shapes.round_small] outline: expected a simple polygon (no crossing edges, positive area), got "
+     "'Self-intersection"),
+    ("outline-extents", ROUND_HOLE, f'kind = "polygon"\nsize = [0.02, 0.01]\noutline = {TRIANGLE}',
+     "[hole_shapes.round_small] size: expected the outline's extents [0.01, 0.01] m along x and y, got [0.02, 0.01]"),
+    ("outline-two-points", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]\noutline = [[0.0, 0.0], [0.01, 0.01]]',
+     "[hole_shapes.round_small] outline: expected the points [[x, y], ...] in m of a simple polygon"),
+    ("outline-far", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]\noutline = [[0.0, 0.0], [0.5, 0.0], [0.0, 0.01]]',
+     "[hole_shapes.round_small] outline: expected"),
+    ("polygon-hole-without-base-mesh", ROUND_HOLE, f'kind = "polygon"\nsize = [0.01, 0.01]\noutline = {TRIANGLE}',
+     "[hole_shapes.round_small] kind: a polygon hole needs a [base] with its own mesh"),
+    ("polygon-peg-without-mesh", 'kind = "round"\nsize = 0.0120', f'kind = "polygon"\nsize = [0.01, 0.01]\n'
+     f"outline = {TRIANGLE}", "[part_shapes.round_peg] mesh: expected the part's own mesh for a polygon section"),
 ]
 
 
