@@ -12,10 +12,10 @@ rotational symmetry apart are the same (a 6-tooth spline in a 6-tooth hub: 60°)
 period is sampled every period / :data:`COARSE_TURNS` (yaw 0 among the samples, the pose
 an assembled CAD holds), each turn from two starts (the peg's smallest enclosing circle's
 centre on the hole's largest inscribed circle's, and the area centroids together). The
-:data:`CANDIDATES` best are refined by zooming in on the best of 17 turns until the peg's
+:data:`CANDIDATES` best are refined by zooming in on the best of 9 turns until the peg's
 farthest corner moves less than :data:`FINE_SHIFT`, then (unless both outlines share a
 rotational symmetry, which keeps their centres together) the shift by zooming in on the
-best of a 5 x 5 grid down to :data:`FINE_SHIFT`, and the turn once more. The search climbs
+best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn once more. The search climbs
 a continuous score: the room where the peg is inside, else minus its deepest overlap (a
 peg corner outside the hole, a hole corner inside the peg). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
@@ -38,7 +38,7 @@ import shapely
 
 COARSE_TURNS = 72
 """Samples of the turn over one period of the pair's symmetry."""
-CANDIDATES = 3
+CANDIDATES = 2
 """The best coarse turns refined."""
 FINE_SHIFT = 1e-7
 """The shift's, the turn's (at the peg's farthest corner) and a negative room's resolution [m]."""
@@ -227,14 +227,14 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     return PolygonFit(room, round(yaw, 9) + 0.0, (float(origin[0]), float(origin[1])))
 
 
-_TURNS = np.linspace(-1.0, 1.0, 17)
-_SHIFTS = np.array([[x, y] for x in np.linspace(-1.0, 1.0, 5) for y in np.linspace(-1.0, 1.0, 5)])
+_TURNS = np.linspace(-1.0, 1.0, 9)
+_SHIFTS = np.array([[x, y] for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)])
 _ROUNDS = 64
 """A refinement stops after this many rounds whatever its step (a score that keeps climbing)."""
 
 
 def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine: float) -> tuple[float, np.ndarray]:
-    """Climb the score along the turn from ``angle`` [rad]: 17 turns within ``step`` [rad]
+    """Climb the score along the turn from ``angle`` [rad]: 9 turns within ``step`` [rad]
     either side at once, the window a quarter as wide when the best is inside it, until it
     is narrower than ``fine`` [rad]."""
     for _ in range(_ROUNDS):
@@ -250,9 +250,9 @@ def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine
 
 
 def _refine_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:
-    """Climb the score over the shift [m] from ``shift``: a 5 x 5 grid at once, from twice
+    """Climb the score over the shift [m] from ``shift``: a 3 x 3 grid at once, from twice
     the score's size (at most a tenth of the peg's ``reach`` [m]) either side, the grid half
-    as wide when the best is inside it, down to :data:`FINE_SHIFT`."""
+    as wide when its centre is the best, down to :data:`FINE_SHIFT`."""
     step = min(reach / 10, max(2 * abs(pair.score(angle, shift)), 100 * FINE_SHIFT))
     for _ in range(_ROUNDS):
         if step <= FINE_SHIFT:
@@ -261,7 +261,7 @@ def _refine_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) ->
         scores = pair.scores(np.full(len(moves), angle), moves)
         k = int(np.argmax(scores))
         shift = moves[k]
-        if np.all(np.abs(_SHIFTS[k]) < 1):
+        if not np.any(_SHIFTS[k]):
             step /= 2
     return shift
 
