@@ -92,6 +92,10 @@ def _check_sections(path: Path, group: str, tables: Mapping[str, HoleShape] | Ma
                        "section)", table.outline)
         if table.outline is not None and isinstance(size, list):
             _check_outline(path, f"{group}.{name}", table.outline, size)
+        if table.corner and (table.kind not in ("square", "rect") or 2 * table.corner > min(_sides(size))):
+            raise fail(path, f"{group}.{name}", "corner", "a corner radius of a square or rect at most half its "
+                       f"short side ({min(_sides(size)) / 2:g} m)" if table.kind in ("square", "rect")
+                       else f"no corner radius for a {table.kind}", table.corner)
 
 
 OUTLINE_EXTENT_TOLERANCE = 1e-6
@@ -112,16 +116,19 @@ def _check_outline(path: Path, table: str, outline: list[list[float]], size: lis
 
 
 def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
-    """A polygon peg is simulated from its own ``mesh``, a polygon hole in the ``[base]``'s
-    mesh (the plate's bosses are round, square or rect)."""
+    """A polygon peg is simulated from its own ``mesh``, a polygon hole or one with a
+    ``corner`` radius in the ``[base]``'s mesh (the plate's bosses are round, square or
+    sharp rect)."""
     for name, part_shape in geo.part_shapes.items():
         if part_shape.kind == "polygon" and part_shape.mesh is None:
             raise BridgeError(f"{path}: [part_shapes.{name}] mesh: expected the part's own mesh for a polygon "
                               "section (the cell simulates no other), got nothing")
     for name, hole_shape in geo.hole_shapes.items():
-        if hole_shape.kind == "polygon" and (geo.base is None or geo.base.mesh is None):
-            raise BridgeError(f"{path}: [hole_shapes.{name}] kind: a polygon hole needs a [base] with its own mesh "
-                              "(the plate's bosses are round, square or rect), got none")
+        shaped = "kind" if hole_shape.kind == "polygon" else "corner" if hole_shape.corner else ""
+        if shaped and (geo.base is None or geo.base.mesh is None):
+            raise BridgeError(f"{path}: [hole_shapes.{name}] {shaped}: a polygon hole or one with rounded corners "
+                              "needs a [base] with its own mesh (the plate's bosses are round, square or sharp "
+                              "rect), got none")
 
 
 def hole_level(plate: Plate, shape: HoleShape) -> tuple[float, float]:

@@ -62,6 +62,7 @@ OutlinePoint = Annotated[list[Annotated[float, Meta(ge=-0.1, le=0.1)]], Meta(
 Outline = Annotated[list[OutlinePoint], Meta(min_length=3, max_length=MAX_OUTLINE_POINTS, description=(
     "the points [[x, y], ...] in m of a simple polygon (3 to 4096 points, no crossing edges), in the part's or "
     "hole's frame"))]
+Corner = Annotated[float, Meta(ge=0.0, le=0.05, description="a number in [0, 0.05] m")]
 Length = Annotated[float, Meta(gt=0.0, le=0.3, description="a number in (0, 0.3] m")]
 Mass = Annotated[float, Meta(gt=0.0, le=10.0, description="a number in (0, 10] kg")]
 Yaw = Annotated[float, Meta(gt=-360.0, le=360.0, description="a number in (-360, 360] degrees")]
@@ -146,7 +147,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[hole_shapes.<name>]``: holes of one cross-section; ``size`` a diameter or side
     [m], for a rect ``[a, b]`` (a along the hole's x axis, turned by ``yaw`` [degrees]),
     for a polygon the extents ``[a, b]`` of its ``outline`` along x and y (about the
-    hole's position, in the hole's frame);
+    hole's position, in the hole's frame); a square's or rect's ``corner`` radius [m];
     ``top_z`` the height of their entry and ``depth`` from the entry to their bottom [m],
     where they differ from the plate's ``top_z`` and ``tile_thickness``."""
 
@@ -154,6 +155,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     kind: Kind
     size: SectionSize
     outline: Outline | None = None
+    corner: Corner = 0.0
     yaw: Yaw = 0.0
     top_z: EntryHeight | None = None
     depth: HoleDepth | None = None
@@ -164,12 +166,14 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     ``length`` [m], ``mass`` [kg], the hole its demonstration is taught in, and ``mesh``
     when they are simulated from their own mesh rather than as a cylinder or box; a
     polygon's ``outline`` about the centre of its section in the part frame, ``size`` its
-    extents ``[a, b]`` along x and y (a polygon peg is simulated from its mesh)."""
+    extents ``[a, b]`` along x and y (a polygon peg is simulated from its mesh); a
+    square's or rect's ``corner`` radius [m]."""
 
     parts: Ids
     kind: Kind
     size: SectionSize
     outline: Outline | None = None
+    corner: Corner = 0.0
     length: Length
     mass: Mass
     demo_hole: Id

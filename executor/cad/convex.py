@@ -90,8 +90,9 @@ def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
 
 def base_is_primitive(derived: Derived) -> bool:
     """Whether the base is its bounding box less its holes (each its section times its
-    depth); never with a polygon hole (the plate's bosses are round, square or rect)."""
-    if any(fit.hole.kind == "polygon" for fit in derived.holes.values()):
+    depth); never with a polygon hole or one with rounded corners (the plate's bosses are
+    round, square or sharp rect)."""
+    if any(fit.hole.kind == "polygon" or fit.hole.corner for fit in derived.holes.values()):
         return False
     mesh = derived.parts[derived.base].mesh
     holes = sum(section_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())

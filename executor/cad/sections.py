@@ -30,6 +30,7 @@ diameter instead.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -161,21 +162,38 @@ def _straight(points: np.ndarray, a: float, b: float, tolerance: float) -> float
     return min(fractions)
 
 
-def _inset(points: np.ndarray, a: float, b: float) -> float:
-    """The least even inset [m] of every side of the centred rectangle ``a`` x ``b`` (the
-    loop's ``points`` in its frame) that puts it inside the loop, to 0.1 µm."""
-    loop = shapely.make_valid(shapely.Polygon(points))
-    shapely.prepare(loop)
-    low, high = 0.0, min(a, b) / 2
-    if loop.covers(shapely.box(-a / 2, -b / 2, a / 2, b / 2)):
-        return 0.0
+def _rounded(a: float, b: float, radius: float, inset: float = 0.0) -> shapely.Polygon:
+    """The centred rect ``a`` x ``b`` [m] with corners of ``radius`` [m], inset by ``inset`` [m] a side."""
+    half_a, half_b = a / 2 - inset, b / 2 - inset
+    core = shapely.box(radius - half_a, radius - half_b, half_a - radius, half_b - radius)
+    return core.buffer(radius, quad_segs=16) if radius > 0 else core
+
+
+def _bisect(low: float, high: float, ok_high: bool, test: Callable[[float], bool]) -> float:
+    """The end of [``low``, ``high``] [m] at which ``test`` changes, to 0.1 µm, on its
+    passing side (``ok_high``: it passes at high)."""
     while high - low > 1e-7:
         mid = (low + high) / 2
-        if loop.covers(shapely.box(mid - a / 2, mid - b / 2, a / 2 - mid, b / 2 - mid)):
+        if test(mid) == ok_high:
             high = mid
         else:
             low = mid
-    return high
+    return high if ok_high else low
+
+
+def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> tuple[float, float]:
+    """The corner radius and inset [m] of a rect section (``points`` in its centred frame):
+    a peg's the largest radius whose rounded rect still holds the loop (inset 0); a hole's
+    the least radius whose rounded rect lies inside the loop, or where none does, the
+    least even inset of the sharp rect that does (radius 0)."""
+    loop = shapely.make_valid(shapely.Polygon(points))
+    shapely.prepare(loop)
+    grown = loop.buffer(1e-9)  # the loop's own points on the rect's sides stay covered
+    if not hole:
+        return _bisect(0.0, b / 2, False, lambda r: bool(_rounded(a, b, r).buffer(1e-9).covers(loop))), 0.0
+    if grown.covers(_rounded(a, b, b / 2)):
+        return _bisect(0.0, b / 2, True, lambda r: bool(grown.covers(_rounded(a, b, r)))), 0.0
+    return 0.0, _bisect(0.0, b / 2, True, lambda d: bool(grown.covers(_rounded(a, b, 0.0, d))))
 
 
 def classify(loop: Loop, *, hole: bool) -> Shape2D:
@@ -194,10 +212,8 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
     local = turned - (turned.max(axis=0) + turned.min(axis=0)) / 2
     if (loop.area >= RECT_FILL * a * b
             and _straight(local, a, b, max(ON_SIDE, 1e-3 * b)) >= STRAIGHT_SIDES):
-        corner = math.sqrt(max(0.0, a * b - loop.area) / (4 - math.pi))
-        if hole:
-            inset = _inset(local, a, b)
-            a, b = a - 2 * inset, b - 2 * inset
+        corner, inset = _corner_and_inset(local, a, b, hole=hole)
+        a, b = a - 2 * inset, b - 2 * inset
         square = a - b <= SQUARE_TOLERANCE
         yaw = math.degrees(angle)
         period, upper = (90.0, 45.0) if square else (180.0, 90.0)
@@ -207,7 +223,7 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
         if square:
             a = b = (a + b) / 2
         return Shape2D("square" if square else "rect", a, b, round(yaw, 6), centre, outline=outline,
-                       corner=corner if corner > ON_SIDE else 0.0)
+                       corner=round(corner, 7) if corner > ON_SIDE else 0.0)
     return Shape2D("polygon", a, b, 0.0, centre, outline=outline)
 
 

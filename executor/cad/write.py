@@ -75,7 +75,7 @@ def section(name: str, shape: Shape2D) -> Section:
     """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
     outline = tuple((_q(x), _q(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
     return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
-                   outline=outline)
+                   outline=outline, corner=shape.corner)
 
 
 def _q(value: float) -> float:
@@ -84,11 +84,12 @@ def _q(value: float) -> float:
 
 
 def _section_lines(shape: Shape2D) -> list[str]:
-    """``kind`` and ``size`` of a section table; a polygon's ``size`` the extents of its
-    ``outline`` along x and y, which follows (about its centre, in the cell's axes)."""
+    """``kind``, ``size`` and a rounded square's or rect's ``corner`` radius of a section
+    table; a polygon's ``size`` the extents of its ``outline`` along x and y, which follows
+    (about its centre, in the cell's axes)."""
     if shape.kind != "polygon":
         size = f"[{_q(shape.a)}, {_q(shape.b)}]" if shape.kind == "rect" else f"{_q(shape.a)}"
-        return [f'kind = "{shape.kind}"', f"size = {size}"]
+        return [f'kind = "{shape.kind}"', f"size = {size}", *([f"corner = {_q(shape.corner)}"] if shape.corner else [])]
     points = section("", shape).outline
     extents = np.ptp(np.array(points), axis=0)
     return ['kind = "polygon"', f"size = [{_q(float(extents[0]))}, {_q(float(extents[1]))}]",

@@ -71,13 +71,14 @@ class Section:
     "square" (``size`` = side [m]), "rect" (``size`` = long side a along x [m],
     ``width`` = short side b along y [m]; 0 means ``size``: round and square) or
     "polygon" (``outline`` its points (x, y) [m] in its own frame, ``size`` and ``width``
-    its extents along x and y)."""
+    its extents along x and y); a square's or rect's ``corner`` radius [m] (0: sharp)."""
 
     id: str
     kind: str
     size: float
     width: float = field(default=0.0, kw_only=True)
     outline: tuple[tuple[float, float], ...] = field(default=(), kw_only=True)
+    corner: float = field(default=0.0, kw_only=True)
 
     @property
     def sides(self) -> tuple[float, float]:
@@ -202,7 +203,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
         top, depth = hole_level(geo.plate, hole_shape)
         for hid in hole_shape.holes:
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
-                                  top_z=top, depth=depth, outline=_outline(hole_shape))
+                                  top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -213,7 +214,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             parts[pid] = PartSpec(
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
-                outline=_outline(part_shape),
+                outline=_outline(part_shape), corner=part_shape.corner,
             )
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
@@ -223,23 +224,45 @@ def margin(part: Section, hole: Section) -> float:
     does not pass; the skill turns the part to the hole's yaw): round in round D - d; a
     square or rect a × b in round D - √(a² + b²); round in a square or rect B - d (its short
     side); a square or rect in a square or rect, long side along long side, min(A - a, B - b)
-    (a square is a rect with a = b); with a polygon on either side twice the room of
-    :func:`section_fit` (the largest uniform offset of the part that passes, at the yaw
-    and shift the polygon relation finds), which agrees with these rules on their kinds
-    (a rect held along the hole's long side)."""
+    (a square is a rect with a = b). Corner radii: a part's rounded corners bring its
+    farthest point in (D - 2 (|c| + ρ), c the centre of its corner's arc); in a square or
+    rect hole the room is twice the largest offset of the part whose corner arcs (or sharp
+    corners) stay inside the hole's (its corner arcs' centres less than ρ_hole - the
+    offset part's radius from the hole's inner rectangle; a bisection to 0.1 nm). With a polygon on either
+    side: twice the room of :func:`section_fit` (the largest uniform offset of the part
+    that passes, at the yaw and shift the polygon relation finds), which agrees with these
+    rules on their kinds (a rect held along the hole's long side)."""
     if "polygon" in (part.kind, hole.kind):
         return section_fit(part, hole).margin
     if hole.kind == "round":
         if part.kind == "round":
             return hole.size - part.size
-        if part.kind == "square":
-            return hole.size - part.size * math.sqrt(2.0)
-        return hole.size - math.hypot(*part.sides)
+        a, b = part.sides
+        return hole.size - 2 * (math.hypot(a / 2 - part.corner, b / 2 - part.corner) + part.corner)
     long_side, short_side = hole.sides
     if part.kind == "round":
         return short_side - part.size
     a, b = part.sides
-    return min(long_side - a, short_side - b)
+    room = min(long_side - a, short_side - b) / 2
+    if not (part.corner or hole.corner):
+        return 2 * room
+
+    def corners_pass(offset: float) -> bool:
+        """Whether the part offset by ``offset`` [m] has its corner arcs (radius ρ + offset,
+        or sharp corners once that is negative) inside the hole's."""
+        arc = max(part.corner + offset, 0.0)
+        inward = min(part.corner + offset, 0.0)  # a sharp corner's centre moves in with it
+        beyond = math.hypot(max(0.0, a / 2 - part.corner + inward - (long_side / 2 - hole.corner)),
+                            max(0.0, b / 2 - part.corner + inward - (short_side / 2 - hole.corner)))
+        return beyond == 0.0 or beyond + arc <= hole.corner
+
+    if corners_pass(room):
+        return 2 * room
+    low = -b / 2  # the part shrunk to a line passes any corner
+    while room - low > 1e-10:
+        mid = (low + room) / 2
+        low, room = (mid, room) if corners_pass(mid) else (low, mid)
+    return 2 * low
 
 
 def passes(part: Section, hole: Section) -> bool:
@@ -250,15 +273,20 @@ def passes(part: Section, hole: Section) -> bool:
 
 def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
     """The section as a polygon in its own frame [m]: a polygon's outline, a square's or
-    rect's exact rectangle, a round one's 256-gon around the circle for a ``peg`` (it holds
-    the part), inside it for a hole. ValueError naming the section when its outline is no
-    simple polygon."""
+    rect's exact rectangle (its corner arcs 256-gons as a circle's), a round one's 256-gon
+    around the circle for a ``peg`` (it holds the part), inside it for a hole.
+    OutlineError naming the section when its outline is no simple polygon."""
     if section.kind == "polygon":
         return polygon(np.array(section.outline), f"the section of '{section.id}'")
     if section.kind == "round":
         return circle(section.size / 2, outside=peg)
     a, b = section.sides
-    return shapely.box(-a / 2, -b / 2, a / 2, b / 2)
+    if section.corner <= 0:
+        return shapely.box(-a / 2, -b / 2, a / 2, b / 2)
+    arc = circle(section.corner, outside=peg)
+    core = shapely.box(section.corner - a / 2, section.corner - b / 2, a / 2 - section.corner, b / 2 - section.corner)
+    return shapely.convex_hull(shapely.union_all([shapely.affinity.translate(arc, x, y)
+                                                  for x, y in np.asarray(core.exterior.coords)[:4]]))
 
 
 def section_fit(part: Section, hole: Section) -> PolygonFit:
@@ -284,7 +312,8 @@ def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
 
 def _key(section: Section) -> Section:
     """The section without its id (pairs of equal sections share one answer)."""
-    return Section("", section.kind, section.size, width=section.width, outline=section.outline)
+    return Section("", section.kind, section.size, width=section.width, outline=section.outline,
+                   corner=section.corner)
 
 
 @functools.lru_cache(maxsize=4096)

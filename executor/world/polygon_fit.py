@@ -179,12 +179,12 @@ class _Pair:
         peg = self.pegs(np.array([angle]), shift[None, :])[0]
 
         def inside(buffer: float) -> bool:
-            return bool(shapely.contains(self.hole, peg.buffer(buffer, join_style="mitre")))
+            """Whether the peg offset by ``buffer`` [m] is inside (shrunk to nothing: it is)."""
+            offset = peg.buffer(buffer, join_style="mitre")
+            return bool(offset.is_empty or shapely.contains(self.hole, offset))
 
         low, high = found, 0.0  # high never passes (the peg overlaps the hole's boundary)
         while not inside(low):
-            if peg.buffer(low).is_empty:
-                return low  # the peg shrinks to nothing before it passes
             high, low = low, 2 * low
         while high - low > FINE_SHIFT:
             mid = (low + high) / 2

@@ -15,10 +15,10 @@ from assembly_constraints.executor.cad.sections import Loop, classify
 MM = 1e-3
 
 
-def rounded_rect(a: float, b: float, radius: float, yaw: float = 0.0) -> shapely.Polygon:
-    """A centred a x b [m] rect with corner ``radius`` [m] (8 segments a quarter), turned by ``yaw`` [°]."""
+def rounded_rect(a: float, b: float, radius: float, yaw: float = 0.0, quad_segs: int = 8) -> shapely.Polygon:
+    """A centred a x b [m] rect with corner ``radius`` [m] (``quad_segs`` segments a quarter), turned by ``yaw`` [°]."""
     core = shapely.box(-a / 2 + radius, -b / 2 + radius, a / 2 - radius, b / 2 - radius)
-    return affinity.rotate(core.buffer(radius, quad_segs=8), yaw, origin=(0, 0))
+    return affinity.rotate(core.buffer(radius, quad_segs=quad_segs), yaw, origin=(0, 0))
 
 
 def loop_of(polygon: shapely.Polygon, at: tuple[float, float] = (0.1, -0.05)) -> Loop:
@@ -40,25 +40,34 @@ def splined(outer: float, root: float, teeth: int, tooth_angle: float, points: i
 
 def test_a_rounded_rect_peg_is_a_rect_of_its_full_size() -> None:
     """Corner radius 1 mm on 10 x 6 mm fills 98.6 % of its rectangle: a rect 10 x 6 mm
-    (the peg's circumscribed rectangle, which holds it) with its radius recorded; the
+    with the largest corner radius whose rounded rect still holds the loop; the
     classification before fell back to 'other' below 99.5 %."""
     peg = classify(loop_of(rounded_rect(10 * MM, 6 * MM, 1 * MM, yaw=20)), hole=False)
     assert peg.kind == "rect"
     assert (peg.a, peg.b) == pytest.approx((10 * MM, 6 * MM), abs=1e-9)
     assert peg.yaw == pytest.approx(20, abs=1e-6)
-    assert peg.corner == pytest.approx(1 * MM, rel=0.02)  # the 8-segment arcs lack a little less area
+    assert peg.corner == pytest.approx(1 * MM, rel=1e-3)
 
 
-def test_a_rounded_rect_hole_is_the_rect_inside_it() -> None:
-    """The hole's rect is inset until it lies inside the rounded corners: 1 mm radius costs
-    1 - 1/√2 mm a side; that rect fits, a wider one does not."""
+def test_a_rounded_rect_hole_is_its_rect_with_a_corner_radius_inside_it() -> None:
+    """The hole's rect is its full 10 x 6 mm with the least corner radius whose rounded
+    rect lies inside the loop: about its 1 mm (the loop's chords lie inside the arcs, so a
+    little more), never less."""
     outline = rounded_rect(10 * MM, 6 * MM, 1 * MM)
     hole = classify(loop_of(outline, (0, 0)), hole=True)
-    inset = 1 * MM * (1 - 1 / math.sqrt(2))
-    assert hole.kind == "rect"
-    assert (hole.a, hole.b) == pytest.approx((10 * MM - 2 * inset, 6 * MM - 2 * inset), abs=2e-7)
-    assert outline.buffer(1e-9).covers(shapely.box(-hole.a / 2, -hole.b / 2, hole.a / 2, hole.b / 2))
-    assert not outline.covers(shapely.box(-hole.a / 2 - 1e-6, -hole.b / 2 - 1e-6, hole.a / 2 + 1e-6, hole.b / 2 + 1e-6))
+    assert hole.kind == "rect" and (hole.a, hole.b) == pytest.approx((10 * MM, 6 * MM), abs=1e-9)
+    assert 1 * MM <= hole.corner <= 1.06 * MM
+    assert outline.buffer(1e-9).covers(rounded_rect(10 * MM, 6 * MM, hole.corner, quad_segs=16))
+    assert not outline.covers(rounded_rect(10 * MM, 6 * MM, 0.9 * MM, quad_segs=16))
+
+
+def test_a_notched_rect_hole_is_the_sharp_rect_inset_inside_it() -> None:
+    """A small bump into a rect hole leaves a rect; no rounded rect fits its loop, so the
+    sharp rect is inset evenly until it does: a fit stays what the hole passes."""
+    outline = shapely.box(-5 * MM, -3 * MM, 5 * MM, 3 * MM).difference(shapely.box(-1 * MM, 2.7 * MM, 1 * MM, 3 * MM))
+    hole = classify(loop_of(outline, (0, 0)), hole=True)
+    assert (hole.kind, hole.corner) == ("rect", 0.0)
+    assert (hole.a, hole.b) == pytest.approx((9.4 * MM, 5.4 * MM), abs=2e-7)
 
 
 def test_a_chamfered_square_is_a_square() -> None:
