@@ -21,7 +21,10 @@ peg corner outside the hole, a hole corner inside the peg). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
 is one the peg can make; a pass whose window of turns the search never samples near can
-be missed (a no-pass is the search's finding, not a proof). A round side has closed
+be missed (a no-pass is the search's finding, not a proof). A peg whose largest
+inscribed circle is wider than the hole's does not pass whatever its turn: its room is
+then given as the difference of those radii, a bound (it lacks at least that much),
+without a search. A round side has closed
 forms: a polygon peg in a round hole has the room R - (the radius of its smallest
 enclosing circle), a round peg in a polygon hole (the radius of the hole's largest
 inscribed circle) - r, at any turn.
@@ -197,6 +200,9 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     docstring); both simple polygons in their own frames [m] (:func:`polygon`)."""
     peg_centre = np.asarray(shapely.minimum_bounding_circle(peg).centroid.coords[0])
     hole_centre = np.asarray(shapely.maximum_inscribed_circle(hole, FINE_SHIFT).coords[0])
+    bound = _room_bound(peg, hole)
+    if bound < 0:
+        return PolygonFit(bound, 0.0, (float(hole_centre[0] - peg_centre[0]), float(hole_centre[1] - peg_centre[1])))
     pair = _Pair(shapely.affinity.translate(peg, *-peg_centre), shapely.affinity.translate(hole, *-hole_centre))
     orders = symmetry(pair.peg), symmetry(pair.hole)
     period = 2 * math.pi / math.lcm(*orders)
@@ -231,6 +237,13 @@ _TURNS = np.linspace(-1.0, 1.0, 9)
 _SHIFTS = np.array([[x, y] for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)])
 _ROUNDS = 64
 """A refinement stops after this many rounds whatever its step (a score that keeps climbing)."""
+
+
+def _room_bound(peg: shapely.Polygon, hole: shapely.Polygon) -> float:
+    """A bound [m] the room cannot exceed: the peg offset by r has a largest inscribed
+    circle r wider (narrower for r < 0), which must fit the hole's."""
+    return float(shapely.length(shapely.maximum_inscribed_circle(hole, FINE_SHIFT))
+                 - shapely.length(shapely.maximum_inscribed_circle(peg, FINE_SHIFT))) + FINE_SHIFT
 
 
 def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine: float) -> tuple[float, np.ndarray]:
