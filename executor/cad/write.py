@@ -35,6 +35,7 @@ import trimesh
 from assembly_constraints.bridge.errors import ToolError
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.product import Mesh
+from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
@@ -48,6 +49,7 @@ from assembly_constraints.executor.cad.derive import Derived, HoleFit
 from assembly_constraints.executor.cad.sections import Shape2D
 from assembly_constraints.executor.cad.sweep import opposite
 from assembly_constraints.executor.world.geometry import Section, load_geometry, margin
+from assembly_constraints.executor.world.polygon_fit import OutlineError
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -143,10 +145,14 @@ def sizes_text(derived: Derived) -> str:
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
     (:func:`assembly_constraints.executor.world.geometry.margin`, the polygon relation for
-    polygon sections; negative: it does not pass)."""
+    polygon sections; negative: it does not pass); ExecutorError naming the part or hole
+    whose polygon section is no simple outline."""
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
-    return {pid: {hid: margin(section(pid, peg), section(hid, fit.hole)) for hid, fit in derived.holes.items()}
-            for pid, peg in pegs.items()}
+    try:
+        return {pid: {hid: margin(section(f"part {pid}", peg), section(f"hole {hid}", fit.hole))
+                      for hid, fit in derived.holes.items()} for pid, peg in pegs.items()}
+    except OutlineError as exc:  # a slice of a mesh that crosses itself
+        raise ExecutorError(f"{exc} (the mesh's slice at the hole's mid-depth)") from None
 
 
 def nominal_text(derived: Derived) -> str:

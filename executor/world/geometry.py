@@ -58,7 +58,14 @@ from assembly_constraints.executor.world.meshes import (
     mesh_link_xml,
     mesh_urdf_text,
 )
-from assembly_constraints.executor.world.polygon_fit import PolygonFit, circle, polygon, polygon_fit, round_fit
+from assembly_constraints.executor.world.polygon_fit import (
+    OutlineError,
+    PolygonFit,
+    circle,
+    polygon,
+    polygon_fit,
+    round_fit,
+)
 
 FLOOR_MIN = 1e-6
 """A hole whose bottom is less than this above the plate under the bosses goes through its
@@ -277,7 +284,7 @@ def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
     around the circle for a ``peg`` (it holds the part), inside it for a hole.
     OutlineError naming the section when its outline is no simple polygon."""
     if section.kind == "polygon":
-        return polygon(np.array(section.outline), f"the section of '{section.id}'")
+        return polygon(np.array(section.outline), f"the section of {section.id}")
     if section.kind == "round":
         return circle(section.size / 2, outside=peg)
     a, b = section.sides
@@ -294,7 +301,12 @@ def section_fit(part: Section, hole: Section) -> PolygonFit:
     the room [m], the part's yaw [°] and offset [m] in the hole's frame; a round side's
     closed forms, the search otherwise; the exact rules of :func:`margin` (room half the
     margin, yaw 0, centred) when neither side is a polygon."""
-    return _section_fit(_key(part), _key(hole))
+    try:
+        return _section_fit(_key(part), _key(hole))
+    except OutlineError:  # the cached answer knows no ids: name the section that is no simple polygon
+        for section in (part, hole):
+            outline_polygon(section, peg=True)
+        raise
 
 
 def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:

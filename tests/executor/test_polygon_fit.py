@@ -86,9 +86,13 @@ def test_a_keyed_shaft_passes_its_keyed_hub_and_no_plain_bore() -> None:
     assert bore.room == pytest.approx(5 * MM - (4.9 * MM + centre), abs=TESSELLATION) and bore.room < -0.2 * MM
 
 
-def test_an_outline_that_crosses_itself_is_refused_naming_it() -> None:
-    with pytest.raises(OutlineError, match="the section of 'peg': expected a simple outline"):
-        polygon([[0, 0], [1e-2, 1e-2], [1e-2, 0], [0, 1e-2]], "the section of 'peg'")
+def test_an_outline_that_crosses_itself_is_refused_naming_its_part() -> None:
+    """The part that is the problem is named, not the hole it is compared with."""
+    bowtie = ((0.0, 0.0), (1e-2, 1e-2), (1e-2, 0.0), (0.0, 1e-2))
+    with pytest.raises(OutlineError, match="^the section of part shaft: expected a simple outline"):
+        margin(Section("part shaft", "polygon", 1e-2, width=1e-2, outline=bowtie), Section("hole h1", "round", 2e-2))
+    with pytest.raises(OutlineError, match="^peg: expected an outline of at least 3 points"):
+        polygon([[0, 0], [1e-2, 1e-2]], "peg")
 
 
 SIZES = st.floats(2 * MM, 20 * MM)
