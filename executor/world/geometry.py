@@ -16,9 +16,12 @@ is that mesh as a static concave triangle mesh instead of the plate.
 
 Cross-sections (``kind``): ``round`` (``size`` = diameter), ``square`` (``size`` = side)
 and ``rect`` (``size = [a, b]``, a ≥ b: the long side a along the part's or hole's x
-axis), all in m; a hole's ``yaw`` [°] turns its x axis about z (counter-clockwise from
-the cell's x axis).  :func:`passes` compares aligned cross-sections: the skills turn
-the part to the hole's (measured) yaw, so the yaw never changes whether a part fits.
+axis), with an optional ``corner`` radius, or ``polygon`` (an ``outline``), all in m; a
+hole's ``yaw`` [°] turns its x axis about z (counter-clockwise from the cell's x axis).
+:func:`passes` compares aligned cross-sections: the skills turn the part to the hole's
+(measured) yaw, so the yaw never changes whether a part fits; with a polygon the polygon
+relation (:mod:`assembly_constraints.executor.world.polygon_fit`) finds the yaw and
+shift, and the skills add them (:func:`fit_pose`).
 ``write_assets`` regenerates ``data/<assembly>/assets/`` deterministically (the URDFs byte
 for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 """
