@@ -210,11 +210,13 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     fine = FINE_SHIFT / reach  # the turn that moves the peg's farthest corner by FINE_SHIFT
     coarse = period / COARSE_TURNS
     turns = np.arange(COARSE_TURNS) * coarse - period / 2  # yaw 0 among them: the pose the CAD may hold
-    # two starts at every turn: the centres together, the area centroids together
-    peg_mid = np.asarray(pair.peg.centroid.coords[0])
-    angles = np.concatenate([turns, turns])
-    starts = np.concatenate([np.zeros((COARSE_TURNS, 2)), np.asarray(pair.hole.centroid.coords[0])
-                             - np.stack([_turn(peg_mid[None, :], t)[0] for t in turns])])
+    # two starts at every turn: the centres together, the area centroids together (one
+    # where they are the centres, as for outlines symmetric about them)
+    peg_mid, hole_mid = np.asarray(pair.peg.centroid.coords[0]), np.asarray(pair.hole.centroid.coords[0])
+    angles, starts = turns, np.zeros((COARSE_TURNS, 2))
+    if max(float(np.linalg.norm(peg_mid)), float(np.linalg.norm(hole_mid))) > FINE_SHIFT:
+        angles = np.concatenate([turns, turns])
+        starts = np.concatenate([starts, hole_mid - np.stack([_turn(peg_mid[None, :], t)[0] for t in turns])])
     scores = pair.scores(angles, starts)
     best = (-math.inf, 0.0, np.zeros(2))
     for index in np.argsort(-scores, kind="stable")[:CANDIDATES]:
