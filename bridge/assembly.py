@@ -126,11 +126,12 @@ def resolve_assembly_folder(name_or_path: str) -> Path:
 
 def assembly_of(product: ProductDescription) -> Assembly:
     """The planner's view of a decoded product: its parts and holes in file order, a rect
-    part's section defaulting to its id, a round or square part's to its shape."""
+    or polygon part's section defaulting to its id, a round or square part's to its shape."""
     layout = product.assembly
     parts = tuple(
         Part(pid, part.name or pid, part.role, None if part.start is None else (part.start[0], part.start[1]),
-             part.shape, part.section or (None if part.shape is None else pid if part.shape == "rect" else part.shape))
+             part.shape, part.section or (None if part.shape is None else pid if part.shape in ("rect", "polygon")
+                                                             else part.shape))
         for pid, part in layout.parts.items())
     holes = tuple(Hole(hid, hole.name or hid, hole.shape,
                        None if hole.position is None else (hole.position[0], hole.position[1]))

@@ -233,7 +233,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("trial-peg-half-a-metre", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      geometry("size = 0.0187", "size = 0.5"), 2, "[part_shapes.shaft] size: expected a number in (0, 0.1] m"),
     ("trial-kind-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
-     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of rect, round, square"),
+     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of polygon, rect, round, square"),
     ("teach-demo-hole-unknown", ("executor", "teach", "--assembly", "asm"),
      geometry('demo_hole = "br"', 'demo_hole = "zz"'), 2, "[part_shapes.shaft] demo_hole"),
     ("trial-geometry-rect-short-side-first", ("executor", "trial", "--part", "p3", "--hole", "s1", "--assembly", "asm"),

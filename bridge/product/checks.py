@@ -13,6 +13,8 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
+import shapely
+
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.inputs import read_bytes, shorten
 from assembly_constraints.bridge.product.tables import (
@@ -72,15 +74,61 @@ def _members(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[s
 
 
 def _check_sections(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[str, PartShape]) -> None:
-    """A rect's size is ``[a, b]`` with a >= b, any other kind's one number."""
+    """A rect's size is ``[a, b]`` with a >= b, a polygon's ``[a, b]`` the extents of its
+    ``outline`` (a simple polygon; no other kind has one), any other kind's one number."""
     for name, table in tables.items():
-        rect, size = table.kind == "rect", table.size
-        if rect != isinstance(size, list):
-            expected = ("[a, b] in m with a >= b > 0 (the long side a along x) for a rect" if rect
+        listed, size = table.kind in ("rect", "polygon"), table.size
+        if listed != isinstance(size, list):
+            expected = ("[a, b] in m with a >= b > 0 (the long side a along x) for a rect" if table.kind == "rect"
+                        else "[a, b] in m (the outline's extents along x and y) for a polygon"
+                        if table.kind == "polygon"
                         else f"one number (the {'diameter' if table.kind == 'round' else 'side'}) for a {table.kind}")
             raise fail(path, f"{group}.{name}", "size", expected, size)
-        if isinstance(size, list) and size[0] < size[1]:
+        if table.kind == "rect" and isinstance(size, list) and size[0] < size[1]:
             raise fail(path, f"{group}.{name}", "size", "[a, b] with a >= b (the long side a along x)", size)
+        if (table.kind == "polygon") != (table.outline is not None):
+            raise fail(path, f"{group}.{name}", "outline", "an outline [[x, y], ...] for a polygon, none for a "
+                       f"{table.kind}" if table.kind != "polygon" else "an outline [[x, y], ...] in m (a polygon's "
+                       "section)", table.outline)
+        if table.outline is not None and isinstance(size, list):
+            _check_outline(path, f"{group}.{name}", table.outline, size)
+        if table.corner and (table.kind not in ("square", "rect") or 2 * table.corner > min(_sides(size))):
+            raise fail(path, f"{group}.{name}", "corner", "a corner radius of a square or rect at most half its "
+                       f"short side ({min(_sides(size)) / 2:g} m)" if table.kind in ("square", "rect")
+                       else f"no corner radius for a {table.kind}", table.corner)
+
+
+OUTLINE_EXTENT_TOLERANCE = 1e-6
+"""A polygon's ``size`` is its outline's extents within this [m]."""
+
+
+def _check_outline(path: Path, table: str, outline: list[list[float]], size: list[float]) -> None:
+    """A polygon's ``outline`` is a simple polygon of positive area whose extents along x
+    and y are its ``size``."""
+    ring = shapely.Polygon(outline)
+    if not ring.is_valid or ring.area <= 0:
+        raise fail(path, table, "outline", "a simple polygon (no crossing edges, positive area)",
+                   f"{shapely.is_valid_reason(ring)} in {outline}")
+    x0, y0, x1, y1 = ring.bounds
+    if abs(x1 - x0 - size[0]) > OUTLINE_EXTENT_TOLERANCE or abs(y1 - y0 - size[1]) > OUTLINE_EXTENT_TOLERANCE:
+        raise fail(path, table, "size", f"the outline's extents [{x1 - x0:.7g}, {y1 - y0:.7g}] m along x and y",
+                   size)
+
+
+def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
+    """A polygon peg is simulated from its own ``mesh``, a polygon hole or one with a
+    ``corner`` radius in the ``[base]``'s mesh (the plate's bosses are round, square or
+    sharp rect)."""
+    for name, part_shape in geo.part_shapes.items():
+        if part_shape.kind == "polygon" and part_shape.mesh is None:
+            raise BridgeError(f"{path}: [part_shapes.{name}] mesh: expected the part's own mesh for a polygon "
+                              "section (the cell simulates no other), got nothing")
+    for name, hole_shape in geo.hole_shapes.items():
+        shaped = "kind" if hole_shape.kind == "polygon" else "corner" if hole_shape.corner else ""
+        if shaped and (geo.base is None or geo.base.mesh is None):
+            raise BridgeError(f"{path}: [hole_shapes.{name}] {shaped}: a polygon hole or one with rounded corners "
+                              "needs a [base] with its own mesh (the plate's bosses are round, square or sharp "
+                              "rect), got none")
 
 
 def hole_level(plate: Plate, shape: HoleShape) -> tuple[float, float]:
@@ -126,9 +174,10 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     pegs = _members(path, "part_shapes", geo.part_shapes)
     _check_sections(path, "hole_shapes", geo.hole_shapes)
     _check_sections(path, "part_shapes", geo.part_shapes)
+    _check_polygons_simulated(path, geo)
     _check_levels(path, plate, geo.hole_shapes)
     for name, hole_shape in geo.hole_shapes.items():
-        if _sides(hole_shape.size)[0] + 2 * plate.chamfer >= plate.tile_size:
+        if max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
                        "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():
@@ -238,7 +287,7 @@ def _check_kinds(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
         spec = part_shape.get(pid)
         if part.shape is None or spec is None:
             continue
-        section = part.section or (pid if part.shape == "rect" else part.shape)
+        section = part.section or (pid if part.shape in ("rect", "polygon") else part.shape)
         other_id, other = first.setdefault(section, (pid, spec))
         (a, b), (oa, ob) = _sides(spec.size), _sides(other.size)
         if (other.kind == "round") != (spec.kind == "round") or not math.isclose(b / a, ob / oa, rel_tol=1e-9):

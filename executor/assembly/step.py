@@ -53,6 +53,7 @@ from assembly_constraints.executor.skills.insertion import insert_in_layer, need
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.trial import APPROACH_HEIGHT, APPROACH_SETTLE_TIME, trial_rng
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, yaw_quat
+from assembly_constraints.executor.world.geometry import fit_pose
 from assembly_constraints.executor.world.perturbation import CellBias
 from assembly_constraints.executor.world.scene import PART_FRICTION
 
@@ -220,13 +221,13 @@ class Assembler:
         return self._uncertainty.draw(rng, self.shape_of(part), hole or part, oriented)
 
     def _yaw(self, part: str, hole: str | None, setup: AttemptSetup) -> float:
-        """The tool yaw [rad] a peg is inserted with: aligned to its hole's estimated yaw
-        (0 for other parts and round pegs or holes)."""
+        """The tool yaw [rad] a peg is inserted with: aligned to its hole's estimated yaw,
+        turned as the polygon relation passes it (0 for other parts and round pegs or holes)."""
         peg = self.product.pegs.get(part)
         if peg is None or hole is None:
             return 0.0
         spec = self.product.geometry.holes[hole]
-        return aligned_yaw(peg.kind, spec.kind, spec.yaw + setup.vision_yaw)
+        return aligned_yaw(peg.kind, spec.kind, spec.yaw + fit_pose(peg, spec)[0] + setup.vision_yaw)
 
     def _pick(self, part: str, setup: AttemptSetup) -> Grasp:
         """Carry the empty tool to the part's grip point and close the gripper."""

@@ -35,7 +35,8 @@ from assembly_constraints.executor.cad.locating import LOCATING_REACH, MAX_REACH
 from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
 from assembly_constraints.executor.cad.step import load_step
 from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.cad.write import Settings, map_product, write_folder
+from assembly_constraints.executor.cad.write import Settings, map_product, section, write_folder
+from assembly_constraints.executor.world.geometry import section_fit
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
 """Default trays: the parts in a row from this point [m], this far apart along x [m]."""
@@ -117,10 +118,9 @@ def report(derived: Derived) -> list[str]:
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
         held = "empty"
         if fit.part is not None and fit.section is not None:
-            ca, cb = fit.clearance
-            clearance = _mm(ca) if fit.hole.kind == fit.section.kind == "round" else f"{_mm(ca)} x {_mm(cb)}"
+            room = section_fit(section(fit.part, fit.section), section(hid, fit.hole))
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
-                    f"{clearance} mm)")
+                    f"{_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg)")
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
                      f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")

@@ -4,7 +4,8 @@
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
-  (:func:`assembly_constraints.executor.world.geometry.passes`), closed world;
+  (:func:`assembly_constraints.executor.world.geometry.passes`: the exact rules of round,
+  square and rect sections, the polygon relation where one is a polygon), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's, the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
@@ -34,6 +35,7 @@ import trimesh
 from assembly_constraints.bridge.errors import ToolError
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.product import Mesh
+from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
@@ -44,8 +46,10 @@ from assembly_constraints.executor.cad.convex import (
 )
 from assembly_constraints.executor.cad.covers import Mapped, map_parts
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.cad.sections import Shape2D
 from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
+from assembly_constraints.executor.world.geometry import Section, load_geometry, margin
+from assembly_constraints.executor.world.polygon_fit import OutlineError
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -69,8 +73,11 @@ class Settings:
     names: dict[str, str]
 
 
-def section(name: str, shape_kind: str, a: float, b: float) -> Section:
-    return Section(name, shape_kind, a, width=b if shape_kind == "rect" else 0.0)
+def section(name: str, shape: Shape2D) -> Section:
+    """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
+    outline = tuple((_q(x), _q(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
+    return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
+                   outline=outline, corner=shape.corner)
 
 
 def _q(value: float) -> float:
@@ -78,8 +85,17 @@ def _q(value: float) -> float:
     return round(value, 7) + 0.0
 
 
-def _size(kind: str, a: float, b: float) -> str:
-    return f"[{_q(a)}, {_q(b)}]" if kind == "rect" else f"{_q(a)}"
+def _section_lines(shape: Shape2D) -> list[str]:
+    """``kind``, ``size`` and a rounded square's or rect's ``corner`` radius of a section
+    table; a polygon's ``size`` the extents of its ``outline`` along x and y, which follows
+    (about its centre, in the cell's axes)."""
+    if shape.kind != "polygon":
+        size = f"[{_q(shape.a)}, {_q(shape.b)}]" if shape.kind == "rect" else f"{_q(shape.a)}"
+        return [f'kind = "{shape.kind}"', f"size = {size}", *([f"corner = {_q(shape.corner)}"] if shape.corner else [])]
+    points = section("", shape).outline
+    extents = np.ptp(np.array(points), axis=0)
+    return ['kind = "polygon"', f"size = [{_q(float(extents[0]))}, {_q(float(extents[1]))}]",
+            "outline = [" + ", ".join(f"[{x}, {y}]" for x, y in points) + "]"]
 
 
 def _symbols(symbols: list[clingo.Symbol]) -> str:
@@ -98,12 +114,12 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
                   f'role = "{role}"']
         x, y = settings.trays[pid]
         lines.append(f"start = [{_q(x)}, {_q(y)}]")
-        if _section_kind(pegs.get(pid)) not in (None, "other"):
+        if _section_kind(pegs.get(pid)) is not None:
             lines.append(f'shape = "{_section_kind(pegs.get(pid))}"')
         lines.append("")
     for hid, fit in derived.holes.items():
         name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
-        lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{_kind(fit.hole.kind)}"',
+        lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(fit.position[0])}, {_q(fit.position[1])}]", ""]
     return "\n".join(lines)
 
@@ -112,21 +128,15 @@ def _section_kind(fit: HoleFit | None) -> str | None:
     return None if fit is None or fit.section is None else fit.section.kind
 
 
-def _kind(kind: str) -> str:
-    """An ``other`` hole is stated as round in assembly.toml (its shape is only a label there)."""
-    return kind if kind != "other" else "round"
-
-
 def sizes_text(derived: Derived) -> str:
-    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
-            if fit.section is not None and fit.section.kind != "other"}
-    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    """``sizes.lp``: ``fits(P,H)`` for every peg whose nominal section passes a hole's (:func:`margins`)."""
+    rooms = margins(derived)
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
-             _symbols([clingo.Function("part", [clingo.Function(p)]) for p in pegs]),
-             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in holes])]
-    for pid, peg in pegs.items():
-        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, hole in holes.items()
-                if passes(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))]
+             _symbols([clingo.Function("part", [clingo.Function(p)]) for p in rooms]),
+             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in derived.holes])]
+    for pid, holes in rooms.items():
+        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, room in holes.items()
+                if room > 0]
         if fits:
             lines.append(_symbols(fits))
     return "\n".join(lines) + "\n"
@@ -134,13 +144,15 @@ def sizes_text(derived: Derived) -> str:
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
-    (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not
-    pass), sections ``other`` left out."""
-    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
-            if fit.section is not None and fit.section.kind != "other"}
-    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
-    return {pid: {hid: margin(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))
-                  for hid, hole in holes.items()} for pid, peg in pegs.items()}
+    (:func:`assembly_constraints.executor.world.geometry.margin`, the polygon relation for
+    polygon sections; negative: it does not pass); ExecutorError naming the part or hole
+    whose polygon section is no simple outline."""
+    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
+    try:
+        return {pid: {hid: margin(section(f"part {pid}", peg), section(f"hole {hid}", fit.hole))
+                      for hid, fit in derived.holes.items()} for pid, peg in pegs.items()}
+    except OutlineError as exc:  # a slice of a mesh that crosses itself
+        raise ExecutorError(f"{exc} (the mesh's slice at the hole's mid-depth)") from None
 
 
 def nominal_text(derived: Derived) -> str:
@@ -203,8 +215,8 @@ def simulable(derived: Derived) -> str | None:
             return f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"
     fits = list(derived.holes.values())
     for fit in fits:
-        if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
-            return f"hole {fit.id} is not entered from above with a round, square or rect section"
+        if fit.axis != "+z":
+            return f"hole {fit.id} is not entered from above"
     if not fits or not derived.hole_of:
         return "no part stands in a hole of the base"
     return None
@@ -301,8 +313,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(max(top - depth - z0, 1e-3))}", ""]
     for hid, fit in derived.holes.items():
-        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', f'kind = "{fit.hole.kind}"',
-                  f"size = {_size(fit.hole.kind, fit.hole.a, fit.hole.b)}"]
+        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', *_section_lines(fit.hole)]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         if abs(fit.entry - top) > _LEVEL:
@@ -313,8 +324,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     for pid, fit in sorted(derived.hole_of.items()):
         mesh, peg = derived.parts[pid].mesh, fit.section
         assert peg is not None
-        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', f'kind = "{peg.kind}"',
-                  f"size = {_size(peg.kind, peg.a, peg.b)}",
+        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', *_section_lines(peg),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",

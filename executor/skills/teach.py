@@ -24,6 +24,7 @@ from assembly_constraints.executor.skills.dmp import PhaseClock, Skill, WrenchPr
 from assembly_constraints.executor.trial import APPROACH_SETTLE_TIME, Cell
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
 from assembly_constraints.executor.world.assets import regenerate_assets
+from assembly_constraints.executor.world.geometry import fit_pose
 from assembly_constraints.executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s]
@@ -76,7 +77,8 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     geometry = cell.geometry
     part = next(p for pid, p in sorted(geometry.parts.items()) if p.shape == shape)
     hole = geometry.holes[part.demo_hole]
-    origin = np.array([*hole.position, hole.top_z])
+    turn, shift = fit_pose(part, hole)
+    origin = np.array([*(np.array(hole.position) + shift), hole.top_z])
     bottom = hole.depth
     motion = cell.motion_for(part.id)
     assert cell.scene is not None  # set by motion_for
@@ -84,7 +86,7 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     arm = motion.controller.arm
     arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
-    yaw = aligned_yaw(part.kind, hole.kind, hole.yaw)
+    yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
     quat = tool_quat(yaw)
 
     def go_to_start() -> None:
