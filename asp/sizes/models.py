@@ -117,11 +117,12 @@ def build_model(name: str, parts: Sequence[str], declared: Mapping[str, str] | N
 
 
 def weaker(model: SizeModel) -> SizeModel | None:
-    """The next weaker model (``line`` -> ``sections`` -> ``pairs``; ``sections`` of a
-    product whose parts all state one section is ``line`` itself, so it goes to
-    ``pairs``), or None for ``pairs``."""
+    """The next weaker model (``line`` -> ``sections`` -> ``pairs``; ``sections`` is
+    skipped where it is ``line`` itself, all parts stating one section, or ``pairs``
+    itself, no two parts on one line), or None for ``pairs``."""
     parts = list(model.sections)
-    if model.name == "line" and len(set(stated_or_own(parts, model.declared).values())) > 1:
+    lines = group_by_section(stated_or_own(parts, model.declared)).values()
+    if model.name == "line" and len(lines) > 1 and max(map(len, lines)) > 1:
         return build_model("sections", parts, model.declared)
     if model.name in ("line", "sections"):
         return build_model("pairs", parts, model.declared)
