@@ -192,6 +192,13 @@ class Skill:
         moved._dmp = self._rollout_dmp()  # its remembered forcing terms do not depend on the goal
         return moved
 
+    def in_hole(self, depth: float) -> Skill:
+        """This skill in a hole ``depth`` [m] deep: :meth:`deeper` by the difference from the
+        depth of the hole it was taught in (its record); ExecutorError for a skill without one."""
+        if self.taught is None:
+            raise ExecutorError(f"skill {self.shape}: no record of its teaching (the depth it was taught at)")
+        return self.deeper(depth - self.taught.depth)
+
     def rollout(self, start_pos: np.ndarray, start_quat_xyzw: np.ndarray, goal_pos: np.ndarray,
                 goal_quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The DMP from a start to a goal pose (hole frame): times (N,) [s], positions

@@ -15,7 +15,8 @@ taught on (:class:`assembly_constraints.executor.skills.dmp.TaughtOn`).
 Poses, wrenches and p_goal are stored in the hole's frame (its
 origin at the centre of the hole's entry, at the hole's own height, turned by the hole's
 yaw), so the skill runs in a hole of any yaw and at any height; in a hole of another depth
-its goal moves with the bottom (:meth:`assembly_constraints.executor.skills.dmp.Skill.deeper`).
+its goal moves with the bottom, by the depth its record gives
+(:meth:`assembly_constraints.executor.skills.dmp.Skill.in_hole`).
 ``./run.sh executor teach`` rebuilds ``data/<assembly>/demonstrations/<shape>.json``: every
 shape is taught first, and the files are written only when all were taught.
 """

@@ -84,3 +84,14 @@ def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(
     trial = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", "--json", timeout=120)
     assert trial.returncode == 0, trial.stderr
     assert json.loads(trial.stdout)["summary"]["no_fit"] == 1
+
+
+def test_a_skill_moves_to_a_hole_s_bottom_from_the_depth_it_was_taught_at(spare: Path) -> None:
+    """The goal follows the depth the record gives, not the product's ``demo_hole`` as it
+    is now (which may have been edited since the teaching)."""
+    skill = load_skill(spare, "square_peg")
+    assert skill.taught is not None and skill.in_hole(skill.taught.depth) is skill
+    deeper = skill.in_hole(skill.taught.depth + 0.005)
+    assert deeper.end_position[2] == pytest.approx(skill.end_position[2] - 0.005, abs=1e-12)
+    assert deeper.demo_goal[2] == pytest.approx(skill.demo_goal[2] - 0.005, abs=1e-12)
+    assert deeper.taught == skill.taught
