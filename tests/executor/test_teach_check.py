@@ -70,7 +70,8 @@ def test_a_skill_whose_teaching_failed_or_whose_record_is_bad_is_refused(spare: 
 def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(spare: Path, run_executor) -> None:
     """The square peg (12 mm side, 17 mm diagonal) demonstrated in the round 13.3 mm hole r1
     stops on its entry: refused, the shipped skills untouched; the trial with them says
-    what the physics does (no fit)."""
+    what the physics does (no fit), and a trial with a skill recording such a teaching is
+    refused."""
     geometry = spare / "geometry.toml"
     geometry.write_text(geometry.read_text().replace('demo_hole = "s1"', 'demo_hole = "r1"'))
     before = {path.name: path.read_bytes() for path in (spare / "demonstrations").iterdir()}
@@ -84,6 +85,11 @@ def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(
     trial = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", "--json", timeout=120)
     assert trial.returncode == 0, trial.stderr
     assert json.loads(trial.stdout)["summary"]["no_fit"] == 1
+    path = _edit_record(spare, {"hole": "r1", "hole_kind": "round", "end_error": error_mm / 1000})  # as it was saved
+    refused = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", timeout=120)
+    lines = [line for line in refused.stderr.splitlines() if not line.startswith("pybullet build time")]
+    assert refused.returncode == 2 and len(lines) == 1 and not refused.stdout, refused.stdout + refused.stderr
+    assert lines[0].startswith(f"error: {path}: its demonstration did not reach its goal (part p3 in hole r1")
 
 
 def test_a_skill_moves_to_a_hole_s_bottom_from_the_depth_it_was_taught_at(spare: Path) -> None:
