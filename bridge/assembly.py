@@ -4,10 +4,11 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
 
 - ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role``, optional ``start``
   ``[x, y]`` [m] (where the part waits in the cell), optional ``shape`` (its cross-section
-  kind, :data:`SHAPES`) and, for a rect part, optional ``section`` (a label: parts of one
-  section are scaled copies of one cross-section; default the shape for round and
-  square, the part's own id for rect); ``[holes.<id>]`` with ``name``, ``shape`` (default
-  round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
+  kind, :data:`SHAPES`; default the kind ``geometry.toml`` gives it) and, for a rect part,
+  optional ``section`` (a label: parts of one section are scaled copies of one
+  cross-section; default the shape for round and square, the part's own id for rect);
+  ``[holes.<id>]`` with ``name``, ``shape`` (default the kind ``geometry.toml`` gives it,
+  else round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
   table with ``model`` (the size model the product declares: ``line``, ``sections`` or
   ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
@@ -34,8 +35,11 @@ from assembly_constraints.bridge.product import (
     SHAPES,
     SIZE_MODELS,
     ProductDescription,
+    hole_kinds,
     is_id,
     load_product_description,
+    part_kinds,
+    section_label,
 )
 
 __all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS", "Assembly", "Hole", "Item", "Part",
@@ -125,15 +129,17 @@ def resolve_assembly_folder(name_or_path: str) -> Path:
 
 
 def assembly_of(product: ProductDescription) -> Assembly:
-    """The planner's view of a decoded product: its parts and holes in file order, a rect
-    or polygon part's section defaulting to its id, a round or square part's to its shape."""
+    """The planner's view of a decoded product: its parts and holes in file order, each
+    with the kind every statement of the product gives it (``shape`` in ``assembly.toml``,
+    the kind of its table in ``geometry.toml``: :func:`assembly_constraints.bridge.product.part_kinds`),
+    a rect or polygon part's section defaulting to its id, a round or square part's to its kind."""
     layout = product.assembly
+    kinds, hole_kind = part_kinds(layout, product.geometry), hole_kinds(layout, product.geometry)
     parts = tuple(
         Part(pid, part.name or pid, part.role, None if part.start is None else (part.start[0], part.start[1]),
-             part.shape, part.section or (None if part.shape is None else pid if part.shape in ("rect", "polygon")
-                                                             else part.shape))
+             kinds.get(pid), None if pid not in kinds else section_label(pid, kinds[pid], part.section))
         for pid, part in layout.parts.items())
-    holes = tuple(Hole(hid, hole.name or hid, hole.shape,
+    holes = tuple(Hole(hid, hole.name or hid, hole_kind[hid],
                        None if hole.position is None else (hole.position[0], hole.position[1]))
                   for hid, hole in layout.holes.items())
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,

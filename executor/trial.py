@@ -188,7 +188,7 @@ class Cell:
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
-        skill = self.check_pair(part, hole).deeper(self.geometry.deeper_than_taught(spec, hole_spec))
+        skill = self.check_pair(part, hole).in_hole(hole_spec.depth)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps

@@ -17,6 +17,7 @@ import shapely
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.inputs import read_bytes, shorten
+from assembly_constraints.bridge.product.kinds import section_label
 from assembly_constraints.bridge.product.tables import (
     CONVEX_HEADER,
     TOUCH_TOLERANCE,
@@ -49,12 +50,14 @@ def _sides(size: float | list[float]) -> tuple[float, float]:
     return (size[0], size[1]) if isinstance(size, list) else (size, size)
 
 
-def check_assembly(path: Path, layout: AssemblyFile) -> None:
-    """A ``section`` only for a rect part; no id both a part and a hole."""
+def check_assembly(path: Path, layout: AssemblyFile, kinds: Mapping[str, str]) -> None:
+    """A ``section`` only for a rect part (``kinds``: part id -> kind, from every statement
+    of the product, :func:`assembly_constraints.bridge.product.kinds.part_kinds`); no id both a part and a hole."""
     for pid, part in layout.parts.items():
-        if part.section is not None and part.shape != "rect":
+        kind = kinds.get(pid)
+        if part.section is not None and kind != "rect":
             raise BridgeError(f"{path}: [parts.{pid}] section: only a part of shape \"rect\" has one "
-                              f"(a {part.shape or 'part without a shape'} is its own section)")
+                              f"(a {kind or 'part without a shape'} is its own section)")
     clash = set(layout.parts) & set(layout.holes)
     if clash:
         raise BridgeError(f"{path}: ids used for both a part and a hole: {sorted(clash)}")
@@ -285,9 +288,9 @@ def _check_kinds(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     first: dict[str, tuple[str, PartShape]] = {}
     for pid, part in layout.parts.items():
         spec = part_shape.get(pid)
-        if part.shape is None or spec is None:
+        if spec is None:
             continue
-        section = part.section or (pid if part.shape in ("rect", "polygon") else part.shape)
+        section = section_label(pid, spec.kind, part.section)
         other_id, other = first.setdefault(section, (pid, spec))
         (a, b), (oa, ob) = _sides(spec.size), _sides(other.size)
         if (other.kind == "round") != (spec.kind == "round") or not math.isclose(b / a, ob / oa, rel_tol=1e-9):

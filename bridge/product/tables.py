@@ -89,11 +89,12 @@ class PartEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 
 class HoleEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """``[holes.<id>]``: a readable ``name``, its cross-section kind, its ``position`` [m]
-    on the base plate."""
+    """``[holes.<id>]``: a readable ``name``, its cross-section kind (default: the kind of
+    its ``[hole_shapes.*]`` in ``geometry.toml``, else round), its ``position`` [m] on the
+    base plate."""
 
     name: Text | None = None
-    shape: Kind = "round"
+    shape: Kind | None = None
     position: XY | None = None
 
 

@@ -287,7 +287,7 @@ class Assembler:
             xy = found.hole_xy
             if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
                 peg = p.pegs[part]
-                skill_obj = self._skill(peg.shape).deeper(p.geometry.deeper_than_taught(peg, p.geometry.holes[hole]))
+                skill_obj = self._skill(peg.shape).in_hole(p.geometry.holes[hole].depth)
             else:
                 skill_obj = self._skill(p.heads[part].skill)
         origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])

@@ -160,11 +160,6 @@ class CellGeometry:
         plate's level (0.0 exactly when no hole is deeper)."""
         return self.plate.top_z - self.plate.tile_thickness - self.base_top
 
-    def deeper_than_taught(self, part: PartSpec, hole: HoleSpec) -> float:
-        """How much deeper [m] ``hole`` is than the hole ``part``'s skill is taught in (its
-        shape's ``demo_hole``; negative: shallower)."""
-        return hole.depth - self.holes[part.demo_hole].depth
-
     @property
     def base_mesh(self) -> Path | None:
         """The base's own mesh file (the cell frame [m]) when it is simulated from it, else None."""
