@@ -351,12 +351,19 @@ def comma_list(
 
 
 def number_in(kind: Callable[[str], float], low: float, high: float) -> Callable[[str], float]:
-    """An item type: a finite number of ``kind`` in [low, high) (ValueError otherwise)."""
+    """An argparse (or :func:`comma_list` item) type: a finite number of ``kind`` (``int``,
+    ``float``, :func:`strict_int`...) in [low, high); ArgumentTypeError naming the range
+    otherwise."""
+    integer = kind in (int, strict_int)
+    expected = f"{'an integer' if integer else 'a finite number'} in [{low:g}, {high:g})"
 
     def parse(text: str) -> float:
-        value = kind(text)
+        try:
+            value = kind(text)
+        except ValueError:
+            value = math.nan
         if not (math.isfinite(value) and low <= value < high):
-            raise ValueError(text)
+            raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected {expected}")
         return value
 
     return parse

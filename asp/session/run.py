@@ -389,6 +389,9 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             directory.wait_for(max(1, len(cell_ids)), timeout=settings.wait_for_cell_s)
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
+        if settings.cells == 0 and not settings.allow_cells:
+            LOG.warning("--cells 0 without --allow-cells: using every cell that answers on the network (now: %s); "
+                        "name the expected ones with --allow-cells", ", ".join(sorted(directory.alive())))
         timings = {"cells_ready_s": time.perf_counter() - started}
         LOG.info("assumes: %s", model.assumption())  # once every input was checked and the cells are up
         if stated_prior is not None:
