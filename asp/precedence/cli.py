@@ -133,7 +133,7 @@ def _learn(args: argparse.Namespace) -> None:
     for path in (args.out, args.dot, args.png):  # before the learning and the drawing
         if path:
             check_writable(path)
-    prior = load_relation([args.prior]) if args.prior else None
+    prior = load_relation([args.prior], data=True) if args.prior else None
     demos = _demonstrations(args, prior)
     if prior is None:
         relation = learn_must_precede(demos, args.min_support)
