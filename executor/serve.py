@@ -61,7 +61,13 @@ from assembly_constraints.bridge.cell_settings import (
     cell_settings_of,
     decode_settings,
 )
-from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, path_setting
+from assembly_constraints.bridge.cli_types import (
+    ArgumentParser,
+    add_assembly_argument,
+    finite_float,
+    nonempty_path,
+    path_setting,
+)
 from assembly_constraints.bridge.inputs import read_bytes
 from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from assembly_constraints.bridge.messages import (
@@ -428,14 +434,14 @@ def build_parser() -> argparse.ArgumentParser:
     add_assembly_argument(parser)
     parser.add_argument("--delay", type=finite_float(0, 3600), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
-    parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
+    parser.add_argument("--rrd", type=nonempty_path, help="save this cell's Rerun recording to FILE")
     parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
     add_viewer_arguments(parser, serve=False)  # a cell serves for as long as it runs: stream to a viewer
     parser.add_argument("--block-hole", action="append", default=[], metavar="H",
                         help="put an obstacle in hole H for plan steps (a fault injection; repeatable)")
     parser.add_argument("--lifeline", action="store_true",
                         help="exit when standard input closes (set by a supervising session)")
-    parser.add_argument("--ilc-state", type=Path, metavar="FILE",
+    parser.add_argument("--ilc-state", type=nonempty_path, metavar="FILE",
                         help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
                         "save them there after every update (a session passes <run>/<cell>-ilc.json)")
     add_cell_arguments(parser)
@@ -498,6 +504,11 @@ def serve(settings: ServeSettings) -> int:
 
             # So is a damaged state.
             read_state(Path(settings.ilc_state), description.ilc, offset_bound(description.admittance))
+    elif settings.cell.description is not None:
+        from assembly_constraints.executor.cell_description import load_cell_description
+
+        # Not used by this backend, but a bad file is refused rather than silently ignored.
+        load_cell_description(Path(settings.cell.description))
     listen = cell_listen(settings.listen, settings.connect, zenoh_config)
     connect = list(settings.connect)
     signal.signal(signal.SIGTERM, _exit_on_signal)

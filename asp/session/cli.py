@@ -38,6 +38,7 @@ from assembly_constraints.bridge.cli_types import (
     comma_list,
     finite_float,
     int_in,
+    nonempty_path,
     path_setting,
 )
 from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
@@ -62,8 +63,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--demos", type=Path, metavar="FILE",
                         help="demonstrations (default: the assembly's demos.txt); a part placed into a "
                              "hole (p1@r1) is a fit the size learning starts from")
-    parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
-    parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
+    parser.add_argument("--out", type=nonempty_path, help="run folder (default runs/<UTC time>)")
+    parser.add_argument("--resume", type=nonempty_path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="cells started here: sim (PyBullet) or truth (answers from the geometry's "
                              "cross-sections, no simulation)")
@@ -138,7 +139,7 @@ def _summary(result: dict, run: Path) -> str:
         if result["plans"] else f"no plan: {result['error']}")
     files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
     python = shlex.quote(sys.executable)
-    learned = shlex.quote(str(run / "learned.lp"))
+    learned = shlex.quote(str(run.resolve() / "learned.lp"))  # the "next" commands work from any folder
     part = result["fits"][0][0] if result["fits"] else "p1"
     return "\n".join([
         f"run {result['run']}: {result['experiments']} experiments "
@@ -157,7 +158,7 @@ def _summary(result: dict, run: Path) -> str:
         f"files written in {run}: {' '.join(files)}",
         "next:",
         *(f"  {(label + ':').ljust(23)} {command}" for label, command in (
-            ("view the recording", f"{_program()} view {shlex.quote(str(run))}"),
+            ("view the recording", f"{_program()} view {shlex.quote(str(run.resolve()))}"),
             (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
             *([("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5")]
               if result["plans"] else []),

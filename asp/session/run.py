@@ -77,7 +77,7 @@ from assembly_constraints.bridge.files import make_folder
 from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
 from assembly_constraints.bridge.recording.reader import read_recording
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
-from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, free_loopback_endpoint, open_session
+from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 LOG = logging.getLogger(__name__)
 RESULT_KEYS = ("run", "experiments", "fits", "must_precede", "plans", "matches_truth", "model", "assumption",
@@ -154,7 +154,7 @@ def _endpoints(settings: SessionSettings) -> tuple[list[str], list[str]]:
     """(listen, connect) of the planner: it listens for its own cells, else connects."""
     listen, connect = list(settings.listen), list(settings.connect)
     if settings.cells > 0:
-        return listen or [free_loopback_endpoint()], connect
+        return listen or [LOOPBACK_ANY_PORT], connect
     return listen, connect or ([] if settings.zenoh_config else [DEFAULT_ENDPOINT])
 
 
@@ -412,6 +412,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         stack.callback(journal.close)
         session = open_session(listen, connect, zenoh_config)
         stack.callback(session.close)
+        listen = bound_endpoints(session, listen)  # the port its cells connect to, as bound
         directory = CellDirectory(session)
         stack.callback(directory.close)
         cells: list[CellProcess] = []
@@ -440,6 +441,9 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             directory.wait_for(max(1, len(cell_ids)), timeout=settings.wait_for_cell_s)
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
+        if settings.cells == 0 and not settings.allow_cells:
+            LOG.warning("--cells 0 without --allow-cells: using every cell that answers on the network (now: %s); "
+                        "name the expected ones with --allow-cells", ", ".join(sorted(directory.alive())))
         timings = {"cells_ready_s": time.perf_counter() - started}
         LOG.info("assumes: %s", model.assumption())  # once every input was checked and the cells are up
         if stated_prior is not None:

@@ -224,9 +224,10 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
     digest), the base none (it is a static concave mesh)."""
     folder = path.parent
     try:
-        digest = hashlib.sha256(read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)).hexdigest()
+        data = read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)
     except BridgeError as exc:
         raise BridgeError(f"{path}: [{table}] mesh.file: {exc}") from None
+    digest = hashlib.sha256(data).hexdigest()
     if digest != mesh.sha256:
         raise fail(path, table, "mesh.sha256", f"the SHA-256 of {mesh.file} ({digest}: the file changed since "
                    "geometry.toml was written; import the product again)", mesh.sha256)
@@ -247,6 +248,32 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
     if first != expected:
         raise fail(path, table, "mesh.convex", f"pieces made from {mesh.file} as it is (first line of "
                    f"{mesh.convex} {expected!r}; stale pieces: import the product again)", first)
+    for key, name, content in (("mesh.file", mesh.file, data), ("mesh.convex", mesh.convex, text)):
+        _check_vertices(path, table, key, folder / name, content)
+
+
+MAX_PART_REACH = 0.5
+"""A moving part's mesh and convex pieces lie within this of its frame's origin on every
+axis [m]: a part the arm carries, not one metres away or the size of a room (millimetres
+written as metres)."""
+
+
+def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes) -> None:
+    """Every vertex ``v x y z`` of the OBJ ``data`` (the file ``obj``) is three finite
+    coordinates within :data:`MAX_PART_REACH` [m]; BridgeError naming ``obj``'s line otherwise."""
+    reach = MAX_PART_REACH
+    for number, line in enumerate(data.splitlines(), 1):
+        words = line.split()
+        if words[:1] != [b"v"]:
+            continue
+        try:
+            vertex = [float(word) for word in words[1:4]]
+        except ValueError:
+            vertex = []
+        if len(vertex) != 3 or not all(-reach <= c <= reach for c in vertex):  # NaN compares False
+            raise BridgeError(f"{path}: [{table}] {key}: {obj}:{number}: expected a vertex 'v x y z' of finite "
+                              f"coordinates within [-{reach:g}, {reach:g}] m of the part frame's origin, got "
+                              f"{shorten(line.decode('utf-8', 'replace'))!r}")
 
 
 def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]], turned: set[str]) -> None:

@@ -25,7 +25,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from assembly_constraints.bridge.cli_types import ArgumentParser, number_in
+from assembly_constraints.bridge.cli_types import ArgumentParser, nonempty_path, number_in
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import MESH_FOLDER
@@ -203,7 +203,7 @@ def main(argv: list[str]) -> int:
                             "geometric_precedence.lp, geometry.toml where the product is made of primitives.",
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("source", type=Path, metavar="SOURCE", help="a STEP file or a folder of *.stl/*.obj meshes")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="the assembly folder to write")
+    parser.add_argument("--out", type=nonempty_path, required=True, metavar="DIR", help="the assembly folder to write")
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
     parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to")
