@@ -248,10 +248,26 @@ class Head(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     mesh: Mesh | None = None
 
 
+class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[manual.<id>]``: a part the cell has no operation for (it goes in along no axis
+    into a hole the cell knows), placed by hand: ``reason`` says why, ``goal`` [x, y, z] [m]
+    is its frame's origin when assembled, ``tray`` where that origin waits [m]; simulated
+    from its own ``mesh`` (its frame at the centre of its bounding box's bottom face, the
+    cell's axes)."""
+
+    reason: Text
+    goal: Annotated[list[Coordinate], Meta(min_length=3, max_length=3,
+                                           description="[x, y, z] in metres, finite and within ±100")]
+    tray: XY
+    mass: Mass
+    mesh: Mesh
+    name: Text | None = None
+
+
 class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``geometry.toml``: the plate, the cross-sections of holes and pegs, the cell's extra
-    parts, an optional gripper (else the cell description's), the product's base, covers
-    and heads."""
+    parts, an optional gripper (else the cell description's), the product's base, covers,
+    heads and the parts placed by hand."""
 
     plate: Plate
     hole_shapes: dict[Id, HoleShape] = {}
@@ -261,6 +277,7 @@ class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True)
     base: Base | None = None
     covers: dict[Id, Cover] = {}
     heads: dict[Id, Head] = {}
+    manual: dict[Id, Manual] = {}
 
 
 class ProductDescription(msgspec.Struct, frozen=True, kw_only=True):

@@ -13,6 +13,9 @@ Per kind of part (the ``skill`` of the step's record):
   unknown grasp offset; a spiral search fails on a long part tilting on the pin tops);
 - ``insert_socket``: a head into the socket of its part, wherever that part is; it stays
   fixed to it from then on (screwed).
+- ``manual``: a part the cell has no operation for (``[manual.*]`` of ``geometry.toml``),
+  placed by hand: put :data:`BY_HAND_ABOVE` above its goal and let go; the step is ``fit``
+  when it settles within :data:`STAY_TOLERANCE` of its goal.
 
 A failed attempt (the goal check fails) lifts the part and tries again with a fresh
 vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
@@ -70,6 +73,8 @@ friction; random parts only (the cell's systematic errors and ILC are used with
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
+BY_HAND_ABOVE = 2e-4  # [m] a part placed by hand is let go this far above its goal
+BY_HAND_SETTLE = 0.3  # [s] it is left to settle this long
 STAY_TOLERANCE = 0.005
 """A part let go at its goal must still be within this distance of it after the tool's
 retreat [m] (placed parts are within 2 mm); else the step is ``no_fit`` and the part is
@@ -130,7 +135,7 @@ class Assembler:
         self.layer, self.ilc = layer, ilc
 
     def skill_of(self, part: str) -> str:
-        """The step's skill: fixture, insert, insert_over or insert_socket."""
+        """The step's skill: fixture, insert, insert_over, insert_socket or manual."""
         p = self.product
         if part == p.base.id:
             return "fixture"
@@ -140,6 +145,8 @@ class Assembler:
             return "insert_over"
         if part in p.heads:
             return "insert_socket"
+        if part in p.manual:
+            return "manual"
         raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(p.parts)})")
 
     def shape_of(self, part: str) -> str:
@@ -175,6 +182,8 @@ class Assembler:
         skill = self.skill_of(part)
         world, motion = self.world, self.world.motion
         wall0, sim0 = time.perf_counter(), motion.steps
+        if skill == "manual":
+            return self._by_hand(part, wall0, sim0)
         rng = trial_rng(seed, part, hole or "none")
         if skill == "insert" and hole is not None:
             world.set_peg_goal(part, hole)
@@ -212,6 +221,19 @@ class Assembler:
         return StepRecord(part, hole, skill, "fit" if ok else "no_fit", len(outcomes), time.perf_counter() - wall0,
                           max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
                           (motion.steps - sim0) * 0.001)
+
+    def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
+        """A part placed by hand (``manual``): let go just above its goal, settled."""
+        world = self.world
+        world.set_pose(part, world.goals[part] + np.array([0.0, 0.0, BY_HAND_ABOVE]))
+        world.settle(BY_HAND_SETTLE)
+        error = world.goal_error(part)
+        ok = error <= STAY_TOLERANCE
+        if ok:
+            self.placed.add(part)
+        world.rest()
+        return StepRecord(part, None, "manual", "fit" if ok else "no_fit", 1, time.perf_counter() - wall0, 0.0, 0.0,
+                          error, (world.motion.steps - sim0) * 0.001)
 
     def _draw(self, rng: np.random.Generator, part: str, hole: str | None) -> AttemptSetup:
         """One execution's errors: of the part's shape and its hole (a cover or head: of

@@ -98,6 +98,7 @@ class AssemblyWorld:
         self._build_covers()
         self.socket_offset: dict[str, np.ndarray] = {}
         self._build_heads()
+        self._build_manual()
         self.reset_tray()
         self.rest()
         self._build_arm()
@@ -129,8 +130,8 @@ class AssemblyWorld:
             self._tray[pid] = np.array([*spec.start, 0.0])
 
     def _mesh_body(self, pid: str) -> int:
-        """A cover or head simulated from its own mesh: its generated URDF (the mesh's
-        inertia, its convex pieces), at the origin."""
+        """A cover, head or part placed by hand simulated from its own mesh: its generated
+        URDF (the mesh's inertia, its convex pieces), at the origin."""
         stem = product_bodies(self.product.geometry)[pid].stem
         return pb.loadURDF(str(self.product.geometry.assets / f"{stem}.urdf"), flags=pb.URDF_USE_INERTIA_FROM_FILE,
                            physicsClientId=self.client)
@@ -154,6 +155,12 @@ class AssemblyWorld:
             cover = self.product.covers[head.into]
             self.socket_offset[hid] = np.array([sx, sy, cover.thickness - depth])
             self.goals[hid] = self.goals[head.into] + self.socket_offset[hid]
+
+    def _build_manual(self) -> None:
+        for mid, manual in sorted(self.product.manual.items()):
+            self.frames[mid] = PartFrames(self._mesh_body(mid), np.zeros(3), np.zeros(3))
+            self.goals[mid] = np.array(manual.goal)
+            self._tray[mid] = np.array([*manual.tray, 0.0])
 
     def _build_arm(self) -> None:
         gripper = self.product.geometry.gripper

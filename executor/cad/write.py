@@ -33,6 +33,7 @@ import trimesh
 
 from assembly_constraints.bridge.errors import ToolError
 from assembly_constraints.bridge.files import make_folder, write_atomic
+from assembly_constraints.bridge.inputs import shorten
 from assembly_constraints.bridge.product import Mesh
 from assembly_constraints.executor.cad.convex import (
     MESH_FOLDER,
@@ -55,6 +56,8 @@ MIN_CHAMFER = 1e-4
 """The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
 _LEVEL = 1e-5
 """A hole whose entry or depth differs by more than this from the plate's [m] states its own."""
+MAX_REASON = 200
+"""The longest ``reason`` of a ``[manual.<id>]`` table (characters)."""
 CELL_DEFLECTION = 1e-5
 """The largest distance [m] of a STEP base's faces from the triangles the cell collides
 with (its own mesh is measured at :data:`assembly_constraints.executor.cad.parts.STEP_DEFLECTION`)."""
@@ -223,6 +226,12 @@ def map_product(derived: Derived, settings: Settings) -> Mapped:
     return mapped if mapped.why is not None else replace(mapped, why=_tray_overlap(derived, mapped, settings))
 
 
+def manual_origin(mesh: trimesh.Trimesh) -> tuple[float, float, float]:
+    """The frame origin of a part placed by hand: the centre of its bounding box's bottom face [m]."""
+    (x0, y0, z0), (x1, y1, _) = mesh.bounds
+    return (float(x0 + x1) / 2, float(y0 + y1) / 2, float(z0))
+
+
 def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
     """Each part's transform (4 × 4) from the cell frame to its part frame (the base's: its
     bounding box's centre at its plate's ``base_center``)."""
@@ -230,6 +239,7 @@ def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
     (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
     origins = {pid: fit.origin for pid, fit in mapped.covers.items()} | {pid: fit.origin for pid, fit in
                                                                          mapped.heads.items()}
+    origins |= {pid: manual_origin(derived.parts[pid].mesh) for pid in mapped.manual}
     origins[derived.base] = ((x0 + x1) / 2, (y0 + y1) / 2, 0.0)
     return frames | {pid: trimesh.transformations.translation_matrix(np.negative(origin))
                      for pid, origin in origins.items()}
@@ -272,6 +282,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str,
     moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
     moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
     moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
+    moving += list(mapped.manual)
     for pid in sorted(moving):
         mesh = derived.parts[pid].mesh
         near = {other: part.mesh.copy().apply_transform(frames[pid]) for other, part in derived.parts.items()
@@ -335,6 +346,12 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   f'into = "{head.into}"', f'kind = "{head.section.kind}"', f"size = {_q(head.section.a)}",
                   f"length = {_q(head.length)}", f"mass = {_q(derived.parts[hid].mesh.volume * DENSITY)}",
                   f'skill = "{head.skill}"', *([_mesh_entry(meshes[hid])] if hid in meshes else []), ""]
+    for mid, reason in sorted(mapped.manual.items()):
+        lines += [f"[manual.{mid}]", f"name = {json.dumps(settings.names.get(mid, derived.parts[mid].name))}",
+                  f"reason = {json.dumps(shorten(reason, MAX_REASON))}",
+                  f"goal = {_numbers(manual_origin(derived.parts[mid].mesh))}",
+                  f"tray = {_numbers(settings.trays[mid])}", f"mass = {_q(derived.parts[mid].mesh.volume * DENSITY)}",
+                  _mesh_entry(meshes[mid]), ""]
     return "\n".join(lines)
 
 
@@ -371,7 +388,8 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     an earlier import left that this one does not use); returns them and why there is no
     ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
     make_folder(out)
-    roles = {pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
+    roles = ({pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
+             | {pid: "manual" for pid in mapped.manual})
     written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title, roles)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
                write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
