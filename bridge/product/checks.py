@@ -160,7 +160,7 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]
     meshes += [(f"covers.{cid}", cover.mesh, True) for cid, cover in geo.covers.items()]
     meshes += [(f"heads.{hid}", head.mesh, True) for hid, head in geo.heads.items()]
-    meshes += [(f"manual.{mid}", manual.mesh, True) for mid, manual in geo.manual.items()]
+    meshes += [(f"manual.{mid}", manual.mesh, False) for mid, manual in geo.manual.items()]
     meshes.append(("base", None if geo.base is None else geo.base.mesh, False))
     for table, mesh, moving in meshes:
         if mesh is not None:
@@ -170,7 +170,7 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
 def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
     """A part's ``mesh``: its ``file`` is there and has the stated ``sha256``; a moving
     part has ``convex`` pieces made from that file as it is (their header names its
-    digest), the base none (it is a static concave mesh)."""
+    digest), the base and a part placed by hand none (static concave meshes)."""
     folder = path.parent
     try:
         digest = hashlib.sha256(read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)).hexdigest()
@@ -181,8 +181,8 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
                    "geometry.toml was written; import the product again)", mesh.sha256)
     if not moving:
         if mesh.convex is not None:
-            raise fail(path, table, "mesh.convex", "no convex pieces (the base is simulated as its static concave "
-                       "mesh)", mesh.convex)
+            raise fail(path, table, "mesh.convex", "no convex pieces (the base and a part placed by hand are "
+                       "simulated as their static concave meshes)", mesh.convex)
         return
     if mesh.convex is None:
         raise BridgeError(f"{path}: [{table}] mesh.convex: expected the convex pieces of {mesh.file} (an .obj file "

@@ -74,7 +74,7 @@ class HeadSpec:
 class ManualSpec:
     """A part the cell has no operation for, placed by hand at its ``goal`` (its frame's
     origin [m]: the centre of its bottom face), waiting at ``tray`` [m]; ``reason`` why;
-    simulated from its own ``mesh``."""
+    simulated as its own ``mesh``, static."""
 
     id: str
     goal: Vec3

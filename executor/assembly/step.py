@@ -14,8 +14,7 @@ Per kind of part (the ``skill`` of the step's record):
 - ``insert_socket``: a head into the socket of its part, wherever that part is; it stays
   fixed to it from then on (screwed).
 - ``manual``: a part the cell has no operation for (``[manual.*]`` of ``geometry.toml``),
-  placed by hand: put :data:`BY_HAND_ABOVE` above its goal and let go; the step is ``fit``
-  when it settles within :data:`STAY_TOLERANCE` of its goal.
+  placed by hand where the CAD has it and fixed there (a static mesh); the arm does not move.
 
 A failed attempt (the goal check fails) lifts the part and tries again with a fresh
 vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
@@ -73,8 +72,6 @@ friction; random parts only (the cell's systematic errors and ILC are used with
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
-BY_HAND_ABOVE = 2e-4  # [m] a part placed by hand is let go this far above its goal
-BY_HAND_SETTLE = 0.3  # [s] it is left to settle this long
 STAY_TOLERANCE = 0.005
 """A part let go at its goal must still be within this distance of it after the tool's
 retreat [m] (placed parts are within 2 mm); else the step is ``no_fit`` and the part is
@@ -223,17 +220,12 @@ class Assembler:
                           (motion.steps - sim0) * 0.001)
 
     def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
-        """A part placed by hand (``manual``): let go just above its goal, settled."""
+        """A part placed by hand (``manual``): at its goal, fixed there."""
         world = self.world
-        world.set_pose(part, world.goals[part] + np.array([0.0, 0.0, BY_HAND_ABOVE]))
-        world.settle(BY_HAND_SETTLE)
-        error = world.goal_error(part)
-        ok = error <= STAY_TOLERANCE
-        if ok:
-            self.placed.add(part)
-        world.rest()
-        return StepRecord(part, None, "manual", "fit" if ok else "no_fit", 1, time.perf_counter() - wall0, 0.0, 0.0,
-                          error, (world.motion.steps - sim0) * 0.001)
+        world.set_pose(part, world.goals[part])
+        self.placed.add(part)
+        return StepRecord(part, None, "manual", "fit", 1, time.perf_counter() - wall0, 0.0, 0.0,
+                          world.goal_error(part), (world.motion.steps - sim0) * 0.001)
 
     def _draw(self, rng: np.random.Generator, part: str, hole: str | None) -> AttemptSetup:
         """One execution's errors: of the part's shape and its hole (a cover or head: of

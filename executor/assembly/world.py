@@ -130,8 +130,8 @@ class AssemblyWorld:
             self._tray[pid] = np.array([*spec.start, 0.0])
 
     def _mesh_body(self, pid: str) -> int:
-        """A cover, head or part placed by hand simulated from its own mesh: its generated
-        URDF (the mesh's inertia, its convex pieces), at the origin."""
+        """A cover or head simulated from its own mesh: its generated URDF (the mesh's
+        inertia, its convex pieces), at the origin."""
         stem = product_bodies(self.product.geometry)[pid].stem
         return pb.loadURDF(str(self.product.geometry.assets / f"{stem}.urdf"), flags=pb.URDF_USE_INERTIA_FROM_FILE,
                            physicsClientId=self.client)
@@ -157,8 +157,16 @@ class AssemblyWorld:
             self.goals[hid] = self.goals[head.into] + self.socket_offset[hid]
 
     def _build_manual(self) -> None:
+        """The parts placed by hand: static concave meshes, moved where they are placed."""
+        c = self.client
         for mid, manual in sorted(self.product.manual.items()):
-            self.frames[mid] = PartFrames(self._mesh_body(mid), np.zeros(3), np.zeros(3))
+            mesh = str(self.product.folder / manual.mesh.file)
+            col = pb.createCollisionShape(pb.GEOM_MESH, fileName=mesh, flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+                                          physicsClientId=c)
+            vis = pb.createVisualShape(pb.GEOM_MESH, fileName=mesh, rgbaColor=(0.55, 0.75, 0.45, 1), physicsClientId=c)
+            body = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                                      physicsClientId=c)
+            self.frames[mid] = PartFrames(body, np.zeros(3), np.zeros(3))
             self.goals[mid] = np.array(manual.goal)
             self._tray[mid] = np.array([*manual.tray, 0.0])
 

@@ -30,6 +30,7 @@ of the peg whose section is nearest its own (same kind first, then size, then id
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -212,14 +213,15 @@ def _nearest_peg(derived: Derived, section: Shape2D) -> str:
     return min(pegs, key=lambda item: (item[1].kind != section.kind, abs(item[1].a - section.a), item[0]))[0]
 
 
-def map_parts(derived: Derived, top: float) -> Mapped:
+def map_parts(derived: Derived, top: float, by_hand: Mapping[str, str]) -> Mapped:
     """The covers and heads of ``derived`` (module docstring), ``top`` [m] the holes'
-    entry (the plate top); each other part is one the cell places by hand, with why it
-    is neither."""
+    entry (the plate top); the parts ``by_hand`` (id -> why) and each other part that is
+    neither are ones the cell places by hand."""
     covers: dict[str, CoverFit] = {}
     heads: dict[str, HeadFit] = {}
-    manual: dict[str, str] = {}
-    others = [pid for pid in derived.parts if pid != derived.base and pid not in derived.hole_of]
+    manual = dict(by_hand)
+    others = [pid for pid in derived.parts if pid != derived.base and pid not in derived.hole_of
+              and pid not in by_hand]
     for pid in sorted(others, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p)):
         if derived.axis[pid] != "+z":
             manual[pid] = f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"

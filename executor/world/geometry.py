@@ -353,12 +353,10 @@ def peg_body(part: PartSpec) -> MeshBody | None:
 
 
 def product_bodies(geometry: CellGeometry) -> dict[str, MeshBody]:
-    """The covers, heads and parts placed by hand simulated from their own meshes, by part id."""
+    """The covers and heads simulated from their own meshes, by part id."""
     tables = geometry.tables
     bodies = {cid: MeshBody(f"cover_{cid}", cover.mesh, cover.mass, f"cover '{cid}'")
               for cid, cover in sorted(tables.covers.items()) if cover.mesh is not None}
-    bodies |= {mid: MeshBody(f"manual_{mid}", manual.mesh, manual.mass, f"part '{mid}' placed by hand")
-               for mid, manual in sorted(tables.manual.items())}
     return bodies | {hid: MeshBody(f"head_{hid}", head.mesh, head.mass, f"head '{hid}'")
                      for hid, head in sorted(tables.heads.items()) if head.mesh is not None}
 
