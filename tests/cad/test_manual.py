@@ -1,7 +1,7 @@
 """A part the cell has no operation for is placed by hand: ``import`` still writes
 ``geometry.toml`` (the part as its own mesh in ``[manual.<id>]`` with the reason), the
 plans mark its step ``(manual)``, ``session`` runs with the truth and the sim backends
-and the sim cell puts it where the CAD has it; the truth backend answers from
+and the sim cell puts it where the CAD has it (fixed there); the truth backend answers from
 ``sizes.lp`` where a product has no ``geometry.toml``."""
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ def test_a_part_on_pin_tops_is_written_to_be_placed_by_hand(tmp_path: Path,
     manual = geometry["manual"]["lid"]
     assert "no pin passes through it" in manual["reason"]
     assert manual["goal"] == pytest.approx([X_MM / 1000, 0.0, 0.035], abs=1e-6)  # its bottom face's centre
-    assert manual["mesh"]["convex"].endswith("lid.convex.obj")
+    assert manual["mesh"]["file"] == "meshes/lid.obj" and "convex" not in manual["mesh"]  # static: no pieces
     assert tomllib.loads((out / "assembly.toml").read_text())["parts"]["lid"]["role"] == "manual"
     product = load_product(str(out))  # the cell's loader takes it
     assert set(product.manual) == {"lid"} and product.manual["lid"].tray == (0.30, 0.28)
