@@ -86,3 +86,20 @@ def test_a_sim_session_places_the_part_by_hand_where_the_cad_has_it(run_cli: Run
     assert report["assembled"] and steps["lid"]["skill"] == "manual" and steps["lid"]["outcome"] == "fit"
     assert set(report["final_pose_error_mm"]) == {"plate", "peg1", "peg2", "lid"}
     assert max(report["final_pose_error_mm"].values()) <= POSE_BOUND_MM
+
+
+@pytest.mark.parametrize(("old", "new", "expected"), [
+    ("goal = [0.56, 0.0, 0.035]", "goal = [0.56, 0.0]", "[manual.lid] goal: expected [x, y, z] in metres"),
+    ('reason = "', 'reason = "" # ', "[manual.lid] reason: expected a non-empty text"),
+    ("[manual.lid]", "[manual.cap]", "[manual.cap]: expected a part of assembly.toml, got 'cap'"),
+])
+def test_a_bad_manual_table_is_one_line_naming_it(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                  old: str, new: str, expected: str) -> None:
+    out = _lid_on_pins(tmp_path)
+    text = (out / "geometry.toml").read_text()
+    assert old in text
+    (out / "geometry.toml").write_text(text.replace(old, new))
+    capsys.readouterr()
+    assert main(["executor", "sizes", "--assembly", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and expected in err, err
