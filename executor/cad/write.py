@@ -10,14 +10,16 @@
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
-- ``geometry.toml``: the simulated cell's product when every part but the base is a peg
-  standing in a hole along +z, a cover or a head (:mod:`assembly_constraints.executor.cad.covers`),
-  and no two parts overlap where they wait (and the cell's loader accepts it; left out
-  otherwise, and the report says why): the plate at the entry height and depth most
-  holes share, a hole at another one with its own ``top_z`` and ``depth``, the plate,
-  pegs, covers and heads as primitives where they are ones, else as their own meshes with
-  convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`; a STEP base
-  tessellated again to :data:`CELL_DEFLECTION` for the cell).
+- ``geometry.toml``: the simulated cell's product unless two parts overlap where they
+  wait (and when the cell's loader accepts it; left out otherwise, and the report says
+  why): pegs standing in holes entered along +z with a round, square or rect section,
+  covers and heads (:mod:`assembly_constraints.executor.cad.covers`), every other part
+  placed by hand (``[manual.<id>]``, :func:`cell_view`); the plate at the entry height and
+  depth most holes share, a hole at another one with its own ``top_z`` and ``depth``, the
+  plate, pegs, covers and heads as primitives where they are ones, else as their own
+  meshes with convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`;
+  a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell), a part placed by
+  hand as its own mesh (static, no pieces), a base without such holes as its own mesh.
 """
 
 from __future__ import annotations
@@ -269,8 +271,9 @@ def _mesh_entry(mesh: Mesh) -> str:
 def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str, Mesh], list[Path]] | str:
     """The meshes of the parts of a mapped product that are no primitive, written into
     ``out`` (the base in the cell frame, the others in their part frames, the moving ones
-    with their convex pieces); returns their ``mesh`` entries by part and the files written, or why a part
-    has no pieces that fit (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
+    with their convex pieces); returns their ``mesh`` entries by part and the files
+    written, or why a part has no pieces that fit
+    (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
     written: list[Path] = []
     if not derived.holes or not base_is_primitive(derived):  # no plate of primitives without holes
