@@ -90,6 +90,12 @@ class Assembly:
     holes: tuple[Hole, ...] = field(default_factory=tuple)
     size_model: str | None = None
     """The size model the product declares (``[sizes] model``), None when it declares none."""
+    manual: dict[str, str] = field(default_factory=dict)
+    """The parts the cell places by hand (``[manual.<id>]`` of ``geometry.toml``): id -> why."""
+
+    def step_text(self, part: str, hole: str | None) -> str:
+        """A plan step as the commands print it: ``p->h``, ``p``, a part placed by hand ``p (manual)``."""
+        return part + (f"->{hole}" if hole else "") + (" (manual)" if part in self.manual else "")
 
     def sections(self) -> dict[str, str]:
         """Part id -> section, for the parts whose cross-section is stated."""
@@ -142,8 +148,9 @@ def assembly_of(product: ProductDescription) -> Assembly:
     holes = tuple(Hole(hid, hole.name or hid, hole_kind[hid],
                        None if hole.position is None else (hole.position[0], hole.position[1]))
                   for hid, hole in layout.holes.items())
+    manual = {} if product.geometry is None else {mid: m.reason for mid, m in product.geometry.manual.items()}
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
-                    size_model=None if layout.sizes is None else layout.sizes.model)
+                    size_model=None if layout.sizes is None else layout.sizes.model, manual=manual)
 
 
 def load_assembly(name_or_path: str) -> Assembly:

@@ -198,9 +198,13 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("trial-unreadable-geometry", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"geometry.toml": unreadable("asm/geometry.toml", CRANFIELD / "geometry.toml")}), 2, "read"),
     # a session's cells answer from the product's geometry: without one, refused before any cell starts
-    ("session-truth-no-geometry", ("session", "--backend", "truth", "--assembly", "asm", "--out", "run"),
+    ("session-sim-no-geometry", ("session", "--assembly", "asm", "--out", "run"),
      assembly(**{"geometry.toml": lambda tmp: (tmp / "asm" / "geometry.toml").unlink()}), 2,
-     "asm/geometry.toml: no such file; the cells a session starts (--backend truth) answer from"),
+     "asm/geometry.toml: no such file; the cells a session starts (--backend sim) answer from"),
+    ("session-truth-no-geometry-no-sizes", ("session", "--backend", "truth", "--assembly", "asm", "--out", "run"),
+     assembly(**{"geometry.toml": lambda tmp: (tmp / "asm" / "geometry.toml").unlink(),
+                 "sizes.lp": lambda tmp: (tmp / "asm" / "sizes.lp").unlink()}), 2,
+     "asm/geometry.toml: no such file; the cells a session starts (--backend truth) answer from geometry.toml or"),
     # session --resume with a damaged session.json: fails before any cell starts
     ("resume-empty", ("session", "--resume", "run"), {"run/session.json": ""}, 2, "JSON"),
     ("resume-binary", ("session", "--resume", "run"), {"run/session.json": b"\x00\xff\xfe{"}, 2, "JSON"),

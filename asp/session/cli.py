@@ -29,6 +29,7 @@ from assembly_constraints.asp.sizes.cli import add_model_option, add_prior_optio
 from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
 from assembly_constraints.asp.sizes.policies import policy_names
 from assembly_constraints.asp.solve import encoding
+from assembly_constraints.bridge.assembly import load_assembly
 from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
@@ -134,8 +135,9 @@ def _summary(result: dict, run: Path) -> str:
     cells: dict[str, int] = {}
     for entry in settings.journal:
         cells[entry["cell"]] = cells.get(entry["cell"], 0) + 1
+    assembly = load_assembly(settings.assembly)
     plan = (f"plan 1 of {len(result['plans'])}: " + " ".join(
-        f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+        assembly.step_text(s["part"], s["hole"]) for s in result["plans"][0])
         if result["plans"] else f"no plan: {result['error']}")
     files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
     python = shlex.quote(sys.executable)

@@ -374,10 +374,11 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     settings, warnings = _resumed(settings, record, run) if settings.resume is not None else (settings, [])
     assembly = load_assembly(record.assembly)
     _check_product(settings, record, assembly, run)
-    if settings.cells > 0 and not assembly.has_file("geometry.toml"):
-        raise PlannerError(f"{assembly.folder / 'geometry.toml'}: no such file; the cells a session starts (--backend "
-                           f"{settings.backend}) answer from the product's geometry (docs/geometry.md); describe it, "
-                           "or use --cells 0 with cells of your own")
+    answers_from = {"sim": ("geometry.toml",), "truth": ("geometry.toml", "sizes.lp")}.get(settings.backend, ())
+    if settings.cells > 0 and answers_from and not any(assembly.has_file(name) for name in answers_from):
+        raise PlannerError(f"{assembly.folder / answers_from[0]}: no such file; the cells a session starts (--backend "
+                           f"{settings.backend}) answer from {' or '.join(answers_from)} (docs/backends.md); describe "
+                           "the product, or use --cells 0 with cells of your own")
     parts, holes, truth, model = _sizes_domain(assembly, record.model)
     decided = ([] if record.size_prior is None
                else cad_prior(assembly, record.tolerance_m, tuple(parts), tuple(holes)))

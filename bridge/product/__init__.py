@@ -60,6 +60,7 @@ from assembly_constraints.bridge.product.tables import (
     HoleEntry,
     HoleShape,
     Id,
+    Manual,
     Mesh,
     PartEntry,
     PartShape,
@@ -71,7 +72,7 @@ from assembly_constraints.bridge.product.tables import (
 
 __all__ = ["CONVEX_HEADER", "DEFAULT_COVER_CLEARANCE", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS",
            "AssemblyFile", "Base", "Cover", "ExtraPart", "GeometryFile", "Gripper", "Head", "HoleEntry", "HoleShape",
-           "Mesh", "PartEntry", "PartShape", "Plate", "ProductDescription", "SizesTable", "check_grasp",
+           "Manual", "Mesh", "PartEntry", "PartShape", "Plate", "ProductDescription", "SizesTable", "check_grasp",
            "decode_toml_file", "hole_kinds", "hole_level", "is_id", "load_product_description", "part_kinds",
            "product_from_tables", "section_label"]
 

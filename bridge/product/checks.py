@@ -212,6 +212,7 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]
     meshes += [(f"covers.{cid}", cover.mesh, True) for cid, cover in geo.covers.items()]
     meshes += [(f"heads.{hid}", head.mesh, True) for hid, head in geo.heads.items()]
+    meshes += [(f"manual.{mid}", manual.mesh, False) for mid, manual in geo.manual.items()]
     meshes.append(("base", None if geo.base is None else geo.base.mesh, False))
     for table, mesh, moving in meshes:
         if mesh is not None:
@@ -221,7 +222,7 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
 def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
     """A part's ``mesh``: its ``file`` is there and has the stated ``sha256``; a moving
     part has ``convex`` pieces made from that file as it is (their header names its
-    digest), the base none (it is a static concave mesh)."""
+    digest), the base and a part placed by hand none (static concave meshes)."""
     folder = path.parent
     try:
         data = read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)
@@ -233,8 +234,8 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
                    "geometry.toml was written; import the product again)", mesh.sha256)
     if not moving:
         if mesh.convex is not None:
-            raise fail(path, table, "mesh.convex", "no convex pieces (the base is simulated as its static concave "
-                       "mesh)", mesh.convex)
+            raise fail(path, table, "mesh.convex", "no convex pieces (the base and a part placed by hand are "
+                       "simulated as their static concave meshes)", mesh.convex)
         return
     if mesh.convex is None:
         raise BridgeError(f"{path}: [{table}] mesh.convex: expected the convex pieces of {mesh.file} (an .obj file "
@@ -360,9 +361,10 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         part = layout.parts.get(hid)
         if part is None or part.start is None:
             raise fail(path, table, "", "a part of assembly.toml with a start", hid)
-    for cid in geo.covers:
-        if cid not in layout.parts:
-            raise fail(path, f"covers.{cid}", "", "a part of assembly.toml", cid)
+    for table_name, ids in (("covers", geo.covers), ("manual", geo.manual)):
+        for pid in ids:
+            if pid not in layout.parts:
+                raise fail(path, f"{table_name}.{pid}", "", "a part of assembly.toml", pid)
     if geo.base is None:
         return
     if geo.base.part not in layout.parts:
@@ -374,11 +376,13 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         owners[pid].append("[covers.*]")
     for pid in geo.heads:
         owners[pid].append("[heads.*]")
+    for pid in geo.manual:
+        owners[pid].append("[manual.*]")
     owners[geo.base.part].append("[base]")
     missing = sorted(pid for pid, tables in owners.items() if not tables)
     if missing:
         raise BridgeError(f"{path}: part(s) {', '.join(missing)} of assembly.toml have no geometry "
-                          "(expected a [part_shapes.*], [covers.*], [heads.*] or [base] entry)")
+                          "(expected a [part_shapes.*], [covers.*], [heads.*], [manual.*] or [base] entry)")
     twice = sorted(pid for pid, tables in owners.items() if len(tables) > 1)
     if twice:
         raise BridgeError(f"{path}: part {twice[0]} of assembly.toml has more than one geometry "

@@ -200,7 +200,8 @@ class Mesh(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     OBJ, metres, in the part frame: a peg's origin at the centre of its section at its
     bottom, z its axis upwards, x its section's long side; a cover's at the centre of the
     holes it goes over at its bottom face, a head's at the centre of its section at its
-    bottom, both with the cell's axes; the base's is the cell frame), the ``sha256`` of that
+    bottom, a part placed by hand's at the centre of its bottom face, all with the cell's
+    axes; the base's is the cell frame), the ``sha256`` of that
     file, and for a moving part ``convex``: the convex pieces it collides as (one OBJ object
     each, first line :data:`CONVEX_HEADER` naming the mesh they were made from)."""
 
@@ -268,10 +269,26 @@ class Head(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     mesh: Mesh | None = None
 
 
+class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[manual.<id>]``: a part the cell has no operation for (it goes in along no axis
+    into a hole the cell knows), placed by hand: ``reason`` says why, ``goal`` [x, y, z] [m]
+    is its frame's origin when assembled, ``tray`` where that origin waits [m]; simulated
+    as its own ``mesh`` (its frame at the centre of its bounding box's bottom face, the
+    cell's axes), a static concave mesh, fixed where it is placed (no convex pieces)."""
+
+    reason: Text
+    goal: Annotated[list[Coordinate], Meta(min_length=3, max_length=3,
+                                           description="[x, y, z] in metres, finite and within ±100")]
+    tray: XY
+    mass: Mass
+    mesh: Mesh
+    name: Text | None = None
+
+
 class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``geometry.toml``: the plate, the cross-sections of holes and pegs, the cell's extra
-    parts, an optional gripper (else the cell description's), the product's base, covers
-    and heads."""
+    parts, an optional gripper (else the cell description's), the product's base, covers,
+    heads and the parts placed by hand."""
 
     plate: Plate
     hole_shapes: dict[Id, HoleShape] = {}
@@ -281,6 +298,7 @@ class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True)
     base: Base | None = None
     covers: dict[Id, Cover] = {}
     heads: dict[Id, Head] = {}
+    manual: dict[Id, Manual] = {}
 
 
 class ProductDescription(msgspec.Struct, frozen=True, kw_only=True):

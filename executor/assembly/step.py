@@ -13,6 +13,8 @@ Per kind of part (the ``skill`` of the step's record):
   unknown grasp offset; a spiral search fails on a long part tilting on the pin tops);
 - ``insert_socket``: a head into the socket of its part, wherever that part is; it stays
   fixed to it from then on (screwed).
+- ``manual``: a part the cell has no operation for (``[manual.*]`` of ``geometry.toml``),
+  placed by hand where the CAD has it and fixed there (a static mesh); the arm does not move.
 
 A failed attempt (the goal check fails) lifts the part and tries again with a fresh
 vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
@@ -131,7 +133,7 @@ class Assembler:
         self.layer, self.ilc = layer, ilc
 
     def skill_of(self, part: str) -> str:
-        """The step's skill: fixture, insert, insert_over or insert_socket."""
+        """The step's skill: fixture, insert, insert_over, insert_socket or manual."""
         p = self.product
         if part == p.base.id:
             return "fixture"
@@ -141,6 +143,8 @@ class Assembler:
             return "insert_over"
         if part in p.heads:
             return "insert_socket"
+        if part in p.manual:
+            return "manual"
         raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(p.parts)})")
 
     def shape_of(self, part: str) -> str:
@@ -176,6 +180,8 @@ class Assembler:
         skill = self.skill_of(part)
         world, motion = self.world, self.world.motion
         wall0, sim0 = time.perf_counter(), motion.steps
+        if skill == "manual":
+            return self._by_hand(part, wall0, sim0)
         rng = trial_rng(seed, part, hole or "none")
         if skill == "insert" and hole is not None:
             world.set_peg_goal(part, hole)
@@ -213,6 +219,14 @@ class Assembler:
         return StepRecord(part, hole, skill, "fit" if ok else "no_fit", len(outcomes), time.perf_counter() - wall0,
                           max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
                           (motion.steps - sim0) * 0.001)
+
+    def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
+        """A part placed by hand (``manual``): at its goal, fixed there."""
+        world = self.world
+        world.set_pose(part, world.goals[part])
+        self.placed.add(part)
+        return StepRecord(part, None, "manual", "fit", 1, time.perf_counter() - wall0, 0.0, 0.0,
+                          world.goal_error(part), (world.motion.steps - sim0) * 0.001)
 
     def _draw(self, rng: np.random.Generator, part: str, hole: str | None) -> AttemptSetup:
         """One execution's errors: of the part's shape and its hole (a cover or head: of

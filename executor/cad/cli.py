@@ -140,7 +140,7 @@ def report(derived: Derived) -> list[str]:
 
 
 def mapped_report(mapped: Mapped) -> list[str]:
-    """The lines ``import`` prints about the covers and heads it found."""
+    """The lines ``import`` prints about the covers and heads it found and the parts placed by hand."""
     lines = []
     for cid, cover in sorted(mapped.covers.items()):
         x0, y0, x1, y1 = cover.outline
@@ -156,6 +156,8 @@ def mapped_report(mapped: Mapped) -> list[str]:
         lines.append(f"head {hid} into {head.into}: {_describe(section.kind, section.a, section.b)} x "
                      f"{_mm(head.length)} mm, skill {head.skill}; "
                      + ("a cylinder or box" if head.primitive else "no cylinder or box: its own mesh"))
+    for pid, reason in sorted(mapped.manual.items()):
+        lines.append(f"manual {pid}: the cell has no operation for it, a plan's step places it by hand ({reason})")
     return lines
 
 

@@ -224,15 +224,15 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
 
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
-               neighbours: dict[str, trimesh.Trimesh] | None) -> tuple[Mesh, list[Path]] | str:
-    """Write ``mesh`` (already in its part frame [m]; ``made``: how, for its header) as
+               neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame"
+               ) -> tuple[Mesh, list[Path]] | str:
+    """Write ``mesh`` (already in ``frame`` [m]; ``made``: how, for its header) as
     ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
-    (``neighbours``: the parts near it, in its frame; None for the base), its convex
-    pieces (:func:`fitting_pieces`); returns the ``mesh`` entry of ``geometry.toml`` and
-    the paths written, or why no pieces fit."""
+    (``neighbours``: the parts near it, in its frame; None for a static one: the base, a
+    part placed by hand), its convex pieces (:func:`fitting_pieces`); returns the ``mesh``
+    entry of ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
-    frame = "the cell frame" if neighbours is None else "its part frame"
     text = obj_text([(pid, mesh.vertices, mesh.faces)],
                     f"# {pid}: its closed mesh [m] in {frame}, {made}, by ./run.sh import")
     written = [write_atomic(folder / name, text)]
