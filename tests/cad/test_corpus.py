@@ -99,7 +99,6 @@ def _xfail(reason: str) -> pytest.MarkDecorator:
     return pytest.mark.xfail(strict=True, reason=reason)
 
 
-SECTIONS = "sections of any shape: hexagon, octagon and 12-gon sections are 'other' and left out of sizes.lp"
 PINS = "fits of any part on any part: a nut over a pin of the base is no hole of the base"
 INSERTED = "fits of any part on any part: the cell has no operation for a part going"
 
@@ -108,8 +107,8 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
-    pytest.param("agh_hex_horizontal", marks=_xfail(SECTIONS)),
-    pytest.param("agh_prism_array", marks=_xfail(SECTIONS)),
+    "agh_hex_horizontal",
+    "agh_prism_array",
     pytest.param("robosuite_nuts", marks=_xfail(PINS)),
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
