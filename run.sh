@@ -20,7 +20,10 @@ setup() {
     if [[ ! -f "$STAMP" ]]; then
         echo "run.sh: installing the project into $VENV (first run only)" >&2
         "$PY" -m pip install --quiet --upgrade pip >&2
-        "$PY" -m pip install --quiet -c "$ROOT/constraints.txt" -e "$ROOT[test]" >&2
+        # setuptools reports every editable install with a note, "Editable installation.",
+        # that names no problem; it is the one message of the build kept out of the output.
+        PYTHONWARNINGS="ignore:Editable installation" \
+            "$PY" -m pip install --quiet -c "$ROOT/constraints.txt" -e "$ROOT[test]" >&2
         rm -f "$VENV"/.installed-*
         touch "$STAMP"
     fi

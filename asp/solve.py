@@ -6,6 +6,10 @@
 - Facts files are plain clingo programs (``learned.lp``, an assembly's ``sizes.lp``...).
   They are read by grounding them with clingo, so a file may also hold rules; what comes
   back is the set of atoms of the (unique) answer set (:func:`load_atoms`).
+- Data files that must hold ground facts only (a CAD prior's ``nominal_sizes.lp``) are read
+  as data, never grounded: :func:`read_ground_facts` parses them with clingo's parser and
+  refuses any rule, variable, interval, pool or operation, and more facts than a bound, so
+  ``n(1..50000000).`` is one line of error, not an unbounded grounding.
 - Facts are written from ``clingo.Symbol`` values, never by string formatting of terms
   (:func:`fact`, :func:`format_facts`, :func:`write_facts`), and atomically.
 - Facts reach clingo as symbols through its backend (:func:`add_facts`), never as
@@ -22,6 +26,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
 import clingo
+import clingo.ast
 
 from assembly_constraints.asp import MAX_IDS, PlannerError
 from assembly_constraints.bridge.assembly import is_id
@@ -94,6 +99,70 @@ def load_atoms(
         names = ", ".join(str(p) for p in paths)
         raise PlannerError(f"{names}: expected facts with exactly one answer set, got {len(models)}")
     return models[0]
+
+
+def _ground_term(term: clingo.ast.AST) -> clingo.Symbol | None:
+    """The symbol of a ground term (a constant, number, string, ``-N`` or a function of
+    ground terms); None for anything else (variable, interval, pool, operation)."""
+    if term.ast_type == clingo.ast.ASTType.SymbolicTerm:
+        return term.symbol
+    if (term.ast_type == clingo.ast.ASTType.UnaryOperation and term.operator_type == clingo.ast.UnaryOperator.Minus
+            and term.argument.ast_type == clingo.ast.ASTType.SymbolicTerm
+            and term.argument.symbol.type == clingo.SymbolType.Number):
+        return clingo.Number(-term.argument.symbol.number)
+    if term.ast_type == clingo.ast.ASTType.Function and not term.external:
+        arguments = [_ground_term(argument) for argument in term.arguments]
+        if all(argument is not None for argument in arguments):
+            return clingo.Function(term.name, [a for a in arguments if a is not None])
+    return None
+
+
+def read_ground_facts(path: Path, expected: str, *, max_facts: int) -> list[tuple[int, clingo.Symbol]]:
+    """The facts of ``path`` with their line numbers, read as data (parsed, never grounded).
+
+    PlannerError naming ``path:line`` and ``expected`` (e.g. ``"nominal_margin(Part,Hole,
+    Micrometres) facts"``) at anything but a ground fact (a rule, a directive, a variable,
+    an interval ``1..N``, a pool ``a;b``, an arithmetic term), and when the file holds more
+    than ``max_facts`` facts; the file itself is read under :func:`read_bytes`'s rules."""
+    data = read_bytes(path, "facts file", error=PlannerError)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise PlannerError(f"{path}: not a text file (expected {expected})") from None
+    _check_ascii(path, text)
+    facts: list[tuple[int, clingo.Symbol]] = []
+    refused: list[str] = []
+
+    def statement(node: clingo.ast.AST) -> None:
+        if refused:
+            return
+        line = node.location.begin.line
+        if node.ast_type == clingo.ast.ASTType.Comment or (
+                node.ast_type == clingo.ast.ASTType.Program and node.name == "base" and not node.parameters):
+            return  # a comment, or the implicit "#program base." every parse starts with
+        head = node.head if node.ast_type == clingo.ast.ASTType.Rule and not node.body else None
+        atom = (head.atom if head is not None and head.ast_type == clingo.ast.ASTType.Literal
+                and head.sign == clingo.ast.Sign.NoSign
+                and head.atom.ast_type == clingo.ast.ASTType.SymbolicAtom else None)
+        symbol = _ground_term(atom.symbol) if atom is not None else None
+        if symbol is None or symbol.type != clingo.SymbolType.Function:
+            refused.append(f"{path}:{line}: {shorten(str(node), 60)}: expected {expected} only (ground facts, "
+                           "no rules, variables, intervals, pools or arithmetic)")
+        elif len(facts) == max_facts:
+            refused.append(f"{path}:{line}: more than {max_facts} facts; expected at most {max_facts}")
+        else:
+            facts.append((line, symbol))
+
+    messages: list[str] = []
+    try:
+        clingo.ast.parse_string(text.replace("\x00", ""), statement,
+                                logger=lambda _code, msg: messages.append(msg.strip()))
+    except RuntimeError:
+        detail = "; ".join(shorten(m.replace("<string>", str(path)), 160) for m in messages[:2]) or "syntax error"
+        raise PlannerError(f"{path}: does not parse as ASP facts: {detail}") from None
+    if refused:
+        raise PlannerError(refused[0])
+    return facts
 
 
 def check_facts(atoms: Iterable[clingo.Symbol], signatures: Mapping[str, int], source: str) -> None:

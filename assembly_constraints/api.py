@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal, TypedDict
+from typing import Literal, NotRequired, TypedDict
 
 from msgspec import UNSET
 
@@ -122,7 +122,8 @@ def plan(facts: Sequence[str | Path], n: int = 1) -> list[Plan]:
 
 
 class SessionResult(TypedDict):
-    """What a session returns (the ``session --json`` contract)."""
+    """What a session returns (the ``session --json`` contract); ``error`` (with ``plans``
+    empty) when the learned relation has no complete hole assignment."""
 
     run: str
     experiments: int
@@ -130,6 +131,7 @@ class SessionResult(TypedDict):
     must_precede: list[list[str]]
     plans: list[list[dict[str, str | None]]]
     matches_truth: bool | None
+    error: NotRequired[str]
 
 
 def run_session(assembly: str | Path = "cranfield", *, out: str | Path | None = None,

@@ -9,7 +9,8 @@ Modules are imported lazily, so ``--help`` of one subcommand does not pay for th
 
 Exit codes (:mod:`assembly_constraints.bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
 missing subcommand too; every :class:`assembly_constraints.bridge.errors.ToolError`), 3 an unsolvable
-assembly, 130 interrupted, 141 stdout closed.
+assembly, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM; both after the processes the
+command started were stopped), 141 stdout closed.
 """
 
 from __future__ import annotations

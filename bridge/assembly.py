@@ -4,10 +4,11 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
 
 - ``assembly.toml``: ``[parts.<id>]`` with ``name``, ``role``, optional ``start``
   ``[x, y]`` [m] (where the part waits in the cell), optional ``shape`` (its cross-section
-  kind, :data:`SHAPES`) and, for a rect part, optional ``section`` (a label: parts of one
-  section are scaled copies of one cross-section; default the shape for round and
-  square, the part's own id for rect); ``[holes.<id>]`` with ``name``, ``shape`` (default
-  round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
+  kind, :data:`SHAPES`; default the kind ``geometry.toml`` gives it) and, for a rect part,
+  optional ``section`` (a label: parts of one section are scaled copies of one
+  cross-section; default the shape for round and square, the part's own id for rect);
+  ``[holes.<id>]`` with ``name``, ``shape`` (default the kind ``geometry.toml`` gives it,
+  else round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
   table with ``model`` (the size model the product declares: ``line``, ``sections`` or
   ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
@@ -15,7 +16,8 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
 - ``sizes.lp`` (optional): which part fits which hole (``part/1``, ``hole/1``,
   ``fits/2``; closed world);
 - ``demos.txt`` (optional): demonstrated feasible sequences;
-- ``geometry.toml`` (optional): dimensions for the simulated cell.
+- ``geometry.toml`` (optional): the cell's dimensions and cross-sections (the simulated
+  and the ``truth`` cells need it; the planner alone does not).
 
 ``assembly.toml`` and ``geometry.toml`` are decoded and checked as a whole by
 :mod:`assembly_constraints.bridge.product`; :func:`load_assembly` gives the planner's view of the result.
@@ -33,8 +35,11 @@ from assembly_constraints.bridge.product import (
     SHAPES,
     SIZE_MODELS,
     ProductDescription,
+    hole_kinds,
     is_id,
     load_product_description,
+    part_kinds,
+    section_label,
 )
 
 __all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS", "Assembly", "Hole", "Item", "Part",
@@ -85,6 +90,12 @@ class Assembly:
     holes: tuple[Hole, ...] = field(default_factory=tuple)
     size_model: str | None = None
     """The size model the product declares (``[sizes] model``), None when it declares none."""
+    manual: dict[str, str] = field(default_factory=dict)
+    """The parts the cell places by hand (``[manual.<id>]`` of ``geometry.toml``): id -> why."""
+
+    def step_text(self, part: str, hole: str | None) -> str:
+        """A plan step as the commands print it: ``p->h``, ``p``, a part placed by hand ``p (manual)``."""
+        return part + (f"->{hole}" if hole else "") + (" (manual)" if part in self.manual else "")
 
     def sections(self) -> dict[str, str]:
         """Part id -> section, for the parts whose cross-section is stated."""
@@ -124,18 +135,22 @@ def resolve_assembly_folder(name_or_path: str) -> Path:
 
 
 def assembly_of(product: ProductDescription) -> Assembly:
-    """The planner's view of a decoded product: its parts and holes in file order, a rect
-    part's section defaulting to its id, a round or square part's to its shape."""
+    """The planner's view of a decoded product: its parts and holes in file order, each
+    with the kind every statement of the product gives it (``shape`` in ``assembly.toml``,
+    the kind of its table in ``geometry.toml``: :func:`assembly_constraints.bridge.product.part_kinds`),
+    a rect or polygon part's section defaulting to its id, a round or square part's to its kind."""
     layout = product.assembly
+    kinds, hole_kind = part_kinds(layout, product.geometry), hole_kinds(layout, product.geometry)
     parts = tuple(
         Part(pid, part.name or pid, part.role, None if part.start is None else (part.start[0], part.start[1]),
-             part.shape, part.section or (None if part.shape is None else pid if part.shape == "rect" else part.shape))
+             kinds.get(pid), None if pid not in kinds else section_label(pid, kinds[pid], part.section))
         for pid, part in layout.parts.items())
-    holes = tuple(Hole(hid, hole.name or hid, hole.shape,
+    holes = tuple(Hole(hid, hole.name or hid, hole_kind[hid],
                        None if hole.position is None else (hole.position[0], hole.position[1]))
                   for hid, hole in layout.holes.items())
+    manual = {} if product.geometry is None else {mid: m.reason for mid, m in product.geometry.manual.items()}
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
-                    size_model=None if layout.sizes is None else layout.sizes.model)
+                    size_model=None if layout.sizes is None else layout.sizes.model, manual=manual)
 
 
 def load_assembly(name_or_path: str) -> Assembly:

@@ -13,13 +13,15 @@ import logging
 import math
 import os
 import re
+import signal
 import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
 from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED
+from assembly_constraints.bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED, EXIT_TERMINATED
 from assembly_constraints.bridge.inputs import shorten
 
 T = TypeVar("T")
@@ -54,15 +56,18 @@ class ArgumentParser(argparse.ArgumentParser):
 
 
 _ROLE = re.compile(r":(?:mod|class|func|meth|data|attr|exc):`~?([^`]+)`")
+_STRONG = re.compile(r"\*\*([^*]+)\*\*")
 
 
 def plain_text(text: str) -> str:
-    """A docstring as a help page shows it: reStructuredText literals (double backquotes)
-    and roles (``:mod:`x` ``) as plain text, the repository's ``./run.sh`` as the program."""
-    return _ROLE.sub(r"\1", text).replace("``", "").replace("./run.sh", PROGRAM)
+    """A docstring as a help page shows it: reStructuredText literals (double backquotes),
+    roles (``:mod:`x` ``) and strong emphasis (``**x**``) as plain text, the repository's
+    ``./run.sh`` as the program."""
+    return _STRONG.sub(r"\1", _ROLE.sub(r"\1", text)).replace("``", "").replace("./run.sh", PROGRAM)
 
 
-ASSEMBLY_HELP = "a shipped assembly's name (cranfield, battery, spare, graded) or a folder holding assembly.toml"
+ASSEMBLY_HELP = ("a shipped assembly's name (cranfield, battery, spare, graded, taskboard) or a folder holding "
+                 "assembly.toml")
 """The one meaning of ``--assembly`` on every help page."""
 
 
@@ -174,12 +179,15 @@ def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...])
     """Run a command line's work and return its exit code: ``errors`` (bad input) become one
     line ``error: ...`` on stderr and exit 2; a closed stdout (``... | head -1``) stops
     quietly with :data:`EXIT_BROKEN_PIPE`; stdout that cannot be written (``> /dev/full``)
-    is ``error: stdout: cannot write (<reason>)``, exit 2; Ctrl-C exits 130. Log records
-    go to stderr as one line each (:func:`configure_logging`)."""
+    is ``error: stdout: cannot write (<reason>)``, exit 2; Ctrl-C exits 130, SIGTERM 143,
+    both after the command's ``finally`` blocks and context managers ran (they stop the
+    processes it started: cells, web viewer, browser). Log records go to stderr as one line
+    each (:func:`configure_logging`)."""
     configure_logging()
     stdout = sys.stdout
     if not isinstance(stdout, _GuardedStdout):
         sys.stdout = _GuardedStdout(stdout)
+    previous = _terminate_by_exception()
     try:
         code = command()
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not in the interpreter's last flush
@@ -196,8 +204,36 @@ def run_command(command: Callable[[], int], errors: tuple[type[Exception], ...])
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated:
+        print("terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     finally:
         sys.stdout = stdout
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived (raised in the main thread by :func:`run_command`'s handler): like
+    KeyboardInterrupt, it unwinds the command so its clean-up runs."""
+
+
+def _on_sigterm(_signum: int, _frame: object) -> None:
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # a repeated SIGTERM does not cut the clean-up short
+    raise Terminated
+
+
+def _terminate_by_exception() -> signal.Handlers | Callable[..., Any] | int | None:
+    """Make SIGTERM raise :class:`Terminated` while a command runs (Python's default ends the
+    process at once, leaving its children running); returns the handler to restore, None
+    when nothing was changed (not the main thread, or a handler of the caller's own)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    current = signal.getsignal(signal.SIGTERM)
+    if current not in (signal.SIG_DFL, None):
+        return None
+    signal.signal(signal.SIGTERM, _on_sigterm)
+    return current
 
 
 MAX_JOBS = 64
@@ -318,12 +354,19 @@ def comma_list(
 
 
 def number_in(kind: Callable[[str], float], low: float, high: float) -> Callable[[str], float]:
-    """An item type: a finite number of ``kind`` in [low, high) (ValueError otherwise)."""
+    """An argparse (or :func:`comma_list` item) type: a finite number of ``kind`` (``int``,
+    ``float``, :func:`strict_int`...) in [low, high); ArgumentTypeError naming the range
+    otherwise."""
+    integer = kind in (int, strict_int)
+    expected = f"{'an integer' if integer else 'a finite number'} in [{low:g}, {high:g})"
 
     def parse(text: str) -> float:
-        value = kind(text)
+        try:
+            value = kind(text)
+        except ValueError:
+            value = math.nan
         if not (math.isfinite(value) and low <= value < high):
-            raise ValueError(text)
+            raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected {expected}")
         return value
 
     return parse

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import logging
 import queue
 import signal
 import threading
@@ -36,6 +37,8 @@ from assembly_constraints.bridge.messages import (
     decode_reply,
     encode,
 )
+
+_LOG = logging.getLogger(__name__)
 
 
 class CellTimeout(BridgeError):
@@ -101,6 +104,8 @@ class CellDirectory:
             instances = self._instances.setdefault(cell, set())
             (instances.add if sample.kind == zenoh.SampleKind.PUT else instances.discard)(instance)
             if len(instances) > 1:
+                if cell not in self.duplicated:
+                    _LOG.warning("%s", self._duplicate_text(cell))
                 self.duplicated.add(cell)
             alive, was_alive = len(instances) == 1, cell in self._alive
             (self._alive.add if alive else self._alive.discard)(cell)
@@ -108,6 +113,12 @@ class CellDirectory:
             self._lock.notify_all()
         for listener in listeners:
             listener(cell, alive)
+
+    def _duplicate_text(self, cell: str) -> str:
+        """Says that ``cell`` is claimed by several processes (call with the lock held)."""
+        return (f"cell id {cell} is claimed by {len(self._instances[cell])} processes (liveliness tokens of "
+                f"instances {', '.join(sorted(self._instances[cell]))}); nothing is sent to it until only one "
+                "is left: stop the other process or give it another --cell-id")
 
     def alive(self) -> set[str]:
         """The cells whose token is currently seen."""
@@ -131,8 +142,10 @@ class CellDirectory:
             while len(self._alive) < count:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
+                    duplicated = [self._duplicate_text(c) for c in sorted(self._instances)
+                                  if len(self._instances[c]) > 1]
                     raise CellTimeout(f"expected {count} alive cell(s) within {timeout:.1f} s, "
-                                      f"saw {sorted(self._alive) or 'none'}")
+                                      f"saw {sorted(self._alive) or 'none'}" + "".join(f"; {d}" for d in duplicated))
                 self._lock.wait(remaining)
             return set(self._alive)
 

@@ -20,6 +20,8 @@ EXIT_UNSOLVABLE = 3
 """The assembly cannot be finished: no complete hole assignment, or a plan stopped."""
 EXIT_INTERRUPTED = 130
 """Ctrl-C."""
+EXIT_TERMINATED = 143
+"""Stopped by SIGTERM (128 + SIGTERM), after stopping the processes the command started."""
 EXIT_BROKEN_PIPE = 141
 """Standard output closed by its reader (``... | head -1``): stopped quietly, as 128 + SIGPIPE."""
 

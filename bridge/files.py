@@ -48,6 +48,14 @@ def os_reason(exc: OSError) -> str:
     return exc.strerror or str(exc)
 
 
+def _write_reason(exc: OSError, folder: Path) -> str:
+    """:func:`os_reason`, naming ``folder`` when it is what is missing (the folder of an
+    output file must exist: only output folders are created)."""
+    if exc.errno == errno.ENOENT and not folder.is_dir():
+        return f"{os_reason(exc)}: no folder {folder}; create it first"
+    return os_reason(exc)
+
+
 def _fsync_folder(folder: Path) -> None:
     fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
     try:
@@ -115,7 +123,7 @@ def write_atomic(path: Path | str, data: bytes | str) -> Path:
         temporary = None
         _fsync_folder(folder)
     except OSError as exc:
-        raise BridgeError(f"{path}: cannot write ({os_reason(exc)})") from None
+        raise BridgeError(f"{path}: cannot write ({_write_reason(exc, folder)})") from None
     finally:
         if temporary is not None:
             with contextlib.suppress(OSError):
@@ -152,7 +160,7 @@ def check_writable(path: Path | str) -> Path:
         os.close(fd)
         os.unlink(temporary)
     except OSError as exc:
-        raise BridgeError(f"{path}: cannot write ({os_reason(exc)})") from None
+        raise BridgeError(f"{path}: cannot write ({_write_reason(exc, path.parent)})") from None
     return path
 
 

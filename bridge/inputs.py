@@ -46,6 +46,13 @@ def duplicate_key(data: bytes | str) -> str | None:
     return twice[0] if twice else None
 
 
+def file_kind(mode: int) -> str:
+    """What a file of ``st_mode`` ``mode`` is, in words: ``a FIFO``, ``a directory``..."""
+    kinds = ((stat.S_ISREG, "a regular file"), (stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO"),
+             (stat.S_ISSOCK, "a socket"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"))
+    return next((name for test, name in kinds if test(mode)), "a special file")
+
+
 def read_bytes(path: Path | str, what: str, *, limit: int = MAX_INPUT_BYTES,
                error: type[Exception] = BridgeError) -> bytes:
     """The bytes of the regular file ``path``, at most ``limit`` [bytes].
@@ -60,7 +67,7 @@ def read_bytes(path: Path | str, what: str, *, limit: int = MAX_INPUT_BYTES,
         if stat.S_ISDIR(mode):
             raise error(f"{path}: is a directory, expected a {what}")
         if not stat.S_ISREG(mode):
-            raise error(f"{path}: not a regular file, expected a {what}")
+            raise error(f"{path}: not a regular file ({file_kind(mode)}), expected a {what}")
         with path.open("rb") as file:
             data = file.read(limit + 1)
     except FileNotFoundError:

@@ -27,6 +27,7 @@ from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import ID_PATTERN
 from assembly_constraints.bridge.inputs import duplicate_key
 from assembly_constraints.bridge.keys import CELL_ID_PATTERN
+from assembly_constraints.bridge.product.tables import MAX_ID_CHARS
 
 PROTOCOL_VERSION: Final = 3
 """2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``. 3: step request and reply."""
@@ -35,12 +36,28 @@ INSERT_VERSIONS: Final = frozenset({2, 3})
 MAX_MESSAGE_BYTES: Final = 16 * 1024
 """Largest accepted payload [bytes]; bigger messages are refused unread."""
 
-RequestId = Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z0-9_.:-]{1,128}$")]
+MAX_COUNT: Final = 2**31 - 1
+"""The largest count or number a message holds (an experiment number, attempts, a version)."""
+MAX_RUN_ID: Final = 64
+"""The longest run id [characters] a planner builds request ids from (a session's recording id)."""
+MAX_REQUEST_ID: Final = MAX_RUN_ID + 2 * (1 + MAX_ID_CHARS) + 1 + len(str(MAX_COUNT))
+"""The longest request id [characters]: ``<run>.<part>.<hole>.<n>`` with ids of the
+longest documented length and ``n`` up to :data:`MAX_COUNT` (205)."""
+MAX_VALUE: Final = 1e9
+"""The largest measurement, duration or timeout a message holds [its unit: N, N m, m, s, mm]."""
+MAX_ERROR_CHARS: Final = 2000
+"""The longest error text of an ErrorReply [characters]."""
+MAX_PLACED: Final = 1000
+"""The most placed parts a step reply reports."""
+
+RequestId = Annotated[str, msgspec.Meta(pattern=rf"^[A-Za-z0-9_.:-]{{1,{MAX_REQUEST_ID}}}$")]
 AspId = Annotated[str, msgspec.Meta(pattern=ID_PATTERN)]
 """A part or hole id: a lower-case ASP constant."""
 CellId = Annotated[str, msgspec.Meta(pattern=CELL_ID_PATTERN)]
 Seed = Annotated[int, msgspec.Meta(ge=0, lt=2**32)]
-NonNegative = Annotated[float, msgspec.Meta(ge=0.0)]
+Count = Annotated[int, msgspec.Meta(ge=0, le=MAX_COUNT)]
+Version = Annotated[int, msgspec.Meta(ge=1, le=MAX_COUNT, description="protocol version")]
+NonNegative = Annotated[float, msgspec.Meta(ge=0.0, le=MAX_VALUE)]
 Result = Literal["fit", "no_fit"]
 ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "id_reused", "invalid_step", "busy",
                     "expired", "failed", "run_active"]
@@ -66,18 +83,18 @@ class InsertRequest(_Message, tag="insert", frozen=True):
     hole: Annotated[AspId, msgspec.Meta(description="the hole to insert it into, e.g. s1")]
     seed: Annotated[Seed, msgspec.Meta(description="seed of a simulated cell's randomisation")] = 0
     retest: Annotated[bool, msgspec.Meta(description="a deliberate re-test of a pair already tried")] = False
-    experiment: Annotated[int, msgspec.Meta(ge=0, description="the planner's experiment number (Rerun timeline "
+    experiment: Annotated[Count, msgspec.Meta(description="the planner's experiment number (Rerun timeline "
                                             "experiment); 0: none")] = 0
     timeout_s: Annotated[NonNegative, msgspec.Meta(description="how long the planner waits for the reply [s]; a cell "
                                                    "drops the request when it is still queued after this long "
                                                    "(its client has gone); 0: no limit")] = 0.0
-    v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
+    v: Version = PROTOCOL_VERSION
 
 
 class Evidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """What the cell measured during the insertion (None for the truth backend)."""
 
-    attempts: Annotated[int, msgspec.Meta(ge=0, description="insertion attempts made")]
+    attempts: Annotated[Count, msgspec.Meta(description="insertion attempts made")]
     max_force_dev: Annotated[NonNegative, msgspec.Meta(description="largest |F_mes - F_des| [N]")]
     max_torque_dev: Annotated[NonNegative, msgspec.Meta(description="largest |M_mes - M_des| [N m]")]
     end_error: Annotated[NonNegative, msgspec.Meta(description="distance of the final tool position from the goal [m]")]
@@ -95,7 +112,7 @@ class InsertReply(_Message, tag="insert_reply", frozen=True):
     result: Annotated[Result, msgspec.Meta(description="fit: the part went in; no_fit: it did not")]
     evidence: Annotated[Evidence | None, msgspec.Meta(description="the cell's measurements, or null")] = None
     wall_s: Annotated[NonNegative, msgspec.Meta(description="wall time the cell spent on the experiment [s]")] = 0.0
-    v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
+    v: Version = PROTOCOL_VERSION
 
 
 class ErrorReply(_Message, tag="error", frozen=True):
@@ -105,10 +122,11 @@ class ErrorReply(_Message, tag="error", frozen=True):
     code: Annotated[ErrorCode, msgspec.Meta(description="why: malformed, oversized, version, unknown_id, id_reused, "
                                             "invalid_step (do not send again); busy, expired, failed, run_active "
                                             "(worth sending again)")]
-    error: Annotated[str, msgspec.Meta(description="what was wrong and what was expected, one line")]
+    error: Annotated[str, msgspec.Meta(max_length=MAX_ERROR_CHARS,
+                                       description="what was wrong and what was expected, one line")]
     id: Annotated[RequestId | None, msgspec.Meta(description="the request's id; null when the payload could not "
                                                  "be read")] = None
-    v: Annotated[int, msgspec.Meta(description="protocol version")] = PROTOCOL_VERSION
+    v: Version = PROTOCOL_VERSION
 
 
 class StepRequest(_Message, tag="step", frozen=True):
@@ -126,7 +144,7 @@ class StepRequest(_Message, tag="step", frozen=True):
     seed: Seed = 0
     timeout_s: NonNegative = 0.0
     """As :attr:`InsertRequest.timeout_s` [s]."""
-    v: int = PROTOCOL_VERSION
+    v: Version = PROTOCOL_VERSION
 
 
 class StepEvidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -134,7 +152,7 @@ class StepEvidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 
     skill: Annotated[str, msgspec.Meta(pattern=r"^[a-z_]{1,32}$")]
     """How the part was placed: fixture, insert, insert_over, insert_socket, or truth."""
-    attempts: Annotated[int, msgspec.Meta(ge=0)]
+    attempts: Count
     max_force_dev: NonNegative
     """Largest ‖F_mes − F_des‖ of the insertions [N]."""
     max_torque_dev: NonNegative
@@ -158,9 +176,9 @@ class StepReply(_Message, tag="step_reply", frozen=True):
     hole: AspId | None
     result: Result
     evidence: StepEvidence
-    pose_errors_mm: tuple[tuple[AspId, NonNegative], ...] = ()
+    pose_errors_mm: Annotated[tuple[tuple[AspId, NonNegative], ...], msgspec.Meta(max_length=MAX_PLACED)] = ()
     wall_s: NonNegative = 0.0
-    v: int = PROTOCOL_VERSION
+    v: Version = PROTOCOL_VERSION
 
 
 class MessageError(BridgeError):

@@ -99,6 +99,8 @@ def make_config(listen: Sequence[str] = (), connect: Sequence[str] = (),
         config.insert_json5("mode", json.dumps(mode))
     if listen or connect or config_file is None:  # --connect alone: listen nowhere
         config.insert_json5("listen/endpoints", json.dumps([check_endpoint(e) for e in listen]))
+    if any(endpoint.endswith(":0") for endpoint in listen):  # bound_endpoints reads the ports bound
+        config.insert_json5("adminspace", '{"enabled": true, "permissions": {"read": true, "write": false}}')
     if connect:
         config.insert_json5("connect/endpoints", json.dumps([check_endpoint(e) for e in connect]))
     return config
@@ -119,8 +121,35 @@ def open_session(listen: Sequence[str] = (), connect: Sequence[str] = (),
         raise BridgeError(f"cannot open a Zenoh session on {where}: {exc}") from None
 
 
+ADMIN_TIMEOUT_S = 5.0
+"""Longest a session may take to answer its own admin-space query [s]."""
+
+
+def bound_endpoints(session: zenoh.Session, asked: Sequence[str]) -> list[str]:
+    """The endpoints ``session`` listens on: ``asked`` as given, or, when one of them asks
+    for any port (``...:0``), the endpoints with the ports the session bound (read from its
+    admin space, which :func:`make_config` opens for reading in that case only), so a
+    process that must connect to it is told a port nobody else can have taken meanwhile.
+    BridgeError when the session does not say."""
+    if not any(endpoint.endswith(":0") for endpoint in asked):
+        return list(asked)
+    for reply in session.get(f"@/{session.zid()}/*", timeout=ADMIN_TIMEOUT_S):
+        if reply.ok is None:
+            continue
+        try:
+            status = json.loads(reply.ok.payload.to_bytes())
+        except ValueError:
+            continue
+        if isinstance(status, dict) and isinstance(status.get("locators"), list) and status["locators"]:
+            return [str(locator) for locator in status["locators"]]
+    raise BridgeError(f"the Zenoh session listening on {', '.join(asked)} did not report its ports")
+
+
 def free_loopback_endpoint() -> str:
-    """A ``tcp/127.0.0.1:PORT`` endpoint on a port that was free a moment ago."""
+    """A ``tcp/127.0.0.1:PORT`` endpoint on a port that was free a moment ago: for tests that
+    start a listener and its peers at once on a port they name. The tool itself never
+    picks a port to bind later: it listens on port 0 and reads the bound port
+    (:func:`bound_endpoints`)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
         sock.bind(("127.0.0.1", 0))
         port = sock.getsockname()[1]
@@ -139,8 +168,8 @@ def router_main(argv: Sequence[str]) -> int:
     Zenoh session in *router mode* opened through the eclipse-zenoh Python API: the same
     routing code as ``zenohd`` (it routes liveliness tokens, queries and replies between the
     sessions connected to it), without ``zenohd``'s plugins (REST, storages) or its command
-    line. It prints ``ready router <zid> listen <endpoints>`` once it listens and runs until
-    SIGTERM or SIGINT (exit 0).
+    line. It prints ``ready router <zid> listen <endpoints>`` once it listens (an endpoint of
+    port 0 with the port it bound) and runs until SIGTERM or SIGINT (exit 0).
 
     By default it listens on :data:`assembly_constraints.bridge.session.DEFAULT_ENDPOINT` (loopback); cells and
     planners on other hosts need an endpoint on an address they can reach
@@ -161,7 +190,7 @@ def router_main(argv: Sequence[str]) -> int:
     signal.signal(signal.SIGINT, _exit_on_signal)
     session = open_session(listen, (), args.zenoh_config, mode="router")
     try:
-        where = " ".join(listen) or f"as in {args.zenoh_config}"
+        where = " ".join(bound_endpoints(session, listen)) or f"as in {args.zenoh_config}"
         print(f"ready router {session.zid()} listen {where}", flush=True)
         while True:
             time.sleep(SIGNAL_POLL_S)

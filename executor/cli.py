@@ -138,6 +138,7 @@ def _export(args: argparse.Namespace) -> int:
     from assembly_constraints.executor.assembly.export import export_cell
     from assembly_constraints.executor.cell_description import load_cell_description
 
+    description = load_cell_description(args.cell_description)  # checked even where not used (--assembled)
     if args.assembled:
         from assembly_constraints.executor.cad.assembled import write_assembled
 
@@ -145,7 +146,7 @@ def _export(args: argparse.Namespace) -> int:
         print(f"wrote {len(files) - 1} part mesh(es) in the assembled pose and import.toml in {args.out}")
         return 0
 
-    written = export_cell(args.assembly, args.out, load_cell_description(args.cell_description))
+    written = export_cell(args.assembly, args.out, description)
     print(f"wrote {written[0]} and {len(written) - 1} mesh file(s) in {args.out / 'meshes'}")
     return 0
 
@@ -180,7 +181,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="attempts per trial before 'no_fit' (default 2)")
     add_assembly_argument(trial)
     trial.add_argument("--gui", action="store_true", help="open the PyBullet GUI")
-    trial.add_argument("--save", "--rrd", dest="rrd", metavar="FILE",
+    trial.add_argument("--save", "--rrd", dest="rrd", metavar="FILE", type=nonempty_path,
                        help="save a Rerun recording of every attempt to this .rrd file")
     add_viewer_arguments(trial)
     trial.add_argument("--plot", metavar="FILE", type=png_path,
@@ -192,7 +193,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sizes = sub.add_parser("sizes", help="write the sizes.lp (which part fits which hole) that the geometry makes")
     add_assembly_argument(sizes, purpose="the product whose fits are derived from geometry.toml")
-    sizes.add_argument("--out", metavar="FILE", type=Path, help="write it to FILE (default: print it)")
+    sizes.add_argument("--out", metavar="FILE", type=nonempty_path, help="write it to FILE (default: print it)")
     sizes.set_defaults(func=_sizes)
 
     export = sub.add_parser("export", help="write the assembling cell as URDF and meshes (arm, plate, every part)")

@@ -16,7 +16,8 @@ process later.
 - Backends: ``sim`` runs the PyBullet :class:`assembly_constraints.executor.trial.Cell` (imported lazily)
   with the execution layer and uncertainty of its cell settings (``--layer``,
   ``--cell-seed``, ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
-  ``truth`` answers from the cell's geometry (cross-sections) without simulation, optionally
+  ``truth`` answers from the cell's geometry (cross-sections), or where the product has no
+  ``geometry.toml`` from its ``sizes.lp``, without simulation, optionally
   after ``--delay`` seconds, to measure the bridge and test the protocol quickly;
   ``MODULE:CLASS`` loads a user's backend (:mod:`assembly_constraints.executor.backend_plugin`), e.g. a real robot.
 - Plan steps (``cell/<id>/step``, :class:`assembly_constraints.bridge.messages.StepRequest`) run in the same
@@ -48,6 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import clingo
 import zenoh
 
 from assembly_constraints.bridge import BridgeError
@@ -61,10 +63,17 @@ from assembly_constraints.bridge.cell_settings import (
     cell_settings_of,
     decode_settings,
 )
-from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, path_setting
+from assembly_constraints.bridge.cli_types import (
+    ArgumentParser,
+    add_assembly_argument,
+    finite_float,
+    nonempty_path,
+    path_setting,
+)
 from assembly_constraints.bridge.inputs import read_bytes
 from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
 from assembly_constraints.bridge.messages import (
+    MAX_ERROR_CHARS,
     MAX_MESSAGE_BYTES,
     ErrorCode,
     ErrorReply,
@@ -114,16 +123,41 @@ QUEUE_SIZE = 16
 """Requests that may wait for the cell; more are refused with ``busy``."""
 
 
+def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
+    """The pegs (``part/1``), holes (``hole/1``) and ``fits/2`` pairs of a product's
+    ``sizes.lp`` (closed world); ExecutorError naming the file when it does not parse."""
+    control = clingo.Control(["--warn=none"])
+    try:
+        control.add("base", [], read_bytes(path, "sizes (ASP facts)").decode("utf-8", "replace"))
+        control.ground([("base", [])])
+    except RuntimeError:
+        raise ExecutorError(f"{path}: expected ASP facts part/1, hole/1, fits/2 (it does not parse)") from None
+    atoms = [atom.symbol for atom in control.symbolic_atoms]
+    pegs = {str(a.arguments[0]) for a in atoms if a.match("part", 1)}
+    holes = {str(a.arguments[0]) for a in atoms if a.match("hole", 1)}
+    return pegs, holes, {(str(a.arguments[0]), str(a.arguments[1])) for a in atoms if a.match("fits", 2)}
+
+
 class TruthBackend:
-    """Answers from the cell's geometry without simulation (a part passes a hole when its
-    cross-section does, :func:`assembly_constraints.executor.world.geometry.passes`), after ``delay_s`` [s]."""
+    """Answers without simulation, after ``delay_s`` [s]: from the cell's geometry (a part
+    passes a hole when its cross-section does,
+    :func:`assembly_constraints.executor.world.geometry.passes`), or from the product's
+    ``sizes.lp`` where it has no ``geometry.toml``."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
                  recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER,
                  blocked: Sequence[str] = ()) -> None:
         try:
-            self._geometry = load_geometry(assembly)
             assembly_of = load_assembly(assembly)
+            if assembly_of.has_file("geometry.toml"):
+                geometry = load_geometry(assembly)
+                self._pegs, self._holes = set(geometry.parts), set(geometry.holes)
+                self._manual: set[str] = set(geometry.tables.manual)
+                self._fits = {(p, h) for p, part in geometry.parts.items() for h, hole in geometry.holes.items()
+                              if passes(part, hole)}
+            else:
+                self._pegs, self._holes, self._fits = sizes_truth(assembly_of.file("sizes.lp"))
+                self._manual = set()
         except BridgeError as exc:
             raise ExecutorError(f"truth backend: {exc}") from None
         self._delay_s = delay_s
@@ -139,13 +173,12 @@ class TruthBackend:
             self._entity = f"executor/{cell_id}/outcome"
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
-        parts, holes = self._geometry.parts, self._geometry.holes
-        if request.part not in parts or request.hole not in holes:
+        if request.part not in self._pegs or request.hole not in self._holes:
             raise UnknownPair(f"unknown pair ({request.part},{request.hole}); expected a part "
-                              f"of {tuple(parts)} and a hole of {tuple(holes)}")
+                              f"of {tuple(sorted(self._pegs))} and a hole of {tuple(sorted(self._holes))}")
         if self._delay_s > 0:
             time.sleep(self._delay_s)  # stands in for the duration of a real insertion
-        result: Result = "fit" if passes(parts[request.part], holes[request.hole]) else "no_fit"
+        result: Result = "fit" if (request.part, request.hole) in self._fits else "no_fit"
         if self._log is not None:
             import rerun as rr
 
@@ -156,23 +189,23 @@ class TruthBackend:
 
     def run_step(self, request: StepRequest) -> StepOutcome:
         """A peg fits when its cross-section passes the hole and the hole is not blocked;
-        another part of the product is always placed. One plan run at a time; a step of
-        another run, or one the product does not allow, is refused before anything changes
+        another part of the product is always placed (skill ``manual`` for one placed by
+        hand). One plan run at a time; a step of another run, or one the product does not
+        allow, is refused before anything changes
         (:func:`assembly_constraints.executor.backend_plugin.check_run`,
         :func:`assembly_constraints.executor.backend_plugin.check_step`)."""
-        parts, holes = self._geometry.parts, self._geometry.holes
         check_run(self._run, request.assembly, self._parts, self._placed)
         fresh = request.assembly != self._run
-        check_step(request.part, request.hole, parts=self._parts, pegs=parts, holes=holes,
+        check_step(request.part, request.hole, parts=self._parts, pegs=self._pegs, holes=self._holes,
                    placed=() if fresh else self._placed)
         if fresh:
             self._run, self._placed = request.assembly, {}
         placed = self._placed
-        ok = request.hole is None or (request.hole not in self._blocked
-                                      and passes(parts[request.part], holes[request.hole]))
+        ok = request.hole is None or (request.hole not in self._blocked and (request.part, request.hole) in self._fits)
         if ok:
             placed[request.part] = 0.0
-        evidence = StepEvidence(skill="truth", attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
+        skill = "manual" if request.part in self._manual else "truth"
+        evidence = StepEvidence(skill=skill, attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
                                 duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
         return ("fit" if ok else "no_fit"), evidence, dict(placed)
 
@@ -299,7 +332,7 @@ class CellNode:
     def _refuse(self, query: zenoh.Query, code: ErrorCode, text: str,
                 request_id: str | None = None) -> None:
         print(f"refused {code}: {text}", flush=True)
-        reply = ErrorReply(cell=self.cell_id, code=code, error=text[:2000], id=request_id)
+        reply = ErrorReply(cell=self.cell_id, code=code, error=text[:MAX_ERROR_CHARS], id=request_id)
         query.reply(query.key_expr, encode(reply))
 
     def on_query(self, query: zenoh.Query) -> None:
@@ -427,14 +460,14 @@ def build_parser() -> argparse.ArgumentParser:
     add_assembly_argument(parser)
     parser.add_argument("--delay", type=finite_float(0, 3600), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
-    parser.add_argument("--rrd", type=Path, help="save this cell's Rerun recording to FILE")
+    parser.add_argument("--rrd", type=nonempty_path, help="save this cell's Rerun recording to FILE")
     parser.add_argument("--recording-id", help="Rerun recording id shared with the planner")
     add_viewer_arguments(parser, serve=False)  # a cell serves for as long as it runs: stream to a viewer
     parser.add_argument("--block-hole", action="append", default=[], metavar="H",
                         help="put an obstacle in hole H for plan steps (a fault injection; repeatable)")
     parser.add_argument("--lifeline", action="store_true",
                         help="exit when standard input closes (set by a supervising session)")
-    parser.add_argument("--ilc-state", type=Path, metavar="FILE",
+    parser.add_argument("--ilc-state", type=nonempty_path, metavar="FILE",
                         help="sim backend: load the cell's ILC corrections from FILE (if it exists) and "
                         "save them there after every update (a session passes <run>/<cell>-ilc.json)")
     add_cell_arguments(parser)
@@ -497,6 +530,11 @@ def serve(settings: ServeSettings) -> int:
 
             # So is a damaged state.
             read_state(Path(settings.ilc_state), description.ilc, offset_bound(description.admittance))
+    elif settings.cell.description is not None:
+        from assembly_constraints.executor.cell_description import load_cell_description
+
+        # Not used by this backend, but a bad file is refused rather than silently ignored.
+        load_cell_description(Path(settings.cell.description))
     listen = cell_listen(settings.listen, settings.connect, zenoh_config)
     connect = list(settings.connect)
     signal.signal(signal.SIGTERM, _exit_on_signal)

@@ -37,7 +37,7 @@ from assembly_constraints.executor.skills.insertion import insert_in_layer, need
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import load_geometry
+from assembly_constraints.executor.world.geometry import fit_pose, load_geometry
 from assembly_constraints.executor.world.perturbation import CellBias
 from assembly_constraints.executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes
 
@@ -188,7 +188,7 @@ class Cell:
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
-        skill = self.check_pair(part, hole).deeper(self.geometry.deeper_than_taught(spec, hole_spec))
+        skill = self.check_pair(part, hole).in_hole(hole_spec.depth)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps
@@ -199,8 +199,9 @@ class Cell:
         self._scenes[spec.shape].set_friction(setup.friction)
         arm.set_grasp_error(setup.grasp_offset, rotvec_quat_xyzw(setup.grasp_tilt))
         surface = hole_spec.top_z
-        est_xy = np.array(hole_spec.position) + setup.vision_error
-        yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + setup.vision_yaw)
+        turn, shift = fit_pose(spec, hole_spec)
+        est_xy = np.array(hole_spec.position) + shift + setup.vision_error
+        yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn + setup.vision_yaw)
         quat = tool_quat(yaw)
         approach = np.array([est_xy[0], est_xy[1], surface + APPROACH_HEIGHT])
         arm.inverse_kinematics(approach, quat)

@@ -67,6 +67,12 @@ def python_module(module: str, *args: str, cwd: Path | str | None = None, input:
                           input=input, capture_output=True, text=True, timeout=timeout)
 
 
+def error_lines(stderr: str) -> list[str]:
+    """The non-empty lines of a command's stderr without PyBullet's banner (printed when the
+    cell's modules are imported, before any input is read)."""
+    return [line for line in stderr.splitlines() if line.strip() and not line.startswith("pybullet build time")]
+
+
 class Runner(Protocol):
     def __call__(self, *args: str, cwd: Path | str | None = None, input: str | None = None,
                  timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]: ...

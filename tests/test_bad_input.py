@@ -197,6 +197,14 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      assembly(**{"precedence.lp": unreadable("asm/precedence.lp", CRANFIELD / "precedence.lp")}), 2, "read"),
     ("trial-unreadable-geometry", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      assembly(**{"geometry.toml": unreadable("asm/geometry.toml", CRANFIELD / "geometry.toml")}), 2, "read"),
+    # a session's cells answer from the product's geometry: without one, refused before any cell starts
+    ("session-sim-no-geometry", ("session", "--assembly", "asm", "--out", "run"),
+     assembly(**{"geometry.toml": lambda tmp: (tmp / "asm" / "geometry.toml").unlink()}), 2,
+     "asm/geometry.toml: no such file; the cells a session starts (--backend sim) answer from"),
+    ("session-truth-no-geometry-no-sizes", ("session", "--backend", "truth", "--assembly", "asm", "--out", "run"),
+     assembly(**{"geometry.toml": lambda tmp: (tmp / "asm" / "geometry.toml").unlink(),
+                 "sizes.lp": lambda tmp: (tmp / "asm" / "sizes.lp").unlink()}), 2,
+     "asm/geometry.toml: no such file; the cells a session starts (--backend truth) answer from geometry.toml or"),
     # session --resume with a damaged session.json: fails before any cell starts
     ("resume-empty", ("session", "--resume", "run"), {"run/session.json": ""}, 2, "JSON"),
     ("resume-binary", ("session", "--resume", "run"), {"run/session.json": b"\x00\xff\xfe{"}, 2, "JSON"),
@@ -229,7 +237,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("trial-peg-half-a-metre", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
      geometry("size = 0.0187", "size = 0.5"), 2, "[part_shapes.shaft] size: expected a number in (0, 0.1] m"),
     ("trial-kind-unknown", ("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", "asm"),
-     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of rect, round, square"),
+     geometry('kind = "square"', 'kind = "hexagon"'), 2, "kind: expected one of polygon, rect, round, square"),
     ("teach-demo-hole-unknown", ("executor", "teach", "--assembly", "asm"),
      geometry('demo_hole = "br"', 'demo_hole = "zz"'), 2, "[part_shapes.shaft] demo_hole"),
     ("trial-geometry-rect-short-side-first", ("executor", "trial", "--part", "p3", "--hole", "s1", "--assembly", "asm"),

@@ -18,13 +18,19 @@ from pathlib import Path
 
 import pytest
 
+from assembly_constraints.bridge.assembly import DATA_DIR
 from assembly_constraints.bridge.cli_types import ASSEMBLY_HELP, PROGRAM
 from assembly_constraints.cli import main
 from tests.conftest import child_env
 
-MARKUP = re.compile(r"``|`|:mod:|:class:|:func:|\.\/run\.sh|\b(?:asp|executor|bridge)\.[a-z_]+\b|\w+\.py\b")
-"""Documentation markup, the wrapper's name, and module names a user never types (a
-``MODULE:CLASS`` example such as ``assembly_constraints.executor.replay:ReplayBackend`` is allowed below)."""
+MARKUP = re.compile(r"``|`|\*\*|:mod:|:class:|:func:|\.\/run\.sh|\b(?:asp|executor|bridge)\.[a-z_]+\b|\w+\.py\b"
+                    r"|\b[A-Z][a-z][A-Za-z]*\.[a-z_]{2,}\b")
+"""Documentation markup (literals, roles, strong emphasis), the wrapper's name, and module
+or method names a user never types (a ``MODULE:CLASS`` example such as
+``assembly_constraints.executor.replay:ReplayBackend`` is allowed below)."""
+OTHER_PROGRAMS = re.compile(r"run\.sh|\bpython3? -m\b|\bassembly_constraints\b")
+"""Names of the program other than ``assembly-constraints``: the repository's wrapper, the
+module run by Python, the package name."""
 ALLOWED = ("assembly_constraints.executor.replay:ReplayBackend",)
 
 
@@ -123,11 +129,28 @@ def test_no_markup_or_internal_words_on_any_page(pages) -> None:
     assert found == []
 
 
+def test_every_page_as_printed_names_one_program_in_plain_text(pages) -> None:
+    """The whole page as ``--help`` prints it (usage, description, option groups, options,
+    epilog): every usage line names the program, no other name of it, no markup."""
+    found = []
+    for path, parser in pages:
+        text = parser.format_help()
+        for allowed in ALLOWED:
+            text = text.replace(allowed, "")
+        where = " ".join([PROGRAM, *path])
+        found += [f"{where}: usage names {name!r}" for name in re.findall(r"usage: (\S+)", text) if name != PROGRAM]
+        found += [f"{where}: {match.group()!r}" for pattern in (MARKUP, OTHER_PROGRAMS)
+                  for match in pattern.finditer(text)]
+    assert found == []
+
+
 def test_assembly_has_one_meaning_everywhere(pages) -> None:
     helps = {" ".join(path): action.help for path, parser in pages for action in parser._actions
              if "--assembly" in action.option_strings}
     assert len(helps) >= 10
     assert {path: text for path, text in helps.items() if not (text or "").startswith(ASSEMBLY_HELP)} == {}
+    shipped = {folder.name for folder in DATA_DIR.iterdir() if (folder / "assembly.toml").is_file()}
+    assert shipped and {name for name in shipped if name not in ASSEMBLY_HELP} == set()  # every one named
 
 
 def test_list_options_reject_malformed_lists(pages) -> None:

@@ -18,10 +18,9 @@ PROGRAM = "assembly-constraints"
 
 
 @pytest.fixture(scope="module")
-def installed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, str]]:
+def pip_install(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     """The package installed (a wheel built from the repository, not editable) into a fresh
-    folder; returns the console command and the environment that runs it (that folder on
-    PYTHONPATH, the repository nowhere on it; the dependencies from this interpreter)."""
+    folder; returns that folder and what pip wrote to stderr."""
     source = tmp_path_factory.mktemp("source") / "repository"  # pip builds in the tree: not in ours
     shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".*", "build", "runs", "*.egg-info", "__pycache__"))
     target = tmp_path_factory.mktemp("site")
@@ -29,6 +28,14 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str,
                            "--target", str(target), str(source)],
                           capture_output=True, text=True, timeout=180)
     assert done.returncode == 0, done.stderr
+    return target, done.stderr
+
+
+@pytest.fixture(scope="module")
+def installed(pip_install: tuple[Path, str]) -> tuple[Path, dict[str, str]]:
+    """The console command of :func:`pip_install` and the environment that runs it (its
+    folder on PYTHONPATH, the repository nowhere on it; the dependencies from this interpreter)."""
+    target = pip_install[0]
     env = {name: value for name, value in os.environ.items() if name not in DISPLAY_VARIABLES}
     env["PYTHONPATH"] = str(target)
     return target / "bin" / PROGRAM, env
@@ -68,3 +75,15 @@ def test_the_installed_package_adds_exactly_one_top_level_name(installed: tuple[
     assert names == {"assembly_constraints"}
     layers = [site / "assembly_constraints" / layer for layer in ("asp", "bridge", "executor")]
     assert all(layer.is_dir() and not layer.is_symlink() and (layer / "__init__.py").is_file() for layer in layers)
+
+
+@pytest.mark.slow
+def test_the_build_warns_of_nothing_and_ships_every_encoding(pip_install: tuple[Path, str]) -> None:
+    """Data folders (``asp/encodings``, each assembly's ``assets/``) are package data, not
+    packages the build would warn about ("Package would be ignored"); pip re-emits whatever
+    the build backend warns as a ``BuildBackendWarning``."""
+    target, stderr = pip_install
+    assert "BuildBackendWarning" not in stderr and "would be ignored" not in stderr, stderr
+    def encodings(asp: Path) -> set[Path]:
+        return {f.relative_to(asp) for f in (asp / "encodings").rglob("*.lp")}
+    assert encodings(ROOT / "asp") == encodings(target / "assembly_constraints" / "asp") != set()

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from assembly_constraints.bridge.recording.reader import column_values, read_blueprint, read_recording
-from assembly_constraints.bridge.recording.sinks import free_port
+from assembly_constraints.bridge.recording.sinks import rerun_server
 from tests.conftest import ROOT, child_env
 
 
@@ -37,16 +37,14 @@ def assert_closed(address: str) -> None:
 @contextmanager
 def headless_viewer(live: Path) -> Iterator[str]:
     """A Rerun server saving what streams into it to ``live``; yields its URL."""
-    port = free_port()
-    viewer = subprocess.Popen([sys.executable, "-m", "rerun_cli", "--port", str(port), "--save", str(live)],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=child_env())
-    try:
-        _wait_for(live)
-        yield f"rerun+http://127.0.0.1:{port}/proxy"
-        time.sleep(1.0)
-    finally:
-        viewer.send_signal(signal.SIGINT)
-        viewer.wait(20)
+    with rerun_server(["--save", str(live)]) as viewer:
+        try:
+            _wait_for(live)
+            yield viewer.url
+            time.sleep(1.0)
+        finally:
+            viewer.process.send_signal(signal.SIGINT)  # it finishes its file
+            viewer.process.wait(20)
 
 
 @pytest.mark.slow

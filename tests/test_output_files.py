@@ -31,7 +31,8 @@ COMMANDS = {  # command line writing one file to OUT
     "sizes evaluate --plot": ("sizes", "evaluate", "--assembly", "cranfield", "--policy", "best",
                               "--relabelings", "2", "--plot", "OUT"),
 }
-BAD_PATHS = {"missing folder": ("missing/out.png", "No such file or directory"),  # .png: --png asks for it
+BAD_PATHS = {"missing folder": ("missing/out.png",  # .png: --png asks for it
+                                "No such file or directory: no folder {tmp}/missing; create it first"),
              "a directory": ("folder.png", "Is a directory"),
              "under a regular file": ("file/out.png", "Not a directory")}
 
@@ -49,7 +50,7 @@ def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_cli, command: st
     out = tmp_path / name
     done = run_cli(*_argv(command, out))
     assert done.returncode == 2, done.stderr
-    assert done.stderr == f"error: {out}: cannot write ({reason})\n"
+    assert done.stderr == f"error: {out}: cannot write ({reason.format(tmp=tmp_path)})\n"
     assert (tmp_path / "file").read_text() == "a regular file\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "folder.png"]
     assert list((tmp_path / "folder.png").iterdir()) == []

@@ -63,6 +63,7 @@ from assembly_constraints.bridge.cli_types import (
     add_assembly_argument,
     finite_float,
     int_in,
+    nonempty_path,
     path_setting,
 )
 from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
@@ -86,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="the cell: sim (PyBullet, default) or truth (geometry rule, no simulation)")
     parser.add_argument("--timeout", type=finite_float(0.0, MAX_STEP_S, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell (default 300)")
-    parser.add_argument("--save", "--rrd", dest="rrd", type=Path, metavar="FILE",
+    parser.add_argument("--save", "--rrd", dest="rrd", type=nonempty_path, metavar="FILE",
                         help="save the cell's Rerun recording to this .rrd file")
     parser.add_argument("--json", action="store_true", help="print the JSON result")
     add_assembly_uncertainty_argument(parser)

@@ -18,7 +18,7 @@ from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, CellSettings
 from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_step
 from assembly_constraints.bridge.inputs import shorten
 from assembly_constraints.bridge.messages import StepReply, StepRequest
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 CELL_ID = "a1"
 CELL_START_S = 60.0
@@ -76,9 +76,10 @@ def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backe
     cell's random errors, ``timeout_s`` bounds one step [s], ``cell``: the sim cell's
     settings (:func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`:
     uncertainty, layer, cell seed)."""
-    listen = list(listen) or [free_loopback_endpoint()]
+    listen = list(listen) or [LOOPBACK_ANY_PORT]
     session = open_session(listen, connect, None if zenoh_config is None else Path(zenoh_config))
     try:
+        listen = bound_endpoints(session, listen)  # the port the cell connects to, as bound
         directory = CellDirectory(session)
         process = start_cell(ServeSettings(cell_id=CELL_ID, backend=backend, assembly=str(assembly_folder),
                                            connect=tuple(listen[:1]), rrd=rrd, zenoh_config=zenoh_config,

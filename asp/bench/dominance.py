@@ -29,7 +29,7 @@ knowledge, entailment and stopping range over all 329 462 5×5 biorders, but dea
 and objective only over T; subtrees holding no truth of T cost nothing. A policy
 never worse than systematic on every biorder is never worse on T, and its cost over
 T is counted exactly, so the least total over T is a lower bound for every such
-policy. A policy found in the relaxation (:meth:`Search.first_policy`) is, conversely,
+policy. A policy found in the relaxation (the search's first policy) is, conversely,
 a decision tree over all 5×5 biorders that is never worse than systematic on every
 Cranfield relabeling; :func:`policy_counts` replays it.
 

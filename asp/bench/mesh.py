@@ -30,7 +30,7 @@ from importlib.metadata import version
 import zenoh
 
 from assembly_constraints.bridge.cli_types import ArgumentParser, int_in
-from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, free_loopback_endpoint, open_session
+from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 TOPOLOGIES = ("star", "star+listen", "together", "apart")
 WATCH_S = 3.0
@@ -39,8 +39,9 @@ WATCH_S = 3.0
 
 def peer(listen: list[str], connect: list[str], name: str) -> None:
     """One peer: token ``bench/alive/NAME`` and queryable ``bench/claim/NAME``; prints
-    ``ready``, then on a line on stdin one JSON line: when it saw each token (Unix time
-    [s]) and which peers answered ``bench/claim/*``; exits when stdin closes."""
+    ``ready`` and the endpoints it listens on (their ports as bound), then on a line on
+    stdin one JSON line: when it saw each token (Unix time [s]) and which peers answered
+    ``bench/claim/*``; exits when stdin closes."""
     seen: dict[str, float] = {}
     with open_session(listen, connect) as session:
         _held = (session.liveliness().declare_subscriber(
@@ -48,7 +49,7 @@ def peer(listen: list[str], connect: list[str], name: str) -> None:
                      history=True),
                  session.declare_queryable(f"bench/claim/{name}", lambda q: q.reply(q.key_expr, name.encode())),
                  session.liveliness().declare_token(f"bench/alive/{name}"))
-        print("ready", flush=True)
+        print("ready", *bound_endpoints(session, listen), flush=True)
         sys.stdin.readline()
         answered = sorted(r.ok.payload.to_bytes().decode() for r in session.get(
             "bench/claim/*", timeout=2.0, consolidation=zenoh.ConsolidationMode.NONE) if r.ok is not None)
@@ -62,32 +63,33 @@ def _start(listen: list[str], connect: list[str], name: str) -> subprocess.Popen
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
 
-def _ready(process: subprocess.Popen[str]) -> float:
-    """Wait for a peer's ``ready``; returns the Unix time [s] it came."""
+def _ready(process: subprocess.Popen[str]) -> tuple[float, list[str]]:
+    """Wait for a peer's ``ready``; returns the Unix time [s] it came and the endpoints the
+    peer listens on."""
     assert process.stdout is not None
-    if process.stdout.readline().strip() != "ready":
+    words = process.stdout.readline().split()
+    if words[:1] != ["ready"]:
         raise RuntimeError("a bench peer did not start")
-    return time.time()
+    return time.time(), words[1:]
 
 
 def one_run(topology: str) -> dict:
     """B's view of A in one run of ``topology``: ``token`` (seen), ``query`` (answered), ``delay_ms``."""
-    planner_port = free_loopback_endpoint()
     listen = [LOOPBACK_ANY_PORT] if topology != "star" else []
     planner = None
     if topology == "apart":
-        a_port, b_port = free_loopback_endpoint(), free_loopback_endpoint()
-        a, b = _start([a_port], [], "A"), _start([b_port], [], "B")
-        _ready(a), _ready(b)
+        a, b = _start([LOOPBACK_ANY_PORT], [], "A"), _start([LOOPBACK_ANY_PORT], [], "B")
+        a_ports, b_ports = _ready(a)[1], _ready(b)[1]
         last = time.time()
-        planner = open_session(connect=[a_port, b_port])
+        planner = open_session(connect=[*a_ports[:1], *b_ports[:1]])
     else:
-        planner = open_session(listen=[planner_port])
+        planner = open_session(listen=[LOOPBACK_ANY_PORT])
+        planner_port = bound_endpoints(planner, [LOOPBACK_ANY_PORT])[0]
         a = _start(listen, [planner_port], "A")
         if topology != "together":
             _ready(a)
         b = _start(listen, [planner_port], "B")
-        last = _ready(b)
+        last = _ready(b)[0]
         if topology == "together":
             _ready(a)
     time.sleep(WATCH_S)

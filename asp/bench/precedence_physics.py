@@ -28,7 +28,6 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import clingo
 
@@ -49,6 +48,7 @@ from assembly_constraints.bridge.cli_types import (
     comma_list,
     finite_float,
     int_in,
+    nonempty_path,
 )
 from assembly_constraints.bridge.files import check_writable, write_atomic
 from assembly_constraints.bridge.progress import progress
@@ -221,7 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--timeout", type=finite_float(0.0, 86_400.0, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell [s] (default 300)")
     parser.add_argument("--json", action="store_true", help="print the JSON result instead of the table")
-    parser.add_argument("--out", type=Path, metavar="FILE", help="also write the JSON result to FILE")
+    parser.add_argument("--out", type=nonempty_path, metavar="FILE", help="also write the JSON result to FILE")
     return parser
 
 

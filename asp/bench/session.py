@@ -55,7 +55,7 @@ from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, comm
 from assembly_constraints.bridge.client import CellDirectory, request_insert
 from assembly_constraints.bridge.keys import ping_key
 from assembly_constraints.bridge.messages import InsertRequest, encode
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 MAX_HOSTS = 16
 """--hosts: at most this many cell namespaces."""
@@ -76,9 +76,9 @@ def _ms(values: list[float]) -> dict[str, float]:
 
 def round_trips(count: int) -> dict:
     """Validated insert round trips vs bare queries, alternating, to one truth cell."""
-    endpoint = free_loopback_endpoint()
-    cell = start_cell(ServeSettings(cell_id="bench", backend="truth", listen=(endpoint,)))
-    session = open_session(connect=[endpoint])
+    session = open_session(listen=[LOOPBACK_ANY_PORT])
+    cell = start_cell(ServeSettings(cell_id="bench", backend="truth",
+                                    connect=tuple(bound_endpoints(session, [LOOPBACK_ANY_PORT])[:1])))
     try:
         CellDirectory(session).wait_for(1, timeout=30)
         replies: queue.SimpleQueue[bytes] = queue.SimpleQueue()

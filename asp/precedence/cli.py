@@ -32,6 +32,7 @@ from assembly_constraints.bridge.cli_types import (
     comma_list,
     int_in,
     non_negative_int,
+    nonempty_path,
     number_in,
     png_path,
     strict_int,
@@ -48,8 +49,9 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("demos", nargs="?",
                        help="demonstrations file (text, or demo/3 facts *.lp); default: the assembly's demos.txt")
     add_assembly_argument(learn, None, purpose="gives the parts and the default demonstrations")
-    learn.add_argument("--out", help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
-    learn.add_argument("--dot", help="write the transitive-reduction graph as Graphviz DOT")
+    learn.add_argument("--out", type=nonempty_path,
+                       help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
+    learn.add_argument("--dot", type=nonempty_path, help="write the transitive-reduction graph as Graphviz DOT")
     learn.add_argument("--png", type=png_path, help="draw the relation to a PNG file (FILE.png)")
     learn.add_argument("--min-support", type=int_in(1, 10**6), default=1, metavar="K",
                        help="drop a constraint only when >= K demonstrations contradict it "
@@ -90,7 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--guided", action="store_true",
                           help="demonstrations to the exact relation, guided vs random")
     evaluate.add_argument("--json", action="store_true", help="print JSON")
-    evaluate.add_argument("--plot", help="write the Figs. 12/13 bar charts to this PNG file")
+    evaluate.add_argument("--plot", type=nonempty_path, help="write the Figs. 12/13 bar charts to this PNG file")
 
     suggest = commands.add_parser("suggest", help="propose the next sequence to demonstrate")
     suggest.add_argument("demos", nargs="?",
@@ -131,7 +133,7 @@ def _learn(args: argparse.Namespace) -> None:
     for path in (args.out, args.dot, args.png):  # before the learning and the drawing
         if path:
             check_writable(path)
-    prior = load_relation([args.prior]) if args.prior else None
+    prior = load_relation([args.prior], data=True) if args.prior else None
     demos = _demonstrations(args, prior)
     if prior is None:
         relation = learn_must_precede(demos, args.min_support)

@@ -170,4 +170,4 @@ def learn_for_assembly(assembly: Assembly,
         demos = Demonstrations(tuple(assembly.part_ids), (), ())
     else:
         demos = load_demos(demos_file or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
-    return demos, learn_with_prior(demos, load_relation([prior_file]), str(prior_file)), prior_file
+    return demos, learn_with_prior(demos, load_relation([prior_file], data=True), str(prior_file)), prior_file

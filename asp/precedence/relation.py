@@ -17,8 +17,15 @@ from pathlib import Path
 import clingo
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name
+from assembly_constraints.asp import MAX_IDS, PlannerError
+from assembly_constraints.asp.solve import (
+    atoms_by_name,
+    check_facts,
+    fact,
+    load_atoms,
+    pairs_by_name,
+    read_ground_facts,
+)
 from assembly_constraints.bridge.assembly import Assembly
 
 Pair = tuple[str, str]
@@ -100,13 +107,26 @@ def precedence_facts(relation: Relation) -> list[clingo.Symbol]:
     ]
 
 
-def load_relation(paths: Sequence[Path | str]) -> Relation:
+MAX_PRIOR_FACTS = MAX_IDS + 2 * MAX_IDS * MAX_IDS
+"""The most facts a precedence prior holds: every part, and every pair in both forms."""
+
+
+def load_relation(paths: Sequence[Path | str], *, data: bool = False) -> Relation:
     """Read ``part/1`` with ``must_precede/2`` and/or ``precedence_edge/2`` facts; closed.
+    With ``data`` (a prior such as the ``geometric_precedence.lp`` import writes) the files
+    are read as ground facts only (:func:`assembly_constraints.asp.solve.read_ground_facts`,
+    at most :data:`MAX_PRIOR_FACTS`), never grounded as a program.
 
     PlannerError when the files hold no ``part/1``, name an unknown part or hold a cycle.
     """
     names = ", ".join(str(p) for p in paths)
-    atoms = load_atoms(paths, encodings=["precedence_closure.lp"], shown_only=False)
+    if data:
+        expected = "part/1, must_precede/2 and precedence_edge/2 facts"
+        facts = [atom for path in paths
+                 for _, atom in read_ground_facts(Path(path), expected, max_facts=MAX_PRIOR_FACTS)]
+        atoms = load_atoms([], encodings=["precedence_closure.lp"], extra=facts, shown_only=False)
+    else:
+        atoms = load_atoms(paths, encodings=["precedence_closure.lp"], shown_only=False)
     check_facts(atoms, {"part": 1, "must_precede": 2, "precedence_edge": 2}, names)
     parts = [p for (p,) in atoms_by_name(atoms, "part", 1)]
     if not parts:

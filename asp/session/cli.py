@@ -29,6 +29,7 @@ from assembly_constraints.asp.sizes.cli import add_model_option, add_prior_optio
 from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
 from assembly_constraints.asp.sizes.policies import policy_names
 from assembly_constraints.asp.solve import encoding
+from assembly_constraints.bridge.assembly import load_assembly
 from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
@@ -38,6 +39,7 @@ from assembly_constraints.bridge.cli_types import (
     comma_list,
     finite_float,
     int_in,
+    nonempty_path,
     path_setting,
 )
 from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
@@ -62,8 +64,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--demos", type=Path, metavar="FILE",
                         help="demonstrations (default: the assembly's demos.txt); a part placed into a "
                              "hole (p1@r1) is a fit the size learning starts from")
-    parser.add_argument("--out", type=Path, help="run folder (default runs/<UTC time>)")
-    parser.add_argument("--resume", type=Path, metavar="RUN", help="continue a killed session")
+    parser.add_argument("--out", type=nonempty_path, help="run folder (default runs/<UTC time>)")
+    parser.add_argument("--resume", type=nonempty_path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
                         help="cells started here: sim (PyBullet) or truth (answers from the geometry's "
                              "cross-sections, no simulation)")
@@ -116,6 +118,16 @@ def _assembly_line(report: dict) -> str:
             f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
 
 
+def _versus_line(truth: dict[str, bool | int | None], matches: bool | None) -> str:
+    """The summary's comparison with the product's truths, saying which cannot be made."""
+    sizes = "unknown (no sizes.lp)" if truth["sizes_equal"] is None else truth["sizes_equal"]
+    precedence = ("unknown (no precedence.lp)" if truth["precedence_sound"] is None
+                  else f"{truth['precedence_sound']} ({truth['precedence_extra']} pairs more than required)")
+    verdict = "unknown" if matches is None else matches
+    return (f"versus the truth: sizes equal {sizes}, every true precedence learned {precedence}; "
+            f"matches truth: {verdict}")
+
+
 def _summary(result: dict, run: Path) -> str:
     """The human ending of a session: what was learned, the files written, what to run next."""
     settings = read_session_file(run)
@@ -123,10 +135,13 @@ def _summary(result: dict, run: Path) -> str:
     cells: dict[str, int] = {}
     for entry in settings.journal:
         cells[entry["cell"]] = cells.get(entry["cell"], 0) + 1
-    plan = " ".join(f"{s['part']}" + (f"->{s['hole']}" if s["hole"] else "") for s in result["plans"][0])
+    assembly = load_assembly(settings.assembly)
+    plan = (f"plan 1 of {len(result['plans'])}: " + " ".join(
+        assembly.step_text(s["part"], s["hole"]) for s in result["plans"][0])
+        if result["plans"] else f"no plan: {result['error']}")
     files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
     python = shlex.quote(sys.executable)
-    learned = shlex.quote(str(run / "learned.lp"))
+    learned = shlex.quote(str(run.resolve() / "learned.lp"))  # the "next" commands work from any folder
     part = result["fits"][0][0] if result["fits"] else "p1"
     return "\n".join([
         f"run {result['run']}: {result['experiments']} experiments "
@@ -138,19 +153,17 @@ def _summary(result: dict, run: Path) -> str:
         *([] if settings.prior is UNSET or settings.prior is None else [f"assumes: {prior_statement(settings.prior)}"]),
         *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
-        "assignment: " + " ".join(f"{p}->{h}" for p, h in settings.assignment.items()),
-        f"plan 1 of {len(result['plans'])}: {plan}",
-        f"versus the truth: sizes equal {settings.truth['sizes_equal']}, every true "
-        f"precedence learned {settings.truth['precedence_sound']} "
-        f"({settings.truth['precedence_extra']} pairs more than required); "
-        f"matches truth: {result['matches_truth']}",
+        "assignment: " + (" ".join(f"{p}->{h}" for p, h in settings.assignment.items()) or "none"),
+        plan,
+        _versus_line(settings.truth, result["matches_truth"]),
         *([_assembly_line(result["assembly"])] if "assembly" in result else []),
         f"files written in {run}: {' '.join(files)}",
         "next:",
-        *(f"  {label + ':':<24}{command}" for label, command in (
-            ("view the recording", f"{_program()} view {shlex.quote(str(run))}"),
+        *(f"  {(label + ':').ljust(23)} {command}" for label, command in (
+            ("view the recording", f"{_program()} view {shlex.quote(str(run.resolve()))}"),
             (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
-            ("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5"),
+            *([("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5")]
+              if result["plans"] else []),
         )),
     ])
 
@@ -162,7 +175,7 @@ def main(argv: list[str]) -> int:
         result = run_session(session_settings(args), live)
         print(json.dumps(result) if args.json else _summary(result, Path(result["run"])), flush=True)
         keep_serving(viewer)
-    stopped = result.get("assembly", {}).get("error")
+    stopped = result.get("error") or result.get("assembly", {}).get("error")
     if stopped:
         LOG.error("%s", stopped)
         return EXIT_UNSOLVABLE

@@ -48,7 +48,7 @@ import msgspec
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.bridge.files import os_reason
 from assembly_constraints.bridge.inputs import duplicate_key, read_bytes
-from assembly_constraints.bridge.messages import AspId, Evidence, RequestId, Result
+from assembly_constraints.bridge.messages import MAX_COUNT, AspId, Evidence, RequestId, Result
 
 JOURNAL_NAME = "journal.jsonl"
 
@@ -57,8 +57,9 @@ MAX_JOURNAL_BYTES = 64 * 1024 * 1024
 start take about 450 bytes, so over 100 000 experiments)."""
 
 
-MAX_EXPERIMENT = 2**31 - 1
-"""The largest experiment number a journal holds (far above what fits in its bound)."""
+MAX_EXPERIMENT = MAX_COUNT
+"""The largest experiment number a journal holds (far above what fits in its bound), the
+largest a message carries."""
 
 Experiment = Annotated[int, msgspec.Meta(ge=0, le=MAX_EXPERIMENT)]
 Started = Annotated[int, msgspec.Meta(ge=1, le=MAX_EXPERIMENT)]

@@ -40,7 +40,7 @@ import msgspec
 import zenoh
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import feasible_assignment, load_learned_facts
+from assembly_constraints.asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts
 from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
 from assembly_constraints.asp.precedence.demos import demo_facts
 from assembly_constraints.asp.precedence.learn import learn_for_assembly
@@ -58,7 +58,9 @@ from assembly_constraints.asp.session.settings import (
     checked,
     new_session_file,
     prior_statement,
+    product_digest,
     read_session_file,
+    resumed_settings,
     write_session_file,
 )
 from assembly_constraints.asp.session.zenoh_oracle import Finished, ZenohOracle
@@ -69,13 +71,13 @@ from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.asp.solve import fact, write_facts
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_settings import ServeSettings
+from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellPool
 from assembly_constraints.bridge.files import make_folder
 from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
 from assembly_constraints.bridge.recording.reader import read_recording
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
-from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, free_loopback_endpoint, open_session
+from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 LOG = logging.getLogger(__name__)
 RESULT_KEYS = ("run", "experiments", "fits", "must_precede", "plans", "matches_truth", "model", "assumption",
@@ -152,7 +154,7 @@ def _endpoints(settings: SessionSettings) -> tuple[list[str], list[str]]:
     """(listen, connect) of the planner: it listens for its own cells, else connects."""
     listen, connect = list(settings.listen), list(settings.connect)
     if settings.cells > 0:
-        return listen or [free_loopback_endpoint()], connect
+        return listen or [LOOPBACK_ANY_PORT], connect
     return listen, connect or ([] if settings.zenoh_config else [DEFAULT_ENDPOINT])
 
 
@@ -307,6 +309,46 @@ def run_session(settings: SessionSettings, viewer: Viewer = NO_VIEWER) -> dict:
         lock.release()
 
 
+def _resumed(settings: SessionSettings, record: SessionFile, run: Path) -> tuple[SessionSettings, list[str]]:
+    """The settings a resume of ``run`` runs with: what its ``session.json`` (``record``)
+    keeps wins over ``settings`` (:func:`resumed_settings`); and the warnings to give once
+    the resume is checked: the options it ignores, a folder that kept no backend (written
+    before it was kept)."""
+    unrecorded = record.backend is None
+    settings, ignored = resumed_settings(settings, record)
+    warnings = [f"resume: {run / SESSION_FILE} keeps no backend, delay or product digest (written by an older "
+                f"version): resuming with --backend {settings.backend} --delay {settings.delay_s:g} and the "
+                "product as it is now"] if unrecorded else []
+    if ignored:
+        warnings.append(f"resume: ignoring {', '.join(ignored)} (a resume keeps the settings of {run / SESSION_FILE})")
+    return settings, warnings
+
+
+def _check_product(settings: SessionSettings, record: SessionFile, assembly: Assembly, run: Path) -> None:
+    """Record the digest of the product as loaded now in ``record``; a resume whose product
+    changed since the run started is refused (PlannerError): its journaled observations are
+    of the product as it was."""
+    digest = product_digest(assembly.folder)
+    if settings.resume is not None and record.product not in (None, digest):
+        raise PlannerError(f"--resume {run}: the product {assembly.folder} changed since the session started "
+                           f"(digest {digest[:12]}, {run / SESSION_FILE} says {(record.product or '')[:12]}); its "
+                           "journaled observations are of the product as it was: start a new session")
+    record.product = digest
+
+
+def _resume_line(settings: SessionSettings, record: SessionFile, run: Path, journal: Journal) -> str:
+    """What a resume of ``run`` resumes, in one line."""
+    magnitudes = msgspec.structs.asdict(record.cell.magnitudes)
+    changed = [f"{name} {value:g}" for name, value in magnitudes.items()
+               if value != getattr(DEFAULT_CELL.magnitudes, name)]
+    return (f"resuming {run} (start {record.starts}): {len(journal.entries)} experiment(s) journaled; "
+            f"assembly {record.assembly} (product digest {(record.product or '')[:12]}), policy {record.policy}, "
+            f"seed {record.seed}, confirm {record.confirm}, backend {settings.backend}"
+            + (f" (delay {settings.delay_s:g} s)" if settings.backend == "truth" else "")
+            + f", cells: layer {record.cell.layer}, first cell seed {record.cell.cell_seed}"
+            + (f", {', '.join(changed)}" if changed else ""))
+
+
 def session_cell(settings: SessionSettings, record: SessionFile, run: Path, number: int, connect: list[str],
                  viewer_url: str | None) -> ServeSettings:
     """The settings of the session's cell ``c<number>`` (1, 2, ...) connecting to
@@ -327,9 +369,16 @@ def session_cell(settings: SessionSettings, record: SessionFile, run: Path, numb
 def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, started: float,
                 viewer: Viewer) -> dict:
     """:func:`run_session` in the locked run folder ``run`` whose ``session.json`` is
-    ``record`` (what is learned comes from there); ``started``: its
-    ``time.perf_counter()`` [s] at the start."""
+    ``record`` (what is learned comes from there, and the cells' backend on a resume);
+    ``started``: its ``time.perf_counter()`` [s] at the start."""
+    settings, warnings = _resumed(settings, record, run) if settings.resume is not None else (settings, [])
     assembly = load_assembly(record.assembly)
+    _check_product(settings, record, assembly, run)
+    answers_from = {"sim": ("geometry.toml",), "truth": ("geometry.toml", "sizes.lp")}.get(settings.backend, ())
+    if settings.cells > 0 and answers_from and not any(assembly.has_file(name) for name in answers_from):
+        raise PlannerError(f"{assembly.folder / answers_from[0]}: no such file; the cells a session starts (--backend "
+                           f"{settings.backend}) answer from {' or '.join(answers_from)} (docs/backends.md); describe "
+                           "the product, or use --cells 0 with cells of your own")
     parts, holes, truth, model = _sizes_domain(assembly, record.model)
     decided = ([] if record.size_prior is None
                else cad_prior(assembly, record.tolerance_m, tuple(parts), tuple(holes)))
@@ -355,11 +404,16 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     except PlannerError:
         journal.close()
         raise
+    for warning in warnings:
+        LOG.warning("%s", warning)
+    if settings.resume is not None:
+        LOG.info("%s", _resume_line(settings, record, run, journal))
     write_session_file(run, record)
     with ExitStack() as stack:
         stack.callback(journal.close)
         session = open_session(listen, connect, zenoh_config)
         stack.callback(session.close)
+        listen = bound_endpoints(session, listen)  # the port its cells connect to, as bound
         directory = CellDirectory(session)
         stack.callback(directory.close)
         cells: list[CellProcess] = []
@@ -388,6 +442,9 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             directory.wait_for(max(1, len(cell_ids)), timeout=settings.wait_for_cell_s)
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
+        if settings.cells == 0 and not settings.allow_cells:
+            LOG.warning("--cells 0 without --allow-cells: using every cell that answers on the network (now: %s); "
+                        "name the expected ones with --allow-cells", ", ".join(sorted(directory.alive())))
         timings = {"cells_ready_s": time.perf_counter() - started}
         LOG.info("assumes: %s", model.assumption())  # once every input was checked and the cells are up
         if stated_prior is not None:
@@ -403,18 +460,24 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             LOG.warning("model changed: %s", change)
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
                     header=_learned_header(assembly, run, sizes, stated_prior))
-        assignment, found = _plans(learned, settings.plans)
-        write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
-                    header="A hole assignment of learned.lp (the paper's greedy one when it finds one, "
-                           "else a matching; paper 2.2).")
-        log.assignment(assignment)
+        unsolvable: UnsolvableAssembly | None = None
+        try:
+            assignment, found = _plans(learned, settings.plans)
+        except UnsolvableAssembly as exc:
+            assignment, found, unsolvable = {}, [], exc
+        if unsolvable is None:
+            write_facts(run / "assignment.lp", [fact("assigned", p, h) for p, h in assignment.items()],
+                        header="A hole assignment of learned.lp (the paper's greedy one when it finds one, "
+                               "else a matching; paper 2.2).")
+            log.assignment(assignment)
         assembly_report = (_assemble(session, cell_ids, learned, found[0], record.seed, settings.timeout_s,
-                                     cells[0] if cells else None) if settings.assemble else None)
+                                     cells[0] if cells else None) if settings.assemble and found else None)
     view_blueprint(run)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()
     versus = _versus_truth(truth, required, fits, must_precede)
-    matches = None if None in versus.values() else bool(versus["sizes_equal"] and versus["precedence_sound"])
+    known = [versus["sizes_equal"], versus["precedence_sound"]]
+    matches = False if False in known else None if None in known else True
     record.run, record.experiments, record.fits = str(run), len(journal.entries), fits
     record.must_precede, record.plans, record.matches_truth = must_precede, [p.as_json() for p in found], matches
     record.model, record.assumption = sizes.model.name, sizes.model.assumption()
@@ -428,5 +491,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     if assembly_report is not None:
         record.assembly_run = assembly_report  # "assembly" in session.json names the assembly
         result["assembly"] = assembly_report
+    if unsolvable is not None:
+        record.error = result["error"] = str(unsolvable)
     write_session_file(run, record)
     return result

@@ -15,6 +15,7 @@ fields of :class:`assembly_constraints.bridge.cell_settings.CellSettings`.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -37,6 +38,7 @@ from assembly_constraints.bridge.cell_settings import (
 )
 from assembly_constraints.bridge.files import write_atomic
 from assembly_constraints.bridge.inputs import read_bytes, shorten
+from assembly_constraints.bridge.messages import MAX_RUN_ID as MAX_RECORDING_ID
 
 SESSION_FILE = "session.json"
 SESSION_FORMAT = 2
@@ -49,10 +51,16 @@ MAX_PLANS = 1000
 """``plans``: at most this many plans (they are written to session.json)."""
 MAX_STARTS = 1_000_000
 """The most starts (the first and its resumes) a run folder records."""
-MAX_RECORDING_ID = 64
-"""The longest recording id [characters]: the cells' request ids are built from it."""
+MAX_DELAY_S = 3600.0
+"""``delay_s``: at most an hour [s]."""
+PRODUCT_FILES = ("assembly.toml", "geometry.toml", "sizes.lp", "precedence.lp", "demos.txt", "nominal_sizes.lp")
+"""The files of a product folder its digest covers (the meshes ``geometry.toml`` names are
+pinned by the SHA-256 it states for each)."""
 
 RecordingId = Annotated[str, Meta(pattern=rf"^[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}$")]
+Digest = Annotated[str, Meta(pattern=r"^[0-9a-f]{64}$")]
+Backend = Literal["sim", "truth"]
+Delay = Annotated[float, Meta(ge=0.0, le=MAX_DELAY_S)]
 Confirm = Annotated[int, Meta(ge=0, le=MAX_CONFIRM)]
 Tolerance = Annotated[float, Meta(ge=0.0, le=MAX_TOLERANCE_M)]
 
@@ -78,12 +86,12 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     ``c<k>`` with cell seed ``cell.cell_seed + k - 1`` (the command line sets
     ``cell.cell_seed`` to ``seed``), ``size_prior`` (``cad``: the learner starts from the
     outcomes the assembly's nominal sections decide beyond ``tolerance_m`` [m],
-    :mod:`assembly_constraints.asp.sizes.cad_prior`; None: no prior). These are kept in
-    ``session.json``; a resume takes them from there and ignores its own.
+    :mod:`assembly_constraints.asp.sizes.cad_prior`; None: no prior), and the ``backend``
+    of the cells it starts (``truth``: each experiment takes ``delay_s`` [s]). These are
+    kept in ``session.json``; a resume takes them from there and ignores its own.
 
     How: ``out`` (None: ``runs/<UTC time>``) or ``resume`` (a run folder); ``cells``
-    co-processes to start (0: use cells on the network, only ``allow_cells`` if given)
-    with ``backend`` (``truth``: each experiment takes ``delay_s`` [s]); ``timeout_s`` [s]
+    co-processes to start (0: use cells on the network, only ``allow_cells`` if given); ``timeout_s`` [s]
     one experiment at one cell before it is sent again; ``wait_for_cell_s`` [s] while no
     cell is alive; ``plans``: how many to compute; ``assemble``: then assemble plan 1 in
     the first cell; ``listen``, ``connect``, ``zenoh_config``: the planner's Zenoh
@@ -102,8 +110,8 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     out: str | None = None
     resume: str | None = None
     cells: Annotated[int, Meta(ge=0, le=MAX_CELLS)] = 1
-    backend: Literal["sim", "truth"] = "sim"
-    delay_s: Annotated[float, Meta(ge=0.0, le=3600.0)] = 0.0
+    backend: Backend = "sim"
+    delay_s: Delay = 0.0
     timeout_s: Annotated[float, Meta(gt=0.0, le=MAX_WAIT_S)] = 120.0
     wait_for_cell_s: Annotated[float, Meta(ge=0.0, le=MAX_WAIT_S)] = 60.0
     plans: Annotated[int, Meta(ge=1, le=MAX_PLANS)] = 5
@@ -140,13 +148,16 @@ class DecidedPrior(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fie
 
 class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     """``RUN/session.json``: the settings kept with the run folder (see
-    :class:`SessionSettings`), its Rerun ``recording_id``, how many times it was
+    :class:`SessionSettings`; ``backend`` and ``delay_s`` None in a folder written before
+    they were kept), the ``product`` digest (:func:`product_digest`; None: not recorded),
+    its Rerun ``recording_id``, how many times it was
     started, ``status`` and the experiments abandoned by resumes; once ``done``, the
     result (the ``session --json`` contract: ``run``, ``experiments``, ``fits``,
     ``must_precede``, ``plans``, ``matches_truth``, and more: the size model used and
     what it assumes, what the size prior decided (``prior``, set at each start; None
     without one), the truth comparison, the assignment, the cells, the journal,
-    wall time [s] and timings [s], the assembly run). Fields not yet known are absent."""
+    wall time [s] and timings [s], the assembly run, and the ``error`` when the learned
+    product has no complete assignment). Fields not yet known are absent."""
 
     format: int = SESSION_FORMAT
     assembly: str
@@ -158,6 +169,9 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     cell: CellSettings = DEFAULT_CELL
     size_prior: Literal["cad"] | None = None
     tolerance_m: Tolerance = 0.0
+    backend: Backend | None = None
+    delay_s: Delay | None = None
+    product: Digest | None = None
     recording_id: RecordingId
     starts: Annotated[int, Meta(ge=1, lt=MAX_STARTS)] = 1
     status: Literal["running", "done"] = "running"
@@ -179,6 +193,7 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     wall_s: float | UnsetType = UNSET
     timings: dict[str, float] | UnsetType = UNSET
     assembly_run: dict[str, Any] | UnsetType = UNSET
+    error: str | UnsetType = UNSET
 
     def __post_init__(self) -> None:
         if self.format != SESSION_FORMAT:
@@ -193,10 +208,46 @@ def prior_statement(prior: DecidedPrior) -> str:
 
 
 def new_session_file(settings: SessionSettings, recording_id: str) -> SessionFile:
-    """The ``session.json`` of a new run folder."""
+    """The ``session.json`` of a new run folder (its ``product`` digest is set once the
+    product is loaded)."""
     return SessionFile(assembly=settings.assembly, policy=settings.policy, model=settings.model, seed=settings.seed,
                        confirm=settings.confirm, demos=settings.demos, cell=settings.cell,
-                       size_prior=settings.size_prior, tolerance_m=settings.tolerance_m, recording_id=recording_id)
+                       size_prior=settings.size_prior, tolerance_m=settings.tolerance_m, backend=settings.backend,
+                       delay_s=settings.delay_s, recording_id=recording_id)
+
+
+KEPT_OPTIONS = {"policy": "--policy", "model": "--model", "seed": "--seed", "confirm": "--confirm",
+                "demos": "--demos", "size_prior": "--prior", "tolerance_m": "--tolerance", "backend": "--backend",
+                "delay_s": "--delay"}
+"""The settings ``session.json`` keeps (besides ``cell``) and their options."""
+
+
+def resumed_settings(settings: SessionSettings, record: SessionFile) -> tuple[SessionSettings, list[str]]:
+    """The settings a resume runs with: ``settings`` with the backend and delay kept in
+    ``record`` (a record without them gets ``settings``' ones, in place), and the options
+    of ``settings`` that are not their defaults and differ from what ``record`` keeps (the
+    resume ignores them: the run folder's settings win)."""
+    if record.backend is None or record.delay_s is None:
+        record.backend, record.delay_s = settings.backend, settings.delay_s
+    default = SessionSettings()
+    ignored = [f"{option} {getattr(settings, name)}" for name, option in KEPT_OPTIONS.items()
+               if getattr(settings, name) not in (getattr(default, name), getattr(record, name))]
+    seedless = msgspec.structs.replace(settings.cell, cell_seed=record.cell.cell_seed)
+    if seedless not in (msgspec.structs.replace(DEFAULT_CELL, cell_seed=record.cell.cell_seed), record.cell):
+        ignored.append("the cell options")
+    return msgspec.structs.replace(settings, backend=record.backend, delay_s=record.delay_s), ignored
+
+
+def product_digest(folder: Path) -> str:
+    """The SHA-256 (hex) of the product folder's files :data:`PRODUCT_FILES` (each one's
+    name and bytes; an absent one counts as absent): equal digests, the same product."""
+    digest = hashlib.sha256()
+    for name in PRODUCT_FILES:
+        path = folder / name
+        data = read_bytes(path, f"product file {name}", error=PlannerError) if path.exists() else None
+        digest.update(f"{name} {-1 if data is None else len(data)}\n".encode())
+        digest.update(data or b"")
+    return digest.hexdigest()
 
 
 def _from_format_1(data: dict[str, Any]) -> dict[str, Any]:

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
+from assembly_constraints.asp import MAX_IDS, PlannerError
 from assembly_constraints.asp.sizes.knowledge import Pair
 from assembly_constraints.asp.sizes.truth_oracle import Result
-from assembly_constraints.asp.solve import load_atoms
+from assembly_constraints.asp.solve import read_ground_facts
 from assembly_constraints.bridge.assembly import Assembly, is_id
 from assembly_constraints.bridge.inputs import shorten
 
@@ -29,16 +29,26 @@ MAX_TOLERANCE_M = 0.1
 
 
 def nominal_margins(path: Path) -> dict[Pair, int]:
-    """(part, hole) -> margin [µm] of ``path``; PlannerError naming the file when it holds
-    other facts or none."""
+    """(part, hole) -> margin [µm] of ``path``, read as data (:func:`read_ground_facts`, at
+    most one fact per pair of :data:`assembly_constraints.asp.MAX_IDS` parts and holes);
+    PlannerError naming the file and line when it holds anything else, two different margins
+    for one pair (naming both lines), or no facts."""
     margins: dict[Pair, int] = {}
-    for atom in load_atoms([path], shown_only=False):
-        arguments = atom.arguments if atom.type == clingo.SymbolType.Function else []
+    lines: dict[Pair, int] = {}
+    for line, atom in read_ground_facts(path, "nominal_margin(Part,Hole,Micrometres) facts",
+                                        max_facts=MAX_IDS * MAX_IDS):
+        arguments = atom.arguments
         if (atom.name != "nominal_margin" or len(arguments) != 3 or not all(is_id(str(a)) for a in arguments[:2])
                 or arguments[2].type != clingo.SymbolType.Number):
-            raise PlannerError(f"{path}: {shorten(atom, 60)}: expected nominal_margin(Part,Hole,Micrometres) "
+            raise PlannerError(f"{path}:{line}: {shorten(atom, 60)}: expected nominal_margin(Part,Hole,Micrometres) "
                                "facts only (a part and hole id, an integer)")
-        margins[(str(arguments[0]), str(arguments[1]))] = arguments[2].number
+        pair, value = (str(arguments[0]), str(arguments[1])), arguments[2].number
+        if pair in margins and margins[pair] != value:
+            raise PlannerError(f"{path}:{line}: nominal_margin({pair[0]},{pair[1]},{value}) contradicts line "
+                               f"{lines[pair]}: nominal_margin({pair[0]},{pair[1]},{margins[pair]}); expected one "
+                               "margin per part and hole")
+        margins[pair] = value
+        lines.setdefault(pair, line)
     if not margins:
         raise PlannerError(f"{path}: no nominal_margin/3 facts (expected the file ./run.sh import writes)")
     return margins
@@ -47,7 +57,12 @@ def nominal_margins(path: Path) -> dict[Pair, int]:
 def decided(margins: dict[Pair, int], tolerance: float, parts: tuple[str, ...], holes: tuple[str, ...]
             ) -> list[tuple[Pair, Result]]:
     """The outcomes the margins decide beyond ``tolerance`` [m], in part then hole order;
-    PlannerError when the margins miss a pair of ``parts`` × ``holes``."""
+    PlannerError when the margins name a part or hole not among ``parts`` and ``holes`` or
+    miss a pair of ``parts`` × ``holes``."""
+    unknown = sorted({p for p, _ in margins if p not in parts} | {h for _, h in margins if h not in holes})
+    if unknown:
+        raise PlannerError(f"{NOMINAL_FILE}: unknown part or hole {' '.join(unknown[:5])} (expected the parts "
+                           f"{' '.join(parts)} and holes {' '.join(holes)} of the product)")
     missing = [f"{p}->{h}" for p in parts for h in holes if (p, h) not in margins]
     if missing:
         raise PlannerError(f"{NOMINAL_FILE}: no nominal margin for {' '.join(missing[:5])} (expected every part "

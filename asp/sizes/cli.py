@@ -31,6 +31,7 @@ from assembly_constraints.bridge.cli_types import (
     add_assembly_argument,
     comma_list,
     int_in,
+    nonempty_path,
     number_in,
 )
 
@@ -110,7 +111,8 @@ def _parser() -> argparse.ArgumentParser:
     learn.add_argument("--demos", metavar="FILE",
                        help="demonstrations; the parts they place into holes (p1@r1) are fits to start from")
     _add_noise_options(learn)
-    learn.add_argument("--out", metavar="FILE.lp", help="write learned facts (tried/4, smaller/2, fits/2, no_fit/2)")
+    learn.add_argument("--out", metavar="FILE.lp", type=nonempty_path,
+                       help="write learned facts (tried/4, smaller/2, fits/2, no_fit/2)")
     learn.add_argument("--json", action="store_true", help="print JSON")
     evaluate = sub.add_parser("evaluate", help="experiments needed over relabelings of parts and holes")
     _add_truth_options(evaluate)
@@ -121,7 +123,7 @@ def _parser() -> argparse.ArgumentParser:
                           help="seed of relabelings, random choices, noise")
     _add_noise_options(evaluate)
     evaluate.add_argument("--json", action="store_true", help="print JSON")
-    evaluate.add_argument("--plot", metavar="FILE.png", help="Fig. 19-style comparison plot")
+    evaluate.add_argument("--plot", metavar="FILE.png", type=nonempty_path, help="Fig. 19-style comparison plot")
     evaluate.add_argument("--compare", default="random", metavar="P,...",
                           type=comma_list(str, "policy names", allow_empty=True),
                           help="policies drawn beside --policy in the plot (default random)")

@@ -10,7 +10,10 @@ relation), independently across sections. Three models, strongest first:
 - ``sections``: one line per cross-section of the product description: pegs with the
   same ``section`` are scaled copies of one cross-section, and whether such a peg
   passes a hole is monotone in its scale (round in round or square, square in round
-  by its diagonal, one rectangle's aspect in any hole), so each section is a line;
+  by its diagonal, one rectangle's aspect in any hole), so each section is a line; a
+  part whose cross-section the product does not state is on a line of its own (nothing
+  says it is a scaled copy of another part, so no outcome of it is entailed through
+  another part's);
 - ``pairs``: every part its own section: nothing is entailed, every pair is tried.
 
 A model is weakened along this order when observations contradict it
@@ -20,7 +23,7 @@ A model is weakened along this order when observations contradict it
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 from assembly_constraints.asp import PlannerError
@@ -31,7 +34,23 @@ MODELS = SIZE_MODELS
 """The size models, strongest first (the names a product may declare)."""
 
 LINE_SECTION = "line"
-"""The one section of the ``line`` model (and of parts with no declared section)."""
+"""The one section of the ``line`` model."""
+
+
+def own_section(part: str, taken: Collection[str]) -> str:
+    """The section of ``part`` alone: ``of_<part>``, with ``_`` appended until it is not in
+    ``taken`` (the sections the product states), so it shares no other part's line."""
+    label = f"of_{part}"
+    while label in taken:
+        label += "_"
+    return label
+
+
+def stated_or_own(parts: Sequence[str], declared: Mapping[str, str]) -> dict[str, str]:
+    """Part -> its stated section in ``declared``, or a section of its own
+    (:func:`own_section`) when the product states none."""
+    taken = set(declared.values())
+    return {part: declared[part] if part in declared else own_section(part, taken) for part in parts}
 
 
 def group_by_section(sections: Mapping[str, str]) -> dict[str, list[str]]:
@@ -47,7 +66,8 @@ class SizeModel:
     """A model applied to a product: its ``name`` and the section of each part.
 
     ``sections`` maps every part to the section whose size line it lies on; ``declared``
-    is the product's own sections (what ``sections`` uses), kept so that a weaker model
+    is the sections the product states (for the parts whose cross-section it states;
+    ``sections`` puts each other part on a line of its own), kept so that a weaker model
     can be derived and the summary can say what ``line`` merges.
     """
 
@@ -68,9 +88,12 @@ class SizeModel:
             kinds = len(set(self.declared.values()))
             merged = f" (the product declares {kinds} cross-sections)" if kinds > 1 else ""
             return f"size model line: every part and hole on one size line{merged}"
-        lines = "; ".join(f"{'no cross-section stated' if section == LINE_SECTION else section}: {' '.join(parts)}"
-                          for section, parts in groups.items())
-        return f"size model sections: one size line per cross-section ({lines})"
+        unstated = [part for part in self.sections if part not in self.declared]
+        lines = [f"{section}: {' '.join(parts)}" for section, parts in groups.items()
+                 if parts[0] in self.declared]
+        if unstated:
+            lines.append(f"no cross-section stated, each on its own line: {' '.join(unstated)}")
+        return f"size model sections: one size line per cross-section ({'; '.join(lines)})"
 
     def information_bits(self, holes: int) -> float:
         """log2 of the number of relations the model allows with ``holes`` holes [bit]:
@@ -79,26 +102,27 @@ class SizeModel:
 
 
 def build_model(name: str, parts: Sequence[str], declared: Mapping[str, str] | None = None) -> SizeModel:
-    """The model ``name`` for ``parts``; ``declared`` maps parts to the product's sections
-    (a part missing from it gets :data:`LINE_SECTION`: no cross-section stated)."""
+    """The model ``name`` for ``parts``; ``declared`` maps parts to the sections the
+    product states (under ``sections`` a part missing from it is on a line of its own)."""
     if name not in MODELS:
         raise PlannerError(f"size model '{name}': expected one of {', '.join(MODELS)}")
-    own = {part: (declared or {}).get(part, LINE_SECTION) for part in parts}
+    stated = {part: section for part, section in (declared or {}).items() if part in parts}
     if name == "line":
         sections = dict.fromkeys(parts, LINE_SECTION)
     elif name == "sections":
-        sections = own
+        sections = stated_or_own(parts, stated)
     else:
         sections = {part: f"of_{part}" for part in parts}
-    return SizeModel(name, sections, own)
+    return SizeModel(name, sections, stated)
 
 
 def weaker(model: SizeModel) -> SizeModel | None:
-    """The next weaker model (``line`` -> ``sections`` -> ``pairs``; ``sections`` of a
-    product with one declared section is ``line`` itself, so it goes to ``pairs``), or
-    None for ``pairs``."""
+    """The next weaker model (``line`` -> ``sections`` -> ``pairs``; ``sections`` is
+    skipped where it is ``line`` itself, all parts stating one section, or ``pairs``
+    itself, no two parts on one line), or None for ``pairs``."""
     parts = list(model.sections)
-    if model.name == "line" and len(set(model.declared.values())) > 1:
+    lines = group_by_section(stated_or_own(parts, model.declared)).values()
+    if model.name == "line" and len(lines) > 1 and max(map(len, lines)) > 1:
         return build_model("sections", parts, model.declared)
     if model.name in ("line", "sections"):
         return build_model("pairs", parts, model.declared)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.models import LINE_SECTION, group_by_section
+from assembly_constraints.asp.sizes.models import LINE_SECTION, group_by_section, stated_or_own
 from assembly_constraints.asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name
 from assembly_constraints.bridge.assembly import load_assembly
 from assembly_constraints.bridge.inputs import read_text
@@ -49,7 +49,8 @@ def ferrers_violation(
 
 class TruthOracle:
     """Answers from a known part-hole relation (closed world), validated as a biorder on
-    each section's parts (``sections``: part -> section; None: all parts on one line).
+    each section's parts (``sections``: part -> section, a part missing from it on a line
+    of its own; None: all parts on one line).
 
     ``parts`` and ``holes`` keep their order: it is the index order of the learner.
     """
@@ -72,8 +73,8 @@ class TruthOracle:
             if h not in self.holes:
                 raise PlannerError(f"{source}: fits({p},{h}): '{h}' is not a declared hole/1")
         for section, members in group_by_section(
-                {part: LINE_SECTION if sections is None else sections.get(part, LINE_SECTION)
-                 for part in self.parts}).items():
+                dict.fromkeys(self.parts, LINE_SECTION) if sections is None
+                else stated_or_own(self.parts, sections)).items():
             bad = ferrers_violation(members, self.holes, self.fits)
             if bad:
                 p, h, q, k = bad
@@ -91,9 +92,14 @@ class TruthOracle:
     @classmethod
     def from_facts(cls, path: Path | str) -> TruthOracle:
         """A truth facts file (``part/1``, ``hole/1``, ``fits/2``, optional ``section/2``, the
-        parts' cross-sections); index order = order of first mention in the file."""
+        parts' cross-sections); index order = order of first mention in the file. Without
+        ``section/2`` the truth is checked to be one size line, and declares the ``line``
+        model (its relation is one); with it, a part it gives no section is on its own line."""
         parts, holes, fits, sections = _read_truth(Path(path))
-        return cls(parts, holes, fits, source=str(path), sections=sections or None)
+        found = cls(parts, holes, fits, source=str(path), sections=sections or None)
+        if not sections:
+            found.declared_model = "line"
+        return found
 
     @classmethod
     def from_assembly(cls, name_or_path: str) -> TruthOracle:
@@ -111,7 +117,7 @@ class TruthOracle:
         parts = [p for p in assembly.part_ids if p in truth_parts]
         holes = [h for h in assembly.hole_ids if h in truth_holes]
         declared = assembly.sections()
-        sections = None if assembly.size_model == "line" else {p: declared.get(p, LINE_SECTION) for p in parts}
+        sections = None if assembly.size_model == "line" else declared
         found = cls(parts, holes, fits, source=str(assembly.folder / "sizes.lp"), sections=sections)
         found.declared_sections, found.declared_model = declared, assembly.size_model
         return found

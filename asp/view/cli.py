@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.bridge.cli_types import ArgumentParser
+from assembly_constraints.bridge.cli_types import ArgumentParser, nonempty_path
 
 if TYPE_CHECKING:
     from assembly_constraints.bridge.recording.layout import TimePoint
@@ -38,8 +38,8 @@ if TYPE_CHECKING:
 
 def recording_files(run: Path) -> list[Path]:
     """The ``.rrd`` files of RUN (a folder or one file); PlannerError if there are none."""
-    if run.is_file() and run.suffix == ".rrd":
-        return [run]
+    if run.suffix == ".rrd" and run.exists() and not run.is_dir():
+        return [run]  # the reader refuses a FIFO or device, naming what it is
     if not run.exists():
         raise PlannerError(f"{run}: no such run folder or .rrd file")
     files = sorted(run.glob("*.rrd")) if run.is_dir() else []
@@ -76,7 +76,7 @@ def main(argv: Sequence[str]) -> int:
     parser.add_argument("run", metavar="RUN", help="run folder (RUN/*.rrd) or an .rrd file")
     parser.add_argument("--print", action="store_true", help="print the contents, no viewer")
     parser.add_argument("--json", action="store_true", help="print the contents as JSON")
-    parser.add_argument("--screenshot", type=Path, metavar="DIR",
+    parser.add_argument("--screenshot", type=nonempty_path, metavar="DIR",
                         help="render every tab in a headless Chromium (Rerun's web viewer), write DIR/<k>-<tab>.png; "
                              "needs chromium on PATH, takes a few minutes")
     parser.add_argument("--at", type=_time_point, action="append", default=[], metavar="TIMELINE=VALUE",

@@ -13,7 +13,9 @@ head's cover), a rect's size ``[a, b]`` with ``a >= b``, a chamfer inside its bo
 every hole deeper than its chamfer (a hole at its own level with its bottom above the
 floor), bosses that do not overlap, a grasp shorter than the part, the shapes of
 ``assembly.toml`` against the kinds of ``geometry.toml``, a part's mesh against the
-digest of its file and its convex pieces against that mesh.
+digest of its file and its convex pieces against that mesh. Each part's and hole's
+cross-section kind comes from every statement the product makes
+(:mod:`assembly_constraints.bridge.product.kinds`).
 
 Every failure is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a
 :class:`assembly_constraints.bridge.BridgeError`, exit 2). Units: lengths and positions [m], masses [kg],
@@ -40,6 +42,7 @@ from assembly_constraints.bridge.product.checks import (
     hole_level,
     where,
 )
+from assembly_constraints.bridge.product.kinds import hole_kinds, part_kinds, section_label
 from assembly_constraints.bridge.product.tables import (
     CONVEX_HEADER,
     DEFAULT_COVER_CLEARANCE,
@@ -57,6 +60,7 @@ from assembly_constraints.bridge.product.tables import (
     HoleEntry,
     HoleShape,
     Id,
+    Manual,
     Mesh,
     PartEntry,
     PartShape,
@@ -68,8 +72,9 @@ from assembly_constraints.bridge.product.tables import (
 
 __all__ = ["CONVEX_HEADER", "DEFAULT_COVER_CLEARANCE", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS",
            "AssemblyFile", "Base", "Cover", "ExtraPart", "GeometryFile", "Gripper", "Head", "HoleEntry", "HoleShape",
-           "Mesh", "PartEntry", "PartShape", "Plate", "ProductDescription", "SizesTable", "check_grasp",
-           "decode_toml_file", "hole_level", "is_id", "load_product_description", "product_from_tables"]
+           "Manual", "Mesh", "PartEntry", "PartShape", "Plate", "ProductDescription", "SizesTable", "check_grasp",
+           "decode_toml_file", "hole_kinds", "hole_level", "is_id", "load_product_description", "part_kinds",
+           "product_from_tables", "section_label"]
 
 _T = TypeVar("_T")
 # ---- reading and translating errors ----
@@ -254,11 +259,10 @@ def product_from_tables(folder: Path, assembly: dict[str, Any], geometry: dict[s
     the table and key, what was expected and what it holds."""
     source = folder / "assembly.toml"
     layout = _decode(source, assembly, AssemblyFile)
-    check_assembly(source, layout)
-    if geometry is None:
-        return ProductDescription(folder=folder, assembly=layout, geometry=None)
     path = folder / "geometry.toml"
-    tables = _decode(path, geometry, GeometryFile)
-    check_geometry(path, tables, layout)
+    tables = None if geometry is None else _decode(path, geometry, GeometryFile)
+    check_assembly(source, layout, part_kinds(layout, tables))
+    if tables is not None:
+        check_geometry(path, tables, layout)
     return ProductDescription(folder=folder, assembly=layout, geometry=tables)
 

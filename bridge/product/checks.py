@@ -13,8 +13,11 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
+import shapely
+
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.inputs import read_bytes, shorten
+from assembly_constraints.bridge.product.kinds import section_label
 from assembly_constraints.bridge.product.tables import (
     CONVEX_HEADER,
     TOUCH_TOLERANCE,
@@ -47,12 +50,14 @@ def _sides(size: float | list[float]) -> tuple[float, float]:
     return (size[0], size[1]) if isinstance(size, list) else (size, size)
 
 
-def check_assembly(path: Path, layout: AssemblyFile) -> None:
-    """A ``section`` only for a rect part; no id both a part and a hole."""
+def check_assembly(path: Path, layout: AssemblyFile, kinds: Mapping[str, str]) -> None:
+    """A ``section`` only for a rect part (``kinds``: part id -> kind, from every statement
+    of the product, :func:`assembly_constraints.bridge.product.kinds.part_kinds`); no id both a part and a hole."""
     for pid, part in layout.parts.items():
-        if part.section is not None and part.shape != "rect":
+        kind = kinds.get(pid)
+        if part.section is not None and kind != "rect":
             raise BridgeError(f"{path}: [parts.{pid}] section: only a part of shape \"rect\" has one "
-                              f"(a {part.shape or 'part without a shape'} is its own section)")
+                              f"(a {kind or 'part without a shape'} is its own section)")
     clash = set(layout.parts) & set(layout.holes)
     if clash:
         raise BridgeError(f"{path}: ids used for both a part and a hole: {sorted(clash)}")
@@ -72,15 +77,61 @@ def _members(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[s
 
 
 def _check_sections(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[str, PartShape]) -> None:
-    """A rect's size is ``[a, b]`` with a >= b, any other kind's one number."""
+    """A rect's size is ``[a, b]`` with a >= b, a polygon's ``[a, b]`` the extents of its
+    ``outline`` (a simple polygon; no other kind has one), any other kind's one number."""
     for name, table in tables.items():
-        rect, size = table.kind == "rect", table.size
-        if rect != isinstance(size, list):
-            expected = ("[a, b] in m with a >= b > 0 (the long side a along x) for a rect" if rect
+        listed, size = table.kind in ("rect", "polygon"), table.size
+        if listed != isinstance(size, list):
+            expected = ("[a, b] in m with a >= b > 0 (the long side a along x) for a rect" if table.kind == "rect"
+                        else "[a, b] in m (the outline's extents along x and y) for a polygon"
+                        if table.kind == "polygon"
                         else f"one number (the {'diameter' if table.kind == 'round' else 'side'}) for a {table.kind}")
             raise fail(path, f"{group}.{name}", "size", expected, size)
-        if isinstance(size, list) and size[0] < size[1]:
+        if table.kind == "rect" and isinstance(size, list) and size[0] < size[1]:
             raise fail(path, f"{group}.{name}", "size", "[a, b] with a >= b (the long side a along x)", size)
+        if (table.kind == "polygon") != (table.outline is not None):
+            raise fail(path, f"{group}.{name}", "outline", "an outline [[x, y], ...] for a polygon, none for a "
+                       f"{table.kind}" if table.kind != "polygon" else "an outline [[x, y], ...] in m (a polygon's "
+                       "section)", table.outline)
+        if table.outline is not None and isinstance(size, list):
+            _check_outline(path, f"{group}.{name}", table.outline, size)
+        if table.corner and (table.kind not in ("square", "rect") or 2 * table.corner > min(_sides(size))):
+            raise fail(path, f"{group}.{name}", "corner", "a corner radius of a square or rect at most half its "
+                       f"short side ({min(_sides(size)) / 2:g} m)" if table.kind in ("square", "rect")
+                       else f"no corner radius for a {table.kind}", table.corner)
+
+
+OUTLINE_EXTENT_TOLERANCE = 1e-6
+"""A polygon's ``size`` is its outline's extents within this [m]."""
+
+
+def _check_outline(path: Path, table: str, outline: list[list[float]], size: list[float]) -> None:
+    """A polygon's ``outline`` is a simple polygon of positive area whose extents along x
+    and y are its ``size``."""
+    ring = shapely.Polygon(outline)
+    if not ring.is_valid or ring.area <= 0:
+        raise fail(path, table, "outline", "a simple polygon (no crossing edges, positive area)",
+                   f"{shapely.is_valid_reason(ring)} in {outline}")
+    x0, y0, x1, y1 = ring.bounds
+    if abs(x1 - x0 - size[0]) > OUTLINE_EXTENT_TOLERANCE or abs(y1 - y0 - size[1]) > OUTLINE_EXTENT_TOLERANCE:
+        raise fail(path, table, "size", f"the outline's extents [{x1 - x0:.7g}, {y1 - y0:.7g}] m along x and y",
+                   size)
+
+
+def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
+    """A polygon peg is simulated from its own ``mesh``, a polygon hole or one with a
+    ``corner`` radius in the ``[base]``'s mesh (the plate's bosses are round, square or
+    sharp rect)."""
+    for name, part_shape in geo.part_shapes.items():
+        if part_shape.kind == "polygon" and part_shape.mesh is None:
+            raise BridgeError(f"{path}: [part_shapes.{name}] mesh: expected the part's own mesh for a polygon "
+                              "section (the cell simulates no other), got nothing")
+    for name, hole_shape in geo.hole_shapes.items():
+        shaped = "kind" if hole_shape.kind == "polygon" else "corner" if hole_shape.corner else ""
+        if shaped and (geo.base is None or geo.base.mesh is None):
+            raise BridgeError(f"{path}: [hole_shapes.{name}] {shaped}: a polygon hole or one with rounded corners "
+                              "needs a [base] with its own mesh (the plate's bosses are round, square or sharp "
+                              "rect), got none")
 
 
 def hole_level(plate: Plate, shape: HoleShape) -> tuple[float, float]:
@@ -126,9 +177,10 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     pegs = _members(path, "part_shapes", geo.part_shapes)
     _check_sections(path, "hole_shapes", geo.hole_shapes)
     _check_sections(path, "part_shapes", geo.part_shapes)
+    _check_polygons_simulated(path, geo)
     _check_levels(path, plate, geo.hole_shapes)
     for name, hole_shape in geo.hole_shapes.items():
-        if _sides(hole_shape.size)[0] + 2 * plate.chamfer >= plate.tile_size:
+        if max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
                        "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():
@@ -160,6 +212,7 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]
     meshes += [(f"covers.{cid}", cover.mesh, True) for cid, cover in geo.covers.items()]
     meshes += [(f"heads.{hid}", head.mesh, True) for hid, head in geo.heads.items()]
+    meshes += [(f"manual.{mid}", manual.mesh, False) for mid, manual in geo.manual.items()]
     meshes.append(("base", None if geo.base is None else geo.base.mesh, False))
     for table, mesh, moving in meshes:
         if mesh is not None:
@@ -169,19 +222,20 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
 def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
     """A part's ``mesh``: its ``file`` is there and has the stated ``sha256``; a moving
     part has ``convex`` pieces made from that file as it is (their header names its
-    digest), the base none (it is a static concave mesh)."""
+    digest), the base and a part placed by hand none (static concave meshes)."""
     folder = path.parent
     try:
-        digest = hashlib.sha256(read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)).hexdigest()
+        data = read_bytes(folder / mesh.file, "mesh file (OBJ)", limit=MAX_MESH_BYTES)
     except BridgeError as exc:
         raise BridgeError(f"{path}: [{table}] mesh.file: {exc}") from None
+    digest = hashlib.sha256(data).hexdigest()
     if digest != mesh.sha256:
         raise fail(path, table, "mesh.sha256", f"the SHA-256 of {mesh.file} ({digest}: the file changed since "
                    "geometry.toml was written; import the product again)", mesh.sha256)
     if not moving:
         if mesh.convex is not None:
-            raise fail(path, table, "mesh.convex", "no convex pieces (the base is simulated as its static concave "
-                       "mesh)", mesh.convex)
+            raise fail(path, table, "mesh.convex", "no convex pieces (the base and a part placed by hand are "
+                       "simulated as their static concave meshes)", mesh.convex)
         return
     if mesh.convex is None:
         raise BridgeError(f"{path}: [{table}] mesh.convex: expected the convex pieces of {mesh.file} (an .obj file "
@@ -195,6 +249,32 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
     if first != expected:
         raise fail(path, table, "mesh.convex", f"pieces made from {mesh.file} as it is (first line of "
                    f"{mesh.convex} {expected!r}; stale pieces: import the product again)", first)
+    for key, name, content in (("mesh.file", mesh.file, data), ("mesh.convex", mesh.convex, text)):
+        _check_vertices(path, table, key, folder / name, content)
+
+
+MAX_PART_REACH = 0.5
+"""A moving part's mesh and convex pieces lie within this of its frame's origin on every
+axis [m]: a part the arm carries, not one metres away or the size of a room (millimetres
+written as metres)."""
+
+
+def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes) -> None:
+    """Every vertex ``v x y z`` of the OBJ ``data`` (the file ``obj``) is three finite
+    coordinates within :data:`MAX_PART_REACH` [m]; BridgeError naming ``obj``'s line otherwise."""
+    reach = MAX_PART_REACH
+    for number, line in enumerate(data.splitlines(), 1):
+        words = line.split()
+        if words[:1] != [b"v"]:
+            continue
+        try:
+            vertex = [float(word) for word in words[1:4]]
+        except ValueError:
+            vertex = []
+        if len(vertex) != 3 or not all(-reach <= c <= reach for c in vertex):  # NaN compares False
+            raise BridgeError(f"{path}: [{table}] {key}: {obj}:{number}: expected a vertex 'v x y z' of finite "
+                              f"coordinates within [-{reach:g}, {reach:g}] m of the part frame's origin, got "
+                              f"{shorten(line.decode('utf-8', 'replace'))!r}")
 
 
 def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]], turned: set[str]) -> None:
@@ -236,9 +316,9 @@ def _check_kinds(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     first: dict[str, tuple[str, PartShape]] = {}
     for pid, part in layout.parts.items():
         spec = part_shape.get(pid)
-        if part.shape is None or spec is None:
+        if spec is None:
             continue
-        section = part.section or (pid if part.shape == "rect" else part.shape)
+        section = section_label(pid, spec.kind, part.section)
         other_id, other = first.setdefault(section, (pid, spec))
         (a, b), (oa, ob) = _sides(spec.size), _sides(other.size)
         if (other.kind == "round") != (spec.kind == "round") or not math.isclose(b / a, ob / oa, rel_tol=1e-9):
@@ -281,9 +361,10 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         part = layout.parts.get(hid)
         if part is None or part.start is None:
             raise fail(path, table, "", "a part of assembly.toml with a start", hid)
-    for cid in geo.covers:
-        if cid not in layout.parts:
-            raise fail(path, f"covers.{cid}", "", "a part of assembly.toml", cid)
+    for table_name, ids in (("covers", geo.covers), ("manual", geo.manual)):
+        for pid in ids:
+            if pid not in layout.parts:
+                raise fail(path, f"{table_name}.{pid}", "", "a part of assembly.toml", pid)
     if geo.base is None:
         return
     if geo.base.part not in layout.parts:
@@ -295,11 +376,13 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         owners[pid].append("[covers.*]")
     for pid in geo.heads:
         owners[pid].append("[heads.*]")
+    for pid in geo.manual:
+        owners[pid].append("[manual.*]")
     owners[geo.base.part].append("[base]")
     missing = sorted(pid for pid, tables in owners.items() if not tables)
     if missing:
         raise BridgeError(f"{path}: part(s) {', '.join(missing)} of assembly.toml have no geometry "
-                          "(expected a [part_shapes.*], [covers.*], [heads.*] or [base] entry)")
+                          "(expected a [part_shapes.*], [covers.*], [heads.*], [manual.*] or [base] entry)")
     twice = sorted(pid for pid, tables in owners.items() if len(tables) > 1)
     if twice:
         raise BridgeError(f"{path}: part {twice[0]} of assembly.toml has more than one geometry "

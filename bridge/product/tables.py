@@ -17,7 +17,9 @@ from typing import Annotated, Literal
 import msgspec
 from msgspec import Meta
 
-ID_PATTERN = r"^(?!not$)[a-z][a-zA-Z0-9_]{0,63}$(?!\n)"
+MAX_ID_CHARS = 64
+"""The longest part or hole id [characters]."""
+ID_PATTERN = rf"^(?!not$)[a-z][a-zA-Z0-9_]{{0,{MAX_ID_CHARS - 1}}}$(?!\n)"
 """A part or hole id: an ASP constant of at most 64 ASCII characters, a lower-case letter
 first, not the keyword ``not`` (clingo's only lower-case keyword). ``(?!\n)`` keeps a
 trailing newline out (Python's ``$`` would match before it); the pattern means the same
@@ -32,7 +34,7 @@ def is_id(value: object) -> bool:
 
 MAX_COORDINATE = 100.0
 """Positions ([x, y] of parts and holes, a tool home) are finite with |x|, |y| <= this [m]."""
-SHAPES = ("round", "square", "rect")
+SHAPES = ("round", "square", "rect", "polygon")
 """The cross-section kinds of a part's or hole's ``shape`` (``kind`` in ``geometry.toml``)."""
 SIZE_MODELS = ("line", "sections", "pairs")
 """The size models a product may declare (``[sizes] model``; docs/sizes.md)."""
@@ -45,7 +47,7 @@ Id = Annotated[str, Meta(pattern=ID_PATTERN, description="an id (a lower-case AS
                          "characters, not 'not')")]
 Ids = Annotated[list[Id], Meta(min_length=1, max_length=1000, description="a non-empty list of distinct ids")]
 Text = Annotated[str, Meta(min_length=1, max_length=200, description="a non-empty text of at most 200 characters")]
-Kind = Literal["round", "square", "rect"]
+Kind = Literal["round", "square", "rect", "polygon"]
 Coordinate = Annotated[float, Meta(ge=-MAX_COORDINATE, le=MAX_COORDINATE,
                                    description="a number in [-100, 100] m")]
 XY = Annotated[list[Coordinate], Meta(min_length=2, max_length=2,
@@ -55,6 +57,14 @@ OffsetXY = Annotated[list[Offset], Meta(min_length=2, max_length=2, description=
 Side = Annotated[float, Meta(gt=0.0, le=0.1, description="a number in (0, 0.1] m")]
 SectionSize = Side | Annotated[list[Side], Meta(min_length=2, max_length=2, description="for a rect [a, b] with "
                                                 "a >= b, each such a number")]
+MAX_OUTLINE_POINTS = 4096
+"""The most points a polygon section's ``outline`` has."""
+OutlinePoint = Annotated[list[Annotated[float, Meta(ge=-0.1, le=0.1)]], Meta(
+    min_length=2, max_length=2, description="[x, y], each a number in [-0.1, 0.1] m")]
+Outline = Annotated[list[OutlinePoint], Meta(min_length=3, max_length=MAX_OUTLINE_POINTS, description=(
+    "the points [[x, y], ...] in m of a simple polygon (3 to 4096 points, no crossing edges), in the part's or "
+    "hole's frame"))]
+Corner = Annotated[float, Meta(ge=0.0, le=0.05, description="a number in [0, 0.05] m")]
 Length = Annotated[float, Meta(gt=0.0, le=0.3, description="a number in (0, 0.3] m")]
 Mass = Annotated[float, Meta(gt=0.0, le=10.0, description="a number in (0, 10] kg")]
 Yaw = Annotated[float, Meta(gt=-360.0, le=360.0, description="a number in (-360, 360] degrees")]
@@ -79,11 +89,12 @@ class PartEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 
 class HoleEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """``[holes.<id>]``: a readable ``name``, its cross-section kind, its ``position`` [m]
-    on the base plate."""
+    """``[holes.<id>]``: a readable ``name``, its cross-section kind (default: the kind of
+    its ``[hole_shapes.*]`` in ``geometry.toml``, else round), its ``position`` [m] on the
+    base plate."""
 
     name: Text | None = None
-    shape: Kind = "round"
+    shape: Kind | None = None
     position: XY | None = None
 
 
@@ -137,13 +148,17 @@ class Gripper(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[hole_shapes.<name>]``: holes of one cross-section; ``size`` a diameter or side
-    [m], for a rect ``[a, b]`` (a along the hole's x axis, turned by ``yaw`` [degrees]);
+    [m], for a rect ``[a, b]`` (a along the hole's x axis, turned by ``yaw`` [degrees]),
+    for a polygon the extents ``[a, b]`` of its ``outline`` along x and y (about the
+    hole's position, in the hole's frame); a square's or rect's ``corner`` radius [m];
     ``top_z`` the height of their entry and ``depth`` from the entry to their bottom [m],
     where they differ from the plate's ``top_z`` and ``tile_thickness``."""
 
     holes: Ids
     kind: Kind
     size: SectionSize
+    outline: Outline | None = None
+    corner: Corner = 0.0
     yaw: Yaw = 0.0
     top_z: EntryHeight | None = None
     depth: HoleDepth | None = None
@@ -152,11 +167,16 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[part_shapes.<name>]``: pegs of one cross-section (the name is their skill's);
     ``length`` [m], ``mass`` [kg], the hole its demonstration is taught in, and ``mesh``
-    when they are simulated from their own mesh rather than as a cylinder or box."""
+    when they are simulated from their own mesh rather than as a cylinder or box; a
+    polygon's ``outline`` about the centre of its section in the part frame, ``size`` its
+    extents ``[a, b]`` along x and y (a polygon peg is simulated from its mesh); a
+    square's or rect's ``corner`` radius [m]."""
 
     parts: Ids
     kind: Kind
     size: SectionSize
+    outline: Outline | None = None
+    corner: Corner = 0.0
     length: Length
     mass: Mass
     demo_hole: Id
@@ -180,7 +200,8 @@ class Mesh(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     OBJ, metres, in the part frame: a peg's origin at the centre of its section at its
     bottom, z its axis upwards, x its section's long side; a cover's at the centre of the
     holes it goes over at its bottom face, a head's at the centre of its section at its
-    bottom, both with the cell's axes; the base's is the cell frame), the ``sha256`` of that
+    bottom, a part placed by hand's at the centre of its bottom face, all with the cell's
+    axes; the base's is the cell frame), the ``sha256`` of that
     file, and for a moving part ``convex``: the convex pieces it collides as (one OBJ object
     each, first line :data:`CONVEX_HEADER` naming the mesh they were made from)."""
 
@@ -248,10 +269,26 @@ class Head(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     mesh: Mesh | None = None
 
 
+class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """``[manual.<id>]``: a part the cell has no operation for (it goes in along no axis
+    into a hole the cell knows), placed by hand: ``reason`` says why, ``goal`` [x, y, z] [m]
+    is its frame's origin when assembled, ``tray`` where that origin waits [m]; simulated
+    as its own ``mesh`` (its frame at the centre of its bounding box's bottom face, the
+    cell's axes), a static concave mesh, fixed where it is placed (no convex pieces)."""
+
+    reason: Text
+    goal: Annotated[list[Coordinate], Meta(min_length=3, max_length=3,
+                                           description="[x, y, z] in metres, finite and within ±100")]
+    tray: XY
+    mass: Mass
+    mesh: Mesh
+    name: Text | None = None
+
+
 class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``geometry.toml``: the plate, the cross-sections of holes and pegs, the cell's extra
-    parts, an optional gripper (else the cell description's), the product's base, covers
-    and heads."""
+    parts, an optional gripper (else the cell description's), the product's base, covers,
+    heads and the parts placed by hand."""
 
     plate: Plate
     hole_shapes: dict[Id, HoleShape] = {}
@@ -261,6 +298,7 @@ class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True)
     base: Base | None = None
     covers: dict[Id, Cover] = {}
     heads: dict[Id, Head] = {}
+    manual: dict[Id, Manual] = {}
 
 
 class ProductDescription(msgspec.Struct, frozen=True, kw_only=True):

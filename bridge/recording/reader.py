@@ -12,6 +12,7 @@ Entity paths are reported as Rerun prints them, with a leading ``/``
 
 from __future__ import annotations
 
+import stat
 import warnings
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
@@ -23,7 +24,7 @@ import pyarrow as pa
 from rerun.chunk import Chunk, RrdReader
 
 from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.inputs import file_kind, shorten
 from assembly_constraints.bridge.recording.torn import readable
 
 
@@ -85,8 +86,14 @@ def _open(path: Path) -> Iterator[RrdReader]:
     """A reader of one ``.rrd`` file (of its whole messages when its tail is torn, with a
     warning: :mod:`assembly_constraints.bridge.recording.torn`); BridgeError naming the file when it is
     missing, unreadable or not a Rerun recording (empty, garbage, another format)."""
-    if not path.is_file():
-        raise BridgeError(f"{path}: no such recording file (expected an .rrd file)")
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise BridgeError(f"{path}: no such recording file (expected an .rrd file)") from None
+    except OSError as exc:
+        raise BridgeError(f"{path}: cannot read the recording: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(mode):
+        raise BridgeError(f"{path}: not a regular file ({file_kind(mode)}); expected an .rrd file")
     try:
         with path.open("rb") as file:
             file.read(1)

@@ -8,7 +8,8 @@ endpoint in ``session`` and ``executor serve``):
 - ``--rerun-connect [URL]``: also stream live to a running viewer (``rerun`` started on
   this machine listens on :data:`DEFAULT_VIEWER_URL`);
 - ``--rerun-serve``: also host the recording for a web browser (headless machines): a
-  gRPC server and the web viewer on free loopback ports; the address is logged.
+  gRPC server and the web viewer on loopback ports the server binds itself (port 0); the
+  address is logged.
 
 :func:`open_stream` makes the stream with both sinks at once (file and viewer), so the
 file is the same whether or not someone watches; :func:`hosted_viewer` runs the web
@@ -22,6 +23,7 @@ import contextlib
 import errno
 import logging
 import os
+import re
 import resource
 import signal
 import socket
@@ -73,13 +75,6 @@ def add_viewer_arguments(parser: argparse.ArgumentParser, serve: bool = True) ->
 def viewer_of(args: argparse.Namespace) -> Viewer:
     """The :class:`Viewer` the options of :func:`add_viewer_arguments` ask for."""
     return Viewer(args.rerun_connect, getattr(args, "rerun_serve", False))
-
-
-def free_port() -> int:
-    """A TCP port free on the loopback interface now."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 def open_stream(application_id: str, recording_id: str, rrd_path: Path | None,
@@ -172,25 +167,77 @@ def _stderr_silenced() -> Iterator[None]:
 @contextmanager
 def hosted_viewer(viewer: Viewer, files: Sequence[Path] = ()) -> Iterator[Viewer]:
     """With ``viewer.serve``: host a web viewer (Rerun's own ``rerun --serve-web``, a child
-    process on free loopback ports, showing ``files`` and whatever streams into it) while
-    the block runs, log its address, and give a :class:`Viewer` that streams to it.
-    Otherwise give ``viewer`` unchanged. BridgeError if the server does not come up."""
+    process on loopback ports it binds itself, showing ``files`` and whatever streams into
+    it) while the block runs, log its address, and give a :class:`Viewer` that streams to
+    it. Otherwise give ``viewer`` unchanged. BridgeError if the server does not come up."""
     if not viewer.serve:
         yield viewer
         return
-    grpc_port, web_port = free_port(), free_port()
-    server_url = f"rerun+http://127.0.0.1:{grpc_port}/proxy"
-    server = subprocess.Popen(
-        [sys.executable, "-m", "rerun_cli", "--serve-web", "--bind", "127.0.0.1", "--port", str(grpc_port),
-         "--web-viewer-port", str(web_port), *map(str, files)],
-        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-    try:
-        _wait_for_port(grpc_port, server)
-        page = f"http://127.0.0.1:{web_port}/?url={quote(server_url, safe='')}"
+    with rerun_server(["--serve-web", "--web-viewer-port", "0", *map(str, files)], web=True) as server:
+        server_url = server.url
+        page = f"http://127.0.0.1:{server.web_port}/?url={quote(server_url, safe='')}"
         _LOG.info("web viewer: open %s", page)
         yield Viewer(connect=server_url, page=page)
-    finally:
-        _stop(server)
+
+
+_GRPC_PORT = re.compile(rb"Listening for gRPC connections on 127\.0\.0\.1:(\d+)")
+_WEB_PORT = re.compile(rb"Hosting a web-viewer at http://127\.0\.0\.1:(\d+)")
+
+
+@dataclass(frozen=True)
+class RerunServer:
+    """A running Rerun server (:func:`rerun_server`): its process (the ``python -m rerun_cli``
+    wrapper, leader of its own process group), the ports it bound [TCP port numbers]."""
+
+    process: subprocess.Popen
+    grpc_port: int
+    web_port: int | None
+
+    @property
+    def url(self) -> str:
+        """Where a recording stream connects to it."""
+        return f"rerun+http://127.0.0.1:{self.grpc_port}/proxy"
+
+
+@contextmanager
+def rerun_server(arguments: Sequence[str], web: bool = False) -> Iterator[RerunServer]:
+    """Run ``python -m rerun_cli --bind 127.0.0.1 --port 0 ARGUMENTS`` (in a process group of
+    its own) while the block runs and give it with its gRPC port and (``web``) its web
+    viewer's port: the ports the server bound itself, read from its log, so no other process
+    can take them between a choice and the bind. The server and its children are stopped at
+    exit (:func:`_stop`). BridgeError when it exits or does not log its ports within
+    :data:`SERVER_START_S`."""
+    with tempfile.TemporaryFile() as log:
+        env = os.environ | {"RUST_LOG": "info", "RUST_LOG_STYLE": "never", "NO_COLOR": "1"}
+        server = subprocess.Popen(
+            [sys.executable, "-m", "rerun_cli", "--bind", "127.0.0.1", "--port", "0", *arguments],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log, env=env, start_new_session=True)
+        try:
+            ports = _logged_ports(log.fileno(), server, [_GRPC_PORT, _WEB_PORT] if web else [_GRPC_PORT])
+            yield RerunServer(server, ports[0], ports[1] if web else None)
+        finally:
+            _stop(server)
+
+
+def _logged_ports(log: int, server: subprocess.Popen, patterns: Sequence[re.Pattern[bytes]]) -> list[int]:
+    """The port each of ``patterns`` finds in the server's log (file descriptor ``log``),
+    once all of them are there and the gRPC port accepts connections."""
+    deadline = time.monotonic() + SERVER_START_S
+    while time.monotonic() < deadline:
+        found = [pattern.search(os.pread(log, MAX_LOG_BYTES, 0)) for pattern in patterns]
+        if all(found):
+            ports = [int(match.group(1)) for match in found if match]
+            with socket.socket() as probe:
+                if probe.connect_ex(("127.0.0.1", ports[0])) == 0:
+                    return ports
+        if server.poll() is not None:
+            raise BridgeError(f"the Rerun server exited at start (code {server.returncode})")
+        time.sleep(0.1)
+    raise BridgeError(f"the Rerun server did not start (log its ports) within {SERVER_START_S:g} s")
+
+
+MAX_LOG_BYTES = 64 * 1024
+"""The start of the Rerun server's log searched for its ports [bytes]."""
 
 
 def _stop(server: subprocess.Popen) -> None:
@@ -207,19 +254,11 @@ def _stop(server: subprocess.Popen) -> None:
 
 
 SERVER_START_S = 30.0
-"""Longest the web viewer's server may take to start or stop [s]."""
+"""Longest the Rerun server may take to start or stop [s]."""
 
-
-def _wait_for_port(port: int, server: subprocess.Popen) -> None:
-    deadline = time.monotonic() + SERVER_START_S
-    while time.monotonic() < deadline:
-        if server.poll() is not None:
-            raise BridgeError(f"the Rerun web viewer exited at start (code {server.returncode})")
-        with socket.socket() as probe:
-            if probe.connect_ex(("127.0.0.1", port)) == 0:
-                return
-        time.sleep(0.1)
-    raise BridgeError(f"the Rerun web viewer did not start within {SERVER_START_S:g} s")
+WAIT_POLL_S = 0.2
+"""How often a command that only waits (:func:`keep_serving`) wakes to let Python run a
+signal handler that one of the native libraries' threads received [s]."""
 
 
 def keep_serving(viewer: Viewer) -> None:
@@ -230,6 +269,6 @@ def keep_serving(viewer: Viewer) -> None:
     _LOG.info("done; still serving the recording to the web viewer (Ctrl-C to stop)")
     try:
         while True:
-            time.sleep(3600)
+            time.sleep(WAIT_POLL_S)
     except KeyboardInterrupt:
         return

@@ -71,6 +71,19 @@ class HeadSpec:
 
 
 @dataclass(frozen=True)
+class ManualSpec:
+    """A part the cell has no operation for, placed by hand at its ``goal`` (its frame's
+    origin [m]: the centre of its bottom face), waiting at ``tray`` [m]; ``reason`` why;
+    simulated as its own ``mesh``, static."""
+
+    id: str
+    goal: Vec3
+    tray: tuple[float, float]
+    reason: str
+    mesh: Mesh
+
+
+@dataclass(frozen=True)
 class BaseSpec:
     """The base part: the plate of the cell geometry, waiting with its ``base_center`` at
     ``tray`` [m], gripped at ``grip`` from ``base_center`` [m]."""
@@ -84,13 +97,14 @@ class BaseSpec:
 @dataclass(frozen=True)
 class Product:
     """Everything the assembling cell builds: the cell geometry, the base, the pegs (the
-    parts of ``assembly.toml`` with a part shape), covers and heads."""
+    parts of ``assembly.toml`` with a part shape), covers, heads and parts placed by hand."""
 
     geometry: CellGeometry
     base: BaseSpec
     pegs: dict[str, PartSpec]
     covers: dict[str, CoverSpec]
     heads: dict[str, HeadSpec]
+    manual: dict[str, ManualSpec]
 
     @property
     def folder(self) -> Path:
@@ -102,7 +116,7 @@ class Product:
 
     @property
     def parts(self) -> list[str]:
-        return sorted([self.base.id, *self.pegs, *self.covers, *self.heads])
+        return sorted([self.base.id, *self.pegs, *self.covers, *self.heads, *self.manual])
 
     def over_centre(self, cover: CoverSpec) -> np.ndarray:
         """The centre [m] of the holes a cover goes over (its body origin, x y)."""
@@ -201,4 +215,6 @@ def load_product(assembly: str = "cranfield", description: CellDescription | Non
         heads[hid] = HeadSpec(hid, head.into, head.kind, head.size, head.length, head.mass, start, head.skill,
                               head.mesh)
     pegs = {pid: spec for pid, spec in geometry.parts.items() if pid in starts}
-    return Product(geometry, base, pegs, covers, heads)
+    manual = {mid: ManualSpec(mid, (table.goal[0], table.goal[1], table.goal[2]), (table.tray[0], table.tray[1]),
+                              table.reason, table.mesh) for mid, table in tables.manual.items()}
+    return Product(geometry, base, pegs, covers, heads, manual)

@@ -37,12 +37,12 @@ PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
 
 
 def _part_solids(world: AssemblyWorld, part: str) -> list[rr.AsComponents]:
-    """The part's solid in its body frame, as Rerun archetypes: a peg, cover or head with
-    its own mesh as that mesh, the others as their boxes and cylinders."""
+    """The part's solid in its body frame, as Rerun archetypes: a peg, cover, head or part
+    placed by hand with its own mesh as that mesh, the others as their boxes and cylinders."""
     p = world.product
     color = [200, 150, 60]
     own = p.pegs[part].mesh if part in p.pegs else p.covers[part].mesh if part in p.covers else \
-        p.heads[part].mesh if part in p.heads else None
+        p.heads[part].mesh if part in p.heads else p.manual[part].mesh if part in p.manual else None
     if own is not None:
         mesh = trimesh.load(p.folder / own.file, force="mesh")
         assert isinstance(mesh, trimesh.Trimesh)  # the loader checked the file

@@ -13,6 +13,8 @@ Per kind of part (the ``skill`` of the step's record):
   unknown grasp offset; a spiral search fails on a long part tilting on the pin tops);
 - ``insert_socket``: a head into the socket of its part, wherever that part is; it stays
   fixed to it from then on (screwed).
+- ``manual``: a part the cell has no operation for (``[manual.*]`` of ``geometry.toml``),
+  placed by hand where the CAD has it and fixed there (a static mesh); the arm does not move.
 
 A failed attempt (the goal check fails) lifts the part and tries again with a fresh
 vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
@@ -53,6 +55,7 @@ from assembly_constraints.executor.skills.insertion import insert_in_layer, need
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.trial import APPROACH_HEIGHT, APPROACH_SETTLE_TIME, trial_rng
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, yaw_quat
+from assembly_constraints.executor.world.geometry import fit_pose
 from assembly_constraints.executor.world.perturbation import CellBias
 from assembly_constraints.executor.world.scene import PART_FRICTION
 
@@ -130,7 +133,7 @@ class Assembler:
         self.layer, self.ilc = layer, ilc
 
     def skill_of(self, part: str) -> str:
-        """The step's skill: fixture, insert, insert_over or insert_socket."""
+        """The step's skill: fixture, insert, insert_over, insert_socket or manual."""
         p = self.product
         if part == p.base.id:
             return "fixture"
@@ -140,6 +143,8 @@ class Assembler:
             return "insert_over"
         if part in p.heads:
             return "insert_socket"
+        if part in p.manual:
+            return "manual"
         raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(p.parts)})")
 
     def shape_of(self, part: str) -> str:
@@ -175,6 +180,8 @@ class Assembler:
         skill = self.skill_of(part)
         world, motion = self.world, self.world.motion
         wall0, sim0 = time.perf_counter(), motion.steps
+        if skill == "manual":
+            return self._by_hand(part, wall0, sim0)
         rng = trial_rng(seed, part, hole or "none")
         if skill == "insert" and hole is not None:
             world.set_peg_goal(part, hole)
@@ -213,6 +220,14 @@ class Assembler:
                           max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
                           (motion.steps - sim0) * 0.001)
 
+    def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
+        """A part placed by hand (``manual``): at its goal, fixed there."""
+        world = self.world
+        world.set_pose(part, world.goals[part])
+        self.placed.add(part)
+        return StepRecord(part, None, "manual", "fit", 1, time.perf_counter() - wall0, 0.0, 0.0,
+                          world.goal_error(part), (world.motion.steps - sim0) * 0.001)
+
     def _draw(self, rng: np.random.Generator, part: str, hole: str | None) -> AttemptSetup:
         """One execution's errors: of the part's shape and its hole (a cover or head: of
         itself), with a yaw error of the estimate for a peg's rect hole."""
@@ -220,13 +235,13 @@ class Assembler:
         return self._uncertainty.draw(rng, self.shape_of(part), hole or part, oriented)
 
     def _yaw(self, part: str, hole: str | None, setup: AttemptSetup) -> float:
-        """The tool yaw [rad] a peg is inserted with: aligned to its hole's estimated yaw
-        (0 for other parts and round pegs or holes)."""
+        """The tool yaw [rad] a peg is inserted with: aligned to its hole's estimated yaw,
+        turned as the polygon relation passes it (0 for other parts and round pegs or holes)."""
         peg = self.product.pegs.get(part)
         if peg is None or hole is None:
             return 0.0
         spec = self.product.geometry.holes[hole]
-        return aligned_yaw(peg.kind, spec.kind, spec.yaw + setup.vision_yaw)
+        return aligned_yaw(peg.kind, spec.kind, spec.yaw + fit_pose(peg, spec)[0] + setup.vision_yaw)
 
     def _pick(self, part: str, setup: AttemptSetup) -> Grasp:
         """Carry the empty tool to the part's grip point and close the gripper."""
@@ -286,7 +301,7 @@ class Assembler:
             xy = found.hole_xy
             if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
                 peg = p.pegs[part]
-                skill_obj = self._skill(peg.shape).deeper(p.geometry.deeper_than_taught(peg, p.geometry.holes[hole]))
+                skill_obj = self._skill(peg.shape).in_hole(p.geometry.holes[hole].depth)
             else:
                 skill_obj = self._skill(p.heads[part].skill)
         origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])

@@ -98,6 +98,7 @@ class AssemblyWorld:
         self._build_covers()
         self.socket_offset: dict[str, np.ndarray] = {}
         self._build_heads()
+        self._build_manual()
         self.reset_tray()
         self.rest()
         self._build_arm()
@@ -154,6 +155,20 @@ class AssemblyWorld:
             cover = self.product.covers[head.into]
             self.socket_offset[hid] = np.array([sx, sy, cover.thickness - depth])
             self.goals[hid] = self.goals[head.into] + self.socket_offset[hid]
+
+    def _build_manual(self) -> None:
+        """The parts placed by hand: static concave meshes, moved where they are placed."""
+        c = self.client
+        for mid, manual in sorted(self.product.manual.items()):
+            mesh = str(self.product.folder / manual.mesh.file)
+            col = pb.createCollisionShape(pb.GEOM_MESH, fileName=mesh, flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+                                          physicsClientId=c)
+            vis = pb.createVisualShape(pb.GEOM_MESH, fileName=mesh, rgbaColor=(0.55, 0.75, 0.45, 1), physicsClientId=c)
+            body = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                                      physicsClientId=c)
+            self.frames[mid] = PartFrames(body, np.zeros(3), np.zeros(3))
+            self.goals[mid] = np.array(manual.goal)
+            self._tray[mid] = np.array([*manual.tray, 0.0])
 
     def _build_arm(self) -> None:
         gripper = self.product.geometry.gripper

@@ -1,6 +1,6 @@
 """``./run.sh bench import``: import plus geometric precedence of a generated product.
 
-The product (``--parts N``, default 20): a plate with ``N - 3`` holes on a grid, round
+The product (``--parts N``, 6 to 200, default 20): a plate with ``N - 3`` holes on a grid, round
 (d 8 mm, 24-gon) and rectangular (12 x 8 mm, turned by 30°) in turn, a peg in each with
 0.3 mm clearance; the pegs of the first row stand 15 mm out, the others 25 mm; two 4 mm
 covers, one lying on the first row, the other on it, each with openings for the others
@@ -77,7 +77,8 @@ def write_product(folder: Path, parts: int) -> None:
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench import", description="Import plus geometric precedence of a generated "
                             "product (docs/import.md): wall and CPU time, collision queries.")
-    parser.add_argument("--parts", type=int_in(4, 200), default=20, help="parts of the product (default 20)")
+    # 6: three pegs at least, so that a second row exists for the covers' openings
+    parser.add_argument("--parts", type=int_in(6, 200), default=20, help="parts of the product (6 to 200, default 20)")
     parser.add_argument("--repeat", type=int_in(1, 100), default=3, help="imports to take the median of (default 3)")
     parser.add_argument("--target", type=number_in(float, 0.0, 3600.0), default=10.0,
                         help="the median CPU time's bound [s] (default 10)")

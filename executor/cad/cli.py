@@ -28,7 +28,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from assembly_constraints.bridge.cli_types import ArgumentParser, int_in, number_in
+from assembly_constraints.bridge.cli_types import ArgumentParser, int_in, nonempty_path, number_in
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import MESH_FOLDER
@@ -45,7 +45,15 @@ from assembly_constraints.executor.cad.parts import (
 )
 from assembly_constraints.executor.cad.step import load_step
 from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.cad.write import MANIFEST, Settings, claim_folder, map_product, write_folder
+from assembly_constraints.executor.cad.write import (
+    MANIFEST,
+    Settings,
+    claim_folder,
+    map_product,
+    section,
+    write_folder,
+)
+from assembly_constraints.executor.world.geometry import section_fit
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
 """Default trays: the parts in a row from this point [m], this far apart along x [m]."""
@@ -127,10 +135,9 @@ def report(derived: Derived) -> list[str]:
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
         held = "empty"
         if fit.part is not None and fit.section is not None:
-            ca, cb = fit.clearance
-            clearance = _mm(ca) if fit.hole.kind == fit.section.kind == "round" else f"{_mm(ca)} x {_mm(cb)}"
+            room = section_fit(section(fit.part, fit.section), section(hid, fit.hole))
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
-                    f"{clearance} mm)")
+                    f"{_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg)")
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
                      f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
@@ -150,7 +157,7 @@ def report(derived: Derived) -> list[str]:
 
 
 def mapped_report(mapped: Mapped) -> list[str]:
-    """The lines ``import`` prints about the covers and heads it found."""
+    """The lines ``import`` prints about the covers and heads it found and the parts placed by hand."""
     lines = []
     for cid, cover in sorted(mapped.covers.items()):
         x0, y0, x1, y1 = cover.outline
@@ -166,6 +173,8 @@ def mapped_report(mapped: Mapped) -> list[str]:
         lines.append(f"head {hid} into {head.into}: {_describe(section.kind, section.a, section.b)} x "
                      f"{_mm(head.length)} mm, skill {head.skill}; "
                      + ("a cylinder or box" if head.primitive else "no cylinder or box: its own mesh"))
+    for pid, reason in sorted(mapped.manual.items()):
+        lines.append(f"manual {pid}: the cell has no operation for it, a plan's step places it by hand ({reason})")
     return lines
 
 
@@ -218,7 +227,7 @@ def main(argv: list[str]) -> int:
                             "geometric_precedence.lp, geometry.toml where the product is made of primitives.",
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("source", type=Path, metavar="SOURCE", help="a STEP file or a folder of *.stl/*.obj meshes")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="the assembly folder to write")
+    parser.add_argument("--out", type=nonempty_path, required=True, metavar="DIR", help="the assembly folder to write")
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
     parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to")

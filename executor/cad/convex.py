@@ -80,14 +80,20 @@ def is_close(volume: float, primitive: float) -> bool:
 
 
 def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
-    """Whether the peg in ``fit`` is the prism of its section over its length along z."""
+    """Whether the peg in ``fit`` is the prism of its section over its length along z (a
+    polygon section never is: the cell has no such primitive)."""
     assert fit.section is not None  # a peg has a section
     section = fit.section
-    return is_close(mesh.volume, section_area(section.kind, section.a, section.b) * float(mesh.extents[2]))
+    prism = section_area(section.kind, section.a, section.b) * float(mesh.extents[2])
+    return section.kind != "polygon" and is_close(mesh.volume, prism)
 
 
 def base_is_primitive(derived: Derived) -> bool:
-    """Whether the base is its bounding box less its holes (each its section times its depth)."""
+    """Whether the base is its bounding box less its holes (each its section times its
+    depth); never with a polygon hole or one with rounded corners (the plate's bosses are
+    round, square or sharp rect)."""
+    if any(fit.hole.kind == "polygon" or fit.hole.corner for fit in derived.holes.values()):
+        return False
     mesh = derived.parts[derived.base].mesh
     holes = sum(section_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
     return is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
@@ -218,15 +224,15 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
 
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
-               neighbours: dict[str, trimesh.Trimesh] | None) -> tuple[Mesh, list[Path]] | str:
-    """Write ``mesh`` (already in its part frame [m]; ``made``: how, for its header) as
+               neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame"
+               ) -> tuple[Mesh, list[Path]] | str:
+    """Write ``mesh`` (already in ``frame`` [m]; ``made``: how, for its header) as
     ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
-    (``neighbours``: the parts near it, in its frame; None for the base), its convex
-    pieces (:func:`fitting_pieces`); returns the ``mesh`` entry of ``geometry.toml`` and
-    the paths written, or why no pieces fit."""
+    (``neighbours``: the parts near it, in its frame; None for a static one: the base, a
+    part placed by hand), its convex pieces (:func:`fitting_pieces`); returns the ``mesh``
+    entry of ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
-    frame = "the cell frame" if neighbours is None else "its part frame"
     text = obj_text([(pid, mesh.vertices, mesh.faces)],
                     f"# {pid}: its closed mesh [m] in {frame}, {made}, by ./run.sh import")
     written = [write_atomic(folder / name, text)]

@@ -30,7 +30,8 @@ of the peg whose section is nearest its own (same kind first, then size, then id
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import trimesh
@@ -95,11 +96,13 @@ class HeadFit:
 
 @dataclass(frozen=True)
 class Mapped:
-    """The covers and heads of a product, or ``why`` its other parts are none."""
+    """The covers and heads of a product, the parts the cell places by hand (``manual``:
+    why it has no operation for each), or ``why`` the cell builds none of it."""
 
     covers: dict[str, CoverFit]
     heads: dict[str, HeadFit]
     why: str | None = None
+    manual: dict[str, str] = field(default_factory=dict)
 
 
 def hole_specs(derived: Derived) -> dict[str, HoleSpec]:
@@ -210,34 +213,40 @@ def _nearest_peg(derived: Derived, section: Shape2D) -> str:
     return min(pegs, key=lambda item: (item[1].kind != section.kind, abs(item[1].a - section.a), item[0]))[0]
 
 
-def map_parts(derived: Derived, top: float) -> Mapped:
+def map_parts(derived: Derived, top: float, by_hand: Mapping[str, str]) -> Mapped:
     """The covers and heads of ``derived`` (module docstring), ``top`` [m] the holes'
-    entry (the plate top), or why one of its other parts is neither."""
+    entry (the plate top); the parts ``by_hand`` (id -> why) and each other part that is
+    neither are ones the cell places by hand."""
     covers: dict[str, CoverFit] = {}
     heads: dict[str, HeadFit] = {}
-    others = [pid for pid in derived.parts if pid != derived.base and pid not in derived.hole_of]
+    manual = dict(by_hand)
+    others = [pid for pid in derived.parts if pid != derived.base and pid not in derived.hole_of
+              and pid not in by_hand]
     for pid in sorted(others, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p)):
         if derived.axis[pid] != "+z":
-            return Mapped(covers, heads, f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above")
+            manual[pid] = f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"
+            continue
         pins = _pins(derived, pid)
         head = None if pins else _head(derived, pid, covers)
         if isinstance(head, str):
-            return Mapped(covers, heads, head)
-        if head is not None:
-            if any(h.into == head.into for h in heads.values()):
-                return Mapped(covers, heads, f"cover '{head.into}' holds two heads (the cell's covers have one socket)")
+            manual[pid] = head
+        elif head is not None and any(h.into == head.into for h in heads.values()):
+            manual[pid] = f"cover '{head.into}' holds two heads (the cell's covers have one socket)"
+        elif head is not None:
             heads[pid] = head
-            continue
-        cover = _cover(derived, pid, pins, covers, top)
-        if isinstance(cover, str):
-            return Mapped(covers, heads, cover)
-        covers[pid] = cover
-    for hid, head in heads.items():  # the sockets are measured with their heads
+        else:
+            cover = _cover(derived, pid, pins, covers, top)
+            if isinstance(cover, str):
+                manual[pid] = cover
+            else:
+                covers[pid] = cover
+    for hid, head in sorted(heads.items()):  # the sockets are measured with their heads
         found = _socket(derived, covers[head.into], derived.parts[hid].mesh)
         if isinstance(found, str):
-            return Mapped(covers, heads, found)
-        covers[head.into] = found
-    return Mapped(covers, heads)
+            manual[hid] = found
+        else:
+            covers[head.into] = found
+    return Mapped(covers, {hid: head for hid, head in heads.items() if hid not in manual}, manual=manual)
 
 
 

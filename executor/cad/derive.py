@@ -62,13 +62,6 @@ class HoleFit:
         """The hole's centre in the cell's x, y [m]."""
         return self.centre[0], self.centre[1]
 
-    @property
-    def clearance(self) -> tuple[float, float]:
-        """Hole minus part along a and b [m] (round: the diameters); zeros without a part."""
-        if self.section is None:
-            return 0.0, 0.0
-        return self.hole.a - self.section.a, self.hole.b - self.section.b
-
 
 @dataclass
 class Derived:
@@ -145,7 +138,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
         result.reasons |= {pair: "locates" for pair in kept if pair not in result.reasons}
     result.edges = set(result.reasons)
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis)], result.axis)
-    result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "other"]
+    result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.queries = sweeper.queries

@@ -4,25 +4,37 @@ A slice perpendicular to an insertion axis gives closed loops (trimesh's plane s
 A loop is classified as
 
 - ``round`` when it has at least :data:`MIN_ROUND_POINTS` points, all within 2 % of one
-  radius, and fills at least 98 % of that circle (a 24-gon fills 98.9 %);
+  radius, and fills at least 98 % of that circle (a 24-gon fills 98.9 %); a splined,
+  keyed or D-shaped outline spreads its radii further and is no round;
 - ``rect`` (``square`` when both sides agree within :data:`SQUARE_TOLERANCE`) when it fills
-  its minimum-area rectangle to 99.5 %, with the long side a, the short side b and the yaw
-  of a from the slice's first axis;
-- ``other`` otherwise.
+  its minimum-area rectangle to :data:`RECT_FILL` and each side of that rectangle is
+  covered by the loop's own edges over at least :data:`STRAIGHT_SIDES` of its length
+  (rounded or chamfered corners: a 10 x 6 mm rect with 1 mm corner radii fills 98.6 % and
+  its sides are straight over 80 % and 67 %), with the long side a, the short side b and
+  the yaw of a from the slice's first axis;
+- ``polygon`` otherwise: the loop itself, compared with
+  :mod:`assembly_constraints.executor.world.fit` (``outline``).
 
-Sizes are what a fit depends on: a part's round section is its circumscribed circle (its
-widest), a hole's its inscribed circle (its narrowest), so a polygonal hole's size is its
-inradius and a tessellated cylinder's is within the tessellation's deflection. Where the
-part's B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
+Sizes are what a fit depends on, conservatively: a part's round section is its
+circumscribed circle (its widest), a hole's its inscribed circle (its narrowest), so a
+polygonal hole's size is its inradius and a tessellated cylinder's is within the
+tessellation's deflection. A part's rect is its minimum-area rectangle (it holds the part,
+corners and all); a hole's is that rectangle inset evenly on every side until it lies
+inside the loop (rounded or chamfered corners cost the inset: 0.29 mm a side for a 1 mm
+radius), so a rect peg that passes the recorded rect passes the hole. The corner radius
+that explains the area the corners lack is kept (``corner``, reported). Where the part's
+B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
 diameter instead.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
@@ -32,6 +44,13 @@ from assembly_constraints.executor.cad.parts import Cylinder
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
 """Sides within this [m] make a square (10 µm)."""
+RECT_FILL = 0.98
+"""A rect fills at least this fraction of its minimum-area rectangle."""
+STRAIGHT_SIDES = 0.5
+"""Each side of a rect's rectangle is covered by the loop's edges over at least this fraction."""
+ON_SIDE = 2e-6
+"""A loop's point within this [m] (or 0.1 % of the short side, if more) of a side of its
+rectangle lies on it (a flat face's slice is straight to the float)."""
 
 
 @dataclass(frozen=True)
@@ -59,17 +78,22 @@ class Loop:
         return bool(PolygonPath(self.points).contains_point((float(point[0]), float(point[1]))))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Shape2D:
-    """A classified loop: ``kind`` (round, square, rect, other), ``a`` ≥ ``b`` [m] (a round
-    section: its diameter twice), ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]),
-    ``centre`` (2,) [m] in the slice's frame."""
+    """A classified loop: ``kind`` (round, square, rect, polygon), ``a`` ≥ ``b`` [m] (a
+    round section: its diameter twice; a polygon: its minimum-area rectangle's sides),
+    ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]; a polygon: 0, its outline
+    holds its turn), ``centre`` (2,) [m] in the slice's frame, ``outline`` (n, 2) [m] the
+    loop's points about the centre, ``corner`` [m] the corner radius a rect's missing
+    area gives (0: sharp)."""
 
     kind: str
     a: float
     b: float
     yaw: float
     centre: np.ndarray
+    outline: np.ndarray = field(repr=False, kw_only=True)
+    corner: float = field(default=0.0, kw_only=True)
 
 
 def frame_of(axis: np.ndarray) -> np.ndarray:
@@ -126,17 +150,70 @@ def edge_distance(points: np.ndarray, centre: np.ndarray) -> float:
     return float(np.min(np.linalg.norm(start + t[:, None] * edge - centre, axis=1)))
 
 
+def _straight(points: np.ndarray, a: float, b: float, tolerance: float) -> float:
+    """The least fraction of a side of the centred rectangle ``a`` x ``b`` [m] (``points``
+    in its frame) covered by the loop's edges lying on that side (both ends within
+    ``tolerance`` [m] of it)."""
+    ends = np.roll(points, -1, axis=0)
+    fractions = []
+    for axis, half, length in ((0, a / 2, b), (0, -a / 2, b), (1, b / 2, a), (1, -b / 2, a)):
+        on = (np.abs(points[:, axis] - half) <= tolerance) & (np.abs(ends[:, axis] - half) <= tolerance)
+        fractions.append(float(np.abs(ends[on, 1 - axis] - points[on, 1 - axis]).sum()) / length)
+    return min(fractions)
+
+
+def _rounded(a: float, b: float, radius: float, inset: float = 0.0) -> shapely.Polygon:
+    """The centred rect ``a`` x ``b`` [m] with corners of ``radius`` [m], inset by ``inset`` [m] a side."""
+    half_a, half_b = a / 2 - inset, b / 2 - inset
+    core = shapely.box(radius - half_a, radius - half_b, half_a - radius, half_b - radius)
+    return core.buffer(radius, quad_segs=16) if radius > 0 else core
+
+
+def _bisect(low: float, high: float, ok_high: bool, test: Callable[[float], bool]) -> float:
+    """The end of [``low``, ``high``] [m] at which ``test`` changes, to 0.1 µm, on its
+    passing side (``ok_high``: it passes at high)."""
+    while high - low > 1e-7:
+        mid = (low + high) / 2
+        if test(mid) == ok_high:
+            high = mid
+        else:
+            low = mid
+    return high if ok_high else low
+
+
+def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> tuple[float, float]:
+    """The corner radius and inset [m] of a rect section (``points`` in its centred frame):
+    a peg's the largest radius whose rounded rect still holds the loop (inset 0); a hole's
+    the least radius whose rounded rect lies inside the loop, or where none does, the
+    least even inset of the sharp rect that does (radius 0)."""
+    loop = shapely.make_valid(shapely.Polygon(points))
+    shapely.prepare(loop)
+    grown = loop.buffer(1e-9)  # the loop's own points on the rect's sides stay covered
+    if not hole:
+        return _bisect(0.0, b / 2, False, lambda r: bool(_rounded(a, b, r).buffer(1e-9).covers(loop))), 0.0
+    if grown.covers(_rounded(a, b, b / 2)):
+        return _bisect(0.0, b / 2, True, lambda r: bool(grown.covers(_rounded(a, b, r)))), 0.0
+    return 0.0, _bisect(0.0, b / 2, True, lambda d: bool(grown.covers(_rounded(a, b, 0.0, d))))
+
+
 def classify(loop: Loop, *, hole: bool) -> Shape2D:
     """The loop's cross-section (the module docstring); ``hole`` picks the inscribed size."""
     points, centre = loop.points, loop.centre
-    radii = np.linalg.norm(points - centre, axis=1)
+    outline = points - centre
+    radii = np.linalg.norm(outline, axis=1)
     outer = float(radii.max())
     if (len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
             and loop.area >= 0.98 * math.pi * outer ** 2):
         d = 2 * (edge_distance(points, centre) if hole else outer)
-        return Shape2D("round", d, d, 0.0, centre)
+        return Shape2D("round", d, d, 0.0, centre, outline=outline)
     a, b, angle = _min_rectangle(points)
-    if loop.area >= 0.995 * a * b:
+    c, s = math.cos(angle), math.sin(angle)
+    turned = points @ np.array([[c, -s], [s, c]])  # side a along the first axis
+    local = turned - (turned.max(axis=0) + turned.min(axis=0)) / 2
+    if (loop.area >= RECT_FILL * a * b
+            and _straight(local, a, b, max(ON_SIDE, 1e-3 * b)) >= STRAIGHT_SIDES):
+        corner, inset = _corner_and_inset(local, a, b, hole=hole)
+        a, b = a - 2 * inset, b - 2 * inset
         square = a - b <= SQUARE_TOLERANCE
         yaw = math.degrees(angle)
         period, upper = (90.0, 45.0) if square else (180.0, 90.0)
@@ -145,8 +222,9 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
             yaw += period
         if square:
             a = b = (a + b) / 2
-        return Shape2D("square" if square else "rect", a, b, round(yaw, 6), centre)
-    return Shape2D("other", a, b, math.degrees(angle), centre)
+        return Shape2D("square" if square else "rect", a, b, round(yaw, 6), centre, outline=outline,
+                       corner=round(corner, 7) if corner > ON_SIDE else 0.0)
+    return Shape2D("polygon", a, b, 0.0, centre, outline=outline)
 
 
 ON_AXIS = 1e-6
@@ -168,5 +246,5 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
                 and np.linalg.norm(off - (off @ cylinder.direction) * cylinder.direction) < ON_AXIS
                 and abs(2 * cylinder.radius - shape.a) <= 2 * tolerance):
             d = 2 * cylinder.radius
-            return Shape2D("round", d, d, 0.0, shape.centre)
+            return Shape2D("round", d, d, 0.0, shape.centre, outline=shape.outline)
     return shape

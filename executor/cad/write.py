@@ -4,20 +4,23 @@
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
-  (:func:`assembly_constraints.executor.world.geometry.passes`), closed world;
+  (:func:`assembly_constraints.executor.world.geometry.passes`: the exact rules of round,
+  square and rect sections, the polygon relation where one is a polygon), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's, the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
-- ``geometry.toml``: the simulated cell's product when every part but the base is a peg
-  standing in a hole along +z, a cover or a head (:mod:`assembly_constraints.executor.cad.covers`),
-  and no two parts overlap where they wait (and the cell's loader accepts it; left out
-  otherwise, and the report says why): the plate at the entry height and depth most
-  holes share, a hole at another one with its own ``top_z`` and ``depth``, the plate,
-  pegs, covers and heads as primitives where they are ones, else as their own meshes with
-  convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`; a STEP base
-  tessellated again to :data:`CELL_DEFLECTION` for the cell);
+- ``geometry.toml``: the simulated cell's product unless two parts overlap where they
+  wait (and when the cell's loader accepts it; left out otherwise, and the report says
+  why): pegs standing in holes entered along +z with a round, square or rect section,
+  covers and heads (:mod:`assembly_constraints.executor.cad.covers`), every other part
+  placed by hand (``[manual.<id>]``, :func:`cell_view`); the plate at the entry height and
+  depth most holes share, a hole at another one with its own ``top_z`` and ``depth``, the
+  plate, pegs, covers and heads as primitives where they are ones, else as their own
+  meshes with convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`;
+  a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell), a part placed by
+  hand as its own mesh (static, no pieces), a base without such holes as its own mesh.
 - ``.import-manifest.json`` (:data:`MANIFEST`): the files this import wrote with their
   SHA-256. A later import into the folder replaces or removes only those of them that
   are still as written (:func:`claim_folder`), and refuses a folder holding any other file
@@ -54,8 +57,10 @@ from assembly_constraints.executor.cad.convex import (
 )
 from assembly_constraints.executor.cad.covers import Mapped, map_parts
 from assembly_constraints.executor.cad.derive import Derived, HoleFit
+from assembly_constraints.executor.cad.sections import Shape2D
 from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.world.geometry import Section, load_geometry, margin, passes
+from assembly_constraints.executor.world.geometry import Section, load_geometry, margin
+from assembly_constraints.executor.world.polygon_fit import OutlineError
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -65,6 +70,10 @@ MIN_CHAMFER = 1e-4
 """The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
 _LEVEL = 1e-5
 """A hole whose entry or depth differs by more than this from the plate's [m] states its own."""
+MAX_PLATE_DEPTH = 0.2
+"""The largest ``tile_thickness`` and ``base_thickness`` of a ``[plate]`` [m]."""
+MAX_REASON = 200
+"""The longest ``reason`` of a ``[manual.<id>]`` table (characters)."""
 MANIFEST = ".import-manifest.json"
 """The files the last import into a folder wrote: ``{"written_by": "./run.sh import",
 "title": the product's name, "files": {path relative to the folder: SHA-256 of its content}}``."""
@@ -86,8 +95,11 @@ class Settings:
     names: dict[str, str]
 
 
-def section(name: str, shape_kind: str, a: float, b: float) -> Section:
-    return Section(name, shape_kind, a, width=b if shape_kind == "rect" else 0.0)
+def section(name: str, shape: Shape2D) -> Section:
+    """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
+    outline = tuple((_q(x), _q(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
+    return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
+                   outline=outline, corner=shape.corner)
 
 
 def _q(value: float) -> float:
@@ -95,8 +107,17 @@ def _q(value: float) -> float:
     return round(value, 7) + 0.0
 
 
-def _size(kind: str, a: float, b: float) -> str:
-    return f"[{_q(a)}, {_q(b)}]" if kind == "rect" else f"{_q(a)}"
+def _section_lines(shape: Shape2D) -> list[str]:
+    """``kind``, ``size`` and a rounded square's or rect's ``corner`` radius of a section
+    table; a polygon's ``size`` the extents of its ``outline`` along x and y, which follows
+    (about its centre, in the cell's axes)."""
+    if shape.kind != "polygon":
+        size = f"[{_q(shape.a)}, {_q(shape.b)}]" if shape.kind == "rect" else f"{_q(shape.a)}"
+        return [f'kind = "{shape.kind}"', f"size = {size}", *([f"corner = {_q(shape.corner)}"] if shape.corner else [])]
+    points = section("", shape).outline
+    extents = np.ptp(np.array(points), axis=0)
+    return ['kind = "polygon"', f"size = [{_q(float(extents[0]))}, {_q(float(extents[1]))}]",
+            "outline = [" + ", ".join(f"[{x}, {y}]" for x, y in points) + "]"]
 
 
 def _symbols(symbols: list[clingo.Symbol]) -> str:
@@ -115,12 +136,12 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
                   f'role = "{role}"']
         x, y = settings.trays[pid]
         lines.append(f"start = [{_q(x)}, {_q(y)}]")
-        if _section_kind(pegs.get(pid)) not in (None, "other"):
+        if _section_kind(pegs.get(pid)) is not None:
             lines.append(f'shape = "{_section_kind(pegs.get(pid))}"')
         lines.append("")
     for hid, fit in derived.holes.items():
         name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
-        lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{_kind(fit.hole.kind)}"',
+        lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(fit.position[0])}, {_q(fit.position[1])}]", ""]
     return "\n".join(lines)
 
@@ -129,21 +150,15 @@ def _section_kind(fit: HoleFit | None) -> str | None:
     return None if fit is None or fit.section is None else fit.section.kind
 
 
-def _kind(kind: str) -> str:
-    """An ``other`` hole is stated as round in assembly.toml (its shape is only a label there)."""
-    return kind if kind != "other" else "round"
-
-
 def sizes_text(derived: Derived) -> str:
-    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
-            if fit.section is not None and fit.section.kind != "other"}
-    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
+    """``sizes.lp``: ``fits(P,H)`` for every peg whose nominal section passes a hole's (:func:`margins`)."""
+    rooms = margins(derived)
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
-             _symbols([clingo.Function("part", [clingo.Function(p)]) for p in pegs]),
-             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in holes])]
-    for pid, peg in pegs.items():
-        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, hole in holes.items()
-                if passes(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))]
+             _symbols([clingo.Function("part", [clingo.Function(p)]) for p in rooms]),
+             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in derived.holes])]
+    for pid, holes in rooms.items():
+        fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, room in holes.items()
+                if room > 0]
         if fits:
             lines.append(_symbols(fits))
     return "\n".join(lines) + "\n"
@@ -151,13 +166,15 @@ def sizes_text(derived: Derived) -> str:
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
-    (:func:`assembly_constraints.executor.world.geometry.margin`; negative: it does not
-    pass), sections ``other`` left out."""
-    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items())
-            if fit.section is not None and fit.section.kind != "other"}
-    holes = {hid: fit.hole for hid, fit in derived.holes.items() if fit.hole.kind != "other"}
-    return {pid: {hid: margin(section(pid, peg.kind, peg.a, peg.b), section(hid, hole.kind, hole.a, hole.b))
-                  for hid, hole in holes.items()} for pid, peg in pegs.items()}
+    (:func:`assembly_constraints.executor.world.geometry.margin`, the polygon relation for
+    polygon sections; negative: it does not pass); ExecutorError naming the part or hole
+    whose polygon section is no simple outline."""
+    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
+    try:
+        return {pid: {hid: margin(section(f"part {pid}", peg), section(f"hole {hid}", fit.hole))
+                      for hid, fit in derived.holes.items()} for pid, peg in pegs.items()}
+    except OutlineError as exc:  # a slice of a mesh that crosses itself
+        raise ExecutorError(f"{exc} (the mesh's slice at the hole's mid-depth)") from None
 
 
 def nominal_text(derived: Derived) -> str:
@@ -212,32 +229,38 @@ def precedence_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
-def simulable(derived: Derived) -> str | None:
-    """Why the product's base and pegs are not ones the simulated cell builds, None when
-    they are (its other parts: :func:`assembly_constraints.executor.cad.covers.map_parts`)."""
-    for pid in sorted(derived.hole_of):
-        if derived.axis[pid] != "+z":
-            return f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"
-    fits = list(derived.holes.values())
-    for fit in fits:
-        if fit.axis != "+z" or "other" in (fit.hole.kind, _section_kind(fit)):
-            return f"hole {fit.id} is not entered from above with a round, square or rect section"
-    if not fits or not derived.hole_of:
-        return "no part stands in a hole of the base"
-    return None
-
+def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
+    """The product as the cell inserts it: only the holes entered from above with a
+    round, square or rect section holding, if anything, a peg entered from above; and the
+    pegs of the other holes, each with why the cell places it by hand (a polygon pair's
+    room is often below what convex pieces of its meshes keep: the cell inserts polygon
+    sections of products described by hand, docs/geometry.md)."""
+    kept: dict[str, HoleFit] = {}
+    by_hand: dict[str, str] = {}
+    for hid, fit in derived.holes.items():
+        if fit.part is not None and derived.axis[fit.part] != "+z":
+            by_hand[fit.part] = f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, not from above"
+        elif fit.axis != "+z" or "polygon" in (fit.hole.kind, _section_kind(fit)):
+            if fit.part is not None:
+                by_hand[fit.part] = f"hole {hid} is not entered from above with a round, square or rect section"
+        else:
+            kept[hid] = fit
+    return replace(derived, holes=kept), by_hand
 
 
 def map_product(derived: Derived, settings: Settings) -> Mapped:
-    """The covers and heads of a product whose base and pegs the cell builds
-    (:func:`simulable`), with ``why`` the cell builds none: the first reason of
-    :func:`simulable`, :func:`assembly_constraints.executor.cad.covers.map_parts`, or two
-    parts overlapping on the tray."""
-    why = simulable(derived)
-    if why is not None:
-        return Mapped({}, {}, why)
-    mapped = map_parts(derived, _plate_level(list(derived.holes.values()))[0])
-    return mapped if mapped.why is not None else replace(mapped, why=_tray_overlap(derived, mapped, settings))
+    """The covers, heads and parts placed by hand of the product as the cell inserts it
+    (:func:`cell_view`: its other pegs are placed by hand), with ``why`` the cell builds
+    none of it: two parts overlapping on the tray."""
+    cell, by_hand = cell_view(derived)
+    mapped = map_parts(cell, _plate_top(cell), by_hand)
+    return replace(mapped, why=_tray_overlap(cell, mapped, settings))
+
+
+def manual_origin(mesh: trimesh.Trimesh) -> tuple[float, float, float]:
+    """The frame origin of a part placed by hand: the centre of its bounding box's bottom face [m]."""
+    (x0, y0, z0), (x1, y1, _) = mesh.bounds
+    return (float(x0 + x1) / 2, float(y0 + y1) / 2, float(z0))
 
 
 def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
@@ -247,6 +270,7 @@ def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
     (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
     origins = {pid: fit.origin for pid, fit in mapped.covers.items()} | {pid: fit.origin for pid, fit in
                                                                          mapped.heads.items()}
+    origins |= {pid: manual_origin(derived.parts[pid].mesh) for pid in mapped.manual}
     origins[derived.base] = ((x0 + x1) / 2, (y0 + y1) / 2, 0.0)
     return frames | {pid: trimesh.transformations.translation_matrix(np.negative(origin))
                      for pid, origin in origins.items()}
@@ -275,17 +299,22 @@ def _mesh_entry(mesh: Mesh) -> str:
 
 def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path]) -> dict[str, Mesh] | str:
     """The meshes of the parts of a mapped product that are no primitive, written into
-    ``out`` (the base in the cell frame, the others in their part frames with their convex
-    pieces; each file written is appended to ``written``); returns their ``mesh`` entries
-    by part, or why a part has no pieces that fit
+    ``out`` (the base in the cell frame, the others in their part frames, the moving ones
+    with their convex pieces; each file written is appended to ``written``); returns their
+    ``mesh`` entries by part, or why a part has no pieces that fit
     (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
-    if not base_is_primitive(derived):
-        done = write_mesh(out, derived.base, *cell_base(derived), None)
+    if not derived.holes or not base_is_primitive(derived):  # no plate of primitives without holes
+        done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")
         assert not isinstance(done, str)  # the base has no pieces
         meshes[derived.base], files = done
         written += files
     frames = _frames(derived, mapped)
+    for pid in sorted(mapped.manual):  # static where it is placed: no pieces
+        done = write_mesh(out, pid, derived.parts[pid].mesh.copy().apply_transform(frames[pid]), "as measured", None)
+        assert not isinstance(done, str)
+        meshes[pid], files = done
+        written += files
     moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
     moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
     moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
@@ -309,18 +338,17 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
-    top, depth = _plate_level(fits)
+    top, depth = _plate_level(derived)
     tile = _tile(fits)
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
              "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
-             f"chamfer = {_q(max(MIN_CHAMFER, *(f.chamfer for f in fits)))}  # [m] at least MIN_CHAMFER",
+             f"chamfer = {_q(max([MIN_CHAMFER, *(f.chamfer for f in fits)]))}  # [m] at least MIN_CHAMFER",
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
-             f"base_thickness = {_q(max(top - depth - z0, 1e-3))}", ""]
+             f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
     for hid, fit in derived.holes.items():
-        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', f'kind = "{fit.hole.kind}"',
-                  f"size = {_size(fit.hole.kind, fit.hole.a, fit.hole.b)}"]
+        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', *_section_lines(fit.hole)]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         if abs(fit.entry - top) > _LEVEL:
@@ -331,8 +359,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     for pid, fit in sorted(derived.hole_of.items()):
         mesh, peg = derived.parts[pid].mesh, fit.section
         assert peg is not None
-        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', f'kind = "{peg.kind}"',
-                  f"size = {_size(peg.kind, peg.a, peg.b)}",
+        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', *_section_lines(peg),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
@@ -353,12 +380,29 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   f'into = "{head.into}"', f'kind = "{head.section.kind}"', f"size = {_q(head.section.a)}",
                   f"length = {_q(head.length)}", f"mass = {_q(derived.parts[hid].mesh.volume * DENSITY)}",
                   f'skill = "{head.skill}"', *([_mesh_entry(meshes[hid])] if hid in meshes else []), ""]
+    for mid, reason in sorted(mapped.manual.items()):
+        lines += [f"[manual.{mid}]", f"name = {json.dumps(settings.names.get(mid, derived.parts[mid].name))}",
+                  f"reason = {json.dumps(shorten(reason, MAX_REASON))}",
+                  f"goal = {_numbers(manual_origin(derived.parts[mid].mesh))}",
+                  f"tray = {_numbers(settings.trays[mid])}", f"mass = {_q(derived.parts[mid].mesh.volume * DENSITY)}",
+                  _mesh_entry(meshes[mid]), ""]
     return "\n".join(lines)
 
 
-def _plate_level(fits: list[HoleFit]) -> tuple[float, float]:
+def _plate_top(derived: Derived) -> float:
+    """The plate's ``top_z`` [m] (:func:`_plate_level`)."""
+    return _plate_level(derived)[0]
+
+
+def _plate_level(derived: Derived) -> tuple[float, float]:
     """The plate's ``top_z`` and ``tile_thickness`` [m]: the entry and depth most holes
-    share (the first hole's among equally many), so that only the others state their own."""
+    share (the first hole's among equally many), so that only the others state their own;
+    without holes the base's top and half its height (at most the largest depth a plate
+    states; the base is then its own mesh, these only place what lies on it)."""
+    fits = list(derived.holes.values())
+    if not fits:
+        (_, _, low), (_, _, high) = derived.parts[derived.base].mesh.bounds
+        return float(high), min(float(high - low) / 2, MAX_PLATE_DEPTH)
     levels = [(f.entry, f.depth) for f in fits]
 
     def sharing(level: tuple[float, float]) -> int:
@@ -378,7 +422,7 @@ def _tile(fits: list[HoleFit]) -> float:
     bosses = [f.outer.b for f in fits if f.outer is not None and f.outer.kind in ("square", "rect")]
     spacing = min((max(abs(a.position[0] - b.position[0]), abs(a.position[1] - b.position[1]))
                    for i, a in enumerate(fits) for b in fits[i + 1:]), default=0.04)
-    widest = max(max(f.hole.a, f.hole.b) + 2 * f.chamfer for f in fits)
+    widest = max([max(f.hole.a, f.hole.b) + 2 * f.chamfer for f in fits], default=0.0)
     tile = min([*bosses, spacing, 0.04])
     return tile if tile > widest else widest + 0.004
 
@@ -442,7 +486,8 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     returns them and why there is no ``geometry.toml`` (None when there is one, checked by
     the cell's loader)."""
     make_folder(out)
-    roles = {pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
+    roles = ({pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
+             | {pid: "manual" for pid in mapped.manual})
     written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title, roles)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
                write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
@@ -451,11 +496,12 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     geometry.unlink(missing_ok=True)  # the claim made it this import's, if there was one
     why = mapped.why
     mesh_files: list[Path] = []
-    meshes = write_meshes(derived, mapped, out, mesh_files) if why is None else None
+    cell = cell_view(derived)[0]
+    meshes = write_meshes(cell, mapped, out, mesh_files) if why is None else None
     if isinstance(meshes, str):
         why = meshes
     elif meshes is not None:
-        write_atomic(geometry, geometry_text(derived, mapped, settings, meshes))
+        write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
         try:
             load_geometry(str(out))
         except ToolError as exc:

@@ -29,15 +29,15 @@ import multiprocessing
 import statistics
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict
 from typing import Any
 
+import msgspec
 import numpy as np
 
 from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.bridge.progress import progress
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.campaign.pairs import campaign_pairs
+from assembly_constraints.executor.campaign.pairs import CampaignPair, campaign_pairs
 from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.ilc import LAYERS
 from assembly_constraints.executor.world.perturbation import random_only
@@ -92,12 +92,15 @@ def variant_row(name: str, rows: Sequence[tuple[bool, int, dict[str, Any]]], f_s
 
 
 def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers: int,
-                 model: Magnitudes) -> dict[str, Any]:
-    """The ablation table (see the module text) as a JSON-ready dict."""
+                 model: Magnitudes, pairs: Sequence[CampaignPair] | None = None) -> dict[str, Any]:
+    """The ablation table (see the module text) as a JSON-ready dict, over ``pairs``
+    (default: every campaign pair; at least one must fit)."""
     if trials < 1 or executions < 1 or workers < 1:
         raise ExecutorError(f"--trials {trials} / --executions {executions} / --jobs {workers}: "
                             "expected positive numbers")
-    pairs = campaign_pairs()
+    pairs = campaign_pairs() if pairs is None else list(pairs)
+    if not any(pair.fits for pair in pairs):
+        raise ExecutorError("--pairs: expected at least one fitting pair (the table is over fitting pairs)")
     groups = [list(range(g * executions, min(trials, (g + 1) * executions)))
               for g in range((trials + executions - 1) // executions)]
     variants = [*LAYERS, FLOOR]
@@ -129,7 +132,7 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
     floor = [_first_force(r) for _, _, r in by_variant[FLOOR]]
     f_stop = CellDescription().thresholds.f_stop  # the cells of the ablation have the built-in description
     return {
-        "trials": trials, "seed": seed, "executions_per_cell": executions, "perturbation": asdict(model),
+        "trials": trials, "seed": seed, "executions_per_cell": executions, "perturbation": msgspec.to_builtins(model),
         "variants": [variant_row(name, by_variant[name], f_stop) for name in LAYERS],
         "ilc": {
             "executions": list(range(1, executions + 1)),

@@ -31,7 +31,7 @@ from assembly_constraints.bridge.cli_types import (
     int_in,
 )
 from assembly_constraints.executor.campaign.ablation import format_ablation, run_ablation
-from assembly_constraints.executor.campaign.pairs import campaign_pairs
+from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT, campaign_pairs, select_pairs
 from assembly_constraints.executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
 
 TARGET_FITTING_TRIAL_S = 1.5
@@ -117,12 +117,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                         "(--trials per pair, default 40)")
     parser.add_argument("--executions", type=int_in(1, 10**5), default=5,
                         help="--ablation: consecutive executions of a pair per cell (default 5)")
+    parser.add_argument("--pairs", type=PAIRS_ARGUMENT,
+                        help="--ablation: only these pairs, e.g. p1:r1,p3:r1 (default: all campaign pairs)")
     add_cell_arguments(parser, layer=False)
     args = parser.parse_args(argv)
+    if args.pairs and not args.ablation:
+        parser.error("--pairs: only with --ablation")
     if args.ablation:
+        pairs = select_pairs(args.pairs)
         with stdout_to_stderr():
             ablation = run_ablation(args.assembly, args.trials or 40, args.seed, args.executions, args.jobs,
-                                    cell_settings_of(args).magnitudes)
+                                    cell_settings_of(args).magnitudes, pairs)
         print(json.dumps(ablation, indent=2) if args.json else format_ablation(ablation))
         return 0
     trials = args.trials or (1 if args.quick else 3)

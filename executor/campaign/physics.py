@@ -1,7 +1,7 @@
 """``./run.sh bench physics``: how far the cell is from the cost of its own physics.
 
 Three figures in one run, each the median over ``--repeats`` runs, as simulated steps
-per second (one step = ``TIME_STEP``, 1 ms):
+per second (one step of the cell's clock, 1 ms):
 
 a. **bare**: ``stepSimulation`` of the cell's scene for one part shape (floor, plate,
    tray, the arm holding the part), the arm held by PyBullet's own joint motors at the
@@ -10,7 +10,7 @@ b. **contact**: the same with the part pushed into a hole it fits, against the h
    wall and bottom (the motors aim 2 mm below the bottom and one clearance sideways):
    the cost of the peg-in-hole contact itself;
 c. **trial**: whole trials (search, insertion, detection, the second attempt where there
-   is one) of the part in that hole, ``Cell.run_trial``: simulated steps over wall time,
+   is one) of the part in that hole, as the cell runs them: simulated steps over wall time,
    each in a fresh cell whose PyBullet scene and taught skill are loaded before the clock
    starts (a cell is made once and runs many trials: its making is no part of a trial).
 

@@ -46,6 +46,7 @@ from assembly_constraints.bridge.cli_types import (
     add_assembly_argument,
     add_jobs_argument,
     int_in,
+    nonempty_path,
 )
 from assembly_constraints.bridge.progress import progress
 from assembly_constraints.executor import ExecutorError
@@ -223,7 +224,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="only these pairs, e.g. p1:r1,p3:r1 (default: all)")
     add_assembly_argument(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
-    parser.add_argument("--plot", metavar="DIR", help="write Fig. 17 and Fig. 18 images here")
+    parser.add_argument("--plot", metavar="DIR", type=nonempty_path, help="write Fig. 17 and Fig. 18 images here")
     add_cell_arguments(parser)
     return parser
 

@@ -4,7 +4,10 @@ stopping.
 
 Poses of a skill are in the *hole frame*: position relative to the hole centre on the
 plate top [m], orientation in the cell frame.  A skill is stored as JSON under
-``data/<assembly>/demonstrations/<shape>.json``.
+``data/<assembly>/demonstrations/<shape>.json`` with the record of its teaching
+(:class:`TaughtOn`: the part, the hole and their sections, the end error of the replay);
+a skill without that record, or whose teaching did not reach its goal, is refused when
+loaded, so no trial runs on a failed demonstration.
 
 Phase stopping: the DMP is rolled out once per attempt (``open_loop``) over its own time
 t ∈ [0, τ]; during execution t advances by dt / (1 + ‖ΔF‖ / F_slow), so a large wrench
@@ -99,10 +102,57 @@ class _MemoForcingTerm:
         return getattr(self.term, name)
 
 
+@dataclass(frozen=True)
+class TaughtOn:
+    """What a skill was taught on: ``part`` in ``hole`` (ids), their sections (``kind``
+    and sides (a, b) [m]), the hole's ``depth`` [m], and ``end_error`` [m], the distance
+    of the replay's end from the demonstration's goal (0.5 mm above the hole's bottom),
+    accepted when at most ``goal_tolerance`` [m] (the cell's, as for a trial)."""
+
+    part: str
+    part_kind: str
+    part_sides: tuple[float, float]
+    hole: str
+    hole_kind: str
+    hole_sides: tuple[float, float]
+    depth: float
+    end_error: float
+    goal_tolerance: float
+
+    @property
+    def reached(self) -> bool:
+        """Whether the taught insertion reached its goal."""
+        return self.end_error <= self.goal_tolerance
+
+    def failure(self) -> str:
+        """``part p3 in hole r1: end error 24.9 mm, more than the 3.0 mm goal tolerance``."""
+        return (f"part {self.part} in hole {self.hole}: end error {1000 * self.end_error:.1f} mm, more than the "
+                f"{1000 * self.goal_tolerance:.1f} mm goal tolerance")
+
+    def to_json(self) -> dict:
+        return {"part": self.part, "part_kind": self.part_kind, "part_sides": _rounded(self.part_sides),
+                "hole": self.hole, "hole_kind": self.hole_kind, "hole_sides": _rounded(self.hole_sides),
+                "depth": self.depth, "end_error": round(self.end_error, 9), "goal_tolerance": self.goal_tolerance}
+
+    @classmethod
+    def from_json(cls, data: dict) -> TaughtOn:
+        """The record of a skill file; ValueError/KeyError/TypeError on a malformed one."""
+        def sides(key: str) -> tuple[float, float]:
+            a, b = (float(v) for v in data[key])
+            return a, b
+
+        numbers = {key: float(data[key]) for key in ("depth", "end_error", "goal_tolerance")}
+        if not all(math.isfinite(v) and v >= 0 for v in numbers.values()):
+            raise ValueError(f"depth, end_error, goal_tolerance: expected numbers >= 0, got {numbers}")
+        return cls(str(data["part"]), str(data["part_kind"]), sides("part_sides"), str(data["hole"]),
+                   str(data["hole_kind"]), sides("hole_sides"), **numbers)
+
+
 @dataclass
 class Skill:
     """A taught insertion: DMP weights, demo start/goal (hole frame), duration τ [s], the
-    expected end position p_goal [m] (hole frame, from the replay) and the wrench profile."""
+    expected end position p_goal [m] (hole frame, from the replay), the wrench profile and
+    the record of its teaching (None while it is being taught)."""
 
     shape: str
     execution_time: float
@@ -111,6 +161,7 @@ class Skill:
     demo_goal: np.ndarray
     end_position: np.ndarray
     wrench: WrenchProfile
+    taught: TaughtOn | None = None
     _dmp: CartesianDMP | None = field(default=None, init=False, repr=False, compare=False)
 
     def make_dmp(self) -> CartesianDMP:
@@ -136,9 +187,17 @@ class Skill:
             return self
         down = np.array([0.0, 0.0, offset])
         moved = Skill(self.shape, self.execution_time, self.weights, self.demo_start,
-                      self.demo_goal - np.concatenate([down, np.zeros(4)]), self.end_position - down, self.wrench)
+                      self.demo_goal - np.concatenate([down, np.zeros(4)]), self.end_position - down, self.wrench,
+                      self.taught)
         moved._dmp = self._rollout_dmp()  # its remembered forcing terms do not depend on the goal
         return moved
+
+    def in_hole(self, depth: float) -> Skill:
+        """This skill in a hole ``depth`` [m] deep: :meth:`deeper` by the difference from the
+        depth of the hole it was taught in (its record); ExecutorError for a skill without one."""
+        if self.taught is None:
+            raise ExecutorError(f"skill {self.shape}: no record of its teaching (the depth it was taught at)")
+        return self.deeper(depth - self.taught.depth)
 
     def rollout(self, start_pos: np.ndarray, start_quat_xyzw: np.ndarray, goal_pos: np.ndarray,
                 goal_quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -161,17 +220,20 @@ class Skill:
             "wrench_centres": _rounded(self.wrench.centres),
             "wrench_width": self.wrench.width,
             "wrench_weights": _rounded(self.wrench.weights),
+            **({} if self.taught is None else {"taught": self.taught.to_json()}),
         }
 
     @classmethod
     def from_json(cls, data: dict) -> Skill:
         arr = {k: np.array(v, dtype=float) for k, v in data.items() if isinstance(v, list)}
+        taught = data.get("taught")
         return cls(data["shape"], float(data["execution_time"]), arr["weights"], arr["demo_start"],
                    arr["demo_goal"], arr["end_position"],
-                   WrenchProfile(arr["wrench_centres"], float(data["wrench_width"]), arr["wrench_weights"]))
+                   WrenchProfile(arr["wrench_centres"], float(data["wrench_width"]), arr["wrench_weights"]),
+                   None if taught is None else TaughtOn.from_json(taught))
 
 
-def _rounded(a: np.ndarray) -> list:
+def _rounded(a: np.ndarray | tuple[float, ...]) -> list:
     return np.round(np.asarray(a, dtype=float), 9).tolist()
 
 
@@ -187,8 +249,10 @@ def skill_path(folder: Path, shape: str) -> Path:
 
 
 def save_skill(folder: Path, skill: Skill) -> Path:
-    """Write the skill to ``<folder>/demonstrations/<shape>.json`` (atomically); returns the path."""
+    """Write the skill to ``<folder>/demonstrations/<shape>.json`` (atomically); returns the
+    path. Only a skill whose teaching reached its goal is written (ExecutorError otherwise)."""
     path = skill_path(folder, skill.shape)
+    _check_taught(path, skill)
     make_folder(path.parent)
     return write_atomic(path, json.dumps(skill.to_json(), indent=1) + "\n")
 
@@ -201,10 +265,22 @@ def load_skill(folder: Path, shape: str) -> Skill:
             f"part shape '{shape}': no demonstration at {path} (expected one; run ./run.sh executor teach)")
     text = read_text(path, "taught skill (JSON)", error=ExecutorError)
     try:
-        return Skill.from_json(json.loads(text))
+        skill = Skill.from_json(json.loads(text))
     except (ValueError, KeyError, TypeError) as exc:
         raise ExecutorError(f"{path}: not a taught skill ({type(exc).__name__}: {str(exc)[:80]}); "
                             "run ./run.sh executor teach") from None
+    _check_taught(path, skill)
+    return skill
+
+
+def _check_taught(path: Path, skill: Skill) -> None:
+    """ExecutorError naming ``path`` unless ``skill`` records a teaching that reached its goal."""
+    if skill.taught is None:
+        raise ExecutorError(f"{path}: no record of its teaching (expected \"taught\": the part, the hole and the "
+                            "end error); run ./run.sh executor teach")
+    if not skill.taught.reached:
+        raise ExecutorError(f"{path}: its demonstration did not reach its goal ({skill.taught.failure()}); "
+                            "run ./run.sh executor teach with a demo_hole the part passes")
 
 
 class PhaseClock:

@@ -6,11 +6,19 @@ the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) dow
 tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
 executed by the impedance controller alone and the wrench it meets is recorded: the
 reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
-replay ends is p_goal.  Poses, wrenches and p_goal are stored in the hole's frame (its
+replay ends is p_goal.  Step 3, the check: p_goal must lie within the cell's goal tolerance
+of the demonstration's goal (0.5 mm above the bottom); a part that does not pass its
+``demo_hole`` stops on the entry instead, and its teaching is refused (ExecutorError naming
+the part, the hole and the end error), no skill written.  The skill records what it was
+taught on (:class:`assembly_constraints.executor.skills.dmp.TaughtOn`).
+
+Poses, wrenches and p_goal are stored in the hole's frame (its
 origin at the centre of the hole's entry, at the hole's own height, turned by the hole's
 yaw), so the skill runs in a hole of any yaw and at any height; in a hole of another depth
-its goal moves with the bottom (:meth:`assembly_constraints.executor.skills.dmp.Skill.deeper`).
-``./run.sh executor teach`` rebuilds ``data/<assembly>/demonstrations/<shape>.json``.
+its goal moves with the bottom, by the depth its record gives
+(:meth:`assembly_constraints.executor.skills.dmp.Skill.in_hole`).
+``./run.sh executor teach`` rebuilds ``data/<assembly>/demonstrations/<shape>.json``: every
+shape is taught first, and the files are written only when all were taught.
 """
 
 from __future__ import annotations
@@ -19,11 +27,21 @@ from pathlib import Path
 
 import numpy as np
 
+from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.control.motion import Motion
-from assembly_constraints.executor.skills.dmp import PhaseClock, Skill, WrenchProfile, fit_dmp, save_skill, xyzw_to_wxyz
+from assembly_constraints.executor.skills.dmp import (
+    PhaseClock,
+    Skill,
+    TaughtOn,
+    WrenchProfile,
+    fit_dmp,
+    save_skill,
+    xyzw_to_wxyz,
+)
 from assembly_constraints.executor.trial import APPROACH_SETTLE_TIME, Cell
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
 from assembly_constraints.executor.world.assets import regenerate_assets
+from assembly_constraints.executor.world.geometry import fit_pose
 from assembly_constraints.executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s]
@@ -72,11 +90,14 @@ def _replay(motion: Motion, skill: Skill, origin: np.ndarray,
 
 
 def teach_shape(cell: Cell, shape: str) -> Skill:
-    """Demonstrate, encode and replay the skill of one part shape."""
+    """Demonstrate, encode and replay the skill of one part shape in its ``demo_hole``;
+    ExecutorError naming the part, the hole and the end error when the replay ends farther
+    than the cell's goal tolerance from the demonstration's goal."""
     geometry = cell.geometry
     part = next(p for pid, p in sorted(geometry.parts.items()) if p.shape == shape)
     hole = geometry.holes[part.demo_hole]
-    origin = np.array([*hole.position, hole.top_z])
+    turn, shift = fit_pose(part, hole)
+    origin = np.array([*(np.array(hole.position) + shift), hole.top_z])
     bottom = hole.depth
     motion = cell.motion_for(part.id)
     assert cell.scene is not None  # set by motion_for
@@ -84,7 +105,7 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     arm = motion.controller.arm
     arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
-    yaw = aligned_yaw(part.kind, hole.kind, hole.yaw)
+    yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
     quat = tool_quat(yaw)
 
     def go_to_start() -> None:
@@ -105,16 +126,22 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     skill.wrench = WrenchProfile.fit(phases, wrenches)
     skill.end_position = end
     cell.scene.release()
+    goal = np.array([0.0, 0.0, -(bottom - DEMO_CLEARANCE)])
+    skill.taught = TaughtOn(part.id, part.kind, part.sides, hole.id, hole.kind, hole.sides, hole.depth,
+                            float(np.linalg.norm(end - goal)), cell.thresholds.goal_tolerance)
+    if not skill.taught.reached:
+        raise ExecutorError(f"teaching {shape} failed: {skill.taught.failure()} (the part does not reach the "
+                            f"bottom of its demo_hole; expected a hole it passes); no skill written")
     return skill
 
 
 def teach_all(assembly: str = "cranfield") -> list[Path]:
-    """Regenerate the assets and teach every part shape; returns the written files."""
+    """Regenerate the assets and teach every part shape, then write the skills (none when
+    one teaching fails: ExecutorError, :func:`teach_shape`); returns the written files."""
     cell = Cell(assembly)
     try:
         written = regenerate_assets(cell.geometry)
-        for shape in sorted({p.shape for p in cell.geometry.parts.values()}):
-            written.append(save_skill(cell.geometry.folder, teach_shape(cell, shape)))
+        skills = [teach_shape(cell, shape) for shape in sorted({p.shape for p in cell.geometry.parts.values()})]
     finally:
         cell.close()
-    return written
+    return written + [save_skill(cell.geometry.folder, skill) for skill in skills]

@@ -60,11 +60,14 @@ def aligned_yaw(part_kind: str, hole_kind: str, yaw: float) -> float:
     """The tool yaw [rad] that puts a part of ``part_kind`` along a hole of ``hole_kind``
     whose x axis is at ``yaw`` [rad]: 0 when either is round (nothing to align), else
     ``yaw`` reduced by the symmetry of the pair (a quarter turn when either is square,
-    a half turn for rect in rect) into the half period around 0, the smallest turn of the
-    wrist."""
+    a half turn for rect in rect, a whole turn with a polygon: its ``yaw`` includes the
+    turn the polygon relation found,
+    :func:`assembly_constraints.executor.world.geometry.fit_pose`) into the half period
+    around 0, the smallest turn of the wrist."""
     if "round" in (part_kind, hole_kind):
         return 0.0
-    period = math.pi / 2 if "square" in (part_kind, hole_kind) else math.pi
+    kinds = (part_kind, hole_kind)
+    period = 2 * math.pi if "polygon" in kinds else math.pi / 2 if "square" in kinds else math.pi
     return yaw - period * round(yaw / period)
 
 

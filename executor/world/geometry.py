@@ -16,15 +16,19 @@ is that mesh as a static concave triangle mesh instead of the plate.
 
 Cross-sections (``kind``): ``round`` (``size`` = diameter), ``square`` (``size`` = side)
 and ``rect`` (``size = [a, b]``, a ≥ b: the long side a along the part's or hole's x
-axis), all in m; a hole's ``yaw`` [°] turns its x axis about z (counter-clockwise from
-the cell's x axis).  :func:`passes` compares aligned cross-sections: the skills turn
-the part to the hole's (measured) yaw, so the yaw never changes whether a part fits.
+axis), with an optional ``corner`` radius, or ``polygon`` (an ``outline``), all in m; a
+hole's ``yaw`` [°] turns its x axis about z (counter-clockwise from the cell's x axis).
+:func:`passes` compares aligned cross-sections: the skills turn the part to the hole's
+(measured) yaw, so the yaw never changes whether a part fits; with a polygon the polygon
+relation (:mod:`assembly_constraints.executor.world.polygon_fit`) finds the yaw and
+shift, and the skills add them (:func:`fit_pose`).
 ``write_assets`` regenerates ``data/<assembly>/assets/`` deterministically (the URDFs byte
 for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +36,7 @@ from pathlib import Path
 import clingo
 import numpy as np
 import pybullet_data
+import shapely
 
 from assembly_constraints.bridge.assembly import Assembly, assembly_of, resolve_assembly_folder
 from assembly_constraints.bridge.files import make_folder, write_atomic
@@ -56,6 +61,14 @@ from assembly_constraints.executor.world.meshes import (
     mesh_link_xml,
     mesh_urdf_text,
 )
+from assembly_constraints.executor.world.polygon_fit import (
+    OutlineError,
+    PolygonFit,
+    circle,
+    polygon,
+    polygon_fit,
+    round_fit,
+)
 
 FLOOR_MIN = 1e-6
 """A hole whose bottom is less than this above the plate under the bosses goes through its
@@ -65,13 +78,17 @@ boss onto the plate [m] (the mesh is printed to 1 µm): no floor thinner than th
 @dataclass(frozen=True)
 class Section:
     """A part's or a hole's cross-section: ``kind`` "round" (``size`` = diameter [m]),
-    "square" (``size`` = side [m]) or "rect" (``size`` = long side a along x [m],
-    ``width`` = short side b along y [m]; 0 means ``size``: round and square)."""
+    "square" (``size`` = side [m]), "rect" (``size`` = long side a along x [m],
+    ``width`` = short side b along y [m]; 0 means ``size``: round and square) or
+    "polygon" (``outline`` its points (x, y) [m] in its own frame, ``size`` and ``width``
+    its extents along x and y); a square's or rect's ``corner`` radius [m] (0: sharp)."""
 
     id: str
     kind: str
     size: float
     width: float = field(default=0.0, kw_only=True)
+    outline: tuple[tuple[float, float], ...] = field(default=(), kw_only=True)
+    corner: float = field(default=0.0, kw_only=True)
 
     @property
     def sides(self) -> tuple[float, float]:
@@ -143,11 +160,6 @@ class CellGeometry:
         plate's level (0.0 exactly when no hole is deeper)."""
         return self.plate.top_z - self.plate.tile_thickness - self.base_top
 
-    def deeper_than_taught(self, part: PartSpec, hole: HoleSpec) -> float:
-        """How much deeper [m] ``hole`` is than the hole ``part``'s skill is taught in (its
-        shape's ``demo_hole``; negative: shallower)."""
-        return hole.depth - self.holes[part.demo_hole].depth
-
     @property
     def base_mesh(self) -> Path | None:
         """The base's own mesh file (the cell frame [m]) when it is simulated from it, else None."""
@@ -176,11 +188,16 @@ def load_geometry(assembly: str = "cranfield", description: CellDescription | No
 
 
 def _section(shape: HoleShape | PartShape) -> tuple[str, float, float]:
-    """``kind``, size and width [m] of a shape table: a rect ``[a, b]`` gives a and b, any
-    other kind its one size and width 0."""
+    """``kind``, size and width [m] of a shape table: a rect's or polygon's ``[a, b]``
+    gives a and b, any other kind its one size and width 0."""
     if isinstance(shape.size, list):
         return shape.kind, float(shape.size[0]), float(shape.size[1])
     return shape.kind, float(shape.size), 0.0
+
+
+def _outline(shape: HoleShape | PartShape) -> tuple[tuple[float, float], ...]:
+    """A polygon's outline points [m] (empty for the other kinds)."""
+    return () if shape.outline is None else tuple((float(x), float(y)) for x, y in shape.outline)
 
 
 def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Gripper) -> CellGeometry:
@@ -191,7 +208,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
         top, depth = hole_level(geo.plate, hole_shape)
         for hid in hole_shape.holes:
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
-                                  top_z=top, depth=depth)
+                                  top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -202,6 +219,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             parts[pid] = PartSpec(
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
+                outline=_outline(part_shape), corner=part_shape.corner,
             )
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
@@ -211,24 +229,112 @@ def margin(part: Section, hole: Section) -> float:
     does not pass; the skill turns the part to the hole's yaw): round in round D - d; a
     square or rect a × b in round D - √(a² + b²); round in a square or rect B - d (its short
     side); a square or rect in a square or rect, long side along long side, min(A - a, B - b)
-    (a square is a rect with a = b)."""
+    (a square is a rect with a = b). Corner radii: a part's rounded corners bring its
+    farthest point in (D - 2 (|c| + ρ), c the centre of its corner's arc); in a square or
+    rect hole the room is twice the largest offset of the part whose corner arcs (or sharp
+    corners) stay inside the hole's (its corner arcs' centres less than ρ_hole - the
+    offset part's radius from the hole's inner rectangle; a bisection to 0.1 nm). With a polygon on either
+    side: twice the room of :func:`section_fit` (the largest uniform offset of the part
+    that passes, at the yaw and shift the polygon relation finds), which agrees with these
+    rules on their kinds (a rect held along the hole's long side)."""
+    if "polygon" in (part.kind, hole.kind):
+        return section_fit(part, hole).margin
     if hole.kind == "round":
         if part.kind == "round":
             return hole.size - part.size
-        if part.kind == "square":
-            return hole.size - part.size * math.sqrt(2.0)
-        return hole.size - math.hypot(*part.sides)
+        a, b = part.sides
+        return hole.size - 2 * (math.hypot(a / 2 - part.corner, b / 2 - part.corner) + part.corner)
     long_side, short_side = hole.sides
     if part.kind == "round":
         return short_side - part.size
     a, b = part.sides
-    return min(long_side - a, short_side - b)
+    room = min(long_side - a, short_side - b) / 2
+    if not (part.corner or hole.corner):
+        return 2 * room
+
+    def corners_pass(offset: float) -> bool:
+        """Whether the part offset by ``offset`` [m] has its corner arcs (radius ρ + offset,
+        or sharp corners once that is negative) inside the hole's."""
+        arc = max(part.corner + offset, 0.0)
+        inward = min(part.corner + offset, 0.0)  # a sharp corner's centre moves in with it
+        beyond = math.hypot(max(0.0, a / 2 - part.corner + inward - (long_side / 2 - hole.corner)),
+                            max(0.0, b / 2 - part.corner + inward - (short_side / 2 - hole.corner)))
+        return beyond == 0.0 or beyond + arc <= hole.corner
+
+    if corners_pass(room):
+        return 2 * room
+    low = -b / 2  # the part shrunk to a line passes any corner
+    while room - low > 1e-10:
+        mid = (low + room) / 2
+        low, room = (mid, room) if corners_pass(mid) else (low, mid)
+    return 2 * low
 
 
 def passes(part: Section, hole: Section) -> bool:
     """Whether the part's cross-section passes the hole's, aligned: a positive
     :func:`margin` (no clearance needed beyond a positive one)."""
     return margin(part, hole) > 0
+
+
+def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
+    """The section as a polygon in its own frame [m]: a polygon's outline, a square's or
+    rect's exact rectangle (its corner arcs 256-gons as a circle's), a round one's 256-gon
+    around the circle for a ``peg`` (it holds the part), inside it for a hole.
+    OutlineError naming the section when its outline is no simple polygon."""
+    if section.kind == "polygon":
+        return polygon(np.array(section.outline), f"the section of {section.id}")
+    if section.kind == "round":
+        return circle(section.size / 2, outside=peg)
+    a, b = section.sides
+    if section.corner <= 0:
+        return shapely.box(-a / 2, -b / 2, a / 2, b / 2)
+    arc = circle(section.corner, outside=peg)
+    core = shapely.box(section.corner - a / 2, section.corner - b / 2, a / 2 - section.corner, b / 2 - section.corner)
+    return shapely.convex_hull(shapely.union_all([shapely.affinity.translate(arc, x, y)
+                                                  for x, y in np.asarray(core.exterior.coords)[:4]]))
+
+
+def section_fit(part: Section, hole: Section) -> PolygonFit:
+    """How the part's section sits in the hole's (:mod:`assembly_constraints.executor.world.polygon_fit`):
+    the room [m], the part's yaw [°] and offset [m] in the hole's frame; a round side's
+    closed forms, the search otherwise; the exact rules of :func:`margin` (room half the
+    margin, yaw 0, centred) when neither side is a polygon."""
+    try:
+        return _section_fit(_key(part), _key(hole))
+    except OutlineError:  # the cached answer knows no ids: name the section that is no simple polygon
+        for section in (part, hole):
+            outline_polygon(section, peg=True)
+        raise
+
+
+def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
+    """The part's yaw [rad] in the hole's frame and its origin's offset (x, y) [m] from the
+    hole's position in the cell's axes where the polygon relation passes it (:func:`section_fit`);
+    (0, 0) for pairs of round, square and rect sections (the skill aligns those itself,
+    :func:`assembly_constraints.executor.world.arm.aligned_yaw`)."""
+    if "polygon" not in (part.kind, hole.kind):
+        return 0.0, np.zeros(2)
+    found = section_fit(part, hole)
+    c, s = math.cos(hole.yaw), math.sin(hole.yaw)
+    x, y = found.offset
+    return math.radians(found.yaw), np.array([c * x - s * y, s * x + c * y])
+
+
+def _key(section: Section) -> Section:
+    """The section without its id (pairs of equal sections share one answer)."""
+    return Section("", section.kind, section.size, width=section.width, outline=section.outline,
+                   corner=section.corner)
+
+
+@functools.lru_cache(maxsize=4096)
+def _section_fit(part: Section, hole: Section) -> PolygonFit:
+    if "polygon" not in (part.kind, hole.kind):
+        return PolygonFit(margin(part, hole) / 2, 0.0, (0.0, 0.0))
+    if hole.kind == "round":
+        return round_fit(outline_polygon(part, peg=True), None, hole_diameter=hole.size)
+    if part.kind == "round":
+        return round_fit(None, outline_polygon(hole, peg=False), peg_diameter=part.size)
+    return polygon_fit(outline_polygon(part, peg=True), outline_polygon(hole, peg=False))
 
 
 def sizes_lp_text(assembly: str) -> str:

@@ -36,7 +36,7 @@ def test_a_new_file_gets_the_usual_mode_an_old_one_keeps_its_own(tmp_path: Path)
 
 
 @pytest.mark.parametrize("name, reason", [
-    ("missing/out.lp", "No such file or directory"),
+    ("missing/out.lp", "No such file or directory: no folder {tmp}/missing; create it first"),
     ("folder", "Is a directory"),
     ("file/out.lp", "Not a directory"),
 ])
@@ -46,10 +46,10 @@ def test_bad_output_paths_are_one_line_errors(tmp_path: Path, name: str, reason:
     target = tmp_path / name
     with pytest.raises(BridgeError) as error:
         write_atomic(target, "x.\n")
-    assert str(error.value) == f"{target}: cannot write ({reason})"
+    assert str(error.value) == f"{target}: cannot write ({reason.format(tmp=tmp_path)})"
     with pytest.raises(BridgeError) as error:
         check_writable(target)
-    assert str(error.value) == f"{target}: cannot write ({reason})"
+    assert str(error.value) == f"{target}: cannot write ({reason.format(tmp=tmp_path)})"
     assert (tmp_path / "file").read_text() == "a regular file"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "folder"]
     assert list((tmp_path / "folder").iterdir()) == []
@@ -78,7 +78,8 @@ def test_write_figure_renders_in_memory_then_writes(tmp_path: Path) -> None:
     figure, axis = plt.subplots()
     axis.plot([0, 1], [1, 0])
     write_figure(tmp_path / "plot.png", figure)
-    with pytest.raises(BridgeError, match=r"/missing/plot\.png: cannot write \(No such file or directory\)$"):
+    missing = r"/missing/plot\.png: cannot write \(No such file or directory: no folder .*/missing; create it first\)$"
+    with pytest.raises(BridgeError, match=missing):
         write_figure(tmp_path / "missing" / "plot.png", figure)
     plt.close(figure)
     assert (tmp_path / "plot.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -2,8 +2,8 @@
 covers and head equal the shipped ones (within 0.05 mm, table by table, skills by the
 stated rule), and the imported product is learned and assembled in the simulated cell;
 a cover with round openings and a flanged head are simulated from their own meshes
-(convex pieces) and rest where they belong; a part the cell cannot place is named and
-no geometry.toml is written."""
+(convex pieces) and rest where they belong (a part the cell cannot place:
+``test_manual``)."""
 
 from __future__ import annotations
 
@@ -154,16 +154,6 @@ def test_a_cover_and_a_head_of_their_own_meshes(tmp_path: Path, capsys: pytest.C
             assert np.linalg.norm(world.position(part) - goal) < REST_BOUND, part
     finally:
         world.close()
-
-
-def test_a_cover_on_pins_only_is_named_and_gets_no_geometry(tmp_path: Path,
-                                                            capsys: pytest.CaptureFixture[str]) -> None:
-    _pegs_and_plate(tmp_path / "cad", (0.0, 0.0))
-    _box((80, 20, 4), (0, 0, 37)).export(tmp_path / "cad" / "lid.stl")  # lies on the peg tops
-    assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
-    assert ("no geometry.toml: part 'lid' is no peg in a hole of the base, no cover (no pin passes through it and "
-            "it rests on no cover)") in capsys.readouterr().out
-    assert not (tmp_path / "out" / "geometry.toml").exists()
 
 
 def test_a_cover_of_more_boxes_than_the_cell_holds_is_refused(tmp_path: Path) -> None:

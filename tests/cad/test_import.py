@@ -20,6 +20,7 @@ from assembly_constraints.cli import main
 from assembly_constraints.executor.cad.cli import run_import
 from assembly_constraints.executor.cad.derive import Derived, derive
 from assembly_constraints.executor.cad.parts import load_meshes
+from assembly_constraints.executor.cad.write import margins
 from assembly_constraints.executor.world.geometry import load_geometry
 
 SIZE_BOUND = 5e-5
@@ -111,7 +112,7 @@ def test_a_step_assembly_made_by_build123d(tmp_path: Path) -> None:
     assert (rect_fit.hole.kind, rect_fit.section.kind) == ("rect", "rect")
     assert (rect_fit.hole.a, rect_fit.hole.b) == pytest.approx((0.0123, 0.0083), abs=SIZE_BOUND)
     assert rect_fit.hole.yaw == pytest.approx(30.0, abs=0.01)
-    assert rect_fit.clearance == pytest.approx((3e-4, 3e-4), abs=SIZE_BOUND)
+    assert margins(derived)["rect_peg"]["h3"] == pytest.approx(3e-4, abs=SIZE_BOUND)
     assert derived.edges == {("plate", "round_peg"), ("plate", "rect_peg"), ("rect_peg", "cap")}
     empty = derived.holes["h2"]
     assert (empty.part, empty.hole.kind, empty.depth) == (None, "square", pytest.approx(0.015, abs=SIZE_BOUND))
@@ -155,7 +156,7 @@ def test_a_peg_in_a_plate_from_meshes(tmp_path: Path, capsys: pytest.CaptureFixt
     assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     printed = capsys.readouterr().out
     assert "hole h1 at (0.000, 0.000) mm, entered along -z: square 10.500 x 10.500 mm, depth 20.000 mm" in printed
-    assert "holds peg (square 10.000 x 10.000 mm, clearance 0.500 x 0.500 mm)" in printed
+    assert "holds peg (square 10.000 x 10.000 mm, clearance 0.500 mm: 0.250 mm all round at yaw 0.000 deg)" in printed
     assert sorted(load_geometry(str(tmp_path / "out")).parts) == ["peg"]
     assert _fits(tmp_path / "out" / "sizes.lp") == {("peg", "h1")}
 

@@ -1,8 +1,17 @@
-"""One variant's line of the ablation table, from trials' JSON (no simulation)."""
+"""The ablation table: one variant's line from trials' JSON (no simulation), and the
+documented command through to its JSON on a reduced run."""
 
 from __future__ import annotations
 
+import json
+
+import msgspec
+import pytest
+
+from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor.campaign.ablation import format_ablation, variant_row
+from assembly_constraints.executor.control.ilc import LAYERS
+from tests.conftest import error_lines
 
 
 def _trial(outcome: str, attempts: list[tuple[str, float, int]]) -> dict:
@@ -27,3 +36,22 @@ def test_force_past_stop_is_the_share_of_attempts_on_fitting_pairs_that_reached_
            "random_only_first_attempt": 1.0}
     table = format_ablation({"variants": [row], "ilc": ilc})
     assert "F>=stop" in table and " 0.500 " in table
+
+
+@pytest.mark.slow
+def test_the_documented_ablation_command_prints_its_json_on_a_reduced_run(run_cli):
+    """``bench executor --ablation --json`` through to its output, on one fitting pair and one
+    execution per variant (six real trials): the JSON holds every layer and the magnitudes."""
+    done = run_cli("bench", "executor", "--ablation", "--trials", "1", "--executions", "1", "--seed", "7311",
+                   "--pairs", "p1:r1", "--json", "--jobs", "1")
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert [v["name"] for v in report["variants"]] == list(LAYERS)
+    assert report["perturbation"] == msgspec.to_builtins(Magnitudes())
+    assert report["ilc"]["executions"] == [1] and set(report["ilc"]["by_pair"]) == {"p1:r1"}
+
+
+def test_the_ablation_refuses_pairs_none_of_which_fits(run_cli):
+    done = run_cli("bench", "executor", "--ablation", "--trials", "1", "--pairs", "p3:r1", "--json")
+    lines = error_lines(done.stderr)
+    assert done.returncode == 2 and len(lines) == 1 and "fitting pair" in lines[0], done.stderr

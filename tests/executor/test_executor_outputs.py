@@ -13,7 +13,8 @@ from assembly_constraints.executor.world.geometry import load_geometry, write_as
 from tests._files_helpers import leftovers
 from tests._tolerances import assert_same_asset
 
-BAD_RRD = {"missing folder": ("missing/x.rrd", "No such file or directory"),
+BAD_RRD = {"missing folder": ("missing/x.rrd",
+                              "No such file or directory: no folder {places}/missing; create it first"),
            "a directory": ("folder", "Is a directory"),
            "under a regular file": ("file/x.rrd", "Not a directory")}
 
@@ -37,7 +38,8 @@ def test_unwritable_rrd_is_one_line_exit_2(places: Path, run_executor, command: 
     rrd = places / name
     done = run_executor(*command, "--rrd", str(rrd), timeout=30)
     assert done.returncode == 2, done.stderr
-    assert done.stderr.splitlines()[-1] == f"error: {rrd}: cannot write ({reason})"  # after PyBullet's banner
+    expected = f"error: {rrd}: cannot write ({reason.format(places=places)})"
+    assert done.stderr.splitlines()[-1] == expected  # after PyBullet's banner
     assert "Traceback" not in done.stderr
     assert "ready" not in done.stdout
     assert sorted(p.name for p in places.iterdir()) == ["file", "folder"]

@@ -29,6 +29,10 @@ grasp_depth = 0.02
 ORIGINAL = (CRANFIELD / "geometry.toml").read_text().replace("[base]", GRIPPER_TABLE + "[base]", 1)
 """Cranfield's geometry with its own [gripper] (a product may override the cell's)."""
 
+ROUND_HOLE = 'kind = "round"\nsize = 0.0133'
+TRIANGLE = "[[-0.005, -0.005], [0.005, -0.005], [-0.005, 0.005]]"
+"""A polygon section's outline [m]."""
+
 # (id, text of data/cranfield/geometry.toml, its replacement, the expected end of the message)
 SIZE = "a number in (0, 0.1] m, or for a rect [a, b] with a >= b, each such a number"
 """What a cross-section's size must be."""
@@ -65,7 +69,7 @@ CASES = [
     ("mass-negative", "mass = 0.06", "mass = -0.06", "[part_shapes.square_peg] mass: expected a number in (0, 10] kg"),
     ("length-zero", "length = 0.05           # [m]", "length = 0", "[part_shapes.round_peg] length: expected"),
     ("kind-unknown", 'kind = "round"\nsize = 0.0187', 'kind = "hexagon"\nsize = 0.0187',
-     "[part_shapes.shaft] kind: expected one of rect, round, square, got 'hexagon'"),
+     "[part_shapes.shaft] kind: expected one of polygon, rect, round, square, got 'hexagon'"),
     ("hole-top-z-text", 'holes = ["br"]', 'holes = ["br"]\ntop_z = "0.11"',
      "[hole_shapes.round_big] top_z: expected a number in (0, 1] m, got '0.11'"),
     ("hole-depth-zero", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.0',
@@ -79,7 +83,7 @@ CASES = [
      "[hole_shapes.round_big] top_z: expected more than the depth (0.025 m, the [plate] tile_thickness: the bottom "
      "above the floor), got 0.02"),
     ("kind-number", 'holes = ["br"]\nkind = "round"', 'holes = ["br"]\nkind = 1',
-     "[hole_shapes.round_big] kind: expected one of rect, round, square, got 1"),
+     "[hole_shapes.round_big] kind: expected one of polygon, rect, round, square, got 1"),
     ("demo-hole-unknown", 'demo_hole = "br"', 'demo_hole = "zz"',
      "[part_shapes.shaft] demo_hole: expected a hole of [hole_shapes.*] (br, r1, r2, s1, s2), got 'zz'"),
     ("hole-twice", 'holes = ["br"]', 'holes = ["br", "r1"]',
@@ -119,6 +123,32 @@ CASES = [
      "that is not in assembly.toml"),
     ("gripper-unknown-key", "grasp_depth = 0.02", "grasp_depth = 0.02\ngrasp_force = 5",
      "[gripper] grasp_force: unknown key"),
+    ("polygon-without-outline", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]',
+     "[hole_shapes.round_small] outline: expected an outline [[x, y], ...] in m (a polygon's section), got None"),
+    ("outline-of-a-round", ROUND_HOLE, ROUND_HOLE + f"\noutline = {TRIANGLE}",
+     "[hole_shapes.round_small] outline: expected an outline [[x, y], ...] for a polygon, none for a round"),
+    ("outline-crossing", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]\n'
+     "outline = [[0.0, 0.0], [0.01, 0.01], [0.01, 0.0], [0.0, 0.01]]",
+     "[hole_shapes.round_small] outline: expected a simple polygon (no crossing edges, positive area), got "
+     "'Self-intersection"),
+    ("outline-extents", ROUND_HOLE, f'kind = "polygon"\nsize = [0.02, 0.01]\noutline = {TRIANGLE}',
+     "[hole_shapes.round_small] size: expected the outline's extents [0.01, 0.01] m along x and y, got [0.02, 0.01]"),
+    ("outline-two-points", ROUND_HOLE, 'kind = "polygon"\nsize = [0.01, 0.01]\noutline = [[0.0, 0.0], [0.01, 0.01]]',
+     "[hole_shapes.round_small] outline: expected the points [[x, y], ...] in m of a simple polygon"),
+    ("outline-far", ROUND_HOLE,
+     'kind = "polygon"\nsize = [0.01, 0.01]\noutline = [[0.0, 0.0], [0.5, 0.0], [0.0, 0.01]]',
+     "[hole_shapes.round_small] outline: expected"),
+    ("polygon-hole-without-base-mesh", ROUND_HOLE, f'kind = "polygon"\nsize = [0.01, 0.01]\noutline = {TRIANGLE}',
+     "[hole_shapes.round_small] kind: a polygon hole or one with rounded corners needs a [base] with its own mesh"),
+    ("corner-of-a-round", ROUND_HOLE, ROUND_HOLE + "\ncorner = 0.001",
+     "[hole_shapes.round_small] corner: expected no corner radius for a round, got 0.001"),
+    ("corner-too-big", 'kind = "square"\nsize = 0.0133', 'kind = "square"\nsize = 0.0133\ncorner = 0.007',
+     "[hole_shapes.square] corner: expected a corner radius of a square or rect at most half its short side "
+     "(0.00665 m), got 0.007"),
+    ("corner-without-base-mesh", 'kind = "square"\nsize = 0.0133', 'kind = "square"\nsize = 0.0133\ncorner = 0.001',
+     "[hole_shapes.square] corner: a polygon hole or one with rounded corners needs a [base] with its own mesh"),
+    ("polygon-peg-without-mesh", 'kind = "round"\nsize = 0.0120', f'kind = "polygon"\nsize = [0.01, 0.01]\n'
+     f"outline = {TRIANGLE}", "[part_shapes.round_peg] mesh: expected the part's own mesh for a polygon section"),
 ]
 
 

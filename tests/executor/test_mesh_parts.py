@@ -174,7 +174,8 @@ def test_the_generated_assets_follow_an_edited_mesh(product: Path) -> None:
     ('convex = "meshes/peg.convex.obj"', 'convex = "meshes/gone.obj"', "[part_shapes.peg] mesh.convex: "
      "{folder}/meshes/gone.obj: no such convex pieces file (OBJ)"),
     ('plate.obj", sha256', 'plate.obj", convex = "meshes/peg.convex.obj", sha256',
-     "[base] mesh.convex: expected no convex pieces (the base is simulated as its static concave mesh)"),
+     "[base] mesh.convex: expected no convex pieces (the base and a part placed by hand are simulated as their "
+     "static concave meshes)"),
     ('convex = "meshes/peg.convex.obj"', 'pieces = "meshes/peg.convex.obj"', "[part_shapes.peg.mesh] pieces: "
      "unknown key; expected one of file, sha256, convex"),
 ])

@@ -1,4 +1,4 @@
-"""Rectangular cross-sections (issue 18): the ``passes`` rules, the plate mesh of a turned
+"""Rectangular cross-sections: the ``passes`` rules, the plate mesh of a turned
 rect hole measured from its vertices, the tool yaw that aligns a part, the yaw error of
 the vision, the parts' ``shape``/``section`` of ``assembly.toml``, and the task board's
 ``sizes.lp`` that the geometry writes."""

@@ -1,4 +1,4 @@
-"""Eqs. (6) and (7) keep deciding for rectangular cross-sections (issue 18), in real
+"""Eqs. (6) and (7) keep deciding for rectangular cross-sections, in real
 PyBullet physics on seeds nothing was tuned on: the cell turns the part to the hole's
 estimated yaw (the vision's yaw error included), a fitting rect (in its own slot, in a
 larger slot, in a round hole by its diagonal) is ``fit``, a too-big one (a side too long,

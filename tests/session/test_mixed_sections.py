@@ -19,16 +19,19 @@ PEGS = {"pa": ("round", 0.014), "pb": ("square", 0.013), "pc": ("round", 0.010),
 HOLES = {"ha": ("round", 0.0145), "hb": ("square", 0.0135), "hc": ("round", 0.0105), "hd": ("square", 0.0095)}
 
 
-def _product(folder: Path) -> Path:
-    """Write the product's ``assembly.toml``, ``geometry.toml`` and ``demos.txt``."""
+def _product(folder: Path, part_shapes: bool = True, hole_shapes: bool = True) -> Path:
+    """Write the product's ``assembly.toml`` (with each part's ``shape`` when
+    ``part_shapes``, each hole's when ``hole_shapes``; without, the kinds are stated in
+    ``geometry.toml`` only), ``geometry.toml`` and ``demos.txt``."""
     folder.mkdir()
     assembly = ['name = "mixed pegs"', "", "[parts.bp]", 'name = "base plate"', 'role = "base"',
                 "start = [0.30, -0.40]"]
     for k, (part, (kind, _)) in enumerate(PEGS.items()):
-        assembly += ["", f"[parts.{part}]", f'name = "{kind} peg {part}"', 'role = "peg"', f'shape = "{kind}"',
-                     f"start = [{0.25 + 0.05 * k:.2f}, 0.40]"]
+        assembly += ["", f"[parts.{part}]", f'name = "{kind} peg {part}"', 'role = "peg"',
+                     *([f'shape = "{kind}"'] if part_shapes else []), f"start = [{0.25 + 0.05 * k:.2f}, 0.40]"]
     for k, (hole, (kind, _)) in enumerate(HOLES.items()):
-        assembly += ["", f"[holes.{hole}]", f'name = "{kind} hole {hole}"', f'shape = "{kind}"',
+        assembly += ["", f"[holes.{hole}]", f'name = "{kind} hole {hole}"',
+                     *([f'shape = "{kind}"'] if hole_shapes else []),
                      f"position = [{0.55 + 0.06 * (k % 2):.2f}, {-0.05 + 0.1 * (k // 2):.2f}]"]
     (folder / "assembly.toml").write_text("\n".join(assembly) + "\n")
     geometry = ["[plate]", "top_z = 0.10", "tile_size = 0.04", "tile_thickness = 0.025", "chamfer = 0.0008",

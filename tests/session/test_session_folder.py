@@ -21,6 +21,7 @@ from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.session import free_loopback_endpoint
 from tests.conftest import TRUTH_SESSION
 from tests.session.test_session_cells import assert_learned_truth
+from tests.session.test_session_startup import short_peg
 
 pytestmark = pytest.mark.timeout(90)
 
@@ -143,9 +144,9 @@ def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, 
 
 @pytest.mark.slow
 def test_a_normal_start_after_a_cell_died_at_start(tmp_path: Path, root: Path, run_cli, run_session) -> None:
-    broken = tmp_path / "no_geometry"
+    broken = tmp_path / "short_peg"
     shutil.copytree(root / "data" / "cranfield", broken)
-    (broken / "geometry.toml").unlink()  # the cell exits at start
+    short_peg(broken)
     run = tmp_path / "run"
     failed = run_cli(*TRUTH_SESSION, "--assembly", str(broken), "--cells", "1", "--out", str(run), timeout=50)
     assert failed.returncode == 2 and "before printing line 'ready" in failed.stderr

@@ -1,7 +1,8 @@
 """``session.json`` is the encoded settings with one decoder: what a session writes reads
 back equal; a folder of the untyped format 1 (the cell's options as argv strings) is
 decoded; settings out of range built in Python are refused naming the field (a size
-prior's tolerance too, and a tolerance without a prior)."""
+prior's tolerance too, and a tolerance without a prior); a resume runs with the kept
+backend and names the options it ignores; the product digest follows the product's files."""
 
 from __future__ import annotations
 
@@ -17,7 +18,9 @@ from assembly_constraints.asp.session.settings import (
     SessionSettings,
     checked,
     new_session_file,
+    product_digest,
     read_session_file,
+    resumed_settings,
     write_session_file,
 )
 from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
@@ -67,3 +70,37 @@ def test_settings_built_in_python_are_checked(settings: SessionSettings, field: 
 def test_an_unknown_policy_is_refused_naming_it() -> None:
     with pytest.raises(PlannerError, match="^session settings: policy 'fastest': expected one of"):
         checked(SessionSettings(policy="fastest"))
+
+
+def test_a_resume_runs_with_the_kept_backend_and_names_the_options_it_ignores() -> None:
+    record = new_session_file(SessionSettings(backend="truth", delay_s=0.5, seed=3,
+                                              cell=CellSettings(cell_seed=3)), "rec-1")
+    given = SessionSettings(backend="sim", delay_s=2.0, seed=3, policy="random", cells=4,
+                            cell=CellSettings(layer="position", cell_seed=3))
+    settings, ignored = resumed_settings(given, record)
+    assert (settings.backend, settings.delay_s, settings.cells) == ("truth", 0.5, 4)  # how many cells: this start's
+    # --backend sim is the default: a resume cannot tell it from no option, so it is not named
+    assert ignored == ["--policy random", "--delay 2.0", "the cell options"]
+    assert resumed_settings(SessionSettings(seed=3, cell=CellSettings(cell_seed=3)), record)[1] == []
+
+
+def test_a_folder_that_kept_no_backend_is_resumed_with_the_given_one(tmp_path: Path) -> None:
+    (tmp_path / SESSION_FILE).write_text('{"format": 2, "assembly": "cranfield", "policy": "best", "seed": 0, '
+                                         '"recording_id": "r"}')
+    record = read_session_file(tmp_path)
+    assert (record.backend, record.delay_s, record.product) == (None, None, None)
+    settings, ignored = resumed_settings(SessionSettings(backend="truth", delay_s=0.1), record)
+    assert (settings.backend, record.backend, record.delay_s, ignored) == ("truth", "truth", 0.1, [])
+
+
+def test_the_product_digest_follows_every_product_file(tmp_path: Path, root: Path) -> None:
+    for name in ("assembly.toml", "geometry.toml", "sizes.lp"):
+        (tmp_path / name).write_bytes((root / "data" / "cranfield" / name).read_bytes())
+    digests = {product_digest(tmp_path)}
+    assert product_digest(tmp_path) in digests  # the same files, the same digest
+    (tmp_path / "demos.txt").write_text("")  # an empty file is not an absent one
+    digests.add(product_digest(tmp_path))
+    (tmp_path / "sizes.lp").write_text((tmp_path / "sizes.lp").read_text() + " ")
+    digests.add(product_digest(tmp_path))
+    (tmp_path / "notes.txt").write_text("not a product file")
+    assert product_digest(tmp_path) in digests and len(digests) == 3

@@ -1,0 +1,298 @@
+"""Whether a peg's cross-section passes a hole's, for sections of any shape (shapely).
+
+A section is a simple polygon in its own frame [m] (a peg's about its section's centre, a
+hole's about the hole's position, x along the part's or hole's x axis). The peg passes
+the hole when some turn ``yaw`` about the peg's origin and some shift ``offset`` put the
+peg's polygon inside the hole's; its **room** is the largest uniform offset (shapely's
+buffer) of the peg that still passes, negative when none does (the peg must shrink by
+that much), so the room of a round peg of diameter d in a round hole of D is (D - d) / 2.
+
+:func:`polygon_fit` searches the turn and the shift. Turns one period of the pair's
+rotational symmetry apart are the same (a 6-tooth spline in a 6-tooth hub: 60°); the
+period is sampled every period / :data:`COARSE_TURNS` (yaw 0 among the samples, the pose
+an assembled CAD holds), each turn from two starts (the peg's smallest enclosing circle's
+centre on the hole's largest inscribed circle's, and the area centroids together). The
+:data:`CANDIDATES` best are refined by zooming in on the best of 9 turns until the peg's
+farthest corner moves less than :data:`FINE_SHIFT`, then (unless both outlines share a
+rotational symmetry, which keeps their centres together) the shift by zooming in on the
+best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn once more. The search climbs
+a continuous score: the room where the peg is inside, else minus its deepest overlap (a
+peg corner outside the hole, a hole corner inside the peg). The room reported is
+measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
+exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
+is one the peg can make; a pass whose window of turns the search never samples near can
+be missed (a no-pass is the search's finding, not a proof). A peg whose largest
+inscribed circle is wider than the hole's does not pass whatever its turn: its room is
+then given as the difference of those radii, a bound (it lacks at least that much),
+without a search. A round side has closed
+forms: a polygon peg in a round hole has the room R - (the radius of its smallest
+enclosing circle), a round peg in a polygon hole (the radius of the hole's largest
+inscribed circle) - r, at any turn.
+Deterministic: the same outlines give the same answer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+COARSE_TURNS = 72
+"""Samples of the turn over one period of the pair's symmetry."""
+CANDIDATES = 2
+"""The best coarse turns refined."""
+FINE_SHIFT = 1e-7
+"""The shift's, the turn's (at the peg's farthest corner) and a negative room's resolution [m]."""
+MAX_ORDER = 64
+"""The highest rotational symmetry looked for (a 64-tooth spline)."""
+SYMMETRY_TOLERANCE = 1e-6
+"""An outline turned by 2π/n onto itself within this [m] has n-fold symmetry."""
+
+
+class OutlineError(ValueError):
+    """An outline that is no simple polygon of positive area (the message says why)."""
+
+
+@dataclass(frozen=True)
+class PolygonFit:
+    """How a peg's section sits in a hole's: ``room`` [m] (the largest uniform offset of
+    the peg that passes; negative: it does not pass), the peg's ``yaw`` [°] and ``offset``
+    (x, y) [m] in the hole's frame where that room was found."""
+
+    room: float
+    yaw: float
+    offset: tuple[float, float]
+
+    @property
+    def margin(self) -> float:
+        """Twice the room [m]: the diametral clearance, as D - d of round in round."""
+        return 2 * self.room
+
+
+def polygon(points: np.ndarray | list[list[float]], what: str) -> shapely.Polygon:
+    """The simple polygon of an outline (n, 2) [m]; OutlineError naming ``what`` when it
+    has fewer than 3 points, a non-finite one, crosses itself or has no area."""
+    array = np.asarray(points, dtype=float)
+    if array.ndim != 2 or array.shape[0] < 3 or array.shape[1] != 2:
+        raise OutlineError(f"{what}: expected an outline of at least 3 points [x, y], got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise OutlineError(f"{what}: expected finite coordinates in its outline")
+    shape = shapely.Polygon(array)
+    if not shape.is_valid or shape.area <= 0:
+        raise OutlineError(f"{what}: expected a simple outline (no crossing edges, positive area), got "
+                           f"{shapely.is_valid_reason(shape)}")
+    return shapely.orient_polygons(shape)
+
+
+def circle(radius: float, *, outside: bool) -> shapely.Polygon:
+    """A 256-gon of a circle of ``radius`` [m]: around it (``outside``, a peg's: it holds
+    the circle) or inside it (a hole's); either is within 0.008 % of the radius."""
+    sides = 256
+    scale = 1 / math.cos(math.pi / sides) if outside else 1.0
+    angles = 2 * math.pi * np.arange(sides) / sides
+    return shapely.Polygon(np.stack([np.cos(angles), np.sin(angles)], axis=1) * radius * scale)
+
+
+def symmetry(shape: shapely.Polygon) -> int:
+    """The largest n <= :data:`MAX_ORDER` such that turning ``shape`` by 2π/n about the
+    origin puts each of its corners on its boundary within :data:`SYMMETRY_TOLERANCE`
+    (eight spread corners tried for every n at once, then all for the likely ones)."""
+    corners = np.asarray(shape.exterior.coords)[:-1]
+    edge = shape.exterior
+    shapely.prepare(edge)
+    few = corners[:: max(1, len(corners) // 8)]
+    orders = np.arange(MAX_ORDER, 1, -1)
+    turned = np.concatenate([_turn(few, 2 * math.pi / order) for order in orders])
+    off = shapely.distance(edge, shapely.points(turned)).reshape(len(orders), len(few)).max(axis=1)
+    for order in orders[off <= SYMMETRY_TOLERANCE]:
+        if float(np.max(shapely.distance(edge, shapely.points(_turn(corners, 2 * math.pi / order))))) \
+                <= SYMMETRY_TOLERANCE:
+            return int(order)
+    return 1
+
+
+def _turn(points: np.ndarray, angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return points @ np.array([[c, s], [-s, c]])
+
+
+class _Pair:
+    """A peg and a hole about their centres (the peg's smallest enclosing circle's, the
+    hole's largest inscribed circle's), scored at a turn [rad] and shift [m]."""
+
+    def __init__(self, peg: shapely.Polygon, hole: shapely.Polygon) -> None:
+        self.hole = hole
+        self.hole_edge = hole.exterior
+        shapely.prepare(hole)
+        shapely.prepare(self.hole_edge)
+        self.peg_points = np.asarray(peg.exterior.coords)[:-1]
+        self.hole_points = np.asarray(hole.exterior.coords)[:-1]
+        self.peg = peg
+        shapely.prepare(peg)
+        self.peg_edge = peg.exterior
+
+    def pegs(self, angles: np.ndarray, shifts: np.ndarray) -> np.ndarray:
+        """The peg polygons turned by ``angles`` (k,) and shifted by ``shifts`` (k, 2)."""
+        c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+        x, y = self.peg_points[:, 0], self.peg_points[:, 1]
+        coords = np.stack([c * x - s * y + shifts[:, :1], s * x + c * y + shifts[:, 1:]], axis=2)
+        return shapely.polygons(coords)
+
+    def scores(self, angles: np.ndarray, shifts: np.ndarray) -> np.ndarray:
+        """The room [m] of the peg at each turn and shift where it is inside the hole, else
+        minus its deepest overlap: the farthest of its corners outside the hole or of the
+        hole's corners inside it."""
+        pegs = self.pegs(angles, shifts)
+        inside = shapely.contains(self.hole, pegs)
+        result = np.empty(len(angles))
+        result[inside] = shapely.distance(self.hole_edge, pegs[inside])
+        out = ~inside
+        if np.any(out):
+            n = len(self.peg_points)
+            corners = shapely.get_coordinates(pegs[out])
+            ends = np.cumsum([0, *[n + 1] * int(out.sum())])
+            points = shapely.points(corners)
+            outside = ~shapely.contains(self.hole, points)
+            depth = np.zeros(len(corners))
+            depth[outside] = shapely.distance(self.hole_edge, points[outside])
+            deepest = np.maximum.reduceat(depth, ends[:-1])
+            # the hole's corners, brought into each peg's frame, inside the peg
+            back = self.hole_points[None, :, :] - shifts[out][:, None, :]
+            c, s = np.cos(-angles[out])[:, None], np.sin(-angles[out])[:, None]
+            local = np.stack([c * back[..., 0] - s * back[..., 1], s * back[..., 0] + c * back[..., 1]], axis=2)
+            points = shapely.points(local.reshape(-1, 2))
+            within = shapely.contains(self.peg, points)
+            poke = np.zeros(len(points))
+            poke[within] = shapely.distance(self.peg_edge, points[within])
+            deepest = np.maximum(deepest, poke.reshape(len(back), -1).max(axis=1))
+            result[out] = -deepest
+        return result
+
+    def score(self, angle: float, shift: np.ndarray) -> float:
+        return float(self.scores(np.array([angle]), shift[None, :])[0])
+
+    def room(self, angle: float, shift: np.ndarray) -> float:
+        """The exact room [m] at a turn and shift: the peg's distance to the hole's boundary
+        when inside, else the buffer (bisection to :data:`FINE_SHIFT`) that brings it in."""
+        found = self.score(angle, shift)
+        if found >= 0:
+            return found
+        peg = self.pegs(np.array([angle]), shift[None, :])[0]
+
+        def inside(buffer: float) -> bool:
+            """Whether the peg offset by ``buffer`` [m] is inside (shrunk to nothing: it is)."""
+            offset = peg.buffer(buffer, join_style="mitre")
+            return bool(offset.is_empty or shapely.contains(self.hole, offset))
+
+        low, high = found, 0.0  # high never passes (the peg overlaps the hole's boundary)
+        while not inside(low):
+            high, low = low, 2 * low
+        while high - low > FINE_SHIFT:
+            mid = (low + high) / 2
+            low, high = (mid, high) if inside(mid) else (low, mid)
+        return low
+
+
+def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
+    """The best turn and shift of ``peg`` in ``hole`` and the room there (the module
+    docstring); both simple polygons in their own frames [m] (:func:`polygon`)."""
+    peg_centre = np.asarray(shapely.minimum_bounding_circle(peg).centroid.coords[0])
+    hole_centre = np.asarray(shapely.maximum_inscribed_circle(hole, FINE_SHIFT).coords[0])
+    bound = _room_bound(peg, hole)
+    if bound < 0:
+        return PolygonFit(bound, 0.0, (float(hole_centre[0] - peg_centre[0]), float(hole_centre[1] - peg_centre[1])))
+    pair = _Pair(shapely.affinity.translate(peg, *-peg_centre), shapely.affinity.translate(hole, *-hole_centre))
+    orders = symmetry(pair.peg), symmetry(pair.hole)
+    period = 2 * math.pi / math.lcm(*orders)
+    reach = float(np.max(np.linalg.norm(pair.peg_points, axis=1)))
+    fine = FINE_SHIFT / reach  # the turn that moves the peg's farthest corner by FINE_SHIFT
+    coarse = period / COARSE_TURNS
+    turns = np.arange(COARSE_TURNS) * coarse - period / 2  # yaw 0 among them: the pose the CAD may hold
+    # two starts at every turn: the centres together, the area centroids together (one
+    # where they are the centres, as for outlines symmetric about them)
+    peg_mid, hole_mid = np.asarray(pair.peg.centroid.coords[0]), np.asarray(pair.hole.centroid.coords[0])
+    angles, starts = turns, np.zeros((COARSE_TURNS, 2))
+    if max(float(np.linalg.norm(peg_mid)), float(np.linalg.norm(hole_mid))) > FINE_SHIFT:
+        angles = np.concatenate([turns, turns])
+        starts = np.concatenate([starts, hole_mid - np.stack([_turn(peg_mid[None, :], t)[0] for t in turns])])
+    scores = pair.scores(angles, starts)
+    best = (-math.inf, 0.0, np.zeros(2))
+    for index in np.argsort(-scores, kind="stable")[:CANDIDATES]:
+        angle, shift = _refine_turn(pair, float(angles[index]), starts[index], coarse, fine)
+        if math.gcd(*orders) == 1:  # no shared symmetry to keep the centres together
+            shift = _refine_shift(pair, angle, shift, reach)
+            angle, shift = _refine_turn(pair, angle, shift, coarse / 8, fine)
+        found = pair.score(angle, shift)
+        if found > best[0] + FINE_SHIFT:
+            best = (found, angle, shift)
+    _, angle, shift = best
+    room = pair.room(angle, shift)
+    # the peg's origin where the turned peg's centre sits at the hole's centre plus the shift
+    origin = hole_centre + shift - _turn(peg_centre[None, :], angle)[0]
+    yaw = math.degrees(math.remainder(angle, period))
+    return PolygonFit(room, round(yaw, 9) + 0.0, (float(origin[0]), float(origin[1])))
+
+
+_TURNS = np.linspace(-1.0, 1.0, 9)
+_SHIFTS = np.array([[x, y] for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)])
+_ROUNDS = 64
+"""A refinement stops after this many rounds whatever its step (a score that keeps climbing)."""
+
+
+def _room_bound(peg: shapely.Polygon, hole: shapely.Polygon) -> float:
+    """A bound [m] the room cannot exceed: the peg offset by r has a largest inscribed
+    circle r wider (narrower for r < 0), which must fit the hole's."""
+    return float(shapely.length(shapely.maximum_inscribed_circle(hole, FINE_SHIFT))
+                 - shapely.length(shapely.maximum_inscribed_circle(peg, FINE_SHIFT))) + FINE_SHIFT
+
+
+def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine: float) -> tuple[float, np.ndarray]:
+    """Climb the score along the turn from ``angle`` [rad]: 9 turns within ``step`` [rad]
+    either side at once, the window a quarter as wide when the best is inside it, until it
+    is narrower than ``fine`` [rad]."""
+    for _ in range(_ROUNDS):
+        if step <= fine:
+            break
+        tried = angle + step * _TURNS
+        scores = pair.scores(tried, np.tile(shift, (len(tried), 1)))
+        k = int(np.argmax(scores))
+        angle = float(tried[k])
+        if 0 < k < len(tried) - 1:
+            step /= 4
+    return angle, shift
+
+
+def _refine_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:
+    """Climb the score over the shift [m] from ``shift``: a 3 x 3 grid at once, from twice
+    the score's size (at most a tenth of the peg's ``reach`` [m]) either side, the grid half
+    as wide when its centre is the best, down to :data:`FINE_SHIFT`."""
+    step = min(reach / 10, max(2 * abs(pair.score(angle, shift)), 100 * FINE_SHIFT))
+    for _ in range(_ROUNDS):
+        if step <= FINE_SHIFT:
+            break
+        moves = shift + step * _SHIFTS
+        scores = pair.scores(np.full(len(moves), angle), moves)
+        k = int(np.argmax(scores))
+        shift = moves[k]
+        if not np.any(_SHIFTS[k]):
+            step /= 2
+    return shift
+
+
+def round_fit(peg: shapely.Polygon | None, hole: shapely.Polygon | None, peg_diameter: float = 0.0,
+              hole_diameter: float = 0.0) -> PolygonFit:
+    """The closed forms of a round side (one of ``peg`` and ``hole`` None: round of that
+    diameter [m]): a polygon peg in a round hole, a round peg in a polygon hole, any turn,
+    the peg's centre on the circle's (the room the largest, the yaw 0)."""
+    if hole is None:
+        assert peg is not None
+        mbc = shapely.minimum_bounding_circle(peg)
+        centre = np.asarray(mbc.centroid.coords[0])
+        reach = float(np.max(np.linalg.norm(np.asarray(peg.exterior.coords) - centre, axis=1)))
+        return PolygonFit(hole_diameter / 2 - reach, 0.0, (float(-centre[0]), float(-centre[1])))
+    mic = shapely.maximum_inscribed_circle(hole, 1e-7)
+    centre = np.asarray(mic.coords[0])
+    inner = float(shapely.distance(hole.exterior, shapely.Point(centre)))
+    return PolygonFit(inner - peg_diameter / 2, 0.0, (float(centre[0]), float(centre[1])))

@@ -1,0 +1,92 @@
+"""Every integer, string and array of every message is bounded by the published schema,
+and the bounds are what the cell and the planner enforce: a cell recording to Rerun
+answers a request at the bounds and refuses one past them (an experiment number of 2**63
+or 10**30) with an error reply, and keeps serving (a real cell process over Zenoh)."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from assembly_constraints.asp.session.cells import start_cell
+from assembly_constraints.bridge.cell_settings import ServeSettings
+from assembly_constraints.bridge.client import request_insert
+from assembly_constraints.bridge.messages import (
+    MAX_COUNT,
+    MAX_REQUEST_ID,
+    ErrorReply,
+    InsertReply,
+    InsertRequest,
+    MessageError,
+    decode_reply,
+    decode_request,
+    encode,
+)
+from assembly_constraints.bridge.protocol_schema import MESSAGES, schema
+from tests.bridge.test_bridge_cells import network, raw_query  # noqa: F401  (the fixture)
+
+BOUNDED_PATTERN = re.compile(r"^\^[^*+]*\{\d+,\d+\}[^*+]*\$")
+"""A pattern that bounds the length of what it matches: one counted repetition, no * or +."""
+
+
+def unbounded(node: object, path: str = "$") -> Iterator[str]:
+    """The paths of the integers, strings and arrays of a JSON Schema without an upper bound."""
+    if isinstance(node, list):
+        for index, item in enumerate(node):
+            yield from unbounded(item, f"{path}[{index}]")
+        return
+    if not isinstance(node, dict):
+        return
+    kind = node.get("type")
+    if kind in ("integer", "number") and "maximum" not in node and "exclusiveMaximum" not in node:
+        yield path
+    if (kind == "string" and "maxLength" not in node and "enum" not in node and "const" not in node
+            and not BOUNDED_PATTERN.match(node.get("pattern", ""))):
+        yield path
+    if kind == "array" and "maxItems" not in node:
+        yield path
+    for key, value in node.items():
+        yield from unbounded(value, f"{path}.{key}")
+
+
+@pytest.mark.parametrize("name", sorted(MESSAGES))
+def test_every_number_string_and_array_of_a_message_is_bounded(name: str) -> None:
+    message, direction = MESSAGES[name]
+    assert list(unbounded(schema(message, direction))) == []
+
+
+def test_the_request_id_holds_the_longest_documented_ids() -> None:
+    run, part, hole = "r" * 64, "p" + "a" * 63, "h" + "b" * 63
+    longest = f"{run}.{part}.{hole}.{MAX_COUNT}"
+    assert len(longest) == MAX_REQUEST_ID
+    request = InsertRequest(id=longest, part=part, hole=hole, experiment=MAX_COUNT)
+    assert decode_request(encode(request)) == request
+
+
+def test_the_planner_refuses_a_reply_past_the_bounds() -> None:
+    reply = b'{"kind":"insert_reply","id":"a","cell":"c1","part":"p1","hole":"r1","result":"fit",' \
+            b'"evidence":{"attempts":%d,"max_force_dev":0,"max_torque_dev":0,"end_error":0,"duration_s":0}}'
+    assert decode_reply(reply % MAX_COUNT).evidence.attempts == MAX_COUNT  # type: ignore[union-attr]
+    with pytest.raises(MessageError, match=r"Expected `int` <= 2147483647 - at `\$.evidence.attempts`"):
+        decode_reply(reply % 2**63)
+
+
+@pytest.mark.slow
+def test_a_cell_refuses_a_huge_experiment_number_and_keeps_serving(network, tmp_path: Path) -> None:  # noqa: F811
+    endpoint, session, directory, cells = network
+    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,),
+                                          rrd=str(tmp_path / "c1.rrd"), recording_id="bounds")))
+    directory.wait_for(1, timeout=20)
+    for number in (2**63, 10**30, -1):
+        payload = b'{"kind":"insert","id":"n%d","part":"sh","hole":"br","experiment":%d}' % (abs(number), number)
+        reply = raw_query(session, "cell/c1/insert", payload)
+        assert isinstance(reply, ErrorReply) and reply.code == "malformed", reply
+        assert "at `$.experiment`" in reply.error
+    at_bounds = InsertRequest(id="x" * MAX_REQUEST_ID, part="sh", hole="br", experiment=MAX_COUNT, seed=2**32 - 1)
+    answer = request_insert(session, "c1", at_bounds, timeout=10)
+    assert isinstance(answer, InsertReply) and answer.result == "fit"
+    assert request_insert(session, "c1", InsertRequest(id="after", part="sh", hole="r1"), 10).result == "no_fit"
+    assert cells[0].popen.poll() is None

@@ -1,0 +1,105 @@
+"""A part the cell has no operation for is placed by hand: ``import`` still writes
+``geometry.toml`` (the part as its own mesh in ``[manual.<id>]`` with the reason), the
+plans mark its step ``(manual)``, ``session`` runs with the truth and the sim backends
+and the sim cell puts it where the CAD has it (fixed there); the truth backend answers from
+``sizes.lp`` where a product has no ``geometry.toml``."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.cli import main
+from assembly_constraints.executor.assembly.product import load_product
+from tests.cad.test_covers import _pegs_and_plate
+from tests.cad.test_mesh_import import _box
+from tests.conftest import Runner
+
+X_MM = 560.0
+"""Where the product stands along x [mm]: within the simulated arm's reach."""
+POSE_BOUND_MM = 2.0
+"""An assembled part is within this of its goal [mm] (the bar of the assembling cell)."""
+
+
+def _lid_on_pins(tmp_path: Path) -> Path:
+    """The plate with two square pegs in their holes and an 80 x 20 x 4 mm lid lying on the
+    peg tops (no pin passes through it, it rests on no cover), imported; the folder written."""
+    _pegs_and_plate(tmp_path / "cad", (X_MM, 0.0))
+    _box((80, 20, 4), (X_MM, 0, 37)).export(tmp_path / "cad" / "lid.stl")
+    (tmp_path / "import.toml").write_text("[parts.lid]\ntray = [0.30, 0.28]\n")
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out"), "--config",
+                 str(tmp_path / "import.toml")]) == 0
+    return tmp_path / "out"
+
+
+def _session(run_cli: Runner, folder: Path, out: Path, backend: str) -> dict:
+    done = run_cli("session", "--backend", backend, "--json", "--assemble", "--assembly", str(folder), "--out",
+                   str(out), timeout=240)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def test_a_part_on_pin_tops_is_written_to_be_placed_by_hand(tmp_path: Path,
+                                                           capsys: pytest.CaptureFixture[str]) -> None:
+    out = _lid_on_pins(tmp_path)
+    printed = capsys.readouterr().out
+    assert "manual lid: the cell has no operation for it, a plan's step places it by hand (part 'lid' is no peg" \
+        in printed and ", geometry.toml;" in printed
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    manual = geometry["manual"]["lid"]
+    assert "no pin passes through it" in manual["reason"]
+    assert manual["goal"] == pytest.approx([X_MM / 1000, 0.0, 0.035], abs=1e-6)  # its bottom face's centre
+    assert manual["mesh"]["file"] == "meshes/lid.obj" and "convex" not in manual["mesh"]  # static: no pieces
+    assert tomllib.loads((out / "assembly.toml").read_text())["parts"]["lid"]["role"] == "manual"
+    product = load_product(str(out))  # the cell's loader takes it
+    assert set(product.manual) == {"lid"} and product.manual["lid"].tray == (0.30, 0.28)
+    assembly = load_assembly(str(out))
+    assert assembly.step_text("lid", None) == "lid (manual)" and assembly.step_text("peg1", "h1") == "peg1->h1"
+
+
+@pytest.mark.slow
+def test_truth_sessions_run_with_a_part_placed_by_hand_and_without_geometry(
+        run_cli: Runner, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = _lid_on_pins(tmp_path)
+    capsys.readouterr()
+    result = _session(run_cli, out, tmp_path / "truth", "truth")
+    steps = {step["part"]: step for step in result["assembly"]["steps"]}
+    assert result["assembly"]["assembled"] and steps["lid"]["skill"] == "manual"
+    assert [s["part"] for s in result["plans"][0]][-1] == "lid"  # the pegs block its way out: it comes last
+    (out / "geometry.toml").unlink()  # a planner-only product: the truth backend answers from sizes.lp
+    bare = _session(run_cli, out, tmp_path / "bare", "truth")
+    assert bare["assembly"]["assembled"] and {tuple(p) for p in bare["fits"]} == {tuple(p) for p in result["fits"]}
+    assert {s["skill"] for s in bare["assembly"]["steps"]} == {"truth"}
+
+
+@pytest.mark.slow
+def test_a_sim_session_places_the_part_by_hand_where_the_cad_has_it(run_cli: Runner, tmp_path: Path) -> None:
+    out = _lid_on_pins(tmp_path)
+    done = run_cli("executor", "teach", "--assembly", str(out), timeout=240)
+    assert done.returncode == 0, done.stderr
+    report = _session(run_cli, out, tmp_path / "sim", "sim")["assembly"]
+    steps = {step["part"]: step for step in report["steps"]}
+    assert report["assembled"] and steps["lid"]["skill"] == "manual" and steps["lid"]["outcome"] == "fit"
+    assert set(report["final_pose_error_mm"]) == {"plate", "peg1", "peg2", "lid"}
+    assert max(report["final_pose_error_mm"].values()) <= POSE_BOUND_MM
+
+
+@pytest.mark.parametrize(("old", "new", "expected"), [
+    ("goal = [0.56, 0.0, 0.035]", "goal = [0.56, 0.0]", "[manual.lid] goal: expected [x, y, z] in metres"),
+    ('reason = "', 'reason = "" # ', "[manual.lid] reason: expected a non-empty text"),
+    ("[manual.lid]", "[manual.cap]", "[manual.cap]: expected a part of assembly.toml, got 'cap'"),
+])
+def test_a_bad_manual_table_is_one_line_naming_it(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                  old: str, new: str, expected: str) -> None:
+    out = _lid_on_pins(tmp_path)
+    text = (out / "geometry.toml").read_text()
+    assert old in text
+    (out / "geometry.toml").write_text(text.replace(old, new))
+    capsys.readouterr()
+    assert main(["executor", "sizes", "--assembly", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and expected in err, err

@@ -1,0 +1,103 @@
+"""Teaching checks its own result: a demonstration that does not reach its goal is
+refused (one line naming the part, the hole and the end error; no skill written), and a
+skill file is loaded only with the record of a teaching that reached its goal, so no
+trial reports a fit from a skill that did not fit."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.skills.dmp import load_skill, skill_path
+from assembly_constraints.executor.world.geometry import load_geometry
+
+
+@pytest.fixture
+def spare(tmp_path: Path, root: Path) -> Path:
+    """A copy of the spare-hole plate (round pegs p1 p2, square peg p3; holes r1 r2 r3 s1)."""
+    folder = tmp_path / "spare"
+    shutil.copytree(root / "data" / "spare", folder, ignore=shutil.ignore_patterns("assets"))
+    return folder
+
+
+def _edit_record(folder: Path, change: dict | None) -> Path:
+    """The square peg's skill file with its ``taught`` record updated by ``change`` (None: removed)."""
+    path = skill_path(folder, "square_peg")
+    data = json.loads(path.read_text())
+    if change is None:
+        del data["taught"]
+    else:
+        data["taught"].update(change)
+    path.write_text(json.dumps(data))
+    return path
+
+
+def test_every_shipped_skill_records_a_teaching_in_its_demonstration_hole() -> None:
+    for name in ("cranfield", "graded", "spare", "taskboard"):
+        geometry = load_geometry(name)
+        for part in geometry.parts.values():
+            taught = load_skill(geometry.folder, part.shape).taught
+            assert taught is not None and taught.reached
+            taught_part = geometry.parts[taught.part]
+            assert taught_part.shape == part.shape and taught.hole == taught_part.demo_hole
+            assert (taught.part_kind, taught.part_sides) == (taught_part.kind, taught_part.sides)
+
+
+def test_a_skill_file_without_its_record_is_refused(spare: Path) -> None:
+    path = _edit_record(spare, None)
+    with pytest.raises(ExecutorError, match="no record of its teaching") as refused:
+        load_skill(spare, "square_peg")
+    assert str(path) in str(refused.value) and "\n" not in str(refused.value)
+
+
+@pytest.mark.parametrize("change", [{"end_error": 0.0249, "hole": "r1", "hole_kind": "round"},
+                                    {"end_error": float("nan")}, {"end_error": "far"}, {"part_sides": [0.012]}])
+def test_a_skill_whose_teaching_failed_or_whose_record_is_bad_is_refused(spare: Path, change: dict) -> None:
+    path = _edit_record(spare, change)
+    with pytest.raises(ExecutorError) as refused:
+        load_skill(spare, "square_peg")
+    message = str(refused.value)
+    assert message.startswith(str(path)) and "\n" not in message
+    if change.get("end_error") == 0.0249:
+        assert "part p3 in hole r1: end error 24.9 mm, more than the 3.0 mm goal tolerance" in message
+
+
+@pytest.mark.slow
+def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(spare: Path, run_executor) -> None:
+    """The square peg (12 mm side, 17 mm diagonal) demonstrated in the round 13.3 mm hole r1
+    stops on its entry: refused, the shipped skills untouched; the trial with them says
+    what the physics does (no fit), and a trial with a skill recording such a teaching is
+    refused."""
+    geometry = spare / "geometry.toml"
+    geometry.write_text(geometry.read_text().replace('demo_hole = "s1"', 'demo_hole = "r1"'))
+    before = {path.name: path.read_bytes() for path in (spare / "demonstrations").iterdir()}
+    done = run_executor("teach", "--assembly", str(spare), timeout=120)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = [line for line in done.stderr.splitlines() if not line.startswith("pybullet build time")]
+    assert len(lines) == 1 and "teaching square_peg failed: part p3 in hole r1: end error" in lines[0], done.stderr
+    error_mm = float(lines[0].split("end error ")[1].split(" mm")[0])
+    assert error_mm > 20  # it stopped on the entry of the 25 mm deep hole
+    assert {path.name: path.read_bytes() for path in (spare / "demonstrations").iterdir()} == before
+    trial = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", "--json", timeout=120)
+    assert trial.returncode == 0, trial.stderr
+    assert json.loads(trial.stdout)["summary"]["no_fit"] == 1
+    path = _edit_record(spare, {"hole": "r1", "hole_kind": "round", "end_error": error_mm / 1000})  # as it was saved
+    refused = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", timeout=120)
+    lines = [line for line in refused.stderr.splitlines() if not line.startswith("pybullet build time")]
+    assert refused.returncode == 2 and len(lines) == 1 and not refused.stdout, refused.stdout + refused.stderr
+    assert lines[0].startswith(f"error: {path}: its demonstration did not reach its goal (part p3 in hole r1")
+
+
+def test_a_skill_moves_to_a_hole_s_bottom_from_the_depth_it_was_taught_at(spare: Path) -> None:
+    """The goal follows the depth the record gives, not the product's ``demo_hole`` as it
+    is now (which may have been edited since the teaching)."""
+    skill = load_skill(spare, "square_peg")
+    assert skill.taught is not None and skill.in_hole(skill.taught.depth) is skill
+    deeper = skill.in_hole(skill.taught.depth + 0.005)
+    assert deeper.end_position[2] == pytest.approx(skill.end_position[2] - 0.005, abs=1e-12)
+    assert deeper.demo_goal[2] == pytest.approx(skill.demo_goal[2] - 0.005, abs=1e-12)
+    assert deeper.taught == skill.taught
