@@ -134,6 +134,7 @@ def report(derived: Derived) -> list[str]:
             f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items()))
     for locator, pid in sorted(derived.dropped):
         lines.append(f"locating pair {locator}->{pid} dropped: the blocking needs {pid} before {locator}")
+    lines += derived.notes()
     lines.append("geometric precedence (A before B): " + (" ".join(
         f"{a}->{b} ({reason})" for (a, b), reason in sorted(derived.reasons.items())) or "none"))
     return lines

@@ -1,24 +1,45 @@
-"""Swept collision along a straight removal path, exact (no sampled poses).
+"""Swept collision along a straight removal path, exact (no sampled poses), with nominal
+zero-clearance fits sliding along their axis.
 
-A part moving by ``length`` along ``direction`` collides with a fixed part B exactly when
-some triangle of its boundary, swept along the path, meets B's interior (the sweep of a
-solid is bounded by the sweeps of its boundary triangles, and the two start apart). So
-the moving part is replaced by convex swept pieces: the convex hull of its start and end
-poses when the part is convex, else one prism per boundary triangle (the triangle and its
-translate). Each piece meets each fixed part's triangle mesh in python-fcl (GJK/EPA on
-the triangles its BVH keeps); a contact deeper than :data:`TOUCH` is a collision, so
-parts that only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
+**Exact sweep.** A body (one part, or parts fixed to each other) moving by ``length``
+along ``direction`` collides with a fixed part B exactly when some triangle of its
+boundary, swept along the path, meets B's interior (the sweep of a solid is bounded by
+the sweeps of its boundary triangles, and the two start apart). Each swept triangle is a
+convex prism (the triangle and its translate) tested against B's triangle BVH in
+python-fcl (GJK/EPA); a contact deeper than :data:`TOUCH` is a collision, so parts that
+only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
 
-:attr:`Sweeper.queries` counts the narrow-phase queries (one moving piece set against one
-fixed part whose bounding box meets the sweep's).
+**Conservative first.** Penetration depth only grows with the moving set, so a convex
+superset that meets B no deeper than :data:`TOUCH` clears every prism inside it: first the
+sweep of the part's convex hull (one query: the answer for a convex part), then the
+sweeps of the hulls of :data:`CHUNK` nearby triangles whose swept box meets B's box, and
+the prisms only of the chunks that still meet B. Same answer as testing every prism.
+
+**Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
+one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
+the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth regions
+whose normals are all perpendicular to one axis and whose vertices lie on one circle);
+an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
+radius within the pair's tolerance (the larger deflection of the two faces plus
+:data:`TOUCH`), are a fit. Swept along its axis against the bore's part, the shaft's part
+is taken thinner there (its vertices within the tolerance of that radius moved towards
+the axis by the bore's deflection, the radii's and the axes' difference and
+:data:`TOUCH`): overlap below the tolerance across the axis is not a collision, every
+other face (a shoulder, an end wall) still is.
+
+:attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
+part whose bounding box meets the sweep's).
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from dataclasses import dataclass
+
 import fcl
 import numpy as np
 import trimesh
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, QhullError
 
 TOUCH = 1e-5
 """Contacts at most this deep [m] are touching, not colliding (10 µm: below every
@@ -28,12 +49,136 @@ DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
 }
 """The removal directions tried, in order of preference (the cell inserts from above)."""
+CHUNK = 48
+"""Triangles per chunk of the conservative test (nearby ones: a median split of their centres)."""
+SMOOTH = np.radians(35.0)
+"""Adjacent triangles meeting at less than this angle are one smooth face (a 12-gon's is 30°)."""
+_MAX_CONTACTS = 100_000
 
 
 def opposite(direction: str) -> str:
     """The name of the direction opposite ``direction`` (a removal direction's insertion axis)."""
-    return ("-" if direction[0] == "+" else "+") + direction[1]
-_MAX_CONTACTS = 100_000
+    return ("-" if direction[0] == "+" else "+") + direction[1:]
+
+
+def axis_name(vector: np.ndarray) -> str:
+    """A direction's name: ``+x`` ... for the axes of :data:`DIRECTIONS`, else
+    ``+(x,y,z)`` with the unit vector's components (the sign of its first nonzero one)."""
+    for name, known in DIRECTIONS.items():
+        if np.dot(vector, known) > 1 - 1e-9:
+            return name
+    first = vector[np.flatnonzero(np.abs(vector) > 1e-9)[0]]
+    unit = vector if first > 0 else -vector
+    return ("+" if first > 0 else "-") + "(" + ",".join(f"{c:.4f}" for c in unit) + ")"
+
+
+@dataclass(frozen=True)
+class CylinderFace:
+    """A cylindrical face fitted on a mesh: a ``point`` on its axis and the unit axis
+    ``direction`` [m], the ``radius`` [m], the ``span`` of its vertices along the axis
+    [m] (projections on ``direction``), ``outward`` (a shaft's face; False: a bore's) and
+    the ``deflection`` [m]: the largest distance of one of its triangles from the circle."""
+
+    point: np.ndarray
+    direction: np.ndarray
+    radius: float
+    span: tuple[float, float]
+    outward: bool
+    deflection: float
+
+
+def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
+    """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
+    six triangles whose normals are perpendicular to one axis (within 1e-3) and span more
+    than a flat face's, whose vertices lie on one circle (within 1 µm plus 1e-4 of the
+    radius) and whose normals all point away from the axis or all towards it."""
+    angles = mesh.face_adjacency_angles
+    regions = trimesh.graph.connected_components(mesh.face_adjacency[angles < SMOOTH], min_len=6)
+    faces: list[CylinderFace] = []
+    for region in regions:
+        normals = mesh.face_normals[region]
+        scatter = normals.T @ normals / len(region)
+        values, vectors = np.linalg.eigh(scatter)
+        axis = vectors[:, 0]
+        if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > 1e-3:
+            continue  # flat, or no cylinder (a cone, a sphere)
+        ring = np.unique(mesh.faces[region].ravel())
+        frame = np.linalg.svd(axis[None, :])[2][1:]  # two unit vectors across the axis
+        flat = mesh.vertices[ring] @ frame.T
+        design = np.column_stack([2 * flat, np.ones(len(flat))])
+        solution = np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0]
+        centre = solution[:2]
+        radius = float(np.sqrt(solution[2] + centre @ centre))
+        if not np.all(np.abs(np.linalg.norm(flat - centre, axis=1) - radius) <= 1e-6 + 1e-4 * radius):
+            continue
+        point = centre @ frame
+        outwards = np.einsum("ij,ij->i", normals, (mesh.triangles_center[region] @ frame.T - centre) @ frame)
+        if not (np.all(outwards > 0) or np.all(outwards < 0)):
+            continue
+        reach = np.abs(np.einsum("ij,ij->i", normals, mesh.vertices[mesh.faces[region, 0]] - point))
+        along = mesh.vertices[ring] @ axis
+        faces.append(CylinderFace(point, axis, radius, (float(along.min()), float(along.max())),
+                                  bool(outwards[0] > 0), float(np.max(radius - reach))))
+    return faces
+
+
+@dataclass(frozen=True)
+class Slide:
+    """A nominal zero-clearance fit: part ``shaft``'s outward ``face`` in part ``bore``'s
+    inward one, coaxial and of equal radius within ``tolerance`` [m]; along the axis the
+    shaft's part is swept (or met) ``thinner`` [m] there (module docstring)."""
+
+    shaft: str
+    bore: str
+    face: CylinderFace
+    tolerance: float
+    thinner: float
+
+    @property
+    def direction(self) -> np.ndarray:
+        return self.face.direction
+
+
+def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
+    """Every pair of an outward face of one part and an inward face of another, parallel
+    (within 1e-4 rad), coaxial and of equal radius within their tolerance, whose spans
+    along the axis overlap by more than it."""
+    found: list[Slide] = []
+    for shaft, outer in faces.items():
+        for bore, inner in faces.items():
+            if bore == shaft:
+                continue
+            for a in (f for f in outer if f.outward):
+                for b in (f for f in inner if not f.outward):
+                    tolerance = max(a.deflection, b.deflection) + TOUCH
+                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
+                            or abs(a.radius - b.radius) > tolerance):
+                        continue
+                    offset = b.point - a.point
+                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
+                    low, high = (b.span if a.direction @ b.direction > 0 else (-b.span[1], -b.span[0]))
+                    if apart > tolerance or min(a.span[1], high) - max(a.span[0], low) <= tolerance:
+                        continue
+                    thinner = max(0.0, a.radius - b.radius) + b.deflection + apart + TOUCH
+                    found.append(Slide(shaft, bore, a, tolerance, thinner))
+    return found
+
+
+def thinned(mesh: trimesh.Trimesh, slides: Iterable[Slide]) -> trimesh.Trimesh:
+    """``mesh`` with the vertices of each slide's shaft face (within its tolerance of the
+    radius, within its span) moved ``thinner`` towards the axis."""
+    vertices = np.array(mesh.vertices, dtype=float)
+    for slide in slides:
+        face = slide.face
+        relative = vertices - face.point
+        along = relative @ face.direction
+        radial = relative - np.outer(along, face.direction)
+        distance = np.linalg.norm(radial, axis=1)
+        near = ((np.abs(distance - face.radius) <= slide.tolerance)
+                & (along >= face.span[0] - slide.tolerance) & (along <= face.span[1] + slide.tolerance))
+        scale = np.maximum(distance[near] - slide.thinner, 0.0) / distance[near]
+        vertices[near] = face.point + np.outer(along[near], face.direction) + radial[near] * scale[:, None]
+    return trimesh.Trimesh(vertices, mesh.faces, process=False)
 
 
 def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
@@ -56,48 +201,100 @@ def _convex(vertices: np.ndarray, count: int, flat: np.ndarray) -> fcl.Collision
     return fcl.CollisionObject(fcl.Convex(np.asarray(vertices, dtype=float), count, flat), fcl.Transform())
 
 
+def _hull_piece(points: np.ndarray) -> fcl.CollisionObject | None:
+    """The convex hull of ``points`` [m] as an fcl shape (its vertices only); None when the
+    points span no volume (the caller then tests the prisms)."""
+    try:
+        hull = ConvexHull(points)
+    except QhullError:
+        return None
+    used, faces = np.unique(hull.simplices, return_inverse=True)
+    flat = np.hstack([np.full((len(hull.simplices), 1), 3), faces.reshape(-1, 3)]).astype(np.int32).ravel()
+    return _convex(points[used], len(hull.simplices), flat)
+
+
 _PRISM_FACES = np.array([3, 0, 2, 1, 3, 3, 4, 5, 4, 0, 1, 4, 3, 4, 1, 2, 5, 4, 4, 2, 0, 3, 5], dtype=np.int32)
 """A triangle (0 1 2) and its translate (3 4 5): two triangles and three quads."""
 
 
-def swept_pieces(mesh: trimesh.Trimesh, shift: np.ndarray) -> list[fcl.CollisionObject]:
-    """Convex pieces whose union's boundary contains the sweep of ``mesh`` by ``shift`` [m]."""
-    if mesh.is_convex:
-        points = np.vstack([mesh.vertices, mesh.vertices + shift])
-        hull = ConvexHull(points)
-        flat = np.hstack([np.full((len(hull.simplices), 1), 3), hull.simplices]).astype(np.int32).ravel()
-        return [_convex(points, len(hull.simplices), flat)]
-    return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in mesh.triangles]
+def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[fcl.CollisionObject]:
+    """The prisms of ``triangles`` (n, 3, 3) [m] swept by ``shift`` [m]."""
+    return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in triangles]
+
+
+def _chunks(mesh: trimesh.Trimesh) -> list[np.ndarray]:
+    """The triangles of ``mesh`` in groups of at most :data:`CHUNK` nearby ones (median
+    splits of their centres along their widest extent)."""
+    centres = mesh.triangles_center
+    pending, done = [np.arange(len(mesh.faces))], []
+    while pending:
+        group = pending.pop()
+        if len(group) <= CHUNK:
+            done.append(group)
+            continue
+        spread = np.ptp(centres[group], axis=0)
+        order = group[np.argsort(centres[group, int(np.argmax(spread))], kind="stable")]
+        pending += [order[:len(order) // 2], order[len(order) // 2:]]
+    return done
+
+
+class _Solid:
+    """One part's mesh for the sweeps: its BVH, hull vertices and chunks (made on first use)."""
+
+    def __init__(self, mesh: trimesh.Trimesh) -> None:
+        self.mesh = mesh
+        self._bvh: fcl.CollisionObject | None = None
+        self._chunks: list[np.ndarray] | None = None
+        self.hull = np.asarray(mesh.convex_hull.vertices, dtype=float)
+        self.convex = bool(mesh.is_convex)
+
+    @property
+    def bvh(self) -> fcl.CollisionObject:
+        if self._bvh is None:
+            self._bvh = bvh(self.mesh)
+        return self._bvh
+
+    @property
+    def chunks(self) -> list[np.ndarray]:
+        if self._chunks is None:
+            self._chunks = _chunks(self.mesh)
+        return self._chunks
 
 
 class Sweeper:
-    """The fixed parts' collision meshes, and swept tests of one part against them."""
+    """The parts' collision meshes, and swept tests of one body against the others;
+    ``slides`` the zero-clearance fits among them."""
 
-    def __init__(self, meshes: dict[str, trimesh.Trimesh]) -> None:
+    def __init__(self, meshes: dict[str, trimesh.Trimesh], slides: Iterable[Slide] = ()) -> None:
         self.meshes = meshes
-        self._objects = {pid: bvh(mesh) for pid, mesh in meshes.items()}
+        self._solids = {pid: _Solid(mesh) for pid, mesh in meshes.items()}
+        self._slides: dict[tuple[str, str], list[Slide]] = {}
+        for slide in slides:
+            self._slides.setdefault((slide.shaft, slide.bore), []).append(slide)
+        self._thinned: dict[tuple[str, str, str], _Solid] = {}
         self.queries = 0
         """Narrow-phase queries made so far."""
 
-    def blockers(self, part: str, direction: np.ndarray, length: float) -> set[str]:
-        """The other parts that ``part`` collides with when moved by ``length`` [m] along
-        the unit vector ``direction``, everything else fixed."""
-        mesh = self.meshes[part]
+    def blockers(self, body: str | Iterable[str], direction: np.ndarray, length: float) -> set[str]:
+        """The other parts that the part (or the parts, moved together) ``body`` collides
+        with when moved by ``length`` [m] along the unit vector ``direction``, everything
+        else fixed."""
+        members = {body} if isinstance(body, str) else set(body)
         shift = np.asarray(direction, dtype=float) * length
-        low = np.minimum(mesh.bounds[0], mesh.bounds[0] + shift)
-        high = np.maximum(mesh.bounds[1], mesh.bounds[1] + shift)
-        pieces: list[fcl.CollisionObject] | None = None
         hit: set[str] = set()
-        for other, other_mesh in self.meshes.items():
-            if other == part:
-                continue
-            if np.any(np.minimum(high, other_mesh.bounds[1]) - np.maximum(low, other_mesh.bounds[0]) <= TOUCH):
-                continue
-            if pieces is None:
-                pieces = swept_pieces(mesh, shift)
-            self.queries += 1
-            if self._meets(pieces, self._objects[other]):
-                hit.add(other)
+        for member in sorted(members):
+            mesh = self.meshes[member]
+            low = np.minimum(mesh.bounds[0], mesh.bounds[0] + shift)
+            high = np.maximum(mesh.bounds[1], mesh.bounds[1] + shift)
+            for other, other_mesh in self.meshes.items():
+                if other in members or other in hit:
+                    continue
+                if np.any(np.minimum(high, other_mesh.bounds[1]) - np.maximum(low, other_mesh.bounds[0]) <= TOUCH):
+                    continue
+                self.queries += 1
+                moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
+                if _collides(moving, fixed, shift):
+                    hit.add(other)
         return hit
 
     def touching(self, a: str, b: str) -> bool:
@@ -105,19 +302,54 @@ class Sweeper:
         request = fcl.DistanceRequest()
         result = fcl.DistanceResult()
         self.queries += 1
-        return bool(fcl.distance(self._objects[a], self._objects[b], request, result) <= TOUCH)
+        return bool(fcl.distance(self._solids[a].bvh, self._solids[b].bvh, request, result) <= TOUCH)
 
-    @staticmethod
-    def _meets(pieces: list[fcl.CollisionObject], fixed: fcl.CollisionObject) -> bool:
-        """Whether a piece meets ``fixed`` deeper than :data:`TOUCH`: a first query without
-        contacts, the contacts' depths only for the pieces that meet at all."""
-        first = fcl.CollisionRequest()
-        deep = fcl.CollisionRequest(num_max_contacts=_MAX_CONTACTS, enable_contact=True)
-        for piece in pieces:
-            if not fcl.collide(piece, fixed, first, fcl.CollisionResult()):
-                continue
-            result = fcl.CollisionResult()
-            fcl.collide(piece, fixed, deep, result)
-            if any(contact.penetration_depth > TOUCH for contact in result.contacts):
-                return True
+    def _solid(self, part: str, against: str, shift: np.ndarray) -> _Solid:
+        """``part``'s solid for a sweep by ``shift`` against (or of) ``against``: thinned
+        at the zero-clearance fits of ``part``'s shafts in ``against``'s bores along the shift."""
+        unit = shift / np.linalg.norm(shift)
+        slides = [s for s in self._slides.get((part, against), []) if abs(float(unit @ s.direction)) > 1 - 1e-9]
+        if not slides:
+            return self._solids[part]
+        key = (part, against, axis_name(slides[0].direction))
+        if key not in self._thinned:
+            self._thinned[key] = _Solid(thinned(self.meshes[part], slides))
+        return self._thinned[key]
+
+
+def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
+    """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
+    (the module docstring: hull, chunks, prisms)."""
+    whole = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
+    if whole is not None and not _meets([whole], fixed.bvh):
         return False
+    if moving.convex and whole is not None:
+        return True
+    low, high = fixed.mesh.bounds
+    for chunk in moving.chunks:
+        corners = moving.mesh.vertices[np.unique(moving.mesh.faces[chunk])]
+        start, end = corners.min(axis=0), corners.max(axis=0)
+        if np.any(np.minimum(np.maximum(end, end + shift), high)
+                  - np.maximum(np.minimum(start, start + shift), low) <= TOUCH):
+            continue
+        piece = _hull_piece(np.vstack([corners, corners + shift]))
+        if piece is not None and not _meets([piece], fixed.bvh):
+            continue
+        if _meets(swept_pieces(moving.mesh.triangles[chunk], shift), fixed.bvh):
+            return True
+    return False
+
+
+def _meets(pieces: list[fcl.CollisionObject], fixed: fcl.CollisionObject) -> bool:
+    """Whether a piece meets ``fixed`` deeper than :data:`TOUCH`: a first query without
+    contacts, the contacts' depths only for the pieces that meet at all."""
+    first = fcl.CollisionRequest()
+    deep = fcl.CollisionRequest(num_max_contacts=_MAX_CONTACTS, enable_contact=True)
+    for piece in pieces:
+        if not fcl.collide(piece, fixed, first, fcl.CollisionResult()):
+            continue
+        result = fcl.CollisionResult()
+        fcl.collide(piece, fixed, deep, result)
+        if any(contact.penetration_depth > TOUCH for contact in result.contacts):
+            return True
+    return False
