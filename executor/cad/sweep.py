@@ -11,9 +11,10 @@ only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
 
 **Conservative first.** Penetration depth only grows with the moving set, so a convex
 superset that meets B no deeper than :data:`TOUCH` clears every prism inside it: first the
-sweep of the part's convex hull (one query: the answer for a convex part), then the
-sweeps of the hulls of :data:`CHUNK` nearby triangles whose swept box meets B's box, and
-the prisms only of the chunks that still meet B. Same answer as testing every prism.
+sweep of the part's convex hull (one query: the answer for a convex part), then down a
+tree of the part's triangles (halves of nearby ones): a node whose swept box misses B's
+box, or whose swept hull clears B, is done; the prisms are tested only in leaves of
+:data:`CHUNK` triangles that still meet B. Same answer as testing every prism.
 
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
@@ -49,8 +50,11 @@ DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
 }
 """The removal directions tried, in order of preference (the cell inserts from above)."""
-CHUNK = 48
-"""Triangles per chunk of the conservative test (nearby ones: a median split of their centres)."""
+CHUNK = 8
+"""Triangles of a leaf of the conservative test's tree (nearby ones: median splits of their centres)."""
+HULL_POINTS = 96
+"""Sets of more points are not hulled for the conservative test (fcl's cost grows with them):
+their halves are."""
 SMOOTH = np.radians(35.0)
 """Adjacent triangles meeting at less than this angle are one smooth face (a 12-gon's is 30°)."""
 _MAX_CONTACTS = 100_000
@@ -125,12 +129,13 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
 @dataclass(frozen=True)
 class Slide:
     """A nominal zero-clearance fit: part ``shaft``'s outward ``face`` in part ``bore``'s
-    inward one, coaxial and of equal radius within ``tolerance`` [m]; along the axis the
-    shaft's part is swept (or met) ``thinner`` [m] there (module docstring)."""
+    inward face ``hole``, coaxial and of equal radius within ``tolerance`` [m]; along the
+    axis the shaft's part is swept (or met) ``thinner`` [m] there (module docstring)."""
 
     shaft: str
     bore: str
     face: CylinderFace
+    hole: CylinderFace
     tolerance: float
     thinner: float
 
@@ -160,25 +165,37 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
                     if apart > tolerance or min(a.span[1], high) - max(a.span[0], low) <= tolerance:
                         continue
                     thinner = max(0.0, a.radius - b.radius) + b.deflection + apart + TOUCH
-                    found.append(Slide(shaft, bore, a, tolerance, thinner))
+                    found.append(Slide(shaft, bore, a, b, tolerance, thinner))
     return found
 
 
-def thinned(mesh: trimesh.Trimesh, slides: Iterable[Slide]) -> trimesh.Trimesh:
-    """``mesh`` with the vertices of each slide's shaft face (within its tolerance of the
-    radius, within its span) moved ``thinner`` towards the axis."""
+def _near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius, within its
+    span), their coordinates along the axis and their radial offsets from it."""
+    relative = points - face.point
+    along = relative @ face.direction
+    radial = relative - np.outer(along, face.direction)
+    distance = np.linalg.norm(radial, axis=1)
+    near = ((np.abs(distance - face.radius) <= tolerance)
+            & (along >= face.span[0] - tolerance) & (along <= face.span[1] + tolerance))
+    return near, along, radial
+
+
+def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide]) -> trimesh.Trimesh:
+    """``mesh`` as swept along the axis of its zero-clearance fits: its vertices on each
+    of ``shafts``' faces moved ``thinner`` towards the axis, and the triangles of those
+    faces and of ``bores``' holes (the mated surfaces) left out, whose sliding on each
+    other is the fit; what meets them meets the part's other triangles first."""
     vertices = np.array(mesh.vertices, dtype=float)
-    for slide in slides:
-        face = slide.face
-        relative = vertices - face.point
-        along = relative @ face.direction
-        radial = relative - np.outer(along, face.direction)
-        distance = np.linalg.norm(radial, axis=1)
-        near = ((np.abs(distance - face.radius) <= slide.tolerance)
-                & (along >= face.span[0] - slide.tolerance) & (along <= face.span[1] + slide.tolerance))
-        scale = np.maximum(distance[near] - slide.thinner, 0.0) / distance[near]
-        vertices[near] = face.point + np.outer(along[near], face.direction) + radial[near] * scale[:, None]
-    return trimesh.Trimesh(vertices, mesh.faces, process=False)
+    mated = np.zeros(len(mesh.faces), dtype=bool)
+    for slide, face in [*((s, s.face) for s in shafts), *((s, s.hole) for s in bores)]:
+        near, along, radial = _near(np.asarray(mesh.vertices), face, slide.tolerance)
+        mated |= np.all(near[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < 1e-3)
+        if face is slide.face:
+            distance = np.linalg.norm(radial[near], axis=1)
+            scale = np.maximum(distance - slide.thinner, 0.0) / distance
+            vertices[near] = face.point + np.outer(along[near], face.direction) + radial[near] * scale[:, None]
+    return trimesh.Trimesh(vertices, mesh.faces[~mated], process=False)
 
 
 def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
@@ -222,31 +239,43 @@ def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[fcl.Collision
     return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in triangles]
 
 
-def _chunks(mesh: trimesh.Trimesh) -> list[np.ndarray]:
-    """The triangles of ``mesh`` in groups of at most :data:`CHUNK` nearby ones (median
-    splits of their centres along their widest extent)."""
+@dataclass
+class _Node:
+    """Nearby triangles of a mesh (``faces``, their ``points`` [m]) and the two halves they
+    split into (none: at most :data:`CHUNK` triangles)."""
+
+    faces: np.ndarray
+    points: np.ndarray
+    children: list[_Node]
+
+
+def _tree(mesh: trimesh.Trimesh) -> _Node:
+    """The triangles of ``mesh`` split in halves (at the median of their centres along
+    their widest extent) down to :data:`CHUNK` triangles."""
     centres = mesh.triangles_center
-    pending, done = [np.arange(len(mesh.faces))], []
-    while pending:
-        group = pending.pop()
+
+    def node(group: np.ndarray) -> _Node:
+        points = mesh.vertices[np.unique(mesh.faces[group])]
         if len(group) <= CHUNK:
-            done.append(group)
-            continue
-        spread = np.ptp(centres[group], axis=0)
-        order = group[np.argsort(centres[group, int(np.argmax(spread))], kind="stable")]
-        pending += [order[:len(order) // 2], order[len(order) // 2:]]
-    return done
+            return _Node(group, points, [])
+        order = group[np.argsort(centres[group, int(np.argmax(np.ptp(centres[group], axis=0)))], kind="stable")]
+        return _Node(group, points, [node(order[:len(order) // 2]), node(order[len(order) // 2:])])
+
+    return node(np.arange(len(mesh.faces)))
 
 
 class _Solid:
-    """One part's mesh for the sweeps: its BVH, hull vertices and chunks (made on first use)."""
+    """One part's mesh for the sweeps: its BVH, hull vertices and triangle tree (made on first use)."""
 
-    def __init__(self, mesh: trimesh.Trimesh) -> None:
+    def __init__(self, mesh: trimesh.Trimesh, convex: bool | None = None) -> None:
+        """``convex``: whether the part is (None: ``mesh`` is the closed part, tested)."""
         self.mesh = mesh
         self._bvh: fcl.CollisionObject | None = None
-        self._chunks: list[np.ndarray] | None = None
-        self.hull = np.asarray(mesh.convex_hull.vertices, dtype=float)
-        self.convex = bool(mesh.is_convex)
+        self._tree: _Node | None = None
+        self.pieces: dict[tuple[float, ...], dict[int, fcl.CollisionObject | None]] = {}
+        """Shift -> tree node (its id) -> its swept hull, kept for the other parts' tests."""
+        self.hull = np.asarray(mesh.vertices[ConvexHull(mesh.vertices).vertices], dtype=float)
+        self.convex = bool(mesh.is_convex) if convex is None else convex
 
     @property
     def bvh(self) -> fcl.CollisionObject:
@@ -255,10 +284,10 @@ class _Solid:
         return self._bvh
 
     @property
-    def chunks(self) -> list[np.ndarray]:
-        if self._chunks is None:
-            self._chunks = _chunks(self.mesh)
-        return self._chunks
+    def tree(self) -> _Node:
+        if self._tree is None:
+            self._tree = _tree(self.mesh)
+        return self._tree
 
 
 class Sweeper:
@@ -271,7 +300,7 @@ class Sweeper:
         self._slides: dict[tuple[str, str], list[Slide]] = {}
         for slide in slides:
             self._slides.setdefault((slide.shaft, slide.bore), []).append(slide)
-        self._thinned: dict[tuple[str, str, str], _Solid] = {}
+        self._slid: dict[tuple[str, str, str], _Solid] = {}
         self.queries = 0
         """Narrow-phase queries made so far."""
 
@@ -293,7 +322,11 @@ class Sweeper:
                     continue
                 self.queries += 1
                 moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
-                if _collides(moving, fixed, shift):
+                if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
+                    moving, fixed, reverse = fixed, moving, -shift  # the same relative motion, cheaper
+                else:
+                    reverse = shift
+                if _collides(moving, fixed, reverse):
                     hit.add(other)
         return hit
 
@@ -305,37 +338,49 @@ class Sweeper:
         return bool(fcl.distance(self._solids[a].bvh, self._solids[b].bvh, request, result) <= TOUCH)
 
     def _solid(self, part: str, against: str, shift: np.ndarray) -> _Solid:
-        """``part``'s solid for a sweep by ``shift`` against (or of) ``against``: thinned
-        at the zero-clearance fits of ``part``'s shafts in ``against``'s bores along the shift."""
+        """``part``'s solid for a sweep by ``shift`` against (or of) ``against``: at their
+        zero-clearance fits along the shift, :func:`slid`."""
         unit = shift / np.linalg.norm(shift)
-        slides = [s for s in self._slides.get((part, against), []) if abs(float(unit @ s.direction)) > 1 - 1e-9]
-        if not slides:
+
+        def along(slides: list[Slide]) -> list[Slide]:
+            return [s for s in slides if abs(float(unit @ s.direction)) > 1 - 1e-9]
+
+        shafts, bores = along(self._slides.get((part, against), [])), along(self._slides.get((against, part), []))
+        if not shafts and not bores:
             return self._solids[part]
-        key = (part, against, axis_name(slides[0].direction))
-        if key not in self._thinned:
-            self._thinned[key] = _Solid(thinned(self.meshes[part], slides))
-        return self._thinned[key]
+        key = (part, against, axis_name(unit)[1:])
+        if key not in self._slid:
+            self._slid[key] = _Solid(slid(self.meshes[part], shafts, bores), self._solids[part].convex)
+        return self._slid[key]
 
 
 def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
     """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
-    (the module docstring: hull, chunks, prisms)."""
-    whole = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
-    if whole is not None and not _meets([whole], fixed.bvh):
-        return False
-    if moving.convex and whole is not None:
-        return True
+    (the module docstring: the hull, then down the triangle tree, the prisms of a leaf last)."""
+    if moving.convex or len(moving.hull) <= HULL_POINTS:
+        whole = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
+        if whole is not None and not _meets([whole], fixed.bvh):
+            return False
+        if whole is not None and moving.convex:
+            return True
     low, high = fixed.mesh.bounds
-    for chunk in moving.chunks:
-        corners = moving.mesh.vertices[np.unique(moving.mesh.faces[chunk])]
-        start, end = corners.min(axis=0), corners.max(axis=0)
+    pieces = moving.pieces.setdefault(tuple(shift), {})
+    pending = [moving.tree]
+    while pending:
+        node = pending.pop()
+        start, end = node.points.min(axis=0), node.points.max(axis=0)
         if np.any(np.minimum(np.maximum(end, end + shift), high)
                   - np.maximum(np.minimum(start, start + shift), low) <= TOUCH):
             continue
-        piece = _hull_piece(np.vstack([corners, corners + shift]))
-        if piece is not None and not _meets([piece], fixed.bvh):
-            continue
-        if _meets(swept_pieces(moving.mesh.triangles[chunk], shift), fixed.bvh):
+        if len(node.points) <= HULL_POINTS:
+            if id(node) not in pieces:
+                pieces[id(node)] = _hull_piece(np.vstack([node.points, node.points + shift]))
+            piece = pieces[id(node)]
+            if piece is not None and not _meets([piece], fixed.bvh):
+                continue
+        if node.children:
+            pending += node.children
+        elif _meets(swept_pieces(moving.mesh.triangles[node.faces], shift), fixed.bvh):
             return True
     return False
 
