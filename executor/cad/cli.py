@@ -193,6 +193,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None, reach: 
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
+    assumed += derived.assumptions()
     mapped = map_product(derived, settings)
     _, why = write_folder(derived, mapped, settings, source.stem, out)
     return Imported(derived, mapped, assumed, why, time.perf_counter() - started)

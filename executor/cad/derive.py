@@ -127,6 +127,14 @@ class Derived:
         """The directions ``part`` leaves the whole product along."""
         return [d for d in self.directions if not self.blockers[(part, d)]]
 
+    def assumptions(self) -> list[str]:
+        """The stated assumptions of the disassembly, as ``import`` prints them."""
+        largest = max((s.tolerance for s in self.slides), default=0.0)
+        return ["the support rule: a part resting on parts other than the base goes after them",
+                "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
+                f"plus 10 µm slide along their axis ({len(self.slides)} found"
+                + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
+
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""

@@ -273,7 +273,7 @@ class _Solid:
         self._bvh: fcl.CollisionObject | None = None
         self._tree: _Node | None = None
         self.pieces: dict[tuple[float, ...], dict[int, fcl.CollisionObject | None]] = {}
-        """Shift -> tree node (its id) -> its swept hull, kept for the other parts' tests."""
+        """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
         self.hull = np.asarray(mesh.vertices[ConvexHull(mesh.vertices).vertices], dtype=float)
         self.convex = bool(mesh.is_convex) if convex is None else convex
 
@@ -357,14 +357,16 @@ class Sweeper:
 def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
     """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
     (the module docstring: the hull, then down the triangle tree, the prisms of a leaf last)."""
+    pieces = moving.pieces.setdefault(tuple(shift), {})
     if moving.convex or len(moving.hull) <= HULL_POINTS:
-        whole = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
+        if -1 not in pieces:
+            pieces[-1] = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
+        whole = pieces[-1]
         if whole is not None and not _meets([whole], fixed.bvh):
             return False
         if whole is not None and moving.convex:
             return True
     low, high = fixed.mesh.bounds
-    pieces = moving.pieces.setdefault(tuple(shift), {})
     pending = [moving.tree]
     while pending:
         node = pending.pop()
