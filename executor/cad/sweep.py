@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import fcl
 import numpy as np
 import trimesh
-from scipy.spatial import ConvexHull, QhullError
+from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
 TOUCH = 1e-5
 """Contacts at most this deep [m] are touching, not colliding (10 µm: below every
@@ -265,6 +265,40 @@ def _tree(mesh: trimesh.Trimesh) -> _Node:
     return node(np.arange(len(mesh.faces)))
 
 
+def _is_convex(mesh: trimesh.Trimesh) -> bool:
+    """Whether the closed ``mesh`` is convex: no concave edge (trimesh's test, whose
+    tolerance passes the fine facets of a bore) and its hull's volume its own (within 1e-6)."""
+    return bool(mesh.is_convex) and mesh.convex_hull.volume - abs(mesh.volume) <= 1e-6 * mesh.convex_hull.volume
+
+
+def _outer_hull(points: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The vertices of the convex hull of ``points`` [m] when it has at most
+    :data:`HULL_POINTS` (tried for at most four times as many points), else of a polytope
+    around it of fewer (its supporting planes along the 26 directions of a cube's faces,
+    edges and corners and, around each axis of the frame, as many as keep a cylinder about
+    that axis within :data:`TOUCH` / 2), and whether it is the hull itself."""
+    hull = points
+    if len(points) <= 4 * HULL_POINTS:
+        hull = points[ConvexHull(points).vertices]
+        if len(hull) <= HULL_POINTS:
+            return hull, True
+    centre = hull.mean(axis=0)
+    cube = np.array([v for v in np.ndindex(3, 3, 3) if v != (1, 1, 1)], dtype=float) - 1
+    normals = [cube / np.linalg.norm(cube, axis=1)[:, None]]
+    for axis in range(3):
+        across = np.delete(hull - centre, axis, axis=1)
+        radius = float(np.max(np.linalg.norm(across, axis=1)))
+        count = min(256, int(np.ceil(np.pi / np.arccos(radius / (radius + TOUCH / 2)))))
+        turn = np.linspace(0, 2 * np.pi, count, endpoint=False)
+        ring = np.zeros((count, 3))
+        ring[:, [k for k in range(3) if k != axis]] = np.column_stack([np.cos(turn), np.sin(turn)])
+        normals.append(ring)
+    planes = np.vstack(normals)
+    offsets = np.max((hull - centre) @ planes.T, axis=0)
+    corners = HalfspaceIntersection(np.column_stack([planes, -offsets]), np.zeros(3)).intersections
+    return corners + centre, False
+
+
 class _Solid:
     """One part's mesh for the sweeps: its BVH, hull vertices and triangle tree (made on first use)."""
 
@@ -275,8 +309,9 @@ class _Solid:
         self._tree: _Node | None = None
         self.pieces: dict[tuple[float, ...], dict[int, fcl.CollisionObject | None]] = {}
         """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
-        self.hull = np.asarray(mesh.vertices[ConvexHull(mesh.vertices).vertices], dtype=float)
-        self.convex = bool(mesh.is_convex) if convex is None else convex
+        self.hull, self.exact = _outer_hull(np.asarray(mesh.vertices, dtype=float))
+        """A convex superset's vertices [m] and whether it is the hull itself."""
+        self.convex = _is_convex(mesh) if convex is None else convex
 
     @property
     def bvh(self) -> fcl.CollisionObject:
@@ -359,13 +394,13 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
     """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
     (the module docstring: the hull, then down the triangle tree, the prisms of a leaf last)."""
     pieces = moving.pieces.setdefault(tuple(shift), {})
-    if moving.convex or len(moving.hull) <= HULL_POINTS:
+    if moving.convex or moving.exact:
         if -1 not in pieces:
             pieces[-1] = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
         whole = pieces[-1]
         if whole is not None and not _meets([whole], fixed.bvh):
             return False
-        if whole is not None and moving.convex:
+        if whole is not None and moving.convex and moving.exact:
             return True
     low, high = fixed.mesh.bounds
     pending = [moving.tree]
