@@ -151,6 +151,7 @@ def report(derived: Derived) -> list[str]:
             f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items()))
     for locator, pid in sorted(derived.dropped):
         lines.append(f"locating pair {locator}->{pid} dropped: the blocking needs {pid} before {locator}")
+    lines += derived.notes()
     lines.append("geometric precedence (A before B): " + (" ".join(
         f"{a}->{b} ({reason})" for (a, b), reason in sorted(derived.reasons.items())) or "none"))
     return lines
@@ -216,6 +217,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None, reach: 
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
+    assumed += derived.assumptions()
     mapped = map_product(derived, settings)
     written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started)

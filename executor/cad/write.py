@@ -205,8 +205,9 @@ def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
 
 
 REASONS = {
-    "blocks": "B blocks A's straight way out along A's insertion axis",
+    "blocks": "A cannot go in once B is there (B, or parts always placed before B, block each way the base leaves A)",
     "base": "A is the base and B touches it",
+    "supports": "B rests on A and not on the base (the support rule, an assumption of the import)",
     "locates": "A alone keeps B from moving sideways (the locating rule, an assumption of the import)",
 }
 """Why a pair of ``geometric_precedence.lp`` holds, as its comments say."""
