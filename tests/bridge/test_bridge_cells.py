@@ -35,7 +35,7 @@ from assembly_constraints.bridge.messages import (
     encode,
 )
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
-from assembly_constraints.executor.serve import QUEUE_SIZE
+from assembly_constraints.executor.serve.node import QUEUE_SIZE
 
 pytestmark = pytest.mark.timeout(60)
 

@@ -148,7 +148,7 @@ def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
     """``executor serve --ilc-state``: the sim backend saves after a successful execution;
     a restarted backend (a resumed session's cell) starts from the saved corrections."""
     from assembly_constraints.bridge.messages import InsertRequest
-    from assembly_constraints.executor.serve import SimBackend
+    from assembly_constraints.executor.serve.sim import SimBackend
 
     state = tmp_path / "c1-ilc.json"
     backend = SimBackend("cranfield", "c1", None, None, ilc_state=state)
