@@ -46,8 +46,14 @@ MAX_ATTEMPTS = 10
 
 def _teach(args: argparse.Namespace) -> int:
     from assembly_constraints.executor.skills.teach import teach_all
+    from assembly_constraints.executor.trial import Cell
 
-    for path in teach_all(args.assembly):
+    cell = Cell(args.assembly)
+    try:
+        written = teach_all(cell)
+    finally:
+        cell.close()
+    for path in written:
         print(f"wrote {path}")
     return 0
 

@@ -24,12 +24,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
-from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor import ExecutorError, UnknownPair
 from assembly_constraints.executor.cell_description import CellDescription, load_cell_description
 from assembly_constraints.executor.control.controller import ImpedanceController
 from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
-from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, Motion
 from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from assembly_constraints.executor.rerun_arm import ArmRecorder
 from assembly_constraints.executor.skills.dmp import Skill, load_skill
@@ -46,7 +46,6 @@ if TYPE_CHECKING:
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
 PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
-APPROACH_SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
 
 
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
@@ -111,11 +110,11 @@ class Cell:
             self.ilc.load(self.ilc_state)
 
     def check_pair(self, part: str, hole: str) -> Skill:
-        """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""
+        """The taught skill of ``part``'s shape; UnknownPair naming an unknown part or hole."""
         if part not in self.geometry.parts:
-            raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
+            raise UnknownPair(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
-            raise ExecutorError(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.geometry.holes))})")
+            raise UnknownPair(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.geometry.holes))})")
         shape = self.geometry.parts[part].shape
         if shape not in self._skills:
             self._skills[shape] = load_skill(self.geometry.folder, shape)
@@ -154,8 +153,9 @@ class Cell:
         return self._arms[shape]
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
-        """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts."""
-        self.check_pair(part, hole)
+        """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts; UnknownPair
+        naming an unknown part or hole."""
+        skill = self.check_pair(part, hole)
         if max_attempts < 1:
             raise ExecutorError(f"max_attempts = {max_attempts}: expected at least 1")
         rng = trial_rng(seed, part, hole)
@@ -164,7 +164,7 @@ class Cell:
         for attempt in range(1, max_attempts + 1):
             if self.logger is not None:
                 self.logger.begin_attempt(part, hole, seed, attempt)
-            ev = self.run_attempt(part, hole, self.draw_setup(rng, part, hole))
+            ev = self._attempt(part, hole, skill, self.draw_setup(rng, part, hole))
             if self.logger is not None:
                 self.logger.end_attempt(ev)
             evidence.append(ev)
@@ -187,8 +187,13 @@ class Cell:
 
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
+        return self._attempt(part, hole, self.check_pair(part, hole), setup, wiggle_enabled)
+
+    def _attempt(self, part: str, hole: str, taught: Skill, setup: AttemptSetup,
+                 wiggle_enabled: bool = True) -> AttemptEvidence:
+        """:meth:`run_attempt` with the pair checked and its taught skill given."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
-        skill = self.check_pair(part, hole).in_hole(hole_spec.depth)
+        skill = taught.in_hole(hole_spec.depth)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps

@@ -48,12 +48,12 @@ from assembly_constraints.executor.backend_plugin import check_step
 from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionLayer, Ilc
-from assembly_constraints.executor.control.motion import StepLogger
+from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
 from assembly_constraints.executor.evidence import AttemptSetup
 from assembly_constraints.executor.skills.dmp import Skill, load_skill
 from assembly_constraints.executor.skills.insertion import insert_in_layer, needs_yaw_compliance
 from assembly_constraints.executor.skills.search import hole_search
-from assembly_constraints.executor.trial import APPROACH_HEIGHT, APPROACH_SETTLE_TIME, trial_rng
+from assembly_constraints.executor.trial import APPROACH_HEIGHT, trial_rng
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, yaw_quat
 from assembly_constraints.executor.world.geometry import fit_pose
 from assembly_constraints.executor.world.perturbation import CellBias

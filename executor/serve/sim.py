@@ -12,8 +12,7 @@ from typing import TYPE_CHECKING
 from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, CellSettings
 from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepRequest
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.backend_plugin import StepOutcome, UnknownPair
+from assembly_constraints.executor.backend_plugin import StepOutcome
 
 if TYPE_CHECKING:
     from assembly_constraints.executor.assembly.step_backend import AssemblyRunner
@@ -73,10 +72,6 @@ class SimBackend:
         return result, step_evidence(record), errors
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
-        try:
-            self._cell.check_pair(request.part, request.hole)
-        except ExecutorError as exc:
-            raise UnknownPair(str(exc)) from None
         if self._logger is not None:
             self._logger.planner_experiment = request.experiment or None
         trial = self._cell.run_trial(request.part, request.hole, seed=request.seed).to_json()
