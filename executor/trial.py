@@ -19,7 +19,7 @@ from __future__ import annotations
 import time
 import zlib
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict
 
 import numpy as np
 
@@ -33,7 +33,12 @@ from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, M
 from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from assembly_constraints.executor.rerun_arm import ArmRecorder
 from assembly_constraints.executor.skills.dmp import Skill, load_skill
-from assembly_constraints.executor.skills.insertion import insert_in_layer, needs_yaw_compliance, rotvec_quat_xyzw
+from assembly_constraints.executor.skills.insertion import (
+    InsertionTask,
+    insert_in_layer,
+    needs_yaw_compliance,
+    rotvec_quat_xyzw,
+)
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
@@ -53,11 +58,21 @@ def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
     return np.random.default_rng([seed, zlib.crc32(part.encode()), zlib.crc32(hole.encode())])
 
 
-def cell_keywords(settings: CellSettings) -> dict[str, Any]:
+class CellKeywords(TypedDict):
+    """The keyword arguments of :class:`Cell` that its settings give (:func:`cell_keywords`)."""
+
+    layer: str
+    magnitudes: Magnitudes
+    cell_seed: int
+    description: CellDescription
+
+
+def cell_keywords(settings: CellSettings) -> CellKeywords:
     """Keyword arguments of :class:`Cell` from the cell settings, the cell description file
-    they name read and checked here (BridgeError naming the file, table and key)."""
+    they name read and checked here, the one place it is decoded (BridgeError naming the
+    file, table and key)."""
     description = None if settings.description is None else Path(settings.description)
-    return {"layer": settings.layer, "perturbation": settings.magnitudes,
+    return {"layer": settings.layer, "magnitudes": settings.magnitudes,
             "cell_seed": settings.cell_seed, "description": load_cell_description(description)}
 
 
@@ -66,14 +81,16 @@ class Cell:
     shape (made on first use), so a trial depends on its seed, the cell seed and, with
     ILC, on the executions before it (the learned corrections) only.
 
-    ``layer``: the execution layer (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
-    ``perturbation``/``cell_seed``: the cell's uncertainty and the seed of its systematic
-    part; ``ilc_state``: a JSON file the ILC corrections are read from (if it exists) and
-    saved to after every update; ``description``: the cell's gripper, gains, thresholds,
-    admittance and ILC parameters (default :class:`CellDescription`)."""
+    ``layer``: the execution layer (a name of
+    :data:`assembly_constraints.executor.control.ilc.LAYERS` or one); ``magnitudes``/``cell_seed``:
+    the magnitudes of the cell's uncertainty and the seed of its systematic part (drawn into
+    ``bias``, :class:`assembly_constraints.executor.world.perturbation.CellBias`); ``ilc_state``: a
+    JSON file the ILC corrections are read from (if it exists) and saved to after every update;
+    ``description``: the cell's gripper, gains, thresholds, admittance and ILC parameters (default
+    :class:`CellDescription`)."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
+                 *, layer: str | ExecutionLayer = "full", magnitudes: Magnitudes | None = None,
                  cell_seed: int = 0, ilc_state: Path | None = None,
                  description: CellDescription | None = None) -> None:
         self.description = CellDescription() if description is None else description
@@ -84,7 +101,7 @@ class Cell:
         self.logger = logger
         self.thresholds = self.description.thresholds
         self.ilc_state = ilc_state
-        self.reset_state(layer=layer, perturbation=perturbation, cell_seed=cell_seed)
+        self.reset_state(layer=layer, magnitudes=magnitudes, cell_seed=cell_seed)
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
@@ -98,12 +115,12 @@ class Cell:
             logger.log_hole_rims(hole_rims(self.geometry))
             logger.log_arm_at_rest(self._arm_of(min(self.geometry.parts.items())[1].shape))
 
-    def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
+    def reset_state(self, *, layer: str | ExecutionLayer = "full", magnitudes: Magnitudes | None = None,
                     cell_seed: int = 0) -> None:
         """Become another cell on the same PyBullet clients: this execution layer, new
         systematic errors, the ILC corrections of ``ilc_state`` (if it exists) or none."""
         self.layer = layer_named(layer) if isinstance(layer, str) else layer
-        self.bias = CellBias(Magnitudes() if perturbation is None else perturbation, cell_seed)
+        self.bias = CellBias(Magnitudes() if magnitudes is None else magnitudes, cell_seed)
         d = self.description
         self.ilc = Ilc(d.ilc, d.gains, d.admittance)
         if self.ilc_state is not None:
@@ -220,9 +237,9 @@ class Cell:
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - self.geometry.gripper.grasp_depth
-        result = insert_in_layer(motion, skill, origin, detector, layer, lever, description=self.description,
-                                 wiggle_enabled=wiggle_enabled, correction=correction, yaw=yaw,
-                                 yaw_compliant=needs_yaw_compliance(spec.kind, hole_spec.kind))
+        task = InsertionTask(origin, lever, yaw, needs_yaw_compliance(spec.kind, hole_spec.kind), correction,
+                             wiggle_enabled)
+        result = insert_in_layer(motion, skill, detector, task, layer, description=self.description)
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

@@ -76,7 +76,7 @@ function or a ``functools.partial`` of one)."""
 
 class CellRunner:
     """A :class:`assembly_constraints.executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
-    ``keywords``: the Cell's options (layer, perturbation, cell seed)."""
+    ``keywords``: the Cell's options (:func:`assembly_constraints.executor.trial.cell_keywords`)."""
 
     def __init__(self, assembly: str, **keywords: Any) -> None:
         from assembly_constraints.executor.trial import Cell

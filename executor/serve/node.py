@@ -43,7 +43,7 @@ from assembly_constraints.bridge.session import SIGNAL_POLL_S, cell_listen, open
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.backend_plugin import Backend, InvalidStep, RunActive, UnknownPair
 from assembly_constraints.executor.claim import CellClaim, ClaimLost
-from assembly_constraints.executor.serve.backends import backend_of, check_backend_settings
+from assembly_constraints.executor.serve.backends import backend_starter
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
@@ -209,7 +209,7 @@ def serve(settings: ServeSettings) -> int:
     serves this cell id (:mod:`assembly_constraints.executor.claim`)."""
     cell_id = check_cell_id(settings.cell_id)
     zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
-    check_backend_settings(settings)  # bad settings are refused here, before the session opens
+    start_backend = backend_starter(settings)  # bad settings are refused here, before the session opens
     listen = cell_listen(settings.listen, settings.connect, zenoh_config)
     connect = list(settings.connect)
     signal.signal(signal.SIGTERM, _exit_on_signal)
@@ -220,7 +220,7 @@ def serve(settings: ServeSettings) -> int:
     try:
         claim = CellClaim(session, cell_id)
         claim.check()  # before the backend starts: a refused cell loads nothing
-        backend = backend_of(settings)
+        backend = start_backend()
         node = CellNode(cell_id, backend)
         claim.on_lost = lambda _why: node.stop()
         if claim.lost is not None:  # lost while the backend started

@@ -5,17 +5,17 @@ state; plan steps in the assembling world of :mod:`assembly_constraints.executor
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, CellSettings
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepRequest
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
 from assembly_constraints.executor.backend_plugin import StepOutcome
 
 if TYPE_CHECKING:
     from assembly_constraints.executor.assembly.step_backend import AssemblyRunner
+    from assembly_constraints.executor.trial import CellKeywords
 
 
 def _planner_numbered_logger() -> type:
@@ -34,26 +34,28 @@ def _planner_numbered_logger() -> type:
 
 
 class SimBackend:
-    """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``rrd`` is given."""
+    """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``settings.rrd`` or
+    ``settings.viewer_url`` is given."""
 
-    def __init__(self, assembly: str, cell_id: str, recording_id: str | None,
-                 rrd: Path | None, viewer: Viewer = NO_VIEWER, blocked: Sequence[str] = (),
-                 cell: CellSettings = DEFAULT_CELL, ilc_state: Path | None = None) -> None:
-        """``viewer``: also stream the recording live; ``blocked``: holes with an obstacle
-        for plan steps; ``cell``: the Cell's settings (layer, uncertainty, cell seed; with
-        ``uncertainty`` ``cell`` plan steps get the Cell's uncertainty (its systematic
-        errors), layer and an ILC, with ``random`` their own); ``ilc_state``: the file its
-        ILC corrections are loaded from and saved to, atomically after every update, so a
-        resumed session's cell starts from them."""
-        from assembly_constraints.executor.trial import Cell, cell_keywords
+    def __init__(self, settings: ServeSettings, cell: CellKeywords) -> None:
+        """``settings``: the node's (assembly, cell id, recording, ``block_holes`` for plan
+        steps, ``ilc_state``: the file its ILC corrections are loaded from and saved to,
+        atomically after every update, so a resumed session's cell starts from them; with
+        ``cell.uncertainty`` ``cell`` plan steps get the Cell's systematic errors, layer
+        and an ILC, with ``random`` their own); ``cell``: the Cell's keywords, its
+        description already decoded (:func:`assembly_constraints.executor.trial.cell_keywords`)."""
+        from assembly_constraints.executor.trial import Cell
 
+        rrd = None if settings.rrd is None else Path(settings.rrd)
+        viewer = Viewer(settings.viewer_url)
         _PlannerNumbered = _planner_numbered_logger()
-        self._logger = (_PlannerNumbered(cell_id, recording_id=recording_id, rrd_path=rrd, viewer=viewer,
-                                         send_blueprint=False)  # the planner sends it
+        self._logger = (_PlannerNumbered(settings.cell_id, recording_id=settings.recording_id, rrd_path=rrd,
+                                         viewer=viewer, send_blueprint=False)  # the planner sends it
                         if rrd is not None or viewer != NO_VIEWER else None)
-        self._cell = Cell(assembly, gui=False, logger=self._logger, ilc_state=ilc_state, **cell_keywords(cell))
-        self._assembly, self._blocked, self._cell_id = assembly, list(blocked), cell_id
-        self._cell_uncertainty = cell.uncertainty == "cell"
+        ilc_state = None if settings.ilc_state is None else Path(settings.ilc_state)
+        self._cell = Cell(settings.assembly, gui=False, logger=self._logger, ilc_state=ilc_state, **cell)
+        self._assembly, self._blocked, self._cell_id = settings.assembly, list(settings.block_holes), settings.cell_id
+        self._cell_uncertainty = settings.cell.uncertainty == "cell"
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
@@ -64,7 +66,7 @@ class SimBackend:
 
             recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
             cell = self._cell
-            self._runner = (AssemblyRunner(self._assembly, self._blocked, recorder, uncertainty=cell.bias,
+            self._runner = (AssemblyRunner(self._assembly, self._blocked, recorder, bias=cell.bias,
                                            layer=cell.layer)
                             if self._cell_uncertainty else AssemblyRunner(self._assembly, self._blocked, recorder))
         record, errors = self._runner.run_step(request)

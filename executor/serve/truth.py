@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import time
 import uuid
-from collections.abc import Sequence
 from pathlib import Path
 
 import clingo
 
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.inputs import read_bytes
 from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
 from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
@@ -37,14 +37,16 @@ def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
 
 
 class TruthBackend:
-    """Answers without simulation, after ``delay_s`` [s]: from the cell's geometry (a part
-    passes a hole when its cross-section does,
+    """Answers without simulation, after ``settings.delay_s`` [s]: from the cell's geometry
+    (a part passes a hole when its cross-section does,
     :func:`assembly_constraints.executor.world.geometry.passes`), or from the product's
-    ``sizes.lp`` where it has no ``geometry.toml``."""
+    ``sizes.lp`` where it has no ``geometry.toml``; logs every outcome to Rerun if
+    ``settings.rrd`` or ``settings.viewer_url`` is given; a hole of ``settings.block_holes``
+    refuses every plan step."""
 
-    def __init__(self, assembly: str, delay_s: float, cell_id: str,
-                 recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER,
-                 blocked: Sequence[str] = ()) -> None:
+    def __init__(self, settings: ServeSettings) -> None:
+        assembly, cell_id = settings.assembly, settings.cell_id
+        rrd, viewer = None if settings.rrd is None else Path(settings.rrd), Viewer(settings.viewer_url)
         try:
             assembly_of = load_assembly(assembly)
             if assembly_of.has_file("geometry.toml"):
@@ -58,8 +60,8 @@ class TruthBackend:
                 self._manual = set()
         except BridgeError as exc:
             raise ExecutorError(f"truth backend: {exc}") from None
-        self._delay_s = delay_s
-        self._blocked = set(blocked)
+        self._delay_s = settings.delay_s
+        self._blocked = set(settings.block_holes)
         self._parts = tuple(assembly_of.part_ids)
         self._run: str | None = None  # the plan run whose product is being built
         self._placed: dict[str, float] = {}  # its placed parts
@@ -67,7 +69,7 @@ class TruthBackend:
         if rrd is not None or viewer != NO_VIEWER:
             from assembly_constraints.executor.rerun_log import open_recording
 
-            self._log = open_recording(recording_id or str(uuid.uuid4()), rrd, viewer)
+            self._log = open_recording(settings.recording_id or str(uuid.uuid4()), rrd, viewer)
             self._entity = f"executor/{cell_id}/outcome"
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
