@@ -65,7 +65,7 @@ from assembly_constraints.asp.session.settings import (
 )
 from assembly_constraints.asp.session.zenoh_oracle import Finished, ZenohOracle
 from assembly_constraints.asp.sizes.cad_prior import cad_prior
-from assembly_constraints.asp.sizes.learner import SizeLearner, SizeLearningResult
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, SizeLearningResult
 from assembly_constraints.asp.sizes.models import SizeModel, model_for
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.asp.solve import fact, write_facts
@@ -390,8 +390,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
     if prior is not None:
         LOG.info("precedence: the geometric prior %s refined by %d demonstration(s)", prior, len(demos.sequences))
-    learner = SizeLearner(parts, holes, record.policy, record.seed,
-                          confirm=record.confirm, demonstrated=demos.placements(), model=model, prior=decided)
+    options = LearningOptions(confirm=record.confirm, demonstrated=demos.placements(), model=model, prior=decided)
+    learner = SizeLearner(parts, holes, record.policy, record.seed, options)
     required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
     run_id = record.recording_id
     listen, connect = _endpoints(settings)
