@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import time
 import zlib
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, TypedDict
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -58,22 +59,27 @@ def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
     return np.random.default_rng([seed, zlib.crc32(part.encode()), zlib.crc32(hole.encode())])
 
 
-class CellKeywords(TypedDict):
-    """The keyword arguments of :class:`Cell` that its settings give (:func:`cell_keywords`)."""
+@dataclass(frozen=True)
+class CellSetup:
+    """What a simulated cell is, decoded (:func:`cell_setup`): ``layer``, its execution layer
+    (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
+    ``magnitudes``, of its uncertainty (units per field of
+    :class:`assembly_constraints.bridge.cell_settings.Magnitudes`); ``cell_seed``, the seed of
+    its systematic errors; ``description``, its gripper, gains, thresholds, admittance and
+    ILC parameters."""
 
-    layer: str
-    magnitudes: Magnitudes
-    cell_seed: int
-    description: CellDescription
+    layer: str | ExecutionLayer = "full"
+    magnitudes: Magnitudes = field(default_factory=Magnitudes)
+    cell_seed: int = 0
+    description: CellDescription = field(default_factory=CellDescription)
 
 
-def cell_keywords(settings: CellSettings) -> CellKeywords:
-    """Keyword arguments of :class:`Cell` from the cell settings, the cell description file
-    they name read and checked here, the one place it is decoded (BridgeError naming the
-    file, table and key)."""
+def cell_setup(settings: CellSettings) -> CellSetup:
+    """The :class:`CellSetup` of the cell settings, the cell description file they name read
+    and checked here, the one place it is decoded (BridgeError naming the file, table and
+    key)."""
     description = None if settings.description is None else Path(settings.description)
-    return {"layer": settings.layer, "magnitudes": settings.magnitudes,
-            "cell_seed": settings.cell_seed, "description": load_cell_description(description)}
+    return CellSetup(settings.layer, settings.magnitudes, settings.cell_seed, load_cell_description(description))
 
 
 class Cell:
@@ -81,19 +87,15 @@ class Cell:
     shape (made on first use), so a trial depends on its seed, the cell seed and, with
     ILC, on the executions before it (the learned corrections) only.
 
-    ``layer``: the execution layer (a name of
-    :data:`assembly_constraints.executor.control.ilc.LAYERS` or one); ``magnitudes``/``cell_seed``:
-    the magnitudes of the cell's uncertainty and the seed of its systematic part (drawn into
-    ``bias``, :class:`assembly_constraints.executor.world.perturbation.CellBias`); ``ilc_state``: a
-    JSON file the ILC corrections are read from (if it exists) and saved to after every update;
-    ``description``: the cell's gripper, gains, thresholds, admittance and ILC parameters (default
-    :class:`CellDescription`)."""
+    ``setup``: the execution layer, the magnitudes of the cell's uncertainty and the seed of
+    its systematic part (drawn into ``bias``,
+    :class:`assembly_constraints.executor.world.perturbation.CellBias`), the cell's
+    description (:class:`CellSetup`); ``ilc_state``: a JSON file the ILC corrections are
+    read from (if it exists) and saved to after every update."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 *, layer: str | ExecutionLayer = "full", magnitudes: Magnitudes | None = None,
-                 cell_seed: int = 0, ilc_state: Path | None = None,
-                 description: CellDescription | None = None) -> None:
-        self.description = CellDescription() if description is None else description
+                 *, setup: CellSetup = CellSetup(), ilc_state: Path | None = None) -> None:
+        self.description = setup.description
         self.geometry = load_geometry(assembly, self.description)
         if gui:
             require_display()
@@ -101,7 +103,7 @@ class Cell:
         self.logger = logger
         self.thresholds = self.description.thresholds
         self.ilc_state = ilc_state
-        self.reset_state(layer=layer, magnitudes=magnitudes, cell_seed=cell_seed)
+        self.reset_state(layer=setup.layer, magnitudes=setup.magnitudes, cell_seed=setup.cell_seed)
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}

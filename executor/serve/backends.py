@@ -22,13 +22,13 @@ def backend_starter(settings: ServeSettings) -> Callable[[], Backend]:
     ignoring it."""
     if settings.backend == "sim":
         from assembly_constraints.executor.control.ilc import offset_bound, read_state
-        from assembly_constraints.executor.trial import cell_keywords
+        from assembly_constraints.executor.trial import cell_setup
 
-        cell = cell_keywords(settings.cell)
-        description = cell["description"]
+        setup = cell_setup(settings.cell)
+        description = setup.description
         if settings.ilc_state is not None:
             read_state(Path(settings.ilc_state), description.ilc, offset_bound(description.admittance))
-        return lambda: SimBackend(settings, cell)
+        return lambda: SimBackend(settings, setup)
     if settings.cell.description is not None:
         from assembly_constraints.executor.cell_description import load_cell_description
 

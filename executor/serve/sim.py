@@ -15,7 +15,7 @@ from assembly_constraints.executor.backend_plugin import StepOutcome
 
 if TYPE_CHECKING:
     from assembly_constraints.executor.assembly.step_backend import AssemblyRunner
-    from assembly_constraints.executor.trial import CellKeywords
+    from assembly_constraints.executor.trial import CellSetup
 
 
 def _planner_numbered_logger() -> type:
@@ -37,13 +37,13 @@ class SimBackend:
     """The PyBullet cell (DIRECT mode); logs every attempt to Rerun if ``settings.rrd`` or
     ``settings.viewer_url`` is given."""
 
-    def __init__(self, settings: ServeSettings, cell: CellKeywords) -> None:
+    def __init__(self, settings: ServeSettings, setup: CellSetup) -> None:
         """``settings``: the node's (assembly, cell id, recording, ``block_holes`` for plan
         steps, ``ilc_state``: the file its ILC corrections are loaded from and saved to,
         atomically after every update, so a resumed session's cell starts from them; with
         ``cell.uncertainty`` ``cell`` plan steps get the Cell's systematic errors, layer
-        and an ILC, with ``random`` their own); ``cell``: the Cell's keywords, its
-        description already decoded (:func:`assembly_constraints.executor.trial.cell_keywords`)."""
+        and an ILC, with ``random`` their own); ``setup``: what the Cell is, its
+        description already decoded (:func:`assembly_constraints.executor.trial.cell_setup`)."""
         from assembly_constraints.executor.trial import Cell
 
         rrd = None if settings.rrd is None else Path(settings.rrd)
@@ -53,7 +53,7 @@ class SimBackend:
                                          viewer=viewer, send_blueprint=False)  # the planner sends it
                         if rrd is not None or viewer != NO_VIEWER else None)
         ilc_state = None if settings.ilc_state is None else Path(settings.ilc_state)
-        self._cell = Cell(settings.assembly, gui=False, logger=self._logger, ilc_state=ilc_state, **cell)
+        self._cell = Cell(settings.assembly, gui=False, logger=self._logger, ilc_state=ilc_state, setup=setup)
         self._assembly, self._blocked, self._cell_id = settings.assembly, list(settings.block_holes), settings.cell_id
         self._cell_uncertainty = settings.cell.uncertainty == "cell"
         self._runner: AssemblyRunner | None = None

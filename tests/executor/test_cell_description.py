@@ -20,7 +20,7 @@ from assembly_constraints.executor.cell_description import CellDescription, load
 from assembly_constraints.executor.control.admittance import AdmittanceParams
 from assembly_constraints.executor.control.detector import Thresholds
 from assembly_constraints.executor.control.ilc import ExecutionTrace, Ilc, offset_bound, read_state
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from assembly_constraints.executor.world.geometry import arm_urdf_text
 from tests.conftest import ROOT
 
@@ -65,7 +65,7 @@ def test_the_cell_uses_its_description() -> None:
     gripper = Gripper(flange_mass=1.0, flange_inertia=0.004, flange_length=0.08, grasp_depth=0.02)
     described = CellDescription(gripper=gripper, thresholds=Thresholds(f_stop=25.0),
                                 admittance=AdmittanceParams(bound=0.001))
-    cell, default = Cell(description=described), Cell()
+    cell, default = Cell(setup=CellSetup(description=described)), Cell()
     try:
         assert cell.thresholds.f_stop == 25.0 and default.thresholds.f_stop == 30.0
         assert cell.geometry.gripper == gripper  # Cranfield has no [gripper] of its own

@@ -16,7 +16,7 @@ from assembly_constraints.executor.control.gains import POSITION_CONTROL_GAINS, 
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionTrace, Ilc
 from assembly_constraints.executor.evidence import AttemptSetup
 from assembly_constraints.executor.skills.insertion import rotvec_quat_xyzw
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, rotation_error
 from assembly_constraints.executor.world.perturbation import NO_PERTURBATION
 
@@ -35,7 +35,7 @@ def _ilc() -> Ilc:
 
 @pytest.fixture(scope="module")
 def cell():
-    c = Cell(magnitudes=NO_PERTURBATION)
+    c = Cell(setup=CellSetup(magnitudes=NO_PERTURBATION))
     yield c
     c.close()
 
@@ -116,7 +116,7 @@ def test_ilc_converges_on_a_repeated_pair(cell, tmp_path):
     assert [r.evidence[0].ilc_iteration for r in runs] == [0, 1, 2, 3]
     saved = json.loads(state.read_text())["keys"]
     assert saved["tight_peg:s1"]["iterations"] == 4
-    restarted = Cell(magnitudes=SYSTEMATIC_ONLY, ilc_state=state)
+    restarted = Cell(setup=CellSetup(magnitudes=SYSTEMATIC_ONLY), ilc_state=state)
     try:
         correction, iteration = restarted.ilc.correction("tight_peg:s1")
         assert iteration == 4 and np.array_equal(correction, cell.ilc.correction("tight_peg:s1")[0])
@@ -150,17 +150,17 @@ def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
     from assembly_constraints.bridge.cell_settings import ServeSettings
     from assembly_constraints.bridge.messages import InsertRequest
     from assembly_constraints.executor.serve.sim import SimBackend
-    from assembly_constraints.executor.trial import cell_keywords
+    from assembly_constraints.executor.trial import cell_setup
 
     state = tmp_path / "c1-ilc.json"
     settings = ServeSettings(ilc_state=str(state))
-    backend = SimBackend(settings, cell_keywords(settings.cell))
+    backend = SimBackend(settings, cell_setup(settings.cell))
     try:
         result, _evidence = backend.run(InsertRequest(id="r1", part="p1", hole="r1", seed=3))
     finally:
         backend.close()
     assert result == "fit"
-    restarted = SimBackend(settings, cell_keywords(settings.cell))
+    restarted = SimBackend(settings, cell_setup(settings.cell))
     try:
         assert restarted._cell.ilc.iterations == {"round_peg:r1": 1}
     finally:

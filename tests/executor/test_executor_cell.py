@@ -12,14 +12,14 @@ import pybullet as pb
 import pytest
 
 from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from tests._tolerances import END_BOUND, FORCE_BOUND, TORQUE_BOUND
 
 
 @pytest.fixture(scope="module")
 def cell():
     """A cell without ILC: a trial then depends on its seed only."""
-    c = Cell(layer="pi_phase_stop")
+    c = Cell(setup=CellSetup(layer="pi_phase_stop"))
     yield c
     c.close()
 
@@ -61,7 +61,7 @@ def test_same_seed_same_trial(cell):
     cell.run_trial("sh", "br", seed=5)  # something else in between
     again = cell.run_trial("p2", "s2", seed=11).to_json()
     assert _stable(first) == _stable(again)
-    fresh = Cell(layer="pi_phase_stop")
+    fresh = Cell(setup=CellSetup(layer="pi_phase_stop"))
     try:
         assert _stable(fresh.run_trial("p2", "s2", seed=11).to_json()) == _stable(first)
     finally:
