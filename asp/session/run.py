@@ -72,7 +72,7 @@ from assembly_constraints.asp.solve import fact, write_facts
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
 from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellPool
+from assembly_constraints.bridge.client import CellDirectory, CellPool, PoolLimits
 from assembly_constraints.bridge.files import make_folder
 from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
 from assembly_constraints.bridge.recording.reader import read_recording
@@ -431,7 +431,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         # by default only its own cells
         allowed = cell_ids if settings.cells > 0 else (list(settings.allow_cells or ()) or None)
         processes = {cell.cell_id: cell for cell in cells}
-        pool = CellPool(session, directory, timeout=settings.timeout_s, wait_for_cell=settings.wait_for_cell_s,
+        pool = CellPool(session, directory, PoolLimits(timeout=settings.timeout_s,
+                                                       wait_for_cell=settings.wait_for_cell_s),
                         allowed=allowed,
                         exit_status=lambda cell: processes[cell].exit_code(CRASH_WAIT_S) if cell in processes else None)
         stack.callback(pool.close)
