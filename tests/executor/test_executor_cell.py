@@ -108,3 +108,23 @@ def test_tight_peg_jam_is_resolved_by_the_wiggle(cell):
     assert freed.outcome == "fit"
     assert freed.end_error < cell.thresholds.goal_tolerance
     json.dumps(dataclasses.asdict(freed))  # evidence goes out as JSON (bridge, CLI)
+
+
+@pytest.mark.slow
+def test_a_trial_checks_its_pair_once(cell, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pair is checked (and its skill looked up) once per trial, whatever its attempts;
+    an unknown part is refused as such."""
+    from assembly_constraints.executor import UnknownPair
+
+    checks: list[tuple[str, str]] = []
+    check = cell.check_pair
+
+    def counted(part: str, hole: str):
+        checks.append((part, hole))
+        return check(part, hole)
+
+    monkeypatch.setattr(cell, "check_pair", counted)
+    result = cell.run_trial("sh", "r1", seed=0)  # too big: two attempts
+    assert (result.outcome, result.attempts) == ("no_fit", 2) and checks == [("sh", "r1")]
+    with pytest.raises(UnknownPair, match="unknown part 'zz'"):
+        cell.run_trial("zz", "r1", seed=0)
