@@ -12,7 +12,9 @@ process later.
   thread; a malformed, oversized or wrong-version request gets an ErrorReply at once and
   the cell keeps serving.
 - Valid requests run one at a time in the main thread. Results are idempotent by
-  request id: a repeated id gets the cached reply and never re-runs the experiment.
+  request id: a repeated id gets the cached reply and never re-runs the experiment. A
+  request whose backend raises gets an ErrorReply ``failed`` naming the exception, and the
+  cell keeps serving.
 - Backends: ``sim`` runs the PyBullet :class:`assembly_constraints.executor.trial.Cell` (imported lazily)
   with the execution layer and uncertainty of its cell settings (``--layer``,
   ``--cell-seed``, ``--grasp-tilt-bias`` ...) and its ILC state in ``--ilc-state``;
@@ -42,6 +44,7 @@ import queue
 import signal
 import threading
 import time
+import traceback
 import uuid
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
@@ -416,6 +419,11 @@ class CellNode:
                                else "failed")
             self._refuse(query, code, str(exc), request.id)
             return None
+        except Exception as exc:  # a bug of the backend: this request fails, the cell keeps serving
+            where = traceback.extract_tb(exc.__traceback__)[-1]
+            self._refuse(query, "failed", f"the backend raised {type(exc).__name__}: {str(exc)[:200]} "
+                         f"(at {Path(where.filename).name}:{where.lineno})", request.id)
+            return None
         reply, result = encode(message), message.result
         with self._lock:
             self._replies[request.id] = (request, reply)
@@ -523,8 +531,12 @@ def serve(settings: ServeSettings) -> int:
     if settings.backend == "sim":
         from assembly_constraints.executor.trial import cell_keywords
 
-        # Bad cell settings or description are refused here, before the session opens.
+        from assembly_constraints.executor.skills.dmp import check_product_skills
+
+        # Bad cell settings or description, a product or skill the cell cannot run, are
+        # refused here, before the session opens.
         description = cell_keywords(settings.cell)["description"]
+        check_product_skills(load_geometry(settings.assembly, description))
         if settings.ilc_state is not None:
             from assembly_constraints.executor.control.ilc import offset_bound, read_state
 

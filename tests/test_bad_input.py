@@ -92,6 +92,20 @@ def geometry(old: str, new: str) -> Callable[[Path], None]:
     return assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(old, new, 1)})
 
 
+def taught(path: str, old: str, new: str) -> Callable[[Path], None]:
+    """Setup: a copy of the spare-hole plate in ``asm/`` with its skills, ``old`` replaced
+    by ``new`` in its file ``path`` (a product changed since its skills were taught)."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(ROOT / "data" / "spare", tmp / "asm", ignore=shutil.ignore_patterns("assets"))
+        edited = tmp / "asm" / path
+        text = edited.read_text()
+        assert old in text
+        edited.write_text(text.replace(old, new, 1))
+
+    return setup
+
+
 def plan_file(name: str, change: Callable[[list[dict]], object]) -> Callable[[Path], None]:
     """Setup: ``name`` holding Cranfield's first plan (real clingo, true facts) as ``plan
     --json`` prints it, after ``change`` edited its list of steps in place."""
@@ -286,6 +300,13 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("trial-cell-description-negative", ("executor", "trial", "--part", "p1", "--hole", "r1",
                                           "--cell-description", "cell.toml"),
      {"cell.toml": "[gains]\nk_trans = -1.0\n"}, 2, "cell.toml: [gains] k_trans: expected a number in (0, 1e6]"),
+    # a skill taught on a section the product no longer has: refused before the cell serves
+    ("serve-sim-peg-resized", ("executor", "serve", "--assembly", "asm", "--listen", "tcp/127.0.0.1:0"),
+     taught("geometry.toml", "size = 0.0120           # diameter [m]", "size = 0.0125"), 2,
+     "taught on part p1 round 12.00 x 12.00 mm, the product's p1 is round 12.50 x 12.50 mm"),
+    ("trial-hole-resized", ("executor", "trial", "--assembly", "asm", "--part", "p3", "--hole", "r1"),
+     taught("geometry.toml", "size = 0.0133           # side [m]", "size = 0.0131"), 2,
+     "taught on hole s1 square 13.30 x 13.30 mm, the product's s1 is square 13.10 x 13.10 mm"),
     ("serve-cell-description-missing", ("executor", "serve", "--cell-description", "none.toml"), None, 2,
      "none.toml"),
     ("trial-cell-gripper-too-deep", ("executor", "trial", "--part", "p1", "--hole", "r1",

@@ -305,6 +305,14 @@ def load_product_skill(geometry: CellGeometry, shape: str) -> Skill:
     return skill
 
 
+def check_product_skills(geometry: CellGeometry) -> None:
+    """The skill of every part shape of the product loads and was taught on it as it is
+    (:func:`load_product_skill`); ExecutorError naming the first that is not. A cell runs
+    this before it serves, so a bad skill ends it at the start, not at its first request."""
+    for shape in sorted({part.shape for part in geometry.parts.values()}):
+        load_product_skill(geometry, shape)
+
+
 def _section(kind: str, sides: tuple[float, float]) -> str:
     """``round 10.00 x 10.00 mm``: a section's kind and sides."""
     a, b = sides
