@@ -5,6 +5,7 @@ from ``/proc``."""
 
 from __future__ import annotations
 
+import os
 import re
 import signal
 import socket
@@ -63,11 +64,12 @@ def _line(process: subprocess.Popen[str], pattern: str, timeout: float = 120.0) 
     raise AssertionError(f"no line matching {pattern!r} in {''.join(seen)[-2000:]}")
 
 
-def _stop_with_sigterm(process: subprocess.Popen[str]) -> set[int]:
-    """SIGTERM ``process``; returns those of its descendants (before the signal) still running."""
+def _stop_by_signal(process: subprocess.Popen[str], signum: int = signal.SIGTERM) -> set[int]:
+    """SIGTERM (or ``signum``) ``process``; returns those of its descendants (before the
+    signal) still running."""
     before = descendants(process.pid)
     assert before, "the command started no process of its own"
-    process.send_signal(signal.SIGTERM)
+    process.send_signal(signum)
     process.communicate(timeout=60)
     deadline = time.monotonic() + 5.0
     while time.monotonic() < deadline and any(running(pid) for pid in before):
@@ -92,7 +94,7 @@ def test_view_web_stopped_by_sigterm_stops_its_web_viewer(tmp_path: Path, cli_ar
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         address = _line(view, r"http://127\.0\.0\.1:\d+/\S*").group(0)
-        left = _stop_with_sigterm(view)
+        left = _stop_by_signal(view)
     finally:
         view.kill()
     assert view.returncode == EXIT_TERMINATED
@@ -110,7 +112,7 @@ def test_a_session_stopped_by_sigterm_stops_its_cells(tmp_path: Path, cli_argv: 
                                cwd=ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         _line(session, r"experiment 1 on c\d")
-        left = _stop_with_sigterm(session)
+        left = _stop_by_signal(session)
     finally:
         session.kill()
     assert session.returncode == EXIT_TERMINATED
@@ -132,3 +134,22 @@ def test_a_router_on_port_0_reports_the_port_it_bound(cli_argv: Callable[..., li
     finally:
         router.kill()
     assert router.returncode == 0
+
+
+@pytest.mark.slow  # the Rerun web viewer's start (~2 s)
+def test_view_web_killed_by_sigkill_leaves_no_web_viewer(tmp_path: Path, cli_argv: Callable[..., list[str]]) -> None:
+    """SIGKILL runs no handler and no ``finally``: the Rerun server dies with its parent by
+    the death signal the kernel sends it."""
+    rrd = _recording(tmp_path / "c2.rrd")
+    view = subprocess.Popen(cli_argv("view", str(rrd), "--web"), cwd=ROOT, env=child_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        address = _line(view, r"http://127\.0\.0\.1:\d+/\S*").group(0)
+        left = _stop_by_signal(view, signal.SIGKILL)
+        for pid in left:  # not left to the next test
+            os.kill(pid, signal.SIGKILL)
+    finally:
+        view.kill()
+    assert view.returncode == -signal.SIGKILL
+    assert not left, f"still running after SIGKILL: {left}"
+    assert_closed(address)
