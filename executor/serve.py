@@ -97,6 +97,7 @@ from assembly_constraints.bridge.session import (
     DEFAULT_ENDPOINT,
     SIGNAL_POLL_S,
     add_endpoint_arguments,
+    bound_endpoints,
     cell_listen,
     open_session,
 )
@@ -529,9 +530,8 @@ def serve(settings: ServeSettings) -> int:
     cell_id = check_cell_id(settings.cell_id)
     zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
     if settings.backend == "sim":
-        from assembly_constraints.executor.trial import cell_keywords
-
         from assembly_constraints.executor.skills.dmp import check_product_skills
+        from assembly_constraints.executor.trial import cell_keywords
 
         # Bad cell settings or description, a product or skill the cell cannot run, are
         # refused here, before the session opens.
@@ -555,6 +555,7 @@ def serve(settings: ServeSettings) -> int:
     claim: CellClaim | None = None
     backend: Backend | None = None
     try:
+        listen = bound_endpoints(session, listen)  # reported as bound (port 0: the port it took)
         claim = CellClaim(session, cell_id)
         claim.check()  # before the backend starts: a refused cell loads nothing
         backend = _backend(settings)

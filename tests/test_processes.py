@@ -119,21 +119,26 @@ def test_a_session_stopped_by_sigterm_stops_its_cells(tmp_path: Path, cli_argv: 
     assert not left, f"still running after SIGTERM: {left}"
 
 
-def test_a_router_on_port_0_reports_the_port_it_bound(cli_argv: Callable[..., list[str]]) -> None:
-    router = subprocess.Popen(cli_argv("router", "--listen", "tcp/127.0.0.1:0"), cwd=ROOT, env=child_env(),
+@pytest.mark.parametrize(("argv", "ready"), [
+    (("router",), r"ready router \w+ listen tcp/127\.0\.0\.1:(\d+)\n"),
+    (("executor", "serve", "--backend", "truth", "--cell", "c5"),
+     r"ready cell c5 backend truth listen \['tcp/127\.0\.0\.1:(\d+)'\] connect \[\]\n")])
+def test_a_listener_on_port_0_reports_the_port_it_bound(argv: tuple[str, ...], ready: str,
+                                                        cli_argv: Callable[..., list[str]]) -> None:
+    listener = subprocess.Popen(cli_argv(*argv, "--listen", "tcp/127.0.0.1:0"), cwd=ROOT, env=child_env(),
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        assert router.stdout is not None
-        ready = router.stdout.readline()
-        match = re.fullmatch(r"ready router \w+ listen tcp/127\.0\.0\.1:(\d+)\n", ready)
-        assert match and int(match.group(1)) != 0, ready
-        with socket.socket() as probe:  # the router listens there
+        assert listener.stdout is not None
+        line = listener.stdout.readline()
+        match = re.fullmatch(ready, line)
+        assert match and int(match.group(1)) != 0, line
+        with socket.socket() as probe:  # it listens there
             assert probe.connect_ex(("127.0.0.1", int(match.group(1)))) == 0
-        router.send_signal(signal.SIGTERM)
-        router.communicate(timeout=30)
+        listener.send_signal(signal.SIGTERM)
+        listener.communicate(timeout=30)
     finally:
-        router.kill()
-    assert router.returncode == 0
+        listener.kill()
+    assert listener.returncode == 0
 
 
 @pytest.mark.slow  # the Rerun web viewer's start (~2 s)
