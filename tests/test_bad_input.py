@@ -106,6 +106,21 @@ def taught(path: str, old: str, new: str) -> Callable[[Path], None]:
     return setup
 
 
+def prior(*margins: str) -> dict[str, str | bytes]:
+    """Setup: a product ``pr`` of two round pegs (u, v) and three holes (k1 k2 k3), its CAD
+    prior ``nominal_sizes.lp`` holding six consistent margins and then ``margins``."""
+    return {"pr/assembly.toml": "name = 'pr'\n[parts.u]\nshape = 'round'\n[parts.v]\nshape = 'round'\n"
+                                "[holes.k1]\n[holes.k2]\n[holes.k3]\n",
+            "pr/sizes.lp": "part(u;v). hole(k1;k2;k3). fits(u,k1). fits(u,k2). fits(u,k3). fits(v,k3).\n",
+            "pr/nominal_sizes.lp": "\n".join(["nominal_margin(u,k1,800).", "nominal_margin(u,k2,400).",
+                                               "nominal_margin(u,k3,1200).", "nominal_margin(v,k1,-400).",
+                                               "nominal_margin(v,k2,-20).", "nominal_margin(v,k3,300).",
+                                               *margins]) + "\n"}
+
+
+PRIOR = ("sizes", "learn", "--assembly", "pr", "--prior", "cad", "--tolerance", "0.0001")
+
+
 def plan_file(name: str, change: Callable[[list[dict]], object]) -> Callable[[Path], None]:
     """Setup: ``name`` holding Cranfield's first plan (real clingo, true facts) as ``plan
     --json`` prints it, after ``change`` edited its list of steps in place."""
@@ -507,6 +522,22 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     ("bench-precedence-physics-edge-twice", ("bench", "precedence-physics", "--edges", "bp-p1,bp-p1"), None, 2,
      "'bp-p1' is given twice"),
     ("session-allow-cells-twice", ("session", "--allow-cells", "c1,c1"), None, 2, "given twice"),
+    # the probes of the newer inputs, new values of the same kinds: a prior that is a program
+    # (unbounded grounding), contradicts itself or names what the product lacks; numbers out of
+    # range; empty output paths; a FIFO as a recording
+    ("prior-interval-of-other-name", PRIOR, prior("k(1..60000000)."), 2, "nominal_sizes.lp:7: k((1..60000000))"),
+    ("prior-pool", PRIOR, prior("nominal_margin(v,k2,(-20;650))."), 2, "nominal_sizes.lp:7:"),
+    ("prior-contradicts", PRIOR, prior("nominal_margin(v,k2,650)."), 2,
+     "nominal_sizes.lp:7: nominal_margin(v,k2,650) contradicts line 5: nominal_margin(v,k2,-20)"),
+    ("prior-unknown-hole", PRIOR, prior("nominal_margin(u,k9,100)."), 2, "unknown part or hole k9"),
+    ("prior-function-id", PRIOR, prior("nominal_margin(f(u),k1,100)."), 2, "nominal_sizes.lp:7:"),
+    ("serve-delay-over-an-hour", ("executor", "serve", "--delay", "3601"), None, 2, "[0, 3600]"),
+    ("session-cells-65", ("session", "--cells", "65"), None, 2, "from 0 to 64"),
+    ("trial-trials-over", ("executor", "trial", "--part", "p1", "--hole", "r1", "--trials", "100001"), None, 2,
+     "from 1 to 100000"),
+    ("assemble-save-empty", ("assemble", "--save", ""), None, 2, "expected a path, got the empty string"),
+    ("view-fifo-in-run", ("view", "run", "--print"),
+     lambda tmp: ((tmp / "run").mkdir(), os.mkfifo(tmp / "run" / "c3.rrd")), 2, "c3.rrd: not a regular file (a FIFO)"),
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
