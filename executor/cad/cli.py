@@ -13,7 +13,10 @@ It prints what it assumes, each part's insertion axis and free directions, each 
 with both cross-sections and the clearance, the disassembly stages, the geometric
 precedence with each pair's reason (``--locating-reach R``: the locating rule's reach [m],
 :mod:`assembly_constraints.executor.cad.locating`; 0: off) and the collision queries; bad
-CAD or a bad file: one line, exit code 2.
+CAD or a bad file: one line, exit code 2. ``--max-triangles N`` bounds the parts'
+triangles together; the folder's ``.import-manifest.json`` lists the files an import
+wrote, the only ones a later import replaces or removes (``--replace``: also a product it
+did not write, :func:`assembly_constraints.executor.cad.write.claim_folder`).
 """
 
 from __future__ import annotations
@@ -25,17 +28,31 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from assembly_constraints.bridge.cli_types import ArgumentParser, nonempty_path, number_in
+from assembly_constraints.bridge.cli_types import ArgumentParser, int_in, nonempty_path, number_in
 from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import MESH_FOLDER
 from assembly_constraints.executor.cad.covers import Mapped
 from assembly_constraints.executor.cad.derive import Derived, derive
 from assembly_constraints.executor.cad.locating import LOCATING_REACH, MAX_REACH
-from assembly_constraints.executor.cad.parts import STEP_SUFFIXES, UNITS, CadPart, check_parts, load_meshes
+from assembly_constraints.executor.cad.parts import (
+    MAX_TRIANGLES,
+    STEP_SUFFIXES,
+    UNITS,
+    CadPart,
+    check_parts,
+    load_meshes,
+)
 from assembly_constraints.executor.cad.step import load_step
 from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.cad.write import Settings, map_product, section, write_folder
+from assembly_constraints.executor.cad.write import (
+    MANIFEST,
+    Settings,
+    claim_folder,
+    map_product,
+    section,
+    write_folder,
+)
 from assembly_constraints.executor.world.geometry import section_fit
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
@@ -134,6 +151,7 @@ def report(derived: Derived) -> list[str]:
             f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items()))
     for locator, pid in sorted(derived.dropped):
         lines.append(f"locating pair {locator}->{pid} dropped: the blocking needs {pid} before {locator}")
+    lines += derived.notes()
     lines.append("geometric precedence (A before B): " + (" ".join(
         f"{a}->{b} ({reason})" for (a, b), reason in sorted(derived.reasons.items())) or "none"))
     return lines
@@ -162,41 +180,47 @@ def mapped_report(mapped: Mapped) -> list[str]:
 
 
 
-def load_source(source: Path, units: str) -> list[CadPart]:
-    """The parts of a mesh folder or a STEP file (``units`` applies to meshes only)."""
+def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
+    """The parts of a mesh folder or a STEP file (``units`` applies to meshes only), of at
+    most ``max_triangles`` together."""
     if source.is_dir():
-        return load_meshes(source, units)
+        return load_meshes(source, units, max_triangles)
     if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
-        return load_step(source)
+        return load_step(source, max_triangles)
     raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
 
 
 @dataclass(frozen=True)
 class Imported:
     """What :func:`run_import` found: the ``derived`` geometry, the ``mapped`` covers and
-    heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is) and
-    the ``seconds`` taken."""
+    heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
+    files ``written`` and the ``seconds`` taken."""
 
     derived: Derived
     mapped: Mapped
     assumed: list[str]
     why: str | None
+    written: list[Path]
     seconds: float
 
 
-def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH) -> Imported:
-    """Read, check, derive (``reach`` [m]: the locating rule's, 0: off), map the covers and
-    heads, and write."""
+def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH,
+               max_triangles: int = MAX_TRIANGLES, replace: bool = False) -> Imported:
+    """Read (at most ``max_triangles``), check, claim ``out`` (``replace``: also a product
+    another import or a person wrote, :func:`assembly_constraints.executor.cad.write.claim_folder`),
+    derive (``reach`` [m]: the locating rule's, 0: off), map the covers and heads, and write."""
     started = time.perf_counter()
-    parts = load_source(source, units)
+    parts = load_source(source, units, max_triangles)
     check_parts(parts, units)
+    removable = claim_folder(out, [p.id for p in parts], replace)
     settings, fixed, assumed = _config(config, parts)
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
+    assumed += derived.assumptions()
     mapped = map_product(derived, settings)
-    _, why = write_folder(derived, mapped, settings, source.stem, out)
-    return Imported(derived, mapped, assumed, why, time.perf_counter() - started)
+    written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
+    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started)
 
 
 def main(argv: list[str]) -> int:
@@ -212,19 +236,27 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
+    parser.add_argument("--max-triangles", type=int_in(1), default=MAX_TRIANGLES, metavar="N",
+                        help=f"the most triangles the parts may have together (default {MAX_TRIANGLES}: about 1.9 kB "
+                             "of memory each)")
+    parser.add_argument("--replace", action="store_true",
+                        help=f"replace the product in DIR even where import did not write it (DIR/{MANIFEST} lists "
+                             "the files import wrote; without --replace any other file it would write is refused)")
     args = parser.parse_args(argv)
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
-    done = run_import(args.source, args.out, args.units, args.config, args.locating_reach)
+    done = run_import(args.source, args.out, args.units, args.config, args.locating_reach, args.max_triangles,
+                      args.replace)
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(done.assumed))
     for line in report(derived) + mapped_report(done.mapped):
         print(line)
-    meshes = sorted(p.name.removesuffix(".obj") for p in (args.out / MESH_FOLDER).glob("*.obj")
-                    if not p.name.endswith(".convex.obj"))
-    print(f"wrote {args.out}: assembly.toml, sizes.lp, geometric_precedence.lp"
+    meshes = sorted(p.name.removesuffix(".obj") for p in done.written
+                    if p.parent.name == MESH_FOLDER and not p.name.endswith(".convex.obj"))
+    print(f"wrote {args.out}: assembly.toml, sizes.lp, nominal_sizes.lp, geometric_precedence.lp"
           + (", geometry.toml" if why is None else f" (no geometry.toml: {why})")
-          + (f"; simulated from their own meshes ({MESH_FOLDER}/): {', '.join(meshes)}" if meshes else ""))
+          + (f"; simulated from their own meshes ({MESH_FOLDER}/): {', '.join(meshes)}" if meshes else "")
+          + f"; the files it wrote listed in {MANIFEST}")
     print(f"{len(derived.parts)} parts, {derived.queries} collision queries, {done.seconds:.2f} s")
     return 0

@@ -1,17 +1,23 @@
 """What the geometry of an assembled product decides: insertion axes, holes with their
 cross-sections, and the geometric precedence by disassembly.
 
-Disassembly: the base stays (it is the fixture); every other part is swept out along
-each of :data:`assembly_constraints.executor.cad.sweep.DIRECTIONS` by the product's size, everything else
-fixed, which gives its blockers per direction (blocking is pairwise, so these are the
-blockers at every stage). Stage by stage, every part that some direction frees from the
-parts still in place leaves along the first such direction: its **insertion axis** is the
-reverse. A part that no stage frees never comes out (an error naming it). **Geometric
-precedence**: A must precede B when B blocks A's path out along A's axis, and the base
-precedes every part touching it. Parts fixed to another (a head screwed into its lever)
-move with it: neither blocks the other. The **locating rule**
-(:mod:`assembly_constraints.executor.cad.locating`, a stated assumption, off with reach 0)
-adds Y before X when Y alone keeps X from moving sideways.
+Disassembly: the base stays (it is the fixture); every moving body (a part with the parts
+``fixed_to`` it, moved as one) is swept out along each direction tried by the product's
+size, everything else fixed, which gives its blockers per direction (blocking is
+pairwise, so these are the blockers at every stage). The directions tried are
+:data:`assembly_constraints.executor.cad.sweep.DIRECTIONS` and both senses of the axis of
+every zero-clearance fit (:func:`assembly_constraints.executor.cad.sweep.zero_clearance_fits`).
+Stage by stage, every part that some direction frees from the parts still in place leaves
+along the first such direction: its **insertion axis** is the reverse. A part that no
+stage frees never comes out (an error naming it and, per direction, its blockers).
+
+**Geometric precedence** (:func:`forced`): A must precede B (``blocks``) when A cannot go
+in once B is there: of the directions the base leaves A free along, B blocks one, and B
+or parts present whenever B is (its body, the base, parts already found to precede B)
+block every one. The base precedes every part touching it (``base``). Two stated rules
+of placing (:mod:`assembly_constraints.executor.cad.locating`) add ``supports`` (a part
+resting on parts other than the base goes after them) and ``locates`` (off with reach 0);
+a pair of theirs that the blocking contradicts is dropped and reported.
 
 **Holes** are the inner loops of the base's slices perpendicular to the axes, at the middle
 of each part's depth in the base (or, with no part reaching into it, at the base's middle
@@ -30,10 +36,23 @@ import numpy as np
 import trimesh
 
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.locating import LOCATING_REACH, locating_pairs, locators
+from assembly_constraints.executor.cad.locating import (
+    LOCATING_REACH,
+    consistent,
+    locating_candidates,
+    locators,
+    support_pairs,
+)
 from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart
 from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
-from assembly_constraints.executor.cad.sweep import DIRECTIONS, Sweeper
+from assembly_constraints.executor.cad.sweep import (
+    DIRECTIONS,
+    Slide,
+    Sweeper,
+    axis_name,
+    cylinder_faces,
+    zero_clearance_fits,
+)
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
@@ -68,15 +87,23 @@ class Derived:
     """Everything :func:`derive` finds; ``free`` the directions each part leaves the whole
     product along, ``axis`` its insertion axis (the name of the removal direction),
     ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs and
-    ``reasons`` why each holds (``blocks``: B blocks A's way out; ``base``: the base
-    precedes the parts touching it; ``locates``: the locating rule,
-    :mod:`assembly_constraints.executor.cad.locating`), ``located`` each moving body's
-    locators per direction across its axis, ``dropped`` the locating pairs the blocking
-    contradicts, ``reach`` the locating reach [m] (0: the rule is off)."""
+    ``reasons`` why each holds (``blocks``: :func:`forced`, its blockers per direction in
+    ``detail``; ``base``: the base precedes the parts touching it; ``supports`` and
+    ``locates``: the rules of :mod:`assembly_constraints.executor.cad.locating`),
+    ``located`` each moving body's locators per direction across its axis, ``dropped``
+    the locating pairs and ``dropped_supports`` the supporting pairs the blocking
+    contradicts, ``reach`` the locating reach [m] (0: the rule is off), ``bodies`` the
+    moving bodies (:func:`bodies`), ``directions`` those tried (name -> unit vector),
+    ``slides`` the zero-clearance fits."""
 
     base: str
     parts: dict[str, CadPart]
     blockers: dict[tuple[str, str], set[str]] = field(default_factory=dict)
+    directions: dict[str, tuple[float, float, float]] = field(default_factory=lambda: dict(DIRECTIONS))
+    bodies: dict[str, set[str]] = field(default_factory=dict)
+    slides: list[Slide] = field(default_factory=list)
+    detail: dict[tuple[str, str], str] = field(default_factory=dict)
+    dropped_supports: set[tuple[str, str]] = field(default_factory=set)
     axis: dict[str, str] = field(default_factory=dict)
     stages: list[list[str]] = field(default_factory=list)
     edges: set[tuple[str, str]] = field(default_factory=set)
@@ -90,7 +117,28 @@ class Derived:
     queries: int = 0
 
     def free(self, part: str) -> list[str]:
-        return [d for d in DIRECTIONS if not self.blockers[(part, d)]]
+        """The directions ``part`` leaves the whole product along."""
+        return [d for d in self.directions if not self.blockers[(part, d)]]
+
+    def assumptions(self) -> list[str]:
+        """The stated assumptions of the disassembly, as ``import`` prints them."""
+        largest = max((s.tolerance for s in self.slides), default=0.0)
+        return ["the support rule: a part resting on parts other than the base goes after them",
+                "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
+                f"plus 10 µm slide along their axis ({len(self.slides)} found"
+                + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
+
+    def notes(self) -> list[str]:
+        """What the report says beyond the axes and holes: the zero-clearance fits, each
+        blocking pair's blockers, the supporting pairs dropped."""
+        lines = [f"zero-clearance fit {s.shaft} in {s.bore}: d {2000 * s.face.radius:.3f} mm along "
+                 f"{axis_name(s.direction)[1:]}, overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding"
+                 for s in self.slides]
+        lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
+                  for (a, b), detail in sorted(self.detail.items())]
+        lines += [f"supporting pair {y}->{x} dropped: the blocking needs {x} before {y}"
+                  for y, x in sorted(self.dropped_supports)]
+        return lines
 
     @property
     def hole_of(self) -> dict[str, HoleFit]:
@@ -101,48 +149,114 @@ class Derived:
 def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH) -> Derived:
     """Axes, stages, precedence and holes of ``parts`` with ``base`` the fixture;
     ``fixed_to`` maps a part to the part it moves with; ``reach`` [m]: the locating rule's
-    (0: off). ExecutorError naming the parts that never come out."""
+    (0: off). ExecutorError naming the parts that never come out with their blockers."""
     by_id = {p.id: p for p in parts}
     result = Derived(base, by_id, reach=reach)
-    sweeper = Sweeper({p.id: p.mesh for p in parts})
+    faces = {p.id: cylinder_faces(p.mesh) for p in parts}
+    result.slides = zero_clearance_fits(faces)
+    for slide in result.slides:
+        result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
+        result.directions.setdefault(axis_name(-slide.direction), tuple(-slide.direction))
+    sweeper = Sweeper({p.id: p.mesh for p in parts}, result.slides)
     lower = np.min([p.mesh.bounds[0] for p in parts], axis=0)
     upper = np.max([p.mesh.bounds[1] for p in parts], axis=0)
     length = 2 * float(np.linalg.norm(upper - lower))
-    group = {pid: {pid} | {c for c, host in fixed_to.items() if host == pid} for pid in by_id}
-    for pid in by_id:
-        if pid == base:
-            continue
-        for name, vector in DIRECTIONS.items():
-            hit = sweeper.blockers(pid, np.array(vector), length)
-            result.blockers[(pid, name)] = hit - group[pid] - {fixed_to.get(pid, "")}
+    result.bodies = bodies(by_id, base, fixed_to)
+    for members in result.bodies.values():
+        for name, vector in result.directions.items():
+            hit = sweeper.blockers(members, np.array(vector), length)
+            result.blockers |= {(pid, name): hit for pid in members}
     remaining = set(by_id) - {base}
     while remaining:
         stage = sorted(pid for pid in remaining if any(
-            not (result.blockers[(pid, d)] & (remaining | {base})) for d in DIRECTIONS))
+            not (result.blockers[(pid, d)] & (remaining | {base})) for d in result.directions))
         if not stage:
-            stuck = ", ".join(sorted(remaining))
-            raise ExecutorError(f"part(s) {stuck} never come out of the assembled product: each is blocked along "
-                                f"{', '.join(DIRECTIONS)} (expected a straight way out for every part but the base)")
+            stuck = "; ".join(f"{pid} along " + ", ".join(
+                f"{d} by {' '.join(sorted(result.blockers[(pid, d)] & (remaining | {base})))}"
+                for d in result.directions) for pid in sorted(remaining))
+            raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
+                                f"blocked: {stuck} (expected a straight way out for every part but the base)")
         for pid in stage:
-            result.axis[pid] = next(d for d in DIRECTIONS
+            result.axis[pid] = next(d for d in result.directions
                                     if not (result.blockers[(pid, d)] & (remaining | {base})))
         result.stages.append(stage)
         remaining -= set(stage)
-    for pid, direction in result.axis.items():
-        result.reasons |= {(pid, other): "blocks" for other in result.blockers[(pid, direction)] if other != base}
+    result.reasons = forced(result)
     result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
+    placing = {pair: "supports" for pair in support_pairs(sweeper, result.bodies, base)}
     if reach > 0:
-        result.located = {pid: locators(sweeper, group[pid], result.axis[pid], reach)
-                          for pid in result.axis if pid not in fixed_to}
-        kept, result.dropped = locating_pairs(result.located, base, set(result.reasons))
-        result.reasons |= {pair: "locates" for pair in kept if pair not in result.reasons}
+        result.located = {root: locators(sweeper, members, result.directions[result.axis[root]], reach)
+                          for root, members in result.bodies.items()}
+        placing |= {pair: "locates" for pair in locating_candidates(result.located, base) if pair not in placing}
+    kept, dropped = consistent(sorted(placing), set(result.reasons))
+    result.reasons |= {pair: placing[pair] for pair in kept if pair not in result.reasons}
+    result.dropped = {pair for pair in dropped if placing[pair] == "locates"}
+    result.dropped_supports = {pair for pair in dropped if placing[pair] == "supports"}
     result.edges = set(result.reasons)
-    found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis)], result.axis)
+    found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis) if result.axis[pid] in DIRECTIONS],
+                   result.axis)
     result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.queries = sweeper.queries
     return result
+
+
+def bodies(parts: dict[str, CadPart], base: str, fixed_to: dict[str, str]) -> dict[str, set[str]]:
+    """The moving bodies: each part not fixed to another (not the base) -> it and the
+    parts fixed to it, directly or through others."""
+    def root(pid: str) -> str:
+        seen = {pid}
+        while pid in fixed_to and fixed_to[pid] not in seen:
+            pid = fixed_to[pid]
+            seen.add(pid)
+        return pid
+    found: dict[str, set[str]] = {}
+    for pid in parts:
+        if pid != base:
+            found.setdefault(root(pid), set()).add(pid)
+    return found
+
+
+def forced(derived: Derived) -> dict[tuple[str, str], str]:
+    """The ``blocks`` pairs: A before B when, of the directions the base leaves A free
+    along, B blocks one and B or the parts present whenever B is (its body, the base, the
+    bodies already found to precede it) block every one; repeated until no pair is added.
+    Each pair's blockers per direction in ``derived.detail``."""
+    rep = {root: min(members) for root, members in derived.bodies.items()}
+    before: dict[str, set[str]] = {root: set() for root in derived.bodies}
+    pairs: dict[tuple[str, str], str] = {}
+
+    def ahead(root: str) -> set[str]:
+        seen: set[str] = set()
+        todo = [root]
+        while todo:
+            for prior in before[todo.pop()] - seen:
+                seen.add(prior)
+                todo.append(prior)
+        return seen
+
+    grown = True
+    while grown:
+        grown = False
+        for a, a_members in derived.bodies.items():
+            ways = [d for d in derived.directions if derived.base not in derived.blockers[(rep[a], d)]]
+            for b, b_members in derived.bodies.items():
+                prior = ahead(b)
+                if b == a or a in prior or not ways:
+                    continue
+                present = b_members.union(*(derived.bodies[p] for p in prior))
+                blocking = {d: derived.blockers[(rep[a], d)] & present for d in ways}
+                if not all(blocking.values()) or not any(found & b_members for found in blocking.values()):
+                    continue
+                before[b].add(a)
+                grown = True
+                detail = "; ".join(f"{d} {' '.join(sorted(found))}" for d, found in blocking.items())
+                for x in sorted(a_members):
+                    for y in sorted(b_members & set().union(*blocking.values())):
+                        pairs[(x, y)] = "blocks"
+                        derived.detail[(x, y)] = detail
+    return pairs
 
 
 def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> float | None:

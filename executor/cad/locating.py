@@ -1,4 +1,11 @@
-"""The locating rule: a stated assumption of ``import`` beside the exact blocking.
+"""The rules of placing: stated assumptions of ``import`` beside the exact blocking.
+
+**Support.** A part resting on other parts is placed onto them: when a moving body moved
+:data:`SUPPORT_GAP` down (-z) meets parts and the base is not among them, every part it
+meets must precede it (reason ``supports``), unless that part rests on it in turn (a ring
+on a horizontal shaft at zero clearance: which holds which the geometry does not say).
+Blocking cannot decide this (a lid lifted off its spacer has a free way in whatever the
+order); it is gravity's order, and like the locating rule it only removes sequences.
 
 **Model.** In the assembled product, a part X is *located* along a direction across its
 insertion axis by the parts it meets when moved :data:`LOCATING_REACH` that way (swept,
@@ -25,6 +32,8 @@ import numpy as np
 
 from assembly_constraints.executor.cad.sweep import DIRECTIONS, Sweeper
 
+SUPPORT_GAP = 1e-4
+"""A part this close above another [m] (0.1 mm) rests on it."""
 LOCATING_REACH = 3e-3
 """How far a part is moved sideways to find what locates it [m]: more than the play of
 the openings a cell places a part over (Cranfield's widest, the front plate over its
@@ -33,37 +42,47 @@ MAX_REACH = 0.1
 """The largest reach ``import --locating-reach`` takes [m]."""
 
 
-def lateral(axis: str) -> list[str]:
-    """The directions of :data:`DIRECTIONS` across the removal direction ``axis``."""
-    return [name for name in DIRECTIONS if name[1] != axis[1]]
+def lateral(axis: tuple[float, float, float]) -> list[str]:
+    """The directions of :data:`DIRECTIONS` across the removal direction ``axis`` (a unit
+    vector): all but those along it."""
+    return [name for name, vector in DIRECTIONS.items() if abs(float(np.dot(vector, axis))) < 1 - 1e-9]
 
 
-def locators(sweeper: Sweeper, group: set[str], axis: str, reach: float) -> dict[str, set[str]]:
+def locators(sweeper: Sweeper, group: set[str], axis: tuple[float, float, float], reach: float
+             ) -> dict[str, set[str]]:
     """Direction -> the other parts that stop the body ``group`` (its members moved
     together) within ``reach`` [m] along each direction across the removal direction ``axis``."""
-    found: dict[str, set[str]] = {}
-    for name in lateral(axis):
-        hit: set[str] = set()
-        for member in sorted(group):
-            hit |= sweeper.blockers(member, np.array(DIRECTIONS[name]), reach)
-        found[name] = hit - group
-    return found
+    return {name: sweeper.blockers(group, np.array(DIRECTIONS[name]), reach) for name in lateral(axis)}
 
 
-def locating_pairs(located: dict[str, dict[str, set[str]]], base: str, edges: set[tuple[str, str]]
-                   ) -> tuple[set[tuple[str, str]], set[tuple[str, str]]]:
-    """(kept, dropped) locating pairs (Y, X) of ``located`` (part -> direction -> its
-    locators): Y is the one locator of X along some direction and not the base; a pair is
-    dropped when X precedes Y through ``edges`` (the blocking precedence)."""
-    candidates = sorted({(next(iter(parts)), part) for part, by_direction in located.items()
-                         for parts in by_direction.values() if len(parts) == 1 and base not in parts})
+def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> set[tuple[str, str]]:
+    """The supporting pairs (Y, X): X a member of a body resting on Y (module docstring)."""
+    pairs: set[tuple[str, str]] = set()
+    for members in bodies.values():
+        under = sweeper.blockers(members, np.array(DIRECTIONS["-z"]), SUPPORT_GAP)
+        if base not in under:
+            pairs |= {(y, x) for y in under for x in members}
+    return {(y, x) for y, x in pairs if (x, y) not in pairs}
+
+
+def locating_candidates(located: dict[str, dict[str, set[str]]], base: str) -> set[tuple[str, str]]:
+    """The locating pairs (Y, X) of ``located`` (body -> direction -> its locators): Y is
+    the one locator of X along some direction and not the base."""
+    return {(next(iter(parts)), part) for part, by_direction in located.items()
+            for parts in by_direction.values() if len(parts) == 1 and base not in parts}
+
+
+def consistent(candidates: list[tuple[str, str]], edges: set[tuple[str, str]]
+               ) -> tuple[set[tuple[str, str]], set[tuple[str, str]]]:
+    """(kept, dropped) ``candidates`` in order: a pair (Y, X) is dropped when X precedes Y
+    through ``edges`` (the blocking precedence) and the pairs kept before it."""
     graph = nx.DiGraph(edges)
     kept: set[tuple[str, str]] = set()
     dropped: set[tuple[str, str]] = set()
-    for locator, part in candidates:  # one by one: kept pairs never close a cycle among themselves either
-        if part in graph and locator in graph and nx.has_path(graph, part, locator):
-            dropped.add((locator, part))
+    for first, then in candidates:  # one by one: kept pairs never close a cycle among themselves either
+        if then in graph and first in graph and nx.has_path(graph, then, first):
+            dropped.add((first, then))
         else:
-            graph.add_edge(locator, part)
-            kept.add((locator, part))
+            graph.add_edge(first, then)
+            kept.add((first, then))
     return kept, dropped

@@ -6,18 +6,27 @@ assembly tree, the id from its name, the placement of the tree applied, units as
 states them: the reader converts to mm). Every part becomes a :class:`trimesh.Trimesh` in
 metres in the CAD frame, which is taken as the cell frame.
 
+A mesh file is read within a size bound (:data:`MAX_TRIANGLES` for the product, its
+triangles counted before the mesh is built), its coordinates must be finite (the line or
+triangle of the first that is not is named) and its vertices are merged by position (an
+OBJ that repeats a vertex once per normal or texture coordinate is one surface).
+
 Checks (:func:`check_parts`), each an :class:`assembly_constraints.executor.ExecutorError` naming the part:
-a mesh that is not closed (its boundary edges), parts whose sizes differ by a factor the
+a mesh that is not closed (its boundary edges counted, one located), a closed mesh whose
+triangles are wound inconsistently (made consistent when the part is one shell, refused
+otherwise: which shells are cavities is not known), parts whose sizes differ by a factor the
 units explain (one part in mm among parts in m), a product too small or too large for its
 stated units, and parts that overlap (intersection volume above :data:`OVERLAP_VOLUME`).
 """
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 import trimesh
@@ -40,6 +49,14 @@ UNIT_RATIO = 300.0
 mismatch (mm vs m is 1000)."""
 STEP_DEFLECTION = 1e-6
 """Tessellation of STEP faces: largest distance of a triangle from its surface [m]."""
+MAX_TRIANGLES = 1_000_000
+"""The most triangles of a product's parts together (``import --max-triangles`` sets
+another bound): the import's peak memory grows by about 1.9 kB per triangle (a plate and
+a peg of 290k triangles: 0.53 GB, of 416k: 0.76 GB), so 1 million stay near 1.9 GB."""
+_STL_HEADER = 84
+"""A binary STL's bytes before its triangles (an 80-byte header, then the count, uint32)."""
+_STL_TRIANGLE = 50
+"""A binary STL's bytes per triangle."""
 
 
 @dataclass(frozen=True)
@@ -77,22 +94,96 @@ def part_id(name: str, source: str) -> str:
     return candidate
 
 
-def load_meshes(folder: Path, units: str) -> list[CadPart]:
-    """Every ``*.stl``/``*.obj`` of ``folder`` as a part, scaled by ``units`` to metres."""
+def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
+    """Every ``*.stl``/``*.obj`` of ``folder`` as a part, scaled by ``units`` to metres,
+    its vertices merged by position; ExecutorError naming the file when the files hold
+    more than ``max_triangles`` together or a coordinate is not finite."""
     files = sorted(p for p in folder.iterdir() if p.suffix.lower() in MESH_SUFFIXES)
     if not files:
         raise ExecutorError(f"{folder}: no mesh files (expected *.stl or *.obj, one per part)")
     parts: list[CadPart] = []
+    total = 0
     for path in files:
+        total = count_triangles(str(path), triangles_in(path), total, max_triangles)
         try:
-            mesh = trimesh.load(path, force="mesh")
+            mesh = trimesh.load(path, force="mesh", process=False)  # processing drops non-finite vertices
         except (ValueError, OSError, IndexError) as exc:
             raise ExecutorError(f"{path}: not a readable mesh ({exc})") from None
         if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
             raise ExecutorError(f"{path}: no triangles (expected one closed mesh per part)")
+        if not np.all(np.isfinite(mesh.vertices)):
+            raise ExecutorError(f"{_non_finite(path, mesh)}: a coordinate that is not a finite number (expected "
+                                "finite coordinates)")
+        mesh.merge_vertices(merge_tex=True, merge_norm=True)
         mesh.apply_scale(UNITS[units])
         parts.append(CadPart(part_id(path.stem, str(path)), path.stem, mesh, str(path)))
     return parts
+
+
+def count_triangles(source: str, count: int, total: int, bound: int) -> int:
+    """``total`` plus the ``count`` triangles of ``source``; ExecutorError naming it when
+    that exceeds ``bound``."""
+    if total + count > bound:
+        before = f" (with the {total} before it, {total + count})" if total else ""
+        raise ExecutorError(f"{source}: {count} triangles{before}, beyond the bound of {bound} for a product "
+                            "(the import needs about 1.9 kB of memory per triangle; --max-triangles N raises it)")
+    return total + count
+
+
+def triangles_in(path: Path) -> int:
+    """The triangles of a mesh file, counted without building the mesh: a binary STL's
+    count (its header's, when the file's size matches it), an ASCII STL's ``endfacet``
+    records, an OBJ's faces (a face of n corners is n - 2 triangles)."""
+    binary = _binary_stl(path)
+    if binary is not None:
+        return binary
+    with path.open("rb") as file:
+        if path.suffix.lower() == ".stl":
+            return _occurrences(file, b"endfacet")
+        return sum(max(len(line.split()) - 3, 0) for line in file if line[:2] in (b"f ", b"f\t"))
+
+
+def _binary_stl(path: Path) -> int | None:
+    """The triangles a binary STL's header states, None when ``path`` is no STL or its
+    size does not match that count (an ASCII STL, whose first line may look alike)."""
+    if path.suffix.lower() != ".stl":
+        return None
+    with path.open("rb") as file:
+        head = file.read(_STL_HEADER)
+    count = int.from_bytes(head[80:], "little")
+    return count if len(head) == _STL_HEADER and path.stat().st_size == _STL_HEADER + _STL_TRIANGLE * count else None
+
+
+def _occurrences(file: BinaryIO, word: bytes) -> int:
+    """How often ``word`` occurs in the rest of ``file`` (read in blocks)."""
+    count, carry = 0, b""
+    while block := file.read(1 << 20):
+        text = carry + block
+        count += text.count(word)
+        carry = text[-(len(word) - 1):]  # too short to hold a whole word: none is counted twice
+    return count
+
+
+def _non_finite(path: Path, mesh: trimesh.Trimesh) -> str:
+    """Where ``path`` first states a coordinate that is not finite: ``file:line`` of a
+    text file's vertex, else the binary STL's triangle (``mesh`` read unprocessed)."""
+    keyword = b"v" if path.suffix.lower() == ".obj" else b"vertex"
+    if _binary_stl(path) is None:
+        with path.open("rb") as file:
+            for number, line in enumerate(file, 1):
+                words = line.split()
+                if words[:1] == [keyword] and not all(math.isfinite(_number(w)) for w in words[1:4]):
+                    return f"{path}:{number}"
+    triangle = int(np.argmax(~np.all(np.isfinite(mesh.vertices[mesh.faces]), axis=(1, 2))))
+    return f"{path}: triangle {triangle + 1}"
+
+
+def _number(word: bytes) -> float:
+    """``word`` as a float, 0 when it is none (the mesh reader accepted the file)."""
+    try:
+        return float(word)
+    except ValueError:
+        return 0.0
 
 
 def check_parts(parts: list[CadPart], units: str) -> None:
@@ -102,13 +193,7 @@ def check_parts(parts: list[CadPart], units: str) -> None:
         if part.id in seen:
             raise ExecutorError(f"{part.source}: part id '{part.id}' also given by {seen[part.id]}")
         seen[part.id] = part.source
-        if not part.mesh.is_watertight:
-            _, uses = np.unique(part.mesh.edges_sorted, axis=0, return_counts=True)
-            raise ExecutorError(f"{part.source}: part '{part.id}' is an open mesh ({int(np.sum(uses == 1))} boundary "
-                                f"edges, {int(np.sum(uses > 2))} edges of more than two faces; expected a closed "
-                                "manifold solid)")
-        if part.mesh.volume <= 0:
-            part.mesh.invert()
+        _make_solid(part, units)
     extents = {p.id: float(np.max(p.mesh.extents)) for p in parts}
     median = float(np.median(list(extents.values())))
     for part in parts:
@@ -124,6 +209,33 @@ def check_parts(parts: list[CadPart], units: str) -> None:
         raise ExecutorError(f"the product is {size:.4g} m across with --units {units}: a unit mismatch "
                             f"(expected {PRODUCT_EXTENT[0]} to {PRODUCT_EXTENT[1]} m; try the other --units)")
     _check_overlaps(parts)
+
+
+def _make_solid(part: CadPart, units: str) -> None:
+    """Check that ``part``'s mesh is closed (ExecutorError locating a crack in ``units``),
+    wind its triangles consistently (ExecutorError naming it when it has several shells)
+    and outwards."""
+    mesh = part.mesh
+    if not mesh.is_watertight:
+        edges, uses = np.unique(mesh.edges_sorted, axis=0, return_counts=True)
+        start, end = mesh.vertices[edges[np.argmax(uses != 2)]] / UNITS[units]
+        raise ExecutorError(f"{part.source}: part '{part.id}' is an open mesh ({int(np.sum(uses == 1))} boundary "
+                            f"edges, {int(np.sum(uses > 2))} edges of more than two faces; one from "
+                            f"({', '.join(f'{v:.6g}' for v in start)}) to ({', '.join(f'{v:.6g}' for v in end)}) "
+                            f"{units}; expected a closed manifold solid)")
+    if not mesh.is_winding_consistent and mesh.body_count == 1:
+        trimesh.repair.fix_winding(mesh)
+    if not mesh.is_winding_consistent:
+        why = ("which shells are cavities is not known" if mesh.body_count > 1 else
+               "no winding makes it so: a surface with one side")
+        raise ExecutorError(f"{part.source}: part '{part.id}' is a closed mesh of {mesh.body_count} "
+                            f"shell{'s' if mesh.body_count > 1 else ''} whose "
+                            "triangles are wound inconsistently (expected each edge run in opposite directions by its "
+                            f"two triangles; {why})")
+    if mesh.volume < 0:
+        mesh.invert()
+    if not mesh.is_volume:
+        raise ExecutorError(f"{part.source}: part '{part.id}' encloses no volume (expected a solid)")
 
 
 def _check_overlaps(parts: list[CadPart]) -> None:

@@ -7,19 +7,36 @@ tessellate it again more coarsely (``CadPart.remesh``: the simulated cell's base
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
 converts to metres. A leaf without a name is named after its parent and position.
+
+A file whose reading Open CASCADE reports a failure for (a syntax error, a reference to a
+missing record, a record with the wrong parameters: its reader goes on without the
+record, which can rename a part or drop its placement) is refused, naming the record
+and its line. The parts' tessellations count against the product's bound of triangles
+(:data:`assembly_constraints.executor.cad.parts.MAX_TRIANGLES`) before they are copied.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import re
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import trimesh
 
+from assembly_constraints.bridge.inputs import shorten
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart, Cylinder, part_id
+from assembly_constraints.executor.cad.parts import (
+    MAX_TRIANGLES,
+    STEP_DEFLECTION,
+    CadPart,
+    Cylinder,
+    count_triangles,
+    part_id,
+)
 
 _MM = 1e-3
 FINE_ANGLE = 0.1
@@ -29,9 +46,10 @@ COARSE_ANGLE = 0.5
 that the linear deflection decides how many sides a round hole gets."""
 
 
-def load_step(path: Path) -> list[CadPart]:
+def load_step(path: Path, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
     """The leaves of the STEP assembly at ``path`` as parts; ExecutorError naming the file
-    when it is not a readable STEP file or holds no solid."""
+    when it is not a readable STEP file, a record of it failed (:func:`_failure`), it
+    holds no solid or its parts' tessellations hold more than ``max_triangles`` together."""
     from OCP.collections import Sequence_TDF_Label
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPCAFControl import STEPCAFControl_Reader
@@ -42,8 +60,15 @@ def load_step(path: Path) -> list[CadPart]:
     document = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
     reader = STEPCAFControl_Reader()
     reader.SetNameMode(True)
-    if reader.ReadFile(str(path)) != IFSelect_RetDone or not reader.Transfer(document):
-        raise ExecutorError(f"{path}: not a readable STEP file")
+    with _quiet():
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise ExecutorError(f"{path}: not a readable STEP file")
+        failure = _failure(path, reader.Reader())
+        if failure is not None:
+            raise ExecutorError(f"{failure} (expected a valid STEP file: read past it, a part can lose its name or "
+                                "placement)")
+        if not reader.Transfer(document):
+            raise ExecutorError(f"{path}: not a readable STEP file")
     tool = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
     roots = Sequence_TDF_Label()
     tool.GetFreeShapes(roots)
@@ -52,9 +77,72 @@ def load_step(path: Path) -> list[CadPart]:
         _collect(tool, roots.Value(k), None, _name(roots.Value(k)) or path.stem, leaves)
     if not leaves:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
-    return [CadPart(part_id(name, f"{path}#{name}"), name, _mesh(shape, f"{path}#{name}"), f"{path}#{name}",
-                    _cylinders(shape), functools.partial(_mesh, shape, f"{path}#{name}", angle=COARSE_ANGLE))
-            for name, shape in leaves]
+    parts: list[CadPart] = []
+    total = 0
+    for name, shape in leaves:
+        source = f"{path}#{name}"
+        _tessellate(shape)
+        total = count_triangles(source, _triangles(shape), total, max_triangles)
+        parts.append(CadPart(part_id(name, source), name, _tessellation(shape, source), source, _cylinders(shape),
+                             functools.partial(_mesh, shape, source, angle=COARSE_ANGLE)))
+    return parts
+
+
+@contextlib.contextmanager
+def _quiet() -> Iterator[None]:
+    """Open CASCADE's messages below failures kept off the standard output (the reader
+    prints its syntax errors there; :func:`_failure` reports them)."""
+    from OCP.Message import Message, Message_Gravity
+
+    printers = Message.DefaultMessenger_s().Printers()
+    kept = [printers.Value(k) for k in range(1, printers.Size() + 1)]
+    levels = [printer.GetTraceLevel() for printer in kept]
+    for printer in kept:
+        printer.SetTraceLevel(Message_Gravity.Message_Fail)
+    try:
+        yield
+    finally:
+        for printer, level in zip(kept, levels, strict=True):
+            printer.SetTraceLevel(level)
+
+
+def _failure(path: Path, reader: Any) -> str | None:
+    """The first failure the reader's check of the file reports, as ``file:line: record
+    #N KEYWORD: message`` (``file:line: message`` for one of the whole file, a syntax
+    error or an unresolved reference), None when there is none (warnings pass)."""
+    model = reader.StepModel()
+    checks = reader.WS().ModelCheckList()
+    checks.Start()
+    while checks.More():
+        check, number = checks.Value(), checks.Number()
+        checks.Next()
+        if check.NbFails() == 0:
+            continue
+        message = shorten(check.CFail(1), 160)
+        more = f" (and {check.NbFails() - 1} more failures)" if check.NbFails() > 1 else ""
+        if number == 0:  # the file's: "Undefined Parsing: Line 12: ...", "Unresolved Reference, Ent.Id.#5 ..."
+            line = re.match(r"Undefined Parsing: Line (\d+): (.*)", message)
+            return f"{path}:{line.group(1)}: {line.group(2)}{more}" if line else f"{path}: {message}{more}"
+        return f"{_record(path, model, number)}: {message}{more}"
+    return None
+
+
+def _record(path: Path, model: Any, number: int) -> str:
+    """``file:line: record #N KEYWORD`` of the model's entity ``number``: the record at
+    that position among those starting a line of the file (the model numbers them in
+    the file's order), checked with the reader's own map of labels (``file: entity N``
+    when they disagree, e.g. records sharing a line)."""
+    starts = []
+    with path.open("rb") as file:
+        for line, text in enumerate(file, 1):
+            found = re.match(rb"\s*#(\d+)\s*=\s*\(?\s*([A-Za-z0-9_]*)", text)  # a complex record: its first type
+            if found:
+                starts.append((line, found.group(1).decode(), found.group(2).decode()))
+    if number <= len(starts):
+        line, ident, keyword = starts[number - 1]
+        if model.NextNumberForLabel(f"#{ident}", 0, True) == number:
+            return f"{path}:{line}: record #{ident} {keyword}".rstrip()
+    return f"{path}: entity {number}"
 
 
 def _name(label: Any) -> str:
@@ -89,20 +177,49 @@ def _collect(tool: object, label: Any, location: Any, name: str, leaves: list[tu
     leaves.append((name, shape.Located(here.Multiplied(shape.Location()))))
 
 
+def _tessellate(shape: Any, deflection: float = STEP_DEFLECTION, angle: float = FINE_ANGLE) -> None:
+    """Tessellate the shape's faces (:func:`_mesh`), replacing an earlier tessellation (a
+    coarser one would only refine it)."""
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.BRepTools import BRepTools
+
+    BRepTools.Clean_s(shape)
+    BRepMesh_IncrementalMesh(shape, deflection / _MM, False, angle, True)
+
+
+def _triangles(shape: Any) -> int:
+    """The triangles of the shape's tessellation."""
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS
+
+    count = 0
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        triangulation = BRep_Tool.Triangulation_s(TopoDS.Face(explorer.Current()), TopLoc_Location())
+        explorer.Next()
+        count += 0 if triangulation is None else triangulation.NbTriangles()
+    return count
+
+
 def _mesh(shape: Any, source: str, deflection: float = STEP_DEFLECTION, angle: float = FINE_ANGLE) -> trimesh.Trimesh:
     """The shape's faces tessellated into one mesh [m]: no point of a face farther than
     ``deflection`` [m] from its triangles, no two normals of one triangle's corners more
     than ``angle`` [rad] apart (the triangles' corners lie on the faces)."""
+    _tessellate(shape, deflection, angle)
+    return _tessellation(shape, source)
+
+
+def _tessellation(shape: Any, source: str) -> trimesh.Trimesh:
+    """The shape's tessellation (:func:`_tessellate`) as one mesh [m], vertices merged."""
     from OCP.BRep import BRep_Tool
-    from OCP.BRepMesh import BRepMesh_IncrementalMesh
-    from OCP.BRepTools import BRepTools
     from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopLoc import TopLoc_Location
     from OCP.TopoDS import TopoDS
 
-    BRepTools.Clean_s(shape)  # a coarser tessellation replaces an earlier one (it would only refine it)
-    BRepMesh_IncrementalMesh(shape, deflection / _MM, False, angle, True)
     vertices: list[np.ndarray] = []
     faces: list[np.ndarray] = []
     count = 0

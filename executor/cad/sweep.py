@@ -1,24 +1,46 @@
-"""Swept collision along a straight removal path, exact (no sampled poses).
+"""Swept collision along a straight removal path, exact (no sampled poses), with nominal
+zero-clearance fits sliding along their axis.
 
-A part moving by ``length`` along ``direction`` collides with a fixed part B exactly when
-some triangle of its boundary, swept along the path, meets B's interior (the sweep of a
-solid is bounded by the sweeps of its boundary triangles, and the two start apart). So
-the moving part is replaced by convex swept pieces: the convex hull of its start and end
-poses when the part is convex, else one prism per boundary triangle (the triangle and its
-translate). Each piece meets each fixed part's triangle mesh in python-fcl (GJK/EPA on
-the triangles its BVH keeps); a contact deeper than :data:`TOUCH` is a collision, so
-parts that only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
+**Exact sweep.** A body (one part, or parts fixed to each other) moving by ``length``
+along ``direction`` collides with a fixed part B exactly when some triangle of its
+boundary, swept along the path, meets B's interior (the sweep of a solid is bounded by
+the sweeps of its boundary triangles, and the two start apart). Each swept triangle is a
+convex prism (the triangle and its translate) tested against B's triangle BVH in
+python-fcl (GJK/EPA); a contact deeper than :data:`TOUCH` is a collision, so parts that
+only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
 
-:attr:`Sweeper.queries` counts the narrow-phase queries (one moving piece set against one
-fixed part whose bounding box meets the sweep's).
+**Conservative first.** Penetration depth only grows with the moving set, so a convex
+superset that meets B no deeper than :data:`TOUCH` clears every prism inside it: first the
+sweep of the part's convex hull (one query: the answer for a convex part), then down a
+tree of the part's triangles (halves of nearby ones): a node whose swept box misses B's
+box, or whose swept hull clears B, is done; the prisms are tested only in leaves of
+:data:`CHUNK` triangles that still meet B. Same answer as testing every prism.
+
+**Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
+one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
+the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth regions
+whose normals are all perpendicular to one axis and whose vertices lie on one circle);
+an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
+radius within the pair's tolerance (the larger deflection of the two faces plus
+:data:`TOUCH`), are a fit. Swept along its axis against the bore's part, the shaft's part
+is taken thinner there (its vertices within the tolerance of that radius moved towards
+the axis by the bore's deflection, the radii's and the axes' difference and
+:data:`TOUCH`): overlap below the tolerance across the axis is not a collision, every
+other face (a shoulder, an end wall) still is.
+
+:attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
+part whose bounding box meets the sweep's).
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from dataclasses import dataclass
+
 import fcl
 import numpy as np
 import trimesh
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
 TOUCH = 1e-5
 """Contacts at most this deep [m] are touching, not colliding (10 µm: below every
@@ -28,12 +50,153 @@ DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
 }
 """The removal directions tried, in order of preference (the cell inserts from above)."""
+CHUNK = 8
+"""Triangles of a leaf of the conservative test's tree (nearby ones: median splits of their centres)."""
+HULL_POINTS = 96
+"""Sets of more points are not hulled for the conservative test (fcl's cost grows with them):
+their halves are."""
+SMOOTH = np.radians(35.0)
+"""Adjacent triangles meeting at less than this angle are one smooth face (a 12-gon's is 30°)."""
+_MAX_CONTACTS = 100_000
+_FEW_CONTACTS = 8
 
 
 def opposite(direction: str) -> str:
     """The name of the direction opposite ``direction`` (a removal direction's insertion axis)."""
-    return ("-" if direction[0] == "+" else "+") + direction[1]
-_MAX_CONTACTS = 100_000
+    return ("-" if direction[0] == "+" else "+") + direction[1:]
+
+
+def axis_name(vector: np.ndarray) -> str:
+    """A direction's name: ``+x`` ... for the axes of :data:`DIRECTIONS`, else
+    ``+(x,y,z)`` with the unit vector's components (the sign of its first nonzero one)."""
+    for name, known in DIRECTIONS.items():
+        if np.dot(vector, known) > 1 - 1e-9:
+            return name
+    first = vector[np.flatnonzero(np.abs(vector) > 1e-9)[0]]
+    unit = vector if first > 0 else -vector
+    return ("+" if first > 0 else "-") + "(" + ",".join(f"{c:.4f}" for c in unit) + ")"
+
+
+@dataclass(frozen=True)
+class CylinderFace:
+    """A cylindrical face fitted on a mesh: a ``point`` on its axis and the unit axis
+    ``direction`` [m], the ``radius`` [m], the ``span`` of its vertices along the axis
+    [m] (projections on ``direction``), ``outward`` (a shaft's face; False: a bore's) and
+    the ``deflection`` [m]: the largest distance of one of its triangles from the circle."""
+
+    point: np.ndarray
+    direction: np.ndarray
+    radius: float
+    span: tuple[float, float]
+    outward: bool
+    deflection: float
+
+
+def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
+    """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
+    six triangles whose normals are perpendicular to one axis (within 1e-3) and span more
+    than a flat face's, whose vertices lie on one circle (within 1 µm plus 1e-4 of the
+    radius) and whose normals all point away from the axis or all towards it."""
+    angles = mesh.face_adjacency_angles
+    regions = trimesh.graph.connected_components(mesh.face_adjacency[angles < SMOOTH], min_len=6)
+    faces: list[CylinderFace] = []
+    for region in regions:
+        normals = mesh.face_normals[region]
+        scatter = normals.T @ normals / len(region)
+        values, vectors = np.linalg.eigh(scatter)
+        axis = vectors[:, 0]
+        if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > 1e-3:
+            continue  # flat, or no cylinder (a cone, a sphere)
+        ring = np.unique(mesh.faces[region].ravel())
+        frame = np.linalg.svd(axis[None, :])[2][1:]  # two unit vectors across the axis
+        flat = mesh.vertices[ring] @ frame.T
+        design = np.column_stack([2 * flat, np.ones(len(flat))])
+        solution = np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0]
+        centre = solution[:2]
+        radius = float(np.sqrt(solution[2] + centre @ centre))
+        if not np.all(np.abs(np.linalg.norm(flat - centre, axis=1) - radius) <= 1e-6 + 1e-4 * radius):
+            continue
+        point = centre @ frame
+        outwards = np.einsum("ij,ij->i", normals, (mesh.triangles_center[region] @ frame.T - centre) @ frame)
+        if not (np.all(outwards > 0) or np.all(outwards < 0)):
+            continue
+        reach = np.abs(np.einsum("ij,ij->i", normals, mesh.vertices[mesh.faces[region, 0]] - point))
+        along = mesh.vertices[ring] @ axis
+        faces.append(CylinderFace(point, axis, radius, (float(along.min()), float(along.max())),
+                                  bool(outwards[0] > 0), float(np.max(radius - reach))))
+    return faces
+
+
+@dataclass(frozen=True)
+class Slide:
+    """A nominal zero-clearance fit: part ``shaft``'s outward ``face`` in part ``bore``'s
+    inward face ``hole``, coaxial and of equal radius within ``tolerance`` [m]; along the
+    axis the shaft's part is swept (or met) ``thinner`` [m] there (module docstring)."""
+
+    shaft: str
+    bore: str
+    face: CylinderFace
+    hole: CylinderFace
+    tolerance: float
+    thinner: float
+
+    @property
+    def direction(self) -> np.ndarray:
+        return self.face.direction
+
+
+def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
+    """Every pair of an outward face of one part and an inward face of another, parallel
+    (within 1e-4 rad), coaxial and of equal radius within their tolerance, whose spans
+    along the axis overlap by more than it."""
+    found: list[Slide] = []
+    for shaft, outer in faces.items():
+        for bore, inner in faces.items():
+            if bore == shaft:
+                continue
+            for a in (f for f in outer if f.outward):
+                for b in (f for f in inner if not f.outward):
+                    tolerance = max(a.deflection, b.deflection) + TOUCH
+                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
+                            or abs(a.radius - b.radius) > tolerance):
+                        continue
+                    offset = b.point - a.point
+                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
+                    low, high = (b.span if a.direction @ b.direction > 0 else (-b.span[1], -b.span[0]))
+                    if apart > tolerance or min(a.span[1], high) - max(a.span[0], low) <= tolerance:
+                        continue
+                    thinner = max(0.0, a.radius - b.radius) + b.deflection + apart + TOUCH
+                    found.append(Slide(shaft, bore, a, b, tolerance, thinner))
+    return found
+
+
+def _near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius, within its
+    span), their coordinates along the axis and their radial offsets from it."""
+    relative = points - face.point
+    along = relative @ face.direction
+    radial = relative - np.outer(along, face.direction)
+    distance = np.linalg.norm(radial, axis=1)
+    near = ((np.abs(distance - face.radius) <= tolerance)
+            & (along >= face.span[0] - tolerance) & (along <= face.span[1] + tolerance))
+    return near, along, radial
+
+
+def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide]) -> trimesh.Trimesh:
+    """``mesh`` as swept along the axis of its zero-clearance fits: its vertices on each
+    of ``shafts``' faces moved ``thinner`` towards the axis, and the triangles of those
+    faces and of ``bores``' holes (the mated surfaces) left out, whose sliding on each
+    other is the fit; what meets them meets the part's other triangles first."""
+    vertices = np.array(mesh.vertices, dtype=float)
+    mated = np.zeros(len(mesh.faces), dtype=bool)
+    for slide, face in [*((s, s.face) for s in shafts), *((s, s.hole) for s in bores)]:
+        near, along, radial = _near(np.asarray(mesh.vertices), face, slide.tolerance)
+        mated |= np.all(near[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < 1e-3)
+        if face is slide.face:
+            distance = np.linalg.norm(radial[near], axis=1)
+            scale = np.maximum(distance - slide.thinner, 0.0) / distance
+            vertices[near] = face.point + np.outer(along[near], face.direction) + radial[near] * scale[:, None]
+    return trimesh.Trimesh(vertices, mesh.faces[~mated], process=False)
 
 
 def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
@@ -56,48 +219,151 @@ def _convex(vertices: np.ndarray, count: int, flat: np.ndarray) -> fcl.Collision
     return fcl.CollisionObject(fcl.Convex(np.asarray(vertices, dtype=float), count, flat), fcl.Transform())
 
 
+def _hull_piece(points: np.ndarray) -> fcl.CollisionObject | None:
+    """The convex hull of ``points`` [m] as an fcl shape (its vertices only); None when the
+    points span no volume (the caller then tests the prisms)."""
+    try:
+        hull = ConvexHull(points)
+    except QhullError:
+        return None
+    used, faces = np.unique(hull.simplices, return_inverse=True)
+    flat = np.hstack([np.full((len(hull.simplices), 1), 3), faces.reshape(-1, 3)]).astype(np.int32).ravel()
+    return _convex(points[used], len(hull.simplices), flat)
+
+
 _PRISM_FACES = np.array([3, 0, 2, 1, 3, 3, 4, 5, 4, 0, 1, 4, 3, 4, 1, 2, 5, 4, 4, 2, 0, 3, 5], dtype=np.int32)
 """A triangle (0 1 2) and its translate (3 4 5): two triangles and three quads."""
 
 
-def swept_pieces(mesh: trimesh.Trimesh, shift: np.ndarray) -> list[fcl.CollisionObject]:
-    """Convex pieces whose union's boundary contains the sweep of ``mesh`` by ``shift`` [m]."""
-    if mesh.is_convex:
-        points = np.vstack([mesh.vertices, mesh.vertices + shift])
-        hull = ConvexHull(points)
-        flat = np.hstack([np.full((len(hull.simplices), 1), 3), hull.simplices]).astype(np.int32).ravel()
-        return [_convex(points, len(hull.simplices), flat)]
-    return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in mesh.triangles]
+def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[fcl.CollisionObject]:
+    """The prisms of ``triangles`` (n, 3, 3) [m] swept by ``shift`` [m]."""
+    return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in triangles]
+
+
+@dataclass
+class _Node:
+    """Nearby triangles of a mesh (``faces``, their ``points`` [m]) and the two halves they
+    split into (none: at most :data:`CHUNK` triangles)."""
+
+    faces: np.ndarray
+    points: np.ndarray
+    children: list[_Node]
+
+
+def _tree(mesh: trimesh.Trimesh) -> _Node:
+    """The triangles of ``mesh`` split in halves (at the median of their centres along
+    their widest extent) down to :data:`CHUNK` triangles."""
+    centres = mesh.triangles_center
+
+    def node(group: np.ndarray) -> _Node:
+        points = mesh.vertices[np.unique(mesh.faces[group])]
+        if len(group) <= CHUNK:
+            return _Node(group, points, [])
+        order = group[np.argsort(centres[group, int(np.argmax(np.ptp(centres[group], axis=0)))], kind="stable")]
+        return _Node(group, points, [node(order[:len(order) // 2]), node(order[len(order) // 2:])])
+
+    return node(np.arange(len(mesh.faces)))
+
+
+def _is_convex(mesh: trimesh.Trimesh) -> bool:
+    """Whether the closed ``mesh`` is convex: no concave edge (trimesh's test, whose
+    tolerance passes the fine facets of a bore) and its hull's volume its own (within 1e-6)."""
+    return bool(mesh.is_convex) and mesh.convex_hull.volume - abs(mesh.volume) <= 1e-6 * mesh.convex_hull.volume
+
+
+def _outer_hull(points: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The vertices of the convex hull of ``points`` [m] when it has at most
+    :data:`HULL_POINTS` (tried for at most four times as many points), else of a polytope
+    around it of fewer (its supporting planes along the 26 directions of a cube's faces,
+    edges and corners and, around each axis of the frame, as many as keep a cylinder about
+    that axis within :data:`TOUCH` / 2), and whether it is the hull itself."""
+    hull = points
+    if len(points) <= 4 * HULL_POINTS:
+        hull = points[ConvexHull(points).vertices]
+        if len(hull) <= HULL_POINTS:
+            return hull, True
+    centre = hull.mean(axis=0)
+    cube = np.array([v for v in np.ndindex(3, 3, 3) if v != (1, 1, 1)], dtype=float) - 1
+    normals = [cube / np.linalg.norm(cube, axis=1)[:, None]]
+    for axis in range(3):
+        across = np.delete(hull - centre, axis, axis=1)
+        radius = float(np.max(np.linalg.norm(across, axis=1)))
+        count = min(256, int(np.ceil(np.pi / np.arccos(radius / (radius + TOUCH / 2)))))
+        turn = np.linspace(0, 2 * np.pi, count, endpoint=False)
+        ring = np.zeros((count, 3))
+        ring[:, [k for k in range(3) if k != axis]] = np.column_stack([np.cos(turn), np.sin(turn)])
+        normals.append(ring)
+    planes = np.vstack(normals)
+    offsets = np.max((hull - centre) @ planes.T, axis=0)
+    corners = HalfspaceIntersection(np.column_stack([planes, -offsets]), np.zeros(3)).intersections
+    return corners + centre, False
+
+
+class _Solid:
+    """One part's mesh for the sweeps: its BVH, hull vertices and triangle tree (made on first use)."""
+
+    def __init__(self, mesh: trimesh.Trimesh, convex: bool | None = None) -> None:
+        """``convex``: whether the part is (None: ``mesh`` is the closed part, tested)."""
+        self.mesh = mesh
+        self._bvh: fcl.CollisionObject | None = None
+        self._tree: _Node | None = None
+        self.pieces: dict[tuple[float, ...], dict[int, fcl.CollisionObject | None]] = {}
+        """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
+        self.hull, self.exact = _outer_hull(np.asarray(mesh.vertices, dtype=float))
+        """A convex superset's vertices [m] and whether it is the hull itself."""
+        self.convex = _is_convex(mesh) if convex is None else convex
+
+    @property
+    def bvh(self) -> fcl.CollisionObject:
+        if self._bvh is None:
+            self._bvh = bvh(self.mesh)
+        return self._bvh
+
+    @property
+    def tree(self) -> _Node:
+        if self._tree is None:
+            self._tree = _tree(self.mesh)
+        return self._tree
 
 
 class Sweeper:
-    """The fixed parts' collision meshes, and swept tests of one part against them."""
+    """The parts' collision meshes, and swept tests of one body against the others;
+    ``slides`` the zero-clearance fits among them."""
 
-    def __init__(self, meshes: dict[str, trimesh.Trimesh]) -> None:
+    def __init__(self, meshes: dict[str, trimesh.Trimesh], slides: Iterable[Slide] = ()) -> None:
         self.meshes = meshes
-        self._objects = {pid: bvh(mesh) for pid, mesh in meshes.items()}
+        self._solids = {pid: _Solid(mesh) for pid, mesh in meshes.items()}
+        self._slides: dict[tuple[str, str], list[Slide]] = {}
+        for slide in slides:
+            self._slides.setdefault((slide.shaft, slide.bore), []).append(slide)
+        self._slid: dict[tuple[str, str, str], _Solid] = {}
         self.queries = 0
         """Narrow-phase queries made so far."""
 
-    def blockers(self, part: str, direction: np.ndarray, length: float) -> set[str]:
-        """The other parts that ``part`` collides with when moved by ``length`` [m] along
-        the unit vector ``direction``, everything else fixed."""
-        mesh = self.meshes[part]
+    def blockers(self, body: str | Iterable[str], direction: np.ndarray, length: float) -> set[str]:
+        """The other parts that the part (or the parts, moved together) ``body`` collides
+        with when moved by ``length`` [m] along the unit vector ``direction``, everything
+        else fixed."""
+        members = {body} if isinstance(body, str) else set(body)
         shift = np.asarray(direction, dtype=float) * length
-        low = np.minimum(mesh.bounds[0], mesh.bounds[0] + shift)
-        high = np.maximum(mesh.bounds[1], mesh.bounds[1] + shift)
-        pieces: list[fcl.CollisionObject] | None = None
         hit: set[str] = set()
-        for other, other_mesh in self.meshes.items():
-            if other == part:
-                continue
-            if np.any(np.minimum(high, other_mesh.bounds[1]) - np.maximum(low, other_mesh.bounds[0]) <= TOUCH):
-                continue
-            if pieces is None:
-                pieces = swept_pieces(mesh, shift)
-            self.queries += 1
-            if self._meets(pieces, self._objects[other]):
-                hit.add(other)
+        for member in sorted(members):
+            mesh = self.meshes[member]
+            low = np.minimum(mesh.bounds[0], mesh.bounds[0] + shift)
+            high = np.maximum(mesh.bounds[1], mesh.bounds[1] + shift)
+            for other, other_mesh in self.meshes.items():
+                if other in members or other in hit:
+                    continue
+                if np.any(np.minimum(high, other_mesh.bounds[1]) - np.maximum(low, other_mesh.bounds[0]) <= TOUCH):
+                    continue
+                self.queries += 1
+                moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
+                if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
+                    moving, fixed, reverse = fixed, moving, -shift  # the same relative motion, cheaper
+                else:
+                    reverse = shift
+                if _collides(moving, fixed, reverse):
+                    hit.add(other)
         return hit
 
     def touching(self, a: str, b: str) -> bool:
@@ -105,19 +371,71 @@ class Sweeper:
         request = fcl.DistanceRequest()
         result = fcl.DistanceResult()
         self.queries += 1
-        return bool(fcl.distance(self._objects[a], self._objects[b], request, result) <= TOUCH)
+        return bool(fcl.distance(self._solids[a].bvh, self._solids[b].bvh, request, result) <= TOUCH)
 
-    @staticmethod
-    def _meets(pieces: list[fcl.CollisionObject], fixed: fcl.CollisionObject) -> bool:
-        """Whether a piece meets ``fixed`` deeper than :data:`TOUCH`: a first query without
-        contacts, the contacts' depths only for the pieces that meet at all."""
-        first = fcl.CollisionRequest()
-        deep = fcl.CollisionRequest(num_max_contacts=_MAX_CONTACTS, enable_contact=True)
-        for piece in pieces:
-            if not fcl.collide(piece, fixed, first, fcl.CollisionResult()):
+    def _solid(self, part: str, against: str, shift: np.ndarray) -> _Solid:
+        """``part``'s solid for a sweep by ``shift`` against (or of) ``against``: at their
+        zero-clearance fits along the shift, :func:`slid`."""
+        unit = shift / np.linalg.norm(shift)
+
+        def along(slides: list[Slide]) -> list[Slide]:
+            return [s for s in slides if abs(float(unit @ s.direction)) > 1 - 1e-9]
+
+        shafts, bores = along(self._slides.get((part, against), [])), along(self._slides.get((against, part), []))
+        if not shafts and not bores:
+            return self._solids[part]
+        key = (part, against, axis_name(unit)[1:])
+        if key not in self._slid:
+            self._slid[key] = _Solid(slid(self.meshes[part], shafts, bores), self._solids[part].convex)
+        return self._slid[key]
+
+
+def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
+    """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
+    (the module docstring: the hull, then down the triangle tree, the prisms of a leaf last)."""
+    pieces = moving.pieces.setdefault(tuple(shift), {})
+    if moving.convex or moving.exact:
+        if -1 not in pieces:
+            pieces[-1] = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
+        whole = pieces[-1]
+        if whole is not None and not _meets([whole], fixed.bvh):
+            return False
+        if whole is not None and moving.convex and moving.exact:
+            return True
+    low, high = fixed.mesh.bounds
+    pending = [moving.tree]
+    while pending:
+        node = pending.pop()
+        start, end = node.points.min(axis=0), node.points.max(axis=0)
+        if np.any(np.minimum(np.maximum(end, end + shift), high)
+                  - np.maximum(np.minimum(start, start + shift), low) <= TOUCH):
+            continue
+        if len(node.points) <= HULL_POINTS:
+            if id(node) not in pieces:
+                pieces[id(node)] = _hull_piece(np.vstack([node.points, node.points + shift]))
+            piece = pieces[id(node)]
+            if piece is not None and not _meets([piece], fixed.bvh):
                 continue
+        if node.children:
+            pending += node.children
+        elif _meets(swept_pieces(moving.mesh.triangles[node.faces], shift), fixed.bvh):
+            return True
+    return False
+
+
+def _meets(pieces: list[fcl.CollisionObject], fixed: fcl.CollisionObject) -> bool:
+    """Whether a piece meets ``fixed`` deeper than :data:`TOUCH`: a first query without
+    contacts, then the depths of the first :data:`_FEW_CONTACTS` contacts, of 16 times as
+    many, of all only when none of those is deeper."""
+    first = fcl.CollisionRequest()
+    for piece in pieces:
+        if not fcl.collide(piece, fixed, first, fcl.CollisionResult()):
+            continue
+        for most in (_FEW_CONTACTS, 16 * _FEW_CONTACTS, _MAX_CONTACTS):
             result = fcl.CollisionResult()
-            fcl.collide(piece, fixed, deep, result)
+            fcl.collide(piece, fixed, fcl.CollisionRequest(num_max_contacts=most, enable_contact=True), result)
             if any(contact.penetration_depth > TOUCH for contact in result.contacts):
                 return True
-        return False
+            if len(result.contacts) < most:
+                break
+    return False

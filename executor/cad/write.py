@@ -21,11 +21,19 @@
   meshes with convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`;
   a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell), a part placed by
   hand as its own mesh (static, no pieces), a base without such holes as its own mesh.
+- ``.import-manifest.json`` (:data:`MANIFEST`): the files this import wrote with their
+  SHA-256. A later import into the folder replaces or removes only those of them that
+  are still as written (:func:`claim_folder`), and refuses a folder holding any other file
+  it would write (a product it did not write, a mesh at its name) unless told to replace
+  it; nothing else in the folder is ever removed.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
+import re
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -35,8 +43,8 @@ import numpy as np
 import trimesh
 
 from assembly_constraints.bridge.errors import ToolError
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.inputs import shorten
+from assembly_constraints.bridge.files import make_folder, os_reason, write_atomic
+from assembly_constraints.bridge.inputs import read_text, shorten
 from assembly_constraints.bridge.product import Mesh
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.cad.convex import (
@@ -66,6 +74,13 @@ MAX_PLATE_DEPTH = 0.2
 """The largest ``tile_thickness`` and ``base_thickness`` of a ``[plate]`` [m]."""
 MAX_REASON = 200
 """The longest ``reason`` of a ``[manual.<id>]`` table (characters)."""
+MANIFEST = ".import-manifest.json"
+"""The files the last import into a folder wrote: ``{"written_by": "./run.sh import",
+"title": the product's name, "files": {path relative to the folder: SHA-256 of its content}}``."""
+PRODUCT_FILES = ("assembly.toml", "sizes.lp", "nominal_sizes.lp", "geometric_precedence.lp", "geometry.toml")
+"""The product's files an import writes (``geometry.toml`` only where the cell builds the product)."""
+_MESH_NAME = re.compile(rf"{MESH_FOLDER}/[a-z][a-z0-9_]*(\.convex)?\.obj")
+"""The name of a mesh file an import writes, relative to the folder (a part id is an ASP constant)."""
 CELL_DEFLECTION = 1e-5
 """The largest distance [m] of a STEP base's faces from the triangles the cell collides
 with (its own mesh is measured at :data:`assembly_constraints.executor.cad.parts.STEP_DEFLECTION`)."""
@@ -190,8 +205,9 @@ def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
 
 
 REASONS = {
-    "blocks": "B blocks A's straight way out along A's insertion axis",
+    "blocks": "A cannot go in once B is there (B, or parts always placed before B, block each way the base leaves A)",
     "base": "A is the base and B touches it",
+    "supports": "B rests on A and not on the base (the support rule, an assumption of the import)",
     "locates": "A alone keeps B from moving sideways (the locating rule, an assumption of the import)",
 }
 """Why a pair of ``geometric_precedence.lp`` holds, as its comments say."""
@@ -282,14 +298,13 @@ def _mesh_entry(mesh: Mesh) -> str:
     return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
 
 
-def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str, Mesh], list[Path]] | str:
+def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path]) -> dict[str, Mesh] | str:
     """The meshes of the parts of a mapped product that are no primitive, written into
     ``out`` (the base in the cell frame, the others in their part frames, the moving ones
-    with their convex pieces); returns their ``mesh`` entries by part and the files
-    written, or why a part has no pieces that fit
+    with their convex pieces; each file written is appended to ``written``); returns their
+    ``mesh`` entries by part, or why a part has no pieces that fit
     (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
-    written: list[Path] = []
     if not derived.holes or not base_is_primitive(derived):  # no plate of primitives without holes
         done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")
         assert not isinstance(done, str)  # the base has no pieces
@@ -311,10 +326,11 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path) -> tuple[dict[str,
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near)
         if isinstance(done, str):
+            written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done
         meshes[pid], files = done
         written += files
-    return meshes, written
+    return meshes
 
 
 def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh]) -> str:
@@ -412,11 +428,64 @@ def _tile(fits: list[HoleFit]) -> float:
     return tile if tile > widest else widest + 0.004
 
 
-def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: str, out: Path
-                 ) -> tuple[list[Path], str | None]:
-    """Write the files of the module docstring into ``out`` (removing the ``meshes/*.obj``
-    an earlier import left that this one does not use); returns them and why there is no
-    ``geometry.toml`` (None when there is one, checked by the cell's loader)."""
+def _digest(path: Path) -> str | None:
+    """The SHA-256 of the file at ``path`` (hex), None when there is none."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise ExecutorError(f"{path}: cannot read ({os_reason(exc)})") from None
+
+
+def _manifest(out: Path) -> dict[str, str]:
+    """The files the last import into ``out`` wrote and their SHA-256 (none without a
+    manifest); ExecutorError naming it when it is no import's manifest."""
+    path = out / MANIFEST
+    if not path.exists():
+        return {}
+    try:
+        files = json.loads(read_text(path, "import manifest (JSON)", error=ExecutorError)).get("files")
+    except (ValueError, AttributeError):  # not JSON, or not an object
+        files = None
+    if not isinstance(files, dict) or not all(isinstance(name, str) and (name in PRODUCT_FILES or _MESH_NAME.fullmatch(
+            name)) and isinstance(digest, str) for name, digest in files.items()):
+        raise ExecutorError(f"{path}: not an import manifest (expected JSON with \"files\": {{path: sha256}} of the "
+                            "files import writes); --replace replaces it")
+    return files
+
+
+def claim_folder(out: Path, ids: Iterable[str], replace: bool) -> set[str]:
+    """The files of the assembly folder ``out`` (paths relative to it) that an import of
+    the parts ``ids`` may remove: those its manifest lists that are still as written,
+    and with ``replace`` the product's files (:data:`PRODUCT_FILES`) whoever wrote them.
+    ExecutorError naming the folder and the files when, without ``replace``, one it may
+    write (the product's files, ``meshes/<id>.obj`` and ``meshes/<id>.convex.obj``)
+    exists and was not written by the last import, or has changed since."""
+    try:
+        owned = _manifest(out)
+    except ExecutorError:
+        if not replace:
+            raise
+        owned = {}
+    mine = {name for name, digest in owned.items() if _digest(out / name) == digest}
+    targets = [*PRODUCT_FILES, *(f"{MESH_FOLDER}/{pid}{suffix}" for pid in sorted(ids)
+                                 for suffix in (".obj", ".convex.obj"))]
+    foreign = [name for name in targets if name not in mine and (out / name).exists()]
+    if foreign and not replace:
+        what = "a product" if "assembly.toml" in foreign else "files"
+        raise ExecutorError(f"{out}: holds {what} that import did not write or that changed since "
+                            f"({shorten(', '.join(foreign), 200)}); expected a new folder or one import wrote "
+                            "(--replace replaces them)")
+    return mine | {name for name in foreign if name in PRODUCT_FILES}
+
+
+def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: str, out: Path,
+                 removable: set[str]) -> tuple[list[Path], str | None]:
+    """Write the files of the module docstring into ``out`` (removing the ``removable``
+    files, :func:`claim_folder`, that this import does not write again; the manifest last);
+    returns them and why there is no ``geometry.toml`` (None when there is one, checked by
+    the cell's loader)."""
     make_folder(out)
     roles = ({pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
              | {pid: "manual" for pid in mapped.manual})
@@ -425,16 +494,14 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
                write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
                write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
     geometry = out / "geometry.toml"
-    if geometry.exists():
-        geometry.unlink()
+    geometry.unlink(missing_ok=True)  # the claim made it this import's, if there was one
     why = mapped.why
     mesh_files: list[Path] = []
     cell = cell_view(derived)[0]
-    made = write_meshes(cell, mapped, out) if why is None else None
-    if isinstance(made, str):
-        why = made
-    elif made is not None:
-        meshes, mesh_files = made
+    meshes = write_meshes(cell, mapped, out, mesh_files) if why is None else None
+    if isinstance(meshes, str):
+        why = meshes
+    elif meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
         try:
             load_geometry(str(out))
@@ -443,7 +510,10 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
             why = f"the cell refuses its geometry ({exc})"
         else:
             written += [*mesh_files, geometry]
-    for stale in sorted((out / MESH_FOLDER).glob("*.obj")):  # meshes of an earlier import, or of a refused one
-        if why is not None or stale not in mesh_files:
-            stale.unlink()
+    kept = {path.relative_to(out).as_posix(): _digest(path) for path in written}
+    # an earlier import's files not written again, and this one's meshes of a geometry not kept
+    for name in sorted((removable | {path.relative_to(out).as_posix() for path in mesh_files}) - set(kept)):
+        (out / name).unlink(missing_ok=True)
+    write_atomic(out / MANIFEST, json.dumps({"written_by": "./run.sh import", "title": title, "files": kept},
+                                            indent=1) + "\n")
     return written, why

@@ -75,7 +75,9 @@ def test_cranfield_geometric_precedence_against_the_physics(
     derived, out = imported("cranfield")
     closure = set(load_relation([out / "geometric_precedence.lp"]).pairs())
     assert closure & (ENFORCED | NOT_ENFORCED) == ENFORCED
-    assert derived.stages == [["fp", "p1", "p2", "p3", "p4", "ph", "sh"], ["pd", "sp"]]
+    assert derived.stages == [["fp", "p1", "p2", "p3", "p4", "sh"], ["pd", "ph", "sp"]]  # ph moves with pd
+    # The front plate rests on the pendulum and the spacer: the support rule orders them.
+    assert {pair for pair, reason in derived.reasons.items() if reason == "supports"} == {("pd", "fp"), ("sp", "fp")}
     # The pendulum's opening is the big hole plus 0.5 mm: the shaft passes it whatever the
     # order, so no blocking orders them; the locating rule does (only the shaft keeps the
     # pendulum from sliding along x). Without it the geometry lacks that one edge.

@@ -1,0 +1,116 @@
+"""The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py) on small
+products of trimesh primitives: a horizontal shaft in a zero-clearance bearing comes out
+along its axis; a precedence pair only where every way in is blocked (a bar that slides
+out sideways under a lid gets none, a washer on a pin under a cap nut gets exactly the
+forced ones); parts fixed to each other move as one; a part that never comes out is named
+with its blockers per direction."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import trimesh
+
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.cad.derive import derive
+from assembly_constraints.executor.cad.parts import CadPart
+from assembly_constraints.executor.cad.sweep import cylinder_faces
+
+MM = 1e-3
+
+
+def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
+    """A box [m] from extents and centre [mm]."""
+    mesh = trimesh.creation.box([MM * e for e in extents])
+    mesh.apply_translation([MM * c for c in centre])
+    return mesh
+
+
+def _along_x(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """A mesh made along z turned onto x, at 30 mm height [m]."""
+    mesh.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (0, 1, 0)))
+    mesh.apply_translation((0, 0, 30 * MM))
+    return mesh
+
+
+def _parts(**meshes: trimesh.Trimesh) -> list[CadPart]:
+    return [CadPart(pid, pid, mesh, f"{pid}.stl") for pid, mesh in meshes.items()]
+
+
+def _shaft_in_bearing() -> list[CadPart]:
+    """A 40 mm housing bored through along x (r 16 mm, 64-gon), a 20 mm bearing in its
+    middle (r 8 to 16 mm, 72-gons) and a 100 mm shaft in the bearing (r 8 mm, 40-gon): the
+    same nominal radii, polygons overlapping by up to 25 µm."""
+    bore = _along_x(trimesh.creation.cylinder(radius=16 * MM, height=42 * MM, sections=64))
+    housing = trimesh.boolean.difference([_box((40, 50, 60), (0, 0, 30)), bore], engine="manifold")
+    bearing = _along_x(trimesh.creation.annulus(r_min=8 * MM, r_max=16 * MM, height=20 * MM, sections=72))
+    shaft = _along_x(trimesh.creation.cylinder(radius=8 * MM, height=100 * MM, sections=40))
+    return _parts(housing=housing, bearing=bearing, shaft=shaft)
+
+
+def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
+    parts = _shaft_in_bearing()
+    faces = cylinder_faces(parts[2].mesh)
+    assert len(faces) == 1 and faces[0].outward and faces[0].radius == pytest.approx(8 * MM, abs=1e-9)
+    assert abs(faces[0].direction[0]) == pytest.approx(1.0)
+    derived = derive(parts, "housing", {}, reach=0.0)
+    assert {(s.shaft, s.bore) for s in derived.slides} == {("shaft", "bearing"), ("bearing", "housing")}
+    assert all(s.tolerance < 40e-6 for s in derived.slides)
+    assert derived.free("shaft") == ["+x", "-x"]
+    assert derived.blockers[("bearing", "+x")] == set() and derived.blockers[("bearing", "+z")] == {"housing", "shaft"}
+    assert derived.axis == {"shaft": "+x", "bearing": "+x"}
+    # Moved along y (not its axis) the shaft is blocked: the overlap counts there.
+    assert derived.blockers[("shaft", "+y")] == {"bearing", "housing"}
+
+
+def test_a_bar_that_slides_out_sideways_under_a_lid_gets_no_pair() -> None:
+    channel = trimesh.boolean.union([_box((80, 60, 5), (0, 0, 2.5)), _box((80, 10, 20), (0, 25, 15)),
+                                     _box((80, 10, 20), (0, -25, 15)), _box((5, 60, 20), (-37.5, 0, 15))],
+                                    engine="manifold")
+    parts = _parts(channel=channel, lid=_box((50, 60, 5), (-15, 0, 27.5)), bar=_box((40, 20, 10), (-15, 0, 10)),
+                   stop=_box((10, 20, 10), (17, 0, 10)))
+    derived = derive(parts, "channel", {}, reach=0.0)
+    # The bar leaves along +z under the lid or along +x past the stop: with either away it goes in.
+    assert derived.blockers[("bar", "+z")] == {"lid"} and derived.blockers[("bar", "+x")] == {"stop"}
+    assert derived.reasons == {("channel", "bar"): "base", ("channel", "lid"): "base", ("channel", "stop"): "base"}
+
+
+def test_a_washer_on_a_pin_under_a_cap_nut_gets_exactly_the_forced_pairs() -> None:
+    plate = trimesh.boolean.difference([_box((60, 60, 10), (0, 0, 5)), _box((8.4, 8.4, 9), (0, 0, 6.5))],
+                                       engine="manifold")
+    washer = trimesh.boolean.difference([_box((20, 20, 2), (0, 0, 11)), _box((10, 10, 4), (0, 0, 11))],
+                                        engine="manifold")
+    nut = trimesh.boolean.difference([_box((16, 16, 8), (0, 0, 16)), _box((8.4, 8.4, 6), (0, 0, 15))],
+                                     engine="manifold")
+    parts = _parts(plate=plate, pin=_box((8, 8, 15), (0, 0, 9.5)), washer=washer, nut=nut)
+    derived = derive(parts, "plate", {}, reach=0.0)
+    # The nut's cap blocks the pin's one way out; with the pin in, the washer's every way out is blocked.
+    assert derived.reasons == {("plate", "pin"): "base", ("plate", "washer"): "base", ("pin", "nut"): "blocks",
+                               ("washer", "nut"): "blocks"}
+    assert derived.detail[("washer", "nut")].startswith("+z nut; +x pin")
+
+
+def test_parts_fixed_to_each_other_are_swept_as_one() -> None:
+    plate = trimesh.boolean.difference([_box((60, 60, 10), (0, 0, 5)), _box((8.4, 8.4, 9), (0, 0, 6.5))],
+                                       engine="manifold")
+    parts = _parts(plate=plate, lever=_box((8, 8, 28), (0, 0, 16)), head=_box((16, 8, 4), (12, 0, 28)),
+                   cover=_box((12, 12, 4), (14, 0, 33)))
+    derived = derive(parts, "plate", {"head": "lever"}, reach=0.0)
+    # Alone, the head slides out along +x and the lever along +z; together only +z is open, under the cover.
+    assert derived.blockers[("head", "+x")] == derived.blockers[("lever", "+x")] == {"plate"}
+    assert derived.stages == [["cover"], ["head", "lever"]]
+    assert {pair for pair, reason in derived.reasons.items() if reason == "blocks"} == {("head", "cover"),
+                                                                                          ("lever", "cover")}
+
+
+def test_a_part_that_never_comes_out_is_named_with_its_blockers() -> None:
+    cage = trimesh.boolean.difference([_box((60, 40, 40), (0, 0, 20)), _box((50, 30, 30), (0, 0, 20))],
+                                      engine="manifold")
+    parts = _parts(cage=cage, left=_box((10, 10, 10), (-10, 0, 10)), right=_box((10, 10, 10), (10, 0, 10)))
+    with pytest.raises(ExecutorError) as error:
+        derive(parts, "cage", {}, reach=0.0)
+    message = str(error.value)
+    assert "part(s) left, right never come out" in message
+    assert "left along +z by cage, -z by cage, +x by cage right, -x by cage" in message
+    assert "right along +z by cage, -z by cage, +x by cage, -x by cage left, +y by cage, -y by cage" in message
