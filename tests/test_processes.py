@@ -77,6 +77,13 @@ def _stop_by_signal(process: subprocess.Popen[str], signum: int = signal.SIGTERM
     return {pid for pid in before if running(pid)}
 
 
+def _accepts(address: str) -> bool:
+    """Something accepts connections on the port of ``address`` (``http://127.0.0.1:PORT/...``)."""
+    port = int(address.split(":")[2].split("/")[0])
+    with socket.socket() as probe:
+        return probe.connect_ex(("127.0.0.1", port)) == 0
+
+
 def _recording(path: Path) -> Path:
     stream = rr.RecordingStream("assembly_constraints", recording_id="sigterm")
     stream.save(str(path))
@@ -157,4 +164,7 @@ def test_view_web_killed_by_sigkill_leaves_no_web_viewer(tmp_path: Path, cli_arg
         view.kill()
     assert view.returncode == -signal.SIGKILL
     assert not left, f"still running after SIGKILL: {left}"
+    deadline = time.monotonic() + 5.0  # its sockets close as it exits, whoever reaps it
+    while time.monotonic() < deadline and _accepts(address):
+        time.sleep(0.1)
     assert_closed(address)
