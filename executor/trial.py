@@ -33,7 +33,7 @@ from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, corre
 from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, Motion
 from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from assembly_constraints.executor.rerun_arm import ArmRecorder
-from assembly_constraints.executor.skills.dmp import Skill, load_skill
+from assembly_constraints.executor.skills.dmp import Skill, load_product_skill
 from assembly_constraints.executor.skills.insertion import (
     InsertionTask,
     insert_in_layer,
@@ -136,7 +136,7 @@ class Cell:
             raise UnknownPair(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.geometry.holes))})")
         shape = self.geometry.parts[part].shape
         if shape not in self._skills:
-            self._skills[shape] = load_skill(self.geometry.folder, shape)
+            self._skills[shape] = load_product_skill(self.geometry, shape)
         return self._skills[shape]
 
     def motion_for(self, part: str) -> Motion:

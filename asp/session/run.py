@@ -117,9 +117,12 @@ def _run_folder(settings: SessionSettings) -> tuple[Path, SessionFile, RunLock, 
         lock.release()
         raise PlannerError(f"--out {run}: already holds a session (its journal); "
                            f"use --resume {run} or another folder")
-    # demos absolute: a resume may run from another folder
+    # demos and a product folder absolute (a shipped product by its name): a resume may run from another folder
     demos = None if settings.demos is None else str(Path(settings.demos).absolute())
-    return run, new_session_file(msgspec.structs.replace(settings, demos=demos), str(uuid.uuid4())), lock, created
+    product = Path(settings.assembly)
+    assembly = str(product.absolute()) if (product / "assembly.toml").is_file() else settings.assembly
+    return run, new_session_file(msgspec.structs.replace(settings, demos=demos, assembly=assembly),
+                                 str(uuid.uuid4())), lock, created
 
 
 def _holds_session(run: Path) -> bool:

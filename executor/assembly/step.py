@@ -50,7 +50,7 @@ from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
 from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.skills.dmp import Skill, load_skill
+from assembly_constraints.executor.skills.dmp import Skill, load_product_skill
 from assembly_constraints.executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.trial import APPROACH_HEIGHT, trial_rng
@@ -154,7 +154,7 @@ class Assembler:
 
     def _skill(self, name: str) -> Skill:
         if name not in self._skills:
-            self._skills[name] = load_skill(self.product.folder, name)
+            self._skills[name] = load_product_skill(self.product.geometry, name)
         return self._skills[name]
 
     def block_hole(self, hole: str) -> None:

@@ -5,7 +5,8 @@ closes), then closes the Zenoh session cleanly (:func:`serve`).
 Every request is size-capped and validated in the Zenoh thread (:class:`CellNode`); a
 malformed, oversized or wrong-version request gets an ErrorReply at once and the cell keeps
 serving. Valid requests run one at a time in the main thread; results are idempotent by
-request id. One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
+request id; a request whose backend raises gets an ErrorReply ``failed`` naming the
+exception, and the cell keeps serving. One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
 ``done <id> <result>``), flushed, so a supervisor can follow the node.
 """
 
@@ -16,6 +17,7 @@ import queue
 import signal
 import threading
 import time
+import traceback
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -39,7 +41,7 @@ from assembly_constraints.bridge.messages import (
     decode_step_request,
     encode,
 )
-from assembly_constraints.bridge.session import SIGNAL_POLL_S, cell_listen, open_session
+from assembly_constraints.bridge.session import SIGNAL_POLL_S, bound_endpoints, cell_listen, open_session
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.backend_plugin import Backend, InvalidStep, RunActive, UnknownPair
 from assembly_constraints.executor.claim import CellClaim, ClaimLost
@@ -178,6 +180,11 @@ class CellNode:
                                else "failed")
             self._refuse(query, code, str(exc), request.id)
             return None
+        except Exception as exc:  # a bug of the backend: this request fails, the cell keeps serving
+            where = traceback.extract_tb(exc.__traceback__)[-1]
+            self._refuse(query, "failed", f"the backend raised {type(exc).__name__}: {str(exc)[:200]} "
+                         f"(at {Path(where.filename).name}:{where.lineno})", request.id)
+            return None
         reply, result = encode(message), message.result
         with self._lock:
             self._replies[request.id] = (request, reply)
@@ -218,6 +225,7 @@ def serve(settings: ServeSettings) -> int:
     claim: CellClaim | None = None
     backend: Backend | None = None
     try:
+        listen = bound_endpoints(session, listen)  # reported as bound (port 0: the port it took)
         claim = CellClaim(session, cell_id)
         claim.check()  # before the backend starts: a refused cell loads nothing
         backend = start_backend()
