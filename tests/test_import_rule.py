@@ -176,7 +176,7 @@ def test_the_resolution_catches_a_link_a_missing_module_and_a_test_import(tmp_pa
     (tmp_path / "tests").mkdir()
     (tmp_path / FRONT / "asp").symlink_to("../asp", target_is_directory=True)
     (tmp_path / "asp" / "solve.py").write_text("def solve(): ...\n")
-    (tmp_path / "bridge" / "keys.py").write_text("from bridge import gone\nimport tests.conftest\n")
+    (tmp_path / "bridge" / "keys.py").write_text("import bridge.gone\nimport tests.conftest\n")
     (tmp_path / "executor" / "cell.py").write_text(f"from {FRONT}.asp.solve import solve\nfrom asp.solve import solve\n"
                                                    "import numpy\n")
     assert (tmp_path / FRONT / "asp" / "solve.py").is_file()  # Python would import it through the link
