@@ -15,6 +15,7 @@ import pytest
 from tests.conftest import DISPLAY_VARIABLES, ROOT
 
 PROGRAM = "assembly-constraints"
+LAYERS = ("asp", "bridge", "executor")
 
 
 @pytest.fixture(scope="module")
@@ -66,15 +67,15 @@ def test_the_installed_command_runs_a_session_from_a_folder_outside_the_reposito
 
 
 @pytest.mark.slow
-def test_the_installed_package_adds_exactly_one_top_level_name(installed: tuple[Path, dict[str, str]]) -> None:
-    """Nothing of ours stands beside other packages: ``asp``, ``bridge`` and ``executor`` are
-    inside ``assembly_constraints``, as real folders (not links back to a checkout)."""
+def test_the_installed_package_adds_the_four_folders_of_the_repository(installed: tuple[Path, dict[str, str]]) -> None:
+    """The packages installed are the repository's folders under their own names, as real
+    folders (not links back to a checkout), and nothing else stands beside other packages."""
     site = Path(installed[1]["PYTHONPATH"])
     names = {p.name for p in site.iterdir()
              if p.name not in {"bin", "__pycache__"} and not p.name.endswith(".dist-info")}
-    assert names == {"assembly_constraints"}
-    layers = [site / "assembly_constraints" / layer for layer in ("asp", "bridge", "executor")]
-    assert all(layer.is_dir() and not layer.is_symlink() and (layer / "__init__.py").is_file() for layer in layers)
+    assert names == set(LAYERS) | {"assembly_constraints"}
+    assert all((site / layer).is_dir() and not (site / layer).is_symlink() and (site / layer / "__init__.py").is_file()
+               for layer in names)
 
 
 @pytest.mark.slow
@@ -86,4 +87,4 @@ def test_the_build_warns_of_nothing_and_ships_every_encoding(pip_install: tuple[
     assert "BuildBackendWarning" not in stderr and "would be ignored" not in stderr, stderr
     def encodings(asp: Path) -> set[Path]:
         return {f.relative_to(asp) for f in (asp / "encodings").rglob("*.lp")}
-    assert encodings(ROOT / "asp") == encodings(target / "assembly_constraints" / "asp") != set()
+    assert encodings(ROOT / "asp") == encodings(target / "asp") != set()
