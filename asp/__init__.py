@@ -4,7 +4,7 @@ Learns precedence constraints from demonstrations (paper 2.1), which part fits w
 hole by active exploration (paper 2.2), assigns holes and builds complete plans.
 """
 
-from assembly_constraints.bridge.errors import ToolError
+from bridge.errors import ToolError
 
 MAX_IDS = 64
 """At most this many parts, and this many holes, in the planner's input (demonstrations,

@@ -28,10 +28,10 @@ from pathlib import Path
 import clingo
 import clingo.ast
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.bridge.assembly import is_id
-from assembly_constraints.bridge.files import write_atomic
-from assembly_constraints.bridge.inputs import read_bytes, shorten
+from asp import MAX_IDS, PlannerError
+from bridge.assembly import is_id
+from bridge.files import write_atomic
+from bridge.inputs import read_bytes, shorten
 
 _CONSTANT = re.compile(r"_*[a-z][A-Za-z0-9_']*")
 _STRINGS_AND_COMMENTS = re.compile(r'"(?:\\.|[^"\\\n])*"|%\*.*?\*%|%[^\n]*', re.DOTALL)
@@ -53,7 +53,7 @@ def _check_ascii(path: Path, text: str) -> None:
 
 def encoding(name: str) -> Path:
     """Path of a shipped encoding, e.g. ``plans.lp`` or ``plans/needs_hole.lp``."""
-    path = Path(str(importlib.resources.files("assembly_constraints.asp") / "encodings" / name))
+    path = Path(str(importlib.resources.files("asp") / "encodings" / name))
     if not path.is_file():
         raise PlannerError(f"encoding '{name}': not found in {path.parent}")
     return path
@@ -68,7 +68,7 @@ def load_atoms(
     ``shown_only``: an encoding's ``#show`` then hides nothing from checks).
 
     Raises PlannerError naming file:line when a file does not exist, cannot be read, is
-    larger than :data:`assembly_constraints.bridge.inputs.MAX_INPUT_BYTES`, does not parse, or has no single
+    larger than :data:`bridge.inputs.MAX_INPUT_BYTES`, does not parse, or has no single
     answer set (clingo's messages are cut to one short line each).
     """
     messages: list[str] = []
@@ -170,7 +170,7 @@ def check_facts(atoms: Iterable[clingo.Symbol], signatures: Mapping[str, int], s
     arguments are all ids: PlannerError naming ``source`` and the atom when one has another
     arity (e.g. ``must_precede/3``, expected ``must_precede/2``), an argument that is not an
     id (a lower-case ASP constant such as ``p1``, not ``"ä"`` or ``3``), or when there are
-    more than :data:`assembly_constraints.asp.MAX_IDS` ``part/1`` or ``hole/1`` atoms."""
+    more than :data:`asp.MAX_IDS` ``part/1`` or ``hole/1`` atoms."""
     counts: dict[str, int] = {}
     for atom in atoms:
         if atom.type != clingo.SymbolType.Function or atom.name not in signatures:
@@ -248,7 +248,7 @@ def format_facts(atoms: Iterable[clingo.Symbol], header: str = "") -> str:
 
 def write_facts(path: Path | str, atoms: Iterable[clingo.Symbol], header: str = "") -> None:
     """Write facts to ``path`` (see :func:`format_facts`), atomically: the old file stays
-    whole unless the new one is complete (:func:`assembly_constraints.bridge.files.write_atomic`; BridgeError
+    whole unless the new one is complete (:func:`bridge.files.write_atomic`; BridgeError
     naming the path when it cannot be written)."""
     write_atomic(path, format_facts(atoms, header))
 

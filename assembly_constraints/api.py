@@ -11,7 +11,7 @@
 
 Paths are relative to the working folder; an assembly is a shipped one's name
 (``cranfield``, ``battery``, ``spare``, ``graded``) or a folder holding ``assembly.toml``. Bad input raises
-:class:`assembly_constraints.asp.PlannerError` or :class:`assembly_constraints.bridge.BridgeError`
+:class:`asp.PlannerError` or :class:`bridge.BridgeError`
 with a one-line message naming the file or value. Documented in ``docs/api.md``.
 """
 
@@ -24,20 +24,20 @@ from typing import Literal, NotRequired, TypedDict
 
 from msgspec import UNSET
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import load_learned_facts
-from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
-from assembly_constraints.asp.precedence.demos import load_demos
-from assembly_constraints.asp.precedence.learn import learn_must_precede
-from assembly_constraints.asp.precedence.relation import Relation, precedence_facts
-from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
-from assembly_constraints.asp.session.settings import SessionFile, SessionSettings, read_session_file
-from assembly_constraints.asp.sizes.learner import Experiment, LearningOptions, SizeLearningResult
-from assembly_constraints.asp.sizes.learner import learn_sizes as _learn_sizes
-from assembly_constraints.asp.sizes.truth_oracle import Oracle, TruthOracle
-from assembly_constraints.asp.solve import write_facts as _write_facts
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
+from asp import PlannerError
+from asp.plans.assign import load_learned_facts
+from asp.plans.plans import Plan, check_plan, plans
+from asp.precedence.demos import load_demos
+from asp.precedence.learn import learn_must_precede
+from asp.precedence.relation import Relation, precedence_facts
+from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from asp.session.settings import SessionFile, SessionSettings, read_session_file
+from asp.sizes.learner import Experiment, LearningOptions, SizeLearningResult
+from asp.sizes.learner import learn_sizes as _learn_sizes
+from asp.sizes.truth_oracle import Oracle, TruthOracle
+from asp.solve import write_facts as _write_facts
+from bridge.assembly import load_assembly
+from bridge.cell_settings import CellSettings, Magnitudes
 
 Result = Literal["fit", "no_fit"]
 """The outcome of one insertion experiment."""
@@ -68,7 +68,7 @@ def truth_oracle(assembly: str | Path = "cranfield") -> TruthOracle:
 
 
 class _CallableOracle:
-    """An :class:`assembly_constraints.asp.sizes.truth_oracle.Oracle` around a function ``(part, hole) -> result``."""
+    """An :class:`asp.sizes.truth_oracle.Oracle` around a function ``(part, hole) -> result``."""
 
     def __init__(self, ask: Callable[[str, str], Result]) -> None:
         self._ask = ask
@@ -111,7 +111,7 @@ def write_facts(path: str | Path, precedence: Relation | None = None,
 def plan(facts: Sequence[str | Path], n: int = 1) -> list[Plan]:
     """Up to ``n`` complete plans (0: all) from learned facts files: a hole for every part
     that needs one and an order respecting ``must_precede``; each checked by the
-    independent plan checker. :class:`assembly_constraints.asp.plans.assign.UnsolvableAssembly` names a part
+    independent plan checker. :class:`asp.plans.assign.UnsolvableAssembly` names a part
     without a hole."""
     learned = load_learned_facts([Path(f) for f in facts])
     found = plans(learned, n=n)
@@ -147,7 +147,7 @@ def run_session(assembly: str | Path = "cranfield", *, out: str | Path | None = 
     one cell before it is sent again. ``cell``: the simulated cells' execution layer and
     uncertainty (default: the defaults, cell seed ``seed``); cell ``c<k>`` has cell seed
     ``cell.cell_seed + k - 1``. PlannerError naming the setting when one is out of range."""
-    from assembly_constraints.asp.session.run import run_session as run
+    from asp.session.run import run_session as run
 
     settings = SessionSettings(assembly=str(assembly), out=None if out is None else str(out), backend=backend,
                                cells=cells, policy=policy, seed=seed, confirm=confirm, timeout_s=timeout_s,
@@ -160,7 +160,7 @@ def run_session(assembly: str | Path = "cranfield", *, out: str | Path | None = 
 class RunFolder:
     """A session's run folder, read back.
 
-    ``settings``: ``session.json`` (:class:`assembly_constraints.asp.session.settings.SessionFile`: assembly,
+    ``settings``: ``session.json`` (:class:`asp.session.settings.SessionFile`: assembly,
     policy, seed, the cells' settings, status, and once done the result and timings);
     ``experiments``: the finished experiments of ``journal.jsonl`` in order (part, hole,
     result, cell, evidence, wall time); ``learned``: ``learned.lp`` (None until the

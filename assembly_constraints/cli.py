@@ -2,13 +2,13 @@
 
 ``assembly-constraints [-v | -q] SUBCOMMAND [ARGS...]`` runs one subcommand; each takes
 ``--help``. :data:`SUBCOMMANDS` is the one registry: the planner's subcommands, the cell's
-under ``executor`` (:mod:`assembly_constraints.executor.cli`), the benchmarks of both under ``bench``
+under ``executor`` (:mod:`executor.cli`), the benchmarks of both under ``bench``
 (:data:`BENCHMARKS`), and ``protocol``, which writes the published message schemas
-(:mod:`assembly_constraints.bridge.protocol_schema`). The tests run this same command line.
+(:mod:`bridge.protocol_schema`). The tests run this same command line.
 Modules are imported lazily, so ``--help`` of one subcommand does not pay for the others.
 
-Exit codes (:mod:`assembly_constraints.bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
-missing subcommand too; every :class:`assembly_constraints.bridge.errors.ToolError`), 3 an unsolvable
+Exit codes (:mod:`bridge.errors`): 0 done, 1 a check failed, 2 bad input or usage (a
+missing subcommand too; every :class:`bridge.errors.ToolError`), 3 an unsolvable
 assembly, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM; both after the processes the
 command started were stopped), 141 stdout closed.
 """
@@ -22,41 +22,41 @@ import sys
 from collections.abc import Callable, Sequence
 
 from assembly_constraints import __version__
-from assembly_constraints.bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
-from assembly_constraints.bridge.errors import ToolError
+from bridge.cli_types import PROGRAM, ArgumentParser, configure_logging, run_command
+from bridge.errors import ToolError
 
 BENCHMARKS: dict[str, str] = {
-    "precedence": "assembly_constraints.asp.bench.precedence",
-    "sizes": "assembly_constraints.asp.bench.sizes",
-    "plan": "assembly_constraints.asp.bench.plans",
-    "session": "assembly_constraints.asp.bench.session",
-    "dominance": "assembly_constraints.asp.bench.dominance",
-    "mesh": "assembly_constraints.asp.bench.mesh",
-    "precedence-physics": "assembly_constraints.asp.bench.precedence_physics",
-    "assemble": "assembly_constraints.asp.bench.assemble_plans",
-    "executor": "assembly_constraints.executor.campaign.bench",
-    "physics": "assembly_constraints.executor.campaign.physics",
-    "import": "assembly_constraints.executor.cad.bench",
+    "precedence": "asp.bench.precedence",
+    "sizes": "asp.bench.sizes",
+    "plan": "asp.bench.plans",
+    "session": "asp.bench.session",
+    "dominance": "asp.bench.dominance",
+    "mesh": "asp.bench.mesh",
+    "precedence-physics": "asp.bench.precedence_physics",
+    "assemble": "asp.bench.assemble_plans",
+    "executor": "executor.campaign.bench",
+    "physics": "executor.campaign.physics",
+    "import": "executor.cad.bench",
 }
 """``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""
 
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "precedence": ("assembly_constraints.asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
-    "sizes": ("assembly_constraints.asp.sizes.cli", "learn/evaluate which part fits which hole"),
-    "assign": ("assembly_constraints.asp.plans.cli:assign_main", "hole assignments from learned facts"),
-    "plan": ("assembly_constraints.asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
-    "session": ("assembly_constraints.asp.session.cli", "the end-to-end learning session (planner + cells)"),
-    "assemble": ("assembly_constraints.asp.assemble.cli",
+    "precedence": ("asp.precedence.cli", "learn/count/sample/evaluate/suggest precedence"),
+    "sizes": ("asp.sizes.cli", "learn/evaluate which part fits which hole"),
+    "assign": ("asp.plans.cli:assign_main", "hole assignments from learned facts"),
+    "plan": ("asp.plans.cli:plan_main", "complete assembly plans from learned facts"),
+    "session": ("asp.session.cli", "the end-to-end learning session (planner + cells)"),
+    "assemble": ("asp.assemble.cli",
                  "execute a plan in a simulated cell, monitored and re-planned"),
-    "view": ("assembly_constraints.asp.view.cli", "open a session's Rerun recording"),
+    "view": ("asp.view.cli", "open a session's Rerun recording"),
     "bench": ("assembly_constraints.cli:bench_main", "benchmarks (bench TOPIC --help): " + ", ".join(BENCHMARKS)),
-    "executor": ("assembly_constraints.executor.cli",
+    "executor": ("executor.cli",
                  "the simulated PyBullet cell: teach, trial, campaign, margins, serve, export"),
-    "import": ("assembly_constraints.executor.cad.cli",
+    "import": ("executor.cad.cli",
                "a product from its CAD (STEP or meshes): holes, sections, geometric precedence"),
-    "protocol": ("assembly_constraints.bridge.protocol_schema",
+    "protocol": ("bridge.protocol_schema",
                  "write or check the JSON Schema of every Zenoh message"),
-    "router": ("assembly_constraints.bridge.session:router_main",
+    "router": ("bridge.session:router_main",
                "a Zenoh router (router mode of eclipse-zenoh) for cells on other hosts"),
 }
 """Every subcommand: name → (``module`` or ``module:function`` taking argv, one-line help)."""

@@ -20,7 +20,7 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
   and the ``truth`` cells need it; the planner alone does not).
 
 ``assembly.toml`` and ``geometry.toml`` are decoded and checked as a whole by
-:mod:`assembly_constraints.bridge.product`; :func:`load_assembly` gives the planner's view of the result.
+:mod:`bridge.product`; :func:`load_assembly` gives the planner's view of the result.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.product import (
+from bridge import BridgeError
+from bridge.product import (
     ID_PATTERN,
     MAX_COORDINATE,
     SHAPES,
@@ -137,7 +137,7 @@ def resolve_assembly_folder(name_or_path: str) -> Path:
 def assembly_of(product: ProductDescription) -> Assembly:
     """The planner's view of a decoded product: its parts and holes in file order, each
     with the kind every statement of the product gives it (``shape`` in ``assembly.toml``,
-    the kind of its table in ``geometry.toml``: :func:`assembly_constraints.bridge.product.part_kinds`),
+    the kind of its table in ``geometry.toml``: :func:`bridge.product.part_kinds`),
     a rect or polygon part's section defaulting to its id, a round or square part's to its kind."""
     layout = product.assembly
     kinds, hole_kind = part_kinds(layout, product.geometry), hole_kinds(layout, product.geometry)
@@ -155,6 +155,6 @@ def assembly_of(product: ProductDescription) -> Assembly:
 
 def load_assembly(name_or_path: str) -> Assembly:
     """Load an assembly folder (its whole product description is checked:
-    :func:`assembly_constraints.bridge.product.load_product_description`); BridgeError naming the file and
+    :func:`bridge.product.load_product_description`); BridgeError naming the file and
     field on bad input."""
     return assembly_of(load_product_description(resolve_assembly_folder(name_or_path)))

@@ -19,12 +19,12 @@ from typing import Annotated, Any, Literal, TypeVar
 
 import msgspec
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cli_types import MAX_SEED, finite_float, int_in
-from assembly_constraints.bridge.inputs import shorten
+from bridge import BridgeError
+from bridge.cli_types import MAX_SEED, finite_float, int_in
+from bridge.inputs import shorten
 
 Layer = Literal["position", "admittance_p", "admittance_pi", "pi_phase_stop", "full"]
-"""An execution layer (:data:`assembly_constraints.executor.control.ilc.LAYERS`)."""
+"""An execution layer (:data:`executor.control.ilc.LAYERS`)."""
 LAYER_NAMES: tuple[Layer, ...] = ("position", "admittance_p", "admittance_pi", "pi_phase_stop", "full")
 """The execution layers, from the least to the whole."""
 DEFAULT_LAYER: Layer = "full"
@@ -47,7 +47,7 @@ def _m(high: float, description: str) -> msgspec.Meta:
 
 class Magnitudes(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """The magnitudes of a simulated cell's uncertainty
-    (:mod:`assembly_constraints.executor.world.perturbation` draws the errors from them).
+    (:mod:`executor.world.perturbation` draws the errors from them).
     Each field's description gives its unit; ``executor trial`` and friends offer one
     ``--<field>`` option per field."""
 

@@ -20,9 +20,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED, EXIT_TERMINATED
-from assembly_constraints.bridge.inputs import shorten
+from bridge import BridgeError
+from bridge.errors import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERRUPTED, EXIT_TERMINATED
+from bridge.inputs import shorten
 
 T = TypeVar("T")
 
@@ -99,7 +99,7 @@ NATIVE_LOG_FILTER = "warn,re_log_encoding::rrd::file_sink=off,re_log_encoding::r
 """``RUST_LOG`` of the Rerun SDK's native code unless the user sets it: its default level
 (warnings and errors), without the file writer's own report of a failed write ("Failed to
 write log stream to ...: ... (os error 28)", "encoder couldn't be finished"), since the
-command reports that as its one error line (:func:`assembly_constraints.bridge.recording.sinks.finish_stream`)."""
+command reports that as its one error line (:func:`bridge.recording.sinks.finish_stream`)."""
 
 
 def configure_logging(level: int | None = None) -> None:

@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import msgspec
 import zenoh
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.keys import ALIVE_PATTERN, cell_of_alive_key, insert_key, step_key
-from assembly_constraints.bridge.messages import (
+from bridge import BridgeError
+from bridge.keys import ALIVE_PATTERN, cell_of_alive_key, insert_key, step_key
+from bridge.messages import (
     ErrorReply,
     InsertReply,
     InsertRequest,

@@ -1,8 +1,8 @@
 """The project's one error root and its exit codes.
 
 Every error the tool reports on purpose (bad input, an unsolvable request, a lost cell)
-is a :class:`ToolError`; each layer has its subclass (:class:`assembly_constraints.asp.PlannerError`,
-:class:`assembly_constraints.bridge.BridgeError`, :class:`assembly_constraints.executor.ExecutorError`), so a
+is a :class:`ToolError`; each layer has its subclass (:class:`asp.PlannerError`,
+:class:`bridge.BridgeError`, :class:`executor.ExecutorError`), so a
 caller may catch one layer's errors or all of them, and nothing needs converting between them. The command
 line prints a ``ToolError`` as one line ``error: <message>`` and exits with
 :data:`EXIT_BAD_INPUT`.

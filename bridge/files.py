@@ -13,7 +13,7 @@
   itself (a Rerun ``.rrd``) can be created there.
 - :func:`make_folder` creates an output folder (with its parents).
 
-Every failure is a :class:`~assembly_constraints.bridge.BridgeError` of one line naming the path and the
+Every failure is a :class:`~bridge.BridgeError` of one line naming the path and the
 operating system's reason, e.g. ``runs/x/learned.lp: cannot write (No space left on device)``.
 """
 
@@ -28,7 +28,7 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from assembly_constraints.bridge import BridgeError
+from bridge import BridgeError
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

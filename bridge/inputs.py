@@ -16,7 +16,7 @@ import os
 import stat
 from pathlib import Path
 
-from assembly_constraints.bridge import BridgeError
+from bridge import BridgeError
 
 MAX_INPUT_BYTES = 10 * 1024 * 1024
 """The largest input file read [bytes] (10 MiB): demonstrations, facts, assembly files."""

@@ -7,14 +7,14 @@ name of the process, so two processes claiming one id show as two tokens);
 ``cell/<id>/ping`` echoes its payload. The planner discovers cells by subscribing to
 ``cell/*/alive/*``. Before and while it serves, a cell process also holds the liveliness
 token ``cell/<id>/claim/<instance>`` and answers queries on that key with its age: cells
-claiming one id find each other there (:mod:`assembly_constraints.executor.claim`).
+claiming one id find each other there (:mod:`executor.claim`).
 """
 
 from __future__ import annotations
 
 import re
 
-from assembly_constraints.bridge import BridgeError
+from bridge import BridgeError
 
 CELL_ID_PATTERN = r"^[a-z][a-z0-9_-]{0,31}$"
 """A cell id: lower-case letter, then up to 31 of ``[a-z0-9_-]`` (one key chunk)."""

@@ -23,11 +23,11 @@ from typing import Annotated, Final, Literal
 
 import msgspec
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import ID_PATTERN
-from assembly_constraints.bridge.inputs import duplicate_key
-from assembly_constraints.bridge.keys import CELL_ID_PATTERN
-from assembly_constraints.bridge.product.tables import MAX_ID_CHARS
+from bridge import BridgeError
+from bridge.assembly import ID_PATTERN
+from bridge.inputs import duplicate_key
+from bridge.keys import CELL_ID_PATTERN
+from bridge.product.tables import MAX_ID_CHARS
 
 PROTOCOL_VERSION: Final = 3
 """2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``. 3: step request and reply."""

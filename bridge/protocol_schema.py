@@ -1,7 +1,7 @@
 """``assembly-constraints protocol``: the JSON Schema of every Zenoh message, generated
-from the message types of :mod:`assembly_constraints.bridge.messages`, and of the product description files
+from the message types of :mod:`bridge.messages`, and of the product description files
 (``assembly.toml``, ``geometry.toml`` as decoded TOML), generated from the structs of
-:mod:`assembly_constraints.bridge.product`.
+:mod:`bridge.product`.
 
 The schemas are published in ``docs/protocol/`` (one file a message or product file,
 described in ``docs/protocol.md`` and ``docs/geometry.md``) for clients and editors in
@@ -20,10 +20,10 @@ from pathlib import Path
 
 import msgspec
 
-from assembly_constraints.bridge.cli_types import ArgumentParser
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.keys import ALIVE_PATTERN, CELL_ID_PATTERN
-from assembly_constraints.bridge.messages import (
+from bridge.cli_types import ArgumentParser
+from bridge.files import make_folder, write_atomic
+from bridge.keys import ALIVE_PATTERN, CELL_ID_PATTERN
+from bridge.messages import (
     MAX_MESSAGE_BYTES,
     PROTOCOL_VERSION,
     ErrorReply,
@@ -32,7 +32,7 @@ from assembly_constraints.bridge.messages import (
     StepReply,
     StepRequest,
 )
-from assembly_constraints.bridge.product import AssemblyFile, GeometryFile
+from bridge.product import AssemblyFile, GeometryFile
 
 MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
     "insert_request": (InsertRequest, "planner → cell, a query on cell/<id>/insert"),

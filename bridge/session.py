@@ -23,9 +23,9 @@ from pathlib import Path
 
 import zenoh
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cli_types import ArgumentParser
-from assembly_constraints.bridge.messages import MAX_MESSAGE_BYTES
+from bridge import BridgeError
+from bridge.cli_types import ArgumentParser
+from bridge.messages import MAX_MESSAGE_BYTES
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 """Where a cell listens and a planner connects when given no endpoint."""
@@ -37,7 +37,7 @@ Python runs its handler only when the main thread next runs."""
 
 MAX_TRANSPORT_BYTES = 8 * MAX_MESSAGE_BYTES
 """Zenoh refuses bigger messages before they reach Python (the application's own cap,
-:data:`assembly_constraints.bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
+:data:`bridge.messages.MAX_MESSAGE_BYTES`, then refuses what gets through and is too big)."""
 
 LOOPBACK_ANY_PORT = "tcp/127.0.0.1:0"
 """A loopback listener on a port the system picks."""
@@ -69,7 +69,7 @@ def cell_listen(listen: Sequence[str], connect: Sequence[str], config_file: Path
     """Where a cell listens: ``listen`` if given; else nowhere new with a config file (the
     file says); else, when it connects only to loopback endpoints, a loopback port the
     system picks (Zenoh's gossip then connects the cells of one planner to each other, so
-    a second process on one cell id is seen: :mod:`assembly_constraints.executor.claim`); else, connecting
+    a second process on one cell id is seen: :mod:`executor.claim`); else, connecting
     elsewhere, nowhere; else :data:`DEFAULT_ENDPOINT`."""
     if listen or config_file is not None:
         return list(listen)
@@ -171,7 +171,7 @@ def router_main(argv: Sequence[str]) -> int:
     line. It prints ``ready router <zid> listen <endpoints>`` once it listens (an endpoint of
     port 0 with the port it bound) and runs until SIGTERM or SIGINT (exit 0).
 
-    By default it listens on :data:`assembly_constraints.bridge.session.DEFAULT_ENDPOINT` (loopback); cells and
+    By default it listens on :data:`bridge.session.DEFAULT_ENDPOINT` (loopback); cells and
     planners on other hosts need an endpoint on an address they can reach
     (``--listen tcp/192.0.2.10:7447``), and a ``--zenoh-config`` file for TLS,
     authentication and access control (``docs/session.md``; its ``mode`` is set to router).

@@ -20,8 +20,8 @@ import sys
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.executor.assembly.step import Assembler
-from assembly_constraints.executor.assembly.step_backend import AssemblyRunner
+from executor.assembly.step import Assembler
+from executor.assembly.step_backend import AssemblyRunner
 
 SHAFT, HOLE, OPENING = 18.7, 20.0, 20.5
 """The shaft's diameter, the br hole's and the side of the pendulum's opening [mm]."""

@@ -2,8 +2,8 @@
 impedance arm, hole search, DMP insertion with admittance and phase stopping, failure
 detection (eqs. 6, 7 and the goal check) and the wiggle exception strategy.
 
-Entry points: :class:`assembly_constraints.executor.trial.Cell` (``run_trial``) and the
-``executor`` subcommand of the command line (:mod:`assembly_constraints.executor.cli`).
+Entry points: :class:`executor.trial.Cell` (``run_trial``) and the
+``executor`` subcommand of the command line (:mod:`executor.cli`).
 Layers (modules of this package), each importing only those before it: ``world`` (geometry,
 PyBullet scene, arm), ``control`` (impedance controller, admittance, detector, motion
 stepper), ``skills`` (DMP, hole search, insertion, wiggle, teaching), the records in
@@ -15,7 +15,7 @@ which ``trial.Cell`` meets) to record the skills the trial then uses.
 """
 
 
-from assembly_constraints.bridge.errors import ToolError
+from bridge.errors import ToolError
 
 
 class ExecutorError(ToolError):

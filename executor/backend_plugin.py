@@ -5,24 +5,24 @@ liveliness); a backend only runs experiments. A real cell plugs in its robot by 
 class with
 
 - ``__init__(self, context: CellContext)``: connect to the robot; raise
-  :class:`assembly_constraints.executor.ExecutorError` with a one-line message if it cannot (exit 2);
+  :class:`executor.ExecutorError` with a one-line message if it cannot (exit 2);
 - ``run(self, request: InsertRequest) -> tuple[Result, Evidence | None]``: insert
   ``request.part`` into ``request.hole`` once and say ``"fit"`` or ``"no_fit"``, with
   the measurements if there are any. Raise :class:`UnknownPair` for a part or hole the
-  cell does not have (the planner gets ``unknown_id``), :class:`assembly_constraints.executor.ExecutorError`
+  cell does not have (the planner gets ``unknown_id``), :class:`executor.ExecutorError`
   when the experiment could not run (``failed``, which the planner sends again);
 - ``run_step(self, request: StepRequest) -> StepOutcome``: carry out one step of a plan
   (``./run.sh assemble``), keeping the product between the steps of one plan run, one
   run at a time (:func:`check_run`: :class:`RunActive`, the planner gets ``run_active``);
   a step the product does not allow raises :class:`InvalidStep` (``invalid_step``, see
   :func:`check_step`) before anything moves; a cell that only learns may raise
-  :class:`assembly_constraints.executor.ExecutorError` (the planner gets ``failed``);
+  :class:`executor.ExecutorError` (the planner gets ``failed``);
 - ``close(self)``: release the robot.
 
 ``run`` is called from one thread, one experiment at a time. Start it with
 ``assembly-constraints executor serve --backend my_package.my_module:MyBackend
 --backend-option speed=0.2`` (the module must be importable: installed, or on
-``PYTHONPATH``). :class:`assembly_constraints.executor.replay.ReplayBackend` is a worked example; docs/backends.md
+``PYTHONPATH``). :class:`executor.replay.ReplayBackend` is a worked example; docs/backends.md
 describes the interface and docs/ros2.md how a backend reaches a ROS 2 robot.
 """
 
@@ -36,9 +36,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
-from assembly_constraints.bridge.inputs import shorten
-from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
-from assembly_constraints.executor import ExecutorError, UnknownPair
+from bridge.inputs import shorten
+from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from executor import ExecutorError, UnknownPair
 
 _SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
 

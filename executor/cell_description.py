@@ -5,7 +5,7 @@
 were made with; :func:`load_cell_description` reads an override file (TOML, any subset of
 the tables and keys, docs/cell.md "The cell description"), so a run may change a gain
 without touching code. A product's ``geometry.toml`` may still carry its own
-``[gripper]``, which wins over the cell's (:func:`assembly_constraints.executor.world.geometry.load_geometry`).
+``[gripper]``, which wins over the cell's (:func:`executor.world.geometry.load_geometry`).
 Every bad value is one line naming the file, table and key (exit 2).
 """
 
@@ -15,11 +15,11 @@ from pathlib import Path
 
 import msgspec
 
-from assembly_constraints.bridge.product import Gripper, decode_toml_file
-from assembly_constraints.executor.control.admittance import AdmittanceParams
-from assembly_constraints.executor.control.detector import Thresholds
-from assembly_constraints.executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
-from assembly_constraints.executor.control.ilc import IlcParams
+from bridge.product import Gripper, decode_toml_file
+from executor.control.admittance import AdmittanceParams
+from executor.control.detector import Thresholds
+from executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
+from executor.control.ilc import IlcParams
 
 
 def _default_gripper() -> Gripper:

@@ -31,8 +31,8 @@ from collections.abc import Callable
 
 import zenoh
 
-from assembly_constraints.bridge.keys import claim_key, claims_pattern, instance_of_claim_key
-from assembly_constraints.executor import ExecutorError
+from bridge.keys import claim_key, claims_pattern, instance_of_claim_key
+from executor import ExecutorError
 
 STARTUP_CHECK_S = 0.5
 """How long a starting cell looks for an older claim of its id [s] (measured: peers

@@ -15,12 +15,12 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from assembly_constraints.bridge.cell_settings import (
+from bridge.cell_settings import (
     add_cell_arguments,
     add_cell_description_argument,
     cell_settings_of,
 )
-from assembly_constraints.bridge.cli_types import (
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -28,8 +28,8 @@ from assembly_constraints.bridge.cli_types import (
     nonempty_path,
     png_path,
 )
-from assembly_constraints.bridge.files import write_atomic
-from assembly_constraints.bridge.recording.sinks import (
+from bridge.files import write_atomic
+from bridge.recording.sinks import (
     NO_VIEWER,
     Viewer,
     add_viewer_arguments,
@@ -45,8 +45,8 @@ MAX_ATTEMPTS = 10
 
 
 def _teach(args: argparse.Namespace) -> int:
-    from assembly_constraints.executor.skills.teach import teach_all
-    from assembly_constraints.executor.trial import Cell
+    from executor.skills.teach import teach_all
+    from executor.trial import Cell
 
     cell = Cell(args.assembly)
     try:
@@ -81,16 +81,16 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from assembly_constraints.executor.trial import Cell, cell_setup
+    from executor.trial import Cell, cell_setup
 
     setup = cell_setup(cell_settings_of(args))  # the cell description checked before anything is written
     logger = None
     if args.plot:
-        from assembly_constraints.bridge.files import check_writable
+        from bridge.files import check_writable
 
         check_writable(Path(args.plot))  # before the trials
     if args.rrd or args.plot or live != NO_VIEWER:
-        from assembly_constraints.executor.rerun_log import AttemptLogger
+        from executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
     cell = Cell(args.assembly, gui=args.gui, logger=logger, setup=setup)
@@ -109,7 +109,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
                 )
         summary = _summary(results)
         if args.plot:
-            from assembly_constraints.executor.campaign.plots import first_attempts, plot_fig17
+            from executor.campaign.plots import first_attempts, plot_fig17
 
             assert logger is not None
             plot_fig17(*first_attempts(logger.traces), Path(args.plot))
@@ -128,8 +128,8 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
 
 def _sizes(args: argparse.Namespace) -> int:
     """Print or write the sizes.lp of ``geometry.toml``
-    (:func:`assembly_constraints.executor.world.geometry.sizes_lp_text`)."""
-    from assembly_constraints.executor.world.geometry import sizes_lp_text
+    (:func:`executor.world.geometry.sizes_lp_text`)."""
+    from executor.world.geometry import sizes_lp_text
 
     text = sizes_lp_text(args.assembly)
     if args.out is None:
@@ -141,12 +141,12 @@ def _sizes(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from assembly_constraints.executor.assembly.export import export_cell
-    from assembly_constraints.executor.cell_description import load_cell_description
+    from executor.assembly.export import export_cell
+    from executor.cell_description import load_cell_description
 
     description = load_cell_description(args.cell_description)  # checked even where not used (--assembled)
     if args.assembled:
-        from assembly_constraints.executor.cad.assembled import write_assembled
+        from executor.cad.assembled import write_assembled
 
         files = write_assembled(args.assembly, args.out)
         print(f"wrote {len(files) - 1} part mesh(es) in the assembled pose and import.toml in {args.out}")
@@ -160,10 +160,10 @@ def _export(args: argparse.Namespace) -> int:
 # Subcommands owned by other modules: subcommand -> (module whose ``main(argv)`` runs it,
 # imported lazily; help text).
 _DELEGATED = {
-    "campaign": ("assembly_constraints.executor.campaign.run",
+    "campaign": ("executor.campaign.run",
                  "Fig. 18: randomised executions of every part-hole pair"),
-    "serve": ("assembly_constraints.executor.serve", "serve insertion requests over Zenoh"),
-    "margins": ("assembly_constraints.executor.campaign.margins",
+    "serve": ("executor.serve", "serve insertion requests over Zenoh"),
+    "margins": ("executor.campaign.margins",
                 "measure the wrench and end-error margins the thresholds come from"),
 }
 

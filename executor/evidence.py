@@ -1,5 +1,5 @@
-"""The plain records of the cell's experiments, shared by the trial (:mod:`assembly_constraints.executor.trial`),
-the Rerun log (:mod:`assembly_constraints.executor.rerun_log`) and the command lines: the random circumstances
+"""The plain records of the cell's experiments, shared by the trial (:mod:`executor.trial`),
+the Rerun log (:mod:`executor.rerun_log`) and the command lines: the random circumstances
 of one attempt (:class:`AttemptSetup`: grasp error [m, rad], vision error [m], friction), what
 one attempt showed (:class:`AttemptEvidence`: wrench deviations [N, Nm], end error [m],
 times [s]) and a whole trial (:class:`TrialResult`, with its ``--json`` form).  Kept apart
@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from assembly_constraints.executor.world import TIME_STEP
+from executor.world import TIME_STEP
 
 
 @dataclass
@@ -76,7 +76,7 @@ class AttemptSetup:
     (rotation vector [rad]) of the part in the hand, vision error of the hole estimate
     [m], seed of the stochastic search, friction coefficient of the part in the hole
     (None: the scene's own, 0.25), error of the hole's estimated yaw [rad] (0 but for a
-    rect hole).  Drawn by :class:`assembly_constraints.executor.world.perturbation.CellBias`."""
+    rect hole).  Drawn by :class:`executor.world.perturbation.CellBias`."""
 
     grasp_offset: np.ndarray
     grasp_tilt: np.ndarray

@@ -1,6 +1,6 @@
 """A cell that answers from a recorded session: the worked example of a backend (docs/backends.md).
 
-    assembly-constraints executor serve --backend assembly_constraints.executor.replay:ReplayBackend \\
+    assembly-constraints executor serve --backend executor.replay:ReplayBackend \\
         --backend-option journal=runs/<time>/journal.jsonl
 
 The journal (``RUN/journal.jsonl``, written by every session) holds one JSON object a
@@ -24,10 +24,10 @@ from collections import defaultdict
 
 import msgspec
 
-from assembly_constraints.bridge.inputs import read_bytes
-from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepRequest
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.backend_plugin import CellContext, StepOutcome, UnknownPair
+from bridge.inputs import read_bytes
+from bridge.messages import Evidence, InsertRequest, Result, StepRequest
+from executor import ExecutorError
+from executor.backend_plugin import CellContext, StepOutcome, UnknownPair
 
 Answer = tuple[Result, Evidence | None, float]
 """A recorded answer: the result, its evidence, the cell's wall time [s]."""

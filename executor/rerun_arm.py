@@ -28,9 +28,9 @@ import numpy as np
 import pybullet as pb
 import rerun as rr
 
-from assembly_constraints.bridge.recording.layout import HELD_PART, HELD_PART_COLOR, HELD_PART_SOLIDS
-from assembly_constraints.bridge.recording.rows import log_row
-from assembly_constraints.executor.world.scene import link_frame
+from bridge.recording.layout import HELD_PART, HELD_PART_COLOR, HELD_PART_SOLIDS
+from bridge.recording.rows import log_row
+from executor.world.scene import link_frame
 
 _ARM_COLOR = [235, 120, 30]
 _TOOL_COLOR = [80, 80, 90]

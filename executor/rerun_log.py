@@ -1,6 +1,6 @@
 """Rerun logging of the cell's insertion attempts (paper 3.2, Fig. 17).
 
-The :class:`~assembly_constraints.executor.trial.Cell` calls an :class:`AttemptLogger` while it executes:
+The :class:`~executor.trial.Cell` calls an :class:`AttemptLogger` while it executes:
 ``log_scene`` once, then per attempt ``begin_attempt``, ``log_search_path``,
 ``log_step`` at every control step and ``end_attempt``.
 
@@ -26,11 +26,11 @@ Entities (all under ``executor/<cell-id>/``):
 ``by_phase/<outcome>/<key>``    Fig. 17: F_des and F_mes of the insertion against the DMP
                                 phase 0..1, a 2D plot growing with the insertion: the part up
                                 to then at a few times during it, whole at its last step
-                                (:func:`assembly_constraints.executor.rerun_plots.send_fig17`)
+                                (:func:`executor.rerun_plots.send_fig17`)
 ``outcome``                     text log, one line per attempt
 ``result/{fit,max_force_dev,max_torque_dev,end_error,...}``  per-attempt scalars
 ``ilc/<shape>/<hole>/correction_norm``  size of the ILC correction after each update
-                                (mm and degrees, :func:`assembly_constraints.executor.control.ilc.correction_norm`)
+                                (mm and degrees, :func:`executor.control.ilc.correction_norm`)
                                 over timeline ``execution``
 =============================== ===================================================
 
@@ -44,8 +44,8 @@ Steps are buffered and sent column-wise (``send_columns``) at ``end_attempt``, w
 keeps the per-step cost to a list append; samples closer than ``period_s`` in sim
 time are skipped so a long campaign stays small. The search path, the growing tool path
 and Fig. 17 are sent then too, each row at the times of the step it ends with
-(:func:`assembly_constraints.executor.rerun_plots.growth_ends`: at most
-:data:`assembly_constraints.executor.rerun_plots.GROWTH_ROWS` rows an attempt).
+(:func:`executor.rerun_plots.growth_ends`: at most
+:data:`executor.rerun_plots.GROWTH_ROWS` rows an attempt).
 """
 
 from __future__ import annotations
@@ -60,8 +60,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import rerun as rr
 
-from assembly_constraints.bridge.recording.compaction import compact_recording
-from assembly_constraints.bridge.recording.layout import (
+from bridge.recording.compaction import compact_recording
+from bridge.recording.layout import (
     APPLICATION_ID,
     HOLE_RIMS,
     SESSION_TIMELINE,
@@ -71,9 +71,9 @@ from assembly_constraints.bridge.recording.layout import (
     fig17_path,
     opening,
 )
-from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.rerun_plots import (
+from bridge.recording.sinks import NO_VIEWER, Viewer, finish_stream, open_stream
+from executor import ExecutorError
+from executor.rerun_plots import (
     AXIS_NAMES,
     DESIRED_COLORS,
     MEASURED_COLORS,
@@ -83,15 +83,15 @@ from assembly_constraints.executor.rerun_plots import (
 )
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.evidence import AttemptEvidence
-    from assembly_constraints.executor.rerun_arm import ArmRecorder
+    from executor.evidence import AttemptEvidence
+    from executor.rerun_arm import ArmRecorder
 
 FORCE_ARROW_M_PER_N = 0.004
 """Length of the force arrow at the tool [m] per newton of F_mes."""
 TIP_RADIUS_UI = 2.0
 """Radius of the tool tip's point [UI points: pixels at 100 % UI scaling, whatever the zoom];
 the 3D views draw the tip over the last second as its trail
-(:data:`assembly_constraints.bridge.recording.layout.TRAIL_S`): a line of dots a few pixels
+(:data:`bridge.recording.layout.TRAIL_S`): a line of dots a few pixels
 wide, in the cell's overview and in the close-ups alike."""
 TIP_COLOR = [30, 110, 230]
 FORCE_COLOR = [200, 30, 160]
@@ -128,7 +128,7 @@ class TraceStep:
     """One control step as logged: ``sim_time`` [s] as the cell reported it, ``phase`` (DMP
     phase), ``tool_pos`` (3,) [m], ``force_mes``/``force_des`` (3,) [N] measured and
     desired, ``torque_mes``/``torque_des`` (3,) [Nm]; ``arm_pose``: the arm's link poses
-    (:meth:`assembly_constraints.executor.rerun_arm.ArmRecorder.sample`) or None;
+    (:meth:`executor.rerun_arm.ArmRecorder.sample`) or None;
     ``wall_time`` [s since the epoch]: when it was logged."""
 
     sim_time: float
@@ -213,7 +213,7 @@ class AttemptLogger:
     (random if None) saving to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
     existing ``rr.RecordingStream`` instead. Without either, data stays in memory
     (``keep_traces`` then still gives the traces for plots). ``viewer``: also stream
-    live to a Rerun viewer or serve it to a browser (:mod:`assembly_constraints.bridge.recording.sinks`).
+    live to a Rerun viewer or serve it to a browser (:mod:`bridge.recording.sinks`).
 
     ``period_s`` [s]: steps closer than this in sim time to the last kept one are
     skipped. ``keep_traces``: keep every finished :class:`AttemptTrace` in ``traces``.

@@ -19,9 +19,9 @@ from collections.abc import Sequence
 import numpy as np
 import rerun as rr
 
-from assembly_constraints.bridge.recording.layout import FIG17_HEIGHT as HEIGHT
-from assembly_constraints.bridge.recording.layout import FIG17_MARGIN
-from assembly_constraints.bridge.recording.layout import FIG17_WIDTH as WIDTH
+from bridge.recording.layout import FIG17_HEIGHT as HEIGHT
+from bridge.recording.layout import FIG17_MARGIN
+from bridge.recording.layout import FIG17_WIDTH as WIDTH
 
 AXIS_NAMES = {"force": ["Fx", "Fy", "Fz"], "torque": ["Mx", "My", "Mz"]}
 MEASURED_COLORS = [[230, 60, 60], [60, 170, 60], [60, 90, 230]]

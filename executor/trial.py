@@ -1,17 +1,17 @@
 """One insertion experiment: part P into hole H, up to two attempts (paper 3.2).
 
 Per attempt: a grasp of the part and a vision estimate of the hole, both off by errors
-unknown to the robot, and a friction of the hole (:mod:`assembly_constraints.executor.world.perturbation`:
+unknown to the robot, and a friction of the hole (:mod:`executor.world.perturbation`:
 a systematic part per cell, a random part per attempt); the part is brought above the
 estimate, the hole is searched, the taught skill inserts it with the chosen execution
-layer (:class:`assembly_constraints.executor.control.ilc.ExecutionLayer`: admittance, phase stopping, ILC),
+layer (:class:`executor.control.ilc.ExecutionLayer`: admittance, phase stopping, ILC),
 the detector decides, and the part goes back to its start on the tray.  A failed attempt
 is repeated once; two failures mean "no_fit".  With ILC, each successful execution
 updates the correction of its (part shape, hole), kept for the cell's next executions
 (and saved to ``ilc_state`` if given).
 The transfer between tray and plate is kinematic (joint-space, not simulated): only
 the force-controlled part of the task is.  The records it returns (the attempt's setup and
-evidence, the trial's result) are plain types in :mod:`assembly_constraints.executor.evidence`.
+evidence, the trial's result) are plain types in :mod:`executor.evidence`.
 """
 
 from __future__ import annotations
@@ -24,31 +24,31 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
-from assembly_constraints.executor import ExecutorError, UnknownPair
-from assembly_constraints.executor.cell_description import CellDescription, load_cell_description
-from assembly_constraints.executor.control.controller import ImpedanceController
-from assembly_constraints.executor.control.detector import Detector
-from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
-from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, Motion
-from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
-from assembly_constraints.executor.rerun_arm import ArmRecorder
-from assembly_constraints.executor.skills.dmp import Skill, load_product_skill
-from assembly_constraints.executor.skills.insertion import (
+from bridge.cell_settings import CellSettings, Magnitudes
+from executor import ExecutorError, UnknownPair
+from executor.cell_description import CellDescription, load_cell_description
+from executor.control.controller import ImpedanceController
+from executor.control.detector import Detector
+from executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
+from executor.control.motion import APPROACH_SETTLE_TIME, Motion
+from executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
+from executor.rerun_arm import ArmRecorder
+from executor.skills.dmp import Skill, load_product_skill
+from executor.skills.insertion import (
     InsertionTask,
     insert_in_layer,
     needs_yaw_compliance,
     rotvec_quat_xyzw,
 )
-from assembly_constraints.executor.skills.search import hole_search
-from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
-from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import fit_pose, load_geometry
-from assembly_constraints.executor.world.perturbation import CellBias
-from assembly_constraints.executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes
+from executor.skills.search import hole_search
+from executor.world.arm import Arm, aligned_yaw, tool_quat
+from executor.world.assets import current_assets
+from executor.world.geometry import fit_pose, load_geometry
+from executor.world.perturbation import CellBias
+from executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.rerun_log import AttemptLogger
+    from executor.rerun_log import AttemptLogger
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
 PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
@@ -62,9 +62,9 @@ def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
 @dataclass(frozen=True)
 class CellSetup:
     """What a simulated cell is, decoded (:func:`cell_setup`): ``layer``, its execution layer
-    (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
+    (a name of :data:`executor.control.ilc.LAYERS` or one);
     ``magnitudes``, of its uncertainty (units per field of
-    :class:`assembly_constraints.bridge.cell_settings.Magnitudes`); ``cell_seed``, the seed of
+    :class:`bridge.cell_settings.Magnitudes`); ``cell_seed``, the seed of
     its systematic errors; ``description``, its gripper, gains, thresholds, admittance and
     ILC parameters."""
 
@@ -89,7 +89,7 @@ class Cell:
 
     ``setup``: the execution layer, the magnitudes of the cell's uncertainty and the seed of
     its systematic part (drawn into ``bias``,
-    :class:`assembly_constraints.executor.world.perturbation.CellBias`), the cell's
+    :class:`executor.world.perturbation.CellBias`), the cell's
     description (:class:`CellSetup`); ``ilc_state``: a JSON file the ILC corrections are
     read from (if it exists) and saved to after every update."""
 

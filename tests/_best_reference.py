@@ -2,7 +2,7 @@
 
 clingo enumerates the possible relations and their classes (program part ``base``), then
 sums the weights per pair and selects (part ``split``); exact for small instances (total
-weight < 2^31, e.g. 4x4). The tests check the numpy paths of :mod:`assembly_constraints.asp.sizes.best`
+weight < 2^31, e.g. 4x4). The tests check the numpy paths of :mod:`asp.sizes.best`
 against it.
 """
 
@@ -14,10 +14,10 @@ from pathlib import Path
 import clingo
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.best import ALPHA, WEIGHT_SCALE
-from assembly_constraints.asp.sizes.knowledge import Knowledge, Pair
-from assembly_constraints.asp.solve import fact, format_facts
+from asp import PlannerError
+from asp.sizes.best import ALPHA, WEIGHT_SCALE
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.solve import fact, format_facts
 
 ENCODING = Path(__file__).with_name("select_best.lp")
 ASP_WEIGHT_LIMIT = 2**31 - 1

@@ -6,7 +6,7 @@ import networkx as nx
 import numpy as np
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.precedence.relation import Relation
+from asp.precedence.relation import Relation
 
 
 def closed_relation(parts: list[str], edges: list[tuple[int, int]]) -> Relation:

@@ -8,9 +8,9 @@ from collections.abc import Callable
 import numpy as np
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.sizes.biorders import all_biorders
-from assembly_constraints.asp.sizes.knowledge import Knowledge
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp.sizes.biorders import all_biorders
+from asp.sizes.knowledge import Knowledge
+from asp.sizes.truth_oracle import TruthOracle
 
 
 @st.composite

@@ -37,7 +37,7 @@ from typing import Protocol
 
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess
+from asp.session.cells import CellProcess
 
 ROOT = Path(__file__).resolve().parent.parent
 CLI_MODULE = "assembly_constraints"  # ./run.sh SUBCOMMAND: the one command line

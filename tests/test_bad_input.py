@@ -25,10 +25,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.journal import MAX_JOURNAL_BYTES
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.errors import EXIT_BROKEN_PIPE
+from asp.session.journal import MAX_JOURNAL_BYTES
 from assembly_constraints.cli import main
+from bridge.assembly import load_assembly
+from bridge.errors import EXIT_BROKEN_PIPE
 from tests.conftest import CLI_MODULE, ROOT, child_env, error_lines, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
@@ -127,8 +127,8 @@ def plan_file(name: str, change: Callable[[list[dict]], object]) -> Callable[[Pa
     --json`` prints it, after ``change`` edited its list of steps in place."""
 
     def setup(tmp: Path) -> None:
-        from assembly_constraints.asp.assemble.cli import truth_facts
-        from assembly_constraints.asp.plans.plans import plans
+        from asp.assemble.cli import truth_facts
+        from asp.plans.plans import plans
 
         steps = plans(truth_facts(load_assembly("cranfield")))[0].as_json()
         change(steps)

@@ -126,8 +126,8 @@ def test_the_scan_finds_a_command_only_where_a_test_runs_it() -> None:
     assert not runs('run_cli("bench", "plan", "sizes")', ("bench", "sizes"))
     assert not runs('run_cli("sizes", "learn")', ("bench", "sizes"))
     assert runs('run_executor("trial", "--part")', ("executor", "trial"))
-    assert imports("from assembly_constraints.asp.bench.mesh import one_run\n", ("bench", "mesh"))
-    assert not imports("from assembly_constraints.asp.bench.mesh import one_run\n", ("bench", "session"))
+    assert imports("from asp.bench.mesh import one_run\n", ("bench", "mesh"))
+    assert not imports("from asp.bench.mesh import one_run\n", ("bench", "session"))
     assert _run_by_a_test(("precedence", "enumerate"), "") and not _run_by_a_test(("precedence", "nosuch"), "")
     assert documented_commands()[("precedence", "enumerate")]  # the docs' code blocks are read
 

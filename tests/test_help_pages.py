@@ -18,20 +18,20 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge.assembly import DATA_DIR
-from assembly_constraints.bridge.cli_types import ASSEMBLY_HELP, PROGRAM
 from assembly_constraints.cli import main
+from bridge.assembly import DATA_DIR
+from bridge.cli_types import ASSEMBLY_HELP, PROGRAM
 from tests.conftest import child_env
 
 MARKUP = re.compile(r"``|`|\*\*|:mod:|:class:|:func:|\.\/run\.sh|\b(?:asp|executor|bridge)\.[a-z_]+\b|\w+\.py\b"
                     r"|\b[A-Z][a-z][A-Za-z]*\.[a-z_]{2,}\b")
 """Documentation markup (literals, roles, strong emphasis), the wrapper's name, and module
 or method names a user never types (a ``MODULE:CLASS`` example such as
-``assembly_constraints.executor.replay:ReplayBackend`` is allowed below)."""
+``executor.replay:ReplayBackend`` is allowed below)."""
 OTHER_PROGRAMS = re.compile(r"run\.sh|\bpython3? -m\b|\bassembly_constraints\b")
 """Names of the program other than ``assembly-constraints``: the repository's wrapper, the
 module run by Python, the package name."""
-ALLOWED = ("assembly_constraints.executor.replay:ReplayBackend",)
+ALLOWED = ("executor.replay:ReplayBackend",)
 
 
 class _Captured(Exception):

@@ -203,10 +203,10 @@ def test_no_python_folder_holds_more_than_twelve_modules() -> None:
 
 def test_every_layer_error_shares_the_one_root() -> None:
     """Callers catch one layer's errors or all of them; none is converted into another."""
-    from assembly_constraints.asp import PlannerError
-    from assembly_constraints.bridge import BridgeError
-    from assembly_constraints.bridge.errors import ToolError
-    from assembly_constraints.executor import ExecutorError
+    from asp import PlannerError
+    from bridge import BridgeError
+    from bridge.errors import ToolError
+    from executor import ExecutorError
 
     assert all(issubclass(error, ToolError) for error in (PlannerError, BridgeError, ExecutorError))
     assert not any(issubclass(a, b) for a in (PlannerError, BridgeError, ExecutorError)

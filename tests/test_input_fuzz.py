@@ -2,7 +2,7 @@
 reader (text and ``demo/3`` facts), the learned facts reader, the plan JSON reader, the
 session journal reader and the product description loader (``assembly.toml``). Whatever
 the bytes, a reader returns valid data or raises its package's error
-(:class:`assembly_constraints.asp.PlannerError`, :class:`assembly_constraints.bridge.BridgeError`) with a
+(:class:`asp.PlannerError`, :class:`bridge.BridgeError`) with a
 short message: never another exception, never unbounded work (each example has a deadline)."""
 
 from __future__ import annotations
@@ -14,14 +14,14 @@ from pathlib import Path
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.asp.assemble.inputs import read_plan_json
-from assembly_constraints.asp.plans.assign import load_learned_facts
-from assembly_constraints.asp.precedence.demos import MAX_DEMONSTRATIONS, load_demos
-from assembly_constraints.asp.session.journal import read_journal
-from assembly_constraints.asp.solve import load_atoms, pairs_by_name
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import ID_PATTERN, load_assembly
+from asp import MAX_IDS, PlannerError
+from asp.assemble.inputs import read_plan_json
+from asp.plans.assign import load_learned_facts
+from asp.precedence.demos import MAX_DEMONSTRATIONS, load_demos
+from asp.session.journal import read_journal
+from asp.solve import load_atoms, pairs_by_name
+from bridge import BridgeError
+from bridge.assembly import ID_PATTERN, load_assembly
 
 FUZZ = settings(max_examples=100, deadline=2000, suppress_health_check=[HealthCheck.too_slow])
 ID = re.compile(ID_PATTERN)

@@ -49,8 +49,8 @@ def test_the_installed_command_runs_a_session_from_a_folder_outside_the_reposito
     version = subprocess.run([str(command), "--version"], cwd=tmp_path, env=env, capture_output=True, text=True,
                              timeout=60)
     assert version.returncode == 0 and version.stdout.startswith(f"{PROGRAM} "), version.stderr
-    where = subprocess.run([sys.executable, "-c", "import assembly_constraints.bridge.assembly as a; "
-                            "import assembly_constraints.asp as asp; print(a.DATA_DIR); print(asp.__file__)"],
+    where = subprocess.run([sys.executable, "-c", "import bridge.assembly as a; "
+                            "import asp as asp; print(a.DATA_DIR); print(asp.__file__)"],
                            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
     data_dir, asp_file = where.stdout.split()
     site = Path(env["PYTHONPATH"])

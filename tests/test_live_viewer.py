@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge.recording.reader import column_values, read_blueprint, read_recording
-from assembly_constraints.bridge.recording.sinks import rerun_server
+from bridge.recording.reader import column_values, read_blueprint, read_recording
+from bridge.recording.sinks import rerun_server
 from tests.conftest import ROOT, child_env
 
 

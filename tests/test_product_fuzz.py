@@ -21,12 +21,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.errors import EXIT_BAD_INPUT, ToolError
-from assembly_constraints.bridge.product import load_product_description
 from assembly_constraints.cli import main
-from assembly_constraints.executor.assembly.product import load_product
-from assembly_constraints.executor.world.geometry import (
+from bridge import BridgeError
+from bridge.errors import EXIT_BAD_INPUT, ToolError
+from bridge.product import load_product_description
+from executor.assembly.product import load_product
+from executor.world.geometry import (
     arm_urdf_text,
     load_geometry,
     part_urdf_text,

@@ -10,13 +10,13 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory
-from assembly_constraints.bridge.keys import alive_key
-from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, free_loopback_endpoint, open_session
+from asp.session.cells import CellProcess, start_cell
 from assembly_constraints.cli import main
+from bridge import BridgeError
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory
+from bridge.keys import alive_key
+from bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, free_loopback_endpoint, open_session
 from tests.conftest import error_lines
 from tests.executor.test_mesh_parts import _edit, _refusal, product  # noqa: F401 (product: the fixture)
 

@@ -11,7 +11,7 @@ of these, plan K of the assembly's true facts (``sizes.lp``, ``precedence.lp``).
 Re-planning after a failed step uses the same facts.
 
 The planner starts one cell (``executor serve``) on loopback and sends it one step
-request per plan step over Zenoh (:mod:`assembly_constraints.asp.assemble.driver`); the cell keeps its world
+request per plan step over Zenoh (:mod:`asp.assemble.driver`); the cell keeps its world
 between steps.  JSON (``--json``): ``{"plan", "steps": [{"part", "hole", "skill",
 "outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled",
 "final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
@@ -33,32 +33,32 @@ from pathlib import Path
 
 from msgspec import UNSET
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.driver import assembling_cell
-from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
-from assembly_constraints.asp.assemble.inputs import (
+from asp import PlannerError
+from asp.assemble.driver import assembling_cell
+from asp.assemble.execute import AssemblyStopped, execute
+from asp.assemble.inputs import (
     check_facts_product,
     check_plan_product,
     plan_of_json,
     read_plan_json,
 )
-from assembly_constraints.asp.assemble.settings import (
+from asp.assemble.settings import (
     MAX_PLAN_INDEX,
     MAX_STEP_S,
     AssemblySettings,
     assembling_cell_settings,
 )
-from assembly_constraints.asp.plans.assign import LearnedFacts, load_learned_facts
-from assembly_constraints.asp.plans.plans import Plan, plans
-from assembly_constraints.asp.session.settings import SESSION_FILE, SessionFile, read_session_file
-from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_settings import (
+from asp.plans.assign import LearnedFacts, load_learned_facts
+from asp.plans.plans import Plan, plans
+from asp.session.settings import SESSION_FILE, SessionFile, read_session_file
+from bridge.assembly import Assembly, load_assembly
+from bridge.cell_settings import (
     ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
     cell_settings_of,
 )
-from assembly_constraints.bridge.cli_types import (
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -67,8 +67,8 @@ from assembly_constraints.bridge.cli_types import (
     nonempty_path,
     path_setting,
 )
-from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
-from assembly_constraints.bridge.session import add_endpoint_arguments
+from bridge.errors import EXIT_UNSOLVABLE
+from bridge.session import add_endpoint_arguments
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,4 +1,4 @@
-"""The planner's end of plan execution over Zenoh: one :class:`assembly_constraints.bridge.messages.StepRequest`
+"""The planner's end of plan execution over Zenoh: one :class:`bridge.messages.StepRequest`
 per step to one cell, waited for (a lost reply is sent again under the same id: the cell
 answers a repeated request from its cache and never runs the step twice)."""
 
@@ -12,14 +12,14 @@ from pathlib import Path
 import msgspec
 import zenoh
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_step
-from assembly_constraints.bridge.inputs import shorten
-from assembly_constraints.bridge.messages import StepReply, StepRequest
-from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
+from asp import PlannerError
+from asp.session.cells import CellProcess, start_cell
+from bridge import BridgeError
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, CellTimeout, request_step
+from bridge.inputs import shorten
+from bridge.messages import StepReply, StepRequest
+from bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 CELL_ID = "a1"
 CELL_START_S = 60.0
@@ -74,7 +74,7 @@ def assembling_cell(served: ServeSettings, seed: int, timeout_s: float, *, liste
     and yield a driver for one plan run in it; the cell is stopped on exit.  ``served``:
     the cell's settings (backend, ``block_holes``, ``rrd``, ``zenoh_config``, also the
     planner's; ``cell``: the sim cell's,
-    :func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`), its cell
+    :func:`asp.assemble.settings.assembling_cell_settings`), its cell
     id and the endpoint it connects to set here; ``seed`` seeds the cell's random errors,
     ``timeout_s`` bounds one step [s]; ``listen``/``connect``: the planner's endpoints."""
     listen = list(listen) or [LOOPBACK_ANY_PORT]

@@ -3,7 +3,7 @@ and recovers from failed steps.
 
 Each step goes to the cell (which retries a failed insertion once, as in the paper);
 a step that still fails is recorded as an observation ``no_fit(P,H)`` with its evidence,
-and the rest is re-planned from the current state (:func:`assembly_constraints.asp.assemble.replan.replan`:
+and the rest is re-planned from the current state (:func:`asp.assemble.replan.replan`:
 placed parts stay placed).  A part placed without a hole that fails, or no assignment
 left, stops the run (:class:`AssemblyStopped`, exit code 3), the placed parts staying
 where they are.
@@ -14,11 +14,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.replan import replan, with_no_fit
-from assembly_constraints.asp.plans.assign import LearnedFacts, UnsolvableAssembly
-from assembly_constraints.asp.plans.plans import Plan, PlanStep
-from assembly_constraints.bridge.messages import StepReply
+from asp import PlannerError
+from asp.assemble.replan import replan, with_no_fit
+from asp.plans.assign import LearnedFacts, UnsolvableAssembly
+from asp.plans.plans import Plan, PlanStep
+from bridge.messages import StepReply
 
 MAX_REPLANS = 20
 """A run stops after this many re-plans (each one withdraws a part-hole pair, so it ends anyway)."""

@@ -2,7 +2,7 @@
 plan JSON file or a run's ``session.json``, and facts and plans held against the product.
 
 - :func:`plan_of_json`: the steps of one plan in the JSON contract (``[{"part": P,
-  "hole": H|null}, ...]``), every id checked against :data:`assembly_constraints.bridge.assembly.ID_PATTERN`;
+  "hole": H|null}, ...]``), every id checked against :data:`bridge.assembly.ID_PATTERN`;
   :func:`read_plan_json` reads plan K of a plan JSON file.
 - :func:`check_facts_product`: the facts describe the product of ``assembly.toml``: the
   same parts, only its holes, and every peg (``role = "peg"``) with something known of
@@ -20,11 +20,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import LearnedFacts
-from assembly_constraints.asp.plans.plans import Plan, PlanStep, check_plan
-from assembly_constraints.bridge.assembly import Assembly, is_id
-from assembly_constraints.bridge.inputs import duplicate_key, read_bytes, shorten
+from asp import PlannerError
+from asp.plans.assign import LearnedFacts
+from asp.plans.plans import Plan, PlanStep, check_plan
+from bridge.assembly import Assembly, is_id
+from bridge.inputs import duplicate_key, read_bytes, shorten
 
 _STEP_KEYS = frozenset({"part", "hole"})
 

@@ -4,7 +4,7 @@ A step that failed in the cell (after the cell's own retry) is an observation
 ``no_fit(P,H)``: the part did not go into that hole, whatever the learned sizes said.
 The new plan keeps what is done (the placed parts keep their steps and holes,
 ``plans/prefix.lp``) and puts the rest into the holes still possible.  When no
-assignment is left, :class:`assembly_constraints.asp.plans.assign.UnsolvableAssembly` names the part that
+assignment is left, :class:`asp.plans.assign.UnsolvableAssembly` names the part that
 gets no hole.
 """
 
@@ -15,10 +15,10 @@ from dataclasses import replace
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import LearnedFacts, UnsolvableAssembly, feasible_assignment
-from assembly_constraints.asp.plans.plans import Plan, PlanStep, check_plan, plans
-from assembly_constraints.asp.solve import fact
+from asp import PlannerError
+from asp.plans.assign import LearnedFacts, UnsolvableAssembly, feasible_assignment
+from asp.plans.plans import Plan, PlanStep, check_plan, plans
+from asp.solve import fact
 
 
 def with_no_fit(facts: LearnedFacts, part: str, hole: str) -> LearnedFacts:

@@ -1,5 +1,5 @@
 """The settings of one assembly run (``./run.sh assemble``), as a typed struct built once
-at the edge (:func:`assembly_constraints.asp.assemble.cli.assembly_settings`, or in Python)."""
+at the edge (:func:`asp.assemble.cli.assembly_settings`, or in Python)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from typing import Annotated, Literal
 
 from msgspec import Meta, Struct
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, CellSettings, Seed, changed_cell_options
+from asp import PlannerError
+from bridge.cell_settings import DEFAULT_CELL, CellSettings, Seed, changed_cell_options
 
 MAX_PLAN_INDEX = 1000
 MAX_STEP_S = 86_400.0

@@ -8,13 +8,13 @@ assembled in a fresh simulated cell with monitoring and re-planning.
 The relation and the sizes: the learned facts of a session's run folder
 (``RUN/learned.lp``) or of facts files, else the assembly's true ones (``precedence.lp``,
 ``sizes.lp``).  Plan k (1..N) is a sequence drawn exactly uniformly among the sequences
-the relation admits (:class:`assembly_constraints.asp.precedence.count.UniformSampler`, as
+the relation admits (:class:`asp.precedence.count.UniformSampler`, as
 ``precedence sample``) with a hole assignment drawn uniformly among the feasible ones
 (at most :data:`ASSIGNMENT_LIMIT`; Cranfield has 4), both from ``random.Random(S)``;
 every plan passes the checker.  Plan k runs in a cell of its own started for it
 (``executor serve``, a fresh world) whose random errors have seed S + k; with
 ``--uncertainty cell`` every cell has the cell options' uncertainty and layer
-(:func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`, the same cell seed for all).
+(:func:`asp.assemble.settings.assembling_cell_settings`, the same cell seed for all).
 
 Prints per plan (to stderr with ``--json``), as it finishes: the plan, assembled,
 re-plans, the worst final pose error of any part [mm] and the wall time [s] (cell
@@ -34,18 +34,18 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.cli import session_plans, truth_facts, truth_sources
-from assembly_constraints.asp.assemble.driver import assembling_cell
-from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
-from assembly_constraints.asp.assemble.inputs import check_facts_product
-from assembly_constraints.asp.assemble.settings import MAX_STEP_S, assembling_cell_settings
-from assembly_constraints.asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
-from assembly_constraints.asp.plans.plans import Plan, PlanStep, check_plan
-from assembly_constraints.asp.precedence.count import UniformSampler
-from assembly_constraints.asp.precedence.relation import Relation
-from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_settings import (
+from asp import PlannerError
+from asp.assemble.cli import session_plans, truth_facts, truth_sources
+from asp.assemble.driver import assembling_cell
+from asp.assemble.execute import AssemblyStopped, execute
+from asp.assemble.inputs import check_facts_product
+from asp.assemble.settings import MAX_STEP_S, assembling_cell_settings
+from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
+from asp.plans.plans import Plan, PlanStep, check_plan
+from asp.precedence.count import UniformSampler
+from asp.precedence.relation import Relation
+from bridge.assembly import Assembly, load_assembly
+from bridge.cell_settings import (
     DEFAULT_CELL,
     CellSettings,
     ServeSettings,
@@ -53,7 +53,7 @@ from assembly_constraints.bridge.cell_settings import (
     add_cell_arguments,
     cell_settings_of,
 )
-from assembly_constraints.bridge.cli_types import (
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -61,7 +61,7 @@ from assembly_constraints.bridge.cli_types import (
     finite_float,
     int_in,
 )
-from assembly_constraints.bridge.progress import progress
+from bridge.progress import progress
 
 ASSIGNMENT_LIMIT = 10_000
 """A plan's assignment is drawn among at most this many feasible ones (clingo's first)."""

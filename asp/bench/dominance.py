@@ -50,10 +50,10 @@ from typing import Generic, NamedTuple, TypeVar
 
 import numpy as np
 
-from assembly_constraints.asp.sizes.biorders import all_biorders, mask_bits
-from assembly_constraints.asp.sizes.evaluate import relabeled_matrices
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.bridge.cli_types import ArgumentParser, comma_list, finite_float, int_in, size_pair
+from asp.sizes.biorders import all_biorders, mask_bits
+from asp.sizes.evaluate import relabeled_matrices
+from asp.sizes.truth_oracle import TruthOracle
+from bridge.cli_types import ArgumentParser, comma_list, finite_float, int_in, size_pair
 
 INFEASIBLE = 1 << 40
 """Value of a state from which no policy meets every deadline."""

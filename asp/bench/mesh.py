@@ -15,7 +15,7 @@ cells claiming one id) and a third peer (the planner) in four topologies:
 For each, over ``--repeat`` runs: in how many runs B's liveliness subscriber saw A's
 token, in how many B's query reached A's queryable, and how long after the last node
 opened its session (B, or the planner for ``apart``) B saw A's token [ms]. Run as a
-module (``python -m assembly_constraints.asp.bench.mesh LISTEN CONNECT NAME``), this file is one such peer.
+module (``python -m asp.bench.mesh LISTEN CONNECT NAME``), this file is one such peer.
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ from importlib.metadata import version
 
 import zenoh
 
-from assembly_constraints.bridge.cli_types import ArgumentParser, int_in
-from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
+from bridge.cli_types import ArgumentParser, int_in
+from bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 TOPOLOGIES = ("star", "star+listen", "together", "apart")
 WATCH_S = 3.0
@@ -58,7 +58,7 @@ def peer(listen: list[str], connect: list[str], name: str) -> None:
 
 
 def _start(listen: list[str], connect: list[str], name: str) -> subprocess.Popen[str]:
-    return subprocess.Popen([sys.executable, "-m", "assembly_constraints.asp.bench.mesh",
+    return subprocess.Popen([sys.executable, "-m", "asp.bench.mesh",
                              json.dumps(listen), json.dumps(connect), name],
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 

@@ -18,13 +18,13 @@ from pathlib import Path
 
 import clingo
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.asp.plans.assign import LearnedFacts, load_learned_facts
-from assembly_constraints.asp.plans.plans import plans, travel_facts
-from assembly_constraints.asp.precedence.relation import precedence_facts, true_relation
-from assembly_constraints.asp.solve import fact, load_atoms, write_facts
-from assembly_constraints.bridge.assembly import Assembly, Hole, Part, load_assembly
-from assembly_constraints.bridge.cli_types import ArgumentParser, finite_float, int_in
+from asp import MAX_IDS, PlannerError
+from asp.plans.assign import LearnedFacts, load_learned_facts
+from asp.plans.plans import plans, travel_facts
+from asp.precedence.relation import precedence_facts, true_relation
+from asp.solve import fact, load_atoms, write_facts
+from bridge.assembly import Assembly, Hole, Part, load_assembly
+from bridge.cli_types import ArgumentParser, finite_float, int_in
 
 
 def _learned(atoms: list[clingo.Symbol]) -> LearnedFacts:

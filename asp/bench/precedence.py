@@ -15,11 +15,11 @@ from collections.abc import Callable
 
 import networkx as nx
 
-from assembly_constraints.asp.precedence.count import exact_count
-from assembly_constraints.asp.precedence.evaluate import PAPER_M, evaluate
-from assembly_constraints.asp.precedence.relation import Relation, close, true_relation
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cli_types import ArgumentParser, int_in
+from asp.precedence.count import exact_count
+from asp.precedence.evaluate import PAPER_M, evaluate
+from asp.precedence.relation import Relation, close, true_relation
+from bridge.assembly import load_assembly
+from bridge.cli_types import ArgumentParser, int_in
 
 
 def median_seconds(work: Callable[[], object], repeat: int) -> float:
@@ -68,7 +68,7 @@ def main(argv: list[str]) -> int:
         print(f"count {parts} parts (3 chains of 5 + {parts - 15} free): {exact_count(matrix)} "
               f"in {1e3 * seconds:.3f} ms (required < 1 s)")
 
-    from assembly_constraints.asp.precedence.guide import evaluate_guided
+    from asp.precedence.guide import evaluate_guided
 
     start = time.perf_counter()
     guided = evaluate_guided(truth, args.guided_trials, seed=1)

@@ -31,17 +31,17 @@ from dataclasses import dataclass, field
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.cli import truth_facts
-from assembly_constraints.asp.assemble.driver import assembling_cell
-from assembly_constraints.asp.assemble.execute import StepDriver, step_json
-from assembly_constraints.asp.plans.plans import PlanStep, plans
-from assembly_constraints.asp.precedence.relation import Pair, Relation, reduction, true_relation
-from assembly_constraints.asp.solve import fact, solve
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.cli_types import (
+from asp import PlannerError
+from asp.assemble.cli import truth_facts
+from asp.assemble.driver import assembling_cell
+from asp.assemble.execute import StepDriver, step_json
+from asp.plans.plans import PlanStep, plans
+from asp.precedence.relation import Pair, Relation, reduction, true_relation
+from asp.solve import fact, solve
+from bridge import BridgeError
+from bridge.assembly import Assembly, load_assembly
+from bridge.cell_settings import ServeSettings
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -51,8 +51,8 @@ from assembly_constraints.bridge.cli_types import (
     int_in,
     nonempty_path,
 )
-from assembly_constraints.bridge.files import check_writable, write_atomic
-from assembly_constraints.bridge.progress import progress
+from bridge.files import check_writable, write_atomic
+from bridge.progress import progress
 
 DriverFactory = Callable[[], AbstractContextManager[StepDriver]]
 """Starts a fresh cell for one sequence and yields its driver."""

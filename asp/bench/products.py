@@ -18,8 +18,8 @@ import random
 import tomllib
 from pathlib import Path
 
-from assembly_constraints.asp.solve import fact, write_facts
-from assembly_constraints.bridge.assembly import DATA_DIR
+from asp.solve import fact, write_facts
+from bridge.assembly import DATA_DIR
 
 _TEMPLATE = DATA_DIR / "cranfield" / "geometry.toml"
 

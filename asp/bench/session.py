@@ -14,7 +14,7 @@
    is reported beside the ratio of the medians).
 3. ``--product N --cell-counts 1,2,4,8``: load. Sessions with 1, 2, 4, 8 ``truth`` cells (each
    experiment takes ``--delay`` seconds without using the cores) on a generated N×N
-   product (:mod:`assembly_constraints.asp.bench.products`): wall time [s] of the whole command, the learning
+   product (:mod:`asp.bench.products`): wall time [s] of the whole command, the learning
    time [s] (from the cells being ready to the last result, ``session.json`` timings), the
    speed-up of each against 1 cell, experiments and their ratio to the 1-cell run,
    duplicates (a request journaled twice, or a pair run again though not a re-test; must
@@ -23,7 +23,7 @@
    with at most 10 % more experiments.
 4. ``--hosts K``: the Cranfield session with K cells on loopback (started by the session),
    then with K cells in K network namespaces joined only through ``./run.sh router``
-   (:mod:`assembly_constraints.asp.session.hosts`; needs root): each run's figures and the ratio of their
+   (:mod:`asp.session.hosts`; needs root): each run's figures and the ratio of their
    learning times.
 """
 
@@ -43,19 +43,19 @@ from pathlib import Path
 
 import zenoh
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.asp.bench.products import write_product
-from assembly_constraints.asp.session.cells import ROOT, start_cell, stop_all
-from assembly_constraints.asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
-from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
-from assembly_constraints.asp.session.settings import MAX_CELLS
-from assembly_constraints.asp.sizes.policies import policy_names
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in, number_in
-from assembly_constraints.bridge.client import CellDirectory, request_insert
-from assembly_constraints.bridge.keys import ping_key
-from assembly_constraints.bridge.messages import InsertRequest, encode
-from assembly_constraints.bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
+from asp import MAX_IDS, PlannerError
+from asp.bench.products import write_product
+from asp.session.cells import ROOT, start_cell, stop_all
+from asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
+from asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
+from asp.session.settings import MAX_CELLS
+from asp.sizes.policies import policy_names
+from bridge.cell_settings import ServeSettings
+from bridge.cli_types import MAX_SEED, ArgumentParser, comma_list, finite_float, int_in, number_in
+from bridge.client import CellDirectory, request_insert
+from bridge.keys import ping_key
+from bridge.messages import InsertRequest, encode
+from bridge.session import LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 MAX_HOSTS = 16
 """--hosts: at most this many cell namespaces."""
@@ -143,7 +143,7 @@ def session_run(cells: int, policy: str, backend: str, delay_s: float, assembly:
 def hosts_runs(count: int, policy: str, backend: str, delay_s: float) -> dict:
     """The Cranfield session with ``count`` cells on loopback (started by the session), then
     with ``count`` cells in network namespaces of their own joined through the router
-    (:mod:`assembly_constraints.asp.session.hosts`): each run's figures and the ratio of the learning times."""
+    (:mod:`asp.session.hosts`): each run's figures and the ratio of the learning times."""
     why_not = unavailable()
     if why_not is not None:
         raise PlannerError(f"--hosts: {why_not}")

@@ -39,14 +39,14 @@ import time
 
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.cli import demonstrated_fits
-from assembly_constraints.asp.sizes.evaluate import evaluate_policy
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
-from assembly_constraints.asp.sizes.models import MODELS, model_for
-from assembly_constraints.asp.sizes.policies import get_policy
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.bridge.cli_types import (
+from asp import PlannerError
+from asp.sizes.cli import demonstrated_fits
+from asp.sizes.evaluate import evaluate_policy
+from asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
+from asp.sizes.models import MODELS, model_for
+from asp.sizes.policies import get_policy
+from asp.sizes.truth_oracle import TruthOracle
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     comma_list,

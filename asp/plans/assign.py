@@ -30,9 +30,9 @@ from pathlib import Path
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.relation import closed_precedence
-from assembly_constraints.asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name, solve
+from asp import PlannerError
+from asp.precedence.relation import closed_precedence
+from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name, solve
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
@@ -105,7 +105,7 @@ def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
     a pair both fitting and not fitting, or a precedence cycle.
 
     Precedence is read in both forms, ``must_precede/2`` and ``precedence_edge/2``, and
-    closed (:func:`assembly_constraints.asp.precedence.relation.closed_precedence`): ``must_precede`` and the
+    closed (:func:`asp.precedence.relation.closed_precedence`): ``must_precede`` and the
     ``must_precede/2`` atoms hold the closure."""
     sources = ", ".join(str(p) for p in paths)
     atoms = load_atoms(paths, encodings=["plans/needs_hole.lp"])

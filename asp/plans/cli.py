@@ -21,18 +21,18 @@ import sys
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import (
+from asp import PlannerError
+from asp.plans.assign import (
     UnsolvableAssembly,
     all_assignments,
     feasible_assignment,
     load_learned_facts,
 )
-from assembly_constraints.asp.plans.plans import HOME, Plan, plans, travel_facts
-from assembly_constraints.asp.solve import write_facts
-from assembly_constraints.bridge.assembly import MAX_COORDINATE, load_assembly
-from assembly_constraints.bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, int_in
-from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
+from asp.plans.plans import HOME, Plan, plans, travel_facts
+from asp.solve import write_facts
+from bridge.assembly import MAX_COORDINATE, load_assembly
+from bridge.cli_types import ArgumentParser, add_assembly_argument, finite_float, int_in
+from bridge.errors import EXIT_UNSOLVABLE
 
 MAX_PLANS = 1_000_000
 """``plan -n K``: at most this many plans (0 = all)."""

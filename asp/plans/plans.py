@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import LearnedFacts, feasible_assignment
-from assembly_constraints.asp.solve import fact, solve
-from assembly_constraints.bridge.assembly import Assembly
+from asp import PlannerError
+from asp.plans.assign import LearnedFacts, feasible_assignment
+from asp.solve import fact, solve
+from bridge.assembly import Assembly
 
 HOME: tuple[float, float] = (0.0, 0.0)
 """Default tool home [m]: the cell origin."""

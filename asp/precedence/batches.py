@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.count import DownSets, down_sets
-from assembly_constraints.asp.precedence.decompose import predecessor_masks
-from assembly_constraints.asp.precedence.relation import Relation
+from asp import PlannerError
+from asp.precedence.count import DownSets, down_sets
+from asp.precedence.decompose import predecessor_masks
+from asp.precedence.relation import Relation
 
 _INT64_LIMIT = 2**62
 

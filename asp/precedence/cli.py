@@ -12,20 +12,20 @@ import logging
 import random
 from itertools import islice
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.batches import GENERATORS
-from assembly_constraints.asp.precedence.count import UniformSampler, count_linear_extensions, linear_extensions
-from assembly_constraints.asp.precedence.demos import Demonstrations, load_demos
-from assembly_constraints.asp.precedence.relation import (
+from asp import PlannerError
+from asp.precedence.batches import GENERATORS
+from asp.precedence.count import UniformSampler, count_linear_extensions, linear_extensions
+from asp.precedence.demos import Demonstrations, load_demos
+from asp.precedence.relation import (
     Relation,
     load_relation,
     precedence_facts,
     reduction,
     true_relation,
 )
-from assembly_constraints.asp.solve import write_facts
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cli_types import (
+from asp.solve import write_facts
+from bridge.assembly import load_assembly
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -126,9 +126,9 @@ def _print_json(data: object) -> None:
 
 
 def _learn(args: argparse.Namespace) -> None:
-    from assembly_constraints.asp.precedence.draw import draw_png, to_dot
-    from assembly_constraints.asp.precedence.learn import learn_must_precede, pair_evidence, suspects
-    from assembly_constraints.bridge.files import check_writable, write_atomic
+    from asp.precedence.draw import draw_png, to_dot
+    from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
+    from bridge.files import check_writable, write_atomic
 
     for path in (args.out, args.dot, args.png):  # before the learning and the drawing
         if path:
@@ -138,7 +138,7 @@ def _learn(args: argparse.Namespace) -> None:
     if prior is None:
         relation = learn_must_precede(demos, args.min_support)
     else:
-        from assembly_constraints.asp.precedence.learn import learn_with_prior
+        from asp.precedence.learn import learn_with_prior
 
         relation = learn_with_prior(demos, prior, args.prior, args.min_support)
         LOG.info("%d demonstration(s) refine the prior %s (%d pairs)", len(demos.sequences), args.prior,
@@ -174,13 +174,13 @@ def _learn(args: argparse.Namespace) -> None:
 
 
 def _evaluate(args: argparse.Namespace) -> None:
-    from assembly_constraints.bridge.files import check_writable
+    from bridge.files import check_writable
 
     if args.plot:
         check_writable(args.plot)  # before the evaluation, which may take minutes
     truth = true_relation(load_assembly(args.assembly))
     if args.guided:
-        from assembly_constraints.asp.precedence.guide import evaluate_guided
+        from asp.precedence.guide import evaluate_guided
 
         if args.generator != "uniform":
             raise PlannerError("--generator applies to the evaluation over m, not to --guided "
@@ -192,7 +192,7 @@ def _evaluate(args: argparse.Namespace) -> None:
                   f"random {result['random_mean']:.2f}")
             print("histogram (demonstrations: trials):", result["demos_to_exact"])
     else:
-        from assembly_constraints.asp.precedence.evaluate import evaluate, plot
+        from asp.precedence.evaluate import evaluate, plot
 
         result = evaluate(truth, args.demonstrations, args.trials, args.seed, args.generator)
         if args.plot:
@@ -208,7 +208,7 @@ def _evaluate(args: argparse.Namespace) -> None:
 
 
 def _suggest(args: argparse.Namespace) -> None:
-    from assembly_constraints.asp.precedence.guide import suggest
+    from asp.precedence.guide import suggest
 
     parts = load_assembly(args.assembly).part_ids if args.assembly else None
     if args.demos is None and parts is None:

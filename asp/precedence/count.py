@@ -1,7 +1,7 @@
 """The assembly sequences a precedence relation admits: count, enumerate, sample.
 
 A sequence is admitted when it is a linear extension of the relation. Counting splits the
-relation into independent and consecutive groups (:mod:`assembly_constraints.asp.precedence.decompose`):
+relation into independent and consecutive groups (:mod:`asp.precedence.decompose`):
 independent groups combine by a multinomial, consecutive ones by a product, and each
 remaining prime group is counted by a dynamic programme over its down-sets (sets of
 parts that can be in place together): exact Python integers of any size, never
@@ -23,14 +23,14 @@ from math import factorial, prod
 
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.decompose import (
+from asp import PlannerError
+from asp.precedence.decompose import (
     Decomposition,
     decompose,
     predecessor_masks,
     transitive_closure,
 )
-from assembly_constraints.asp.precedence.relation import Relation
+from asp.precedence.relation import Relation
 
 
 def count_downset_paths(masks: Sequence[int]) -> int:

@@ -10,11 +10,11 @@ given, and one demonstration puts at most one part into a hole.
 
 The same data is accepted as ASP facts (a file ending in ``.lp``): ``demo(D,I,P)``,
 demonstration ``D`` places part ``P`` at position ``I`` (1-based), or ``demo(D,I,P,H)``,
-into hole ``H``; plus optional ``part/1``. Every error raises :class:`assembly_constraints.asp.PlannerError`
+into hole ``H``; plus optional ``part/1``. Every error raises :class:`asp.PlannerError`
 naming file:line (or the demonstration) and what was expected.
 
-Bounds: a file of at most :data:`assembly_constraints.bridge.inputs.MAX_INPUT_BYTES`, at most
-:data:`assembly_constraints.asp.MAX_IDS` parts and :data:`MAX_DEMONSTRATIONS` sequences; a step number of
+Bounds: a file of at most :data:`bridge.inputs.MAX_INPUT_BYTES`, at most
+:data:`asp.MAX_IDS` parts and :data:`MAX_DEMONSTRATIONS` sequences; a step number of
 ``demo/3`` is at most the number of parts. Echoed ids are cut to 40 characters.
 """
 
@@ -27,10 +27,10 @@ from pathlib import Path
 
 import clingo
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.asp.solve import atoms_by_name, fact, load_atoms
-from assembly_constraints.bridge.assembly import is_id
-from assembly_constraints.bridge.inputs import read_bytes, shorten
+from asp import MAX_IDS, PlannerError
+from asp.solve import atoms_by_name, fact, load_atoms
+from bridge.assembly import is_id
+from bridge.inputs import read_bytes, shorten
 
 _SEPARATOR = re.compile(r"[\s,]+")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")

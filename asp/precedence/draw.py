@@ -11,8 +11,8 @@ from pathlib import Path
 
 import networkx as nx
 
-from assembly_constraints.asp.precedence.relation import Pair, Relation
-from assembly_constraints.bridge.files import write_figure
+from asp.precedence.relation import Pair, Relation
+from bridge.files import write_figure
 
 
 def _graph(relation: Relation, reduction: list[Pair]) -> nx.DiGraph:

@@ -6,7 +6,7 @@ sequences M it admits. Reported per m: the mean of M, P(M = all), P(M > all/2) a
 the distribution of M in bins of 200 sequences (key: the bin's lower bound; the key
 ``"all"`` holds M = all, the paper's last column). Probabilities are fractions of
 the trials. Sampling and counting are batched over trials
-(:class:`assembly_constraints.asp.precedence.batches.ExtensionBatches`).
+(:class:`asp.precedence.batches.ExtensionBatches`).
 """
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ from typing import Any
 
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.batches import GENERATORS, ExtensionBatches, positions_of
-from assembly_constraints.asp.precedence.learn import intersect_orders
-from assembly_constraints.asp.precedence.relation import Relation
-from assembly_constraints.bridge.files import write_figure
-from assembly_constraints.bridge.progress import progress
+from asp import PlannerError
+from asp.precedence.batches import GENERATORS, ExtensionBatches, positions_of
+from asp.precedence.learn import intersect_orders
+from asp.precedence.relation import Relation
+from bridge.files import write_figure
+from bridge.progress import progress
 
 BIN = 200  # width of a histogram bin [sequences], as in the paper
 PAPER_M = (5, 7, 10, 15, 20, 30)

@@ -25,10 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from assembly_constraints.asp.precedence.batches import ExtensionBatches, positions_of
-from assembly_constraints.asp.precedence.decompose import predecessor_masks, transitive_closure
-from assembly_constraints.asp.precedence.relation import Relation
-from assembly_constraints.bridge.progress import progress
+from asp.precedence.batches import ExtensionBatches, positions_of
+from asp.precedence.decompose import predecessor_masks, transitive_closure
+from asp.precedence.relation import Relation
+from bridge.progress import progress
 
 
 def teacher_order(suggestion: Sequence[int], truth: Relation) -> list[int]:

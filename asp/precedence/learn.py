@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.demos import Demonstrations, load_demos
-from assembly_constraints.asp.precedence.relation import Pair, Relation, close, load_relation
-from assembly_constraints.bridge.assembly import Assembly
+from asp import PlannerError
+from asp.precedence.demos import Demonstrations, load_demos
+from asp.precedence.relation import Pair, Relation, close, load_relation
+from bridge.assembly import Assembly
 
 GEOMETRIC_PRIOR = "geometric_precedence.lp"
 """The file of an assembly folder holding the precedence its geometry forces (``import``)."""

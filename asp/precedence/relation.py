@@ -17,8 +17,8 @@ from pathlib import Path
 import clingo
 import numpy as np
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.asp.solve import (
+from asp import MAX_IDS, PlannerError
+from asp.solve import (
     atoms_by_name,
     check_facts,
     fact,
@@ -26,7 +26,7 @@ from assembly_constraints.asp.solve import (
     pairs_by_name,
     read_ground_facts,
 )
-from assembly_constraints.bridge.assembly import Assembly
+from bridge.assembly import Assembly
 
 Pair = tuple[str, str]
 
@@ -114,7 +114,7 @@ MAX_PRIOR_FACTS = MAX_IDS + 2 * MAX_IDS * MAX_IDS
 def load_relation(paths: Sequence[Path | str], *, data: bool = False) -> Relation:
     """Read ``part/1`` with ``must_precede/2`` and/or ``precedence_edge/2`` facts; closed.
     With ``data`` (a prior such as the ``geometric_precedence.lp`` import writes) the files
-    are read as ground facts only (:func:`assembly_constraints.asp.solve.read_ground_facts`,
+    are read as ground facts only (:func:`asp.solve.read_ground_facts`,
     at most :data:`MAX_PRIOR_FACTS`), never grounded as a program.
 
     PlannerError when the files hold no ``part/1``, name an unknown part or hold a cycle.
@@ -143,7 +143,7 @@ def load_relation(paths: Sequence[Path | str], *, data: bool = False) -> Relatio
 
 
 def closed_precedence(atoms: Sequence[clingo.Symbol], source: str) -> frozenset[Pair]:
-    """The precedence of checked facts atoms (:func:`assembly_constraints.asp.solve.check_facts`) in both forms,
+    """The precedence of checked facts atoms (:func:`asp.solve.check_facts`) in both forms,
     ``must_precede/2`` and ``precedence_edge/2`` (a reduction, as every shipped
     ``precedence.lp`` has it), transitively closed.
 

@@ -1,7 +1,7 @@
 """Cell co-processes: start ``executor serve`` nodes, follow their output, stop them.
 
 A session (or a test) starts its cells with :func:`start_cell`, each with its settings as
-one document (:class:`assembly_constraints.bridge.cell_settings.ServeSettings`). Each cell runs with
+one document (:class:`bridge.cell_settings.ServeSettings`). Each cell runs with
 ``lifeline`` set: it holds our pipe on its stdin and exits when we die, so a killed
 planner leaves no cell behind. Output lines (``ready``, ``start <id> ...``,
 ``done <id> ...``) are collected by a reader thread; :meth:`CellProcess.wait_for_line`
@@ -22,9 +22,9 @@ from pathlib import Path
 
 import msgspec
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.bridge.cell_settings import ServeSettings, encode_settings
-from assembly_constraints.bridge.cli_types import MAX_SEED
+from asp import PlannerError
+from bridge.cell_settings import ServeSettings, encode_settings
+from bridge.cli_types import MAX_SEED
 
 ROOT = Path(__file__).resolve().parents[2]
 """The folder holding the packages (the repository, or site-packages when installed): the
@@ -109,7 +109,7 @@ class LineProcess:
 
     def stop(self, timeout: float = STOP_S) -> int:
         """SIGTERM, then SIGKILL after ``timeout`` [s]; returns the exit code. A cell
-        compacts its recording before it exits (:mod:`assembly_constraints.bridge.recording.compaction`), which
+        compacts its recording before it exits (:mod:`bridge.recording.compaction`), which
         on a loaded machine takes tens of seconds; killed earlier, it leaves the file
         uncompacted."""
         return stop_all([self], timeout)[0]

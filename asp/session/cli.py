@@ -1,7 +1,7 @@
 """``./run.sh session``: the end-to-end learning session, planner and cells over Zenoh.
 
-The command line of :mod:`assembly_constraints.asp.session.run`: the options become one
-:class:`assembly_constraints.asp.session.settings.SessionSettings` (:func:`session_settings`), the session
+The command line of :mod:`asp.session.run`: the options become one
+:class:`asp.session.settings.SessionSettings` (:func:`session_settings`), the session
 runs from it, and a summary (or, with ``--json``, the result) is printed.
 """
 
@@ -15,9 +15,9 @@ from pathlib import Path
 
 from msgspec import UNSET
 
-from assembly_constraints.asp.session.cells import ROOT
-from assembly_constraints.asp.session.run import LOG, run_session
-from assembly_constraints.asp.session.settings import (
+from asp.session.cells import ROOT
+from asp.session.run import LOG, run_session
+from asp.session.settings import (
     MAX_CELLS,
     MAX_PLANS,
     MAX_WAIT_S,
@@ -25,13 +25,13 @@ from assembly_constraints.asp.session.settings import (
     prior_statement,
     read_session_file,
 )
-from assembly_constraints.asp.sizes.cli import add_model_option, add_prior_options, check_prior_options
-from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
-from assembly_constraints.asp.sizes.policies import policy_names
-from assembly_constraints.asp.solve import encoding
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
-from assembly_constraints.bridge.cli_types import (
+from asp.sizes.cli import add_model_option, add_prior_options, check_prior_options
+from asp.sizes.learner import MAX_CONFIRM
+from asp.sizes.policies import policy_names
+from asp.solve import encoding
+from bridge.assembly import load_assembly
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
+from bridge.cli_types import (
     MAX_SEED,
     PROGRAM,
     ArgumentParser,
@@ -42,10 +42,10 @@ from assembly_constraints.bridge.cli_types import (
     nonempty_path,
     path_setting,
 )
-from assembly_constraints.bridge.errors import EXIT_UNSOLVABLE
-from assembly_constraints.bridge.keys import check_cell_id
-from assembly_constraints.bridge.recording.sinks import add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
-from assembly_constraints.bridge.session import add_endpoint_arguments
+from bridge.errors import EXIT_UNSOLVABLE
+from bridge.keys import check_cell_id
+from bridge.recording.sinks import add_viewer_arguments, hosted_viewer, keep_serving, viewer_of
+from bridge.session import add_endpoint_arguments
 
 
 def build_parser() -> argparse.ArgumentParser:

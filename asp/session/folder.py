@@ -15,8 +15,8 @@ import fcntl
 import os
 from pathlib import Path
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.bridge.files import os_reason
+from asp import PlannerError
+from bridge.files import os_reason
 
 LOCK_NAME = ".lock"
 

@@ -21,9 +21,9 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.cells import CellProcess, LineProcess
-from assembly_constraints.bridge.cell_settings import ServeSettings
+from asp import PlannerError
+from asp.session.cells import CellProcess, LineProcess
+from bridge.cell_settings import ServeSettings
 
 ROUTER_PORT = 7447
 """The port the router listens on in the router namespace."""

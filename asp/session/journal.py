@@ -45,10 +45,10 @@ from typing import Annotated, Literal
 
 import msgspec
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.bridge.files import os_reason
-from assembly_constraints.bridge.inputs import duplicate_key, read_bytes
-from assembly_constraints.bridge.messages import MAX_COUNT, AspId, Evidence, RequestId, Result
+from asp import PlannerError
+from bridge.files import os_reason
+from bridge.inputs import duplicate_key, read_bytes
+from bridge.messages import MAX_COUNT, AspId, Evidence, RequestId, Result
 
 JOURNAL_NAME = "journal.jsonl"
 

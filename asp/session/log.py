@@ -1,11 +1,11 @@
 """The planner's Rerun log of a session (entities ``planner/...``).
 
 Planner and cells log into ONE recording id (application
-:data:`assembly_constraints.bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
+:data:`bridge.recording.layout.APPLICATION_ID`), each process to its own ``RUN/*.rrd``; the
 files opened together are one recording. Their blueprint is ``RUN/view.rbl``, which the
 session writes from what was recorded when it ends; the planner's file holds none (a
 viewer opening the folder would take whichever it read last). A viewer watching live gets
-the session's blueprint (:func:`assembly_constraints.bridge.recording.layout.blueprint`)
+the session's blueprint (:func:`bridge.recording.layout.blueprint`)
 with what is certain when it starts: the planner's views in a first tab, then one tab per
 cell it starts (whether a cell will assemble is not known yet). The knowledge learning
 starts from is logged as experiment 0, so a viewer opened paused at the start of a
@@ -25,7 +25,7 @@ timeline shows it.
 ``planner/experiments``     one text line per experiment (pair, result, cell)
 ``planner/smaller``         smaller-than graph over parts ∪ holes (its transitive
                             reduction), after every experiment, laid out by levels
-                            (:mod:`assembly_constraints.asp.session.layered`: smallest on top)
+                            (:mod:`asp.session.layered`: smallest on top)
 ``planner/precedence``      learned must-precede graph (transitive reduction), static,
                             laid out by levels (first parts on top)
 ``planner/assignment``      part → hole graph (parts above their holes) and a markdown
@@ -44,13 +44,13 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 
-from assembly_constraints.asp.precedence.relation import Relation, reduction
-from assembly_constraints.asp.session.layered import positions
-from assembly_constraints.asp.sizes.knowledge import Knowledge
-from assembly_constraints.bridge.recording.compaction import compact_recording
-from assembly_constraints.bridge.recording.layout import APPLICATION_ID, SESSION_TIMELINE, Contents, blueprint, opening
-from assembly_constraints.bridge.recording.rows import log_row
-from assembly_constraints.bridge.recording.sinks import (
+from asp.precedence.relation import Relation, reduction
+from asp.session.layered import positions
+from asp.sizes.knowledge import Knowledge
+from bridge.recording.compaction import compact_recording
+from bridge.recording.layout import APPLICATION_ID, SESSION_TIMELINE, Contents, blueprint, opening
+from bridge.recording.rows import log_row
+from bridge.recording.sinks import (
     NO_VIEWER,
     Viewer,
     finish_stream,

@@ -1,5 +1,5 @@
-"""The end-to-end learning session (``./run.sh session``, :mod:`assembly_constraints.asp.session.cli`), planner
-and cells over Zenoh, from its settings (:class:`assembly_constraints.asp.session.settings.SessionSettings`).
+"""The end-to-end learning session (``./run.sh session``, :mod:`asp.session.cli`), planner
+and cells over Zenoh, from its settings (:class:`asp.session.settings.SessionSettings`).
 
 1. learns must-precede from the assembly's demonstrations (Algorithm 1; ``--demos FILE``
    for others); parts they place into holes (``p1@r1``) are fits the size learner
@@ -9,7 +9,7 @@ and cells over Zenoh, from its settings (:class:`assembly_constraints.asp.sessio
 3. learns which part fits which hole (``--prior cad``: starting from the outcomes the
    nominal sections of an imported product decide), keeping every alive cell busy with experiments
    none of whose outcomes can entail another's (:func:`_learn_sizes`,
-   :mod:`assembly_constraints.asp.session.zenoh_oracle`); every finished experiment is journaled (fsynced) before
+   :mod:`asp.session.zenoh_oracle`); every finished experiment is journaled (fsynced) before
    the learner uses it;
 4. assigns holes (the paper's greedy rule, else a matching) and computes complete plans, each run through the checker;
 5. writes ``RUN/learned.lp`` (the project's facts vocabulary), ``RUN/assignment.lp``,
@@ -39,17 +39,17 @@ from pathlib import Path
 import msgspec
 import zenoh
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts
-from assembly_constraints.asp.plans.plans import Plan, check_plan, plans
-from assembly_constraints.asp.precedence.demos import demo_facts
-from assembly_constraints.asp.precedence.learn import learn_for_assembly
-from assembly_constraints.asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
-from assembly_constraints.asp.session.cells import CellProcess, cell_seed, stop_all
-from assembly_constraints.asp.session.folder import RunLock, lock_run_folder
-from assembly_constraints.asp.session.journal import JOURNAL_NAME, Journal
-from assembly_constraints.asp.session.log import PlannerLog
-from assembly_constraints.asp.session.settings import (
+from asp import PlannerError
+from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts
+from asp.plans.plans import Plan, check_plan, plans
+from asp.precedence.demos import demo_facts
+from asp.precedence.learn import learn_for_assembly
+from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
+from asp.session.cells import CellProcess, cell_seed, stop_all
+from asp.session.folder import RunLock, lock_run_folder
+from asp.session.journal import JOURNAL_NAME, Journal
+from asp.session.log import PlannerLog
+from asp.session.settings import (
     MAX_STARTS,
     SESSION_FILE,
     DecidedPrior,
@@ -63,21 +63,21 @@ from assembly_constraints.asp.session.settings import (
     resumed_settings,
     write_session_file,
 )
-from assembly_constraints.asp.session.zenoh_oracle import Finished, ZenohOracle
-from assembly_constraints.asp.sizes.cad_prior import cad_prior
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, SizeLearningResult
-from assembly_constraints.asp.sizes.models import SizeModel, model_for
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.asp.solve import fact, write_facts
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import Assembly, load_assembly
-from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellPool, PoolLimits
-from assembly_constraints.bridge.files import make_folder
-from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
-from assembly_constraints.bridge.recording.reader import read_recording
-from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
-from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, LOOPBACK_ANY_PORT, bound_endpoints, open_session
+from asp.session.zenoh_oracle import Finished, ZenohOracle
+from asp.sizes.cad_prior import cad_prior
+from asp.sizes.learner import LearningOptions, SizeLearner, SizeLearningResult
+from asp.sizes.models import SizeModel, model_for
+from asp.sizes.truth_oracle import TruthOracle
+from asp.solve import fact, write_facts
+from bridge import BridgeError
+from bridge.assembly import Assembly, load_assembly
+from bridge.cell_settings import DEFAULT_CELL, ServeSettings
+from bridge.client import CellDirectory, CellPool, PoolLimits
+from bridge.files import make_folder
+from bridge.recording.layout import Contents, write_blueprint
+from bridge.recording.reader import read_recording
+from bridge.recording.sinks import NO_VIEWER, Viewer
+from bridge.session import DEFAULT_ENDPOINT, LOOPBACK_ANY_PORT, bound_endpoints, open_session
 
 LOG = logging.getLogger(__name__)
 RESULT_KEYS = ("run", "experiments", "fits", "must_precede", "plans", "matches_truth", "model", "assumption",
@@ -90,7 +90,7 @@ be reaped."""
 
 
 def _run_folder(settings: SessionSettings) -> tuple[Path, SessionFile, RunLock, bool]:
-    """The run folder, locked for this session (:mod:`assembly_constraints.asp.session.folder`), its
+    """The run folder, locked for this session (:mod:`asp.session.folder`), its
     ``session.json`` (read back when resuming) and whether this start created the folder.
     ``out`` creates the folder and refuses one that holds a session (journaled experiments or a
     finished run); a folder a failed start left (one that existed before) may be used again."""
@@ -269,11 +269,11 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
 
 def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: Plan, seed: int,
               timeout_s: float, process: CellProcess | None) -> dict:
-    """Execute ``plan`` in the session's first cell (:mod:`assembly_constraints.asp.assemble`; ``process``: its
+    """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`; ``process``: its
     process if the session started it); the report, with ``"error"`` when the product
     could not be finished."""
-    from assembly_constraints.asp.assemble.driver import ZenohDriver
-    from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
+    from asp.assemble.driver import ZenohDriver
+    from asp.assemble.execute import AssemblyStopped, execute
 
     if not cell_ids:
         raise PlannerError("--assemble needs a cell of this session (--cells 1 or more)")
@@ -289,7 +289,7 @@ def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: 
 
 def view_blueprint(run: Path) -> Path:
     """``RUN/view.rbl``, the blueprint of what ``RUN/*.rrd`` hold once every writer closed
-    its file (:meth:`assembly_constraints.bridge.recording.layout.Contents.of`): an assembly tab
+    its file (:meth:`bridge.recording.layout.Contents.of`): an assembly tab
     only for a cell that assembled, each cell's Fig. 17 on its first fitting attempt."""
     summary = read_recording(sorted(run.glob("*.rrd")))
     return write_blueprint(run, Contents.of(summary.entities))
@@ -356,7 +356,7 @@ def session_cell(settings: SessionSettings, record: SessionFile, run: Path, numb
                  viewer_url: str | None) -> ServeSettings:
     """The settings of the session's cell ``c<number>`` (1, 2, ...) connecting to
     ``connect``: its recording ``RUN/c<k>[-<start>].rrd`` in the run's recording id, its
-    cell seed (:func:`assembly_constraints.asp.session.cells.cell_seed`) and, for a sim cell, its ILC
+    cell seed (:func:`asp.session.cells.cell_seed`) and, for a sim cell, its ILC
     corrections kept in ``RUN/c<k>-ilc.json`` (a resume passes the same file, so the
     cell reloads what it learned)."""
     cell_id = f"c{number}"

@@ -1,7 +1,7 @@
 """The settings of a learning session, and ``RUN/session.json``, their encoding.
 
 :class:`SessionSettings` is one start of a session, built once at the edge (the command
-line, :mod:`assembly_constraints.asp.session.cli`, or :func:`assembly_constraints.api.run_session`).
+line, :mod:`asp.session.cli`, or :func:`assembly_constraints.api.run_session`).
 :class:`SessionFile` is ``session.json``: the settings that stay with the run folder
 (assembly, policy, model, seed, confirmations, demonstrations, the cells' settings, the
 size prior), the recording id and the count of starts, and, once the session is done, its result.
@@ -10,7 +10,7 @@ assemble``, the summary and :func:`assembly_constraints.api.read_run` read it.
 
 A folder written before the settings were typed (``"cell_options"``: the cell's options
 as command-line arguments, no ``"format"``) is decoded too: its options are read as the
-fields of :class:`assembly_constraints.bridge.cell_settings.CellSettings`.
+fields of :class:`bridge.cell_settings.CellSettings`.
 """
 
 from __future__ import annotations
@@ -23,22 +23,22 @@ from typing import Annotated, Any, Literal
 import msgspec
 from msgspec import UNSET, Meta, UnsetType
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.cad_prior import MAX_TOLERANCE_M, prior_text
-from assembly_constraints.asp.sizes.learner import MAX_CONFIRM
-from assembly_constraints.asp.sizes.models import MODELS
-from assembly_constraints.asp.sizes.policies import policy_names
-from assembly_constraints.asp.sizes.truth_oracle import Result
-from assembly_constraints.bridge.cell_settings import (
+from asp import PlannerError
+from asp.sizes.cad_prior import MAX_TOLERANCE_M, prior_text
+from asp.sizes.learner import MAX_CONFIRM
+from asp.sizes.models import MODELS
+from asp.sizes.policies import policy_names
+from asp.sizes.truth_oracle import Result
+from bridge.cell_settings import (
     DEFAULT_CELL,
     MAGNITUDE_FIELDS,
     CellSettings,
     Seed,
     validation_text,
 )
-from assembly_constraints.bridge.files import write_atomic
-from assembly_constraints.bridge.inputs import read_bytes, shorten
-from assembly_constraints.bridge.messages import MAX_RUN_ID as MAX_RECORDING_ID
+from bridge.files import write_atomic
+from bridge.inputs import read_bytes, shorten
+from bridge.messages import MAX_RUN_ID as MAX_RECORDING_ID
 
 SESSION_FILE = "session.json"
 SESSION_FORMAT = 2
@@ -86,7 +86,7 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     ``c<k>`` with cell seed ``cell.cell_seed + k - 1`` (the command line sets
     ``cell.cell_seed`` to ``seed``), ``size_prior`` (``cad``: the learner starts from the
     outcomes the assembly's nominal sections decide beyond ``tolerance_m`` [m],
-    :mod:`assembly_constraints.asp.sizes.cad_prior`; None: no prior), and the ``backend``
+    :mod:`asp.sizes.cad_prior`; None: no prior), and the ``backend``
     of the cells it starts (``truth``: each experiment takes ``delay_s`` [s]). These are
     kept in ``session.json``; a resume takes them from there and ignores its own.
 

@@ -1,11 +1,11 @@
 """The size learner's oracle over Zenoh: experiments run on every alive cell at once.
 
-:class:`ZenohOracle` satisfies :class:`assembly_constraints.asp.sizes.truth_oracle.Oracle`
+:class:`ZenohOracle` satisfies :class:`asp.sizes.truth_oracle.Oracle`
 (``ask(part, hole)``) and adds a pipelined interface: :meth:`~ZenohOracle.submit` an experiment, get finished ones
 with :meth:`~ZenohOracle.next_result`. The session submits only experiments that the
 size learner put in one batch with everything still running (none of their outcomes
 can entail another's), so parallel work is never wasted. Underneath,
-:class:`assembly_constraints.bridge.client.CellPool` sends one request per alive cell and re-sends the
+:class:`bridge.client.CellPool` sends one request per alive cell and re-sends the
 request of a cell that dies mid-experiment to another cell (or waits for one).
 
 Request ids are ``<run>.<part>.<hole>.<n>`` for the n-th time the pair is started in
@@ -25,12 +25,12 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.journal import Journal, JournalEntry
-from assembly_constraints.asp.sizes.truth_oracle import Result
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.client import CellDirectory, CellPool
-from assembly_constraints.bridge.messages import InsertReply, InsertRequest
+from asp import PlannerError
+from asp.session.journal import Journal, JournalEntry
+from asp.sizes.truth_oracle import Result
+from bridge import BridgeError
+from bridge.client import CellDirectory, CellPool
+from bridge.messages import InsertReply, InsertRequest
 
 Pair = tuple[str, str]
 

@@ -2,7 +2,7 @@
 
 With sizes on one line (paper 2.2, last paragraph) the relations still possible after
 some experiments are exactly the biorders that contain every known fit and no known
-no-fit; under a model of several lines (:mod:`assembly_constraints.asp.sizes.models`) they are the products
+no-fit; under a model of several lines (:mod:`asp.sizes.models`) they are the products
 of such biorders, one per section, and each section is weighed on its own. Each
 biorder gets the prior weight ``(∏ k!)**ALPHA`` over its classes of k identical parts
 (rows) and k identical holes (columns): ∏ k! counts the orders of parts and holes
@@ -35,8 +35,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.biorders import (
+from asp import PlannerError
+from asp.sizes.biorders import (
     all_biorder_orders,
     all_biorders,
     biorder_count,
@@ -46,9 +46,9 @@ from assembly_constraints.asp.sizes.biorders import (
     sample_biorders,
     weighted_bit_sums,
 )
-from assembly_constraints.asp.sizes.knowledge import Knowledge, Pair
-from assembly_constraints.asp.sizes.models import group_by_section
-from assembly_constraints.asp.sizes.policies import SelectionPolicy
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.models import group_by_section
+from asp.sizes.policies import SelectionPolicy
 
 ALPHA = 0.5
 """Exponent of the prior weight ∏ k! of a relation (see the module docstring)."""

@@ -4,7 +4,7 @@
 part P's nominal cross-section in hole H's (negative: it does not pass). Real parts are
 made within a tolerance, so only margins beyond it decide: M > T is a fit, M < -T a
 no-fit, |M| <= T is left to the experiments. The decided outcomes start the learner as
-answers (:class:`assembly_constraints.asp.sizes.learner.SizeLearner`'s ``prior``), so its closure entails
+answers (:class:`asp.sizes.learner.SizeLearner`'s ``prior``), so its closure entails
 more and it tries fewer pairs; it still learns from what it observes, and an
 observation that contradicts the prior is a conflict re-tested like any other.
 """
@@ -16,12 +16,12 @@ from pathlib import Path
 
 import clingo
 
-from assembly_constraints.asp import MAX_IDS, PlannerError
-from assembly_constraints.asp.sizes.knowledge import Pair
-from assembly_constraints.asp.sizes.truth_oracle import Result
-from assembly_constraints.asp.solve import read_ground_facts
-from assembly_constraints.bridge.assembly import Assembly, is_id
-from assembly_constraints.bridge.inputs import shorten
+from asp import MAX_IDS, PlannerError
+from asp.sizes.knowledge import Pair
+from asp.sizes.truth_oracle import Result
+from asp.solve import read_ground_facts
+from bridge.assembly import Assembly, is_id
+from bridge.inputs import shorten
 
 NOMINAL_FILE = "nominal_sizes.lp"
 MAX_TOLERANCE_M = 0.1
@@ -30,7 +30,7 @@ MAX_TOLERANCE_M = 0.1
 
 def nominal_margins(path: Path) -> dict[Pair, int]:
     """(part, hole) -> margin [µm] of ``path``, read as data (:func:`read_ground_facts`, at
-    most one fact per pair of :data:`assembly_constraints.asp.MAX_IDS` parts and holes);
+    most one fact per pair of :data:`asp.MAX_IDS` parts and holes);
     PlannerError naming the file and line when it holds anything else, two different margins
     for one pair (naming both lines), or no facts."""
     margins: dict[Pair, int] = {}

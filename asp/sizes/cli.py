@@ -14,18 +14,18 @@ import argparse
 import json
 import sys
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.demos import load_demos
-from assembly_constraints.asp.sizes.cad_prior import MAX_TOLERANCE_M, NOMINAL_FILE, cad_prior, prior_text
-from assembly_constraints.asp.sizes.evaluate import evaluate_policy, plot_comparison
-from assembly_constraints.asp.sizes.knowledge import Knowledge
-from assembly_constraints.asp.sizes.learner import MAX_CONFIRM, Experiment, LearningOptions, learn_sizes
-from assembly_constraints.asp.sizes.models import MODELS, SizeModel, model_for
-from assembly_constraints.asp.sizes.policies import get_policy, policy_names
-from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, Oracle, Result, TruthOracle
-from assembly_constraints.asp.solve import write_facts
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cli_types import (
+from asp import PlannerError
+from asp.precedence.demos import load_demos
+from asp.sizes.cad_prior import MAX_TOLERANCE_M, NOMINAL_FILE, cad_prior, prior_text
+from asp.sizes.evaluate import evaluate_policy, plot_comparison
+from asp.sizes.knowledge import Knowledge
+from asp.sizes.learner import MAX_CONFIRM, Experiment, LearningOptions, learn_sizes
+from asp.sizes.models import MODELS, SizeModel, model_for
+from asp.sizes.policies import get_policy, policy_names
+from asp.sizes.truth_oracle import NoisyOracle, Oracle, Result, TruthOracle
+from asp.solve import write_facts
+from bridge.assembly import load_assembly
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -69,7 +69,7 @@ def add_model_option(parser: argparse.ArgumentParser) -> None:
 
 def add_prior_options(parser: argparse.ArgumentParser) -> None:
     """``--prior cad`` and ``--tolerance T`` [m]: the size prior from the nominal CAD
-    (:mod:`assembly_constraints.asp.sizes.cad_prior`); :func:`check_prior_options` refuses a tolerance alone."""
+    (:mod:`asp.sizes.cad_prior`); :func:`check_prior_options` refuses a tolerance alone."""
     parser.add_argument("--prior", choices=["cad"],
                         help="cad: start from the outcomes the nominal cross-sections decide beyond --tolerance "
                              "(the assembly's nominal_sizes.lp, written by the import subcommand)")
@@ -215,7 +215,7 @@ def _learn(args: argparse.Namespace) -> int:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
-    from assembly_constraints.bridge.files import check_writable
+    from bridge.files import check_writable
 
     if args.plot:
         check_writable(args.plot)  # before the evaluation, which may take minutes

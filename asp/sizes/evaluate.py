@@ -13,7 +13,7 @@ Non-deterministic policies (``random``) run every case, case i with seed
 ``seed * 1_000_003 + i``. With ``noise`` every case is a session of its own too, its
 answers flipped by a :class:`NoisyOracle` of the case's seed; the cases that end with
 a wrong relation are counted. ``confirm`` is the learner's
-(see :class:`assembly_constraints.asp.sizes.learner.SizeLearner`). Work is spread over the machine's cores.
+(see :class:`asp.sizes.learner.SizeLearner`). Work is spread over the machine's cores.
 """
 
 from __future__ import annotations
@@ -27,12 +27,12 @@ from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, run_learner
-from assembly_constraints.asp.sizes.policies import get_policy
-from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, TruthOracle
-from assembly_constraints.bridge.files import write_figure
-from assembly_constraints.bridge.progress import progress
+from asp import PlannerError
+from asp.sizes.learner import LearningOptions, SizeLearner, run_learner
+from asp.sizes.policies import get_policy
+from asp.sizes.truth_oracle import NoisyOracle, TruthOracle
+from bridge.files import write_figure
+from bridge.progress import progress
 
 Matrix = tuple[tuple[bool, ...], ...]
 """Truth in index order: ``matrix[i][j]`` is True when part i+1 fits hole j+1."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import clingo
 
-from assembly_constraints.asp.sizes.models import LINE_SECTION
+from asp.sizes.models import LINE_SECTION
 
 Pair = tuple[str, str]
 """A part-hole pair ``(part, hole)`` of ASP constants."""

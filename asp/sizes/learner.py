@@ -19,7 +19,7 @@ on the cycle are named and re-tested; per pair the majority of its answers is ke
 (a tie keeps the latest), so the kept relation never contradicts itself. It is done
 when every pair is known and no conflict is left.
 
-What is entailed follows the size model (:mod:`assembly_constraints.asp.sizes.models`; default ``line``, the
+What is entailed follows the size model (:mod:`asp.sizes.models`; default ``line``, the
 paper's): ``section(P,S)`` facts put each part on a section's size line. Observations
 that contradict the model cannot be noise once re-tests reproduce them: when every
 observation on a cycle has been answered at least twice with one result (or a pair
@@ -28,7 +28,7 @@ model (``line`` -> ``sections`` -> ``pairs``) and asks the pairs the
 weaker model no longer entails. ``model_changes`` lists the moves.
 
 A prior from the nominal CAD (``prior``: pairs and results the nominal cross-sections
-decide beyond a tolerance, :mod:`assembly_constraints.asp.sizes.cad_prior`) starts the same way: one answer
+decide beyond a tolerance, :mod:`asp.sizes.cad_prior`) starts the same way: one answer
 each, no experiment, re-tested only when a conflict names them.
 
 Demonstrations that say where a part went (``p1@r1``; paper 4.2, last paragraph) are
@@ -56,12 +56,12 @@ from dataclasses import dataclass
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.knowledge import RESULTS, Knowledge, Pair
-from assembly_constraints.asp.sizes.models import SizeModel, build_model, weaker
-from assembly_constraints.asp.sizes.policies import SelectionPolicy, get_policy
-from assembly_constraints.asp.sizes.truth_oracle import Oracle
-from assembly_constraints.asp.solve import add_facts, encoding, fact
+from asp import PlannerError
+from asp.sizes.knowledge import RESULTS, Knowledge, Pair
+from asp.sizes.models import SizeModel, build_model, weaker
+from asp.sizes.policies import SelectionPolicy, get_policy
+from asp.sizes.truth_oracle import Oracle
+from asp.solve import add_facts, encoding, fact
 
 GROUND_ONCE_PAIRS = 100
 """Products of at most this many part-hole pairs are grounded once with the observations

@@ -26,9 +26,9 @@ import math
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.biorders import biorder_count
-from assembly_constraints.bridge.assembly import SIZE_MODELS
+from asp import PlannerError
+from asp.sizes.biorders import biorder_count
+from bridge.assembly import SIZE_MODELS
 
 MODELS = SIZE_MODELS
 """The size models, strongest first (the names a product may declare)."""

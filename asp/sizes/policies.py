@@ -8,7 +8,7 @@ A policy tells the learner which unknown part-hole pair to try next. It is eithe
   order) and whatever ``session_facts`` adds, and shows exactly one ``select(P,H)``
   while some pair is unknown (in the last model, if it optimises); or
 - a Python callable ``choose(knowledge, rng) -> (part, hole)`` over the current
-  :class:`assembly_constraints.asp.sizes.knowledge.Knowledge` (it must return an unknown pair).
+  :class:`asp.sizes.knowledge.Knowledge` (it must return an unknown pair).
 
 Registry entries are :class:`SelectionPolicy` objects or ``"module:attribute"`` strings
 naming one, imported on first use (so ``best`` lives in its own module).
@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import clingo
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.knowledge import Knowledge, Pair
-from assembly_constraints.asp.solve import fact
+from asp import PlannerError
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.solve import fact
 
 Chooser = Callable[[Knowledge, random.Random], Pair]
 BatchRank = Callable[[Knowledge, Sequence[Pair]], list[Pair]]
@@ -88,7 +88,7 @@ POLICIES: dict[str, SelectionPolicy | str] = {
         "the paper's template count with its tie-breaks (paper 2.2)",
         encoding="select_heuristic.lp",
     ),
-    "best": "assembly_constraints.asp.sizes.best:POLICY",
+    "best": "asp.sizes.best:POLICY",
 }
 
 

@@ -4,7 +4,7 @@ Here the answers come from a ground truth (an assembly's ``sizes.lp``, paper Fig
 or any facts file of ``part/1``, ``hole/1``, ``fits/2``; closed world: a pair not
 listed does not fit). Later the simulated cell answers through Zenoh behind the same
 :class:`Oracle` protocol. A truth must be one the size model allows: within each
-section (a line of the model, :mod:`assembly_constraints.asp.sizes.models`) a biorder (Ferrers relation),
+section (a line of the model, :mod:`asp.sizes.models`) a biorder (Ferrers relation),
 else the learner's reasoning by transitivity would be unsound for it.
 """
 
@@ -16,11 +16,11 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Literal, Protocol
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.models import LINE_SECTION, group_by_section, stated_or_own
-from assembly_constraints.asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.inputs import read_text
+from asp import PlannerError
+from asp.sizes.models import LINE_SECTION, group_by_section, stated_or_own
+from asp.solve import atoms_by_name, check_facts, load_atoms, pairs_by_name
+from bridge.assembly import load_assembly
+from bridge.inputs import read_text
 
 Result = Literal["fit", "no_fit"]
 

@@ -19,7 +19,7 @@ import tempfile
 import time
 from typing import Any
 
-from assembly_constraints.asp import PlannerError
+from asp import PlannerError
 
 NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 """Executables looked for on PATH, in this order."""

@@ -4,7 +4,7 @@ RUN is a run folder (``runs/<id>``, its ``*.rrd`` files are opened together: pla
 and cells log into one recording id) or a single ``.rrd`` file. With a display, the
 Rerun viewer shipped in the venv (``rerun`` next to the Python executable) is started
 on the files plus ``RUN/view.rbl``, the blueprint of what the recording holds
-(``assembly_constraints.bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
+(``bridge.recording.layout.Contents.of``): the planner's tab when it has ``planner/...``
 entities, one tab per cell that logged more than an assembly (its Fig. 17 view on its first
 fitting attempt), one assembly tab per cell that assembled. Without a display (no ``DISPLAY`` /
 ``WAYLAND_DISPLAY``) or with ``--print`` it prints what the recording holds: ids and
@@ -12,7 +12,7 @@ one line per entity path with its row count, timelines and components (``--json`
 same as JSON). ``--web`` serves the files to a web browser instead (Rerun's web viewer on
 free loopback ports; the address is logged; Ctrl-C stops). ``--screenshot DIR`` writes a
 picture of every tab, rendered by the web viewer in a headless Chromium
-(:mod:`assembly_constraints.asp.view.screenshot`), as the viewer opens the recording and, for each ``--at
+(:mod:`asp.view.screenshot`), as the viewer opens the recording and, for each ``--at
 TIMELINE=VALUE`` (``experiment=1``), paused at that time. A RUN without ``.rrd`` files is
 an error (exit code 2).
 """
@@ -29,11 +29,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.bridge.cli_types import ArgumentParser, nonempty_path
+from asp import PlannerError
+from bridge.cli_types import ArgumentParser, nonempty_path
 
 if TYPE_CHECKING:
-    from assembly_constraints.bridge.recording.layout import TimePoint
+    from bridge.recording.layout import TimePoint
 
 
 def recording_files(run: Path) -> list[Path]:
@@ -62,8 +62,8 @@ def rerun_executable() -> str:
 
 
 def _time_point(text: str) -> TimePoint:
-    """``--at``'s value as a :class:`assembly_constraints.bridge.recording.layout.TimePoint`."""
-    from assembly_constraints.bridge.recording.layout import TimePoint
+    """``--at``'s value as a :class:`bridge.recording.layout.TimePoint`."""
+    from bridge.recording.layout import TimePoint
 
     try:
         return TimePoint.parse(text)
@@ -87,8 +87,8 @@ def main(argv: Sequence[str]) -> int:
                              "is printed, Ctrl-C stops")
     args = parser.parse_args(list(argv))
 
-    from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
-    from assembly_constraints.bridge.recording.reader import format_summary, read_recording
+    from bridge.recording.layout import Contents, write_blueprint
+    from bridge.recording.reader import format_summary, read_recording
 
     run = Path(args.run)
     files = recording_files(run)
@@ -102,7 +102,7 @@ def main(argv: Sequence[str]) -> int:
             raise PlannerError(f"--at {point}: {run} has no timeline {point.timeline!r}; "
                                f"it has {', '.join(sorted(timelines)) or 'none'}")
     if args.screenshot:
-        from assembly_constraints.asp.view.screenshot import take_screenshots
+        from asp.view.screenshot import take_screenshots
 
         recording_id = min(summary.recording_ids, default="view")
         for picture in take_screenshots(files, contents, recording_id, args.screenshot, args.at):
@@ -116,7 +116,7 @@ def main(argv: Sequence[str]) -> int:
         return 0
     blueprint = write_blueprint(run if run.is_dir() else run.parent, contents)
     if args.web:
-        from assembly_constraints.bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
+        from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
 
         served = Viewer(serve=True)
         with hosted_viewer(served, [*files, blueprint]):

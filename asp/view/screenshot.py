@@ -1,7 +1,7 @@
 """``./run.sh view RUN --screenshot DIR [--at TIMELINE=VALUE]``: every tab of a recording pictured in a browser.
 
-The recording is served to Rerun's web viewer (:func:`assembly_constraints.bridge.recording.sinks.hosted_viewer`)
-and opened in a headless Chromium (:mod:`assembly_constraints.asp.view.browser`). The viewer needs tens of
+The recording is served to Rerun's web viewer (:func:`bridge.recording.sinks.hosted_viewer`)
+and opened in a headless Chromium (:mod:`asp.view.browser`). The viewer needs tens of
 seconds to load and render on a software rasteriser; the first picture is taken once two
 in a row, :data:`POLL_S` apart, are the same and the viewer's state has not changed
 between them (all data has arrived), later ones once two in a row are the same. Then,
@@ -10,7 +10,7 @@ the viewer and the tab is pictured once it has settled (or, after :data:`TAB_TIM
 
 First every tab is pictured as the viewer opens the recording: paused where it placed the
 cursor when the data arrived, the blueprint of ``view.rbl``
-(:func:`assembly_constraints.bridge.recording.layout.blueprint`): ``DIR/<k>-<tab>.png``, k from 1.
+(:func:`bridge.recording.layout.blueprint`): ``DIR/<k>-<tab>.png``, k from 1.
 Then, for each ``--at`` time, the viewer is paused with its cursor there and every tab is
 pictured again: ``DIR/<k>-<tab>-<timeline>-<value>.png``. A blueprint cannot place the
 cursor; the page's viewer handle (``window._handle``, set by the page ``rerun
@@ -31,10 +31,10 @@ from pathlib import Path
 
 import rerun as rr
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.view.browser import Browser, find_chromium
-from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, TimePoint, blueprint, tab_names
-from assembly_constraints.bridge.recording.sinks import Viewer, hosted_viewer
+from asp import PlannerError
+from asp.view.browser import Browser, find_chromium
+from bridge.recording.layout import APPLICATION_ID, Contents, TimePoint, blueprint, tab_names
+from bridge.recording.sinks import Viewer, hosted_viewer
 
 POLL_S = 5.0
 """Time between two pictures while waiting for the page to settle [s]."""
@@ -53,7 +53,7 @@ def take_screenshots(files: Sequence[Path], contents: Contents, recording_id: st
                      at: Sequence[TimePoint] = ()) -> list[Path]:
     """Write one PNG per tab of ``contents``' blueprint into ``folder`` (created), as the
     viewer opens the recording and paused at each of ``at``; PlannerError when there is no Chromium
-    (:data:`assembly_constraints.asp.view.browser.NAMES`), the page never settles or does not take the time."""
+    (:data:`asp.view.browser.NAMES`), the page never settles or does not take the time."""
     chromium = find_chromium()
     if chromium is None:
         raise PlannerError("--screenshot needs a Chromium on PATH (chromium, chromium-browser or google-chrome; "

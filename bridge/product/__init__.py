@@ -7,7 +7,7 @@ loader is here. :func:`load_product_description` reads the files with :mod:`toml
 converts them with msgspec into :class:`AssemblyFile` and :class:`GeometryFile` (types,
 ranges, required and unknown keys; the ranges and their units are in the types'
 descriptions, so the JSON Schema ``protocol --out`` publishes, docs/protocol/, says the
-same), then checks (:mod:`assembly_constraints.bridge.product.checks`) what one struct cannot: references
+same), then checks (:mod:`bridge.product.checks`) what one struct cannot: references
 between tables (a hole's position, a part's start, a ``demo_hole``, a cover's holes, a
 head's cover), a rect's size ``[a, b]`` with ``a >= b``, a chamfer inside its boss,
 every hole deeper than its chamfer (a hole at its own level with its bottom above the
@@ -15,10 +15,10 @@ floor), bosses that do not overlap, a grasp shorter than the part, the shapes of
 ``assembly.toml`` against the kinds of ``geometry.toml``, a part's mesh against the
 digest of its file and its convex pieces against that mesh. Each part's and hole's
 cross-section kind comes from every statement the product makes
-(:mod:`assembly_constraints.bridge.product.kinds`).
+(:mod:`bridge.product.kinds`).
 
 Every failure is one line ``<file>: [<table>] <key>: expected ..., got ...`` (a
-:class:`assembly_constraints.bridge.BridgeError`, exit 2). Units: lengths and positions [m], masses [kg],
+:class:`bridge.BridgeError`, exit 2). Units: lengths and positions [m], masses [kg],
 inertia [kg m^2], yaw [degrees].
 """
 
@@ -32,9 +32,9 @@ from typing import Any, TypeVar
 
 import msgspec
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.inputs import read_text, shorten
-from assembly_constraints.bridge.product.checks import (
+from bridge import BridgeError
+from bridge.inputs import read_text, shorten
+from bridge.product.checks import (
     check_assembly,
     check_geometry,
     check_grasp,
@@ -42,8 +42,8 @@ from assembly_constraints.bridge.product.checks import (
     hole_level,
     where,
 )
-from assembly_constraints.bridge.product.kinds import hole_kinds, part_kinds, section_label
-from assembly_constraints.bridge.product.tables import (
+from bridge.product.kinds import hole_kinds, part_kinds, section_label
+from bridge.product.tables import (
     CONVEX_HEADER,
     DEFAULT_COVER_CLEARANCE,
     ID_PATTERN,

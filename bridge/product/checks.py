@@ -1,4 +1,4 @@
-"""The checks of a product description that one struct cannot make (:mod:`assembly_constraints.bridge.product`):
+"""The checks of a product description that one struct cannot make (:mod:`bridge.product`):
 references between tables, a rect's ``[a, b]``, a chamfer inside its boss, every hole
 deeper than its chamfer (a hole at its own level with its bottom above the floor), bosses
 that do not overlap, a grasp shorter than the part, the shapes of ``assembly.toml``
@@ -15,10 +15,10 @@ from pathlib import Path
 
 import shapely
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.inputs import read_bytes, shorten
-from assembly_constraints.bridge.product.kinds import section_label
-from assembly_constraints.bridge.product.tables import (
+from bridge import BridgeError
+from bridge.inputs import read_bytes, shorten
+from bridge.product.kinds import section_label
+from bridge.product.tables import (
     CONVEX_HEADER,
     TOUCH_TOLERANCE,
     AssemblyFile,
@@ -52,7 +52,7 @@ def _sides(size: float | list[float]) -> tuple[float, float]:
 
 def check_assembly(path: Path, layout: AssemblyFile, kinds: Mapping[str, str]) -> None:
     """A ``section`` only for a rect part (``kinds``: part id -> kind, from every statement
-    of the product, :func:`assembly_constraints.bridge.product.kinds.part_kinds`); no id both a part and a hole."""
+    of the product, :func:`bridge.product.kinds.part_kinds`); no id both a part and a hole."""
     for pid, part in layout.parts.items():
         kind = kinds.get(pid)
         if part.section is not None and kind != "rect":

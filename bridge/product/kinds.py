@@ -3,13 +3,13 @@ product makes about it: ``shape`` in ``assembly.toml`` (``[parts.<id>]``,
 ``[holes.<id>]``) and the ``kind`` of the ``[part_shapes.*]`` or ``[hole_shapes.*]`` of
 ``geometry.toml`` that holds it (a part simulated from its ``mesh`` has its table's kind
 too). Statements that disagree are refused by the checks
-(:mod:`assembly_constraints.bridge.product.checks`, naming both files); a part no statement gives a
+(:mod:`bridge.product.checks`, naming both files); a part no statement gives a
 kind (a base, a cover, a head, or a planner-only product's part without ``shape``) has
 none, and the size models put it on no other part's line (docs/sizes.md)."""
 
 from __future__ import annotations
 
-from assembly_constraints.bridge.product.tables import AssemblyFile, GeometryFile
+from bridge.product.tables import AssemblyFile, GeometryFile
 
 
 def part_kinds(layout: AssemblyFile, geometry: GeometryFile | None) -> dict[str, str]:

@@ -1,4 +1,4 @@
-"""The structs of the product description (:mod:`assembly_constraints.bridge.product`): ``assembly.toml``
+"""The structs of the product description (:mod:`bridge.product`): ``assembly.toml``
 (:class:`AssemblyFile`) and ``geometry.toml`` (:class:`GeometryFile`) as decoded TOML,
 their ranges and units in the types' descriptions (the error messages and the published
 JSON Schema say the same). Units: lengths and positions [m], masses [kg], inertia

@@ -44,7 +44,7 @@ from typing import Literal
 import rerun as rr
 import rerun.blueprint as rrb
 
-from assembly_constraints.bridge.files import check_writable
+from bridge.files import check_writable
 
 APPLICATION_ID = "assembly_constraints"
 PLANNER_ROOT = "planner"
@@ -61,7 +61,7 @@ TRAIL_S = 1.0
 
 CELL_EYE = rrb.EyeControls3D(position=(1.7, 1.2, 1.05), look_target=(0.35, 0.15, 0.3), eye_up=(0.0, 0.0, 1.0))
 """The cell's default camera [m]: the arm's base at the origin, the plate around x = 0.6 m,
-the tray around y = 0.4 m (``assembly_constraints.executor.world``): seen from beyond the tray, all three in view."""
+the tray around y = 0.4 m (``executor.world``): seen from beyond the tray, all three in view."""
 HELD_PART = "arm/part/held"
 """Entity of the part in the hand, below a cell's root (``executor.rerun_arm``)."""
 HELD_PART_COLOR = (205, 155, 50)

@@ -4,7 +4,7 @@ Rerun 0.41 dropped ``rr.dataframe``; this module uses the SDK's own chunk reader
 (``rerun.chunk.RrdReader``, in process, no extra dependency) instead of parsing the
 output of ``rerun rrd print``. Used by the tests and by ``./run.sh view RUN --print``.
 A file with a torn tail (its writer died mid-message) is read up to its last whole
-message, with a warning (:mod:`assembly_constraints.bridge.recording.torn`).
+message, with a warning (:mod:`bridge.recording.torn`).
 
 Entity paths are reported as Rerun prints them, with a leading ``/``
 (``/executor/c1/outcome``); Rerun's own ``/__properties`` entities are left out.
@@ -23,9 +23,9 @@ from typing import Any
 import pyarrow as pa
 from rerun.chunk import Chunk, RrdReader
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.inputs import file_kind, shorten
-from assembly_constraints.bridge.recording.torn import readable
+from bridge import BridgeError
+from bridge.inputs import file_kind, shorten
+from bridge.recording.torn import readable
 
 
 @dataclass
@@ -84,7 +84,7 @@ _VISUALIZER_TYPE = "VisualizerInstruction:visualizer_type"  # its overrides name
 @contextmanager
 def _open(path: Path) -> Iterator[RrdReader]:
     """A reader of one ``.rrd`` file (of its whole messages when its tail is torn, with a
-    warning: :mod:`assembly_constraints.bridge.recording.torn`); BridgeError naming the file when it is
+    warning: :mod:`bridge.recording.torn`); BridgeError naming the file when it is
     missing, unreadable or not a Rerun recording (empty, garbage, another format)."""
     try:
         mode = path.stat().st_mode
@@ -126,7 +126,7 @@ def _chunks(reader: RrdReader) -> Iterator[Chunk]:
 
 def chunk_count(path: Path | str) -> int:
     """How many chunks the recording stores of ``path`` hold (blueprints excluded): what
-    compaction (:mod:`assembly_constraints.bridge.recording.compaction`) brings down."""
+    compaction (:mod:`bridge.recording.compaction`) brings down."""
     with _open(Path(path)) as reader:
         return sum(1 for _ in _chunks(reader))
 

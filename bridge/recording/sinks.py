@@ -42,8 +42,8 @@ from urllib.parse import quote
 import rerun as rr
 import rerun.blueprint as rrb
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.files import check_writable
+from bridge import BridgeError
+from bridge.files import check_writable
 
 DEFAULT_VIEWER_URL = "rerun+http://127.0.0.1:9876/proxy"
 """Where a Rerun viewer started on this machine listens for recordings."""

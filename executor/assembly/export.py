@@ -22,13 +22,13 @@ from xml.sax.saxutils import quoteattr
 
 import pybullet as pb
 
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.inputs import read_bytes
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.product import load_product
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.world.scene import link_frame
+from bridge.files import make_folder, write_atomic
+from bridge.inputs import read_bytes
+from executor import ExecutorError
+from executor.assembly.product import load_product
+from executor.assembly.world import AssemblyWorld
+from executor.cell_description import CellDescription
+from executor.world.scene import link_frame
 
 _BASE = -1
 

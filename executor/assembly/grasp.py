@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.skills.insertion import rotvec_quat_xyzw
-from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.assembly.world import AssemblyWorld
+from executor.skills.insertion import rotvec_quat_xyzw
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW
 
 GRASP_FORCE = 500.0  # [N] the constraint's maximum force
 

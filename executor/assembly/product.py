@@ -1,5 +1,5 @@
 """The whole product as the assembling cell sees it: the cell geometry of
-:mod:`assembly_constraints.executor.world.geometry` (plate, holes, pegs) plus the ``[base]``, ``[covers.*]``
+:mod:`executor.world.geometry` (plate, holes, pegs) plus the ``[base]``, ``[covers.*]``
 and ``[heads.*]`` tables of ``geometry.toml`` (documented in ``docs/geometry.md``).
 
 Every part gets a tray pose (where it waits), a goal pose (where the product has it),
@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from assembly_constraints.bridge.product import Cover, Mesh
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.world.geometry import CellGeometry, HoleSpec, PartSpec, load_geometry
+from bridge.product import Cover, Mesh
+from executor import ExecutorError
+from executor.cell_description import CellDescription
+from executor.world.geometry import CellGeometry, HoleSpec, PartSpec, load_geometry
 
 Vec3 = tuple[float, float, float]
 
@@ -169,7 +169,7 @@ def rect_minus_squares(outline: tuple[float, float, float, float],
 
 
 def cover_spec(cid: str, table: Cover, holes: Mapping[str, HoleSpec]) -> CoverSpec:
-    """A checked ``[covers.<id>]`` table (:mod:`assembly_constraints.bridge.product`) over
+    """A checked ``[covers.<id>]`` table (:mod:`bridge.product`) over
     the plate's ``holes``: its solid is the outline minus square openings (each hole's size
     + clearance, and the socket), or its own mesh."""
     centre = np.mean([holes[h].position for h in table.over], axis=0)
@@ -192,7 +192,7 @@ def cover_spec(cid: str, table: Cover, holes: Mapping[str, HoleSpec]) -> CoverSp
 
 def load_product(assembly: str = "cranfield", description: CellDescription | None = None) -> Product:
     """The product of an assembly folder with the gripper of the cell ``description``
-    unless ``geometry.toml`` has its own (:func:`assembly_constraints.executor.world.geometry.load_geometry`:
+    unless ``geometry.toml`` has its own (:func:`executor.world.geometry.load_geometry`:
     the whole description checked); ExecutorError when it has no ``[base]`` table."""
     geometry = load_geometry(assembly, description)
     tables, path = geometry.tables, geometry.folder / "geometry.toml"

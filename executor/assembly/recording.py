@@ -8,14 +8,14 @@ Entities (under ``executor/<cell-id>/assembly/``):
                                 solid (boxes, cylinders or its own mesh, in its frame)
                                 logged when the world is attached
 ``arm/<link>``                  the arm's links (meshes, as in a cell's recording:
-                                :class:`assembly_constraints.executor.rerun_arm.ArmRecorder`) over ``sim_time``,
+                                :class:`executor.rerun_arm.ArmRecorder`) over ``sim_time``,
                                 their geometry logged when the world is attached
 ``force``                       measured contact force at the TCP (series Fx, Fy, Fz [N])
 ``steps``                       one text line per plan step (timelines ``plan_step``
                                 and ``sim_time``)
 =============================== ===================================================
 
-The recorder is the Motion's step logger (:class:`assembly_constraints.executor.control.motion.StepLogger`):
+The recorder is the Motion's step logger (:class:`executor.control.motion.StepLogger`):
 it samples the world every ``period_s`` of simulated time. The solids and meshes are logged
 at the time the world is attached with the poses then, not static: in a session's
 recording the assembly comes after learning, and before it nothing of it is drawn (static
@@ -28,10 +28,10 @@ import numpy as np
 import rerun as rr
 import trimesh
 
-from assembly_constraints.bridge.recording.layout import assembly_root
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.rerun_arm import ArmRecorder
-from assembly_constraints.executor.rerun_plots import AXIS_NAMES, MEASURED_COLORS
+from bridge.recording.layout import assembly_root
+from executor.assembly.world import AssemblyWorld
+from executor.rerun_arm import ArmRecorder
+from executor.rerun_plots import AXIS_NAMES, MEASURED_COLORS
 
 PERIOD_S = 0.04  # [s] of sim time between two samples of the poses
 

@@ -5,7 +5,7 @@ Per kind of part (the ``skill`` of the step's record):
 - ``fixture``: the back plate, carried kinematically into the fixture, whose locating pins
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
-  then the taught force-monitored insertion (:func:`assembly_constraints.executor.skills.insertion.insert`);
+  then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
 - ``insert_over``: a part with openings down over the pins standing in its holes, by the
   same insertion skill, from above the pins to its resting height, aimed at the holes'
   centres without a search (a pin stands within half its hole's clearance of the centre,
@@ -38,26 +38,26 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.grasp import Grasp
-from assembly_constraints.executor.assembly.product import Product
-from assembly_constraints.executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.backend_plugin import check_step
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.control.detector import Detector
-from assembly_constraints.executor.control.ilc import LAYERS, ExecutionLayer, Ilc
-from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
-from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.skills.dmp import Skill, load_product_skill
-from assembly_constraints.executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
-from assembly_constraints.executor.skills.search import hole_search
-from assembly_constraints.executor.trial import APPROACH_HEIGHT, trial_rng
-from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, yaw_quat
-from assembly_constraints.executor.world.geometry import fit_pose
-from assembly_constraints.executor.world.perturbation import CellBias
-from assembly_constraints.executor.world.scene import PART_FRICTION
+from bridge.cell_settings import Magnitudes
+from executor import ExecutorError
+from executor.assembly.grasp import Grasp
+from executor.assembly.product import Product
+from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
+from executor.assembly.world import AssemblyWorld
+from executor.backend_plugin import check_step
+from executor.cell_description import CellDescription
+from executor.control.detector import Detector
+from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
+from executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
+from executor.evidence import AttemptSetup
+from executor.skills.dmp import Skill, load_product_skill
+from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
+from executor.skills.search import hole_search
+from executor.trial import APPROACH_HEIGHT, trial_rng
+from executor.world.arm import aligned_yaw, tool_quat, yaw_quat
+from executor.world.geometry import fit_pose
+from executor.world.perturbation import CellBias
+from executor.world.scene import PART_FRICTION
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
 RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
@@ -105,7 +105,7 @@ class StepRecord:
 
 
 def check_product_step(product: Product, part: str, hole: str | None, placed: Collection[str]) -> None:
-    """:func:`assembly_constraints.executor.backend_plugin.check_step` against ``product``, with ``placed`` parts."""
+    """:func:`executor.backend_plugin.check_step` against ``product``, with ``placed`` parts."""
     check_step(part, hole, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes, placed=placed)
 
 

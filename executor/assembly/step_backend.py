@@ -1,6 +1,6 @@
 """Plan steps served over Zenoh (``executor serve``): the :class:`Assembler` of the current
 plan run, kept between its steps. One run at a time: a step of another run (``assembly``
-id) is refused (:class:`assembly_constraints.executor.backend_plugin.RunActive`) while the current run's product is
+id) is refused (:class:`executor.backend_plugin.RunActive`) while the current run's product is
 unfinished, and starts a fresh world with every part on the tray once it is complete. A
 refused step (another run, or one the product does not allow) changes nothing. Holes
 blocked with ``--block-hole`` get their obstacle in every fresh world. With
@@ -13,17 +13,17 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from assembly_constraints.bridge.messages import StepEvidence, StepRequest
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.product import Product, load_product
-from assembly_constraints.executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
-from assembly_constraints.executor.backend_plugin import check_run
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc
+from bridge.messages import StepEvidence, StepRequest
+from executor import ExecutorError
+from executor.assembly.product import Product, load_product
+from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
+from executor.backend_plugin import check_run
+from executor.cell_description import CellDescription
+from executor.control.ilc import ExecutionLayer, Ilc
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.assembly.recording import AssemblyRecorder
-    from assembly_constraints.executor.world.perturbation import CellBias
+    from executor.assembly.recording import AssemblyRecorder
+    from executor.world.perturbation import CellBias
 
 
 def step_evidence(record: StepRecord) -> StepEvidence:

@@ -13,9 +13,9 @@ from collections.abc import Callable
 import msgspec
 import numpy as np
 
-from assembly_constraints.executor.control.motion import Motion
-from assembly_constraints.executor.world.arm import tool_quat
-from assembly_constraints.executor.world.scene import TIME_STEP
+from executor.control.motion import Motion
+from executor.world.arm import tool_quat
+from executor.world.scene import TIME_STEP
 
 DAMPING_FACTOR = 2.0
 SAFE_Z = 0.20  # [m] TCP height for carrying: above every part standing on the plate or the tray

@@ -3,7 +3,7 @@ kinematically while carried), every other part as a free rigid body on the tray,
 arm with a gripper tool (the wrist force/torque sensor between flange and tool).
 
 The tool link has no collisions: the gripper is a grasp constraint
-(:mod:`assembly_constraints.executor.assembly.grasp`), not simulated fingers.  The world
+(:mod:`executor.assembly.grasp`), not simulated fingers.  The world
 persists between plan steps: placed parts stay placed.
 """
 
@@ -17,15 +17,15 @@ import numpy as np
 import pybullet as pb
 import pybullet_data
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.product import HeadSpec, Product, rect_minus_squares
-from assembly_constraints.executor.control.controller import ImpedanceController
-from assembly_constraints.executor.control.gains import ImpedanceGains
-from assembly_constraints.executor.control.motion import Motion, StepLogger
-from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
-from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import PartSpec, arm_urdf_text, product_bodies
-from assembly_constraints.executor.world.scene import TIME_STEP, load_plate
+from executor import ExecutorError
+from executor.assembly.product import HeadSpec, Product, rect_minus_squares
+from executor.control.controller import ImpedanceController
+from executor.control.gains import ImpedanceGains
+from executor.control.motion import Motion, StepLogger
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
+from executor.world.assets import current_assets
+from executor.world.geometry import PartSpec, arm_urdf_text, product_bodies
+from executor.world.scene import TIME_STEP, load_plate
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -177,7 +177,7 @@ class AssemblyWorld:
                         demo_hole="")
         self.arm_urdf = arm_urdf_text(tool, gripper)
         """The arm's URDF text (absolute mesh paths), as loaded:
-        :mod:`assembly_constraints.executor.assembly.export`."""
+        :mod:`executor.assembly.export`."""
         with tempfile.TemporaryDirectory(prefix="executor-assembly-arm-") as tmp:
             urdf = Path(tmp) / "arm_gripper.urdf"
             urdf.write_text(self.arm_urdf)

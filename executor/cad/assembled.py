@@ -2,9 +2,9 @@
 cell builds them (``executor export --assembled OUT``): the input of ``import``'s round
 trips.
 
-The assembling world (:class:`assembly_constraints.executor.assembly.world.AssemblyWorld`) is built, every part
+The assembling world (:class:`executor.assembly.world.AssemblyWorld`) is built, every part
 is put at its goal pose (each peg turned to its hole's yaw, in the first hole by id it passes
-(:func:`assembly_constraints.executor.world.geometry.passes`) among those still free, smallest hole first), and
+(:func:`executor.world.geometry.passes`) among those still free, smallest hole first), and
 each part's shapes are read back from PyBullet (boxes, grown by :data:`JOIN` in a part
 of several shapes; cylinders as 256-gons whose corners lie on the circle; meshes) and
 joined by an exact boolean union (manifold3d, in double precision) into one solid; the base is its plate's
@@ -22,13 +22,13 @@ import numpy as np
 import pybullet as pb
 import trimesh
 
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.product import load_product
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.cell_description import load_cell_description
-from assembly_constraints.executor.world.geometry import passes
-from assembly_constraints.executor.world.scene import link_frame
+from bridge.files import make_folder, write_atomic
+from executor import ExecutorError
+from executor.assembly.product import load_product
+from executor.assembly.world import AssemblyWorld
+from executor.cell_description import load_cell_description
+from executor.world.geometry import passes
+from executor.world.scene import link_frame
 
 CYLINDER_SECTIONS = 256
 JOIN = 1e-6

@@ -5,7 +5,7 @@ The product (``--parts N``, 6 to 200, default 20): a plate with ``N - 3`` holes 
 0.3 mm clearance; the pegs of the first row stand 15 mm out, the others 25 mm; two 4 mm
 covers, one lying on the first row, the other on it, each with openings for the others
 (which pass through both). Written as STL files in mm, then imported
-(:func:`assembly_constraints.executor.cad.cli.run_import`) ``--repeat`` times. Prints the median wall and CPU
+(:func:`executor.cad.cli.run_import`) ``--repeat`` times. Prints the median wall and CPU
 time of the import, the collision queries and the edges found; exit code 1 when the
 median CPU time (the process's, all its threads: what one core would need) exceeds
 ``--target``. The wall time is printed too: on a shared machine it also counts the
@@ -22,8 +22,8 @@ from pathlib import Path
 
 import trimesh
 
-from assembly_constraints.bridge.cli_types import ArgumentParser, int_in, number_in
-from assembly_constraints.executor.cad.cli import Imported, run_import
+from bridge.cli_types import ArgumentParser, int_in, number_in
+from executor.cad.cli import Imported, run_import
 
 PITCH = 30.0  # grid pitch of the holes [mm]
 DEPTH = 15.0  # hole depth [mm]; the plate is 20 mm thick

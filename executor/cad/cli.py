@@ -12,11 +12,11 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 It prints what it assumes, each part's insertion axis and free directions, each hole
 with both cross-sections and the clearance, the disassembly stages, the geometric
 precedence with each pair's reason (``--locating-reach R``: the locating rule's reach [m],
-:mod:`assembly_constraints.executor.cad.locating`; 0: off) and the collision queries; bad
+:mod:`executor.cad.locating`; 0: off) and the collision queries; bad
 CAD or a bad file: one line, exit code 2. ``--max-triangles N`` bounds the parts'
 triangles together; the folder's ``.import-manifest.json`` lists the files an import
 wrote, the only ones a later import replaces or removes (``--replace``: also a product it
-did not write, :func:`assembly_constraints.executor.cad.write.claim_folder`).
+did not write, :func:`executor.cad.write.claim_folder`).
 """
 
 from __future__ import annotations
@@ -28,14 +28,14 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from assembly_constraints.bridge.cli_types import ArgumentParser, int_in, nonempty_path, number_in
-from assembly_constraints.bridge.inputs import read_text, shorten
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.convex import MESH_FOLDER
-from assembly_constraints.executor.cad.covers import Mapped
-from assembly_constraints.executor.cad.derive import Derived, derive
-from assembly_constraints.executor.cad.locating import LOCATING_REACH, MAX_REACH
-from assembly_constraints.executor.cad.parts import (
+from bridge.cli_types import ArgumentParser, int_in, nonempty_path, number_in
+from bridge.inputs import read_text, shorten
+from executor import ExecutorError
+from executor.cad.convex import MESH_FOLDER
+from executor.cad.covers import Mapped
+from executor.cad.derive import Derived, derive
+from executor.cad.locating import LOCATING_REACH, MAX_REACH
+from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
     UNITS,
@@ -43,9 +43,9 @@ from assembly_constraints.executor.cad.parts import (
     check_parts,
     load_meshes,
 )
-from assembly_constraints.executor.cad.step import load_step
-from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.cad.write import (
+from executor.cad.step import load_step
+from executor.cad.sweep import opposite
+from executor.cad.write import (
     MANIFEST,
     Settings,
     claim_folder,
@@ -53,7 +53,7 @@ from assembly_constraints.executor.cad.write import (
     section,
     write_folder,
 )
-from assembly_constraints.executor.world.geometry import section_fit
+from executor.world.geometry import section_fit
 
 TRAY_ROW = ((0.25, 0.40), 0.05)
 """Default trays: the parts in a row from this point [m], this far apart along x [m]."""
@@ -207,7 +207,7 @@ class Imported:
 def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH,
                max_triangles: int = MAX_TRIANGLES, replace: bool = False) -> Imported:
     """Read (at most ``max_triangles``), check, claim ``out`` (``replace``: also a product
-    another import or a person wrote, :func:`assembly_constraints.executor.cad.write.claim_folder`),
+    another import or a person wrote, :func:`executor.cad.write.claim_folder`),
     derive (``reach`` [m]: the locating rule's, 0: off), map the covers and heads, and write."""
     started = time.perf_counter()
     parts = load_source(source, units, max_triangles)

@@ -22,7 +22,7 @@ reach beyond the kept pieces' face planes. The pieces must fit where the part is
 must leave each part near it (:data:`NEAR`: a cover's pins and head, a head's cover, a
 peg's base) :data:`ROOM_KEPT` of the room its mesh leaves it, and overlap none it touches
 (measured with python-fcl in the assembled pose), each piece at least 2 mm thick (the
-cell's hull margin twice: :mod:`assembly_constraints.executor.world.meshes`); CoACD's
+cell's hull margin twice: :mod:`executor.world.meshes`); CoACD's
 :data:`THRESHOLDS` are tried in turn until they do (the third line names the threshold and the least room left), and
 a part whose pieces never do is named and gets none. The decomposition is made here,
 never when a cell starts.
@@ -41,13 +41,13 @@ import fcl
 import numpy as np
 import trimesh
 
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.product import CONVEX_HEADER, Mesh
-from assembly_constraints.executor.assembly.product import Box
-from assembly_constraints.executor.cad.derive import Derived, HoleFit
-from assembly_constraints.executor.cad.sections import Shape2D
-from assembly_constraints.executor.cad.sweep import TOUCH, bvh, convex_object
-from assembly_constraints.executor.world.meshes import URDF_HULL_MARGIN, eroded, obj_text
+from bridge.files import make_folder, write_atomic
+from bridge.product import CONVEX_HEADER, Mesh
+from executor.assembly.product import Box
+from executor.cad.derive import Derived, HoleFit
+from executor.cad.sections import Shape2D
+from executor.cad.sweep import TOUCH, bvh, convex_object
+from executor.world.meshes import URDF_HULL_MARGIN, eroded, obj_text
 
 PRIMITIVE_TOLERANCE = 0.01
 """A part is the primitive its sections describe when their volumes differ by less than
@@ -101,7 +101,7 @@ def base_is_primitive(derived: Derived) -> bool:
 
 def cover_is_primitive(mesh: trimesh.Trimesh, boxes: Sequence[Box]) -> bool:
     """Whether a cover's ``mesh`` (in its frame) is the cell's solid of ``boxes`` (its
-    outline less square openings: :func:`assembly_constraints.executor.assembly.product.cover_spec`):
+    outline less square openings: :func:`executor.assembly.product.cover_spec`):
     their symmetric difference is less than :data:`PRIMITIVE_TOLERANCE` of the mesh's
     volume. The boxes are disjoint, so it is both volumes less twice the mesh's
     intersections with each box (exact booleans, manifold3d)."""
@@ -160,7 +160,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
     parts near it in the assembled pose, in its frame); or why no decomposition leaves
     each of them :data:`ROOM_KEPT` of the room the mesh leaves it (touching: none
-    deeper than :data:`assembly_constraints.executor.cad.sweep.TOUCH`) with every piece
+    deeper than :data:`executor.cad.sweep.TOUCH`) with every piece
     at least twice the cell's hull margin thick."""
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
     own = bvh(mesh)

@@ -38,14 +38,14 @@ import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull, QhullError
 
-from assembly_constraints.bridge.product import Cover
-from assembly_constraints.executor.assembly.product import MAX_COVER_BOXES, cover_spec
-from assembly_constraints.executor.cad.convex import cover_is_primitive, head_is_primitive, section_area
-from assembly_constraints.executor.cad.derive import Derived, first_hit
-from assembly_constraints.executor.cad.parts import STEP_DEFLECTION
-from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, edge_distance, exact_round, slice_loops
-from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.world.geometry import HoleSpec
+from bridge.product import Cover
+from executor.assembly.product import MAX_COVER_BOXES, cover_spec
+from executor.cad.convex import cover_is_primitive, head_is_primitive, section_area
+from executor.cad.derive import Derived, first_hit
+from executor.cad.parts import STEP_DEFLECTION
+from executor.cad.sections import Loop, Shape2D, classify, edge_distance, exact_round, slice_loops
+from executor.cad.sweep import opposite
+from executor.world.geometry import HoleSpec
 
 PROBE = 1e-5
 """How far [m] from a face a slice or ray looks for what touches it (10 µm)."""

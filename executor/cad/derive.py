@@ -5,8 +5,8 @@ Disassembly: the base stays (it is the fixture); every moving body (a part with 
 ``fixed_to`` it, moved as one) is swept out along each direction tried by the product's
 size, everything else fixed, which gives its blockers per direction (blocking is
 pairwise, so these are the blockers at every stage). The directions tried are
-:data:`assembly_constraints.executor.cad.sweep.DIRECTIONS` and both senses of the axis of
-every zero-clearance fit (:func:`assembly_constraints.executor.cad.sweep.zero_clearance_fits`).
+:data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
+every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
 along the first such direction: its **insertion axis** is the reverse. A part that no
 stage frees never comes out (an error naming it and, per direction, its blockers).
@@ -15,7 +15,7 @@ stage frees never comes out (an error naming it and, per direction, its blockers
 in once B is there: of the directions the base leaves A free along, B blocks one, and B
 or parts present whenever B is (its body, the base, parts already found to precede B)
 block every one. The base precedes every part touching it (``base``). Two stated rules
-of placing (:mod:`assembly_constraints.executor.cad.locating`) add ``supports`` (a part
+of placing (:mod:`executor.cad.locating`) add ``supports`` (a part
 resting on parts other than the base goes after them) and ``locates`` (off with reach 0);
 a pair of theirs that the blocking contradicts is dropped and reported.
 
@@ -35,17 +35,17 @@ from dataclasses import dataclass, field
 import numpy as np
 import trimesh
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.locating import (
+from executor import ExecutorError
+from executor.cad.locating import (
     LOCATING_REACH,
     consistent,
     locating_candidates,
     locators,
     support_pairs,
 )
-from assembly_constraints.executor.cad.parts import STEP_DEFLECTION, CadPart
-from assembly_constraints.executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
-from assembly_constraints.executor.cad.sweep import (
+from executor.cad.parts import STEP_DEFLECTION, CadPart
+from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
+from executor.cad.sweep import (
     DIRECTIONS,
     Slide,
     Sweeper,
@@ -89,7 +89,7 @@ class Derived:
     ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs and
     ``reasons`` why each holds (``blocks``: :func:`forced`, its blockers per direction in
     ``detail``; ``base``: the base precedes the parts touching it; ``supports`` and
-    ``locates``: the rules of :mod:`assembly_constraints.executor.cad.locating`),
+    ``locates``: the rules of :mod:`executor.cad.locating`),
     ``located`` each moving body's locators per direction across its axis, ``dropped``
     the locating pairs and ``dropped_supports`` the supporting pairs the blocking
     contradicts, ``reach`` the locating reach [m] (0: the rule is off), ``bodies`` the

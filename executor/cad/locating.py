@@ -9,7 +9,7 @@ order); it is gravity's order, and like the locating rule it only removes sequen
 
 **Model.** In the assembled product, a part X is *located* along a direction across its
 insertion axis by the parts it meets when moved :data:`LOCATING_REACH` that way (swept,
-everything else fixed, as the blocking is found: :class:`assembly_constraints.executor.cad.sweep.Sweeper`).
+everything else fixed, as the blocking is found: :class:`executor.cad.sweep.Sweeper`).
 When, along some such direction, one part Y other than the base is the only one that
 locates X, Y must precede X (reason ``locates``): placed before Y, X would lie unlocated
 that way, lined up with what lies below only within the cell's placing error, and Y would
@@ -30,7 +30,7 @@ from __future__ import annotations
 import networkx as nx
 import numpy as np
 
-from assembly_constraints.executor.cad.sweep import DIRECTIONS, Sweeper
+from executor.cad.sweep import DIRECTIONS, Sweeper
 
 SUPPORT_GAP = 1e-4
 """A part this close above another [m] (0.1 mm) rests on it."""

@@ -11,7 +11,7 @@ triangles counted before the mesh is built), its coordinates must be finite (the
 triangle of the first that is not is named) and its vertices are merged by position (an
 OBJ that repeats a vertex once per normal or texture coordinate is one surface).
 
-Checks (:func:`check_parts`), each an :class:`assembly_constraints.executor.ExecutorError` naming the part:
+Checks (:func:`check_parts`), each an :class:`executor.ExecutorError` naming the part:
 a mesh that is not closed (its boundary edges counted, one located), a closed mesh whose
 triangles are wound inconsistently (made consistent when the part is one shell, refused
 otherwise: which shells are cavities is not known), parts whose sizes differ by a factor the
@@ -31,8 +31,8 @@ from typing import BinaryIO
 import numpy as np
 import trimesh
 
-from assembly_constraints.bridge.assembly import is_id
-from assembly_constraints.executor import ExecutorError
+from bridge.assembly import is_id
+from executor import ExecutorError
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""

@@ -13,7 +13,7 @@ A loop is classified as
   its sides are straight over 80 % and 67 %), with the long side a, the short side b and
   the yaw of a from the slice's first axis;
 - ``polygon`` otherwise: the loop itself, compared with
-  :mod:`assembly_constraints.executor.world.fit` (``outline``).
+  :mod:`executor.world.fit` (``outline``).
 
 Sizes are what a fit depends on, conservatively: a part's round section is its
 circumscribed circle (its widest), a hole's its inscribed circle (its narrowest), so a
@@ -39,7 +39,7 @@ import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
 
-from assembly_constraints.executor.cad.parts import Cylinder
+from executor.cad.parts import Cylinder
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5

@@ -12,7 +12,7 @@ A file whose reading Open CASCADE reports a failure for (a syntax error, a refer
 missing record, a record with the wrong parameters: its reader goes on without the
 record, which can rename a part or drop its placement) is refused, naming the record
 and its line. The parts' tessellations count against the product's bound of triangles
-(:data:`assembly_constraints.executor.cad.parts.MAX_TRIANGLES`) before they are copied.
+(:data:`executor.cad.parts.MAX_TRIANGLES`) before they are copied.
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ from typing import Any
 import numpy as np
 import trimesh
 
-from assembly_constraints.bridge.inputs import shorten
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.parts import (
+from bridge.inputs import shorten
+from executor import ExecutorError
+from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_DEFLECTION,
     CadPart,

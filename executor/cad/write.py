@@ -4,7 +4,7 @@
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
-  (:func:`assembly_constraints.executor.world.geometry.passes`: the exact rules of round,
+  (:func:`executor.world.geometry.passes`: the exact rules of round,
   square and rect sections, the polygon relation where one is a polygon), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's, the input of ``sizes learn --prior cad``;
@@ -14,11 +14,11 @@
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
   wait (and when the cell's loader accepts it; left out otherwise, and the report says
   why): pegs standing in holes entered along +z with a round, square or rect section,
-  covers and heads (:mod:`assembly_constraints.executor.cad.covers`), every other part
+  covers and heads (:mod:`executor.cad.covers`), every other part
   placed by hand (``[manual.<id>]``, :func:`cell_view`); the plate at the entry height and
   depth most holes share, a hole at another one with its own ``top_z`` and ``depth``, the
   plate, pegs, covers and heads as primitives where they are ones, else as their own
-  meshes with convex pieces (``meshes/``, :mod:`assembly_constraints.executor.cad.convex`;
+  meshes with convex pieces (``meshes/``, :mod:`executor.cad.convex`;
   a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell), a part placed by
   hand as its own mesh (static, no pieces), a base without such holes as its own mesh.
 - ``.import-manifest.json`` (:data:`MANIFEST`): the files this import wrote with their
@@ -42,12 +42,12 @@ import networkx as nx
 import numpy as np
 import trimesh
 
-from assembly_constraints.bridge.errors import ToolError
-from assembly_constraints.bridge.files import make_folder, os_reason, write_atomic
-from assembly_constraints.bridge.inputs import read_text, shorten
-from assembly_constraints.bridge.product import Mesh
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.convex import (
+from bridge.errors import ToolError
+from bridge.files import make_folder, os_reason, write_atomic
+from bridge.inputs import read_text, shorten
+from bridge.product import Mesh
+from executor import ExecutorError
+from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
     base_is_primitive,
@@ -55,12 +55,12 @@ from assembly_constraints.executor.cad.convex import (
     peg_is_primitive,
     write_mesh,
 )
-from assembly_constraints.executor.cad.covers import Mapped, map_parts
-from assembly_constraints.executor.cad.derive import Derived, HoleFit
-from assembly_constraints.executor.cad.sections import Shape2D
-from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.world.geometry import Section, load_geometry, margin
-from assembly_constraints.executor.world.polygon_fit import OutlineError
+from executor.cad.covers import Mapped, map_parts
+from executor.cad.derive import Derived, HoleFit
+from executor.cad.sections import Shape2D
+from executor.cad.sweep import opposite
+from executor.world.geometry import Section, load_geometry, margin
+from executor.world.polygon_fit import OutlineError
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -83,7 +83,7 @@ _MESH_NAME = re.compile(rf"{MESH_FOLDER}/[a-z][a-z0-9_]*(\.convex)?\.obj")
 """The name of a mesh file an import writes, relative to the folder (a part id is an ASP constant)."""
 CELL_DEFLECTION = 1e-5
 """The largest distance [m] of a STEP base's faces from the triangles the cell collides
-with (its own mesh is measured at :data:`assembly_constraints.executor.cad.parts.STEP_DEFLECTION`)."""
+with (its own mesh is measured at :data:`executor.cad.parts.STEP_DEFLECTION`)."""
 
 
 @dataclass(frozen=True)
@@ -166,7 +166,7 @@ def sizes_text(derived: Derived) -> str:
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
-    (:func:`assembly_constraints.executor.world.geometry.margin`, the polygon relation for
+    (:func:`executor.world.geometry.margin`, the polygon relation for
     polygon sections; negative: it does not pass); ExecutorError naming the part or hole
     whose polygon section is no simple outline."""
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
@@ -303,7 +303,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
     ``out`` (the base in the cell frame, the others in their part frames, the moving ones
     with their convex pieces; each file written is appended to ``written``); returns their
     ``mesh`` entries by part, or why a part has no pieces that fit
-    (:func:`assembly_constraints.executor.cad.convex.fitting_pieces`)."""
+    (:func:`executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
     if not derived.holes or not base_is_primitive(derived):  # no plate of primitives without holes
         done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")

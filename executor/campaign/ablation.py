@@ -1,7 +1,7 @@
 """``./run.sh bench executor --ablation --trials N --seed S [--json]``: what each part of
 the execution layer adds, measured side by side.
 
-Every variant of :data:`assembly_constraints.executor.control.ilc.LAYERS` (pure position control along the
+Every variant of :data:`executor.control.ilc.LAYERS` (pure position control along the
 DMP, admittance P, admittance PI, PI + phase stopping, all + ILC) runs ``N`` trials of
 every campaign pair (the fitting rows of Fig. 18 and the too-big pairs) on the same
 seeded perturbations: the trials of a pair are run as groups of ``--executions``
@@ -9,7 +9,7 @@ consecutive executions (default 5) in one cell, group ``g`` with cell seed ``S +
 (its systematic errors) and execution ``j`` with trial seed ``S + g·E + j`` (its random
 errors), so with ILC execution ``j`` learns from executions ``0..j−1`` of that pair in
 that cell.  A last run, PI + phase stopping with the systematic errors set to zero
-(:func:`assembly_constraints.executor.world.perturbation.random_only`), gives the force
+(:func:`executor.world.perturbation.random_only`), gives the force
 deviation the random part alone leaves: the floor no learning across executions can go
 below.
 
@@ -34,13 +34,13 @@ from typing import Any
 import msgspec
 import numpy as np
 
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.bridge.progress import progress
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.campaign.pairs import CampaignPair, campaign_pairs
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.control.ilc import LAYERS
-from assembly_constraints.executor.world.perturbation import random_only
+from bridge.cell_settings import Magnitudes
+from bridge.progress import progress
+from executor import ExecutorError
+from executor.campaign.pairs import CampaignPair, campaign_pairs
+from executor.cell_description import CellDescription
+from executor.control.ilc import LAYERS
+from executor.world.perturbation import random_only
 
 FLOOR = "random_only"
 """The extra run: PI + phase stopping with only the random part of the perturbations."""
@@ -50,7 +50,7 @@ _CELL: Any = None  # the worker's Cell (reused: one PyBullet client per part sha
 
 def _run_group(task: tuple[str, str, int, str, str, list[int], Magnitudes]) -> list[dict[str, Any]]:
     """One group: consecutive executions of one pair in a fresh cell state (cell seed)."""
-    from assembly_constraints.executor.trial import Cell
+    from executor.trial import Cell
 
     global _CELL
     variant, assembly, cell_seed, part, hole, seeds, magnitudes = task

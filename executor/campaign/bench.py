@@ -22,17 +22,17 @@ import statistics
 from collections.abc import Sequence
 from typing import Any
 
-from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
-from assembly_constraints.bridge.cli_types import (
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
     add_jobs_argument,
     int_in,
 )
-from assembly_constraints.executor.campaign.ablation import format_ablation, run_ablation
-from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT, campaign_pairs, select_pairs
-from assembly_constraints.executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
+from executor.campaign.ablation import format_ablation, run_ablation
+from executor.campaign.pairs import PAIRS_ARGUMENT, campaign_pairs, select_pairs
+from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr, timed_campaign
 
 TARGET_FITTING_TRIAL_S = 1.5
 TARGET_ALL_TRIAL_S = 2.5

@@ -17,10 +17,10 @@ from collections.abc import Sequence
 
 import msgspec
 
-from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
-from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, int_in
-from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT
-from assembly_constraints.executor.trial import Cell, cell_setup, trial_rng
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
+from bridge.cli_types import MAX_SEED, ArgumentParser, int_in
+from executor.campaign.pairs import PAIRS_ARGUMENT
+from executor.trial import Cell, cell_setup, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:

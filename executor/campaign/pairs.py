@@ -2,8 +2,8 @@
 
 The pairs are the fitting rows of Fig. 18, in the paper's order, then every non-fitting
 pair of parts {p1, tp, p3, sh} x holes {r1, br, s1}; :class:`PairStats` holds one row of
-the table.  Shared by the campaign (:mod:`assembly_constraints.executor.campaign.run`) and its figures
-(:mod:`assembly_constraints.executor.campaign.plots`), which is why it is a module of its own.
+the table.  Shared by the campaign (:mod:`executor.campaign.run`) and its figures
+(:mod:`executor.campaign.plots`), which is why it is a module of its own.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from assembly_constraints.bridge.cli_types import comma_list, part_hole_pair
-from assembly_constraints.executor import ExecutorError
+from bridge.cli_types import comma_list, part_hole_pair
+from executor import ExecutorError
 
 FIG18_FITTING_PAIRS: tuple[tuple[str, str], ...] = (
     ("p1", "r1"), ("p1", "br"), ("p1", "s1"),

@@ -32,14 +32,14 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, number_in
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.campaign.run import stdout_to_stderr
-from assembly_constraints.executor.trial import Cell
-from assembly_constraints.executor.world import TIME_STEP
-from assembly_constraints.executor.world.arm import Arm
-from assembly_constraints.executor.world.geometry import load_geometry, passes
-from assembly_constraints.executor.world.scene import Scene
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in, number_in
+from executor import ExecutorError
+from executor.campaign.run import stdout_to_stderr
+from executor.trial import Cell
+from executor.world import TIME_STEP
+from executor.world.arm import Arm
+from executor.world.geometry import load_geometry, passes
+from executor.world.scene import Scene
 
 TOOL_DOWN = np.array([1.0, 0.0, 0.0, 0.0])
 """Tool orientation pointing down (xyzw quaternion), as the skills hold it."""

@@ -6,7 +6,7 @@
   successful round-peg insertion (``p1``→``r1``, left) and a failed square-peg one
   (``p3``→``r1``, right), each against its own part's desired profile (dotted): the
   paper's Fig. 17 (``executor trial --plot FILE`` draws the same for its own trials). The traces come from two
-  extra trials run here with an :class:`~assembly_constraints.executor.rerun_log.AttemptLogger`, which also
+  extra trials run here with an :class:`~executor.rerun_log.AttemptLogger`, which also
   saves them as ``fig17.rrd``.
 """
 
@@ -20,10 +20,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from assembly_constraints.bridge.files import make_folder, write_figure  # noqa: E402
-from assembly_constraints.executor import ExecutorError  # noqa: E402
-from assembly_constraints.executor.campaign.pairs import HOLE_NAMES, PART_NAMES, PairStats  # noqa: E402
-from assembly_constraints.executor.rerun_log import AttemptLogger, AttemptTrace  # noqa: E402
+from bridge.files import make_folder, write_figure  # noqa: E402
+from executor import ExecutorError  # noqa: E402
+from executor.campaign.pairs import HOLE_NAMES, PART_NAMES, PairStats  # noqa: E402
+from executor.rerun_log import AttemptLogger, AttemptTrace  # noqa: E402
 
 FIG17_SUCCESS = ("p1", "r1")
 FIG17_FAILURE = ("p3", "r1")
@@ -33,7 +33,7 @@ _SEEDS_TO_TRY = 5  # seeds tried to find a successful / failed attempt to show
 def traced_trials(assembly: str, seed: int, rrd_path: Path) -> tuple[AttemptTrace, AttemptTrace]:
     """Run Fig. 17's two pairs in a logged cell; the first fitting attempt of
     ``p1``→``r1`` and the first attempt of ``p3``→``r1`` (which must fail)."""
-    from assembly_constraints.executor.trial import Cell
+    from executor.trial import Cell
 
     logger = AttemptLogger("fig17", rrd_path=rrd_path, keep_traces=True)
     cell = Cell(assembly, logger=logger)

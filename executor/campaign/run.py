@@ -39,8 +39,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
-from assembly_constraints.bridge.cli_types import (
+from bridge.cell_settings import add_cell_arguments, cell_settings_of
+from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
@@ -48,9 +48,9 @@ from assembly_constraints.bridge.cli_types import (
     int_in,
     nonempty_path,
 )
-from assembly_constraints.bridge.progress import progress
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.campaign.pairs import (
+from bridge.progress import progress
+from executor import ExecutorError
+from executor.campaign.pairs import (
     HOLE_NAMES,
     PAIRS_ARGUMENT,
     PART_NAMES,
@@ -59,7 +59,7 @@ from assembly_constraints.executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from assembly_constraints.executor.trial import CellSetup, cell_setup
+from executor.trial import CellSetup, cell_setup
 
 
 class TrialRunner(Protocol):
@@ -75,11 +75,11 @@ function or a ``functools.partial`` of one)."""
 
 
 class CellRunner:
-    """A :class:`assembly_constraints.executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
-    ``setup``: what the cell is (:class:`assembly_constraints.executor.trial.CellSetup`)."""
+    """A :class:`executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
+    ``setup``: what the cell is (:class:`executor.trial.CellSetup`)."""
 
     def __init__(self, assembly: str, setup: CellSetup) -> None:
-        from assembly_constraints.executor.trial import Cell
+        from executor.trial import Cell
 
         self.cell = Cell(assembly, setup=setup)
 
@@ -235,7 +235,7 @@ def main(argv: Sequence[str]) -> int:
     pairs = select_pairs(args.pairs)
     setup = cell_setup(cell_settings_of(args))  # the cell description checked before anything is written
     if args.plot:  # before the campaign, which takes minutes
-        from assembly_constraints.bridge.files import check_writable, make_folder
+        from bridge.files import check_writable, make_folder
 
         check_writable(make_folder(args.plot) / "fig18_table.png")
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
@@ -245,7 +245,7 @@ def main(argv: Sequence[str]) -> int:
         )
         report = campaign_report(run, args.seed, args.jobs)
         if args.plot:
-            from assembly_constraints.executor.campaign.plots import write_plots
+            from executor.campaign.plots import write_plots
 
             plots = write_plots(Path(args.plot), run.stats, args.assembly, args.seed)
             report["plots"] = [str(p) for p in plots]

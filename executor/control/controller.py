@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.executor.control.gains import ImpedanceGains
-from assembly_constraints.executor.world.arm import REST_POSTURE, Arm, ArmState, rotation_error
+from executor.control.gains import ImpedanceGains
+from executor.world.arm import REST_POSTURE, Arm, ArmState, rotation_error
 
 
 class ImpedanceController:

@@ -1,4 +1,4 @@
-"""The impedance controller's gains (:mod:`assembly_constraints.executor.control.controller`), here without
+"""The impedance controller's gains (:mod:`executor.control.controller`), here without
 PyBullet so the cell description can be read without loading the simulator."""
 
 from __future__ import annotations

@@ -40,14 +40,14 @@ from typing import TYPE_CHECKING, Annotated
 import msgspec
 import numpy as np
 
-from assembly_constraints.bridge.cell_settings import LAYER_NAMES
-from assembly_constraints.bridge.files import write_atomic
-from assembly_constraints.bridge.inputs import duplicate_key, read_bytes, shorten
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.control.admittance import AdmittanceParams
+from bridge.cell_settings import LAYER_NAMES
+from bridge.files import write_atomic
+from bridge.inputs import duplicate_key, read_bytes, shorten
+from executor import ExecutorError
+from executor.control.admittance import AdmittanceParams
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.control.gains import ImpedanceGains
+    from executor.control.gains import ImpedanceGains
 
 AXES = 5
 """The corrected axes: dx, dy, dz [m], rx, ry [rad]."""

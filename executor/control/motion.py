@@ -7,9 +7,9 @@ from typing import Protocol
 
 import numpy as np
 
-from assembly_constraints.executor.control.controller import ImpedanceController
-from assembly_constraints.executor.world.arm import ArmState
-from assembly_constraints.executor.world.scene import TIME_STEP
+from executor.control.controller import ImpedanceController
+from executor.world.arm import ArmState
+from executor.world.scene import TIME_STEP
 
 APPROACH_SETTLE_TIME = 0.02  # [s] held at a start pose before the F/T sensor is tared
 # Log every this many physics steps (10 ms of sim time).
@@ -18,7 +18,7 @@ _ZERO3 = np.zeros(3)
 
 
 class StepLogger(Protocol):
-    """What Motion logs into (:class:`assembly_constraints.executor.rerun_log.AttemptLogger` is one): sim time
+    """What Motion logs into (:class:`executor.rerun_log.AttemptLogger` is one): sim time
     [s], DMP phase, tool tip [m], measured and desired force [N] and torque [Nm]."""
 
     def log_step(self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
@@ -34,7 +34,7 @@ class Motion:
         self.steps = 0
         self.tool_yaw = 0.0
         """[rad] the yaw of the pointing-down tool the transfers last commanded
-        (:mod:`assembly_constraints.executor.assembly.transfer`): where their next move turns it from."""
+        (:mod:`executor.assembly.transfer`): where their next move turns it from."""
 
     @property
     def sim_time(self) -> float:

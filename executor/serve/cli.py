@@ -1,32 +1,32 @@
 """The command line of ``./run.sh executor serve``: its options, the
-:class:`assembly_constraints.bridge.cell_settings.ServeSettings` they build (or the
-``--settings`` document), then :func:`assembly_constraints.executor.serve.node.serve`."""
+:class:`bridge.cell_settings.ServeSettings` they build (or the
+``--settings`` document), then :func:`executor.serve.node.serve`."""
 
 from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cell_settings import (
+from bridge import BridgeError
+from bridge.cell_settings import (
     ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
     cell_settings_of,
     decode_settings,
 )
-from assembly_constraints.bridge.cli_types import (
+from bridge.cli_types import (
     ArgumentParser,
     add_assembly_argument,
     finite_float,
     nonempty_path,
     path_setting,
 )
-from assembly_constraints.bridge.inputs import read_bytes
-from assembly_constraints.bridge.recording.sinks import add_viewer_arguments
-from assembly_constraints.bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments
-from assembly_constraints.executor.backend_plugin import backend_option
-from assembly_constraints.executor.serve.node import serve
+from bridge.inputs import read_bytes
+from bridge.recording.sinks import add_viewer_arguments
+from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments
+from executor.backend_plugin import backend_option
+from executor.serve.node import serve
 
 SETTINGS_HELP = ("the cell's settings as one document: a JSON object (ServeSettings, docs/cell.md), or a file "
                  "holding one; instead of the other options (a session starts its cells so)")

@@ -25,9 +25,9 @@ from pathlib import Path
 
 import zenoh
 
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
-from assembly_constraints.bridge.messages import (
+from bridge.cell_settings import ServeSettings
+from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
+from bridge.messages import (
     MAX_ERROR_CHARS,
     MAX_MESSAGE_BYTES,
     ErrorCode,
@@ -41,11 +41,11 @@ from assembly_constraints.bridge.messages import (
     decode_step_request,
     encode,
 )
-from assembly_constraints.bridge.session import SIGNAL_POLL_S, bound_endpoints, cell_listen, open_session
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.backend_plugin import Backend, InvalidStep, RunActive, UnknownPair
-from assembly_constraints.executor.claim import CellClaim, ClaimLost
-from assembly_constraints.executor.serve.backends import backend_starter
+from bridge.session import SIGNAL_POLL_S, bound_endpoints, cell_listen, open_session
+from executor import ExecutorError
+from executor.backend_plugin import Backend, InvalidStep, RunActive, UnknownPair
+from executor.claim import CellClaim, ClaimLost
+from executor.serve.backends import backend_starter
 
 CACHE_SIZE = 100_000
 """Replies kept for idempotency (oldest dropped first)."""
@@ -213,7 +213,7 @@ def _stop_when_stdin_closes(node: CellNode) -> None:
 
 def serve(settings: ServeSettings) -> int:
     """Serve until SIGTERM/SIGINT; exit code 2 on bad settings, a damaged ``ilc_state`` or when another process
-    serves this cell id (:mod:`assembly_constraints.executor.claim`)."""
+    serves this cell id (:mod:`executor.claim`)."""
     cell_id = check_cell_id(settings.cell_id)
     zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
     start_backend = backend_starter(settings)  # bad settings are refused here, before the session opens

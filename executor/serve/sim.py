@@ -1,6 +1,6 @@
-"""The ``sim`` backend of a cell node: the PyBullet :class:`assembly_constraints.executor.trial.Cell`
+"""The ``sim`` backend of a cell node: the PyBullet :class:`executor.trial.Cell`
 (imported lazily) with the execution layer and uncertainty of its cell settings and its ILC
-state; plan steps in the assembling world of :mod:`assembly_constraints.executor.assembly`
+state; plan steps in the assembling world of :mod:`executor.assembly`
 (kept between the steps of one plan run)."""
 
 from __future__ import annotations
@@ -8,19 +8,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepRequest
-from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
-from assembly_constraints.executor.backend_plugin import StepOutcome
+from bridge.cell_settings import ServeSettings
+from bridge.messages import Evidence, InsertRequest, Result, StepRequest
+from bridge.recording.sinks import NO_VIEWER, Viewer
+from executor.backend_plugin import StepOutcome
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.assembly.step_backend import AssemblyRunner
-    from assembly_constraints.executor.trial import CellSetup
+    from executor.assembly.step_backend import AssemblyRunner
+    from executor.trial import CellSetup
 
 
 def _planner_numbered_logger() -> type:
     """AttemptLogger that logs a trial under the planner's experiment number, if given."""
-    from assembly_constraints.executor.rerun_log import AttemptLogger
+    from executor.rerun_log import AttemptLogger
 
     class PlannerNumbered(AttemptLogger):
         planner_experiment: int | None = None
@@ -43,8 +43,8 @@ class SimBackend:
         atomically after every update, so a resumed session's cell starts from them; with
         ``cell.uncertainty`` ``cell`` plan steps get the Cell's systematic errors, layer
         and an ILC, with ``random`` their own); ``setup``: what the Cell is, its
-        description already decoded (:func:`assembly_constraints.executor.trial.cell_setup`)."""
-        from assembly_constraints.executor.trial import Cell
+        description already decoded (:func:`executor.trial.cell_setup`)."""
+        from executor.trial import Cell
 
         rrd = None if settings.rrd is None else Path(settings.rrd)
         viewer = Viewer(settings.viewer_url)
@@ -59,10 +59,10 @@ class SimBackend:
         self._runner: AssemblyRunner | None = None
 
     def run_step(self, request: StepRequest) -> StepOutcome:
-        from assembly_constraints.executor.assembly.step_backend import AssemblyRunner, step_evidence
+        from executor.assembly.step_backend import AssemblyRunner, step_evidence
 
         if self._runner is None:  # the assembling world is made on the first step
-            from assembly_constraints.executor.assembly.recording import AssemblyRecorder
+            from executor.assembly.recording import AssemblyRecorder
 
             recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
             cell = self._cell

@@ -10,15 +10,15 @@ from pathlib import Path
 
 import clingo
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.inputs import read_bytes
-from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
-from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.backend_plugin import StepOutcome, UnknownPair, check_run, check_step
-from assembly_constraints.executor.world.geometry import load_geometry, passes
+from bridge import BridgeError
+from bridge.assembly import load_assembly
+from bridge.cell_settings import ServeSettings
+from bridge.inputs import read_bytes
+from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from bridge.recording.sinks import NO_VIEWER, Viewer
+from executor import ExecutorError
+from executor.backend_plugin import StepOutcome, UnknownPair, check_run, check_step
+from executor.world.geometry import load_geometry, passes
 
 
 def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
@@ -39,7 +39,7 @@ def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
 class TruthBackend:
     """Answers without simulation, after ``settings.delay_s`` [s]: from the cell's geometry
     (a part passes a hole when its cross-section does,
-    :func:`assembly_constraints.executor.world.geometry.passes`), or from the product's
+    :func:`executor.world.geometry.passes`), or from the product's
     ``sizes.lp`` where it has no ``geometry.toml``; logs every outcome to Rerun if
     ``settings.rrd`` or ``settings.viewer_url`` is given; a hole of ``settings.block_holes``
     refuses every plan step."""
@@ -67,7 +67,7 @@ class TruthBackend:
         self._placed: dict[str, float] = {}  # its placed parts
         self._log = None
         if rrd is not None or viewer != NO_VIEWER:
-            from assembly_constraints.executor.rerun_log import open_recording
+            from executor.rerun_log import open_recording
 
             self._log = open_recording(settings.recording_id or str(uuid.uuid4()), rrd, viewer)
             self._entity = f"executor/{cell_id}/outcome"
@@ -92,8 +92,8 @@ class TruthBackend:
         another part of the product is always placed (skill ``manual`` for one placed by
         hand). One plan run at a time; a step of another run, or one the product does not
         allow, is refused before anything changes
-        (:func:`assembly_constraints.executor.backend_plugin.check_run`,
-        :func:`assembly_constraints.executor.backend_plugin.check_step`)."""
+        (:func:`executor.backend_plugin.check_run`,
+        :func:`executor.backend_plugin.check_step`)."""
         check_run(self._run, request.assembly, self._parts, self._placed)
         fresh = request.assembly != self._run
         check_step(request.part, request.hole, parts=self._parts, pegs=self._pegs, holes=self._holes,

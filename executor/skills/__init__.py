@@ -2,4 +2,4 @@
 wrench and phase stopping (:mod:`.dmp`), the stochastic hole search (:mod:`.search`), the
 insertion proper (:mod:`.insertion`), the wiggle exception strategy (:mod:`.wiggle`) and
 the scripted kinesthetic teaching that records the DMPs (:mod:`.teach`).  Skills move the
-arm through :class:`assembly_constraints.executor.control.motion.Motion`."""
+arm through :class:`executor.control.motion.Motion`."""

@@ -26,12 +26,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from movement_primitives.dmp import CartesianDMP
 
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.inputs import read_text
-from assembly_constraints.executor import ExecutorError
+from bridge.files import make_folder, write_atomic
+from bridge.inputs import read_text
+from executor import ExecutorError
 
 if TYPE_CHECKING:
-    from assembly_constraints.executor.world.geometry import CellGeometry
+    from executor.world.geometry import CellGeometry
 
 # Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
 ROLLOUT_DT = 0.005

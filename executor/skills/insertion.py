@@ -12,16 +12,16 @@ import msgspec
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.control.admittance import Admittance
-from assembly_constraints.executor.control.detector import Detector
-from assembly_constraints.executor.control.ilc import ExecutionLayer, ExecutionTrace
-from assembly_constraints.executor.control.motion import Motion
-from assembly_constraints.executor.skills.dmp import PhaseClock, Skill
-from assembly_constraints.executor.skills.search import SINK_DEPTH
-from assembly_constraints.executor.skills.wiggle import wiggle
-from assembly_constraints.executor.world.arm import turn_quats_z, turn_z
-from assembly_constraints.executor.world.scene import TIME_STEP
+from executor.cell_description import CellDescription
+from executor.control.admittance import Admittance
+from executor.control.detector import Detector
+from executor.control.ilc import ExecutionLayer, ExecutionTrace
+from executor.control.motion import Motion
+from executor.skills.dmp import PhaseClock, Skill
+from executor.skills.search import SINK_DEPTH
+from executor.skills.wiggle import wiggle
+from executor.world.arm import turn_quats_z, turn_z
+from executor.world.scene import TIME_STEP
 
 # The insertion gives up when phase stopping has stretched it beyond this many τ.
 TIMEOUT_FACTOR = 3.0
@@ -73,7 +73,7 @@ class InsertionTask:
     was taught in); ``yaw_compliant``: the admittance also turns the part about the tool
     axis (a part aligned to a rect hole's estimated yaw, :func:`needs_yaw_compliance`);
     ``correction`` (bins, 5): the pair's ILC pose correction over the phase (dx, dy, dz
-    [m], rx, ry [rad], :mod:`assembly_constraints.executor.control.ilc`), added to the
+    [m], rx, ry [rad], :mod:`executor.control.ilc`), added to the
     command; ``wiggle_enabled``: the wiggle exception strategy may run on a jam."""
 
     hole_origin: np.ndarray

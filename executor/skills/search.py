@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
-from assembly_constraints.executor.control.motion import Motion
-from assembly_constraints.executor.world.scene import TIME_STEP
+from executor.control.admittance import Admittance, AdmittanceParams
+from executor.control.motion import Motion
+from executor.world.scene import TIME_STEP
 
 SINK_DEPTH = 0.0005
 """[m] below the surface: the tip is in a hole's entry chamfer."""

@@ -10,13 +10,13 @@ replay ends is p_goal.  Step 3, the check: p_goal must lie within the cell's goa
 of the demonstration's goal (0.5 mm above the bottom); a part that does not pass its
 ``demo_hole`` stops on the entry instead, and its teaching is refused (ExecutorError naming
 the part, the hole and the end error), no skill written.  The skill records what it was
-taught on (:class:`assembly_constraints.executor.skills.dmp.TaughtOn`).
+taught on (:class:`executor.skills.dmp.TaughtOn`).
 
 Poses, wrenches and p_goal are stored in the hole's frame (its
 origin at the centre of the hole's entry, at the hole's own height, turned by the hole's
 yaw), so the skill runs in a hole of any yaw and at any height; in a hole of another depth
 its goal moves with the bottom, by the depth its record gives
-(:meth:`assembly_constraints.executor.skills.dmp.Skill.in_hole`).
+(:meth:`executor.skills.dmp.Skill.in_hole`).
 ``./run.sh executor teach`` rebuilds ``data/<assembly>/demonstrations/<shape>.json``: every
 shape is taught first, and the files are written only when all were taught.
 """
@@ -28,10 +28,10 @@ from typing import Protocol
 
 import numpy as np
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.control.detector import Thresholds
-from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, Motion
-from assembly_constraints.executor.skills.dmp import (
+from executor import ExecutorError
+from executor.control.detector import Thresholds
+from executor.control.motion import APPROACH_SETTLE_TIME, Motion
+from executor.skills.dmp import (
     PhaseClock,
     Skill,
     TaughtOn,
@@ -40,10 +40,10 @@ from assembly_constraints.executor.skills.dmp import (
     save_skill,
     xyzw_to_wxyz,
 )
-from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
-from assembly_constraints.executor.world.assets import regenerate_assets
-from assembly_constraints.executor.world.geometry import CellGeometry, fit_pose
-from assembly_constraints.executor.world.scene import TIME_STEP, Scene
+from executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
+from executor.world.assets import regenerate_assets
+from executor.world.geometry import CellGeometry, fit_pose
+from executor.world.scene import TIME_STEP, Scene
 
 DEMO_DURATION = 0.8  # [s]
 DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole
@@ -51,7 +51,7 @@ DEMO_CLEARANCE = 0.0005  # [m] left between the part and the hole bottom at the 
 
 
 class TeachingCell(Protocol):
-    """What teaching needs of a cell (:class:`assembly_constraints.executor.trial.Cell` is
+    """What teaching needs of a cell (:class:`executor.trial.Cell` is
     one): its geometry and thresholds, and a part put in the hand (:meth:`motion_for`,
     which sets ``scene`` to the PyBullet client holding it)."""
 

@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from assembly_constraints.executor.control.motion import Motion
-from assembly_constraints.executor.world.arm import cross, quat_to_matrix
-from assembly_constraints.executor.world.scene import TIME_STEP
+from executor.control.motion import Motion
+from executor.world.arm import cross, quat_to_matrix
+from executor.world.scene import TIME_STEP
 
 AMPLITUDE = 10.0  # [N]
 FREQUENCY = 2.0  # [Hz]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
-from assembly_constraints.executor import ExecutorError
+from executor import ExecutorError
 
 N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
@@ -62,7 +62,7 @@ def aligned_yaw(part_kind: str, hole_kind: str, yaw: float) -> float:
     ``yaw`` reduced by the symmetry of the pair (a quarter turn when either is square,
     a half turn for rect in rect, a whole turn with a polygon: its ``yaw`` includes the
     turn the polygon relation found,
-    :func:`assembly_constraints.executor.world.geometry.fit_pose`) into the half period
+    :func:`executor.world.geometry.fit_pose`) into the half period
     around 0, the smallest turn of the wrist."""
     if "round" in (part_kind, hole_kind):
         return 0.0

@@ -3,7 +3,7 @@
 ``<assembly>/assets/`` (plate mesh, part URDFs, a mesh part's eroded convex pieces, the URDF of a
 cover or head simulated from its mesh) is
 generated from ``geometry.toml`` and ``assembly.toml`` by
-:func:`assembly_constraints.executor.world.geometry.write_assets`. The folder records the
+:func:`executor.world.geometry.write_assets`. The folder records the
 SHA-256 of the values it was made from (``assets/sources.sha256``: the ``[plate]`` table,
 every hole (its entry height and depth where they are its own) and part as loaded, as
 canonical JSON, a part's, cover's, head's or the base's ``mesh`` with the digest of its
@@ -25,11 +25,11 @@ from pathlib import Path
 
 import msgspec
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.files import write_atomic
-from assembly_constraints.bridge.product import Plate
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.world.geometry import (
+from bridge import BridgeError
+from bridge.files import write_atomic
+from bridge.product import Plate
+from executor import ExecutorError
+from executor.world.geometry import (
     CellGeometry,
     HoleSpec,
     PartSpec,

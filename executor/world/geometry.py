@@ -11,7 +11,7 @@ holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square a
 rectangular holes exact; a hole with a yaw has its whole boss turned by it about the
 hole's centre.  Parts are exact primitive shapes (cylinder with
 ``URDF_USE_IMPLICIT_CYLINDER``, box), or, with a ``mesh``, their own mesh colliding as its
-convex pieces (:mod:`assembly_constraints.executor.world.meshes`); a base with a ``mesh``
+convex pieces (:mod:`executor.world.meshes`); a base with a ``mesh``
 is that mesh as a static concave triangle mesh instead of the plate.
 
 Cross-sections (``kind``): ``round`` (``size`` = diameter), ``square`` (``size`` = side)
@@ -20,7 +20,7 @@ axis), with an optional ``corner`` radius, or ``polygon`` (an ``outline``), all 
 hole's ``yaw`` [°] turns its x axis about z (counter-clockwise from the cell's x axis).
 :func:`passes` compares aligned cross-sections: the skills turn the part to the hole's
 (measured) yaw, so the yaw never changes whether a part fits; with a polygon the polygon
-relation (:mod:`assembly_constraints.executor.world.polygon_fit`) finds the yaw and
+relation (:mod:`executor.world.polygon_fit`) finds the yaw and
 shift, and the skills add them (:func:`fit_pose`).
 ``write_assets`` regenerates ``data/<assembly>/assets/`` deterministically (the URDFs byte
 for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
@@ -38,9 +38,9 @@ import numpy as np
 import pybullet_data
 import shapely
 
-from assembly_constraints.bridge.assembly import Assembly, assembly_of, resolve_assembly_folder
-from assembly_constraints.bridge.files import make_folder, write_atomic
-from assembly_constraints.bridge.product import (
+from bridge.assembly import Assembly, assembly_of, resolve_assembly_folder
+from bridge.files import make_folder, write_atomic
+from bridge.product import (
     GeometryFile,
     Gripper,
     HoleShape,
@@ -51,9 +51,9 @@ from assembly_constraints.bridge.product import (
     hole_level,
     load_product_description,
 )
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.world.meshes import (
+from executor import ExecutorError
+from executor.cell_description import CellDescription
+from executor.world.meshes import (
     MeshBody,
     MeshFiles,
     eroded_pieces_text,
@@ -61,7 +61,7 @@ from assembly_constraints.executor.world.meshes import (
     mesh_link_xml,
     mesh_urdf_text,
 )
-from assembly_constraints.executor.world.polygon_fit import (
+from executor.world.polygon_fit import (
     OutlineError,
     PolygonFit,
     circle,
@@ -169,9 +169,9 @@ class CellGeometry:
 
 def load_geometry(assembly: str = "cranfield", description: CellDescription | None = None) -> CellGeometry:
     """The cell geometry of an assembly folder (a name under ``data/`` or a path): its
-    product description (:func:`assembly_constraints.bridge.product.load_product_description`, checked as a
+    product description (:func:`bridge.product.load_product_description`, checked as a
     whole) with the gripper of ``geometry.toml`` or else of the cell ``description``
-    (default :class:`assembly_constraints.executor.cell_description.CellDescription`); BridgeError naming the
+    (default :class:`executor.cell_description.CellDescription`); BridgeError naming the
     file, table and key."""
     folder = resolve_assembly_folder(assembly)
     product = load_product_description(folder)
@@ -295,7 +295,7 @@ def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
 
 
 def section_fit(part: Section, hole: Section) -> PolygonFit:
-    """How the part's section sits in the hole's (:mod:`assembly_constraints.executor.world.polygon_fit`):
+    """How the part's section sits in the hole's (:mod:`executor.world.polygon_fit`):
     the room [m], the part's yaw [°] and offset [m] in the hole's frame; a round side's
     closed forms, the search otherwise; the exact rules of :func:`margin` (room half the
     margin, yaw 0, centred) when neither side is a polygon."""
@@ -311,7 +311,7 @@ def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
     """The part's yaw [rad] in the hole's frame and its origin's offset (x, y) [m] from the
     hole's position in the cell's axes where the polygon relation passes it (:func:`section_fit`);
     (0, 0) for pairs of round, square and rect sections (the skill aligns those itself,
-    :func:`assembly_constraints.executor.world.arm.aligned_yaw`)."""
+    :func:`executor.world.arm.aligned_yaw`)."""
     if "polygon" not in (part.kind, hole.kind):
         return 0.0, np.zeros(2)
     found = section_fit(part, hole)
@@ -351,7 +351,7 @@ def sizes_lp_text(assembly: str) -> str:
         return " ".join(f"{symbol}." for symbol in symbols)
 
     lines = [f"% {geometry.folder.name}: which part fits which hole (closed world), generated from geometry.toml",
-             "% by assembly_constraints.executor.world.geometry.passes; do not edit, regenerate with",
+             "% by executor.world.geometry.passes; do not edit, regenerate with",
              f"% ./run.sh executor sizes --assembly {geometry.folder.name} --out "
              f"data/{geometry.folder.name}/sizes.lp",
              facts([clingo.Function("part", [clingo.Function(pid)]) for pid in pegs]),

@@ -24,8 +24,8 @@ import trimesh
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
-from assembly_constraints.bridge.product import Mesh
-from assembly_constraints.executor import ExecutorError
+from bridge.product import Mesh
+from executor import ExecutorError
 
 URDF_HULL_MARGIN = 0.001
 """How much PyBullet's URDF importer inflates each convex hull of a link [m]."""

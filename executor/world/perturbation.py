@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 import msgspec
 import numpy as np
 
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor.evidence import AttemptSetup
+from bridge.cell_settings import Magnitudes
+from executor.evidence import AttemptSetup
 
 
 def random_only(magnitudes: Magnitudes) -> Magnitudes:

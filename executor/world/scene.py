@@ -17,11 +17,11 @@ import numpy as np
 import pybullet as pb
 import pybullet_data
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.world import TIME_STEP
-from assembly_constraints.executor.world.arm import turn_z, yaw_quat
-from assembly_constraints.executor.world.assets import current_assets
-from assembly_constraints.executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files, peg_body
+from executor import ExecutorError
+from executor.world import TIME_STEP
+from executor.world.arm import turn_z, yaw_quat
+from executor.world.assets import current_assets
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files, peg_body
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)

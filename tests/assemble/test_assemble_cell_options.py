@@ -9,14 +9,14 @@ from collections.abc import Callable
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.cli import assembly_settings, build_parser
-from assembly_constraints.asp.assemble.settings import assembling_cell_settings
-from assembly_constraints.asp.bench.assemble_plans import build_parser as bench_parser
-from assembly_constraints.asp.session.cells import CellProcess
-from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, ServeSettings, cell_settings_of
-from assembly_constraints.executor.serve import build_parser as serve_parser
-from assembly_constraints.executor.serve import serve_settings_of
+from asp import PlannerError
+from asp.assemble.cli import assembly_settings, build_parser
+from asp.assemble.settings import assembling_cell_settings
+from asp.bench.assemble_plans import build_parser as bench_parser
+from asp.session.cells import CellProcess
+from bridge.cell_settings import DEFAULT_CELL, ServeSettings, cell_settings_of
+from executor.serve import build_parser as serve_parser
+from executor.serve import serve_settings_of
 
 
 def _checked(parser: ArgumentParser, argv: list[str]):

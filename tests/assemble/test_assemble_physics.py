@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from assembly_constraints.bridge.recording.reader import column_values, read_recording
+from bridge.recording.reader import column_values, read_recording
 
 STEP_KEYS = {"part", "hole", "skill", "outcome", "attempts", "duration_s", "max_force_dev"}
 

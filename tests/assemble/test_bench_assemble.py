@@ -7,11 +7,11 @@ import json
 
 import pytest
 
-from assembly_constraints.asp.assemble.cli import truth_facts
-from assembly_constraints.asp.bench.assemble_plans import draw_plans, summary
-from assembly_constraints.asp.plans.plans import check_plan
-from assembly_constraints.asp.precedence.relation import true_relation
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.assemble.cli import truth_facts
+from asp.bench.assemble_plans import draw_plans, summary
+from asp.plans.plans import check_plan
+from asp.precedence.relation import true_relation
+from bridge.assembly import load_assembly
 
 
 def test_drawn_plans_pass_the_checker_and_the_seed_reproduces_them() -> None:

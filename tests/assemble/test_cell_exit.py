@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.assemble.driver import assembling_cell
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import ServeSettings
+from asp import PlannerError
+from asp.assemble.driver import assembling_cell
+from bridge.assembly import load_assembly
+from bridge.cell_settings import ServeSettings
 
 CRASHING_BACKEND = '''
 import os

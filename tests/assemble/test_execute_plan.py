@@ -1,4 +1,4 @@
-"""The planner's side of plan execution (assembly_constraints.asp.assemble): the step loop, the no_fit
+"""The planner's side of plan execution (asp.assemble): the step loop, the no_fit
 observation of a failed step, re-planning from the current state, the stop with exit
 code 3; against a fake cell that answers from the true sizes and a set of blocked holes."""
 
@@ -9,12 +9,12 @@ import re
 
 import pytest
 
-from assembly_constraints.asp.assemble.cli import truth_facts
-from assembly_constraints.asp.assemble.execute import AssemblyStopped, execute
-from assembly_constraints.asp.plans.plans import Plan, PlanStep, check_plan, plans
-from assembly_constraints.asp.precedence.relation import true_relation
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.messages import StepEvidence, StepReply
+from asp.assemble.cli import truth_facts
+from asp.assemble.execute import AssemblyStopped, execute
+from asp.plans.plans import Plan, PlanStep, check_plan, plans
+from asp.precedence.relation import true_relation
+from bridge.assembly import load_assembly
+from bridge.messages import StepEvidence, StepReply
 from tests.conftest import ROOT
 
 

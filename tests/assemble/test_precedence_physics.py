@@ -7,8 +7,8 @@ from contextlib import contextmanager
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.bench.precedence_physics import (
+from asp import PlannerError
+from asp.bench.precedence_physics import (
     SequenceRun,
     edge_runs,
     edge_sequence,
@@ -18,11 +18,11 @@ from assembly_constraints.asp.bench.precedence_physics import (
     verdict,
     violated_pairs,
 )
-from assembly_constraints.asp.plans.plans import PlanStep
-from assembly_constraints.asp.precedence.relation import reduction, true_relation
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.messages import StepEvidence, StepReply
+from asp.plans.plans import PlanStep
+from asp.precedence.relation import reduction, true_relation
+from bridge.assembly import load_assembly
+from bridge.cell_settings import ServeSettings
+from bridge.messages import StepEvidence, StepReply
 
 CRANFIELD = load_assembly("cranfield")
 RELATION = true_relation(CRANFIELD)
@@ -128,7 +128,7 @@ def test_a_cell_error_ends_the_run_with_the_message() -> None:
 def test_a_peg_before_the_back_plate_is_detected_in_physics() -> None:
     """Edge bp->p1 in a real cell (PyBullet over Zenoh), up to its breaking step: p1 let go
     in r1 while the back plate still waits on the tray falls, and the step says no_fit."""
-    from assembly_constraints.asp.assemble.driver import assembling_cell
+    from asp.assemble.driver import assembling_cell
 
     (violating, _) = edge_runs(RELATION, {"p1": "r1"} | {p: None for p in RELATION.parts if p != "p1"},
                                [("bp", "p1")])

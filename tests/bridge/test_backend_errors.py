@@ -9,12 +9,12 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellRefused, request_insert
-from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
-from assembly_constraints.executor.backend_plugin import CellContext
+from asp.session.cells import CellProcess, start_cell
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, CellRefused, request_insert
+from bridge.messages import Evidence, InsertRequest, Result
+from bridge.session import free_loopback_endpoint, open_session
+from executor.backend_plugin import CellContext
 
 pytestmark = pytest.mark.timeout(60)
 

@@ -11,9 +11,9 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import (
+from asp.session.cells import CellProcess, start_cell
+from bridge.cell_settings import ServeSettings
+from bridge.client import (
     CellConflict,
     CellDirectory,
     CellPool,
@@ -24,8 +24,8 @@ from assembly_constraints.bridge.client import (
     request_insert,
     send_insert,
 )
-from assembly_constraints.bridge.keys import alive_key
-from assembly_constraints.bridge.messages import (
+from bridge.keys import alive_key
+from bridge.messages import (
     MAX_MESSAGE_BYTES,
     ErrorReply,
     InsertReply,
@@ -35,8 +35,8 @@ from assembly_constraints.bridge.messages import (
     decode_request,
     encode,
 )
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
-from assembly_constraints.executor.serve.node import QUEUE_SIZE
+from bridge.session import free_loopback_endpoint, open_session
+from executor.serve.node import QUEUE_SIZE
 
 pytestmark = pytest.mark.timeout(60)
 

@@ -1,4 +1,4 @@
-"""Atomic output files (assembly_constraints.bridge.files): whole or not at all, one-line errors naming the path."""
+"""Atomic output files (bridge.files): whole or not at all, one-line errors naming the path."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.files import check_writable, make_folder, write_atomic, write_figure
+from bridge import BridgeError
+from bridge.files import check_writable, make_folder, write_atomic, write_figure
 from tests._files_helpers import leftovers, run_with_file_limit
 
 
@@ -58,8 +58,8 @@ def test_bad_output_paths_are_one_line_errors(tmp_path: Path, name: str, reason:
 def test_a_full_disk_leaves_the_old_file_whole(tmp_path: Path) -> None:
     target = tmp_path / "facts.lp"
     target.write_text("old.\n")
-    program = ("import sys; from assembly_constraints.bridge.files import write_atomic\n"
-               "from assembly_constraints.bridge import BridgeError\n"
+    program = ("import sys; from bridge.files import write_atomic\n"
+               "from bridge import BridgeError\n"
                "try:\n    write_atomic(sys.argv[1], 'x' * 100_000)\n"
                "except BridgeError as exc:\n    print(exc)\n")
     done = run_with_file_limit([sys.executable, "-c", program, str(target)], limit=10_000)

@@ -5,9 +5,9 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.keys import alive_key, cell_of_alive_key, insert_key
-from assembly_constraints.bridge.messages import (
+from bridge import BridgeError
+from bridge.keys import alive_key, cell_of_alive_key, insert_key
+from bridge.messages import (
     MAX_MESSAGE_BYTES,
     ErrorReply,
     Evidence,
@@ -72,7 +72,7 @@ def test_keys() -> None:
 
 
 def test_step_messages_round_trip_and_need_version_3() -> None:
-    from assembly_constraints.bridge.messages import StepEvidence, StepReply, StepRequest, decode_step_request
+    from bridge.messages import StepEvidence, StepReply, StepRequest, decode_step_request
 
     request = StepRequest(id="run-7-2", assembly="run-7", step=2, part="sp", hole=None, seed=3)
     assert decode_step_request(encode(request)) == request
@@ -93,7 +93,7 @@ def test_step_messages_round_trip_and_need_version_3() -> None:
 def test_ids_that_break_clingo_are_malformed(bad: str) -> None:
     """An id is an ASCII ASP constant: not the keyword ``not``, no trailing newline, no
     non-ASCII letter (clingo panics on one), no lone surrogate."""
-    from assembly_constraints.bridge.messages import decode_step_request
+    from bridge.messages import decode_step_request
 
     step = msgspec.json.encode({"kind": "step", "id": "a", "assembly": "r", "step": 1, "part": "p1", "hole": "r1"})
     for field in ("part", "hole"):
@@ -110,7 +110,7 @@ def test_ids_that_break_clingo_are_malformed(bad: str) -> None:
 def test_a_key_given_twice_is_malformed() -> None:
     """msgspec keeps the last of two equal keys: a message with one is refused instead, so
     that a reader of the first one never sees another request than the cell runs."""
-    from assembly_constraints.bridge.messages import decode_step_request
+    from bridge.messages import decode_step_request
 
     step = b'{"kind":"step","id":"a","assembly":"r","step":1,"part":"p1","hole":"r1","hole":"br"}'
     with pytest.raises(MessageError, match="the key 'hole' appears twice") as refused:

@@ -19,11 +19,11 @@ from cryptography.hazmat.primitives import hashes, serialization
 from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import NameOID
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_insert
-from assembly_constraints.bridge.messages import InsertRequest
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from asp.session.cells import CellProcess, start_cell
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, CellTimeout, request_insert
+from bridge.messages import InsertRequest
+from bridge.session import free_loopback_endpoint, open_session
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(120)]
 

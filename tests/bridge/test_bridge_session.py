@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.session import free_loopback_endpoint, make_config, open_session
+from bridge import BridgeError
+from bridge.session import free_loopback_endpoint, make_config, open_session
 
 
 def test_default_config_is_a_peer_without_multicast_listening_nowhere() -> None:

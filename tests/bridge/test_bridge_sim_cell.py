@@ -6,17 +6,17 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import start_cell
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, request_insert
-from assembly_constraints.bridge.messages import InsertRequest
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from asp.session.cells import start_cell
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, request_insert
+from bridge.messages import InsertRequest
+from bridge.session import free_loopback_endpoint, open_session
 
 
 @pytest.mark.timeout(90)
 @pytest.mark.slow
 def test_sim_cell_inserts_a_fitting_peg_and_logs_it(tmp_path: Path) -> None:
-    from assembly_constraints.bridge.recording.reader import column_values, read_recording
+    from bridge.recording.reader import column_values, read_recording
 
     endpoint = free_loopback_endpoint()
     rrd = tmp_path / "c1.rrd"

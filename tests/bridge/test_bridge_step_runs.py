@@ -11,14 +11,14 @@ from contextlib import contextmanager
 import pytest
 import zenoh
 
-from assembly_constraints.asp.assemble.cli import truth_facts
-from assembly_constraints.asp.plans.plans import plans
-from assembly_constraints.asp.session.cells import start_cell
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellRefused, request_step
-from assembly_constraints.bridge.messages import StepReply, StepRequest
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from asp.assemble.cli import truth_facts
+from asp.plans.plans import plans
+from asp.session.cells import start_cell
+from bridge.assembly import load_assembly
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, CellRefused, request_step
+from bridge.messages import StepReply, StepRequest
+from bridge.session import free_loopback_endpoint, open_session
 
 
 @contextmanager

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import start_cell
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import request_insert
-from assembly_constraints.bridge.messages import (
+from asp.session.cells import start_cell
+from bridge.cell_settings import ServeSettings
+from bridge.client import request_insert
+from bridge.messages import (
     MAX_COUNT,
     MAX_REQUEST_ID,
     ErrorReply,
@@ -25,7 +25,7 @@ from assembly_constraints.bridge.messages import (
     decode_request,
     encode,
 )
-from assembly_constraints.bridge.protocol_schema import MESSAGES, schema
+from bridge.protocol_schema import MESSAGES, schema
 from tests.bridge.test_bridge_cells import network, raw_query  # noqa: F401  (the fixture)
 
 BOUNDED_PATTERN = re.compile(r"^\^[^*+]*\{\d+,\d+\}[^*+]*\$")

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge.progress import progress
+from bridge.progress import progress
 
 
 class Terminal(io.StringIO):

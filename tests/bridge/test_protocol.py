@@ -12,12 +12,12 @@ from pathlib import Path
 import msgspec
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.messages import ErrorReply, Evidence, InsertReply, InsertRequest, encode
-from assembly_constraints.bridge.product import ID_PATTERN
-from assembly_constraints.bridge.protocol_schema import MESSAGES, drift, main, schemas
-from assembly_constraints.bridge.session import free_loopback_endpoint
+from asp.session.cells import CellProcess, start_cell
+from bridge.cell_settings import ServeSettings
+from bridge.messages import ErrorReply, Evidence, InsertReply, InsertRequest, encode
+from bridge.product import ID_PATTERN
+from bridge.protocol_schema import MESSAGES, drift, main, schemas
+from bridge.session import free_loopback_endpoint
 from tests.conftest import ROOT, child_env
 
 PUBLISHED = ROOT / "docs" / "protocol"

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import rerun as rr
 
-from assembly_constraints.bridge.recording.compaction import compact_recording
-from assembly_constraints.bridge.recording.layout import APPLICATION_ID, Contents, blueprint
-from assembly_constraints.bridge.recording.reader import blueprint_origins, chunk_count, column_values, read_recording
+from bridge.recording.compaction import compact_recording
+from bridge.recording.layout import APPLICATION_ID, Contents, blueprint
+from bridge.recording.reader import blueprint_origins, chunk_count, column_values, read_recording
 
 
 def _many_chunk_recording(path: Path, rows: int = 60) -> None:

@@ -1,6 +1,6 @@
 """A recording with a torn tail (its writer died mid-message: a full disk, a kill) is read
 up to its last whole message, with a warning naming the file, by ``view RUN --print`` and
-by :mod:`assembly_constraints.bridge.recording.reader`."""
+by :mod:`bridge.recording.reader`."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.recording.reader import column_values, read_recording
+from bridge import BridgeError
+from bridge.recording.reader import column_values, read_recording
 
 
 @pytest.fixture(scope="module")

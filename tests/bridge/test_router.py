@@ -15,12 +15,12 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import LineProcess, start_cell
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, request_insert
-from assembly_constraints.bridge.messages import InsertRequest
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from asp.session.cells import LineProcess, start_cell
+from bridge import BridgeError
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, request_insert
+from bridge.messages import InsertRequest
+from bridge.session import free_loopback_endpoint, open_session
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # router and cell processes, ~5 s
 

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from assembly_constraints.cli import main
-from assembly_constraints.executor.cad.cli import run_import
-from assembly_constraints.executor.cad.derive import Derived
+from executor.cad.cli import run_import
+from executor.cad.derive import Derived
 
 
 @pytest.fixture(scope="session")

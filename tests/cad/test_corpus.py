@@ -25,9 +25,9 @@ from typing import Any
 import clingo
 import pytest
 
-from assembly_constraints.executor.cad.cli import run_import
-from assembly_constraints.executor.cad.sweep import opposite
-from assembly_constraints.executor.world.geometry import load_geometry
+from executor.cad.cli import run_import
+from executor.cad.sweep import opposite
+from executor.world.geometry import load_geometry
 
 CORPUS = Path(__file__).parent / "corpus"
 FEATURE_REACH_MM = 2.0

@@ -18,14 +18,14 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.assembly.product import MAX_COVER_BOXES, load_product
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.cad.covers import GRIP_MARGIN
-from assembly_constraints.executor.cad.derive import Derived
-from assembly_constraints.executor.cad.write import DENSITY
-from assembly_constraints.executor.cell_description import load_cell_description
-from assembly_constraints.executor.world.meshes import read_objects
+from executor import ExecutorError
+from executor.assembly.product import MAX_COVER_BOXES, load_product
+from executor.assembly.world import AssemblyWorld
+from executor.cad.covers import GRIP_MARGIN
+from executor.cad.derive import Derived
+from executor.cad.write import DENSITY
+from executor.cell_description import load_cell_description
+from executor.world.meshes import read_objects
 from tests.cad.test_import import _fits
 from tests.cad.test_mesh_import import _box
 from tests.conftest import ROOT, Runner

@@ -12,10 +12,10 @@ import math
 import pytest
 import trimesh
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.derive import derive
-from assembly_constraints.executor.cad.parts import CadPart
-from assembly_constraints.executor.cad.sweep import cylinder_faces
+from executor import ExecutorError
+from executor.cad.derive import derive
+from executor.cad.parts import CadPart
+from executor.cad.sweep import cylinder_faces
 
 MM = 1e-3
 

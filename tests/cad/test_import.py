@@ -14,14 +14,14 @@ import clingo
 import pytest
 import trimesh
 
-from assembly_constraints.asp.precedence.relation import load_relation
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.relation import load_relation
 from assembly_constraints.cli import main
-from assembly_constraints.executor.cad.cli import run_import
-from assembly_constraints.executor.cad.derive import Derived, derive
-from assembly_constraints.executor.cad.parts import load_meshes
-from assembly_constraints.executor.cad.write import margins
-from assembly_constraints.executor.world.geometry import load_geometry
+from bridge.assembly import load_assembly
+from executor.cad.cli import run_import
+from executor.cad.derive import Derived, derive
+from executor.cad.parts import load_meshes
+from executor.cad.write import margins
+from executor.world.geometry import load_geometry
 
 SIZE_BOUND = 5e-5
 """Imported sizes within this of the nominal ones [m] (0.05 mm)."""

@@ -14,10 +14,10 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
-from assembly_constraints.executor.skills.teach import DEMO_CLEARANCE, teach_all
-from assembly_constraints.executor.trial import Cell
-from assembly_constraints.executor.world.geometry import load_geometry
-from assembly_constraints.executor.world.scene import Scene
+from executor.skills.teach import DEMO_CLEARANCE, teach_all
+from executor.trial import Cell
+from executor.world.geometry import load_geometry
+from executor.world.scene import Scene
 from tests.cad.test_import import SIZE_BOUND, _box
 
 LEVELS = {"stepped": ((0.020, 0.015), (0.030, 0.012)), "flat": ((0.020, 0.015), (0.020, 0.010))}

@@ -22,9 +22,9 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cad.parts import MAX_TRIANGLES, check_parts, load_meshes
-from assembly_constraints.executor.cad.step import load_step
+from executor import ExecutorError
+from executor.cad.parts import MAX_TRIANGLES, check_parts, load_meshes
+from executor.cad.step import load_step
 from tests.conftest import CLI_MODULE, child_env, python_argv
 
 

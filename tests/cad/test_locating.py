@@ -8,8 +8,8 @@ from __future__ import annotations
 import pytest
 import trimesh
 
-from assembly_constraints.executor.cad.derive import derive
-from assembly_constraints.executor.cad.parts import CadPart
+from executor.cad.derive import derive
+from executor.cad.parts import CadPart
 
 MM = 1e-3
 

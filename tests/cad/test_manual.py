@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge.assembly import load_assembly
 from assembly_constraints.cli import main
-from assembly_constraints.executor.assembly.product import load_product
+from bridge.assembly import load_assembly
+from executor.assembly.product import load_product
 from tests.cad.test_covers import _pegs_and_plate
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner

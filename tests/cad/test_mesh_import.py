@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from assembly_constraints.bridge.product import CONVEX_HEADER
 from assembly_constraints.cli import main
-from assembly_constraints.executor.cad.sections import edge_distance, slice_loops
-from assembly_constraints.executor.cad.write import CELL_DEFLECTION
-from assembly_constraints.executor.world.geometry import load_geometry
-from assembly_constraints.executor.world.meshes import read_objects
+from bridge.product import CONVEX_HEADER
+from executor.cad.sections import edge_distance, slice_loops
+from executor.cad.write import CELL_DEFLECTION
+from executor.world.geometry import load_geometry
+from executor.world.meshes import read_objects
 
 POSE_BOUND_MM = 2.0
 """An assembled part is within this of its goal [mm] (the bar of the assembling cell)."""
@@ -69,7 +69,7 @@ def test_a_flanged_peg_is_its_own_mesh_and_its_convex_pieces(tmp_path: Path) -> 
 @pytest.mark.slow
 def test_clingo_still_prints_symbols_after_the_decomposition_is_loaded() -> None:
     # CoACD's library loaded before clingo's makes printing a clingo symbol throw std::bad_cast.
-    code = ("import assembly_constraints.executor.cad.convex, clingo; "
+    code = ("import executor.cad.convex, clingo; "
             "print(clingo.Function('a', [clingo.Number(1)]))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False,
                           cwd=Path(__file__).resolve().parents[2])

@@ -15,11 +15,11 @@ import pytest
 import shapely
 import trimesh
 
-from assembly_constraints.executor.cad.cli import report
-from assembly_constraints.executor.cad.derive import derive
-from assembly_constraints.executor.cad.parts import load_meshes
-from assembly_constraints.executor.cad.sections import Shape2D
-from assembly_constraints.executor.cad.write import (
+from executor.cad.cli import report
+from executor.cad.derive import derive
+from executor.cad.parts import load_meshes
+from executor.cad.sections import Shape2D
+from executor.cad.write import (
     Settings,
     _section_lines,
     assembly_text,
@@ -27,7 +27,7 @@ from assembly_constraints.executor.cad.write import (
     nominal_text,
     sizes_text,
 )
-from assembly_constraints.executor.world.geometry import Section, margin
+from executor.world.geometry import Section, margin
 
 GAP = 0.04
 """The hub's outline is the shaft's offset by this [mm] (the designed radial gap)."""

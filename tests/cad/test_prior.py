@@ -84,9 +84,9 @@ def test_an_assembly_folder_s_own_geometric_precedence_is_the_session_s_prior(tm
     """:func:`learn_for_assembly` (what a session learns its precedence with): the folder's
     ``geometric_precedence.lp`` alone without demonstrations, refined by its ``demos.txt``,
     and a demonstration that breaks it refused naming its line."""
-    from assembly_constraints.asp import PlannerError
-    from assembly_constraints.asp.precedence.learn import GEOMETRIC_PRIOR, learn_for_assembly
-    from assembly_constraints.bridge.assembly import load_assembly
+    from asp import PlannerError
+    from asp.precedence.learn import GEOMETRIC_PRIOR, learn_for_assembly
+    from bridge.assembly import load_assembly
 
     (tmp_path / GEOMETRIC_PRIOR).write_text(PRIOR)
     (tmp_path / "assembly.toml").write_text("name = 't'\n" + "".join(

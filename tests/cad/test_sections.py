@@ -10,7 +10,7 @@ import pytest
 import shapely
 from shapely import affinity
 
-from assembly_constraints.executor.cad.sections import Loop, classify
+from executor.cad.sections import Loop, classify
 
 MM = 1e-3
 

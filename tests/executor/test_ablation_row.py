@@ -8,9 +8,9 @@ import json
 import msgspec
 import pytest
 
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor.campaign.ablation import format_ablation, variant_row
-from assembly_constraints.executor.control.ilc import LAYERS
+from bridge.cell_settings import Magnitudes
+from executor.campaign.ablation import format_ablation, variant_row
+from executor.control.ilc import LAYERS
 from tests.conftest import error_lines
 
 

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge.assembly import DATA_DIR
-from assembly_constraints.executor.world.assets import STAMP, current_assets, sources_digest
-from assembly_constraints.executor.world.geometry import load_geometry, plate_obj_text
+from bridge.assembly import DATA_DIR
+from executor.world.assets import STAMP, current_assets, sources_digest
+from executor.world.geometry import load_geometry, plate_obj_text
 from tests._tolerances import assert_same_asset
 
 WITH_ASSETS = sorted(p.parent.parent.name for p in DATA_DIR.glob("*/assets/plate.obj"))
@@ -66,7 +66,7 @@ def test_an_edit_the_assets_do_not_depend_on_keeps_them(cranfield: Path) -> None
 
 
 def test_assets_that_cannot_be_regenerated_are_refused_naming_the_file(cranfield: Path) -> None:
-    from assembly_constraints.executor import ExecutorError
+    from executor import ExecutorError
 
     _narrow_s1(cranfield)
     (cranfield / "assets" / "plate.obj").unlink()

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge.recording.reader import column_values, read_recording
+from bridge.recording.reader import column_values, read_recording
 from tests._tolerances import END_BOUND, FORCE_BOUND
 
 pytestmark = pytest.mark.slow  # real PyBullet campaigns, 10-15 s each
@@ -44,8 +44,8 @@ def test_mini_campaign_with_plots(tmp_path: Path, run_executor) -> None:
 def test_real_results_do_not_depend_on_scheduling() -> None:
     import functools
 
-    from assembly_constraints.executor.campaign.pairs import select_pairs
-    from assembly_constraints.executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr
+    from executor.campaign.pairs import select_pairs
+    from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr
 
     pairs = select_pairs("tp:r1,sh:s1")
     factory = functools.partial(CellRunner, "cranfield")

@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.campaign.pairs import FIG18_FITTING_PAIRS, campaign_pairs, pair_stats, select_pairs
-from assembly_constraints.executor.campaign.run import CampaignRun, campaign_report, format_table, run_campaign
+from executor import ExecutorError
+from executor.campaign.pairs import FIG18_FITTING_PAIRS, campaign_pairs, pair_stats, select_pairs
+from executor.campaign.run import CampaignRun, campaign_report, format_table, run_campaign
 
 
 def fake_runner(flaky_every: int, barrier: Any = None) -> Any:
@@ -90,7 +90,7 @@ def test_a_too_big_part_reported_fitting_is_counted() -> None:
 
 
 def _trace(part: str, outcome: str, stop_at: float) -> Any:
-    from assembly_constraints.executor.rerun_log import AttemptTrace
+    from executor.rerun_log import AttemptTrace
 
     trace = AttemptTrace(part, "r1", 0, 1, 1, outcome)
     import numpy as np
@@ -108,7 +108,7 @@ def _trace(part: str, outcome: str, stop_at: float) -> Any:
 @pytest.mark.slow
 def test_figures_are_written(tmp_path: Path) -> None:
     # Imported here: worker processes of the test above import this module.
-    from assembly_constraints.executor.campaign.plots import plot_fig17, plot_fig18
+    from executor.campaign.plots import plot_fig17, plot_fig18
 
     pairs = campaign_pairs()[:3]
     stats = [pair_stats(p, [{"outcome": "fit", "attempts": 1, "duration_s": 1.0}]) for p in pairs]

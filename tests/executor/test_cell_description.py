@@ -12,16 +12,16 @@ import msgspec
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.product import Gripper
 from assembly_constraints.cli import main
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.cell_description import CellDescription, load_cell_description
-from assembly_constraints.executor.control.admittance import AdmittanceParams
-from assembly_constraints.executor.control.detector import Thresholds
-from assembly_constraints.executor.control.ilc import ExecutionTrace, Ilc, offset_bound, read_state
-from assembly_constraints.executor.trial import Cell, CellSetup
-from assembly_constraints.executor.world.geometry import arm_urdf_text
+from bridge import BridgeError
+from bridge.product import Gripper
+from executor import ExecutorError
+from executor.cell_description import CellDescription, load_cell_description
+from executor.control.admittance import AdmittanceParams
+from executor.control.detector import Thresholds
+from executor.control.ilc import ExecutionTrace, Ilc, offset_bound, read_state
+from executor.trial import Cell, CellSetup
+from executor.world.geometry import arm_urdf_text
 from tests.conftest import ROOT
 
 EXAMPLE = ROOT / "docs" / "examples" / "cell.toml"
@@ -111,9 +111,9 @@ def test_a_threshold_of_the_file_decides_the_trial(tmp_path: Path, capsys: pytes
 def test_the_served_sim_cell_decodes_its_description_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """``executor serve``: the description is decoded once, before the session opens, and
     what it says reaches the cell the backend starts."""
-    from assembly_constraints.bridge.cell_settings import CellSettings, ServeSettings
-    from assembly_constraints.executor import trial
-    from assembly_constraints.executor.serve.backends import backend_starter
+    from bridge.cell_settings import CellSettings, ServeSettings
+    from executor import trial
+    from executor.serve.backends import backend_starter
 
     path = tmp_path / "cell.toml"
     path.write_text("[thresholds]\nf_stop = 7.5\n")

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.executor.trial import Cell, trial_rng
+from executor.trial import Cell, trial_rng
 
 STATE = Path(__file__).parent / "data" / "ilc_tight_peg_r1_after_12.json"
 

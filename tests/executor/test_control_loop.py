@@ -10,13 +10,13 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
-from assembly_constraints.executor.control.detector import Detector, Thresholds
-from assembly_constraints.executor.skills.dmp import load_skill, xyzw_to_wxyz
-from assembly_constraints.executor.trial import Cell
-from assembly_constraints.executor.world import TIME_STEP
-from assembly_constraints.executor.world.arm import rotation_error, tool_quat
-from assembly_constraints.executor.world.geometry import load_geometry
+from executor.control.admittance import Admittance, AdmittanceParams
+from executor.control.detector import Detector, Thresholds
+from executor.skills.dmp import load_skill, xyzw_to_wxyz
+from executor.trial import Cell
+from executor.world import TIME_STEP
+from executor.world.arm import rotation_error, tool_quat
+from executor.world.geometry import load_geometry
 from tests._tolerances import PATH_BOUND
 
 

@@ -9,16 +9,16 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.control.detector import Thresholds
-from assembly_constraints.executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
-from assembly_constraints.executor.control.ilc import LAYERS, ExecutionTrace, Ilc
-from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.skills.insertion import rotvec_quat_xyzw
-from assembly_constraints.executor.trial import Cell, CellSetup
-from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, rotation_error
-from assembly_constraints.executor.world.perturbation import NO_PERTURBATION
+from bridge.cell_settings import Magnitudes
+from executor.cell_description import CellDescription
+from executor.control.detector import Thresholds
+from executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
+from executor.control.ilc import LAYERS, ExecutionTrace, Ilc
+from executor.evidence import AttemptSetup
+from executor.skills.insertion import rotvec_quat_xyzw
+from executor.trial import Cell, CellSetup
+from executor.world.arm import TOOL_DOWN_QUAT_XYZW, rotation_error
+from executor.world.perturbation import NO_PERTURBATION
 
 # The tight peg tilted 2° in the hand, otherwise exact: it touches the walls all the way down.
 TILTED = AttemptSetup(np.zeros(3), np.array([np.radians(2.0), 0.0, 0.0]), np.zeros(2), search_seed=1)
@@ -147,10 +147,10 @@ def test_ilc_update_learns_against_the_error_and_round_trips(tmp_path):
 def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
     """``executor serve --ilc-state``: the sim backend saves after a successful execution;
     a restarted backend (a resumed session's cell) starts from the saved corrections."""
-    from assembly_constraints.bridge.cell_settings import ServeSettings
-    from assembly_constraints.bridge.messages import InsertRequest
-    from assembly_constraints.executor.serve.sim import SimBackend
-    from assembly_constraints.executor.trial import cell_setup
+    from bridge.cell_settings import ServeSettings
+    from bridge.messages import InsertRequest
+    from executor.serve.sim import SimBackend
+    from executor.trial import cell_setup
 
     state = tmp_path / "c1-ilc.json"
     settings = ServeSettings(ilc_state=str(state))
@@ -168,7 +168,7 @@ def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
 
 
 def test_a_corrupt_ilc_state_is_refused_naming_the_file(tmp_path):
-    from assembly_constraints.executor import ExecutorError
+    from executor import ExecutorError
 
     path = tmp_path / "c1-ilc.json"
     path.write_text('{"keys": {"round_peg:r1": {"iterations": 1, "correction": [[0.0]]}}}')

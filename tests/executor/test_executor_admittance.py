@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assembly_constraints.executor.control.admittance import Admittance, AdmittanceParams
+from executor.control.admittance import Admittance, AdmittanceParams
 
 DT = 0.001  # [s], the control period
 

@@ -11,8 +11,8 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.trial import Cell, CellSetup
+from executor.evidence import AttemptSetup
+from executor.trial import Cell, CellSetup
 from tests._tolerances import END_BOUND, FORCE_BOUND, TORQUE_BOUND
 
 
@@ -72,7 +72,7 @@ def test_same_seed_same_trial(cell):
 def test_same_seed_same_trial_in_other_processes(root, cli_env):
     """The same outcome across processes, also after the cell switched part shapes; the
     figures within the bounds another process (maybe another CPU) may move them by."""
-    code = ("import json; from assembly_constraints.executor.trial import Cell; c = Cell(); "
+    code = ("import json; from executor.trial import Cell; c = Cell(); "
             "c.run_trial('p3', 'r1', 3); "
             "r = c.run_trial('tp', 'r1', 3).to_json(); "
             "print(json.dumps([r['outcome'], r['attempts'], r['max_force_dev'], r['max_torque_dev'], r['end_error']]))")
@@ -114,7 +114,7 @@ def test_tight_peg_jam_is_resolved_by_the_wiggle(cell):
 def test_a_trial_checks_its_pair_once(cell, monkeypatch: pytest.MonkeyPatch) -> None:
     """The pair is checked (and its skill looked up) once per trial, whatever its attempts;
     an unknown part is refused as such."""
-    from assembly_constraints.executor import UnknownPair
+    from executor import UnknownPair
 
     checks: list[tuple[str, str]] = []
     check = cell.check_pair

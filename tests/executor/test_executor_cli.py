@@ -43,7 +43,7 @@ def test_trial_json_contract_and_rerun_file(tmp_path, run_executor):
         assert key in trial
     assert trial["outcome"] == "fit"
     assert out["summary"]["trials"] == 1
-    from assembly_constraints.bridge.recording.reader import read_recording
+    from bridge.recording.reader import read_recording
 
     entities = read_recording(rrd).entities
     assert any("wrench/force/measured" in path for path in entities)

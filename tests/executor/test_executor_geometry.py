@@ -9,9 +9,9 @@ import re
 
 import pytest
 
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.bridge.assembly import DATA_DIR
-from assembly_constraints.executor.world.geometry import (
+from asp.sizes.truth_oracle import TruthOracle
+from bridge.assembly import DATA_DIR
+from executor.world.geometry import (
     PartSpec,
     Section,
     load_geometry,

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.executor.world.geometry import load_geometry, write_assets
+from bridge import BridgeError
+from executor.world.geometry import load_geometry, write_assets
 from tests._files_helpers import leftovers
 from tests._tolerances import assert_same_asset
 

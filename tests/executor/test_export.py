@@ -11,8 +11,8 @@ from pathlib import Path
 import pybullet as pb
 import pytest
 
-from assembly_constraints.executor.assembly.export import export_cell
-from assembly_constraints.executor.assembly.product import load_product
+from executor.assembly.export import export_cell
+from executor.assembly.product import load_product
 from tests._files_helpers import leftovers, run_with_file_limit
 from tests.conftest import CLI_MODULE
 

@@ -12,11 +12,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import DATA_DIR
-from assembly_constraints.bridge.errors import ToolError
-from assembly_constraints.bridge.product import Gripper, Plate, product_from_tables
-from assembly_constraints.executor.world.geometry import load_geometry
+from bridge import BridgeError
+from bridge.assembly import DATA_DIR
+from bridge.errors import ToolError
+from bridge.product import Gripper, Plate, product_from_tables
+from executor.world.geometry import load_geometry
 
 CRANFIELD = DATA_DIR / "cranfield"
 GRIPPER_TABLE = """[gripper]

@@ -18,16 +18,16 @@ import numpy as np
 import pytest
 import trimesh
 
-from assembly_constraints.bridge.assembly import DATA_DIR
 from assembly_constraints.cli import main
-from assembly_constraints.executor.assembly.product import load_product
-from assembly_constraints.executor.assembly.step import Assembler
-from assembly_constraints.executor.cell_description import CellDescription
-from assembly_constraints.executor.skills.dmp import load_skill, save_skill
-from assembly_constraints.executor.skills.teach import DEMO_CLEARANCE, teach_shape
-from assembly_constraints.executor.trial import Cell
-from assembly_constraints.executor.world.assets import sources_digest
-from assembly_constraints.executor.world.geometry import CellGeometry, load_geometry, plate_obj_text
+from bridge.assembly import DATA_DIR
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
+from executor.cell_description import CellDescription
+from executor.skills.dmp import load_skill, save_skill
+from executor.skills.teach import DEMO_CLEARANCE, teach_shape
+from executor.trial import Cell
+from executor.world.assets import sources_digest
+from executor.world.geometry import CellGeometry, load_geometry, plate_obj_text
 from tests._tolerances import END_BOUND
 
 RAISE = 0.010  # [m] r2's entry above the plate's

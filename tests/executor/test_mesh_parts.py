@@ -14,16 +14,16 @@ import pybullet as pb
 import pytest
 import trimesh
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.product import CONVEX_HEADER
 from assembly_constraints.cli import main
-from assembly_constraints.executor.assembly.product import load_product
-from assembly_constraints.executor.assembly.world import AssemblyWorld
-from assembly_constraints.executor.cad.assembled import part_meshes
-from assembly_constraints.executor.cell_description import load_cell_description
-from assembly_constraints.executor.world.assets import sources_digest
-from assembly_constraints.executor.world.geometry import load_geometry
-from assembly_constraints.executor.world.meshes import obj_text
+from bridge import BridgeError
+from bridge.product import CONVEX_HEADER
+from executor.assembly.product import load_product
+from executor.assembly.world import AssemblyWorld
+from executor.cad.assembled import part_meshes
+from executor.cell_description import load_cell_description
+from executor.world.assets import sources_digest
+from executor.world.geometry import load_geometry
+from executor.world.meshes import obj_text
 
 REST_BOUND = 3e-4
 """A part at rest is within this of where it should be [m] (contact penetration and the

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor.trial import trial_rng
-from assembly_constraints.executor.world.perturbation import CellBias, random_only
+from bridge.cell_settings import Magnitudes
+from executor.trial import trial_rng
+from executor.world.perturbation import CellBias, random_only
 
 MODEL = Magnitudes()
 

@@ -14,8 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely import affinity
 
-from assembly_constraints.executor.world.geometry import Section, margin, outline_polygon, section_fit
-from assembly_constraints.executor.world.polygon_fit import OutlineError, polygon, polygon_fit, round_fit
+from executor.world.geometry import Section, margin, outline_polygon, section_fit
+from executor.world.polygon_fit import OutlineError, polygon, polygon_fit, round_fit
 
 MM = 1e-3
 TESSELLATION = 1e-6

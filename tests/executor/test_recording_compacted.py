@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge.recording.reader import chunk_count, column_values
-from assembly_constraints.executor.evidence import AttemptEvidence
-from assembly_constraints.executor.rerun_log import AttemptLogger
+from bridge.recording.reader import chunk_count, column_values
+from executor.evidence import AttemptEvidence
+from executor.rerun_log import AttemptLogger
 
 
 def _log_attempts(rrd: Path) -> None:
@@ -32,7 +32,7 @@ def _log_attempts(rrd: Path) -> None:
 def test_the_cell_logger_compacts_its_file_when_it_closes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     compacted = tmp_path / "compacted.rrd"
     _log_attempts(compacted)
-    monkeypatch.setattr("assembly_constraints.executor.rerun_log.compact_recording", lambda path: False)
+    monkeypatch.setattr("executor.rerun_log.compact_recording", lambda path: False)
     raw = tmp_path / "raw.rrd"
     _log_attempts(raw)
     assert len(column_values(compacted, "executor/c1/outcome", "TextLog:text")) == 30

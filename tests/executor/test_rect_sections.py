@@ -10,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.bridge.cell_settings import Magnitudes
-from assembly_constraints.executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quats_z, turn_z
-from assembly_constraints.executor.world.geometry import (
+from bridge.assembly import load_assembly
+from bridge.cell_settings import Magnitudes
+from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quats_z, turn_z
+from executor.world.geometry import (
     HoleSpec,
     PartSpec,
     load_geometry,
@@ -22,7 +22,7 @@ from assembly_constraints.executor.world.geometry import (
     plate_obj_text,
     sizes_lp_text,
 )
-from assembly_constraints.executor.world.perturbation import CellBias
+from executor.world.perturbation import CellBias
 
 
 def _peg(kind: str, a: float, b: float = 0.0) -> PartSpec:

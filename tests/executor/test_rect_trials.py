@@ -12,10 +12,10 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup
-from assembly_constraints.executor.trial import Cell, CellSetup
-from assembly_constraints.executor.world.geometry import passes
-from assembly_constraints.executor.world.perturbation import NO_PERTURBATION
+from executor.evidence import AttemptEvidence, AttemptSetup
+from executor.trial import Cell, CellSetup
+from executor.world.geometry import passes
+from executor.world.perturbation import NO_PERTURBATION
 
 SEEDS = (91_000, 91_001)
 PAIRS = [("rect16", "slot16"), ("rect12", "slot16"), ("rect8", "hole12"), ("round8", "slot12"),

@@ -1,5 +1,5 @@
 """``executor serve --backend MODULE:CLASS``: a user's backend loaded by name; the replay
-backend (assembly_constraints.executor.replay) answers from a recorded session's journal."""
+backend (executor.replay) answers from a recorded session's journal."""
 
 from __future__ import annotations
 
@@ -8,15 +8,15 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.messages import InsertRequest
-from assembly_constraints.bridge.session import free_loopback_endpoint
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.backend_plugin import CellContext, UnknownPair
-from assembly_constraints.executor.replay import ReplayBackend
+from asp.session.cells import CellProcess
+from bridge.cell_settings import ServeSettings
+from bridge.messages import InsertRequest
+from bridge.session import free_loopback_endpoint
+from executor import ExecutorError
+from executor.backend_plugin import CellContext, UnknownPair
+from executor.replay import ReplayBackend
 
-REPLAY = "assembly_constraints.executor.replay:ReplayBackend"
+REPLAY = "executor.replay:ReplayBackend"
 
 
 def _journal(path: Path, *records: dict) -> Path:
@@ -49,8 +49,8 @@ def test_a_bad_journal_line_is_named(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_bad_backend_names_exit_2_with_one_line(run_executor, tmp_path: Path) -> None:
     for argv, expected in [(["--backend", "no_such_module:Backend"], "cannot import no_such_module"),
-                           (["--backend", "assembly_constraints.executor.replay:Nope"],
-                            "expected a class Nope in assembly_constraints.executor.replay"),
+                           (["--backend", "executor.replay:Nope"],
+                            "expected a class Nope in executor.replay"),
                            (["--backend", REPLAY], "needs --backend-option journal=")]:
         done = run_executor("serve", *argv, cwd=tmp_path, timeout=60)
         assert done.returncode == 2 and expected in done.stderr and len(done.stderr.splitlines()) == 1, done.stderr

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge.recording.reader import column_values, read_recording
-from assembly_constraints.executor.rerun_log import AttemptLogger
-from assembly_constraints.executor.trial import Cell
+from bridge.recording.reader import column_values, read_recording
+from executor.rerun_log import AttemptLogger
+from executor.trial import Cell
 
 KUKA_LINKS = [f"lbr_iiwa_link_{k}" for k in range(1, 8)]
 

@@ -8,17 +8,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.recording.reader import (
+from bridge import BridgeError
+from bridge.recording.reader import (
     blueprint_origins,
     column_values,
     format_summary,
     read_blueprint,
     read_recording,
 )
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.rerun_log import PATH_COLOR, TIP_RADIUS_UI, AttemptLogger
-from assembly_constraints.executor.rerun_plots import FIT_COLOR, GROWTH_ROWS, HEIGHT, WIDTH, growth_ends
+from executor import ExecutorError
+from executor.rerun_log import PATH_COLOR, TIP_RADIUS_UI, AttemptLogger
+from executor.rerun_plots import FIT_COLOR, GROWTH_ROWS, HEIGHT, WIDTH, growth_ends
 
 
 @dataclass
@@ -177,7 +177,7 @@ def test_loggers_on_a_callers_stream(tmp_path: Path) -> None:
 def test_the_plan_steps_of_a_session_keep_its_experiment_timeline(tmp_path: Path) -> None:
     import rerun as rr
 
-    from assembly_constraints.executor.assembly.recording import AssemblyRecorder
+    from executor.assembly.recording import AssemblyRecorder
 
     stream = rr.RecordingStream("assembly_constraints", recording_id="steps")
     stream.save(str(tmp_path / "steps.rrd"))

@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from assembly_constraints.executor.skills.dmp import Skill, load_skill
-from assembly_constraints.executor.skills.teach import teach_shape
-from assembly_constraints.executor.trial import Cell, CellSetup
+from executor.skills.dmp import Skill, load_skill
+from executor.skills.teach import teach_shape
+from executor.trial import Cell, CellSetup
 from tests._tolerances import END_BOUND, FORCE_BOUND, PATH_BOUND, TORQUE_BOUND
 
 SHAPES = ("round_peg", "square_peg", "shaft", "tight_peg")

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.skills.dmp import load_skill, skill_path
-from assembly_constraints.executor.trial import Cell
-from assembly_constraints.executor.world.geometry import load_geometry
+from executor import ExecutorError
+from executor.skills.dmp import load_skill, skill_path
+from executor.trial import Cell
+from executor.world.geometry import load_geometry
 
 
 @pytest.fixture

@@ -16,7 +16,7 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.plans.assign import (
+from asp.plans.assign import (
     LearnedFacts,
     UnsolvableAssembly,
     all_assignments,
@@ -24,8 +24,8 @@ from assembly_constraints.asp.plans.assign import (
     greedy_assignment,
     load_learned_facts,
 )
-from assembly_constraints.asp.plans.plans import check_assignment
-from assembly_constraints.asp.solve import encoding, fact, write_facts
+from asp.plans.plans import check_assignment
+from asp.solve import encoding, fact, write_facts
 from tests.conftest import ROOT
 
 ASSIGNMENTS_LP = str(encoding("assignments.lp"))

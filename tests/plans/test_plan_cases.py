@@ -17,9 +17,9 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.plans.assign import LearnedFacts, UnsolvableAssembly, load_learned_facts
-from assembly_constraints.asp.plans.plans import PlanStep, check_plan, plans
-from assembly_constraints.asp.solve import fact, write_facts
+from asp.plans.assign import LearnedFacts, UnsolvableAssembly, load_learned_facts
+from asp.plans.plans import PlanStep, check_plan, plans
+from asp.solve import fact, write_facts
 from tests.conftest import ROOT
 
 ENCODINGS = ROOT / "asp" / "encodings"

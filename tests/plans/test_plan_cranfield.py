@@ -15,12 +15,12 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
-from assembly_constraints.asp.plans.plans import PlanStep, check_plan, plans, travel_facts
-from assembly_constraints.asp.precedence.relation import load_relation
-from assembly_constraints.asp.solve import load_atoms, write_facts
-from assembly_constraints.bridge.assembly import Assembly, Hole, Part, load_assembly
+from asp import PlannerError
+from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
+from asp.plans.plans import PlanStep, check_plan, plans, travel_facts
+from asp.precedence.relation import load_relation
+from asp.solve import load_atoms, write_facts
+from bridge.assembly import Assembly, Hole, Part, load_assembly
 from tests.conftest import ROOT
 from tests.plans.test_plan_cases import assemblies, brute_force_assignments, linear_extensions, random_facts
 

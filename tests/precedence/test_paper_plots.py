@@ -9,11 +9,11 @@ from typing import Any
 import pytest
 from matplotlib.figure import Figure
 
-from assembly_constraints.asp.precedence.draw import draw_png
-from assembly_constraints.asp.precedence.evaluate import evaluate, plot
-from assembly_constraints.asp.precedence.relation import reduction, true_relation
-from assembly_constraints.asp.sizes.evaluate import Evaluation, plot_comparison
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.draw import draw_png
+from asp.precedence.evaluate import evaluate, plot
+from asp.precedence.relation import reduction, true_relation
+from asp.sizes.evaluate import Evaluation, plot_comparison
+from bridge.assembly import load_assembly
 
 
 @pytest.fixture
@@ -24,8 +24,8 @@ def figures(monkeypatch: pytest.MonkeyPatch) -> list[Figure]:
     def capture(path: Any, figure: Figure, **options: Any) -> None:
         captured.append(figure)
 
-    for module in ("assembly_constraints.asp.precedence.draw", "assembly_constraints.asp.precedence.evaluate",
-                   "assembly_constraints.asp.sizes.evaluate"):
+    for module in ("asp.precedence.draw", "asp.precedence.evaluate",
+                   "asp.sizes.evaluate"):
         monkeypatch.setattr(f"{module}.write_figure", capture)
     return captured
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.precedence.relation import load_relation, true_relation
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.relation import load_relation, true_relation
+from bridge.assembly import load_assembly
 
 
 @pytest.mark.slow

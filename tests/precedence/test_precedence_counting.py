@@ -11,17 +11,17 @@ import numpy as np
 from hypothesis import given, settings
 from scipy.stats import chisquare
 
-from assembly_constraints.asp.precedence.batches import ExtensionBatches, positions_of
-from assembly_constraints.asp.precedence.count import (
+from asp.precedence.batches import ExtensionBatches, positions_of
+from asp.precedence.count import (
     UniformSampler,
     count_linear_extensions,
     exact_count,
     linear_extensions,
 )
-from assembly_constraints.asp.precedence.learn import intersect_orders
-from assembly_constraints.asp.precedence.relation import Relation, true_relation
-from assembly_constraints.asp.solve import encoding, fact
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.learn import intersect_orders
+from asp.precedence.relation import Relation, true_relation
+from asp.solve import encoding, fact
+from bridge.assembly import load_assembly
 from tests._precedence_helpers import closed_relation, posets
 
 

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.demos import demo_facts, load_demos, parse_demos
-from assembly_constraints.asp.solve import atoms_by_name, load_atoms, write_facts
-from assembly_constraints.bridge.assembly import load_assembly
+from asp import PlannerError
+from asp.precedence.demos import demo_facts, load_demos, parse_demos
+from asp.solve import atoms_by_name, load_atoms, write_facts
+from bridge.assembly import load_assembly
 
 
 def test_spaces_commas_comments_and_blank_lines_give_the_same_sequences() -> None:

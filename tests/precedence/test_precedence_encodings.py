@@ -7,7 +7,7 @@ from clintest.quantifier import All, Exact
 from clintest.solver import Clingo
 from clintest.test import And, Assert
 
-from assembly_constraints.asp.solve import encoding
+from asp.solve import encoding
 
 
 def _solve(name: str, facts: str, test) -> None:

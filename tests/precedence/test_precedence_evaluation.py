@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import given, settings
 
-from assembly_constraints.asp.precedence.evaluate import PAPER_M, evaluate
-from assembly_constraints.asp.precedence.guide import Guide, evaluate_guided, suggest, teacher_order
-from assembly_constraints.asp.precedence.relation import Relation, true_relation
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.evaluate import PAPER_M, evaluate
+from asp.precedence.guide import Guide, evaluate_guided, suggest, teacher_order
+from asp.precedence.relation import Relation, true_relation
+from bridge.assembly import load_assembly
 from tests._precedence_helpers import posets
 
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import given, settings
 
-from assembly_constraints.asp.precedence.count import count_linear_extensions, linear_extensions
-from assembly_constraints.asp.precedence.demos import Demonstrations, load_demos, parse_demos
-from assembly_constraints.asp.precedence.learn import learn_must_precede, pair_evidence, suspects
-from assembly_constraints.asp.precedence.relation import Relation, reduction, true_relation
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.count import count_linear_extensions, linear_extensions
+from asp.precedence.demos import Demonstrations, load_demos, parse_demos
+from asp.precedence.learn import learn_must_precede, pair_evidence, suspects
+from asp.precedence.relation import Relation, reduction, true_relation
+from bridge.assembly import load_assembly
 from tests._precedence_helpers import poset_with_demos
 
 
@@ -86,8 +86,8 @@ def test_a_wrong_demonstration_is_flagged_and_min_support_keeps_the_constraint()
 
 
 def test_learned_relation_facts_are_queryable_by_plain_clingo(tmp_path, run_python) -> None:
-    from assembly_constraints.asp.precedence.relation import precedence_facts
-    from assembly_constraints.asp.solve import encoding, write_facts
+    from asp.precedence.relation import precedence_facts
+    from asp.solve import encoding, write_facts
 
     learned = learn_must_precede(parse_demos("o r2 i2 r1 i1\no r1 r2 i1 i2\n", "d.txt"))
     path = tmp_path / "learned.lp"

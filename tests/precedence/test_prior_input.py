@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.precedence.learn import GEOMETRIC_PRIOR, learn_for_assembly
-from assembly_constraints.bridge.assembly import load_assembly
+from asp import PlannerError
+from asp.precedence.learn import GEOMETRIC_PRIOR, learn_for_assembly
 from assembly_constraints.cli import main
+from bridge.assembly import load_assembly
 
 PRIOR = "part(base). part(a). part(b).\nmust_precede(base,a). must_precede(base,b).\n"
 

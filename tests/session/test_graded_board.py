@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from assembly_constraints.asp.precedence.demos import load_demos
-from assembly_constraints.asp.precedence.learn import learn_must_precede
-from assembly_constraints.asp.precedence.relation import true_relation
-from assembly_constraints.asp.sizes.learner import learn_sizes
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.bridge.assembly import load_assembly
+from asp.precedence.demos import load_demos
+from asp.precedence.learn import learn_must_precede
+from asp.precedence.relation import true_relation
+from asp.sizes.learner import learn_sizes
+from asp.sizes.truth_oracle import TruthOracle
+from bridge.assembly import load_assembly
 
 
 def test_the_graded_board_is_learned_in_process() -> None:

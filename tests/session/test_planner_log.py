@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from assembly_constraints.asp.session.layered import SPACING, levels, positions
-from assembly_constraints.asp.session.log import PlannerLog
-from assembly_constraints.asp.sizes.knowledge import Knowledge
-from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
-from assembly_constraints.bridge.recording.reader import column_values, read_blueprint, read_recording
+from asp.session.layered import SPACING, levels, positions
+from asp.session.log import PlannerLog
+from asp.sizes.knowledge import Knowledge
+from bridge.recording.layout import Contents, write_blueprint
+from bridge.recording.reader import column_values, read_blueprint, read_recording
 
 PARTS, HOLES = ("p1", "p2"), ("r1", "r2")
 

@@ -10,10 +10,10 @@ import pytest
 import rerun as rr
 from rerun.chunk import RrdReader
 
-from assembly_constraints.bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names, write_blueprint
-from assembly_constraints.bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
-from assembly_constraints.executor.evidence import AttemptEvidence
-from assembly_constraints.executor.rerun_log import AttemptLogger
+from bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names, write_blueprint
+from bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
+from executor.evidence import AttemptEvidence
+from executor.rerun_log import AttemptLogger
 
 
 def _run_folder(folder: Path) -> Path:
@@ -129,7 +129,7 @@ def test_a_session_opens_with_an_assembly_tab_only_when_it_recorded_one(tmp_path
 def test_the_view_blueprint_of_a_session_that_assembled_has_its_assembly_tab(tmp_path: Path) -> None:
     """The session's ``view.rbl`` comes from the entities its files hold: a cell that logged
     an assembly gets its tab, without the planner having announced it."""
-    from assembly_constraints.asp.session.run import view_blueprint
+    from asp.session.run import view_blueprint
 
     run = _run_folder(tmp_path / "run")
     logger = AttemptLogger("c1", recording_id="run-7", rrd_path=run / "c1-assembly.rrd", send_blueprint=False)

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from assembly_constraints.asp.view.browser import find_chromium
-from assembly_constraints.asp.view.screenshot import take_screenshots
-from assembly_constraints.bridge.recording.layout import Contents, TimePoint
-from assembly_constraints.bridge.recording.reader import read_recording
-from assembly_constraints.executor.rerun_log import AttemptLogger
+from asp.view.browser import find_chromium
+from asp.view.screenshot import take_screenshots
+from bridge.recording.layout import Contents, TimePoint
+from bridge.recording.reader import read_recording
+from executor.rerun_log import AttemptLogger
 
 pytestmark = [
     pytest.mark.slow,

@@ -16,11 +16,11 @@ import random
 
 import pytest
 
-from assembly_constraints.asp.sizes.best import knowledge_masks
-from assembly_constraints.asp.sizes.biorders import all_biorders, consistent_index
-from assembly_constraints.asp.sizes.knowledge import Knowledge, Pair
-from assembly_constraints.asp.sizes.learner import SizeLearner
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp.sizes.best import knowledge_masks
+from asp.sizes.biorders import all_biorders, consistent_index
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.learner import SizeLearner
+from asp.sizes.truth_oracle import TruthOracle
 
 TRUTH = TruthOracle.from_assembly("cranfield")
 BEST_TWO_CELLS = 21

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess, cell_seed
-from assembly_constraints.asp.session.cli import build_parser, session_settings
-from assembly_constraints.asp.session.run import session_cell
-from assembly_constraints.asp.session.settings import new_session_file
-from assembly_constraints.executor.serve import build_parser as serve_parser
-from assembly_constraints.executor.serve import serve_settings_of
+from asp.session.cells import CellProcess, cell_seed
+from asp.session.cli import build_parser, session_settings
+from asp.session.run import session_cell
+from asp.session.settings import new_session_file
+from executor.serve import build_parser as serve_parser
+from executor.serve import serve_settings_of
 
 
 def _cells(argv: list[str], run: Path) -> list:
@@ -51,7 +51,7 @@ def test_a_cell_description_reaches_every_cell_by_its_absolute_path(tmp_path: Pa
                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     """``session --cell-description FILE`` (relative to the caller) is in every cell's
     settings as an absolute path, and the cell builds its Cell with that file's values."""
-    from assembly_constraints.executor.trial import cell_setup
+    from executor.trial import cell_setup
 
     (tmp_path / "cell.toml").write_text("[thresholds]\nf_stop = 7.5\n")
     monkeypatch.chdir(tmp_path)

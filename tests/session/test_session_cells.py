@@ -18,12 +18,12 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.asp.session.journal import read_journal
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.asp.solve import atoms_by_name, load_atoms
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.session import free_loopback_endpoint
+from asp.session.cells import CellProcess, start_cell
+from asp.session.journal import read_journal
+from asp.sizes.truth_oracle import TruthOracle
+from asp.solve import atoms_by_name, load_atoms
+from bridge.cell_settings import ServeSettings
+from bridge.session import free_loopback_endpoint
 from tests.conftest import ROOT, TRUTH_SESSION
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
@@ -103,7 +103,7 @@ def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[Ce
 
 
 def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path, run_session) -> None:
-    from assembly_constraints.bridge.recording.reader import column_values, read_recording
+    from bridge.recording.reader import column_values, read_recording
 
     run = tmp_path / "run"
     result = run_session("--cells", "2", "--out", str(run), "--policy", "best")
@@ -178,7 +178,7 @@ def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path
 
 
 def test_a_session_starts_from_the_fits_its_demonstrations_show(tmp_path: Path, run_session) -> None:
-    from assembly_constraints.asp.sizes.learner import LearningOptions, learn_sizes
+    from asp.sizes.learner import LearningOptions, learn_sizes
 
     demos = ROOT / "data" / "cranfield" / "demos_annotated.txt"
     run = tmp_path / "run"
@@ -198,9 +198,9 @@ def test_a_session_starts_from_the_fits_its_demonstrations_show(tmp_path: Path, 
 def test_a_rogue_cell_that_answers_fit_to_everything_is_never_used(tmp_path: Path, run_session) -> None:
     """A local process declares ``cell/evil/alive`` and answers every request with "fit";
     a session that started its own cell uses only that cell and learns the truth."""
-    from assembly_constraints.bridge.keys import alive_key
-    from assembly_constraints.bridge.messages import InsertReply, decode_request, encode
-    from assembly_constraints.bridge.session import open_session
+    from bridge.keys import alive_key
+    from bridge.messages import InsertReply, decode_request, encode
+    from bridge.session import open_session
 
     endpoint = free_loopback_endpoint()
     rogue = open_session(connect=(endpoint,))

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.journal import read_journal
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp.session.journal import read_journal
+from asp.sizes.truth_oracle import TruthOracle
 from tests.conftest import TRUTH_SESSION
 
 pytestmark = [pytest.mark.timeout(120), pytest.mark.slow]  # real processes over Zenoh, 5-15 s each

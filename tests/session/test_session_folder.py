@@ -15,10 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import CellProcess, start_cell
-from assembly_constraints.asp.session.journal import JournalEntry, JournalEvent, read_journal, read_records
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.session import free_loopback_endpoint
+from asp.session.cells import CellProcess, start_cell
+from asp.session.journal import JournalEntry, JournalEvent, read_journal, read_records
+from bridge.cell_settings import ServeSettings
+from bridge.session import free_loopback_endpoint
 from tests.conftest import TRUTH_SESSION
 from tests.session.test_session_cells import assert_learned_truth
 from tests.session.test_session_startup import short_peg

@@ -1,5 +1,5 @@
 """Cells on other hosts: a planner and two cells in network namespaces of their own, joined
-only through ``./run.sh router`` (:mod:`assembly_constraints.asp.session.hosts` makes the namespaces and links
+only through ``./run.sh router`` (:mod:`asp.session.hosts` makes the namespaces and links
 and removes them after the test, also when it fails; skipped where namespaces cannot be
 made). One cell's link is cut mid-session: the session drops it and finishes with the
 other, the relation exact, no experiment lost or run twice."""
@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cells import LineProcess
-from assembly_constraints.asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
-from assembly_constraints.asp.session.journal import read_journal
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp.session.cells import LineProcess
+from asp.session.hosts import CLIENT_CONFIG, Hosts, unavailable
+from asp.session.journal import read_journal
+from asp.sizes.truth_oracle import TruthOracle
 from tests.conftest import TRUTH_SESSION
 
 pytestmark = [pytest.mark.timeout(150), pytest.mark.slow]  # real namespaces and processes, 15-40 s

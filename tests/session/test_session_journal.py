@@ -9,8 +9,8 @@ from pathlib import Path
 import msgspec
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.journal import Journal, JournalEntry, read_journal, read_records
+from asp import PlannerError
+from asp.session.journal import Journal, JournalEntry, read_journal, read_records
 from tests._files_helpers import run_with_file_limit
 
 
@@ -90,8 +90,8 @@ def test_a_full_disk_keeps_the_journal_whole(tmp_path: Path) -> None:
     journal.close()
     path = tmp_path / "journal.jsonl"
     before = path.read_bytes()
-    program = ("import sys; from pathlib import Path; from assembly_constraints.asp import PlannerError\n"
-               "from assembly_constraints.asp.session.journal import Journal, JournalEntry\n"
+    program = ("import sys; from pathlib import Path; from asp import PlannerError\n"
+               "from asp.session.journal import Journal, JournalEntry\n"
                "journal = Journal(Path(sys.argv[1]))\n"
                "try:\n"
                "    journal.append(JournalEntry(id='run.p1.r1.2', part='p1', hole='r1', result='fit',\n"

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.bench.products import write_product
-from assembly_constraints.asp.bench.session import load_runs
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.executor.world.geometry import load_geometry, passes
+from asp.bench.products import write_product
+from asp.bench.session import load_runs
+from asp.sizes.truth_oracle import TruthOracle
+from executor.world.geometry import load_geometry, passes
 
 
 def test_a_generated_product_is_a_biorder_its_cell_geometry_agrees_with(tmp_path: Path) -> None:

@@ -6,15 +6,15 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.cells import start_cell
-from assembly_constraints.asp.session.journal import Journal, read_journal
-from assembly_constraints.asp.session.zenoh_oracle import ZenohOracle
-from assembly_constraints.asp.sizes.learner import learn_sizes
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellPool, PoolLimits
-from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
+from asp import PlannerError
+from asp.session.cells import start_cell
+from asp.session.journal import Journal, read_journal
+from asp.session.zenoh_oracle import ZenohOracle
+from asp.sizes.learner import learn_sizes
+from asp.sizes.truth_oracle import TruthOracle
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, CellPool, PoolLimits
+from bridge.session import free_loopback_endpoint, open_session
 
 
 @pytest.mark.timeout(60)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.cli import main as session_main
+from asp.session.cli import main as session_main
 from tests.conftest import ROOT
 
 LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s\); (\d+) pairs unknown")
@@ -19,7 +19,7 @@ LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s
 @pytest.mark.timeout(90)
 def test_one_progress_line_per_experiment_down_to_no_unknown_pair(
         tmp_path: Path, caplog: pytest.LogCaptureFixture, capsys: pytest.CaptureFixture[str]) -> None:
-    caplog.set_level(logging.INFO, logger="assembly_constraints.asp.session.run")
+    caplog.set_level(logging.INFO, logger="asp.session.run")
     assert session_main(["--backend", "truth", "--cells", "2", "--out", str(tmp_path / "run")]) == 0
     lines = [LINE.fullmatch(r.getMessage()) for r in caplog.records if r.getMessage().startswith("experiment")]
     assert lines and all(lines)

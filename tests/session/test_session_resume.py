@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.journal import JournalEntry, read_journal, read_records
-from assembly_constraints.asp.session.settings import (
+from asp.session.journal import JournalEntry, read_journal, read_records
+from asp.session.settings import (
     SessionSettings,
     new_session_file,
     product_digest,

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.session.settings import (
+from asp import PlannerError
+from asp.session.settings import (
     SESSION_FILE,
     DecidedPrior,
     SessionSettings,
@@ -23,7 +23,7 @@ from assembly_constraints.asp.session.settings import (
     resumed_settings,
     write_session_file,
 )
-from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
+from bridge.cell_settings import CellSettings, Magnitudes
 
 
 def test_what_a_session_writes_reads_back_equal(tmp_path: Path) -> None:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.session.journal import read_journal
+from asp.session.journal import read_journal
 from tests.session.test_session_cells import assert_learned_truth
 
 SIM_SESSION = ("session", "--json")  # the default backend: sim

@@ -11,8 +11,8 @@ from collections.abc import Callable
 import pytest
 from rerun.experimental import ViewerClient
 
-from assembly_constraints.asp.view.screenshot import set_time_request
-from assembly_constraints.bridge.recording.layout import TimePoint
+from asp.view.screenshot import set_time_request
+from bridge.recording.layout import TimePoint
 
 _PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n"
 _DATA, _END_STREAM = 0, 0x1

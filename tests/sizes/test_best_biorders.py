@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.sizes.best import smaller_matrix
-from assembly_constraints.asp.sizes.biorders import (
+from asp.sizes.best import smaller_matrix
+from asp.sizes.biorders import (
     all_biorder_orders,
     all_biorders,
     biorder_count,
@@ -21,7 +21,7 @@ from assembly_constraints.asp.sizes.biorders import (
     sample_biorders,
     weighted_bit_sums,
 )
-from assembly_constraints.asp.sizes.learner import SizeLearner
+from asp.sizes.learner import SizeLearner
 
 
 def is_ferrers(fits: np.ndarray) -> bool:

@@ -8,10 +8,10 @@ import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.sizes.best import batch_rank, choose, choose_bit, knowledge_masks, split_weights
-from assembly_constraints.asp.sizes.biorders import all_biorders, consistent_index
-from assembly_constraints.asp.sizes.learner import SizeLearner
-from assembly_constraints.asp.sizes.policies import get_policy
+from asp.sizes.best import batch_rank, choose, choose_bit, knowledge_masks, split_weights
+from asp.sizes.biorders import all_biorders, consistent_index
+from asp.sizes.learner import SizeLearner
+from asp.sizes.policies import get_policy
 from tests._best_reference import choose_by_asp, possible_relations_asp
 from tests.sizes.test_best_biorders import biorder_truths, closure_after
 

@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from assembly_constraints.asp.sizes.best import choose_bit
-from assembly_constraints.asp.sizes.biorders import all_biorders
-from assembly_constraints.asp.sizes.evaluate import relabeled_matrices
-from assembly_constraints.asp.sizes.learner import learn_sizes
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp.sizes.best import choose_bit
+from asp.sizes.biorders import all_biorders
+from asp.sizes.evaluate import relabeled_matrices
+from asp.sizes.learner import learn_sizes
+from asp.sizes.truth_oracle import TruthOracle
 from tests._sizes_helpers import Chooser, consistent, experiments_per_truth, known_masks, systematic
 
 

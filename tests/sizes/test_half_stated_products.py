@@ -9,12 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
-from assembly_constraints.asp.sizes.models import build_model, model_for
-from assembly_constraints.asp.sizes.truth_oracle import Result
-from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.assembly import load_assembly
-from assembly_constraints.executor.world.geometry import load_geometry, passes
+from asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
+from asp.sizes.models import build_model, model_for
+from asp.sizes.truth_oracle import Result
+from bridge import BridgeError
+from bridge.assembly import load_assembly
+from executor.world.geometry import load_geometry, passes
 from tests.session.test_mixed_sections import HOLES, PEGS, _product
 
 

@@ -1,7 +1,7 @@
 """Size models on products of mixed cross-sections: sound entailment, weakening, matching.
 
 The truths here come from the cross-sections, as the cell's truth backend answers
-(``assembly_constraints.executor.world.geometry.passes``): a round peg d passes a round hole D when d < D,
+(``executor.world.geometry.passes``): a round peg d passes a round hole D when d < D,
 a square hole S when d < S; a square peg s passes a square hole when s < S and a round
 hole by its diagonal, s·√2 < D. Such relations are not one biorder, so the paper's one
 line entails fits that do not exist; one line per cross-section does not.
@@ -16,16 +16,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.plans.assign import LearnedFacts, UnsolvableAssembly, feasible_assignment
-from assembly_constraints.asp.sizes.biorders import biorder_count
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
-from assembly_constraints.asp.sizes.models import build_model, model_for
-from assembly_constraints.asp.sizes.policies import policy_names
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle, ferrers_violation
-from assembly_constraints.asp.solve import fact
-from assembly_constraints.executor.world.geometry import PartSpec, passes
-from assembly_constraints.executor.world.geometry import Section as CrossSection
+from asp import PlannerError
+from asp.plans.assign import LearnedFacts, UnsolvableAssembly, feasible_assignment
+from asp.sizes.biorders import biorder_count
+from asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
+from asp.sizes.models import build_model, model_for
+from asp.sizes.policies import policy_names
+from asp.sizes.truth_oracle import TruthOracle, ferrers_violation
+from asp.solve import fact
+from executor.world.geometry import PartSpec, passes
+from executor.world.geometry import Section as CrossSection
 
 Section = tuple[str, float, float]
 """(kind, size [m], width [m]) of a peg's or a hole's cross-section: a rect is size x width

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.solve import atoms_by_name, load_atoms
+from asp.solve import atoms_by_name, load_atoms
 
 
 def test_learn_json_follows_the_contract_and_writes_facts(tmp_path: Path, run_cli) -> None:

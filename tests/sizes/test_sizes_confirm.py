@@ -9,13 +9,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.bench.sizes import main as bench_main
-from assembly_constraints.asp.sizes.knowledge import Pair
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes, run_learner
-from assembly_constraints.asp.sizes.policies import policy_names
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.asp.solve import encoding, fact, format_facts
+from asp import PlannerError
+from asp.bench.sizes import main as bench_main
+from asp.sizes.knowledge import Pair
+from asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes, run_learner
+from asp.sizes.policies import policy_names
+from asp.sizes.truth_oracle import TruthOracle
+from asp.solve import encoding, fact, format_facts
 from tests._sizes_helpers import biorders
 
 CRANFIELD = TruthOracle.from_assembly("cranfield")

@@ -7,7 +7,7 @@ import random
 import numpy as np
 import pytest
 
-from assembly_constraints.asp.bench.dominance import (
+from asp.bench.dominance import (
     Relaxation,
     Search,
     add_answer,
@@ -16,7 +16,7 @@ from assembly_constraints.asp.bench.dominance import (
     reductions,
     systematic_counts,
 )
-from assembly_constraints.asp.sizes.biorders import all_biorders
+from asp.sizes.biorders import all_biorders
 from tests._sizes_helpers import consistent, experiments_per_truth, known_masks, systematic
 
 

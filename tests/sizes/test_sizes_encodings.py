@@ -14,7 +14,7 @@ from clintest.test import And, Assert
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.solve import encoding, fact, format_facts
+from asp.solve import encoding, fact, format_facts
 
 TWO_BY_TWO = "part(a;b). hole(x;y). part_index(a,1). part_index(b,2). hole_index(x,1). hole_index(y,2). "
 

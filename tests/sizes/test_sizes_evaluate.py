@@ -6,9 +6,9 @@ from collections import Counter
 
 import pytest
 
-from assembly_constraints.asp.sizes.evaluate import evaluate_policy, relabeled_matrices
-from assembly_constraints.asp.sizes.learner import learn_sizes
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp.sizes.evaluate import evaluate_policy, relabeled_matrices
+from asp.sizes.learner import learn_sizes
+from asp.sizes.truth_oracle import TruthOracle
 
 pytestmark = pytest.mark.slow  # each test evaluates a policy over hundreds of relabelings (3-40 s)
 CRANFIELD = TruthOracle.from_assembly("cranfield")

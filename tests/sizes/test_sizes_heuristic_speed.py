@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp.sizes.knowledge import Knowledge, Pair
-from assembly_constraints.asp.sizes.learner import SizeLearner
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
-from assembly_constraints.asp.solve import encoding, fact, format_facts
+from asp.sizes.knowledge import Knowledge, Pair
+from asp.sizes.learner import SizeLearner
+from asp.sizes.truth_oracle import TruthOracle
+from asp.solve import encoding, fact, format_facts
 from tests._sizes_helpers import biorders
 
 

@@ -9,11 +9,11 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes import learner as learner_module
-from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
-from assembly_constraints.asp.sizes.models import build_model
-from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
+from asp import PlannerError
+from asp.sizes import learner as learner_module
+from asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
+from asp.sizes.models import build_model
+from asp.sizes.truth_oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
 from tests.conftest import ROOT
 
@@ -171,7 +171,7 @@ def test_the_learner_starts_from_demonstrated_fits_and_what_they_entail_with_exp
 
 @pytest.mark.parametrize("policy", ["systematic", "heuristic", "best"])
 def test_annotated_cranfield_demonstrations_save_experiments(policy: str) -> None:
-    from assembly_constraints.asp.sizes.cli import demonstrated_fits
+    from asp.sizes.cli import demonstrated_fits
 
     truth = TruthOracle.from_assembly("cranfield")
     shown = demonstrated_fits(str(ROOT / "data" / "cranfield" / "demos_annotated.txt"), "cranfield")
