@@ -249,7 +249,7 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     by hand (a polygon pair's room is often below what convex pieces of its meshes keep:
     the cell inserts polygon sections of products described by hand, docs/geometry.md)."""
     kept: dict[str, HoleFit] = {}
-    by_hand = {pid: "goes onto a pin: the cell has no operation for it" for pin in derived.pins.values()
+    by_hand = {pid: f"goes onto a pin ({pin.id}): the cell has no operation for it" for pin in derived.pins.values()
                for pid in pin.parts}
     for hid, fit in derived.holes.items():
         if fit.part is not None and derived.axis[fit.part] != "+z":

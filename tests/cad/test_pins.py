@@ -74,4 +74,5 @@ def test_a_washer_and_a_gear_go_onto_the_pins_of_a_plate(tmp_path: Path) -> None
     assert rooms[("gear", "plate_pin1")] < 0 < rooms[("gear", "plate_pin2")] < rooms[("washer", "plate_pin2")]
     manual = tomllib.loads((out / "geometry.toml").read_text())["manual"]
     assert {pid: entry["reason"] for pid, entry in manual.items()} == {
-        pid: "goes onto a pin: the cell has no operation for it" for pid in ("washer", "gear")}
+        "washer": "goes onto a pin (plate_pin1): the cell has no operation for it",
+        "gear": "goes onto a pin (plate_pin2): the cell has no operation for it"}
