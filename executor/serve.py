@@ -142,7 +142,9 @@ class TruthBackend:
     """Answers without simulation, after ``delay_s`` [s]: from the cell's geometry (a part
     passes a hole when its cross-section does,
     :func:`assembly_constraints.executor.world.geometry.passes`), or from the product's
-    ``sizes.lp`` where it has no ``geometry.toml``."""
+    ``sizes.lp`` where it has no ``geometry.toml``; the parts ``geometry.toml`` places by
+    hand answer from ``sizes.lp`` on its holes the geometry has not (the pins an
+    imported part goes onto)."""
 
     def __init__(self, assembly: str, delay_s: float, cell_id: str,
                  recording_id: str | None, rrd: Path | None, viewer: Viewer = NO_VIEWER,
@@ -155,6 +157,13 @@ class TruthBackend:
                 self._manual: set[str] = set(geometry.tables.manual)
                 self._fits = {(p, h) for p, part in geometry.parts.items() for h, hole in geometry.holes.items()
                               if passes(part, hole)}
+                if assembly_of.has_file("sizes.lp"):  # parts placed by hand onto features the cell does not model
+                    pegs, holes, fits = sizes_truth(assembly_of.file("sizes.lp"))
+                    pegs &= self._manual
+                    holes -= self._holes
+                    self._pegs |= pegs
+                    self._holes |= holes
+                    self._fits |= {(p, h) for p, h in fits if p in pegs and h in holes}
             else:
                 self._pegs, self._holes, self._fits = sizes_truth(assembly_of.file("sizes.lp"))
                 self._manual = set()
