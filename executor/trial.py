@@ -79,6 +79,9 @@ class Cell:
                  description: CellDescription | None = None) -> None:
         self.description = CellDescription() if description is None else description
         self.geometry = load_geometry(assembly, self.description)
+        if not self.geometry.parts:
+            raise ExecutorError(f"{self.geometry.folder / 'geometry.toml'}: no part the cell inserts (every part is "
+                                "placed by hand); expected at least one [part_shapes] (the truth backend takes it)")
         if gui:
             require_display()
         self.gui = gui
