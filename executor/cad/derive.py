@@ -29,8 +29,9 @@ loop that is no round, square or rect section is a pocket, reported but no hole.
 
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
-around a solid loop of another part there (the base's pin, another part's shaft) goes
-onto that pin. The pin is a feature of its owner (``<owner>_pin1``, ``_pin2``, ... by
+around a solid loop of another part there (the base's pin, another part's shaft), that
+part the base or one the geometric precedence puts before it, goes onto that pin; a peg
+standing in a hole of the base is no pin (a part over it is a cover). The pin is a feature of its owner (``<owner>_pin1``, ``_pin2``, ... by
 position), its section measured on the owner's slice; the fit is the pin's section inside
 the bore's, so the planner learns which part goes onto which pin as it learns pegs in holes.
 """
@@ -39,6 +40,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import networkx as nx
 import numpy as np
 import trimesh
 
@@ -365,9 +367,13 @@ def _outer(loop: Loop, loops: list[Loop]) -> bool:
 def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     """The pins moving parts go onto and each such part's bore section (module docstring):
     a part whose slice at the middle of its extent along its insertion axis has an inner
-    loop holding the centre of another part's outline there. A bore around no other
-    part's outline (an empty bore) is no fit."""
+    loop holding the centre of another part's outline there, that part the base or one the
+    geometric precedence puts before it (a part that goes in after, into the bore, is no
+    pin: a head in a cover's socket). A bore around no such outline is no fit; nor is one
+    around a peg standing in a hole of the base (that part is a cover,
+    :mod:`assembly_constraints.executor.cad.covers`)."""
     found: list[tuple[str, str, Shape2D, np.ndarray, str]] = []  # owner, axis, pin, centre, part
+    order = nx.DiGraph(list(derived.edges))
     bores: dict[str, Shape2D] = {}
     for pid in sorted(derived.axis):
         if pid in derived.hole_of:
@@ -379,7 +385,8 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
         own = slice_loops(derived.parts[pid].mesh, axis, level)
         frame = frame_of(axis)
         for bore in (loop for loop in own if not _outer(loop, own)):
-            for other in sorted(set(derived.parts) - {pid}):
+            before = nx.ancestors(order, pid) if pid in order else set()
+            for other in sorted(({derived.base} | before) - set(derived.hole_of)):
                 theirs = slice_loops(derived.parts[other].mesh, axis, level)
                 inside = [o for o in theirs if _outer(o, theirs) and bore.contains(o.centre) and o.area < bore.area]
                 if len(inside) == 1:
