@@ -31,9 +31,10 @@ loop that is no round, square or rect section is a pocket, reported but no hole.
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
 around a solid loop of another part there (the base's pin, another part's shaft), that
 part the base or one the geometric precedence puts before it, goes onto that pin; a peg
-standing in a hole of the base is no pin (a part over it is a cover). The pin is a feature of its owner (``<owner>_pin1``, ``_pin2``, ... by
-position), its section measured on the owner's slice; the fit is the pin's section inside
-the bore's, so the planner learns which part goes onto which pin as it learns pegs in holes.
+standing in a hole of the base is no pin (a part over it is a cover). The pin is a
+feature of its owner (``<owner>_pin1``, ``_pin2``, ... by position), its section measured
+on the owner's slice; the fit is the pin's section inside the bore's, so the planner
+learns which part goes onto which pin as it learns pegs in holes.
 """
 
 from __future__ import annotations
