@@ -32,7 +32,7 @@ from assembly_constraints.asp.precedence.learn import learn_must_precede
 from assembly_constraints.asp.precedence.relation import Relation, precedence_facts
 from assembly_constraints.asp.session.journal import JOURNAL_NAME, JournalEntry, read_journal
 from assembly_constraints.asp.session.settings import SessionFile, SessionSettings, read_session_file
-from assembly_constraints.asp.sizes.learner import Experiment, SizeLearningResult
+from assembly_constraints.asp.sizes.learner import Experiment, LearningOptions, SizeLearningResult
 from assembly_constraints.asp.sizes.learner import learn_sizes as _learn_sizes
 from assembly_constraints.asp.sizes.truth_oracle import Oracle, TruthOracle
 from assembly_constraints.asp.solve import write_facts as _write_facts
@@ -94,7 +94,8 @@ def learn_sizes(oracle: Oracle | Callable[[str, str], Result], parts: Sequence[s
     """
     asker = oracle if hasattr(oracle, "ask") else _CallableOracle(oracle)
     report = None if on_experiment is None else (lambda experiment, _knowledge: on_experiment(experiment))
-    return _learn_sizes(parts, holes, asker, policy, seed, on_experiment=report, confirm=confirm)
+    return _learn_sizes(parts, holes, asker, policy, seed, on_experiment=report,
+                        options=LearningOptions(confirm=confirm))
 
 
 def write_facts(path: str | Path, precedence: Relation | None = None,

@@ -265,15 +265,26 @@ class _Sent:
     cancel: zenoh.CancellationToken
 
 
+@dataclass(frozen=True)
+class PoolLimits:
+    """How long a :class:`CellPool` waits and how often it retries: ``timeout`` [s] bounds
+    one attempt at one cell; ``wait_for_cell`` [s] bounds a wait while no usable cell is
+    alive; ``max_failures`` bounds the failed attempts of one request; a cell that misses
+    ``max_misses`` replies in a row is dropped for the rest of the pool's life."""
+
+    timeout: float = 60.0
+    wait_for_cell: float = 60.0
+    max_failures: int = 3
+    max_misses: int = 2
+
+
 class CellPool:
     """Keeps every alive cell busy with submitted requests, with failover (module doc).
 
     :meth:`submit` queues a request (distinct ids); :meth:`next_reply` dispatches queued
     requests to idle alive cells and returns the next finished request and its reply;
-    each submitted request is returned exactly once. ``timeout`` [s] bounds one attempt
-    at one cell; ``wait_for_cell`` [s] bounds a wait while no usable cell is alive;
-    ``max_failures`` bounds the failed attempts of one request; a cell that misses
-    ``max_misses`` replies in a row is dropped for the rest of the pool's life. Only the
+    each submitted request is returned exactly once, within ``limits``
+    (:class:`PoolLimits`). Only the
     cells in ``allowed`` are used (None: any cell that shows a token). ``exit_status(cell)``
     gives the exit status of a cell's process when this planner started it and it has
     ended (None otherwise; it may wait a moment for a process whose links just closed, and
@@ -288,16 +299,15 @@ class CellPool:
     Close it when done.
     """
 
-    def __init__(self, session: zenoh.Session, directory: CellDirectory, *,
-                 timeout: float = 60.0, wait_for_cell: float = 60.0, max_failures: int = 3,
-                 max_misses: int = 2, allowed: Collection[str] | None = None,
+    def __init__(self, session: zenoh.Session, directory: CellDirectory, limits: PoolLimits = PoolLimits(), *,
+                 allowed: Collection[str] | None = None,
                  exit_status: Callable[[str], int | None] | None = None) -> None:
         self._session = session
         self._directory = directory
-        self.timeout = timeout
-        self.wait_for_cell = wait_for_cell
-        self.max_failures = max_failures
-        self.max_misses = max_misses
+        self.timeout = limits.timeout
+        self.wait_for_cell = limits.wait_for_cell
+        self.max_failures = limits.max_failures
+        self.max_misses = limits.max_misses
         self._allowed = None if allowed is None else frozenset(allowed)
         self._attempts = itertools.count()
         self._events: queue.SimpleQueue[tuple] = queue.SimpleQueue()

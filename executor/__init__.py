@@ -10,8 +10,8 @@ stepper), ``skills`` (DMP, hole search, insertion, wiggle, teaching), the record
 ``evidence``, the Rerun log ``rerun_log``, the trial ``trial``, and on top ``campaign``,
 ``serve`` (with the backend interface ``backend_plugin`` and the replay backend ``replay``)
 and ``cli``; beside them ``cad``, a product from its CAD (on ``world`` and ``assembly``).
-One exception: teaching (``skills.teach``) drives a ``trial.Cell`` to record the skills
-the trial then uses.
+Teaching (``skills.teach``) drives any cell with a hand (its ``TeachingCell`` protocol,
+which ``trial.Cell`` meets) to record the skills the trial then uses.
 """
 
 
@@ -24,3 +24,7 @@ class ExecutorError(ToolError):
     The message names the bad value and what was expected; the command line prints
     ``error: <message>`` and exits with code 2.
     """
+
+
+class UnknownPair(ExecutorError):
+    """The request names a part or hole the cell does not have."""

@@ -38,13 +38,9 @@ from typing import Protocol
 
 from assembly_constraints.bridge.inputs import shorten
 from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
-from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor import ExecutorError, UnknownPair
 
 _SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
-
-
-class UnknownPair(ExecutorError):
-    """The request names a part or hole the cell does not have."""
 
 
 class InvalidStep(ExecutorError):

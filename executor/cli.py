@@ -46,8 +46,14 @@ MAX_ATTEMPTS = 10
 
 def _teach(args: argparse.Namespace) -> int:
     from assembly_constraints.executor.skills.teach import teach_all
+    from assembly_constraints.executor.trial import Cell
 
-    for path in teach_all(args.assembly):
+    cell = Cell(args.assembly)
+    try:
+        written = teach_all(cell)
+    finally:
+        cell.close()
+    for path in written:
         print(f"wrote {path}")
     return 0
 
@@ -75,9 +81,9 @@ def _trial(args: argparse.Namespace) -> int:
 def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
     """The trials of ``executor trial``, recorded to ``args.rrd`` and streamed to ``live``;
     with ``viewer.serve`` the web viewer stays up at the end until Ctrl-C."""
-    from assembly_constraints.executor.trial import Cell, cell_keywords
+    from assembly_constraints.executor.trial import Cell, cell_setup
 
-    keywords = cell_keywords(cell_settings_of(args))  # the cell description checked before anything is written
+    setup = cell_setup(cell_settings_of(args))  # the cell description checked before anything is written
     logger = None
     if args.plot:
         from assembly_constraints.bridge.files import check_writable
@@ -87,7 +93,7 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
         from assembly_constraints.executor.rerun_log import AttemptLogger
 
         logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
-    cell = Cell(args.assembly, gui=args.gui, logger=logger, **keywords)
+    cell = Cell(args.assembly, gui=args.gui, logger=logger, setup=setup)
     try:
         results = []
         for k in range(args.trials):

@@ -123,6 +123,25 @@ class SceneShape(NamedTuple):
     color: Sequence[int] | None = None
 
 
+@dataclass(frozen=True)
+class TraceStep:
+    """One control step as logged: ``sim_time`` [s] as the cell reported it, ``phase`` (DMP
+    phase), ``tool_pos`` (3,) [m], ``force_mes``/``force_des`` (3,) [N] measured and
+    desired, ``torque_mes``/``torque_des`` (3,) [Nm]; ``arm_pose``: the arm's link poses
+    (:meth:`assembly_constraints.executor.rerun_arm.ArmRecorder.sample`) or None;
+    ``wall_time`` [s since the epoch]: when it was logged."""
+
+    sim_time: float
+    phase: float
+    tool_pos: np.ndarray
+    force_mes: np.ndarray
+    force_des: np.ndarray
+    torque_mes: np.ndarray
+    torque_des: np.ndarray
+    arm_pose: np.ndarray | None
+    wall_time: float
+
+
 @dataclass
 class AttemptTrace:
     """The buffered samples of one attempt (also kept for plots, e.g. Fig. 17).
@@ -151,24 +170,15 @@ class AttemptTrace:
     search_step: int = 0
     """The hole-search path ``(N, 3)`` [m] and the step it was logged at (when the search ended)."""
 
-    def add(
-        self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
-        force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray,
-        arm_pose: np.ndarray | None = None, wall_time: float | None = None,
-    ) -> None:
-        """Append one step (units as in the class docstring; ``arm_pose``: the arm's link
-        poses, see :meth:`assembly_constraints.executor.rerun_arm.ArmRecorder.sample`; ``wall_time``: now when
-        None)."""
-        if arm_pose is not None:
-            self.arm_poses.append(arm_pose)
-        self.sim_time.append(float(sim_time))
-        self.wall_time.append(time.time() if wall_time is None else wall_time)
-        self.phase.append(float(phase))
-        for name, value in (
-            ("tool_pos", tool_pos), ("force_mes", force_mes), ("force_des", force_des),
-            ("torque_mes", torque_mes), ("torque_des", torque_des),
-        ):
-            getattr(self, name).append(np.array(value, dtype=np.float64))
+    def add(self, step: TraceStep) -> None:
+        """Append one step (:class:`TraceStep`)."""
+        if step.arm_pose is not None:
+            self.arm_poses.append(step.arm_pose)
+        self.sim_time.append(float(step.sim_time))
+        self.wall_time.append(step.wall_time)
+        self.phase.append(float(step.phase))
+        for name in ("tool_pos", "force_mes", "force_des", "torque_mes", "torque_des"):
+            getattr(self, name).append(np.array(getattr(step, name), dtype=np.float64))
 
     def insertion(self) -> np.ndarray:
         """Indices of the DMP insertion's steps (wiggles included): those logged with
@@ -243,7 +253,7 @@ class AttemptLogger:
         self._time_offset = 0.0  # [s] added to the cell's sim_time
         self._last_time = 0.0  # [s] last logged (offset) sim time
         self._sent_steps = False
-        self._skipped: tuple[Any, ...] | None = None  # last step not kept (yet)
+        self._skipped: TraceStep | None = None  # last step not kept (yet)
         self._arm: ArmRecorder | None = None
         self._arm_static_sent = False
         self._held: str | None = None
@@ -362,14 +372,14 @@ class AttemptLogger:
         """
         trace = self._require_attempt("log_step")
         arm_pose = None if self._arm is None else self._arm.sample()
-        step = (sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des, arm_pose, time.time())
+        step = TraceStep(sim_time, phase, tool_pos, force_mes, force_des, torque_mes, torque_des, arm_pose, time.time())
         if trace.sim_time:
             if sim_time - trace.sim_time[-1] < self.period_s - _TIME_TOLERANCE:
                 self._skipped = step
                 return
         elif self._sent_steps and sim_time + self._time_offset <= self._last_time:
             self._time_offset = self._last_time + _ATTEMPT_GAP_S - sim_time
-        trace.add(*step)
+        trace.add(step)
         self._skipped = None
 
     def log_search_path(self, points: np.ndarray) -> None:
@@ -385,7 +395,7 @@ class AttemptLogger:
         trace = self._require_attempt("end_attempt")
         trace.outcome = evidence.outcome
         if self._skipped is not None:
-            trace.add(*self._skipped)
+            trace.add(self._skipped)
             self._skipped = None
         if trace.sim_time:
             self._send_steps(trace)

@@ -18,22 +18,28 @@ from __future__ import annotations
 
 import time
 import zlib
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from assembly_constraints.bridge.cell_settings import CellSettings, Magnitudes
-from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor import ExecutorError, UnknownPair
 from assembly_constraints.executor.cell_description import CellDescription, load_cell_description
 from assembly_constraints.executor.control.controller import ImpedanceController
 from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import ExecutionLayer, Ilc, correction_norm, layer_named
-from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, Motion
 from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup, TrialResult
 from assembly_constraints.executor.rerun_arm import ArmRecorder
-from assembly_constraints.executor.skills.dmp import Skill, load_skill
-from assembly_constraints.executor.skills.insertion import insert_in_layer, needs_yaw_compliance, rotvec_quat_xyzw
+from assembly_constraints.executor.skills.dmp import Skill, load_product_skill
+from assembly_constraints.executor.skills.insertion import (
+    InsertionTask,
+    insert_in_layer,
+    needs_yaw_compliance,
+    rotvec_quat_xyzw,
+)
 from assembly_constraints.executor.skills.search import hole_search
 from assembly_constraints.executor.world.arm import Arm, aligned_yaw, tool_quat
 from assembly_constraints.executor.world.assets import current_assets
@@ -46,7 +52,6 @@ if TYPE_CHECKING:
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
 PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
-APPROACH_SETTLE_TIME = 0.02  # [s] at the approach pose before the F/T sensor is tared
 
 
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
@@ -54,12 +59,27 @@ def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
     return np.random.default_rng([seed, zlib.crc32(part.encode()), zlib.crc32(hole.encode())])
 
 
-def cell_keywords(settings: CellSettings) -> dict[str, Any]:
-    """Keyword arguments of :class:`Cell` from the cell settings, the cell description file
-    they name read and checked here (BridgeError naming the file, table and key)."""
+@dataclass(frozen=True)
+class CellSetup:
+    """What a simulated cell is, decoded (:func:`cell_setup`): ``layer``, its execution layer
+    (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
+    ``magnitudes``, of its uncertainty (units per field of
+    :class:`assembly_constraints.bridge.cell_settings.Magnitudes`); ``cell_seed``, the seed of
+    its systematic errors; ``description``, its gripper, gains, thresholds, admittance and
+    ILC parameters."""
+
+    layer: str | ExecutionLayer = "full"
+    magnitudes: Magnitudes = field(default_factory=Magnitudes)
+    cell_seed: int = 0
+    description: CellDescription = field(default_factory=CellDescription)
+
+
+def cell_setup(settings: CellSettings) -> CellSetup:
+    """The :class:`CellSetup` of the cell settings, the cell description file they name read
+    and checked here, the one place it is decoded (BridgeError naming the file, table and
+    key)."""
     description = None if settings.description is None else Path(settings.description)
-    return {"layer": settings.layer, "perturbation": settings.magnitudes,
-            "cell_seed": settings.cell_seed, "description": load_cell_description(description)}
+    return CellSetup(settings.layer, settings.magnitudes, settings.cell_seed, load_cell_description(description))
 
 
 class Cell:
@@ -67,17 +87,15 @@ class Cell:
     shape (made on first use), so a trial depends on its seed, the cell seed and, with
     ILC, on the executions before it (the learned corrections) only.
 
-    ``layer``: the execution layer (a name of :data:`assembly_constraints.executor.control.ilc.LAYERS` or one);
-    ``perturbation``/``cell_seed``: the cell's uncertainty and the seed of its systematic
-    part; ``ilc_state``: a JSON file the ILC corrections are read from (if it exists) and
-    saved to after every update; ``description``: the cell's gripper, gains, thresholds,
-    admittance and ILC parameters (default :class:`CellDescription`)."""
+    ``setup``: the execution layer, the magnitudes of the cell's uncertainty and the seed of
+    its systematic part (drawn into ``bias``,
+    :class:`assembly_constraints.executor.world.perturbation.CellBias`), the cell's
+    description (:class:`CellSetup`); ``ilc_state``: a JSON file the ILC corrections are
+    read from (if it exists) and saved to after every update."""
 
     def __init__(self, assembly: str = "cranfield", gui: bool = False, logger: AttemptLogger | None = None,
-                 *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
-                 cell_seed: int = 0, ilc_state: Path | None = None,
-                 description: CellDescription | None = None) -> None:
-        self.description = CellDescription() if description is None else description
+                 *, setup: CellSetup = CellSetup(), ilc_state: Path | None = None) -> None:
+        self.description = setup.description
         self.geometry = load_geometry(assembly, self.description)
         if not self.geometry.parts:
             raise ExecutorError(f"{self.geometry.folder / 'geometry.toml'}: no part the cell inserts (every part is "
@@ -88,7 +106,7 @@ class Cell:
         self.logger = logger
         self.thresholds = self.description.thresholds
         self.ilc_state = ilc_state
-        self.reset_state(layer=layer, perturbation=perturbation, cell_seed=cell_seed)
+        self.reset_state(layer=setup.layer, magnitudes=setup.magnitudes, cell_seed=setup.cell_seed)
         self._skills: dict[str, Skill] = {}
         self._scenes: dict[str, Scene] = {}  # one PyBullet client per part shape
         self._motions: dict[str, Motion] = {}
@@ -102,26 +120,26 @@ class Cell:
             logger.log_hole_rims(hole_rims(self.geometry))
             logger.log_arm_at_rest(self._arm_of(min(self.geometry.parts.items())[1].shape))
 
-    def reset_state(self, *, layer: str | ExecutionLayer = "full", perturbation: Magnitudes | None = None,
+    def reset_state(self, *, layer: str | ExecutionLayer = "full", magnitudes: Magnitudes | None = None,
                     cell_seed: int = 0) -> None:
         """Become another cell on the same PyBullet clients: this execution layer, new
         systematic errors, the ILC corrections of ``ilc_state`` (if it exists) or none."""
         self.layer = layer_named(layer) if isinstance(layer, str) else layer
-        self.bias = CellBias(Magnitudes() if perturbation is None else perturbation, cell_seed)
+        self.bias = CellBias(Magnitudes() if magnitudes is None else magnitudes, cell_seed)
         d = self.description
         self.ilc = Ilc(d.ilc, d.gains, d.admittance)
         if self.ilc_state is not None:
             self.ilc.load(self.ilc_state)
 
     def check_pair(self, part: str, hole: str) -> Skill:
-        """The taught skill of ``part``'s shape; ExecutorError naming an unknown part or hole."""
+        """The taught skill of ``part``'s shape; UnknownPair naming an unknown part or hole."""
         if part not in self.geometry.parts:
-            raise ExecutorError(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
+            raise UnknownPair(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
-            raise ExecutorError(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.geometry.holes))})")
+            raise UnknownPair(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.geometry.holes))})")
         shape = self.geometry.parts[part].shape
         if shape not in self._skills:
-            self._skills[shape] = load_skill(self.geometry.folder, shape)
+            self._skills[shape] = load_product_skill(self.geometry, shape)
         return self._skills[shape]
 
     def motion_for(self, part: str) -> Motion:
@@ -157,8 +175,9 @@ class Cell:
         return self._arms[shape]
 
     def run_trial(self, part: str, hole: str, seed: int, max_attempts: int = 2) -> TrialResult:
-        """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts."""
-        self.check_pair(part, hole)
+        """Insert ``part`` into ``hole`` with up to ``max_attempts`` attempts; UnknownPair
+        naming an unknown part or hole."""
+        skill = self.check_pair(part, hole)
         if max_attempts < 1:
             raise ExecutorError(f"max_attempts = {max_attempts}: expected at least 1")
         rng = trial_rng(seed, part, hole)
@@ -167,7 +186,7 @@ class Cell:
         for attempt in range(1, max_attempts + 1):
             if self.logger is not None:
                 self.logger.begin_attempt(part, hole, seed, attempt)
-            ev = self.run_attempt(part, hole, self.draw_setup(rng, part, hole))
+            ev = self._attempt(part, hole, skill, self.draw_setup(rng, part, hole))
             if self.logger is not None:
                 self.logger.end_attempt(ev)
             evidence.append(ev)
@@ -190,8 +209,13 @@ class Cell:
 
     def run_attempt(self, part: str, hole: str, setup: AttemptSetup, wiggle_enabled: bool = True) -> AttemptEvidence:
         """One attempt under given circumstances; the part returns to its start after."""
+        return self._attempt(part, hole, self.check_pair(part, hole), setup, wiggle_enabled)
+
+    def _attempt(self, part: str, hole: str, taught: Skill, setup: AttemptSetup,
+                 wiggle_enabled: bool = True) -> AttemptEvidence:
+        """:meth:`run_attempt` with the pair checked and its taught skill given."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
-        skill = self.check_pair(part, hole).in_hole(hole_spec.depth)
+        skill = taught.in_hole(hole_spec.depth)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
         sim0 = motion.steps
@@ -218,9 +242,9 @@ class Cell:
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
         lever = spec.length - self.geometry.gripper.grasp_depth
-        result = insert_in_layer(motion, skill, origin, detector, layer, lever, description=self.description,
-                                 wiggle_enabled=wiggle_enabled, correction=correction, yaw=yaw,
-                                 yaw_compliant=needs_yaw_compliance(spec.kind, hole_spec.kind))
+        task = InsertionTask(origin, lever, yaw, needs_yaw_compliance(spec.kind, hole_spec.kind), correction,
+                             wiggle_enabled)
+        result = insert_in_layer(motion, skill, detector, task, layer, description=self.description)
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

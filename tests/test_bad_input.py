@@ -28,7 +28,8 @@ import pytest
 from assembly_constraints.asp.session.journal import MAX_JOURNAL_BYTES
 from assembly_constraints.bridge.assembly import load_assembly
 from assembly_constraints.bridge.errors import EXIT_BROKEN_PIPE
-from tests.conftest import CLI_MODULE, ROOT, child_env, python_argv
+from assembly_constraints.cli import main
+from tests.conftest import CLI_MODULE, ROOT, child_env, error_lines, python_argv
 
 CRANFIELD = ROOT / "data" / "cranfield"
 TRUTH = (str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"))
@@ -92,6 +93,35 @@ def geometry(old: str, new: str) -> Callable[[Path], None]:
     return assembly(**{"geometry.toml": (CRANFIELD / "geometry.toml").read_text().replace(old, new, 1)})
 
 
+def taught(path: str, old: str, new: str) -> Callable[[Path], None]:
+    """Setup: a copy of the spare-hole plate in ``asm/`` with its skills, ``old`` replaced
+    by ``new`` in its file ``path`` (a product changed since its skills were taught)."""
+
+    def setup(tmp: Path) -> None:
+        shutil.copytree(ROOT / "data" / "spare", tmp / "asm", ignore=shutil.ignore_patterns("assets"))
+        edited = tmp / "asm" / path
+        text = edited.read_text()
+        assert old in text
+        edited.write_text(text.replace(old, new, 1))
+
+    return setup
+
+
+def prior(*margins: str) -> dict[str, str | bytes]:
+    """Setup: a product ``pr`` of two round pegs (u, v) and three holes (k1 k2 k3), its CAD
+    prior ``nominal_sizes.lp`` holding six consistent margins and then ``margins``."""
+    return {"pr/assembly.toml": "name = 'pr'\n[parts.u]\nshape = 'round'\n[parts.v]\nshape = 'round'\n"
+                                "[holes.k1]\n[holes.k2]\n[holes.k3]\n",
+            "pr/sizes.lp": "part(u;v). hole(k1;k2;k3). fits(u,k1). fits(u,k2). fits(u,k3). fits(v,k3).\n",
+            "pr/nominal_sizes.lp": "\n".join(["nominal_margin(u,k1,800).", "nominal_margin(u,k2,400).",
+                                               "nominal_margin(u,k3,1200).", "nominal_margin(v,k1,-400).",
+                                               "nominal_margin(v,k2,-20).", "nominal_margin(v,k3,300).",
+                                               *margins]) + "\n"}
+
+
+PRIOR = ("sizes", "learn", "--assembly", "pr", "--prior", "cad", "--tolerance", "0.0001")
+
+
 def plan_file(name: str, change: Callable[[list[dict]], object]) -> Callable[[Path], None]:
     """Setup: ``name`` holding Cranfield's first plan (real clingo, true facts) as ``plan
     --json`` prints it, after ``change`` edited its list of steps in place."""
@@ -137,6 +167,36 @@ def huge_journal(run: Path) -> None:
     (run / "session.json").write_text('{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}')
     with (run / "journal.jsonl").open("wb") as file:
         file.truncate(MAX_JOURNAL_BYTES + 1)
+
+
+PROBES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
+    # the probes of the newer inputs, new values of the same kinds: a prior that is a program
+    # (unbounded grounding), contradicts itself or names what the product lacks; numbers out of
+    # range; empty output paths; a FIFO as a recording
+    ("prior-interval-of-other-name", PRIOR, prior("k(1..60000000)."), 2, "nominal_sizes.lp:7: k((1..60000000))"),
+    ("prior-pool", PRIOR, prior("nominal_margin(v,k2,(-20;650))."), 2, "nominal_sizes.lp:7:"),
+    ("prior-contradicts", PRIOR, prior("nominal_margin(v,k2,650)."), 2,
+     "nominal_sizes.lp:7: nominal_margin(v,k2,650) contradicts line 5: nominal_margin(v,k2,-20)"),
+    ("prior-unknown-hole", PRIOR, prior("nominal_margin(u,k9,100)."), 2, "unknown part or hole k9"),
+    ("prior-function-id", PRIOR, prior("nominal_margin(f(u),k1,100)."), 2, "nominal_sizes.lp:7:"),
+    ("serve-delay-over-an-hour", ("executor", "serve", "--delay", "3601"), None, 2, "[0, 3600]"),
+    ("session-cells-65", ("session", "--cells", "65"), None, 2, "from 0 to 64"),
+    ("trial-trials-over", ("executor", "trial", "--part", "p1", "--hole", "r1", "--trials", "100001"), None, 2,
+     "from 1 to 100000"),
+    ("assemble-save-empty", ("assemble", "--save", ""), None, 2, "expected a path, got the empty string"),
+    ("view-fifo-in-run", ("view", "run", "--print"),
+     lambda tmp: ((tmp / "run").mkdir(), os.mkfifo(tmp / "run" / "c3.rrd")), 2, "c3.rrd: not a regular file (a FIFO)"),
+    # a skill taught on a section the product no longer has: refused before the cell serves
+    ("serve-sim-peg-resized", ("executor", "serve", "--assembly", "asm", "--listen", "tcp/127.0.0.1:0"),
+     taught("geometry.toml", "size = 0.0120           # diameter [m]", "size = 0.0125"), 2,
+     "taught on part p1 round 12.00 x 12.00 mm, the product's p1 is round 12.50 x 12.50 mm"),
+    ("trial-hole-resized", ("executor", "trial", "--assembly", "asm", "--part", "p3", "--hole", "r1"),
+     taught("geometry.toml", "size = 0.0133           # side [m]", "size = 0.0131"), 2,
+     "taught on hole s1 square 13.30 x 13.30 mm, the product's s1 is square 13.10 x 13.10 mm"),
+]
+"""Rows of the probes of the newer inputs, refused before any process starts or any cell
+serves: fast enough for the quick loop, they also run in this process
+(:func:`test_a_probe_gives_one_line_error_in_this_process`)."""
 
 
 CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
@@ -489,6 +549,7 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
+    *PROBES,
 ]
 
 
@@ -511,19 +572,41 @@ def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
             process.wait()
 
 
+def _set_up(setup: Setup, tmp: Path) -> None:
+    """The input files of a row in ``tmp`` (and ``facts.lp``, which rows use as a good one)."""
+    (tmp / "facts.lp").write_text("part(p1). hole(r1). fits(p1,r1).\n")
+    if callable(setup):
+        setup(tmp)
+    elif setup:
+        for name, content in setup.items():
+            path = tmp / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(content if isinstance(content, bytes) else content.encode())
+
+
+@pytest.mark.parametrize(("argv", "setup", "code", "word"), [case[1:] for case in PROBES],
+                         ids=[case[0] for case in PROBES])
+def test_a_probe_gives_one_line_error_in_this_process(argv: tuple[str, ...], setup: Setup, code: int, word: str,
+                                                      tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    _set_up(setup, tmp_path)
+    monkeypatch.chdir(tmp_path)
+    capsys.readouterr()
+    try:
+        returncode = main(list(argv))
+    except SystemExit as exit_:  # argparse's errors
+        returncode = exit_.code
+    lines = error_lines(capsys.readouterr().err)
+    assert returncode == code and len(lines) == 1 and lines[0].startswith("error: "), (returncode, lines)
+    assert word in lines[0]
+
+
 @pytest.mark.slow  # one process per case: about 0.5 s each
 @pytest.mark.parametrize(("argv", "setup", "code", "word"), [case[1:] for case in CASES],
                          ids=[case[0] for case in CASES])
 def test_bad_input_gives_one_line_error(argv: tuple[str, ...], setup: Setup, code: int, word: str,
                                         tmp_path: Path) -> None:
-    (tmp_path / "facts.lp").write_text("part(p1). hole(r1). fits(p1,r1).\n")
-    if callable(setup):
-        setup(tmp_path)
-    elif setup:
-        for name, content in setup.items():
-            path = tmp_path / name
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    _set_up(setup, tmp_path)
     returncode, stderr = _run(argv, tmp_path, head=code == EXIT_BROKEN_PIPE)
     lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("pybullet build time")]
     assert "Traceback" not in stderr, stderr[-3000:]

@@ -5,6 +5,7 @@ from ``/proc``."""
 
 from __future__ import annotations
 
+import os
 import re
 import signal
 import socket
@@ -63,16 +64,24 @@ def _line(process: subprocess.Popen[str], pattern: str, timeout: float = 120.0) 
     raise AssertionError(f"no line matching {pattern!r} in {''.join(seen)[-2000:]}")
 
 
-def _stop_with_sigterm(process: subprocess.Popen[str]) -> set[int]:
-    """SIGTERM ``process``; returns those of its descendants (before the signal) still running."""
+def _stop_by_signal(process: subprocess.Popen[str], signum: int = signal.SIGTERM) -> set[int]:
+    """SIGTERM (or ``signum``) ``process``; returns those of its descendants (before the
+    signal) still running."""
     before = descendants(process.pid)
     assert before, "the command started no process of its own"
-    process.send_signal(signal.SIGTERM)
+    process.send_signal(signum)
     process.communicate(timeout=60)
     deadline = time.monotonic() + 5.0
     while time.monotonic() < deadline and any(running(pid) for pid in before):
         time.sleep(0.1)
     return {pid for pid in before if running(pid)}
+
+
+def _accepts(address: str) -> bool:
+    """Something accepts connections on the port of ``address`` (``http://127.0.0.1:PORT/...``)."""
+    port = int(address.split(":")[2].split("/")[0])
+    with socket.socket() as probe:
+        return probe.connect_ex(("127.0.0.1", port)) == 0
 
 
 def _recording(path: Path) -> Path:
@@ -92,7 +101,7 @@ def test_view_web_stopped_by_sigterm_stops_its_web_viewer(tmp_path: Path, cli_ar
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         address = _line(view, r"http://127\.0\.0\.1:\d+/\S*").group(0)
-        left = _stop_with_sigterm(view)
+        left = _stop_by_signal(view)
     finally:
         view.kill()
     assert view.returncode == EXIT_TERMINATED
@@ -110,25 +119,52 @@ def test_a_session_stopped_by_sigterm_stops_its_cells(tmp_path: Path, cli_argv: 
                                cwd=ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         _line(session, r"experiment 1 on c\d")
-        left = _stop_with_sigterm(session)
+        left = _stop_by_signal(session)
     finally:
         session.kill()
     assert session.returncode == EXIT_TERMINATED
     assert not left, f"still running after SIGTERM: {left}"
 
 
-def test_a_router_on_port_0_reports_the_port_it_bound(cli_argv: Callable[..., list[str]]) -> None:
-    router = subprocess.Popen(cli_argv("router", "--listen", "tcp/127.0.0.1:0"), cwd=ROOT, env=child_env(),
+@pytest.mark.parametrize(("argv", "ready"), [
+    (("router",), r"ready router \w+ listen tcp/127\.0\.0\.1:(\d+)\n"),
+    (("executor", "serve", "--backend", "truth", "--cell", "c5"),
+     r"ready cell c5 backend truth listen \['tcp/127\.0\.0\.1:(\d+)'\] connect \[\]\n")])
+def test_a_listener_on_port_0_reports_the_port_it_bound(argv: tuple[str, ...], ready: str,
+                                                        cli_argv: Callable[..., list[str]]) -> None:
+    listener = subprocess.Popen(cli_argv(*argv, "--listen", "tcp/127.0.0.1:0"), cwd=ROOT, env=child_env(),
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        assert router.stdout is not None
-        ready = router.stdout.readline()
-        match = re.fullmatch(r"ready router \w+ listen tcp/127\.0\.0\.1:(\d+)\n", ready)
-        assert match and int(match.group(1)) != 0, ready
-        with socket.socket() as probe:  # the router listens there
+        assert listener.stdout is not None
+        line = listener.stdout.readline()
+        match = re.fullmatch(ready, line)
+        assert match and int(match.group(1)) != 0, line
+        with socket.socket() as probe:  # it listens there
             assert probe.connect_ex(("127.0.0.1", int(match.group(1)))) == 0
-        router.send_signal(signal.SIGTERM)
-        router.communicate(timeout=30)
+        listener.send_signal(signal.SIGTERM)
+        listener.communicate(timeout=30)
     finally:
-        router.kill()
-    assert router.returncode == 0
+        listener.kill()
+    assert listener.returncode == 0
+
+
+@pytest.mark.slow  # the Rerun web viewer's start (~2 s)
+def test_view_web_killed_by_sigkill_leaves_no_web_viewer(tmp_path: Path, cli_argv: Callable[..., list[str]]) -> None:
+    """SIGKILL runs no handler and no ``finally``: the Rerun server dies with its parent by
+    the death signal the kernel sends it."""
+    rrd = _recording(tmp_path / "c2.rrd")
+    view = subprocess.Popen(cli_argv("view", str(rrd), "--web"), cwd=ROOT, env=child_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        address = _line(view, r"http://127\.0\.0\.1:\d+/\S*").group(0)
+        left = _stop_by_signal(view, signal.SIGKILL)
+        for pid in left:  # not left to the next test
+            os.kill(pid, signal.SIGKILL)
+    finally:
+        view.kill()
+    assert view.returncode == -signal.SIGKILL
+    assert not left, f"still running after SIGKILL: {left}"
+    deadline = time.monotonic() + 5.0  # its sockets close as it exits, whoever reaps it
+    while time.monotonic() < deadline and _accepts(address):
+        time.sleep(0.1)
+    assert_closed(address)

@@ -64,18 +64,20 @@ def test_an_empty_output_path_is_refused_not_the_current_folder(
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize(("mesh", "new"), [
-    ("peg.obj", "v 10.005 0.005 0.04"),  # 10 m away
-    ("peg.obj", "v 5.0 -4.0 3.0"),  # the size of a room
-    ("peg.convex.obj", "v nan 0.005 0.036"),
+@pytest.mark.parametrize(("mesh", "new", "reach"), [
+    ("peg.obj", "v 10.005 0.005 0.04", 0.5),  # 10 m away
+    ("peg.obj", "v 5.0 -4.0 3.0", 0.5),  # the size of a room
+    ("peg.convex.obj", "v nan 0.005 0.036", 0.5),
+    ("plate.obj", "v 0.02 inf 0.0", 2.0),  # the base: a static mesh, no pieces, checked as well
+    ("plate.obj", "v -0.01 0.03 -2.5", 2.0),
 ])
 def test_a_mesh_far_from_its_part_or_not_finite_is_refused_with_the_range(
-        product: Path, mesh: str, new: str) -> None:  # noqa: F811 (the fixture)
+        product: Path, mesh: str, new: str, reach: float) -> None:  # noqa: F811 (the fixture)
     path = product / "meshes" / mesh
     text = path.read_text()
     old = next(line for line in text.splitlines() if line.startswith("v "))
     path.write_text(text.replace(old, new, 1))
-    if mesh == "peg.obj":  # its entry and pieces follow the edited file, as import writes them
+    if ".convex." not in mesh:  # its entry (and pieces) follow the edited file, as import writes them
         import hashlib
 
         digests = [hashlib.sha256(t.encode()).hexdigest() for t in (text, path.read_text())]
@@ -83,7 +85,8 @@ def test_a_mesh_far_from_its_part_or_not_finite_is_refused_with_the_range(
         pieces = product / "meshes" / "peg.convex.obj"
         pieces.write_text(pieces.read_text().replace(*digests, 1))
     message = _refusal(product)
-    assert f"{path}:" in message and "within [-0.5, 0.5] m" in message and new.split()[1] in message, message
+    assert f"{path}:" in message and f"within [-{reach:g}, {reach:g}] m" in message and new.split()[1] in message, \
+        message
 
 
 def test_a_fifo_given_as_a_recording_says_it_is_not_a_regular_file(tmp_path: Path,

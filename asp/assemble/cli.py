@@ -53,6 +53,7 @@ from assembly_constraints.asp.plans.plans import Plan, plans
 from assembly_constraints.asp.session.settings import SESSION_FILE, SessionFile, read_session_file
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
 from assembly_constraints.bridge.cell_settings import (
+    ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
     cell_settings_of,
@@ -185,9 +186,11 @@ def assemble(settings: AssemblySettings) -> tuple[dict, int]:
     started = time.perf_counter()
     cell = assembling_cell_settings(settings.cell, settings.backend)
     assembly, facts, plan = resolve(settings)
-    with assembling_cell(assembly.folder, settings.seed, settings.timeout_s, backend=settings.backend,
-                         block_holes=settings.block_holes, rrd=settings.rrd, listen=settings.listen,
-                         connect=settings.connect, zenoh_config=settings.zenoh_config, cell=cell) as driver:
+    served = ServeSettings(assembly=str(assembly.folder), backend=settings.backend,
+                           block_holes=tuple(settings.block_holes), rrd=settings.rrd,
+                           zenoh_config=settings.zenoh_config, cell=cell)
+    with assembling_cell(served, settings.seed, settings.timeout_s, listen=settings.listen,
+                         connect=settings.connect) as driver:
         try:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:

@@ -9,12 +9,13 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
+import msgspec
 import zenoh
 
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.session.cells import CellProcess, start_cell
 from assembly_constraints.bridge import BridgeError
-from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, CellSettings, ServeSettings
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.client import CellDirectory, CellTimeout, request_step
 from assembly_constraints.bridge.inputs import shorten
 from assembly_constraints.bridge.messages import StepReply, StepRequest
@@ -67,23 +68,22 @@ class ZenohDriver:
 
 
 @contextmanager
-def assembling_cell(assembly_folder: Path, seed: int, timeout_s: float, *, backend: str = "sim",
-                    block_holes: Sequence[str] = (), rrd: str | None = None, listen: Sequence[str] = (),
-                    connect: Sequence[str] = (), zenoh_config: str | None = None,
-                    cell: CellSettings = DEFAULT_CELL) -> Iterator[ZenohDriver]:
-    """Start one cell (``executor serve``, a fresh world of ``assembly_folder``) on loopback and
-    yield a driver for one plan run in it; the cell is stopped on exit.  ``seed`` seeds the
-    cell's random errors, ``timeout_s`` bounds one step [s], ``cell``: the sim cell's
-    settings (:func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`:
-    uncertainty, layer, cell seed)."""
+def assembling_cell(served: ServeSettings, seed: int, timeout_s: float, *, listen: Sequence[str] = (),
+                    connect: Sequence[str] = ()) -> Iterator[ZenohDriver]:
+    """Start one cell (``executor serve``, a fresh world of ``served.assembly``) on loopback
+    and yield a driver for one plan run in it; the cell is stopped on exit.  ``served``:
+    the cell's settings (backend, ``block_holes``, ``rrd``, ``zenoh_config``, also the
+    planner's; ``cell``: the sim cell's,
+    :func:`assembly_constraints.asp.assemble.settings.assembling_cell_settings`), its cell
+    id and the endpoint it connects to set here; ``seed`` seeds the cell's random errors,
+    ``timeout_s`` bounds one step [s]; ``listen``/``connect``: the planner's endpoints."""
     listen = list(listen) or [LOOPBACK_ANY_PORT]
+    zenoh_config = served.zenoh_config
     session = open_session(listen, connect, None if zenoh_config is None else Path(zenoh_config))
     try:
         listen = bound_endpoints(session, listen)  # the port the cell connects to, as bound
         directory = CellDirectory(session)
-        process = start_cell(ServeSettings(cell_id=CELL_ID, backend=backend, assembly=str(assembly_folder),
-                                           connect=tuple(listen[:1]), rrd=rrd, zenoh_config=zenoh_config,
-                                           block_holes=tuple(block_holes), cell=cell))
+        process = start_cell(msgspec.structs.replace(served, cell_id=CELL_ID, connect=tuple(listen[:1])))
         try:
             # Its queryables reach us with its liveliness token: a step sent before might find no one.
             directory.wait_for(1, timeout=CELL_START_S)

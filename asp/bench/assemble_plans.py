@@ -48,6 +48,7 @@ from assembly_constraints.bridge.assembly import Assembly, load_assembly
 from assembly_constraints.bridge.cell_settings import (
     DEFAULT_CELL,
     CellSettings,
+    ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
     cell_settings_of,
@@ -101,8 +102,8 @@ def run_plan(assembly: Assembly, facts: LearnedFacts, plan: Plan, seed: int, tim
     started = time.perf_counter()
     error = None
     try:
-        with assembling_cell(assembly.folder, seed, timeout_s, backend=backend,
-                             cell=cell) as driver:
+        with assembling_cell(ServeSettings(assembly=str(assembly.folder), backend=backend, cell=cell), seed,
+                             timeout_s) as driver:
             report = execute(facts, plan, driver)
     except AssemblyStopped as exc:
         report, error = exc.report, str(exc)

@@ -40,6 +40,7 @@ from assembly_constraints.asp.precedence.relation import Pair, Relation, reducti
 from assembly_constraints.asp.solve import fact, solve
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
@@ -240,7 +241,7 @@ def main(argv: list[str]) -> int:
         return 2
 
     def cell() -> AbstractContextManager[StepDriver]:
-        return assembling_cell(assembly.folder, args.seed, args.timeout)
+        return assembling_cell(ServeSettings(assembly=str(assembly.folder)), args.seed, args.timeout)
 
     with ThreadPoolExecutor(args.jobs) as pool:
         runs = list(progress(pool.map(lambda run: run_sequence(cell, run), pending), desc="sequences",

@@ -42,7 +42,7 @@ import numpy as np
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.sizes.cli import demonstrated_fits
 from assembly_constraints.asp.sizes.evaluate import evaluate_policy
-from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
 from assembly_constraints.asp.sizes.models import MODELS, model_for
 from assembly_constraints.asp.sizes.policies import get_policy
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
@@ -120,7 +120,8 @@ def demos_rows(demos: str, policies: list[str], seeds: int, seed: int) -> list[d
             rng = random.Random(case)
             parts, holes = rng.sample(truth.parts, len(truth.parts)), rng.sample(truth.holes, len(truth.holes))
             for kind, prior in (("without", []), ("with", demonstrated)):
-                counts[kind].append(learn_sizes(parts, holes, truth, policy, case, demonstrated=prior).count)
+                known = LearningOptions(demonstrated=prior)
+                counts[kind].append(learn_sizes(parts, holes, truth, policy, case, options=known).count)
         rows.append({"policy": policy, "sessions": seeds, "demonstrated": len(demonstrated),
                      **{f"{k}_mean": round(statistics.mean(v), 2) for k, v in counts.items()},
                      **{f"{k}_median": statistics.median(v) for k, v in counts.items()},
@@ -139,7 +140,8 @@ def product_rows(products: list[str], policies: list[str], model: str | None, se
                      "bound_bits": round(size_model.information_bits(len(truth.holes)), 2)}
         for policy in policies:
             runs = range(seed, seed + (seeds if not get_policy(policy).deterministic else 1))
-            results = [learn_sizes(truth.parts, truth.holes, truth, policy, case, model=size_model) for case in runs]
+            under = LearningOptions(model=size_model)
+            results = [learn_sizes(truth.parts, truth.holes, truth, policy, case, options=under) for case in runs]
             if any(r.knowledge.fits != frozenset(truth.fits) for r in results):
                 raise PlannerError(f"bench sizes: policy {policy} learned a wrong relation of {product}")
             row[policy] = round(statistics.mean(r.count for r in results), 2)

@@ -65,14 +65,14 @@ from assembly_constraints.asp.session.settings import (
 )
 from assembly_constraints.asp.session.zenoh_oracle import Finished, ZenohOracle
 from assembly_constraints.asp.sizes.cad_prior import cad_prior
-from assembly_constraints.asp.sizes.learner import SizeLearner, SizeLearningResult
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, SizeLearningResult
 from assembly_constraints.asp.sizes.models import SizeModel, model_for
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.asp.solve import fact, write_facts
 from assembly_constraints.bridge import BridgeError
 from assembly_constraints.bridge.assembly import Assembly, load_assembly
 from assembly_constraints.bridge.cell_settings import DEFAULT_CELL, ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellPool
+from assembly_constraints.bridge.client import CellDirectory, CellPool, PoolLimits
 from assembly_constraints.bridge.files import make_folder
 from assembly_constraints.bridge.recording.layout import Contents, write_blueprint
 from assembly_constraints.bridge.recording.reader import read_recording
@@ -117,9 +117,12 @@ def _run_folder(settings: SessionSettings) -> tuple[Path, SessionFile, RunLock, 
         lock.release()
         raise PlannerError(f"--out {run}: already holds a session (its journal); "
                            f"use --resume {run} or another folder")
-    # demos absolute: a resume may run from another folder
+    # demos and a product folder absolute (a shipped product by its name): a resume may run from another folder
     demos = None if settings.demos is None else str(Path(settings.demos).absolute())
-    return run, new_session_file(msgspec.structs.replace(settings, demos=demos), str(uuid.uuid4())), lock, created
+    product = Path(settings.assembly)
+    assembly = str(product.absolute()) if (product / "assembly.toml").is_file() else settings.assembly
+    return run, new_session_file(msgspec.structs.replace(settings, demos=demos, assembly=assembly),
+                                 str(uuid.uuid4())), lock, created
 
 
 def _holds_session(run: Path) -> bool:
@@ -390,8 +393,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
     if prior is not None:
         LOG.info("precedence: the geometric prior %s refined by %d demonstration(s)", prior, len(demos.sequences))
-    learner = SizeLearner(parts, holes, record.policy, record.seed,
-                          confirm=record.confirm, demonstrated=demos.placements(), model=model, prior=decided)
+    options = LearningOptions(confirm=record.confirm, demonstrated=demos.placements(), model=model, prior=decided)
+    learner = SizeLearner(parts, holes, record.policy, record.seed, options)
     required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
     run_id = record.recording_id
     listen, connect = _endpoints(settings)
@@ -431,7 +434,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         # by default only its own cells
         allowed = cell_ids if settings.cells > 0 else (list(settings.allow_cells or ()) or None)
         processes = {cell.cell_id: cell for cell in cells}
-        pool = CellPool(session, directory, timeout=settings.timeout_s, wait_for_cell=settings.wait_for_cell_s,
+        pool = CellPool(session, directory, PoolLimits(timeout=settings.timeout_s,
+                                                       wait_for_cell=settings.wait_for_cell_s),
                         allowed=allowed,
                         exit_status=lambda cell: processes[cell].exit_code(CRASH_WAIT_S) if cell in processes else None)
         stack.callback(pool.close)

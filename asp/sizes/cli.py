@@ -19,7 +19,7 @@ from assembly_constraints.asp.precedence.demos import load_demos
 from assembly_constraints.asp.sizes.cad_prior import MAX_TOLERANCE_M, NOMINAL_FILE, cad_prior, prior_text
 from assembly_constraints.asp.sizes.evaluate import evaluate_policy, plot_comparison
 from assembly_constraints.asp.sizes.knowledge import Knowledge
-from assembly_constraints.asp.sizes.learner import MAX_CONFIRM, Experiment, learn_sizes
+from assembly_constraints.asp.sizes.learner import MAX_CONFIRM, Experiment, LearningOptions, learn_sizes
 from assembly_constraints.asp.sizes.models import MODELS, SizeModel, model_for
 from assembly_constraints.asp.sizes.policies import get_policy, policy_names
 from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, Oracle, Result, TruthOracle
@@ -176,15 +176,16 @@ def _learn(args: argparse.Namespace) -> int:
               + " ".join(f"{p}->{h}" for p, h in demonstrated))
     if prior and not args.json:
         print(prior_text(prior, args.tolerance, len(truth.parts) * len(truth.holes)))
-    result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show,
-                         confirm=args.confirm, demonstrated=demonstrated, model=model, prior=prior)
+    options = LearningOptions(confirm=args.confirm, demonstrated=demonstrated, model=model, prior=prior)
+    result = learn_sizes(truth.parts, truth.holes, oracle, args.policy, args.seed, show, options)
     saved = None
     if args.prior:
         # The same session without the prior, against the same truth (and noise seed):
         # what the prior saved is the difference.
         again: Oracle = NoisyOracle(truth, args.noise, args.seed) if args.noise else truth
-        saved = learn_sizes(truth.parts, truth.holes, again, args.policy, args.seed, confirm=args.confirm,
-                            demonstrated=demonstrated, model=model).count - result.count
+        without_prior = LearningOptions(confirm=args.confirm, demonstrated=demonstrated, model=model)
+        saved = learn_sizes(truth.parts, truth.holes, again, args.policy, args.seed,
+                            options=without_prior).count - result.count
         if not args.json:
             print(f"the CAD prior saved {saved} experiments (same policy, seed and truth without it)")
     if not args.json:

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from assembly_constraints.asp import PlannerError
-from assembly_constraints.asp.sizes.learner import SizeLearner, run_learner
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, run_learner
 from assembly_constraints.asp.sizes.policies import get_policy
 from assembly_constraints.asp.sizes.truth_oracle import NoisyOracle, TruthOracle
 from assembly_constraints.bridge.files import write_figure
@@ -121,9 +121,9 @@ def _learner(policy: str, matrix: Matrix, seed: int, confirm: int) -> SizeLearne
     parts, holes = _names(matrix)
     key = (policy, len(parts), len(holes), confirm)
     if not get_policy(policy).deterministic:
-        return SizeLearner(parts, holes, policy, seed, confirm=confirm)
+        return SizeLearner(parts, holes, policy, seed, options=LearningOptions(confirm=confirm))
     if key not in _LEARNERS:
-        _LEARNERS[key] = SizeLearner(parts, holes, policy, seed, confirm=confirm)
+        _LEARNERS[key] = SizeLearner(parts, holes, policy, seed, options=LearningOptions(confirm=confirm))
     learner = _LEARNERS[key]
     learner.reset(seed)
     return learner

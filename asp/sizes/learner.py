@@ -128,6 +128,24 @@ class SizeLearningResult:
         return atoms
 
 
+@dataclass(frozen=True)
+class LearningOptions:
+    """What a size learner knows before its first experiment and how sure it must be.
+
+    ``confirm`` K ≥ 0 [answers]: each essential observation's kept result must lead the
+    other by K+1 answers (0: no confirmation); ``max_answers`` [answers] caps the answers per
+    pair, at least K+1 (None: 5, or 4K+1 if more); ``demonstrated``: (part, hole) pairs
+    demonstrations placed, known to fit (module doc); ``model``: the size model over the
+    parts (None: the paper's ``line``); ``prior``: ((part, hole), result) outcomes known
+    before any experiment."""
+
+    max_answers: int | None = None
+    confirm: int = 0
+    demonstrated: Sequence[Pair] = ()
+    model: SizeModel | None = None
+    prior: Sequence[tuple[Pair, str]] = ()
+
+
 class SizeLearner:
     """Knowledge of one learning session and the choice of its next experiments."""
 
@@ -137,18 +155,12 @@ class SizeLearner:
         holes: Sequence[str],
         policy: str | SelectionPolicy = "systematic",
         seed: int = 0,
-        max_answers: int | None = None,
-        confirm: int = 0,
-        demonstrated: Sequence[Pair] = (),
-        model: SizeModel | None = None,
-        prior: Sequence[tuple[Pair, str]] = (),
+        options: LearningOptions = LearningOptions(),
     ) -> None:
-        """``parts``/``holes`` in index order; ``confirm`` K ≥ 0: each essential
-        observation's kept result must lead the other by K+1 answers (0: no confirmation);
-        ``max_answers`` caps the answers per pair, at least K+1 (default 5, or 4K+1 if more);
-        ``demonstrated``: (part, hole) pairs demonstrations placed, known to fit (module doc);
-        ``model``: the size model over ``parts`` (default: the paper's ``line``);
-        ``prior``: ((part, hole), result) outcomes known before any experiment."""
+        """``parts``/``holes`` in index order; ``policy`` chooses the experiments, with its
+        random ``seed``; ``options``: :class:`LearningOptions`."""
+        max_answers, confirm, demonstrated, model, prior = (options.max_answers, options.confirm,
+                                                            options.demonstrated, options.model, options.prior)
         if len(set(parts) | set(holes)) != len(parts) + len(holes):
             raise PlannerError("parts and holes need distinct ids")
         if not 0 <= confirm <= MAX_CONFIRM:
@@ -527,16 +539,13 @@ def learn_sizes(
     policy: str | SelectionPolicy = "systematic",
     seed: int = 0,
     on_experiment: Callable[[Experiment, Knowledge], None] | None = None,
-    max_answers: int | None = None,
-    confirm: int = 0,
-    demonstrated: Sequence[Pair] = (),
-    model: SizeModel | None = None,
-    prior: Sequence[tuple[Pair, str]] = (),
+    options: LearningOptions = LearningOptions(),
 ) -> SizeLearningResult:
     """Run experiments chosen by ``policy`` against ``oracle`` until every pair is known
-    (and, with ``confirm`` > 0, every essential observation confirmed), starting from the
-    fits ``demonstrated``, under the size ``model``; see :class:`SizeLearner`."""
-    learner = SizeLearner(parts, holes, policy, seed, max_answers, confirm, demonstrated, model, prior)
+    (and, with ``options.confirm`` > 0, every essential observation confirmed), starting
+    from the fits ``options.demonstrated``, under the size ``options.model``; see
+    :class:`SizeLearner`."""
+    learner = SizeLearner(parts, holes, policy, seed, options)
     return run_learner(learner, oracle, on_experiment)
 
 

@@ -236,6 +236,8 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
         if mesh.convex is not None:
             raise fail(path, table, "mesh.convex", "no convex pieces (the base and a part placed by hand are "
                        "simulated as their static concave meshes)", mesh.convex)
+        _check_vertices(path, table, "mesh.file", folder / mesh.file, data,
+                        MAX_BASE_REACH if table == "base" else MAX_PART_REACH)
         return
     if mesh.convex is None:
         raise BridgeError(f"{path}: [{table}] mesh.convex: expected the convex pieces of {mesh.file} (an .obj file "
@@ -250,19 +252,22 @@ def _check_mesh(path: Path, table: str, mesh: Mesh, moving: bool) -> None:
         raise fail(path, table, "mesh.convex", f"pieces made from {mesh.file} as it is (first line of "
                    f"{mesh.convex} {expected!r}; stale pieces: import the product again)", first)
     for key, name, content in (("mesh.file", mesh.file, data), ("mesh.convex", mesh.convex, text)):
-        _check_vertices(path, table, key, folder / name, content)
+        _check_vertices(path, table, key, folder / name, content, MAX_PART_REACH)
 
 
 MAX_PART_REACH = 0.5
-"""A moving part's mesh and convex pieces lie within this of its frame's origin on every
-axis [m]: a part the arm carries, not one metres away or the size of a room (millimetres
-written as metres)."""
+"""A part's mesh and convex pieces (moving, or placed by hand) lie within this of its
+frame's origin on every axis [m]: a part the arm carries, not one metres away or the size
+of a room (millimetres written as metres)."""
+
+MAX_BASE_REACH = 2.0
+"""The base's mesh lies within this of its frame's origin on every axis [m]: a plate or
+table in the cell's workspace, not metres of millimetres."""
 
 
-def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes) -> None:
+def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes, reach: float) -> None:
     """Every vertex ``v x y z`` of the OBJ ``data`` (the file ``obj``) is three finite
-    coordinates within :data:`MAX_PART_REACH` [m]; BridgeError naming ``obj``'s line otherwise."""
-    reach = MAX_PART_REACH
+    coordinates within ``reach`` [m]; BridgeError naming ``obj``'s line otherwise."""
     for number, line in enumerate(data.splitlines(), 1):
         words = line.split()
         if words[:1] != [b"v"]:
@@ -273,7 +278,7 @@ def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes) ->
             vertex = []
         if len(vertex) != 3 or not all(-reach <= c <= reach for c in vertex):  # NaN compares False
             raise BridgeError(f"{path}: [{table}] {key}: {obj}:{number}: expected a vertex 'v x y z' of finite "
-                              f"coordinates within [-{reach:g}, {reach:g}] m of the part frame's origin, got "
+                              f"coordinates within [-{reach:g}, {reach:g}] m of its frame's origin, got "
                               f"{shorten(line.decode('utf-8', 'replace'))!r}")
 
 

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import ctypes
 import errno
+import importlib.util
 import logging
 import os
 import re
@@ -31,7 +33,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -186,8 +188,8 @@ _WEB_PORT = re.compile(rb"Hosting a web-viewer at http://127\.0\.0\.1:(\d+)")
 
 @dataclass(frozen=True)
 class RerunServer:
-    """A running Rerun server (:func:`rerun_server`): its process (the ``python -m rerun_cli``
-    wrapper, leader of its own process group), the ports it bound [TCP port numbers]."""
+    """A running Rerun server (:func:`rerun_server`): its process (Rerun's binary, leader of
+    its own process group), the ports it bound [TCP port numbers]."""
 
     process: subprocess.Popen
     grpc_port: int
@@ -201,22 +203,53 @@ class RerunServer:
 
 @contextmanager
 def rerun_server(arguments: Sequence[str], web: bool = False) -> Iterator[RerunServer]:
-    """Run ``python -m rerun_cli --bind 127.0.0.1 --port 0 ARGUMENTS`` (in a process group of
+    """Run Rerun's binary ``rerun --bind 127.0.0.1 --port 0 ARGUMENTS`` (in a process group of
     its own) while the block runs and give it with its gRPC port and (``web``) its web
     viewer's port: the ports the server bound itself, read from its log, so no other process
     can take them between a choice and the bind. The server and its children are stopped at
-    exit (:func:`_stop`). BridgeError when it exits or does not log its ports within
-    :data:`SERVER_START_S`."""
+    exit (:func:`_stop`), and it dies with the thread that started it even when that one is
+    killed (SIGKILL: no exit code runs; :func:`_die_with_parent`). BridgeError when it exits
+    or does not log its ports within :data:`SERVER_START_S`."""
     with tempfile.TemporaryFile() as log:
         env = os.environ | {"RUST_LOG": "info", "RUST_LOG_STYLE": "never", "NO_COLOR": "1"}
         server = subprocess.Popen(
-            [sys.executable, "-m", "rerun_cli", "--bind", "127.0.0.1", "--port", "0", *arguments],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log, env=env, start_new_session=True)
+            [_rerun_binary(), "--bind", "127.0.0.1", "--port", "0", *arguments],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log, env=env, start_new_session=True,
+            preexec_fn=_die_with_parent(os.getpid()))
         try:
             ports = _logged_ports(log.fileno(), server, [_GRPC_PORT, _WEB_PORT] if web else [_GRPC_PORT])
             yield RerunServer(server, ports[0], ports[1] if web else None)
         finally:
             _stop(server)
+
+
+def _rerun_binary() -> str:
+    """The viewer binary ``rerun-sdk`` ships in its ``rerun_cli`` package, run directly: its
+    wrapper ``python -m rerun_cli`` runs it as a child, which would outlive a killed wrapper."""
+    spec = importlib.util.find_spec("rerun_cli")
+    if spec is None or spec.origin is None:
+        raise BridgeError("the Rerun viewer binary: no package rerun_cli (expected it installed with rerun-sdk)")
+    return str(Path(spec.origin).parent / "rerun")
+
+
+PR_SET_PDEATHSIG = 1
+"""``prctl`` option: the signal a process gets when its parent thread ends (Linux)."""
+
+
+def _die_with_parent(parent: int) -> Callable[[], None] | None:
+    """The ``preexec_fn`` that makes a child get SIGKILL when the thread that started it
+    ends, however it ends (Linux ``prctl(PR_SET_PDEATHSIG)``; elsewhere None, nothing);
+    ``parent`` (its process id) ended already when the child's parent is another one."""
+    if not sys.platform.startswith("linux"):
+        return None
+    prctl = ctypes.CDLL(None, use_errno=True).prctl  # looked up before the fork
+
+    def set_death_signal() -> None:
+        prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # it died before the signal was set
+            os._exit(1)
+
+    return set_death_signal
 
 
 def _logged_ports(log: int, server: subprocess.Popen, patterns: Sequence[re.Pattern[bytes]]) -> list[int]:
@@ -241,9 +274,8 @@ MAX_LOG_BYTES = 64 * 1024
 
 
 def _stop(server: subprocess.Popen) -> None:
-    """Stop the server and its children: ``python -m rerun_cli`` runs the viewer binary as
-    a child, which a signal to the wrapper alone would leave running, so the whole process
-    group (its own session) gets SIGTERM, and SIGKILL for whatever is left."""
+    """Stop the server and its children: the whole process group (its own session) gets
+    SIGTERM, and SIGKILL for whatever is left."""
     with contextlib.suppress(ProcessLookupError):
         os.killpg(server.pid, signal.SIGTERM)
     with contextlib.suppress(subprocess.TimeoutExpired):

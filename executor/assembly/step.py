@@ -48,12 +48,12 @@ from assembly_constraints.executor.backend_plugin import check_step
 from assembly_constraints.executor.cell_description import CellDescription
 from assembly_constraints.executor.control.detector import Detector
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionLayer, Ilc
-from assembly_constraints.executor.control.motion import StepLogger
+from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
 from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.skills.dmp import Skill, load_skill
-from assembly_constraints.executor.skills.insertion import insert_in_layer, needs_yaw_compliance
+from assembly_constraints.executor.skills.dmp import Skill, load_product_skill
+from assembly_constraints.executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
 from assembly_constraints.executor.skills.search import hole_search
-from assembly_constraints.executor.trial import APPROACH_HEIGHT, APPROACH_SETTLE_TIME, trial_rng
+from assembly_constraints.executor.trial import APPROACH_HEIGHT, trial_rng
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, yaw_quat
 from assembly_constraints.executor.world.geometry import fit_pose
 from assembly_constraints.executor.world.perturbation import CellBias
@@ -113,13 +113,13 @@ class Assembler:
     """The assembling cell: one :class:`AssemblyWorld` kept between steps."""
 
     def __init__(self, product: Product, logger: StepLogger | None = None, *, description: CellDescription,
-                 uncertainty: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER,
+                 bias: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER,
                  ilc: Ilc | None = None) -> None:
         """``description``: the cell's gains, thresholds and admittance (the product was
-        loaded with its gripper); ``uncertainty``: the errors of each execution (default
-        :data:`ASSEMBLY_UNCERTAINTY`); ``layer``: the insertion's execution layer; ``ilc``:
-        the corrections its ILC uses and updates (kept by the caller, e.g. across plan
-        runs; required when ``layer.ilc``)."""
+        loaded with its gripper); ``bias``: the errors of each execution, drawn around the
+        cell's systematic errors (default from :data:`ASSEMBLY_UNCERTAINTY`, cell seed 0);
+        ``layer``: the insertion's execution layer; ``ilc``: the corrections its ILC uses and
+        updates (kept by the caller, e.g. across plan runs; required when ``layer.ilc``)."""
         if layer.ilc and ilc is None:
             raise ExecutorError(f"execution layer '{layer.name}' needs an ILC state")
         self.product, self.description = product, description
@@ -129,7 +129,7 @@ class Assembler:
         self.placed: set[str] = set()
         self._screwed: dict[str, int] = {}
         self.blocked: set[str] = set()
-        self._uncertainty = CellBias(ASSEMBLY_UNCERTAINTY, 0) if uncertainty is None else uncertainty
+        self._bias = CellBias(ASSEMBLY_UNCERTAINTY, 0) if bias is None else bias
         self.layer, self.ilc = layer, ilc
 
     def skill_of(self, part: str) -> str:
@@ -154,7 +154,7 @@ class Assembler:
 
     def _skill(self, name: str) -> Skill:
         if name not in self._skills:
-            self._skills[name] = load_skill(self.product.folder, name)
+            self._skills[name] = load_product_skill(self.product.geometry, name)
         return self._skills[name]
 
     def block_hole(self, hole: str) -> None:
@@ -232,7 +232,7 @@ class Assembler:
         """One execution's errors: of the part's shape and its hole (a cover or head: of
         itself), with a yaw error of the estimate for a peg's rect hole."""
         oriented = hole is not None and self.product.geometry.holes[hole].kind == "rect"
-        return self._uncertainty.draw(rng, self.shape_of(part), hole or part, oriented)
+        return self._bias.draw(rng, self.shape_of(part), hole or part, oriented)
 
     def _yaw(self, part: str, hole: str | None, setup: AttemptSetup) -> float:
         """The tool yaw [rad] a peg is inserted with: aligned to its hole's estimated yaw,
@@ -314,8 +314,8 @@ class Assembler:
             pb.changeDynamics(plate, -1, lateralFriction=setup.friction / PART_FRICTION, physicsClientId=world.client)
         compliant = skill == "insert" and hole is not None and needs_yaw_compliance(
             p.pegs[part].kind, p.geometry.holes[hole].kind)
-        result = insert_in_layer(motion, skill_obj, origin, detector, layer, lever, description=self.description,
-                                 correction=correction, yaw=yaw, yaw_compliant=compliant)
+        task = InsertionTask(origin, lever, yaw, yaw_compliant=compliant, correction=correction)
+        result = insert_in_layer(motion, skill_obj, detector, task, layer, description=self.description)
         pb.changeDynamics(plate, -1, lateralFriction=PART_FRICTION, physicsClientId=world.client)
         if result.reached and result.trace is not None and self.ilc is not None:
             self.ilc.update(key, result.trace)

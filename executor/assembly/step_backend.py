@@ -37,15 +37,15 @@ class AssemblyRunner:
     """One assembling world at a time, keyed by the plan run's id."""
 
     def __init__(self, assembly: str, blocked: Sequence[str] = (), recorder: AssemblyRecorder | None = None, *,
-                 uncertainty: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER,
+                 bias: CellBias | None = None, layer: ExecutionLayer = DEFAULT_LAYER,
                  description: CellDescription | None = None) -> None:
-        """``uncertainty``/``layer``: the cell's (``--uncertainty cell``), else the assembling
+        """``bias``/``layer``: the cell's (``--uncertainty cell``), else the assembling
         cell's own (:class:`Assembler`); with an ILC layer one :class:`Ilc` serves every run;
         ``description``: the cell's gripper, gains, thresholds, admittance and ILC
         parameters (default :class:`CellDescription`)."""
         self.description = d = CellDescription() if description is None else description
         self.product: Product = load_product(assembly, d)
-        self.uncertainty, self.layer = uncertainty, layer
+        self.bias, self.layer = bias, layer
         self.ilc = Ilc(d.ilc, d.gains, d.admittance) if layer.ilc else None
         self.blocked = list(blocked)
         for hole in self.blocked:
@@ -61,7 +61,7 @@ class AssemblyRunner:
         if self._assembler is None or run != self._run:
             self.close()
             self._assembler = Assembler(self.product, self.recorder, description=self.description,
-                                        uncertainty=self.uncertainty,
+                                        bias=self.bias,
                                         layer=self.layer, ilc=self.ilc)
             if self.recorder is not None:
                 self.recorder.attach(self._assembler.world)

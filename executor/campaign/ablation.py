@@ -53,11 +53,11 @@ def _run_group(task: tuple[str, str, int, str, str, list[int], Magnitudes]) -> l
     from assembly_constraints.executor.trial import Cell
 
     global _CELL
-    variant, assembly, cell_seed, part, hole, seeds, model = task
+    variant, assembly, cell_seed, part, hole, seeds, magnitudes = task
     if _CELL is None:
         _CELL = Cell(assembly)
     _CELL.reset_state(layer="pi_phase_stop" if variant == FLOOR else variant,
-                      perturbation=random_only(model) if variant == FLOOR else model, cell_seed=cell_seed)
+                      magnitudes=random_only(magnitudes) if variant == FLOOR else magnitudes, cell_seed=cell_seed)
     return [_CELL.run_trial(part, hole, seed).to_json() for seed in seeds]
 
 
@@ -92,7 +92,7 @@ def variant_row(name: str, rows: Sequence[tuple[bool, int, dict[str, Any]]], f_s
 
 
 def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers: int,
-                 model: Magnitudes, pairs: Sequence[CampaignPair] | None = None) -> dict[str, Any]:
+                 magnitudes: Magnitudes, pairs: Sequence[CampaignPair] | None = None) -> dict[str, Any]:
     """The ablation table (see the module text) as a JSON-ready dict, over ``pairs``
     (default: every campaign pair; at least one must fit)."""
     if trials < 1 or executions < 1 or workers < 1:
@@ -104,7 +104,7 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
     groups = [list(range(g * executions, min(trials, (g + 1) * executions)))
               for g in range((trials + executions - 1) // executions)]
     variants = [*LAYERS, FLOOR]
-    tasks = [(variant, assembly, seed + g, pair.part, pair.hole, [seed + j for j in group], model)
+    tasks = [(variant, assembly, seed + g, pair.part, pair.hole, [seed + j for j in group], magnitudes)
              for variant in variants for g, group in enumerate(groups) for pair in pairs
              if pair.fits or variant != FLOOR]
     if workers == 1:
@@ -132,7 +132,8 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
     floor = [_first_force(r) for _, _, r in by_variant[FLOOR]]
     f_stop = CellDescription().thresholds.f_stop  # the cells of the ablation have the built-in description
     return {
-        "trials": trials, "seed": seed, "executions_per_cell": executions, "perturbation": msgspec.to_builtins(model),
+        "trials": trials, "seed": seed, "executions_per_cell": executions,
+        "perturbation": msgspec.to_builtins(magnitudes),
         "variants": [variant_row(name, by_variant[name], f_stop) for name in LAYERS],
         "ilc": {
             "executions": list(range(1, executions + 1)),

@@ -11,6 +11,7 @@ goal tolerance.  Too-big parts are stopped only by the insertion time-out here.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -19,7 +20,7 @@ import msgspec
 from assembly_constraints.bridge.cell_settings import add_cell_arguments, cell_settings_of
 from assembly_constraints.bridge.cli_types import MAX_SEED, ArgumentParser, int_in
 from assembly_constraints.executor.campaign.pairs import PAIRS_ARGUMENT
-from assembly_constraints.executor.trial import Cell, cell_keywords, trial_rng
+from assembly_constraints.executor.trial import Cell, cell_setup, trial_rng
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -29,11 +30,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--pairs", type=PAIRS_ARGUMENT, help="comma-separated part:hole pairs (default: all)")
     add_cell_arguments(parser)
     args = parser.parse_args(argv)
-    keywords = cell_keywords(cell_settings_of(args))
-    described = keywords["description"]
-    keywords["description"] = msgspec.structs.replace(described, thresholds=msgspec.structs.replace(
-        described.thresholds, f_stop=math.inf, m_stop=math.inf))
-    cell = Cell(**keywords)
+    setup = cell_setup(cell_settings_of(args))
+    described = setup.description
+    unstopped = msgspec.structs.replace(described.thresholds, f_stop=math.inf, m_stop=math.inf)
+    setup = dataclasses.replace(setup, description=msgspec.structs.replace(described, thresholds=unstopped))
+    cell = Cell(setup=setup)
     pairs = args.pairs or [(p, h) for p in sorted(cell.geometry.parts) for h in sorted(cell.geometry.holes)]
     try:
         for part, hole in pairs:  # an unknown part or hole is an error before any trial runs

@@ -59,7 +59,7 @@ from assembly_constraints.executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from assembly_constraints.executor.trial import cell_keywords
+from assembly_constraints.executor.trial import CellSetup, cell_setup
 
 
 class TrialRunner(Protocol):
@@ -76,12 +76,12 @@ function or a ``functools.partial`` of one)."""
 
 class CellRunner:
     """A :class:`assembly_constraints.executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
-    ``keywords``: the Cell's options (layer, perturbation, cell seed)."""
+    ``setup``: what the cell is (:class:`assembly_constraints.executor.trial.CellSetup`)."""
 
-    def __init__(self, assembly: str, **keywords: Any) -> None:
+    def __init__(self, assembly: str, setup: CellSetup) -> None:
         from assembly_constraints.executor.trial import Cell
 
-        self.cell = Cell(assembly, **keywords)
+        self.cell = Cell(assembly, setup=setup)
 
     def __call__(self, part: str, hole: str, seed: int) -> dict[str, Any]:
         return self.cell.run_trial(part, hole, seed=seed, max_attempts=2).to_json()
@@ -233,7 +233,7 @@ def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
     args = build_parser().parse_args(list(argv))
     pairs = select_pairs(args.pairs)
-    keywords = cell_keywords(cell_settings_of(args))  # the cell description checked before anything is written
+    setup = cell_setup(cell_settings_of(args))  # the cell description checked before anything is written
     if args.plot:  # before the campaign, which takes minutes
         from assembly_constraints.bridge.files import check_writable, make_folder
 
@@ -241,7 +241,7 @@ def main(argv: Sequence[str]) -> int:
     with stdout_to_stderr():  # PyBullet prints its banner on fd 1, also in the workers
         run = timed_campaign(
             pairs, args.trials, args.seed, args.jobs,
-            functools.partial(CellRunner, args.assembly, **keywords),
+            functools.partial(CellRunner, args.assembly, setup),
         )
         report = campaign_report(run, args.seed, args.jobs)
         if args.plot:

@@ -11,6 +11,7 @@ from assembly_constraints.executor.control.controller import ImpedanceController
 from assembly_constraints.executor.world.arm import ArmState
 from assembly_constraints.executor.world.scene import TIME_STEP
 
+APPROACH_SETTLE_TIME = 0.02  # [s] held at a start pose before the F/T sensor is tared
 # Log every this many physics steps (10 ms of sim time).
 LOG_EVERY = 10
 _ZERO3 = np.zeros(3)

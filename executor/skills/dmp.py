@@ -21,7 +21,7 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from movement_primitives.dmp import CartesianDMP
@@ -29,6 +29,9 @@ from movement_primitives.dmp import CartesianDMP
 from assembly_constraints.bridge.files import make_folder, write_atomic
 from assembly_constraints.bridge.inputs import read_text
 from assembly_constraints.executor import ExecutorError
+
+if TYPE_CHECKING:
+    from assembly_constraints.executor.world.geometry import CellGeometry
 
 # Rollout resolution of the DMP [s]; poses in between are interpolated linearly.
 ROLLOUT_DT = 0.005
@@ -271,6 +274,49 @@ def load_skill(folder: Path, shape: str) -> Skill:
                             "run ./run.sh executor teach") from None
     _check_taught(path, skill)
     return skill
+
+
+SECTION_TOLERANCE = 1e-6
+"""[m] a recorded side and the product's that differ by more are a changed section (the
+record keeps 9 decimals, so a saved skill matches its product exactly)."""
+
+
+def load_product_skill(geometry: CellGeometry, shape: str) -> Skill:
+    """The stored skill of ``shape`` (:func:`load_skill`), refused (ExecutorError naming
+    the file and the change) unless the part and the hole it was taught on are still in the
+    product with the sections its record gives: a part resized or a hole reshaped since
+    the teaching would run a skill never shown to fit there."""
+    skill = load_skill(geometry.folder, shape)
+    assert skill.taught is not None  # load_skill refuses a skill without its record
+    taught, path = skill.taught, skill_path(geometry.folder, shape)
+    part, hole = geometry.parts.get(taught.part), geometry.holes.get(taught.hole)
+    for role, recorded, kind, sides in (("part", part, taught.part_kind, taught.part_sides),
+                                        ("hole", hole, taught.hole_kind, taught.hole_sides)):
+        name = taught.part if role == "part" else taught.hole
+        if recorded is None:
+            raise ExecutorError(f"{path}: taught on {role} {name}, which the product no longer has; "
+                                "run ./run.sh executor teach")
+        if recorded.kind != kind or max(abs(a - b) for a, b in zip(recorded.sides, sides)) > SECTION_TOLERANCE:
+            raise ExecutorError(f"{path}: taught on {role} {name} {_section(kind, sides)}, the product's {name} is "
+                                f"{_section(recorded.kind, recorded.sides)}; run ./run.sh executor teach")
+    if part is not None and part.shape != shape:
+        raise ExecutorError(f"{path}: taught on part {taught.part}, whose shape is now {part.shape}, not {shape}; "
+                            "run ./run.sh executor teach")
+    return skill
+
+
+def check_product_skills(geometry: CellGeometry) -> None:
+    """The skill of every part shape of the product loads and was taught on it as it is
+    (:func:`load_product_skill`); ExecutorError naming the first that is not. A cell runs
+    this before it serves, so a bad skill ends it at the start, not at its first request."""
+    for shape in sorted({part.shape for part in geometry.parts.values()}):
+        load_product_skill(geometry, shape)
+
+
+def _section(kind: str, sides: tuple[float, float]) -> str:
+    """``round 10.00 x 10.00 mm``: a section's kind and sides."""
+    a, b = sides
+    return f"{kind} {1000 * a:.2f} x {1000 * b:.2f} mm"
 
 
 def _check_taught(path: Path, skill: Skill) -> None:

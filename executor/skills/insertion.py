@@ -62,20 +62,37 @@ def rotvec_quat_xyzw(rotvec: np.ndarray) -> np.ndarray:
     return np.array([x, y, z, math.cos(angle / 2)])
 
 
-def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
-           admittance: Admittance | None, gripper_lever: float, wiggle_enabled: bool = True, *,
-           phase_stopping: bool = True, feedforward: np.ndarray | None = None,
-           record: bool = False, yaw: float = 0.0) -> InsertionResult:
-    """Run the skill in the hole frame at ``hole_origin`` (hole centre on the plate top,
-    [m]), turned by ``yaw`` [rad] about z (the tool yaw aligned to the hole's estimated
-    yaw; the skill's poses and reference wrench are in the frame it was taught in),
-    starting from the current tip pose.
+@dataclass(frozen=True)
+class InsertionTask:
+    """One insertion: where it goes and what the cell knows of the pair.
+
+    ``hole_origin`` (3,) [m]: the origin of the hole frame, the hole centre on the plate top
+    where the search found it; ``gripper_lever`` [m]: from the grasp to the part's tip (the
+    wiggle's lever); ``yaw`` [rad]: the hole frame's turn about z (the tool yaw aligned to
+    the hole's estimated yaw; the skill's poses and reference wrench are in the frame it
+    was taught in); ``yaw_compliant``: the admittance also turns the part about the tool
+    axis (a part aligned to a rect hole's estimated yaw, :func:`needs_yaw_compliance`);
+    ``correction`` (bins, 5): the pair's ILC pose correction over the phase (dx, dy, dz
+    [m], rx, ry [rad], :mod:`assembly_constraints.executor.control.ilc`), added to the
+    command; ``wiggle_enabled``: the wiggle exception strategy may run on a jam."""
+
+    hole_origin: np.ndarray
+    gripper_lever: float
+    yaw: float = 0.0
+    yaw_compliant: bool = False
+    correction: np.ndarray | None = None
+    wiggle_enabled: bool = True
+
+
+def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask, admittance: Admittance | None,
+           *, phase_stopping: bool = True, record: bool = False) -> InsertionResult:
+    """Run the skill in the hole frame of ``task`` (:class:`InsertionTask`), starting from
+    the current tip pose, with the task's ILC correction added to the command.
 
     The execution layer: ``admittance`` None is pure position control along the DMP;
     ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
-    ``feedforward`` (bins, 5) is a pose correction (dx, dy, dz [m], rx, ry [rad]) over the
-    phase added to the command (ILC, :mod:`assembly_constraints.executor.control.ilc`); ``record`` keeps the
-    per-step wrench deviations and admittance offsets in ``result.trace`` for ILC.
+    ``record`` keeps the per-step wrench deviations and admittance offsets in
+    ``result.trace`` for ILC.
 
     A breach with the tip sunk into the hole (deeper than ``JAM_DEPTH``: in the entry
     chamfer or past it) is a jam: the wiggle runs once and the insertion goes on;
@@ -83,6 +100,8 @@ def insert(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Dete
     execution; the goal check then decides.  A trajectory that ends with the part stuck
     in the hole short of the goal (forces below the thresholds) is a jam as well: the
     wiggle runs there, and the goal is checked again."""
+    hole_origin, gripper_lever, yaw = task.hole_origin, task.gripper_lever, task.yaw
+    feedforward, wiggle_enabled = task.correction, task.wiggle_enabled
     s = motion.controller.arm.read()
     goal = skill.demo_goal
     times, pos, quats = skill.rollout(turn_z(s.tip_pos - hole_origin, -yaw), turn_quats_z(s.tip_quat_xyzw, -yaw),
@@ -170,27 +189,22 @@ def needs_yaw_compliance(part_kind: str, hole_kind: str) -> bool:
     return hole_kind == "rect" and part_kind != "round"
 
 
-def insert_in_layer(motion: Motion, skill: Skill, hole_origin: np.ndarray, detector: Detector,
-                    layer: ExecutionLayer, gripper_lever: float, *, description: CellDescription,
-                    wiggle_enabled: bool = True, correction: np.ndarray | None = None, yaw: float = 0.0,
-                    yaw_compliant: bool = False) -> InsertionResult:
+def insert_in_layer(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask, layer: ExecutionLayer,
+                    *, description: CellDescription) -> InsertionResult:
     """:func:`insert` under an execution layer: its admittance (P or PI, none for pure
-    position control) with the admittance of the cell ``description``, phase stopping,
-    the ILC ``correction`` and recording; with ``layer.stiff`` the insertion tracks with
-    the description's ``position_gains`` and the controller's own gains come back after
-    (the search and the release stay compliant);
-    ``yaw`` [rad]: the hole frame's (:func:`insert`); ``yaw_compliant``: the admittance
-    also turns the part about the tool axis (a part aligned to a rect hole's estimated
-    yaw, :func:`needs_yaw_compliance`)."""
+    position control; turning the part about the tool axis when ``task.yaw_compliant``)
+    with the admittance of the cell ``description``, phase stopping and recording; with
+    ``layer.stiff`` the insertion tracks with the description's ``position_gains`` and the
+    controller's own gains come back after (the search and the release stay compliant)."""
     params = description.admittance if layer.integral else msgspec.structs.replace(description.admittance,
                                                                                       integral_gain=0.0)
-    admittance = Admittance(params, yaw=yaw_compliant) if layer.admittance else None
+    admittance = Admittance(params, yaw=task.yaw_compliant) if layer.admittance else None
     controller = motion.controller
     compliant = controller.gains
     if layer.stiff:
         controller.gains = description.position_gains
     try:
-        return insert(motion, skill, hole_origin, detector, admittance, gripper_lever, wiggle_enabled,
-                      phase_stopping=layer.phase_stopping, feedforward=correction, record=layer.ilc, yaw=yaw)
+        return insert(motion, skill, detector, task, admittance, phase_stopping=layer.phase_stopping,
+                      record=layer.ilc)
     finally:
         controller.gains = compliant

@@ -24,11 +24,13 @@ shape is taught first, and the files are written only when all were taught.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
 from assembly_constraints.executor import ExecutorError
-from assembly_constraints.executor.control.motion import Motion
+from assembly_constraints.executor.control.detector import Thresholds
+from assembly_constraints.executor.control.motion import APPROACH_SETTLE_TIME, Motion
 from assembly_constraints.executor.skills.dmp import (
     PhaseClock,
     Skill,
@@ -38,15 +40,28 @@ from assembly_constraints.executor.skills.dmp import (
     save_skill,
     xyzw_to_wxyz,
 )
-from assembly_constraints.executor.trial import APPROACH_SETTLE_TIME, Cell
 from assembly_constraints.executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
 from assembly_constraints.executor.world.assets import regenerate_assets
-from assembly_constraints.executor.world.geometry import fit_pose
-from assembly_constraints.executor.world.scene import TIME_STEP
+from assembly_constraints.executor.world.geometry import CellGeometry, fit_pose
+from assembly_constraints.executor.world.scene import TIME_STEP, Scene
 
 DEMO_DURATION = 0.8  # [s]
 DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole
 DEMO_CLEARANCE = 0.0005  # [m] left between the part and the hole bottom at the end
+
+
+class TeachingCell(Protocol):
+    """What teaching needs of a cell (:class:`assembly_constraints.executor.trial.Cell` is
+    one): its geometry and thresholds, and a part put in the hand (:meth:`motion_for`,
+    which sets ``scene`` to the PyBullet client holding it)."""
+
+    geometry: CellGeometry
+    thresholds: Thresholds
+    scene: Scene | None
+
+    def motion_for(self, part: str) -> Motion:
+        """Put the part in the hand; the Motion driving the arm that holds it."""
+        ...
 
 
 def _min_jerk(s: np.ndarray) -> np.ndarray:
@@ -89,7 +104,7 @@ def _replay(motion: Motion, skill: Skill, origin: np.ndarray,
     return np.array(phases), np.array(wrenches), turn_z(end.tip_pos - origin, -yaw)
 
 
-def teach_shape(cell: Cell, shape: str) -> Skill:
+def teach_shape(cell: TeachingCell, shape: str) -> Skill:
     """Demonstrate, encode and replay the skill of one part shape in its ``demo_hole``;
     ExecutorError naming the part, the hole and the end error when the replay ends farther
     than the cell's goal tolerance from the demonstration's goal."""
@@ -135,13 +150,10 @@ def teach_shape(cell: Cell, shape: str) -> Skill:
     return skill
 
 
-def teach_all(assembly: str = "cranfield") -> list[Path]:
-    """Regenerate the assets and teach every part shape, then write the skills (none when
-    one teaching fails: ExecutorError, :func:`teach_shape`); returns the written files."""
-    cell = Cell(assembly)
-    try:
-        written = regenerate_assets(cell.geometry)
-        skills = [teach_shape(cell, shape) for shape in sorted({p.shape for p in cell.geometry.parts.values()})]
-    finally:
-        cell.close()
+def teach_all(cell: TeachingCell) -> list[Path]:
+    """Regenerate the assets of the cell's product and teach every part shape, then write
+    the skills (none when one teaching fails: ExecutorError, :func:`teach_shape`); returns
+    the written files."""
+    written = regenerate_assets(cell.geometry)
+    skills = [teach_shape(cell, shape) for shape in sorted({p.shape for p in cell.geometry.parts.values()})]
     return written + [save_skill(cell.geometry.folder, skill) for skill in skills]

@@ -39,11 +39,11 @@ from assembly_constraints.bridge.cell_settings import Magnitudes
 from assembly_constraints.executor.evidence import AttemptSetup
 
 
-def random_only(model: Magnitudes) -> Magnitudes:
+def random_only(magnitudes: Magnitudes) -> Magnitudes:
     """The same random parts with every systematic part zero (friction: the middle of its
     range): what no learning across executions can remove."""
-    mid = (model.friction_min + model.friction_max) / 2
-    return msgspec.structs.replace(model, grasp_offset_bias=0.0, grasp_tilt_bias=0.0, vision_bias=0.0,
+    mid = (magnitudes.friction_min + magnitudes.friction_max) / 2
+    return msgspec.structs.replace(magnitudes, grasp_offset_bias=0.0, grasp_tilt_bias=0.0, vision_bias=0.0,
                                    vision_yaw_bias=0.0, friction_min=mid, friction_max=mid)
 
 
@@ -74,7 +74,7 @@ class CellBias:
     Drawn lazily, each from its own stream of (cell seed, name), so it does not depend on
     the order in which shapes and holes are first used."""
 
-    model: Magnitudes
+    magnitudes: Magnitudes
     seed: int
     grasp: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     holes: dict[str, tuple[np.ndarray, float]] = field(default_factory=dict)
@@ -87,21 +87,22 @@ class CellBias:
         """Habitual grasp offset [m] and tilt [rad] of a part shape."""
         if shape not in self.grasp:
             rng = self._rng("grasp", shape)
-            self.grasp[shape] = (_disc(rng, self.model.grasp_offset_bias), _tilt(rng, self.model.grasp_tilt_bias))
+            m = self.magnitudes
+            self.grasp[shape] = (_disc(rng, m.grasp_offset_bias), _tilt(rng, m.grasp_tilt_bias))
         return self.grasp[shape]
 
     def of_hole(self, hole: str) -> tuple[np.ndarray, float]:
         """Vision bias (x, y) [m] and friction coefficient of a hole."""
         if hole not in self.holes:
             rng = self._rng("hole", hole)
-            m = self.model
+            m = self.magnitudes
             self.holes[hole] = (_disc(rng, m.vision_bias)[:2], float(rng.uniform(m.friction_min, m.friction_max)))
         return self.holes[hole]
 
     def yaw_of_hole(self, hole: str) -> float:
         """Vision yaw bias of a rect hole [rad], uniform in ± ``vision_yaw_bias``."""
         if hole not in self.yaws:
-            bias = self.model.vision_yaw_bias
+            bias = self.magnitudes.vision_yaw_bias
             self.yaws[hole] = math.radians(float(self._rng("hole_yaw", hole).uniform(-bias, bias)))
         return self.yaws[hole]
 
@@ -110,7 +111,7 @@ class CellBias:
         ``rng``); ``oriented``: the hole's yaw is estimated too (a rect hole), with an error
         from a stream of its own (the hole's bias, then a stream of the search seed), so
         ``rng`` is drawn from the same way either way."""
-        m = self.model
+        m = self.magnitudes
         offset0, tilt0 = self.of_shape(shape)
         vision0, friction0 = self.of_hole(hole)
         offset = offset0 + _disc(rng, m.grasp_offset_random)

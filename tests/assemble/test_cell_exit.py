@@ -11,6 +11,7 @@ import pytest
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.assemble.driver import assembling_cell
 from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_settings import ServeSettings
 
 CRASHING_BACKEND = '''
 import os
@@ -37,6 +38,7 @@ class Crash:
 def test_a_cell_that_dies_at_step_one_is_reported_as_exited(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     (tmp_path / "crashing_cell.py").write_text(CRASHING_BACKEND)
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")])))
-    with assembling_cell(load_assembly("cranfield").folder, 0, 20.0, backend="crashing_cell:Crash") as driver:
+    with assembling_cell(ServeSettings(assembly=str(load_assembly("cranfield").folder), backend="crashing_cell:Crash"),
+                         0, 20.0) as driver:
         with pytest.raises(PlannerError, match=r"^step 1 \(bp\): cell a1 exited \(code 7\) during the step"):
             driver.step(1, "bp", None)

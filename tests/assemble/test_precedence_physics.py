@@ -21,6 +21,7 @@ from assembly_constraints.asp.bench.precedence_physics import (
 from assembly_constraints.asp.plans.plans import PlanStep
 from assembly_constraints.asp.precedence.relation import reduction, true_relation
 from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_settings import ServeSettings
 from assembly_constraints.bridge.messages import StepEvidence, StepReply
 
 CRANFIELD = load_assembly("cranfield")
@@ -131,7 +132,8 @@ def test_a_peg_before_the_back_plate_is_detected_in_physics() -> None:
 
     (violating, _) = edge_runs(RELATION, {"p1": "r1"} | {p: None for p in RELATION.parts if p != "p1"},
                                [("bp", "p1")])
-    run = run_sequence(lambda: assembling_cell(CRANFIELD.folder, 0, 120.0), violating, stop_at_break=True)
+    served = ServeSettings(assembly=str(CRANFIELD.folder))
+    run = run_sequence(lambda: assembling_cell(served, 0, 120.0), violating, stop_at_break=True)
     assert run.error is None
     assert [s["part"] for s in run.steps] == ["p1"] and run.steps[0]["outcome"] == "no_fit"
     assert run.steps[0]["pose_error_mm"] > 20.0 and run.detected and verdict(run) == "enforced"

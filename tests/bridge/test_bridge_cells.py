@@ -19,6 +19,7 @@ from assembly_constraints.bridge.client import (
     CellPool,
     CellRefused,
     CellTimeout,
+    PoolLimits,
     check_echo,
     request_insert,
     send_insert,
@@ -35,7 +36,7 @@ from assembly_constraints.bridge.messages import (
     encode,
 )
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
-from assembly_constraints.executor.serve import QUEUE_SIZE
+from assembly_constraints.executor.serve.node import QUEUE_SIZE
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -125,7 +126,7 @@ def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(net
 
     killer = threading.Thread(target=kill_c1_in_its_second_experiment)
     killer.start()
-    pool = CellPool(session, directory, timeout=20.0, wait_for_cell=20.0)
+    pool = CellPool(session, directory, PoolLimits(timeout=20.0, wait_for_cell=20.0))
     for request in requests:
         pool.submit(request)
     replies: dict[str, InsertReply] = {}
@@ -160,7 +161,7 @@ def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
 
     replacer = threading.Thread(target=replace_c1_in_its_second_experiment)
     replacer.start()
-    pool = CellPool(session, directory, timeout=20.0, wait_for_cell=30.0)
+    pool = CellPool(session, directory, PoolLimits(timeout=20.0, wait_for_cell=30.0))
     requests = [InsertRequest(id=f"w{i}", part="p1", hole=h) for i, h in enumerate(("r1", "s1", "br"))]
     for request in requests:
         pool.submit(request)
@@ -255,7 +256,7 @@ def test_a_token_with_nothing_behind_it_is_dropped_and_others_are_not_trusted(ne
     try:
         tokens = [rogue.liveliness().declare_token(alive_key(cell)) for cell in ("c1", "evil")]
         directory.wait_for(2, timeout=20)
-        pool = CellPool(session, directory, timeout=1.0, wait_for_cell=1.0, max_misses=2, allowed={"c1"})
+        pool = CellPool(session, directory, PoolLimits(timeout=1.0, wait_for_cell=1.0, max_misses=2), allowed={"c1"})
         pool.submit(InsertRequest(id="t1", part="p1", hole="r1"))
         started = time.monotonic()
         with pytest.raises(CellTimeout, match="no cell alive"):

@@ -67,7 +67,11 @@ def test_holes_at_two_levels_get_a_geometry_the_cell_builds(imported: dict[str, 
 def taught(imported: dict[str, Path]) -> dict[str, Path]:
     """The imported products with their skills taught (each peg in its own hole)."""
     for folder in imported.values():
-        teach_all(str(folder))
+        cell = Cell(str(folder))
+        try:
+            teach_all(cell)
+        finally:
+            cell.close()
     return imported
 
 

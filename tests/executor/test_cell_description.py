@@ -20,7 +20,7 @@ from assembly_constraints.executor.cell_description import CellDescription, load
 from assembly_constraints.executor.control.admittance import AdmittanceParams
 from assembly_constraints.executor.control.detector import Thresholds
 from assembly_constraints.executor.control.ilc import ExecutionTrace, Ilc, offset_bound, read_state
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from assembly_constraints.executor.world.geometry import arm_urdf_text
 from tests.conftest import ROOT
 
@@ -65,7 +65,7 @@ def test_the_cell_uses_its_description() -> None:
     gripper = Gripper(flange_mass=1.0, flange_inertia=0.004, flange_length=0.08, grasp_depth=0.02)
     described = CellDescription(gripper=gripper, thresholds=Thresholds(f_stop=25.0),
                                 admittance=AdmittanceParams(bound=0.001))
-    cell, default = Cell(description=described), Cell()
+    cell, default = Cell(setup=CellSetup(description=described)), Cell()
     try:
         assert cell.thresholds.f_stop == 25.0 and default.thresholds.f_stop == 30.0
         assert cell.geometry.gripper == gripper  # Cranfield has no [gripper] of its own
@@ -106,3 +106,29 @@ def test_a_threshold_of_the_file_decides_the_trial(tmp_path: Path, capsys: pytes
         assert main(["executor", "trial", "--part", "p1", "--hole", "r1", "--json", *extra]) == 0
         outcomes.append(json.loads(capsys.readouterr().out)["trials"][0]["outcome"])
     assert outcomes == ["fit", "no_fit"]
+
+
+def test_the_served_sim_cell_decodes_its_description_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``executor serve``: the description is decoded once, before the session opens, and
+    what it says reaches the cell the backend starts."""
+    from assembly_constraints.bridge.cell_settings import CellSettings, ServeSettings
+    from assembly_constraints.executor import trial
+    from assembly_constraints.executor.serve.backends import backend_starter
+
+    path = tmp_path / "cell.toml"
+    path.write_text("[thresholds]\nf_stop = 7.5\n")
+    reads: list[Path | None] = []
+
+    def counted(file: Path | None) -> CellDescription:
+        reads.append(file)
+        return load_cell_description(file)
+
+    monkeypatch.setattr(trial, "load_cell_description", counted)
+    start = backend_starter(ServeSettings(cell=CellSettings(description=str(path))))
+    assert reads == [path]
+    backend = start()
+    try:
+        assert reads == [path]
+        assert backend._cell.thresholds.f_stop == 7.5  # type: ignore[attr-defined]
+    finally:
+        backend.close()

@@ -16,7 +16,7 @@ from assembly_constraints.executor.control.gains import POSITION_CONTROL_GAINS, 
 from assembly_constraints.executor.control.ilc import LAYERS, ExecutionTrace, Ilc
 from assembly_constraints.executor.evidence import AttemptSetup
 from assembly_constraints.executor.skills.insertion import rotvec_quat_xyzw
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from assembly_constraints.executor.world.arm import TOOL_DOWN_QUAT_XYZW, rotation_error
 from assembly_constraints.executor.world.perturbation import NO_PERTURBATION
 
@@ -35,7 +35,7 @@ def _ilc() -> Ilc:
 
 @pytest.fixture(scope="module")
 def cell():
-    c = Cell(perturbation=NO_PERTURBATION)
+    c = Cell(setup=CellSetup(magnitudes=NO_PERTURBATION))
     yield c
     c.close()
 
@@ -50,7 +50,7 @@ def test_every_layer_switch_changes_the_execution(cell):
     seen = {}
     controller = cell.motion_for("tp").controller
     for name in LAYERS:
-        cell.reset_state(layer=name, perturbation=NO_PERTURBATION)
+        cell.reset_state(layer=name, magnitudes=NO_PERTURBATION)
         seen[name] = cell.run_attempt("tp", "r1", TILTED)
         assert controller.gains == ImpedanceGains()
     assert [name for name, layer in LAYERS.items() if layer.stiff] == ["position"]
@@ -106,7 +106,7 @@ def test_ilc_converges_on_a_repeated_pair(cell, tmp_path):
     state = tmp_path / "c1-ilc.json"
     cell.ilc_state = state
     try:
-        cell.reset_state(layer="full", perturbation=SYSTEMATIC_ONLY)
+        cell.reset_state(layer="full", magnitudes=SYSTEMATIC_ONLY)
         runs = [cell.run_trial("tp", "s1", seed) for seed in range(4)]
     finally:
         cell.ilc_state = None
@@ -116,7 +116,7 @@ def test_ilc_converges_on_a_repeated_pair(cell, tmp_path):
     assert [r.evidence[0].ilc_iteration for r in runs] == [0, 1, 2, 3]
     saved = json.loads(state.read_text())["keys"]
     assert saved["tight_peg:s1"]["iterations"] == 4
-    restarted = Cell(perturbation=SYSTEMATIC_ONLY, ilc_state=state)
+    restarted = Cell(setup=CellSetup(magnitudes=SYSTEMATIC_ONLY), ilc_state=state)
     try:
         correction, iteration = restarted.ilc.correction("tight_peg:s1")
         assert iteration == 4 and np.array_equal(correction, cell.ilc.correction("tight_peg:s1")[0])
@@ -147,17 +147,20 @@ def test_ilc_update_learns_against_the_error_and_round_trips(tmp_path):
 def test_the_served_cell_saves_and_reloads_its_corrections(tmp_path):
     """``executor serve --ilc-state``: the sim backend saves after a successful execution;
     a restarted backend (a resumed session's cell) starts from the saved corrections."""
+    from assembly_constraints.bridge.cell_settings import ServeSettings
     from assembly_constraints.bridge.messages import InsertRequest
-    from assembly_constraints.executor.serve import SimBackend
+    from assembly_constraints.executor.serve.sim import SimBackend
+    from assembly_constraints.executor.trial import cell_setup
 
     state = tmp_path / "c1-ilc.json"
-    backend = SimBackend("cranfield", "c1", None, None, ilc_state=state)
+    settings = ServeSettings(ilc_state=str(state))
+    backend = SimBackend(settings, cell_setup(settings.cell))
     try:
         result, _evidence = backend.run(InsertRequest(id="r1", part="p1", hole="r1", seed=3))
     finally:
         backend.close()
     assert result == "fit"
-    restarted = SimBackend("cranfield", "c1", None, None, ilc_state=state)
+    restarted = SimBackend(settings, cell_setup(settings.cell))
     try:
         assert restarted._cell.ilc.iterations == {"round_peg:r1": 1}
     finally:

@@ -12,14 +12,14 @@ import pybullet as pb
 import pytest
 
 from assembly_constraints.executor.evidence import AttemptSetup
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from tests._tolerances import END_BOUND, FORCE_BOUND, TORQUE_BOUND
 
 
 @pytest.fixture(scope="module")
 def cell():
     """A cell without ILC: a trial then depends on its seed only."""
-    c = Cell(layer="pi_phase_stop")
+    c = Cell(setup=CellSetup(layer="pi_phase_stop"))
     yield c
     c.close()
 
@@ -61,7 +61,7 @@ def test_same_seed_same_trial(cell):
     cell.run_trial("sh", "br", seed=5)  # something else in between
     again = cell.run_trial("p2", "s2", seed=11).to_json()
     assert _stable(first) == _stable(again)
-    fresh = Cell(layer="pi_phase_stop")
+    fresh = Cell(setup=CellSetup(layer="pi_phase_stop"))
     try:
         assert _stable(fresh.run_trial("p2", "s2", seed=11).to_json()) == _stable(first)
     finally:
@@ -108,3 +108,23 @@ def test_tight_peg_jam_is_resolved_by_the_wiggle(cell):
     assert freed.outcome == "fit"
     assert freed.end_error < cell.thresholds.goal_tolerance
     json.dumps(dataclasses.asdict(freed))  # evidence goes out as JSON (bridge, CLI)
+
+
+@pytest.mark.slow
+def test_a_trial_checks_its_pair_once(cell, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pair is checked (and its skill looked up) once per trial, whatever its attempts;
+    an unknown part is refused as such."""
+    from assembly_constraints.executor import UnknownPair
+
+    checks: list[tuple[str, str]] = []
+    check = cell.check_pair
+
+    def counted(part: str, hole: str):
+        checks.append((part, hole))
+        return check(part, hole)
+
+    monkeypatch.setattr(cell, "check_pair", counted)
+    result = cell.run_trial("sh", "r1", seed=0)  # too big: two attempts
+    assert (result.outcome, result.attempts) == ("no_fit", 2) and checks == [("sh", "r1")]
+    with pytest.raises(UnknownPair, match="unknown part 'zz'"):
+        cell.run_trial("zz", "r1", seed=0)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from assembly_constraints.executor.evidence import AttemptEvidence, AttemptSetup
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from assembly_constraints.executor.world.geometry import passes
 from assembly_constraints.executor.world.perturbation import NO_PERTURBATION
 
@@ -49,7 +49,7 @@ def test_the_yaw_axis_takes_up_a_yaw_error_and_a_gross_one_is_no_fit() -> None:
     what lets it in. (3° and 4° fit at the first attempt too, but after one wiggle: since
     the damping acts on the tip's velocity, not that of a point 25 mm up the part, the
     corner wedges once there; docs/results.md, the task board's yaw table.)"""
-    cell = Cell("taskboard", perturbation=NO_PERTURBATION, layer="pi_phase_stop")
+    cell = Cell("taskboard", setup=CellSetup(magnitudes=NO_PERTURBATION, layer="pi_phase_stop"))
     try:
         def attempt(degrees: float) -> AttemptEvidence:
             setup = AttemptSetup(np.zeros(3), np.zeros(3), np.zeros(2), search_seed=1,

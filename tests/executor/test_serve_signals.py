@@ -12,7 +12,7 @@ from tests.conftest import ROOT
 
 SCRIPT = """
 import signal, sys, threading, time
-from assembly_constraints.executor.serve import CellNode, _exit_on_signal
+from assembly_constraints.executor.serve.node import CellNode, _exit_on_signal
 signal.signal(signal.SIGTERM, _exit_on_signal)
 node = CellNode("c1", backend=None)  # no work arrives: the backend is never used
 

@@ -10,7 +10,7 @@ import pytest
 
 from assembly_constraints.executor.skills.dmp import Skill, load_skill
 from assembly_constraints.executor.skills.teach import teach_shape
-from assembly_constraints.executor.trial import Cell
+from assembly_constraints.executor.trial import Cell, CellSetup
 from tests._tolerances import END_BOUND, FORCE_BOUND, PATH_BOUND, TORQUE_BOUND
 
 SHAPES = ("round_peg", "square_peg", "shaft", "tight_peg")
@@ -26,7 +26,7 @@ def _path(skill: Skill) -> tuple[np.ndarray, np.ndarray]:
 
 @pytest.fixture(scope="module")
 def cell():
-    c = Cell(layer="pi_phase_stop")
+    c = Cell(setup=CellSetup(layer="pi_phase_stop"))
     yield c
     c.close()
 

@@ -13,6 +13,7 @@ import pytest
 
 from assembly_constraints.executor import ExecutorError
 from assembly_constraints.executor.skills.dmp import load_skill, skill_path
+from assembly_constraints.executor.trial import Cell
 from assembly_constraints.executor.world.geometry import load_geometry
 
 
@@ -101,3 +102,39 @@ def test_a_skill_moves_to_a_hole_s_bottom_from_the_depth_it_was_taught_at(spare:
     assert deeper.end_position[2] == pytest.approx(skill.end_position[2] - 0.005, abs=1e-12)
     assert deeper.demo_goal[2] == pytest.approx(skill.demo_goal[2] - 0.005, abs=1e-12)
     assert deeper.taught == skill.taught
+
+
+@pytest.mark.parametrize(("edit", "changed"), [
+    (('size = 0.0120           # side [m]', 'size = 0.0110'), "part p3 square 12.00 x 12.00 mm, the product's p3 is "
+                                                               "square 11.00 x 11.00 mm"),
+    (('size = 0.0133           # side [m]', 'size = 0.0140'), "hole s1 square 13.30 x 13.30 mm, the product's s1 is "
+                                                               "square 14.00 x 14.00 mm"),
+    (('parts = ["p3"]', 'parts = ["p9"]'), "part p3, which the product no longer has")])
+def test_a_skill_taught_on_a_section_the_product_no_longer_has_is_refused(spare: Path, edit: tuple[str, str],
+                                                                         changed: str) -> None:
+    """The square peg resized or renamed or its hole resized since the teaching: the cell
+    refuses the skill, naming the file and the change, instead of running it."""
+    geometry = spare / "geometry.toml"
+    text = geometry.read_text()
+    assert edit[0] in text
+    geometry.write_text(text.replace(*edit))
+    if edit[1].startswith("parts"):  # the part renamed in the product as well
+        product = spare / "assembly.toml"
+        product.write_text(product.read_text().replace("[parts.p3]", "[parts.p9]"))
+    cell = Cell(str(spare))
+    try:
+        with pytest.raises(ExecutorError) as refused:
+            cell.check_pair("p9" if "p9" in cell.geometry.parts else "p3", "s1")
+    finally:
+        cell.close()
+    message = str(refused.value)
+    assert message.startswith(f"{skill_path(spare, 'square_peg')}: taught on {changed}"), message
+    assert "\n" not in message and message.endswith("run ./run.sh executor teach")
+
+
+def test_a_skill_on_the_product_it_was_taught_on_is_used(spare: Path) -> None:
+    cell = Cell(str(spare))
+    try:
+        assert cell.check_pair("p3", "s1").taught == load_skill(spare, "square_peg").taught
+    finally:
+        cell.close()

@@ -51,10 +51,10 @@ def test_a_cell_description_reaches_every_cell_by_its_absolute_path(tmp_path: Pa
                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     """``session --cell-description FILE`` (relative to the caller) is in every cell's
     settings as an absolute path, and the cell builds its Cell with that file's values."""
-    from assembly_constraints.executor.trial import cell_keywords
+    from assembly_constraints.executor.trial import cell_setup
 
     (tmp_path / "cell.toml").write_text("[thresholds]\nf_stop = 7.5\n")
     monkeypatch.chdir(tmp_path)
     first, second = _cells(["--cell-description", "cell.toml"], tmp_path)
     assert first.cell.description == second.cell.description == str(tmp_path / "cell.toml")
-    assert cell_keywords(first.cell)["description"].thresholds.f_stop == 7.5
+    assert cell_setup(first.cell).description.thresholds.f_stop == 7.5

@@ -178,7 +178,7 @@ def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path
 
 
 def test_a_session_starts_from_the_fits_its_demonstrations_show(tmp_path: Path, run_session) -> None:
-    from assembly_constraints.asp.sizes.learner import learn_sizes
+    from assembly_constraints.asp.sizes.learner import LearningOptions, learn_sizes
 
     demos = ROOT / "data" / "cranfield" / "demos_annotated.txt"
     run = tmp_path / "run"
@@ -186,7 +186,7 @@ def test_a_session_starts_from_the_fits_its_demonstrations_show(tmp_path: Path, 
     assert_learned_truth(result, run)
     shown = {tuple(pair) for pair in result["demonstrated"]}
     assert len(shown) == 9 and shown <= TRUTH.fits
-    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", demonstrated=list(shown))
+    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", options=LearningOptions(demonstrated=list(shown)))
     assert result["experiments"] == alone.count < 19  # 19: best from nothing
     assert not {(e.part, e.hole) for e in read_journal(run / "journal.jsonl")} & shown
     learned = load_atoms([run / "learned.lp"])

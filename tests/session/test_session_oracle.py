@@ -13,7 +13,7 @@ from assembly_constraints.asp.session.zenoh_oracle import ZenohOracle
 from assembly_constraints.asp.sizes.learner import learn_sizes
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.bridge.cell_settings import ServeSettings
-from assembly_constraints.bridge.client import CellDirectory, CellPool
+from assembly_constraints.bridge.client import CellDirectory, CellPool, PoolLimits
 from assembly_constraints.bridge.session import free_loopback_endpoint, open_session
 
 
@@ -25,7 +25,7 @@ def test_learn_sizes_through_the_zenoh_oracle(tmp_path: Path) -> None:
     cell = start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,)))
     session = open_session(connect=(endpoint,))
     directory = CellDirectory(session)
-    pool = CellPool(session, directory, timeout=10.0, wait_for_cell=10.0)
+    pool = CellPool(session, directory, PoolLimits(timeout=10.0, wait_for_cell=10.0))
     journal = Journal(tmp_path)
     try:
         directory.wait_for(1, timeout=20)

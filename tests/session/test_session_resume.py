@@ -131,6 +131,22 @@ def test_a_resume_keeps_the_backend_and_says_what_it_resumes(tmp_path: Path, run
     assert json.loads(resumed.stdout)["matches_truth"] is True
 
 
+def test_a_resume_from_another_folder_finds_a_product_given_by_a_relative_path(tmp_path: Path, run_cli,
+                                                                               root: Path) -> None:
+    """``session.json`` keeps a product folder as an absolute path (a shipped one by its name)."""
+    (tmp_path / "here").mkdir()
+    cranfield_copy(root, tmp_path / "here" / "plate")
+    run = tmp_path / "run"
+    first = run_cli("session", "--json", "--plans", "1", "--backend", "truth", "--assembly", "plate", "--out",
+                    str(run), cwd=tmp_path / "here", timeout=90)
+    assert first.returncode == 0, first.stderr
+    assert json.loads((run / "session.json").read_text())["assembly"] == str(tmp_path / "here" / "plate")
+    as_if_killed(run, keep=4)
+    resumed = run_cli("session", "--json", "--plans", "1", "--resume", str(run), cwd=tmp_path, timeout=90)
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads(resumed.stdout)["matches_truth"] is True
+
+
 def test_a_resume_of_an_edited_product_is_refused_changing_nothing(tmp_path: Path, run_cli, root: Path) -> None:
     product, run = cranfield_copy(root, tmp_path / "product"), tmp_path / "run"
     run.mkdir()

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
 from assembly_constraints.asp.sizes.models import build_model, model_for
 from assembly_constraints.asp.sizes.truth_oracle import Result
 from assembly_constraints.bridge import BridgeError
@@ -44,7 +44,7 @@ def test_kinds_stated_only_in_geometry_give_exactly_the_true_fits(tmp_path: Path
     model = model_for(list(PEGS), None, assembly.size_model, assembly.sections())
     assert model.assumption() == "size model sections: one size line per cross-section (round: pa pc; square: pb pd)"
     truth = _CrossSections(product)
-    result = learn_sizes(list(PEGS), list(HOLES), truth, policy, seed, model=model)
+    result = learn_sizes(list(PEGS), list(HOLES), truth, policy, seed, options=LearningOptions(model=model))
     assert result.knowledge.fits == frozenset(truth.fits)
 
 
@@ -53,7 +53,7 @@ def test_a_part_of_unknown_section_shares_no_line() -> None:
     model = build_model("sections", ["a", "b", "c"], {"a": "round", "b": "round"})
     assert model.sections["c"] not in ("round", model.sections["a"])
     assert model.assumption().endswith("(round: a b; no cross-section stated, each on its own line: c)")
-    learner = SizeLearner(["a", "b", "c"], ["h1", "h2"], "systematic", model=model)
+    learner = SizeLearner(["a", "b", "c"], ["h1", "h2"], "systematic", options=LearningOptions(model=model))
     learner.record("c", "h1", "fit")
     learner.record("a", "h1", "no_fit")  # on one line: a is bigger than c
     learner.record("a", "h2", "fit")  # ... so c would fit h2

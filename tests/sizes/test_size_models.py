@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.plans.assign import LearnedFacts, UnsolvableAssembly, feasible_assignment
 from assembly_constraints.asp.sizes.biorders import biorder_count
-from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
 from assembly_constraints.asp.sizes.models import build_model, model_for
 from assembly_constraints.asp.sizes.policies import policy_names
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle, ferrers_violation
@@ -68,7 +68,7 @@ def test_mixed_products_are_learned_exactly_by_every_policy(pairs: int, policy: 
     assert ferrers_violation(truth.parts, truth.holes, truth.fits) is not None  # not one line
     model = model_for(truth.parts, None, None, sections)
     assert model.name == "sections"
-    result = learn_sizes(truth.parts, truth.holes, truth, policy, seed=3, model=model)
+    result = learn_sizes(truth.parts, truth.holes, truth, policy, seed=3, options=LearningOptions(model=model))
     assert result.knowledge.fits == frozenset(truth.fits)
     assert result.knowledge.no_fit == frozenset(
         (p, h) for p in truth.parts for h in truth.holes if (p, h) not in truth.fits)
@@ -82,7 +82,8 @@ def test_mixed_products_are_learned_exactly_by_every_policy(pairs: int, policy: 
 def test_the_single_line_entails_a_fit_that_does_not_exist() -> None:
     """Why the model matters: on the four-peg example one line learns wrong facts."""
     truth, _ = _example(2)
-    line = learn_sizes(truth.parts, truth.holes, truth, "heuristic", model=build_model("line", truth.parts))
+    line = learn_sizes(truth.parts, truth.holes, truth, "heuristic",
+                       options=LearningOptions(model=build_model("line", truth.parts)))
     assert line.knowledge.fits != frozenset(truth.fits)
 
 
@@ -145,7 +146,7 @@ def test_every_policy_learns_random_mixed_products_exactly(product, policy: str,
     """Zero wrong facts; a complete assignment whenever one exists, else Hall's witness."""
     truth, sections = product
     model = model_for(truth.parts, None, None, sections)
-    result = learn_sizes(truth.parts, truth.holes, truth, policy, seed, model=model)
+    result = learn_sizes(truth.parts, truth.holes, truth, policy, seed, options=LearningOptions(model=model))
     assert result.knowledge.fits == frozenset(truth.fits)
     assert not result.model_changes
     facts = _facts(truth.parts, truth.holes, result.knowledge.fits)
@@ -178,7 +179,7 @@ def test_entailed_outcomes_hold_in_every_allowed_relation(product, name: str, as
     every relation of the model agreeing with the observations gives it one outcome."""
     truth, sections = product
     model = build_model(name, truth.parts, sections)
-    learner = SizeLearner(truth.parts, truth.holes, "systematic", model=model)
+    learner = SizeLearner(truth.parts, truth.holes, "systematic", options=LearningOptions(model=model))
     observed: dict[tuple[str, str], str] = {}
     for i, j in asked:
         pair = (truth.parts[i % len(truth.parts)], truth.holes[j % len(truth.holes)])
@@ -214,8 +215,8 @@ def test_a_contradicted_line_moves_to_sections_then_learns_the_truth() -> None:
     line = model_for(truth.parts, "line", "line", sections)  # declared by the product: allowed
     # p1 (round 14) in h1 (round 14.5) and p2 (square 13) in h2 (square 13.5): demonstrated;
     # p1 -> h2 no_fit and p2 -> h1 no_fit close a cycle on one line (p1 < h1 < p2 < h2 < p1).
-    learner = SizeLearner(truth.parts, truth.holes, "systematic", demonstrated=[("p1", "h1"), ("p2", "h2")],
-                          model=line)
+    learner = SizeLearner(truth.parts, truth.holes, "systematic",
+                          options=LearningOptions(demonstrated=[("p1", "h1"), ("p2", "h2")], model=line))
     learner.record("p1", "h2", truth.ask("p1", "h2"))
     assert learner.knowledge.result("p2", "h1") == "fit"  # p2 < h2 < p1 < h1 on one line: wrong
     learner.record("p2", "h1", truth.ask("p2", "h1"))
@@ -231,7 +232,8 @@ def test_a_contradicted_line_moves_to_sections_then_learns_the_truth() -> None:
 @pytest.mark.parametrize("policy", policy_names())
 def test_under_pairs_every_policy_tries_every_pair_and_learns_the_truth(policy: str) -> None:
     truth, sections = _example(2)
-    result = learn_sizes(truth.parts, truth.holes, truth, policy, model=build_model("pairs", truth.parts, sections))
+    result = learn_sizes(truth.parts, truth.holes, truth, policy,
+                         options=LearningOptions(model=build_model("pairs", truth.parts, sections)))
     assert result.knowledge.fits == frozenset(truth.fits)
     assert result.count == len(truth.parts) * len(truth.holes)
     assert len({(e.part, e.hole) for e in result.experiments}) == result.count
@@ -243,7 +245,8 @@ def test_parallel_batches_under_sections_never_conflict_and_learn_exactly(produc
     """Pairs handed out together are independent on their section's line: answered in
     any order they never contradict each other, and the relation is learned exactly."""
     truth, sections = product
-    learner = SizeLearner(truth.parts, truth.holes, policy, model=model_for(truth.parts, None, None, sections))
+    learner = SizeLearner(truth.parts, truth.holes, policy,
+                          options=LearningOptions(model=model_for(truth.parts, None, None, sections)))
     while batch := learner.next_batch(cells):
         for pair in reversed(batch):
             learner.record(*pair, truth.ask(*pair))

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.bench.sizes import main as bench_main
 from assembly_constraints.asp.sizes.knowledge import Pair
-from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes, run_learner
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes, run_learner
 from assembly_constraints.asp.sizes.policies import policy_names
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from assembly_constraints.asp.solve import encoding, fact, format_facts
@@ -36,14 +36,14 @@ class LyingOracle:
 
 
 def _final_essentials(truth: TruthOracle, policy: str = "systematic") -> list[Pair]:
-    learner = SizeLearner(truth.parts, truth.holes, policy, confirm=1)
+    learner = SizeLearner(truth.parts, truth.holes, policy, options=LearningOptions(confirm=1))
     run_learner(learner, truth)
     return learner.essential()
 
 
 def test_essentials_of_a_hand_checked_chain() -> None:
     # a < x < b < y observed; a < y is entailed by the chain, so observing it adds nothing
-    learner = SizeLearner(["a", "b"], ["x", "y"], confirm=1)
+    learner = SizeLearner(["a", "b"], ["x", "y"], options=LearningOptions(confirm=1))
     for part, hole, result in [("a", "x", "fit"), ("b", "x", "no_fit"), ("b", "y", "fit")]:
         learner.record(part, hole, result)
     assert learner.knowledge.complete
@@ -71,7 +71,7 @@ def test_essentials_are_the_observations_whose_pair_is_unknown_without_them(trut
     pairs = [(p, h) for p in truth.parts for h in truth.holes]
     observed = data.draw(st.permutations(pairs).flatmap(lambda order: st.sampled_from(
         [order[:k] for k in range(1, len(order) + 1)])))
-    learner = SizeLearner(truth.parts, truth.holes, confirm=1)
+    learner = SizeLearner(truth.parts, truth.holes, options=LearningOptions(confirm=1))
     for pair in observed:
         learner.record(*pair, truth.ask(*pair))
     expected = [pair for pair in pairs if pair in observed and _unknown_without(truth, observed, pair)]
@@ -84,14 +84,14 @@ def test_confirm_1_undoes_a_lie_on_an_essential_pair_that_confirm_0_keeps() -> N
     for pair in _final_essentials(CRANFIELD):
         plain = learn_sizes(CRANFIELD.parts, CRANFIELD.holes, LyingOracle(CRANFIELD, pair), "systematic")
         confirmed = learn_sizes(CRANFIELD.parts, CRANFIELD.holes, LyingOracle(CRANFIELD, pair),
-                                "systematic", confirm=1)
+                                "systematic", options=LearningOptions(confirm=1))
         assert plain.knowledge.fits != truth_fits, pair
         assert confirmed.knowledge.fits == truth_fits, pair
 
 
 def test_a_disagreeing_retest_is_repeated_until_the_kept_result_leads_by_k_plus_1() -> None:
     pair = ("p3", "s1")  # essential; the truth is fit: answers fit, (lie) no_fit, fit, fit
-    learner = SizeLearner(CRANFIELD.parts, CRANFIELD.holes, "systematic", confirm=1)
+    learner = SizeLearner(CRANFIELD.parts, CRANFIELD.holes, "systematic", options=LearningOptions(confirm=1))
     result = run_learner(learner, LyingOracle(CRANFIELD, pair, lies=(2,)))
     assert learner.answers[pair] == ["fit", "no_fit", "fit", "fit"]
     assert learner.lead(pair) == 2
@@ -104,7 +104,7 @@ def test_a_disagreeing_retest_is_repeated_until_the_kept_result_leads_by_k_plus_
 @pytest.mark.parametrize("confirm", [1, 2])
 def test_without_noise_confirm_costs_k_experiments_per_essential_observation(policy, confirm) -> None:
     plain = learn_sizes(CRANFIELD.parts, CRANFIELD.holes, CRANFIELD, policy, seed=4)
-    learner = SizeLearner(CRANFIELD.parts, CRANFIELD.holes, policy, seed=4, confirm=confirm)
+    learner = SizeLearner(CRANFIELD.parts, CRANFIELD.holes, policy, seed=4, options=LearningOptions(confirm=confirm))
     result = run_learner(learner, CRANFIELD)
     assert result.count == plain.count + confirm * len(learner.essential())
     assert result.experiments[:plain.count] == plain.experiments
@@ -116,7 +116,7 @@ def test_without_noise_confirm_costs_k_experiments_per_essential_observation(pol
 @given(truth=biorders(max_parts=5, max_holes=5))
 def test_without_noise_confirm_1_adds_one_experiment_per_essential_on_any_biorder(truth) -> None:
     plain = learn_sizes(truth.parts, truth.holes, truth, "systematic")
-    learner = SizeLearner(truth.parts, truth.holes, "systematic", confirm=1)
+    learner = SizeLearner(truth.parts, truth.holes, "systematic", options=LearningOptions(confirm=1))
     assert run_learner(learner, truth).count == plain.count + len(learner.essential())
 
 
@@ -137,7 +137,7 @@ def _parallel(learner: SizeLearner, oracle, cells: int) -> list[list[Pair]]:
 @pytest.mark.parametrize("cells", [2, 3])
 def test_batches_beside_pending_experiments_confirm_and_correct_a_lie(cells: int) -> None:
     pair = ("p3", "s1")
-    learner = SizeLearner(CRANFIELD.parts, CRANFIELD.holes, "best", confirm=1)
+    learner = SizeLearner(CRANFIELD.parts, CRANFIELD.holes, "best", options=LearningOptions(confirm=1))
     batches = _parallel(learner, LyingOracle(CRANFIELD, pair), cells)
     assert learner.knowledge.fits == frozenset(CRANFIELD.fits)
     assert learner.essential() == _final_essentials(CRANFIELD)
@@ -147,9 +147,9 @@ def test_batches_beside_pending_experiments_confirm_and_correct_a_lie(cells: int
 
 def test_bad_confirm_settings_are_errors() -> None:
     with pytest.raises(PlannerError, match="confirm -1"):
-        SizeLearner(["a"], ["x"], confirm=-1)
+        SizeLearner(["a"], ["x"], options=LearningOptions(confirm=-1))
     with pytest.raises(PlannerError, match="max_answers 2"):
-        SizeLearner(["a"], ["x"], max_answers=2, confirm=2)
+        SizeLearner(["a"], ["x"], options=LearningOptions(max_answers=2, confirm=2))
 
 
 @pytest.mark.slow

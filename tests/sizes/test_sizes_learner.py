@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from assembly_constraints.asp import PlannerError
 from assembly_constraints.asp.sizes import learner as learner_module
-from assembly_constraints.asp.sizes.learner import SizeLearner, learn_sizes
+from assembly_constraints.asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
 from assembly_constraints.asp.sizes.models import build_model
 from assembly_constraints.asp.sizes.truth_oracle import TruthOracle
 from tests._sizes_helpers import CheckingOracle, biorders
@@ -151,7 +151,7 @@ def test_a_batch_avoids_pairs_pending_at_other_cells() -> None:
 
 
 def test_the_learner_starts_from_demonstrated_fits_and_what_they_entail_with_experiments() -> None:
-    learner = SizeLearner(["a", "b"], ["x", "y"], demonstrated=[("a", "x")])
+    learner = SizeLearner(["a", "b"], ["x", "y"], options=LearningOptions(demonstrated=[("a", "x")]))
     assert learner.knowledge.result("a", "x") == "fit" and learner.experiments == []
     assert learner.next_experiment() != ("a", "x")
     learner.record("b", "x", "no_fit")  # x < b, and a < x from the demonstration: a < b
@@ -166,7 +166,7 @@ def test_the_learner_starts_from_demonstrated_fits_and_what_they_entail_with_exp
     learner.reset()
     assert learner.knowledge.result("a", "x") == "fit"  # a fresh session keeps what was demonstrated
     with pytest.raises(PlannerError, match=r"demonstrated placement\(s\) a@z"):
-        SizeLearner(["a", "b"], ["x", "y"], demonstrated=[("a", "z")])
+        SizeLearner(["a", "b"], ["x", "y"], options=LearningOptions(demonstrated=[("a", "z")]))
 
 
 @pytest.mark.parametrize("policy", ["systematic", "heuristic", "best"])
@@ -178,7 +178,7 @@ def test_annotated_cranfield_demonstrations_save_experiments(policy: str) -> Non
     plain = learn_sizes(truth.parts, truth.holes, truth, policy)
     oracle = CheckingOracle(truth)
     annotated = learn_sizes(truth.parts, truth.holes, oracle, policy, on_experiment=oracle.observe,
-                            demonstrated=shown)
+                            options=LearningOptions(demonstrated=shown))
     assert annotated.knowledge.fits == frozenset(truth.fits)
     assert not set(oracle.asked) & set(shown)
     assert annotated.count <= plain.count - 5
@@ -194,7 +194,7 @@ def test_grounding_once_and_per_decision_make_the_same_session(policy, monkeypat
     sessions = []
     for limit in (0, 10_000):
         monkeypatch.setattr(learner_module, "GROUND_ONCE_PAIRS", limit)
-        learner = SizeLearner(parts, holes, policy, confirm=1, model=model)
+        learner = SizeLearner(parts, holes, policy, options=LearningOptions(confirm=1, model=model))
         flipped = False
         while (pair := learner.next_experiment()) is not None:
             result = "fit" if pair in fits else "no_fit"

@@ -1,0 +1,123 @@
+"""The ``truth`` backend of a cell node: answers from the cell's geometry (cross-sections),
+or where the product has no ``geometry.toml`` from its ``sizes.lp``, without simulation,
+optionally after a delay, to measure the bridge and test the protocol quickly."""
+
+from __future__ import annotations
+
+import time
+import uuid
+from pathlib import Path
+
+import clingo
+
+from assembly_constraints.bridge import BridgeError
+from assembly_constraints.bridge.assembly import load_assembly
+from assembly_constraints.bridge.cell_settings import ServeSettings
+from assembly_constraints.bridge.inputs import read_bytes
+from assembly_constraints.bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from assembly_constraints.bridge.recording.sinks import NO_VIEWER, Viewer
+from assembly_constraints.executor import ExecutorError
+from assembly_constraints.executor.backend_plugin import StepOutcome, UnknownPair, check_run, check_step
+from assembly_constraints.executor.world.geometry import load_geometry, passes
+
+
+def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
+    """The pegs (``part/1``), holes (``hole/1``) and ``fits/2`` pairs of a product's
+    ``sizes.lp`` (closed world); ExecutorError naming the file when it does not parse."""
+    control = clingo.Control(["--warn=none"])
+    try:
+        control.add("base", [], read_bytes(path, "sizes (ASP facts)").decode("utf-8", "replace"))
+        control.ground([("base", [])])
+    except RuntimeError:
+        raise ExecutorError(f"{path}: expected ASP facts part/1, hole/1, fits/2 (it does not parse)") from None
+    atoms = [atom.symbol for atom in control.symbolic_atoms]
+    pegs = {str(a.arguments[0]) for a in atoms if a.match("part", 1)}
+    holes = {str(a.arguments[0]) for a in atoms if a.match("hole", 1)}
+    return pegs, holes, {(str(a.arguments[0]), str(a.arguments[1])) for a in atoms if a.match("fits", 2)}
+
+
+class TruthBackend:
+    """Answers without simulation, after ``settings.delay_s`` [s]: from the cell's geometry
+    (a part passes a hole when its cross-section does,
+    :func:`assembly_constraints.executor.world.geometry.passes`), or from the product's
+    ``sizes.lp`` where it has no ``geometry.toml`` (the parts ``geometry.toml`` places by
+    hand answer from ``sizes.lp`` on its holes the geometry has not: the pins an imported
+    part goes onto); logs every outcome to Rerun if
+    ``settings.rrd`` or ``settings.viewer_url`` is given; a hole of ``settings.block_holes``
+    refuses every plan step."""
+
+    def __init__(self, settings: ServeSettings) -> None:
+        assembly, cell_id = settings.assembly, settings.cell_id
+        rrd, viewer = None if settings.rrd is None else Path(settings.rrd), Viewer(settings.viewer_url)
+        try:
+            assembly_of = load_assembly(assembly)
+            if assembly_of.has_file("geometry.toml"):
+                geometry = load_geometry(assembly)
+                self._pegs, self._holes = set(geometry.parts), set(geometry.holes)
+                self._manual: set[str] = set(geometry.tables.manual)
+                self._fits = {(p, h) for p, part in geometry.parts.items() for h, hole in geometry.holes.items()
+                              if passes(part, hole)}
+                if assembly_of.has_file("sizes.lp"):  # parts placed by hand onto features the cell does not model
+                    pegs, holes, fits = sizes_truth(assembly_of.file("sizes.lp"))
+                    pegs &= self._manual
+                    holes -= self._holes
+                    self._pegs |= pegs
+                    self._holes |= holes
+                    self._fits |= {(p, h) for p, h in fits if p in pegs and h in holes}
+            else:
+                self._pegs, self._holes, self._fits = sizes_truth(assembly_of.file("sizes.lp"))
+                self._manual = set()
+        except BridgeError as exc:
+            raise ExecutorError(f"truth backend: {exc}") from None
+        self._delay_s = settings.delay_s
+        self._blocked = set(settings.block_holes)
+        self._parts = tuple(assembly_of.part_ids)
+        self._run: str | None = None  # the plan run whose product is being built
+        self._placed: dict[str, float] = {}  # its placed parts
+        self._log = None
+        if rrd is not None or viewer != NO_VIEWER:
+            from assembly_constraints.executor.rerun_log import open_recording
+
+            self._log = open_recording(settings.recording_id or str(uuid.uuid4()), rrd, viewer)
+            self._entity = f"executor/{cell_id}/outcome"
+
+    def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
+        if request.part not in self._pegs or request.hole not in self._holes:
+            raise UnknownPair(f"unknown pair ({request.part},{request.hole}); expected a part "
+                              f"of {tuple(sorted(self._pegs))} and a hole of {tuple(sorted(self._holes))}")
+        if self._delay_s > 0:
+            time.sleep(self._delay_s)  # stands in for the duration of a real insertion
+        result: Result = "fit" if (request.part, request.hole) in self._fits else "no_fit"
+        if self._log is not None:
+            import rerun as rr
+
+            if request.experiment:
+                self._log.set_time("experiment", sequence=request.experiment)
+            self._log.log(self._entity, rr.TextLog(f"{request.part}->{request.hole}: {result}"))
+        return result, None
+
+    def run_step(self, request: StepRequest) -> StepOutcome:
+        """A peg fits when its cross-section passes the hole and the hole is not blocked;
+        another part of the product is always placed (skill ``manual`` for one placed by
+        hand). One plan run at a time; a step of another run, or one the product does not
+        allow, is refused before anything changes
+        (:func:`assembly_constraints.executor.backend_plugin.check_run`,
+        :func:`assembly_constraints.executor.backend_plugin.check_step`)."""
+        check_run(self._run, request.assembly, self._parts, self._placed)
+        fresh = request.assembly != self._run
+        check_step(request.part, request.hole, parts=self._parts, pegs=self._pegs, holes=self._holes,
+                   placed=() if fresh else self._placed)
+        if fresh:
+            self._run, self._placed = request.assembly, {}
+        placed = self._placed
+        ok = request.hole is None or (request.hole not in self._blocked and (request.part, request.hole) in self._fits)
+        if ok:
+            placed[request.part] = 0.0
+        skill = "manual" if request.part in self._manual else "truth"
+        evidence = StepEvidence(skill=skill, attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
+                                duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
+        return ("fit" if ok else "no_fit"), evidence, dict(placed)
+
+    def close(self) -> None:
+        if self._log is not None:
+            self._log.flush()
