@@ -97,6 +97,9 @@ class Cell:
                  *, setup: CellSetup = CellSetup(), ilc_state: Path | None = None) -> None:
         self.description = setup.description
         self.geometry = load_geometry(assembly, self.description)
+        if not self.geometry.parts:
+            raise ExecutorError(f"{self.geometry.folder / 'geometry.toml'}: no part the cell inserts (every part is "
+                                "placed by hand); expected at least one [part_shapes] (the truth backend takes it)")
         if gui:
             require_display()
         self.gui = gui

@@ -141,6 +141,16 @@ def report(derived: Derived) -> list[str]:
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
                      f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
+    for pin_id, pin in derived.pins.items():
+        onto = []
+        for pid in pin.parts:
+            bore = derived.bores[pid]
+            room = section_fit(section(pin_id, pin.section), section(pid, bore))
+            onto.append(f"{pid} onto it (bore {_describe(bore.kind, bore.a, bore.b)} mm, clearance "
+                        f"{_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg)")
+        lines.append(f"pin {pin_id} of {pin.owner} at ({_mm(pin.position[0])}, {_mm(pin.position[1])}) mm, "
+                     f"entered along {opposite(pin.axis)}: {_describe(pin.section.kind, pin.section.a, pin.section.b)}"
+                     f" mm; {'; '.join(onto)}")
     for pocket in derived.pockets:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
                      f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: no round, "

@@ -26,12 +26,22 @@ cross-sections, their clearance, the hole's entry (the base's highest point arou
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
 loop that is no round, square or rect section is a pocket, reported but no hole.
+
+**Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
+of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
+around a solid loop of another part there (the base's pin, another part's shaft), that
+part the base or one the geometric precedence puts before it, goes onto that pin; a peg
+standing in a hole of the base is no pin (a part over it is a cover). The pin is a
+feature of its owner (``<owner>_pin1``, ``_pin2``, ... by position), its section measured
+on the owner's slice; the fit is the pin's section inside the bore's, so the planner
+learns which part goes onto which pin as it learns pegs in holes.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import networkx as nx
 import numpy as np
 import trimesh
 
@@ -82,6 +92,25 @@ class HoleFit:
         return self.centre[0], self.centre[1]
 
 
+@dataclass(frozen=True)
+class PinFit:
+    """A pin (``id`` ``<owner>_pin<k>``) of part ``owner`` that ``parts`` go onto against
+    ``axis`` (their removal direction), with its measured ``section`` (circumscribed, as a
+    peg's) and ``centre`` [m] on the slice that found it."""
+
+    id: str
+    owner: str
+    axis: str
+    section: Shape2D
+    centre: tuple[float, float, float]
+    parts: tuple[str, ...]
+
+    @property
+    def position(self) -> tuple[float, float]:
+        """The pin's centre in the cell's x, y [m]."""
+        return self.centre[0], self.centre[1]
+
+
 @dataclass
 class Derived:
     """Everything :func:`derive` finds; ``free`` the directions each part leaves the whole
@@ -114,6 +143,9 @@ class Derived:
     holes: dict[str, HoleFit] = field(default_factory=dict)
     pockets: list[HoleFit] = field(default_factory=list)
     """Empty inner loops of the base that are no round, square or rect section: not holes."""
+    pins: dict[str, PinFit] = field(default_factory=dict)
+    bores: dict[str, Shape2D] = field(default_factory=dict)
+    """Part -> the section of its bore around a pin (:func:`pins`)."""
     queries: int = 0
 
     def free(self, part: str) -> list[str]:
@@ -198,6 +230,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
+    result.pins, result.bores = pins(result)
     result.queries = sweeper.queries
     return result
 
@@ -325,6 +358,64 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> list[Ho
                 fits.append(fit)
     fits.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     return fits
+
+
+def _outer(loop: Loop, loops: list[Loop]) -> bool:
+    """Whether ``loop`` is an outline of its slice (inside an even number of the others)."""
+    return sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0
+
+
+def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
+    """The pins moving parts go onto and each such part's bore section (module docstring):
+    a part whose slice at the middle of its extent along its insertion axis has an inner
+    loop holding the centre of another part's outline there, that part the base or one the
+    geometric precedence puts before it (a part that goes in after, into the bore, is no
+    pin: a head in a cover's socket). A bore around no such outline is no fit; nor is one
+    around a peg standing in a hole of the base (that part is a cover,
+    :mod:`executor.cad.covers`)."""
+    found: list[tuple[str, str, Shape2D, np.ndarray, str]] = []  # owner, axis, pin, centre, part
+    order = nx.DiGraph(list(derived.edges))
+    bores: dict[str, Shape2D] = {}
+    for pid in sorted(derived.axis):
+        if pid in derived.hole_of:
+            continue
+        name = derived.axis[pid]
+        axis = np.array(derived.directions[name])
+        along = derived.parts[pid].mesh.vertices @ axis
+        level = float(along.min() + along.max()) / 2
+        own = slice_loops(derived.parts[pid].mesh, axis, level)
+        frame = frame_of(axis)
+        for bore in (loop for loop in own if not _outer(loop, own)):
+            before = nx.ancestors(order, pid) if pid in order else set()
+            for other in sorted(({derived.base} | before) - set(derived.hole_of)):
+                theirs = slice_loops(derived.parts[other].mesh, axis, level)
+                inside = [o for o in theirs if _outer(o, theirs) and bore.contains(o.centre) and o.area < bore.area]
+                if len(inside) == 1:
+                    pin = classify(inside[0], hole=False)
+                    centre = frame.T @ pin.centre + axis * level
+                    found.append((other, name, pin, centre, pid))
+                    bores[pid] = classify(bore, hole=True)
+                    break
+            if pid in bores:
+                break
+    merged: list[tuple[str, str, Shape2D, np.ndarray, list[str]]] = []
+    for owner, name, pin, centre, pid in found:
+        axis = np.array(derived.directions[name])
+        same = next((m for m in merged if m[0] == owner and m[1] == name and np.linalg.norm(
+            (m[3] - centre) - axis * np.dot(m[3] - centre, axis)) < _SAME_HOLE), None)
+        if same is None:
+            merged.append((owner, name, pin, centre, [pid]))
+        else:
+            same[4].append(pid)
+    merged.sort(key=lambda m: (m[0], round(float(m[3][0]), 6), round(float(m[3][1]), 6), round(float(m[3][2]), 6)))
+    counts: dict[str, int] = {}
+    result: dict[str, PinFit] = {}
+    for owner, name, pin, centre, parts in merged:
+        counts[owner] = counts.get(owner, 0) + 1
+        pin_id = f"{owner}_pin{counts[owner]}"
+        result[pin_id] = PinFit(pin_id, owner, name, pin, (float(centre[0]), float(centre[1]), float(centre[2])),
+                                tuple(parts))
+    return result, bores
 
 
 def _fields(fit: HoleFit) -> tuple:

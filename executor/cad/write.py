@@ -2,8 +2,11 @@
 
 - ``assembly.toml``: every part (the base with role ``base``, a part in a hole with role
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
-  every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position;
-- ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass
+  every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position,
+  and every pin a part goes onto (``<owner>_pin1``, ... :func:`executor.cad.derive.pins`)
+  as a hole at the pin's position with the pin's section kind;
+- ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
+  every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
   square and rect sections, the polygon relation where one is a polygon), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
@@ -143,6 +146,9 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(fit.position[0])}, {_q(fit.position[1])}]", ""]
+    for pin_id, pin in derived.pins.items():
+        lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner} ({" ".join(pin.parts)} onto it)"',
+                  f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]", ""]
     return "\n".join(lines)
 
 
@@ -155,7 +161,7 @@ def sizes_text(derived: Derived) -> str:
     rooms = margins(derived)
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in rooms]),
-             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in derived.holes])]
+             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in [*derived.holes, *derived.pins]])]
     for pid, holes in rooms.items():
         fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, room in holes.items()
                 if room > 0]
@@ -165,14 +171,20 @@ def sizes_text(derived: Derived) -> str:
 
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
-    """Peg -> hole -> the room [m] of the peg's nominal section in the hole's
+    """Peg -> hole -> the room [m] of the peg's nominal section in the hole's, and part
+    with a bore -> pin -> the room of the pin's section in the bore's
     (:func:`executor.world.geometry.margin`, the polygon relation for
-    polygon sections; negative: it does not pass); ExecutorError naming the part or hole
-    whose polygon section is no simple outline."""
+    polygon sections; negative: it does not pass); ExecutorError naming the part, hole,
+    pin or bore whose polygon section is no simple outline."""
     pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
     try:
-        return {pid: {hid: margin(section(f"part {pid}", peg), section(f"hole {hid}", fit.hole))
-                      for hid, fit in derived.holes.items()} for pid, peg in pegs.items()}
+        rooms = {pid: {hid: margin(section(f"part {pid}", peg), section(f"hole {hid}", fit.hole))
+                       for hid, fit in derived.holes.items()} for pid, peg in pegs.items()}
+        for pid, bore in sorted(derived.bores.items()):
+            rooms.setdefault(pid, {}).update({
+                pin_id: margin(section(f"pin {pin_id}", pin.section), section(f"bore of {pid}", bore))
+                for pin_id, pin in derived.pins.items()})
+        return rooms
     except OutlineError as exc:  # a slice of a mesh that crosses itself
         raise ExecutorError(f"{exc} (the mesh's slice at the hole's mid-depth)") from None
 
@@ -233,11 +245,12 @@ def precedence_text(derived: Derived) -> str:
 def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above with a
     round, square or rect section holding, if anything, a peg entered from above; and the
-    pegs of the other holes, each with why the cell places it by hand (a polygon pair's
-    room is often below what convex pieces of its meshes keep: the cell inserts polygon
-    sections of products described by hand, docs/geometry.md)."""
+    pegs of the other holes and the parts going onto pins, each with why the cell places it
+    by hand (a polygon pair's room is often below what convex pieces of its meshes keep:
+    the cell inserts polygon sections of products described by hand, docs/geometry.md)."""
     kept: dict[str, HoleFit] = {}
-    by_hand: dict[str, str] = {}
+    by_hand = {pid: f"goes onto a pin ({pin.id}): the cell has no operation for it" for pin in derived.pins.values()
+               for pid in pin.parts}
     for hid, fit in derived.holes.items():
         if fit.part is not None and derived.axis[fit.part] != "+z":
             by_hand[fit.part] = f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, not from above"

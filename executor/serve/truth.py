@@ -40,7 +40,9 @@ class TruthBackend:
     """Answers without simulation, after ``settings.delay_s`` [s]: from the cell's geometry
     (a part passes a hole when its cross-section does,
     :func:`executor.world.geometry.passes`), or from the product's
-    ``sizes.lp`` where it has no ``geometry.toml``; logs every outcome to Rerun if
+    ``sizes.lp`` where it has no ``geometry.toml`` (the parts ``geometry.toml`` places by
+    hand answer from ``sizes.lp`` on its holes the geometry has not: the pins an imported
+    part goes onto); logs every outcome to Rerun if
     ``settings.rrd`` or ``settings.viewer_url`` is given; a hole of ``settings.block_holes``
     refuses every plan step."""
 
@@ -55,6 +57,13 @@ class TruthBackend:
                 self._manual: set[str] = set(geometry.tables.manual)
                 self._fits = {(p, h) for p, part in geometry.parts.items() for h, hole in geometry.holes.items()
                               if passes(part, hole)}
+                if assembly_of.has_file("sizes.lp"):  # parts placed by hand onto features the cell does not model
+                    pegs, holes, fits = sizes_truth(assembly_of.file("sizes.lp"))
+                    pegs &= self._manual
+                    holes -= self._holes
+                    self._pegs |= pegs
+                    self._holes |= holes
+                    self._fits |= {(p, h) for p, h in fits if p in pegs and h in holes}
             else:
                 self._pegs, self._holes, self._fits = sizes_truth(assembly_of.file("sizes.lp"))
                 self._manual = set()

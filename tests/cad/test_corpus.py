@@ -99,7 +99,6 @@ def _xfail(reason: str) -> pytest.MarkDecorator:
     return pytest.mark.xfail(strict=True, reason=reason)
 
 
-PINS = "fits of any part on any part: a nut over a pin of the base is no hole of the base"
 INSERTED = "fits of any part on any part: the cell has no operation for a part going"
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
@@ -109,7 +108,7 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
-    pytest.param("robosuite_nuts", marks=_xfail(PINS)),
+    "robosuite_nuts",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
