@@ -28,13 +28,23 @@ MAX_TOLERANCE_M = 0.1
 """The largest tolerance a prior takes [m]."""
 
 
-def nominal_margins(path: Path) -> dict[Pair, int]:
+class Margins(dict[Pair, int]):
+    """(part, hole) -> margin [µm] read from ``path``, with the ``lines`` of the file that
+    state them (so that a later check can name the line)."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__()
+        self.path = path
+        self.lines: dict[Pair, int] = {}
+
+
+def nominal_margins(path: Path) -> Margins:
     """(part, hole) -> margin [µm] of ``path``, read as data (:func:`read_ground_facts`, at
     most one fact per pair of :data:`asp.MAX_IDS` parts and holes);
     PlannerError naming the file and line when it holds anything else, two different margins
     for one pair (naming both lines), or no facts."""
-    margins: dict[Pair, int] = {}
-    lines: dict[Pair, int] = {}
+    margins = Margins(path)
+    lines = margins.lines
     for line, atom in read_ground_facts(path, "nominal_margin(Part,Hole,Micrometres) facts",
                                         max_facts=MAX_IDS * MAX_IDS):
         arguments = atom.arguments
@@ -54,18 +64,21 @@ def nominal_margins(path: Path) -> dict[Pair, int]:
     return margins
 
 
-def decided(margins: dict[Pair, int], tolerance: float, parts: tuple[str, ...], holes: tuple[str, ...]
+def decided(margins: Margins, tolerance: float, parts: tuple[str, ...], holes: tuple[str, ...]
             ) -> list[tuple[Pair, Result]]:
     """The outcomes the margins decide beyond ``tolerance`` [m], in part then hole order;
-    PlannerError when the margins name a part or hole not among ``parts`` and ``holes`` or
-    miss a pair of ``parts`` × ``holes``."""
-    unknown = sorted({p for p, _ in margins if p not in parts} | {h for _, h in margins if h not in holes})
-    if unknown:
-        raise PlannerError(f"{NOMINAL_FILE}: unknown part or hole {' '.join(unknown[:5])} (expected the parts "
-                           f"{' '.join(parts)} and holes {' '.join(holes)} of the product)")
+    PlannerError naming the file (and the line of the first fact) when the margins name a
+    part or hole not among ``parts`` and ``holes``, or miss a pair of ``parts`` × ``holes``."""
+    strange = sorted((line, pair) for pair, line in margins.lines.items()
+                     if pair[0] not in parts or pair[1] not in holes)
+    if strange:
+        unknown = sorted({p for _, (p, _) in strange if p not in parts}
+                         | {h for _, (_, h) in strange if h not in holes})
+        raise PlannerError(f"{margins.path}:{strange[0][0]}: unknown part or hole {' '.join(unknown[:5])} (expected "
+                           f"the parts {' '.join(parts)} and holes {' '.join(holes)} of the product)")
     missing = [f"{p}->{h}" for p in parts for h in holes if (p, h) not in margins]
     if missing:
-        raise PlannerError(f"{NOMINAL_FILE}: no nominal margin for {' '.join(missing[:5])} (expected every part "
+        raise PlannerError(f"{margins.path}: no nominal margin for {' '.join(missing[:5])} (expected every part "
                            "and hole of sizes.lp)")
     bound = 1e6 * tolerance
     outcomes: list[tuple[Pair, Result]] = []
