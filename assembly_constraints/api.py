@@ -6,7 +6,7 @@
 >>> sizes = api.learn_sizes(truth, truth.parts, truth.holes)  # active exploration, policy "best"
 >>> facts = api.write_facts("learned.lp", relation, sizes)
 >>> first = api.plan([facts], n=1)[0]                         # a complete plan, checked
->>> result = api.run_session("cranfield", backend="truth", out="runs/x")  # planner + a cell process
+>>> result = api.run_session("cranfield", api.SessionOptions(backend="truth", out="runs/x"))  # + a cell
 >>> run = api.read_run("runs/x")                              # its settings, journal, files
 
 Paths are relative to the working folder; an assembly is a shipped one's name
@@ -43,8 +43,8 @@ Result = Literal["fit", "no_fit"]
 """The outcome of one insertion experiment."""
 
 __all__ = ["CellSettings", "Experiment", "JournalEntry", "Magnitudes", "Plan", "PlannerError", "Relation", "Result",
-           "RunFolder", "SessionFile", "SessionResult", "SizeLearningResult", "learn_precedence", "learn_sizes",
-           "plan", "read_run", "run_session", "truth_oracle", "write_facts"]
+           "RunFolder", "SessionFile", "SessionOptions", "SessionResult", "SizeLearningResult", "learn_precedence",
+           "learn_sizes", "plan", "read_run", "run_session", "truth_oracle", "write_facts"]
 
 
 def learn_precedence(assembly: str | Path = "cranfield", demos: str | Path | None = None,
@@ -135,24 +135,42 @@ class SessionResult(TypedDict):
     error: NotRequired[str]
 
 
-def run_session(assembly: str | Path = "cranfield", *, out: str | Path | None = None,
-                backend: Literal["sim", "truth"] = "sim", cells: int = 1, policy: str = "best", seed: int = 0,
-                confirm: int = 0, timeout_s: float = 120.0, plans: int = 5,
-                connect: Sequence[str] = (), cell: CellSettings | None = None) -> SessionResult:
-    """A whole learning session (``assembly-constraints session``): learns precedence from
-    the demonstrations, starts ``cells`` cell processes (``backend`` ``sim``: PyBullet,
-    ``truth``: answers from the geometry, fast) or, with ``cells=0``, uses the cells
-    reachable at the Zenoh endpoints ``connect``; learns the sizes, plans, and writes the
-    run folder ``out`` (default ``runs/<UTC time>``). ``timeout_s`` [s]: one experiment at
-    one cell before it is sent again. ``cell``: the simulated cells' execution layer and
-    uncertainty (default: the defaults, cell seed ``seed``); cell ``c<k>`` has cell seed
-    ``cell.cell_seed + k - 1``. PlannerError naming the setting when one is out of range."""
+@dataclass(frozen=True)
+class SessionOptions:
+    """How :func:`run_session` runs (the options of ``assembly-constraints session``):
+    ``out`` the run folder (default ``runs/<UTC time>``); ``backend`` ``sim`` (PyBullet) or
+    ``truth`` (answers from the geometry, fast); ``cells`` cell processes to start, or 0 to
+    use the cells reachable at the Zenoh endpoints ``connect``; the size ``policy``, its
+    ``seed`` and ``confirm`` (re-tests per outcome); ``timeout_s`` [s]: one experiment at
+    one cell before it is sent again; ``plans`` to compute; ``cell``: the simulated cells'
+    execution layer and uncertainty (default: the defaults, cell seed ``seed``), cell
+    ``c<k>`` having cell seed ``cell.cell_seed + k - 1``."""
+
+    out: str | Path | None = None
+    backend: Literal["sim", "truth"] = "sim"
+    cells: int = 1
+    policy: str = "best"
+    seed: int = 0
+    confirm: int = 0
+    timeout_s: float = 120.0
+    plans: int = 5
+    connect: Sequence[str] = ()
+    cell: CellSettings | None = None
+
+
+def run_session(assembly: str | Path = "cranfield", options: SessionOptions | None = None) -> SessionResult:
+    """A whole learning session (``assembly-constraints session``) on ``assembly`` as
+    ``options`` say (default: :class:`SessionOptions`' defaults): learns precedence from
+    the demonstrations, starts the cells or uses those reachable, learns the sizes, plans,
+    and writes the run folder. PlannerError naming the setting when one is out of range."""
     from asp.session.run import run_session as run
 
-    settings = SessionSettings(assembly=str(assembly), out=None if out is None else str(out), backend=backend,
-                               cells=cells, policy=policy, seed=seed, confirm=confirm, timeout_s=timeout_s,
-                               plans=plans, connect=tuple(connect),
-                               cell=CellSettings(cell_seed=seed) if cell is None else cell)
+    chosen = SessionOptions() if options is None else options
+    settings = SessionSettings(assembly=str(assembly), out=None if chosen.out is None else str(chosen.out),
+                               backend=chosen.backend, cells=chosen.cells, policy=chosen.policy, seed=chosen.seed,
+                               confirm=chosen.confirm, timeout_s=chosen.timeout_s, plans=chosen.plans,
+                               connect=tuple(chosen.connect),
+                               cell=CellSettings(cell_seed=chosen.seed) if chosen.cell is None else chosen.cell)
     return SessionResult(**run(settings))  # type: ignore[typeddict-item]
 
 

@@ -31,7 +31,7 @@ def test_learn_sizes_takes_a_function_and_rejects_an_answer_that_is_no_result() 
 @pytest.mark.slow
 def test_a_session_run_from_python_is_read_back_from_its_folder(tmp_path: Path) -> None:
     cell = api.CellSettings(layer="position", cell_seed=5, magnitudes=api.Magnitudes(vision_bias=0.002))
-    result = api.run_session("cranfield", backend="truth", out=tmp_path / "run", cell=cell)
+    result = api.run_session("cranfield", api.SessionOptions(backend="truth", out=tmp_path / "run", cell=cell))
     assert result["matches_truth"] is True
     run = api.read_run(tmp_path / "run")
     assert len(run.experiments) == result["experiments"] == 19
@@ -45,8 +45,8 @@ def test_a_session_run_from_python_is_read_back_from_its_folder(tmp_path: Path) 
 
 def test_session_settings_out_of_range_are_refused_before_anything_starts(tmp_path: Path) -> None:
     with pytest.raises(api.PlannerError, match='^session settings: "cells": expected `int` <= 64'):
-        api.run_session("cranfield", backend="truth", cells=65, out=tmp_path / "run")
+        api.run_session("cranfield", api.SessionOptions(backend="truth", cells=65, out=tmp_path / "run"))
     with pytest.raises(api.PlannerError, match='"cell.magnitudes.vision_bias": expected `float` <= 0.02'):
-        api.run_session("cranfield", backend="truth", out=tmp_path / "run",
-                        cell=api.CellSettings(magnitudes=api.Magnitudes(vision_bias=0.5)))
+        api.run_session("cranfield", api.SessionOptions(
+            backend="truth", out=tmp_path / "run", cell=api.CellSettings(magnitudes=api.Magnitudes(vision_bias=0.5))))
     assert not (tmp_path / "run").exists()
