@@ -37,11 +37,13 @@ FEATURE_REACH_MM = 2.0
 @dataclass(frozen=True)
 class Imported:
     """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
-    moving part's insertion ``axes`` (the reverse of the direction it leaves along)."""
+    moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
+    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the cell."""
 
     truth: dict[str, Any]
     out: Path
     axes: dict[str, str]
+    offset: tuple[float, float]
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -66,18 +68,20 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
         if name not in done:
             folder = CORPUS / name
             out = tmp_path_factory.mktemp(name) / "out"
-            derived = run_import(folder / "meshes", out, "mm", folder / "import.toml").derived
+            result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
             truth = tomllib.loads((folder / "truth.toml").read_text())
-            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()})
+            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in result.derived.axis.items()},
+                                  result.offset)
         return done[name]
 
     return get
 
 
-def _distance_to_axis(position: list[float], feature: dict[str, Any]) -> float:
-    """How far an imported hole's ``position`` [m] (x, y, or x, y, z) lies from a truth
-    feature's axis line [mm]; with x, y only, from the line's projection on the xy plane."""
-    point = [1000.0 * v for v in position]
+def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float]) -> float:
+    """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, moved by
+    ``offset`` [m] from the CAD frame) lies from a truth feature's axis line [mm]; with x, y
+    only, from the line's projection on the xy plane."""
+    point = [1000.0 * (v - (offset[k] if k < 2 else 0.0)) for k, v in enumerate(position)]
     origin = feature["axis_point"][:len(point)]
     direction = {"x": 0, "y": 1, "z": 2}[feature["axis"][1]]
     across = [point[k] - origin[k] for k in range(len(point)) if k != direction]
@@ -89,7 +93,8 @@ def _feature_holes(done: Imported) -> dict[str, str]:
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
-        near = [hid for hid, hole in holes.items() if _distance_to_axis(hole["position"], feature) <= FEATURE_REACH_MM]
+        near = [hid for hid, hole in holes.items()
+                if _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM]
         if len(near) == 1:
             found[fid] = near[0]
     return found
