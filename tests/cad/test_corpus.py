@@ -15,6 +15,7 @@ the mark must go; the truths are never weakened to pass.
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from collections.abc import Callable
@@ -28,6 +29,7 @@ import pytest
 from executor.cad.cli import run_import
 from executor.cad.sweep import opposite
 from executor.world.geometry import load_geometry
+from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
 FEATURE_REACH_MM = 2.0
@@ -181,6 +183,19 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
+
+
+@pytest.mark.slow  # imports the product, teaches it and runs two insertions in the sim cell (about 30 s)
+def test_a_product_drawn_at_the_origin_is_inserted_where_the_import_placed_it(
+        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+    done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
+    assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
+    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
+    assert taught.returncode == 0, taught.stderr
+    trial = run_executor("trial", "--assembly", str(done.out), "--part", "peg4", "--hole", "h1", "--trials", "2",
+                         "--json", timeout=240)
+    assert trial.returncode == 0, trial.stderr
+    assert json.loads(trial.stdout)["summary"]["fit"] == 2  # the square peg in its only fitting hole
 
 
 @pytest.mark.parametrize("name", PRODUCTS)
