@@ -8,6 +8,11 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
     tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: a row)
     name = "round peg"
     fixed_to = "lever"        # moves with that part (screwed, glued): neither blocks the other
+    place = [0.56, 0.0]       # where the base's centre stands on the cell's table [m]
+
+``--place X,Y`` overrides ``place``. Without either, a product whose base's centre lies
+outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
+says so; every part is moved right after reading, so every file written is in the cell frame.
 
 It prints what it assumes, each part's insertion axis and free directions, each hole
 with both cross-sections and the clearance, the disassembly stages, the geometric
@@ -28,7 +33,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from bridge.cli_types import ArgumentParser, int_in, nonempty_path, number_in
+from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
 from executor.cad.convex import MESH_FOLDER
@@ -42,6 +47,7 @@ from executor.cad.parts import (
     CadPart,
     check_parts,
     load_meshes,
+    translated,
 )
 from executor.cad.step import load_step
 from executor.cad.sweep import opposite
@@ -59,11 +65,65 @@ TRAY_ROW = ((0.25, 0.40), 0.05)
 """Default trays: the parts in a row from this point [m], this far apart along x [m]."""
 BASE_TRAY = (0.30, -0.40)
 """Default tray of the base [m]."""
+WORK_POSITION = (0.56, 0.0)
+"""Where a product out of the arm's reach is placed by default: its base's centre [m] in the
+cell (the arm's base at the origin); the tests' products stand at x = 0.55 to 0.63 m."""
+REACH = (0.35, 0.70)
+"""A base whose centre lies this far [m] from the arm's base horizontally (inclusive) stays
+where the CAD has it: the span of the shipped products' holes (Cranfield's at 0.55 to 0.63 m)
+and trays (0.47 to 0.50 m), widened; nearer or farther is taken as out of reach (a product
+at x = 0 failed its fits in the sim cell)."""
+PLACE_BOUND = 1.0
+"""``place`` coordinates lie in [-PLACE_BOUND, PLACE_BOUND] [m] (the cell's table)."""
 
 
-def _config(path: Path | None, parts: list[CadPart]) -> tuple[Settings, dict[str, str], list[str]]:
+def place_pair(text: str) -> tuple[float, float]:
+    """An argparse type: ``"X,Y"`` [m], both finite in [-PLACE_BOUND, PLACE_BOUND]."""
+    parse = finite_float(-PLACE_BOUND, PLACE_BOUND)
+    values = text.split(",")
+    if len(values) != 2:
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected X,Y in m, each a finite number in "
+                                         f"[{-PLACE_BOUND:g}, {PLACE_BOUND:g}]")
+    return parse(values[0].strip()), parse(values[1].strip())
+
+
+def _place_setting(path: Path | None, value: object) -> tuple[float, float] | None:
+    """``place`` of ``--config`` (None: not set); ExecutorError naming the file otherwise."""
+    if value is None:
+        return None
+    if not (isinstance(value, list) and len(value) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            and abs(v) <= PLACE_BOUND for v in value)):
+        raise ExecutorError(f"{path}: place: expected [x, y] in m, each in [{-PLACE_BOUND:g}, {PLACE_BOUND:g}], got "
+                            f"{shorten(repr(value))}")
+    return float(value[0]), float(value[1])
+
+
+def placement(parts: list[CadPart], base: str, place: tuple[float, float] | None) -> tuple[tuple[float, float], str]:
+    """The horizontal offset [m] that puts the centre of ``base``'s box at ``place`` (None:
+    at :data:`WORK_POSITION` when it lies out of :data:`REACH`, else no offset), and the
+    assumption to print."""
+    bounds = next(p.mesh.bounds for p in parts if p.id == base)
+    centre = (float(bounds[0][0] + bounds[1][0]) / 2, float(bounds[0][1] + bounds[1][1]) / 2)
+    distance = math.hypot(*centre)
+    if place is None:
+        if REACH[0] <= distance <= REACH[1]:
+            return (0.0, 0.0), (f"the CAD frame is the cell frame (the base's centre {_mm(distance)} mm from the "
+                                "arm's base, within reach; set place = [x, y] to move it)")
+        place = WORK_POSITION
+        why = (f"the base's centre {_mm(distance)} mm from the arm's base is out of its reach "
+               f"({_mm(REACH[0])} to {_mm(REACH[1])} mm); set place = [x, y] or --place X,Y")
+    else:
+        why = "place"
+    offset = (place[0] - centre[0], place[1] - centre[1])
+    return offset, (f"the base's centre placed at ({_mm(place[0])}, {_mm(place[1])}) mm in the cell ({why}): every "
+                    f"part moved by ({_mm(offset[0])}, {_mm(offset[1])}) mm from the CAD frame")
+
+
+def _config(path: Path | None, parts: list[CadPart]
+            ) -> tuple[Settings, dict[str, str], list[str], tuple[float, float] | None]:
     """The settings of ``--config`` (checked: one line naming the file and key), the
-    fixed-to map, and what was assumed for lack of them."""
+    fixed-to map, what was assumed for lack of them, and ``place`` (None: not set)."""
     ids = {p.id for p in parts}
     data: dict = {}
     if path is not None:
@@ -111,7 +171,7 @@ def _config(path: Path | None, parts: list[CadPart]) -> tuple[Settings, dict[str
         trays[base] = BASE_TRAY
     if missing:
         assumed.append(f"trays of {', '.join(sorted(missing))} in a row (set [parts.<id>] tray)")
-    return Settings(base, trays, names), fixed, assumed
+    return Settings(base, trays, names), fixed, assumed, _place_setting(path, data.get("place"))
 
 
 def _mm(value: float) -> str:
@@ -204,7 +264,8 @@ def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES) ->
 class Imported:
     """What :func:`run_import` found: the ``derived`` geometry, the ``mapped`` covers and
     heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
-    files ``written`` and the ``seconds`` taken."""
+    files ``written``, the ``seconds`` taken and the ``offset`` (x, y) [m] by which every
+    part was moved from the CAD frame into the cell (:func:`placement`)."""
 
     derived: Derived
     mapped: Mapped
@@ -212,25 +273,31 @@ class Imported:
     why: str | None
     written: list[Path]
     seconds: float
+    offset: tuple[float, float]
 
 
 def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH,
-               max_triangles: int = MAX_TRIANGLES, replace: bool = False) -> Imported:
+               max_triangles: int = MAX_TRIANGLES, replace: bool = False,
+               place: tuple[float, float] | None = None) -> Imported:
     """Read (at most ``max_triangles``), check, claim ``out`` (``replace``: also a product
-    another import or a person wrote, :func:`executor.cad.write.claim_folder`),
-    derive (``reach`` [m]: the locating rule's, 0: off), map the covers and heads, and write."""
+    another import or a person wrote, :func:`executor.cad.write.claim_folder`), move the
+    parts into the cell (``place`` [m]: where the base's centre goes, over the config's,
+    :func:`placement`), derive (``reach`` [m]: the locating rule's, 0: off), map the covers and heads, and write."""
     started = time.perf_counter()
     parts = load_source(source, units, max_triangles)
     check_parts(parts, units)
     removable = claim_folder(out, [p.id for p in parts], replace)
-    settings, fixed, assumed = _config(config, parts)
+    settings, fixed, assumed, placed = _config(config, parts)
+    offset, where = placement(parts, settings.base, place or placed)
+    parts = translated(parts, offset)
+    assumed.insert(0, where)
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
     assumed += derived.assumptions()
     mapped = map_product(derived, settings)
     written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
-    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started)
+    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
 
 
 def main(argv: list[str]) -> int:
@@ -242,7 +309,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--out", type=nonempty_path, required=True, metavar="DIR", help="the assembly folder to write")
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
-    parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to")
+    parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to, place")
+    parser.add_argument("--place", type=place_pair, metavar="X,Y",
+                        help="where the base's centre stands in the cell [m] (over the config's place; default: "
+                             f"where the CAD has it, or ({WORK_POSITION[0]:g}, {WORK_POSITION[1]:g}) when that is "
+                             "out of the arm's reach)")
     parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
@@ -256,10 +327,10 @@ def main(argv: list[str]) -> int:
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
     done = run_import(args.source, args.out, args.units, args.config, args.locating_reach, args.max_triangles,
-                      args.replace)
+                      args.replace, args.place)
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
-    print(f"assumes: units {units}; the CAD frame is the cell frame; " + "; ".join(done.assumed))
+    print(f"assumes: units {units}; " + "; ".join(done.assumed))
     for line in report(derived) + mapped_report(done.mapped):
         print(line)
     meshes = sorted(p.name.removesuffix(".obj") for p in done.written

@@ -4,7 +4,7 @@ A source is a folder of ``*.stl``/``*.obj`` meshes (one part per file, the id is
 name's stem, units given by the caller) or a STEP assembly (one part per leaf of its
 assembly tree, the id from its name, the placement of the tree applied, units as the file
 states them: the reader converts to mm). Every part becomes a :class:`trimesh.Trimesh` in
-metres in the CAD frame, which is taken as the cell frame.
+metres in the CAD frame; :func:`translated` moves them into the cell (``import --place``).
 
 A mesh file is read within a size bound (:data:`MAX_TRIANGLES` for the product, its
 triangles counted before the mesh is built), its coordinates must be finite (the line or
@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import BinaryIO
 
@@ -62,7 +62,7 @@ _STL_TRIANGLE = 50
 @dataclass(frozen=True)
 class Cylinder:
     """A cylindrical face of a part's B-rep: a ``point`` (3,) [m] on its axis, the axis
-    ``direction`` (3,) (unit) and the ``radius`` [m], in the cell frame."""
+    ``direction`` (3,) (unit) and the ``radius`` [m], in the frame of its mesh."""
 
     point: np.ndarray
     direction: np.ndarray
@@ -72,9 +72,9 @@ class Cylinder:
 @dataclass(frozen=True)
 class CadPart:
     """One part in the assembled pose: ``id`` (an ASP constant), the ``name`` the source
-    gives, its closed ``mesh`` [m] in the cell frame, ``source`` (file, or file#name), the
-    ``cylinders`` of its B-rep and ``remesh``, its B-rep tessellated again to a given
-    linear deflection [m] (a STEP part's; none for a mesh)."""
+    gives, its closed ``mesh`` [m] in the CAD frame (the cell frame once :func:`translated`),
+    ``source`` (file, or file#name), the ``cylinders`` of its B-rep and ``remesh``, its
+    B-rep tessellated again to a given linear deflection [m] (a STEP part's; none for a mesh)."""
 
     id: str
     name: str
@@ -82,6 +82,26 @@ class CadPart:
     source: str
     cylinders: tuple[Cylinder, ...] = ()
     remesh: Callable[[float], trimesh.Trimesh] | None = None
+
+
+def translated(parts: list[CadPart], offset: tuple[float, float]) -> list[CadPart]:
+    """The parts moved by ``offset`` (x, y) [m] in the horizontal plane: their meshes,
+    their B-rep cylinders and the meshes of ``remesh`` (the parts given are not changed)."""
+    shift = np.array([offset[0], offset[1], 0.0])
+    if not shift.any():
+        return parts
+
+    def moved_mesh(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+        copy = mesh.copy()
+        copy.apply_translation(shift)
+        return copy
+
+    def moved_remesh(remesh: Callable[[float], trimesh.Trimesh]) -> Callable[[float], trimesh.Trimesh]:
+        return lambda deflection: moved_mesh(remesh(deflection))
+
+    return [replace(part, mesh=moved_mesh(part.mesh),
+                    cylinders=tuple(replace(c, point=c.point + shift) for c in part.cylinders),
+                    remesh=None if part.remesh is None else moved_remesh(part.remesh)) for part in parts]
 
 
 def part_id(name: str, source: str) -> str:

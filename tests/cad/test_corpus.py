@@ -15,6 +15,7 @@ the mark must go; the truths are never weakened to pass.
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from collections.abc import Callable
@@ -28,6 +29,7 @@ import pytest
 from executor.cad.cli import run_import
 from executor.cad.sweep import opposite
 from executor.world.geometry import load_geometry
+from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
 FEATURE_REACH_MM = 2.0
@@ -37,11 +39,13 @@ FEATURE_REACH_MM = 2.0
 @dataclass(frozen=True)
 class Imported:
     """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
-    moving part's insertion ``axes`` (the reverse of the direction it leaves along)."""
+    moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
+    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the cell."""
 
     truth: dict[str, Any]
     out: Path
     axes: dict[str, str]
+    offset: tuple[float, float]
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -66,18 +70,20 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
         if name not in done:
             folder = CORPUS / name
             out = tmp_path_factory.mktemp(name) / "out"
-            derived = run_import(folder / "meshes", out, "mm", folder / "import.toml").derived
+            result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
             truth = tomllib.loads((folder / "truth.toml").read_text())
-            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()})
+            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in result.derived.axis.items()},
+                                  result.offset)
         return done[name]
 
     return get
 
 
-def _distance_to_axis(position: list[float], feature: dict[str, Any]) -> float:
-    """How far an imported hole's ``position`` [m] (x, y, or x, y, z) lies from a truth
-    feature's axis line [mm]; with x, y only, from the line's projection on the xy plane."""
-    point = [1000.0 * v for v in position]
+def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float]) -> float:
+    """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, moved by
+    ``offset`` [m] from the CAD frame) lies from a truth feature's axis line [mm]; with x, y
+    only, from the line's projection on the xy plane."""
+    point = [1000.0 * (v - (offset[k] if k < 2 else 0.0)) for k, v in enumerate(position)]
     origin = feature["axis_point"][:len(point)]
     direction = {"x": 0, "y": 1, "z": 2}[feature["axis"][1]]
     across = [point[k] - origin[k] for k in range(len(point)) if k != direction]
@@ -89,7 +95,8 @@ def _feature_holes(done: Imported) -> dict[str, str]:
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
-        near = [hid for hid, hole in holes.items() if _distance_to_axis(hole["position"], feature) <= FEATURE_REACH_MM]
+        near = [hid for hid, hole in holes.items()
+                if _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM]
         if len(near) == 1:
             found[fid] = near[0]
     return found
@@ -176,6 +183,19 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
+
+
+@pytest.mark.slow  # imports the product, teaches it and runs two insertions in the sim cell (about 30 s)
+def test_a_product_drawn_at_the_origin_is_inserted_where_the_import_placed_it(
+        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+    done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
+    assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
+    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
+    assert taught.returncode == 0, taught.stderr
+    trial = run_executor("trial", "--assembly", str(done.out), "--part", "peg4", "--hole", "h1", "--trials", "2",
+                         "--json", timeout=240)
+    assert trial.returncode == 0, trial.stderr
+    assert json.loads(trial.stdout)["summary"]["fit"] == 2  # the square peg in its only fitting hole
 
 
 @pytest.mark.parametrize("name", PRODUCTS)

@@ -157,7 +157,10 @@ def test_a_peg_in_a_plate_from_meshes(tmp_path: Path, capsys: pytest.CaptureFixt
     _plate_with_peg(tmp_path / "cad")
     assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     printed = capsys.readouterr().out
-    assert "hole h1 at (0.000, 0.000) mm, entered along -z: square 10.500 x 10.500 mm, depth 20.000 mm" in printed
+    # Drawn around the CAD origin, out of the arm's reach: placed at the cell's work position, and said so.
+    assert ("the base's centre placed at (560.000, 0.000) mm in the cell (the base's centre 0.000 mm from the arm's "
+            "base is out of its reach (350.000 to 700.000 mm)") in printed
+    assert "hole h1 at (560.000, 0.000) mm, entered along -z: square 10.500 x 10.500 mm, depth 20.000 mm" in printed
     assert "holds peg (square 10.000 x 10.000 mm, clearance 0.500 mm: 0.250 mm all round at yaw 0.000 deg)" in printed
     assert sorted(load_geometry(str(tmp_path / "out")).parts) == ["peg"]
     assert _fits(tmp_path / "out" / "sizes.lp") == {("peg", "h1")}

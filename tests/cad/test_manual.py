@@ -11,6 +11,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
+import trimesh
 
 from assembly_constraints.cli import main
 from bridge.assembly import load_assembly
@@ -25,15 +26,77 @@ POSE_BOUND_MM = 2.0
 """An assembled part is within this of its goal [mm] (the bar of the assembling cell)."""
 
 
-def _lid_on_pins(tmp_path: Path) -> Path:
+def _lid_on_pins(tmp_path: Path, x_mm: float = X_MM, *options: str) -> Path:
     """The plate with two square pegs in their holes and an 80 x 20 x 4 mm lid lying on the
-    peg tops (no pin passes through it, it rests on no cover), imported; the folder written."""
-    _pegs_and_plate(tmp_path / "cad", (X_MM, 0.0))
-    _box((80, 20, 4), (X_MM, 0, 37)).export(tmp_path / "cad" / "lid.stl")
+    peg tops (no pin passes through it, it rests on no cover), drawn at ``x_mm`` and
+    imported with ``options``; the folder written."""
+    _pegs_and_plate(tmp_path / "cad", (x_mm, 0.0))
+    _box((80, 20, 4), (x_mm, 0, 37)).export(tmp_path / "cad" / "lid.stl")
     (tmp_path / "import.toml").write_text("[parts.lid]\ntray = [0.30, 0.28]\n")
     assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out"), "--config",
-                 str(tmp_path / "import.toml")]) == 0
+                 str(tmp_path / "import.toml"), *options]) == 0
     return tmp_path / "out"
+
+
+def _positions(folder: Path) -> dict[str, list[float]]:
+    """Every position [m] of ``assembly.toml`` and ``geometry.toml`` by its table's path, the
+    parts' waiting trays left out (they are the cell's, not the product's)."""
+    found: dict[str, list[float]] = {}
+
+    def walk(path: str, value: object) -> None:
+        if isinstance(value, dict):
+            for key, item in value.items():
+                walk(f"{path}.{key}", item)
+        elif path.rsplit(".", 1)[-1] in ("position", "goal", "base_center") and isinstance(value, list):
+            found[path] = value
+
+    for name in ("assembly.toml", "geometry.toml"):
+        walk(name, tomllib.loads((folder / name).read_text()))
+    return found
+
+
+@pytest.mark.parametrize("options", [(), ("--place", "0.56,0")])
+def test_a_product_drawn_at_the_origin_is_placed_where_the_arm_reaches(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], options: tuple[str, ...]) -> None:
+    for name in ("origin", "cell"):
+        (tmp_path / name).mkdir()
+    placed = _lid_on_pins(tmp_path / "origin", 0.0, *options)
+    printed = capsys.readouterr().out
+    assert "the base's centre placed at (560.000, 0.000) mm in the cell (" + (
+        "place" if options else "the base's centre 0.000 mm from the arm's base is out of its reach") in printed
+    drawn = _lid_on_pins(tmp_path / "cell")  # drawn where the arm reaches: kept as it is drawn
+    assert "the CAD frame is the cell frame (the base's centre 560.000 mm from the arm's base" in \
+        capsys.readouterr().out
+    expected, got = _positions(drawn), _positions(placed)
+    assert len(got) >= 4 and set(got) == set(expected)  # the holes, the plate, the lid
+    for key, value in got.items():
+        assert value == pytest.approx(expected[key], abs=1e-9), key
+    lid = [trimesh.load(folder / "meshes" / "lid.obj").bounds for folder in (placed, drawn)]
+    assert lid[0] == pytest.approx(lid[1], abs=1e-9)  # the meshes written too
+
+
+@pytest.mark.parametrize(("setting", "expected"), [
+    (["--place", "0.56"], "argument --place: '0.56': expected X,Y in m, each a finite number in [-1, 1]"),
+    (["--place", "0.56,nan"], "argument --place: 'nan': expected a finite number in [-1, 1]"),
+    (["--place", "2,0"], "argument --place: '2': expected a finite number in [-1, 1]"),
+    ("place = [0.56]", "import.toml: place: expected [x, y] in m, each in [-1, 1], got [0.56]"),
+    ('place = [0.56, "0"]', "import.toml: place: expected [x, y] in m, each in [-1, 1]"),
+])
+def test_a_bad_place_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str], setting: list[str] | str,
+                                 expected: str) -> None:
+    _pegs_and_plate(tmp_path / "cad", (0.0, 0.0))
+    config = tmp_path / "import.toml"
+    config.write_text(setting if isinstance(setting, str) else "")
+    options = setting if isinstance(setting, list) else []
+    try:  # argparse's errors exit (one line on stderr, code 2), the config's are returned
+        code = main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out"), "--config", str(config),
+                     *options])
+    except SystemExit as exc:
+        code = exc.code
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and expected in err, err
+    assert not (tmp_path / "out").exists()
 
 
 def _session(run_cli: Runner, folder: Path, out: Path, backend: str) -> dict:
