@@ -92,6 +92,15 @@ class Assembly:
     """The size model the product declares (``[sizes] model``), None when it declares none."""
     manual: dict[str, str] = field(default_factory=dict)
     """The parts the cell places by hand (``[manual.<id>]`` of ``geometry.toml``): id -> why."""
+    cell_holes: frozenset[str] | None = None
+    """The holes the simulated cell models (``[hole_shapes.*]`` of ``geometry.toml``), None
+    without a ``geometry.toml``."""
+
+    def tried_by_hand(self, part: str, hole: str) -> bool:
+        """Whether no cell can try ``part`` in ``hole``: the part is placed by hand, or the
+        hole is one the cell does not model (a pin an imported part goes onto, a hole of a
+        section the cell inserts no part in)."""
+        return part in self.manual or (self.cell_holes is not None and hole not in self.cell_holes)
 
     def step_text(self, part: str, hole: str | None) -> str:
         """A plan step as the commands print it: ``p->h``, ``p``, a part placed by hand ``p (manual)``."""
@@ -148,9 +157,13 @@ def assembly_of(product: ProductDescription) -> Assembly:
     holes = tuple(Hole(hid, hole.name or hid, hole_kind[hid],
                        None if hole.position is None else (hole.position[0], hole.position[1]))
                   for hid, hole in layout.holes.items())
-    manual = {} if product.geometry is None else {mid: m.reason for mid, m in product.geometry.manual.items()}
+    geometry = product.geometry
+    manual = {} if geometry is None else {mid: m.reason for mid, m in geometry.manual.items()}
+    cell_holes = (None if geometry is None
+                  else frozenset(h for shape in geometry.hole_shapes.values() for h in shape.holes))
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
-                    size_model=None if layout.sizes is None else layout.sizes.model, manual=manual)
+                    size_model=None if layout.sizes is None else layout.sizes.model, manual=manual,
+                    cell_holes=cell_holes)
 
 
 def load_assembly(name_or_path: str) -> Assembly:

@@ -65,9 +65,10 @@ from asp.session.settings import (
 )
 from asp.session.zenoh_oracle import Finished, ZenohOracle
 from asp.sizes.cad_prior import cad_prior
+from asp.sizes.knowledge import Pair
 from asp.sizes.learner import LearningOptions, SizeLearner, SizeLearningResult
 from asp.sizes.models import SizeModel, model_for
-from asp.sizes.truth_oracle import TruthOracle
+from asp.sizes.truth_oracle import Result, TruthOracle
 from asp.solve import fact, write_facts
 from bridge import BridgeError
 from bridge.assembly import Assembly, load_assembly
@@ -151,6 +152,28 @@ def _sizes_domain(assembly: Assembly, requested_model: str | None
             raise PlannerError(f"assembly '{assembly.name}': no sizes.lp and no pegs/holes to learn")
     model = model_for(parts, requested_model, assembly.size_model, assembly.sections())
     return parts, holes, truth, model
+
+
+def _placed_by_hand(assembly: Assembly, truth: TruthOracle | None, decided: list[tuple[Pair, Result]]
+                    ) -> list[tuple[Pair, Result]]:
+    """The outcomes of the pairs no cell can try (:meth:`bridge.assembly.Assembly.tried_by_hand`:
+    a part placed by hand, a hole the cell does not model), from the product's ``sizes.lp``
+    (an imported product's nominal sections), except those ``decided`` already."""
+    if truth is None:
+        return []
+    known = {pair for pair, _ in decided}
+    return [((part, hole), "fit" if (part, hole) in truth.fits else "no_fit")
+            for part in truth.parts for hole in truth.holes
+            if assembly.tried_by_hand(part, hole) and (part, hole) not in known]
+
+
+def _by_hand_statement(assembly: Assembly, by_hand: list[tuple[Pair, Result]]) -> str:
+    """The line a run prints (and ``learned.lp`` keeps) for the pairs it takes from
+    ``sizes.lp`` because the cell places their parts by hand."""
+    fits = sum(result == "fit" for _, result in by_hand)
+    shown = " ".join(f"{part}->{hole}" for (part, hole), _ in by_hand[:8]) + (" ..." if len(by_hand) > 8 else "")
+    return (f"{len(by_hand)} pairs no cell can try (a part placed by hand or a hole the cell does not model: "
+            f"{shown}) are taken from {assembly.folder / 'sizes.lp'} (the nominal sections, {fits} fit), not observed")
 
 
 def _endpoints(settings: SessionSettings) -> tuple[list[str], list[str]]:
@@ -388,7 +411,11 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     record.prior = None if record.size_prior is None else DecidedPrior(
         kind=record.size_prior, tolerance_m=record.tolerance_m, pairs=len(parts) * len(holes),
         decided=[(p, h, result) for (p, h), result in decided])
-    stated_prior = None if record.prior is None else prior_statement(record.prior)
+    by_hand = _placed_by_hand(assembly, truth, decided)
+    decided = [*decided, *by_hand]
+    stated_prior = "; ".join(statement for statement in (
+        None if record.prior is None else prior_statement(record.prior),
+        None if not by_hand else _by_hand_statement(assembly, by_hand)) if statement is not None) or None
     # Every input file is read before any cell starts: bad input fails fast.
     demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
     if prior is not None:
