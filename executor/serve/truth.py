@@ -63,7 +63,7 @@ class TruthBackend:
                     holes -= self._holes
                     self._pegs |= pegs
                     self._holes |= holes
-                    self._fits |= {(p, h) for p, h in fits if p in pegs and h in holes}
+                    self._fits |= {(p, h) for p, h in fits if p in pegs or h in holes}
             else:
                 self._pegs, self._holes, self._fits = sizes_truth(assembly_of.file("sizes.lp"))
                 self._manual = set()

@@ -26,8 +26,11 @@ from typing import Any
 import clingo
 import pytest
 
+from bridge.cell_settings import ServeSettings
+from bridge.messages import InsertRequest
 from executor.cad.cli import run_import
 from executor.cad.sweep import opposite
+from executor.serve.truth import TruthBackend
 from executor.world.geometry import load_geometry
 from tests.conftest import Runner
 
@@ -215,3 +218,15 @@ def test_each_truth_is_a_closed_world(name: str) -> None:
     assert all(part["in"] in truth["features"] for part in truth["parts"].values())
     assert all(row["fits"] == (row["room_mm"] > 0) for row in truth["fits"])
     assert (CORPUS / name / "SOURCE.md").is_file()
+
+
+@pytest.mark.slow  # the first test of a product imports it
+def test_the_truth_backend_answers_every_pair_of_a_part_placed_by_hand_as_sizes_lp(
+        imported: Callable[[str], Imported]) -> None:
+    done = imported("agh_prism_array")  # its polygon pegs are placed by hand, h1 alone is modelled
+    backend = TruthBackend(ServeSettings(backend="truth", assembly=str(done.out)))
+    sizes = _atoms(done.out / "sizes.lp")
+    for (part,) in sorted(sizes["part"]):
+        for (hole,) in sorted(sizes["hole"]):
+            result, _ = backend.run(InsertRequest(id=f"t.{part}.{hole}", part=part, hole=hole))
+            assert result == ("fit" if (part, hole) in sizes.get("fits", set()) else "no_fit"), (part, hole)
