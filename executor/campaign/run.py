@@ -76,12 +76,12 @@ function or a ``functools.partial`` of one)."""
 
 class CellRunner:
     """A :class:`executor.trial.Cell` in DIRECT mode, reused for every trial of a worker;
-    ``setup``: what the cell is (:class:`executor.trial.CellSetup`)."""
+    ``setup``: what the cell is (:class:`executor.trial.CellSetup`; default: the default cell)."""
 
-    def __init__(self, assembly: str, setup: CellSetup) -> None:
+    def __init__(self, assembly: str, setup: CellSetup | None = None) -> None:
         from executor.trial import Cell
 
-        self.cell = Cell(assembly, setup=setup)
+        self.cell = Cell(assembly, setup=CellSetup() if setup is None else setup)
 
     def __call__(self, part: str, hole: str, seed: int) -> dict[str, Any]:
         return self.cell.run_trial(part, hole, seed=seed, max_attempts=2).to_json()
