@@ -29,7 +29,8 @@ the axis by the bore's deflection, the radii's and the axes' difference and
 other face (a shoulder, an end wall) still is.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
-part whose bounding box meets the sweep's).
+part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
+moved back against A along the same path) is answered from the first.
 """
 
 from __future__ import annotations
@@ -347,6 +348,9 @@ class Sweeper:
         self._slid: dict[tuple[str, str, str], _Solid] = {}
         self.queries = 0
         """Narrow-phase queries made so far."""
+        self._answers: dict[tuple[int, int, tuple[float, ...]], bool] = {}
+        """(moving solid, fixed solid (their ids), shift [m]) -> whether the sweep collides:
+        A moved against B and B moved back against A are one test."""
 
     def blockers(self, body: str | Iterable[str], direction: np.ndarray, length: float) -> set[str]:
         """The other parts that the part (or the parts, moved together) ``body`` collides
@@ -364,15 +368,21 @@ class Sweeper:
                     continue
                 if np.any(np.minimum(high, other_mesh.bounds[1]) - np.maximum(low, other_mesh.bounds[0]) <= TOUCH):
                     continue
-                self.queries += 1
-                moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
-                if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
-                    moving, fixed, reverse = fixed, moving, -shift  # the same relative motion, cheaper
-                else:
-                    reverse = shift
-                if _collides(moving, fixed, reverse):
+                if self._sweep(member, other, shift):
                     hit.add(other)
         return hit
+
+    def _sweep(self, member: str, other: str, shift: np.ndarray) -> bool:
+        """Whether part ``member`` swept by ``shift`` [m] collides with part ``other`` (one
+        narrow-phase query unless asked before)."""
+        moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
+        if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
+            moving, fixed, shift = fixed, moving, -shift  # the same relative motion, cheaper
+        key = (id(moving), id(fixed), tuple(shift))
+        if key not in self._answers:
+            self.queries += 1
+            self._answers[key] = _collides(moving, fixed, shift)
+        return self._answers[key]
 
     def touching(self, a: str, b: str) -> bool:
         """Whether parts ``a`` and ``b`` are within :data:`TOUCH` of each other."""
