@@ -29,7 +29,8 @@ the axis by the bore's deflection, the radii's and the axes' difference and
 other face (a shoulder, an end wall) still is.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
-part whose bounding box meets the sweep's).
+part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
+moved back against A along the same path) is answered from the first.
 """
 
 from __future__ import annotations
@@ -240,29 +241,37 @@ def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[fcl.Collision
     return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in triangles]
 
 
-@dataclass
 class _Node:
-    """Nearby triangles of a mesh (``faces``, their ``points`` [m]) and the two halves they
-    split into (none: at most :data:`CHUNK` triangles)."""
+    """Nearby triangles of a mesh (``faces``), their ``points`` [m] and their bounds, and
+    the two halves they split into (none: at most :data:`CHUNK` triangles); each made on
+    first use, as most nodes lie in no sweep's way."""
 
-    faces: np.ndarray
-    points: np.ndarray
-    children: list[_Node]
+    def __init__(self, mesh: trimesh.Trimesh, faces: np.ndarray) -> None:
+        self.mesh = mesh
+        self.faces = faces
+        self._points: np.ndarray | None = None
+        self._children: list[_Node] | None = None
+        self.low: np.ndarray
+        self.high: np.ndarray
+        """The bounds of ``points`` [m] (set with them)."""
 
+    @property
+    def points(self) -> np.ndarray:
+        if self._points is None:
+            self._points = self.mesh.vertices[np.unique(self.mesh.faces[self.faces])]
+            self.low, self.high = self._points.min(axis=0), self._points.max(axis=0)
+        return self._points
 
-def _tree(mesh: trimesh.Trimesh) -> _Node:
-    """The triangles of ``mesh`` split in halves (at the median of their centres along
-    their widest extent) down to :data:`CHUNK` triangles."""
-    centres = mesh.triangles_center
-
-    def node(group: np.ndarray) -> _Node:
-        points = mesh.vertices[np.unique(mesh.faces[group])]
-        if len(group) <= CHUNK:
-            return _Node(group, points, [])
-        order = group[np.argsort(centres[group, int(np.argmax(np.ptp(centres[group], axis=0)))], kind="stable")]
-        return _Node(group, points, [node(order[:len(order) // 2]), node(order[len(order) // 2:])])
-
-    return node(np.arange(len(mesh.faces)))
+    @property
+    def children(self) -> list[_Node]:
+        """The halves: split at the median of the triangles' centres along their widest extent."""
+        if self._children is None:
+            self._children = []
+            if len(self.faces) > CHUNK:
+                centres = self.mesh.triangles_center[self.faces]
+                order = self.faces[np.argsort(centres[:, int(np.argmax(np.ptp(centres, axis=0)))], kind="stable")]
+                self._children = [_Node(self.mesh, order[:len(order) // 2]), _Node(self.mesh, order[len(order) // 2:])]
+        return self._children
 
 
 def _is_convex(mesh: trimesh.Trimesh) -> bool:
@@ -322,7 +331,7 @@ class _Solid:
     @property
     def tree(self) -> _Node:
         if self._tree is None:
-            self._tree = _tree(self.mesh)
+            self._tree = _Node(self.mesh, np.arange(len(self.mesh.faces)))
         return self._tree
 
 
@@ -339,6 +348,9 @@ class Sweeper:
         self._slid: dict[tuple[str, str, str], _Solid] = {}
         self.queries = 0
         """Narrow-phase queries made so far."""
+        self._answers: dict[tuple[int, int, tuple[float, ...]], bool] = {}
+        """(moving solid, fixed solid (their ids), shift [m]) -> whether the sweep collides:
+        A moved against B and B moved back against A are one test."""
 
     def blockers(self, body: str | Iterable[str], direction: np.ndarray, length: float) -> set[str]:
         """The other parts that the part (or the parts, moved together) ``body`` collides
@@ -356,15 +368,21 @@ class Sweeper:
                     continue
                 if np.any(np.minimum(high, other_mesh.bounds[1]) - np.maximum(low, other_mesh.bounds[0]) <= TOUCH):
                     continue
-                self.queries += 1
-                moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
-                if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
-                    moving, fixed, reverse = fixed, moving, -shift  # the same relative motion, cheaper
-                else:
-                    reverse = shift
-                if _collides(moving, fixed, reverse):
+                if self._sweep(member, other, shift):
                     hit.add(other)
         return hit
+
+    def _sweep(self, member: str, other: str, shift: np.ndarray) -> bool:
+        """Whether part ``member`` swept by ``shift`` [m] collides with part ``other`` (one
+        narrow-phase query unless asked before)."""
+        moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
+        if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
+            moving, fixed, shift = fixed, moving, -shift  # the same relative motion, cheaper
+        key = (id(moving), id(fixed), tuple(shift))
+        if key not in self._answers:
+            self.queries += 1
+            self._answers[key] = _collides(moving, fixed, shift)
+        return self._answers[key]
 
     def touching(self, a: str, b: str) -> bool:
         """Whether parts ``a`` and ``b`` are within :data:`TOUCH` of each other."""
@@ -406,13 +424,14 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
     pending = [moving.tree]
     while pending:
         node = pending.pop()
-        start, end = node.points.min(axis=0), node.points.max(axis=0)
+        points = node.points
+        start, end = node.low, node.high
         if np.any(np.minimum(np.maximum(end, end + shift), high)
                   - np.maximum(np.minimum(start, start + shift), low) <= TOUCH):
             continue
-        if len(node.points) <= HULL_POINTS:
+        if len(points) <= HULL_POINTS:
             if id(node) not in pieces:
-                pieces[id(node)] = _hull_piece(np.vstack([node.points, node.points + shift]))
+                pieces[id(node)] = _hull_piece(np.vstack([points, points + shift]))
             piece = pieces[id(node)]
             if piece is not None and not _meets([piece], fixed.bvh):
                 continue
