@@ -90,9 +90,9 @@ def _trials(args: argparse.Namespace, live: Viewer, viewer: Viewer) -> int:
 
         check_writable(Path(args.plot))  # before the trials
     if args.rrd or args.plot or live != NO_VIEWER:
-        from executor.rerun_log import AttemptLogger
+        from executor.rerun_log import AttemptLogger, LogTarget
 
-        logger = AttemptLogger(rrd_path=args.rrd, keep_traces=bool(args.plot), viewer=live)
+        logger = AttemptLogger(target=LogTarget(rrd_path=args.rrd, viewer=live), keep_traces=bool(args.plot))
     cell = Cell(args.assembly, gui=args.gui, logger=logger, setup=setup)
     try:
         results = []

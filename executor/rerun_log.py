@@ -205,33 +205,37 @@ def open_recording(recording_id: str, rrd_path: Path | None, viewer: Viewer = NO
         raise ExecutorError(f"{rrd_path}: cannot write ({exc})") from None
 
 
+@dataclass(frozen=True)
+class LogTarget:
+    """Where an :class:`AttemptLogger`'s recording goes: a new stream of ``application_id``
+    with ``recording_id`` (random if None) saved to ``rrd_path``, or the existing
+    ``recording`` stream (not both; neither: data stays in memory); ``viewer``: also
+    streamed live to a Rerun viewer or served to a browser (:mod:`bridge.recording.sinks`);
+    ``send_blueprint``: send the cell's view layout (off where the planner sends it)."""
+
+    rrd_path: str | Path | None = None
+    recording_id: str | None = None
+    application_id: str = APPLICATION_ID
+    recording: rr.RecordingStream | None = None
+    viewer: Viewer = NO_VIEWER
+    send_blueprint: bool = True
+
+
 class AttemptLogger:
     """Logs a cell's attempts into one Rerun recording (explicit stream, not global).
 
-    ``AttemptLogger(cell_id="c1", rrd_path="runs/x/c1.rrd")`` opens a new stream of
-    ``application_id`` (default ``assembly_constraints``) with ``recording_id``
-    (random if None) saving to the file; ``AttemptLogger(cell_id="c1", recording=stream)`` logs into an
-    existing ``rr.RecordingStream`` instead. Without either, data stays in memory
-    (``keep_traces`` then still gives the traces for plots). ``viewer``: also stream
-    live to a Rerun viewer or serve it to a browser (:mod:`bridge.recording.sinks`).
+    ``AttemptLogger("c1", LogTarget(rrd_path="runs/x/c1.rrd"))`` opens a new stream saving
+    to the file; ``AttemptLogger("c1", LogTarget(recording=stream))`` logs into an existing
+    ``rr.RecordingStream`` instead (:class:`LogTarget`). Without either, data stays in
+    memory (``keep_traces`` then still gives the traces for plots).
 
     ``period_s`` [s]: steps closer than this in sim time to the last kept one are
     skipped. ``keep_traces``: keep every finished :class:`AttemptTrace` in ``traces``.
     """
 
-    def __init__(
-        self,
-        cell_id: str = "c1",
-        *,
-        recording_id: str | None = None,
-        application_id: str = APPLICATION_ID,
-        rrd_path: str | Path | None = None,
-        recording: rr.RecordingStream | None = None,
-        period_s: float = 0.005,
-        keep_traces: bool = False,
-        send_blueprint: bool = True,
-        viewer: Viewer = NO_VIEWER,
-    ) -> None:
+    def __init__(self, cell_id: str = "c1", target: LogTarget = LogTarget(), *, period_s: float = 0.005,
+                 keep_traces: bool = False) -> None:
+        recording, rrd_path, viewer = target.recording, target.rrd_path, target.viewer
         if recording is not None and rrd_path is not None:
             raise ExecutorError("AttemptLogger: give rrd_path or recording, not both")
         if period_s < 0:
@@ -244,7 +248,8 @@ class AttemptLogger:
         self._owns_stream = recording is None
         self._rrd_path = Path(rrd_path) if rrd_path is not None else None
         if recording is None:
-            recording = open_recording(recording_id or str(uuid.uuid4()), self._rrd_path, viewer, application_id)
+            recording = open_recording(target.recording_id or str(uuid.uuid4()), self._rrd_path, viewer,
+                                       target.application_id)
         self.rec = recording
         self._experiment = 0
         self._last_attempt: tuple[str, str, int, int] | None = None
@@ -257,7 +262,7 @@ class AttemptLogger:
         self._arm: ArmRecorder | None = None
         self._arm_static_sent = False
         self._held: str | None = None
-        if send_blueprint:
+        if target.send_blueprint:
             live = viewer.connect is not None
             self.rec.send_blueprint(blueprint(Contents(cells=(cell_id,)), play_state=opening(live)))
 
@@ -268,7 +273,7 @@ class AttemptLogger:
     ) -> AttemptLogger:
         """A logger saving to ``rrd_path`` (its folder must exist; ExecutorError naming the
         path if the file cannot be created) and streaming to ``viewer``."""
-        return cls(cell_id, recording_id=recording_id, rrd_path=rrd_path, viewer=viewer)
+        return cls(cell_id, LogTarget(rrd_path=rrd_path, recording_id=recording_id, viewer=viewer))
 
     # -- static geometry -------------------------------------------------------------
 

@@ -276,13 +276,25 @@ class Imported:
     offset: tuple[float, float]
 
 
-def run_import(source: Path, out: Path, units: str, config: Path | None, reach: float = LOCATING_REACH,
-               max_triangles: int = MAX_TRIANGLES, replace: bool = False,
-               place: tuple[float, float] | None = None) -> Imported:
-    """Read (at most ``max_triangles``), check, claim ``out`` (``replace``: also a product
-    another import or a person wrote, :func:`executor.cad.write.claim_folder`), move the
-    parts into the cell (``place`` [m]: where the base's centre goes, over the config's,
-    :func:`placement`), derive (``reach`` [m]: the locating rule's, 0: off), map the covers and heads, and write."""
+@dataclass(frozen=True)
+class ImportOptions:
+    """The command line's choices of an import: ``reach`` [m], the locating rule's (0:
+    off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
+    over a product another import or a person wrote (:func:`executor.cad.write.claim_folder`);
+    ``place`` [m]: where the base's centre goes in the cell, over the config's
+    (:func:`placement`)."""
+
+    reach: float = LOCATING_REACH
+    max_triangles: int = MAX_TRIANGLES
+    replace: bool = False
+    place: tuple[float, float] | None = None
+
+
+def run_import(source: Path, out: Path, units: str, config: Path | None,
+               options: ImportOptions = ImportOptions()) -> Imported:
+    """Read, check, claim ``out``, move the parts into the cell, derive, map the covers and
+    heads, and write, as ``options`` say (:class:`ImportOptions`)."""
+    reach, max_triangles, replace, place = options.reach, options.max_triangles, options.replace, options.place
     started = time.perf_counter()
     parts = load_source(source, units, max_triangles)
     check_parts(parts, units)
@@ -326,8 +338,8 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
-    done = run_import(args.source, args.out, args.units, args.config, args.locating_reach, args.max_triangles,
-                      args.replace, args.place)
+    done = run_import(args.source, args.out, args.units, args.config,
+                      ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place))
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; " + "; ".join(done.assumed))

@@ -23,7 +23,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bridge.files import make_folder, write_figure  # noqa: E402
 from executor import ExecutorError  # noqa: E402
 from executor.campaign.pairs import HOLE_NAMES, PART_NAMES, PairStats  # noqa: E402
-from executor.rerun_log import AttemptLogger, AttemptTrace  # noqa: E402
+from executor.rerun_log import AttemptLogger, AttemptTrace, LogTarget  # noqa: E402
 
 FIG17_SUCCESS = ("p1", "r1")
 FIG17_FAILURE = ("p3", "r1")
@@ -35,7 +35,7 @@ def traced_trials(assembly: str, seed: int, rrd_path: Path) -> tuple[AttemptTrac
     ``p1``→``r1`` and the first attempt of ``p3``→``r1`` (which must fail)."""
     from executor.trial import Cell
 
-    logger = AttemptLogger("fig17", rrd_path=rrd_path, keep_traces=True)
+    logger = AttemptLogger("fig17", LogTarget(rrd_path=rrd_path), keep_traces=True)
     cell = Cell(assembly, logger=logger)
     try:
         found: dict[str, AttemptTrace] = {}

@@ -44,13 +44,15 @@ class SimBackend:
         ``cell.uncertainty`` ``cell`` plan steps get the Cell's systematic errors, layer
         and an ILC, with ``random`` their own); ``setup``: what the Cell is, its
         description already decoded (:func:`executor.trial.cell_setup`)."""
+        from executor.rerun_log import LogTarget
         from executor.trial import Cell
 
         rrd = None if settings.rrd is None else Path(settings.rrd)
         viewer = Viewer(settings.viewer_url)
         _PlannerNumbered = _planner_numbered_logger()
-        self._logger = (_PlannerNumbered(settings.cell_id, recording_id=settings.recording_id, rrd_path=rrd,
-                                         viewer=viewer, send_blueprint=False)  # the planner sends it
+        target = LogTarget(rrd_path=rrd, recording_id=settings.recording_id, viewer=viewer,
+                           send_blueprint=False)  # the planner sends it
+        self._logger = (_PlannerNumbered(settings.cell_id, target)
                         if rrd is not None or viewer != NO_VIEWER else None)
         ilc_state = None if settings.ilc_state is None else Path(settings.ilc_state)
         self._cell = Cell(settings.assembly, gui=False, logger=self._logger, ilc_state=ilc_state, setup=setup)

@@ -17,7 +17,7 @@ from bridge.recording.reader import (
     read_recording,
 )
 from executor import ExecutorError
-from executor.rerun_log import PATH_COLOR, TIP_RADIUS_UI, AttemptLogger
+from executor.rerun_log import PATH_COLOR, TIP_RADIUS_UI, AttemptLogger, LogTarget
 from executor.rerun_plots import FIT_COLOR, GROWTH_ROWS, HEIGHT, WIDTH, growth_ends
 
 
@@ -53,7 +53,7 @@ def _attempt(logger: AttemptLogger, part: str, hole: str, seed: int, attempt: in
 
 def test_attempts_are_read_back(tmp_path: Path) -> None:
     rrd = tmp_path / "c1.rrd"
-    logger = AttemptLogger("c1", recording_id="run-1", rrd_path=rrd, period_s=0.01)
+    logger = AttemptLogger("c1", LogTarget(recording_id="run-1", rrd_path=rrd), period_s=0.01)
     logger.log_scene([
         ("plate", "box", (0.1, 0.12, 0.01), (0.59, 0.0, 0.08)),
         ("peg_p1", "cylinder", (0.006, 0.006, 0.025), (0.3, 0.1, 0.125), (0, 0, 0, 1), (200, 90, 40)),
@@ -135,7 +135,7 @@ def test_attempts_are_read_back(tmp_path: Path) -> None:
 
 
 def test_two_cells_in_one_process_share_a_recording(tmp_path: Path) -> None:
-    loggers = [AttemptLogger(cell, recording_id="shared", rrd_path=tmp_path / f"{cell}.rrd")
+    loggers = [AttemptLogger(cell, LogTarget(recording_id="shared", rrd_path=tmp_path / f"{cell}.rrd"))
                for cell in ("c1", "c2")]
     _attempt(loggers[0], "p1", "br", 1, 1, "fit", steps=100)
     _attempt(loggers[1], "sh", "r1", 2, 1, "no_fit", steps=100)
@@ -164,7 +164,7 @@ def test_loggers_on_a_callers_stream(tmp_path: Path) -> None:
     stream = rr.RecordingStream("assembly_constraints", recording_id="mine")
     stream.save(str(tmp_path / "both.rrd"))
     for cell in ("a", "b"):
-        logger = AttemptLogger(cell, recording=stream, send_blueprint=False)
+        logger = AttemptLogger(cell, LogTarget(recording=stream, send_blueprint=False))
         _attempt(logger, "p1", "s1", 5, 1, "fit", steps=50)
         logger.close()  # flushes, but leaves the caller's stream open
     stream.log("planner/note", rr.TextLog("still open"))
@@ -195,7 +195,7 @@ def test_the_plots_of_an_attempt_grow_with_it(tmp_path: Path) -> None:
     """Fig. 17 and the tool path, read back at a time inside the attempt: the latest row
     before it holds the attempt up to then, drawn to the scale of what was measured so far."""
     rrd = tmp_path / "c1.rrd"
-    logger = AttemptLogger("c1", recording_id="grow", rrd_path=rrd, period_s=0.01)
+    logger = AttemptLogger("c1", LogTarget(recording_id="grow", rrd_path=rrd), period_s=0.01)
     _attempt(logger, "p1", "r1", 8, 1, "fit")
     logger.close()
     fig17 = "executor/c1/by_phase/fit/e0001_p1_r1_s8_a1"
@@ -231,7 +231,7 @@ def test_an_attempt_shows_its_own_search_path(tmp_path: Path) -> None:
     """The search path appears when the search ends; before, in the same attempt, none (not
     the previous attempt's)."""
     rrd = tmp_path / "c1.rrd"
-    logger = AttemptLogger("c1", recording_id="search", rrd_path=rrd, period_s=0.01)
+    logger = AttemptLogger("c1", LogTarget(recording_id="search", rrd_path=rrd), period_s=0.01)
     for attempt in (1, 2):
         logger.begin_attempt("p1", "r1", 8, attempt)
         for k in range(100):

@@ -13,14 +13,14 @@ from rerun.chunk import RrdReader
 from bridge.recording.layout import TRAIL_S, Contents, TimePoint, tab_names, write_blueprint
 from bridge.recording.reader import blueprint_origins, read_blueprint, read_recording
 from executor.evidence import AttemptEvidence
-from executor.rerun_log import AttemptLogger
+from executor.rerun_log import AttemptLogger, LogTarget
 
 
 def _run_folder(folder: Path) -> Path:
     """A run with two cells' recordings sharing one recording id."""
     folder.mkdir()
     for cell in ("c1", "c2"):
-        logger = AttemptLogger(cell, recording_id="run-7", rrd_path=folder / f"{cell}.rrd")
+        logger = AttemptLogger(cell, LogTarget(recording_id="run-7", rrd_path=folder / f"{cell}.rrd"))
         logger.log_scene([("plate", "box", (0.1, 0.1, 0.01), (0.6, 0.0, 0.09))])
         logger.begin_attempt("p1", "r1", 3, 1)
         for k in range(20):
@@ -132,7 +132,8 @@ def test_the_view_blueprint_of_a_session_that_assembled_has_its_assembly_tab(tmp
     from asp.session.run import view_blueprint
 
     run = _run_folder(tmp_path / "run")
-    logger = AttemptLogger("c1", recording_id="run-7", rrd_path=run / "c1-assembly.rrd", send_blueprint=False)
+    logger = AttemptLogger("c1", LogTarget(recording_id="run-7", rrd_path=run / "c1-assembly.rrd",
+                                              send_blueprint=False))
     logger.rec.log("executor/c1/assembly/steps", rr.TextLog("p1 -> r1: fit"))
     logger.close()
     layout = read_blueprint(view_blueprint(run))

@@ -16,7 +16,7 @@ from asp.view.browser import find_chromium
 from asp.view.screenshot import take_screenshots
 from bridge.recording.layout import Contents, TimePoint
 from bridge.recording.reader import read_recording
-from executor.rerun_log import AttemptLogger
+from executor.rerun_log import AttemptLogger, LogTarget
 
 pytestmark = [
     pytest.mark.slow,
@@ -27,7 +27,7 @@ pytestmark = [
 @pytest.mark.timeout(900)
 def test_every_tab_is_rendered_and_not_blank(tmp_path: Path) -> None:
     rrd = tmp_path / "c1.rrd"
-    logger = AttemptLogger("c1", recording_id="shots", rrd_path=rrd)
+    logger = AttemptLogger("c1", LogTarget(recording_id="shots", rrd_path=rrd))
     logger.log_scene([("plate", "box", (0.1, 0.12, 0.0375), (0.59, 0.0, 0.0375), (0, 0, 0, 1), (150, 160, 175))])
     for experiment, force in ((1, 10.0), (2, 40.0)):
         logger.begin_attempt("p1", "r1", experiment, 1, experiment=experiment)
