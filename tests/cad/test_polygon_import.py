@@ -5,12 +5,10 @@ backend read) give the same rooms."""
 
 from __future__ import annotations
 
-import math
 import tomllib
 from pathlib import Path
 
 import clingo
-import numpy as np
 import pytest
 import shapely
 import trimesh
@@ -28,20 +26,10 @@ from executor.cad.write import (
     sizes_text,
 )
 from executor.world.geometry import Section, margin
+from tests._outlines import splined
 
 GAP = 0.04
 """The hub's outline is the shaft's offset by this [mm] (the designed radial gap)."""
-
-
-def splined(outer: float, root: float, teeth: int, tooth: float) -> shapely.Polygon:
-    """A splined outline [mm]: ``teeth`` teeth ``tooth`` [rad] wide at radius ``outer``, the root at ``root``."""
-    ring = []
-    pitch = 2 * math.pi / teeth
-    for k in range(teeth):
-        start = k * pitch - tooth / 2
-        ring += [(outer * math.cos(t), outer * math.sin(t)) for t in np.linspace(start, start + tooth, 6)]
-        ring += [(root * math.cos(t), root * math.sin(t)) for t in np.linspace(start + tooth, start + pitch, 6)[1:-1]]
-    return shapely.Polygon(ring)
 
 
 def rounded(a: float, b: float, radius: float) -> shapely.Polygon:

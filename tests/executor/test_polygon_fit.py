@@ -16,21 +16,11 @@ from shapely import affinity
 
 from executor.world.geometry import Section, margin, outline_polygon, section_fit
 from executor.world.polygon_fit import OutlineError, polygon, polygon_fit, round_fit
+from tests._outlines import splined
 
 MM = 1e-3
 TESSELLATION = 1e-6
 """The relation's room is within this [m] of the designed one (its turn and shift resolution, 256-gons)."""
-
-
-def splined(outer: float, root: float, teeth: int, tooth: float) -> shapely.Polygon:
-    """A splined outline [m]: ``teeth`` teeth ``tooth`` [rad] wide at radius ``outer``, the root at ``root``."""
-    ring = []
-    pitch = 2 * math.pi / teeth
-    for k in range(teeth):
-        start = k * pitch - tooth / 2
-        ring += [(outer * math.cos(t), outer * math.sin(t)) for t in np.linspace(start, start + tooth, 6)]
-        ring += [(root * math.cos(t), root * math.sin(t)) for t in np.linspace(start + tooth, start + pitch, 6)[1:-1]]
-    return shapely.Polygon(ring)
 
 
 SHAFT = splined(5 * MM, 4 * MM, 6, 0.5)
