@@ -75,12 +75,7 @@ def load_atoms(
     ctl = clingo.Control(["--models=2"], logger=lambda _code, msg: messages.append(msg.strip()))
     for path in paths:
         path = Path(path)
-        data = read_bytes(path, "facts file", error=PlannerError)
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError:
-            raise PlannerError(f"{path}: not a text file (expected ASP facts)") from None
-        _check_ascii(path, text)
+        text = _facts_text(path, "ASP facts")
         try:
             ctl.add("base", [], text.replace("\x00", ""))
         except RuntimeError:
@@ -117,6 +112,18 @@ def _ground_term(term: clingo.ast.AST) -> clingo.Symbol | None:
     return None
 
 
+def _facts_text(path: Path, expected: str) -> str:
+    """The text of the facts file ``path`` (read under :func:`read_bytes`'s rules, UTF-8,
+    checked by :func:`_check_ascii`); PlannerError naming the file and ``expected`` otherwise."""
+    data = read_bytes(path, "facts file", error=PlannerError)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise PlannerError(f"{path}: not a text file (expected {expected})") from None
+    _check_ascii(path, text)
+    return text
+
+
 def read_ground_facts(path: Path, expected: str, *, max_facts: int) -> list[tuple[int, clingo.Symbol]]:
     """The facts of ``path`` with their line numbers, read as data (parsed, never grounded).
 
@@ -124,12 +131,7 @@ def read_ground_facts(path: Path, expected: str, *, max_facts: int) -> list[tupl
     Micrometres) facts"``) at anything but a ground fact (a rule, a directive, a variable,
     an interval ``1..N``, a pool ``a;b``, an arithmetic term), and when the file holds more
     than ``max_facts`` facts; the file itself is read under :func:`read_bytes`'s rules."""
-    data = read_bytes(path, "facts file", error=PlannerError)
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise PlannerError(f"{path}: not a text file (expected {expected})") from None
-    _check_ascii(path, text)
+    text = _facts_text(path, expected)
     facts: list[tuple[int, clingo.Symbol]] = []
     refused: list[str] = []
 
