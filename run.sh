@@ -23,7 +23,7 @@ setup() {
         # setuptools reports every editable install with a note, "Editable installation.",
         # that names no problem; it is the one message of the build kept out of the output.
         PYTHONWARNINGS="ignore:Editable installation" \
-            "$PY" -m pip install --quiet -c "$ROOT/constraints.txt" -e "$ROOT[test]" >&2
+            "$PY" -m pip install --quiet -c "$ROOT/constraints.txt" -e "$ROOT[test,franka]" >&2
         rm -f "$VENV"/.installed-*
         touch "$STAMP"
     fi
