@@ -119,19 +119,13 @@ def _check_outline(path: Path, table: str, outline: list[list[float]], size: lis
 
 
 def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
-    """A polygon peg is simulated from its own ``mesh``, a polygon hole or one with a
-    ``corner`` radius in the ``[base]``'s mesh (the plate's bosses are round, square or
-    sharp rect)."""
-    for name, part_shape in geo.part_shapes.items():
-        if part_shape.kind == "polygon" and part_shape.mesh is None:
-            raise BridgeError(f"{path}: [part_shapes.{name}] mesh: expected the part's own mesh for a polygon "
-                              "section (the cell simulates no other), got nothing")
+    """A hole with a ``corner`` radius is in the ``[base]``'s mesh (the plate's bosses are
+    round, square, sharp rect or polygon; a polygon peg without a mesh is the prism of its
+    outline)."""
     for name, hole_shape in geo.hole_shapes.items():
-        shaped = "kind" if hole_shape.kind == "polygon" else "corner" if hole_shape.corner else ""
-        if shaped and (geo.base is None or geo.base.mesh is None):
-            raise BridgeError(f"{path}: [hole_shapes.{name}] {shaped}: a polygon hole or one with rounded corners "
-                              "needs a [base] with its own mesh (the plate's bosses are round, square or sharp "
-                              "rect), got none")
+        if hole_shape.corner and (geo.base is None or geo.base.mesh is None):
+            raise BridgeError(f"{path}: [hole_shapes.{name}] corner: a hole with rounded corners needs a [base] with "
+                              "its own mesh (the plate's bosses are round, square, sharp rect or polygon), got none")
 
 
 def hole_level(plate: Plate, shape: HoleShape) -> tuple[float, float]:

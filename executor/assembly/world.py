@@ -122,8 +122,9 @@ class AssemblyWorld:
     def _build_pegs(self) -> None:
         grasp_depth = self.product.geometry.gripper.grasp_depth
         for pid, spec in sorted(self.product.pegs.items()):
-            # A mesh peg's inertia is its mesh's (in the URDF); PyBullet's own would be its pieces' box.
-            flags = pb.URDF_USE_IMPLICIT_CYLINDER | (pb.URDF_USE_INERTIA_FROM_FILE if spec.mesh is not None else 0)
+            # A mesh or polygon peg's inertia is its solid's (in the URDF); PyBullet's own would be its pieces' box.
+            solid = spec.mesh is not None or spec.kind == "polygon"
+            flags = pb.URDF_USE_IMPLICIT_CYLINDER | (pb.URDF_USE_INERTIA_FROM_FILE if solid else 0)
             body = pb.loadURDF(str(self.product.geometry.assets / f"part_{spec.shape}.urdf"),
                                basePosition=(*spec.start, 0.0), flags=flags, physicsClientId=self.client)
             self.frames[pid] = PartFrames(body, np.array([0.0, 0.0, spec.length - grasp_depth]), np.zeros(3))

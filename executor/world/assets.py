@@ -1,6 +1,7 @@
 """Generated assets that follow their sources.
 
-``<assembly>/assets/`` (plate mesh, part URDFs, a mesh part's eroded convex pieces, the URDF of a
+``<assembly>/assets/`` (plate mesh, part URDFs, a mesh part's eroded convex pieces, a polygon
+peg's prism pieces, the URDF of a
 cover or head simulated from its mesh) is
 generated from ``geometry.toml`` and ``assembly.toml`` by
 :func:`executor.world.geometry.write_assets`. The folder records the
@@ -34,6 +35,8 @@ from executor.world.geometry import (
     HoleSpec,
     PartSpec,
     peg_body,
+    prism,
+    prism_names,
     product_bodies,
     write_assets,
 )
@@ -83,8 +86,9 @@ def _generated_names(geometry: CellGeometry) -> list[str]:
     shapes = {p.shape: p for p in geometry.parts.values()}
     bodies = [body for body in map(peg_body, shapes.values()) if body is not None]
     others = list(product_bodies(geometry).values())
+    prisms = [name for s, p in shapes.items() if prism(p) is not None for name in prism_names(s)]
     return ["plate.obj", *sorted(f"part_{s}.urdf" for s in shapes), *sorted(f"{b.stem}.urdf" for b in others),
-            *sorted(body.convex_asset for body in bodies + others)]
+            *sorted(body.convex_asset for body in bodies + others), *sorted(prisms)]
 
 
 def regenerate_assets(geometry: CellGeometry) -> list[Path]:

@@ -9,8 +9,10 @@ bottom (the plate's ``tile_thickness`` or its own ``depth`` below the entry): th
 boss when the bottom is the plate's top, else onto a floor of the boss; round
 holes are n-gons (``polygon_sides``) whose inradius is the hole radius, square and
 rectangular holes exact; a hole with a yaw has its whole boss turned by it about the
-hole's centre.  Parts are exact primitive shapes (cylinder with
-``URDF_USE_IMPLICIT_CYLINDER``, box), or, with a ``mesh``, their own mesh colliding as its
+hole's centre; a polygon hole's boss is made from its outline the same way
+(:mod:`executor.world.outlines`).  Parts are exact primitive shapes (cylinder with
+``URDF_USE_IMPLICIT_CYLINDER``, box, a polygon peg the prism of its outline over its
+length as exact convex pieces), or, with a ``mesh``, their own mesh colliding as its
 convex pieces (:mod:`executor.world.meshes`); a base with a ``mesh``
 is that mesh as a static concave triangle mesh instead of the plate.
 
@@ -37,6 +39,7 @@ import clingo
 import numpy as np
 import pybullet_data
 import shapely
+import trimesh
 
 from bridge.assembly import Assembly, assembly_of, resolve_assembly_folder
 from bridge.files import make_folder, write_atomic
@@ -57,10 +60,14 @@ from executor.world.meshes import (
     MeshBody,
     MeshFiles,
     eroded_pieces_text,
+    eroded_text,
     mesh_inertia,
     mesh_link_xml,
     mesh_urdf_text,
+    obj_text,
+    pieces_inertia,
 )
+from executor.world.outlines import boss_triangles, corners, prism_pieces
 from executor.world.polygon_fit import (
     OutlineError,
     PolygonFit,
@@ -393,11 +400,14 @@ def _boss_triangles(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarra
     """Triangles (3×3 vertex arrays [m], outward normals) of one boss standing on the
     plate under the bosses (its top at ``base`` [m]) up to the hole's entry, with a 45°
     entry chamfer and the hole down to its bottom: through the boss (the plate is the
-    bottom) when the bottom is at ``base``, else onto a floor of the boss."""
+    bottom) when the bottom is at ``base``, else onto a floor of the boss; a polygon
+    hole's from its outline (:func:`executor.world.outlines.boss_triangles`)."""
     n = plate.polygon_sides
     cx, cy = hole.position
     top = hole.top_z
     floor = hole.bottom_z if hole.bottom_z - base >= FLOOR_MIN else None
+    if hole.kind == "polygon":
+        return _oriented(_polygon_boss(hole, plate, base if floor is None else floor, base))
     chamfer = plate.chamfer
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
     outer = _turned(_ring("square", plate.tile_size / 2, n), hole.yaw) + (cx, cy)
@@ -428,12 +438,32 @@ def _boss_triangles(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarra
             tris += [(b0, b1, f1, down), (b0, f1, f0, down)]
         else:  # the boss's floor inside the hole, its solid bottom on the plate
             tris += [(np.array([cx, cy, floor]), f0, f1, up), (np.array([cx, cy, base]), b0, b1, down)]
+    return _oriented([(np.array([a, b, c]), wanted) for a, b, c, wanted in tris])
+
+
+def _oriented(tris: list[tuple[np.ndarray, np.ndarray]]) -> list[np.ndarray]:
+    """Each triangle (3×3 [m]) with its corners in the order whose normal points along its wanted normal."""
     out = []
-    for a, b, c, wanted in tris:
+    for tri, wanted in tris:
+        a, b, c = tri
         if np.dot(np.cross(b - a, c - a), wanted) < 0:
             b, c = c, b
         out.append(np.array([a, b, c]))
     return out
+
+
+def _polygon_boss(hole: HoleSpec, plate: Plate, bottom: float, base: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The boss of a polygon hole in the cell frame (:func:`executor.world.outlines.boss_triangles`);
+    ExecutorError naming the hole when its chamfered mouth leaves the boss."""
+    ring = corners(outline_polygon(hole, peg=False))
+    half = plate.tile_size / 2
+    tile = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
+    found = boss_triangles(_turned(ring, hole.yaw) + hole.position, _turned(tile, hole.yaw) + hole.position,
+                           plate.chamfer, hole.top_z, bottom, base)
+    if isinstance(found, str):
+        raise ExecutorError(f"hole '{hole.id}': {found} ([plate] tile_size {plate.tile_size:g} m, chamfer "
+                            f"{plate.chamfer:g} m)")
+    return found
 
 
 def plate_obj_text(geometry: CellGeometry) -> str:
@@ -465,6 +495,31 @@ def product_bodies(geometry: CellGeometry) -> dict[str, MeshBody]:
               for cid, cover in sorted(tables.covers.items()) if cover.mesh is not None}
     return bodies | {hid: MeshBody(f"head_{hid}", head.mesh, head.mass, f"head '{hid}'")
                      for hid, head in sorted(tables.heads.items()) if head.mesh is not None}
+
+
+def prism(part: PartSpec) -> list[np.ndarray] | None:
+    """The convex pieces (vertices (n, 3) [m] in its upright part frame) of a polygon peg
+    without a mesh: its outline's prism over its length (:func:`executor.world.outlines.prism_pieces`);
+    None for any other peg."""
+    if part.kind != "polygon" or part.mesh is not None:
+        return None
+    return prism_pieces(outline_polygon(part, peg=True), part.length)
+
+
+def prism_names(shape: str) -> tuple[str, str]:
+    """The files in ``assets/`` of a polygon peg shape's prism: its exact pieces (the
+    visual) and those pieces eroded by the hull margin (the collision)."""
+    return f"part_{shape}.prism.obj", f"part_{shape}.convex.obj"
+
+
+def peg_files(geometry: CellGeometry, part: PartSpec, *, absolute: bool) -> MeshFiles | None:
+    """The files of a peg simulated from its own mesh (:func:`mesh_files`) or as the prism
+    of its polygon outline (:func:`prism`); None for a cylinder or box."""
+    pieces = prism(part)
+    if pieces is None:
+        return mesh_files(geometry, peg_body(part), absolute=absolute)
+    visual, collision = (str(geometry.assets / name) if absolute else name for name in prism_names(part.shape))
+    return MeshFiles(visual, collision, pieces_inertia(pieces, part.mass))
 
 
 def mesh_files(geometry: CellGeometry, body: MeshBody | None, *, absolute: bool) -> MeshFiles | None:
@@ -556,9 +611,16 @@ def arm_urdf_text(part: PartSpec, gripper: Gripper, files: MeshFiles | None = No
     return text.replace("</robot>", tool + "</robot>")
 
 
+def _hull(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (n, 3) [m] and faces (m, 3) of the convex hull of ``vertices``."""
+    hull = trimesh.convex.convex_hull(vertices)
+    return np.asarray(hull.vertices), np.asarray(hull.faces)
+
+
 def write_assets(geometry: CellGeometry) -> list[Path]:
     """(Re)generate ``assets/plate.obj``, ``assets/part_<shape>.urdf``, for a part shape,
-    cover or head simulated from its own mesh its eroded convex pieces, and for such a
+    cover or head simulated from its own mesh its eroded convex pieces, for a polygon peg
+    shape without one its prism's pieces, exact and eroded (:func:`prism_names`), for such a
     cover or head its URDF (``cover_<id>.urdf``, ``head_<id>.urdf``), each written
     atomically (a cell starting meanwhile never loads half a file); returns the paths."""
     make_folder(geometry.assets)
@@ -572,7 +634,17 @@ def write_assets(geometry: CellGeometry) -> list[Path]:
             written.append(write_atomic(geometry.assets / body.convex_asset,
                                         eroded_pieces_text(geometry.folder / body.mesh.convex, body.what)))
     for shape, part in sorted(pegs.items()):
-        files = mesh_files(geometry, peg_body(part), absolute=False)
+        pieces = prism(part)
+        if pieces is not None:
+            exact, collision = prism_names(shape)
+            what = f"the prism of part '{part.id}'"
+            written += [write_atomic(geometry.assets / exact, obj_text(
+                            [(f"piece{k + 1}", *_hull(piece)) for k, piece in enumerate(pieces)],
+                            f"# generated from [part_shapes.{shape}] outline and length: its convex pieces")),
+                        write_atomic(geometry.assets / collision,
+                                     eroded_text(pieces, what, f"[part_shapes.{shape}] outline"))]
+    for shape, part in sorted(pegs.items()):
+        files = peg_files(geometry, part, absolute=False)
         written.append(write_atomic(geometry.assets / f"part_{shape}.urdf", part_urdf_text(part, files)))
     for body in others.values():
         files = mesh_files(geometry, body, absolute=False)

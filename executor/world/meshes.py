@@ -87,17 +87,23 @@ def eroded(vertices: np.ndarray, margin: float) -> trimesh.Trimesh | None:
 
 def eroded_pieces_text(convex: Path, what: str) -> str:
     """The asset a URDF collides as: every piece of the ``convex`` file eroded by
-    :data:`URDF_HULL_MARGIN`; ExecutorError naming ``what`` (the part) and the piece when
-    one is too thin."""
+    :data:`URDF_HULL_MARGIN` (:func:`eroded_text`)."""
+    return eroded_text(read_objects(convex), what, str(convex))
+
+
+def eroded_text(pieces: Sequence[np.ndarray], what: str, source: str) -> str:
+    """Wavefront OBJ of the convex hulls of ``pieces`` (vertices (n, 3) [m] each) eroded by
+    :data:`URDF_HULL_MARGIN`; ExecutorError naming the ``source`` (a file, or a table of
+    ``geometry.toml``), ``what`` (the part) and the piece when one is too thin."""
     objects = []
-    for k, vertices in enumerate(read_objects(convex)):
+    for k, vertices in enumerate(pieces):
         piece = eroded(vertices, URDF_HULL_MARGIN)
         if piece is None:
-            raise ExecutorError(f"{convex}: convex piece {k + 1} of {what} is thinner than "
+            raise ExecutorError(f"{source}: convex piece {k + 1} of {what} is thinner than "
                                 f"{2000 * URDF_HULL_MARGIN:g} mm (the cell's hull margin twice); expected pieces "
                                 "the simulated cell can collide as")
         objects.append((f"piece{k + 1}", piece.vertices, piece.faces))
-    return obj_text(objects, f"# generated from {convex.name}: each piece eroded by {URDF_HULL_MARGIN} m, "
+    return obj_text(objects, f"# generated from {Path(source).name}: each piece eroded by {URDF_HULL_MARGIN} m, "
                              "the URDF hull margin that PyBullet adds back")
 
 
@@ -118,6 +124,14 @@ def mesh_inertia(path: Path, mass: float) -> MeshInertia:
         raise ExecutorError(f"{path}: not a closed mesh with a volume; expected the part's own closed mesh [m]")
     mesh.density = mass / mesh.volume
     return MeshInertia(mass, np.array(mesh.center_mass), np.array(mesh.moment_inertia))
+
+
+def pieces_inertia(pieces: Sequence[np.ndarray], mass: float) -> MeshInertia:
+    """Centre of mass and inertia of the solid made of the convex hulls of ``pieces``
+    (vertices (n, 3) [m] each, interiors apart) for ``mass`` [kg] spread uniformly."""
+    solid = trimesh.util.concatenate([trimesh.convex.convex_hull(vertices) for vertices in pieces])
+    solid.density = mass / solid.volume
+    return MeshInertia(mass, np.array(solid.center_mass), np.array(solid.moment_inertia))
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from executor import ExecutorError
 from executor.world import TIME_STEP
 from executor.world.arm import turn_z, yaw_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, mesh_files, peg_body
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, peg_files
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -72,7 +72,7 @@ class Scene:
         part = next(p for _, p in sorted(geometry.parts.items()) if p.shape == shape)
         with tempfile.TemporaryDirectory(prefix="executor-arm-") as tmp:
             urdf = Path(tmp) / f"arm_{shape}.urdf"
-            urdf.write_text(arm_urdf_text(part, geometry.gripper, mesh_files(geometry, peg_body(part), absolute=True)))
+            urdf.write_text(arm_urdf_text(part, geometry.gripper, peg_files(geometry, part, absolute=True)))
             self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
                                      flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                                      physicsClientId=self.client)

@@ -138,17 +138,13 @@ CASES = [
     ("outline-far", ROUND_HOLE,
      'kind = "polygon"\nsize = [0.01, 0.01]\noutline = [[0.0, 0.0], [0.5, 0.0], [0.0, 0.01]]',
      "[hole_shapes.round_small] outline: expected"),
-    ("polygon-hole-without-base-mesh", ROUND_HOLE, f'kind = "polygon"\nsize = [0.01, 0.01]\noutline = {TRIANGLE}',
-     "[hole_shapes.round_small] kind: a polygon hole or one with rounded corners needs a [base] with its own mesh"),
     ("corner-of-a-round", ROUND_HOLE, ROUND_HOLE + "\ncorner = 0.001",
      "[hole_shapes.round_small] corner: expected no corner radius for a round, got 0.001"),
     ("corner-too-big", 'kind = "square"\nsize = 0.0133', 'kind = "square"\nsize = 0.0133\ncorner = 0.007',
      "[hole_shapes.square] corner: expected a corner radius of a square or rect at most half its short side "
      "(0.00665 m), got 0.007"),
     ("corner-without-base-mesh", 'kind = "square"\nsize = 0.0133', 'kind = "square"\nsize = 0.0133\ncorner = 0.001',
-     "[hole_shapes.square] corner: a polygon hole or one with rounded corners needs a [base] with its own mesh"),
-    ("polygon-peg-without-mesh", 'kind = "round"\nsize = 0.0120', f'kind = "polygon"\nsize = [0.01, 0.01]\n'
-     f"outline = {TRIANGLE}", "[part_shapes.round_peg] mesh: expected the part's own mesh for a polygon section"),
+     "[hole_shapes.square] corner: a hole with rounded corners needs a [base] with its own mesh"),
 ]
 
 

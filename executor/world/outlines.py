@@ -1,0 +1,131 @@
+"""Solids of polygon sections, exact to their outline: a peg's convex pieces and a hole's boss.
+
+A polygon peg collides as the prism of its outline over its length, cut into convex pieces
+(:func:`convex_parts`: the outline's constrained Delaunay triangles merged greedily,
+longest shared edge first, while the union stays convex; Hertel and Mehlhorn's bound: at
+most four times the fewest pieces), each piece one convex hull of the part's URDF link, so
+the union of the pieces is the outline's prism itself (no hull bridges a notch, as a
+decomposition of the mesh may). A polygon hole's boss (:func:`boss_triangles`) is a
+static triangle mesh like the other holes' bosses: the top of the square boss, the 45°
+entry chamfer (the outline offset by the chamfer along each corner's bisector, each edge
+moved out by the chamfer), the wall and the bottom (open onto the plate or a floor).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+
+CONVEX_TOLERANCE = 1e-7
+"""A union of pieces is convex when its hull lies within this [m] of it (0.1 µm, the
+resolution an outline is written to)."""
+
+
+def corners(shape: shapely.Polygon) -> np.ndarray:
+    """The exterior corners (n, 2) [m] of a polygon, counter-clockwise, collinear ones dropped."""
+    clean = shapely.orient_polygons(shapely.simplify(shape, 0.0))
+    return np.asarray(clean.exterior.coords)[:-1]
+
+
+def convex_parts(outline: shapely.Polygon) -> list[np.ndarray]:
+    """Convex polygons (each its corners (k, 2) [m], counter-clockwise) whose union is
+    ``outline`` (a simple polygon) and whose interiors do not overlap (module docstring)."""
+    if shapely.hausdorff_distance(outline.convex_hull, outline) <= CONVEX_TOLERANCE:
+        return [corners(outline)]
+    triangles = list(shapely.constrained_delaunay_triangles(outline).geoms)
+    owner = list(range(len(triangles)))  # piece of each triangle (the index of its first triangle)
+    pieces: dict[int, shapely.Polygon] = dict(enumerate(triangles))
+    edges: dict[tuple[tuple[float, float], tuple[float, float]], list[int]] = {}
+    for k, triangle in enumerate(triangles):
+        points = [tuple(c) for c in np.asarray(triangle.exterior.coords)[:3]]
+        for a, b in ((points[0], points[1]), (points[1], points[2]), (points[2], points[0])):
+            edges.setdefault((min(a, b), max(a, b)), []).append(k)
+    shared = sorted((pair for pair in edges.items() if len(pair[1]) == 2),
+                    key=lambda pair: -math.dist(*pair[0]))
+    for _, (first, second) in shared:
+        a, b = owner[first], owner[second]
+        if a == b:
+            continue
+        union = shapely.union(pieces[a], pieces[b])
+        if not isinstance(union, shapely.Polygon) or (
+                shapely.hausdorff_distance(union.convex_hull, union) > CONVEX_TOLERANCE):
+            continue
+        pieces[a] = union
+        del pieces[b]
+        owner = [a if o == b else o for o in owner]
+    return [corners(piece) for _, piece in sorted(pieces.items())]
+
+
+def prism_pieces(outline: shapely.Polygon, length: float) -> list[np.ndarray]:
+    """The vertices (2k, 3) [m] of each convex piece of the prism of ``outline`` from z = 0
+    to ``length`` [m] (:func:`convex_parts`)."""
+    return [np.vstack([np.column_stack([part, np.full(len(part), z)]) for z in (0.0, length)])
+            for part in convex_parts(outline)]
+
+
+def mitre_offset(ring: np.ndarray, distance: float) -> np.ndarray | None:
+    """The counter-clockwise ``ring`` (n, 2) [m] with each edge moved outwards by
+    ``distance`` [m], its corners where the moved edges meet (the same corners in the same
+    order); None when an edge would turn over or the ring cross itself."""
+    edge = np.roll(ring, -1, axis=0) - ring
+    edge /= np.linalg.norm(edge, axis=1)[:, None]
+    normal = np.column_stack([edge[:, 1], -edge[:, 0]])  # outwards of a counter-clockwise ring
+    before, after = np.roll(normal, 1, axis=0), normal
+    moved = ring + distance * (before + after) / (1.0 + np.einsum("ij,ij->i", before, after))[:, None]
+    new_edge = np.roll(moved, -1, axis=0) - moved
+    if np.any(np.einsum("ij,ij->i", new_edge, edge) <= 0) or not shapely.Polygon(moved).is_valid:
+        return None
+    return moved
+
+
+def _flat(shape: shapely.Polygon, z: float) -> list[np.ndarray]:
+    """The constrained Delaunay triangles (3 × 3 [m]) of a polygon (holes allowed) at height ``z``."""
+    return [np.column_stack([np.asarray(t.exterior.coords)[:3], np.full(3, z)])
+            for t in shapely.constrained_delaunay_triangles(shape).geoms]
+
+
+def _band(upper: np.ndarray, lower: np.ndarray) -> list[np.ndarray]:
+    """Two triangles for each edge between two rings (n, 3) [m] of corresponding corners."""
+    out = []
+    for k in range(len(upper)):
+        j = (k + 1) % len(upper)
+        out += [np.array([upper[k], upper[j], lower[j]]), np.array([upper[k], lower[j], lower[k]])]
+    return out
+
+
+def _lift(ring: np.ndarray, z: float) -> np.ndarray:
+    return np.column_stack([ring, np.full(len(ring), z)])
+
+
+def boss_triangles(hole: np.ndarray, tile: np.ndarray, chamfer: float, top: float, bottom: float,
+                   base: float) -> list[tuple[np.ndarray, np.ndarray]] | str:
+    """The boss of a polygon hole as ``(triangle 3 × 3, wanted normal)`` pairs [m]: the
+    counter-clockwise ``hole`` ring and the boss's square ``tile`` (4, 2) in the cell
+    frame, the entry at ``top``, the chamfer ``chamfer`` deep, the hole's bottom at
+    ``bottom``, the plate under the bosses at ``base`` (a bottom at it opens onto the plate;
+    above it, a floor). Or why none can be made: the chamfered mouth is no simple polygon
+    inside the tile."""
+    mouth = mitre_offset(hole, chamfer)
+    square = shapely.Polygon(tile)
+    if mouth is None or not square.contains(shapely.Polygon(mouth)):
+        return (f"its outline offset by the chamfer ({1e3 * chamfer:g} mm, each edge moved out) is no simple polygon "
+                "inside its boss")
+    up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
+    tris = [(t, up) for t in _flat(shapely.Polygon(tile, [mouth]), top)]
+    edge = np.roll(hole, -1, axis=0) - hole
+    inwards = np.column_stack([-edge[:, 1], edge[:, 0]]) / np.linalg.norm(edge, axis=1)[:, None]
+    mouth3, wall_top, wall_bottom = _lift(mouth, top), _lift(hole, top - chamfer), _lift(hole, bottom)
+    for faces, normal_xy, slope in ((_band(mouth3, wall_top), inwards, 1.0),
+                                    (_band(wall_top, wall_bottom), inwards, 0.0)):
+        tris += [(t, np.array([*normal_xy[k // 2], slope])) for k, t in enumerate(faces)]
+    tile_edge = np.roll(tile, -1, axis=0) - tile
+    outwards = np.column_stack([tile_edge[:, 1], -tile_edge[:, 0]])
+    tris += [(t, np.array([*outwards[k // 2], 0.0])) for k, t in enumerate(_band(_lift(tile, top), _lift(tile, base)))]
+    if bottom - base <= 0:  # an open ring on the plate, which is the hole's bottom
+        tris += [(t, down) for t in _flat(shapely.Polygon(tile, [hole]), base)]
+    else:  # the boss's floor inside the hole, its solid bottom on the plate
+        tris += [(t, up) for t in _flat(shapely.Polygon(hole), bottom)]
+        tris += [(t, down) for t in _flat(shapely.Polygon(tile), base)]
+    return tris
