@@ -1,8 +1,9 @@
 """Parts the simulated cell builds from their own meshes, decided and written at import.
 
 A peg or a head is a **primitive** when its mesh's volume is within
-:data:`PRIMITIVE_TOLERANCE` of the prism of its cross-section over its length (a cylinder
-or a box: the cell builds it as one; a head's box has the cell's axes); a cover when the
+:data:`PRIMITIVE_TOLERANCE` of the prism of its cross-section over its length (a cylinder,
+a box or a polygon peg's prism of its outline: the cell builds it as one; a head's box has
+the cell's axes); a cover when the
 symmetric difference of its mesh and the cell's cover (its outline less square openings
 of its holes' sizes plus its clearance, and its socket) is within that of its volume;
 the base when its volume is within that of its bounding box less its holes (cross-section
@@ -39,6 +40,7 @@ import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print
 import coacd
 import fcl
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.files import make_folder, write_atomic
@@ -81,11 +83,12 @@ def is_close(volume: float, primitive: float) -> bool:
 
 def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
     """Whether the peg in ``fit`` is the prism of its section over its length along z (a
-    polygon section never is: the cell has no such primitive)."""
+    polygon section's: of its outline, which the cell builds as exact convex pieces)."""
     assert fit.section is not None  # a peg has a section
     section = fit.section
-    prism = section_area(section.kind, section.a, section.b) * float(mesh.extents[2])
-    return section.kind != "polygon" and is_close(mesh.volume, prism)
+    area = (shapely.Polygon(section.outline).area if section.kind == "polygon"
+            else section_area(section.kind, section.a, section.b))
+    return is_close(mesh.volume, area * float(mesh.extents[2]))
 
 
 def base_is_primitive(derived: Derived) -> bool:

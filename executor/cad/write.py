@@ -16,8 +16,8 @@
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
   wait (and when the cell's loader accepts it; left out otherwise, and the report says
-  why): pegs standing in holes entered along +z with a round, square or rect section,
-  covers and heads (:mod:`executor.cad.covers`), every other part
+  why): pegs standing in holes entered along +z with a round, square or rect section or
+  the prism of a polygon (built by the cell from its outline), covers and heads (:mod:`executor.cad.covers`), every other part
   placed by hand (``[manual.<id>]``, :func:`cell_view`); the plate at the entry height and
   depth most holes share, a hole at another one with its own ``top_z`` and ``depth``, the
   plate, pegs, covers and heads as primitives where they are ones, else as their own
@@ -62,7 +62,7 @@ from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit
 from executor.cad.sections import Shape2D
 from executor.cad.sweep import opposite
-from executor.world.geometry import Section, load_geometry, margin
+from executor.world.geometry import Section, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 
 DENSITY = 2700.0
@@ -243,23 +243,38 @@ def precedence_text(derived: Derived) -> str:
 
 
 def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
-    """The product as the cell inserts it: only the holes entered from above with a
-    round, square or rect section holding, if anything, a peg entered from above; and the
-    pegs of the other holes and the parts going onto pins, each with why the cell places it
-    by hand (a polygon pair's room is often below what convex pieces of its meshes keep:
-    the cell inserts polygon sections of products described by hand, docs/geometry.md)."""
+    """The product as the cell inserts it: only the holes entered from above holding, if
+    anything, a peg entered from above that is no polygon section, or the prism of its
+    polygon (the cell builds that from its outline, exactly); and the pegs of the other
+    holes and the parts going onto pins, each with why the cell places it by hand (a
+    polygon peg's room is often below what convex pieces of its mesh keep)."""
     kept: dict[str, HoleFit] = {}
     by_hand = {pid: f"goes onto a pin ({pin.id}): the cell has no operation for it" for pin in derived.pins.values()
                for pid in pin.parts}
     for hid, fit in derived.holes.items():
         if fit.part is not None and derived.axis[fit.part] != "+z":
             by_hand[fit.part] = f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, not from above"
-        elif fit.axis != "+z" or "polygon" in (fit.hole.kind, _section_kind(fit)):
+        elif fit.axis != "+z":
             if fit.part is not None:
-                by_hand[fit.part] = f"hole {hid} is not entered from above with a round, square or rect section"
+                by_hand[fit.part] = f"hole {hid} is not entered from above"
+        elif fit.part is not None and _section_kind(fit) == "polygon" and _polygon_refused(fit, derived):
+            by_hand[fit.part] = _polygon_refused(fit, derived)
         else:
             kept[hid] = fit
     return replace(derived, holes=kept), by_hand
+
+
+def _polygon_refused(fit: HoleFit, derived: Derived) -> str:
+    """Why the cell cannot insert the polygon peg of ``fit`` ("" when it can): it is no
+    prism of its section (convex pieces of its mesh would not keep its room), or its
+    outline's prism has a piece the cell's hull margin would widen."""
+    assert fit.part is not None and fit.section is not None
+    mesh = derived.parts[fit.part].mesh
+    if not peg_is_primitive(fit, mesh):
+        return (f"part '{fit.part}' has a polygon section but is no prism of it: convex pieces of its mesh would not "
+                "keep its room")
+    thin = thin_prism(section(fit.part, fit.section), float(mesh.extents[2]))
+    return "" if thin is None else f"part '{fit.part}': {thin}"
 
 
 def map_product(derived: Derived, settings: Settings) -> Mapped:

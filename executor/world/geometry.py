@@ -58,7 +58,9 @@ from executor import ExecutorError
 from executor.cell_description import CellDescription
 from executor.world.meshes import (
     MeshBody,
+    URDF_HULL_MARGIN,
     MeshFiles,
+    eroded,
     eroded_pieces_text,
     eroded_text,
     mesh_inertia,
@@ -504,6 +506,19 @@ def prism(part: PartSpec) -> list[np.ndarray] | None:
     if part.kind != "polygon" or part.mesh is not None:
         return None
     return prism_pieces(outline_polygon(part, peg=True), part.length)
+
+
+def thin_prism(part: Section, length: float) -> str | None:
+    """Why the cell cannot collide as the prism of a polygon section over ``length`` [m]
+    (a convex piece of its outline thinner than twice the URDF hull margin, which the
+    margin would widen), None when it can."""
+    for k, vertices in enumerate(prism_pieces(outline_polygon(part, peg=True), length)):
+        if eroded(vertices, URDF_HULL_MARGIN) is None:
+            inradius = shapely.length(shapely.maximum_inscribed_circle(shapely.MultiPoint(vertices[:, :2]).convex_hull,
+                                                                       1e-7))
+            return (f"convex piece {k + 1} of its outline is {2e3 * inradius:.3f} mm thick, less than the cell's hull "
+                    f"margin twice ({2e3 * URDF_HULL_MARGIN:g} mm)")
+    return None
 
 
 def prism_names(shape: str) -> tuple[str, str]:
