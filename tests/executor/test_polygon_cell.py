@@ -1,0 +1,114 @@
+"""The cell builds polygon sections from their outlines: a peg as the exact convex pieces
+of its outline's prism, a hole as a boss around its outline; a hexagon peg goes into a
+hexagon hole with 40 µm room all round, turned by the yaw the polygon relation finds, and a
+hexagon hole 40 µm too small refuses it, in physics.
+
+The product (made here, as a user would describe it): a plate with two hexagon holes, hx
+(inradius 6.04 mm, turned 30° in its outline: a vertex on +y) and hs (inradius 5.96 mm, a
+vertex on +x), and one hexagon peg (inradius 6 mm, a vertex on +x)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+
+from executor import ExecutorError
+from executor.world.assets import current_assets
+from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
+from executor.world.meshes import URDF_HULL_MARGIN, read_objects
+from executor.world.outlines import convex_parts
+from tests._outlines import splined
+
+HOLES = {"hx": (0.00604, math.pi / 6), "hs": (0.00596, 0.0)}
+"""Each hole's inradius [m] and the turn of its outline [rad]."""
+PEG = 0.006
+"""The peg's inradius [m]."""
+
+
+def hexagon(inradius: float, turn: float = 0.0) -> list[list[float]]:
+    """A regular hexagon's corners [m], the first at ``turn`` [rad] from +x."""
+    r = inradius / math.cos(math.pi / 6)
+    return [[round(r * math.cos(k * math.pi / 3 + turn), 9), round(r * math.sin(k * math.pi / 3 + turn), 9)]
+            for k in range(6)]
+
+
+def _section(points: list[list[float]]) -> str:
+    xs, ys = [p[0] for p in points], [p[1] for p in points]
+    return f"size = [{max(xs) - min(xs):.9g}, {max(ys) - min(ys):.9g}]\noutline = {points}"
+
+
+def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04) -> Path:
+    folder.mkdir()
+    assembly = ['name = "hexagon peg"', "", "[parts.bp]", 'name = "base plate"', 'role = "base"',
+                "start = [0.30, -0.40]", "", "[parts.p1]", 'name = "hexagon peg"', 'role = "peg"', 'shape = "polygon"',
+                "start = [0.30, 0.40]"]
+    for k, hole in enumerate(HOLES):
+        assembly += ["", f"[holes.{hole}]", f'name = "hexagon hole {hole}"', 'shape = "polygon"',
+                     f"position = [{0.55 + 0.06 * k:.2f}, 0.0]"]
+    (folder / "assembly.toml").write_text("\n".join(assembly) + "\n")
+    geometry = ["[plate]", "top_z = 0.10", f"tile_size = {tile}", "tile_thickness = 0.025", f"chamfer = {chamfer}",
+                "polygon_sides = 24", "base_size = [0.20, 0.10]", "base_center = [0.58, 0.0]", "base_thickness = 0.02"]
+    for hole, (inradius, turn) in HOLES.items():
+        geometry += ["", f"[hole_shapes.{hole}]", f'holes = ["{hole}"]', 'kind = "polygon"',
+                     _section(hexagon(inradius, turn))]
+    geometry += ["", "[part_shapes.hexagon]", 'parts = ["p1"]', 'kind = "polygon"', _section(hexagon(PEG)),
+                 "length = 0.05", "mass = 0.05", 'demo_hole = "hx"', "", "[base]", 'part = "bp"',
+                 "tray = [0.25, -0.33]", "grip = [0.0, 0.0]", "mass = 2.0"]
+    (folder / "geometry.toml").write_text("\n".join(geometry) + "\n")
+    return folder
+
+
+def test_convex_parts_are_the_outline_exactly() -> None:
+    shaft = splined(0.010, 0.007, 8, 0.3)  # concave: eight teeth on a root circle
+    parts = [shapely.Polygon(p) for p in convex_parts(shaft)]
+    assert 1 < len(parts) < len(shaft.exterior.coords)
+    assert all(shapely.hausdorff_distance(p.convex_hull, p) < 1e-9 for p in parts)  # each convex
+    assert sum(p.area for p in parts) == pytest.approx(shaft.area, rel=1e-12)  # interiors apart
+    assert shapely.symmetric_difference(shapely.union_all(parts), shaft).area < 1e-12 * shaft.area
+    assert len(convex_parts(shapely.Polygon(hexagon(PEG)))) == 1
+
+
+def test_the_peg_collides_as_its_outline_and_the_hole_is_its_outline(tmp_path: Path) -> None:
+    geometry = load_geometry(str(_product(tmp_path / "hex")))
+    assets = current_assets(geometry)
+    (piece,) = read_objects(assets / "part_hexagon.convex.obj")
+    # the eroded piece grown by the hull margin PyBullet adds is the outline's prism (its edges rounded)
+    grown = shapely.MultiPoint(piece[:, :2]).convex_hull.buffer(URDF_HULL_MARGIN, join_style="mitre")
+    assert shapely.hausdorff_distance(grown, shapely.Polygon(hexagon(PEG))) < 2e-7
+    assert piece[:, 2].min() == pytest.approx(URDF_HULL_MARGIN) and piece[:, 2].max() == pytest.approx(0.049)
+    # the wall of hx (below its chamfer) has the outline's corners, turned as written, at the hole's position
+    vertices = np.array([[float(w) for w in line.split()[1:]] for line in plate_obj_text(geometry).splitlines()
+                         if line.startswith("v ")])
+    hx = geometry.holes["hx"]
+    wall = vertices[(vertices[:, 2] < hx.top_z - geometry.plate.chamfer + 1e-7) & (vertices[:, 2] > 0.08)
+                    & (np.linalg.norm(vertices[:, :2] - hx.position, axis=1) < 0.01)]
+    expected = np.array(hexagon(*HOLES["hx"])) + hx.position
+    assert all(np.min(np.linalg.norm(wall[:, :2] - corner, axis=1)) < 1e-6 for corner in expected)
+    # the polygon relation: 40 µm all round at a turn of 30° (the hexagon's half period), 40 µm short in hs
+    assert margin(geometry.parts["p1"], hx) == pytest.approx(2 * 0.00004, abs=1e-7)
+    assert abs(math.degrees(fit_pose(geometry.parts["p1"], hx)[0])) == pytest.approx(30.0, abs=1e-3)
+    assert margin(geometry.parts["p1"], geometry.holes["hs"]) == pytest.approx(-2 * 0.00004, abs=1e-6)
+
+
+def test_a_chamfer_that_leaves_the_boss_is_refused_naming_the_hole(tmp_path: Path) -> None:
+    # size + 2 chamfer < tile_size, as for any hole, but the mitred corners reach 0.35 mm beyond the boss
+    geometry = load_geometry(str(_product(tmp_path / "hex", chamfer=0.003, tile=0.02)))
+    with pytest.raises(ExecutorError, match=r"hole 'h[sx]': its outline offset by the chamfer \(3 mm"):
+        plate_obj_text(geometry)
+
+
+@pytest.mark.slow  # teaches the peg and runs two trials in physics (about 25 s)
+def test_a_hexagon_peg_goes_into_a_hexagon_hole_with_40_um_room_and_not_into_one_40_um_short(
+        tmp_path: Path, run_executor) -> None:
+    folder = str(_product(tmp_path / "hex"))
+    taught = run_executor("teach", "--assembly", folder, timeout=240)
+    assert taught.returncode == 0, taught.stderr
+    for hole, outcome in (("hx", "fit"), ("hs", "no_fit")):
+        done = run_executor("trial", "--part", "p1", "--hole", hole, "--assembly", folder, "--json", timeout=240)
+        assert done.returncode == 0, done.stderr
+        assert json.loads(done.stdout)["trials"][0]["outcome"] == outcome, hole
