@@ -17,9 +17,10 @@
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
   wait (and when the cell's loader accepts it; left out otherwise, and the report says
   why): pegs standing in holes entered along +z with a round, square or rect section or
-  the prism of a polygon (built by the cell from its outline), covers and heads (:mod:`executor.cad.covers`), every other part
-  placed by hand (``[manual.<id>]``, :func:`cell_view`); the plate at the entry height and
-  depth most holes share, a hole at another one with its own ``top_z`` and ``depth``, the
+  the prism of a polygon (built by the cell from its outline), covers and heads
+  (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
+  :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
+  at another one with its own ``top_z`` and ``depth``, the
   plate, pegs, covers and heads as primitives where they are ones, else as their own
   meshes with convex pieces (``meshes/``, :mod:`executor.cad.convex`;
   a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell), a part placed by

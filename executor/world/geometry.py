@@ -57,8 +57,8 @@ from bridge.product import (
 from executor import ExecutorError
 from executor.cell_description import CellDescription
 from executor.world.meshes import (
-    MeshBody,
     URDF_HULL_MARGIN,
+    MeshBody,
     MeshFiles,
     eroded,
     eroded_pieces_text,

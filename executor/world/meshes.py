@@ -130,6 +130,7 @@ def pieces_inertia(pieces: Sequence[np.ndarray], mass: float) -> MeshInertia:
     """Centre of mass and inertia of the solid made of the convex hulls of ``pieces``
     (vertices (n, 3) [m] each, interiors apart) for ``mass`` [kg] spread uniformly."""
     solid = trimesh.util.concatenate([trimesh.convex.convex_hull(vertices) for vertices in pieces])
+    assert isinstance(solid, trimesh.Trimesh)  # hulls are triangle meshes
     solid.density = mass / solid.volume
     return MeshInertia(mass, np.array(solid.center_mass), np.array(solid.moment_inertia))
 

@@ -40,8 +40,8 @@ def convex_parts(outline: shapely.Polygon) -> list[np.ndarray]:
     edges: dict[tuple[tuple[float, float], tuple[float, float]], list[int]] = {}
     for k, triangle in enumerate(triangles):
         points = [tuple(c) for c in np.asarray(triangle.exterior.coords)[:3]]
-        for a, b in ((points[0], points[1]), (points[1], points[2]), (points[2], points[0])):
-            edges.setdefault((min(a, b), max(a, b)), []).append(k)
+        for start, end in ((points[0], points[1]), (points[1], points[2]), (points[2], points[0])):
+            edges.setdefault((min(start, end), max(start, end)), []).append(k)
     shared = sorted((pair for pair in edges.items() if len(pair[1]) == 2),
                     key=lambda pair: -math.dist(*pair[0]))
     for _, (first, second) in shared:

@@ -1,7 +1,8 @@
 """The cell builds polygon sections from their outlines: a peg as the exact convex pieces
 of its outline's prism, a hole as a boss around its outline; a hexagon peg goes into a
 hexagon hole with 40 µm room all round, turned by the yaw the polygon relation finds, and a
-hexagon hole 40 µm too small refuses it, in physics.
+hexagon hole 40 µm too small refuses it, in physics; the assembling cell stands it in its
+hole turned by that yaw.
 
 The product (made here, as a user would describe it): a plate with two hexagon holes, hx
 (inradius 6.04 mm, turned 30° in its outline: a vertex on +y) and hs (inradius 5.96 mm, a
@@ -18,6 +19,9 @@ import pytest
 import shapely
 
 from executor import ExecutorError
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
+from executor.cell_description import CellDescription
 from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
 from executor.world.meshes import URDF_HULL_MARGIN, read_objects
@@ -102,7 +106,7 @@ def test_a_chamfer_that_leaves_the_boss_is_refused_naming_the_hole(tmp_path: Pat
         plate_obj_text(geometry)
 
 
-@pytest.mark.slow  # teaches the peg and runs two trials in physics (about 25 s)
+@pytest.mark.slow  # teaches the peg, runs two trials and assembles in physics (about 30 s)
 def test_a_hexagon_peg_goes_into_a_hexagon_hole_with_40_um_room_and_not_into_one_40_um_short(
         tmp_path: Path, run_executor) -> None:
     folder = str(_product(tmp_path / "hex"))
@@ -112,3 +116,14 @@ def test_a_hexagon_peg_goes_into_a_hexagon_hole_with_40_um_room_and_not_into_one
         done = run_executor("trial", "--part", "p1", "--hole", hole, "--assembly", folder, "--json", timeout=240)
         assert done.returncode == 0, done.stderr
         assert json.loads(done.stdout)["trials"][0]["outcome"] == outcome, hole
+    # the assembling cell picks it from the tray, turns it by 30° and stands it in hx
+    assembler = Assembler(load_product(folder), description=CellDescription())
+    try:
+        assert assembler.run_step("bp", None, 0).outcome == "fit"
+        step = assembler.run_step("p1", "hx", 0)
+        _, quat = assembler.world.pose("p1")
+    finally:
+        assembler.close()
+    assert step.outcome == "fit" and step.pose_error < 0.002
+    yaw = math.degrees(2 * math.atan2(quat[2], quat[3]))
+    assert abs(abs(yaw) - 30.0) < 1.0  # the hexagon's half period: the relation's turn, within the room's play
