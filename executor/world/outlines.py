@@ -7,8 +7,9 @@ most four times the fewest pieces), each piece one convex hull of the part's URD
 the union of the pieces is the outline's prism itself (no hull bridges a notch, as a
 decomposition of the mesh may). A polygon hole's boss (:func:`boss_triangles`) is a
 static triangle mesh like the other holes' bosses: the top of the square boss, the 45°
-entry chamfer (the outline offset by the chamfer along each corner's bisector, each edge
-moved out by the chamfer), the wall and the bottom (open onto the plate or a floor).
+entry chamfer (each edge of the outline moved out by the chamfer, its corners where the
+moved edges meet: :func:`mitre_offset`), the wall and the bottom (open onto the plate or
+a floor).
 """
 
 from __future__ import annotations
@@ -66,18 +67,60 @@ def prism_pieces(outline: shapely.Polygon, length: float) -> list[np.ndarray]:
 
 
 def mitre_offset(ring: np.ndarray, distance: float) -> np.ndarray | None:
-    """The counter-clockwise ``ring`` (n, 2) [m] with each edge moved outwards by
-    ``distance`` [m], its corners where the moved edges meet (the same corners in the same
-    order); None when an edge would turn over or the ring cross itself."""
-    edge = np.roll(ring, -1, axis=0) - ring
-    edge /= np.linalg.norm(edge, axis=1)[:, None]
-    normal = np.column_stack([edge[:, 1], -edge[:, 0]])  # outwards of a counter-clockwise ring
-    before, after = np.roll(normal, 1, axis=0), normal
-    moved = ring + distance * (before + after) / (1.0 + np.einsum("ij,ij->i", before, after))[:, None]
-    new_edge = np.roll(moved, -1, axis=0) - moved
-    if np.any(np.einsum("ij,ij->i", new_edge, edge) <= 0) or not shapely.Polygon(moved).is_valid:
+    """Where each corner of the counter-clockwise ``ring`` (n, 2) [m] goes when every edge
+    moves outwards by ``distance`` [m]: where the moved edges meet. An edge that the move
+    turns over (a short edge between two inward corners) is dropped, the one turned
+    furthest first, and its two corners go to where its neighbours' moved edges meet (its
+    chamfer face is then a triangle). None when the moved ring crosses itself or differs
+    from the ring's mitred buffer by more than :data:`CONVEX_TOLERANCE` (an offset no
+    dropping of edges describes)."""
+    n = len(ring)
+    direction = np.roll(ring, -1, axis=0) - ring
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    normal = np.column_stack([direction[:, 1], -direction[:, 0]])  # outwards of a counter-clockwise ring
+    kept = list(range(n))
+    while len(kept) >= 3:
+        corners = {edge: _meet(ring, direction, normal, distance, kept[k - 1], edge) for k, edge in enumerate(kept)}
+        lengths = [float((corners[kept[(k + 1) % len(kept)]] - corners[edge]) @ direction[edge])
+                   for k, edge in enumerate(kept)]
+        worst = int(np.argmin(lengths))
+        if lengths[worst] > 0:
+            break
+        del kept[worst]
+    else:
+        return None
+    # corner i (between edges i - 1 and i) goes where the kept edges around it meet
+    moved = np.array([corners[_next_kept(kept, i)] for i in range(n)])
+    shape = shapely.Polygon(_distinct(moved))
+    expected = shapely.Polygon(ring).buffer(distance, join_style="mitre", mitre_limit=1e6)
+    if not shape.is_valid or shapely.hausdorff_distance(shape, expected) > CONVEX_TOLERANCE:
         return None
     return moved
+
+
+def _next_kept(kept: list[int], corner: int) -> int:
+    """The first kept edge at or after ``corner``, round the ring."""
+    return next((e for e in kept if e >= corner), kept[0])
+
+
+def _meet(ring: np.ndarray, direction: np.ndarray, normal: np.ndarray, distance: float, before: int,
+          after: int) -> np.ndarray:
+    """Where edges ``before`` and ``after``, moved outwards by ``distance`` [m], meet (on
+    one line: the moved start of ``after``)."""
+    start = ring[after] + distance * normal[after]
+    other = ring[before] + distance * normal[before]
+    cross = direction[before, 0] * direction[after, 1] - direction[before, 1] * direction[after, 0]
+    if abs(cross) < 1e-12:
+        return start
+    offset = other - start
+    t = (offset[0] * direction[before, 1] - offset[1] * direction[before, 0]) / -cross
+    return start + t * direction[after]
+
+
+def _distinct(points: np.ndarray) -> np.ndarray:
+    """The ring's points without a repeat of the one before (round the ring)."""
+    keep = np.linalg.norm(points - np.roll(points, 1, axis=0), axis=1) > 1e-12
+    return points[keep]
 
 
 def _flat(shape: shapely.Polygon, z: float) -> list[np.ndarray]:
@@ -86,12 +129,15 @@ def _flat(shape: shapely.Polygon, z: float) -> list[np.ndarray]:
             for t in shapely.constrained_delaunay_triangles(shape).geoms]
 
 
-def _band(upper: np.ndarray, lower: np.ndarray) -> list[np.ndarray]:
-    """Two triangles for each edge between two rings (n, 3) [m] of corresponding corners."""
+def _band(upper: np.ndarray, lower: np.ndarray) -> list[tuple[int, np.ndarray]]:
+    """The triangles between two rings (n, 3) [m] of corresponding corners, each with the
+    index of its edge: two for an edge, one where the upper ring's corners are one point."""
     out = []
     for k in range(len(upper)):
         j = (k + 1) % len(upper)
-        out += [np.array([upper[k], upper[j], lower[j]]), np.array([upper[k], lower[j], lower[k]])]
+        if np.linalg.norm(upper[j] - upper[k]) > 1e-12:
+            out.append((k, np.array([upper[k], upper[j], lower[j]])))
+        out.append((k, np.array([upper[k], lower[j], lower[k]])))
     return out
 
 
@@ -109,20 +155,20 @@ def boss_triangles(hole: np.ndarray, tile: np.ndarray, chamfer: float, top: floa
     inside the tile."""
     mouth = mitre_offset(hole, chamfer)
     square = shapely.Polygon(tile)
-    if mouth is None or not square.contains(shapely.Polygon(mouth)):
+    if mouth is None or not square.contains(shapely.Polygon(_distinct(mouth))):
         return (f"its outline offset by the chamfer ({1e3 * chamfer:g} mm, each edge moved out) is no simple polygon "
                 "inside its boss")
     up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
-    tris = [(t, up) for t in _flat(shapely.Polygon(tile, [mouth]), top)]
+    tris = [(t, up) for t in _flat(shapely.Polygon(tile, [_distinct(mouth)]), top)]
     edge = np.roll(hole, -1, axis=0) - hole
     inwards = np.column_stack([-edge[:, 1], edge[:, 0]]) / np.linalg.norm(edge, axis=1)[:, None]
     mouth3, wall_top, wall_bottom = _lift(mouth, top), _lift(hole, top - chamfer), _lift(hole, bottom)
     for faces, normal_xy, slope in ((_band(mouth3, wall_top), inwards, 1.0),
                                     (_band(wall_top, wall_bottom), inwards, 0.0)):
-        tris += [(t, np.array([*normal_xy[k // 2], slope])) for k, t in enumerate(faces)]
+        tris += [(t, np.array([*normal_xy[k], slope])) for k, t in faces]
     tile_edge = np.roll(tile, -1, axis=0) - tile
     outwards = np.column_stack([tile_edge[:, 1], -tile_edge[:, 0]])
-    tris += [(t, np.array([*outwards[k // 2], 0.0])) for k, t in enumerate(_band(_lift(tile, top), _lift(tile, base)))]
+    tris += [(t, np.array([*outwards[k], 0.0])) for k, t in _band(_lift(tile, top), _lift(tile, base))]
     if bottom - base <= 0:  # an open ring on the plate, which is the hole's bottom
         tris += [(t, down) for t in _flat(shapely.Polygon(tile, [hole]), base)]
     else:  # the boss's floor inside the hole, its solid bottom on the plate

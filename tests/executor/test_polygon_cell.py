@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+import trimesh
 
 from executor import ExecutorError
 from executor.assembly.product import load_product
@@ -25,7 +26,7 @@ from executor.cell_description import CellDescription
 from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
 from executor.world.meshes import URDF_HULL_MARGIN, read_objects
-from executor.world.outlines import convex_parts
+from executor.world.outlines import boss_triangles, convex_parts, corners
 from tests._outlines import splined
 
 HOLES = {"hx": (0.00604, math.pi / 6), "hs": (0.00596, 0.0)}
@@ -75,6 +76,28 @@ def test_convex_parts_are_the_outline_exactly() -> None:
     assert sum(p.area for p in parts) == pytest.approx(shaft.area, rel=1e-12)  # interiors apart
     assert shapely.symmetric_difference(shapely.union_all(parts), shaft).area < 1e-12 * shaft.area
     assert len(convex_parts(shapely.Polygon(hexagon(PEG)))) == 1
+
+
+def keyed() -> shapely.Polygon:
+    """A shaft of radius 6 mm (a 64-gon) with a key 3 mm wide standing 2.5 mm out along +y [m]."""
+    angles = np.linspace(0, 2 * math.pi, 64, endpoint=False)
+    shaft = shapely.Polygon(np.column_stack([np.cos(angles), np.sin(angles)]) * 0.006)
+    return shapely.union(shaft, shapely.box(-0.0015, 0.0, 0.0015, 0.0085)).simplify(0)
+
+
+def test_a_keyed_outline_is_two_pieces_and_its_boss_is_closed() -> None:
+    """The key meets the shaft at two inward corners of the hole, beside edges shorter than
+    the chamfer: those edges' chamfer faces are triangles, and the boss stays closed."""
+    assert [len(part) for part in convex_parts(keyed())] == [61, 4]
+    hole = corners(keyed()) + (0.5, 0.1)
+    tile = np.array([[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [-0.02, 0.02]]) + (0.5, 0.1)
+    for bottom in (0.075, 0.08):  # through onto the plate, onto a floor
+        found = boss_triangles(hole, tile, 0.0008, 0.1, bottom, 0.075)
+        assert not isinstance(found, str), found
+        mesh = trimesh.Trimesh(np.concatenate([t for t, _ in found]), np.arange(3 * len(found)).reshape(-1, 3))
+        mesh.merge_vertices()
+        assert mesh.is_watertight
+        assert all(np.dot(np.cross(t[1] - t[0], t[2] - t[0]), wanted) != 0 for t, wanted in found)  # no sliver
 
 
 def test_the_peg_collides_as_its_outline_and_the_hole_is_its_outline(tmp_path: Path) -> None:
