@@ -21,7 +21,7 @@ from executor import ExecutorError
 from executor.world import TIME_STEP
 from executor.world.arm import turn_z, yaw_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, peg_files
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, outline_polygon, peg_files
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -177,12 +177,15 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
 
 def hole_rims(geometry: CellGeometry, segments: int = 48) -> list[np.ndarray]:
     """Each hole's rim at the plate's top as a closed line ``(K, 3)`` [m]: a circle of the
-    hole's diameter, or its rectangle turned by its yaw."""
+    hole's diameter, its outline (a polygon) or its rectangle, turned by its yaw."""
     top = geometry.plate.top_z
     rims = []
     for _hid, hole in sorted(geometry.holes.items()):
         a, b = hole.sides
-        if hole.kind == "round":
+        if hole.kind == "polygon":
+            ring = np.asarray(outline_polygon(hole, peg=False).exterior.coords)
+            outline = np.column_stack([ring, np.zeros(len(ring))])
+        elif hole.kind == "round":
             angle = np.linspace(0.0, 2.0 * np.pi, segments + 1)
             outline = np.column_stack([a / 2 * np.cos(angle), b / 2 * np.sin(angle), np.zeros(segments + 1)])
         else:

@@ -27,6 +27,7 @@ from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
 from executor.world.meshes import URDF_HULL_MARGIN, read_objects
 from executor.world.outlines import boss_triangles, convex_parts, corners
+from executor.world.scene import hole_rims
 from tests._outlines import splined
 
 HOLES = {"hx": (0.00604, math.pi / 6), "hs": (0.00596, 0.0)}
@@ -116,6 +117,8 @@ def test_the_peg_collides_as_its_outline_and_the_hole_is_its_outline(tmp_path: P
                     & (np.linalg.norm(vertices[:, :2] - hx.position, axis=1) < 0.01)]
     expected = np.array(hexagon(*HOLES["hx"])) + hx.position
     assert all(np.min(np.linalg.norm(wall[:, :2] - corner, axis=1)) < 1e-6 for corner in expected)
+    rim = hole_rims(geometry)[sorted(geometry.holes).index("hx")]  # what the Rerun log draws
+    assert np.allclose(rim[:-1, :2], expected, atol=1e-9)
     # the polygon relation: 40 µm all round at a turn of 30° (the hexagon's half period), 40 µm short in hs
     assert margin(geometry.parts["p1"], hx) == pytest.approx(2 * 0.00004, abs=1e-7)
     assert abs(math.degrees(fit_pose(geometry.parts["p1"], hx)[0])) == pytest.approx(30.0, abs=1e-3)
