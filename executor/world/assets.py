@@ -34,8 +34,8 @@ from executor.world.geometry import (
     CellGeometry,
     HoleSpec,
     PartSpec,
+    is_prism,
     peg_body,
-    prism,
     prism_names,
     product_bodies,
     write_assets,
@@ -86,7 +86,7 @@ def _generated_names(geometry: CellGeometry) -> list[str]:
     shapes = {p.shape: p for p in geometry.parts.values()}
     bodies = [body for body in map(peg_body, shapes.values()) if body is not None]
     others = list(product_bodies(geometry).values())
-    prisms = [name for s, p in shapes.items() if prism(p) is not None for name in prism_names(s)]
+    prisms = [name for s, p in shapes.items() if is_prism(p) for name in prism_names(s)]
     return ["plate.obj", *sorted(f"part_{s}.urdf" for s in shapes), *sorted(f"{b.stem}.urdf" for b in others),
             *sorted(body.convex_asset for body in bodies + others), *sorted(prisms)]
 

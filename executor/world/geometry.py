@@ -499,13 +499,16 @@ def product_bodies(geometry: CellGeometry) -> dict[str, MeshBody]:
                      for hid, head in sorted(tables.heads.items()) if head.mesh is not None}
 
 
+def is_prism(part: PartSpec) -> bool:
+    """Whether the cell builds the peg as the prism of its outline: a polygon without a mesh."""
+    return part.kind == "polygon" and part.mesh is None
+
+
 def prism(part: PartSpec) -> list[np.ndarray] | None:
-    """The convex pieces (vertices (n, 3) [m] in its upright part frame) of a polygon peg
-    without a mesh: its outline's prism over its length (:func:`executor.world.outlines.prism_pieces`);
-    None for any other peg."""
-    if part.kind != "polygon" or part.mesh is not None:
-        return None
-    return prism_pieces(outline_polygon(part, peg=True), part.length)
+    """The convex pieces (vertices (n, 3) [m] in its upright part frame) of a peg the cell
+    builds as its outline's prism over its length (:func:`is_prism`,
+    :func:`executor.world.outlines.prism_pieces`); None for any other peg."""
+    return prism_pieces(outline_polygon(part, peg=True), part.length) if is_prism(part) else None
 
 
 def thin_prism(part: Section, length: float) -> str | None:
