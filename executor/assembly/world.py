@@ -24,7 +24,7 @@ from executor.control.gains import ImpedanceGains
 from executor.control.motion import Motion, StepLogger
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import PartSpec, arm_urdf_text, product_bodies
+from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies
 from executor.world.scene import TIME_STEP, load_plate
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
@@ -195,9 +195,11 @@ class AssemblyWorld:
             self.set_pose(pid, self.tray_position(pid))
 
     def set_peg_goal(self, part: str, hole: str) -> None:
-        """A peg's goal: standing on the bottom of ``hole``."""
+        """A peg's goal: standing on the bottom of ``hole``, shifted as the polygon relation
+        passes it (:func:`executor.world.geometry.fit_pose`; no shift for other sections)."""
         spec = self.product.geometry.holes[hole]
-        self.goals[part] = np.array([*spec.position, spec.bottom_z])
+        x, y = np.array(spec.position) + fit_pose(self.product.pegs[part], spec)[1]
+        self.goals[part] = np.array([x, y, spec.bottom_z])
 
     def lock(self, part: str) -> None:
         """Lock a placed peg in its hole: fixed where it rests, its contacts with the plate
