@@ -21,6 +21,7 @@ from executor.cad.write import (
     Settings,
     _section_lines,
     assembly_text,
+    cell_view,
     margins,
     nominal_text,
     sizes_text,
@@ -91,6 +92,10 @@ def test_a_splined_pair_and_a_rounded_rect_pair_are_true_fits_with_their_real_ro
     assert f"nominal_margin(shaft,{holes['shaft']},{round(2 * GAP * 1000)})." in nominal_text(derived)
     assembly = assembly_text(derived, Settings("plate", {p: (0.0, 0.0) for p in derived.parts}, {}), "t", {})
     assert f'[holes.{holes["shaft"]}]\nname = "hole of shaft"\nshape = "polygon"' in assembly
+    # the cell would insert the shaft as its outline's prism, but its 1 mm teeth are convex
+    # pieces the 1 mm hull margin would widen: it is placed by hand, and says so
+    assert cell_view(derived)[1] == {"shaft": "part 'shaft': convex piece 1 of its outline is 1.249 mm thick, less "
+                                              "than the cell's hull margin twice (2 mm)"}
     # geometry.toml's sections, read back as the cell (and its truth backend) reads them, give the same rooms
     rooms = margins(derived)
     for pid, fit in derived.hole_of.items():
