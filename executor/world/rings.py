@@ -1,0 +1,107 @@
+"""Parts with a bore that go onto a pin (a nut, a washer, a gear, a pulley), as the cell
+collides with them: their exact convex pieces.
+
+A moving part collides as convex pieces (:mod:`executor.world.meshes`). A decomposition
+that approximates (CoACD) fills part of a bore, and the room between a pin and its bore is
+what decides whether the part goes on. So a part with a bore is taken as what it is in
+most products, a **prism**: its section across its axis (z of its part frame), at half
+its height, swept over its height; it is one when the prism and the mesh differ by less
+than :data:`PRISM_TOLERANCE` of the mesh's volume (exact booleans, manifold3d). The
+section, a polygon with the bore as its hole (and the part's outline, a gear's teeth or
+a nut's handle, as its shell), is cut into convex polygons whose union is that section
+exactly: its constrained Delaunay triangles (shapely) merged pairwise across their
+shared edges while the union stays convex (Hertel and Mehlhorn: at most four times the
+fewest convex pieces). Each convex polygon swept over the height is a piece; every
+piece touching the bore must have an eroded form (:func:`executor.world.meshes.eroded`,
+thicker than the cell's hull margin twice), so the bore's faces are where the mesh has them
+and only edges are rounded by the margin; a thinner piece of the outline away from the
+bore (the 0.2 mm notch where two boxes of a nut meet) is left out, counted in the
+prism's difference from the mesh.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+import trimesh
+
+from executor.world.meshes import URDF_HULL_MARGIN, eroded
+
+PRISM_TOLERANCE = 0.01
+"""A part is the prism of its mid-height section when the two differ by less than this
+fraction of its volume."""
+_CONVEX = 1e-9
+"""A union is convex when its hull is larger by less than this fraction of its area."""
+
+
+def section_at(mesh: trimesh.Trimesh, z: float) -> shapely.MultiPolygon:
+    """The closed mesh's section at height ``z`` [m] of its frame: its polygons, holes
+    included (each loop's inside, even-odd: a loop within one other is a hole)."""
+    cut = mesh.section(plane_origin=(0.0, 0.0, z), plane_normal=(0.0, 0.0, 1.0))
+    found = shapely.MultiPolygon()
+    for loop in [] if cut is None else cut.discrete:
+        if len(loop) >= 4:
+            found = shapely.symmetric_difference(found, shapely.Polygon(np.asarray(loop)[:, :2]))
+    return found if isinstance(found, shapely.MultiPolygon) else shapely.MultiPolygon([found])
+
+
+def convex_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
+    """Convex polygons whose union is ``section`` exactly (module docstring)."""
+    pieces = [shapely.Polygon(t.exterior.coords)
+              for t in shapely.constrained_delaunay_triangles(section).geoms if t.area > 0]
+    merged = True
+    while merged:
+        merged = False
+        pieces.sort(key=lambda p: -p.area)
+        for i, a in enumerate(pieces):
+            for j in range(i + 1, len(pieces)):
+                b = pieces[j]
+                if a.intersection(b).length <= 0:
+                    continue  # no edge in common
+                union = shapely.union(a, b)
+                if isinstance(union, shapely.Polygon) and union.convex_hull.area - union.area <= _CONVEX * union.area:
+                    pieces[i] = shapely.simplify(union, 0.0)
+                    del pieces[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return pieces
+
+
+def ring_pieces(pid: str, mesh: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+    """The exact convex pieces of part ``pid`` with a bore, its closed ``mesh`` in its part
+    frame [m] (z its axis; module docstring), each with 0.0 (no vertex dropped) and a line
+    saying how they were made; or why the part has none: no prism of its section, or a
+    piece too thin for the cell."""
+    low, high = (float(v) for v in mesh.bounds[:, 2])
+    section = section_at(mesh, (low + high) / 2)
+    if len(section.geoms) != 1 or not section.geoms[0].interiors:
+        return f"part '{pid}' has no bore in one section at half its height"
+    shape = section.geoms[0]
+    prism = trimesh.creation.extrude_polygon(shape, high - low)
+    prism.apply_translation((0.0, 0.0, low))
+    common = trimesh.boolean.intersection([mesh, prism], engine="manifold")
+    differ = mesh.volume + prism.volume - 2 * (float(common.volume) if len(common.faces) else 0.0)
+    if differ >= PRISM_TOLERANCE * mesh.volume:
+        return (f"part '{pid}' is no prism of its section at half its height (they differ by {differ / mesh.volume:.1%}"
+                f" of its volume; the cell's exact pieces of a part with a bore are a prism's)")
+    pieces, dropped = [], 0.0
+    bores = shapely.MultiLineString([ring.coords for ring in shape.interiors])
+    for part in convex_parts(shape):
+        ring = np.asarray(part.exterior.coords)[:-1]
+        vertices = np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (low, high)])
+        piece = trimesh.convex.convex_hull(vertices)
+        if eroded(piece.vertices, URDF_HULL_MARGIN) is not None:
+            pieces.append((piece, 0.0))
+        elif part.distance(bores) > 0:  # a sliver of the outline (a corner of two boxes joined): left out
+            dropped += part.area * (high - low)
+        else:
+            return (f"part '{pid}': a convex piece of its section at its bore is thinner than "
+                    f"{2000 * URDF_HULL_MARGIN:g} mm (the cell's hull margin twice)")
+    if differ + dropped >= PRISM_TOLERANCE * mesh.volume:
+        return (f"part '{pid}': the convex pieces of its section thick enough for the cell differ from its mesh by "
+                f"{(differ + dropped) / mesh.volume:.1%} of its volume")
+    return pieces, (f"exact at the bore: {len(pieces)} convex prism(s) of its section at half its height over its "
+                    f"{1e3 * (high - low):.3f} mm, {(differ + dropped) / mesh.volume:.2%} of its volume apart from the "
+                    "mesh (slivers of the outline thinner than the cell's hull margin twice left out)")
