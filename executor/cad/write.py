@@ -278,6 +278,9 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
     if pin.axis != "+z":
         return f"goes onto its pin ({pin.id}) along {opposite(pin.axis)}, not from above"
+    lowest = min(pin.parts, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p))
+    if pid != lowest:
+        return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
     found = ring_pieces(pid, mesh)
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None

@@ -46,27 +46,37 @@ def section_at(mesh: trimesh.Trimesh, z: float) -> shapely.MultiPolygon:
 
 
 def convex_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
-    """Convex polygons whose union is ``section`` exactly (module docstring)."""
-    pieces = [shapely.Polygon(t.exterior.coords)
-              for t in shapely.constrained_delaunay_triangles(section).geoms if t.area > 0]
-    merged = True
-    while merged:
-        merged = False
-        pieces.sort(key=lambda p: -p.area)
-        for i, a in enumerate(pieces):
-            for j in range(i + 1, len(pieces)):
-                b = pieces[j]
-                if a.intersection(b).length <= 0:
-                    continue  # no edge in common
-                union = shapely.union(a, b)
-                if isinstance(union, shapely.Polygon) and union.convex_hull.area - union.area <= _CONVEX * union.area:
-                    pieces[i] = shapely.simplify(union, 0.0)
-                    del pieces[j]
-                    merged = True
-                    break
-            if merged:
-                break
-    return pieces
+    """Convex polygons whose union is ``section`` exactly (module docstring): each
+    diagonal of its constrained Delaunay triangulation, longest first, joins the pieces on
+    its two sides when their union is convex."""
+    triangles = [np.asarray(t.exterior.coords)[:3] for t in shapely.constrained_delaunay_triangles(section).geoms
+                 if t.area > 0]
+    sides: dict[tuple[tuple[float, float], ...], list[int]] = {}
+    for k, corners in enumerate(triangles):
+        for i in range(3):
+            edge = tuple(sorted((tuple(corners[i]), tuple(corners[(i + 1) % 3]))))
+            sides.setdefault(edge, []).append(k)
+    owner = list(range(len(triangles)))
+    pieces: dict[int, shapely.Polygon] = {k: shapely.Polygon(c) for k, c in enumerate(triangles)}
+
+    def root(k: int) -> int:
+        while owner[k] != k:
+            owner[k] = owner[owner[k]]
+            k = owner[k]
+        return k
+
+    diagonals = sorted((edge for edge, on in sides.items() if len(on) == 2),
+                       key=lambda e: -float(np.hypot(e[0][0] - e[1][0], e[0][1] - e[1][1])))
+    for edge in diagonals:
+        a, b = (root(k) for k in sides[edge])
+        if a == b:
+            continue
+        union = shapely.union(pieces[a], pieces[b])
+        if isinstance(union, shapely.Polygon) and union.convex_hull.area - union.area <= _CONVEX * union.area:
+            owner[b] = a
+            pieces[a] = shapely.simplify(union, 0.0)
+            del pieces[b]
+    return list(pieces.values())
 
 
 def ring_pieces(pid: str, mesh: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
