@@ -21,6 +21,8 @@ prism's difference from the mesh.
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 import shapely
 import trimesh
@@ -79,11 +81,26 @@ def convex_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
     return list(pieces.values())
 
 
-def ring_pieces(pid: str, mesh: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+Found = tuple[list[tuple[trimesh.Trimesh, float]], str] | str
+"""A part's pieces, each with 0.0 (no vertex dropped), and how they were made; or why it has none."""
+_FOUND: dict[bytes, Found] = {}
+""":func:`ring_pieces` of each part and mesh asked for (an import asks for each more than once)."""
+
+
+def ring_pieces(pid: str, mesh: trimesh.Trimesh) -> Found:
     """The exact convex pieces of part ``pid`` with a bore, its closed ``mesh`` in its part
     frame [m] (z its axis; module docstring), each with 0.0 (no vertex dropped) and a line
     saying how they were made; or why the part has none: no prism of its section, or a
     piece too thin for the cell."""
+    key = hashlib.sha256(pid.encode() + np.ascontiguousarray(mesh.vertices).tobytes()
+                         + np.ascontiguousarray(mesh.faces).tobytes()).digest()
+    if key not in _FOUND:
+        _FOUND[key] = _pieces(pid, mesh)
+    return _FOUND[key]
+
+
+def _pieces(pid: str, mesh: trimesh.Trimesh) -> Found:
+    """:func:`ring_pieces`, made."""
     low, high = (float(v) for v in mesh.bounds[:, 2])
     section = section_at(mesh, (low + high) / 2)
     if len(section.geoms) != 1 or not section.geoms[0].interiors:
