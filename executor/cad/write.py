@@ -33,6 +33,7 @@
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -246,8 +247,9 @@ def precedence_text(derived: Derived) -> str:
 
 def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above with a
-    round, square or rect section holding, if anything, a peg entered from above, and the
-    pins of the base that parts go down onto with their exact pieces (:func:`_onto_pin`);
+    round, square or rect section holding, if anything, a peg entered from above, the pins
+    of the base that parts go down onto, and of the parts with a bore those it puts onto
+    them (:func:`_onto_pin`);
     the pegs of the other holes and the other parts going onto pins, each with why the cell
     places it by hand (a polygon pair's room is often below what convex pieces of its
     meshes keep: the cell inserts polygon sections of products described by hand,
@@ -263,12 +265,9 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
                 by_hand[fit.part] = f"hole {hid} is not entered from above with a round, square or rect section"
         else:
             kept[hid] = fit
-    pins = {pin_id: replace(pin, parts=tuple(p for p in pin.parts if p not in by_hand))
-            for pin_id, pin in derived.pins.items()}
-    pins = {pin_id: pin for pin_id, pin in pins.items() if pin.parts}
-    onto = {pid for pin in pins.values() for pid in pin.parts}
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items() if pin.owner == derived.base and pin.axis == "+z"}
     return replace(derived, holes=kept, pins=pins,
-                   bores={pid: bore for pid, bore in derived.bores.items() if pid in onto}), by_hand
+                   bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
 
 
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
@@ -282,8 +281,22 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     if pid != lowest:
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
-    found = ring_pieces(pid, mesh)
+    found = ring_pieces(pid, mesh, bore_loss(derived, pid))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+BORE_LOSS = 0.25
+"""The cell's bore of a part may be smaller than its mesh's by this fraction of the least
+positive (diametral) room the part has on a pin [m/m] (half its room all round), so the
+cell's physics keeps every fit and no-fit of the nominal sections
+(:func:`executor.world.rings.coarser_bores`)."""
+
+
+def bore_loss(derived: Derived, pid: str) -> float:
+    """How much smaller [m] the cell's bore of part ``pid`` may be (:data:`BORE_LOSS`; 0 when
+    it goes onto no pin with room: a smaller bore keeps a no-fit)."""
+    rooms = [room for hole, room in margins(derived).get(pid, {}).items() if hole in derived.pins and room > 0]
+    return BORE_LOSS * min(rooms) if rooms else 0.0
 
 
 def pin_level(derived: Derived, pin: PinFit) -> tuple[float, float]:
@@ -375,7 +388,8 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                 if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
-                          exact=ring_pieces if pid in derived.bores else None)
+                          exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid))
+                          if pid in derived.bores else None)
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done
