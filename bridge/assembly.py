@@ -95,12 +95,18 @@ class Assembly:
     cell_holes: frozenset[str] | None = None
     """The holes the simulated cell models (``[hole_shapes.*]`` of ``geometry.toml``), None
     without a ``geometry.toml``."""
+    pins: frozenset[str] = frozenset()
+    """Of those, the pins parts with a bore go onto (``pin = true``)."""
+    bores: frozenset[str] = frozenset()
+    """The parts with a bore the cell puts onto pins (``bore = true`` of ``[part_shapes.*]``)."""
 
     def tried_by_hand(self, part: str, hole: str) -> bool:
-        """Whether no cell can try ``part`` in ``hole``: the part is placed by hand, or the
+        """Whether no cell can try ``part`` in ``hole``: the part is placed by hand, the
         hole is one the cell does not model (a pin an imported part goes onto, a hole of a
-        section the cell inserts no part in)."""
-        return part in self.manual or (self.cell_holes is not None and hole not in self.cell_holes)
+        section the cell inserts no part in), or a peg and a pin, a part with a bore and a
+        hole (the cell puts parts with a bore onto pins only, pegs into holes only)."""
+        return (part in self.manual or (self.cell_holes is not None and hole not in self.cell_holes)
+                or (self.cell_holes is not None and (part in self.bores) != (hole in self.pins)))
 
     def step_text(self, part: str, hole: str | None) -> str:
         """A plan step as the commands print it: ``p->h``, ``p``, a part placed by hand ``p (manual)``."""
@@ -161,9 +167,13 @@ def assembly_of(product: ProductDescription) -> Assembly:
     manual = {} if geometry is None else {mid: m.reason for mid, m in geometry.manual.items()}
     cell_holes = (None if geometry is None
                   else frozenset(h for shape in geometry.hole_shapes.values() for h in shape.holes))
+    pins = frozenset() if geometry is None else frozenset(
+        h for shape in geometry.hole_shapes.values() if shape.pin for h in shape.holes)
+    bores = frozenset() if geometry is None else frozenset(
+        p for shape in geometry.part_shapes.values() if shape.bore for p in shape.parts)
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
                     size_model=None if layout.sizes is None else layout.sizes.model, manual=manual,
-                    cell_holes=cell_holes)
+                    cell_holes=cell_holes, pins=pins, bores=bores)
 
 
 def load_assembly(name_or_path: str) -> Assembly:

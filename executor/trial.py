@@ -132,11 +132,16 @@ class Cell:
             self.ilc.load(self.ilc_state)
 
     def check_pair(self, part: str, hole: str) -> Skill:
-        """The taught skill of ``part``'s shape; UnknownPair naming an unknown part or hole."""
+        """The taught skill of ``part``'s shape; UnknownPair naming an unknown part or hole,
+        or a peg and a pin, a part with a bore and a hole (:func:`executor.world.geometry.feature_passes`)."""
         if part not in self.geometry.parts:
             raise UnknownPair(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
             raise UnknownPair(f"unknown hole '{hole}' (expected one of {', '.join(sorted(self.geometry.holes))})")
+        spec, feature = self.geometry.parts[part], self.geometry.holes[hole]
+        if spec.bore != feature.pin:
+            raise UnknownPair(f"part '{part}' {'goes onto pins' if spec.bore else 'goes into holes'}, '{hole}' is "
+                              f"{'a pin' if feature.pin else 'a hole'}: the cell does not try that pair")
         shape = self.geometry.parts[part].shape
         if shape not in self._skills:
             self._skills[shape] = load_product_skill(self.geometry, shape)
@@ -241,7 +246,7 @@ class Cell:
             self.logger.log_search_path(found.path)
         detector = Detector(self.thresholds)
         origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
-        lever = spec.length - self.geometry.gripper.grasp_depth
+        lever = spec.length - spec.held_depth(self.geometry.gripper)
         task = InsertionTask(origin, lever, yaw, needs_yaw_compliance(spec.kind, hole_spec.kind), correction,
                              wiggle_enabled)
         result = insert_in_layer(motion, skill, detector, task, layer, description=self.description)

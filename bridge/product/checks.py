@@ -128,6 +128,27 @@ def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
                               "its own mesh (the plate's bosses are round, square, sharp rect or polygon), got none")
 
 
+def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None:
+    """Pins are in the ``[base]``'s own mesh and state their ``top_z`` and ``depth``; a part
+    with a ``bore`` is taught on a pin, a peg in a hole."""
+    for name, shape in geo.hole_shapes.items():
+        if not shape.pin:
+            continue
+        if geo.base is None or geo.base.mesh is None:
+            raise BridgeError(f"{path}: [hole_shapes.{name}] pin: a pin needs a [base] with its own mesh (the pin is "
+                              "part of it), got none")
+        for key in ("top_z", "depth"):
+            if getattr(shape, key) is None:
+                raise BridgeError(f"{path}: [hole_shapes.{name}] {key}: expected the pin's "
+                                  + ("top [m]" if key == "top_z" else "height above where a part rests on it [m]")
+                                  + ", got nothing (a pin states both)")
+    for name, part_shape in geo.part_shapes.items():
+        demo = geo.hole_shapes.get(holes.get(part_shape.demo_hole, ""))
+        if demo is not None and demo.pin != part_shape.bore:
+            raise fail(path, f"part_shapes.{name}", "demo_hole", "a pin for parts with a bore, a hole for pegs"
+                       f" ({part_shape.demo_hole} is {'a pin' if demo.pin else 'a hole'})", part_shape.demo_hole)
+
+
 def hole_level(plate: Plate, shape: HoleShape) -> tuple[float, float]:
     """(entry height, depth) [m] of the holes of ``shape``: its own ``top_z`` and
     ``depth``, else the plate's ``top_z`` and ``tile_thickness``."""
@@ -155,9 +176,10 @@ def _check_levels(path: Path, plate: Plate, shapes: Mapping[str, HoleShape]) -> 
 
 
 def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
-    """Every peg is longer than the part of it inside ``gripper``'s fingers."""
+    """Every peg is longer than the part of it inside ``gripper``'s fingers (a part with a
+    bore is held at most half its length deep, as a head)."""
     for name, table in geometry.part_shapes.items():
-        if gripper.grasp_depth >= table.length:
+        if not table.bore and gripper.grasp_depth >= table.length:
             raise fail(path, f"part_shapes.{name}", "length",
                        f"longer than [gripper] grasp_depth ({gripper.grasp_depth:g} m)", table.length)
 
@@ -173,8 +195,9 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     _check_sections(path, "part_shapes", geo.part_shapes)
     _check_polygons_simulated(path, geo)
     _check_levels(path, plate, geo.hole_shapes)
+    _check_pins(path, geo, holes)
     for name, hole_shape in geo.hole_shapes.items():
-        if max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
+        if not hole_shape.pin and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
                        "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():
@@ -200,7 +223,9 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
                        f"[extra_parts] ({pid} is neither)", pid)
     positions = {hid: layout.holes[hid].position for hid in holes}
     turned = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.yaw for hid in hole_shape.holes}
-    _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items() if p is not None}, turned)
+    pins = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.pin for hid in hole_shape.holes}
+    _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items()
+                                          if p is not None and h not in pins}, turned)
     _check_kinds(path, geo, layout)
     _check_product(path, geo, layout, holes)
     meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]

@@ -152,7 +152,10 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     for a polygon the extents ``[a, b]`` of its ``outline`` along x and y (about the
     hole's position, in the hole's frame); a square's or rect's ``corner`` radius [m];
     ``top_z`` the height of their entry and ``depth`` from the entry to their bottom [m],
-    where they differ from the plate's ``top_z`` and ``tile_thickness``."""
+    where they differ from the plate's ``top_z`` and ``tile_thickness``. With ``pin`` they
+    are pins of the base (in its own mesh) that parts with a bore go onto: the section is
+    the pin's, ``top_z`` its top and ``depth`` from its top down to where a part going
+    onto it rests (both required)."""
 
     holes: Ids
     kind: Kind
@@ -162,6 +165,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     yaw: Yaw = 0.0
     top_z: EntryHeight | None = None
     depth: HoleDepth | None = None
+    pin: bool = False
 
 
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
@@ -170,7 +174,9 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     when they are simulated from their own mesh rather than as a cylinder or box; a
     polygon's ``outline`` about the centre of its section in the part frame, ``size`` its
     extents ``[a, b]`` along x and y (a polygon peg is simulated from its mesh); a
-    square's or rect's ``corner`` radius [m]."""
+    square's or rect's ``corner`` radius [m]. With ``bore`` they are parts with a bore
+    that go onto pins (``[hole_shapes.*]`` with ``pin``): the section is the bore's, the
+    part frame's origin the centre of the bore at the part's bottom, ``demo_hole`` a pin."""
 
     parts: Ids
     kind: Kind
@@ -181,6 +187,7 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     mass: Mass
     demo_hole: Id
     mesh: Mesh | None = None
+    bore: bool = False
 
 
 MESH_FILE_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*(/[A-Za-z0-9_-][A-Za-z0-9_.-]*)*\.obj$(?!\n)"

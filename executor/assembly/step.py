@@ -6,6 +6,8 @@ Per kind of part (the ``skill`` of the step's record):
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
+  a part with a bore onto a pin of the base likewise, centred on the pin by contact once
+  past its top (:mod:`executor.skills.centring`);
 - ``insert_over``: a part with openings down over the pins standing in its holes, by the
   same insertion skill, from above the pins to its resting height, aimed at the holes'
   centres without a search (a pin stands within half its hole's clearance of the centre,
@@ -50,6 +52,7 @@ from executor.control.detector import Detector
 from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
 from executor.evidence import AttemptSetup
+from executor.skills.centring import centre_on_pin
 from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
@@ -60,6 +63,7 @@ from executor.world.perturbation import CellBias
 from executor.world.scene import PART_FRICTION
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
+CENTRING_MARGIN = 0.005  # [m] a bore's probes reach this beyond its half diagonal
 RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
 ASSEMBLY_UNCERTAINTY = Magnitudes(
@@ -299,6 +303,11 @@ class Assembler:
             found = hole_search(motion, approach[:2], surface, approach[2], quat,
                                 np.random.default_rng(setup.search_seed))
             xy = found.hole_xy
+            feature = None if hole is None else p.geometry.holes[hole]
+            if skill == "insert" and feature is not None and feature.pin and found.found:
+                # over the pin: centred on it by contact (a wide bore never meets it on the way down)
+                reach = float(np.hypot(*p.pegs[part].sides)) / 2 + CENTRING_MARGIN
+                xy = centre_on_pin(motion, motion.controller.arm.read().tip_pos, quat, reach, feature.depth)[:2]
             if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
                 peg = p.pegs[part]
                 skill_obj = self._skill(peg.shape).in_hole(p.geometry.holes[hole].depth)

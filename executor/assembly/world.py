@@ -25,7 +25,7 @@ from executor.control.motion import Motion, StepLogger
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies
-from executor.world.scene import TIME_STEP, load_plate
+from executor.world.scene import TIME_STEP, load_plate, wrist_clear_of
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -120,14 +120,15 @@ class AssemblyWorld:
         self._tray[p.base.id] = np.array([p.base.tray[0] - cx, p.base.tray[1] - cy, 0.0])
 
     def _build_pegs(self) -> None:
-        grasp_depth = self.product.geometry.gripper.grasp_depth
+        gripper = self.product.geometry.gripper
         for pid, spec in sorted(self.product.pegs.items()):
             # A mesh or polygon peg's inertia is its solid's (in the URDF); PyBullet's own would be its pieces' box.
             solid = spec.mesh is not None or spec.kind == "polygon"
             flags = pb.URDF_USE_IMPLICIT_CYLINDER | (pb.URDF_USE_INERTIA_FROM_FILE if solid else 0)
             body = pb.loadURDF(str(self.product.geometry.assets / f"part_{spec.shape}.urdf"),
                                basePosition=(*spec.start, 0.0), flags=flags, physicsClientId=self.client)
-            self.frames[pid] = PartFrames(body, np.array([0.0, 0.0, spec.length - grasp_depth]), np.zeros(3))
+            self.frames[pid] = PartFrames(body, np.array([0.0, 0.0, spec.length - spec.held_depth(gripper)]),
+                                          np.zeros(3))
             self._tray[pid] = np.array([*spec.start, 0.0])
 
     def _mesh_body(self, pid: str) -> int:
@@ -188,6 +189,8 @@ class AssemblyWorld:
         self.arm = Arm(self.client, self.robot)
         self.tool_link = self.arm.sensor
         pb.setCollisionFilterGroupMask(self.robot, self.tool_link, 0, 0, physicsClientId=self.client)
+        if any(hole.pin for hole in self.product.geometry.holes.values()):
+            wrist_clear_of(self.client, self.robot, self.frames[self.product.base.id].body)
 
     def reset_tray(self) -> None:
         """Every part to its tray pose (at rest); the head-in-socket state is not kept."""

@@ -4,7 +4,7 @@ trips.
 
 The assembling world (:class:`executor.assembly.world.AssemblyWorld`) is built, every part
 is put at its goal pose (each peg turned to its hole's yaw, in the first hole by id it passes
-(:func:`executor.world.geometry.passes`) among those still free, smallest hole first), and
+(:func:`executor.world.geometry.feature_passes`) among those still free, smallest hole first), and
 each part's shapes are read back from PyBullet (boxes, grown by :data:`JOIN` in a part
 of several shapes; cylinders as 256-gons whose corners lie on the circle; meshes) and
 joined by an exact boolean union (manifold3d, in double precision) into one solid; the base is its plate's
@@ -27,7 +27,7 @@ from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.world import AssemblyWorld
 from executor.cell_description import load_cell_description
-from executor.world.geometry import passes
+from executor.world.geometry import feature_passes
 from executor.world.scene import link_frame
 
 CYLINDER_SECTIONS = 256
@@ -45,7 +45,7 @@ def _peg_holes(world: AssemblyWorld) -> dict[str, str]:
     free = sorted(geometry.holes, key=lambda h: (max(geometry.holes[h].sides), h))
     chosen: dict[str, str] = {}
     for pid in sorted(world.product.pegs):
-        hole = next((h for h in free if passes(world.product.pegs[pid], geometry.holes[h])), None)
+        hole = next((h for h in free if feature_passes(world.product.pegs[pid], geometry.holes[h])), None)
         if hole is not None:
             chosen[pid] = hole
             free.remove(hole)

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print a symbol, std::bad_cast)
@@ -126,11 +126,12 @@ def head_is_primitive(section: Shape2D, mesh: trimesh.Trimesh) -> bool:
                                    * float(mesh.extents[2]))
 
 
-def peg_frame(fit: HoleFit, mesh: trimesh.Trimesh) -> np.ndarray:
-    """The 4 × 4 transform from the cell frame to the peg's part frame (module docstring)."""
-    assert fit.section is not None  # a peg has a section
-    x, y = fit.section.centre
-    yaw = math.radians(fit.section.yaw) if fit.section.kind != "round" else 0.0
+def peg_frame(section: Shape2D, mesh: trimesh.Trimesh) -> np.ndarray:
+    """The 4 × 4 transform from the cell frame to the part frame of a peg of ``section``
+    (module docstring), or of a part with a bore of that ``section`` (its origin the centre
+    of the bore at the part's bottom)."""
+    x, y = section.centre
+    yaw = math.radians(section.yaw) if section.kind != "round" else 0.0
     turn = trimesh.transformations.rotation_matrix(-yaw, (0, 0, 1))
     shift = trimesh.transformations.translation_matrix((-x, -y, -float(mesh.bounds[0][2])))
     return turn @ shift
@@ -198,6 +199,11 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             f"{1e3 * rooms[name]:.3f} mm its mesh leaves it ({tried}; expected at least {ROOM_KEPT:.0%})")
 
 
+Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, float]], str] | str]
+"""A part's own convex pieces (its id and its closed mesh in its frame -> the pieces, each
+with how far dropped vertices reach, and how they were made; or why it has none)."""
+
+
 def _beyond(hull: trimesh.Trimesh, points: np.ndarray) -> np.ndarray:
     """How far [m] each point lies beyond the face planes of a convex ``hull`` (<= 0 inside)."""
     offsets = np.einsum("ij,ij->i", hull.face_normals, hull.triangles[:, 0])
@@ -227,13 +233,14 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
 
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
-               neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame"
-               ) -> tuple[Mesh, list[Path]] | str:
+               neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame",
+               exact: Pieces | None = None) -> tuple[Mesh, list[Path]] | str:
     """Write ``mesh`` (already in ``frame`` [m]; ``made``: how, for its header) as
     ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
     (``neighbours``: the parts near it, in its frame; None for a static one: the base, a
-    part placed by hand), its convex pieces (:func:`fitting_pieces`); returns the ``mesh``
-    entry of ``geometry.toml`` and the paths written, or why no pieces fit."""
+    part placed by hand), its convex pieces (:func:`fitting_pieces`, or ``exact``'s:
+    :func:`executor.world.rings.ring_pieces`); returns the ``mesh`` entry of
+    ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
     text = obj_text([(pid, mesh.vertices, mesh.faces)],
@@ -243,9 +250,9 @@ def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
     if neighbours is None:
         return Mesh(file=name, sha256=digest), written
     # The pieces of the mesh as written (0.1 µm), so that they are pieces of that file.
-    exact = trimesh.load(folder / name, force="mesh")
-    assert isinstance(exact, trimesh.Trimesh)  # the closed mesh just written
-    found = fitting_pieces(pid, exact, neighbours)
+    written_mesh = trimesh.load(folder / name, force="mesh")
+    assert isinstance(written_mesh, trimesh.Trimesh)  # the closed mesh just written
+    found = fitting_pieces(pid, written_mesh, neighbours) if exact is None else exact(pid, written_mesh)
     if isinstance(found, str):
         return found
     kept, made = found

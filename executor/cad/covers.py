@@ -216,12 +216,12 @@ def _nearest_peg(derived: Derived, section: Shape2D) -> str:
 def map_parts(derived: Derived, top: float, by_hand: Mapping[str, str]) -> Mapped:
     """The covers and heads of ``derived`` (module docstring), ``top`` [m] the holes'
     entry (the plate top); the parts ``by_hand`` (id -> why) and each other part that is
-    neither are ones the cell places by hand."""
+    neither, and goes onto no pin of ``derived.pins``, are ones the cell places by hand."""
     covers: dict[str, CoverFit] = {}
     heads: dict[str, HeadFit] = {}
     manual = dict(by_hand)
     others = [pid for pid in derived.parts if pid != derived.base and pid not in derived.hole_of
-              and pid not in by_hand]
+              and pid not in by_hand and pid not in derived.bores]
     for pid in sorted(others, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p)):
         if derived.axis[pid] != "+z":
             manual[pid] = f"part '{pid}' goes in along {opposite(derived.axis[pid])}, not from above"

@@ -34,8 +34,10 @@
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
+import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
@@ -60,11 +62,12 @@ from executor.cad.convex import (
     write_mesh,
 )
 from executor.cad.covers import Mapped, map_parts
-from executor.cad.derive import Derived, HoleFit
+from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D
 from executor.cad.sweep import opposite
 from executor.world.geometry import Section, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
+from executor.world.rings import ring_pieces
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -246,12 +249,14 @@ def precedence_text(derived: Derived) -> str:
 def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above holding, if
     anything, a peg entered from above that is no polygon section, or the prism of its
-    polygon (the cell builds that from its outline, exactly); and the pegs of the other
-    holes and the parts going onto pins, each with why the cell places it by hand (a
-    polygon peg's room is often below what convex pieces of its mesh keep)."""
+    polygon (the cell builds that from its outline, exactly); the pins of the base that
+    parts go down onto, and of the parts with a bore those it puts onto them
+    (:func:`_onto_pin`); the pegs of the other holes and the other parts going onto pins,
+    each with why the cell places it by hand (a polygon peg's room is often below what
+    convex pieces of its mesh keep)."""
     kept: dict[str, HoleFit] = {}
-    by_hand = {pid: f"goes onto a pin ({pin.id}): the cell has no operation for it" for pin in derived.pins.values()
-               for pid in pin.parts}
+    by_hand = {pid: why for pin in derived.pins.values() for pid in pin.parts
+               if (why := _onto_pin(derived, pin, pid)) is not None}
     for hid, fit in derived.holes.items():
         if fit.part is not None and derived.axis[fit.part] != "+z":
             by_hand[fit.part] = f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, not from above"
@@ -262,7 +267,48 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
             by_hand[fit.part] = _polygon_refused(fit, derived)
         else:
             kept[hid] = fit
-    return replace(derived, holes=kept), by_hand
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items() if pin.owner == derived.base and pin.axis == "+z"}
+    return replace(derived, holes=kept, pins=pins,
+                   bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
+
+
+def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
+    """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
+    the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`)."""
+    if pin.owner != derived.base:
+        return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
+    if pin.axis != "+z":
+        return f"goes onto its pin ({pin.id}) along {opposite(pin.axis)}, not from above"
+    lowest = min(pin.parts, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p))
+    if pid != lowest:
+        return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
+    mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
+    found = ring_pieces(pid, mesh, bore_loss(derived, pid))
+    return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+BORE_LOSS = 0.25
+"""The cell's bore of a part may be smaller than its mesh's by this fraction of the least
+positive (diametral) room the part has on a pin [m/m] (half its room all round), so the
+cell's physics keeps every fit and no-fit of the nominal sections
+(:func:`executor.world.rings.coarser_bores`)."""
+
+
+def bore_loss(derived: Derived, pid: str) -> float:
+    """How much smaller [m] the cell's bore of part ``pid`` may be (:data:`BORE_LOSS`; 0 when
+    it goes onto no pin with room: a smaller bore keeps a no-fit)."""
+    rooms = [room for hole, room in margins(derived).get(pid, {}).items() if hole in derived.pins and room > 0]
+    return BORE_LOSS * min(rooms) if rooms else 0.0
+
+
+def pin_level(derived: Derived, pin: PinFit) -> tuple[float, float]:
+    """A pin's top (the base's highest point within its section around its axis) and its
+    height [m] above the lowest bottom of the parts going onto it (where the first rests)."""
+    vertices = derived.parts[pin.owner].mesh.vertices
+    reach = math.hypot(pin.section.a, pin.section.b) / 2
+    near = np.linalg.norm(vertices[:, :2] - np.array(pin.position), axis=1) <= reach + 1e-9
+    top = float(vertices[near, 2].max())
+    return top, top - min(float(derived.parts[pid].mesh.bounds[0][2]) for pid in pin.parts)
 
 
 def _polygon_refused(fit: HoleFit, derived: Derived) -> str:
@@ -296,7 +342,9 @@ def manual_origin(mesh: trimesh.Trimesh) -> tuple[float, float, float]:
 def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
     """Each part's transform (4 × 4) from the cell frame to its part frame (the base's: its
     bounding box's centre at its plate's ``base_center``)."""
-    frames = {pid: peg_frame(fit, derived.parts[pid].mesh) for pid, fit in derived.hole_of.items()}
+    frames = {pid: peg_frame(fit.section, derived.parts[pid].mesh) for pid, fit in derived.hole_of.items()
+              if fit.section is not None}
+    frames |= {pid: peg_frame(bore, derived.parts[pid].mesh) for pid, bore in derived.bores.items()}
     (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
     origins = {pid: fit.origin for pid, fit in mapped.covers.items()} | {pid: fit.origin for pid, fit in
                                                                          mapped.heads.items()}
@@ -334,7 +382,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
     ``mesh`` entries by part, or why a part has no pieces that fit
     (:func:`executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
-    if not derived.holes or not base_is_primitive(derived):  # no plate of primitives without holes
+    if not derived.holes or derived.pins or not base_is_primitive(derived):  # the plate has no pins
         done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")
         assert not isinstance(done, str)  # the base has no pieces
         meshes[derived.base], files = done
@@ -348,12 +396,15 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
     moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
     moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
     moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
+    moving += list(derived.bores)
     for pid in sorted(moving):
         mesh = derived.parts[pid].mesh
         near = {other: part.mesh.copy().apply_transform(frames[pid]) for other, part in derived.parts.items()
                 if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
-        done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near)
+        done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
+                          exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid))
+                          if pid in derived.bores else None)
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done
@@ -392,6 +443,17 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', *_section_lines(peg),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
+    for pin_id, pin in derived.pins.items():
+        top, height = pin_level(derived, pin)
+        lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section)]
+        if pin.section.yaw and pin.section.kind != "round":
+            lines.append(f"yaw = {pin.section.yaw:.6g}")
+        lines += [f"top_z = {_q(top)}", f"depth = {_q(height)}", ""]
+    for pid, bore in sorted(derived.bores.items()):
+        mesh, pin = derived.parts[pid].mesh, next(p for p in derived.pins.values() if pid in p.parts)
+        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true", *_section_lines(bore),
+                  f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
+                  f'demo_hole = "{pin.id}"', _mesh_entry(meshes[pid]), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
               "[base]", f'part = "{derived.base}"', f"tray = {_numbers(settings.trays[derived.base])}",
               "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}",

@@ -38,7 +38,7 @@ from executor.campaign.run import stdout_to_stderr
 from executor.trial import Cell
 from executor.world import TIME_STEP
 from executor.world.arm import Arm
-from executor.world.geometry import load_geometry, passes
+from executor.world.geometry import feature_passes, load_geometry
 from executor.world.scene import Scene
 
 TOOL_DOWN = np.array([1.0, 0.0, 0.0, 0.0])
@@ -124,7 +124,7 @@ def main(argv: list[str]) -> int:
     if args.part not in geometry.parts or args.hole not in geometry.holes:
         raise ExecutorError(f"--part {args.part} --hole {args.hole}: expected a part of "
                             f"{' '.join(sorted(geometry.parts))} and a hole of {' '.join(sorted(geometry.holes))}")
-    if not passes(geometry.parts[args.part], geometry.holes[args.hole]):
+    if not feature_passes(geometry.parts[args.part], geometry.holes[args.hole]):
         raise ExecutorError(f"--part {args.part} --hole {args.hole}: the part does not fit that hole; "
                             "expected a fitting pair (the contact figure presses the part into the hole)")
     with stdout_to_stderr():

@@ -18,7 +18,7 @@ from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepR
 from bridge.recording.sinks import NO_VIEWER, Viewer
 from executor import ExecutorError
 from executor.backend_plugin import StepOutcome, UnknownPair, check_run, check_step
-from executor.world.geometry import load_geometry, passes
+from executor.world.geometry import feature_passes, load_geometry
 
 
 def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
@@ -39,7 +39,7 @@ def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
 class TruthBackend:
     """Answers without simulation, after ``settings.delay_s`` [s]: from the cell's geometry
     (a part passes a hole when its cross-section does,
-    :func:`executor.world.geometry.passes`), or from the product's
+    :func:`executor.world.geometry.feature_passes`), or from the product's
     ``sizes.lp`` where it has no ``geometry.toml`` (the parts ``geometry.toml`` places by
     hand answer from ``sizes.lp`` on its holes the geometry has not: the pins an imported
     part goes onto); logs every outcome to Rerun if
@@ -56,7 +56,7 @@ class TruthBackend:
                 self._pegs, self._holes = set(geometry.parts), set(geometry.holes)
                 self._manual: set[str] = set(geometry.tables.manual)
                 self._fits = {(p, h) for p, part in geometry.parts.items() for h, hole in geometry.holes.items()
-                              if passes(part, hole)}
+                              if feature_passes(part, hole)}
                 if assembly_of.has_file("sizes.lp"):  # parts placed by hand onto features the cell does not model
                     pegs, holes, fits = sizes_truth(assembly_of.file("sizes.lp"))
                     pegs &= self._manual

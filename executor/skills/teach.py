@@ -1,6 +1,7 @@
 """Scripted kinesthetic teaching (paper 3.1), one skill per part shape.
 
-Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path (0.8 s)
+Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path (0.8 s,
+longer for a travel over 40 mm: :data:`DEMO_SPEED`)
 from 2 mm inside the entrance of the shape's ``demo_hole`` (where the hole search leaves
 the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom; the
 tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
@@ -45,7 +46,11 @@ from executor.world.assets import regenerate_assets
 from executor.world.geometry import CellGeometry, fit_pose
 from executor.world.scene import TIME_STEP, Scene
 
-DEMO_DURATION = 0.8  # [s]
+DEMO_DURATION = 0.8  # [s], or longer for a travel longer than DEMO_SPEED allows in it
+DEMO_SPEED = 0.05
+"""The demonstration's largest mean speed [m/s]: a deep insertion (a part going down a
+150 mm pin) takes travel / DEMO_SPEED, so the compliant arm follows it (at 0.19 m/s it
+ended 6.8 mm short); a hole up to 40 mm deep keeps DEMO_DURATION."""
 DEMO_START_HEIGHT = -0.002  # [m] relative to the plate top: the search leaves the tip ~2 mm in the hole
 DEMO_CLEARANCE = 0.0005  # [m] left between the part and the hole bottom at the end
 
@@ -74,7 +79,8 @@ def _demonstrate(motion: Motion, origin: np.ndarray, bottom: float,
     returns recorded times [s], positions [m] and quaternions (xyzw) in the hole frame
     (turned by ``yaw``)."""
     quat = tool_quat(yaw)
-    n = int(round(DEMO_DURATION / TIME_STEP))
+    travel = bottom - DEMO_CLEARANCE + DEMO_START_HEIGHT
+    n = int(round(max(DEMO_DURATION, travel / DEMO_SPEED) / TIME_STEP))
     z = DEMO_START_HEIGHT + (-(bottom - DEMO_CLEARANCE) - DEMO_START_HEIGHT) * _min_jerk(np.linspace(0, 1, n))
     times, positions, quats = [], [], []
     for k in range(n):

@@ -68,17 +68,19 @@ def sources_digest(geometry: CellGeometry) -> str:
 
 
 def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
-    """A hole's fields, its entry height and depth only where they are not the plate's (so
-    a product whose holes are all at the plate's level keeps its digest)."""
+    """A hole's fields, its entry height and depth only where they are not the plate's and
+    ``pin`` only for a pin (so a product whose holes are all at the plate's level keeps
+    its digest)."""
     fields = dataclasses.asdict(hole)
-    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness)):
+    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False)):
         if fields[key] == default:
             del fields[key]
     return fields
 
 
 def _part_fields(part: PartSpec) -> dict[str, object]:
-    fields = {key: value for key, value in dataclasses.asdict(part).items() if key != "mesh"}
+    fields = {key: value for key, value in dataclasses.asdict(part).items()
+              if key != "mesh" and (key != "bore" or value)}  # a peg's digest as before parts had bores
     return fields if part.mesh is None else fields | {"mesh": msgspec.structs.asdict(part.mesh)}
 
 

@@ -108,12 +108,15 @@ class Section:
 @dataclass(frozen=True)
 class HoleSpec(Section):
     """A hole of the plate at ``position`` [m], its x axis turned by ``yaw`` [rad] about z,
-    its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry."""
+    its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry; a
+    ``pin`` of the base a part with a bore goes onto (its section the pin's, ``top_z`` its
+    top, the bottom where a part going onto it rests)."""
 
     position: tuple[float, float]
     yaw: float = 0.0
     top_z: float = field(kw_only=True)
     depth: float = field(kw_only=True)
+    pin: bool = field(default=False, kw_only=True)
 
     @property
     def bottom_z(self) -> float:
@@ -126,7 +129,8 @@ class PartSpec(Section):
     """A graspable part of shape ``shape`` (its skill's name): ``length`` [m], ``mass`` [kg],
     ``start`` on the tray [m], ``demo_hole`` where its shape's skill is taught (a rect
     part's long side is along the tool's x axis when held), ``mesh`` when it is simulated
-    from its own mesh (paths inside the assembly folder)."""
+    from its own mesh (paths inside the assembly folder); a part with a ``bore`` goes
+    onto pins (its section the bore's, its tip the centre of the bore at its bottom)."""
 
     shape: str
     length: float
@@ -134,6 +138,12 @@ class PartSpec(Section):
     start: tuple[float, float]
     demo_hole: str
     mesh: Mesh | None = field(default=None, kw_only=True)
+    bore: bool = field(default=False, kw_only=True)
+
+    def held_depth(self, gripper: Gripper) -> float:
+        """How deep [m] the part is in the gripper's fingers: ``grasp_depth``, a part with a
+        bore at most half its length (a ring is held by its top)."""
+        return min(gripper.grasp_depth, self.length / 2) if self.bore else gripper.grasp_depth
 
 
 @dataclass(frozen=True)
@@ -217,7 +227,8 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
         top, depth = hole_level(geo.plate, hole_shape)
         for hid in hole_shape.holes:
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
-                                  top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner)
+                                  top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner,
+                                  pin=hole_shape.pin)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -228,7 +239,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             parts[pid] = PartSpec(
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
-                outline=_outline(part_shape), corner=part_shape.corner,
+                outline=_outline(part_shape), corner=part_shape.corner, bore=part_shape.bore,
             )
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
@@ -285,6 +296,16 @@ def passes(part: Section, hole: Section) -> bool:
     return margin(part, hole) > 0
 
 
+def feature_passes(part: PartSpec, hole: HoleSpec) -> bool:
+    """Whether the cell's ``part`` goes into or onto the feature ``hole``: a peg into a
+    hole when its section :func:`passes` the hole's, a part with a bore onto a pin when the
+    pin's section passes the bore's; a peg onto a pin or a part with a bore into a hole
+    never (the cell does not try them, and an import's closed world has no such fit)."""
+    if part.bore != hole.pin:
+        return False
+    return passes(hole, part) if hole.pin else passes(part, hole)
+
+
 def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
     """The section as a polygon in its own frame [m]: a polygon's outline, a square's or
     rect's exact rectangle (its corner arcs 256-gons as a circle's), a round one's 256-gon
@@ -320,13 +341,20 @@ def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
     """The part's yaw [rad] in the hole's frame and its origin's offset (x, y) [m] from the
     hole's position in the cell's axes where the polygon relation passes it (:func:`section_fit`);
     (0, 0) for pairs of round, square and rect sections (the skill aligns those itself,
-    :func:`executor.world.arm.aligned_yaw`)."""
+    :func:`executor.world.arm.aligned_yaw`). A part with a bore onto a pin: the relation
+    places the pin in the bore, so the part's pose is that placement's inverse."""
     if "polygon" not in (part.kind, hole.kind):
         return 0.0, np.zeros(2)
-    found = section_fit(part, hole)
+    if hole.pin:  # the pin at (yaw φ, offset o) in the bore: the bore at (-φ, -R(-φ) o) about the pin
+        found = section_fit(hole, part)
+        yaw = -math.radians(found.yaw)
+        x, y = found.offset
+        x, y = -(math.cos(yaw) * x - math.sin(yaw) * y), -(math.sin(yaw) * x + math.cos(yaw) * y)
+    else:
+        found = section_fit(part, hole)
+        yaw, (x, y) = math.radians(found.yaw), found.offset
     c, s = math.cos(hole.yaw), math.sin(hole.yaw)
-    x, y = found.offset
-    return math.radians(found.yaw), np.array([c * x - s * y, s * x + c * y])
+    return yaw, np.array([c * x - s * y, s * x + c * y])
 
 
 def _key(section: Section) -> Section:
@@ -349,7 +377,7 @@ def _section_fit(part: Section, hole: Section) -> PolygonFit:
 def sizes_lp_text(assembly: str) -> str:
     """The ``sizes.lp`` of an assembly folder as its geometry makes it: ``part/1`` for each
     part of ``assembly.toml`` with a cross-section (``[part_shapes.*]``), ``hole/1`` for
-    each hole, ``fits/2`` for every pair that :func:`passes` (closed world), as clingo
+    each hole, ``fits/2`` for every pair that :func:`feature_passes` (closed world), as clingo
     symbols in the order of ``assembly.toml``, one line per part."""
     geometry = load_geometry(assembly)
     layout = geometry.layout
@@ -367,7 +395,7 @@ def sizes_lp_text(assembly: str) -> str:
              facts([clingo.Function("hole", [clingo.Function(hid)]) for hid in holes])]
     for pid in pegs:
         fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid in holes
-                if passes(geometry.parts[pid], geometry.holes[hid])]
+                if feature_passes(geometry.parts[pid], geometry.holes[hid])]
         if fits:
             lines.append(facts(fits))
     return "\n".join(lines) + "\n"
@@ -610,7 +638,7 @@ def arm_urdf_text(part: PartSpec, gripper: Gripper, files: MeshFiles | None = No
     source = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
     text = source.read_text().replace('filename="meshes/', f'filename="{source.parent}/meshes/')
     flange_len = gripper.flange_length
-    tip = flange_len + part.length - gripper.grasp_depth
+    tip = flange_len + part.length - part.held_depth(gripper)
     tool = (
         '  <joint name="flange_joint" type="fixed"><parent link="lbr_iiwa_link_7"/><child link="flange"/>'
         f'<origin xyz="0 0 {_FLANGE_OFFSET}" rpy="0 0 0"/></joint>\n'

@@ -76,6 +76,8 @@ class Scene:
             self.robot = pb.loadURDF(str(urdf), useFixedBase=True,
                                      flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                                      physicsClientId=self.client)
+        if any(hole.pin for hole in geometry.holes.values()):
+            wrist_clear_of(self.client, self.robot, self.plate)
         self.held: str | None = None
 
     def set_friction(self, coefficient: float | None) -> None:
@@ -107,6 +109,16 @@ class Scene:
     def close(self) -> None:
         if pb.isConnected(self.client):
             pb.disconnect(self.client)
+
+
+def wrist_clear_of(client: int, robot: int, base: int) -> None:
+    """Only the held part (the arm's last link) of ``robot`` collides with ``base``: a pin
+    a part with a bore goes onto reaches up past the part's top, where a real gripper's
+    fingers hold the part from its sides (the cell simulates no fingers, and its wrist is
+    no cylinder around them)."""
+    held = pb.getNumJoints(robot, physicsClientId=client) - 1
+    for link in range(-1, held):
+        pb.setCollisionFilterPair(robot, base, link, -1, 0, physicsClientId=client)
 
 
 def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,

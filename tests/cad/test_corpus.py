@@ -180,7 +180,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     pytest.param("agh_hex_horizontal", marks=_xfail(INSERTED + " in along a horizontal axis")),
     "agh_prism_array",
-    pytest.param("robosuite_nuts", marks=_xfail(INSERTED + " over a pin of the base")),
+    "robosuite_nuts",
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual

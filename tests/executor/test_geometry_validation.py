@@ -76,6 +76,11 @@ CASES = [
      "[hole_shapes.round_big] depth: expected a number in (0, 0.2] m, got 0.0"),
     ("hole-depth-within-the-chamfer", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.0005',
      "[hole_shapes.round_big] depth: expected more than the [plate] chamfer (0.0008 m), got 0.0005"),
+    ("pin-without-a-base-mesh", 'holes = ["br"]', 'holes = ["br"]\npin = true',
+     "[hole_shapes.round_big] pin: a pin needs a [base] with its own mesh (the pin is part of it), got none"),
+    ("bore-taught-in-a-hole", "mass = 0.06", "mass = 0.06\nbore = true",
+     "[part_shapes.square_peg] demo_hole: expected a pin for parts with a bore, a hole for pegs (s1 is a hole), "
+     "got 's1'"),
     ("hole-bottom-under-the-floor", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.1',
      "[hole_shapes.round_big] depth: expected less than the entry height (0.1 m: the bottom above the floor), "
      "got 0.1"),
