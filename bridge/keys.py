@@ -50,7 +50,7 @@ def step_key(cell_id: str) -> str:
 
 def precedence_key(cell_id: str) -> str:
     """Queryable key on which cell ``cell_id`` runs precedence experiments
-    (:mod:`bridge.precedence_experiment`)."""
+    (:mod:`bridge.precedence.experiment`)."""
     return f"cell/{check_cell_id(cell_id)}/precedence"
 
 

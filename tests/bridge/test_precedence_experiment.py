@@ -8,7 +8,7 @@ import re
 import pytest
 
 from bridge.messages import MessageError, encode
-from bridge.precedence_experiment import (
+from bridge.precedence.experiment import (
     ExperimentStep,
     PrecedenceExperiment,
     PrecedenceOutcome,
