@@ -12,6 +12,7 @@ from hypothesis import given, settings
 
 from asp import PlannerError
 from asp.precedence.demos import Demonstrations, load_demos
+from asp.precedence.explore.bound import information_bound
 from asp.precedence.explore.knowledge import Evidence, PrecedenceConflict, Trial, know
 from asp.precedence.explore.learner import geometric_reasons, learn_sources
 from asp.precedence.explore.oracle import TruthOracle
@@ -141,3 +142,12 @@ def test_exploration_reaches_the_true_relation_and_no_pair_is_wrong(case: tuple[
     learned = learn_sources(_explored(Evidence(demos), truth, "first"))
     assert learned.relation.same_as(truth)
     assert set(learned.support.values()) <= {"experiment"}
+
+
+def test_information_bound_counts_the_relations_left() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("a", "b", "c"),), ("d:1",))
+    bound = information_bound(know(Evidence(demos)))
+    assert (bound.relations, bound.complete) == (7, True)  # the naturally labelled posets on 3 parts
+    truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
+    settled = information_bound(know(_explored(Evidence(demos), truth)))
+    assert (settled.relations, settled.bits) == (1, 0.0)
