@@ -131,7 +131,7 @@ def test_experiments_file_round_trip_and_bad_files(tmp_path: Path) -> None:
         load_trials(path, truth.parts)
 
 
-@settings(max_examples=20, deadline=None)
+@settings(max_examples=12, deadline=None)
 @given(poset_with_demos(max_parts=5, max_demos=2))
 def test_exploration_reaches_the_true_relation_and_no_pair_is_wrong(case: tuple[Relation, list[tuple[str, ...]]]
                                                                      ) -> None:
