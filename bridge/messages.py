@@ -194,8 +194,9 @@ _STEP_DECODER = msgspec.json.Decoder(StepRequest)
 _REPLY_DECODER = msgspec.json.Decoder(InsertReply | StepReply | ErrorReply)
 
 
-def encode(message: InsertRequest | InsertReply | StepRequest | StepReply | ErrorReply) -> bytes:
-    """Serialise a message to JSON bytes; MessageError if it exceeds the size cap."""
+def encode(message: msgspec.Struct) -> bytes:
+    """Serialise a message (any message struct of the bridge) to JSON bytes; MessageError if it
+    exceeds the size cap."""
     data = msgspec.json.encode(message)
     if len(data) > MAX_MESSAGE_BYTES:
         raise MessageError("oversized", f"message of {len(data)} bytes exceeds the "
@@ -203,7 +204,11 @@ def encode(message: InsertRequest | InsertReply | StepRequest | StepReply | Erro
     return data
 
 
-def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
+def decode_checked(decoder: msgspec.json.Decoder, payload: bytes, what: str,
+                   versions: frozenset[int] | None = None):
+    """Decode ``payload`` with ``decoder``: size cap, types, no key twice, and the protocol
+    version ``v`` in ``versions`` (default: this module's, by message kind); MessageError
+    (with its code) naming ``what`` otherwise."""
     if len(payload) > MAX_MESSAGE_BYTES:
         raise MessageError("oversized", f"{what} of {len(payload)} bytes exceeds the "
                            f"{MAX_MESSAGE_BYTES}-byte cap")
@@ -215,7 +220,10 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
     if twice is not None:
         raise MessageError("malformed", f"{what} is not valid: the key {twice!r} appears twice in one object; "
                            "expected each key once")
-    accepted = {PROTOCOL_VERSION} if isinstance(message, (StepRequest, StepReply)) else INSERT_VERSIONS
+    if versions is not None:
+        accepted = versions
+    else:
+        accepted = frozenset({PROTOCOL_VERSION}) if isinstance(message, (StepRequest, StepReply)) else INSERT_VERSIONS
     if message.v not in accepted:
         raise MessageError("version", f"{what} has protocol version {message.v}; "
                            f"expected {' or '.join(map(str, sorted(accepted)))}")
@@ -224,14 +232,14 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
 
 def decode_request(payload: bytes) -> InsertRequest:
     """Validate and decode an insert request; MessageError (with a code) if invalid."""
-    return _decode(_REQUEST_DECODER, payload, "insert request")
+    return decode_checked(_REQUEST_DECODER, payload, "insert request")
 
 
 def decode_step_request(payload: bytes) -> StepRequest:
     """Validate and decode a step request; MessageError (with a code) if invalid."""
-    return _decode(_STEP_DECODER, payload, "step request")
+    return decode_checked(_STEP_DECODER, payload, "step request")
 
 
 def decode_reply(payload: bytes) -> InsertReply | StepReply | ErrorReply:
     """Validate and decode a cell's reply; MessageError if invalid."""
-    return _decode(_REPLY_DECODER, payload, "reply")
+    return decode_checked(_REPLY_DECODER, payload, "reply")

@@ -1,0 +1,65 @@
+"""The next precedence experiment, chosen by ASP, and the exploration loop.
+
+Policies (one encoding each): ``informative`` (``select_precedence_informative.lp``: the
+candidate deciding the most open pairs whatever its outcome) and ``first``
+(``select_precedence_first.lp``: the first candidate in part order, a systematic
+baseline). The experiment on (a, b) places every part that precedes b in the upper bound
+except a, in the order of the first demonstration (a linear extension of the upper
+bound), then b.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from asp import PlannerError
+from asp.precedence.explore.knowledge import POLICIES, Evidence, Knowledge, Trial, decisive, know
+from asp.precedence.explore.oracle import Oracle
+from asp.precedence.relation import Pair
+from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment
+
+
+def select_pair(knowledge: Knowledge, policy: str = "informative") -> Pair | None:
+    """The pair the policy tests next; None when nothing is open."""
+    if policy not in POLICIES:
+        raise PlannerError(f"--policy {policy}: expected one of {', '.join(POLICIES)}")
+    if not knowledge.candidates:
+        return None
+    if not knowledge.evidence.demos.sequences:
+        raise PlannerError("precedence experiments need at least one demonstration (a feasible order to start "
+                           "from); expected a demonstrations file")
+    if knowledge.policy != policy:
+        knowledge = know(knowledge.evidence, policy, knowledge.confirmed)
+    if knowledge.selected is None:
+        raise AssertionError(f"{POLICIES[policy]} selected no pair among {len(knowledge.candidates)} candidates")
+    return knowledge.selected
+
+
+def experiment_for(knowledge: Knowledge, pair: Pair, request_id: str) -> PrecedenceExperiment:
+    """The experiment testing ``pair`` (a candidate of ``knowledge``)."""
+    first_demo = knowledge.evidence.demos.sequences[0]
+    before = sorted(knowledge.requires[pair], key=first_demo.index)
+    steps = tuple(ExperimentStep(p) for p in (*before, pair[1]))
+    return PrecedenceExperiment(id=request_id, pair=pair, sequence=steps)
+
+
+def explore(evidence: Evidence, oracle: Oracle, policy: str = "informative", run_id: str = "explore",
+            limit: int | None = None) -> Iterator[tuple[Knowledge, Trial]]:
+    """Experiments until nothing is open (or ``limit`` of them): yields the knowledge each
+    was chosen from and the trial (experiment and outcome); the last knowledge is
+    :func:`know` of the evidence with every trial."""
+    knowledge = know(evidence, policy)
+    count = 0
+    while limit is None or count < limit:
+        pair = select_pair(knowledge, policy)
+        if pair is None:
+            return
+        count += 1
+        experiment = experiment_for(knowledge, pair, f"{run_id}.{len(evidence.trials) + 1}")
+        trial = Trial(experiment, oracle.run(experiment), "oracle")
+        yield knowledge, trial
+        evidence = evidence.with_trial(trial)
+        confirmed = dict(knowledge.confirmed)
+        if decisive(trial, knowledge.excluded, evidence.parts):
+            confirmed[len(evidence.trials)] = pair
+        knowledge = know(evidence, policy, confirmed)
