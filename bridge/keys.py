@@ -1,7 +1,8 @@
 """Every Zenoh key expression of the project, in one place.
 
 A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert``, plan steps on
-``cell/<id>/step`` (its world persists between steps), and holds the
+``cell/<id>/step`` (its world persists between steps), precedence experiments on
+``cell/<id>/precedence`` (each in a fresh world of its own), and holds the
 liveliness token ``cell/<id>/alive/<instance>`` while it is up (``<instance>``: a random
 name of the process, so two processes claiming one id show as two tokens);
 ``cell/<id>/ping`` echoes its payload. The planner discovers cells by subscribing to
@@ -45,6 +46,11 @@ def insert_key(cell_id: str) -> str:
 def step_key(cell_id: str) -> str:
     """Queryable key on which cell ``cell_id`` carries out plan steps."""
     return f"cell/{check_cell_id(cell_id)}/step"
+
+
+def precedence_key(cell_id: str) -> str:
+    """Queryable key on which cell ``cell_id`` runs precedence experiments."""
+    return f"cell/{check_cell_id(cell_id)}/precedence"
 
 
 def alive_key(cell_id: str, instance: str = "0") -> str:

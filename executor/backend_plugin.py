@@ -17,6 +17,10 @@ class with
   a step the product does not allow raises :class:`InvalidStep` (``invalid_step``, see
   :func:`check_step`) before anything moves; a cell that only learns may raise
   :class:`executor.ExecutorError` (the planner gets ``failed``);
+- optionally ``run_precedence(self, request: PrecedenceRequest) -> PrecedenceOutcome``: a
+  precedence experiment (set the ``placed`` parts at their goals, assemble ``sequence``,
+  stop at the first failing step and say why), checked first with
+  :func:`check_experiment`; a backend without it answers ``failed``;
 - ``close(self)``: release the robot.
 
 ``run`` is called from one thread, one experiment at a time. Start it with
@@ -37,7 +41,15 @@ from pathlib import Path
 from typing import Protocol
 
 from bridge.inputs import shorten
-from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from bridge.messages import (
+    Evidence,
+    ExperimentStep,
+    InsertRequest,
+    PrecedenceRequest,
+    Result,
+    StepEvidence,
+    StepRequest,
+)
 from executor import ExecutorError, UnknownPair
 
 _SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
@@ -80,6 +92,26 @@ def check_run(current: str | None, run: str, parts: Collection[str], placed: Col
 
 StepOutcome = tuple[Result, StepEvidence, dict[str, float]]
 """A plan step's outcome, its evidence and every placed part's distance from its goal [mm]."""
+PrecedenceOutcome = tuple[tuple[ExperimentStep, ...], tuple[str, ...], float]
+"""A precedence experiment's steps (the last one the failing one, if any), the placed parts
+that did not stay at their goals (then no step ran) and the simulated time [s]."""
+
+
+def check_experiment(request: PrecedenceRequest, *, parts: Collection[str], pegs: Collection[str],
+                     holes: Collection[str]) -> None:
+    """Refuse a precedence experiment before anything moves: every placement of ``placed``
+    then ``sequence`` checked by :func:`check_step` against the ones before it (a part at most
+    once), and InvalidStep for a hole given twice."""
+    placed: list[str] = []
+    used: set[str] = set()
+    for placement in (*request.placed, *request.sequence):
+        check_step(placement.part, placement.hole, parts=parts, pegs=pegs, holes=holes, placed=placed)
+        if placement.hole is not None and placement.hole in used:
+            raise InvalidStep(f"hole '{placement.hole}' is given twice (to {placement.part} and another part); "
+                              "expected every hole at most once")
+        placed.append(placement.part)
+        if placement.hole is not None:
+            used.add(placement.hole)
 
 
 class Backend(Protocol):

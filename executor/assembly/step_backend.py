@@ -6,20 +6,25 @@ refused step (another run, or one the product does not allow) changes nothing. H
 blocked with ``--block-hole`` get their obstacle in every fresh world. With
 ``--uncertainty cell`` every world gets the cell's uncertainty and execution layer, and
 the ILC corrections are kept across the plan runs this cell serves (in memory: not
-saved)."""
+saved).
+
+Precedence experiments (:meth:`AssemblyRunner.run_experiment`) run each in a world of
+their own, made for the experiment and closed after it, beside the plan run's world,
+which they leave as it was."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from bridge.messages import StepEvidence, StepRequest
+from bridge.messages import ExperimentStep, PrecedenceRequest, StepEvidence, StepRequest
 from executor import ExecutorError
 from executor.assembly.product import Product, load_product
 from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
-from executor.backend_plugin import check_run
+from executor.backend_plugin import PrecedenceOutcome, check_experiment, check_run
 from executor.cell_description import CellDescription
 from executor.control.ilc import ExecutionLayer, Ilc
+from executor.world import TIME_STEP
 
 if TYPE_CHECKING:
     from executor.assembly.recording import AssemblyRecorder
@@ -87,6 +92,30 @@ class AssemblyRunner:
                                         record.pose_error * 1000.0)
             self.recorder.flush()
         return record, {part: errors[part] * 1000.0 for part in sorted(assembler.placed)}
+
+    def run_experiment(self, request: PrecedenceRequest) -> PrecedenceOutcome:
+        """In a fresh world (blocked holes obstructed): set ``request.placed`` at their goals by
+        hand (:meth:`Assembler.place_by_hand`), then carry out ``request.sequence`` step by step
+        up to the first that fails. UnknownPair or InvalidStep before anything is made
+        (:func:`check_experiment`)."""
+        product = self.product
+        check_experiment(request, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes)
+        assembler = Assembler(product, description=self.description, bias=self.bias, layer=self.layer, ilc=self.ilc)
+        try:
+            for hole in self.blocked:
+                assembler.block_hole(hole)
+            start = assembler.world.motion.steps
+            fell = assembler.place_by_hand([(p.part, p.hole) for p in request.placed])
+            steps: list[ExperimentStep] = []
+            for placement in () if fell else request.sequence:
+                record = assembler.run_step(placement.part, placement.hole, request.seed)
+                steps.append(ExperimentStep(placement.part, placement.hole, "fit" if record.outcome == "fit"
+                                            else "no_fit", record.reason, record.involved, step_evidence(record)))
+                if record.outcome != "fit":
+                    break
+            return tuple(steps), tuple(sorted(fell)), (assembler.world.motion.steps - start) * TIME_STEP
+        finally:
+            assembler.close()
 
     def close(self) -> None:
         if self._assembler is not None:

@@ -7,7 +7,8 @@ malformed, oversized or wrong-version request gets an ErrorReply at once and the
 serving. Valid requests run one at a time in the main thread; results are idempotent by
 request id; a request whose backend raises gets an ErrorReply ``failed`` naming the
 exception, and the cell keeps serving. One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
-``done <id> <result>``), flushed, so a supervisor can follow the node.
+``done <id> <result>``; a precedence experiment's ``<part> <hole>`` is ``placed <parts>
+sequence <parts>``), flushed, so a supervisor can follow the node.
 """
 
 from __future__ import annotations
@@ -26,17 +27,23 @@ from pathlib import Path
 import zenoh
 
 from bridge.cell_settings import ServeSettings
-from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
+from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, precedence_key, step_key
 from bridge.messages import (
     MAX_ERROR_CHARS,
     MAX_MESSAGE_BYTES,
     ErrorCode,
     ErrorReply,
+    ExperimentResult,
     InsertReply,
     InsertRequest,
     MessageError,
+    PrecedenceReply,
+    PrecedenceRequest,
+    Reply,
+    Request,
     StepReply,
     StepRequest,
+    decode_precedence_request,
     decode_request,
     decode_step_request,
     encode,
@@ -59,8 +66,17 @@ class _Work:
     """A valid request waiting for the cell, and when it arrived (``time.monotonic`` [s])."""
 
     query: zenoh.Query
-    request: InsertRequest | StepRequest
+    request: Request
     arrived: float
+
+
+def _what(request: Request) -> str:
+    """What a request asks, for a log line: ``part hole``, or a precedence experiment's
+    ``placed a,b sequence c,d``."""
+    if isinstance(request, PrecedenceRequest):
+        return (f"placed {','.join(p.part for p in request.placed) or '-'} "
+                f"sequence {','.join(p.part for p in request.sequence)}")
+    return f"{request.part} {request.hole}"
 
 
 class CellNode:
@@ -77,19 +93,19 @@ class CellNode:
         self.cell_id = cell_id
         self._backend = backend
         self._work: queue.Queue[_Work | None] = queue.Queue(maxsize=queue_size)
-        self._replies: OrderedDict[str, tuple[InsertRequest | StepRequest, bytes]] = OrderedDict()
+        self._replies: OrderedDict[str, tuple[Request, bytes]] = OrderedDict()
         self._lock = threading.Lock()
         self._stopped = threading.Event()
 
-    def _cached(self, query: zenoh.Query, request: InsertRequest | StepRequest) -> bytes | None:
+    def _cached(self, query: zenoh.Query, request: Request) -> bytes | None:
         """The cached reply of this very request; refuses a reused id (then returns b"")."""
         with self._lock:
             cached = self._replies.get(request.id)
         if cached is None:
             return None
         if cached[0] != request:
-            self._refuse(query, "id_reused", f"request id {request.id} was used for "
-                         f"({cached[0].part},{cached[0].hole}); expected a new id", request.id)
+            self._refuse(query, "id_reused", f"request id {request.id} was used for ({_what(cached[0])}); "
+                         "expected a new id", request.id)
             return b""
         return cached[1]
 
@@ -107,7 +123,11 @@ class CellNode:
         """Zenoh-thread callback of ``step``, as :meth:`on_query`."""
         self._accept(query, decode_step_request)
 
-    def _accept(self, query: zenoh.Query, decode: Callable[[bytes], InsertRequest | StepRequest]) -> None:
+    def on_precedence_query(self, query: zenoh.Query) -> None:
+        """Zenoh-thread callback of ``precedence``, as :meth:`on_query`."""
+        self._accept(query, decode_precedence_request)
+
+    def _accept(self, query: zenoh.Query, decode: Callable[[bytes], Request]) -> None:
         payload = query.payload.to_bytes() if query.payload is not None else b""
         try:
             request = decode(payload)
@@ -125,13 +145,25 @@ class CellNode:
             self._refuse(query, "busy", f"{self._work.maxsize} requests are waiting; send it again later",
                          request.id)
 
-    def _answer(self, request: InsertRequest | StepRequest, started: float) -> InsertReply | StepReply:
-        """Run the request on the backend; the reply (an insert reply in the request's version)."""
+    def _answer(self, request: Request, started: float) -> Reply:
+        """Run the request on the backend; the reply (in the request's version). A backend
+        without ``run_precedence`` fails a precedence experiment."""
+        if isinstance(request, PrecedenceRequest):
+            run_precedence = getattr(self._backend, "run_precedence", None)
+            if run_precedence is None:
+                raise ExecutorError(f"this cell's backend ({type(self._backend).__name__}) runs no precedence "
+                                    "experiments")
+            steps, unstable, sim_s = run_precedence(request)
+            verdict: ExperimentResult = ("unstable" if unstable else
+                                         "failed" if steps and steps[-1].result != "fit" else "success")
+            return PrecedenceReply(id=request.id, cell=self.cell_id, placed=request.placed, sequence=request.sequence,
+                                   result=verdict, steps=steps, unstable=unstable,
+                                   wall_s=time.perf_counter() - started, sim_s=sim_s)
         if isinstance(request, StepRequest):
             result, step_evidence, errors = self._backend.run_step(request)
             return StepReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=result,
                              evidence=step_evidence, pose_errors_mm=tuple(sorted(errors.items())),
-                             wall_s=time.perf_counter() - started)
+                             wall_s=time.perf_counter() - started, v=request.v)
         outcome, evidence = self._backend.run(request)
         return InsertReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=outcome,
                            evidence=evidence, wall_s=time.perf_counter() - started, v=request.v)
@@ -168,9 +200,10 @@ class CellNode:
                 query.reply(query.key_expr, cached)
             query.drop()  # finalises the query: the planner need not wait for its timeout
 
-    def _run(self, query: zenoh.Query, request: InsertRequest | StepRequest) -> bytes | None:
-        number = request.experiment if isinstance(request, InsertRequest) else f"step {request.step}"
-        print(f"start {request.id} {request.part} {request.hole} {number}", flush=True)
+    def _run(self, query: zenoh.Query, request: Request) -> bytes | None:
+        number = (request.experiment if isinstance(request, InsertRequest) else
+                  f"step {request.step}" if isinstance(request, StepRequest) else "precedence")
+        print(f"start {request.id} {_what(request)} {number}", flush=True)
         started = time.perf_counter()
         try:
             message = self._answer(request, started)
@@ -235,6 +268,7 @@ def serve(settings: ServeSettings) -> int:
             raise ClaimLost(claim.lost)
         _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
                      session.declare_queryable(step_key(cell_id), node.on_step_query),
+                     session.declare_queryable(precedence_key(cell_id), node.on_precedence_query),
                      session.declare_queryable(ping_key(cell_id), _echo),
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
         if settings.lifeline:
