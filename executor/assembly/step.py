@@ -262,8 +262,9 @@ class Assembler:
         for part, hole in sorted(placements, key=lambda ph: ph[0] in self.product.heads):  # heads after their parts
             if part in self.product.pegs and hole is not None:
                 world.set_peg_goal(part, hole)
-            goal = self._goal_tcp(part, "insert_socket") if part in self.product.heads else world.goals[part]
-            world.set_pose(part, goal - world.frames[part].tcp)
+            socket = part in self.product.heads  # a head's goal is the socket where its part is now
+            world.set_pose(part, self._goal_tcp(part, "insert_socket") - world.frames[part].tcp if socket
+                           else world.goals[part])
             self._screw(part)
             pb.changeDynamics(world.frames[part].body, -1, activationState=pb.ACTIVATION_STATE_WAKE_UP,
                               physicsClientId=world.client)
