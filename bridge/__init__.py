@@ -9,6 +9,7 @@
 - :mod:`bridge.recording.reader`: reading ``.rrd`` recordings back;
 - :mod:`bridge.cli_types`: argument types both command lines use;
 - :mod:`bridge.files`: writing output files atomically, checking output paths;
+- :mod:`bridge.precedence.experiment`: the precedence experiment a cell runs and its outcome;
 - :mod:`bridge.protocol_schema`: the JSON Schemas of the messages, as published in
   ``docs/protocol/``.
 

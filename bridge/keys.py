@@ -2,7 +2,7 @@
 
 A cell ``<id>`` serves insertions on the queryable ``cell/<id>/insert``, plan steps on
 ``cell/<id>/step`` (its world persists between steps), precedence experiments on
-``cell/<id>/precedence`` (each in a fresh world of its own), and holds the
+``cell/<id>/precedence``, and holds the
 liveliness token ``cell/<id>/alive/<instance>`` while it is up (``<instance>``: a random
 name of the process, so two processes claiming one id show as two tokens);
 ``cell/<id>/ping`` echoes its payload. The planner discovers cells by subscribing to
@@ -49,7 +49,8 @@ def step_key(cell_id: str) -> str:
 
 
 def precedence_key(cell_id: str) -> str:
-    """Queryable key on which cell ``cell_id`` runs precedence experiments."""
+    """Queryable key on which cell ``cell_id`` runs precedence experiments
+    (:mod:`bridge.precedence.experiment`)."""
     return f"cell/{check_cell_id(cell_id)}/precedence"
 
 

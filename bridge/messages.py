@@ -11,15 +11,10 @@ message is ever executed; ids are matched against fixed patterns before use.
   the cell's persistent world (pick the part, place it, into ``hole`` if it has one);
 - :class:`StepReply` (cell → planner): the step's outcome, its evidence and how far every
   placed part is from its goal;
-- :class:`PrecedenceRequest` (planner → cell, since version 4): a precedence experiment:
-  from a known state (the base with ``placed`` parts at their goals) assemble ``sequence``;
-- :class:`PrecedenceReply` (cell → planner): success, or the failing step and why
-  (:data:`FailureReason`), with every step's evidence;
 - :class:`ErrorReply` (cell → planner): the request was refused, with a reason code.
 
-Versions: 3 added the step messages, 4 the precedence messages; the older messages did
-not change, so a cell still serves a version-2 insert request and a version-3 step request
-and answers each in its request's version.
+Versions: 3 added the step messages; insert messages did not change, so a cell still
+serves a version-2 insert request and answers it as version 2.
 """
 
 from __future__ import annotations
@@ -34,13 +29,10 @@ from bridge.inputs import duplicate_key
 from bridge.keys import CELL_ID_PATTERN
 from bridge.product.tables import MAX_ID_CHARS
 
-PROTOCOL_VERSION: Final = 4
-"""2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``. 3: step request and reply.
-4: precedence request and reply."""
-INSERT_VERSIONS: Final = frozenset({2, 3, 4})
-"""Versions of insert and error messages accepted (their form is the same in all)."""
-STEP_VERSIONS: Final = frozenset({3, 4})
-"""Versions of step messages accepted (their form is the same in both)."""
+PROTOCOL_VERSION: Final = 3
+"""2: requests carry ``timeout_s``; replies echo ``part`` and ``hole``. 3: step request and reply."""
+INSERT_VERSIONS: Final = frozenset({2, 3})
+"""Versions of insert and error messages accepted (their form is the same in both)."""
 MAX_MESSAGE_BYTES: Final = 16 * 1024
 """Largest accepted payload [bytes]; bigger messages are refused unread."""
 
@@ -56,7 +48,7 @@ MAX_VALUE: Final = 1e9
 MAX_ERROR_CHARS: Final = 2000
 """The longest error text of an ErrorReply [characters]."""
 MAX_PLACED: Final = 1000
-"""The most placed parts a step reply reports, a precedence request sets up or assembles."""
+"""The most placed parts a step reply reports."""
 
 RequestId = Annotated[str, msgspec.Meta(pattern=rf"^[A-Za-z0-9_.:-]{{1,{MAX_REQUEST_ID}}}$")]
 AspId = Annotated[str, msgspec.Meta(pattern=ID_PATTERN)]
@@ -67,13 +59,6 @@ Count = Annotated[int, msgspec.Meta(ge=0, le=MAX_COUNT)]
 Version = Annotated[int, msgspec.Meta(ge=1, le=MAX_COUNT, description="protocol version")]
 NonNegative = Annotated[float, msgspec.Meta(ge=0.0, le=MAX_VALUE)]
 Result = Literal["fit", "no_fit"]
-FailureReason = Literal["blocked", "jammed", "unsupported", "precedence", "size"]
-"""Why a step of a precedence experiment failed. Observed in physics (``sim``): ``blocked``
-(the part did not get into its place: it stopped above its entry, or against another
-part), ``jammed`` (it entered its place and stuck before its goal), ``unsupported`` (it
-reached its goal but did not stay there once let go). Stated by the ``truth`` backend from
-the product's known facts, without physics: ``precedence`` (a part that must precede it is
-not placed), ``size`` (the peg does not pass its hole)."""
 ErrorCode = Literal["malformed", "oversized", "version", "unknown_id", "id_reused", "invalid_step", "busy",
                     "expired", "failed", "run_active"]
 """Why a request was refused: it is invalid (``malformed``, ``oversized``, ``version``), names an
@@ -196,80 +181,6 @@ class StepReply(_Message, tag="step_reply", frozen=True):
     v: Version = PROTOCOL_VERSION
 
 
-ExperimentResult = Literal["success", "failed", "unstable"]
-"""A precedence experiment's outcome (:class:`PrecedenceReply`)."""
-
-
-class Placement(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
-    """A part and the hole it goes into (None: a part placed without a hole)."""
-
-    part: Annotated[AspId, msgspec.Meta(description="the part, e.g. p3")]
-    hole: Annotated[AspId | None, msgspec.Meta(description="its hole, e.g. s1; null for a part placed without "
-                                               "one")] = None
-
-
-Placements = Annotated[tuple[Placement, ...], msgspec.Meta(max_length=MAX_PLACED)]
-
-
-class PrecedenceRequest(_Message, tag="precedence", frozen=True):
-    """A precedence experiment: in a fresh world, put the ``placed`` parts at their goals (set up
-    by hand, not assembled), then assemble ``sequence`` step by step, stopping at the first step
-    that fails; e.g. placed bp, p3, p4 and sequence sp, p1 tests whether sp may precede p1.
-    Every part at most once in the two, every hole at most once."""
-
-    id: Annotated[RequestId, msgspec.Meta(description="request id, as for insert")]
-    placed: Annotated[Placements, msgspec.Meta(description="the known state: the parts already in place, "
-                                               "with their holes")] = ()
-    sequence: Annotated[Placements, msgspec.Meta(min_length=1, description="the steps to assemble, in order")] = ()
-    seed: Annotated[Seed, msgspec.Meta(description="seed of a simulated cell's randomisation")] = 0
-    timeout_s: Annotated[NonNegative, msgspec.Meta(description="as for insert [s]")] = 0.0
-    v: Version = PROTOCOL_VERSION
-
-
-class ExperimentStep(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
-    """One step of a precedence experiment as the cell carried it out."""
-
-    part: AspId
-    hole: AspId | None
-    result: Annotated[Result, msgspec.Meta(description="fit: the part is in place; no_fit: it is not")]
-    reason: Annotated[FailureReason | None, msgspec.Meta(description="why it failed: blocked, jammed, "
-                                                         "unsupported (observed in physics), precedence, size "
-                                                         "(the truth backend); null when it fit")] = None
-    involved: Annotated[tuple[AspId, ...], msgspec.Meta(max_length=MAX_PLACED, description=(
-        "blocked: the other parts the part touched where it stopped; precedence: the parts that must "
-        "precede it and were not placed; else empty"))] = ()
-    evidence: StepEvidence | None = None
-
-
-class PrecedenceReply(_Message, tag="precedence_reply", frozen=True):
-    """The outcome of precedence experiment ``id`` as observed by cell ``cell``: ``result``
-    ``success`` (every step fit), ``failed`` (the last of ``steps`` did not fit) or
-    ``unstable`` (a part of ``placed`` did not stay at its goal once set there: the known state
-    is not one the product can be in; nothing of the sequence ran)."""
-
-    id: RequestId
-    cell: CellId
-    placed: Placements
-    sequence: Placements
-    result: ExperimentResult
-    steps: Annotated[tuple[ExperimentStep, ...], msgspec.Meta(max_length=MAX_PLACED,
-                                                              description="the steps run, in order")] = ()
-    unstable: Annotated[tuple[AspId, ...], msgspec.Meta(max_length=MAX_PLACED, description=(
-        "the placed parts that did not stay at their goal"))] = ()
-    wall_s: NonNegative = 0.0
-    sim_s: Annotated[NonNegative, msgspec.Meta(description="simulated time of the experiment [s]")] = 0.0
-    v: Version = PROTOCOL_VERSION
-
-    @property
-    def failed_step(self) -> ExperimentStep | None:
-        """The step that failed, None when none did."""
-        return self.steps[-1] if self.result == "failed" else None
-
-
-Request = InsertRequest | StepRequest | PrecedenceRequest
-Reply = InsertReply | StepReply | PrecedenceReply
-
-
 class MessageError(BridgeError):
     """A payload that is not a valid message; ``code`` is the ErrorReply code to send."""
 
@@ -280,12 +191,12 @@ class MessageError(BridgeError):
 
 _REQUEST_DECODER = msgspec.json.Decoder(InsertRequest)
 _STEP_DECODER = msgspec.json.Decoder(StepRequest)
-_PRECEDENCE_DECODER = msgspec.json.Decoder(PrecedenceRequest)
-_REPLY_DECODER = msgspec.json.Decoder(InsertReply | StepReply | PrecedenceReply | ErrorReply)
+_REPLY_DECODER = msgspec.json.Decoder(InsertReply | StepReply | ErrorReply)
 
 
-def encode(message: Request | Reply | ErrorReply) -> bytes:
-    """Serialise a message to JSON bytes; MessageError if it exceeds the size cap."""
+def encode(message: msgspec.Struct) -> bytes:
+    """Serialise a message (any message struct of the bridge) to JSON bytes; MessageError if it
+    exceeds the size cap."""
     data = msgspec.json.encode(message)
     if len(data) > MAX_MESSAGE_BYTES:
         raise MessageError("oversized", f"message of {len(data)} bytes exceeds the "
@@ -293,7 +204,11 @@ def encode(message: Request | Reply | ErrorReply) -> bytes:
     return data
 
 
-def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
+def decode_checked(decoder: msgspec.json.Decoder, payload: bytes, what: str,
+                   versions: frozenset[int] | None = None):
+    """Decode ``payload`` with ``decoder``: size cap, types, no key twice, and the protocol
+    version ``v`` in ``versions`` (default: this module's, by message kind); MessageError
+    (with its code) naming ``what`` otherwise."""
     if len(payload) > MAX_MESSAGE_BYTES:
         raise MessageError("oversized", f"{what} of {len(payload)} bytes exceeds the "
                            f"{MAX_MESSAGE_BYTES}-byte cap")
@@ -305,8 +220,10 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
     if twice is not None:
         raise MessageError("malformed", f"{what} is not valid: the key {twice!r} appears twice in one object; "
                            "expected each key once")
-    accepted = (STEP_VERSIONS if isinstance(message, (StepRequest, StepReply)) else
-                {PROTOCOL_VERSION} if isinstance(message, (PrecedenceRequest, PrecedenceReply)) else INSERT_VERSIONS)
+    if versions is not None:
+        accepted = versions
+    else:
+        accepted = frozenset({PROTOCOL_VERSION}) if isinstance(message, (StepRequest, StepReply)) else INSERT_VERSIONS
     if message.v not in accepted:
         raise MessageError("version", f"{what} has protocol version {message.v}; "
                            f"expected {' or '.join(map(str, sorted(accepted)))}")
@@ -315,19 +232,14 @@ def _decode(decoder: msgspec.json.Decoder, payload: bytes, what: str):
 
 def decode_request(payload: bytes) -> InsertRequest:
     """Validate and decode an insert request; MessageError (with a code) if invalid."""
-    return _decode(_REQUEST_DECODER, payload, "insert request")
+    return decode_checked(_REQUEST_DECODER, payload, "insert request")
 
 
 def decode_step_request(payload: bytes) -> StepRequest:
     """Validate and decode a step request; MessageError (with a code) if invalid."""
-    return _decode(_STEP_DECODER, payload, "step request")
+    return decode_checked(_STEP_DECODER, payload, "step request")
 
 
-def decode_precedence_request(payload: bytes) -> PrecedenceRequest:
-    """Validate and decode a precedence request; MessageError (with a code) if invalid."""
-    return _decode(_PRECEDENCE_DECODER, payload, "precedence request")
-
-
-def decode_reply(payload: bytes) -> Reply | ErrorReply:
+def decode_reply(payload: bytes) -> InsertReply | StepReply | ErrorReply:
     """Validate and decode a cell's reply; MessageError if invalid."""
-    return _decode(_REPLY_DECODER, payload, "reply")
+    return decode_checked(_REPLY_DECODER, payload, "reply")

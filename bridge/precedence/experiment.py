@@ -1,0 +1,128 @@
+"""A precedence experiment and its outcome: the messages between the planner and a cell.
+
+An experiment tests the hypothesis that part ``a`` must precede part ``b`` (a pair the
+demonstrations never contradicted) by assembling a short sequence that places ``b``
+while ``a`` is absent. The cell starts from its known state (a fresh world: every part on
+its tray), carries out the steps in order and stops at the first that fails.
+
+- :class:`PrecedenceExperiment` (planner → cell, on :func:`bridge.keys.precedence_key`):
+  ``pair`` = (a, b) and the ``sequence`` of steps, the last placing ``b``; ``a`` is in no
+  step. The steps before the last are an order the planner knows feasible.
+- :class:`PrecedenceOutcome` (cell → planner): ``success`` (every step done: ``b`` can go
+  before ``a``), or ``failed``, with the 1-based ``failed_step`` and the ``reason``:
+  ``blocked`` (the part could not reach its place: a placed part is in the way),
+  ``jammed`` (it reached the entry and stuck), ``unsupported`` (it did not stay where it
+  was put: nothing under it yet). A failure at a step before the last says the known state
+  could not be reached: the planner reports it, it is no evidence on the pair.
+
+Both are serialised with :func:`bridge.messages.encode`. A bad message is refused with
+:class:`bridge.messages.ErrorReply`, as every other request (:func:`decode_experiment`,
+:func:`decode_outcome`).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Final, Literal
+
+import msgspec
+
+from bridge.messages import (
+    MAX_ERROR_CHARS,
+    AspId,
+    CellId,
+    NonNegative,
+    RequestId,
+    Seed,
+    Version,
+    decode_checked,
+)
+
+EXPERIMENT_VERSION: Final = 1
+"""Version of the precedence experiment messages."""
+MAX_STEPS: Final = 1000
+"""The most steps an experiment holds."""
+
+Outcome = Literal["success", "failed"]
+FailureReason = Literal["blocked", "jammed", "unsupported"]
+"""Why a step failed: ``blocked`` (a placed part is in the part's way), ``jammed`` (it stuck
+in its hole or on its pin), ``unsupported`` (it did not stay where it was put)."""
+
+
+class ExperimentStep(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """Place ``part`` (into ``hole``; None: a part placed without a hole)."""
+
+    part: AspId
+    hole: AspId | None = None
+
+
+class PrecedenceExperiment(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
+                           tag_field="kind", tag="precedence_experiment"):
+    """Does ``pair[0]`` truly have to precede ``pair[1]``? Carry out ``sequence`` from a
+    fresh world; its last step places ``pair[1]``, no step places ``pair[0]``."""
+
+    id: Annotated[RequestId, msgspec.Meta(description="request id: the same request again gets the cached "
+                                          "outcome and is never run twice")]
+    pair: Annotated[tuple[AspId, AspId], msgspec.Meta(description="(a, b): the hypothesis a must precede b")]
+    sequence: Annotated[tuple[ExperimentStep, ...], msgspec.Meta(min_length=1, max_length=MAX_STEPS,
+                                                                 description="the steps, the last placing b")]
+    seed: Annotated[Seed, msgspec.Meta(description="seed of a simulated cell's randomisation")] = 0
+    timeout_s: Annotated[NonNegative, msgspec.Meta(description="how long the planner waits for the outcome [s]; "
+                                                   "0: no limit")] = 0.0
+    v: Version = EXPERIMENT_VERSION
+
+    def __post_init__(self) -> None:
+        a, b = self.pair
+        parts = [step.part for step in self.sequence]
+        if a == b:
+            raise ValueError(f"pair ({a}, {b}): expected two different parts")
+        if parts[-1] != b:
+            raise ValueError(f"sequence ends with {parts[-1]}: expected its last step to place {b}, pair[1]")
+        if a in parts:
+            raise ValueError(f"sequence places {a}: expected pair[0] absent from it")
+        twice = next((p for i, p in enumerate(parts) if p in parts[:i]), None)
+        if twice is not None:
+            raise ValueError(f"sequence places {twice} twice: expected each part at most once")
+
+    @property
+    def tested(self) -> str:
+        """The pair as ``a<b``."""
+        return f"{self.pair[0]}<{self.pair[1]}"
+
+
+class PrecedenceOutcome(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
+                        tag_field="kind", tag="precedence_outcome"):
+    """What cell ``cell`` observed carrying out experiment ``id``."""
+
+    id: Annotated[RequestId, msgspec.Meta(description="the experiment's id")]
+    cell: Annotated[CellId, msgspec.Meta(description="the cell that ran it (truth: the truth oracle)")]
+    pair: Annotated[tuple[AspId, AspId], msgspec.Meta(description="the experiment's pair, echoed")]
+    outcome: Annotated[Outcome, msgspec.Meta(description="success: every step done; failed: see failed_step")]
+    failed_step: Annotated[Annotated[int, msgspec.Meta(ge=1, le=MAX_STEPS)] | None,
+                           msgspec.Meta(description="the 1-based step that failed; null on success")] = None
+    reason: Annotated[FailureReason | None, msgspec.Meta(description="why it failed; null on success")] = None
+    detail: Annotated[str, msgspec.Meta(max_length=MAX_ERROR_CHARS,
+                                        description="what the cell saw, one line (may be empty)")] = ""
+    sim_s: Annotated[NonNegative, msgspec.Meta(description="simulated (physics) time spent [s]; 0 for truth")] = 0.0
+    wall_s: Annotated[NonNegative, msgspec.Meta(description="wall time the cell spent [s]")] = 0.0
+    v: Version = EXPERIMENT_VERSION
+
+    def __post_init__(self) -> None:
+        if (self.outcome == "failed") != (self.failed_step is not None and self.reason is not None):
+            raise ValueError(f"outcome {self.outcome} with failed_step {self.failed_step} and reason {self.reason}: "
+                             "expected both set exactly when the outcome is failed")
+
+
+_EXPERIMENT_DECODER = msgspec.json.Decoder(PrecedenceExperiment)
+_OUTCOME_DECODER = msgspec.json.Decoder(PrecedenceOutcome)
+_VERSIONS: Final = frozenset({EXPERIMENT_VERSION})
+
+def decode_experiment(payload: bytes) -> PrecedenceExperiment:
+    """Validate and decode an experiment; :class:`bridge.messages.MessageError` (with a code) if invalid."""
+    message: PrecedenceExperiment = decode_checked(_EXPERIMENT_DECODER, payload, "precedence experiment", _VERSIONS)
+    return message
+
+
+def decode_outcome(payload: bytes) -> PrecedenceOutcome:
+    """Validate and decode an outcome; :class:`bridge.messages.MessageError` (with a code) if invalid."""
+    message: PrecedenceOutcome = decode_checked(_OUTCOME_DECODER, payload, "precedence outcome", _VERSIONS)
+    return message
