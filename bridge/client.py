@@ -2,7 +2,7 @@
 
 - :class:`CellDirectory` follows the cells' liveliness tokens (``cell/*/alive``).
 - :func:`send_insert` sends one request asynchronously; :func:`request_insert` waits for it;
-  :func:`request_step` sends one plan step and waits for it, :func:`request_precedence` one
+  :func:`request_step` sends one plan step and waits for it, :func:`request_experiment` one
   precedence experiment.
 - :class:`CellPool` keeps every alive cell busy with submitted requests: one request per
   cell, a cell that dies (token gone) or times out has its request re-sent to another
@@ -33,17 +33,19 @@ from bridge.messages import (
     InsertReply,
     InsertRequest,
     MessageError,
-    PrecedenceReply,
-    PrecedenceRequest,
-    Reply,
-    Request,
     StepReply,
     StepRequest,
     decode_reply,
     encode,
 )
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome, decode_outcome_reply
 
 _LOG = logging.getLogger(__name__)
+
+Request = InsertRequest | StepRequest | PrecedenceExperiment
+"""What a planner asks a cell."""
+Reply = InsertReply | StepReply | PrecedenceOutcome
+"""What a cell answers a request it ran."""
 
 
 class CellTimeout(BridgeError):
@@ -186,7 +188,9 @@ def _send(session: zenoh.Session, key: str, cell: str, request: Request, timeout
             if ok is None:
                 detail = err.payload.to_string() if err is not None else "neither a sample nor an error"
                 raise CellTimeout(f"cell {cell}: query error: {detail}")
-            message = decode_reply(ok.payload.to_bytes())
+            payload = ok.payload.to_bytes()
+            message = (decode_outcome_reply(payload) if isinstance(request, PrecedenceExperiment)
+                       else decode_reply(payload))
             check_echo(message, cell, request)
         except BridgeError as exc:
             with lock:
@@ -218,14 +222,15 @@ def _send(session: zenoh.Session, key: str, cell: str, request: Request, timeout
     return cancel
 
 
-_ANSWERS: dict[type, type] = {InsertRequest: InsertReply, StepRequest: StepReply, PrecedenceRequest: PrecedenceReply}
+_ANSWERS: dict[type, type] = {InsertRequest: InsertReply, StepRequest: StepReply,
+                              PrecedenceExperiment: PrecedenceOutcome}
 """The reply type of each request type."""
 
 
 def _asked(message: Request | Reply) -> tuple:
-    """What a reply echoes of its request: part and hole, or a precedence experiment's placements."""
-    if isinstance(message, (PrecedenceRequest, PrecedenceReply)):
-        return message.placed, message.sequence
+    """What a reply echoes of its request: part and hole, or a precedence experiment's pair."""
+    if isinstance(message, (PrecedenceExperiment, PrecedenceOutcome)):
+        return (message.pair,)
     return message.part, message.hole
 
 
@@ -277,11 +282,11 @@ def request_step(session: zenoh.Session, cell: str, request: StepRequest, timeou
     return outcome
 
 
-def request_precedence(session: zenoh.Session, cell: str, request: PrecedenceRequest,
-                       timeout: float) -> PrecedenceReply:
+def request_experiment(session: zenoh.Session, cell: str, experiment: PrecedenceExperiment,
+                       timeout: float) -> PrecedenceOutcome:
     """Send a precedence experiment to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
-    outcome = _request(session, precedence_key(cell), cell, request, timeout)
-    assert isinstance(outcome, PrecedenceReply)  # check_echo let only a PrecedenceReply through
+    outcome = _request(session, precedence_key(cell), cell, experiment, timeout)
+    assert isinstance(outcome, PrecedenceOutcome)  # check_echo let only a PrecedenceOutcome through
     return outcome
 
 

@@ -41,7 +41,7 @@ import numpy as np
 import pybullet as pb
 
 from bridge.cell_settings import Magnitudes
-from bridge.messages import FailureReason
+from bridge.precedence.experiment import FailureReason
 from executor import ExecutorError
 from executor.assembly.failure import targets_of, why_stuck
 from executor.assembly.grasp import Grasp

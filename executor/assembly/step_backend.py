@@ -17,14 +17,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from bridge.messages import ExperimentStep, PrecedenceRequest, StepEvidence, StepRequest
+from bridge.messages import StepEvidence, StepRequest
+from bridge.precedence.experiment import PrecedenceExperiment
 from executor import ExecutorError
 from executor.assembly.product import Product, load_product
-from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
-from executor.backend_plugin import PrecedenceOutcome, check_experiment, check_run
+from executor.assembly.step import DEFAULT_LAYER, SETTLE_S, Assembler, StepRecord, check_product_step
+from executor.backend_plugin import ExperimentRun, InvalidStep, check_experiment, check_run
 from executor.cell_description import CellDescription
 from executor.control.ilc import ExecutionLayer, Ilc
-from executor.world import TIME_STEP
 
 if TYPE_CHECKING:
     from executor.assembly.recording import AssemblyRecorder
@@ -93,27 +93,32 @@ class AssemblyRunner:
             self.recorder.flush()
         return record, {part: errors[part] * 1000.0 for part in sorted(assembler.placed)}
 
-    def run_experiment(self, request: PrecedenceRequest) -> PrecedenceOutcome:
-        """In a fresh world (blocked holes obstructed): set ``request.placed`` at their goals by
-        hand (:meth:`Assembler.place_by_hand`), then carry out ``request.sequence`` step by step
-        up to the first that fails. UnknownPair or InvalidStep before anything is made
-        (:func:`check_experiment`)."""
+    def run_experiment(self, experiment: PrecedenceExperiment) -> ExperimentRun:
+        """In a fresh world (blocked holes obstructed): set ``experiment.placed`` at their goals
+        by hand (:meth:`Assembler.place_by_hand`), then carry out ``experiment.sequence`` step by
+        step up to the first that fails. UnknownPair or InvalidStep before anything is made
+        (:func:`check_experiment`); InvalidStep when a placed part does not stay at its goal."""
         product = self.product
-        check_experiment(request, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes)
+        check_experiment(experiment, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes)
         assembler = Assembler(product, description=self.description, bias=self.bias, layer=self.layer, ilc=self.ilc)
         try:
             for hole in self.blocked:
                 assembler.block_hole(hole)
-            start = assembler.world.motion.steps
-            fell = assembler.place_by_hand([(p.part, p.hole) for p in request.placed])
-            steps: list[ExperimentStep] = []
-            for placement in () if fell else request.sequence:
-                record = assembler.run_step(placement.part, placement.hole, request.seed)
-                steps.append(ExperimentStep(placement.part, placement.hole, "fit" if record.outcome == "fit"
-                                            else "no_fit", record.reason, record.involved, step_evidence(record)))
+            fell = assembler.place_by_hand([(step.part, step.hole) for step in experiment.placed])
+            if fell:
+                raise InvalidStep(f"the known state does not hold: {', '.join(sorted(fell))} did not stay at "
+                                  "its goal once set there (no state the product can be in)")
+            sim_s = SETTLE_S if experiment.placed else 0.0  # the placed parts are left to the physics that long
+            for k, step in enumerate(experiment.sequence, start=1):
+                record = assembler.run_step(step.part, step.hole, experiment.seed)
+                sim_s += record.sim_time_s
                 if record.outcome != "fit":
-                    break
-            return tuple(steps), tuple(sorted(fell)), (assembler.world.motion.steps - start) * TIME_STEP
+                    touched = f", touching {' '.join(record.involved)}" if record.involved else ""
+                    detail = (f"{step.part} {record.reason} after {record.attempts} attempt(s): largest force "
+                              f"deviation {record.max_force_dev:.1f} N, {record.pose_error * 1000.0:.1f} mm from "
+                              f"its goal{touched}")
+                    return ExperimentRun(k, record.reason, detail, sim_s)
+            return ExperimentRun(sim_s=sim_s)
         finally:
             assembler.close()
 

@@ -27,27 +27,23 @@ from pathlib import Path
 import zenoh
 
 from bridge.cell_settings import ServeSettings
+from bridge.client import Reply, Request
 from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, precedence_key, step_key
 from bridge.messages import (
     MAX_ERROR_CHARS,
     MAX_MESSAGE_BYTES,
     ErrorCode,
     ErrorReply,
-    ExperimentResult,
     InsertReply,
     InsertRequest,
     MessageError,
-    PrecedenceReply,
-    PrecedenceRequest,
-    Reply,
-    Request,
     StepReply,
     StepRequest,
-    decode_precedence_request,
     decode_request,
     decode_step_request,
     encode,
 )
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome, decode_experiment
 from bridge.session import SIGNAL_POLL_S, bound_endpoints, cell_listen, open_session
 from executor import ExecutorError
 from executor.backend_plugin import Backend, InvalidStep, RunActive, UnknownPair
@@ -72,10 +68,10 @@ class _Work:
 
 def _what(request: Request) -> str:
     """What a request asks, for a log line: ``part hole``, or a precedence experiment's
-    ``placed a,b sequence c,d``."""
-    if isinstance(request, PrecedenceRequest):
-        return (f"placed {','.join(p.part for p in request.placed) or '-'} "
-                f"sequence {','.join(p.part for p in request.sequence)}")
+    ``a<b placed p,q sequence r,b``."""
+    if isinstance(request, PrecedenceExperiment):
+        return (f"{request.tested} placed {','.join(s.part for s in request.placed) or '-'} "
+                f"sequence {','.join(s.part for s in request.sequence)}")
     return f"{request.part} {request.hole}"
 
 
@@ -125,7 +121,7 @@ class CellNode:
 
     def on_precedence_query(self, query: zenoh.Query) -> None:
         """Zenoh-thread callback of ``precedence``, as :meth:`on_query`."""
-        self._accept(query, decode_precedence_request)
+        self._accept(query, decode_experiment)
 
     def _accept(self, query: zenoh.Query, decode: Callable[[bytes], Request]) -> None:
         payload = query.payload.to_bytes() if query.payload is not None else b""
@@ -148,17 +144,17 @@ class CellNode:
     def _answer(self, request: Request, started: float) -> Reply:
         """Run the request on the backend; the reply (in the request's version). A backend
         without ``run_precedence`` fails a precedence experiment."""
-        if isinstance(request, PrecedenceRequest):
+        if isinstance(request, PrecedenceExperiment):
             run_precedence = getattr(self._backend, "run_precedence", None)
             if run_precedence is None:
                 raise ExecutorError(f"this cell's backend ({type(self._backend).__name__}) runs no precedence "
                                     "experiments")
-            steps, unstable, sim_s = run_precedence(request)
-            verdict: ExperimentResult = ("unstable" if unstable else
-                                         "failed" if steps and steps[-1].result != "fit" else "success")
-            return PrecedenceReply(id=request.id, cell=self.cell_id, placed=request.placed, sequence=request.sequence,
-                                   result=verdict, steps=steps, unstable=unstable,
-                                   wall_s=time.perf_counter() - started, sim_s=sim_s)
+            run = run_precedence(request)
+            return PrecedenceOutcome(id=request.id, cell=self.cell_id, pair=request.pair,
+                                     outcome="success" if run.failed_step is None else "failed",
+                                     failed_step=run.failed_step, reason=run.reason,
+                                     detail=run.detail[:MAX_ERROR_CHARS], sim_s=run.sim_s,
+                                     wall_s=time.perf_counter() - started)
         if isinstance(request, StepRequest):
             result, step_evidence, errors = self._backend.run_step(request)
             return StepReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=result,
@@ -202,7 +198,7 @@ class CellNode:
 
     def _run(self, query: zenoh.Query, request: Request) -> bytes | None:
         number = (request.experiment if isinstance(request, InsertRequest) else
-                  f"step {request.step}" if isinstance(request, StepRequest) else "precedence")
+                  f"step {request.step}" if isinstance(request, StepRequest) else "experiment")
         print(f"start {request.id} {_what(request)} {number}", flush=True)
         started = time.perf_counter()
         try:
@@ -218,7 +214,8 @@ class CellNode:
             self._refuse(query, "failed", f"the backend raised {type(exc).__name__}: {str(exc)[:200]} "
                          f"(at {Path(where.filename).name}:{where.lineno})", request.id)
             return None
-        reply, result = encode(message), message.result
+        reply = encode(message)
+        result = message.outcome if isinstance(message, PrecedenceOutcome) else message.result
         with self._lock:
             self._replies[request.id] = (request, reply)
             while len(self._replies) > CACHE_SIZE:

@@ -10,9 +10,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from bridge.cell_settings import ServeSettings
-from bridge.messages import Evidence, InsertRequest, PrecedenceRequest, Result, StepRequest
+from bridge.messages import Evidence, InsertRequest, Result, StepRequest
+from bridge.precedence.experiment import PrecedenceExperiment
 from bridge.recording.sinks import NO_VIEWER, Viewer
-from executor.backend_plugin import PrecedenceOutcome, StepOutcome
+from executor.backend_plugin import ExperimentRun, StepOutcome
 
 if TYPE_CHECKING:
     from executor.assembly.step_backend import AssemblyRunner
@@ -81,8 +82,8 @@ class SimBackend:
         result: Result = "fit" if record.outcome == "fit" else "no_fit"
         return result, step_evidence(record), errors
 
-    def run_precedence(self, request: PrecedenceRequest) -> PrecedenceOutcome:
-        return self._assembling().run_experiment(request)
+    def run_precedence(self, experiment: PrecedenceExperiment) -> ExperimentRun:
+        return self._assembling().run_experiment(experiment)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
         if self._logger is not None:

@@ -15,20 +15,13 @@ from bridge import BridgeError
 from bridge.assembly import load_assembly
 from bridge.cell_settings import ServeSettings
 from bridge.inputs import read_bytes
-from bridge.messages import (
-    Evidence,
-    ExperimentStep,
-    FailureReason,
-    InsertRequest,
-    PrecedenceRequest,
-    Result,
-    StepEvidence,
-    StepRequest,
-)
+from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from bridge.precedence.experiment import FailureReason, PrecedenceExperiment
 from bridge.recording.sinks import NO_VIEWER, Viewer
 from executor import ExecutorError
 from executor.backend_plugin import (
-    PrecedenceOutcome,
+    ExperimentRun,
+    InvalidStep,
     StepOutcome,
     UnknownPair,
     check_experiment,
@@ -158,8 +151,8 @@ class TruthBackend:
                                 duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
         return ("fit" if ok else "no_fit"), evidence, dict(placed)
 
-    def run_precedence(self, request: PrecedenceRequest) -> PrecedenceOutcome:
-        check_experiment(request, parts=self._parts, pegs=self._pegs, holes=self._holes)
+    def run_precedence(self, experiment: PrecedenceExperiment) -> ExperimentRun:
+        check_experiment(experiment, parts=self._parts, pegs=self._pegs, holes=self._holes)
         if self._precedence is None:
             if self._precedence_file is None:
                 raise ExecutorError("truth backend: the product has no precedence.lp to answer precedence "
@@ -167,25 +160,27 @@ class TruthBackend:
             self._precedence = precedence_truth(self._precedence_file)
         if self._delay_s > 0:
             time.sleep(self._delay_s)
-        placed = {p.part for p in request.placed}
-        unstable = tuple(sorted(p for p in placed if any((a, p) in self._precedence and a not in placed
-                                                         for a in self._parts)))
-        steps: list[ExperimentStep] = []
-        for placement in () if unstable else request.sequence:
-            missing = tuple(sorted(a for a in self._parts if (a, placement.part) in self._precedence
-                                   and a not in placed))
-            too_big = placement.hole is not None and (placement.part, placement.hole) not in self._fits
-            reason: FailureReason | None = ("precedence" if missing else "size" if too_big else
-                                            "blocked" if placement.hole in self._blocked else None)
-            evidence = StepEvidence(skill="manual" if placement.part in self._manual else "truth", attempts=1,
-                                    max_force_dev=0.0, max_torque_dev=0.0, duration_s=0.0, sim_time_s=0.0,
-                                    pose_error_mm=0.0)
-            steps.append(ExperimentStep(placement.part, placement.hole, "no_fit" if reason else "fit", reason,
-                                        missing, evidence))
-            if reason:
-                break
-            placed.add(placement.part)
-        return tuple(steps), unstable, 0.0
+        placed = {step.part for step in experiment.placed}
+        unstable = sorted(p for p in placed if self._missing(p, placed))
+        if unstable:
+            raise InvalidStep(f"the known state does not hold: {', '.join(unstable)} placed without "
+                              f"{', '.join(sorted(set().union(*(self._missing(p, placed) for p in unstable))))}, "
+                              "which the product's precedence puts first")
+        for k, step in enumerate(experiment.sequence, start=1):
+            missing = self._missing(step.part, placed)
+            reason: FailureReason | None = (
+                "precedence" if missing else "blocked" if step.hole in self._blocked else
+                "size" if step.hole is not None and (step.part, step.hole) not in self._fits else None)
+            if reason is not None:
+                why = f"without {' '.join(missing)}" if missing else f"into {step.hole}"
+                return ExperimentRun(k, reason, f"{step.part} {reason} ({why}; the truth backend, no physics)")
+            placed.add(step.part)
+        return ExperimentRun()
+
+    def _missing(self, part: str, placed: set[str]) -> list[str]:
+        """The parts the product's precedence puts before ``part`` that are not ``placed``, sorted."""
+        assert self._precedence is not None
+        return sorted(a for a in self._parts if (a, part) in self._precedence and a not in placed)
 
     def close(self) -> None:
         if self._log is not None:
