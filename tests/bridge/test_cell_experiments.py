@@ -9,6 +9,7 @@ import queue
 
 import pytest
 
+from asp.session.cell_oracle import CellOracle
 from bridge.client import CellRefused, request_experiment
 from bridge.messages import ErrorReply
 from bridge.precedence.experiment import (
@@ -58,6 +59,13 @@ def test_truth_cell_answers_experiments_from_the_precedence_and_refuses_bad_ones
         assert isinstance(bad, ErrorReply) and bad.code == "malformed"
         again = request_experiment(session, "c1", experiment("e6", ("p1", "sp"), "p3 p4 sp", placed="bp"), 30)
         assert again.outcome == "success"  # still serving
+        # the session's oracle: holes from its assignment, the steps before the tested one set by hand
+        oracle = CellOracle(session, "c1", HOLES)
+        tested = PrecedenceExperiment(id="o1", pair=("p4", "sp"),
+                                      sequence=(ExperimentStep("bp"), ExperimentStep("p3"), ExperimentStep("sp")))
+        assert oracle.sent(tested).placed == (ExperimentStep("bp"), ExperimentStep("p3", "s1"))
+        outcome = oracle.run(tested)
+        assert (outcome.outcome, outcome.failed_step, outcome.reason) == ("failed", 3, "precedence")
 
 
 @pytest.mark.slow
