@@ -9,7 +9,7 @@ import queue
 
 import pytest
 
-from asp.session.cell_oracle import CellOracle
+from asp.session.precedence import CellOracle
 from bridge.client import CellRefused, request_experiment
 from bridge.messages import ErrorReply
 from bridge.precedence.experiment import (

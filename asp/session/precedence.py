@@ -1,0 +1,185 @@
+"""Precedence by exploration in a session (``session --precedence explore``,
+:func:`explore_precedence`), and the session's cells as the oracle of its precedence
+experiments (:class:`CellOracle`): each experiment the planner
+chooses (:class:`bridge.precedence.experiment.PrecedenceExperiment`, its steps without
+holes) goes to a cell over Zenoh (``cell/<id>/precedence``), with the holes of the
+session's assignment, and the cell's outcome comes back.
+
+With ``by_hand`` (the default) the steps before the tested one, an order the planner
+knows feasible, are not assembled: the cell sets those parts at their goals by hand (the
+experiment's ``placed``) and assembles only the tested step, so an experiment costs one
+step of physics; the outcome is returned numbered as for the whole sequence. A known state
+that does not hold at the cell (a part set there does not stay) is a PlannerError naming
+the cell's words: the planner believed that order feasible, so it is a conflict, never
+read as evidence on the pair. A lost reply is sent again under the same id (the cell
+answers it from its cache, never running it twice).
+"""
+
+from __future__ import annotations
+
+import logging
+import random
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import clingo
+import msgspec
+import zenoh
+
+from asp import PlannerError
+from asp.precedence.count import UniformSampler
+from asp.precedence.demos import Demonstrations
+from asp.precedence.explore.knowledge import Evidence, Trial, know
+from asp.precedence.explore.select import explore
+from asp.precedence.learn import learn_must_precede
+from asp.precedence.relation import Pair, Relation
+from asp.solve import fact
+from bridge import BridgeError
+from bridge.client import CellRefused, CellTimeout, request_experiment
+from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment, PrecedenceOutcome
+
+LOG = logging.getLogger(__name__)
+SEND_ATTEMPTS = 3
+"""An experiment whose reply is lost is sent this many times in all."""
+
+
+class CellOracle:
+    """Runs precedence experiments at cell ``cell`` of ``session``: pegs go into the holes of
+    ``holes`` (part → hole), each experiment waits at most ``timeout_s`` [s] per send;
+    ``seed`` seeds the cell's random errors. ``sim_s`` and ``wall_s`` add up what the cell
+    reported spending [s]."""
+
+    def __init__(self, session: zenoh.Session, cell: str, holes: Mapping[str, str], *, seed: int = 0,
+                 timeout_s: float = 300.0, by_hand: bool = True) -> None:
+        self.session, self.cell, self.holes = session, cell, dict(holes)
+        self.seed, self.timeout_s, self.by_hand = seed, timeout_s, by_hand
+        self.sim_s = 0.0
+        self.wall_s = 0.0
+        self.outcomes: list[PrecedenceOutcome] = []
+
+    def sent(self, experiment: PrecedenceExperiment) -> PrecedenceExperiment:
+        """What goes to the cell for ``experiment``: every step with its hole, the steps before
+        the tested one as ``placed`` when ``by_hand``."""
+        steps = tuple(ExperimentStep(s.part, s.hole or self.holes.get(s.part)) for s in experiment.sequence)
+        placed = tuple(ExperimentStep(s.part, s.hole or self.holes.get(s.part)) for s in experiment.placed)
+        if self.by_hand:
+            placed, steps = placed + steps[:-1], steps[-1:]
+        return msgspec.structs.replace(experiment, sequence=steps, placed=placed, seed=self.seed,
+                                       timeout_s=self.timeout_s)
+
+    def run(self, experiment: PrecedenceExperiment) -> PrecedenceOutcome:
+        """The cell's outcome of ``experiment``, its failed step numbered in ``experiment.sequence``."""
+        sent = self.sent(experiment)
+        for attempt in range(1, SEND_ATTEMPTS + 1):
+            try:
+                outcome = request_experiment(self.session, self.cell, sent, self.timeout_s)
+                break
+            except CellTimeout as exc:
+                if attempt == SEND_ATTEMPTS:
+                    raise PlannerError(f"experiment {experiment.id} ({experiment.tested}): {exc}; gave up after "
+                                       f"{attempt} sends") from None
+            except CellRefused as exc:
+                known_state = " (the known state, an order the evidence showed feasible)" \
+                    if exc.reply.code == "invalid_step" else ""
+                raise PlannerError(f"experiment {experiment.id} ({experiment.tested}){known_state}: {exc}") from None
+            except BridgeError as exc:
+                raise PlannerError(f"experiment {experiment.id} ({experiment.tested}): {exc}") from None
+        self.sim_s += outcome.sim_s
+        self.wall_s += outcome.wall_s
+        if outcome.failed_step is not None:
+            skipped = len(experiment.sequence) - len(sent.sequence)
+            outcome = msgspec.structs.replace(outcome, failed_step=outcome.failed_step + skipped)
+        self.outcomes.append(outcome)
+        return outcome
+
+
+MAX_DEMOS = 2
+"""``session --precedence explore`` learns from at most this many demonstrations."""
+
+
+def explore_demos(demos: Demonstrations, truth: Relation | None, seed: int) -> Demonstrations:
+    """The demonstrations an exploring session starts from: the first :data:`MAX_DEMOS` of
+    ``demos``; without any, :data:`MAX_DEMOS` drawn uniformly among the sequences ``truth``
+    admits (a simulated teacher, seeded by ``seed``); PlannerError when there is neither."""
+    if demos.sequences:
+        keep = min(MAX_DEMOS, len(demos.sequences))
+        return Demonstrations(demos.parts, demos.sequences[:keep], demos.origins[:keep], demos.holes[:keep])
+    if truth is None:
+        raise PlannerError("--precedence explore: the product has no demonstrations and no precedence.lp to "
+                           "generate them from; expected a demos.txt or --demos FILE")
+    sampler, rng = UniformSampler(truth), random.Random(seed)
+    sequences = tuple(sampler.sample(rng) for _ in range(MAX_DEMOS))
+    return Demonstrations(truth.parts, sequences, tuple(f"generated demonstration {k} (seed {seed})"
+                                                        for k in range(1, MAX_DEMOS + 1)))
+
+
+@dataclass(frozen=True)
+class ExploredPrecedence:
+    """What an exploring session learned: ``relation`` (closed), what each of its pairs rests
+    on (``supports``: pair → sources, e.g. ``geometry``, ``experiment 3``, ``closure``), the
+    pairs every demonstration shows that the experiments showed free (``process``: to confirm
+    with the user, not learned), the experiments' ``trials``, and the cell's ``sim_s`` and
+    ``wall_s`` [s]."""
+
+    relation: Relation
+    supports: dict[Pair, tuple[str, ...]]
+    process: tuple[Pair, ...]
+    trials: tuple[Trial, ...]
+    sim_s: float
+    wall_s: float
+
+    def lines(self) -> list[str]:
+        """What each learned pair rests on, one line a pair, then the process constraints."""
+        lines = [f"{a}<{b}: {', '.join(self.supports[(a, b)])}" for a, b in self.relation.pairs()]
+        lines += [f"{a}<{b}: every demonstration, but an experiment showed it free: a process constraint to "
+                  "confirm with the user (not learned)" for a, b in self.process]
+        return lines
+
+    def summary(self) -> dict[str, Any]:
+        """What ``session.json`` keeps: ``experiments``, ``sim_s`` and ``wall_s`` [s], ``rests_on``
+        (the :meth:`lines`), ``process`` (pairs)."""
+        return {"experiments": len(self.trials), "sim_s": round(self.sim_s, 3), "wall_s": round(self.wall_s, 3),
+                "rests_on": self.lines(), "process": [list(pair) for pair in self.process]}
+
+    def facts(self) -> list[clingo.Symbol]:
+        """``must_precede/2`` and ``rests_on(A,B,S)`` (S: ``geometry``, ``experiment(E)``,
+        ``closure``), ``process_constraint/2``, ``experiment(E,A,B,R)`` (R: ``success`` or the
+        failure's reason)."""
+        atoms = [fact("must_precede", a, b) for a, b in self.relation.pairs()]
+        for (a, b), sources in sorted(self.supports.items()):
+            for source in sources:
+                name, _, number = source.partition(" ")
+                atoms.append(clingo.Function("rests_on", [clingo.Function(a), clingo.Function(b),
+                                                          clingo.Function(name, [clingo.Number(int(number))])
+                                                          if number else clingo.Function(name)]))
+        atoms += [fact("process_constraint", a, b) for a, b in self.process]
+        atoms += [clingo.Function("experiment", [clingo.Number(e), clingo.Function(t.experiment.pair[0]),
+                                                 clingo.Function(t.experiment.pair[1]),
+                                                 clingo.Function(t.outcome.reason or "success")])
+                  for e, t in enumerate(self.trials, 1)]
+        return atoms
+
+
+def explore_precedence(demos: Demonstrations, geometry: Relation | None, geometry_source: str, oracle: CellOracle,
+                       policy: str = "informative", run_id: str = "explore") -> ExploredPrecedence:
+    """Learn the must-precede relation from ``demos``, the ``geometry`` pairs (None: no CAD)
+    and the experiments the ASP ``policy`` chooses, run by ``oracle``
+    (:func:`asp.precedence.explore.select.explore`) until no pair is open."""
+    evidence = Evidence(demos, () if geometry is None else tuple(geometry.pairs()), geometry_source)
+    for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=1):
+        LOG.info("precedence experiment %d on %s: %s", number, oracle.cell, trial.describe())
+        evidence = evidence.with_trial(trial)
+    knowledge = know(evidence)
+    if knowledge.open:
+        raise PlannerError(f"precedence exploration ended with {len(knowledge.open)} pair(s) open: "
+                           f"{' '.join(f'{a}<{b}' for a, b in sorted(knowledge.open))}")
+    geometric = set(evidence.geometry)
+    confirmed = {pair: e for e, pair in knowledge.confirmed.items()}
+    supports = {pair: tuple(s for s in ("geometry" if pair in geometric else "",
+                                        f"experiment {confirmed[pair]}" if pair in confirmed else "") if s)
+                or ("closure",) for pair in knowledge.known}
+    shown = set(learn_must_precede(demos).pairs())
+    process = tuple(sorted(pair for pair in shown - knowledge.known if pair in knowledge.excluded))
+    return ExploredPrecedence(Relation.from_pairs(demos.parts, knowledge.known), supports, process,
+                              evidence.trials, oracle.sim_s, oracle.wall_s)
