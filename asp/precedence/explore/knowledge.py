@@ -1,0 +1,227 @@
+"""What is known of the true must-precede relation from demonstrations, geometry and
+experiment outcomes (encodings ``precedence_knowledge.lp``: ``precedence/evidence.lp``,
+``precedence/knowledge.lp``, ``precedence/experiment_candidates.lp``).
+
+A failed experiment confirms its pair only when the pair's first part is the one absent
+part that may precede the failing part: the others must be excluded. Exclusions grow with
+the confirmed pairs, so the confirmed pairs are found by a fixpoint (each round one
+solve; knowledge only grows). A failure still undecided at the fixpoint is kept and
+reported, never read as a confirmation. A failure before the tested step (the known
+state was not reached) and every conflict between sources are errors naming their
+evidence (:class:`PrecedenceConflict`).
+"""
+
+from __future__ import annotations
+
+import re
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import clingo
+
+from asp import PlannerError
+from asp.precedence.demos import Demonstrations
+from asp.precedence.relation import Pair
+from asp.solve import fact, solve
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
+
+GEOMETRY = "geometry"
+
+
+class PrecedenceConflict(PlannerError):
+    """Two sources of precedence disagree; the message names both and their evidence."""
+
+
+@dataclass(frozen=True)
+class Trial:
+    """An experiment, its outcome and where the pair came from (a file:line, or the oracle)."""
+
+    experiment: PrecedenceExperiment
+    outcome: PrecedenceOutcome
+    origin: str
+
+    def describe(self) -> str:
+        """E.g. ``experiment run.3 (sh<pd: failed at step 4, unsupported)``."""
+        if self.outcome.outcome == "success":
+            result = f"{self.experiment.pair[1]} placed before {self.experiment.pair[0]}"
+        else:
+            result = f"failed at step {self.outcome.failed_step}, {self.outcome.reason}"
+        where = "" if self.origin == "oracle" else f", {self.origin}"
+        return f"experiment {self.experiment.id} ({self.experiment.tested}: {result}{where})"
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """Everything precedence is learned from. ``geometry``: the pairs the CAD forces (with
+    ``geometry_reasons[pair]`` where the import named one); ``geometry_source``: its file."""
+
+    demos: Demonstrations
+    geometry: tuple[Pair, ...] = ()
+    geometry_source: str = "the geometric precedence"
+    geometry_reasons: dict[Pair, str] = field(default_factory=dict)
+    trials: tuple[Trial, ...] = ()
+
+    @property
+    def parts(self) -> tuple[str, ...]:
+        return self.demos.parts
+
+    def with_trial(self, trial: Trial) -> Evidence:
+        return Evidence(self.demos, self.geometry, self.geometry_source, self.geometry_reasons,
+                        (*self.trials, trial))
+
+    def source_name(self, source: str) -> str:
+        """The evidence a source (``demo(D)``, ``experiment(E)``, ``geometry``) stands for."""
+        name, _, number = source.rstrip(")").partition("(")
+        if name == "demo":
+            return f"demonstration {self.demos.origins[int(number) - 1]}"
+        if name == "experiment":
+            return self.trials[int(number) - 1].describe()
+        return self.geometry_source
+
+    def facts(self) -> list[clingo.Symbol]:
+        """``part/1``, ``part_index/2``, ``demo/3``, ``forced/3`` (geometry) and the experiments'
+        ``experiment_step/3``, ``experiment_success/1``, ``experiment_failed/3`` (E: 1-based)."""
+        atoms = [fact("part", p) for p in self.parts]
+        atoms += [fact("part_index", p, i) for i, p in enumerate(self.parts, 1)]
+        atoms += [fact("demo", d, i, p) for d, sequence in enumerate(self.demos.sequences, 1)
+                  for i, p in enumerate(sequence, 1)]
+        atoms += [fact("forced", a, b, GEOMETRY) for a, b in self.geometry]
+        for e, trial in enumerate(self.trials, 1):
+            atoms += [fact("experiment_step", e, i, step.part) for i, step in enumerate(trial.experiment.sequence, 1)]
+            if trial.outcome.outcome == "success":
+                atoms.append(fact("experiment_success", e))
+            else:
+                assert trial.outcome.failed_step is not None and trial.outcome.reason is not None
+                atoms.append(fact("experiment_failed", e, trial.outcome.failed_step, trial.outcome.reason))
+        return atoms
+
+
+@dataclass(frozen=True)
+class Knowledge:
+    """The knowledge state: ``known`` (closed), ``excluded``, ``open`` pairs; ``candidates``
+    (experiments whose outcome decides their pair) with the parts each ``requires`` before its
+    second part; ``confirmed`` (pairs of failed experiments, by trial index); ``undecided``
+    (failed experiments that confirm nothing yet); ``facts`` (the solver's input)."""
+
+    evidence: Evidence
+    known: frozenset[Pair]
+    excluded: frozenset[Pair]
+    open: frozenset[Pair]
+    candidates: tuple[Pair, ...]
+    requires: dict[Pair, tuple[str, ...]]
+    confirmed: dict[int, Pair]
+    undecided: tuple[Trial, ...]
+    facts: tuple[clingo.Symbol, ...]
+
+
+_ATOM = re.compile(r"^([a-z_]\w*)\((.*)\)$")
+_ARGUMENT = re.compile(r"[a-z_]\w*(?:\(\d+\))?|\d+")
+Atoms = dict[str, list[tuple[str, ...]]]
+
+
+def _solve_knowledge(facts: Sequence[clingo.Symbol]) -> Atoms:
+    """The shown atoms by name, arguments as text (``demo(2)`` for a source): one string
+    per symbol, as clingo's symbol accessors cost a foreign call each."""
+    texts: list[str] = []
+    solve(["precedence_knowledge.lp"], facts, ["--models=1"],
+          lambda m: texts.extend(str(s) for s in m.symbols(shown=True)))
+    atoms: Atoms = {}
+    for text in texts:
+        match = _ATOM.match(text)
+        if match is not None:
+            atoms.setdefault(match.group(1), []).append(tuple(_ARGUMENT.findall(match.group(2))))
+    return atoms
+
+
+def _pairs(atoms: Atoms, name: str) -> frozenset[Pair]:
+    return frozenset((a[0], a[1]) for a in atoms.get(name, ()))
+
+
+def _chain(start: str, goal: str, edges: dict[Pair, str]) -> list[Pair]:
+    """A shortest path of forced edges from ``start`` to ``goal`` (breadth first; a cycle
+    when they are the same part)."""
+    came: dict[str, Pair] = {}
+    queue = deque([start])
+    while queue:
+        node = queue.popleft()
+        for a, b in sorted(edges):
+            if a != node or b in came:
+                continue
+            came[b] = (a, b)
+            if b == goal:
+                path = [came[b]]
+                while path[0][0] != start:
+                    path.insert(0, came[path[0][0]])
+                return path
+            queue.append(b)
+    raise AssertionError(f"no forced chain {start} < {goal}")
+
+
+def _explain_forced(evidence: Evidence, edges: dict[Pair, str], start: str, goal: str) -> str:
+    parts = []
+    for a, b in _chain(start, goal, edges):
+        source = edges[(a, b)]
+        reason = evidence.geometry_reasons.get((a, b)) if source == GEOMETRY else None
+        parts.append(f"{a}<{b} by {evidence.source_name(source)}" + (f" ({reason})" if reason else ""))
+    return "; ".join(parts)
+
+
+def _check_conflicts(evidence: Evidence, atoms: Atoms, edges: dict[Pair, str]) -> None:
+    for (part,) in sorted(atoms.get("cycle", ())):
+        raise PrecedenceConflict(f"conflict: the forced pairs chain {part} before itself: "
+                                 f"{_explain_forced(evidence, edges, part, part)}")
+    for a, b, source in sorted(atoms.get("conflict", ())):
+        raise PrecedenceConflict(f"conflict on {a}<{b}: {evidence.source_name(source)} places {b} before "
+                                     f"{a}, but {a} must precede {b}: {_explain_forced(evidence, edges, a, b)}")
+
+
+def _check_tested_step(trial: Trial) -> None:
+    failed = trial.outcome.failed_step
+    if failed is not None and failed < len(trial.experiment.sequence):
+        step = trial.experiment.sequence[failed - 1]
+        raise PrecedenceConflict(
+            f"{trial.describe()}: step {failed} placing {step.part} failed before the tested step "
+            f"{len(trial.experiment.sequence)}, in an order the evidence showed feasible; expected the known "
+            "state to be reached")
+
+
+def know(evidence: Evidence) -> Knowledge:
+    """The knowledge of ``evidence``; PrecedenceConflict naming the sources that disagree."""
+    for trial in evidence.trials:
+        _check_tested_step(trial)
+        if trial.outcome.pair != trial.experiment.pair:
+            raise PlannerError(f"{trial.describe()}: the outcome is for {'<'.join(trial.outcome.pair)}; "
+                               "expected the experiment's pair")
+    base = evidence.facts()
+    confirmed: dict[int, Pair] = {}
+    while True:
+        facts = base + [clingo.Function("forced", [clingo.Function(a), clingo.Function(b),
+                                                   clingo.Function("experiment", [clingo.Number(e)])])
+                        for e, (a, b) in confirmed.items()]
+        atoms = _solve_knowledge(facts)
+        edges = {(a, b): GEOMETRY for a, b in evidence.geometry}
+        edges.update({pair: f"experiment({e})" for e, pair in confirmed.items()})
+        _check_conflicts(evidence, atoms, edges)
+        excluded = _pairs(atoms, "excluded")
+        grown = dict(confirmed)
+        for e, trial in enumerate(evidence.trials, 1):
+            if e in confirmed or trial.outcome.outcome == "success":
+                continue
+            a, b = trial.experiment.pair
+            before = {step.part for step in trial.experiment.sequence[:-1]}
+            others = [x for x in evidence.parts if x not in before and x not in (a, b)]
+            if all((x, b) in excluded for x in others):
+                grown[e] = (a, b)
+        if grown == confirmed:
+            break
+        confirmed = grown
+    requires: dict[Pair, list[str]] = {}
+    for a, b, x in atoms.get("requires", ()):
+        requires.setdefault((a, b), []).append(x)
+    candidates = sorted(_pairs(atoms, "candidate"))
+    undecided = tuple(t for e, t in enumerate(evidence.trials, 1)
+                      if t.outcome.outcome == "failed" and e not in confirmed)
+    return Knowledge(evidence, _pairs(atoms, "known"), excluded, _pairs(atoms, "open"), tuple(candidates),
+                     {pair: tuple(requires.get(pair, ())) for pair in candidates}, confirmed, undecided,
+                     tuple(facts))
