@@ -326,8 +326,9 @@ def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Dem
     geometry = None if prior is None else load_relation([prior], data=True)
     oracle = CellOracle(session, cells[0], assignment, seed=record.seed, timeout_s=timeout_s)
     explored = explore_precedence(demos, geometry, str(prior or ""), oracle, run_id=f"{record.recording_id}.p")
-    LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)", len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})",
-             len(explored.trials), cells[0], explored.sim_s)
+    LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)",
+             len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})", len(explored.trials),
+             cells[0], explored.sim_s)
     return explored
 
 
@@ -534,7 +535,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             relation = explored.relation
             timings["precedence_s"] = time.perf_counter() - started_explore
             record.precedence_explored = explored.summary()
-            write_facts(run / "precedence_support.lp", explored.facts(), header=_explored_header(assembly, run, explored))
+            write_facts(run / "precedence_support.lp", explored.facts(),
+                        header=_explored_header(assembly, run, explored))
             write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
                         header=_learned_header(assembly, run, sizes, stated_prior))
             log.precedence(relation.parts, reduction(relation))
