@@ -1,4 +1,4 @@
-"""``./run.sh precedence ...``: learn, count, enumerate, sample, evaluate, suggest.
+"""``./run.sh precedence ...``: learn, count, enumerate, sample, evaluate, explore, suggest.
 
 JSON keys are a contract (docs/cli.md). Sequences are printed one per line,
 ids separated by spaces: the demonstrations format, so output can be fed back.
@@ -11,6 +11,8 @@ import json
 import logging
 import random
 from itertools import islice
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from asp import PlannerError
 from asp.precedence.batches import GENERATORS
@@ -38,6 +40,10 @@ from bridge.cli_types import (
     strict_int,
 )
 
+if TYPE_CHECKING:
+    from asp.precedence.explore.knowledge import Evidence
+    from asp.precedence.explore.learner import Learned
+
 LOG = logging.getLogger(__name__)
 
 
@@ -60,6 +66,10 @@ def _parser() -> argparse.ArgumentParser:
                        help="a precedence the demonstrations refine (part/1, must_precede/2: the "
                             "geometric_precedence.lp the import subcommand writes); a demonstration breaking it "
                             "is an error; without demonstrations the prior alone is the relation")
+    learn.add_argument("--experiments", metavar="FILE",
+                       help="precedence experiments and their outcomes (experiments.lp, as `precedence explore` "
+                            "writes it): learn from demonstrations, --prior and experiments, each pair with its "
+                            "support (support/3 facts in --out)")
     learn.add_argument("--evidence", action="store_true",
                        help="add per-pair support/contradiction counts and suspect demonstrations "
                             "(JSON keys evidence, suspects)")
@@ -93,6 +103,19 @@ def _parser() -> argparse.ArgumentParser:
                           help="demonstrations to the exact relation, guided vs random")
     evaluate.add_argument("--json", action="store_true", help="print JSON")
     evaluate.add_argument("--plot", type=nonempty_path, help="write the Figs. 12/13 bar charts to this PNG file")
+
+    explore = commands.add_parser("explore", help="settle what demonstrations and geometry leave open by "
+                                                  "experiments chosen by ASP (answered from the assembly's "
+                                                  "precedence.lp)")
+    explore.add_argument("demos", nargs="?", help="demonstrations file; default: the assembly's demos.txt")
+    add_assembly_argument(explore, None, required=True, purpose="gives the parts and the truth oracle's relation")
+    explore.add_argument("--prior", metavar="FILE", help="the geometric precedence (geometric_precedence.lp)")
+    explore.add_argument("--policy", choices=("informative", "first"), default="informative",
+                         help="informative: the experiment deciding the most pairs whatever its outcome (default); "
+                              "first: the first candidate in part order")
+    explore.add_argument("--limit", type=non_negative_int, help="run at most this many experiments")
+    explore.add_argument("--experiments", type=nonempty_path, help="write the experiments and outcomes here (.lp)")
+    explore.add_argument("--out", type=nonempty_path, help="write the learned facts (with support/3) here")
 
     suggest = commands.add_parser("suggest", help="propose the next sequence to demonstrate")
     suggest.add_argument("demos", nargs="?",
@@ -135,6 +158,9 @@ def _learn(args: argparse.Namespace) -> None:
             check_writable(path)
     prior = load_relation([args.prior], data=True) if args.prior else None
     demos = _demonstrations(args, prior)
+    if args.experiments is not None:
+        _learn_sources(args, demos, prior)
+        return
     if prior is None:
         relation = learn_must_precede(demos, args.min_support)
     else:
@@ -171,6 +197,58 @@ def _learn(args: argparse.Namespace) -> None:
     print("must_precede:", " ".join(f"{a}<{b}" for a, b in relation.pairs()))
     print("reduction:   ", " ".join(f"{a}<{b}" for a, b in edges))
     print("admitted:    ", result["admitted"])
+
+
+def _evidence(args: argparse.Namespace, demos: Demonstrations, prior: Relation | None) -> Evidence:
+    from asp.precedence.explore.knowledge import Evidence
+    from asp.precedence.explore.learner import geometric_reasons
+    from asp.precedence.explore.trials import load_trials
+
+    geometry = tuple(prior.pairs()) if prior is not None else ()
+    trials = load_trials(args.experiments, demos.parts) if getattr(args, "experiments", None) else ()
+    return Evidence(demos, geometry, args.prior or "the geometric precedence", geometric_reasons(args.prior),
+                    trials)
+
+
+def _report(learned: Learned, out: Path | None) -> None:
+    from asp.solve import write_facts
+
+    if out:
+        write_facts(out, learned.facts(), header="precedence learned from demonstrations, geometry and experiments")
+    print(learned.summary())
+    print("admitted:", count_linear_extensions(learned.relation))
+
+
+def _learn_sources(args: argparse.Namespace, demos: Demonstrations, prior: Relation | None) -> None:
+    from asp.precedence.explore.learner import learn_sources
+
+    if args.json or args.dot or args.png or args.evidence or args.min_support != 1:
+        raise PlannerError("--experiments: expected none of --json, --dot, --png, --evidence, --min-support")
+    _report(learn_sources(_evidence(args, demos, prior)), args.out)
+
+
+def _explore(args: argparse.Namespace) -> None:
+    from asp.precedence.explore.learner import learn_sources
+    from asp.precedence.explore.oracle import TruthOracle
+    from asp.precedence.explore.select import explore
+    from asp.precedence.explore.trials import write_trials
+    from bridge.files import check_writable
+
+    for path in (args.out, args.experiments):
+        if path:
+            check_writable(path)
+    assembly = load_assembly(args.assembly)
+    prior = load_relation([args.prior], data=True) if args.prior else None
+    demos = load_demos(args.demos or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
+    evidence = _evidence(argparse.Namespace(prior=args.prior), demos, prior)
+    oracle = TruthOracle(true_relation(assembly))
+    for _knowledge, trial in explore(evidence, oracle, args.policy, limit=args.limit):
+        evidence = evidence.with_trial(trial)
+        print(trial.describe())
+    if args.experiments:
+        write_trials(args.experiments, evidence.trials)
+    print(f"{len(evidence.trials)} experiments")
+    _report(learn_sources(evidence), args.out)
 
 
 def _evaluate(args: argparse.Namespace) -> None:
@@ -243,6 +321,8 @@ def main(argv: list[str]) -> int:
             print(" ".join(sampler.sample(rng)))
     elif args.command == "evaluate":
         _evaluate(args)
+    elif args.command in ("explore",):
+        _explore(args)
     else:
         _suggest(args)
     return 0
