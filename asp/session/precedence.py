@@ -21,20 +21,19 @@ import logging
 import random
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
-import clingo
 import msgspec
 import zenoh
 
 from asp import PlannerError
 from asp.precedence.count import UniformSampler
 from asp.precedence.demos import Demonstrations
-from asp.precedence.explore.knowledge import Evidence, Trial, know
+from asp.precedence.explore.knowledge import Evidence, Trial
+from asp.precedence.explore.learner import Learned, geometric_reasons, learn_sources
 from asp.precedence.explore.select import explore
-from asp.precedence.learn import learn_must_precede
-from asp.precedence.relation import Pair, Relation
-from asp.solve import fact
+from asp.precedence.relation import Relation, load_relation
 from bridge import BridgeError
 from bridge.client import CellRefused, CellTimeout, request_experiment
 from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment, PrecedenceOutcome
@@ -116,70 +115,36 @@ def explore_demos(demos: Demonstrations, truth: Relation | None, seed: int) -> D
 
 @dataclass(frozen=True)
 class ExploredPrecedence:
-    """What an exploring session learned: ``relation`` (closed), what each of its pairs rests
-    on (``supports``: pair → sources, e.g. ``geometry``, ``experiment 3``, ``closure``), the
-    pairs every demonstration shows that the experiments showed free (``process``: to confirm
-    with the user, not learned), the experiments' ``trials``, and the cell's ``sim_s`` and
-    ``wall_s`` [s]."""
+    """What an exploring session learned (``learned``: the relation, each pair's support, the
+    process constraints, :func:`asp.precedence.explore.learner.learn_sources`), the
+    experiments' ``trials``, and the cell's ``sim_s`` and ``wall_s`` [s]."""
 
-    relation: Relation
-    supports: dict[Pair, tuple[str, ...]]
-    process: tuple[Pair, ...]
+    learned: Learned
     trials: tuple[Trial, ...]
     sim_s: float
     wall_s: float
 
-    def lines(self) -> list[str]:
-        """What each learned pair rests on, one line a pair, then the process constraints."""
-        lines = [f"{a}<{b}: {', '.join(self.supports[(a, b)])}" for a, b in self.relation.pairs()]
-        lines += [f"{a}<{b}: every demonstration, but an experiment showed it free: a process constraint to "
-                  "confirm with the user (not learned)" for a, b in self.process]
-        return lines
-
     def summary(self) -> dict[str, Any]:
         """What ``session.json`` keeps: ``experiments``, ``sim_s`` and ``wall_s`` [s], ``rests_on``
-        (the :meth:`lines`), ``process`` (pairs)."""
+        (the learner's summary lines: the pairs by support), ``process`` (pairs)."""
         return {"experiments": len(self.trials), "sim_s": round(self.sim_s, 3), "wall_s": round(self.wall_s, 3),
-                "rests_on": self.lines(), "process": [list(pair) for pair in self.process]}
-
-    def facts(self) -> list[clingo.Symbol]:
-        """``must_precede/2`` and ``rests_on(A,B,S)`` (S: ``geometry``, ``experiment(E)``,
-        ``closure``), ``process_constraint/2``, ``experiment(E,A,B,R)`` (R: ``success`` or the
-        failure's reason)."""
-        atoms = [fact("must_precede", a, b) for a, b in self.relation.pairs()]
-        for (a, b), sources in sorted(self.supports.items()):
-            for source in sources:
-                name, _, number = source.partition(" ")
-                atoms.append(clingo.Function("rests_on", [clingo.Function(a), clingo.Function(b),
-                                                          clingo.Function(name, [clingo.Number(int(number))])
-                                                          if number else clingo.Function(name)]))
-        atoms += [fact("process_constraint", a, b) for a, b in self.process]
-        atoms += [clingo.Function("experiment", [clingo.Number(e), clingo.Function(t.experiment.pair[0]),
-                                                 clingo.Function(t.experiment.pair[1]),
-                                                 clingo.Function(t.outcome.reason or "success")])
-                  for e, t in enumerate(self.trials, 1)]
-        return atoms
+                "rests_on": self.learned.summary().splitlines(), "process": [list(p) for p in self.learned.process]}
 
 
-def explore_precedence(demos: Demonstrations, geometry: Relation | None, geometry_source: str, oracle: CellOracle,
+def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOracle,
                        policy: str = "informative", run_id: str = "explore") -> ExploredPrecedence:
-    """Learn the must-precede relation from ``demos``, the ``geometry`` pairs (None: no CAD)
-    and the experiments the ASP ``policy`` chooses, run by ``oracle``
-    (:func:`asp.precedence.explore.select.explore`) until no pair is open."""
-    evidence = Evidence(demos, () if geometry is None else tuple(geometry.pairs()), geometry_source)
+    """Learn the must-precede relation from ``demos``, the geometric precedence in ``prior``
+    (None: no CAD) and the experiments the ASP ``policy`` chooses, run by ``oracle``
+    (:func:`asp.precedence.explore.select.explore`) until no pair is open; PlannerError when
+    one is left open, PrecedenceConflict where the sources disagree."""
+    geometry = () if prior is None else tuple(load_relation([prior], data=True).pairs())
+    evidence = Evidence(demos, geometry, str(prior or "the geometric precedence"),
+                        geometric_reasons(None if prior is None else str(prior)))
     for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=1):
         LOG.info("precedence experiment %d on %s: %s", number, oracle.cell, trial.describe())
         evidence = evidence.with_trial(trial)
-    knowledge = know(evidence)
-    if knowledge.open:
-        raise PlannerError(f"precedence exploration ended with {len(knowledge.open)} pair(s) open: "
-                           f"{' '.join(f'{a}<{b}' for a, b in sorted(knowledge.open))}")
-    geometric = set(evidence.geometry)
-    confirmed = {pair: e for e, pair in knowledge.confirmed.items()}
-    supports = {pair: tuple(s for s in ("geometry" if pair in geometric else "",
-                                        f"experiment {confirmed[pair]}" if pair in confirmed else "") if s)
-                or ("closure",) for pair in knowledge.known}
-    shown = set(learn_must_precede(demos).pairs())
-    process = tuple(sorted(pair for pair in shown - knowledge.known if pair in knowledge.excluded))
-    return ExploredPrecedence(Relation.from_pairs(demos.parts, knowledge.known), supports, process,
-                              evidence.trials, oracle.sim_s, oracle.wall_s)
+    learned = learn_sources(evidence)
+    if learned.knowledge.open:
+        raise PlannerError(f"precedence exploration ended with {len(learned.knowledge.open)} pair(s) open: "
+                           f"{' '.join(f'{a}<{b}' for a, b in sorted(learned.knowledge.open))}")
+    return ExploredPrecedence(learned, evidence.trials, oracle.sim_s, oracle.wall_s)

@@ -43,6 +43,8 @@ from asp import PlannerError
 from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import Demonstrations, demo_facts
+from asp.precedence.explore.learner import SUPPORTS
+from asp.precedence.explore.trials import write_trials
 from asp.precedence.learn import learn_for_assembly, learn_must_precede, learn_with_prior
 from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from asp.session.cells import CellProcess, cell_seed, stop_all
@@ -323,23 +325,12 @@ def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Dem
     except UnsolvableAssembly as exc:
         raise PlannerError(f"--precedence explore: the learned sizes give no hole assignment to experiment "
                            f"with: {exc}") from None
-    geometry = None if prior is None else load_relation([prior], data=True)
     oracle = CellOracle(session, cells[0], assignment, seed=record.seed, timeout_s=timeout_s)
-    explored = explore_precedence(demos, geometry, str(prior or ""), oracle, run_id=f"{record.recording_id}.p")
+    explored = explore_precedence(demos, prior, oracle, run_id=f"{record.recording_id}.p")
     LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)",
              len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})", len(explored.trials),
              cells[0], explored.sim_s)
     return explored
-
-
-def _explored_header(assembly: Assembly, run: Path, explored: ExploredPrecedence) -> str:
-    """The comment atop ``RUN/precedence_support.lp``."""
-    return "\n".join([
-        f"Precedence learned by exploration on {assembly.name} ({run}): {len(explored.trials)} experiment(s).",
-        "must_precede(A,B): learned; rests_on(A,B,S): its support, S = geometry (the CAD), experiment(E)",
-        "(experiment E failed without A), closure (chained by the others); process_constraint(A,B): every",
-        "demonstration has A before B but an experiment showed it free (to confirm with the user, not learned);",
-        "experiment(E,A,B,R): experiment E tested A<B, R its outcome (success or the failure's reason)."])
 
 
 def view_blueprint(run: Path) -> Path:
@@ -532,11 +523,16 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             started_explore = time.perf_counter()
             explored = _explore(session, cell_ids or sorted(set(directory.alive()) & set(allowed or directory.alive())),
                                 learned, demos, prior, record, settings.timeout_s)
-            relation = explored.relation
+            relation = explored.learned.relation
             timings["precedence_s"] = time.perf_counter() - started_explore
             record.precedence_explored = explored.summary()
-            write_facts(run / "precedence_support.lp", explored.facts(),
-                        header=_explored_header(assembly, run, explored))
+            write_facts(run / "precedence_support.lp", explored.learned.facts(),
+                        header=f"Precedence learned by a session on {assembly.name} ({run}) from "
+                               f"{len(demos.sequences)} demonstration(s), "
+                               f"{'' if prior is None else 'the geometric precedence, '}"
+                               f"{len(explored.trials)} experiment(s) (experiments.lp): support(A,B,S), S one of "
+                               f"{', '.join(SUPPORTS)}; process_constraint(A,B): to confirm with the user.")
+            write_trials(run / "experiments.lp", explored.trials)
             write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
                         header=_learned_header(assembly, run, sizes, stated_prior))
             log.precedence(relation.parts, reduction(relation))
