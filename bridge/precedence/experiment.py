@@ -66,7 +66,10 @@ class ExperimentStep(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 class PrecedenceExperiment(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
                            tag_field="kind", tag="precedence_experiment"):
     """Does ``pair[0]`` truly have to precede ``pair[1]``? Carry out ``sequence`` from a
-    fresh world; its last step places ``pair[1]``, no step places ``pair[0]``."""
+    fresh world; its last step places ``pair[1]``, no step places ``pair[0]``; or, "B then
+    A", it places ``pair[1]`` and then ``pair[0]`` (a precedence the physics shows only when
+    the first part comes second: a cover that goes in without the part under it, which then
+    cannot go in)."""
 
     id: Annotated[RequestId, msgspec.Meta(description="request id: the same request again gets the cached "
                                           "outcome and is never run twice")]
@@ -87,15 +90,22 @@ class PrecedenceExperiment(msgspec.Struct, frozen=True, forbid_unknown_fields=Tr
         given = [step.part for step in self.placed] + parts
         if a == b:
             raise ValueError(f"pair ({a}, {b}): expected two different parts")
-        if parts[-1] != b:
-            raise ValueError(f"sequence ends with {parts[-1]}: expected its last step to place {b}, pair[1]")
-        if a in parts:
-            raise ValueError(f"sequence places {a}: expected pair[0] absent from it")
-        if a in given or b in given[:len(self.placed)]:
+        then_a = self.then_first
+        if parts[-2 if then_a else -1:] != ([b, a] if then_a else [b]):
+            raise ValueError(f"sequence ends with {' '.join(parts[-2:])}: expected its last step to place {b}, "
+                             f"pair[1] (or {b} then {a}, pair[0])")
+        if a in parts[:-1] or (a in parts and not then_a):
+            raise ValueError(f"sequence places {a}: expected pair[0] absent from it (but as the step after {b})")
+        if a in given[:len(self.placed)] or b in given[:len(self.placed)]:
             raise ValueError(f"placed holds {a if a in given else b}: expected neither part of the pair in it")
         twice = next((p for i, p in enumerate(given) if p in given[:i]), None)
         if twice is not None:
             raise ValueError(f"placed and sequence give {twice} twice: expected each part at most once")
+
+    @property
+    def then_first(self) -> bool:
+        """Whether the sequence places ``pair[0]`` after ``pair[1]`` ("B then A")."""
+        return len(self.sequence) >= 2 and self.sequence[-1].part == self.pair[0]
 
     @property
     def tested(self) -> str:

@@ -9,6 +9,7 @@ import queue
 
 import pytest
 
+from asp import PlannerError
 from asp.session.precedence import CellOracle
 from bridge.client import CellRefused, request_experiment
 from bridge.messages import ErrorReply
@@ -69,7 +70,7 @@ def test_truth_cell_answers_experiments_from_the_precedence_and_refuses_bad_ones
 
 
 @pytest.mark.slow
-@pytest.mark.timeout(600)
+@pytest.mark.timeout(900)
 def test_sim_cell_observes_why_a_step_fails() -> None:
     with one_cell("sim", stop_s=120.0) as session:
         # a peg before the back plate: it reaches its goal height in air, and falls once let go
@@ -79,3 +80,10 @@ def test_sim_cell_observes_why_a_step_fails() -> None:
         with pytest.raises(CellRefused) as refused:  # a peg set by hand where the plate is not
             request_experiment(session, "c1", experiment("s2", ("bp", "p2"), "p2", placed="p1"), 300)
         assert refused.value.reply.code == "invalid_step" and "p1 did not stay" in refused.value.reply.error
+        # fp goes in without sp (it rests on pd and the pins), but sp then cannot: the session's
+        # oracle places sp after fp ("B then A") and stops rather than learn sp<fp free
+        oracle = CellOracle(session, "c1", HOLES, seed=1, timeout_s=300)
+        before_fp = PrecedenceExperiment(id="s3", pair=("sp", "fp"), sequence=tuple(
+            ExperimentStep(p) for p in ("bp", "p1", "p2", "p3", "p4", "sh", "ph", "pd", "fp")))
+        with pytest.raises(PlannerError, match=r"fp went in without sp, but sp then did not \(blocked: .*fp"):
+            oracle.run(before_fp)
