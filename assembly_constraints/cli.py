@@ -33,6 +33,7 @@ BENCHMARKS: dict[str, str] = {
     "dominance": "asp.bench.dominance",
     "mesh": "asp.bench.mesh",
     "precedence-physics": "asp.bench.precedence_physics",
+    "precedence-explore": "asp.bench.precedence_explore",
     "assemble": "asp.bench.assemble_plans",
     "executor": "executor.campaign.bench",
     "physics": "executor.campaign.physics",

@@ -199,14 +199,17 @@ def _learn(args: argparse.Namespace) -> None:
     print("admitted:    ", result["admitted"])
 
 
-def _evidence(args: argparse.Namespace, demos: Demonstrations, prior: Relation | None) -> Evidence:
+def _evidence(demos: Demonstrations, prior: Relation | None, prior_file: str | None,
+              experiments: str | None = None) -> Evidence:
+    """The three sources: demonstrations, the geometric prior (and its file) and the
+    experiments file, if any."""
     from asp.precedence.explore.knowledge import Evidence
     from asp.precedence.explore.learner import geometric_reasons
     from asp.precedence.explore.trials import load_trials
 
     geometry = tuple(prior.pairs()) if prior is not None else ()
-    trials = load_trials(args.experiments, demos.parts) if getattr(args, "experiments", None) else ()
-    return Evidence(demos, geometry, args.prior or "the geometric precedence", geometric_reasons(args.prior),
+    trials = load_trials(experiments, demos.parts) if experiments else ()
+    return Evidence(demos, geometry, prior_file or "the geometric precedence", geometric_reasons(prior_file),
                     trials)
 
 
@@ -224,7 +227,7 @@ def _learn_sources(args: argparse.Namespace, demos: Demonstrations, prior: Relat
 
     if args.json or args.dot or args.png or args.evidence or args.min_support != 1:
         raise PlannerError("--experiments: expected none of --json, --dot, --png, --evidence, --min-support")
-    _report(learn_sources(_evidence(args, demos, prior)), args.out)
+    _report(learn_sources(_evidence(demos, prior, args.prior, args.experiments)), args.out)
 
 
 def _explore(args: argparse.Namespace) -> None:
@@ -240,7 +243,7 @@ def _explore(args: argparse.Namespace) -> None:
     assembly = load_assembly(args.assembly)
     prior = load_relation([args.prior], data=True) if args.prior else None
     demos = load_demos(args.demos or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
-    evidence = _evidence(argparse.Namespace(prior=args.prior), demos, prior)
+    evidence = _evidence(demos, prior, args.prior)
     oracle = TruthOracle(true_relation(assembly))
     for _knowledge, trial in explore(evidence, oracle, args.policy, limit=args.limit):
         evidence = evidence.with_trial(trial)

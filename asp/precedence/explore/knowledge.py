@@ -27,6 +27,8 @@ from asp.solve import fact, solve
 from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
 
 GEOMETRY = "geometry"
+POLICIES = {"informative": "select_precedence_informative.lp", "first": "select_precedence_first.lp"}
+"""Experiment policies and their entry encodings (:mod:`asp.precedence.explore.select`)."""
 
 
 class PrecedenceConflict(PlannerError):
@@ -102,7 +104,8 @@ class Knowledge:
     """The knowledge state: ``known`` (closed), ``excluded``, ``open`` pairs; ``candidates``
     (experiments whose outcome decides their pair) with the parts each ``requires`` before its
     second part; ``confirmed`` (pairs of failed experiments, by trial index); ``undecided``
-    (failed experiments that confirm nothing yet); ``facts`` (the solver's input)."""
+    (failed experiments that confirm nothing yet); ``facts`` (the solver's input); the pair
+    ``selected`` by ``policy`` (None: no policy asked, or nothing open)."""
 
     evidence: Evidence
     known: frozenset[Pair]
@@ -113,6 +116,8 @@ class Knowledge:
     confirmed: dict[int, Pair]
     undecided: tuple[Trial, ...]
     facts: tuple[clingo.Symbol, ...]
+    policy: str | None = None
+    selected: Pair | None = None
 
 
 _ATOM = re.compile(r"^([a-z_]\w*)\((.*)\)$")
@@ -120,12 +125,16 @@ _ARGUMENT = re.compile(r"[a-z_]\w*(?:\(\d+\))?|\d+")
 Atoms = dict[str, list[tuple[str, ...]]]
 
 
-def _solve_knowledge(facts: Sequence[clingo.Symbol]) -> Atoms:
-    """The shown atoms by name, arguments as text (``demo(2)`` for a source): one string
-    per symbol, as clingo's symbol accessors cost a foreign call each."""
+def _solve_knowledge(facts: Sequence[clingo.Symbol], entry: str) -> Atoms:
+    """The shown atoms of the last (optimal) model of ``entry`` by name, arguments as text
+    (``demo(2)`` for a source): one string per symbol, as clingo's symbol accessors cost a
+    foreign call each."""
     texts: list[str] = []
-    solve(["precedence_knowledge.lp"], facts, ["--models=1"],
-          lambda m: texts.extend(str(s) for s in m.symbols(shown=True)))
+
+    def on_model(model: clingo.Model) -> None:
+        texts[:] = [str(s) for s in model.symbols(shown=True)]
+
+    solve([entry], facts, ["--opt-mode=opt"], on_model)
     atoms: Atoms = {}
     for text in texts:
         match = _ATOM.match(text)
@@ -186,33 +195,40 @@ def _check_tested_step(trial: Trial) -> None:
             "state to be reached")
 
 
-def know(evidence: Evidence) -> Knowledge:
-    """The knowledge of ``evidence``; PrecedenceConflict naming the sources that disagree."""
+def decisive(trial: Trial, excluded: frozenset[Pair], parts: Sequence[str]) -> bool:
+    """Whether a failure at the tested step confirms the pair: every absent part but its
+    first is excluded from preceding its second."""
+    a, b = trial.experiment.pair
+    before = {step.part for step in trial.experiment.sequence[:-1]}
+    return trial.outcome.outcome == "failed" and all(
+        (x, b) in excluded for x in parts if x not in before and x not in (a, b))
+
+
+def know(evidence: Evidence, policy: str | None = None, confirmed: dict[int, Pair] | None = None) -> Knowledge:
+    """The knowledge of ``evidence`` and, with a ``policy`` (:data:`POLICIES`), the pair it
+    tests next; PrecedenceConflict naming the sources that disagree. ``confirmed``: failed
+    trials (by 1-based index) already found decisive on earlier knowledge (it only grows,
+    so they stay decisive): the fixpoint starts from them."""
     for trial in evidence.trials:
         _check_tested_step(trial)
         if trial.outcome.pair != trial.experiment.pair:
             raise PlannerError(f"{trial.describe()}: the outcome is for {'<'.join(trial.outcome.pair)}; "
                                "expected the experiment's pair")
     base = evidence.facts()
-    confirmed: dict[int, Pair] = {}
+    confirmed = dict(confirmed or {})
+    entry = POLICIES[policy] if policy is not None else "precedence_knowledge.lp"
     while True:
         facts = base + [clingo.Function("forced", [clingo.Function(a), clingo.Function(b),
                                                    clingo.Function("experiment", [clingo.Number(e)])])
                         for e, (a, b) in confirmed.items()]
-        atoms = _solve_knowledge(facts)
+        atoms = _solve_knowledge(facts, entry)
         edges = {(a, b): GEOMETRY for a, b in evidence.geometry}
         edges.update({pair: f"experiment({e})" for e, pair in confirmed.items()})
         _check_conflicts(evidence, atoms, edges)
         excluded = _pairs(atoms, "excluded")
         grown = dict(confirmed)
-        for e, trial in enumerate(evidence.trials, 1):
-            if e in confirmed or trial.outcome.outcome == "success":
-                continue
-            a, b = trial.experiment.pair
-            before = {step.part for step in trial.experiment.sequence[:-1]}
-            others = [x for x in evidence.parts if x not in before and x not in (a, b)]
-            if all((x, b) in excluded for x in others):
-                grown[e] = (a, b)
+        grown.update({e: trial.experiment.pair for e, trial in enumerate(evidence.trials, 1)
+                      if e not in confirmed and decisive(trial, excluded, evidence.parts)})
         if grown == confirmed:
             break
         confirmed = grown
@@ -222,6 +238,7 @@ def know(evidence: Evidence) -> Knowledge:
     candidates = sorted(_pairs(atoms, "candidate"))
     undecided = tuple(t for e, t in enumerate(evidence.trials, 1)
                       if t.outcome.outcome == "failed" and e not in confirmed)
+    selected = sorted(_pairs(atoms, "select"))
     return Knowledge(evidence, _pairs(atoms, "known"), excluded, _pairs(atoms, "open"), tuple(candidates),
                      {pair: tuple(requires.get(pair, ())) for pair in candidates}, confirmed, undecided,
-                     tuple(facts))
+                     tuple(facts), policy, selected[0] if selected else None)

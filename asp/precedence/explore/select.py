@@ -12,16 +12,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-import clingo
-
 from asp import PlannerError
-from asp.precedence.explore.knowledge import Evidence, Knowledge, Trial, know
+from asp.precedence.explore.knowledge import POLICIES, Evidence, Knowledge, Trial, decisive, know
 from asp.precedence.explore.oracle import Oracle
 from asp.precedence.relation import Pair
-from asp.solve import solve
 from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment
-
-POLICIES = {"informative": "select_precedence_informative.lp", "first": "select_precedence_first.lp"}
 
 
 def select_pair(knowledge: Knowledge, policy: str = "informative") -> Pair | None:
@@ -33,16 +28,11 @@ def select_pair(knowledge: Knowledge, policy: str = "informative") -> Pair | Non
     if not knowledge.evidence.demos.sequences:
         raise PlannerError("precedence experiments need at least one demonstration (a feasible order to start "
                            "from); expected a demonstrations file")
-    chosen: list[Pair] = []
-
-    def on_model(model: clingo.Model) -> None:
-        chosen[:] = [(str(s.arguments[0]), str(s.arguments[1])) for s in model.symbols(shown=True)
-                     if s.name == "select"]
-
-    solve([POLICIES[policy]], knowledge.facts, ["--opt-mode=opt"], on_model)
-    if len(chosen) != 1:
-        raise AssertionError(f"{POLICIES[policy]} selected {chosen}; expected one pair")
-    return chosen[0]
+    if knowledge.policy != policy:
+        knowledge = know(knowledge.evidence, policy, knowledge.confirmed)
+    if knowledge.selected is None:
+        raise AssertionError(f"{POLICIES[policy]} selected no pair among {len(knowledge.candidates)} candidates")
+    return knowledge.selected
 
 
 def experiment_for(knowledge: Knowledge, pair: Pair, request_id: str) -> PrecedenceExperiment:
@@ -58,7 +48,7 @@ def explore(evidence: Evidence, oracle: Oracle, policy: str = "informative", run
     """Experiments until nothing is open (or ``limit`` of them): yields the knowledge each
     was chosen from and the trial (experiment and outcome); the last knowledge is
     :func:`know` of the evidence with every trial."""
-    knowledge = know(evidence)
+    knowledge = know(evidence, policy)
     count = 0
     while limit is None or count < limit:
         pair = select_pair(knowledge, policy)
@@ -69,4 +59,7 @@ def explore(evidence: Evidence, oracle: Oracle, policy: str = "informative", run
         trial = Trial(experiment, oracle.run(experiment), "oracle")
         yield knowledge, trial
         evidence = evidence.with_trial(trial)
-        knowledge = know(evidence)
+        confirmed = dict(knowledge.confirmed)
+        if decisive(trial, knowledge.excluded, evidence.parts):
+            confirmed[len(evidence.trials)] = pair
+        knowledge = know(evidence, policy, confirmed)

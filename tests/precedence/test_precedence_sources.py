@@ -1,0 +1,153 @@
+"""One learner of demonstrations, geometry and experiments (truth oracle): the support of
+each pair, process constraints, conflicts named with their evidence, the experiments file,
+and exploration reaching the true relation with no wrong pair (property test)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+
+from asp import PlannerError
+from asp.precedence.demos import Demonstrations, load_demos
+from asp.precedence.explore.bound import information_bound
+from asp.precedence.explore.knowledge import Evidence, PrecedenceConflict, Trial, know
+from asp.precedence.explore.learner import geometric_reasons, learn_sources
+from asp.precedence.explore.oracle import TruthOracle
+from asp.precedence.explore.select import explore
+from asp.precedence.explore.trials import load_trials, write_trials
+from asp.precedence.relation import Relation, close, true_relation
+from bridge.assembly import load_assembly
+from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment, PrecedenceOutcome
+from tests._precedence_helpers import poset_with_demos
+
+CRANFIELD_GEOMETRY = """% bp->p1: base
+% sh->pd: locates
+% pd->fp: supports
+part(bp). part(p1). part(p2). part(p3). part(p4). part(sh). part(sp). part(pd). part(ph). part(fp).
+must_precede(bp,p1). must_precede(sh,pd). must_precede(pd,fp). must_precede(sh,fp).
+"""
+
+
+def _explored(evidence: Evidence, truth: Relation, policy: str = "informative") -> Evidence:
+    for _knowledge, trial in explore(evidence, TruthOracle(truth), policy):
+        evidence = evidence.with_trial(trial)
+    return evidence
+
+
+def _trial(number: int, pair: tuple[str, str], parts: list[str], failed: int | None = None) -> Trial:
+    experiment = PrecedenceExperiment(id=f"t.{number}", pair=pair, sequence=tuple(map(ExperimentStep, parts)))
+    outcome = (PrecedenceOutcome(id=f"t.{number}", cell="c", pair=pair, outcome="success") if failed is None else
+               PrecedenceOutcome(id=f"t.{number}", cell="c", pair=pair, outcome="failed", failed_step=failed,
+                                 reason="jammed"))
+    return Trial(experiment, outcome, f"x.lp:{number}")
+
+
+@pytest.mark.slow
+def test_cranfield_from_demonstrations_geometry_and_experiments_each_pair_with_its_support(
+        tmp_path: Path, root: Path) -> None:
+    truth = true_relation(load_assembly("cranfield"))
+    prior = tmp_path / "geometric_precedence.lp"
+    prior.write_text(CRANFIELD_GEOMETRY)
+    demos = load_demos(root / "data/cranfield/demos.txt", truth.parts)
+    geometry = (("bp", "p1"), ("sh", "pd"), ("pd", "fp"), ("sh", "fp"))
+    evidence = _explored(Evidence(demos, geometry, str(prior), geometric_reasons(str(prior))), truth)
+    learned = learn_sources(evidence)
+    assert learned.relation.same_as(truth)
+    assert {p for p, s in learned.support.items() if s == "geometry"} == set(geometry)
+    assert {p for p, s in learned.support.items() if s == "experiment"} == set(truth.pairs()) - set(geometry)
+    assert not learned.process and not learned.undecided
+    # the geometric pairs were never tested: every experiment was on another pair
+    assert not {t.experiment.pair for t in evidence.trials} & set(geometry)
+    assert "sh<pd (locates)" in learned.summary()
+
+
+def test_without_experiments_open_pairs_are_demonstrated_only() -> None:
+    truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
+    learned = learn_sources(Evidence(Demonstrations(truth.parts, (("a", "b", "c"),), ("d:1",))))
+    assert learned.support == {("a", "b"): "demonstrated", ("a", "c"): "demonstrated", ("b", "c"): "demonstrated"}
+
+
+def test_a_demonstrated_order_the_physics_shows_free_is_a_process_constraint() -> None:
+    truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
+    demos = Demonstrations(truth.parts, (("a", "b", "c"), ("a", "b", "c")), ("d:1", "d:2"))
+    learned = learn_sources(_explored(Evidence(demos), truth))
+    assert learned.relation.same_as(truth) and learned.support == {("a", "b"): "experiment"}
+    assert learned.process == (("a", "c"), ("b", "c"))
+    assert "process constraints to confirm with the user" in learned.summary()
+
+
+def test_a_demonstration_against_geometry_names_both() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("b", "a", "c"),), ("demos.txt:3",))
+    with pytest.raises(PrecedenceConflict, match=re.escape("demonstration demos.txt:3 places b before a, but a must "
+                                                           "precede b: a<b by geo.lp (blocks)")):
+        know(Evidence(demos, (("a", "b"),), "geo.lp", {("a", "b"): "blocks"}))
+
+
+def test_an_experiment_against_a_demonstration_names_both() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("b", "a", "c"),), ("demos.txt:1",))
+    trial = _trial(1, ("a", "b"), ["c", "b"], failed=2)
+    with pytest.raises(PrecedenceConflict, match=re.escape("demonstration demos.txt:1 places b before a, but a must "
+                                                           "precede b: a<b by experiment t.1 (a<b: failed at step 2, "
+                                                           "jammed, x.lp:1)")):
+        know(Evidence(demos, trials=(trial,)))
+
+
+def test_two_experiments_against_each_other_name_both() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("a", "b", "c"),), ("demos.txt:1",))
+    failed = _trial(1, ("a", "b"), ["c", "b"], failed=2)
+    success = _trial(2, ("a", "b"), ["b"])
+    with pytest.raises(PrecedenceConflict, match=r"experiment t\.2 \(a<b: b placed before a.*experiment t\.1"):
+        know(Evidence(demos, trials=(failed, success)))
+
+
+def test_a_failure_before_the_tested_step_is_an_error() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("a", "b", "c"),), ("demos.txt:1",))
+    with pytest.raises(PrecedenceConflict, match="step 1 placing c failed before the tested step 2"):
+        know(Evidence(demos, trials=(_trial(1, ("a", "b"), ["c", "b"], failed=1),)))
+
+
+def test_a_failure_another_absent_part_may_explain_confirms_nothing() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("a", "b", "c"),), ("demos.txt:1",))
+    learned = learn_sources(Evidence(demos, trials=(_trial(1, ("b", "c"), ["c"], failed=1),)))
+    assert [t.experiment.id for t in learned.undecided] == ["t.1"]
+    assert learned.support[("b", "c")] == "demonstrated"  # a may be the part c needs
+
+
+def test_experiments_file_round_trip_and_bad_files(tmp_path: Path) -> None:
+    truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
+    evidence = _explored(Evidence(Demonstrations(truth.parts, (("a", "b", "c"),), ("d:1",))), truth)
+    path = tmp_path / "experiments.lp"
+    write_trials(path, evidence.trials)
+    loaded = load_trials(path, truth.parts)
+    assert [(t.experiment, t.outcome.outcome, t.outcome.failed_step) for t in loaded] == [
+        (t.experiment, t.outcome.outcome, t.outcome.failed_step) for t in evidence.trials]
+    path.write_text('experiment(1,"x",a,b).\nexperiment_step(1,1,q).\nexperiment_success(1).\n')
+    with pytest.raises(PlannerError, match=re.escape(f"{path}:2: q is not a part (a b c)")):
+        load_trials(path, truth.parts)
+    path.write_text('experiment(1,"x",a,b).\nexperiment_step(1,1,a).\nexperiment_step(1,2,b).\nexperiment_success(1).\n')
+    with pytest.raises(PlannerError, match="expected pair\\[0\\] absent"):
+        load_trials(path, truth.parts)
+
+
+@pytest.mark.slow
+@settings(max_examples=10, deadline=None)
+@given(poset_with_demos(max_parts=5, max_demos=2))
+def test_exploration_reaches_the_true_relation_and_no_pair_is_wrong(case: tuple[Relation, list[tuple[str, ...]]]
+                                                                     ) -> None:
+    truth, sequences = case
+    demos = Demonstrations(truth.parts, tuple(sequences), tuple(f"d:{i}" for i in range(len(sequences))))
+    learned = learn_sources(_explored(Evidence(demos), truth, "first"))
+    assert learned.relation.same_as(truth)
+    assert set(learned.support.values()) <= {"experiment"}
+
+
+def test_information_bound_counts_the_relations_left() -> None:
+    demos = Demonstrations(("a", "b", "c"), (("a", "b", "c"),), ("d:1",))
+    bound = information_bound(know(Evidence(demos)))
+    assert (bound.relations, bound.complete) == (7, True)  # the naturally labelled posets on 3 parts
+    truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
+    settled = information_bound(know(_explored(Evidence(demos), truth)))
+    assert (settled.relations, settled.bits) == (1, 0.0)
