@@ -114,9 +114,10 @@ class AssemblyRunner:
                 sim_s += record.sim_time_s
                 if record.outcome != "fit":
                     touched = f", touching {' '.join(record.involved)}" if record.involved else ""
+                    where = (f"left {record.pose_error * 1000.0:.1f} mm from its goal" if record.reason == "unsupported"
+                             else "put back on the tray")
                     detail = (f"{step.part} {record.reason} after {record.attempts} attempt(s): largest force "
-                              f"deviation {record.max_force_dev:.1f} N, {record.pose_error * 1000.0:.1f} mm from "
-                              f"its goal{touched}")
+                              f"deviation {record.max_force_dev:.1f} N, {where}{touched}")
                     return ExperimentRun(k, record.reason, detail, sim_s)
             return ExperimentRun(sim_s=sim_s)
         finally:
