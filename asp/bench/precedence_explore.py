@@ -30,7 +30,7 @@ from asp.precedence.explore.select import POLICIES, explore
 from asp.precedence.guide import evaluate_guided
 from asp.precedence.relation import Relation, load_relation, true_relation
 from bridge.assembly import load_assembly
-from bridge.cli_types import ArgumentParser, comma_list, int_in, number_in, strict_int
+from bridge.cli_types import ASSEMBLY_HELP, ArgumentParser, comma_list, int_in, number_in, strict_int
 from bridge.progress import progress
 
 
@@ -122,8 +122,8 @@ def _print(result: dict[str, Any], seeds: int) -> None:
 def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench precedence-explore", description=__doc__.splitlines()[0])
     parser.add_argument("--assembly", action="append", metavar="A[:PRIOR]",
-                        help="a product with precedence.lp, optionally with its geometric_precedence.lp after a "
-                             "colon (repeatable; default cranfield)")
+                        help=f"{ASSEMBLY_HELP}, with precedence.lp; after a colon its geometric_precedence.lp "
+                             "(repeatable; default cranfield)")
     parser.add_argument("--seeds", type=int_in(1, 10**5), default=100, help="seeds per product (default 100)")
     parser.add_argument("--policies", default="informative,first",
                         type=comma_list(str, "policies such as informative,first"),

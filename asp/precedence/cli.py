@@ -67,7 +67,7 @@ def _parser() -> argparse.ArgumentParser:
                             "geometric_precedence.lp the import subcommand writes); a demonstration breaking it "
                             "is an error; without demonstrations the prior alone is the relation")
     learn.add_argument("--experiments", metavar="FILE",
-                       help="precedence experiments and their outcomes (experiments.lp, as `precedence explore` "
+                       help="precedence experiments and their outcomes (experiments.lp, as precedence explore "
                             "writes it): learn from demonstrations, --prior and experiments, each pair with its "
                             "support (support/3 facts in --out)")
     learn.add_argument("--evidence", action="store_true",

@@ -45,7 +45,6 @@ def _trial(number: int, pair: tuple[str, str], parts: list[str], failed: int | N
     return Trial(experiment, outcome, f"x.lp:{number}")
 
 
-@pytest.mark.slow
 def test_cranfield_from_demonstrations_geometry_and_experiments_each_pair_with_its_support(
         tmp_path: Path, root: Path) -> None:
     truth = true_relation(load_assembly("cranfield"))
@@ -132,8 +131,7 @@ def test_experiments_file_round_trip_and_bad_files(tmp_path: Path) -> None:
         load_trials(path, truth.parts)
 
 
-@pytest.mark.slow
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=12, deadline=None)
 @given(poset_with_demos(max_parts=5, max_demos=2))
 def test_exploration_reaches_the_true_relation_and_no_pair_is_wrong(case: tuple[Relation, list[tuple[str, ...]]]
                                                                      ) -> None:
