@@ -2,7 +2,8 @@
 
 - :class:`CellDirectory` follows the cells' liveliness tokens (``cell/*/alive``).
 - :func:`send_insert` sends one request asynchronously; :func:`request_insert` waits for it;
-  :func:`request_step` sends one plan step and waits for it.
+  :func:`request_step` sends one plan step and waits for it, :func:`request_experiment` one
+  precedence experiment.
 - :class:`CellPool` keeps every alive cell busy with submitted requests: one request per
   cell, a cell that dies (token gone) or times out has its request re-sent to another
   cell (or the pool waits for one), and each request's reply is returned exactly once.
@@ -26,7 +27,7 @@ import msgspec
 import zenoh
 
 from bridge import BridgeError
-from bridge.keys import ALIVE_PATTERN, cell_of_alive_key, insert_key, step_key
+from bridge.keys import ALIVE_PATTERN, cell_of_alive_key, insert_key, precedence_key, step_key
 from bridge.messages import (
     ErrorReply,
     InsertReply,
@@ -37,8 +38,14 @@ from bridge.messages import (
     decode_reply,
     encode,
 )
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome, decode_outcome_reply
 
 _LOG = logging.getLogger(__name__)
+
+Request = InsertRequest | StepRequest | PrecedenceExperiment
+"""What a planner asks a cell."""
+Reply = InsertReply | StepReply | PrecedenceOutcome
+"""What a cell answers a request it ran."""
 
 
 class CellTimeout(BridgeError):
@@ -159,8 +166,8 @@ def send_insert(session: zenoh.Session, cell: str, request: InsertRequest, timeo
     return _send(session, insert_key(cell), cell, request, timeout, on_outcome)  # type: ignore[arg-type]
 
 
-def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | StepRequest, timeout: float,
-          on_outcome: Callable[[InsertReply | StepReply | BridgeError], None]) -> zenoh.CancellationToken:
+def _send(session: zenoh.Session, key: str, cell: str, request: Request, timeout: float,
+          on_outcome: Callable[[Reply | BridgeError], None]) -> zenoh.CancellationToken:
     """Send ``request`` to ``cell``; ``on_outcome`` is called exactly once (Zenoh thread),
     when the query ends (the cell finalises it after replying, or ``timeout`` [s] passes).
 
@@ -171,7 +178,7 @@ def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | 
     the query was cancelled. Returns a token that cancels the query.
     """
     lock = threading.Lock()
-    answers: list[InsertReply | StepReply | ErrorReply] = []
+    answers: list[Reply | ErrorReply] = []
     faults: list[BridgeError] = []
     sent = time.monotonic()
 
@@ -181,7 +188,9 @@ def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | 
             if ok is None:
                 detail = err.payload.to_string() if err is not None else "neither a sample nor an error"
                 raise CellTimeout(f"cell {cell}: query error: {detail}")
-            message = decode_reply(ok.payload.to_bytes())
+            payload = ok.payload.to_bytes()
+            message = (decode_outcome_reply(payload) if isinstance(request, PrecedenceExperiment)
+                       else decode_reply(payload))
             check_echo(message, cell, request)
         except BridgeError as exc:
             with lock:
@@ -213,17 +222,28 @@ def _send(session: zenoh.Session, key: str, cell: str, request: InsertRequest | 
     return cancel
 
 
-def check_echo(message: InsertReply | StepReply | ErrorReply, cell: str,
-               request: InsertRequest | StepRequest) -> None:
+_ANSWERS: dict[type, type] = {InsertRequest: InsertReply, StepRequest: StepReply,
+                              PrecedenceExperiment: PrecedenceOutcome}
+"""The reply type of each request type."""
+
+
+def _asked(message: Request | Reply) -> tuple:
+    """What a reply echoes of its request: part and hole, or a precedence experiment's pair."""
+    if isinstance(message, (PrecedenceExperiment, PrecedenceOutcome)):
+        return (message.pair,)
+    return message.part, message.hole
+
+
+def check_echo(message: Reply | ErrorReply, cell: str, request: Request) -> None:
     """MessageError unless ``message`` comes from ``cell`` and answers ``request`` (a reply of
     the request's kind)."""
-    asked = (cell, request.id, request.part, request.hole)
-    if isinstance(message, (InsertReply, StepReply)):
-        if isinstance(message, StepReply) != isinstance(request, StepRequest):
-            raise MessageError("malformed", f"a {type(message).__name__} does not answer a {type(request).__name__}")
-        answered = (message.cell, message.id, message.part, message.hole)
+    asked = (cell, request.id, *_asked(request))
+    if isinstance(message, ErrorReply):
+        answered = (message.cell, message.id or request.id, *_asked(request))
     else:
-        answered = (message.cell, message.id or request.id, request.part, request.hole)
+        if not isinstance(message, _ANSWERS[type(request)]):
+            raise MessageError("malformed", f"a {type(message).__name__} does not answer a {type(request).__name__}")
+        answered = (message.cell, message.id, *_asked(message))
     if answered != asked:
         raise MessageError("malformed", f"reply {answered} does not echo the request {asked}")
 
@@ -242,17 +262,31 @@ def request_insert(session: zenoh.Session, cell: str, request: InsertRequest,
     return outcome
 
 
-def request_step(session: zenoh.Session, cell: str, request: StepRequest, timeout: float) -> StepReply:
-    """Send a plan step to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
-    box: queue.SimpleQueue[InsertReply | StepReply | BridgeError] = queue.SimpleQueue()
-    _send(session, step_key(cell), cell, request, timeout, box.put)
+def _request(session: zenoh.Session, key: str, cell: str, request: Request, timeout: float) -> Reply:
+    """Send ``request`` on ``key`` to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
+    box: queue.SimpleQueue[Reply | BridgeError] = queue.SimpleQueue()
+    _send(session, key, cell, request, timeout, box.put)
     try:
         outcome = box.get(timeout=timeout + 5.0)
     except queue.Empty:
         raise CellTimeout(f"cell {cell}: query {request.id} never ended") from None
     if isinstance(outcome, BridgeError):
         raise outcome
+    return outcome
+
+
+def request_step(session: zenoh.Session, cell: str, request: StepRequest, timeout: float) -> StepReply:
+    """Send a plan step to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
+    outcome = _request(session, step_key(cell), cell, request, timeout)
     assert isinstance(outcome, StepReply)  # check_echo let only a StepReply through
+    return outcome
+
+
+def request_experiment(session: zenoh.Session, cell: str, experiment: PrecedenceExperiment,
+                       timeout: float) -> PrecedenceOutcome:
+    """Send a precedence experiment to ``cell`` and wait; raises CellTimeout, CellRefused, MessageError."""
+    outcome = _request(session, precedence_key(cell), cell, experiment, timeout)
+    assert isinstance(outcome, PrecedenceOutcome)  # check_echo let only a PrecedenceOutcome through
     return outcome
 
 

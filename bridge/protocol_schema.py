@@ -32,16 +32,23 @@ from bridge.messages import (
     StepReply,
     StepRequest,
 )
+from bridge.precedence.experiment import EXPERIMENT_VERSION, PrecedenceExperiment, PrecedenceOutcome
 from bridge.product import AssemblyFile, GeometryFile
 
 MESSAGES: dict[str, tuple[type[msgspec.Struct], str]] = {
     "insert_request": (InsertRequest, "planner → cell, a query on cell/<id>/insert"),
     "insert_reply": (InsertReply, "cell → planner, the reply to an insert request"),
-    "error_reply": (ErrorReply, "cell → planner, a refused insert or step request"),
+    "error_reply": (ErrorReply, "cell → planner, a refused insert, step or precedence request"),
     "step_request": (StepRequest, "planner → cell, a query on cell/<id>/step: one step of a plan"),
     "step_reply": (StepReply, "cell → planner, the reply to a step request"),
+    "precedence_experiment": (PrecedenceExperiment, "planner → cell, a query on cell/<id>/precedence: a "
+                              "precedence experiment"),
+    "precedence_outcome": (PrecedenceOutcome, "cell → planner, the reply to a precedence experiment"),
 }
 """File stem → (message type, who sends it where)."""
+VERSIONS: dict[type[msgspec.Struct], int] = {PrecedenceExperiment: EXPERIMENT_VERSION,
+                                             PrecedenceOutcome: EXPERIMENT_VERSION}
+"""The message types versioned on their own (the others: PROTOCOL_VERSION)."""
 PRODUCT_FILES: dict[str, tuple[type[msgspec.Struct], str]] = {
     "assembly": (AssemblyFile, "assembly.toml of a product folder: parts, holes, the declared size model"),
     "geometry": (GeometryFile, "geometry.toml of a product folder: the cell geometry, base, covers and heads"),
@@ -61,7 +68,8 @@ def _plain(value: object) -> object:
 
 def schema(message: type[msgspec.Struct], direction: str) -> dict:
     """The JSON Schema (draft 2020-12) of one message type, self-contained (``$defs``)."""
-    return _schema(message, f"{direction}; protocol version {PROTOCOL_VERSION}, at most {MAX_MESSAGE_BYTES} "
+    version = VERSIONS.get(message, PROTOCOL_VERSION)
+    return _schema(message, f"{direction}; protocol version {version}, at most {MAX_MESSAGE_BYTES} "
                    "bytes of UTF-8 JSON")
 
 
@@ -83,7 +91,9 @@ def schemas() -> dict[str, str]:
               for stem, (kind, what) in PRODUCT_FILES.items()}
     texts["protocol.json"] = {"protocol_version": PROTOCOL_VERSION, "max_message_bytes": MAX_MESSAGE_BYTES,
                               "cell_id_pattern": CELL_ID_PATTERN, "alive_pattern": ALIVE_PATTERN,
-                              "keys": {"insert": "cell/<id>/insert", "ping": "cell/<id>/ping",
+                              "experiment_version": EXPERIMENT_VERSION,
+                              "keys": {"insert": "cell/<id>/insert", "step": "cell/<id>/step",
+                                       "precedence": "cell/<id>/precedence", "ping": "cell/<id>/ping",
                                        "alive": "cell/<id>/alive/<instance>"},
                               "messages": {f"{stem}.schema.json": direction
                                            for stem, (_, direction) in MESSAGES.items()}}

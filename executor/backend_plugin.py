@@ -17,6 +17,11 @@ class with
   a step the product does not allow raises :class:`InvalidStep` (``invalid_step``, see
   :func:`check_step`) before anything moves; a cell that only learns may raise
   :class:`executor.ExecutorError` (the planner gets ``failed``);
+- optionally ``run_precedence(self, experiment: PrecedenceExperiment) -> ExperimentRun``: a
+  precedence experiment (set the ``placed`` parts at their goals, assemble ``sequence``,
+  stop at the first failing step and say why), checked first with
+  :func:`check_experiment`; :class:`InvalidStep` when the placed parts do not stay where
+  they were set; a backend without it answers ``failed``;
 - ``close(self)``: release the robot.
 
 ``run`` is called from one thread, one experiment at a time. Start it with
@@ -38,6 +43,7 @@ from typing import Protocol
 
 from bridge.inputs import shorten
 from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from bridge.precedence.experiment import FailureReason, PrecedenceExperiment
 from executor import ExecutorError, UnknownPair
 
 _SPEC = re.compile(r"^([A-Za-z_][\w.]*):([A-Za-z_]\w*)$")
@@ -80,6 +86,35 @@ def check_run(current: str | None, run: str, parts: Collection[str], placed: Col
 
 StepOutcome = tuple[Result, StepEvidence, dict[str, float]]
 """A plan step's outcome, its evidence and every placed part's distance from its goal [mm]."""
+
+
+@dataclass(frozen=True)
+class ExperimentRun:
+    """What a cell saw carrying out a precedence experiment: the 1-based ``failed_step`` of
+    its sequence and the ``reason`` (None, None: every step done), a one-line ``detail`` and
+    the simulated time ``sim_s`` [s]."""
+
+    failed_step: int | None = None
+    reason: FailureReason | None = None
+    detail: str = ""
+    sim_s: float = 0.0
+
+
+def check_experiment(experiment: PrecedenceExperiment, *, parts: Collection[str], pegs: Collection[str],
+                     holes: Collection[str]) -> None:
+    """Refuse a precedence experiment before anything moves: every step of ``placed`` then
+    ``sequence`` checked by :func:`check_step` against the ones before it, and InvalidStep
+    for a hole given twice."""
+    placed: list[str] = []
+    used: set[str] = set()
+    for step in (*experiment.placed, *experiment.sequence):
+        check_step(step.part, step.hole, parts=parts, pegs=pegs, holes=holes, placed=placed)
+        if step.hole is not None and step.hole in used:
+            raise InvalidStep(f"hole '{step.hole}' is given twice (the second time to {step.part}); "
+                              "expected every hole at most once")
+        placed.append(step.part)
+        if step.hole is not None:
+            used.add(step.hole)
 
 
 class Backend(Protocol):

@@ -13,7 +13,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from msgspec import UNSET
+from msgspec import UNSET, UnsetType
 
 from asp.session.cells import ROOT
 from asp.session.run import LOG, run_session
@@ -21,6 +21,7 @@ from asp.session.settings import (
     MAX_CELLS,
     MAX_PLANS,
     MAX_WAIT_S,
+    PRECEDENCE_MODES,
     SessionSettings,
     prior_statement,
     read_session_file,
@@ -64,6 +65,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--demos", type=Path, metavar="FILE",
                         help="demonstrations (default: the assembly's demos.txt); a part placed into a "
                              "hole (p1@r1) is a fit the size learning starts from")
+    parser.add_argument("--precedence", choices=PRECEDENCE_MODES, default="demos",
+                        help="how precedence is learned: demos (Algorithm 1 on every demonstration, default) or "
+                             "explore (at most 2 demonstrations, the CAD's geometric precedence when the product "
+                             "has one, and precedence experiments at the cell, chosen by ASP)")
     parser.add_argument("--out", type=nonempty_path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=nonempty_path, metavar="RUN", help="continue a killed session")
     parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
@@ -96,7 +101,7 @@ def session_settings(args: argparse.Namespace) -> SessionSettings:
     check_prior_options(args)
     return SessionSettings(
         assembly=args.assembly, policy=args.policy, model=args.model, seed=args.seed, confirm=args.confirm,
-        size_prior=args.prior, tolerance_m=args.tolerance,
+        size_prior=args.prior, tolerance_m=args.tolerance, precedence=args.precedence,
         demos=path_setting(args.demos), cell=cell_settings_of(args, cell_seed=args.seed), out=path_setting(args.out),
         resume=path_setting(args.resume), cells=args.cells, backend=args.backend, delay_s=args.delay,
         timeout_s=args.timeout, wait_for_cell_s=args.wait_for_cell, plans=args.plans,
@@ -128,6 +133,14 @@ def _versus_line(truth: dict[str, bool | int | None], matches: bool | None) -> s
             f"matches truth: {verdict}")
 
 
+def _explored_lines(explored: dict | UnsetType) -> list[str]:
+    """The lines of ``--precedence explore``: the experiments, what each pair rests on."""
+    if explored is UNSET:
+        return []
+    return [f"precedence by exploration: {explored['experiments']} experiment(s), {explored['sim_s']:.1f} s "
+            "simulated; what each pair rests on:", *(f"  {line}" for line in explored["rests_on"])]
+
+
 def _summary(result: dict, run: Path) -> str:
     """The human ending of a session: what was learned, the files written, what to run next."""
     settings = read_session_file(run)
@@ -153,6 +166,7 @@ def _summary(result: dict, run: Path) -> str:
         *([] if settings.prior is UNSET or settings.prior is None else [f"assumes: {prior_statement(settings.prior)}"]),
         *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
+        *_explored_lines(settings.precedence_explored),
         "assignment: " + (" ".join(f"{p}->{h}" for p, h in settings.assignment.items()) or "none"),
         plan,
         _versus_line(settings.truth, result["matches_truth"]),

@@ -42,13 +42,16 @@ import zenoh
 from asp import PlannerError
 from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts
 from asp.plans.plans import Plan, check_plan, plans
-from asp.precedence.demos import demo_facts
-from asp.precedence.learn import learn_for_assembly
-from asp.precedence.relation import Relation, precedence_facts, reduction, true_relation
+from asp.precedence.demos import Demonstrations, demo_facts
+from asp.precedence.explore.learner import SUPPORTS
+from asp.precedence.explore.trials import write_trials
+from asp.precedence.learn import learn_for_assembly, learn_must_precede, learn_with_prior
+from asp.precedence.relation import Relation, load_relation, precedence_facts, reduction, true_relation
 from asp.session.cells import CellProcess, cell_seed, stop_all
 from asp.session.folder import RunLock, lock_run_folder
 from asp.session.journal import JOURNAL_NAME, Journal
 from asp.session.log import PlannerLog
+from asp.session.precedence import CellOracle, ExploredPrecedence, explore_demos, explore_precedence
 from asp.session.settings import (
     MAX_STARTS,
     SESSION_FILE,
@@ -310,6 +313,26 @@ def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: 
     return report
 
 
+def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Demonstrations, prior: Path | None,
+             record: SessionFile, timeout_s: float) -> ExploredPrecedence:
+    """``session --precedence explore``: precedence from ``demos``, the geometric ``prior``
+    (None: no CAD) and experiments at the first of ``cells``, its pegs in the holes of an
+    assignment of the sizes just learned (``learned``)."""
+    if not cells:
+        raise PlannerError("--precedence explore needs a cell (none is alive)")
+    try:
+        assignment = feasible_assignment(load_learned_facts([learned]))
+    except UnsolvableAssembly as exc:
+        raise PlannerError(f"--precedence explore: the learned sizes give no hole assignment to experiment "
+                           f"with: {exc}") from None
+    oracle = CellOracle(session, cells[0], assignment, seed=record.seed, timeout_s=timeout_s)
+    explored = explore_precedence(demos, prior, oracle, run_id=f"{record.recording_id}.p")
+    LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)",
+             len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})", len(explored.trials),
+             cells[0], explored.sim_s)
+    return explored
+
+
 def view_blueprint(run: Path) -> Path:
     """``RUN/view.rbl``, the blueprint of what ``RUN/*.rrd`` hold once every writer closed
     its file (:meth:`bridge.recording.layout.Contents.of`): an assembly tab
@@ -418,11 +441,16 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         None if not by_hand else _by_hand_statement(assembly, by_hand)) if statement is not None) or None
     # Every input file is read before any cell starts: bad input fails fast.
     demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
+    truth_relation = true_relation(assembly) if assembly.has_file("precedence.lp") else None
+    if record.precedence == "explore":
+        demos = explore_demos(demos, truth_relation, record.seed)
+        relation = learn_must_precede(demos) if prior is None else learn_with_prior(
+            demos, load_relation([prior], data=True), str(prior))
     if prior is not None:
         LOG.info("precedence: the geometric prior %s refined by %d demonstration(s)", prior, len(demos.sequences))
     options = LearningOptions(confirm=record.confirm, demonstrated=demos.placements(), model=model, prior=decided)
     learner = SizeLearner(parts, holes, record.policy, record.seed, options)
-    required = set(true_relation(assembly).pairs()) if assembly.has_file("precedence.lp") else None
+    required = None if truth_relation is None else set(truth_relation.pairs())
     run_id = record.recording_id
     listen, connect = _endpoints(settings)
     zenoh_config = None if settings.zenoh_config is None else Path(settings.zenoh_config)
@@ -491,6 +519,23 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
             LOG.warning("model changed: %s", change)
         write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
                     header=_learned_header(assembly, run, sizes, stated_prior))
+        if record.precedence == "explore":
+            started_explore = time.perf_counter()
+            explored = _explore(session, cell_ids or sorted(set(directory.alive()) & set(allowed or directory.alive())),
+                                learned, demos, prior, record, settings.timeout_s)
+            relation = explored.learned.relation
+            timings["precedence_s"] = time.perf_counter() - started_explore
+            record.precedence_explored = explored.summary()
+            write_facts(run / "precedence_support.lp", explored.learned.facts(),
+                        header=f"Precedence learned by a session on {assembly.name} ({run}) from "
+                               f"{len(demos.sequences)} demonstration(s), "
+                               f"{'' if prior is None else 'the geometric precedence, '}"
+                               f"{len(explored.trials)} experiment(s) (experiments.lp): support(A,B,S), S one of "
+                               f"{', '.join(SUPPORTS)}; process_constraint(A,B): to confirm with the user.")
+            write_trials(run / "experiments.lp", explored.trials)
+            write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
+                        header=_learned_header(assembly, run, sizes, stated_prior))
+            log.precedence(relation.parts, reduction(relation))
         unsolvable: UnsolvableAssembly | None = None
         try:
             assignment, found = _plans(learned, settings.plans)

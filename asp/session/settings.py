@@ -63,6 +63,8 @@ Backend = Literal["sim", "truth"]
 Delay = Annotated[float, Meta(ge=0.0, le=MAX_DELAY_S)]
 Confirm = Annotated[int, Meta(ge=0, le=MAX_CONFIRM)]
 Tolerance = Annotated[float, Meta(ge=0.0, le=MAX_TOLERANCE_M)]
+PrecedenceMode = Literal["demos", "explore"]
+PRECEDENCE_MODES: tuple[PrecedenceMode, ...] = ("demos", "explore")
 
 
 def _check_choices(policy: str, model: str | None, size_prior: str | None, tolerance_m: float) -> None:
@@ -87,8 +89,10 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     ``cell.cell_seed`` to ``seed``), ``size_prior`` (``cad``: the learner starts from the
     outcomes the assembly's nominal sections decide beyond ``tolerance_m`` [m],
     :mod:`asp.sizes.cad_prior`; None: no prior), and the ``backend``
-    of the cells it starts (``truth``: each experiment takes ``delay_s`` [s]). These are
-    kept in ``session.json``; a resume takes them from there and ignores its own.
+    of the cells it starts (``truth``: each experiment takes ``delay_s`` [s]), ``precedence``
+    (``demos``: Algorithm 1 on the demonstrations; ``explore``: at most 2 of them, the
+    geometric precedence and experiments at the cell, :mod:`asp.session.precedence`). These
+    are kept in ``session.json``; a resume takes them from there and ignores its own.
 
     How: ``out`` (None: ``runs/<UTC time>``) or ``resume`` (a run folder); ``cells``
     co-processes to start (0: use cells on the network, only ``allow_cells`` if given); ``timeout_s`` [s]
@@ -107,6 +111,7 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     cell: CellSettings = DEFAULT_CELL
     size_prior: Literal["cad"] | None = None
     tolerance_m: Tolerance = 0.0
+    precedence: PrecedenceMode = "demos"
     out: str | None = None
     resume: str | None = None
     cells: Annotated[int, Meta(ge=0, le=MAX_CELLS)] = 1
@@ -156,7 +161,8 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     ``must_precede``, ``plans``, ``matches_truth``, and more: the size model used and
     what it assumes, what the size prior decided (``prior``, set at each start; None
     without one), the truth comparison, the assignment, the cells, the journal,
-    wall time [s] and timings [s], the assembly run, and the ``error`` when the learned
+    wall time [s] and timings [s], the assembly run, with ``--precedence explore`` what the
+    exploration did (:meth:`asp.session.precedence.ExploredPrecedence.summary`), and the ``error`` when the learned
     product has no complete assignment). Fields not yet known are absent."""
 
     format: int = SESSION_FORMAT
@@ -169,6 +175,7 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     cell: CellSettings = DEFAULT_CELL
     size_prior: Literal["cad"] | None = None
     tolerance_m: Tolerance = 0.0
+    precedence: PrecedenceMode = "demos"
     backend: Backend | None = None
     delay_s: Delay | None = None
     product: Digest | None = None
@@ -193,6 +200,7 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     wall_s: float | UnsetType = UNSET
     timings: dict[str, float] | UnsetType = UNSET
     assembly_run: dict[str, Any] | UnsetType = UNSET
+    precedence_explored: dict[str, Any] | UnsetType = UNSET
     error: str | UnsetType = UNSET
 
     def __post_init__(self) -> None:
@@ -212,12 +220,14 @@ def new_session_file(settings: SessionSettings, recording_id: str) -> SessionFil
     product is loaded)."""
     return SessionFile(assembly=settings.assembly, policy=settings.policy, model=settings.model, seed=settings.seed,
                        confirm=settings.confirm, demos=settings.demos, cell=settings.cell,
-                       size_prior=settings.size_prior, tolerance_m=settings.tolerance_m, backend=settings.backend,
+                       size_prior=settings.size_prior, tolerance_m=settings.tolerance_m,
+                       precedence=settings.precedence, backend=settings.backend,
                        delay_s=settings.delay_s, recording_id=recording_id)
 
 
 KEPT_OPTIONS = {"policy": "--policy", "model": "--model", "seed": "--seed", "confirm": "--confirm",
-                "demos": "--demos", "size_prior": "--prior", "tolerance_m": "--tolerance", "backend": "--backend",
+                "demos": "--demos", "size_prior": "--prior", "tolerance_m": "--tolerance",
+                "precedence": "--precedence", "backend": "--backend",
                 "delay_s": "--delay"}
 """The settings ``session.json`` keeps (besides ``cell``) and their options."""
 

@@ -3,7 +3,10 @@
 An experiment tests the hypothesis that part ``a`` must precede part ``b`` (a pair the
 demonstrations never contradicted) by assembling a short sequence that places ``b``
 while ``a`` is absent. The cell starts from its known state (a fresh world: every part on
-its tray), carries out the steps in order and stops at the first that fails.
+its tray, except the ``placed`` parts, set at their goals by hand: a peg in its hole),
+carries out the steps in order and stops at the first that fails. A known state whose
+placed parts do not stay where they were set (a peg set in a plate that is not there) is
+refused (``invalid_step``): it is no state the product can be in, and no evidence on the pair.
 
 - :class:`PrecedenceExperiment` (planner → cell, on :func:`bridge.keys.precedence_key`):
   ``pair`` = (a, b) and the ``sequence`` of steps, the last placing ``b``; ``a`` is in no
@@ -27,9 +30,12 @@ from typing import Annotated, Final, Literal
 import msgspec
 
 from bridge.messages import (
+    INSERT_VERSIONS,
     MAX_ERROR_CHARS,
     AspId,
     CellId,
+    ErrorReply,
+    MessageError,
     NonNegative,
     RequestId,
     Seed,
@@ -43,9 +49,11 @@ MAX_STEPS: Final = 1000
 """The most steps an experiment holds."""
 
 Outcome = Literal["success", "failed"]
-FailureReason = Literal["blocked", "jammed", "unsupported"]
+FailureReason = Literal["blocked", "jammed", "unsupported", "precedence", "size"]
 """Why a step failed: ``blocked`` (a placed part is in the part's way), ``jammed`` (it stuck
-in its hole or on its pin), ``unsupported`` (it did not stay where it was put)."""
+in its hole or on its pin), ``unsupported`` (it did not stay where it was put), observed in
+physics; ``precedence`` (a part the product's known precedence puts first is absent) and
+``size`` (the peg does not pass its hole), stated without physics by the ``truth`` cell."""
 
 
 class ExperimentStep(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -58,13 +66,19 @@ class ExperimentStep(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 class PrecedenceExperiment(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
                            tag_field="kind", tag="precedence_experiment"):
     """Does ``pair[0]`` truly have to precede ``pair[1]``? Carry out ``sequence`` from a
-    fresh world; its last step places ``pair[1]``, no step places ``pair[0]``."""
+    fresh world; its last step places ``pair[1]``, no step places ``pair[0]``; or, "B then
+    A", it places ``pair[1]`` and then ``pair[0]`` (a precedence the physics shows only when
+    the first part comes second: a cover that goes in without the part under it, which then
+    cannot go in)."""
 
     id: Annotated[RequestId, msgspec.Meta(description="request id: the same request again gets the cached "
                                           "outcome and is never run twice")]
     pair: Annotated[tuple[AspId, AspId], msgspec.Meta(description="(a, b): the hypothesis a must precede b")]
     sequence: Annotated[tuple[ExperimentStep, ...], msgspec.Meta(min_length=1, max_length=MAX_STEPS,
                                                                  description="the steps, the last placing b")]
+    placed: Annotated[tuple[ExperimentStep, ...], msgspec.Meta(max_length=MAX_STEPS, description=(
+        "the known state: parts set at their goals by hand before the first step (a peg in its hole); "
+        "empty: every part on its tray"))] = ()
     seed: Annotated[Seed, msgspec.Meta(description="seed of a simulated cell's randomisation")] = 0
     timeout_s: Annotated[NonNegative, msgspec.Meta(description="how long the planner waits for the outcome [s]; "
                                                    "0: no limit")] = 0.0
@@ -73,15 +87,25 @@ class PrecedenceExperiment(msgspec.Struct, frozen=True, forbid_unknown_fields=Tr
     def __post_init__(self) -> None:
         a, b = self.pair
         parts = [step.part for step in self.sequence]
+        given = [step.part for step in self.placed] + parts
         if a == b:
             raise ValueError(f"pair ({a}, {b}): expected two different parts")
-        if parts[-1] != b:
-            raise ValueError(f"sequence ends with {parts[-1]}: expected its last step to place {b}, pair[1]")
-        if a in parts:
-            raise ValueError(f"sequence places {a}: expected pair[0] absent from it")
-        twice = next((p for i, p in enumerate(parts) if p in parts[:i]), None)
+        then_a = self.then_first
+        if parts[-2 if then_a else -1:] != ([b, a] if then_a else [b]):
+            raise ValueError(f"sequence ends with {' '.join(parts[-2:])}: expected its last step to place {b}, "
+                             f"pair[1] (or {b} then {a}, pair[0])")
+        if a in parts[:-1] or (a in parts and not then_a):
+            raise ValueError(f"sequence places {a}: expected pair[0] absent from it (but as the step after {b})")
+        if a in given[:len(self.placed)] or b in given[:len(self.placed)]:
+            raise ValueError(f"placed holds {a if a in given else b}: expected neither part of the pair in it")
+        twice = next((p for i, p in enumerate(given) if p in given[:i]), None)
         if twice is not None:
-            raise ValueError(f"sequence places {twice} twice: expected each part at most once")
+            raise ValueError(f"placed and sequence give {twice} twice: expected each part at most once")
+
+    @property
+    def then_first(self) -> bool:
+        """Whether the sequence places ``pair[0]`` after ``pair[1]`` ("B then A")."""
+        return len(self.sequence) >= 2 and self.sequence[-1].part == self.pair[0]
 
     @property
     def tested(self) -> str:
@@ -115,6 +139,8 @@ class PrecedenceOutcome(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
 _EXPERIMENT_DECODER = msgspec.json.Decoder(PrecedenceExperiment)
 _OUTCOME_DECODER = msgspec.json.Decoder(PrecedenceOutcome)
 _VERSIONS: Final = frozenset({EXPERIMENT_VERSION})
+_REPLY_DECODER = msgspec.json.Decoder(PrecedenceOutcome | ErrorReply)
+
 
 def decode_experiment(payload: bytes) -> PrecedenceExperiment:
     """Validate and decode an experiment; :class:`bridge.messages.MessageError` (with a code) if invalid."""
@@ -125,4 +151,16 @@ def decode_experiment(payload: bytes) -> PrecedenceExperiment:
 def decode_outcome(payload: bytes) -> PrecedenceOutcome:
     """Validate and decode an outcome; :class:`bridge.messages.MessageError` (with a code) if invalid."""
     message: PrecedenceOutcome = decode_checked(_OUTCOME_DECODER, payload, "precedence outcome", _VERSIONS)
+    return message
+
+
+def decode_outcome_reply(payload: bytes) -> PrecedenceOutcome | ErrorReply:
+    """A cell's reply to an experiment: its outcome, or the error that refused it (each in
+    its own versions); :class:`bridge.messages.MessageError` (with a code) if invalid."""
+    message: PrecedenceOutcome | ErrorReply = decode_checked(_REPLY_DECODER, payload, "precedence reply",
+                                                             _VERSIONS | INSERT_VERSIONS)
+    accepted = _VERSIONS if isinstance(message, PrecedenceOutcome) else INSERT_VERSIONS
+    if message.v not in accepted:
+        raise MessageError("version", f"precedence reply has protocol version {message.v}; "
+                           f"expected {' or '.join(map(str, sorted(accepted)))}")
     return message

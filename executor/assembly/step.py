@@ -20,9 +20,11 @@ Per kind of part (the ``skill`` of the step's record):
 
 A failed attempt (the goal check fails) lifts the part and tries again with a fresh
 vision estimate; after ``max_attempts`` the part is put back on the tray and the step is
-``no_fit``.  A part that reached its goal but does not stay there once let go (nothing
-holds it: :data:`STAY_TOLERANCE`) is ``no_fit`` too, left where it lies.  Placed parts
-stay where they are.
+``no_fit``, its reason read where the last attempt stopped (``blocked`` or ``jammed``,
+:mod:`executor.assembly.failure`).  A part that reached its goal but does not stay there
+once let go (nothing holds it: :data:`STAY_TOLERANCE`) is ``no_fit`` too (``unsupported``),
+left where it lies.  Placed parts stay where they are; :meth:`Assembler.place_by_hand` puts
+a part at its goal without the arm (the known state of a precedence experiment).
 
 The uncertainty and the execution layer: by default :data:`ASSEMBLY_UNCERTAINTY` and the
 layer ``pi_phase_stop`` (admittance PI and phase stopping, no ILC); a cell with
@@ -34,14 +36,16 @@ trials, (part shape, hole), a cover or head being its own shape and hole.
 from __future__ import annotations
 
 import time
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import pybullet as pb
 
 from bridge.cell_settings import Magnitudes
+from bridge.precedence.experiment import FailureReason
 from executor import ExecutorError
+from executor.assembly.failure import targets_of, why_stuck
 from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
 from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
@@ -74,6 +78,8 @@ ASSEMBLY_UNCERTAINTY = Magnitudes(
 a vision error σ 1.5 mm (≤ 3 mm), a rect hole's yaw error σ 0.5° (≤ 1°), the teaching
 friction; random parts only (the cell's systematic errors and ILC are used with
 ``--uncertainty cell``)."""
+SETTLE_S = 0.5
+"""How long parts set at their goals by hand are left to the physics before the check that they stayed [s]."""
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
@@ -82,6 +88,12 @@ STAY_TOLERANCE = 0.005
 retreat [m] (placed parts are within 2 mm); else the step is ``no_fit`` and the part is
 left where it lies (e.g. a peg let go in a hole of a plate that is not in its fixture
 falls: the insertion itself met no resistance to tell it)."""
+
+
+def _free_approach(skill: str) -> float:
+    """How far above the entry of its place (a hole's top, the pin tops, a socket's top) a
+    part's insertion starts [m]."""
+    return APPROACH_HEIGHT if skill == "insert" else ABOVE_PINS
 
 
 @dataclass
@@ -100,6 +112,11 @@ class StepRecord:
     max_torque_dev: float
     pose_error: float
     sim_time_s: float
+    reason: FailureReason | None = None
+    """Why it failed: blocked, jammed (:func:`executor.assembly.failure.why_stuck`) or
+    unsupported (it did not stay at its goal); None when it fit."""
+    involved: tuple[str, ...] = ()
+    """blocked: the other parts it touched where it stopped."""
 
     def to_json(self) -> dict:
         return {"part": self.part, "hole": self.hole, "skill": self.skill, "outcome": self.outcome,
@@ -131,6 +148,7 @@ class Assembler:
         self.thresholds = description.thresholds
         self._skills: dict[str, Skill] = {}
         self.placed: set[str] = set()
+        self.hole_of: dict[str, str] = {}  # placed peg -> its hole
         self._screwed: dict[str, int] = {}
         self.blocked: set[str] = set()
         self._bias = CellBias(ASSEMBLY_UNCERTAINTY, 0) if bias is None else bias
@@ -191,6 +209,7 @@ class Assembler:
             world.set_peg_goal(part, hole)
         setup = self._draw(rng, part, hole)
         grasp = self._pick(part, setup)
+        stuck: tuple[FailureReason | None, tuple[str, ...]] = (None, ())
         if skill == "fixture":
             carry(motion, world.frames[part].grip, grasp.follow)
             world.set_pose(part, world.goals[part])  # the fixture's locating pins
@@ -203,26 +222,73 @@ class Assembler:
                 outcomes.append(self._insert(part, hole, skill, setup, grasp))
                 if outcomes[-1][0]:
                     break
+                stuck = self._why_stuck(part, hole, skill)
                 here = motion.controller.arm.read().tip_pos
                 move_line(motion, here + np.array([0.0, 0.0, 0.04]), tolerance=VIA_TOLERANCE)
         ok = outcomes[-1][0]
+        if ok:
+            stuck = (None, ())
         if not ok:  # back to the tray
             carry(motion, world.tray_position(part) + world.frames[part].tcp + np.array([0.0, 0.0, 0.002]))
         grasp.release()
         here = motion.controller.arm.read().tip_pos
         move_line(motion, here + np.array([0.0, 0.0, RETREAT]), tolerance=VIA_TOLERANCE)
         if ok and world.goal_error(part) > STAY_TOLERANCE:  # let go, it did not stay: nothing holds it there
-            ok = False
+            ok, stuck = False, ("unsupported", ())
         if ok:
-            self.placed.add(part)
-            self._screw(part)
-            if skill == "insert":
-                world.lock(part)
+            self._placed(part, hole)
         world.rest()
         error = world.goal_error(part) if ok else float(np.linalg.norm(world.position(part) - world.goals[part]))
         return StepRecord(part, hole, skill, "fit" if ok else "no_fit", len(outcomes), time.perf_counter() - wall0,
                           max(o[1] for o in outcomes), max(o[2] for o in outcomes), error,
-                          (motion.steps - sim0) * 0.001)
+                          (motion.steps - sim0) * 0.001, *stuck)
+
+    def _placed(self, part: str, hole: str | None) -> None:
+        """``part`` is at its goal: a head is screwed to its part, a peg locked in its hole."""
+        self.placed.add(part)
+        if part not in self._screwed:
+            self._screw(part)
+        if part in self.product.pegs and hole is not None:
+            self.hole_of[part] = hole
+            self.world.lock(part)
+
+    def place_by_hand(self, placements: Sequence[tuple[str, str | None]], settle_s: float = SETTLE_S) -> list[str]:
+        """Put each (part, hole) at its goal without the arm (a peg into its hole, a head into
+        the socket of its part wherever that part is, screwed), let the world run ``settle_s``
+        [s] so the physics decides whether each stays there, and return the parts that did not
+        (more than :data:`STAY_TOLERANCE` from their goals); the others are placed (pegs locked
+        in their holes). InvalidStep or UnknownPair, as for :meth:`run_step`, before anything moves."""
+        placed = list(self.placed)
+        for part, hole in placements:
+            check_product_step(self.product, part, hole, placed)
+            placed.append(part)
+        world = self.world
+        for part, hole in sorted(placements, key=lambda ph: ph[0] in self.product.heads):  # heads after their parts
+            if part in self.product.pegs and hole is not None:
+                world.set_peg_goal(part, hole)
+            socket = part in self.product.heads  # a head's goal is the socket where its part is now
+            world.set_pose(part, self._goal_tcp(part, "insert_socket") - world.frames[part].tcp if socket
+                           else world.goals[part])
+            self._screw(part)
+            pb.changeDynamics(world.frames[part].body, -1, activationState=pb.ACTIVATION_STATE_WAKE_UP,
+                              physicsClientId=world.client)
+        world.settle(settle_s)
+        fell = [part for part, _ in placements if world.goal_error(part) > STAY_TOLERANCE]
+        for part, hole in placements:
+            if part not in fell:
+                self._placed(part, hole)
+        world.rest()
+        return fell
+
+    def _why_stuck(self, part: str, hole: str | None, skill: str) -> tuple[FailureReason, tuple[str, ...]]:
+        """Why ``part``, stopped short of its goal and still held, is stuck (:func:`why_stuck`),
+        the entry of its place being where the insertion's free approach ends."""
+        p = self.product
+        approach = self._approach(part, hole, skill, self._goal_tcp(part, skill))
+        entry_z = float(approach[2] - _free_approach(skill))
+        targets = targets_of(part, skill, p.base.id, {c: spec.over for c, spec in p.covers.items()},
+                             {h: spec.into for h, spec in p.heads.items()}, self.hole_of)
+        return why_stuck(self.world, part, targets, entry_z, self.placed)
 
     def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
         """A part placed by hand (``manual``): at its goal, fixed there."""
@@ -299,7 +365,7 @@ class Assembler:
             skill_obj, xy = self._skill(p.covers[part].skill), approach[:2]
         else:
             # The hole search around the estimate, on the plate or on the socket's part.
-            surface = approach[2] - (APPROACH_HEIGHT if skill == "insert" else ABOVE_PINS)
+            surface = approach[2] - _free_approach(skill)
             found = hole_search(motion, approach[:2], surface, approach[2], quat,
                                 np.random.default_rng(setup.search_seed))
             xy = found.hole_xy

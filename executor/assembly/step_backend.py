@@ -6,7 +6,11 @@ refused step (another run, or one the product does not allow) changes nothing. H
 blocked with ``--block-hole`` get their obstacle in every fresh world. With
 ``--uncertainty cell`` every world gets the cell's uncertainty and execution layer, and
 the ILC corrections are kept across the plan runs this cell serves (in memory: not
-saved)."""
+saved).
+
+Precedence experiments (:meth:`AssemblyRunner.run_experiment`) run each in a world of
+their own, made for the experiment and closed after it, beside the plan run's world,
+which they leave as it was."""
 
 from __future__ import annotations
 
@@ -14,10 +18,11 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from bridge.messages import StepEvidence, StepRequest
+from bridge.precedence.experiment import PrecedenceExperiment
 from executor import ExecutorError
 from executor.assembly.product import Product, load_product
-from executor.assembly.step import DEFAULT_LAYER, Assembler, StepRecord, check_product_step
-from executor.backend_plugin import check_run
+from executor.assembly.step import DEFAULT_LAYER, SETTLE_S, Assembler, StepRecord, check_product_step
+from executor.backend_plugin import ExperimentRun, InvalidStep, check_experiment, check_run
 from executor.cell_description import CellDescription
 from executor.control.ilc import ExecutionLayer, Ilc
 
@@ -87,6 +92,36 @@ class AssemblyRunner:
                                         record.pose_error * 1000.0)
             self.recorder.flush()
         return record, {part: errors[part] * 1000.0 for part in sorted(assembler.placed)}
+
+    def run_experiment(self, experiment: PrecedenceExperiment) -> ExperimentRun:
+        """In a fresh world (blocked holes obstructed): set ``experiment.placed`` at their goals
+        by hand (:meth:`Assembler.place_by_hand`), then carry out ``experiment.sequence`` step by
+        step up to the first that fails. UnknownPair or InvalidStep before anything is made
+        (:func:`check_experiment`); InvalidStep when a placed part does not stay at its goal."""
+        product = self.product
+        check_experiment(experiment, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes)
+        assembler = Assembler(product, description=self.description, bias=self.bias, layer=self.layer, ilc=self.ilc)
+        try:
+            for hole in self.blocked:
+                assembler.block_hole(hole)
+            fell = assembler.place_by_hand([(step.part, step.hole) for step in experiment.placed])
+            if fell:
+                raise InvalidStep(f"the known state does not hold: {', '.join(sorted(fell))} did not stay at "
+                                  "its goal once set there (no state the product can be in)")
+            sim_s = SETTLE_S if experiment.placed else 0.0  # the placed parts are left to the physics that long
+            for k, step in enumerate(experiment.sequence, start=1):
+                record = assembler.run_step(step.part, step.hole, experiment.seed)
+                sim_s += record.sim_time_s
+                if record.outcome != "fit":
+                    touched = f", touching {' '.join(record.involved)}" if record.involved else ""
+                    where = (f"left {record.pose_error * 1000.0:.1f} mm from its goal" if record.reason == "unsupported"
+                             else "put back on the tray")
+                    detail = (f"{step.part} {record.reason} after {record.attempts} attempt(s): largest force "
+                              f"deviation {record.max_force_dev:.1f} N, {where}{touched}")
+                    return ExperimentRun(k, record.reason, detail, sim_s)
+            return ExperimentRun(sim_s=sim_s)
+        finally:
+            assembler.close()
 
     def close(self) -> None:
         if self._assembler is not None:

@@ -7,7 +7,8 @@ malformed, oversized or wrong-version request gets an ErrorReply at once and the
 serving. Valid requests run one at a time in the main thread; results are idempotent by
 request id; a request whose backend raises gets an ErrorReply ``failed`` naming the
 exception, and the cell keeps serving. One line per event is printed to stdout (``ready``, ``start <id> <part> <hole>``,
-``done <id> <result>``), flushed, so a supervisor can follow the node.
+``done <id> <result>``; a precedence experiment's ``<part> <hole>`` is ``placed <parts>
+sequence <parts>``), flushed, so a supervisor can follow the node.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from pathlib import Path
 import zenoh
 
 from bridge.cell_settings import ServeSettings
-from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, step_key
+from bridge.client import Reply, Request
+from bridge.keys import alive_key, check_cell_id, insert_key, ping_key, precedence_key, step_key
 from bridge.messages import (
     MAX_ERROR_CHARS,
     MAX_MESSAGE_BYTES,
@@ -41,6 +43,7 @@ from bridge.messages import (
     decode_step_request,
     encode,
 )
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome, decode_experiment
 from bridge.session import SIGNAL_POLL_S, bound_endpoints, cell_listen, open_session
 from executor import ExecutorError
 from executor.backend_plugin import Backend, InvalidStep, RunActive, UnknownPair
@@ -59,8 +62,17 @@ class _Work:
     """A valid request waiting for the cell, and when it arrived (``time.monotonic`` [s])."""
 
     query: zenoh.Query
-    request: InsertRequest | StepRequest
+    request: Request
     arrived: float
+
+
+def _what(request: Request) -> str:
+    """What a request asks, for a log line: ``part hole``, or a precedence experiment's
+    ``a<b placed p,q sequence r,b``."""
+    if isinstance(request, PrecedenceExperiment):
+        return (f"{request.tested} placed {','.join(s.part for s in request.placed) or '-'} "
+                f"sequence {','.join(s.part for s in request.sequence)}")
+    return f"{request.part} {request.hole}"
 
 
 class CellNode:
@@ -77,19 +89,19 @@ class CellNode:
         self.cell_id = cell_id
         self._backend = backend
         self._work: queue.Queue[_Work | None] = queue.Queue(maxsize=queue_size)
-        self._replies: OrderedDict[str, tuple[InsertRequest | StepRequest, bytes]] = OrderedDict()
+        self._replies: OrderedDict[str, tuple[Request, bytes]] = OrderedDict()
         self._lock = threading.Lock()
         self._stopped = threading.Event()
 
-    def _cached(self, query: zenoh.Query, request: InsertRequest | StepRequest) -> bytes | None:
+    def _cached(self, query: zenoh.Query, request: Request) -> bytes | None:
         """The cached reply of this very request; refuses a reused id (then returns b"")."""
         with self._lock:
             cached = self._replies.get(request.id)
         if cached is None:
             return None
         if cached[0] != request:
-            self._refuse(query, "id_reused", f"request id {request.id} was used for "
-                         f"({cached[0].part},{cached[0].hole}); expected a new id", request.id)
+            self._refuse(query, "id_reused", f"request id {request.id} was used for ({_what(cached[0])}); "
+                         "expected a new id", request.id)
             return b""
         return cached[1]
 
@@ -107,7 +119,11 @@ class CellNode:
         """Zenoh-thread callback of ``step``, as :meth:`on_query`."""
         self._accept(query, decode_step_request)
 
-    def _accept(self, query: zenoh.Query, decode: Callable[[bytes], InsertRequest | StepRequest]) -> None:
+    def on_precedence_query(self, query: zenoh.Query) -> None:
+        """Zenoh-thread callback of ``precedence``, as :meth:`on_query`."""
+        self._accept(query, decode_experiment)
+
+    def _accept(self, query: zenoh.Query, decode: Callable[[bytes], Request]) -> None:
         payload = query.payload.to_bytes() if query.payload is not None else b""
         try:
             request = decode(payload)
@@ -125,13 +141,25 @@ class CellNode:
             self._refuse(query, "busy", f"{self._work.maxsize} requests are waiting; send it again later",
                          request.id)
 
-    def _answer(self, request: InsertRequest | StepRequest, started: float) -> InsertReply | StepReply:
-        """Run the request on the backend; the reply (an insert reply in the request's version)."""
+    def _answer(self, request: Request, started: float) -> Reply:
+        """Run the request on the backend; the reply (in the request's version). A backend
+        without ``run_precedence`` fails a precedence experiment."""
+        if isinstance(request, PrecedenceExperiment):
+            run_precedence = getattr(self._backend, "run_precedence", None)
+            if run_precedence is None:
+                raise ExecutorError(f"this cell's backend ({type(self._backend).__name__}) runs no precedence "
+                                    "experiments")
+            run = run_precedence(request)
+            return PrecedenceOutcome(id=request.id, cell=self.cell_id, pair=request.pair,
+                                     outcome="success" if run.failed_step is None else "failed",
+                                     failed_step=run.failed_step, reason=run.reason,
+                                     detail=run.detail[:MAX_ERROR_CHARS], sim_s=run.sim_s,
+                                     wall_s=time.perf_counter() - started)
         if isinstance(request, StepRequest):
             result, step_evidence, errors = self._backend.run_step(request)
             return StepReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=result,
                              evidence=step_evidence, pose_errors_mm=tuple(sorted(errors.items())),
-                             wall_s=time.perf_counter() - started)
+                             wall_s=time.perf_counter() - started, v=request.v)
         outcome, evidence = self._backend.run(request)
         return InsertReply(id=request.id, cell=self.cell_id, part=request.part, hole=request.hole, result=outcome,
                            evidence=evidence, wall_s=time.perf_counter() - started, v=request.v)
@@ -168,9 +196,10 @@ class CellNode:
                 query.reply(query.key_expr, cached)
             query.drop()  # finalises the query: the planner need not wait for its timeout
 
-    def _run(self, query: zenoh.Query, request: InsertRequest | StepRequest) -> bytes | None:
-        number = request.experiment if isinstance(request, InsertRequest) else f"step {request.step}"
-        print(f"start {request.id} {request.part} {request.hole} {number}", flush=True)
+    def _run(self, query: zenoh.Query, request: Request) -> bytes | None:
+        number = (request.experiment if isinstance(request, InsertRequest) else
+                  f"step {request.step}" if isinstance(request, StepRequest) else "experiment")
+        print(f"start {request.id} {_what(request)} {number}", flush=True)
         started = time.perf_counter()
         try:
             message = self._answer(request, started)
@@ -185,7 +214,8 @@ class CellNode:
             self._refuse(query, "failed", f"the backend raised {type(exc).__name__}: {str(exc)[:200]} "
                          f"(at {Path(where.filename).name}:{where.lineno})", request.id)
             return None
-        reply, result = encode(message), message.result
+        reply = encode(message)
+        result = message.outcome if isinstance(message, PrecedenceOutcome) else message.result
         with self._lock:
             self._replies[request.id] = (request, reply)
             while len(self._replies) > CACHE_SIZE:
@@ -235,6 +265,7 @@ def serve(settings: ServeSettings) -> int:
             raise ClaimLost(claim.lost)
         _declared = (session.declare_queryable(insert_key(cell_id), node.on_query),  # held
                      session.declare_queryable(step_key(cell_id), node.on_step_query),
+                     session.declare_queryable(precedence_key(cell_id), node.on_precedence_query),
                      session.declare_queryable(ping_key(cell_id), _echo),
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
         if settings.lifeline:

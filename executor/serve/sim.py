@@ -1,7 +1,8 @@
 """The ``sim`` backend of a cell node: the PyBullet :class:`executor.trial.Cell`
 (imported lazily) with the execution layer and uncertainty of its cell settings and its ILC
 state; plan steps in the assembling world of :mod:`executor.assembly`
-(kept between the steps of one plan run)."""
+(kept between the steps of one plan run); precedence experiments each in a fresh
+assembling world (:meth:`executor.assembly.step_backend.AssemblyRunner.run_experiment`)."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ from typing import TYPE_CHECKING
 
 from bridge.cell_settings import ServeSettings
 from bridge.messages import Evidence, InsertRequest, Result, StepRequest
+from bridge.precedence.experiment import PrecedenceExperiment
 from bridge.recording.sinks import NO_VIEWER, Viewer
-from executor.backend_plugin import StepOutcome
+from executor.backend_plugin import ExperimentRun, StepOutcome
 
 if TYPE_CHECKING:
     from executor.assembly.step_backend import AssemblyRunner
@@ -60,20 +62,28 @@ class SimBackend:
         self._cell_uncertainty = settings.cell.uncertainty == "cell"
         self._runner: AssemblyRunner | None = None
 
-    def run_step(self, request: StepRequest) -> StepOutcome:
-        from executor.assembly.step_backend import AssemblyRunner, step_evidence
-
-        if self._runner is None:  # the assembling world is made on the first step
+    def _assembling(self) -> AssemblyRunner:
+        """The assembling runner, made on the first plan step or precedence experiment."""
+        if self._runner is None:
             from executor.assembly.recording import AssemblyRecorder
+            from executor.assembly.step_backend import AssemblyRunner
 
             recorder = None if self._logger is None else AssemblyRecorder(self._logger.rec, self._cell_id)
             cell = self._cell
             self._runner = (AssemblyRunner(self._assembly, self._blocked, recorder, bias=cell.bias,
                                            layer=cell.layer)
                             if self._cell_uncertainty else AssemblyRunner(self._assembly, self._blocked, recorder))
-        record, errors = self._runner.run_step(request)
+        return self._runner
+
+    def run_step(self, request: StepRequest) -> StepOutcome:
+        from executor.assembly.step_backend import step_evidence
+
+        record, errors = self._assembling().run_step(request)
         result: Result = "fit" if record.outcome == "fit" else "no_fit"
         return result, step_evidence(record), errors
+
+    def run_precedence(self, experiment: PrecedenceExperiment) -> ExperimentRun:
+        return self._assembling().run_experiment(experiment)
 
     def run(self, request: InsertRequest) -> tuple[Result, Evidence | None]:
         if self._logger is not None:

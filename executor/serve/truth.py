@@ -1,6 +1,7 @@
 """The ``truth`` backend of a cell node: answers from the cell's geometry (cross-sections),
-or where the product has no ``geometry.toml`` from its ``sizes.lp``, without simulation,
-optionally after a delay, to measure the bridge and test the protocol quickly."""
+or where the product has no ``geometry.toml`` from its ``sizes.lp``, and precedence
+experiments from the product's ``precedence.lp``, without simulation, optionally after a
+delay, to measure the bridge and test the protocol quickly."""
 
 from __future__ import annotations
 
@@ -15,25 +16,52 @@ from bridge.assembly import load_assembly
 from bridge.cell_settings import ServeSettings
 from bridge.inputs import read_bytes
 from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
+from bridge.precedence.experiment import FailureReason, PrecedenceExperiment
 from bridge.recording.sinks import NO_VIEWER, Viewer
 from executor import ExecutorError
-from executor.backend_plugin import StepOutcome, UnknownPair, check_run, check_step
+from executor.backend_plugin import (
+    ExperimentRun,
+    InvalidStep,
+    StepOutcome,
+    UnknownPair,
+    check_experiment,
+    check_run,
+    check_step,
+)
 from executor.world.geometry import feature_passes, load_geometry
+
+
+def _facts(path: Path, what: str, expected: str) -> list[clingo.Symbol]:
+    """The atoms of the ASP facts file ``path``; ExecutorError naming it when it does not parse."""
+    control = clingo.Control(["--warn=none"])
+    try:
+        control.add("base", [], read_bytes(path, what).decode("utf-8", "replace"))
+        control.ground([("base", [])])
+    except RuntimeError:
+        raise ExecutorError(f"{path}: expected ASP facts {expected} (it does not parse)") from None
+    return [atom.symbol for atom in control.symbolic_atoms]
 
 
 def sizes_truth(path: Path) -> tuple[set[str], set[str], set[tuple[str, str]]]:
     """The pegs (``part/1``), holes (``hole/1``) and ``fits/2`` pairs of a product's
     ``sizes.lp`` (closed world); ExecutorError naming the file when it does not parse."""
-    control = clingo.Control(["--warn=none"])
-    try:
-        control.add("base", [], read_bytes(path, "sizes (ASP facts)").decode("utf-8", "replace"))
-        control.ground([("base", [])])
-    except RuntimeError:
-        raise ExecutorError(f"{path}: expected ASP facts part/1, hole/1, fits/2 (it does not parse)") from None
-    atoms = [atom.symbol for atom in control.symbolic_atoms]
+    atoms = _facts(path, "sizes (ASP facts)", "part/1, hole/1, fits/2")
     pegs = {str(a.arguments[0]) for a in atoms if a.match("part", 1)}
     holes = {str(a.arguments[0]) for a in atoms if a.match("hole", 1)}
     return pegs, holes, {(str(a.arguments[0]), str(a.arguments[1])) for a in atoms if a.match("fits", 2)}
+
+
+def precedence_truth(path: Path) -> set[tuple[str, str]]:
+    """The transitive closure of the ``precedence_edge/2`` and ``must_precede/2`` pairs of a
+    product's ``precedence.lp``; ExecutorError naming the file when it does not parse."""
+    atoms = _facts(path, "precedence (ASP facts)", "part/1, precedence_edge/2")
+    pairs = {(str(a.arguments[0]), str(a.arguments[1])) for a in atoms
+             if a.match("precedence_edge", 2) or a.match("must_precede", 2)}
+    while True:
+        longer = pairs | {(a, d) for a, b in pairs for c, d in pairs if b == c}
+        if longer == pairs:
+            return pairs
+        pairs = longer
 
 
 class TruthBackend:
@@ -44,7 +72,10 @@ class TruthBackend:
     hand answer from ``sizes.lp`` on its holes the geometry has not: the pins an imported
     part goes onto); logs every outcome to Rerun if
     ``settings.rrd`` or ``settings.viewer_url`` is given; a hole of ``settings.block_holes``
-    refuses every plan step."""
+    refuses every plan step. A precedence experiment's step fails when a part that must
+    precede it (:func:`precedence_truth`) is not placed (``precedence``) or its peg does not
+    pass its hole (``size``) or its hole is blocked (``blocked``); a placed part missing such a
+    part does not stay."""
 
     def __init__(self, settings: ServeSettings) -> None:
         assembly, cell_id = settings.assembly, settings.cell_id
@@ -72,6 +103,8 @@ class TruthBackend:
         self._delay_s = settings.delay_s
         self._blocked = set(settings.block_holes)
         self._parts = tuple(assembly_of.part_ids)
+        self._precedence_file = assembly_of.file("precedence.lp") if assembly_of.has_file("precedence.lp") else None
+        self._precedence: set[tuple[str, str]] | None = None  # read on the first experiment
         self._run: str | None = None  # the plan run whose product is being built
         self._placed: dict[str, float] = {}  # its placed parts
         self._log = None
@@ -117,6 +150,37 @@ class TruthBackend:
         evidence = StepEvidence(skill=skill, attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
                                 duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
         return ("fit" if ok else "no_fit"), evidence, dict(placed)
+
+    def run_precedence(self, experiment: PrecedenceExperiment) -> ExperimentRun:
+        check_experiment(experiment, parts=self._parts, pegs=self._pegs, holes=self._holes)
+        if self._precedence is None:
+            if self._precedence_file is None:
+                raise ExecutorError("truth backend: the product has no precedence.lp to answer precedence "
+                                    "experiments from")
+            self._precedence = precedence_truth(self._precedence_file)
+        if self._delay_s > 0:
+            time.sleep(self._delay_s)
+        placed = {step.part for step in experiment.placed}
+        unstable = sorted(p for p in placed if self._missing(p, placed))
+        if unstable:
+            raise InvalidStep(f"the known state does not hold: {', '.join(unstable)} placed without "
+                              f"{', '.join(sorted(set().union(*(self._missing(p, placed) for p in unstable))))}, "
+                              "which the product's precedence puts first")
+        for k, step in enumerate(experiment.sequence, start=1):
+            missing = self._missing(step.part, placed)
+            reason: FailureReason | None = (
+                "precedence" if missing else "blocked" if step.hole in self._blocked else
+                "size" if step.hole is not None and (step.part, step.hole) not in self._fits else None)
+            if reason is not None:
+                why = f"without {' '.join(missing)}" if missing else f"into {step.hole}"
+                return ExperimentRun(k, reason, f"{step.part} {reason} ({why}; the truth backend, no physics)")
+            placed.add(step.part)
+        return ExperimentRun()
+
+    def _missing(self, part: str, placed: set[str]) -> list[str]:
+        """The parts the product's precedence puts before ``part`` that are not ``placed``, sorted."""
+        assert self._precedence is not None
+        return sorted(a for a in self._parts if (a, part) in self._precedence and a not in placed)
 
     def close(self) -> None:
         if self._log is not None:

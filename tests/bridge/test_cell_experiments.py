@@ -1,0 +1,89 @@
+"""Precedence experiments at a cell, over a real Zenoh session to ``executor serve`` in its
+own process: the truth cell answers from the product's precedence, a bad or impossible
+experiment gets an error reply and the cell keeps serving; the sim cell observes why a step
+fails (the physics, not a rule)."""
+
+from __future__ import annotations
+
+import queue
+
+import pytest
+
+from asp import PlannerError
+from asp.session.precedence import CellOracle
+from bridge.client import CellRefused, request_experiment
+from bridge.messages import ErrorReply
+from bridge.precedence.experiment import (
+    ExperimentStep,
+    PrecedenceExperiment,
+    decode_outcome_reply,
+)
+from tests.bridge.test_bridge_step_runs import one_cell
+
+HOLES = {"p1": "r1", "p2": "r2", "p3": "s1", "p4": "s2", "sh": "br"}
+
+
+def experiment(name: str, pair: tuple[str, str], sequence: str, placed: str = "",
+               seed: int = 0) -> PrecedenceExperiment:
+    """An experiment on Cranfield: parts named by space-separated ids, pegs in their plan-1 holes."""
+    def steps(parts: str) -> tuple[ExperimentStep, ...]:
+        return tuple(ExperimentStep(p, HOLES.get(p)) for p in parts.split())
+
+    return PrecedenceExperiment(id=name, pair=pair, sequence=steps(sequence), placed=steps(placed), seed=seed)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_truth_cell_answers_experiments_from_the_precedence_and_refuses_bad_ones() -> None:
+    with one_cell("truth") as session:
+        done = request_experiment(session, "c1", experiment("e1", ("p1", "sp"), "p3 p4 sp", placed="bp"), 30)
+        assert (done.outcome, done.failed_step, done.pair) == ("success", None, ("p1", "sp"))
+        # sp needs p4 (the square pegs hold the separator): the step that places sp fails
+        failed = request_experiment(session, "c1", experiment("e2", ("p4", "sp"), "p3 sp", placed="bp"), 30)
+        assert (failed.outcome, failed.failed_step, failed.reason) == ("failed", 2, "precedence")
+        assert "without p4" in failed.detail
+        refusals = (
+            experiment("e3", ("bp", "p1"), "p1", placed="p3"),  # p3 set in a plate that is not there
+            PrecedenceExperiment(id="e4", pair=("p1", "p2"), placed=(ExperimentStep("bp"),),  # s1 twice
+                                 sequence=(ExperimentStep("p3", "s1"), ExperimentStep("p2", "s1"))),
+            PrecedenceExperiment(id="e5", pair=("p1", "p2"), sequence=(ExperimentStep("p2", "zz"),)),  # no hole zz
+        )
+        for bad_one in refusals:
+            with pytest.raises(CellRefused) as refused:
+                request_experiment(session, "c1", bad_one, 30)
+            assert refused.value.reply.code == "invalid_step", refused.value
+        box: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+        session.get("cell/c1/precedence", lambda reply: box.put(reply.ok.payload.to_bytes()),
+                    payload=b'{"kind":"precedence_experiment","id":"x","pair":["a","b"],"sequence":[{"part":"a"}]}',
+                    timeout=10.0)
+        bad = decode_outcome_reply(box.get(timeout=15.0))
+        assert isinstance(bad, ErrorReply) and bad.code == "malformed"
+        again = request_experiment(session, "c1", experiment("e6", ("p1", "sp"), "p3 p4 sp", placed="bp"), 30)
+        assert again.outcome == "success"  # still serving
+        # the session's oracle: holes from its assignment, the steps before the tested one set by hand
+        oracle = CellOracle(session, "c1", HOLES)
+        tested = PrecedenceExperiment(id="o1", pair=("p4", "sp"),
+                                      sequence=(ExperimentStep("bp"), ExperimentStep("p3"), ExperimentStep("sp")))
+        assert oracle.sent(tested).placed == (ExperimentStep("bp"), ExperimentStep("p3", "s1"))
+        outcome = oracle.run(tested)
+        assert (outcome.outcome, outcome.failed_step, outcome.reason) == ("failed", 3, "precedence")
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_sim_cell_observes_why_a_step_fails() -> None:
+    with one_cell("sim", stop_s=120.0) as session:
+        # a peg before the back plate: it reaches its goal height in air, and falls once let go
+        fell = request_experiment(session, "c1", experiment("s1", ("bp", "p1"), "p1", seed=1), 300)
+        assert (fell.outcome, fell.failed_step, fell.reason) == ("failed", 1, "unsupported")
+        assert fell.sim_s > 0.0
+        with pytest.raises(CellRefused) as refused:  # a peg set by hand where the plate is not
+            request_experiment(session, "c1", experiment("s2", ("bp", "p2"), "p2", placed="p1"), 300)
+        assert refused.value.reply.code == "invalid_step" and "p1 did not stay" in refused.value.reply.error
+        # fp goes in without sp (it rests on pd and the pins), but sp then cannot: the session's
+        # oracle places sp after fp ("B then A") and stops rather than learn sp<fp free
+        oracle = CellOracle(session, "c1", HOLES, seed=1, timeout_s=300)
+        before_fp = PrecedenceExperiment(id="s3", pair=("sp", "fp"), sequence=tuple(
+            ExperimentStep(p) for p in ("bp", "p1", "p2", "p3", "p4", "sh", "ph", "pd", "fp")))
+        with pytest.raises(PlannerError, match=r"fp went in without sp, but sp then did not \(blocked: .*fp"):
+            oracle.run(before_fp)

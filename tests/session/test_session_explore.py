@@ -1,0 +1,53 @@
+"""``session --precedence explore``: precedence and sizes in one session from at most 2
+demonstrations and precedence experiments at the session's own cell (real processes:
+planner, ``executor serve``, Zenoh on loopback)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from asp.plans.assign import load_learned_facts
+from asp.precedence.relation import true_relation
+from bridge.assembly import load_assembly
+
+
+def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
+    """learned.lp holds exactly the product's precedence closure, and precedence_support.lp
+    says what each learned pair rests on: here every one on the experiments."""
+    truth = set(true_relation(load_assembly(assembly)).pairs())
+    assert set(load_learned_facts([run / "learned.lp"]).must_precede) == truth
+    support = (run / "precedence_support.lp").read_text()
+    for a, b in truth:
+        assert f"support({a},{b},experiment)." in support
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(180)
+def test_truth_cell_session_explores_cranfield_to_its_exact_relation(tmp_path: Path, run_session) -> None:
+    run = tmp_path / "run"
+    result = run_session("--precedence", "explore", "--out", str(run), timeout=150)
+    assert result["matches_truth"] is True
+    _learned_exactly_the_truth(run, "cranfield")
+    explored = json.loads((run / "session.json").read_text())["precedence_explored"]
+    # Cranfield's demos.txt: its first two demonstrations order p2 before p1 and p3 before p4,
+    # which the experiments show free: process constraints, not learned
+    assert explored["process"] == [["p2", "p1"], ["p3", "p4"]]
+    assert 1 <= explored["experiments"] <= 20 and explored["sim_s"] == 0.0
+    assert explored["rests_on"][0] == "learned 20 pairs: 0 geometry, 20 experiment, 0 demonstrated, 0 assumed"
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(400)
+def test_sim_cell_session_explores_a_small_product_in_physics(tmp_path: Path, run_cli) -> None:
+    run = tmp_path / "run"
+    done = run_cli("session", "--json", "--assembly", "spare", "--precedence", "explore", "--out", str(run),
+                   timeout=360)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["matches_truth"] is True
+    _learned_exactly_the_truth(run, "spare")
+    explored = json.loads((run / "session.json").read_text())["precedence_explored"]
+    assert explored["experiments"] == 3 and explored["sim_s"] > 0.0  # bp<p1, bp<p2, bp<p3, each in physics
+    assert (run / "experiments.lp").read_text().count(",1,unsupported).") == 3  # each peg fell: no plate
