@@ -171,7 +171,7 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
     return found
 
 
-def _near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius, within its
     span), their coordinates along the axis and their radial offsets from it."""
     relative = points - face.point
@@ -191,12 +191,12 @@ def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide])
     vertices = np.array(mesh.vertices, dtype=float)
     mated = np.zeros(len(mesh.faces), dtype=bool)
     for slide, face in [*((s, s.face) for s in shafts), *((s, s.hole) for s in bores)]:
-        near, along, radial = _near(np.asarray(mesh.vertices), face, slide.tolerance)
-        mated |= np.all(near[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < 1e-3)
+        on, along, radial = near(np.asarray(mesh.vertices), face, slide.tolerance)
+        mated |= np.all(on[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < 1e-3)
         if face is slide.face:
-            distance = np.linalg.norm(radial[near], axis=1)
+            distance = np.linalg.norm(radial[on], axis=1)
             scale = np.maximum(distance - slide.thinner, 0.0) / distance
-            vertices[near] = face.point + np.outer(along[near], face.direction) + radial[near] * scale[:, None]
+            vertices[on] = face.point + np.outer(along[on], face.direction) + radial[on] * scale[:, None]
     return trimesh.Trimesh(vertices, mesh.faces[~mated], process=False)
 
 
