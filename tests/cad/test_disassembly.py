@@ -131,3 +131,24 @@ def test_a_part_that_never_comes_out_is_named_with_its_blockers() -> None:
     assert "part(s) left, right never come out" in message
     assert "left along +z by cage, -z by cage, +x by cage right, -x by cage" in message
     assert "right along +z by cage, -z by cage, +x by cage, -x by cage left, +y by cage, -y by cage" in message
+
+
+def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fit() -> None:
+    # A 3 mm nut (bore r 5 mm, 36-gon) whose top ring is turned half a step against its
+    # bottom one, as Open CASCADE meshes a B-spline bore: its triangles lean along the axis
+    # by 0.013 to 0.019. Down on a plate around a bolt of the same radius (40-gon).
+    nut = trimesh.creation.annulus(r_min=5 * MM, r_max=10 * MM, height=3 * MM, sections=36)
+    vertices = nut.vertices.copy()
+    top = vertices[:, 2] > 0
+    turn = math.pi / 36
+    vertices[top, :2] = vertices[top, :2] @ [[math.cos(turn), math.sin(turn)], [-math.sin(turn), math.cos(turn)]]
+    nut = trimesh.Trimesh(vertices + [0, 0, 11.5 * MM], nut.faces, process=False)
+    bore = trimesh.creation.cylinder(radius=5 * MM, height=30 * MM, sections=64)
+    plate = trimesh.boolean.difference([_box((40, 40, 10), (0, 0, 5)), bore], engine="manifold")
+    bolt = trimesh.creation.cylinder(radius=5 * MM, height=30 * MM, sections=40)
+    bolt.apply_translation((0, 0, 5 * MM))
+    parts = _parts(plate=plate, bolt=bolt, nut=nut)
+    assert [(f.outward, round(f.radius / MM, 6)) for f in cylinder_faces(nut)] == [(True, 10.0), (False, 5.0)]
+    derived = derive(parts, "plate", {}, reach=0.0)
+    assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
+    assert derived.blockers[("nut", "+z")] == set() and derived.axis["nut"] == "+z"
