@@ -217,8 +217,9 @@ def report(derived: Derived) -> list[str]:
                      "square or rect section, no hole")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     for pid, by_direction in sorted(derived.located.items()):
-        lines.append(f"part {pid} sideways within {_mm(derived.reach)} mm: " + "; ".join(
-            f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items()))
+        lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(
+            f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items())
+            + f" (its ways in: along {', '.join(opposite(way) for way in derived.ways(pid))})")
     for locator, pid in sorted(derived.dropped):
         lines.append(f"locating pair {locator}->{pid} dropped: the blocking needs {pid} before {locator}")
     lines += derived.notes()

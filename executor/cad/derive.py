@@ -16,7 +16,8 @@ in once B is there: of the directions the base leaves A free along, B blocks one
 or parts present whenever B is (its body, the base, parts already found to precede B)
 block every one. The base precedes every part touching it (``base``). Two stated rules
 of placing (:mod:`executor.cad.locating`) add ``supports`` (a part
-resting on parts other than the base goes after them) and ``locates`` (off with reach 0);
+resting on parts other than the base goes after them) and ``locates`` (whichever way a part
+goes in, one other part alone locates it across that way; off with reach 0);
 a pair of theirs that the blocking contradicts is dropped and reported.
 
 **Holes** are the inner loops of the base's slices perpendicular to the axes, at the middle
@@ -119,7 +120,7 @@ class Derived:
     ``reasons`` why each holds (``blocks``: :func:`forced`, its blockers per direction in
     ``detail``; ``base``: the base precedes the parts touching it; ``supports`` and
     ``locates``: the rules of :mod:`executor.cad.locating`),
-    ``located`` each moving body's locators per direction across its axis, ``dropped``
+    ``located`` each moving body's locators per direction (of the six axes), ``dropped``
     the locating pairs and ``dropped_supports`` the supporting pairs the blocking
     contradicts, ``reach`` the locating reach [m] (0: the rule is off), ``bodies`` the
     moving bodies (:func:`bodies`), ``directions`` those tried (name -> unit vector),
@@ -151,6 +152,11 @@ class Derived:
     def free(self, part: str) -> list[str]:
         """The directions ``part`` leaves the whole product along."""
         return [d for d in self.directions if not self.blockers[(part, d)]]
+
+    def ways(self, part: str) -> dict[str, tuple[float, float, float]]:
+        """The directions tried (name -> unit vector) that the base does not block ``part``
+        along: its ways out (reversed, in) in any state of the fixture."""
+        return {d: vector for d, vector in self.directions.items() if self.base not in self.blockers[(part, d)]}
 
     def assumptions(self) -> list[str]:
         """The stated assumptions of the disassembly, as ``import`` prints them."""
@@ -217,9 +223,10 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
     placing = {pair: "supports" for pair in support_pairs(sweeper, result.bodies, base)}
     if reach > 0:
-        result.located = {root: locators(sweeper, members, result.directions[result.axis[root]], reach)
-                          for root, members in result.bodies.items()}
-        placing |= {pair: "locates" for pair in locating_candidates(result.located, base) if pair not in placing}
+        result.located = {root: locators(sweeper, members, reach) for root, members in result.bodies.items()}
+        ways = {root: result.ways(root) for root in result.bodies}
+        placing |= {pair: "locates" for pair in locating_candidates(result.located, ways, base)
+                    if pair not in placing}
     kept, dropped = consistent(sorted(placing), set(result.reasons))
     result.reasons |= {pair: placing[pair] for pair in kept if pair not in result.reasons}
     result.dropped = {pair for pair in dropped if placing[pair] == "locates"}
@@ -273,7 +280,7 @@ def forced(derived: Derived) -> dict[tuple[str, str], str]:
     while grown:
         grown = False
         for a, a_members in derived.bodies.items():
-            ways = [d for d in derived.directions if derived.base not in derived.blockers[(rep[a], d)]]
+            ways = list(derived.ways(rep[a]))
             for b, b_members in derived.bodies.items():
                 prior = ahead(b)
                 if b == a or a in prior or not ways:

@@ -7,16 +7,21 @@ on a horizontal shaft at zero clearance: which holds which the geometry does not
 Blocking cannot decide this (a lid lifted off its spacer has a free way in whatever the
 order); it is gravity's order, and like the locating rule it only removes sequences.
 
-**Model.** In the assembled product, a part X is *located* along a direction across its
-insertion axis by the parts it meets when moved :data:`LOCATING_REACH` that way (swept,
-everything else fixed, as the blocking is found: :class:`executor.cad.sweep.Sweeper`).
-When, along some such direction, one part Y other than the base is the only one that
-locates X, Y must precede X (reason ``locates``): placed before Y, X would lie unlocated
-that way, lined up with what lies below only within the cell's placing error, and Y would
-have to thread X's opening and the hole under it in series. A part located by two or more
-parts (a cover over several pins) gets no edge: any one of them locates it, which a
-must-precede pair cannot say. Parts fixed to another move with it (one body: its
-members' locators together, less the members).
+**Model.** In the assembled product, a part X is *located* along a direction by the parts
+it meets when moved :data:`LOCATING_REACH` that way (swept, everything else fixed, as the
+blocking is found: :class:`executor.cad.sweep.Sweeper`). X may go in along any of its
+*ways*: the directions the base leaves it free along (those the blocking rule tries).
+Gone in along a way, X is located along every direction but the way out: across it, and
+along the insertion itself by what stops it there. When, whichever way X goes in, one
+part Y other than the base is the only one that locates X along some such direction, Y
+must precede X (reason ``locates``): placed before Y, X would lie unlocated that way,
+where the cell put it within its placing error, and Y would have to thread X's opening
+and what lies beyond it in series. A way along which Y locates nothing alone takes the
+pair away (a ring slid on along its shaft is located by the shaft across and by the part
+it stops against, not by the pulley beside it: no pulley-before-ring pair). A part located by two or more parts (a cover
+over several pins) gets no edge: any one of them locates it, which a must-precede pair
+cannot say. Parts fixed to another move with it (one body: its members' locators
+together, less the members).
 
 This is a model of the process, not a consequence of the geometry: the straight paths
 stay free whatever the order, and the cell may well succeed (Cranfield's shaft through
@@ -42,17 +47,17 @@ MAX_REACH = 0.1
 """The largest reach ``import --locating-reach`` takes [m]."""
 
 
-def lateral(axis: tuple[float, float, float]) -> list[str]:
-    """The directions of :data:`DIRECTIONS` across the removal direction ``axis`` (a unit
-    vector): all but those along it."""
-    return [name for name, vector in DIRECTIONS.items() if abs(float(np.dot(vector, axis))) < 1 - 1e-9]
+def beside(way: tuple[float, float, float]) -> list[str]:
+    """The directions of :data:`DIRECTIONS` a part that goes in against the removal
+    direction ``way`` (a unit vector) is located along: all but the way out itself (along
+    it lies what goes in later, over the part: the blocking's to order)."""
+    return [name for name, vector in DIRECTIONS.items() if float(np.dot(vector, way)) < 1 - 1e-9]
 
 
-def locators(sweeper: Sweeper, group: set[str], axis: tuple[float, float, float], reach: float
-             ) -> dict[str, set[str]]:
+def locators(sweeper: Sweeper, group: set[str], reach: float) -> dict[str, set[str]]:
     """Direction -> the other parts that stop the body ``group`` (its members moved
-    together) within ``reach`` [m] along each direction across the removal direction ``axis``."""
-    return {name: sweeper.blockers(group, np.array(DIRECTIONS[name]), reach) for name in lateral(axis)}
+    together) within ``reach`` [m] along each direction of :data:`DIRECTIONS`."""
+    return {name: sweeper.blockers(group, np.array(vector), reach) for name, vector in DIRECTIONS.items()}
 
 
 def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> set[tuple[str, str]]:
@@ -65,11 +70,20 @@ def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> s
     return {(y, x) for y, x in pairs if (x, y) not in pairs}
 
 
-def locating_candidates(located: dict[str, dict[str, set[str]]], base: str) -> set[tuple[str, str]]:
-    """The locating pairs (Y, X) of ``located`` (body -> direction -> its locators): Y is
-    the one locator of X along some direction and not the base."""
-    return {(next(iter(parts)), part) for part, by_direction in located.items()
-            for parts in by_direction.values() if len(parts) == 1 and base not in parts}
+def locating_candidates(located: dict[str, dict[str, set[str]]], ways: dict[str, dict[str, tuple[float, float, float]]],
+                        base: str) -> set[tuple[str, str]]:
+    """The locating pairs (Y, X) of ``located`` (body -> direction -> its locators) and
+    ``ways`` (body -> its ways in, named removal directions -> unit vectors): along every
+    way, Y (not the base) is the one locator of X along some direction :func:`beside` it."""
+    pairs: set[tuple[str, str]] = set()
+    for part, by_direction in located.items():
+        alone: set[str] | None = None
+        for axis in ways[part].values():
+            here = {next(iter(by_direction[name])) for name in beside(axis)
+                    if len(by_direction[name]) == 1 and base not in by_direction[name]}
+            alone = here if alone is None else alone & here
+        pairs |= {(locator, part) for locator in alone or ()}
+    return pairs
 
 
 def consistent(candidates: list[tuple[str, str]], edges: set[tuple[str, str]]

@@ -16,7 +16,10 @@ a mesh that is not closed (its boundary edges counted, one located), a closed me
 triangles are wound inconsistently (made consistent when the part is one shell, refused
 otherwise: which shells are cavities is not known), parts whose sizes differ by a factor the
 units explain (one part in mm among parts in m), a product too small or too large for its
-stated units, and parts that overlap (intersection volume above :data:`OVERLAP_VOLUME`).
+stated units, and parts that overlap (intersection volume above :data:`OVERLAP_VOLUME`,
+leaving out what lies within a zero-clearance fit's tolerance of its two faces: coaxial
+cylinders of one nominal radius, each tessellated on its own, overlap by up to the larger
+deflection however coarse the tessellation; :func:`executor.cad.sweep.zero_clearance_fits`).
 """
 
 from __future__ import annotations
@@ -33,14 +36,16 @@ import trimesh
 
 from bridge.assembly import is_id
 from executor import ExecutorError
+from executor.cad.sweep import CylinderFace, Slide, cylinder_faces, near, zero_clearance_fits
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
 MESH_SUFFIXES = (".stl", ".obj")
 STEP_SUFFIXES = (".step", ".stp")
 OVERLAP_VOLUME = 1e-9
-"""Two parts overlap when their intersection is larger than this [m³] (1 mm³); touching
-faces and fits with clearance have none."""
+"""Two parts overlap when their intersection, less the pieces within their zero-clearance
+fits' tolerance of the mated faces, is larger than this [m³] (1 mm³); touching faces and
+fits with clearance have none."""
 PRODUCT_EXTENT = (0.005, 5.0)
 """A product's largest extent must lie in this range [m] (a cell's products), else its
 units are doubted."""
@@ -260,7 +265,9 @@ def _make_solid(part: CadPart, units: str) -> None:
 
 def _check_overlaps(parts: list[CadPart]) -> None:
     """ExecutorError naming the first pair whose intersection exceeds :data:`OVERLAP_VOLUME`
-    (exact booleans by manifold3d on the pairs whose bounding boxes meet)."""
+    (exact booleans by manifold3d on the pairs whose bounding boxes meet), less the pieces
+    of it that lie within their zero-clearance fits' tolerance of the mated faces."""
+    faces: dict[str, list[CylinderFace]] = {}
     for i, a in enumerate(parts):
         for b in parts[i + 1:]:
             low = np.maximum(a.mesh.bounds[0], b.mesh.bounds[0])
@@ -268,9 +275,35 @@ def _check_overlaps(parts: list[CadPart]) -> None:
             if np.any(high - low <= 0):
                 continue
             common = trimesh.boolean.intersection([a.mesh, b.mesh], engine="manifold")
-            with np.errstate(divide="ignore", invalid="ignore"):  # an empty intersection has no centre
-                volume = float(common.volume) if len(common.faces) else 0.0
+            volume = _volume(common)
+            if volume > OVERLAP_VOLUME:
+                for part in (a, b):
+                    if part.id not in faces:
+                        faces[part.id] = cylinder_faces(part.mesh)
+                volume = _beyond_fits(common, zero_clearance_fits({a.id: faces[a.id], b.id: faces[b.id]}))
             if volume > OVERLAP_VOLUME:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
-                                    "that at most touch)")
+                                    "that at most touch, or coaxial cylinders of one radius within their "
+                                    "tessellations' deflection)")
+
+
+def _volume(mesh: trimesh.Trimesh) -> float:
+    """The volume of a closed ``mesh`` [m³], 0 when it has no triangles."""
+    with np.errstate(divide="ignore", invalid="ignore"):  # an empty intersection has no centre
+        return float(mesh.volume) if len(mesh.faces) else 0.0
+
+
+def _beyond_fits(common: trimesh.Trimesh, slides: list[Slide]) -> float:
+    """The volume [m³] of the pieces of the intersection ``common`` that do not lie, every
+    vertex, within a fit's tolerance of its shaft's or its bore's face (the overlap of two
+    tessellations of one nominal cylinder, as the sweeps take it: :mod:`executor.cad.sweep`)."""
+    if not slides:
+        return _volume(common)
+    outside = 0.0
+    for piece in common.split(only_watertight=False):
+        points = np.asarray(piece.vertices)
+        if not any(np.all(near(points, slide.face, slide.tolerance)[0] | near(points, slide.hole, slide.tolerance)[0])
+                   for slide in slides):
+            outside += abs(_volume(piece))
+    return outside

@@ -6,7 +6,8 @@ cylindrical faces of its B-rep (axis and radius, exact where the tessellation is
 tessellate it again more coarsely (``CadPart.remesh``: the simulated cell's base).
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
-converts to metres. A leaf without a name is named after its parent and position.
+converts to metres. A leaf without a name is named after its parent and position; leaves
+of one name (a sub-assembly placed twice) are told apart by their assemblies' names.
 
 A file whose reading Open CASCADE reports a failure for (a syntax error, a reference to a
 missing record, a record with the wrong parameters: its reader goes on without the
@@ -72,14 +73,14 @@ def load_step(path: Path, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
     tool = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
     roots = Sequence_TDF_Label()
     tool.GetFreeShapes(roots)
-    leaves: list[tuple[str, Any]] = []
+    leaves: list[tuple[tuple[str, ...], Any]] = []
     for k in range(1, roots.Length() + 1):
-        _collect(tool, roots.Value(k), None, _name(roots.Value(k)) or path.stem, leaves)
+        _collect(tool, roots.Value(k), None, (_name(roots.Value(k)) or path.stem,), leaves)
     if not leaves:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
     parts: list[CadPart] = []
     total = 0
-    for name, shape in leaves:
+    for name, (_, shape) in zip(_unique_names([names for names, _ in leaves]), leaves, strict=True):
         source = f"{path}#{name}"
         _tessellate(shape)
         total = count_triangles(source, _triangles(shape), total, max_triangles)
@@ -154,9 +155,26 @@ def _name(label: Any) -> str:
     return ""
 
 
-def _collect(tool: object, label: Any, location: Any, name: str, leaves: list[tuple[str, Any]]) -> None:
-    """Append ``(name, located shape)`` for every leaf under ``label``; ``location`` is the
-    placement of ``label`` in the product (None at a root)."""
+def _unique_names(paths: list[tuple[str, ...]]) -> list[str]:
+    """Each leaf's name from its ``paths`` (the names from the root down to it): its own,
+    and where several leaves share it (a sub-assembly placed twice), joined with ``_``
+    to those of as many of its assemblies as tell them apart (``l-bracket-assembly_1_bolt_1``)."""
+    depth = [1] * len(paths)
+    while True:
+        names = ["_".join(path[-d:]) for path, d in zip(paths, depth, strict=True)]
+        shared = {name for name in names if names.count(name) > 1}
+        longer = [k for k, name in enumerate(names) if name in shared and depth[k] < len(paths[k])]
+        if not longer:
+            return names
+        for k in longer:
+            depth[k] += 1
+
+
+def _collect(tool: object, label: Any, location: Any, path: tuple[str, ...],
+             leaves: list[tuple[tuple[str, ...], Any]]) -> None:
+    """Append ``(names from the root, located shape)`` for every leaf under ``label``
+    (``path``: the names down to it); ``location`` is the placement of ``label`` in the
+    product (None at a root)."""
     from OCP.collections import Sequence_TDF_Label
     from OCP.TDF import TDF_Label
     from OCP.TopLoc import TopLoc_Location
@@ -171,10 +189,10 @@ def _collect(tool: object, label: Any, location: Any, name: str, leaves: list[tu
         for k in range(1, children.Length() + 1):
             child = children.Value(k)
             placement = here.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(child))
-            _collect(tool, child, placement, _name(child) or _name(definition) or f"{name}_{k}", leaves)
+            _collect(tool, child, placement, (*path, _name(child) or _name(definition) or f"{path[-1]}_{k}"), leaves)
         return
     shape = XCAFDoc_ShapeTool.GetShape_s(definition)
-    leaves.append((name, shape.Located(here.Multiplied(shape.Location()))))
+    leaves.append((path, shape.Located(here.Multiplied(shape.Location()))))
 
 
 def _tessellate(shape: Any, deflection: float = STEP_DEFLECTION, angle: float = FINE_ANGLE) -> None:

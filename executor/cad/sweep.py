@@ -58,6 +58,12 @@ HULL_POINTS = 96
 their halves are."""
 SMOOTH = np.radians(35.0)
 """Adjacent triangles meeting at less than this angle are one smooth face (a 12-gon's is 30°)."""
+TILT = 0.05
+"""How far a cylindrical face's triangle normals may lean along its axis (the cosine: 2.9°):
+a tessellation whose rings are not lined up (a vertex of one end between two of the
+other, as Open CASCADE meshes a B-spline bore) leans them by about its chord error over
+the face's length (a 3 mm nut's bore at 0.02 mm: 1.4e-3). That the vertices lie on one
+circle is what makes the face a cylinder (a cone or a sphere fails it)."""
 _MAX_CONTACTS = 100_000
 _FEW_CONTACTS = 8
 
@@ -95,7 +101,7 @@ class CylinderFace:
 
 def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
     """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
-    six triangles whose normals are perpendicular to one axis (within 1e-3) and span more
+    six triangles whose normals are perpendicular to one axis (within :data:`TILT`) and span more
     than a flat face's, whose vertices lie on one circle (within 1 µm plus 1e-4 of the
     radius) and whose normals all point away from the axis or all towards it."""
     angles = mesh.face_adjacency_angles
@@ -106,7 +112,7 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
         scatter = normals.T @ normals / len(region)
         values, vectors = np.linalg.eigh(scatter)
         axis = vectors[:, 0]
-        if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > 1e-3:
+        if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > TILT:
             continue  # flat, or no cylinder (a cone, a sphere)
         ring = np.unique(mesh.faces[region].ravel())
         frame = np.linalg.svd(axis[None, :])[2][1:]  # two unit vectors across the axis
@@ -171,7 +177,7 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
     return found
 
 
-def _near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius, within its
     span), their coordinates along the axis and their radial offsets from it."""
     relative = points - face.point
@@ -191,12 +197,12 @@ def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide])
     vertices = np.array(mesh.vertices, dtype=float)
     mated = np.zeros(len(mesh.faces), dtype=bool)
     for slide, face in [*((s, s.face) for s in shafts), *((s, s.hole) for s in bores)]:
-        near, along, radial = _near(np.asarray(mesh.vertices), face, slide.tolerance)
-        mated |= np.all(near[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < 1e-3)
+        on, along, radial = near(np.asarray(mesh.vertices), face, slide.tolerance)
+        mated |= np.all(on[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < TILT)
         if face is slide.face:
-            distance = np.linalg.norm(radial[near], axis=1)
+            distance = np.linalg.norm(radial[on], axis=1)
             scale = np.maximum(distance - slide.thinner, 0.0) / distance
-            vertices[near] = face.point + np.outer(along[near], face.direction) + radial[near] * scale[:, None]
+            vertices[on] = face.point + np.outer(along[on], face.direction) + radial[on] * scale[:, None]
     return trimesh.Trimesh(vertices, mesh.faces[~mated], process=False)
 
 

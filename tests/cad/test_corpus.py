@@ -43,12 +43,14 @@ FEATURE_REACH_MM = 2.0
 class Imported:
     """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
     moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
-    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the cell."""
+    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the
+    cell, and each imported hole's or pin's ``occupants`` (the parts in it or onto it)."""
 
     truth: dict[str, Any]
     out: Path
     axes: dict[str, str]
     offset: tuple[float, float]
+    occupants: dict[str, set[str]]
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -75,8 +77,11 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
             out = tmp_path_factory.mktemp(name) / "out"
             result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
             truth = tomllib.loads((folder / "truth.toml").read_text())
-            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in result.derived.axis.items()},
-                                  result.offset)
+            derived = result.derived
+            occupants = {hid: {fit.part} for hid, fit in derived.holes.items() if fit.part is not None}
+            occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
+            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
+                                  result.offset, occupants)
         return done[name]
 
     return get
@@ -94,12 +99,16 @@ def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tu
 
 
 def _feature_holes(done: Imported) -> dict[str, str]:
-    """Each truth feature's imported hole id (the one on its axis; absent: none found)."""
+    """Each truth feature's imported hole id (absent: none found): the one on its axis
+    that is empty or holds a part the truth puts in that feature (of a plate's hole and the
+    end of the bolt in it, of the two ends of one rod, the one its own part is in)."""
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
+        inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
         near = [hid for hid, hole in holes.items()
-                if _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM]
+                if _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
+                and (not done.occupants.get(hid) or done.occupants[hid] & inside)]
         if len(near) == 1:
             found[fid] = near[0]
     return found
@@ -114,10 +123,17 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
 
+ANY_PART = ("fits of any part on any part: the bolts' ends the nuts under the plate go onto and the brackets' bores "
+            "the rod goes through are no features")
+ZERO_CLEARANCE = ("nominal zero-clearance fits: a d 10 bolt in its d 10 hole is measured on the tessellation as a "
+                  "10.000 mm peg in a 9.981 mm hole (the inscribed polygon's circle) and written as no fit")
+
+
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("occt_as1", marks=_xfail(ANY_PART)),
     "robosuite_nuts",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
@@ -136,6 +152,22 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
     # The CAD prior's margins agree in sign (the room's measure may differ by convention).
     margins = {(p, h): int(m) for p, h, m in _atoms(done.out / "nominal_sizes.lp").get("nominal_margin", set())}
     assert all((margins[row["part"], holes[row["feature"]]] > 0) == row["fits"] for row in done.truth["fits"])
+
+
+@pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", [
+    "agh_hex_horizontal",
+    "agh_prism_array",
+    pytest.param("occt_as1", marks=_xfail(ZERO_CLEARANCE)),
+    "robosuite_nuts",
+])
+def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
+    # On the features the import finds: the part the CAD has in each fits it.
+    done = imported(name)
+    fits = _atoms(done.out / "sizes.lp").get("fits", set())
+    holes = _feature_holes(done)
+    pairs = [(pid, holes[part["in"]]) for pid, part in done.truth["parts"].items() if part.get("in") in holes]
+    assert pairs and [pair for pair in pairs if pair not in fits] == []
 
 
 @pytest.mark.slow  # the first test of a product imports it
@@ -180,6 +212,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     pytest.param("agh_hex_horizontal", marks=_xfail(INSERTED + " in along a horizontal axis")),
     "agh_prism_array",
+    pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
+                                          "rod through two brackets")),
     "robosuite_nuts",
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
@@ -210,11 +244,15 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
 
 @pytest.mark.parametrize("name", PRODUCTS)
 def test_each_truth_is_a_closed_world(name: str) -> None:
+    # Every part that goes into a feature against every feature of that kind (a hole, a
+    # pin); a part in none (a bracket on the base) has no row. Room 0 is a nominal
+    # zero-clearance fit: the CAD has the part in it.
     truth = tomllib.loads((CORPUS / name / "truth.toml").read_text())
+    features = truth["features"]
     rows = [(row["part"], row["feature"]) for row in truth["fits"]]
-    assert sorted(rows) == sorted((p, f) for p in truth["parts"] for f in truth["features"])
-    assert all(part["in"] in truth["features"] for part in truth["parts"].values())
-    assert all(row["fits"] == (row["room_mm"] > 0) for row in truth["fits"])
+    assert sorted(rows) == sorted((p, f) for p, part in truth["parts"].items() if "in" in part
+                                  for f, feature in features.items() if feature["kind"] == features[part["in"]]["kind"])
+    assert all(row["fits"] == (row["room_mm"] >= 0) for row in truth["fits"])
     assert (CORPUS / name / "SOURCE.md").is_file()
 
 

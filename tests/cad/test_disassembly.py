@@ -1,9 +1,10 @@
 """The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py) on small
 products of trimesh primitives: a horizontal shaft in a zero-clearance bearing comes out
-along its axis; a precedence pair only where every way in is blocked (a bar that slides
-out sideways under a lid gets none, a washer on a pin under a cap nut gets exactly the
-forced ones); parts fixed to each other move as one; a part that never comes out is named
-with its blockers per direction."""
+along its axis, and passes the overlap check however coarse the tessellation; a
+precedence pair only where every way in is blocked (a bar that slides out sideways under
+a lid gets none, a washer on a pin under a cap nut gets exactly the forced ones); parts
+fixed to each other move as one; a part that never comes out is named with its blockers
+per direction."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import trimesh
 
 from executor import ExecutorError
 from executor.cad.derive import derive
-from executor.cad.parts import CadPart
+from executor.cad.parts import CadPart, check_parts
 from executor.cad.sweep import cylinder_faces
 
 MM = 1e-3
@@ -38,15 +39,31 @@ def _parts(**meshes: trimesh.Trimesh) -> list[CadPart]:
     return [CadPart(pid, pid, mesh, f"{pid}.stl") for pid, mesh in meshes.items()]
 
 
-def _shaft_in_bearing() -> list[CadPart]:
-    """A 40 mm housing bored through along x (r 16 mm, 64-gon), a 20 mm bearing in its
-    middle (r 8 to 16 mm, 72-gons) and a 100 mm shaft in the bearing (r 8 mm, 40-gon): the
-    same nominal radii, polygons overlapping by up to 25 µm."""
-    bore = _along_x(trimesh.creation.cylinder(radius=16 * MM, height=42 * MM, sections=64))
+def _shaft_in_bearing(sections: tuple[int, int, int] = (64, 72, 40)) -> list[CadPart]:
+    """A 40 mm housing bored through along x (r 16 mm), a 20 mm bearing in its middle (r 8
+    to 16 mm) and a 100 mm shaft in the bearing (r 8 mm), as polygons of ``sections`` sides
+    (the housing's bore, the bearing's, the shaft's): the same nominal radii, overlapping
+    by up to 25 µm with the default ones."""
+    bore = _along_x(trimesh.creation.cylinder(radius=16 * MM, height=42 * MM, sections=sections[0]))
     housing = trimesh.boolean.difference([_box((40, 50, 60), (0, 0, 30)), bore], engine="manifold")
-    bearing = _along_x(trimesh.creation.annulus(r_min=8 * MM, r_max=16 * MM, height=20 * MM, sections=72))
-    shaft = _along_x(trimesh.creation.cylinder(radius=8 * MM, height=100 * MM, sections=40))
+    bearing = _along_x(trimesh.creation.annulus(r_min=8 * MM, r_max=16 * MM, height=20 * MM, sections=sections[1]))
+    shaft = _along_x(trimesh.creation.cylinder(radius=8 * MM, height=100 * MM, sections=sections[2]))
     return _parts(housing=housing, bearing=bearing, shaft=shaft)
+
+
+def test_a_coarse_zero_clearance_fit_passes_the_overlap_check_and_a_collar_in_it_does_not() -> None:
+    # 18-, 14- and 12-gons: the bearing overlaps the housing by 43 mm³, the shaft the
+    # bearing by 22 mm³, all of it within the 0.27 mm deflection of the mated faces.
+    parts = _shaft_in_bearing((18, 14, 12))
+    check_parts(parts, "m")
+    derived = derive(parts, "housing", {}, reach=0.0)
+    assert derived.free("shaft") == ["+x", "-x"] and derived.axis == {"shaft": "+x", "bearing": "+x"}
+    # A collar on the shaft 1 mm into the bearing's face is no tessellation: still refused.
+    collar = _along_x(trimesh.creation.cylinder(radius=12 * MM, height=5 * MM, sections=12))
+    collar.apply_translation((11.5 * MM, 0, 0))
+    shaft = trimesh.boolean.union([parts[2].mesh, collar], engine="manifold")
+    with pytest.raises(ExecutorError, match="parts 'bearing' and 'shaft' overlap by"):
+        check_parts([*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")], "m")
 
 
 def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
@@ -114,3 +131,24 @@ def test_a_part_that_never_comes_out_is_named_with_its_blockers() -> None:
     assert "part(s) left, right never come out" in message
     assert "left along +z by cage, -z by cage, +x by cage right, -x by cage" in message
     assert "right along +z by cage, -z by cage, +x by cage, -x by cage left, +y by cage, -y by cage" in message
+
+
+def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fit() -> None:
+    # A 3 mm nut (bore r 5 mm, 36-gon) whose top ring is turned half a step against its
+    # bottom one, as Open CASCADE meshes a B-spline bore: its triangles lean along the axis
+    # by 0.013 to 0.019. Down on a plate around a bolt of the same radius (40-gon).
+    nut = trimesh.creation.annulus(r_min=5 * MM, r_max=10 * MM, height=3 * MM, sections=36)
+    vertices = nut.vertices.copy()
+    top = vertices[:, 2] > 0
+    turn = math.pi / 36
+    vertices[top, :2] = vertices[top, :2] @ [[math.cos(turn), math.sin(turn)], [-math.sin(turn), math.cos(turn)]]
+    nut = trimesh.Trimesh(vertices + [0, 0, 11.5 * MM], nut.faces, process=False)
+    bore = trimesh.creation.cylinder(radius=5 * MM, height=30 * MM, sections=64)
+    plate = trimesh.boolean.difference([_box((40, 40, 10), (0, 0, 5)), bore], engine="manifold")
+    bolt = trimesh.creation.cylinder(radius=5 * MM, height=30 * MM, sections=40)
+    bolt.apply_translation((0, 0, 5 * MM))
+    parts = _parts(plate=plate, bolt=bolt, nut=nut)
+    assert [(f.outward, round(f.radius / MM, 6)) for f in cylinder_faces(nut)] == [(True, 10.0), (False, 5.0)]
+    derived = derive(parts, "plate", {}, reach=0.0)
+    assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
+    assert derived.blockers[("nut", "+z")] == set() and derived.axis["nut"] == "+z"

@@ -283,3 +283,22 @@ def test_a_manifest_listing_other_files_is_refused(tmp_path: Path) -> None:
     assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(out)]) == 2
     assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(out), "--replace"]) == 0
     assert victim.read_text() == "not the import's\n"
+
+
+@pytest.mark.slow  # build123d writes the STEP file (about 5 s)
+def test_parts_of_one_name_in_two_sub_assemblies_are_told_apart_by_them(tmp_path: Path) -> None:
+    # A bracket assembly placed twice (as AS1 of the STEP test suite places its l-brackets):
+    # each copy's bolt is named 'bolt'.
+    script = tmp_path / "make.py"
+    script.write_text(
+        "from build123d import *\n"
+        "plate = Box(100, 60, 20); plate.label = 'plate'\n"
+        "def side(x, label):\n"
+        "    bolt = Pos(x, 0, 20) * Cylinder(5, 20); bolt.label = 'bolt'\n"
+        "    return Compound(label=label, children=[bolt])\n"
+        f"export_step(Compound(label='unit', children=[plate, side(-30, 'left'), side(30, 'right')]), "
+        f"{str(tmp_path / 'u.step')!r})\n")
+    subprocess.run([sys.executable, str(script)], check=True)
+    parts = {part.id: part for part in load_step(tmp_path / "u.step")}
+    assert sorted(parts) == ["left_bolt", "plate", "right_bolt"]
+    assert parts["left_bolt"].mesh.centroid[0] == pytest.approx(-0.03, abs=1e-6)

@@ -5,6 +5,8 @@ is dropped; reach 0 turns the rule off."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 import trimesh
 
@@ -46,7 +48,8 @@ def _product(pegs: list[float], head: bool = False) -> list[CadPart]:
 def test_a_part_only_a_peg_locates_goes_after_the_peg() -> None:
     derived = derive(_product([0.0]), "plate", {})
     assert derived.reasons == {("plate", "peg0"): "base", ("plate", "washer"): "base", ("peg0", "washer"): "locates"}
-    assert derived.located["washer"] == {"+x": {"peg0"}, "-x": {"peg0"}, "+y": {"peg0"}, "-y": {"peg0"}}
+    assert derived.located["washer"] == {"+z": set(), "-z": {"plate"}, "+x": {"peg0"}, "-x": {"peg0"},
+                                         "+y": {"peg0"}, "-y": {"peg0"}}
     assert not derived.dropped
     assert derive(_product([0.0]), "plate", {}, reach=0.0).reasons == {
         ("plate", "peg0"): "base", ("plate", "washer"): "base"}
@@ -65,3 +68,35 @@ def test_a_locating_pair_the_blocking_contradicts_is_dropped(reach: float) -> No
     derived = derive(_product([0.0], head=True), "plate", {}, reach)
     assert derived.reasons[("washer", "peg0")] == "blocks"  # the bolt's head lies over the washer
     assert derived.dropped == {("peg0", "washer")} and ("peg0", "washer") not in derived.edges
+
+
+def _ring(pid: str, inner: float, outer: float, start: float, end: float, sections: int) -> CadPart:
+    """A ring along x from ``start`` to ``end`` [mm] at 30 mm height, bore ``inner``, outside ``outer`` [mm]."""
+    ring = trimesh.creation.annulus(r_min=inner * MM, r_max=outer * MM, height=(end - start) * MM, sections=sections)
+    ring.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (0, 1, 0)))
+    ring.apply_translation(((start + end) / 2 * MM, 0, 30 * MM))
+    return _part(pid, ring)
+
+
+def test_a_ring_that_slides_on_along_its_shaft_is_located_by_the_shaft_alone() -> None:
+    """A housing bored along x (r 16 mm), a bearing in it, a horizontal shaft through the
+    bearing, then a spacer and a pulley on the shaft outside the housing, all at zero
+    clearance. Lowered from above (once the shaft is out) the spacer is located along x by
+    the bearing and the pulley alone; slid on along the shaft from outside it stops on the
+    bearing, and from inside (through the bore) on the pulley: only the shaft locates it
+    whichever way it goes in. The pulley, lowered or slid on, stops on the spacer."""
+    bore = trimesh.creation.cylinder(radius=16 * MM, height=62 * MM, sections=64)
+    bore.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (0, 1, 0)))
+    bore.apply_translation((0, 0, 30 * MM))
+    housing = trimesh.boolean.difference([trimesh.boolean.union(
+        [_box((80, 50, 5), (0, 0, -2.5)), _box((60, 50, 60), (0, 0, 30))], engine="manifold"), bore],
+        engine="manifold")
+    shaft = trimesh.creation.cylinder(radius=8 * MM, height=130 * MM, sections=43)
+    shaft.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (0, 1, 0)))
+    shaft.apply_translation((0, 0, 30 * MM))
+    parts = [_part("housing", housing), _part("shaft", shaft), _ring("bearing", 8, 16, -30, -18, 45),
+             _ring("spacer", 8, 12, -40, -30, 47), _ring("pulley", 8, 25, -55, -40, 49)]
+    derived = derive(parts, "housing", {})
+    assert derived.located["spacer"]["+x"] == {"bearing"} and derived.located["spacer"]["-x"] == {"pulley"}
+    assert {pair for pair, reason in derived.reasons.items() if reason == "locates"} == {
+        ("shaft", "spacer"), ("shaft", "pulley"), ("spacer", "pulley")}
