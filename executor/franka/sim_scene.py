@@ -147,13 +147,9 @@ def _part_body(worldbody: ET.Element, asset: ET.Element, geometry: CellGeometry,
     half = part.length / 2
     common = {"friction": _FRICTION, "rgba": _PART_RGBA}
     if part.mesh is None:
-        if part.kind == "round":
-            ET.SubElement(body, "geom", type="cylinder", size=_vec((part.size / 2, half)), pos=_vec((0, 0, half)),
-                          mass=f"{part.mass:.9g}", **common)
-        else:
-            a, b = part.sides
-            ET.SubElement(body, "geom", type="box", size=_vec((a / 2, b / 2, half)), pos=_vec((0, 0, half)),
-                          mass=f"{part.mass:.9g}", **common)
+        a, b = part.sides
+        kind, size = ("cylinder", (part.size / 2, half)) if part.kind == "round" else ("box", (a / 2, b / 2, half))
+        ET.SubElement(body, "geom", common, type=kind, size=_vec(size), pos=_vec((0, 0, half)), mass=f"{part.mass:.9g}")
         return name
     if part.mesh.convex is None:
         raise ExecutorError(f"{geometry.folder / 'geometry.toml'}: [part_shapes.{part.shape}] mesh has no convex "
@@ -164,7 +160,7 @@ def _part_body(worldbody: ET.Element, asset: ET.Element, geometry: CellGeometry,
                   fullinertia=_vec((i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2])))
     for k, vertices in enumerate(read_objects(geometry.folder / part.mesh.convex)):
         ET.SubElement(asset, "mesh", name=f"{name}_{k}", vertex=_vec(vertices))
-        ET.SubElement(body, "geom", type="mesh", mesh=f"{name}_{k}", **common)
+        ET.SubElement(body, "geom", common, type="mesh", mesh=f"{name}_{k}")
     return name
 
 

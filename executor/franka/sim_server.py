@@ -197,7 +197,7 @@ class SimRobot:
         names = add_product(sim.scene, sim.worldbody, self.geometry)
         add_flange_sensor(sim)
         server = SimulationServer(sim) if self._hostname is None else SimulationServer(sim, [self._hostname])
-        self._sim, self._server, self._robot = sim, server, robot  # type: ignore[assignment]
+        self._sim, self._server, self._robot = sim, server, robot
         try:
             server.init()
         except (OSError, RuntimeError) as exc:
