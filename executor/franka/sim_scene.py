@@ -25,10 +25,10 @@ each is refused or left out as stated in :func:`add_product`.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 
 from bridge.product import Plate
@@ -50,6 +50,23 @@ _FRICTION = f"{TEACH_FRICTION} 0.005 0.0001"  # sliding, torsional [m], rolling 
 _PART_CONDIM = "4"  # sliding and torsional friction: a held part does not spin about the fingers' closing axis
 _PLATE_RGBA = "0.7 0.72 0.75 1"
 _PART_RGBA = "0.8 0.6 0.2 1"
+
+
+CONTACT_OPTIONS = {"cone": "elliptic", "impratio": "10", "noslip_iterations": "5"}
+"""MuJoCo's contact options (its documentation's advice against slip in a grasp: elliptic
+friction cones, friction 10x stiffer than normal forces, a no-slip pass)."""
+
+TIME_STEP = 0.001
+"""MuJoCo's step [s]: franky-sim's, one per control packet (the PyBullet cell's too)."""
+
+
+def set_contact_options(scene: ET.Element) -> None:
+    """Put :data:`CONTACT_OPTIONS` into the ``<option>`` of a MuJoCo scene (made if missing)."""
+    option = scene.find("option")
+    if option is None:
+        option = ET.SubElement(scene, "option")
+    for key, value in CONTACT_OPTIONS.items():
+        option.set(key, value)
 
 
 def to_base(point: np.ndarray) -> np.ndarray:
@@ -186,13 +203,39 @@ def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry
     return {pid: _part_body(worldbody, asset, geometry, part) for pid, part in sorted(geometry.parts.items())}
 
 
-def hole_entry(geometry: CellGeometry, hole: str) -> np.ndarray:
-    """The centre of a hole's entry [m] in the arm's base frame."""
-    spec = geometry.holes[hole]
-    return to_base(np.array([*spec.position, spec.top_z]))
+def product_model(geometry: CellGeometry, drive: str | None = None
+                  ) -> tuple[mujoco.MjModel, mujoco.MjData, dict[str, int]]:
+    """A MuJoCo model of the product alone (floor, plate, pegs at their tray starts; no
+    arm), gravity, :data:`TIME_STEP` and :data:`CONTACT_OPTIONS`, as franky-sim's scene has
+    them; its data after a forward pass, and the body id of each peg and of the plate
+    (``"plate"``). ``drive``: a part welded to a mocap body (``"drive"``) that moves it."""
+    root = ET.Element("mujoco", model="product")
+    ET.SubElement(root, "option", timestep=str(TIME_STEP), gravity="0 0 -9.81", integrator="implicitfast")
+    set_contact_options(root)
+    ET.SubElement(root, "asset")
+    world = ET.SubElement(root, "worldbody")
+    ET.SubElement(world, "geom", name="floor", type="plane", size="10 10 0.1")
+    names = add_product(root, world, geometry) | {"plate": "plate"}
+    if drive is not None:
+        ET.SubElement(world, "body", name="drive", mocap="true")
+        ET.SubElement(ET.SubElement(root, "equality"), "weld", body1="drive", body2=names[drive], solref="0.005 1",
+                      relpose="0 0 0 1 0 0 0")  # the part at the drive body, axes aligned
+        names["drive"] = "drive"
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return model, data, {key: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for key, name in names.items()}
 
 
-def yaw_of(quat_wxyz: np.ndarray) -> float:
-    """The rotation [rad] about z of a MuJoCo quaternion (w x y z) of an upright body."""
-    w, x, y, z = (float(v) for v in quat_wxyz)
-    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+def contact_force(model: mujoco.MjModel, data: mujoco.MjData, body: int, other: int) -> np.ndarray:
+    """The total contact force [N] (world axes) that body ``other`` exerts on body ``body``."""
+    total, wrench = np.zeros(3), np.zeros(6)
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        first, second = (int(model.geom_bodyid[g]) for g in contact.geom)
+        if {first, second} != {body, other}:
+            continue
+        mujoco.mj_contactForce(model, data, i, wrench)
+        on_second = contact.frame.reshape(3, 3).T @ wrench[:3]  # the contact frame's rows are its axes
+        total += on_second if second == body else -on_second
+    return total

@@ -41,7 +41,7 @@ from bridge.cli_types import ArgumentParser, add_assembly_argument, run_command
 from bridge.errors import ToolError
 from bridge.files import write_atomic
 from executor import ExecutorError
-from executor.franka.sim_scene import add_product, from_base
+from executor.franka.sim_scene import add_product, contact_force, from_base, set_contact_options
 from executor.world.geometry import CellGeometry, load_geometry
 
 JOINT_KV = (450.0, 450.0, 350.0, 350.0, 200.0, 200.0, 60.0)
@@ -57,10 +57,6 @@ FINGER_DAMPING = 10.0
 outside MuJoCo's implicit integrator, so at the 1 ms step a finger of 15 g is stable only
 for kv dt / m well below 2 (franky-sim's 50 gives 3.3: the fingers chatter and a held part
 walks along the pads)."""
-
-CONTACT_OPTIONS = {"cone": "elliptic", "impratio": "10", "noslip_iterations": "5"}
-"""MuJoCo's contact options for grasping (its documentation's advice against slip in a
-grasp: elliptic friction cones, friction 10x stiffer than normal forces)."""
 
 HAND_BODY = "robot0_hand"
 """The MuJoCo body of the Franka Hand; its origin is the flange."""
@@ -207,9 +203,7 @@ class SimRobot:
         robot._kv_hand = np.full(2, FINGER_DAMPING)
         names = add_product(sim.scene, sim.worldbody, self.geometry)
         add_flange_sensor(sim)
-        option = sim.scene.find("option")
-        for key, value in CONTACT_OPTIONS.items():
-            (ET.SubElement(sim.scene, "option") if option is None else option).set(key, value)
+        set_contact_options(sim.scene)
         server = SimulationServer(sim) if self._hostname is None else SimulationServer(sim, [self._hostname])
         self._sim, self._server, self._robot = sim, server, robot
         try:
@@ -259,20 +253,7 @@ class SimRobot:
         model, data = sim.model, sim.data
         poses = {pid: (from_base(data.xpos[body].copy()), data.xquat[body].copy())
                  for pid, body in self._bodies.items()}
-        forces = {pid: np.zeros(3) for pid in self._bodies}
-        parts = {body: pid for pid, body in self._bodies.items()}
-        wrench6 = np.zeros(6)
-        for i in range(data.ncon):
-            contact = data.contact[i]
-            first, second = (int(model.geom_bodyid[g]) for g in contact.geom)
-            if self._plate not in (first, second) or (first if second == self._plate else second) not in parts:
-                continue
-            mujoco.mj_contactForce(model, data, i, wrench6)
-            on_second = contact.frame.reshape(3, 3).T @ wrench6[:3]  # the contact frame's rows are its axes
-            if second == self._plate:
-                forces[parts[first]] -= on_second
-            else:
-                forces[parts[second]] += on_second
+        forces = {pid: contact_force(model, data, body, self._plate) for pid, body in self._bodies.items()}
         return Truth(float(data.time), poses, forces, robot.last_wrench)
 
     def __enter__(self) -> SimRobot:
