@@ -151,11 +151,12 @@ def compare(assembly: str, pairs: list[tuple[str, str]] | None = None) -> dict[s
     geometry = load_geometry(assembly)
     if pairs is None:
         pairs = [(p, h) for p in sorted(geometry.parts) for h in sorted(geometry.holes)]
-    rows: list[dict[str, Any]] = []
     for pid, hid in pairs:
         if pid not in geometry.parts or hid not in geometry.holes:
             raise ExecutorError(f"--pair {pid}:{hid}: expected a part of {' '.join(sorted(geometry.parts))} and a "
                                 f"hole of {' '.join(sorted(geometry.holes))}")
+    rows: list[dict[str, Any]] = []
+    for pid, hid in pairs:
         part, hole = geometry.parts[pid], geometry.holes[hid]
         rows.append({"part": pid, "hole": hid, "geometry": passes(part, hole),
                      "pybullet": asdict(pybullet_insertion(geometry, part, hole)),
