@@ -24,7 +24,7 @@ def test_bench_engines_inserts_where_the_part_fits_and_stops_where_not_in_both(r
         assert rows["p3", "r1"][engine]["force"] > 10.0
     assert report["engines_differ"] == [] and report["differ_from_geometry"] == {"pybullet": [], "mujoco": []}
     rates = report["steps_per_s"]
-    assert rates["pair"] == "p3:s1" and rates["pybullet"]["wall"] > 0 and rates["mujoco"]["cpu"] > 0
+    assert all(rates[engine][clock] > 0 for engine in ("pybullet", "mujoco") for clock in ("wall", "cpu"))
 
 
 @pytest.mark.slow
