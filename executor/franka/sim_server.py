@@ -2,7 +2,7 @@
 and benchmarks of the Franka backend: in-process (:class:`SimRobot`, :func:`sim_robot`) or
 as a process that a cell connects to by address::
 
-    python -m executor.franka.sim_server --assembly data/spare [--hostname 127.0.0.5] [--poses-out FILE]
+    python -m executor.franka.sim_server --assembly spare [--hostname 127.0.0.5] [--poses-out FILE]
 
 It prints ``franky-sim serving <folder> at <hostname>`` once the arm is up, then serves
 until SIGTERM or Ctrl-C, and then writes the parts' poses to ``--poses-out``. libfranka's
@@ -18,7 +18,9 @@ file of it is changed; figures in docs/franka.md, "Testing against franky-sim"):
 2. the measured pose: franky-sim reports the commanded pose as ``O_T_EE`` (its forward
    kinematics returns a view that the next call overwrites); it is recomputed from q;
 3. joint 7's damping: :data:`JOINT_KV` (franky-sim's 200 chatters at the 1 ms step);
-4. the fingers' stiffness: :data:`FINGER_GAIN` (franky-sim's squeezes ~6 N, the part creeps).
+4. the fingers: :data:`FINGER_GAIN` and :data:`FINGER_DAMPING` (franky-sim's squeeze ~6 N,
+   and its damping is unstable at the 1 ms step); and MuJoCo's contact options against slip
+   in a grasp (:data:`executor.franka.sim_scene.CONTACT_OPTIONS`).
 """
 
 from __future__ import annotations
@@ -134,7 +136,6 @@ class SensedRobot(FrankaMujocoRobot):
     (same attributes) and sets ``sensor`` once the scene is compiled."""
 
     sensor: FlangeSensor | None = None
-    last_wrench: Wrench | None = None
 
     @property
     def state(self) -> FrankaRobotState:
@@ -143,7 +144,6 @@ class SensedRobot(FrankaMujocoRobot):
             return state
         pose = self.kinematics(np.array(state.q)).copy()  # a copy: the next call overwrites the view
         wrench = self.sensor.wrench(pose.translation, self.m_load, self.F_x_Cload)
-        self.last_wrench = wrench
         k_axes = pose.rotation @ np.array(self.EE_T_K).reshape(4, 4, order="F")[:3, :3]
         return state.replace(
             O_T_EE=self.to_franka_pose(pose),
@@ -158,8 +158,7 @@ class Truth:
     """The simulated world between two steps, for tests: ``time`` [s] since the start;
     ``poses`` of the parts (position [m] of the body frame, the bottom face centre, in
     the product frame; quaternion w x y z); ``plate_force`` [N], base axes, the plate's
-    contact force on each part; ``wrench`` the one the arm reports (None before a client
-    read the state)."""
+    contact force on each part; ``wrench`` the one the arm reports, at the same step."""
 
     time: float
     poses: dict[str, tuple[np.ndarray, np.ndarray]]
@@ -254,7 +253,11 @@ class SimRobot:
         poses = {pid: (from_base(data.xpos[body].copy()), data.xquat[body].copy())
                  for pid, body in self._bodies.items()}
         forces = {pid: contact_force(model, data, body, self._plate) for pid, body in self._bodies.items()}
-        return Truth(float(data.time), poses, forces, robot.last_wrench)
+        wrench = None
+        if robot.sensor is not None:  # the wrench of this very step, as the plate's force is
+            tcp = robot.kinematics(np.array(robot.inner_state.q)).copy().translation
+            wrench = robot.sensor.wrench(tcp, robot.m_load, robot.F_x_Cload)
+        return Truth(float(data.time), poses, forces, wrench)
 
     def __enter__(self) -> SimRobot:
         self.start()
