@@ -32,3 +32,17 @@ def test_bench_engines_refuses_an_unknown_pair(run_cli) -> None:
     done = run_cli("bench", "engines", "--assembly", "spare", "--pair", "p3:zz")
     assert done.returncode == 2 and "--pair p3:zz: expected a part of" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+@pytest.mark.slow
+def test_mujoco_stops_a_peg_on_an_interference_under_a_millimetre() -> None:
+    """An 8 mm round peg on a 8.3 x 7.3 mm slot (0.35 mm too wide on each side) stops at the
+    entry; an 8 x 7 mm rect peg goes in (MuJoCo's default contacts let the round one through)."""
+    from executor.campaign.engines import FIT_DEPTH, mujoco_insertion
+    from executor.world.geometry import load_geometry
+
+    geometry = load_geometry("taskboard")
+    slot = geometry.holes["slot8"]
+    stopped = mujoco_insertion(geometry, geometry.parts["round8"], slot)
+    assert not stopped.fits and stopped.depth < 0.002 and stopped.force > 10.0
+    assert mujoco_insertion(geometry, geometry.parts["rect8"], slot).depth > FIT_DEPTH
