@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from collections.abc import Collection
 from dataclasses import dataclass
 
 import mujoco
@@ -197,12 +198,13 @@ def _part_body(worldbody: ET.Element, asset: ET.Element, geometry: CellGeometry,
     return name
 
 
-def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry) -> dict[str, str]:
+def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry,
+                parts: Collection[str] | None = None) -> dict[str, str]:
     """Add the plate (static) and the pegs (free, at their tray starts) of ``geometry`` to a
     MuJoCo scene (``scene``: the ``<mujoco>`` root, whose ``<asset>`` gets the pieces'
     meshes; ``worldbody`` its ``<worldbody>``), before the model is compiled. Returns the
-    MuJoCo body name of each peg by part id. Covers, heads and parts placed by hand are
-    not added."""
+    MuJoCo body name of each peg by part id. ``parts``: only these pegs (default all).
+    Covers, heads and parts placed by hand are not added."""
     asset = scene.find("asset")
     if asset is None:
         asset = ET.SubElement(scene, "asset")
@@ -215,7 +217,8 @@ def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry
         ET.SubElement(asset, "mesh", name=piece.name, vertex=_vec(piece.vertices))
         ET.SubElement(plate, "geom", name=piece.name, type="mesh", mesh=piece.name, friction=_FRICTION,
                       solref=_SOLREF, rgba=_PLATE_RGBA)
-    return {pid: _part_body(worldbody, asset, geometry, part) for pid, part in sorted(geometry.parts.items())}
+    return {pid: _part_body(worldbody, asset, geometry, part) for pid, part in sorted(geometry.parts.items())
+            if parts is None or pid in parts}
 
 
 def product_model(geometry: CellGeometry, drive: str | None = None
@@ -223,14 +226,14 @@ def product_model(geometry: CellGeometry, drive: str | None = None
     """A MuJoCo model of the product alone (floor, plate, pegs at their tray starts; no
     arm), gravity, :data:`TIME_STEP` and :data:`CONTACT_OPTIONS`, as franky-sim's scene has
     them; its data after a forward pass, and the body id of each peg and of the plate
-    (``"plate"``). ``drive``: a part welded to a mocap body (``"drive"``) that moves it."""
+    (``"plate"``). ``drive``: the one part built, welded to a mocap body (``"drive"``) that moves it."""
     root = ET.Element("mujoco", model="product")
     ET.SubElement(root, "option", timestep=str(TIME_STEP), gravity="0 0 -9.81", integrator="implicitfast")
     set_contact_options(root)
     ET.SubElement(root, "asset")
     world = ET.SubElement(root, "worldbody")
     ET.SubElement(world, "geom", name="floor", type="plane", size="10 10 0.1")
-    names = add_product(root, world, geometry) | {"plate": "plate"}
+    names = add_product(root, world, geometry, None if drive is None else [drive]) | {"plate": "plate"}
     if drive is not None:
         ET.SubElement(world, "body", name="drive", mocap="true")
         ET.SubElement(ET.SubElement(root, "equality"), "weld", body1="drive", body2=names[drive], solref="0.005 1",
