@@ -3,21 +3,19 @@ the MuJoCo scene that franky-sim serves the Franka arm from, side by side.
 
 Per pair and engine, one straight force-stopped insertion of the part alone: the part
 (free rigid body, its mass, the cell's part-plate friction) starts upright with its
-bottom :data:`START_ABOVE` above the hole's entry, centred on the hole and turned to it
-(:func:`executor.world.arm.aligned_yaw`), and a stiff drive (PyBullet: a fixed constraint
-of at most :data:`DRIVE_FORCE`; MuJoCo: a weld to a mocap body) moves it straight down at
-:data:`SPEED` toward :data:`TARGET_DEPTH` below the entry (less when the hole is
+bottom 5 mm above the hole's entry, centred on the hole and turned to it, and a stiff
+drive (PyBullet: a fixed constraint of at most 500 N; MuJoCo: a weld to a moving body)
+moves it straight down at 20 mm/s toward 12 mm below the entry (less when the hole is
 shallower). The drive stops and holds where the part is once the plate's contact force
-on the part (z, each engine's own contact forces) exceeds :data:`STOP_FORCE`: the outcome is
-**fit** when the part's bottom got deeper than :data:`FIT_DEPTH` below the entry, else
-**no fit**. The plate is each engine's own build of ``geometry.toml``: PyBullet's concave
-triangle mesh (:func:`executor.world.scene.load_plate`), MuJoCo's convex pieces
-(:mod:`executor.franka.sim_scene`); the same surfaces.
+on the part (z, each engine's own contact forces) exceeds 10 N: the outcome is **fit**
+when the part's bottom got deeper than 6 mm below the entry, else **no fit**. The plate
+is each engine's own build of geometry.toml: PyBullet's concave triangle mesh, MuJoCo's
+convex pieces; the same surfaces.
 
-It prints one row per pair (the geometry's answer :func:`executor.world.geometry.passes`,
-each engine's outcome and depth), the pairs where the engines disagree (or disagree with
-the geometry), and each engine's physics steps per second (wall and CPU time) of one
-insertion, the median over the pairs, the arm left out of both.
+It prints one row per pair (the geometry's answer, each engine's outcome, depth and
+largest force), the pairs where the engines disagree (or disagree with the geometry),
+and each engine's physics steps per second (wall and CPU time) of one insertion, the
+median over the pairs, the arm left out of both.
 """
 
 from __future__ import annotations
