@@ -133,6 +133,7 @@ ZERO_CLEARANCE = ("nominal zero-clearance fits: a d 10 bolt in its d 10 hole is 
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(ANY_PART)),
     "robosuite_nuts",
 ])
@@ -158,6 +159,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(ZERO_CLEARANCE)),
     "robosuite_nuts",
 ])
@@ -212,6 +214,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     pytest.param("agh_hex_horizontal", marks=_xfail(INSERTED + " in along a horizontal axis")),
     "agh_prism_array",
+    pytest.param("metaworld_assembly", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (a "
+                                                    "torus ring with a handle)")),
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
                                           "rod through two brackets")),
     "robosuite_nuts",
