@@ -1,0 +1,321 @@
+"""franky-sim serving one simulated FR3 with a product in its MuJoCo scene, for the tests
+and benchmarks of the Franka backend: in-process (:class:`SimRobot`, :func:`sim_robot`) or
+as a process that a cell connects to by address::
+
+    python -m executor.franka.sim_server --assembly data/spare [--hostname 127.0.0.5] [--poses-out FILE]
+
+It prints ``franky-sim serving <folder> at <hostname>`` once the arm is up, then serves
+until SIGTERM or Ctrl-C, and then writes the parts' poses to ``--poses-out``. libfranka's
+ports are fixed (1337 the arm, 1338 the gripper), so servers on one machine differ by
+their loopback address: the first free one of 127.0.0.1, 127.0.0.2, … unless given.
+
+franky-sim 1.0.4 needs four things for a peg insertion, all done here at run time (no
+file of it is changed; figures in docs/franka.md, "Testing against franky-sim"):
+
+1. a wrench: franky-sim reports none (``O_F_ext_hat_K`` zero). A MuJoCo force/torque
+   sensor at the flange (the hand body's origin) gives it, as a wrist F/T sensor would:
+   the hand's and the load's gravity removed, moved to the TCP (:class:`FlangeSensor`);
+2. the measured pose: franky-sim reports the commanded pose as ``O_T_EE`` (its forward
+   kinematics returns a view that the next call overwrites); it is recomputed from q;
+3. joint 7's damping: :data:`JOINT_KV` (franky-sim's 200 chatters at the 1 ms step);
+4. the fingers' stiffness: :data:`FINGER_GAIN` (franky-sim's squeezes ~6 N, the part creeps).
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import xml.etree.ElementTree as ET
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from franky_sim import SimulationServer
+from franky_sim.franka_robot_state import FrankaRobotState
+from franky_sim.mujoco_simulator import FrankaMujocoRobot, MujocoSimulator
+
+from bridge.cli_types import ArgumentParser, add_assembly_argument, run_command
+from bridge.errors import ToolError
+from bridge.files import write_atomic
+from executor import ExecutorError
+from executor.franka.sim_scene import add_product, from_base
+from executor.world.geometry import CellGeometry, load_geometry
+
+JOINT_KV = (450.0, 450.0, 350.0, 350.0, 200.0, 200.0, 60.0)
+"""Joint damping gains [N m s/rad] of franky-sim's joint controller: its own but joint 7's
+(200 chatters ±12 N m at the 1 ms step, a false ±1.1 N at the sensor at rest)."""
+
+FINGER_GAIN = 5000.0
+"""Stiffness [N/m] of each simulated finger toward its target width (franky-sim's 1000
+squeezes ~6 N per finger; 5000 gives ~27 N)."""
+
+HAND_BODY = "robot0_hand"
+"""The MuJoCo body of the Franka Hand; its origin is the flange."""
+
+GRAVITY = np.array([0.0, 0.0, -9.81])
+"""franky-sim's gravity [m/s^2], base frame."""
+
+_FLANGE_IN_HAND = np.array([[np.sqrt(0.5), -np.sqrt(0.5), 0.0], [np.sqrt(0.5), np.sqrt(0.5), 0.0], [0.0, 0.0, 1.0]])
+"""The flange's axes (libfranka's F frame) in the hand body's: the hand is mounted turned
+-45° about z, so the flange is the hand turned +45°."""
+
+
+@dataclass(frozen=True)
+class Wrench:
+    """The environment's wrench on the arm, base frame: ``force`` [N], ``torque`` [N m]
+    about the TCP (libfranka's ``O_F_ext_hat_K``: pressing down reads +z), and ``tau``
+    [N m] the arm's joint torques it makes (Jᵀ F, ``tau_ext_hat_filtered``)."""
+
+    force: np.ndarray
+    torque: np.ndarray
+    tau: np.ndarray
+
+
+class FlangeSensor:
+    """A force/torque sensor at the flange of a compiled scene (the site and sensors of
+    :func:`add_flange_sensor`): the wrench the environment exerts on the hand and what it
+    holds, the weight of the hand's subtree and of the load (libfranka's ``set_load``)
+    removed, as a wrist F/T sensor tared with the hand and load reads it."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, arm_dofs: Sequence[int]) -> None:
+        self.model, self.data, self.arm_dofs = model, data, list(arm_dofs)
+        self.hand = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, HAND_BODY)
+        self.site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "flange_ft")
+        self._force, self._torque = (int(model.sensor_adr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, n)])
+                                     for n in ("flange_force", "flange_torque"))
+        self.hand_mass = float(model.body_subtreemass[self.hand])
+
+    def wrench(self, tcp: np.ndarray, load_mass: float, load_com: Sequence[float]) -> Wrench:
+        """The wrench at ``tcp`` [m] (base frame) with a load of ``load_mass`` [kg] whose
+        centre of mass is ``load_com`` [m] in the flange frame. MuJoCo's sensors read the
+        force and torque that the hand's parent exerts on the hand's subtree, in the
+        site's axes; at rest the environment's share is minus that, minus the weights."""
+        d = self.data
+        axes = d.site_xmat[self.site].reshape(3, 3)
+        origin = d.site_xpos[self.site]
+        load = load_mass * GRAVITY
+        force = -axes @ d.sensordata[self._force:self._force + 3] - self.hand_mass * GRAVITY - load
+        hand_com = d.subtree_com[self.hand] - origin
+        load_com_base = axes @ _FLANGE_IN_HAND @ np.asarray(load_com, dtype=float)
+        torque = (-axes @ d.sensordata[self._torque:self._torque + 3]
+                  - np.cross(hand_com, self.hand_mass * GRAVITY) - np.cross(load_com_base, load))
+        torque = torque + np.cross(origin - tcp, force)  # the same wrench, about the TCP
+        jacp, jacr = np.zeros((3, self.model.nv)), np.zeros((3, self.model.nv))
+        mujoco.mj_jac(self.model, d, jacp, jacr, tcp, self.hand)
+        tau = jacp[:, self.arm_dofs].T @ force + jacr[:, self.arm_dofs].T @ torque
+        return Wrench(force, torque, tau)
+
+
+def add_flange_sensor(sim: MujocoSimulator) -> None:
+    """A site at the flange (the hand body's origin and axes) with a force and a torque
+    sensor, added to the scene of ``sim`` before it starts."""
+    hand = next(body for body in sim.worldbody.iter("body") if body.get("name") == HAND_BODY)
+    ET.SubElement(hand, "site", name="flange_ft", pos="0 0 0")
+    sensors = sim.scene.find("sensor")
+    if sensors is None:
+        sensors = ET.SubElement(sim.scene, "sensor")
+    ET.SubElement(sensors, "force", name="flange_force", site="flange_ft")
+    ET.SubElement(sensors, "torque", name="flange_torque", site="flange_ft")
+
+
+class SensedRobot(FrankaMujocoRobot):
+    """franky-sim's FR3 whose state carries the flange sensor's wrench (``O_F_ext_hat_K``,
+    ``K_F_ext_hat_K``, ``tau_ext_hat_filtered``) and the pose measured from q (``O_T_EE``).
+    franky-sim's ``add_robot`` makes the robot; :class:`SimRobot` turns it into this class
+    (same attributes) and sets ``sensor`` once the scene is compiled."""
+
+    sensor: FlangeSensor | None = None
+    last_wrench: Wrench | None = None
+
+    @property
+    def state(self) -> FrankaRobotState:
+        state = super().state
+        if self.sensor is None:
+            return state
+        pose = self.kinematics(np.array(state.q)).copy()  # a copy: the next call overwrites the view
+        wrench = self.sensor.wrench(pose.translation, self.m_load, self.F_x_Cload)
+        self.last_wrench = wrench
+        k_axes = pose.rotation @ np.array(self.EE_T_K).reshape(4, 4, order="F")[:3, :3]
+        return state.replace(
+            O_T_EE=self.to_franka_pose(pose),
+            O_F_ext_hat_K=(*wrench.force, *wrench.torque),
+            K_F_ext_hat_K=(*(k_axes.T @ wrench.force), *(k_axes.T @ wrench.torque)),
+            tau_ext_hat_filtered=tuple(wrench.tau),
+        )
+
+
+@dataclass(frozen=True)
+class Truth:
+    """The simulated world between two steps, for tests: ``time`` [s] since the start;
+    ``poses`` of the parts (position [m] of the body frame, the bottom face centre, in
+    the product frame; quaternion w x y z); ``plate_force`` [N], base axes, the plate's
+    contact force on each part; ``wrench`` the one the arm reports (None before a client
+    read the state)."""
+
+    time: float
+    poses: dict[str, tuple[np.ndarray, np.ndarray]]
+    plate_force: dict[str, np.ndarray]
+    wrench: Wrench | None
+
+
+class SimRobot:
+    """franky-sim with ``product``'s plate and pegs in its scene and the four run-time
+    fixes (module docstring), serving one arm at ``host`` from a background thread.
+    ``realtime``: False steps as fast as it can (a free-running loop: 1 ms of simulated time
+    per tick, a client or not), True paces at wall time, a number is a speed factor."""
+
+    def __init__(self, product: str | Path, *, hostname: str | None = None, realtime: bool | float = False) -> None:
+        self.geometry: CellGeometry = load_geometry(str(product))
+        self._hostname, self._realtime = hostname, realtime
+        self._sim: MujocoSimulator | None = None
+        self._server: SimulationServer | None = None
+        self._robot: SensedRobot | None = None
+        self._bodies: dict[str, int] = {}
+        self._plate = -1
+        self._wanted = threading.Event()
+        self._taken = threading.Event()
+        self._truth: Truth | None = None
+
+    @property
+    def host(self) -> str:
+        """The address a franky client connects to (``franky.Robot(host)``)."""
+        if self._robot is None or self._robot.hostname is None:
+            raise ExecutorError("the simulated arm is not running; start() it first")
+        return str(self._robot.hostname)
+
+    def start(self) -> str:
+        """Build the scene, bind the arm's and the gripper's servers and start stepping;
+        returns :attr:`host`."""
+        sim = MujocoSimulator()
+        sim.init()
+        robot = sim.add_robot(kv=JOINT_KV)
+        robot.__class__ = SensedRobot  # the state with the wrench; the robot keeps all it has
+        robot._kp_hand = np.full(2, FINGER_GAIN)
+        names = add_product(sim.scene, sim.worldbody, self.geometry)
+        add_flange_sensor(sim)
+        server = SimulationServer(sim) if self._hostname is None else SimulationServer(sim, [self._hostname])
+        self._sim, self._server, self._robot = sim, server, robot
+        try:
+            server.init()
+        except (OSError, RuntimeError) as exc:
+            self.stop()
+            raise ExecutorError(f"franky-sim could not serve the arm ({exc}); expected a free loopback address "
+                                "for ports 1337 and 1338") from None
+        model, data = sim.model, sim.data
+        assert model is not None and data is not None  # compiled by server.init()
+        self._robot.sensor = FlangeSensor(model, data, robot._dof_addrs)
+        self._bodies = {pid: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for pid, name in names.items()}
+        self._plate = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "plate")
+        sim.register_post_step_callback(self._after_step)
+        server.run_async(self._realtime)
+        return self.host
+
+    def stop(self) -> None:
+        """Stop stepping and close the servers (idempotent)."""
+        server, sim = self._server, self._sim
+        self._server = self._sim = None
+        if server is not None:
+            server.cleanup()
+        if sim is not None and sim.is_initialized and not sim.is_cleaned_up:
+            sim.cleanup()
+
+    def truth(self, timeout: float = 5.0) -> Truth:
+        """The world as it is between two steps (taken by the stepping thread)."""
+        if self._server is None or not self._server.running:
+            raise ExecutorError("the simulated arm is not running; start() it first")
+        self._taken.clear()
+        self._wanted.set()
+        if not self._taken.wait(timeout):
+            raise ExecutorError(f"franky-sim took no step in {timeout} s")
+        assert self._truth is not None
+        return self._truth
+
+    def _after_step(self, _sim: MujocoSimulator) -> None:
+        if self._wanted.is_set():
+            self._wanted.clear()
+            self._truth = self._read_truth()
+            self._taken.set()
+
+    def _read_truth(self) -> Truth:
+        sim, robot = self._sim, self._robot
+        assert sim is not None and sim.model is not None and sim.data is not None and robot is not None
+        model, data = sim.model, sim.data
+        poses = {pid: (from_base(data.xpos[body].copy()), data.xquat[body].copy())
+                 for pid, body in self._bodies.items()}
+        forces = {pid: np.zeros(3) for pid in self._bodies}
+        parts = {body: pid for pid, body in self._bodies.items()}
+        wrench6 = np.zeros(6)
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            first, second = (int(model.geom_bodyid[g]) for g in contact.geom)
+            if self._plate not in (first, second) or (first if second == self._plate else second) not in parts:
+                continue
+            mujoco.mj_contactForce(model, data, i, wrench6)
+            on_second = contact.frame.reshape(3, 3).T @ wrench6[:3]  # the contact frame's rows are its axes
+            if second == self._plate:
+                forces[parts[first]] -= on_second
+            else:
+                forces[parts[second]] += on_second
+        return Truth(float(data.time), poses, forces, robot.last_wrench)
+
+    def __enter__(self) -> SimRobot:
+        self.start()
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.stop()
+
+
+@contextmanager
+def sim_robot(product: str | Path, *, hostname: str | None = None, realtime: bool | float = False
+              ) -> Iterator[SimRobot]:
+    """A running :class:`SimRobot` for ``product`` (its ``host`` is the address), stopped on exit."""
+    robot = SimRobot(product, hostname=hostname, realtime=realtime)
+    robot.start()
+    try:
+        yield robot
+    finally:
+        robot.stop()
+
+
+def poses_json(truth: Truth) -> str:
+    """The parts' poses of ``truth`` as JSON: ``{"time": s, "parts": {id: {"position": [m],
+    "quat_wxyz": [...]}}}``, product frame."""
+    parts = {pid: {"position": [round(float(v), 9) for v in pos], "quat_wxyz": [round(float(v), 9) for v in quat]}
+             for pid, (pos, quat) in sorted(truth.poses.items())}
+    return json.dumps({"time": truth.time, "parts": parts}, indent=1) + "\n"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = ArgumentParser(prog="python -m executor.franka.sim_server",
+                            description="Serve a simulated FR3 (franky-sim, MuJoCo) with a product's plate and pegs "
+                                        "in its scene until SIGTERM or Ctrl-C.")
+    add_assembly_argument(parser, "cranfield", purpose="the product whose plate and pegs are in the scene")
+    parser.add_argument("--hostname", help="the loopback address to serve at (default: the first free of "
+                                           "127.0.0.1, 127.0.0.2, ...)")
+    parser.add_argument("--realtime", action="store_true", help="pace at wall time (default: as fast as it steps)")
+    parser.add_argument("--poses-out", type=Path, metavar="FILE",
+                        help="on stopping, write the parts' poses (JSON, product frame) to FILE")
+    args = parser.parse_args(argv)
+
+    def serve() -> int:
+        robot = SimRobot(args.assembly, hostname=args.hostname, realtime=args.realtime)
+        robot.start()
+        try:
+            print(f"franky-sim serving {robot.geometry.folder} at {robot.host}", flush=True)
+            threading.Event().wait()
+        finally:
+            truth = robot.truth() if args.poses_out is not None else None
+            robot.stop()
+            if truth is not None:
+                write_atomic(args.poses_out, poses_json(truth))
+        return 0
+
+    return run_command(serve, (ToolError,))
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
