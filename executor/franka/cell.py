@@ -41,6 +41,7 @@ OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before 
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point
 RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
 GRIPPER_SPEED = 0.05  # [m/s] of the fingers
+HELD_TOLERANCE = 0.002  # [m] the closed hand may be narrower than the part it holds
 ABOVE_TRAY = 0.002  # [m] a part carried back is let go this far above the table
 
 
@@ -103,7 +104,8 @@ class FrankaCell:
             self._skills[shape] = load_product_skill(self.geometry, shape)
         return self._skills[shape]
 
-    def _carry(self, goal: np.ndarray, yaw: float = 0.0, tolerance: float = VIA_TOLERANCE) -> None:
+    def carry_to(self, goal: np.ndarray, yaw: float = 0.0, tolerance: float = VIA_TOLERANCE) -> None:
+        """Up to the carrying height, across, down to ``goal`` [m] (tool yaw ``yaw`` [rad])."""
         carry(self.motion, goal, safe_z=SAFE_Z + self.options.offset[2], tolerance=tolerance, yaw=yaw,
               speed=self.options.speed)
 
@@ -119,10 +121,14 @@ class FrankaCell:
         width = max(spec.sides)
         self._open(width + OPEN_MARGIN)
         grip = self.to_base(np.array([*spec.start, spec.length - self.geometry.gripper.grasp_depth]))
-        self._carry(grip + np.array([0.0, 0.0, 0.05]))
+        self.carry_to(grip + np.array([0.0, 0.0, 0.05]))
         move_line(self.motion, grip, tolerance=GRIP_TOLERANCE, speed=self.options.speed / 5)
-        if not self.gripper.grasp(width, GRIPPER_SPEED, self.options.grasp_force, epsilon_inner=0.005,
-                                  epsilon_outer=0.005):
+        # Closed toward zero width with the grasp force, held when the fingers stopped on
+        # the part (the hand's width) rather than on nothing; franky-sim's fingers are a
+        # spring toward the commanded width, which squeezes only when it is below the part's.
+        self.gripper.grasp(0.0, GRIPPER_SPEED, self.options.grasp_force, epsilon_inner=0.001,
+                           epsilon_outer=width + OPEN_MARGIN)
+        if self.gripper.width < width - HELD_TOLERANCE:
             self._open(width + OPEN_MARGIN)
             raise ExecutorError(f"the hand closed on nothing at part {part}'s place on the table "
                                 f"({np.round(grip, 4).tolist()} m)")
@@ -149,7 +155,7 @@ class FrankaCell:
         if self.held is None:
             return
         spec = self.geometry.parts[self.held]
-        self._carry(self.to_base(np.array([*spec.start, ABOVE_TRAY])))
+        self.carry_to(self.to_base(np.array([*spec.start, ABOVE_TRAY])))
         self.release()
 
     def insert(self, part: str, hole: str, rng: np.random.Generator) -> tuple[InsertionResult, Detector,
@@ -163,7 +169,7 @@ class FrankaCell:
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn)
         quat = tool_quat(yaw)
         approach = est + np.array([0.0, 0.0, APPROACH_HEIGHT])
-        self._carry(approach, yaw=yaw, tolerance=GRIP_TOLERANCE)
+        self.carry_to(approach, yaw=yaw, tolerance=GRIP_TOLERANCE)
         self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         self.arm.tare_sensor()
         found = hole_search(self.motion, est[:2], est[2], approach[2], quat, rng)
