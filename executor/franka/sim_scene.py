@@ -46,7 +46,8 @@ cell, whose arm also stands at the origin. Every pose between the two goes throu
 PART_PREFIX = "part_"
 """MuJoCo body name of a part: this prefix and the part's id."""
 
-_FRICTION = f"{TEACH_FRICTION} 0.005 0.0001"  # sliding, torsional, rolling (MuJoCo's defaults for the last two)
+_FRICTION = f"{TEACH_FRICTION} 0.005 0.0001"  # sliding, torsional [m], rolling [m] (MuJoCo's defaults for the last two)
+_PART_CONDIM = "4"  # sliding and torsional friction: a held part does not spin about the fingers' closing axis
 _PLATE_RGBA = "0.7 0.72 0.75 1"
 _PART_RGBA = "0.8 0.6 0.2 1"
 
@@ -145,7 +146,7 @@ def _part_body(worldbody: ET.Element, asset: ET.Element, geometry: CellGeometry,
     body = ET.SubElement(worldbody, "body", name=name, pos=_vec(to_base(np.array([*part.start, 0.0]))))
     ET.SubElement(body, "freejoint", name=f"{name}_free")
     half = part.length / 2
-    common = {"friction": _FRICTION, "rgba": _PART_RGBA}
+    common = {"friction": _FRICTION, "condim": _PART_CONDIM, "rgba": _PART_RGBA}
     if part.mesh is None:
         a, b = part.sides
         kind, size = ("cylinder", (part.size / 2, half)) if part.kind == "round" else ("box", (a / 2, b / 2, half))

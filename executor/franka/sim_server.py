@@ -52,6 +52,16 @@ FINGER_GAIN = 5000.0
 """Stiffness [N/m] of each simulated finger toward its target width (franky-sim's 1000
 squeezes ~6 N per finger; 5000 gives ~27 N)."""
 
+FINGER_DAMPING = 10.0
+"""Damping [N s/m] of each simulated finger: franky-sim applies its finger PD as a force
+outside MuJoCo's implicit integrator, so at the 1 ms step a finger of 15 g is stable only
+for kv dt / m well below 2 (franky-sim's 50 gives 3.3: the fingers chatter and a held part
+walks along the pads)."""
+
+CONTACT_OPTIONS = {"cone": "elliptic", "impratio": "10", "noslip_iterations": "5"}
+"""MuJoCo's contact options for grasping (its documentation's advice against slip in a
+grasp: elliptic friction cones, friction 10x stiffer than normal forces)."""
+
 HAND_BODY = "robot0_hand"
 """The MuJoCo body of the Franka Hand; its origin is the flange."""
 
@@ -194,8 +204,12 @@ class SimRobot:
         robot = sim.add_robot(kv=JOINT_KV)
         robot.__class__ = SensedRobot  # the state with the wrench; the robot keeps all it has
         robot._kp_hand = np.full(2, FINGER_GAIN)
+        robot._kv_hand = np.full(2, FINGER_DAMPING)
         names = add_product(sim.scene, sim.worldbody, self.geometry)
         add_flange_sensor(sim)
+        option = sim.scene.find("option")
+        for key, value in CONTACT_OPTIONS.items():
+            (ET.SubElement(sim.scene, "option") if option is None else option).set(key, value)
         server = SimulationServer(sim) if self._hostname is None else SimulationServer(sim, [self._hostname])
         self._sim, self._server, self._robot = sim, server, robot
         try:

@@ -1,0 +1,146 @@
+"""franky-sim with a product in its MuJoCo scene (executor.franka.sim_scene, sim_server):
+the holes are where and as large as geometry.toml says, and a Franka driven through franky
+grasps a peg, inserts it where it fits, stops on force where it does not, and reports the
+contact force that MuJoCo applies."""
+
+from __future__ import annotations
+
+import shutil
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco")
+franky = pytest.importorskip("franky")
+
+from executor.franka.sim_scene import add_product, to_base  # noqa: E402
+from executor.franka.sim_server import sim_robot  # noqa: E402
+from executor.world.geometry import load_geometry  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _product_model(assembly: str) -> tuple[object, object]:
+    root = ET.Element("mujoco")
+    ET.SubElement(root, "asset")
+    world = ET.SubElement(root, "worldbody")
+    add_product(root, world, load_geometry(assembly))
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def _drop(model: object, data: object, x: float, y: float) -> float:
+    """Height [m] where a ray down from 1 m at (x, y) first hits the plate (-1: nothing)."""
+    geom = np.zeros(1, dtype=np.int32)
+    start = to_base(np.array([x, y, 1.0]))
+    distance = mujoco.mj_ray(model, data, start, np.array([0.0, 0.0, -1.0]), None, 1, -1, geom)
+    return -1.0 if distance < 0 else float(start[2] - distance)
+
+
+@pytest.mark.parametrize("assembly", ["spare", "taskboard"])
+def test_holes_are_open_to_their_size_and_the_boss_stands_around_them(assembly: str) -> None:
+    geometry = load_geometry(assembly)
+    model, data = _product_model(assembly)
+    base = geometry.base_top
+    for hid, hole in geometry.holes.items():
+        cx, cy = hole.position
+        c, s = np.cos(hole.yaw), np.sin(hole.yaw)
+        a, b = hole.sides
+        inset = 1e-4 + (hole.size / 2 * (1 / np.cos(np.pi / geometry.plate.polygon_sides) - 1)
+                        if hole.kind == "round" else 0.0)
+        # Inside the hole, 0.1 mm from its wall, along its x and y axes: down to its bottom.
+        for u, v in ((a / 2 - 1e-4, 0.0), (0.0, b / 2 - 1e-4), (-(a / 2 - 1e-4), 0.0)):
+            assert _drop(model, data, cx + c * u - s * v, cy + s * u + c * v) == pytest.approx(
+                max(hole.bottom_z, base), abs=2e-6), (hid, u, v)
+        # Beyond the chamfer (0.1 mm past it): the boss's top at the entry.
+        out = a / 2 + geometry.plate.chamfer + 1e-4 + inset
+        assert _drop(model, data, cx + c * out, cy + s * out) == pytest.approx(hole.top_z, abs=2e-6), hid
+        # On the chamfer, halfway: halfway down it (45°).
+        mid = a / 2 + geometry.plate.chamfer / 2
+        if hole.kind != "round":
+            assert _drop(model, data, cx + c * mid, cy + s * mid) == pytest.approx(
+                hole.top_z - geometry.plate.chamfer / 2, abs=2e-6), hid
+
+
+def _spare_with_peg_at(tmp_path: Path, part: str, start: tuple[float, float]) -> Path:
+    """data/spare with ``part`` waiting at ``start`` [m] (on the line of the holes: a straight transfer)."""
+    folder = tmp_path / "spare"
+    shutil.copytree(ROOT / "data" / "spare", folder, ignore=shutil.ignore_patterns("assets", "demonstrations"))
+    toml = folder / "assembly.toml"
+    text = toml.read_text()
+    block = text.index(f"[parts.{part}]")
+    line = text.index("start = ", block)
+    end = text.index("\n", line)
+    toml.write_text(text[:line] + f"start = [{start[0]}, {start[1]}]" + text[end:])
+    return folder
+
+
+class _Arm:
+    """The franky client of the test: moves the TCP, tool pointing down, and waits until
+    the measured pose is there (franky's move returns when the commanded path ends)."""
+
+    def __init__(self, host: str) -> None:
+        self.robot = franky.Robot(host, realtime_config=franky.RealtimeConfig.Ignore)
+        self.robot.relative_dynamics_factor = franky.RelativeDynamicsFactor(0.3)
+        self.gripper = franky.Gripper(host)
+        self.quat = self.robot.current_cartesian_state.pose.end_effector_pose.quaternion
+
+    def tcp(self) -> np.ndarray:
+        return np.array(self.robot.current_cartesian_state.pose.end_effector_pose.translation)
+
+    def go(self, target: np.ndarray, timeout: float = 20.0) -> None:
+        self.robot.move(franky.CartesianMotion(franky.Affine(list(to_base(target)), self.quat)))
+        deadline = time.monotonic() + timeout
+        while np.linalg.norm(self.tcp() - to_base(target)) > 1e-3:
+            assert time.monotonic() < deadline, f"the arm did not reach {target}: at {self.tcp()}"
+            time.sleep(0.02)
+
+    def press_down(self, distance: float, force: float) -> bool:
+        """Move the tool ``distance`` [m] down, stopping when the wrench's z exceeds ``force``
+        [N]; whether the force stopped it."""
+        fired: list[float] = []
+        reaction = franky.Reaction(franky.Measure.FORCE_Z > force, franky.CartesianStopMotion())
+        reaction.register_callback(lambda _state, _rel, abs_time: fired.append(abs_time.to_sec()))
+        motion = franky.CartesianMotion(franky.Affine([0.0, 0.0, distance]), franky.ReferenceType.Relative,
+                                        franky.RelativeDynamicsFactor(0.1))
+        motion.add_reaction(reaction)
+        self.robot.move(motion)
+        return bool(fired)
+
+
+@pytest.mark.slow
+def test_franka_inserts_a_peg_where_it_fits_and_stops_on_force_where_not(tmp_path: Path) -> None:
+    folder = _spare_with_peg_at(tmp_path, "p3", (0.42, -0.06))
+    geometry = load_geometry(str(folder))
+    peg, fits, too_small = geometry.parts["p3"], geometry.holes["s1"], geometry.holes["r1"]
+    held = 0.015  # the fingers hold the peg's top 15 mm; its bottom is this far below the TCP:
+    below = peg.length - held
+    with sim_robot(folder) as sim:
+        arm = _Arm(sim.host)
+        arm.go(np.array([*peg.start, peg.length + 0.03]))
+        arm.go(np.array([*peg.start, peg.length - held]))
+        assert arm.gripper.grasp(0.0, 0.05, 60.0, epsilon_inner=0.005, epsilon_outer=0.03)
+        arm.robot.set_load(peg.mass, [0.0, 0.0, 0.1034 - held + peg.length / 2], [0.0] * 9)
+
+        arm.go(np.array([*peg.start, too_small.top_z + below + 0.01]))  # up, then across at that height
+        arm.go(np.array([*too_small.position, too_small.top_z + below + 0.01]))
+        assert arm.press_down(0.028, 8.0), "no force stop on a hole too small for the peg"
+        time.sleep(0.3)
+        truth = sim.truth()
+        assert too_small.top_z - truth.poses["p3"][0][2] < 0.005  # on the entry, not in
+        assert truth.wrench is not None
+        plate = truth.plate_force["p3"][2]
+        assert plate > 8.0
+        assert truth.wrench.force[2] == pytest.approx(plate, rel=0.05)  # the sensor reads the contact
+
+        arm.go(np.array([*too_small.position, too_small.top_z + below + 0.01]))
+        arm.go(np.array([*fits.position, fits.top_z + below + 0.01]))
+        assert not arm.press_down(0.028, 8.0), "a force stop in a hole the peg fits"
+        time.sleep(0.3)
+        depth = fits.top_z - sim.truth().poses["p3"][0][2]
+        assert depth > 0.010  # in the hole (18 mm commanded below the entry; the no-fit stays within 5 mm)
