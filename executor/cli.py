@@ -47,9 +47,8 @@ MAX_ATTEMPTS = 10
 
 def _teach(args: argparse.Namespace) -> int:
     from executor import ExecutorError
-    from executor.skills.teach import TeachingCell, teach_all
-
     from executor.cell_description import load_cell_description
+    from executor.skills.teach import TeachingCell, teach_all
 
     description = load_cell_description(args.cell_description)
     cell: TeachingCell

@@ -65,13 +65,12 @@ def settle_steps(duration: float) -> int:
 
 
 def carry(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,
-          safe_z: float = SAFE_Z, tolerance: float = TOLERANCE, yaw: float = 0.0, speed: float = SPEED) -> None:
-    """Lift to ``safe_z``, move across above ``goal`` turning the tool to ``yaw`` [rad] at a
-    mean ``speed`` [m/s], go down to it [m] (at ``speed`` × DESCENT_SPEED / SPEED, until
-    within ``tolerance`` [m])."""
+          safe_z: float = SAFE_Z, tolerance: float = TOLERANCE, yaw: float = 0.0) -> None:
+    """Lift to ``safe_z``, move across above ``goal`` turning the tool to ``yaw`` [rad], go
+    down to it [m] (slowly, until within ``tolerance`` [m])."""
     here = motion.controller.arm.read().tip_pos
     high = max(safe_z, float(goal[2]), float(here[2]))
     if here[2] < high - 1e-3:
-        move_line(motion, np.array([here[0], here[1], high]), after_step, speed=speed, tolerance=VIA_TOLERANCE)
-    move_line(motion, np.array([goal[0], goal[1], high]), after_step, speed=speed, tolerance=VIA_TOLERANCE, yaw=yaw)
-    move_line(motion, goal, after_step, speed=speed * DESCENT_SPEED / SPEED, tolerance=tolerance)
+        move_line(motion, np.array([here[0], here[1], high]), after_step, tolerance=VIA_TOLERANCE)
+    move_line(motion, np.array([goal[0], goal[1], high]), after_step, tolerance=VIA_TOLERANCE, yaw=yaw)
+    move_line(motion, goal, after_step, speed=DESCENT_SPEED, tolerance=tolerance)

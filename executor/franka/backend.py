@@ -36,7 +36,7 @@ from executor.trial import CellSetup, cell_setup, trial_rng
 from executor.world.geometry import load_geometry
 
 MAX_ATTEMPTS = 2
-OPTIONS = ("host", "offset", "speed", "grasp-force", "realtime", "dynamics", "torque-threshold", "force-threshold",
+OPTIONS = ("host", "offset", "grasp-force", "realtime", "dynamics", "torque-threshold", "force-threshold",
            "workspace")
 """The keys of ``--backend-option`` the backend reads."""
 
@@ -80,7 +80,7 @@ def franka_options(options: Mapping[str, str]) -> FrankaOptions:
     if "workspace" in options:
         box = _floats("workspace", options["workspace"], 6)
         workspace = Workspace((box[0], box[1], box[2]), (box[3], box[4], box[5]))
-    return FrankaOptions(options["host"], (offset[0], offset[1], offset[2]), number("speed", 0.25, 0.0, 1.0),
+    return FrankaOptions(options["host"], (offset[0], offset[1], offset[2]),
                          number("grasp-force", 40.0, 0.0, 70.0), realtime == "enforce", limits, workspace)
 
 

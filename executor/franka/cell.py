@@ -3,7 +3,9 @@ at their tray positions (``start`` of ``assembly.toml``), the Franka Hand pickin
 
 One insertion runs as in the PyBullet cell (:mod:`executor.trial`), with the same skill
 code on the arm behind :class:`executor.franka.arm.FrankyController`: pick the part with the
-hand, carry it above the hole's calibrated position (:mod:`executor.assembly.transfer`),
+hand, carry it above the hole's calibrated position (franky's own Cartesian motions: exact
+positioning, planned within the arm's limits; the PyBullet cell's impedance-tracked
+transfers lag by millimetres here, and a part grasped off-centre tilts in the fingers),
 tare the wrench estimate, the hole search (:func:`executor.skills.search.hole_search`), the
 taught skill under the cell's execution layer
 (:func:`executor.skills.insertion.insert_in_layer`: DMP, admittance, phase stopping,
@@ -17,13 +19,14 @@ base frame (axes parallel).
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from executor import ExecutorError
-from executor.assembly.transfer import SAFE_Z, VIA_TOLERANCE, carry, move_line
+from executor.assembly.transfer import SAFE_Z
 from executor.cell_description import CellDescription
 from executor.control.detector import Detector
 from executor.control.ilc import ExecutionLayer, Ilc
@@ -34,11 +37,12 @@ from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionResult, InsertionTask, insert_in_layer, needs_yaw_compliance
 from executor.skills.search import SearchResult, hole_search
 from executor.trial import APPROACH_HEIGHT
-from executor.world.arm import aligned_yaw, tool_quat
+from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat
 from executor.world.geometry import CellGeometry, PartSpec, fit_pose
 
 OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before a pick
-GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point
+TOLERANCE = 0.0005  # [m] a move ends when the measured tool tip is this close to its goal
+ARRIVAL = 3.0  # [s] of wall time a move waits for the arm to arrive after its path ended
 RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
 GRIPPER_SPEED = 0.05  # [m/s] of the fingers
 HELD_FRACTION = 0.3
@@ -51,13 +55,12 @@ ABOVE_TRAY = 0.002  # [m] a part carried back is let go this far above the table
 class FrankaOptions:
     """The Franka cell's settings (``--backend-option KEY=VALUE``, docs/franka.md):
     ``host`` the arm's FCI address; ``offset`` [m] of the product frame in the robot's base
-    frame; ``speed`` [m/s] mean speed of the carrying moves; ``grasp_force`` [N];
+    frame; ``grasp_force`` [N];
     ``realtime``: libfranka's real-time check enforced (a real-time kernel; False for the
     simulator); ``limits``, ``workspace``: :mod:`executor.franka.safety`."""
 
     host: str
     offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    speed: float = 0.25
     grasp_force: float = 40.0
     realtime: bool = True
     limits: Limits = field(default_factory=Limits)
@@ -106,10 +109,39 @@ class FrankaCell:
             self._skills[shape] = load_product_skill(self.geometry, shape)
         return self._skills[shape]
 
-    def carry_to(self, goal: np.ndarray, yaw: float = 0.0, tolerance: float = VIA_TOLERANCE) -> None:
-        """Up to the carrying height, across, down to ``goal`` [m] (tool yaw ``yaw`` [rad])."""
-        carry(self.motion, goal, safe_z=SAFE_Z + self.options.offset[2], tolerance=tolerance, yaw=yaw,
-              speed=self.options.speed)
+    def move_to(self, tip: np.ndarray, yaw: float | None = None) -> None:
+        """The tool tip [m] in a straight line to ``tip``, the tool pointing down turned to
+        ``yaw`` [rad] (None: as it is), by franky's own Cartesian motion (its path planned
+        within the arm's limits scaled by the dynamics factor; the impedance tracking is
+        stopped meanwhile); returns once the measured tip is within :data:`TOLERANCE`
+        (franky returns when the path ends, the arm trails it). SafetyStop when the goal
+        is outside the workspace (the straight line between two points of the box stays in it)."""
+        import franky
+
+        self.options.workspace.check(tip)
+        self.controller.stop()
+        yaw = self.motion.tool_yaw if yaw is None else yaw
+        quat = tool_quat(yaw)
+        ee = tip - quat_to_matrix(quat)[:, 2] * self.arm.tcp
+        self.robot.move(franky.CartesianMotion(franky.Affine(ee, quat), franky.ReferenceType.Absolute,
+                                               franky.RelativeDynamicsFactor(self.options.limits.dynamics)))
+        self.motion.tool_yaw = yaw
+        deadline = time.monotonic() + ARRIVAL
+        while np.linalg.norm(self.arm.read().tip_pos - tip) > TOLERANCE:
+            if time.monotonic() > deadline:
+                raise ExecutorError(f"the arm did not reach {np.round(tip, 4).tolist()} m (at "
+                                    f"{np.round(self.arm.read().tip_pos, 4).tolist()} m)")
+            time.sleep(0.01)
+
+    def carry_to(self, goal: np.ndarray, yaw: float = 0.0) -> None:
+        """Up to the carrying height, across turning the tool to ``yaw`` [rad], down to
+        ``goal`` [m]."""
+        here = self.arm.read().tip_pos
+        high = max(SAFE_Z + self.options.offset[2], float(goal[2]), float(here[2]))
+        if here[2] < high - 1e-3:
+            self.move_to(np.array([here[0], here[1], high]))
+        self.move_to(np.array([goal[0], goal[1], high]), yaw)
+        self.move_to(goal)
 
     def _open(self, width: float) -> None:
         if not self.gripper.move(width, GRIPPER_SPEED):
@@ -124,7 +156,7 @@ class FrankaCell:
         self._open(width + OPEN_MARGIN)
         grip = self.to_base(np.array([*spec.start, spec.length - self.geometry.gripper.grasp_depth]))
         self.carry_to(grip + np.array([0.0, 0.0, 0.05]))
-        move_line(self.motion, grip, tolerance=GRIP_TOLERANCE, speed=self.options.speed / 5)
+        self.move_to(grip)
         # Closed toward zero width with the grasp force, held when the fingers stopped on
         # the part (the hand's width) rather than on nothing; franky-sim's fingers are a
         # spring toward the commanded width, which squeezes only when it is below the part's.
@@ -149,8 +181,7 @@ class FrankaCell:
         self._open(max(spec.sides) + OPEN_MARGIN)
         self.held = None
         self.arm.set_tcp(0.0)
-        here = self.arm.read().tip_pos
-        move_line(self.motion, here + np.array([0.0, 0.0, RETREAT]), tolerance=VIA_TOLERANCE)
+        self.move_to(self.arm.read().tip_pos + np.array([0.0, 0.0, RETREAT]))
 
     def put_back(self) -> None:
         """Carry the held part back to its place on the table and let it go."""
@@ -171,7 +202,7 @@ class FrankaCell:
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn)
         quat = tool_quat(yaw)
         approach = est + np.array([0.0, 0.0, APPROACH_HEIGHT])
-        self.carry_to(approach, yaw=yaw, tolerance=GRIP_TOLERANCE)
+        self.carry_to(approach, yaw=yaw)
         self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         self.arm.tare_sensor()
         found = hole_search(self.motion, est[:2], est[2], approach[2], quat, rng)
@@ -188,8 +219,7 @@ class FrankaCell:
     def lift(self) -> None:
         """The tool straight up to the carrying height."""
         here = self.arm.read().tip_pos
-        move_line(self.motion, np.array([here[0], here[1], SAFE_Z + self.options.offset[2]]),
-                  tolerance=VIA_TOLERANCE, speed=self.options.speed)
+        self.move_to(np.array([here[0], here[1], SAFE_Z + self.options.offset[2]]))
 
     def stop(self) -> None:
         """Stop the arm (the tracking motion ends, the arm comes to rest) and clear its

@@ -1,8 +1,9 @@
 """What keeps a real Franka arm safe while the skills drive it (docs/franka.md, "Safety").
 
 - **Speed**: franky's relative dynamics factor scales the arm's velocity, acceleration and
-  jerk limits of every motion franky plans; the skills' own moves keep their speeds
-  (:mod:`executor.assembly.transfer`: 0.5 m/s mean, the insertion a few cm/s).
+  jerk limits of every motion franky plans (the carrying moves of
+  :meth:`executor.franka.cell.FrankaCell.move_to`, the stop); the skills under impedance
+  keep their own speeds (the search 2.5-4.5 cm/s, the insertion's taught path).
 - **Force**: libfranka's collision behaviour: a joint torque or Cartesian force above its
   threshold stops the arm with a reflex (a ``ControlException``); the impedance's
   stiffness is capped (:data:`MAX_TRANSLATIONAL_STIFFNESS`, :data:`MAX_ROTATIONAL_STIFFNESS`)

@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from executor.assembly.transfer import move_line
 from executor.control.motion import APPROACH_SETTLE_TIME, Motion
-from executor.franka.cell import GRIP_TOLERANCE, FrankaCell
+from executor.franka.cell import FrankaCell
 
 ABOVE_START = 0.02  # [m] the part comes down onto the start from this far above
-ENTRY_SPEED = 0.02  # [m/s] mean speed of that last move (into the hole's entrance)
 SAME_PLACE = 0.005  # [m] a start this close (horizontally) is reached without the carrying height
 
 
@@ -34,17 +32,17 @@ class FrankaTeacher:
         return self.cell.motion
 
     def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
-        """Above the start, straight down onto it slowly, settled, the wrench tared: the
+        """Above the start, straight down onto it, settled, the wrench tared: the
         grasp is the one the hand made (the real one, not known to the robot)."""
         cell = self.cell
         above = tip + np.array([0.0, 0.0, ABOVE_START])
         here = cell.arm.read().tip_pos
         yaw = float(2 * np.arctan2(quat_xyzw[1], quat_xyzw[0]))  # of tool_quat(yaw)
         if np.linalg.norm(here[:2] - tip[:2]) > SAME_PLACE:
-            cell.carry_to(above, yaw=yaw, tolerance=GRIP_TOLERANCE)
+            cell.carry_to(above, yaw=yaw)
         else:
-            move_line(motion, above, tolerance=GRIP_TOLERANCE, yaw=yaw)
-        move_line(motion, tip, speed=ENTRY_SPEED, tolerance=GRIP_TOLERANCE)
+            cell.move_to(above, yaw)
+        cell.move_to(tip)
         motion.hold(tip, quat_xyzw, APPROACH_SETTLE_TIME)
         cell.arm.tare_sensor()
 

@@ -11,9 +11,9 @@ from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS, SafetyStop, Work
 
 
 def test_options_parse_into_the_cell_settings() -> None:
-    options = franka_options({"host": "172.16.0.2", "offset": "0.01,-0.02,0.005", "speed": "0.1",
+    options = franka_options({"host": "172.16.0.2", "offset": "0.01,-0.02,0.005",
                               "realtime": "ignore", "dynamics": "0.1", "workspace": "0.1,-0.5,0,0.8,0.5,0.6"})
-    assert options.host == "172.16.0.2" and options.offset == (0.01, -0.02, 0.005) and options.speed == 0.1
+    assert options.host == "172.16.0.2" and options.offset == (0.01, -0.02, 0.005)
     assert not options.realtime and options.limits.dynamics == 0.1
     assert options.workspace.low == (0.1, -0.5, 0.0) and options.workspace.high == (0.8, 0.5, 0.6)
     assert franka_options({"host": "x"}).realtime  # the real-time check is on unless switched off
@@ -21,9 +21,9 @@ def test_options_parse_into_the_cell_settings() -> None:
 
 @pytest.mark.parametrize(("options", "message"), [
     ({}, "needs --backend-option host=ADDRESS"),
-    ({"host": "x", "speeed": "1"}, "speeed: unknown to the franka backend"),
-    ({"host": "x", "speed": "2"}, r"speed=2: expected a number in \(0, 1\]"),
-    ({"host": "x", "speed": "fast"}, "speed=fast: expected 1 comma-separated numbers"),
+    ({"host": "x", "speed": "1"}, "speed: unknown to the franka backend"),
+    ({"host": "x", "grasp-force": "200"}, r"grasp-force=200: expected a number in \(0, 70\]"),
+    ({"host": "x", "grasp-force": "firm"}, "grasp-force=firm: expected 1 comma-separated numbers"),
     ({"host": "x", "offset": "0,0"}, "offset=0,0: expected 3 comma-separated numbers"),
     ({"host": "x", "realtime": "maybe"}, "realtime=maybe: expected enforce or ignore"),
     ({"host": "x", "dynamics": "0"}, r"dynamics=0: expected a number in \(0, 1\]"),
