@@ -41,8 +41,8 @@ from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat
 from executor.world.geometry import CellGeometry, PartSpec, fit_pose
 
 OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before a pick
-TOLERANCE = 0.0005  # [m] a move ends when the measured tool tip is this close to its goal
-ARRIVAL = 3.0  # [s] of wall time a move waits for the arm to arrive after its path ended
+TOLERANCE = 0.002  # [m] a move ends when the measured tool tip is this close to its goal
+ARRIVAL = 30.0  # [s] of wall time a move waits for the arm to arrive after its path ended
 RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
 GRIPPER_SPEED = 0.05  # [m/s] of the fingers
 HELD_FRACTION = 0.3
