@@ -4,8 +4,9 @@ of three graded pegs exactly, and ``--assemble`` places every peg within 2 mm of
 in the simulated world (its truth, not the robot's own reading).
 
 One test, long (the simulator steps at about a tenth of real time on a shared 2-core
-machine: about 20 min); in one xdist group so that it never shares the machine with
-another franky loop."""
+machine: 30-40 min); in one xdist group (with ``--dist loadgroup``) so that it never shares
+the machine with another franky loop. Expected to fail until franky-sim's hand holds a
+peg rigidly (docs/franka.md)."""
 
 from __future__ import annotations
 
@@ -29,6 +30,9 @@ PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="franky-sim's hand lets a peg pivot and slide in the fingers under the "
+                   "insertion's forces: p2 (d 11) into h1 (d 10.8) came back fit (docs/franka.md, 'What does not "
+                   "hold yet')")
 @pytest.mark.timeout(3600)
 @pytest.mark.xdist_group("franka")
 def test_a_session_through_the_franka_backend_learns_the_fits_and_assembles(run_cli, tmp_path: Path) -> None:
@@ -40,6 +44,7 @@ def test_a_session_through_the_franka_backend_learns_the_fits_and_assembles(run_
     with sim_robot(folder) as sim:
         done = run_cli("session", "--assembly", str(folder), "--cells", "1", "--backend", "franka",
                        "--backend-option", f"host={sim.host}", "--backend-option", "realtime=ignore",
+                       "--backend-option", "dynamics=0.5",
                        "--cell-description", str(description), "--timeout", "1500", "--assemble", "--json",
                        "--out", str(tmp_path / "run"), timeout=3300)
         assert done.returncode == 0, done.stderr
