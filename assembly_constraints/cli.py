@@ -36,6 +36,7 @@ BENCHMARKS: dict[str, str] = {
     "assemble": "asp.bench.assemble_plans",
     "executor": "executor.campaign.bench",
     "physics": "executor.campaign.physics",
+    "engines": "executor.campaign.engines",
     "import": "executor.cad.bench",
 }
 """``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""

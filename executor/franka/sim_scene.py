@@ -5,13 +5,12 @@ cell loads (:func:`executor.world.geometry.load_geometry`: ``geometry.toml`` and
 What is built, in MuJoCo's world frame (= the arm's base frame, :data:`PRODUCT_IN_BASE`):
 
 - the plate under the bosses: one box from the floor up to :attr:`CellGeometry.base_top`;
-- each hole's boss as convex pieces (MuJoCo collides a mesh as its convex hull, so a
-  concave boss is cut into convex ones): for each of the ``polygon_sides`` sectors of the
-  boss ring, the solid between the hole's wall and the boss's square outline, with the
-  45° entry chamfer as a plane cut (:func:`boss_pieces`); the same surfaces as the
-  PyBullet cell's triangle mesh (:func:`executor.world.geometry.plate_obj_text`), round
-  holes the same n-gons, square and rect holes exact; a hole with a floor gets the floor
-  as one more piece;
+- each hole's boss as overlapping convex pieces (MuJoCo collides a mesh as its convex
+  hull, so a concave boss is made of convex ones): per face of the hole's wall, the boss
+  beyond that face and its 45° entry chamfer (:func:`boss_pieces`); their union has the
+  surfaces of the PyBullet cell's triangle mesh
+  (:func:`executor.world.geometry.plate_obj_text`): round holes the same n-gons, square
+  and rect holes exact; a hole with a floor gets the floor as one more piece;
 - each peg (``[part_shapes.*]``) as a free body at its tray start, upright on the floor:
   a cylinder or box of its mass, or with a ``mesh`` its convex pieces (the ``convex``
   file as made at import, not eroded: MuJoCo adds no margin) with the mesh's inertia.
@@ -27,9 +26,12 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from collections.abc import Collection
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
+from scipy.spatial import HalfspaceIntersection
 
 from bridge.product import Plate
 from executor import ExecutorError
@@ -47,9 +49,31 @@ PART_PREFIX = "part_"
 """MuJoCo body name of a part: this prefix and the part's id."""
 
 _FRICTION = f"{TEACH_FRICTION} 0.005 0.0001"  # sliding, torsional [m], rolling [m] (MuJoCo's defaults for the last two)
+_SOLREF = "0.002 1"
+"""Contact time constant [s] and damping ratio of the plate and the parts: the stiffest
+MuJoCo allows at a 1 ms step. Its default (0.02 s) lets a 50 g part squeeze through an
+interference of up to ~1 mm under 10 N (an 8 mm peg went into a 7.3 mm slot)."""
 _PART_CONDIM = "4"  # sliding and torsional friction: a held part does not spin about the fingers' closing axis
 _PLATE_RGBA = "0.7 0.72 0.75 1"
 _PART_RGBA = "0.8 0.6 0.2 1"
+
+
+CONTACT_OPTIONS = {"cone": "elliptic", "impratio": "10", "noslip_iterations": "5"}
+"""MuJoCo's contact options (its documentation's advice against slip in a grasp: elliptic
+friction cones, friction 10x stiffer than normal forces, a no-slip pass)."""
+
+TIME_STEP = 0.001
+"""MuJoCo's step [s]: franky-sim's, one per control packet (the PyBullet cell's too)."""
+
+
+def set_contact_options(scene: ET.Element) -> None:
+    """Put :data:`CONTACT_OPTIONS` into the ``<option>`` of a MuJoCo scene (made if missing)."""
+    option = scene.find("option")
+    if option is None:
+        option = ET.SubElement(scene, "option")
+    for key, value in CONTACT_OPTIONS.items():
+        option.set(key, value)
+
 
 
 def to_base(point: np.ndarray) -> np.ndarray:
@@ -80,35 +104,44 @@ class ConvexPiece:
 
 
 def boss_pieces(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarray]:
-    """The boss around ``hole`` as convex solids, vertices (n, 3) [m]: sector k of the ring
-    between the hole's wall (points k, k+1 of its n-gon, square or rect ring) and the
-    boss's square outline (points k, k+1 of the square ring; both rings have their corners
-    at the same indices, so each sector's inner and outer edges are straight), from the
-    plate under the bosses (``base`` [m]) up to the entry, the chamfer cut off it by the
-    plane through the mouth's and the wall's edges (a convex prism cut by a plane stays
-    convex); plus the hole's floor, the inner prism from ``base`` up to the bottom, when the
-    hole does not go through its boss (as :func:`executor.world.geometry._boss_triangles`)."""
+    """The boss around ``hole`` as convex solids, vertices (n, 3) [m], whose union is the
+    PyBullet cell's boss (:func:`executor.world.geometry._boss_triangles`): the hole is the
+    intersection of the half-planes inside its wall's faces (the n-gon's sides, a square's
+    or rect's four), so the boss is the union, over the faces, of the solid beyond one face:
+    from the plate under the bosses (``base`` [m]) to the entry, inside the boss's square
+    outline, behind the face's plane and behind its chamfer's 45° plane (each an
+    intersection of half-spaces: convex). The pieces overlap: a part pressing on a wall
+    meets one wide piece and is pushed back through the wall's face (thin sectors of a ring
+    let a penetrating corner out sideways, through the seams between them). Plus the hole's
+    floor, the inner prism from ``base`` to the bottom, when the hole does not go through
+    its boss."""
     n = plate.polygon_sides
     centre = np.array(hole.position)
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
-    outer = _turned(_ring("square", plate.tile_size / 2, n), hole.yaw) + centre
-    mouth = _turned(_ring(hole.kind, half_a + plate.chamfer, n, half_b + plate.chamfer), hole.yaw) + centre
-    inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw) + centre
-    top, below_chamfer = hole.top_z, hole.top_z - plate.chamfer
+    inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw)  # about the centre
+    top, chamfer, half_tile = hole.top_z, plate.chamfer, plate.tile_size / 2
     floor = hole.bottom_z if hole.bottom_z - base >= FLOOR_MIN else base
-
-    def at(ring: np.ndarray, k: int, z: float) -> list[float]:
-        return [*ring[k % n], z]
-
-    pieces = []
+    yaw = np.array([math.cos(hole.yaw), math.sin(hole.yaw)])
+    outline = [np.array(v) for v in (yaw, -yaw, (-yaw[1], yaw[0]), (yaw[1], -yaw[0]))]
+    # Half-spaces a·x + b <= 0, x = (x, y, z) in the product frame.
+    fixed = [[*m, 0.0, -(m @ centre) - half_tile] for m in outline] + [[0, 0, -1, base], [0, 0, 1, -top]]
+    faces: dict[tuple[float, float, float], np.ndarray] = {}
     for k in range(n):
-        points = []
-        for j in (k, k + 1):
-            points += [at(outer, j, top), at(outer, j, base), at(mouth, j, top),
-                       at(inner, j, below_chamfer), at(inner, j, floor)]
-        pieces.append(np.array(points))
+        edge = inner[(k + 1) % n] - inner[k]
+        normal = np.array([edge[1], -edge[0]]) / np.linalg.norm(edge)  # outward: the ring runs counter-clockwise
+        distance = float(normal @ inner[k])
+        faces.setdefault((round(normal[0], 9), round(normal[1], 9), round(distance, 12)), normal)
+    pieces = []
+    for (_nx, _ny, distance), normal in faces.items():
+        if distance + chamfer >= half_tile:
+            raise ExecutorError(f"hole {hole.id}: its wall is {distance * 1000:.2f} mm from its centre, the boss's "
+                                f"outline {half_tile * 1000:.2f} mm; expected a hole inside its boss (tile_size)")
+        offset = normal @ centre + distance
+        rows = np.array([*fixed, [*-normal, 0.0, offset], [*-normal, 1.0, offset - top + chamfer]])
+        inside = np.array([*(centre + normal * (distance + chamfer + half_tile) / 2), (base + top - chamfer) / 2])
+        pieces.append(HalfspaceIntersection(rows, inside).intersections)
     if floor > base:
-        pieces.append(np.array([at(inner, k, z) for k in range(n) for z in (base, floor)]))
+        pieces.append(np.array([[*(centre + point), z] for point in inner for z in (base, floor)]))
     return pieces
 
 
@@ -146,7 +179,7 @@ def _part_body(worldbody: ET.Element, asset: ET.Element, geometry: CellGeometry,
     body = ET.SubElement(worldbody, "body", name=name, pos=_vec(to_base(np.array([*part.start, 0.0]))))
     ET.SubElement(body, "freejoint", name=f"{name}_free")
     half = part.length / 2
-    common = {"friction": _FRICTION, "condim": _PART_CONDIM, "rgba": _PART_RGBA}
+    common = {"friction": _FRICTION, "condim": _PART_CONDIM, "solref": _SOLREF, "rgba": _PART_RGBA}
     if part.mesh is None:
         a, b = part.sides
         kind, size = ("cylinder", (part.size / 2, half)) if part.kind == "round" else ("box", (a / 2, b / 2, half))
@@ -165,12 +198,13 @@ def _part_body(worldbody: ET.Element, asset: ET.Element, geometry: CellGeometry,
     return name
 
 
-def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry) -> dict[str, str]:
+def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry,
+                parts: Collection[str] | None = None) -> dict[str, str]:
     """Add the plate (static) and the pegs (free, at their tray starts) of ``geometry`` to a
     MuJoCo scene (``scene``: the ``<mujoco>`` root, whose ``<asset>`` gets the pieces'
     meshes; ``worldbody`` its ``<worldbody>``), before the model is compiled. Returns the
-    MuJoCo body name of each peg by part id. Covers, heads and parts placed by hand are
-    not added."""
+    MuJoCo body name of each peg by part id. ``parts``: only these pegs (default all).
+    Covers, heads and parts placed by hand are not added."""
     asset = scene.find("asset")
     if asset is None:
         asset = ET.SubElement(scene, "asset")
@@ -178,21 +212,48 @@ def add_product(scene: ET.Element, worldbody: ET.Element, geometry: CellGeometry
     plate = ET.SubElement(worldbody, "body", name="plate", pos=_vec(PRODUCT_IN_BASE))
     for box in boxes:
         ET.SubElement(plate, "geom", name=box.name, type="box", size=_vec(box.half), pos=_vec(box.centre),
-                      friction=_FRICTION, rgba=_PLATE_RGBA)
+                      friction=_FRICTION, solref=_SOLREF, rgba=_PLATE_RGBA)
     for piece in pieces:
         ET.SubElement(asset, "mesh", name=piece.name, vertex=_vec(piece.vertices))
         ET.SubElement(plate, "geom", name=piece.name, type="mesh", mesh=piece.name, friction=_FRICTION,
-                      rgba=_PLATE_RGBA)
-    return {pid: _part_body(worldbody, asset, geometry, part) for pid, part in sorted(geometry.parts.items())}
+                      solref=_SOLREF, rgba=_PLATE_RGBA)
+    return {pid: _part_body(worldbody, asset, geometry, part) for pid, part in sorted(geometry.parts.items())
+            if parts is None or pid in parts}
 
 
-def hole_entry(geometry: CellGeometry, hole: str) -> np.ndarray:
-    """The centre of a hole's entry [m] in the arm's base frame."""
-    spec = geometry.holes[hole]
-    return to_base(np.array([*spec.position, spec.top_z]))
+def product_model(geometry: CellGeometry, drive: str | None = None
+                  ) -> tuple[mujoco.MjModel, mujoco.MjData, dict[str, int]]:
+    """A MuJoCo model of the product alone (floor, plate, pegs at their tray starts; no
+    arm), gravity, :data:`TIME_STEP` and :data:`CONTACT_OPTIONS`, as franky-sim's scene has
+    them; its data after a forward pass, and the body id of each peg and of the plate
+    (``"plate"``). ``drive``: the one part built, welded to a mocap body (``"drive"``) that moves it."""
+    root = ET.Element("mujoco", model="product")
+    ET.SubElement(root, "option", timestep=str(TIME_STEP), gravity="0 0 -9.81", integrator="implicitfast")
+    set_contact_options(root)
+    ET.SubElement(root, "asset")
+    world = ET.SubElement(root, "worldbody")
+    ET.SubElement(world, "geom", name="floor", type="plane", size="10 10 0.1")
+    names = add_product(root, world, geometry, None if drive is None else [drive]) | {"plate": "plate"}
+    if drive is not None:
+        ET.SubElement(world, "body", name="drive", mocap="true")
+        ET.SubElement(ET.SubElement(root, "equality"), "weld", body1="drive", body2=names[drive], solref="0.005 1",
+                      relpose="0 0 0 1 0 0 0")  # the part at the drive body, axes aligned
+        names["drive"] = "drive"
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return model, data, {key: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for key, name in names.items()}
 
 
-def yaw_of(quat_wxyz: np.ndarray) -> float:
-    """The rotation [rad] about z of a MuJoCo quaternion (w x y z) of an upright body."""
-    w, x, y, z = (float(v) for v in quat_wxyz)
-    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+def contact_force(model: mujoco.MjModel, data: mujoco.MjData, body: int, other: int) -> np.ndarray:
+    """The total contact force [N] (world axes) that body ``other`` exerts on body ``body``."""
+    total, wrench = np.zeros(3), np.zeros(6)
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        first, second = (int(model.geom_bodyid[g]) for g in contact.geom)
+        if {first, second} != {body, other}:
+            continue
+        mujoco.mj_contactForce(model, data, i, wrench)
+        on_second = contact.frame.reshape(3, 3).T @ wrench[:3]  # the contact frame's rows are its axes
+        total += on_second if second == body else -on_second
+    return total

@@ -2,7 +2,7 @@
 and benchmarks of the Franka backend: in-process (:class:`SimRobot`, :func:`sim_robot`) or
 as a process that a cell connects to by address::
 
-    python -m executor.franka.sim_server --assembly data/spare [--hostname 127.0.0.5] [--poses-out FILE]
+    python -m executor.franka.sim_server --assembly spare [--hostname 127.0.0.5] [--poses-out FILE]
 
 It prints ``franky-sim serving <folder> at <hostname>`` once the arm is up, then serves
 until SIGTERM or Ctrl-C, and then writes the parts' poses to ``--poses-out``. libfranka's
@@ -18,7 +18,9 @@ file of it is changed; figures in docs/franka.md, "Testing against franky-sim"):
 2. the measured pose: franky-sim reports the commanded pose as ``O_T_EE`` (its forward
    kinematics returns a view that the next call overwrites); it is recomputed from q;
 3. joint 7's damping: :data:`JOINT_KV` (franky-sim's 200 chatters at the 1 ms step);
-4. the fingers' stiffness: :data:`FINGER_GAIN` (franky-sim's squeezes ~6 N, the part creeps).
+4. the fingers: :data:`FINGER_GAIN` and :data:`FINGER_DAMPING` (franky-sim's squeeze ~6 N,
+   and its damping is unstable at the 1 ms step); and MuJoCo's contact options against slip
+   in a grasp (:data:`executor.franka.sim_scene.CONTACT_OPTIONS`).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ from bridge.cli_types import ArgumentParser, add_assembly_argument, run_command
 from bridge.errors import ToolError
 from bridge.files import write_atomic
 from executor import ExecutorError
-from executor.franka.sim_scene import add_product, from_base
+from executor.franka.sim_scene import add_product, contact_force, from_base, set_contact_options
 from executor.world.geometry import CellGeometry, load_geometry
 
 JOINT_KV = (450.0, 450.0, 350.0, 350.0, 200.0, 200.0, 60.0)
@@ -57,10 +59,6 @@ FINGER_DAMPING = 10.0
 outside MuJoCo's implicit integrator, so at the 1 ms step a finger of 15 g is stable only
 for kv dt / m well below 2 (franky-sim's 50 gives 3.3: the fingers chatter and a held part
 walks along the pads)."""
-
-CONTACT_OPTIONS = {"cone": "elliptic", "impratio": "10", "noslip_iterations": "5"}
-"""MuJoCo's contact options for grasping (its documentation's advice against slip in a
-grasp: elliptic friction cones, friction 10x stiffer than normal forces)."""
 
 HAND_BODY = "robot0_hand"
 """The MuJoCo body of the Franka Hand; its origin is the flange."""
@@ -138,7 +136,6 @@ class SensedRobot(FrankaMujocoRobot):
     (same attributes) and sets ``sensor`` once the scene is compiled."""
 
     sensor: FlangeSensor | None = None
-    last_wrench: Wrench | None = None
 
     @property
     def state(self) -> FrankaRobotState:
@@ -147,7 +144,6 @@ class SensedRobot(FrankaMujocoRobot):
             return state
         pose = self.kinematics(np.array(state.q)).copy()  # a copy: the next call overwrites the view
         wrench = self.sensor.wrench(pose.translation, self.m_load, self.F_x_Cload)
-        self.last_wrench = wrench
         k_axes = pose.rotation @ np.array(self.EE_T_K).reshape(4, 4, order="F")[:3, :3]
         return state.replace(
             O_T_EE=self.to_franka_pose(pose),
@@ -162,8 +158,7 @@ class Truth:
     """The simulated world between two steps, for tests: ``time`` [s] since the start;
     ``poses`` of the parts (position [m] of the body frame, the bottom face centre, in
     the product frame; quaternion w x y z); ``plate_force`` [N], base axes, the plate's
-    contact force on each part; ``wrench`` the one the arm reports (None before a client
-    read the state)."""
+    contact force on each part; ``wrench`` the one the arm reports, at the same step."""
 
     time: float
     poses: dict[str, tuple[np.ndarray, np.ndarray]]
@@ -207,9 +202,7 @@ class SimRobot:
         robot._kv_hand = np.full(2, FINGER_DAMPING)
         names = add_product(sim.scene, sim.worldbody, self.geometry)
         add_flange_sensor(sim)
-        option = sim.scene.find("option")
-        for key, value in CONTACT_OPTIONS.items():
-            (ET.SubElement(sim.scene, "option") if option is None else option).set(key, value)
+        set_contact_options(sim.scene)
         server = SimulationServer(sim) if self._hostname is None else SimulationServer(sim, [self._hostname])
         self._sim, self._server, self._robot = sim, server, robot
         try:
@@ -259,21 +252,12 @@ class SimRobot:
         model, data = sim.model, sim.data
         poses = {pid: (from_base(data.xpos[body].copy()), data.xquat[body].copy())
                  for pid, body in self._bodies.items()}
-        forces = {pid: np.zeros(3) for pid in self._bodies}
-        parts = {body: pid for pid, body in self._bodies.items()}
-        wrench6 = np.zeros(6)
-        for i in range(data.ncon):
-            contact = data.contact[i]
-            first, second = (int(model.geom_bodyid[g]) for g in contact.geom)
-            if self._plate not in (first, second) or (first if second == self._plate else second) not in parts:
-                continue
-            mujoco.mj_contactForce(model, data, i, wrench6)
-            on_second = contact.frame.reshape(3, 3).T @ wrench6[:3]  # the contact frame's rows are its axes
-            if second == self._plate:
-                forces[parts[first]] -= on_second
-            else:
-                forces[parts[second]] += on_second
-        return Truth(float(data.time), poses, forces, robot.last_wrench)
+        forces = {pid: contact_force(model, data, body, self._plate) for pid, body in self._bodies.items()}
+        wrench = None
+        if robot.sensor is not None:  # the wrench of this very step, as the plate's force is
+            tcp = robot.kinematics(np.array(robot.inner_state.q)).copy().translation
+            wrench = robot.sensor.wrench(tcp, robot.m_load, robot.F_x_Cload)
+        return Truth(float(data.time), poses, forces, wrench)
 
     def __enter__(self) -> SimRobot:
         self.start()

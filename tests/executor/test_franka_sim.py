@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import shutil
 import time
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -16,22 +15,11 @@ import pytest
 mujoco = pytest.importorskip("mujoco")
 franky = pytest.importorskip("franky")
 
-from executor.franka.sim_scene import add_product, to_base  # noqa: E402
+from executor.franka.sim_scene import product_model, to_base  # noqa: E402
 from executor.franka.sim_server import sim_robot  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def _product_model(assembly: str) -> tuple[object, object]:
-    root = ET.Element("mujoco")
-    ET.SubElement(root, "asset")
-    world = ET.SubElement(root, "worldbody")
-    add_product(root, world, load_geometry(assembly))
-    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    return model, data
 
 
 def _drop(model: object, data: object, x: float, y: float) -> float:
@@ -45,7 +33,7 @@ def _drop(model: object, data: object, x: float, y: float) -> float:
 @pytest.mark.parametrize("assembly", ["spare", "taskboard"])
 def test_holes_are_open_to_their_size_and_the_boss_stands_around_them(assembly: str) -> None:
     geometry = load_geometry(assembly)
-    model, data = _product_model(assembly)
+    model, data, _bodies = product_model(geometry)
     base = geometry.base_top
     for hid, hole in geometry.holes.items():
         cx, cy = hole.position
