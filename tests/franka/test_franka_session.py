@@ -30,7 +30,7 @@ PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="franky-sim's hand lets a peg pivot and slide in the fingers under the "
+@pytest.mark.xfail(reason="franky-sim's hand lets a peg pivot and slide in the fingers under the "
                    "insertion's forces: p2 (d 11) into h1 (d 10.8) came back fit (docs/franka.md, 'What does not "
                    "hold yet')")
 @pytest.mark.timeout(3600)
