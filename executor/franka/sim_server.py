@@ -52,7 +52,7 @@ JOINT_KV = (450.0, 450.0, 350.0, 350.0, 200.0, 200.0, 60.0)
 
 FINGER_GAIN = 5000.0
 """Stiffness [N/m] of each simulated finger toward its target width (franky-sim's 1000
-squeezes ~6 N per finger; 5000 gives ~27 N)."""
+squeezes ~6 N per finger; 5000 gives ~26 N at a 60 N grasp)."""
 
 FINGER_DAMPING = 10.0
 """Damping [N s/m] of each simulated finger: franky-sim applies its finger PD as a force

@@ -5,7 +5,12 @@ contact force that MuJoCo applies."""
 
 from __future__ import annotations
 
+import json
+import os
 import shutil
+import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -132,3 +137,28 @@ def test_franka_inserts_a_peg_where_it_fits_and_stops_on_force_where_not(tmp_pat
         time.sleep(0.3)
         depth = fits.top_z - sim.truth().poses["p3"][0][2]
         assert depth > 0.010  # in the hole (18 mm commanded below the entry; the no-fit stays within 5 mm)
+
+
+@pytest.mark.slow
+def test_the_server_process_prints_its_address_and_writes_the_poses_when_stopped(tmp_path: Path) -> None:
+    poses = tmp_path / "poses.json"
+    process = subprocess.Popen([sys.executable, "-m", "executor.franka.sim_server", "--assembly", "spare",
+                                "--poses-out", str(poses)], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    try:
+        assert process.stdout is not None
+        line = process.stdout.readline()
+        assert line.startswith("franky-sim serving ") and " at 127." in line, line
+        host = line.rsplit(" ", 1)[1].strip()
+        robot = franky.Robot(host, realtime_config=franky.RealtimeConfig.Ignore)  # the address serves the arm
+        assert len(robot.state.q) == 7
+    finally:
+        process.send_signal(signal.SIGTERM)
+        _out, err = process.communicate(timeout=60)
+    assert process.returncode == 143 and "Traceback" not in err, err
+    parts = json.loads(poses.read_text())["parts"]
+    geometry = load_geometry("spare")
+    assert parts.keys() == geometry.parts.keys()
+    for pid, part in geometry.parts.items():  # waiting on the tray, upright
+        assert np.allclose(parts[pid]["position"], [*part.start, 0.0], atol=1e-3), pid
+        assert parts[pid]["quat_wxyz"][0] == pytest.approx(1.0, abs=1e-3)
