@@ -403,3 +403,11 @@ def part_hole_pair(text: str) -> tuple[str, str]:
     if not (sep and part and hole) or ":" in hole:
         raise ValueError(text)
     return part, hole
+
+
+def backend_option(text: str) -> tuple[str, str]:
+    """An argparse type: ``"key=value"`` → ``("key", "value")``."""
+    key, sep, value = text.partition("=")
+    if not (sep and re.fullmatch(r"[A-Za-z_][\w-]*", key)):
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected KEY=VALUE")
+    return key, value

@@ -9,9 +9,12 @@ PyBullet scene, arm), ``control`` (impedance controller, admittance, detector, m
 stepper), ``skills`` (DMP, hole search, insertion, wiggle, teaching), the records in
 ``evidence``, the Rerun log ``rerun_log``, the trial ``trial``, and on top ``campaign``,
 ``serve`` (with the backend interface ``backend_plugin`` and the replay backend ``replay``)
-and ``cli``; beside them ``cad``, a product from its CAD (on ``world`` and ``assembly``).
+and ``cli``; beside them ``cad``, a product from its CAD (on ``world`` and ``assembly``), and
+``franka``, the same skills on a Franka arm through franky (the arm behind
+``control.motion.ArmController``; a ``serve`` backend) and franky-sim with the product.
 Teaching (``skills.teach``) drives any cell with a hand (its ``TeachingCell`` protocol,
-which ``trial.Cell`` meets) to record the skills the trial then uses.
+which ``trial.Cell`` and ``franka.teach.FrankaTeacher`` meet) to record the skills the
+trial then uses.
 """
 
 

@@ -33,7 +33,6 @@ describes the interface and docs/ros2.md how a backend reaches a ROS 2 robot.
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import re
 from collections.abc import Collection, Mapping
@@ -41,7 +40,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
-from bridge.inputs import shorten
 from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
 from bridge.precedence.experiment import FailureReason, PrecedenceExperiment
 from executor import ExecutorError, UnknownPair
@@ -149,14 +147,6 @@ class CellContext:
         if key not in self.options:
             raise ExecutorError(f"this backend needs --backend-option {key}=...")
         return self.options[key]
-
-
-def backend_option(text: str) -> tuple[str, str]:
-    """An argparse type: ``"key=value"`` → ``("key", "value")``."""
-    key, sep, value = text.partition("=")
-    if not (sep and re.fullmatch(r"[A-Za-z_][\w-]*", key)):
-        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected KEY=VALUE")
-    return key, value
 
 
 def load_backend(spec: str, context: CellContext) -> Backend:

@@ -24,6 +24,7 @@ from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
+    backend_option,
     int_in,
     nonempty_path,
     png_path,
@@ -45,14 +46,34 @@ MAX_ATTEMPTS = 10
 
 
 def _teach(args: argparse.Namespace) -> int:
-    from executor.skills.teach import teach_all
-    from executor.trial import Cell
+    from executor import ExecutorError
+    from executor.cell_description import load_cell_description
+    from executor.skills.teach import TeachingCell, teach_all
 
-    cell = Cell(args.assembly)
+    description = load_cell_description(args.cell_description)
+    cell: TeachingCell
+    if args.backend == "franka":
+        from executor.control.ilc import layer_named
+        from executor.franka.backend import franka_options
+        from executor.franka.cell import FrankaCell
+        from executor.franka.teach import FrankaTeacher
+        from executor.world.geometry import load_geometry
+
+        options = franka_options(dict(args.backend_option))
+        arm = FrankaCell(load_geometry(args.assembly, description), description, layer_named("full"), options)
+        cell = FrankaTeacher(arm)
+        close = arm.stop
+    else:
+        from executor.trial import Cell, CellSetup
+
+        if args.backend_option:
+            raise ExecutorError("--backend-option: the sim backend takes none (expected --backend franka)")
+        sim = Cell(args.assembly, setup=CellSetup(description=description))
+        cell, close = sim, sim.close
     try:
         written = teach_all(cell)
     finally:
-        cell.close()
+        close()
     for path in written:
         print(f"wrote {path}")
     return 0
@@ -174,6 +195,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     teach = sub.add_parser("teach", help="record the scripted demonstrations (DMP + reference wrench)")
     add_assembly_argument(teach)
+    teach.add_argument("--backend", choices=("sim", "franka"), default="sim",
+                       help="sim: in the PyBullet cell; franka: on a Franka arm through franky (docs/franka.md) "
+                            "(default sim)")
+    teach.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
+                       help="franka: an option of the arm, e.g. host=172.16.0.2 (repeatable)")
+    add_cell_description_argument(teach)
     teach.set_defaults(func=_teach)
 
     trial = sub.add_parser("trial", help="insert one part into one hole, N randomised trials")

@@ -147,7 +147,7 @@ class Cell:
             self._skills[shape] = load_product_skill(self.geometry, shape)
         return self._skills[shape]
 
-    def motion_for(self, part: str) -> Motion:
+    def motion_for(self, part: str) -> Motion[ImpedanceController]:
         """Put the part in the hand; the Motion driving the arm that holds it.  Each part
         shape has its own PyBullet client, made on first use (with ``gui``, the first
         one is the GUI); the step count carries over, so sim time only grows."""
@@ -161,6 +161,23 @@ class Cell:
             motion.steps = self._motion.steps
         self._motion, self.scene = motion, scene
         return motion
+
+    def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
+        """Teaching (:class:`executor.skills.teach.TeachingCell`): the held part exactly in
+        the hand, the teaching friction, the arm placed at the pose and settled, the sensor tared."""
+        assert self.scene is not None  # set by motion_for
+        self.scene.set_friction(None)
+        arm = motion.controller.arm
+        arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+        arm.inverse_kinematics(tip, quat_xyzw)
+        motion.controller.reset()
+        motion.hold(tip, quat_xyzw, APPROACH_SETTLE_TIME)
+        arm.tare_sensor()
+
+    def let_go(self) -> None:
+        """Teaching: the part out of the hand."""
+        assert self.scene is not None  # set by motion_for
+        self.scene.release()
 
     def _scene_of(self, shape: str) -> Scene:
         """The PyBullet client of ``shape``'s arm, made (with its Motion) on first use."""

@@ -37,6 +37,7 @@ from bridge.cli_types import (
     PROGRAM,
     ArgumentParser,
     add_assembly_argument,
+    backend_option,
     comma_list,
     finite_float,
     int_in,
@@ -71,9 +72,12 @@ def build_parser() -> argparse.ArgumentParser:
                              "has one, and precedence experiments at the cell, chosen by ASP)")
     parser.add_argument("--out", type=nonempty_path, help="run folder (default runs/<UTC time>)")
     parser.add_argument("--resume", type=nonempty_path, metavar="RUN", help="continue a killed session")
-    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
-                        help="cells started here: sim (PyBullet) or truth (answers from the geometry's "
-                             "cross-sections, no simulation)")
+    parser.add_argument("--backend", choices=("sim", "truth", "franka"), default="sim",
+                        help="cells started here: sim (PyBullet), truth (answers from the geometry's "
+                             "cross-sections, no simulation) or franka (a Franka arm through franky, "
+                             "docs/franka.md)")
+    parser.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
+                        help="an option of the cells' backend, e.g. host=172.16.0.2 for franka (repeatable)")
     parser.add_argument("--delay", type=finite_float(0.0, 3600.0), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")
     parser.add_argument("--timeout", type=finite_float(0.0, MAX_WAIT_S, low_open=True), default=120.0, metavar="S",
@@ -103,7 +107,8 @@ def session_settings(args: argparse.Namespace) -> SessionSettings:
         assembly=args.assembly, policy=args.policy, model=args.model, seed=args.seed, confirm=args.confirm,
         size_prior=args.prior, tolerance_m=args.tolerance, precedence=args.precedence,
         demos=path_setting(args.demos), cell=cell_settings_of(args, cell_seed=args.seed), out=path_setting(args.out),
-        resume=path_setting(args.resume), cells=args.cells, backend=args.backend, delay_s=args.delay,
+        resume=path_setting(args.resume), cells=args.cells, backend=args.backend,
+        backend_options=dict(args.backend_option), delay_s=args.delay,
         timeout_s=args.timeout, wait_for_cell_s=args.wait_for_cell, plans=args.plans,
         allow_cells=None if args.allow_cells is None else tuple(args.allow_cells), assemble=args.assemble,
         listen=tuple(args.listen), connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config))

@@ -408,7 +408,8 @@ def session_cell(settings: SessionSettings, record: SessionFile, run: Path, numb
     cell_id = f"c{number}"
     suffix = "" if record.starts == 1 else f"-{record.starts}"
     return ServeSettings(
-        cell_id=cell_id, backend=settings.backend, assembly=str(load_assembly(record.assembly).folder),
+        cell_id=cell_id, backend=settings.backend, backend_options=settings.backend_options,
+        assembly=str(load_assembly(record.assembly).folder),
         connect=tuple(connect), delay_s=settings.delay_s, rrd=str(run / f"{cell_id}{suffix}.rrd"),
         recording_id=record.recording_id, zenoh_config=settings.zenoh_config, viewer_url=viewer_url,
         ilc_state=str(run / f"{cell_id}-ilc.json") if settings.backend == "sim" else None,
@@ -423,7 +424,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     settings, warnings = _resumed(settings, record, run) if settings.resume is not None else (settings, [])
     assembly = load_assembly(record.assembly)
     _check_product(settings, record, assembly, run)
-    answers_from = {"sim": ("geometry.toml",), "truth": ("geometry.toml", "sizes.lp")}.get(settings.backend, ())
+    answers_from = {"sim": ("geometry.toml",), "franka": ("geometry.toml",),
+                    "truth": ("geometry.toml", "sizes.lp")}.get(settings.backend, ())
     if settings.cells > 0 and answers_from and not any(assembly.has_file(name) for name in answers_from):
         raise PlannerError(f"{assembly.folder / answers_from[0]}: no such file; the cells a session starts (--backend "
                            f"{settings.backend}) answer from {' or '.join(answers_from)} (docs/backends.md); describe "

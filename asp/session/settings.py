@@ -59,7 +59,7 @@ pinned by the SHA-256 it states for each)."""
 
 RecordingId = Annotated[str, Meta(pattern=rf"^[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}$")]
 Digest = Annotated[str, Meta(pattern=r"^[0-9a-f]{64}$")]
-Backend = Literal["sim", "truth"]
+Backend = Literal["sim", "truth", "franka"]
 Delay = Annotated[float, Meta(ge=0.0, le=MAX_DELAY_S)]
 Confirm = Annotated[int, Meta(ge=0, le=MAX_CONFIRM)]
 Tolerance = Annotated[float, Meta(ge=0.0, le=MAX_TOLERANCE_M)]
@@ -93,6 +93,8 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     (``demos``: Algorithm 1 on the demonstrations; ``explore``: at most 2 of them, the
     geometric precedence and experiments at the cell, :mod:`asp.session.precedence`). These
     are kept in ``session.json``; a resume takes them from there and ignores its own.
+    ``backend_options``: the ``--backend-option`` pairs of those cells (a ``franka`` cell's
+    ``host``, ...: how to reach the arm, not what is learned, so not kept).
 
     How: ``out`` (None: ``runs/<UTC time>``) or ``resume`` (a run folder); ``cells``
     co-processes to start (0: use cells on the network, only ``allow_cells`` if given); ``timeout_s`` [s]
@@ -116,6 +118,7 @@ class SessionSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     resume: str | None = None
     cells: Annotated[int, Meta(ge=0, le=MAX_CELLS)] = 1
     backend: Backend = "sim"
+    backend_options: dict[str, str] = {}
     delay_s: Delay = 0.0
     timeout_s: Annotated[float, Meta(gt=0.0, le=MAX_WAIT_S)] = 120.0
     wait_for_cell_s: Annotated[float, Meta(ge=0.0, le=MAX_WAIT_S)] = 60.0

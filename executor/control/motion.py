@@ -1,13 +1,17 @@
-"""One physics step at a time: the impedance controller plus bookkeeping (sim time,
-step count, decimated logging).  Search, insertion and wiggle all move through it."""
+"""One control step at a time: an arm's impedance controller plus bookkeeping (time,
+step count, decimated logging).  Search, insertion, wiggle and the transfers all move
+through it, so they run unchanged on any arm behind :class:`ArmController`: the PyBullet
+cell's (:class:`executor.control.controller.ImpedanceController`, one physics step per
+control step) and a Franka's (:class:`executor.franka.arm.FrankyController`, paced by the
+robot's 1 kHz clock)."""
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
-from executor.control.controller import ImpedanceController
+from executor.control.gains import ImpedanceGains
 from executor.world.arm import ArmState
 from executor.world.scene import TIME_STEP
 
@@ -25,10 +29,40 @@ class StepLogger(Protocol):
                  force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray) -> None: ...
 
 
-class Motion:
+class ArmReader(Protocol):
+    """The arm's state as the skills read it (believed tool tip, contact wrench)."""
+
+    def read(self) -> ArmState: ...
+
+
+class ArmController(Protocol):
+    """What the skills drive: a Cartesian impedance about the tool tip whose ``gains``
+    (:class:`ImpedanceGains`) a skill may change, one :meth:`step` per control period
+    (:data:`TIME_STEP` of the skill's clock) toward a desired tip pose, and ``arm`` to read."""
+
+    gains: ImpedanceGains
+
+    @property
+    def arm(self) -> ArmReader: ...
+
+    def step(self, pos_des: np.ndarray, quat_des_xyzw: np.ndarray,
+             wrench_ff: np.ndarray | None = None) -> ArmState:
+        """One control period toward the tip pose [m, xyzw], plus an optional feed-forward
+        wrench [N, Nm] (world frame); returns the state read before it."""
+        ...
+
+    def reset(self) -> None:
+        """Forget what the controller cached about the arm's previous motion."""
+        ...
+
+
+C = TypeVar("C", bound=ArmController)
+
+
+class Motion(Generic[C]):
     """Steps the controller toward desired poses; counts sim time [s] and logs."""
 
-    def __init__(self, controller: ImpedanceController, logger: StepLogger | None = None) -> None:
+    def __init__(self, controller: C, logger: StepLogger | None = None) -> None:
         self.controller = controller
         self.logger = logger
         self.steps = 0
@@ -43,7 +77,7 @@ class Motion:
 
     def step(self, pos_des: np.ndarray, quat_des_xyzw: np.ndarray, wrench_ff: np.ndarray | None = None,
              phase: float = 0.0, wrench_des: np.ndarray | None = None) -> ArmState:
-        """One 1 ms step toward the pose (tip [m], quaternion); ``phase`` (0..1) and the
+        """One control step toward the pose (tip [m], quaternion); ``phase`` (0..1) and the
         desired wrench [N, Nm] only go to the log.  Returns the state before the step."""
         state = self.controller.step(pos_des, quat_des_xyzw, wrench_ff)
         if self.logger is not None and self.steps % LOG_EVERY == 0:

@@ -1,5 +1,5 @@
-"""The backend a cell node's settings name: ``sim`` (:mod:`.sim`), ``truth`` (:mod:`.truth`)
-or ``MODULE:CLASS`` (:mod:`executor.backend_plugin`): its settings
+"""The backend a cell node's settings name: ``sim`` (:mod:`.sim`), ``truth`` (:mod:`.truth`),
+``franka`` (:mod:`executor.franka.backend`) or ``MODULE:CLASS`` (:mod:`executor.backend_plugin`): its settings
 checked before the node opens its session, the backend started after the node claimed its
 cell id."""
 
@@ -33,6 +33,10 @@ def backend_starter(settings: ServeSettings) -> Callable[[], Backend]:
         if settings.ilc_state is not None:
             read_state(Path(settings.ilc_state), description.ilc, offset_bound(description.admittance))
         return lambda: SimBackend(settings, setup)
+    if settings.backend == "franka":
+        from executor.franka.backend import franka_starter
+
+        return franka_starter(settings)
     if settings.cell.description is not None:
         from executor.cell_description import load_cell_description
 

@@ -18,6 +18,7 @@ from bridge.cell_settings import (
 from bridge.cli_types import (
     ArgumentParser,
     add_assembly_argument,
+    backend_option,
     finite_float,
     nonempty_path,
     path_setting,
@@ -25,7 +26,6 @@ from bridge.cli_types import (
 from bridge.inputs import read_bytes
 from bridge.recording.sinks import add_viewer_arguments
 from bridge.session import DEFAULT_ENDPOINT, add_endpoint_arguments
-from executor.backend_plugin import backend_option
 from executor.serve.node import serve
 
 SETTINGS_HELP = ("the cell's settings as one document: a JSON object (ServeSettings, docs/cell.md), or a file "
@@ -38,11 +38,13 @@ def build_parser() -> argparse.ArgumentParser:
         f"(default: listen on {DEFAULT_ENDPOINT}).")
     parser.add_argument("--settings", metavar="JSON|FILE", help=SETTINGS_HELP)
     parser.add_argument("--cell", default="c1", help="cell id (default c1)")
-    parser.add_argument("--backend", default="sim", metavar="{sim,truth,MODULE:CLASS}",
-                        help="sim: PyBullet cell; truth: answer from the geometry, no simulation; MODULE:CLASS: "
-                             "your class driving a real cell (docs/backends.md) (default sim)")
+    parser.add_argument("--backend", default="sim", metavar="{sim,truth,franka,MODULE:CLASS}",
+                        help="sim: PyBullet cell; truth: answer from the geometry, no simulation; franka: a Franka "
+                             "arm through franky (docs/franka.md); MODULE:CLASS: your class driving a real cell "
+                             "(docs/backends.md) (default sim)")
     parser.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
-                        help="an option for a MODULE:CLASS backend, e.g. journal=runs/x/journal.jsonl (repeatable)")
+                        help="an option for the franka or a MODULE:CLASS backend, e.g. host=172.16.0.2 "
+                             "(repeatable)")
     add_assembly_argument(parser)
     parser.add_argument("--delay", type=finite_float(0, 3600), default=0.0, metavar="S",
                         help="truth backend: seconds each experiment takes (default 0)")

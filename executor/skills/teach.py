@@ -44,7 +44,7 @@ from executor.skills.dmp import (
 from executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
 from executor.world.assets import regenerate_assets
 from executor.world.geometry import CellGeometry, fit_pose
-from executor.world.scene import TIME_STEP, Scene
+from executor.world.scene import TIME_STEP
 
 DEMO_DURATION = 0.8  # [s], or longer for a travel longer than DEMO_SPEED allows in it
 DEMO_SPEED = 0.05
@@ -56,16 +56,25 @@ DEMO_CLEARANCE = 0.0005  # [m] left between the part and the hole bottom at the 
 
 
 class TeachingCell(Protocol):
-    """What teaching needs of a cell (:class:`executor.trial.Cell` is
-    one): its geometry and thresholds, and a part put in the hand (:meth:`motion_for`,
-    which sets ``scene`` to the PyBullet client holding it)."""
+    """What teaching needs of a cell (:class:`executor.trial.Cell` and
+    :class:`executor.franka.teach.FrankaTeacher` are ones): its geometry and thresholds, a
+    part put in the hand (:meth:`motion_for`), held at the demonstration's start
+    (:meth:`hold_at`) and let go at the end (:meth:`let_go`)."""
 
     geometry: CellGeometry
     thresholds: Thresholds
-    scene: Scene | None
 
     def motion_for(self, part: str) -> Motion:
         """Put the part in the hand; the Motion driving the arm that holds it."""
+        ...
+
+    def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
+        """The held part's tip at rest at ``tip`` [m] turned to ``quat_xyzw``, with the
+        grasp taken as exact and the teaching friction, and the wrench tared there."""
+        ...
+
+    def let_go(self) -> None:
+        """The part out of the hand (back where it waits)."""
         ...
 
 
@@ -121,32 +130,21 @@ def teach_shape(cell: TeachingCell, shape: str) -> Skill:
     origin = np.array([*(np.array(hole.position) + shift), hole.top_z])
     bottom = hole.depth
     motion = cell.motion_for(part.id)
-    assert cell.scene is not None  # set by motion_for
-    cell.scene.set_friction(None)  # the teaching friction, whatever ran before
-    arm = motion.controller.arm
-    arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
     yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
     quat = tool_quat(yaw)
-
-    def go_to_start() -> None:
-        arm.inverse_kinematics(start, quat)
-        motion.controller.reset()
-        motion.hold(start, quat, APPROACH_SETTLE_TIME)
-        arm.tare_sensor()
-
-    go_to_start()
+    cell.hold_at(motion, start, quat)
     times, positions, quats = _demonstrate(motion, origin, bottom, yaw)
     weights = fit_dmp(times, positions, quats)
     skill = Skill(shape, float(times[-1]), weights,
                   np.concatenate([positions[0], xyzw_to_wxyz(quats[0])]),
                   np.concatenate([positions[-1], xyzw_to_wxyz(quats[-1])]),
                   np.zeros(3), WrenchProfile.fit(np.zeros(1), np.zeros((1, 6))))
-    go_to_start()
+    cell.hold_at(motion, start, quat)
     phases, wrenches, end = _replay(motion, skill, origin, yaw)
     skill.wrench = WrenchProfile.fit(phases, wrenches)
     skill.end_position = end
-    cell.scene.release()
+    cell.let_go()
     goal = np.array([0.0, 0.0, -(bottom - DEMO_CLEARANCE)])
     skill.taught = TaughtOn(part.id, part.kind, part.sides, hole.id, hole.kind, hole.sides, hole.depth,
                             float(np.linalg.norm(end - goal)), cell.thresholds.goal_tolerance)

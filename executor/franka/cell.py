@@ -1,0 +1,233 @@
+"""The cell on a Franka arm: the product fixed on the table, its pegs standing on the table
+at their tray positions (``start`` of ``assembly.toml``), the Franka Hand picking them.
+
+One insertion runs as in the PyBullet cell (:mod:`executor.trial`), with the same skill
+code on the arm behind :class:`executor.franka.arm.FrankyController`: pick the part with the
+hand, carry it above the hole's calibrated position (franky's own Cartesian motions: exact
+positioning, planned within the arm's limits; the PyBullet cell's impedance-tracked
+transfers lag by millimetres here, and a part grasped off-centre tilts in the fingers),
+tare the wrench estimate, the hole search (:func:`executor.skills.search.hole_search`), the
+taught skill under the cell's execution layer
+(:func:`executor.skills.insertion.insert_in_layer`: DMP, admittance, phase stopping,
+eqs. (6)/(7), the wiggle, the goal check; ILC corrections per (part shape, hole) kept in
+memory), then the part is let go in the hole (a plan step) or carried back to its tray
+position (an experiment). What differs from the simulated cell: the grasp and the hole's
+position carry the real errors, none is drawn; the hole's position is where the product's
+geometry puts it, moved by the calibrated ``offset`` of the product frame in the robot's
+base frame (axes parallel).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from executor import ExecutorError
+from executor.assembly.transfer import SAFE_Z
+from executor.cell_description import CellDescription
+from executor.control.detector import Detector
+from executor.control.ilc import ExecutionLayer, Ilc
+from executor.control.motion import APPROACH_SETTLE_TIME, Motion
+from executor.franka.arm import FrankyArm, FrankyController
+from executor.franka.safety import Limits, Workspace
+from executor.skills.dmp import Skill, load_product_skill
+from executor.skills.insertion import InsertionResult, InsertionTask, insert_in_layer, needs_yaw_compliance
+from executor.skills.search import SearchResult, hole_search
+from executor.trial import APPROACH_HEIGHT
+from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat
+from executor.world.geometry import CellGeometry, PartSpec, fit_pose
+
+OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before a pick
+TOLERANCE = 0.002  # [m] a move ends when the measured tool tip is this close to its goal
+ARRIVAL = 30.0  # [s] of wall time a move waits for the arm to arrive after its path ended
+RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
+GRIPPER_SPEED = 0.05  # [m/s] of the fingers
+HELD_FRACTION = 0.3
+"""The hand holds the part when its width after closing is at least this fraction of the
+part's (closed on nothing it is about 0; franky-sim's fingers read 5.7 mm on a 10 mm peg)."""
+ABOVE_TRAY = 0.002  # [m] a part carried back is let go this far above the table
+
+
+@dataclass(frozen=True)
+class FrankaOptions:
+    """The Franka cell's settings (``--backend-option KEY=VALUE``, docs/franka.md):
+    ``host`` the arm's FCI address; ``offset`` [m] of the product frame in the robot's base
+    frame; ``grasp_force`` [N];
+    ``realtime``: libfranka's real-time check enforced (a real-time kernel; False for the
+    simulator); ``limits``, ``workspace``: :mod:`executor.franka.safety`."""
+
+    host: str
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    grasp_force: float = 40.0
+    realtime: bool = True
+    limits: Limits = field(default_factory=Limits)
+    workspace: Workspace = field(default_factory=Workspace)
+
+
+def connect(options: FrankaOptions) -> tuple[Any, Any]:
+    """franky's ``Robot`` and ``Gripper`` at ``options.host``, errors recovered, the
+    collision behaviour set; ExecutorError naming the host when the arm does not answer."""
+    import franky
+
+    config = franky.RealtimeConfig.Enforce if options.realtime else franky.RealtimeConfig.Ignore
+    limits = options.limits
+    try:
+        robot = franky.Robot(options.host, relative_dynamics_factor=limits.dynamics, realtime_config=config)
+        robot.recover_from_errors()
+        robot.set_collision_behavior([limits.torque_threshold] * 7, [limits.force_threshold] * 6)
+        gripper = franky.Gripper(options.host)
+    except (franky.Exception, franky.GripperException) as exc:
+        raise ExecutorError(f"franka: cannot drive the arm at {options.host} ({exc}); expected a Franka with FCI "
+                            "enabled (docs/franka.md)") from None
+    return robot, gripper
+
+
+class FrankaCell:
+    """The arm, its hand and the product (``geometry``), with the cell ``description``'s
+    gains, thresholds and admittance and the execution ``layer``."""
+
+    def __init__(self, geometry: CellGeometry, description: CellDescription, layer: ExecutionLayer,
+                 options: FrankaOptions) -> None:
+        self.geometry, self.description, self.layer, self.options = geometry, description, layer, options
+        self.robot, self.gripper = connect(options)
+        self.arm = FrankyArm(self.robot)
+        self.controller = FrankyController(self.arm, description.gains, options.workspace)
+        self.motion: Motion[FrankyController] = Motion(self.controller)
+        self.ilc = Ilc(description.ilc, description.gains, description.admittance)
+        self._skills: dict[str, Skill] = {}
+        self.held: str | None = None
+
+    def to_base(self, point: np.ndarray) -> np.ndarray:
+        """A point [m] of the product frame in the robot's base frame."""
+        return np.asarray(point, dtype=float) + np.array(self.options.offset)
+
+    def skill(self, shape: str) -> Skill:
+        if shape not in self._skills:
+            self._skills[shape] = load_product_skill(self.geometry, shape)
+        return self._skills[shape]
+
+    def move_to(self, tip: np.ndarray, yaw: float | None = None) -> None:
+        """The tool tip [m] in a straight line to ``tip``, the tool pointing down turned to
+        ``yaw`` [rad] (None: as it is), by franky's own Cartesian motion (its path planned
+        within the arm's limits scaled by the dynamics factor; the impedance tracking is
+        stopped meanwhile); returns once the measured tip is within :data:`TOLERANCE`
+        (franky returns when the path ends, the arm trails it). SafetyStop when the goal
+        is outside the workspace (the straight line between two points of the box stays in it)."""
+        import franky
+
+        self.options.workspace.check(tip)
+        self.controller.stop()
+        yaw = self.motion.tool_yaw if yaw is None else yaw
+        quat = tool_quat(yaw)
+        ee = tip - quat_to_matrix(quat)[:, 2] * self.arm.tcp
+        self.robot.move(franky.CartesianMotion(franky.Affine(ee, quat), franky.ReferenceType.Absolute,
+                                               franky.RelativeDynamicsFactor(self.options.limits.dynamics)))
+        self.motion.tool_yaw = yaw
+        deadline = time.monotonic() + ARRIVAL
+        while np.linalg.norm(self.arm.read().tip_pos - tip) > TOLERANCE:
+            if time.monotonic() > deadline:
+                raise ExecutorError(f"the arm did not reach {np.round(tip, 4).tolist()} m (at "
+                                    f"{np.round(self.arm.read().tip_pos, 4).tolist()} m)")
+            time.sleep(0.01)
+
+    def carry_to(self, goal: np.ndarray, yaw: float = 0.0) -> None:
+        """Up to the carrying height, across turning the tool to ``yaw`` [rad], down to
+        ``goal`` [m]."""
+        here = self.arm.read().tip_pos
+        high = max(SAFE_Z + self.options.offset[2], float(goal[2]), float(here[2]))
+        if here[2] < high - 1e-3:
+            self.move_to(np.array([here[0], here[1], high]))
+        self.move_to(np.array([goal[0], goal[1], high]), yaw)
+        self.move_to(goal)
+
+    def _open(self, width: float) -> None:
+        if not self.gripper.move(width, GRIPPER_SPEED):
+            raise ExecutorError(f"the hand did not open to {width * 1000:.0f} mm")
+
+    def pick(self, part: str) -> None:
+        """Open the hand, carry it to the part's grip point on the table, close it on the
+        part; the tool tip becomes the part's tip. ExecutorError when the hand holds nothing."""
+        spec = self.geometry.parts[part]
+        self.arm.set_tcp(0.0)
+        width = max(spec.sides)
+        self._open(width + OPEN_MARGIN)
+        grip = self.to_base(np.array([*spec.start, spec.length - self.geometry.gripper.grasp_depth]))
+        self.carry_to(grip + np.array([0.0, 0.0, 0.05]))
+        self.move_to(grip)
+        # Closed toward zero width with the grasp force, held when the fingers stopped on
+        # the part (the hand's width) rather than on nothing; franky-sim's fingers are a
+        # spring toward the commanded width, which squeezes only when it is below the part's.
+        self.gripper.grasp(0.0, GRIPPER_SPEED, self.options.grasp_force, epsilon_inner=0.001,
+                           epsilon_outer=width + OPEN_MARGIN)
+        if self.gripper.width < HELD_FRACTION * width:
+            self._open(width + OPEN_MARGIN)
+            raise ExecutorError(f"the hand closed on nothing at part {part}'s place on the table "
+                                f"({np.round(grip, 4).tolist()} m)")
+        self.held = part
+        self.arm.set_tcp(self.lever(spec))
+
+    def lever(self, spec: PartSpec) -> float:
+        """[m] from the grip point to the part's tip."""
+        return spec.length - self.geometry.gripper.grasp_depth
+
+    def release(self) -> None:
+        """Open the hand where it is and go up by :data:`RETREAT`."""
+        if self.held is None:
+            return
+        spec = self.geometry.parts[self.held]
+        self._open(max(spec.sides) + OPEN_MARGIN)
+        self.held = None
+        self.arm.set_tcp(0.0)
+        self.move_to(self.arm.read().tip_pos + np.array([0.0, 0.0, RETREAT]))
+
+    def put_back(self) -> None:
+        """Carry the held part back to its place on the table and let it go."""
+        if self.held is None:
+            return
+        spec = self.geometry.parts[self.held]
+        self.carry_to(self.to_base(np.array([*spec.start, ABOVE_TRAY])))
+        self.release()
+
+    def insert(self, part: str, hole: str, rng: np.random.Generator) -> tuple[InsertionResult, Detector,
+                                                                                SearchResult]:
+        """One attempt with the held part: above the hole, the search, the skill; the ILC
+        correction of (part shape, hole) updated after a success with ILC."""
+        spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
+        skill = self.skill(spec.shape).in_hole(hole_spec.depth)
+        turn, shift = fit_pose(spec, hole_spec)
+        est = self.to_base(np.array([*(np.array(hole_spec.position) + shift), hole_spec.top_z]))
+        yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn)
+        quat = tool_quat(yaw)
+        approach = est + np.array([0.0, 0.0, APPROACH_HEIGHT])
+        self.carry_to(approach, yaw=yaw)
+        self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
+        self.arm.tare_sensor()
+        found = hole_search(self.motion, est[:2], est[2], approach[2], quat, rng)
+        key = f"{spec.shape}:{hole}"
+        correction = self.ilc.correction(key)[0] if self.layer.ilc else None
+        task = InsertionTask(np.array([found.hole_xy[0], found.hole_xy[1], est[2]]), self.lever(spec), yaw,
+                             needs_yaw_compliance(spec.kind, hole_spec.kind), correction)
+        detector = Detector(self.description.thresholds)
+        result = insert_in_layer(self.motion, skill, detector, task, self.layer, description=self.description)
+        if result.reached and result.trace is not None:
+            self.ilc.update(key, result.trace)
+        return result, detector, found
+
+    def lift(self) -> None:
+        """The tool straight up to the carrying height."""
+        here = self.arm.read().tip_pos
+        self.move_to(np.array([here[0], here[1], SAFE_Z + self.options.offset[2]]))
+
+    def stop(self) -> None:
+        """Stop the arm (the tracking motion ends, the arm comes to rest) and clear its
+        errors; what is held stays held."""
+        import franky
+
+        try:
+            self.controller.stop()
+        except franky.Exception:
+            pass  # the motion already ended with the error being handled
+        self.robot.recover_from_errors()

@@ -1,0 +1,82 @@
+"""The franka backend against franky-sim, without Zenoh: an experiment whose part cannot
+pass (the square peg, diagonal 17 mm, onto a round hole of 13.3 mm) stops on eq. (6) and
+answers no_fit with the part back on the table, standing; a plan step that puts a round
+peg into a round hole is checked in the simulated world (not the robot's reading), within
+2 mm of its goal: expected to fail until franky-sim's hand holds a peg firmly
+(docs/franka.md, "What does not hold yet").
+
+Long (the simulator steps at about a tenth of real time on a shared 2-core machine: 2-4 min
+each); in one xdist group (with ``--dist loadgroup``) with the other franky loop."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("franky")
+pytest.importorskip("mujoco")
+
+from bridge.assembly import DATA_DIR  # noqa: E402
+from bridge.cell_settings import CellSettings, ServeSettings  # noqa: E402
+from bridge.messages import InsertRequest, StepRequest  # noqa: E402
+from executor.control.detector import Thresholds  # noqa: E402
+from executor.franka.backend import FrankaBackend, franka_starter  # noqa: E402
+from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
+from executor.world.geometry import CellGeometry, load_geometry  # noqa: E402
+
+GRASP_DEPTH = 0.012  # [m] the Franka Hand's pads reach 8.5 mm below its TCP: they clear the plate so
+PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
+BACK = 0.015
+"""[m] a part carried back lies this close to where it waited, at most: franky-sim's hand lets
+the peg slide along its pads under the insertion's forces (13 mm measured, docs/franka.md)."""
+
+
+@pytest.fixture
+def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
+    """franky-sim with the spare-hole plate and a franka backend driving it."""
+    folder = Path(shutil.copytree(DATA_DIR / "spare", tmp_path / "spare", ignore=shutil.ignore_patterns("assets")))
+    description = tmp_path / "franka-cell.toml"
+    description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
+                           f"grasp_depth = {GRASP_DEPTH}\n")
+    with sim_robot(folder) as sim:
+        settings = ServeSettings(backend="franka", assembly=str(folder),
+                                 backend_options={"host": sim.host, "realtime": "ignore", "dynamics": "0.5"},
+                                 cell=CellSettings(layer="pi_phase_stop", description=str(description)))
+        backend = franka_starter(settings)()
+        try:
+            yield sim, backend, load_geometry(str(folder))
+        finally:
+            backend.close()
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1200)
+@pytest.mark.xdist_group("franka")
+def test_a_part_too_big_stops_on_force_and_goes_back(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
+    sim, backend, geometry = spare_arm
+    result, evidence = backend.run(InsertRequest(id="a", part="p3", hole="r1"))
+    assert result == "no_fit" and evidence is not None, evidence
+    assert evidence.max_force_dev >= Thresholds().f_stop, evidence  # eq. (6) stopped it
+    back, quat = sim.truth().poses["p3"]
+    assert np.linalg.norm(back[:2] - np.array(geometry.parts["p3"].start)) < BACK, back
+    assert abs(back[2]) < 0.001 and abs(quat[0]) > np.cos(np.radians(5) / 2), (back, quat)  # standing
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="franky-sim's hand lets the peg pivot and slide in the fingers: the step came back fit "
+                   "with the peg on the plate, then no_fit (docs/franka.md, 'What does not hold yet')")
+@pytest.mark.timeout(1200)
+@pytest.mark.xdist_group("franka")
+def test_a_plan_step_places_a_peg_in_its_hole(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
+    sim, backend, geometry = spare_arm
+    assert backend.run_step(StepRequest(id="s1", assembly="run", step=1, part="bp"))[0] == "fit"
+    outcome, step, placed = backend.run_step(StepRequest(id="s2", assembly="run", step=2, part="p1", hole="r1"))
+    assert outcome == "fit" and set(placed) == {"bp", "p1"}, step
+    hole = geometry.holes["r1"]
+    goal = np.array([*hole.position, hole.bottom_z])  # the peg's body frame: its bottom face's centre
+    position = sim.truth().poses["p1"][0]
+    assert np.linalg.norm(position - goal) <= PLACED, (position, goal)

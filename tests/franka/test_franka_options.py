@@ -1,0 +1,47 @@
+"""The franka backend's options and safety checks, without an arm: each bad value named."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from executor import ExecutorError
+from executor.franka.backend import franka_options
+from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS, SafetyStop, Workspace, capped
+
+
+def test_options_parse_into_the_cell_settings() -> None:
+    options = franka_options({"host": "172.16.0.2", "offset": "0.01,-0.02,0.005",
+                              "realtime": "ignore", "dynamics": "0.1", "workspace": "0.1,-0.5,0,0.8,0.5,0.6"})
+    assert options.host == "172.16.0.2" and options.offset == (0.01, -0.02, 0.005)
+    assert not options.realtime and options.limits.dynamics == 0.1
+    assert options.workspace.low == (0.1, -0.5, 0.0) and options.workspace.high == (0.8, 0.5, 0.6)
+    assert franka_options({"host": "x"}).realtime  # the real-time check is on unless switched off
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({}, "needs --backend-option host=ADDRESS"),
+    ({"host": "x", "speed": "1"}, "speed: unknown to the franka backend"),
+    ({"host": "x", "grasp-force": "200"}, r"grasp-force=200: expected a number in \(0, 70\]"),
+    ({"host": "x", "grasp-force": "firm"}, "grasp-force=firm: expected 1 comma-separated numbers"),
+    ({"host": "x", "offset": "0,0"}, "offset=0,0: expected 3 comma-separated numbers"),
+    ({"host": "x", "realtime": "maybe"}, "realtime=maybe: expected enforce or ignore"),
+    ({"host": "x", "dynamics": "0"}, r"dynamics=0: expected a number in \(0, 1\]"),
+    ({"host": "x", "force-threshold": "500"}, r"force-threshold=500: expected a number in \(0, 100\]"),
+    ({"host": "x", "workspace": "1,1,1,0,0,0"}, "expected low < high on every axis"),
+])
+def test_a_bad_option_is_named(options: dict[str, str], message: str) -> None:
+    with pytest.raises(ExecutorError, match=message):
+        franka_options(options)
+
+
+def test_a_pose_outside_the_workspace_is_stopped_before_it_is_sent() -> None:
+    box = Workspace((0.2, -0.5, 0.0), (0.8, 0.5, 0.6))
+    box.check(np.array([0.5, 0.0, 0.1]))
+    with pytest.raises(SafetyStop, match=r"outside the workspace"):
+        box.check(np.array([0.5, 0.0, -0.001]))
+
+
+def test_the_stiff_layer_is_capped_to_what_the_arm_is_sent() -> None:
+    assert capped(20000.0, 600.0) == (MAX_TRANSLATIONAL_STIFFNESS, 300.0)
+    assert capped(2000.0, 60.0) == (2000.0, 60.0)
