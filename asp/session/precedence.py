@@ -35,12 +35,16 @@ from asp.precedence.demos import Demonstrations
 from asp.precedence.explore.knowledge import Evidence, Trial
 from asp.precedence.explore.learner import Learned, geometric_reasons, learn_sources
 from asp.precedence.explore.select import explore
+from asp.precedence.explore.trials import load_trials, write_trials
 from asp.precedence.relation import Relation, load_relation
 from bridge import BridgeError
 from bridge.client import CellRefused, CellTimeout, request_experiment
 from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment, PrecedenceOutcome
 
 LOG = logging.getLogger(__name__)
+PRECEDENCE_JOURNAL = "precedence_experiments.lp"
+"""``RUN/precedence_experiments.lp``: every precedence experiment of a session and its
+outcome (:mod:`asp.precedence.explore.trials`), rewritten whole (atomically) after each."""
 SEND_ATTEMPTS = 3
 """An experiment whose reply is lost is sent this many times in all."""
 
@@ -133,16 +137,26 @@ class ExploredPrecedence:
 
 
 def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOracle,
-                       policy: str = "informative", run_id: str = "explore") -> ExploredPrecedence:
+                       policy: str = "informative", run_id: str = "explore",
+                       journal: Path | None = None) -> ExploredPrecedence:
     """Learn the must-precede relation from ``demos``, the geometric precedence in ``prior``
     (None: no CAD) and the experiments the ASP ``policy`` chooses, run by ``oracle``
     (:func:`asp.precedence.explore.select.explore`) until no pair is open; PlannerError when
-    one is left open, PrecedenceConflict where the sources disagree."""
+    one is left open, PrecedenceConflict where the sources disagree. ``journal`` (a
+    :data:`PRECEDENCE_JOURNAL`): the experiments it holds are evidence and never run again
+    (a resumed session), and every new one is written there before it is learned from;
+    ``sim_s`` and ``wall_s`` count this call's experiments only."""
     geometry = () if prior is None else tuple(load_relation([prior], data=True).pairs())
     evidence = Evidence(demos, geometry, str(prior or "the geometric precedence"),
                         geometric_reasons(None if prior is None else str(prior)))
-    for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=1):
+    if journal is not None and journal.is_file():
+        for trial in load_trials(journal, demos.parts):
+            evidence = evidence.with_trial(trial)
+        LOG.info("resumed: %d precedence experiment(s) from %s", len(evidence.trials), journal)
+    for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=len(evidence.trials) + 1):
         LOG.info("precedence experiment %d on %s: %s", number, oracle.cell, trial.describe())
+        if journal is not None:
+            write_trials(journal, (*evidence.trials, trial))
         evidence = evidence.with_trial(trial)
     learned = learn_sources(evidence)
     if learned.knowledge.open:
