@@ -89,11 +89,13 @@ StepOutcome = tuple[Result, StepEvidence, dict[str, float]]
 @dataclass(frozen=True)
 class ExperimentRun:
     """What a cell saw carrying out a precedence experiment: the 1-based ``failed_step`` of
-    its sequence and the ``reason`` (None, None: every step done), a one-line ``detail`` and
-    the simulated time ``sim_s`` [s]."""
+    its sequence and the ``reason`` (None, None: every step done), the placed parts the
+    failing part touched where it stopped (``blocked_by``, observed), a one-line ``detail``
+    and the simulated time ``sim_s`` [s]."""
 
     failed_step: int | None = None
     reason: FailureReason | None = None
+    blocked_by: tuple[str, ...] = ()
     detail: str = ""
     sim_s: float = 0.0
 

@@ -8,12 +8,9 @@ session's assignment, and the cell's outcome comes back.
 With ``by_hand`` (the default) the steps before the tested one, an order the planner
 knows feasible, are not assembled: the cell sets those parts at their goals by hand (the
 experiment's ``placed``) and assembles only the tested step, so an experiment costs one
-step of physics; the outcome is returned numbered as for the whole sequence. With
-``then_first`` (the default) the cell then places the pair's first part too ("B then A"):
-a precedence the physics enforces only at that later step (a cover goes in without the part
-under it, which then cannot go in) would otherwise pass as a success and the pair be
-learned free; such a failure stops the exploration with a PlannerError naming it, as the
-planner's model reads only a failure of the tested step. A known state
+step of physics (two in "B then A", the planner's experiments,
+:func:`asp.precedence.explore.select.experiment_for`); the outcome is returned numbered as
+for the whole sequence. A known state
 that does not hold at the cell (a part set there does not stay) is a PlannerError naming
 the cell's words: the planner believed that order feasible, so it is a conflict, never
 read as evidence on the pair. A lost reply is sent again under the same id (the cell
@@ -38,12 +35,16 @@ from asp.precedence.demos import Demonstrations
 from asp.precedence.explore.knowledge import Evidence, Trial
 from asp.precedence.explore.learner import Learned, geometric_reasons, learn_sources
 from asp.precedence.explore.select import explore
+from asp.precedence.explore.trials import load_trials, write_trials
 from asp.precedence.relation import Relation, load_relation
 from bridge import BridgeError
 from bridge.client import CellRefused, CellTimeout, request_experiment
 from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment, PrecedenceOutcome
 
 LOG = logging.getLogger(__name__)
+PRECEDENCE_JOURNAL = "precedence_experiments.lp"
+"""``RUN/precedence_experiments.lp``: every precedence experiment of a session and its
+outcome (:mod:`asp.precedence.explore.trials`), rewritten whole (atomically) after each."""
 SEND_ATTEMPTS = 3
 """An experiment whose reply is lost is sent this many times in all."""
 
@@ -55,9 +56,9 @@ class CellOracle:
     reported spending [s]."""
 
     def __init__(self, session: zenoh.Session, cell: str, holes: Mapping[str, str], *, seed: int = 0,
-                 timeout_s: float = 300.0, by_hand: bool = True, then_first: bool = True) -> None:
+                 timeout_s: float = 300.0, by_hand: bool = True) -> None:
         self.session, self.cell, self.holes = session, cell, dict(holes)
-        self.seed, self.timeout_s, self.by_hand, self.then_first = seed, timeout_s, by_hand, then_first
+        self.seed, self.timeout_s, self.by_hand = seed, timeout_s, by_hand
         self.sim_s = 0.0
         self.wall_s = 0.0
 
@@ -67,9 +68,8 @@ class CellOracle:
         steps = tuple(ExperimentStep(s.part, s.hole or self.holes.get(s.part)) for s in experiment.sequence)
         placed = tuple(ExperimentStep(s.part, s.hole or self.holes.get(s.part)) for s in experiment.placed)
         if self.by_hand:
-            placed, steps = placed + steps[:-1], steps[-1:]
-        if self.then_first and not experiment.then_first:
-            steps += (ExperimentStep(experiment.pair[0], self.holes.get(experiment.pair[0])),)
+            kept = 1 + int(experiment.then_first)
+            placed, steps = placed + steps[:-kept], steps[-kept:]
         return msgspec.structs.replace(experiment, sequence=steps, placed=placed, seed=self.seed,
                                        timeout_s=self.timeout_s)
 
@@ -92,16 +92,9 @@ class CellOracle:
                 raise PlannerError(f"experiment {experiment.id} ({experiment.tested}): {exc}") from None
         self.sim_s += outcome.sim_s
         self.wall_s += outcome.wall_s
-        added = int(sent.then_first and not experiment.then_first)
-        if added and outcome.failed_step == len(sent.sequence):
-            a, b = experiment.pair
-            raise PlannerError(f"experiment {experiment.id} ({experiment.tested}): {b} went in without {a}, but "
-                               f"{a} then did not ({outcome.reason}: {outcome.detail}); the precedence shows at "
-                               f"{a}'s step, which the experiment (it reads a failure of {b}) cannot take as "
-                               f"evidence: stopped rather than learn {a}<{b} free")
         if outcome.outcome == "success" or outcome.failed_step is None:
             return outcome
-        skipped = len(experiment.sequence) - (len(sent.sequence) - added)
+        skipped = len(experiment.sequence) - len(sent.sequence)
         return msgspec.structs.replace(outcome, failed_step=outcome.failed_step + skipped)
 
 
@@ -144,16 +137,26 @@ class ExploredPrecedence:
 
 
 def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOracle,
-                       policy: str = "informative", run_id: str = "explore") -> ExploredPrecedence:
+                       policy: str = "informative", run_id: str = "explore",
+                       journal: Path | None = None) -> ExploredPrecedence:
     """Learn the must-precede relation from ``demos``, the geometric precedence in ``prior``
     (None: no CAD) and the experiments the ASP ``policy`` chooses, run by ``oracle``
     (:func:`asp.precedence.explore.select.explore`) until no pair is open; PlannerError when
-    one is left open, PrecedenceConflict where the sources disagree."""
+    one is left open, PrecedenceConflict where the sources disagree. ``journal`` (a
+    :data:`PRECEDENCE_JOURNAL`): the experiments it holds are evidence and never run again
+    (a resumed session), and every new one is written there before it is learned from;
+    ``sim_s`` and ``wall_s`` count this call's experiments only."""
     geometry = () if prior is None else tuple(load_relation([prior], data=True).pairs())
     evidence = Evidence(demos, geometry, str(prior or "the geometric precedence"),
                         geometric_reasons(None if prior is None else str(prior)))
-    for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=1):
+    if journal is not None and journal.is_file():
+        for trial in load_trials(journal, demos.parts):
+            evidence = evidence.with_trial(trial)
+        LOG.info("resumed: %d precedence experiment(s) from %s", len(evidence.trials), journal)
+    for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=len(evidence.trials) + 1):
         LOG.info("precedence experiment %d on %s: %s", number, oracle.cell, trial.describe())
+        if journal is not None:
+            write_trials(journal, (*evidence.trials, trial))
         evidence = evidence.with_trial(trial)
     learned = learn_sources(evidence)
     if learned.knowledge.open:

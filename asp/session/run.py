@@ -51,7 +51,13 @@ from asp.session.cells import CellProcess, cell_seed, stop_all
 from asp.session.folder import RunLock, lock_run_folder
 from asp.session.journal import JOURNAL_NAME, Journal
 from asp.session.log import PlannerLog
-from asp.session.precedence import CellOracle, ExploredPrecedence, explore_demos, explore_precedence
+from asp.session.precedence import (
+    PRECEDENCE_JOURNAL,
+    CellOracle,
+    ExploredPrecedence,
+    explore_demos,
+    explore_precedence,
+)
 from asp.session.settings import (
     MAX_STARTS,
     SESSION_FILE,
@@ -131,9 +137,9 @@ def _run_folder(settings: SessionSettings) -> tuple[Path, SessionFile, RunLock, 
 
 def _holds_session(run: Path) -> bool:
     """Whether ``run`` holds a session to resume rather than overwrite: a journal with
-    at least one line, or a ``session.json`` with status ``done``."""
+    at least one line, a precedence journal, or a ``session.json`` with status ``done``."""
     journal = run / JOURNAL_NAME
-    if journal.is_file() and journal.stat().st_size > 0:
+    if (journal.is_file() and journal.stat().st_size > 0) or (run / PRECEDENCE_JOURNAL).is_file():
         return True
     try:
         return read_session_file(run).status == "done"
@@ -326,7 +332,8 @@ def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Dem
         raise PlannerError(f"--precedence explore: the learned sizes give no hole assignment to experiment "
                            f"with: {exc}") from None
     oracle = CellOracle(session, cells[0], assignment, seed=record.seed, timeout_s=timeout_s)
-    explored = explore_precedence(demos, prior, oracle, run_id=f"{record.recording_id}.p")
+    explored = explore_precedence(demos, prior, oracle, run_id=f"{record.recording_id}.p",
+                                  journal=learned.parent / PRECEDENCE_JOURNAL)
     LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)",
              len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})", len(explored.trials),
              cells[0], explored.sim_s)

@@ -15,8 +15,18 @@ refused (``invalid_step``): it is no state the product can be in, and no evidenc
   before ``a``), or ``failed``, with the 1-based ``failed_step`` and the ``reason``:
   ``blocked`` (the part could not reach its place: a placed part is in the way),
   ``jammed`` (it reached the entry and stuck), ``unsupported`` (it did not stay where it
-  was put: nothing under it yet). A failure at a step before the last says the known state
-  could not be reached: the planner reports it, it is no evidence on the pair.
+  was put: nothing under it yet), and ``blocked_by``, the placed parts the failing part
+  touched where it stopped, as the cell observed them (a field, never read from the
+  ``detail`` prose). A failure at a step before the tested one says the known state could
+  not be reached: the planner reports it, it is no evidence on the pair.
+
+"B then A": a precedence the physics shows only when the first part comes second (a
+cover goes in without the part under it, which then cannot go in). The planner reads a
+failure of ``a``'s step, after ``b``, as ``a`` must precede ``b`` only when the cell saw
+``a`` blocked by ``b`` alone (``blocked_by == (b,)``); any other cause, or none observed,
+decides nothing. A ``truth`` cell states a precedence at the later part's step (reason
+``precedence``, :func:`first_missing`): with every part that precedes ``a`` placed, its
+``a`` step never fails.
 
 Both are serialised with :func:`bridge.messages.encode`. A bad message is refused with
 :class:`bridge.messages.ErrorReply`, as every other request (:func:`decode_experiment`,
@@ -25,6 +35,7 @@ Both are serialised with :func:`bridge.messages.encode`. A bad message is refuse
 
 from __future__ import annotations
 
+from collections.abc import Collection, Mapping
 from typing import Annotated, Final, Literal
 
 import msgspec
@@ -124,6 +135,9 @@ class PrecedenceOutcome(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
     failed_step: Annotated[Annotated[int, msgspec.Meta(ge=1, le=MAX_STEPS)] | None,
                            msgspec.Meta(description="the 1-based step that failed; null on success")] = None
     reason: Annotated[FailureReason | None, msgspec.Meta(description="why it failed; null on success")] = None
+    blocked_by: Annotated[tuple[AspId, ...], msgspec.Meta(max_length=MAX_STEPS, description=(
+        "the placed parts the failed step's part touched where it stopped, as observed; empty: none seen "
+        "(or not blocked)"))] = ()
     detail: Annotated[str, msgspec.Meta(max_length=MAX_ERROR_CHARS,
                                         description="what the cell saw, one line (may be empty)")] = ""
     sim_s: Annotated[NonNegative, msgspec.Meta(description="simulated (physics) time spent [s]; 0 for truth")] = 0.0
@@ -134,6 +148,23 @@ class PrecedenceOutcome(msgspec.Struct, frozen=True, forbid_unknown_fields=True,
         if (self.outcome == "failed") != (self.failed_step is not None and self.reason is not None):
             raise ValueError(f"outcome {self.outcome} with failed_step {self.failed_step} and reason {self.reason}: "
                              "expected both set exactly when the outcome is failed")
+        if self.blocked_by and self.outcome != "failed":
+            raise ValueError(f"blocked_by {' '.join(self.blocked_by)} on a success: expected it empty")
+
+
+def first_missing(experiment: PrecedenceExperiment,
+                  before: Mapping[str, Collection[str]]) -> tuple[int, str, list[str]] | None:
+    """The first step of ``experiment`` whose part needs a part not yet placed (set by hand
+    or by an earlier step): its 1-based number, its part and the missing parts of
+    ``before[part]`` (the parts that must precede it), sorted; None when no step does. How a
+    cell that knows the precedence answers (``reason`` ``precedence``)."""
+    placed = {step.part for step in experiment.placed}
+    for number, step in enumerate(experiment.sequence, 1):
+        missing = sorted(set(before.get(step.part, ())) - placed)
+        if missing:
+            return number, step.part, missing
+        placed.add(step.part)
+    return None
 
 
 _EXPERIMENT_DECODER = msgspec.json.Decoder(PrecedenceExperiment)

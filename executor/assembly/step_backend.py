@@ -118,7 +118,7 @@ class AssemblyRunner:
                              else "put back on the tray")
                     detail = (f"{step.part} {record.reason} after {record.attempts} attempt(s): largest force "
                               f"deviation {record.max_force_dev:.1f} N, {where}{touched}")
-                    return ExperimentRun(k, record.reason, detail, sim_s)
+                    return ExperimentRun(k, record.reason, record.involved, detail, sim_s)
             return ExperimentRun(sim_s=sim_s)
         finally:
             assembler.close()

@@ -152,7 +152,7 @@ class CellNode:
             run = run_precedence(request)
             return PrecedenceOutcome(id=request.id, cell=self.cell_id, pair=request.pair,
                                      outcome="success" if run.failed_step is None else "failed",
-                                     failed_step=run.failed_step, reason=run.reason,
+                                     failed_step=run.failed_step, reason=run.reason, blocked_by=run.blocked_by,
                                      detail=run.detail[:MAX_ERROR_CHARS], sim_s=run.sim_s,
                                      wall_s=time.perf_counter() - started)
         if isinstance(request, StepRequest):

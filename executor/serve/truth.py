@@ -16,7 +16,7 @@ from bridge.assembly import load_assembly
 from bridge.cell_settings import ServeSettings
 from bridge.inputs import read_bytes
 from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
-from bridge.precedence.experiment import FailureReason, PrecedenceExperiment
+from bridge.precedence.experiment import FailureReason, PrecedenceExperiment, first_missing
 from bridge.recording.sinks import NO_VIEWER, Viewer
 from executor import ExecutorError
 from executor.backend_plugin import (
@@ -73,7 +73,8 @@ class TruthBackend:
     part goes onto); logs every outcome to Rerun if
     ``settings.rrd`` or ``settings.viewer_url`` is given; a hole of ``settings.block_holes``
     refuses every plan step. A precedence experiment's step fails when a part that must
-    precede it (:func:`precedence_truth`) is not placed (``precedence``) or its peg does not
+    precede it (:func:`precedence_truth`) is not placed (``precedence``, at the later part's
+    step, :func:`bridge.precedence.experiment.first_missing`) or its peg does not
     pass its hole (``size``) or its hole is blocked (``blocked``); a placed part missing such a
     part does not stay."""
 
@@ -166,15 +167,18 @@ class TruthBackend:
             raise InvalidStep(f"the known state does not hold: {', '.join(unstable)} placed without "
                               f"{', '.join(sorted(set().union(*(self._missing(p, placed) for p in unstable))))}, "
                               "which the product's precedence puts first")
+        before = {p: {a for a in self._parts if (a, p) in self._precedence} for p in self._parts}
+        first = first_missing(experiment, before)
         for k, step in enumerate(experiment.sequence, start=1):
-            missing = self._missing(step.part, placed)
+            if first is not None and first[0] == k:
+                return ExperimentRun(k, "precedence", detail=f"{step.part} precedence (without "
+                                     f"{' '.join(first[2])}; the truth backend, no physics)")
             reason: FailureReason | None = (
-                "precedence" if missing else "blocked" if step.hole in self._blocked else
+                "blocked" if step.hole in self._blocked else
                 "size" if step.hole is not None and (step.part, step.hole) not in self._fits else None)
             if reason is not None:
-                why = f"without {' '.join(missing)}" if missing else f"into {step.hole}"
-                return ExperimentRun(k, reason, f"{step.part} {reason} ({why}; the truth backend, no physics)")
-            placed.add(step.part)
+                return ExperimentRun(k, reason, detail=f"{step.part} {reason} (into {step.hole}; the truth "
+                                     "backend, no physics)")
         return ExperimentRun()
 
     def _missing(self, part: str, placed: set[str]) -> list[str]:

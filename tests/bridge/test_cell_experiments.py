@@ -9,7 +9,6 @@ import queue
 
 import pytest
 
-from asp import PlannerError
 from asp.session.precedence import CellOracle
 from bridge.client import CellRefused, request_experiment
 from bridge.messages import ErrorReply
@@ -67,6 +66,12 @@ def test_truth_cell_answers_experiments_from_the_precedence_and_refuses_bad_ones
         assert oracle.sent(tested).placed == (ExperimentStep("bp"), ExperimentStep("p3", "s1"))
         outcome = oracle.run(tested)
         assert (outcome.outcome, outcome.failed_step, outcome.reason) == ("failed", 3, "precedence")
+        # "B then A" at the truth cell: the precedence shows at the later part's step, blamed on no part
+        then_a = PrecedenceExperiment(id="o2", pair=("p4", "sp"), sequence=tuple(
+            ExperimentStep(p) for p in ("bp", "p3", "sp", "p4")))
+        outcome = oracle.run(then_a)
+        assert (outcome.outcome, outcome.failed_step, outcome.reason, outcome.blocked_by) == (
+            "failed", 3, "precedence", ())
 
 
 @pytest.mark.slow
@@ -80,10 +85,12 @@ def test_sim_cell_observes_why_a_step_fails() -> None:
         with pytest.raises(CellRefused) as refused:  # a peg set by hand where the plate is not
             request_experiment(session, "c1", experiment("s2", ("bp", "p2"), "p2", placed="p1"), 300)
         assert refused.value.reply.code == "invalid_step" and "p1 did not stay" in refused.value.reply.error
-        # fp goes in without sp (it rests on pd and the pins), but sp then cannot: the session's
-        # oracle places sp after fp ("B then A") and stops rather than learn sp<fp free
+        # fp goes in without sp (it rests on pd and the pins), but sp then cannot: "B then A"
+        # sees sp blocked, and the cell names fp as the part it touched
         oracle = CellOracle(session, "c1", HOLES, seed=1, timeout_s=300)
         before_fp = PrecedenceExperiment(id="s3", pair=("sp", "fp"), sequence=tuple(
-            ExperimentStep(p) for p in ("bp", "p1", "p2", "p3", "p4", "sh", "ph", "pd", "fp")))
-        with pytest.raises(PlannerError, match=r"fp went in without sp, but sp then did not \(blocked: .*fp"):
-            oracle.run(before_fp)
+            ExperimentStep(p) for p in ("bp", "p1", "p2", "p3", "p4", "sh", "ph", "pd", "fp", "sp")))
+        assert len(oracle.sent(before_fp).sequence) == 2  # fp then sp; the rest set by hand
+        outcome = oracle.run(before_fp)
+        assert (outcome.outcome, outcome.failed_step, outcome.reason) == ("failed", 10, "blocked")
+        assert outcome.blocked_by == ("fp",), outcome

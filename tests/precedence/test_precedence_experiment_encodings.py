@@ -64,6 +64,32 @@ def test_no_candidate_has_a_part_between_and_nothing_known_is_open() -> None:
     test.assert_()
 
 
+# "B then A" on (a,b) with c placed first: c, b, then a; a's step (3) is where it may fail
+_THEN_A = (_index("a", "b", "c") + _demo(1, "c", "a", "b")
+           + " experiment(1,a,b). experiment_step(1,1,c). experiment_step(1,2,b). experiment_step(1,3,a).")
+
+
+@pytest.mark.parametrize("name,program,present,absent", [
+    ("a blocked by b alone after b: a must precede b", _THEN_A + " experiment_failed(1,3,blocked). "
+     "experiment_blocker(1,b).", {"blocked_first(1,a,b)", "known(a,b)"}, {"free(a,b,experiment(1))", "undecided(1)"}),
+    ("a blocked by another part too: nothing decided", _THEN_A + " experiment_failed(1,3,blocked). "
+     "experiment_blocker(1,b). experiment_blocker(1,c).", {"undecided(1)", "open(a,b)"},
+     {"free(a,b,experiment(1))", "known(a,b)", "blocked_first(1,a,b)"}),
+    ("a blocked with no part seen: nothing decided", _THEN_A + " experiment_failed(1,3,blocked).",
+     {"undecided(1)", "open(a,b)"}, {"free(a,b,experiment(1))", "known(a,b)"}),
+    ("a jammed touching b: not blocked, nothing decided", _THEN_A + " experiment_failed(1,3,jammed). "
+     "experiment_blocker(1,b).", {"undecided(1)", "open(a,b)"}, {"known(a,b)"}),
+    ("b then a both done: a need not precede b", _THEN_A + " experiment_success(1).",
+     {"free(a,b,experiment(1))", "excluded(a,b)"}, {"undecided(1)", "known(a,b)"}),
+])
+def test_b_then_a_reads_a_failure_of_a_only_when_b_alone_blocked_it(name: str, program: str, present: set[str],
+                                                                     absent: set[str]) -> None:
+    test = And(Assert(Exact(1), True_()), *(Assert(All(), Contains(atom)) for atom in sorted(present)),
+               *(Assert(All(), Not(Contains(atom))) for atom in sorted(absent)))
+    Clingo(program=program, files=[KNOWLEDGE]).solve(test)
+    test.assert_()
+
+
 @pytest.mark.parametrize("entry,expected", [("select_precedence_informative.lp", "select(b,c)"),
                                             ("select_precedence_first.lp", "select(a,b)")])
 def test_policies_choose_by_their_rule(entry: str, expected: str) -> None:

@@ -63,6 +63,62 @@ def test_cranfield_from_demonstrations_geometry_and_experiments_each_pair_with_i
     assert "sh<pd (locates)" in learned.summary()
 
 
+class _PhysicsOracle:
+    """The truth, but for the pairs of ``late``, shown as the physics shows them: b goes in
+    without a, and a, placed after b, is then blocked, touching the parts ``late[(a, b)]``."""
+
+    def __init__(self, truth: Relation, late: dict[tuple[str, str], tuple[str, ...]]) -> None:
+        self.truth, self.late = TruthOracle(truth), late
+
+    def run(self, experiment: PrecedenceExperiment) -> PrecedenceOutcome:
+        if experiment.pair not in self.late:
+            return self.truth.run(experiment)
+        if not experiment.then_first:
+            return PrecedenceOutcome(id=experiment.id, cell="sim", pair=experiment.pair, outcome="success")
+        return PrecedenceOutcome(id=experiment.id, cell="sim", pair=experiment.pair, outcome="failed",
+                                 failed_step=len(experiment.sequence), reason="blocked",
+                                 blocked_by=self.late[experiment.pair])
+
+
+def _cranfield_two_demos(root: Path) -> tuple[Relation, Demonstrations]:
+    truth = true_relation(load_assembly("cranfield"))
+    demos = load_demos(root / "data/cranfield/demos.txt", truth.parts)
+    return truth, Demonstrations(demos.parts, demos.sequences[:2], demos.origins[:2])
+
+
+def test_a_precedence_shown_only_at_the_first_parts_step_is_learned_from_b_then_a(root: Path) -> None:
+    # the sim Cranfield cell: fp goes in without sp, then sp is blocked by fp; pd goes in
+    # without sh, then sh is blocked by pd
+    truth, demos = _cranfield_two_demos(root)
+    assert {("sp", "fp"), ("sh", "pd")} <= set(truth.pairs())
+    oracle = _PhysicsOracle(truth, {("sp", "fp"): ("fp",), ("sh", "pd"): ("pd",)})
+    evidence = Evidence(demos)
+    for _knowledge, trial in explore(evidence, oracle):
+        evidence = evidence.with_trial(trial)
+    learned = learn_sources(evidence)
+    assert learned.relation.same_as(truth) and not learned.undecided
+    assert learned.support[("sp", "fp")] == learned.support[("sh", "pd")] == "experiment"
+    late = [t for t in evidence.trials if t.experiment.pair in oracle.late]
+    assert [t.experiment.sequence[-2:] for t in late] == [
+        (ExperimentStep(b), ExperimentStep(a)) for a, b in (t.experiment.pair for t in late)]
+    assert all("blocked by" in t.describe() for t in late)
+
+
+@pytest.mark.parametrize("blocked_by", [("pd",), ("fp", "pd"), ()], ids=["another part", "two parts", "none seen"])
+def test_a_failure_of_the_first_part_not_blamed_on_b_alone_decides_nothing(root: Path,
+                                                                           blocked_by: tuple[str, ...]) -> None:
+    truth, demos = _cranfield_two_demos(root)
+    evidence = Evidence(demos)
+    with pytest.raises(PlannerError, match=r"decided nothing and would be run again: sp<fp stays open"):
+        for _knowledge, trial in explore(evidence, _PhysicsOracle(truth, {("sp", "fp"): blocked_by})):
+            evidence = evidence.with_trial(trial)
+    learned = learn_sources(evidence)
+    assert ("sp", "fp") in learned.knowledge.open and ("fp", "sp") not in learned.relation.pairs()
+    assert [t.experiment.pair for t in learned.undecided] == [("sp", "fp")]
+    assert "sp was not seen blocked by fp alone" in learned.summary()
+    assert not set(learned.relation.pairs()) - set(truth.pairs()) - {("sp", "fp")}
+
+
 def test_without_experiments_open_pairs_are_demonstrated_only() -> None:
     truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
     learned = learn_sources(Evidence(Demonstrations(truth.parts, (("a", "b", "c"),), ("d:1",))))

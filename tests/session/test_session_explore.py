@@ -1,6 +1,7 @@
 """``session --precedence explore``: precedence and sizes in one session from at most 2
 demonstrations and precedence experiments at the session's own cell (real processes:
-planner, ``executor serve``, Zenoh on loopback)."""
+planner, ``executor serve``, Zenoh on loopback); a resumed exploration runs no journaled
+experiment again."""
 
 from __future__ import annotations
 
@@ -9,9 +10,15 @@ from pathlib import Path
 
 import pytest
 
+from asp import PlannerError
 from asp.plans.assign import load_learned_facts
-from asp.precedence.relation import true_relation
+from asp.precedence.demos import Demonstrations, load_demos
+from asp.precedence.explore.oracle import TruthOracle
+from asp.precedence.explore.trials import load_trials
+from asp.precedence.relation import Relation, true_relation
+from asp.session.precedence import PRECEDENCE_JOURNAL, explore_precedence
 from bridge.assembly import load_assembly
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
 
 
 def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
@@ -22,6 +29,39 @@ def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
     support = (run / "precedence_support.lp").read_text()
     for a, b in truth:
         assert f"support({a},{b},experiment)." in support
+
+
+class _Cell:
+    """A cell answering from ``truth`` (:class:`TruthOracle`) that records the pairs it ran and,
+    after ``dies_after`` of them, fails as a session killed in the middle would stop."""
+
+    def __init__(self, truth: Relation, dies_after: int | None = None) -> None:
+        self.truth, self.dies_after = TruthOracle(truth), dies_after
+        self.cell, self.sim_s, self.wall_s = "c1", 0.0, 0.0
+        self.ran: list[tuple[str, str]] = []
+
+    def run(self, experiment: PrecedenceExperiment) -> PrecedenceOutcome:
+        if len(self.ran) == self.dies_after:
+            raise PlannerError("the session was killed")
+        self.ran.append(experiment.pair)
+        return self.truth.run(experiment)
+
+
+def test_a_resumed_exploration_runs_no_journaled_experiment_again(tmp_path: Path, root: Path) -> None:
+    truth = true_relation(load_assembly("cranfield"))
+    every = load_demos(root / "data/cranfield/demos.txt", truth.parts)
+    demos = Demonstrations(every.parts, every.sequences[:2], every.origins[:2])
+    journal = tmp_path / PRECEDENCE_JOURNAL
+    killed = _Cell(truth, dies_after=3)
+    with pytest.raises(PlannerError, match="killed"):
+        explore_precedence(demos, None, killed, journal=journal)
+    assert [t.experiment.pair for t in load_trials(journal, truth.parts)] == killed.ran
+    cell = _Cell(truth)
+    resumed = explore_precedence(demos, None, cell, journal=journal)
+    ran = killed.ran + cell.ran
+    assert len(set(ran)) == len(ran) == len(resumed.trials)  # no pair run twice
+    assert resumed.learned.relation.same_as(truth)
+    assert [t.experiment.pair for t in load_trials(journal, truth.parts)] == ran
 
 
 @pytest.mark.slow

@@ -5,8 +5,10 @@ experiment outcomes (encodings ``precedence_knowledge.lp``: ``precedence/evidenc
 A failed experiment confirms its pair only when the pair's first part is the one absent
 part that may precede the failing part: the others must be excluded. Exclusions grow with
 the confirmed pairs, so the confirmed pairs are found by a fixpoint (each round one
-solve; knowledge only grows). A failure still undecided at the fixpoint is kept and
-reported, never read as a confirmation. A failure before the tested step (the known
+solve; knowledge only grows). A "B then A" experiment whose A step, after B, the cell saw
+blocked by B alone confirms its pair by ``precedence/evidence.lp`` (``blocked_first``);
+failed there for another cause it decides nothing. A failure still undecided at the
+fixpoint is kept and reported, never read as a confirmation. A failure before the tested step (the known
 state was not reached) and every conflict between sources are errors naming their
 evidence (:class:`PrecedenceConflict`).
 """
@@ -45,10 +47,12 @@ class Trial:
 
     def describe(self) -> str:
         """E.g. ``experiment run.3 (sh<pd: failed at step 4, unsupported)``."""
+        a, b = self.experiment.pair
         if self.outcome.outcome == "success":
-            result = f"{self.experiment.pair[1]} placed before {self.experiment.pair[0]}"
+            result = f"{b} placed before {a}" + (f", then {a}" if self.experiment.then_first else "")
         else:
-            result = f"failed at step {self.outcome.failed_step}, {self.outcome.reason}"
+            by = f" by {' '.join(self.outcome.blocked_by)}" if self.outcome.blocked_by else ""
+            result = f"failed at step {self.outcome.failed_step}, {self.outcome.reason}{by}"
         where = "" if self.origin == "oracle" else f", {self.origin}"
         return f"experiment {self.experiment.id} ({self.experiment.tested}: {result}{where})"
 
@@ -83,13 +87,16 @@ class Evidence:
 
     def facts(self) -> list[clingo.Symbol]:
         """``part/1``, ``part_index/2``, ``demo/3``, ``forced/3`` (geometry) and the experiments'
-        ``experiment_step/3``, ``experiment_success/1``, ``experiment_failed/3`` (E: 1-based)."""
+        ``experiment/3``, ``experiment_step/3``, ``experiment_success/1``, ``experiment_failed/3``,
+        ``experiment_blocker/2`` (E: 1-based)."""
         atoms = [fact("part", p) for p in self.parts]
         atoms += [fact("part_index", p, i) for i, p in enumerate(self.parts, 1)]
         atoms += [fact("demo", d, i, p) for d, sequence in enumerate(self.demos.sequences, 1)
                   for i, p in enumerate(sequence, 1)]
         atoms += [fact("forced", a, b, GEOMETRY) for a, b in self.geometry]
         for e, trial in enumerate(self.trials, 1):
+            atoms.append(fact("experiment", e, *trial.experiment.pair))
+            atoms += [fact("experiment_blocker", e, part) for part in trial.outcome.blocked_by]
             atoms += [fact("experiment_step", e, i, step.part) for i, step in enumerate(trial.experiment.sequence, 1)]
             if trial.outcome.outcome == "success":
                 atoms.append(fact("experiment_success", e))
@@ -185,22 +192,30 @@ def _check_conflicts(evidence: Evidence, atoms: Atoms, edges: dict[Pair, str]) -
                                      f"{a}, but {a} must precede {b}: {_explain_forced(evidence, edges, a, b)}")
 
 
+def tested_step(experiment: PrecedenceExperiment) -> int:
+    """The 1-based step placing the pair's second part (the last, or the one before it in
+    "B then A")."""
+    return len(experiment.sequence) - int(experiment.then_first)
+
+
 def _check_tested_step(trial: Trial) -> None:
     failed = trial.outcome.failed_step
-    if failed is not None and failed < len(trial.experiment.sequence):
+    tested = tested_step(trial.experiment)
+    if failed is not None and failed < tested:
         step = trial.experiment.sequence[failed - 1]
         raise PrecedenceConflict(
             f"{trial.describe()}: step {failed} placing {step.part} failed before the tested step "
-            f"{len(trial.experiment.sequence)}, in an order the evidence showed feasible; expected the known "
-            "state to be reached")
+            f"{tested}, in an order the evidence showed feasible; expected the known state to be reached")
 
 
 def decisive(trial: Trial, excluded: frozenset[Pair], parts: Sequence[str]) -> bool:
-    """Whether a failure at the tested step confirms the pair: every absent part but its
-    first is excluded from preceding its second."""
+    """Whether a failure at the tested step (placing the pair's second part) confirms the
+    pair: every absent part but its first is excluded from preceding its second. (A failure
+    of the first part's step in "B then A" is read by ``precedence/evidence.lp``.)"""
     a, b = trial.experiment.pair
-    before = {step.part for step in trial.experiment.sequence[:-1]}
-    return trial.outcome.outcome == "failed" and all(
+    tested = tested_step(trial.experiment)
+    before = {step.part for step in trial.experiment.sequence[:tested - 1]}
+    return trial.outcome.failed_step == tested and all(
         (x, b) in excluded for x in parts if x not in before and x not in (a, b))
 
 
@@ -222,6 +237,7 @@ def know(evidence: Evidence, policy: str | None = None, confirmed: dict[int, Pai
                                                    clingo.Function("experiment", [clingo.Number(e)])])
                         for e, (a, b) in confirmed.items()]
         atoms = _solve_knowledge(facts, entry)
+        confirmed.update({int(e): (a, b) for e, a, b in atoms.get("blocked_first", ())})
         edges = {(a, b): GEOMETRY for a, b in evidence.geometry}
         edges.update({pair: f"experiment({e})" for e, pair in confirmed.items()})
         _check_conflicts(evidence, atoms, edges)

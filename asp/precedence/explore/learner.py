@@ -74,7 +74,11 @@ class Learned:
             lines.append("process constraints to confirm with the user (every demonstration keeps the order, "
                          "experiments show it free): " + " ".join(f"{a}<{b}" for a, b in self.process))
         for trial in self.undecided:
-            lines.append(f"undecided: {trial.describe()}: another absent part may be the cause")
+            a, b = trial.experiment.pair
+            cause = (f"{a} was not seen blocked by {b} alone: another part, or none seen, may be the cause"
+                     if trial.outcome.failed_step == len(trial.experiment.sequence) and trial.experiment.then_first
+                     else "another absent part may be the cause")
+            lines.append(f"undecided: {trial.describe()}: {cause}")
         lines.append(f"open pairs left: {len(self.knowledge.open)}")
         return "\n".join(lines)
 

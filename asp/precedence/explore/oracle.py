@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Protocol
 
 from asp.precedence.relation import Relation
-from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
+from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome, first_missing
 
 
 class Oracle(Protocol):
@@ -17,8 +17,10 @@ class Oracle(Protocol):
 
 
 class TruthOracle:
-    """Answers from ``truth`` (closed): a step fails, ``blocked``, when a part that must
-    precede its part is not yet placed. It spends no physics time."""
+    """Answers from ``truth`` (closed) as a ``truth`` cell does: a step fails, ``precedence``,
+    when a part that must precede its part is not yet placed
+    (:func:`bridge.precedence.experiment.first_missing`); nothing is ever ``blocked_by`` a
+    part. It spends no physics time."""
 
     def __init__(self, truth: Relation, cell: str = "truth") -> None:
         self.truth = truth
@@ -27,12 +29,10 @@ class TruthOracle:
                         for j, p in enumerate(truth.parts)}
 
     def run(self, experiment: PrecedenceExperiment) -> PrecedenceOutcome:
-        placed: set[str] = set()
-        for number, step in enumerate(experiment.sequence, 1):
-            missing = sorted(self._before[step.part] - placed)
-            if missing:
-                return PrecedenceOutcome(id=experiment.id, cell=self.cell, pair=experiment.pair, outcome="failed",
-                                         failed_step=number, reason="blocked",
-                                         detail=f"{step.part} needs {' '.join(missing)} placed first")
-            placed.add(step.part)
-        return PrecedenceOutcome(id=experiment.id, cell=self.cell, pair=experiment.pair, outcome="success")
+        first = first_missing(experiment, self._before)
+        if first is None:
+            return PrecedenceOutcome(id=experiment.id, cell=self.cell, pair=experiment.pair, outcome="success")
+        number, part, missing = first
+        return PrecedenceOutcome(id=experiment.id, cell=self.cell, pair=experiment.pair, outcome="failed",
+                                 failed_step=number, reason="precedence",
+                                 detail=f"{part} precedence (without {' '.join(missing)}; the known relation)")

@@ -5,7 +5,8 @@ candidate deciding the most open pairs whatever its outcome) and ``first``
 (``select_precedence_first.lp``: the first candidate in part order, a systematic
 baseline). The experiment on (a, b) places every part that precedes b in the upper bound
 except a, in the order of the first demonstration (a linear extension of the upper
-bound), then b.
+bound), then b, then a ("B then A": a precedence the physics shows only at a's step,
+once b is in, is seen too).
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ def experiment_for(knowledge: Knowledge, pair: Pair, request_id: str) -> Precede
     """The experiment testing ``pair`` (a candidate of ``knowledge``)."""
     first_demo = knowledge.evidence.demos.sequences[0]
     before = sorted(knowledge.requires[pair], key=first_demo.index)
-    steps = tuple(ExperimentStep(p) for p in (*before, pair[1]))
+    steps = tuple(ExperimentStep(p) for p in (*before, pair[1], pair[0]))
     return PrecedenceExperiment(id=request_id, pair=pair, sequence=steps)
 
 
@@ -47,7 +48,8 @@ def explore(evidence: Evidence, oracle: Oracle, policy: str = "informative", run
             limit: int | None = None) -> Iterator[tuple[Knowledge, Trial]]:
     """Experiments until nothing is open (or ``limit`` of them): yields the knowledge each
     was chosen from and the trial (experiment and outcome); the last knowledge is
-    :func:`know` of the evidence with every trial."""
+    :func:`know` of the evidence with every trial. PlannerError when the next experiment is
+    one that already decided nothing (it would decide nothing again)."""
     knowledge = know(evidence, policy)
     count = 0
     while limit is None or count < limit:
@@ -56,6 +58,11 @@ def explore(evidence: Evidence, oracle: Oracle, policy: str = "informative", run
             return
         count += 1
         experiment = experiment_for(knowledge, pair, f"{run_id}.{len(evidence.trials) + 1}")
+        again = next((t for t in knowledge.undecided if t.experiment.pair == pair
+                      and t.experiment.sequence == experiment.sequence), None)
+        if again is not None:
+            raise PlannerError(f"{again.describe()} decided nothing and would be run again: {pair[0]}<{pair[1]} "
+                               "stays open (no experiment of this planner can decide it)")
         trial = Trial(experiment, oracle.run(experiment), "oracle")
         yield knowledge, trial
         evidence = evidence.with_trial(trial)
