@@ -408,11 +408,22 @@ class Sweeper:
         return self._answers[key]
 
     def touching(self, a: str, b: str) -> bool:
-        """Whether parts ``a`` and ``b`` are within :data:`TOUCH` of each other."""
-        request = fcl.DistanceRequest()
-        result = fcl.DistanceResult()
+        """Whether parts ``a`` and ``b`` are within :data:`TOUCH` of each other: their
+        distance, unless their boxes or one's convex superset and the other are farther
+        apart (no nearer than the part itself), or they meet."""
+        one, other = self._solids[a], self._solids[b]
+        gap = np.maximum(one.mesh.bounds[0] - other.mesh.bounds[1], other.mesh.bounds[0] - one.mesh.bounds[1])
+        if np.any(gap > TOUCH):
+            return False
         self.queries += 1
-        return bool(fcl.distance(self._solids[a].bvh, self._solids[b].bvh, request, result) <= TOUCH)
+        for solid, against in ((one, other), (other, one)):
+            around = _hull_piece(solid.hull)
+            if around is not None and fcl.distance(around, against.bvh, fcl.DistanceRequest(),
+                                                   fcl.DistanceResult()) > TOUCH:
+                return False
+        if fcl.collide(one.bvh, other.bvh, fcl.CollisionRequest(), fcl.CollisionResult()):
+            return True
+        return bool(fcl.distance(one.bvh, other.bvh, fcl.DistanceRequest(), fcl.DistanceResult()) <= TOUCH)
 
     def _solid(self, part: str, against: str, shift: np.ndarray) -> _Solid:
         """``part``'s solid for a sweep by ``shift`` against (or of) ``against``: at their
