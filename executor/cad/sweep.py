@@ -14,10 +14,10 @@ superset that meets B no deeper than :data:`TOUCH` clears every prism inside it:
 sweep of the part's convex hull (one query: the answer for a convex part), then down a
 tree of the part's triangles (halves of nearby ones): a node whose swept box misses B's
 box, or whose swept hull clears B, is done; the prisms are tested only in leaves of
-:data:`CHUNK` triangles that still meet B. Before descending, the prisms of the few
-triangles that lead the sweep into B's box (:func:`_front`) are tested: where the part is
-blocked, one of them usually meets B deeply, which decides at once. Same answer as
-testing every prism.
+:data:`CHUNK` triangles that still meet B. The tree is searched depth first, the half
+holding more of the few triangles that lead the sweep into B's box (:func:`_front`)
+first: where the part is blocked, they usually meet B deeply, so the search ends soon;
+the order changes no answer. Same answer as testing every prism.
 
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
@@ -60,7 +60,7 @@ HULL_POINTS = 96
 """Sets of more points are not hulled for the conservative test (fcl's cost grows with them):
 their halves are."""
 FRONT = 16
-"""Triangles whose prisms are tested first, a witness of a blocked sweep (:func:`_front`)."""
+"""Leading triangles whose part of the tree is searched first (:func:`_front`)."""
 HULL_SAMPLE = 1000
 """Vertices of the sample whose hull shows a large part not convex (:func:`_is_convex`)."""
 _FLAT = 1e-12
@@ -475,21 +475,17 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
     """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
     (the module docstring: the hull, then down the triangle tree, the prisms of a leaf last)."""
     pieces = moving.pieces.setdefault(tuple(shift), {})
-    whole = None
     if moving.convex or moving.exact:
         if -1 not in pieces:
             pieces[-1] = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
         whole = pieces[-1]
-        if whole is not None and not fcl.collide(whole, fixed.bvh, fcl.CollisionRequest(), fcl.CollisionResult()):
+        if whole is not None and not _meets([whole], fixed.bvh):
             return False
-    low, high = fixed.bounds
-    if _meets(swept_pieces(moving.triangles[_front(moving, low, high, shift)], shift), fixed.bvh):
-        return True
-    if whole is not None:
-        if not _meets([whole], fixed.bvh):
-            return False
-        if moving.convex and moving.exact:
+        if whole is not None and moving.convex and moving.exact:
             return True
+    low, high = fixed.bounds
+    leading = np.zeros(len(moving.triangles), dtype=int)
+    leading[_front(moving, low, high, shift)] = 1
     pending = [moving.tree]
     while pending:
         node = pending.pop()
@@ -505,7 +501,9 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
             if piece is not None and not _meets([piece], fixed.bvh):
                 continue
         if node.children:
-            pending += node.children
+            # the half holding more leading triangles first (popped last pushed); the
+            # answer does not depend on the order, only how soon a blocked sweep ends
+            pending += sorted(node.children, key=lambda child: int(leading[child.faces].sum()))
         elif _meets(swept_pieces(moving.triangles[node.faces], shift), fixed.bvh):
             return True
     return False
@@ -514,7 +512,7 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
 def _front(solid: _Solid, low: np.ndarray, high: np.ndarray, shift: np.ndarray) -> np.ndarray:
     """The :data:`FRONT` triangles of ``solid`` that lead its sweep by ``shift`` [m] into
     the box ``low``, ``high`` [m]: facing along the shift, swept into the box, farthest
-    along the shift (where a blocked part meets what blocks it: one deep prism decides)."""
+    along the shift (where a blocked part meets what blocks it)."""
     start, end, normals, centres = solid.leading
     inside = np.all(np.minimum(np.maximum(end, end + shift), high)
                     - np.maximum(np.minimum(start, start + shift), low) > TOUCH, axis=1)
