@@ -14,9 +14,9 @@ import pytest
 import trimesh
 
 from executor import ExecutorError
+from executor.cad import sweep
 from executor.cad.derive import derive
 from executor.cad.parts import CadPart
-from executor.cad import sweep
 from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
 
 MM = 1e-3
