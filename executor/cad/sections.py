@@ -38,6 +38,7 @@ import shapely
 import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
+from trimesh.path.traversal import discretize_path
 
 from executor.cad.parts import Cylinder
 
@@ -114,7 +115,9 @@ def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[L
         return []
     frame = frame_of(axis)
     loops = []
-    for polyline in section.discrete:
+    # a plane section is made of straight lines, which need no scale to be discretised
+    # (the section's ``discrete`` would measure every line's bounds for one)
+    for polyline in (discretize_path(section.entities, section.vertices, path) for path in section.paths):
         points = np.asarray(polyline) @ frame.T
         if len(points) > 1 and np.allclose(points[0], points[-1]):
             points = points[:-1]

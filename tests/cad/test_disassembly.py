@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 import trimesh
 
 from executor import ExecutorError
+from executor.cad import sweep
 from executor.cad.derive import derive
 from executor.cad.parts import CadPart, check_parts
-from executor.cad.sweep import cylinder_faces
+from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
 
 MM = 1e-3
 
@@ -152,3 +154,31 @@ def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fi
     derived = derive(parts, "plate", {}, reach=0.0)
     assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
     assert derived.blockers[("nut", "+z")] == set() and derived.axis["nut"] == "+z"
+
+
+def test_convexity_is_decided_as_the_hull_volume_decides_it() -> None:
+    # A fine bore passes trimesh's edge test (its facets turn by 0.2°): its hull is larger.
+    ring = trimesh.creation.annulus(r_min=8 * MM, r_max=16 * MM, height=12 * MM, sections=2000)
+    assert ring.is_convex and not _is_convex(ring)
+    assert _is_convex(trimesh.creation.cylinder(radius=8 * MM, height=130 * MM, sections=2000))
+    # A vertex pushed in by 1e-5 of the radius: concave at its edges, its hull's volume its own within 1e-6.
+    dented = trimesh.creation.icosphere(subdivisions=4, radius=20 * MM)
+    dented.vertices[0] *= 1 - 1e-5
+    hull = dented.convex_hull.volume
+    assert _is_convex(dented) == (hull - dented.volume <= 1e-6 * hull) == True  # noqa: E712
+    dented.vertices[0] *= 0.5
+    assert not _is_convex(dented)
+
+
+def test_the_leading_triangles_change_no_answer(monkeypatch: pytest.MonkeyPatch) -> None:
+    sweeps = [("bearing", (0, 0, 1), 3e-3), ("shaft", (0, 0, 1), 3e-3), ("housing", (0, 0, -1), 1e-4),
+              ("shaft", (0, 1, 0), 0.3), ("bearing", (1, 0, 0), 0.3), ("shaft", (-1, 0, 0), 0.3)]
+    found = []
+    for front in (0, FRONT):  # none searched first: the plain depth-first order
+        monkeypatch.setattr(sweep, "FRONT", front)
+        sweeper = sweep.Sweeper({p.id: p.mesh for p in _shaft_in_bearing()})
+        found.append([sweeper.blockers(part, np.array(direction, dtype=float), length)
+                      for part, direction, length in sweeps])
+    assert found[0] == found[1]
+    # Lifted, the bearing meets the housing and the shaft; moved sideways, the shaft meets both.
+    assert found[1][0] == {"housing", "shaft"} and found[1][3] == {"bearing", "housing"}
