@@ -28,8 +28,11 @@ import pytest
 
 from bridge.cell_settings import ServeSettings
 from bridge.messages import InsertRequest
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
 from executor.cad.cli import run_import
 from executor.cad.sweep import opposite
+from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.world.geometry import load_geometry
 from tests.conftest import Runner
@@ -187,15 +190,15 @@ def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: 
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
 
 
-@pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 110 s)
-def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it_and_assembled(
+@pytest.mark.slow  # imports the product, teaches it and runs a sim session of 16 experiments (about 70 s)
+def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
     assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
     assert taught.returncode == 0, taught.stderr
     run = tmp_path / "run"
-    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json", timeout=400)
+    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--json", timeout=240)
     assert session.returncode == 0, session.stderr
     result = json.loads(session.stdout)
     # Every peg, the hexagon, octagon and 12-gon prisms too, goes into every hole in
@@ -206,11 +209,25 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     assert {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e} == truth
     assert sorted(map(tuple, result["fits"])) == sorted(pair for pair, outcome in truth.items() if outcome == "fit")
-    # Assembled with every prism within 2 mm of its hole's centre: each has 1.8 to 2.4 mm
-    # of room all round, so the cell centres it by contact before it goes down.
-    report = result["assembly"]
-    assert report["assembled"] is True
-    assert max(report["final_pose_error_mm"].values()) <= 2.0, report["final_pose_error_mm"]
+
+
+@pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 60 s)
+def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
+        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+    done = imported("agh_prism_array")
+    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
+    assert taught.returncode == 0, taught.stderr
+    holes = _feature_holes(done)
+    assembler = Assembler(load_product(str(done.out)), description=CellDescription())
+    try:
+        assert assembler.run_step(done.truth["base"], None, 0).outcome == "fit"
+        steps = [assembler.run_step(pid, holes[part["in"]], 0) for pid, part in sorted(done.truth["parts"].items())]
+    finally:
+        assembler.close()
+    # Each prism has 1.8 to 2.4 mm of room all round: held where the hole search found the
+    # hole, it would stand up to that far off its hole's centre; centred by contact, it is not.
+    assert {s.part: s.outcome for s in steps} == dict.fromkeys(done.truth["parts"], "fit")
+    assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
 @pytest.mark.parametrize("name", PRODUCTS)
