@@ -211,7 +211,7 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
     assert sorted(map(tuple, result["fits"])) == sorted(pair for pair, outcome in truth.items() if outcome == "fit")
 
 
-@pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 60 s)
+@pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 140 s under load)
 def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
         imported: Callable[[str], Imported], run_executor: Runner) -> None:
     done = imported("agh_prism_array")
