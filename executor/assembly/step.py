@@ -6,8 +6,9 @@ Per kind of part (the ``skill`` of the step's record):
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
-  a part with a bore onto a pin of the base likewise, centred on the pin by contact once
-  past its top (:mod:`executor.skills.centring`);
+  a part with a bore onto a pin of the base likewise; once past the feature's top, a part
+  with a bore is centred on its pin by contact, and so is a peg with more room than
+  :data:`CENTRING_ROOM` in its hole (:mod:`executor.skills.centring`);
 - ``insert_over``: a part with openings down over the pins standing in its holes, by the
   same insertion skill, from above the pins to its resting height, aimed at the holes'
   centres without a search (a pin stands within half its hole's clearance of the centre,
@@ -56,18 +57,22 @@ from executor.control.detector import Detector
 from executor.control.ilc import LAYERS, ExecutionLayer, Ilc
 from executor.control.motion import APPROACH_SETTLE_TIME, StepLogger
 from executor.evidence import AttemptSetup
-from executor.skills.centring import centre_on_pin
+from executor.skills.centring import centre_by_contact
 from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, trial_rng
-from executor.world.arm import aligned_yaw, tool_quat, yaw_quat
-from executor.world.geometry import fit_pose
+from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
+from executor.world.geometry import fit_pose, margin
 from executor.world.perturbation import CellBias
 from executor.world.scene import PART_FRICTION
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
-CENTRING_MARGIN = 0.005  # [m] a bore's probes reach this beyond its half diagonal
+CENTRING_MARGIN = 0.005  # [m] the centring probes reach this beyond the farthest the feature can be
+CENTRING_ROOM = 0.001
+"""[m] a peg with more room than this all round in its hole is centred in it by contact
+(:mod:`executor.skills.centring`): with less the hole itself holds it within the placed
+parts' 2 mm (a square peg's corner direction: √2 × its room)."""
 RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
 ASSEMBLY_UNCERTAINTY = Magnitudes(
@@ -332,6 +337,21 @@ class Assembler:
             return world.position(into) + world.socket_offset[part] + world.frames[part].tcp
         return world.goals[part] + world.frames[part].tcp
 
+    def _centring_reach(self, part: str, hole: str | None) -> float | None:
+        """How far [m] the centring probes of a peg found in ``hole`` reach each way, None
+        where it is not centred: a bore on a pin, its half diagonal (the pin's axis is at
+        most that far) + :data:`CENTRING_MARGIN`; a peg with more room than
+        :data:`CENTRING_ROOM` in a hole, twice its room (from one wall to the other) +
+        :data:`CENTRING_MARGIN`."""
+        peg = self.product.pegs.get(part)
+        if peg is None or hole is None:
+            return None
+        feature = self.product.geometry.holes[hole]
+        if feature.pin:
+            return float(np.hypot(*peg.sides)) / 2 + CENTRING_MARGIN
+        room = margin(peg, feature) / 2
+        return 2 * room + CENTRING_MARGIN if room > CENTRING_ROOM else None
+
     def _approach(self, part: str, hole: str | None, skill: str, goal: np.ndarray) -> np.ndarray:
         """Where the insertion starts [m]: above the entry of ``hole`` (pegs), above the pin
         tops (covers: the longest peg standing in the highest of its holes), above the
@@ -361,6 +381,7 @@ class Assembler:
         carry(motion, approach, yaw=yaw)
         motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         world.arm.tare_sensor()
+        centred = False
         if skill == "insert_over":
             skill_obj, xy = self._skill(p.covers[part].skill), approach[:2]
         else:
@@ -369,17 +390,19 @@ class Assembler:
             found = hole_search(motion, approach[:2], surface, approach[2], quat,
                                 np.random.default_rng(setup.search_seed))
             xy = found.hole_xy
-            feature = None if hole is None else p.geometry.holes[hole]
-            if skill == "insert" and feature is not None and feature.pin and found.found:
-                # over the pin: centred on it by contact (a wide bore never meets it on the way down)
-                reach = float(np.hypot(*p.pegs[part].sides)) / 2 + CENTRING_MARGIN
-                xy = centre_on_pin(motion, motion.controller.arm.read().tip_pos, quat, reach, feature.depth)[:2]
+            reach = self._centring_reach(part, hole) if skill == "insert" and found.found else None
+            centred = reach is not None and hole is not None
+            if reach is not None and hole is not None:  # in the feature's room, not touching it yet
+                xy = centre_by_contact(motion, motion.controller.arm.read().tip_pos, quat, reach,
+                                       p.geometry.holes[hole].depth)[:2]
             if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
                 peg = p.pegs[part]
                 skill_obj = self._skill(peg.shape).in_hole(p.geometry.holes[hole].depth)
             else:
                 skill_obj = self._skill(p.heads[part].skill)
         origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])
+        if centred:  # the skill's end aimed at the centre found: its taught end is off the hole frame's
+            origin[:2] -= turn_z(skill_obj.end_position, yaw)[:2]  # axis where the taught hole left room
         detector = Detector(self.thresholds)
         lever = float(np.linalg.norm(world.frames[part].grip - world.frames[part].tcp))
         layer, key = self.layer, f"{self.shape_of(part)}:{hole or part}"

@@ -1,13 +1,18 @@
-"""Centring a part with a bore on its pin before it is put down.
+"""Centring a part by contact in the feature it goes into or onto, before it is put down.
 
-A bore much wider than its pin (a nut over a pin with 11 mm of room) never touches the
-pin on the way down: the part ends where the robot's vision put it, up to its error
-(3 mm) off the pin's axis, where a peg in its hole is held within half the hole's
-clearance. So once the hole search has found the pin (the part past the pin's top), the
+A feature with much room never touches the part on the way down: a bore much wider than
+its pin (a nut over a pin with 11 mm of room), or a peg in a loose hole (a prism with
+2 mm of room all round). The part ends where the hole search left it, up to the room
+off the feature's axis (the search stops where the part first sinks past the entry,
+the grasp's offset and tilt besides), where a peg in a tight hole is held within half the
+hole's clearance. So once the search has found the feature (the part past its top), the
 part goes :data:`ENGAGE` further down and probes by contact: along +x, -x, +y and -y in
-turn it moves at :data:`PROBE_SPEED` until the bore meets the pin (a lateral force over
-:data:`TOUCH_FORCE`) or it has gone ``reach``; midway between the two contacts of an
-axis is the pin's axis (an axis without both contacts keeps the search's value).
+turn it moves at :data:`PROBE_SPEED` until it meets the feature (a lateral force over
+:data:`TOUCH_FORCE`: the bore the pin, the peg the hole's wall) or it has gone ``reach``;
+midway between the two contacts of an axis is the feature's axis (exact where the free
+play is mirror symmetric about that axis, as for a round pair and the regular prisms;
+an axis without both contacts keeps the search's value). The probes touch with the part
+itself, so its grasp offset is in the contacts and the tip position found carries it.
 """
 
 from __future__ import annotations
@@ -18,11 +23,11 @@ from executor.control.motion import Motion
 from executor.world.scene import TIME_STEP
 
 ENGAGE = 0.004
-"""[m] below the pin's top the probes run at (the part's rounded edges are 1 mm)."""
+"""[m] below the feature's top the probes run at (the part's rounded edges are 1 mm)."""
 PROBE_SPEED = 0.02
 """[m/s] of a probe and of the way back."""
 TOUCH_FORCE = 3.0
-"""[N] lateral: the bore meets the pin."""
+"""[N] lateral: the part meets the feature."""
 SETTLE = 0.1
 """[s] held at the centre found."""
 
@@ -48,10 +53,10 @@ def _go(motion: Motion, start: np.ndarray, goal: np.ndarray, quat: np.ndarray) -
         motion.step(start + (goal - start) * k / steps, quat)
 
 
-def centre_on_pin(motion: Motion, found: np.ndarray, quat: np.ndarray, reach: float, depth: float) -> np.ndarray:
-    """The tip position [m] over the pin's axis: from ``found`` (where the search left the
-    tip, just past the pin's top), :data:`ENGAGE` (at most half the pin's ``depth`` [m])
-    down, probed ``reach`` [m] each way (module docstring); the tip is held there."""
+def centre_by_contact(motion: Motion, found: np.ndarray, quat: np.ndarray, reach: float, depth: float) -> np.ndarray:
+    """The tip position [m] over the feature's axis: from ``found`` (where the search left
+    the tip, just past the feature's top), :data:`ENGAGE` (at most half the feature's
+    ``depth`` [m]) down, probed ``reach`` [m] each way (module docstring); the tip is held there."""
     start = found - np.array([0.0, 0.0, min(ENGAGE, depth / 2)])
     _go(motion, found, start, quat)
     centre = start.copy()
