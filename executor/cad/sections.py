@@ -15,10 +15,14 @@ A loop is classified as
 - ``polygon`` otherwise: the loop itself, compared with
   :mod:`executor.world.fit` (``outline``).
 
-Sizes are what a fit depends on, conservatively: a part's round section is its
-circumscribed circle (its widest), a hole's its inscribed circle (its narrowest), so a
-polygonal hole's size is its inradius and a tessellated cylinder's is within the
-tessellation's deflection. A part's rect is its minimum-area rectangle (it holds the part,
+A round section is a tessellated cylinder, and a tessellation puts its vertices on the
+true surface: its diameter, a part's and a hole's alike, is its vertex circle (the
+circumscribed circle of the loop), the cylinder's nominal diameter; its ``deflection`` is
+how far the loop's edges come in from that circle (the chord's sagitta, measured), the
+most by which the polygon is narrower than the cylinder. A peg and a hole whose diameters
+differ by less than the larger deflection plus :data:`executor.cad.sweep.TOUCH` are a
+nominal zero-clearance fit (:func:`zero_clearance`), as the disassembly's sliding
+cylinders are. Other sizes are what a fit depends on, conservatively: a part's rect is its minimum-area rectangle (it holds the part,
 corners and all); a hole's is that rectangle inset evenly on every side until it lies
 inside the loop (rounded or chamfered corners cost the inset: 0.29 mm a side for a 1 mm
 radius), so a rect peg that passes the recorded rect passes the hole. The corner radius
@@ -40,6 +44,7 @@ from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
 
 from executor.cad.parts import Cylinder
+from executor.cad.sweep import TOUCH
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
@@ -82,6 +87,7 @@ class Loop:
 class Shape2D:
     """A classified loop: ``kind`` (round, square, rect, polygon), ``a`` ≥ ``b`` [m] (a
     round section: its diameter twice; a polygon: its minimum-area rectangle's sides),
+    ``deflection`` [m] a round section's sagitta (its loop's edges inside its circle; 0: exact),
     ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]; a polygon: 0, its outline
     holds its turn), ``centre`` (2,) [m] in the slice's frame, ``outline`` (n, 2) [m] the
     loop's points about the centre, ``corner`` [m] the corner radius a rect's missing
@@ -94,6 +100,7 @@ class Shape2D:
     centre: np.ndarray
     outline: np.ndarray = field(repr=False, kw_only=True)
     corner: float = field(default=0.0, kw_only=True)
+    deflection: float = field(default=0.0, kw_only=True)
 
 
 def frame_of(axis: np.ndarray) -> np.ndarray:
@@ -197,15 +204,15 @@ def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> 
 
 
 def classify(loop: Loop, *, hole: bool) -> Shape2D:
-    """The loop's cross-section (the module docstring); ``hole`` picks the inscribed size."""
+    """The loop's cross-section (the module docstring); ``hole`` picks a rect's inscribed size."""
     points, centre = loop.points, loop.centre
     outline = points - centre
     radii = np.linalg.norm(outline, axis=1)
     outer = float(radii.max())
     if (len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
             and loop.area >= 0.98 * math.pi * outer ** 2):
-        d = 2 * (edge_distance(points, centre) if hole else outer)
-        return Shape2D("round", d, d, 0.0, centre, outline=outline)
+        return Shape2D("round", 2 * outer, 2 * outer, 0.0, centre, outline=outline,
+                       deflection=outer - edge_distance(points, centre))
     a, b, angle = _min_rectangle(points)
     c, s = math.cos(angle), math.sin(angle)
     turned = points @ np.array([[c, -s], [s, c]])  # side a along the first axis
@@ -235,7 +242,7 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
                 tolerance: float) -> Shape2D:
     """``shape`` with the diameter of the B-rep cylinder it tessellates, if it is round and
     one of ``cylinders`` is parallel to ``axis``, on the loop's centre (``level`` [m] along
-    the axis) and within ``tolerance`` [m] of its radius; else ``shape`` unchanged."""
+    the axis) and within ``tolerance`` [m] of its radius (deflection 0); else ``shape`` unchanged."""
     if shape.kind != "round":
         return shape
     axis = np.asarray(axis, dtype=float)
@@ -248,3 +255,13 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
             d = 2 * cylinder.radius
             return Shape2D("round", d, d, 0.0, shape.centre, outline=shape.outline)
     return shape
+
+
+def zero_clearance(peg: Shape2D, hole: Shape2D) -> float | None:
+    """The tolerance [m] of a nominal zero-clearance fit of ``peg`` in ``hole``: both
+    round, their diameters apart by less than the larger deflection plus
+    :data:`executor.cad.sweep.TOUCH` (the tolerance); None when they are no such pair."""
+    if peg.kind != "round" or hole.kind != "round":
+        return None
+    tolerance = max(peg.deflection, hole.deflection) + TOUCH
+    return tolerance if abs(hole.a - peg.a) < tolerance else None
