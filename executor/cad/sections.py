@@ -22,11 +22,12 @@ how far the loop's edges come in from that circle (the chord's sagitta, measured
 most by which the polygon is narrower than the cylinder. A peg and a hole whose diameters
 differ by less than the larger deflection plus :data:`executor.cad.sweep.TOUCH` are a
 nominal zero-clearance fit (:func:`zero_clearance`), as the disassembly's sliding
-cylinders are. Other sizes are what a fit depends on, conservatively: a part's rect is its minimum-area rectangle (it holds the part,
-corners and all); a hole's is that rectangle inset evenly on every side until it lies
-inside the loop (rounded or chamfered corners cost the inset: 0.29 mm a side for a 1 mm
-radius), so a rect peg that passes the recorded rect passes the hole. The corner radius
-that explains the area the corners lack is kept (``corner``, reported). Where the part's
+cylinders are. Other sizes are what a fit depends on, conservatively: a part's rect is
+its minimum-area rectangle (it holds the part, corners and all); a hole's is that
+rectangle inset evenly on every side until it lies inside the loop (rounded or chamfered
+corners cost the inset: 0.29 mm a side for a 1 mm radius), so a rect peg that passes the
+recorded rect passes the hole. The corner radius that explains the area the corners lack
+is kept (``corner``, reported). Where the part's
 B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
 diameter instead.
 """
