@@ -308,7 +308,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
-    assumed += [*derived.assumptions(), nominal_assumption(derived)]
+    assumed += [*derived.assumptions(), *nominal_assumption(derived)]
     mapped = map_product(derived, settings)
     written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)

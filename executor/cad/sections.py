@@ -15,14 +15,15 @@ A loop is classified as
 - ``polygon`` otherwise: the loop itself, compared with
   :mod:`executor.world.fit` (``outline``).
 
-A round section is a tessellated cylinder, and a tessellation puts its vertices on the
-true surface: its diameter, a part's and a hole's alike, is its vertex circle (the
-circumscribed circle of the loop), the cylinder's nominal diameter; its ``deflection`` is
-how far the loop's edges come in from that circle (the chord's sagitta, measured), the
-most by which the polygon is narrower than the cylinder. A peg and a hole whose diameters
-differ by less than the larger deflection plus :data:`executor.cad.sweep.TOUCH` are a
-nominal zero-clearance fit (:func:`zero_clearance`), as the disassembly's sliding
-cylinders are. Other sizes are what a fit depends on, conservatively: a part's rect is
+Sizes are what a fit depends on, conservatively: a part's round section is its vertex
+circle (its widest), a hole's its inscribed circle (its narrowest), so a polygonal hole's
+size is its inradius and a tessellated cylinder's is within the tessellation's deflection;
+the ``deflection`` kept is how far the loop's edges come in from its vertex circle (the
+chords' sagitta, measured). Whether a tessellation's vertices or its edges lie on the true
+cylinder the mesh does not say (a CAD kernel's vertices do, Cranfield's export's hole
+edges do): a round peg and hole whose vertex circles' radii differ by less than the larger
+deflection plus :data:`executor.cad.sweep.TOUCH` are a nominal zero-clearance fit
+(:func:`zero_clearance`), as the disassembly's sliding cylinders are. A part's rect is
 its minimum-area rectangle (it holds the part, corners and all); a hole's is that
 rectangle inset evenly on every side until it lies inside the loop (rounded or chamfered
 corners cost the inset: 0.29 mm a side for a 1 mm radius), so a rect peg that passes the
@@ -88,7 +89,8 @@ class Loop:
 class Shape2D:
     """A classified loop: ``kind`` (round, square, rect, polygon), ``a`` ≥ ``b`` [m] (a
     round section: its diameter twice; a polygon: its minimum-area rectangle's sides),
-    ``deflection`` [m] a round section's sagitta (its loop's edges inside its circle; 0: exact),
+    ``deflection`` [m] a round section's sagitta (its loop's edges inside its vertex circle,
+    whose diameter is a part's ``a`` and a hole's ``a`` + 2 ``deflection``; 0: exact),
     ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]; a polygon: 0, its outline
     holds its turn), ``centre`` (2,) [m] in the slice's frame, ``outline`` (n, 2) [m] the
     loop's points about the centre, ``corner`` [m] the corner radius a rect's missing
@@ -205,15 +207,16 @@ def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> 
 
 
 def classify(loop: Loop, *, hole: bool) -> Shape2D:
-    """The loop's cross-section (the module docstring); ``hole`` picks a rect's inscribed size."""
+    """The loop's cross-section (the module docstring); ``hole`` picks the inscribed size."""
     points, centre = loop.points, loop.centre
     outline = points - centre
     radii = np.linalg.norm(outline, axis=1)
     outer = float(radii.max())
     if (len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
             and loop.area >= 0.98 * math.pi * outer ** 2):
-        return Shape2D("round", 2 * outer, 2 * outer, 0.0, centre, outline=outline,
-                       deflection=outer - edge_distance(points, centre))
+        inner = edge_distance(points, centre)
+        d = 2 * (inner if hole else outer)
+        return Shape2D("round", d, d, 0.0, centre, outline=outline, deflection=outer - inner)
     a, b, angle = _min_rectangle(points)
     c, s = math.cos(angle), math.sin(angle)
     turned = points @ np.array([[c, -s], [s, c]])  # side a along the first axis
@@ -260,9 +263,9 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
 
 def zero_clearance(peg: Shape2D, hole: Shape2D) -> float | None:
     """The tolerance [m] of a nominal zero-clearance fit of ``peg`` in ``hole``: both
-    round, their diameters apart by less than the larger deflection plus
+    round, their vertex circles' radii apart by less than the larger deflection plus
     :data:`executor.cad.sweep.TOUCH` (the tolerance); None when they are no such pair."""
     if peg.kind != "round" or hole.kind != "round":
         return None
     tolerance = max(peg.deflection, hole.deflection) + TOUCH
-    return tolerance if abs(hole.a - peg.a) < tolerance else None
+    return tolerance if abs(hole.a / 2 + hole.deflection - peg.a / 2) < tolerance else None

@@ -146,4 +146,4 @@ def test_coaxial_cylinders_of_one_nominal_diameter_are_a_fit_whatever_their_tess
     assert "nominal zero-clearance fits" in done.stdout and "(2 pairs" in done.stdout  # the stated assumption
     margins = (tmp_path / "out" / "nominal_sizes.lp").read_text()
     assert "nominal_margin(peg,h1,0)." in margins and "nominal_margin(peg,h2,0)." in margins
-    assert "nominal_margin(peg,h3,-50)." in margins
+    assert "nominal_margin(peg,h3,-" in margins  # no room: the peg is larger
