@@ -144,6 +144,7 @@ def test_coaxial_cylinders_of_one_nominal_diameter_are_a_fit_whatever_their_tess
     fits = (tmp_path / "out" / "sizes.lp").read_text()
     assert "fits(peg,h1)." in fits and "fits(peg,h2)." in fits and "fits(peg,h3)" not in fits
     assert "nominal zero-clearance fits" in done.stdout and "(2 pairs" in done.stdout  # the stated assumption
+    assert "holds peg (round d 10.000 mm, nominal zero-clearance fit, room 0" in done.stdout
     margins = (tmp_path / "out" / "nominal_sizes.lp").read_text()
     assert "nominal_margin(peg,h1,0)." in margins and "nominal_margin(peg,h2,0)." in margins
     assert "nominal_margin(peg,h3,-" in margins  # no room: the peg is larger
