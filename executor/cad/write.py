@@ -8,9 +8,10 @@
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
-  square and rect sections, the polygon relation where one is a polygon), closed world;
+  square and rect sections, the polygon relation where one is a polygon) or when they
+  are a nominal zero-clearance fit (:func:`nominal_fits`, named in a comment), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
-  section in each hole's, the input of ``sizes learn --prior cad``;
+  section in each hole's (0: a nominal zero-clearance fit), the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
