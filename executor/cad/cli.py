@@ -191,10 +191,10 @@ def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> st
     (:func:`executor.world.geometry.section_fit`), or a nominal zero-clearance fit
     (:func:`executor.cad.sections.zero_clearance`) with the measured difference."""
     room = section_fit(section(peg_name, peg), section(hole_name, hole))
-    tolerance = zero_clearance(peg, hole)
-    if tolerance is not None:
-        return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, within the tessellation's "
-                f"{1e6 * tolerance:.1f} µm)")
+    apart = zero_clearance(peg, hole)
+    if apart is not None:
+        return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, vertex circles "
+                f"{1e6 * apart:+.1f} µm apart)")
     return f"clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
 
 

@@ -21,9 +21,10 @@ size is its inradius and a tessellated cylinder's is within the tessellation's d
 the ``deflection`` kept is how far the loop's edges come in from its vertex circle (the
 chords' sagitta, measured). Whether a tessellation's vertices or its edges lie on the true
 cylinder the mesh does not say (a CAD kernel's vertices do, Cranfield's export's hole
-edges do): a round peg and hole whose vertex circles' radii differ by less than the larger
-deflection plus :data:`executor.cad.sweep.TOUCH` are a nominal zero-clearance fit
-(:func:`zero_clearance`), as the disassembly's sliding cylinders are. A part's rect is
+edges do): a round peg at least as wide as a round hole's inscribed circle, whose vertex
+circle's radius is the hole's within :data:`executor.cad.sweep.TOUCH`, is taken for the
+same nominal diameter, a nominal zero-clearance fit (:func:`zero_clearance`), as the
+disassembly's sliding cylinders are. A part's rect is
 its minimum-area rectangle (it holds the part, corners and all); a hole's is that
 rectangle inset evenly on every side until it lies inside the loop (rounded or chamfered
 corners cost the inset: 0.29 mm a side for a 1 mm radius), so a rect peg that passes the
@@ -262,10 +263,11 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
 
 
 def zero_clearance(peg: Shape2D, hole: Shape2D) -> float | None:
-    """The tolerance [m] of a nominal zero-clearance fit of ``peg`` in ``hole``: both
-    round, their vertex circles' radii apart by less than the larger deflection plus
-    :data:`executor.cad.sweep.TOUCH` (the tolerance); None when they are no such pair."""
-    if peg.kind != "round" or hole.kind != "round":
+    """How far apart [m] the vertex circles' radii of ``peg`` and ``hole`` are when they
+    are a nominal zero-clearance fit: both round, the peg not narrower than the hole's
+    inscribed circle (else it passes with room), their vertex circles' radii within
+    :data:`executor.cad.sweep.TOUCH`; None when they are no such pair."""
+    if peg.kind != "round" or hole.kind != "round" or peg.a < hole.a:
         return None
-    tolerance = max(peg.deflection, hole.deflection) + TOUCH
-    return tolerance if abs(hole.a / 2 + hole.deflection - peg.a / 2) < tolerance else None
+    apart = hole.a / 2 + hole.deflection - peg.a / 2
+    return apart if abs(apart) < TOUCH else None

@@ -189,30 +189,33 @@ def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
 
 
 def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
-    """(peg, hole) -> the tolerance [m] of each nominal zero-clearance fit
-    (:func:`executor.cad.sections.zero_clearance`: round sections whose vertex circles' radii
-    differ by less than the tessellation's measured deflection plus 10 µm); a part with a
-    bore and a pin too."""
+    """(peg, hole) -> how far apart [m] the vertex circles' radii of each nominal
+    zero-clearance fit are (:func:`executor.cad.sections.zero_clearance`: a round peg at
+    least as wide as a round hole's inscribed circle, their vertex circles' radii within
+    10 µm); a part with a bore and a pin too."""
     found = {(pid, hid): zero_clearance(peg, hole)
              for pid, holes in _pairs(derived).items() for hid, (peg, hole) in holes.items()}
-    return {pair: tolerance for pair, tolerance in found.items() if tolerance is not None}
+    return {pair: apart for pair, apart in found.items() if apart is not None}
+
+
+RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
+        "is taken for one nominal diameter: a fit, room 0")
+"""The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
 
 
 def nominal_assumption(derived: Derived) -> list[str]:
     """The assumption of the nominal zero-clearance fits, as ``import`` prints it (none without one)."""
     nominal = nominal_fits(derived)
-    return [("nominal zero-clearance fits: a round peg and hole whose vertex circles' radii differ by less than the "
-             f"larger section deflection plus 10 µm fit with room 0 ({len(nominal)} pairs, tolerances up to "
-             f"{1e6 * max(nominal.values()):.1f} µm)")] if nominal else []
+    return [f"nominal zero-clearance fits: {RULE.format(um='µm')} ({len(nominal)} pairs, vertex circles up to "
+            f"{1e6 * max(map(abs, nominal.values())):.1f} µm apart)"] if nominal else []
 
 
 def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
     """``sizes.lp``'s and ``nominal_sizes.lp``'s comment naming the nominal zero-clearance fits."""
     if not nominal:
         return []
-    return ["% Assumed: round sections whose vertex circles' radii differ by less than the tessellation's deflection "
-            "plus 10 um are nominal zero-clearance fits (room 0): "
-            + ", ".join(f"{p}->{h} ({1e6 * t:.1f} um)" for (p, h), t in nominal.items()) + "."]
+    return [f"% Assumed: {RULE.format(um='um')}: "
+            + ", ".join(f"{p}->{h} ({1e6 * t:+.1f} um)" for (p, h), t in nominal.items()) + "."]
 
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
