@@ -194,7 +194,7 @@ def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> st
     apart = zero_clearance(peg, hole)
     if apart is not None:
         return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, vertex circles "
-                f"{1e6 * apart:+.1f} µm apart)")
+                f"{round(1e6 * apart, 1) + 0.0:+.1f} µm apart)")
     return f"clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
 
 

@@ -215,7 +215,7 @@ def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
     if not nominal:
         return []
     return [f"% Assumed: {RULE.format(um='um')}: "
-            + ", ".join(f"{p}->{h} ({1e6 * t:+.1f} um)" for (p, h), t in nominal.items()) + "."]
+            + ", ".join(f"{p}->{h} ({round(1e6 * t, 1) + 0.0:+.1f} um)" for (p, h), t in nominal.items()) + "."]
 
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
