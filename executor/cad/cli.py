@@ -49,6 +49,7 @@ from executor.cad.parts import (
     load_meshes,
     translated,
 )
+from executor.cad.sections import Shape2D, zero_clearance
 from executor.cad.step import load_step
 from executor.cad.sweep import opposite
 from executor.cad.write import (
@@ -56,6 +57,7 @@ from executor.cad.write import (
     Settings,
     claim_folder,
     map_product,
+    nominal_assumption,
     section,
     write_folder,
 )
@@ -184,6 +186,18 @@ def _describe(kind: str, a: float, b: float) -> str:
     return f"round d {_mm(a)}" if kind == "round" else f"{kind} {_mm(a)} x {_mm(b)}"
 
 
+def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> str:
+    """How ``peg`` passes ``hole`` as the report says it: the clearance and room all round
+    (:func:`executor.world.geometry.section_fit`), or a nominal zero-clearance fit
+    (:func:`executor.cad.sections.zero_clearance`) with the measured difference."""
+    room = section_fit(section(peg_name, peg), section(hole_name, hole))
+    apart = zero_clearance(peg, hole)
+    if apart is not None:
+        return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, vertex circles "
+                f"{round(1e6 * apart, 1) + 0.0:+.1f} µm apart)")
+    return f"clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
+
+
 def report(derived: Derived) -> list[str]:
     """The lines ``import`` prints about what it derived."""
     lines = []
@@ -195,9 +209,8 @@ def report(derived: Derived) -> list[str]:
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
         held = "empty"
         if fit.part is not None and fit.section is not None:
-            room = section_fit(section(fit.part, fit.section), section(hid, fit.hole))
-            held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, clearance "
-                    f"{_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg)")
+            held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, "
+                    f"{_clearance(fit.section, fit.hole, fit.part, hid)})")
         lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
                      f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
@@ -205,9 +218,8 @@ def report(derived: Derived) -> list[str]:
         onto = []
         for pid in pin.parts:
             bore = derived.bores[pid]
-            room = section_fit(section(pin_id, pin.section), section(pid, bore))
-            onto.append(f"{pid} onto it (bore {_describe(bore.kind, bore.a, bore.b)} mm, clearance "
-                        f"{_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg)")
+            onto.append(f"{pid} onto it (bore {_describe(bore.kind, bore.a, bore.b)} mm, "
+                        f"{_clearance(pin.section, bore, pin_id, pid)})")
         lines.append(f"pin {pin_id} of {pin.owner} at ({_mm(pin.position[0])}, {_mm(pin.position[1])}) mm, "
                      f"entered along {opposite(pin.axis)}: {_describe(pin.section.kind, pin.section.a, pin.section.b)}"
                      f" mm; {'; '.join(onto)}")
@@ -307,7 +319,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
-    assumed += derived.assumptions()
+    assumed += [*derived.assumptions(), *nominal_assumption(derived)]
     mapped = map_product(derived, settings)
     written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)

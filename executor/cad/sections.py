@@ -15,14 +15,21 @@ A loop is classified as
 - ``polygon`` otherwise: the loop itself, compared with
   :mod:`executor.world.fit` (``outline``).
 
-Sizes are what a fit depends on, conservatively: a part's round section is its
-circumscribed circle (its widest), a hole's its inscribed circle (its narrowest), so a
-polygonal hole's size is its inradius and a tessellated cylinder's is within the
-tessellation's deflection. A part's rect is its minimum-area rectangle (it holds the part,
-corners and all); a hole's is that rectangle inset evenly on every side until it lies
-inside the loop (rounded or chamfered corners cost the inset: 0.29 mm a side for a 1 mm
-radius), so a rect peg that passes the recorded rect passes the hole. The corner radius
-that explains the area the corners lack is kept (``corner``, reported). Where the part's
+Sizes are what a fit depends on, conservatively: a part's round section is its vertex
+circle (its widest), a hole's its inscribed circle (its narrowest), so a polygonal hole's
+size is its inradius and a tessellated cylinder's is within the tessellation's deflection;
+the ``deflection`` kept is how far the loop's edges come in from its vertex circle (the
+chords' sagitta, measured). Whether a tessellation's vertices or its edges lie on the true
+cylinder the mesh does not say (a CAD kernel's vertices do, Cranfield's export's hole
+edges do): a round peg at least as wide as a round hole's inscribed circle, whose vertex
+circle's radius is the hole's within :data:`executor.cad.sweep.TOUCH`, is taken for the
+same nominal diameter, a nominal zero-clearance fit (:func:`zero_clearance`), as the
+disassembly's sliding cylinders are. A part's rect is
+its minimum-area rectangle (it holds the part, corners and all); a hole's is that
+rectangle inset evenly on every side until it lies inside the loop (rounded or chamfered
+corners cost the inset: 0.29 mm a side for a 1 mm radius), so a rect peg that passes the
+recorded rect passes the hole. The corner radius that explains the area the corners lack
+is kept (``corner``, reported). Where the part's
 B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
 diameter instead.
 """
@@ -41,6 +48,7 @@ from scipy.spatial import ConvexHull
 from trimesh.path.traversal import discretize_path
 
 from executor.cad.parts import Cylinder
+from executor.cad.sweep import TOUCH
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
@@ -83,6 +91,8 @@ class Loop:
 class Shape2D:
     """A classified loop: ``kind`` (round, square, rect, polygon), ``a`` ≥ ``b`` [m] (a
     round section: its diameter twice; a polygon: its minimum-area rectangle's sides),
+    ``deflection`` [m] a round section's sagitta (its loop's edges inside its vertex circle,
+    whose diameter is a part's ``a`` and a hole's ``a`` + 2 ``deflection``; 0: exact),
     ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]; a polygon: 0, its outline
     holds its turn), ``centre`` (2,) [m] in the slice's frame, ``outline`` (n, 2) [m] the
     loop's points about the centre, ``corner`` [m] the corner radius a rect's missing
@@ -95,6 +105,7 @@ class Shape2D:
     centre: np.ndarray
     outline: np.ndarray = field(repr=False, kw_only=True)
     corner: float = field(default=0.0, kw_only=True)
+    deflection: float = field(default=0.0, kw_only=True)
 
 
 def frame_of(axis: np.ndarray) -> np.ndarray:
@@ -207,8 +218,9 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
     outer = float(radii.max())
     if (len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
             and loop.area >= 0.98 * math.pi * outer ** 2):
-        d = 2 * (edge_distance(points, centre) if hole else outer)
-        return Shape2D("round", d, d, 0.0, centre, outline=outline)
+        inner = edge_distance(points, centre)
+        d = 2 * (inner if hole else outer)
+        return Shape2D("round", d, d, 0.0, centre, outline=outline, deflection=outer - inner)
     a, b, angle = _min_rectangle(points)
     c, s = math.cos(angle), math.sin(angle)
     turned = points @ np.array([[c, -s], [s, c]])  # side a along the first axis
@@ -238,7 +250,7 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
                 tolerance: float) -> Shape2D:
     """``shape`` with the diameter of the B-rep cylinder it tessellates, if it is round and
     one of ``cylinders`` is parallel to ``axis``, on the loop's centre (``level`` [m] along
-    the axis) and within ``tolerance`` [m] of its radius; else ``shape`` unchanged."""
+    the axis) and within ``tolerance`` [m] of its radius (deflection 0); else ``shape`` unchanged."""
     if shape.kind != "round":
         return shape
     axis = np.asarray(axis, dtype=float)
@@ -251,3 +263,14 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
             d = 2 * cylinder.radius
             return Shape2D("round", d, d, 0.0, shape.centre, outline=shape.outline)
     return shape
+
+
+def zero_clearance(peg: Shape2D, hole: Shape2D) -> float | None:
+    """How far apart [m] the vertex circles' radii of ``peg`` and ``hole`` are when they
+    are a nominal zero-clearance fit: both round, the peg not narrower than the hole's
+    inscribed circle (else it passes with room), their vertex circles' radii within
+    :data:`executor.cad.sweep.TOUCH`; None when they are no such pair."""
+    if peg.kind != "round" or hole.kind != "round" or peg.a < hole.a:
+        return None
+    apart = hole.a / 2 + hole.deflection - peg.a / 2
+    return apart if abs(apart) < TOUCH else None

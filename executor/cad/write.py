@@ -8,9 +8,10 @@
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
-  square and rect sections, the polygon relation where one is a polygon), closed world;
+  square and rect sections, the polygon relation where one is a polygon) or when they
+  are a nominal zero-clearance fit (:func:`nominal_fits`, named in a comment), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
-  section in each hole's, the input of ``sizes learn --prior cad``;
+  section in each hole's (0: a nominal zero-clearance fit), the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
   from the disassembly and the locating rule, each direct pair's reason in a comment
   (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
@@ -63,7 +64,7 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.sections import Shape2D
+from executor.cad.sections import Shape2D, zero_clearance
 from executor.cad.sweep import opposite
 from executor.world.geometry import Section, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
@@ -161,34 +162,76 @@ def _section_kind(fit: HoleFit | None) -> str | None:
 
 
 def sizes_text(derived: Derived) -> str:
-    """``sizes.lp``: ``fits(P,H)`` for every peg whose nominal section passes a hole's (:func:`margins`)."""
-    rooms = margins(derived)
+    """``sizes.lp``: ``fits(P,H)`` for every peg whose nominal section passes a hole's
+    (:func:`margins`) or is a nominal zero-clearance fit in it (:func:`nominal_fits`, named
+    in a comment as the assumption it is)."""
+    rooms, nominal = margins(derived), nominal_fits(derived)
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
+             *_nominal_comments(nominal),
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in rooms]),
              _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in [*derived.holes, *derived.pins]])]
     for pid, holes in rooms.items():
         fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, room in holes.items()
-                if room > 0]
+                if room > 0 or (pid, hid) in nominal]
         if fits:
             lines.append(_symbols(fits))
     return "\n".join(lines) + "\n"
+
+
+def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
+    """Peg -> hole -> the measured sections of the peg and the hole, and part with a bore
+    -> pin -> those of the pin and the bore (the pin goes into the bore)."""
+    pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in derived.holes.items()}
+             for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
+    for pid, bore in sorted(derived.bores.items()):
+        pairs.setdefault(pid, {}).update({pin_id: (pin.section, bore) for pin_id, pin in derived.pins.items()})
+    return pairs
+
+
+def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
+    """(peg, hole) -> how far apart [m] the vertex circles' radii of each nominal
+    zero-clearance fit are (:func:`executor.cad.sections.zero_clearance`: a round peg at
+    least as wide as a round hole's inscribed circle, their vertex circles' radii within
+    10 µm); a part with a bore and a pin too."""
+    found = {(pid, hid): zero_clearance(peg, hole)
+             for pid, holes in _pairs(derived).items() for hid, (peg, hole) in holes.items()}
+    return {pair: apart for pair, apart in found.items() if apart is not None}
+
+
+RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
+        "is taken for one nominal diameter: a fit, room 0")
+"""The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
+
+
+def nominal_assumption(derived: Derived) -> list[str]:
+    """The assumption of the nominal zero-clearance fits, as ``import`` prints it (none without one)."""
+    nominal = nominal_fits(derived)
+    return [f"nominal zero-clearance fits: {RULE.format(um='µm')} ({len(nominal)} pairs, vertex circles up to "
+            f"{1e6 * max(map(abs, nominal.values())):.1f} µm apart)"] if nominal else []
+
+
+def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
+    """``sizes.lp``'s and ``nominal_sizes.lp``'s comment naming the nominal zero-clearance fits."""
+    if not nominal:
+        return []
+    return [f"% Assumed: {RULE.format(um='um')}: "
+            + ", ".join(f"{p}->{h} ({round(1e6 * t, 1) + 0.0:+.1f} um)" for (p, h), t in nominal.items()) + "."]
 
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's, and part
     with a bore -> pin -> the room of the pin's section in the bore's
     (:func:`executor.world.geometry.margin`, the polygon relation for
-    polygon sections; negative: it does not pass); ExecutorError naming the part, hole,
-    pin or bore whose polygon section is no simple outline."""
-    pegs = {pid: fit.section for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
+    polygon sections; negative: it does not pass; 0 for a nominal zero-clearance fit,
+    :func:`nominal_fits`); ExecutorError naming the part, hole, pin or bore whose polygon
+    section is no simple outline."""
+    nominal = nominal_fits(derived)
     try:
-        rooms = {pid: {hid: margin(section(f"part {pid}", peg), section(f"hole {hid}", fit.hole))
-                       for hid, fit in derived.holes.items()} for pid, peg in pegs.items()}
-        for pid, bore in sorted(derived.bores.items()):
-            rooms.setdefault(pid, {}).update({
-                pin_id: margin(section(f"pin {pin_id}", pin.section), section(f"bore of {pid}", bore))
-                for pin_id, pin in derived.pins.items()})
-        return rooms
+        return {pid: {hid: 0.0 if (pid, hid) in nominal else margin(
+                    section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
+                    section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+                      for hid, (peg, hole) in holes.items()}
+                for pid, holes in _pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself
         raise ExecutorError(f"{exc} (the mesh's slice at the hole's mid-depth)") from None
 
@@ -196,7 +239,7 @@ def margins(derived: Derived) -> dict[str, dict[str, float]]:
 def nominal_text(derived: Derived) -> str:
     """``nominal_margin(P,H,M)``: the room [µm, rounded] of each peg in each hole (:func:`margins`)."""
     lines = ["% The nominal room of every peg in every hole [um] (negative: it does not pass), by ./run.sh import;",
-             "% the input of sizes learn --prior cad."]
+             "% the input of sizes learn --prior cad.", *_nominal_comments(nominal_fits(derived))]
     for pid, rooms in margins(derived).items():
         lines.append(_symbols([clingo.Function("nominal_margin", [
             clingo.Function(pid), clingo.Function(hid), clingo.Number(round(1e6 * room))])

@@ -118,3 +118,33 @@ def test_a_step_product_with_a_flanged_peg_is_assembled_in_the_simulated_cell(
     assert result["assembled"] is True
     assert [step["part"] for step in result["steps"]] == ["plate", "flange_peg"]
     assert result["final_pose_error_mm"]["flange_peg"] < POSE_BOUND_MM, result
+
+
+def _cylinder(diameter: float, sections: int, height: float, z: float, x: float = 0.0) -> trimesh.Trimesh:
+    """A cylinder [mm] along z tessellated with ``sections`` vertices a ring, centred at (x, 0, z)."""
+    mesh = trimesh.creation.cylinder(radius=diameter / 2, height=height, sections=sections)
+    mesh.apply_translation((x, 0, z))
+    return mesh
+
+
+@pytest.mark.slow  # imports a product (about 3 s)
+def test_coaxial_cylinders_of_one_nominal_diameter_are_a_fit_whatever_their_tessellation(tmp_path: Path) -> None:
+    # A d 10 peg (64-gon) stands in a d 10 hole (48-gon); an empty d 10 hole (40-gon) and an
+    # empty d 9.95 hole (56-gon, the peg 50 µm larger) beside it. Measured on the polygons'
+    # inscribed circles the peg fitted none of them.
+    folder = tmp_path / "cad"
+    folder.mkdir()
+    holes = [_cylinder(d, n, 15, 2.5 + 1e-3, x) for d, n, x in ((10, 48, -30), (10, 40, 0), (9.95, 56, 30))]
+    plate = trimesh.boolean.difference([_box((100, 100, 20), (0, 0, 0)), *holes], engine="manifold")
+    plate.export(folder / "plate.stl")
+    _cylinder(10, 64, 30, 10 + 1e-3, -30).export(folder / "peg.stl")  # on the hole's floor
+    done = subprocess.run([sys.executable, "-m", "assembly_constraints.cli", "import", str(folder),
+                           "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    fits = (tmp_path / "out" / "sizes.lp").read_text()
+    assert "fits(peg,h1)." in fits and "fits(peg,h2)." in fits and "fits(peg,h3)" not in fits
+    assert "nominal zero-clearance fits" in done.stdout and "(2 pairs" in done.stdout  # the stated assumption
+    assert "holds peg (round d 10.000 mm, nominal zero-clearance fit, room 0" in done.stdout
+    margins = (tmp_path / "out" / "nominal_sizes.lp").read_text()
+    assert "nominal_margin(peg,h1,0)." in margins and "nominal_margin(peg,h2,0)." in margins
+    assert "nominal_margin(peg,h3,-" in margins  # no room: the peg is larger

@@ -97,4 +97,6 @@ def test_outlines_that_are_no_round_square_or_rect_are_polygons(name: str, outli
 def test_a_tessellated_cylinder_stays_round() -> None:
     circle = shapely.Point(0, 0).buffer(5 * MM, quad_segs=6)  # a 24-gon
     assert classify(loop_of(circle), hole=False).kind == "round"
-    assert classify(loop_of(circle), hole=True).a == pytest.approx(10 * MM * math.cos(math.pi / 24), rel=1e-9)
+    hole = classify(loop_of(circle), hole=True)
+    assert hole.a == pytest.approx(10 * MM * math.cos(math.pi / 24), rel=1e-9)
+    assert hole.deflection == pytest.approx(5 * MM * (1 - math.cos(math.pi / 24)), rel=1e-6)
