@@ -325,6 +325,7 @@ class SimRobot:
             gripper = robot_server.gripper_server
             if gripper is not None:
                 gripper.__class__ = WeldingGripperServer  # as the robot's class: all it has is kept
+                assert isinstance(gripper, WeldingGripperServer)
                 gripper.welds = self._welds
         sim.register_post_step_callback(self._after_step)
         server.run_async(self._realtime)

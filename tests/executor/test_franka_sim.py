@@ -1,7 +1,7 @@
 """franky-sim with a product in its MuJoCo scene (executor.franka.sim_scene, sim_server):
 the holes are where and as large as geometry.toml says, and a Franka driven through franky
-grasps a peg (welded to the hand while held), inserts it where it fits, stops on force where it does not, and reports the
-contact force that MuJoCo applies."""
+grasps a peg (welded to the hand while held), inserts it where it fits, stops on force where
+it does not, and reports the contact force that MuJoCo applies."""
 
 from __future__ import annotations
 
