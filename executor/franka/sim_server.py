@@ -20,12 +20,16 @@ file of it is changed; figures in docs/franka.md, "Testing against franky-sim"):
 3. joint 7's damping: :data:`JOINT_KV` (franky-sim's 200 chatters at the 1 ms step);
 4. the fingers: :data:`FINGER_GAIN` and :data:`FINGER_DAMPING` (franky-sim's squeeze ~6 N,
    and its damping is unstable at the 1 ms step); and MuJoCo's contact options against slip
-   in a grasp (:data:`executor.franka.sim_scene.CONTACT_OPTIONS`).
+   in a grasp (:data:`executor.franka.sim_scene.CONTACT_OPTIONS`). Even so, two point
+   contacts let a peg pivot and slide under insertion forces (3-31 mm), so a grasped part
+   is held as the PyBullet cell holds it (:mod:`executor.assembly.grasp`): welded to the
+   hand while the fingers close on it (:class:`GraspWelds`, :class:`WeldingGripperServer`).
 """
 
 from __future__ import annotations
 
 import json
+import socket
 import threading
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Sequence
@@ -36,6 +40,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 from franky_sim import SimulationServer
+from franky_sim.franka_gripper_server import FrankaGripperServer, _MotionState
 from franky_sim.franka_robot_state import FrankaRobotState
 from franky_sim.mujoco_simulator import FrankaMujocoRobot, MujocoSimulator
 
@@ -43,7 +48,14 @@ from bridge.cli_types import ArgumentParser, add_assembly_argument, run_command
 from bridge.errors import ToolError
 from bridge.files import write_atomic
 from executor import ExecutorError
-from executor.franka.sim_scene import add_product, contact_force, from_base, set_contact_options
+from executor.franka.sim_scene import (
+    add_grasp_welds,
+    add_product,
+    contact_force,
+    from_base,
+    set_contact_options,
+    weld_name,
+)
 from executor.world.geometry import CellGeometry, load_geometry
 
 JOINT_KV = (450.0, 450.0, 350.0, 350.0, 200.0, 200.0, 60.0)
@@ -62,6 +74,9 @@ walks along the pads)."""
 
 HAND_BODY = "robot0_hand"
 """The MuJoCo body of the Franka Hand; its origin is the flange."""
+
+FINGER_BODIES = ("robot0_left_finger", "robot0_right_finger")
+"""The MuJoCo bodies of the Franka Hand's fingers (children of :data:`HAND_BODY`)."""
 
 GRAVITY = np.array([0.0, 0.0, -9.81])
 """franky-sim's gravity [m/s^2], base frame."""
@@ -153,17 +168,104 @@ class SensedRobot(FrankaMujocoRobot):
         )
 
 
+class GraspWelds:
+    """The welds of :func:`executor.franka.sim_scene.add_grasp_welds` in a compiled scene:
+    each part's, inactive until the fingers close on the part. Called from franky-sim's
+    stepping thread between two steps (the gripper server runs there), so the data it reads
+    and writes is that of the last step."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, parts: dict[str, int]) -> None:
+        self.model, self.data = model, data
+        body = mujoco.mjtObj.mjOBJ_BODY
+        self.hand = mujoco.mj_name2id(model, body, HAND_BODY)
+        self.fingers = tuple(mujoco.mj_name2id(model, body, name) for name in FINGER_BODIES)
+        self.parts = dict(parts)
+        self.welds = {pid: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, weld_name(pid)) for pid in parts}
+
+    def held(self) -> set[str]:
+        """The parts welded to the hand."""
+        return {pid for pid, weld in self.welds.items() if self.data.eq_active[weld]}
+
+    def touched(self) -> set[str]:
+        """The parts in contact with both fingers at the last step."""
+        touching: dict[int, set[int]] = {}
+        for i in range(self.data.ncon):
+            first, second = (int(self.model.geom_bodyid[g]) for g in self.data.contact[i].geom)
+            for finger, other in ((first, second), (second, first)):
+                if finger in self.fingers:
+                    touching.setdefault(other, set()).add(finger)
+        return {pid for pid, body in self.parts.items() if touching.get(body) == set(self.fingers)}
+
+    def hold_touched(self) -> None:
+        """Weld each part touched by both fingers to the hand at the pose it has now
+        (the weld's relative pose set from the present poses: nothing jumps)."""
+        d = self.data
+        for pid in self.touched() - self.held():
+            body, weld = self.parts[pid], self.welds[pid]
+            hand_axes = d.xmat[self.hand].reshape(3, 3)
+            hand_inverse = np.zeros(4)
+            mujoco.mju_negQuat(hand_inverse, d.xquat[self.hand])
+            relative = np.zeros(4)
+            mujoco.mju_mulQuat(relative, hand_inverse, d.xquat[body])
+            # MuJoCo's weld data: anchor on the part (3, its origin), the part's position and
+            # orientation in the hand's frame (3 + 4), then the torque scale.
+            self.model.eq_data[weld, 0:3] = 0.0
+            self.model.eq_data[weld, 3:6] = hand_axes.T @ (d.xpos[body] - d.xpos[self.hand])
+            self.model.eq_data[weld, 6:10] = relative
+            d.eq_active[weld] = 1
+
+    def release(self) -> None:
+        """Let every welded part go."""
+        self.data.eq_active[list(self.welds.values())] = 0
+
+
+class WeldingGripperServer(FrankaGripperServer):
+    """franky-sim's gripper server that welds the part it closed on to the hand and lets
+    it go as it opens: a command that opens the fingers (a target wider than they are, or
+    homing) releases at its start; a move or grasp welds, as it ends, each part that both
+    fingers touch. :class:`SimRobot` turns franky-sim's server into this class and sets
+    ``welds``."""
+
+    welds: GraspWelds | None = None
+
+    def start_move(self, width: float, speed: float, command_id: int, tcp_socket: socket.socket) -> None:
+        self._release_if_opening(width)
+        super().start_move(width, speed, command_id, tcp_socket)
+
+    def start_grasp(self, width: float, speed: float, force: float, epsilon_inner: float, epsilon_outer: float,
+                    command_id: int, tcp_socket: socket.socket) -> None:
+        self._release_if_opening(width)
+        super().start_grasp(width, speed, force, epsilon_inner, epsilon_outer, command_id, tcp_socket)
+
+    def start_homing(self, command_id: int, tcp_socket: socket.socket) -> None:
+        if self.welds is not None:
+            self.welds.release()
+        super().start_homing(command_id, tcp_socket)
+
+    def _release_if_opening(self, width: float) -> None:
+        if self.welds is not None and width > self._robot.hand_width:
+            self.welds.release()
+
+    def _check_motion_state(self) -> None:
+        closing = self._motion_state in (_MotionState.MOVING, _MotionState.GRASPING)
+        super()._check_motion_state()
+        if closing and self._motion_state is _MotionState.IDLE and self.welds is not None:
+            self.welds.hold_touched()
+
+
 @dataclass(frozen=True)
 class Truth:
     """The simulated world between two steps, for tests: ``time`` [s] since the start;
     ``poses`` of the parts (position [m] of the body frame, the bottom face centre, in
     the product frame; quaternion w x y z); ``plate_force`` [N], base axes, the plate's
-    contact force on each part; ``wrench`` the one the arm reports, at the same step."""
+    contact force on each part; ``wrench`` the one the arm reports, at the same step;
+    ``held`` the parts welded to the hand (:class:`GraspWelds`)."""
 
     time: float
     poses: dict[str, tuple[np.ndarray, np.ndarray]]
     plate_force: dict[str, np.ndarray]
     wrench: Wrench | None
+    held: frozenset[str] = frozenset()
 
 
 class SimRobot:
@@ -178,6 +280,7 @@ class SimRobot:
         self._sim: MujocoSimulator | None = None
         self._server: SimulationServer | None = None
         self._robot: SensedRobot | None = None
+        self._welds: GraspWelds | None = None
         self._bodies: dict[str, int] = {}
         self._plate = -1
         self._wanted = threading.Event()
@@ -203,6 +306,7 @@ class SimRobot:
         names = add_product(sim.scene, sim.worldbody, self.geometry)
         add_flange_sensor(sim)
         set_contact_options(sim.scene)
+        add_grasp_welds(sim.scene, HAND_BODY, names)
         server = SimulationServer(sim) if self._hostname is None else SimulationServer(sim, [self._hostname])
         self._sim, self._server, self._robot = sim, server, robot
         try:
@@ -216,6 +320,13 @@ class SimRobot:
         self._robot.sensor = FlangeSensor(model, data, robot._dof_addrs)
         self._bodies = {pid: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for pid, name in names.items()}
         self._plate = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "plate")
+        self._welds = GraspWelds(model, data, self._bodies)
+        for robot_server in server.robot_servers:
+            gripper = robot_server.gripper_server
+            if gripper is not None:
+                gripper.__class__ = WeldingGripperServer  # as the robot's class: all it has is kept
+                assert isinstance(gripper, WeldingGripperServer)
+                gripper.welds = self._welds
         sim.register_post_step_callback(self._after_step)
         server.run_async(self._realtime)
         return self.host
@@ -257,7 +368,8 @@ class SimRobot:
         if robot.sensor is not None:  # the wrench of this very step, as the plate's force is
             tcp = robot.kinematics(np.array(robot.inner_state.q)).copy().translation
             wrench = robot.sensor.wrench(tcp, robot.m_load, robot.F_x_Cload)
-        return Truth(float(data.time), poses, forces, wrench)
+        held = frozenset() if self._welds is None else frozenset(self._welds.held())
+        return Truth(float(data.time), poses, forces, wrench, held)
 
     def __enter__(self) -> SimRobot:
         self.start()

@@ -1,7 +1,7 @@
 """franky-sim with a product in its MuJoCo scene (executor.franka.sim_scene, sim_server):
 the holes are where and as large as geometry.toml says, and a Franka driven through franky
-grasps a peg, inserts it where it fits, stops on force where it does not, and reports the
-contact force that MuJoCo applies."""
+grasps a peg (welded to the hand while held), inserts it where it fits, stops on force where
+it does not, and reports the contact force that MuJoCo applies."""
 
 from __future__ import annotations
 
@@ -117,7 +117,11 @@ def test_franka_inserts_a_peg_where_it_fits_and_stops_on_force_where_not(tmp_pat
         arm = _Arm(sim.host)
         arm.go(np.array([*peg.start, peg.length + 0.03]))
         arm.go(np.array([*peg.start, peg.length - held]))
+        before = sim.truth().poses["p3"][0]
         assert arm.gripper.grasp(0.0, 0.05, 60.0, epsilon_inner=0.005, epsilon_outer=0.03)
+        grasped = sim.truth()
+        assert grasped.held == {"p3"}  # welded to the hand where the fingers closed on it: no jump
+        assert np.allclose(grasped.poses["p3"][0], before, atol=1e-3)
         arm.robot.set_load(peg.mass, [0.0, 0.0, 0.1034 - held + peg.length / 2], [0.0] * 9)
 
         arm.go(np.array([*peg.start, too_small.top_z + below + 0.01]))  # up, then across at that height
@@ -137,6 +141,8 @@ def test_franka_inserts_a_peg_where_it_fits_and_stops_on_force_where_not(tmp_pat
         time.sleep(0.3)
         depth = fits.top_z - sim.truth().poses["p3"][0][2]
         assert depth > 0.010  # in the hole (18 mm commanded below the entry; the no-fit stays within 5 mm)
+        assert arm.gripper.move(0.04, 0.05)
+        assert sim.truth().held == frozenset()  # let go as the fingers opened
 
 
 @pytest.mark.slow
