@@ -26,11 +26,13 @@ test starts in-process).
 
 from __future__ import annotations
 
+import fcntl
 import functools
 import json
 import os
 import subprocess
 import sys
+import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Protocol
@@ -76,6 +78,16 @@ def error_lines(stderr: str) -> list[str]:
 class Runner(Protocol):
     def __call__(self, *args: str, cwd: Path | str | None = None, input: str | None = None,
                  timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]: ...
+
+
+@pytest.fixture
+def one_simulated_arm() -> Iterator[None]:
+    """Waits for, then holds, the machine's lock of franky-sim arms for the test: each runs
+    a free-running 1 kHz loop with its client, and two at once (one per test worker)
+    starved each other into libfranka timeouts."""
+    with open(Path(tempfile.gettempdir()) / "assembly-constraints-franky-sim.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -107,6 +107,8 @@ class _Arm:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1200)  # the wait for the arm lock included
+@pytest.mark.usefixtures("one_simulated_arm")
 def test_franka_inserts_a_peg_where_it_fits_and_stops_on_force_where_not(tmp_path: Path) -> None:
     folder = _spare_with_peg_at(tmp_path, "p3", (0.42, -0.06))
     geometry = load_geometry(str(folder))
@@ -146,6 +148,8 @@ def test_franka_inserts_a_peg_where_it_fits_and_stops_on_force_where_not(tmp_pat
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1200)  # the wait for the arm lock included
+@pytest.mark.usefixtures("one_simulated_arm")
 def test_the_server_process_prints_its_address_and_writes_the_poses_when_stopped(tmp_path: Path) -> None:
     poses = tmp_path / "poses.json"
     process = subprocess.Popen([sys.executable, "-m", "executor.franka.sim_server", "--assembly", "spare",
