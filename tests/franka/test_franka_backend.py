@@ -56,6 +56,7 @@ def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeo
 @pytest.mark.slow
 @pytest.mark.timeout(1200)
 @pytest.mark.usefixtures("one_simulated_arm")
+@pytest.mark.franka_arm
 def test_a_part_too_big_stops_on_force_and_goes_back(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
     sim, backend, geometry = spare_arm
     result, evidence = backend.run(InsertRequest(id="a", part="p3", hole="r1"))
@@ -69,6 +70,7 @@ def test_a_part_too_big_stops_on_force_and_goes_back(spare_arm: tuple[SimRobot, 
 @pytest.mark.slow
 @pytest.mark.timeout(1200)
 @pytest.mark.usefixtures("one_simulated_arm")
+@pytest.mark.franka_arm
 def test_a_plan_step_places_a_peg_in_its_hole(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
     sim, backend, geometry = spare_arm
     assert backend.run_step(StepRequest(id="s1", assembly="run", step=1, part="bp"))[0] == "fit"

@@ -31,6 +31,7 @@ PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 @pytest.mark.slow
 @pytest.mark.timeout(1800)
 @pytest.mark.usefixtures("one_simulated_arm")
+@pytest.mark.franka_arm
 def test_a_session_through_the_franka_backend_learns_the_fits_and_assembles(run_cli, tmp_path: Path) -> None:
     folder = Path(shutil.copytree(TRIO, tmp_path / "trio"))
     description = tmp_path / "franka-cell.toml"
