@@ -34,6 +34,10 @@ BACK = 0.002
 """[m] a part carried back lies this close to where it waited, at most (0.2 mm measured with
 the grasp weld; 12.9 mm without it, the peg sliding along franky-sim's pads)."""
 
+# Both tests drive the simulated arm: long, one arm on the machine at a time, on demand (-m franka_arm).
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtures("one_simulated_arm"),
+              pytest.mark.franka_arm]
+
 
 @pytest.fixture
 def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
@@ -53,10 +57,6 @@ def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeo
             backend.close()
 
 
-@pytest.mark.slow
-@pytest.mark.timeout(1200)
-@pytest.mark.usefixtures("one_simulated_arm")
-@pytest.mark.franka_arm
 def test_a_part_too_big_stops_on_force_and_goes_back(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
     sim, backend, geometry = spare_arm
     result, evidence = backend.run(InsertRequest(id="a", part="p3", hole="r1"))
@@ -67,10 +67,6 @@ def test_a_part_too_big_stops_on_force_and_goes_back(spare_arm: tuple[SimRobot, 
     assert abs(back[2]) < 0.001 and abs(quat[0]) > np.cos(np.radians(5) / 2), (back, quat)  # standing
 
 
-@pytest.mark.slow
-@pytest.mark.timeout(1200)
-@pytest.mark.usefixtures("one_simulated_arm")
-@pytest.mark.franka_arm
 def test_a_plan_step_places_a_peg_in_its_hole(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
     sim, backend, geometry = spare_arm
     assert backend.run_step(StepRequest(id="s1", assembly="run", step=1, part="bp"))[0] == "fit"
