@@ -164,12 +164,13 @@ class Cell:
 
     def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
         """Teaching (:class:`executor.skills.teach.TeachingCell`): the held part exactly in
-        the hand, the teaching friction, the arm placed at the pose and settled, the sensor tared."""
+        the hand, the teaching friction, the arm placed at the pose (in the motion's frame)
+        and settled, the sensor tared."""
         assert self.scene is not None  # set by motion_for
         self.scene.set_friction(None)
         arm = motion.controller.arm
         arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
-        arm.inverse_kinematics(tip, quat_xyzw)
+        arm.inverse_kinematics(*motion.cell_pose(tip, quat_xyzw))
         motion.controller.reset()
         motion.hold(tip, quat_xyzw, APPROACH_SETTLE_TIME)
         arm.tare_sensor()
@@ -253,20 +254,25 @@ class Cell:
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn + setup.vision_yaw)
         quat = tool_quat(yaw)
         approach = np.array([est_xy[0], est_xy[1], surface + APPROACH_HEIGHT])
-        arm.inverse_kinematics(approach, quat)
-        motion.controller.reset()
-        motion.hold(approach, quat, APPROACH_SETTLE_TIME)
-        arm.tare_sensor()
-        found = hole_search(motion, est_xy, surface, approach[2], quat,
-                            np.random.default_rng(setup.search_seed))
-        if self.logger is not None and len(found.path):
-            self.logger.log_search_path(found.path)
-        detector = Detector(self.thresholds)
-        origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
-        lever = spec.length - spec.held_depth(self.geometry.gripper)
-        task = InsertionTask(origin, lever, yaw, needs_yaw_compliance(spec.kind, hole_spec.kind), correction,
-                             wiggle_enabled)
-        result = insert_in_layer(motion, skill, detector, task, layer, description=self.description)
+        motion.frame = hole_spec.frame  # the hole's: the attempt runs down its z axis
+        try:
+            arm.inverse_kinematics(*motion.cell_pose(approach, quat))
+            motion.controller.reset()
+            motion.hold(approach, quat, APPROACH_SETTLE_TIME)
+            arm.tare_sensor()
+            found = hole_search(motion, est_xy, surface, approach[2], quat,
+                                np.random.default_rng(setup.search_seed))
+            if self.logger is not None and len(found.path):
+                self.logger.log_search_path(found.path if motion.frame is None
+                                            else motion.frame.points_to_cell(found.path))
+            detector = Detector(self.thresholds)
+            origin = np.array([found.hole_xy[0], found.hole_xy[1], found.surface_z])
+            lever = spec.length - spec.held_depth(self.geometry.gripper)
+            task = InsertionTask(origin, lever, yaw, needs_yaw_compliance(spec.kind, hole_spec.kind), correction,
+                                 wiggle_enabled)
+            result = insert_in_layer(motion, skill, detector, task, layer, description=self.description)
+        finally:
+            motion.frame = None
         self._scenes[spec.shape].release()
         if result.reached and result.trace is not None:
             learned = self.ilc.update(key, result.trace)

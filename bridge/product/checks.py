@@ -128,6 +128,23 @@ def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
                               "its own mesh (the plate's bosses are round, square, sharp rect or polygon), got none")
 
 
+def _check_sideways(path: Path, geo: GeometryFile) -> None:
+    """A hole entered sideways (``axis`` other than ``-z``) is in the ``[base]``'s own mesh,
+    states its entry's ``top_z`` and is no pin."""
+    for name, shape in geo.hole_shapes.items():
+        if shape.axis == "-z":
+            continue
+        table = f"hole_shapes.{name}"
+        if geo.base is None or geo.base.mesh is None:
+            raise BridgeError(f"{path}: [{table}] axis: a hole entered along {shape.axis} needs a [base] with its own "
+                              "mesh (the plate's bosses are entered from above), got none")
+        if shape.pin:
+            raise fail(path, table, "axis", "-z for a pin (parts go down onto pins)", shape.axis)
+        if shape.top_z is None:
+            raise BridgeError(f"{path}: [{table}] top_z: expected the height of the entry's centre [m] of a hole "
+                              f"entered along {shape.axis}, got nothing")
+
+
 def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None:
     """Pins are in the ``[base]``'s own mesh and state their ``top_z`` and ``depth``; a part
     with a ``bore`` is taught on a pin, a peg in a hole."""
@@ -166,6 +183,8 @@ def _check_levels(path: Path, plate: Plate, shapes: Mapping[str, HoleShape]) -> 
         table = f"hole_shapes.{name}"
         if shape.depth is not None and plate.chamfer >= depth:
             raise fail(path, table, "depth", f"more than the [plate] chamfer ({plate.chamfer:g} m)", depth)
+        if shape.axis != "-z":  # its bottom is no height: the entry's top_z is checked with the sideways holes
+            continue
         if depth < top or (shape.top_z is None and shape.depth is None):
             continue
         if shape.depth is not None:
@@ -196,8 +215,9 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     _check_polygons_simulated(path, geo)
     _check_levels(path, plate, geo.hole_shapes)
     _check_pins(path, geo, holes)
+    _check_sideways(path, geo)
     for name, hole_shape in geo.hole_shapes.items():
-        if not hole_shape.pin and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
+        if not hole_shape.pin and hole_shape.axis == "-z" and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
                        "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():
@@ -223,7 +243,8 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
                        f"[extra_parts] ({pid} is neither)", pid)
     positions = {hid: layout.holes[hid].position for hid in holes}
     turned = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.yaw for hid in hole_shape.holes}
-    pins = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.pin for hid in hole_shape.holes}
+    pins = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.pin or hole_shape.axis != "-z"
+            for hid in hole_shape.holes}  # no boss on the plate
     _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items()
                                           if p is not None and h not in pins}, turned)
     _check_kinds(path, geo, layout)

@@ -48,6 +48,8 @@ Id = Annotated[str, Meta(pattern=ID_PATTERN, description="an id (a lower-case AS
 Ids = Annotated[list[Id], Meta(min_length=1, max_length=1000, description="a non-empty list of distinct ids")]
 Text = Annotated[str, Meta(min_length=1, max_length=200, description="a non-empty text of at most 200 characters")]
 Kind = Literal["round", "square", "rect", "polygon"]
+InsertionAxis = Literal["-z", "+x", "-x", "+y", "-y"]
+"""The direction [cell frame] a part goes into a hole along: down, or sideways along an axis."""
 Coordinate = Annotated[float, Meta(ge=-MAX_COORDINATE, le=MAX_COORDINATE,
                                    description="a number in [-100, 100] m")]
 XY = Annotated[list[Coordinate], Meta(min_length=2, max_length=2,
@@ -155,7 +157,13 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     where they differ from the plate's ``top_z`` and ``tile_thickness``. With ``pin`` they
     are pins of the base (in its own mesh) that parts with a bore go onto: the section is
     the pin's, ``top_z`` its top and ``depth`` from its top down to where a part going
-    onto it rests (both required)."""
+    onto it rests (both required). ``axis`` is the direction a part goes in along: ``-z``
+    (down) or sideways (``+x``, ``-x``, ``+y``, ``-y``); a sideways hole is in the
+    ``[base]``'s own mesh, its section, ``outline`` and ``yaw`` in its hole frame (z out of
+    the hole, x and y the import's slice axes: :func:`executor.world.frames.hole_rotation`),
+    its position (``assembly.toml``) and ``top_z`` the x, y and z of its entry's centre
+    (``top_z`` required), ``depth`` from the entry along the axis to where a part's tip
+    rests plus the demonstration's clearance (nothing stops a part in a through hole)."""
 
     holes: Ids
     kind: Kind
@@ -166,6 +174,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     top_z: EntryHeight | None = None
     depth: HoleDepth | None = None
     pin: bool = False
+    axis: InsertionAxis = "-z"
 
 
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -66,6 +66,8 @@ from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, zero_clearance
 from executor.cad.sweep import opposite
+from executor.skills.teach import DEMO_CLEARANCE
+from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import ring_pieces
@@ -149,8 +151,9 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         lines.append("")
     for hid, fit in derived.holes.items():
         name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
+        x, y, _ = entry_point(fit)
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
-                  f"position = [{_q(fit.position[0])}, {_q(fit.position[1])}]", ""]
+                  f"position = [{_q(x)}, {_q(y)}]", ""]
     for pin_id, pin in derived.pins.items():
         lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner} ({" ".join(pin.parts)} onto it)"',
                   f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]", ""]
@@ -159,6 +162,40 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
 
 def _section_kind(fit: HoleFit | None) -> str | None:
     return None if fit is None or fit.section is None else fit.section.kind
+
+
+def _turn(fit: HoleFit) -> np.ndarray:
+    """The 4 × 4 rotation from the cell frame to the frame of ``fit``'s hole (z out of it,
+    x and y its slice axes: :func:`executor.world.frames.hole_rotation`); the identity
+    for a hole entered from above."""
+    turn = np.eye(4)
+    turn[:3, :3] = hole_rotation(opposite(fit.axis)).T
+    return turn
+
+
+def _upright(derived: Derived, fit: HoleFit) -> trimesh.Trimesh:
+    """The mesh of the peg in ``fit`` in its hole's frame (:func:`_turn`): its axis along z."""
+    assert fit.part is not None
+    mesh = derived.parts[fit.part].mesh
+    return mesh if fit.axis == "+z" else mesh.copy().apply_transform(_turn(fit))
+
+
+def entry_point(fit: HoleFit) -> tuple[float, float, float]:
+    """The centre of a hole's entry in the cell frame [m] (x, y its position, z its ``top_z``)."""
+    if fit.axis == "+z":
+        return fit.centre
+    x, y, z = hole_rotation(opposite(fit.axis)) @ np.array([*fit.hole.centre, fit.entry])
+    return float(x), float(y), float(z)
+
+
+def sideways_depth(derived: Derived, fit: HoleFit) -> float:
+    """The ``depth`` [m] of a hole entered sideways: from its entry along its axis to where
+    its part's tip is in the CAD, plus the demonstration's clearance (its taught goal is
+    the CAD's pose: nothing stops a part in a through hole), or the measured depth of an
+    empty one."""
+    if fit.part is None:
+        return fit.depth
+    return fit.entry - float(_upright(derived, fit).bounds[0][2]) + DEMO_CLEARANCE
 
 
 def sizes_text(derived: Derived) -> str:
@@ -290,9 +327,9 @@ def precedence_text(derived: Derived) -> str:
 
 
 def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
-    """The product as the cell inserts it: only the holes entered from above holding, if
-    anything, a peg entered from above that is no polygon section, or the prism of its
-    polygon (the cell builds that from its outline, exactly); the pins of the base that
+    """The product as the cell inserts it: only the holes entered from above or sideways
+    holding, if anything, a peg going in along the hole's axis that is no polygon section,
+    or the prism of its polygon (the cell builds that from its outline, exactly); the pins of the base that
     parts go down onto, and of the parts with a bore those it puts onto them
     (:func:`_onto_pin`); the pegs of the other holes and the other parts going onto pins,
     each with why the cell places it by hand (a polygon peg's room is often below what
@@ -301,11 +338,12 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     by_hand = {pid: why for pin in derived.pins.values() for pid in pin.parts
                if (why := _onto_pin(derived, pin, pid)) is not None}
     for hid, fit in derived.holes.items():
-        if fit.part is not None and derived.axis[fit.part] != "+z":
-            by_hand[fit.part] = f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, not from above"
-        elif fit.axis != "+z":
+        if fit.part is not None and derived.axis[fit.part] != fit.axis:
+            by_hand[fit.part] = (f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, its hole {hid} "
+                                 f"is entered along {opposite(fit.axis)}")
+        elif fit.axis == "-z":
             if fit.part is not None:
-                by_hand[fit.part] = f"hole {hid} is not entered from above"
+                by_hand[fit.part] = f"hole {hid} is entered from below"
         elif fit.part is not None and _section_kind(fit) == "polygon" and _polygon_refused(fit, derived):
             by_hand[fit.part] = _polygon_refused(fit, derived)
         else:
@@ -359,7 +397,7 @@ def _polygon_refused(fit: HoleFit, derived: Derived) -> str:
     prism of its section (convex pieces of its mesh would not keep its room), or its
     outline's prism has a piece the cell's hull margin would widen."""
     assert fit.part is not None and fit.section is not None
-    mesh = derived.parts[fit.part].mesh
+    mesh = _upright(derived, fit)
     if not peg_is_primitive(fit, mesh):
         return (f"part '{fit.part}' has a polygon section but is no prism of it: convex pieces of its mesh would not "
                 "keep its room")
@@ -385,7 +423,7 @@ def manual_origin(mesh: trimesh.Trimesh) -> tuple[float, float, float]:
 def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
     """Each part's transform (4 × 4) from the cell frame to its part frame (the base's: its
     bounding box's centre at its plate's ``base_center``)."""
-    frames = {pid: peg_frame(fit.section, derived.parts[pid].mesh) for pid, fit in derived.hole_of.items()
+    frames = {pid: peg_frame(fit.section, _upright(derived, fit)) @ _turn(fit) for pid, fit in derived.hole_of.items()
               if fit.section is not None}
     frames |= {pid: peg_frame(bore, derived.parts[pid].mesh) for pid, bore in derived.bores.items()}
     (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
@@ -425,7 +463,8 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
     ``mesh`` entries by part, or why a part has no pieces that fit
     (:func:`executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
-    if not derived.holes or derived.pins or not base_is_primitive(derived):  # the plate has no pins
+    sideways = any(fit.axis != "+z" for fit in derived.holes.values())
+    if not derived.holes or derived.pins or sideways or not base_is_primitive(derived):  # the plate: no pins, all down
         done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")
         assert not isinstance(done, str)  # the base has no pieces
         meshes[derived.base], files = done
@@ -436,7 +475,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
         assert not isinstance(done, str)
         meshes[pid], files = done
         written += files
-    moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, derived.parts[pid].mesh)]
+    moving = [pid for pid, fit in derived.hole_of.items() if not peg_is_primitive(fit, _upright(derived, fit))]
     moving += [pid for pid, cover in mapped.covers.items() if not cover.primitive]
     moving += [pid for pid, head in mapped.heads.items() if not head.primitive]
     moving += list(derived.bores)
@@ -475,13 +514,17 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', *_section_lines(fit.hole)]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
-        if abs(fit.entry - top) > _LEVEL:
-            lines.append(f"top_z = {_q(fit.entry)}")
-        if abs(fit.depth - depth) > _LEVEL:
-            lines.append(f"depth = {_q(fit.depth)}")
+        if fit.axis != "+z":  # entered sideways: its entry's height, its depth to its part's tip
+            lines += [f'axis = "{opposite(fit.axis)}"', f"top_z = {_q(entry_point(fit)[2])}",
+                      f"depth = {_q(sideways_depth(derived, fit))}"]
+        else:
+            if abs(fit.entry - top) > _LEVEL:
+                lines.append(f"top_z = {_q(fit.entry)}")
+            if abs(fit.depth - depth) > _LEVEL:
+                lines.append(f"depth = {_q(fit.depth)}")
         lines.append("")
     for pid, fit in sorted(derived.hole_of.items()):
-        mesh, peg = derived.parts[pid].mesh, fit.section
+        mesh, peg = _upright(derived, fit), fit.section
         assert peg is not None
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', *_section_lines(peg),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
@@ -534,7 +577,7 @@ def _plate_level(derived: Derived) -> tuple[float, float]:
     share (the first hole's among equally many), so that only the others state their own;
     without holes the base's top and half its height (at most the largest depth a plate
     states; the base is then its own mesh, these only place what lies on it)."""
-    fits = list(derived.holes.values())
+    fits = [fit for fit in derived.holes.values() if fit.axis == "+z"]  # a sideways hole states its own
     if not fits:
         (_, _, low), (_, _, high) = derived.parts[derived.base].mesh.bounds
         return float(high), min(float(high - low) / 2, MAX_PLATE_DEPTH)

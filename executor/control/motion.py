@@ -13,6 +13,7 @@ import numpy as np
 
 from executor.control.gains import ImpedanceGains
 from executor.world.arm import ArmState
+from executor.world.frames import HoleFrame
 from executor.world.scene import TIME_STEP
 
 APPROACH_SETTLE_TIME = 0.02  # [s] held at a start pose before the F/T sensor is tared
@@ -60,7 +61,12 @@ C = TypeVar("C", bound=ArmController)
 
 
 class Motion(Generic[C]):
-    """Steps the controller toward desired poses; counts sim time [s] and logs."""
+    """Steps the controller toward desired poses; counts sim time [s] and logs.
+
+    With a ``frame`` (:class:`executor.world.frames.HoleFrame`, set for the insertion into
+    a hole entered sideways) the poses and feed-forward wrenches it takes and the states it
+    returns are in that frame, so the skills insert down its z axis unchanged; the log
+    stays in the cell frame."""
 
     def __init__(self, controller: C, logger: StepLogger | None = None) -> None:
         self.controller = controller
@@ -69,6 +75,16 @@ class Motion(Generic[C]):
         self.tool_yaw = 0.0
         """[rad] the yaw of the pointing-down tool the transfers last commanded
         (:mod:`executor.assembly.transfer`): where their next move turns it from."""
+        self.frame: HoleFrame | None = None
+
+    def read(self) -> ArmState:
+        """The arm's state now (in the ``frame``, if any)."""
+        state = self.controller.arm.read()
+        return state if self.frame is None else self.frame.state_in(state)
+
+    def cell_pose(self, pos: np.ndarray, quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A pose (tip [m], quaternion xyzw) of the ``frame`` in the cell frame (unchanged without one)."""
+        return (pos, quat_xyzw) if self.frame is None else self.frame.pose_to_cell(pos, quat_xyzw)
 
     @property
     def sim_time(self) -> float:
@@ -79,13 +95,20 @@ class Motion(Generic[C]):
              phase: float = 0.0, wrench_des: np.ndarray | None = None) -> ArmState:
         """One control step toward the pose (tip [m], quaternion); ``phase`` (0..1) and the
         desired wrench [N, Nm] only go to the log.  Returns the state before the step."""
+        frame = self.frame
+        if frame is not None:
+            pos_des, quat_des_xyzw = frame.pose_to_cell(pos_des, quat_des_xyzw)
+            if wrench_ff is not None:
+                wrench_ff = frame.vector_to_cell(wrench_ff.reshape(2, 3)).reshape(6)
         state = self.controller.step(pos_des, quat_des_xyzw, wrench_ff)
         if self.logger is not None and self.steps % LOG_EVERY == 0:
             f_des = _ZERO3 if wrench_des is None else wrench_des[:3]
             m_des = _ZERO3 if wrench_des is None else wrench_des[3:]
+            if frame is not None:
+                f_des, m_des = frame.vector_to_cell(f_des), frame.vector_to_cell(m_des)
             self.logger.log_step(self.sim_time, phase, state.tip_pos, state.force, f_des, state.torque, m_des)
         self.steps += 1
-        return state
+        return state if frame is None else frame.state_in(state)
 
     def hold(self, pos: np.ndarray, quat_xyzw: np.ndarray, duration: float) -> ArmState:
         """Hold a pose for ``duration`` [s]; returns the last state."""

@@ -196,6 +196,9 @@ class FrankaCell:
         """One attempt with the held part: above the hole, the search, the skill; the ILC
         correction of (part shape, hole) updated after a success with ILC."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
+        if hole_spec.sideways:
+            raise ExecutorError(f"hole '{hole}' is entered along {hole_spec.axis}: the Franka backend inserts down "
+                                "(-z) only")
         skill = self.skill(spec.shape).in_hole(hole_spec.depth)
         turn, shift = fit_pose(spec, hole_spec)
         est = self.to_base(np.array([*(np.array(hole_spec.position) + shift), hole_spec.top_z]))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from executor import ExecutorError
 from executor.control.motion import APPROACH_SETTLE_TIME, Motion
 from executor.franka.cell import FrankaCell
 
@@ -35,6 +36,8 @@ class FrankaTeacher:
         """Above the start, straight down onto it, settled, the wrench tared: the
         grasp is the one the hand made (the real one, not known to the robot)."""
         cell = self.cell
+        if motion.frame is not None:
+            raise ExecutorError("a hole entered sideways: the Franka backend teaches and inserts down (-z) only")
         above = tip + np.array([0.0, 0.0, ABOVE_START])
         here = cell.arm.read().tip_pos
         yaw = float(2 * np.arctan2(quat_xyzw[1], quat_xyzw[0]))  # of tool_quat(yaw)

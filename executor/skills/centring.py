@@ -38,7 +38,7 @@ def _probe(motion: Motion, start: np.ndarray, direction: np.ndarray, reach: floa
     the motion exceeds :data:`TOUCH_FORCE` or it has gone ``reach`` [m]; returns the tip
     position [m] where it ended and whether it touched."""
     steps = max(1, int(reach / PROBE_SPEED / TIME_STEP))
-    state = motion.controller.arm.read()
+    state = motion.read()
     for k in range(1, steps + 1):
         state = motion.step(start + direction * reach * k / steps, quat)
         if -float(np.dot(state.force, direction)) > TOUCH_FORCE:

@@ -102,7 +102,7 @@ def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask
     wiggle runs there, and the goal is checked again."""
     hole_origin, gripper_lever, yaw = task.hole_origin, task.gripper_lever, task.yaw
     feedforward, wiggle_enabled = task.correction, task.wiggle_enabled
-    s = motion.controller.arm.read()
+    s = motion.read()
     goal = skill.demo_goal
     times, pos, quats = skill.rollout(turn_z(s.tip_pos - hole_origin, -yaw), turn_quats_z(s.tip_quat_xyzw, -yaw),
                                       goal[:3], np.roll(goal[3:], -1))
@@ -167,7 +167,7 @@ def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask
     pos_d, quat_d = clock.pose()
     ff_pos = ff_at(clock.phase)[0]
     pos_d = pos_d + ff_pos
-    end = motion.hold(pos_d + d_pos, quat_d, END_SETTLE_TIME) if completed else motion.controller.arm.read()
+    end = motion.hold(pos_d + d_pos, quat_d, END_SETTLE_TIME) if completed else motion.read()
     # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets
     # included; not ILC's z, which only shapes the push, never where the part must end).
     p_goal = hole_origin + turn_z(skill.end_position, yaw) + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])

@@ -66,7 +66,7 @@ def _slide_in(motion: Motion, xy: np.ndarray, touched_z: float, quat_xyzw: np.nd
     below the surface (past the chamfer) or ``dip_hold`` is over.  Returns the tip
     position [m]."""
     comply = Admittance(AdmittanceParams())
-    s = motion.controller.arm.read()
+    s = motion.read()
     for _ in range(int(p.dip_hold / TIME_STEP)):
         shift = comply.update(s.force, np.zeros(3), TIME_STEP)[0]
         s = motion.step(np.array([xy[0] + shift[0], xy[1] + shift[1], touched_z - 2 * p.press_depth]), quat_xyzw)

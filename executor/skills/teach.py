@@ -133,15 +133,19 @@ def teach_shape(cell: TeachingCell, shape: str) -> Skill:
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
     yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
     quat = tool_quat(yaw)
-    cell.hold_at(motion, start, quat)
-    times, positions, quats = _demonstrate(motion, origin, bottom, yaw)
-    weights = fit_dmp(times, positions, quats)
-    skill = Skill(shape, float(times[-1]), weights,
-                  np.concatenate([positions[0], xyzw_to_wxyz(quats[0])]),
-                  np.concatenate([positions[-1], xyzw_to_wxyz(quats[-1])]),
-                  np.zeros(3), WrenchProfile.fit(np.zeros(1), np.zeros((1, 6))))
-    cell.hold_at(motion, start, quat)
-    phases, wrenches, end = _replay(motion, skill, origin, yaw)
+    motion.frame = hole.frame  # a hole entered sideways: demonstrated and replayed down its frame's z axis
+    try:
+        cell.hold_at(motion, start, quat)
+        times, positions, quats = _demonstrate(motion, origin, bottom, yaw)
+        weights = fit_dmp(times, positions, quats)
+        skill = Skill(shape, float(times[-1]), weights,
+                      np.concatenate([positions[0], xyzw_to_wxyz(quats[0])]),
+                      np.concatenate([positions[-1], xyzw_to_wxyz(quats[-1])]),
+                      np.zeros(3), WrenchProfile.fit(np.zeros(1), np.zeros((1, 6))))
+        cell.hold_at(motion, start, quat)
+        phases, wrenches, end = _replay(motion, skill, origin, yaw)
+    finally:
+        motion.frame = None
     skill.wrench = WrenchProfile.fit(phases, wrenches)
     skill.end_position = end
     cell.let_go()

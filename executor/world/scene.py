@@ -78,6 +78,10 @@ class Scene:
                                      physicsClientId=self.client)
         if any(hole.pin for hole in geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.plate)
+        if any(hole.sideways for hole in geometry.holes.values()):
+            # A hole entered sideways a few cm above the floor puts the wrist below the
+            # floor's level: the cell simulates no table under it (docs/cell.md).
+            wrist_clear_of(self.client, self.robot, self.floor)
         self.held: str | None = None
 
     def set_friction(self, coefficient: float | None) -> None:
@@ -112,10 +116,11 @@ class Scene:
 
 
 def wrist_clear_of(client: int, robot: int, base: int) -> None:
-    """Only the held part (the arm's last link) of ``robot`` collides with ``base``: a pin
-    a part with a bore goes onto reaches up past the part's top, where a real gripper's
-    fingers hold the part from its sides (the cell simulates no fingers, and its wrist is
-    no cylinder around them)."""
+    """Only the held part (the arm's last link) of ``robot`` collides with ``base`` (a body):
+    a pin a part with a bore goes onto reaches up past the part's top, where a real
+    gripper's fingers hold the part from its sides (the cell simulates no fingers, and its
+    wrist is no cylinder around them); the floor, under a wrist holding a part sideways
+    into a hole near it."""
     held = pb.getNumJoints(robot, physicsClientId=client) - 1
     for link in range(-1, held):
         pb.setCollisionFilterPair(robot, base, link, -1, 0, physicsClientId=client)

@@ -1,0 +1,93 @@
+"""The hole frame: the skills insert down its z axis, whatever way the hole points.
+
+The search, the insertion (DMP, admittance, phase stopping, eqs. (6)/(7), wiggle, ILC,
+goal check) and teaching are written for a part going down (-z) into a hole whose entry
+is at a height. A hole entered sideways (``axis`` ``+x``, ``-x``, ``+y``, ``-y`` in
+``geometry.toml``) gets a :class:`HoleFrame`: its z axis points out of the hole (against
+the insertion), its x and y are the axes its section was measured in
+(:func:`hole_rotation`), and it is the cell frame turned about the hole's entry centre.
+:class:`executor.control.motion.Motion` with a frame carries every commanded pose and
+feed-forward wrench into the cell frame and every reading (tip pose, velocities,
+Jacobian, wrench) out of it, so the same skill code runs in it unchanged; a hole entered
+down has no frame (the identity, and its trials are unchanged bit for bit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as pb
+
+from executor.world.arm import ArmState
+
+_ORIGIN = (0.0, 0.0, 0.0)
+_OUT = {"+x": (-1.0, 0.0, 0.0), "-x": (1.0, 0.0, 0.0), "+y": (0.0, -1.0, 0.0), "-y": (0.0, 1.0, 0.0),
+        "-z": (0.0, 0.0, 1.0)}
+"""Out of the hole (the removal direction) for each insertion axis."""
+
+
+def hole_rotation(axis: str) -> np.ndarray:
+    """The rotation (3 × 3, columns x, y, z of the hole frame in the cell frame) of a hole
+    entered along ``axis`` (``-z``, ``+x``, ``-x``, ``+y``, ``-y``): z out of the hole, x
+    and y the slice axes the import measures its section in
+    (:func:`executor.cad.sections.frame_of` of the removal direction: x the cell's x, or
+    its y for a hole along x), right-handed; the identity for ``-z``."""
+    out = np.array(_OUT[axis])
+    helper = np.array([1.0, 0.0, 0.0]) if abs(out[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = helper - np.dot(helper, out) * out
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(out, x), out])
+
+
+def _quat_of(rotation: np.ndarray) -> tuple[float, float, float, float]:
+    """The quaternion (xyzw) of a rotation matrix whose entries are 0 and ±1."""
+    m = rotation
+    w = np.sqrt(max(0.0, 1.0 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
+    x = np.copysign(np.sqrt(max(0.0, 1.0 + m[0, 0] - m[1, 1] - m[2, 2])) / 2, m[2, 1] - m[1, 2])
+    y = np.copysign(np.sqrt(max(0.0, 1.0 - m[0, 0] + m[1, 1] - m[2, 2])) / 2, m[0, 2] - m[2, 0])
+    z = np.copysign(np.sqrt(max(0.0, 1.0 - m[0, 0] - m[1, 1] + m[2, 2])) / 2, m[1, 0] - m[0, 1])
+    return float(x), float(y), float(z), float(w)
+
+
+@dataclass(frozen=True)
+class HoleFrame:
+    """The cell frame turned by ``rotation`` (3 × 3, :func:`hole_rotation`) about ``entry``
+    (3,) [m], the centre of the hole's entry, which both frames share: a point p of the
+    hole frame is ``entry + rotation (p - entry)`` in the cell frame."""
+
+    rotation: np.ndarray
+    entry: np.ndarray
+    quat: tuple[float, float, float, float]
+    """The rotation as a quaternion (xyzw)."""
+
+    def pose_to_cell(self, pos: np.ndarray, quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A pose (position [m], quaternion xyzw) of the hole frame in the cell frame."""
+        turned = pb.multiplyTransforms(_ORIGIN, self.quat, _ORIGIN, list(quat_xyzw))[1]
+        return self.points_to_cell(pos), np.array(turned)
+
+    def points_to_cell(self, points: np.ndarray) -> np.ndarray:
+        """Points (..., 3) [m] of the hole frame in the cell frame."""
+        return self.entry + (np.asarray(points) - self.entry) @ self.rotation.T
+
+    def vector_to_cell(self, vector: np.ndarray) -> np.ndarray:
+        """A vector (..., 3) of the hole frame (a force, a velocity) in the cell frame."""
+        return np.asarray(vector) @ self.rotation.T
+
+    def state_in(self, state: ArmState) -> ArmState:
+        """A reading of the cell frame expressed in the hole frame (joints unchanged)."""
+        back = self.rotation.T
+        inverse = (-self.quat[0], -self.quat[1], -self.quat[2], self.quat[3])
+        quat = np.array(pb.multiplyTransforms(_ORIGIN, inverse, _ORIGIN, list(state.tip_quat_xyzw))[1])
+        jac = np.vstack([back @ state.jac[:3], back @ state.jac[3:]])
+        return ArmState(state.q, state.qd, back @ (state.tip_pos - self.entry) + self.entry, quat, back @ state.tip_vel,
+                        back @ state.tip_omega, jac, back @ state.force, back @ state.torque)
+
+
+def hole_frame(axis: str, entry: tuple[float, float, float]) -> HoleFrame | None:
+    """The frame a hole entered along ``axis`` is inserted in, about its ``entry`` centre
+    [m]; None for a hole entered down (``-z``: the cell frame itself)."""
+    if axis == "-z":
+        return None
+    rotation = hole_rotation(axis)
+    return HoleFrame(rotation, np.array(entry, dtype=float), _quat_of(rotation))
