@@ -163,7 +163,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     the hole, x and y the import's slice axes: :func:`executor.world.frames.hole_rotation`),
     its position (``assembly.toml``) and ``top_z`` the x, y and z of its entry's centre
     (``top_z`` required), ``depth`` from the entry along the axis to where a part's tip
-    rests plus the demonstration's clearance (nothing stops a part in a through hole)."""
+    ends (the taught goal: nothing stops a part in a through hole)."""
 
     holes: Ids
     kind: Kind

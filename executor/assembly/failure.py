@@ -20,6 +20,7 @@ from typing import Literal
 import pybullet as pb
 
 from executor.assembly.world import AssemblyWorld
+from executor.world.frames import HoleFrame
 
 ENTRY_MARGIN = 0.001
 """How far below its place's entry the part's TCP must be to count as entered [m]."""
@@ -37,15 +38,16 @@ def touching(world: AssemblyWorld, part: str, among: Collection[str]) -> tuple[s
 
 
 def why_stuck(world: AssemblyWorld, part: str, targets: Collection[str], entry_z: float,
-              placed: Collection[str]) -> tuple[StuckReason, tuple[str, ...]]:
+              placed: Collection[str], frame: HoleFrame | None = None) -> tuple[StuckReason, tuple[str, ...]]:
     """Why ``part``, stopped short of its goal and still held, is stuck: (``blocked``, the
     other parts it touches) when it touches a part of ``placed`` not in ``targets``;
-    (``jammed``, ()) when its TCP is below ``entry_z`` [m] by :data:`ENTRY_MARGIN`;
-    else (``blocked``, ())."""
+    (``jammed``, ()) when its TCP is below ``entry_z`` [m] by :data:`ENTRY_MARGIN` (z of
+    the hole's ``frame`` for a hole entered sideways); else (``blocked``, ())."""
     obstacles = touching(world, part, [p for p in placed if p not in targets])
     if obstacles:
         return "blocked", obstacles
-    tcp_z = float(world.position(part)[2] + world.frames[part].tcp[2])
+    tcp = world.position(part) + world.frames[part].tcp
+    tcp_z = float((tcp if frame is None else frame.points_in(tcp))[2])
     return ("jammed" if tcp_z < entry_z - ENTRY_MARGIN else "blocked"), ()
 
 

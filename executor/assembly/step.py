@@ -49,7 +49,7 @@ from executor import ExecutorError
 from executor.assembly.failure import targets_of, why_stuck
 from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
-from executor.assembly.transfer import VIA_TOLERANCE, carry, move_line
+from executor.assembly.transfer import DESCENT_SPEED, SAFE_Z, VIA_TOLERANCE, carry, move_line, reorient
 from executor.assembly.world import AssemblyWorld
 from executor.backend_plugin import check_step
 from executor.cell_description import CellDescription
@@ -63,6 +63,7 @@ from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_
 from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, trial_rng
 from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
+from executor.world.frames import HoleFrame
 from executor.world.geometry import fit_pose, margin
 from executor.world.perturbation import CellBias
 from executor.world.scene import PART_FRICTION
@@ -73,7 +74,10 @@ CENTRING_ROOM = 0.001
 """[m] a peg with more room than this all round in its hole is centred in it by contact
 (:mod:`executor.skills.centring`): with less the hole itself holds it within the placed
 parts' 2 mm (a square peg's corner direction: √2 × its room)."""
-RETREAT = 0.03  # [m] the tool goes up this far after opening the gripper
+RETREAT = 0.03  # [m] the tool goes up (out of a hole entered sideways) this far after opening the gripper
+SIDEWAYS_OUT = 0.05
+"""[m] a part going into a hole entered sideways comes down this far out of its entry
+along its axis, then goes in along the axis."""
 GRIP_TOLERANCE = 0.002  # [m] of the empty tool at the grip point (the grasp error model sets the real offset)
 ASSEMBLY_UNCERTAINTY = Magnitudes(
     grasp_offset_bias=0.0, grasp_offset_random=0.001, grasp_tilt_bias=0.0, grasp_tilt_random=1.0,
@@ -228,16 +232,18 @@ class Assembler:
                 if outcomes[-1][0]:
                     break
                 stuck = self._why_stuck(part, hole, skill)
-                here = motion.controller.arm.read().tip_pos
+                here = motion.read().tip_pos  # up, or out along a sideways hole's axis
                 move_line(motion, here + np.array([0.0, 0.0, 0.04]), tolerance=VIA_TOLERANCE)
         ok = outcomes[-1][0]
         if ok:
             stuck = (None, ())
         if not ok:  # back to the tray
+            self._leave_frame()
             carry(motion, world.tray_position(part) + world.frames[part].tcp + np.array([0.0, 0.0, 0.002]))
         grasp.release()
-        here = motion.controller.arm.read().tip_pos
+        here = motion.read().tip_pos
         move_line(motion, here + np.array([0.0, 0.0, RETREAT]), tolerance=VIA_TOLERANCE)
+        self._leave_frame()
         if ok and world.goal_error(part) > STAY_TOLERANCE:  # let go, it did not stay: nothing holds it there
             ok, stuck = False, ("unsupported", ())
         if ok:
@@ -273,7 +279,7 @@ class Assembler:
                 world.set_peg_goal(part, hole)
             socket = part in self.product.heads  # a head's goal is the socket where its part is now
             world.set_pose(part, self._goal_tcp(part, "insert_socket") - world.frames[part].tcp if socket
-                           else world.goals[part])
+                           else world.goals[part], world.goal_quats.get(part, (0.0, 0.0, 0.0, 1.0)))
             self._screw(part)
             pb.changeDynamics(world.frames[part].body, -1, activationState=pb.ACTIVATION_STATE_WAKE_UP,
                               physicsClientId=world.client)
@@ -289,11 +295,13 @@ class Assembler:
         """Why ``part``, stopped short of its goal and still held, is stuck (:func:`why_stuck`),
         the entry of its place being where the insertion's free approach ends."""
         p = self.product
-        approach = self._approach(part, hole, skill, self._goal_tcp(part, skill))
+        frame = self._frame(hole, skill)
+        goal = self._goal_tcp(part, skill)
+        approach = self._approach(part, hole, skill, goal if frame is None else frame.points_in(goal))
         entry_z = float(approach[2] - _free_approach(skill))
         targets = targets_of(part, skill, p.base.id, {c: spec.over for c, spec in p.covers.items()},
                              {h: spec.into for h, spec in p.heads.items()}, self.hole_of)
-        return why_stuck(self.world, part, targets, entry_z, self.placed)
+        return why_stuck(self.world, part, targets, entry_z, self.placed, frame)
 
     def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
         """A part placed by hand (``manual``): at its goal, fixed there."""
@@ -372,13 +380,19 @@ class Assembler:
                 grasp: Grasp) -> tuple[bool, float, float]:
         """One attempt from above the goal: (goal reached, max force dev [N], max torque dev [Nm])."""
         world, motion, p = self.world, self.world.motion, self.product
+        frame = self._frame(hole, skill)  # a hole entered sideways: the attempt runs in its frame
         goal = self._goal_tcp(part, skill)
+        if frame is not None:
+            goal = frame.points_in(goal)
         approach = self._approach(part, hole, skill, goal)
         if skill != "insert_over":  # a cover is aimed at its holes' centres (module docstring)
             approach[:2] += setup.vision_error
         yaw = self._yaw(part, hole, setup)
         quat = tool_quat(yaw)
-        carry(motion, approach, yaw=yaw)
+        if frame is None:
+            carry(motion, approach, yaw=yaw)
+        else:
+            self._enter(frame, approach, yaw)
         motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         world.arm.tare_sensor()
         centred = False
@@ -393,7 +407,7 @@ class Assembler:
             reach = self._centring_reach(part, hole) if skill == "insert" and found.found else None
             centred = reach is not None and hole is not None
             if reach is not None and hole is not None:  # in the feature's room, not touching it yet
-                xy = centre_by_contact(motion, motion.controller.arm.read().tip_pos, quat, reach,
+                xy = centre_by_contact(motion, motion.read().tip_pos, quat, reach,
                                        p.geometry.holes[hole].depth)[:2]
             if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
                 peg = p.pegs[part]
@@ -418,6 +432,35 @@ class Assembler:
         if result.reached and result.trace is not None and self.ilc is not None:
             self.ilc.update(key, result.trace)
         return result.reached, detector.max_force_dev, detector.max_torque_dev
+
+    def _frame(self, hole: str | None, skill: str) -> HoleFrame | None:
+        """The frame of a peg's hole entered sideways (:attr:`executor.world.geometry.HoleSpec.frame`), else None."""
+        return self.product.geometry.holes[hole].frame if skill == "insert" and hole is not None else None
+
+    def _enter(self, frame: HoleFrame, approach: np.ndarray, yaw: float) -> None:
+        """Bring the held part to ``approach`` [m, in ``frame``] of a hole entered sideways: up
+        to the carrying height, across above the point :data:`SIDEWAYS_OUT` out of the entry
+        along the hole's axis while the tool turns down that axis (:func:`reorient`), down to
+        that point, and in to the approach (from where a failed attempt backed out, only in)."""
+        motion = self.world.motion
+        outside = approach + np.array([0.0, 0.0, SIDEWAYS_OUT])
+        if motion.frame is not frame:
+            self._leave_frame()
+            here = motion.read().tip_pos
+            if here[2] < SAFE_Z - 1e-3:
+                move_line(motion, np.array([here[0], here[1], SAFE_Z]), tolerance=VIA_TOLERANCE)
+            above = frame.points_to_cell(outside)
+            reorient(motion, np.array([above[0], above[1], max(SAFE_Z, float(above[2]))]), frame, yaw)
+        move_line(motion, outside, tolerance=VIA_TOLERANCE, yaw=yaw)
+        move_line(motion, approach, speed=DESCENT_SPEED)
+
+    def _leave_frame(self) -> None:
+        """After a hole entered sideways: the tool straight up to the carrying height, turning
+        to point down the cell's z again (nothing to do outside a hole's frame)."""
+        motion = self.world.motion
+        if motion.frame is not None:
+            here = motion.controller.arm.read().tip_pos
+            reorient(motion, np.array([here[0], here[1], max(SAFE_Z, float(here[2]))]), None, 0.0)
 
     def _screw(self, part: str) -> None:
         """A head placed in its socket stays fixed to that part."""

@@ -92,6 +92,7 @@ class AssemblyWorld:
         self.floor = pb.loadURDF("plane.urdf", physicsClientId=c)
         self.frames: dict[str, PartFrames] = {}
         self.goals: dict[str, np.ndarray] = {}  # body position [m] of each part in the product
+        self.goal_quats: dict[str, tuple[float, ...]] = {}  # a peg's body orientation (xyzw) there
         self._tray: dict[str, np.ndarray] = {}
         self._build_base()
         self._build_pegs()
@@ -191,6 +192,8 @@ class AssemblyWorld:
         pb.setCollisionFilterGroupMask(self.robot, self.tool_link, 0, 0, physicsClientId=self.client)
         if any(hole.pin for hole in self.product.geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.frames[self.product.base.id].body)
+        if any(hole.sideways for hole in self.product.geometry.holes.values()):  # as in the trial's scene
+            wrist_clear_of(self.client, self.robot, self.floor)
 
     def reset_tray(self) -> None:
         """Every part to its tray pose (at rest); the head-in-socket state is not kept."""
@@ -199,10 +202,15 @@ class AssemblyWorld:
 
     def set_peg_goal(self, part: str, hole: str) -> None:
         """A peg's goal: standing on the bottom of ``hole``, shifted as the polygon relation
-        passes it (:func:`executor.world.geometry.fit_pose`; no shift for other sections)."""
+        passes it (:func:`executor.world.geometry.fit_pose`; no shift for other sections);
+        in a hole entered sideways, at its tip's depth and along the hole's axis
+        (``goal_quats``)."""
         spec = self.product.geometry.holes[hole]
         x, y = np.array(spec.position) + fit_pose(self.product.pegs[part], spec)[1]
-        self.goals[part] = np.array([x, y, spec.bottom_z])
+        frame = spec.frame  # a hole entered sideways: the peg lies along its axis
+        goal = np.array([x, y, spec.bottom_z])
+        self.goals[part] = goal if frame is None else frame.points_to_cell(goal)
+        self.goal_quats[part] = _IDENTITY if frame is None else frame.quat
 
     def lock(self, part: str) -> None:
         """Lock a placed peg in its hole: fixed where it rests, its contacts with the plate

@@ -66,7 +66,6 @@ from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, zero_clearance
 from executor.cad.sweep import opposite
-from executor.skills.teach import DEMO_CLEARANCE
 from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
@@ -190,12 +189,11 @@ def entry_point(fit: HoleFit) -> tuple[float, float, float]:
 
 def sideways_depth(derived: Derived, fit: HoleFit) -> float:
     """The ``depth`` [m] of a hole entered sideways: from its entry along its axis to where
-    its part's tip is in the CAD, plus the demonstration's clearance (its taught goal is
-    the CAD's pose: nothing stops a part in a through hole), or the measured depth of an
-    empty one."""
+    its part's tip is in the CAD (the taught goal: nothing stops a part in a through hole),
+    or the measured depth of an empty one."""
     if fit.part is None:
         return fit.depth
-    return fit.entry - float(_upright(derived, fit).bounds[0][2]) + DEMO_CLEARANCE
+    return fit.entry - float(_upright(derived, fit).bounds[0][2])
 
 
 def sizes_text(derived: Derived) -> str:

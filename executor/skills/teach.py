@@ -3,7 +3,7 @@
 Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path (0.8 s,
 longer for a travel over 40 mm: :data:`DEMO_SPEED`)
 from 2 mm inside the entrance of the shape's ``demo_hole`` (where the hole search leaves
-the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom; the
+the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom (in a hole entered sideways, to its depth: where the CAD has the part's tip); the
 tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
 executed by the impedance controller alone and the wrench it meets is recorded: the
 reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
@@ -128,7 +128,7 @@ def teach_shape(cell: TeachingCell, shape: str) -> Skill:
     hole = geometry.holes[part.demo_hole]
     turn, shift = fit_pose(part, hole)
     origin = np.array([*(np.array(hole.position) + shift), hole.top_z])
-    bottom = hole.depth
+    bottom = hole.depth + (DEMO_CLEARANCE if hole.sideways else 0.0)  # sideways: the depth is the part's end
     motion = cell.motion_for(part.id)
     start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
     yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)

@@ -70,6 +70,10 @@ class HoleFrame:
         """Points (..., 3) [m] of the hole frame in the cell frame."""
         return self.entry + (np.asarray(points) - self.entry) @ self.rotation.T
 
+    def points_in(self, points: np.ndarray) -> np.ndarray:
+        """Points (..., 3) [m] of the cell frame in the hole frame."""
+        return self.entry + (np.asarray(points) - self.entry) @ self.rotation
+
     def vector_to_cell(self, vector: np.ndarray) -> np.ndarray:
         """A vector (..., 3) of the hole frame (a force, a velocity) in the cell frame."""
         return np.asarray(vector) @ self.rotation.T

@@ -131,7 +131,7 @@ class HoleSpec(Section):
         own mesh, its ``position`` and ``top_z`` its entry's centre)."""
         return self.axis != "-z"
 
-    @property
+    @functools.cached_property
     def frame(self) -> HoleFrame | None:
         """The frame the skills insert down into this hole in (:mod:`executor.world.frames`):
         its ``position``, ``top_z``, section and ``yaw`` are this frame's; None for a hole
