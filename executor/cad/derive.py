@@ -118,7 +118,8 @@ class Derived:
     product along, ``axis`` its insertion axis (the name of the removal direction),
     ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs and
     ``reasons`` why each holds (``blocks``: :func:`forced`, its blockers per direction in
-    ``detail``; ``base``: the base precedes the parts touching it; ``supports`` and
+    ``detail``; ``base``: the base precedes the parts touching it; ``holds``: and the parts in
+    its holes entered sideways, which it holds up; ``supports`` and
     ``locates``: the rules of :mod:`executor.cad.locating`),
     ``located`` each moving body's locators per direction (of the six axes), ``dropped``
     the locating pairs and ``dropped_supports`` the supporting pairs the blocking
@@ -237,6 +238,11 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
+    # A part in a hole of the base entered sideways lies on the hole's walls once let go: the base holds it up.
+    held = {(base, fit.part): "holds" for fit in result.holes.values()
+            if fit.part is not None and fit.axis[1] != "z" and (base, fit.part) not in result.reasons}
+    result.reasons |= held
+    result.edges |= set(held)
     result.pins, result.bores = pins(result)
     result.queries = sweeper.queries
     return result

@@ -301,6 +301,7 @@ def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
 REASONS = {
     "blocks": "A cannot go in once B is there (B, or parts always placed before B, block each way the base leaves A)",
     "base": "A is the base and B touches it",
+    "holds": "A is the base and B lies in a hole of it entered sideways (nothing else holds B up)",
     "supports": "B rests on A and not on the base (the support rule, an assumption of the import)",
     "locates": "A alone keeps B from moving sideways (the locating rule, an assumption of the import)",
 }
