@@ -56,6 +56,7 @@ from executor.cad.write import (
     MANIFEST,
     Settings,
     claim_folder,
+    entry_point,
     map_product,
     nominal_assumption,
     section,
@@ -211,7 +212,9 @@ def report(derived: Derived) -> list[str]:
         if fit.part is not None and fit.section is not None:
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, "
                     f"{_clearance(fit.section, fit.hole, fit.part, hid)})")
-        lines.append(f"hole {hid} at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm, entered along "
+        where = (f"at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm" if fit.axis == "+z" else
+                 "entry at ({}, {}, {}) mm".format(*map(_mm, entry_point(fit))))
+        lines.append(f"hole {hid} {where}, entered along "
                      f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
     for pin_id, pin in derived.pins.items():

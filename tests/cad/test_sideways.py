@@ -1,0 +1,140 @@
+"""A hole entered sideways: the corpus's ``agh_hex_horizontal`` (real CAD: a hexagonal peg
+going along -y through a hexagonal hole of a box, 0.433 mm of room all round) is imported
+with its hole's axis and entry, taught, learned and assembled in physics by the same
+skills as a hole entered from above, run in the hole's frame
+(:mod:`executor.world.frames`)."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from bridge import BridgeError
+from bridge.product import load_product_description
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
+from executor.cad.cli import run_import
+from executor.cad.sections import frame_of
+from executor.cad.sweep import DIRECTIONS, opposite
+from executor.cell_description import CellDescription
+from executor.trial import Cell
+from executor.world.arm import ArmState, quat_to_matrix, tool_quat
+from executor.world.frames import hole_frame, hole_rotation
+from tests.conftest import Runner
+
+CORPUS = Path(__file__).parent / "corpus" / "agh_hex_horizontal"
+ENTRY = (0.56, 0.025, 0.03)
+"""The hole's entry centre in the cell [m]: its +y face, 30 mm up, the box placed at x = 560 mm."""
+
+
+def _import(out: Path) -> Path:
+    run_import(CORPUS / "meshes", out, "mm", CORPUS / "import.toml")
+    return out
+
+
+@pytest.fixture(scope="module")
+def taught(tmp_path_factory: pytest.TempPathFactory, run_executor: Runner) -> Path:
+    """The product imported and its peg's skill taught in its hole."""
+    out = _import(tmp_path_factory.mktemp("sideways") / "out")
+    done = run_executor("teach", "--assembly", str(out), timeout=300)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+@pytest.mark.parametrize("axis", ["-z", "+x", "-x", "+y", "-y"])
+def test_the_hole_frame_has_the_axes_the_import_measures_sections_in(axis: str) -> None:
+    rotation = hole_rotation(axis)
+    out = np.array(DIRECTIONS[opposite(axis)])
+    assert np.array_equal(rotation[:, 2], out)  # z out of the hole
+    assert np.array_equal(rotation[:, :2].T, frame_of(out))  # x, y: the slice's axes of the section
+    assert np.linalg.det(rotation) == pytest.approx(1.0)
+
+
+def test_poses_and_readings_go_through_the_hole_frame() -> None:
+    frame = hole_frame("-y", ENTRY)
+    assert frame is not None and hole_frame("-z", ENTRY) is None
+    # 2.5 mm above the entry, the tool pointing down the frame: 2.5 mm out along +y, pointing along -y.
+    pos, quat = frame.pose_to_cell(np.array([0.56, 0.025, 0.0325]), tool_quat(0.0))
+    assert pos == pytest.approx([0.56, 0.0275, 0.03], abs=1e-12)
+    assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, -1.0, 0.0], abs=1e-12)
+    rng = np.random.default_rng(0)
+    state = ArmState(rng.normal(size=7), rng.normal(size=7), pos, quat, *rng.normal(size=(2, 3)),
+                     rng.normal(size=(6, 7)), np.array([0.0, 3.0, 0.0]), rng.normal(size=3))
+    seen = frame.state_in(state)
+    assert seen.tip_pos == pytest.approx([0.56, 0.025, 0.0325], abs=1e-12)
+    assert quat_to_matrix(seen.tip_quat_xyzw) == pytest.approx(quat_to_matrix(tool_quat(0.0)), abs=1e-12)
+    assert seen.force == pytest.approx([0.0, 0.0, 3.0])  # pushed back out of the hole: up in its frame
+    for ours, theirs in ((seen.tip_vel, state.tip_vel), (seen.torque, state.torque)):
+        assert frame.vector_to_cell(ours) == pytest.approx(theirs)
+    assert frame.vector_to_cell(seen.jac[:3].T).T == pytest.approx(state.jac[:3])
+    assert frame.points_in(frame.points_to_cell(np.array([0.1, 0.2, 0.3]))) == pytest.approx([0.1, 0.2, 0.3])
+
+
+def test_a_sideways_hole_is_written_with_its_axis_and_entry_and_checked(tmp_path: Path) -> None:
+    out = _import(tmp_path / "out")
+    geometry = load_product_description(out).geometry
+    assert geometry is not None and geometry.manual == {}
+    hole = geometry.hole_shapes["h1"]
+    assert (hole.axis, hole.top_z, hole.depth) == ("-y", 0.03, 0.075)  # the peg's tip 25 mm past the far face
+    assert geometry.part_shapes["hex_peg"].length == pytest.approx(0.1)
+    text = (out / "geometry.toml").read_text()
+    for old, new, expected in [('axis = "-y"\ntop_z = 0.03\n', 'axis = "-y"\n', "top_z: expected the height of the "
+                                "entry's centre [m] of a hole entered along -y, got nothing"),
+                               ('axis = "-y"', 'axis = "+z"', "axis")]:
+        (out / "geometry.toml").write_text(text.replace(old, new))
+        with pytest.raises(BridgeError, match=re.escape(expected)) as caught:
+            load_product_description(out)
+        assert "\n" not in str(caught.value) and "[hole_shapes.h1]" in str(caught.value)
+
+
+def _narrowed(folder: Path, out: Path, scale: float) -> Path:
+    """A copy of the taught product whose box (its own mesh) is shrunk by ``scale`` across
+    the hole's axis about that axis: the same nominal sections, a hole too narrow for the peg."""
+    shutil.copytree(folder, out)
+    mesh_file = out / "meshes" / "box.obj"
+    box = trimesh.load(mesh_file, force="mesh")
+    x, _, z = ENTRY
+    box.apply_transform(trimesh.transformations.translation_matrix((x, 0.0, z))
+                        @ np.diag([scale, 1.0, scale, 1.0])
+                        @ trimesh.transformations.translation_matrix((-x, 0.0, -z)))
+    box.export(mesh_file)
+    old = hashlib.sha256((folder / "meshes" / "box.obj").read_bytes()).hexdigest()
+    geometry = out / "geometry.toml"
+    geometry.write_text(geometry.read_text().replace(old, hashlib.sha256(mesh_file.read_bytes()).hexdigest()))
+    return out
+
+
+@pytest.mark.slow  # teaches the peg, then two trials in physics (about 60 s under load)
+def test_a_horizontal_insertion_is_decided_in_physics(taught: Path, tmp_path: Path) -> None:
+    cell = Cell(str(taught))
+    try:
+        fits = cell.run_trial("hex_peg", "h1", 0)
+    finally:
+        cell.close()
+    assert fits.outcome == "fit" and fits.end_error < 0.003
+    # The hole 3 % narrower (circumradius 19.9 mm, the peg's 20 mm): stopped at the entry.
+    narrow = Cell(str(_narrowed(taught, tmp_path / "narrow", 0.97)))
+    try:
+        refused = narrow.run_trial("hex_peg", "h1", 0)
+    finally:
+        narrow.close()
+    assert refused.outcome == "no_fit" and refused.end_error > 0.02
+
+
+@pytest.mark.slow  # teaches the peg (shared), then the box and the peg assembled in physics (about 40 s under load)
+def test_a_horizontal_peg_is_assembled_within_2_mm(taught: Path) -> None:
+    assembler = Assembler(load_product(str(taught)), description=CellDescription())
+    try:
+        assert assembler.run_step("box", None, 0).outcome == "fit"
+        step = assembler.run_step("hex_peg", "h1", 0)
+        _, quat = assembler.world.pose("hex_peg")
+    finally:
+        assembler.close()
+    assert step.outcome == "fit" and step.pose_error < 0.002, step
+    assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.02)  # lying along the hole's axis
