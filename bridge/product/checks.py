@@ -217,7 +217,8 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     _check_pins(path, geo, holes)
     _check_sideways(path, geo)
     for name, hole_shape in geo.hole_shapes.items():
-        if not hole_shape.pin and hole_shape.axis == "-z" and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
+        bossed = not hole_shape.pin and hole_shape.axis == "-z"  # a boss of the plate
+        if bossed and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
             raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
                        "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():

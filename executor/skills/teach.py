@@ -1,17 +1,19 @@
 """Scripted kinesthetic teaching (paper 3.1), one skill per part shape.
 
 Step 1, the demonstration: a "human" guides the tip along a minimum-jerk path (0.8 s,
-longer for a travel over 40 mm: :data:`DEMO_SPEED`)
-from 2 mm inside the entrance of the shape's ``demo_hole`` (where the hole search leaves
-the part; exactly aligned, the part turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom (in a hole entered sideways, to its depth: where the CAD has the part's tip); the
-tip poses are recorded at 1 kHz and encoded as a Cartesian DMP.  Step 2, the replay: the DMP is
-executed by the impedance controller alone and the wrench it meets is recorded: the
-reference F_des, M_des, fitted with RBFs over the phase; the tip position where the
-replay ends is p_goal.  Step 3, the check: p_goal must lie within the cell's goal tolerance
-of the demonstration's goal (0.5 mm above the bottom); a part that does not pass its
-``demo_hole`` stops on the entry instead, and its teaching is refused (ExecutorError naming
-the part, the hole and the end error), no skill written.  The skill records what it was
-taught on (:class:`executor.skills.dmp.TaughtOn`).
+longer for a travel over 40 mm: :data:`DEMO_SPEED`) from 2 mm inside the entrance of the
+shape's ``demo_hole`` (where the hole search leaves the part; exactly aligned, the part
+turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom (in a
+hole entered sideways, down its frame's z axis to its depth, where the CAD has the
+part's tip: :mod:`executor.world.frames`); the tip poses are recorded at 1 kHz and
+encoded as a Cartesian DMP. Step 2, the replay: the DMP is executed by the impedance
+controller alone and the wrench it meets is recorded: the reference F_des, M_des, fitted
+with RBFs over the phase; the tip position where the replay ends is p_goal. Step 3, the
+check: p_goal must lie within the cell's goal tolerance of the demonstration's goal (0.5
+mm above the bottom); a part that does not pass its ``demo_hole`` stops on the entry
+instead, and its teaching is refused (ExecutorError naming the part, the hole and the
+end error), no skill written. The skill records what it was taught on
+(:class:`executor.skills.dmp.TaughtOn`).
 
 Poses, wrenches and p_goal are stored in the hole's frame (its
 origin at the centre of the hole's entry, at the hole's own height, turned by the hole's
