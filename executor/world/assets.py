@@ -69,10 +69,10 @@ def sources_digest(geometry: CellGeometry) -> str:
 
 def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
     """A hole's fields, its entry height and depth only where they are not the plate's and
-    ``pin`` only for a pin (so a product whose holes are all at the plate's level keeps
-    its digest)."""
+    ``pin`` only for a pin, ``axis`` only for a hole entered sideways (so a product whose
+    holes are all at the plate's level keeps its digest)."""
     fields = dataclasses.asdict(hole)
-    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False)):
+    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False), ("axis", "-z")):
         if fields[key] == default:
             del fields[key]
     return fields
