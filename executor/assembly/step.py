@@ -195,6 +195,9 @@ class Assembler:
         if spec is None:
             holes = ", ".join(sorted(self.product.geometry.holes))
             raise ExecutorError(f"unknown hole '{hole}' (expected one of {holes})")
+        if spec.sideways:
+            raise ExecutorError(f"hole '{hole}' is entered along {spec.axis}: an obstacle in it is not modelled "
+                                "(expected a hole entered down)")
         depth = spec.depth - 0.005
         a, b = spec.sides
         half = [a / 2 - 0.0002, b / 2 - 0.0002, depth / 2]

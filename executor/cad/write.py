@@ -501,7 +501,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = _plate_level(derived)
-    tile = _tile(fits)
+    tile = _tile([fit for fit in fits if fit.axis == "+z"])  # the plate's bosses: none around a sideways hole
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
              "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",

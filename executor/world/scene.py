@@ -178,13 +178,18 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
     half_tile = plate.tile_size / 2
     for hid, hole in sorted(geometry.holes.items()):
         turned = yaw_quat(hole.yaw)  # the boss turns with its hole
-        half_thick = (hole.depth + (hole.bottom_z - boss_bottom)) / 2  # its depth and floor
-        shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
-                       (*hole.position, hole.top_z - half_thick), turned, (180, 185, 190)))
         half_depth = hole.depth / 2
         a, b = hole.sides
+        cavity, cavity_quat = np.array([*hole.position, hole.top_z - half_depth]), np.array(turned)
+        frame = hole.frame
+        if frame is None:
+            half_thick = (hole.depth + (hole.bottom_z - boss_bottom)) / 2  # its depth and floor
+            shapes.append((f"boss_{hid}", "box", (half_tile, half_tile, half_thick),
+                           (*hole.position, hole.top_z - half_thick), turned, (180, 185, 190)))
+        else:  # in the base's own mesh (no boss), along its axis
+            cavity, cavity_quat = frame.pose_to_cell(cavity, cavity_quat)
         shapes.append((f"hole_{hid}", "cylinder" if hole.kind == "round" else "box", (a / 2, b / 2, half_depth),
-                       (*hole.position, hole.top_z - half_depth), turned, (40, 40, 40)))
+                       tuple(cavity.tolist()), tuple(cavity_quat.tolist()), (40, 40, 40)))
     for pid, part in sorted(geometry.parts.items()):
         a, b = part.sides
         shapes.append((f"part_{pid}", "cylinder" if part.kind == "round" else "box", (a / 2, b / 2, part.length / 2),
@@ -194,7 +199,8 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
 
 def hole_rims(geometry: CellGeometry, segments: int = 48) -> list[np.ndarray]:
     """Each hole's rim at the plate's top as a closed line ``(K, 3)`` [m]: a circle of the
-    hole's diameter, its outline (a polygon) or its rectangle, turned by its yaw."""
+    hole's diameter, its outline (a polygon) or its rectangle, turned by its yaw; a hole
+    entered sideways's at its entry, across its axis."""
     top = geometry.plate.top_z
     rims = []
     for _hid, hole in sorted(geometry.holes.items()):
@@ -208,7 +214,11 @@ def hole_rims(geometry: CellGeometry, segments: int = 48) -> list[np.ndarray]:
         else:
             corners = [(1, 1), (-1, 1), (-1, -1), (1, -1), (1, 1)]
             outline = np.array([[sx * a / 2, sy * b / 2, 0.0] for sx, sy in corners])
-        rims.append(turn_z(outline, hole.yaw) + np.array([*hole.position, top]))
+        frame = hole.frame
+        if frame is None:
+            rims.append(turn_z(outline, hole.yaw) + np.array([*hole.position, top]))
+        else:  # at its own entry, across its axis
+            rims.append(frame.points_to_cell(turn_z(outline, hole.yaw) + np.array([*hole.position, hole.top_z])))
     return rims
 
 
