@@ -144,16 +144,20 @@ def mujoco_insertion(geometry: CellGeometry, part: PartSpec, hole: HoleSpec) -> 
 
 
 def compare(assembly: str, pairs: list[tuple[str, str]] | None = None) -> dict[str, Any]:
-    """Both engines' insertions of ``pairs`` (default: every part with every hole) of an
-    assembly: rows, the pairs where they disagree, each engine's steps per second (the
-    median over the insertions)."""
+    """Both engines' insertions of ``pairs`` (default: every part with every hole entered
+    down; a hole entered sideways is refused) of an assembly: rows, the pairs where they
+    disagree, each engine's steps per second (the median over the insertions)."""
     geometry = load_geometry(assembly)
     if pairs is None:
-        pairs = [(p, h) for p in sorted(geometry.parts) for h in sorted(geometry.holes)]
+        down = [hid for hid, spec in sorted(geometry.holes.items()) if not spec.sideways]
+        pairs = [(p, h) for p in sorted(geometry.parts) for h in down]
     for pid, hid in pairs:
         if pid not in geometry.parts or hid not in geometry.holes:
             raise ExecutorError(f"--pair {pid}:{hid}: expected a part of {' '.join(sorted(geometry.parts))} and a "
                                 f"hole of {' '.join(sorted(geometry.holes))}")
+        if geometry.holes[hid].sideways:
+            raise ExecutorError(f"--pair {pid}:{hid}: hole {hid} is entered along {geometry.holes[hid].axis}; the "
+                                "engines' comparison drops parts down into holes entered down (-z) only")
     rows: list[dict[str, Any]] = []
     for pid, hid in pairs:
         part, hole = geometry.parts[pid], geometry.holes[hid]

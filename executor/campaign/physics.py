@@ -69,6 +69,9 @@ def physics_rates(assembly: str, part: str, hole: str, steps: int) -> dict[str, 
     the hole, and the contact points the part has with the plate in (b)."""
     geometry = load_geometry(assembly)
     spec, hole_spec = geometry.parts[part], geometry.holes[hole]
+    if hole_spec.sideways:
+        raise ExecutorError(f"hole {hole} is entered along {hole_spec.axis}: the contact rate is measured in a hole "
+                            "entered down (-z)")
     scene = Scene(geometry, spec.shape)
     try:
         scene.hold(spec)
