@@ -51,7 +51,21 @@ if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger
 
 APPROACH_HEIGHT = 0.0025  # [m] above the plate where the search starts
+REACH_TOLERANCE = 0.005
+"""[m] an arm placed by IK farther than this from its pose does not reach it (IK ends within
+1 µm of a pose it reaches): the attempt or the teaching stops with an error, no outcome."""
 PLATE_MESH_COLOR = (180, 185, 190)  # RGB of the plate's bosses in the Rerun scene
+
+
+def place_arm(arm: Arm, tip: np.ndarray, quat_xyzw: np.ndarray, what: str) -> None:
+    """The arm placed by IK at the pose (tip [m], quaternion xyzw, cell frame) of ``what``;
+    ExecutorError naming it when the arm does not reach it (:data:`REACH_TOLERANCE`)."""
+    arm.inverse_kinematics(tip, quat_xyzw)
+    missed = arm.tip_error(tip)
+    if missed > REACH_TOLERANCE:
+        raise ExecutorError(f"the arm does not reach {what} at ({', '.join(f'{1e3 * v:.1f}' for v in tip)}) mm: its "
+                            f"tip ends {1e3 * missed:.1f} mm from it; expected a pose within its reach (place the "
+                            "product nearer the arm: import --place X,Y)")
 
 
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
@@ -170,7 +184,7 @@ class Cell:
         self.scene.set_friction(None)
         arm = motion.controller.arm
         arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
-        arm.inverse_kinematics(*motion.cell_pose(tip, quat_xyzw))
+        place_arm(arm, *motion.cell_pose(tip, quat_xyzw), "the demonstration's start")
         motion.controller.reset()
         motion.hold(tip, quat_xyzw, APPROACH_SETTLE_TIME)
         arm.tare_sensor()
@@ -256,7 +270,7 @@ class Cell:
         approach = np.array([est_xy[0], est_xy[1], surface + APPROACH_HEIGHT])
         motion.frame = hole_spec.frame  # the hole's: the attempt runs down its z axis
         try:
-            arm.inverse_kinematics(*motion.cell_pose(approach, quat))
+            place_arm(arm, *motion.cell_pose(approach, quat), f"the approach to hole '{hole}'")
             motion.controller.reset()
             motion.hold(approach, quat, APPROACH_SETTLE_TIME)
             arm.tare_sensor()

@@ -158,6 +158,13 @@ class Arm:
         self.reset(q)
         return q
 
+    def tip_error(self, tip_pos: np.ndarray) -> float:
+        """How far [m] the believed tip is from ``tip_pos`` now (a reach check after
+        :meth:`inverse_kinematics`; reads no sensor, so the wrench filter is untouched)."""
+        ls = pb.getLinkState(self.robot, self.sensor, computeForwardKinematics=1, physicsClientId=self.client)
+        rot = np.array(pb.getMatrixFromQuaternion(ls[5])).reshape(3, 3)
+        return float(np.linalg.norm(np.array(ls[4]) + rot @ self._inv_pos - np.asarray(tip_pos)))
+
     def read(self) -> ArmState:
         """The current state; the wrench is tared and low-pass filtered (α = 0.1 per 1 ms step, τ ≈ 10 ms).
 

@@ -17,12 +17,14 @@ import trimesh
 
 from bridge import BridgeError
 from bridge.product import load_product_description
+from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad.cli import run_import
+from executor.cad.cli import ImportOptions, run_import
 from executor.cad.sections import frame_of
 from executor.cad.sweep import DIRECTIONS, opposite
 from executor.cell_description import CellDescription
+from executor.skills.teach import teach_all
 from executor.trial import Cell
 from executor.world.arm import ArmState, quat_to_matrix, tool_quat
 from executor.world.frames import hole_frame, hole_rotation
@@ -138,3 +140,31 @@ def test_a_horizontal_peg_is_assembled_within_2_mm(taught: Path) -> None:
         assembler.close()
     assert step.outcome == "fit" and step.pose_error < 0.002, step
     assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.02)  # lying along the hole's axis
+
+
+@pytest.mark.slow  # imports the product turned a quarter turn, twice; teaches it, one trial (about 25 s under load)
+def test_along_x_the_arm_must_reach_the_hole_and_then_inserts(tmp_path: Path) -> None:
+    # The box turned so that its hole runs along x: the peg goes in along -x, towards the
+    # arm, the wrist 185 mm beyond the entry.
+    cad = tmp_path / "cad"
+    cad.mkdir()
+    for name in ("box", "hex_peg"):
+        mesh = trimesh.load(CORPUS / "meshes" / f"{name}.stl", force="mesh")
+        mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (0.0, 0.0, 1.0)))
+        mesh.export(cad / f"{name}.stl")
+    far = run_import(cad, tmp_path / "far", "mm", CORPUS / "import.toml")  # the box at x = 560 mm
+    assert far.derived.axis == {"hex_peg": "+x"}
+    cell = Cell(str(tmp_path / "far"))
+    try:
+        with pytest.raises(ExecutorError, match=r"does not reach the demonstration's start at \(583.0, 0.0, 30.0\) mm"):
+            teach_all(cell)  # out of reach: an error, no skill, never an outcome
+    finally:
+        cell.close()
+    assert not (tmp_path / "far" / "demonstrations").exists()
+    run_import(cad, tmp_path / "near", "mm", CORPUS / "import.toml", ImportOptions(place=(0.42, 0.0)))
+    cell = Cell(str(tmp_path / "near"))
+    try:
+        teach_all(cell)
+        assert cell.run_trial("hex_peg", "h1", 0).outcome == "fit"
+    finally:
+        cell.close()
