@@ -61,7 +61,7 @@ from executor.skills.centring import centre_by_contact
 from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
-from executor.trial import APPROACH_HEIGHT, trial_rng
+from executor.trial import APPROACH_HEIGHT, REACH_TOLERANCE, trial_rng
 from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
 from executor.world.frames import HoleFrame
 from executor.world.geometry import fit_pose, margin
@@ -456,6 +456,12 @@ class Assembler:
             reorient(motion, np.array([above[0], above[1], max(SAFE_Z, float(above[2]))]), frame, yaw)
         move_line(motion, outside, tolerance=VIA_TOLERANCE, yaw=yaw)
         move_line(motion, approach, speed=DESCENT_SPEED)
+        missed = float(np.linalg.norm(motion.read().tip_pos - approach))
+        if missed > REACH_TOLERANCE:  # out of the arm's reach: no outcome to report
+            where = ", ".join(f"{1e3 * v:.1f}" for v in frame.points_to_cell(approach))
+            raise ExecutorError(f"the arm does not reach the approach to a hole entered sideways at ({where}) mm: "
+                                f"its tip stays {1e3 * missed:.1f} mm from it; expected a pose within its reach (place "
+                                "the product nearer the arm: import --place X,Y)")
 
     def _leave_frame(self) -> None:
         """After a hole entered sideways: the tool straight up to the carrying height, turning
