@@ -14,7 +14,8 @@ stage frees never comes out (an error naming it and, per direction, its blockers
 **Geometric precedence** (:func:`forced`): A must precede B (``blocks``) when A cannot go
 in once B is there: of the directions the base leaves A free along, B blocks one, and B
 or parts present whenever B is (its body, the base, parts already found to precede B)
-block every one. The base precedes every part touching it (``base``). Two stated rules
+block every one. The base precedes every part touching it (``base``), the owner of a
+feature every part going into or onto it (``feature``, :func:`owner_pairs`). Two stated rules
 of placing (:mod:`executor.cad.locating`) add ``supports`` (a part
 resting on parts other than the base goes after them) and ``locates`` (whichever way a part
 goes in, one other part alone locates it across that way; off with reach 0);
@@ -118,7 +119,8 @@ class Derived:
     product along, ``axis`` its insertion axis (the name of the removal direction),
     ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs and
     ``reasons`` why each holds (``blocks``: :func:`forced`, its blockers per direction in
-    ``detail``; ``base``: the base precedes the parts touching it; ``supports`` and
+    ``detail``; ``base``: the base precedes the parts touching it; ``feature``: the
+    owner of a feature precedes the parts going into or onto it; ``supports`` and
     ``locates``: the rules of :mod:`executor.cad.locating`),
     ``located`` each moving body's locators per direction (of the six axes), ``dropped``
     the locating pairs and ``dropped_supports`` the supporting pairs the blocking
@@ -238,8 +240,25 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.pins, result.bores = pins(result)
+    result.reasons |= owner_pairs(result)
+    result.edges = set(result.reasons)
     result.queries = sweeper.queries
     return result
+
+
+def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:
+    """The ``feature`` pairs: the owner of a feature before each part that goes into or
+    onto it (the base before the part in each of its holes, a pin's owner before the parts
+    on it), where ``derived.edges`` do not order them already. The cell inserts a part into
+    its feature, so the feature's owner must be in place first: a precondition of the
+    insertion, not a consequence of the blocking (a peg standing on the floor through a
+    hole of the base, touching none of it, has every way in free whatever the order; with
+    the base carried into its fixture after it, the base pushes it aside)."""
+    order = nx.DiGraph(list(derived.edges))
+    wanted = [(derived.base, fit.part) for fit in derived.holes.values() if fit.part is not None]
+    wanted += [(pin.owner, part) for pin in derived.pins.values() for part in pin.parts]
+    return {(owner, part): "feature" for owner, part in sorted(set(wanted))
+            if not (owner in order and part in order and nx.has_path(order, owner, part))}
 
 
 def bodies(parts: dict[str, CadPart], base: str, fixed_to: dict[str, str]) -> dict[str, set[str]]:

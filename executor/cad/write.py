@@ -13,8 +13,9 @@
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's (0: a nominal zero-clearance fit), the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
-  from the disassembly and the locating rule, each direct pair's reason in a comment
-  (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
+  from the disassembly, the features and the rules of placing, each direct pair's reason
+  in a comment (``blocks``, ``base``, ``feature``, ``supports``, ``locates``), the input
+  of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
   wait (and when the cell's loader accepts it; left out otherwise, and the report says
   why): pegs standing in holes entered along +z with a round, square or rect section or
@@ -266,6 +267,8 @@ def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
 REASONS = {
     "blocks": "A cannot go in once B is there (B, or parts always placed before B, block each way the base leaves A)",
     "base": "A is the base and B touches it",
+    "feature": "B goes into or onto a feature of A (a hole, a pin): the cell inserts it there, so A is in place "
+               "first (the insertion's precondition, not the blocking's)",
     "supports": "B rests on A and not on the base (the support rule, an assumption of the import)",
     "locates": "A alone keeps B from moving sideways (the locating rule, an assumption of the import)",
 }

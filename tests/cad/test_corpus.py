@@ -202,6 +202,21 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", PRODUCTS)
+def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str], Imported], name: str) -> None:
+    # The cell inserts a part into its feature: the feature's owner is placed first, for a
+    # reason of its own where nothing else orders them (agh_prism_array's pegs stand on the
+    # floor through the box's holes, touching none of it).
+    done = imported(name)
+    text = (done.out / "geometric_precedence.lp").read_text()
+    written = _atoms(done.out / "geometric_precedence.lp").get("must_precede", set())
+    owners = {(done.truth["features"][part["in"]]["owner"], pid) for pid, part in done.truth["parts"].items()
+              if "in" in part}
+    assert owners <= written
+    assert all(f"% {a}->{b}: blocks" not in text for a, b in owners - {tuple(p) for p in done.truth["precedence"]})
+
+
+@pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", PRODUCTS)
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
