@@ -514,6 +514,8 @@ def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float
     line = outlines[0].centre
     reach = 2 * float(np.linalg.norm(part.mesh.vertices @ frame.T - line, axis=1).max())
     near = np.linalg.norm(owner.mesh.vertices @ frame.T - line, axis=1) <= reach
+    if not near.any():  # nothing of the owner around the part: no slice needed
+        return None
     levels = np.unique(np.round(np.clip(owner_along[near], low, high), 9))
     bounds = np.unique(np.concatenate([[low, high], levels]))
     spans = sorted(zip(bounds[:-1], bounds[1:], strict=True), key=lambda span: span[0] - span[1])
