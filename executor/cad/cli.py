@@ -206,15 +206,16 @@ def report(derived: Derived) -> list[str]:
         lines.append(f"part {pid}: insertion axis {opposite(derived.axis[pid])} (leaves along "
                      f"{derived.axis[pid]}); free in the assembled product along "
                      f"{', '.join(derived.free(pid)) or 'none'}")
-    for hid, fit in derived.holes.items():
+    for hid, fit in [*derived.holes.items(), *derived.part_holes.items()]:
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
         held = "empty"
         if fit.part is not None and fit.section is not None:
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, "
                     f"{_clearance(fit.section, fit.hole, fit.part, hid)})")
+        owner = "" if fit.owner is None else f" of {fit.owner}"
         where = (f"at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm" if fit.axis == "+z" else
                  "entry at ({}, {}, {}) mm".format(*map(_mm, entry_point(fit))))
-        lines.append(f"hole {hid} {where}, entered along "
+        lines.append(f"hole {hid}{owner} {where}, entered along "
                      f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
     for pin_id, pin in derived.pins.items():

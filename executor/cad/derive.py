@@ -14,7 +14,8 @@ stage frees never comes out (an error naming it and, per direction, its blockers
 **Geometric precedence** (:func:`forced`): A must precede B (``blocks``) when A cannot go
 in once B is there: of the directions the base leaves A free along, B blocks one, and B
 or parts present whenever B is (its body, the base, parts already found to precede B)
-block every one. The base precedes every part touching it (``base``). Two stated rules
+block every one. The base precedes every part touching it (``base``), the owner of a
+feature every part going into or onto it (``feature``, :func:`owner_pairs`). Two stated rules
 of placing (:mod:`executor.cad.locating`) add ``supports`` (a part
 resting on parts other than the base goes after them) and ``locates`` (whichever way a part
 goes in, one other part alone locates it across that way; off with reach 0);
@@ -28,11 +29,18 @@ along the axis), depth (entry to the first face down its centre line, or through
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
 loop that is no round, square or rect section is a pocket, reported but no hole.
 
+**Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
+onto no pin is in the hole of another moving part that the geometric precedence puts
+before it when its outline across its insertion axis lies in an inner loop of that part
+(a rod through a bracket's bore), measured as a hole of the base is.
+
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
 around a solid loop of another part there (the base's pin, another part's shaft), that
 part the base or one the geometric precedence puts before it, goes onto that pin; a peg
-standing in a hole of the base is no pin (a part over it is a cover). The pin is a
+standing in a hole of the base is a pin only of a part going in along another axis (a
+nut onto a bolt's end under the plate; one going in along the peg's, over it, is a
+cover). The pin is a
 feature of its owner (``<owner>_pin1``, ``_pin2``, ... by position), its section measured
 on the owner's slice; the fit is the pin's section inside the bore's, so the planner
 learns which part goes onto which pin as it learns pegs in holes.
@@ -40,7 +48,7 @@ learns which part goes onto which pin as it learns pegs in holes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import networkx as nx
 import numpy as np
@@ -67,6 +75,8 @@ from executor.cad.sweep import (
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
+_HOLE_LEVELS = 8
+"""How many levels :func:`_hole_around` slices an owner at, at most."""
 
 
 @dataclass(frozen=True)
@@ -86,6 +96,8 @@ class HoleFit:
     """The loop of the base around the hole at mid-depth (a boss), None when there is none."""
     part: str | None = None
     section: Shape2D | None = None
+    owner: str | None = None
+    """The moving part the hole is in (:func:`part_holes`), None for a hole of the base."""
 
     @property
     def position(self) -> tuple[float, float]:
@@ -118,8 +130,8 @@ class Derived:
     product along, ``axis`` its insertion axis (the name of the removal direction),
     ``stages`` the disassembly stages, ``edges`` the geometric must-precede pairs and
     ``reasons`` why each holds (``blocks``: :func:`forced`, its blockers per direction in
-    ``detail``; ``base``: the base precedes the parts touching it; ``holds``: and the parts in
-    its holes entered sideways, which it holds up; ``supports`` and
+    ``detail``; ``base``: the base precedes the parts touching it; ``feature``: the
+    owner of a feature precedes the parts going into or onto it; ``supports`` and
     ``locates``: the rules of :mod:`executor.cad.locating`),
     ``located`` each moving body's locators per direction (of the six axes), ``dropped``
     the locating pairs and ``dropped_supports`` the supporting pairs the blocking
@@ -148,6 +160,8 @@ class Derived:
     pins: dict[str, PinFit] = field(default_factory=dict)
     bores: dict[str, Shape2D] = field(default_factory=dict)
     """Part -> the section of its bore around a pin (:func:`pins`)."""
+    part_holes: dict[str, HoleFit] = field(default_factory=dict)
+    """The holes of moving parts, each with the part through it (:func:`part_holes`)."""
     queries: int = 0
 
     def free(self, part: str) -> list[str]:
@@ -181,8 +195,14 @@ class Derived:
 
     @property
     def hole_of(self) -> dict[str, HoleFit]:
-        """Part → the hole it stands in."""
+        """Part → the hole of the base it stands in."""
         return {fit.part: fit for fit in self.holes.values() if fit.part is not None}
+
+    @property
+    def in_holes(self) -> dict[str, HoleFit]:
+        """Part → the hole it is in: of the base, else the first of a moving part's it passes."""
+        found = {fit.part: fit for fit in reversed(self.part_holes.values()) if fit.part is not None}
+        return found | self.hole_of
 
 
 def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH) -> Derived:
@@ -238,14 +258,28 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
-    # A part in a hole of the base entered sideways lies on the hole's walls once let go: the base holds it up.
-    held = {(base, fit.part): "holds" for fit in result.holes.values()
-            if fit.part is not None and fit.axis[1] != "z" and (base, fit.part) not in result.reasons}
-    result.reasons |= held
-    result.edges |= set(held)
     result.pins, result.bores = pins(result)
+    result.part_holes = part_holes(result)
+    result.reasons |= owner_pairs(result)
+    result.edges = set(result.reasons)
     result.queries = sweeper.queries
     return result
+
+
+def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:
+    """The ``feature`` pairs: the owner of a feature before each part that goes into or
+    onto it (the base, or the moving part a hole is in, before the part in the hole; a
+    pin's owner before the parts on it), where ``derived.edges`` do not order them already.
+    The cell inserts a part into its feature, so the feature's owner must be in place
+    first: a precondition of the insertion, not a consequence of the blocking (a peg
+    standing on the floor through a hole of the base, touching none of it, has every way in
+    free whatever the order, and the base would be carried into its fixture over it)."""
+    order = nx.DiGraph(list(derived.edges))
+    wanted = [(derived.base if fit.owner is None else fit.owner, fit.part)
+              for fit in [*derived.holes.values(), *derived.part_holes.values()] if fit.part is not None]
+    wanted += [(pin.owner, part) for pin in derived.pins.values() for part in pin.parts]
+    return {(owner, part): "feature" for owner, part in sorted(set(wanted))
+            if not (owner in order and part in order and nx.has_path(order, owner, part))}
 
 
 def bodies(parts: dict[str, CadPart], base: str, fixed_to: dict[str, str]) -> dict[str, set[str]]:
@@ -384,8 +418,8 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     loop holding the centre of another part's outline there, that part the base or one the
     geometric precedence puts before it (a part that goes in after, into the bore, is no
     pin: a head in a cover's socket). A bore around no such outline is no fit; nor is one
-    around a peg standing in a hole of the base (that part is a cover,
-    :mod:`executor.cad.covers`)."""
+    around a peg standing in a hole of the base that goes in along the part's own axis
+    (that part is a cover, :mod:`executor.cad.covers`)."""
     found: list[tuple[str, str, Shape2D, np.ndarray, str]] = []  # owner, axis, pin, centre, part
     order = nx.DiGraph(list(derived.edges))
     bores: dict[str, Shape2D] = {}
@@ -400,7 +434,8 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
         frame = frame_of(axis)
         for bore in (loop for loop in own if not _outer(loop, own)):
             before = nx.ancestors(order, pid) if pid in order else set()
-            for other in sorted(({derived.base} | before) - set(derived.hole_of)):
+            covered = {peg for peg in derived.hole_of if derived.axis[peg] == name}  # over it: a cover
+            for other in sorted(({derived.base} | before) - covered):
                 theirs = slice_loops(derived.parts[other].mesh, axis, level)
                 inside = [o for o in theirs if _outer(o, theirs) and bore.contains(o.centre) and o.area < bore.area]
                 if len(inside) == 1:
@@ -431,23 +466,93 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     return result, bores
 
 
+def part_holes(derived: Derived) -> dict[str, HoleFit]:
+    """The holes of moving parts (``<owner>_hole1``, ... by position) and the part through
+    each (module docstring): a moving part in no hole of the base and onto no pin, whose
+    outline across its insertion axis (one of the six) lies in an inner loop of a part the
+    geometric precedence puts before it (not the base, not of its own body) at a level both
+    reach: a rod through a bracket's bore, a shaft into a bearing placed before it."""
+    order = nx.DiGraph(list(derived.edges))
+    found: list[HoleFit] = []
+    for pid in sorted(derived.axis):
+        name = derived.axis[pid]
+        if pid in derived.hole_of or pid in derived.bores or name not in DIRECTIONS or pid not in order:
+            continue
+        body = next(members for members in derived.bodies.values() if pid in members)
+        for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body):
+            hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
+            if hit is not None:
+                level, loop, outer, own = hit
+                fit = _measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own))
+                found.append(replace(fit, owner=owner))
+    found.sort(key=lambda f: (f.owner or "", round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
+    counts: dict[str, int] = {}
+    result: dict[str, HoleFit] = {}
+    for fit in found:
+        owner = fit.owner or ""
+        counts[owner] = counts.get(owner, 0) + 1
+        result[f"{owner}_hole{counts[owner]}"] = replace(fit, id=f"{owner}_hole{counts[owner]}")
+    return result
+
+
+def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float, Loop, Loop | None, Loop] | None:
+    """Where ``owner`` has a hole around ``part`` across ``axis``: the level [m], the
+    hole's loop, the loop around it (None: none) and the part's loop in it; None when no
+    level tried has one. The levels tried are the middles of the spans between the owner's
+    vertices near the part's centre line (within twice the part's reach across it) along
+    the axis, where both reach, :data:`_HOLE_LEVELS` longest first: an owner's slice changes
+    only at its vertices' levels."""
+    along, owner_along = part.mesh.vertices @ axis, owner.mesh.vertices @ axis
+    low, high = max(along.min(), owner_along.min()), min(along.max(), owner_along.max())
+    if high - low <= 1e-6:
+        return None
+    frame = frame_of(axis)
+    middle = slice_loops(part.mesh, axis, float(along.min() + along.max()) / 2)
+    outlines = [loop for loop in middle if _outer(loop, middle)]
+    if len(outlines) != 1:
+        return None
+    line = outlines[0].centre
+    reach = 2 * float(np.linalg.norm(part.mesh.vertices @ frame.T - line, axis=1).max())
+    near = np.linalg.norm(owner.mesh.vertices @ frame.T - line, axis=1) <= reach
+    if not near.any():  # nothing of the owner around the part: no slice needed
+        return None
+    levels = np.unique(np.round(np.clip(owner_along[near], low, high), 9))
+    bounds = np.unique(np.concatenate([[low, high], levels]))
+    spans = sorted(zip(bounds[:-1], bounds[1:], strict=True), key=lambda span: span[0] - span[1])
+    for start, end in spans[:_HOLE_LEVELS]:
+        if end - start <= 1e-6:
+            break
+        level = float(start + end) / 2
+        loops = slice_loops(owner.mesh, axis, level)
+        cut = slice_loops(part.mesh, axis, level)
+        own = [o for o in cut if _outer(o, cut)]
+        for loop in (o for o in loops if not _outer(o, loops)):
+            inside = [o for o in own if loop.contains(o.centre) and o.area < loop.area]
+            if len(inside) == 1:
+                around = sorted((o for o in loops if o is not loop and o.area > loop.area
+                                 and o.contains(loop.centre)), key=lambda o: o.area)
+                return level, loop, around[0] if around else None, inside[0]
+    return None
+
+
 def _fields(fit: HoleFit) -> tuple:
     return (fit.axis, fit.hole, fit.centre, fit.entry, fit.depth, fit.chamfer, fit.outer, fit.part, fit.section)
 
 
 def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
              occupant: tuple[CadPart, Loop] | None) -> HoleFit:
-    """Section, entry, depth (to the first face of the base down the hole's centre line;
-    through the base when there is none) and chamfer of the hole ``loop``."""
+    """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
+    the hole's centre line; through it, to its lowest point around the hole, when there is
+    none) and chamfer of the hole ``loop``."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
     hole = exact_round(classify(loop, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
-    base_along = base.mesh.vertices @ axis
     radial = base.mesh.vertices @ frame.T - hole.centre
-    entry = float(base_along[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)].max())
+    around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)]
+    entry = float(around.max())
     centre = frame.T @ hole.centre + axis * level
     bottom = first_hit(base.mesh, centre, -axis)
-    depth = entry - (level - bottom if bottom is not None else float(base_along.min()))
+    depth = entry - (level - bottom if bottom is not None else float(around.min()))
     probe = [o for o in slice_loops(base.mesh, axis, entry - _ENTRY_PROBE) if o.contains(hole.centre)]
     chamfer = 0.0
     if probe:

@@ -3,8 +3,10 @@
 - ``assembly.toml``: every part (the base with role ``base``, a part in a hole with role
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position,
-  and every pin a part goes onto (``<owner>_pin1``, ... :func:`executor.cad.derive.pins`)
-  as a hole at the pin's position with the pin's section kind;
+  every hole of a moving part a part passes (``<owner>_hole1``, ...
+  :func:`executor.cad.derive.part_holes`), and every pin a part goes onto (``<owner>_pin1``,
+  ... :func:`executor.cad.derive.pins`) as a hole at the pin's position with the pin's
+  section kind;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
@@ -13,8 +15,9 @@
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's (0: a nominal zero-clearance fit), the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
-  from the disassembly and the locating rule, each direct pair's reason in a comment
-  (``blocks``, ``base``, ``locates``), the input of ``precedence learn --prior`` and ``precedence count``;
+  from the disassembly, the features and the rules of placing, each direct pair's reason
+  in a comment (``blocks``, ``base``, ``feature``, ``supports``, ``locates``), the input
+  of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
   wait (and when the cell's loader accepts it; left out otherwise, and the report says
   why): pegs standing in holes entered along +z with a round, square or rect section or
@@ -148,9 +151,11 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         if _section_kind(pegs.get(pid)) is not None:
             lines.append(f'shape = "{_section_kind(pegs.get(pid))}"')
         lines.append("")
-    for hid, fit in derived.holes.items():
+    for hid, fit in [*derived.holes.items(), *derived.part_holes.items()]:
         name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
         x, y, _ = entry_point(fit)
+        if fit.owner is not None:
+            name = f"hole of {fit.owner} ({fit.part} in it)"
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(x)}, {_q(y)}]", ""]
     for pin_id, pin in derived.pins.items():
@@ -204,7 +209,8 @@ def sizes_text(derived: Derived) -> str:
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
              *_nominal_comments(nominal),
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in rooms]),
-             _symbols([clingo.Function("hole", [clingo.Function(h)]) for h in [*derived.holes, *derived.pins]])]
+             _symbols([clingo.Function("hole", [clingo.Function(h)])
+                       for h in [*derived.holes, *derived.part_holes, *derived.pins]])]
     for pid, holes in rooms.items():
         fits = [clingo.Function("fits", [clingo.Function(pid), clingo.Function(hid)]) for hid, room in holes.items()
                 if room > 0 or (pid, hid) in nominal]
@@ -214,10 +220,12 @@ def sizes_text(derived: Derived) -> str:
 
 
 def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
-    """Peg -> hole -> the measured sections of the peg and the hole, and part with a bore
-    -> pin -> those of the pin and the bore (the pin goes into the bore)."""
-    pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in derived.holes.items()}
-             for pid, fit in sorted(derived.hole_of.items()) if fit.section is not None}
+    """Peg (a part in a hole of the base or of a moving part) -> hole -> the measured
+    sections of the peg and the hole, and part with a bore -> pin -> those of the pin and
+    the bore (the pin goes into the bore)."""
+    holes = {**derived.holes, **derived.part_holes}
+    pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in holes.items()}
+             for pid, fit in sorted(derived.in_holes.items()) if fit.section is not None}
     for pid, bore in sorted(derived.bores.items()):
         pairs.setdefault(pid, {}).update({pin_id: (pin.section, bore) for pin_id, pin in derived.pins.items()})
     return pairs
@@ -301,7 +309,8 @@ def cell_base(derived: Derived) -> tuple[trimesh.Trimesh, str]:
 REASONS = {
     "blocks": "A cannot go in once B is there (B, or parts always placed before B, block each way the base leaves A)",
     "base": "A is the base and B touches it",
-    "holds": "A is the base and B lies in a hole of it entered sideways (nothing else holds B up)",
+    "feature": "B goes into or onto a feature of A (a hole, a pin): the cell inserts it there, so A is in place "
+               "first (the insertion's precondition, not the blocking's)",
     "supports": "B rests on A and not on the base (the support rule, an assumption of the import)",
     "locates": "A alone keeps B from moving sideways (the locating rule, an assumption of the import)",
 }

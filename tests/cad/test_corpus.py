@@ -47,13 +47,15 @@ class Imported:
     """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
     moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
     ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the
-    cell, and each imported hole's or pin's ``occupants`` (the parts in it or onto it)."""
+    cell, each imported hole's or pin's ``occupants`` (the parts in it or onto it) and
+    ``owners`` (the part it is a feature of)."""
 
     truth: dict[str, Any]
     out: Path
     axes: dict[str, str]
     offset: tuple[float, float]
     occupants: dict[str, set[str]]
+    owners: dict[str, str]
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -81,10 +83,13 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
             result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
             truth = tomllib.loads((folder / "truth.toml").read_text())
             derived = result.derived
-            occupants = {hid: {fit.part} for hid, fit in derived.holes.items() if fit.part is not None}
+            holes = derived.holes | derived.part_holes
+            occupants = {hid: {fit.part} for hid, fit in holes.items() if fit.part is not None}
             occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
+            owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
+            owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
             done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
-                                  result.offset, occupants)
+                                  result.offset, occupants, owners)
         return done[name]
 
     return get
@@ -102,16 +107,17 @@ def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tu
 
 
 def _feature_holes(done: Imported) -> dict[str, str]:
-    """Each truth feature's imported hole id (absent: none found): the one on its axis
-    that is empty or holds a part the truth puts in that feature (of a plate's hole and the
-    end of the bolt in it, of the two ends of one rod, the one its own part is in)."""
+    """Each truth feature's imported hole id (absent: none found): the one of the
+    feature's owner on its axis; of several (the two ends of one rod), the one that is
+    empty or holds a part the truth puts in that feature."""
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
         inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
-        near = [hid for hid, hole in holes.items()
-                if _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
-                and (not done.occupants.get(hid) or done.occupants[hid] & inside)]
+        near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
+                and _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM]
+        if len(near) > 1:
+            near = [hid for hid in near if not done.occupants.get(hid) or done.occupants[hid] & inside]
         if len(near) == 1:
             found[fid] = near[0]
     return found
@@ -126,16 +132,12 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
 
-ANY_PART = ("fits of any part on any part: the bolts' ends the nuts under the plate go onto and the brackets' bores "
-            "the rod goes through are no features")
-
-
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
     "metaworld_assembly",
-    pytest.param("occt_as1", marks=_xfail(ANY_PART)),
+    "occt_as1",
     "robosuite_nuts",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
@@ -151,9 +153,10 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
     wrong = [(row["part"], row["feature"]) for row in done.truth["fits"]
              if ((row["part"], holes[row["feature"]]) in fits) != row["fits"]]
     assert not wrong, f"fits differ from the truth on {wrong}"
-    # The CAD prior's margins agree in sign (the room's measure may differ by convention).
+    # The CAD prior's margins agree in sign (the room's measure may differ by convention),
+    # room 0 a nominal zero-clearance fit as in the truth.
     margins = {(p, h): int(m) for p, h, m in _atoms(done.out / "nominal_sizes.lp").get("nominal_margin", set())}
-    assert all((margins[row["part"], holes[row["feature"]]] > 0) == row["fits"] for row in done.truth["fits"])
+    assert all((margins[row["part"], holes[row["feature"]]] >= 0) == row["fits"] for row in done.truth["fits"])
 
 
 @pytest.mark.slow  # the first test of a product imports it
@@ -202,6 +205,21 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", PRODUCTS)
+def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str], Imported], name: str) -> None:
+    # The cell inserts a part into its feature: the feature's owner is placed first, for a
+    # reason of its own where nothing else orders them (agh_prism_array's pegs stand on the
+    # floor through the box's holes, touching none of it).
+    done = imported(name)
+    text = (done.out / "geometric_precedence.lp").read_text()
+    written = _atoms(done.out / "geometric_precedence.lp").get("must_precede", set())
+    owners = {(done.truth["features"][part["in"]]["owner"], pid) for pid, part in done.truth["parts"].items()
+              if "in" in part}
+    assert owners <= written
+    assert all(f"% {a}->{b}: blocks" not in text for a, b in owners - {tuple(p) for p in done.truth["precedence"]})
+
+
+@pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", PRODUCTS)
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -226,7 +244,8 @@ def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: 
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
 
 
-@pytest.mark.slow  # imports the product, teaches it and runs a sim session of 16 experiments (about 70 s)
+@pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 90 s)
+@pytest.mark.timeout(600)  # 257 s while the machine ran other work
 def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
@@ -234,7 +253,7 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
     assert taught.returncode == 0, taught.stderr
     run = tmp_path / "run"
-    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--json", timeout=240)
+    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json", timeout=400)
     assert session.returncode == 0, session.stderr
     result = json.loads(session.stdout)
     # Every peg, the hexagon, octagon and 12-gon prisms too, goes into every hole in
@@ -245,6 +264,10 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     assert {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e} == truth
     assert sorted(map(tuple, result["fits"])) == sorted(pair for pair, outcome in truth.items() if outcome == "fit")
+    # The plan places the box (the holes' owner) first and every peg ends within 2 mm.
+    report = result["assembly"]
+    assert report["final_plan"][0]["part"] == done.truth["base"]
+    assert report["assembled"] and max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
 
 
 @pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 140 s under load)

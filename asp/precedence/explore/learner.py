@@ -35,7 +35,7 @@ _REASON = re.compile(r"^% ([a-z]\w*)->([a-z]\w*): ([a-z]+)$", re.MULTILINE)
 
 def geometric_reasons(path: str | None) -> dict[Pair, str]:
     """The reason of each direct pair of a ``geometric_precedence.lp`` (its ``% a->b: reason``
-    comments, as ``import`` writes them: blocks, base, supports, locates); {} without a file."""
+    comments, as ``import`` writes them: blocks, base, feature, supports, locates); {} without a file."""
     if path is None:
         return {}
     text = read_bytes(Path(path), "geometric precedence").decode("utf-8", errors="replace")
