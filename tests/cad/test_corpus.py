@@ -134,6 +134,7 @@ ANY_PART = ("fits of any part on any part: the bolts' ends the nuts under the pl
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "factory_rect_pegs",
     "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(ANY_PART)),
     "robosuite_nuts",
@@ -160,6 +161,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "factory_rect_pegs",
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
@@ -215,6 +217,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     pytest.param("agh_hex_horizontal", marks=_xfail(INSERTED + " in along a horizontal axis")),
     "agh_prism_array",
+    "factory_rect_pegs",
     pytest.param("metaworld_assembly", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (a "
                                                     "torus ring with a handle)")),
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
