@@ -54,6 +54,7 @@ class Imported:
     axes: dict[str, str]
     offset: tuple[float, float]
     occupants: dict[str, set[str]]
+    pins: frozenset[str] = frozenset()
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -84,7 +85,7 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
             occupants = {hid: {fit.part} for hid, fit in derived.holes.items() if fit.part is not None}
             occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
             done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
-                                  result.offset, occupants)
+                                  result.offset, occupants, frozenset(derived.pins))
         return done[name]
 
     return get
@@ -104,14 +105,16 @@ def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tu
 def _feature_holes(done: Imported) -> dict[str, str]:
     """Each truth feature's imported hole id (absent: none found): the one on its axis
     that is empty or holds a part the truth puts in that feature (of a plate's hole and the
-    end of the bolt in it, of the two ends of one rod, the one its own part is in)."""
+    end of the bolt in it, of the two ends of one rod, the one its own part is in), and is
+    a pin where the feature is one (of a hollow shaft's bore and the shaft, the shaft)."""
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
         inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
         near = [hid for hid, hole in holes.items()
                 if _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
-                and (not done.occupants.get(hid) or done.occupants[hid] & inside)]
+                and (not done.occupants.get(hid) or done.occupants[hid] & inside)
+                and (hid in done.pins) == (feature["kind"] == "pin")]
         if len(near) == 1:
             found[fid] = near[0]
     return found
@@ -126,6 +129,9 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
 
+EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the large gear's shaft; Factory's "
+             "large gear is absent from the repository) is no feature, pins are found only under a part")
+
 ANY_PART = ("fits of any part on any part: the bolts' ends the nuts under the plate go onto and the brackets' bores "
             "the rod goes through are no features")
 
@@ -134,6 +140,7 @@ ANY_PART = ("fits of any part on any part: the bolts' ends the nuts under the pl
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("factory_gears", marks=_xfail(EMPTY_PIN)),
     "factory_rect_pegs",
     "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(ANY_PART)),
@@ -161,6 +168,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "factory_gears",
     "factory_rect_pegs",
     "metaworld_assembly",
     "occt_as1",
@@ -217,6 +225,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     pytest.param("agh_hex_horizontal", marks=_xfail(INSERTED + " in along a horizontal axis")),
     "agh_prism_array",
+    pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (spur gears "
+                                               "whose hub stands 10 mm above their teeth)")),
     "factory_rect_pegs",
     pytest.param("metaworld_assembly", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (a "
                                                     "torus ring with a handle)")),
