@@ -128,6 +128,12 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
+ZERO_CLEARANCE_CROSS = ("nominal zero-clearance fits: a Technic axle in cross holes of its own size (the liftarm's, the "
+                        "bush's, the gear's) is called blocked in every direction, so the import refuses the product")
+REFUSED = {"ldraw_axles": ZERO_CLEARANCE_CROSS}
+IMPORTED = [pytest.param(name, marks=_xfail(REFUSED[name])) if name in REFUSED else name for name in PRODUCTS]
+"""Every product, marked where the import refuses it."""
+
 
 EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the large gear's shaft; Factory's "
              "large gear is absent from the repository) is no feature, pins are found only under a part")
@@ -142,6 +148,7 @@ ANY_PART = ("fits of any part on any part: the bolts' ends the nuts under the pl
     "agh_prism_array",
     pytest.param("factory_gears", marks=_xfail(EMPTY_PIN)),
     "factory_rect_pegs",
+    pytest.param("ldraw_axles", marks=_xfail(ZERO_CLEARANCE_CROSS)),
     "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(ANY_PART)),
     "robosuite_nuts",
@@ -170,6 +177,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
     "agh_prism_array",
     "factory_gears",
     "factory_rect_pegs",
+    pytest.param("ldraw_axles", marks=_xfail(ZERO_CLEARANCE_CROSS)),
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
@@ -184,7 +192,7 @@ def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported]
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     allowed = {pid: part["axes"] for pid, part in done.truth["parts"].items()}
@@ -193,7 +201,7 @@ def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], I
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     base = done.truth["base"]
@@ -211,7 +219,7 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -228,6 +236,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (spur gears "
                                                "whose hub stands 10 mm above their teeth)")),
     "factory_rect_pegs",
+    pytest.param("ldraw_axles", marks=_xfail(ZERO_CLEARANCE_CROSS)),
     pytest.param("metaworld_assembly", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (a "
                                                     "torus ring with a handle)")),
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
