@@ -128,8 +128,9 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-ZERO_CLEARANCE_CROSS = ("nominal zero-clearance fits: a Technic axle in cross holes of its own size (the liftarm's, the "
-                        "bush's, the gear's) is called blocked in every direction, so the import refuses the product")
+ZERO_CLEARANCE_CROSS = ("nominal zero-clearance fits: a Technic axle in cross holes of its own size (the "
+                        "liftarm's, the bush's, the gear's) is called blocked in every direction, so the import "
+                        "refuses the product")
 REFUSED = {"ldraw_axles": ZERO_CLEARANCE_CROSS}
 IMPORTED = [pytest.param(name, marks=_xfail(REFUSED[name])) if name in REFUSED else name for name in PRODUCTS]
 """Every product, marked where the import refuses it."""
