@@ -173,6 +173,23 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears", "factory_rect_pegs",
+                                  "metaworld_assembly", "robosuite_nuts"])
+def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:
+    # nominal_sizes.lp's margin is diametral: twice the room all round, within 2 um, on each
+    # pair that fits of the features the import finds (a no-fit's negative measure is a
+    # convention: the sign is checked above).
+    done = imported(name)
+    holes = _feature_holes(done)
+    margins = {(p, h): int(m) for p, h, m in _atoms(done.out / "nominal_sizes.lp").get("nominal_margin", set())}
+    rows = [row for row in done.truth["fits"] if row["feature"] in holes and row["fits"]]
+    assert rows
+    off = {(row["part"], row["feature"]): (margins[row["part"], holes[row["feature"]]], round(2000 * row["room_mm"]))
+           for row in rows if abs(margins[row["part"], holes[row["feature"]]] - 2000 * row["room_mm"]) > 2}
+    assert off == {}
+
+
+@pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
