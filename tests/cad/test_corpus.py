@@ -56,6 +56,7 @@ class Imported:
     offset: tuple[float, float]
     occupants: dict[str, set[str]]
     owners: dict[str, str]
+    pins: frozenset[str] = frozenset()
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -89,7 +90,7 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
             owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
             owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
             done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
-                                  result.offset, occupants, owners)
+                                  result.offset, occupants, owners, frozenset(derived.pins))
         return done[name]
 
     return get
@@ -108,14 +109,16 @@ def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tu
 
 def _feature_holes(done: Imported) -> dict[str, str]:
     """Each truth feature's imported hole id (absent: none found): the one of the
-    feature's owner on its axis; of several (the two ends of one rod), the one that is
-    empty or holds a part the truth puts in that feature."""
+    feature's owner on its axis that is a pin where the feature is one (of a hollow
+    shaft's bore and the shaft, the shaft); of several (the two ends of one rod), the one
+    that is empty or holds a part the truth puts in that feature."""
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
         inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
         near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
-                and _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM]
+                and _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
+                and (hid in done.pins) == (feature["kind"] == "pin")]
         if len(near) > 1:
             near = [hid for hid in near if not done.occupants.get(hid) or done.occupants[hid] & inside]
         if len(near) == 1:
@@ -131,11 +134,24 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
+ZERO_CLEARANCE_CROSS = ("nominal zero-clearance fits: a Technic axle in cross holes of its own size (the "
+                        "liftarm's, the bush's, the gear's) is called blocked in every direction, so the import "
+                        "refuses the product")
+REFUSED = {"ldraw_axles": ZERO_CLEARANCE_CROSS}
+IMPORTED = [pytest.param(name, marks=_xfail(REFUSED[name])) if name in REFUSED else name for name in PRODUCTS]
+"""Every product, marked where the import refuses it."""
+
+
+EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the large gear's shaft; Factory's "
+             "large gear is absent from the repository) is no feature, pins are found only under a part")
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("factory_gears", marks=_xfail(EMPTY_PIN)),
+    "factory_rect_pegs",
+    pytest.param("ldraw_axles", marks=_xfail(ZERO_CLEARANCE_CROSS)),
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
@@ -160,9 +176,29 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears", "factory_rect_pegs",
+                                  "metaworld_assembly", "robosuite_nuts"])
+def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:
+    # nominal_sizes.lp's margin is diametral: twice the room all round, within 2 um, on each
+    # pair that fits of the features the import finds (a no-fit's negative measure is a
+    # convention: the sign is checked above).
+    done = imported(name)
+    holes = _feature_holes(done)
+    margins = {(p, h): int(m) for p, h, m in _atoms(done.out / "nominal_sizes.lp").get("nominal_margin", set())}
+    rows = [row for row in done.truth["fits"] if row["feature"] in holes and row["fits"]]
+    assert rows
+    off = {(row["part"], row["feature"]): (margins[row["part"], holes[row["feature"]]], round(2000 * row["room_mm"]))
+           for row in rows if abs(margins[row["part"], holes[row["feature"]]] - 2000 * row["room_mm"]) > 2}
+    assert off == {}
+
+
+@pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "factory_gears",
+    "factory_rect_pegs",
+    pytest.param("ldraw_axles", marks=_xfail(ZERO_CLEARANCE_CROSS)),
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
@@ -177,7 +213,7 @@ def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported]
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     allowed = {pid: part["axes"] for pid, part in done.truth["parts"].items()}
@@ -186,7 +222,7 @@ def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], I
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     base = done.truth["base"]
@@ -204,7 +240,7 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str], Imported], name: str) -> None:
     # The cell inserts a part into its feature: the feature's owner is placed first, for a
     # reason of its own where nothing else orders them (agh_prism_array's pegs stand on the
@@ -219,7 +255,7 @@ def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str]
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", PRODUCTS)
+@pytest.mark.parametrize("name", IMPORTED)
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -233,6 +269,10 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (spur gears "
+                                               "whose hub stands 10 mm above their teeth)")),
+    "factory_rect_pegs",
+    pytest.param("ldraw_axles", marks=_xfail(ZERO_CLEARANCE_CROSS)),
     pytest.param("metaworld_assembly", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (a "
                                                     "torus ring with a handle)")),
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
