@@ -2,7 +2,8 @@
 pass (the square peg, diagonal 17 mm, onto a round hole of 13.3 mm) stops on eq. (6) and
 answers no_fit with the part back on the table, standing, where it waited; a plan step that
 puts a round peg into a round hole is checked in the simulated world (not the robot's
-reading), within 2 mm of its goal. The harness holds a grasped part welded to the hand
+reading), within 2 mm of its goal; a cover and a head, which the arm has no skill for, are
+manual steps that do not move it. The harness holds a grasped part welded to the hand
 (docs/franka.md, "Testing against franky-sim").
 
 Long (the simulator steps at a fraction of real time on a shared 2-core machine: 1-4 min
