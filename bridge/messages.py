@@ -151,7 +151,8 @@ class StepEvidence(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """What the cell measured during a plan step."""
 
     skill: Annotated[str, msgspec.Meta(pattern=r"^[a-z_]{1,32}$")]
-    """How the part was placed: fixture, insert, insert_over, insert_socket, or truth."""
+    """How the part was placed: fixture, insert, insert_over, insert_socket, manual (by hand: the cell has no
+    operation for it), or truth."""
     attempts: Count
     max_force_dev: NonNegative
     """Largest ‖F_mes − F_des‖ of the insertions [N]."""

@@ -13,7 +13,7 @@ Re-planning after a failed step uses the same facts.
 The planner starts one cell (``executor serve``) on loopback and sends it one step
 request per plan step over Zenoh (:mod:`asp.assemble.driver`); the cell keeps its world
 between steps.  JSON (``--json``): ``{"plan", "steps": [{"part", "hole", "skill",
-"outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled",
+"outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled", "manual": [part],
 "final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
 Exit code 3 when the product cannot be finished (e.g. no hole left for a part).
 
@@ -173,6 +173,8 @@ def _summary(report: dict) -> str:
     for replan in report["replans"]:
         lines.append(f"re-plan at step {replan['step']}: {replan['reason']}; new plan "
                      + " ".join(s["part"] + (f"->{s['hole']}" if s["hole"] else "") for s in replan["plan"]))
+    if report["manual"]:
+        lines.append(f"placed by hand (manual, the cell has no operation for them): {' '.join(report['manual'])}")
     errors = report["final_pose_error_mm"]
     if errors:
         worst = max(errors, key=lambda p: errors[p])

@@ -51,8 +51,14 @@ class _Run:
 
     def report(self, original: Plan, assembled: bool) -> dict:
         return {"plan": original.as_json(), "steps": self.steps, "assembled": assembled,
-                "final_pose_error_mm": self.errors_mm, "replans": self.replans,
+                "manual": manual_parts(self.steps), "final_pose_error_mm": self.errors_mm, "replans": self.replans,
                 "observations": self.observations, "final_plan": self.plan.as_json()}
+
+
+def manual_parts(steps: list[dict]) -> list[str]:
+    """The parts of the report's ``steps`` the cell answered as placed by hand (skill
+    ``manual``: its arm has no operation for them), in step order."""
+    return [s["part"] for s in steps if s["skill"] == "manual" and s["outcome"] == "fit"]
 
 
 def step_json(reply: StepReply) -> dict:
@@ -64,8 +70,9 @@ def step_json(reply: StepReply) -> dict:
 
 def execute(facts: LearnedFacts, plan: Plan, driver: StepDriver, max_replans: int = MAX_REPLANS) -> dict:
     """Run ``plan`` in the cell of ``driver`` with monitoring and re-planning; the JSON report
-    ``{"plan", "steps", "assembled", "final_pose_error_mm", "replans", "observations",
-    "final_plan"}``.  AssemblyStopped (with the report) when the product cannot be finished."""
+    ``{"plan", "steps", "assembled", "manual", "final_pose_error_mm", "replans", "observations",
+    "final_plan"}`` (``manual``: :func:`manual_parts`).  AssemblyStopped (with the report)
+    when the product cannot be finished."""
     run = _Run(plan)
     while len(run.done) < len(run.plan.steps):
         step = run.plan.steps[len(run.done)]

@@ -108,7 +108,7 @@ def run_plan(assembly: Assembly, facts: LearnedFacts, plan: Plan, seed: int, tim
     except AssemblyStopped as exc:
         report, error = exc.report, str(exc)
     except PlannerError as exc:  # the cell did not start or a step timed out: this plan failed
-        report = {"plan": plan.as_json(), "steps": [], "assembled": False, "final_pose_error_mm": {},
+        report = {"plan": plan.as_json(), "steps": [], "assembled": False, "manual": [], "final_pose_error_mm": {},
                   "replans": [], "observations": [], "final_plan": plan.as_json()}
         error = str(exc)
     return dict(report, seed=seed, wall_s=round(time.perf_counter() - started, 3), error=error)

@@ -124,7 +124,8 @@ def _program() -> str:
 def _assembly_line(report: dict) -> str:
     errors = report["final_pose_error_mm"]
     worst = max(errors.values(), default=0.0)
-    return (f"assembly of plan 1: assembled {report['assembled']}, {len(report['steps'])} steps, "
+    manual = f" ({len(report['manual'])} placed by hand: {' '.join(report['manual'])})" if report["manual"] else ""
+    return (f"assembly of plan 1: assembled {report['assembled']}, {len(report['steps'])} steps{manual}, "
             f"{len(report['replans'])} re-plan(s), largest pose error {worst:.2f} mm, {report['wall_s']:.1f} s")
 
 

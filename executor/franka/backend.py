@@ -8,8 +8,11 @@ through franky (:class:`executor.franka.cell.FrankaCell`).
 - A plan step (``run_step``): the base is the product fixed on the table (the step moves
   nothing); a peg is picked and inserted, let go in its hole on success, else carried back
   (``no_fit``); its pose error is the robot's own reading, the tip's distance from the
-  goal where the insertion ended. Covers, heads and parts placed by hand are refused (the
-  cell has no skill for them on the arm).
+  goal where the insertion ended. A cover, a head or a part placed by hand (``[manual.*]``)
+  is a ``manual`` step (:func:`by_hand_reason`): the arm has no skill for it and does not
+  move; the step is answered ``fit`` with skill ``manual`` and 0 attempts (an operator sets
+  the part at its goal, as the PyBullet cell sets a ``[manual.*]`` part), logged as a
+  warning, and the part is left out of the pose errors (nothing measured it).
 - A stop on any error: whatever raises during a request (a franky exception, a reflex, a
   pose outside the workspace, a failed grasp) stops the arm, clears its errors and answers
   the request with ``failed``; the node keeps serving. A part the hand held stays in it.
@@ -19,6 +22,7 @@ Options (``--backend-option KEY=VALUE``, :func:`franka_options`) are in docs/fra
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
@@ -26,7 +30,7 @@ from contextlib import contextmanager
 from bridge.cell_settings import ServeSettings
 from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
 from executor import ExecutorError, UnknownPair
-from executor.assembly.product import load_product
+from executor.assembly.product import Product, load_product
 from executor.backend_plugin import StepOutcome, check_run, check_step
 from executor.control.ilc import layer_named
 from executor.franka.cell import FrankaCell, FrankaOptions
@@ -39,6 +43,20 @@ MAX_ATTEMPTS = 2
 OPTIONS = ("host", "offset", "grasp-force", "realtime", "dynamics", "torque-threshold", "force-threshold",
            "workspace")
 """The keys of ``--backend-option`` the backend reads."""
+
+LOG = logging.getLogger(__name__)
+
+
+def by_hand_reason(product: Product, part: str) -> str | None:
+    """Why the arm cannot place ``part`` of ``product`` (None: the base, fixed on the table,
+    or a peg, which the arm inserts): it has a skill for pegs only."""
+    if part in product.covers:
+        return f"'{part}' is a cover (it goes over the pegs standing in {', '.join(product.covers[part].over)})"
+    if part in product.heads:
+        return f"'{part}' is a head (it goes into the socket of {product.heads[part].into})"
+    if part in product.manual:
+        return f"'{part}' is placed by hand ({product.manual[part].reason})"
+    return None
 
 
 def _floats(key: str, text: str, count: int) -> tuple[float, ...]:
@@ -102,6 +120,7 @@ class FrankaBackend:
         self.cell = FrankaCell(self.product.geometry, setup.description, layer, options)
         self._run: str | None = None
         self._placed: dict[str, float] = {}
+        self._by_hand: set[str] = set()
 
     @contextmanager
     def _stop_on_error(self) -> Iterator[None]:
@@ -144,19 +163,24 @@ class FrankaBackend:
 
     def run_step(self, request: StepRequest) -> StepOutcome:
         p = self.product
-        check_run(self._run, request.assembly, p.parts, self._placed)
+        check_run(self._run, request.assembly, p.parts, {*self._placed, *self._by_hand})
         fresh = request.assembly != self._run
         check_step(request.part, request.hole, parts=p.parts, pegs=p.pegs, holes=p.geometry.holes,
-                   placed=() if fresh else self._placed)
-        if request.part != p.base.id and request.part not in p.pegs:
-            raise ExecutorError(f"part '{request.part}': the franka cell places pegs only (the base is fixed on the "
-                                "table); place it by hand")
+                   placed=() if fresh else {*self._placed, *self._by_hand})
         if fresh:
-            self._run, self._placed = request.assembly, {}
+            self._run, self._placed, self._by_hand = request.assembly, {}, set()
         start = time.perf_counter()
         if request.part == p.base.id:  # the product is fixed on the table
             self._placed[request.part] = 0.0
             evidence = StepEvidence(skill="fixture", attempts=1, max_force_dev=0.0, max_torque_dev=0.0,
+                                    duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
+            return "fit", evidence, dict(self._placed)
+        reason = by_hand_reason(p, request.part)
+        if reason is not None:
+            LOG.warning("step %d: %s; the arm has no skill for it: placed by hand (manual), the arm does not move",
+                        request.step, reason)
+            self._by_hand.add(request.part)
+            evidence = StepEvidence(skill="manual", attempts=0, max_force_dev=0.0, max_torque_dev=0.0,
                                     duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
             return "fit", evidence, dict(self._placed)
         assert request.hole is not None  # check_step: a peg has a hole

@@ -10,7 +10,9 @@ What is built, in MuJoCo's world frame (= the arm's base frame, :data:`PRODUCT_I
   beyond that face and its 45° entry chamfer (:func:`boss_pieces`); their union has the
   surfaces of the PyBullet cell's triangle mesh
   (:func:`executor.world.geometry.plate_obj_text`): round holes the same n-gons, square
-  and rect holes exact; a hole with a floor gets the floor as one more piece;
+  and rect holes exact; a hole with a floor gets the floor as one more piece; a polygon
+  hole's boss is cut into convex pieces that do not overlap
+  (:func:`executor.world.outlines.boss_solids`), exact to its outline and chamfer;
 - each peg (``[part_shapes.*]``) as a free body at its tray start, upright on the floor:
   a cylinder or box of its mass, or with a ``mesh`` its convex pieces (the ``convex``
   file as made at import, not eroded: MuJoCo adds no margin) with the mesh's inertia.
@@ -18,8 +20,8 @@ What is built, in MuJoCo's world frame (= the arm's base frame, :data:`PRODUCT_I
 Part-plate friction is the PyBullet cell's teaching friction (MuJoCo takes the larger of
 two geoms' coefficients, so the pegs and the plate both carry it; the fingers keep
 MuJoCo's 1.0 and grip with that). Not built: covers, heads, parts placed by hand, a
-base given as its own mesh (a concave mesh has no convex-hull form) and polygon holes;
-each is refused or left out as stated in :func:`add_product`.
+base given as its own mesh (a concave mesh has no convex-hull form); each is refused or
+left out as stated in :func:`add_product`.
 """
 
 from __future__ import annotations
@@ -35,8 +37,9 @@ from scipy.spatial import HalfspaceIntersection
 
 from bridge.product import Plate
 from executor import ExecutorError
-from executor.world.geometry import FLOOR_MIN, CellGeometry, HoleSpec, PartSpec, _ring, _turned
+from executor.world.geometry import FLOOR_MIN, CellGeometry, HoleSpec, PartSpec, _ring, _turned, polygon_boss
 from executor.world.meshes import mesh_inertia, read_objects
+from executor.world.outlines import boss_solids
 from executor.world.scene import TEACH_FRICTION
 
 PRODUCT_IN_BASE = np.zeros(3)
@@ -142,13 +145,16 @@ def boss_pieces(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarray]:
     meets one wide piece and is pushed back through the wall's face (thin sectors of a ring
     let a penetrating corner out sideways, through the seams between them). Plus the hole's
     floor, the inner prism from ``base`` to the bottom, when the hole does not go through
-    its boss."""
+    its boss. A polygon hole's boss is its outline's
+    (:func:`executor.world.outlines.boss_solids`)."""
+    floor = hole.bottom_z if hole.bottom_z - base >= FLOOR_MIN else base
+    if hole.kind == "polygon":
+        return polygon_boss(hole, plate, floor, base, boss_solids)
     n = plate.polygon_sides
     centre = np.array(hole.position)
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
     inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw)  # about the centre
     top, chamfer, half_tile = hole.top_z, plate.chamfer, plate.tile_size / 2
-    floor = hole.bottom_z if hole.bottom_z - base >= FLOOR_MIN else base
     yaw = np.array([math.cos(hole.yaw), math.sin(hole.yaw)])
     outline = [np.array(v) for v in (yaw, -yaw, (-yaw[1], yaw[0]), (yaw[1], -yaw[0]))]
     # Half-spaces a·x + b <= 0, x = (x, y, z) in the product frame.
@@ -176,15 +182,11 @@ def boss_pieces(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarray]:
 def plate_solids(geometry: CellGeometry) -> tuple[list[StaticBox], list[ConvexPiece]]:
     """The plate as MuJoCo builds it: the box under the bosses and every boss's convex
     pieces (:func:`boss_pieces`), in the product frame; ExecutorError naming
-    ``geometry.toml`` for a base given as its own mesh or a polygon hole."""
+    ``geometry.toml`` for a base given as its own mesh."""
     path = geometry.folder / "geometry.toml"
     if geometry.base_mesh is not None:
         raise ExecutorError(f"{path}: [base] mesh: the MuJoCo scene collides a mesh as its convex hull and has no "
                             "form of a concave base; expected a plate of [plate] and [hole_shapes.*]")
-    polygons = sorted(hid for hid, hole in geometry.holes.items() if hole.kind == "polygon")
-    if polygons:
-        raise ExecutorError(f"{path}: hole {polygons[0]} is a polygon; the MuJoCo scene builds round, square and "
-                            "rect holes")
     plate = geometry.plate
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     top = geometry.base_top

@@ -32,8 +32,10 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import clingo
 import numpy as np
@@ -497,14 +499,28 @@ def _oriented(tris: list[tuple[np.ndarray, np.ndarray]]) -> list[np.ndarray]:
     return out
 
 
+_Made = TypeVar("_Made")
+
+
 def _polygon_boss(hole: HoleSpec, plate: Plate, bottom: float, base: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """The boss of a polygon hole in the cell frame (:func:`executor.world.outlines.boss_triangles`);
     ExecutorError naming the hole when its chamfered mouth leaves the boss."""
+    return polygon_boss(hole, plate, bottom, base, boss_triangles)
+
+
+def polygon_boss(hole: HoleSpec, plate: Plate, bottom: float, base: float,
+                 make: Callable[[np.ndarray, np.ndarray, float, float, float, float], list[_Made] | str]
+                 ) -> list[_Made]:
+    """The boss of a polygon hole as ``make`` builds it
+    (:func:`executor.world.outlines.boss_triangles` or ``boss_solids``) from the hole's
+    outline and its square tile in the cell frame (turned by its yaw, at its position),
+    the plate's chamfer, the hole's entry, ``bottom`` and ``base`` [m]; ExecutorError naming
+    the hole when its chamfered mouth leaves the boss."""
     ring = corners(outline_polygon(hole, peg=False))
     half = plate.tile_size / 2
     tile = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
-    found = boss_triangles(_turned(ring, hole.yaw) + hole.position, _turned(tile, hole.yaw) + hole.position,
-                           plate.chamfer, hole.top_z, bottom, base)
+    found = make(_turned(ring, hole.yaw) + hole.position, _turned(tile, hole.yaw) + hole.position,
+                 plate.chamfer, hole.top_z, bottom, base)
     if isinstance(found, str):
         raise ExecutorError(f"hole '{hole.id}': {found} ([plate] tile_size {plate.tile_size:g} m, chamfer "
                             f"{plate.chamfer:g} m)")

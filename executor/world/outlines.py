@@ -9,7 +9,8 @@ decomposition of the mesh may). A polygon hole's boss (:func:`boss_triangles`) i
 static triangle mesh like the other holes' bosses: the top of the square boss, the 45°
 entry chamfer (each edge of the outline moved out by the chamfer, its corners where the
 moved edges meet: :func:`mitre_offset`), the wall and the bottom (open onto the plate or
-a floor).
+a floor). For an engine that collides convex solids only (MuJoCo), the same boss is cut
+into convex pieces (:func:`boss_solids`).
 """
 
 from __future__ import annotations
@@ -153,11 +154,9 @@ def boss_triangles(hole: np.ndarray, tile: np.ndarray, chamfer: float, top: floa
     ``bottom``, the plate under the bosses at ``base`` (a bottom at it opens onto the plate;
     above it, a floor). Or why none can be made: the chamfered mouth is no simple polygon
     inside the tile."""
-    mouth = mitre_offset(hole, chamfer)
-    square = shapely.Polygon(tile)
-    if mouth is None or not square.contains(shapely.Polygon(_distinct(mouth))):
-        return (f"its outline offset by the chamfer ({1e3 * chamfer:g} mm, each edge moved out) is no simple polygon "
-                "inside its boss")
+    mouth = _mouth(hole, tile, chamfer)
+    if isinstance(mouth, str):
+        return mouth
     up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
     tris = [(t, up) for t in _flat(shapely.Polygon(tile, [_distinct(mouth)]), top)]
     edge = np.roll(hole, -1, axis=0) - hole
@@ -175,3 +174,45 @@ def boss_triangles(hole: np.ndarray, tile: np.ndarray, chamfer: float, top: floa
         tris += [(t, up) for t in _flat(shapely.Polygon(hole), bottom)]
         tris += [(t, down) for t in _flat(shapely.Polygon(tile), base)]
     return tris
+
+
+def _mouth(hole: np.ndarray, tile: np.ndarray, chamfer: float) -> np.ndarray | str:
+    """The ``hole`` ring's corners moved out by ``chamfer`` (:func:`mitre_offset`), or why
+    none can be made: the chamfered mouth is no simple polygon inside the ``tile``."""
+    mouth = mitre_offset(hole, chamfer)
+    if mouth is None or not shapely.Polygon(tile).contains(shapely.Polygon(_distinct(mouth))):
+        return (f"its outline offset by the chamfer ({1e3 * chamfer:g} mm, each edge moved out) is no simple polygon "
+                "inside its boss")
+    return mouth
+
+
+def boss_solids(hole: np.ndarray, tile: np.ndarray, chamfer: float, top: float, bottom: float,
+                base: float) -> list[np.ndarray] | str:
+    """The boss of :func:`boss_triangles` (same arguments) as convex solids, each its
+    vertices (k, 3) [m], whose union is that boss and whose interiors do not overlap: the
+    ring between the tile and the hole (:func:`convex_parts` of the tile with the hole cut
+    out) from ``base`` up to the chamfer; above it the ring between the tile and the
+    chamfered mouth, and per edge of the hole the wedge under its chamfer face (the edge,
+    its moved edge on the mouth and the vertical through that, a triangular prism, or a
+    tetrahedron for an edge the offset dropped); the hole's floor (the prism of its
+    outline's pieces from ``base`` to ``bottom``) when ``bottom`` is above ``base``. Or
+    why none can be made (as :func:`boss_triangles`)."""
+    mouth = _mouth(hole, tile, chamfer)
+    if isinstance(mouth, str):
+        return mouth
+    wall_top = top - chamfer
+
+    def prisms(outline: shapely.Polygon, low: float, high: float) -> list[np.ndarray]:
+        return [np.vstack([_lift(part, low), _lift(part, high)]) for part in convex_parts(outline)]
+
+    solids = prisms(shapely.Polygon(tile, [hole]), base, wall_top)
+    if chamfer > 0:
+        solids += prisms(shapely.Polygon(tile, [_distinct(mouth)]), wall_top, top)
+    for k in range(len(hole) if chamfer > 0 else 0):
+        j = (k + 1) % len(hole)
+        points = np.array([[*hole[k], wall_top], [*hole[j], wall_top], *(
+            [*mouth[i], z] for i in (k, j) for z in (wall_top, top))])
+        solids.append(np.unique(points.round(12), axis=0))
+    if bottom > base:
+        solids += prisms(shapely.Polygon(hole), base, bottom)
+    return solids

@@ -21,8 +21,9 @@ from tests.conftest import ROOT
 class FakeCell:
     """Places a part when it fits the hole (true sizes) and the hole is not blocked."""
 
-    def __init__(self, fits: frozenset[tuple[str, str]], blocked: set[str]) -> None:
-        self.fits, self.blocked = fits, blocked
+    def __init__(self, fits: frozenset[tuple[str, str]], blocked: set[str], manual: frozenset[str] = frozenset()
+                 ) -> None:
+        self.fits, self.blocked, self.manual = fits, blocked, manual
         self.placed: dict[str, str | None] = {}
         self.asked: list[tuple[int, str, str | None]] = []
 
@@ -33,15 +34,16 @@ class FakeCell:
         if ok:
             assert hole is None or hole not in self.placed.values(), "two parts in one hole"
             self.placed[part] = hole
-        evidence = StepEvidence(skill="truth", attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
+        skill = "manual" if part in self.manual else "truth"
+        evidence = StepEvidence(skill=skill, attempts=1 if ok else 2, max_force_dev=0.0, max_torque_dev=0.0,
                                 duration_s=0.0, sim_time_s=0.0, pose_error_mm=0.0)
         return StepReply(id=f"s{number}", cell="fake", part=part, hole=hole, result="fit" if ok else "no_fit",
                          evidence=evidence, pose_errors_mm=tuple((p, 0.0) for p in sorted(self.placed)))
 
 
-def _run(assembly: str, blocked: set[str]) -> tuple[dict, FakeCell]:
+def _run(assembly: str, blocked: set[str], manual: frozenset[str] = frozenset()) -> tuple[dict, FakeCell]:
     facts = truth_facts(load_assembly(assembly))
-    cell = FakeCell(facts.fits, blocked)
+    cell = FakeCell(facts.fits, blocked, manual)
     return execute(facts, plans(facts, n=1)[0], cell), cell
 
 
@@ -51,6 +53,15 @@ def test_the_default_cranfield_plan_is_executed_step_by_step() -> None:
     assert [s["part"] for s in report["steps"]] == [s["part"] for s in report["plan"]]
     assert set(report["final_pose_error_mm"]) == set(cell.placed) and len(cell.placed) == 10
     json.dumps(report)  # the report is JSON
+
+
+def test_the_parts_a_cell_places_by_hand_are_named_in_the_report() -> None:
+    """A cell whose arm has no operation for the covers and the head (the Franka cell)
+    answers their steps with skill manual: the report lists them, in step order."""
+    report, _ = _run("cranfield", set(), frozenset({"sp", "pd", "ph", "fp"}))
+    assert report["assembled"] is True
+    assert report["manual"] == [s["part"] for s in report["steps"] if s["part"] in {"sp", "pd", "ph", "fp"}]
+    assert len(report["manual"]) == 4 and _run("cranfield", set())[0]["manual"] == []
 
 
 @pytest.mark.parametrize("assembly, blocked, spare, parts", [

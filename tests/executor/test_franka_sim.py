@@ -23,6 +23,7 @@ franky = pytest.importorskip("franky")
 from executor.franka.sim_scene import product_model, to_base  # noqa: E402
 from executor.franka.sim_server import sim_robot  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
+from tests.executor.test_polygon_cell import HOLES, _product, hexagon  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -35,7 +36,7 @@ def _drop(model: object, data: object, x: float, y: float) -> float:
     return -1.0 if distance < 0 else float(start[2] - distance)
 
 
-@pytest.mark.parametrize("assembly", ["spare", "taskboard"])
+@pytest.mark.parametrize("assembly", ["spare", "taskboard", "cranfield"])
 def test_holes_are_open_to_their_size_and_the_boss_stands_around_them(assembly: str) -> None:
     geometry = load_geometry(assembly)
     model, data, _bodies = product_model(geometry)
@@ -58,6 +59,26 @@ def test_holes_are_open_to_their_size_and_the_boss_stands_around_them(assembly: 
         if hole.kind != "round":
             assert _drop(model, data, cx + c * mid, cy + s * mid) == pytest.approx(
                 hole.top_z - geometry.plate.chamfer / 2, abs=2e-6), hid
+
+
+def test_polygon_holes_are_open_to_their_outline_and_the_boss_stands_around_them(tmp_path: Path) -> None:
+    """The hexagon holes of tests/executor/test_polygon_cell.py (one turned 30° in its
+    outline) in the MuJoCo plate: at the middle of every edge of each outline, 0.1 mm
+    inside down to the plate, halfway across the chamfer halfway down it, 0.1 mm past the
+    chamfer the entry."""
+    geometry = load_geometry(str(_product(tmp_path / "hex")))
+    model, data, _bodies = product_model(geometry)
+    chamfer = geometry.plate.chamfer
+    for hid, (inradius, turn) in HOLES.items():
+        hole = geometry.holes[hid]
+        outline = np.array(hexagon(inradius, turn)) + hole.position  # yaw 0
+        for k in range(6):
+            middle = (outline[k] + outline[(k + 1) % 6]) / 2
+            out = (middle - hole.position) / np.linalg.norm(middle - hole.position)  # the edge's normal
+            for distance, height in ((-1e-4, geometry.base_top), (chamfer / 2, hole.top_z - chamfer / 2),
+                                     (chamfer + 1e-4, hole.top_z)):
+                x, y = middle + distance * out
+                assert _drop(model, data, x, y) == pytest.approx(height, abs=2e-6), (hid, k, distance)
 
 
 def _spare_with_peg_at(tmp_path: Path, part: str, start: tuple[float, float]) -> Path:

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import shapely
 import trimesh
+from scipy.spatial import ConvexHull
 
 from executor import ExecutorError
 from executor.assembly.product import load_product
@@ -26,7 +27,7 @@ from executor.cell_description import CellDescription
 from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
 from executor.world.meshes import URDF_HULL_MARGIN, read_objects
-from executor.world.outlines import boss_triangles, convex_parts, corners
+from executor.world.outlines import boss_solids, boss_triangles, convex_parts, corners
 from executor.world.scene import hole_rims
 from tests._outlines import splined
 
@@ -99,6 +100,26 @@ def test_a_keyed_outline_is_two_pieces_and_its_boss_is_closed() -> None:
         mesh.merge_vertices()
         assert mesh.is_watertight
         assert all(np.dot(np.cross(t[1] - t[0], t[2] - t[0]), wanted) != 0 for t, wanted in found)  # no sliver
+
+
+def test_the_boss_in_convex_solids_is_the_boss_mesh_exactly() -> None:
+    """The convex solids of a keyed hole's boss (for MuJoCo) fill the PyBullet cell's closed
+    boss mesh: their volumes add up to its volume (no overlap, no gap), each solid convex."""
+    hole = corners(keyed()) + (0.5, 0.1)
+    tile = np.array([[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [-0.02, 0.02]]) + (0.5, 0.1)
+    for bottom in (0.075, 0.08):  # through onto the plate, onto a floor
+        found, solids = boss_triangles(hole, tile, 0.0008, 0.1, bottom, 0.075), boss_solids(
+            hole, tile, 0.0008, 0.1, bottom, 0.075)
+        assert not isinstance(found, str) and not isinstance(solids, str)
+        oriented = [t if np.dot(np.cross(t[1] - t[0], t[2] - t[0]), wanted) > 0 else t[[0, 2, 1]]
+                    for t, wanted in found]
+        mesh = trimesh.Trimesh(np.concatenate(oriented), np.arange(3 * len(found)).reshape(-1, 3))
+        mesh.merge_vertices()
+        assert mesh.is_watertight and mesh.volume > 0
+        hulls = [ConvexHull(solid) for solid in solids]
+        assert sum(h.volume for h in hulls) == pytest.approx(mesh.volume, rel=1e-9)
+        assert all(len(h.vertices) == len(solid) for h, solid in zip(hulls, solids, strict=True))  # each convex
+    assert boss_solids(hole, tile, 0.012, 0.1, 0.075, 0.075) == boss_triangles(hole, tile, 0.012, 0.1, 0.075, 0.075)
 
 
 def test_the_peg_collides_as_its_outline_and_the_hole_is_its_outline(tmp_path: Path) -> None:

@@ -2,7 +2,8 @@
 pass (the square peg, diagonal 17 mm, onto a round hole of 13.3 mm) stops on eq. (6) and
 answers no_fit with the part back on the table, standing, where it waited; a plan step that
 puts a round peg into a round hole is checked in the simulated world (not the robot's
-reading), within 2 mm of its goal. The harness holds a grasped part welded to the hand
+reading), within 2 mm of its goal; a cover and a head, which the arm has no skill for, are
+manual steps that do not move it. The harness holds a grasped part welded to the hand
 (docs/franka.md, "Testing against franky-sim").
 
 Long (the simulator steps at a fraction of real time on a shared 2-core machine: 1-4 min
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import shutil
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +25,7 @@ pytest.importorskip("mujoco")
 from bridge.assembly import DATA_DIR  # noqa: E402
 from bridge.cell_settings import CellSettings, ServeSettings  # noqa: E402
 from bridge.messages import InsertRequest, StepRequest  # noqa: E402
+from executor.backend_plugin import InvalidStep  # noqa: E402
 from executor.control.detector import Thresholds  # noqa: E402
 from executor.franka.backend import FrankaBackend, franka_starter  # noqa: E402
 from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
@@ -34,15 +37,15 @@ BACK = 0.002
 """[m] a part carried back lies this close to where it waited, at most (0.2 mm measured with
 the grasp weld; 12.9 mm without it, the peg sliding along franky-sim's pads)."""
 
-# Both tests drive the simulated arm: long, one arm on the machine at a time, on demand (-m franka_arm).
+# The tests drive the simulated arm: long, one arm on the machine at a time, on demand (-m franka_arm).
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtures("one_simulated_arm"),
               pytest.mark.franka_arm]
 
 
-@pytest.fixture
-def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
-    """franky-sim with the spare-hole plate and a franka backend driving it."""
-    folder = Path(shutil.copytree(DATA_DIR / "spare", tmp_path / "spare", ignore=shutil.ignore_patterns("assets")))
+@contextmanager
+def _arm(tmp_path: Path, product: str) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
+    """franky-sim with a copy of the shipped ``product`` and a franka backend driving it."""
+    folder = Path(shutil.copytree(DATA_DIR / product, tmp_path / product, ignore=shutil.ignore_patterns("assets")))
     description = tmp_path / "franka-cell.toml"
     description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
                            f"grasp_depth = {GRASP_DEPTH}\n")
@@ -55,6 +58,13 @@ def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeo
             yield sim, backend, load_geometry(str(folder))
         finally:
             backend.close()
+
+
+@pytest.fixture
+def spare_arm(tmp_path: Path) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
+    """franky-sim with the spare-hole plate and a franka backend driving it."""
+    with _arm(tmp_path, "spare") as arm:
+        yield arm
 
 
 def test_a_part_too_big_stops_on_force_and_goes_back(spare_arm: tuple[SimRobot, FrankaBackend, CellGeometry]) -> None:
@@ -76,3 +86,19 @@ def test_a_plan_step_places_a_peg_in_its_hole(spare_arm: tuple[SimRobot, FrankaB
     goal = np.array([*hole.position, hole.bottom_z])  # the peg's body frame: its bottom face's centre
     position = sim.truth().poses["p1"][0]
     assert np.linalg.norm(position - goal) <= PLACED, (position, goal)
+
+
+def test_covers_and_heads_are_left_to_an_operator_and_the_arm_stays(tmp_path: Path) -> None:
+    """Cranfield's separator (a cover) and pendulum head: steps the arm has no skill for,
+    answered manual without a motion, not among the placed parts' pose errors."""
+    with _arm(tmp_path, "cranfield") as (_sim, backend, _geometry):
+        backend.run_step(StepRequest(id="s1", assembly="run", step=1, part="bp"))
+        tcp = backend.cell.robot.current_cartesian_state.pose.end_effector_pose.translation
+        for number, part in ((2, "sp"), (3, "ph")):
+            outcome, step, placed = backend.run_step(StepRequest(id=f"s{number}", assembly="run", step=number,
+                                                                 part=part))
+            assert (outcome, step.skill, step.attempts, set(placed)) == ("fit", "manual", 0, {"bp"}), step
+        with pytest.raises(InvalidStep, match="already placed"):
+            backend.run_step(StepRequest(id="s4", assembly="run", step=4, part="sp"))
+        moved = backend.cell.robot.current_cartesian_state.pose.end_effector_pose.translation
+        assert np.linalg.norm(np.array(moved) - np.array(tcp)) < 1e-4

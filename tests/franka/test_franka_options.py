@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from executor import ExecutorError
-from executor.franka.backend import franka_options
+from executor.assembly.product import load_product
+from executor.franka.backend import by_hand_reason, franka_options
 from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS, SafetyStop, Workspace, capped
 
 
@@ -45,3 +46,11 @@ def test_a_pose_outside_the_workspace_is_stopped_before_it_is_sent() -> None:
 def test_the_stiff_layer_is_capped_to_what_the_arm_is_sent() -> None:
     assert capped(20000.0, 600.0) == (MAX_TRANSLATIONAL_STIFFNESS, 300.0)
     assert capped(2000.0, 60.0) == (2000.0, 60.0)
+
+
+def test_the_arm_places_the_pegs_and_leaves_covers_and_heads_to_an_operator() -> None:
+    product = load_product("cranfield")
+    assert [part for part in product.parts if by_hand_reason(product, part) is None] == [
+        "bp", "p1", "p2", "p3", "p4", "sh"]
+    assert by_hand_reason(product, "sp") == "'sp' is a cover (it goes over the pegs standing in s1, s2)"
+    assert by_hand_reason(product, "ph") == "'ph' is a head (it goes into the socket of pd)"
