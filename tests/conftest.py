@@ -40,6 +40,11 @@ from typing import Protocol
 import pytest
 
 from asp.session.cells import CellProcess
+from tests._schedule import (  # noqa: F401 (hooks: the order on xdist's workers)
+    pytest_collection_modifyitems,
+    pytest_configure,
+    pytest_xdist_make_scheduler,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 CLI_MODULE = "assembly_constraints"  # ./run.sh SUBCOMMAND: the one command line
