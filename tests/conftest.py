@@ -7,6 +7,10 @@ Fixtures (session-scoped but ``cli_env``, so hypothesis tests may use them too):
 - ``root`` → ``Path``: the repository root (also the constant ``ROOT``, for module-level paths);
 - ``run_cli(*args, cwd=None, input=None, timeout=120)``: ``python -m assembly_constraints ARGS``;
 - ``run_executor(*args, cwd=None, input=None, timeout=120)``: the same with ``executor ARGS``;
+- ``run_main(*args, cwd=None, input=None, timeout=120)``: ``assembly_constraints.cli.main(ARGS)``
+  in this process (function-scoped), for what a command does that is not about its process
+  (its exit code, output and files): the same result without a child's start-up (Python and
+  the imports of clingo, PyBullet, Rerun: about 1 s of CPU each), ``timeout`` unused;
 - ``run_python(module, *args, cwd=None, input=None, timeout=120)``: ``python -m MODULE ARGS``
   (e.g. ``clingo``);
 - ``run_session(*args, timeout=60)`` → ``dict``: ``session --backend truth --json ARGS`` (the
@@ -28,7 +32,9 @@ from __future__ import annotations
 
 import fcntl
 import functools
+import io
 import json
+import logging
 import os
 import subprocess
 import sys
@@ -40,6 +46,11 @@ from typing import Protocol
 import pytest
 
 from asp.session.cells import CellProcess
+from tests._schedule import (  # noqa: F401 (hooks: the order on xdist's workers)
+    pytest_collection_modifyitems,
+    pytest_configure,
+    pytest_xdist_make_scheduler,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 CLI_MODULE = "assembly_constraints"  # ./run.sh SUBCOMMAND: the one command line
@@ -117,6 +128,31 @@ def run_cli() -> Runner:
 @pytest.fixture(scope="session")
 def run_executor() -> Runner:
     return functools.partial(python_module, CLI_MODULE, "executor")
+
+
+@pytest.fixture
+def run_main(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> Runner:
+    from assembly_constraints.cli import main
+
+    def run(*args: str, cwd: Path | str | None = None, input: str | None = None,
+            timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]:
+        capsys.readouterr()
+        root_logger = logging.getLogger()
+        level = root_logger.level
+        with monkeypatch.context() as patch:
+            patch.chdir(ROOT if cwd is None else cwd)
+            patch.setattr(sys, "stdin", io.StringIO(input or ""))
+            # the command's log handler is made on this test's stderr, as a child's is on its own
+            patch.setattr(root_logger, "handlers", [])
+            try:
+                code = main(list(args))
+            except SystemExit as exit_:  # argparse's errors
+                code = exit_.code if isinstance(exit_.code, int) else 1
+            finally:
+                root_logger.setLevel(level)
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess([CLI_MODULE, *args], code, out, err)
+    return run
 
 
 @pytest.fixture(scope="session")

@@ -3,6 +3,8 @@
 A bad output path (missing folder, a directory, under a regular file) is one line
 ``error: <path>: cannot write (<reason>)`` and exit code 2; a full disk (a child process
 limited by ``RLIMIT_FSIZE``) leaves the previous file whole and no temporary file behind.
+The commands run in this process (``run_main``) but where the limit or stdout of a process
+is what is tested.
 """
 
 from __future__ import annotations
@@ -43,12 +45,12 @@ def _argv(command: str, out: Path) -> list[str]:
 
 @pytest.mark.parametrize("bad", BAD_PATHS)
 @pytest.mark.parametrize("command", COMMANDS)
-def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_cli, command: str, bad: str) -> None:
+def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_main, command: str, bad: str) -> None:
     (tmp_path / "folder.png").mkdir()
     (tmp_path / "file").write_text("a regular file\n")
     name, reason = BAD_PATHS[bad]
     out = tmp_path / name
-    done = run_cli(*_argv(command, out))
+    done = run_main(*_argv(command, out))
     assert done.returncode == 2, done.stderr
     assert done.stderr == f"error: {out}: cannot write ({reason.format(tmp=tmp_path)})\n"
     assert (tmp_path / "file").read_text() == "a regular file\n"
@@ -57,9 +59,9 @@ def test_bad_output_path_is_one_line_exit_2(tmp_path: Path, run_cli, command: st
 
 
 @pytest.mark.parametrize("command", ["plan --travel-out", "precedence learn --out"])
-def test_full_disk_leaves_the_old_file_whole(tmp_path: Path, run_cli, command: str) -> None:
+def test_full_disk_leaves_the_old_file_whole(tmp_path: Path, run_main, command: str) -> None:
     out = tmp_path / "facts.lp"
-    first = run_cli(*_argv(command, out))
+    first = run_main(*_argv(command, out))
     assert first.returncode == 0, first.stderr
     good = out.read_bytes()
     assert len(good) > 600
@@ -72,16 +74,16 @@ def test_full_disk_leaves_the_old_file_whole(tmp_path: Path, run_cli, command: s
 
 
 @pytest.mark.parametrize("command", ["plan --travel-out", "precedence learn --out"])
-def test_a_device_is_written_through_never_replaced(tmp_path: Path, run_cli, command: str) -> None:
+def test_a_device_is_written_through_never_replaced(tmp_path: Path, run_main, command: str) -> None:
     """``--out /dev/null`` discards the output (exit 0), ``/dev/full`` is a full disk (exit
     2); both stay devices. Links to them, so that a writer that replaced the path would
     replace the link, never the machine's ``/dev/null``."""
     null, full = tmp_path / "null", tmp_path / "full"
     null.symlink_to("/dev/null")
     full.symlink_to("/dev/full")
-    done = run_cli(*_argv(command, null))
+    done = run_main(*_argv(command, null))
     assert done.returncode == 0, done.stderr
-    done = run_cli(*_argv(command, full))
+    done = run_main(*_argv(command, full))
     assert done.returncode == 2, done.stderr
     assert done.stderr.splitlines() == [f"error: {full}: cannot write (No space left on device)"]
     assert null.resolve() == Path("/dev/null") and full.resolve() == Path("/dev/full")

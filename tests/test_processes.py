@@ -128,8 +128,9 @@ def test_a_session_stopped_by_sigterm_stops_its_cells(tmp_path: Path, cli_argv: 
 
 @pytest.mark.parametrize(("argv", "ready"), [
     (("router",), r"ready router \w+ listen tcp/127\.0\.0\.1:(\d+)\n"),
-    (("executor", "serve", "--backend", "truth", "--cell", "c5"),
-     r"ready cell c5 backend truth listen \['tcp/127\.0\.0\.1:(\d+)'\] connect \[\]\n")])
+    pytest.param(("executor", "serve", "--backend", "truth", "--cell", "c5"),
+                 r"ready cell c5 backend truth listen \['tcp/127\.0\.0\.1:(\d+)'\] connect \[\]\n",
+                 marks=pytest.mark.slow)])  # a cell's start: about 2.5 s of CPU (its imports)
 def test_a_listener_on_port_0_reports_the_port_it_bound(argv: tuple[str, ...], ready: str,
                                                         cli_argv: Callable[..., list[str]]) -> None:
     listener = subprocess.Popen(cli_argv(*argv, "--listen", "tcp/127.0.0.1:0"), cwd=ROOT, env=child_env(),

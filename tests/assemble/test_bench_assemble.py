@@ -42,8 +42,8 @@ def test_the_summary_counts_a_part_beyond_2_mm_as_a_failure() -> None:
     assert figures["median_wall_s"] == 40.0
 
 
-def test_bad_input_is_one_line_and_exit_2(run_cli, tmp_path) -> None:
-    done = run_cli("bench", "assemble", "--run", str(tmp_path), timeout=60)
+def test_bad_input_is_one_line_and_exit_2(run_main, tmp_path) -> None:
+    done = run_main("bench", "assemble", "--run", str(tmp_path), timeout=60)
     assert done.returncode == 2
     assert done.stderr.strip().count("\n") == 0 and "session.json" in done.stderr
 

@@ -129,8 +129,8 @@ def test_a_session_learns_plans_and_assembles(run_session, tmp_path) -> None:
     (("missing.json",), "missing.json"),
     (("--run", "."), "session.json"),
 ])
-def test_bad_input_exits_2_with_one_line(run_cli, tmp_path, args, expected) -> None:
-    done = run_cli("assemble", "--backend", "truth", *args, cwd=tmp_path)
+def test_bad_input_exits_2_with_one_line(run_main, tmp_path, args, expected) -> None:
+    done = run_main("assemble", "--backend", "truth", *args, cwd=tmp_path)
     assert done.returncode == 2, done.stderr
     assert expected in done.stderr and len(done.stderr.strip().splitlines()) == 1
 

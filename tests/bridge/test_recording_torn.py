@@ -58,8 +58,8 @@ def test_the_reader_reads_a_torn_recording_up_to_its_last_whole_message(torn: Pa
 
 
 @pytest.mark.slow
-def test_view_prints_a_torn_run_with_a_warning(torn: Path, run_cli) -> None:
-    done = run_cli("view", str(torn.parent), "--print")
+def test_view_prints_a_torn_run_with_a_warning(torn: Path, run_main) -> None:
+    done = run_main("view", str(torn.parent), "--print")
     assert done.returncode == 0, done.stderr
     assert "/executor/c1/wrench/force/measured" in done.stdout
     lines = [line for line in done.stderr.splitlines() if line.strip()]

@@ -85,8 +85,16 @@ FITS = {("washer", "plate_pin1"), ("washer", "plate_pin2"), ("gear", "plate_pin2
 """The washer's 10.5 mm bore passes both pins (10 and 8 mm), the gear's 8.6 mm only the 8 mm one."""
 
 
-def test_a_washer_and_a_gear_go_onto_the_pins_of_a_plate(tmp_path: Path) -> None:
-    out = _import(tmp_path)
+@pytest.fixture(scope="module")
+def washer_and_gear(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The default product of :func:`_import`, imported once for the module (a session run on
+    it adds the generated assets, nothing a test reads)."""
+    return _import(tmp_path_factory.mktemp("pins"))
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_a_washer_and_a_gear_go_onto_the_pins_of_a_plate(washer_and_gear: Path) -> None:
+    out = washer_and_gear
     holes = tomllib.loads((out / "assembly.toml").read_text())["holes"]
     assert {hid: (hole["shape"], round(1000 * hole["position"][0])) for hid, hole in holes.items()} == {
         "plate_pin1": ("round", X_MM - 25), "plate_pin2": ("round", X_MM + 25)}
@@ -104,8 +112,9 @@ def test_a_washer_and_a_gear_go_onto_the_pins_of_a_plate(tmp_path: Path) -> None
 
 
 @pytest.mark.slow
-def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_cli: Runner, tmp_path: Path) -> None:
-    out = _import(tmp_path)
+def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_cli: Runner, washer_and_gear: Path,
+                                                               tmp_path: Path) -> None:
+    out = washer_and_gear
     done = run_cli("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
                    str(tmp_path / "truth"), timeout=240)
     assert done.returncode == 0, done.stderr

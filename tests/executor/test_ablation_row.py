@@ -51,7 +51,7 @@ def test_the_documented_ablation_command_prints_its_json_on_a_reduced_run(run_cl
     assert report["ilc"]["executions"] == [1] and set(report["ilc"]["by_pair"]) == {"p1:r1"}
 
 
-def test_the_ablation_refuses_pairs_none_of_which_fits(run_cli):
-    done = run_cli("bench", "executor", "--ablation", "--trials", "1", "--pairs", "p3:r1", "--json")
+def test_the_ablation_refuses_pairs_none_of_which_fits(run_main):
+    done = run_main("bench", "executor", "--ablation", "--trials", "1", "--pairs", "p3:r1", "--json")
     lines = error_lines(done.stderr)
     assert done.returncode == 2 and len(lines) == 1 and "fitting pair" in lines[0], done.stderr

@@ -1,4 +1,4 @@
-"""The executor's command line: JSON contract, bad input → exit code 2, Rerun file."""
+"""The executor's command line: JSON contract, bad input → exit code 2 (in this process), Rerun file."""
 
 from __future__ import annotations
 
@@ -9,25 +9,25 @@ import pytest
 
 
 @pytest.mark.slow
-def test_unknown_part_exits_2_naming_it(run_executor):
-    proc = run_executor("trial", "--part", "zz", "--hole", "r1")
+def test_unknown_part_exits_2_naming_it(run_main):
+    proc = run_main("executor", "trial", "--part", "zz", "--hole", "r1")
     assert proc.returncode == 2
     assert "unknown part 'zz'" in proc.stderr and "p1" in proc.stderr
     assert "Traceback" not in proc.stderr
 
 
 @pytest.mark.slow
-def test_unknown_hole_exits_2_naming_it(run_executor):
-    proc = run_executor("trial", "--part", "p1", "--hole", "h9")
+def test_unknown_hole_exits_2_naming_it(run_main):
+    proc = run_main("executor", "trial", "--part", "p1", "--hole", "h9")
     assert proc.returncode == 2
     assert "unknown hole 'h9'" in proc.stderr
 
 
 @pytest.mark.slow
-def test_part_without_demonstration_exits_2(tmp_path, root, run_executor):
+def test_part_without_demonstration_exits_2(tmp_path, root, run_main):
     folder = tmp_path / "cell"
     shutil.copytree(root / "data" / "cranfield", folder, ignore=shutil.ignore_patterns("demonstrations"))
-    proc = run_executor("trial", "--part", "p1", "--hole", "r1", "--assembly", str(folder))
+    proc = run_main("executor", "trial", "--part", "p1", "--hole", "r1", "--assembly", str(folder))
     assert proc.returncode == 2
     assert "no demonstration" in proc.stderr and "round_peg" in proc.stderr
 

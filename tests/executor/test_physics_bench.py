@@ -23,7 +23,7 @@ def test_bench_physics_measures_bare_contact_and_trial_steps(run_cli) -> None:
 
 
 @pytest.mark.slow
-def test_bench_physics_refuses_a_pair_that_does_not_fit(run_cli) -> None:
-    done = run_cli("bench", "physics", "--part", "sh", "--hole", "r1", "--repeats", "1")
+def test_bench_physics_refuses_a_pair_that_does_not_fit(run_main) -> None:
+    done = run_main("bench", "physics", "--part", "sh", "--hole", "r1", "--repeats", "1")
     assert done.returncode == 2 and "the part does not fit that hole" in done.stderr
     assert "Traceback" not in done.stderr

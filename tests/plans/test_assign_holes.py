@@ -162,26 +162,26 @@ def test_feasible_assignment_when_greedy_gets_stuck() -> None:
     assert assignment in _brute_force(facts) and check_assignment(facts, assignment) == []
 
 
-def test_assign_command_json(tmp_path: Path, run_cli) -> None:
-    greedy = json.loads(run_cli("assign", str(CRANFIELD_SIZES), "--json").stdout)
-    every = json.loads(run_cli("assign", str(CRANFIELD_SIZES), "--all", "--json").stdout)
+def test_assign_command_json(tmp_path: Path, run_main) -> None:
+    greedy = json.loads(run_main("assign", str(CRANFIELD_SIZES), "--json").stdout)
+    every = json.loads(run_main("assign", str(CRANFIELD_SIZES), "--all", "--json").stdout)
     facts = load_learned_facts([CRANFIELD_SIZES])
     assert list(greedy) == ["assignments"] and len(greedy["assignments"]) == 1
     assert greedy["assignments"][0] in every["assignments"]
     assert every["assignments"] == all_assignments(facts)
 
 
-def test_assign_command_names_the_part_without_hole(tmp_path: Path, run_cli) -> None:
+def test_assign_command_names_the_part_without_hole(tmp_path: Path, run_main) -> None:
     path = _facts_file(tmp_path, {"a": ["h1", "h2"], "b": ["h2"], "c": ["h2"]}, ["h1", "h2"])
     for extra in ([], ["--all"]):
-        done = run_cli("assign", str(path), "--json", *extra)
+        done = run_main("assign", str(path), "--json", *extra)
         assert done.returncode == 3
         report = json.loads(done.stdout)
         assert report["assignments"] == [] and report["parts"] == ["b", "c"]
         assert "parts b c fit only 1 hole(s) between them (h2)" in done.stderr
 
 
-def test_assign_command_bad_input(tmp_path: Path, run_cli) -> None:
+def test_assign_command_bad_input(tmp_path: Path, run_main) -> None:
     broken = tmp_path / "broken.lp"
     broken.write_text("part(a). fits(a,\n")
     unknown = tmp_path / "unknown.lp"
@@ -189,6 +189,6 @@ def test_assign_command_bad_input(tmp_path: Path, run_cli) -> None:
     reserved = tmp_path / "reserved.lp"
     reserved.write_text("part(a). hole(none). fits(a,none).\n")
     for path, word in ((broken, "parse"), (unknown, "zz"), (reserved, "reserved")):
-        done = run_cli("assign", str(path))
+        done = run_main("assign", str(path))
         assert done.returncode == 2 and word in done.stderr
-    assert run_cli("assign", "--help").returncode == 0
+    assert run_main("assign", "--help").returncode == 0

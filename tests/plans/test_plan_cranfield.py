@@ -117,15 +117,15 @@ def _steps(atoms: list[tuple[str, str, str]]) -> list[PlanStep]:
 
 
 @pytest.mark.slow
-def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path, run_cli, run_python) -> None:
-    done = run_cli("plan", str(learned), "-n", "3", "--json")
+def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path, run_main, run_python) -> None:
+    done = run_main("plan", str(learned), "-n", "3", "--json")
     report = json.loads(done.stdout)
     assert done.returncode == 0 and list(report) == ["plans"] and len(report["plans"]) == 3
     for plan in report["plans"]:
         assert all(set(step) == {"part", "hole"} for step in plan)
         assert check_plan(facts, [PlanStep(s["part"], s["hole"]) for s in plan]) == []
     travel_file = tmp_path / "travel.lp"
-    done = run_cli("plan", str(learned), "--optimal", "--assembly", "cranfield",
+    done = run_main("plan", str(learned), "--optimal", "--assembly", "cranfield",
                 "--json", "--travel-out", str(travel_file))
     report = json.loads(done.stdout)
     assert report["cost"] == _brute_force_optimum(facts, load_assembly("cranfield"))[0] and len(report["plans"]) == 1
@@ -138,20 +138,20 @@ def test_plan_command_json(learned: Path, facts: LearnedFacts, tmp_path: Path, r
 
 
 @pytest.mark.slow
-def test_plan_command_errors(learned: Path, tmp_path: Path, run_cli) -> None:
-    assert run_cli("plan", "--help").returncode == 0
-    no_geometry = run_cli("plan", str(learned), "--optimal")
+def test_plan_command_errors(learned: Path, tmp_path: Path, run_main) -> None:
+    assert run_main("plan", "--help").returncode == 0
+    no_geometry = run_main("plan", str(learned), "--optimal")
     assert no_geometry.returncode == 2 and "--assembly" in no_geometry.stderr
-    too_slow = run_cli("plan", str(learned), "--optimal", "--assembly", "cranfield",
+    too_slow = run_main("plan", str(learned), "--optimal", "--assembly", "cranfield",
                     "--time-limit", "0.001")
     assert too_slow.returncode == 2 and "did not finish within 0.001 s" in too_slow.stderr
     cyclic = tmp_path / "cyclic.lp"
     cyclic.write_text("part(a;b). must_precede(a,b). must_precede(b,a).\n")
-    done = run_cli("plan", str(cyclic))
+    done = run_main("plan", str(cyclic))
     assert done.returncode == 2 and "must_precede has a cycle a < b < a" in done.stderr
     unsolvable = tmp_path / "unsolvable.lp"
     unsolvable.write_text("part(a;b). hole(h). fits(a,h). no_fit(b,h).\n")
-    done = run_cli("plan", str(unsolvable), "--json")
+    done = run_main("plan", str(unsolvable), "--json")
     assert done.returncode == 3 and json.loads(done.stdout)["part"] == "b"
 
 
@@ -186,24 +186,24 @@ def test_plans_of_shipped_files_respect_their_precedence_edges(name: str) -> Non
 
 
 @pytest.mark.slow
-def test_plan_command_reads_precedence_edges_and_mixed_forms(tmp_path: Path, run_cli) -> None:
+def test_plan_command_reads_precedence_edges_and_mixed_forms(tmp_path: Path, run_main) -> None:
     truth = load_relation([CRANFIELD / "precedence.lp"])
-    done = run_cli("plan", str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"), "-n", "20", "--json")
+    done = run_main("plan", str(CRANFIELD / "sizes.lp"), str(CRANFIELD / "precedence.lp"), "-n", "20", "--json")
     assert done.returncode == 0, done.stderr
     for plan in json.loads(done.stdout)["plans"]:
         assert truth.admits([step["part"] for step in plan])
     mixed = tmp_path / "mixed.lp"
     mixed.write_text("part(a;b;c). must_precede(a,b). precedence_edge(b,c).\n")
-    done = run_cli("plan", str(mixed), "-n", "0", "--json")
+    done = run_main("plan", str(mixed), "-n", "0", "--json")
     assert done.returncode == 0, done.stderr
     assert [[step["part"] for step in plan] for plan in json.loads(done.stdout)["plans"]] == [["a", "b", "c"]]
     cyclic = tmp_path / "cyclic_edges.lp"
     cyclic.write_text("part(a;b). must_precede(a,b). precedence_edge(b,a).\n")
-    done = run_cli("plan", str(cyclic))
+    done = run_main("plan", str(cyclic))
     assert done.returncode == 2 and "has a cycle a < b < a" in done.stderr
     unknown = tmp_path / "unknown.lp"
     unknown.write_text("part(a;b). precedence_edge(a,zz).\n")
-    done = run_cli("plan", str(unknown))
+    done = run_main("plan", str(unknown))
     assert done.returncode == 2 and "precedence_edge(a,zz): zz is not a part/1" in done.stderr
 
 

@@ -88,10 +88,10 @@ def test_demo_facts_with_a_gap_or_a_repeat_are_rejected(tmp_path: Path) -> None:
         (b"\x89PNG\r\n\x1a\n\x00\x00", ":1: binary data"),
     ],
 )
-def test_cli_bad_input_exits_2_without_traceback(tmp_path: Path, content: bytes, message: str, run_cli) -> None:
+def test_cli_bad_input_exits_2_without_traceback(tmp_path: Path, content: bytes, message: str, run_main) -> None:
     path = tmp_path / "demos.txt"
     path.write_bytes(content)
-    result = run_cli("precedence", "learn", str(path), "--assembly", "cranfield")
+    result = run_main("precedence", "learn", str(path), "--assembly", "cranfield")
     assert result.returncode == 2
     assert result.stderr.startswith(f"error: {path}")
     assert message in result.stderr

@@ -66,9 +66,9 @@ def test_a_session_learns_the_mixed_product_exactly_and_assigns_every_peg(run_se
     assert "% Assumes: size model sections" in learned
 
 
-def test_line_on_the_mixed_product_is_refused_before_any_cell_starts(run_cli, tmp_path) -> None:
+def test_line_on_the_mixed_product_is_refused_before_any_cell_starts(run_main, tmp_path) -> None:
     product = _product(tmp_path / "mixed")
-    done = run_cli("session", "--backend", "truth", "--assembly", str(product), "--model", "line",
+    done = run_main("session", "--backend", "truth", "--assembly", str(product), "--model", "line",
                    "--out", str(tmp_path / "run"), timeout=60)
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "size model line puts parts of 2 cross-sections" in done.stderr

@@ -34,15 +34,15 @@ def _run_folder(folder: Path) -> Path:
 
 
 @pytest.mark.slow
-def test_view_prints_the_recording_without_display(tmp_path: Path, run_cli) -> None:
+def test_view_prints_the_recording_without_display(tmp_path: Path, run_main) -> None:
     run = _run_folder(tmp_path / "run")
-    text = run_cli("view", str(run))
+    text = run_main("view", str(run))
     assert text.returncode == 0, text.stderr
     assert "no display" in text.stderr
     assert "/executor/c1/scene/plate" in text.stdout and "/executor/c2/scene/plate" in text.stdout
     assert "recording ids: run-7" in text.stdout
 
-    as_json = run_cli("view", str(run / "c2.rrd"), "--json")
+    as_json = run_main("view", str(run / "c2.rrd"), "--json")
     data = json.loads(as_json.stdout)
     assert data["recording_ids"] == ["run-7"]
     assert data["entities"]["/executor/c2/scene/plate"]["static_rows"] == 1
@@ -50,10 +50,10 @@ def test_view_prints_the_recording_without_display(tmp_path: Path, run_cli) -> N
 
 
 @pytest.mark.slow
-def test_view_without_recording_exits_2(tmp_path: Path, run_cli) -> None:
-    empty = run_cli("view", str(tmp_path), "--print")
+def test_view_without_recording_exits_2(tmp_path: Path, run_main) -> None:
+    empty = run_main("view", str(tmp_path), "--print")
     assert empty.returncode == 2 and "holds no Rerun recording" in empty.stderr
-    missing = run_cli("view", str(tmp_path / "nope"))
+    missing = run_main("view", str(tmp_path / "nope"))
     assert missing.returncode == 2 and "no such run folder" in missing.stderr
 
 
@@ -158,14 +158,14 @@ def test_a_bad_time_point_says_what_is_expected(text: str, message: str) -> None
 
 
 @pytest.mark.slow
-def test_view_at_needs_a_timeline_of_the_recording(tmp_path: Path, run_cli) -> None:
+def test_view_at_needs_a_timeline_of_the_recording(tmp_path: Path, run_main) -> None:
     run = _run_folder(tmp_path / "run")
-    missing = run_cli("view", str(run), "--screenshot", str(tmp_path / "shots"), "--at", "plan_step=1")
+    missing = run_main("view", str(run), "--screenshot", str(tmp_path / "shots"), "--at", "plan_step=1")
     assert missing.returncode == 2 and missing.stderr.splitlines() == [
         f"error: --at plan_step=1: {run} has no timeline 'plan_step'; it has experiment, log_time, sim_time"]
-    malformed = run_cli("view", str(run), "--at", "experiment=first")
+    malformed = run_main("view", str(run), "--at", "experiment=first")
     assert malformed.returncode == 2
     assert "experiment is a sequence timeline, expected a whole number" in malformed.stderr
-    alone = run_cli("view", str(run), "--at", "experiment=1")
+    alone = run_main("view", str(run), "--at", "experiment=1")
     assert alone.returncode == 2 and "--at: only with --screenshot DIR" in alone.stderr
     assert not (tmp_path / "shots").exists()

@@ -118,11 +118,11 @@ def test_out_on_a_folder_with_a_journal_is_refused(tmp_path: Path, run_cli) -> N
 
 
 @pytest.mark.parametrize("parent", ["file", "folder"])
-def test_out_under_a_regular_file_is_one_line(tmp_path: Path, run_cli, parent: str) -> None:
+def test_out_under_a_regular_file_is_one_line(tmp_path: Path, run_main, parent: str) -> None:
     (tmp_path / "file").write_text("")
     (tmp_path / "folder").mkdir()
     run = tmp_path / parent / "run" if parent == "file" else tmp_path / "file"
-    done = run_cli(*TRUTH_SESSION, "--cells", "0", "--out", str(run), timeout=30)
+    done = run_main(*TRUTH_SESSION, "--cells", "0", "--out", str(run), timeout=30)
     assert done.returncode == 2
     reason = "Not a directory" if parent == "file" else "a file of that name exists"
     assert done.stderr == f"error: {run}: cannot create the folder ({reason})\n"

@@ -10,9 +10,9 @@ import pytest
 from asp.solve import atoms_by_name, load_atoms
 
 
-def test_learn_json_follows_the_contract_and_writes_facts(tmp_path: Path, run_cli) -> None:
+def test_learn_json_follows_the_contract_and_writes_facts(tmp_path: Path, run_main) -> None:
     out = tmp_path / "learned.lp"
-    done = run_cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--json", "--out", str(out))
+    done = run_main("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--json", "--out", str(out))
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert set(report) == {"policy", "model", "assumption", "model_changes", "experiments", "count", "fits"}
@@ -28,19 +28,19 @@ def test_learn_json_follows_the_contract_and_writes_facts(tmp_path: Path, run_cl
     assert "% assumes: size model line" in out.read_text()
 
 
-def test_learn_from_a_truth_file_keeps_its_order(tmp_path: Path, run_cli) -> None:
+def test_learn_from_a_truth_file_keeps_its_order(tmp_path: Path, run_main) -> None:
     truth = tmp_path / "truth.lp"
     truth.write_text("part(big). part(small). hole(wide). hole(narrow).\n"
                      "fits(small,wide). fits(small,narrow). fits(big,wide).\n")
-    report = json.loads(run_cli("sizes", "learn", "--truth", str(truth), "--policy", "systematic", "--json").stdout)
+    report = json.loads(run_main("sizes", "learn", "--truth", str(truth), "--policy", "systematic", "--json").stdout)
     assert report["experiments"][0] == {"part": "big", "hole": "wide", "result": "fit"}
     assert sorted(map(tuple, report["fits"])) == [("big", "wide"), ("small", "narrow"), ("small", "wide")]
 
 
 @pytest.mark.slow
-def test_evaluate_json_follows_the_contract(tmp_path: Path, run_cli) -> None:
+def test_evaluate_json_follows_the_contract(tmp_path: Path, run_main) -> None:
     plot = tmp_path / "fig19.png"
-    done = run_cli("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "30",
+    done = run_main("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "30",
                 "--json", "--plot", str(plot), "--compare", "random")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
@@ -61,10 +61,10 @@ def test_evaluate_json_follows_the_contract(tmp_path: Path, run_cli) -> None:
         ("fits(a,x).", "expected at least one part/1"),
     ],
 )
-def test_bad_truth_exits_2_with_a_clear_message(tmp_path: Path, text: str, message: str, run_cli) -> None:
+def test_bad_truth_exits_2_with_a_clear_message(tmp_path: Path, text: str, message: str, run_main) -> None:
     truth = tmp_path / "truth.lp"
     truth.write_text(text + "\n")
-    done = run_cli("sizes", "learn", "--truth", str(truth))
+    done = run_main("sizes", "learn", "--truth", str(truth))
     assert done.returncode == 2
     assert message in done.stderr and str(truth) in done.stderr
     assert "Traceback" not in done.stderr
@@ -79,14 +79,14 @@ def test_bad_truth_exits_2_with_a_clear_message(tmp_path: Path, text: str, messa
         ["learn", "--truth", "/nonexistent/truth.lp"],
     ],
 )
-def test_bad_arguments_exit_2(args: list[str], run_cli) -> None:
-    done = run_cli("sizes", *args)
+def test_bad_arguments_exit_2(args: list[str], run_main) -> None:
+    done = run_main("sizes", *args)
     assert done.returncode == 2 and "Traceback" not in done.stderr and done.stderr.strip()
 
 
-def test_assembly_sizes_with_an_undeclared_part_exits_2(tmp_path: Path, run_cli) -> None:
+def test_assembly_sizes_with_an_undeclared_part_exits_2(tmp_path: Path, run_main) -> None:
     (tmp_path / "assembly.toml").write_text('[parts.a]\nname = "a"\n[holes.x]\nname = "x"\n')
     (tmp_path / "sizes.lp").write_text("part(a;ghost). hole(x). fits(a,x).\n")
-    done = run_cli("sizes", "learn", "--assembly", str(tmp_path))
+    done = run_main("sizes", "learn", "--assembly", str(tmp_path))
     assert done.returncode == 2
     assert "ghost" in done.stderr and "assembly.toml" in done.stderr

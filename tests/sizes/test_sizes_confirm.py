@@ -153,13 +153,13 @@ def test_bad_confirm_settings_are_errors() -> None:
 
 
 @pytest.mark.slow
-def test_cli_learn_and_evaluate_take_confirm_and_noise(run_cli) -> None:
-    done = run_cli("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--confirm", "1", "--json")
+def test_cli_learn_and_evaluate_take_confirm_and_noise(run_main) -> None:
+    done = run_main("sizes", "learn", "--assembly", "cranfield", "--policy", "systematic", "--confirm", "1", "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert {"policy", "experiments", "count", "fits"} <= set(report)
     assert report["count"] == 25 + 15  # Cranfield's 15 essential observations, each re-tested once
-    done = run_cli("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "6",
+    done = run_main("sizes", "evaluate", "--assembly", "cranfield", "--policy", "systematic", "--relabelings", "6",
                 "--noise", "0.1", "--confirm", "1", "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
@@ -174,8 +174,8 @@ def test_cli_learn_and_evaluate_take_confirm_and_noise(run_cli) -> None:
     ["bench", "sizes", "--noise", "0.1,x"],
     ["bench", "sizes", "--noise", "0.1", "--seeds", "0"],
 ])
-def test_bad_confirm_or_noise_exits_2(args: list[str], run_cli) -> None:
-    done = run_cli(*args)
+def test_bad_confirm_or_noise_exits_2(args: list[str], run_main) -> None:
+    done = run_main(*args)
     assert done.returncode == 2 and "Traceback" not in done.stderr and done.stderr.strip()
 
 
