@@ -17,7 +17,8 @@ box, or whose swept hull clears B, is done; the prisms are tested only in leaves
 :data:`CHUNK` triangles that still meet B. The tree is searched depth first, the half
 holding more of the few triangles that lead the sweep into B's box (:func:`_front`)
 first: where the part is blocked, they usually meet B deeply, so the search ends soon;
-the order changes no answer. Same answer as testing every prism.
+the order changes no answer. Same answer as testing every prism. A piece that meets B is
+decided by fcl's depths of B's triangles, the likeliest deep ones first (:func:`_meets`).
 
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
