@@ -17,7 +17,8 @@ box, or whose swept hull clears B, is done; the prisms are tested only in leaves
 :data:`CHUNK` triangles that still meet B. The tree is searched depth first, the half
 holding more of the few triangles that lead the sweep into B's box (:func:`_front`)
 first: where the part is blocked, they usually meet B deeply, so the search ends soon;
-the order changes no answer. Same answer as testing every prism.
+the order changes no answer. Same answer as testing every prism. A piece that meets B is
+decided by fcl's depths of B's triangles, the likeliest deep ones first (:func:`_meets`).
 
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
@@ -76,6 +77,8 @@ the face's length (a 3 mm nut's bore at 0.02 mm: 1.4e-3). That the vertices lie 
 circle is what makes the face a cylinder (a cone or a sphere fails it)."""
 _MAX_CONTACTS = 100_000
 _FEW_CONTACTS = 8
+LIKELY = 64
+"""Triangles of a fixed part tested first against a piece (:func:`_meets`)."""
 
 
 def opposite(direction: str) -> str:
@@ -218,9 +221,14 @@ def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide])
 
 def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
     """The triangles of ``mesh`` as an fcl object (its BVH)."""
+    return _bvh(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32))
+
+
+def _bvh(vertices: np.ndarray, faces: np.ndarray) -> fcl.CollisionObject:
+    """The triangles ``faces`` (int32 indices into ``vertices`` [m]) as an fcl object."""
     model = fcl.BVHModel()
-    model.beginModel(len(mesh.vertices), len(mesh.faces))
-    model.addSubModel(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32))
+    model.beginModel(len(vertices), len(faces))
+    model.addSubModel(vertices, faces)
     model.endModel()
     return fcl.CollisionObject(model, fcl.Transform())
 
@@ -236,25 +244,75 @@ def _convex(vertices: np.ndarray, count: int, flat: np.ndarray) -> fcl.Collision
     return fcl.CollisionObject(fcl.Convex(np.asarray(vertices, dtype=float), count, flat), fcl.Transform())
 
 
-def _hull_piece(points: np.ndarray) -> fcl.CollisionObject | None:
-    """The convex hull of ``points`` [m] as an fcl shape (its vertices only); None when the
-    points span no volume (the caller then tests the prisms)."""
+class _Piece:
+    """A convex piece swept against a fixed part: its ``points`` [m] (the hull's vertices)
+    and its fcl shape (made on first use)."""
+
+    def __init__(self, points: np.ndarray, faces: tuple[int, np.ndarray]) -> None:
+        """``faces``: their count and fcl's flat list of them (size, indices ...)."""
+        self.points = points
+        self._faces = faces
+        self._object: fcl.CollisionObject | None = None
+
+    @property
+    def object(self) -> fcl.CollisionObject:
+        if self._object is None:
+            self._object = _convex(self.points, *self._faces)
+        return self._object
+
+
+def _hull_piece(points: np.ndarray) -> _Piece | None:
+    """The convex hull of ``points`` [m] (its vertices only); None when the points span no
+    volume (the caller then tests the prisms)."""
     try:
         hull = ConvexHull(points)
     except QhullError:
         return None
     used, faces = np.unique(hull.simplices, return_inverse=True)
     flat = np.hstack([np.full((len(hull.simplices), 1), 3), faces.reshape(-1, 3)]).astype(np.int32).ravel()
-    return _convex(points[used], len(hull.simplices), flat)
+    return _Piece(points[used], (len(hull.simplices), flat))
 
 
 _PRISM_FACES = np.array([3, 0, 2, 1, 3, 3, 4, 5, 4, 0, 1, 4, 3, 4, 1, 2, 5, 4, 4, 2, 0, 3, 5], dtype=np.int32)
 """A triangle (0 1 2) and its translate (3 4 5): two triangles and three quads."""
 
 
-def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[fcl.CollisionObject]:
+def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[_Piece]:
     """The prisms of ``triangles`` (n, 3, 3) [m] swept by ``shift`` [m]."""
-    return [_convex(np.vstack([triangle, triangle + shift]), 5, _PRISM_FACES) for triangle in triangles]
+    return [_Piece(np.vstack([triangle, triangle + shift]), (5, _PRISM_FACES)) for triangle in triangles]
+
+
+BLOCK = 64
+"""Triangles of a block of the fixed part's index (:class:`_Triangles`)."""
+
+
+class _Triangles:
+    """A fixed part's triangles: their ``corners`` (n, 3, 3) [m], ``centres``, boxes and blocks of
+    :data:`BLOCK` nearby ones (in the order of their centres' Morton codes) with their
+    boxes, to find those near a piece (:func:`_likely`)."""
+
+    def __init__(self, corners: np.ndarray) -> None:
+        self.corners = corners
+        self.low, self.high = corners.min(axis=1), corners.max(axis=1)
+        self.centres = corners.mean(axis=1)
+        centres = self.centres
+        cells = ((centres - centres.min(axis=0)) / max(float(np.ptp(centres)), 1e-12) * 1023).astype(np.int64)
+        code = np.zeros(len(corners), dtype=np.int64)
+        for bit in range(10):
+            for axis in range(3):
+                code |= ((cells[:, axis] >> bit) & 1) << (3 * bit + axis)
+        order = np.argsort(code, kind="stable")
+        self.blocks = np.concatenate([order, np.full(-len(order) % BLOCK, -1)]).reshape(-1, BLOCK)
+        """Triangle indices, the last block's padded with -1."""
+        low, high = np.vstack([self.low, np.full(3, np.inf)]), np.vstack([self.high, np.full(3, -np.inf)])
+        self.block_low, self.block_high = low[self.blocks].min(axis=1), high[self.blocks].max(axis=1)
+
+    def near(self, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+        """The triangles whose boxes meet the box ``low``, ``high`` [m]."""
+        blocks = np.all(np.minimum(high, self.block_high) >= np.maximum(low, self.block_low), axis=1)
+        found = self.blocks[blocks].ravel()
+        found = found[found >= 0]
+        return found[np.all(np.minimum(high, self.high[found]) >= np.maximum(low, self.low[found]), axis=1)]
 
 
 @dataclass(frozen=True)
@@ -360,7 +418,7 @@ class _Solid:
         self.mesh = mesh
         self._bvh: fcl.CollisionObject | None = None
         self._tree: _Node | None = None
-        self.pieces: dict[tuple[float, ...], dict[int, fcl.CollisionObject | None]] = {}
+        self.pieces: dict[tuple[float, ...], dict[int, _Piece | None]] = {}
         """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
         self.hull, self.exact = _outer_hull(np.asarray(mesh.vertices, dtype=float))
         """A convex superset's vertices [m] and whether it is the hull itself."""
@@ -370,12 +428,20 @@ class _Solid:
         self.triangles = np.array(mesh.triangles)
         """(n, 3, 3): the triangles' corners [m]."""
         self._leading: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._index: _Triangles | None = None
 
     @property
     def bvh(self) -> fcl.CollisionObject:
         if self._bvh is None:
             self._bvh = bvh(self.mesh)
         return self._bvh
+
+    @property
+    def index(self) -> _Triangles:
+        """The triangles, to find those near a piece (:func:`_likely`)."""
+        if self._index is None:
+            self._index = _Triangles(self.triangles)
+        return self._index
 
     @property
     def leading(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -453,7 +519,7 @@ class Sweeper:
         self.queries += 1
         for solid, against in ((one, other), (other, one)):
             around = _hull_piece(solid.hull)
-            if around is not None and fcl.distance(around, against.bvh, fcl.DistanceRequest(),
+            if around is not None and fcl.distance(around.object, against.bvh, fcl.DistanceRequest(),
                                                    fcl.DistanceResult()) > TOUCH:
                 return False
         if fcl.collide(one.bvh, other.bvh, fcl.CollisionRequest(), fcl.CollisionResult()):
@@ -485,7 +551,7 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
         if -1 not in pieces:
             pieces[-1] = _hull_piece(np.vstack([moving.hull, moving.hull + shift]))
         whole = pieces[-1]
-        if whole is not None and not _meets([whole], fixed.bvh):
+        if whole is not None and not _meets([whole], fixed):
             return False
         if whole is not None and moving.convex and moving.exact:
             return True
@@ -504,13 +570,13 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
             if id(node) not in pieces:
                 pieces[id(node)] = _hull_piece(np.vstack([points, points + shift]))
             piece = pieces[id(node)]
-            if piece is not None and not _meets([piece], fixed.bvh):
+            if piece is not None and not _meets([piece], fixed):
                 continue
         if node.children:
             # the half holding more leading triangles first (popped last pushed); the
             # answer does not depend on the order, only how soon a blocked sweep ends
             pending += sorted(node.children, key=lambda child: int(leading[child.faces].sum()))
-        elif _meets(swept_pieces(moving.triangles[node.faces], shift), fixed.bvh):
+        elif _meets(swept_pieces(moving.triangles[node.faces], shift), fixed):
             return True
     return False
 
@@ -527,19 +593,61 @@ def _front(solid: _Solid, low: np.ndarray, high: np.ndarray, shift: np.ndarray) 
     return found[np.argsort(-ahead, kind="stable")[:FRONT]]
 
 
-def _meets(pieces: list[fcl.CollisionObject], fixed: fcl.CollisionObject) -> bool:
-    """Whether a piece meets ``fixed`` deeper than :data:`TOUCH`: a first query without
-    contacts, then the depths of the first :data:`_FEW_CONTACTS` contacts, of 16 times as
-    many, of all only when none of those is deeper."""
+def _meets(pieces: list[_Piece], fixed: _Solid) -> bool:
+    """Whether a piece meets ``fixed`` deeper than :data:`TOUCH` (fcl's depth of a triangle
+    of ``fixed`` it meets): a first query without contacts, then the depths of the first
+    :data:`_FEW_CONTACTS` contacts; then, in a query of their own, the :data:`LIKELY`
+    triangles of ``fixed`` that reach deepest into the piece along the line between their
+    centres (:func:`_likely`: fcl's depth is found along that line); then the depths of 16
+    times as many contacts, of all only when none of those is deeper. fcl finds each
+    triangle's contact on its own, whatever the other triangles, so the likely ones answer
+    only where all would answer the same; where the piece meets a face along its whole
+    length (a zero-clearance fit) they spare the thousands of shallow contacts before the
+    deep one."""
     first = fcl.CollisionRequest()
     for piece in pieces:
-        if not fcl.collide(piece, fixed, first, fcl.CollisionResult()):
+        if not fcl.collide(piece.object, fixed.bvh, first, fcl.CollisionResult()):
             continue
-        for most in (_FEW_CONTACTS, 16 * _FEW_CONTACTS, _MAX_CONTACTS):
-            result = fcl.CollisionResult()
-            fcl.collide(piece, fixed, fcl.CollisionRequest(num_max_contacts=most, enable_contact=True), result)
-            if any(contact.penetration_depth > TOUCH for contact in result.contacts):
+        deeper, count = _deeper(piece.object, fixed.bvh, _FEW_CONTACTS)
+        if deeper:
+            return True
+        if count < _FEW_CONTACTS:
+            continue
+        likely = _likely(piece, fixed.index)
+        if len(likely):
+            corners = fixed.index.corners[likely].reshape(-1, 3)
+            if _deeper(piece.object, _bvh(corners, np.arange(len(corners), dtype=np.int32).reshape(-1, 3)),
+                       len(likely))[0]:
                 return True
-            if len(result.contacts) < most:
+        for most in (16 * _FEW_CONTACTS, _MAX_CONTACTS):
+            deeper, count = _deeper(piece.object, fixed.bvh, most)
+            if deeper:
+                return True
+            if count < most:
                 break
     return False
+
+
+def _deeper(piece: fcl.CollisionObject, fixed: fcl.CollisionObject, most: int) -> tuple[bool, int]:
+    """Whether one of the first ``most`` contacts of ``piece`` with ``fixed`` is deeper than
+    :data:`TOUCH`, and how many contacts fcl gave."""
+    result = fcl.CollisionResult()
+    fcl.collide(piece, fixed, fcl.CollisionRequest(num_max_contacts=most, enable_contact=True), result)
+    return any(contact.penetration_depth > TOUCH for contact in result.contacts), len(result.contacts)
+
+
+def _likely(piece: _Piece, triangles: _Triangles) -> np.ndarray:
+    """The (at most :data:`LIKELY`) triangles near ``piece`` that reach farthest into it,
+    deeper than :data:`TOUCH`, along the line from its centre to theirs: the piece's extent
+    beyond the triangle's nearest corner along that line, what fcl's depth (libccd's portal
+    refinement from the centres' difference) approaches."""
+    found = triangles.near(piece.points.min(axis=0), piece.points.max(axis=0))
+    if not len(found):
+        return found
+    corners = triangles.corners[found]
+    toward = triangles.centres[found] - piece.points.mean(axis=0)
+    lengths = np.linalg.norm(toward, axis=1, keepdims=True)
+    toward = np.divide(toward, lengths, out=np.zeros_like(toward), where=lengths > 0)
+    reach = np.max(toward @ piece.points.T, axis=1) - np.min(np.einsum("mvc,mc->mv", corners, toward), axis=1)
+    order = np.argsort(-reach, kind="stable")[:LIKELY]
+    return found[order[reach[order] > TOUCH]]
