@@ -5,8 +5,9 @@ geometric precedence with ``--prior``), then experiments chosen by each policy, 
 by the truth oracle (the product's ``precedence.lp``), until nothing is open. Reported:
 the experiments (median, quartiles, range; failures confirm a pair, successes exclude
 one), the information bound at the start (log2 of the relations consistent with the two
-demonstrations and the prior, counted by clingo within ``--bound-seconds``; ``>=`` when cut
-short), the learned pairs not in the true relation (must be 0, and the relation exact:
+demonstrations and the prior, counted exactly within ``--bound-seconds``, else enumerated by
+clingo as long again: a lower bound when cut short, :mod:`asp.precedence.explore.bound`),
+the learned pairs not in the true relation (must be 0, and the relation exact:
 exit code 1 otherwise), next to demonstrations alone: random and guided
 (:func:`asp.precedence.guide.evaluate_guided`, ``--demo-trials`` trials).
 """
@@ -129,7 +130,8 @@ def main(argv: list[str]) -> int:
                         type=comma_list(str, "policies such as informative,first"),
                         help=f"experiment policies, comma separated ({', '.join(POLICIES)}; default both)")
     parser.add_argument("--bound-seconds", type=number_in(float, 0, 3600), default=2.0,
-                        help="time to count the consistent relations per seed [s] (0: no bound; default 2)")
+                        help="time to count the consistent relations per seed [s], exactly, then as long to "
+                             "enumerate them where that gives up (0: no bound; default 2)")
     parser.add_argument("--demo-trials", type=number_in(strict_int, 0, 10**6), default=1000,
                         help="trials of demonstrations alone (0: none; default 1000)")
     parser.add_argument("--json", action="store_true", help="print JSON")
