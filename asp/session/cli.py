@@ -144,7 +144,8 @@ def _explored_lines(explored: dict | UnsetType) -> list[str]:
     if explored is UNSET:
         return []
     return [f"precedence by exploration: {explored['experiments']} experiment(s), {explored['sim_s']:.1f} s "
-            "simulated; what each pair rests on:", *(f"  {line}" for line in explored["rests_on"])]
+            f"simulated, {explored['wall_s']:.1f} s wall; what each pair rests on:",
+            *(f"  {line}" for line in explored["rests_on"])]
 
 
 def _summary(result: dict, run: Path) -> str:

@@ -154,7 +154,8 @@ def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOr
             evidence = evidence.with_trial(trial)
         LOG.info("resumed: %d precedence experiment(s) from %s", len(evidence.trials), journal)
     for number, (_, trial) in enumerate(explore(evidence, oracle, policy, run_id), start=len(evidence.trials) + 1):
-        LOG.info("precedence experiment %d on %s: %s", number, oracle.cell, trial.describe())
+        LOG.info("precedence experiment %d on %s: %s; %.1f s simulated", number, oracle.cell, trial.describe(),
+                 trial.outcome.sim_s)
         if journal is not None:
             write_trials(journal, (*evidence.trials, trial))
         evidence = evidence.with_trial(trial)

@@ -2,10 +2,12 @@
 precedence experiment reports (:data:`bridge.messages.FailureReason`), observed, never
 inferred from a rule.
 
-- ``blocked``: after its last attempt the part touches another part of the product that is
-  not what it goes into (a peg: the base; a cover: the base and the pegs in its holes; a
-  head: its part), or it never got below the entry of its place (its hole's top, the pin
-  tops, the socket's top): something kept it out;
+- ``blocked``: after its last attempt the part, or a part fixed to it that moves with it
+  (a head screwed into it), touches another part of the product that is not what it goes
+  into (a peg: the base; a cover: the base and the pegs in its holes; a head: its part), or
+  it never got below the entry of its place (its hole's top, the pin tops, the socket's
+  top): something kept it out. The parts it carries are never among those blocking it
+  (a pendulum's head touches the pendulum wherever it is);
 - ``jammed``: it got below that entry, touching only what it goes into, and stuck before
   its goal;
 - ``unsupported``: it reached its goal but did not stay there once let go (decided by the
@@ -38,12 +40,16 @@ def touching(world: AssemblyWorld, part: str, among: Collection[str]) -> tuple[s
 
 
 def why_stuck(world: AssemblyWorld, part: str, targets: Collection[str], entry_z: float,
-              placed: Collection[str], frame: HoleFrame | None = None) -> tuple[StuckReason, tuple[str, ...]]:
+              placed: Collection[str], carried: Collection[str] = (),
+              frame: HoleFrame | None = None) -> tuple[StuckReason, tuple[str, ...]]:
     """Why ``part``, stopped short of its goal and still held, is stuck: (``blocked``, the
-    other parts it touches) when it touches a part of ``placed`` not in ``targets``;
+    parts of ``placed`` outside ``targets`` and ``carried`` that it or a part of ``carried``
+    (fixed to it, moving with it: :func:`carried_by`) touches) when there are any;
     (``jammed``, ()) when its TCP is below ``entry_z`` [m] by :data:`ENTRY_MARGIN` (z of
     the hole's ``frame`` for a hole entered sideways); else (``blocked``, ())."""
-    obstacles = touching(world, part, [p for p in placed if p not in targets])
+    moving = {part, *carried}
+    others = [p for p in placed if p not in targets and p not in moving]
+    obstacles = tuple(sorted({o for m in moving for o in touching(world, m, others)}))
     if obstacles:
         return "blocked", obstacles
     tcp = world.position(part) + world.frames[part].tcp
@@ -62,3 +68,9 @@ def targets_of(part: str, skill: str, base: str, covers_over: Mapping[str, Colle
         over = set(covers_over[part])
         return {base} | {peg for peg, hole in hole_of.items() if hole in over}
     return {base}
+
+
+def carried_by(part: str, into: Mapping[str, str], placed: Collection[str]) -> set[str]:
+    """The parts fixed to ``part`` that move with it: the heads of ``placed`` screwed into it
+    (``into``: head → the part it goes into)."""
+    return {head for head, owner in into.items() if owner == part and head in placed}

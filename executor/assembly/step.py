@@ -46,7 +46,7 @@ import pybullet as pb
 from bridge.cell_settings import Magnitudes
 from bridge.precedence.experiment import FailureReason
 from executor import ExecutorError
-from executor.assembly.failure import targets_of, why_stuck
+from executor.assembly.failure import carried_by, targets_of, why_stuck
 from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
 from executor.assembly.transfer import DESCENT_SPEED, SAFE_Z, VIA_TOLERANCE, carry, move_line, reorient
@@ -234,7 +234,7 @@ class Assembler:
                 outcomes.append(self._insert(part, hole, skill, setup, grasp))
                 if outcomes[-1][0]:
                     break
-                stuck = self._why_stuck(part, hole, skill)
+                stuck = self.why_stuck(part, hole, skill)
                 here = motion.read().tip_pos  # up, or out along a sideways hole's axis
                 move_line(motion, here + np.array([0.0, 0.0, 0.04]), tolerance=VIA_TOLERANCE)
         ok = outcomes[-1][0]
@@ -294,17 +294,20 @@ class Assembler:
         world.rest()
         return fell
 
-    def _why_stuck(self, part: str, hole: str | None, skill: str) -> tuple[FailureReason, tuple[str, ...]]:
-        """Why ``part``, stopped short of its goal and still held, is stuck (:func:`why_stuck`),
+    def why_stuck(self, part: str, hole: str | None, skill: str) -> tuple[FailureReason, tuple[str, ...]]:
+        """Why ``part``, stopped short of its goal and still held, is stuck
+        (:func:`executor.assembly.failure.why_stuck`, the heads screwed into it moving with it),
         the entry of its place being where the insertion's free approach ends."""
         p = self.product
         frame = self._frame(hole, skill)
         goal = self._goal_tcp(part, skill)
         approach = self._approach(part, hole, skill, goal if frame is None else frame.points_in(goal))
         entry_z = float(approach[2] - _free_approach(skill))
-        targets = targets_of(part, skill, p.base.id, {c: spec.over for c, spec in p.covers.items()},
-                             {h: spec.into for h, spec in p.heads.items()}, self.hole_of)
-        return why_stuck(self.world, part, targets, entry_z, self.placed, frame)
+        into = {h: spec.into for h, spec in p.heads.items()}
+        targets = targets_of(part, skill, p.base.id, {c: spec.over for c, spec in p.covers.items()}, into,
+                             self.hole_of)
+        return why_stuck(self.world, part, targets, entry_z, self.placed, carried_by(part, into, self.placed),
+                         frame)
 
     def _by_hand(self, part: str, wall0: float, sim0: int) -> StepRecord:
         """A part placed by hand (``manual``): at its goal, fixed there."""

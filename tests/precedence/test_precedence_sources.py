@@ -4,18 +4,21 @@ and exploration reaching the true relation with no wrong pair (property test).""
 
 from __future__ import annotations
 
+import itertools
 import re
 from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from asp import PlannerError
 from asp.precedence.demos import Demonstrations, load_demos
-from asp.precedence.explore.bound import information_bound
+from asp.precedence.explore.bound import Bound, enumerated_bound, information_bound
 from asp.precedence.explore.knowledge import Evidence, PrecedenceConflict, Trial, know
 from asp.precedence.explore.learner import geometric_reasons, learn_sources
 from asp.precedence.explore.oracle import TruthOracle
+from asp.precedence.explore.orders import count_orders
 from asp.precedence.explore.select import explore
 from asp.precedence.explore.trials import load_trials, write_trials
 from asp.precedence.relation import Relation, close, true_relation
@@ -205,3 +208,42 @@ def test_information_bound_counts_the_relations_left() -> None:
     truth = close(Relation.from_pairs(("a", "b", "c"), [("a", "b")]))
     settled = information_bound(know(_explored(Evidence(demos), truth)))
     assert (settled.relations, settled.bits) == (1, 0.0)
+
+
+def _orders_by_brute_force(parts: list[str], lower: set[tuple[str, str]], upper: set[tuple[str, str]]) -> int:
+    """The transitive, antisymmetric T with lower ⊆ T ⊆ upper, every subset of the free pairs tried."""
+    free = sorted(upper - lower)
+    found = 0
+    for chosen in itertools.product((False, True), repeat=len(free)):
+        t = lower | {pair for pair, keep in zip(free, chosen) if keep}
+        found += all((a, c) in t for a, b in t for b2, c in t if b == b2) and not any((b, a) in t for a, b in t)
+    return found
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.data())
+def test_the_exact_count_of_orders_is_that_of_every_relation_tried(data: st.DataObject) -> None:
+    n = data.draw(st.integers(1, 14))
+    parts = [f"p{i:02d}" for i in data.draw(st.permutations(range(n)))]  # the order is not the names'
+    forward = [(parts[i], parts[j]) for i in range(n) for j in range(i + 1, n)]
+    chosen = data.draw(st.lists(st.sampled_from(forward), max_size=40)) if forward else []
+    lower = {(a, b) for a, b in close(Relation.from_pairs(parts, chosen[:len(chosen) // 2])).pairs()}
+    free = sorted(set(chosen[len(chosen) // 2:]) - lower)[:8]
+    upper = lower | set(free)
+    assert count_orders(parts, lower, upper, 30.0) == _orders_by_brute_force(parts, lower, upper)
+
+
+def test_the_exact_count_agrees_with_clingo_and_gives_up_where_it_cannot_count() -> None:
+    truth = true_relation(load_assembly("cranfield"))
+    demos = Demonstrations(truth.parts, (("bp", "p1", "p2", "p3", "p4", "sh", "sp", "ph", "pd", "fp"),
+                                         ("bp", "sh", "ph", "pd", "p4", "p3", "sp", "p2", "p1", "fp")), ("a", "b"))
+    geometry = tuple(truth.pairs())[:8]  # bp before the others forced: clingo enumerates the rest in a second
+    knowledge = know(Evidence(demos, geometry))
+    exact = information_bound(knowledge, 30.0)
+    clingo_count = enumerated_bound(knowledge, 60.0)
+    assert exact.complete and clingo_count.complete and exact.relations == clingo_count.relations > 10000
+    assert count_orders(truth.parts, knowledge.known, knowledge.known | knowledge.open, 0.0) is None  # no time
+    cycle = {("a", "b"), ("b", "a")}
+    assert count_orders(("a", "b"), set(), cycle, 10.0) is None
+    nothing_known = know(Evidence(Demonstrations(("a", "b", "c"), (), ())))  # no demonstration: every pair open
+    assert information_bound(nothing_known, 10.0) == Bound(19, True)  # the labelled posets on 3 parts, by clingo
