@@ -43,9 +43,9 @@ from executor.skills.insertion import (
 from executor.skills.search import hole_search
 from executor.world.arm import Arm, aligned_yaw, tool_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import fit_pose, load_geometry
+from executor.world.geometry import fit_pose, load_geometry, margin
 from executor.world.perturbation import CellBias
-from executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes
+from executor.world.scene import SIZE_RESOLUTION, TIME_STEP, Scene, hole_rims, require_display, scene_shapes
 
 if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger
@@ -147,7 +147,9 @@ class Cell:
 
     def check_pair(self, part: str, hole: str) -> Skill:
         """The taught skill of ``part``'s shape; UnknownPair naming an unknown part or hole,
-        or a peg and a pin, a part with a bore and a hole (:func:`executor.world.geometry.feature_passes`)."""
+        or a peg and a pin, a part with a bore and a hole (:func:`executor.world.geometry.feature_passes`);
+        ExecutorError for a pair whose room or interference per side is below
+        :data:`executor.world.scene.SIZE_RESOLUTION` (the physics cannot tell them apart)."""
         if part not in self.geometry.parts:
             raise UnknownPair(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
@@ -156,6 +158,13 @@ class Cell:
         if spec.bore != feature.pin:
             raise UnknownPair(f"part '{part}' {'goes onto pins' if spec.bore else 'goes into holes'}, '{hole}' is "
                               f"{'a pin' if feature.pin else 'a hole'}: the cell does not try that pair")
+        room = margin(feature, spec) if feature.pin else margin(spec, feature)
+        if abs(room) / 2 < SIZE_RESOLUTION:
+            raise ExecutorError(
+                f"part '{part}' {'onto' if feature.pin else 'into'} '{hole}': the geometry gives it "
+                f"{room * 500:+.3f} mm per side ({'room' if room > 0 else 'an interference'}), less than the "
+                f"{SIZE_RESOLUTION * 1000:g} mm the simulated cell resolves: it claims neither fit nor no_fit "
+                "(docs/cell.md#what-the-physics-resolves)")
         shape = self.geometry.parts[part].shape
         if shape not in self._skills:
             self._skills[shape] = load_product_skill(self.geometry, shape)

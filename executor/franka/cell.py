@@ -43,6 +43,10 @@ from executor.world.geometry import CellGeometry, PartSpec, fit_pose
 OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before a pick
 TOLERANCE = 0.002  # [m] a move ends when the measured tool tip is this close to its goal
 ARRIVAL = 30.0  # [s] of wall time a move waits for the arm to arrive after its path ended
+REST_SPEED = 0.0005
+"""[m/s] the arm is at rest when its tool tip moves slower than this: the hand closes on a
+part only then (closing while the arm still came down the last 2 mm of its move gripped
+the part 0.8 mm higher than ``grasp_depth`` in franky-sim, docs/franka.md)."""
 RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
 GRIPPER_SPEED = 0.05  # [m/s] of the fingers
 HELD_FRACTION = 0.3
@@ -133,6 +137,16 @@ class FrankaCell:
                                     f"{np.round(self.arm.read().tip_pos, 4).tolist()} m)")
             time.sleep(0.01)
 
+    def settle(self) -> None:
+        """Wait until the arm is at rest (:data:`REST_SPEED`): franky's motion ends while the
+        arm still trails its path. ExecutorError after :data:`ARRIVAL` s of wall time."""
+        deadline = time.monotonic() + ARRIVAL
+        while np.linalg.norm(self.arm.read().tip_vel) > REST_SPEED:
+            if time.monotonic() > deadline:
+                here = np.round(self.arm.read().tip_pos, 4).tolist()
+                raise ExecutorError(f"the arm did not come to rest at {here} m")
+            time.sleep(0.01)
+
     def carry_to(self, goal: np.ndarray, yaw: float = 0.0) -> None:
         """Up to the carrying height, across turning the tool to ``yaw`` [rad], down to
         ``goal`` [m]."""
@@ -157,6 +171,7 @@ class FrankaCell:
         grip = self.to_base(np.array([*spec.start, spec.length - self.geometry.gripper.grasp_depth]))
         self.carry_to(grip + np.array([0.0, 0.0, 0.05]))
         self.move_to(grip)
+        self.settle()
         # Closed toward zero width with the grasp force, held when the fingers stopped on
         # the part (the hand's width) rather than on nothing; franky-sim's fingers are a
         # spring toward the commanded width, which squeezes only when it is below the part's.

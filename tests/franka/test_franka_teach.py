@@ -1,0 +1,62 @@
+"""Teaching on the arm: ``executor teach --backend franka`` against franky-sim records the
+skill of every part shape of a product that has none (the scripted demonstration, the
+reference wrench from the harness's wrist sensor) and stores it as the PyBullet cell's
+skills are; a franka cell then starts on those skills and inserts a peg with one of them.
+
+Long (each shape is picked, guided down its hole, replayed and put back; then one
+insertion): several minutes on the shared 2-core machine."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("franky")
+pytest.importorskip("mujoco")
+
+from bridge.cell_settings import CellSettings, ServeSettings  # noqa: E402
+from bridge.messages import InsertRequest  # noqa: E402
+from executor import ExecutorError  # noqa: E402
+from executor.franka.backend import franka_starter  # noqa: E402
+from executor.franka.sim_server import sim_robot  # noqa: E402
+
+TRIO = Path(__file__).parent / "data" / "trio"
+GRASP_DEPTH = 0.012  # [m] the Franka Hand's pads reach 8.5 mm below its TCP: they clear the plate so
+DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2"), "peg_d12": ("p3", "h3")}
+"""Each shape's part and the hole it is taught in (``demo_hole``)."""
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)
+@pytest.mark.usefixtures("one_simulated_arm")
+@pytest.mark.franka_arm
+def test_skills_taught_on_the_arm_are_stored_and_an_insertion_uses_them(run_executor, tmp_path: Path) -> None:
+    folder = Path(shutil.copytree(TRIO, tmp_path / "trio", ignore=shutil.ignore_patterns("assets", "demonstrations")))
+    description = tmp_path / "franka-cell.toml"
+    description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
+                           f"grasp_depth = {GRASP_DEPTH}\n")
+    with sim_robot(folder) as sim:
+        options = {"host": sim.host, "realtime": "ignore", "dynamics": "0.5"}
+        settings = ServeSettings(backend="franka", assembly=str(folder), backend_options=options,
+                                 cell=CellSettings(description=str(description)))
+        with pytest.raises(ExecutorError, match="peg_d10"):
+            franka_starter(settings)  # no skills yet: the cell refuses to start
+        done = run_executor("teach", "--assembly", str(folder), "--backend", "franka",
+                            *(arg for key, value in options.items() for arg in ("--backend-option", f"{key}={value}")),
+                            "--cell-description", str(description), timeout=1500)
+        assert done.returncode == 0, done.stderr
+        for shape, (part, hole) in DEMOS.items():
+            path = folder / "demonstrations" / f"{shape}.json"
+            assert f"wrote {path}" in done.stdout, done.stdout
+            taught = json.loads(path.read_text(encoding="utf-8"))["taught"]
+            assert (taught["part"], taught["hole"]) == (part, hole), taught
+            assert taught["end_error"] < taught["goal_tolerance"], taught  # the demonstration reached its goal
+        backend = franka_starter(settings)()
+        try:
+            result, evidence = backend.run(InsertRequest(id="a", part="p1", hole="h1"))
+        finally:
+            backend.close()
+    assert result == "fit" and evidence is not None and evidence.attempts >= 1, evidence
