@@ -236,13 +236,15 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
     zero-clearance fit are (:func:`executor.cad.sections.zero_clearance`: a round peg at
     least as wide as a round hole's inscribed circle, their vertex circles' radii within
     10 µm); a part with a bore and a pin too."""
-    found = {(pid, hid): zero_clearance(peg, hole)
+    rooms = _rooms(derived)
+    found = {(pid, hid): zero_clearance(peg, hole, rooms[pid][hid])
              for pid, holes in _pairs(derived).items() for hid, (peg, hole) in holes.items()}
     return {pair: apart for pair, apart in found.items() if apart is not None}
 
 
 RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
-        "is taken for one nominal diameter: a fit, room 0")
+        "or a peg and hole of a polygon section that pass with an overlap of at most 10 {um} all round, "
+        "is taken for one nominal section: a fit, room 0")
 """The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
 
 
@@ -291,10 +293,18 @@ def margins(derived: Derived) -> dict[str, dict[str, float]]:
     :func:`nominal_fits`); ExecutorError naming the part, hole, pin or bore whose polygon
     section is no simple outline."""
     nominal = nominal_fits(derived)
+    return {pid: {hid: 0.0 if (pid, hid) in nominal else room for hid, room in holes.items()}
+            for pid, holes in _rooms(derived).items()}
+
+
+def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
+    """Peg -> hole -> the room [m] of its measured section in the hole's, and part with a
+    bore -> pin -> that of the pin in the bore (:func:`executor.world.geometry.margin`;
+    negative: it does not pass); ExecutorError naming the part, hole, pin or bore whose
+    polygon section is no simple outline."""
     try:
-        return {pid: {hid: 0.0 if (pid, hid) in nominal else margin(
-                    section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
-                    section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+        return {pid: {hid: margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
+                                  section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
                       for hid, (peg, hole) in holes.items()}
                 for pid, holes in _pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself
