@@ -19,8 +19,10 @@
   in a comment (``blocks``, ``base``, ``feature``, ``supports``, ``locates``), the input
   of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
-  wait (and when the cell's loader accepts it; left out otherwise, and the report says
-  why): pegs standing in holes entered along +z with a round, square or rect section or
+  wait (and when the cell's loader accepts it and its sections answer every pair as
+  ``sizes.lp``, :func:`_cell_disagrees`; left out otherwise, and the report says why; a
+  hole or bore with nominal zero-clearance fits at its nominal diameter, naming them,
+  :func:`nominal_section`): pegs standing in holes entered along +z with a round, square or rect section or
   the prism of a polygon (built by the cell from its outline), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
   :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
