@@ -120,7 +120,7 @@ class HoleSpec(Section):
     depth: float = field(kw_only=True)
     pin: bool = field(default=False, kw_only=True)
     axis: str = field(default="-z", kw_only=True)
-    zero_clearance: frozenset[str] = field(default=frozenset(), kw_only=True)
+    zero_clearance: tuple[str, ...] = field(default=(), kw_only=True)
 
     @property
     def bottom_z(self) -> float:
@@ -246,7 +246,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
                                   top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner,
                                   pin=hole_shape.pin, axis=hole_shape.axis,
-                                  zero_clearance=frozenset(hole_shape.zero_clearance or ()))
+                                  zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())))
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}

@@ -55,7 +55,7 @@ def test_a_rect_passes_a_round_hole_by_its_diagonal_and_a_round_peg_a_rect_by_it
 
 
 def test_room_0_passes_only_a_part_the_hole_states_a_zero_clearance_fit_with_and_never_an_interference() -> None:
-    stated = HoleSpec("h", "round", 0.01, (0.0, 0.0), top_z=0.1, depth=0.025, zero_clearance=frozenset({"q"}))
+    stated = HoleSpec("h", "round", 0.01, (0.0, 0.0), top_z=0.1, depth=0.025, zero_clearance=("q",))
     assert feature_passes(_peg("round", 0.01), stated)  # room 0, stated
     assert not feature_passes(_peg("round", 0.01), _hole("round", 0.01))  # room 0, not stated
     assert not feature_passes(_peg("round", 0.0100001), stated)  # 0.1 um of interference
