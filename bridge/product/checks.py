@@ -147,7 +147,7 @@ def _check_sideways(path: Path, geo: GeometryFile) -> None:
 
 def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None:
     """Pins are in the ``[base]``'s own mesh and state their ``top_z`` and ``depth``; a part
-    with a ``bore`` is taught on a pin, a peg in a hole."""
+    with a ``bore`` is taught on a pin and fits one at zero clearance, a peg a hole."""
     for name, shape in geo.hole_shapes.items():
         if not shape.pin:
             continue
@@ -159,6 +159,12 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
                 raise BridgeError(f"{path}: [hole_shapes.{name}] {key}: expected the pin's "
                                   + ("top [m]" if key == "top_z" else "height above where a part rests on it [m]")
                                   + ", got nothing (a pin states both)")
+    bores = {pid: shape.bore for shape in geo.part_shapes.values() for pid in shape.parts}
+    for name, shape in geo.hole_shapes.items():
+        for pid in shape.zero_clearance or []:
+            if bores.get(pid) != shape.pin:
+                raise fail(path, f"hole_shapes.{name}", "zero_clearance", "parts with a bore of [part_shapes.*] "
+                           "for a pin, pegs of [part_shapes.*] for a hole", pid)
     for name, part_shape in geo.part_shapes.items():
         demo = geo.hole_shapes.get(holes.get(part_shape.demo_hole, ""))
         if demo is not None and demo.pin != part_shape.bore:

@@ -192,9 +192,10 @@ def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> st
     (:func:`executor.world.geometry.section_fit`), or a nominal zero-clearance fit
     (:func:`executor.cad.sections.zero_clearance`) with the measured difference."""
     room = section_fit(section(peg_name, peg), section(hole_name, hole))
-    apart = zero_clearance(peg, hole)
+    apart = zero_clearance(peg, hole, room.margin)
     if apart is not None:
-        return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, vertex circles "
+        measured = "vertex circles" if peg.kind == hole.kind == "round" else "outlines"
+        return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, {measured} "
                 f"{round(1e6 * apart, 1) + 0.0:+.1f} µm apart)")
     return f"clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
 

@@ -66,10 +66,12 @@ from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
 from executor.cad.sweep import (
     DIRECTIONS,
+    CylinderFace,
+    PrismFace,
     Slide,
     Sweeper,
     axis_name,
-    cylinder_faces,
+    fit_faces,
     zero_clearance_fits,
 )
 
@@ -178,15 +180,15 @@ class Derived:
         largest = max((s.tolerance for s in self.slides), default=0.0)
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
-                f"plus 10 µm slide along their axis ({len(self.slides)} found"
+                "plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, slide along their "
+                f"axis ({len(self.slides)} found"
                 + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""
-        lines = [f"zero-clearance fit {s.shaft} in {s.bore}: d {2000 * s.face.radius:.3f} mm along "
-                 f"{axis_name(s.direction)[1:]}, overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding"
-                 for s in self.slides]
+        lines = [f"zero-clearance fit {s.shaft} in {s.bore}: {_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
+                 f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding" for s in self.slides]
         lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
                   for (a, b), detail in sorted(self.detail.items())]
         lines += [f"supporting pair {y}->{x} dropped: the blocking needs {x} before {y}"
@@ -205,13 +207,21 @@ class Derived:
         return found | self.hole_of
 
 
+def _face_size(face: CylinderFace | PrismFace) -> str:
+    """A fitted face's size as the report gives it: a cylinder's diameter, a prism's extents [mm]."""
+    if isinstance(face, PrismFace):
+        x0, y0, x1, y1 = face.outline.bounds
+        return f"prism {1000 * (x1 - x0):.3f} x {1000 * (y1 - y0):.3f} mm"
+    return f"d {2000 * face.radius:.3f} mm"
+
+
 def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH) -> Derived:
     """Axes, stages, precedence and holes of ``parts`` with ``base`` the fixture;
     ``fixed_to`` maps a part to the part it moves with; ``reach`` [m]: the locating rule's
     (0: off). ExecutorError naming the parts that never come out with their blockers."""
     by_id = {p.id: p for p in parts}
     result = Derived(base, by_id, reach=reach)
-    faces = {p.id: cylinder_faces(p.mesh) for p in parts}
+    faces = {p.id: fit_faces(p.mesh) for p in parts}
     result.slides = zero_clearance_fits(faces)
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
@@ -358,10 +368,19 @@ def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) 
 
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
-    """The level [m] in the middle of the part's depth inside the base along ``axis`` and
-    the part's one loop there; None when the part does not reach into the base or its
-    slice there is not one loop."""
-    along, base_along = part.mesh.vertices @ axis, base.mesh.vertices @ axis
+    """The level [m] in the middle of the part's depth inside the base along ``axis`` (the
+    base's extent there taken over its vertices within the part's box across the axis
+    grown by the box's larger side on each side: a pin of the base standing farther off is
+    not around it) and the part's one loop there; None when the part does not reach into
+    the base or its slice there is not one loop."""
+    across = np.abs(axis) < 0.5
+    lower, upper = part.mesh.bounds[0][across], part.mesh.bounds[1][across]
+    grown = float(np.max(upper - lower))
+    lower, upper = lower - grown, upper + grown
+    inside = np.all((base.mesh.vertices[:, across] >= lower) & (base.mesh.vertices[:, across] <= upper), axis=1)
+    if not np.any(inside):
+        return None
+    along, base_along = part.mesh.vertices @ axis, base.mesh.vertices[inside] @ axis
     low, high = max(along.min(), base_along.min()), min(along.max(), base_along.max())
     if high - low <= 1e-6:
         return None

@@ -36,7 +36,7 @@ import trimesh
 
 from bridge.assembly import is_id
 from executor import ExecutorError
-from executor.cad.sweep import CylinderFace, Slide, cylinder_faces, near, zero_clearance_fits
+from executor.cad.sweep import CylinderFace, PrismFace, Slide, fit_faces, near, zero_clearance_fits
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
@@ -267,7 +267,7 @@ def _check_overlaps(parts: list[CadPart]) -> None:
     """ExecutorError naming the first pair whose intersection exceeds :data:`OVERLAP_VOLUME`
     (exact booleans by manifold3d on the pairs whose bounding boxes meet), less the pieces
     of it that lie within their zero-clearance fits' tolerance of the mated faces."""
-    faces: dict[str, list[CylinderFace]] = {}
+    faces: dict[str, list[CylinderFace | PrismFace]] = {}
     for i, a in enumerate(parts):
         for b in parts[i + 1:]:
             low = np.maximum(a.mesh.bounds[0], b.mesh.bounds[0])
@@ -279,7 +279,7 @@ def _check_overlaps(parts: list[CadPart]) -> None:
             if volume > OVERLAP_VOLUME:
                 for part in (a, b):
                     if part.id not in faces:
-                        faces[part.id] = cylinder_faces(part.mesh)
+                        faces[part.id] = fit_faces(part.mesh)
                 volume = _beyond_fits(common, zero_clearance_fits({a.id: faces[a.id], b.id: faces[b.id]}))
             if volume > OVERLAP_VOLUME:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "

@@ -265,11 +265,17 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
     return shape
 
 
-def zero_clearance(peg: Shape2D, hole: Shape2D) -> float | None:
-    """How far apart [m] the vertex circles' radii of ``peg`` and ``hole`` are when they
-    are a nominal zero-clearance fit: both round, the peg not narrower than the hole's
-    inscribed circle (else it passes with room), their vertex circles' radii within
-    :data:`executor.cad.sweep.TOUCH`; None when they are no such pair."""
+def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
+    """How far apart [m] ``peg`` and ``hole`` are when they are a nominal zero-clearance
+    fit, given the ``room`` [m] of the peg's section in the hole's
+    (:func:`executor.world.geometry.margin`): both round, the peg not narrower than the
+    hole's inscribed circle (else it passes with room), their vertex circles' radii within
+    :data:`executor.cad.sweep.TOUCH` (their difference); or a polygon on either side (a
+    polygon's outline is its loop's vertices and straight sides: no deflection) that
+    passes only with an overlap of at most that all round (half the room, at most 0); None
+    when they are no such pair."""
+    if "polygon" in (peg.kind, hole.kind):
+        return room / 2 if -2 * TOUCH <= room <= 0 else None
     if peg.kind != "round" or hole.kind != "round" or peg.a < hole.a:
         return None
     apart = hole.a / 2 + hole.deflection - peg.a / 2

@@ -30,7 +30,11 @@ radius within the pair's tolerance (the larger deflection of the two faces plus
 is taken thinner there (its vertices within the tolerance of that radius moved towards
 the axis by the bore's deflection, the radii's and the axes' difference and
 :data:`TOUCH`): overlap below the tolerance across the axis is not a collision, every
-other face (a shoulder, an end wall) still is.
+other face (a shoulder, an end wall) still is. Prismatic faces along the cell's axes (a
+spline, a cross axle: :func:`prism_faces`) are a fit when the peg's outline, shrunk by
+:data:`TOUCH`, lies in the hole's and the two come within it of each other; the peg's
+part is then scaled towards the axis so that each of its sides moves in by at least
+twice :data:`TOUCH`.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
 part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
@@ -40,10 +44,11 @@ moved back against A along the same path) is answered from the first.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import fcl
 import numpy as np
+import shapely
 import trimesh
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
@@ -147,16 +152,87 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
     return faces
 
 
+_PRISM_FRAMES = tuple((axis, np.array([np.roll(axis, 1), np.roll(axis, 2)])) for axis in np.eye(3))
+"""The cell's axes a prismatic face is looked for along, each with the two others (its section's frame)."""
+
+
+@dataclass(frozen=True)
+class PrismFace:
+    """A prismatic face fitted on a mesh along one of the cell's axes: its ``outline``
+    (the section of its triangles at mid-span, in ``frame``'s coordinates [m]), a
+    ``point`` on its axis (the outline's centroid) and the unit axis ``direction``, the
+    ``span`` of its vertices along the axis [m], ``outward`` (a peg's face; False: a
+    hole's), ``radius`` [m] the least distance of its sides' lines from the axis (a
+    thinning towards the axis by a factor 1 - t / radius moves every side in by at least
+    t) and ``deflection`` 0 (its sides are planes)."""
+
+    point: np.ndarray
+    direction: np.ndarray
+    frame: np.ndarray
+    outline: shapely.Polygon
+    span: tuple[float, float]
+    outward: bool
+    radius: float
+    deflection: float = 0.0
+
+
+def prism_faces(mesh: trimesh.Trimesh) -> list[PrismFace]:
+    """The prismatic faces of ``mesh`` along the cell's axes: connected sets of at least
+    four triangles whose normals are perpendicular to the axis (within :data:`TILT`), not
+    all meeting smoothly (those are cylinders, :func:`cylinder_faces`), whose section at
+    mid-span is one closed loop around its centroid (every side's line off it), the
+    triangles cut there all facing out of it or all into it: the face is the set's
+    triangles on that loop (within :data:`TOUCH`) facing the same way, its span theirs."""
+    faces: list[PrismFace] = []
+    smooth = mesh.face_adjacency_angles < SMOOTH
+    for axis, frame in _PRISM_FRAMES:
+        lateral = np.abs(mesh.face_normals @ axis) < TILT
+        pairs = lateral[mesh.face_adjacency].all(axis=1)
+        for region in trimesh.graph.connected_components(mesh.face_adjacency[pairs], min_len=4):
+            if np.all(smooth[pairs & np.isin(mesh.face_adjacency, region).all(axis=1)]):
+                continue
+            along = mesh.vertices[np.unique(mesh.faces[region].ravel())] @ axis
+            low, high = float(along.min()), float(along.max())
+            if high - low <= TOUCH:
+                continue
+            part = mesh.submesh([region], append=True)
+            segments = trimesh.intersections.mesh_plane(part, axis, axis * (low + high) / 2)
+            lines = shapely.union_all([shapely.LineString(s) for s in np.round(segments @ frame.T, 9)])
+            polygons = list(shapely.polygonize([lines]).geoms)  # its ends joined to 1 nm
+            if len(polygons) != 1 or polygons[0].area <= 0:
+                continue
+            outline = shapely.normalize(polygons[0])
+            centre = np.array(outline.centroid.coords[0])
+            ring = np.asarray(outline.exterior.coords)
+            sides = ring[1:] - ring[:-1]
+            normals = np.column_stack([sides[:, 1], -sides[:, 0]]) / np.linalg.norm(sides, axis=1)[:, None]
+            reach = float(np.min(np.abs(np.einsum("ij,ij->i", ring[:-1] - centre, normals))))
+            # the face is the region's triangles on the outline, facing as those cut at mid-span do
+            corners = mesh.triangles[region] @ frame.T
+            on = np.all(shapely.distance(outline.exterior, shapely.points(corners)) <= TOUCH, axis=1)
+            probe = mesh.triangles_center[region] @ frame.T + 1e-6 * (mesh.face_normals[region] @ frame.T)
+            inside = shapely.contains_xy(outline, probe[:, 0], probe[:, 1])
+            heights = mesh.triangles[region] @ axis
+            cut = (heights.min(axis=1) < (low + high) / 2) & (heights.max(axis=1) > (low + high) / 2)
+            if reach <= TOUCH or len(set(inside[cut])) != 1:
+                continue
+            kept = heights[on & (inside == inside[cut][0])]
+            faces.append(PrismFace(centre @ frame, axis, frame, outline, (float(kept.min()), float(kept.max())),
+                                   not bool(inside[cut][0]), reach))
+    return faces
+
+
 @dataclass(frozen=True)
 class Slide:
     """A nominal zero-clearance fit: part ``shaft``'s outward ``face`` in part ``bore``'s
-    inward face ``hole``, coaxial and of equal radius within ``tolerance`` [m]; along the
-    axis the shaft's part is swept (or met) ``thinner`` [m] there (module docstring)."""
+    inward face ``hole``, coaxial and of equal radius (prisms: the peg's outline within the
+    hole's) within ``tolerance`` [m]; along the axis the shaft's part is swept (or met)
+    ``thinner`` [m] there (module docstring)."""
 
     shaft: str
     bore: str
-    face: CylinderFace
-    hole: CylinderFace
+    face: CylinderFace | PrismFace
+    hole: CylinderFace | PrismFace
     tolerance: float
     thinner: float
 
@@ -165,17 +241,41 @@ class Slide:
         return self.face.direction
 
 
-def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
-    """Every pair of an outward face of one part and an inward face of another, parallel
-    (within 1e-4 rad), coaxial and of equal radius within their tolerance, whose spans
-    along the axis overlap by more than it."""
+def fit_faces(mesh: trimesh.Trimesh) -> list[CylinderFace | PrismFace]:
+    """The faces of ``mesh`` a zero-clearance fit may slide on: its cylinders and prisms."""
+    return [*cylinder_faces(mesh), *prism_faces(mesh)]
+
+
+def _prism_fit(a: PrismFace, b: PrismFace) -> Slide | None:
+    """The fit of the outward prism ``a`` in the inward ``b`` (the parts' names filled in
+    by the caller) when they share their axis, the outline of ``a`` shrunk by
+    :data:`TOUCH` lies in that of ``b``, the two outlines come within it of each other
+    (else there is room) and their spans overlap by more than it."""
+    if not np.array_equal(a.direction, b.direction):
+        return None
+    if (not shapely.covers(b.outline, a.outline.buffer(-TOUCH, join_style="mitre"))
+            or shapely.distance(a.outline.exterior, b.outline.exterior) > TOUCH
+            or min(a.span[1], b.span[1]) - max(a.span[0], b.span[0]) <= TOUCH):
+        return None
+    return Slide("", "", a, b, TOUCH, 2 * TOUCH)
+
+
+def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
+    """Every pair of an outward face of one part and an inward face of another: cylinders
+    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance, whose
+    spans along the axis overlap by more than it; prisms along one of the cell's axes whose
+    outlines are one within :data:`TOUCH` (:func:`_prism_fit`)."""
     found: list[Slide] = []
     for shaft, outer in faces.items():
         for bore, inner in faces.items():
             if bore == shaft:
                 continue
-            for a in (f for f in outer if f.outward):
-                for b in (f for f in inner if not f.outward):
+            for p in (f for f in outer if isinstance(f, PrismFace) and f.outward):
+                for q in (f for f in inner if isinstance(f, PrismFace) and not f.outward):
+                    if (prism := _prism_fit(p, q)) is not None:
+                        found.append(replace(prism, shaft=shaft, bore=bore))
+            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
+                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
                     tolerance = max(a.deflection, b.deflection) + TOUCH
                     if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
                             or abs(a.radius - b.radius) > tolerance):
@@ -190,21 +290,25 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace]]) -> list[Slide]:
     return found
 
 
-def near(points: np.ndarray, face: CylinderFace, tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius, within its
-    span), their coordinates along the axis and their radial offsets from it."""
+def near(points: np.ndarray, face: CylinderFace | PrismFace,
+         tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius or its
+    outline, within its span), their coordinates along the axis and their radial offsets from it."""
     relative = points - face.point
     along = relative @ face.direction
     radial = relative - np.outer(along, face.direction)
-    distance = np.linalg.norm(radial, axis=1)
-    near = ((np.abs(distance - face.radius) <= tolerance)
-            & (along >= face.span[0] - tolerance) & (along <= face.span[1] + tolerance))
+    if isinstance(face, PrismFace):
+        off = shapely.distance(face.outline.exterior, shapely.points(points @ face.frame.T))
+    else:
+        off = np.abs(np.linalg.norm(radial, axis=1) - face.radius)
+    near = (off <= tolerance) & (along >= face.span[0] - tolerance) & (along <= face.span[1] + tolerance)
     return near, along, radial
 
 
 def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide]) -> trimesh.Trimesh:
     """``mesh`` as swept along the axis of its zero-clearance fits: its vertices on each
-    of ``shafts``' faces moved ``thinner`` towards the axis, and the triangles of those
+    of ``shafts``' faces moved ``thinner`` towards the axis (a prism's scaled towards it so
+    that every side moves in by at least that), and the triangles of those
     faces and of ``bores``' holes (the mated surfaces) left out, whose sliding on each
     other is the fit; what meets them meets the part's other triangles first."""
     vertices = np.array(mesh.vertices, dtype=float)
@@ -214,7 +318,8 @@ def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide])
         mated |= np.all(on[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < TILT)
         if face is slide.face:
             distance = np.linalg.norm(radial[on], axis=1)
-            scale = np.maximum(distance - slide.thinner, 0.0) / distance
+            inward = slide.thinner * (distance / face.radius if isinstance(face, PrismFace) else 1.0)
+            scale = np.maximum(distance - inward, 0.0) / distance
             vertices[on] = face.point + np.outer(along[on], face.direction) + radial[on] * scale[:, None]
     return trimesh.Trimesh(vertices, mesh.faces[~mated], process=False)
 

@@ -19,8 +19,10 @@
   in a comment (``blocks``, ``base``, ``feature``, ``supports``, ``locates``), the input
   of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
-  wait (and when the cell's loader accepts it; left out otherwise, and the report says
-  why): pegs standing in holes entered along +z with a round, square or rect section or
+  wait (and when the cell's loader accepts it and its sections answer every pair as
+  ``sizes.lp``, :func:`_cell_disagrees`; left out otherwise, and the report says why; a
+  hole or bore with nominal zero-clearance fits at its nominal diameter, naming them,
+  :func:`nominal_section`): pegs standing in holes entered along +z with a round, square or rect section or
   the prism of a polygon (built by the cell from its outline), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
   :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
@@ -70,7 +72,7 @@ from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, zero_clearance
 from executor.cad.sweep import opposite
 from executor.world.frames import hole_rotation
-from executor.world.geometry import Section, load_geometry, margin, thin_prism
+from executor.world.geometry import CellGeometry, Section, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import ring_pieces
 
@@ -236,13 +238,15 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
     zero-clearance fit are (:func:`executor.cad.sections.zero_clearance`: a round peg at
     least as wide as a round hole's inscribed circle, their vertex circles' radii within
     10 µm); a part with a bore and a pin too."""
-    found = {(pid, hid): zero_clearance(peg, hole)
+    rooms = _rooms(derived)
+    found = {(pid, hid): zero_clearance(peg, hole, rooms[pid][hid])
              for pid, holes in _pairs(derived).items() for hid, (peg, hole) in holes.items()}
     return {pair: apart for pair, apart in found.items() if apart is not None}
 
 
 RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
-        "is taken for one nominal diameter: a fit, room 0")
+        "or a peg and hole of a polygon section that pass with an overlap of at most 10 {um} all round, "
+        "is taken for one nominal section: a fit, room 0")
 """The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
 
 
@@ -261,6 +265,28 @@ def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
             + ", ".join(f"{p}->{h} ({round(1e6 * t, 1) + 0.0:+.1f} um)" for (p, h), t in nominal.items()) + "."]
 
 
+def zero_clearance_parts(derived: Derived) -> dict[str, list[str]]:
+    """Feature (a hole or a pin) -> the parts that are a nominal zero-clearance fit in or on
+    it (:func:`nominal_fits`), sorted: a hole's ``zero_clearance`` in ``geometry.toml``."""
+    found: dict[str, list[str]] = {}
+    for pid, hid in sorted(nominal_fits(derived)):
+        found.setdefault(hid, []).append(pid)
+    return found
+
+
+def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
+    """A hole's or bore's section (``inward``) at its nominal diameter when it is a nominal
+    zero-clearance fit with the round ``outward`` sections (the pegs in it, the pins in the
+    bore): its vertex circle's diameter, or the widest of theirs where that is wider, so
+    that the cell simulates every such fit at room 0 or more, never an interference;
+    ``inward`` unchanged with none."""
+    widths = [shape.a for shape in outward]
+    if not widths:
+        return inward
+    size = max(inward.a + 2 * inward.deflection, *widths)
+    return replace(inward, a=size, b=size, deflection=0.0)
+
+
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's, and part
     with a bore -> pin -> the room of the pin's section in the bore's
@@ -269,10 +295,18 @@ def margins(derived: Derived) -> dict[str, dict[str, float]]:
     :func:`nominal_fits`); ExecutorError naming the part, hole, pin or bore whose polygon
     section is no simple outline."""
     nominal = nominal_fits(derived)
+    return {pid: {hid: 0.0 if (pid, hid) in nominal else room for hid, room in holes.items()}
+            for pid, holes in _rooms(derived).items()}
+
+
+def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
+    """Peg -> hole -> the room [m] of its measured section in the hole's, and part with a
+    bore -> pin -> that of the pin in the bore (:func:`executor.world.geometry.margin`;
+    negative: it does not pass); ExecutorError naming the part, hole, pin or bore whose
+    polygon section is no simple outline."""
     try:
-        return {pid: {hid: 0.0 if (pid, hid) in nominal else margin(
-                    section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
-                    section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+        return {pid: {hid: margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
+                                  section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
                       for hid, (peg, hole) in holes.items()}
                 for pid, holes in _pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself
@@ -518,8 +552,12 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
+    nominal, pairs = zero_clearance_parts(derived), _pairs(derived)
     for hid, fit in derived.holes.items():
-        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]', *_section_lines(fit.hole)]
+        listed = nominal.get(hid, [])
+        lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
+                  *_section_lines(nominal_section(fit.hole, [pairs[pid][hid][0] for pid in listed])),
+                  *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         if fit.axis != "+z":  # entered sideways: its entry's height, its depth to its part's tip
@@ -539,13 +577,16 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
     for pin_id, pin in derived.pins.items():
         top, height = pin_level(derived, pin)
-        lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section)]
+        lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section),
+                  *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores])]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
         lines += [f"top_z = {_q(top)}", f"depth = {_q(height)}", ""]
     for pid, bore in sorted(derived.bores.items()):
         mesh, pin = derived.parts[pid].mesh, next(p for p in derived.pins.values() if pid in p.parts)
-        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true", *_section_lines(bore),
+        onto = [pins[0] for pin_id, pins in pairs[pid].items() if pid in nominal.get(pin_id, [])]
+        lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true",
+                  *_section_lines(nominal_section(bore, onto)),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{pin.id}"', _mesh_entry(meshes[pid]), ""]
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
@@ -573,6 +614,11 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   f"tray = {_numbers(settings.trays[mid])}", f"mass = {_q(derived.parts[mid].mesh.volume * DENSITY)}",
                   _mesh_entry(meshes[mid]), ""]
     return "\n".join(lines)
+
+
+def _zero_clearance_line(parts: list[str]) -> list[str]:
+    """A feature's ``zero_clearance`` line naming ``parts`` (none without one)."""
+    return [f"zero_clearance = {json.dumps(parts)}  # nominal zero-clearance fits: room 0"] if parts else []
 
 
 def _plate_top(derived: Derived) -> float:
@@ -665,6 +711,22 @@ def claim_folder(out: Path, ids: Iterable[str], replace: bool) -> set[str]:
     return mine | {name for name in foreign if name in PRODUCT_FILES}
 
 
+def _cell_disagrees(derived: Derived, geometry: CellGeometry) -> str | None:
+    """Why the cell's ``geometry`` would answer a pair otherwise than ``sizes.lp``
+    (:func:`executor.world.geometry.feature_passes` on its sections against
+    :func:`margins` and :func:`nominal_fits`), naming the first such pair; None when it
+    answers every pair alike."""
+    rooms, nominal = margins(derived), nominal_fits(derived)
+    for pid, part in sorted(geometry.parts.items()):
+        for hid, hole in sorted(geometry.holes.items()):
+            room = rooms.get(pid, {}).get(hid)
+            stated = room is not None and (room > 0 or (pid, hid) in nominal)
+            if feature_passes(part, hole) != stated:
+                return (f"the cell's sections would decide {pid} in {hid} as {'no fit' if stated else 'a fit'}, "
+                        f"sizes.lp as {'a fit' if stated else 'no fit'}")
+    return None
+
+
 def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: str, out: Path,
                  removable: set[str]) -> tuple[list[Path], str | None]:
     """Write the files of the module docstring into ``out`` (removing the ``removable``
@@ -689,12 +751,13 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     elif meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
         try:
-            load_geometry(str(out))
+            why = _cell_disagrees(derived, load_geometry(str(out)))
         except ToolError as exc:
-            geometry.unlink()
             why = f"the cell refuses its geometry ({exc})"
-        else:
+        if why is None:
             written += [*mesh_files, geometry]
+        else:
+            geometry.unlink()
     kept = {path.relative_to(out).as_posix(): _digest(path) for path in written}
     # an earlier import's files not written again, and this one's meshes of a geometry not kept
     for name in sorted((removable | {path.relative_to(out).as_posix() for path in mesh_files}) - set(kept)):

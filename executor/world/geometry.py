@@ -113,7 +113,8 @@ class HoleSpec(Section):
     """A hole of the plate at ``position`` [m], its x axis turned by ``yaw`` [rad] about z,
     its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry; a
     ``pin`` of the base a part with a bore goes onto (its section the pin's, ``top_z`` its
-    top, the bottom where a part going onto it rests)."""
+    top, the bottom where a part going onto it rests); the parts stated to fit it at room 0
+    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`)."""
 
     position: tuple[float, float]
     yaw: float = 0.0
@@ -121,6 +122,7 @@ class HoleSpec(Section):
     depth: float = field(kw_only=True)
     pin: bool = field(default=False, kw_only=True)
     axis: str = field(default="-z", kw_only=True)
+    zero_clearance: tuple[str, ...] = field(default=(), kw_only=True)
 
     @property
     def bottom_z(self) -> float:
@@ -245,7 +247,8 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
         for hid in hole_shape.holes:
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
                                   top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner,
-                                  pin=hole_shape.pin, axis=hole_shape.axis)
+                                  pin=hole_shape.pin, axis=hole_shape.axis,
+                                  zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())))
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -316,11 +319,14 @@ def passes(part: Section, hole: Section) -> bool:
 def feature_passes(part: PartSpec, hole: HoleSpec) -> bool:
     """Whether the cell's ``part`` goes into or onto the feature ``hole``: a peg into a
     hole when its section :func:`passes` the hole's, a part with a bore onto a pin when the
-    pin's section passes the bore's; a peg onto a pin or a part with a bore into a hole
-    never (the cell does not try them, and an import's closed world has no such fit)."""
+    pin's section passes the bore's, and at room 0 too (a :func:`margin` of 0, never less)
+    when the part is one the hole states a nominal zero-clearance fit with
+    (``zero_clearance``); a peg onto a pin or a part with a bore into a hole never (the
+    cell does not try them, and an import's closed world has no such fit)."""
     if part.bore != hole.pin:
         return False
-    return passes(hole, part) if hole.pin else passes(part, hole)
+    room = margin(hole, part) if hole.pin else margin(part, hole)
+    return room > 0 or (room >= 0 and part.id in hole.zero_clearance)
 
 
 def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:

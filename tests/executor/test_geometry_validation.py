@@ -81,6 +81,9 @@ CASES = [
     ("bore-taught-in-a-hole", "mass = 0.06", "mass = 0.06\nbore = true",
      "[part_shapes.square_peg] demo_hole: expected a pin for parts with a bore, a hole for pegs (s1 is a hole), "
      "got 's1'"),
+    ("zero-clearance-unknown-part", 'holes = ["br"]', 'holes = ["br"]\nzero_clearance = ["zz"]',
+     "[hole_shapes.round_big] zero_clearance: expected parts with a bore of [part_shapes.*] for a pin, pegs of "
+     "[part_shapes.*] for a hole, got 'zz'"),
     ("hole-bottom-under-the-floor", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.1',
      "[hole_shapes.round_big] depth: expected less than the entry height (0.1 m: the bottom above the floor), "
      "got 0.1"),

@@ -16,6 +16,7 @@ from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quat
 from executor.world.geometry import (
     HoleSpec,
     PartSpec,
+    feature_passes,
     load_geometry,
     part_urdf_text,
     passes,
@@ -51,6 +52,14 @@ def test_a_rect_passes_a_round_hole_by_its_diagonal_and_a_round_peg_a_rect_by_it
     assert passes(round_peg, _hole("rect", 0.0123, 0.0083))
     assert not passes(round_peg, _hole("rect", 0.0163, 0.0079))
     assert passes(round_peg, _hole("square", 0.0081))
+
+
+def test_room_0_passes_only_a_part_the_hole_states_a_zero_clearance_fit_with_and_never_an_interference() -> None:
+    stated = HoleSpec("h", "round", 0.01, (0.0, 0.0), top_z=0.1, depth=0.025, zero_clearance=("q",))
+    assert feature_passes(_peg("round", 0.01), stated)  # room 0, stated
+    assert not feature_passes(_peg("round", 0.01), _hole("round", 0.01))  # room 0, not stated
+    assert not feature_passes(_peg("round", 0.0100001), stated)  # 0.1 um of interference
+    assert feature_passes(_peg("round", 0.0099), _hole("round", 0.01))
 
 
 def test_a_square_is_a_rect_with_equal_sides() -> None:
