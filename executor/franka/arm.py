@@ -32,19 +32,12 @@ from executor.control.gains import ImpedanceGains
 from executor.franka.safety import ERROR_CLIP, SafetyStop, Workspace, capped
 from executor.skills.insertion import rotvec_quat_xyzw
 from executor.world.arm import ArmState, cross, quat_to_matrix, rotation_error
+from executor.world.frames import quat_mul
 from executor.world.scene import TIME_STEP
 
 _POLL = 0.0002  # [s] between two looks at the robot's clock
 _STALL = 2.0  # [s] of wall time without a new robot cycle: the connection is lost
 FILTER = 0.1  # the wrench's low-pass per step (as the PyBullet cell's sensor)
-
-
-def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The product a·b of quaternions (x, y, z, w)."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz])
 
 
 class FrankyArm:

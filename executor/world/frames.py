@@ -15,13 +15,13 @@ down has no frame (the identity, and its trials are unchanged bit for bit).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pybullet as pb
 
-from executor.world.arm import ArmState
+if TYPE_CHECKING:  # the arm module loads PyBullet, which the import of a product does not need
+    from executor.world.arm import ArmState
 
-_ORIGIN = (0.0, 0.0, 0.0)
 _OUT = {"+x": (-1.0, 0.0, 0.0), "-x": (1.0, 0.0, 0.0), "+y": (0.0, -1.0, 0.0), "-y": (0.0, 1.0, 0.0),
         "-z": (0.0, 0.0, 1.0)}
 """Out of the hole (the removal direction) for each insertion axis."""
@@ -38,6 +38,14 @@ def hole_rotation(axis: str) -> np.ndarray:
     x = helper - np.dot(helper, out) * out
     x /= np.linalg.norm(x)
     return np.column_stack([x, np.cross(out, x), out])
+
+
+def quat_mul(a: np.ndarray | tuple[float, ...], b: np.ndarray | tuple[float, ...]) -> np.ndarray:
+    """The product a·b of quaternions (x, y, z, w)."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz])
 
 
 def _quat_of(rotation: np.ndarray) -> tuple[float, float, float, float]:
@@ -63,8 +71,7 @@ class HoleFrame:
 
     def pose_to_cell(self, pos: np.ndarray, quat_xyzw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A pose (position [m], quaternion xyzw) of the hole frame in the cell frame."""
-        turned = pb.multiplyTransforms(_ORIGIN, self.quat, _ORIGIN, list(quat_xyzw))[1]
-        return self.points_to_cell(pos), np.array(turned)
+        return self.points_to_cell(pos), quat_mul(self.quat, quat_xyzw)
 
     def points_to_cell(self, points: np.ndarray) -> np.ndarray:
         """Points (..., 3) [m] of the hole frame in the cell frame."""
@@ -80,9 +87,11 @@ class HoleFrame:
 
     def state_in(self, state: ArmState) -> ArmState:
         """A reading of the cell frame expressed in the hole frame (joints unchanged)."""
+        from executor.world.arm import ArmState
+
         back = self.rotation.T
         inverse = (-self.quat[0], -self.quat[1], -self.quat[2], self.quat[3])
-        quat = np.array(pb.multiplyTransforms(_ORIGIN, inverse, _ORIGIN, list(state.tip_quat_xyzw))[1])
+        quat = quat_mul(inverse, state.tip_quat_xyzw)
         jac = np.vstack([back @ state.jac[:3], back @ state.jac[3:]])
         return ArmState(state.q, state.qd, back @ (state.tip_pos - self.entry) + self.entry, quat, back @ state.tip_vel,
                         back @ state.tip_omega, jac, back @ state.force, back @ state.torque)
