@@ -19,9 +19,10 @@
   in a comment (``blocks``, ``base``, ``feature``, ``supports``, ``locates``), the input
   of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
-  wait (and when the cell's loader accepts it; left out otherwise, and the report says
-  why): pegs standing in holes entered along +z with a round, square or rect section or
-  the prism of a polygon (built by the cell from its outline), covers and heads
+  wait or parts without a tray find none in the arm's reach (:func:`default_trays`), and
+  when the cell's loader accepts it (left out otherwise, and the report says why): pegs
+  standing in holes entered along +z with a round, square or rect section or the prism
+  of a polygon (built by the cell from its outline), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
   :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
   at another one with its own ``top_z`` and ``depth``, the
@@ -510,7 +511,7 @@ def default_trays(boxes: dict[str, Box], trays: dict[str, tuple[float, float]], 
     taken = [product, *(_at(boxes[pid], tray) for pid, tray in trays.items())]
     x, y = TRAY_START
     edge = math.inf  # the lowest y [m] of the row before's footprints
-    low = y  # the lowest y [m] of this row's footprints so far
+    low = math.inf  # the lowest y [m] of this row's footprints so far
     unreached = []
     for pid in sorted(set(boxes) - set(trays)):
         box = boxes[pid]
