@@ -5,7 +5,7 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 
     base = "plate"            # the fixture part (default: the part of largest volume)
     [parts.peg1]
-    tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: a row)
+    tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: laid out by footprints)
     name = "round peg"
     fixed_to = "lever"        # moves with that part (screwed, glued): neither blocks the other
     place = [0.56, 0.0]       # where the base's centre stands on the cell's table [m]
@@ -54,6 +54,9 @@ from executor.cad.step import load_step
 from executor.cad.sweep import opposite
 from executor.cad.write import (
     MANIFEST,
+    REACH,
+    TRAY_GAP,
+    TRAY_START,
     Settings,
     claim_folder,
     entry_point,
@@ -64,18 +67,9 @@ from executor.cad.write import (
 )
 from executor.world.geometry import section_fit
 
-TRAY_ROW = ((0.25, 0.40), 0.05)
-"""Default trays: the parts in a row from this point [m], this far apart along x [m]."""
-BASE_TRAY = (0.30, -0.40)
-"""Default tray of the base [m]."""
 WORK_POSITION = (0.56, 0.0)
 """Where a product out of the arm's reach is placed by default: its base's centre [m] in the
 cell (the arm's base at the origin); the tests' products stand at x = 0.55 to 0.63 m."""
-REACH = (0.35, 0.70)
-"""A base whose centre lies this far [m] from the arm's base horizontally (inclusive) stays
-where the CAD has it: the span of the shipped products' holes (Cranfield's at 0.55 to 0.63 m)
-and trays (0.47 to 0.50 m), widened; nearer or farther is taken as out of reach (a product
-at x = 0 failed its fits in the sim cell)."""
 PLACE_BOUND = 1.0
 """``place`` coordinates lie in [-PLACE_BOUND, PLACE_BOUND] [m] (the cell's table)."""
 
@@ -125,8 +119,9 @@ def placement(parts: list[CadPart], base: str, place: tuple[float, float] | None
 
 def _config(path: Path | None, parts: list[CadPart]
             ) -> tuple[Settings, dict[str, str], list[str], tuple[float, float] | None]:
-    """The settings of ``--config`` (checked: one line naming the file and key), the
-    fixed-to map, what was assumed for lack of them, and ``place`` (None: not set)."""
+    """The settings of ``--config`` (checked: one line naming the file and key; the trays
+    it sets only), the fixed-to map, what was assumed for lack of them, and ``place``
+    (None: not set)."""
     ids = {p.id for p in parts}
     data: dict = {}
     if path is not None:
@@ -165,15 +160,6 @@ def _config(path: Path | None, parts: list[CadPart]
                 raise ExecutorError(f"{path}: [parts.{pid}] fixed_to: expected another part than it and the base, "
                                     f"got {shorten(repr(host))}")
             fixed[pid] = host
-    missing = [p.id for p in parts if p.id not in trays]
-    (x, y), step = TRAY_ROW
-    row = [pid for pid in sorted(missing) if pid != base]
-    for k, pid in enumerate(row):
-        trays[pid] = (x + step * k, y)
-    if base in missing:
-        trays[base] = BASE_TRAY
-    if missing:
-        assumed.append(f"trays of {', '.join(sorted(missing))} in a row (set [parts.<id>] tray)")
     return Settings(base, trays, names), fixed, assumed, _place_setting(path, data.get("place"))
 
 
@@ -325,7 +311,13 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
     assumed += [*derived.assumptions(), *nominal_assumption(derived)]
-    mapped = map_product(derived, settings)
+    mapped, laid = map_product(derived, settings)
+    missing = sorted(set(laid.trays) - set(settings.trays))
+    if missing:
+        assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "
+                       f"{_mm(TRAY_GAP)} mm apart and clear of the product, in rows from "
+                       f"({_mm(TRAY_START[0])}, {_mm(TRAY_START[1])}) mm (set [parts.<id>] tray)")
+    settings = laid
     written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
 

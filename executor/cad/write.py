@@ -19,11 +19,12 @@
   in a comment (``blocks``, ``base``, ``feature``, ``supports``, ``locates``), the input
   of ``precedence learn --prior`` and ``precedence count``;
 - ``geometry.toml``: the simulated cell's product unless two parts overlap where they
-  wait (and when the cell's loader accepts it and its sections answer every pair as
-  ``sizes.lp``, :func:`_cell_disagrees`; left out otherwise, and the report says why; a
-  hole or bore with nominal zero-clearance fits at its nominal diameter, naming them,
-  :func:`nominal_section`): pegs standing in holes entered along +z with a round, square or rect section or
-  the prism of a polygon (built by the cell from its outline), covers and heads
+  wait or parts without a tray find none in the arm's reach (:func:`default_trays`), and
+  when the cell's loader accepts it and its sections answer every pair as ``sizes.lp``
+  (:func:`_cell_disagrees`; left out otherwise, and the report says why; a hole or bore
+  with nominal zero-clearance fits at its nominal diameter, naming them,
+  :func:`nominal_section`): pegs standing in holes entered along +z with a round, square
+  or rect section or the prism of a polygon (built by the cell from its outline), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
   :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
   at another one with its own ``top_z`` and ``depth``, the
@@ -80,6 +81,20 @@ DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
 GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02}
 """The simulated gripper of every imported product (Cranfield's)."""
+TRAY_START = (0.25, 0.40)
+"""The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
+TRAY_PITCH = 0.05
+"""The least distance [m] along its row from a default tray to the one before."""
+TRAY_GAP = 0.02
+"""The least room [m] between a part's footprint on a default tray and any other part's
+footprint on its tray or the product's where it stands."""
+BASE_TRAY = (0.30, -0.40)
+"""Default tray of the base [m]."""
+REACH = (0.35, 0.70)
+"""A base whose centre, or a default tray, lies this far [m] from the arm's base
+horizontally (inclusive) is within the arm's reach: the span of the shipped products'
+holes (Cranfield's at 0.55 to 0.63 m) and trays (0.47 to 0.50 m), widened; nearer or
+farther is taken as out of reach (a product at x = 0 failed its fits in the sim cell)."""
 MIN_CHAMFER = 1e-4
 """The simulated plate's chamfer when the CAD has a smaller one or none [m] (the cell needs one)."""
 _LEVEL = 1e-5
@@ -447,13 +462,22 @@ def _polygon_refused(fit: HoleFit, derived: Derived) -> str:
     return "" if thin is None else f"part '{fit.part}': {thin}"
 
 
-def map_product(derived: Derived, settings: Settings) -> Mapped:
+def map_product(derived: Derived, settings: Settings) -> tuple[Mapped, Settings]:
     """The covers, heads and parts placed by hand of the product as the cell inserts it
     (:func:`cell_view`: its other pegs are placed by hand), with ``why`` the cell builds
-    none of it: two parts overlapping on the tray."""
+    none of it (two parts overlapping on the tray, or parts without a tray in ``settings``
+    that cannot all wait within the arm's reach), and the settings with every part's tray
+    (:func:`default_trays` for those it lacks)."""
     cell, by_hand = cell_view(derived)
     mapped = map_parts(cell, _plate_top(cell), by_hand)
-    return replace(mapped, why=_tray_overlap(cell, mapped, settings))
+    boxes = _footprints(cell, mapped)
+    trays, unreached = default_trays(boxes, settings.trays, derived.base, _product_box(derived))
+    settings = replace(settings, trays=trays)
+    why = _tray_overlap(boxes, trays) or (
+        None if not unreached else f"parts {', '.join(unreached)} find no tray within the arm's reach "
+        f"({1000 * REACH[0]:g} to {1000 * REACH[1]:g} mm) clear of the product and the other parts "
+        "(set [parts.<id>] tray in the import settings)")
+    return replace(mapped, why=why), settings
 
 
 def manual_origin(mesh: trimesh.Trimesh) -> tuple[float, float, float]:
@@ -477,17 +501,87 @@ def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
                      for pid, origin in origins.items()}
 
 
-def _tray_overlap(derived: Derived, mapped: Mapped, settings: Settings) -> str | None:
-    """Why two parts overlap where they wait (their footprints: bounding boxes of their
-    meshes in their part frames at their trays), None when none do."""
+Box = tuple[np.ndarray, np.ndarray]
+"""A footprint: the lowest and highest (x, y) [m] of an axis-aligned rectangle."""
+
+
+def _footprints(derived: Derived, mapped: Mapped) -> dict[str, Box]:
+    """Each part's footprint about its tray: the bounding box of its mesh in its part frame
+    (a part without one: about its bounding box's bottom centre, :func:`manual_origin`)."""
+    frames = _frames(derived, mapped)
     boxes = {}
-    for pid, frame in _frames(derived, mapped).items():
-        corners = trimesh.transform_points(trimesh.bounds.corners(derived.parts[pid].mesh.bounds), frame)[:, :2]
-        boxes[pid] = (corners.min(axis=0) + settings.trays[pid], corners.max(axis=0) + settings.trays[pid])
+    for pid, part in derived.parts.items():
+        frame = frames.get(pid, trimesh.transformations.translation_matrix(np.negative(manual_origin(part.mesh))))
+        corners = trimesh.transform_points(trimesh.bounds.corners(part.mesh.bounds), frame)[:, :2]
+        boxes[pid] = (corners.min(axis=0), corners.max(axis=0))
+    return boxes
+
+
+def _product_box(derived: Derived) -> Box:
+    """The footprint of the assembled product where it stands in the cell [m]."""
+    bounds = np.array([part.mesh.bounds for part in derived.parts.values()])
+    return bounds[:, 0, :2].min(axis=0), bounds[:, 1, :2].max(axis=0)
+
+
+def _at(box: Box, tray: tuple[float, float]) -> Box:
+    return box[0] + tray, box[1] + tray
+
+
+def _apart(a: Box, b: Box, gap: float) -> bool:
+    """Whether footprints ``a`` and ``b`` leave more than ``gap`` [m] between them along x or y."""
+    return bool(np.any(np.maximum(a[0], b[0]) - np.minimum(a[1], b[1]) > gap))
+
+
+def default_trays(boxes: dict[str, Box], trays: dict[str, tuple[float, float]], base: str, product: Box
+                  ) -> tuple[dict[str, tuple[float, float]], list[str]]:
+    """Every part's tray [m]: those in ``trays``, the base's at :data:`BASE_TRAY`, the others
+    by id in rows along +x from :data:`TRAY_START`, each row below (towards -y) the one
+    before: a tray at least :data:`TRAY_PITCH` after the one before in its row, its
+    footprint (``boxes``) :data:`TRAY_GAP` clear of every other part's at its tray and of
+    the ``product`` where it stands, its point within :data:`REACH` of the arm's base; and
+    the parts that find no such tray (they wait in a row beyond the others, out of reach)."""
+    trays = dict(trays)
+    trays.setdefault(base, BASE_TRAY)
+    taken = [product, *(_at(boxes[pid], tray) for pid, tray in trays.items())]
+    x, y = TRAY_START
+    edge = math.inf  # the lowest y [m] of the row before's footprints
+    low = math.inf  # the lowest y [m] of this row's footprints so far
+    unreached = []
+    for pid in sorted(set(boxes) - set(trays)):
+        box = boxes[pid]
+        while True:
+            y = TRAY_START[1] if math.isinf(edge) else edge - TRAY_GAP - float(box[1][1])
+            if y < -REACH[1]:
+                break
+            x = max(x, math.sqrt(max(0.0, REACH[0] ** 2 - y * y)))
+            while (blocker := next((t for t in taken if not _apart(_at(box, (x, y)), t, TRAY_GAP)), None)) is not None:
+                x = float(blocker[1][0]) + TRAY_GAP - float(box[0][0]) + 1e-9
+            if math.hypot(x, y) <= REACH[1]:
+                break
+            edge, low, x = min(low, y + float(box[0][1])), math.inf, TRAY_START[0]
+        if y < -REACH[1]:
+            unreached.append(pid)
+            continue
+        trays[pid] = (x, y)
+        taken.append(_at(box, (x, y)))
+        low = min(low, y + float(box[0][1]))
+        x += TRAY_PITCH
+    top = max(float(t[1][1]) for t in taken)
+    x = TRAY_START[0]
+    for pid in unreached:
+        trays[pid] = (x - float(boxes[pid][0][0]), top + TRAY_GAP - float(boxes[pid][0][1]))
+        x = trays[pid][0] + float(boxes[pid][1][0]) + TRAY_GAP
+    return trays, unreached
+
+
+def _tray_overlap(boxes: dict[str, Box], trays: dict[str, tuple[float, float]]) -> str | None:
+    """Why two parts overlap where they wait (their footprints ``boxes`` at their
+    ``trays``), None when none do."""
     ids = sorted(boxes)
     for k, a in enumerate(ids):
         for b in ids[k + 1:]:
-            if np.all(np.minimum(boxes[a][1], boxes[b][1]) - np.maximum(boxes[a][0], boxes[b][0]) > _LEVEL):
+            box_a, box_b = _at(boxes[a], trays[a]), _at(boxes[b], trays[b])
+            if np.all(np.minimum(box_a[1], box_b[1]) - np.maximum(box_a[0], box_b[0]) > _LEVEL):
                 return (f"parts '{a}' and '{b}' overlap where they wait on the tray (set [parts.<id>] tray in the "
                         "import settings)")
     return None
