@@ -68,6 +68,12 @@ def place_arm(arm: Arm, tip: np.ndarray, quat_xyzw: np.ndarray, what: str) -> No
                             "product nearer the arm: import --place X,Y)")
 
 
+def _room_kind(room: float) -> str:
+    """How a section's room [m] reads: room, a nominal zero-clearance fit (0 exactly, as the
+    import states one), or an interference."""
+    return "room" if room > 0 else "a nominal zero-clearance fit" if room == 0 else "an interference"
+
+
 def trial_rng(seed: int, part: str, hole: str) -> np.random.Generator:
     """The random stream of one trial: same seed, part and hole → same trial."""
     return np.random.default_rng([seed, zlib.crc32(part.encode()), zlib.crc32(hole.encode())])
@@ -162,7 +168,7 @@ class Cell:
         if abs(room) / 2 < SIZE_RESOLUTION:
             raise ExecutorError(
                 f"part '{part}' {'onto' if feature.pin else 'into'} '{hole}': the geometry gives it "
-                f"{room * 500:+.3f} mm per side ({'room' if room > 0 else 'an interference'}), less than the "
+                f"{room * 500:+.3f} mm per side ({_room_kind(room)}), less than the "
                 f"{SIZE_RESOLUTION * 1000:g} mm the simulated cell resolves: it claims neither fit nor no_fit "
                 "(docs/cell.md#what-the-physics-resolves)")
         shape = self.geometry.parts[part].shape
