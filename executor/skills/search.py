@@ -6,6 +6,11 @@ Archimedean spiral whose start angle, direction and pitch are drawn at random.  
 hole is found when the tip sinks into the hole's entry chamfer and, pushed down it,
 past it: a part that is too big never sinks, so the search gives up at ``max_radius``
 and the insertion is tried at the estimate (and fails there).
+
+A push that stops short of the chamfer's end is a find only when the part is held below
+the hole's top face (wedged in the chamfer): a tilted part whose low edge has dipped over
+a sharp rim (a hole without entry chamfer) sinks as far but rests on the top face by the
+rim, up to the hole's room off its centre, and the spiral goes on (:func:`below_top_face`).
 """
 
 from __future__ import annotations
@@ -29,8 +34,9 @@ class SearchParams:
     """Approach speed [m/s], contact force that means "on the surface" [N], how far
     below the surface the tip is pushed while sliding [m] (× 2000 N/m = contact force),
     sink depth that means "in the hole's chamfer" [m], depth that means "past the
-    chamfer" [m], dip that pauses the spiral [m] and for how long at most [s], spiral
-    pitch [m] (± ``pitch_jitter``),
+    chamfer" [m], how much lower than a part resting on the top face can be the tip of a
+    part held below it must be [m] (:func:`below_top_face`), dip that pauses the spiral
+    [m] and for how long at most [s], spiral pitch [m] (± ``pitch_jitter``),
     sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm
     + half a pitch)
     and time limit [s]."""
@@ -40,6 +46,7 @@ class SearchParams:
     press_depth: float = 0.0025
     sink_depth: float = SINK_DEPTH
     enter_depth: float = 0.0012
+    rest_tolerance: float = 0.00025
     dip_depth: float = 0.0001
     dip_hold: float = 0.3
     pitch: float = 0.0012
@@ -76,6 +83,25 @@ def _slide_in(motion: Motion, xy: np.ndarray, touched_z: float, quat_xyzw: np.nd
     return s.tip_pos
 
 
+def below_top_face(tip_z: float, touched_z: float, surface_z: float, p: SearchParams) -> bool:
+    """Whether a part whose push ended with its tip at ``tip_z`` [m] is held below the
+    top face at ``surface_z`` [m] (in the hole's chamfer or past it) rather than resting
+    on it.  The hole axis is z: on a hole entered sideways these heights are the hole
+    frame's.
+
+    Resting on the top face (a tilted part over a sharp rim, its low edge dipped into the
+    hole), the part's support is a point of its bottom at the face's height, so its tip is
+    at most the height of its bottom's highest point above the tip below the face.  The
+    touch measured that height: the tip rested ``touched_z - surface_z`` above the face on
+    the part's lowest point, and the highest point is as high above the tip as the lowest
+    is below it (a tilted flat bottom, a footprint symmetric about the tip).  A tip more
+    than that plus ``rest_tolerance`` (the grasp offset's asymmetry, the compliance's
+    turn) below the face is held by something under it; past ``enter_depth`` below the
+    touch it is in the hole in any case."""
+    lift = max(touched_z - surface_z, 0.0)
+    return tip_z < touched_z - p.enter_depth or tip_z < surface_z - lift - p.rest_tolerance
+
+
 def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: float, quat_xyzw: np.ndarray,
                 rng: np.random.Generator, params: SearchParams = SearchParams()) -> SearchResult:
     """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m].
@@ -84,7 +110,10 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
     the part is over the hole) pauses the spiral for up to ``dip_hold``; meanwhile the
     commanded position complies to the lateral contact force (admittance).  A sink of
     ``sink_depth`` means the part is in the hole's chamfer: it is then pushed down the
-    chamfer into the hole (``_slide_in``) and the hole is found where it ends."""
+    chamfer into the hole (``_slide_in``) and the hole is found where it ends, if the
+    part is held below the top face there (:func:`below_top_face`); else it rests on a
+    rim, and the spiral goes on out of that dip, where a further sink of ``sink_depth``
+    below the rest counts again.  The pushes count in ``max_time``."""
     p = params
     path: list[np.ndarray] = []
     target_z = surface_z - p.press_depth
@@ -104,6 +133,7 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
     direction = rng.choice([-1.0, 1.0])
     pitch = p.pitch * (1 + rng.uniform(-p.pitch_jitter, p.pitch_jitter))
     theta, elapsed, paused, may_pause = 0.0, 0.0, 0, True
+    sink_from = touched_z  # [m] the height a sink is measured from: below a rest on a rim, in its dip
     comply = Admittance(AdmittanceParams())
     offset = np.zeros(2)
     while elapsed < p.max_time:
@@ -111,6 +141,8 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         if radius > p.max_radius:
             break
         dipped = s.tip_pos[2] < touched_z - p.dip_depth
+        if not dipped:
+            sink_from = touched_z
         if dipped and may_pause and paused < p.dip_hold / TIME_STEP:
             paused += 1
             shift = comply.update(s.force, np.zeros(3), TIME_STEP)[0][:2]
@@ -127,7 +159,12 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
         elapsed += TIME_STEP
         if motion.steps % 10 == 0:
             path.append(s.tip_pos.copy())
-        if s.tip_pos[2] < touched_z - p.sink_depth:
+        if s.tip_pos[2] < sink_from - p.sink_depth:
+            pushed_at = motion.steps
             tip = _slide_in(motion, xy, touched_z, quat_xyzw, p, path)
-            return SearchResult(True, tip[:2].copy(), surface_z, np.array(path))
+            if below_top_face(float(tip[2]), touched_z, surface_z, p):
+                return SearchResult(True, tip[:2].copy(), surface_z, np.array(path))
+            elapsed += (motion.steps - pushed_at) * TIME_STEP
+            sink_from, may_pause = float(tip[2]), False
+            s = motion.read()
     return SearchResult(False, np.asarray(est_xy, dtype=float).copy(), surface_z, np.array(path).reshape(-1, 3))
