@@ -1,0 +1,37 @@
+"""A part tilted over a hole's sharp rim is not a part in the hole.
+
+`agh_prism_array` (imported from real CAD) has holes without entry chamfer. In seed 11 of
+`executor trial --part peg6 --hole h2` (2.165 mm of room per side), the part, tilted in
+the hand, touches the top face 0.4 mm above it with its lowest edge, and the spiral brings
+that edge over the hexagon's rim: the tip sinks 0.5 mm and, pushed, goes no deeper, the
+part resting on the top face by the rim 3.3 mm off the hole's centre. Taken for a find,
+the insertion started there pressed the part on the top face until eq. (6) fired, in both
+attempts (a wrong no_fit); the search goes on instead and finds the hole."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from executor.cad.cli import run_import
+from executor.skills.dmp import save_skill
+from executor.skills.teach import teach_shape
+from executor.trial import Cell, trial_rng
+
+PRISMS = Path(__file__).parents[1] / "cad" / "corpus" / "agh_prism_array"
+
+
+@pytest.mark.slow  # imports the product, teaches one shape and runs one attempt (about 15 s)
+def test_a_part_resting_on_a_sharp_rim_is_no_find(tmp_path: Path) -> None:
+    out = tmp_path / "prisms"
+    run_import(PRISMS / "meshes", out, "mm", PRISMS / "import.toml")
+    cell = Cell(str(out))
+    try:
+        save_skill(out, teach_shape(cell, "peg6"))
+        setup = cell.draw_setup(trial_rng(11, "peg6", "h2"), "peg6", "h2")
+        first = cell.run_attempt("peg6", "h2", setup)
+        assert first.hole_found and first.outcome == "fit", first
+        assert first.max_force_dev < cell.thresholds.f_stop  # never pressed on the top face
+    finally:
+        cell.close()
