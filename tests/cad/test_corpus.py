@@ -286,11 +286,6 @@ def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: 
 
 @pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 90 s)
 @pytest.mark.timeout(600)  # 257 s while the machine ran other work
-@pytest.mark.xfail(strict=False, reason=(
-    "a known defect of the cell, not of the test: into the hexagon hole h2 both attempts stop on eq. (6) "
-    "at 30 N in 1 of 20 seeds for peg6 (2.165 mm of room) and 2 of 20 for peg12 and peg4 (0.167 mm), a wrong "
-    "no_fit that leaves the assembly unsolvable (executor trial --trials 20; docs/cell.md, What the physics "
-    "resolves); the octagon and 12-gon holes 0 of 20"))
 def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
