@@ -34,8 +34,8 @@ class SearchParams:
     """Approach speed [m/s], contact force that means "on the surface" [N], how far
     below the surface the tip is pushed while sliding [m] (× 2000 N/m = contact force),
     sink depth that means "in the hole's chamfer" [m], depth that means "past the
-    chamfer" [m], how much lower than a part resting on the top face can be the tip of a
-    part held below it must be [m] (:func:`below_top_face`), dip that pauses the spiral
+    chamfer" [m], margin below the lowest tip of a part resting on the top face that
+    means "held below it" [m] (:func:`below_top_face`), dip that pauses the spiral
     [m] and for how long at most [s], spiral pitch [m] (± ``pitch_jitter``),
     sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm
     + half a pitch)
@@ -97,7 +97,8 @@ def below_top_face(tip_z: float, touched_z: float, surface_z: float, p: SearchPa
     is below it (a tilted flat bottom, a footprint symmetric about the tip).  A tip more
     than that plus ``rest_tolerance`` (the grasp offset's asymmetry, the compliance's
     turn) below the face is held by something under it; past ``enter_depth`` below the
-    touch it is in the hole in any case."""
+    touch it is in the hole in any case.  A part that sank on the way down touched
+    nothing: ``touched_z`` is then ``surface_z``, its lift unmeasured (taken as 0)."""
     lift = max(touched_z - surface_z, 0.0)
     return tip_z < touched_z - p.enter_depth or tip_z < surface_z - lift - p.rest_tolerance
 

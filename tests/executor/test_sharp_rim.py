@@ -16,6 +16,7 @@ import pytest
 
 from executor.cad.cli import run_import
 from executor.skills.dmp import save_skill
+from executor.skills.search import SearchParams, below_top_face
 from executor.skills.teach import teach_shape
 from executor.trial import Cell, trial_rng
 
@@ -35,3 +36,15 @@ def test_a_part_resting_on_a_sharp_rim_is_no_find(tmp_path: Path) -> None:
         assert first.max_force_dev < cell.thresholds.f_stop  # never pressed on the top face
     finally:
         cell.close()
+
+
+@pytest.mark.parametrize(("tip", "touched", "held"), [
+    (0.45, 0.99, False),  # peg6 in h2, seed 0: on the rim, its tip above the face
+    (-0.10, 0.42, False),  # seed 11: on the rim, its tip below the face by less than the lift
+    (-0.89, -0.07, True),  # tp in r1, seed 132 (test_chamfer_jam): wedged in the chamfer
+    (-0.55, 0.28, True),  # agh_hex_horizontal's sideways hole, seed 2: then fit
+    (-0.24, 0.99, True),  # peg6 in h2, seed 0, the next push: past enter_depth below the touch
+])
+def test_a_push_is_a_find_when_the_part_is_held_below_the_top_face(tip: float, touched: float, held: bool) -> None:
+    """Heights [mm] from the top face, as the searches of the trials above ended."""
+    assert below_top_face(tip / 1000, touched / 1000, 0.0, SearchParams()) is held
