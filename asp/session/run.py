@@ -469,6 +469,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     by_hand = _placed_by_hand(assembly, truth, decided)
     decided = [*decided, *by_hand]
     record.not_observed = [(part, hole, result) for (part, hole), result in by_hand]
+    not_observed = [pair for pair, _ in by_hand]
     record.nominal_fits = _nominal_fits(assembly, settings.backend, parts, holes)
     stated_prior = "; ".join(statement for statement in (
         None if record.prior is None else prior_statement(record.prior),
@@ -553,7 +554,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         learned = run / "learned.lp"
         for change in sizes.model_changes:
             LOG.warning("model changed: %s", change)
-        write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes, [pair for pair, _ in by_hand]),
+        write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes, not_observed),
                     header=_learned_header(assembly, run, sizes, stated_prior))
         if record.precedence == "explore":
             started_explore = time.perf_counter()
@@ -569,7 +570,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
                                f"{len(explored.trials)} experiment(s) (experiments.lp): support(A,B,S), S one of "
                                f"{', '.join(SUPPORTS)}; process_constraint(A,B): to confirm with the user.")
             write_trials(run / "experiments.lp", explored.trials)
-            write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes, [pair for pair, _ in by_hand]),
+            write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes, not_observed),
                         header=_learned_header(assembly, run, sizes, stated_prior))
             log.precedence(relation.parts, reduction(relation))
         unsolvable: UnsolvableAssembly | None = None

@@ -60,7 +60,8 @@ def _graded_stating(tmp_path: Path, p3_size: float) -> Path:
     a zero-clearance fit with p2) and p3 made ``p3_size`` [m]."""
     folder = _graded_with(tmp_path, {"d10_8": 0.011})
     text = (folder / "geometry.toml").read_text(encoding="utf-8")
-    text = text.replace('[hole_shapes.d10_8]\nholes = ["h1"]\n', '[hole_shapes.d10_8]\nholes = ["h1"]\nzero_clearance = ["p2"]\n')
+    stated = '[hole_shapes.d10_8]\nholes = ["h1"]\n'
+    text = text.replace(stated, stated + 'zero_clearance = ["p2"]\n')
     text, count = re.subn(r"(\[part_shapes\.peg_d12\]\nparts = [^\n]*\nkind = \"round\"\nsize = )[0-9.]+",
                           rf"\g<1>{p3_size}", text)
     assert count == 1
