@@ -84,3 +84,14 @@ def test_a_nominal_zero_clearance_fit_is_built_with_the_stated_room_and_changes_
     # p3 0.02 mm wider than h1's nominal section: no fit, a fit in the widened hole
     with pytest.raises(ExecutorError, match=r"hole 'h1': .* part 'p3' \(-0\.0200 mm of room\) would then fit"):
         load_geometry(str(_graded_stating(tmp_path / "wider", 0.01102)))
+
+
+@pytest.mark.slow  # one insertion in physics (about 10 s)
+def test_a_nominal_zero_clearance_fit_goes_in_in_physics(tmp_path: Path) -> None:
+    # p2 (d 11 mm) in h1 stated d 11 mm, room 0: refused at room 0, built with room it goes in
+    cell = Cell(str(_graded_stating(tmp_path, 0.012)))
+    try:
+        result = cell.run_trial("p2", "h1", seed=0)
+    finally:
+        cell.close()
+    assert result.outcome == "fit", result
