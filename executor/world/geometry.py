@@ -295,7 +295,7 @@ def _with_nominal_room(hole: HoleSpec, parts: dict[str, PartSpec]) -> HoleSpec:
             raise ExecutorError(
                 f"hole '{hole.id}': the simulated cell builds its nominal zero-clearance fits "
                 f"({', '.join(hole.zero_clearance)}) with {NOMINAL_FIT_ROOM * 1e3:g} mm of room per side, and "
-                f"part '{pid}' ({margin(part, hole) * 1e3:+.4f} mm of room) would then "
+                f"part '{pid}' ({margin(part, hole) * 500:+.4f} mm per side) would then "
                 f"{'fit' if feature_passes(part, built) else 'not fit'}: expected every other pair's answer "
                 "unchanged (docs/cell.md#nominal-zero-clearance-fits)")
     return built

@@ -10,11 +10,12 @@ import shutil
 from pathlib import Path
 
 import pytest
+import shapely
 
 from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.trial import Cell
-from executor.world.geometry import load_geometry, margin
+from executor.world.geometry import HoleSpec, load_geometry, margin, widened
 from executor.world.scene import SIZE_RESOLUTION
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -82,7 +83,7 @@ def test_a_nominal_zero_clearance_fit_is_built_with_the_stated_room_and_changes_
     finally:
         cell.close()
     # p3 0.02 mm wider than h1's nominal section: no fit, a fit in the widened hole
-    with pytest.raises(ExecutorError, match=r"hole 'h1': .* part 'p3' \(-0\.0200 mm of room\) would then fit"):
+    with pytest.raises(ExecutorError, match=r"hole 'h1': .* part 'p3' \(-0\.0100 mm per side\) would then fit"):
         load_geometry(str(_graded_stating(tmp_path / "wider", 0.01102)))
 
 
@@ -95,3 +96,15 @@ def test_a_nominal_zero_clearance_fit_goes_in_in_physics(tmp_path: Path) -> None
     finally:
         cell.close()
     assert result.outcome == "fit", result
+
+
+def test_a_widened_hole_has_the_room_all_round_whatever_its_section() -> None:
+    square = ((-0.005, -0.005), (0.005, -0.005), (0.005, 0.005), (-0.005, 0.005))
+    polygon = HoleSpec("h", "polygon", 0.01, (0.0, 0.0), width=0.01, outline=square, top_z=0.1, depth=0.02)
+    rect = HoleSpec("r", "rect", 0.012, (0.0, 0.0), width=0.008, corner=0.001, top_z=0.1, depth=0.02)
+    for hole in (polygon, rect):
+        built = widened(hole, 1e-4)
+        assert built.sides == pytest.approx((hole.sides[0] + 2e-4, hole.sides[1] + 2e-4), abs=1e-12)
+    grown = shapely.Polygon(widened(polygon, 1e-4).outline)
+    assert grown.symmetric_difference(shapely.box(-0.0051, -0.0051, 0.0051, 0.0051)).area < 1e-15  # mitred: sharp
+    assert widened(rect, 1e-4).corner == pytest.approx(0.0011, abs=1e-12)
