@@ -334,7 +334,7 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
     assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
-@pytest.mark.slow  # imports the product (about 8 s) and runs a sim session of no experiment (about 25 s)
+@pytest.mark.slow  # imports the product and runs a sim session of no experiment (45 s under load)
 def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
