@@ -41,6 +41,7 @@ from bridge.product import (
     part_kinds,
     section_label,
 )
+from bridge.product.nominal import models_nominal_fits, stated_nominal_fits
 
 __all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS", "Assembly", "Hole", "Item", "Part",
            "is_id", "load_assembly", "resolve_assembly_folder"]
@@ -99,14 +100,22 @@ class Assembly:
     """Of those, the pins parts with a bore go onto (``pin = true``)."""
     bores: frozenset[str] = frozenset()
     """The parts with a bore the cell puts onto pins (``bore = true`` of ``[part_shapes.*]``)."""
+    nominal_fits: frozenset[tuple[str, str]] = frozenset()
+    """The (part, hole) pairs ``geometry.toml`` states as nominal zero-clearance fits (``zero_clearance``)."""
+    nominal_modelled: bool = False
+    """Whether the simulated cell builds those fits with
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
+    it cannot resolve them and they are no experiment."""
 
     def tried_by_hand(self, part: str, hole: str) -> bool:
         """Whether no cell can try ``part`` in ``hole``: the part is placed by hand, the
         hole is one the cell does not model (a pin an imported part goes onto, a hole of a
-        section the cell inserts no part in), or a peg and a pin, a part with a bore and a
-        hole (the cell puts parts with a bore onto pins only, pegs into holes only)."""
+        section the cell inserts no part in), a peg and a pin, a part with a bore and a
+        hole (the cell puts parts with a bore onto pins only, pegs into holes only), or a
+        nominal zero-clearance fit the cell cannot build with room (:attr:`nominal_modelled`)."""
         return (part in self.manual or (self.cell_holes is not None and hole not in self.cell_holes)
-                or (self.cell_holes is not None and (part in self.bores) != (hole in self.pins)))
+                or (self.cell_holes is not None and (part in self.bores) != (hole in self.pins))
+                or ((part, hole) in self.nominal_fits and not self.nominal_modelled))
 
     def step_text(self, part: str, hole: str | None) -> str:
         """A plan step as the commands print it: ``p->h``, ``p``, a part placed by hand ``p (manual)``."""
@@ -173,7 +182,9 @@ def assembly_of(product: ProductDescription) -> Assembly:
         p for shape in geometry.part_shapes.values() if shape.bore for p in shape.parts)
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
                     size_model=None if layout.sizes is None else layout.sizes.model, manual=manual,
-                    cell_holes=cell_holes, pins=pins, bores=bores)
+                    cell_holes=cell_holes, pins=pins, bores=bores,
+                    nominal_fits=frozenset() if geometry is None else frozenset(stated_nominal_fits(geometry)),
+                    nominal_modelled=geometry is not None and models_nominal_fits(geometry))
 
 
 def load_assembly(name_or_path: str) -> Assembly:

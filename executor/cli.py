@@ -76,6 +76,9 @@ def _teach(args: argparse.Namespace) -> int:
         close()
     for path in written:
         print(f"wrote {path}")
+    if not cell.geometry.parts:
+        print(f"no skill to teach: {cell.geometry.folder / 'geometry.toml'} has no part the cell inserts (every "
+              "part is placed by hand)")
     return 0
 
 

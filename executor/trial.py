@@ -117,9 +117,6 @@ class Cell:
                  *, setup: CellSetup = CellSetup(), ilc_state: Path | None = None) -> None:
         self.description = setup.description
         self.geometry = load_geometry(assembly, self.description)
-        if not self.geometry.parts:
-            raise ExecutorError(f"{self.geometry.folder / 'geometry.toml'}: no part the cell inserts (every part is "
-                                "placed by hand); expected at least one [part_shapes] (the truth backend takes it)")
         if gui:
             require_display()
         self.gui = gui
@@ -138,7 +135,8 @@ class Cell:
             plate_obj = current_assets(self.geometry) / "plate.obj"
             logger.log_scene_mesh("plate_mesh", self.geometry.base_mesh or plate_obj, PLATE_MESH_COLOR)
             logger.log_hole_rims(hole_rims(self.geometry))
-            logger.log_arm_at_rest(self._arm_of(min(self.geometry.parts.items())[1].shape))
+            if self.geometry.parts:  # a product whose every part is placed by hand has no arm to show
+                logger.log_arm_at_rest(self._arm_of(min(self.geometry.parts.items())[1].shape))
 
     def reset_state(self, *, layer: str | ExecutionLayer = "full", magnitudes: Magnitudes | None = None,
                     cell_seed: int = 0) -> None:

@@ -148,6 +148,22 @@ def _explored_lines(explored: dict | UnsetType) -> list[str]:
             *(f"  {line}" for line in explored["rests_on"])]
 
 
+def _stated_lines(result: dict) -> list[str]:
+    """The summary's lines on what was not observed as the CAD states it: the pairs taken
+    from ``sizes.lp`` (no cell can try them), the nominal zero-clearance fits the sim cell
+    built with room."""
+    lines = []
+    if result["not_observed"]:
+        fits = [f"{p}->{h}" for p, h, outcome in result["not_observed"] if outcome == "fit"]
+        lines.append(f"not observed (no cell can try them; from sizes.lp, the CAD): {len(result['not_observed'])} "
+                     f"pairs, {len(fits)} fit" + (f": {' '.join(fits)}" if fits else ""))
+    nominal = result["nominal_fits"]
+    if nominal:
+        lines.append(f"observed with {nominal['room_m'] * 1e3:.3f} mm of room per side, not at the CAD's room 0 "
+                     f"(nominal zero-clearance fits): {' '.join(f'{p}->{h}' for p, h in nominal['pairs'])}")
+    return lines
+
+
 def _summary(result: dict, run: Path) -> str:
     """The human ending of a session: what was learned, the files written, what to run next."""
     settings = read_session_file(run)
@@ -171,6 +187,7 @@ def _summary(result: dict, run: Path) -> str:
            if result["demonstrated"] else ""),
         f"assumes: {result['assumption']}",
         *([] if settings.prior is UNSET or settings.prior is None else [f"assumes: {prior_statement(settings.prior)}"]),
+        *_stated_lines(result),
         *(f"model changed: {change}" for change in result["model_changes"]),
         f"must precede: {len(result['must_precede'])} pairs",
         *_explored_lines(settings.precedence_explored),

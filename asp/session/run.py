@@ -62,6 +62,7 @@ from asp.session.settings import (
     MAX_STARTS,
     SESSION_FILE,
     DecidedPrior,
+    NominalFits,
     SessionFile,
     SessionSettings,
     checked,
@@ -84,6 +85,7 @@ from bridge.assembly import Assembly, load_assembly
 from bridge.cell_settings import DEFAULT_CELL, ServeSettings
 from bridge.client import CellDirectory, CellPool, PoolLimits
 from bridge.files import make_folder
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from bridge.recording.layout import Contents, write_blueprint
 from bridge.recording.reader import read_recording
 from bridge.recording.sinks import NO_VIEWER, Viewer
@@ -91,7 +93,7 @@ from bridge.session import DEFAULT_ENDPOINT, LOOPBACK_ANY_PORT, bound_endpoints,
 
 LOG = logging.getLogger(__name__)
 RESULT_KEYS = ("run", "experiments", "fits", "must_precede", "plans", "matches_truth", "model", "assumption",
-               "prior", "model_changes", "demonstrated")
+               "prior", "model_changes", "demonstrated", "not_observed", "nominal_fits")
 """What :func:`run_session` returns (``session --json``), in this order, as ``session.json`` holds them."""
 CRASH_WAIT_S = 2.0
 """How long the pool waits for a started cell's process to end when its links just closed
@@ -185,6 +187,24 @@ def _by_hand_statement(assembly: Assembly, by_hand: list[tuple[Pair, Result]]) -
             f"{shown}) are taken from {assembly.folder / 'sizes.lp'} (the nominal sections, {fits} fit), not observed")
 
 
+def _nominal_fits(assembly: Assembly, backend: str, parts: list[str], holes: list[str]) -> NominalFits | None:
+    """The nominal zero-clearance fits the simulated cell (``backend`` sim) tries with the
+    room it builds them with (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`); None with
+    another backend or without such a pair among ``parts`` x ``holes``."""
+    pairs = sorted(pair for pair in assembly.nominal_fits
+                   if pair[0] in parts and pair[1] in holes and not assembly.tried_by_hand(*pair))
+    return NominalFits(room_m=NOMINAL_FIT_ROOM, pairs=pairs) if backend == "sim" and pairs else None
+
+
+def _nominal_statement(nominal: NominalFits) -> str:
+    """The line a run prints (and ``learned.lp`` keeps) for the nominal zero-clearance fits
+    its simulated cell builds with room."""
+    shown = " ".join(f"{part}->{hole}" for part, hole in nominal.pairs[:8]) + (" ..." if len(nominal.pairs) > 8 else "")
+    return (f"{len(nominal.pairs)} nominal zero-clearance fits stated by the CAD at room 0 ({shown}) are built in "
+            f"the simulated cell with {nominal.room_m * 1e3:.3f} mm of room per side (room 0 is below what its physics "
+            "resolves): their outcomes are observed in that model, not at room 0")
+
+
 def _endpoints(settings: SessionSettings) -> tuple[list[str], list[str]]:
     """(listen, connect) of the planner: it listens for its own cells, else connects."""
     listen, connect = list(settings.listen), list(settings.connect)
@@ -251,9 +271,12 @@ def _learn_sizes(oracle: ZenohOracle, learner: SizeLearner, journal: Journal,
 
 
 def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
-                   sizes: SizeLearningResult) -> list:
+                   sizes: SizeLearningResult, not_observed: list[Pair]) -> list:
+    """The facts of ``learned.lp``; ``not_observed(P,H)`` for each pair taken from the
+    product's ``sizes.lp`` because no cell can try it (:func:`_placed_by_hand`)."""
     atoms = [fact("part", p) for p in assembly.part_ids] + [fact("hole", h) for h in assembly.hole_ids]
     atoms += demos_atoms + precedence_facts(relation) + sizes.facts()
+    atoms += [fact("not_observed", part, hole) for part, hole in not_observed]
     return list(dict.fromkeys(atoms))
 
 
@@ -445,9 +468,14 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         decided=[(p, h, result) for (p, h), result in decided])
     by_hand = _placed_by_hand(assembly, truth, decided)
     decided = [*decided, *by_hand]
+    record.not_observed = [(part, hole, result) for (part, hole), result in by_hand]
+    not_observed = [pair for pair, _ in by_hand]
+    record.nominal_fits = _nominal_fits(assembly, settings.backend, parts, holes)
     stated_prior = "; ".join(statement for statement in (
         None if record.prior is None else prior_statement(record.prior),
-        None if not by_hand else _by_hand_statement(assembly, by_hand)) if statement is not None) or None
+        None if not by_hand else _by_hand_statement(assembly, by_hand),
+        None if record.nominal_fits is None else _nominal_statement(record.nominal_fits))
+        if statement is not None) or None
     # Every input file is read before any cell starts: bad input fails fast.
     demos, relation, prior = learn_for_assembly(assembly, None if record.demos is None else Path(record.demos))
     truth_relation = true_relation(assembly) if assembly.has_file("precedence.lp") else None
@@ -526,7 +554,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         learned = run / "learned.lp"
         for change in sizes.model_changes:
             LOG.warning("model changed: %s", change)
-        write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
+        write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes, not_observed),
                     header=_learned_header(assembly, run, sizes, stated_prior))
         if record.precedence == "explore":
             started_explore = time.perf_counter()
@@ -542,7 +570,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
                                f"{len(explored.trials)} experiment(s) (experiments.lp): support(A,B,S), S one of "
                                f"{', '.join(SUPPORTS)}; process_constraint(A,B): to confirm with the user.")
             write_trials(run / "experiments.lp", explored.trials)
-            write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes),
+            write_facts(learned, _learned_atoms(assembly, demo_facts(demos), relation, sizes, not_observed),
                         header=_learned_header(assembly, run, sizes, stated_prior))
             log.precedence(relation.parts, reduction(relation))
         unsolvable: UnsolvableAssembly | None = None

@@ -154,6 +154,15 @@ class DecidedPrior(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fie
     decided: list[tuple[str, str, Result]]
 
 
+class NominalFits(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
+    """The nominal zero-clearance fits (room 0 in the CAD) a sim session's cell tries, built
+    with ``room_m`` [m] per side (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`): the
+    ``pairs`` [part, hole] whose outcomes are observed in that model, not at room 0."""
+
+    room_m: Annotated[float, Meta(gt=0)]
+    pairs: list[tuple[str, str]]
+
+
 class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     """``RUN/session.json``: the settings kept with the run folder (see
     :class:`SessionSettings`; ``backend`` and ``delay_s`` None in a folder written before
@@ -163,7 +172,10 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     result (the ``session --json`` contract: ``run``, ``experiments``, ``fits``,
     ``must_precede``, ``plans``, ``matches_truth``, and more: the size model used and
     what it assumes, what the size prior decided (``prior``, set at each start; None
-    without one), the truth comparison, the assignment, the cells, the journal,
+    without one), the pairs no cell can try, taken from ``sizes.lp`` and not observed
+    (``not_observed``: [part, hole, result], set at each start), the nominal zero-clearance
+    fits its sim cell builds with room (``nominal_fits``: :class:`NominalFits`, None
+    without), the truth comparison, the assignment, the cells, the journal,
     wall time [s] and timings [s], the assembly run, with ``--precedence explore`` what the
     exploration did (:meth:`asp.session.precedence.ExploredPrecedence.summary`), and the ``error`` when the learned
     product has no complete assignment). Fields not yet known are absent."""
@@ -196,6 +208,8 @@ class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):
     prior: DecidedPrior | None | UnsetType = UNSET
     model_changes: list[str] | UnsetType = UNSET
     demonstrated: list[tuple[str, str]] | UnsetType = UNSET
+    not_observed: list[tuple[str, str, Result]] | UnsetType = UNSET
+    nominal_fits: NominalFits | None | UnsetType = UNSET
     truth: dict[str, bool | int | None] | UnsetType = UNSET
     assignment: dict[str, str] | UnsetType = UNSET
     cells: list[str] | UnsetType = UNSET

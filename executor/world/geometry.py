@@ -30,6 +30,7 @@ for byte on any CPU; the mesh's cos/sin may move its last printed digit, 1 µm).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from collections.abc import Callable
@@ -56,6 +57,7 @@ from bridge.product import (
     hole_level,
     load_product_description,
 )
+from bridge.product.nominal import NOMINAL_FIT_ROOM, models_nominal_fits
 from executor import ExecutorError
 from executor.cell_description import CellDescription
 from executor.world.frames import HoleFrame, hole_frame
@@ -261,7 +263,42 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
                 outline=_outline(part_shape), corner=part_shape.corner, bore=part_shape.bore,
             )
+    if models_nominal_fits(geo):
+        holes = {hid: _with_nominal_room(hole, parts) for hid, hole in holes.items()}
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
+
+
+def widened(hole: HoleSpec, room: float) -> HoleSpec:
+    """``hole`` with ``room`` [m] more all round: a round, square or rect section ``2 room``
+    wider on each side's extent (a corner radius grown by ``room``, a sharp corner kept
+    sharp), a polygon's outline offset outwards by ``room`` (mitred corners)."""
+    if hole.kind == "polygon":
+        grown = shapely.Polygon(hole.outline).buffer(room, join_style="mitre")
+        outline = tuple((float(x), float(y)) for x, y in np.asarray(grown.exterior.coords)[:-1])
+        xmin, ymin, xmax, ymax = grown.bounds
+        return dataclasses.replace(hole, outline=outline, size=xmax - xmin, width=ymax - ymin)
+    return dataclasses.replace(hole, size=hole.size + 2 * room, width=hole.width + 2 * room if hole.width else 0.0,
+                               corner=hole.corner + room if hole.corner else 0.0)
+
+
+def _with_nominal_room(hole: HoleSpec, parts: dict[str, PartSpec]) -> HoleSpec:
+    """The hole as the simulated cell builds it: one that states nominal zero-clearance
+    fits (``zero_clearance``) :func:`widened` by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side, so that the physics resolves
+    them (docs/cell.md#nominal-zero-clearance-fits); ExecutorError naming the first part
+    whose answer in the hole that room would change (:func:`feature_passes`)."""
+    if not hole.zero_clearance or hole.pin:
+        return hole
+    built = widened(hole, NOMINAL_FIT_ROOM)
+    for pid, part in sorted(parts.items()):
+        if not part.bore and feature_passes(part, hole) != feature_passes(part, built):
+            raise ExecutorError(
+                f"hole '{hole.id}': the simulated cell builds its nominal zero-clearance fits "
+                f"({', '.join(hole.zero_clearance)}) with {NOMINAL_FIT_ROOM * 1e3:g} mm of room per side, and "
+                f"part '{pid}' ({margin(part, hole) * 500:+.4f} mm per side) would then "
+                f"{'fit' if feature_passes(part, built) else 'not fit'}: expected every other pair's answer "
+                "unchanged (docs/cell.md#nominal-zero-clearance-fits)")
+    return built
 
 
 def margin(part: Section, hole: Section) -> float:

@@ -329,6 +329,34 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
     assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
+@pytest.mark.slow  # imports the product and runs a sim session of no experiment (45 s under load)
+def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
+        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+    # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
+    # has no operation for (each placed by hand): the sim session must not refuse the
+    # product; it takes every pair from sizes.lp and says none was observed.
+    done = imported("ldraw_axles")
+    taught = run_executor("teach", "--assembly", str(done.out), timeout=120)
+    assert taught.returncode == 0 and "no skill to teach" in taught.stdout, taught.stderr
+    run = tmp_path / "run"
+    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--json", timeout=300)
+    assert session.stdout, session.stderr
+    result = json.loads(session.stdout)
+    holes = _feature_holes(done)  # the liftarm's empty 16-gon pin hole is a pocket (POCKET): not compared
+    truth = {(row["part"], holes[row["feature"]]) for row in done.truth["fits"] if row["feature"] in holes
+             and row["fits"]}
+    assert {tuple(pair) for pair in result["fits"]} == truth
+    sizes = _atoms(done.out / "sizes.lp")
+    pairs = {(part, hole) for (part,) in sizes["part"] for (hole,) in sizes["hole"]}
+    assert {(p, h) for p, h, _ in result["not_observed"]} == pairs  # every pair labelled, none observed
+    assert {(p, h) for p, h, outcome in result["not_observed"] if outcome == "fit"} == truth
+    assert result["experiments"] == 0 and not (run / "journal.jsonl").read_text().strip()
+    assert _atoms(run / "learned.lp")["not_observed"] == pairs
+    assert result["nominal_fits"] is None  # no pair the cell builds with room
+    if session.returncode != 0:  # the bush and the gear share the axle: an assignment has one part per feature
+        assert "parts bush gear fit only 1 hole(s)" in result["error"], result
+
+
 @pytest.mark.parametrize("name", PRODUCTS)
 def test_each_truth_is_a_closed_world(name: str) -> None:
     # Every part that goes into a feature against every feature of that kind (a hole, a

@@ -1,0 +1,41 @@
+"""The nominal zero-clearance fits a product states and how the simulated cell models them.
+
+A ``[hole_shapes.*]`` table's ``zero_clearance`` names the parts the CAD has in that hole (or
+on that pin) at one nominal section, room 0. Room 0 is below what the simulated cell's
+physics resolves (``executor.world.scene.SIZE_RESOLUTION``, 0.025 mm per side): a part
+built at room 0 jams, and the cell's trials refuse such a pair. A nominal zero-clearance
+fit is a sliding fit in practice, so the simulated cell builds it with
+:data:`NOMINAL_FIT_ROOM` per side where it builds the hole itself from its section (a base
+of ``[plate]`` primitives: the hole is widened by that room all round, and the cell's loader
+refuses the product when that changes the answer of any other pair). Where the hole is
+part of the base's own mesh (a ``[base]`` with ``mesh``: holes entered sideways, pins) the
+cell cannot widen it: those pairs are no experiment, the planner takes them from the CAD
+(``sizes.lp``), not observed. Both sides read the rule here, so they agree on which pairs
+the cell tries (docs/decisions.md, "Nominal zero-clearance fits in the simulated cell").
+"""
+
+from __future__ import annotations
+
+from bridge.product.tables import GeometryFile
+
+NOMINAL_FIT_ROOM = 150e-6
+"""[m] per side: the room the simulated cell builds a stated nominal zero-clearance fit with,
+six times the 0.025 mm per side its physics resolves (looser than a real sliding fit: ISO
+286's loose running fit 10 H11/c11 has 0.04 to 0.13 mm per side). The least of those
+measured on ``occt_as1``'s six d 10 mm bolts in their 20 mm deep holes (``executor
+teach``): at 0.05 mm per side bolt_a1 stopped 4.4 mm short of the bottom, at 0.10 mm
+bolt_a2 3.2 mm short (the cell's goal tolerance is 3 mm), at 0.15 mm all six were taught
+(docs/cell.md#nominal-zero-clearance-fits)."""
+
+
+def models_nominal_fits(geometry: GeometryFile) -> bool:
+    """Whether the simulated cell builds ``geometry``'s holes from their sections (a base of
+    ``[plate]`` primitives), so that it can widen a hole by :data:`NOMINAL_FIT_ROOM` for the
+    parts it states a nominal zero-clearance fit with; False for a base with its own mesh."""
+    return geometry.base is None or geometry.base.mesh is None
+
+
+def stated_nominal_fits(geometry: GeometryFile) -> list[tuple[str, str]]:
+    """The (part, hole) pairs ``geometry`` states as nominal zero-clearance fits, sorted."""
+    return sorted((pid, hid) for shape in geometry.hole_shapes.values() for hid in shape.holes
+                  for pid in shape.zero_clearance or ())
