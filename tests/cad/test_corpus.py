@@ -136,8 +136,12 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 POCKET = ("features: an empty hole whose section is a polygon is a pocket, not written as a hole (the liftarm's "
           "16-gon pin hole the axle passes with its tips on the vertices)")
-IMPORTED = PRODUCTS
-"""Every product (the import refuses none)."""
+REFUSED = {"occt_pulley": ("removal: the import refuses the product, pulley_front never comes out (along +y its d 26 "
+                           "bore meets the hub's d 26 collar, a zero-clearance passage it reaches only on its way "
+                           "out, not touching it where it is: the tessellations overlap, a collision)")}
+"""The products the import refuses though they are sound, with why."""
+IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
+"""Every product the import takes."""
 
 PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 26.951, 4.975 mm all round) and no "
                  "hole is found in the bearing ring the shaft runs in (d 21), the ring in its d 27 bore in no feature; "
@@ -265,6 +269,15 @@ def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str]
               if "in" in part}
     assert owners <= written
     assert all(f"% {a}->{b}: blocks" not in text for a, b in owners - {tuple(p) for p in done.truth["precedence"]})
+
+
+@pytest.mark.slow  # imports the product
+@pytest.mark.parametrize("name", [pytest.param(p, marks=_xfail(why)) for p, why in REFUSED.items()])
+def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: str) -> None:
+    # Once it is, the product goes out of REFUSED and into every test of the imported ones.
+    done = imported(name)
+    allowed = {pid: part["axes"] for pid, part in done.truth["parts"].items()}
+    assert {pid: axis for pid, axis in done.axes.items() if axis not in allowed[pid]} == {}
 
 
 @pytest.mark.slow  # the first test of a product imports it
