@@ -28,6 +28,7 @@ import pytest
 
 from bridge.cell_settings import ServeSettings
 from bridge.messages import InsertRequest
+from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad.cli import run_import
@@ -153,7 +154,7 @@ PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on n
 
 
 def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
-    """Every product, ``name`` with ``mark``."""
+    """Every imported product, ``name`` with ``mark``."""
     return [pytest.param(p, marks=mark) if p == name else p for p in IMPORTED]
 
 
@@ -272,7 +273,8 @@ def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str]
 
 
 @pytest.mark.slow  # imports the product
-@pytest.mark.parametrize("name", [pytest.param(p, marks=_xfail(why)) for p, why in REFUSED.items()])
+@pytest.mark.parametrize("name", [pytest.param(p, marks=pytest.mark.xfail(strict=True, raises=ExecutorError,
+                                                                         reason=why)) for p, why in REFUSED.items()])
 def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: str) -> None:
     # Once it is, the product goes out of REFUSED and into every test of the imported ones.
     done = imported(name)
