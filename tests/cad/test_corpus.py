@@ -28,6 +28,7 @@ import pytest
 
 from bridge.cell_settings import ServeSettings
 from bridge.messages import InsertRequest
+from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad.cli import run_import
@@ -136,8 +137,25 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 POCKET = ("features: an empty hole whose section is a polygon is a pocket, not written as a hole (the liftarm's "
           "16-gon pin hole the axle passes with its tips on the vertices)")
-IMPORTED = PRODUCTS
-"""Every product (the import refuses none)."""
+REFUSED = {"occt_pulley": ("removal: the import refuses the product, pulley_front never comes out (along +y its d 26 "
+                           "bore meets the hub's d 26 collar, a zero-clearance passage it reaches only on its way "
+                           "out, not touching it where it is: the tessellations overlap, a collision)")}
+"""The products the import refuses though they are sound, with why."""
+IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
+"""Every product the import takes."""
+
+PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 26.951, 4.975 mm all round) and no "
+                 "hole is found in the bearing ring the shaft runs in (d 21), the ring in its d 27 bore in no feature; "
+                 "of the three parts on the shaft's d 17 end only gland_3 is on a pin, with a bore of d 33.901 (its "
+                 "recess, not its d 17 lips)")
+PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on nothing else (2 mm all round, the "
+                "source's balls left out), but it touches nothing in the CAD and the locating rule counts the glands "
+                "and the impeller on it among what keeps it from moving sideways: bearing_ring->shaft is not written")
+
+
+def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
+    """Every imported product, ``name`` with ``mark``."""
+    return [pytest.param(p, marks=mark) if p == name else p for p in IMPORTED]
 
 
 EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the large gear's shaft; Factory's "
@@ -153,6 +171,7 @@ EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
+    pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -200,6 +219,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
+    pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
@@ -220,7 +240,7 @@ def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], I
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", IMPORTED)
+@pytest.mark.parametrize("name", _imported_but("occt_pump", _xfail(PUMP_SUPPORT)))
 def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     base = done.truth["base"]
@@ -238,7 +258,7 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", IMPORTED)
+@pytest.mark.parametrize("name", _imported_but("occt_pump", _xfail(PUMP_SUPPORT)))
 def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str], Imported], name: str) -> None:
     # The cell inserts a part into its feature: the feature's owner is placed first, for a
     # reason of its own where nothing else orders them (agh_prism_array's pegs stand on the
@@ -250,6 +270,16 @@ def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str]
               if "in" in part}
     assert owners <= written
     assert all(f"% {a}->{b}: blocks" not in text for a, b in owners - {tuple(p) for p in done.truth["precedence"]})
+
+
+@pytest.mark.slow  # imports the product
+@pytest.mark.parametrize("name", [pytest.param(p, marks=pytest.mark.xfail(strict=True, raises=ExecutorError,
+                                                                         reason=why)) for p, why in REFUSED.items()])
+def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: str) -> None:
+    # Once it is, the product goes out of REFUSED and into every test of the imported ones.
+    done = imported(name)
+    allowed = {pid: part["axes"] for pid, part in done.truth["parts"].items()}
+    assert {pid: axis for pid, axis in done.axes.items() if axis not in allowed[pid]} == {}
 
 
 @pytest.mark.slow  # the first test of a product imports it
@@ -278,6 +308,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
                                           "rod through two brackets")),
     "robosuite_nuts",
+    pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into no hole found (the ring, gland_2, the impeller: "
+                                           "in no feature) or onto a pin of a part that is not the base (gland_3)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
