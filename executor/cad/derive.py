@@ -181,13 +181,16 @@ class Derived:
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
                 "plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, slide along their "
-                f"axis ({len(self.slides)} found"
+                f"axis where they sit and on the way ({sum(s.seated for s in self.slides)} fit(s) and "
+                f"{sum(not s.seated for s in self.slides)} passage(s) found"
                 + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""
-        lines = [f"zero-clearance fit {s.shaft} in {s.bore}: {_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
+        lines = [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
+                  f"zero-clearance passage {s.shaft} through {s.bore} (met only on a way along the axis): ")
+                 + f"{_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
                  f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding" for s in self.slides]
         lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
                   for (a, b), detail in sorted(self.detail.items())]

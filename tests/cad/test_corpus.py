@@ -137,9 +137,7 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 POCKET = ("features: an empty hole whose section is a polygon is a pocket, not written as a hole (the liftarm's "
           "16-gon pin hole the axle passes with its tips on the vertices)")
-REFUSED = {"occt_pulley": ("removal: the import refuses the product, pulley_front never comes out (along +y its d 26 "
-                           "bore meets the hub's d 26 collar, a zero-clearance passage it reaches only on its way "
-                           "out, not touching it where it is: the tessellations overlap, a collision)")}
+REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
 """Every product the import takes."""
@@ -151,6 +149,9 @@ PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 
 PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on nothing else (2 mm all round, the "
                 "source's balls left out), but it touches nothing in the CAD and the locating rule counts the glands "
                 "and the impeller on it among what keeps it from moving sideways: bearing_ring->shaft is not written")
+PULLEY_FEATURES = ("features: no hole is found in the hub's disc for the bolts (their d 6 holes), the bolts are put "
+                   "into three holes of the pulley on its axis (its d 77.328 recess); the pin the pulley goes onto "
+                   "(the hub's boss) is not found")
 
 
 def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
@@ -172,6 +173,7 @@ EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the
     "occt_as1",
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
+    pytest.param("occt_pulley", marks=_xfail(PULLEY_FEATURES)),
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -220,6 +222,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "occt_as1",
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
+    pytest.param("occt_pulley", marks=_xfail(PULLEY_FEATURES)),
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
@@ -310,6 +313,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into no hole found (the ring, gland_2, the impeller: "
                                            "in no feature) or onto a pin of a part that is not the base (gland_3)")),
+    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y (the bolts into the hub's disc, the pulley "
+                                             "onto its boss)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual

@@ -83,6 +83,34 @@ def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
     assert derived.blockers[("shaft", "+y")] == {"bearing", "housing"}
 
 
+def _ring_past_a_collar(collar: float) -> list[CadPart]:
+    """A plate with a post standing on it (r 6 mm, a collar of radius ``collar`` [mm] from
+    z 8 to 11 mm, a 48-gon) and a ring on the post's foot (bore r 8 mm, a 40-gon, z 2 to
+    5 mm), clear of the collar where it sits."""
+    post = trimesh.boolean.union([trimesh.creation.cylinder(radius=6 * MM, height=20 * MM, sections=48),
+                                  trimesh.creation.cylinder(radius=collar * MM, height=3 * MM, sections=48)
+                                  .apply_translation((0, 0, -0.5 * MM))], engine="manifold")
+    post.apply_translation((0, 0, 12 * MM))
+    base = trimesh.boolean.union([_box((40, 40, 2), (0, 0, 1)), post], engine="manifold")
+    ring = trimesh.creation.annulus(r_min=8 * MM, r_max=14 * MM, height=3 * MM, sections=40)
+    ring.apply_translation((0, 0, 3.5 * MM))
+    return _parts(base=base, ring=ring)
+
+
+def test_a_ring_passes_a_collar_of_its_bore_size_on_its_way_out_but_not_a_larger_one() -> None:
+    # The collar's 48-gon pokes 25 µm into the ring's 40-gon bore on the way up: the
+    # tessellations of one nominal d 16, a passage that slides along the axis.
+    parts = _ring_past_a_collar(8.0)
+    check_parts(parts, "m")
+    derived = derive(parts, "base", {}, reach=0.0)
+    assert [(s.shaft, s.bore, s.seated) for s in derived.slides] == [("base", "ring", False)]
+    assert derived.free("ring") == ["+z"] and derived.axis == {"ring": "+z"}
+    assert any(line.startswith("zero-clearance passage base through ring") for line in derived.notes())
+    # A collar 0.2 mm larger in radius is no tessellation of the bore: the ring never comes out.
+    with pytest.raises(ExecutorError, match=r"part\(s\) ring never come out .* ring along \+z by base, -z by base"):
+        derive(_ring_past_a_collar(8.2), "base", {}, reach=0.0)
+
+
 def test_a_bar_that_slides_out_sideways_under_a_lid_gets_no_pair() -> None:
     channel = trimesh.boolean.union([_box((80, 60, 5), (0, 0, 2.5)), _box((80, 10, 20), (0, 25, 15)),
                                      _box((80, 10, 20), (0, -25, 15)), _box((5, 60, 20), (-37.5, 0, 15))],
