@@ -26,7 +26,9 @@ the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth 
 whose normals are all perpendicular to one axis and whose vertices lie on one circle);
 an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
 radius within the pair's tolerance (the larger deflection of the two faces plus
-:data:`TOUCH`), are a fit. Swept along its axis against the bore's part, the shaft's part
+:data:`TOUCH`), are a fit, wherever on the way along the axis they meet: seated (their
+spans overlap in the assembled pose) or a passage (a bore passing a collar of that size
+on its way out). Swept along its axis against the bore's part, the shaft's part
 is taken thinner there (its vertices within the tolerance of that radius moved towards
 the axis by the bore's deflection, the radii's and the axes' difference and
 :data:`TOUCH`): overlap below the tolerance across the axis is not a collision, every
