@@ -52,6 +52,7 @@ from dataclasses import dataclass, field, replace
 
 import networkx as nx
 import numpy as np
+import shapely
 import trimesh
 
 from executor import ExecutorError
@@ -66,6 +67,7 @@ from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
 from executor.cad.sweep import (
     DIRECTIONS,
+    TOUCH,
     CylinderFace,
     PrismFace,
     Slide,
@@ -181,13 +183,16 @@ class Derived:
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
                 "plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, slide along their "
-                f"axis ({len(self.slides)} found"
+                f"axis where they sit and on the way ({sum(s.seated for s in self.slides)} fit(s) and "
+                f"{sum(not s.seated for s in self.slides)} passage(s) found"
                 + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""
-        lines = [f"zero-clearance fit {s.shaft} in {s.bore}: {_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
+        lines = [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
+                  f"zero-clearance passage {s.shaft} through {s.bore} (met only on a way along the axis): ")
+                 + f"{_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
                  f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding" for s in self.slides]
         lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
                   for (a, b), detail in sorted(self.detail.items())]
@@ -368,11 +373,14 @@ def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) 
 
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
-    """The level [m] in the middle of the part's depth inside the base along ``axis`` (the
+    """The level [m] (to 0.1 µm) in the middle of the part's depth inside the base along ``axis`` (the
     base's extent there taken over its vertices within the part's box across the axis
     grown by the box's larger side on each side: a pin of the base standing farther off is
     not around it) and the part's one loop there; None when the part does not reach into
-    the base or its slice there is not one loop."""
+    the base or its slice there is not one loop. Where the base's slice at that level has
+    no inner loop around the part (a boss of the base beside it stretches the base's extent:
+    a bolt in a hub's disc next to its boss, sliced at the disc's face), the level of the
+    base's hole around it that :func:`_hole_around` finds, if any."""
     across = np.abs(axis) < 0.5
     lower, upper = part.mesh.bounds[0][across], part.mesh.bounds[1][across]
     grown = float(np.max(upper - lower))
@@ -384,9 +392,16 @@ def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, 
     low, high = max(along.min(), base_along.min()), min(along.max(), base_along.max())
     if high - low <= 1e-6:
         return None
-    level = float(low + high) / 2
+    level = round(float(low + high) / 2, 7)
     own = slice_loops(part.mesh, axis, level)
-    return (level, own[0]) if len(own) == 1 else None
+    if len(own) != 1:
+        return None
+    loops = slice_loops(base.mesh, axis, level)
+    if not any(loop.contains(own[0].centre) and not _outer(loop, loops) for loop in loops):
+        hit = _hole_around(base, part, axis)
+        if hit is not None:
+            return round(hit[0], 7), hit[3]
+    return level, own[0]
 
 
 def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str]) -> list[HoleFit]:
@@ -546,12 +561,21 @@ def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float
         cut = slice_loops(part.mesh, axis, level)
         own = [o for o in cut if _outer(o, cut)]
         for loop in (o for o in loops if not _outer(o, loops)):
-            inside = [o for o in own if loop.contains(o.centre) and o.area < loop.area]
+            inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
             if len(inside) == 1:
                 around = sorted((o for o in loops if o is not loop and o.area > loop.area
                                  and o.contains(loop.centre)), key=lambda o: o.area)
                 return level, loop, around[0] if around else None, inside[0]
     return None
+
+
+def _in_loop(outline: Loop, hole: Loop) -> bool:
+    """Whether a part's ``outline`` lies in the ``hole`` loop of another part's slice: at
+    most the hole's sagitta (a round one's) plus :data:`executor.cad.sweep.TOUCH` beyond
+    it, as a shaft tessellated at a nominal zero-clearance fit is (its vertices on the
+    circle the bore's chords cut inside); a ring around a tube is not in the tube's bore."""
+    margin = classify(hole, hole=True).deflection + TOUCH
+    return bool(shapely.Polygon(hole.points).buffer(margin).covers(shapely.Polygon(outline.points)))
 
 
 def _fields(fit: HoleFit) -> tuple:

@@ -280,7 +280,8 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                 for part in (a, b):
                     if part.id not in faces:
                         faces[part.id] = fit_faces(part.mesh)
-                volume = _beyond_fits(common, zero_clearance_fits({a.id: faces[a.id], b.id: faces[b.id]}))
+                seated = [s for s in zero_clearance_fits({a.id: faces[a.id], b.id: faces[b.id]}) if s.seated]
+                volume = _beyond_fits(common, seated)
             if volume > OVERLAP_VOLUME:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "

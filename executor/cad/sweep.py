@@ -26,7 +26,9 @@ the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth 
 whose normals are all perpendicular to one axis and whose vertices lie on one circle);
 an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
 radius within the pair's tolerance (the larger deflection of the two faces plus
-:data:`TOUCH`), are a fit. Swept along its axis against the bore's part, the shaft's part
+:data:`TOUCH`), are a fit, wherever on the way along the axis they meet: seated (their
+spans overlap in the assembled pose) or a passage (a bore passing a collar of that size
+on its way out). Swept along its axis against the bore's part, the shaft's part
 is taken thinner there (its vertices within the tolerance of that radius moved towards
 the axis by the bore's deflection, the radii's and the axes' difference and
 :data:`TOUCH`): overlap below the tolerance across the axis is not a collision, every
@@ -227,7 +229,10 @@ class Slide:
     """A nominal zero-clearance fit: part ``shaft``'s outward ``face`` in part ``bore``'s
     inward face ``hole``, coaxial and of equal radius (prisms: the peg's outline within the
     hole's) within ``tolerance`` [m]; along the axis the shaft's part is swept (or met)
-    ``thinner`` [m] there (module docstring)."""
+    ``thinner`` [m] there (module docstring). ``seated``: the two faces' spans along the
+    axis overlap by more than the tolerance in the assembled pose (the shaft is in the
+    bore); else it is a **passage**, the faces meeting only on a way along the axis (a
+    pulley's bore passing a collar of its hub on its way off the hub's end)."""
 
     shaft: str
     bore: str
@@ -235,6 +240,7 @@ class Slide:
     hole: CylinderFace | PrismFace
     tolerance: float
     thinner: float
+    seated: bool
 
     @property
     def direction(self) -> np.ndarray:
@@ -246,25 +252,32 @@ def fit_faces(mesh: trimesh.Trimesh) -> list[CylinderFace | PrismFace]:
     return [*cylinder_faces(mesh), *prism_faces(mesh)]
 
 
+def _seated(a: CylinderFace | PrismFace, b: CylinderFace | PrismFace, tolerance: float) -> bool:
+    """Whether the spans of the parallel faces ``a`` and ``b`` along ``a``'s axis overlap
+    by more than ``tolerance`` [m]."""
+    low, high = (b.span if a.direction @ b.direction > 0 else (-b.span[1], -b.span[0]))
+    return min(a.span[1], high) - max(a.span[0], low) > tolerance
+
+
 def _prism_fit(a: PrismFace, b: PrismFace) -> Slide | None:
     """The fit of the outward prism ``a`` in the inward ``b`` (the parts' names filled in
     by the caller) when they share their axis, the outline of ``a`` shrunk by
-    :data:`TOUCH` lies in that of ``b``, the two outlines come within it of each other
-    (else there is room) and their spans overlap by more than it."""
+    :data:`TOUCH` lies in that of ``b`` and the two outlines come within it of each other
+    (else there is room); seated when their spans overlap by more than it."""
     if not np.array_equal(a.direction, b.direction):
         return None
     if (not shapely.covers(b.outline, a.outline.buffer(-TOUCH, join_style="mitre"))
-            or shapely.distance(a.outline.exterior, b.outline.exterior) > TOUCH
-            or min(a.span[1], b.span[1]) - max(a.span[0], b.span[0]) <= TOUCH):
+            or shapely.distance(a.outline.exterior, b.outline.exterior) > TOUCH):
         return None
-    return Slide("", "", a, b, TOUCH, 2 * TOUCH)
+    return Slide("", "", a, b, TOUCH, 2 * TOUCH, _seated(a, b, TOUCH))
 
 
 def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
     """Every pair of an outward face of one part and an inward face of another: cylinders
-    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance, whose
-    spans along the axis overlap by more than it; prisms along one of the cell's axes whose
-    outlines are one within :data:`TOUCH` (:func:`_prism_fit`)."""
+    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance; prisms
+    along one of the cell's axes whose outlines are one within :data:`TOUCH`
+    (:func:`_prism_fit`). Each slides along its axis wherever the two faces meet on the
+    way, in the assembled pose (``seated``) or only on it (a passage)."""
     found: list[Slide] = []
     for shaft, outer in faces.items():
         for bore, inner in faces.items():
@@ -282,11 +295,10 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> lis
                         continue
                     offset = b.point - a.point
                     apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
-                    low, high = (b.span if a.direction @ b.direction > 0 else (-b.span[1], -b.span[0]))
-                    if apart > tolerance or min(a.span[1], high) - max(a.span[0], low) <= tolerance:
+                    if apart > tolerance:
                         continue
                     thinner = max(0.0, a.radius - b.radius) + b.deflection + apart + TOUCH
-                    found.append(Slide(shaft, bore, a, b, tolerance, thinner))
+                    found.append(Slide(shaft, bore, a, b, tolerance, thinner, _seated(a, b, tolerance)))
     return found
 
 

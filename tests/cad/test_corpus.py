@@ -137,9 +137,7 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 POCKET = ("features: an empty hole whose section is a polygon is a pocket, not written as a hole (the liftarm's "
           "16-gon pin hole the axle passes with its tips on the vertices)")
-REFUSED = {"occt_pulley": ("removal: the import refuses the product, pulley_front never comes out (along +y its d 26 "
-                           "bore meets the hub's d 26 collar, a zero-clearance passage it reaches only on its way "
-                           "out, not touching it where it is: the tessellations overlap, a collision)")}
+REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
 """Every product the import takes."""
@@ -151,6 +149,11 @@ PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 
 PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on nothing else (2 mm all round, the "
                 "source's balls left out), but it touches nothing in the CAD and the locating rule counts the glands "
                 "and the impeller on it among what keeps it from moving sideways: bearing_ring->shaft is not written")
+PULLEY_PIN = ("features: the pin the pulley goes onto (the hub's boss) is not found: pins are looked for at the middle "
+              "of the part's extent along its axis only, where the pulley's slice (y -27.124 mm, through its rim, "
+              "behind the hub's disc) crosses nothing of the hub")
+PULLEY_CONVEX = ("simulated: no geometry.toml, the bolts' convex pieces (CoACD, a hexagonal head on a d 6 shank) "
+                 "overlap the pulley's web 0.121 mm at their zero-clearance fit in its d 6 holes (the mesh 0)")
 
 
 def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
@@ -172,6 +175,7 @@ EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the
     "occt_as1",
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
+    pytest.param("occt_pulley", marks=_xfail(PULLEY_PIN)),
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -194,7 +198,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears", "factory_rect_pegs",
-                                  "metaworld_assembly", "robosuite_nuts"])
+                                  "metaworld_assembly", "robosuite_nuts", "occt_pulley"])
 def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:
     # nominal_sizes.lp's margin is diametral: twice the room all round, within 2 um, on each
     # pair that fits of the features the import finds (a no-fit's negative measure is a
@@ -220,6 +224,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "occt_as1",
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
+    "occt_pulley",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
@@ -283,7 +288,7 @@ def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: 
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", IMPORTED)
+@pytest.mark.parametrize("name", _imported_but("occt_pulley", _xfail(PULLEY_CONVEX)))
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -310,6 +315,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into no hole found (the ring, gland_2, the impeller: "
                                            "in no feature) or onto a pin of a part that is not the base (gland_3)")),
+    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin that is not found (the pulley "
+                                             "onto the hub's boss); and no geometry.toml: " + PULLEY_CONVEX)),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual

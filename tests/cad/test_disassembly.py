@@ -4,7 +4,8 @@ along its axis, and passes the overlap check however coarse the tessellation; a
 precedence pair only where every way in is blocked (a bar that slides out sideways under
 a lid gets none, a washer on a pin under a cap nut gets exactly the forced ones); parts
 fixed to each other move as one; a part that never comes out is named with its blockers
-per direction."""
+per direction; a ring passes a collar of its bore's size on its way out; a bolt at zero
+clearance beside a boss of the base is found in its hole."""
 
 from __future__ import annotations
 
@@ -81,6 +82,58 @@ def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
     assert derived.axis == {"shaft": "+x", "bearing": "+x"}
     # Moved along y (not its axis) the shaft is blocked: the overlap counts there.
     assert derived.blockers[("shaft", "+y")] == {"bearing", "housing"}
+
+
+def _ring_past_a_collar(collar: float) -> list[CadPart]:
+    """A plate with a post standing on it (r 6 mm, a collar of radius ``collar`` [mm] from
+    z 8 to 11 mm, a 48-gon) and a ring on the post's foot (bore r 8 mm, a 40-gon, z 2 to
+    5 mm), clear of the collar where it sits."""
+    post = trimesh.boolean.union([trimesh.creation.cylinder(radius=6 * MM, height=20 * MM, sections=48),
+                                  trimesh.creation.cylinder(radius=collar * MM, height=3 * MM, sections=48)
+                                  .apply_translation((0, 0, -0.5 * MM))], engine="manifold")
+    post.apply_translation((0, 0, 12 * MM))
+    base = trimesh.boolean.union([_box((40, 40, 2), (0, 0, 1)), post], engine="manifold")
+    ring = trimesh.creation.annulus(r_min=8 * MM, r_max=14 * MM, height=3 * MM, sections=40)
+    ring.apply_translation((0, 0, 3.5 * MM))
+    return _parts(base=base, ring=ring)
+
+
+def test_a_ring_passes_a_collar_of_its_bore_size_on_its_way_out_but_not_a_larger_one() -> None:
+    # The collar's 48-gon pokes 25 µm into the ring's 40-gon bore on the way up: the
+    # tessellations of one nominal d 16, a passage that slides along the axis.
+    parts = _ring_past_a_collar(8.0)
+    check_parts(parts, "m")
+    derived = derive(parts, "base", {}, reach=0.0)
+    assert [(s.shaft, s.bore, s.seated) for s in derived.slides] == [("base", "ring", False)]
+    assert derived.free("ring") == ["+z"] and derived.axis == {"ring": "+z"}
+    assert any(line.startswith("zero-clearance passage base through ring") for line in derived.notes())
+    # A collar 0.2 mm larger in radius is no tessellation of the bore: the ring never comes out.
+    with pytest.raises(ExecutorError, match=r"part\(s\) ring never come out .* ring along \+z by base, -z by base"):
+        derive(_ring_past_a_collar(8.2), "base", {}, reach=0.0)
+
+
+def test_a_bolt_at_zero_clearance_beside_a_boss_of_the_base_is_in_its_hole() -> None:
+    # A 6 mm disc with a d 6 hole (a 24-gon) beside a 30 mm boss; a bolt (a 32-gon shank
+    # d 6 through the disc, a head above it, 14 mm in all): the middle of its depth among
+    # the base's vertices near it (z 7 mm, the boss's) is above the disc, and its polygon
+    # is larger than the hole's (the tessellations of one nominal d 6).
+    hole = trimesh.creation.cylinder(radius=3 * MM, height=20 * MM, sections=24)
+    hole.apply_translation((10 * MM, 0, 0))
+    boss = trimesh.creation.cylinder(radius=8 * MM, height=30 * MM, sections=48)
+    boss.apply_translation((-6 * MM, 0, 15 * MM))
+    base = trimesh.boolean.difference([trimesh.boolean.union([_box((40, 40, 6), (0, 0, 3)), boss],
+                                                             engine="manifold"), hole], engine="manifold")
+    shank = trimesh.creation.cylinder(radius=3 * MM, height=10 * MM, sections=32)
+    shank.apply_translation((10 * MM, 0, 5 * MM))
+    head = trimesh.creation.cylinder(radius=5 * MM, height=4 * MM, sections=32)
+    head.apply_translation((10 * MM, 0, 12 * MM))
+    parts = _parts(base=base, bolt=trimesh.boolean.union([shank, head], engine="manifold"))
+    check_parts(parts, "m")
+    derived = derive(parts, "base", {}, reach=0.0)
+    assert derived.axis == {"bolt": "+z"}
+    fit = derived.hole_of["bolt"]
+    assert fit.hole.kind == "round" and fit.hole.a == pytest.approx(6 * MM * math.cos(math.pi / 24), abs=1e-7)
+    assert fit.centre[:2] == pytest.approx((10 * MM, 0.0), abs=1e-6)
 
 
 def test_a_bar_that_slides_out_sideways_under_a_lid_gets_no_pair() -> None:
