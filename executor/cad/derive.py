@@ -27,7 +27,8 @@ along z). A part is in the hole whose loop holds its slice's centre. Measured: b
 cross-sections, their clearance, the hole's entry (the base's highest point around it
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
-loop that is no round, square or rect section is a pocket, reported but no hole.
+loop whose section is a polygon is a hole only when it receives a part (:func:`receives`:
+some part standing in a hole along its axis passes it), else a pocket, reported but no hole.
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
@@ -63,7 +64,7 @@ from executor.cad.locating import (
     support_pairs,
 )
 from executor.cad.parts import STEP_DEFLECTION, CadPart
-from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
+from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, passes, slice_loops
 from executor.cad.sweep import (
     DIRECTIONS,
     CylinderFace,
@@ -158,7 +159,7 @@ class Derived:
     reach: float = 0.0
     holes: dict[str, HoleFit] = field(default_factory=dict)
     pockets: list[HoleFit] = field(default_factory=list)
-    """Empty inner loops of the base that are no round, square or rect section: not holes."""
+    """Empty inner loops of the base whose polygon section no part passes (:func:`receives`): not holes."""
     pins: dict[str, PinFit] = field(default_factory=dict)
     bores: dict[str, Shape2D] = field(default_factory=dict)
     """Part -> the section of its bore around a pin (:func:`pins`)."""
@@ -265,7 +266,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis) if result.axis[pid] in DIRECTIONS],
                    result.axis)
-    result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
+    result.pockets = [fit for fit in found if fit.part is None and not receives(fit, found)]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.pins, result.bores = pins(result)
@@ -274,6 +275,18 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     result.queries = sweeper.queries
     return result
+
+
+def receives(fit: HoleFit, found: list[HoleFit]) -> bool:
+    """Whether the empty hole ``fit`` receives a part: its section is round, square or rect
+    (a drilled or milled hole), or some part standing in a hole of ``found`` along the same
+    axis passes its polygon (:func:`executor.cad.sections.passes`, as ``sizes.lp`` decides).
+    A polygon that no such part passes is a pocket: a relieved corner of a hole the base's
+    own pin fills, a slot beside it, a gap between two of its bodies."""
+    if fit.hole.kind != "polygon":
+        return True
+    return any(peg.section is not None and peg.axis == fit.axis and passes(peg.section, fit.hole)
+               for peg in found if peg.part is not None)
 
 
 def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:

@@ -70,10 +70,11 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.sections import Shape2D, zero_clearance
+from executor.cad.sections import Shape2D, section, zero_clearance
+from executor.cad.sections import rounded as _q
 from executor.cad.sweep import opposite
 from executor.world.frames import hole_rotation
-from executor.world.geometry import CellGeometry, Section, feature_passes, load_geometry, margin, thin_prism
+from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import ring_pieces
 
@@ -122,18 +123,6 @@ class Settings:
     base: str
     trays: dict[str, tuple[float, float]]
     names: dict[str, str]
-
-
-def section(name: str, shape: Shape2D) -> Section:
-    """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
-    outline = tuple((_q(x), _q(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
-    return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
-                   outline=outline, corner=shape.corner)
-
-
-def _q(value: float) -> float:
-    """Metres rounded to 0.1 µm (a printed tessellation is no finer), never -0.0."""
-    return round(value, 7) + 0.0
 
 
 def _section_lines(shape: Shape2D) -> list[str]:

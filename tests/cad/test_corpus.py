@@ -134,8 +134,6 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-POCKET = ("features: an empty hole whose section is a polygon is a pocket, not written as a hole (the liftarm's "
-          "16-gon pin hole the axle passes with its tips on the vertices)")
 IMPORTED = PRODUCTS
 """Every product (the import refuses none)."""
 
@@ -149,7 +147,7 @@ EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the
     "agh_prism_array",
     pytest.param("factory_gears", marks=_xfail(EMPTY_PIN)),
     "factory_rect_pegs",
-    pytest.param("ldraw_axles", marks=_xfail(POCKET)),
+    "ldraw_axles",
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
