@@ -49,10 +49,12 @@ learns which part goes onto which pin as it learns pegs in holes.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 import networkx as nx
 import numpy as np
+import shapely
 import trimesh
 
 from executor import ExecutorError
@@ -78,6 +80,7 @@ from executor.cad.sweep import (
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
+_ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, at most."""
 
@@ -452,16 +455,17 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     pin: a head in a cover's socket). A bore around no such outline is no fit; nor is one
     around a peg standing in a hole of the base that goes in along the part's own axis
     (that part is a cover, :mod:`executor.cad.covers`)."""
-    found: list[tuple[str, str, Shape2D, np.ndarray, str]] = []  # owner, axis, pin, centre, part
+    found: list[tuple[str, str, Shape2D, np.ndarray, str | None]] = []  # owner, axis, pin, centre, part
     order = nx.DiGraph(list(derived.edges))
     bores: dict[str, Shape2D] = {}
+    levels: dict[str, float] = {}
     for pid in sorted(derived.axis):
         if pid in derived.hole_of:
             continue
         name = derived.axis[pid]
         axis = np.array(derived.directions[name])
         along = derived.parts[pid].mesh.vertices @ axis
-        level = float(along.min() + along.max()) / 2
+        level = levels[pid] = float(along.min() + along.max()) / 2
         own = slice_loops(derived.parts[pid].mesh, axis, level)
         frame = frame_of(axis)
         for bore in (loop for loop in own if not _outer(loop, own)):
@@ -478,15 +482,17 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
                     break
             if pid in bores:
                 break
+    found += [(derived.base, derived.axis[pid], pin, centre, None) for pid in sorted(bores)
+              for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str]]] = []
-    for owner, name, pin, centre, pid in found:
+    for owner, name, pin, centre, on in found:
         axis = np.array(derived.directions[name])
         same = next((m for m in merged if m[0] == owner and m[1] == name and np.linalg.norm(
             (m[3] - centre) - axis * np.dot(m[3] - centre, axis)) < _SAME_HOLE), None)
         if same is None:
-            merged.append((owner, name, pin, centre, [pid]))
-        else:
-            same[4].append(pid)
+            merged.append((owner, name, pin, centre, [] if on is None else [on]))
+        elif on is not None:
+            same[4].append(on)
     merged.sort(key=lambda m: (m[0], round(float(m[3][0]), 6), round(float(m[3][1]), 6), round(float(m[3][2]), 6)))
     counts: dict[str, int] = {}
     result: dict[str, PinFit] = {}
@@ -496,6 +502,35 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
         result[pin_id] = PinFit(pin_id, owner, name, pin, (float(centre[0]), float(centre[1]), float(centre[2])),
                                 tuple(parts))
     return result, bores
+
+
+def _standing_pins(derived: Derived, name: str, level: float,
+                   bores: Iterable[Shape2D]) -> list[tuple[Shape2D, np.ndarray]]:
+    """The pins of the base that stand out along ``name`` through ``level`` [m] and that
+    some of ``bores`` passes over, each with its centre [m] on that level: the outlines
+    of the base's slice there with no outline inside them (a pin, solid or hollow) and
+    nothing of the base beyond the level within their circumscribed circle but the pin
+    itself (its free end: a part comes down onto it), whose section passes a bore
+    (:func:`executor.cad.sections.passes`, as ``sizes.lp`` decides)."""
+    axis = np.array(derived.directions[name])
+    frame = frame_of(axis)
+    vertices = derived.parts[derived.base].mesh.vertices
+    beyond = vertices[vertices @ axis > level] @ frame.T
+    loops = slice_loops(derived.parts[derived.base].mesh, axis, level)
+    standing = []
+    for loop in loops:
+        if not _outer(loop, loops) or any(o is not loop and _outer(o, loops) and loop.contains(o.centre)
+                                          for o in loops):
+            continue
+        reach = float(np.linalg.norm(loop.points - loop.centre, axis=1).max()) + _SAME_HOLE
+        over = beyond[np.linalg.norm(beyond - loop.centre, axis=1) <= reach]
+        outline = shapely.Polygon(loop.points).buffer(_ON_PIN)
+        if not shapely.contains_xy(outline, over[:, 0], over[:, 1]).all():
+            continue
+        pin = classify(loop, hole=False)
+        if any(passes(pin, bore) for bore in bores):
+            standing.append((pin, frame.T @ pin.centre + axis * level))
+    return standing
 
 
 def part_holes(derived: Derived) -> dict[str, HoleFit]:

@@ -165,7 +165,8 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(x)}, {_q(y)}]", ""]
     for pin_id, pin in derived.pins.items():
-        lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner} ({" ".join(pin.parts)} onto it)"',
+        onto = f" ({' '.join(pin.parts)} onto it)" if pin.parts else ""
+        lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner}{onto}"',
                   f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]", ""]
     return "\n".join(lines)
 
@@ -394,7 +395,8 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
             by_hand[fit.part] = _polygon_refused(fit, derived)
         else:
             kept[hid] = fit
-    pins = {pin_id: pin for pin_id, pin in derived.pins.items() if pin.owner == derived.base and pin.axis == "+z"}
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items()
+            if pin.owner == derived.base and pin.axis == "+z" and pin.parts}  # an empty pin: no goal on it
     return replace(derived, holes=kept, pins=pins,
                    bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
 

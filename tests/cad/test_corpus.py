@@ -138,14 +138,11 @@ IMPORTED = PRODUCTS
 """Every product (the import refuses none)."""
 
 
-EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the large gear's shaft; Factory's "
-             "large gear is absent from the repository) is no feature, pins are found only under a part")
-
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
-    pytest.param("factory_gears", marks=_xfail(EMPTY_PIN)),
+    "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
     "metaworld_assembly",
