@@ -44,7 +44,9 @@ nut onto a bolt's end under the plate; one going in along the peg's, over it, is
 cover). The pin is a
 feature of its owner (``<owner>_pin1``, ``_pin2``, ... by position), its section measured
 on the owner's slice; the fit is the pin's section inside the bore's, so the planner
-learns which part goes onto which pin as it learns pegs in holes.
+learns which part goes onto which pin as it learns pegs in holes. At those levels and
+along those axes, a pin of the base no part is on is found too when it stands out with
+its free end along the axis and some bore passes over it (:func:`_standing_pins`).
 """
 
 from __future__ import annotations
