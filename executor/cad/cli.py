@@ -216,8 +216,8 @@ def report(derived: Derived) -> list[str]:
                      f" mm; {'; '.join(onto) or 'empty'}")
     for pocket in derived.pockets:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
-                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon no part "
-                     "standing in a hole along its axis passes, no hole")
+                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon with no "
+                     "rotational symmetry about its centre, no hole")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     for pid, by_direction in sorted(derived.located.items()):
         lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(

@@ -27,8 +27,8 @@ along z). A part is in the hole whose loop holds its slice's centre. Measured: b
 cross-sections, their clearance, the hole's entry (the base's highest point around it
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
-loop whose section is a polygon is a hole only when it receives a part (:func:`receives`:
-some part standing in a hole along its axis passes it), else a pocket, reported but no hole.
+loop whose section is a polygon is a hole only when it has rotational symmetry about its
+centre (:func:`receives`), else a pocket, reported but no hole.
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
@@ -79,6 +79,7 @@ from executor.cad.sweep import (
     fit_faces,
     zero_clearance_fits,
 )
+from executor.world.polygon_fit import OutlineError, polygon, symmetry
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
@@ -164,7 +165,7 @@ class Derived:
     reach: float = 0.0
     holes: dict[str, HoleFit] = field(default_factory=dict)
     pockets: list[HoleFit] = field(default_factory=list)
-    """Empty inner loops of the base whose polygon section no part passes (:func:`receives`): not holes."""
+    """Empty inner loops of the base whose polygon section has no rotational symmetry (:func:`receives`)."""
     pins: dict[str, PinFit] = field(default_factory=dict)
     bores: dict[str, Shape2D] = field(default_factory=dict)
     """Part -> the section of its bore around a pin (:func:`pins`)."""
@@ -271,7 +272,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis) if result.axis[pid] in DIRECTIONS],
                    result.axis)
-    result.pockets = [fit for fit in found if fit.part is None and not receives(fit, found)]
+    result.pockets = [fit for fit in found if fit.part is None and not receives(fit)]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.pins, result.bores = pins(result)
@@ -282,16 +283,19 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     return result
 
 
-def receives(fit: HoleFit, found: list[HoleFit]) -> bool:
-    """Whether the empty hole ``fit`` receives a part: its section is round, square or rect
-    (a drilled or milled hole), or some part standing in a hole of ``found`` along the same
-    axis passes its polygon (:func:`executor.cad.sections.passes`, as ``sizes.lp`` decides).
-    A polygon that no such part passes is a pocket: a relieved corner of a hole the base's
-    own pin fills, a slot beside it, a gap between two of its bodies."""
+def receives(fit: HoleFit) -> bool:
+    """Whether the empty hole ``fit`` is one a part goes into along its axis: its section is
+    round, square or rect, or a simple polygon that turns onto itself about its centre by
+    a fraction of a turn (:func:`executor.world.polygon_fit.symmetry` of order 2 or more:
+    a hexagon, a spline, a cross, a 16-gon). A polygon with no such axis is a pocket: the
+    open corner beside a turned boss, a relieved corner or a slot left around a pin of the
+    base's own in its hole, the gap between two of its bodies."""
     if fit.hole.kind != "polygon":
         return True
-    return any(peg.section is not None and peg.axis == fit.axis and passes(peg.section, fit.hole)
-               for peg in found if peg.part is not None)
+    try:
+        return symmetry(polygon(fit.hole.outline, "hole")) >= 2
+    except OutlineError:  # no simple polygon: a gap of no area between faces that touch
+        return False
 
 
 def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:
