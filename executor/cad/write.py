@@ -4,9 +4,9 @@
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position,
   every hole of a moving part a part passes (``<owner>_hole1``, ...
-  :func:`executor.cad.derive.part_holes`), and every pin a part goes onto (``<owner>_pin1``,
-  ... :func:`executor.cad.derive.pins`) as a hole at the pin's position with the pin's
-  section kind;
+  :func:`executor.cad.derive.part_holes`), and every pin a part goes onto or no part is on
+  (``<owner>_pin1``, ... :func:`executor.cad.derive.pins`) as a hole at the pin's
+  position with the pin's section kind;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
