@@ -213,11 +213,11 @@ def report(derived: Derived) -> list[str]:
                         f"{_clearance(pin.section, bore, pin_id, pid)})")
         lines.append(f"pin {pin_id} of {pin.owner} at ({_mm(pin.position[0])}, {_mm(pin.position[1])}) mm, "
                      f"entered along {opposite(pin.axis)}: {_describe(pin.section.kind, pin.section.a, pin.section.b)}"
-                     f" mm; {'; '.join(onto)}")
+                     f" mm; {'; '.join(onto) or 'empty'}")
     for pocket in derived.pockets:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
-                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: no round, "
-                     "square or rect section, no hole")
+                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon with no "
+                     "rotational symmetry about its centre, no hole")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     for pid, by_direction in sorted(derived.located.items()):
         lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(

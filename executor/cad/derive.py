@@ -27,7 +27,8 @@ along z). A part is in the hole whose loop holds its slice's centre. Measured: b
 cross-sections, their clearance, the hole's entry (the base's highest point around it
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
-loop that is no round, square or rect section is a pocket, reported but no hole.
+loop whose section is a polygon is a hole only when it has rotational symmetry about its
+centre (:func:`receives`), else a pocket, reported but no hole.
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
@@ -43,11 +44,14 @@ nut onto a bolt's end under the plate; one going in along the peg's, over it, is
 cover). The pin is a
 feature of its owner (``<owner>_pin1``, ``_pin2``, ... by position), its section measured
 on the owner's slice; the fit is the pin's section inside the bore's, so the planner
-learns which part goes onto which pin as it learns pegs in holes.
+learns which part goes onto which pin as it learns pegs in holes. At those levels and
+along those axes, a pin of the base no part is on is found too when it stands out with
+its free end along the axis and some bore passes over it (:func:`_standing_pins`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 import networkx as nx
@@ -64,7 +68,7 @@ from executor.cad.locating import (
     support_pairs,
 )
 from executor.cad.parts import STEP_DEFLECTION, CadPart
-from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, slice_loops
+from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, passes, slice_loops
 from executor.cad.sweep import (
     DIRECTIONS,
     TOUCH,
@@ -76,9 +80,11 @@ from executor.cad.sweep import (
     fit_faces,
     zero_clearance_fits,
 )
+from executor.world.polygon_fit import OutlineError, polygon, symmetry
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
+_ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, at most."""
 
@@ -160,7 +166,7 @@ class Derived:
     reach: float = 0.0
     holes: dict[str, HoleFit] = field(default_factory=dict)
     pockets: list[HoleFit] = field(default_factory=list)
-    """Empty inner loops of the base that are no round, square or rect section: not holes."""
+    """Empty inner loops of the base whose polygon section has no rotational symmetry (:func:`receives`)."""
     pins: dict[str, PinFit] = field(default_factory=dict)
     bores: dict[str, Shape2D] = field(default_factory=dict)
     """Part -> the section of its bore around a pin (:func:`pins`)."""
@@ -270,7 +276,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis) if result.axis[pid] in DIRECTIONS],
                    result.axis)
-    result.pockets = [fit for fit in found if fit.part is None and fit.hole.kind == "polygon"]
+    result.pockets = [fit for fit in found if fit.part is None and not receives(fit)]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
     result.pins, result.bores = pins(result)
@@ -279,6 +285,21 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     result.queries = sweeper.queries
     return result
+
+
+def receives(fit: HoleFit) -> bool:
+    """Whether the empty hole ``fit`` is one a part goes into along its axis: its section is
+    round, square or rect, or a simple polygon that turns onto itself about its centre by
+    a fraction of a turn (:func:`executor.world.polygon_fit.symmetry` of order 2 or more:
+    a hexagon, a spline, a cross, a 16-gon). A polygon with no such axis is a pocket: the
+    open corner beside a turned boss, a relieved corner or a slot left around a pin of the
+    base's own in its hole, the gap between two of its bodies."""
+    if fit.hole.kind != "polygon":
+        return True
+    try:
+        return symmetry(polygon(fit.hole.outline, "hole")) >= 2
+    except OutlineError:  # no simple polygon: a gap of no area between faces that touch
+        return False
 
 
 def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:
@@ -454,16 +475,17 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     pin: a head in a cover's socket). A bore around no such outline is no fit; nor is one
     around a peg standing in a hole of the base that goes in along the part's own axis
     (that part is a cover, :mod:`executor.cad.covers`)."""
-    found: list[tuple[str, str, Shape2D, np.ndarray, str]] = []  # owner, axis, pin, centre, part
+    found: list[tuple[str, str, Shape2D, np.ndarray, str | None]] = []  # owner, axis, pin, centre, part
     order = nx.DiGraph(list(derived.edges))
     bores: dict[str, Shape2D] = {}
+    levels: dict[str, float] = {}
     for pid in sorted(derived.axis):
         if pid in derived.hole_of:
             continue
         name = derived.axis[pid]
         axis = np.array(derived.directions[name])
         along = derived.parts[pid].mesh.vertices @ axis
-        level = float(along.min() + along.max()) / 2
+        level = levels[pid] = float(along.min() + along.max()) / 2
         own = slice_loops(derived.parts[pid].mesh, axis, level)
         frame = frame_of(axis)
         for bore in (loop for loop in own if not _outer(loop, own)):
@@ -480,15 +502,17 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
                     break
             if pid in bores:
                 break
+    found += [(derived.base, derived.axis[pid], pin, centre, None) for pid in sorted(bores)
+              for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str]]] = []
-    for owner, name, pin, centre, pid in found:
+    for owner, name, pin, centre, on in found:
         axis = np.array(derived.directions[name])
         same = next((m for m in merged if m[0] == owner and m[1] == name and np.linalg.norm(
             (m[3] - centre) - axis * np.dot(m[3] - centre, axis)) < _SAME_HOLE), None)
         if same is None:
-            merged.append((owner, name, pin, centre, [pid]))
-        else:
-            same[4].append(pid)
+            merged.append((owner, name, pin, centre, [] if on is None else [on]))
+        elif on is not None:
+            same[4].append(on)
     merged.sort(key=lambda m: (m[0], round(float(m[3][0]), 6), round(float(m[3][1]), 6), round(float(m[3][2]), 6)))
     counts: dict[str, int] = {}
     result: dict[str, PinFit] = {}
@@ -498,6 +522,35 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
         result[pin_id] = PinFit(pin_id, owner, name, pin, (float(centre[0]), float(centre[1]), float(centre[2])),
                                 tuple(parts))
     return result, bores
+
+
+def _standing_pins(derived: Derived, name: str, level: float,
+                   bores: Iterable[Shape2D]) -> list[tuple[Shape2D, np.ndarray]]:
+    """The pins of the base that stand out along ``name`` through ``level`` [m] and that
+    some of ``bores`` passes over, each with its centre [m] on that level: the outlines
+    of the base's slice there with no outline inside them (a pin, solid or hollow) and
+    nothing of the base beyond the level within their circumscribed circle but the pin
+    itself (its free end: a part comes down onto it), whose section passes a bore
+    (:func:`executor.cad.sections.passes`, as ``sizes.lp`` decides)."""
+    axis = np.array(derived.directions[name])
+    frame = frame_of(axis)
+    vertices = derived.parts[derived.base].mesh.vertices
+    beyond = vertices[vertices @ axis > level] @ frame.T
+    loops = slice_loops(derived.parts[derived.base].mesh, axis, level)
+    standing = []
+    for loop in loops:
+        if not _outer(loop, loops) or any(o is not loop and _outer(o, loops) and loop.contains(o.centre)
+                                          for o in loops):
+            continue
+        reach = float(np.linalg.norm(loop.points - loop.centre, axis=1).max()) + _SAME_HOLE
+        over = beyond[np.linalg.norm(beyond - loop.centre, axis=1) <= reach]
+        outline = shapely.Polygon(loop.points).buffer(_ON_PIN)
+        if not shapely.contains_xy(outline, over[:, 0], over[:, 1]).all():
+            continue
+        pin = classify(loop, hole=False)
+        if any(passes(pin, bore) for bore in bores):
+            standing.append((pin, frame.T @ pin.centre + axis * level))
+    return standing
 
 
 def part_holes(derived: Derived) -> dict[str, HoleFit]:

@@ -49,6 +49,8 @@ from trimesh.path.traversal import discretize_path
 
 from executor.cad.parts import Cylinder
 from executor.cad.sweep import TOUCH
+from executor.world.geometry import Section, margin
+from executor.world.polygon_fit import OutlineError
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
@@ -280,3 +282,26 @@ def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
         return None
     apart = hole.a / 2 + hole.deflection - peg.a / 2
     return apart if abs(apart) < TOUCH else None
+
+
+def rounded(value: float) -> float:
+    """Metres rounded to 0.1 µm (a printed tessellation is no finer), never -0.0."""
+    return round(value, 7) + 0.0
+
+
+def section(name: str, shape: Shape2D) -> Section:
+    """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
+    outline = tuple((rounded(x), rounded(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
+    return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
+                   outline=outline, corner=shape.corner)
+
+
+def passes(peg: Shape2D, hole: Shape2D) -> bool:
+    """Whether ``peg`` passes ``hole`` as ``sizes.lp`` writes it: a positive room
+    (:func:`executor.world.geometry.margin`) or a nominal zero-clearance fit
+    (:func:`zero_clearance`); False when either outline is no simple polygon."""
+    try:
+        room = margin(section("peg", peg), section("hole", hole))
+    except OutlineError:
+        return False
+    return room > 0 or zero_clearance(peg, hole, room) is not None

@@ -4,9 +4,9 @@
   ``peg`` and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray ``start``,
   every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and position,
   every hole of a moving part a part passes (``<owner>_hole1``, ...
-  :func:`executor.cad.derive.part_holes`), and every pin a part goes onto (``<owner>_pin1``,
-  ... :func:`executor.cad.derive.pins`) as a hole at the pin's position with the pin's
-  section kind;
+  :func:`executor.cad.derive.part_holes`), and every pin a part goes onto or no part is on
+  (``<owner>_pin1``, ... :func:`executor.cad.derive.pins`) as a hole at the pin's
+  position with the pin's section kind;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
@@ -70,10 +70,11 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.sections import Shape2D, zero_clearance
+from executor.cad.sections import Shape2D, section, zero_clearance
+from executor.cad.sections import rounded as _q
 from executor.cad.sweep import opposite
 from executor.world.frames import hole_rotation
-from executor.world.geometry import CellGeometry, Section, feature_passes, load_geometry, margin, thin_prism
+from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import ring_pieces
 
@@ -124,18 +125,6 @@ class Settings:
     names: dict[str, str]
 
 
-def section(name: str, shape: Shape2D) -> Section:
-    """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
-    outline = tuple((_q(x), _q(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
-    return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
-                   outline=outline, corner=shape.corner)
-
-
-def _q(value: float) -> float:
-    """Metres rounded to 0.1 µm (a printed tessellation is no finer), never -0.0."""
-    return round(value, 7) + 0.0
-
-
 def _section_lines(shape: Shape2D) -> list[str]:
     """``kind``, ``size`` and a rounded square's or rect's ``corner`` radius of a section
     table; a polygon's ``size`` the extents of its ``outline`` along x and y, which follows
@@ -176,7 +165,8 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(x)}, {_q(y)}]", ""]
     for pin_id, pin in derived.pins.items():
-        lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner} ({" ".join(pin.parts)} onto it)"',
+        onto = f" ({' '.join(pin.parts)} onto it)" if pin.parts else ""
+        lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner}{onto}"',
                   f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]", ""]
     return "\n".join(lines)
 
@@ -405,7 +395,8 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
             by_hand[fit.part] = _polygon_refused(fit, derived)
         else:
             kept[hid] = fit
-    pins = {pin_id: pin for pin_id, pin in derived.pins.items() if pin.owner == derived.base and pin.axis == "+z"}
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items()
+            if pin.owner == derived.base and pin.axis == "+z" and pin.parts}  # an empty pin: no goal on it
     return replace(derived, holes=kept, pins=pins,
                    bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
 

@@ -135,8 +135,6 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-POCKET = ("features: an empty hole whose section is a polygon is a pocket, not written as a hole (the liftarm's "
-          "16-gon pin hole the axle passes with its tips on the vertices)")
 REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
@@ -161,16 +159,13 @@ def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
     return [pytest.param(p, marks=mark) if p == name else p for p in IMPORTED]
 
 
-EMPTY_PIN = ("fits of any part on any part: a pin of the base no part is on (the large gear's shaft; Factory's "
-             "large gear is absent from the repository) is no feature, pins are found only under a part")
-
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
-    pytest.param("factory_gears", marks=_xfail(EMPTY_PIN)),
+    "factory_gears",
     "factory_rect_pegs",
-    pytest.param("ldraw_axles", marks=_xfail(POCKET)),
+    "ldraw_axles",
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",

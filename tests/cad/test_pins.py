@@ -59,14 +59,16 @@ def _atoms(path: Path, name: str) -> set[tuple[str, ...]]:
         return {tuple(str(a) for a in s.arguments) for s in model.symbols(atoms=True) if s.name == name}
 
 
-def _import(tmp_path: Path, parts: dict[str, trimesh.Trimesh] | None = None) -> Path:
-    """The plate with a round pin of 10 mm (at x - 25 mm) and one of 8 mm (at x + 25 mm) and
-    ``parts`` (id -> mesh [mm]; default a washer with a 10.5 mm bore on the first and a
-    12-tooth gear with an 8.6 mm bore on the second), imported; the folder written."""
+def _import(tmp_path: Path, parts: dict[str, trimesh.Trimesh] | None = None,
+            more: tuple[trimesh.Trimesh, ...] = ()) -> Path:
+    """The plate with a round pin of 10 mm (at x - 25 mm) and one of 8 mm (at x + 25 mm),
+    joined with ``more`` [mm], and ``parts`` (id -> mesh [mm]; default a washer with a
+    10.5 mm bore on the first and a 12-tooth gear with an 8.6 mm bore on the second),
+    imported; the folder written."""
     cad = tmp_path / "cad"
     cad.mkdir()
-    plate = trimesh.boolean.union([_box((100, 60, 10), (X_MM, 0, 5)), _pin(5.0, X_MM - 25), _pin(4.0, X_MM + 25)],
-                                  engine="manifold")
+    plate = trimesh.boolean.union([_box((100, 60, 10), (X_MM, 0, 5)), _pin(5.0, X_MM - 25), _pin(4.0, X_MM + 25),
+                                   *more], engine="manifold")
     plate.export(cad / "plate.stl")
     if parts is None:
         parts = {"washer": _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM - 25),
@@ -109,6 +111,21 @@ def test_a_washer_and_a_gear_go_onto_the_pins_of_a_plate(washer_and_gear: Path) 
     assert {pid: entry["reason"] for pid, entry in geometry["manual"].items()} == {  # its 2 mm teeth are too thin
         "gear": "goes onto a pin (plate_pin2), but part 'gear': the convex pieces of its section thick enough for the "
                 "cell differ from its mesh by 13.7% of its volume"}
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_an_empty_pin_of_the_base_is_a_feature_when_a_bore_passes_over_it(tmp_path: Path) -> None:
+    # The washer (10.5 mm bore) is on the 10 mm pin; the 8 mm pin stands empty, and so do a
+    # 12 mm pin and a wall that the bore does not pass over: of these, the 8 mm pin only is
+    # a pin (the washer fits it), the others receive no part of the product.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM - 25)
+    out = _import(tmp_path, {"washer": washer}, (_pin(6.0, X_MM), _box((60, 4, 20), (X_MM, 22, 20))))
+    holes = tomllib.loads((out / "assembly.toml").read_text())["holes"]
+    assert {hid: (hole["name"], round(1000 * hole["position"][0])) for hid, hole in holes.items()} == {
+        "plate_pin1": ("pin of plate (washer onto it)", X_MM - 25), "plate_pin2": ("pin of plate", X_MM + 25)}
+    assert _atoms(out / "sizes.lp", "fits") == {("washer", "plate_pin1"), ("washer", "plate_pin2")}
+    # the cell has no goal on a pin no part of the CAD is on: the session takes its pairs from sizes.lp
+    assert set(tomllib.loads((out / "geometry.toml").read_text())["hole_shapes"]) == {"plate_pin1"}
 
 
 @pytest.mark.slow
