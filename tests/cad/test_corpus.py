@@ -376,7 +376,7 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
     session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--json", timeout=300)
     assert session.stdout, session.stderr
     result = json.loads(session.stdout)
-    holes = _feature_holes(done)  # the liftarm's empty 16-gon pin hole is a pocket (POCKET): not compared
+    holes = _feature_holes(done)
     truth = {(row["part"], holes[row["feature"]]) for row in done.truth["fits"] if row["feature"] in holes
              and row["fits"]}
     assert {tuple(pair) for pair in result["fits"]} == truth
