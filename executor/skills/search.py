@@ -53,7 +53,8 @@ class SearchParams:
     pitch_jitter: float = 0.05
     speed: float = 0.045
     max_radius: float = 0.0046
-    max_time: float = 2.2
+    passes: int = 2
+    max_time: float = 4.4
 
 
 @dataclass
@@ -134,12 +135,16 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
     direction = rng.choice([-1.0, 1.0])
     pitch = p.pitch * (1 + rng.uniform(-p.pitch_jitter, p.pitch_jitter))
     theta, elapsed, paused, may_pause = 0.0, 0.0, 0, True
+    inward = False  # the second pass: back in to the estimate, half a pitch inside the first
     sink_from = touched_z  # [m] the height a sink is measured from: below a rest on a rim, in its dip
     comply = Admittance(AdmittanceParams())
     offset = np.zeros(2)
     while elapsed < p.max_time:
-        radius = pitch * theta / (2 * math.pi)
-        if radius > p.max_radius:
+        radius = pitch * theta / (2 * math.pi) - (pitch / 2 if inward else 0.0)
+        if radius > p.max_radius and p.passes > 1:
+            inward = True
+            radius -= pitch / 2
+        if radius > p.max_radius or radius < 0:
             break
         dipped = s.tip_pos[2] < touched_z - p.dip_depth
         if not dipped:
@@ -152,7 +157,7 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
             paused = 0
             comply.reset()
             shift = _NO_SHIFT
-            theta += p.speed * TIME_STEP / max(radius, pitch / 2)
+            theta += (-1 if inward else 1) * p.speed * TIME_STEP / max(radius, pitch / 2)
             angle = angle0 + direction * theta
             offset = radius * np.array([math.cos(angle), math.sin(angle)])
         xy = est_xy + offset + shift
