@@ -10,6 +10,7 @@ attempts (a wrong no_fit); the search goes on instead and finds the hole."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -23,19 +24,42 @@ from executor.trial import Cell, trial_rng
 PRISMS = Path(__file__).parents[1] / "cad" / "corpus" / "agh_prism_array"
 
 
-@pytest.mark.slow  # imports the product, teaches one shape and runs one attempt (about 15 s)
-def test_a_part_resting_on_a_sharp_rim_is_no_find(tmp_path: Path) -> None:
-    out = tmp_path / "prisms"
+@pytest.fixture(scope="module")
+def prisms(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Path, Cell]]:
+    """The imported product and a cell on it."""
+    out = tmp_path_factory.mktemp("sharp_rim") / "prisms"
     run_import(PRISMS / "meshes", out, "mm", PRISMS / "import.toml")
     cell = Cell(str(out))
     try:
-        save_skill(out, teach_shape(cell, "peg6"))
-        setup = cell.draw_setup(trial_rng(11, "peg6", "h2"), "peg6", "h2")
-        first = cell.run_attempt("peg6", "h2", setup)
-        assert first.hole_found and first.outcome == "fit", first
-        assert first.max_force_dev < cell.thresholds.f_stop  # never pressed on the top face
+        yield out, cell
     finally:
         cell.close()
+
+
+@pytest.mark.slow  # imports the product, teaches one shape and runs one attempt (about 15 s)
+def test_a_part_resting_on_a_sharp_rim_is_no_find(prisms: tuple[Path, Cell]) -> None:
+    out, cell = prisms
+    save_skill(out, teach_shape(cell, "peg6"))
+    setup = cell.draw_setup(trial_rng(11, "peg6", "h2"), "peg6", "h2")
+    first = cell.run_attempt("peg6", "h2", setup)
+    assert first.hole_found and first.outcome == "fit", first
+    assert first.max_force_dev < cell.thresholds.f_stop  # never pressed on the top face
+
+
+@pytest.mark.slow  # teaches one shape and runs one trial (about 15 s)
+def test_a_tight_part_the_outward_spiral_missed_fits_after_the_way_back(prisms: tuple[Path, Cell]) -> None:
+    """Seed 11 of `executor trial --part peg12 --hole h2` (0.167 mm of room per side, no
+    chamfer): the outward spiral of either attempt passes no closer than 1.0 and 0.65 mm
+    to the hole's centre (the estimate 2.8 and 3.5 mm off it) and the part never sinks;
+    with that spiral alone both attempts ended ``no_fit``, pressed on the top face at the
+    estimate until eq. (6) fired.  The second pass, back in half a pitch inside the first,
+    ends with the part dipped 0.6 mm into the hole's mouth 0.5 mm off its centre, and the
+    first attempt fits."""
+    out, cell = prisms
+    save_skill(out, teach_shape(cell, "peg12"))
+    result = cell.run_trial("peg12", "h2", seed=11)
+    assert result.outcome == "fit", result
+    assert result.evidence[-1].end_error < cell.thresholds.goal_tolerance
 
 
 @pytest.mark.parametrize(("tip", "touched", "held"), [
