@@ -154,6 +154,7 @@ class HandGuiding:
                                      rec.quats[first:last + 1])
         force = np.linalg.norm(rec.wrenches[first:last + 1, :3], axis=1).max()
         self.prompt(f"recorded {times[-1]:.2f} s, {1000 * (pos[0, 2] - pos[-1, 2]):.1f} mm down, the largest force "
-                    f"{force:.1f} N (the hand's and the contact's); let go of the part: the arm replays it in {LET_GO:g} s")
+                    f"{force:.1f} N (the hand's and the contact's); let go of the part: the arm replays it in "
+                    f"{LET_GO:g} s")
         time.sleep(LET_GO)
         return Demonstration(times, turn_z(pos - origin, -yaw), turn_quats_z(quats, -yaw), pos[0])

@@ -7,6 +7,7 @@ from __future__ import annotations
 from argparse import ArgumentParser
 from collections.abc import Callable
 
+import msgspec
 import pytest
 
 from asp import PlannerError
@@ -59,3 +60,34 @@ def test_a_cell_option_with_the_truth_backend_is_refused_naming_both(parser: Cal
                                                                       option: list[str], named: str) -> None:
     with pytest.raises(PlannerError, match=f"^{named} has no effect with --backend truth"):
         _checked(parser(), ["--backend", "truth", *option])
+
+
+def test_a_franka_cell_gets_the_backend_options_and_its_layer() -> None:
+    from asp.assemble.cli import assembling_cell_of
+    from asp.assemble.settings import check_assembling_backend
+    from bridge.assembly import load_assembly
+
+    settings = assembly_settings(build_parser().parse_args(["--backend", "franka", "--backend-option", "host=10.0.0.2",
+                                                            "--backend-option", "dynamics=0.1", "--layer", "position"]))
+    check_assembling_backend(settings)
+    served = assembling_cell_of(settings, load_assembly("spare"), assembling_cell_settings(settings.cell, "franka"))
+    argv = CellProcess.command(msgspec.structs.replace(served, cell_id="a1"))
+    cell = serve_settings_of(serve_parser().parse_args(argv[argv.index("serve") + 1:]))
+    assert (cell.backend, cell.backend_options, cell.cell.layer) == ("franka", {"host": "10.0.0.2", "dynamics": "0.1"},
+                                                                      "position")
+
+
+@pytest.mark.parametrize(("argv", "named"), [
+    (["--backend-option", "host=10.0.0.2"], "--backend-option host: only --backend franka"),
+    (["--backend", "truth", "--backend-option", "host=10.0.0.2"], "--backend-option host: only --backend franka"),
+    (["--backend", "franka", "--block-hole", "r1"], "--block-hole has no effect with --backend franka"),
+    (["--backend", "franka", "--save", "x.rrd"], "--save has no effect with --backend franka"),
+    (["--backend", "franka", "--uncertainty", "cell"], "--uncertainty cell has no effect with --backend franka"),
+    (["--backend", "franka", "--cell-seed", "2"], "--cell-seed has no effect with --backend franka")])
+def test_an_option_without_effect_on_the_chosen_backend_is_refused(argv: list[str], named: str) -> None:
+    from asp.assemble.settings import check_assembling_backend
+
+    settings = assembly_settings(build_parser().parse_args(argv))
+    with pytest.raises(PlannerError, match=f"^{named}"):
+        check_assembling_backend(settings)
+        assembling_cell_settings(settings.cell, settings.backend)
