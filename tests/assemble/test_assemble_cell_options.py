@@ -1,6 +1,7 @@
 """``assemble --uncertainty cell``: the cell's options reach the assembling cell's settings
 document (no physics), and are refused where they would have no effect: without
-``--uncertainty cell``, or with ``--backend truth``."""
+``--uncertainty cell``, or with ``--backend truth``; ``--backend franka``'s options and
+layer reach its cell, and what only a simulated cell uses is refused with it."""
 
 from __future__ import annotations
 
@@ -11,10 +12,11 @@ import msgspec
 import pytest
 
 from asp import PlannerError
-from asp.assemble.cli import assembly_settings, build_parser
-from asp.assemble.settings import assembling_cell_settings
+from asp.assemble.cli import assembling_cell_of, assembly_settings, build_parser
+from asp.assemble.settings import assembling_cell_settings, check_assembling_backend
 from asp.bench.assemble_plans import build_parser as bench_parser
 from asp.session.cells import CellProcess
+from bridge.assembly import load_assembly
 from bridge.cell_settings import DEFAULT_CELL, ServeSettings, cell_settings_of
 from executor.serve import build_parser as serve_parser
 from executor.serve import serve_settings_of
@@ -63,10 +65,6 @@ def test_a_cell_option_with_the_truth_backend_is_refused_naming_both(parser: Cal
 
 
 def test_a_franka_cell_gets_the_backend_options_and_its_layer() -> None:
-    from asp.assemble.cli import assembling_cell_of
-    from asp.assemble.settings import check_assembling_backend
-    from bridge.assembly import load_assembly
-
     settings = assembly_settings(build_parser().parse_args(["--backend", "franka", "--backend-option", "host=10.0.0.2",
                                                             "--backend-option", "dynamics=0.1", "--layer", "position"]))
     check_assembling_backend(settings)
@@ -85,8 +83,6 @@ def test_a_franka_cell_gets_the_backend_options_and_its_layer() -> None:
     (["--backend", "franka", "--uncertainty", "cell"], "--uncertainty cell has no effect with --backend franka"),
     (["--backend", "franka", "--cell-seed", "2"], "--cell-seed has no effect with --backend franka")])
 def test_an_option_without_effect_on_the_chosen_backend_is_refused(argv: list[str], named: str) -> None:
-    from asp.assemble.settings import check_assembling_backend
-
     settings = assembly_settings(build_parser().parse_args(argv))
     with pytest.raises(PlannerError, match=f"^{named}"):
         check_assembling_backend(settings)
