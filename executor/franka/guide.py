@@ -2,7 +2,9 @@
 person guides the part in the hand from above its ``demo_hole`` into it, the arm compliant.
 
 The arm brings the part :data:`GUIDE_HEIGHT` above the hole's calibrated entrance (tool
-pointing down, turned to the hole's yaw), tares the wrench estimate and hands itself over:
+pointing down, turned to the hole's yaw), takes the held part as its load (its gravity
+compensation carries the part's weight, :func:`carried`), tares the wrench estimate and
+hands itself over:
 Cartesian impedance with no spring on the translation (only :data:`GUIDE_DAMPING`, felt as
 a light drag) and the orientation held by the cell's rotational gains, so the part stays
 upright and turned to the hole while the hand moves it. The recorder samples the tip's
@@ -26,7 +28,8 @@ reported, not taught.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,6 +37,8 @@ import numpy as np
 from executor import ExecutorError
 from executor.control.motion import Motion
 from executor.franka.arm import FrankyController
+from executor.franka.cell import FrankaCell
+from executor.franka.teach import FrankaTeacher
 from executor.skills.teach import DEMO_START_HEIGHT, Demonstration, TeachingCell
 from executor.world.arm import tool_quat, turn_quats_z, turn_z
 from executor.world.scene import TIME_STEP
@@ -45,6 +50,9 @@ REST_TIME = 1.0  # [s] of robot time at rest below the start depth: the demonstr
 GUIDE_TIMEOUT = 300.0  # [s] of robot time from the handover to the end of the demonstration
 MIN_DURATION = 0.05  # [s] a shorter span between the triggers is refused
 LET_GO = 2.0  # [s] of wall time between the line that asks to let go and the arm's next motion
+LOAD_INERTIA = (1e-5, 0.0, 0.0, 0.0, 1e-5, 0.0, 0.0, 0.0, 1e-5)
+"""[kg m^2] the held part's inertia as the arm's load (column-major): a small part's is
+negligible beside the hand's; only its weight matters to the gravity compensation."""
 
 
 @dataclass(frozen=True)
@@ -95,11 +103,11 @@ def resample(times: np.ndarray, positions: np.ndarray, quats: np.ndarray
     return grid, pos, q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
-def record_guided(controller: FrankyController, start_z: float) -> Recording:
+def record_guided(controller: FrankyController, start_z: float, timeout: float = GUIDE_TIMEOUT) -> Recording:
     """Hand the arm over (:meth:`FrankyController.guide`) and sample every robot cycle until
     the tip has rested :data:`REST_TIME` below ``start_z`` [m]; the arm is stopped (at
-    rest, the tracking ended) on return and on any error. ExecutorError after
-    :data:`GUIDE_TIMEOUT`, SafetyStop when the tip leaves the workspace."""
+    rest, the tracking ended) on return and on any error. ExecutorError after ``timeout``
+    [s] of robot time, SafetyStop when the tip leaves the workspace."""
     times: list[float] = []
     positions: list[np.ndarray] = []
     quats: list[np.ndarray] = []
@@ -123,32 +131,54 @@ def record_guided(controller: FrankyController, start_z: float) -> Recording:
                 rest_since = now
             elif now - rest_since >= REST_TIME:
                 break
-            if now - times[0] > GUIDE_TIMEOUT:
-                raise ExecutorError(f"no demonstration within {GUIDE_TIMEOUT:g} s: expected the part guided into "
+            if now - times[0] > timeout:
+                raise ExecutorError(f"no demonstration within {timeout:g} s: expected the part guided into "
                                     f"the hole and held still there for {REST_TIME:g} s")
     finally:
         controller.stop()
     return Recording(np.array(times), np.array(positions), np.array(quats), np.array(speeds), np.array(wrenches))
 
 
+@contextmanager
+def carried(cell: FrankaCell) -> Iterator[None]:
+    """Meanwhile, the arm at rest (its motion ended) carries the held part as its load
+    (``Robot.set_load``: its gravity compensation takes the part's weight, at its centre
+    of mass) and the wrench estimate is tared with it; the load is set back on exit.
+    Without it, a 40 g part would move the spring-less guided arm down at 20 mm/s
+    against :data:`GUIDE_DAMPING`."""
+    if cell.held is None:
+        raise ExecutorError("a demonstration by hand-guiding needs a part in the hand")
+    spec = cell.geometry.parts[cell.held]
+    cell.controller.stop()
+    robot = cell.robot
+    before = robot.state
+    centre = np.asarray(before.F_T_EE.translation) + np.array([0.0, 0.0, cell.lever(spec) - spec.length / 2])
+    robot.set_load(spec.mass, centre.tolist(), list(LOAD_INERTIA))
+    try:
+        cell.arm.tare_sensor()
+        yield
+    finally:
+        robot.set_load(before.m_load, list(before.F_x_Cload), list(before.I_load))
+
+
 class HandGuiding:
     """A :data:`executor.skills.teach.Demonstrator` that records a person's demonstration
     on the arm (module docstring); ``prompt`` gets one line for the person before each
-    demonstration and one after it."""
+    demonstration and one after it; ``timeout`` [s] of robot time for each."""
 
-    def __init__(self, prompt: Callable[[str], None]) -> None:
-        self.prompt = prompt
+    def __init__(self, prompt: Callable[[str], None], timeout: float = GUIDE_TIMEOUT) -> None:
+        self.prompt, self.timeout = prompt, timeout
 
     def __call__(self, cell: TeachingCell, motion: Motion, origin: np.ndarray, bottom: float,
                  yaw: float) -> Demonstration:
-        controller = motion.controller
-        if not isinstance(controller, FrankyController):
+        if not isinstance(cell, FrankaTeacher):
             raise ExecutorError("a demonstration by hand-guiding needs the Franka backend (--backend franka)")
         cell.hold_at(motion, origin + np.array([0.0, 0.0, GUIDE_HEIGHT]), tool_quat(yaw))
         start_z = float(origin[2] + DEMO_START_HEIGHT)
-        self.prompt(f"guide the part into the hole ({np.round(origin, 4).tolist()} m, "
-                    f"{bottom * 1000:.1f} mm deep) and hold it still at the bottom for {REST_TIME:g} s")
-        rec = record_guided(controller, start_z)
+        with carried(cell.cell):
+            self.prompt(f"guide the part into the hole ({np.round(origin, 4).tolist()} m, "
+                        f"{bottom * 1000:.1f} mm deep) and hold it still at the bottom for {REST_TIME:g} s")
+            rec = record_guided(cell.cell.controller, start_z, self.timeout)
         first, last = demonstration_span(rec, start_z)
         times, pos, quats = resample(rec.times[first:last + 1], rec.positions[first:last + 1],
                                      rec.quats[first:last + 1])

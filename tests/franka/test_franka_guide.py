@@ -107,7 +107,7 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
         options = franka_options({"host": sim.host, "realtime": "ignore", "dynamics": "0.5"})
         cell = FrankaCell(geometry, description, layer_named("full"), options)
         try:
-            skill = teach_shape(FrankaTeacher(cell), "peg_d10", HandGuiding(prompt))
+            skill = teach_shape(FrankaTeacher(cell), "peg_d10", HandGuiding(prompt, timeout=30.0))
         finally:
             cell.stop()
     assert len(lines) == 2 and lines[1].startswith("recorded"), lines
