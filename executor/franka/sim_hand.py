@@ -12,9 +12,12 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-HAND_STIFFNESS = 400.0  # [N/m] of the hand's pull toward its path
-HAND_DAMPING = 40.0  # [N s/m] of the hand against the part's velocity
-HAND_FORCE = 25.0  # [N] the largest pull
+HAND_STIFFNESS = 4000.0
+"""[N/m] of the hand's pull toward its path: a firm hand. The simulated FR3's joints have
+dry friction (MuJoCo ``frictionloss`` up to 1.14 N m, as a real arm's), a few newtons at the
+tool: a hand of 400 N/m stopped 2 mm off the hole's centre, on its rim."""
+HAND_DAMPING = 150.0  # [N s/m] of the hand against the part's velocity
+HAND_FORCE = 30.0  # [N] the largest pull
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ and is stored and read back as the scripted teaching's skills are."""
 
 from __future__ import annotations
 
+import logging
 import shutil
 from pathlib import Path
 
@@ -21,6 +22,7 @@ from executor.franka.guide import REST_SPEED, Recording, demonstration_span, res
 from executor.world.scene import TIME_STEP  # noqa: E402
 
 TRIO = Path(__file__).parent / "data" / "trio"
+LOG = logging.getLogger(__name__)  # the figures of the run (pytest --log-cli-level=INFO shows them)
 
 
 def _recording(z: np.ndarray, dt: float = TIME_STEP) -> Recording:
@@ -94,11 +96,12 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
     geometry = load_geometry(str(folder), description)
     hole = geometry.holes["h1"]
     descent = 4.0  # [s] of the hand's path from 5 mm above the entrance to the bottom
-    path = [Waypoint((hole.position[0], hole.position[1], hole.top_z + 0.005), 1.0),
+    path = [Waypoint((hole.position[0], hole.position[1], hole.top_z + 0.005), 1.5),
             Waypoint((hole.position[0], hole.position[1], hole.bottom_z - 0.001), descent)]
     lines: list[str] = []
     with sim_robot(folder) as sim:
         def prompt(line: str) -> None:
+            LOG.info("%s", line)
             lines.append(line)
             if line.startswith("guide"):
                 hands.append(sim.guide("p1", path, hold=2.0))
@@ -110,6 +113,9 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
             skill = teach_shape(FrankaTeacher(cell), "peg_d10", HandGuiding(prompt, timeout=30.0))
         finally:
             cell.stop()
+    LOG.info("skill: %.3f s, start %s, goal %s, taught %s; the hand's largest pull %.1f N", skill.duration,
+             np.round(skill.demo_start, 5).tolist(), np.round(skill.demo_goal, 5).tolist(), skill.taught,
+             hands[0].peak if hands else 0.0)
     assert len(lines) == 2 and lines[1].startswith("recorded"), lines
     assert hands and hands[0].done and hands[0].peak > 1.0, hands
     # The hand's: it crosses the start depth 7 mm into its 4 s descent of 31 mm (minimum jerk,
