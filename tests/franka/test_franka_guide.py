@@ -3,7 +3,7 @@ on recordings made up here, the command's refusal without an arm, and, slow, a p
 in franky-sim's MuJoCo world (an external force on the held part, executor.franka.sim_hand)
 guiding a peg from above its hole into it while the arm is compliant: the skill taught from
 that demonstration is the hand's (its duration and its end), reaches its goal in the replay
-and is stored and read back as the scripted teaching's skills are."""
+and is stored and read back as the scripted teaching's skills are (long: `-m franka_arm`)."""
 
 from __future__ import annotations
 
@@ -75,6 +75,7 @@ def test_hand_guiding_needs_the_franka_backend(run_executor) -> None:
 @pytest.mark.slow
 @pytest.mark.timeout(1200)
 @pytest.mark.usefixtures("one_simulated_arm")
+@pytest.mark.franka_arm
 def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
     from executor.cell_description import load_cell_description
     from executor.control.ilc import layer_named
