@@ -158,7 +158,8 @@ def carried(cell: FrankaCell) -> Iterator[None]:
         cell.arm.tare_sensor()
         yield
     finally:
-        robot.set_load(before.m_load, list(before.F_x_Cload), list(before.I_load))
+        robot.set_load(before.m_load, np.asarray(before.F_x_Cload, dtype=float).tolist(),
+                       np.asarray(before.I_load, dtype=float).flatten(order="F").tolist())
 
 
 class HandGuiding:

@@ -114,17 +114,17 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
             skill = teach_shape(FrankaTeacher(cell), "peg_d10", HandGuiding(prompt, timeout=30.0))
         finally:
             cell.stop()
-    LOG.info("skill: %.3f s, start %s, goal %s, taught %s; the hand's largest pull %.1f N", skill.duration,
+    LOG.info("skill: %.3f s, start %s, goal %s, taught %s; the hand's largest pull %.1f N", skill.execution_time,
              np.round(skill.demo_start, 5).tolist(), np.round(skill.demo_goal, 5).tolist(), skill.taught,
              hands[0].peak if hands else 0.0)
     assert len(lines) == 2 and lines[1].startswith("recorded"), lines
     assert hands and hands[0].done and hands[0].peak > 1.0, hands
     # The hand's: it crosses the start depth 7 mm into its 4 s descent of 31 mm (minimum jerk,
     # at 1.3 s) and the part stops on the bottom (30 mm, at 3.4 s); the scripted one lasts 0.8 s.
-    assert 1.2 < skill.duration < descent, skill.duration
+    assert 1.2 < skill.execution_time < descent, skill.execution_time
     assert abs(skill.demo_start[2] - DEMO_START_HEIGHT) < 0.001, skill.demo_start
     assert abs(skill.demo_goal[2] + hole.depth) < 0.001, skill.demo_goal  # at the hole's bottom
     assert skill.taught is not None and skill.taught.reached, skill.taught
     path_written = save_skill(folder, skill)
     again = load_skill(folder, "peg_d10")
-    assert path_written.name == "peg_d10.json" and again.duration == pytest.approx(skill.duration)
+    assert path_written.name == "peg_d10.json" and again.execution_time == pytest.approx(skill.execution_time)
