@@ -63,6 +63,11 @@ def _teach(args: argparse.Namespace) -> int:
         from executor.world.geometry import load_geometry
 
         options = franka_options(dict(args.backend_option))
+        if any(options.offset):
+            # The taught poses are the geometry's (product frame) as they are sent to the arm.
+            raise ExecutorError("--backend-option offset: teaching on the arm does not move its poses by the "
+                                "offset; expected offset=0,0,0 (the plate where geometry.toml puts it in the "
+                                "robot's base frame)")
         arm = FrankaCell(load_geometry(args.assembly, description), description, layer_named("full"), options)
         cell = FrankaTeacher(arm)
         close = arm.stop

@@ -72,6 +72,12 @@ def test_hand_guiding_needs_the_franka_backend(run_executor) -> None:
     assert done.returncode == 2 and "--backend franka" in done.stderr and "Traceback" not in done.stderr, done.stderr
 
 
+def test_teaching_on_the_arm_refuses_an_offset_it_would_not_apply(run_executor) -> None:
+    done = run_executor("teach", "--assembly", str(TRIO), "--backend", "franka", "--backend-option", "host=127.0.0.9",
+                        "--backend-option", "offset=0.01,0,0")
+    assert done.returncode == 2 and "offset=0,0,0" in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
 @pytest.mark.slow
 @pytest.mark.timeout(1200)
 @pytest.mark.usefixtures("one_simulated_arm")
