@@ -48,10 +48,13 @@ MAX_ATTEMPTS = 10
 def _teach(args: argparse.Namespace) -> int:
     from executor import ExecutorError
     from executor.cell_description import load_cell_description
-    from executor.skills.teach import TeachingCell, teach_all
+    from executor.skills.teach import Demonstrator, TeachingCell, scripted_demonstration, teach_all
 
+    if args.demonstration == "hand" and args.backend != "franka":
+        raise ExecutorError("--demonstration hand: a person guides the part on a real arm; expected --backend franka")
     description = load_cell_description(args.cell_description)
     cell: TeachingCell
+    demonstrate: Demonstrator = scripted_demonstration
     if args.backend == "franka":
         from executor.control.ilc import layer_named
         from executor.franka.backend import franka_options
@@ -60,9 +63,18 @@ def _teach(args: argparse.Namespace) -> int:
         from executor.world.geometry import load_geometry
 
         options = franka_options(dict(args.backend_option))
+        if any(options.offset):
+            # The taught poses are the geometry's (product frame) as they are sent to the arm.
+            raise ExecutorError("--backend-option offset: teaching on the arm does not move its poses by the "
+                                "offset; expected offset=0,0,0 (the plate where geometry.toml puts it in the "
+                                "robot's base frame)")
         arm = FrankaCell(load_geometry(args.assembly, description), description, layer_named("full"), options)
         cell = FrankaTeacher(arm)
         close = arm.stop
+        if args.demonstration == "hand":
+            from executor.franka.guide import HandGuiding
+
+            demonstrate = HandGuiding(lambda line: print(line, flush=True))
     else:
         from executor.trial import Cell, CellSetup
 
@@ -71,7 +83,7 @@ def _teach(args: argparse.Namespace) -> int:
         sim = Cell(args.assembly, setup=CellSetup(description=description))
         cell, close = sim, sim.close
     try:
-        written = teach_all(cell)
+        written = teach_all(cell, demonstrate)
     finally:
         close()
     for path in written:
@@ -196,13 +208,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="executor", description="The simulated PyBullet assembly cell (paper 3).")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    teach = sub.add_parser("teach", help="record the scripted demonstrations (DMP + reference wrench)")
+    teach = sub.add_parser("teach", help="record the demonstrations (DMP + reference wrench)")
     add_assembly_argument(teach)
     teach.add_argument("--backend", choices=("sim", "franka"), default="sim",
                        help="sim: in the PyBullet cell; franka: on a Franka arm through franky (docs/franka.md) "
                             "(default sim)")
     teach.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
                        help="franka: an option of the arm, e.g. host=172.16.0.2 (repeatable)")
+    teach.add_argument("--demonstration", choices=("scripted", "hand"), default="scripted",
+                       help="scripted: the cell guides the part down its hole; hand: a person guides it on the arm, "
+                            "compliant (--backend franka only; docs/franka.md, Teaching) (default scripted)")
     add_cell_description_argument(teach)
     teach.set_defaults(func=_teach)
 

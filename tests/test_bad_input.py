@@ -480,6 +480,8 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
      "--uncertainty cell has no effect with --backend truth"),
     ("assemble-layer-truth", ("assemble", "--backend", "truth", "--layer", "position"), None, 2,
      "--layer has no effect with --backend truth"),
+    ("assemble-block-hole-franka", ("assemble", "--backend", "franka", "--backend-option", "host=10.0.0.2",
+                                    "--block-hole", "r1"), None, 2, "--block-hole has no effect with --backend franka"),
     ("bench-assemble-uncertainty-cell-truth", ("bench", "assemble", "--backend", "truth", "--plans", "1",
                                                "--uncertainty", "cell", "--grasp-tilt-bias", "2"), None, 2,
      "--uncertainty cell has no effect with --backend truth"),

@@ -2,6 +2,7 @@
 
     ./run.sh assemble [--run RUN [--plan K] | PLAN.json [FACTS.lp ...] | FACTS.lp ...]
                       [--assembly A] [--seed S] [--block-hole H] [--rrd FILE] [--json]
+                      [--backend {sim,truth,franka} [--backend-option KEY=VALUE ...]]
                       [--uncertainty {random,cell} [--cell-seed C] [--layer L] [--<magnitude> X ...]]
 
 The plan: plan K (default 1) of a session's run folder (``RUN/session.json``, facts
@@ -47,12 +48,14 @@ from asp.assemble.settings import (
     MAX_STEP_S,
     AssemblySettings,
     assembling_cell_settings,
+    check_assembling_backend,
 )
 from asp.plans.assign import LearnedFacts, load_learned_facts
 from asp.plans.plans import Plan, plans
 from asp.session.settings import SESSION_FILE, SessionFile, read_session_file
 from bridge.assembly import Assembly, load_assembly
 from bridge.cell_settings import (
+    CellSettings,
     ServeSettings,
     add_assembly_uncertainty_argument,
     add_cell_arguments,
@@ -62,6 +65,7 @@ from bridge.cli_types import (
     MAX_SEED,
     ArgumentParser,
     add_assembly_argument,
+    backend_option,
     finite_float,
     int_in,
     nonempty_path,
@@ -84,8 +88,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "vision and search errors (default 0)")
     parser.add_argument("--block-hole", action="append", default=[], metavar="H",
                         help="put an obstacle in hole H (fault injection; repeatable)")
-    parser.add_argument("--backend", choices=("sim", "truth"), default="sim",
-                        help="the cell: sim (PyBullet, default) or truth (geometry rule, no simulation)")
+    parser.add_argument("--backend", choices=("sim", "truth", "franka"), default="sim",
+                        help="the cell: sim (PyBullet, default), truth (geometry rule, no simulation) or franka "
+                             "(a Franka arm through franky, docs/franka.md)")
+    parser.add_argument("--backend-option", type=backend_option, action="append", default=[], metavar="KEY=VALUE",
+                        help="franka: an option of the arm, e.g. host=172.16.0.2 (repeatable)")
     parser.add_argument("--timeout", type=finite_float(0.0, MAX_STEP_S, low_open=True), default=300.0, metavar="S",
                         help="one step at the cell (default 300)")
     parser.add_argument("--save", "--rrd", dest="rrd", type=nonempty_path, metavar="FILE",
@@ -101,7 +108,8 @@ def assembly_settings(args: argparse.Namespace) -> AssemblySettings:
     """The settings the options of :func:`build_parser` give."""
     return AssemblySettings(
         inputs=tuple(map(str, args.inputs)), run=path_setting(args.run), plan=args.plan, assembly=args.assembly,
-        seed=args.seed, block_holes=tuple(args.block_hole), backend=args.backend, timeout_s=args.timeout,
+        seed=args.seed, block_holes=tuple(args.block_hole), backend=args.backend,
+        backend_options=dict(args.backend_option), timeout_s=args.timeout,
         rrd=path_setting(args.rrd), cell=cell_settings_of(args), listen=tuple(args.listen),
         connect=tuple(args.connect), zenoh_config=path_setting(args.zenoh_config))
 
@@ -183,14 +191,21 @@ def _summary(report: dict) -> str:
     return "\n".join(lines)
 
 
+def assembling_cell_of(settings: AssemblySettings, assembly: Assembly, cell: CellSettings) -> ServeSettings:
+    """The settings of the cell that assembles ``assembly``: the backend and its options of
+    ``settings``, the checked ``cell`` (:func:`assembling_cell_settings`)."""
+    return ServeSettings(assembly=str(assembly.folder), backend=settings.backend,
+                         backend_options=settings.backend_options, block_holes=tuple(settings.block_holes),
+                         rrd=settings.rrd, zenoh_config=settings.zenoh_config, cell=cell)
+
+
 def assemble(settings: AssemblySettings) -> tuple[dict, int]:
     """Start the cell, run the plan; (report, exit code)."""
     started = time.perf_counter()
+    check_assembling_backend(settings)
     cell = assembling_cell_settings(settings.cell, settings.backend)
     assembly, facts, plan = resolve(settings)
-    served = ServeSettings(assembly=str(assembly.folder), backend=settings.backend,
-                           block_holes=tuple(settings.block_holes), rrd=settings.rrd,
-                           zenoh_config=settings.zenoh_config, cell=cell)
+    served = assembling_cell_of(settings, assembly, cell)
     with assembling_cell(served, settings.seed, settings.timeout_s, listen=settings.listen,
                          connect=settings.connect) as driver:
         try:

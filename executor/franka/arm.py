@@ -59,9 +59,10 @@ class FrankyArm:
     def _raw(self, state: Any) -> np.ndarray:
         return np.asarray(state.O_F_ext_hat_K, dtype=float)
 
-    def read(self) -> ArmState:
-        """The robot's latest state, as the skills read it (the module docstring)."""
-        s = self.robot.state
+    def read(self, state: Any = None) -> ArmState:
+        """The robot's latest state (or ``state``, a franky ``RobotState``), as the skills
+        read it (the module docstring)."""
+        s = self.robot.state if state is None else state
         ee = s.O_T_EE
         rot = quat_to_matrix(np.asarray(ee.quaternion))
         lever = rot[:, 2] * self.tcp
@@ -183,6 +184,30 @@ class FrankyController:
         self._tracker.set_target(franky.Affine(ee_pos, quat_des_xyzw), franky.Twist(twist[:3], twist[3:]))
         self._wait_cycle()
         return s
+
+    def guide(self, damping: float) -> None:
+        """Hand the arm over to a human hand: no spring on the translation, ``damping``
+        [N s/m] per axis only; the tool's orientation held where it is by the cell's
+        rotational gains (as :meth:`step` holds it). :meth:`stop` ends it."""
+        import franky
+
+        if self._tracker is None:
+            self.start()
+        gains = self._franky_gains()
+        stiffness, damping_matrix = np.diag(gains.stiffness).copy(), np.diag(gains.damping).copy()
+        stiffness[:3], damping_matrix[:3] = 0.0, damping
+        ee = self._arm.robot.state.O_T_EE
+        self._last_ref = None
+        self._tracker.set_target(franky.Affine(np.asarray(ee.translation), np.asarray(ee.quaternion)),
+                                 franky.Twist(np.zeros(3), np.zeros(3)))
+        self._tracker.set_gains(gains=franky.CartesianImpedanceGains.diagonal(stiffness, damping_matrix))
+
+    def sample(self) -> tuple[float, ArmState]:
+        """Wait for the robot's next cycle; its clock [s] and its state then, read
+        together. ExecutorError as :meth:`step`."""
+        self._wait_cycle()
+        state = self._arm.robot.state
+        return float(state.time.to_sec()), self._arm.read(state)
 
     def _wait_cycle(self) -> None:
         robot = self._arm.robot

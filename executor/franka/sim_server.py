@@ -48,6 +48,7 @@ from bridge.cli_types import ArgumentParser, add_assembly_argument, run_command
 from bridge.errors import ToolError
 from bridge.files import write_atomic
 from executor import ExecutorError
+from executor.franka.sim_hand import GuidingHand, Waypoint
 from executor.franka.sim_scene import (
     add_grasp_welds,
     add_product,
@@ -286,6 +287,7 @@ class SimRobot:
         self._wanted = threading.Event()
         self._taken = threading.Event()
         self._truth: Truth | None = None
+        self._hand: GuidingHand | None = None
 
     @property
     def host(self) -> str:
@@ -327,6 +329,7 @@ class SimRobot:
                 gripper.__class__ = WeldingGripperServer  # as the robot's class: all it has is kept
                 assert isinstance(gripper, WeldingGripperServer)
                 gripper.welds = self._welds
+        sim.register_pre_step_callback(self._before_step)
         sim.register_post_step_callback(self._after_step)
         server.run_async(self._realtime)
         return self.host
@@ -350,6 +353,19 @@ class SimRobot:
             raise ExecutorError(f"franky-sim took no step in {timeout} s")
         assert self._truth is not None
         return self._truth
+
+    def guide(self, part: str, waypoints: Sequence[Waypoint], hold: float) -> GuidingHand:
+        """A person's hand takes hold of ``part`` and pulls it along ``waypoints`` (base
+        frame), holds the last one ``hold`` [s] and lets go (:class:`GuidingHand`, from
+        the next step on; its ``done`` tells when it let go)."""
+        hand = GuidingHand(self._bodies[part], waypoints, hold)
+        self._hand = hand
+        return hand
+
+    def _before_step(self, sim: MujocoSimulator) -> None:
+        hand = self._hand
+        if hand is not None and sim.model is not None and sim.data is not None:
+            hand.apply(sim.model, sim.data)
 
     def _after_step(self, _sim: MujocoSimulator) -> None:
         if self._wanted.is_set():

@@ -1,9 +1,9 @@
 """Teaching on the arm (``executor teach --backend franka``): the scripted demonstration of
 :mod:`executor.skills.teach` run by the Franka (a part picked from the table by the hand,
 guided along the same minimum-jerk path down its ``demo_hole``, replayed to record the
-reference wrench from the arm's estimate), stored as the PyBullet cell's skills are.
-A kinesthetic demonstration by hand-guiding is not implemented: on a real arm the
-scripted one runs too (docs/franka.md)."""
+reference wrench from the arm's estimate), stored as the PyBullet cell's skills are; or,
+with ``--demonstration hand``, a person's demonstration by hand-guiding
+(:mod:`executor.franka.guide`) in place of the scripted path (docs/franka.md, "Teaching")."""
 
 from __future__ import annotations
 

@@ -26,6 +26,8 @@ shape is taught first, and the files are written only when all were taught.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
@@ -80,6 +82,25 @@ class TeachingCell(Protocol):
         ...
 
 
+@dataclass(frozen=True)
+class Demonstration:
+    """A demonstrated insertion: ``times`` [s] from 0 in steps of TIME_STEP, the tip's
+    ``positions`` [m] and quaternions ``quats`` (xyzw) in the hole frame (turned by the
+    hole's yaw), and ``start`` [m], the tip position (cell frame) the replay starts from."""
+
+    times: np.ndarray
+    positions: np.ndarray
+    quats: np.ndarray
+    start: np.ndarray
+
+
+Demonstrator = Callable[[TeachingCell, Motion, np.ndarray, float, float], Demonstration]
+"""Demonstrates an insertion with the part in the hand: (cell, motion, the hole frame's
+origin [m], the depth of the demonstration's end below it [m] before the clearance, the
+hole's yaw [rad]) → the :class:`Demonstration`. :func:`scripted_demonstration` is the
+cell's; :class:`executor.franka.guide.HandGuiding` records a human's."""
+
+
 def _min_jerk(s: np.ndarray) -> np.ndarray:
     return 10 * s**3 - 15 * s**4 + 6 * s**5
 
@@ -102,6 +123,15 @@ def _demonstrate(motion: Motion, origin: np.ndarray, bottom: float,
     return np.array(times), np.array(positions), np.array(quats)
 
 
+def scripted_demonstration(cell: TeachingCell, motion: Motion, origin: np.ndarray, bottom: float,
+                           yaw: float) -> Demonstration:
+    """The scripted "human" (module docstring): held at 2 mm inside the entrance, guided
+    along the minimum-jerk path to :data:`DEMO_CLEARANCE` above ``bottom`` [m]."""
+    start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
+    cell.hold_at(motion, start, tool_quat(yaw))
+    return Demonstration(*_demonstrate(motion, origin, bottom, yaw), start)
+
+
 def _replay(motion: Motion, skill: Skill, origin: np.ndarray,
             yaw: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Run the DMP without adaptation in the hole frame turned by ``yaw`` [rad]; returns
@@ -121,10 +151,10 @@ def _replay(motion: Motion, skill: Skill, origin: np.ndarray,
     return np.array(phases), np.array(wrenches), turn_z(end.tip_pos - origin, -yaw)
 
 
-def teach_shape(cell: TeachingCell, shape: str) -> Skill:
-    """Demonstrate, encode and replay the skill of one part shape in its ``demo_hole``;
-    ExecutorError naming the part, the hole and the end error when the replay ends farther
-    than the cell's goal tolerance from the demonstration's goal."""
+def teach_shape(cell: TeachingCell, shape: str, demonstrate: Demonstrator = scripted_demonstration) -> Skill:
+    """Demonstrate (``demonstrate``), encode and replay the skill of one part shape in its
+    ``demo_hole``; ExecutorError naming the part, the hole and the end error when the
+    replay ends farther than the cell's goal tolerance from the demonstration's goal."""
     geometry = cell.geometry
     part = next(p for pid, p in sorted(geometry.parts.items()) if p.shape == shape)
     hole = geometry.holes[part.demo_hole]
@@ -132,19 +162,16 @@ def teach_shape(cell: TeachingCell, shape: str) -> Skill:
     origin = np.array([*(np.array(hole.position) + shift), hole.top_z])
     bottom = hole.depth + (DEMO_CLEARANCE if hole.sideways else 0.0)  # sideways: the depth is the part's end
     motion = cell.motion_for(part.id)
-    start = origin + np.array([0.0, 0.0, DEMO_START_HEIGHT])
     yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
-    quat = tool_quat(yaw)
     motion.frame = hole.frame  # a hole entered sideways: demonstrated and replayed down its frame's z axis
     try:
-        cell.hold_at(motion, start, quat)
-        times, positions, quats = _demonstrate(motion, origin, bottom, yaw)
-        weights = fit_dmp(times, positions, quats)
-        skill = Skill(shape, float(times[-1]), weights,
-                      np.concatenate([positions[0], xyzw_to_wxyz(quats[0])]),
-                      np.concatenate([positions[-1], xyzw_to_wxyz(quats[-1])]),
+        demo = demonstrate(cell, motion, origin, bottom, yaw)
+        weights = fit_dmp(demo.times, demo.positions, demo.quats)
+        skill = Skill(shape, float(demo.times[-1]), weights,
+                      np.concatenate([demo.positions[0], xyzw_to_wxyz(demo.quats[0])]),
+                      np.concatenate([demo.positions[-1], xyzw_to_wxyz(demo.quats[-1])]),
                       np.zeros(3), WrenchProfile.fit(np.zeros(1), np.zeros((1, 6))))
-        cell.hold_at(motion, start, quat)
+        cell.hold_at(motion, demo.start, tool_quat(yaw))
         phases, wrenches, end = _replay(motion, skill, origin, yaw)
     finally:
         motion.frame = None
@@ -160,10 +187,11 @@ def teach_shape(cell: TeachingCell, shape: str) -> Skill:
     return skill
 
 
-def teach_all(cell: TeachingCell) -> list[Path]:
-    """Regenerate the assets of the cell's product and teach every part shape, then write
-    the skills (none when one teaching fails: ExecutorError, :func:`teach_shape`); returns
-    the written files."""
+def teach_all(cell: TeachingCell, demonstrate: Demonstrator = scripted_demonstration) -> list[Path]:
+    """Regenerate the assets of the cell's product and teach every part shape, each
+    demonstrated by ``demonstrate``, then write the skills (none when one teaching fails:
+    ExecutorError, :func:`teach_shape`); returns the written files."""
     written = regenerate_assets(cell.geometry)
-    skills = [teach_shape(cell, shape) for shape in sorted({p.shape for p in cell.geometry.parts.values()})]
+    skills = [teach_shape(cell, shape, demonstrate)
+              for shape in sorted({p.shape for p in cell.geometry.parts.values()})]
     return written + [save_skill(cell.geometry.folder, skill) for skill in skills]

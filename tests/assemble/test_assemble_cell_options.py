@@ -1,19 +1,22 @@
 """``assemble --uncertainty cell``: the cell's options reach the assembling cell's settings
 document (no physics), and are refused where they would have no effect: without
-``--uncertainty cell``, or with ``--backend truth``."""
+``--uncertainty cell``, or with ``--backend truth``; ``--backend franka``'s options and
+layer reach its cell, and what only a simulated cell uses is refused with it."""
 
 from __future__ import annotations
 
 from argparse import ArgumentParser
 from collections.abc import Callable
 
+import msgspec
 import pytest
 
 from asp import PlannerError
-from asp.assemble.cli import assembly_settings, build_parser
-from asp.assemble.settings import assembling_cell_settings
+from asp.assemble.cli import assembling_cell_of, assembly_settings, build_parser
+from asp.assemble.settings import assembling_cell_settings, check_assembling_backend
 from asp.bench.assemble_plans import build_parser as bench_parser
 from asp.session.cells import CellProcess
+from bridge.assembly import load_assembly
 from bridge.cell_settings import DEFAULT_CELL, ServeSettings, cell_settings_of
 from executor.serve import build_parser as serve_parser
 from executor.serve import serve_settings_of
@@ -59,3 +62,28 @@ def test_a_cell_option_with_the_truth_backend_is_refused_naming_both(parser: Cal
                                                                       option: list[str], named: str) -> None:
     with pytest.raises(PlannerError, match=f"^{named} has no effect with --backend truth"):
         _checked(parser(), ["--backend", "truth", *option])
+
+
+def test_a_franka_cell_gets_the_backend_options_and_its_layer() -> None:
+    settings = assembly_settings(build_parser().parse_args(["--backend", "franka", "--backend-option", "host=10.0.0.2",
+                                                            "--backend-option", "dynamics=0.1", "--layer", "position"]))
+    check_assembling_backend(settings)
+    served = assembling_cell_of(settings, load_assembly("spare"), assembling_cell_settings(settings.cell, "franka"))
+    argv = CellProcess.command(msgspec.structs.replace(served, cell_id="a1"))
+    cell = serve_settings_of(serve_parser().parse_args(argv[argv.index("serve") + 1:]))
+    assert (cell.backend, cell.backend_options, cell.cell.layer) == ("franka", {"host": "10.0.0.2", "dynamics": "0.1"},
+                                                                      "position")
+
+
+@pytest.mark.parametrize(("argv", "named"), [
+    (["--backend-option", "host=10.0.0.2"], "--backend-option host: only --backend franka"),
+    (["--backend", "truth", "--backend-option", "host=10.0.0.2"], "--backend-option host: only --backend franka"),
+    (["--backend", "franka", "--block-hole", "r1"], "--block-hole has no effect with --backend franka"),
+    (["--backend", "franka", "--save", "x.rrd"], "--save has no effect with --backend franka"),
+    (["--backend", "franka", "--uncertainty", "cell"], "--uncertainty cell has no effect with --backend franka"),
+    (["--backend", "franka", "--cell-seed", "2"], "--cell-seed has no effect with --backend franka")])
+def test_an_option_without_effect_on_the_chosen_backend_is_refused(argv: list[str], named: str) -> None:
+    settings = assembly_settings(build_parser().parse_args(argv))
+    with pytest.raises(PlannerError, match=f"^{named}"):
+        check_assembling_backend(settings)
+        assembling_cell_settings(settings.cell, settings.backend)
