@@ -17,6 +17,13 @@ longer than 1 ms, the robot's controller keeps tracking the last reference meanw
 the skill runs slower than taught (DMP, admittance and detector count steps, not robot
 time). ``FrankyController.robot_period`` gives the robot time per step measured
 (docs/franka.md has the figure against franky-sim).
+
+The torque loop: franky computes the impedance's torques in its own thread of this process,
+one command per robot cycle; on a loaded machine it misses cycles, and the robot applies
+the last torques again (franky-sim) or counts them lost (a real arm, which stops with a
+reflex when too many are). ``FrankyController.lowest_rate`` is the lowest
+``control_command_success_rate`` (the share of the last 100 cycles whose command arrived)
+the steps read since :meth:`FrankyController.watch_rate`.
 """
 
 from __future__ import annotations
@@ -51,6 +58,10 @@ class FrankyArm:
         self.tcp = 0.0
         self.tare = np.zeros(6)
         self._filtered = np.zeros(6)
+        self.command_rate = 0.0
+        """libfranka's ``control_command_success_rate`` at the last :meth:`read`: the share
+        of the last 100 robot cycles on which this client's control command arrived (0
+        while no motion runs)."""
 
     def set_tcp(self, length: float) -> None:
         """The tool tip is ``length`` [m] below the end effector along the tool axis."""
@@ -63,6 +74,7 @@ class FrankyArm:
         """The robot's latest state (or ``state``, a franky ``RobotState``), as the skills
         read it (the module docstring)."""
         s = self.robot.state if state is None else state
+        self.command_rate = float(s.control_command_success_rate)
         ee = s.O_T_EE
         rot = quat_to_matrix(np.asarray(ee.quaternion))
         lever = rot[:, 2] * self.tcp
@@ -108,6 +120,7 @@ class FrankyController:
         self._last_time = 0.0
         self.steps = 0
         self.robot_seconds = 0.0
+        self.lowest_rate = 1.0
 
     @property
     def arm(self) -> FrankyArm:
@@ -155,6 +168,10 @@ class FrankyController:
     def reset(self) -> None:
         """Nothing is cached between motions on the arm."""
 
+    def watch_rate(self) -> None:
+        """Start :attr:`lowest_rate` afresh (1)."""
+        self.lowest_rate = 1.0
+
     def step(self, pos_des: np.ndarray, quat_des_xyzw: np.ndarray,
              wrench_ff: np.ndarray | None = None) -> ArmState:
         """Send the tip pose [m, xyzw] (plus the feed-forward wrench as a pose offset) and
@@ -165,6 +182,8 @@ class FrankyController:
         if self._tracker is None:
             self.start()
         s = self._arm.read()
+        if self._arm.command_rate > 0.0:  # 0: the tracking loop has sent no command yet
+            self.lowest_rate = min(self.lowest_rate, self._arm.command_rate)
         if wrench_ff is not None:
             k_t, k_r = capped(self._gains.k_trans, self._gains.k_rot)
             pos_des = pos_des + wrench_ff[:3] / k_t

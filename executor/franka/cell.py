@@ -209,7 +209,8 @@ class FrankaCell:
     def insert(self, part: str, hole: str, rng: np.random.Generator) -> tuple[InsertionResult, Detector,
                                                                                 SearchResult]:
         """One attempt with the held part: above the hole, the search, the skill; the ILC
-        correction of (part shape, hole) updated after a success with ILC."""
+        correction of (part shape, hole) updated after a success with ILC. The controller's
+        ``lowest_rate`` is that of this attempt's search and skill."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
         if hole_spec.sideways:
             raise ExecutorError(f"hole '{hole}' is entered along {hole_spec.axis}: the Franka backend inserts down "
@@ -221,6 +222,7 @@ class FrankaCell:
         quat = tool_quat(yaw)
         approach = est + np.array([0.0, 0.0, APPROACH_HEIGHT])
         self.carry_to(approach, yaw=yaw)
+        self.controller.watch_rate()
         self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         self.arm.tare_sensor()
         found = hole_search(self.motion, est[:2], est[2], approach[2], quat, rng)

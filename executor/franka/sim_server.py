@@ -24,6 +24,11 @@ file of it is changed; figures in docs/franka.md, "Testing against franky-sim"):
    contacts let a peg pivot and slide under insertion forces (3-31 mm), so a grasped part
    is held as the PyBullet cell holds it (:mod:`executor.assembly.grasp`): welded to the
    hand while the fingers close on it (:class:`GraspWelds`, :class:`WeldingGripperServer`).
+
+And one thing a client needs to see its own lateness: franky-sim's loop advances 1 ms per
+tick whether a command came or not (the last one is applied again), and reports a
+``control_command_success_rate`` of 1 always; here it is libfranka's figure, the share of
+the last 100 ticks of a motion on which a new command arrived (:class:`CommandRate`).
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ import json
 import socket
 import threading
 import xml.etree.ElementTree as ET
+from collections import deque
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -41,6 +47,7 @@ import mujoco
 import numpy as np
 from franky_sim import SimulationServer
 from franky_sim.franka_gripper_server import FrankaGripperServer, _MotionState
+from franky_sim.franka_robot_server import FrankaRobotServer
 from franky_sim.franka_robot_state import FrankaRobotState
 from franky_sim.mujoco_simulator import FrankaMujocoRobot, MujocoSimulator
 
@@ -145,6 +152,56 @@ def add_flange_sensor(sim: MujocoSimulator) -> None:
     ET.SubElement(sensors, "torque", name="flange_torque", site="flange_ft")
 
 
+COMMAND_WINDOW = 100
+"""libfranka's ``control_command_success_rate`` is taken over the last this many control
+cycles (ticks of 1 ms)."""
+
+
+class CommandRate:
+    """libfranka's ``control_command_success_rate`` for franky-sim: the share of the last
+    :data:`COMMAND_WINDOW` ticks of a motion on which a new control command arrived (0 while
+    no motion runs, as on the robot). franky-sim applies the last command again on a tick
+    that got none, where a real arm counts it lost (and stops with a reflex when too many
+    are)."""
+
+    def __init__(self) -> None:
+        self._ticks: deque[bool] = deque(maxlen=COMMAND_WINDOW)
+        self.value = 0.0
+
+    def tick(self, in_motion: bool, commanded: bool) -> None:
+        """One tick: whether a motion runs, whether a command arrived on it. The count
+        starts with a motion's first command (the client answers the state that follows
+        the motion's start)."""
+        if not in_motion:
+            self._ticks.clear()
+            self.value = 0.0
+        elif self._ticks or commanded:
+            self._ticks.append(commanded)
+            self.value = sum(self._ticks) / len(self._ticks)
+
+
+class CountingRobotServer(FrankaRobotServer):
+    """franky-sim's robot server that counts, per tick, whether a control command arrived
+    during a motion (:class:`CommandRate`). :class:`SimRobot` turns franky-sim's server into
+    this class and sets ``rate``."""
+
+    rate: CommandRate | None = None
+    _commanded = False
+
+    def _pre_process_commands(self) -> None:
+        self._commanded = False
+        super()._pre_process_commands()
+
+    def _handle_udp_command(self, command_data: bytes) -> None:
+        self._commanded = True
+        super()._handle_udp_command(command_data)
+
+    def _post_process_commands(self) -> None:
+        if self.rate is not None:
+            self.rate.tick(self.current_motion_id > 0, self._commanded)
+        super()._post_process_commands()
+
+
 class SensedRobot(FrankaMujocoRobot):
     """franky-sim's FR3 whose state carries the flange sensor's wrench (``O_F_ext_hat_K``,
     ``K_F_ext_hat_K``, ``tau_ext_hat_filtered``) and the pose measured from q (``O_T_EE``).
@@ -152,10 +209,13 @@ class SensedRobot(FrankaMujocoRobot):
     (same attributes) and sets ``sensor`` once the scene is compiled."""
 
     sensor: FlangeSensor | None = None
+    command_rate: CommandRate | None = None
 
     @property
     def state(self) -> FrankaRobotState:
         state = super().state
+        if self.command_rate is not None:
+            state = state.replace(control_command_success_rate=self.command_rate.value)
         if self.sensor is None:
             return state
         pose = self.kinematics(np.array(state.q)).copy()  # a copy: the next call overwrites the view
@@ -324,6 +384,9 @@ class SimRobot:
         self._plate = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "plate")
         self._welds = GraspWelds(model, data, self._bodies)
         for robot_server in server.robot_servers:
+            robot_server.__class__ = CountingRobotServer  # as the robot's class: all it has is kept
+            assert isinstance(robot_server, CountingRobotServer)
+            robot_server.rate = robot.command_rate = CommandRate()
             gripper = robot_server.gripper_server
             if gripper is not None:
                 gripper.__class__ = WeldingGripperServer  # as the robot's class: all it has is kept

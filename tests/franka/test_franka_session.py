@@ -44,7 +44,7 @@ def test_a_session_through_the_franka_backend_learns_the_fits_and_assembles(run_
                        "--backend-option", "dynamics=0.5",
                        "--cell-description", str(description), "--timeout", "1500", "--assemble", "--json",
                        "--out", str(tmp_path / "run"), timeout=1700)
-        assert done.returncode == 0, done.stderr
+        assert done.returncode == 0, (done.stderr, done.stdout)  # stdout: the steps' goal errors, if it got there
         result = json.loads(done.stdout)
         assert sorted(map(tuple, result["fits"])) == sorted(truth) and result["matches_truth"] is True
         assert result["assembly"]["assembled"], result["assembly"]
