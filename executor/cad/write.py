@@ -64,6 +64,7 @@ from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
     base_is_primitive,
+    fitted,
     peg_frame,
     peg_is_primitive,
     write_mesh,
@@ -622,7 +623,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
                           exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid))
-                          if pid in derived.bores else None)
+                          if pid in derived.bores else None, fits=frozenset(fitted(derived, pid)))
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done
