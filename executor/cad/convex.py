@@ -65,8 +65,8 @@ THRESHOLDS = (0.05, 0.03, 0.02, 0.01)
 part's size) tried in turn, its default first, until the pieces fit (:data:`ROOM_KEPT`)."""
 SEEDS = (0, 1)
 """CoACD's random seeds, each with every threshold in turn until the pieces fit: a seed
-can cut a thin slice at a step of the part (a bolt's head on its shank, 0.68 mm thick at
-seed 0) where another cuts none."""
+can cut a piece thinner than the cell's hull margin twice where another cuts none (an
+occt_pulley bolt, a hexagonal head on a d 6 shank, at seed 0)."""
 ROOM_KEPT = 0.5
 """A part's convex pieces must leave each part near it at least this share of the room
 its mesh leaves it in the assembled pose (a hull bridging an opening would fill it)."""
