@@ -314,8 +314,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into no hole found (the ring, gland_2, the impeller: "
                                            "in no feature) or onto a pin of a part that is not the base (gland_3)")),
     pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin that is not found (the pulley "
-                                             "onto the hub's boss), or into a hole and shorter than the gripper's grasp depth "
-                                             "(the bolts, 14 mm)")),
+                                             "onto the hub's boss), or into a hole and shorter than the gripper's "
+                                             "grasp depth (the bolts, 14 mm)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
