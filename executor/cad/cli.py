@@ -36,7 +36,7 @@ from pathlib import Path
 from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
-from executor.cad.convex import MESH_FOLDER
+from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
@@ -310,7 +310,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
-    assumed += [*derived.assumptions(), *nominal_assumption(derived)]
+    assumed += [*derived.assumptions(), *nominal_assumption(derived), *overlap_assumption(derived)]
     mapped, laid = map_product(derived, settings)
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:

@@ -64,6 +64,7 @@ from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
     base_is_primitive,
+    fitted,
     peg_frame,
     peg_is_primitive,
     write_mesh,
@@ -376,7 +377,8 @@ def precedence_text(derived: Derived) -> str:
 def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above or sideways
     holding, if anything, a peg going in along the hole's axis that is no polygon section,
-    or the prism of its polygon (the cell builds that from its outline, exactly); the pins of the base that
+    or the prism of its polygon (the cell builds that from its outline, exactly), longer than the gripper's
+    grasp depth (the cell holds it by that much); the pins of the base that
     parts go down onto, and of the parts with a bore those it puts onto them
     (:func:`_onto_pin`); the pegs of the other holes and the other parts going onto pins,
     each with why the cell places it by hand (a polygon peg's room is often below what
@@ -393,6 +395,9 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
                 by_hand[fit.part] = f"hole {hid} is entered from below"
         elif fit.part is not None and _section_kind(fit) == "polygon" and _polygon_refused(fit, derived):
             by_hand[fit.part] = _polygon_refused(fit, derived)
+        elif fit.part is not None and (length := float(_upright(derived, fit).extents[2])) <= GRIPPER["grasp_depth"]:
+            by_hand[fit.part] = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's "
+                                 f"grasp depth ({1e3 * GRIPPER['grasp_depth']:g} mm)")
         else:
             kept[hid] = fit
     pins = {pin_id: pin for pin_id, pin in derived.pins.items()
@@ -613,7 +618,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
                           exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid))
-                          if pid in derived.bores else None)
+                          if pid in derived.bores else None, fits=frozenset(fitted(derived, pid)))
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done

@@ -124,6 +124,17 @@ def test_a_part_on_pin_tops_is_written_to_be_placed_by_hand(tmp_path: Path,
     assert assembly.step_text("lid", None) == "lid (manual)" and assembly.step_text("peg1", "h1") == "peg1->h1"
 
 
+def test_a_peg_no_longer_than_the_grasp_is_placed_by_hand(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _pegs_and_plate(tmp_path / "cad", (X_MM, 0.0))
+    _box((12, 12, 18), (X_MM + 25, 0, 14)).export(tmp_path / "cad" / "peg2.stl")  # 18 mm: the gripper holds 20
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    printed = capsys.readouterr().out
+    assert ("manual peg2: the cell has no operation for it, a plan's step places it by hand (part 'peg2' is "
+            "18.000 mm long, no longer than the gripper's grasp depth (20 mm))") in printed
+    product = load_product(str(tmp_path / "out"))  # written, and the cell's loader takes it
+    assert set(product.manual) == {"peg2"} and "peg1" in product.parts
+
+
 @pytest.mark.slow
 def test_truth_sessions_run_with_a_part_placed_by_hand_and_without_geometry(
         run_cli: Runner, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

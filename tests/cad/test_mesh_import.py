@@ -10,13 +10,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+import fcl
 import numpy as np
 import pytest
 import trimesh
 
 from assembly_constraints.cli import main
 from bridge.product import CONVEX_HEADER
+from executor.cad.convex import NOMINAL_OVERLAP, fitting_pieces
 from executor.cad.sections import edge_distance, slice_loops
+from executor.cad.sweep import TOUCH, bvh, convex_object
 from executor.cad.write import CELL_DEFLECTION
 from executor.world.geometry import load_geometry
 from executor.world.meshes import read_objects
@@ -148,3 +151,22 @@ def test_coaxial_cylinders_of_one_nominal_diameter_are_a_fit_whatever_their_tess
     margins = (tmp_path / "out" / "nominal_sizes.lp").read_text()
     assert "nominal_margin(peg,h1,0)." in margins and "nominal_margin(peg,h2,0)." in margins
     assert "nominal_margin(peg,h3,-" in margins  # no room: the peg is larger
+
+
+@pytest.mark.slow  # CoACD on a bolt, its pieces measured against the pulley's mesh (5 s)
+def test_convex_pieces_overlap_a_part_at_a_zero_clearance_fit_by_at_most_the_stated_bound() -> None:
+    folder = Path(__file__).parent / "corpus" / "occt_pulley" / "meshes"
+    meshes = {name: trimesh.load(folder / f"{name}.stl", force="mesh").apply_scale(1e-3)
+              for name in ("bolt_1", "pulley_front", "hub")}
+    bolt = meshes.pop("bolt_1")  # a hexagonal head on a d 6 shank, at room 0 in the pulley's and the hub's holes
+    found = fitting_pieces("bolt_1", bolt, meshes, frozenset(meshes))
+    assert not isinstance(found, str), found
+    pieces, made = found
+    assert "they overlap" in made and "pulley_front" in made
+    deepest = 0.0
+    for piece, _ in pieces:
+        contacts = fcl.CollisionResult()
+        request = fcl.CollisionRequest(num_max_contacts=100, enable_contact=True)
+        fcl.collide(convex_object(piece), bvh(meshes["pulley_front"]), request, contacts)
+        deepest = max([deepest, *(c.penetration_depth for c in contacts.contacts)])
+    assert TOUCH < deepest <= NOMINAL_OVERLAP  # beyond touching: the decomposition's error, within the bound
