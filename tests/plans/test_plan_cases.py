@@ -80,14 +80,14 @@ CHECK_CASES = [
     ("hole not fitting", "plan_step(1,a,h2). plan_step(2,b,h1). plan_step(3,c,none).",
      {"error(not_fitting(a,h2))"}),
     ("hole used twice", "plan_step(1,a,h1). plan_step(2,b,h1). plan_step(3,c,none).",
-     {"error(hole_twice(h1))"}),
+     {"error(over_capacity(h1))"}),
     ("part without its hole", "plan_step(1,a,none). plan_step(2,b,h2). plan_step(3,c,none).",
      {"error(no_hole(a))"}),
     ("unknown part", "plan_step(1,a,h1). plan_step(2,b,h2). plan_step(3,c,none). plan_step(4,x,none).",
      {"error(unknown_part(x))", "error(bad_step(4))"}),
     ("assignment misses a part", "assigned(a,h1).", {"error(no_hole(b))"}),
     ("assignment gives two holes", "assigned(a,h1). assigned(b,h1). assigned(b,h2).",
-     {"error(two_holes(b))", "error(hole_twice(h1))"}),
+     {"error(two_holes(b))", "error(over_capacity(h1))"}),
 ]
 
 
