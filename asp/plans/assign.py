@@ -138,10 +138,11 @@ def _capacities(atoms: Sequence[clingo.Symbol], holes: set[str], sources: str) -
 
 def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     """What the product says about its holes beyond sizes: ``capacity(H,C)`` for a hole
-    taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not placed by
-    hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`)."""
+    taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not the base,
+    not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`)."""
     atoms = [fact("capacity", hole.id, hole.capacity) for hole in assembly.holes if hole.capacity > 1]
-    return atoms + [fact("out_of_reach", part, hole) for part in assembly.part_ids if part not in assembly.manual
+    inserted = [part.id for part in assembly.parts if part.role != "base" and part.id not in assembly.manual]
+    return atoms + [fact("out_of_reach", part, hole) for part in inserted
                     for hole in assembly.hole_ids if assembly.cell_cannot_insert(part, hole)]
 
 
