@@ -99,7 +99,7 @@ class HoleEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     name: Text | None = None
     shape: Kind | None = None
     position: XY | None = None
-    capacity: Annotated[int, Meta(ge=1, le=100, description="an integer in 1 .. 100")] = 1
+    capacity: Annotated[int, Meta(ge=1, le=64, description="an integer in 1 .. 64")] = 1
 
 
 class SizesTable(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
