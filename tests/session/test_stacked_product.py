@@ -4,9 +4,8 @@ the bush before the gear, and ``assemble`` takes its plan."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import json
+from pathlib import Path
 
 import pytest
 
