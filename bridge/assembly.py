@@ -8,7 +8,8 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
   optional ``section`` (a label: parts of one section are scaled copies of one
   cross-section; default the shape for round and square, the part's own id for rect);
   ``[holes.<id>]`` with ``name``, ``shape`` (default the kind ``geometry.toml`` gives it,
-  else round) and ``position`` ``[x, y]`` [m] on the base plate; an optional ``[sizes]``
+  else round), ``position`` ``[x, y]`` [m] on the base plate and ``capacity`` (the number
+  of parts stacked in it or onto it along its axis, default 1); an optional ``[sizes]``
   table with ``model`` (the size model the product declares: ``line``, ``sections`` or
   ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
@@ -75,10 +76,12 @@ class Part(Item):
 
 @dataclass(frozen=True)
 class Hole(Item):
-    """One hole of the base plate; ``position`` [m] or None."""
+    """One hole of the base plate; ``position`` [m] or None; ``capacity``: how many parts
+    go in it or onto it, one above the other."""
 
     shape: str = "round"
     position: tuple[float, float] | None = None
+    capacity: int = 1
 
 
 @dataclass(frozen=True)
@@ -113,9 +116,16 @@ class Assembly:
         section the cell inserts no part in), a peg and a pin, a part with a bore and a
         hole (the cell puts parts with a bore onto pins only, pegs into holes only), or a
         nominal zero-clearance fit the cell cannot build with room (:attr:`nominal_modelled`)."""
-        return (part in self.manual or (self.cell_holes is not None and hole not in self.cell_holes)
-                or (self.cell_holes is not None and (part in self.bores) != (hole in self.pins))
+        return (part in self.manual or self.cell_cannot_insert(part, hole)
                 or ((part, hole) in self.nominal_fits and not self.nominal_modelled))
+
+    def cell_cannot_insert(self, part: str, hole: str) -> bool:
+        """Whether the simulated cell refuses to put ``part`` into ``hole`` even were the
+        part one it inserts: the hole is not one it models (a hole of a part placed by
+        hand, a hole of a section it inserts nothing in), or a peg and a pin, a part with
+        a bore and a hole. False without a ``geometry.toml`` (every hole is the plate's)."""
+        return self.cell_holes is not None and (hole not in self.cell_holes
+                                                or (part in self.bores) != (hole in self.pins))
 
     def step_text(self, part: str, hole: str | None) -> str:
         """A plan step as the commands print it: ``p->h``, ``p``, a part placed by hand ``p (manual)``."""
@@ -170,7 +180,7 @@ def assembly_of(product: ProductDescription) -> Assembly:
              kinds.get(pid), None if pid not in kinds else section_label(pid, kinds[pid], part.section))
         for pid, part in layout.parts.items())
     holes = tuple(Hole(hid, hole.name or hid, hole_kind[hid],
-                       None if hole.position is None else (hole.position[0], hole.position[1]))
+                       None if hole.position is None else (hole.position[0], hole.position[1]), hole.capacity)
                   for hid, hole in layout.holes.items())
     geometry = product.geometry
     manual = {} if geometry is None else {mid: m.reason for mid, m in geometry.manual.items()}

@@ -50,7 +50,7 @@ from asp.assemble.settings import (
     assembling_cell_settings,
     check_assembling_backend,
 )
-from asp.plans.assign import LearnedFacts, load_learned_facts
+from asp.plans.assign import LearnedFacts, load_learned_facts, product_facts
 from asp.plans.plans import Plan, plans
 from asp.session.settings import SESSION_FILE, SessionFile, read_session_file
 from bridge.assembly import Assembly, load_assembly
@@ -120,8 +120,9 @@ def truth_sources(assembly: Assembly) -> str:
 
 
 def truth_facts(assembly: Assembly) -> LearnedFacts:
-    """The assembly's true sizes and precedence as learned facts (``must_precede`` closed)."""
-    return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")])
+    """The assembly's true sizes and precedence as learned facts (``must_precede`` closed),
+    with what the product says about its holes (:func:`asp.plans.assign.product_facts`)."""
+    return load_learned_facts([assembly.file("sizes.lp"), assembly.file("precedence.lp")], product_facts(assembly))
 
 
 def session_plans(run: Path) -> tuple[SessionFile, list[list[dict[str, str | None]]]]:
@@ -158,7 +159,7 @@ def resolve(settings: AssemblySettings) -> tuple[Assembly, LearnedFacts, Plan]:
     if unknown:
         raise PlannerError(f"--block-hole {unknown[0]}: expected a hole of {assembly.name} "
                            f"({', '.join(assembly.hole_ids)})")
-    facts = load_learned_facts(lps) if lps else truth_facts(assembly)
+    facts = load_learned_facts(lps, product_facts(assembly)) if lps else truth_facts(assembly)
     check_facts_product(assembly, facts, ", ".join(map(str, lps)) or truth_sources(assembly))
     if jsons:
         plan_source = str(jsons[0])

@@ -104,7 +104,7 @@ def check_facts_product(assembly: Assembly, facts: LearnedFacts, sources: str) -
 def check_plan_product(facts: LearnedFacts, plan: Plan, source: str) -> None:
     """PlannerError naming ``source`` and the first step in error when the plan is not
     valid for facts of the product (:func:`check_facts_product`): every part exactly
-    once, each peg in a distinct hole it fits, the precedence respected."""
+    once, each peg in a hole it fits with room for it, the precedence respected."""
     errors = check_plan(facts, plan.steps)
     if not errors:
         return
@@ -118,7 +118,7 @@ def check_plan_product(facts: LearnedFacts, plan: Plan, source: str) -> None:
     where = f"step {k} ({_step_text(plan.steps[k - 1])})" if k <= len(plan.steps) else "the plan"
     more = f" and {len(errors) - 1} more" if len(errors) > 1 else ""
     raise PlannerError(f"{source}: {where}: {first}{more}; expected every part of the product once, "
-                       "each peg in a distinct hole it fits, in an order the precedence admits")
+                       "each peg in a hole it fits with room for it, in an order the precedence admits")
 
 
 def _step_text(step: PlanStep) -> str:

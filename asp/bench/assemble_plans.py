@@ -40,7 +40,7 @@ from asp.assemble.driver import assembling_cell
 from asp.assemble.execute import AssemblyStopped, execute
 from asp.assemble.inputs import check_facts_product
 from asp.assemble.settings import MAX_STEP_S, assembling_cell_settings
-from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts
+from asp.plans.assign import LearnedFacts, all_assignments, load_learned_facts, product_facts
 from asp.plans.plans import Plan, PlanStep, check_plan
 from asp.precedence.count import UniformSampler
 from asp.precedence.relation import Relation
@@ -153,7 +153,7 @@ def _facts(args: argparse.Namespace) -> tuple[Assembly, LearnedFacts]:
         name = name or session_plans(args.run)[0].assembly
         paths = [args.run / "learned.lp"]
     assembly = load_assembly(name or "cranfield")
-    facts = load_learned_facts(paths) if paths else truth_facts(assembly)
+    facts = load_learned_facts(paths, product_facts(assembly)) if paths else truth_facts(assembly)
     check_facts_product(assembly, facts, ", ".join(map(str, paths)) or truth_sources(assembly))
     return assembly, facts
 

@@ -6,6 +6,12 @@ hole* when it has a ``fits/2`` or ``no_fit/2`` fact or a ``needs_hole/1`` fact
 (``asp/encodings/plans/needs_hole.lp``); every other part (Cranfield: bp sp pd ph fp) is
 placed without a hole.
 
+A hole takes one part, or ``capacity(H,C)`` parts (a pin the product stacks parts
+onto, one above the other: the import writes it); parts that share a hole must be
+ordered by ``must_precede/2`` (the lower first), else their order along it is unknown.
+A part is never given a hole the cell cannot put it in (``out_of_reach(P,H)``: a hole of
+a part placed by hand; :func:`product_facts`).
+
 - :func:`greedy_assignment`: the paper's greedy: the biggest unassigned part gets a free
   hole big enough for it. Sizes come from the learned relation: a part is the bigger
   the fewer holes it fits, a hole the bigger the more parts fit it. The part takes the
@@ -24,15 +30,17 @@ part exists.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import clingo
 
-from asp import PlannerError
+from asp import MAX_IDS, PlannerError
 from asp.precedence.relation import closed_precedence
 from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name, solve
+from bridge.assembly import Assembly
+from bridge.inputs import shorten
 
 Assignment = dict[str, str]
 """Part id -> hole id, for the parts that need a hole."""
@@ -63,14 +71,26 @@ class LearnedFacts:
     fits: frozenset[tuple[str, str]]
     needs_hole: tuple[str, ...]
     must_precede: frozenset[tuple[str, str]]
+    capacity: Mapping[str, int] = field(default_factory=dict)
+    """Hole -> the number of parts it takes, for the holes of a ``capacity/2`` fact (others: 1)."""
+    out_of_reach: frozenset[tuple[str, str]] = frozenset()
+    """(part, hole) pairs the cell cannot put in (``out_of_reach/2``)."""
 
     def holes_of(self, part: str) -> list[str]:
-        """The holes ``part`` fits, sorted."""
-        return [hole for hole in self.holes if (part, hole) in self.fits]
+        """The holes ``part`` fits and the cell can put it in, sorted."""
+        return [hole for hole in self.holes if (part, hole) in self.fits and (part, hole) not in self.out_of_reach]
+
+    def room(self, hole: str) -> int:
+        """How many parts ``hole`` takes."""
+        return self.capacity.get(hole, 1)
+
+    def ordered(self, first: str, then: str) -> bool:
+        """Whether precedence orders the two parts (either way), so they can share a hole."""
+        return (first, then) in self.must_precede or (then, first) in self.must_precede
 
 
 LEARNED_SIGNATURES = {"part": 1, "hole": 1, "fits": 2, "no_fit": 2, "needs_hole": 1,
-                      "must_precede": 2, "precedence_edge": 2}
+                      "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2}
 """The predicates of learned facts the planner reads, with their arities (ids only)."""
 
 RESERVED_IDS = frozenset({"none", "home", "site"})
@@ -85,7 +105,7 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
             f"{sources}: hole({reserved[0]}): the ids {', '.join(sorted(RESERVED_IDS))} are "
             "reserved for plans (no hole, tool home, assembly site); rename the hole"
         )
-    for name in ("fits", "no_fit"):
+    for name in ("fits", "no_fit", "out_of_reach"):
         for part, hole in atoms_by_name(facts.atoms, name, 2):
             if part not in known_parts or hole not in known_holes:
                 raise PlannerError(
@@ -99,16 +119,44 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
                            "expected one result per part and hole")
 
 
-def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
-    """Read learned facts files; PlannerError on a file that does not parse, a predicate of
-    the wrong arity or with non-id arguments (:data:`LEARNED_SIGNATURES`), unknown ids,
+def _capacities(atoms: Sequence[clingo.Symbol], holes: set[str], sources: str) -> dict[str, int]:
+    """Hole -> capacity from the ``capacity(H,C)`` atoms; PlannerError naming the atom
+    unless H is a hole/1 and C an integer in 1 .. MAX_IDS, one per hole."""
+    capacity: dict[str, int] = {}
+    for atom in atoms:
+        if atom.type != clingo.SymbolType.Function or atom.name != "capacity":
+            continue
+        args = atom.arguments
+        if (len(args) != 2 or args[0].type != clingo.SymbolType.Function or str(args[0]) not in holes
+                or args[1].type != clingo.SymbolType.Number or not 1 <= args[1].number <= MAX_IDS
+                or str(args[0]) in capacity):
+            raise PlannerError(f"{sources}: {shorten(atom, 60)}: expected capacity(H,C), H a hole/1 and C the "
+                               f"number of parts it takes (an integer in 1 .. {MAX_IDS}), one per hole")
+        capacity[str(args[0])] = args[1].number
+    return capacity
+
+
+def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
+    """What the product says about its holes beyond sizes: ``capacity(H,C)`` for a hole
+    taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not the base,
+    not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`)."""
+    atoms = [fact("capacity", hole.id, hole.capacity) for hole in assembly.holes if hole.capacity > 1]
+    inserted = [part.id for part in assembly.parts if part.role != "base" and part.id not in assembly.manual]
+    return atoms + [fact("out_of_reach", part, hole) for part in inserted
+                    for hole in assembly.hole_ids if assembly.cell_cannot_insert(part, hole)]
+
+
+def load_learned_facts(paths: Sequence[Path | str], product: Sequence[clingo.Symbol] = ()) -> LearnedFacts:
+    """Read learned facts files (and the ``product`` facts, :func:`product_facts`);
+    PlannerError on a file that does not parse, a predicate of the wrong arity or with
+    non-id arguments (:data:`LEARNED_SIGNATURES`), unknown ids, a bad ``capacity/2``,
     a pair both fitting and not fitting, or a precedence cycle.
 
     Precedence is read in both forms, ``must_precede/2`` and ``precedence_edge/2``, and
     closed (:func:`asp.precedence.relation.closed_precedence`): ``must_precede`` and the
     ``must_precede/2`` atoms hold the closure."""
     sources = ", ".join(str(p) for p in paths)
-    atoms = load_atoms(paths, encodings=["plans/needs_hole.lp"])
+    atoms = list(dict.fromkeys([*load_atoms(paths, encodings=["plans/needs_hole.lp"]), *product]))
     check_facts(atoms, LEARNED_SIGNATURES, sources)
     if not atoms_by_name(atoms, "part", 1):
         raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
@@ -122,83 +170,117 @@ def load_learned_facts(paths: Sequence[Path | str]) -> LearnedFacts:
         fits=frozenset(pairs_by_name(atoms, "fits")),
         needs_hole=tuple(p for (p,) in atoms_by_name(atoms, "needs_hole", 1)),
         must_precede=must_precede,
+        capacity=_capacities(atoms, {h for (h,) in atoms_by_name(atoms, "hole", 1)}, sources),
+        out_of_reach=frozenset(pairs_by_name(atoms, "out_of_reach")),
     )
     _check_ids(facts, sources)
     return facts
 
 
 def greedy_assignment(facts: LearnedFacts) -> Assignment:
-    """The paper's greedy assignment; UnsolvableAssembly naming the part left without a hole."""
+    """The paper's greedy assignment; UnsolvableAssembly naming the part left without a
+    hole. A hole that takes several parts is free for a part while it has room and the
+    part is ordered with each part already in it."""
     holes_of = {part: facts.holes_of(part) for part in facts.needs_hole}
     parts_in = {hole: sum(hole in holes for holes in holes_of.values()) for hole in facts.holes}
     biggest_first = sorted(facts.needs_hole, key=lambda part: (len(holes_of[part]), part))
     assignment: Assignment = {}
-    taken_by: dict[str, str] = {}
+    taken_by: dict[str, list[str]] = {hole: [] for hole in facts.holes}
     for part in biggest_first:
-        free = [hole for hole in holes_of[part] if hole not in taken_by]
+        free = [hole for hole in holes_of[part] if len(taken_by[hole]) < facts.room(hole)
+                and all(facts.ordered(part, other) for other in taken_by[hole])]
         if not free:
-            raise UnsolvableAssembly([part], _no_hole_message(part, holes_of[part], taken_by))
+            raise UnsolvableAssembly([part], _no_hole_message(facts, part, holes_of[part], taken_by))
         hole = min(free, key=lambda h: (parts_in[h], h))
         assignment[part] = hole
-        taken_by[hole] = part
+        taken_by[hole].append(part)
     return assignment
 
 
-def _no_hole_message(part: str, fitting: list[str], taken_by: dict[str, str]) -> str:
+def _no_hole_message(facts: LearnedFacts, part: str, fitting: list[str], taken_by: dict[str, list[str]]) -> str:
     if not fitting:
-        return f"the assembly is not solvable: part {part} fits no hole"
-    taken = ", ".join(f"{hole} by {taken_by[hole]}" for hole in fitting)
+        return f"the assembly is not solvable: part {part} fits no hole{_reach_note(facts, [part])}"
+    taken = ", ".join(f"{hole} by {' '.join(taken_by[hole])}" for hole in fitting)
     return (
         f"the assembly is not solvable: part {part} gets no hole; the holes it fits are "
         f"taken by parts at least as big ({taken})"
     )
 
 
+def _reach_note(facts: LearnedFacts, parts: Sequence[str]) -> str:
+    """`` the cell can use`` when the cell cannot reach a hole one of ``parts`` fits."""
+    return " the cell can use" if any(pair[0] in parts for pair in facts.out_of_reach & facts.fits) else ""
+
+
 def maximum_matching(facts: LearnedFacts) -> Assignment:
-    """A largest set of parts with distinct holes they fit (augmenting paths, Kuhn's
-    algorithm; parts in id order, holes in the facts' order)."""
+    """A largest set of parts with holes they fit, each hole holding at most its
+    :meth:`LearnedFacts.room` (augmenting paths, Kuhn's algorithm over the holes' places;
+    parts in id order, holes in the facts' order). Precedence between parts sharing a
+    hole is not looked at."""
     holes_of = {part: facts.holes_of(part) for part in sorted(facts.needs_hole)}
-    owner: dict[str, str] = {}
+    owners: dict[str, list[str]] = {hole: [] for hole in facts.holes}
 
     def augment(part: str, seen: set[str]) -> bool:
         for hole in holes_of[part]:
             if hole not in seen:
                 seen.add(hole)
-                if hole not in owner or augment(owner[hole], seen):
-                    owner[hole] = part
+                if len(owners[hole]) < facts.room(hole):
+                    owners[hole].append(part)
                     return True
+                for k, other in enumerate(owners[hole]):
+                    if augment(other, seen):
+                        owners[hole][k] = part
+                        return True
         return False
 
     for part in holes_of:
         augment(part, set())
-    return {part: hole for hole, part in owner.items()}
+    return {part: hole for hole, parts in owners.items() for part in parts}
 
 
 def hall_violation(facts: LearnedFacts, matching: Assignment) -> tuple[list[str], list[str]]:
     """For a maximum ``matching`` that leaves a part out: parts S and the holes N(S) they
-    fit, with |N(S)| < |S| (König: the parts reachable from an unmatched part along
-    alternating paths; every hole they reach is matched, to another part of S)."""
+    fit, with room for fewer than |S| parts (König: the parts reachable from an unmatched
+    part along alternating paths; every hole they reach is full, of other parts of S)."""
     unmatched = sorted(p for p in facts.needs_hole if p not in matching)
-    owner = {hole: part for part, hole in matching.items()}
+    owners: dict[str, list[str]] = {}
+    for part, hole in matching.items():
+        owners.setdefault(hole, []).append(part)
     parts, holes, frontier = {unmatched[0]}, set(), [unmatched[0]]
     while frontier:
         for hole in facts.holes_of(frontier.pop()):
             if hole not in holes:
                 holes.add(hole)
-                if owner[hole] not in parts:
-                    parts.add(owner[hole])
-                    frontier.append(owner[hole])
+                for owner in owners[hole]:
+                    if owner not in parts:
+                        parts.add(owner)
+                        frontier.append(owner)
     return sorted(parts), [h for h in facts.holes if h in holes]
 
 
 def _unsolvable(facts: LearnedFacts, matching: Assignment) -> UnsolvableAssembly:
     """The error for facts whose maximum ``matching`` leaves a part without a hole."""
     parts, holes = hall_violation(facts, matching)
+    reach = _reach_note(facts, parts)
     if not holes:
-        return UnsolvableAssembly(parts, f"the assembly is not solvable: part {parts[0]} fits no hole")
+        return UnsolvableAssembly(parts, f"the assembly is not solvable: part {parts[0]} fits no hole{reach}")
+    room = sum(facts.room(hole) for hole in holes)
+    fewer = "fewer holes than parts" if room == len(holes) else f"room for {room} part(s), fewer than parts"
     return UnsolvableAssembly(parts, f"the assembly is not solvable: parts {' '.join(parts)} fit only "
-                                     f"{len(holes)} hole(s) between them ({' '.join(holes)}): fewer holes "
-                                     "than parts")
+                                     f"{len(holes)} hole(s){reach} between them "
+                                     f"({' '.join(holes)}): {fewer}")
+
+
+def _unordered_stack(facts: LearnedFacts, matching: Assignment) -> UnsolvableAssembly:
+    """The error for facts with a complete matching but no assignment: every one stacks
+    parts on a hole that precedence does not order (their order along it is unknown);
+    names two such parts of ``matching``."""
+    pairs = sorted((a, b, hole) for a, hole in matching.items() for b, other in matching.items()
+                   if other == hole and a < b and not facts.ordered(a, b))
+    a, b, hole = pairs[0]
+    return UnsolvableAssembly([a, b], f"the assembly is not solvable: every hole assignment puts parts that no "
+                                      f"precedence orders onto one hole (e.g. {a} {b} on {hole}), so their order "
+                                      "along it is unknown")
 
 
 def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
@@ -213,10 +295,14 @@ def _solve_assignments(facts: LearnedFacts, limit: int) -> list[Assignment]:
 
 
 def _require_complete_matching(facts: LearnedFacts) -> None:
-    """UnsolvableAssembly naming a Hall violator when no complete assignment exists."""
+    """UnsolvableAssembly naming a Hall violator when no complete assignment exists (or
+    two parts no precedence orders when the holes' room suffices but every assignment
+    stacks such parts)."""
     matching = maximum_matching(facts)
     if len(matching) < len(facts.needs_hole):
         raise _unsolvable(facts, matching)
+    if any(facts.room(hole) > 1 for hole in facts.holes) and not _solve_assignments(facts, 1):
+        raise _unordered_stack(facts, matching)
 
 
 def all_assignments(facts: LearnedFacts, limit: int = 0) -> list[Assignment]:

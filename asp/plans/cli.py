@@ -27,6 +27,7 @@ from asp.plans.assign import (
     all_assignments,
     feasible_assignment,
     load_learned_facts,
+    product_facts,
 )
 from asp.plans.plans import HOME, Plan, plans, travel_facts
 from asp.solve import write_facts
@@ -99,7 +100,8 @@ def plan_main(argv: list[str]) -> int:
                         help="how many plans (0 = all; default 1; as session --plans)")
     parser.add_argument("--optimal", action="store_true",
                         help="plans of least total tool travel [mm] (needs --assembly)")
-    add_assembly_argument(parser, None, purpose="gives the positions for --optimal")
+    add_assembly_argument(parser, None, purpose="gives the positions for --optimal, how many parts each hole "
+                                                "takes and the holes the cell can use")
     parser.add_argument("--home", type=finite_float(-MAX_COORDINATE, MAX_COORDINATE), nargs=2, default=HOME,
                         metavar=("X", "Y"),
                         help="tool home [m] (default: 0 0, the cell origin)")
@@ -110,10 +112,11 @@ def plan_main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     if (args.optimal or args.travel_out) and not args.assembly:
         raise PlannerError("--optimal and --travel-out need --assembly (part and hole positions)")
-    facts = load_learned_facts(args.facts)
+    assembly = load_assembly(args.assembly) if args.assembly else None
+    facts = load_learned_facts(args.facts, () if assembly is None else product_facts(assembly))
     travel: list[clingo.Symbol] = []
-    if args.optimal or args.travel_out:
-        travel = travel_facts(load_assembly(args.assembly), facts, tuple(args.home))
+    if assembly is not None and (args.optimal or args.travel_out):
+        travel = travel_facts(assembly, facts, tuple(args.home))
     if args.travel_out:
         write_facts(args.travel_out, travel, header="travel(From,To,D): leg lengths [mm]")
     try:

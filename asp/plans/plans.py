@@ -146,7 +146,7 @@ def check_plan(facts: LearnedFacts, steps: Sequence[PlanStep]) -> list[str]:
 
 
 def check_assignment(facts: LearnedFacts, assignment: Mapping[str, str]) -> list[str]:
-    """Errors of a hole assignment (part -> hole), e.g. ``hole_twice(br)``."""
+    """Errors of a hole assignment (part -> hole), e.g. ``over_capacity(br)``."""
     return _errors(facts, [fact("assigned", part, hole) for part, hole in assignment.items()])
 
 

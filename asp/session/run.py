@@ -40,7 +40,7 @@ import msgspec
 import zenoh
 
 from asp import PlannerError
-from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts
+from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts, product_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import Demonstrations, demo_facts
 from asp.precedence.explore.learner import SUPPORTS
@@ -276,7 +276,7 @@ def _learned_atoms(assembly: Assembly, demos_atoms: list, relation: Relation,
     product's ``sizes.lp`` because no cell can try it (:func:`_placed_by_hand`)."""
     atoms = [fact("part", p) for p in assembly.part_ids] + [fact("hole", h) for h in assembly.hole_ids]
     atoms += demos_atoms + precedence_facts(relation) + sizes.facts()
-    atoms += [fact("not_observed", part, hole) for part, hole in not_observed]
+    atoms += [fact("not_observed", part, hole) for part, hole in not_observed] + product_facts(assembly)
     return list(dict.fromkeys(atoms))
 
 

@@ -93,11 +93,13 @@ class PartEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 class HoleEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[holes.<id>]``: a readable ``name``, its cross-section kind (default: the kind of
     its ``[hole_shapes.*]`` in ``geometry.toml``, else round), its ``position`` [m] on the
-    base plate."""
+    base plate, its ``capacity``: how many parts the product stacks in it or onto it (a
+    pin several parts go onto, one above the other)."""
 
     name: Text | None = None
     shape: Kind | None = None
     position: XY | None = None
+    capacity: Annotated[int, Meta(ge=1, le=64, description="an integer in 1 .. 64")] = 1
 
 
 class SizesTable(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -135,8 +135,11 @@ class StepRecord:
 
 
 def check_product_step(product: Product, part: str, hole: str | None, placed: Collection[str]) -> None:
-    """:func:`executor.backend_plugin.check_step` against ``product``, with ``placed`` parts."""
-    check_step(part, hole, parts=product.parts, pegs=product.pegs, holes=product.geometry.holes, placed=placed)
+    """:func:`executor.backend_plugin.check_step` against ``product``, with ``placed`` parts;
+    the hole a plan names for a part placed by hand is not checked (it goes to its goal in
+    the CAD, on whatever feature: the planner's feature for it, as the truth backend takes it)."""
+    check_step(part, None if part in product.manual else hole, parts=product.parts, pegs=product.pegs,
+               holes=product.geometry.holes, placed=placed)
 
 
 class Assembler:

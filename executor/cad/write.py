@@ -145,7 +145,8 @@ def _symbols(symbols: list[clingo.Symbol]) -> str:
 
 def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[str, str]) -> str:
     """``assembly.toml``: the parts with their ``roles`` (base, peg, else the given one or
-    ``part``) and trays, the holes."""
+    ``part``) and trays, the holes (a pin several parts go onto with their number as its
+    ``capacity``)."""
     pegs = derived.hole_of
     lines = [f"# Imported from {title} by ./run.sh import: parts in the CAD frame (the cell frame) [m].",
              f"name = {json.dumps(title)}", ""]
@@ -168,7 +169,9 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
     for pin_id, pin in derived.pins.items():
         onto = f" ({' '.join(pin.parts)} onto it)" if pin.parts else ""
         lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner}{onto}"',
-                  f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]", ""]
+                  f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]"]
+        lines += [f"capacity = {len(pin.parts)}"] if len(pin.parts) > 1 else []
+        lines.append("")
     return "\n".join(lines)
 
 

@@ -38,7 +38,8 @@ from bridge.cell_settings import ServeSettings
 from bridge.messages import Evidence, InsertRequest, Result, StepEvidence, StepRequest
 from executor import ExecutorError, UnknownPair
 from executor.assembly.product import Product, load_product
-from executor.backend_plugin import StepOutcome, check_run, check_step
+from executor.assembly.step import check_product_step
+from executor.backend_plugin import StepOutcome, check_run
 from executor.control.detector import Detector
 from executor.control.ilc import layer_named
 from executor.franka.cell import FrankaCell, FrankaOptions
@@ -204,8 +205,7 @@ class FrankaBackend:
         p = self.product
         check_run(self._run, request.assembly, p.parts, {*self._placed, *self._by_hand})
         fresh = request.assembly != self._run
-        check_step(request.part, request.hole, parts=p.parts, pegs=p.pegs, holes=p.geometry.holes,
-                   placed=() if fresh else {*self._placed, *self._by_hand})
+        check_product_step(p, request.part, request.hole, placed=() if fresh else {*self._placed, *self._by_hand})
         if fresh:
             self._run, self._placed, self._by_hand = request.assembly, {}, set()
         start = time.perf_counter()
