@@ -421,7 +421,7 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     if pid != lowest:
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
-    found = ring_pieces(pid, mesh, bore_loss(derived, pid))
+    found = ring_pieces(pid, mesh, bore_loss(derived, pid), round_pins(derived, pid))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
 
 
@@ -437,6 +437,13 @@ def bore_loss(derived: Derived, pid: str) -> float:
     it goes onto no pin with room: a smaller bore keeps a no-fit)."""
     rooms = [room for hole, room in margins(derived).get(pid, {}).items() if hole in derived.pins and room > 0]
     return BORE_LOSS * min(rooms) if rooms else 0.0
+
+
+def round_pins(derived: Derived, pid: str) -> bool:
+    """Whether part ``pid``'s bore is round and every pin it may go onto too (its cell's
+    bore may then be a polygon about its inscribed circle:
+    :func:`executor.world.rings.round_bores`)."""
+    return derived.bores[pid].kind == "round" and all(pin.section.kind == "round" for pin in derived.pins.values())
 
 
 def pin_level(derived: Derived, pin: PinFit) -> tuple[float, float]:
@@ -621,7 +628,8 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                 if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
-                          exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid))
+                          exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid),
+                                                  round_pins=round_pins(derived, pid))
                           if pid in derived.bores else None)
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
