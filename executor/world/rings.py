@@ -28,6 +28,7 @@ loss reported.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from collections.abc import Callable
 
@@ -155,7 +156,7 @@ def sector_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
     section's outline (a polygon inscribed in it); and the convex parts
     (:func:`convex_parts`) of what lies beyond those circles (a gear's teeth, a handle)."""
     ring = np.asarray(section.interiors[0].coords)[:-1]
-    centre = ring.mean(axis=0)
+    centre = np.round(ring.mean(axis=0) / _GRID) * _GRID  # one disc for every bore of one section
     outline = shapely.Polygon(section.exterior)
     disc = shapely.Point(*centre).buffer(float(shapely.distance(shapely.Point(*centre), outline.exterior)), quad_segs=32)
     far = 2 * float(np.max(np.linalg.norm(np.asarray(outline.exterior.coords) - centre, axis=1)))
@@ -164,21 +165,24 @@ def sector_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
         wedge = shapely.Polygon([a, b, centre + far * (b - centre) / np.linalg.norm(b - centre),
                                  centre + far * (a - centre) / np.linalg.norm(a - centre)])
         cores.append(shapely.intersection(wedge, disc))
-    beyond = shapely.difference(section, shapely.union_all(cores))
-    rest = [part for polygon in getattr(beyond, "geoms", [beyond]) if isinstance(polygon, shapely.Polygon)
-            and polygon.area > 0 for part in convex_parts(shapely.set_precision(polygon, _GRID))]
-    return cores + rest
+    return cores + list(_beyond(outline, disc))
+
+
+@functools.lru_cache(maxsize=16)
+def _beyond(outline: shapely.Polygon, disc: shapely.Polygon) -> tuple[shapely.Polygon, ...]:
+    """The convex parts of ``outline`` beyond ``disc`` (the same for every bore tried)."""
+    beyond = shapely.difference(outline, disc)
+    return tuple(part for polygon in getattr(beyond, "geoms", [beyond]) if isinstance(polygon, shapely.Polygon)
+                 and polygon.area > 0 for part in convex_parts(shapely.set_precision(polygon, _GRID)))
 
 
 def round_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapely.Polygon, float]]:
-    """``section`` and, for its one bore, regular polygons of :data:`ROUND_BORE_CORNERS`
-    corners, most first, whose inscribed circle is the bore's (about its centroid); each
+    """``section`` with its one bore made a regular polygon of :data:`ROUND_BORE_CORNERS`
+    corners (most first) whose inscribed circle is the bore's (about its centroid); each
     with loss 0.0 (``allowed`` is not needed): a round pin passes such a polygon exactly
     when it passes that circle, as it passes the bore. The polygon's corners reach beyond
     the bore, so it is for parts that go onto round pins only."""
-    found = [(section, 0.0)]
-    if len(section.interiors) != 1:
-        return found
+    found: list[tuple[shapely.Polygon, float]] = []
     bore = shapely.Polygon(section.interiors[0])
     centre = bore.centroid
     radius = float(shapely.distance(centre, bore.exterior))
@@ -243,11 +247,13 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -
     # the exact sections first, then the finest coarser bores that work, found by bisection
     # (a coarser bore has wider pieces at it); each one returned is checked whole
     order, low_k, high_k = [0], 1, min(len(c) for c in candidates) - 1
+    if high_k < 0:
+        return f"part '{pid}': no regular polygon about its bore lies within its outline"
     tried: dict[int, tuple[list[tuple[trimesh.Trimesh, float]], float] | None] = {}
     while order:
         k = order.pop()
         tried[k] = _cut([(c[k][0], bottom, top) for c, (_, bottom, top) in zip(candidates, layers)],
-                        sector_parts if round_pins and k > 0 else convex_parts)
+                        sector_parts if round_pins else convex_parts)
         if k == 0 and tried[0] is None and low_k <= high_k:
             order.append((low_k + high_k) // 2)
         elif k > 0:
@@ -262,9 +268,8 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -
             return (f"part '{pid}': the parts of its sections thinner than the cell's hull margin twice are "
                     f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
         corners = "/".join(map(str, sorted({len(c[k][0].interiors[0].coords) - 1 for c in candidates})))
-        bore = ("exact at the bore" if k == 0 else
-                f"the bore a regular {corners}-gon about its inscribed circle (round pins pass it as they pass the "
-                "mesh's)" if round_pins else
+        bore = (f"the bore a regular {corners}-gon about its inscribed circle (round pins pass it as they pass the "
+                "mesh's)" if round_pins else "exact at the bore" if k == 0 else
                 f"the bore {corners}-cornered, inscribed in the mesh's, {1e6 * loss:.1f} um smaller")
         heights = ", ".join(f"{1e3 * (top - bottom):.3f}" for _, bottom, top in layers)
         return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section(s) over its {len(layers)} layer(s) of "
