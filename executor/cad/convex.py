@@ -199,6 +199,24 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             f"{1e3 * rooms[name]:.3f} mm its mesh leaves it ({tried}; expected at least {ROOM_KEPT:.0%})")
 
 
+def pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: float
+               ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+    """The convex pieces of part ``pid`` with a bore whose closed ``mesh`` is no stack of
+    prisms (a torus ring): :func:`fitting_pieces` with its ``pin`` (the pin's solid in the
+    part's frame, where the part rests on it) as its neighbour, which they may leave at most
+    ``allowed`` [m] less room than the mesh leaves it (the cell's bore smaller by at most
+    that, as :func:`executor.world.rings.coarser_bores`); or why they do not."""
+    found = fitting_pieces(pid, mesh, {"its pin": pin})
+    if isinstance(found, str):
+        return found
+    room = fcl.distance(bvh(mesh), bvh(pin), fcl.DistanceRequest(), fcl.DistanceResult())
+    left = _room([convex_object(piece) for piece, _ in found[0]], bvh(pin))
+    if room - left > allowed:
+        return (f"the convex pieces of part '{pid}' leave its pin {1e3 * left:.3f} of the {1e3 * room:.3f} mm its mesh "
+                f"leaves it (expected at most {1e3 * allowed:.3f} mm less)")
+    return found
+
+
 Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, float]], str] | str]
 """A part's own convex pieces (its id and its closed mesh in its frame -> the pieces, each
 with how far dropped vertices reach, and how they were made; or why it has none)."""

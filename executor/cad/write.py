@@ -53,6 +53,7 @@ from pathlib import Path
 import clingo
 import networkx as nx
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.errors import ToolError
@@ -63,8 +64,10 @@ from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
+    Pieces,
     base_is_primitive,
     peg_frame,
+    pin_pieces,
     peg_is_primitive,
     write_mesh,
 )
@@ -421,8 +424,30 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     if pid != lowest:
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
-    found = ring_pieces(pid, mesh, bore_loss(derived, pid), round_pins(derived, pid))
+    found = bore_pieces(derived, pid)(pid, mesh)
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+def bore_pieces(derived: Derived, pid: str) -> Pieces:
+    """How the pieces of part ``pid`` with a bore are made from its mesh in its part frame:
+    a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), else
+    CoACD's pieces that keep its bore within :func:`bore_loss` of its pin's room
+    (:func:`executor.cad.convex.pin_pieces`)."""
+    allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
+    pin = next(p for p in derived.pins.values() if pid in p.parts)
+    low, high = (float(v) for v in mesh.bounds[:, 2])
+    solid = trimesh.creation.extrude_polygon(shapely.Polygon(pin.section.outline + np.array(pin.position)),
+                                             high - low + 2 * NEAR)
+    solid.apply_translation((0.0, 0.0, low - NEAR))
+    solid.apply_transform(peg_frame(derived.bores[pid], mesh))
+
+    def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid))
+        if not isinstance(found, str):
+            return found
+        other = pin_pieces(name, part, solid, allowed)
+        return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
+    return pieces
 
 
 BORE_LOSS = 0.25
@@ -628,9 +653,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                 if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
-                          exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid),
-                                                  round_pins=round_pins(derived, pid))
-                          if pid in derived.bores else None)
+                          exact=bore_pieces(derived, pid) if pid in derived.bores else None)
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done

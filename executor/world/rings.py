@@ -230,6 +230,8 @@ def stack(pid: str, mesh: trimesh.Trimesh) -> list[tuple[shapely.Polygon, float,
 
 def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -> Found:
     """:func:`ring_pieces`, made."""
+    if not mesh.is_volume:  # as written, a mesh can lose a sliver face to rounding
+        return f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections"
     layers = stack(pid, mesh)
     if isinstance(layers, str):
         return layers
