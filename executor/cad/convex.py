@@ -40,6 +40,7 @@ import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print
 import coacd
 import fcl
 import numpy as np
+import scipy.spatial
 import shapely
 import trimesh
 
@@ -250,6 +251,26 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
     return kept, float(max(0.0, np.max(_beyond(kept, points))))
 
 
+APART = 2e-7
+"""Distinct vertices of a written mesh are at least this far apart [m]: twice the 0.1 µm
+its file keeps, so that rounding and a loader's merge (trimesh: 10 nm) keep them two."""
+
+
+def apart(vertices: np.ndarray) -> np.ndarray:
+    """``vertices`` (n, 3) [m] with each pair closer than :data:`APART` (a source's seam
+    where two sheets meet, 4 nm apart in a CAD drawn in mm) moved apart along the line
+    through them to that distance, each by at most half of it."""
+    moved = np.array(vertices, dtype=float)
+    for i, j in sorted(scipy.spatial.cKDTree(moved).query_pairs(APART)):
+        gap = moved[j] - moved[i]
+        size = float(np.linalg.norm(gap))
+        if size > 0:
+            shift = gap / size * (APART - size) / 2
+            moved[i] -= shift
+            moved[j] += shift
+    return moved
+
+
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
                neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame",
                exact: Pieces | None = None) -> tuple[Mesh, list[Path]] | str:
@@ -261,7 +282,7 @@ def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
     ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
-    text = obj_text([(pid, mesh.vertices, mesh.faces)],
+    text = obj_text([(pid, apart(mesh.vertices), mesh.faces)],
                     f"# {pid}: its closed mesh [m] in {frame}, {made}, by ./run.sh import")
     written = [write_atomic(folder / name, text)]
     digest = hashlib.sha256(text.encode()).hexdigest()
