@@ -41,7 +41,6 @@
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import math
@@ -67,8 +66,8 @@ from executor.cad.convex import (
     Pieces,
     base_is_primitive,
     peg_frame,
-    pin_pieces,
     peg_is_primitive,
+    pin_pieces,
     write_mesh,
 )
 from executor.cad.covers import Mapped, map_parts
@@ -78,7 +77,7 @@ from executor.cad.sweep import opposite
 from executor.world.frames import hole_rotation
 from executor.world.geometry import CellGeometry, Section, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
-from executor.world.rings import ring_pieces
+from executor.world.rings import NoStack, ring_pieces
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -430,8 +429,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
 
 def bore_pieces(derived: Derived, pid: str) -> Pieces:
     """How the pieces of part ``pid`` with a bore are made from its mesh in its part frame:
-    a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), else
-    CoACD's pieces that keep its bore within :func:`bore_loss` of its pin's room
+    a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), or, for
+    a part that is no such stack, CoACD's pieces that keep its bore within :func:`bore_loss` of its pin's room
     (:func:`executor.cad.convex.pin_pieces`)."""
     allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
     pin = next(p for p in derived.pins.values() if pid in p.parts)
@@ -443,7 +442,7 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
         found = ring_pieces(name, part, allowed, round_pins(derived, pid))
-        if not isinstance(found, str):
+        if not isinstance(found, NoStack):
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"

@@ -106,6 +106,11 @@ def convex_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
     return list(pieces.values())
 
 
+class NoStack(str):
+    """Why a part is no stack of prisms of its sections (its pieces are then made otherwise:
+    :func:`executor.cad.convex.pin_pieces`)."""
+
+
 Found = tuple[list[tuple[trimesh.Trimesh, float]], str] | str
 """A part's pieces, each with 0.0 (no vertex dropped), and how they were made; or why it has none."""
 _FOUND: dict[bytes, Found] = {}
@@ -158,7 +163,8 @@ def sector_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
     ring = np.asarray(section.interiors[0].coords)[:-1]
     centre = np.round(ring.mean(axis=0) / _GRID) * _GRID  # one disc for every bore of one section
     outline = shapely.Polygon(section.exterior)
-    disc = shapely.Point(*centre).buffer(float(shapely.distance(shapely.Point(*centre), outline.exterior)), quad_segs=32)
+    inner = float(shapely.distance(shapely.Point(*centre), outline.exterior))
+    disc = shapely.Point(*centre).buffer(inner, quad_segs=32)
     far = 2 * float(np.max(np.linalg.norm(np.asarray(outline.exterior.coords) - centre, axis=1)))
     cores = []
     for a, b in zip(ring, np.roll(ring, -1, axis=0)):
@@ -222,8 +228,8 @@ def stack(pid: str, mesh: trimesh.Trimesh) -> list[tuple[shapely.Polygon, float,
     for section, bottom, top in layers:
         polygons = list(getattr(section, "geoms", [section]))
         if len(polygons) != 1 or len(polygons[0].interiors) != 1:
-            return (f"part '{pid}' has no one bore in its section from {1e3 * (bottom - low):.3f} to "
-                    f"{1e3 * (top - low):.3f} mm of its height")
+            return NoStack(f"part '{pid}' has no one bore in its section from {1e3 * (bottom - low):.3f} to "
+                           f"{1e3 * (top - low):.3f} mm of its height")
         found.append((polygons[0], bottom, top))
     return found
 
@@ -231,7 +237,7 @@ def stack(pid: str, mesh: trimesh.Trimesh) -> list[tuple[shapely.Polygon, float,
 def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -> Found:
     """:func:`ring_pieces`, made."""
     if not mesh.is_volume:  # as written, a mesh can lose a sliver face to rounding
-        return f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections"
+        return NoStack(f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections")
     layers = stack(pid, mesh)
     if isinstance(layers, str):
         return layers
@@ -242,8 +248,9 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -
         common = trimesh.boolean.intersection([mesh, prism], engine="manifold")
         differ += prism.volume - 2 * (float(common.volume) if len(common.faces) else 0.0)
     if differ >= PRISM_TOLERANCE * mesh.volume:
-        return (f"part '{pid}' is no stack of prisms of its sections (they differ by {differ / mesh.volume:.1%} of its "
-                f"volume over {len(layers)} layer(s); the cell's exact pieces of a part with a bore are prisms')")
+        return NoStack(f"part '{pid}' is no stack of prisms of its sections (they differ by "
+                       f"{differ / mesh.volume:.1%} of its volume over {len(layers)} layer(s); the cell's exact "
+                       "pieces of a part with a bore are prisms')")
     bores = round_bores if round_pins else coarser_bores
     candidates = [bores(section, allowed) for section, _, _ in layers]
     # the exact sections first, then the finest coarser bores that work, found by bisection

@@ -267,14 +267,12 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
-    pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (spur gears "
-                                               "whose hub stands 10 mm above their teeth)")),
+    "factory_gears",
     "factory_rect_pegs",
     pytest.param("ldraw_axles", marks=_xfail(INSERTED + " onto a pin on top of another (the gear on the bush), "
                                               "or a cross axle whose arms (1.6 mm) are thinner than the cell's "
                                               "hull margin twice")),
-    pytest.param("metaworld_assembly", marks=_xfail(INSERTED + " onto a pin that is no prism of its section (a "
-                                                    "torus ring with a handle)")),
+    "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
                                           "rod through two brackets")),
     "robosuite_nuts",
