@@ -42,7 +42,7 @@ ROUND_BORE_CORNERS = (64, 48, 32, 24, 16, 12, 8)
 """The corners of the regular polygons a round bore on round pins is tried as (:func:`round_bores`)."""
 MIN_BORE_CORNERS = 6
 """A bore made coarser keeps at least this many corners."""
-THIN_TOLERANCE = 0.25
+THIN_TOLERANCE = 0.2
 """The parts of a part's sections away from its bore that are too thin for the cell (a
 gear's teeth) are left out up to this fraction of its volume."""
 PRISM_TOLERANCE = 0.01
