@@ -360,7 +360,7 @@ def test_the_truth_backend_answers_every_pair_as_sizes_lp(imported: Callable[[st
             assert result == ("fit" if (part, hole) in sizes.get("fits", set()) else "no_fit"), (part, hole)
 
 
-@pytest.mark.slow  # imports the product, teaches the ring, runs a sim session of 1 experiment and assembles (291 s loaded)
+@pytest.mark.slow  # imports, teaches the ring, a sim session of 1 experiment and its assembly (291 s loaded)
 @pytest.mark.timeout(600)
 def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physics(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
