@@ -4,26 +4,32 @@ collides with them: their convex pieces, exact or with a bore smaller by a state
 A moving part collides as convex pieces (:mod:`executor.world.meshes`). A decomposition
 that approximates (CoACD) fills part of a bore, and the room between a pin and its bore is
 what decides whether the part goes on. So a part with a bore is taken as what it is in
-most products, a **prism**: its section across its axis (z of its part frame), at half
-its height, swept over its height; it is one when the prism and the mesh differ by less
-than :data:`PRISM_TOLERANCE` of the mesh's volume (exact booleans, manifold3d). The
-section, a polygon with the bore as its hole (and the part's outline, a gear's teeth or
-a nut's handle, as its shell), is cut into convex polygons whose union is that section
-exactly: its constrained Delaunay triangles (shapely) merged across their diagonals,
-longest first, while the union stays convex (Hertel and Mehlhorn: at most four times the
-fewest convex pieces). Each convex polygon swept over the height is a piece. Every piece
-touching the bore must have an eroded form (:func:`executor.world.meshes.eroded`: its
-section inset by the cell's hull margin is something, and its height is more than twice
-the margin), so the bore's faces are where the mesh has them and only edges are rounded
-by the margin; a thinner piece of the outline away from the bore (the 0.2 mm notch where
-two boxes of a nut meet) is left out, counted in the prism's difference from the mesh.
+most products, a **stack of prisms** (:func:`stack`): it is cut across its axis (z of its
+part frame) at the levels of its faces across that axis (within :data:`LEVEL`), each
+layer's section the union of its sections near its ends and at its middle (a chamfer or a
+set-screw hole adds material, never removes it: the bore is the layer's narrowest), and
+adjacent layers are joined while that adds less than :data:`PRISM_TOLERANCE` of the
+part's volume (a gear: its teeth, then its hub). It is such a stack when the layers'
+prisms and the mesh differ by less than that (exact booleans, manifold3d). Each section,
+a polygon with the bore as its hole (and the part's outline, a gear's teeth or a nut's
+handle, as its shell), is cut into convex polygons whose union is that section exactly:
+its constrained Delaunay triangles (shapely) merged across their diagonals, longest
+first, while the union stays convex (Hertel and Mehlhorn: at most four times the fewest
+convex pieces). Each convex polygon swept over its layer is a piece. Every piece touching
+the bore must have an eroded form (:func:`executor.world.meshes.eroded`: its section inset
+by the cell's hull margin is something, and its height is more than twice the margin), so
+the bore's faces are where the mesh has them and only edges are rounded by the margin; the
+thinner parts away from the bore (a gear's teeth, the 0.2 mm notch where two boxes of a
+nut meet) are left out, up to :data:`THIN_TOLERANCE` of the part's volume.
 
 A convex piece holds at most one edge of a bore (its corners point into the piece), so a
 finely tessellated round bore (128 edges of 0.26 mm) has no piece thick enough. Then the
 bore is made coarser (:func:`coarser_bores`): a polygon of some of its corners, inscribed
 in it, so the cell's bore is smaller by a ``loss`` (the largest distance of the bore from
 it), never larger; the finest that works within the ``allowed`` loss is taken and the
-loss reported.
+loss reported. A round bore of a part that goes onto round pins only is made a regular
+polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_parts`): a
+round pin passes it exactly when it passes the bore.
 """
 
 from __future__ import annotations
