@@ -44,6 +44,7 @@ import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print
 import coacd
 import fcl
 import numpy as np
+import scipy.spatial
 import shapely
 import trimesh
 
@@ -185,7 +186,8 @@ def overlap_assumption(derived: Derived) -> list[str]:
 
 
 def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimesh.Trimesh],
-                   fits: frozenset[str] = frozenset()) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+                   fits: frozenset[str] = frozenset(), thresholds: Sequence[float] = THRESHOLDS
+                   ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
     """The convex pieces of part ``pid``'s closed mesh (module docstring; each with how far
     its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
     parts near it in the assembled pose, in its frame); or why no decomposition leaves
@@ -202,7 +204,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     convex = hull.volume < (1 + CONVEX_TOLERANCE) * mesh.volume
     left: dict[str, float] = {}
     short: list[str] = []
-    for seed, threshold in [(0, 0.0)] if convex else [(s, t) for s in SEEDS for t in THRESHOLDS]:
+    for seed, threshold in [(0, 0.0)] if convex else [(s, t) for s in SEEDS for t in thresholds]:
         kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed))]
         if any(eroded(piece.vertices, URDF_HULL_MARGIN) is None for piece, _ in kept):
             continue  # a piece the cell cannot collide as
@@ -221,7 +223,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             name = min(apart, key=lambda n: left[n] / rooms[n])
             return kept, (f"{kind}; they leave {name} {1e3 * left[name]:.3f} of {1e3 * rooms[name]:.3f} mm"
                           + (touching if len(apart) < len(rooms) else ""))
-    tried = f"CoACD's thresholds {', '.join(f'{t:g}' for t in THRESHOLDS)}, seeds {', '.join(map(str, SEEDS))}"
+    tried = f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
     if not short:
         return (f"part '{pid}' has no convex pieces the cell can collide as ({tried}: each gave a piece thinner than "
                 f"{2000 * URDF_HULL_MARGIN:g} mm, the cell's hull margin twice)")
@@ -230,6 +232,55 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
                 if name in fits else f"expected at least {ROOM_KEPT:.0%}")
     return (f"the convex pieces of part '{pid}' leave '{name}' {1e3 * left[name]:.3f} mm of the "
             f"{1e3 * rooms[name]:.3f} mm its mesh leaves it ({tried}; {expected})")
+
+
+def pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: float
+               ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+    """The convex pieces of part ``pid`` with a bore whose closed ``mesh`` is no stack of
+    prisms (a torus ring): :func:`fitting_pieces` with its ``pin`` (the pin's solid in the
+    part's frame, where the part rests on it) as its neighbour, which they may leave at most
+    ``allowed`` [m] less room than the mesh leaves it (the cell's bore smaller by at most
+    that, as :func:`executor.world.rings.coarser_bores`); or why they do not. Made once for
+    a mesh and the file written of it (alike within the 0.1 µm the file keeps)."""
+    points = np.round(apart(mesh.vertices), 7)
+    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.round(pin.vertices, 7).tobytes()
+                         + points[np.lexsort(points.T)].tobytes()).digest()
+    if key not in _PIN_PIECES:
+        _PIN_PIECES[key] = _pin_pieces(pid, mesh, pin, allowed)
+    return _PIN_PIECES[key]
+
+
+_PIN_PIECES: dict[bytes, tuple[list[tuple[trimesh.Trimesh, float]], str] | str] = {}
+""":func:`pin_pieces` of each part, mesh and pin asked for."""
+
+
+def _pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: float
+                ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+    """:func:`pin_pieces`, made."""
+    room = fcl.distance(bvh(mesh), bvh(pin), fcl.DistanceRequest(), fcl.DistanceResult())
+    bound = min(allowed, CENTRED)
+    why = ""
+    for threshold in PIN_THRESHOLDS:
+        found = fitting_pieces(pid, mesh, {"its pin": pin}, thresholds=(threshold,))
+        if isinstance(found, str):
+            why = found
+            continue
+        left = _room([convex_object(piece) for piece, _ in found[0]], bvh(pin))
+        if room - left <= bound:
+            return found
+        why = (f"the convex pieces of part '{pid}' (CoACD at threshold {threshold:g}) leave its pin {1e3 * left:.3f} "
+               f"of the {1e3 * room:.3f} mm its mesh leaves it (expected at most {1e3 * bound:.3f} mm less)")
+    return why
+
+
+PIN_THRESHOLDS = (0.02, 0.01)
+"""CoACD's concavity thresholds tried in turn for a part with a bore (:func:`pin_pieces`):
+finer than a part's default, for a bore round enough to be centred on its pin."""
+CENTRED = 0.002
+"""The most [m] a part's pieces may take from the room its mesh leaves its pin, whatever
+its room: the cell centres it on the pin by contact with them, so its bore's centre is
+then within half of that of the mesh's (Meta-World's ring: CoACD at 0.05 took 5.4 mm of
+17.3 and left it 2.1 mm off its goal; at 0.02, 1.5 mm)."""
 
 
 Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, float]], str] | str]
@@ -265,6 +316,26 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
     return kept, float(max(0.0, np.max(_beyond(kept, points))))
 
 
+APART = 2e-7
+"""Distinct vertices of a written mesh are at least this far apart [m]: twice the 0.1 µm
+its file keeps, so that rounding and a loader's merge (trimesh: 10 nm) keep them two."""
+
+
+def apart(vertices: np.ndarray) -> np.ndarray:
+    """``vertices`` (n, 3) [m] with each pair closer than :data:`APART` (a source's seam
+    where two sheets meet, 4 nm apart in a CAD drawn in mm) moved apart along the line
+    through them to that distance, each by at most half of it."""
+    moved = np.array(vertices, dtype=float)
+    for i, j in sorted(scipy.spatial.cKDTree(moved).query_pairs(APART)):
+        gap = moved[j] - moved[i]
+        size = float(np.linalg.norm(gap))
+        if size > 0:
+            shift = gap / size * (APART - size) / 2
+            moved[i] -= shift
+            moved[j] += shift
+    return moved
+
+
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
                neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame",
                exact: Pieces | None = None, fits: frozenset[str] = frozenset()) -> tuple[Mesh, list[Path]] | str:
@@ -277,7 +348,7 @@ def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
     ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
-    text = obj_text([(pid, mesh.vertices, mesh.faces)],
+    text = obj_text([(pid, apart(mesh.vertices), mesh.faces)],
                     f"# {pid}: its closed mesh [m] in {frame}, {made}, by ./run.sh import")
     written = [write_atomic(folder / name, text)]
     digest = hashlib.sha256(text.encode()).hexdigest()

@@ -41,7 +41,6 @@
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import math
@@ -53,6 +52,7 @@ from pathlib import Path
 import clingo
 import networkx as nx
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.errors import ToolError
@@ -63,10 +63,12 @@ from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
+    Pieces,
     base_is_primitive,
     fitted,
     peg_frame,
     peg_is_primitive,
+    pin_pieces,
     write_mesh,
 )
 from executor.cad.covers import Mapped, map_parts
@@ -77,7 +79,7 @@ from executor.cad.sweep import opposite
 from executor.world.frames import hole_rotation
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
-from executor.world.rings import ring_pieces
+from executor.world.rings import NoStack, ring_pieces
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -420,8 +422,31 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     if pid != lowest:
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
-    found = ring_pieces(pid, mesh, bore_loss(derived, pid))
+    found = bore_pieces(derived, pid)(pid, mesh)
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+def bore_pieces(derived: Derived, pid: str) -> Pieces:
+    """How the pieces of part ``pid`` with a bore are made from its mesh in its part frame:
+    a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), or, for
+    a part that is no such stack and has room on a pin, CoACD's pieces that keep its bore
+    within :func:`bore_loss` of its pin's room
+    (:func:`executor.cad.convex.pin_pieces`)."""
+    allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
+    pin = next(p for p in derived.pins.values() if pid in p.parts)
+    low, high = (float(v) for v in mesh.bounds[:, 2])
+    solid = trimesh.creation.extrude_polygon(shapely.Polygon(pin.section.outline + np.array(pin.position)),
+                                             high - low + 2 * NEAR)
+    solid.apply_translation((0.0, 0.0, low - NEAR))
+    solid.apply_transform(peg_frame(derived.bores[pid], mesh))
+
+    def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid))
+        if not isinstance(found, NoStack) or allowed <= 0:  # no room to lose: no approximate pieces
+            return found
+        other = pin_pieces(name, part, solid, allowed)
+        return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
+    return pieces
 
 
 BORE_LOSS = 0.25
@@ -436,6 +461,13 @@ def bore_loss(derived: Derived, pid: str) -> float:
     it goes onto no pin with room: a smaller bore keeps a no-fit)."""
     rooms = [room for hole, room in margins(derived).get(pid, {}).items() if hole in derived.pins and room > 0]
     return BORE_LOSS * min(rooms) if rooms else 0.0
+
+
+def round_pins(derived: Derived, pid: str) -> bool:
+    """Whether part ``pid``'s bore is round and every pin it may go onto too (its cell's
+    bore may then be a polygon about its inscribed circle:
+    :func:`executor.world.rings.round_bores`)."""
+    return derived.bores[pid].kind == "round" and all(pin.section.kind == "round" for pin in derived.pins.values())
 
 
 def pin_level(derived: Derived, pin: PinFit) -> tuple[float, float]:
@@ -620,8 +652,8 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                 if other != pid and np.all(np.minimum(mesh.bounds[1], part.mesh.bounds[1])
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
-                          exact=functools.partial(ring_pieces, allowed=bore_loss(derived, pid))
-                          if pid in derived.bores else None, fits=frozenset(fitted(derived, pid)))
+                          exact=bore_pieces(derived, pid) if pid in derived.bores else None,
+                          fits=frozenset(fitted(derived, pid)))
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             return done

@@ -4,31 +4,39 @@ collides with them: their convex pieces, exact or with a bore smaller by a state
 A moving part collides as convex pieces (:mod:`executor.world.meshes`). A decomposition
 that approximates (CoACD) fills part of a bore, and the room between a pin and its bore is
 what decides whether the part goes on. So a part with a bore is taken as what it is in
-most products, a **prism**: its section across its axis (z of its part frame), at half
-its height, swept over its height; it is one when the prism and the mesh differ by less
-than :data:`PRISM_TOLERANCE` of the mesh's volume (exact booleans, manifold3d). The
-section, a polygon with the bore as its hole (and the part's outline, a gear's teeth or
-a nut's handle, as its shell), is cut into convex polygons whose union is that section
-exactly: its constrained Delaunay triangles (shapely) merged across their diagonals,
-longest first, while the union stays convex (Hertel and Mehlhorn: at most four times the
-fewest convex pieces). Each convex polygon swept over the height is a piece. Every piece
-touching the bore must have an eroded form (:func:`executor.world.meshes.eroded`: its
-section inset by the cell's hull margin is something, and its height is more than twice
-the margin), so the bore's faces are where the mesh has them and only edges are rounded
-by the margin; a thinner piece of the outline away from the bore (the 0.2 mm notch where
-two boxes of a nut meet) is left out, counted in the prism's difference from the mesh.
+most products, a **stack of prisms** (:func:`stack`): it is cut across its axis (z of its
+part frame) at the levels of its faces across that axis (within :data:`LEVEL`), each
+layer's section the union of its sections near its ends and at its middle (a chamfer or a
+set-screw hole adds material, never removes it: the bore is the layer's narrowest), and
+adjacent layers are joined while that adds less than :data:`PRISM_TOLERANCE` of the
+part's volume (a gear: its teeth, then its hub). It is such a stack when the layers'
+prisms and the mesh differ by less than that (exact booleans, manifold3d). Each section,
+a polygon with the bore as its hole (and the part's outline, a gear's teeth or a nut's
+handle, as its shell), is cut into convex polygons whose union is that section exactly:
+its constrained Delaunay triangles (shapely) merged across their diagonals, longest
+first, while the union stays convex (Hertel and Mehlhorn: at most four times the fewest
+convex pieces). Each convex polygon swept over its layer is a piece. Every piece touching
+the bore must have an eroded form (:func:`executor.world.meshes.eroded`: its section inset
+by the cell's hull margin is something, and its height is more than twice the margin), so
+the bore's faces are where the mesh has them and only edges are rounded by the margin; the
+thinner parts away from the bore (a gear's teeth, the 0.2 mm notch where two boxes of a
+nut meet) are left out, up to :data:`THIN_TOLERANCE` of the part's volume.
 
 A convex piece holds at most one edge of a bore (its corners point into the piece), so a
 finely tessellated round bore (128 edges of 0.26 mm) has no piece thick enough. Then the
 bore is made coarser (:func:`coarser_bores`): a polygon of some of its corners, inscribed
 in it, so the cell's bore is smaller by a ``loss`` (the largest distance of the bore from
 it), never larger; the finest that works within the ``allowed`` loss is taken and the
-loss reported.
+loss reported. A round bore of a part that goes onto round pins only is made a regular
+polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_parts`): a
+round pin passes it exactly when it passes the bore.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
+from collections.abc import Callable
 
 import numpy as np
 import shapely
@@ -36,11 +44,25 @@ import trimesh
 
 from executor.world.meshes import URDF_HULL_MARGIN
 
+ROUND_BORE_CORNERS = (64, 48, 32, 24, 16, 12, 8)
+"""The corners of the regular polygons a round bore on round pins is tried as (:func:`round_bores`)."""
 MIN_BORE_CORNERS = 6
 """A bore made coarser keeps at least this many corners."""
+THIN_TOLERANCE = 0.2
+"""The parts of a part's sections away from its bore that are too thin for the cell (a
+gear's teeth) are left out up to this fraction of its volume."""
 PRISM_TOLERANCE = 0.01
 """A part is the prism of its mid-height section when the two differ by less than this
 fraction of its volume."""
+LEVEL = 1e-5
+"""Faces across the axis within this height [m] of each other are at one level."""
+_ACROSS = 1e-6
+"""A face is across the axis when its normal is within this of it (1 - |n_z|)."""
+_INSET = 0.01
+"""A layer's sections are taken this fraction of its height inside its ends, and at its middle."""
+_GRID = 1e-8
+"""A layer's section is snapped to this grid [m] (a union of sections has corners closer
+than a mesh can be made of)."""
 _CONVEX = 1e-9
 """A union is convex when its hull is larger by less than this fraction of its area."""
 
@@ -90,22 +112,29 @@ def convex_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
     return list(pieces.values())
 
 
+class NoStack(str):
+    """Why a part is no stack of prisms of its sections (its pieces are then made otherwise:
+    :func:`executor.cad.convex.pin_pieces`)."""
+
+
 Found = tuple[list[tuple[trimesh.Trimesh, float]], str] | str
 """A part's pieces, each with 0.0 (no vertex dropped), and how they were made; or why it has none."""
 _FOUND: dict[bytes, Found] = {}
 """:func:`ring_pieces` of each part and mesh asked for (an import asks for each more than once)."""
 
 
-def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0) -> Found:
+def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pins: bool = False) -> Found:
     """The convex pieces of part ``pid`` with a bore, its closed ``mesh`` in its part frame
     [m] (z its axis; module docstring), each with 0.0 (no vertex dropped) and a line saying
     how they were made; or why the part has none: no prism of its section, or a piece at
     the bore too thin for the cell even with the bore made coarser by at most ``allowed``
-    [m] (:func:`coarser_bores`)."""
-    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.ascontiguousarray(mesh.vertices).tobytes()
+    [m] (:func:`coarser_bores`), or, when it goes onto ``round_pins`` only, circumscribing
+    the bore's inscribed circle (:func:`round_bores`)."""
+    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + bytes([round_pins])
+                         + np.ascontiguousarray(mesh.vertices).tobytes()
                          + np.ascontiguousarray(mesh.faces).tobytes()).digest()
     if key not in _FOUND:
-        _FOUND[key] = _pieces(pid, mesh, allowed)
+        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins)
     return _FOUND[key]
 
 
@@ -131,29 +160,115 @@ def coarser_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapel
     return found
 
 
-def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float) -> Found:
-    """:func:`ring_pieces`, made."""
+def sector_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
+    """Convex polygons whose union is ``section``, whose one bore is a regular polygon
+    (:func:`round_bores`): for each edge of the bore, the sector between the rays from the
+    bore's centre through its ends, out to the largest circle about the centre within the
+    section's outline (a polygon inscribed in it); and the convex parts
+    (:func:`convex_parts`) of what lies beyond those circles (a gear's teeth, a handle)."""
+    ring = np.asarray(section.interiors[0].coords)[:-1]
+    centre = np.round(ring.mean(axis=0) / _GRID) * _GRID  # one disc for every bore of one section
+    outline = shapely.Polygon(section.exterior)
+    inner = float(shapely.distance(shapely.Point(*centre), outline.exterior))
+    disc = shapely.Point(*centre).buffer(inner, quad_segs=32)
+    far = 2 * float(np.max(np.linalg.norm(np.asarray(outline.exterior.coords) - centre, axis=1)))
+    cores = []
+    for a, b in zip(ring, np.roll(ring, -1, axis=0)):
+        wedge = shapely.Polygon([a, b, centre + far * (b - centre) / np.linalg.norm(b - centre),
+                                 centre + far * (a - centre) / np.linalg.norm(a - centre)])
+        cores.append(shapely.intersection(wedge, disc))
+    return cores + list(_beyond(outline, disc))
+
+
+@functools.lru_cache(maxsize=16)
+def _beyond(outline: shapely.Polygon, disc: shapely.Polygon) -> tuple[shapely.Polygon, ...]:
+    """The convex parts of ``outline`` beyond ``disc`` (the same for every bore tried)."""
+    beyond = shapely.difference(outline, disc)
+    return tuple(part for polygon in getattr(beyond, "geoms", [beyond]) if isinstance(polygon, shapely.Polygon)
+                 and polygon.area > 0 for part in convex_parts(shapely.set_precision(polygon, _GRID)))
+
+
+def round_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapely.Polygon, float]]:
+    """``section`` with its one bore made a regular polygon of :data:`ROUND_BORE_CORNERS`
+    corners (most first) whose inscribed circle is the bore's (about its centroid); each
+    with loss 0.0 (``allowed`` is not needed): a round pin passes such a polygon exactly
+    when it passes that circle, as it passes the bore. The polygon's corners reach beyond
+    the bore, so it is for parts that go onto round pins only."""
+    found: list[tuple[shapely.Polygon, float]] = []
+    bore = shapely.Polygon(section.interiors[0])
+    centre = bore.centroid
+    radius = float(shapely.distance(centre, bore.exterior))
+    for corners in ROUND_BORE_CORNERS:
+        turn = np.linspace(0.0, 2 * np.pi, corners, endpoint=False)
+        reach = radius / np.cos(np.pi / corners)
+        ring = np.column_stack([centre.x + reach * np.cos(turn), centre.y + reach * np.sin(turn)])
+        if shapely.Polygon(ring).within(shapely.Polygon(section.exterior)):
+            found.append((shapely.Polygon(section.exterior.coords, [ring]), 0.0))
+    return found
+
+
+def stack(pid: str, mesh: trimesh.Trimesh) -> list[tuple[shapely.Polygon, float, float]] | str:
+    """The layers of part ``pid`` with a bore, its closed ``mesh`` in its part frame [m]
+    (module docstring), each as (its section, its bottom, its top) [m], the section one
+    polygon with one bore; or why it has none."""
     low, high = (float(v) for v in mesh.bounds[:, 2])
-    section = section_at(mesh, (low + high) / 2)
-    if len(section.geoms) != 1 or not section.geoms[0].interiors:
-        return f"part '{pid}' has no bore in one section at half its height"
-    shape = section.geoms[0]
-    prism = trimesh.creation.extrude_polygon(shape, high - low)
-    prism.apply_translation((0.0, 0.0, low))
-    common = trimesh.boolean.intersection([mesh, prism], engine="manifold")
-    differ = mesh.volume + prism.volume - 2 * (float(common.volume) if len(common.faces) else 0.0)
+    levels = [low]
+    for z in np.sort(mesh.triangles_center[np.abs(mesh.face_normals[:, 2]) > 1 - _ACROSS, 2]):
+        if z - levels[-1] > LEVEL and high - z > LEVEL:
+            levels.append(float(z))
+    levels.append(high)
+    layers: list[tuple[shapely.Geometry, float, float]] = []
+    for bottom, top in zip(levels, levels[1:]):
+        inset = _INSET * (top - bottom)
+        section = shapely.set_precision(shapely.union_all(
+            [section_at(mesh, z) for z in (bottom + inset, (bottom + top) / 2, top - inset)]), _GRID)
+        if layers:
+            below, start, _ = layers[-1]
+            union = shapely.set_precision(shapely.union(below, section), _GRID)
+            if (union.area * (top - start) - below.area * (bottom - start) - section.area * (top - bottom)
+                    < PRISM_TOLERANCE * mesh.volume):
+                layers[-1] = (union, start, top)
+                continue
+        layers.append((section, bottom, top))
+    found = []
+    for section, bottom, top in layers:
+        polygons = list(getattr(section, "geoms", [section]))
+        if len(polygons) != 1 or len(polygons[0].interiors) != 1:
+            return NoStack(f"part '{pid}' has no one bore in its section from {1e3 * (bottom - low):.3f} to "
+                           f"{1e3 * (top - low):.3f} mm of its height")
+        found.append((polygons[0], bottom, top))
+    return found
+
+
+def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -> Found:
+    """:func:`ring_pieces`, made."""
+    if not mesh.is_volume:  # as written, a mesh can lose a sliver face to rounding
+        return NoStack(f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections")
+    layers = stack(pid, mesh)
+    if isinstance(layers, str):
+        return layers
+    differ = mesh.volume
+    for section, bottom, top in layers:
+        prism = trimesh.creation.extrude_polygon(section, top - bottom)
+        prism.apply_translation((0.0, 0.0, bottom))
+        common = trimesh.boolean.intersection([mesh, prism], engine="manifold")
+        differ += prism.volume - 2 * (float(common.volume) if len(common.faces) else 0.0)
     if differ >= PRISM_TOLERANCE * mesh.volume:
-        return (f"part '{pid}' is no prism of its section at half its height (they differ by {differ / mesh.volume:.1%}"
-                f" of its volume; the cell's exact pieces of a part with a bore are a prism's)")
-    height = high - low
-    candidates = coarser_bores(shape, allowed)
-    # the exact section first, then the finest coarser bore that works, found by bisection
+        return NoStack(f"part '{pid}' is no stack of prisms of its sections (they differ by "
+                       f"{differ / mesh.volume:.1%} of its volume over {len(layers)} layer(s); the cell's exact "
+                       "pieces of a part with a bore are prisms')")
+    bores = round_bores if round_pins else coarser_bores
+    candidates = [bores(section, allowed) for section, _, _ in layers]
+    # the exact sections first, then the finest coarser bores that work, found by bisection
     # (a coarser bore has wider pieces at it); each one returned is checked whole
-    order, low_k, high_k = [0], 1, len(candidates) - 1
+    order, low_k, high_k = [0], 1, min(len(c) for c in candidates) - 1
+    if high_k < 0:
+        return f"part '{pid}': no regular polygon about its bore lies within its outline"
     tried: dict[int, tuple[list[tuple[trimesh.Trimesh, float]], float] | None] = {}
     while order:
         k = order.pop()
-        tried[k] = _cut(candidates[k][0], low, high)
+        tried[k] = _cut([(c[k][0], bottom, top) for c, (_, bottom, top) in zip(candidates, layers)],
+                        sector_parts if round_pins else convex_parts)
         if k == 0 and tried[0] is None and low_k <= high_k:
             order.append((low_k + high_k) // 2)
         elif k > 0:
@@ -163,35 +278,43 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float) -> Found:
     working = {k: found for k, found in tried.items() if found is not None}
     if working:
         k = min(working)
-        (pieces, dropped), (cut, loss) = working[k], candidates[k]
-        if differ + dropped * height >= PRISM_TOLERANCE * mesh.volume:
-            return (f"part '{pid}': the convex pieces of its section thick enough for the cell differ from its "
-                    f"mesh by {(differ + dropped * height) / mesh.volume:.1%} of its volume")
-        bore = ("exact at the bore" if loss == 0 else
-                f"the bore {len(cut.interiors[0].coords) - 1}-cornered, inscribed in the mesh's, "
-                f"{1e6 * loss:.1f} um smaller")
-        return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section at half its height over its "
-                        f"{1e3 * height:.3f} mm, {(differ + dropped * height) / mesh.volume:.2%} of its volume apart "
-                        "from the mesh (slivers of the outline thinner than the cell's hull margin twice left out)")
+        (pieces, dropped), loss = working[k], max(c[k][1] for c in candidates)
+        if dropped >= THIN_TOLERANCE * mesh.volume:
+            return (f"part '{pid}': the parts of its sections thinner than the cell's hull margin twice are "
+                    f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
+        corners = "/".join(map(str, sorted({len(c[k][0].interiors[0].coords) - 1 for c in candidates})))
+        bore = (f"the bore a regular {corners}-gon about its inscribed circle (round pins pass it as they pass the "
+                "mesh's)" if round_pins else "exact at the bore" if k == 0 else
+                f"the bore {corners}-cornered, inscribed in the mesh's, {1e6 * loss:.1f} um smaller")
+        heights = ", ".join(f"{1e3 * (top - bottom):.3f}" for _, bottom, top in layers)
+        return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section(s) over its {len(layers)} layer(s) of "
+                        f"{heights} mm, {differ / mesh.volume:.2%} of its volume apart from the mesh; the parts of "
+                        f"its outline thinner than the cell's hull margin twice (a gear's teeth), "
+                        f"{dropped / mesh.volume:.2%} of its volume, left out")
     return (f"part '{pid}': a convex piece of its section at its bore is thinner than {2000 * URDF_HULL_MARGIN:g} mm "
             f"(the cell's hull margin twice; a coarser bore would lose more than {1e6 * allowed:.1f} um)")
 
 
-def _cut(section: shapely.Polygon, low: float, high: float) -> tuple[list[tuple[trimesh.Trimesh, float]], float] | None:
-    """The convex prisms from ``low`` to ``high`` [m] of ``section``'s convex parts and the
-    area [m²] of the outline's slivers left out (parts away from the bore too thin for the
-    cell); None when a part at the bore is too thin. A right prism's eroded form (the
-    cell's, :func:`executor.world.meshes.eroded`) is its section's inset by the margin over
-    its height less twice the margin: it has one when both are something."""
-    bores = shapely.MultiLineString([ring.coords for ring in section.interiors])
-    parts = convex_parts(section)
-    tall = high - low > 2 * URDF_HULL_MARGIN
-    thick = [tall and not shapely.buffer(part, -URDF_HULL_MARGIN).is_empty for part in parts]
-    if any(not ok and part.distance(bores) == 0 for ok, part in zip(thick, parts)):
-        return None
-    pieces = []
-    for part in (part for ok, part in zip(thick, parts) if ok):
-        ring = np.asarray(part.exterior.coords)[:-1]
-        pieces.append((trimesh.convex.convex_hull(np.vstack([np.column_stack([ring, np.full(len(ring), z)])
-                                                              for z in (low, high)])), 0.0))
-    return pieces, sum(part.area for ok, part in zip(thick, parts) if not ok)
+def _cut(layers: list[tuple[shapely.Polygon, float, float]],
+         partition: Callable[[shapely.Polygon], list[shapely.Polygon]]
+         ) -> tuple[list[tuple[trimesh.Trimesh, float]], float] | None:
+    """The convex prisms of each layer's section's convex parts (``partition``: :func:`convex_parts`,
+    or :func:`sector_parts` about a regular bore), from its bottom to its top
+    [m], and the volume [m³] of the outline's slivers left out (parts away from the bore
+    too thin for the cell); None when a part at a bore is too thin. A right prism's eroded
+    form (the cell's, :func:`executor.world.meshes.eroded`) is its section's inset by the
+    margin over its height less twice the margin: it has one when both are something."""
+    pieces, dropped = [], 0.0
+    for section, low, high in layers:
+        bores = shapely.MultiLineString([ring.coords for ring in section.interiors])
+        parts = partition(section)
+        tall = high - low > 2 * URDF_HULL_MARGIN
+        thick = [tall and not shapely.buffer(part, -URDF_HULL_MARGIN).is_empty for part in parts]
+        if any(not ok and part.distance(bores) == 0 for ok, part in zip(thick, parts)):
+            return None
+        for part in (part for ok, part in zip(thick, parts) if ok):
+            ring = np.asarray(part.exterior.coords)[:-1]
+            pieces.append((trimesh.convex.convex_hull(np.vstack([np.column_stack([ring, np.full(len(ring), z)])
+                                                                  for z in (low, high)])), 0.0))
+        dropped += (high - low) * sum(part.area for ok, part in zip(thick, parts) if not ok)
+    return pieces, dropped

@@ -1,0 +1,63 @@
+"""Parts with a bore that are no prism of one section: a gear whose hub stands above its
+teeth is a stack of prisms of its sections, each layer cut into convex pieces the cell
+collides as; a round bore on round pins is a regular polygon about its inscribed circle
+(a round pin passes it exactly as it passes the bore)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+import trimesh
+
+from executor.cad.convex import APART, apart
+from executor.world.rings import NoStack, ring_pieces
+
+BORE = 5.0e-3
+"""The bore's radius [m] (a 64-gon's vertex circle)."""
+
+
+def _stepped() -> trimesh.Trimesh:
+    """A disc of radius 20 mm and 6 mm under a hub of radius 10 mm and 8 mm, through both
+    a round bore (64 corners on the circle of :data:`BORE`), in its part frame [m]."""
+    bore = shapely.Point(0, 0).buffer(BORE, quad_segs=16)
+    disc = trimesh.creation.extrude_polygon(shapely.Point(0, 0).buffer(0.02, quad_segs=8).difference(bore), 0.006)
+    hub = trimesh.creation.extrude_polygon(shapely.Point(0, 0).buffer(0.01, quad_segs=8).difference(bore), 0.008)
+    hub.apply_translation((0.0, 0.0, 0.006))
+    return trimesh.boolean.union([disc, hub], engine="manifold")
+
+
+@pytest.mark.slow  # about 3 s on a loaded machine (the sections' convex parts)
+def test_a_hub_over_a_disc_is_a_stack_of_two_prisms_whose_bore_is_the_inscribed_circle() -> None:
+    found = ring_pieces("stepped", _stepped(), 0.0, round_pins=True)
+    assert not isinstance(found, str), found
+    pieces, made = [piece for piece, _ in found[0]], found[1]
+    assert "2 layer(s) of 6.000, 8.000 mm" in made
+    # each layer is covered up to its own outline, and nothing of it reaches into the bore's
+    # inscribed circle (the mesh's, as trimesh cuts it), which every layer's bore touches
+    # (within 1 um: its sections are snapped and joined)
+    cut = _stepped().section(plane_origin=(0, 0, 0.003), plane_normal=(0, 0, 1))
+    assert cut is not None
+    inner = min(cut.discrete, key=lambda loop: float(np.ptp(loop[:, 0])))
+    inscribed = shapely.distance(shapely.Point(0, 0), shapely.LinearRing(inner[:, :2]))
+    assert inscribed == pytest.approx(BORE * np.cos(np.pi / 64), abs=1e-6)
+    for low, high, outer in ((0.0, 0.006, 0.02), (0.006, 0.014, 0.01)):
+        layer = [p for p in pieces if abs(p.bounds[0][2] - low) < 1e-9 and abs(p.bounds[1][2] - high) < 1e-9]
+        rings = shapely.union_all([shapely.MultiPoint(p.vertices[:, :2]).convex_hull for p in layer])
+        assert abs(rings.area - (np.pi * outer**2 - np.pi * inscribed**2)) < 0.03 * rings.area
+        assert inscribed - 1e-6 < shapely.distance(shapely.Point(0, 0), rings.boundary) <= inscribed
+
+
+def test_a_part_that_is_no_stack_of_prisms_says_so() -> None:
+    # a cone with a bore: every height its own section
+    cone = trimesh.creation.cone(radius=0.02, height=0.02, sections=32)
+    bore = trimesh.creation.cylinder(radius=BORE, height=0.05, sections=32)
+    found = ring_pieces("cone", trimesh.boolean.difference([cone, bore], engine="manifold"), 0.0, round_pins=True)
+    assert isinstance(found, NoStack) and "is no stack of prisms of its sections" in found
+
+
+def test_vertices_closer_than_a_written_file_keeps_are_moved_apart() -> None:
+    points = np.array([[0.1, 0.0, 0.0], [0.1 + 4e-9, 0.0, 0.0], [0.2, 0.0, 0.0]])
+    moved = apart(points)
+    assert np.linalg.norm(moved[1] - moved[0]) == pytest.approx(APART, abs=1e-12)
+    assert np.allclose(moved[:2].mean(axis=0), points[:2].mean(axis=0)) and np.array_equal(moved[2], points[2])
