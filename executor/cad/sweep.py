@@ -13,7 +13,8 @@ only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
 superset that meets B no deeper than :data:`TOUCH` clears every prism inside it: first the
 sweep of the part's convex hull (one query: the answer for a convex part), then down a
 tree of the part's triangles (halves of nearby ones): a node whose swept box misses B's
-box, or whose swept hull clears B, is done; the prisms are tested only in leaves of
+box, or meets no cell of B's grid that B's triangles' boxes meet (:meth:`_Triangles.meets`:
+no contact is found in it), or whose swept hull clears B, is done; the prisms are tested only in leaves of
 :data:`CHUNK` triangles that still meet B. The tree is searched depth first, the half
 holding more of the few triangles that lead the sweep into B's box (:func:`_front`)
 first: where the part is blocked, they usually meet B deeply, so the search ends soon;
@@ -399,6 +400,8 @@ def swept_pieces(triangles: np.ndarray, shift: np.ndarray) -> list[_Piece]:
     return [_Piece(np.vstack([triangle, triangle + shift]), (5, _PRISM_FACES)) for triangle in triangles]
 
 
+GRID = 128
+"""Cells of the fixed part's grid along its longest side (:meth:`_Triangles.meets`)."""
 BLOCK = 64
 """Triangles of a block of the fixed part's index (:class:`_Triangles`)."""
 
@@ -406,7 +409,8 @@ BLOCK = 64
 class _Triangles:
     """A fixed part's triangles: their ``corners`` (n, 3, 3) [m], ``centres``, boxes and blocks of
     :data:`BLOCK` nearby ones (in the order of their centres' Morton codes) with their
-    boxes, to find those near a piece (:func:`_likely`)."""
+    boxes, to find those near a piece (:func:`_likely`), and a grid of the cells their
+    boxes meet, to find that none is near a box (:func:`_collides`)."""
 
     def __init__(self, corners: np.ndarray) -> None:
         self.corners = corners
@@ -423,6 +427,19 @@ class _Triangles:
         """Triangle indices, the last block's padded with -1."""
         low, high = np.vstack([self.low, np.full(3, np.inf)]), np.vstack([self.high, np.full(3, -np.inf)])
         self.block_low, self.block_high = low[self.blocks].min(axis=1), high[self.blocks].max(axis=1)
+        self.origin = self.low.min(axis=0)
+        self.cell = max(float(np.max(self.high.max(axis=0) - self.origin)) / GRID, 1e-12)
+        """The grid's corner and its cells' side [m]."""
+        first = np.floor((self.low - self.origin) / self.cell).astype(int)
+        last = np.floor((self.high - self.origin) / self.cell).astype(int)
+        starts = np.zeros(last.max(axis=0) + 2, dtype=np.int64)  # +1, -1 at a box's corners: summed, its cells
+        for corner in np.ndindex(2, 2, 2):
+            np.add.at(starts, tuple(np.where(corner, last + 1, first).T), (-1) ** sum(corner))
+        occupied = starts.cumsum(axis=0).cumsum(axis=1).cumsum(axis=2)[:-1, :-1, :-1] > 0
+        self.grid = np.zeros(np.array(occupied.shape) + 1, dtype=np.int32)
+        """The summed-volume table of the cells that a triangle's box meets: the count of
+        those with indices below (i, j, k) at [i, j, k]."""
+        self.grid[1:, 1:, 1:] = occupied.cumsum(axis=0).cumsum(axis=1).cumsum(axis=2)
 
     def near(self, low: np.ndarray, high: np.ndarray) -> np.ndarray:
         """The triangles whose boxes meet the box ``low``, ``high`` [m]."""
@@ -430,6 +447,21 @@ class _Triangles:
         found = self.blocks[blocks].ravel()
         found = found[found >= 0]
         return found[np.all(np.minimum(high, self.high[found]) >= np.maximum(low, self.low[found]), axis=1)]
+
+    def meets(self, low: np.ndarray, high: np.ndarray) -> bool:
+        """Whether the box ``low``, ``high`` [m] meets a cell of :attr:`grid` that a
+        triangle's box meets (False: it meets no triangle's box; cells are compared by
+        their indices, which rounding keeps in order)."""
+        first = np.floor((low - self.origin) / self.cell)
+        last = np.floor((high - self.origin) / self.cell)
+        shape = np.array(self.grid.shape) - 1
+        if np.any(last < 0) or np.any(first >= shape):
+            return False
+        a, b = np.maximum(first, 0).astype(int), np.minimum(last, shape - 1).astype(int) + 1
+        ends = (b, a)  # the cells below b less those below a on some axis: inclusion-exclusion
+        inside = sum((-1) ** sum(c) * int(self.grid[ends[c[0]][0], ends[c[1]][1], ends[c[2]][2]])
+                     for c in np.ndindex(2, 2, 2))
+        return inside > 0
 
 
 @dataclass(frozen=True)
@@ -679,11 +711,12 @@ def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
     while pending:
         node = pending.pop()
         points = node.points
-        start, end = node.low, node.high
-        if np.any(np.minimum(np.maximum(end, end + shift), high)
-                  - np.maximum(np.minimum(start, start + shift), low) <= TOUCH):
+        start, end = np.minimum(node.low, node.low + shift), np.maximum(node.high, node.high + shift)
+        if np.any(np.minimum(end, high) - np.maximum(start, low) <= TOUCH):
             continue
         if len(points) <= HULL_POINTS:
+            if not fixed.index.meets(start - TOUCH, end + TOUCH):
+                continue  # every piece in the swept box lies farther than TOUCH from fixed's triangles: no contact
             if id(node) not in pieces:
                 pieces[id(node)] = _hull_piece(np.vstack([points, points + shift]))
             piece = pieces[id(node)]
