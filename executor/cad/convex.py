@@ -50,6 +50,7 @@ import trimesh
 
 from bridge.files import make_folder, write_atomic
 from bridge.product import CONVEX_HEADER, Mesh
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor.assembly.product import Box
 from executor.cad.derive import Derived, HoleFit
 from executor.cad.sections import Shape2D
@@ -75,11 +76,11 @@ NEAR = 0.002
 """The parts whose bounding boxes come this close [m] to a part's are its neighbours."""
 PIECE_VERTICES = 64
 """The most vertices a convex piece keeps (the 12 mm shaft of the tests then within 0.06 mm)."""
-NOMINAL_OVERLAP = 1.5e-4
+NOMINAL_OVERLAP = NOMINAL_FIT_ROOM
 """How deep [m] a part's convex pieces may overlap a part at a stated zero-clearance fit or
 passage with it (their meshes touch: any decomposition error is an overlap there): the
-room per side the simulated cell models a nominal zero-clearance fit with (0.15 mm,
-docs/decisions.md), so that in that model the pieces clear it."""
+room per side the simulated cell models a nominal zero-clearance fit with
+(:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`), so that in that model the pieces clear it."""
 MESH_FOLDER = "meshes"
 YAW_TOLERANCE = 0.01
 """A square section within this of the cell's axes [°] is not turned."""
