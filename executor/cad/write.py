@@ -437,8 +437,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
 def bore_pieces(derived: Derived, pid: str) -> Pieces:
     """How the pieces of part ``pid`` with a bore are made from its mesh in its part frame:
     a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), or, for
-    a part that is no such stack and has room on a pin, CoACD's pieces that keep its bore
-    within :func:`bore_loss` of its pin's room
+    a part that is no such stack, CoACD's pieces that keep its bore within :func:`bore_loss`
+    of its pin's room (the part has room on its pin: :func:`_onto_pin`)
     (:func:`executor.cad.convex.pin_pieces`)."""
     allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
     pin = next(p for p in derived.pins.values() if pid in p.parts)
@@ -450,7 +450,7 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
         found = ring_pieces(name, part, allowed, round_pins(derived, pid))
-        if not isinstance(found, NoStack) or allowed <= 0:  # no room to lose: no approximate pieces
+        if not isinstance(found, NoStack):
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
