@@ -80,6 +80,7 @@ from executor.world.frames import hole_rotation
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
+from executor.world.scene import SIZE_RESOLUTION
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
@@ -413,7 +414,10 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
 
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
-    the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`)."""
+    the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`);
+    a part whose room on it per side (:func:`margins`) is under
+    :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
+    experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
     if pin.owner != derived.base:
         return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
     if pin.axis != "+z":
@@ -421,6 +425,10 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     lowest = min(pin.parts, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p))
     if pid != lowest:
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
+    room = margins(derived)[pid][pin.id]
+    if abs(room) / 2 < SIZE_RESOLUTION:
+        return (f"goes onto a pin ({pin.id}) with {room * 500:+.4f} mm of room per side, less than the "
+                f"{SIZE_RESOLUTION * 1e3:g} mm the simulated cell resolves")
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
     found = bore_pieces(derived, pid)(pid, mesh)
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
@@ -429,8 +437,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
 def bore_pieces(derived: Derived, pid: str) -> Pieces:
     """How the pieces of part ``pid`` with a bore are made from its mesh in its part frame:
     a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), or, for
-    a part that is no such stack and has room on a pin, CoACD's pieces that keep its bore
-    within :func:`bore_loss` of its pin's room
+    a part that is no such stack, CoACD's pieces that keep its bore within :func:`bore_loss`
+    of its pin's room (the part has room on its pin: :func:`_onto_pin`)
     (:func:`executor.cad.convex.pin_pieces`)."""
     allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
     pin = next(p for p in derived.pins.values() if pid in p.parts)
@@ -442,7 +450,7 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
         found = ring_pieces(name, part, allowed, round_pins(derived, pid))
-        if not isinstance(found, NoStack) or allowed <= 0:  # no room to lose: no approximate pieces
+        if not isinstance(found, NoStack):
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"

@@ -295,7 +295,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
-    "factory_gears",
+    pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a shaft with less room than the cell resolves "
+                                               "(0.012 mm per side)")),
     "factory_rect_pegs",
     pytest.param("ldraw_axles", marks=_xfail(INSERTED + " onto a pin on top of another (the gear on the bush), "
                                               "or a cross axle whose arms (1.6 mm) are thinner than the cell's "
@@ -360,19 +361,16 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
     assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
-@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
-def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
-    # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
-    # has no operation for (each placed by hand): the sim session must not refuse the
-    # product; it takes every pair from sizes.lp and says none was observed.
-    done = imported("ldraw_axles")
+def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: Runner, run: Path) -> dict[str, Any]:
+    """Teach, run a sim session of ``done`` (every part placed by hand) and assemble its
+    plan 1; checks that nothing is taught, no experiment run, every pair of ``sizes.lp``
+    labelled not observed with the truth's fits, and the product assembled within 2 mm,
+    every part placed by hand. The session's result."""
     taught = run_executor("teach", "--assembly", str(done.out), timeout=120)
     assert taught.returncode == 0 and "no skill to teach" in taught.stdout, taught.stderr
-    run = tmp_path / "run"
     session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--json", timeout=300)
     assert session.stdout, session.stderr
-    result = json.loads(session.stdout)
+    result: dict[str, Any] = json.loads(session.stdout)
     holes = _feature_holes(done)
     truth = {(row["part"], holes[row["feature"]]) for row in done.truth["fits"] if row["feature"] in holes
              and row["fits"]}
@@ -384,17 +382,42 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
     assert result["experiments"] == 0 and not (run / "journal.jsonl").read_text().strip()
     assert _atoms(run / "learned.lp")["not_observed"] == pairs
     assert result["nominal_fits"] is None  # no pair the cell builds with room
-    # the bush and the gear share the liftarm's pin (capacity 2 in assembly.toml): the bush first
     assert session.returncode == 0, result.get("error")
-    for plan in result["plans"]:
-        order = [step["part"] for step in plan]
-        assert {step["part"]: step["hole"] for step in plan if step["part"] in ("bush", "gear")} == {
-            "bush": "liftarm_pin1", "gear": "liftarm_pin1"} and order.index("bush") < order.index("gear")
     # the sim cell takes plan 1, each part placed by hand on the feature the plan names
     done_run = run_cli("assemble", "--run", str(run), "--json", timeout=300)
     report = json.loads(done_run.stdout)
     assert done_run.returncode == 0 and report["assembled"], done_run.stderr
-    assert max(report["final_pose_error_mm"].values()) < 2.0 and set(report["manual"]) == {"axle3", "bush", "gear"}
+    assert max(report["final_pose_error_mm"].values()) < 2.0
+    assert set(report["manual"]) == set(done.truth["parts"]) - {done.truth["base"]}
+    return result
+
+
+@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
+def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
+        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+    # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
+    # has no operation for (each placed by hand): the sim session must not refuse the
+    # product; it takes every pair from sizes.lp and says none was observed.
+    result = _learned_from_its_cad_alone(imported("ldraw_axles"), run_executor, run_cli, tmp_path / "run")
+    # the bush and the gear share the liftarm's pin (capacity 2 in assembly.toml): the bush first
+    for plan in result["plans"]:
+        order = [step["part"] for step in plan]
+        assert {step["part"]: step["hole"] for step in plan if step["part"] in ("bush", "gear")} == {
+            "bush": "liftarm_pin1", "gear": "liftarm_pin1"} and order.index("bush") < order.index("gear")
+
+
+@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s)
+def test_gears_with_less_room_on_their_shafts_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
+        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+    # factory_gears: each gear has 0.012 mm of room per side on its shaft, under the 0.025 mm
+    # the cell resolves (it jammed 11.5 mm short when taught): no experiment, each placed by
+    # hand with that reason, every pair taken from sizes.lp as not observed.
+    done = imported("factory_gears")
+    manual = load_geometry(str(done.out)).tables.manual
+    assert set(manual) == {"gear_small", "gear_medium"}
+    assert all("mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason
+               for table in manual.values()), {pid: table.reason for pid, table in manual.items()}
+    _learned_from_its_cad_alone(done, run_executor, run_cli, tmp_path / "run")
 
 
 @pytest.mark.parametrize("name", PRODUCTS)
