@@ -41,7 +41,8 @@ class InsertionResult:
     """``completed``: the DMP ran to its end without an unresolved eq. (6)/(7) breach;
     ``reached``: goal check passed where the execution ended (the success criterion:
     an interrupted execution succeeds only if the part is already at its goal);
-    ``end_error`` ‖p_end − p_goal‖ [m]; ``jammed``: a breach inside the hole, or the part
+    ``end_error`` ‖p_end − p_goal‖ [m] (p_goal: the taught end in the found hole, not moved
+    by the admittance); ``jammed``: a breach inside the hole, or the part
     stuck in the hole at the end of the trajectory."""
 
     completed: bool
@@ -168,9 +169,12 @@ def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask
     ff_pos = ff_at(clock.phase)[0]
     pos_d = pos_d + ff_pos
     end = motion.hold(pos_d + d_pos, quat_d, END_SETTLE_TIME) if completed else motion.read()
-    # p_goal: where the adapted trajectory ends (the lateral admittance and ILC offsets
-    # included; not ILC's z, which only shapes the push, never where the part must end).
-    p_goal = hole_origin + turn_z(skill.end_position, yaw) + d_pos + ff_pos * np.array([1.0, 1.0, 0.0])
+    # p_goal: the taught end in the hole the search found, moved by ILC's lateral
+    # correction (not its z, which only shapes the push, never where the part must end).
+    # Not by the admittance's offset: that follows the reference wrench, which a part held
+    # by the hole's walls meets only by pressing one, so it can drift to its bound while
+    # the part stays in the hole.
+    p_goal = hole_origin + turn_z(skill.end_position, yaw) + ff_pos * np.array([1.0, 1.0, 0.0])
     reached, err = detector.goal_reached(end.tip_pos, p_goal)
     stalled = completed and not reached and bool(end.tip_pos[2] < hole_origin[2] - JAM_DEPTH)
     jammed = jammed or stalled  # stuck in the hole below the thresholds: a jam too
