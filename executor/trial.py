@@ -41,11 +41,12 @@ from executor.skills.insertion import (
     rotvec_quat_xyzw,
 )
 from executor.skills.search import hole_search
+from executor.world import SIZE_RESOLUTION
 from executor.world.arm import Arm, aligned_yaw, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin
 from executor.world.perturbation import CellBias
-from executor.world.scene import SIZE_RESOLUTION, TIME_STEP, Scene, hole_rims, require_display, scene_shapes
+from executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes
 
 if TYPE_CHECKING:
     from executor.rerun_log import AttemptLogger

@@ -76,11 +76,11 @@ from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, section, zero_clearance
 from executor.cad.sections import rounded as _q
 from executor.cad.sweep import opposite
+from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
-from executor.world.scene import SIZE_RESOLUTION
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""

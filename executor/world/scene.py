@@ -25,14 +25,6 @@ from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, outli
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
-SIZE_RESOLUTION = 25e-6
-"""The smallest room or interference per side [m] between a part's section and a hole's
-that the cell's physics tells apart (docs/cell.md#what-the-physics-resolves): a part's
-primitive has its edges rounded by Bullet's 1 mm collision margin, so its bottom edge meets
-a hole's rim as a ramp that turns horizontal, and the contacts give by up to ~0.1 mm under
-the insertion's forces. Measured (a d 11 mm peg, 2-3 trials each): 0.005 and 0.01 mm
-per side came out wrong (an interference ``fit``, a clearance ``no_fit``), 0.02 to
-0.1 mm right on both sides."""
 # Parked parts (the one in the hand) wait here, out of the way [m].
 _PARKED = (0.0, -2.0, 0.05)
 

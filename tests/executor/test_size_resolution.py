@@ -15,8 +15,8 @@ import shapely
 from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.trial import Cell
+from executor.world import SIZE_RESOLUTION
 from executor.world.geometry import HoleSpec, load_geometry, margin, widened
-from executor.world.scene import SIZE_RESOLUTION
 
 ROOT = Path(__file__).resolve().parents[2]
 
