@@ -316,24 +316,30 @@ def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: 
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
 
 
+def _taught_and_learned_in_the_cell(done: Imported, run_executor: Runner, run_cli: Runner,
+                                    run: Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Teach the imported product, run a sim session with ``--assemble`` into ``run``; its
+    result and its journal's entries."""
+    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
+    assert taught.returncode == 0, taught.stderr
+    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json", timeout=400)
+    assert session.returncode == 0, session.stderr
+    journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
+    return json.loads(session.stdout), journal
+
+
 @pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 90 s)
 @pytest.mark.timeout(600)  # 257 s while the machine ran other work
 def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
     assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
-    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
-    assert taught.returncode == 0, taught.stderr
-    run = tmp_path / "run"
-    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json", timeout=400)
-    assert session.returncode == 0, session.stderr
-    result = json.loads(session.stdout)
+    result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     # Every peg, the hexagon, octagon and 12-gon prisms too, goes into every hole in
     # physics: each pair is an experiment whose outcome is the truth's (peg8 refused by
     # the hexagon, 0.343 mm short; peg12 into it with 0.167 mm to spare).
     holes = _feature_holes(done)
     truth = {(row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
-    journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     assert {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e} == truth
     assert sorted(map(tuple, result["fits"])) == sorted(pair for pair, outcome in truth.items() if outcome == "fit")
     # The plan places the box (the holes' owner) first and every peg ends within 2 mm.
@@ -457,14 +463,8 @@ def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physic
     # over the peg and inserts it down onto it with the skill taught on that peg.
     done = imported("metaworld_assembly")
     assert "CoACD" in (done.out / "meshes" / "round_nut.convex.obj").read_text().splitlines()[2]
-    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
-    assert taught.returncode == 0, taught.stderr
-    run = tmp_path / "run"
-    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json", timeout=400)
-    assert session.returncode == 0, session.stderr
-    result = json.loads(session.stdout)
+    result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     holes = _feature_holes(done)
-    journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     assert {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e} == {
         (row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
     report = result["assembly"]

@@ -18,6 +18,7 @@ pytest.importorskip("mujoco")
 
 from executor.franka.sim_server import sim_robot  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
+from tests.franka import franka_cell_description
 
 TRIO = Path(__file__).parent / "data" / "trio"
 PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
@@ -29,9 +30,7 @@ PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 @pytest.mark.franka_arm
 def test_assemble_on_the_franka_places_every_peg(run_cli, tmp_path: Path) -> None:
     folder = Path(shutil.copytree(TRIO, tmp_path / "trio"))
-    description = tmp_path / "franka-cell.toml"
-    description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                           "grasp_depth = 0.012\n")
+    description = franka_cell_description(tmp_path)
     with sim_robot(folder) as sim:
         done = run_cli("assemble", "--assembly", str(folder), "--backend", "franka",
                        "--backend-option", f"host={sim.host}", "--backend-option", "realtime=ignore",

@@ -30,8 +30,8 @@ from executor.control.detector import Thresholds  # noqa: E402
 from executor.franka.backend import FrankaBackend, franka_starter  # noqa: E402
 from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
 from executor.world.geometry import CellGeometry, load_geometry  # noqa: E402
+from tests.franka import franka_cell_description
 
-GRASP_DEPTH = 0.012  # [m] the Franka Hand's pads reach 8.5 mm below its TCP: they clear the plate so
 PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 BACK = 0.002
 """[m] a part carried back lies this close to where it waited, at most (0.2 mm measured with
@@ -46,9 +46,7 @@ pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtur
 def _arm(tmp_path: Path, product: str) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
     """franky-sim with a copy of the shipped ``product`` and a franka backend driving it."""
     folder = Path(shutil.copytree(DATA_DIR / product, tmp_path / product, ignore=shutil.ignore_patterns("assets")))
-    description = tmp_path / "franka-cell.toml"
-    description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                           f"grasp_depth = {GRASP_DEPTH}\n")
+    description = franka_cell_description(tmp_path)
     with sim_robot(folder) as sim:
         settings = ServeSettings(backend="franka", assembly=str(folder),
                                  backend_options={"host": sim.host, "realtime": "ignore", "dynamics": "0.5"},

@@ -20,6 +20,7 @@ pytest.importorskip("mujoco")
 from executor import ExecutorError  # noqa: E402
 from executor.franka.guide import REST_SPEED, Recording, demonstration_span, resample  # noqa: E402
 from executor.world.scene import TIME_STEP  # noqa: E402
+from tests.franka import franka_cell_description
 
 TRIO = Path(__file__).parent / "data" / "trio"
 LOG = logging.getLogger(__name__)  # the figures of the run (pytest --log-cli-level=INFO shows them)
@@ -96,9 +97,7 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
     from executor.world.geometry import load_geometry
 
     folder = Path(shutil.copytree(TRIO, tmp_path / "trio", ignore=shutil.ignore_patterns("assets", "demonstrations")))
-    description_file = tmp_path / "franka-cell.toml"
-    description_file.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                                "grasp_depth = 0.012\n")
+    description_file = franka_cell_description(tmp_path)
     description = load_cell_description(str(description_file))
     geometry = load_geometry(str(folder), description)
     hole = geometry.holes["h1"]

@@ -22,9 +22,9 @@ pytest.importorskip("mujoco")
 from executor.franka.sim_server import sim_robot  # noqa: E402
 from executor.serve.truth import sizes_truth  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
+from tests.franka import franka_cell_description
 
 TRIO = Path(__file__).parent / "data" / "trio"
-GRASP_DEPTH = 0.012  # [m] the Franka Hand's pads reach 8.5 mm below its TCP: they clear the plate so
 PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 
 
@@ -34,9 +34,7 @@ PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 @pytest.mark.franka_arm
 def test_a_session_through_the_franka_backend_learns_the_fits_and_assembles(run_cli, tmp_path: Path) -> None:
     folder = Path(shutil.copytree(TRIO, tmp_path / "trio"))
-    description = tmp_path / "franka-cell.toml"
-    description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                           f"grasp_depth = {GRASP_DEPTH}\n")
+    description = franka_cell_description(tmp_path)
     _, _, truth = sizes_truth(folder / "sizes.lp")
     with sim_robot(folder) as sim:
         done = run_cli("session", "--assembly", str(folder), "--cells", "1", "--backend", "franka",

@@ -22,9 +22,9 @@ from bridge.messages import InsertRequest  # noqa: E402
 from executor import ExecutorError  # noqa: E402
 from executor.franka.backend import franka_starter  # noqa: E402
 from executor.franka.sim_server import sim_robot  # noqa: E402
+from tests.franka import franka_cell_description
 
 TRIO = Path(__file__).parent / "data" / "trio"
-GRASP_DEPTH = 0.012  # [m] the Franka Hand's pads reach 8.5 mm below its TCP: they clear the plate so
 DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2"), "peg_d12": ("p3", "h3")}
 """Each shape's part and the hole it is taught in (``demo_hole``)."""
 
@@ -35,9 +35,7 @@ DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2"), "peg_d12": ("p3", "h3
 @pytest.mark.franka_arm
 def test_skills_taught_on_the_arm_are_stored_and_an_insertion_uses_them(run_executor, tmp_path: Path) -> None:
     folder = Path(shutil.copytree(TRIO, tmp_path / "trio", ignore=shutil.ignore_patterns("assets", "demonstrations")))
-    description = tmp_path / "franka-cell.toml"
-    description.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                           f"grasp_depth = {GRASP_DEPTH}\n")
+    description = franka_cell_description(tmp_path)
     with sim_robot(folder) as sim:
         options = {"host": sim.host, "realtime": "ignore", "dynamics": "0.5"}
         settings = ServeSettings(backend="franka", assembly=str(folder), backend_options=options,
