@@ -289,17 +289,45 @@ Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, floa
 with how far dropped vertices reach, and how they were made; or why it has none)."""
 
 
-def _beyond(hull: trimesh.Trimesh, points: np.ndarray) -> np.ndarray:
-    """How far [m] each point lies beyond the face planes of a convex ``hull`` (<= 0 inside)."""
-    offsets = np.einsum("ij,ij->i", hull.face_normals, hull.triangles[:, 0])
-    return np.max(points @ hull.face_normals.T - offsets, axis=1)
+def _beyond(planes: tuple[np.ndarray, np.ndarray], points: np.ndarray) -> np.ndarray:
+    """How far [m] each point lies beyond the face ``planes`` of a convex hull (their
+    outward unit normals and each normal's dot with its face's first corner; <= 0 inside)."""
+    normals, offsets = planes
+    return np.max(points @ normals.T - offsets, axis=1)
+
+
+def _planes(hull: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray]:
+    """The face planes (:func:`_beyond`) of a convex ``hull``."""
+    return hull.face_normals, np.einsum("ij,ij->i", hull.face_normals, hull.triangles[:, 0])
+
+
+def _hull_planes(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The face planes (:func:`_beyond`) of ``trimesh.convex.convex_hull(points)``, the same
+    numbers without making the mesh (a third of the cost): qhull's triangles with their
+    degenerate ones left out, each wound outwards from the area-weighted centroid of the
+    triangles' centres, its normal its corners' unit cross product; trimesh's repair after
+    that (winding mended across neighbours) changes no face of a hull qhull gives whole.
+    Where qhull refuses the points (flat), trimesh's own hull (it joggles them)."""
+    try:
+        hull = scipy.spatial.ConvexHull(points, qhull_options=str(trimesh.convex.QHULL_DEFAULT))
+    except scipy.spatial.QhullError:
+        return _planes(trimesh.convex.convex_hull(points))
+    crosses = trimesh.triangles.cross(points[hull.simplices])
+    normals, valid = trimesh.util.unitize(crosses, check_valid=True)
+    faces = hull.simplices[valid]
+    centres = points[faces].mean(axis=1)
+    centroid = np.average(centres, weights=trimesh.triangles.area(crosses=crosses[valid]), axis=0)
+    backwards = trimesh.util.diagonal_dot(normals, centres - centroid) < 0.0
+    faces[backwards] = np.fliplr(faces[backwards])
+    normals, _ = trimesh.triangles.normals(points[faces])
+    return normals, np.einsum("ij,ij->i", normals, points[faces[:, 0]])
 
 
 def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimesh.Trimesh, float]:
     """The hull of at most ``count`` vertices of a convex ``piece`` and how far [m] the
     piece's vertices reach beyond its face planes (0 when it keeps them all): from the
     four vertices of the largest tetrahedron found greedily, the vertex farthest beyond
-    the kept hull is added until ``count`` are kept."""
+    the kept hull (:func:`_hull_planes`) is added until ``count`` are kept."""
     points = np.asarray(piece.vertices)
     if len(points) <= count:
         return piece, 0.0
@@ -310,11 +338,10 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
     normal = np.cross(line, points[third] - points[first])
     fourth = int(np.argmax(np.abs((points - points[first]) @ normal)))
     chosen = [first, second, third, fourth]
-    kept = trimesh.convex.convex_hull(points[chosen])
     while len(chosen) < count:
-        chosen.append(int(np.argmax(_beyond(kept, points))))
-        kept = trimesh.convex.convex_hull(points[chosen])
-    return kept, float(max(0.0, np.max(_beyond(kept, points))))
+        chosen.append(int(np.argmax(_beyond(_hull_planes(points[chosen]), points))))
+    kept = trimesh.convex.convex_hull(points[chosen])
+    return kept, float(max(0.0, np.max(_beyond(_planes(kept), points))))
 
 
 APART = 2e-7
