@@ -36,6 +36,7 @@ never when a cell starts.
 from __future__ import annotations
 
 import hashlib
+import io
 import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -296,9 +297,8 @@ PIN_ITERATIONS = (30, ITERATIONS)
 """CoACD's tree-search iterations per cut tried in turn at each of :data:`PIN_THRESHOLDS`
 (:func:`pin_pieces`): a fifth of its default first, then its default; the pieces of
 either are kept only when they pass the same checks. Its search is most of an import
-with a ring: Meta-World's (1612 triangles, threshold 0.02) took 13.4 s of CPU at 150
-iterations, 4.7 s at 30, and those pieces leave its pin 15.534 of 17.284 mm (at 150:
-15.537)."""
+with a ring: Meta-World's (1612 triangles, threshold 0.02) took 14.3 s of CPU at 150
+iterations, 4.6 s at 30, and those pieces leave its pin 15.660 of 17.284 mm."""
 
 
 Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, float]], str] | str]
@@ -379,6 +379,17 @@ def apart(vertices: np.ndarray) -> np.ndarray:
             moved[i] -= shift
             moved[j] += shift
     return moved
+
+
+def as_written(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` as :func:`write_mesh` writes it and reads it back (its vertices moved
+    :func:`apart` and kept to 0.1 µm, loaded as trimesh loads the file): the mesh whose
+    pieces are written, so that they are found once, before it is (:func:`pin_pieces` and
+    :func:`executor.world.rings.ring_pieces` keep what they found by the mesh)."""
+    text = obj_text([("mesh", apart(mesh.vertices), mesh.faces)], "# as written")
+    loaded = trimesh.load(io.StringIO(text), file_type="obj", force="mesh")
+    assert isinstance(loaded, trimesh.Trimesh)  # one object, closed as given
+    return loaded
 
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,

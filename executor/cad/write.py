@@ -64,6 +64,7 @@ from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
     Pieces,
+    as_written,
     base_is_primitive,
     fitted,
     peg_frame,
@@ -430,7 +431,7 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return (f"goes onto a pin ({pin.id}) with {room * 500:+.4f} mm of room per side, less than the "
                 f"{SIZE_RESOLUTION * 1e3:g} mm the simulated cell resolves")
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
-    found = bore_pieces(derived, pid)(pid, mesh)
+    found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
 
 
