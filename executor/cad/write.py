@@ -432,7 +432,8 @@ def _highest_near(mesh: trimesh.Trimesh, xy: tuple[float, float], radius: float)
 def tool_length(derived: Derived) -> tuple[float | None, str]:
     """The length [m] of the gripper's flange that keeps the arm's wrist (:data:`WRIST_RADIUS`
     about the tool's axis, at the flange's top) :data:`WRIST_CLEARANCE` above every part that
-    may be in place (any but those the geometric precedence puts after it) within that radius
+    may be in place (any but those the geometric precedence puts after it, and but a base with
+    pins: :func:`executor.world.scene.wrist_clear_of`) within that radius
     of the axis of each part the cell inserts from above, held :data:`GRIPPER`'s grasp depth
     deep (a part with a bore: at most half its length) at its goal (a peg standing on its
     hole's bottom, a part with a bore where the CAD has it), rounded up to the millimetre;
@@ -450,9 +451,10 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
             low, high = (float(v) for v in derived.parts[pid].mesh.bounds[:, 2])
             grips[pid] = (pin.position, high - min(depth, (high - low) / 2))
     need, why = GRIPPER["flange_length"], ""
+    clear = {derived.base} if derived.pins else set()  # the cell's wrist does not collide with a base with pins
     for pid, (xy, grip) in sorted(grips.items()):
         later = nx.descendants(graph, pid)
-        for other in sorted(set(derived.parts) - later - {pid}):
+        for other in sorted(set(derived.parts) - later - clear - {pid}):
             top = _highest_near(derived.parts[other].mesh, xy, WRIST_RADIUS)
             if top is not None and top - grip + WRIST_CLEARANCE > need + 1e-9:
                 need = top - grip + WRIST_CLEARANCE
