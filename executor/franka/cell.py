@@ -219,13 +219,8 @@ class FrankaCell:
         turn, shift = fit_pose(spec, hole_spec)
         est = self.to_base(np.array([*(np.array(hole_spec.position) + shift), hole_spec.top_z]))
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn)
-        quat = tool_quat(yaw)
-        approach = est + np.array([0.0, 0.0, APPROACH_HEIGHT])
-        self.carry_to(approach, yaw=yaw)
         self.controller.watch_rate()
-        self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
-        self.arm.tare_sensor()
-        found = hole_search(self.motion, est[:2], est[2], approach[2], quat, rng)
+        found = self.search(est, yaw, rng)
         key = f"{spec.shape}:{hole}"
         correction = self.ilc.correction(key)[0] if self.layer.ilc else None
         task = InsertionTask(np.array([found.hole_xy[0], found.hole_xy[1], est[2]]), self.lever(spec), yaw,
@@ -235,6 +230,19 @@ class FrankaCell:
         if result.reached and result.trace is not None:
             self.ilc.update(key, result.trace)
         return result, detector, found
+
+    def search(self, entry: np.ndarray, yaw: float, rng: np.random.Generator) -> SearchResult:
+        """The held part carried above the hole's calibrated entry ``entry`` [m] (its centre
+        at the top face, base frame) by :data:`executor.trial.APPROACH_HEIGHT`, the tool
+        turned to ``yaw`` [rad], held still, the wrench estimate tared, then the hole search
+        (:func:`executor.skills.search.hole_search`, its spiral drawn from ``rng``) around it:
+        where the part sinks into the hole, in the robot's reading of the tip."""
+        quat = tool_quat(yaw)
+        approach = entry + np.array([0.0, 0.0, APPROACH_HEIGHT])
+        self.carry_to(approach, yaw=yaw)
+        self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
+        self.arm.tare_sensor()
+        return hole_search(self.motion, entry[:2], entry[2], approach[2], quat, rng)
 
     def lift(self) -> None:
         """The tool straight up to the carrying height."""
