@@ -12,7 +12,6 @@ insertion): several minutes on the shared 2-core machine."""
 from __future__ import annotations
 
 import json
-import re
 import shutil
 from pathlib import Path
 
@@ -26,7 +25,7 @@ from bridge.messages import InsertRequest  # noqa: E402
 from executor import ExecutorError  # noqa: E402
 from executor.franka.backend import franka_starter  # noqa: E402
 from executor.franka.sim_server import sim_robot  # noqa: E402
-from tests.franka import franka_cell_description
+from tests.franka import franka_cell_description, parts_moved
 
 TRIO = Path(__file__).parent / "data" / "trio"
 DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2"), "peg_d12": ("p3", "h3")}
@@ -36,18 +35,6 @@ GRASP_ERROR = 0.002
 its ``start`` in the simulated world."""
 
 
-def _pegs_moved(folder: Path, to: Path, dx: float) -> Path:
-    """A copy of the product ``folder`` at ``to`` whose parts wait ``dx`` [m] along x from
-    their ``start`` (the world the simulator builds; the cell believes ``folder``)."""
-    moved = Path(shutil.copytree(folder, to))
-    toml = moved / "assembly.toml"
-    text, count = re.subn(r"^start = \[([-0-9.]+), ", lambda m: f"start = [{float(m[1]) + dx:.4f}, ",
-                          toml.read_text(encoding="utf-8"), flags=re.M)
-    assert count == 4, text  # the base and the three pegs
-    toml.write_text(text, encoding="utf-8")
-    return moved
-
-
 @pytest.mark.slow
 @pytest.mark.timeout(1800)
 @pytest.mark.usefixtures("one_simulated_arm")
@@ -55,7 +42,7 @@ def _pegs_moved(folder: Path, to: Path, dx: float) -> Path:
 def test_skills_taught_on_the_arm_are_stored_and_an_insertion_uses_them(run_executor, tmp_path: Path) -> None:
     folder = Path(shutil.copytree(TRIO, tmp_path / "trio", ignore=shutil.ignore_patterns("assets", "demonstrations")))
     description = franka_cell_description(tmp_path)
-    with sim_robot(_pegs_moved(folder, tmp_path / "world", GRASP_ERROR)) as sim:
+    with sim_robot(parts_moved(folder, tmp_path / "world", GRASP_ERROR)) as sim:
         options = {"host": sim.host, "realtime": "ignore", "dynamics": "0.5"}
         settings = ServeSettings(backend="franka", assembly=str(folder), backend_options=options,
                                  cell=CellSettings(description=str(description)))
