@@ -3,10 +3,11 @@
 The tip comes down on the estimate until it touches the plate (or drops straight into
 the hole), then slides over the surface under a light contact force along an
 Archimedean spiral whose start angle, direction and pitch are drawn at random, out to
-``max_radius`` and back in to the estimate half a pitch inside the way out.  The hole is
-found when the tip sinks into the hole's entry chamfer and, pushed down it, past it: a
-part that is too big never sinks, so the search gives up back at the estimate and the
-insertion is tried there (and fails there).
+``max_radius`` and back in to the estimate half a pitch inside the way out, the command
+leading the spiral by the part's measured lag (friction drags it behind); if that found
+nothing, out once more at a third of the speed.  The hole is found when the tip sinks into
+the hole's entry chamfer and, pushed down it, past it: a part that is too big never sinks,
+so the search gives up and the insertion is tried back at the estimate (and fails there).
 
 A push that stops short of the chamfer's end is a find only when the part is held below
 the hole's top face (wedged in the chamfer): a tilted part whose low edge has dipped over
@@ -41,7 +42,10 @@ class SearchParams:
     [m] and for how long at most [s], spiral pitch [m] (± ``pitch_jitter``),
     sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm
     + half a pitch), whether the spiral comes back in from it half a pitch inside the way
-    out (the part's path then twice as dense) and time limit [s]."""
+    out (the part's path then twice as dense), gain [1/s] of the command's lead on the
+    part's lag behind the spiral and its bound [m], time limit [s] of that pass, speed
+    [m/s] and time limit [s] of the slow pass out that follows a pass that found nothing
+    (0 s: none)."""
 
     approach_speed: float = 0.025
     contact_force: float = 2.0
@@ -219,9 +223,9 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
             break
     # 2. Spirals under contact: fast out and back, then slow out.
     contact = _Contact(float(s.tip_pos[2]), surface_z, s, path)
-    tip = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.speed, p.back_in, p.max_time)
-    if tip is None and p.slow_time > 0:
-        tip = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.slow_speed, False, p.slow_time)
-    if tip is not None:
-        return SearchResult(True, tip[:2].copy(), surface_z, np.array(path))
+    found = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.speed, p.back_in, p.max_time)
+    if found is None and p.slow_time > 0:
+        found = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.slow_speed, False, p.slow_time)
+    if found is not None:
+        return SearchResult(True, found[:2].copy(), surface_z, np.array(path))
     return SearchResult(False, np.asarray(est_xy, dtype=float).copy(), surface_z, np.array(path).reshape(-1, 3))
