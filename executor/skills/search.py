@@ -3,9 +3,9 @@
 The tip comes down on the estimate until it touches the plate (or drops straight into
 the hole), then slides over the surface under a light contact force along an
 Archimedean spiral whose start angle, direction and pitch are drawn at random, out to
-``max_radius`` and back in to the estimate half a pitch inside the way out, the command
-leading the spiral by the part's measured lag (friction drags it behind); if that found
-nothing, out once more at a third of the speed.  The hole is found when the tip sinks into
+``max_radius`` and back in to the estimate half a pitch inside the way out; if that found
+nothing, out once more at a third of the speed, the command leading the spiral by the
+part's measured lag (friction drags it behind).  The hole is found when the tip sinks into
 the hole's entry chamfer and, pushed down it, past it: a part that is too big never sinks,
 so the search gives up and the insertion is tried back at the estimate (and fails there).
 
@@ -42,10 +42,10 @@ class SearchParams:
     [m] and for how long at most [s], spiral pitch [m] (± ``pitch_jitter``),
     sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm
     + half a pitch), whether the spiral comes back in from it half a pitch inside the way
-    out (the part's path then twice as dense), gain [1/s] of the command's lead on the
-    part's lag behind the spiral and its bound [m], time limit [s] of that pass, speed
-    [m/s] and time limit [s] of the slow pass out that follows a pass that found nothing
-    (0 s: none)."""
+    out (the part's path then twice as dense), gain [1/s] of the slow pass's lead on the
+    part's lag behind the spiral and its bound [m], time limit [s] of the first pass,
+    speed [m/s] and time limit [s] of the slow pass out that follows a first pass that
+    found nothing (0 s: none)."""
 
     approach_speed: float = 0.025
     contact_force: float = 2.0
@@ -126,12 +126,13 @@ class _Contact:
 
 
 def _spiral(motion: Motion, est_xy: np.ndarray, contact: _Contact, quat_xyzw: np.ndarray, rng: np.random.Generator,
-            p: SearchParams, speed: float, back_in: bool, max_time: float) -> np.ndarray | None:
+            p: SearchParams, speed: float, back_in: bool, max_time: float, lead_gain: float) -> np.ndarray | None:
     """One spiral pass under contact at ``speed`` [m/s] from ``est_xy`` [m] out to
     ``max_radius`` (and back in half a pitch inside the way out if ``back_in``), for at
-    most ``max_time`` [s] counting the pushes.  Returns the tip position [m] of a find,
-    else None (``contact.state`` then the last reading, the part back near the estimate
-    if ``back_in``)."""
+    most ``max_time`` [s] counting the pushes, the command leading the spiral by the
+    part's lag measured along its way (integral gain ``lead_gain`` [1/s], 0: none).
+    Returns the tip position [m] of a find, else None (``contact.state`` then the last
+    reading, the part back near the estimate if ``back_in``)."""
     s, touched_z = contact.state, contact.touched_z
     target_z = contact.surface_z - p.press_depth
     # r = pitch·θ/2π at a constant sliding speed, from a random start angle and direction.
@@ -165,7 +166,7 @@ def _spiral(motion: Motion, est_xy: np.ndarray, contact: _Contact, quat_xyzw: np
                 shift = _NO_SHIFT
                 # The part drags behind under friction: lead the command by the lag measured along the way.
                 lag = float((est_xy + offset - s.tip_pos[:2]) @ heading)
-                lead = min(max(lead + p.track_gain * lag * TIME_STEP, 0.0), p.max_lead)
+                lead = min(max(lead + lead_gain * lag * TIME_STEP, 0.0), p.max_lead)
                 theta += (-1 if inward else 1) * speed * TIME_STEP / max(radius, pitch / 2)
                 angle = angle0 + direction * theta
                 step = radius * np.array([math.cos(angle), math.sin(angle)]) - offset
@@ -201,13 +202,14 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
     part is held below the top face there (:func:`below_top_face`); else it rests on a
     rim, and the spiral goes on out of that dip, where a further sink of ``sink_depth``
     below the rest counts again.  At ``max_radius`` the spiral turns back in along
-    r = pitch·θ/2π − pitch/2 (``back_in``).  The command leads the spiral by the part's
-    lag behind it, measured along the way (gain ``track_gain``, at most ``max_lead``):
-    dragged with 2 to 6 N of friction at 2000 N/m, the part would trail 1 to 3 mm and
-    sweep a spiral that much smaller, sparse near its centre.  A pass that found nothing
-    is followed by one at ``slow_speed`` out to ``max_radius`` (``slow_time``; 0: none):
-    a tight hole on a sharp rim (room of 0.17 mm) drops a part that passes over it
-    slowly, and a fast one skates across.  The pushes count in the passes' times."""
+    r = pitch·θ/2π − pitch/2 (``back_in``).  A pass that found nothing is followed by one
+    at ``slow_speed`` out to ``max_radius`` (``slow_time``; 0: none): a tight hole on a
+    sharp rim (room of 0.17 mm) drops a part that passes over it slowly, and a fast one
+    skates across.  On that pass the command leads the spiral by the part's lag behind
+    it, measured along the way (gain ``track_gain``, at most ``max_lead``): dragged with
+    2 to 6 N of friction at 2000 N/m, the part trails 1 to 4 mm and sweeps a spiral that
+    much smaller, sparse near its centre (the fast pass is not led: on a chamfer it finds
+    the hole as it is).  The pushes count in the passes' times."""
     p = params
     path: list[np.ndarray] = []
     target_z = surface_z - p.press_depth
@@ -223,9 +225,9 @@ def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: f
             break
     # 2. Spirals under contact: fast out and back, then slow out.
     contact = _Contact(float(s.tip_pos[2]), surface_z, s, path)
-    found = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.speed, p.back_in, p.max_time)
+    found = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.speed, p.back_in, p.max_time, 0.0)
     if found is None and p.slow_time > 0:
-        found = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.slow_speed, False, p.slow_time)
+        found = _spiral(motion, est_xy, contact, quat_xyzw, rng, p, p.slow_speed, False, p.slow_time, p.track_gain)
     if found is not None:
         return SearchResult(True, found[:2].copy(), surface_z, np.array(path))
     return SearchResult(False, np.asarray(est_xy, dtype=float).copy(), surface_z, np.array(path).reshape(-1, 3))
