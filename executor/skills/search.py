@@ -169,9 +169,9 @@ def _spiral(motion: Motion, est_xy: np.ndarray, contact: _Contact, quat_xyzw: np
                 lead = min(max(lead + lead_gain * lag * TIME_STEP, 0.0), p.max_lead)
                 theta += (-1 if inward else 1) * speed * TIME_STEP / max(radius, pitch / 2)
                 angle = angle0 + direction * theta
-                step = radius * np.array([math.cos(angle), math.sin(angle)]) - offset
-                heading = step / max(float(np.linalg.norm(step)), 1e-9)
-                offset = offset + step
+                ahead = radius * np.array([math.cos(angle), math.sin(angle)])
+                heading = (ahead - offset) / max(float(np.linalg.norm(ahead - offset)), 1e-9)
+                offset = ahead
             xy = est_xy + offset + lead * heading + shift
             s = motion.step(np.array([xy[0], xy[1], target_z]), quat_xyzw)
             elapsed += TIME_STEP
