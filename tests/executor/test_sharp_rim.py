@@ -75,11 +75,10 @@ def test_a_tight_part_the_outward_spiral_missed_fits_after_the_way_back(peg12_ce
 def test_a_tight_hole_on_a_sharp_rim_is_found_in_the_first_attempt(peg12_cell: Cell, seed: int) -> None:
     """The first attempts of seeds 0 and 6 of `executor trial --part peg12 --hole h2`
     (0.167 mm of room per side, no chamfer; the estimate 3.3 and 4.0 mm off the hole's
-    centre): with the command along the spiral alone the part, dragged 2 to 4 mm behind
-    it, passed no closer than 0.8 and 1.8 mm to the centre, never sank, and the attempt
-    ended ``no_fit`` pressed on the top face at the estimate.  Led by its lag, the part
-    sweeps the spiral: seed 0 drops into the hole on the way back; seed 6, skated over on
-    the fast pass, drops in on the slow one."""
+    centre): the fast spiral alone finds nothing, the part dragged 2 to 4 mm behind it
+    (no closer than 0.8 and 1.8 mm to the centre), and the attempt ended ``no_fit``
+    pressed on the top face at the estimate.  The slow pass that follows, its command
+    leading the spiral by the part's lag, drops the part into the hole."""
     cell = peg12_cell
     cell.reset_state()
     rng = trial_rng(seed, "peg12", "h2")
