@@ -59,6 +59,7 @@ from bridge.errors import ToolError
 from bridge.files import make_folder, os_reason, write_atomic
 from bridge.inputs import read_text, shorten
 from bridge.product import Mesh
+from bridge.product.checks import overlapping_bosses
 from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
@@ -678,11 +679,13 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = _plate_level(derived)
+    chamfer = max([MIN_CHAMFER, *(f.chamfer for f in fits)])
     tile = _tile([fit for fit in fits if fit.axis == "+z"])  # the plate's bosses: none around a sideways hole
+    own = _own_tiles(derived, tile, chamfer)
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
              "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
-             f"chamfer = {_q(max([MIN_CHAMFER, *(f.chamfer for f in fits)]))}  # [m] at least MIN_CHAMFER",
+             f"chamfer = {_q(chamfer)}  # [m] at least MIN_CHAMFER",
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
@@ -694,6 +697,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
+        if hid in own:
+            lines.append(f"tile = {_q(own[hid])}  # its own boss: the plate's would overlap its neighbours'")
         if fit.axis != "+z":  # entered sideways: its entry's height, its depth to its part's tip
             lines += [f'axis = "{opposite(fit.axis)}"', f"top_z = {_q(entry_point(fit)[2])}",
                       f"depth = {_q(sideways_depth(derived, fit))}"]
@@ -782,6 +787,11 @@ def _numbers(values: tuple[float, ...]) -> str:
     return f"[{', '.join(str(_q(v)) for v in values)}]"
 
 
+_BOSS_WALL = 0.002
+"""The wall a boss leaves beyond its hole's chamfered mouth on each side when the holes'
+spacing does not set its side [m]."""
+
+
 def _tile(fits: list[HoleFit]) -> float:
     """The side of the square boss around every hole [m]: the measured boss when the base
     has one around each hole, else the largest square the holes' spacing leaves room for."""
@@ -790,7 +800,19 @@ def _tile(fits: list[HoleFit]) -> float:
                    for i, a in enumerate(fits) for b in fits[i + 1:]), default=0.04)
     widest = max([max(f.hole.a, f.hole.b) + 2 * f.chamfer for f in fits], default=0.0)
     tile = min([*bosses, spacing, 0.04])
-    return tile if tile > widest else widest + 0.004
+    return tile if tile > widest else widest + 2 * _BOSS_WALL
+
+
+def _own_tiles(derived: Derived, tile: float, chamfer: float) -> dict[str, float]:
+    """Each hole's own boss side [m] where bosses of side ``tile`` (:func:`_tile`) around
+    every hole would overlap: its section's widest side and the ``chamfer`` on each side,
+    with :data:`_BOSS_WALL` of wall beyond (at most ``tile``); none where they do not."""
+    fits = {hid: fit for hid, fit in derived.holes.items() if fit.axis == "+z"}
+    turned = {hid for hid, fit in fits.items() if fit.hole.yaw}
+    if overlapping_bosses({hid: (*fit.position, tile) for hid, fit in fits.items()}, turned) is None:
+        return {}
+    own = {hid: min(max(fit.hole.a, fit.hole.b) + 2 * (chamfer + _BOSS_WALL), tile) for hid, fit in fits.items()}
+    return {hid: side for hid, side in own.items() if side < tile}
 
 
 def _digest(path: Path) -> str | None:
