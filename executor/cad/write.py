@@ -805,13 +805,24 @@ def _tile(fits: list[HoleFit]) -> float:
 
 def _own_tiles(derived: Derived, tile: float, chamfer: float) -> dict[str, float]:
     """Each hole's own boss side [m] where bosses of side ``tile`` (:func:`_tile`) around
-    every hole would overlap: its section's widest side and the ``chamfer`` on each side,
-    with :data:`_BOSS_WALL` of wall beyond (at most ``tile``); none where they do not."""
+    every hole would overlap; none where they do not. A hole's boss is its section's
+    widest side with the ``chamfer`` on each side (its need) and :data:`_BOSS_WALL` of wall
+    beyond, at most ``tile``, and no wider than leaves each neighbour's boss half the room
+    between the two needs: the distance of their centres (the larger of x and y, or
+    straight for a turned hole) plus half the difference of the needs."""
     fits = {hid: fit for hid, fit in derived.holes.items() if fit.axis == "+z"}
     turned = {hid for hid, fit in fits.items() if fit.hole.yaw}
     if overlapping_bosses({hid: (*fit.position, tile) for hid, fit in fits.items()}, turned) is None:
         return {}
-    own = {hid: min(max(fit.hole.a, fit.hole.b) + 2 * (chamfer + _BOSS_WALL), tile) for hid, fit in fits.items()}
+    need = {hid: max(fit.hole.a, fit.hole.b) + 2 * chamfer for hid, fit in fits.items()}
+
+    def apart(a: str, b: str) -> float:
+        (xa, ya), (xb, yb) = fits[a].position, fits[b].position
+        return math.hypot(xa - xb, ya - yb) if {a, b} & turned else max(abs(xa - xb), abs(ya - yb))
+
+    own = {hid: min([need[hid] + 2 * _BOSS_WALL, tile,
+                     *(apart(hid, other) + (need[hid] - need[other]) / 2 for other in fits if other != hid)])
+           for hid in fits}
     return {hid: side for hid, side in own.items() if side < tile}
 
 
