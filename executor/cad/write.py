@@ -80,7 +80,7 @@ from executor.cad.sections import rounded as _q
 from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
-from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
+from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, plate_obj_text, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -806,7 +806,8 @@ def _tile(fits: list[HoleFit]) -> float:
 def _own_tiles(derived: Derived, tile: float, chamfer: float) -> dict[str, float]:
     """Each hole's own boss side [m] where bosses of side ``tile`` (:func:`_tile`) around
     every hole would overlap; none where they do not. A hole's boss is its section's
-    widest side with the ``chamfer`` on each side (its need) and :data:`_BOSS_WALL` of wall
+    widest side, or twice its outline's farthest reach from its centre, with the
+    ``chamfer`` on each side (its need) and :data:`_BOSS_WALL` of wall
     beyond, at most ``tile``, and no wider than leaves each neighbour's boss half the room
     between the two needs: the distance of their centres (the larger of x and y, or
     straight for a turned hole) plus half the difference of the needs."""
@@ -814,7 +815,8 @@ def _own_tiles(derived: Derived, tile: float, chamfer: float) -> dict[str, float
     turned = {hid for hid, fit in fits.items() if fit.hole.yaw}
     if overlapping_bosses({hid: (*fit.position, tile) for hid, fit in fits.items()}, turned) is None:
         return {}
-    need = {hid: max(fit.hole.a, fit.hole.b) + 2 * chamfer for hid, fit in fits.items()}
+    need = {hid: max(fit.hole.a, fit.hole.b, 2 * float(np.abs(fit.hole.outline).max())) + 2 * chamfer
+            for hid, fit in fits.items()}  # a polygon's outline may reach farther on one side
 
     def apart(a: str, b: str) -> float:
         (xa, ya), (xb, yb) = fits[a].position, fits[b].position
@@ -918,7 +920,9 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     elif meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
         try:
-            why = _cell_disagrees(derived, load_geometry(str(out)))
+            loaded = load_geometry(str(out))
+            plate_obj_text(loaded)  # the cell builds its plate's bosses from it
+            why = _cell_disagrees(derived, loaded)
         except ToolError as exc:
             why = f"the cell refuses its geometry ({exc})"
         if why is None:
