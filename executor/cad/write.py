@@ -59,6 +59,7 @@ from bridge.errors import ToolError
 from bridge.files import make_folder, os_reason, write_atomic
 from bridge.inputs import read_text, shorten
 from bridge.product import Mesh
+from bridge.product.checks import overlapping_bosses
 from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
@@ -79,7 +80,7 @@ from executor.cad.sections import rounded as _q
 from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
-from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
+from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, plate_obj_text, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -736,11 +737,13 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = _plate_level(derived)
+    chamfer = max([MIN_CHAMFER, *(f.chamfer for f in fits)])
     tile = _tile([fit for fit in fits if fit.axis == "+z"])  # the plate's bosses: none around a sideways hole
+    own = _own_tiles(derived, tile, chamfer)
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
              "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
-             f"chamfer = {_q(max([MIN_CHAMFER, *(f.chamfer for f in fits)]))}  # [m] at least MIN_CHAMFER",
+             f"chamfer = {_q(chamfer)}  # [m] at least MIN_CHAMFER",
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
@@ -752,6 +755,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
+        if hid in own:
+            lines.append(f"tile = {_q(own[hid])}  # its own boss: the plate's would overlap its neighbours'")
         if fit.axis != "+z":  # entered sideways: its entry's height, its depth to its part's tip
             lines += [f'axis = "{opposite(fit.axis)}"', f"top_z = {_q(entry_point(fit)[2])}",
                       f"depth = {_q(sideways_depth(derived, fit))}"]
@@ -841,6 +846,11 @@ def _numbers(values: tuple[float, ...]) -> str:
     return f"[{', '.join(str(_q(v)) for v in values)}]"
 
 
+_BOSS_WALL = 0.002
+"""The wall a boss leaves beyond its hole's chamfered mouth on each side when the holes'
+spacing does not set its side [m]."""
+
+
 def _tile(fits: list[HoleFit]) -> float:
     """The side of the square boss around every hole [m]: the measured boss when the base
     has one around each hole, else the largest square the holes' spacing leaves room for."""
@@ -849,7 +859,32 @@ def _tile(fits: list[HoleFit]) -> float:
                    for i, a in enumerate(fits) for b in fits[i + 1:]), default=0.04)
     widest = max([max(f.hole.a, f.hole.b) + 2 * f.chamfer for f in fits], default=0.0)
     tile = min([*bosses, spacing, 0.04])
-    return tile if tile > widest else widest + 0.004
+    return tile if tile > widest else widest + 2 * _BOSS_WALL
+
+
+def _own_tiles(derived: Derived, tile: float, chamfer: float) -> dict[str, float]:
+    """Each hole's own boss side [m] where bosses of side ``tile`` (:func:`_tile`) around
+    every hole would overlap; none where they do not. A hole's boss is its section's
+    widest side, or twice its outline's farthest reach from its centre, with the
+    ``chamfer`` on each side (its need) and :data:`_BOSS_WALL` of wall
+    beyond, at most ``tile``, and no wider than leaves each neighbour's boss half the room
+    between the two needs: the distance of their centres (the larger of x and y, or
+    straight for a turned hole) plus half the difference of the needs."""
+    fits = {hid: fit for hid, fit in derived.holes.items() if fit.axis == "+z"}
+    turned = {hid for hid, fit in fits.items() if fit.hole.yaw}
+    if overlapping_bosses({hid: (*fit.position, tile) for hid, fit in fits.items()}, turned) is None:
+        return {}
+    need = {hid: max(fit.hole.a, fit.hole.b, 2 * float(np.abs(fit.hole.outline).max())) + 2 * chamfer
+            for hid, fit in fits.items()}  # a polygon's outline may reach farther on one side
+
+    def apart(a: str, b: str) -> float:
+        (xa, ya), (xb, yb) = fits[a].position, fits[b].position
+        return math.hypot(xa - xb, ya - yb) if {a, b} & turned else max(abs(xa - xb), abs(ya - yb))
+
+    own = {hid: min([need[hid] + 2 * _BOSS_WALL, tile,
+                     *(apart(hid, other) + (need[hid] - need[other]) / 2 for other in fits if other != hid)])
+           for hid in fits}
+    return {hid: side for hid, side in own.items() if side < tile}
 
 
 def _digest(path: Path) -> str | None:
@@ -944,7 +979,9 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     elif meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
         try:
-            why = _cell_disagrees(derived, load_geometry(str(out)))
+            loaded = load_geometry(str(out))
+            plate_obj_text(loaded)  # the cell builds its plate's bosses from it
+            why = _cell_disagrees(derived, loaded)
         except ToolError as exc:
             why = f"the cell refuses its geometry ({exc})"
         if why is None:

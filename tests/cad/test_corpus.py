@@ -151,9 +151,6 @@ VITAC_ROOM = ("rooms: the polygon search stops short of the best pose on 5 of th
               "hole 0.847 mm all round, the truth's 1.000 at yaw 0 and a shift of 0.5 mm; concave2 in its hole 1.651, "
               "the truth's 1.855; the hexagon and the octagon in concave2's hole 1.255 and 1.282, the truth's 1.343; "
               "the hexagon in convex's 0.958, the truth's 1.000): its 3 x 3 zoom on the shift halts on a ridge")
-VITAC_PLATE = ("geometry: no geometry.toml: the plate's square bosses (as wide as the widest hole, 52 mm, plus 4 mm) "
-               "overlap on holes 50 mm apart, which the cell's loader refuses, though the holes' walls are 16.5 mm "
-               "apart at the least")
 PULLEY_PIN = ("features: the pin the pulley goes onto (the hub's boss) is not found: pins are looked for at the middle "
               "of the part's extent along its axis only, where the pulley's slice (y -27.124 mm, through its rim, "
               "behind the hub's disc) crosses nothing of the hub")
@@ -291,7 +288,7 @@ def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: 
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", _imported_but("vitac_shapes", _xfail(VITAC_PLATE)))
+@pytest.mark.parametrize("name", IMPORTED)
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -320,7 +317,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin that is not found (the pulley "
                                              "onto the hub's boss), or into a hole and shorter than the gripper's "
                                              "grasp depth (the bolts, 14 mm)")),
-    pytest.param("vitac_shapes", marks=_xfail(VITAC_PLATE)),
+    "vitac_shapes",
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
