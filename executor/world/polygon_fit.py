@@ -222,8 +222,9 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     for index in np.argsort(-scores, kind="stable")[:CANDIDATES]:
         angle, shift = _refine_turn(pair, float(angles[index]), starts[index], coarse, fine)
         if math.gcd(*orders) == 1:  # no shared symmetry to keep the centres together
-            shift = _refine_shift(pair, angle, shift, reach)
-            angle, shift = _refine_turn(pair, angle, shift, coarse / 8, fine)
+            angle, shift = _refine_turn_shifted(pair, angle, shift, coarse, reach)
+            angle, shift = _refine_turn(pair, angle, shift, coarse / _SHIFTED_ZOOM, fine)
+            shift = _best_shift(pair, angle, shift, reach)
         found = pair.score(angle, shift)
         if found > best[0] + FINE_SHIFT:
             best = (found, angle, shift)
@@ -239,6 +240,8 @@ _TURNS = np.linspace(-1.0, 1.0, 9)
 _SHIFTS = np.array([[x, y] for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)])
 _ROUNDS = 64
 """A refinement stops after this many rounds whatever its step (a score that keeps climbing)."""
+_SHIFTED_ZOOM = 64
+"""The turn climbed at its best shift from one coarse step either side down to this many times narrower."""
 
 
 def _room_bound(peg: shapely.Polygon, hole: shapely.Polygon) -> float:
@@ -262,6 +265,51 @@ def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine
         if 0 < k < len(tried) - 1:
             step /= 4
     return angle, shift
+
+
+def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: float,
+                         reach: float) -> tuple[float, np.ndarray]:
+    """Climb the room along the turn from ``angle`` [rad], each turn at its best shift
+    (:func:`_best_shift`): 9 turns within ``step`` [rad] either side, the window a quarter
+    as wide when the best is inside it, until it is :data:`_SHIFTED_ZOOM` times narrower."""
+    stop = step / _SHIFTED_ZOOM
+    for _ in range(_ROUNDS):
+        if step <= stop:
+            break
+        tried = angle + step * _TURNS
+        shifts = [_best_shift(pair, float(turn), shift, reach) for turn in tried]
+        scores = [pair.score(float(turn), moved) for turn, moved in zip(tried, shifts, strict=True)]
+        k = int(np.argmax(scores))
+        angle, shift = float(tried[k]), shifts[k]
+        if 0 < k < len(tried) - 1:
+            step /= 4
+    return angle, shift
+
+
+def _best_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:
+    """The shift [m] with the most room at the turn ``angle`` [rad], from the free shifts:
+    the peg at shift t touches the hole's boundary where t lies on ∂hole ⊕ (−∂peg), the
+    union of the parallelograms of each hole edge minus each peg edge, and its room there
+    is t's distance to that set. The regions that set leaves, whose peg is inside the hole,
+    are the shifts that pass; the centre of the largest circle in them (to
+    :data:`FINE_SHIFT`) is the best shift (a parallelogram of two parallel edges is flat and
+    left out, covered by its neighbours' sides unless an outline has two collinear edges in
+    a row: the room is measured at the shift found, never taken from the circle). Where
+    none passes, the climb from ``shift`` (:func:`_refine_shift`)."""
+    peg = _turn(pair.peg_points, angle)
+    hole_edges = np.stack([pair.hole_points, np.roll(pair.hole_points, -1, axis=0)], axis=1)
+    peg_edges = np.stack([peg, np.roll(peg, -1, axis=0)], axis=1)
+    corners = (hole_edges[:, None, :, None, :] - peg_edges[None, :, None, :, :]).reshape(-1, 2)
+    hulls = shapely.convex_hull(shapely.multipoints(corners, indices=np.repeat(np.arange(len(corners) // 4), 4)))
+    touching = shapely.union_all(hulls[shapely.get_type_id(hulls) == shapely.GeometryType.POLYGON])
+    low, high = pair.hole_points.min(axis=0) - 2 * reach, pair.hole_points.max(axis=0) + 2 * reach
+    free = shapely.get_parts(shapely.difference(shapely.box(*low, *high), touching))
+    free = free[shapely.get_type_id(free) == shapely.GeometryType.POLYGON]
+    inside = [region for region in free if pair.score(angle, np.asarray(region.representative_point().coords[0])) > 0]
+    if not inside:
+        return _refine_shift(pair, angle, shift, reach)
+    circles = shapely.maximum_inscribed_circle(np.array(inside), FINE_SHIFT)
+    return np.asarray(circles[int(np.argmax(shapely.length(circles)))].coords[0])
 
 
 def _refine_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:
