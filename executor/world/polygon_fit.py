@@ -45,6 +45,8 @@ CANDIDATES = 2
 """The best coarse turns refined."""
 FINE_SHIFT = 1e-7
 """The shift's, the turn's (at the peg's farthest corner) and a negative room's resolution [m]."""
+SWEEP_PIECES = 1024
+"""The most edge pairs of two non-convex outlines whose free shifts are built (more: the shift climbed)."""
 MAX_ORDER = 64
 """The highest rotational symmetry looked for (a 64-tooth spline)."""
 SYMMETRY_TOLERANCE = 1e-6
@@ -132,6 +134,11 @@ class _Pair:
         self.peg = peg
         shapely.prepare(peg)
         self.peg_edge = peg.exterior
+        hull = shapely.convex_hull(peg)
+        self.peg_hull = np.asarray(hull.exterior.coords)[:-1]
+        self.sweep_convex = hull.area <= peg.area * (1 + 1e-12) or \
+            shapely.convex_hull(hole).area <= hole.area * (1 + 1e-12)
+        """Whether :func:`_best_shift` sweeps the peg's convex hull (either outline convex)."""
 
     def pegs(self, angles: np.ndarray, shifts: np.ndarray) -> np.ndarray:
         """The peg polygons turned by ``angles`` (k,) and shifted by ``shifts`` (k, 2)."""
@@ -222,9 +229,13 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     for index in np.argsort(-scores, kind="stable")[:CANDIDATES]:
         angle, shift = _refine_turn(pair, float(angles[index]), starts[index], coarse, fine)
         if math.gcd(*orders) == 1:  # no shared symmetry to keep the centres together
-            angle, shift = _refine_turn_shifted(pair, angle, shift, coarse, reach)
-            angle, shift = _refine_turn(pair, angle, shift, coarse / _SHIFTED_ZOOM, fine)
-            shift = _best_shift(pair, angle, shift, reach)
+            if pair.sweep_convex or len(pair.peg_points) * len(pair.hole_points) <= SWEEP_PIECES:
+                angle, shift = _refine_turn_shifted(pair, angle, shift, coarse, reach)
+                angle, shift = _refine_turn(pair, angle, shift, coarse / _SHIFTED_ZOOM, fine)
+                shift = _best_shift(pair, angle, shift, reach)
+            else:
+                shift = _refine_shift(pair, angle, shift, reach)
+                angle, shift = _refine_turn(pair, angle, shift, coarse / 8, fine)
         found = pair.score(angle, shift)
         if found > best[0] + FINE_SHIFT:
             best = (found, angle, shift)
@@ -288,19 +299,28 @@ def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: flo
 
 def _best_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:
     """The shift [m] with the most room at the turn ``angle`` [rad], from the free shifts:
-    the peg at shift t touches the hole's boundary where t lies on ∂hole ⊕ (−∂peg), the
-    union of the parallelograms of each hole edge minus each peg edge, and its room there
-    is t's distance to that set. The regions that set leaves, whose peg is inside the hole,
-    are the shifts that pass; the centre of the largest circle in them (to
+    the peg at shift t meets the hole's boundary where t lies in ∂hole ⊕ (−peg), and its
+    room there is t's distance to that set (the distance from peg + t to ∂hole). With a
+    convex peg, or a convex hole (where the peg's convex hull passes as the peg does, with
+    the same room), that set is the union of the convex hulls of each hole edge's ends
+    minus the (hull's) corners; else ∂hole ⊕ (−∂peg), the union of the parallelograms of
+    each hole edge minus each peg edge. The regions that set leaves, whose peg is inside
+    the hole, are the shifts that pass; the centre of the largest circle in them (to
     :data:`FINE_SHIFT`) is the best shift (a parallelogram of two parallel edges is flat and
     left out, covered by its neighbours' sides unless an outline has two collinear edges in
     a row: the room is measured at the shift found, never taken from the circle). Where
     none passes, the climb from ``shift`` (:func:`_refine_shift`)."""
-    peg = _turn(pair.peg_points, angle)
     hole_edges = np.stack([pair.hole_points, np.roll(pair.hole_points, -1, axis=0)], axis=1)
-    peg_edges = np.stack([peg, np.roll(peg, -1, axis=0)], axis=1)
-    corners = (hole_edges[:, None, :, None, :] - peg_edges[None, :, None, :, :]).reshape(-1, 2)
-    hulls = shapely.convex_hull(shapely.multipoints(corners, indices=np.repeat(np.arange(len(corners) // 4), 4)))
+    if pair.sweep_convex:
+        peg = _turn(pair.peg_hull, angle)
+        corners = (hole_edges[:, :, None, :] - peg[None, None, :, :]).reshape(-1, 2)
+        size = 2 * len(peg)
+    else:
+        peg = _turn(pair.peg_points, angle)
+        peg_edges = np.stack([peg, np.roll(peg, -1, axis=0)], axis=1)
+        corners = (hole_edges[:, None, :, None, :] - peg_edges[None, :, None, :, :]).reshape(-1, 2)
+        size = 4
+    hulls = shapely.convex_hull(shapely.multipoints(corners, indices=np.repeat(np.arange(len(corners) // size), size)))
     touching = shapely.union_all(hulls[shapely.get_type_id(hulls) == shapely.GeometryType.POLYGON])
     low, high = pair.hole_points.min(axis=0) - 2 * reach, pair.hole_points.max(axis=0) + 2 * reach
     free = shapely.get_parts(shapely.difference(shapely.box(*low, *high), touching))
