@@ -229,10 +229,12 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     for index in np.argsort(-scores, kind="stable")[:CANDIDATES]:
         angle, shift = _refine_turn(pair, float(angles[index]), starts[index], coarse, fine)
         if math.gcd(*orders) == 1:  # no shared symmetry to keep the centres together
-            if pair.sweep_convex or len(pair.peg_points) * len(pair.hole_points) <= SWEEP_PIECES:
-                angle, shift = _refine_turn_shifted(pair, angle, shift, coarse, reach)
+            sweep = pair.sweep_convex or len(pair.peg_points) * len(pair.hole_points) <= SWEEP_PIECES
+            if sweep and (free := _best_shift(pair, angle)) is not None:
+                angle, shift = _refine_turn_shifted(pair, angle, free, coarse)
                 angle, shift = _refine_turn(pair, angle, shift, coarse / _SHIFTED_ZOOM, fine)
-                shift = _best_shift(pair, angle, shift, reach)
+                free = _best_shift(pair, angle)
+                shift = shift if free is None else free
             else:
                 shift = _refine_shift(pair, angle, shift, reach)
                 angle, shift = _refine_turn(pair, angle, shift, coarse / 8, fine)
@@ -278,17 +280,16 @@ def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine
     return angle, shift
 
 
-def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: float,
-                         reach: float) -> tuple[float, np.ndarray]:
+def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: float) -> tuple[float, np.ndarray]:
     """Climb the room along the turn from ``angle`` [rad], each turn at its best shift
-    (:func:`_best_shift`): 9 turns within ``step`` [rad] either side, the window a quarter
+    (:func:`_best_shift`, else ``shift``): 9 turns within ``step`` [rad] either side, the window a quarter
     as wide when the best is inside it, until it is :data:`_SHIFTED_ZOOM` times narrower."""
     stop = step / _SHIFTED_ZOOM
     for _ in range(_ROUNDS):
         if step <= stop:
             break
         tried = angle + step * _TURNS
-        shifts = [_best_shift(pair, float(turn), shift, reach) for turn in tried]
+        shifts = [shift if (free := _best_shift(pair, float(turn))) is None else free for turn in tried]
         scores = [pair.score(float(turn), moved) for turn, moved in zip(tried, shifts, strict=True)]
         k = int(np.argmax(scores))
         angle, shift = float(tried[k]), shifts[k]
@@ -297,7 +298,7 @@ def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: flo
     return angle, shift
 
 
-def _best_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:
+def _best_shift(pair: _Pair, angle: float) -> np.ndarray | None:
     """The shift [m] with the most room at the turn ``angle`` [rad], from the free shifts:
     the peg at shift t meets the hole's boundary where t lies in ∂hole ⊕ (−peg), and its
     room there is t's distance to that set (the distance from peg + t to ∂hole). With a
@@ -308,8 +309,8 @@ def _best_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> n
     the hole, are the shifts that pass; the centre of the largest circle in them (to
     :data:`FINE_SHIFT`) is the best shift (a parallelogram of two parallel edges is flat and
     left out, covered by its neighbours' sides unless an outline has two collinear edges in
-    a row: the room is measured at the shift found, never taken from the circle). Where
-    none passes, the climb from ``shift`` (:func:`_refine_shift`)."""
+    a row: the room is measured at the shift found, never taken from the circle); None
+    where no shift passes."""
     hole_edges = np.stack([pair.hole_points, np.roll(pair.hole_points, -1, axis=0)], axis=1)
     if pair.sweep_convex:
         peg = _turn(pair.peg_hull, angle)
@@ -322,12 +323,13 @@ def _best_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> n
         size = 4
     hulls = shapely.convex_hull(shapely.multipoints(corners, indices=np.repeat(np.arange(len(corners) // size), size)))
     touching = shapely.union_all(hulls[shapely.get_type_id(hulls) == shapely.GeometryType.POLYGON])
+    reach = float(np.max(np.linalg.norm(peg, axis=1)))  # the shifts that pass lie within it of the hole
     low, high = pair.hole_points.min(axis=0) - 2 * reach, pair.hole_points.max(axis=0) + 2 * reach
     free = shapely.get_parts(shapely.difference(shapely.box(*low, *high), touching))
     free = free[shapely.get_type_id(free) == shapely.GeometryType.POLYGON]
     inside = [region for region in free if pair.score(angle, np.asarray(region.representative_point().coords[0])) > 0]
     if not inside:
-        return _refine_shift(pair, angle, shift, reach)
+        return None
     circles = shapely.maximum_inscribed_circle(np.array(inside), FINE_SHIFT)
     return np.asarray(circles[int(np.argmax(shapely.length(circles)))].coords[0])
 
