@@ -14,9 +14,14 @@ an assembled CAD holds), each turn from two starts (the peg's smallest enclosing
 centre on the hole's largest inscribed circle's, and the area centroids together). The
 :data:`CANDIDATES` best are refined by zooming in on the best of 9 turns until the peg's
 farthest corner moves less than :data:`FINE_SHIFT`, then (unless both outlines share a
-rotational symmetry, which keeps their centres together) the shift by zooming in on the
-best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn once more. The search climbs
-a continuous score: the room where the peg is inside, else minus its deepest overlap (a
+rotational symmetry, which keeps their centres together) the shift. Where a shift passes
+at that turn, the best shift at a turn is exact (:func:`_best_shift`: the centre of the
+largest circle in the shifts that pass, the regions ∂hole ⊕ (−peg) leaves, to
+:data:`FINE_SHIFT`), and the turn is climbed once more with each turn at its best shift
+(one coarse step either side), then at the shift found down to the resolution. Where none
+passes, or for two non-convex outlines of more than :data:`SWEEP_PIECES` edge pairs, the
+shift by zooming in on the best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn
+once more. The turn's search climbs a continuous score: the room where the peg is inside, else minus its deepest overlap (a
 peg corner outside the hole, a hole corner inside the peg). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
