@@ -21,7 +21,8 @@ largest circle in the shifts that pass, the regions ∂hole ⊕ (−peg) leaves,
 (one coarse step either side), then at the shift found down to the resolution. Where none
 passes, or for two non-convex outlines of more than :data:`SWEEP_PIECES` edge pairs, the
 shift by zooming in on the best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn
-once more. The turn's search climbs a continuous score: the room where the peg is inside, else minus its deepest overlap (a
+once more. The turn's search climbs a continuous score: the room where the peg is inside,
+else minus its deepest overlap (a
 peg corner outside the hole, a hole corner inside the peg). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
