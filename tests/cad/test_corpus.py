@@ -147,10 +147,6 @@ PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 
 PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on nothing else (2 mm all round, the "
                 "source's balls left out), but it touches nothing in the CAD and the locating rule counts the glands "
                 "and the impeller on it among what keeps it from moving sideways: bearing_ring->shaft is not written")
-VITAC_ROOM = ("rooms: the polygon search stops short of the best pose on 5 of the 15 pairs that fit (convex in its "
-              "hole 0.847 mm all round, the truth's 1.000 at yaw 0 and a shift of 0.5 mm; concave2 in its hole 1.651, "
-              "the truth's 1.855; the hexagon and the octagon in concave2's hole 1.255 and 1.282, the truth's 1.343; "
-              "the hexagon in convex's 0.958, the truth's 1.000): its 3 x 3 zoom on the shift halts on a ridge")
 PULLEY_PIN = ("features: the pin the pulley goes onto (the hub's boss) is not found: pins are looked for at the middle "
               "of the part's extent along its axis only, where the pulley's slice (y -27.124 mm, through its rim, "
               "behind the hub's disc) crosses nothing of the hub")
@@ -197,7 +193,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears", "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
-                                  pytest.param("vitac_shapes", marks=_xfail(VITAC_ROOM))])
+                                  "vitac_shapes"])
 def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:
     # nominal_sizes.lp's margin is diametral: twice the room all round, within 2 um, on each
     # pair that fits of the features the import finds (a no-fit's negative measure is a
