@@ -60,7 +60,7 @@ from executor.evidence import AttemptSetup
 from executor.skills.centring import centre_by_contact
 from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
-from executor.skills.search import SearchParams, hole_search
+from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, REACH_TOLERANCE, trial_rng
 from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
 from executor.world.frames import HoleFrame
@@ -95,6 +95,10 @@ FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no 
 SURFACE_RAYS = (8, 24)
 """The rays that measure where a peg's hole search presses (:meth:`Assembler.search_surface`):
 this many rings about the hole's axis, this many rays a ring, plus one on the axis."""
+SURFACE_MARGIN = 0.001
+"""[m] beyond the peg's section about its hole's axis, the reach of those rays: the rim of
+an opening over the hole (a bracket's flange about its bore), not a wall beside it (the
+wall of ``occt_as1``'s bracket stands 10 mm from its bolts' axes, 5 mm from their shanks)."""
 STAY_TOLERANCE = 0.005
 """A part let go at its goal must still be within this distance of it after the tool's
 retreat [m] (placed parts are within 2 mm); else the step is ``no_fit`` and the part is
@@ -379,13 +383,20 @@ class Assembler:
     def search_surface(self, part: str, hole: str) -> float:
         """The height [m] where the hole search for peg ``part`` presses at ``hole`` (entered
         down): the hole's top, or higher the highest point of a placed part other than the
-        base within the peg's half diagonal plus the search's radius (``max_radius`` of
-        :class:`SearchParams`) of the hole's axis (a bracket's flange over the hole, the
-        peg going through its bore), measured by rays straight down onto the world (a ray
+        base within the peg's section (its circumradius) plus :data:`SURFACE_MARGIN` of the
+        hole's axis (a bracket's flange over the hole, the peg going through its bore),
+        measured by rays straight down onto the world (a ray
         that meets anything else, the arm or the held part, goes on under its bounding box)."""
         world, spec = self.world, self.product.geometry.holes[hole]
         bodies = {world.frames[q].body for q in self.placed if q not in (part, self.product.base.id)}
-        reach = float(np.hypot(*self.product.pegs[part].sides)) / 2 + SearchParams().max_radius
+        peg = self.product.pegs[part]
+        if peg.kind == "round":
+            circumradius = peg.size / 2
+        elif peg.outline:
+            circumradius = float(np.max(np.linalg.norm(np.asarray(peg.outline), axis=1)))
+        else:
+            circumradius = float(np.hypot(*peg.sides)) / 2
+        reach = circumradius + SURFACE_MARGIN
         rings, per_ring = SURFACE_RAYS
         xy = [np.asarray(spec.position[:2], dtype=float)]
         for r in np.linspace(reach / rings, reach, rings):
