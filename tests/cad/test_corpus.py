@@ -378,7 +378,7 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
     assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
-@pytest.mark.slow  # imports the product, teaches its bolts and inserts two in physics (about 220 s under load)
+@pytest.mark.slow  # imports the product, teaches its bolts and inserts two in physics (330 s under load)
 @pytest.mark.timeout(900)  # the import alone took 155 s while the machine ran other work
 def test_bolts_beside_a_bracket_s_wall_and_through_its_flange_are_inserted(
         imported: Callable[[str], Imported], run_executor: Runner) -> None:
