@@ -519,7 +519,7 @@ def _vitac_trial(done: Imported, run_executor: Runner, part: str, feature: str) 
     return json.loads(trial.stdout)["trials"][0]["outcome"], "fit" if truth else "no_fit"
 
 
-@pytest.mark.slow  # imports the board, teaches its seven shapes and runs four trials in physics (about 300 s loaded)
+@pytest.mark.slow  # imports the board, teaches its seven shapes, four trials in physics (501 s, 2 cores, 8 jobs)
 @pytest.mark.timeout(900)
 def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decided_in_physics(
         imported: Callable[[str], Imported], run_executor: Runner) -> None:
@@ -535,7 +535,7 @@ def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decide
     assert all(cell == truth for cell, truth in outcomes.values()), outcomes
 
 
-@pytest.mark.slow  # imports the board, teaches it (unless the test above did) and runs one trial (about 60 s loaded)
+@pytest.mark.slow  # imports the board, teaches it (unless the test above did), one trial (69 s after it, loaded)
 @pytest.mark.timeout(900)
 @pytest.mark.xfail(strict=True, reason="the cell's polygon peg is its prism with its vertical edges rounded by the "
                                        "1 mm hull margin PyBullet adds: the heptagon, 0.0014 mm too big for the rect "
