@@ -31,13 +31,15 @@ from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
 from executor.world.meshes import URDF_HULL_MARGIN, read_objects
 from executor.world.outlines import boss_solids, boss_triangles, convex_parts, corners
-from executor.world.scene import hole_rims
+from executor.world.scene import hole_rims, link_frame
 from tests._outlines import splined
 
 HOLES = {"hx": (0.00604, math.pi / 6), "hs": (0.00596, 0.0)}
 """Each hole's inradius [m] and the turn of its outline [rad]."""
 PEG = 0.006
 """The peg's inradius [m]."""
+QUAD = [[-0.008, -0.006], [0.010, -0.006], [0.004, 0.007], [-0.006, 0.005]]
+"""An irregular quadrilateral peg's corners [m]: its inertia has products of inertia."""
 
 
 def hexagon(inradius: float, turn: float = 0.0) -> list[list[float]]:
@@ -159,7 +161,7 @@ def test_a_chamfer_that_leaves_the_boss_is_refused_naming_the_hole(tmp_path: Pat
 def test_the_arm_is_placed_with_a_peg_turned_as_asked_whatever_its_principal_axes(tmp_path: Path) -> None:
     # an irregular quadrilateral: its inertia has products of inertia, so PyBullet turns the
     # link's inertial frame onto its principal axes (9° here), which its IK turns to the target
-    folder = _product(tmp_path / "quad", peg=[[-0.008, -0.006], [0.010, -0.006], [0.004, 0.007], [-0.006, 0.005]])
+    folder = _product(tmp_path / "quad", peg=QUAD)
     cell = Cell(str(folder))
     arm = cell.motion_for("p1").controller.arm
     inertial = pb.getDynamicsInfo(arm.robot, arm.sensor, physicsClientId=arm.client)[4]
@@ -168,6 +170,24 @@ def test_the_arm_is_placed_with_a_peg_turned_as_asked_whatever_its_principal_axe
         target = tool_quat(yaw)
         arm.inverse_kinematics(np.array([0.55, 0.0, 0.15]), target)
         assert np.linalg.norm(rotation_error(target, arm.read().tip_quat_xyzw)) < 1e-4  # [rad]
+
+
+def test_the_assembling_cell_poses_a_peg_by_its_frame_whatever_its_principal_axes(tmp_path: Path) -> None:
+    # PyBullet poses a free body by its inertial frame, turned 9° about this peg's axis onto
+    # its principal axes; the peg set upright and unturned has its URDF frame (where its
+    # collision pieces are placed) so, and the cell reads that pose back
+    folder = _product(tmp_path / "quad", peg=QUAD)
+    assembler = Assembler(load_product(str(folder)), description=CellDescription())
+    origin = np.array([0.5, 0.0, 0.2])
+    try:
+        world = assembler.world
+        world.set_pose("p1", origin)
+        placed = link_frame(world.client, world.frames["p1"].body, -1)
+        read = world.pose("p1")
+    finally:
+        assembler.close()
+    for pos, quat in (placed, read):
+        assert np.allclose(pos, origin, atol=1e-7) and np.allclose(quat, [0.0, 0.0, 0.0, 1.0], atol=1e-7)
 
 
 @pytest.mark.slow  # teaches the peg, runs two trials and assembles in physics (about 30 s)
