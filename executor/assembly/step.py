@@ -66,7 +66,7 @@ from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
 from executor.world.frames import HoleFrame
 from executor.world.geometry import fit_pose, margin
 from executor.world.perturbation import CellBias
-from executor.world.scene import PART_FRICTION
+from executor.world.scene import PART_FRICTION, inertial_frame
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
 CENTRING_MARGIN = 0.005  # [m] the centring probes reach this beyond the farthest the feature can be
@@ -539,12 +539,12 @@ class Assembler:
         inv = pb.invertTransform(list(pos), list(quat))
         rel_pos, rel_quat = pb.multiplyTransforms(*inv, list(mine[0]), list(mine[1]))
         c = world.client
-        into_com = np.array(pb.getDynamicsInfo(into, -1, physicsClientId=c)[3])
-        my_com = np.array(pb.getDynamicsInfo(me, -1, physicsClientId=c)[3])
+        parent = pb.multiplyTransforms(*pb.invertTransform(*inertial_frame(c, into)), rel_pos, rel_quat)
+        child = pb.invertTransform(*inertial_frame(c, me))
         self._screwed[part] = pb.createConstraint(into, -1, me, -1, pb.JOINT_FIXED, (0, 0, 0),
-                                                  parentFramePosition=list(np.array(rel_pos) - into_com),
-                                                  childFramePosition=list(-my_com),
-                                                  parentFrameOrientation=rel_quat, physicsClientId=c)
+                                                  parentFramePosition=parent[0], childFramePosition=child[0],
+                                                  parentFrameOrientation=parent[1], childFrameOrientation=child[1],
+                                                  physicsClientId=c)
 
     def pose_errors(self) -> dict[str, float]:
         """Distance of every part from its goal [m] (a peg without a goal: from its tray pose)."""

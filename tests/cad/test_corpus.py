@@ -504,3 +504,43 @@ def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physic
     steps = {step["part"]: step for step in report["steps"]}
     assert report["assembled"] and steps["round_nut"]["skill"] == "insert", report
     assert steps["round_nut"]["pose_error_mm"] < 2.0, report["final_pose_error_mm"]
+
+
+def _vitac_trial(done: Imported, run_executor: Runner, part: str, feature: str) -> tuple[str, str]:
+    """One trial of one attempt of ``part`` into the ViTac board's hole of truth ``feature``
+    in physics (the board taught first, once); (the cell's outcome, the truth's)."""
+    if not (done.out / "demonstrations" / f"{part}.json").is_file():
+        taught = run_executor("teach", "--assembly", str(done.out), timeout=300)
+        assert taught.returncode == 0, taught.stderr
+    trial = run_executor("trial", "--assembly", str(done.out), "--part", part, "--hole",
+                         _feature_holes(done)[feature], "--attempts", "1", "--json", timeout=300)
+    assert trial.returncode == 0, trial.stderr
+    truth = next(row["fits"] for row in done.truth["fits"] if (row["part"], row["feature"]) == (part, feature))
+    return json.loads(trial.stdout)["trials"][0]["outcome"], "fit" if truth else "no_fit"
+
+
+@pytest.mark.slow  # imports the board, teaches its seven shapes, four trials in physics (501 s, 2 cores, 8 jobs)
+@pytest.mark.timeout(900)
+def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decided_in_physics(
+        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+    # concave2's products of inertia turn its link's principal axes 22° about its axis; the
+    # arm was placed with those axes, not the part, at the yaw asked, so teaching started it
+    # overlapping its notched hole and it ended 19 mm short. The hexagon and the octagon pass
+    # that hole only turned and shifted (1.343 mm of room); the octagon misses the trapezoid
+    # hole by 0.183 mm.
+    done = imported("vitac_shapes")
+    pairs = [("concave2", "h_concave2"), ("hexagon", "h_concave2"), ("octagon", "h_concave2"),
+             ("octagon", "h_trapezoid")]
+    outcomes = {pair: _vitac_trial(done, run_executor, *pair) for pair in pairs}
+    assert all(cell == truth for cell, truth in outcomes.values()), outcomes
+
+
+@pytest.mark.slow  # imports the board, teaches it (unless the test above did), one trial (69 s after it, loaded)
+@pytest.mark.timeout(900)
+@pytest.mark.xfail(strict=True, reason="the cell's polygon peg is its prism with its vertical edges rounded by the "
+                                       "1 mm hull margin PyBullet adds: the heptagon, 0.0014 mm too big for the rect "
+                                       "hole, passes it so")
+def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_refused_in_physics(
+        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+    cell, truth = _vitac_trial(imported("vitac_shapes"), run_executor, "convex", "h_cuboid")
+    assert cell == truth == "no_fit"
