@@ -367,8 +367,8 @@ class Assembler:
 
     def _centring_reach(self, part: str, hole: str | None) -> float | None:
         """How far [m] the centring probes of a peg found in ``hole`` reach each way, None
-        where it is not centred: a bore on a pin, its half diagonal (the pin's axis is at
-        most that far) + :data:`CENTRING_MARGIN`; a peg with more room than
+        where it is not centred: a bore on a pin, its circumradius (the pin's axis is
+        at most that far from the bore's centre) + :data:`CENTRING_MARGIN`; a peg with more room than
         :data:`CENTRING_ROOM` in a hole, twice its room (from one wall to the other) +
         :data:`CENTRING_MARGIN`."""
         peg = self.product.pegs.get(part)
@@ -376,7 +376,7 @@ class Assembler:
             return None
         feature = self.product.geometry.holes[hole]
         if feature.pin:
-            return float(np.hypot(*peg.sides)) / 2 + CENTRING_MARGIN
+            return peg.circumradius + CENTRING_MARGIN
         room = margin(peg, feature) / 2
         return 2 * room + CENTRING_MARGIN if room > CENTRING_ROOM else None
 
@@ -389,14 +389,7 @@ class Assembler:
         that meets anything else, the arm or the held part, goes on under its bounding box)."""
         world, spec = self.world, self.product.geometry.holes[hole]
         bodies = {world.frames[q].body for q in self.placed if q not in (part, self.product.base.id)}
-        peg = self.product.pegs[part]
-        if peg.kind == "round":
-            circumradius = peg.size / 2
-        elif peg.outline:
-            circumradius = float(np.max(np.linalg.norm(np.asarray(peg.outline), axis=1)))
-        else:
-            circumradius = float(np.hypot(*peg.sides)) / 2
-        reach = circumradius + SURFACE_MARGIN
+        reach = self.product.pegs[part].circumradius + SURFACE_MARGIN
         rings, per_ring = SURFACE_RAYS
         xy = [np.asarray(spec.position[:2], dtype=float)]
         for r in np.linspace(reach / rings, reach, rings):
