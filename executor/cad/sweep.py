@@ -691,14 +691,17 @@ class Sweeper:
         the new ones in :attr:`workers` processes when there are several."""
         keys = []
         pending: dict[tuple[int, int, tuple[float, ...]], tuple[str, str, np.ndarray]] = {}
+        size: dict[tuple[int, int, tuple[float, ...]], int] = {}
         for member, other, shift in tests:
             moving, fixed, relative = self._oriented(member, other, shift)
             key = (id(moving), id(fixed), tuple(relative))
             keys.append(key)
             if key not in self._answers and key not in pending:
                 pending[key] = (member, other, shift)
+                size[key] = len(moving.triangles) + len(fixed.triangles)
         self.queries += len(pending)
         if self.workers > 1 and len(pending) > 1:
+            pending = {key: pending[key] for key in sorted(pending, key=lambda k: -size[k])}  # the larger first
             if self._pool is None:
                 global _FORKED
                 _FORKED = self  # the workers' copy, forked now
