@@ -41,7 +41,10 @@ twice :data:`TOUCH`.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
 part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
-moved back against A along the same path) is answered from the first.
+moved back against A along the same path) is answered from the first. The tests asked
+together (:meth:`Sweeper.blocked`) run in :attr:`Sweeper.workers` processes forked from
+this one, each the same test on a copy of the same parts: the answers and their count
+are those of one process.
 """
 
 from __future__ import annotations
