@@ -242,10 +242,10 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     upper = np.max([p.mesh.bounds[1] for p in parts], axis=0)
     length = 2 * float(np.linalg.norm(upper - lower))
     result.bodies = bodies(by_id, base, fixed_to)
-    for members in result.bodies.values():
-        for name, vector in result.directions.items():
-            hit = sweeper.blockers(members, np.array(vector), length)
-            result.blockers |= {(pid, name): hit for pid in members}
+    requests = [(members, name) for members in result.bodies.values() for name in result.directions]
+    hits = sweeper.blocked([(members, np.array(result.directions[name]), length) for members, name in requests])
+    for (members, name), hit in zip(requests, hits):
+        result.blockers |= {(pid, name): hit for pid in members}
     remaining = set(by_id) - {base}
     while remaining:
         stage = sorted(pid for pid in remaining if any(
@@ -265,7 +265,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
     placing = {pair: "supports" for pair in support_pairs(sweeper, result.bodies, base)}
     if reach > 0:
-        result.located = {root: locators(sweeper, members, reach) for root, members in result.bodies.items()}
+        result.located = locators(sweeper, result.bodies, reach)
         ways = {root: result.ways(root) for root in result.bodies}
         placing |= {pair: "locates" for pair in locating_candidates(result.located, ways, base)
                     if pair not in placing}

@@ -54,17 +54,22 @@ def beside(way: tuple[float, float, float]) -> list[str]:
     return [name for name, vector in DIRECTIONS.items() if float(np.dot(vector, way)) < 1 - 1e-9]
 
 
-def locators(sweeper: Sweeper, group: set[str], reach: float) -> dict[str, set[str]]:
-    """Direction -> the other parts that stop the body ``group`` (its members moved
+def locators(sweeper: Sweeper, bodies: dict[str, set[str]], reach: float) -> dict[str, dict[str, set[str]]]:
+    """Body -> direction -> the other parts that stop the body (its members moved
     together) within ``reach`` [m] along each direction of :data:`DIRECTIONS`."""
-    return {name: sweeper.blockers(group, np.array(vector), reach) for name, vector in DIRECTIONS.items()}
+    requests = [(root, name) for root in bodies for name in DIRECTIONS]
+    hits = sweeper.blocked([(bodies[root], np.array(DIRECTIONS[name]), reach) for root, name in requests])
+    located: dict[str, dict[str, set[str]]] = {root: {} for root in bodies}
+    for (root, name), hit in zip(requests, hits):
+        located[root][name] = hit
+    return located
 
 
 def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> set[tuple[str, str]]:
     """The supporting pairs (Y, X): X a member of a body resting on Y (module docstring)."""
     pairs: set[tuple[str, str]] = set()
-    for members in bodies.values():
-        under = sweeper.blockers(members, np.array(DIRECTIONS["-z"]), SUPPORT_GAP)
+    down = np.array(DIRECTIONS["-z"])
+    for members, under in zip(bodies.values(), sweeper.blocked([(m, down, SUPPORT_GAP) for m in bodies.values()])):
         if base not in under:
             pairs |= {(y, x) for y in under for x in members}
     return {(y, x) for y, x in pairs if (x, y) not in pairs}
