@@ -100,8 +100,10 @@ def placing_pairs(supports: set[tuple[str, str]], located: dict[str, dict[str, s
     located across by a bearing and by the glands on it, which the shaft alone locates,
     goes after the bearing). Each round only removes locators, so this ends."""
     later: dict[str, set[str]] = {root: set() for root in bodies}
+    placing = dict.fromkeys(supports, "supports")
     while True:
-        placing = dict.fromkeys(supports, "supports")
+        # every round's pairs are kept: a later round only adds pairs, or loses ones the
+        # pairs kept contradict (a locator after its part), which stay to be reported dropped
         placing |= {pair: "locates" for pair in locating_candidates(located, ways, base, later)
                     if pair not in placing}
         kept, _ = consistent(sorted(placing), edges)

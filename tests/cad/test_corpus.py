@@ -140,23 +140,6 @@ REFUSED: dict[str, str] = {}
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
 """Every product the import takes."""
 
-PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 26.951, 4.975 mm all round) and no "
-                 "hole is found in the bearing ring the shaft runs in (d 21), the ring in its d 27 bore in no feature; "
-                 "of the three parts on the shaft's d 17 end only gland_3 is on a pin, with a bore of d 33.901 (its "
-                 "recess, not its d 17 lips)")
-PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on nothing else (2 mm all round, the "
-                "source's balls left out), but it touches nothing in the CAD and the locating rule counts the glands "
-                "and the impeller on it among what keeps it from moving sideways: bearing_ring->shaft is not written")
-PULLEY_PIN = ("features: the pin the pulley goes onto (the hub's boss) is not found: pins are looked for at the middle "
-              "of the part's extent along its axis only, where the pulley's slice (y -27.124 mm, through its rim, "
-              "behind the hub's disc) crosses nothing of the hub")
-
-
-def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
-    """Every imported product, ``name`` with ``mark``."""
-    return [pytest.param(p, marks=mark) if p == name else p for p in IMPORTED]
-
-
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
@@ -167,8 +150,8 @@ def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
-    pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
-    pytest.param("occt_pulley", marks=_xfail(PULLEY_PIN)),
+    "occt_pump",
+    "occt_pulley",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -216,7 +199,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "metaworld_assembly",
     "occt_as1",
     "robosuite_nuts",
-    pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
+    "occt_pump",
     "occt_pulley",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
@@ -238,7 +221,7 @@ def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], I
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", _imported_but("occt_pump", _xfail(PUMP_SUPPORT)))
+@pytest.mark.parametrize("name", IMPORTED)
 def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     base = done.truth["base"]
@@ -256,7 +239,7 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", _imported_but("occt_pump", _xfail(PUMP_SUPPORT)))
+@pytest.mark.parametrize("name", IMPORTED)
 def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str], Imported], name: str) -> None:
     # The cell inserts a part into its feature: the feature's owner is placed first, for a
     # reason of its own where nothing else orders them (agh_prism_array's pegs stand on the
@@ -305,11 +288,12 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
                                           "rod through two brackets")),
     "robosuite_nuts",
-    pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into no hole found (the ring, gland_2, the impeller: "
-                                           "in no feature) or onto a pin of a part that is not the base (gland_3)")),
-    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin that is not found (the pulley "
-                                             "onto the hub's boss), or into a hole and shorter than the gripper's "
-                                             "grasp depth (the bolts, 14 mm)")),
+    pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into a hole of a part that is not the base (the "
+                                           "shaft into the bearing ring) or onto a pin of a part that is not the base "
+                                           "(the glands and the impeller onto the shaft's end)")),
+    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin (the pulley onto the hub's boss: the "
+                                             "cell puts parts onto pins from above), or into a hole and shorter than "
+                                             "the gripper's grasp depth (the bolts, 14 mm)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
