@@ -90,7 +90,7 @@ _ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on i
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
-_PIN_LEVELS = 256
+_PIN_LEVELS = 64
 """How many levels :func:`_pin_of` measures a part's bore and its pin at, at most (the longest spans)."""
 
 
@@ -582,7 +582,8 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS]):
         own, theirs = slice_loops(part, axis, level), slice_loops(other, axis, level)
         bores = [o for o in own if not _outer(o, own) and o.contains(line)]
-        pins = [o for o in theirs if _outer(o, theirs) and o.contains(line)]
+        pins = [o for o in theirs if _outer(o, theirs) and o.contains(line)
+                and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach]  # the base's plate is no pin
         stretch.append((level, min(bores, key=lambda o: o.area) if bores else None,
                         shapely.Polygon(min(pins, key=lambda o: o.area).points) if pins else None))
     beyond: shapely.Polygon | None = None
