@@ -87,6 +87,7 @@ from executor.world.polygon_fit import OutlineError, polygon, symmetry
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
 _ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
+_GRID = 1e-8  # the grid [m] the union of a pin's sections is snapped to (far below a fit's room)
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
@@ -591,7 +592,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     rooms: dict[tuple[bytes, bytes], float] = {}
     for level, bore, pin in reversed(stretch):
         if pin is not None:
-            beyond = pin if beyond is None else shapely.union(beyond, pin)
+            beyond = _joined(beyond, pin)
         if bore is None or beyond is None:
             continue
         union = classify(Loop(np.asarray(shapely.Polygon(beyond.exterior).exterior.coords)[:-1]), hole=False)
@@ -608,6 +609,14 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
         return None
     _, pin, hole, level = best
     return pin, hole, frame.T @ pin.centre + axis * level, level
+
+
+def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Polygon:
+    """The union of a pin's sections ``beyond`` a level (None: none yet) and ``pin``, its
+    section at the level, its vertices on a grid of :data:`_GRID` [m]: the sections of a
+    straight pin differ by the mesh's noise (under 1 µm), and GEOS takes seconds over the
+    slivers between two alike many-sided outlines unless their vertices snap together."""
+    return pin if beyond is None else shapely.union(beyond, pin, grid_size=_GRID)
 
 
 def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float) -> np.ndarray | None:
