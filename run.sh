@@ -3,7 +3,7 @@
 # `pip install .` installs): it sets up .venv (editable, versions pinned by constraints.txt).
 #   ./run.sh                 set up .venv and run the main job (Cranfield: learn, plan, assemble)
 #   ./run.sh test [ARGS]     set up .venv, run the linters (ruff, mypy) and the test suite (pytest ARGS;
-#                            the franka_arm tests only when asked for: -m franka_arm)
+#                            without a selection in ARGS, then the franka_arm tests serially)
 #   ./run.sh lint            set up .venv and run the linters only
 #   ./run.sh <subcommand>    assembly-constraints <subcommand> (each has --help)
 # Commands run in the caller's working directory, so relative paths (--out rel.lp, the
@@ -30,10 +30,32 @@ setup() {
     fi
 }
 
-# The suite on two workers; the franky arm tests (marker franka_arm) only when asked for:
-# under a loaded machine franky-sim falls behind (docs/development.md).
+# Whether pytest ARGS select tests themselves: a marker (-m), a keyword (-k), a path, a
+# deselection, the last failures or the stepwise run.
+selects_tests() {
+    local arg
+    for arg in "$@"; do
+        case "$arg" in
+            -m|-m*|-k|-k*|--deselect*|--ignore*|--lf|--last-failed|--ff|--failed-first|--sw*|--stepwise*) return 0 ;;
+            -*) ;;
+            *) [[ -e "${arg%%::*}" ]] && return 0 ;;
+        esac
+    done
+    return 1
+}
+
+# The suite on two workers, then (unless ARGS select tests) the franky arm tests alone and
+# serially: each runs a 1 kHz control loop beside franky-sim's, and a second worker's
+# physics starves them (docs/development.md).
 run_tests() {
-    "$PY" -m pytest -n 2 "$@"
+    local status=0 arm=0
+    "$PY" -m pytest -n 2 "$@" || status=$?
+    if ! selects_tests "$@"; then
+        echo "run.sh: the franka_arm tests, serially" >&2
+        "$PY" -m pytest "$@" -n 0 -m franka_arm || arm=$?
+        [[ $status -ne 0 ]] || status=$arm
+    fi
+    return "$status"
 }
 
 lint() {
@@ -48,8 +70,8 @@ usage: ./run.sh [SUBCOMMAND] [ARGS...]
 The repository's wrapper around assembly-constraints (below); without a subcommand it
 runs the main job: Cranfield end to end, learn, plan, assemble the first plan (same as
 session --assemble). Two subcommands of its own:
-  test          run the linters and the test suite (pytest options pass through, e.g. -m "not slow";
-                the franka arm tests with -m franka_arm)
+  test          run the linters and the test suite (pytest options pass through, e.g. -m "not slow");
+                without a selection (-m, -k, a path) the franka_arm tests follow, serially
   lint          run the linters (ruff, mypy)
 
 USAGE

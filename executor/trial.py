@@ -190,6 +190,11 @@ class Cell:
         self._motion, self.scene = motion, scene
         return motion
 
+    def find_hole(self, motion: Motion, origin: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
+        """Teaching: the hole where the geometry puts it (the held part is exactly in the
+        hand, :meth:`hold_at`; no search)."""
+        return origin
+
     def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
         """Teaching (:class:`executor.skills.teach.TeachingCell`): the held part exactly in
         the hand, the teaching friction, the arm placed at the pose (in the motion's frame)

@@ -1,9 +1,11 @@
 """``./run.sh`` runs commands in the caller's working directory: relative paths resolve
-there, not in the repository (``test`` and ``lint`` still run in the repository)."""
+there, not in the repository (``test`` and ``lint`` still run in the repository); ``test``
+runs the franka_arm tests after the suite only when its arguments select no tests."""
 
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import uuid
 from pathlib import Path
@@ -46,3 +48,20 @@ def test_session_default_run_folder_is_under_the_callers_folder(tmp_path: Path) 
     assert not run.is_absolute() and run.parts[0] == "runs"
     assert (tmp_path / run / "session.json").is_file()
     assert (tmp_path / run / "c1.rrd").is_file() and (tmp_path / run / "planner.rrd").is_file()
+
+
+@pytest.mark.parametrize(("args", "selects"), [
+    ((), False), (("-p", "no:cacheprovider"), False), (("-n", "0", "-x"), False),
+    (("-m", "not slow"), True), (("-mslow",), True), (("-k", "session"), True), (("--lf",), True),
+    (("--deselect", "tests/test_api.py"), True), (("tests/test_run_sh.py",), True),
+    (("tests/test_run_sh.py::test_relative_out_is_written_in_the_callers_folder",), True),
+])
+def test_the_franka_arm_tests_follow_the_suite_only_without_a_selection(args: tuple[str, ...], selects: bool) -> None:
+    """``./run.sh test ARGS`` runs the franka_arm tests after the suite when ARGS select no
+    tests themselves (run.sh's ``selects_tests``, run here in bash): CI's plain run does,
+    the quick loop ``-m "not slow"``, a keyword, a path, a deselection do not."""
+    function = re.search(r"^selects_tests\(\) \{\n.*?^\}\n", RUN_SH.read_text(encoding="utf-8"), re.M | re.S)
+    assert function is not None
+    done = subprocess.run(["bash", "-c", function[0] + 'selects_tests "$@"', "bash", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=30)
+    assert done.returncode == (0 if selects else 1), (args, done.stderr)

@@ -224,9 +224,10 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     _check_sideways(path, geo)
     for name, hole_shape in geo.hole_shapes.items():
         bossed = not hole_shape.pin and hole_shape.axis == "-z"  # a boss of the plate
-        if bossed and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= plate.tile_size:
-            raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {plate.tile_size:g} "
-                       "m boss (size + 2 chamfer < tile_size)", hole_shape.size)
+        tile = plate.tile_size if hole_shape.tile is None else hole_shape.tile
+        if bossed and max(_sides(hole_shape.size)) + 2 * plate.chamfer >= tile:
+            raise fail(path, f"hole_shapes.{name}", "size", f"a hole and its chamfer inside the {tile:g} "
+                       "m boss (size + 2 chamfer < tile or the plate's tile_size)", hole_shape.size)
     for name, part_shape in geo.part_shapes.items():
         if part_shape.demo_hole not in holes:
             raise fail(path, f"part_shapes.{name}", "demo_hole",
@@ -252,8 +253,10 @@ def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
     turned = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.yaw for hid in hole_shape.holes}
     pins = {hid for hole_shape in geo.hole_shapes.values() if hole_shape.pin or hole_shape.axis != "-z"
             for hid in hole_shape.holes}  # no boss on the plate
-    _check_bosses(path, plate.tile_size, {h: (p[0], p[1]) for h, p in positions.items()
-                                          if p is not None and h not in pins}, turned)
+    tiles = {hid: plate.tile_size if hole_shape.tile is None else hole_shape.tile
+             for hole_shape in geo.hole_shapes.values() for hid in hole_shape.holes}
+    _check_bosses(path, {h: (p[0], p[1], tiles[h]) for h, p in positions.items()
+                         if p is not None and h not in pins}, turned)
     _check_kinds(path, geo, layout)
     _check_product(path, geo, layout, holes)
     meshes = [(f"part_shapes.{name}", shape.mesh, True) for name, shape in geo.part_shapes.items()]
@@ -329,20 +332,32 @@ def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes, re
                               f"{shorten(line.decode('utf-8', 'replace'))!r}")
 
 
-def _check_bosses(path: Path, tile: float, positions: Mapping[str, tuple[float, float]], turned: set[str]) -> None:
-    """No two square bosses (side ``tile`` [m], around the holes at ``positions``) overlap.
-    A boss of a ``turned`` hole is turned with it: two bosses whose centres are closer than
-    ``tile`` overlap whatever their yaws (their inscribed circles do)."""
-    ordered = sorted(positions.items())
-    for k, (a, (xa, ya)) in enumerate(ordered):
-        for b, (xb, yb) in ordered[k + 1:]:
+def _check_bosses(path: Path, bosses: Mapping[str, tuple[float, float, float]], turned: set[str]) -> None:
+    """No two square bosses overlap (:func:`overlapping_bosses`)."""
+    found = overlapping_bosses(bosses, turned)
+    if found is not None:
+        (a, (xa, ya, ta)), (b, (xb, yb, tb)) = ((hid, bosses[hid]) for hid in found)
+        raise BridgeError(f"{path}: [plate] tile_size: expected bosses that do not overlap, got holes "
+                          f"{a} at ({xa:g}, {ya:g}) and {b} at ({xb:g}, {yb:g}) m closer than their "
+                          f"bosses' half sides together ({(ta + tb) / 2:g} m)")
+
+
+def overlapping_bosses(bosses: Mapping[str, tuple[float, float, float]], turned: set[str]) -> tuple[str, str] | None:
+    """The first two holes (by id) whose square bosses overlap, each ``(x, y, side)`` [m]
+    around the hole it is named for; None when none do. A boss of a ``turned`` hole is
+    turned with it: two bosses whose centres are closer than half their sides together
+    overlap whatever their yaws (their inscribed circles do)."""
+    ordered = sorted(bosses.items())
+    for k, (a, (xa, ya, ta)) in enumerate(ordered):
+        for b, (xb, yb, tb) in ordered[k + 1:]:
+            reach = (ta + tb) / 2 - TOUCH_TOLERANCE
             if a in turned or b in turned:
-                overlap = math.hypot(xa - xb, ya - yb) < tile - TOUCH_TOLERANCE
+                overlap = math.hypot(xa - xb, ya - yb) < reach
             else:
-                overlap = abs(xa - xb) < tile - TOUCH_TOLERANCE and abs(ya - yb) < tile - TOUCH_TOLERANCE
+                overlap = abs(xa - xb) < reach and abs(ya - yb) < reach
             if overlap:
-                raise BridgeError(f"{path}: [plate] tile_size: expected bosses that do not overlap, got holes "
-                                  f"{a} at ({xa:g}, {ya:g}) and {b} at ({xb:g}, {yb:g}) m closer than {tile:g} m")
+                return a, b
+    return None
 
 
 def _describe(kind: str, size: float | list[float]) -> str:

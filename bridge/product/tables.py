@@ -123,13 +123,16 @@ EntryHeight = Annotated[float, Meta(gt=0.0, le=1.0, description="a number in (0,
 HoleDepth = Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
 
 
+TileSize = Annotated[float, Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] m")]
+
+
 class Plate(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[plate]``: the bosses' top face height (the hole entries), side and thickness (=
     the hole depth), each hole's unless its shape gives its own, the entry chamfer [m],
     the sides of a round hole's polygon, the plate under the bosses."""
 
     top_z: EntryHeight
-    tile_size: Annotated[float, Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] m")]
+    tile_size: TileSize
     tile_thickness: HoleDepth
     chamfer: Annotated[float, Meta(gt=0.0, le=0.01, description="a number in (0, 0.01] m")]
     polygon_sides: Annotated[int, Meta(ge=8, le=256, multiple_of=8,
@@ -168,7 +171,8 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     ends (the taught goal: nothing stops a part in a through hole). ``zero_clearance`` names
     the parts stated to fit at room 0, a nominal zero-clearance fit (pegs of ``part_shapes``,
     or parts with a ``bore`` for a pin): the section is the nominal one, and a listed part
-    whose section is not wider passes (any other part needs room above 0)."""
+    whose section is not wider passes (any other part needs room above 0). ``tile`` is the
+    side of their square bosses [m] where it differs from the plate's ``tile_size``."""
 
     holes: Ids
     kind: Kind
@@ -181,6 +185,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     pin: bool = False
     axis: InsertionAxis = "-z"
     zero_clearance: Ids | None = None
+    tile: TileSize | None = None
 
 
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -92,6 +92,13 @@ SETTLE_S = 0.5
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
+SURFACE_RAYS = (8, 24)
+"""The rays that measure where a peg's hole search presses (:meth:`Assembler.search_surface`):
+this many rings about the hole's axis, this many rays a ring, plus one on the axis."""
+SURFACE_MARGIN = 0.001
+"""[m] beyond the peg's section about its hole's axis, the reach of those rays: the rim of
+an opening over the hole (a bracket's flange about its bore), not a wall beside it (the
+wall of ``occt_as1``'s bracket stands 10 mm from its bolts' axes, 5 mm from their shanks)."""
 STAY_TOLERANCE = 0.005
 """A part let go at its goal must still be within this distance of it after the tool's
 retreat [m] (placed parts are within 2 mm); else the step is ``no_fit`` and the part is
@@ -164,6 +171,7 @@ class Assembler:
         self._screwed: dict[str, int] = {}
         self.blocked: set[str] = set()
         self._bias = CellBias(ASSEMBLY_UNCERTAINTY, 0) if bias is None else bias
+        self._surface: dict[str, float] = {}  # hole -> where its search presses, measured this step
         self.layer, self.ilc = layer, ilc
 
     def skill_of(self, part: str) -> str:
@@ -224,6 +232,9 @@ class Assembler:
             world.set_peg_goal(part, hole)
         setup = self._draw(rng, part, hole)
         grasp = self._pick(part, setup)
+        self._surface.clear()
+        if skill == "insert" and hole is not None and self._frame(hole, skill) is None:
+            self._surface[hole] = self.search_surface(part, hole)  # the arm at the tray, clear of the product
         stuck: tuple[FailureReason | None, tuple[str, ...]] = (None, ())
         if skill == "fixture":
             carry(motion, world.frames[part].grip, grasp.follow)
@@ -369,13 +380,52 @@ class Assembler:
         room = margin(peg, feature) / 2
         return 2 * room + CENTRING_MARGIN if room > CENTRING_ROOM else None
 
+    def search_surface(self, part: str, hole: str) -> float:
+        """The height [m] where the hole search for peg ``part`` presses at ``hole`` (entered
+        down): the hole's top, or higher the highest point of a placed part other than the
+        base within the peg's section (its circumradius) plus :data:`SURFACE_MARGIN` of the
+        hole's axis (a bracket's flange over the hole, the peg going through its bore),
+        measured by rays straight down onto the world (a ray
+        that meets anything else, the arm or the held part, goes on under its bounding box)."""
+        world, spec = self.world, self.product.geometry.holes[hole]
+        bodies = {world.frames[q].body for q in self.placed if q not in (part, self.product.base.id)}
+        peg = self.product.pegs[part]
+        if peg.kind == "round":
+            circumradius = peg.size / 2
+        elif peg.outline:
+            circumradius = float(np.max(np.linalg.norm(np.asarray(peg.outline), axis=1)))
+        else:
+            circumradius = float(np.hypot(*peg.sides)) / 2
+        reach = circumradius + SURFACE_MARGIN
+        rings, per_ring = SURFACE_RAYS
+        xy = [np.asarray(spec.position[:2], dtype=float)]
+        for r in np.linspace(reach / rings, reach, rings):
+            xy += [xy[0] + r * np.array([np.cos(a), np.sin(a)])
+                   for a in np.linspace(0.0, 2 * np.pi, per_ring, endpoint=False)]
+        starts = [[x, y, SAFE_Z + 0.5] for x, y in xy]
+        top = spec.top_z
+        while starts:
+            hits = pb.rayTestBatch(starts, [[x, y, spec.top_z] for x, y, _ in starts], physicsClientId=world.client)
+            going_on = []
+            for start, (body, link, _, position, _) in zip(starts, hits, strict=True):
+                if body in bodies:
+                    top = max(top, float(position[2]))
+                elif body >= 0:  # on under what it met
+                    under = float(pb.getAABB(body, link, physicsClientId=world.client)[0][2]) - 1e-4
+                    if spec.top_z < under < start[2]:
+                        going_on.append([start[0], start[1], under])
+            starts = going_on
+        return top
+
     def _approach(self, part: str, hole: str | None, skill: str, goal: np.ndarray) -> np.ndarray:
-        """Where the insertion starts [m]: above the entry of ``hole`` (pegs), above the pin
+        """Where the insertion starts [m]: above the entry of ``hole`` (pegs; above the part
+        over it where one is placed: :meth:`search_surface`, measured as the step began), above the pin
         tops (covers: the longest peg standing in the highest of its holes), above the
         socket (heads)."""
         p = self.product
         if skill == "insert" and hole is not None:
-            return np.array([goal[0], goal[1], p.geometry.holes[hole].top_z + APPROACH_HEIGHT])
+            top = self._surface.get(hole, p.geometry.holes[hole].top_z)
+            return np.array([goal[0], goal[1], top + APPROACH_HEIGHT])
         if skill == "insert_over":
             longest = max(s.length for s in p.pegs.values())
             holes = [p.geometry.holes[h] for h in p.covers[part].over]

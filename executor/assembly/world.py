@@ -24,7 +24,7 @@ from executor.control.gains import ImpedanceGains
 from executor.control.motion import Motion, StepLogger
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies
+from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies, tile_of
 from executor.world.scene import TIME_STEP, load_plate, wrist_clear_of
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
@@ -111,7 +111,7 @@ class AssemblyWorld:
     # --- building -------------------------------------------------------------------
     def _build_base(self) -> None:
         p, plate = self.product, self.product.geometry.plate
-        tiles = [(*h.position, plate.tile_size) for h in p.geometry.holes.values()]
+        tiles = [(*h.position, tile_of(plate, h)) for h in p.geometry.holes.values()]
         (sx, sy), (cx, cy) = plate.base_size, plate.base_center
         deck = rect_minus_squares((cx - sx / 2, cy - sy / 2, cx + sx / 2, cy + sy / 2), tiles)
         body = load_plate(self.client, p.geometry, p.geometry.assets / "plate.obj", deck)

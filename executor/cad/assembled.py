@@ -27,7 +27,7 @@ from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.world import AssemblyWorld
 from executor.cell_description import load_cell_description
-from executor.world.geometry import feature_passes
+from executor.world.geometry import feature_passes, tile_of
 from executor.world.scene import link_frame
 
 CYLINDER_SECTIONS = 256
@@ -95,7 +95,7 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
         assert isinstance(own, trimesh.Trimesh)  # the loader checked the file
         return own
     plate = geometry.plate
-    top, tile, depth = plate.top_z, plate.tile_size, plate.tile_thickness
+    top, depth = plate.top_z, plate.tile_thickness
     levelled = sorted(h.id for h in geometry.holes.values() if (h.top_z, h.depth) != (top, depth))
     if levelled:
         raise ExecutorError(f"{geometry.folder / 'geometry.toml'}: holes {', '.join(levelled)} have their own top_z or "
@@ -105,6 +105,7 @@ def _base_solid(world: AssemblyWorld) -> trimesh.Trimesh:
     block.apply_translation((cx, cy, top / 2))
     tiles = []
     for hole in geometry.holes.values():
+        tile = tile_of(plate, hole)
         square = trimesh.creation.box((tile, tile, depth))
         square.apply_translation((*hole.position, top - depth / 2))
         tiles.append(square)

@@ -314,6 +314,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     derived = derive(parts, settings.base, fixed, reach)
     assumed += [*derived.assumptions(), *nominal_assumption(derived), *overlap_assumption(derived)]
     mapped, laid = map_product(derived, settings)
+    assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "

@@ -36,6 +36,7 @@ never when a cell starts.
 from __future__ import annotations
 
 import hashlib
+import io
 import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -65,6 +66,8 @@ CONVEX_TOLERANCE = 1e-3
 THRESHOLDS = (0.05, 0.03, 0.02, 0.01)
 """CoACD's concavity thresholds (the largest concavity left in a piece, relative to the
 part's size) tried in turn, its default first, until the pieces fit (:data:`ROOM_KEPT`)."""
+ITERATIONS = 150
+"""CoACD's tree-search iterations per cut (its default)."""
 SEEDS = (0, 1)
 """CoACD's random seeds, each with every threshold in turn until the pieces fit: a seed
 can cut a piece thinner than the cell's hull margin twice where another cuts none (an
@@ -152,10 +155,12 @@ def peg_frame(section: Shape2D, mesh: trimesh.Trimesh) -> np.ndarray:
     return turn @ shift
 
 
-def _decomposed(mesh: trimesh.Trimesh, threshold: float, seed: int) -> list[trimesh.Trimesh]:
-    """CoACD's convex pieces of a closed mesh at a concavity ``threshold`` and a random ``seed``."""
+def _decomposed(mesh: trimesh.Trimesh, threshold: float, seed: int, iterations: int) -> list[trimesh.Trimesh]:
+    """CoACD's convex pieces of a closed mesh at a concavity ``threshold``, a random
+    ``seed`` and ``iterations`` of its tree search per cut."""
     coacd.set_log_level("error")
-    pieces = coacd.run_coacd(coacd.Mesh(mesh.vertices, mesh.faces), threshold=threshold, seed=seed)
+    pieces = coacd.run_coacd(coacd.Mesh(mesh.vertices, mesh.faces), threshold=threshold, seed=seed,
+                             mcts_iterations=iterations)
     return [trimesh.convex.convex_hull(vertices) for vertices, _ in pieces]
 
 
@@ -187,15 +192,16 @@ def overlap_assumption(derived: Derived) -> list[str]:
 
 
 def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimesh.Trimesh],
-                   fits: frozenset[str] = frozenset(), thresholds: Sequence[float] = THRESHOLDS
-                   ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+                   fits: frozenset[str] = frozenset(), thresholds: Sequence[float] = THRESHOLDS,
+                   iterations: int = ITERATIONS) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
     """The convex pieces of part ``pid``'s closed mesh (module docstring; each with how far
     its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
     parts near it in the assembled pose, in its frame); or why no decomposition leaves
     each of them :data:`ROOM_KEPT` of the room the mesh leaves it (touching: none
     deeper than :data:`executor.cad.sweep.TOUCH`; those in ``fits``, at a stated
     zero-clearance fit or passage with it: none deeper than :data:`NOMINAL_OVERLAP`)
-    with every piece at least twice the cell's hull margin thick."""
+    with every piece at least twice the cell's hull margin thick (CoACD's tree search
+    making ``iterations`` per cut)."""
     allowed = {name: NOMINAL_OVERLAP if name in fits else TOUCH for name in neighbours}
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
     own = bvh(mesh)
@@ -206,14 +212,16 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     left: dict[str, float] = {}
     short: list[str] = []
     for seed, threshold in [(0, 0.0)] if convex else [(s, t) for s in SEEDS for t in thresholds]:
-        kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed))]
+        kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed, iterations))]
         if any(eroded(piece.vertices, URDF_HULL_MARGIN) is None for piece, _ in kept):
             continue  # a piece the cell cannot collide as
         objects = [convex_object(piece) for piece, _ in kept]
         left = {name: _room(objects, other) for name, other in others.items()}
         short = [name for name in others if left[name] < ROOM_KEPT * rooms[name] - allowed[name]]
         if not short:
-            kind = "its hull" if convex else f"CoACD at threshold {threshold:g}" + (f", seed {seed}" if seed else "")
+            kind = "its hull" if convex else (f"CoACD at threshold {threshold:g}" + (f", seed {seed}" if seed else "")
+                                              + (f", {iterations} tree-search iterations" if iterations != ITERATIONS
+                                                 else ""))
             apart = [name for name in rooms if rooms[name] > TOUCH]
             over = sorted(name for name in rooms if left[name] < -TOUCH)
             touching = (f"; they overlap none of the parts they touch ({' '.join(sorted(set(rooms) - set(apart)))})"
@@ -224,7 +232,8 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             name = min(apart, key=lambda n: left[n] / rooms[n])
             return kept, (f"{kind}; they leave {name} {1e3 * left[name]:.3f} of {1e3 * rooms[name]:.3f} mm"
                           + (touching if len(apart) < len(rooms) else ""))
-    tried = f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
+    tried = (f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
+             + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else ""))
     if not short:
         return (f"part '{pid}' has no convex pieces the cell can collide as ({tried}: each gave a piece thinner than "
                 f"{2000 * URDF_HULL_MARGIN:g} mm, the cell's hull margin twice)")
@@ -241,7 +250,8 @@ def pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: f
     prisms (a torus ring): :func:`fitting_pieces` with its ``pin`` (the pin's solid in the
     part's frame, where the part rests on it) as its neighbour, which they may leave at most
     ``allowed`` [m] less room than the mesh leaves it (the cell's bore smaller by at most
-    that, as :func:`executor.world.rings.coarser_bores`); or why they do not. Made once for
+    that, as :func:`executor.world.rings.coarser_bores`), CoACD's :data:`PIN_THRESHOLDS` tried
+    in turn, each with :data:`PIN_ITERATIONS` in turn; or why they do not. Made once for
     a mesh and the file written of it (alike within the 0.1 µm the file keeps)."""
     points = np.round(apart(mesh.vertices), 7)
     key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.round(pin.vertices, 7).tobytes()
@@ -261,16 +271,17 @@ def _pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: 
     room = fcl.distance(bvh(mesh), bvh(pin), fcl.DistanceRequest(), fcl.DistanceResult())
     bound = min(allowed, CENTRED)
     why = ""
-    for threshold in PIN_THRESHOLDS:
-        found = fitting_pieces(pid, mesh, {"its pin": pin}, thresholds=(threshold,))
+    for threshold, iterations in [(t, n) for t in PIN_THRESHOLDS for n in PIN_ITERATIONS]:
+        found = fitting_pieces(pid, mesh, {"its pin": pin}, thresholds=(threshold,), iterations=iterations)
         if isinstance(found, str):
             why = found
             continue
         left = _room([convex_object(piece) for piece, _ in found[0]], bvh(pin))
         if room - left <= bound:
             return found
-        why = (f"the convex pieces of part '{pid}' (CoACD at threshold {threshold:g}) leave its pin {1e3 * left:.3f} "
-               f"of the {1e3 * room:.3f} mm its mesh leaves it (expected at most {1e3 * bound:.3f} mm less)")
+        why = (f"the convex pieces of part '{pid}' (CoACD at threshold {threshold:g}, {iterations} tree-search "
+               f"iterations) leave its pin {1e3 * left:.3f} of the {1e3 * room:.3f} mm its mesh leaves it "
+               f"(expected at most {1e3 * bound:.3f} mm less)")
     return why
 
 
@@ -282,6 +293,12 @@ CENTRED = 0.002
 its room: the cell centres it on the pin by contact with them, so its bore's centre is
 then within half of that of the mesh's (Meta-World's ring: CoACD at 0.05 took 5.4 mm of
 17.3 and left it 2.1 mm off its goal; at 0.02, 1.5 mm)."""
+PIN_ITERATIONS = (30, ITERATIONS)
+"""CoACD's tree-search iterations per cut tried in turn at each of :data:`PIN_THRESHOLDS`
+(:func:`pin_pieces`): a fifth of its default first, then its default; the pieces of
+either are kept only when they pass the same checks. Its search is most of an import
+with a ring: Meta-World's (1612 triangles, threshold 0.02) took 14.3 s of CPU at 150
+iterations, 4.6 s at 30, and those pieces leave its pin 15.660 of 17.284 mm."""
 
 
 Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, float]], str] | str]
@@ -289,17 +306,45 @@ Pieces = Callable[[str, trimesh.Trimesh], tuple[list[tuple[trimesh.Trimesh, floa
 with how far dropped vertices reach, and how they were made; or why it has none)."""
 
 
-def _beyond(hull: trimesh.Trimesh, points: np.ndarray) -> np.ndarray:
-    """How far [m] each point lies beyond the face planes of a convex ``hull`` (<= 0 inside)."""
-    offsets = np.einsum("ij,ij->i", hull.face_normals, hull.triangles[:, 0])
-    return np.max(points @ hull.face_normals.T - offsets, axis=1)
+def _beyond(planes: tuple[np.ndarray, np.ndarray], points: np.ndarray) -> np.ndarray:
+    """How far [m] each point lies beyond the face ``planes`` of a convex hull (their
+    outward unit normals and each normal's dot with its face's first corner; <= 0 inside)."""
+    normals, offsets = planes
+    return np.max(points @ normals.T - offsets, axis=1)
+
+
+def _planes(hull: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray]:
+    """The face planes (:func:`_beyond`) of a convex ``hull``."""
+    return hull.face_normals, np.einsum("ij,ij->i", hull.face_normals, hull.triangles[:, 0])
+
+
+def _hull_planes(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The face planes (:func:`_beyond`) of ``trimesh.convex.convex_hull(points)``, the same
+    numbers without making the mesh (a third of the cost): qhull's triangles with their
+    degenerate ones left out, each wound outwards from the area-weighted centroid of the
+    triangles' centres, its normal its corners' unit cross product; trimesh's repair after
+    that (winding mended across neighbours) changes no face of a hull qhull gives whole.
+    Where qhull refuses the points (flat), trimesh's own hull (it joggles them)."""
+    try:
+        hull = scipy.spatial.ConvexHull(points, qhull_options=str(trimesh.convex.QHULL_DEFAULT))
+    except scipy.spatial.QhullError:
+        return _planes(trimesh.convex.convex_hull(points))
+    crosses = trimesh.triangles.cross(points[hull.simplices])
+    normals, valid = trimesh.util.unitize(crosses, check_valid=True)
+    faces = hull.simplices[valid]
+    centres = points[faces].mean(axis=1)
+    centroid = np.average(centres, weights=trimesh.triangles.area(crosses=crosses[valid]), axis=0)
+    backwards = trimesh.util.diagonal_dot(normals, centres - centroid) < 0.0
+    faces[backwards] = np.fliplr(faces[backwards])
+    normals, _ = trimesh.triangles.normals(points[faces])
+    return normals, np.einsum("ij,ij->i", normals, points[faces[:, 0]])
 
 
 def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimesh.Trimesh, float]:
     """The hull of at most ``count`` vertices of a convex ``piece`` and how far [m] the
     piece's vertices reach beyond its face planes (0 when it keeps them all): from the
     four vertices of the largest tetrahedron found greedily, the vertex farthest beyond
-    the kept hull is added until ``count`` are kept."""
+    the kept hull (:func:`_hull_planes`) is added until ``count`` are kept."""
     points = np.asarray(piece.vertices)
     if len(points) <= count:
         return piece, 0.0
@@ -310,11 +355,10 @@ def reduced(piece: trimesh.Trimesh, count: int = PIECE_VERTICES) -> tuple[trimes
     normal = np.cross(line, points[third] - points[first])
     fourth = int(np.argmax(np.abs((points - points[first]) @ normal)))
     chosen = [first, second, third, fourth]
-    kept = trimesh.convex.convex_hull(points[chosen])
     while len(chosen) < count:
-        chosen.append(int(np.argmax(_beyond(kept, points))))
-        kept = trimesh.convex.convex_hull(points[chosen])
-    return kept, float(max(0.0, np.max(_beyond(kept, points))))
+        chosen.append(int(np.argmax(_beyond(_hull_planes(points[chosen]), points))))
+    kept = trimesh.convex.convex_hull(points[chosen])
+    return kept, float(max(0.0, np.max(_beyond(_planes(kept), points))))
 
 
 APART = 2e-7
@@ -335,6 +379,17 @@ def apart(vertices: np.ndarray) -> np.ndarray:
             moved[i] -= shift
             moved[j] += shift
     return moved
+
+
+def as_written(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` as :func:`write_mesh` writes it and reads it back (its vertices moved
+    :func:`apart` and kept to 0.1 µm, loaded as trimesh loads the file): the mesh whose
+    pieces are written, so that they are found once, before it is (:func:`pin_pieces` and
+    :func:`executor.world.rings.ring_pieces` keep what they found by the mesh)."""
+    text = obj_text([("mesh", apart(mesh.vertices), mesh.faces)], "# as written")
+    loaded = trimesh.load(io.StringIO(text), file_type="obj", force="mesh")
+    assert isinstance(loaded, trimesh.Trimesh)  # one object, closed as given
+    return loaded
 
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,

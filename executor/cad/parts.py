@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import BinaryIO
 
+import manifold3d
 import numpy as np
 import trimesh
 
@@ -268,13 +269,17 @@ def _check_overlaps(parts: list[CadPart]) -> None:
     (exact booleans by manifold3d on the pairs whose bounding boxes meet), less the pieces
     of it that lie within their zero-clearance fits' tolerance of the mated faces."""
     faces: dict[str, list[CylinderFace | PrismFace]] = {}
+    solids: dict[str, manifold3d.Manifold] = {}
     for i, a in enumerate(parts):
         for b in parts[i + 1:]:
             low = np.maximum(a.mesh.bounds[0], b.mesh.bounds[0])
             high = np.minimum(a.mesh.bounds[1], b.mesh.bounds[1])
             if np.any(high - low <= 0):
                 continue
-            common = trimesh.boolean.intersection([a.mesh, b.mesh], engine="manifold")
+            for part in (a, b):
+                if part.id not in solids:
+                    solids[part.id] = _manifold(part.mesh)
+            common = _mesh((solids[a.id] ^ solids[b.id]).to_mesh())
             volume = _volume(common)
             if volume > OVERLAP_VOLUME:
                 for part in (a, b):
@@ -287,6 +292,19 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
                                     "that at most touch, or coaxial cylinders of one radius within their "
                                     "tessellations' deflection)")
+
+
+def _manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:
+    """A closed ``mesh`` as manifold3d takes it in trimesh's booleans (single precision),
+    made once per part: its triangle index (its collider) is built with it and serves
+    every pair the part is in."""
+    return manifold3d.Manifold(manifold3d.Mesh(vert_properties=np.array(mesh.vertices, dtype=np.float32),
+                                               tri_verts=np.array(mesh.faces, dtype=np.uint32)))
+
+
+def _mesh(mesh: manifold3d.Mesh) -> trimesh.Trimesh:
+    """A manifold3d result as a trimesh mesh, as trimesh's booleans return it."""
+    return trimesh.Trimesh(vertices=mesh.vert_properties, faces=mesh.tri_verts, process=False)
 
 
 def _volume(mesh: trimesh.Trimesh) -> float:

@@ -41,12 +41,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import networkx as nx
 import numpy as np
 import shapely
 import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
-from trimesh.path.traversal import discretize_path
+from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
 from executor.cad.parts import Cylinder
 from executor.cad.sweep import TOUCH
@@ -131,13 +132,62 @@ def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[L
     loops = []
     # a plane section is made of straight lines, which need no scale to be discretised
     # (the section's ``discrete`` would measure every line's bounds for one)
-    for polyline in (discretize_path(section.entities, section.vertices, path) for path in section.paths):
+    for polyline in _closed_polylines(section):
         points = np.asarray(polyline) @ frame.T
         if len(points) > 1 and np.allclose(points[0], points[-1]):
             points = points[:-1]
         if len(points) >= 3:
             loops.append(Loop(points))
     return loops
+
+
+def _closed_polylines(section: trimesh.path.Path3D) -> list[np.ndarray]:
+    """The points (n, 3) [m] of each closed path of a plane section, the first repeated
+    last: those of :func:`_closed_paths` discretised, in the same order. Where the
+    section's other entities all go from a vertex to itself they make no cycle, so its
+    paths are its closed entities and no graph is built (most sections of a fine mesh in
+    metres: thousands of such lines, whose graph took most of a slice's time)."""
+    entities, vertices = section.entities, section.vertices
+    closed = _only_closed(entities)
+    paths = _closed_paths(section) if closed is None else [[index] for index in closed]
+    return [discretize_path(entities, vertices, path) for path in paths]
+
+
+def _only_closed(entities: list[trimesh.path.entities.Entity]) -> list[int] | None:
+    """The indices of the closed entities when each other entity is a line of two points
+    at one vertex (a self-loop, no cycle of :func:`_closed_paths`' graph), else None."""
+    ends = [entity.points for entity in entities]
+    sizes = np.fromiter(map(len, ends), dtype=np.int64, count=len(ends))
+    others = np.flatnonzero(sizes != 2)
+    closed = [int(index) for index in others if entities[index].closed]
+    if len(closed) < len(others):
+        return None
+    lines = np.flatnonzero(sizes == 2)
+    if len(lines) and np.any(np.diff(np.concatenate([ends[index] for index in lines]).reshape(-1, 2), axis=1)):
+        return None
+    return closed
+
+
+def _closed_paths(section: trimesh.path.Path3D) -> list[list[int]]:
+    """The closed paths of a plane section (lists of its entities' indices): trimesh's
+    ``closed_paths``, the same paths in the same order (the cycles of one graph of the
+    lines' vertices, built with the same edges in the same order), the graph built in one
+    call instead of one per line (trimesh's per-line calls took most of a slice's time on
+    meshes of 10⁵ triangles)."""
+    graph = nx.Graph()
+    paths: list[list[int]] = []
+    edges: list[tuple[int, int, dict[str, int]]] = []
+    for index, entity in enumerate(section.entities):
+        if entity.closed:
+            paths.append([index])
+        else:
+            points = entity.points.tolist()
+            edges += [(a, b, {"entity_index": index}) for a, b in zip(points[:-1], points[1:], strict=True)]
+    graph.add_edges_from(edges)
+    for cycle in nx.cycle_basis(graph):
+        if len(cycle) >= 2:
+            paths.append(vertex_to_entity_path(cycle, graph, section.entities, section.vertices))
+    return paths
 
 
 def _min_rectangle(points: np.ndarray) -> tuple[float, float, float]:

@@ -59,11 +59,13 @@ from bridge.errors import ToolError
 from bridge.files import make_folder, os_reason, write_atomic
 from bridge.inputs import read_text, shorten
 from bridge.product import Mesh
+from bridge.product.checks import overlapping_bosses
 from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
     NEAR,
     Pieces,
+    as_written,
     base_is_primitive,
     fitted,
     peg_frame,
@@ -78,14 +80,21 @@ from executor.cad.sections import rounded as _q
 from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
-from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, thin_prism
+from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, plate_obj_text, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
 DENSITY = 2700.0
 """Mass of a peg in the simulated cell: its volume times this [kg/m³] (aluminium)."""
 GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02}
-"""The simulated gripper of every imported product (Cranfield's)."""
+"""The simulated gripper of every imported product (Cranfield's), its flange longer where the
+arm's wrist would meet the product (:func:`tool_length`)."""
+WRIST_RADIUS = 0.06
+"""[m] the arm's wrist about the tool's axis: pybullet_data's ``kuka_iiwa`` ``lbr_iiwa_link_7``,
+52.1 mm in radius, its face where the gripper's flange starts, widened for the part's tilt
+in the grasp (a 1 deg tilt moves its rim 1 mm down)."""
+WRIST_CLEARANCE = 0.01
+"""[m] how far above the product near a part's axis the arm's wrist stays with the part at its goal."""
 TRAY_START = (0.25, 0.40)
 """The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
 TRAY_PITCH = 0.05
@@ -412,6 +421,55 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
                    bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
 
 
+def _highest_near(mesh: trimesh.Trimesh, xy: tuple[float, float], radius: float) -> float | None:
+    """The highest point [m] of ``mesh`` within ``radius`` [m] of the vertical line through
+    ``xy`` [m] (within the 32-gon prism circumscribing that circle), None where it has none."""
+    turns = np.arange(32) * 2 * math.pi / 32
+    out = np.c_[np.cos(turns), np.sin(turns), np.zeros(32)]
+    origins = out * radius / math.cos(math.pi / 32) + np.array([xy[0], xy[1], 0.0])
+    inside = trimesh.intersections.slice_mesh_plane(mesh, -out, origins)
+    return float(inside.bounds[1][2]) if len(inside.faces) else None
+
+
+def tool_length(derived: Derived) -> tuple[float | None, str]:
+    """The length [m] of the gripper's flange that keeps the arm's wrist (:data:`WRIST_RADIUS`
+    about the tool's axis, at the flange's top) :data:`WRIST_CLEARANCE` above every part that
+    may be in place (any but those the geometric precedence puts after it, and but a base with
+    pins: :func:`executor.world.scene.wrist_clear_of`) within that radius
+    of the axis of each part the cell inserts from above, held :data:`GRIPPER`'s grasp depth
+    deep (a part with a bore: at most half its length) at its goal (a peg standing on its
+    hole's bottom, a part with a bore where the CAD has it), rounded up to the millimetre;
+    None where :data:`GRIPPER`'s keeps it clear, with why (the part, the part below the
+    wrist and how high it stands) otherwise. A part the wrist meets stops short of its goal
+    (``occt_as1``: bolt_a1 4.1 mm above it, the wrist on bracket_a's wall)."""
+    graph = nx.DiGraph()
+    graph.add_nodes_from(derived.parts)
+    graph.add_edges_from(derived.edges)
+    depth = GRIPPER["grasp_depth"]
+    grips = {pid: (fit.position, fit.entry - fit.depth + float(_upright(derived, fit).extents[2]) - depth)
+             for pid, fit in derived.hole_of.items() if fit.axis == "+z"}
+    for pin in derived.pins.values():
+        for pid in (p for p in pin.parts if p in derived.bores and pin.axis == "+z"):
+            low, high = (float(v) for v in derived.parts[pid].mesh.bounds[:, 2])
+            grips[pid] = (pin.position, high - min(depth, (high - low) / 2))
+    need, why = GRIPPER["flange_length"], ""
+    clear = {derived.base} if derived.pins else set()  # the cell's wrist does not collide with a base with pins
+    for pid, (xy, grip) in sorted(grips.items()):
+        later = nx.descendants(graph, pid)
+        for other in sorted(set(derived.parts) - later - clear - {pid}):
+            top = _highest_near(derived.parts[other].mesh, xy, WRIST_RADIUS)
+            if top is not None and top - grip + WRIST_CLEARANCE > need + 1e-9:
+                need = top - grip + WRIST_CLEARANCE
+                why = (f"the gripper's flange {{flange:.3f}} m long, not {GRIPPER['flange_length']:g}: with '{pid}' at "
+                       f"its goal the arm's wrist ({1e3 * WRIST_RADIUS:g} mm about the tool's axis) stays "
+                       f"{1e3 * WRIST_CLEARANCE:g} mm above '{other}' (up to {1e3 * top:.3f} mm within "
+                       f"{1e3 * WRIST_RADIUS:g} mm of that axis)")
+    if not why:
+        return None, ""
+    flange = math.ceil(round(need * 1e3, 6)) / 1e3
+    return flange, why.format(flange=flange)
+
+
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
     the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`);
@@ -430,7 +488,7 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return (f"goes onto a pin ({pin.id}) with {room * 500:+.4f} mm of room per side, less than the "
                 f"{SIZE_RESOLUTION * 1e3:g} mm the simulated cell resolves")
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
-    found = bore_pieces(derived, pid)(pid, mesh)
+    found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
 
 
@@ -505,10 +563,12 @@ def map_product(derived: Derived, settings: Settings) -> tuple[Mapped, Settings]
     """The covers, heads and parts placed by hand of the product as the cell inserts it
     (:func:`cell_view`: its other pegs are placed by hand), with ``why`` the cell builds
     none of it (two parts overlapping on the tray, or parts without a tray in ``settings``
-    that cannot all wait within the arm's reach), and the settings with every part's tray
+    that cannot all wait within the arm's reach), its gripper's flange where the default's is
+    too short (:func:`tool_length`), and the settings with every part's tray
     (:func:`default_trays` for those it lacks)."""
     cell, by_hand = cell_view(derived)
-    mapped = map_parts(cell, _plate_top(cell), by_hand)
+    flange, tool = tool_length(cell)
+    mapped = replace(map_parts(cell, _plate_top(cell), by_hand), flange=flange, tool=tool)
     boxes = _footprints(cell, mapped)
     trays, unreached = default_trays(boxes, settings.trays, derived.base, _product_box(derived))
     settings = replace(settings, trays=trays)
@@ -677,11 +737,13 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = _plate_level(derived)
+    chamfer = max([MIN_CHAMFER, *(f.chamfer for f in fits)])
     tile = _tile([fit for fit in fits if fit.axis == "+z"])  # the plate's bosses: none around a sideways hole
+    own = _own_tiles(derived, tile, chamfer)
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
              "# parts that are none as their own meshes (meshes/, checked by their SHA-256).", "",
              "[plate]", f"top_z = {_q(top)}", f"tile_size = {_q(tile)}", f"tile_thickness = {_q(depth)}",
-             f"chamfer = {_q(max([MIN_CHAMFER, *(f.chamfer for f in fits)]))}  # [m] at least MIN_CHAMFER",
+             f"chamfer = {_q(chamfer)}  # [m] at least MIN_CHAMFER",
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
@@ -693,6 +755,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
+        if hid in own:
+            lines.append(f"tile = {_q(own[hid])}  # its own boss: the plate's would overlap its neighbours'")
         if fit.axis != "+z":  # entered sideways: its entry's height, its depth to its part's tip
             lines += [f'axis = "{opposite(fit.axis)}"', f"top_z = {_q(entry_point(fit)[2])}",
                       f"depth = {_q(sideways_depth(derived, fit))}"]
@@ -722,7 +786,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_section_lines(nominal_section(bore, onto)),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{pin.id}"', _mesh_entry(meshes[pid]), ""]
-    lines += ["[gripper]", *(f"{key} = {value}" for key, value in GRIPPER.items()), "",
+    gripper = GRIPPER if mapped.flange is None else GRIPPER | {"flange_length": mapped.flange}
+    lines += ["[gripper]", *(f"{key} = {value}" for key, value in gripper.items()), "",
               "[base]", f'part = "{derived.base}"', f"tray = {_numbers(settings.trays[derived.base])}",
               "grip = [0.0, 0.0]", f"mass = {_q(base.volume * DENSITY)}",
               *([_mesh_entry(meshes[derived.base])] if derived.base in meshes else []), ""]
@@ -781,6 +846,11 @@ def _numbers(values: tuple[float, ...]) -> str:
     return f"[{', '.join(str(_q(v)) for v in values)}]"
 
 
+_BOSS_WALL = 0.002
+"""The wall a boss leaves beyond its hole's chamfered mouth on each side when the holes'
+spacing does not set its side [m]."""
+
+
 def _tile(fits: list[HoleFit]) -> float:
     """The side of the square boss around every hole [m]: the measured boss when the base
     has one around each hole, else the largest square the holes' spacing leaves room for."""
@@ -789,7 +859,32 @@ def _tile(fits: list[HoleFit]) -> float:
                    for i, a in enumerate(fits) for b in fits[i + 1:]), default=0.04)
     widest = max([max(f.hole.a, f.hole.b) + 2 * f.chamfer for f in fits], default=0.0)
     tile = min([*bosses, spacing, 0.04])
-    return tile if tile > widest else widest + 0.004
+    return tile if tile > widest else widest + 2 * _BOSS_WALL
+
+
+def _own_tiles(derived: Derived, tile: float, chamfer: float) -> dict[str, float]:
+    """Each hole's own boss side [m] where bosses of side ``tile`` (:func:`_tile`) around
+    every hole would overlap; none where they do not. A hole's boss is its section's
+    widest side, or twice its outline's farthest reach from its centre, with the
+    ``chamfer`` on each side (its need) and :data:`_BOSS_WALL` of wall
+    beyond, at most ``tile``, and no wider than leaves each neighbour's boss half the room
+    between the two needs: the distance of their centres (the larger of x and y, or
+    straight for a turned hole) plus half the difference of the needs."""
+    fits = {hid: fit for hid, fit in derived.holes.items() if fit.axis == "+z"}
+    turned = {hid for hid, fit in fits.items() if fit.hole.yaw}
+    if overlapping_bosses({hid: (*fit.position, tile) for hid, fit in fits.items()}, turned) is None:
+        return {}
+    need = {hid: max(fit.hole.a, fit.hole.b, 2 * float(np.abs(fit.hole.outline).max())) + 2 * chamfer
+            for hid, fit in fits.items()}  # a polygon's outline may reach farther on one side
+
+    def apart(a: str, b: str) -> float:
+        (xa, ya), (xb, yb) = fits[a].position, fits[b].position
+        return math.hypot(xa - xb, ya - yb) if {a, b} & turned else max(abs(xa - xb), abs(ya - yb))
+
+    own = {hid: min([need[hid] + 2 * _BOSS_WALL, tile,
+                     *(apart(hid, other) + (need[hid] - need[other]) / 2 for other in fits if other != hid)])
+           for hid in fits}
+    return {hid: side for hid, side in own.items() if side < tile}
 
 
 def _digest(path: Path) -> str | None:
@@ -884,7 +979,9 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     elif meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
         try:
-            why = _cell_disagrees(derived, load_geometry(str(out)))
+            loaded = load_geometry(str(out))
+            plate_obj_text(loaded)  # the cell builds its plate's bosses from it
+            why = _cell_disagrees(derived, loaded)
         except ToolError as exc:
             why = f"the cell refuses its geometry ({exc})"
         if why is None:

@@ -51,7 +51,8 @@ RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
 GRIPPER_SPEED = 0.05  # [m/s] of the fingers
 HELD_FRACTION = 0.3
 """The hand holds the part when its width after closing is at least this fraction of the
-part's (closed on nothing it is about 0; franky-sim's fingers read 5.7 mm on a 10 mm peg)."""
+part's (closed on nothing it is about 0; franky-sim's fingers read 7.1 mm on a 10 mm peg at
+40 N, their contact soft)."""
 ABOVE_TRAY = 0.002  # [m] a part carried back is let go this far above the table
 
 
@@ -177,10 +178,12 @@ class FrankaCell:
         # spring toward the commanded width, which squeezes only when it is below the part's.
         self.gripper.grasp(0.0, GRIPPER_SPEED, self.options.grasp_force, epsilon_inner=0.001,
                            epsilon_outer=width + OPEN_MARGIN)
-        if self.gripper.width < HELD_FRACTION * width:
+        closed = float(self.gripper.width)
+        if closed < HELD_FRACTION * width:
             self._open(width + OPEN_MARGIN)
             raise ExecutorError(f"the hand closed on nothing at part {part}'s place on the table "
-                                f"({np.round(grip, 4).tolist()} m)")
+                                f"({np.round(grip, 4).tolist()} m): its fingers closed to {closed * 1000:.1f} mm, "
+                                f"the part is {width * 1000:.1f} mm wide")
         self.held = part
         self.arm.set_tcp(self.lever(spec))
 
@@ -219,13 +222,8 @@ class FrankaCell:
         turn, shift = fit_pose(spec, hole_spec)
         est = self.to_base(np.array([*(np.array(hole_spec.position) + shift), hole_spec.top_z]))
         yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn)
-        quat = tool_quat(yaw)
-        approach = est + np.array([0.0, 0.0, APPROACH_HEIGHT])
-        self.carry_to(approach, yaw=yaw)
         self.controller.watch_rate()
-        self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
-        self.arm.tare_sensor()
-        found = hole_search(self.motion, est[:2], est[2], approach[2], quat, rng)
+        found = self.search(est, yaw, rng)
         key = f"{spec.shape}:{hole}"
         correction = self.ilc.correction(key)[0] if self.layer.ilc else None
         task = InsertionTask(np.array([found.hole_xy[0], found.hole_xy[1], est[2]]), self.lever(spec), yaw,
@@ -235,6 +233,19 @@ class FrankaCell:
         if result.reached and result.trace is not None:
             self.ilc.update(key, result.trace)
         return result, detector, found
+
+    def search(self, entry: np.ndarray, yaw: float, rng: np.random.Generator) -> SearchResult:
+        """The held part carried above the hole's calibrated entry ``entry`` [m] (its centre
+        at the top face, base frame) by :data:`executor.trial.APPROACH_HEIGHT`, the tool
+        turned to ``yaw`` [rad], held still, the wrench estimate tared, then the hole search
+        (:func:`executor.skills.search.hole_search`, its spiral drawn from ``rng``) around it:
+        where the part sinks into the hole, in the robot's reading of the tip."""
+        quat = tool_quat(yaw)
+        approach = entry + np.array([0.0, 0.0, APPROACH_HEIGHT])
+        self.carry_to(approach, yaw=yaw)
+        self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
+        self.arm.tare_sensor()
+        return hole_search(self.motion, entry[:2], entry[2], approach[2], quat, rng)
 
     def lift(self) -> None:
         """The tool straight up to the carrying height."""

@@ -1,7 +1,8 @@
 """Teaching by hand-guiding (``executor teach --backend franka --demonstration hand``): a
 person guides the part in the hand from above its ``demo_hole`` into it, the arm compliant.
 
-The arm brings the part :data:`GUIDE_HEIGHT` above the hole's calibrated entrance (tool
+The arm brings the part :data:`GUIDE_HEIGHT` above the hole's entrance where the hole
+search found it (:meth:`executor.franka.teach.FrankaTeacher.find_hole`) (tool
 pointing down, turned to the hole's yaw), takes the held part as its load (its gravity
 compensation carries the part's weight, :func:`carried`), tares the wrench estimate and
 hands itself over:

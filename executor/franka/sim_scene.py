@@ -37,7 +37,7 @@ from scipy.spatial import HalfspaceIntersection
 
 from bridge.product import Plate
 from executor import ExecutorError
-from executor.world.geometry import FLOOR_MIN, CellGeometry, HoleSpec, PartSpec, _ring, _turned, polygon_boss
+from executor.world.geometry import FLOOR_MIN, CellGeometry, HoleSpec, PartSpec, _ring, _turned, polygon_boss, tile_of
 from executor.world.meshes import mesh_inertia, read_objects
 from executor.world.outlines import boss_solids
 from executor.world.scene import TEACH_FRICTION
@@ -154,7 +154,7 @@ def boss_pieces(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarray]:
     centre = np.array(hole.position)
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
     inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw)  # about the centre
-    top, chamfer, half_tile = hole.top_z, plate.chamfer, plate.tile_size / 2
+    top, chamfer, half_tile = hole.top_z, plate.chamfer, tile_of(plate, hole) / 2
     yaw = np.array([math.cos(hole.yaw), math.sin(hole.yaw)])
     outline = [np.array(v) for v in (yaw, -yaw, (-yaw[1], yaw[0]), (yaw[1], -yaw[0]))]
     # Half-spaces a·x + b <= 0, x = (x, y, z) in the product frame.

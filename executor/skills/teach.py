@@ -6,7 +6,10 @@ shape's ``demo_hole`` (where the hole search leaves the part; exactly aligned, t
 turned to the hole's yaw, perfect grasp) down to 0.5 mm above the hole's bottom (in a
 hole entered sideways, down its frame's z axis to its depth, where the CAD has the
 part's tip: :mod:`executor.world.frames`); the tip poses are recorded at 1 kHz and
-encoded as a Cartesian DMP. Step 2, the replay: the DMP is executed by the impedance
+encoded as a Cartesian DMP. On an arm, whose grasp and plate calibration carry real
+errors, the hole is first found with the held part by the insertion's hole search
+(:meth:`TeachingCell.find_hole`), and the demonstration and the replay run in the hole
+frame there. Step 2, the replay: the DMP is executed by the impedance
 controller alone and the wrench it meets is recorded: the reference F_des, M_des, fitted
 with RBFs over the phase; the tip position where the replay ends is p_goal. Step 3, the
 check: p_goal must lie within the cell's goal tolerance of the demonstration's goal (0.5
@@ -62,14 +65,23 @@ DEMO_CLEARANCE = 0.0005  # [m] left between the part and the hole bottom at the 
 class TeachingCell(Protocol):
     """What teaching needs of a cell (:class:`executor.trial.Cell` and
     :class:`executor.franka.teach.FrankaTeacher` are ones): its geometry and thresholds, a
-    part put in the hand (:meth:`motion_for`), held at the demonstration's start
-    (:meth:`hold_at`) and let go at the end (:meth:`let_go`)."""
+    part put in the hand (:meth:`motion_for`), the hole found with it (:meth:`find_hole`),
+    held at the demonstration's start (:meth:`hold_at`) and let go at the end
+    (:meth:`let_go`)."""
 
     geometry: CellGeometry
     thresholds: Thresholds
 
     def motion_for(self, part: str) -> Motion:
         """Put the part in the hand; the Motion driving the arm that holds it."""
+        ...
+
+    def find_hole(self, motion: Motion, origin: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
+        """The hole frame's origin [m] (the centre of the hole's entry) where the held
+        part, turned to ``quat_xyzw``, finds the hole whose geometry puts it at ``origin``:
+        ``origin`` itself in a simulated cell (the part exactly in the hand), where the hole
+        search finds it on an arm (the real grasp and calibration errors). ExecutorError
+        when no hole is found."""
         ...
 
     def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
@@ -165,6 +177,7 @@ def teach_shape(cell: TeachingCell, shape: str, demonstrate: Demonstrator = scri
     yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
     motion.frame = hole.frame  # a hole entered sideways: demonstrated and replayed down its frame's z axis
     try:
+        origin = cell.find_hole(motion, origin, tool_quat(yaw))
         demo = demonstrate(cell, motion, origin, bottom, yaw)
         weights = fit_dmp(demo.times, demo.positions, demo.quats)
         skill = Skill(shape, float(demo.times[-1]), weights,

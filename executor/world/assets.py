@@ -68,11 +68,12 @@ def sources_digest(geometry: CellGeometry) -> str:
 
 
 def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
-    """A hole's fields, its entry height and depth only where they are not the plate's and
-    ``pin`` only for a pin, ``axis`` only for a hole entered sideways (so a product whose
-    holes are all at the plate's level keeps its digest)."""
+    """A hole's fields, its entry height and depth only where they are not the plate's,
+    ``pin`` only for a pin, ``axis`` only for a hole entered sideways and ``tile`` only for a
+    boss of its own (so a product whose holes are all at the plate's level keeps its digest)."""
     fields = dataclasses.asdict(hole)
-    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False), ("axis", "-z")):
+    for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False), ("axis", "-z"),
+                         ("tile", None)):
         if fields[key] == default:
             del fields[key]
     return fields

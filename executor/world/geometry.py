@@ -116,7 +116,9 @@ class HoleSpec(Section):
     its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry; a
     ``pin`` of the base a part with a bore goes onto (its section the pin's, ``top_z`` its
     top, the bottom where a part going onto it rests); the parts stated to fit it at room 0
-    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`)."""
+    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); ``tile``
+    the side of its square boss [m] where it differs from the plate's ``tile_size``
+    (:func:`tile_of`)."""
 
     position: tuple[float, float]
     yaw: float = 0.0
@@ -125,6 +127,7 @@ class HoleSpec(Section):
     pin: bool = field(default=False, kw_only=True)
     axis: str = field(default="-z", kw_only=True)
     zero_clearance: tuple[str, ...] = field(default=(), kw_only=True)
+    tile: float | None = field(default=None, kw_only=True)
 
     @property
     def bottom_z(self) -> float:
@@ -250,7 +253,8 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             holes[hid] = HoleSpec(hid, kind, size, positions[hid], yaw=math.radians(hole_shape.yaw), width=width,
                                   top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner,
                                   pin=hole_shape.pin, axis=hole_shape.axis,
-                                  zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())))
+                                  zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())),
+                                  tile=hole_shape.tile)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}
@@ -500,7 +504,7 @@ def _boss_triangles(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarra
         return _oriented(_polygon_boss(hole, plate, base if floor is None else floor, base))
     chamfer = plate.chamfer
     half_a, half_b = hole.sides[0] / 2, hole.sides[1] / 2
-    outer = _turned(_ring("square", plate.tile_size / 2, n), hole.yaw) + (cx, cy)
+    outer = _turned(_ring("square", tile_of(plate, hole) / 2, n), hole.yaw) + (cx, cy)
     mouth = _turned(_ring(hole.kind, half_a + chamfer, n, half_b + chamfer), hole.yaw) + (cx, cy)
     inner = _turned(_ring(hole.kind, half_a, n, half_b), hole.yaw) + (cx, cy)
 
@@ -560,14 +564,19 @@ def polygon_boss(hole: HoleSpec, plate: Plate, bottom: float, base: float,
     the plate's chamfer, the hole's entry, ``bottom`` and ``base`` [m]; ExecutorError naming
     the hole when its chamfered mouth leaves the boss."""
     ring = corners(outline_polygon(hole, peg=False))
-    half = plate.tile_size / 2
+    half = tile_of(plate, hole) / 2
     tile = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
     found = make(_turned(ring, hole.yaw) + hole.position, _turned(tile, hole.yaw) + hole.position,
                  plate.chamfer, hole.top_z, bottom, base)
     if isinstance(found, str):
-        raise ExecutorError(f"hole '{hole.id}': {found} ([plate] tile_size {plate.tile_size:g} m, chamfer "
+        raise ExecutorError(f"hole '{hole.id}': {found} (boss side {tile_of(plate, hole):g} m, chamfer "
                             f"{plate.chamfer:g} m)")
     return found
+
+
+def tile_of(plate: Plate, hole: HoleSpec) -> float:
+    """The side of ``hole``'s square boss [m]: its own ``tile``, else the plate's ``tile_size``."""
+    return plate.tile_size if hole.tile is None else hole.tile
 
 
 def plate_obj_text(geometry: CellGeometry) -> str:

@@ -14,9 +14,15 @@ an assembled CAD holds), each turn from two starts (the peg's smallest enclosing
 centre on the hole's largest inscribed circle's, and the area centroids together). The
 :data:`CANDIDATES` best are refined by zooming in on the best of 9 turns until the peg's
 farthest corner moves less than :data:`FINE_SHIFT`, then (unless both outlines share a
-rotational symmetry, which keeps their centres together) the shift by zooming in on the
-best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn once more. The search climbs
-a continuous score: the room where the peg is inside, else minus its deepest overlap (a
+rotational symmetry, which keeps their centres together) the shift. Where a shift passes
+at that turn, the best shift at a turn is exact (:func:`_best_shift`: the centre of the
+largest circle in the shifts that pass, the regions ∂hole ⊕ (−peg) leaves, to
+:data:`FINE_SHIFT`), and the turn is climbed once more with each turn at its best shift
+(one coarse step either side), then at the shift found down to the resolution. Where none
+passes, or for two non-convex outlines of more than :data:`SWEEP_PIECES` edge pairs, the
+shift by zooming in on the best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn
+once more. The turn's search climbs a continuous score: the room where the peg is inside,
+else minus its deepest overlap (a
 peg corner outside the hole, a hole corner inside the peg). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
@@ -45,6 +51,8 @@ CANDIDATES = 2
 """The best coarse turns refined."""
 FINE_SHIFT = 1e-7
 """The shift's, the turn's (at the peg's farthest corner) and a negative room's resolution [m]."""
+SWEEP_PIECES = 1024
+"""The most edge pairs of two non-convex outlines whose free shifts are built (more: the shift climbed)."""
 MAX_ORDER = 64
 """The highest rotational symmetry looked for (a 64-tooth spline)."""
 SYMMETRY_TOLERANCE = 1e-6
@@ -132,6 +140,11 @@ class _Pair:
         self.peg = peg
         shapely.prepare(peg)
         self.peg_edge = peg.exterior
+        hull = shapely.convex_hull(peg)
+        self.peg_hull = np.asarray(hull.exterior.coords)[:-1]
+        self.sweep_convex = hull.area <= peg.area * (1 + 1e-12) or \
+            shapely.convex_hull(hole).area <= hole.area * (1 + 1e-12)
+        """Whether :func:`_best_shift` sweeps the peg's convex hull (either outline convex)."""
 
     def pegs(self, angles: np.ndarray, shifts: np.ndarray) -> np.ndarray:
         """The peg polygons turned by ``angles`` (k,) and shifted by ``shifts`` (k, 2)."""
@@ -222,8 +235,15 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     for index in np.argsort(-scores, kind="stable")[:CANDIDATES]:
         angle, shift = _refine_turn(pair, float(angles[index]), starts[index], coarse, fine)
         if math.gcd(*orders) == 1:  # no shared symmetry to keep the centres together
-            shift = _refine_shift(pair, angle, shift, reach)
-            angle, shift = _refine_turn(pair, angle, shift, coarse / 8, fine)
+            sweep = pair.sweep_convex or len(pair.peg_points) * len(pair.hole_points) <= SWEEP_PIECES
+            if sweep and (free := _best_shift(pair, angle)) is not None:
+                angle, shift = _refine_turn_shifted(pair, angle, free, coarse)
+                angle, shift = _refine_turn(pair, angle, shift, coarse / _SHIFTED_ZOOM, fine)
+                free = _best_shift(pair, angle)
+                shift = shift if free is None else free
+            else:
+                shift = _refine_shift(pair, angle, shift, reach)
+                angle, shift = _refine_turn(pair, angle, shift, coarse / 8, fine)
         found = pair.score(angle, shift)
         if found > best[0] + FINE_SHIFT:
             best = (found, angle, shift)
@@ -239,6 +259,8 @@ _TURNS = np.linspace(-1.0, 1.0, 9)
 _SHIFTS = np.array([[x, y] for x in (-1.0, 0.0, 1.0) for y in (-1.0, 0.0, 1.0)])
 _ROUNDS = 64
 """A refinement stops after this many rounds whatever its step (a score that keeps climbing)."""
+_SHIFTED_ZOOM = 64
+"""The turn climbed at its best shift from one coarse step either side down to this many times narrower."""
 
 
 def _room_bound(peg: shapely.Polygon, hole: shapely.Polygon) -> float:
@@ -262,6 +284,60 @@ def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine
         if 0 < k < len(tried) - 1:
             step /= 4
     return angle, shift
+
+
+def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: float) -> tuple[float, np.ndarray]:
+    """Climb the room along the turn from ``angle`` [rad], each turn at its best shift
+    (:func:`_best_shift`, else ``shift``): 9 turns within ``step`` [rad] either side, the window a quarter
+    as wide when the best is inside it, until it is :data:`_SHIFTED_ZOOM` times narrower."""
+    stop = step / _SHIFTED_ZOOM
+    for _ in range(_ROUNDS):
+        if step <= stop:
+            break
+        tried = angle + step * _TURNS
+        shifts = [shift if (free := _best_shift(pair, float(turn))) is None else free for turn in tried]
+        scores = [pair.score(float(turn), moved) for turn, moved in zip(tried, shifts, strict=True)]
+        k = int(np.argmax(scores))
+        angle, shift = float(tried[k]), shifts[k]
+        if 0 < k < len(tried) - 1:
+            step /= 4
+    return angle, shift
+
+
+def _best_shift(pair: _Pair, angle: float) -> np.ndarray | None:
+    """The shift [m] with the most room at the turn ``angle`` [rad], from the free shifts:
+    the peg at shift t meets the hole's boundary where t lies in ∂hole ⊕ (−peg), and its
+    room there is t's distance to that set (the distance from peg + t to ∂hole). With a
+    convex peg, or a convex hole (where the peg's convex hull passes as the peg does, with
+    the same room), that set is the union of the convex hulls of each hole edge's ends
+    minus the (hull's) corners; else ∂hole ⊕ (−∂peg), the union of the parallelograms of
+    each hole edge minus each peg edge. The regions that set leaves, whose peg is inside
+    the hole, are the shifts that pass; the centre of the largest circle in them (to
+    :data:`FINE_SHIFT`) is the best shift (a parallelogram of two parallel edges is flat and
+    left out, covered by its neighbours' sides unless an outline has two collinear edges in
+    a row: the room is measured at the shift found, never taken from the circle); None
+    where no shift passes."""
+    hole_edges = np.stack([pair.hole_points, np.roll(pair.hole_points, -1, axis=0)], axis=1)
+    if pair.sweep_convex:
+        peg = _turn(pair.peg_hull, angle)
+        corners = (hole_edges[:, :, None, :] - peg[None, None, :, :]).reshape(-1, 2)
+        size = 2 * len(peg)
+    else:
+        peg = _turn(pair.peg_points, angle)
+        peg_edges = np.stack([peg, np.roll(peg, -1, axis=0)], axis=1)
+        corners = (hole_edges[:, None, :, None, :] - peg_edges[None, :, None, :, :]).reshape(-1, 2)
+        size = 4
+    hulls = shapely.convex_hull(shapely.multipoints(corners, indices=np.repeat(np.arange(len(corners) // size), size)))
+    touching = shapely.union_all(hulls[shapely.get_type_id(hulls) == shapely.GeometryType.POLYGON])
+    reach = float(np.max(np.linalg.norm(peg, axis=1)))  # the shifts that pass lie within it of the hole
+    low, high = pair.hole_points.min(axis=0) - 2 * reach, pair.hole_points.max(axis=0) + 2 * reach
+    free = shapely.get_parts(shapely.difference(shapely.box(*low, *high), touching))
+    free = free[shapely.get_type_id(free) == shapely.GeometryType.POLYGON]
+    inside = [region for region in free if pair.score(angle, np.asarray(region.representative_point().coords[0])) > 0]
+    if not inside:
+        return None
+    circles = shapely.maximum_inscribed_circle(np.array(inside), FINE_SHIFT)
+    return np.asarray(circles[int(np.argmax(shapely.length(circles)))].coords[0])
 
 
 def _refine_shift(pair: _Pair, angle: float, shift: np.ndarray, reach: float) -> np.ndarray:

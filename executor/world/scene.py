@@ -21,7 +21,7 @@ from executor import ExecutorError
 from executor.world import TIME_STEP
 from executor.world.arm import turn_z, yaw_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, outline_polygon, peg_files
+from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, outline_polygon, peg_files, tile_of
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -175,8 +175,8 @@ def scene_shapes(geometry: CellGeometry) -> list[tuple]:
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     shapes: list[tuple] = [("plate", "box", (sx / 2, sy / 2, boss_bottom / 2), (cx, cy, boss_bottom / 2),
                             (0, 0, 0, 1), (140, 150, 165))]
-    half_tile = plate.tile_size / 2
     for hid, hole in sorted(geometry.holes.items()):
+        half_tile = tile_of(plate, hole) / 2
         turned = yaw_quat(hole.yaw)  # the boss turns with its hole
         half_depth = hole.depth / 2
         a, b = hole.sides

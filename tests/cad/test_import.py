@@ -11,6 +11,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 import clingo
+import numpy as np
+import pybullet_data
 import pytest
 import trimesh
 
@@ -20,7 +22,7 @@ from bridge.assembly import load_assembly
 from executor.cad.cli import run_import
 from executor.cad.derive import Derived, derive
 from executor.cad.parts import load_meshes
-from executor.cad.write import margins
+from executor.cad.write import WRIST_RADIUS, margins
 from executor.world.geometry import load_geometry
 
 SIZE_BOUND = 5e-5
@@ -187,3 +189,11 @@ def test_bad_cad_is_one_line_naming_the_part(tmp_path: Path, capsys: pytest.Capt
     _box((10, 10, 10), (0, 0, 0)).export(tmp_path / "caged" / "bird.stl")
     assert "part(s) bird never come out" in _error(capsys, ["import", str(tmp_path / "caged"), "--out",
                                                           str(tmp_path / "o4")])
+
+
+def test_the_wrist_the_import_keeps_clear_of_the_product_holds_the_arm_s_last_link() -> None:
+    # The import makes the gripper's flange long enough that a circle of WRIST_RADIUS about
+    # the tool's axis clears the product; the simulated arm's last link must lie within it.
+    link = trimesh.load(Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "meshes" / "link_7.stl", force="mesh")
+    radius = float(np.hypot(link.vertices[:, 0], link.vertices[:, 1]).max())
+    assert 0.05 < radius < WRIST_RADIUS

@@ -17,7 +17,7 @@ import trimesh
 
 from assembly_constraints.cli import main
 from bridge.product import CONVEX_HEADER
-from executor.cad.convex import NOMINAL_OVERLAP, fitting_pieces
+from executor.cad.convex import NOMINAL_OVERLAP, PIECE_VERTICES, _beyond, _hull_planes, _planes, fitting_pieces, reduced
 from executor.cad.sections import edge_distance, slice_loops
 from executor.cad.sweep import TOUCH, bvh, convex_object
 from executor.cad.write import CELL_DEFLECTION
@@ -170,3 +170,23 @@ def test_convex_pieces_overlap_a_part_at_a_zero_clearance_fit_by_at_most_the_sta
         fcl.collide(convex_object(piece), bvh(meshes["pulley_front"]), request, contacts)
         deepest = max([deepest, *(c.penetration_depth for c in contacts.contacts)])
     assert TOUCH < deepest <= NOMINAL_OVERLAP  # beyond touching: the decomposition's error, within the bound
+
+
+def test_a_pieces_vertices_are_kept_on_the_face_planes_of_trimeshs_hull_of_them() -> None:
+    # The kept hull's planes are computed from qhull without making trimesh's mesh each
+    # step: they must be trimesh's own numbers, on a random cloud and on a cylinder's
+    # co-circular rings (where a rounding would pick another of two equally far vertices).
+    rng = np.random.default_rng(0)
+    cylinder = trimesh.creation.cylinder(radius=0.006, height=0.02, sections=96)
+    directions = rng.normal(size=(300, 3))
+    ellipsoid = directions / np.linalg.norm(directions, axis=1)[:, None] * [0.01, 0.02, 0.005]
+    clouds = [ellipsoid, np.asarray(cylinder.vertices)]
+    for points in clouds:
+        for count in (8, 30, 64):
+            some = points[rng.choice(len(points), size=count, replace=False)]
+            hull = trimesh.convex.convex_hull(some)
+            assert np.array_equal(_beyond(_hull_planes(some), points), _beyond(_planes(hull), points))
+    piece = trimesh.convex.convex_hull(ellipsoid)  # every point a vertex of it
+    kept, reach = reduced(piece)
+    assert len(kept.vertices) == PIECE_VERTICES and reach == pytest.approx(max(0.0, float(np.max(
+        _beyond(_planes(kept), np.asarray(piece.vertices))))), abs=0.0)

@@ -8,8 +8,11 @@ import math
 import numpy as np
 import pytest
 import shapely
+import trimesh
 from shapely import affinity
+from trimesh.path.traversal import discretize_path
 
+from executor.cad import sections
 from executor.cad.sections import Loop, classify
 
 MM = 1e-3
@@ -100,3 +103,18 @@ def test_a_tessellated_cylinder_stays_round() -> None:
     hole = classify(loop_of(circle), hole=True)
     assert hole.a == pytest.approx(10 * MM * math.cos(math.pi / 24), rel=1e-9)
     assert hole.deflection == pytest.approx(5 * MM * (1 - math.cos(math.pi / 24)), rel=1e-6)
+
+
+def test_a_fine_section_takes_its_closed_entities_as_the_graph_would() -> None:
+    """A fine ring in metres: its section's open entities are lines from a vertex to itself,
+    and its loops, taken without the graph, are the graph's point for point."""
+    ring = trimesh.creation.annulus(r_min=0.005, r_max=0.01, height=0.004, sections=3000)
+    ring.apply_transform(trimesh.transformations.rotation_matrix(0.3, (1, 1, 0)))
+    fast, graph = (ring.section(plane_origin=(0, 0, 3e-4), plane_normal=(0, 0, 1)) for _ in range(2))
+    assert fast is not None and graph is not None
+    assert any(len(entity.points) == 2 for entity in fast.entities)
+    assert sections._only_closed(fast.entities) is not None
+    loops = sections._closed_polylines(fast)
+    expected = [discretize_path(graph.entities, graph.vertices, path) for path in sections._closed_paths(graph)]
+    assert len(loops) == len(expected) == 2
+    assert all(np.array_equal(a, b) for a, b in zip(loops, expected, strict=True))

@@ -16,7 +16,7 @@ from bridge import BridgeError
 from bridge.assembly import DATA_DIR
 from bridge.errors import ToolError
 from bridge.product import Gripper, Plate, product_from_tables
-from executor.world.geometry import load_geometry
+from executor.world.geometry import load_geometry, plate_obj_text
 
 CRANFIELD = DATA_DIR / "cranfield"
 GRIPPER_TABLE = """[gripper]
@@ -64,6 +64,11 @@ CASES = [
     ("size-zero", "size = 0.0200", "size = 0.0", "[hole_shapes.round_big] size: expected"),
     ("hole-wider-than-its-boss", "size = 0.0200", "size = 0.04",
      "[hole_shapes.round_big] size: expected a hole and its chamfer inside the 0.04 m boss"),
+    ("hole-wider-than-its-own-boss", "size = 0.0200", "size = 0.0200\ntile = 0.02",
+     "[hole_shapes.round_big] size: expected a hole and its chamfer inside the 0.02 m boss"),
+    ("own-bosses-overlap", "size = 0.0200", "size = 0.0200\ntile = 0.0801",
+     "[plate] tile_size: expected bosses that do not overlap, got holes br at (0.59, 0) and r1 at (0.55, -0.06) m "
+     "closer than their bosses' half sides together (0.06005 m)"),
     ("peg-half-a-metre", "size = 0.0187", "size = 0.5",
      f"[part_shapes.shaft] size: expected {SIZE}, got 0.5"),
     ("mass-negative", "mass = 0.06", "mass = -0.06", "[part_shapes.square_peg] mass: expected a number in (0, 10] kg"),
@@ -181,6 +186,17 @@ def test_two_holes_at_one_position_are_refused(tmp_path: Path) -> None:
     with pytest.raises(BridgeError, match=r"geometry.toml: \[plate\] tile_size: expected bosses that do not "
                                             r"overlap, got holes r1 at \(0.55, -0.06\) and s1 at \(0.55, -0.06\)"):
         load_geometry(str(folder))
+
+
+def test_a_hole_s_own_boss_may_reach_its_neighbours(tmp_path: Path) -> None:
+    """br's own 80 mm boss touches the plate's 40 mm ones 60 mm away (x and y) and is built that wide."""
+    folder = _folder(tmp_path, ORIGINAL.replace("size = 0.0200", "size = 0.0200\ntile = 0.08", 1))
+    geometry = load_geometry(str(folder))
+    assert (geometry.holes["br"].tile, geometry.holes["r1"].tile) == (0.08, None)
+    vertices = [(float(x), float(y)) for line in plate_obj_text(geometry).splitlines() if line.startswith("v ")
+                for x, y in [line.split()[1:3]]]
+    between = [abs(y) for x, y in vertices if 0.571 < x < 0.609]  # br's alone: the others' reach 0.57 and 0.61
+    assert max(between) == pytest.approx(0.04, abs=2e-6)
 
 
 @pytest.mark.parametrize("assembly", ["cranfield", "spare", "graded", "taskboard"])

@@ -46,8 +46,16 @@ def test_a_part_resting_on_a_sharp_rim_is_no_find(prisms: tuple[Path, Cell]) -> 
     assert first.max_force_dev < cell.thresholds.f_stop  # never pressed on the top face
 
 
+@pytest.fixture(scope="module")
+def peg12_cell(prisms: tuple[Path, Cell]) -> Cell:
+    """The cell on the product with ``peg12`` taught."""
+    out, cell = prisms
+    save_skill(out, teach_shape(cell, "peg12"))
+    return cell
+
+
 @pytest.mark.slow  # teaches one shape and runs one trial (about 15 s)
-def test_a_tight_part_the_outward_spiral_missed_fits_after_the_way_back(prisms: tuple[Path, Cell]) -> None:
+def test_a_tight_part_the_outward_spiral_missed_fits_after_the_way_back(peg12_cell: Cell) -> None:
     """Seed 11 of `executor trial --part peg12 --hole h2` (0.167 mm of room per side, no
     chamfer): the outward spiral of either attempt passes no closer than 1.0 and 0.65 mm
     to the hole's centre (the estimate 2.8 and 3.5 mm off it) and the part never sinks;
@@ -55,11 +63,27 @@ def test_a_tight_part_the_outward_spiral_missed_fits_after_the_way_back(prisms: 
     estimate until eq. (6) fired.  The second pass, back in half a pitch inside the first,
     ends with the part dipped 0.6 mm into the hole's mouth 0.5 mm off its centre, and the
     first attempt fits."""
-    out, cell = prisms
-    save_skill(out, teach_shape(cell, "peg12"))
+    cell = peg12_cell
+    cell.reset_state()
     result = cell.run_trial("peg12", "h2", seed=11)
     assert result.outcome == "fit", result
     assert result.evidence[-1].end_error < cell.thresholds.goal_tolerance
+
+
+@pytest.mark.slow  # teaches one shape (shared) and runs one attempt (about 10 s each)
+@pytest.mark.parametrize("seed", [0, 6])
+def test_a_tight_hole_on_a_sharp_rim_is_found_in_the_first_attempt(peg12_cell: Cell, seed: int) -> None:
+    """The first attempts of seeds 0 and 6 of `executor trial --part peg12 --hole h2`
+    (0.167 mm of room per side, no chamfer; the estimate 3.3 and 4.0 mm off the hole's
+    centre): the fast spiral alone finds nothing, the part dragged 2 to 4 mm behind it
+    (no closer than 0.8 and 1.8 mm to the centre), and the attempt ended ``no_fit``
+    pressed on the top face at the estimate.  The slow pass that follows, its command
+    leading the spiral by the part's lag, drops the part into the hole."""
+    cell = peg12_cell
+    cell.reset_state()
+    rng = trial_rng(seed, "peg12", "h2")
+    first = cell.run_attempt("peg12", "h2", cell.draw_setup(rng, "peg12", "h2"))
+    assert first.hole_found and first.outcome == "fit", first
 
 
 @pytest.mark.parametrize(("tip", "touched", "held"), [

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+import shutil
 from pathlib import Path
 
 GRASP_DEPTH = 0.012
@@ -16,3 +18,20 @@ def franka_cell_description(folder: Path) -> Path:
     path.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
                     f"grasp_depth = {GRASP_DEPTH}\n")
     return path
+
+
+def parts_moved(folder: Path, to: Path, dx: float, parts: set[str] | None = None) -> Path:
+    """A copy of the product ``folder`` at ``to`` whose ``parts`` (default all) wait ``dx``
+    [m] along x from their ``start``: the world the simulator builds, while the cell
+    believes ``folder``."""
+    moved = Path(shutil.copytree(folder, to))
+    toml = moved / "assembly.toml"
+
+    def shift(match: re.Match[str]) -> str:
+        return f"{match[1]}{float(match[3]) + dx:.4f}" if parts is None or match[2] in parts else match[0]
+
+    text, count = re.subn(r"(^\[parts\.([\w-]+)\]\n(?:[^\[\n].*\n)*?start = \[)([-0-9.]+)", shift,
+                          toml.read_text(encoding="utf-8"), flags=re.M)
+    assert count > 0, text
+    toml.write_text(text, encoding="utf-8")
+    return moved

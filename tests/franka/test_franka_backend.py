@@ -2,7 +2,8 @@
 pass (the square peg, diagonal 17 mm, onto a round hole of 13.3 mm) stops on eq. (6) and
 answers no_fit with the part back on the table, standing, where it waited; a plan step that
 puts a round peg into a round hole is checked in the simulated world (not the robot's
-reading), within 2 mm of its goal; a cover and a head, which the arm has no skill for, are
+reading), within 2 mm of its goal; a hand that closes on nothing (the part elsewhere)
+fails the request; a cover and a head, which the arm has no skill for, are
 manual steps that do not move it. The harness holds a grasped part welded to the hand
 (docs/franka.md, "Testing against franky-sim").
 
@@ -25,12 +26,13 @@ pytest.importorskip("mujoco")
 from bridge.assembly import DATA_DIR  # noqa: E402
 from bridge.cell_settings import CellSettings, ServeSettings  # noqa: E402
 from bridge.messages import InsertRequest, StepRequest  # noqa: E402
+from executor import ExecutorError  # noqa: E402
 from executor.backend_plugin import InvalidStep  # noqa: E402
 from executor.control.detector import Thresholds  # noqa: E402
 from executor.franka.backend import FrankaBackend, franka_starter  # noqa: E402
 from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
 from executor.world.geometry import CellGeometry, load_geometry  # noqa: E402
-from tests.franka import franka_cell_description
+from tests.franka import franka_cell_description, parts_moved
 
 PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 BACK = 0.002
@@ -43,11 +45,14 @@ pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtur
 
 
 @contextmanager
-def _arm(tmp_path: Path, product: str) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
-    """franky-sim with a copy of the shipped ``product`` and a franka backend driving it."""
+def _arm(tmp_path: Path, product: str, moved: tuple[str, float] | None = None
+         ) -> Iterator[tuple[SimRobot, FrankaBackend, CellGeometry]]:
+    """franky-sim with a copy of the shipped ``product`` and a franka backend driving it;
+    ``moved``: a part and how far [m] along x from its ``start`` the simulated world has it."""
     folder = Path(shutil.copytree(DATA_DIR / product, tmp_path / product, ignore=shutil.ignore_patterns("assets")))
     description = franka_cell_description(tmp_path)
-    with sim_robot(folder) as sim:
+    world = folder if moved is None else parts_moved(folder, tmp_path / "world", moved[1], {moved[0]})
+    with sim_robot(world) as sim:
         settings = ServeSettings(backend="franka", assembly=str(folder),
                                  backend_options={"host": sim.host, "realtime": "ignore", "dynamics": "0.5"},
                                  cell=CellSettings(layer="pi_phase_stop", description=str(description)))
@@ -84,6 +89,19 @@ def test_a_plan_step_places_a_peg_in_its_hole(spare_arm: tuple[SimRobot, FrankaB
     goal = np.array([*hole.position, hole.bottom_z])  # the peg's body frame: its bottom face's centre
     position = sim.truth().poses["p1"][0]
     assert np.linalg.norm(position - goal) <= PLACED, (position, goal)
+
+
+def test_a_hand_that_closes_on_nothing_says_so(tmp_path: Path) -> None:
+    """p1 waits 50 mm from where the cell believes it: the hand comes down on its believed
+    place and closes on nothing, and the request fails naming that (no outcome); the hand
+    holds nothing and the part was not touched."""
+    with _arm(tmp_path, "spare", moved=("p1", -0.05)) as (sim, backend, geometry):
+        with pytest.raises(ExecutorError, match="closed on nothing at part p1's place"):
+            backend.run(InsertRequest(id="a", part="p1", hole="r1"))
+        world = sim.truth()
+    assert not world.held, world.held
+    waits = np.array([geometry.parts["p1"].start[0] - 0.05, geometry.parts["p1"].start[1], 0.0])
+    assert np.linalg.norm(world.poses["p1"][0] - waits) < 1e-4, world.poses["p1"]
 
 
 def test_covers_and_heads_are_left_to_an_operator_and_the_arm_stays(tmp_path: Path) -> None:
