@@ -292,8 +292,9 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                           "rod through two brackets")),
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into a hole of a part that is not the base (the "
-                                           "shaft into the bearing ring) or onto a pin of a part that is not the base "
-                                           "(the glands and the impeller onto the shaft's end)")),
+                                           "shaft into the bearing ring), into a hole of the base's own mesh with less "
+                                           "room than the cell resolves (the ring, room 0), or onto a pin of a part "
+                                           "that is not the base (the glands and the impeller onto the shaft's end)")),
     pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin (the pulley onto the hub's boss: the "
                                              "cell puts parts onto pins from above), or into a hole and shorter than "
                                              "the gripper's grasp depth (the bolts, 14 mm)")),
@@ -429,17 +430,22 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
             "bush": "liftarm_pin1", "gear": "liftarm_pin1"} and order.index("bush") < order.index("gear")
 
 
-@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s)
-def test_gears_with_less_room_on_their_shafts_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s each)
+@pytest.mark.parametrize(("name", "unresolved"), [("factory_gears", {"gear_small", "gear_medium"}),
+                                                  ("occt_pump", {"bearing_ring"})])
+def test_parts_with_less_room_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
+        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path, name: str,
+        unresolved: set[str]) -> None:
     # factory_gears: each gear has 0.012 mm of room per side on its shaft, under the 0.025 mm
-    # the cell resolves (it jammed 11.5 mm short when taught): no experiment, each placed by
-    # hand with that reason, every pair taken from sizes.lp as not observed.
-    done = imported("factory_gears")
+    # the cell resolves (it jammed 11.5 mm short when taught). occt_pump: the bearing ring is
+    # a nominal zero-clearance fit in the housing's bore, which the cell widens only in a base
+    # it builds of primitives, not in the housing's own mesh (CoACD's pieces of the ring,
+    # sought to keep that room, took 146 s of CPU a try and never fitted). No experiment, each
+    # placed by hand with that reason, every pair taken from sizes.lp as not observed.
+    done = imported(name)
     manual = load_geometry(str(done.out)).tables.manual
-    assert set(manual) == {"gear_small", "gear_medium"}
-    assert all("mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason
-               for table in manual.values()), {pid: table.reason for pid, table in manual.items()}
+    assert {pid for pid, table in manual.items()
+            if "mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason} == unresolved
     _learned_from_its_cad_alone(done, run_executor, run_cli, tmp_path / "run")
 
 
