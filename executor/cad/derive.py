@@ -88,6 +88,7 @@ _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
 _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
 _ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
 _GRID = 1e-8  # the grid [m] the union of a pin's sections is snapped to (far below a fit's room)
+_JITTER = 5e-8  # [m] a vertex of that union this close to the line through its neighbours is dropped
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
@@ -595,7 +596,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
             beyond = _joined(beyond, pin)
         if bore is None or beyond is None:
             continue
-        union = classify(Loop(np.asarray(shapely.Polygon(beyond.exterior).exterior.coords)[:-1]), hole=False)
+        union = classify(_outline(beyond), hole=False)
         hole = classify(bore, hole=True)
         key = (np.round(union.outline + union.centre, 8).tobytes(), np.round(bore.points, 8).tobytes())
         if key not in rooms:
@@ -617,6 +618,15 @@ def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Pol
     straight pin differ by the mesh's noise (under 1 µm), and GEOS takes seconds over the
     slivers between two alike many-sided outlines unless their vertices snap together."""
     return pin if beyond is None else shapely.union(beyond, pin, grid_size=_GRID)
+
+
+def _outline(union: shapely.Polygon) -> Loop:
+    """The outer loop of the ``union`` of a pin's sections (:func:`_joined`) without its
+    jitter: its vertices within :data:`_JITTER` of the line through their neighbours
+    dropped (Douglas-Peucker). Where two alike outlines cross at a small angle the union
+    alternates between them in edges of a few tens of nm, which the cell's chamfer
+    offsets into spikes (``ldraw_axles``' cross axle: 630 vertices for its 16 corners)."""
+    return Loop(np.asarray(shapely.simplify(shapely.Polygon(union.exterior), _JITTER).exterior.coords)[:-1])
 
 
 def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float) -> np.ndarray | None:
