@@ -563,7 +563,9 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     bore at one level and the union of the pin's outlines beyond it, measured over the
     middles of the spans between the vertex levels of both (a gland's d 17 lips, not the
     d 28 recess between them; a pulley's d 26 web over the boss's d 26 collar, not the
-    d 22 it sits on)."""
+    d 22 it sits on) and the middle of the part's extent (a bore is narrowest at a vertex
+    level, which no span's middle is: Meta-World's torus ring, d 74.569 mm at its middle,
+    d 74.980 at the nearest span's)."""
     axis = np.array(derived.directions[name])
     part, other = derived.parts[pid].mesh, derived.parts[owner].mesh
     along, other_along = part.vertices @ axis, other.vertices @ axis
@@ -581,7 +583,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     near = other_along[np.linalg.norm(other.vertices @ frame.T - line, axis=1) <= reach + _SAME_HOLE]
     start, end = float(along.min()), float(near.max())
     stretch: list[tuple[float, Loop | None, shapely.Polygon | None]] = []
-    for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS]):
+    for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS] + [middle]):
         own, theirs = slice_loops(part, axis, level), slice_loops(other, axis, level)
         bores = [o for o in own if not _outer(o, own) and o.contains(line)]
         pins = [o for o in theirs if _outer(o, theirs) and o.contains(line)
