@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import networkx as nx
 import numpy as np
@@ -71,12 +72,12 @@ class Loop:
 
     points: np.ndarray
 
-    @property
+    @cached_property
     def area(self) -> float:
         x, y = self.points[:, 0], self.points[:, 1]
         return abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2
 
-    @property
+    @cached_property
     def centre(self) -> np.ndarray:
         """The area centroid [m] (a mean of the points would lean towards denser edges)."""
         x, y = self.points[:, 0], self.points[:, 1]
