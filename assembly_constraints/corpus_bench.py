@@ -94,20 +94,30 @@ class Learned:
 
 @dataclass
 class Assembled:
-    """Plan 1 assembled in the sim cell: each part's final pose error [mm] (``errors``),
-    the parts placed by hand (``manual``: fixed at their goal, no test of the cell)."""
+    """Plan 1 assembled in the sim cell: each part's final pose error [mm] (``errors``) and
+    the skill of its last step (``skills``): ``manual`` (placed by hand, fixed at its goal)
+    and ``fixture`` (the base, set on its locating pins) test nothing of the cell."""
 
     errors: dict[str, float]
-    manual: list[str]
+    skills: dict[str, str]
+
+    @property
+    def manual(self) -> list[str]:
+        return [part for part in self.errors if self.skills.get(part) == "manual"]
+
+    @property
+    def placed(self) -> dict[str, float]:
+        """The errors [mm] of the parts the cell placed with a skill of its own."""
+        return {part: mm for part, mm in self.errors.items() if self.skills.get(part) not in ("manual", "fixture")}
 
     @property
     def worst_mm(self) -> float | None:
         """The largest final pose error [mm] of the parts the cell placed (None: none)."""
-        placed = [mm for part, mm in self.errors.items() if part not in self.manual]
-        return max(placed) if placed else None
+        return max(self.placed.values(), default=None)
 
     def as_json(self) -> dict[str, Any]:
-        return {"final_pose_error_mm": {p: "manual" if p in self.manual else mm for p, mm in self.errors.items()},
+        return {"final_pose_error_mm": {p: self.skills.get(p) if p not in self.placed else mm
+                                        for p, mm in self.errors.items()},
                 "manual": self.manual, "max_mm": self.worst_mm, "target_mm": TARGET_MM}
 
 
@@ -131,8 +141,7 @@ class Row:
         found += [f"sim session: {w}" for w in (self.sim.fits.wrong if self.sim else [])]
         if self.assembly is not None:
             found += [f"assembly: {part} {mm:.2f} mm off (target {TARGET_MM:g} mm)"
-                      for part, mm in self.assembly.errors.items() if part not in self.assembly.manual
-                      and mm > TARGET_MM]
+                      for part, mm in self.assembly.placed.items() if mm > TARGET_MM]
         return found
 
     @property
@@ -260,7 +269,7 @@ def bench_product(folder: Path, out: Path, truth_only: bool, seed: int, timeout:
         report = result.get("assembly")
         if report is None:
             raise StepFailed("sim session", one_line(result.get("error") or "no plan to assemble", 400))
-        row.assembly = Assembled(dict(report["final_pose_error_mm"]), list(report["manual"]))
+        row.assembly = Assembled(dict(report["final_pose_error_mm"]), {s["part"]: s["skill"] for s in report["steps"]})
         if not report["assembled"]:
             raise StepFailed("assemble", one_line(report.get("error") or "not assembled", 400))
     except TruthError as exc:
@@ -297,8 +306,10 @@ def _details(row: Row) -> list[str]:
     if row.sim is not None and row.sim.widened:
         lines.append(f"observed with the sim cell's room, not at the CAD's room 0: {' '.join(row.sim.widened)}")
     if row.assembly is not None:
+        placed = row.assembly.placed
         lines.append("final pose error: " + ", ".join(
-            f"{p} manual" if p in row.assembly.manual else f"{p} {mm:.2f} mm" for p, mm in row.assembly.errors.items()))
+            f"{p} {mm:.2f} mm" if p in placed else f"{p} {row.assembly.skills.get(p)}"
+            for p, mm in row.assembly.errors.items()))
     return [f"{row.product}: {line}" for line in lines]
 
 
@@ -321,7 +332,7 @@ def _products(corpus: Path, names: list[str]) -> list[Path]:
     unknown = [n for n in names if not (corpus / n / "truth.toml").is_file()]
     if unknown:
         raise BenchError(f"--product {unknown[0]}: no {corpus / unknown[0] / 'truth.toml'}; expected one of: "
-                         f"{', '.join(p.name for p in found)}")
+                         f"{', '.join(p.name for p in found) or '(none: no folder of it holds truth.toml)'}")
     return [corpus / n for n in dict.fromkeys(names)]
 
 
