@@ -205,11 +205,13 @@ def _tool(step: str, argv: list[str], log: Path, timeout: float, accept: tuple[i
 
 
 def _session(step: str, done: CorpusImport, run: Path, extra: list[str], timeout: float) -> tuple[dict, list]:
-    """``session --assembly OUT --out RUN --json EXTRA``: its JSON result and the atoms of
+    """``session --assembly OUT --out RUN --json EXTRA``, waiting for its cell up to
+    ``timeout`` [s]: its JSON result and the atoms of
     its ``learned.lp``. A session that learned but has no plan, or whose assembly stopped,
     exits 3 with its result: the caller reads ``error`` and ``assembly`` in it."""
-    out = _tool(step, ["session", "--assembly", str(done.out), "--out", str(run), "--json", *extra],
-                run.with_suffix(".log"), timeout, accept=(0, 3))
+    # a cell that reads a large product starts slowly on a loaded machine: the step's time bounds that wait too
+    out = _tool(step, ["session", "--assembly", str(done.out), "--out", str(run), "--json",
+                       "--wait-for-cell", f"{timeout:g}", *extra], run.with_suffix(".log"), timeout, accept=(0, 3))
     try:
         result = json.loads(out)
     except json.JSONDecodeError:
