@@ -72,23 +72,25 @@ class StepFailed(Exception):
 
 @dataclass
 class Learned:
-    """A sim session's relation: ``fits`` against the truth, the ``experiments``, how each
-    compared pair was learned (``observed``: an experiment in physics; ``entailed``: by the
-    size model from other answers; ``from_cad``: taken from ``sizes.lp``, no cell can try
-    it; ``demonstrated``), and the pairs observed with the room the sim cell gives a
-    nominal zero-clearance fit (``widened``), not at the CAD's room 0."""
+    """A sim session's relation: ``fits`` against the truth, the ``experiments``, and how
+    each compared pair was learned (``sources``): ``observed`` (an experiment in physics),
+    ``entailed`` (by the size model from other answers), ``CAD`` (taken from ``sizes.lp``:
+    no cell can try it) or ``demonstrated``; the pairs observed with the room the sim cell
+    gives a nominal zero-clearance fit (``widened``), not at the CAD's room 0."""
 
     fits: FitCount
     experiments: int
-    observed: int
-    entailed: int
-    from_cad: int
-    demonstrated: int
+    sources: dict[tuple[str, str], str]
     widened: list[str]
 
+    def count(self, source: str) -> int:
+        return sum(s == source for s in self.sources.values())
+
     def as_json(self) -> dict[str, Any]:
-        return {**self.fits.as_json(), "experiments": self.experiments, "observed": self.observed,
-                "entailed": self.entailed, "from_cad": self.from_cad, "demonstrated": self.demonstrated,
+        return {**self.fits.as_json(), "experiments": self.experiments,
+                **{key: self.count(source) for key, source in (("observed", "observed"), ("entailed", "entailed"),
+                                                              ("from_cad", "CAD"), ("demonstrated", "demonstrated"))},
+                "sources": {f"{p}->{h}": source for (p, h), source in sorted(self.sources.items())},
                 "widened": self.widened}
 
 
@@ -137,8 +139,10 @@ class Row:
     @property
     def wrong(self) -> list[str]:
         """What is wrong: pairs against the truth, parts the cell placed beyond the target."""
-        found = [f"truth session: {w}" for w in (self.truth.wrong if self.truth else [])]
-        found += [f"sim session: {w}" for w in (self.sim.fits.wrong if self.sim else [])]
+        found = [] if self.truth is None else [f"truth session: {self.truth.describe(p)}" for p in self.truth.wrong]
+        if self.sim is not None:
+            found += [f"sim session: {self.sim.fits.describe(pair)} ({self.sim.sources[pair]})"
+                      for pair in self.sim.fits.wrong]
         if self.assembly is not None:
             found += [f"assembly: {part} {mm:.2f} mm off (target {TARGET_MM:g} mm)"
                       for part, mm in self.assembly.placed.items() if mm > TARGET_MM]
@@ -150,8 +154,8 @@ class Row:
         found = [f"{len(c.missing)} truth pair(s) missing in the {name} session: {', '.join(c.missing)}"
                  for name, c in (("truth", self.truth), ("sim", self.sim.fits if self.sim else None))
                  if c is not None and c.missing]
-        if self.sim is not None and self.sim.from_cad:
-            found.append(f"{self.sim.from_cad} pair(s) taken from the CAD, not observed")
+        if self.sim is not None and self.sim.count("CAD"):
+            found.append(f"{self.sim.count('CAD')} pair(s) taken from the CAD, not observed")
         if self.assembly is not None and self.assembly.manual:
             found.append(f"{len(self.assembly.manual)} part(s) placed by hand: {' '.join(self.assembly.manual)}")
         if self.sim is None and self.failed is None:
@@ -233,11 +237,10 @@ def _learned(done: CorpusImport, holes: dict[str, str], result: dict, atoms: lis
     tried = {(p, h) for _, p, h, _ in atoms_by_name(atoms, "tried", 4)}
     stated = {(p, h) for p, h in atoms_by_name(atoms, "not_observed", 2)}
     shown = {(p, h) for p, h in result.get("demonstrated", [])}
-    pairs = set(count.pairs)
+    sources = {pair: "observed" if pair in tried else "CAD" if pair in stated else
+               "demonstrated" if pair in shown else "entailed" for pair in count.pairs}
     nominal = result.get("nominal_fits") or {}
-    return Learned(count, result["experiments"], len(pairs & tried), len(pairs - tried - stated - shown),
-                   len(pairs & stated - tried), len(pairs & shown - tried),
-                   [f"{p}->{h}" for p, h in nominal.get("pairs", [])])
+    return Learned(count, result["experiments"], sources, [f"{p}->{h}" for p, h in nominal.get("pairs", [])])
 
 
 def bench_product(folder: Path, out: Path, truth_only: bool, seed: int, timeout: float) -> Row:
@@ -293,7 +296,8 @@ def _cells(row: Row) -> list[str]:
             "-" if row.import_s is None else f"{row.import_s:.1f}",
             "-" if row.truth is None else f"{row.truth.ok}/{row.truth.total}",
             "-" if sim is None else str(sim.experiments),
-            "-" if sim is None else f"{sim.fits.ok}/{sim.fits.total} ({sim.observed}, {sim.entailed}, {sim.from_cad})",
+            "-" if sim is None else (f"{sim.fits.ok}/{sim.fits.total} "
+                                     f"({sim.count('observed')}, {sim.count('entailed')}, {sim.count('CAD')})"),
             str(len(row.wrong)),
             "-" if assembly is None else ("all manual" if worst is None else f"{worst:.2f}"),
             "-" if assembly is None else str(len(assembly.manual)),

@@ -118,12 +118,12 @@ def feature_holes(done: CorpusImport) -> dict[str, str]:
 @dataclass
 class FitCount:
     """A learned fit relation against the truth's rows: ``ok`` rows learned as the truth
-    has them, ``wrong`` ones (``part->hole``, what was learned), ``missing`` ones (the
-    feature not found by the import, or the pair not in the learned domain); ``pairs``
-    maps each compared row's (part, imported hole) to whether the truth has it fit."""
+    has them, ``wrong`` ones (part, imported hole), ``missing`` ones (``part->feature``:
+    the feature not found by the import, or the pair not in the learned domain);
+    ``pairs`` maps each compared row's (part, imported hole) to whether the truth has it fit."""
 
     ok: int = 0
-    wrong: list[str] = field(default_factory=list)
+    wrong: list[tuple[str, str]] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
     pairs: dict[tuple[str, str], bool] = field(default_factory=dict)
 
@@ -131,8 +131,14 @@ class FitCount:
     def total(self) -> int:
         return self.ok + len(self.wrong) + len(self.missing)
 
+    def describe(self, pair: tuple[str, str]) -> str:
+        """A wrong pair in words: what was learned, what the truth has."""
+        fits = self.pairs[pair]
+        return f"{pair[0]}->{pair[1]} learned {'no_fit' if fits else 'fit'}, the truth {'fit' if fits else 'no_fit'}"
+
     def as_json(self) -> dict[str, Any]:
-        return {"ok": self.ok, "total": self.total, "wrong": self.wrong, "missing": self.missing}
+        return {"ok": self.ok, "total": self.total, "wrong": [self.describe(pair) for pair in self.wrong],
+                "missing": self.missing}
 
 
 def compare_fits(done: CorpusImport, holes: dict[str, str], fits: Collection[tuple[str, str]],
@@ -150,6 +156,5 @@ def compare_fits(done: CorpusImport, holes: dict[str, str], fits: Collection[tup
         if ((part, hole) in fits) == row["fits"]:
             count.ok += 1
         else:
-            learned = "fit" if (part, hole) in fits else "no_fit"
-            count.wrong.append(f"{part}->{hole} learned {learned}, the truth {'fit' if row['fits'] else 'no_fit'}")
+            count.wrong.append((part, hole))
     return count
