@@ -299,7 +299,8 @@ def _cells(row: Row) -> list[str]:
             "-" if sim is None else (f"{sim.fits.ok}/{sim.fits.total} "
                                      f"({sim.count('observed')}, {sim.count('entailed')}, {sim.count('CAD')})"),
             str(len(row.wrong)),
-            "-" if assembly is None else ("all manual" if worst is None else f"{worst:.2f}"),
+            "-" if assembly is None else f"{worst:.2f}" if worst is not None else
+            "all manual" if assembly.manual else "none placed",
             "-" if assembly is None else str(len(assembly.manual)),
             row.verdict]
 
