@@ -300,7 +300,7 @@ def _cells(row: Row) -> list[str]:
                                      f"({sim.count('observed')}, {sim.count('entailed')}, {sim.count('CAD')})"),
             str(len(row.wrong)),
             "-" if assembly is None else f"{worst:.2f}" if worst is not None else
-            "all manual" if assembly.manual else "none placed",
+            "all manual" if assembly.manual and row.failed is None else "none placed",
             "-" if assembly is None else str(len(assembly.manual)),
             row.verdict]
 
