@@ -225,15 +225,15 @@ def _session(step: str, done: CorpusImport, run: Path, extra: list[str], timeout
     return result, load_atoms([run / "learned.lp"])
 
 
-def _domain(atoms: list) -> tuple[set[tuple[str, str]], set[str], set[str]]:
-    """``learned.lp``'s fits, parts and holes."""
-    fits = {(p, h) for p, h in atoms_by_name(atoms, "fits", 2)}
-    return fits, {p for (p,) in atoms_by_name(atoms, "part", 1)}, {h for (h,) in atoms_by_name(atoms, "hole", 1)}
+def _decided(atoms: list) -> tuple[set[tuple[str, str]], set[tuple[str, str]]]:
+    """``learned.lp``'s ``fits`` and ``no_fit`` pairs."""
+    return ({(p, h) for p, h in atoms_by_name(atoms, "fits", 2)},
+            {(p, h) for p, h in atoms_by_name(atoms, "no_fit", 2)})
 
 
 def _learned(done: CorpusImport, holes: dict[str, str], result: dict, atoms: list) -> Learned:
     """The sim session's relation against the truth, each compared pair's source."""
-    count = compare_fits(done, holes, *_domain(atoms))
+    count = compare_fits(done, holes, *_decided(atoms))
     tried = {(p, h) for _, p, h, _ in atoms_by_name(atoms, "tried", 4)}
     stated = {(p, h) for p, h in atoms_by_name(atoms, "not_observed", 2)}
     shown = {(p, h) for p, h in result.get("demonstrated", [])}
@@ -261,7 +261,7 @@ def bench_product(folder: Path, out: Path, truth_only: bool, seed: int, timeout:
         _, atoms = _session("truth session", done, out / "truth", ["--backend", "truth", "--seed", str(seed)],
                             timeout)
         row.seconds["truth session"] = round(time.perf_counter() - started, 2)
-        row.truth = compare_fits(done, holes, *_domain(atoms))
+        row.truth = compare_fits(done, holes, *_decided(atoms))
         if truth_only:
             return row
         started = time.perf_counter()

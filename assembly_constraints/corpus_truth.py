@@ -119,7 +119,7 @@ def feature_holes(done: CorpusImport) -> dict[str, str]:
 class FitCount:
     """A learned fit relation against the truth's rows: ``ok`` rows learned as the truth
     has them, ``wrong`` ones (part, imported hole), ``missing`` ones (``part->feature``:
-    the feature not found by the import, or the pair not in the learned domain);
+    the feature not found by the import, or the pair not learned either way);
     ``pairs`` maps each compared row's (part, imported hole) to whether the truth has it fit."""
 
     ok: int = 0
@@ -142,14 +142,14 @@ class FitCount:
 
 
 def compare_fits(done: CorpusImport, holes: dict[str, str], fits: Collection[tuple[str, str]],
-                 parts: Collection[str], hole_ids: Collection[str]) -> FitCount:
-    """The learned ``fits`` (every other pair of ``parts`` x ``hole_ids``, the domain
-    learned over, a no-fit) against each truth row, its feature taken as ``holes`` maps it
-    (:func:`feature_holes`)."""
+                 no_fits: Collection[tuple[str, str]]) -> FitCount:
+    """A learned relation (``fits``, ``no_fits``: the pairs it decided) against each truth
+    row, its feature taken as ``holes`` maps it (:func:`feature_holes`); a pair decided
+    neither way (its part or hole outside what was learned) is missing."""
     count = FitCount()
     for row in done.truth["fits"]:
         part, hole = row["part"], holes.get(row["feature"])
-        if hole is None or part not in parts or hole not in hole_ids:
+        if hole is None or ((part, hole) not in fits and (part, hole) not in no_fits):
             count.missing.append(f"{part}->{row['feature']}" + ("" if hole is None else f" ({hole})"))
             continue
         count.pairs[part, hole] = row["fits"]

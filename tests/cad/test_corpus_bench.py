@@ -67,3 +67,13 @@ def test_an_unknown_product_is_refused_in_one_line(run_main: Runner) -> None:
     done = run_main("bench", "corpus", "--product", "no_such_product")
     assert done.returncode == 2 and "--product no_such_product: no " in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and "robosuite_nuts" in done.stderr
+
+
+def test_a_pair_the_session_did_not_decide_is_missing_not_a_no_fit(tmp_path: Path) -> None:
+    truth = {"base": "box", "parts": {"a": {"in": "f"}, "b": {"in": "f"}, "c": {"in": "f"}},
+             "features": {"f": {"owner": "box", "kind": "hole", "axis_point": [0.0, 0.0, 0.0], "axis": "-z"}},
+             "fits": [{"part": p, "feature": "f", "fits": fits} for p, fits in (("a", True), ("b", False), ("c", False))]}
+    done = CorpusImport(truth, tmp_path, {}, (0.0, 0.0), {}, {})
+    count = compare_fits(done, {"f": "h1"}, fits={("a", "h1"), ("b", "h1")}, no_fits=set())
+    assert (count.ok, count.wrong, count.missing) == (1, [("b", "h1")], ["c->f (h1)"])
+    assert count.as_json()["wrong"] == ["b->h1 learned fit, the truth no_fit"]
