@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from assembly_constraints.corpus_truth import CorpusImport, compare_fits
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -72,7 +73,7 @@ def test_an_unknown_product_is_refused_in_one_line(run_main: Runner) -> None:
 def test_a_pair_the_session_did_not_decide_is_missing_not_a_no_fit(tmp_path: Path) -> None:
     truth = {"base": "box", "parts": {"a": {"in": "f"}, "b": {"in": "f"}, "c": {"in": "f"}},
              "features": {"f": {"owner": "box", "kind": "hole", "axis_point": [0.0, 0.0, 0.0], "axis": "-z"}},
-             "fits": [{"part": p, "feature": "f", "fits": fits} for p, fits in (("a", True), ("b", False), ("c", False))]}
+             "fits": [{"part": p, "feature": "f", "fits": p == "a"} for p in "abc"]}
     done = CorpusImport(truth, tmp_path, {}, (0.0, 0.0), {}, {})
     count = compare_fits(done, {"f": "h1"}, fits={("a", "h1"), ("b", "h1")}, no_fits=set())
     assert (count.ok, count.wrong, count.missing) == (1, [("b", "h1")], ["c->f (h1)"])
