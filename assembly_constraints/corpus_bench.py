@@ -6,7 +6,8 @@ repeatable, picks some), in ``--out DIR/<name>/`` (default a temporary folder):
 
 1. ``import meshes/ --config import.toml`` (in this process, timed);
 2. ``session --backend truth`` (a child process): its fit relation against ``truth.toml``,
-   each truth row ok, wrong or missing (the feature not found by the import);
+   each truth row ok, wrong or missing (the feature not found by the import, or the pair
+   decided neither way);
 3. ``executor teach`` and ``session --assemble`` on the sim cell (child processes): the
    learned relation against the truth, each pair said to be observed (an experiment in
    physics), entailed (by the size model from observed pairs) or taken from the CAD
