@@ -20,7 +20,7 @@ def _copy(corpus: Path, name: str, as_name: str | None = None) -> Path:
     return Path(shutil.copytree(CORPUS / name, corpus / (as_name or name)))
 
 
-@pytest.mark.slow  # imports, teaches, learns in physics and assembles the hexagonal peg (157 s loaded)
+@pytest.mark.slow  # imports, teaches, learns in physics, assembles the hexagonal peg (153-260 s at load 15-20)
 @pytest.mark.timeout(1200)
 def test_a_product_is_learned_and_assembled_exactly_and_a_flipped_truth_is_reported_wrong(
         run_cli: Runner, tmp_path: Path) -> None:
