@@ -16,48 +16,28 @@ the mark must go; the truths are never weakened to pass.
 from __future__ import annotations
 
 import json
-import math
 import tomllib
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import clingo
 import pytest
 
+from assembly_constraints.corpus_truth import CorpusImport as Imported
+from assembly_constraints.corpus_truth import feature_holes as _feature_holes
+from assembly_constraints.corpus_truth import import_product
 from bridge.cell_settings import ServeSettings
 from bridge.messages import InsertRequest
 from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad.cli import run_import
-from executor.cad.sweep import opposite
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.world.geometry import load_geometry
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
-FEATURE_REACH_MM = 2.0
-"""An imported hole is a truth feature when its position lies this close to the feature's axis [mm]."""
-
-
-@dataclass(frozen=True)
-class Imported:
-    """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
-    moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
-    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the
-    cell, each imported hole's or pin's ``occupants`` (the parts in it or onto it) and
-    ``owners`` (the part it is a feature of)."""
-
-    truth: dict[str, Any]
-    out: Path
-    axes: dict[str, str]
-    offset: tuple[float, float]
-    occupants: dict[str, set[str]]
-    owners: dict[str, str]
-    pins: frozenset[str] = frozenset()
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -80,51 +60,10 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
 
     def get(name: str) -> Imported:
         if name not in done:
-            folder = CORPUS / name
-            out = tmp_path_factory.mktemp(name) / "out"
-            result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
-            truth = tomllib.loads((folder / "truth.toml").read_text())
-            derived = result.derived
-            holes = derived.holes | derived.part_holes
-            occupants = {hid: {fit.part} for hid, fit in holes.items() if fit.part is not None}
-            occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
-            owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
-            owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
-            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
-                                  result.offset, occupants, owners, frozenset(derived.pins))
+            done[name] = import_product(CORPUS / name, tmp_path_factory.mktemp(name) / "out")
         return done[name]
 
     return get
-
-
-def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float]) -> float:
-    """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, moved by
-    ``offset`` [m] from the CAD frame) lies from a truth feature's axis line [mm]; with x, y
-    only, from the line's projection on the xy plane."""
-    point = [1000.0 * (v - (offset[k] if k < 2 else 0.0)) for k, v in enumerate(position)]
-    origin = feature["axis_point"][:len(point)]
-    direction = {"x": 0, "y": 1, "z": 2}[feature["axis"][1]]
-    across = [point[k] - origin[k] for k in range(len(point)) if k != direction]
-    return math.hypot(*across)
-
-
-def _feature_holes(done: Imported) -> dict[str, str]:
-    """Each truth feature's imported hole id (absent: none found): the one of the
-    feature's owner on its axis that is a pin where the feature is one (of a hollow
-    shaft's bore and the shaft, the shaft); of several (the two ends of one rod), the one
-    that is empty or holds a part the truth puts in that feature."""
-    holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
-    found = {}
-    for fid, feature in done.truth["features"].items():
-        inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
-        near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
-                and _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
-                and (hid in done.pins) == (feature["kind"] == "pin")]
-        if len(near) > 1:
-            near = [hid for hid in near if not done.occupants.get(hid) or done.occupants[hid] & inside]
-        if len(near) == 1:
-            found[fid] = near[0]
-    return found
 
 
 def _xfail(reason: str) -> pytest.MarkDecorator:
