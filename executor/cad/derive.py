@@ -613,17 +613,21 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
 
 def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Polygon:
     """The union of a pin's sections ``beyond`` a level (None: none yet) and ``pin``, its
-    section at the level, its vertices on a grid of :data:`_GRID` [m], those within the grid
-    of the line through their neighbours left out (Douglas-Peucker, topology kept): the
-    sections of a straight pin differ by the mesh's noise (under 1 µm), GEOS takes seconds
-    over the slivers between two alike many-sided outlines unless their vertices snap
-    together, and their union would gather every section's vertices (25 000 over 64
-    levels of a 300-sided pin, each union slower than the last) where those within the
-    grid of its outline change it by less than the grid (64 noisy sections of a round pin:
-    within 3 grid steps of their union taken at once, its vertices about one section's)."""
+    section at the level, its vertices on a grid of :data:`_GRID` [m]: the sections of a
+    straight pin differ by the mesh's noise (under 1 µm), and GEOS takes seconds over the
+    slivers between two alike many-sided outlines unless their vertices snap together.
+    A union with more than twice the section's vertices has gathered the sections' noise
+    (25 000 vertices over 64 levels of a 300-sided pin, each union slower than the last):
+    its vertices within the grid of the line through their neighbours are left out
+    (Douglas-Peucker, topology kept), which moves it less than the grid (64 noisy sections
+    of a round pin: within 3 grid steps of their union taken at once, about one section's
+    vertices). Alike sections whose union stays that small are kept as they are."""
     if beyond is None:
         return pin
-    return shapely.simplify(shapely.union(beyond, pin, grid_size=_GRID), _GRID)
+    union = shapely.union(beyond, pin, grid_size=_GRID)
+    if len(union.exterior.coords) > 2 * len(pin.exterior.coords):
+        return shapely.simplify(union, _GRID)
+    return union
 
 
 def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float) -> np.ndarray | None:
