@@ -582,9 +582,9 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     stretch: list[tuple[float, Loop | None, shapely.Polygon | None]] = []
     for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS]):
         own, theirs = slice_loops(part, axis, level), slice_loops(other, axis, level)
-        bores = [o for o in own if not _outer(o, own) and o.contains(line)]
-        pins = [o for o in theirs if _outer(o, theirs) and o.contains(line)
-                and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach]  # the base's plate is no pin
+        bores = [o for o in own if o.contains(line) and not _outer(o, own)]
+        pins = [o for o in theirs if o.contains(line) and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach
+                and _outer(o, theirs)]  # the base's plate is no pin
         stretch.append((level, min(bores, key=lambda o: o.area) if bores else None,
                         shapely.Polygon(min(pins, key=lambda o: o.area).points) if pins else None))
     beyond: shapely.Polygon | None = None
