@@ -621,9 +621,10 @@ def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Pol
     its vertices within the grid of the line through their neighbours are left out
     (Douglas-Peucker, topology kept), which moves it less than the grid (64 noisy sections
     of a round pin: within 3 grid steps of their union taken at once, about one section's
-    vertices). A union that stays smaller is kept as it is (ldraw_axles' cross axle, 45
-    vertices a section, 137 at most: its simplified union, a clean cross, gives its parts
-    0.1 µm more room)."""
+    vertices). A union that stays smaller is kept as it is. On ldraw_axles' cross axle
+    (45 vertices a section, its union 239) the simplified union gives the bush and the
+    gear on it 0.1 µm more room than the union kept whole (+0.0 µm, not -0.1 µm: the same
+    nominal fits)."""
     if beyond is None:
         return pin
     union = shapely.union(beyond, pin, grid_size=_GRID)
