@@ -585,9 +585,9 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     stretch: list[tuple[float, Loop | None, shapely.Polygon | None]] = []
     for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS] + [middle]):
         own, theirs = slice_loops(part, axis, level), slice_loops(other, axis, level)
-        bores = [o for o in own if not _outer(o, own) and o.contains(line)]
-        pins = [o for o in theirs if _outer(o, theirs) and o.contains(line)
-                and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach]  # the base's plate is no pin
+        bores = [o for o in own if o.contains(line) and not _outer(o, own)]
+        pins = [o for o in theirs if o.contains(line) and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach
+                and _outer(o, theirs)]  # the base's plate is no pin
         stretch.append((level, min(bores, key=lambda o: o.area) if bores else None,
                         shapely.Polygon(min(pins, key=lambda o: o.area).points) if pins else None))
     beyond: shapely.Polygon | None = None
@@ -618,8 +618,22 @@ def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Pol
     """The union of a pin's sections ``beyond`` a level (None: none yet) and ``pin``, its
     section at the level, its vertices on a grid of :data:`_GRID` [m]: the sections of a
     straight pin differ by the mesh's noise (under 1 µm), and GEOS takes seconds over the
-    slivers between two alike many-sided outlines unless their vertices snap together."""
-    return pin if beyond is None else shapely.union(beyond, pin, grid_size=_GRID)
+    slivers between two alike many-sided outlines unless their vertices snap together.
+    A union with more than 4 times the section's vertices has gathered the sections' noise
+    (25 000 vertices over 64 levels of a 300-sided pin, each union slower than the last):
+    its vertices within the grid of the line through their neighbours are left out
+    (Douglas-Peucker, topology kept), which moves it less than the grid (64 noisy sections
+    of a round pin: within 3 grid steps of their union taken at once, about one section's
+    vertices). A union that stays smaller is kept as it is. On ldraw_axles' cross axle
+    (45 vertices a section, its union 239) the simplified union gives the bush and the
+    gear on it 0.1 µm more room than the union kept whole (+0.0 µm, not -0.1 µm: the same
+    nominal fits)."""
+    if beyond is None:
+        return pin
+    union = shapely.union(beyond, pin, grid_size=_GRID)
+    if len(union.exterior.coords) > 4 * len(pin.exterior.coords):
+        return shapely.simplify(union, _GRID)
+    return union
 
 
 def _outline(union: shapely.Polygon) -> Loop:
