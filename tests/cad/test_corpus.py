@@ -334,9 +334,10 @@ def _taught_and_learned_in_the_cell(done: Imported, run_executor: Runner, run_cl
 
 @pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 90 s)
 @pytest.mark.timeout(600)  # 257 s while the machine ran other work
+@pytest.mark.parametrize("name", ["agh_prism_array"])  # a unit of the workers' work with the product's other tests
 def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
-    done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+    done = imported(name)  # drawn around x = 0, out of the arm's reach: placed
     assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
     result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     # Every peg, the hexagon, octagon and 12-gon prisms too, goes into every hole in
@@ -353,9 +354,10 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
 
 
 @pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 140 s under load)
+@pytest.mark.parametrize("name", ["agh_prism_array"])  # a unit of the workers' work with the product's other tests
 def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
-    done = imported("agh_prism_array")
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+    done = imported(name)
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
     assert taught.returncode == 0, taught.stderr
     holes = _feature_holes(done)
@@ -373,8 +375,9 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
 
 @pytest.mark.slow  # imports the product, teaches its bolts and inserts two in physics (330 s under load)
 @pytest.mark.timeout(900)  # the import alone took 155 s while the machine ran other work
+@pytest.mark.parametrize("name", ["occt_as1"])  # a unit of the workers' work with the product's other tests
 def test_bolts_beside_a_bracket_s_wall_and_through_its_flange_are_inserted(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
     # occt_as1: bolt_a1's axis is 10 mm from bracket_a's wall, whose top stands 80 mm high.
     # With the default 60 mm flange the arm's wrist came down on the wall top and the bolt
     # stopped 4.1 mm above its goal (no_fit, blocked by bracket_a); the import makes the
@@ -382,7 +385,7 @@ def test_bolts_beside_a_bracket_s_wall_and_through_its_flange_are_inserted(
     # bracket_b's 10 mm flange over the plate: with the search pressing at the plate's top,
     # 10 mm under the flange's, the bolt was pushed onto the flange with 14-15 N, dragged
     # behind the spiral, and missed the opening in both attempts (no_fit, blocked by bracket_b).
-    done = imported("occt_as1")
+    done = imported(name)
     gripper = load_geometry(str(done.out)).tables.gripper
     assert gripper is not None and gripper.flange_length > 0.06
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
@@ -432,12 +435,13 @@ def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: R
 
 
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
+@pytest.mark.parametrize("name", ["ldraw_axles"])  # a unit of the workers' work with the product's other tests
 def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
     # has no operation for (each placed by hand): the sim session must not refuse the
     # product; it takes every pair from sizes.lp and says none was observed.
-    result = _learned_from_its_cad_alone(imported("ldraw_axles"), run_executor, run_cli, tmp_path / "run")
+    result = _learned_from_its_cad_alone(imported(name), run_executor, run_cli, tmp_path / "run")
     # the bush and the gear share the liftarm's pin (capacity 2 in assembly.toml): the bush first
     for plan in result["plans"]:
         order = [step["part"] for step in plan]
@@ -446,12 +450,13 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
 
 
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s)
+@pytest.mark.parametrize("name", ["factory_gears"])  # a unit of the workers' work with the product's other tests
 def test_gears_with_less_room_on_their_shafts_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # factory_gears: each gear has 0.012 mm of room per side on its shaft, under the 0.025 mm
     # the cell resolves (it jammed 11.5 mm short when taught): no experiment, each placed by
     # hand with that reason, every pair taken from sizes.lp as not observed.
-    done = imported("factory_gears")
+    done = imported(name)
     manual = load_geometry(str(done.out)).tables.manual
     assert set(manual) == {"gear_small", "gear_medium"}
     assert all("mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason
@@ -489,12 +494,13 @@ def test_the_truth_backend_answers_every_pair_as_sizes_lp(imported: Callable[[st
 
 @pytest.mark.slow  # imports, teaches the ring, a sim session of 1 experiment and its assembly (291 s loaded)
 @pytest.mark.timeout(600)
+@pytest.mark.parametrize("name", ["metaworld_assembly"])  # a unit of the workers' work with the product's other tests
 def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physics(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # Meta-World's ring is a torus with a handle: no stack of prisms, it collides as CoACD's
     # pieces, which keep its bore within its room on the peg; the cell grips it, carries it
     # over the peg and inserts it down onto it with the skill taught on that peg.
-    done = imported("metaworld_assembly")
+    done = imported(name)
     assert "CoACD" in (done.out / "meshes" / "round_nut.convex.obj").read_text().splitlines()[2]
     result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     holes = _feature_holes(done)
