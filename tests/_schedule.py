@@ -2,15 +2,16 @@
 
 Each test file is one unit of work (as xdist's ``loadfile``), so a module- or session-scoped
 fixture (a wheel installed, a product imported, a cell taught) is set up by one worker, not by
-each. A file of :data:`BY_PARAMETER` is split by its tests' parameter instead: the tests of one
-parameter (a corpus product, which its module fixture imports once, on first use) are a unit,
-so the file's parts run on both workers. The units are ordered by their expected time, the longest first, so
-the long physics units start at once and the quick ones fill the end and the two workers finish
-together (longest-processing-time-first scheduling). The expected time of a test is its last
-measured time (setup, call and teardown) kept in pytest's cache under ``CACHE_KEY`` by every run
-with the cache on, else its time in ``EXPECTED`` (the slowest tests of a whole run, committed,
-for runs without the cache: CI's clean clone, ``-p no:cacheprovider``), else a guess from its
-marker. The hooks are imported by ``tests/conftest.py``.
+each. A file of :data:`BY_PARAMETER` is split by its tests' parameter instead (the tests of one
+corpus product, which its module fixture imports once, on first use; a row of bad input), so
+the parts of a long file run on both workers. The units are ordered by their expected time, the
+longest first, so the long physics units start at once and the quick ones fill the end and the
+two workers finish together (longest-processing-time-first scheduling). The expected time of a
+test is its last measured time (setup, call and teardown) kept in pytest's cache under
+``CACHE_KEY`` by every run with the cache on, else its time in :data:`EXPECTED` (the slowest
+tests of a whole run, committed, for runs without the cache: CI's clean clone, ``-p
+no:cacheprovider``), else a guess from its marker. The hooks are imported by
+``tests/conftest.py``.
 """
 
 from __future__ import annotations
@@ -23,9 +24,10 @@ from typing import Any
 import pytest
 
 CACHE_KEY = "assembly-constraints/durations"
-BY_PARAMETER = ("tests/cad/test_corpus.py",)
-"""Files whose tests share an expensive set-up by their parameter only (``[name]``: each corpus
-product imported once by the module fixture ``imported``)."""
+BY_PARAMETER = ("tests/cad/test_corpus.py", "tests/test_bad_input.py")
+"""Files split by their tests' parameter: the tests of a corpus product (``[name]``) share its
+import (the module fixture ``imported`` of ``test_corpus.py``), the rows of ``test_bad_input.py``
+(a process each, about 1.3 s of CPU) share nothing."""
 EXPECTED = Path(__file__).with_name("durations.json")
 """Measured times [s] of the slowest tests, by node id (``python -m tests._schedule LOG``
 writes it from the ``--durations`` lines of a whole run)."""
