@@ -17,6 +17,7 @@ no:cacheprovider``), else a guess from its marker. The hooks are imported by
 from __future__ import annotations
 
 import json
+import re
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -113,12 +114,9 @@ def durations_from_log(text: str) -> dict[str, float]:
     run's output (``12.34s call     tests/x.py::test_y``)."""
     seconds: dict[str, float] = defaultdict(float)
     for line in text.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[0].endswith("s") and parts[1] in ("setup", "call", "teardown"):
-            try:
-                seconds[parts[2]] += float(parts[0][:-1])
-            except ValueError:
-                continue
+        found = re.fullmatch(r"\s*(\d+(?:\.\d+)?)s (?:setup|call|teardown) +(\S.*?)\s*", line)
+        if found:
+            seconds[found[2]] += float(found[1])
     return {nodeid: round(value, 1) for nodeid, value in sorted(seconds.items())}
 
 
