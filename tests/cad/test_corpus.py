@@ -258,9 +258,10 @@ def _taught_and_learned_in_the_cell(done: Imported, run_executor: Runner, run_cl
 
 @pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 90 s)
 @pytest.mark.timeout(600)  # 257 s while the machine ran other work
+@pytest.mark.parametrize("name", ["agh_prism_array"])  # a unit of the workers' work with the product's other tests
 def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
-    done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+    done = imported(name)  # drawn around x = 0, out of the arm's reach: placed
     assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
     result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     # Every peg, the hexagon, octagon and 12-gon prisms too, goes into every hole in
@@ -277,9 +278,10 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
 
 
 @pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 140 s under load)
+@pytest.mark.parametrize("name", ["agh_prism_array"])  # a unit of the workers' work with the product's other tests
 def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
-    done = imported("agh_prism_array")
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+    done = imported(name)
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
     assert taught.returncode == 0, taught.stderr
     holes = _feature_holes(done)
@@ -297,8 +299,9 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
 
 @pytest.mark.slow  # imports, teaches, assembles 18 steps in physics: 194 s of CPU, 983 s at load 21 to 24
 @pytest.mark.timeout(1800)  # on 2 cores shared with other work: over 900 s at load averages of 20 to 28
+@pytest.mark.parametrize("name", ["occt_as1"])  # a unit of the workers' work with the product's other tests
 def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_assembled_within_2_mm(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner) -> None:
     # occt_as1: the cell inserts the six bolts, each down through its bracket's flange into
     # the plate; the brackets, the rod and the eight nuts are placed by hand. bolt_a1's axis
     # is 10 mm from bracket_a's wall, whose top stands 80 mm high: with the default 60 mm
@@ -307,7 +310,7 @@ def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_assembled_wi
     # wall. bolt_b2 goes through bracket_b's 10 mm flange over the plate: with the search
     # pressing at the plate's top, 10 mm under the flange's, it was pushed onto the flange,
     # dragged behind the spiral and missed the opening in both attempts (no_fit).
-    done = imported("occt_as1")
+    done = imported(name)
     gripper = load_geometry(str(done.out)).tables.gripper
     assert gripper is not None and gripper.flange_length > 0.06
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
@@ -360,12 +363,13 @@ def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: R
 
 
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
+@pytest.mark.parametrize("name", ["ldraw_axles"])  # a unit of the workers' work with the product's other tests
 def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
     # has no operation for (each placed by hand): the sim session must not refuse the
     # product; it takes every pair from sizes.lp and says none was observed.
-    result = _learned_from_its_cad_alone(imported("ldraw_axles"), run_executor, run_cli, tmp_path / "run")
+    result = _learned_from_its_cad_alone(imported(name), run_executor, run_cli, tmp_path / "run")
     # the bush and the gear share the liftarm's pin (capacity 2 in assembly.toml): the bush first
     for plan in result["plans"]:
         order = [step["part"] for step in plan]
@@ -374,8 +378,9 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
 
 
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s each)
-@pytest.mark.parametrize(("name", "unresolved"), [("factory_gears", {"gear_small", "gear_medium"}),
-                                                  ("occt_pump", {"bearing_ring"})])
+@pytest.mark.parametrize(("name", "unresolved"), [  # each a unit of the workers' work with its product's other tests
+    pytest.param("factory_gears", {"gear_small", "gear_medium"}, id="factory_gears"),
+    pytest.param("occt_pump", {"bearing_ring"}, id="occt_pump")])
 def test_parts_with_less_room_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
         imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path, name: str,
         unresolved: set[str]) -> None:
@@ -422,12 +427,13 @@ def test_the_truth_backend_answers_every_pair_as_sizes_lp(imported: Callable[[st
 
 @pytest.mark.slow  # imports, teaches the ring, a sim session of 1 experiment and its assembly (291 s loaded)
 @pytest.mark.timeout(600)
+@pytest.mark.parametrize("name", ["metaworld_assembly"])  # a unit of the workers' work with the product's other tests
 def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physics(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # Meta-World's ring is a torus with a handle: no stack of prisms, it collides as CoACD's
     # pieces, which keep its bore within its room on the peg; the cell grips it, carries it
     # over the peg and inserts it down onto it with the skill taught on that peg.
-    done = imported("metaworld_assembly")
+    done = imported(name)
     assert "CoACD" in (done.out / "meshes" / "round_nut.convex.obj").read_text().splitlines()[2]
     result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     holes = _feature_holes(done)
@@ -454,14 +460,15 @@ def _vitac_trial(done: Imported, run_executor: Runner, part: str, feature: str) 
 
 @pytest.mark.slow  # imports the board, teaches its seven shapes, four trials in physics (501 s, 2 cores, 8 jobs)
 @pytest.mark.timeout(900)
+@pytest.mark.parametrize("name", ["vitac_shapes"])  # a unit of the workers' work with the product's other tests
 def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decided_in_physics(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
     # concave2's products of inertia turn its link's principal axes 22° about its axis; the
     # arm was placed with those axes, not the part, at the yaw asked, so teaching started it
     # overlapping its notched hole and it ended 19 mm short. The hexagon and the octagon pass
     # that hole only turned and shifted (1.343 mm of room); the octagon misses the trapezoid
     # hole by 0.183 mm.
-    done = imported("vitac_shapes")
+    done = imported(name)
     pairs = [("concave2", "h_concave2"), ("hexagon", "h_concave2"), ("octagon", "h_concave2"),
              ("octagon", "h_trapezoid")]
     outcomes = {pair: _vitac_trial(done, run_executor, *pair) for pair in pairs}
@@ -473,7 +480,8 @@ def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decide
 @pytest.mark.xfail(strict=True, reason="the cell's polygon peg is its prism with its vertical edges rounded by the "
                                        "1 mm hull margin PyBullet adds: the heptagon, 0.0014 mm too big for the rect "
                                        "hole, passes it so")
+@pytest.mark.parametrize("name", ["vitac_shapes"])  # a unit of the workers' work with the product's other tests
 def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_refused_in_physics(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
-    cell, truth = _vitac_trial(imported("vitac_shapes"), run_executor, "convex", "h_cuboid")
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+    cell, truth = _vitac_trial(imported(name), run_executor, "convex", "h_cuboid")
     assert cell == truth == "no_fit"
