@@ -536,7 +536,7 @@ def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decide
     assert all(cell == truth for cell, truth in outcomes.values()), outcomes
 
 
-@pytest.mark.slow  # imports the board (shared with the test above), one refused trial
+@pytest.mark.slow  # imports the board (unless the test above did: 120 s alone, loaded), one refused trial
 @pytest.mark.timeout(900)
 def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_no_experiment_but_taken_from_the_cad(
         imported: Callable[[str], Imported], run_executor: Runner) -> None:
