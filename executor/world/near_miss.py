@@ -6,8 +6,9 @@ peg's prism pieces are eroded by it before it is added back
 (:mod:`executor.world.meshes`). Either way a piece's vertical edges are rounded with the
 margin's radius, so the cell's peg lies inside its section and falls short of it at each
 corner of a piece: by r (1/sin(θ/2) - 1) at a corner of angle θ (0.41 mm at a right
-angle), and a point of the section at most r (1 - sin(θ/2)) from its outline is missing
-(0.29 mm at a right angle). A cylinder's side is its circle (only its rims are rounded):
+angle), the points it lacks there lying at most r (1 - sin(θ/2)) inside the outline
+(0.29 mm at a right angle); a notched polygon's pieces also leave slits where they meet
+at a reflex corner. A cylinder's side is its circle (only its rims are rounded):
 a round peg lacks nothing. A peg whose tightest contacts in a hole are its corners and
 that misses the hole by less than that passes in physics (``vitac_shapes``' heptagon,
 1.36 µm short of the rect hole, ``fit`` 2 of 2).
@@ -17,8 +18,11 @@ depth of a missing point, plus the :data:`SIZE_RESOLUTION` the physics resolves)
 inside the cell's peg, so when that eroded section does not pass a hole the cell's peg
 does not either and its no-fit is observed; when it passes while the section does not,
 the cell cannot tell the pair from a fit, and it is no experiment (the import writes it
-``near_miss`` in ``geometry.toml``: docs/cell.md#what-the-physics-resolves). Pegs simulated
-from their own meshes (convex pieces of a mesh) are not covered.
+``near_miss`` in ``geometry.toml``: docs/cell.md#what-the-physics-resolves). Whether the
+eroded section passes is :func:`executor.world.geometry.margin`'s decision, the same
+polygon relation the import decides every pair by (for two polygons a search: a no-pass
+is its finding). Pegs simulated from their own meshes (convex pieces of a mesh) are not
+covered.
 """
 
 from __future__ import annotations
