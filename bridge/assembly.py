@@ -105,6 +105,9 @@ class Assembly:
     """The parts with a bore the cell puts onto pins (``bore = true`` of ``[part_shapes.*]``)."""
     nominal_fits: frozenset[tuple[str, str]] = frozenset()
     """The (part, hole) pairs ``geometry.toml`` states as nominal zero-clearance fits (``zero_clearance``)."""
+    near_misses: frozenset[tuple[str, str]] = frozenset()
+    """The (part, hole) pairs ``geometry.toml`` states the simulated cell cannot tell from a fit
+    (``near_miss``: the part misses the hole by less than the cell's peg lacks at its corners)."""
     nominal_modelled: bool = False
     """Whether the simulated cell builds those fits with
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
@@ -114,9 +117,10 @@ class Assembly:
         """Whether no cell can try ``part`` in ``hole``: the part is placed by hand, the
         hole is one the cell does not model (a pin an imported part goes onto, a hole of a
         section the cell inserts no part in), a peg and a pin, a part with a bore and a
-        hole (the cell puts parts with a bore onto pins only, pegs into holes only), or a
-        nominal zero-clearance fit the cell cannot build with room (:attr:`nominal_modelled`)."""
-        return (part in self.manual or self.cell_cannot_insert(part, hole)
+        hole (the cell puts parts with a bore onto pins only, pegs into holes only), a
+        nominal zero-clearance fit the cell cannot build with room (:attr:`nominal_modelled`),
+        or a near miss the cell cannot tell from a fit (:attr:`near_misses`)."""
+        return (part in self.manual or self.cell_cannot_insert(part, hole) or (part, hole) in self.near_misses
                 or ((part, hole) in self.nominal_fits and not self.nominal_modelled))
 
     def cell_cannot_insert(self, part: str, hole: str) -> bool:
@@ -194,6 +198,9 @@ def assembly_of(product: ProductDescription) -> Assembly:
                     size_model=None if layout.sizes is None else layout.sizes.model, manual=manual,
                     cell_holes=cell_holes, pins=pins, bores=bores,
                     nominal_fits=frozenset() if geometry is None else frozenset(stated_nominal_fits(geometry)),
+                    near_misses=frozenset() if geometry is None else frozenset(
+                        (pid, hid) for shape in geometry.hole_shapes.values() for hid in shape.holes
+                        for pid in shape.near_miss or ()),
                     nominal_modelled=geometry is not None and models_nominal_fits(geometry))
 
 

@@ -154,7 +154,8 @@ class Cell:
         """The taught skill of ``part``'s shape; UnknownPair naming an unknown part or hole,
         or a peg and a pin, a part with a bore and a hole (:func:`executor.world.geometry.feature_passes`);
         ExecutorError for a pair whose room or interference per side is below
-        :data:`executor.world.scene.SIZE_RESOLUTION` (the physics cannot tell them apart)."""
+        :data:`executor.world.scene.SIZE_RESOLUTION` (the physics cannot tell them apart) or
+        that the geometry states a near miss (``near_miss``)."""
         if part not in self.geometry.parts:
             raise UnknownPair(f"unknown part '{part}' (expected one of {', '.join(sorted(self.geometry.parts))})")
         if hole not in self.geometry.holes:
@@ -163,6 +164,11 @@ class Cell:
         if spec.bore != feature.pin:
             raise UnknownPair(f"part '{part}' {'goes onto pins' if spec.bore else 'goes into holes'}, '{hole}' is "
                               f"{'a pin' if feature.pin else 'a hole'}: the cell does not try that pair")
+        if part in feature.near_miss:
+            raise ExecutorError(
+                f"part '{part}' into '{hole}': the geometry states it a near miss (near_miss): it misses the hole by "
+                "less than the cell's peg lacks at its corners, rounded by the hull margin, plus what the cell "
+                "resolves: it claims neither fit nor no_fit (docs/cell.md#what-the-physics-resolves)")
         room = margin(feature, spec) if feature.pin else margin(spec, feature)
         if abs(room) / 2 < SIZE_RESOLUTION:
             raise ExecutorError(

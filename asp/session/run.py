@@ -169,8 +169,8 @@ def _sizes_domain(assembly: Assembly, requested_model: str | None
 def _placed_by_hand(assembly: Assembly, truth: TruthOracle | None, decided: list[tuple[Pair, Result]]
                     ) -> list[tuple[Pair, Result]]:
     """The outcomes of the pairs no cell can try (:meth:`bridge.assembly.Assembly.tried_by_hand`:
-    a part placed by hand, a hole the cell does not model), from the product's ``sizes.lp``
-    (an imported product's nominal sections), except those ``decided`` already."""
+    a part placed by hand, a hole the cell does not model, a near miss it does not resolve),
+    from the product's ``sizes.lp`` (an imported product's nominal sections), except those ``decided`` already."""
     if truth is None:
         return []
     known = {pair for pair, _ in decided}
@@ -184,7 +184,8 @@ def _by_hand_statement(assembly: Assembly, by_hand: list[tuple[Pair, Result]]) -
     ``sizes.lp`` because the cell places their parts by hand."""
     fits = sum(result == "fit" for _, result in by_hand)
     shown = " ".join(f"{part}->{hole}" for (part, hole), _ in by_hand[:8]) + (" ..." if len(by_hand) > 8 else "")
-    return (f"{len(by_hand)} pairs no cell can try (a part placed by hand or a hole the cell does not model: "
+    return (f"{len(by_hand)} pairs no cell can try (a part placed by hand, a hole the cell does not model or a near "
+            f"miss it does not resolve: "
             f"{shown}) are taken from {assembly.folder / 'sizes.lp'} (the nominal sections, {fits} fit), not observed")
 
 

@@ -165,6 +165,9 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
             if bores.get(pid) != shape.pin:
                 raise fail(path, f"hole_shapes.{name}", "zero_clearance", "parts with a bore of [part_shapes.*] "
                            "for a pin, pegs of [part_shapes.*] for a hole", pid)
+        for pid in shape.near_miss or []:
+            if bores.get(pid) is not False or shape.pin:
+                raise fail(path, f"hole_shapes.{name}", "near_miss", "pegs of [part_shapes.*] in a hole", pid)
     for name, part_shape in geo.part_shapes.items():
         demo = geo.hole_shapes.get(holes.get(part_shape.demo_hole, ""))
         if demo is not None and demo.pin != part_shape.bore:

@@ -171,7 +171,10 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     ends (the taught goal: nothing stops a part in a through hole). ``zero_clearance`` names
     the parts stated to fit at room 0, a nominal zero-clearance fit (pegs of ``part_shapes``,
     or parts with a ``bore`` for a pin): the section is the nominal one, and a listed part
-    whose section is not wider passes (any other part needs room above 0). ``tile`` is the
+    whose section is not wider passes (any other part needs room above 0). ``near_miss``
+    names the pegs that miss the hole by less than the simulated cell resolves with their
+    corners rounded by its hull margin (``executor.world.near_miss``): no experiment, their
+    outcome is taken from ``sizes.lp``. ``tile`` is the
     side of their square bosses [m] where it differs from the plate's ``tile_size``."""
 
     holes: Ids
@@ -185,6 +188,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     pin: bool = False
     axis: InsertionAxis = "-z"
     zero_clearance: Ids | None = None
+    near_miss: Ids | None = None
     tile: TileSize | None = None
 
 

@@ -61,6 +61,7 @@ from executor.cad.write import (
     claim_folder,
     entry_point,
     map_product,
+    near_miss_assumption,
     nominal_assumption,
     section,
     write_folder,
@@ -312,7 +313,8 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
-    assumed += [*derived.assumptions(), *nominal_assumption(derived), *overlap_assumption(derived)]
+    assumed += [*derived.assumptions(), *nominal_assumption(derived), *near_miss_assumption(derived),
+                *overlap_assumption(derived)]
     mapped, laid = map_product(derived, settings)
     assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))

@@ -81,6 +81,7 @@ from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, plate_obj_text, thin_prism
+from executor.world.near_miss import near_miss
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -293,6 +294,35 @@ def zero_clearance_parts(derived: Derived) -> dict[str, list[str]]:
     for pid, hid in sorted(nominal_fits(derived)):
         found.setdefault(hid, []).append(pid)
     return found
+
+
+def near_misses(derived: Derived) -> dict[tuple[str, str], float]:
+    """(peg, hole of the base) -> the erosion [m] of each no-fit the simulated cell cannot
+    resolve (:func:`executor.world.near_miss.near_miss`: the peg's section eroded by what
+    its collision shape may lack, plus the cell's resolution, passes the hole), for the
+    pegs the cell builds from their sections (a cylinder, a box, a polygon's prism; not a
+    peg simulated from its mesh): a hole's ``near_miss`` in ``geometry.toml``."""
+    rooms, pairs, found = margins(derived), _pairs(derived), {}
+    for pid, fit in sorted(derived.hole_of.items()):
+        if fit.section is None or not peg_is_primitive(fit, _upright(derived, fit)):
+            continue
+        for hid in derived.holes:
+            peg, hole = pairs[pid][hid]
+            depth = near_miss(section(f"part {pid}", peg), section(f"hole {hid}", hole), rooms[pid][hid])
+            if depth is not None:
+                found[(pid, hid)] = depth
+    return found
+
+
+def near_miss_reason(pid: str, hid: str, depth: float) -> str:
+    """Why the pair is no experiment of the simulated cell (:func:`near_misses`)."""
+    return (f"{pid} in {hid}: misses by less than the cell's peg lacks at its corners (rounded by its 1 mm hull "
+            f"margin) plus what the cell resolves ({1e3 * depth:.3f} mm), decided from the CAD")
+
+
+def near_miss_assumption(derived: Derived) -> list[str]:
+    """The near misses the simulated cell does not observe, as ``import`` prints them (none without one)."""
+    return [f"no experiment: {near_miss_reason(pid, hid, depth)}" for (pid, hid), depth in near_misses(derived).items()]
 
 
 def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
@@ -783,12 +813,16 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
-    nominal, pairs = zero_clearance_parts(derived), _pairs(derived)
+    nominal, pairs, missed = zero_clearance_parts(derived), _pairs(derived), near_misses(derived)
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
                   *_section_lines(nominal_section(fit.hole, [pairs[pid][hid][0] for pid in listed])),
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
+        close = [(pid, depth) for (pid, h), depth in missed.items() if h == hid]
+        if close:
+            lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
+                         + "; ".join(near_miss_reason(pid, hid, depth) for pid, depth in close))
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         if hid in own:

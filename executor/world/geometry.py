@@ -127,7 +127,9 @@ class HoleSpec(Section):
     its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry; a
     ``pin`` of the base a part with a bore goes onto (its section the pin's, ``top_z`` its
     top, the bottom where a part going onto it rests); the parts stated to fit it at room 0
-    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); ``tile``
+    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the pegs
+    that miss it by less than the cell resolves (``near_miss``: :mod:`executor.world.near_miss`,
+    no experiment); ``tile``
     the side of its square boss [m] where it differs from the plate's ``tile_size``
     (:func:`tile_of`)."""
 
@@ -138,6 +140,7 @@ class HoleSpec(Section):
     pin: bool = field(default=False, kw_only=True)
     axis: str = field(default="-z", kw_only=True)
     zero_clearance: tuple[str, ...] = field(default=(), kw_only=True)
+    near_miss: tuple[str, ...] = field(default=(), kw_only=True)
     tile: float | None = field(default=None, kw_only=True)
 
     @property
@@ -265,6 +268,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
                                   top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner,
                                   pin=hole_shape.pin, axis=hole_shape.axis,
                                   zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())),
+                                  near_miss=tuple(sorted(hole_shape.near_miss or ())),
                                   tile=hole_shape.tile)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}

@@ -1,0 +1,102 @@
+"""The pegs' sections the cell's collision shapes lack, and the near misses it cannot resolve.
+
+Bullet inflates every convex collision shape by its hull margin (:data:`URDF_HULL_MARGIN`,
+1 mm): a box primitive is its box shrunk by the margin and added back, and a polygon
+peg's prism pieces are eroded by it before it is added back
+(:mod:`executor.world.meshes`). Either way a piece's vertical edges are rounded with the
+margin's radius, so the cell's peg lies inside its section and falls short of it at each
+corner of a piece: by r (1/sin(θ/2) - 1) at a corner of angle θ (0.41 mm at a right
+angle), the points it lacks there lying at most r (1 - sin(θ/2)) inside the outline
+(0.29 mm at a right angle); a notched polygon's pieces also leave slits where they meet
+at a reflex corner. A cylinder's side is its circle (only its rims are rounded):
+a round peg lacks nothing. A peg whose tightest contacts in a hole are its corners and
+that misses the hole by less than that passes in physics (``vitac_shapes``' heptagon,
+1.36 µm short of the rect hole, ``fit`` 2 of 2).
+
+:func:`near_miss` is the sound test: the section eroded by :func:`erosion` (the largest
+depth of a missing point, plus the :data:`SIZE_RESOLUTION` the physics resolves) lies
+inside the cell's peg, so when that eroded section does not pass a hole the cell's peg
+does not either and its no-fit is observed; when it passes while the section does not,
+the cell cannot tell the pair from a fit, and it is no experiment (the import writes it
+``near_miss`` in ``geometry.toml``: docs/cell.md#what-the-physics-resolves). Whether the
+eroded section passes is :func:`executor.world.geometry.margin`'s decision, the same
+polygon relation the import decides every pair by (for two polygons a search: a no-pass
+is its finding). Pegs simulated from their own meshes (convex pieces of a mesh) are not
+covered.
+"""
+
+from __future__ import annotations
+
+import shapely
+
+from executor.world import SIZE_RESOLUTION
+from executor.world.geometry import Section, margin, outline_polygon
+from executor.world.meshes import URDF_HULL_MARGIN
+from executor.world.outlines import convex_parts
+
+ARC_SEGMENTS = 32
+"""Chords per quarter of a rounded corner's arc (the chords lie inside it, so the peg
+built from them is smaller than the cell's: its deficit is over-, never underestimated,
+by at most r (1 - cos(π/128)), 0.3 µm at r = 1 mm)."""
+
+
+def collision_section(part: Section) -> shapely.Polygon | None:
+    """The section of the cell's collision peg built from ``part``'s section [m]: a box's
+    rectangle (the cell's box has sharp sides a x b whatever the section's corner) or each
+    convex piece of a polygon's prism opened by the hull margin (shrunk by it, then
+    widened by it); None for a round section (a cylinder's side is its circle)."""
+    if part.kind == "round":
+        return None
+    if part.kind == "polygon":
+        pieces = [shapely.Polygon(piece) for piece in convex_parts(outline_polygon(part, peg=True))]
+    else:
+        a, b = part.sides
+        pieces = [shapely.box(-a / 2, -b / 2, a / 2, b / 2)]
+    opened = [shapely.buffer(shapely.buffer(piece, -URDF_HULL_MARGIN, join_style="mitre"), URDF_HULL_MARGIN,
+                             quad_segs=ARC_SEGMENTS) for piece in pieces]
+    union = shapely.union_all(opened)
+    shells = union.geoms if isinstance(union, shapely.MultiPolygon) else [union]
+    return shapely.union_all([shapely.Polygon(shell.exterior) for shell in shells])  # gaps between pieces filled
+
+
+def erosion(part: Section) -> float:
+    """How far [m] ``part``'s section must be eroded to lie inside the cell's collision peg
+    (:func:`collision_section`: the largest distance from the section's outline of a point
+    the peg lacks), plus :data:`SIZE_RESOLUTION`; that resolution alone for a round one."""
+    cell = collision_section(part)
+    if cell is None:
+        return SIZE_RESOLUTION
+    whole = outline_polygon(part, peg=True)
+    lacking = shapely.segmentize(shapely.difference(whole, cell), URDF_HULL_MARGIN / 64)
+    points = shapely.points(shapely.get_coordinates(lacking))
+    deepest = float(shapely.distance(whole.exterior, points).max()) if len(points) else 0.0
+    return deepest + SIZE_RESOLUTION
+
+
+def eroded_section(part: Section, depth: float) -> Section:
+    """``part``'s section eroded by ``depth`` [m] (every point of the result at least that
+    far inside it): a round one's diameter less twice that, a rect's sides (its corner
+    radius less that), a polygon's outline offset with mitred corners (its reflex corners
+    cut further in than the exact erosion's arcs; where that cuts it in two, the larger part)."""
+    if part.kind == "round":
+        return Section(part.id, "round", part.size - 2 * depth)
+    if part.kind != "polygon":
+        a, b = part.sides
+        return Section(part.id, part.kind, a - 2 * depth, width=b - 2 * depth if part.width > 0 else 0.0,
+                       corner=max(part.corner - depth, 0.0))
+    shrunk = shapely.buffer(outline_polygon(part, peg=True), -depth, join_style="mitre", mitre_limit=1e3)
+    if isinstance(shrunk, shapely.MultiPolygon):  # a narrow waist cut through: its largest part is inside it too
+        shrunk = max(shrunk.geoms, key=lambda piece: piece.area)
+    (x0, y0, x1, y1), outline = shrunk.bounds, shapely.get_coordinates(shrunk.exterior)[:-1]
+    return Section(part.id, "polygon", x1 - x0, width=y1 - y0, outline=tuple((float(x), float(y)) for x, y in outline))
+
+
+def near_miss(part: Section, hole: Section, room: float) -> float | None:
+    """The :func:`erosion` [m] of a peg ``part`` with ``room`` [m] (its :func:`margin`,
+    negative: it does not pass) in ``hole`` when the cell cannot resolve that no-fit (the
+    section eroded by it passes the hole), None when it can, or when the pair fits
+    (``room`` >= 0: the cell's smaller peg passes too)."""
+    if room >= 0:
+        return None
+    depth = erosion(part)
+    return depth if margin(eroded_section(part, depth), hole) > 0 else None
