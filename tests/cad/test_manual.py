@@ -195,7 +195,7 @@ def _facts(out: Path) -> list[str]:
 
 
 def test_a_part_placed_by_hand_is_planned_onto_its_feature_in_the_cad(
-        nuts_on_bolts: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        nuts_on_bolts: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = nuts_on_bolts
     sizes = (out / "sizes.lp").read_text()
     assert "fits(nut1,bolt2_pin1)" in sizes and "fits(bolt1,h2)" in sizes  # interchangeable
@@ -207,6 +207,10 @@ def test_a_part_placed_by_hand_is_planned_onto_its_feature_in_the_cad(
     plans = json.loads(capsys.readouterr().out)["plans"]
     truth = {"plate": None, "bolt1": "h1", "bolt2": "h2", "nut1": "bolt1_pin1", "nut2": "bolt2_pin1"}
     assert len(plans) == 6 and all({s["part"]: s["hole"] for s in plan} == truth for plan in plans)
+    learned = tmp_path / "sizes.lp"  # nut1 not fitting its own bolt's end: no plan, named
+    learned.write_text(sizes.replace("fits(nut1,bolt1_pin1).", "no_fit(nut1,bolt1_pin1)."))
+    assert main(["plan", str(learned), _facts(out)[1], "--assembly", str(out)]) == 3
+    assert "part nut1 fits no hole the CAD leaves it (cad_hole/2)" in capsys.readouterr().err
 
 
 @pytest.mark.slow
