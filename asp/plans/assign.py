@@ -110,7 +110,7 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
             f"{sources}: hole({reserved[0]}): the ids {', '.join(sorted(RESERVED_IDS))} are "
             "reserved for plans (no hole, tool home, assembly site); rename the hole"
         )
-    for name in ("fits", "no_fit", "out_of_reach", "cad_hole"):
+    for name in ("fits", "no_fit", "cad_hole", "out_of_reach"):  # cad_hole first: out_of_reach follows from it
         for part, hole in atoms_by_name(facts.atoms, name, 2):
             if part not in known_parts or hole not in known_holes:
                 raise PlannerError(
