@@ -96,6 +96,11 @@ class Assembly:
     """The size model the product declares (``[sizes] model``), None when it declares none."""
     manual: dict[str, str] = field(default_factory=dict)
     """The parts the cell places by hand (``[manual.<id>]`` of ``geometry.toml``): id -> why."""
+    cad_holes: dict[str, frozenset[str]] = field(default_factory=dict)
+    """Part -> the holes it is in or on where the CAD has it, for each part whose step must
+    put it there: a part placed by hand goes to its goal in the CAD (``on`` of its
+    ``[manual.<id>]``), and a part the cell places that carries its feature must be where
+    the CAD has it (``held_by``)."""
     cell_holes: frozenset[str] | None = None
     """The holes the simulated cell models (``[hole_shapes.*]`` of ``geometry.toml``), None
     without a ``geometry.toml``."""
@@ -188,6 +193,10 @@ def assembly_of(product: ProductDescription) -> Assembly:
                   for hid, hole in layout.holes.items())
     geometry = product.geometry
     manual = {} if geometry is None else {mid: m.reason for mid, m in geometry.manual.items()}
+    cad_holes: dict[str, frozenset[str]] = {} if geometry is None else {
+        mid: frozenset(m.on) for mid, m in geometry.manual.items() if m.on is not None}
+    if geometry is not None:
+        cad_holes |= {pid: frozenset(holes) for m in geometry.manual.values() for pid, holes in m.held_by.items()}
     cell_holes = (None if geometry is None
                   else frozenset(h for shape in geometry.hole_shapes.values() for h in shape.holes))
     pins = frozenset() if geometry is None else frozenset(
@@ -196,7 +205,7 @@ def assembly_of(product: ProductDescription) -> Assembly:
         p for shape in geometry.part_shapes.values() if shape.bore for p in shape.parts)
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
                     size_model=None if layout.sizes is None else layout.sizes.model, manual=manual,
-                    cell_holes=cell_holes, pins=pins, bores=bores,
+                    cad_holes=cad_holes, cell_holes=cell_holes, pins=pins, bores=bores,
                     nominal_fits=frozenset() if geometry is None else frozenset(stated_nominal_fits(geometry)),
                     near_misses=frozenset() if geometry is None else frozenset(
                         (pid, hid) for shape in geometry.hole_shapes.values() for hid in shape.holes

@@ -10,7 +10,10 @@ A hole takes one part, or ``capacity(H,C)`` parts (a pin the product stacks part
 onto, one above the other: the import writes it); parts that share a hole must be
 ordered by ``must_precede/2`` (the lower first), else their order along it is unknown.
 A part is never given a hole the cell cannot put it in (``out_of_reach(P,H)``: a hole of
-a part placed by hand; :func:`product_facts`).
+a part placed by hand; :func:`product_facts`). A part held where the CAD has it
+(``cad_hole(P,H)``: a part placed by hand, and a part the cell places that carries its
+hole or pin) gets only one of those holes, and they go to no other part
+(``asp/encodings/plans/cad_hole.lp``).
 
 - :func:`greedy_assignment`: the paper's greedy: the biggest unassigned part gets a free
   hole big enough for it. Sizes come from the learned relation: a part is the bigger
@@ -74,7 +77,9 @@ class LearnedFacts:
     capacity: Mapping[str, int] = field(default_factory=dict)
     """Hole -> the number of parts it takes, for the holes of a ``capacity/2`` fact (others: 1)."""
     out_of_reach: frozenset[tuple[str, str]] = frozenset()
-    """(part, hole) pairs the cell cannot put in (``out_of_reach/2``)."""
+    """(part, hole) pairs the cell cannot put in or the CAD holds elsewhere (``out_of_reach/2``)."""
+    cad_holes: frozenset[tuple[str, str]] = frozenset()
+    """(part, hole) pairs of a part held where the CAD has it (``cad_hole/2``)."""
 
     def holes_of(self, part: str) -> list[str]:
         """The holes ``part`` fits and the cell can put it in, sorted."""
@@ -90,7 +95,7 @@ class LearnedFacts:
 
 
 LEARNED_SIGNATURES = {"part": 1, "hole": 1, "fits": 2, "no_fit": 2, "needs_hole": 1,
-                      "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2}
+                      "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2, "cad_hole": 2}
 """The predicates of learned facts the planner reads, with their arities (ids only)."""
 
 RESERVED_IDS = frozenset({"none", "home", "site"})
@@ -105,7 +110,7 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
             f"{sources}: hole({reserved[0]}): the ids {', '.join(sorted(RESERVED_IDS))} are "
             "reserved for plans (no hole, tool home, assembly site); rename the hole"
         )
-    for name in ("fits", "no_fit", "out_of_reach"):
+    for name in ("fits", "no_fit", "cad_hole", "out_of_reach"):  # cad_hole first: out_of_reach follows from it
         for part, hole in atoms_by_name(facts.atoms, name, 2):
             if part not in known_parts or hole not in known_holes:
                 raise PlannerError(
@@ -139,8 +144,11 @@ def _capacities(atoms: Sequence[clingo.Symbol], holes: set[str], sources: str) -
 def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     """What the product says about its holes beyond sizes: ``capacity(H,C)`` for a hole
     taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not the base,
-    not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`)."""
+    not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`),
+    ``cad_hole(P,H)`` for a part held where the CAD has it (:attr:`bridge.assembly.Assembly.cad_holes`)."""
     atoms = [fact("capacity", hole.id, hole.capacity) for hole in assembly.holes if hole.capacity > 1]
+    atoms += [fact("cad_hole", part, hole) for part, holes in sorted(assembly.cad_holes.items())
+              for hole in sorted(holes)]
     inserted = [part.id for part in assembly.parts if part.role != "base" and part.id not in assembly.manual]
     return atoms + [fact("out_of_reach", part, hole) for part in inserted
                     for hole in assembly.hole_ids if assembly.cell_cannot_insert(part, hole)]
@@ -150,13 +158,15 @@ def load_learned_facts(paths: Sequence[Path | str], product: Sequence[clingo.Sym
     """Read learned facts files (and the ``product`` facts, :func:`product_facts`);
     PlannerError on a file that does not parse, a predicate of the wrong arity or with
     non-id arguments (:data:`LEARNED_SIGNATURES`), unknown ids, a bad ``capacity/2``,
-    a pair both fitting and not fitting, or a precedence cycle.
+    a pair both fitting and not fitting, or a precedence cycle. ``out_of_reach`` holds
+    too the pairs ``cad_hole/2`` rules out (``plans/cad_hole.lp``).
 
     Precedence is read in both forms, ``must_precede/2`` and ``precedence_edge/2``, and
     closed (:func:`asp.precedence.relation.closed_precedence`): ``must_precede`` and the
     ``must_precede/2`` atoms hold the closure."""
     sources = ", ".join(str(p) for p in paths)
-    atoms = list(dict.fromkeys([*load_atoms(paths, encodings=["plans/needs_hole.lp"]), *product]))
+    atoms = list(dict.fromkeys(load_atoms(paths, encodings=["plans/needs_hole.lp", "plans/cad_hole.lp"],
+                                          extra=product)))
     check_facts(atoms, LEARNED_SIGNATURES, sources)
     if not atoms_by_name(atoms, "part", 1):
         raise PlannerError(f"{sources}: expected part/1 facts (the assembly's parts), found none")
@@ -172,6 +182,7 @@ def load_learned_facts(paths: Sequence[Path | str], product: Sequence[clingo.Sym
         must_precede=must_precede,
         capacity=_capacities(atoms, {h for (h,) in atoms_by_name(atoms, "hole", 1)}, sources),
         out_of_reach=frozenset(pairs_by_name(atoms, "out_of_reach")),
+        cad_holes=frozenset(pairs_by_name(atoms, "cad_hole")),
     )
     _check_ids(facts, sources)
     return facts
@@ -208,8 +219,13 @@ def _no_hole_message(facts: LearnedFacts, part: str, fitting: list[str], taken_b
 
 
 def _reach_note(facts: LearnedFacts, parts: Sequence[str]) -> str:
-    """`` the cell can use`` when the cell cannot reach a hole one of ``parts`` fits."""
-    return " the cell can use" if any(pair[0] in parts for pair in facts.out_of_reach & facts.fits) else ""
+    """`` the cell can use`` when the cell cannot reach a hole one of ``parts`` fits,
+    `` the CAD leaves it`` when the CAD holds one of them or such a hole elsewhere."""
+    ruled_out = [pair for pair in facts.out_of_reach & facts.fits if pair[0] in parts]
+    held = {part for part, _ in facts.cad_holes} | {hole for _, hole in facts.cad_holes}
+    if any(part in held or hole in held for part, hole in ruled_out):
+        return " the CAD leaves it (cad_hole/2)"
+    return " the cell can use" if ruled_out else ""
 
 
 def maximum_matching(facts: LearnedFacts) -> Assignment:

@@ -399,6 +399,26 @@ def _check_kinds(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
                               f"{_describe(spec.kind, spec.size)} in geometry.toml)")
 
 
+def _check_manual_features(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:
+    """A part placed by hand is ``on`` holes of ``assembly.toml``, and ``held_by`` parts the
+    cell places (a peg of ``[part_shapes.*]``), each in holes of ``assembly.toml``, the same
+    ones in every table naming it."""
+    pegs = {pid for shape in geo.part_shapes.values() for pid in shape.parts}
+    held: dict[str, set[str]] = {}
+    for mid, manual in geo.manual.items():
+        table = f"manual.{mid}"
+        for hid in [*(manual.on or []), *(h for holes in manual.held_by.values() for h in holes)]:
+            if hid not in layout.holes:
+                raise fail(path, table, "on" if hid in (manual.on or []) else "held_by",
+                           "holes of assembly.toml", hid)
+        for pid in manual.held_by:
+            if pid not in pegs:
+                raise fail(path, table, "held_by", "parts the cell places (of [part_shapes.*])", pid)
+            if held.setdefault(pid, set(manual.held_by[pid])) != set(manual.held_by[pid]):
+                raise fail(path, table, f"held_by.{pid}",
+                           f"the holes another [manual.*] gives it ({sorted(held[pid])})", manual.held_by[pid])
+
+
 def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: Mapping[str, str]) -> None:
     """The base, covers and heads name parts of ``assembly.toml``, holes of the plate, part
     shapes (their skills) and covers with a socket; with a ``[base]``, every part of
@@ -437,6 +457,7 @@ def _check_product(path: Path, geo: GeometryFile, layout: AssemblyFile, holes: M
         for pid in ids:
             if pid not in layout.parts:
                 raise fail(path, f"{table_name}.{pid}", "", "a part of assembly.toml", pid)
+    _check_manual_features(path, geo, layout)
     if geo.base is None:
         return
     if geo.base.part not in layout.parts:

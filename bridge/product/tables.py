@@ -305,7 +305,11 @@ class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     into a hole the cell knows), placed by hand: ``reason`` says why, ``goal`` [x, y, z] [m]
     is its frame's origin when assembled, ``tray`` where that origin waits [m]; simulated
     as its own ``mesh`` (its frame at the centre of its bounding box's bottom face, the
-    cell's axes), a static concave mesh, fixed where it is placed (no convex pieces)."""
+    cell's axes), a static concave mesh, fixed where it is placed (no convex pieces).
+    ``on``: the holes and pins of ``assembly.toml`` it is in or on where the CAD has it
+    (its goal), the plan gives it one of them; ``held_by``: the parts the cell places
+    that carry one of those (a nut on a bolt's end), each with the holes it is in where
+    the CAD has it, the plan puts it into one of them (else the part would not be on it)."""
 
     reason: Text
     goal: Annotated[list[Coordinate], Meta(min_length=3, max_length=3,
@@ -314,6 +318,8 @@ class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     mass: Mass
     mesh: Mesh
     name: Text | None = None
+    on: Ids | None = None
+    held_by: dict[Id, Ids] = {}
 
 
 class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

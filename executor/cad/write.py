@@ -796,9 +796,32 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
     return meshes
 
 
-def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh]) -> str:
+def manual_features(derived: Derived, mapped: Mapped) -> dict[str, tuple[list[str], dict[str, list[str]]]]:
+    """Each part placed by hand that is in or on features in the CAD (``derived``, the whole
+    product, not the cell's view) -> those features (``on``) and the parts the cell places
+    that carry one of them, each with the features it is in (``held_by``): a nut at its
+    goal is on the bolt's end only with that bolt in its hole of the CAD."""
+    def features(pid: str) -> list[str]:
+        return sorted([hid for hid, fit in (derived.holes | derived.part_holes).items() if fit.part == pid]
+                      + [pin_id for pin_id, pin in derived.pins.items() if pid in pin.parts])
+
+    owner = {hid: fit.owner for hid, fit in derived.part_holes.items() if fit.owner is not None} | {
+        pin_id: pin.owner for pin_id, pin in derived.pins.items()}
+    placed = {pid for pid in derived.parts if pid != derived.base} - set(mapped.manual) - set(mapped.covers) - set(
+        mapped.heads)  # into a hole the plan chooses
+    found: dict[str, tuple[list[str], dict[str, list[str]]]] = {}
+    for mid in mapped.manual:
+        on = features(mid)
+        if on:
+            carriers = sorted({owner[f] for f in on if f in owner} & placed)
+            found[mid] = (on, {pid: features(pid) for pid in carriers if features(pid)})
+    return found
+
+
+def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh],
+                  features: dict[str, tuple[list[str], dict[str, list[str]]]]) -> str:
     """``geometry.toml`` of a mapped product (:func:`map_product`), the parts in ``meshes``
-    as their own meshes."""
+    as their own meshes, the features of the parts placed by hand (:func:`manual_features`)."""
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
@@ -880,7 +903,12 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   f"reason = {json.dumps(shorten(reason, MAX_REASON))}",
                   f"goal = {_numbers(manual_origin(derived.parts[mid].mesh))}",
                   f"tray = {_numbers(settings.trays[mid])}", f"mass = {_q(derived.parts[mid].mesh.volume * DENSITY)}",
-                  _mesh_entry(meshes[mid]), ""]
+                  _mesh_entry(meshes[mid])]
+        on, held_by = features.get(mid, ([], {}))
+        lines += [f"on = {json.dumps(on)}"] if on else []
+        lines += [f"held_by = {{ {', '.join(f'{pid} = {json.dumps(holes)}' for pid, holes in held_by.items())} }}",
+                  ] if held_by else []
+        lines.append("")
     return "\n".join(lines)
 
 
@@ -1047,7 +1075,7 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     if isinstance(meshes, str):
         why = meshes
     elif meshes is not None:
-        write_atomic(geometry, geometry_text(cell, mapped, settings, meshes))
+        write_atomic(geometry, geometry_text(cell, mapped, settings, meshes, manual_features(derived, mapped)))
         try:
             loaded = load_geometry(str(out))
             plate_obj_text(loaded)  # the cell builds its plate's bosses from it

@@ -330,6 +330,12 @@ def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_assembled_wi
     assert report["assembled"] and report["replans"] == []
     assert set(report["manual"]) == set(report["manual_reasons"]) == set(done.truth["parts"]) - bolts
     assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
+    # each step names where the part is: a bolt in the hole the CAD has it in, so that each
+    # nut placed by hand at its pose in the CAD is on the end of the bolt its step names
+    holes = tomllib.loads((done.out / "assembly.toml").read_text())["holes"]
+    named = {s["part"]: s["hole"] for s in report["steps"]}
+    assert all(holes[named[pid]]["name"] == f"hole of {pid}" for pid in bolts), named
+    assert all(named[pid] == f"bolt_{pid[4:]}_pin1" for pid in named if pid.startswith("nut_")), named
 
 
 def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: Runner, run: Path) -> dict[str, Any]:

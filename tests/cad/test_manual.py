@@ -1,6 +1,7 @@
 """A part the cell has no operation for is placed by hand: ``import`` still writes
-``geometry.toml`` (the part as its own mesh in ``[manual.<id>]`` with the reason), the
-plans mark its step ``(manual)``, ``session`` runs with the truth and the sim backends
+``geometry.toml`` (the part as its own mesh in ``[manual.<id>]`` with the reason and the
+features it is in or on in the CAD), the plans mark its step ``(manual)`` and give it
+only that feature, ``session`` runs with the truth and the sim backends
 and the sim cell puts it where the CAD has it (fixed there); the truth backend answers from
 ``sizes.lp`` where a product has no ``geometry.toml``."""
 
@@ -16,7 +17,7 @@ import trimesh
 from assembly_constraints.cli import main
 from bridge.assembly import load_assembly
 from executor.assembly.product import load_product
-from tests.cad.test_covers import _pegs_and_plate
+from tests.cad.test_covers import _pegs_and_plate, _solid
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -164,10 +165,79 @@ def test_a_sim_session_places_the_part_by_hand_where_the_cad_has_it(run_cli: Run
     assert max(report["final_pose_error_mm"].values()) <= POSE_BOUND_MM
 
 
+def _nuts_on_bolts(tmp_path: Path) -> Path:
+    """A 120 x 80 x 20 mm plate with two 13 mm square holes through it 50 mm apart along x,
+    a 12 mm square bolt 40 mm long through each (8 mm out below) and a 20 mm square nut
+    6 mm thick with a 12.5 mm square bore on each bolt's lower end under the plate, drawn
+    at :data:`X_MM` and imported; the folder written. Any bolt fits any hole and any nut
+    any bolt's end; the nuts are placed by hand (they go onto pins of moving parts)."""
+    cad = tmp_path / "cad"
+    cad.mkdir()
+    holes = [_box((13, 13, 20.002), (X_MM + dx, 0, 10)) for dx in (-25, 25)]
+    _solid(_box((120, 80, 20), (X_MM, 0, 10)), *holes).export(cad / "plate.stl")
+    for k, dx in enumerate((-25, 25)):
+        _box((12, 12, 40), (X_MM + dx, 0, 12)).export(cad / f"bolt{k + 1}.stl")
+        _solid(_box((20, 20, 6), (X_MM + dx, 0, -3)), _box((12.5, 12.5, 6.002), (X_MM + dx, 0, -3))).export(
+            cad / f"nut{k + 1}.stl")
+    (tmp_path / "import.toml").write_text("[parts.nut1]\ntray = [0.30, 0.28]\n[parts.nut2]\ntray = [0.40, 0.28]\n")
+    assert main(["-q", "import", str(cad), "--out", str(tmp_path / "out"), "--config",
+                 str(tmp_path / "import.toml")]) == 0
+    return tmp_path / "out"
+
+
+@pytest.fixture(scope="module")
+def nuts_on_bolts(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _nuts_on_bolts(tmp_path_factory.mktemp("nuts"))
+
+
+def _facts(out: Path) -> list[str]:
+    return [str(out / "sizes.lp"), str(out / "geometric_precedence.lp")]
+
+
+def test_a_part_placed_by_hand_is_planned_onto_its_feature_in_the_cad(
+        nuts_on_bolts: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = nuts_on_bolts
+    sizes = (out / "sizes.lp").read_text()
+    assert "fits(nut1,bolt2_pin1)" in sizes and "fits(bolt1,h2)" in sizes  # interchangeable
+    manual = tomllib.loads((out / "geometry.toml").read_text())["manual"]
+    assert {mid: (m["on"], m["held_by"]) for mid, m in manual.items()} == {
+        "nut1": (["bolt1_pin1"], {"bolt1": ["h1"]}), "nut2": (["bolt2_pin1"], {"bolt2": ["h2"]})}
+    capsys.readouterr()
+    assert main(["plan", *_facts(out), "--assembly", str(out), "-n", "0", "--json"]) == 0
+    plans = json.loads(capsys.readouterr().out)["plans"]
+    truth = {"plate": None, "bolt1": "h1", "bolt2": "h2", "nut1": "bolt1_pin1", "nut2": "bolt2_pin1"}
+    assert len(plans) == 6 and all({s["part"]: s["hole"] for s in plan} == truth for plan in plans)
+    learned = tmp_path / "sizes.lp"  # nut1 not fitting its own bolt's end: no plan, named
+    learned.write_text(sizes.replace("fits(nut1,bolt1_pin1).", "no_fit(nut1,bolt1_pin1)."))
+    assert main(["plan", str(learned), _facts(out)[1], "--assembly", str(out)]) == 3
+    assert "part nut1 fits no hole the CAD leaves it (cad_hole/2)" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_report_names_the_feature_a_part_placed_by_hand_is_on(
+        nuts_on_bolts: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = nuts_on_bolts
+    capsys.readouterr()
+    assert main(["assemble", *_facts(out), "--assembly", str(out), "--backend", "truth", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    goals = {mid: m["goal"] for mid, m in tomllib.loads((out / "geometry.toml").read_text())["manual"].items()}
+    positions = {hid: hole["position"] for hid, hole in tomllib.loads((out / "assembly.toml").read_text())[
+        "holes"].items()}
+    hole_of = {step["part"]: step["hole"] for step in report["steps"]}
+    assert report["assembled"] and sorted(report["manual"]) == ["nut1", "nut2"]
+    for nut in ("nut1", "nut2"):  # the pin its step names and the bolt that pin is the end of: where its goal is
+        bolt = hole_of[nut].removesuffix("_pin1")
+        for hid in (hole_of[nut], hole_of[bolt]):
+            assert positions[hid] == pytest.approx(goals[nut][:2], abs=1e-6), (nut, hid)
+
+
 @pytest.mark.parametrize(("old", "new", "expected"), [
     ("goal = [0.56, 0.0, 0.035]", "goal = [0.56, 0.0]", "[manual.lid] goal: expected [x, y, z] in metres"),
     ('reason = "', 'reason = "" # ', "[manual.lid] reason: expected a non-empty text"),
     ("[manual.lid]", "[manual.cap]", "[manual.cap]: expected a part of assembly.toml, got 'cap'"),
+    ('reason = "', 'on = ["h9"]\nreason = "', "[manual.lid] on: expected holes of assembly.toml, got 'h9'"),
+    ('reason = "', 'held_by = { lid = ["h1"] }\nreason = "',
+     "[manual.lid] held_by: expected parts the cell places (of [part_shapes.*]), got 'lid'"),
 ])
 def test_a_bad_manual_table_is_one_line_naming_it(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                   old: str, new: str, expected: str) -> None:

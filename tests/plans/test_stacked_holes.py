@@ -91,6 +91,12 @@ CHECK_CASES = [
      {"error(unordered(a,b,h1))"}),
     ("a hole out of the cell's reach", "out_of_reach(c,h2). must_precede(a,b). assigned(a,h1). "
                                        "assigned(b,h1). assigned(c,h2).", {"error(out_of_reach(c,h2))"}),
+    ("a part held elsewhere in the CAD", "cad_hole(c,h1). must_precede(a,b). assigned(a,h1). "
+                                         "assigned(b,h1). assigned(c,h2).", {"error(out_of_reach(c,h2))",
+                                                                             "error(out_of_reach(a,h1))",
+                                                                             "error(out_of_reach(b,h1))"}),
+    ("a hole the CAD gives another part", "cad_hole(c,h2). must_precede(a,b). assigned(a,h1). assigned(b,h1). "
+                                          "assigned(c,h2).", set()),
 ]
 
 
