@@ -151,6 +151,14 @@ PULLEY_PIN = ("features: the pin the pulley goes onto (the hub's boss) is not fo
               "of the part's extent along its axis only, where the pulley's slice (y -27.124 mm, through its rim, "
               "behind the hub's disc) crosses nothing of the hub")
 
+BEAM_RECT_NOMINAL = ("fits: sizes.lp has none: each upright's tenon is in its mortise as rect 9.606 x 5.796 mm in "
+                     "rect 9.605 x 5.795 mm (the tapers sliced at mid-depth, where they meet), 0.3 um of overlap a "
+                     "side, and the nominal zero-clearance rule takes only round or polygon sections")
+BEAM_PINS = ("features: the uprights' upper tenons the feet go onto are not found as pins: each foot is taken for a "
+             "cover (50.8 mm above the plate top); and " + BEAM_RECT_NOMINAL)
+BEAM_CONVEX = ("no geometry.toml: the convex pieces of upright_a leave foot_a -3.979 mm of the 0.000 mm its mesh "
+               "leaves it (CoACD, a tapered tenon in a tapered mortise at zero clearance)")
+
 
 def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
     """Every imported product, ``name`` with ``mark``."""
@@ -161,6 +169,7 @@ def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("asap_beam", marks=_xfail(BEAM_PINS)),
     "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
@@ -191,7 +200,8 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears", "factory_rect_pegs",
+@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "asap_beam", "factory_gears",
+                                  "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes"])
 def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:
@@ -212,6 +222,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("asap_beam", marks=_xfail(BEAM_RECT_NOMINAL)),
     "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
@@ -284,7 +295,7 @@ def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: 
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", IMPORTED)
+@pytest.mark.parametrize("name", _imported_but("asap_beam", _xfail(BEAM_CONVEX)))
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -298,6 +309,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("asap_beam", marks=_xfail(BEAM_CONVEX + "; and " + INSERTED + " onto a tenon of another part "
+                                           "(each foot, taken for a cover 50.8 mm above the plate top)")),
     pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a shaft with less room than the cell resolves "
                                                "(0.012 mm per side)")),
     "factory_rect_pegs",
