@@ -39,6 +39,7 @@ BENCHMARKS: dict[str, str] = {
     "physics": "executor.campaign.physics",
     "engines": "executor.campaign.engines",
     "import": "executor.cad.bench",
+    "corpus": "assembly_constraints.corpus_bench",
 }
 """``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""
 

@@ -15,7 +15,7 @@ The planner starts one cell (``executor serve``) on loopback and sends it one st
 request per plan step over Zenoh (:mod:`asp.assemble.driver`); the cell keeps its world
 between steps.  JSON (``--json``): ``{"plan", "steps": [{"part", "hole", "skill",
 "outcome", "attempts", "duration_s", "max_force_dev", ...}], "assembled", "manual": [part],
-"final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
+"manual_reasons": {part: why}, "final_pose_error_mm": {part: mm}, "replans": [{"step", "reason", "plan"}], ...}``.
 Exit code 3 when the product cannot be finished (e.g. no hole left for a part).
 
 ``--uncertainty cell`` gives the plan steps the uncertainty of a single-trial cell (the
@@ -36,7 +36,7 @@ from msgspec import UNSET
 
 from asp import PlannerError
 from asp.assemble.driver import assembling_cell
-from asp.assemble.execute import AssemblyStopped, execute
+from asp.assemble.execute import AssemblyStopped, execute, with_manual_reasons
 from asp.assemble.inputs import (
     check_facts_product,
     check_plan_product,
@@ -184,6 +184,7 @@ def _summary(report: dict) -> str:
                      + " ".join(s["part"] + (f"->{s['hole']}" if s["hole"] else "") for s in replan["plan"]))
     if report["manual"]:
         lines.append(f"placed by hand (manual, the cell has no operation for them): {' '.join(report['manual'])}")
+        lines += [f"  {part}: {reason}" for part, reason in report["manual_reasons"].items()]
     errors = report["final_pose_error_mm"]
     if errors:
         worst = max(errors, key=lambda p: errors[p])
@@ -213,6 +214,7 @@ def assemble(settings: AssemblySettings) -> tuple[dict, int]:
             report, code = execute(facts, plan, driver), 0
         except AssemblyStopped as exc:
             report, code = dict(exc.report, error=str(exc)), EXIT_UNSOLVABLE
+    report = with_manual_reasons(report, assembly.manual)
     report["wall_s"] = round(time.perf_counter() - started, 3)
     return report, code
 

@@ -11,6 +11,7 @@ where they are.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -59,6 +60,13 @@ def manual_parts(steps: list[dict]) -> list[str]:
     """The parts of the report's ``steps`` the cell answered as placed by hand (skill
     ``manual``: its arm has no operation for them), in step order."""
     return [s["part"] for s in steps if s["skill"] == "manual" and s["outcome"] == "fit"]
+
+
+def with_manual_reasons(report: dict, reasons: Mapping[str, str]) -> dict:
+    """``report`` with ``"manual_reasons"``: why each of its ``manual`` parts is placed by
+    hand, where the product says (``reasons``: part -> reason, ``[manual.<id>]`` of its
+    geometry, :attr:`bridge.assembly.Assembly.manual`)."""
+    return dict(report, manual_reasons={part: reasons[part] for part in report["manual"] if part in reasons})
 
 
 def step_json(reply: StepReply) -> dict:

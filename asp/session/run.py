@@ -32,6 +32,7 @@ import logging
 import shutil
 import time
 import uuid
+from collections.abc import Mapping
 from contextlib import ExitStack
 from datetime import UTC, datetime
 from pathlib import Path
@@ -323,12 +324,12 @@ def _plans(learned: Path, count: int) -> tuple[dict[str, str], list[Plan]]:
 
 
 def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: Plan, seed: int,
-              timeout_s: float, process: CellProcess | None) -> dict:
+              timeout_s: float, process: CellProcess | None, manual: Mapping[str, str]) -> dict:
     """Execute ``plan`` in the session's first cell (:mod:`asp.assemble`; ``process``: its
-    process if the session started it); the report, with ``"error"`` when the product
-    could not be finished."""
+    process if the session started it; ``manual``: why the product places parts by hand);
+    the report, with ``"error"`` when the product could not be finished."""
     from asp.assemble.driver import ZenohDriver
-    from asp.assemble.execute import AssemblyStopped, execute
+    from asp.assemble.execute import AssemblyStopped, execute, with_manual_reasons
 
     if not cell_ids:
         raise PlannerError("--assemble needs a cell of this session (--cells 1 or more)")
@@ -338,6 +339,7 @@ def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: 
         report = execute(load_learned_facts([learned]), plan, driver)
     except AssemblyStopped as exc:
         report = dict(exc.report, error=str(exc))
+    report = with_manual_reasons(report, manual)
     report["wall_s"] = round(time.perf_counter() - started, 3)
     return report
 
@@ -584,7 +586,8 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
                                "else a matching; paper 2.2).")
             log.assignment(assignment)
         assembly_report = (_assemble(session, cell_ids, learned, found[0], record.seed, settings.timeout_s,
-                                     cells[0] if cells else None) if settings.assemble and found else None)
+                                     cells[0] if cells else None, assembly.manual)
+                           if settings.assemble and found else None)
     view_blueprint(run)
     fits = sorted(sizes.knowledge.fits)
     must_precede = relation.pairs()

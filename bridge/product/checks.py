@@ -319,14 +319,16 @@ def _check_vertices(path: Path, table: str, key: str, obj: Path, data: bytes, re
     """Every vertex ``v x y z`` of the OBJ ``data`` (the file ``obj``) is three finite
     coordinates within ``reach`` [m]; BridgeError naming ``obj``'s line otherwise."""
     for number, line in enumerate(data.splitlines(), 1):
+        if line[:1] != b"v" and not line[:1].isspace():
+            continue  # its first word is no "v" (a face, a comment): not split
         words = line.split()
         if words[:1] != [b"v"]:
             continue
         try:
-            vertex = [float(word) for word in words[1:4]]
-        except ValueError:
-            vertex = []
-        if len(vertex) != 3 or not all(-reach <= c <= reach for c in vertex):  # NaN compares False
+            x, y, z = map(float, words[1:4])
+        except ValueError:  # not three numbers
+            x = y = z = math.nan
+        if not (-reach <= x <= reach and -reach <= y <= reach and -reach <= z <= reach):  # NaN compares False
             raise BridgeError(f"{path}: [{table}] {key}: {obj}:{number}: expected a vertex 'v x y z' of finite "
                               f"coordinates within [-{reach:g}, {reach:g}] m of its frame's origin, got "
                               f"{shorten(line.decode('utf-8', 'replace'))!r}")

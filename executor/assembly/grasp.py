@@ -15,6 +15,7 @@ import pybullet as pb
 from executor.assembly.world import AssemblyWorld
 from executor.skills.insertion import rotvec_quat_xyzw
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.world.scene import inertial_frame
 
 GRASP_FORCE = 500.0  # [N] the constraint's maximum force
 
@@ -33,14 +34,14 @@ class Grasp:
         self.kinematic = part == world.product.base.id
         self.constraint: int | None = None
         if not self.kinematic:
-            # Constraint frames are relative to the links' centres of mass.
-            tool_com = np.array(pb.getDynamicsInfo(world.robot, world.tool_link, physicsClientId=c)[3])
-            part_com = np.array(pb.getDynamicsInfo(frames.body, -1, physicsClientId=c)[3])
+            # Constraint frames are relative to the links' inertial frames.
+            parent = pb.multiplyTransforms(*pb.invertTransform(*inertial_frame(c, world.robot, world.tool_link)),
+                                           *self.body_in_tool)
+            child = pb.invertTransform(*inertial_frame(c, frames.body))
             self.constraint = pb.createConstraint(
                 world.robot, world.tool_link, frames.body, -1, pb.JOINT_FIXED, (0, 0, 0),
-                parentFramePosition=list(np.array(self.body_in_tool[0]) - tool_com),
-                childFramePosition=list(-part_com),
-                parentFrameOrientation=self.body_in_tool[1], physicsClientId=c)
+                parentFramePosition=parent[0], childFramePosition=child[0],
+                parentFrameOrientation=parent[1], childFrameOrientation=child[1], physicsClientId=c)
             pb.changeConstraint(self.constraint, maxForce=GRASP_FORCE, physicsClientId=c)
         # The believed TCP in the tool frame (nominal grasp): what the controller drives.
         tcp_in_tool = pb.multiplyTransforms(body_pos, body_quat, list(frames.tcp), [0, 0, 0, 1])[0]

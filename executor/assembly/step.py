@@ -66,7 +66,7 @@ from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
 from executor.world.frames import HoleFrame
 from executor.world.geometry import fit_pose, margin
 from executor.world.perturbation import CellBias
-from executor.world.scene import PART_FRICTION
+from executor.world.scene import PART_FRICTION, inertial_frame
 
 ABOVE_PINS = 0.004  # [m] gap between a cover's bottom and the pin tops where its insertion starts
 CENTRING_MARGIN = 0.005  # [m] the centring probes reach this beyond the farthest the feature can be
@@ -367,8 +367,8 @@ class Assembler:
 
     def _centring_reach(self, part: str, hole: str | None) -> float | None:
         """How far [m] the centring probes of a peg found in ``hole`` reach each way, None
-        where it is not centred: a bore on a pin, its half diagonal (the pin's axis is at
-        most that far) + :data:`CENTRING_MARGIN`; a peg with more room than
+        where it is not centred: a bore on a pin, its circumradius (the pin's axis is
+        at most that far from the bore's centre) + :data:`CENTRING_MARGIN`; a peg with more room than
         :data:`CENTRING_ROOM` in a hole, twice its room (from one wall to the other) +
         :data:`CENTRING_MARGIN`."""
         peg = self.product.pegs.get(part)
@@ -376,7 +376,7 @@ class Assembler:
             return None
         feature = self.product.geometry.holes[hole]
         if feature.pin:
-            return float(np.hypot(*peg.sides)) / 2 + CENTRING_MARGIN
+            return peg.circumradius + CENTRING_MARGIN
         room = margin(peg, feature) / 2
         return 2 * room + CENTRING_MARGIN if room > CENTRING_ROOM else None
 
@@ -389,14 +389,7 @@ class Assembler:
         that meets anything else, the arm or the held part, goes on under its bounding box)."""
         world, spec = self.world, self.product.geometry.holes[hole]
         bodies = {world.frames[q].body for q in self.placed if q not in (part, self.product.base.id)}
-        peg = self.product.pegs[part]
-        if peg.kind == "round":
-            circumradius = peg.size / 2
-        elif peg.outline:
-            circumradius = float(np.max(np.linalg.norm(np.asarray(peg.outline), axis=1)))
-        else:
-            circumradius = float(np.hypot(*peg.sides)) / 2
-        reach = circumradius + SURFACE_MARGIN
+        reach = self.product.pegs[part].circumradius + SURFACE_MARGIN
         rings, per_ring = SURFACE_RAYS
         xy = [np.asarray(spec.position[:2], dtype=float)]
         for r in np.linspace(reach / rings, reach, rings):
@@ -539,12 +532,12 @@ class Assembler:
         inv = pb.invertTransform(list(pos), list(quat))
         rel_pos, rel_quat = pb.multiplyTransforms(*inv, list(mine[0]), list(mine[1]))
         c = world.client
-        into_com = np.array(pb.getDynamicsInfo(into, -1, physicsClientId=c)[3])
-        my_com = np.array(pb.getDynamicsInfo(me, -1, physicsClientId=c)[3])
+        parent = pb.multiplyTransforms(*pb.invertTransform(*inertial_frame(c, into)), rel_pos, rel_quat)
+        child = pb.invertTransform(*inertial_frame(c, me))
         self._screwed[part] = pb.createConstraint(into, -1, me, -1, pb.JOINT_FIXED, (0, 0, 0),
-                                                  parentFramePosition=list(np.array(rel_pos) - into_com),
-                                                  childFramePosition=list(-my_com),
-                                                  parentFrameOrientation=rel_quat, physicsClientId=c)
+                                                  parentFramePosition=parent[0], childFramePosition=child[0],
+                                                  parentFrameOrientation=parent[1], childFrameOrientation=child[1],
+                                                  physicsClientId=c)
 
     def pose_errors(self) -> dict[str, float]:
         """Distance of every part from its goal [m] (a peg without a goal: from its tray pose)."""

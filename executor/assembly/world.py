@@ -25,7 +25,7 @@ from executor.control.motion import Motion, StepLogger
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies, tile_of
-from executor.world.scene import TIME_STEP, load_plate, wrist_clear_of
+from executor.world.scene import TIME_STEP, inertial_frame, link_frame, load_plate, wrist_clear_of
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -241,26 +241,20 @@ class AssemblyWorld:
         s = self.arm.read()
         self.motion.hold(s.tip_pos, tool_quat(self.motion.tool_yaw), duration)
 
-    def _com(self, part: str) -> tuple[float, float, float]:
-        """The body's centre of mass in its frame [m] (PyBullet's base pose is the COM's)."""
-        return pb.getDynamicsInfo(self.frames[part].body, -1, physicsClientId=self.client)[3]
-
     def position(self, part: str) -> np.ndarray:
         """The part's body origin [m]."""
         return self.pose(part)[0]
 
     def pose(self, part: str) -> tuple[np.ndarray, np.ndarray]:
-        """Body origin [m] and quaternion xyzw."""
-        pos, quat = pb.getBasePositionAndOrientation(self.frames[part].body, physicsClientId=self.client)
-        inv_pos, inv_quat = pb.invertTransform(self._com(part), _IDENTITY)
-        origin = pb.multiplyTransforms(pos, quat, inv_pos, inv_quat)[0]
-        return np.array(origin), np.array(quat)
+        """Body origin [m] and quaternion xyzw (its URDF frame's, :func:`link_frame`)."""
+        pos, quat = link_frame(self.client, self.frames[part].body, -1)
+        return np.array(pos), np.array(quat)
 
     def set_pose(self, part: str, pos: np.ndarray, quat: tuple = _IDENTITY) -> None:
-        """Put the body origin at ``pos`` [m], at rest."""
-        com = pb.multiplyTransforms(list(pos), list(quat), self._com(part), _IDENTITY)[0]
+        """Put the body origin at ``pos`` [m] turned by ``quat``, at rest."""
         body = self.frames[part].body
-        pb.resetBasePositionAndOrientation(body, com, list(quat), physicsClientId=self.client)
+        com, com_quat = pb.multiplyTransforms(list(pos), list(quat), *inertial_frame(self.client, body))
+        pb.resetBasePositionAndOrientation(body, com, com_quat, physicsClientId=self.client)
         pb.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
 
     def goal_error(self, part: str) -> float:

@@ -5,16 +5,19 @@ The product (``--parts N``, 6 to 200, default 20): a plate with ``N - 3`` holes 
 0.3 mm clearance; the pegs of the first row stand 15 mm out, the others 25 mm; two 4 mm
 covers, one lying on the first row, the other on it, each with openings for the others
 (which pass through both). Written as STL files in mm, then imported
-(:func:`executor.cad.cli.run_import`) ``--repeat`` times. Prints the median wall and CPU
-time of the import, the collision queries and the edges found, and the CPU time as a
-fraction of ``--target``; exit code 1 when the median CPU time (the process's, all its
-threads: what one core would need) exceeds it. The wall time is printed too: on a shared
-machine it also counts the waits for a core.
+(:func:`executor.cad.cli.run_import`) ``--repeat`` times. Prints the collision queries,
+the edges found, and the median wall and CPU time of the import, each as a fraction of
+``--target``; exit code 1 when the median wall time (what a user waits) exceeds it. The
+CPU time is the process's and its sweep workers' (:data:`executor.cad.sweep.WORKERS`,
+``--workers``), all their threads: what one core would need; on a shared machine the wall
+time also counts the waits for a core.
 """
 
 from __future__ import annotations
 
+import gc
 import math
+import resource
 import statistics
 import tempfile
 import time
@@ -23,6 +26,7 @@ from pathlib import Path
 import trimesh
 
 from bridge.cli_types import ArgumentParser, int_in, number_in
+from executor.cad import sweep
 from executor.cad.cli import Imported, run_import
 
 PITCH = 30.0  # grid pitch of the holes [mm]
@@ -126,14 +130,23 @@ def write_shafts(folder: Path, parts: int, sections: int) -> None:
         mesh.export(folder / f"{pid}.stl")
 
 
+def _children_cpu() -> float:
+    """The CPU time [s] of this process's ended and reaped child processes (the sweep workers)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def _timed(source: Path, out: Path, config: Path | None, repeat: int) -> tuple[float, float, Imported]:
-    """Median wall and CPU time [s] of ``repeat`` imports of ``source``, and the last import."""
+    """Median wall and CPU time [s] of ``repeat`` imports of ``source``, and the last
+    import; the CPU time this process's and its sweep workers' (ended with the import's
+    sweeper: collected before the clocks are read)."""
     walls, cpus = [], []
     for k in range(repeat):
-        wall, cpu = time.perf_counter(), time.process_time()
+        wall, cpu = time.perf_counter(), time.process_time() + _children_cpu()
         done = run_import(source, out / str(k), "mm", config)
+        gc.collect()
         walls.append(time.perf_counter() - wall)
-        cpus.append(time.process_time() - cpu)
+        cpus.append(time.process_time() + _children_cpu() - cpu)
     return statistics.median(walls), statistics.median(cpus), done
 
 
@@ -150,8 +163,12 @@ def main(argv: list[str]) -> int:
                         help="triangles of the 9-part shafts product; the 20-part one is as fine (default 250000)")
     parser.add_argument("--repeat", type=int_in(1, 100), default=3, help="imports to take the median of (default 3)")
     parser.add_argument("--target", type=number_in(float, 0.0, 3600.0), default=None,
-                        help="the median CPU time's bound [s] (default: 10 for 9 parts, 30 for 20, 10 for the plate)")
+                        help="the median wall time's bound [s] (default: 10 for 9 parts, 30 for 20, 10 for the plate)")
+    parser.add_argument("--workers", type=int_in(1, 64), default=None,
+                        help="processes the sweeps run in (default: two where the cores allow and the parts have "
+                             f"{sweep.PARALLEL_TRIANGLES} triangles or more, else one)")
     args = parser.parse_args(argv)
+    sweep.WORKERS = args.workers
     sizes = [(args.parts, 10.0)] if args.product == "plate" else [(9, 10.0), (20, 30.0)]
     met = True
     with tempfile.TemporaryDirectory(prefix="bench-import-") as tmp:
@@ -167,12 +184,14 @@ def main(argv: list[str]) -> int:
             wall, cpu, done = _timed(source, Path(tmp) / f"out{parts}", config, args.repeat)
             derived, bound = done.derived, target if args.target is None else args.target
             triangles = sum(len(part.mesh.faces) for part in derived.parts.values())
+            workers = args.workers or sweep.default_workers(part.mesh for part in derived.parts.values())
             print(f"{args.product}: {len(derived.parts)} parts, {triangles} triangles, {len(derived.slides)} "
-                  f"zero-clearance fits, {derived.queries} collision queries, {len(derived.edges)} geometric "
-                  f"edges, stages {len(derived.stages)}")
-            verdict = "met" if cpu <= bound else "not met"
-            print(f"  import + geometric precedence: median {wall:.2f} s wall, {cpu:.2f} s CPU over {args.repeat} "
-                  f"run(s) (target {bound:g} s CPU: {cpu / bound:.2f} of it, {verdict})"
+                  f"zero-clearance fits, {len(derived.edges)} geometric edges, stages {len(derived.stages)}, "
+                  f"sweeps in {workers} process(es)")
+            verdict = "met" if wall <= bound else "not met"
+            print(f"  import + geometric precedence: median over {args.repeat} run(s) {wall:.2f} s wall "
+                  f"({wall / bound:.2f} of the {bound:g} s target: {verdict}), {cpu:.2f} s CPU ({cpu / bound:.2f} "
+                  f"of it), {derived.queries} collision queries"
                   + ("" if done.why is None else f"; no geometry.toml: {done.why}"))
-            met = met and cpu <= bound
+            met = met and wall <= bound
     return 0 if met else 1

@@ -222,7 +222,9 @@ def report(derived: Derived) -> list[str]:
     for pid, by_direction in sorted(derived.located.items()):
         lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(
             f"{name} {' '.join(sorted(found)) or 'free'}" for name, found in by_direction.items())
-            + f" (its ways in: along {', '.join(opposite(way) for way in derived.ways(pid))})")
+            + f" (its ways in: along {', '.join(opposite(way) for way in derived.ways(pid))}"
+            + (f"; not counted, they go in after it: {' '.join(sorted(after))})" if (after := {
+                p for found in by_direction.values() for p in found} & derived.later.get(pid, set())) else ")"))
     for locator, pid in sorted(derived.dropped):
         lines.append(f"locating pair {locator}->{pid} dropped: the blocking needs {pid} before {locator}")
     lines += derived.notes()

@@ -54,36 +54,70 @@ def beside(way: tuple[float, float, float]) -> list[str]:
     return [name for name, vector in DIRECTIONS.items() if float(np.dot(vector, way)) < 1 - 1e-9]
 
 
-def locators(sweeper: Sweeper, group: set[str], reach: float) -> dict[str, set[str]]:
-    """Direction -> the other parts that stop the body ``group`` (its members moved
+def locators(sweeper: Sweeper, bodies: dict[str, set[str]], reach: float) -> dict[str, dict[str, set[str]]]:
+    """Body -> direction -> the other parts that stop the body (its members moved
     together) within ``reach`` [m] along each direction of :data:`DIRECTIONS`."""
-    return {name: sweeper.blockers(group, np.array(vector), reach) for name, vector in DIRECTIONS.items()}
+    requests = [(root, name) for root in bodies for name in DIRECTIONS]
+    hits = sweeper.blocked([(bodies[root], np.array(DIRECTIONS[name]), reach) for root, name in requests])
+    located: dict[str, dict[str, set[str]]] = {root: {} for root in bodies}
+    for (root, name), hit in zip(requests, hits):
+        located[root][name] = hit
+    return located
 
 
 def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> set[tuple[str, str]]:
     """The supporting pairs (Y, X): X a member of a body resting on Y (module docstring)."""
     pairs: set[tuple[str, str]] = set()
-    for members in bodies.values():
-        under = sweeper.blockers(members, np.array(DIRECTIONS["-z"]), SUPPORT_GAP)
+    down = np.array(DIRECTIONS["-z"])
+    for members, under in zip(bodies.values(), sweeper.blocked([(m, down, SUPPORT_GAP) for m in bodies.values()])):
         if base not in under:
             pairs |= {(y, x) for y in under for x in members}
     return {(y, x) for y, x in pairs if (x, y) not in pairs}
 
 
 def locating_candidates(located: dict[str, dict[str, set[str]]], ways: dict[str, dict[str, tuple[float, float, float]]],
-                        base: str) -> set[tuple[str, str]]:
+                        base: str, later: dict[str, set[str]] | None = None) -> set[tuple[str, str]]:
     """The locating pairs (Y, X) of ``located`` (body -> direction -> its locators) and
     ``ways`` (body -> its ways in, named removal directions -> unit vectors): along every
-    way, Y (not the base) is the one locator of X along some direction :func:`beside` it."""
+    way, Y (not the base) is the one locator of X along some direction :func:`beside` it,
+    the parts ``later`` puts after X (body -> parts that must follow it) not counted: they
+    are not there when X goes in."""
     pairs: set[tuple[str, str]] = set()
     for part, by_direction in located.items():
+        after = (later or {}).get(part, set())
         alone: set[str] | None = None
         for axis in ways[part].values():
-            here = {next(iter(by_direction[name])) for name in beside(axis)
-                    if len(by_direction[name]) == 1 and base not in by_direction[name]}
+            here = {next(iter(by_direction[name] - after)) for name in beside(axis)
+                    if len(by_direction[name] - after) == 1 and base not in by_direction[name]}
             alone = here if alone is None else alone & here
         pairs |= {(locator, part) for locator in alone or ()}
     return pairs
+
+
+def placing_pairs(supports: set[tuple[str, str]], located: dict[str, dict[str, set[str]]],
+                  ways: dict[str, dict[str, tuple[float, float, float]]], bodies: dict[str, set[str]], base: str,
+                  edges: set[tuple[str, str]]) -> tuple[dict[tuple[str, str], str], dict[str, set[str]]]:
+    """The supporting and locating pairs with their reasons (``supports``, ``locates``) and
+    each body's parts that must follow it by the blocking ``edges`` and the pairs of these
+    that :func:`consistent` keeps. A part that must follow X does not locate
+    X (it is not there when X goes in): the locating pairs are found again without the
+    parts that the pairs kept so far put after each body, until that adds none (a shaft
+    located across by a bearing and by the glands on it, which the shaft alone locates,
+    goes after the bearing). Each round only removes locators, so this ends."""
+    later: dict[str, set[str]] = {root: set() for root in bodies}
+    placing = dict.fromkeys(supports, "supports")
+    while True:
+        # every round's pairs are kept: a later round only adds pairs, or loses ones the
+        # pairs kept contradict (a locator after its part), which stay to be reported dropped
+        placing |= {pair: "locates" for pair in locating_candidates(located, ways, base, later)
+                    if pair not in placing}
+        kept, _ = consistent(sorted(placing), edges)
+        graph = nx.DiGraph(edges | kept)
+        after = {root: later[root] | (set().union(*(nx.descendants(graph, m) for m in members if m in graph))
+                                      - members) for root, members in bodies.items()}
+        if after == later:
+            return placing, later
+        later = after
 
 
 def consistent(candidates: list[tuple[str, str]], edges: set[tuple[str, str]]

@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import networkx as nx
 import numpy as np
@@ -71,12 +72,12 @@ class Loop:
 
     points: np.ndarray
 
-    @property
+    @cached_property
     def area(self) -> float:
         x, y = self.points[:, 0], self.points[:, 1]
         return abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2
 
-    @property
+    @cached_property
     def centre(self) -> np.ndarray:
         """The area centroid [m] (a mean of the points would lean towards denser edges)."""
         x, y = self.points[:, 0], self.points[:, 1]
@@ -317,6 +318,14 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
     return shape
 
 
+OUTLINE_TOUCH = 5e-7
+"""A polygon section's outline is its loop's own vertices, written to 0.1 µm
+(:func:`rounded`): a peg and hole of which either is one and that pass only with an
+overlap of at most this [m] all round (0.5 µm, five times that resolution) are taken for
+one nominal section. More is a peg of another size or shape that does not pass (the
+ViTac heptagon misses the rect hole by 1.36 µm all round at its best turn)."""
+
+
 def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
     """How far apart [m] ``peg`` and ``hole`` are when they are a nominal zero-clearance
     fit, given the ``room`` [m] of the peg's section in the hole's
@@ -324,10 +333,10 @@ def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
     hole's inscribed circle (else it passes with room), their vertex circles' radii within
     :data:`executor.cad.sweep.TOUCH` (their difference); or a polygon on either side (a
     polygon's outline is its loop's vertices and straight sides: no deflection) that
-    passes only with an overlap of at most that all round (half the room, at most 0); None
-    when they are no such pair."""
+    passes only with an overlap of at most :data:`OUTLINE_TOUCH` all round (half the
+    room, at most 0); None when they are no such pair."""
     if "polygon" in (peg.kind, hole.kind):
-        return room / 2 if -2 * TOUCH <= room <= 0 else None
+        return room / 2 if -2 * OUTLINE_TOUCH <= room <= 0 else None
     if peg.kind != "round" or hole.kind != "round" or peg.a < hole.a:
         return None
     apart = hole.a / 2 + hole.deflection - peg.a / 2

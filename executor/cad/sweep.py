@@ -41,12 +41,19 @@ twice :data:`TOUCH`.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
 part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
-moved back against A along the same path) is answered from the first.
+moved back against A along the same path) is answered from the first. The tests asked
+together (:meth:`Sweeper.blocked`) run in :attr:`Sweeper.workers` processes forked from
+this one, each the same test on a copy of the same parts: the answers and their count
+are those of one process.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import multiprocessing
+import multiprocessing.pool
+import os
+import weakref
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 
 import fcl
@@ -610,12 +617,33 @@ class _Solid:
         return self._tree
 
 
+PARALLEL_TRIANGLES = 100_000
+"""Parts of fewer triangles together are swept in one process (:func:`default_workers`)."""
+WORKERS: int | None = None
+"""The processes every :class:`Sweeper` runs its queries in (None: :func:`default_workers`;
+``bench import --workers`` sets it)."""
+
+
+def default_workers(meshes: Iterable[trimesh.Trimesh]) -> int:
+    """The processes to sweep ``meshes`` in: the cores this process may use, at most two,
+    where the meshes have :data:`PARALLEL_TRIANGLES` triangles or more (below, forking costs
+    about what it saves); else one."""
+    if sum(len(mesh.faces) for mesh in meshes) < PARALLEL_TRIANGLES:
+        return 1
+    return min(2, len(os.sched_getaffinity(0)))
+
+
 class Sweeper:
     """The parts' collision meshes, and swept tests of one body against the others;
     ``slides`` the zero-clearance fits among them."""
 
-    def __init__(self, meshes: dict[str, trimesh.Trimesh], slides: Iterable[Slide] = ()) -> None:
+    def __init__(self, meshes: dict[str, trimesh.Trimesh], slides: Iterable[Slide] = (),
+                 workers: int | None = None) -> None:
+        """``workers``: the processes the queries run in (None: :data:`WORKERS`, else
+        :func:`default_workers` of the meshes)."""
         self.meshes = meshes
+        self.workers = workers or WORKERS or default_workers(meshes.values())
+        self._pool: multiprocessing.pool.Pool | None = None
         self._solids = {pid: _Solid(mesh) for pid, mesh in meshes.items()}
         self._slides: dict[tuple[str, str], list[Slide]] = {}
         for slide in slides:
@@ -631,33 +659,73 @@ class Sweeper:
         """The other parts that the part (or the parts, moved together) ``body`` collides
         with when moved by ``length`` [m] along the unit vector ``direction``, everything
         else fixed."""
-        members = {body} if isinstance(body, str) else set(body)
-        shift = np.asarray(direction, dtype=float) * length
-        hit: set[str] = set()
-        for member in sorted(members):
-            bounds = self._solids[member].bounds
-            low = np.minimum(bounds[0], bounds[0] + shift)
-            high = np.maximum(bounds[1], bounds[1] + shift)
-            for other, solid in self._solids.items():
-                if other in members or other in hit:
-                    continue
-                if np.any(np.minimum(high, solid.bounds[1]) - np.maximum(low, solid.bounds[0]) <= TOUCH):
-                    continue
-                if self._sweep(member, other, shift):
-                    hit.add(other)
-        return hit
+        return self.blocked([(body, direction, length)])[0]
 
-    def _sweep(self, member: str, other: str, shift: np.ndarray) -> bool:
-        """Whether part ``member`` swept by ``shift`` [m] collides with part ``other`` (one
-        narrow-phase query unless asked before)."""
+    def blocked(self, requests: Sequence[tuple[str | Iterable[str], np.ndarray, float]]) -> list[set[str]]:
+        """:meth:`blockers` of each request (body, direction, length), their queries made
+        together: a body's members one after the other (a part one member hits is not
+        tested again for the next), the queries of every request's member of one rank at
+        once, in :attr:`workers` processes."""
+        bodies = [sorted({body} if isinstance(body, str) else set(body)) for body, _, _ in requests]
+        shifts = [np.asarray(direction, dtype=float) * length for _, direction, length in requests]
+        hits: list[set[str]] = [set() for _ in requests]
+        for rank in range(max(map(len, bodies), default=0)):
+            tests: list[tuple[int, str, str]] = []  # (request, member, other)
+            for k, members in enumerate(bodies):
+                if rank >= len(members):
+                    continue
+                member, shift = members[rank], shifts[k]
+                bounds = self._solids[member].bounds
+                low = np.minimum(bounds[0], bounds[0] + shift)
+                high = np.maximum(bounds[1], bounds[1] + shift)
+                for other, solid in self._solids.items():
+                    if other in members or other in hits[k]:
+                        continue
+                    if np.any(np.minimum(high, solid.bounds[1]) - np.maximum(low, solid.bounds[0]) <= TOUCH):
+                        continue
+                    tests.append((k, member, other))
+            answers = self._sweeps([(member, other, shifts[k]) for k, member, other in tests])
+            for (k, _, other), collides in zip(tests, answers):
+                if collides:
+                    hits[k].add(other)
+        return hits
+
+    def _sweeps(self, tests: list[tuple[str, str, np.ndarray]]) -> list[bool]:
+        """Whether part ``member`` swept by ``shift`` [m] collides with part ``other``, for
+        each test (member, other, shift): one narrow-phase query each unless asked before,
+        the new ones in :attr:`workers` processes when there are several."""
+        keys = []
+        pending: dict[tuple[int, int, tuple[float, ...]], tuple[str, str, np.ndarray]] = {}
+        size: dict[tuple[int, int, tuple[float, ...]], int] = {}
+        for member, other, shift in tests:
+            moving, fixed, relative = self._oriented(member, other, shift)
+            key = (id(moving), id(fixed), tuple(relative))
+            keys.append(key)
+            if key not in self._answers and key not in pending:
+                pending[key] = (member, other, shift)
+                size[key] = len(moving.triangles) + len(fixed.triangles)
+        self.queries += len(pending)
+        if self.workers > 1 and len(pending) > 1:
+            pending = {key: pending[key] for key in sorted(pending, key=lambda k: -size[k])}  # the larger first
+            if self._pool is None:
+                global _FORKED
+                _FORKED = self  # the workers' copy, forked now
+                self._pool = multiprocessing.get_context("fork").Pool(self.workers)
+                _FORKED = None
+                weakref.finalize(self, self._pool.terminate)  # the workers end (and are reaped) with the sweeper
+            self._answers.update(zip(pending, self._pool.map(_swept, pending.values(), chunksize=1)))
+        else:
+            self._answers.update((key, _collides(*self._oriented(*test))) for key, test in pending.items())
+        return [self._answers[key] for key in keys]
+
+    def _oriented(self, member: str, other: str, shift: np.ndarray) -> tuple[_Solid, _Solid, np.ndarray]:
+        """The moving solid, the fixed one and the shift [m] of the test whether part
+        ``member`` swept by ``shift`` collides with part ``other``: the same relative
+        motion with the cheaper part moving."""
         moving, fixed = self._solid(member, other, shift), self._solid(other, member, shift)
         if not moving.convex and (fixed.convex or len(fixed.mesh.faces) < len(moving.mesh.faces)):
-            moving, fixed, shift = fixed, moving, -shift  # the same relative motion, cheaper
-        key = (id(moving), id(fixed), tuple(shift))
-        if key not in self._answers:
-            self.queries += 1
-            self._answers[key] = _collides(moving, fixed, shift)
-        return self._answers[key]
+            return fixed, moving, -shift
+        return moving, fixed, shift
 
     def touching(self, a: str, b: str) -> bool:
         """Whether parts ``a`` and ``b`` are within :data:`TOUCH` of each other: their
@@ -692,6 +760,18 @@ class Sweeper:
         if key not in self._slid:
             self._slid[key] = _Solid(slid(self.meshes[part], shafts, bores), self._solids[part].convex)
         return self._slid[key]
+
+
+_FORKED: Sweeper | None = None
+"""The sweeper whose pool is being forked: a worker's copy of it answers :func:`_swept`."""
+
+
+def _swept(test: tuple[str, str, np.ndarray]) -> bool:
+    """In a worker forked by :meth:`Sweeper._sweeps`: whether part ``member`` swept by
+    ``shift`` [m] collides with part ``other``, for ``test`` (member, other, shift), on the
+    worker's copy of the sweeper (its solids, made or completed there)."""
+    assert _FORKED is not None, "a sweep worker forked without its sweeper"
+    return _collides(*_FORKED._oriented(*test))
 
 
 def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:

@@ -266,7 +266,7 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
 
 
 RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
-        "or a peg and hole of a polygon section that pass with an overlap of at most 10 {um} all round, "
+        "or a peg and hole of a polygon section that pass with an overlap of at most 0.5 {um} all round, "
         "is taken for one nominal section: a fit, room 0")
 """The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
 
@@ -393,7 +393,8 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above or sideways
     holding, if anything, a peg going in along the hole's axis that is no polygon section,
     or the prism of its polygon (the cell builds that from its outline, exactly), longer than the gripper's
-    grasp depth (the cell holds it by that much); the pins of the base that
+    grasp depth (the cell holds it by that much), with room in it the cell resolves or a
+    nominal zero-clearance fit the cell widens (:func:`_unresolved_in_hole`); the pins of the base that
     parts go down onto, and of the parts with a bore those it puts onto them
     (:func:`_onto_pin`); the pegs of the other holes and the other parts going onto pins,
     each with why the cell places it by hand (a polygon peg's room is often below what
@@ -417,8 +418,46 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
             kept[hid] = fit
     pins = {pin_id: pin for pin_id, pin in derived.pins.items()
             if pin.owner == derived.base and pin.axis == "+z" and pin.parts}  # an empty pin: no goal on it
+    # A hole whose part goes by hand leaves the cell, which may make the base its own mesh,
+    # where the cell widens no zero-clearance fit: until no more parts go.
+    while unresolved := _unresolved_in_hole(derived, replace(derived, holes=kept, pins=pins)):
+        by_hand |= unresolved
+        kept = {hid: fit for hid, fit in kept.items() if fit.part not in unresolved}
     return replace(derived, holes=kept, pins=pins,
                    bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
+
+
+def builds_plate(cell: Derived) -> bool:
+    """Whether the simulated cell builds the base of the product as it inserts it
+    (:func:`cell_view`) as ``[plate]`` primitives, its holes from their sections: it has
+    holes, all entered from above, no pins, and is its bounding box less them
+    (:func:`executor.cad.convex.base_is_primitive`); else the base is its own mesh."""
+    return (bool(cell.holes) and not cell.pins and all(fit.axis == "+z" for fit in cell.holes.values())
+            and base_is_primitive(cell))
+
+
+def _unresolved(room: float) -> str:
+    """Why the cell cannot tell a (diametral) ``room`` [m] from its sign: ``with ... mm of room
+    per side, less than`` :data:`executor.world.SIZE_RESOLUTION`; "" where it can."""
+    if abs(room) / 2 >= SIZE_RESOLUTION:
+        return ""
+    return f"with {room * 500:+.4f} mm of room per side, less than the {SIZE_RESOLUTION * 1e3:g} mm the simulated " \
+           "cell resolves"
+
+
+def _unresolved_in_hole(derived: Derived, cell: Derived) -> dict[str, str]:
+    """Each part in a hole of ``cell`` (``derived`` as the cell inserts it, so far) whose room
+    in it (:func:`margins`) is under the cell's resolution (a nominal zero-clearance fit too)
+    and that the cell does not widen (it widens a nominal zero-clearance fit by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` in a base it builds of primitives,
+    :func:`builds_plate`: ``occt_as1``'s bolts), with why the cell places it by hand: it
+    would jam there (``occt_pump``'s bearing ring in its housing's bore, room 0)."""
+    rooms, nominal, plate = margins(derived), nominal_fits(derived), builds_plate(cell)
+    return {fit.part: f"goes into hole {hid} {why}" + ("; a zero-clearance fit the cell widens only in a base it "
+                                                       "builds of primitives" if (fit.part, hid) in nominal else "")
+            for hid, fit in cell.holes.items()
+            if fit.part is not None and (why := _unresolved(rooms[fit.part][hid]))
+            and not (plate and (fit.part, hid) in nominal)}
 
 
 def _highest_near(mesh: trimesh.Trimesh, xy: tuple[float, float], radius: float) -> float | None:
@@ -483,10 +522,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     lowest = min(pin.parts, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p))
     if pid != lowest:
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
-    room = margins(derived)[pid][pin.id]
-    if abs(room) / 2 < SIZE_RESOLUTION:
-        return (f"goes onto a pin ({pin.id}) with {room * 500:+.4f} mm of room per side, less than the "
-                f"{SIZE_RESOLUTION * 1e3:g} mm the simulated cell resolves")
+    if why := _unresolved(margins(derived)[pid][pin.id]):
+        return f"goes onto a pin ({pin.id}) {why}"
     mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
@@ -698,8 +735,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
     ``mesh`` entries by part, or why a part has no pieces that fit
     (:func:`executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
-    sideways = any(fit.axis != "+z" for fit in derived.holes.values())
-    if not derived.holes or derived.pins or sideways or not base_is_primitive(derived):  # the plate: no pins, all down
+    if not builds_plate(derived):
         done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")
         assert not isinstance(done, str)  # the base has no pieces
         meshes[derived.base], files = done

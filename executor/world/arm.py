@@ -124,6 +124,10 @@ class Arm:
         self.joints = list(range(N_JOINTS))
         self._read_joints = [*self.joints, self.sensor]  # one getJointStates per read
         pb.enableJointForceTorqueSensor(robot, self.sensor, True, physicsClientId=client)
+        # PyBullet's IK turns the link's inertial frame (its principal axes, which PyBullet
+        # chooses for an inertia tensor with products of inertia: a polygon peg's, a mesh
+        # part's) to the target orientation, not the link frame: the target is turned by it.
+        self._inertial_quat = tuple(pb.getDynamicsInfo(robot, self.sensor, physicsClientId=client)[4])
         self._zeros = [0.0] * N_JOINTS
         self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         self.tare = np.zeros(6)
@@ -149,6 +153,7 @@ class Arm:
         used only to place the arm before an attempt, never per control step)."""
         real_pos, real_quat = pb.multiplyTransforms(list(tip_pos), list(tip_quat_xyzw),
                                                     list(self.grasp_offset), list(self.grasp_quat_xyzw))
+        real_quat = pb.multiplyTransforms(_ORIGIN, real_quat, _ORIGIN, self._inertial_quat)[1]
         q = REST_POSTURE.copy()
         for _ in range(4):
             self.reset(q)

@@ -109,6 +109,17 @@ class Section:
         """(a, b) [m]: the extents along x and y (a round section: its diameter twice)."""
         return self.size, self.width if self.width > 0 else self.size
 
+    @property
+    def circumradius(self) -> float:
+        """How far [m] the section reaches from its centre: a round one's radius, a
+        polygon's farthest outline point, a square's or rect's half diagonal (its corners
+        taken sharp)."""
+        if self.kind == "round":
+            return self.size / 2
+        if self.outline:
+            return float(np.max(np.linalg.norm(np.asarray(self.outline), axis=1)))
+        return math.hypot(*self.sides) / 2
+
 
 @dataclass(frozen=True)
 class HoleSpec(Section):

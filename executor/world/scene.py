@@ -230,7 +230,15 @@ def link_frame(client: int, body: int, link: int) -> tuple[tuple[float, ...], tu
         state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
         return tuple(state[4]), tuple(state[5])
     pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-    local_pos, local_quat = pb.getDynamicsInfo(body, -1, physicsClientId=client)[3:5]
-    inv_pos, inv_quat = pb.invertTransform(local_pos, local_quat)
+    inv_pos, inv_quat = pb.invertTransform(*inertial_frame(client, body))
     frame_pos, frame_quat = pb.multiplyTransforms(pos, quat, inv_pos, inv_quat)
     return tuple(frame_pos), tuple(frame_quat)
+
+
+def inertial_frame(client: int, body: int, link: int = -1) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """A link's inertial frame in its URDF frame (position [m], quaternion x y z w): its
+    centre of mass, turned onto its principal axes where its inertia has products of
+    inertia (a polygon peg's, a mesh part's). PyBullet poses a base, and places
+    constraints on a link, in this frame."""
+    local_pos, local_quat = pb.getDynamicsInfo(body, link, physicsClientId=client)[3:5]
+    return tuple(local_pos), tuple(local_quat)

@@ -16,48 +16,28 @@ the mark must go; the truths are never weakened to pass.
 from __future__ import annotations
 
 import json
-import math
 import tomllib
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import clingo
 import pytest
 
+from assembly_constraints.corpus_truth import CorpusImport as Imported
+from assembly_constraints.corpus_truth import feature_holes as _feature_holes
+from assembly_constraints.corpus_truth import import_product
 from bridge.cell_settings import ServeSettings
 from bridge.messages import InsertRequest
 from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad.cli import run_import
-from executor.cad.sweep import opposite
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.world.geometry import load_geometry
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
-FEATURE_REACH_MM = 2.0
-"""An imported hole is a truth feature when its position lies this close to the feature's axis [mm]."""
-
-
-@dataclass(frozen=True)
-class Imported:
-    """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
-    moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
-    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the
-    cell, each imported hole's or pin's ``occupants`` (the parts in it or onto it) and
-    ``owners`` (the part it is a feature of)."""
-
-    truth: dict[str, Any]
-    out: Path
-    axes: dict[str, str]
-    offset: tuple[float, float]
-    occupants: dict[str, set[str]]
-    owners: dict[str, str]
-    pins: frozenset[str] = frozenset()
 
 
 def _atoms(path: Path) -> dict[str, set[tuple[str, ...]]]:
@@ -80,51 +60,10 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Import
 
     def get(name: str) -> Imported:
         if name not in done:
-            folder = CORPUS / name
-            out = tmp_path_factory.mktemp(name) / "out"
-            result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
-            truth = tomllib.loads((folder / "truth.toml").read_text())
-            derived = result.derived
-            holes = derived.holes | derived.part_holes
-            occupants = {hid: {fit.part} for hid, fit in holes.items() if fit.part is not None}
-            occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
-            owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
-            owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
-            done[name] = Imported(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
-                                  result.offset, occupants, owners, frozenset(derived.pins))
+            done[name] = import_product(CORPUS / name, tmp_path_factory.mktemp(name) / "out")
         return done[name]
 
     return get
-
-
-def _distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float]) -> float:
-    """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, moved by
-    ``offset`` [m] from the CAD frame) lies from a truth feature's axis line [mm]; with x, y
-    only, from the line's projection on the xy plane."""
-    point = [1000.0 * (v - (offset[k] if k < 2 else 0.0)) for k, v in enumerate(position)]
-    origin = feature["axis_point"][:len(point)]
-    direction = {"x": 0, "y": 1, "z": 2}[feature["axis"][1]]
-    across = [point[k] - origin[k] for k in range(len(point)) if k != direction]
-    return math.hypot(*across)
-
-
-def _feature_holes(done: Imported) -> dict[str, str]:
-    """Each truth feature's imported hole id (absent: none found): the one of the
-    feature's owner on its axis that is a pin where the feature is one (of a hollow
-    shaft's bore and the shaft, the shaft); of several (the two ends of one rod), the one
-    that is empty or holds a part the truth puts in that feature."""
-    holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
-    found = {}
-    for fid, feature in done.truth["features"].items():
-        inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
-        near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
-                and _distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
-                and (hid in done.pins) == (feature["kind"] == "pin")]
-        if len(near) > 1:
-            near = [hid for hid in near if not done.occupants.get(hid) or done.occupants[hid] & inside]
-        if len(near) == 1:
-            found[fid] = near[0]
-    return found
 
 
 def _xfail(reason: str) -> pytest.MarkDecorator:
@@ -139,17 +78,6 @@ REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
 """Every product the import takes."""
-
-PUMP_FEATURES = ("features: the housing's bore is taken for the shaft's hole (d 26.951, 4.975 mm all round) and no "
-                 "hole is found in the bearing ring the shaft runs in (d 21), the ring in its d 27 bore in no feature; "
-                 "of the three parts on the shaft's d 17 end only gland_3 is on a pin, with a bore of d 33.901 (its "
-                 "recess, not its d 17 lips)")
-PUMP_SUPPORT = ("precedence: the shaft rests in the bearing ring's bore and on nothing else (2 mm all round, the "
-                "source's balls left out), but it touches nothing in the CAD and the locating rule counts the glands "
-                "and the impeller on it among what keeps it from moving sideways: bearing_ring->shaft is not written")
-PULLEY_PIN = ("features: the pin the pulley goes onto (the hub's boss) is not found: pins are looked for at the middle "
-              "of the part's extent along its axis only, where the pulley's slice (y -27.124 mm, through its rim, "
-              "behind the hub's disc) crosses nothing of the hub")
 
 BEAM_RECT_NOMINAL = ("fits: sizes.lp has none: each upright's tenon is in its mortise as rect 9.606 x 5.796 mm in "
                      "rect 9.605 x 5.795 mm (the tapers sliced at mid-depth, where they meet), 0.3 um of overlap a "
@@ -177,8 +105,8 @@ def _imported_but(name: str, mark: pytest.MarkDecorator) -> list[Any]:
     "occt_as1",
     "robosuite_nuts",
     "vitac_shapes",
-    pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
-    pytest.param("occt_pulley", marks=_xfail(PULLEY_PIN)),
+    "occt_pump",
+    "occt_pulley",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -230,7 +158,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "occt_as1",
     "robosuite_nuts",
     "vitac_shapes",
-    pytest.param("occt_pump", marks=_xfail(PUMP_FEATURES)),
+    "occt_pump",
     "occt_pulley",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
@@ -252,7 +180,7 @@ def test_insertion_axes_are_ones_the_geometry_allows(imported: Callable[[str], I
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", _imported_but("occt_pump", _xfail(PUMP_SUPPORT)))
+@pytest.mark.parametrize("name", IMPORTED)
 def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     base = done.truth["base"]
@@ -270,7 +198,7 @@ def test_no_precedence_the_geometry_does_not_force(imported: Callable[[str], Imp
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", _imported_but("occt_pump", _xfail(PUMP_SUPPORT)))
+@pytest.mark.parametrize("name", IMPORTED)
 def test_the_owner_of_a_feature_precedes_the_part_in_it(imported: Callable[[str], Imported], name: str) -> None:
     # The cell inserts a part into its feature: the feature's owner is placed first, for a
     # reason of its own where nothing else orders them (agh_prism_array's pegs stand on the
@@ -321,11 +249,13 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
                                           "rod through two brackets")),
     "robosuite_nuts",
-    pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into no hole found (the ring, gland_2, the impeller: "
-                                           "in no feature) or onto a pin of a part that is not the base (gland_3)")),
-    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin that is not found (the pulley "
-                                             "onto the hub's boss), or into a hole and shorter than the gripper's "
-                                             "grasp depth (the bolts, 14 mm)")),
+    pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into a hole of a part that is not the base (the "
+                                           "shaft into the bearing ring), into a hole of the base's own mesh with less "
+                                           "room than the cell resolves (the ring, room 0), or onto a pin of a part "
+                                           "that is not the base (the glands and the impeller onto the shaft's end)")),
+    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin (the pulley onto the hub's boss: the "
+                                             "cell puts parts onto pins from above), or into a hole and shorter than "
+                                             "the gripper's grasp depth (the bolts, 14 mm)")),
     "vitac_shapes",
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
@@ -347,9 +277,10 @@ def _taught_and_learned_in_the_cell(done: Imported, run_executor: Runner, run_cl
 
 @pytest.mark.slow  # imports the product, teaches it, runs a sim session of 16 experiments and assembles (about 90 s)
 @pytest.mark.timeout(600)  # 257 s while the machine ran other work
+@pytest.mark.parametrize("name", ["agh_prism_array"])  # a unit of the workers' work with the product's other tests
 def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_placed_it(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
-    done = imported("agh_prism_array")  # drawn around x = 0, out of the arm's reach: placed
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+    done = imported(name)  # drawn around x = 0, out of the arm's reach: placed
     assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
     result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     # Every peg, the hexagon, octagon and 12-gon prisms too, goes into every hole in
@@ -366,9 +297,10 @@ def test_a_product_drawn_at_the_origin_is_learned_in_the_cell_where_the_import_p
 
 
 @pytest.mark.slow  # imports the product, teaches it and assembles it in physics (about 140 s under load)
+@pytest.mark.parametrize("name", ["agh_prism_array"])  # a unit of the workers' work with the product's other tests
 def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
-    done = imported("agh_prism_array")
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+    done = imported(name)
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
     assert taught.returncode == 0, taught.stderr
     holes = _feature_holes(done)
@@ -384,33 +316,38 @@ def test_prisms_with_2_mm_of_room_all_round_are_assembled_within_2_mm(
     assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
-@pytest.mark.slow  # imports the product, teaches its bolts and inserts two in physics (330 s under load)
-@pytest.mark.timeout(900)  # the import alone took 155 s while the machine ran other work
-def test_bolts_beside_a_bracket_s_wall_and_through_its_flange_are_inserted(
-        imported: Callable[[str], Imported], run_executor: Runner) -> None:
-    # occt_as1: bolt_a1's axis is 10 mm from bracket_a's wall, whose top stands 80 mm high.
-    # With the default 60 mm flange the arm's wrist came down on the wall top and the bolt
-    # stopped 4.1 mm above its goal (no_fit, blocked by bracket_a); the import makes the
-    # flange long enough that the wrist stays above the wall. bolt_b2 goes through
-    # bracket_b's 10 mm flange over the plate: with the search pressing at the plate's top,
-    # 10 mm under the flange's, the bolt was pushed onto the flange with 14-15 N, dragged
-    # behind the spiral, and missed the opening in both attempts (no_fit, blocked by bracket_b).
-    done = imported("occt_as1")
+@pytest.mark.slow  # imports, teaches, assembles 18 steps in physics: 194 s of CPU, 983 s at load 21 to 24
+@pytest.mark.timeout(1800)  # on 2 cores shared with other work: over 900 s at load averages of 20 to 28
+@pytest.mark.parametrize("name", ["occt_as1"])  # a unit of the workers' work with the product's other tests
+def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_assembled_within_2_mm(
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner) -> None:
+    # occt_as1: the cell inserts the six bolts, each down through its bracket's flange into
+    # the plate; the brackets, the rod and the eight nuts are placed by hand. bolt_a1's axis
+    # is 10 mm from bracket_a's wall, whose top stands 80 mm high: with the default 60 mm
+    # flange the arm's wrist came down on the wall top and the bolt stopped 4.1 mm above its
+    # goal (no_fit); the import makes the flange long enough that the wrist stays above the
+    # wall. bolt_b2 goes through bracket_b's 10 mm flange over the plate: with the search
+    # pressing at the plate's top, 10 mm under the flange's, it was pushed onto the flange,
+    # dragged behind the spiral and missed the opening in both attempts (no_fit).
+    done = imported(name)
     gripper = load_geometry(str(done.out)).tables.gripper
     assert gripper is not None and gripper.flange_length > 0.06
     taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
     assert taught.returncode == 0, taught.stderr
-    holes = _feature_holes(done)
-    assembler = Assembler(load_product(str(done.out)), description=CellDescription())
-    try:
-        steps = [assembler.run_step(part, holes[done.truth["parts"][part]["in"]] if "bolt" in part else None, 0)
-                 for part in ("plate", "bracket_a", "bolt_a1", "bracket_b", "bolt_b2")]
-    finally:
-        assembler.close()
-    assert [(s.part, s.skill, s.outcome) for s in steps] == [
-        ("plate", "fixture", "fit"), ("bracket_a", "manual", "fit"), ("bolt_a1", "insert", "fit"),
-        ("bracket_b", "manual", "fit"), ("bolt_b2", "insert", "fit")]
-    assert max(s.pose_error for s in steps) < 0.002, steps
+    # The facts a sim session learns here: its experiments observe the bolts in the plate's
+    # holes to fit (all 36 pairs), the other pairs it takes from sizes.lp, and its precedence
+    # is the import's geometric prior (no demonstration refines it).
+    facts = [str(done.out / "sizes.lp"), str(done.out / "geometric_precedence.lp")]
+    assembled = run_cli("assemble", *facts, "--assembly", str(done.out), "--seed", "1", "--json", timeout=1500)
+    assert assembled.returncode == 0, assembled.stderr
+    report = json.loads(assembled.stdout)
+    bolts = {pid for pid in done.truth["parts"] if pid.startswith("bolt")}
+    assert {s["part"]: (s["skill"], s["outcome"]) for s in report["steps"]} == {
+        done.truth["base"]: ("fixture", "fit"),
+        **{pid: ("insert" if pid in bolts else "manual", "fit") for pid in done.truth["parts"]}}
+    assert report["assembled"] and report["replans"] == []
+    assert set(report["manual"]) == set(report["manual_reasons"]) == set(done.truth["parts"]) - bolts
+    assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
 
 
 def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: Runner, run: Path) -> dict[str, Any]:
@@ -435,7 +372,7 @@ def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: R
     assert _atoms(run / "learned.lp")["not_observed"] == pairs
     assert result["nominal_fits"] is None  # no pair the cell builds with room
     assert session.returncode == 0, result.get("error")
-    # the sim cell takes plan 1, each part placed by hand on the feature the plan names
+    # the sim cell takes plan 1, each part placed by hand where the CAD has it
     done_run = run_cli("assemble", "--run", str(run), "--json", timeout=300)
     report = json.loads(done_run.stdout)
     assert done_run.returncode == 0 and report["assembled"], done_run.stderr
@@ -445,12 +382,13 @@ def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: R
 
 
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
+@pytest.mark.parametrize("name", ["ldraw_axles"])  # a unit of the workers' work with the product's other tests
 def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
     # has no operation for (each placed by hand): the sim session must not refuse the
     # product; it takes every pair from sizes.lp and says none was observed.
-    result = _learned_from_its_cad_alone(imported("ldraw_axles"), run_executor, run_cli, tmp_path / "run")
+    result = _learned_from_its_cad_alone(imported(name), run_executor, run_cli, tmp_path / "run")
     # the bush and the gear share the liftarm's pin (capacity 2 in assembly.toml): the bush first
     for plan in result["plans"]:
         order = [step["part"] for step in plan]
@@ -458,17 +396,23 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
             "bush": "liftarm_pin1", "gear": "liftarm_pin1"} and order.index("bush") < order.index("gear")
 
 
-@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s)
-def test_gears_with_less_room_on_their_shafts_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s each)
+@pytest.mark.parametrize(("name", "unresolved"), [  # each a unit of the workers' work with its product's other tests
+    pytest.param("factory_gears", {"gear_small", "gear_medium"}, id="factory_gears"),
+    pytest.param("occt_pump", {"bearing_ring"}, id="occt_pump")])
+def test_parts_with_less_room_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
+        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path, name: str,
+        unresolved: set[str]) -> None:
     # factory_gears: each gear has 0.012 mm of room per side on its shaft, under the 0.025 mm
-    # the cell resolves (it jammed 11.5 mm short when taught): no experiment, each placed by
-    # hand with that reason, every pair taken from sizes.lp as not observed.
-    done = imported("factory_gears")
+    # the cell resolves (it jammed 11.5 mm short when taught). occt_pump: the bearing ring is
+    # a nominal zero-clearance fit in the housing's bore, which the cell widens only in a base
+    # it builds of primitives, not in the housing's own mesh (CoACD's pieces of the ring,
+    # sought to keep that room, took 146 s of CPU a try and never fitted). No experiment, each
+    # placed by hand with that reason, every pair taken from sizes.lp as not observed.
+    done = imported(name)
     manual = load_geometry(str(done.out)).tables.manual
-    assert set(manual) == {"gear_small", "gear_medium"}
-    assert all("mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason
-               for table in manual.values()), {pid: table.reason for pid, table in manual.items()}
+    assert {pid for pid, table in manual.items()
+            if "mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason} == unresolved
     _learned_from_its_cad_alone(done, run_executor, run_cli, tmp_path / "run")
 
 
@@ -502,12 +446,13 @@ def test_the_truth_backend_answers_every_pair_as_sizes_lp(imported: Callable[[st
 
 @pytest.mark.slow  # imports, teaches the ring, a sim session of 1 experiment and its assembly (291 s loaded)
 @pytest.mark.timeout(600)
+@pytest.mark.parametrize("name", ["metaworld_assembly"])  # a unit of the workers' work with the product's other tests
 def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physics(
-        imported: Callable[[str], Imported], run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
     # Meta-World's ring is a torus with a handle: no stack of prisms, it collides as CoACD's
     # pieces, which keep its bore within its room on the peg; the cell grips it, carries it
     # over the peg and inserts it down onto it with the skill taught on that peg.
-    done = imported("metaworld_assembly")
+    done = imported(name)
     assert "CoACD" in (done.out / "meshes" / "round_nut.convex.obj").read_text().splitlines()[2]
     result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
     holes = _feature_holes(done)
@@ -517,3 +462,45 @@ def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physic
     steps = {step["part"]: step for step in report["steps"]}
     assert report["assembled"] and steps["round_nut"]["skill"] == "insert", report
     assert steps["round_nut"]["pose_error_mm"] < 2.0, report["final_pose_error_mm"]
+
+
+def _vitac_trial(done: Imported, run_executor: Runner, part: str, feature: str) -> tuple[str, str]:
+    """One trial of one attempt of ``part`` into the ViTac board's hole of truth ``feature``
+    in physics (the board taught first, once); (the cell's outcome, the truth's)."""
+    if not (done.out / "demonstrations" / f"{part}.json").is_file():
+        taught = run_executor("teach", "--assembly", str(done.out), timeout=300)
+        assert taught.returncode == 0, taught.stderr
+    trial = run_executor("trial", "--assembly", str(done.out), "--part", part, "--hole",
+                         _feature_holes(done)[feature], "--attempts", "1", "--json", timeout=300)
+    assert trial.returncode == 0, trial.stderr
+    truth = next(row["fits"] for row in done.truth["fits"] if (row["part"], row["feature"]) == (part, feature))
+    return json.loads(trial.stdout)["trials"][0]["outcome"], "fit" if truth else "no_fit"
+
+
+@pytest.mark.slow  # imports the board, teaches its seven shapes, four trials in physics (501 s, 2 cores, 8 jobs)
+@pytest.mark.timeout(900)
+@pytest.mark.parametrize("name", ["vitac_shapes"])  # a unit of the workers' work with the product's other tests
+def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decided_in_physics(
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+    # concave2's products of inertia turn its link's principal axes 22° about its axis; the
+    # arm was placed with those axes, not the part, at the yaw asked, so teaching started it
+    # overlapping its notched hole and it ended 19 mm short. The hexagon and the octagon pass
+    # that hole only turned and shifted (1.343 mm of room); the octagon misses the trapezoid
+    # hole by 0.183 mm.
+    done = imported(name)
+    pairs = [("concave2", "h_concave2"), ("hexagon", "h_concave2"), ("octagon", "h_concave2"),
+             ("octagon", "h_trapezoid")]
+    outcomes = {pair: _vitac_trial(done, run_executor, *pair) for pair in pairs}
+    assert all(cell == truth for cell, truth in outcomes.values()), outcomes
+
+
+@pytest.mark.slow  # imports the board, teaches it (unless the test above did), one trial (69 s after it, loaded)
+@pytest.mark.timeout(900)
+@pytest.mark.xfail(strict=True, reason="the cell's polygon peg is its prism with its vertical edges rounded by the "
+                                       "1 mm hull margin PyBullet adds: the heptagon, 0.0014 mm too big for the rect "
+                                       "hole, passes it so")
+@pytest.mark.parametrize("name", ["vitac_shapes"])  # a unit of the workers' work with the product's other tests
+def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_refused_in_physics(
+        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+    cell, truth = _vitac_trial(imported(name), run_executor, "convex", "h_cuboid")
+    assert cell == truth == "no_fit"

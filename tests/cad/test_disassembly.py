@@ -235,3 +235,22 @@ def test_the_leading_triangles_change_no_answer(monkeypatch: pytest.MonkeyPatch)
     assert found[0] == found[1]
     # Lifted, the bearing meets the housing and the shaft; moved sideways, the shaft meets both.
     assert found[1][0] == {"housing", "shaft"} and found[1][3] == {"bearing", "housing"}
+
+
+def test_sweeps_in_two_processes_give_the_answers_and_queries_of_one() -> None:
+    parts = _shaft_in_bearing()
+    meshes = {p.id: p.mesh for p in parts}
+    slides = sweep.zero_clearance_fits({pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()})
+    requests = [(pid, np.array(vector), 0.3) for pid in ("bearing", "shaft") for vector in sweep.DIRECTIONS.values()]
+    requests.append((["bearing", "shaft"], np.array(sweep.DIRECTIONS["+z"]), 3e-3))  # moved as one
+    found = []
+    for workers in (1, 2):
+        sweeper = sweep.Sweeper(meshes, slides, workers=workers)
+        found.append((sweeper.blocked(requests), sweeper.queries))
+    assert found[0] == found[1]
+    # The bearing comes out along x only (the shaft slides in it), the shaft too; lifted together they meet the housing.
+    hits, queries = found[1]
+    assert hits[:6] == [{"housing", "shaft"}, {"housing", "shaft"}, set(), set(), {"housing", "shaft"},
+                        {"housing", "shaft"}]
+    assert hits[8:12] == [set(), set(), {"bearing", "housing"}, {"bearing", "housing"}] and hits[12] == {"housing"}
+    assert queries == found[0][1] > 0

@@ -143,11 +143,13 @@ def test_truth_sessions_run_with_a_part_placed_by_hand_and_without_geometry(
     result = _session(run_cli, out, tmp_path / "truth", "truth")
     steps = {step["part"]: step for step in result["assembly"]["steps"]}
     assert result["assembly"]["assembled"] and steps["lid"]["skill"] == "manual"
+    reason = tomllib.loads((out / "geometry.toml").read_text())["manual"]["lid"]["reason"]
+    assert result["assembly"]["manual_reasons"] == {"lid": reason}  # why the operator placed it
     assert [s["part"] for s in result["plans"][0]][-1] == "lid"  # the pegs block its way out: it comes last
     (out / "geometry.toml").unlink()  # a planner-only product: the truth backend answers from sizes.lp
     bare = _session(run_cli, out, tmp_path / "bare", "truth")
     assert bare["assembly"]["assembled"] and {tuple(p) for p in bare["fits"]} == {tuple(p) for p in result["fits"]}
-    assert {s["skill"] for s in bare["assembly"]["steps"]} == {"truth"}
+    assert {s["skill"] for s in bare["assembly"]["steps"]} == {"truth"} and bare["assembly"]["manual_reasons"] == {}
 
 
 @pytest.mark.slow

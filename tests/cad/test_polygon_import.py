@@ -9,6 +9,7 @@ import tomllib
 from pathlib import Path
 
 import clingo
+import numpy as np
 import pytest
 import shapely
 import trimesh
@@ -16,7 +17,7 @@ import trimesh
 from executor.cad.cli import report
 from executor.cad.derive import derive
 from executor.cad.parts import load_meshes
-from executor.cad.sections import Shape2D
+from executor.cad.sections import Shape2D, passes, zero_clearance
 from executor.cad.write import (
     Settings,
     _section_lines,
@@ -102,3 +103,20 @@ def test_a_splined_pair_and_a_rounded_rect_pair_are_true_fits_with_their_real_ro
         assert fit.section is not None
         read = {name: _read_back(name, shape) for name, shape in (("peg", fit.section), ("hole", fit.hole))}
         assert margin(read["peg"], read["hole"]) == pytest.approx(rooms[pid][fit.id], abs=1e-6)
+
+
+def test_a_polygon_peg_a_micrometre_too_big_is_no_nominal_fit_and_one_a_tenth_of_it_is() -> None:
+    # A nominal zero-clearance fit of polygon outlines is one section read twice (its loop's
+    # own vertices, written to 0.1 µm); the ViTac heptagon misses the rect hole by 1.36 µm
+    # all round and does not pass it. The same here: an octagon 1.4 µm a side wider than its
+    # hole, and one 0.1 µm wider.
+    def octagon(inradius: float) -> Shape2D:
+        ring = shapely.Polygon([(inradius * x, inradius * y) for x, y in
+                                [(1, 0.41421356), (0.41421356, 1), (-0.41421356, 1), (-1, 0.41421356),
+                                 (-1, -0.41421356), (-0.41421356, -1), (0.41421356, -1), (1, -0.41421356)]])
+        return Shape2D("polygon", 2 * inradius, 2 * inradius, 0.0, np.zeros(2),
+                       outline=np.asarray(ring.exterior.coords)[:-1])
+
+    hole = octagon(0.008)
+    assert not passes(octagon(0.008 + 1.4e-6), hole)
+    assert passes(octagon(0.008 + 1e-7), hole) and zero_clearance(octagon(0.008 + 1e-7), hole, -2e-7) == -1e-7

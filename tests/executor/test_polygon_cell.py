@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pybullet as pb
 import pytest
 import shapely
 import trimesh
@@ -24,17 +25,21 @@ from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cell_description import CellDescription
+from executor.trial import Cell
+from executor.world.arm import rotation_error, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import fit_pose, load_geometry, margin, plate_obj_text
 from executor.world.meshes import URDF_HULL_MARGIN, read_objects
 from executor.world.outlines import boss_solids, boss_triangles, convex_parts, corners
-from executor.world.scene import hole_rims
+from executor.world.scene import hole_rims, link_frame
 from tests._outlines import splined
 
 HOLES = {"hx": (0.00604, math.pi / 6), "hs": (0.00596, 0.0)}
 """Each hole's inradius [m] and the turn of its outline [rad]."""
 PEG = 0.006
 """The peg's inradius [m]."""
+QUAD = [[-0.008, -0.006], [0.010, -0.006], [0.004, 0.007], [-0.006, 0.005]]
+"""An irregular quadrilateral peg's corners [m]: its inertia has products of inertia."""
 
 
 def hexagon(inradius: float, turn: float = 0.0) -> list[list[float]]:
@@ -49,7 +54,7 @@ def _section(points: list[list[float]]) -> str:
     return f"size = [{max(xs) - min(xs):.9g}, {max(ys) - min(ys):.9g}]\noutline = {points}"
 
 
-def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04) -> Path:
+def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04, peg: list[list[float]] | None = None) -> Path:
     folder.mkdir()
     assembly = ['name = "hexagon peg"', "", "[parts.bp]", 'name = "base plate"', 'role = "base"',
                 "start = [0.30, -0.40]", "", "[parts.p1]", 'name = "hexagon peg"', 'role = "peg"', 'shape = "polygon"',
@@ -63,9 +68,9 @@ def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04) -> Path:
     for hole, (inradius, turn) in HOLES.items():
         geometry += ["", f"[hole_shapes.{hole}]", f'holes = ["{hole}"]', 'kind = "polygon"',
                      _section(hexagon(inradius, turn))]
-    geometry += ["", "[part_shapes.hexagon]", 'parts = ["p1"]', 'kind = "polygon"', _section(hexagon(PEG)),
-                 "length = 0.05", "mass = 0.05", 'demo_hole = "hx"', "", "[base]", 'part = "bp"',
-                 "tray = [0.25, -0.33]", "grip = [0.0, 0.0]", "mass = 2.0"]
+    geometry += ["", "[part_shapes.hexagon]", 'parts = ["p1"]', 'kind = "polygon"',
+                 _section(hexagon(PEG) if peg is None else peg), "length = 0.05", "mass = 0.05", 'demo_hole = "hx"',
+                 "", "[base]", 'part = "bp"', "tray = [0.25, -0.33]", "grip = [0.0, 0.0]", "mass = 2.0"]
     (folder / "geometry.toml").write_text("\n".join(geometry) + "\n")
     return folder
 
@@ -151,6 +156,38 @@ def test_a_chamfer_that_leaves_the_boss_is_refused_naming_the_hole(tmp_path: Pat
     geometry = load_geometry(str(_product(tmp_path / "hex", chamfer=0.003, tile=0.02)))
     with pytest.raises(ExecutorError, match=r"hole 'h[sx]': its outline offset by the chamfer \(3 mm"):
         plate_obj_text(geometry)
+
+
+def test_the_arm_is_placed_with_a_peg_turned_as_asked_whatever_its_principal_axes(tmp_path: Path) -> None:
+    # an irregular quadrilateral: its inertia has products of inertia, so PyBullet turns the
+    # link's inertial frame onto its principal axes (9° here), which its IK turns to the target
+    folder = _product(tmp_path / "quad", peg=QUAD)
+    cell = Cell(str(folder))
+    arm = cell.motion_for("p1").controller.arm
+    inertial = pb.getDynamicsInfo(arm.robot, arm.sensor, physicsClientId=arm.client)[4]
+    assert abs(2 * math.degrees(math.asin(inertial[2]))) > 5  # the principal axes are turned about the part's axis
+    for yaw in (0.0, 0.3, -1.2):
+        target = tool_quat(yaw)
+        arm.inverse_kinematics(np.array([0.55, 0.0, 0.15]), target)
+        assert np.linalg.norm(rotation_error(target, arm.read().tip_quat_xyzw)) < 1e-4  # [rad]
+
+
+def test_the_assembling_cell_poses_a_peg_by_its_frame_whatever_its_principal_axes(tmp_path: Path) -> None:
+    # PyBullet poses a free body by its inertial frame, turned 9° about this peg's axis onto
+    # its principal axes; the peg set upright and unturned has its URDF frame (where its
+    # collision pieces are placed) so, and the cell reads that pose back
+    folder = _product(tmp_path / "quad", peg=QUAD)
+    assembler = Assembler(load_product(str(folder)), description=CellDescription())
+    origin = np.array([0.5, 0.0, 0.2])
+    try:
+        world = assembler.world
+        world.set_pose("p1", origin)
+        placed = link_frame(world.client, world.frames["p1"].body, -1)
+        read = world.pose("p1")
+    finally:
+        assembler.close()
+    for pos, quat in (placed, read):
+        assert np.allclose(pos, origin, atol=1e-7) and np.allclose(quat, [0.0, 0.0, 0.0, 1.0], atol=1e-7)
 
 
 @pytest.mark.slow  # teaches the peg, runs two trials and assembles in physics (about 30 s)

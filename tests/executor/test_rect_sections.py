@@ -54,6 +54,20 @@ def test_a_rect_passes_a_round_hole_by_its_diagonal_and_a_round_peg_a_rect_by_it
     assert passes(round_peg, _hole("square", 0.0081))
 
 
+def test_a_section_s_circumradius_is_half_the_narrowest_round_hole_it_passes() -> None:
+    # The reach the hole search measures a placed part over the hole within, and the
+    # centring probes' reach on a pin: a round, a rect and a polygon (a right triangle
+    # whose farthest vertex is 13 mm from its frame's origin).
+    triangle = PartSpec("q", "polygon", 0.017, shape="q", length=0.05, mass=0.05, start=(0.0, 0.0),
+                        demo_hole="h", width=0.012, outline=((-0.005, -0.012), (0.012, 0.0), (-0.005, 0.0)))
+    for peg, radius in ((_peg("round", 0.008), 0.004), (_peg("rect", 0.012, 0.008), math.hypot(6, 4) / 1000),
+                        (triangle, 0.013)):
+        assert peg.circumradius == pytest.approx(radius, abs=1e-12)
+    for peg in (_peg("round", 0.008), _peg("rect", 0.012, 0.008)):
+        assert passes(peg, _hole("round", 2 * peg.circumradius + 1e-5))
+        assert not passes(peg, _hole("round", 2 * peg.circumradius - 1e-5))
+
+
 def test_room_0_passes_only_a_part_the_hole_states_a_zero_clearance_fit_with_and_never_an_interference() -> None:
     stated = HoleSpec("h", "round", 0.01, (0.0, 0.0), top_z=0.1, depth=0.025, zero_clearance=("q",))
     assert feature_passes(_peg("round", 0.01), stated)  # room 0, stated
