@@ -135,3 +135,18 @@ def test_a_rect_peg_a_third_of_a_micrometre_too_big_is_a_nominal_fit_and_one_two
     assert not passes(far, hole) and zero_clearance(far, hole, -4e-6) is None
     square = Shape2D("square", 0.006 + 6e-7, 0.006 + 6e-7, 0.0, np.zeros(2), outline=np.zeros((0, 2)))
     assert passes(square, rect(0.006, 0.006))
+
+
+def test_the_printed_line_says_what_sizes_lp_writes_for_every_section_kind() -> None:
+    # An overlap under 0.5 um prints as 0.000 mm: a pair that does not pass must say so.
+    from executor.cad.cli import _clearance
+
+    def square(side: float) -> Shape2D:
+        h = side / 2
+        return Shape2D("square", side, side, 0.0, np.zeros(2), outline=np.array([(h, h), (-h, h), (-h, -h), (h, -h)]))
+
+    round_peg = Shape2D("round", 0.006 + 6e-7, 0.006 + 6e-7, 0.0, np.zeros(2), outline=np.zeros((0, 2)))
+    pairs = ((round_peg, square(0.006)), (square(0.006 + 6e-7), square(0.006)), (square(0.005), square(0.006)))
+    for peg, hole in pairs:
+        printed = _clearance(peg, hole, "peg", "hole")
+        assert passes(peg, hole) == (not printed.startswith("no fit")), printed
