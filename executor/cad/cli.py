@@ -176,15 +176,19 @@ def _describe(kind: str, a: float, b: float) -> str:
 
 def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> str:
     """How ``peg`` passes ``hole`` as the report says it: the clearance and room all round
-    (:func:`executor.world.geometry.section_fit`), or a nominal zero-clearance fit
-    (:func:`executor.cad.sections.zero_clearance`) with the measured difference."""
+    (:func:`executor.world.geometry.section_fit`), preceded by ``no fit`` and the
+    clearance [µm] where it is not positive, or a nominal zero-clearance fit
+    (:func:`executor.cad.sections.zero_clearance`) with the measured difference: as
+    ``sizes.lp`` writes it (:func:`executor.cad.sections.passes`)."""
     room = section_fit(section(peg_name, peg), section(hole_name, hole))
     apart = zero_clearance(peg, hole, room.margin)
     if apart is not None:
         measured = "vertex circles" if peg.kind == hole.kind == "round" else "outlines"
         return (f"nominal zero-clearance fit, room 0 (measured {_mm(room.margin)} mm, {measured} "
                 f"{round(1e6 * apart, 1) + 0.0:+.1f} µm apart)")
-    return f"clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
+    # a pair that does not pass says so: an overlap under 0.5 µm prints as 0.000 mm
+    verdict = "" if room.margin > 0 else f"no fit ({round(1e6 * room.margin, 1) + 0.0:+.1f} µm), "
+    return f"{verdict}clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
 
 
 def report(derived: Derived) -> list[str]:

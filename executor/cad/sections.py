@@ -319,11 +319,17 @@ def exact_round(shape: Shape2D, cylinders: tuple[Cylinder, ...], axis: np.ndarra
 
 
 OUTLINE_TOUCH = 5e-7
-"""A polygon section's outline is its loop's own vertices, written to 0.1 µm
-(:func:`rounded`): a peg and hole of which either is one and that pass only with an
-overlap of at most this [m] all round (0.5 µm, five times that resolution) are taken for
-one nominal section. More is a peg of another size or shape that does not pass (the
-ViTac heptagon misses the rect hole by 1.36 µm all round at its best turn)."""
+"""A straight-sided section (rect, square, polygon) has no deflection: its sides are its
+loop's own (a polygon's outline is the loop's vertices, written to 0.1 µm by
+:func:`rounded`; a rect's sides are its minimum-area rectangle through them). A peg and
+hole of which either is a polygon, or both rect or square, that pass only with an overlap
+of at most this [m] all round (0.5 µm, five times that resolution) are taken for one
+nominal section. More is a peg of another size or shape that does not pass (the ViTac
+heptagon misses the rect hole by 1.36 µm all round at its best turn)."""
+
+
+STRAIGHT = frozenset({"rect", "square"})
+"""The section kinds measured as a rectangle (no deflection)."""
 
 
 def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
@@ -331,11 +337,11 @@ def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
     fit, given the ``room`` [m] of the peg's section in the hole's
     (:func:`executor.world.geometry.margin`): both round, the peg not narrower than the
     hole's inscribed circle (else it passes with room), their vertex circles' radii within
-    :data:`executor.cad.sweep.TOUCH` (their difference); or a polygon on either side (a
-    polygon's outline is its loop's vertices and straight sides: no deflection) that
-    passes only with an overlap of at most :data:`OUTLINE_TOUCH` all round (half the
-    room, at most 0); None when they are no such pair."""
-    if "polygon" in (peg.kind, hole.kind):
+    :data:`executor.cad.sweep.TOUCH` (their difference); or a polygon on either side, or
+    rect or square both (straight sides: no deflection), that pass only with an overlap of
+    at most :data:`OUTLINE_TOUCH` all round (half the room, at most 0); None when they are
+    no such pair."""
+    if "polygon" in (peg.kind, hole.kind) or {peg.kind, hole.kind} <= STRAIGHT:
         return room / 2 if -2 * OUTLINE_TOUCH <= room <= 0 else None
     if peg.kind != "round" or hole.kind != "round" or peg.a < hole.a:
         return None

@@ -227,6 +227,8 @@ def prism_faces(mesh: trimesh.Trimesh) -> list[PrismFace]:
             if reach <= TOUCH or len(set(inside[cut])) != 1:
                 continue
             kept = heights[on & (inside == inside[cut][0])]
+            if not kept.size:  # every triangle leans off the mid-span section: a taper within TILT, no prism
+                continue
             faces.append(PrismFace(centre @ frame, axis, frame, outline, (float(kept.min()), float(kept.max())),
                                    not bool(inside[cut][0]), reach))
     return faces

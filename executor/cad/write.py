@@ -267,7 +267,8 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
 
 
 RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
-        "or a peg and hole of a polygon section that pass with an overlap of at most 0.5 {um} all round, "
+        "or a peg and hole of a polygon section (or both rect or square) that pass with an overlap of at most "
+        "0.5 {um} all round, "
         "is taken for one nominal section: a fit, room 0")
 """The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
 

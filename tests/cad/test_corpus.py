@@ -77,7 +77,12 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
-IMPORTED = [p for p in PRODUCTS if p not in REFUSED]
+TOO_SLOW: dict[str, str] = {
+    "asap_beam": "its import takes over 200 s of CPU (CoACD decomposing the tapered tenons and mortises at zero "
+                 "clearance for the cell's convex pieces, 30 s a call): run ./run.sh import on it by hand",
+}
+"""The products whose import is too slow for the suite (their closed-world test still runs), with why."""
+IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 """Every product the import takes."""
 
 @pytest.mark.slow  # the first test of a product imports it
@@ -114,7 +119,8 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears", "factory_rect_pegs",
+@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears",
+                                  "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes"])
 def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:

@@ -120,3 +120,33 @@ def test_a_polygon_peg_a_micrometre_too_big_is_no_nominal_fit_and_one_a_tenth_of
     hole = octagon(0.008)
     assert not passes(octagon(0.008 + 1.4e-6), hole)
     assert passes(octagon(0.008 + 1e-7), hole) and zero_clearance(octagon(0.008 + 1e-7), hole, -2e-7) == -1e-7
+
+
+def test_a_rect_peg_a_third_of_a_micrometre_too_big_is_a_nominal_fit_and_one_two_micrometres_too_big_is_not() -> None:
+    # Straight sides have no deflection, as a polygon's: asap_beam's tapered rect tenons
+    # overlap their mortises by 0.3 µm a side, one nominal section; 2 µm a side is another size.
+    def rect(a: float, b: float) -> Shape2D:
+        outline = np.array([(a / 2, b / 2), (-a / 2, b / 2), (-a / 2, -b / 2), (a / 2, -b / 2)])
+        return Shape2D("rect", a, b, 0.0, np.zeros(2), outline=outline)
+
+    hole = rect(0.009605, 0.005795)
+    close, far = rect(0.009605 + 6e-7, 0.005795 + 6e-7), rect(0.009605 + 4e-6, 0.005795 + 4e-6)
+    assert passes(close, hole) and zero_clearance(close, hole, -6e-7) == pytest.approx(-3e-7)
+    assert not passes(far, hole) and zero_clearance(far, hole, -4e-6) is None
+    square = Shape2D("square", 0.006 + 6e-7, 0.006 + 6e-7, 0.0, np.zeros(2), outline=np.zeros((0, 2)))
+    assert passes(square, rect(0.006, 0.006))
+
+
+def test_the_printed_line_says_what_sizes_lp_writes_for_every_section_kind() -> None:
+    # An overlap under 0.5 um prints as 0.000 mm: a pair that does not pass must say so.
+    from executor.cad.cli import _clearance
+
+    def square(side: float) -> Shape2D:
+        h = side / 2
+        return Shape2D("square", side, side, 0.0, np.zeros(2), outline=np.array([(h, h), (-h, h), (-h, -h), (h, -h)]))
+
+    round_peg = Shape2D("round", 0.006 + 6e-7, 0.006 + 6e-7, 0.0, np.zeros(2), outline=np.zeros((0, 2)))
+    pairs = ((round_peg, square(0.006)), (square(0.006 + 6e-7), square(0.006)), (square(0.005), square(0.006)))
+    for peg, hole in pairs:
+        printed = _clearance(peg, hole, "peg", "hole")
+        assert passes(peg, hole) == (not printed.startswith("no fit")), printed
