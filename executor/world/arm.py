@@ -15,6 +15,7 @@ import numpy as np
 import pybullet as pb
 
 from executor import ExecutorError
+from executor.world.frames import quat_mul
 
 N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
@@ -153,7 +154,7 @@ class Arm:
         used only to place the arm before an attempt, never per control step)."""
         real_pos, real_quat = pb.multiplyTransforms(list(tip_pos), list(tip_quat_xyzw),
                                                     list(self.grasp_offset), list(self.grasp_quat_xyzw))
-        real_quat = pb.multiplyTransforms(_ORIGIN, real_quat, _ORIGIN, self._inertial_quat)[1]
+        real_quat = tuple(quat_mul(real_quat, self._inertial_quat))  # in doubles: PyBullet's product is float32
         q = REST_POSTURE.copy()
         for _ in range(4):
             self.reset(q)
