@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import pybullet as pb
+from scipy.spatial.transform import Rotation
 
 from executor import ExecutorError
-from executor.world.frames import quat_mul
 
 N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
@@ -154,7 +154,8 @@ class Arm:
         used only to place the arm before an attempt, never per control step)."""
         real_pos, real_quat = pb.multiplyTransforms(list(tip_pos), list(tip_quat_xyzw),
                                                     list(self.grasp_offset), list(self.grasp_quat_xyzw))
-        real_quat = tuple(quat_mul(real_quat, self._inertial_quat))  # in doubles: PyBullet's product is float32
+        if self._inertial_quat != (0.0, 0.0, 0.0, 1.0):  # in doubles: PyBullet's product rounds to float32
+            real_quat = tuple((Rotation.from_quat(real_quat) * Rotation.from_quat(self._inertial_quat)).as_quat())
         q = REST_POSTURE.copy()
         for _ in range(4):
             self.reset(q)
