@@ -113,15 +113,17 @@ def test_the_command_line_stops_with_exit_code_3(run_cli) -> None:
     assert report["assembled"] is False and "fewer holes than parts" in done.stderr
 
 
-@pytest.mark.slow
-def test_a_session_learns_plans_and_assembles(run_session, tmp_path) -> None:
-    run = tmp_path / "run"
-    result = run_session("--assemble", "--out", str(run))
-    assert result["assembly"]["assembled"] is True
-    assert [s["part"] for s in result["assembly"]["steps"]] == [s["part"] for s in result["plans"][0]]
-    settings = json.loads((run / "session.json").read_text())
-    assert settings["assembly"] == "cranfield"  # the assembly's name stays (a resume reads it)
-    assert settings["assembly_run"] == result["assembly"]
+@pytest.mark.slow  # starts a truth cell
+def test_a_plan_file_is_executed_as_written(run_main) -> None:
+    """examples/taskboard-plan.json: the task board's pegs each in its own hole, in the file's
+    order (not the order of the assembly's first plan)."""
+    plan = ROOT / "examples" / "taskboard-plan.json"
+    done = run_main("assemble", "--assembly", "taskboard", str(plan), "--backend", "truth", "--json", timeout=120)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["assembled"] is True and not report["replans"]
+    written = [(s["part"], s["hole"]) for s in json.loads(plan.read_text())]
+    assert [(s["part"], s["hole"]) for s in report["steps"]] == written
 
 
 @pytest.mark.parametrize("args, expected", [
