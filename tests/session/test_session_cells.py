@@ -25,6 +25,7 @@ from asp.solve import atoms_by_name, load_atoms
 from bridge.cell_settings import ServeSettings
 from bridge.session import free_loopback_endpoint
 from tests.conftest import ROOT, TRUTH_SESSION
+from tests.session.test_session_batches import BEST_TWO_CELLS
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
 TRUTH = TruthOracle.from_assembly("cranfield")
@@ -102,12 +103,13 @@ def test_killed_planner_resumes_without_repeating(tmp_path: Path, cells: list[Ce
     assert not rerun_ids & {e.id for e in before}
 
 
-def test_session_with_its_own_cells_writes_one_recording(tmp_path: Path, run_session) -> None:
+def test_a_two_cell_session_needs_few_experiments_and_writes_one_recording(tmp_path: Path, run_session) -> None:
     from bridge.recording.reader import column_values, read_recording
 
     run = tmp_path / "run"
     result = run_session("--cells", "2", "--out", str(run), "--policy", "best")
     assert_learned_truth(result, run)
+    assert result["experiments"] <= BEST_TWO_CELLS  # batches of independent pairs waste none
     assert all(len(plan) == 10 for plan in result["plans"])
     settings = json.loads((run / "session.json").read_text())
     assert settings["status"] == "done" and set(settings["cells"]) == {"c1", "c2"}
@@ -163,45 +165,34 @@ def is_cell(pid: int) -> bool:
 
 
 def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path, run_session) -> None:
-    """--confirm 1 with truthful cells: one agreeing re-test per essential experiment."""
-    plain = run_session("--cells", "1", "--out", str(tmp_path / "plain"), "--policy", "systematic")
+    """--confirm 1 with truthful cells: one agreeing re-test per essential experiment, on top
+    of the experiments the same policy needs without (learned in process)."""
+    from asp.sizes.learner import learn_sizes
+
+    plain = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "systematic").count
     run = tmp_path / "confirmed"
     result = run_session("--cells", "1", "--out", str(run), "--policy", "systematic", "--confirm", "1")
     assert result["matches_truth"] is True
     journal = read_journal(run / "journal.jsonl")
     retests = [e for e in journal if e.retest]
-    assert len(journal) == result["experiments"] == plain["experiments"] + len(retests)
+    assert len(journal) == result["experiments"] == plain + len(retests)
     assert len(retests) == 15  # Cranfield's essential observations, for every policy
     asked = Counter((e.part, e.hole) for e in journal)
     assert all(asked[(e.part, e.hole)] == 2 for e in retests)
     assert all(e.result == TRUTH.ask(e.part, e.hole) for e in journal)
 
 
-def test_a_session_starts_from_the_fits_its_demonstrations_show(tmp_path: Path, run_session) -> None:
+def test_a_session_starts_from_its_demonstrations_and_never_uses_a_rogue_cell(tmp_path: Path, run_session) -> None:
+    """``--demos``: the session starts from the fits its demonstrations show. A local process
+    declares ``cell/evil/alive`` and answers every request with "fit"; the session, which
+    started its own cell, uses only that cell and learns the truth."""
     from asp.sizes.learner import LearningOptions, learn_sizes
-
-    demos = ROOT / "data" / "cranfield" / "demos_annotated.txt"
-    run = tmp_path / "run"
-    result = run_session("--cells", "1", "--out", str(run), "--demos", str(demos))
-    assert_learned_truth(result, run)
-    shown = {tuple(pair) for pair in result["demonstrated"]}
-    assert len(shown) == 9 and shown <= TRUTH.fits
-    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", options=LearningOptions(demonstrated=list(shown)))
-    assert result["experiments"] == alone.count < 19  # 19: best from nothing
-    assert not {(e.part, e.hole) for e in read_journal(run / "journal.jsonl")} & shown
-    learned = load_atoms([run / "learned.lp"])
-    assert set(atoms_by_name(learned, "demonstrated", 2)) == shown
-    assert len([a for a in learned if a.match("demo", 4)]) == 4 * 5  # 4 demonstrations, 5 pegs each
-    assert json.loads((run / "session.json").read_text())["demos"] == str(demos)
-
-
-def test_a_rogue_cell_that_answers_fit_to_everything_is_never_used(tmp_path: Path, run_session) -> None:
-    """A local process declares ``cell/evil/alive`` and answers every request with "fit";
-    a session that started its own cell uses only that cell and learns the truth."""
     from bridge.keys import alive_key
     from bridge.messages import InsertReply, decode_request, encode
     from bridge.session import open_session
 
+    demos = ROOT / "data" / "cranfield" / "demos_annotated.txt"
+    run = tmp_path / "run"
     endpoint = free_loopback_endpoint()
     rogue = open_session(connect=(endpoint,))
     asked: list[str] = []
@@ -215,10 +206,20 @@ def test_a_rogue_cell_that_answers_fit_to_everything_is_never_used(tmp_path: Pat
     try:
         handles = (rogue.declare_queryable("cell/evil/insert", always_fit),
                    rogue.liveliness().declare_token(alive_key("evil")))
-        result = run_session("--listen", endpoint, "--out", str(tmp_path / "run"))
-        assert_learned_truth(result, tmp_path / "run")
-        assert asked == []
-        assert {e.cell for e in read_journal(tmp_path / "run" / "journal.jsonl")} == {"c1"}
+        result = run_session("--listen", endpoint, "--out", str(run), "--demos", str(demos))
         del handles
     finally:
         rogue.close()
+    assert_learned_truth(result, run)
+    assert "assembly" not in result  # no --assemble
+    assert asked == []
+    assert {e.cell for e in read_journal(run / "journal.jsonl")} == {"c1"}
+    shown = {tuple(pair) for pair in result["demonstrated"]}
+    assert len(shown) == 9 and shown <= TRUTH.fits
+    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", options=LearningOptions(demonstrated=list(shown)))
+    assert result["experiments"] == alone.count < 19  # 19: best from nothing
+    assert not {(e.part, e.hole) for e in read_journal(run / "journal.jsonl")} & shown
+    learned = load_atoms([run / "learned.lp"])
+    assert set(atoms_by_name(learned, "demonstrated", 2)) == shown
+    assert len([a for a in learned if a.match("demo", 4)]) == 4 * 5  # 4 demonstrations, 5 pegs each
+    assert json.loads((run / "session.json").read_text())["demos"] == str(demos)
