@@ -53,9 +53,18 @@ def started_numbers(cell: CellProcess) -> list[int]:
 
 
 @pytest.mark.slow
-def test_two_sessions_started_at_once_on_one_folder(tmp_path: Path, root: Path, cli_argv,
-                                                    cli_env: dict[str, str]) -> None:
+@pytest.mark.timeout(180)  # two tests' sessions in one
+def test_after_a_cell_died_at_start_two_sessions_started_at_once_on_one_folder(
+        tmp_path: Path, root: Path, cli_argv, cli_env: dict[str, str], run_main) -> None:
+    """A start whose cell dies leaves no folder and blocks nothing; of two sessions then
+    started at once on the folder, one learns, the other is refused naming the first."""
+    broken = tmp_path / "short_peg"
+    shutil.copytree(root / "data" / "cranfield", broken)
+    short_peg(broken)
     run = tmp_path / "run"
+    failed = run_main(*TRUTH_SESSION, "--assembly", str(broken), "--cells", "1", "--out", str(run), timeout=50)
+    assert failed.returncode == 2 and "before printing line 'ready" in failed.stderr
+    assert not run.exists()
     argv = cli_argv(*TRUTH_SESSION, "--cells", "1", "--delay", "0.05", "--out", str(run))
     both = [subprocess.Popen(argv, cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
             for _ in range(2)]
@@ -79,36 +88,12 @@ def test_two_sessions_started_at_once_on_one_folder(tmp_path: Path, root: Path, 
 
 
 @pytest.mark.slow
-def test_resume_of_a_running_session_is_refused_before_any_cell(tmp_path: Path, cells: list[CellProcess],
-                                                                root: Path, cli_argv, cli_env: dict[str, str],
-                                                                run_cli) -> None:
-    endpoint = free_loopback_endpoint()
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", listen=(endpoint,), delay_s=0.2)))
-    run = tmp_path / "run"
-    planner = subprocess.Popen(cli_argv(*TRUTH_SESSION, "--cells", "0", "--connect", endpoint, "--out", str(run)),
-                               cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        cells[0].wait_for_line("start", timeout=30, count=2)
-        second = run_cli("session", "--backend", "truth", "--cells", "1", "--resume", str(run), timeout=30)
-        assert second.returncode == 2
-        assert second.stderr == (f"error: {run}: in use by another session (pid {planner.pid}); "
-                                 "wait for it to end or use another folder\n")
-        assert sorted(p.name for p in run.glob("c*.rrd")) == []  # it started no cell
-        out, err = planner.communicate(timeout=60)
-    finally:
-        planner.kill()
-    assert planner.returncode == 0, err
-    assert_learned_truth(json.loads(out), run)
-    assert json.loads((run / "session.json").read_text())["starts"] == 1
-
-
-@pytest.mark.slow
-def test_out_on_a_folder_with_a_journal_is_refused(tmp_path: Path, run_cli) -> None:
+def test_out_on_a_folder_with_a_journal_is_refused(tmp_path: Path, run_main) -> None:
     run = tmp_path / "run"
     run.mkdir()
     line = '{"id":"x.p1.r1.1","part":"p1","hole":"r1","result":"fit","cell":"c1","experiment":1}\n'
     (run / "journal.jsonl").write_text(line)
-    done = run_cli(*TRUTH_SESSION, "--cells", "0", "--connect", free_loopback_endpoint(), "--wait-for-cell", "1",
+    done = run_main(*TRUTH_SESSION, "--cells", "0", "--connect", free_loopback_endpoint(), "--wait-for-cell", "1",
                    "--out", str(run), timeout=30)
     assert done.returncode == 2
     assert done.stderr == (f"error: --out {run}: already holds a session (its journal); "
@@ -129,7 +114,7 @@ def test_out_under_a_regular_file_is_one_line(tmp_path: Path, run_main, parent: 
 
 
 @pytest.mark.slow
-def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, run_cli) -> None:
+def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, run_cli, run_main) -> None:
     run = tmp_path / "run"
     argv = (*TRUTH_SESSION, "--cells", "1", "--listen", "tcp/127.0.0.1:99999", "--out", str(run))
     failed = run_cli(*argv, timeout=30)
@@ -137,27 +122,16 @@ def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, 
     assert failed.stderr.count("\n") == 1
     assert not run.exists()  # the folder this start made is gone
     run.mkdir()  # a folder the user made stays, and a failed start there blocks nothing
-    again = run_cli(*argv, timeout=30)
+    again = run_main(*argv, timeout=30)  # in process: the first start was the real process
     assert again.returncode == 2 and again.stderr == failed.stderr
     assert run.is_dir() and lock_is_free(run)
 
 
 @pytest.mark.slow
-def test_a_normal_start_after_a_cell_died_at_start(tmp_path: Path, root: Path, run_cli, run_session) -> None:
-    broken = tmp_path / "short_peg"
-    shutil.copytree(root / "data" / "cranfield", broken)
-    short_peg(broken)
-    run = tmp_path / "run"
-    failed = run_cli(*TRUTH_SESSION, "--assembly", str(broken), "--cells", "1", "--out", str(run), timeout=50)
-    assert failed.returncode == 2 and "before printing line 'ready" in failed.stderr
-    assert not run.exists()
-    result = run_session("--cells", "1", "--out", str(run))
-    assert_learned_truth(result, run)
-
-
-@pytest.mark.slow
-def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv,
-                                                 cli_env: dict[str, str], run_session) -> None:
+@pytest.mark.timeout(180)  # two tests' sessions in one
+def test_a_running_session_refuses_a_resume_and_once_killed_resumes_with_new_numbers(
+        tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv, cli_env: dict[str, str], run_session,
+        run_main) -> None:
     endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
     for cell_id, endpoint in zip(("c1", "c2"), endpoints):
         cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", listen=(endpoint,), delay_s=0.3)))
@@ -167,6 +141,11 @@ def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[Cel
                                cwd=root, env=cli_env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         cells[0].wait_for_line("start", timeout=30, count=3)  # two cells busy: experiments in flight
+        second = run_main("session", "--backend", "truth", "--cells", "1", "--resume", str(run), timeout=30)
+        assert second.returncode == 2
+        assert second.stderr == (f"error: {run}: in use by another session (pid {planner.pid}); "
+                                 "wait for it to end or use another folder\n")
+        assert sorted(p.name for p in run.glob("c*.rrd")) == []  # it started no cell
         planner.send_signal(signal.SIGKILL)
         planner.wait(10)
     finally:
@@ -198,5 +177,5 @@ def test_killed_planner_resumes_with_new_numbers(tmp_path: Path, cells: list[Cel
     assert len(sent) == len(set(sent)), "an experiment number went to the cells twice"
     assert all(n > highest for c in cells for n in started_numbers(c)[sent_before[c.cell_id]:])
     settings = json.loads((run / "session.json").read_text())
-    assert settings["starts"] == 2 and sorted(settings["abandoned"]) == sorted(in_flight)
+    assert settings["starts"] == 2 and sorted(settings["abandoned"]) == sorted(in_flight)  # not the refused one
     assert len(read_journal(run / "journal.jsonl")) == result["experiments"]
