@@ -57,6 +57,24 @@ def network() -> Iterator[tuple[str, zenoh.Session, CellDirectory, list[CellProc
         session.close()
 
 
+@pytest.fixture(scope="module")
+def served() -> Iterator[tuple[str, zenoh.Session, CellDirectory, CellProcess]]:
+    """A planner-side session listening on a free loopback port and one truth cell c1 on it,
+    shared by the tests that leave c1 serving (one cell start for them all; each uses
+    request ids of its own, as the cell caches replies by id)."""
+    endpoint = free_loopback_endpoint()
+    session = open_session(listen=(endpoint,))
+    directory = CellDirectory(session)
+    cell = start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,)))
+    try:
+        directory.wait_for(1, timeout=20)
+        yield endpoint, session, directory, cell
+    finally:
+        cell.kill()
+        directory.close()
+        session.close()
+
+
 def raw_query(session: zenoh.Session, key: str, payload: bytes) -> InsertReply | ErrorReply:
     box: queue.SimpleQueue[bytes] = queue.SimpleQueue()
     session.get(key, lambda reply: box.put(reply.ok.payload.to_bytes()), payload=payload,
@@ -65,10 +83,8 @@ def raw_query(session: zenoh.Session, key: str, payload: bytes) -> InsertReply |
 
 
 @pytest.mark.slow
-def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
+def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(served) -> None:
+    endpoint, session, directory, cell = served
     bad = {
         b"x" * 100_000: "oversized",
         b"\xff\xfe not json": "malformed",
@@ -82,20 +98,18 @@ def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(network) -> N
         request_insert(session, "c1", InsertRequest(id="u1", part="zz", hole="r1"), timeout=10)
     assert request_insert(session, "c1", InsertRequest(id="ok1", part="sh", hole="br"), 10).result == "fit"
     assert request_insert(session, "c1", InsertRequest(id="ok2", part="sh", hole="r1"), 10).result == "no_fit"
-    assert cells[0].popen.poll() is None
+    assert cell.popen.poll() is None
 
 
 @pytest.mark.slow
-def test_a_repeated_id_returns_the_cached_reply_without_rerunning(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,), delay_s=0.2)))
-    directory.wait_for(1, timeout=20)
+def test_a_repeated_id_returns_the_cached_reply_without_rerunning(served) -> None:
+    endpoint, session, directory, cell = served
     request = InsertRequest(id="same", part="p3", hole="s1")
     first = request_insert(session, "c1", request, timeout=10)
     again = request_insert(session, "c1", request, timeout=10)
     assert first == again  # same wall_s: the experiment was not run again
-    cells[0].wait_for_line("done same", timeout=5)
-    assert sum(line.startswith("start same") for line in cells[0].lines) == 1
+    cell.wait_for_line("done same", timeout=5)
+    assert sum(line.startswith("start same") for line in cell.lines) == 1
 
 
 @pytest.mark.slow
@@ -175,10 +189,8 @@ def test_with_no_cell_left_the_pool_waits_for_a_new_one(network) -> None:
 
 
 @pytest.mark.slow
-def test_a_reused_id_with_another_pair_is_refused_not_answered_from_the_cache(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
+def test_a_reused_id_with_another_pair_is_refused_not_answered_from_the_cache(served) -> None:
+    endpoint, session, directory, cell = served
     assert request_insert(session, "c1", InsertRequest(id="r", part="sh", hole="br"), 10).result == "fit"
     with pytest.raises(CellRefused, match="id_reused"):
         request_insert(session, "c1", InsertRequest(id="r", part="sh", hole="r1"), timeout=10)
@@ -215,10 +227,8 @@ def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(networ
 
 
 @pytest.mark.slow
-def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_taken(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
+def test_a_reply_that_does_not_echo_the_request_or_contradicts_another_is_never_taken(served) -> None:
+    endpoint, session, directory, cell = served
 
     def liar(query: zenoh.Query) -> None:  # a second process answering for c1: "fit", for p9
         request = decode_request(query.payload.to_bytes())
@@ -281,13 +291,14 @@ def _refusal(cell: CellProcess) -> str:
 
 
 @pytest.mark.slow  # two or three cell processes
-def test_a_second_process_on_a_served_cell_id_refuses_to_start(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
-    cells.append(CellProcess(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    assert "error: cell id c1 is already served by another process" in _refusal(cells[1])
-    assert cells[0].popen.poll() is None and directory.duplicated == set()  # the planner never saw it
+def test_a_second_process_on_a_served_cell_id_refuses_to_start(served) -> None:
+    endpoint, session, directory, cell = served
+    second = CellProcess(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,)))
+    try:
+        assert "error: cell id c1 is already served by another process" in _refusal(second)
+    finally:
+        second.kill()
+    assert cell.popen.poll() is None and directory.duplicated == set()  # the planner never saw it
     assert request_insert(session, "c1", InsertRequest(id="d1", part="sh", hole="br"), 10).result == "fit"
 
 
@@ -321,12 +332,10 @@ def test_cells_on_one_id_that_meet_later_leave_the_older_serving(network) -> Non
 
 
 @pytest.mark.slow
-def test_a_token_of_a_second_claimant_the_cells_cannot_see_makes_the_planner_wait(network) -> None:
+def test_a_token_of_a_second_claimant_the_cells_cannot_see_makes_the_planner_wait(served) -> None:
     """The planner's own guard: two tokens on one id (here a peer that listens nowhere, so
     the cell cannot meet it) and that id gets nothing until one is gone."""
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
+    endpoint, session, directory, cell = served
     hidden = open_session(connect=(endpoint,))
     try:
         token = hidden.liveliness().declare_token(alive_key("c1", "hidden"))
