@@ -223,6 +223,7 @@ def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(networ
     assert codes.count("busy") >= 1, codes
     assert codes.count("expired") >= 5, codes  # waited behind 0.3 s experiments longer than 0.5 s
     assert 1 <= len(answered) <= 4, codes
+    cells[0].wait_for_line("start q", timeout=10, count=len(answered))  # its stdout is read by a thread
     assert sum(line.startswith("start q") for line in cells[0].lines) == len(answered)
 
 
