@@ -26,6 +26,13 @@ With ``--demos FILE`` it measures what demonstrations that say where each part w
 random relabeling (index order of parts and holes, seed ``--seed`` + i, also the
 policy's seed), once from nothing and once from the demonstrated fits; the experiments
 per session (mean, median) of both and the mean saved.
+
+With ``--cells K`` it counts the experiments of parallel learning: for each policy,
+``--seeds`` N sessions on Cranfield, session i on a random relabeling (seed ``--seed`` +
+i; session 0 of seed 0 in Cranfield's own order) with K cells, each finished experiment
+drawn at random among the running ones (the same seed), the batches handed out as a
+session hands them out (``next_batch(free, pending=running)``); the experiments per
+session (min, median, max).
 """
 
 from __future__ import annotations
@@ -36,12 +43,14 @@ import json
 import random
 import statistics
 import time
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from asp import PlannerError
 from asp.sizes.cli import demonstrated_fits
 from asp.sizes.evaluate import evaluate_policy
+from asp.sizes.knowledge import Pair
 from asp.sizes.learner import LearningOptions, SizeLearner, learn_sizes
 from asp.sizes.models import MODELS, model_for
 from asp.sizes.policies import get_policy
@@ -129,6 +138,57 @@ def demos_rows(demos: str, policies: list[str], seeds: int, seed: int) -> list[d
     return rows
 
 
+Watch = Callable[[SizeLearner, list[Pair], list[Pair]], None]
+"""Called with the learner, the new batch and every running pair (the batch included)."""
+
+
+def parallel_learning(parts: Sequence[str], holes: Sequence[str], truth: TruthOracle, cells: int, policy: str,
+                      seed: int, together: bool = False, watch: Watch | None = None) -> tuple[SizeLearner, int]:
+    """Learn with ``cells`` simulated cells that finish in a seeded random order; returns the
+    learner and the number of experiments. ``together``: a random number of the running
+    experiments finish at once and are recorded with one solve (``record_all``), as a
+    session takes them; ``watch`` (:data:`Watch`) is called after every batch."""
+    learner = SizeLearner(parts, holes, policy)
+    rng = random.Random(seed)
+    running: list[Pair] = []
+    asked = 0
+    while True:
+        batch = learner.next_batch(cells - len(running), pending=running)
+        running += batch
+        asked += len(batch)
+        if watch is not None:
+            watch(learner, batch, running)
+        if not running:
+            return learner, asked
+        if together:
+            rng.shuffle(running)
+            count = rng.randint(1, len(running))
+            finished, running = running[:count], running[count:]
+            learner.record_all([(*pair, truth.ask(*pair)) for pair in finished])
+        else:
+            pair = running.pop(rng.randrange(len(running)))
+            learner.record(*pair, truth.ask(*pair))
+
+
+def parallel_rows(cells: int, policies: list[str], seeds: int, seed: int) -> list[dict]:
+    """Experiments per Cranfield session with ``cells`` cells (module doc), per policy."""
+    truth = TruthOracle.from_assembly(CRANFIELD)
+    rows = []
+    for policy in policies:
+        counts = []
+        for case in range(seed, seed + seeds):
+            rng = random.Random(case)
+            parts, holes = ((truth.parts, truth.holes) if case == 0 else
+                            (rng.sample(truth.parts, len(truth.parts)), rng.sample(truth.holes, len(truth.holes))))
+            learner, asked = parallel_learning(parts, holes, truth, cells, policy, case)
+            if learner.knowledge.fits != frozenset(truth.fits):
+                raise PlannerError(f"bench sizes: policy {policy} with {cells} cells learned a wrong relation")
+            counts.append(asked)
+        rows.append({"policy": policy, "cells": cells, "sessions": seeds, "min": min(counts),
+                     "median": statistics.median(counts), "max": max(counts)})
+    return rows
+
+
 def product_rows(products: list[str], policies: list[str], model: str | None, seeds: int, seed: int) -> list[dict]:
     """Experiments per policy for each product, with |parts| × |holes| and the bound [bit]."""
     rows = []
@@ -155,6 +215,12 @@ def _print_products(rows: list[dict], policies: list[str]) -> None:
     for r in rows:
         print(f"{r['product']:>12} {r['model']:>9} {str(r['parts']) + ' x ' + str(r['holes']):>13} "
               f"{r['bound_bits']:>10.2f} " + " ".join(f"{r[p]:>10}" for p in policies))
+
+
+def _print_parallel(rows: list[dict]) -> None:
+    print(f"{'policy':>11} {'cells':>5} {'sessions':>8} {'min':>4} {'median':>6} {'max':>4}")
+    for r in rows:
+        print(f"{r['policy']:>11} {r['cells']:>5} {r['sessions']:>8} {r['min']:>4} {r['median']:>6} {r['max']:>4}")
 
 
 def _print_demos(rows: list[dict]) -> None:
@@ -194,13 +260,16 @@ def main(argv: list[str]) -> int:
                         metavar="K,...",
                         help="with --noise: the learner's confirm values (default 0)")
     parser.add_argument("--seeds", type=int_in(1, 10**5), default=30, metavar="N",
-                        help="with --noise or --demos: sessions per setting (default 30)")
+                        help="with --noise, --demos or --cells: sessions per setting (default 30)")
     parser.add_argument("--demos", metavar="FILE",
                         help="measure the experiments saved by the fits these demonstrations show (p1@r1) "
                              "instead of timing (Cranfield; with --seeds, --policies)")
     parser.add_argument("--products", type=comma_list(str, "assembly names or folders"), metavar="A,...",
                         help="count experiments per policy on these products instead of timing "
                              "(with --policies, --model, --seeds)")
+    parser.add_argument("--cells", type=int_in(1, 64), metavar="K",
+                        help="count experiments of sessions with K cells instead of timing "
+                             "(Cranfield; with --seeds, --policies)")
     parser.add_argument("--model", choices=MODELS, default=None,
                         help="with --products: the size model (default: each product's own)")
     parser.add_argument("--json", action="store_true", help="print JSON")
@@ -213,6 +282,13 @@ def main(argv: list[str]) -> int:
             print(json.dumps({"products": counted}))
         else:
             _print_products(counted, args.policies)
+        return 0
+    if args.cells:
+        parallel = parallel_rows(args.cells, args.policies, args.seeds, args.seed)
+        if args.json:
+            print(json.dumps({"parallel": parallel}))
+        else:
+            _print_parallel(parallel)
         return 0
     if args.demos:
         saved = demos_rows(args.demos, args.policies, args.seeds, args.seed)
