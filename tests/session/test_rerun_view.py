@@ -109,14 +109,19 @@ def test_a_session_blueprint_shows_what_the_session_holds(tmp_path: Path) -> Non
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("assemble", [True, False])
-def test_a_session_opens_with_an_assembly_tab_only_when_it_recorded_one(tmp_path: Path, run_session,
-                                                                        assemble: bool) -> None:
+def test_a_session_learns_plans_assembles_and_opens_with_an_assembly_tab_only_when_it_recorded_one(
+        tmp_path: Path, run_session) -> None:
     """Truth cells answer the plan's steps from the product's truth and record no assembly:
-    with ``--assemble`` the session's report has an assembly, its recording none."""
+    with ``--assemble`` the session's report has the assembly of its first plan, its
+    recording none (a session without ``--assemble`` has none in its report:
+    ``tests/session/test_session_cells.py``)."""
     run = tmp_path / "run"
-    result = run_session("--cells", "1", "--out", str(run), *(["--assemble"] if assemble else []))
-    assert ("assembly" in result) == assemble and (not assemble or result["assembly"]["assembled"])
+    result = run_session("--cells", "1", "--out", str(run), "--assemble")
+    assert result["assembly"]["assembled"] is True
+    assert [s["part"] for s in result["assembly"]["steps"]] == [s["part"] for s in result["plans"][0]]
+    settings = json.loads((run / "session.json").read_text())
+    assert settings["assembly"] == "cranfield"  # the assembly's name stays (a resume reads it)
+    assert settings["assembly_run"] == result["assembly"]
     files = sorted(run.glob("*.rrd"))
     assert [f.name for f in files] == ["c1.rrd", "planner.rrd"]
     assert not any("/assembly/" in path for path in read_recording(files).entities)
