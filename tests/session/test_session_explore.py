@@ -81,13 +81,20 @@ def test_truth_cell_session_explores_cranfield_to_its_exact_relation(tmp_path: P
 
 @pytest.mark.slow
 @pytest.mark.timeout(400)
-def test_sim_cell_session_explores_a_small_product_in_physics(tmp_path: Path, run_cli) -> None:
+def test_sim_cell_session_explores_a_small_product_in_physics_with_the_layer_it_was_given(
+        tmp_path: Path, run_cli) -> None:
+    """``--layer pi_phase_stop`` (no ILC) and a smaller vision error reach the cell: it
+    learns nothing across executions, so no ILC state appears in the run folder (the
+    default layer writes one at the first fit: ``tests/session/test_session_sim.py``)."""
     run = tmp_path / "run"
-    done = run_cli("session", "--json", "--assembly", "spare", "--precedence", "explore", "--out", str(run),
-                   timeout=360)
+    done = run_cli("session", "--json", "--assembly", "spare", "--precedence", "explore", "--layer", "pi_phase_stop",
+                   "--vision-sigma", "0.001", "--out", str(run), timeout=360)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["matches_truth"] is True
     _learned_exactly_the_truth(run, "spare")
+    cell = json.loads((run / "session.json").read_text())["cell"]
+    assert cell["layer"] == "pi_phase_stop" and cell["magnitudes"]["vision_sigma"] == 0.001
+    assert not (run / "c1-ilc.json").exists()
     explored = json.loads((run / "session.json").read_text())["precedence_explored"]
     assert explored["experiments"] == 3 and explored["sim_s"] > 0.0  # bp<p1, bp<p2, bp<p3, each in physics
     assert (run / "experiments.lp").read_text().count(",1,unsupported).") == 3  # each peg fell: no plate

@@ -1,7 +1,8 @@
-"""Sessions with simulated (PyBullet) cells: the cell's options reach the cells, a killed
-session resumes with what its cell had learned (ILC), and the default session learns
-the exact Cranfield relation with the cell's default uncertainty (second attempts
-included).  Real processes throughout: planner, ``executor serve``, Zenoh on loopback."""
+"""Sessions with simulated (PyBullet) cells: a killed session resumes with what its cell
+had learned (ILC), and the default session learns the exact Cranfield relation with the
+cell's default uncertainty (second attempts included); the cell's options reach the
+cells in ``tests/session/test_session_explore.py``.  Real processes throughout: planner,
+``executor serve``, Zenoh on loopback."""
 
 from __future__ import annotations
 
@@ -41,22 +42,6 @@ def _wait_for(condition, timeout: float, what: str) -> None:
     while not condition():
         assert time.monotonic() < deadline, f"waited {timeout:.0f} s for {what}"
         time.sleep(0.1)
-
-
-@pytest.mark.slow
-def test_a_sim_session_runs_with_the_layer_and_uncertainty_it_was_given(tmp_path: Path, run_cli) -> None:
-    """``--layer pi_phase_stop`` (no ILC) and a smaller vision error reach the cell: it
-    learns nothing across executions, so no ILC state appears in the run folder (the
-    default layer writes one at the first fit, see below)."""
-    run = tmp_path / "run"
-    done = run_cli(*SIM_SESSION, "--assembly", "spare", "--layer", "pi_phase_stop", "--vision-sigma", "0.001",
-                   "--out", str(run), timeout=120)
-    assert done.returncode == 0, done.stderr
-    result = json.loads(done.stdout)
-    assert result["matches_truth"] is True
-    cell = json.loads((run / "session.json").read_text())["cell"]
-    assert cell["layer"] == "pi_phase_stop" and cell["magnitudes"]["vision_sigma"] == 0.001
-    assert not (run / "c1-ilc.json").exists()
 
 
 @pytest.mark.slow
