@@ -69,7 +69,17 @@ from executor.cad.locating import (
     support_pairs,
 )
 from executor.cad.parts import STEP_DEFLECTION, CadPart
-from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, passes, section, slice_loops
+from executor.cad.sections import (
+    Loop,
+    Shape2D,
+    classify,
+    exact_round,
+    frame_of,
+    over_span,
+    passes,
+    section,
+    slice_loops,
+)
 from executor.cad.sweep import (
     DIRECTIONS,
     TOUCH,
@@ -583,13 +593,17 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     near = other_along[np.linalg.norm(other.vertices @ frame.T - line, axis=1) <= reach + _SAME_HOLE]
     start, end = float(along.min()), float(near.max())
     stretch: list[tuple[float, Loop | None, shapely.Polygon | None]] = []
-    for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS] + [middle]):
+    for low, high in _intervals(np.concatenate([along, near]), start, end, _PIN_LEVELS):
+        level = (low + high) / 2
         own, theirs = slice_loops(part, axis, level), slice_loops(other, axis, level)
         bores = [o for o in own if o.contains(line) and not _outer(o, own)]
         pins = [o for o in theirs if o.contains(line) and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach
                 and _outer(o, theirs)]  # the base's plate is no pin
-        stretch.append((level, min(bores, key=lambda o: o.area) if bores else None,
-                        shapely.Polygon(min(pins, key=lambda o: o.area).points) if pins else None))
+        narrowest = over_span(min(bores, key=lambda o: o.area), part, axis, low, high, hole=True) if bores else None
+        widest = over_span(min(pins, key=lambda o: o.area), other, axis, low, high, hole=False,
+                           reach=reach) if pins else None
+        stretch.append((level, narrowest if narrowest is not None and len(narrowest.points) >= 3 else None,
+                        None if widest is None else shapely.Polygon(widest.points)))
     beyond: shapely.Polygon | None = None
     best: tuple[float, Shape2D, Shape2D, float] | None = None
     rooms: dict[tuple[bytes, bytes], float] = {}
@@ -670,6 +684,25 @@ def _spans(levels: np.ndarray, low: float, high: float) -> list[float]:
     bounds = np.unique(np.concatenate([[low, high], np.unique(np.round(np.clip(levels, low, high), 9))]))
     spans = sorted(zip(bounds[:-1], bounds[1:], strict=True), key=lambda span: span[0] - span[1])
     return [float(a + b) / 2 for a, b in spans if b - a > 1e-6]
+
+
+def _intervals(levels: np.ndarray, low: float, high: float, count: int) -> list[tuple[float, float]]:
+    """Spans [m] that cover [``low``, ``high``] end to end, split at the distinct
+    ``levels`` [m] within it (a slice changes only at its mesh's vertex levels, so within
+    a span each section's corners move in straight lines), spans of 1 µm or less joined to
+    the next; where that makes more than ``count`` spans, split only at the ends of the
+    ``count`` longest (a joined span is measured over its whole length: never less
+    narrow, only coarser)."""
+    bounds = [low]
+    for level in np.unique(np.round(np.clip(levels, low, high), 9)):
+        if level - bounds[-1] > 1e-6 and high - level > 1e-6:
+            bounds.append(float(level))
+    bounds.append(high)
+    spans = list(zip(bounds[:-1], bounds[1:], strict=True))
+    if len(spans) > count:
+        kept = sorted({low, high} | {end for span in sorted(spans, key=lambda s: s[0] - s[1])[:count] for end in span})
+        spans = list(zip(kept[:-1], kept[1:], strict=True))
+    return spans
 
 
 def _standing_pins(derived: Derived, name: str, level: float,
@@ -784,10 +817,19 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     none) and chamfer of the hole ``loop``."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
-    hole = exact_round(classify(loop, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
-    radial = base.mesh.vertices @ frame.T - hole.centre
-    around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)]
+    sliced = classify(loop, hole=True)
+    radial = base.mesh.vertices @ frame.T - sliced.centre
+    around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(sliced.a, sliced.b)]
     entry = float(around.max())
+    tip = level if occupant is None else float((occupant[0].mesh.vertices @ axis).min())
+    low = max(tip, float(around.min()))
+    narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
+    if len(narrowest.points) < 3:
+        x, y, z = 1e3 * (frame.T @ sliced.centre + axis * level)
+        raise ExecutorError(f"the hole of part {base.id} at ({x:.3f}, {y:.3f}, {z:.3f}) mm is closed between "
+                            f"{1e3 * (entry - low):.3f} mm below its entry and its entry along {name[1:]} "
+                            "(expected an opening all the way in)")
+    hole = exact_round(classify(narrowest, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
     centre = frame.T @ hole.centre + axis * level
     bottom = first_hit(base.mesh, centre, -axis)
     depth = entry - (level - bottom if bottom is not None else float(around.min()))
@@ -797,7 +839,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
     part, section = (None, None) if occupant is None else (
-        occupant[0].id, exact_round(classify(occupant[1], hole=False), occupant[0].cylinders, axis, level,
-                                    STEP_DEFLECTION))
+        occupant[0].id, exact_round(classify(over_span(occupant[1], occupant[0].mesh, axis, tip, entry, hole=False),
+                                             hole=False), occupant[0].cylinders, axis, level, STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)
