@@ -316,14 +316,16 @@ def near_misses(derived: Derived) -> dict[tuple[str, str], float]:
 
 
 def near_miss_reason(pid: str, hid: str, depth: float) -> str:
-    """Why the pair is no experiment of the simulated cell (:func:`near_misses`)."""
+    """Why the pair is no experiment of the PyBullet cell (:func:`near_misses`)."""
     return (f"{pid} in {hid}: misses by less than the cell's peg lacks at its corners (rounded by its 1 mm hull "
             f"margin) plus what the cell resolves ({1e3 * depth:.3f} mm), decided from the CAD")
 
 
 def near_miss_assumption(derived: Derived) -> list[str]:
-    """The near misses the simulated cell does not observe, as ``import`` prints them (none without one)."""
-    return [f"no experiment: {near_miss_reason(pid, hid, depth)}" for (pid, hid), depth in near_misses(derived).items()]
+    """The near misses the PyBullet cell does not observe, as ``import`` prints them (none
+    without one), saying which backends try them (:data:`bridge.assembly.NEAR_MISS_BACKENDS`)."""
+    return [f"no experiment of the PyBullet cell (backend sim; the truth and franka backends try it): "
+            f"{near_miss_reason(pid, hid, depth)}" for (pid, hid), depth in near_misses(derived).items()]
 
 
 def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
