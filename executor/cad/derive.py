@@ -28,7 +28,9 @@ cross-sections, their clearance, the hole's entry (the base's highest point arou
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
 loop whose section is a polygon is a hole only when it has rotational symmetry about its
-centre (:func:`receives`), else a pocket, reported but no hole.
+centre (:func:`receives`), else a pocket, reported but no hole. Both sections are those
+over the stretch the part passes, from its end to the entry
+(:func:`executor.cad.sections.over_span`: the hole's narrowest, the part's widest).
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
@@ -103,7 +105,7 @@ _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
 _PIN_LEVELS = 64
-"""How many levels :func:`_pin_of` measures a part's bore and its pin at, at most (the longest spans)."""
+"""How many spans :func:`_pin_of` measures a part's bore and its pin over, split at the ends of the longest."""
 
 
 @dataclass(frozen=True)
@@ -570,12 +572,13 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     (the owner's farthest vertex along the direction near the line): its bore at each level
     passes every section of the pin beyond that level. The sections kept are those of the
     narrowest such passage (the least room, :func:`executor.world.geometry.margin`): the
-    bore at one level and the union of the pin's outlines beyond it, measured over the
-    middles of the spans between the vertex levels of both (a gland's d 17 lips, not the
-    d 28 recess between them; a pulley's d 26 web over the boss's d 26 collar, not the
-    d 22 it sits on) and the middle of the part's extent (a bore is narrowest at a vertex
-    level, which no span's middle is: Meta-World's torus ring, d 74.569 mm at its middle,
-    d 74.980 at the nearest span's)."""
+    bore over one span and the union of the pin's outlines beyond it, over spans end to end
+    split at the vertex levels of both (:func:`_intervals`), each measured over its whole
+    length (:func:`executor.cad.sections.over_span`: the bore free at every level of it,
+    the pin covering at some level), so a bore narrowest at a vertex level is measured
+    there (Meta-World's torus ring, d 74.569 mm at its middle, d 74.980 at the nearest
+    span's middle); a gland's d 17 lips, not the d 28 recess between them; a pulley's
+    d 26 web over the boss's d 26 collar, not the d 22 it sits on."""
     axis = np.array(derived.directions[name])
     part, other = derived.parts[pid].mesh, derived.parts[owner].mesh
     along, other_along = part.vertices @ axis, other.vertices @ axis
@@ -814,7 +817,11 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
              occupant: tuple[CadPart, Loop] | None) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
     the hole's centre line; through it, to its lowest point around the hole, when there is
-    none) and chamfer of the hole ``loop``."""
+    none) and chamfer of the hole ``loop`` sliced at ``level`` [m], and the section of the
+    ``occupant`` (its part, its loop there). The sections are over the stretch from the
+    occupant's end (or the hole's lowest point around it, if higher; without one, from
+    ``level``) to the entry (:func:`executor.cad.sections.over_span`); ExecutorError when
+    nothing of the hole is free all along it."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
     sliced = classify(loop, hole=True)
