@@ -193,7 +193,8 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     the loop's box (where that leaves several pieces, the largest). A part's: the points
     it covers at some level, the loop with the shadow of its faces within ``reach`` [m] of
     the loop's centre across the axis, by their box (a pin's owner's other pins are not the
-    pin), its outer outline (pieces apart joined by their convex hull). Exact, whatever
+    pin), its outer outline (pieces apart joined by their convex hull, but slivers within
+    :data:`SAME_OUTLINE` of it: a wall's faces along the axis, tilted by the float). Exact, whatever
     lies between the levels slices are taken at (a taper, a groove's edge, a slanted
     facet): a point free at one level of the span and covered at another lies under a
     face crossing the span. ``loop`` itself when the section lies within
@@ -212,9 +213,11 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
             return Loop(np.zeros((0, 2)))
         found = max(pieces, key=lambda piece: piece.area)
     else:
-        joined = shapely.union(outline, cover)
-        found = joined if isinstance(joined, shapely.Polygon) else joined.convex_hull
-        found = shapely.Polygon(found.exterior)
+        pieces = list(shapely.get_parts(shapely.union(outline, cover)))
+        main = max(pieces, key=lambda piece: piece.area)
+        near = main.buffer(SAME_OUTLINE)
+        apart = [piece for piece in pieces if piece is not main and not near.covers(piece)]
+        found = shapely.Polygon((shapely.union_all([main, *apart]).convex_hull if apart else main).exterior)
     if shapely.hausdorff_distance(outline.exterior, found.exterior) <= SAME_OUTLINE:
         return loop
     return Loop(np.asarray(found.exterior.coords)[:-1])

@@ -138,6 +138,7 @@ def _narrowed(radius: float, narrow: float, levels: tuple[float, float, float], 
 
 
 
+@pytest.mark.slow  # the derivation: 4 to 7 s under load
 @pytest.mark.parametrize(("narrow", "fits"), [(4.975 * MM, False), (5.1 * MM, True)])
 def test_a_hole_narrowed_between_the_levels_sliced_is_measured_at_its_throat(narrow: float, fits: bool) -> None:
     # A 100 x 50 x 20 mm plate with two d 10.4 mm bores (48 corners on their circles), the
@@ -160,6 +161,7 @@ def test_a_hole_narrowed_between_the_levels_sliced_is_measured_at_its_throat(nar
     assert (margins(derived)["wide"][hid] > 0) == fits
 
 
+@pytest.mark.slow  # the derivation: 4 to 7 s under load
 @pytest.mark.parametrize(("narrow", "fits"), [(4.975 * MM, False), (5.1 * MM, True)])
 def test_a_bore_narrowed_at_a_level_no_slice_is_taken_at_is_measured_at_its_throat(narrow: float, fits: bool) -> None:
     # A plate with a d 10 mm pin and a d 9.8 mm one 40 mm apart, standing 20 mm on it; on
