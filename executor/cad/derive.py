@@ -648,6 +648,9 @@ def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Pol
     if beyond is None:
         return pin
     union = shapely.union(beyond, pin, grid_size=_GRID)
+    if not isinstance(union, shapely.Polygon):  # snapped apart, or with lines of no area: what holds them all
+        polygons = [part for part in shapely.get_parts(union) if isinstance(part, shapely.Polygon)]
+        union = polygons[0] if len(polygons) == 1 else shapely.union_all(polygons).convex_hull
     if len(union.exterior.coords) > 4 * len(pin.exterior.coords):
         return shapely.simplify(union, _GRID)
     return union
