@@ -198,8 +198,11 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     lies between the levels slices are taken at (a taper, a groove's edge, a slanted
     facet): a point free at one level of the span and covered at another lies under a
     face crossing the span. ``loop`` itself when the section lies within
-    :data:`SAME_OUTLINE` of it; no points when nothing of the hole is free all along."""
+    :data:`SAME_OUTLINE` of it, or when it is no simple polygon; no points when nothing of
+    the hole is free all along."""
     outline = shapely.make_valid(shapely.Polygon(loop.points))
+    if not isinstance(outline, shapely.Polygon):
+        return loop  # no simple polygon (faces that touch): the fit relation refuses it as sliced
     x0, y0, x1, y1 = outline.bounds
     if not hole:
         x, y = loop.centre
