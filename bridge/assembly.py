@@ -44,14 +44,20 @@ from bridge.product import (
 )
 from bridge.product.nominal import models_nominal_fits, stated_nominal_fits
 
-__all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "SHAPES", "SIZE_MODELS", "Assembly", "Hole", "Item", "Part",
-           "is_id", "load_assembly", "resolve_assembly_folder"]
+__all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "NEAR_MISS_BACKENDS", "SHAPES", "SIZE_MODELS", "Assembly",
+           "Hole", "Item", "Part", "is_id", "load_assembly", "resolve_assembly_folder"]
 
 _INSTALLED_ASSEMBLIES = Path(__file__).resolve().parent / "assemblies"
 DATA_DIR = (_INSTALLED_ASSEMBLIES if _INSTALLED_ASSEMBLIES.is_dir()
             else Path(__file__).resolve().parent.parent / "data")
 """The shipped assemblies: the repository's ``data/``, or in an installed copy its package
 data ``bridge/assemblies`` (``setup.py``), so ``--assembly cranfield`` works from any folder."""
+NEAR_MISS_BACKENDS = frozenset({"sim"})
+"""The backends whose physics cannot tell a near miss (``near_miss`` of ``geometry.toml``)
+from a fit: the PyBullet cell's (``sim``), whose pegs built from sections lack their
+corners by its 1 mm hull margin (docs/cell.md#what-the-physics-resolves). The ``truth``
+backend answers from the CAD, the arm (``franka``, real or franky-sim) inserts the real
+part and a plugin's physics is its own: they try such a pair."""
 
 
 @dataclass(frozen=True)
@@ -111,21 +117,25 @@ class Assembly:
     nominal_fits: frozenset[tuple[str, str]] = frozenset()
     """The (part, hole) pairs ``geometry.toml`` states as nominal zero-clearance fits (``zero_clearance``)."""
     near_misses: frozenset[tuple[str, str]] = frozenset()
-    """The (part, hole) pairs ``geometry.toml`` states the simulated cell cannot tell from a fit
-    (``near_miss``: the part misses the hole by less than the cell's peg lacks at its corners)."""
+    """The (part, hole) pairs ``geometry.toml`` states the PyBullet cell cannot tell from a
+    fit (``near_miss``: the part misses the hole by less than the cell's peg lacks at its
+    corners); a near miss only with a backend of :data:`NEAR_MISS_BACKENDS`."""
     nominal_modelled: bool = False
     """Whether the simulated cell builds those fits with
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
     it cannot resolve them and they are no experiment."""
 
-    def tried_by_hand(self, part: str, hole: str) -> bool:
-        """Whether no cell can try ``part`` in ``hole``: the part is placed by hand, the
+    def tried_by_hand(self, part: str, hole: str, backend: str) -> bool:
+        """Whether no cell of ``backend`` (``sim``, ``truth``, ``franka`` or a plugin's
+        ``MODULE:CLASS``) can try ``part`` in ``hole``: the part is placed by hand, the
         hole is one the cell does not model (a pin an imported part goes onto, a hole of a
         section the cell inserts no part in), a peg and a pin, a part with a bore and a
         hole (the cell puts parts with a bore onto pins only, pegs into holes only), a
         nominal zero-clearance fit the cell cannot build with room (:attr:`nominal_modelled`),
-        or a near miss the cell cannot tell from a fit (:attr:`near_misses`)."""
-        return (part in self.manual or self.cell_cannot_insert(part, hole) or (part, hole) in self.near_misses
+        or, with a backend of :data:`NEAR_MISS_BACKENDS`, a near miss its physics cannot
+        tell from a fit (:attr:`near_misses`)."""
+        return (part in self.manual or self.cell_cannot_insert(part, hole)
+                or (backend in NEAR_MISS_BACKENDS and (part, hole) in self.near_misses)
                 or ((part, hole) in self.nominal_fits and not self.nominal_modelled))
 
     def cell_cannot_insert(self, part: str, hole: str) -> bool:

@@ -82,7 +82,7 @@ from asp.sizes.models import SizeModel, model_for
 from asp.sizes.truth_oracle import Result, TruthOracle
 from asp.solve import fact, write_facts
 from bridge import BridgeError
-from bridge.assembly import Assembly, load_assembly
+from bridge.assembly import NEAR_MISS_BACKENDS, Assembly, load_assembly
 from bridge.cell_settings import DEFAULT_CELL, ServeSettings
 from bridge.client import CellDirectory, CellPool, PoolLimits
 from bridge.files import make_folder
@@ -166,27 +166,42 @@ def _sizes_domain(assembly: Assembly, requested_model: str | None
     return parts, holes, truth, model
 
 
-def _placed_by_hand(assembly: Assembly, truth: TruthOracle | None, decided: list[tuple[Pair, Result]]
+def _placed_by_hand(assembly: Assembly, backend: str, truth: TruthOracle | None, decided: list[tuple[Pair, Result]]
                     ) -> list[tuple[Pair, Result]]:
-    """The outcomes of the pairs no cell can try (:meth:`bridge.assembly.Assembly.tried_by_hand`:
-    a part placed by hand, a hole the cell does not model, a near miss it does not resolve),
-    from the product's ``sizes.lp`` (an imported product's nominal sections), except those ``decided`` already."""
+    """The outcomes of the pairs no cell of ``backend`` can try
+    (:meth:`bridge.assembly.Assembly.tried_by_hand`: a part placed by hand, a hole the
+    cell does not model, a near miss the PyBullet cell does not resolve), from the
+    product's ``sizes.lp`` (an imported product's nominal sections), except those ``decided`` already."""
     if truth is None:
         return []
     known = {pair for pair, _ in decided}
     return [((part, hole), "fit" if (part, hole) in truth.fits else "no_fit")
             for part in truth.parts for hole in truth.holes
-            if assembly.tried_by_hand(part, hole) and (part, hole) not in known]
+            if assembly.tried_by_hand(part, hole, backend) and (part, hole) not in known]
 
 
-def _by_hand_statement(assembly: Assembly, by_hand: list[tuple[Pair, Result]]) -> str:
+def _by_hand_statement(assembly: Assembly, backend: str, by_hand: list[tuple[Pair, Result]]) -> str:
     """The line a run prints (and ``learned.lp`` keeps) for the pairs it takes from
-    ``sizes.lp`` because the cell places their parts by hand."""
+    ``sizes.lp`` because no cell of ``backend`` can try them."""
     fits = sum(result == "fit" for _, result in by_hand)
     shown = " ".join(f"{part}->{hole}" for (part, hole), _ in by_hand[:8]) + (" ..." if len(by_hand) > 8 else "")
-    return (f"{len(by_hand)} pairs no cell can try (a part placed by hand, a hole the cell does not model or a near "
-            f"miss it does not resolve: "
+    near = " or a near miss its physics does not resolve" if backend in NEAR_MISS_BACKENDS else ""
+    return (f"{len(by_hand)} pairs no cell can try (a part placed by hand, a hole the cell does not model{near}: "
             f"{shown}) are taken from {assembly.folder / 'sizes.lp'} (the nominal sections, {fits} fit), not observed")
+
+
+def _near_miss_statement(assembly: Assembly, backend: str, by_hand: list[tuple[Pair, Result]]) -> str | None:
+    """The line a run prints (and ``learned.lp`` keeps) for the product's near misses
+    (``near_miss`` of ``geometry.toml``) that its cells try: those of a backend not in
+    :data:`bridge.assembly.NEAR_MISS_BACKENDS`, whose pegs lack no corners; None when
+    there is none (or the backend takes them from ``sizes.lp``)."""
+    taken = {pair for pair, _ in by_hand}
+    tried = sorted(pair for pair in assembly.near_misses if pair not in taken)
+    if backend in NEAR_MISS_BACKENDS or not tried:
+        return None
+    shown = " ".join(f"{part}->{hole}" for part, hole in tried[:8]) + (" ..." if len(tried) > 8 else "")
+    return (f"{len(tried)} near miss(es) the PyBullet cell does not resolve ({shown}) are tried: backend {backend} "
+            "does not build its pegs from sections with corners rounded by a hull margin")
 
 
 def _nominal_fits(assembly: Assembly, backend: str, parts: list[str], holes: list[str]) -> NominalFits | None:
@@ -194,7 +209,7 @@ def _nominal_fits(assembly: Assembly, backend: str, parts: list[str], holes: lis
     room it builds them with (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`); None with
     another backend or without such a pair among ``parts`` x ``holes``."""
     pairs = sorted(pair for pair in assembly.nominal_fits
-                   if pair[0] in parts and pair[1] in holes and not assembly.tried_by_hand(*pair))
+                   if pair[0] in parts and pair[1] in holes and not assembly.tried_by_hand(*pair, backend))
     return NominalFits(room_m=NOMINAL_FIT_ROOM, pairs=pairs) if backend == "sim" and pairs else None
 
 
@@ -469,14 +484,15 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
     record.prior = None if record.size_prior is None else DecidedPrior(
         kind=record.size_prior, tolerance_m=record.tolerance_m, pairs=len(parts) * len(holes),
         decided=[(p, h, result) for (p, h), result in decided])
-    by_hand = _placed_by_hand(assembly, truth, decided)
+    by_hand = _placed_by_hand(assembly, settings.backend, truth, decided)
     decided = [*decided, *by_hand]
     record.not_observed = [(part, hole, result) for (part, hole), result in by_hand]
     not_observed = [pair for pair, _ in by_hand]
     record.nominal_fits = _nominal_fits(assembly, settings.backend, parts, holes)
     stated_prior = "; ".join(statement for statement in (
         None if record.prior is None else prior_statement(record.prior),
-        None if not by_hand else _by_hand_statement(assembly, by_hand),
+        None if not by_hand else _by_hand_statement(assembly, settings.backend, by_hand),
+        _near_miss_statement(assembly, settings.backend, by_hand),
         None if record.nominal_fits is None else _nominal_statement(record.nominal_fits))
         if statement is not None) or None
     # Every input file is read before any cell starts: bad input fails fast.

@@ -61,6 +61,7 @@ from executor.cad.write import (
     claim_folder,
     entry_point,
     map_product,
+    mesh_pieces,
     near_miss_assumption,
     nominal_assumption,
     section,
@@ -317,8 +318,9 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     derived = derive(parts, settings.base, fixed, reach)
-    assumed += [*derived.assumptions(), *nominal_assumption(derived), *near_miss_assumption(derived),
-                *overlap_assumption(derived)]
+    assumed += [*derived.assumptions(), *nominal_assumption(derived)]
+    near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
+    assumed += overlap_assumption(derived)
     mapped, laid = map_product(derived, settings)
     assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))
@@ -328,6 +330,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
                        f"({_mm(TRAY_START[0])}, {_mm(TRAY_START[1])}) mm (set [parts.<id>] tray)")
     settings = laid
     written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
+    assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
 
 

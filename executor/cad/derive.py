@@ -28,7 +28,9 @@ cross-sections, their clearance, the hole's entry (the base's highest point arou
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
 loop whose section is a polygon is a hole only when it has rotational symmetry about its
-centre (:func:`receives`), else a pocket, reported but no hole.
+centre (:func:`receives`), else a pocket, reported but no hole. Both sections are those
+over the stretch the part passes, from its end to the entry
+(:func:`executor.cad.sections.over_span`: the hole's narrowest, the part's widest).
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
@@ -69,7 +71,17 @@ from executor.cad.locating import (
     support_pairs,
 )
 from executor.cad.parts import STEP_DEFLECTION, CadPart
-from executor.cad.sections import Loop, Shape2D, classify, exact_round, frame_of, passes, section, slice_loops
+from executor.cad.sections import (
+    Loop,
+    Shape2D,
+    classify,
+    exact_round,
+    frame_of,
+    over_span,
+    passes,
+    section,
+    slice_loops,
+)
 from executor.cad.sweep import (
     DIRECTIONS,
     TOUCH,
@@ -93,7 +105,7 @@ _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
 _PIN_LEVELS = 64
-"""How many levels :func:`_pin_of` measures a part's bore and its pin at, at most (the longest spans)."""
+"""How many spans :func:`_pin_of` measures a part's bore and its pin over, split at the ends of the longest."""
 
 
 @dataclass(frozen=True)
@@ -560,12 +572,13 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     (the owner's farthest vertex along the direction near the line): its bore at each level
     passes every section of the pin beyond that level. The sections kept are those of the
     narrowest such passage (the least room, :func:`executor.world.geometry.margin`): the
-    bore at one level and the union of the pin's outlines beyond it, measured over the
-    middles of the spans between the vertex levels of both (a gland's d 17 lips, not the
-    d 28 recess between them; a pulley's d 26 web over the boss's d 26 collar, not the
-    d 22 it sits on) and the middle of the part's extent (a bore is narrowest at a vertex
-    level, which no span's middle is: Meta-World's torus ring, d 74.569 mm at its middle,
-    d 74.980 at the nearest span's)."""
+    bore over one span and the union of the pin's outlines beyond it, over spans end to end
+    split at the vertex levels of both (:func:`_intervals`), each measured over its whole
+    length (:func:`executor.cad.sections.over_span`: the bore free at every level of it,
+    the pin covering at some level), so a bore narrowest at a vertex level is measured
+    there (Meta-World's torus ring, d 74.569 mm at its middle, d 74.980 at the nearest
+    span's middle); a gland's d 17 lips, not the d 28 recess between them; a pulley's
+    d 26 web over the boss's d 26 collar, not the d 22 it sits on."""
     axis = np.array(derived.directions[name])
     part, other = derived.parts[pid].mesh, derived.parts[owner].mesh
     along, other_along = part.vertices @ axis, other.vertices @ axis
@@ -583,13 +596,17 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     near = other_along[np.linalg.norm(other.vertices @ frame.T - line, axis=1) <= reach + _SAME_HOLE]
     start, end = float(along.min()), float(near.max())
     stretch: list[tuple[float, Loop | None, shapely.Polygon | None]] = []
-    for level in sorted(_spans(np.concatenate([along, near]), start, end)[:_PIN_LEVELS] + [middle]):
+    for low, high in _intervals(np.concatenate([along, near]), start, end, _PIN_LEVELS):
+        level = (low + high) / 2
         own, theirs = slice_loops(part, axis, level), slice_loops(other, axis, level)
         bores = [o for o in own if o.contains(line) and not _outer(o, own)]
         pins = [o for o in theirs if o.contains(line) and float(np.linalg.norm(o.points - line, axis=1).max()) <= reach
                 and _outer(o, theirs)]  # the base's plate is no pin
-        stretch.append((level, min(bores, key=lambda o: o.area) if bores else None,
-                        shapely.Polygon(min(pins, key=lambda o: o.area).points) if pins else None))
+        narrowest = over_span(min(bores, key=lambda o: o.area), part, axis, low, high, hole=True) if bores else None
+        widest = over_span(min(pins, key=lambda o: o.area), other, axis, low, high, hole=False,
+                           reach=reach) if pins else None
+        stretch.append((level, narrowest if narrowest is not None and len(narrowest.points) >= 3 else None,
+                        None if widest is None else shapely.Polygon(widest.points)))
     beyond: shapely.Polygon | None = None
     best: tuple[float, Shape2D, Shape2D, float] | None = None
     rooms: dict[tuple[bytes, bytes], float] = {}
@@ -631,6 +648,9 @@ def _joined(beyond: shapely.Polygon | None, pin: shapely.Polygon) -> shapely.Pol
     if beyond is None:
         return pin
     union = shapely.union(beyond, pin, grid_size=_GRID)
+    if not isinstance(union, shapely.Polygon):  # snapped apart, or with lines of no area: what holds them all
+        polygons = [part for part in shapely.get_parts(union) if isinstance(part, shapely.Polygon)]
+        union = polygons[0] if len(polygons) == 1 else shapely.union_all(polygons).convex_hull
     if len(union.exterior.coords) > 4 * len(pin.exterior.coords):
         return shapely.simplify(union, _GRID)
     return union
@@ -670,6 +690,25 @@ def _spans(levels: np.ndarray, low: float, high: float) -> list[float]:
     bounds = np.unique(np.concatenate([[low, high], np.unique(np.round(np.clip(levels, low, high), 9))]))
     spans = sorted(zip(bounds[:-1], bounds[1:], strict=True), key=lambda span: span[0] - span[1])
     return [float(a + b) / 2 for a, b in spans if b - a > 1e-6]
+
+
+def _intervals(levels: np.ndarray, low: float, high: float, count: int) -> list[tuple[float, float]]:
+    """Spans [m] that cover [``low``, ``high``] end to end, split at the distinct
+    ``levels`` [m] within it (a slice changes only at its mesh's vertex levels, so within
+    a span each section's corners move in straight lines), spans of 1 µm or less joined to
+    the next; where that makes more than ``count`` spans, split only at the ends of the
+    ``count`` longest (a joined span is measured over its whole length: never less
+    narrow, only coarser)."""
+    bounds = [low]
+    for level in np.unique(np.round(np.clip(levels, low, high), 9)):
+        if level - bounds[-1] > 1e-6 and high - level > 1e-6:
+            bounds.append(float(level))
+    bounds.append(high)
+    spans = list(zip(bounds[:-1], bounds[1:], strict=True))
+    if len(spans) > count:
+        kept = sorted({low, high} | {end for span in sorted(spans, key=lambda s: s[0] - s[1])[:count] for end in span})
+        spans = list(zip(kept[:-1], kept[1:], strict=True))
+    return spans
 
 
 def _standing_pins(derived: Derived, name: str, level: float,
@@ -781,13 +820,26 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
              occupant: tuple[CadPart, Loop] | None) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
     the hole's centre line; through it, to its lowest point around the hole, when there is
-    none) and chamfer of the hole ``loop``."""
+    none) and chamfer of the hole ``loop`` sliced at ``level`` [m], and the section of the
+    ``occupant`` (its part, its loop there). The sections are over the stretch from the
+    occupant's end (or the hole's lowest point around it, if higher; without one, from
+    ``level``) to the entry (:func:`executor.cad.sections.over_span`); ExecutorError when
+    nothing of the hole is free all along it."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
-    hole = exact_round(classify(loop, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
-    radial = base.mesh.vertices @ frame.T - hole.centre
-    around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(hole.a, hole.b)]
+    sliced = classify(loop, hole=True)
+    radial = base.mesh.vertices @ frame.T - sliced.centre
+    around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(sliced.a, sliced.b)]
     entry = float(around.max())
+    tip = level if occupant is None else float((occupant[0].mesh.vertices @ axis).min())
+    low = max(tip, float(around.min()))
+    narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
+    if len(narrowest.points) < 3:
+        x, y, z = 1e3 * (frame.T @ sliced.centre + axis * level)
+        raise ExecutorError(f"the hole of part {base.id} at ({x:.3f}, {y:.3f}, {z:.3f}) mm is closed between "
+                            f"{1e3 * (entry - low):.3f} mm below its entry and its entry along {name[1:]} "
+                            "(expected an opening all the way in)")
+    hole = exact_round(classify(narrowest, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
     centre = frame.T @ hole.centre + axis * level
     bottom = first_hit(base.mesh, centre, -axis)
     depth = entry - (level - bottom if bottom is not None else float(around.min()))
@@ -797,7 +849,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
     part, section = (None, None) if occupant is None else (
-        occupant[0].id, exact_round(classify(occupant[1], hole=False), occupant[0].cylinders, axis, level,
-                                    STEP_DEFLECTION))
+        occupant[0].id, exact_round(classify(over_span(occupant[1], occupant[0].mesh, axis, tip, entry, hole=False),
+                                             hole=False), occupant[0].cylinders, axis, level, STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)

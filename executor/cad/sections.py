@@ -141,6 +141,91 @@ def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[L
     return loops
 
 
+SPAN_TOLERANCE = 1e-8
+"""A face lying within this [m] of an end of a span, beyond its inside, is no part of it
+(:func:`shadow`): the faces across the axis that bound it there (a hole's floor a peg
+stands on, a bolt head's face on the plate's) are taken as at that end's level."""
+SAME_OUTLINE = 1e-8
+"""A section over a span whose outline lies within this [m] of the loop sliced in it
+(Hausdorff) is that loop (the projected faces meet its edges to the float)."""
+
+
+def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
+           near: tuple[float, float, float, float]) -> shapely.Geometry:
+    """The union of the projections across ``axis`` (in :func:`frame_of`'s axes) of the
+    pieces of ``mesh``'s triangles between the levels ``low`` and ``high`` [m] (not those
+    within :data:`SPAN_TOLERANCE` of an end, beyond it), of those whose projection meets the box
+    ``near`` (x0, y0, x1, y1) [m]. A triangle clipped to the span is convex, so its
+    projection is the convex hull of its clipped corners; a wall along the axis projects
+    to no area. Every point the solid covers at some level of the span, and not at a level
+    inside it where it is sliced, lies under a face crossing the span: this is exactly the
+    set that sections over the span gain or lose (:func:`over_span`)."""
+    axis = np.asarray(axis, dtype=float)
+    triangles = mesh.triangles
+    heights = triangles @ axis
+    flat = triangles @ frame_of(axis).T
+    keep = ((heights.max(axis=1) > low + SPAN_TOLERANCE) & (heights.min(axis=1) < high - SPAN_TOLERANCE)
+            & (flat[:, :, 0].max(axis=1) >= near[0]) & (flat[:, :, 0].min(axis=1) <= near[2])
+            & (flat[:, :, 1].max(axis=1) >= near[1]) & (flat[:, :, 1].min(axis=1) <= near[3]))
+    heights, flat = heights[keep], flat[keep]
+    if not len(heights):
+        return shapely.Polygon()
+    points, valid = [flat], [(heights >= low) & (heights <= high)]
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        for level in (low, high):
+            crossing = (heights[:, i] - level) * (heights[:, j] - level) < 0
+            step = np.where(crossing, heights[:, j] - heights[:, i], 1.0)
+            t = np.where(crossing, (level - heights[:, i]) / step, 0.0)
+            points.append((flat[:, i] + t[:, None] * (flat[:, j] - flat[:, i]))[:, None])
+            valid.append(crossing[:, None])
+    corners, mask = np.concatenate(points, axis=1), np.concatenate(valid, axis=1)
+    owner = np.nonzero(mask)[0]
+    hulls = shapely.convex_hull(shapely.multipoints(corners[mask], indices=owner))
+    hulls = hulls[shapely.area(hulls) > 0]
+    return shapely.union_all(hulls) if len(hulls) else shapely.Polygon()
+
+
+def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float, *, hole: bool,
+              reach: float = math.inf) -> Loop:
+    """The section of ``mesh`` over the span between the levels ``low`` and ``high`` [m]
+    along ``axis``, from its ``loop`` sliced at a level inside it. A hole's: the points
+    free at every level of the span, the loop less the :func:`shadow` of the faces within
+    the loop's box (where that leaves several pieces, the largest). A part's: the points
+    it covers at some level, the loop with the shadow of its faces within ``reach`` [m] of
+    the loop's centre across the axis, by their box (a pin's owner's other pins are not the
+    pin), its outer outline (pieces apart joined by their convex hull, but slivers within
+    :data:`SAME_OUTLINE` of it: a wall's faces along the axis, tilted by the float). Exact, whatever
+    lies between the levels slices are taken at (a taper, a groove's edge, a slanted
+    facet): a point free at one level of the span and covered at another lies under a
+    face crossing the span. ``loop`` itself when the section lies within
+    :data:`SAME_OUTLINE` of it, or when it is no simple polygon; no points when nothing of
+    the hole is free all along."""
+    outline = shapely.make_valid(shapely.Polygon(loop.points))
+    if not isinstance(outline, shapely.Polygon):
+        return loop  # no simple polygon (faces that touch): the fit relation refuses it as sliced
+    x0, y0, x1, y1 = outline.bounds
+    if not hole:
+        x, y = loop.centre
+        x0, y0, x1, y1 = x - reach, y - reach, x + reach, y + reach
+    cover = shadow(mesh, axis, low, high, (x0, y0, x1, y1))
+    if cover.is_empty:
+        return loop
+    if hole:
+        pieces = shapely.get_parts(shapely.difference(outline, cover))
+        if not len(pieces):
+            return Loop(np.zeros((0, 2)))
+        found = max(pieces, key=lambda piece: piece.area)
+    else:
+        pieces = list(shapely.get_parts(shapely.union(outline, cover)))
+        main = max(pieces, key=lambda piece: piece.area)
+        near = main.buffer(SAME_OUTLINE)
+        apart = [piece for piece in pieces if piece is not main and not near.covers(piece)]
+        found = shapely.Polygon((shapely.union_all([main, *apart]).convex_hull if apart else main).exterior)
+    if shapely.hausdorff_distance(outline.exterior, found.exterior) <= SAME_OUTLINE:
+        return loop
+    return Loop(np.asarray(found.exterior.coords)[:-1])
+
+
 def _closed_polylines(section: trimesh.path.Path3D) -> list[np.ndarray]:
     """The points (n, 3) [m] of each closed path of a plane section, the first repeated
     last: those of :func:`_closed_paths` discretised, in the same order. Where the

@@ -45,7 +45,7 @@ import hashlib
 import json
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -77,11 +77,12 @@ from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, section, zero_clearance
 from executor.cad.sections import rounded as _q
-from executor.cad.sweep import opposite
+from executor.cad.sweep import DIRECTIONS, opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, margin, plate_obj_text, thin_prism
-from executor.world.near_miss import near_miss
+from executor.world.meshes import read_objects
+from executor.world.near_miss import mesh_near_miss, near_miss
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -297,33 +298,53 @@ def zero_clearance_parts(derived: Derived) -> dict[str, list[str]]:
     return found
 
 
-def near_misses(derived: Derived) -> dict[tuple[str, str], float]:
-    """(peg, hole of the base) -> the erosion [m] of each no-fit the simulated cell cannot
-    resolve (:func:`executor.world.near_miss.near_miss`: the peg's section eroded by what
-    its collision shape may lack, plus the cell's resolution, passes the hole), for the
-    pegs the cell builds from their sections (a cylinder, a box, a polygon's prism; not a
-    peg simulated from its mesh): a hole's ``near_miss`` in ``geometry.toml``."""
+def near_misses(derived: Derived, pieces: Mapping[str, Sequence[np.ndarray]] | None = None
+                ) -> dict[tuple[str, str], float]:
+    """(peg, hole of the base) -> how deep [m] the cell's peg lacks its section, plus the
+    cell's resolution, for each no-fit the simulated cell cannot resolve: for a peg the
+    cell builds from its section (a cylinder, a box, a polygon's prism),
+    :func:`executor.world.near_miss.near_miss` (its section eroded by what its collision
+    shape may lack passes the hole); for a peg simulated from its mesh, whose convex
+    pieces (vertices in its part frame) are in ``pieces``,
+    :func:`executor.world.near_miss.mesh_near_miss` (what its pieces cover over the
+    stretch that enters the hole passes it). A hole's ``near_miss`` in ``geometry.toml``."""
     rooms, pairs, found = margins(derived), _pairs(derived), {}
     for pid, fit in sorted(derived.hole_of.items()):
-        if fit.section is None or not peg_is_primitive(fit, _upright(derived, fit)):
+        if fit.section is None:
             continue
+        primitive = peg_is_primitive(fit, _upright(derived, fit))
+        if not primitive and (pieces is None or pid not in pieces):
+            continue
+        tip = float((derived.parts[pid].mesh.vertices @ np.array(DIRECTIONS[fit.axis])).min())
         for hid in derived.holes:
             peg, hole = pairs[pid][hid]
-            depth = near_miss(section(f"part {pid}", peg), section(f"hole {hid}", hole), rooms[pid][hid])
+            part, cell_hole = section(f"part {pid}", peg), section(f"hole {hid}", hole)
+            depth = (near_miss(part, cell_hole, rooms[pid][hid]) if primitive else
+                     mesh_near_miss(part, (pieces or {})[pid], fit.entry - tip, cell_hole, rooms[pid][hid]))
             if depth is not None:
                 found[(pid, hid)] = depth
     return found
 
 
+def mesh_pieces(out: Path, written: Iterable[Path]) -> dict[str, list[np.ndarray]]:
+    """Part -> the vertices [m] of each convex piece of its ``convex`` file among the files
+    ``written`` into the assembly folder ``out`` (a part simulated from its mesh)."""
+    return {path.name.removesuffix(".convex.obj"): read_objects(out / MESH_FOLDER / path.name)
+            for path in written if path.name.endswith(".convex.obj")}
+
+
 def near_miss_reason(pid: str, hid: str, depth: float) -> str:
-    """Why the pair is no experiment of the simulated cell (:func:`near_misses`)."""
+    """Why the pair is no experiment of the PyBullet cell (:func:`near_misses`)."""
     return (f"{pid} in {hid}: misses by less than the cell's peg lacks at its corners (rounded by its 1 mm hull "
             f"margin) plus what the cell resolves ({1e3 * depth:.3f} mm), decided from the CAD")
 
 
-def near_miss_assumption(derived: Derived) -> list[str]:
-    """The near misses the simulated cell does not observe, as ``import`` prints them (none without one)."""
-    return [f"no experiment: {near_miss_reason(pid, hid, depth)}" for (pid, hid), depth in near_misses(derived).items()]
+def near_miss_assumption(derived: Derived, pieces: Mapping[str, Sequence[np.ndarray]] | None = None) -> list[str]:
+    """The near misses the PyBullet cell does not observe (:func:`near_misses`), as
+    ``import`` prints them (none without one), saying which backends try them
+    (:data:`bridge.assembly.NEAR_MISS_BACKENDS`)."""
+    return [f"no experiment of the PyBullet cell (backend sim; the truth and franka backends try it): "
+            f"{near_miss_reason(pid, hid, depth)}" for (pid, hid), depth in near_misses(derived, pieces).items()]
 
 
 def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
@@ -820,9 +841,11 @@ def manual_features(derived: Derived, mapped: Mapped) -> dict[str, tuple[list[st
 
 
 def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh],
-                  features: dict[str, tuple[list[str], dict[str, list[str]]]]) -> str:
+                  features: dict[str, tuple[list[str], dict[str, list[str]]]],
+                  pieces: Mapping[str, Sequence[np.ndarray]]) -> str:
     """``geometry.toml`` of a mapped product (:func:`map_product`), the parts in ``meshes``
-    as their own meshes, the features of the parts placed by hand (:func:`manual_features`)."""
+    as their own meshes (``pieces``: the convex pieces of those that move, :func:`mesh_pieces`),
+    the features of the parts placed by hand (:func:`manual_features`)."""
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
@@ -837,7 +860,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              "polygon_sides = 24",
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
-    nominal, pairs, missed = zero_clearance_parts(derived), _pairs(derived), near_misses(derived)
+    nominal, pairs, missed = zero_clearance_parts(derived), _pairs(derived), near_misses(derived, pieces)
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
@@ -1076,7 +1099,8 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     if isinstance(meshes, str):
         why = meshes
     elif meshes is not None:
-        write_atomic(geometry, geometry_text(cell, mapped, settings, meshes, manual_features(derived, mapped)))
+        write_atomic(geometry, geometry_text(cell, mapped, settings, meshes, manual_features(derived, mapped),
+                                             mesh_pieces(out, mesh_files)))
         try:
             loaded = load_geometry(str(out))
             plate_obj_text(loaded)  # the cell builds its plate's bosses from it

@@ -21,17 +21,29 @@ the cell cannot tell the pair from a fit, and it is no experiment (the import wr
 ``near_miss`` in ``geometry.toml``: docs/cell.md#what-the-physics-resolves). Whether the
 eroded section passes is :func:`executor.world.geometry.margin`'s decision, the same
 polygon relation the import decides every pair by (for two polygons a search: a no-pass
-is its finding). Pegs simulated from their own meshes (convex pieces of a mesh) are not
-covered.
+is its finding).
+
+A peg simulated from its own mesh collides as its convex pieces, each the asset's piece
+eroded by the margin (:func:`executor.world.meshes.eroded`) that Bullet adds back: its
+edges rounded alike (measured: a 10 mm square piece's vertical edge lies 0.414 mm inside
+the CAD's corner, r (√2 - 1), its faces where the CAD has them). What such a peg covers
+across its axis over the stretch that enters the hole holds, at least,
+:func:`pieces_section`: each eroded piece clipped to that stretch, projected, and widened
+by the margin. :func:`mesh_near_miss` decides its pairs by that section as
+:func:`near_miss` decides a primitive peg's by the eroded one.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+import numpy as np
 import shapely
+import trimesh
 
 from executor.world import SIZE_RESOLUTION
 from executor.world.geometry import Section, margin, outline_polygon
-from executor.world.meshes import URDF_HULL_MARGIN
+from executor.world.meshes import URDF_HULL_MARGIN, eroded
 from executor.world.outlines import convex_parts
 
 ARC_SEGMENTS = 32
@@ -100,3 +112,53 @@ def near_miss(part: Section, hole: Section, room: float) -> float | None:
         return None
     depth = erosion(part)
     return depth if margin(eroded_section(part, depth), hole) > 0 else None
+
+
+def pieces_section(pieces: Sequence[np.ndarray], low: float, high: float) -> shapely.Polygon:
+    """What the cell's peg made of convex ``pieces`` (vertices (n, 3) [m] each, in its part
+    frame, z up its axis) covers across its axis between the levels ``low`` and ``high``
+    [m], at least: each piece eroded by :data:`URDF_HULL_MARGIN` (the asset the cell
+    loads), clipped to the levels, projected (the convex hull of its corners) and widened
+    by the margin, which Bullet adds back all round (the arcs' chords lie inside them);
+    where the pieces' shadows fall apart, the largest (a peg must pass as one piece)."""
+    shadows = []
+    for vertices in pieces:
+        core = eroded(vertices, URDF_HULL_MARGIN)
+        if core is None:
+            continue
+        clipped = trimesh.intersections.slice_mesh_plane(core, (0.0, 0.0, 1.0), (0.0, 0.0, low), cap=True)
+        if clipped is None or clipped.is_empty:
+            continue
+        clipped = trimesh.intersections.slice_mesh_plane(clipped, (0.0, 0.0, -1.0), (0.0, 0.0, high), cap=True)
+        if clipped is None or clipped.is_empty:
+            continue
+        shadow = shapely.MultiPoint(clipped.vertices[:, :2]).convex_hull
+        shadows.append(shapely.buffer(shadow, URDF_HULL_MARGIN, quad_segs=ARC_SEGMENTS))
+    union = shapely.union_all(shadows)
+    if isinstance(union, shapely.Polygon):
+        return union
+    return max(shapely.get_parts(union), key=lambda piece: piece.area, default=shapely.Polygon())
+
+
+def mesh_near_miss(part: Section, pieces: Sequence[np.ndarray], stretch: float, hole: Section,
+                   room: float) -> float | None:
+    """How deep [m] a peg simulated from its convex ``pieces`` (:func:`pieces_section`, its
+    part frame's origin the centre of its section ``part``) lacks its section over the
+    ``stretch`` [m] from its end that enters the hole, plus :data:`SIZE_RESOLUTION`, when
+    the cell cannot resolve its no-fit in ``hole`` (``room`` [m] < 0, and what its pieces
+    cover there, eroded by that resolution, passes the hole); None when it can or the pair
+    fits (``room`` >= 0)."""
+    if room >= 0:
+        return None
+    cell = pieces_section(pieces, 0.0, stretch)
+    whole = outline_polygon(part, peg=True)
+    lacking = shapely.segmentize(shapely.difference(whole, cell), URDF_HULL_MARGIN / 64)
+    points = shapely.points(shapely.get_coordinates(lacking))
+    depth = (float(shapely.distance(whole.exterior, points).max()) if len(points) else 0.0) + SIZE_RESOLUTION
+    resolved = shapely.buffer(cell, -SIZE_RESOLUTION, join_style="mitre")
+    if resolved.is_empty or not isinstance(resolved, shapely.Polygon):
+        return depth  # nothing of it resolved: no pair of it is
+    (x0, y0, x1, y1), outline = resolved.bounds, shapely.get_coordinates(resolved.exterior)[:-1]
+    shrunk = Section(part.id, "polygon", x1 - x0, width=y1 - y0,
+                     outline=tuple((float(x), float(y)) for x, y in outline))
+    return depth if margin(shrunk, hole) > 0 else None

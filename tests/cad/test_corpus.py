@@ -504,8 +504,8 @@ def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_no_experiment_but_t
     assert not truth
     near = tomllib.loads((done.out / "geometry.toml").read_text())["hole_shapes"][h7].get("near_miss", [])
     assert "convex" in near, near
-    assert load_assembly(str(done.out)).tried_by_hand("convex", h7)
-    assert not load_assembly(str(done.out)).tried_by_hand("cuboid", h7)  # its own hole: a fit, observed
+    assert load_assembly(str(done.out)).tried_by_hand("convex", h7, "sim")
+    assert not load_assembly(str(done.out)).tried_by_hand("cuboid", h7, "sim")  # its own hole: a fit, observed
     trial = run_executor("trial", "--assembly", str(done.out), "--part", "convex", "--hole", h7, "--attempts", "1",
                          "--json", timeout=300)
     assert trial.returncode == 2 and "near miss" in trial.stderr, (trial.returncode, trial.stderr)

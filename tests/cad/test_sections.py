@@ -13,7 +13,10 @@ from shapely import affinity
 from trimesh.path.traversal import discretize_path
 
 from executor.cad import sections
+from executor.cad.derive import derive
+from executor.cad.parts import CadPart
 from executor.cad.sections import Loop, classify
+from executor.cad.write import margins
 
 MM = 1e-3
 
@@ -118,3 +121,65 @@ def test_a_fine_section_takes_its_closed_entities_as_the_graph_would() -> None:
     expected = [discretize_path(graph.entities, graph.vertices, path) for path in sections._closed_paths(graph)]
     assert len(loops) == len(expected) == 2
     assert all(np.array_equal(a, b) for a, b in zip(loops, expected, strict=True))
+
+
+
+def _revolved(profile: list[tuple[float, float]], sections: int = 48) -> trimesh.Trimesh:
+    """The solid of ``profile`` ((radius, z) [m], from the axis out and back) turned about z."""
+    return trimesh.creation.revolve(np.array(profile), sections=sections)
+
+
+def _narrowed(radius: float, narrow: float, levels: tuple[float, float, float], top: float) -> trimesh.Trimesh:
+    """A bore of ``radius`` [m] from below 0 to above ``top`` [m] that narrows from the
+    first of ``levels`` [m] to ``narrow`` at the second and widens again by the third."""
+    low, throat, high = levels
+    return _revolved([(0.0, -MM), (radius, -MM), (radius, low), (narrow, throat), (radius, high),
+                      (radius, top + MM), (0.0, top + MM)])
+
+
+
+@pytest.mark.slow  # the derivation: 4 to 7 s under load
+@pytest.mark.parametrize(("narrow", "fits"), [(4.975 * MM, False), (5.1 * MM, True)])
+def test_a_hole_narrowed_between_the_levels_sliced_is_measured_at_its_throat(narrow: float, fits: bool) -> None:
+    # A 100 x 50 x 20 mm plate with two d 10.4 mm bores (48 corners on their circles), the
+    # second narrowing from 12 mm up to a throat at 17 mm and widening again by 18 mm; a
+    # d 10 mm peg stands through the first on the floor, a d 9.8 mm one through the second.
+    # The plate is sliced in the middle of the pegs' depth in it (10 mm, d 10.4): a throat
+    # of d 9.95 leaves the d 10 peg 0.05 mm too wide, one of d 10.2 leaves it room.
+    box = trimesh.creation.box((0.1, 0.05, 0.02), trimesh.transformations.translation_matrix((0.02, 0, 0.01)))
+    straight = _narrowed(5.2 * MM, 5.2 * MM, (12 * MM, 17 * MM, 18 * MM), 20 * MM)
+    narrowed = _narrowed(5.2 * MM, narrow, (12 * MM, 17 * MM, 18 * MM), 20 * MM)
+    narrowed.apply_translation((0.04, 0, 0))
+    plate = trimesh.boolean.difference([box, straight, narrowed], engine="manifold")
+    wide = _revolved([(0.0, 0.0), (5 * MM, 0.0), (5 * MM, 40 * MM), (0.0, 40 * MM)], sections=64)
+    thin = _revolved([(0.0, 0.0), (4.9 * MM, 0.0), (4.9 * MM, 40 * MM), (0.0, 40 * MM)], sections=64)
+    thin.apply_translation((0.04, 0, 0))
+    derived = derive([CadPart("plate", "plate", plate, "plate.stl"), CadPart("wide", "wide", wide, "wide.stl"),
+                      CadPart("thin", "thin", thin, "thin.stl")], "plate", {})
+    hid = next(hid for hid, fit in derived.holes.items() if fit.part == "thin")
+    assert derived.holes[hid].hole.a == pytest.approx(2 * narrow * math.cos(math.pi / 48), abs=1e-8)  # the throat's
+    assert (margins(derived)["wide"][hid] > 0) == fits
+
+
+@pytest.mark.slow  # the derivation: 4 to 7 s under load
+@pytest.mark.parametrize(("narrow", "fits"), [(4.975 * MM, False), (5.1 * MM, True)])
+def test_a_bore_narrowed_at_a_level_no_slice_is_taken_at_is_measured_at_its_throat(narrow: float, fits: bool) -> None:
+    # A plate with a d 10 mm pin and a d 9.8 mm one 40 mm apart, standing 20 mm on it; on
+    # each a nut 8 mm high with a d 10.4 mm bore, the second's narrowing from 5 mm up to a
+    # throat at 6 mm (a vertex level, where no span's middle is, nor the nut's middle)
+    # and widening again by 7 mm: a throat of d 9.95 does not pass the d 10 pin, one of
+    # d 10.2 does.
+    box = trimesh.creation.box((0.1, 0.05, 0.02), trimesh.transformations.translation_matrix((0.02, 0, 0.01)))
+    pins = [_revolved([(0.0, 19 * MM), (radius, 19 * MM), (radius, 40 * MM), (0.0, 40 * MM)], sections=64)
+            for radius in (5 * MM, 4.9 * MM)]
+    pins[1].apply_translation((0.04, 0, 0))
+    plate = trimesh.boolean.union([box, *pins], engine="manifold")
+    nuts = [_revolved([(5.2 * MM, 20 * MM), (10 * MM, 20 * MM), (10 * MM, 28 * MM), (5.2 * MM, 28 * MM),
+                       (5.2 * MM, 27 * MM), (throat, 26 * MM), (5.2 * MM, 25 * MM), (5.2 * MM, 20 * MM)])
+            for throat in (5.2 * MM, narrow)]
+    nuts[1].apply_translation((0.04, 0, 0))
+    derived = derive([CadPart("plate", "plate", plate, "plate.stl"), CadPart("plain", "plain", nuts[0], "plain.stl"),
+                      CadPart("narrowed", "narrowed", nuts[1], "narrowed.stl")], "plate", {})
+    wide = next(pid for pid, pin in derived.pins.items() if pin.parts == ("plain",))
+    assert derived.bores["narrowed"].a == pytest.approx(2 * narrow * math.cos(math.pi / 48), abs=1e-8)  # the throat's
+    assert (margins(derived)["narrowed"][wide] > 0) == fits

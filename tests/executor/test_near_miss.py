@@ -5,14 +5,25 @@ section misses by less than that, so such a pair is no experiment."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
+import numpy as np
+import pybullet as p
 import pytest
 import shapely
+import trimesh
 
 from executor.world import SIZE_RESOLUTION
 from executor.world.geometry import Section, margin, outline_polygon
-from executor.world.meshes import URDF_HULL_MARGIN
-from executor.world.near_miss import collision_section, eroded_section, erosion, near_miss
+from executor.world.meshes import URDF_HULL_MARGIN, eroded_text
+from executor.world.near_miss import (
+    collision_section,
+    eroded_section,
+    erosion,
+    mesh_near_miss,
+    near_miss,
+    pieces_section,
+)
 
 SQUARE = (( -0.005, -0.005), (0.005, -0.005), (0.005, 0.005), (-0.005, 0.005))
 L_SHAPE = ((-0.01, -0.01), (0.01, -0.01), (0.01, -0.004), (-0.004, -0.004), (-0.004, 0.01), (-0.01, 0.01))
@@ -53,3 +64,54 @@ def test_the_eroded_section_of_a_notched_polygon_lies_inside_the_cells_peg() -> 
     inner = outline_polygon(eroded_section(peg, depth), peg=True)
     assert shapely.difference(inner, cell).area < 1e-12
     assert shapely.difference(outline_polygon(eroded_section(peg, depth / 2), peg=True), cell).area > 1e-10
+
+
+BOX = trimesh.creation.box((0.01, 0.01, 0.03)).vertices + (0.0, 0.0, 0.015)
+"""A 10 x 10 x 30 mm peg's one convex piece [m], in its part frame (its bottom's centre at the origin)."""
+
+
+def _outline_along(body: int, direction: tuple[float, float], level: float) -> float:
+    """How far [m] from the z axis, along ``direction`` at ``level`` [m], PyBullet's collision
+    shape of ``body`` reaches: where a probe sphere of 0.1 mm first touches it (bisected to 0.1 µm)."""
+    probe_radius = 1e-4
+    probe = p.createMultiBody(0, p.createCollisionShape(p.GEOM_SPHERE, radius=probe_radius))
+    unit = np.array(direction) / np.linalg.norm(direction)
+    low, high = 0.0, 0.02
+    while high - low > 1e-7:
+        mid = (low + high) / 2
+        p.resetBasePositionAndOrientation(probe, (*(unit * (mid + probe_radius)), level), (0, 0, 0, 1))
+        touching = p.getClosestPoints(body, probe, 0.0)
+        low, high = (mid, high) if touching and min(contact[8] for contact in touching) <= 0 else (low, mid)
+    return (low + high) / 2
+
+
+def test_a_mesh_pegs_pieces_lack_their_edges_in_pybullet_as_the_rule_takes_them(tmp_path: Path) -> None:
+    # The piece as the cell writes a mesh part's collision asset (eroded by the hull margin)
+    # and loads it (a URDF link), probed at mid-height: its faces where the CAD has them,
+    # its vertical edges r (sqrt 2 - 1) = 0.414 mm inside the CAD's corners along the
+    # diagonal; what the rule takes it to cover reaches as far, never farther.
+    (tmp_path / "piece.obj").write_text(eroded_text([BOX], "peg", "peg.convex.obj"))
+    (tmp_path / "peg.urdf").write_text(
+        '<?xml version="1.0"?><robot name="peg"><link name="part"><inertial><mass value="0.05"/>'
+        '<inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial><collision><geometry>'
+        f'<mesh filename="{tmp_path / "piece.obj"}"/></geometry></collision></link></robot>')
+    client = p.connect(p.DIRECT)
+    try:
+        peg = p.loadURDF(str(tmp_path / "peg.urdf"), useFixedBase=True)
+        face, corner = _outline_along(peg, (1, 0), 0.015), _outline_along(peg, (1, 1), 0.015)
+    finally:
+        p.disconnect(client)
+    assert face == pytest.approx(0.005, abs=2e-6)
+    assert 0.005 * math.sqrt(2) - corner == pytest.approx(URDF_HULL_MARGIN * (math.sqrt(2) - 1), abs=2e-6)
+    covered = pieces_section([BOX], 0.0, 0.03)
+    reach = max(float(np.dot(point, (1, 1))) / math.sqrt(2) for point in shapely.get_coordinates(covered))
+    assert corner - 2e-6 <= reach <= corner + 1e-7  # the arcs' chords lie inside them
+
+
+def test_a_mesh_peg_that_misses_a_round_hole_by_less_than_its_rounded_edges_is_not_observable() -> None:
+    peg, diagonal = Section("mesh", "square", 0.01), 0.01 * math.sqrt(2)  # 14.142 mm
+    close = Section("close", "round", diagonal - 0.0002)
+    depth = mesh_near_miss(peg, [BOX], 0.02, close, margin(peg, close))
+    assert depth == pytest.approx(URDF_HULL_MARGIN * (1 - math.sin(math.pi / 4)) + SIZE_RESOLUTION, abs=2e-6)
+    for hole in (Section("far", "round", diagonal - 0.002), Section("fits", "round", diagonal + 0.0002)):
+        assert mesh_near_miss(peg, [BOX], 0.02, hole, margin(peg, hole)) is None  # observed: a no-fit, a fit
