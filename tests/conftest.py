@@ -10,7 +10,9 @@ Fixtures (session-scoped but ``cli_env``, so hypothesis tests may use them too):
 - ``run_main(*args, cwd=None, input=None, timeout=120)``: ``assembly_constraints.cli.main(ARGS)``
   in this process (function-scoped), for what a command does that is not about its process
   (its exit code, output and files): the same result without a child's start-up (Python and
-  the imports of clingo, PyBullet, Rerun: about 1 s of CPU each), ``timeout`` unused;
+  the imports of clingo, PyBullet, Rerun: about 1 s of CPU each), ``timeout`` unused; the
+  working directory, stdin, the root logger's handlers and level, the environment and the
+  handlers of :data:`HANDLED_SIGNALS` are this process's again after it;
 - ``run_python(module, *args, cwd=None, input=None, timeout=120)``: ``python -m MODULE ARGS``
   (e.g. ``clingo``);
 - ``run_session(*args, timeout=60)`` → ``dict``: ``session --backend truth --json ARGS`` (the
@@ -30,12 +32,14 @@ test starts in-process).
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import functools
 import io
 import json
 import logging
 import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -58,6 +62,9 @@ DEFAULT_TIMEOUT = 120.0  # [s] per command line run
 TRUTH_SESSION = ("session", "--backend", "truth", "--json")  # a learning session with truthful cells
 # Unset for the whole test run and its children: no viewer or GUI ever opens.
 DISPLAY_VARIABLES = ("DISPLAY", "WAYLAND_DISPLAY")
+HANDLED_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGPIPE, signal.SIGHUP)
+"""Signals whose handlers ``run_main`` puts back after the command (a cell or a session
+installs its own for SIGINT and SIGTERM)."""
 
 
 def child_env() -> dict[str, str]:
@@ -91,13 +98,21 @@ class Runner(Protocol):
                  timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]: ...
 
 
-@pytest.fixture
-def one_simulated_arm() -> Iterator[None]:
-    """Waits for, then holds, the machine's lock of franky-sim arms for the test: each runs
-    a free-running 1 kHz loop with its client, and two at once (one per test worker)
-    starved each other into libfranka timeouts."""
+@contextlib.contextmanager
+def simulated_arm_lock() -> Iterator[None]:
+    """Waits for, then holds, the machine's lock of franky-sim arms: each runs a
+    free-running 1 kHz loop with its client, and two at once (one per test worker) starved
+    each other into libfranka timeouts. For a module's fixture that shares one arm among
+    its tests (which then do not take ``one_simulated_arm``: the lock is not re-entrant)."""
     with open(Path(tempfile.gettempdir()) / "assembly-constraints-franky-sim.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+@pytest.fixture
+def one_simulated_arm() -> Iterator[None]:
+    """The machine's lock of franky-sim arms (:func:`simulated_arm_lock`), held for the test."""
+    with simulated_arm_lock():
         yield
 
 
@@ -139,6 +154,8 @@ def run_main(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
         capsys.readouterr()
         root_logger = logging.getLogger()
         level = root_logger.level
+        environ = dict(os.environ)
+        handlers = {number: signal.getsignal(number) for number in HANDLED_SIGNALS}
         with monkeypatch.context() as patch:
             patch.chdir(ROOT if cwd is None else cwd)
             patch.setattr(sys, "stdin", io.StringIO(input or ""))
@@ -149,7 +166,13 @@ def run_main(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
             except SystemExit as exit_:  # argparse's errors
                 code = exit_.code if isinstance(exit_.code, int) else 1
             finally:
+                # what a command sets for its process (RUST_LOG, its signal handlers) ends with it
                 root_logger.setLevel(level)
+                os.environ.clear()
+                os.environ.update(environ)
+                for number, handler in handlers.items():
+                    if handler is not None:
+                        signal.signal(number, handler)
         out, err = capsys.readouterr()
         return subprocess.CompletedProcess([CLI_MODULE, *args], code, out, err)
     return run

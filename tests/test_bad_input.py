@@ -1,13 +1,15 @@
 """A corpus of bad input for both command lines (repository level: it spans the packages).
 
 One row per case: ``(id, argv, setup, expected exit code, a word the message must hold)``.
-``argv`` runs the one command line, ``python -m assembly_constraints`` (as ``./run.sh``
-does), as a separate process in ``tmp_path``. ``setup`` is None, a dict of input files
-(name → text or bytes) or a callable ``setup(tmp_path)``. Every bad input must give one
-line ``error: ...`` on stderr holding the word, the exit code, and never a traceback.
+``argv`` runs the one command line, ``assembly_constraints.cli.main(argv)``, in this process
+in ``tmp_path`` (the fixture ``run_main``); the rows of :data:`PROCESS_ROWS`, one per kind of
+command, also run as ``python -m assembly_constraints`` (as ``./run.sh`` does), a process of
+their own. ``setup`` is None, a dict of input files (name → text or bytes) or a callable
+``setup(tmp_path)``. Every bad input must give one line ``error: ...`` on stderr holding the
+word, the exit code, and never a traceback.
 
-Rows expecting :data:`EXIT_BROKEN_PIPE` run as ``... | head -1``: stdout is closed after
-its first line, and stderr must stay empty.
+Rows expecting :data:`EXIT_BROKEN_PIPE` run as processes only, as ``... | head -1``: stdout
+is closed after its first line, and stderr must stay empty.
 
 Unreadable files: ``chmod 000`` does not stop root (the tests may run as root), so under
 root the file is replaced by a symbolic link to ``/proc/self/mem``, a regular file whose
@@ -20,13 +22,14 @@ import json
 import os
 import shutil
 import subprocess
+import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 from asp.session.journal import MAX_JOURNAL_BYTES
-from assembly_constraints.cli import main
 from bridge.assembly import load_assembly
 from bridge.errors import EXIT_BROKEN_PIPE
 from tests.conftest import CLI_MODULE, ROOT, child_env, error_lines, python_argv
@@ -167,36 +170,6 @@ def huge_journal(run: Path) -> None:
     (run / "session.json").write_text('{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}')
     with (run / "journal.jsonl").open("wb") as file:
         file.truncate(MAX_JOURNAL_BYTES + 1)
-
-
-PROBES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
-    # the probes of the newer inputs, new values of the same kinds: a prior that is a program
-    # (unbounded grounding), contradicts itself or names what the product lacks; numbers out of
-    # range; empty output paths; a FIFO as a recording
-    ("prior-interval-of-other-name", PRIOR, prior("k(1..60000000)."), 2, "nominal_sizes.lp:7: k((1..60000000))"),
-    ("prior-pool", PRIOR, prior("nominal_margin(v,k2,(-20;650))."), 2, "nominal_sizes.lp:7:"),
-    ("prior-contradicts", PRIOR, prior("nominal_margin(v,k2,650)."), 2,
-     "nominal_sizes.lp:7: nominal_margin(v,k2,650) contradicts line 5: nominal_margin(v,k2,-20)"),
-    ("prior-unknown-hole", PRIOR, prior("nominal_margin(u,k9,100)."), 2, "unknown part or hole k9"),
-    ("prior-function-id", PRIOR, prior("nominal_margin(f(u),k1,100)."), 2, "nominal_sizes.lp:7:"),
-    ("serve-delay-over-an-hour", ("executor", "serve", "--delay", "3601"), None, 2, "[0, 3600]"),
-    ("session-cells-65", ("session", "--cells", "65"), None, 2, "from 0 to 64"),
-    ("trial-trials-over", ("executor", "trial", "--part", "p1", "--hole", "r1", "--trials", "100001"), None, 2,
-     "from 1 to 100000"),
-    ("assemble-save-empty", ("assemble", "--save", ""), None, 2, "expected a path, got the empty string"),
-    ("view-fifo-in-run", ("view", "run", "--print"),
-     lambda tmp: ((tmp / "run").mkdir(), os.mkfifo(tmp / "run" / "c3.rrd")), 2, "c3.rrd: not a regular file (a FIFO)"),
-    # a skill taught on a section the product no longer has: refused before the cell serves
-    ("serve-sim-peg-resized", ("executor", "serve", "--assembly", "asm", "--listen", "tcp/127.0.0.1:0"),
-     taught("geometry.toml", "size = 0.0120           # diameter [m]", "size = 0.0125"), 2,
-     "taught on part p1 round 12.00 x 12.00 mm, the product's p1 is round 12.50 x 12.50 mm"),
-    ("trial-hole-resized", ("executor", "trial", "--assembly", "asm", "--part", "p3", "--hole", "r1"),
-     taught("geometry.toml", "size = 0.0133           # side [m]", "size = 0.0131"), 2,
-     "taught on hole s1 square 13.30 x 13.30 mm, the product's s1 is square 13.10 x 13.10 mm"),
-]
-"""Rows of the probes of the newer inputs, refused before any process starts or any cell
-serves: fast enough for the quick loop, they also run in this process
-(:func:`test_a_probe_gives_one_line_error_in_this_process`)."""
 
 
 CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
@@ -551,8 +524,52 @@ CASES: list[tuple[str, tuple[str, ...], Setup, int, str]] = [
     # a closed pipe: quiet, exit 141 like `yes | head -1`
     ("enumerate-head", ("precedence", "enumerate", "--assembly", "cranfield"), None, EXIT_BROKEN_PIPE, ""),
     ("sample-head", ("precedence", "sample", "--assembly", "cranfield", "-n", "20000"), None, EXIT_BROKEN_PIPE, ""),
-    *PROBES,
+    # the probes of the newer inputs, new values of the same kinds: a prior that is a program
+    # (unbounded grounding), contradicts itself or names what the product lacks; numbers out of
+    # range; empty output paths; a FIFO as a recording
+    ("prior-interval-of-other-name", PRIOR, prior("k(1..60000000)."), 2, "nominal_sizes.lp:7: k((1..60000000))"),
+    ("prior-pool", PRIOR, prior("nominal_margin(v,k2,(-20;650))."), 2, "nominal_sizes.lp:7:"),
+    ("prior-contradicts", PRIOR, prior("nominal_margin(v,k2,650)."), 2,
+     "nominal_sizes.lp:7: nominal_margin(v,k2,650) contradicts line 5: nominal_margin(v,k2,-20)"),
+    ("prior-unknown-hole", PRIOR, prior("nominal_margin(u,k9,100)."), 2, "unknown part or hole k9"),
+    ("prior-function-id", PRIOR, prior("nominal_margin(f(u),k1,100)."), 2, "nominal_sizes.lp:7:"),
+    ("serve-delay-over-an-hour", ("executor", "serve", "--delay", "3601"), None, 2, "[0, 3600]"),
+    ("session-cells-65", ("session", "--cells", "65"), None, 2, "from 0 to 64"),
+    ("trial-trials-over", ("executor", "trial", "--part", "p1", "--hole", "r1", "--trials", "100001"), None, 2,
+     "from 1 to 100000"),
+    ("assemble-save-empty", ("assemble", "--save", ""), None, 2, "expected a path, got the empty string"),
+    ("view-fifo-in-run", ("view", "run", "--print"),
+     lambda tmp: ((tmp / "run").mkdir(), os.mkfifo(tmp / "run" / "c3.rrd")), 2, "c3.rrd: not a regular file (a FIFO)"),
+    # a skill taught on a section the product no longer has: refused before the cell serves
+    ("serve-sim-peg-resized", ("executor", "serve", "--assembly", "asm", "--listen", "tcp/127.0.0.1:0"),
+     taught("geometry.toml", "size = 0.0120           # diameter [m]", "size = 0.0125"), 2,
+     "taught on part p1 round 12.00 x 12.00 mm, the product's p1 is round 12.50 x 12.50 mm"),
+    ("trial-hole-resized", ("executor", "trial", "--assembly", "asm", "--part", "p3", "--hole", "r1"),
+     taught("geometry.toml", "size = 0.0133           # side [m]", "size = 0.0131"), 2,
+     "taught on hole s1 square 13.30 x 13.30 mm, the product's s1 is square 13.10 x 13.10 mm"),
 ]
+
+
+PROCESS_ROWS = ("learn-unreadable-text", "sizes-truth-quoted-id", "plan-cycle", "resume-binary",
+                "assemble-plan-injected-fact", "view-garbage", "serve-settings-not-json", "trial-kind-unknown",
+                "bench-unknown", "enumerate-head", "sample-head")
+"""Rows also run as a process of their own (``python -m assembly_constraints``), one per
+kind of command (the planner's subcommands, session, assemble, view, the cell's serve and
+trial, bench) and the closed pipes: what the process boundary adds (the interpreter's exit
+code, nothing it prints on its way out, PyBullet's banner) is checked there."""
+
+
+def _threads_children_clients() -> tuple[set[int], set[int], set[int]]:
+    """This process's Python threads, child processes and connected PyBullet clients (ids):
+    what a command run in this process could leave behind for the next row."""
+    children = {int(pid) for task in Path("/proc/self/task").iterdir()
+                for pid in (task / "children").read_text().split()}
+    pybullet = sys.modules.get("pybullet")
+    clients = {n for n in range(PYBULLET_CLIENTS) if pybullet.isConnected(physicsClientId=n)} if pybullet else set()
+    return {thread.ident or 0 for thread in threading.enumerate()}, children, clients
+
+
+PYBULLET_CLIENTS = 1024  # PyBullet's own bound on the clients of one process (MAX_PHYSICS_CLIENTS)
 
 
 def _run(argv: tuple[str, ...], tmp: Path, head: bool) -> tuple[int, str]:
@@ -586,31 +603,10 @@ def _set_up(setup: Setup, tmp: Path) -> None:
             path.write_bytes(content if isinstance(content, bytes) else content.encode())
 
 
-@pytest.mark.parametrize(("argv", "setup", "code", "word"), [case[1:] for case in PROBES],
-                         ids=[case[0] for case in PROBES])
-def test_a_probe_gives_one_line_error_in_this_process(argv: tuple[str, ...], setup: Setup, code: int, word: str,
-                                                      tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                      capsys: pytest.CaptureFixture[str]) -> None:
-    _set_up(setup, tmp_path)
-    monkeypatch.chdir(tmp_path)
-    capsys.readouterr()
-    try:
-        returncode = main(list(argv))
-    except SystemExit as exit_:  # argparse's errors
-        returncode = exit_.code
-    lines = error_lines(capsys.readouterr().err)
-    assert returncode == code and len(lines) == 1 and lines[0].startswith("error: "), (returncode, lines)
-    assert word in lines[0]
-
-
-@pytest.mark.slow  # one process per case: about 0.5 s each
-@pytest.mark.parametrize(("argv", "setup", "code", "word"), [case[1:] for case in CASES],
-                         ids=[case[0] for case in CASES])
-def test_bad_input_gives_one_line_error(argv: tuple[str, ...], setup: Setup, code: int, word: str,
-                                        tmp_path: Path) -> None:
-    _set_up(setup, tmp_path)
-    returncode, stderr = _run(argv, tmp_path, head=code == EXIT_BROKEN_PIPE)
-    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("pybullet build time")]
+def _check_one_line(code: int, word: str, returncode: int, stderr: str) -> None:
+    """A row's outcome: its exit code, and one line ``error: ...`` holding ``word`` (nothing
+    after a closed pipe), never a traceback."""
+    lines = error_lines(stderr)
     assert "Traceback" not in stderr, stderr[-3000:]
     assert returncode == code, stderr[-3000:]
     if code == EXIT_BROKEN_PIPE:
@@ -619,3 +615,34 @@ def test_bad_input_gives_one_line_error(argv: tuple[str, ...], setup: Setup, cod
     assert len(lines) == 1 and lines[0].startswith("error: "), stderr[-3000:]
     assert word in lines[0]
     assert len(lines[0]) < 600, "an error message must not echo long input"
+
+
+IN_PROCESS = [pytest.param(*case[1:], id=case[0]) for case in CASES if case[3] != EXIT_BROKEN_PIPE]
+
+
+@pytest.mark.parametrize(("argv", "setup", "code", "word"), IN_PROCESS)
+def test_bad_input_gives_one_line_error(argv: tuple[str, ...], setup: Setup, code: int, word: str,
+                                        tmp_path: Path, run_main) -> None:
+    """Every row but the closed pipes, run in this process (``run_main``: ``main(argv)``, its
+    exit code, its stderr; an exception escaping it fails the test as a traceback would): it
+    leaves no thread, child process or PyBullet client behind (nor, by ``run_main``, a
+    working directory, environment, log handler or signal handler)."""
+    _set_up(setup, tmp_path)
+    before = _threads_children_clients()
+    done = run_main(*argv, cwd=tmp_path)
+    _check_one_line(code, word, done.returncode, done.stderr)
+    assert _threads_children_clients() == before, "the command left a thread, a process or a PyBullet client"
+
+
+@pytest.mark.slow  # a process each: about 1.5 s of CPU
+@pytest.mark.parametrize(("argv", "setup", "code", "word"),
+                         [pytest.param(*case[1:], id=case[0]) for case in CASES if case[0] in PROCESS_ROWS])
+def test_bad_input_gives_one_line_error_as_a_process(argv: tuple[str, ...], setup: Setup, code: int, word: str,
+                                                     tmp_path: Path) -> None:
+    """:data:`PROCESS_ROWS` as processes; rows expecting :data:`EXIT_BROKEN_PIPE` as ``... | head -1``."""
+    _set_up(setup, tmp_path)
+    _check_one_line(code, word, *_run(argv, tmp_path, head=code == EXIT_BROKEN_PIPE))
+
+
+def test_every_process_row_is_a_row() -> None:
+    assert set(PROCESS_ROWS) <= {case[0] for case in CASES}
