@@ -75,11 +75,19 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-REFUSED: dict[str, str] = {}
+REFUSED: dict[str, str] = {
+    "asm4_axis_bearings": "the bearings' bores (d 20 on the axis's d 20 seats) have 0.3 mm edge radii, so the "
+                          "tessellated bore, its radii and the ring's end faces are one smooth face (adjacent "
+                          "triangles under 35 deg) that is no cylinder: the seats' zero-clearance fits are not "
+                          "found and their tessellations' overlap (1.9 mm3) is refused as overlapping parts",
+}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {
     "asap_beam": "its import takes over 200 s of CPU (CoACD decomposing the tapered tenons and mortises at zero "
                  "clearance for the cell's convex pieces, 30 s a call): run ./run.sh import on it by hand",
+    "asm4_disk_arm": "its import took over 300 s of CPU without finishing (in CoACD, decomposing parts for the "
+                     "cell's convex pieces; the arm's bore and slot fit their pins at zero clearance): run "
+                     "./run.sh import on it by hand",
 }
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
