@@ -121,7 +121,7 @@ def straight_walls(base: CadPart, fit: HoleFit) -> bool:
     """Whether hole ``fit`` of ``base``, entered from above, is the prism of its measured
     section (at mid-depth): its section at :data:`WALL_LEVELS` differs from it by at most
     :data:`executor.world.SIZE_RESOLUTION` per side. A tapered mortise is not (asap_beam's,
-    2.5° per side: 0.14 mm per side at a quarter of its depth): the cell's straight hole
+    2.5° per side: 0.11 mm per side a quarter of the way down): the cell's straight hole
     of its mid-depth section would stop a tapered tenon half way in."""
     up = np.array([0.0, 0.0, 1.0])
     for share in WALL_LEVELS:
