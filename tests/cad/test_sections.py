@@ -118,3 +118,15 @@ def test_a_fine_section_takes_its_closed_entities_as_the_graph_would() -> None:
     expected = [discretize_path(graph.entities, graph.vertices, path) for path in sections._closed_paths(graph)]
     assert len(loops) == len(expected) == 2
     assert all(np.array_equal(a, b) for a, b in zip(loops, expected, strict=True))
+
+
+def test_a_slice_in_metres_keeps_a_corner_4_um_from_its_neighbour() -> None:
+    # trimesh's section joins points on a grid of 1e-5 of the mesh's units: in metres, 10 µm.
+    # asap_beam's foot has a mortise corner 4 µm from the next point of its slice; joined,
+    # the corner was cut off and the 6.286 mm mortise measured 6.280 mm.
+    outline = shapely.Polygon([(0.0, 0.0), (0.006, 0.0), (0.006, 0.006 - 4e-6), (0.006, 0.006), (0.006 - 4e-6, 0.006),
+                               (0.0, 0.006)])
+    prism = trimesh.creation.extrude_polygon(outline, 0.01)
+    loops = sections.slice_loops(prism, np.array([0.0, 0.0, 1.0]), 0.005)
+    assert len(loops) == 1 and loops[0].area == pytest.approx(0.006 ** 2, rel=1e-9)
+    assert classify(loops[0], hole=True).a == pytest.approx(0.006, abs=1e-9)
