@@ -208,6 +208,7 @@ def _plate_with(hole: trimesh.Trimesh) -> Derived:
                   "plate", {})
 
 
+@pytest.mark.slow  # two plates cut and derived (9 s at load 33)
 @pytest.mark.parametrize(("taper", "plate"), [(0.0, True), (math.radians(2.5), False)])
 def test_a_plate_with_a_tapered_rect_hole_is_no_plate_of_straight_holes(taper: float, plate: bool) -> None:
     # A rect hole 2.5° a side (asap_beam's mortises) has the volume of its mid-depth section
