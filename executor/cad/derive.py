@@ -587,9 +587,9 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     level, which no span's middle is: Meta-World's torus ring, d 74.569 mm at its middle,
     d 74.980 at the nearest span's). Of the passages within
     :data:`executor.cad.sections.OUTLINE_TOUCH` of the narrowest (one nominal room), the
-    one nearest the part's trailing end: a taper passes at zero clearance at every level,
+    one nearest the pin's free end: a taper passes at zero clearance at every level,
     and alike parts on alike pins are then measured at the same level (asap_beam's feet on
-    their tapered tenons: at levels 0.8 mm apart their sections differed by 63 µm)."""
+    their tapered tenons: at levels 0.7 mm apart their sections differed by 63 µm)."""
     axis = np.array(derived.directions[name])
     part, other = derived.parts[pid].mesh, derived.parts[owner].mesh
     along, other_along = part.vertices @ axis, other.vertices @ axis
@@ -634,7 +634,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     if not passages:
         return None
     least = min(room for room, *_ in passages)
-    _, pin, hole, level = min((p for p in passages if p[0] <= least + OUTLINE_TOUCH), key=lambda p: p[3])
+    _, pin, hole, level = max((p for p in passages if p[0] <= least + OUTLINE_TOUCH), key=lambda p: p[3])
     return pin, hole, frame.T @ pin.centre + axis * level, level
 
 
