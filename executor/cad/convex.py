@@ -7,7 +7,8 @@ the cell's axes); a cover when the
 symmetric difference of its mesh and the cell's cover (its outline less square openings
 of its holes' sizes plus its clearance, and its socket) is within that of its volume;
 the base when its volume is within that of its bounding box less its holes (cross-section
-times depth: the cell's plate). Any other part is written as its own mesh
+times depth: the cell's plate) and each hole is the prism of its section
+(:func:`straight_walls`: a tapered mortise is not, though its volume is). Any other part is written as its own mesh
 (``meshes/<id>.obj``, Wavefront OBJ [m]): a peg in its part frame (origin at the centre of
 its section at its bottom, z up its axis, x along its section's long side), a cover in its
 frame (origin at the centre of the holes it goes over at its bottom, the cell's axes), a
@@ -54,8 +55,10 @@ from bridge.product import CONVEX_HEADER, Mesh
 from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor.assembly.product import Box
 from executor.cad.derive import Derived, HoleFit
-from executor.cad.sections import Shape2D
+from executor.cad.parts import STEP_DEFLECTION, CadPart
+from executor.cad.sections import Shape2D, classify, exact_round, slice_loops
 from executor.cad.sweep import TOUCH, bvh, convex_object
+from executor.world import SIZE_RESOLUTION
 from executor.world.meshes import URDF_HULL_MARGIN, eroded, obj_text
 
 PRIMITIVE_TOLERANCE = 0.01
@@ -109,13 +112,39 @@ def peg_is_primitive(fit: HoleFit, mesh: trimesh.Trimesh) -> bool:
     return is_close(mesh.volume, area * float(mesh.extents[2]))
 
 
+WALL_LEVELS = (0.25, 0.75)
+"""Where a hole's section is compared with its measured one (:func:`straight_walls`): these
+fractions of the way from the foot of its entry chamfer to its bottom."""
+
+
+def straight_walls(base: CadPart, fit: HoleFit) -> bool:
+    """Whether hole ``fit`` of ``base``, entered from above, is the prism of its measured
+    section (at mid-depth): its section at :data:`WALL_LEVELS` differs from it by at most
+    :data:`executor.world.SIZE_RESOLUTION` per side. A tapered mortise is not (asap_beam's,
+    2.5° per side: 0.11 mm per side a quarter of the way down): the cell's straight hole
+    of its mid-depth section would stop a tapered tenon half way in."""
+    up = np.array([0.0, 0.0, 1.0])
+    for share in WALL_LEVELS:
+        level = fit.entry - fit.chamfer - share * (fit.depth - fit.chamfer)
+        loops = [loop for loop in slice_loops(base.mesh, up, level) if loop.contains(fit.hole.centre)]
+        if not loops:
+            return False
+        here = exact_round(classify(min(loops, key=lambda loop: loop.area), hole=True), base.cylinders, up, level,
+                           STEP_DEFLECTION)
+        if max(abs(here.a - fit.hole.a), abs(here.b - fit.hole.b)) > 2 * SIZE_RESOLUTION:
+            return False
+    return True
+
+
 def base_is_primitive(derived: Derived) -> bool:
     """Whether the base is its bounding box less its holes (each its section times its
-    depth); never with a polygon hole or one with rounded corners (the plate's bosses are
-    round, square or sharp rect)."""
-    if any(fit.hole.kind == "polygon" or fit.hole.corner for fit in derived.holes.values()):
+    depth, :func:`straight_walls`); never with a polygon hole or one with rounded corners
+    (the plate's bosses are round, square or sharp rect)."""
+    base = derived.parts[derived.base]
+    if any(fit.hole.kind == "polygon" or fit.hole.corner or not straight_walls(base, fit)
+           for fit in derived.holes.values()):
         return False
-    mesh = derived.parts[derived.base].mesh
+    mesh = base.mesh
     holes = sum(section_area(fit.hole.kind, fit.hole.a, fit.hole.b) * fit.depth for fit in derived.holes.values())
     return is_close(mesh.volume, float(np.prod(mesh.extents)) - holes)
 

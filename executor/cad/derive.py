@@ -43,7 +43,9 @@ around a solid loop of another part there (the base's pin, another part's shaft)
 part the base or one the geometric precedence puts before it, goes onto that pin; a peg
 standing in a hole of the base is a pin only of a part going in along another axis (a
 nut onto a bolt's end under the plate; one going in along the peg's, over it, is a
-cover). The pin is a
+cover), or of a part going in along its axis that rests on such pegs alone (a foot down
+onto a table leg's tenon, on nothing but the leg's shoulder: no cover, which rests on the
+base or on covers). The pin is a
 feature of its owner (``<owner>_pin1``, ``_pin2``, ... by position), its section measured
 on the owner's slice; the fit is the pin's section inside the bore's, so the planner
 learns which part goes onto which pin as it learns pegs in holes. At those levels and
@@ -72,6 +74,7 @@ from executor.cad.locating import (
 )
 from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import (
+    OUTLINE_TOUCH,
     Loop,
     Shape2D,
     classify,
@@ -193,6 +196,9 @@ class Derived:
     """Part -> the section of its bore around a pin (:func:`pins`)."""
     part_holes: dict[str, HoleFit] = field(default_factory=dict)
     """The holes of moving parts, each with the part through it (:func:`part_holes`)."""
+    supports: set[tuple[str, str]] = field(default_factory=set)
+    """The supporting pairs (Y, X): X rests on Y and not on the base
+    (:func:`executor.cad.locating.support_pairs`)."""
     queries: int = 0
 
     def free(self, part: str) -> list[str]:
@@ -287,8 +293,9 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     if reach > 0:
         result.located = locators(sweeper, result.bodies, reach)
     ways = {root: result.ways(root) for root in result.bodies}
-    placing, result.later = placing_pairs(support_pairs(sweeper, result.bodies, base), result.located, ways,
-                                          result.bodies, base, set(result.reasons))
+    result.supports = support_pairs(sweeper, result.bodies, base)
+    placing, result.later = placing_pairs(result.supports, result.located, ways, result.bodies, base,
+                                          set(result.reasons))
     kept, dropped = consistent(sorted(placing), set(result.reasons))
     result.reasons |= {pair: placing[pair] for pair in kept if pair not in result.reasons}
     result.dropped = {pair for pair in dropped if placing[pair] == "locates"}
@@ -511,7 +518,8 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     base or one the geometric precedence puts before it (a part that goes in after, into
     the bore, is no pin: a head in a cover's socket). A bore around no such outline is no
     fit; nor is one around a peg standing in a hole of the base that goes in along the
-    part's own axis (that part is a cover, :mod:`executor.cad.covers`). Parts on one pin
+    part's own axis (that part is a cover, :mod:`executor.cad.covers`), unless the part
+    rests on such pegs alone (:attr:`Derived.supports`: it goes onto their ends). Parts on one pin
     share its section, the one measured over the longest stretch of it (from the part
     farthest from its end)."""
     found: list[tuple[str, str, Shape2D, np.ndarray, str | None, float]] = []  # owner, axis, pin, centre, part, level
@@ -526,6 +534,9 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
         levels[pid] = float(along.min() + along.max()) / 2
         before = nx.ancestors(order, pid) if pid in order else set()
         covered = {peg for peg in derived.hole_of if derived.axis[peg] == name}  # over it: a cover
+        resting = {y for y, x in derived.supports if x == pid}
+        if resting and resting <= covered:  # on those pegs alone: onto their ends, as no cover rests
+            covered -= resting
         for other in sorted(({derived.base} | before) - covered):
             hit = _pin_of(derived, pid, name, other)
             if hit is not None:
@@ -578,7 +589,11 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     the pin covering at some level), so a bore narrowest at a vertex level is measured
     there (Meta-World's torus ring, d 74.569 mm at its middle, d 74.980 at the nearest
     span's middle); a gland's d 17 lips, not the d 28 recess between them; a pulley's
-    d 26 web over the boss's d 26 collar, not the d 22 it sits on."""
+    d 26 web over the boss's d 26 collar, not the d 22 it sits on. Of the passages within
+    :data:`executor.cad.sections.OUTLINE_TOUCH` of the narrowest (one nominal room), the
+    one nearest the pin's free end: a taper passes at zero clearance at every level,
+    and alike parts on alike pins are then measured at the same level (asap_beam's feet on
+    their tapered tenons: at levels 0.7 mm apart their sections differed by 63 µm)."""
     axis = np.array(derived.directions[name])
     part, other = derived.parts[pid].mesh, derived.parts[owner].mesh
     along, other_along = part.vertices @ axis, other.vertices @ axis
@@ -608,7 +623,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
         stretch.append((level, narrowest if narrowest is not None and len(narrowest.points) >= 3 else None,
                         None if widest is None else shapely.Polygon(widest.points)))
     beyond: shapely.Polygon | None = None
-    best: tuple[float, Shape2D, Shape2D, float] | None = None
+    passages: list[tuple[float, Shape2D, Shape2D, float]] = []
     rooms: dict[tuple[bytes, bytes], float] = {}
     for level, bore, pin in reversed(stretch):
         if pin is not None:
@@ -623,11 +638,11 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
                 rooms[key] = margin(section("pin", union), section("bore", hole))
             except OutlineError:
                 continue
-        if best is None or rooms[key] < best[0]:
-            best = (rooms[key], union, hole, level)
-    if best is None:
+        passages.append((rooms[key], union, hole, level))
+    if not passages:
         return None
-    _, pin, hole, level = best
+    least = min(room for room, *_ in passages)
+    _, pin, hole, level = max((p for p in passages if p[0] <= least + OUTLINE_TOUCH), key=lambda p: p[3])
     return pin, hole, frame.T @ pin.centre + axis * level, level
 
 

@@ -47,6 +47,7 @@ import shapely
 import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.spatial import ConvexHull
+from trimesh.path.exchange.misc import lines_to_path
 from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
 from executor.cad.parts import Cylinder
@@ -122,12 +123,21 @@ def frame_of(axis: np.ndarray) -> np.ndarray:
     return np.array([u, np.cross(axis, u) if axis[2] >= 0 else np.cross(u, axis)])
 
 
+_SECTION_SCALE = 1e6
+"""The scale [1/m] a section's points are joined at (:func:`slice_loops`)."""
+
+
 def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[Loop]:
     """The closed loops of ``mesh`` cut by the plane ``dot(x, axis) = level`` [m]."""
     axis = np.asarray(axis, dtype=float)
-    section = mesh.section(plane_origin=axis * level, plane_normal=axis)
-    if section is None:
+    lines = trimesh.intersections.mesh_plane(mesh, plane_normal=axis, plane_origin=axis * level)
+    if len(lines) == 0:
         return []
+    # trimesh joins a section's points on a grid of 1e-5 of its units (its mesh.section, in
+    # metres: 10 µm, which closed a tapered mortise's corner 4 µm from the next point): the
+    # points are joined in µm [m × 1e6], on a grid of 10 pm, as only those of one edge are
+    path = lines_to_path(lines * _SECTION_SCALE)
+    section = trimesh.path.Path3D(entities=path["entities"], vertices=path["vertices"] / _SECTION_SCALE)
     frame = frame_of(axis)
     loops = []
     # a plane section is made of straight lines, which need no scale to be discretised

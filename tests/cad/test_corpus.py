@@ -83,8 +83,6 @@ REFUSED: dict[str, str] = {
 }
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {
-    "asap_beam": "its import takes over 200 s of CPU (CoACD decomposing the tapered tenons and mortises at zero "
-                 "clearance for the cell's convex pieces, 30 s a call): run ./run.sh import on it by hand",
     "asm4_disk_arm": "its import took over 300 s of CPU without finishing (in CoACD, decomposing parts for the "
                      "cell's convex pieces; the arm's bore and slot fit their pins at zero clearance): run "
                      "./run.sh import on it by hand",
@@ -97,6 +95,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "asap_beam",
     "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
@@ -149,6 +148,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    "asap_beam",
     "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
@@ -235,6 +235,9 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("asap_beam", marks=_xfail(INSERTED + " into a tapered hole (the uprights, room 0: the cell's plate "
+                                           "has straight holes, the top's own mesh no room it resolves) or onto a pin "
+                                           "of a part that is not the base (the feet onto the uprights' tenons)")),
     pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a shaft with less room than the cell resolves "
                                                "(0.012 mm per side)")),
     "factory_rect_pegs",
@@ -400,6 +403,7 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
 
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (about 40 s each)
 @pytest.mark.parametrize(("name", "unresolved"), [  # each a unit of the workers' work with its product's other tests
+    pytest.param("asap_beam", {"upright_a", "upright_b"}, id="asap_beam"),
     pytest.param("factory_gears", {"gear_small", "gear_medium"}, id="factory_gears"),
     pytest.param("occt_pump", {"bearing_ring"}, id="occt_pump")])
 def test_parts_with_less_room_than_the_cell_resolves_are_learned_from_the_cad_not_observed(
@@ -409,8 +413,11 @@ def test_parts_with_less_room_than_the_cell_resolves_are_learned_from_the_cad_no
     # the cell resolves (it jammed 11.5 mm short when taught). occt_pump: the bearing ring is
     # a nominal zero-clearance fit in the housing's bore, which the cell widens only in a base
     # it builds of primitives, not in the housing's own mesh (CoACD's pieces of the ring,
-    # sought to keep that room, took 146 s of CPU a try and never fitted). No experiment, each
-    # placed by hand with that reason, every pair taken from sizes.lp as not observed.
+    # sought to keep that room, took 146 s of CPU a try and never fitted). asap_beam: the
+    # uprights' tapered tenons are nominal zero-clearance fits in the top's tapered mortises,
+    # which make the top its own mesh (a plate's holes are straight); its feet go onto the
+    # uprights' tenons, pins of no base. No experiment, each placed by hand with that
+    # reason, every pair taken from sizes.lp as not observed.
     done = imported(name)
     manual = load_geometry(str(done.out)).tables.manual
     assert {pid for pid, table in manual.items()

@@ -20,8 +20,9 @@ from asp.precedence.relation import load_relation
 from assembly_constraints.cli import main
 from bridge.assembly import load_assembly
 from executor.cad.cli import run_import
+from executor.cad.convex import base_is_primitive
 from executor.cad.derive import Derived, derive
-from executor.cad.parts import load_meshes
+from executor.cad.parts import CadPart, load_meshes
 from executor.cad.write import WRIST_RADIUS, margins
 from executor.world.geometry import load_geometry
 
@@ -197,3 +198,25 @@ def test_the_wrist_the_import_keeps_clear_of_the_product_holds_the_arm_s_last_li
     link = trimesh.load(Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "meshes" / "link_7.stl", force="mesh")
     radius = float(np.hypot(link.vertices[:, 0], link.vertices[:, 1]).max())
     assert 0.05 < radius < WRIST_RADIUS
+
+
+def _plate_with(hole: trimesh.Trimesh) -> Derived:
+    """A 40 x 40 x 10 mm plate less ``hole`` [m], derived alone (its holes sliced at its middle)."""
+    plate = trimesh.creation.box((0.04, 0.04, 0.01))
+    plate.apply_translation((0.0, 0.0, 0.005))
+    return derive([CadPart("plate", "plate", trimesh.boolean.difference([plate, hole], engine="manifold"), "test")],
+                  "plate", {})
+
+
+@pytest.mark.slow  # two plates cut and derived (9 s at load 33)
+@pytest.mark.parametrize(("taper", "plate"), [(0.0, True), (math.radians(2.5), False)])
+def test_a_plate_with_a_tapered_rect_hole_is_no_plate_of_straight_holes(taper: float, plate: bool) -> None:
+    # A rect hole 2.5° a side (asap_beam's mortises) has the volume of its mid-depth section
+    # times its depth, as a straight hole has: the cell's plate would give it straight walls,
+    # which stop a tapered tenon half way in.
+    spread = 0.012 * math.tan(taper)  # [m] per side, over its 12 mm (through the 10 mm plate)
+    corners = [(x * (0.003 + s), y * (0.005 + s), z) for z, s in ((-0.001, 0.0), (0.011, spread))
+               for x in (-1, 1) for y in (-1, 1)]
+    derived = _plate_with(trimesh.convex.convex_hull(np.array(corners)))
+    assert [fit.hole.kind for fit in derived.holes.values()] == ["rect"]
+    assert base_is_primitive(derived) == plate

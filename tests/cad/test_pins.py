@@ -19,7 +19,8 @@ import shapely.affinity
 import trimesh
 
 from assembly_constraints.cli import main
-from executor.cad.derive import _GRID, _joined
+from executor.cad.derive import _GRID, _joined, derive
+from executor.cad.parts import CadPart
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -191,3 +192,30 @@ def test_the_union_of_a_straight_pin_s_noisy_sections_keeps_a_section_s_size_and
     whole = shapely.union_all(sections, grid_size=_GRID)
     assert len(union.exterior.coords) <= 4 * len(sections[0].exterior.coords)
     assert shapely.hausdorff_distance(union, whole) <= 3 * _GRID
+
+
+def _prism(outline: shapely.Polygon, low: float, high: float) -> trimesh.Trimesh:
+    """``outline`` [m] extruded from ``low`` to ``high`` [m] along z."""
+    solid = trimesh.creation.extrude_polygon(outline, high - low)
+    solid.apply_translation((0.0, 0.0, low))
+    return solid
+
+
+@pytest.mark.slow  # derives three parts (5 s at load 33)
+def test_a_part_resting_on_a_peg_alone_goes_onto_its_end_and_is_no_cover() -> None:
+    # asap_beam's table base: an upright stands in a hole of the top on its lower tenon, and
+    # a foot goes down onto its upper tenon, resting on the upright's shoulder and on nothing
+    # else: a pin of the upright, not a cover over it (a cover rests on the base or covers).
+    mm = 1e-3
+    tenon, wide, bore = (shapely.box(-a * mm, -a * mm, a * mm, a * mm) for a in (3.0, 5.0, 3.1))
+    plate = trimesh.boolean.difference([_prism(shapely.box(-0.02, -0.02, 0.02, 0.02), 0.0, 0.01),
+                                        _prism(bore, -0.001, 0.011)], engine="manifold")
+    upright = trimesh.boolean.union([_prism(tenon, 0.0, 0.01), _prism(wide, 0.01, 0.04), _prism(tenon, 0.04, 0.05)],
+                                    engine="manifold")
+    foot = trimesh.boolean.difference([_prism(shapely.box(-0.01, -0.01, 0.01, 0.01), 0.04, 0.05),
+                                       _prism(bore, 0.039, 0.051)], engine="manifold")
+    derived = derive([CadPart(pid, pid, mesh, "test") for pid, mesh in
+                      (("top", plate), ("upright", upright), ("foot", foot))], "top", {})
+    assert [fit.part for fit in derived.holes.values()] == ["upright"]
+    assert [(pin.owner, pin.parts) for pin in derived.pins.values()] == [("upright", ("foot",))]
+    assert set(derived.bores) == {"foot"}

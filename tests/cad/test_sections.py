@@ -183,3 +183,15 @@ def test_a_bore_narrowed_at_a_level_no_slice_is_taken_at_is_measured_at_its_thro
     wide = next(pid for pid, pin in derived.pins.items() if pin.parts == ("plain",))
     assert derived.bores["narrowed"].a == pytest.approx(2 * narrow * math.cos(math.pi / 48), abs=1e-8)  # the throat's
     assert (margins(derived)["narrowed"][wide] > 0) == fits
+
+
+def test_a_slice_in_metres_keeps_a_corner_4_um_from_its_neighbour() -> None:
+    # trimesh's section joins points on a grid of 1e-5 of the mesh's units: in metres, 10 µm.
+    # asap_beam's foot has a mortise corner 4 µm from the next point of its slice; joined,
+    # the corner was cut off and the 6.286 mm mortise measured 6.280 mm.
+    outline = shapely.Polygon([(0.0, 0.0), (0.006, 0.0), (0.006, 0.006 - 4e-6), (0.006, 0.006), (0.006 - 4e-6, 0.006),
+                               (0.0, 0.006)])
+    prism = trimesh.creation.extrude_polygon(outline, 0.01)
+    loops = sections.slice_loops(prism, np.array([0.0, 0.0, 1.0]), 0.005)
+    assert len(loops) == 1 and loops[0].area == pytest.approx(0.006 ** 2, rel=1e-9)
+    assert classify(loops[0], hole=True).a == pytest.approx(0.006, abs=1e-9)
