@@ -18,7 +18,7 @@ import trimesh
 from executor import ExecutorError
 from executor.cad import sweep
 from executor.cad.derive import derive
-from executor.cad.parts import CadPart, check_parts
+from executor.cad.parts import CadPart, check_parts, overlaps_checked
 from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
 
 MM = 1e-3
@@ -67,6 +67,25 @@ def test_a_coarse_zero_clearance_fit_passes_the_overlap_check_and_a_collar_in_it
     shaft = trimesh.boolean.union([parts[2].mesh, collar], engine="manifold")
     with pytest.raises(ExecutorError, match="parts 'bearing' and 'shaft' overlap by"):
         check_parts([*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")], "m")
+
+
+def test_the_overlap_check_in_its_own_process_raises_first_and_as_in_one() -> None:
+    parts = _shaft_in_bearing((18, 14, 12))
+    collar = _along_x(trimesh.creation.cylinder(radius=12 * MM, height=5 * MM, sections=12))
+    collar.apply_translation((11.5 * MM, 0, 0))
+    shaft = trimesh.boolean.union([parts[2].mesh, collar], engine="manifold")
+    bad = [*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")]
+    with pytest.raises(ExecutorError) as alone:
+        check_parts(bad, "m")
+    ran = []
+    with pytest.raises(ExecutorError) as forked:  # raised on leaving, over the block's own error
+        with overlaps_checked(bad, forked=True):
+            ran.append(True)
+            raise ExecutorError("the block's error")
+    assert ran and str(forked.value) == str(alone.value)
+    with overlaps_checked(parts, forked=True):  # a sound product: nothing raised
+        ran.append(True)
+    assert len(ran) == 2
 
 
 def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
