@@ -600,8 +600,11 @@ def surveys(meshes: dict[str, trimesh.Trimesh]) -> dict[str, Survey]:
     try:
         order = sorted(meshes, key=lambda pid: -len(meshes[pid].faces))
         found = dict(zip(order, pool.map(_surveyed, order, chunksize=1)))
-    finally:
+        pool.close()  # the workers end on their own (a SIGTERM would meet the command's handler in them)
+    except BaseException:
         pool.terminate()
+        raise
+    finally:
         pool.join()  # reaped: their CPU is this process's children's
     return {pid: found[pid] for pid in meshes}
 
