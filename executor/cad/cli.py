@@ -36,6 +36,7 @@ from pathlib import Path
 from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
+from executor.cad import sweep
 from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
@@ -45,13 +46,14 @@ from executor.cad.parts import (
     STEP_SUFFIXES,
     UNITS,
     CadPart,
-    check_parts,
+    check_solids,
     load_meshes,
+    overlaps_checked,
     translated,
 )
 from executor.cad.sections import Shape2D, zero_clearance
 from executor.cad.step import load_step
-from executor.cad.sweep import opposite
+from executor.cad.sweep import default_workers, opposite
 from executor.cad.write import (
     MANIFEST,
     REACH,
@@ -306,10 +308,25 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
                options: ImportOptions = ImportOptions()) -> Imported:
     """Read, check, claim ``out``, move the parts into the cell, derive, map the covers and
     heads, and write, as ``options`` say (:class:`ImportOptions`)."""
-    reach, max_triangles, replace, place = options.reach, options.max_triangles, options.replace, options.place
     started = time.perf_counter()
-    parts = load_source(source, units, max_triangles)
-    check_parts(parts, units)
+    parts = load_source(source, units, options.max_triangles)
+    check_solids(parts, units)
+    # the overlap check runs beside the derivation where the sweeps would take two cores
+    with overlaps_checked(parts, (sweep.WORKERS or default_workers(p.mesh for p in parts)) > 1):
+        found = _derived(parts, out, config, options)
+    removable, settings, derived, assumed, offset, mapped, near = found
+    written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
+    assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
+    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
+
+
+def _derived(parts: list[CadPart], out: Path, config: Path | None, options: ImportOptions
+             ) -> tuple[set[str], Settings, Derived, list[str], tuple[float, float], Mapped, int]:
+    """What :func:`run_import` finds before it writes: the files of ``out`` it may remove,
+    the settings with every tray, the derived product, the assumptions, the offset into
+    the cell, the mapped product and where in the assumptions the near misses go (they are
+    known once the meshes' pieces are written)."""
+    reach, replace, place = options.reach, options.replace, options.place
     removable = claim_folder(out, [p.id for p in parts], replace)
     settings, fixed, assumed, placed = _config(config, parts)
     offset, where = placement(parts, settings.base, place or placed)
@@ -328,10 +345,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "
                        f"{_mm(TRAY_GAP)} mm apart and clear of the product, in rows from "
                        f"({_mm(TRAY_START[0])}, {_mm(TRAY_START[1])}) mm (set [parts.<id>] tray)")
-    settings = laid
-    written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
-    assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
-    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
+    return removable, laid, derived, assumed, offset, mapped, near
 
 
 def main(argv: list[str]) -> int:

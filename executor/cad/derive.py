@@ -93,7 +93,7 @@ from executor.cad.sweep import (
     Slide,
     Sweeper,
     axis_name,
-    fit_faces,
+    surveys,
     zero_clearance_fits,
 )
 from executor.world.geometry import margin
@@ -259,12 +259,12 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     (0: off). ExecutorError naming the parts that never come out with their blockers."""
     by_id = {p.id: p for p in parts}
     result = Derived(base, by_id, reach=reach)
-    faces = {p.id: fit_faces(p.mesh) for p in parts}
-    result.slides = zero_clearance_fits(faces)
+    made = surveys({p.id: p.mesh for p in parts})
+    result.slides = zero_clearance_fits({pid: survey.faces for pid, survey in made.items()})
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
         result.directions.setdefault(axis_name(-slide.direction), tuple(-slide.direction))
-    sweeper = Sweeper({p.id: p.mesh for p in parts}, result.slides)
+    sweeper = Sweeper({p.id: p.mesh for p in parts}, result.slides, made=made)
     lower = np.min([p.mesh.bounds[0] for p in parts], axis=0)
     upper = np.max([p.mesh.bounds[1] for p in parts], axis=0)
     length = 2 * float(np.linalg.norm(upper - lower))

@@ -11,7 +11,8 @@ triangles counted before the mesh is built), its coordinates must be finite (the
 triangle of the first that is not is named) and its vertices are merged by position (an
 OBJ that repeats a vertex once per normal or texture coordinate is one surface).
 
-Checks (:func:`check_parts`), each an :class:`executor.ExecutorError` naming the part:
+Checks (:func:`check_parts`; the last, the overlaps, can run in a process of its own
+while the import goes on: :func:`overlaps_checked`), each an :class:`executor.ExecutorError` naming the part:
 a mesh that is not closed (its boundary edges counted, one located), a closed mesh whose
 triangles are wound inconsistently (made consistent when the part is one shell, refused
 otherwise: which shells are cavities is not known), parts whose sizes differ by a factor the
@@ -24,9 +25,13 @@ deflection however coarse the tessellation; :func:`executor.cad.sweep.zero_clear
 
 from __future__ import annotations
 
+import contextlib
 import math
+import multiprocessing
+import multiprocessing.connection
 import re
-from collections.abc import Callable
+import traceback
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import BinaryIO
@@ -214,6 +219,13 @@ def _number(word: bytes) -> float:
 
 def check_parts(parts: list[CadPart], units: str) -> None:
     """The checks of the module docstring, in that order; ExecutorError naming the part."""
+    check_solids(parts, units)
+    _check_overlaps(parts)
+
+
+def check_solids(parts: list[CadPart], units: str) -> None:
+    """The checks of the module docstring but the overlaps (:func:`overlaps_checked`), in
+    that order; ExecutorError naming the part."""
     seen: dict[str, str] = {}
     for part in parts:
         if part.id in seen:
@@ -234,7 +246,6 @@ def check_parts(parts: list[CadPart], units: str) -> None:
     if not PRODUCT_EXTENT[0] <= size <= PRODUCT_EXTENT[1]:
         raise ExecutorError(f"the product is {size:.4g} m across with --units {units}: a unit mismatch "
                             f"(expected {PRODUCT_EXTENT[0]} to {PRODUCT_EXTENT[1]} m; try the other --units)")
-    _check_overlaps(parts)
 
 
 def _make_solid(part: CadPart, units: str) -> None:
@@ -262,6 +273,51 @@ def _make_solid(part: CadPart, units: str) -> None:
         mesh.invert()
     if not mesh.is_volume:
         raise ExecutorError(f"{part.source}: part '{part.id}' encloses no volume (expected a solid)")
+
+
+@contextlib.contextmanager
+def overlaps_checked(parts: list[CadPart], forked: bool) -> Iterator[None]:
+    """The overlap check of ``parts`` (the last of :func:`check_parts`) around the block:
+    with ``forked``, in a process forked on entry while the block runs (the two share
+    nothing: the check only reads the parts), its ExecutorError raised on leaving, before
+    any error of the block, as when it ran first; else before the block."""
+    if not forked:
+        _check_overlaps(parts)
+        yield
+        return
+    receiver, sender = multiprocessing.get_context("fork").Pipe(duplex=False)
+    child = multiprocessing.get_context("fork").Process(target=_overlaps_to, args=(parts, sender), daemon=True)
+    child.start()
+    sender.close()
+    try:
+        yield
+    finally:
+        try:
+            found = receiver.recv()
+        except EOFError:  # it ended without an answer (killed)
+            found = None
+        child.join()
+        if found is None and child.exitcode != 0:
+            found = ("crash", f"its process ended with exit code {child.exitcode}")
+        receiver.close()
+        if found is not None:
+            kind, text = found
+            raise ExecutorError(text) if kind == "error" else RuntimeError(f"the overlap check failed:\n{text}")
+
+
+def _overlaps_to(parts: list[CadPart], sender: multiprocessing.connection.Connection) -> None:
+    """In the process :func:`overlaps_checked` forks: :func:`_check_overlaps`, its answer
+    sent (None: no overlap; ``("error", message)`` its ExecutorError; ``("crash",
+    traceback)`` any other exception)."""
+    try:
+        _check_overlaps(parts)
+        found = None
+    except ExecutorError as exc:
+        found = ("error", str(exc))
+    except Exception:  # noqa: BLE001  (handed to the parent, which raises it)
+        found = ("crash", traceback.format_exc())
+    sender.send(found)
+    sender.close()
 
 
 def _check_overlaps(parts: list[CadPart]) -> None:

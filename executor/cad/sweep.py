@@ -55,6 +55,7 @@ import os
 import weakref
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import fcl
 import numpy as np
@@ -568,19 +569,71 @@ def _outer_hull(points: np.ndarray) -> tuple[np.ndarray, bool]:
     return corners + centre, False
 
 
+class Survey(NamedTuple):
+    r"""What the sweeps and the fits need of one closed part, made once: its ``faces``
+    (:func:`fit_faces`), the vertices [m] of its ``hull`` (:func:`_outer_hull`: a convex
+    superset), whether that is ``exact``\ ly the hull, and whether the part is ``convex``
+    (:func:`_is_convex`)."""
+
+    faces: list[CylinderFace | PrismFace]
+    hull: np.ndarray
+    exact: bool
+    convex: bool
+
+
+def _survey(mesh: trimesh.Trimesh) -> Survey:
+    """:class:`Survey` of the closed ``mesh``."""
+    return Survey(fit_faces(mesh), *_outer_hull(np.asarray(mesh.vertices, dtype=float)), _is_convex(mesh))
+
+
+def surveys(meshes: dict[str, trimesh.Trimesh]) -> dict[str, Survey]:
+    """:class:`Survey` of each closed mesh, in :data:`WORKERS` (None: :func:`default_workers`)
+    processes forked now where there are more than one, the largest parts first: each
+    part's made alone from its mesh, as one process makes it, and handed back whole."""
+    workers = WORKERS or default_workers(meshes.values())
+    if workers < 2 or len(meshes) < 2:
+        return {pid: _survey(mesh) for pid, mesh in meshes.items()}
+    global _SURVEYED
+    _SURVEYED = meshes  # the workers' copy, forked now
+    pool = multiprocessing.get_context("fork").Pool(min(workers, len(meshes)))
+    _SURVEYED = None
+    try:
+        order = sorted(meshes, key=lambda pid: -len(meshes[pid].faces))
+        found = dict(zip(order, pool.map(_surveyed, order, chunksize=1)))
+        pool.close()  # the workers end on their own (a SIGTERM would meet the command's handler in them)
+    except BaseException:
+        pool.terminate()
+        raise
+    finally:
+        pool.join()  # reaped: their CPU is this process's children's
+    return {pid: found[pid] for pid in meshes}
+
+
+_SURVEYED: dict[str, trimesh.Trimesh] | None = None
+"""The meshes whose surveys are being forked: a worker's copy of them answers :func:`_surveyed`."""
+
+
+def _surveyed(pid: str) -> Survey:
+    """In a worker forked by :func:`surveys`: the :class:`Survey` of part ``pid``."""
+    assert _SURVEYED is not None, "a survey worker forked without its meshes"
+    return _survey(_SURVEYED[pid])
+
+
 class _Solid:
     """One part's mesh for the sweeps: its BVH, hull vertices and triangle tree (made on first use)."""
 
-    def __init__(self, mesh: trimesh.Trimesh, convex: bool | None = None) -> None:
-        """``convex``: whether the part is (None: ``mesh`` is the closed part, tested)."""
+    def __init__(self, mesh: trimesh.Trimesh, convex: bool | None = None, survey: Survey | None = None) -> None:
+        """``convex``: whether the part is (None: ``mesh`` is the closed part, tested);
+        ``survey``: the closed part's, made already (None: made here)."""
         self.mesh = mesh
         self._bvh: fcl.CollisionObject | None = None
         self._tree: _Node | None = None
         self.pieces: dict[tuple[float, ...], dict[int, _Piece | None]] = {}
         """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
-        self.hull, self.exact = _outer_hull(np.asarray(mesh.vertices, dtype=float))
+        self.hull, self.exact = (_outer_hull(np.asarray(mesh.vertices, dtype=float)) if survey is None
+                                 else (survey.hull, survey.exact))
         """A convex superset's vertices [m] and whether it is the hull itself."""
-        self.convex = _is_convex(mesh) if convex is None else convex
+        self.convex = survey.convex if survey is not None else _is_convex(mesh) if convex is None else convex
         self.bounds = np.array(mesh.bounds)
         """The mesh's box [m] (a copy: trimesh checks its cache by hashing the mesh on each use)."""
         self.triangles = np.array(mesh.triangles)
@@ -638,13 +691,14 @@ class Sweeper:
     ``slides`` the zero-clearance fits among them."""
 
     def __init__(self, meshes: dict[str, trimesh.Trimesh], slides: Iterable[Slide] = (),
-                 workers: int | None = None) -> None:
+                 workers: int | None = None, made: dict[str, Survey] | None = None) -> None:
         """``workers``: the processes the queries run in (None: :data:`WORKERS`, else
-        :func:`default_workers` of the meshes)."""
+        :func:`default_workers` of the meshes); ``made``: the parts' :func:`surveys`
+        where made already."""
         self.meshes = meshes
         self.workers = workers or WORKERS or default_workers(meshes.values())
         self._pool: multiprocessing.pool.Pool | None = None
-        self._solids = {pid: _Solid(mesh) for pid, mesh in meshes.items()}
+        self._solids = {pid: _Solid(mesh, survey=(made or {}).get(pid)) for pid, mesh in meshes.items()}
         self._slides: dict[tuple[str, str], list[Slide]] = {}
         for slide in slides:
             self._slides.setdefault((slide.shaft, slide.bore), []).append(slide)

@@ -13,12 +13,13 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from executor import ExecutorError
 from executor.cad import sweep
 from executor.cad.derive import derive
-from executor.cad.parts import CadPart, check_parts
+from executor.cad.parts import CadPart, check_parts, overlaps_checked
 from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
 
 MM = 1e-3
@@ -67,6 +68,44 @@ def test_a_coarse_zero_clearance_fit_passes_the_overlap_check_and_a_collar_in_it
     shaft = trimesh.boolean.union([parts[2].mesh, collar], engine="manifold")
     with pytest.raises(ExecutorError, match="parts 'bearing' and 'shaft' overlap by"):
         check_parts([*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")], "m")
+
+
+def test_the_overlap_check_in_its_own_process_raises_first_and_as_in_one() -> None:
+    parts = _shaft_in_bearing((18, 14, 12))
+    collar = _along_x(trimesh.creation.cylinder(radius=12 * MM, height=5 * MM, sections=12))
+    collar.apply_translation((11.5 * MM, 0, 0))
+    shaft = trimesh.boolean.union([parts[2].mesh, collar], engine="manifold")
+    bad = [*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")]
+    with pytest.raises(ExecutorError) as alone:
+        check_parts(bad, "m")
+    ran = []
+    with pytest.raises(ExecutorError) as forked:  # raised on leaving, over the block's own error
+        with overlaps_checked(bad, forked=True):
+            ran.append(True)
+            raise ExecutorError("the block's error")
+    assert ran and str(forked.value) == str(alone.value)
+    with overlaps_checked(parts, forked=True):  # a sound product: nothing raised
+        ran.append(True)
+    assert len(ran) == 2
+
+
+def test_surveys_in_two_processes_are_those_of_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    meshes = {p.id: p.mesh for p in _shaft_in_bearing()}
+    found = []
+    for workers in (1, 2):
+        monkeypatch.setattr(sweep, "WORKERS", workers)
+        found.append(sweep.surveys(meshes))
+    assert list(found[0]) == list(found[1]) == list(meshes)
+    for one, two in zip(found[0].values(), found[1].values(), strict=True):  # the same bits
+        assert np.array_equal(one.hull, two.hull) and (one.exact, one.convex) == (two.exact, two.convex)
+        assert len(one.faces) == len(two.faces)
+        for a, b in zip(one.faces, two.faces, strict=True):
+            assert type(a) is type(b) and list(vars(a)) == list(vars(b))
+            for key, value in vars(a).items():
+                other = vars(b)[key]
+                assert (shapely.to_wkb(value) == shapely.to_wkb(other) if isinstance(value, shapely.Geometry)
+                        else np.array_equal(value, other)), key
+    assert [len(s.faces) for s in found[1].values()] == [2, 2, 1] and not found[1]["housing"].convex
 
 
 def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
