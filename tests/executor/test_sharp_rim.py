@@ -83,7 +83,7 @@ def test_a_tight_hole_on_a_sharp_rim_is_found_in_the_first_attempt(peg12_cell: C
     pressed on the top face at the estimate.  The slow pass that follows, its command
     leading the spiral by the part's lag, drops the part into the hole.  Whether it drops
     in one attempt turns on the contact's path: seed 0's missed with the arm's start
-    1e-8 rad off in its joints (1 of 3 such starts; seeds 6 and 13 fitted from every
+    1e-8 rad off in its joints (1 of 5 such starts; seeds 6 and 13 fitted from every
     start tried), so the test asks for two of the three."""
     cell = peg12_cell
     cell.reset_state()
