@@ -37,7 +37,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from bridge.cell_settings import add_cell_arguments, cell_settings_of
 from bridge.cli_types import (
@@ -59,7 +59,9 @@ from executor.campaign.pairs import (
     pair_stats,
     select_pairs,
 )
-from executor.trial import CellSetup, cell_setup
+
+if TYPE_CHECKING:  # the cell's modules (PyBullet, trimesh, SciPy, Rerun) only where a cell is made:
+    from executor.trial import CellSetup  # a worker of an injected runner starts without them
 
 
 class TrialRunner(Protocol):
@@ -79,7 +81,7 @@ class CellRunner:
     ``setup``: what the cell is (:class:`executor.trial.CellSetup`; default: the default cell)."""
 
     def __init__(self, assembly: str, setup: CellSetup | None = None) -> None:
-        from executor.trial import Cell
+        from executor.trial import Cell, CellSetup
 
         self.cell = Cell(assembly, setup=CellSetup() if setup is None else setup)
 
@@ -231,6 +233,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str]) -> int:
     """``executor campaign``; returns 0 when every outcome was correct, else 1."""
+    from executor.trial import cell_setup
+
     args = build_parser().parse_args(list(argv))
     pairs = select_pairs(args.pairs)
     setup = cell_setup(cell_settings_of(args))  # the cell description checked before anything is written

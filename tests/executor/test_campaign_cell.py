@@ -17,9 +17,9 @@ from tests._tolerances import END_BOUND, FORCE_BOUND
 pytestmark = pytest.mark.slow  # real PyBullet campaigns, 10-15 s each
 
 
-def test_mini_campaign_with_plots(tmp_path: Path, run_executor) -> None:
-    done = run_executor("campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1", "--jobs", "2",
-                        "--json", "--plot", str(tmp_path), timeout=240)
+def test_mini_campaign_with_plots(tmp_path: Path, run_main) -> None:
+    done = run_main("executor", "campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1", "--jobs", "2",
+                    "--json", "--plot", str(tmp_path))
     assert done.returncode == 0, done.stdout + done.stderr
     report = json.loads(done.stdout)
     assert report["all_correct"] and report["false_fits"] == 0 and report["jobs"] == 2
@@ -47,7 +47,7 @@ def test_real_results_do_not_depend_on_scheduling() -> None:
     from executor.campaign.pairs import select_pairs
     from executor.campaign.run import CellRunner, run_campaign, stdout_to_stderr
 
-    pairs = select_pairs("tp:r1,sh:s1")
+    pairs = select_pairs("tp:r1,p1:s1")  # fits, cheaper than blocked parts (no_fit: the campaign above)
     factory = functools.partial(CellRunner, "cranfield")
     with stdout_to_stderr():
         one = run_campaign(pairs, trials=2, seed=7, workers=1, factory=factory)
@@ -62,5 +62,4 @@ def test_real_results_do_not_depend_on_scheduling() -> None:
     assert outcomes(one) == outcomes(two)
     # Two workers are other processes: the figures within what cannot change an outcome.
     assert np.all(np.abs(figures(one) - figures(two)) < [FORCE_BOUND, END_BOUND])
-    assert [r["outcome"] for r in one[0]] == ["fit", "fit"]
-    assert [r["outcome"] for r in one[1]] == ["no_fit", "no_fit"]
+    assert [r["outcome"] for row in one for r in row] == ["fit"] * 4

@@ -98,29 +98,43 @@ def test_stiff_tracking_settles_at_the_cell_time_step(cell):
         controller.gains = ImpedanceGains()
 
 
+ILC_EXECUTIONS = 6
+"""Executions of the repeated pair in the ILC test."""
+ILC_BEST_RATIO = 0.8
+"""The ILC test's bound on the smallest largest force deviation of the executions after the
+first, as a fraction of the first's."""
+
+
 @pytest.mark.slow
 def test_ilc_converges_on_a_repeated_pair(cell, tmp_path):
     """Tight peg in the square hole (0.1 mm clearance on the flats), the same 2.5° habitual
-    tilt every time: the force deviation of the 4th execution is well below the 1st, and
-    the learned correction is saved, reloaded and used by a restarted cell."""
+    tilt every time: the learned correction brings the force deviation well below the
+    first execution's, and it is saved, reloaded and used by a restarted cell.
+
+    An execution's largest force deviation is the peak of a contact: with ILC it scatters
+    by up to 40 % from one execution to the next (9.4 N first; then 5.3-10.5 N, and an arm
+    started 1e-8 rad off in its joints draws another sequence), so no single execution is
+    asserted. The smallest of the five after the first was 0.56-0.68 of the first over six
+    such starts; without ILC every execution repeats the first (9.4 N, 11.2 N at most),
+    1.0 or more. The bound ``ILC_BEST_RATIO`` sits between."""
     state = tmp_path / "c1-ilc.json"
     cell.ilc_state = state
     try:
         cell.reset_state(layer="full", magnitudes=SYSTEMATIC_ONLY)
-        runs = [cell.run_trial("tp", "s1", seed) for seed in range(4)]
+        runs = [cell.run_trial("tp", "s1", seed) for seed in range(ILC_EXECUTIONS)]
     finally:
         cell.ilc_state = None
     assert all(r.outcome == "fit" and r.attempts == 1 for r in runs)
     forces = [r.evidence[0].max_force_dev for r in runs]
-    assert forces[3] < 0.7 * forces[0], forces
-    assert [r.evidence[0].ilc_iteration for r in runs] == [0, 1, 2, 3]
+    assert min(forces[1:]) < ILC_BEST_RATIO * forces[0], forces
+    assert [r.evidence[0].ilc_iteration for r in runs] == list(range(ILC_EXECUTIONS))
     saved = json.loads(state.read_text())["keys"]
-    assert saved["tight_peg:s1"]["iterations"] == 4
+    assert saved["tight_peg:s1"]["iterations"] == ILC_EXECUTIONS
     restarted = Cell(setup=CellSetup(magnitudes=SYSTEMATIC_ONLY), ilc_state=state)
     try:
         correction, iteration = restarted.ilc.correction("tight_peg:s1")
-        assert iteration == 4 and np.array_equal(correction, cell.ilc.correction("tight_peg:s1")[0])
-        assert restarted.run_trial("tp", "s1", 4).evidence[0].ilc_iteration == 4
+        assert iteration == ILC_EXECUTIONS and np.array_equal(correction, cell.ilc.correction("tight_peg:s1")[0])
+        assert restarted.run_trial("tp", "s1", ILC_EXECUTIONS).evidence[0].ilc_iteration == ILC_EXECUTIONS
     finally:
         restarted.close()
 

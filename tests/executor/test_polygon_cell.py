@@ -192,12 +192,12 @@ def test_the_assembling_cell_poses_a_peg_by_its_frame_whatever_its_principal_axe
 
 @pytest.mark.slow  # teaches the peg, runs two trials and assembles in physics (about 30 s)
 def test_a_hexagon_peg_goes_into_a_hexagon_hole_with_40_um_room_and_not_into_one_40_um_short(
-        tmp_path: Path, run_executor) -> None:
+        tmp_path: Path, run_main) -> None:
     folder = str(_product(tmp_path / "hex"))
-    taught = run_executor("teach", "--assembly", folder, timeout=240)
+    taught = run_main("executor", "teach", "--assembly", folder)
     assert taught.returncode == 0, taught.stderr
     for hole, outcome in (("hx", "fit"), ("hs", "no_fit")):
-        done = run_executor("trial", "--part", "p1", "--hole", hole, "--assembly", folder, "--json", timeout=240)
+        done = run_main("executor", "trial", "--part", "p1", "--hole", hole, "--assembly", folder, "--json")
         assert done.returncode == 0, done.stderr
         assert json.loads(done.stdout)["trials"][0]["outcome"] == outcome, hole
     # the assembling cell picks it from the tray, turns it by 30° and stands it in hx

