@@ -3,7 +3,8 @@
 Meshes: an OBJ that repeats its vertices once per normal (Blender's export) is one closed
 surface; a closed mesh wound inconsistently is wound again (one shell) or named (several);
 a coordinate that is not finite, a crack, a mesh beyond the bound of triangles and a STEP
-file with a failing record are one line, exit code 2, from the real command. Files: import
+file with a failing record are one line, exit code 2 (the STEP file's from the real
+command as a process, the others from its ``main`` in this process). Files: import
 removes only the files its manifest lists, keeps the user's, and refuses a folder holding
 a product or a file it did not write unless given ``--replace``.
 """
@@ -25,7 +26,7 @@ from assembly_constraints.cli import main
 from executor import ExecutorError
 from executor.cad.parts import MAX_TRIANGLES, check_parts, load_meshes
 from executor.cad.step import load_step
-from tests.conftest import CLI_MODULE, child_env, python_argv
+from tests.conftest import CLI_MODULE, Runner, child_env, error_lines, python_argv
 
 
 def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
@@ -160,22 +161,17 @@ def _run_import(tmp: Path, *argv: str) -> tuple[int, str, str]:
     return done.returncode, done.stdout, done.stderr
 
 
-def _one_line(tmp: Path, *argv: str) -> str:
-    """The one error line of an ``import`` refused with exit code 2."""
-    code, _, err = _run_import(tmp, *argv)
-    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("pybullet build time")]
-    assert "Traceback" not in err and code == 2, err[-3000:]
-    assert len(lines) == 1 and lines[0].startswith("error: "), err[-3000:]
-    return lines[0]
-
-
-@pytest.mark.slow  # one process each, about 2 s of CPU
 @pytest.mark.parametrize(("setup", "words"), [case[1:] for case in BAD], ids=[case[0] for case in BAD])
-def test_bad_mesh_or_folder_is_one_line(tmp_path: Path, setup: Callable[[Path], None], words: list[str]) -> None:
+def test_bad_mesh_or_folder_is_one_line(tmp_path: Path, setup: Callable[[Path], None], words: list[str],
+                                        run_main: Runner) -> None:
+    # in this process (the real command's exit code 2 and one line: the corrupted STEP record below)
     setup(tmp_path)
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
-    line = _one_line(tmp_path, "cad", "--out", "out")
-    assert all(word in line for word in words), line
+    done = run_main("import", "cad", "--out", "out", cwd=tmp_path)
+    lines = error_lines(done.stderr)
+    assert "Traceback" not in done.stderr and done.returncode == 2, done.stderr[-3000:]
+    assert len(lines) == 1 and lines[0].startswith("error: "), done.stderr[-3000:]
+    assert all(word in lines[0] for word in words), lines[0]
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before  # nothing written or lost
 
 
@@ -224,17 +220,25 @@ def test_a_source_mesh_in_the_out_folder_is_never_overwritten(tmp_path: Path) ->
 
 
 @pytest.fixture(scope="module")
-def step_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A plate and a round peg placed 10 mm up in it, written by build123d."""
+def step_files(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The folder of two STEP files written by build123d (one process): ``p.step``, a plate
+    and a round peg placed 10 mm up in it; ``u.step``, a bracket assembly placed twice (as
+    AS1 of the STEP test suite places its l-brackets), each copy's bolt named 'bolt'."""
     folder = tmp_path_factory.mktemp("step")
     script = folder / "make.py"
     script.write_text(
         "from build123d import *\n"
         "plate = Box(100, 60, 20) - Pos(-20, 0, 2.5) * Cylinder(6.65, 15); plate.label = 'plate'\n"
         "peg = Pos(-20, 0, 10) * Cylinder(6.0, 30); peg.label = 'round peg'\n"
-        f"export_step(Compound(label='pegs', children=[plate, peg]), {str(folder / 'p.step')!r})\n")
+        f"export_step(Compound(label='pegs', children=[plate, peg]), {str(folder / 'p.step')!r})\n"
+        "plate = Box(100, 60, 20); plate.label = 'plate'\n"
+        "def side(x, label):\n"
+        "    bolt = Pos(x, 0, 20) * Cylinder(5, 20); bolt.label = 'bolt'\n"
+        "    return Compound(label=label, children=[bolt])\n"
+        f"export_step(Compound(label='unit', children=[plate, side(-30, 'left'), side(30, 'right')]), "
+        f"{str(folder / 'u.step')!r})\n")
     subprocess.run([sys.executable, str(script)], check=True)
-    return folder / "p.step"
+    return folder
 
 
 CORRUPTED = [
@@ -256,7 +260,8 @@ def _corrupt(step: Path, old: str, new: str, folder: Path) -> tuple[Path, int]:
 
 
 @pytest.mark.slow  # build123d writes the STEP file (about 5 s)
-def test_a_corrupted_step_record_is_refused_naming_it(step_file: Path, tmp_path: Path) -> None:
+def test_a_corrupted_step_record_is_refused_naming_it(step_files: Path, tmp_path: Path) -> None:
+    step_file = step_files / "p.step"
     parts = {part.id: part for part in load_step(step_file)}
     assert parts["round_peg"].mesh.bounds[:, 2] == pytest.approx([-0.005, 0.025])  # placed 10 mm up
     for name, old, new, word in CORRUPTED:
@@ -285,20 +290,8 @@ def test_a_manifest_listing_other_files_is_refused(tmp_path: Path) -> None:
     assert victim.read_text() == "not the import's\n"
 
 
-@pytest.mark.slow  # build123d writes the STEP file (about 5 s)
-def test_parts_of_one_name_in_two_sub_assemblies_are_told_apart_by_them(tmp_path: Path) -> None:
-    # A bracket assembly placed twice (as AS1 of the STEP test suite places its l-brackets):
-    # each copy's bolt is named 'bolt'.
-    script = tmp_path / "make.py"
-    script.write_text(
-        "from build123d import *\n"
-        "plate = Box(100, 60, 20); plate.label = 'plate'\n"
-        "def side(x, label):\n"
-        "    bolt = Pos(x, 0, 20) * Cylinder(5, 20); bolt.label = 'bolt'\n"
-        "    return Compound(label=label, children=[bolt])\n"
-        f"export_step(Compound(label='unit', children=[plate, side(-30, 'left'), side(30, 'right')]), "
-        f"{str(tmp_path / 'u.step')!r})\n")
-    subprocess.run([sys.executable, str(script)], check=True)
-    parts = {part.id: part for part in load_step(tmp_path / "u.step")}
+@pytest.mark.slow  # build123d writes the STEP files (shared, about 5 s)
+def test_parts_of_one_name_in_two_sub_assemblies_are_told_apart_by_them(step_files: Path) -> None:
+    parts = {part.id: part for part in load_step(step_files / "u.step")}
     assert sorted(parts) == ["left_bolt", "plate", "right_bolt"]
     assert parts["left_bolt"].mesh.centroid[0] == pytest.approx(-0.03, abs=1e-6)

@@ -100,8 +100,8 @@ def test_a_bad_place_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert not (tmp_path / "out").exists()
 
 
-def _session(run_cli: Runner, folder: Path, out: Path, backend: str) -> dict:
-    done = run_cli("session", "--backend", backend, "--json", "--assemble", "--assembly", str(folder), "--out",
+def _session(run_main: Runner, folder: Path, out: Path, backend: str) -> dict:
+    done = run_main("session", "--backend", backend, "--json", "--assemble", "--assembly", str(folder), "--out",
                    str(out), timeout=240)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
@@ -138,29 +138,34 @@ def test_a_peg_no_longer_than_the_grasp_is_placed_by_hand(tmp_path: Path, capsys
 
 @pytest.mark.slow
 def test_truth_sessions_run_with_a_part_placed_by_hand_and_without_geometry(
-        run_cli: Runner, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        run_main: Runner, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = _lid_on_pins(tmp_path)
     capsys.readouterr()
-    result = _session(run_cli, out, tmp_path / "truth", "truth")
+    result = _session(run_main, out, tmp_path / "truth", "truth")
     steps = {step["part"]: step for step in result["assembly"]["steps"]}
     assert result["assembly"]["assembled"] and steps["lid"]["skill"] == "manual"
     reason = tomllib.loads((out / "geometry.toml").read_text())["manual"]["lid"]["reason"]
     assert result["assembly"]["manual_reasons"] == {"lid": reason}  # why the operator placed it
     assert [s["part"] for s in result["plans"][0]][-1] == "lid"  # the pegs block its way out: it comes last
     (out / "geometry.toml").unlink()  # a planner-only product: the truth backend answers from sizes.lp
-    bare = _session(run_cli, out, tmp_path / "bare", "truth")
+    bare = _session(run_main, out, tmp_path / "bare", "truth")
     assert bare["assembly"]["assembled"] and {tuple(p) for p in bare["fits"]} == {tuple(p) for p in result["fits"]}
     assert {s["skill"] for s in bare["assembly"]["steps"]} == {"truth"} and bare["assembly"]["manual_reasons"] == {}
 
 
-@pytest.mark.slow
-def test_a_sim_session_places_the_part_by_hand_where_the_cad_has_it(run_cli: Runner, tmp_path: Path) -> None:
+@pytest.mark.slow  # teaches the pegs, assembles the product in physics
+def test_the_sim_cell_places_the_part_by_hand_where_the_cad_has_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # The plan of the import's relation (a session learning it: the truth sessions above),
+    # assembled by the sim cell: the pegs inserted, the lid set where the CAD has it.
     out = _lid_on_pins(tmp_path)
-    done = run_cli("executor", "teach", "--assembly", str(out), timeout=240)
-    assert done.returncode == 0, done.stderr
-    report = _session(run_cli, out, tmp_path / "sim", "sim")["assembly"]
+    assert main(["-q", "executor", "teach", "--assembly", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["assemble", *_facts(out), "--assembly", str(out), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
     steps = {step["part"]: step for step in report["steps"]}
     assert report["assembled"] and steps["lid"]["skill"] == "manual" and steps["lid"]["outcome"] == "fit"
+    assert {steps[peg]["skill"] for peg in ("peg1", "peg2")} == {"insert"}
     assert set(report["final_pose_error_mm"]) == {"plate", "peg1", "peg2", "lid"}
     assert max(report["final_pose_error_mm"].values()) <= POSE_BOUND_MM
 

@@ -1,8 +1,9 @@
 """A product from its CAD, end to end through the console front: a STEP assembly made by
 build123d (``examples/step_pegs.py``: a plate, a round peg and a rect peg at 30°) is
-imported, its skills taught in the cell, learned by sessions in physics (PyBullet cells)
-and assembled; with the size prior of its nominal sections the session needs fewer
-experiments and learns the same relation."""
+imported, its skills taught in the cell, learned by a session in physics (a PyBullet cell)
+and assembled; with the size prior of its nominal sections a session needs fewer
+experiments and learns the same relation (a truth session: the prior's logic is the
+planner's, whatever cell answers)."""
 
 from __future__ import annotations
 
@@ -22,30 +23,31 @@ TOLERANCE_M = "0.0005"
 """The prior's tolerance [m]: the rect peg's 0.3 mm room is left to the experiments."""
 
 
-def _session(run_cli: Runner, *argv: str) -> dict:
-    done = run_cli("session", "--backend", "sim", "--json", *argv, timeout=240)
+def _session(run: Runner, backend: str, *argv: str) -> dict:
+    done = run("session", "--backend", backend, "--json", *argv, timeout=240)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
 
 @pytest.mark.slow
-def test_a_build123d_step_product_is_learned_in_physics_and_assembled(run_cli: Runner, tmp_path: Path) -> None:
+def test_a_build123d_step_product_is_learned_in_physics_and_assembled(run_cli: Runner, run_main: Runner,
+                                                                      tmp_path: Path) -> None:
     step, product = tmp_path / "pegs.step", tmp_path / "pegs"
     subprocess.run([sys.executable, str(ROOT / "examples" / "step_pegs.py"), str(step)], check=True, timeout=120)
     for argv in (("import", str(step), "--out", str(product)), ("executor", "teach", "--assembly", str(product))):
-        done = run_cli(*argv)
+        done = run_main(*argv)
         assert done.returncode == 0, done.stderr
     truth = _fits(product / "sizes.lp")
     assert truth == {("round_peg", "h1"), ("rect_peg", "h3")}
 
-    plain = _session(run_cli, "--assembly", str(product), "--assemble", "--out", str(tmp_path / "plain"))
+    plain = _session(run_cli, "sim", "--assembly", str(product), "--assemble", "--out", str(tmp_path / "plain"))
     assert {tuple(pair) for pair in plain["fits"]} == truth and plain["prior"] is None
     report = plain["assembly"]
     assert report["assembled"] and set(report["final_pose_error_mm"]) == {"plate", "round_peg", "rect_peg"}
     assert max(report["final_pose_error_mm"].values()) <= ASSEMBLY_BOUND_MM
 
     run = tmp_path / "prior"
-    prior = _session(run_cli, "--assembly", str(product), "--prior", "cad", "--tolerance", TOLERANCE_M,
+    prior = _session(run_main, "truth", "--assembly", str(product), "--prior", "cad", "--tolerance", TOLERANCE_M,
                      "--out", str(run))
     assert {tuple(pair) for pair in prior["fits"]} == truth
     assert prior["experiments"] < plain["experiments"]
