@@ -69,6 +69,30 @@ def test_a_coarse_zero_clearance_fit_passes_the_overlap_check_and_a_collar_in_it
         check_parts([*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")], "m")
 
 
+def _filleted_ring(bore: float, outside: float, width: float, radius: float, sections: int) -> trimesh.Trimesh:
+    """A ring along z [m] from its bore's and outside radius, width and the bore's edge
+    radius [mm], revolved in ``sections`` (each edge radius a quarter circle of 3 segments)."""
+    quarter = np.linspace(0, math.pi / 2, 4)
+    top = [(bore + radius - radius * math.sin(a), width - radius + radius * math.cos(a)) for a in quarter]
+    bottom = [(bore + radius - radius * math.cos(a), radius - radius * math.sin(a)) for a in quarter]
+    profile = [(outside, 0.0), (outside, width), *top, *bottom, (outside, 0.0)]
+    return trimesh.creation.revolve(MM * np.array(profile), sections=sections)
+
+
+def test_a_bore_with_edge_radii_is_found_as_a_cylinder_and_its_radii_are_not() -> None:
+    # A 20 x 37 x 9 bearing's inner ring (bore edge radii 0.3 mm, joined smoothly to the
+    # bore and to the end faces: one smooth face) at zero clearance on a d 20 pin.
+    ring = _filleted_ring(10.0, 18.5, 9.0, 0.3, 48)
+    pin = trimesh.creation.cylinder(radius=10 * MM, height=30 * MM, sections=40)
+    faces = cylinder_faces(ring)
+    assert [(f.outward, round(f.radius / MM, 6)) for f in faces] == [(True, 18.5), (False, 10.0)]
+    bore = faces[1]
+    assert bore.span == pytest.approx((0.3 * MM, 8.7 * MM), abs=1e-9)  # the bore's band, not its radii
+    assert [(s.shaft, s.bore, s.seated) for s in sweep.zero_clearance_fits(
+        {"pin": sweep.fit_faces(pin), "ring": sweep.fit_faces(ring)})] == [("pin", "ring", True)]
+    check_parts(_parts(pin=pin, ring=ring), "m")  # the tessellations' overlap is the fit's
+
+
 def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
     parts = _shaft_in_bearing()
     faces = cylinder_faces(parts[2].mesh)
