@@ -75,12 +75,12 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-REFUSED: dict[str, str] = {
-    "asm4_axis_bearings": "the bearings' bores (d 20 on the axis's d 20 seats) have 0.3 mm edge radii, so the "
-                          "tessellated bore, its radii and the ring's end faces are one smooth face (adjacent "
-                          "triangles under 35 deg) that is no cylinder: the seats' zero-clearance fits are not "
-                          "found and their tessellations' overlap (1.9 mm3) is refused as overlapping parts",
-}
+BEARING_3 = ("bearing_3's bore is measured at a level in its edge radius, where the shadow of the radius's "
+             "triangles leaves a sliver reaching 47 um beyond the bore's vertex circle: its section's sagitta "
+             "reads 72 um (the others' 25 um), so the d 20 seat is no nominal zero-clearance fit for it (-50 um)")
+"""Why asm4_axis_bearings' third bearing fits no seat in sizes.lp (the truth: both, room 0)."""
+
+REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {
     "asap_beam": "its import takes over 200 s of CPU (CoACD decomposing the tapered tenons and mortises at zero "
@@ -95,6 +95,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
+    pytest.param("asm4_axis_bearings", marks=_xfail(BEARING_3)),
     "agh_hex_horizontal",
     "agh_prism_array",
     "factory_gears",
@@ -127,7 +128,8 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears",
+@pytest.mark.parametrize("name", [pytest.param("asm4_axis_bearings", marks=_xfail(BEARING_3)),
+                                  "agh_hex_horizontal", "agh_prism_array", "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes"])
@@ -147,6 +149,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
+    pytest.param("asm4_axis_bearings", marks=_xfail(BEARING_3)),
     "agh_hex_horizontal",
     "agh_prism_array",
     "factory_gears",
@@ -233,6 +236,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
+    pytest.param("asm4_axis_bearings", marks=_xfail(INSERTED + " along x onto a pin (the bearings onto the "
+                                                    "axis's seats: the cell puts parts onto pins from above)")),
     "agh_hex_horizontal",
     "agh_prism_array",
     pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a shaft with less room than the cell resolves "
