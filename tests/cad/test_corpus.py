@@ -75,11 +75,6 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-BEARING_3 = ("bearing_3's bore is measured at a level in its edge radius, where the shadow of the radius's "
-             "triangles leaves a sliver reaching 47 um beyond the bore's vertex circle: its section's sagitta "
-             "reads 72 um (the others' 25 um), so the d 20 seat is no nominal zero-clearance fit for it (-50 um)")
-"""Why asm4_axis_bearings' third bearing fits no seat in sizes.lp (the truth: both, room 0)."""
-
 REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {
@@ -95,7 +90,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
-    pytest.param("asm4_axis_bearings", marks=_xfail(BEARING_3)),
+    "asm4_axis_bearings",
     "agh_hex_horizontal",
     "agh_prism_array",
     "factory_gears",
@@ -128,8 +123,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", [pytest.param("asm4_axis_bearings", marks=_xfail(BEARING_3)),
-                                  "agh_hex_horizontal", "agh_prism_array", "factory_gears",
+@pytest.mark.parametrize("name", ["asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array", "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes"])
@@ -149,7 +143,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
-    pytest.param("asm4_axis_bearings", marks=_xfail(BEARING_3)),
+    "asm4_axis_bearings",
     "agh_hex_horizontal",
     "agh_prism_array",
     "factory_gears",

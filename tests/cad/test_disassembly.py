@@ -16,7 +16,7 @@ import pytest
 import trimesh
 
 from executor import ExecutorError
-from executor.cad import sweep
+from executor.cad import sections, sweep
 from executor.cad.derive import derive
 from executor.cad.parts import CadPart, check_parts
 from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
@@ -91,6 +91,21 @@ def test_a_bore_with_edge_radii_is_found_as_a_cylinder_and_its_radii_are_not() -
     assert [(s.shaft, s.bore, s.seated) for s in sweep.zero_clearance_fits(
         {"pin": sweep.fit_faces(pin), "ring": sweep.fit_faces(ring)})] == [("pin", "ring", True)]
     check_parts(_parts(pin=pin, ring=ring), "m")  # the tessellations' overlap is the fit's
+
+
+def test_a_bore_section_over_a_span_in_its_edge_radius_has_the_polygons_sagitta() -> None:
+    # The spans between the ring's vertex levels, their ends rounded to 1 nm as the pin's
+    # stretch is split: a corner a fraction of a nm beyond an end is at that end, or the
+    # radius's shadow cracks and the section keeps a sliver (a 75 µm sagitta; the 48-gon's: 22 µm at most).
+    ring = _filleted_ring(10.0, 18.5, 9.0, 0.3, 48)
+    axis = np.array([0.0, 0.0, 1.0])
+    levels = np.unique(np.round(ring.vertices[:, 2], 9))
+    sagittas = []
+    for low, high in zip(levels[:-1], levels[1:], strict=True):
+        loops = sections.slice_loops(ring, axis, (low + high) / 2)
+        bore = sections.over_span(min(loops, key=lambda o: o.area), ring, axis, low, high, hole=True)
+        sagittas.append(sections.classify(bore, hole=True).deflection)
+    assert len(sagittas) == 7 and max(sagittas) <= 10.3 * MM * (1 - math.cos(math.pi / 48)) + 1e-9
 
 
 def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
