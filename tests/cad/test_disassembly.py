@@ -5,7 +5,8 @@ precedence pair only where every way in is blocked (a bar that slides out sidewa
 a lid gets none, a washer on a pin under a cap nut gets exactly the forced ones); parts
 fixed to each other move as one; a part that never comes out is named with its blockers
 per direction; a ring passes a collar of its bore's size on its way out; a bolt at zero
-clearance beside a boss of the base is found in its hole."""
+clearance beside a boss of the base is found in its hole; a bore with edge radii is fitted
+as a cylinder, seated on its pin, and measured over its radii without a sliver."""
 
 from __future__ import annotations
 
