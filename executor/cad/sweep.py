@@ -132,8 +132,8 @@ class CylinderFace:
 def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
     """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
     six triangles that are one cylinder (:func:`_cylinder`), and of every other smooth
-    region its bands lateral to its axis (:func:`_bands`) that are (a bore whose edge radii
-    join it smoothly to the ring's end faces: the bore, not the radii)."""
+    region its bands lateral to its axis (:func:`_bands`) that are cylinders (a bore whose
+    edge radii join it smoothly to the ring's end faces: the bore, not the radii)."""
     angles = mesh.face_adjacency_angles
     smooth = mesh.face_adjacency[angles < SMOOTH]
     faces: list[CylinderFace] = []
@@ -192,7 +192,8 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     bands are the connected sets of at least six of the region's triangles whose normals
     are perpendicular to it (within :data:`TILT`), joined by the ``smooth`` adjacencies: a
     bore's band, not its edge radii (their normals lean along the axis) nor the end faces
-    beyond them. Each band is a cylinder only if :func:`_cylinder` finds it one."""
+    beyond them. Each band is a cylinder only if :func:`_cylinder` finds it one. One axis a
+    region: bands about another axis in the same smooth region are not looked for."""
     inside = np.zeros(len(mesh.faces), dtype=bool)
     inside[region] = True
     pairs = smooth[inside[smooth].all(axis=1)]
