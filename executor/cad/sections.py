@@ -154,7 +154,10 @@ def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[L
 SPAN_TOLERANCE = 1e-8
 """A face lying within this [m] of an end of a span, beyond its inside, is no part of it
 (:func:`shadow`): the faces across the axis that bound it there (a hole's floor a peg
-stands on, a bolt head's face on the plate's) are taken as at that end's level."""
+stands on, a bolt head's face on the plate's) are taken as at that end's level; so is a
+corner of a face crossing the span that lies within it of an end (the ends are vertex
+levels rounded to 1 nm: cut a fraction of a nm from their corner, the faces sharing it
+left cracks in their shadow, and a bore's section over a span in its edge radius a sliver)."""
 SAME_OUTLINE = 1e-8
 """A section over a span whose outline lies within this [m] of the loop sliced in it
 (Hausdorff) is that loop (the projected faces meet its edges to the float)."""
@@ -178,6 +181,9 @@ def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
             & (flat[:, :, 0].max(axis=1) >= near[0]) & (flat[:, :, 0].min(axis=1) <= near[2])
             & (flat[:, :, 1].max(axis=1) >= near[1]) & (flat[:, :, 1].min(axis=1) <= near[3]))
     heights, flat = heights[keep], flat[keep]
+    # a corner within SPAN_TOLERANCE of an end is at that end (SPAN_TOLERANCE)
+    heights = np.where(np.abs(heights - low) <= SPAN_TOLERANCE, low,
+                       np.where(np.abs(heights - high) <= SPAN_TOLERANCE, high, heights))
     if not len(heights):
         return shapely.Polygon()
     points, valid = [flat], [(heights >= low) & (heights <= high)]

@@ -24,7 +24,9 @@ decided by fcl's depths of B's triangles, the likeliest deep ones first (:func:`
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
 the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth regions
-whose normals are all perpendicular to one axis and whose vertices lie on one circle);
+whose normals are all perpendicular to one axis and whose vertices lie on one circle; of
+a smooth region that is none, as a bore joined to its ring's end faces by edge radii,
+its bands whose normals are perpendicular to the axis most of its bends turn about);
 an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
 radius within the pair's tolerance (the larger deflection of the two faces plus
 :data:`TOUCH`), are a fit, wherever on the way along the axis they meet: seated (their
@@ -130,37 +132,85 @@ class CylinderFace:
 
 def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
     """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
-    six triangles whose normals are perpendicular to one axis (within :data:`TILT`) and span more
-    than a flat face's, whose vertices lie on one circle (within 1 µm plus 1e-4 of the
-    radius) and whose normals all point away from the axis or all towards it."""
+    six triangles that are one cylinder (:func:`_cylinder`), and of every other smooth
+    region its bands lateral to its axis (:func:`_bands`) that are cylinders (a bore whose
+    edge radii join it smoothly to the ring's end faces: the bore, not the radii)."""
     angles = mesh.face_adjacency_angles
-    regions = trimesh.graph.connected_components(mesh.face_adjacency[angles < SMOOTH], min_len=6)
+    smooth = mesh.face_adjacency[angles < SMOOTH]
     faces: list[CylinderFace] = []
-    for region in regions:
-        normals = mesh.face_normals[region]
-        scatter = normals.T @ normals / len(region)
-        values, vectors = np.linalg.eigh(scatter)
-        axis = vectors[:, 0]
-        if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > TILT:
-            continue  # flat, or no cylinder (a cone, a sphere)
-        ring = np.unique(mesh.faces[region].ravel())
-        frame = np.linalg.svd(axis[None, :])[2][1:]  # two unit vectors across the axis
-        flat = mesh.vertices[ring] @ frame.T
-        design = np.column_stack([2 * flat, np.ones(len(flat))])
-        solution = np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0]
-        centre = solution[:2]
-        radius = float(np.sqrt(solution[2] + centre @ centre))
-        if not np.all(np.abs(np.linalg.norm(flat - centre, axis=1) - radius) <= 1e-6 + 1e-4 * radius):
+    for region in trimesh.graph.connected_components(smooth, min_len=6):
+        face = _cylinder(mesh, region)
+        if face is not None:
+            faces.append(face)
             continue
-        point = centre @ frame
-        outwards = np.einsum("ij,ij->i", normals, (mesh.triangles_center[region] @ frame.T - centre) @ frame)
-        if not (np.all(outwards > 0) or np.all(outwards < 0)):
-            continue
-        reach = np.abs(np.einsum("ij,ij->i", normals, mesh.vertices[mesh.faces[region, 0]] - point))
-        along = mesh.vertices[ring] @ axis
-        faces.append(CylinderFace(point, axis, radius, (float(along.min()), float(along.max())),
-                                  bool(outwards[0] > 0), float(np.max(radius - reach))))
+        faces.extend(f for band in _bands(mesh, region, smooth) if (f := _cylinder(mesh, band)) is not None)
     return faces
+
+
+def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
+    """The triangles ``region`` of ``mesh`` as one cylindrical face, or None: their normals
+    perpendicular to one axis (within :data:`TILT`) and spanning more than a flat face's,
+    their vertices on one circle (within 1 µm plus 1e-4 of the radius) and their normals
+    all pointing away from the axis or all towards it."""
+    normals = mesh.face_normals[region]
+    scatter = normals.T @ normals / len(region)
+    values, vectors = np.linalg.eigh(scatter)
+    axis = vectors[:, 0]
+    if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > TILT:
+        return None  # flat, or no cylinder (a cone, a sphere)
+    ring = np.unique(mesh.faces[region].ravel())
+    frame = np.linalg.svd(axis[None, :])[2][1:]  # two unit vectors across the axis
+    flat = mesh.vertices[ring] @ frame.T
+    design = np.column_stack([2 * flat, np.ones(len(flat))])
+    solution = np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0]
+    centre = solution[:2]
+    radius = float(np.sqrt(solution[2] + centre @ centre))
+    if not np.all(np.abs(np.linalg.norm(flat - centre, axis=1) - radius) <= 1e-6 + 1e-4 * radius):
+        return None
+    point = centre @ frame
+    outwards = np.einsum("ij,ij->i", normals, (mesh.triangles_center[region] @ frame.T - centre) @ frame)
+    if not (np.all(outwards > 0) or np.all(outwards < 0)):
+        return None
+    reach = np.abs(np.einsum("ij,ij->i", normals, mesh.vertices[mesh.faces[region, 0]] - point))
+    along = mesh.vertices[ring] @ axis
+    return CylinderFace(point, axis, radius, (float(along.min()), float(along.max())),
+                        bool(outwards[0] > 0), float(np.max(radius - reach)))
+
+
+BEND = 1e-2
+"""Adjacent triangles whose normals differ by more than this (the sine: 0.6°) bend about
+an axis, their normals' cross product (:func:`_bands`); flatter pairs show none."""
+CANDIDATES = 256
+"""Bends of a smooth region tried as its axis (:func:`_bands`; evenly spaced among them)."""
+
+
+def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> list[np.ndarray]:
+    """The smooth ``region`` of ``mesh`` split where it stops being a band parallel to one
+    axis. Adjacent triangles that bend (:data:`BEND`) bend about their normals' cross
+    product: on a cylinder all about its axis, on an edge radius or a sphere about
+    directions that vary. The axis is the bend shared (within :data:`TILT`) by most of the
+    region's bending pairs (tried among :data:`CANDIDATES` of them), averaged over those; the
+    bands are the connected sets of at least six of the region's triangles whose normals
+    are perpendicular to it (within :data:`TILT`), joined by the ``smooth`` adjacencies: a
+    bore's band, not its edge radii (their normals lean along the axis) nor the end faces
+    beyond them. Each band is a cylinder only if :func:`_cylinder` finds it one. One axis a
+    region: bands about another axis in the same smooth region are not looked for."""
+    inside = np.zeros(len(mesh.faces), dtype=bool)
+    inside[region] = True
+    pairs = smooth[inside[smooth].all(axis=1)]
+    bends = np.cross(mesh.face_normals[pairs[:, 0]], mesh.face_normals[pairs[:, 1]])
+    sizes = np.linalg.norm(bends, axis=1)
+    bends = bends[sizes > BEND] / sizes[sizes > BEND, None]
+    if len(bends) < 2:
+        return []
+    tried = bends[np.linspace(0, len(bends) - 1, min(CANDIDATES, len(bends))).astype(int)]
+    shared = np.abs(tried @ bends.T) >= np.sqrt(1 - TILT ** 2)
+    best = tried[np.argmax(shared.sum(axis=1))]
+    along = bends[np.abs(bends @ best) >= np.sqrt(1 - TILT ** 2)]
+    axis = np.linalg.eigh(along.T @ along)[1][:, -1]
+    lateral = np.zeros(len(mesh.faces), dtype=bool)
+    lateral[region] = np.abs(mesh.face_normals[region] @ axis) <= TILT
+    return list(trimesh.graph.connected_components(pairs[lateral[pairs].all(axis=1)], min_len=6))
 
 
 _PRISM_FRAMES = tuple((axis, np.array([np.roll(axis, 1), np.roll(axis, 2)])) for axis in np.eye(3))

@@ -79,12 +79,7 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-REFUSED: dict[str, str] = {
-    "asm4_axis_bearings": "the bearings' bores (d 20 on the axis's d 20 seats) have 0.3 mm edge radii, so the "
-                          "tessellated bore, its radii and the ring's end faces are one smooth face (adjacent "
-                          "triangles under 35 deg) that is no cylinder: the seats' zero-clearance fits are not "
-                          "found and their tessellations' overlap (1.9 mm3) is refused as overlapping parts",
-}
+REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {
     "asm4_disk_arm": "its import took over 300 s of CPU without finishing (in CoACD, decomposing parts for the "
@@ -97,6 +92,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
+    "asm4_axis_bearings",
     "agh_hex_horizontal",
     "agh_prism_array",
     "asap_beam",
@@ -130,7 +126,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["agh_hex_horizontal", "agh_prism_array", "factory_gears",
+@pytest.mark.parametrize("name", ["asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array", "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes"])
@@ -150,6 +146,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
+    "asm4_axis_bearings",
     "agh_hex_horizontal",
     "agh_prism_array",
     "asap_beam",
@@ -237,6 +234,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
+    pytest.param("asm4_axis_bearings", marks=_xfail(INSERTED + " along x onto a pin (the bearings onto the "
+                                                    "axis's seats: the cell puts parts onto pins from above)")),
     "agh_hex_horizontal",
     "agh_prism_array",
     pytest.param("asap_beam", marks=_xfail(INSERTED + " into a tapered hole (the uprights, room 0: the cell's plate "

@@ -5,7 +5,8 @@ precedence pair only where every way in is blocked (a bar that slides out sidewa
 a lid gets none, a washer on a pin under a cap nut gets exactly the forced ones); parts
 fixed to each other move as one; a part that never comes out is named with its blockers
 per direction; a ring passes a collar of its bore's size on its way out; a bolt at zero
-clearance beside a boss of the base is found in its hole."""
+clearance beside a boss of the base is found in its hole; a bore with edge radii is fitted
+as a cylinder, seated on its pin, and measured over its radii without a sliver."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import shapely
 import trimesh
 
 from executor import ExecutorError
-from executor.cad import sweep
+from executor.cad import sections, sweep
 from executor.cad.derive import derive
 from executor.cad.parts import CadPart, check_parts, overlaps_checked
 from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
@@ -106,6 +107,45 @@ def test_surveys_in_two_processes_are_those_of_one(monkeypatch: pytest.MonkeyPat
                 assert (shapely.to_wkb(value) == shapely.to_wkb(other) if isinstance(value, shapely.Geometry)
                         else np.array_equal(value, other)), key
     assert [len(s.faces) for s in found[1].values()] == [2, 2, 1] and not found[1]["housing"].convex
+
+
+def _filleted_ring(bore: float, outside: float, width: float, radius: float, sections: int) -> trimesh.Trimesh:
+    """A ring along z [m] from its bore's and outside radius, width and the bore's edge
+    radius [mm], revolved in ``sections`` (each edge radius a quarter circle of 3 segments)."""
+    quarter = np.linspace(0, math.pi / 2, 4)
+    top = [(bore + radius - radius * math.sin(a), width - radius + radius * math.cos(a)) for a in quarter]
+    bottom = [(bore + radius - radius * math.cos(a), radius - radius * math.sin(a)) for a in quarter]
+    profile = [(outside, 0.0), (outside, width), *top, *bottom, (outside, 0.0)]
+    return trimesh.creation.revolve(MM * np.array(profile), sections=sections)
+
+
+def test_a_bore_with_edge_radii_is_found_as_a_cylinder_and_its_radii_are_not() -> None:
+    # A 20 x 37 x 9 bearing's inner ring (bore edge radii 0.3 mm, joined smoothly to the
+    # bore and to the end faces: one smooth face) at zero clearance on a d 20 pin.
+    ring = _filleted_ring(10.0, 18.5, 9.0, 0.3, 48)
+    pin = trimesh.creation.cylinder(radius=10 * MM, height=30 * MM, sections=40)
+    faces = cylinder_faces(ring)
+    assert [(f.outward, round(f.radius / MM, 6)) for f in faces] == [(True, 18.5), (False, 10.0)]
+    bore = faces[1]
+    assert bore.span == pytest.approx((0.3 * MM, 8.7 * MM), abs=1e-9)  # the bore's band, not its radii
+    assert [(s.shaft, s.bore, s.seated) for s in sweep.zero_clearance_fits(
+        {"pin": sweep.fit_faces(pin), "ring": sweep.fit_faces(ring)})] == [("pin", "ring", True)]
+    check_parts(_parts(pin=pin, ring=ring), "m")  # the tessellations' overlap is the fit's
+
+
+def test_a_bore_section_over_a_span_in_its_edge_radius_has_the_polygons_sagitta() -> None:
+    # The spans between the ring's vertex levels, their ends rounded to 1 nm as the pin's
+    # stretch is split: a corner a fraction of a nm beyond an end is at that end, or the
+    # radius's shadow cracks and the section keeps a sliver (a 75 µm sagitta; the 48-gon's: 22 µm at most).
+    ring = _filleted_ring(10.0, 18.5, 9.0, 0.3, 48)
+    axis = np.array([0.0, 0.0, 1.0])
+    levels = np.unique(np.round(ring.vertices[:, 2], 9))
+    sagittas = []
+    for low, high in zip(levels[:-1], levels[1:], strict=True):
+        loops = sections.slice_loops(ring, axis, (low + high) / 2)
+        bore = sections.over_span(min(loops, key=lambda o: o.area), ring, axis, low, high, hole=True)
+        sagittas.append(sections.classify(bore, hole=True).deflection)
+    assert len(sagittas) == 7 and max(sagittas) <= 10.3 * MM * (1 - math.cos(math.pi / 48)) + 1e-9
 
 
 def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
