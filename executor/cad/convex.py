@@ -299,8 +299,15 @@ def _pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: 
     """:func:`pin_pieces`, made."""
     room = fcl.distance(bvh(mesh), bvh(pin), fcl.DistanceRequest(), fcl.DistanceResult())
     bound = min(allowed, CENTRED)
+    size = float(max(mesh.extents))
+    thresholds = [t for t in PIN_THRESHOLDS if t * size <= CONCAVITY_REACH * bound]
+    if not thresholds:
+        finest = min(PIN_THRESHOLDS)
+        return (f"CoACD's finest threshold for it, {finest:g} of its {1e3 * size:.3f} mm size, allows pieces "
+                f"{1e3 * finest * size:.3f} mm concave, over {CONCAVITY_REACH:g} times the {1e3 * bound:.3f} mm they "
+                f"may take from the {1e3 * room:.3f} mm its mesh leaves its pin (not sought)")
     why = ""
-    for threshold, iterations in [(t, n) for t in PIN_THRESHOLDS for n in PIN_ITERATIONS]:
+    for threshold, iterations in [(t, n) for t in thresholds for n in PIN_ITERATIONS]:
         found = fitting_pieces(pid, mesh, {"its pin": pin}, thresholds=(threshold,), iterations=iterations)
         if isinstance(found, str):
             why = found
@@ -322,6 +329,15 @@ CENTRED = 0.002
 its room: the cell centres it on the pin by contact with them, so its bore's centre is
 then within half of that of the mesh's (Meta-World's ring: CoACD at 0.05 took 5.4 mm of
 17.3 and left it 2.1 mm off its goal; at 0.02, 1.5 mm)."""
+CONCAVITY_REACH = 4.0
+"""A threshold of :data:`PIN_THRESHOLDS` is tried (:func:`pin_pieces`) only when the
+concavity it allows a piece, the threshold times the part's longest extent (CoACD's
+concavity is relative to the part's size), is at most this many times what the pieces may
+take from the room its mesh leaves its pin: CoACD's pieces took about two fifths of that
+concavity from it (Meta-World's ring at 0.02: 1.6 of 4.7 mm; asm4_disk_arm's disk, a d 21
+bore in a d 240 disk, at 0.02: 2.0 of 4.8 mm, where 0.24 mm may be taken), and a finer
+threshold on a large part runs for minutes (that disk at 0.01: over 50 s of CPU for one
+seed without finishing), so a part beyond this reach is placed by hand at once."""
 PIN_ITERATIONS = (30, ITERATIONS)
 """CoACD's tree-search iterations per cut tried in turn at each of :data:`PIN_THRESHOLDS`
 (:func:`pin_pieces`): a fifth of its default first, then its default; the pieces of
