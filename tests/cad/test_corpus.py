@@ -81,11 +81,7 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
-TOO_SLOW: dict[str, str] = {
-    "asm4_disk_arm": "its import took over 300 s of CPU without finishing (in CoACD, decomposing parts for the "
-                     "cell's convex pieces; the arm's bore and slot fit their pins at zero clearance): run "
-                     "./run.sh import on it by hand",
-}
+TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 """Every product the import takes."""
