@@ -83,6 +83,9 @@ REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
+NIPPLE = ("asm4_disk_arm's nipple, a d 20 pin of the disk (not of the base) standing in the arm's slot, is found "
+          "as no feature: no imported hole on its axis")
+"""What the import does not find of asm4_disk_arm."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 """Every product the import takes."""
 
@@ -101,6 +104,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
     "vitac_shapes",
     "occt_pump",
     "occt_pulley",
+    pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(strict=True, raises=AssertionError, reason=NIPPLE)),
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -125,7 +129,11 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 @pytest.mark.parametrize("name", ["asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array", "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
-                                  "vitac_shapes"])
+                                  "vitac_shapes",
+                                  pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
+                                      strict=True, raises=AssertionError,
+                                      reason="its disk's d 21 bore is measured on its tessellation, d 20.951: "
+                                             "margin 951 um, the truth's 1000"))])
 def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str], Imported], name: str) -> None:
     # nominal_sizes.lp's margin is diametral: twice the room all round, within 2 um, on each
     # pair that fits of the features the import finds (a no-fit's negative measure is a
@@ -155,6 +163,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "vitac_shapes",
     "occt_pump",
     "occt_pulley",
+    "asm4_disk_arm",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
