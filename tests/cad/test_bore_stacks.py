@@ -10,7 +10,7 @@ import pytest
 import shapely
 import trimesh
 
-from executor.cad.convex import APART, apart
+from executor.cad.convex import APART, CONCAVITY_REACH, apart, pin_pieces
 from executor.world.rings import NoStack, ring_pieces
 
 BORE = 5.0e-3
@@ -54,6 +54,22 @@ def test_a_part_that_is_no_stack_of_prisms_says_so() -> None:
     bore = trimesh.creation.cylinder(radius=BORE, height=0.05, sections=32)
     found = ring_pieces("cone", trimesh.boolean.difference([cone, bore], engine="manifold"), 0.0, round_pins=True)
     assert isinstance(found, NoStack) and "is no stack of prisms of its sections" in found
+
+
+def test_a_large_part_whose_bore_coacd_cannot_keep_is_refused_without_decomposing() -> None:
+    # asm4_disk_arm's disk: a d 240 disk with a d 21 bore and a nipple off its axis (no
+    # stack of prisms), on a d 20 pin; its pieces may take 0.238 mm of the pin's room, and
+    # CoACD's finest threshold allows them 2.4 mm of concavity on a part that size
+    bore = shapely.Point(0, 0).buffer(0.0105, quad_segs=16)
+    disc = trimesh.creation.extrude_polygon(shapely.Point(0, 0).buffer(0.12, quad_segs=16).difference(bore), 0.01)
+    nipple = trimesh.creation.cylinder(radius=0.01, height=0.02, sections=32)
+    nipple.apply_translation((0.0766, 0.0643, 0.02))
+    disk = trimesh.boolean.union([disc, nipple], engine="manifold")
+    pin = trimesh.creation.cylinder(radius=0.01, height=0.05, sections=64)
+    found = pin_pieces("disk", disk, pin, 0.000238)
+    assert isinstance(found, str)
+    assert f"allows pieces 2.400 mm concave, over {CONCAVITY_REACH:g} times the 0.238 mm" in found, found
+    assert "(not sought)" in found
 
 
 def test_vertices_closer_than_a_written_file_keeps_are_moved_apart() -> None:
