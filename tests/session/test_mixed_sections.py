@@ -78,6 +78,7 @@ def test_line_on_the_mixed_product_is_refused_before_any_cell_starts(run_main, t
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(600)  # two sim cells learn and assemble the board: 245 s of CPU alone
 def test_the_task_board_is_learned_through_physics_and_assembled_within_2_mm(run_cli, tmp_path) -> None:
     """NIST task board 1's pegs (data/taskboard): round, square and three rect aspect
     ratios, no one size line. Sim cells learn the board exactly (its sizes.lp) under the

@@ -216,7 +216,8 @@ def test_a_session_starts_from_its_demonstrations_and_never_uses_a_rogue_cell(tm
     assert {e.cell for e in read_journal(run / "journal.jsonl")} == {"c1"}
     shown = {tuple(pair) for pair in result["demonstrated"]}
     assert len(shown) == 9 and shown <= TRUTH.fits
-    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", options=LearningOptions(demonstrated=list(shown)))
+    in_order = [tuple(pair) for pair in result["demonstrated"]]  # the learner's choices follow their order
+    alone = learn_sizes(TRUTH.parts, TRUTH.holes, TRUTH, "best", options=LearningOptions(demonstrated=in_order))
     assert result["experiments"] == alone.count < 19  # 19: best from nothing
     assert not {(e.part, e.hole) for e in read_journal(run / "journal.jsonl")} & shown
     learned = load_atoms([run / "learned.lp"])
