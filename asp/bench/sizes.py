@@ -276,34 +276,22 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     for name in args.policies:
         get_policy(name)
-    if args.products:
-        counted = product_rows(args.products, args.policies, args.model, args.seeds, args.seed)
-        if args.json:
-            print(json.dumps({"products": counted}))
-        else:
-            _print_products(counted, args.policies)
-        return 0
-    if args.cells:
-        parallel = parallel_rows(args.cells, args.policies, args.seeds, args.seed)
-        if args.json:
-            print(json.dumps({"parallel": parallel}))
-        else:
-            _print_parallel(parallel)
-        return 0
-    if args.demos:
-        saved = demos_rows(args.demos, args.policies, args.seeds, args.seed)
-        if args.json:
-            print(json.dumps({"demos": saved}))
-        else:
-            _print_demos(saved)
-        return 0
-    if args.noise:
-        noisy = noise_rows(args.noise, args.policies, args.confirm, args.seeds, args.seed)
-        if args.json:
-            print(json.dumps({"noise": noisy}))
-        else:
-            _print_noise(noisy)
-        return 0
+    counts: list[tuple[str, Callable[[], list[dict]], Callable[[list[dict]], None]]] = [
+        ("products", lambda: product_rows(args.products, args.policies, args.model, args.seeds, args.seed),
+         lambda rows: _print_products(rows, args.policies)),
+        ("parallel", lambda: parallel_rows(args.cells, args.policies, args.seeds, args.seed), _print_parallel),
+        ("demos", lambda: demos_rows(args.demos, args.policies, args.seeds, args.seed), _print_demos),
+        ("noise", lambda: noise_rows(args.noise, args.policies, args.confirm, args.seeds, args.seed), _print_noise),
+    ]
+    chosen = {"products": args.products, "parallel": args.cells, "demos": args.demos, "noise": args.noise}
+    for key, count, show in counts:
+        if chosen[key]:
+            found = count()
+            if args.json:
+                print(json.dumps({key: found}))
+            else:
+                show(found)
+            return 0
     rows = [
         time_decisions(int(n), policy, args.seed, args.decisions)
         for n in args.sizes
