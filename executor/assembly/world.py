@@ -17,7 +17,6 @@ import numpy as np
 import pybullet as pb
 import pybullet_data
 
-from executor import ExecutorError
 from executor.assembly.product import HeadSpec, Product, rect_minus_squares
 from executor.control.controller import ImpedanceController
 from executor.control.gains import ImpedanceGains
@@ -25,7 +24,7 @@ from executor.control.motion import Motion, StepLogger
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies, tile_of
-from executor.world.scene import TIME_STEP, inertial_frame, link_frame, load_plate, wrist_clear_of
+from executor.world.scene import TIME_STEP, connect, inertial_frame, link_frame, load_plate, wrist_clear_of
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -80,11 +79,7 @@ class AssemblyWorld:
         """``gains``: the controller's (the cell description's compliant impedance)."""
         self.product = product
         geometry = product.geometry
-        self.client = pb.connect(pb.DIRECT)
-        if self.client < 0:
-            raise ExecutorError("could not connect to PyBullet")
-        c = self.client
-        pb.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
+        self.client = c = connect()
         pb.setTimeStep(TIME_STEP, physicsClientId=c)
         pb.setGravity(0, 0, -9.81, physicsClientId=c)
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)

@@ -37,7 +37,7 @@ from executor.franka.sim_scene import TIME_STEP, contact_force, product_model
 from executor.world.arm import aligned_yaw, yaw_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import CellGeometry, HoleSpec, PartSpec, load_geometry, passes
-from executor.world.scene import PART_FRICTION, TEACH_FRICTION, load_plate
+from executor.world.scene import PART_FRICTION, TEACH_FRICTION, connect, load_plate
 
 START_ABOVE = 0.005
 """Where the part's bottom starts above the hole's entry [m]."""
@@ -88,10 +88,9 @@ def _result(depth: float, force: float, steps: int, wall: float, cpu: float) -> 
 def pybullet_insertion(geometry: CellGeometry, part: PartSpec, hole: HoleSpec) -> Insertion:
     """The insertion in PyBullet: the cell's plate and part URDF, the cell's step and
     friction, :data:`SOLVER_ITERATIONS`."""
-    client = pb.connect(pb.DIRECT)
+    client = connect()
     try:
-        pb.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=SOLVER_ITERATIONS,
-                                     physicsClientId=client)
+        pb.setPhysicsEngineParameter(numSolverIterations=SOLVER_ITERATIONS, physicsClientId=client)
         pb.setTimeStep(TIME_STEP, physicsClientId=client)
         pb.setGravity(0, 0, -9.81, physicsClientId=client)
         plate = load_plate(client, geometry, current_assets(geometry) / "plate.obj")

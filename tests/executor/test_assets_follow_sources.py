@@ -8,11 +8,13 @@ import json
 import shutil
 from pathlib import Path
 
+import pybullet as pb
 import pytest
 
 from bridge.assembly import DATA_DIR
 from executor.world.assets import STAMP, current_assets, sources_digest
 from executor.world.geometry import load_geometry, plate_obj_text
+from executor.world.scene import connect, load_plate
 from tests._tolerances import assert_same_asset
 
 WITH_ASSETS = sorted(p.parent.parent.name for p in DATA_DIR.glob("*/assets/plate.obj"))
@@ -76,12 +78,34 @@ def test_assets_that_cannot_be_regenerated_are_refused_naming_the_file(cranfield
         current_assets(load_geometry(str(cranfield)))
 
 
+def test_a_new_client_loads_a_regenerated_plate(cranfield: Path) -> None:
+    """PyBullet caches parsed Wavefront files per process by path: a client made after the
+    plate was regenerated under the same path must read the new file (a ray down the narrowed
+    s2, 6 mm off its centre, meets the floor of the 13.3 mm hole, then the top of the 10 mm one)."""
+    def depth_at_s2() -> float:
+        geometry = load_geometry(str(cranfield))
+        client = connect()
+        try:
+            plate = load_plate(client, geometry, current_assets(geometry) / "plate.obj")
+            x, y = geometry.holes["s2"].position
+            hit = pb.rayTest((x + 0.006, y, 1.0), (x + 0.006, y, 0.0), physicsClientId=client)[0]
+            assert hit[0] == plate
+            return geometry.plate.top_z - hit[3][2]
+        finally:
+            pb.disconnect(client)
+
+    assert depth_at_s2() > 0.02  # down to the tile's bottom (25 mm deep)
+    _narrow_s2(cranfield)
+    assert depth_at_s2() < 0.001  # the tile's top
+
+
 @pytest.mark.slow
-def test_a_trial_after_editing_a_hole_sees_the_edit(cranfield: Path, run_executor) -> None:
-    first = run_executor("trial", "--part", "p3", "--hole", "s2", "--assembly", str(cranfield), "--json")
+def test_a_trial_after_editing_a_hole_sees_the_edit(cranfield: Path, run_main) -> None:
+    """Both trials in this process: the plate the first one loaded is not simulated after the edit."""
+    first = run_main("executor", "trial", "--part", "p3", "--hole", "s2", "--assembly", str(cranfield), "--json")
     assert first.returncode == 0, first.stderr
     assert json.loads(first.stdout)["trials"][0]["outcome"] == "fit"
     _narrow_s2(cranfield)
-    done = run_executor("trial", "--part", "p3", "--hole", "s2", "--assembly", str(cranfield), "--json")
+    done = run_main("executor", "trial", "--part", "p3", "--hole", "s2", "--assembly", str(cranfield), "--json")
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["trials"][0]["outcome"] == "no_fit"
