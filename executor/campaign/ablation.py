@@ -45,17 +45,26 @@ from executor.world.perturbation import random_only
 FLOOR = "random_only"
 """The extra run: PI + phase stopping with only the random part of the perturbations."""
 
-_CELL: Any = None  # the worker's Cell (reused: one PyBullet client per part shape)
+_CELL: Any = None
+"""This process's cell of the run's product (one PyBullet client per part shape), made by
+:func:`_make_cell` for each run: a run in process never uses a cell of an earlier run's
+product or of its files before an edit."""
 
 
-def _run_group(task: tuple[str, str, int, str, str, list[int], Magnitudes]) -> list[dict[str, Any]]:
-    """One group: consecutive executions of one pair in a fresh cell state (cell seed)."""
+def _make_cell(assembly: str) -> None:
+    """This process's cell of ``assembly``, made now (an earlier one closed)."""
     from executor.trial import Cell
 
     global _CELL
-    variant, assembly, cell_seed, part, hole, seeds, magnitudes = task
-    if _CELL is None:
-        _CELL = Cell(assembly)
+    if _CELL is not None:
+        _CELL.close()
+    _CELL = Cell(assembly)
+
+
+def _run_group(task: tuple[str, int, str, str, list[int], Magnitudes]) -> list[dict[str, Any]]:
+    """One group: consecutive executions of one pair in a fresh cell state (cell seed)."""
+    variant, cell_seed, part, hole, seeds, magnitudes = task
+    assert _CELL is not None, "a group run before its cell was made"
     _CELL.reset_state(layer="pi_phase_stop" if variant == FLOOR else variant,
                       magnitudes=random_only(magnitudes) if variant == FLOOR else magnitudes, cell_seed=cell_seed)
     return [_CELL.run_trial(part, hole, seed).to_json() for seed in seeds]
@@ -104,19 +113,21 @@ def run_ablation(assembly: str, trials: int, seed: int, executions: int, workers
     groups = [list(range(g * executions, min(trials, (g + 1) * executions)))
               for g in range((trials + executions - 1) // executions)]
     variants = [*LAYERS, FLOOR]
-    tasks = [(variant, assembly, seed + g, pair.part, pair.hole, [seed + j for j in group], magnitudes)
+    tasks = [(variant, seed + g, pair.part, pair.hole, [seed + j for j in group], magnitudes)
              for variant in variants for g, group in enumerate(groups) for pair in pairs
              if pair.fits or variant != FLOOR]
     if workers == 1:
+        _make_cell(assembly)
         outputs = [_run_group(task) for task in progress(tasks, desc="ablation", total=len(tasks), unit="group")]
     else:
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=_make_cell, initargs=(assembly,)) as pool:
             outputs = list(progress(pool.map(_run_group, tasks), desc="ablation", total=len(tasks), unit="group"))
     fits = {(p.part, p.hole): p.fits for p in pairs}
     by_variant: dict[str, list[tuple[bool, int, dict[str, Any]]]] = {v: [] for v in variants}
     for task, results in zip(tasks, outputs):
         for index, result in enumerate(results):
-            by_variant[task[0]].append((fits[task[3], task[4]], index, result))
+            by_variant[task[0]].append((fits[task[2], task[3]], index, result))
 
     def per_execution(name: str) -> list[list[dict[str, Any]]]:
         return [[r for fit, i, r in by_variant[name] if fit and i == j] for j in range(executions)]

@@ -9,7 +9,8 @@ import msgspec
 import pytest
 
 from bridge.cell_settings import Magnitudes
-from executor.campaign.ablation import format_ablation, variant_row
+from executor.campaign.ablation import format_ablation, run_ablation, variant_row
+from executor.campaign.pairs import CampaignPair
 from executor.control.ilc import LAYERS
 from tests.conftest import error_lines
 
@@ -55,3 +56,30 @@ def test_the_ablation_refuses_pairs_none_of_which_fits(run_main):
     done = run_main("bench", "executor", "--ablation", "--trials", "1", "--pairs", "p3:r1", "--json")
     lines = error_lines(done.stderr)
     assert done.returncode == 2 and len(lines) == 1 and "fitting pair" in lines[0], done.stderr
+
+
+def test_each_ablation_run_in_process_uses_a_cell_of_its_own_product(monkeypatch: pytest.MonkeyPatch):
+    """Two runs in one process (one worker): the second's trials are run by a cell of its
+    product, not by the cell the first one made (no simulation: a cell that names its product)."""
+    made: list[str] = []
+
+    class NamedCell:
+        def __init__(self, assembly: str) -> None:
+            made.append(assembly)
+
+        def reset_state(self, **_: object) -> None:
+            pass
+
+        def run_trial(self, part: str, hole: str, seed: int) -> object:
+            trial = _trial("fit", [("fit", 1.0, 0)]) | {"part": part, "hole": hole}
+            return type("Trial", (), {"to_json": lambda _self: trial})()
+
+        def close(self) -> None:
+            pass
+
+    monkeypatch.setattr("executor.trial.Cell", NamedCell)
+    for assembly in ("first", "second"):
+        report = run_ablation(assembly, trials=1, seed=0, executions=1, workers=1, magnitudes=Magnitudes(),
+                              pairs=[CampaignPair("p1", "r1", True)])
+        assert [v["name"] for v in report["variants"]] == list(LAYERS)
+    assert made == ["first", "second"]
