@@ -216,7 +216,7 @@ def report(derived: Derived) -> list[str]:
     for pin_id, pin in derived.pins.items():
         onto = []
         for pid in pin.parts:
-            bore = derived.bores[pid]
+            bore = derived.bore_on(pid, pin_id)
             onto.append(f"{pid} onto it (bore {_describe(bore.kind, bore.a, bore.b)} mm, "
                         f"{_clearance(pin.section, bore, pin_id, pid)})")
         lines.append(f"pin {pin_id} of {pin.owner} at ({_mm(pin.position[0])}, {_mm(pin.position[1])}) mm, "

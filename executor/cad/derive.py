@@ -40,7 +40,9 @@ before it when its outline across its insertion axis lies in an inner loop of th
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
 around a solid loop of another part there (the base's pin, another part's shaft), that
-part the base or one the geometric precedence puts before it, goes onto that pin; a peg
+part the base or one the geometric precedence puts before it, goes onto that pin (onto
+one pin of each such part, through bores of its own: an arm on the base's pivot pin
+through its bore and on a disk's nipple through its slot); a peg
 standing in a hole of the base is a pin only of a part going in along another axis (a
 nut onto a bolt's end under the plate; one going in along the peg's, over it, is a
 cover), or of a part going in along its axis that rests on such pegs alone (a foot down
@@ -193,7 +195,12 @@ class Derived:
     """Empty inner loops of the base whose polygon section has no rotational symmetry (:func:`receives`)."""
     pins: dict[str, PinFit] = field(default_factory=dict)
     bores: dict[str, Shape2D] = field(default_factory=dict)
-    """Part -> the section of its bore around a pin (:func:`pins`)."""
+    """Part -> the section of its bore around the first pin it is on (:func:`pins`), the one it
+    is compared with every pin by."""
+    further_bores: dict[tuple[str, str], Shape2D] = field(default_factory=dict)
+    """(part, pin) -> the section of another bore of the part, around a further pin it is on
+    (of another owner: the arm's slot over the disk's nipple), the one its pair with that
+    pin is measured by (:func:`pins`)."""
     part_holes: dict[str, HoleFit] = field(default_factory=dict)
     """The holes of moving parts, each with the part through it (:func:`part_holes`)."""
     supports: set[tuple[str, str]] = field(default_factory=set)
@@ -232,6 +239,15 @@ class Derived:
         lines += [f"supporting pair {y}->{x} dropped: the blocking needs {x} before {y}"
                   for y, x in sorted(self.dropped_supports)]
         return lines
+
+    def pin_of(self, part: str) -> PinFit:
+        """The first pin ``part`` (one with a bore) is on: the one its bore of :attr:`bores` is around."""
+        return next(pin for pin in self.pins.values() if part in pin.parts and (part, pin.id) not in self.further_bores)
+
+    def bore_on(self, part: str, pin: str) -> Shape2D:
+        """The section of ``part``'s bore that is compared with ``pin``: the one around it
+        where the part is on it, else its first (:attr:`bores`)."""
+        return self.further_bores.get((part, pin), self.bores[part])
 
     @property
     def hole_of(self) -> dict[str, HoleFit]:
@@ -308,7 +324,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.pockets = [fit for fit in found if fit.part is None and not receives(fit)]
     holes = [fit for fit in found if fit not in result.pockets]
     result.holes = {f"h{k}": HoleFit(f"h{k}", *_fields(fit)) for k, fit in enumerate(holes, start=1)}
-    result.pins, result.bores = pins(result)
+    result.pins, result.bores, result.further_bores = pins(result)
     result.part_holes = part_holes(result)
     result.reasons |= owner_pairs(result)
     result.edges = set(result.reasons)
@@ -512,7 +528,7 @@ def _outer(loop: Loop, loops: list[Loop]) -> bool:
     return sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0
 
 
-def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
+def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[tuple[str, str], Shape2D]]:
     """The pins moving parts go onto and each such part's bore section (module docstring,
     :func:`_pin_of`): a part with a bore around one outline of another part, that part the
     base or one the geometric precedence puts before it (a part that goes in after, into
@@ -521,8 +537,14 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
     part's own axis (that part is a cover, :mod:`executor.cad.covers`), unless the part
     rests on such pegs alone (:attr:`Derived.supports`: it goes onto their ends). Parts on one pin
     share its section, the one measured over the longest stretch of it (from the part
-    farthest from its end)."""
+    farthest from its end). A part goes onto a pin of each such owner (in order of their
+    names) through a bore of its own around no pin it is on already: asm4_disk_arm's arm
+    onto the base's pivot pin through its bore and onto the disk's nipple through its
+    slot. Its first bore is its section against every pin (:attr:`Derived.bores`), each
+    further one against its own pin (:attr:`Derived.further_bores`): also the (part,
+    pin) -> bore pairs returned third."""
     found: list[tuple[str, str, Shape2D, np.ndarray, str | None, float]] = []  # owner, axis, pin, centre, part, level
+    further: dict[int, Shape2D] = {}  # index in found -> the part's bore there, on a pin other than its first
     order = nx.DiGraph(list(derived.edges))
     bores: dict[str, Shape2D] = {}
     levels: dict[str, float] = {}
@@ -537,43 +559,54 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D]]:
         resting = {y for y, x in derived.supports if x == pid}
         if resting and resting <= covered:  # on those pegs alone: onto their ends, as no cover rests
             covered -= resting
+        taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
         for other in sorted(({derived.base} | before) - covered):
-            hit = _pin_of(derived, pid, name, other)
-            if hit is not None:
-                pin, bores[pid], centre, level = hit
-                found.append((other, name, pin, centre, pid, level))
-                break
+            hit = _pin_of(derived, pid, name, other, taken)
+            if hit is None:
+                continue
+            pin, bore, centre, level = hit
+            if taken:
+                further[len(found)] = bore
+            else:
+                bores[pid] = bore
+            taken.append(pin.centre)
+            found.append((other, name, pin, centre, pid, level))
     found += [(derived.base, derived.axis[pid], pin, centre, None, math.inf) for pid in sorted(bores)
               for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str], float]] = []
+    into: list[int] = []  # index in found -> index in merged
     for owner, name, pin, centre, on, level in found:
         axis = np.array(derived.directions[name])
         same = next((k for k, m in enumerate(merged) if m[0] == owner and m[1] == name and np.linalg.norm(
             (m[3] - centre) - axis * np.dot(m[3] - centre, axis)) < _SAME_HOLE), None)
+        into.append(len(merged) if same is None else same)
         if same is None:
             merged.append((owner, name, pin, centre, [] if on is None else [on], level))
             continue
         parts = merged[same][4] + ([] if on is None else [on])
         merged[same] = (owner, name, pin, centre, parts, level) if level < merged[same][5] else (
             *merged[same][:4], parts, merged[same][5])
-    merged.sort(key=lambda m: (m[0], round(float(m[3][0]), 6), round(float(m[3][1]), 6), round(float(m[3][2]), 6)))
+    ids: dict[int, str] = {}
     counts: dict[str, int] = {}
     result: dict[str, PinFit] = {}
-    for owner, name, pin, centre, parts, _ in merged:
+    for k in sorted(range(len(merged)), key=lambda k: (merged[k][0], *(round(float(v), 6) for v in merged[k][3]))):
+        owner, name, pin, centre, parts, _ = merged[k]
         counts[owner] = counts.get(owner, 0) + 1
-        pin_id = f"{owner}_pin{counts[owner]}"
+        ids[k] = pin_id = f"{owner}_pin{counts[owner]}"
         result[pin_id] = PinFit(pin_id, owner, name, pin, (float(centre[0]), float(centre[1]), float(centre[2])),
                                 tuple(parts))
-    return result, bores
+    return result, bores, {(str(found[k][4]), ids[into[k]]): bore for k, bore in further.items()}
 
 
-def _pin_of(derived: Derived, pid: str, name: str, owner: str
+def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[np.ndarray] = ()
             ) -> tuple[Shape2D, Shape2D, np.ndarray, float] | None:
     """Part ``pid`` on a pin of ``owner`` along removal direction ``name``: the pin's
     section, the bore's, the pin's centre [m] and the level [m] along the direction they
     were measured at; None when no level tried has one of ``pid``'s inner loops (its bore)
     around exactly one outline of ``owner`` lying in it (within the bore's sagitta and
-    :data:`executor.cad.sweep.TOUCH`, as a nominal zero-clearance fit lies). The levels
+    :data:`executor.cad.sweep.TOUCH`, as a nominal zero-clearance fit lies), no bore around
+    a point of ``taken`` (the centres [m] across the axis of pins the part is on already: it
+    goes onto another part's pin only through another bore of its own). The levels
     tried: the middle of the part's extent along the direction, then
     :data:`_HOLE_LEVELS` middles of the spans between the owner's vertex levels where both
     reach, longest first (a pulley whose middle lies behind the hub's disc has its bore
@@ -603,7 +636,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str
     middle = float(along.min() + along.max()) / 2
     line = next((found for level in ([middle] if low < middle < high else [])
                  + _spans(other_along, low, high)[:_HOLE_LEVELS]
-                 if (found := _bore_around(part, other, axis, level)) is not None), None)
+                 if (found := _bore_around(part, other, axis, level, taken)) is not None), None)
     if line is None:
         return None
     frame = frame_of(axis)
@@ -680,12 +713,16 @@ def _outline(union: shapely.Polygon) -> Loop:
     return Loop(np.asarray(shapely.simplify(shapely.Polygon(union.exterior), _JITTER).exterior.coords)[:-1])
 
 
-def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float) -> np.ndarray | None:
+def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float,
+                 taken: Iterable[np.ndarray] = ()) -> np.ndarray | None:
     """The centre (2,) [m] of the one outline of ``other`` that lies in an inner loop (a
-    bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`_in_loop`); None
-    when no bore holds exactly one."""
+    bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`_in_loop`),
+    of the bores around none of the points ``taken`` (2,) [m]; None when no bore holds
+    exactly one."""
     own = slice_loops(part, axis, level)
-    bores = [o for o in own if not _outer(o, own)]
+    bores = [o for o in own if not _outer(o, own) and not any(o.contains(point) for point in taken)]
+    if not bores:
+        return None
     across = other.vertices @ frame_of(axis).T
     if not any(np.all((across >= bore.points.min(axis=0)) & (across <= bore.points.max(axis=0)), axis=1).any()
                for bore in bores):

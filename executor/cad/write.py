@@ -251,8 +251,9 @@ def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
     holes = {**derived.holes, **derived.part_holes}
     pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in holes.items()}
              for pid, fit in sorted(derived.in_holes.items()) if fit.section is not None}
-    for pid, bore in sorted(derived.bores.items()):
-        pairs.setdefault(pid, {}).update({pin_id: (pin.section, bore) for pin_id, pin in derived.pins.items()})
+    for pid in sorted(derived.bores):
+        pairs.setdefault(pid, {}).update({pin_id: (pin.section, derived.bore_on(pid, pin_id))
+                                          for pin_id, pin in derived.pins.items()})
     return pairs
 
 
@@ -452,8 +453,11 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
     each with why the cell places it by hand (a polygon peg's room is often below what
     convex pieces of its mesh keep)."""
     kept: dict[str, HoleFit] = {}
-    by_hand = {pid: why for pin in derived.pins.values() for pid in pin.parts
-               if (why := _onto_pin(derived, pin, pid)) is not None}
+    by_hand: dict[str, str] = {}
+    for pin in sorted(derived.pins.values(), key=lambda p: p.owner == derived.base):  # the cheap reasons first
+        for pid in pin.parts:
+            if pid not in by_hand and (why := _onto_pin(derived, pin, pid)) is not None:
+                by_hand[pid] = why
     for hid, fit in derived.holes.items():
         if fit.part is not None and derived.axis[fit.part] != fit.axis:
             by_hand[fit.part] = (f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, its hole {hid} "
@@ -588,7 +592,7 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     of its pin's room (the part has room on its pin: :func:`_onto_pin`)
     (:func:`executor.cad.convex.pin_pieces`)."""
     allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
-    pin = next(p for p in derived.pins.values() if pid in p.parts)
+    pin = derived.pin_of(pid)
     low, high = (float(v) for v in mesh.bounds[:, 2])
     solid = trimesh.creation.extrude_polygon(shapely.Polygon(pin.section.outline + np.array(pin.position)),
                                              high - low + 2 * NEAR)
@@ -897,7 +901,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
             lines.append(f"yaw = {pin.section.yaw:.6g}")
         lines += [f"top_z = {_q(top)}", f"depth = {_q(height)}", ""]
     for pid, bore in sorted(derived.bores.items()):
-        mesh, pin = derived.parts[pid].mesh, next(p for p in derived.pins.values() if pid in p.parts)
+        mesh, pin = derived.parts[pid].mesh, derived.pin_of(pid)
         onto = [pins[0] for pin_id, pins in pairs[pid].items() if pid in nominal.get(pin_id, [])]
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true",
                   *_section_lines(nominal_section(bore, onto)),

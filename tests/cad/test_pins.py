@@ -21,6 +21,7 @@ import trimesh
 from assembly_constraints.cli import main
 from executor.cad.derive import _GRID, _joined, derive
 from executor.cad.parts import CadPart
+from executor.cad.write import margins
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -219,3 +220,36 @@ def test_a_part_resting_on_a_peg_alone_goes_onto_its_end_and_is_no_cover() -> No
     assert [fit.part for fit in derived.holes.values()] == ["upright"]
     assert [(pin.owner, pin.parts) for pin in derived.pins.values()] == [("upright", ("foot",))]
     assert set(derived.bores) == {"foot"}
+
+
+def _round(x: float, radius: float, low: float, high: float) -> trimesh.Trimesh:
+    """A round pin of ``radius`` [m] about (``x``, 0), from ``low`` to ``high`` [m] along z."""
+    return _prism(shapely.Point(x, 0.0).buffer(radius, quad_segs=16), low, high)
+
+
+def test_a_part_goes_onto_a_pin_of_another_part_through_a_second_bore_of_its_own() -> None:
+    # asm4_disk_arm: a disk down a pin of the base, with a nipple standing on it; an arm down
+    # another pin of the base, lying on the disk, the nipple in its slot. The arm is on both
+    # pins, each pair measured by its own bore: the slot (0.8 mm of room across) for the
+    # nipple, the round bore (0.4 mm) for the base's pin; the disk goes first because the
+    # arm lies on it (no pair of the feature's own).
+    mm = 1e-3
+    plate = trimesh.boolean.union([_prism(shapely.box(-30 * mm, -20 * mm, 100 * mm, 20 * mm), 0.0, 10 * mm),
+                                   _round(0.0, 5 * mm, 5 * mm, 15 * mm), _round(80 * mm, 5 * mm, 5 * mm, 30 * mm)],
+                                  engine="manifold")
+    disk = trimesh.boolean.union([
+        trimesh.boolean.difference([_prism(shapely.box(-20 * mm, -15 * mm, 40 * mm, 15 * mm), 10 * mm, 15 * mm),
+                                    _round(0.0, 5.25 * mm, 9 * mm, 16 * mm)], engine="manifold"),
+        _round(30 * mm, 5 * mm, 14 * mm, 30 * mm)], engine="manifold")
+    slot = shapely.LineString([(25 * mm, 0.0), (35 * mm, 0.0)]).buffer(5.4 * mm, quad_segs=8)
+    arm = trimesh.boolean.difference([_prism(shapely.box(15 * mm, -10 * mm, 95 * mm, 10 * mm), 15 * mm, 20 * mm),
+                                      _round(80 * mm, 5.2 * mm, 14 * mm, 21 * mm), _prism(slot, 14 * mm, 21 * mm)],
+                                     engine="manifold")
+    derived = derive([CadPart(pid, pid, mesh, "test") for pid, mesh in
+                      (("base", plate), ("disk", disk), ("arm", arm))], "base", {})
+    assert {pin.id: (pin.owner, pin.parts) for pin in derived.pins.values()} == {
+        "base_pin1": ("base", ("disk",)), "base_pin2": ("base", ("arm",)), "disk_pin1": ("disk", ("arm",))}
+    assert derived.pin_of("arm").id == "base_pin2" and set(derived.further_bores) == {("arm", "disk_pin1")}
+    rooms = margins(derived)["arm"]
+    assert abs(rooms["disk_pin1"] - 0.8 * mm) < 0.02 * mm and abs(rooms["base_pin2"] - 0.4 * mm) < 0.02 * mm, rooms
+    assert derived.reasons[("disk", "arm")] != "feature"
