@@ -253,6 +253,8 @@ def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
              for pid, fit in sorted(derived.in_holes.items()) if fit.section is not None}
     for pid, bore in sorted(derived.bores.items()):
         pairs.setdefault(pid, {}).update({pin_id: (pin.section, bore) for pin_id, pin in derived.pins.items()})
+    for (pid, hid), (peg, hole, _) in derived.swept.items():
+        pairs[pid][hid] = (peg, hole)
     return pairs
 
 
@@ -378,8 +380,9 @@ def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
     negative: it does not pass); ExecutorError naming the part, hole, pin or bore whose
     polygon section is no simple outline."""
     try:
-        return {pid: {hid: margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
-                                  section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+        return {pid: {hid: derived.swept[(pid, hid)][2] if (pid, hid) in derived.swept else
+                      margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
+                             section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
                       for hid, (peg, hole) in holes.items()}
                 for pid, holes in _pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself
