@@ -254,7 +254,8 @@ def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
     for pid, bore in sorted(derived.bores.items()):
         pairs.setdefault(pid, {}).update({pin_id: (pin.section, bore) for pin_id, pin in derived.pins.items()})
     for (pid, hid), (peg, hole, _) in derived.swept.items():
-        pairs[pid][hid] = (peg, hole)
+        if hid in pairs.get(pid, {}):  # the cell's view leaves out the parts it places by hand
+            pairs[pid][hid] = (peg, hole)
     return pairs
 
 
