@@ -126,7 +126,8 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array", "factory_gears",
+@pytest.mark.parametrize("name", ["asap_beam", "asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array",
+                                  "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes",

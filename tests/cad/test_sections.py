@@ -237,3 +237,26 @@ def test_a_taper_passes_its_own_taper_and_not_a_narrower_one(narrower: float, fi
     assert way.room == pytest.approx(-math.sqrt(2) * narrower, abs=2e-8)
     shapes = classify(way.peg, hole=False), classify(way.hole, hole=True)
     assert (way.room > 0 or sections.zero_clearance(*shapes, way.room) is not None) == fits
+
+
+def test_a_tenon_swept_into_its_own_taper_fits_alike_tapers_and_not_a_straight_hole_of_its_middle() -> None:
+    # The tenon of _tapered_pair in its mortise, beside an empty mortise of the same taper
+    # and an empty straight 5.5 mm square hole (the tenon's section half way in). Over the
+    # stretch the tenon (6 mm under its shoulder) passes none; swept, it passes both tapers
+    # at room 0 and not the straight hole, whose mouth its upper half does not pass.
+    plate = trimesh.creation.box((0.07, 0.03, 0.01), trimesh.transformations.translation_matrix((0, 0, 0.005)))
+    cuts = [_frustum(-MM, 11 * MM, 4.9 * MM, 6.1 * MM), _frustum(-MM, 11 * MM, 4.9 * MM, 6.1 * MM),
+            trimesh.creation.box((0.0055, 0.0055, 0.012), trimesh.transformations.translation_matrix((0, 0, 0.005)))]
+    for cut, x in zip(cuts, (0.0, 0.02, -0.02), strict=True):
+        cut.apply_translation((x, 0.0, 0.0))
+    plate = trimesh.boolean.difference([plate, *cuts], engine="manifold")
+    tenon = _tapered_pair(0.0)[1]
+    derived = derive([CadPart("plate", "plate", plate, "plate.stl"), CadPart("tenon", "tenon", tenon, "tenon.stl")],
+                     "plate", {})
+    at = {round(fit.position[0], 3): hid for hid, fit in derived.holes.items()}
+    own, alike, straight = at[0.0], at[0.02], at[-0.02]
+    assert derived.holes[own].part == "tenon"
+    assert set(derived.swept) == {("tenon", own), ("tenon", alike)}
+    assert derived.swept[("tenon", own)][2] == pytest.approx(0.0, abs=2e-8)
+    rooms = margins(derived)["tenon"]
+    assert rooms[own] == rooms[alike] == 0.0 and rooms[straight] < -0.0004
