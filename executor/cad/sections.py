@@ -293,24 +293,37 @@ class Passage:
     hole: Loop
 
 
-def _cleaned(loop: Loop, shift: np.ndarray, *, hole: bool) -> shapely.Polygon:
-    """The ``loop`` moved by ``shift`` (2,) [m] as a polygon without its spikes (:data:`SPIKE`)."""
-    outline = shapely.make_valid(shapely.Polygon(loop.points + shift))
-    pieces = [piece for piece in shapely.get_parts(outline) if isinstance(piece, shapely.Polygon)]
-    polygon = max(pieces, key=lambda piece: piece.area) if pieces else shapely.Polygon()
-    kept = polygon.buffer(-SPIKE, join_style="mitre").buffer(SPIKE, join_style="mitre") if hole else \
-        polygon.buffer(SPIKE, join_style="mitre").buffer(-SPIKE, join_style="mitre")
-    parts = [piece for piece in shapely.get_parts(kept) if isinstance(piece, shapely.Polygon)]
-    return max(parts, key=lambda piece: piece.area) if parts else shapely.Polygon()
+def _cleaned(loop: Loop, *, hole: bool) -> shapely.Geometry:
+    """The ``loop`` as a region without its spikes (:data:`SPIKE`): a hole's largest piece
+    (where the loop touches itself), a peg's every piece."""
+    pieces = [piece for piece in shapely.get_parts(shapely.make_valid(shapely.Polygon(loop.points)))
+              if isinstance(piece, shapely.Polygon)]
+    if not pieces:
+        return shapely.Polygon()
+    if hole:
+        opened = max(pieces, key=lambda piece: piece.area).buffer(-SPIKE, join_style="mitre").buffer(
+            SPIKE, join_style="mitre")
+        parts = [piece for piece in shapely.get_parts(opened) if isinstance(piece, shapely.Polygon)]
+        return max(parts, key=lambda piece: piece.area) if parts else shapely.Polygon()
+    return shapely.union_all(pieces).buffer(SPIKE, join_style="mitre").buffer(-SPIKE, join_style="mitre")
 
 
-def _around(loops: list[Loop], line: np.ndarray, *, hole: bool) -> Loop | None:
+def _hole_around(loops: list[Loop], line: np.ndarray) -> Loop | None:
     """The smallest loop holding the point ``line`` that is a hole (inside an odd number of
-    the others) or, for a peg, an outline (an even number); None when none is."""
+    the others); None when none is (the point is in the solid)."""
     holding = [loop for loop in loops if loop.contains(line)]
-    found = [loop for loop in holding
-             if (sum(1 for o in holding if o is not loop and o.area > loop.area) % 2 == 1) == hole]
+    found = [loop for loop in holding if sum(1 for o in holding if o is not loop and o.area > loop.area) % 2 == 1]
     return min(found, key=lambda loop: loop.area) if found else None
+
+
+def _peg_near(loops: list[Loop], line: np.ndarray, reach: float, shift: np.ndarray) -> list[Loop]:
+    """The outlines (inside an even number of the others) of a peg's slice, moved by
+    ``shift`` (2,) [m], that come within ``reach`` [m] of the point ``line``: every piece
+    of it that could enter the hole, whole (a piece reaching beyond the hole's mouth does
+    not pass it)."""
+    moved = [Loop(loop.points + shift) for loop in loops
+             if sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0]
+    return [loop for loop in moved if shapely.distance(shapely.Polygon(loop.points), shapely.Point(line)) <= reach]
 
 
 def sweep_levels(levels: np.ndarray, low: float, high: float) -> list[float]:
@@ -348,48 +361,42 @@ def passage(peg: Slicer, owner: Slicer, line: np.ndarray, low: float, high: floa
     to a wall then moves in a straight line); None when the hole closes at a level."""
     offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=float)
     across, along = frame_of(owner.axis) @ offset, float(owner.axis @ offset)
-    mouth = _around(owner.at(high - SEAT), line, hole=True)
+    mouth = _hole_around(owner.at(high - SEAT), line)
     if mouth is None:
         return None
     reach = float(np.linalg.norm(mouth.points - line, axis=1).max()) + SEAT
     levels = np.concatenate([owner.levels(line, reach), peg.levels(line - across, reach) + along])
     best: tuple[float, int, int] | None = None
-    last = -1  # the highest level with a section of the peg
-    points = np.zeros((0, 2))
-    marks = np.zeros(0, dtype=object)
-    which = np.zeros(0, dtype=np.int64)
-    union = shapely.Polygon()
+    union = shapely.Polygon()  # the peg's sections at the levels so far
+    sections: list[tuple[int, shapely.Polygon]] = []
     found: list[tuple[Loop | None, Loop]] = []
     for index, level in enumerate(sweep_levels(levels, low + SEAT, high - SEAT)):
-        hole_loop = _around(owner.at(level), line, hole=True)
-        if hole_loop is None:
+        hole_loop = _hole_around(owner.at(level), line)
+        hole = shapely.Polygon() if hole_loop is None else _cleaned(hole_loop, hole=True)
+        if hole_loop is None or hole.is_empty:
             return None
-        peg_loop = _around(peg.at(level - along), line - across, hole=False)
-        hole = _cleaned(hole_loop, np.zeros(2), hole=True)
-        if hole.is_empty:
-            return None
-        if peg_loop is not None:
-            section = _cleaned(peg_loop, across, hole=False)
-            corners = np.asarray(section.exterior.coords)[:-1]
-            points = np.concatenate([points, corners])
-            marks = np.concatenate([marks, shapely.points(corners)])
-            which = np.concatenate([which, np.full(len(corners), index)])
+        pieces = _peg_near(peg.at(level - along), line, reach, across)
+        found.append((max(pieces, key=lambda loop: loop.area) if pieces else None, hole_loop))
+        if pieces:
+            section = shapely.union_all([_cleaned(loop, hole=False) for loop in pieces])
+            sections.append((index, section))
             union = shapely.union(union, section)
-            last = index
-        found.append((None if peg_loop is None else Loop(peg_loop.points + across), hole_loop))
-        if not len(points):
+        if union.is_empty:
             continue
-        distance = shapely.distance(marks, hole.exterior)
-        inside = shapely.contains_xy(hole, points[:, 0], points[:, 1])
-        clearance = np.where(inside, distance, -distance)
-        least, at = float(clearance.min()), int(which[int(clearance.argmin())])
+        # the union's corners are the peg's farthest points from a wall (a corner of the
+        # hole inside it is measured from its outline below)
+        corners = shapely.get_coordinates(union)
+        distance = shapely.distance(shapely.points(corners), hole.exterior)
+        clearance = np.where(shapely.contains_xy(hole, corners[:, 0], corners[:, 1]), distance, -distance)
+        least, nearest = float(clearance.min()), shapely.Point(corners[int(clearance.argmin())])
         walls = np.asarray(hole.exterior.coords)[:-1]
         poking = shapely.contains_xy(union, walls[:, 0], walls[:, 1])
         if poking.any():
-            depth = -float(shapely.distance(shapely.points(walls[poking]), union.boundary).max())
-            if depth < least:
-                least, at = depth, last
+            depths = shapely.distance(shapely.points(walls[poking]), union.boundary)
+            if -float(depths.max()) < least:
+                least, nearest = -float(depths.max()), shapely.Point(walls[poking][int(depths.argmax())])
         if best is None or least < best[0]:
+            at = min(sections, key=lambda item: shapely.distance(item[1].boundary, nearest))[0]
             best = (least, at, index)
     if best is None:
         return None
