@@ -31,6 +31,8 @@ loop whose section is a polygon is a hole only when it has rotational symmetry a
 centre (:func:`receives`), else a pocket, reported but no hole. Both sections are those
 over the stretch the part passes, from its end to the entry
 (:func:`executor.cad.sections.over_span`: the hole's narrowest, the part's widest).
+Where those do not pass, the part is swept out of its hole level by level
+(:func:`swept_fits`: a taper in its own taper passes).
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
