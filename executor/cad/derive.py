@@ -712,7 +712,7 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
                 found[(fit.part, other)] = way
     for pin_id, pin in derived.pins.items():
         out = -np.array(derived.directions[pin.axis])
-        name = f"-{pin.axis}"
+        name = f"against {pin.axis}"  # the slicers across the pin's way out of the bore
         line = frame_of(out) @ np.array(pin.centre)
         reach = max(pin.section.a, pin.section.b)
         for pid in pin.parts:
