@@ -194,6 +194,20 @@ def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> st
     return f"{verdict}clearance {_mm(room.margin)} mm: {_mm(room.room)} mm all round at yaw {room.yaw:.3f} deg"
 
 
+def _swept(derived: Derived, part: str, feature: str) -> str:
+    """What the report adds where the sweep admits a pair the sections over the whole
+    stretch do not (:func:`executor.cad.derive.swept_fits`): the sections at the levels of
+    least room on the way in and that room, as ``sizes.lp`` takes it; "" elsewhere."""
+    if (part, feature) not in derived.swept:
+        return ""
+    peg, hole, room = derived.swept[(part, feature)]
+    apart = zero_clearance(peg, hole, room)
+    verdict = f"room {_mm(room)} mm" if apart is None else \
+        f"nominal zero-clearance fit, room 0 (measured {_mm(room)} mm)"
+    return (f"; the sweep admits it: {_describe(peg.kind, peg.a, peg.b)} mm in {_describe(hole.kind, hole.a, hole.b)}"
+            f" mm at the levels of least room on the way in, {verdict}")
+
+
 def report(derived: Derived) -> list[str]:
     """The lines ``import`` prints about what it derived."""
     lines = []
@@ -206,7 +220,7 @@ def report(derived: Derived) -> list[str]:
         held = "empty"
         if fit.part is not None and fit.section is not None:
             held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, "
-                    f"{_clearance(fit.section, fit.hole, fit.part, hid)})")
+                    f"{_clearance(fit.section, fit.hole, fit.part, hid)}{_swept(derived, fit.part, hid)})")
         owner = "" if fit.owner is None else f" of {fit.owner}"
         where = (f"at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm" if fit.axis == "+z" else
                  "entry at ({}, {}, {}) mm".format(*map(_mm, entry_point(fit))))
@@ -218,7 +232,7 @@ def report(derived: Derived) -> list[str]:
         for pid in pin.parts:
             bore = derived.bore_on(pid, pin_id)
             onto.append(f"{pid} onto it (bore {_describe(bore.kind, bore.a, bore.b)} mm, "
-                        f"{_clearance(pin.section, bore, pin_id, pid)})")
+                        f"{_clearance(pin.section, bore, pin_id, pid)}{_swept(derived, pid, pin_id)})")
         lines.append(f"pin {pin_id} of {pin.owner} at ({_mm(pin.position[0])}, {_mm(pin.position[1])}) mm, "
                      f"entered along {opposite(pin.axis)}: {_describe(pin.section.kind, pin.section.a, pin.section.b)}"
                      f" mm; {'; '.join(onto) or 'empty'}")

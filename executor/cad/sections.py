@@ -242,6 +242,170 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     return Loop(np.asarray(found.exterior.coords)[:-1])
 
 
+SPIKE = 5e-8
+"""A level's section in the sweep (:func:`passage`) loses its spikes and slivers narrower
+than twice this [m] (50 nm, a tenth of :data:`OUTLINE_TOUCH`): a hole's is opened (buffered
+in by it and out again: never wider), a peg's closed (out and in: never narrower), with
+mitred joins that give a corner back where it was, so both stay conservative where the
+faces of a tessellation meet at a hair's angle."""
+SEAT = TOUCH
+"""The sweep's stretch is taken this far [m] inside its ends: a peg's shoulder resting on
+the entry face, or its tip on a hole's floor, overlaps that face by the tessellations'
+touch (asap_beam's shoulders lie 27 nm below the top's face), which the disassembly takes
+for touching up to :data:`executor.cad.sweep.TOUCH` (10 µm)."""
+_SPLIT = 1e-8
+"""Vertex levels closer than this [m] are one (the sweep's levels, :func:`passage`)."""
+_INSIDE = 3e-9
+"""The sweep slices this far [m] inside each span's ends (a section's limit from within the span)."""
+
+
+class Slicer:
+    """The loops of ``mesh``'s slices across ``axis``, each level sliced once."""
+
+    def __init__(self, mesh: trimesh.Trimesh, axis: np.ndarray) -> None:
+        self.mesh, self.axis = mesh, np.asarray(axis, dtype=float)
+        self._done: dict[float, list[Loop]] = {}
+
+    def at(self, level: float) -> list[Loop]:
+        """The loops at ``level`` [m] along the axis."""
+        key = round(level, 12)
+        if key not in self._done:
+            self._done[key] = slice_loops(self.mesh, self.axis, key)
+        return self._done[key]
+
+    def levels(self, line: np.ndarray, reach: float) -> np.ndarray:
+        """The levels [m] along the axis of the mesh's vertices within ``reach`` [m] of the
+        point ``line`` (2,) across it (in :func:`frame_of`'s axes)."""
+        vertices = self.mesh.vertices
+        near = np.linalg.norm(vertices @ frame_of(self.axis).T - line, axis=1) <= reach
+        return vertices[near] @ self.axis
+
+
+@dataclass(frozen=True)
+class Passage:
+    """A peg's way into a hole along an axis (:func:`passage`): ``room`` [m] twice the least
+    clearance of the peg's section at a level to the hole's at a level it crosses on the way
+    in (diametral, as :func:`executor.world.geometry.margin`; negative: an overlap), and the
+    ``peg``'s and ``hole``'s loops at the pair of levels where it is least."""
+
+    room: float
+    peg: Loop
+    hole: Loop
+
+
+def _cleaned(loop: Loop, *, hole: bool) -> shapely.Geometry:
+    """The ``loop`` as a region without its spikes (:data:`SPIKE`): a hole's largest piece
+    (where the loop touches itself), a peg's every piece."""
+    pieces = [piece for piece in shapely.get_parts(shapely.make_valid(shapely.Polygon(loop.points)))
+              if isinstance(piece, shapely.Polygon)]
+    if not pieces:
+        return shapely.Polygon()
+    if hole:
+        opened = max(pieces, key=lambda piece: piece.area).buffer(-SPIKE, join_style="mitre").buffer(
+            SPIKE, join_style="mitre")
+        parts = [piece for piece in shapely.get_parts(opened) if isinstance(piece, shapely.Polygon)]
+        return max(parts, key=lambda piece: piece.area) if parts else shapely.Polygon()
+    return shapely.union_all(pieces).buffer(SPIKE, join_style="mitre").buffer(-SPIKE, join_style="mitre")
+
+
+def _hole_around(loops: list[Loop], line: np.ndarray) -> Loop | None:
+    """The smallest loop holding the point ``line`` that is a hole (inside an odd number of
+    the others); None when none is (the point is in the solid)."""
+    holding = [loop for loop in loops if loop.contains(line)]
+    found = [loop for loop in holding if sum(1 for o in holding if o is not loop and o.area > loop.area) % 2 == 1]
+    return min(found, key=lambda loop: loop.area) if found else None
+
+
+def _peg_near(loops: list[Loop], line: np.ndarray, reach: float, shift: np.ndarray) -> list[Loop]:
+    """The outlines (inside an even number of the others) of a peg's slice, moved by
+    ``shift`` (2,) [m], that come within ``reach`` [m] of the point ``line``: every piece
+    of it that could enter the hole, whole (a piece reaching beyond the hole's mouth does
+    not pass it)."""
+    moved = [Loop(loop.points + shift) for loop in loops
+             if sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0]
+    return [loop for loop in moved if shapely.distance(shapely.Polygon(loop.points), shapely.Point(line)) <= reach]
+
+
+def sweep_levels(levels: np.ndarray, low: float, high: float) -> list[float]:
+    """The levels [m] :func:`passage` slices at: just inside both ends of each span between
+    the distinct ``levels`` clipped to [``low``, ``high``] (:data:`_INSIDE`; within a span
+    every section's corners move in straight lines), the middle of a span too short for two."""
+    bounds = [low]
+    for level in np.unique(np.round(np.clip(levels, low, high), 9)):
+        if level - bounds[-1] > _SPLIT and high - level > _SPLIT:
+            bounds.append(float(level))
+    bounds.append(high)
+    found: list[float] = []
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        found += [a + _INSIDE, b - _INSIDE] if b - a > 4 * _INSIDE else [(a + b) / 2]
+    return found
+
+
+def passage(peg: Slicer, owner: Slicer, line: np.ndarray, low: float, high: float,
+            offset: np.ndarray | None = None) -> Passage | None:
+    """The sweep of a peg leaving a hole along the slicers' common axis (``owner``'s the
+    hole's, ``peg``'s the peg's, moved by ``offset`` (3,) [m]): the peg's sections at the
+    levels between ``low`` and ``high`` [m] (its tip and the entry, :data:`SEAT` inside
+    them) each against the hole's at that level and every level above it, the loops around
+    the point ``line`` (2,) [m] across the axis. The stretch is split at the levels of the
+    vertices of both within the hole's reach at the entry (its loop's farthest point from
+    the line; :func:`sweep_levels`): a peg passing the entry lies within it, and there a
+    section changes only at such a level (a face's vertex beyond it bends the face's trace
+    beyond it). The peg passes when each of its
+    sections lies in the hole's at every level it crosses on the way in: a taper in its own
+    taper, whose narrow tip meets the hole's wide mouth; not a prism through a throat. The
+    clearance of a pair is the least distance of the peg's corners to the hole's walls
+    (negative outside it) and of the hole's corners inside the peg's sections below to
+    their outline, each section in the pose the product has it (not centred). Exact at the
+    levels sliced, and between them where the hole's section is convex (a corner's distance
+    to a wall then moves in a straight line); None when the hole closes at a level."""
+    offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=float)
+    across, along = frame_of(owner.axis) @ offset, float(owner.axis @ offset)
+    mouth = _hole_around(owner.at(high - SEAT), line)
+    if mouth is None:
+        return None
+    reach = float(np.linalg.norm(mouth.points - line, axis=1).max()) + SEAT
+    levels = np.concatenate([owner.levels(line, reach), peg.levels(line - across, reach) + along])
+    best: tuple[float, int, int] | None = None
+    union = shapely.Polygon()  # the peg's sections at the levels so far
+    sections: list[tuple[int, shapely.Polygon]] = []
+    found: list[tuple[Loop | None, Loop]] = []
+    for index, level in enumerate(sweep_levels(levels, low + SEAT, high - SEAT)):
+        hole_loop = _hole_around(owner.at(level), line)
+        hole = shapely.Polygon() if hole_loop is None else _cleaned(hole_loop, hole=True)
+        if hole_loop is None or hole.is_empty:
+            return None
+        pieces = _peg_near(peg.at(level - along), line, reach, across)
+        found.append((max(pieces, key=lambda loop: loop.area) if pieces else None, hole_loop))
+        if pieces:
+            section = shapely.union_all([_cleaned(loop, hole=False) for loop in pieces])
+            sections.append((index, section))
+            union = shapely.union(union, section)
+        if union.is_empty:
+            continue
+        # the union's corners are the peg's farthest points from a wall (a corner of the
+        # hole inside it is measured from its outline below)
+        corners = shapely.get_coordinates(union)
+        distance = shapely.distance(shapely.points(corners), hole.exterior)
+        clearance = np.where(shapely.contains_xy(hole, corners[:, 0], corners[:, 1]), distance, -distance)
+        least, nearest = float(clearance.min()), shapely.Point(corners[int(clearance.argmin())])
+        walls = np.asarray(hole.exterior.coords)[:-1]
+        poking = shapely.contains_xy(union, walls[:, 0], walls[:, 1])
+        if poking.any():
+            depths = shapely.distance(shapely.points(walls[poking]), union.boundary)
+            if -float(depths.max()) < least:
+                least, nearest = -float(depths.max()), shapely.Point(walls[poking][int(depths.argmax())])
+        if best is None or least < best[0]:
+            at = min(sections, key=lambda item: shapely.distance(item[1].boundary, nearest))[0]
+            best = (least, at, index)
+    if best is None:
+        return None
+    least, at, index = best
+    peg_loop = found[at][0]
+    assert peg_loop is not None  # a clearance is measured only from a section of the peg
+    return Passage(2 * least, peg_loop, found[index][1])
+
+
 def _closed_polylines(section: trimesh.path.Path3D) -> list[np.ndarray]:
     """The points (n, 3) [m] of each closed path of a plane section, the first repeated
     last: those of :func:`_closed_paths` discretised, in the same order. Where the

@@ -11,7 +11,8 @@
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.world.geometry.passes`: the exact rules of round,
   square and rect sections, the polygon relation where one is a polygon) or when they
-  are a nominal zero-clearance fit (:func:`nominal_fits`, named in a comment), closed world;
+  are a nominal zero-clearance fit (:func:`nominal_fits`, named in a comment), or when
+  the sweep admits them (:func:`executor.cad.derive.swept_fits`: a taper in its taper), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's (0: a nominal zero-clearance fit), the input of ``sizes learn --prior cad``;
 - ``geometric_precedence.lp``: ``part/1`` and ``must_precede/2`` (transitively closed)
@@ -247,13 +248,17 @@ def sizes_text(derived: Derived) -> str:
 def _pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2D]]]:
     """Peg (a part in a hole of the base or of a moving part) -> hole -> the measured
     sections of the peg and the hole, and part with a bore -> pin -> those of the pin and
-    the bore (the pin goes into the bore)."""
+    the bore (the pin goes into the bore); for a pair the sweep admits, those at its levels
+    of least room (:func:`executor.cad.derive.swept_fits`)."""
     holes = {**derived.holes, **derived.part_holes}
     pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in holes.items()}
              for pid, fit in sorted(derived.in_holes.items()) if fit.section is not None}
     for pid in sorted(derived.bores):
         pairs.setdefault(pid, {}).update({pin_id: (pin.section, derived.bore_on(pid, pin_id))
                                           for pin_id, pin in derived.pins.items()})
+    for (pid, hid), (peg, hole, _) in derived.swept.items():
+        if hid in pairs.get(pid, {}):  # the cell's view leaves out the parts it places by hand
+            pairs[pid][hid] = (peg, hole)
     return pairs
 
 
@@ -376,11 +381,13 @@ def margins(derived: Derived) -> dict[str, dict[str, float]]:
 def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of its measured section in the hole's, and part with a
     bore -> pin -> that of the pin in the bore (:func:`executor.world.geometry.margin`;
-    negative: it does not pass); ExecutorError naming the part, hole, pin or bore whose
-    polygon section is no simple outline."""
+    negative: it does not pass), or the least room of the sweep where it admits the pair
+    (:func:`executor.cad.derive.swept_fits`); ExecutorError naming the part, hole, pin or
+    bore whose polygon section is no simple outline."""
     try:
-        return {pid: {hid: margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
-                                  section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+        return {pid: {hid: derived.swept[(pid, hid)][2] if (pid, hid) in derived.swept else
+                      margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
+                             section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
                       for hid, (peg, hole) in holes.items()}
                 for pid, holes in _pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself

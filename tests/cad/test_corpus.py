@@ -81,11 +81,7 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
-TOO_SLOW: dict[str, str] = {
-    "asap_beam": "its uprights' tapered tenons narrow with the top's tapered mortises, and a section over the whole "
-                 "span (the peg's widest against the hole's narrowest) reads a taper in its own taper as no fit, so "
-                 "the cell would insert the uprights and the import seeks CoACD pieces for them (over 300 s of CPU)",
-}
+TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 """Every product the import takes."""
@@ -95,6 +91,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
     "asm4_axis_bearings",
     "agh_hex_horizontal",
     "agh_prism_array",
+    "asap_beam",
     "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
@@ -126,7 +123,8 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array", "factory_gears",
+@pytest.mark.parametrize("name", ["asap_beam", "asm4_axis_bearings", "agh_hex_horizontal", "agh_prism_array",
+                                  "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes",
@@ -154,6 +152,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "asm4_axis_bearings",
     "agh_hex_horizontal",
     "agh_prism_array",
+    "asap_beam",
     "factory_gears",
     "factory_rect_pegs",
     "ldraw_axles",
@@ -243,6 +242,9 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                                     "axis's seats: the cell puts parts onto pins from above)")),
     "agh_hex_horizontal",
     "agh_prism_array",
+    pytest.param("asap_beam", marks=_xfail(INSERTED + " into a tapered hole (the uprights, room 0: the cell's plate "
+                                           "has straight holes, the top's own mesh no room it resolves) or onto a pin "
+                                           "of a part that is not the base (the feet onto the uprights' tenons)")),
     pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a shaft with less room than the cell resolves "
                                                "(0.012 mm per side)")),
     "factory_rect_pegs",
@@ -426,6 +428,7 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize(("name", "unresolved"), [  # each a unit of the workers' work with its product's other tests
+    pytest.param("asap_beam", {"upright_a", "upright_b"}, id="asap_beam"),
     pytest.param("factory_gears", {"gear_small", "gear_medium"}, id="factory_gears"),
     pytest.param("occt_pump", {"bearing_ring"}, id="occt_pump")])
 def test_parts_with_less_room_than_the_cell_resolves_are_placed_by_hand_saying_so(
@@ -434,9 +437,12 @@ def test_parts_with_less_room_than_the_cell_resolves_are_placed_by_hand_saying_s
     # the cell resolves (it jammed 11.5 mm short when taught). occt_pump: the bearing ring is
     # a nominal zero-clearance fit in the housing's bore, which the cell widens only in a base
     # it builds of primitives, not in the housing's own mesh (CoACD's pieces of the ring,
-    # sought to keep that room, took 146 s of CPU a try and never fitted). Each is placed by
-    # hand with that reason; a sim session of such a product takes every pair from sizes.lp
-    # as not observed (ldraw_axles' test above; these end to end: `./run.sh bench corpus`).
+    # sought to keep that room, took 146 s of CPU a try and never fitted). asap_beam: the
+    # uprights' tapered tenons are nominal zero-clearance fits in the top's tapered mortises,
+    # which make the top its own mesh (a plate's holes are straight); its feet go onto the
+    # uprights' tenons, pins of no base. Each is placed by hand with that reason; a sim
+    # session of such a product takes every pair from sizes.lp as not observed (ldraw_axles'
+    # test above; these end to end: `./run.sh bench corpus`).
     manual = load_geometry(str(imported(name).out)).tables.manual
     assert {pid for pid, table in manual.items()
             if "mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason} == unresolved

@@ -195,3 +195,68 @@ def test_a_slice_in_metres_keeps_a_corner_4_um_from_its_neighbour() -> None:
     loops = sections.slice_loops(prism, np.array([0.0, 0.0, 1.0]), 0.005)
     assert len(loops) == 1 and loops[0].area == pytest.approx(0.006 ** 2, rel=1e-9)
     assert classify(loops[0], hole=True).a == pytest.approx(0.006, abs=1e-9)
+
+
+def _frustum(low: float, high: float, bottom: float, top: float) -> trimesh.Trimesh:
+    """A square frustum about z from ``low`` (side ``bottom``) to ``high`` (side ``top``) [m]."""
+    corners = [(x * side / 2, y * side / 2, z) for z, side in ((low, bottom), (high, top))
+               for x, y in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    return trimesh.convex.convex_hull(np.array(corners))
+
+
+def _tapered_pair(narrower: float) -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
+    """A 30 x 30 x 10 mm plate with a square mortise tapered 0.05 mm per mm per side (5 mm
+    at its foot, 6 mm at its mouth, less ``narrower`` [m]), and a tenon of that taper
+    (5 to 6 mm, 0.1 mm a side short of its tip's chamfer-free foot) under a 12 mm square
+    shoulder resting on the plate."""
+    plate = trimesh.creation.box((0.03, 0.03, 0.01), trimesh.transformations.translation_matrix((0, 0, 0.005)))
+    cut = _frustum(-MM, 11 * MM, 4.9 * MM - narrower, 6.1 * MM - narrower)
+    tenon = trimesh.boolean.union([_frustum(0.0, 10 * MM, 5 * MM, 6 * MM), trimesh.creation.box(
+        (0.012, 0.012, 0.01), trimesh.transformations.translation_matrix((0, 0, 0.015)))], engine="manifold")
+    return trimesh.boolean.difference([plate, cut], engine="manifold"), tenon
+
+
+@pytest.mark.parametrize(("narrower", "fits"), [(0.0, True), (0.01 * MM, False)])
+def test_a_taper_passes_its_own_taper_and_not_a_narrower_one(narrower: float, fits: bool) -> None:
+    # Over the whole stretch the tenon's widest section (6 mm, under the shoulder) meets the
+    # mortise's narrowest (5 mm, at its foot): no fit, though the tenon's narrow tip meets
+    # the mortise's wide mouth all the way in. The sweep compares each level of the tenon
+    # with the levels of the mortise it crosses: room 0 in its own taper (a nominal
+    # zero-clearance fit), and 0.01 mm short all round in a taper 0.01 mm narrower.
+    plate, tenon = _tapered_pair(narrower)
+    up = np.array([0.0, 0.0, 1.0])
+    loop = next(o for o in sections.slice_loops(plate, up, 5 * MM) if o.area < 1e-4)
+    spanned = classify(sections.over_span(loop, plate, up, 0.0, 10 * MM, hole=True), hole=True)
+    peg = classify(sections.over_span(sections.slice_loops(tenon, up, 5 * MM)[0], tenon, up, 0.0, 10 * MM,
+                                      hole=False, reach=0.006), hole=False)
+    assert not sections.passes(peg, spanned)  # the sections over the stretch: no fit, either way
+    way = sections.passage(sections.Slicer(tenon, up), sections.Slicer(plate, up), np.zeros(2), 0.0, 10 * MM)
+    assert way is not None
+    # diametral, twice the least distance of a corner to the walls: outside, a corner lies 0.005 mm out of
+    # each of two walls, 0.007 mm from their corner
+    assert way.room == pytest.approx(-math.sqrt(2) * narrower, abs=2e-8)
+    shapes = classify(way.peg, hole=False), classify(way.hole, hole=True)
+    assert (way.room > 0 or sections.zero_clearance(*shapes, way.room) is not None) == fits
+
+
+def test_a_tenon_swept_into_its_own_taper_fits_alike_tapers_and_not_a_straight_hole_of_its_middle() -> None:
+    # The tenon of _tapered_pair in its mortise, beside an empty mortise of the same taper
+    # and an empty straight 5.5 mm square hole (the tenon's section half way in). Over the
+    # stretch the tenon (6 mm under its shoulder) passes none; swept, it passes both tapers
+    # at room 0 and not the straight hole, whose mouth its upper half does not pass.
+    plate = trimesh.creation.box((0.07, 0.03, 0.01), trimesh.transformations.translation_matrix((0, 0, 0.005)))
+    cuts = [_frustum(-MM, 11 * MM, 4.9 * MM, 6.1 * MM), _frustum(-MM, 11 * MM, 4.9 * MM, 6.1 * MM),
+            trimesh.creation.box((0.0055, 0.0055, 0.012), trimesh.transformations.translation_matrix((0, 0, 0.005)))]
+    for cut, x in zip(cuts, (0.0, 0.02, -0.02), strict=True):
+        cut.apply_translation((x, 0.0, 0.0))
+    plate = trimesh.boolean.difference([plate, *cuts], engine="manifold")
+    tenon = _tapered_pair(0.0)[1]
+    derived = derive([CadPart("plate", "plate", plate, "plate.stl"), CadPart("tenon", "tenon", tenon, "tenon.stl")],
+                     "plate", {})
+    at = {round(fit.position[0], 3): hid for hid, fit in derived.holes.items()}
+    own, alike, straight = at[0.0], at[0.02], at[-0.02]
+    assert derived.holes[own].part == "tenon"
+    assert set(derived.swept) == {("tenon", own), ("tenon", alike)}
+    assert derived.swept[("tenon", own)][2] == pytest.approx(0.0, abs=2e-8)
+    rooms = margins(derived)["tenon"]
+    assert rooms[own] == rooms[alike] == 0.0 and rooms[straight] < -0.0004
