@@ -91,13 +91,13 @@ needed 21 to 23. The whole board through the same session is a row of the task b
 results (docs/results/assembly.md, ``./run.sh session --assembly taskboard --assemble``)."""
 
 
-def _small_board(folder: Path, keep: tuple[str, ...] = SMALL_BOARD) -> Path:
-    """A copy of data/taskboard in ``folder`` with only the parts and holes ``keep``: the
-    tables of the others left out of ``assembly.toml`` and ``geometry.toml``, their facts out
-    of ``sizes.lp`` and ``precedence.lp`` (a pooled ``part(a;b)`` keeps the kept ids), their
-    ids out of ``demos.txt`` and their skills out of ``demonstrations/`` (the assets are
-    made anew by the first cell)."""
-    board = ROOT / "data" / "taskboard"
+def _small_board(folder: Path) -> Path:
+    """A copy of data/taskboard in ``folder`` with only the parts and holes of
+    :data:`SMALL_BOARD`: the tables of the others left out of ``assembly.toml`` and
+    ``geometry.toml``, their facts out of ``sizes.lp`` and ``precedence.lp`` (a pooled
+    ``part(a;b)`` keeps the kept ids), their ids out of ``demos.txt`` and their skills out of
+    ``demonstrations/`` (the assets are made anew by the first cell)."""
+    board, keep = ROOT / "data" / "taskboard", SMALL_BOARD
     (folder / "demonstrations").mkdir(parents=True)
     for name in ("assembly.toml", "geometry.toml"):
         blocks = re.split(r"(?m)^(?=\[)", (board / name).read_text())
