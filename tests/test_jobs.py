@@ -1,4 +1,5 @@
-"""``--jobs N``: the commands that run work in parallel give the same results for any N."""
+"""``--jobs N``: the commands that run work in parallel give the same results for any N
+(each command in the test's process; its jobs are processes of their own)."""
 
 from __future__ import annotations
 
@@ -22,22 +23,25 @@ def _results(value: Any) -> Any:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("argv", [
-    ("bench", "assemble", "--plans", "3", "--backend", "truth", "--seed", "4"),
-    ("executor", "campaign", "--trials", "1", "--seed", "3", "--pairs", "p1:br,p3:r1"),
-])
-def test_one_and_two_jobs_give_the_same_json(run_cli, argv: tuple[str, ...]) -> None:
+def test_two_drawn_plans_in_two_truth_cells_at_once_give_the_json_of_one_cell(run_main) -> None:
+    """``bench assemble --jobs 2``: two plans in two truth cells at once, each assembled, the
+    report that of ``--jobs 1``. (The campaign's workers, one against two, are compared in
+    ``tests/executor/test_campaign_cell.py``, where ``--jobs`` reaches ``run_campaign``.)"""
     reports = []
     for jobs in ("1", "2"):
-        done = run_cli(*argv, "--jobs", jobs, "--json", timeout=300)
+        done = run_main("bench", "assemble", "--plans", "2", "--seed", "5", "--backend", "truth", "--jobs", jobs,
+                        "--json", timeout=300)
         assert done.returncode == 0, done.stderr
         reports.append(json.loads(done.stdout))
     assert _results(reports[0]) == _results(reports[1])
+    assert [r["seed"] for r in reports[1]["plans"]] == [6, 7]
+    assert reports[1]["summary"]["assembled"] == 2
+    assert all(len(r["steps"]) == 10 for r in reports[1]["plans"])
 
 
 @pytest.mark.slow
-def test_jobs_defaults_to_the_cores_and_is_bounded(run_cli) -> None:
-    done = run_cli("executor", "campaign", "--help")
+def test_jobs_defaults_to_the_cores_and_is_bounded(run_main) -> None:
+    done = run_main("executor", "campaign", "--help")
     assert "--jobs N" in done.stdout and "default: the machine's" in " ".join(done.stdout.split())
-    done = run_cli("bench", "assemble", "--jobs", "65")
+    done = run_main("bench", "assemble", "--jobs", "65")
     assert done.returncode == 2 and "--jobs" in done.stderr

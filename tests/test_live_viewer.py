@@ -87,11 +87,20 @@ def test_a_trial_serves_its_recording_to_a_web_browser_until_ctrl_c(tmp_path: Pa
     assert len(column_values(rrd, "executor/c1/outcome", "TextLog:text")) == 1
 
 
-@pytest.mark.slow
-def test_a_session_streams_planner_and_cells_live(tmp_path: Path, run_session) -> None:
-    live = tmp_path / "live.rrd"
+@pytest.fixture(scope="module")
+def live_session(tmp_path_factory: pytest.TempPathFactory, run_session) -> tuple[Path, Path, dict]:
+    """A two-cell truth session streamed live to a headless viewer: the viewer's file, the
+    session's run folder and its result (the run folder is also the one ``view --web`` serves)."""
+    tmp = tmp_path_factory.mktemp("live")
+    live, run = tmp / "live.rrd", tmp / "run"
     with headless_viewer(live) as url:
-        result = run_session("--cells", "2", "--out", str(tmp_path / "run"), "--rerun-connect", url)
+        result = run_session("--cells", "2", "--out", str(run), "--rerun-connect", url)
+    return live, run, result
+
+
+@pytest.mark.slow
+def test_a_session_streams_planner_and_cells_live(live_session: tuple[Path, Path, dict]) -> None:
+    live, run, result = live_session
     entities = read_recording(live).entities
     assert "/planner/experiments" in entities
     assert {"/executor/c1/outcome", "/executor/c2/outcome"} <= set(entities)
@@ -99,13 +108,12 @@ def test_a_session_streams_planner_and_cells_live(tmp_path: Path, run_session) -
     assert streamed == result["experiments"] + 1  # and the start, experiment 0
     layout = read_blueprint(live)  # the live viewer's blueprint, following the newest data
     assert layout.tabs == ["planner", "c1", "c2"] and layout.time_panel["play_state"] == 3
-    assert read_recording(tmp_path / "run" / "planner.rrd").blueprints == 0  # the folder's is view.rbl
+    assert read_recording(run / "planner.rrd").blueprints == 0  # the folder's is view.rbl
 
 
 @pytest.mark.slow
-def test_view_web_serves_a_run_folder_until_ctrl_c(tmp_path: Path, run_session) -> None:
-    run = tmp_path / "run"
-    run_session("--out", str(run))
+def test_view_web_serves_a_run_folder_until_ctrl_c(live_session: tuple[Path, Path, dict]) -> None:
+    _, run, _ = live_session
     view = subprocess.Popen([sys.executable, "-m", "assembly_constraints", "view", str(run), "--web"],
                             cwd=ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:

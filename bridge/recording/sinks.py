@@ -298,8 +298,8 @@ def keep_serving(viewer: Viewer) -> None:
     (which ends the command normally); returns at once otherwise."""
     if not viewer.serve:
         return
-    _LOG.info("done; still serving the recording to the web viewer (Ctrl-C to stop)")
-    try:
+    try:  # from the line on: a Ctrl-C right after it is already the normal end
+        _LOG.info("done; still serving the recording to the web viewer (Ctrl-C to stop)")
         while True:
             time.sleep(WAIT_POLL_S)
     except KeyboardInterrupt:

@@ -1,5 +1,6 @@
 """``./run.sh assemble`` in physics: the planner drives a simulated cell over Zenoh through
-a whole plan (real PyBullet, real Zenoh processes on loopback)."""
+a whole plan (real PyBullet in the cell's process, Zenoh on loopback; the planner is the
+command in the test's process, its process start being checked by ``tests/test_bad_input.py``)."""
 
 from __future__ import annotations
 
@@ -13,8 +14,8 @@ STEP_KEYS = {"part", "hole", "skill", "outcome", "attempts", "duration_s", "max_
 
 
 @pytest.mark.slow
-def test_the_default_cranfield_plan_is_assembled_within_2_mm(run_cli) -> None:
-    done = run_cli("assemble", "--json", timeout=280)
+def test_the_default_cranfield_plan_is_assembled_within_2_mm(run_main) -> None:
+    done = run_main("assemble", "--json", timeout=280)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] is True
@@ -27,13 +28,13 @@ def test_the_default_cranfield_plan_is_assembled_within_2_mm(run_cli) -> None:
 
 @pytest.mark.slow
 def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole_with_the_cells_uncertainty(
-        run_cli, tmp_path) -> None:
+        run_main, tmp_path) -> None:
     """``--uncertainty cell``: systematic grasp and vision errors from cell seed 3, the hole's
     friction, the full layer (ILC); the peg refused by the obstacle in r1 goes into the spare
     hole, every part within 2 mm, and the recording holds the whole run."""
     rrd = tmp_path / "a1.rrd"
-    done = run_cli("assemble", "--assembly", "spare", "--block-hole", "r1", "--uncertainty", "cell", "--cell-seed", "3",
-                   "--rrd", str(rrd), "--json", timeout=280)
+    done = run_main("assemble", "--assembly", "spare", "--block-hole", "r1", "--uncertainty", "cell",
+                    "--cell-seed", "3", "--rrd", str(rrd), "--json", timeout=280)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] is True and report["replans"]
@@ -54,10 +55,10 @@ def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole_with_the_cel
 
 
 @pytest.mark.slow
-def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_physics(run_cli) -> None:
+def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_physics(run_main) -> None:
     """h1 blocked: p1 (d 10 mm) is re-planned into the free d 12.8 mm hole, the loosest fit
     of any complete assignment of the graded board, and still stands within 2 mm of its goal."""
-    done = run_cli("assemble", "--assembly", "graded", "--block-hole", "h1", "--json", timeout=280)
+    done = run_main("assemble", "--assembly", "graded", "--block-hole", "h1", "--json", timeout=280)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] is True and report["replans"]

@@ -1,11 +1,8 @@
 """``bench assemble``: plans drawn uniformly from a precedence relation, each with a
-hole assignment, assembled in fresh cells; a part more than 2 mm from its goal counts as a failure."""
+hole assignment, assembled in fresh cells; a part more than 2 mm from its goal counts as a
+failure. Two drawn plans in two truth cells at once: ``tests/test_jobs.py``."""
 
 from __future__ import annotations
-
-import json
-
-import pytest
 
 from asp.assemble.cli import truth_facts
 from asp.bench.assemble_plans import draw_plans, summary
@@ -46,14 +43,3 @@ def test_bad_input_is_one_line_and_exit_2(run_main, tmp_path) -> None:
     done = run_main("bench", "assemble", "--run", str(tmp_path), timeout=60)
     assert done.returncode == 2
     assert done.stderr.strip().count("\n") == 0 and "session.json" in done.stderr
-
-
-@pytest.mark.slow
-def test_two_drawn_plans_run_in_two_truth_cells_at_once(run_cli) -> None:
-    done = run_cli("bench", "assemble", "--plans", "2", "--seed", "5", "--jobs", "2", "--backend", "truth",
-                   "--json", timeout=120)
-    assert done.returncode == 0, done.stderr
-    result = json.loads(done.stdout)
-    assert [r["seed"] for r in result["plans"]] == [6, 7]
-    assert result["summary"]["assembled"] == 2
-    assert all(len(r["steps"]) == 10 for r in result["plans"])

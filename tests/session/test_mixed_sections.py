@@ -11,11 +11,14 @@ entail fits that do not exist. The truth cells answer from the cross-sections.
 from __future__ import annotations
 
 import json
+import re
+import shutil
 from pathlib import Path
 
 import pytest
 
 from bridge.assembly import load_assembly
+from tests.conftest import ROOT
 
 PEGS = {"pa": ("round", 0.014), "pb": ("square", 0.013), "pc": ("round", 0.010), "pd": ("square", 0.009)}
 HOLES = {"ha": ("round", 0.0145), "hb": ("square", 0.0135), "hc": ("round", 0.0105), "hd": ("square", 0.0095)}
@@ -77,25 +80,79 @@ def test_line_on_the_mixed_product_is_refused_before_any_cell_starts(run_main, t
     assert not (tmp_path / "run").exists()
 
 
+SMALL_BOARD = ("base", "round4", "round8", "round12", "rect4", "rect12", "hole4", "hole8", "hole12", "slot4",
+               "slot12")
+"""The task board's parts and holes the session test keeps: every kind of cross-section
+(three round pegs on one size line, the square 4 x 4, the rect 12 x 8 in its slot turned
+30°) and the base. Three round pegs, not two: with two round pegs among 4 x 4 pairs a
+two-cell learner needed all 16 experiments in a quarter to a half of 80 random completion
+orders (``next_batch`` as a session calls it, the sections model); on these 5 x 5 pairs it
+needed 21 to 23. The whole board through the same session is a row of the task board's
+results (docs/results/assembly.md, ``./run.sh session --assembly taskboard --assemble``)."""
+
+
+def _small_board(folder: Path) -> Path:
+    """A copy of data/taskboard in ``folder`` with only the parts and holes of
+    :data:`SMALL_BOARD`: the tables of the others left out of ``assembly.toml`` and
+    ``geometry.toml``, their facts out of ``sizes.lp`` and ``precedence.lp`` (a pooled
+    ``part(a;b)`` keeps the kept ids), their ids out of ``demos.txt`` and their skills out of
+    ``demonstrations/`` (the assets are made anew by the first cell)."""
+    board, keep = ROOT / "data" / "taskboard", SMALL_BOARD
+    (folder / "demonstrations").mkdir(parents=True)
+    for name in ("assembly.toml", "geometry.toml"):
+        blocks = re.split(r"(?m)^(?=\[)", (board / name).read_text())
+        (folder / name).write_text("".join(block for block in blocks if not (
+            m := re.match(r"\[\w+\.(\w+)\]", block)) or m[1] in keep))
+
+    def kept(fact: re.Match[str]) -> str:
+        args = fact[2].split(",")
+        if len(args) > 1:  # a relation: kept whole or left out
+            return fact[0] if all(arg in keep for arg in args) else ""
+        pool = [arg for arg in fact[2].split(";") if arg in keep]
+        return f"{fact[1]}({';'.join(pool)})." if pool else ""
+    for name in ("sizes.lp", "precedence.lp"):
+        text = re.sub(r"(\w+)\(([\w,;]+)\)\.", kept, (board / name).read_text())
+        (folder / name).write_text(re.sub(r"(?m)^ +| +$", "", text))
+    (folder / "demos.txt").write_text("".join(" ".join(w for w in line.split() if w in keep) + "\n"
+                                              for line in (board / "demos.txt").read_text().splitlines()
+                                              if not line.startswith("#")))
+    for part in keep:
+        if (board / "demonstrations" / f"{part}.json").is_file():
+            shutil.copy(board / "demonstrations" / f"{part}.json", folder / "demonstrations")
+    return folder
+
+
+def test_the_small_board_is_the_task_boards_parts_and_facts_restricted(tmp_path: Path) -> None:
+    board, small = load_assembly("taskboard"), load_assembly(str(_small_board(tmp_path / "board")))
+    assert {p.id for p in small.parts} | {h.id for h in small.holes} == set(SMALL_BOARD)
+    assert {p.id: p.shape for p in small.parts} == {p.id: p.shape for p in board.parts if p.id in SMALL_BOARD}
+    assert {"round", "square", "rect"} <= {p.shape for p in small.parts}
+    facts = (tmp_path / "board" / "sizes.lp").read_text()
+    assert "fits(round8,slot12)." in facts and "fits(rect4,slot4)." in facts and "round16" not in facts
+    assert "precedence_edge(base,rect12)." in (tmp_path / "board" / "precedence.lp").read_text()
+    assert sorted(p.name for p in (tmp_path / "board" / "demonstrations").iterdir()) == [
+        "rect12.json", "rect4.json", "round12.json", "round4.json", "round8.json"]
+
+
 @pytest.mark.slow
-@pytest.mark.timeout(600)  # two sim cells learn and assemble the board: 245 s of CPU alone
+@pytest.mark.timeout(600)  # two sim cells learn and assemble the small board
 def test_the_task_board_is_learned_through_physics_and_assembled_within_2_mm(run_cli, tmp_path) -> None:
-    """NIST task board 1's pegs (data/taskboard): round, square and three rect aspect
-    ratios, no one size line. Sim cells learn the board exactly (its sizes.lp) under the
-    sections model, and the first plan is assembled in physics: the eight pegs (three
-    slots turned) each in its own hole, every step a fit, every part within 2 mm of its goal."""
-    done = run_cli("session", "--assembly", "taskboard", "--cells", "2", "--assemble", "--json",
+    """NIST task board 1's pegs (data/taskboard), five of them (:data:`SMALL_BOARD`): round,
+    square and rect, no one size line. Sim cells learn the board exactly (its sizes.lp)
+    under the sections model, and the first plan is assembled in physics: the five pegs (the
+    slot turned 30°) each in its own hole, every step a fit, every part within 2 mm of its goal."""
+    board = _small_board(tmp_path / "board")
+    done = run_cli("session", "--assembly", str(board), "--cells", "2", "--assemble", "--json",
                    "--out", str(tmp_path / "run"), timeout=900)
     assert done.returncode == 0, done.stderr[-2000:]
     result = json.loads(done.stdout)
     assert result["matches_truth"] is True and result["model"] == "sections"
-    assert result["experiments"] < 64  # the round pegs' line spares experiments
+    assert result["experiments"] < 25  # the round pegs' line spares experiments
     report = result["assembly"]
     assert report["assembled"] is True and not report["replans"]
-    own = {"base": None} | {f"{kind}{n}": f"{hole}{n}" for kind, hole in (("round", "hole"), ("rect", "slot"))
-                            for n in (4, 8, 12, 16)}
+    own = {"base": None} | {f"round{n}": f"hole{n}" for n in (4, 8, 12)} | {"rect4": "slot4", "rect12": "slot12"}
     assert {s["part"]: s["hole"] for s in report["steps"]} == own
-    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 9
+    assert [s["outcome"] for s in report["steps"]] == ["fit"] * 6
     assert set(report["final_pose_error_mm"]) == set(own)
     assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
 

@@ -108,18 +108,25 @@ def as_if_killed(run: Path, keep: int) -> None:
     (run / "session.json").write_text(json.dumps({**record, "status": "running"}))
 
 
-def session(run_cli, *args: str) -> subprocess.CompletedProcess[str]:
-    return run_cli("session", "--json", "--plans", "1", *args, timeout=90)
+def session(run_cli, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return run_cli("session", "--json", "--plans", "1", *args, cwd=cwd, timeout=90)
 
 
-def test_a_resume_keeps_the_backend_and_says_what_it_resumes(tmp_path: Path, run_cli, root: Path) -> None:
-    product, run = cranfield_copy(root, tmp_path / "product"), tmp_path / "run"
-    first = session(run_cli, "--backend", "truth", "--delay", "0.01", "--assembly", str(product), "--out", str(run))
+def test_a_resume_from_another_folder_keeps_the_backend_and_says_what_it_resumes(tmp_path: Path, run_cli,
+                                                                                root: Path) -> None:
+    """A session on a product given by a path relative to its folder, resumed from another
+    folder: ``session.json`` keeps the product folder as an absolute path (a shipped one by
+    its name), and the resume keeps the run's backend and settings, saying so."""
+    (tmp_path / "here").mkdir()
+    product, run = cranfield_copy(root, tmp_path / "here" / "plate"), tmp_path / "run"
+    first = session(run_cli, "--backend", "truth", "--delay", "0.01", "--assembly", "plate", "--out", str(run),
+                    cwd=tmp_path / "here")
     assert first.returncode == 0, first.stderr
     kept = json.loads((run / "session.json").read_text())
     assert (kept["backend"], kept["delay_s"]) == ("truth", 0.01) and len(kept["product"]) == 64
+    assert kept["assembly"] == str(product)
     as_if_killed(run, keep=8)  # 4 experiments finished
-    resumed = session(run_cli, "--resume", str(run), "--seed", "5")  # no --backend: the run's, not sim
+    resumed = session(run_cli, "--resume", str(run), "--seed", "5", cwd=tmp_path)  # no --backend: the run's
     assert resumed.returncode == 0, resumed.stderr
     assert f"resuming {run} (start 2): 4 experiment(s) journaled" in resumed.stderr
     assert "backend truth (delay 0.01 s)" in resumed.stderr
@@ -128,22 +135,6 @@ def test_a_resume_keeps_the_backend_and_says_what_it_resumes(tmp_path: Path, run
     journal = read_journal(run / "journal.jsonl")
     assert len(journal) == json.loads(resumed.stdout)["experiments"] > 4
     assert all(entry.evidence is None for entry in journal)  # a truth cell's answers: a sim cell gives evidence
-    assert json.loads(resumed.stdout)["matches_truth"] is True
-
-
-def test_a_resume_from_another_folder_finds_a_product_given_by_a_relative_path(tmp_path: Path, run_cli,
-                                                                               root: Path) -> None:
-    """``session.json`` keeps a product folder as an absolute path (a shipped one by its name)."""
-    (tmp_path / "here").mkdir()
-    cranfield_copy(root, tmp_path / "here" / "plate")
-    run = tmp_path / "run"
-    first = run_cli("session", "--json", "--plans", "1", "--backend", "truth", "--assembly", "plate", "--out",
-                    str(run), cwd=tmp_path / "here", timeout=90)
-    assert first.returncode == 0, first.stderr
-    assert json.loads((run / "session.json").read_text())["assembly"] == str(tmp_path / "here" / "plate")
-    as_if_killed(run, keep=4)
-    resumed = run_cli("session", "--json", "--plans", "1", "--resume", str(run), cwd=tmp_path, timeout=90)
-    assert resumed.returncode == 0, resumed.stderr
     assert json.loads(resumed.stdout)["matches_truth"] is True
 
 
