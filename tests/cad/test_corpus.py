@@ -269,13 +269,14 @@ def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: 
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
 
 
-def _taught_and_learned_in_the_cell(done: Imported, run_executor: Runner, run_cli: Runner,
+def _taught_and_learned_in_the_cell(done: Imported, run_main: Runner,
                                     run: Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Teach the imported product, run a sim session with ``--assemble`` into ``run``; its
-    result and its journal's entries."""
-    taught = run_executor("teach", "--assembly", str(done.out), timeout=240)
+    """Teach the imported product, run a sim session with ``--assemble`` into ``run`` (the
+    commands in this process, the session's cell a process of its own); its result and its
+    journal's entries."""
+    taught = run_main("executor", "teach", "--assembly", str(done.out))
     assert taught.returncode == 0, taught.stderr
-    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json", timeout=400)
+    session = run_main("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json")
     assert session.returncode == 0, session.stderr
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     return json.loads(session.stdout), journal
@@ -367,8 +368,9 @@ def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_planned_and_
     assert all(holes[named[pid]]["name"] == f"hole of {pid}" for pid in bolts), named
     assert all(named[pid] == f"bolt_{pid[4:]}_pin1" for pid in named if pid.startswith("nut_")), named
     # in physics: the base on its fixture, the brackets placed by hand, bolt_a1 beside
-    # bracket_a's wall and bolt_b2 through bracket_b's flange, each into its hole
-    _taught(done)
+    # bracket_a's wall and bolt_b2 through bracket_b's flange, each into its hole (each bolt
+    # is a shape of its own: those two taught)
+    _taught(done, {"bolt_a1", "bolt_b2"})
     assembler = Assembler(load_product(str(done.out)), description=CellDescription())
     try:
         placed = [assembler.run_step(pid, named[pid], 0)
@@ -380,14 +382,14 @@ def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_planned_and_
     assert max(s.pose_error for s in placed) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in placed}
 
 
-def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: Runner, run: Path) -> dict[str, Any]:
+def _learned_from_its_cad_alone(done: Imported, run_main: Runner, run: Path) -> dict[str, Any]:
     """Teach, run a sim session of ``done`` (every part placed by hand) and assemble its
-    plan 1; checks that nothing is taught, no experiment run, every pair of ``sizes.lp``
-    labelled not observed with the truth's fits, and the product assembled within 2 mm,
-    every part placed by hand. The session's result."""
-    taught = run_executor("teach", "--assembly", str(done.out), timeout=120)
+    plan 1 (the commands in this process); checks that nothing is taught, no experiment
+    run, every pair of ``sizes.lp`` labelled not observed with the truth's fits, and the
+    product assembled within 2 mm, every part placed by hand. The session's result."""
+    taught = run_main("executor", "teach", "--assembly", str(done.out))
     assert taught.returncode == 0 and "no skill to teach" in taught.stdout, taught.stderr
-    session = run_cli("session", "--assembly", str(done.out), "--out", str(run), "--json", timeout=300)
+    session = run_main("session", "--assembly", str(done.out), "--out", str(run), "--json")
     assert session.stdout, session.stderr
     result: dict[str, Any] = json.loads(session.stdout)
     holes = _feature_holes(done)
@@ -403,7 +405,7 @@ def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: R
     assert result["nominal_fits"] is None  # no pair the cell builds with room
     assert session.returncode == 0, result.get("error")
     # the sim cell takes plan 1, each part placed by hand where the CAD has it
-    done_run = run_cli("assemble", "--run", str(run), "--json", timeout=300)
+    done_run = run_main("assemble", "--run", str(run), "--json")
     report = json.loads(done_run.stdout)
     assert done_run.returncode == 0 and report["assembled"], done_run.stderr
     assert max(report["final_pose_error_mm"].values()) < 2.0
@@ -414,11 +416,11 @@ def _learned_from_its_cad_alone(done: Imported, run_executor: Runner, run_cli: R
 @pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
 @pytest.mark.parametrize("name", ["ldraw_axles"])  # a unit of the workers' work with the product's other tests
 def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
-        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_main: Runner, tmp_path: Path) -> None:
     # ldraw_axles: the axle, the bush and the gear are nominal zero-clearance fits the cell
     # has no operation for (each placed by hand): the sim session must not refuse the
     # product; it takes every pair from sizes.lp and says none was observed.
-    result = _learned_from_its_cad_alone(imported(name), run_executor, run_cli, tmp_path / "run")
+    result = _learned_from_its_cad_alone(imported(name), run_main, tmp_path / "run")
     # the bush and the gear share the liftarm's pin (capacity 2 in assembly.toml): the bush first
     for plan in result["plans"]:
         order = [step["part"] for step in plan]
@@ -480,13 +482,13 @@ def test_the_truth_backend_answers_every_pair_as_sizes_lp(imported: Callable[[st
 @pytest.mark.timeout(600)
 @pytest.mark.parametrize("name", ["metaworld_assembly"])  # a unit of the workers' work with the product's other tests
 def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physics(
-        imported: Callable[[str], Imported], name: str, run_executor: Runner, run_cli: Runner, tmp_path: Path) -> None:
+        imported: Callable[[str], Imported], name: str, run_main: Runner, tmp_path: Path) -> None:
     # Meta-World's ring is a torus with a handle: no stack of prisms, it collides as CoACD's
     # pieces, which keep its bore within its room on the peg; the cell grips it, carries it
     # over the peg and inserts it down onto it with the skill taught on that peg.
     done = imported(name)
     assert "CoACD" in (done.out / "meshes" / "round_nut.convex.obj").read_text().splitlines()[2]
-    result, journal = _taught_and_learned_in_the_cell(done, run_executor, run_cli, tmp_path / "run")
+    result, journal = _taught_and_learned_in_the_cell(done, run_main, tmp_path / "run")
     holes = _feature_holes(done)
     assert {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e} == {
         (row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
@@ -527,7 +529,7 @@ def test_the_notched_heptagon_is_taught_and_pegs_turned_into_its_hole_are_decide
 @pytest.mark.timeout(900)
 @pytest.mark.parametrize("name", ["vitac_shapes"])  # a unit of the workers' work with the product's other tests
 def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_no_experiment_but_taken_from_the_cad(
-        imported: Callable[[str], Imported], name: str, run_executor: Runner) -> None:
+        imported: Callable[[str], Imported], name: str, run_main: Runner) -> None:
     # the cell's heptagon is its prism with its vertical edges rounded by the 1 mm hull
     # margin PyBullet adds: 0.0014 mm too big for the rect hole, it passed it in physics
     # (fit 2 of 2), and a session learned that wrong fit. Its section eroded by what its
@@ -541,6 +543,6 @@ def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_no_experiment_but_t
     assert "convex" in near, near
     assert load_assembly(str(done.out)).tried_by_hand("convex", h7, "sim")
     assert not load_assembly(str(done.out)).tried_by_hand("cuboid", h7, "sim")  # its own hole: a fit, observed
-    trial = run_executor("trial", "--assembly", str(done.out), "--part", "convex", "--hole", h7, "--attempts", "1",
-                         "--json", timeout=300)
+    trial = run_main("executor", "trial", "--assembly", str(done.out), "--part", "convex", "--hole", h7, "--attempts",
+                     "1", "--json")
     assert trial.returncode == 2 and "near miss" in trial.stderr, (trial.returncode, trial.stderr)

@@ -23,11 +23,12 @@ def _copy(corpus: Path, name: str, as_name: str | None = None) -> Path:
 @pytest.mark.slow  # imports, teaches, learns in physics, assembles the hexagonal peg (153-260 s at load 15-20)
 @pytest.mark.timeout(1200)
 def test_a_product_is_learned_and_assembled_exactly_and_a_flipped_truth_is_reported_wrong(
-        run_cli: Runner, tmp_path: Path) -> None:
+        run_main: Runner, tmp_path: Path) -> None:
+    # the bench in this process, its steps (the sessions, the teaching) processes of their own
     corpus = tmp_path / "corpus"
     _copy(corpus, "agh_hex_horizontal")
-    done = run_cli("bench", "corpus", "--corpus", str(corpus), "--product", "agh_hex_horizontal",
-                   "--json", str(tmp_path / "exact.json"), timeout=1100)
+    done = run_main("bench", "corpus", "--corpus", str(corpus), "--product", "agh_hex_horizontal",
+                    "--json", str(tmp_path / "exact.json"))
     assert done.returncode == 0, done.stdout + done.stderr
     (row,) = json.loads((tmp_path / "exact.json").read_text())["rows"]
     assert row["verdict"] == "exact", row
@@ -41,8 +42,8 @@ def test_a_product_is_learned_and_assembled_exactly_and_a_flipped_truth_is_repor
     text = truth.read_text()
     assert text.count("fits = true") == 1
     truth.write_text(text.replace("fits = true", "fits = false"))
-    wrong = run_cli("bench", "corpus", "--corpus", str(corpus), "--product", "hex_flipped", "--truth-only",
-                    "--json", str(tmp_path / "wrong.json"), timeout=600)
+    wrong = run_main("bench", "corpus", "--corpus", str(corpus), "--product", "hex_flipped", "--truth-only",
+                     "--json", str(tmp_path / "wrong.json"))
     assert wrong.returncode == 1, wrong.stdout + wrong.stderr
     (row,) = json.loads((tmp_path / "wrong.json").read_text())["rows"]
     assert row["verdict"] == "wrong" and row["truth"]["ok"] == 0

@@ -133,11 +133,11 @@ def test_an_empty_pin_of_the_base_is_a_feature_when_a_bore_passes_over_it(tmp_pa
 
 
 @pytest.mark.slow
-def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_cli: Runner, washer_and_gear: Path,
+def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_main: Runner, washer_and_gear: Path,
                                                                tmp_path: Path) -> None:
     out = washer_and_gear
-    done = run_cli("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
-                   str(tmp_path / "truth"), timeout=240)
+    done = run_main("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
+                    str(tmp_path / "truth"))
     assert done.returncode == 0, done.stderr
     result = json.loads(done.stdout)
     assert {tuple(pair) for pair in result["fits"]} == FITS
@@ -146,7 +146,7 @@ def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_cli: Runner, 
 
 
 @pytest.mark.slow  # imports, teaches two parts and runs a sim session with its assembly (about 90 s)
-def test_square_nuts_go_onto_the_pins_in_physics(run_cli: Runner, run_executor: Runner, tmp_path: Path) -> None:
+def test_square_nuts_go_onto_the_pins_in_physics(run_main: Runner, tmp_path: Path) -> None:
     square = shapely.box(-1.0, -1.0, 1.0, 1.0)
     nuts = {"nut10": _with_bore(shapely.affinity.scale(square, 10.0, 10.0), shapely.affinity.scale(square, 5.5, 5.5),
                                 X_MM - 25),  # a 20 mm square with an 11 mm square bore on the 10 mm pin
@@ -156,10 +156,10 @@ def test_square_nuts_go_onto_the_pins_in_physics(run_cli: Runner, run_executor: 
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     assert "manual" not in geometry and {name: shape.get("bore") for name, shape in geometry["part_shapes"].items()} \
         == {"nut10": True, "nut8": True}
-    taught = run_executor("teach", "--assembly", str(out), timeout=300)
+    taught = run_main("executor", "teach", "--assembly", str(out))  # the commands in this process, the cell in its own
     assert taught.returncode == 0, taught.stderr
     run = tmp_path / "run"
-    done = run_cli("session", "--assembly", str(out), "--out", str(run), "--json", "--assemble", timeout=600)
+    done = run_main("session", "--assembly", str(out), "--out", str(run), "--json", "--assemble")
     assert done.returncode == 0, done.stderr
     result = json.loads(done.stdout)
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]

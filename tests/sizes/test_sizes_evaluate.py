@@ -10,7 +10,7 @@ from asp.sizes.evaluate import evaluate_policy, relabeled_matrices
 from asp.sizes.learner import learn_sizes
 from asp.sizes.truth_oracle import TruthOracle
 
-pytestmark = pytest.mark.slow  # each test evaluates a policy over hundreds of relabelings (3-40 s)
+pytestmark = pytest.mark.slow  # each test evaluates a policy over a hundred relabelings or more (3-10 s)
 CRANFIELD = TruthOracle.from_assembly("cranfield")
 
 
@@ -23,12 +23,15 @@ def test_systematic_over_all_relabelings_gives_the_papers_figures() -> None:
     assert f"{100 * report['max_share']:.2f}" == "4.11"
 
 
-def test_heuristic_over_all_relabelings_is_near_the_paper_and_beats_systematic() -> None:
-    report = evaluate_policy(CRANFIELD, "heuristic").as_json()
-    assert report["cases"] == 14400
-    assert 19.3 < report["mean"] < 20.53  # paper: 19.57
-    assert (report["min"], report["max"]) == (16, 24)  # as in the paper
-    assert report["min_share"] == round(16 / 14400, 6)  # paper: 0.11 %
+def test_heuristic_over_sampled_relabelings_is_near_the_paper_and_beats_systematic() -> None:
+    # 100 of the 14400 relabelings; all of them (the paper's figures: mean 19.57, 16 to 24)
+    # are `sizes evaluate --assembly cranfield --policy heuristic --relabelings all`
+    # (docs/results/sizes.md), 30 s of CPU.
+    heuristic = evaluate_policy(CRANFIELD, "heuristic", 100, seed=3).as_json()
+    systematic = evaluate_policy(CRANFIELD, "systematic", 100, seed=3).as_json()
+    assert heuristic["cases"] == systematic["cases"] == 100
+    assert 19.3 < heuristic["mean"] < systematic["mean"]  # paper: 19.57 against 20.53
+    assert 16 <= heuristic["min"] and heuristic["max"] <= 24  # the paper's range over all relabelings
 
 
 def test_the_decision_tree_walk_equals_one_session_per_relabeling() -> None:
