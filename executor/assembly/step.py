@@ -6,7 +6,9 @@ Per kind of part (the ``skill`` of the step's record):
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
-  a part with a bore onto a pin of the base likewise; once past the feature's top, a part
+  a part with a bore onto a pin of the base likewise; into a hole or onto a pin entered
+  sideways, all of it in the feature's frame (:attr:`executor.world.geometry.HoleSpec.frame`),
+  the part carried there along its axis; once past the feature's top, a part
   with a bore is centred on its pin by contact, and so is a peg with more room than
   :data:`CENTRING_ROOM` in its hole (:mod:`executor.skills.centring`);
 - ``insert_over``: a part with openings down over the pins standing in its holes, by the
@@ -486,7 +488,8 @@ class Assembler:
         return result.reached, detector.max_force_dev, detector.max_torque_dev
 
     def _frame(self, hole: str | None, skill: str) -> HoleFrame | None:
-        """The frame of a peg's hole entered sideways (:attr:`executor.world.geometry.HoleSpec.frame`), else None."""
+        """The frame of a peg's hole or a bore's pin entered sideways
+        (:attr:`executor.world.geometry.HoleSpec.frame`), else None."""
         return self.product.geometry.holes[hole].frame if skill == "insert" and hole is not None else None
 
     def _enter(self, frame: HoleFrame, approach: np.ndarray, yaw: float) -> None:

@@ -241,8 +241,9 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
-    pytest.param("asm4_axis_bearings", marks=_xfail(INSERTED + " along x onto a pin (the bearings onto the "
-                                                    "axis's seats: the cell puts parts onto pins from above)")),
+    pytest.param("asm4_axis_bearings", marks=_xfail(INSERTED + " onto a pin with less room than the cell resolves "
+                                                    "(the bearings onto the axis's d 20 seats along x: room 0), or "
+                                                    "onto a pin after another (bearing_2 after bearing_1)")),
     "agh_hex_horizontal",
     "agh_prism_array",
     pytest.param("factory_gears", marks=_xfail(INSERTED + " onto a shaft with less room than the cell resolves "
@@ -259,9 +260,9 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                            "shaft into the bearing ring), into a hole of the base's own mesh with less "
                                            "room than the cell resolves (the ring, room 0), or onto a pin of a part "
                                            "that is not the base (the glands and the impeller onto the shaft's end)")),
-    pytest.param("occt_pulley", marks=_xfail(INSERTED + " along -y onto a pin (the pulley onto the hub's boss: the "
-                                             "cell puts parts onto pins from above), or into a hole and shorter than "
-                                             "the gripper's grasp depth (the bolts, 14 mm)")),
+    pytest.param("occt_pulley", marks=_xfail(INSERTED + " onto a pin with less room than the cell resolves (the "
+                                             "pulley onto the hub's boss along -y: room 0), or into a hole and "
+                                             "shorter than the gripper's grasp depth (the bolts, 14 mm)")),
     "vitac_shapes",
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
