@@ -511,9 +511,9 @@ class Assembler:
         missed = float(np.linalg.norm(motion.read().tip_pos - approach))
         if missed > REACH_TOLERANCE:  # out of the arm's reach: no outcome to report
             where = ", ".join(f"{1e3 * v:.1f}" for v in frame.points_to_cell(approach))
-            raise ExecutorError(f"the arm does not reach the approach to a hole entered sideways at ({where}) mm: "
-                                f"its tip stays {1e3 * missed:.1f} mm from it; expected a pose within its reach (place "
-                                "the product nearer the arm: import --place X,Y)")
+            raise ExecutorError(f"the arm does not reach the approach to a hole or pin entered sideways at ({where}) "
+                                f"mm: its tip stays {1e3 * missed:.1f} mm from it; expected a pose within its reach "
+                                "(place the product nearer the arm: import --place X,Y)")
 
     def _leave_frame(self) -> None:
         """After a hole entered sideways: the tool straight up to the carrying height, turning
