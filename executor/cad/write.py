@@ -197,8 +197,11 @@ def _section_kind(fit: HoleFit | None) -> str | None:
 def _turn(fit: HoleFit | PinFit) -> np.ndarray:
     """The 4 × 4 rotation from the cell frame to the frame of ``fit``'s hole or pin (z out
     of it, x and y its slice axes: :func:`executor.world.frames.hole_rotation`); the
-    identity for a hole entered from above and a pin parts go down onto."""
+    identity along z (a hole entered from above or below, a pin parts go down or up onto:
+    the slice's axes are the cell's x and y)."""
     turn = np.eye(4)
+    if fit.axis in ("+z", "-z"):
+        return turn
     turn[:3, :3] = hole_rotation(opposite(fit.axis)).T
     return turn
 

@@ -253,8 +253,9 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                               "or a cross axle whose arms (1.6 mm) are thinner than the cell's "
                                               "hull margin twice")),
     "metaworld_assembly",
-    pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a horizontal rod, or a "
-                                          "rod through two brackets")),
+    pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a pin of a part that is "
+                                          "not the base (the nuts onto the rod's ends), or a rod through two "
+                                          "brackets")),
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into a hole of a part that is not the base (the "
                                            "shaft into the bearing ring), into a hole of the base's own mesh with less "
