@@ -129,8 +129,8 @@ def _check_polygons_simulated(path: Path, geo: GeometryFile) -> None:
 
 
 def _check_sideways(path: Path, geo: GeometryFile) -> None:
-    """A hole entered sideways (``axis`` other than ``-z``) is in the ``[base]``'s own mesh,
-    states its entry's ``top_z`` and is no pin."""
+    """A hole or pin entered sideways (``axis`` other than ``-z``) is in the ``[base]``'s
+    own mesh and states its entry's ``top_z`` (a pin's: its free end's)."""
     for name, shape in geo.hole_shapes.items():
         if shape.axis == "-z":
             continue
@@ -138,8 +138,6 @@ def _check_sideways(path: Path, geo: GeometryFile) -> None:
         if geo.base is None or geo.base.mesh is None:
             raise BridgeError(f"{path}: [{table}] axis: a hole entered along {shape.axis} needs a [base] with its own "
                               "mesh (the plate's bosses are entered from above), got none")
-        if shape.pin:
-            raise fail(path, table, "axis", "-z for a pin (parts go down onto pins)", shape.axis)
         if shape.top_z is None:
             raise BridgeError(f"{path}: [{table}] top_z: expected the height of the entry's centre [m] of a hole "
                               f"entered along {shape.axis}, got nothing")

@@ -168,7 +168,8 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     the hole, x and y the import's slice axes: :func:`executor.world.frames.hole_rotation`),
     its position (``assembly.toml``) and ``top_z`` the x, y and z of its entry's centre
     (``top_z`` required), ``depth`` from the entry along the axis to where a part's tip
-    ends (the taught goal: nothing stops a part in a through hole). ``zero_clearance`` names
+    ends (the taught goal: nothing stops a part in a through hole); a sideways pin's entry
+    is its free end, its ``depth`` along the axis to its part's nearest end. ``zero_clearance`` names
     the parts stated to fit at room 0, a nominal zero-clearance fit (pegs of ``part_shapes``,
     or parts with a ``bore`` for a pin): the section is the nominal one, and a listed part
     whose section is not wider passes (any other part needs room above 0). ``near_miss``

@@ -6,7 +6,9 @@ Per kind of part (the ``skill`` of the step's record):
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
-  a part with a bore onto a pin of the base likewise; once past the feature's top, a part
+  a part with a bore onto a pin of the base likewise; into a hole or onto a pin entered
+  sideways, all of it in the feature's frame (:attr:`executor.world.geometry.HoleSpec.frame`),
+  the part carried there along its axis; once past the feature's top, a part
   with a bore is centred on its pin by contact, and so is a peg with more room than
   :data:`CENTRING_ROOM` in its hole (:mod:`executor.skills.centring`);
 - ``insert_over``: a part with openings down over the pins standing in its holes, by the
@@ -486,7 +488,8 @@ class Assembler:
         return result.reached, detector.max_force_dev, detector.max_torque_dev
 
     def _frame(self, hole: str | None, skill: str) -> HoleFrame | None:
-        """The frame of a peg's hole entered sideways (:attr:`executor.world.geometry.HoleSpec.frame`), else None."""
+        """The frame of a peg's hole or a bore's pin entered sideways
+        (:attr:`executor.world.geometry.HoleSpec.frame`), else None."""
         return self.product.geometry.holes[hole].frame if skill == "insert" and hole is not None else None
 
     def _enter(self, frame: HoleFrame, approach: np.ndarray, yaw: float) -> None:
@@ -508,9 +511,9 @@ class Assembler:
         missed = float(np.linalg.norm(motion.read().tip_pos - approach))
         if missed > REACH_TOLERANCE:  # out of the arm's reach: no outcome to report
             where = ", ".join(f"{1e3 * v:.1f}" for v in frame.points_to_cell(approach))
-            raise ExecutorError(f"the arm does not reach the approach to a hole entered sideways at ({where}) mm: "
-                                f"its tip stays {1e3 * missed:.1f} mm from it; expected a pose within its reach (place "
-                                "the product nearer the arm: import --place X,Y)")
+            raise ExecutorError(f"the arm does not reach the approach to a hole or pin entered sideways at ({where}) "
+                                f"mm: its tip stays {1e3 * missed:.1f} mm from it; expected a pose within its reach "
+                                "(place the product nearer the arm: import --place X,Y)")
 
     def _leave_frame(self) -> None:
         """After a hole entered sideways: the tool straight up to the carrying height, turning

@@ -66,6 +66,7 @@ from executor.cad.write import (
     mesh_pieces,
     near_miss_assumption,
     nominal_assumption,
+    pin_entry,
     section,
     write_folder,
 )
@@ -233,7 +234,9 @@ def report(derived: Derived) -> list[str]:
             bore = derived.bore_on(pid, pin_id)
             onto.append(f"{pid} onto it (bore {_describe(bore.kind, bore.a, bore.b)} mm, "
                         f"{_clearance(pin.section, bore, pin_id, pid)}{_swept(derived, pid, pin_id)})")
-        lines.append(f"pin {pin_id} of {pin.owner} at ({_mm(pin.position[0])}, {_mm(pin.position[1])}) mm, "
+        where = (f"at ({_mm(pin.position[0])}, {_mm(pin.position[1])})" if pin.axis in ("+z", "-z") else
+                 "end at ({}, {}, {})".format(*map(_mm, pin_entry(derived, pin))))  # standing out of a side
+        lines.append(f"pin {pin_id} of {pin.owner} {where} mm, "
                      f"entered along {opposite(pin.axis)}: {_describe(pin.section.kind, pin.section.a, pin.section.b)}"
                      f" mm; {'; '.join(onto) or 'empty'}")
     for pocket in derived.pockets:

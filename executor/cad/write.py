@@ -183,8 +183,9 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
                   f"position = [{_q(x)}, {_q(y)}]", ""]
     for pin_id, pin in derived.pins.items():
         onto = f" ({' '.join(pin.parts)} onto it)" if pin.parts else ""
+        x, y, _ = pin_entry(derived, pin)
         lines += [f"[holes.{pin_id}]", f'name = "pin of {pin.owner}{onto}"',
-                  f'shape = "{pin.section.kind}"', f"position = [{_q(pin.position[0])}, {_q(pin.position[1])}]"]
+                  f'shape = "{pin.section.kind}"', f"position = [{_q(x)}, {_q(y)}]"]
         lines += [f"capacity = {len(pin.parts)}"] if len(pin.parts) > 1 else []
         lines.append("")
     return "\n".join(lines)
@@ -194,11 +195,14 @@ def _section_kind(fit: HoleFit | None) -> str | None:
     return None if fit is None or fit.section is None else fit.section.kind
 
 
-def _turn(fit: HoleFit) -> np.ndarray:
-    """The 4 × 4 rotation from the cell frame to the frame of ``fit``'s hole (z out of it,
-    x and y its slice axes: :func:`executor.world.frames.hole_rotation`); the identity
-    for a hole entered from above."""
+def _turn(fit: HoleFit | PinFit) -> np.ndarray:
+    """The 4 × 4 rotation from the cell frame to the frame of ``fit``'s hole or pin (z out
+    of it, x and y its slice axes: :func:`executor.world.frames.hole_rotation`); the
+    identity along z (a hole entered from above or below, a pin parts go down or up onto:
+    the slice's axes are the cell's x and y)."""
     turn = np.eye(4)
+    if fit.axis in ("+z", "-z"):
+        return turn
     turn[:3, :3] = hole_rotation(opposite(fit.axis)).T
     return turn
 
@@ -480,7 +484,7 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
         else:
             kept[hid] = fit
     pins = {pin_id: pin for pin_id, pin in derived.pins.items()
-            if pin.owner == derived.base and pin.axis == "+z" and pin.parts}  # an empty pin: no goal on it
+            if pin.owner == derived.base and pin.axis != "-z" and pin.parts}  # an empty pin: no goal on it
     # A hole whose part goes by hand leaves the cell, which may make the base its own mesh,
     # where the cell widens no zero-clearance fit: until no more parts go.
     while unresolved := _unresolved_in_hole(derived, replace(derived, holes=kept, pins=pins)):
@@ -580,14 +584,16 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
     if pin.owner != derived.base:
         return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
-    if pin.axis != "+z":
-        return f"goes onto its pin ({pin.id}) along {opposite(pin.axis)}, not from above"
-    lowest = min(pin.parts, key=lambda p: (float(derived.parts[p].mesh.bounds[0][2]), p))
-    if pid != lowest:
+    if pin.axis == "-z":
+        return f"goes onto its pin ({pin.id}) along +z, from below"
+    lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
+    if pid != lowest and pin.axis == "+z":
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
+    if pid != lowest:
+        return f"goes onto a pin ({pin.id}) after '{lowest}': the cell puts one part onto a pin, the nearest its root"
     if why := _unresolved(margins(derived)[pid][pin.id]):
         return f"goes onto a pin ({pin.id}) {why}"
-    mesh = derived.parts[pid].mesh.copy().apply_transform(peg_frame(derived.bores[pid], derived.parts[pid].mesh))
+    mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
 
@@ -598,13 +604,13 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     a part that is no such stack, CoACD's pieces that keep its bore within :func:`bore_loss`
     of its pin's room (the part has room on its pin: :func:`_onto_pin`)
     (:func:`executor.cad.convex.pin_pieces`)."""
-    allowed, mesh = bore_loss(derived, pid), derived.parts[pid].mesh
     pin = derived.pin_of(pid)
-    low, high = (float(v) for v in mesh.bounds[:, 2])
-    solid = trimesh.creation.extrude_polygon(shapely.Polygon(pin.section.outline + np.array(pin.position)),
+    allowed, along = bore_loss(derived, pid), _along(derived.parts[pid].mesh, pin)[:, 2]
+    low, high = float(along.min()), float(along.max())
+    solid = trimesh.creation.extrude_polygon(shapely.Polygon(pin.section.outline + pin.section.centre),
                                              high - low + 2 * NEAR)
-    solid.apply_translation((0.0, 0.0, low - NEAR))
-    solid.apply_transform(peg_frame(derived.bores[pid], mesh))
+    solid.apply_translation((0.0, 0.0, low - NEAR))  # the pin in its frame, turned into the part frame
+    solid.apply_transform(bore_frame(derived, pid) @ _turn(pin).T)
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
         found = ring_pieces(name, part, allowed, round_pins(derived, pid))
@@ -636,14 +642,43 @@ def round_pins(derived: Derived, pid: str) -> bool:
     return derived.bores[pid].kind == "round" and all(pin.section.kind == "round" for pin in derived.pins.values())
 
 
-def pin_level(derived: Derived, pin: PinFit) -> tuple[float, float]:
-    """A pin's top (the base's highest point within its section around its axis) and its
-    height [m] above the lowest bottom of the parts going onto it (where the first rests)."""
-    vertices = derived.parts[pin.owner].mesh.vertices
+def _along(mesh: trimesh.Trimesh, pin: PinFit) -> np.ndarray:
+    """The vertices (n, 3) [m] of ``mesh`` in the frame of ``pin`` (:func:`_turn`): z along
+    its removal direction."""
+    return mesh.vertices @ _turn(pin)[:3, :3].T
+
+
+def _pin_top(derived: Derived, pin: PinFit) -> float:
+    """A pin's top [m] in its frame (:func:`_turn`): its owner's farthest point along the
+    pin's removal direction within its section around its axis (a pin parts go down onto:
+    its highest)."""
+    vertices = _along(derived.parts[pin.owner].mesh, pin)
     reach = math.hypot(pin.section.a, pin.section.b) / 2
-    near = np.linalg.norm(vertices[:, :2] - np.array(pin.position), axis=1) <= reach + 1e-9
-    top = float(vertices[near, 2].max())
-    return top, top - min(float(derived.parts[pid].mesh.bounds[0][2]) for pid in pin.parts)
+    near = np.linalg.norm(vertices[:, :2] - pin.section.centre, axis=1) <= reach + 1e-9
+    return float(vertices[near, 2].max())
+
+
+def pin_level(derived: Derived, pin: PinFit) -> tuple[float, float]:
+    """A pin's top (:func:`_pin_top`) and its height [m] above the nearest end of the parts
+    going onto it (where the first rests, or, on a pin along a horizontal axis, where the
+    CAD has it), in the pin's frame."""
+    top = _pin_top(derived, pin)
+    return top, top - min(float(_along(derived.parts[pid].mesh, pin)[:, 2].min()) for pid in pin.parts)
+
+
+def pin_entry(derived: Derived, pin: PinFit) -> tuple[float, float, float]:
+    """The centre of a pin's free end in the cell frame [m] (:func:`_pin_top`): its
+    ``position`` (x, y) and, on a pin along a horizontal axis, its ``top_z``."""
+    x, y, z = _turn(pin)[:3, :3].T @ np.array([*pin.section.centre, _pin_top(derived, pin)])
+    return float(x), float(y), float(z)
+
+
+def bore_frame(derived: Derived, pid: str) -> np.ndarray:
+    """The 4 × 4 transform from the cell frame to the part frame of part ``pid`` with a bore:
+    turned into its pin's frame (:func:`_turn`), its origin the centre of the bore at the
+    part's end nearest the pin's root (:func:`executor.cad.convex.peg_frame`)."""
+    turn = _turn(derived.pin_of(pid))
+    return peg_frame(derived.bores[pid], derived.parts[pid].mesh.copy().apply_transform(turn)) @ turn
 
 
 def _polygon_refused(fit: HoleFit, derived: Derived) -> str:
@@ -690,7 +725,7 @@ def _frames(derived: Derived, mapped: Mapped) -> dict[str, np.ndarray]:
     bounding box's centre at its plate's ``base_center``)."""
     frames = {pid: peg_frame(fit.section, _upright(derived, fit)) @ _turn(fit) for pid, fit in derived.hole_of.items()
               if fit.section is not None}
-    frames |= {pid: peg_frame(bore, derived.parts[pid].mesh) for pid, bore in derived.bores.items()}
+    frames |= {pid: bore_frame(derived, pid) for pid in derived.bores}
     (x0, y0, _), (x1, y1, _) = derived.parts[derived.base].mesh.bounds
     origins = {pid: fit.origin for pid, fit in mapped.covers.items()} | {pid: fit.origin for pid, fit in
                                                                          mapped.heads.items()}
@@ -906,13 +941,17 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores])]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
+        if pin.axis != "+z":  # along a horizontal axis: its free end's height, the depth along its axis
+            lines += [f'axis = "{opposite(pin.axis)}"']
+            top = pin_entry(derived, pin)[2]
         lines += [f"top_z = {_q(top)}", f"depth = {_q(height)}", ""]
     for pid, bore in sorted(derived.bores.items()):
         mesh, pin = derived.parts[pid].mesh, derived.pin_of(pid)
         onto = [pins[0] for pin_id, pins in pairs[pid].items() if pid in nominal.get(pin_id, [])]
+        length = float(np.ptp(_along(mesh, pin)[:, 2]))
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true",
                   *_section_lines(nominal_section(bore, onto)),
-                  f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
+                  f"length = {_q(length)}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{pin.id}"', _mesh_entry(meshes[pid]), ""]
     gripper = GRIPPER if mapped.flange is None else GRIPPER | {"flange_length": mapped.flange}
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in gripper.items()), "",

@@ -172,7 +172,9 @@ def teach_shape(cell: TeachingCell, shape: str, demonstrate: Demonstrator = scri
     hole = geometry.holes[part.demo_hole]
     turn, shift = fit_pose(part, hole)
     origin = np.array([*(np.array(hole.position) + shift), hole.top_z])
-    bottom = hole.depth + (DEMO_CLEARANCE if hole.sideways else 0.0)  # sideways: the depth is the part's end
+    # into a hole entered sideways the depth is where the CAD has the part's tip (nothing stops
+    # it in a through hole); a part onto a pin rests against what its depth reaches, whatever its axis
+    bottom = hole.depth + (DEMO_CLEARANCE if hole.sideways and not hole.pin else 0.0)
     motion = cell.motion_for(part.id)
     yaw = aligned_yaw(part.kind, hole.kind, hole.yaw + turn)
     motion.frame = hole.frame  # a hole entered sideways: demonstrated and replayed down its frame's z axis

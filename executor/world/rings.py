@@ -63,6 +63,8 @@ _INSET = 0.01
 _GRID = 1e-8
 """A layer's section is snapped to this grid [m] (a union of sections has corners closer
 than a mesh can be made of)."""
+_KEPT = 1e-9
+"""[m] a piece at a bore, eroded and grown back by the hull margin, still touches the bore within this."""
 _CONVEX = 1e-9
 """A union is convex when its hull is larger by less than this fraction of its area."""
 
@@ -303,14 +305,23 @@ def _cut(layers: list[tuple[shapely.Polygon, float, float]],
     [m], and the volume [m³] of the outline's slivers left out (parts away from the bore
     too thin for the cell); None when a part at a bore is too thin. A right prism's eroded
     form (the cell's, :func:`executor.world.meshes.eroded`) is its section's inset by the
-    margin over its height less twice the margin: it has one when both are something."""
+    margin over its height less twice the margin: it has one when both are something. A
+    part with a face along a bore must keep that face: its inset grown back by the margin
+    (what the cell collides as, its corners rounded) still reaches the bore (a sector of a
+    32-gon about a d 10.2 bore, its face 1 mm wide, ends 4.1 mm out from it: a pin across
+    it hung the part that low)."""
     pieces, dropped = [], 0.0
     for section, low, high in layers:
         bores = shapely.MultiLineString([ring.coords for ring in section.interiors])
         parts = partition(section)
         tall = high - low > 2 * URDF_HULL_MARGIN
-        thick = [tall and not shapely.buffer(part, -URDF_HULL_MARGIN).is_empty for part in parts]
+        inset = [shapely.buffer(part, -URDF_HULL_MARGIN) for part in parts]
+        thick = [tall and not core.is_empty for core in inset]
         if any(not ok and part.distance(bores) == 0 for ok, part in zip(thick, parts)):
+            return None
+        faces = [shapely.intersection(part.exterior, bores).length > _KEPT for part in parts]  # along the bore
+        if any(face and shapely.buffer(core, URDF_HULL_MARGIN).distance(bores) > _KEPT
+               for face, core in zip(faces, inset)):
             return None
         for part in (part for ok, part in zip(thick, parts) if ok):
             ring = np.asarray(part.exterior.coords)[:-1]

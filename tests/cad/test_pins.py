@@ -109,8 +109,10 @@ def test_a_washer_and_a_gear_go_onto_the_pins_of_a_plate(washer_and_gear: Path) 
     assert rooms[("gear", "plate_pin1")] < 0 < rooms[("gear", "plate_pin2")] < rooms[("washer", "plate_pin2")]
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     # the washer's 128-cornered bore has no convex pieces the cell can collide as; on round
-    # pins a regular 32-gon about its inscribed circle does, which they pass as they pass it
-    assert geometry["part_shapes"]["washer"]["bore"] and "the bore a regular 32-gon about its inscribed circle" \
+    # pins a regular polygon about its inscribed circle does, which they pass as they pass
+    # it: a 16-gon, whose pieces keep their 2 mm faces at the d 10.5 bore under the cell's
+    # 1 mm hull margin (a 32-gon's 1 mm faces do not)
+    assert geometry["part_shapes"]["washer"]["bore"] and "the bore a regular 16-gon about its inscribed circle" \
         in (out / "meshes" / "washer.convex.obj").read_text().splitlines()[2]
     assert {pid: entry["reason"] for pid, entry in geometry["manual"].items()} == {  # its 2 mm teeth are too thin
         "gear": "goes onto a pin (plate_pin2), but part 'gear': the parts of its sections thinner than the cell's hull "
