@@ -309,3 +309,29 @@ def test_a_dowel_pin_in_another_part_s_bore_is_no_second_pin_of_the_plate() -> N
     assert {pin.id: pin.parts for pin in derived.pins.values()} == {"base_pin1": ("plate",),
                                                                      "base_pin2": ("sleeve",)}
     assert not derived.further_bores and margins(derived)["plate"]["base_pin2"] < 0
+
+
+@pytest.mark.slow  # the import and a truth session with its assembly
+def test_a_plate_over_both_pins_is_learned_on_each_and_placed_by_hand(run_cli: Runner, tmp_path: Path) -> None:
+    # the plate's d 10.4 and d 8.4 bores go over the d 10 and d 8 pins: both pairs are written
+    # for the learner, the truth backend and the CAD prior, each with 0.4 mm of room (its
+    # d 8.4 bore does not pass the d 10 pin); the cell aligns one bore with one pin, so the
+    # plate is placed by hand with that reason, and the truth session learns both pairs.
+    outline = shapely.box(-40.0, -10.0, 40.0, 10.0).difference(shapely.Point(-25.0, 0.0).buffer(5.2, quad_segs=32))
+    outline = outline.difference(shapely.Point(25.0, 0.0).buffer(4.2, quad_segs=32))
+    plate = trimesh.creation.extrude_polygon(outline, 4.0)
+    plate.apply_translation((X_MM, 0.0, 10.0))
+    out = _import(tmp_path, {"cover": plate})
+    assert _atoms(out / "sizes.lp", "fits") == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
+    rooms = {(p, h): int(m) for p, h, m in _atoms(out / "nominal_sizes.lp", "nominal_margin")}
+    assert {pair: abs(room - 400) <= 20 for pair, room in rooms.items()} == {
+        ("cover", "plate_pin1"): True, ("cover", "plate_pin2"): True}, rooms
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    assert {pid: entry["reason"] for pid, entry in geometry["manual"].items()} == {
+        "cover": "goes onto 2 pins (plate_pin1, plate_pin2): the cell puts a part onto one pin"}
+    done = run_cli("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
+                   str(tmp_path / "truth"), timeout=240)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert {tuple(pair) for pair in result["fits"]} == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
+    assert result["assembly"]["assembled"]
