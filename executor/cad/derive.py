@@ -43,8 +43,8 @@ before it when its outline across its insertion axis lies in an inner loop of th
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
 around a solid loop of another part there (the base's pin, another part's shaft), that
 part the base or one the geometric precedence puts before it, goes onto that pin (onto
-one pin of each such part, through bores of its own: an arm on the base's pivot pin
-through its bore and on a disk's nipple through its slot); a peg
+every pin of such parts in a bore of its own: a plate on two dowel pins of the base, an
+arm on the base's pivot pin through its bore and on a disk's nipple through its slot); a peg
 standing in a hole of the base is a pin only of a part going in along another axis (a
 nut onto a bolt's end under the plate; one going in along the peg's, over it, is a
 cover), or of a part going in along its axis that rests on such pegs alone (a foot down
@@ -205,7 +205,7 @@ class Derived:
     is compared with every pin by."""
     further_bores: dict[tuple[str, str], Shape2D] = field(default_factory=dict)
     """(part, pin) -> the section of another bore of the part, around a further pin it is on
-    (of another owner: the arm's slot over the disk's nipple), the one its pair with that
+    (a plate's second dowel pin, the arm's slot over the disk's nipple), the one its pair with that
     pin is measured by (:func:`pins`)."""
     part_holes: dict[str, HoleFit] = field(default_factory=dict)
     """The holes of moving parts, each with the part through it (:func:`part_holes`)."""
@@ -549,10 +549,12 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
     part's own axis (that part is a cover, :mod:`executor.cad.covers`), unless the part
     rests on such pegs alone (:attr:`Derived.supports`: it goes onto their ends). Parts on one pin
     share its section, the one measured over the longest stretch of it (from the part
-    farthest from its end). A part goes onto a pin of each such owner (in order of their
-    names) through a bore of its own around no pin it is on already: asm4_disk_arm's arm
-    onto the base's pivot pin through its bore and onto the disk's nipple through its
-    slot. Its first bore is its section against every pin (:attr:`Derived.bores`), each
+    farthest from its end). A part goes onto every pin of each such owner (in order of their
+    names) that stands in a bore of its own around no pin it is on already: a plate onto
+    both dowel pins of the base, asm4_disk_arm's arm onto the base's pivot pin through its
+    bore and onto the disk's nipple through its slot; but not onto a further pin that
+    another part is around (:func:`_within_another`: a washer over a sleeve over a pin).
+    Its first bore is its section against every pin (:attr:`Derived.bores`), each
     further one against its own pin (:attr:`Derived.further_bores`): also the (part,
     pin) -> bore pairs returned third."""
     found: list[tuple[str, str, Shape2D, np.ndarray, str | None, float]] = []  # owner, axis, pin, centre, part, level
@@ -573,16 +575,18 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
             covered -= resting
         taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
         for other in sorted(({derived.base} | before) - covered):
-            hit = _pin_of(derived, pid, name, other, taken)
-            if hit is None:
-                continue
-            pin, bore, centre, level = hit
-            if taken:
-                further[len(found)] = bore
-            else:
-                bores[pid] = bore
-            taken.append(pin.centre)
-            found.append((other, name, pin, centre, pid, level))
+            while (hit := _pin_of(derived, pid, name, other, taken)) is not None:
+                pin, bore, centre, level = hit
+                if any(np.linalg.norm(pin.centre - point) < _SAME_HOLE for point in taken):
+                    break  # its bore is around a pin the part is on already
+                taken.append(pin.centre)
+                if len(taken) > 1 and _within_another(derived, pid, other, name, pin.centre, levels[pid]):
+                    continue  # a washer over a sleeve over a pin: the pin is the sleeve's to go into
+                if len(taken) > 1:
+                    further[len(found)] = bore
+                else:
+                    bores[pid] = bore
+                found.append((other, name, pin, centre, pid, level))
     found += [(derived.base, derived.axis[pid], pin, centre, None, math.inf) for pid in sorted(bores)
               for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str], float]] = []
@@ -610,6 +614,25 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
     return result, bores, {(str(found[k][4]), ids[into[k]]): bore for k, bore in further.items()}
 
 
+def _within_another(derived: Derived, pid: str, owner: str, name: str, centre: np.ndarray, level: float) -> bool:
+    """Whether a part other than ``pid`` and ``owner`` is around the point ``centre`` (2,) [m]
+    across removal direction ``name`` (an outline of its slice at ``level`` [m] along it
+    holds the point): a pin of ``owner`` there stands in that part's bore (or under it),
+    so ``pid``'s bore around both goes over that part, not onto the pin."""
+    axis = np.array(derived.directions[name])
+    frame = frame_of(axis)
+    for other in sorted(set(derived.parts) - {pid, owner}):
+        mesh = derived.parts[other].mesh
+        along, across = mesh.vertices @ axis, mesh.vertices @ frame.T
+        if not (along.min() < level < along.max()) or not np.all(
+                (across.min(axis=0) <= centre) & (centre <= across.max(axis=0))):
+            continue  # it does not reach the level, or no outline of it can hold the point
+        loops = slice_loops(mesh, axis, level)
+        if any(_outer(loop, loops) and loop.contains(centre) for loop in loops):
+            return True
+    return False
+
+
 def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[np.ndarray] = ()
             ) -> tuple[Shape2D, Shape2D, np.ndarray, float] | None:
     """Part ``pid`` on a pin of ``owner`` along removal direction ``name``: the pin's
@@ -618,7 +641,9 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[n
     around exactly one outline of ``owner`` lying in it (within the bore's sagitta and
     :data:`executor.cad.sweep.TOUCH`, as a nominal zero-clearance fit lies), no bore around
     a point of ``taken`` (the centres [m] across the axis of pins the part is on already: it
-    goes onto another part's pin only through another bore of its own). The levels
+    goes onto another pin only through another bore of its own). The pin is the owner's
+    within the part's reach across the axis, short of the owner's outlines in the part's
+    other bores by twice :data:`_SAME_HOLE` (a plate's other dowel pin is not this one). The levels
     tried: the middle of the part's extent along the direction, then
     :data:`_HOLE_LEVELS` middles of the spans between the owner's vertex levels where both
     reach, longest first (a pulley whose middle lies behind the hub's disc has its bore
@@ -646,13 +671,14 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[n
     if high - low <= 1e-6:
         return None
     middle = float(along.min() + along.max()) / 2
-    line = next((found for level in ([middle] if low < middle < high else [])
-                 + _spans(other_along, low, high)[:_HOLE_LEVELS]
-                 if (found := _bore_around(part, other, axis, level, taken)) is not None), None)
-    if line is None:
+    hit = next((found for level in ([middle] if low < middle < high else [])
+                + _spans(other_along, low, high)[:_HOLE_LEVELS]
+                if (found := _bore_around(part, other, axis, level, taken)) is not None), None)
+    if hit is None:
         return None
+    line, apart = hit
     frame = frame_of(axis)
-    reach = float(np.linalg.norm(part.vertices @ frame.T - line, axis=1).max())
+    reach = min(float(np.linalg.norm(part.vertices @ frame.T - line, axis=1).max()), apart - 2 * _SAME_HOLE)
     near = other_along[np.linalg.norm(other.vertices @ frame.T - line, axis=1) <= reach + _SAME_HOLE]
     start, end = float(along.min()), float(near.max())
     stretch: list[tuple[float, Loop | None, shapely.Polygon | None]] = []
@@ -803,11 +829,12 @@ def _outline(union: shapely.Polygon) -> Loop:
 
 
 def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float,
-                 taken: Iterable[np.ndarray] = ()) -> np.ndarray | None:
+                 taken: Iterable[np.ndarray] = ()) -> tuple[np.ndarray, float] | None:
     """The centre (2,) [m] of the one outline of ``other`` that lies in an inner loop (a
     bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`_in_loop`),
-    of the bores around none of the points ``taken`` (2,) [m]; None when no bore holds
-    exactly one."""
+    of the bores around none of the points ``taken`` (2,) [m], and how far [m] from it the
+    nearest outline of ``other`` in another inner loop of ``part`` lies (a plate's other
+    dowel pin: inf when there is none); None when no bore holds exactly one."""
     own = slice_loops(part, axis, level)
     bores = [o for o in own if not _outer(o, own) and not any(o.contains(point) for point in taken)]
     if not bores:
@@ -817,10 +844,15 @@ def _bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray
                for bore in bores):
         return None  # nothing of the other part in a bore's box across the axis, at any level: no slice needed
     theirs = slice_loops(other, axis, level)
+    outlines = [o for o in theirs if _outer(o, theirs)]
     for bore in bores:
-        inside = [o for o in theirs if _outer(o, theirs) and bore.contains(o.centre) and _in_loop(o, bore)]
+        inside = [o for o in outlines if bore.contains(o.centre) and _in_loop(o, bore)]
         if len(inside) == 1:
-            return inside[0].centre
+            centre = inside[0].centre
+            apart = [float(np.linalg.norm(o.points - centre, axis=1).min()) for o in outlines
+                     if o is not inside[0] and any(h is not bore and h.contains(o.centre) for h in own
+                                                   if not _outer(h, own))]
+            return centre, min(apart, default=math.inf)
     return None
 
 

@@ -579,6 +579,8 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
     the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`);
+    a part on more than one pin (a plate over two dowel pins) is placed by hand, the cell
+    aligning one bore with one pin;
     a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
@@ -586,6 +588,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
     if pin.axis == "-z":
         return f"goes onto its pin ({pin.id}) along +z, from below"
+    if len(on := [p.id for p in derived.pins.values() if pid in p.parts]) > 1:
+        return f"goes onto {len(on)} pins ({', '.join(on)}): the cell puts a part onto one pin"
     lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
     if pid != lowest and pin.axis == "+z":
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"

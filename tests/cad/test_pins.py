@@ -19,6 +19,7 @@ import shapely.affinity
 import trimesh
 
 from assembly_constraints.cli import main
+from executor import ExecutorError
 from executor.cad.derive import _GRID, _joined, derive
 from executor.cad.parts import CadPart
 from executor.cad.write import margins
@@ -255,3 +256,84 @@ def test_a_part_goes_onto_a_pin_of_another_part_through_a_second_bore_of_its_own
     rooms = margins(derived)["arm"]
     assert abs(rooms["disk_pin1"] - 0.8 * mm) < 0.02 * mm and abs(rooms["base_pin2"] - 0.4 * mm) < 0.02 * mm, rooms
     assert derived.reasons[("disk", "arm")] != "feature"
+
+
+def _dowelled(second_bore: float) -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
+    """A base with two dowel pins, d 6 at x 0 and d 8 at x 40 mm, standing 10 mm above its
+    top (z 10 mm), and a 4 mm plate on that top with a d 6.2 bore over the first and a bore
+    of ``second_bore`` [mm] over the second; both in metres."""
+    mm = 1e-3
+    base = trimesh.boolean.union([_prism(shapely.box(-20 * mm, -15 * mm, 60 * mm, 15 * mm), 0.0, 10 * mm),
+                                  _round(0.0, 3 * mm, 5 * mm, 20 * mm), _round(40 * mm, 4 * mm, 5 * mm, 20 * mm)],
+                                 engine="manifold")
+    plate = trimesh.boolean.difference([_prism(shapely.box(-10 * mm, -10 * mm, 50 * mm, 10 * mm), 10 * mm, 14 * mm),
+                                        _round(0.0, 3.1 * mm, 9 * mm, 15 * mm),
+                                        _round(40 * mm, second_bore / 2 * mm, 9 * mm, 15 * mm)], engine="manifold")
+    return base, plate
+
+
+def test_a_plate_goes_onto_both_dowel_pins_of_the_base_each_through_its_own_bore() -> None:
+    # the commonest locating scheme: a plate over two dowel pins of the base. It is on both,
+    # each pair measured by its own bore (0.2 mm of room on the d 6 pin, 0.4 mm on the d 8),
+    # and on neither through the other's bore; the base goes first as ever, nothing else.
+    mm = 1e-3
+    base, plate = _dowelled(8.4)
+    derived = derive([CadPart("base", "base", base, "test"), CadPart("plate", "plate", plate, "test")], "base", {})
+    assert {pin.id: pin.parts for pin in derived.pins.values()} == {"base_pin1": ("plate",), "base_pin2": ("plate",)}
+    assert len(derived.further_bores) == 1 and derived.bore_on("plate", "base_pin1").a < 7 * mm
+    rooms = margins(derived)["plate"]
+    assert abs(rooms["base_pin1"] - 0.2 * mm) < 0.02 * mm and abs(rooms["base_pin2"] - 0.4 * mm) < 0.02 * mm, rooms
+    assert set(derived.edges) == {("base", "plate")}
+
+
+def test_a_plate_whose_bore_is_too_small_for_its_dowel_pin_is_refused() -> None:
+    # the second bore (d 7.8) is smaller than its d 8 pin: the parts overlap, so the plate
+    # never comes out of the product and the import refuses it, naming the part, rather than
+    # writing a pair of a product that cannot be assembled.
+    base, plate = _dowelled(7.8)
+    with pytest.raises(ExecutorError, match="part\\(s\\) plate never come out of the assembled product"):
+        derive([CadPart("base", "base", base, "test"), CadPart("plate", "plate", plate, "test")], "base", {})
+
+
+def test_a_dowel_pin_in_another_part_s_bore_is_no_second_pin_of_the_plate() -> None:
+    # the plate's second bore (d 12.4) goes over a sleeve (d 12, its d 8.2 bore on the d 8
+    # pin), not onto the pin: the plate is on the d 6 pin alone, the sleeve on the d 8, and
+    # the plate's pair with the d 8 pin is measured by its first bore (no fit).
+    mm = 1e-3
+    base, _ = _dowelled(8.4)
+    plate = trimesh.boolean.difference([_prism(shapely.box(-10 * mm, -10 * mm, 50 * mm, 10 * mm), 10 * mm, 14 * mm),
+                                        _round(0.0, 3.1 * mm, 9 * mm, 15 * mm),
+                                        _round(40 * mm, 6.2 * mm, 9 * mm, 15 * mm)], engine="manifold")
+    ring = shapely.Point(40 * mm, 0.0).buffer(6 * mm, quad_segs=16)
+    sleeve = _prism(ring.difference(shapely.Point(40 * mm, 0.0).buffer(4.1 * mm, quad_segs=16)), 10 * mm, 14 * mm)
+    derived = derive([CadPart(pid, pid, mesh, "test") for pid, mesh in
+                      (("base", base), ("plate", plate), ("sleeve", sleeve))], "base", {})
+    assert {pin.id: pin.parts for pin in derived.pins.values()} == {"base_pin1": ("plate",),
+                                                                     "base_pin2": ("sleeve",)}
+    assert not derived.further_bores and margins(derived)["plate"]["base_pin2"] < 0
+
+
+@pytest.mark.slow  # the import and a truth session with its assembly
+def test_a_plate_over_both_pins_is_learned_on_each_and_placed_by_hand(run_cli: Runner, tmp_path: Path) -> None:
+    # the plate's d 10.4 and d 8.4 bores go over the d 10 and d 8 pins: both pairs are written
+    # for the learner, the truth backend and the CAD prior, each with 0.4 mm of room (its
+    # d 8.4 bore does not pass the d 10 pin); the cell aligns one bore with one pin, so the
+    # plate is placed by hand with that reason, and the truth session learns both pairs.
+    outline = shapely.box(-40.0, -10.0, 40.0, 10.0).difference(shapely.Point(-25.0, 0.0).buffer(5.2, quad_segs=32))
+    outline = outline.difference(shapely.Point(25.0, 0.0).buffer(4.2, quad_segs=32))
+    plate = trimesh.creation.extrude_polygon(outline, 4.0)
+    plate.apply_translation((X_MM, 0.0, 10.0))
+    out = _import(tmp_path, {"cover": plate})
+    assert _atoms(out / "sizes.lp", "fits") == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
+    rooms = {(p, h): int(m) for p, h, m in _atoms(out / "nominal_sizes.lp", "nominal_margin")}
+    assert {pair: abs(room - 400) <= 20 for pair, room in rooms.items()} == {
+        ("cover", "plate_pin1"): True, ("cover", "plate_pin2"): True}, rooms
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    assert {pid: entry["reason"] for pid, entry in geometry["manual"].items()} == {
+        "cover": "goes onto 2 pins (plate_pin1, plate_pin2): the cell puts a part onto one pin"}
+    done = run_cli("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
+                   str(tmp_path / "truth"), timeout=240)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert {tuple(pair) for pair in result["fits"]} == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
+    assert result["assembly"]["assembled"]
