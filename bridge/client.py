@@ -142,16 +142,20 @@ class CellDirectory:
         with self._lock:
             self._listeners.remove(listener)
 
-    def wait_for(self, count: int, timeout: float) -> set[str]:
-        """Wait up to ``timeout`` [s] until at least ``count`` cells are alive; CellTimeout if not."""
+    def wait_for(self, count: int, timeout: float, among: Collection[str] | None = None) -> set[str]:
+        """Wait up to ``timeout`` [s] until at least ``count`` cells are alive, counting only
+        those in ``among`` if given (a token of another id neither counts nor shortens the
+        wait); the alive cells then (all of them). CellTimeout if not."""
+        wanted = None if among is None else frozenset(among)
         deadline = time.monotonic() + timeout
         with self._lock:
-            while len(self._alive) < count:
+            while len(self._alive if wanted is None else self._alive & wanted) < count:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     duplicated = [self._duplicate_text(c) for c in sorted(self._instances)
                                   if len(self._instances[c]) > 1]
-                    raise CellTimeout(f"expected {count} alive cell(s) within {timeout:.1f} s, "
+                    of = "" if wanted is None else f" of {', '.join(sorted(wanted))}"
+                    raise CellTimeout(f"expected {count} alive cell(s){of} within {timeout:.1f} s, "
                                       f"saw {sorted(self._alive) or 'none'}" + "".join(f"; {d}" for d in duplicated))
                 self._lock.wait(remaining)
             return set(self._alive)
@@ -359,6 +363,13 @@ class CellPool:
         self.incidents: list[str] = []
         self._alive = {cell for cell in directory.listen(self._on_change) if self._usable(cell)}
         self.on_dispatch: Callable[[str, InsertRequest], None] | None = None
+
+    def usable_alive(self) -> set[str]:
+        """The cells whose token is seen now and that the pool may use (in ``allowed``, not
+        dropped): how many requests can run at once. A token of any other id (a cell of
+        another planner, a rogue process) is not counted, so it cannot change how much work
+        the planner hands out at a time."""
+        return {cell for cell in self._directory.alive() if self._usable(cell)}
 
     def _usable(self, cell: str) -> bool:
         return (self._allowed is None or cell in self._allowed) and cell not in self._dropped

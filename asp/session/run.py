@@ -550,11 +550,11 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
                         allowed=allowed,
                         exit_status=lambda cell: processes[cell].exit_code(CRASH_WAIT_S) if cell in processes else None)
         stack.callback(pool.close)
-        oracle = ZenohOracle(pool, directory, journal, run_id, record.seed)
+        oracle = ZenohOracle(pool, journal, run_id, record.seed)
         for cell in cells:
             cell.wait_for_line("ready", timeout=settings.wait_for_cell_s)
         try:
-            directory.wait_for(max(1, len(cell_ids)), timeout=settings.wait_for_cell_s)
+            directory.wait_for(max(1, len(cell_ids)), timeout=settings.wait_for_cell_s, among=allowed)
         except BridgeError as exc:
             raise PlannerError(f"cells: {exc}") from None
         if settings.cells == 0 and not settings.allow_cells:

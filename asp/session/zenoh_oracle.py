@@ -29,7 +29,7 @@ from asp import PlannerError
 from asp.session.journal import Journal, JournalEntry
 from asp.sizes.truth_oracle import Result
 from bridge import BridgeError
-from bridge.client import CellDirectory, CellPool
+from bridge.client import CellPool
 from bridge.messages import InsertReply, InsertRequest
 
 Pair = tuple[str, str]
@@ -52,12 +52,10 @@ class Finished:
 
 
 class ZenohOracle:
-    """Runs experiments on the cells of ``directory``; journals each finished one."""
+    """Runs experiments on the cells of ``pool``; journals each finished one."""
 
-    def __init__(self, pool: CellPool, directory: CellDirectory, journal: Journal,
-                 run_id: str, seed: int = 0) -> None:
+    def __init__(self, pool: CellPool, journal: Journal, run_id: str, seed: int = 0) -> None:
         self._pool = pool
-        self._directory = directory
         self._journal = journal
         self._run_id = run_id
         self._seed = seed
@@ -69,8 +67,10 @@ class ZenohOracle:
         pool.on_dispatch = self._on_dispatch
 
     def alive_cells(self) -> int:
-        """How many cells are alive now (how many experiments can run at once)."""
-        return len(self._directory.alive())
+        """How many cells the pool may use are alive now (how many experiments can run at
+        once); a token of a cell the session does not use is not counted, so the batches,
+        and thus the experiments chosen, do not depend on it."""
+        return len(self._pool.usable_alive())
 
     def submit(self, part: str, hole: str) -> None:
         """Queue one experiment under the next number; it starts as soon as a cell is idle."""

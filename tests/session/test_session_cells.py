@@ -12,6 +12,7 @@ import json
 import os
 import signal
 import subprocess
+import threading
 import time
 from collections import Counter
 from pathlib import Path
@@ -185,9 +186,11 @@ def test_confirmed_session_retests_each_essential_experiment_once(tmp_path: Path
 
 
 def test_a_session_starts_from_its_demonstrations_and_never_uses_a_rogue_cell(tmp_path: Path, run_session) -> None:
-    """``--demos``: the session starts from the fits its demonstrations show. A local process
-    declares ``cell/evil/alive`` and answers every request with "fit"; the session, which
-    started its own cell, uses only that cell and learns the truth."""
+    """``--demos``: the session starts from the fits its demonstrations show. Once its first
+    experiment is journaled, a local process joins it, declares ``cell/evil/alive`` and
+    answers every request with "fit"; the session, which started its own cell, uses only
+    that cell, learns the truth, and chooses the experiments it would choose without the
+    rogue (a token counted mid-session would make its batches bigger, hence its choices other)."""
     from asp.sizes.learner import LearningOptions, learn_sizes
     from bridge.keys import alive_key
     from bridge.messages import InsertReply, decode_request, encode
@@ -195,9 +198,11 @@ def test_a_session_starts_from_its_demonstrations_and_never_uses_a_rogue_cell(tm
 
     demos = ROOT / "data" / "cranfield" / "demos_annotated.txt"
     run = tmp_path / "run"
+    journal = run / "journal.jsonl"
     endpoint = free_loopback_endpoint()
-    rogue = open_session(connect=(endpoint,))
     asked: list[str] = []
+    joined: list[int] = []  # how many experiments were journaled when the rogue was linked
+    stop = threading.Event()
 
     def always_fit(query) -> None:
         request = decode_request(query.payload.to_bytes())
@@ -205,16 +210,33 @@ def test_a_session_starts_from_its_demonstrations_and_never_uses_a_rogue_cell(tm
         query.reply(query.key_expr, encode(InsertReply(id=request.id, cell="evil", part=request.part,
                                                        hole=request.hole, result="fit")))
 
-    try:
-        handles = (rogue.declare_queryable("cell/evil/insert", always_fit),
-                   rogue.liveliness().declare_token(alive_key("evil")))
-        result = run_session("--listen", endpoint, "--out", str(run), "--demos", str(demos))
-        del handles
+    def rogue() -> None:
+        while not (journal.is_file() and read_journal(journal)):
+            if stop.wait(0.02):
+                return
+        session = open_session(connect=(endpoint,))  # the session listens by now: linked at once
+        try:
+            handles = (session.declare_queryable("cell/evil/insert", always_fit),
+                       session.liveliness().declare_token(alive_key("evil")))
+            while not list(session.info.peers_zid()):
+                if stop.wait(0.02):
+                    return
+            joined.append(len(read_journal(journal)))
+            stop.wait()
+            del handles
+        finally:
+            session.close()
+
+    thread = threading.Thread(target=rogue, daemon=True)
+    thread.start()
+    try:  # experiments of 0.3 s: the rogue joins while several are left to choose
+        result = run_session("--listen", endpoint, "--out", str(run), "--demos", str(demos), "--delay", "0.3")
     finally:
-        rogue.close()
+        stop.set()
+        thread.join(30)
     assert_learned_truth(result, run)
     assert "assembly" not in result  # no --assemble
-    assert asked == []
+    assert joined and joined[0] < result["experiments"] and asked == [], joined
     assert {e.cell for e in read_journal(run / "journal.jsonl")} == {"c1"}
     shown = {tuple(pair) for pair in result["demonstrated"]}
     assert len(shown) == 9 and shown <= TRUTH.fits
