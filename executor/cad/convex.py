@@ -282,9 +282,8 @@ def pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: f
     that, as :func:`executor.world.rings.coarser_bores`), CoACD's :data:`PIN_THRESHOLDS` tried
     in turn, each with :data:`PIN_ITERATIONS` in turn; or why they do not. Made once for
     a mesh and the file written of it (alike within the 0.1 µm the file keeps)."""
-    points = np.round(apart(mesh.vertices), 7)
     key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.round(pin.vertices, 7).tobytes()
-                         + points[np.lexsort(points.T)].tobytes()).digest()
+                         + _shape_key(mesh)).digest()
     if key not in _PIN_PIECES:
         _PIN_PIECES[key] = _pin_pieces(pid, mesh, pin, allowed)
     return _PIN_PIECES[key]
@@ -292,6 +291,20 @@ def pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: f
 
 _PIN_PIECES: dict[bytes, tuple[list[tuple[trimesh.Trimesh, float]], str] | str] = {}
 """:func:`pin_pieces` of each part, mesh and pin asked for."""
+
+
+def _shape_key(mesh: trimesh.Trimesh) -> bytes:
+    """The bytes of ``mesh``'s shape whatever the order of its vertices and faces: its
+    vertices (:func:`apart`, on the 0.1 µm grid a written file keeps) in sorted order, and
+    its triangles as the indices of their corners in that order, each turned to start at
+    its least index (its winding kept), sorted. Two meshes alike within the grid have one
+    key; the same vertices joined by other triangles (another shape) have another."""
+    points, inverse = np.unique(np.round(apart(mesh.vertices), 7), axis=0, return_inverse=True)
+    faces = inverse.reshape(-1)[np.asarray(mesh.faces)]
+    first = np.argmin(faces, axis=1)[:, None]
+    faces = np.take_along_axis(faces, (first + np.arange(3)) % 3, axis=1)
+    faces = faces[np.lexsort(faces.T[::-1])]
+    return points.tobytes() + faces.astype(np.int64).tobytes()
 
 
 def _pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: float

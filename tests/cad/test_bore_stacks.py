@@ -10,7 +10,7 @@ import pytest
 import shapely
 import trimesh
 
-from executor.cad.convex import APART, CONCAVITY_REACH, apart, pin_pieces
+from executor.cad.convex import APART, CONCAVITY_REACH, _shape_key, apart, pin_pieces
 from executor.world.rings import NoStack, ring_pieces
 
 BORE = 5.0e-3
@@ -77,3 +77,18 @@ def test_vertices_closer_than_a_written_file_keeps_are_moved_apart() -> None:
     moved = apart(points)
     assert np.linalg.norm(moved[1] - moved[0]) == pytest.approx(APART, abs=1e-12)
     assert np.allclose(moved[:2].mean(axis=0), points[:2].mean(axis=0)) and np.array_equal(moved[2], points[2])
+
+
+def test_a_pin_pieces_key_tells_apart_the_same_vertices_joined_by_other_triangles() -> None:
+    # the cache of CoACD's pieces serves a mesh alike within the file's grid, never another
+    # shape: a square's two triangulations share their four vertices, not their faces
+    square = trimesh.creation.box((0.01, 0.01, 0.01))
+    turned = square.copy()
+    turned.faces = turned.faces[::-1][:, [1, 2, 0]]  # the same triangles, listed otherwise
+    flipped = square.copy()
+    quad = flipped.faces[:2]  # two triangles sharing a diagonal: the other diagonal
+    shared = np.intersect1d(quad[0], quad[1])
+    rim = [int(v) for v in np.union1d(quad[0], quad[1]) if v not in shared]
+    flipped.faces[:2] = [[rim[0], shared[0], rim[1]], [rim[1], shared[1], rim[0]]]
+    assert _shape_key(square) == _shape_key(turned)
+    assert _shape_key(square) != _shape_key(flipped)
