@@ -237,7 +237,7 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
         near = main.buffer(SAME_OUTLINE)
         apart = [piece for piece in pieces if piece is not main and not near.covers(piece)]
         found = shapely.Polygon((shapely.union_all([main, *apart]).convex_hull if apart else main).exterior)
-    if shapely.hausdorff_distance(outline.exterior, found.exterior) <= SAME_OUTLINE:
+    if _same_outline(outline.exterior, found.exterior):
         return loop
     return Loop(np.asarray(found.exterior.coords)[:-1])
 
@@ -404,6 +404,56 @@ def passage(peg: Slicer, owner: Slicer, line: np.ndarray, low: float, high: floa
     peg_loop = found[at][0]
     assert peg_loop is not None  # a clearance is measured only from a section of the peg
     return Passage(2 * least, peg_loop, found[index][1])
+
+
+def _same_outline(first: shapely.LinearRing, second: shapely.LinearRing) -> bool:
+    """Whether the rings lie within :data:`SAME_OUTLINE` of each other: their discrete
+    Hausdorff distance (``shapely.hausdorff_distance``, each one's vertices to the other's
+    edges) is at most it, decided as that comparison decides (:func:`_vertices_near`, one
+    way, then the other) without measuring every vertex against every edge."""
+    return _vertices_near(shapely.get_coordinates(first), shapely.get_coordinates(second)) and _vertices_near(
+        shapely.get_coordinates(second), shapely.get_coordinates(first))
+
+
+def _vertices_near(points: np.ndarray, ring: np.ndarray) -> bool:
+    """Whether each of ``points`` (n, 2) [m] lies within :data:`SAME_OUTLINE` of an edge of
+    the closed polyline ``ring`` (m, 2) [m] (its first point repeated last), each distance
+    computed as GEOS's discrete Hausdorff distance computes it, operation for operation (the
+    edge's closest point: the projection where its factor lies strictly between 0 and 1,
+    else the nearer end; then the squared distance), so the comparison decides alike to the
+    last bit. Only the edges whose box,
+    widened by twice :data:`SAME_OUTLINE`, holds the point are measured: any other edge and
+    its closest point, rounded or not, lie farther than :data:`SAME_OUTLINE`."""
+    if not len(points) or not len(ring):
+        return False  # GEOS's distance to or from nothing is NaN, within no distance
+    # GEOS walks the ring with one segment, replacing its ends in turn: every second edge
+    # runs from its end back to its start (which the rounding of its projection follows)
+    start, end = ring[:-1].copy(), ring[1:].copy()
+    start[1::2], end[1::2] = ring[2::2], ring[1:-1:2]
+    reach = 2 * SAME_OUTLINE
+    low, high = np.minimum(start, end) - reach, np.maximum(start, end) + reach
+    tree = shapely.STRtree(shapely.box(low[:, 0], low[:, 1], high[:, 0], high[:, 1]))
+    which, edge = tree.query(shapely.points(points))  # the boxes holding each point
+    if len(np.unique(which)) < len(points):
+        return False
+    p, a, b = points[which], start[edge], end[edge]
+    dx, dy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        factor = ((p[:, 0] - a[:, 0]) * dx + (p[:, 1] - a[:, 1]) * dy) / (dx * dx + dy * dy)
+    at_a, at_b = np.all(p == a, axis=1), np.all(p == b, axis=1)
+    factor = np.where(at_a | (~at_b & np.all(a == b, axis=1)), 0.0, np.where(at_b, 1.0, factor))
+    inside = (factor > 0) & (factor < 1)
+    nearer_end = np.where((np.sqrt(_squared(a, p)) < np.sqrt(_squared(b, p)))[:, None], a, b)
+    closest = np.where(inside[:, None], np.stack([a[:, 0] + factor * dx, a[:, 1] + factor * dy], axis=1), nearer_end)
+    nearest = np.full(len(points), np.inf)
+    np.minimum.at(nearest, which, _squared(closest, p))
+    return bool(math.sqrt(float(nearest.max())) <= SAME_OUTLINE)
+
+
+def _squared(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """The squared distances [m²] of the rows of two (n, 2) arrays, as GEOS sums them (dx² + dy²)."""
+    dx, dy = first[:, 0] - second[:, 0], first[:, 1] - second[:, 1]
+    return dx * dx + dy * dy
 
 
 def _closed_polylines(section: trimesh.path.Path3D) -> list[np.ndarray]:

@@ -260,3 +260,38 @@ def test_a_tenon_swept_into_its_own_taper_fits_alike_tapers_and_not_a_straight_h
     assert derived.swept[("tenon", own)][2] == pytest.approx(0.0, abs=2e-8)
     rooms = margins(derived)["tenon"]
     assert rooms[own] == rooms[alike] == 0.0 and rooms[straight] < -0.0004
+
+
+def _rings_near(rng: np.random.Generator) -> tuple[shapely.LinearRing, shapely.LinearRing]:
+    """A random convex ring [m] and its copy with a point between each two of its corners,
+    pushed off their edge by :data:`sections.SAME_OUTLINE` give or take a few ulps, or the
+    copy shifted by that much (so the rings' Hausdorff distance lies on the tolerance)."""
+    angles = np.sort(rng.uniform(0, 2 * math.pi, int(rng.integers(3, 30))))
+    points = np.stack([np.cos(angles), np.sin(angles)], axis=1) * rng.uniform(0.001, 0.05) + rng.uniform(-0.3, 0.3, 2)
+    off = sections.SAME_OUTLINE * (1 + rng.integers(-3, 4, (len(points), 1)) * 1e-16)
+    if rng.integers(2):
+        turn = rng.uniform(0, 2 * math.pi)
+        return shapely.LinearRing(points), shapely.LinearRing(points + off * [math.cos(turn), math.sin(turn)])
+    edges = np.roll(points, -1, axis=0) - points
+    normals = edges[:, ::-1] * [1, -1] / np.linalg.norm(edges, axis=1)[:, None]
+    between = (points + np.roll(points, -1, axis=0)) / 2 + normals * off
+    return shapely.LinearRing(points), shapely.LinearRing(np.stack([points, between], axis=1).reshape(-1, 2))
+
+
+def test_a_section_is_its_loop_exactly_as_their_hausdorff_distance_decides() -> None:
+    # over_span keeps the loop sliced when the section over the span lies within
+    # SAME_OUTLINE of it, as shapely's discrete Hausdorff distance (GEOS's) decides; the
+    # check measures each vertex only against the edges near it, each as GEOS does, so it
+    # decides alike on rings whose distance lies on the tolerance to the last bits. The
+    # first pair is off by 1e-8 m and 9.1e-18 m as GEOS measures it: GEOS measures every
+    # second edge from its end (from its start, the pair comes out 5.3e-18 m within).
+    first = [(-0.17051113754895594, 0.07954860562642242), (-0.14556593338799292, 0.031272340684703574),
+             (-0.11329761921450417, 0.04715225115214819), (-0.1092857903794663, 0.05776384061486611)]
+    second = [first[0], (-0.15803854435254833, 0.0554104685650041), first[1],
+              (-0.12943177188575766, 0.03921228694605495), first[2], (-0.11129169544314062, 0.052458042347182675),
+              first[3], (-0.13989846061196257, 0.06865623254202577)]
+    rng = np.random.default_rng(7)
+    pairs = [(shapely.LinearRing(first), shapely.LinearRing(second))] + [_rings_near(rng) for _ in range(300)]
+    expected = [bool(shapely.hausdorff_distance(a, b) <= sections.SAME_OUTLINE) for a, b in pairs]
+    assert [sections._same_outline(a, b) for a, b in pairs] == expected
+    assert expected[0] is False and 0 < sum(expected) < len(expected)  # both outcomes decided
