@@ -98,12 +98,17 @@ WRIST_RADIUS = 0.06
 in the grasp (a 1 deg tilt moves its rim 1 mm down)."""
 WRIST_CLEARANCE = 0.01
 """[m] how far above the product near a part's axis the arm's wrist stays with the part at its goal."""
-SIDEWAYS_PIN_AXES = ("+x", "-y")
-"""The horizontal axes (the part's motion) along which the cell puts a part onto a pin of
-the base: those its arm was measured to reach, teaching and assembling, with the base's
-centre at (560, 0) mm. Along -x (towards the arm) the arm stops 36 mm short of the
-demonstration's start there and 10.3 mm short of the goal at (420, 0) mm; along +y the
-assembling cell's transfer ends 17 mm short of the approach (docs/cell.md)."""
+SIDEWAYS_PIN_REACH = {"+x": (0.4475, 0.6575), "-y": (0.4221, 0.6813)}
+"""Where the cell puts a part onto a pin of the base along a horizontal axis: the axes (the
+part's motion) and, on each, the span of the horizontal distance [m] of the pin's free end
+from the arm's base over which its arm was measured to reach the pin, teaching and
+assembling (the block and ring of ``tests/cad/test_horizontal_pins.py`` turned about z and
+placed along x, the free end 30 mm up: along +x its free end 447.5 to 657.5 mm out, along
+-y 422.1 to 681.3 mm, all put on). Along -x (towards the arm) the arm stops 36 mm short of
+the demonstration's start with the base's centre at (560, 0) mm and 10.3 mm short of the
+goal at (420, 0) mm; along +y the assembling cell's transfer ends 17 mm short of the
+approach at (560, 0) mm; along +x with the free end 377.5 mm out, 15.4 mm short
+(docs/cell.md). Nearer or farther, or along another axis, is taken as out of reach."""
 TRAY_START = (0.25, 0.40)
 """The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
 TRAY_PITCH = 0.05
@@ -609,14 +614,27 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) after '{lowest}': the cell puts one part onto a pin, the nearest its root"
     if why := _unresolved(margins(derived)[pid][pin.id]):
         return f"goes onto a pin ({pin.id}) {why}"
-    if pin.axis != "+z" and opposite(pin.axis) not in SIDEWAYS_PIN_AXES:
-        return (f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: the cell's arm was measured to reach a "
-                f"horizontal pin along {' and '.join(SIDEWAYS_PIN_AXES)} only")
+    if pin.axis != "+z" and (why := _unreached(derived, pin)):
+        return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: {why}"
     if pin.axis != "+z" and (why := _wrist_on_pin(derived, pin, pid)):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}, but {why}"
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+def _unreached(derived: Derived, pin: PinFit) -> str:
+    """Why the cell's arm may not reach ``pin`` along its horizontal axis ("" where it was
+    measured to: :data:`SIDEWAYS_PIN_REACH`)."""
+    axis = opposite(pin.axis)
+    if axis not in SIDEWAYS_PIN_REACH:
+        return f"the cell's arm was measured to reach a horizontal pin along {' and '.join(SIDEWAYS_PIN_REACH)} only"
+    x, y, _ = pin_entry(derived, pin)
+    low, high = SIDEWAYS_PIN_REACH[axis]
+    if low - 1e-9 <= (distance := math.hypot(x, y)) <= high + 1e-9:
+        return ""
+    return (f"its free end {1e3 * distance:.1f} mm from the arm's base, out of the {1e3 * low:g} to {1e3 * high:g} mm "
+            f"at which the arm was measured to reach it along {axis}")
 
 
 def _wrist_on_pin(derived: Derived, pin: PinFit, pid: str) -> str:

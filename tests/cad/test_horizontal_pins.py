@@ -19,7 +19,7 @@ import trimesh
 from bridge.product import load_product_description
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad.cli import run_import
+from executor.cad.cli import ImportOptions, run_import
 from executor.cell_description import CellDescription
 from executor.skills.teach import teach_all
 from executor.trial import Cell
@@ -60,9 +60,10 @@ def _cad(folder: Path, bore: float, wall: float | None = None, turn: int = 0) ->
     return folder
 
 
-def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0) -> Path:
+def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0,
+            place: tuple[float, float] | None = None) -> Path:
     cad = _cad(tmp / "cad", bore, wall, turn)
-    run_import(cad, tmp / "out", "mm", tmp / "import.toml")
+    run_import(cad, tmp / "out", "mm", tmp / "import.toml", ImportOptions(place=place))
     return tmp / "out"
 
 
@@ -116,15 +117,20 @@ def test_a_ring_whose_wrist_would_meet_a_wall_of_the_base_is_placed_by_hand(tmp_
         "grip) would meet 'block', 56.000 mm out from the grip within 60 mm of the axis")
 
 
-@pytest.mark.parametrize(("turn", "axis", "by_hand"), [(1, "+x", False), (2, "+y", True), (3, "-x", True)])
-def test_a_ring_onto_a_pin_along_an_axis_the_arm_was_not_seen_to_reach_is_placed_by_hand(
-        tmp_path: Path, turn: int, axis: str, by_hand: bool) -> None:
-    geometry = load_product_description(_import(tmp_path, 10.2, turn=turn)).geometry
+_ONLY = "the cell's arm was measured to reach a horizontal pin along +x and -y only"
+
+
+@pytest.mark.parametrize(("turn", "place", "axis", "why"), [
+    (1, None, "+x", None), (2, None, "+y", _ONLY), (3, None, "-x", _ONLY), (0, (0.42, 0.0), "-y", None),
+    (1, (0.42, 0.0), "+x", "its free end 377.5 mm from the arm's base, out of the 447.5 to 657.5 mm at which the arm "
+                           "was measured to reach it along +x")])
+def test_a_ring_onto_a_pin_where_the_arm_was_not_seen_to_reach_it_is_placed_by_hand(
+        tmp_path: Path, turn: int, place: tuple[float, float] | None, axis: str, why: str | None) -> None:
+    # Turned a quarter turn (1), the pin stands out of the block's -x face: the ring goes on along +x.
+    geometry = load_product_description(_import(tmp_path, 10.2, turn=turn, place=place)).geometry
     assert geometry is not None and geometry.hole_shapes["block_pin1"].axis == axis
-    assert ("ring" in geometry.manual) == by_hand
-    if by_hand:
-        assert geometry.manual["ring"].reason == (f"goes onto a pin (block_pin1) along {axis}: the cell's arm was "
-                                                  "measured to reach a horizontal pin along +x and -y only")
+    reason = geometry.manual["ring"].reason if "ring" in geometry.manual else None
+    assert reason == (None if why is None else f"goes onto a pin (block_pin1) along {axis}: {why}")
 
 
 def test_the_ring_s_pieces_keep_its_bore_under_the_cell_s_hull_margin() -> None:
