@@ -98,13 +98,13 @@ WRIST_RADIUS = 0.06
 in the grasp (a 1 deg tilt moves its rim 1 mm down)."""
 WRIST_CLEARANCE = 0.01
 """[m] how far above the product near a part's axis the arm's wrist stays with the part at its goal."""
-SIDEWAYS_PIN_REACH = {"+x": (0.4475, 0.6575), "-y": (0.4221, 0.6813)}
+SIDEWAYS_PIN_REACH = {"+x": (0.4475, 0.6575), "-y": (0.35258, 0.70128)}
 """Where the cell puts a part onto a pin of the base along a horizontal axis: the axes (the
 part's motion) and, on each, the span of the horizontal distance [m] of the pin's free end
 from the arm's base over which its arm was measured to reach the pin, teaching and
 assembling (the block and ring of ``tests/cad/test_horizontal_pins.py`` turned about z and
 placed along x, the free end 30 mm up: along +x its free end 447.5 to 657.5 mm out, along
--y 422.1 to 681.3 mm, all put on). Along -x (towards the arm) the arm stops 36 mm short of
+-y 352.6 to 701.3 mm, all put on). Along -x (towards the arm) the arm stops 36 mm short of
 the demonstration's start with the base's centre at (560, 0) mm and 10.3 mm short of the
 goal at (420, 0) mm; along +y the assembling cell's transfer ends 17 mm short of the
 approach at (560, 0) mm; along +x with the free end 377.5 mm out, 15.4 mm short
