@@ -20,6 +20,7 @@ from bridge.product import load_product_description
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad.cli import ImportOptions, run_import
+from executor.cad.write import _highest_near
 from executor.cell_description import CellDescription
 from executor.skills.teach import teach_all
 from executor.trial import Cell
@@ -115,6 +116,18 @@ def test_a_ring_whose_wrist_would_meet_a_wall_of_the_base_is_placed_by_hand(tmp_
     assert near.manual["ring"].reason == (
         "goes onto a pin (block_pin1) along -y, but the arm's wrist (60 mm about the tool's axis, 60 mm out from the "
         "grip) would meet 'block', 56.000 mm out from the grip within 60 mm of the axis")
+
+
+def test_the_wrist_s_rule_leaves_out_the_pin_it_passes_around() -> None:
+    # A plate 10 mm thick with a d 10 pin standing 80 mm out of it: within 60 mm of the
+    # pin's axis the pin is what stands farthest out, the plate outside a 32-gon about it.
+    plate = trimesh.creation.box((0.1, 0.1, 0.01))
+    plate.apply_translation((0.0, 0.0, 0.005))
+    pin = trimesh.creation.cylinder(radius=0.005, height=0.08, sections=64)
+    pin.apply_translation((0.0, 0.0, 0.04))
+    base = trimesh.boolean.union([plate, pin], engine="manifold")
+    assert _highest_near(base, (0.0, 0.0), 0.06) == pytest.approx(0.08)
+    assert _highest_near(base, (0.0, 0.0), 0.06, 0.006) == pytest.approx(0.01)
 
 
 _ONLY = "the cell's arm was measured to reach a horizontal pin along +x and -y only"
