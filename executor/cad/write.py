@@ -98,6 +98,17 @@ WRIST_RADIUS = 0.06
 in the grasp (a 1 deg tilt moves its rim 1 mm down)."""
 WRIST_CLEARANCE = 0.01
 """[m] how far above the product near a part's axis the arm's wrist stays with the part at its goal."""
+SIDEWAYS_PIN_REACH = {"+x": (0.4475, 0.6575), "-y": (0.35258, 0.70128)}
+"""Where the cell puts a part onto a pin of the base along a horizontal axis: the axes (the
+part's motion) and, on each, the span of the horizontal distance [m] of the pin's free end
+from the arm's base over which its arm was measured to reach the pin, teaching and
+assembling (the block and ring of ``tests/cad/test_horizontal_pins.py`` turned about z and
+placed along x, the free end 30 mm up: along +x its free end 447.5 to 657.5 mm out, along
+-y 352.6 to 701.3 mm, all put on). Along -x (towards the arm) the arm stops 36 mm short of
+the demonstration's start with the base's centre at (560, 0) mm and 10.3 mm short of the
+goal at (420, 0) mm; along +y the assembling cell's transfer ends 17 mm short of the
+approach at (560, 0) mm; along +x with the free end 377.5 mm out, 15.4 mm short
+(docs/cell.md). Nearer or farther, or along another axis, is taken as out of reach."""
 TRAY_START = (0.25, 0.40)
 """The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
 TRAY_PITCH = 0.05
@@ -527,14 +538,20 @@ def _unresolved_in_hole(derived: Derived, cell: Derived) -> dict[str, str]:
             and not (plate and (fit.part, hid) in nominal)}
 
 
-def _highest_near(mesh: trimesh.Trimesh, xy: tuple[float, float], radius: float) -> float | None:
+def _highest_near(mesh: trimesh.Trimesh, xy: tuple[float, float], radius: float, inner: float = 0.0) -> float | None:
     """The highest point [m] of ``mesh`` within ``radius`` [m] of the vertical line through
-    ``xy`` [m] (within the 32-gon prism circumscribing that circle), None where it has none."""
+    ``xy`` [m] (within the 32-gon prism circumscribing that circle) and outside the 32-gon
+    prism circumscribing the circle of radius ``inner`` [m] about it (0: none), None where it
+    has none."""
     turns = np.arange(32) * 2 * math.pi / 32
     out = np.c_[np.cos(turns), np.sin(turns), np.zeros(32)]
-    origins = out * radius / math.cos(math.pi / 32) + np.array([xy[0], xy[1], 0.0])
-    inside = trimesh.intersections.slice_mesh_plane(mesh, -out, origins)
-    return float(inside.bounds[1][2]) if len(inside.faces) else None
+    centre = np.array([xy[0], xy[1], 0.0])
+    inside = trimesh.intersections.slice_mesh_plane(mesh, -out, out * radius / math.cos(math.pi / 32) + centre)
+    if not len(inside.faces) or inner <= 0:
+        return float(inside.bounds[1][2]) if len(inside.faces) else None
+    # outside a convex prism: the union of the half-spaces beyond its sides
+    beyond = [trimesh.intersections.slice_mesh_plane(inside, side, side * inner + centre) for side in out]
+    return max((float(piece.bounds[1][2]) for piece in beyond if len(piece.faces)), default=None)
 
 
 def tool_length(derived: Derived) -> tuple[float | None, str]:
@@ -597,9 +614,56 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) after '{lowest}': the cell puts one part onto a pin, the nearest its root"
     if why := _unresolved(margins(derived)[pid][pin.id]):
         return f"goes onto a pin ({pin.id}) {why}"
+    if pin.axis != "+z" and (why := _unreached(derived, pin)):
+        return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: {why}"
+    if pin.axis != "+z" and (why := _wrist_on_pin(derived, pin, pid)):
+        return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}, but {why}"
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+def _unreached(derived: Derived, pin: PinFit) -> str:
+    """Why the cell's arm may not reach ``pin`` along its horizontal axis ("" where it was
+    measured to: :data:`SIDEWAYS_PIN_REACH`)."""
+    axis = opposite(pin.axis)
+    if axis not in SIDEWAYS_PIN_REACH:
+        return f"the cell's arm was measured to reach a horizontal pin along {' and '.join(SIDEWAYS_PIN_REACH)} only"
+    x, y, _ = pin_entry(derived, pin)
+    low, high = SIDEWAYS_PIN_REACH[axis]
+    if low - 1e-9 <= (distance := math.hypot(x, y)) <= high + 1e-9:
+        return ""
+    return (f"its free end {1e3 * distance:.1f} mm from the arm's base, out of the {1e3 * low:g} to {1e3 * high:g} mm "
+            f"at which the arm was measured to reach it along {axis}")
+
+
+def _wrist_on_pin(derived: Derived, pin: PinFit, pid: str) -> str:
+    """Why the arm's wrist would meet the product with part ``pid`` at its goal on ``pin``
+    along a horizontal axis ("" where it would not): :func:`tool_length`'s rule in the pin's
+    frame (z out along its axis). The part is held :data:`GRIPPER`'s grasp depth deep (at
+    most half its length) from its outer end, the wrist (:data:`WRIST_RADIUS` about the
+    tool's axis) starts the default flange beyond, and every part that may be in place (any
+    but those the geometric precedence puts after ``pid``) and the base outside the pin
+    itself (its section's half diagonal about the axis, the gripper's fingers beside it) must
+    end :data:`WRIST_CLEARANCE` short of it within that radius of the axis. Any longer flange
+    the product gets keeps this: the wrist only moves farther out along the axis."""
+    graph = nx.DiGraph()
+    graph.add_nodes_from(derived.parts)
+    graph.add_edges_from(derived.edges)
+    turn = _turn(pin)
+    along = _along(derived.parts[pid].mesh, pin)[:, 2]
+    low, high = float(along.min()), float(along.max())
+    grip = high - min(GRIPPER["grasp_depth"], (high - low) / 2)
+    centre = (float(pin.section.centre[0]), float(pin.section.centre[1]))
+    pin_reach = math.hypot(pin.section.a, pin.section.b) / 2 + NEAR
+    for other in sorted(set(derived.parts) - nx.descendants(graph, pid) - {pid}):
+        mesh = derived.parts[other].mesh.copy().apply_transform(turn)
+        top = _highest_near(mesh, centre, WRIST_RADIUS, pin_reach if other == pin.owner else 0.0)
+        if top is not None and top - grip + WRIST_CLEARANCE > GRIPPER["flange_length"] + 1e-9:
+            return (f"the arm's wrist ({1e3 * WRIST_RADIUS:g} mm about the tool's axis, "
+                    f"{1e3 * GRIPPER['flange_length']:g} mm out from the grip) would meet '{other}', "
+                    f"{1e3 * (top - grip):.3f} mm out from the grip within {1e3 * WRIST_RADIUS:g} mm of the axis")
+    return ""
 
 
 def bore_pieces(derived: Derived, pid: str) -> Pieces:

@@ -19,7 +19,8 @@ import trimesh
 from bridge.product import load_product_description
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad.cli import run_import
+from executor.cad.cli import ImportOptions, run_import
+from executor.cad.write import _highest_near
 from executor.cell_description import CellDescription
 from executor.skills.teach import teach_all
 from executor.trial import Cell
@@ -31,30 +32,39 @@ PIN = 10.0
 """The pin's diameter [mm] (a 64-gon's vertex circle)."""
 
 
-def _cad(folder: Path, bore: float) -> Path:
+def _cad(folder: Path, bore: float, wall: float | None = None, turn: int = 0) -> Path:
     """The block (60 x 50 x 60 mm on the floor) with the pin from its +y face (y 25) to y 60,
     30 mm up, and the ring with a round ``bore`` [mm] (a 128-gon) against that face, as STL
-    files [mm] in ``folder``, and the import settings beside it."""
+    files [mm] in ``folder``, and the import settings beside it; with a ``wall`` [mm], a
+    10 mm wall beside the pin (x 20 to 30 mm, as high as the block) reaches that far out of
+    the block's +y face; all turned ``turn`` quarter turns about z."""
     folder.mkdir(parents=True)
     block = trimesh.creation.box((60.0, 50.0, 60.0))
     block.apply_translation((0.0, 0.0, 30.0))
     pin = trimesh.creation.cylinder(radius=PIN / 2, height=40.0, sections=64)
     pin.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1.0, 0.0, 0.0)))
     pin.apply_translation((0.0, 40.0, 30.0))
-    trimesh.boolean.union([block, pin], engine="manifold").export(folder / "block.stl")
+    solids = [block, pin]
+    if wall is not None:
+        side = trimesh.creation.box((10.0, wall, 60.0))
+        side.apply_translation((25.0, 25.0 + wall / 2, 30.0))
+        solids.append(side)
     section = shapely.Point(0, 0).buffer(12.0, quad_segs=32).difference(shapely.Point(0, 0).buffer(bore / 2,
                                                                                                     quad_segs=32))
     ring = trimesh.creation.extrude_polygon(section, 8.0)
     ring.apply_transform(trimesh.transformations.rotation_matrix(-np.pi / 2, (1.0, 0.0, 0.0)))  # its axis along y
     ring.apply_translation((0.0, 25.0, 30.0))
-    ring.export(folder / "ring.stl")
+    quarter = trimesh.transformations.rotation_matrix(turn * np.pi / 2, (0.0, 0.0, 1.0))
+    trimesh.boolean.union(solids, engine="manifold").apply_transform(quarter).export(folder / "block.stl")
+    ring.apply_transform(quarter).export(folder / "ring.stl")
     (folder.parent / "import.toml").write_text('base = "block"\n')
     return folder
 
 
-def _import(tmp: Path, bore: float) -> Path:
-    cad = _cad(tmp / "cad", bore)
-    run_import(cad, tmp / "out", "mm", tmp / "import.toml")
+def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0,
+            place: tuple[float, float] | None = None) -> Path:
+    cad = _cad(tmp / "cad", bore, wall, turn)
+    run_import(cad, tmp / "out", "mm", tmp / "import.toml", ImportOptions(place=place))
     return tmp / "out"
 
 
@@ -92,6 +102,48 @@ def test_a_ring_with_no_room_on_a_horizontal_pin_is_placed_by_hand(tmp_path: Pat
     assert geometry is not None
     assert geometry.manual["ring"].reason == ("goes onto a pin (block_pin1) with +0.0000 mm of room per side, less "
                                               "than the 0.025 mm the simulated cell resolves")
+
+
+def test_a_ring_whose_wrist_would_meet_a_wall_of_the_base_is_placed_by_hand(tmp_path: Path) -> None:
+    # The wrist starts 60 mm beyond the grip (4 mm out from the block's face, half the
+    # ring's 8 mm) and must stay 10 mm short of the base within 60 mm of the pin's axis:
+    # a wall beside the pin reaching 50 mm out keeps it clear, one reaching 60 mm does not
+    # (the base of a pin is no obstacle to the simulated wrist, which passes through it).
+    clear = load_product_description(_import(tmp_path / "far", 10.2, wall=50.0)).geometry
+    assert clear is not None and clear.manual == {}
+    near = load_product_description(_import(tmp_path / "near", 10.2, wall=60.0)).geometry
+    assert near is not None
+    assert near.manual["ring"].reason == (
+        "goes onto a pin (block_pin1) along -y, but the arm's wrist (60 mm about the tool's axis, 60 mm out from the "
+        "grip) would meet 'block', 56.000 mm out from the grip within 60 mm of the axis")
+
+
+def test_the_wrist_s_rule_leaves_out_the_pin_it_passes_around() -> None:
+    # A plate 10 mm thick with a d 10 pin standing 80 mm out of it: within 60 mm of the
+    # pin's axis the pin is what stands farthest out, the plate outside a 32-gon about it.
+    plate = trimesh.creation.box((0.1, 0.1, 0.01))
+    plate.apply_translation((0.0, 0.0, 0.005))
+    pin = trimesh.creation.cylinder(radius=0.005, height=0.08, sections=64)
+    pin.apply_translation((0.0, 0.0, 0.04))
+    base = trimesh.boolean.union([plate, pin], engine="manifold")
+    assert _highest_near(base, (0.0, 0.0), 0.06) == pytest.approx(0.08)
+    assert _highest_near(base, (0.0, 0.0), 0.06, 0.006) == pytest.approx(0.01)
+
+
+_ONLY = "the cell's arm was measured to reach a horizontal pin along +x and -y only"
+
+
+@pytest.mark.parametrize(("turn", "place", "axis", "why"), [
+    (1, None, "+x", None), (2, None, "+y", _ONLY), (3, None, "-x", _ONLY), (0, (0.42, 0.0), "-y", None),
+    (1, (0.42, 0.0), "+x", "its free end 377.5 mm from the arm's base, out of the 447.5 to 657.5 mm at which the arm "
+                           "was measured to reach it along +x")])
+def test_a_ring_onto_a_pin_where_the_arm_was_not_seen_to_reach_it_is_placed_by_hand(
+        tmp_path: Path, turn: int, place: tuple[float, float] | None, axis: str, why: str | None) -> None:
+    # Turned a quarter turn (1), the pin stands out of the block's -x face: the ring goes on along +x.
+    geometry = load_product_description(_import(tmp_path, 10.2, turn=turn, place=place)).geometry
+    assert geometry is not None and geometry.hole_shapes["block_pin1"].axis == axis
+    reason = geometry.manual["ring"].reason if "ring" in geometry.manual else None
+    assert reason == (None if why is None else f"goes onto a pin (block_pin1) along {axis}: {why}")
 
 
 def test_the_ring_s_pieces_keep_its_bore_under_the_cell_s_hull_margin() -> None:
