@@ -20,7 +20,7 @@ pytest.importorskip("mujoco")
 from executor import ExecutorError  # noqa: E402
 from executor.franka.guide import REST_SPEED, Recording, demonstration_span, resample  # noqa: E402
 from executor.world.scene import TIME_STEP  # noqa: E402
-from tests.franka import franka_cell_description
+from tests.franka import SIM_DYNAMICS, franka_cell_description
 
 TRIO = Path(__file__).parent / "data" / "trio"
 LOG = logging.getLogger(__name__)  # the figures of the run (pytest --log-cli-level=INFO shows them)
@@ -113,7 +113,7 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
                 hands.append(sim.guide("p1", path, hold=2.0))
 
         hands: list = []
-        options = franka_options({"host": sim.host, "realtime": "ignore", "dynamics": "0.5"})
+        options = franka_options({"host": sim.host, "realtime": "ignore", "dynamics": SIM_DYNAMICS})
         cell = FrankaCell(geometry, description, layer_named("full"), options)
         try:
             skill = teach_shape(FrankaTeacher(cell), "peg_d10", HandGuiding(prompt, timeout=30.0))
