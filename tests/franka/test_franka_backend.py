@@ -27,7 +27,7 @@ from executor.backend_plugin import InvalidStep  # noqa: E402
 from executor.franka.backend import FrankaBackend, franka_starter  # noqa: E402
 from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
 from executor.world.geometry import CellGeometry, load_geometry  # noqa: E402
-from tests.franka import franka_cell_description, parts_moved
+from tests.franka import SIM_DYNAMICS, franka_cell_description, parts_moved
 
 # The tests drive the simulated arm: long, one arm on the machine at a time, on demand (-m franka_arm).
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtures("one_simulated_arm"),
@@ -44,7 +44,7 @@ def _arm(tmp_path: Path, product: str, moved: tuple[str, float] | None = None
     world = folder if moved is None else parts_moved(folder, tmp_path / "world", moved[1], {moved[0]})
     with sim_robot(world) as sim:
         settings = ServeSettings(backend="franka", assembly=str(folder),
-                                 backend_options={"host": sim.host, "realtime": "ignore", "dynamics": "0.5"},
+                                 backend_options={"host": sim.host, "realtime": "ignore", "dynamics": SIM_DYNAMICS},
                                  cell=CellSettings(layer="pi_phase_stop", description=str(description)))
         backend = franka_starter(settings)()
         try:

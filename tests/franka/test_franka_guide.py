@@ -20,9 +20,10 @@ pytest.importorskip("mujoco")
 from executor import ExecutorError  # noqa: E402
 from executor.franka.guide import REST_SPEED, Recording, demonstration_span, resample  # noqa: E402
 from executor.world.scene import TIME_STEP  # noqa: E402
-from tests.franka import franka_cell_description
+from tests.franka import SIM_DYNAMICS, franka_cell_description
 
 TRIO = Path(__file__).parent / "data" / "trio"
+DUO = Path(__file__).parent / "data" / "duo"  # its pegs stand in front of their holes: short carrying moves
 LOG = logging.getLogger(__name__)  # the figures of the run (pytest --log-cli-level=INFO shows them)
 
 
@@ -96,7 +97,7 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
     from executor.skills.teach import DEMO_START_HEIGHT, teach_shape
     from executor.world.geometry import load_geometry
 
-    folder = Path(shutil.copytree(TRIO, tmp_path / "trio", ignore=shutil.ignore_patterns("assets", "demonstrations")))
+    folder = Path(shutil.copytree(DUO, tmp_path / "duo", ignore=shutil.ignore_patterns("assets", "demonstrations")))
     description_file = franka_cell_description(tmp_path)
     description = load_cell_description(str(description_file))
     geometry = load_geometry(str(folder), description)
@@ -113,7 +114,7 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
                 hands.append(sim.guide("p1", path, hold=2.0))
 
         hands: list = []
-        options = franka_options({"host": sim.host, "realtime": "ignore", "dynamics": "0.5"})
+        options = franka_options({"host": sim.host, "realtime": "ignore", "dynamics": SIM_DYNAMICS})
         cell = FrankaCell(geometry, description, layer_named("full"), options)
         try:
             skill = teach_shape(FrankaTeacher(cell), "peg_d10", HandGuiding(prompt, timeout=30.0))

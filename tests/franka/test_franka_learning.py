@@ -43,7 +43,7 @@ from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
 from executor.serve.truth import sizes_truth  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
 from tests.conftest import simulated_arm_lock
-from tests.franka import franka_cell_description, parts_moved
+from tests.franka import SIM_DYNAMICS, franka_cell_description, parts_moved
 
 DUO = Path(__file__).parent / "data" / "duo"
 DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2")}
@@ -80,7 +80,7 @@ def taught(tmp_path_factory: pytest.TempPathFactory, run_executor) -> Iterator[T
     folder = Path(shutil.copytree(DUO, tmp / "duo", ignore=shutil.ignore_patterns("assets", "demonstrations")))
     description = franka_cell_description(tmp)
     with simulated_arm_lock(), sim_robot(parts_moved(folder, tmp / "world", GRASP_ERROR)) as sim:
-        options = {"host": sim.host, "realtime": "ignore", "dynamics": "0.5"}
+        options = {"host": sim.host, "realtime": "ignore", "dynamics": SIM_DYNAMICS}
         arm = (*(arg for key, value in options.items() for arg in ("--backend-option", f"{key}={value}")),
                "--cell-description", str(description))
         try:
