@@ -50,9 +50,8 @@ def test_real_results_do_not_depend_on_scheduling() -> None:
     pairs = select_pairs("tp:r1,p1:s1")  # fits, cheaper than blocked parts (no_fit: the campaign above)
     factory = functools.partial(CellRunner, "cranfield")
     with stdout_to_stderr():
-        # A worker takes a pair's trials in turn: one trial per pair, the pairs shared out.
-        one = run_campaign(pairs, trials=1, seed=7, workers=1, factory=factory)
-        two = run_campaign(pairs, trials=1, seed=7, workers=2, factory=factory)
+        one = run_campaign(pairs, trials=2, seed=7, workers=1, factory=factory)
+        two = run_campaign(pairs, trials=2, seed=7, workers=2, factory=factory)
 
     def outcomes(results: list[list[dict]]) -> list:
         return [[(r["outcome"], r["attempts"]) for r in row] for row in results]
@@ -63,4 +62,4 @@ def test_real_results_do_not_depend_on_scheduling() -> None:
     assert outcomes(one) == outcomes(two)
     # Two workers are other processes: the figures within what cannot change an outcome.
     assert np.all(np.abs(figures(one) - figures(two)) < [FORCE_BOUND, END_BOUND])
-    assert [r["outcome"] for row in one for r in row] == ["fit"] * 2
+    assert [r["outcome"] for row in one for r in row] == ["fit"] * 4
