@@ -174,10 +174,11 @@ def test_a_ring_onto_a_horizontal_pin_is_assembled_within_2_mm(taught: Path) -> 
     assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.02)  # along the pin's axis
 
 
-@pytest.mark.slow  # teaches the ring (shared), then one trial of two attempts in physics (about 25 s under load)
+@pytest.mark.slow  # teaches the ring (shared), then one attempt in physics (about 12 s under load)
 def test_a_pin_wider_than_the_bore_stops_the_ring_at_its_end_in_physics(taught: Path, tmp_path: Path) -> None:
     # The block (its own mesh) widened by 3 % about the pin's axis: a d 10.3 pin, the ring's
-    # bore d 10.197 as measured: 0.05 mm of interference per side.
+    # bore d 10.197 as measured: 0.05 mm of interference per side. One attempt: the trial's
+    # second one after a no-fit is tests/executor/test_executor_cell.py's.
     wide = tmp_path / "wide"
     shutil.copytree(taught, wide)
     geometry = load_product_description(wide)
@@ -195,7 +196,7 @@ def test_a_pin_wider_than_the_bore_stops_the_ring_at_its_end_in_physics(taught: 
     text.write_text(text.read_text().replace(old, hashlib.sha256(mesh_file.read_bytes()).hexdigest()))
     cell = Cell(str(wide))
     try:
-        refused = cell.run_trial("ring", "block_pin1", 0)
+        refused = cell.run_trial("ring", "block_pin1", 0, max_attempts=1)
     finally:
         cell.close()
     assert refused.outcome == "no_fit" and refused.end_error > 0.02  # stopped at the pin's end, 34 mm out

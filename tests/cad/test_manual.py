@@ -8,6 +8,7 @@ and the sim cell puts it where the CAD has it (fixed there); the truth backend a
 from __future__ import annotations
 
 import json
+import shutil
 import tomllib
 from pathlib import Path
 
@@ -39,6 +40,18 @@ def _lid_on_pins(tmp_path: Path, x_mm: float = X_MM, *options: str) -> Path:
     return tmp_path / "out"
 
 
+@pytest.fixture(scope="module")
+def lid_on_pins(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The product of :func:`_lid_on_pins` drawn at :data:`X_MM`, imported once for the
+    module (a test that changes its files works on a copy: :func:`_copy`)."""
+    return _lid_on_pins(tmp_path_factory.mktemp("lid"))
+
+
+def _copy(folder: Path, tmp_path: Path) -> Path:
+    """A copy of the imported product ``folder`` in ``tmp_path``, to change."""
+    return Path(shutil.copytree(folder, tmp_path / "out"))
+
+
 def _positions(folder: Path) -> dict[str, list[float]]:
     """Every position [m] of ``assembly.toml`` and ``geometry.toml`` by its table's path, the
     parts' waiting trays left out (they are the cell's, not the product's)."""
@@ -58,16 +71,12 @@ def _positions(folder: Path) -> dict[str, list[float]]:
 
 @pytest.mark.parametrize("options", [(), ("--place", "0.56,0")])
 def test_a_product_drawn_at_the_origin_is_placed_where_the_arm_reaches(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str], options: tuple[str, ...]) -> None:
-    for name in ("origin", "cell"):
-        (tmp_path / name).mkdir()
-    placed = _lid_on_pins(tmp_path / "origin", 0.0, *options)
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], options: tuple[str, ...], lid_on_pins: Path) -> None:
+    placed = _lid_on_pins(tmp_path, 0.0, *options)
     printed = capsys.readouterr().out
     assert "the base's centre placed at (560.000, 0.000) mm in the cell (" + (
         "place" if options else "the base's centre 0.000 mm from the arm's base is out of its reach") in printed
-    drawn = _lid_on_pins(tmp_path / "cell")  # drawn where the arm reaches: kept as it is drawn
-    assert "the CAD frame is the cell frame (the base's centre 560.000 mm from the arm's base" in \
-        capsys.readouterr().out
+    drawn = lid_on_pins  # drawn where the arm reaches: kept as it is drawn
     expected, got = _positions(drawn), _positions(placed)
     assert len(got) >= 4 and set(got) == set(expected)  # the holes, the plate, the lid
     for key, value in got.items():
@@ -109,10 +118,12 @@ def _session(run_main: Runner, folder: Path, out: Path, backend: str) -> dict:
 
 def test_a_part_on_pin_tops_is_written_to_be_placed_by_hand(tmp_path: Path,
                                                            capsys: pytest.CaptureFixture[str]) -> None:
-    out = _lid_on_pins(tmp_path)
+    out = _lid_on_pins(tmp_path)  # its own import, for what it prints
     printed = capsys.readouterr().out
     assert "manual lid: the cell has no operation for it, a plan's step places it by hand (part 'lid' is no peg" \
         in printed and ", geometry.toml;" in printed
+    # drawn where the arm reaches: kept as it is drawn
+    assert "the CAD frame is the cell frame (the base's centre 560.000 mm from the arm's base" in printed
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     manual = geometry["manual"]["lid"]
     assert "no pin passes through it" in manual["reason"]
@@ -138,9 +149,8 @@ def test_a_peg_no_longer_than_the_grasp_is_placed_by_hand(tmp_path: Path, capsys
 
 @pytest.mark.slow
 def test_truth_sessions_run_with_a_part_placed_by_hand_and_without_geometry(
-        run_main: Runner, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    out = _lid_on_pins(tmp_path)
-    capsys.readouterr()
+        run_main: Runner, tmp_path: Path, lid_on_pins: Path) -> None:
+    out = _copy(lid_on_pins, tmp_path)
     result = _session(run_main, out, tmp_path / "truth", "truth")
     steps = {step["part"]: step for step in result["assembly"]["steps"]}
     assert result["assembly"]["assembled"] and steps["lid"]["skill"] == "manual"
@@ -155,10 +165,10 @@ def test_truth_sessions_run_with_a_part_placed_by_hand_and_without_geometry(
 
 @pytest.mark.slow  # teaches the pegs, assembles the product in physics
 def test_the_sim_cell_places_the_part_by_hand_where_the_cad_has_it(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], lid_on_pins: Path) -> None:
     # The plan of the import's relation (a session learning it: the truth sessions above),
     # assembled by the sim cell: the pegs inserted, the lid set where the CAD has it.
-    out = _lid_on_pins(tmp_path)
+    out = _copy(lid_on_pins, tmp_path)
     assert main(["-q", "executor", "teach", "--assembly", str(out)]) == 0
     capsys.readouterr()
     assert main(["assemble", *_facts(out), "--assembly", str(out), "--json"]) == 0
@@ -245,8 +255,8 @@ def test_the_report_names_the_feature_a_part_placed_by_hand_is_on(
      "[manual.lid] held_by: expected parts the cell places (of [part_shapes.*]), got 'lid'"),
 ])
 def test_a_bad_manual_table_is_one_line_naming_it(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                  old: str, new: str, expected: str) -> None:
-    out = _lid_on_pins(tmp_path)
+                                                  old: str, new: str, expected: str, lid_on_pins: Path) -> None:
+    out = _copy(lid_on_pins, tmp_path)
     text = (out / "geometry.toml").read_text()
     assert old in text
     (out / "geometry.toml").write_text(text.replace(old, new))

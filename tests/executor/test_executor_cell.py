@@ -88,16 +88,23 @@ def test_same_seed_same_trial_another_seed_another(cell):
 
 @pytest.mark.slow
 def test_same_seed_same_trial_in_other_processes(root, cli_env):
-    """The same outcome in two processes, each after its cell switched part shapes; the
-    figures within the bounds another process (maybe another CPU) may move them by."""
+    """The same outcome in two processes (a child and this one), each in a fresh cell after it
+    switched part shapes; the figures within the bounds another process (maybe another CPU)
+    may move them by."""
     code = ("import json; from executor.trial import Cell; c = Cell(); "
             "c.run_trial('p1', 'r1', 3); "
             "r = c.run_trial('tp', 'r1', 3).to_json(); "
             "print(json.dumps([r['outcome'], r['attempts'], r['max_force_dev'], r['max_torque_dev'], r['end_error']]))")
-    procs = [subprocess.Popen([sys.executable, "-c", code], cwd=root, stdout=subprocess.PIPE,
-                              stderr=subprocess.DEVNULL, text=True, env=cli_env)
-             for _ in range(2)]
-    runs = [json.loads(p.communicate(timeout=240)[0]) for p in procs]
+    child = subprocess.Popen([sys.executable, "-c", code], cwd=root, stdout=subprocess.PIPE,
+                             stderr=subprocess.DEVNULL, text=True, env=cli_env)
+    here = Cell()
+    try:
+        here.run_trial("p1", "r1", 3)
+        mine = here.run_trial("tp", "r1", 3).to_json()
+    finally:
+        here.close()
+    runs = [json.loads(child.communicate(timeout=240)[0]),
+            [mine[key] for key in ("outcome", "attempts", "max_force_dev", "max_torque_dev", "end_error")]]
     assert all(run[:2] == ["fit", 1] for run in runs), runs
     figures = np.array([run[2:] for run in runs])
     # The tight peg's 0.1 mm-clearance contact: force and torque within the thresholds'

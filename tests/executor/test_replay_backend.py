@@ -1,5 +1,6 @@
 """``executor serve --backend MODULE:CLASS``: a user's backend loaded by name; the replay
-backend (executor.replay) answers from a recorded session's journal."""
+backend (executor.replay) answers from a recorded session's journal. The commands run in
+this process (``run_main``); the cells are processes of their own."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from bridge.session import free_loopback_endpoint
 from executor import ExecutorError
 from executor.backend_plugin import CellContext, UnknownPair
 from executor.replay import ReplayBackend
+from tests.conftest import TRUTH_SESSION, Runner
 
 REPLAY = "executor.replay:ReplayBackend"
 
@@ -46,19 +48,24 @@ def test_a_bad_journal_line_is_named(tmp_path: Path) -> None:
         ReplayBackend(CellContext("c1", "cranfield", options={"journal": str(journal)}))
 
 
-@pytest.mark.slow
-def test_bad_backend_names_exit_2_with_one_line(run_executor, tmp_path: Path) -> None:
+@pytest.mark.slow  # the cell's imports (about 3 s)
+def test_bad_backend_names_exit_2_with_one_line(run_main: Runner, tmp_path: Path) -> None:
     for argv, expected in [(["--backend", "no_such_module:Backend"], "cannot import no_such_module"),
                            (["--backend", "executor.replay:Nope"],
                             "expected a class Nope in executor.replay"),
                            (["--backend", REPLAY], "needs --backend-option journal=")]:
-        done = run_executor("serve", *argv, cwd=tmp_path, timeout=60)
+        done = run_main("executor", "serve", *argv, cwd=tmp_path, timeout=60)
         assert done.returncode == 2 and expected in done.stderr and len(done.stderr.splitlines()) == 1, done.stderr
 
 
 @pytest.mark.slow
 def test_a_session_against_a_replay_cell_repeats_the_recorded_session(
-        run_session, cells: list[CellProcess], tmp_path: Path) -> None:
+        run_main: Runner, cells: list[CellProcess], tmp_path: Path) -> None:
+    def run_session(*args: str) -> dict:
+        done = run_main(*TRUTH_SESSION, *args, timeout=60)
+        assert done.returncode == 0, done.stderr
+        return json.loads(done.stdout)
+
     recorded = run_session("--out", str(tmp_path / "recorded"))
     endpoint = free_loopback_endpoint()
     cell = CellProcess(ServeSettings(cell_id="c1", backend=REPLAY, listen=(endpoint,),

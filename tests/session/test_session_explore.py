@@ -1,7 +1,7 @@
 """``session --precedence explore``: precedence and sizes in one session from at most 2
-demonstrations and precedence experiments at the session's own cell (real processes:
-planner, ``executor serve``, Zenoh on loopback); a resumed exploration runs no journaled
-experiment again."""
+demonstrations and precedence experiments at the session's own cell (the session in the
+test's process, ``executor serve`` a process of its own, Zenoh on loopback); a resumed
+exploration runs no journaled experiment again."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ from asp.precedence.relation import Relation, true_relation
 from asp.session.precedence import PRECEDENCE_JOURNAL, explore_precedence
 from bridge.assembly import load_assembly
 from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
+from tests.conftest import TRUTH_SESSION, Runner
 
 
 def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
@@ -66,9 +67,11 @@ def test_a_resumed_exploration_runs_no_journaled_experiment_again(tmp_path: Path
 
 @pytest.mark.slow
 @pytest.mark.timeout(180)
-def test_truth_cell_session_explores_cranfield_to_its_exact_relation(tmp_path: Path, run_session) -> None:
+def test_truth_cell_session_explores_cranfield_to_its_exact_relation(tmp_path: Path, run_main: Runner) -> None:
     run = tmp_path / "run"
-    result = run_session("--precedence", "explore", "--out", str(run), timeout=150)
+    done = run_main(*TRUTH_SESSION, "--precedence", "explore", "--out", str(run), timeout=150)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
     assert result["matches_truth"] is True
     _learned_exactly_the_truth(run, "cranfield")
     explored = json.loads((run / "session.json").read_text())["precedence_explored"]
@@ -82,12 +85,12 @@ def test_truth_cell_session_explores_cranfield_to_its_exact_relation(tmp_path: P
 @pytest.mark.slow
 @pytest.mark.timeout(400)
 def test_sim_cell_session_explores_a_small_product_in_physics_with_the_layer_it_was_given(
-        tmp_path: Path, run_cli) -> None:
+        tmp_path: Path, run_main: Runner) -> None:
     """``--layer pi_phase_stop`` (no ILC) and a smaller vision error reach the cell: it
     learns nothing across executions, so no ILC state appears in the run folder (the
     default layer writes one at the first fit: ``tests/session/test_session_sim.py``)."""
     run = tmp_path / "run"
-    done = run_cli("session", "--json", "--assembly", "spare", "--precedence", "explore", "--layer", "pi_phase_stop",
+    done = run_main("session", "--json", "--assembly", "spare", "--precedence", "explore", "--layer", "pi_phase_stop",
                    "--vision-sigma", "0.001", "--out", str(run), timeout=360)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["matches_truth"] is True
