@@ -109,14 +109,18 @@ the demonstration's start with the base's centre at (560, 0) mm and 10.3 mm shor
 goal at (420, 0) mm; along +y the assembling cell's transfer ends 17 mm short of the
 approach at (560, 0) mm; along +x with the free end 377.5 mm out, 15.4 mm short
 (docs/cell.md). Nearer or farther, or along another axis, is taken as out of reach."""
-SIDEWAYS_HOLE_REACH = {"-y": (0.30104, 0.65048)}
+SIDEWAYS_HOLE_REACH = {"+x": (0.4925, 0.8725), "-y": (0.25125, 0.68045)}
 """Where the cell inserts a peg into a hole of the base entered sideways: the axes (the
 peg's motion) and, on each, the span of the horizontal distance [m] of the hole's entry
 centre from the arm's base over which its arm was measured to reach it, teaching and
-assembling (``agh_hex_horizontal`` of ``tests/cad/test_sideways.py`` turned about z and
-placed along x, the entry 30 mm up; docs/import.md). The wrist is 185 mm beyond the entry
-there, farther than on a pin: the pins' spans do not carry over. Nearer or farther, or
-along another axis, is taken as out of reach."""
+assembling (``agh_hex_horizontal`` of ``tests/cad/test_sideways.py``, along +x its hole
+closed at the far end, turned about z and placed along x, the entry 30 mm up: along +x
+492.5 to 872.5 mm out, along -y 251.2 to 680.5 mm, all inserted; docs/import.md). The
+wrist is 185 mm beyond the entry, farther than on a pin: the pins' spans do not carry
+over. Along -x (towards the arm) and +y the assembling cell's transfer ends short of the
+approach wherever teaching reaches; along +x 462.5 mm out the transfer ends 5.1 mm short,
+along -y 690.5 mm out teaching 3.3 mm short. Nearer or farther, or along another axis,
+is taken as out of reach."""
 TRAY_START = (0.25, 0.40)
 """The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
 TRAY_PITCH = 0.05

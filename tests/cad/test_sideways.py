@@ -161,15 +161,15 @@ def _turned(folder: Path, wall: float | None = None) -> Path:
 
 
 def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_arm_was_not_measured_to_reach(tmp_path: Path) -> None:
-    # Along -x the assembling cell's transfer ends short of the approach (70.9 mm at the
-    # entry 375 mm out, 75.4 mm at 445 mm) and teaching fails farther out: never the cell's.
+    # Along -x the assembling cell's transfer ends short of the approach (70.9 mm with the
+    # entry 375 mm out, 75.4 mm at 445 mm) and teaching does not reach farther out: never the cell's.
     turned = _turned(tmp_path / "turned")
     for place, out in (((0.56, 0.0), "default"), ((0.42, 0.0), "near")):
         imported = run_import(turned, tmp_path / out, "mm", CORPUS / "import.toml", ImportOptions(place=place))
         assert imported.derived.axis == {"hex_peg": "+x"}
         manual = load_product_description(tmp_path / out).geometry.manual  # type: ignore[union-attr]
         assert "hex_peg" in manual and "along -x: the cell's arm was measured to reach a hole entered sideways " \
-            "along -y only" in manual["hex_peg"].reason, manual
+            "along +x and -y only" in manual["hex_peg"].reason, manual
     # Along -y the entry 700.4 mm out: teaching does not reach the demonstration's start.
     run_import(CORPUS / "meshes", tmp_path / "far", "mm", CORPUS / "import.toml", ImportOptions(place=(0.70, 0.0)))
     manual = load_product_description(tmp_path / "far").geometry.manual  # type: ignore[union-attr]
