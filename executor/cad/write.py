@@ -109,6 +109,18 @@ the demonstration's start with the base's centre at (560, 0) mm and 10.3 mm shor
 goal at (420, 0) mm; along +y the assembling cell's transfer ends 17 mm short of the
 approach at (560, 0) mm; along +x with the free end 377.5 mm out, 15.4 mm short
 (docs/cell.md). Nearer or farther, or along another axis, is taken as out of reach."""
+SIDEWAYS_HOLE_REACH = {"+x": (0.4925, 0.8725), "-y": (0.25125, 0.68045)}
+"""Where the cell inserts a peg into a hole of the base entered sideways: the axes (the
+peg's motion) and, on each, the span of the horizontal distance [m] of the hole's entry
+centre from the arm's base over which its arm was measured to reach it, teaching and
+assembling (``agh_hex_horizontal`` of ``tests/cad/test_sideways.py``, along +x its hole
+closed at the far end, turned about z and placed along x, the entry 30 mm up: along +x
+492.5 to 872.5 mm out, along -y 251.2 to 680.5 mm, all inserted; docs/import.md). The
+wrist is 185 mm beyond the entry, farther than on a pin: the pins' spans do not carry
+over. Along -x (towards the arm) and +y the assembling cell's transfer ends short of the
+approach wherever teaching reaches; along +x 462.5 mm out the transfer ends 5.1 mm short,
+along -y 690.5 mm out teaching 3.3 mm short. Nearer or farther, or along another axis,
+is taken as out of reach."""
 TRAY_START = (0.25, 0.40)
 """The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
 TRAY_PITCH = 0.05
@@ -487,6 +499,8 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
         elif fit.axis == "-z":
             if fit.part is not None:
                 by_hand[fit.part] = f"hole {hid} is entered from below"
+        elif fit.part is not None and fit.axis != "+z" and (why := _sideways_refused(derived, hid, fit)):
+            by_hand[fit.part] = why
         elif fit.part is not None and _section_kind(fit) == "polygon" and _polygon_refused(fit, derived):
             by_hand[fit.part] = _polygon_refused(fit, derived)
         elif fit.part is not None and (length := float(_upright(derived, fit).extents[2])) <= GRIPPER["grasp_depth"]:
@@ -614,7 +628,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) after '{lowest}': the cell puts one part onto a pin, the nearest its root"
     if why := _unresolved(margins(derived)[pid][pin.id]):
         return f"goes onto a pin ({pin.id}) {why}"
-    if pin.axis != "+z" and (why := _unreached(derived, pin)):
+    if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
+                                               "a horizontal pin")):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: {why}"
     if pin.axis != "+z" and (why := _wrist_on_pin(derived, pin, pid)):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}, but {why}"
@@ -623,46 +638,72 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
 
 
-def _unreached(derived: Derived, pin: PinFit) -> str:
-    """Why the cell's arm may not reach ``pin`` along its horizontal axis ("" where it was
-    measured to: :data:`SIDEWAYS_PIN_REACH`)."""
-    axis = opposite(pin.axis)
-    if axis not in SIDEWAYS_PIN_REACH:
-        return f"the cell's arm was measured to reach a horizontal pin along {' and '.join(SIDEWAYS_PIN_REACH)} only"
-    x, y, _ = pin_entry(derived, pin)
-    low, high = SIDEWAYS_PIN_REACH[axis]
-    if low - 1e-9 <= (distance := math.hypot(x, y)) <= high + 1e-9:
+def _unreached(axis: str, end: tuple[float, float, float], spans: Mapping[str, tuple[float, float]],
+               what: str) -> str:
+    """Why the cell's arm may not reach ``what`` (a horizontal pin, its free end at ``end``
+    [m]; a hole entered sideways, its entry there) along the horizontal ``axis`` (the part's
+    motion): "" where it was measured to (``spans``: :data:`SIDEWAYS_PIN_REACH`,
+    :data:`SIDEWAYS_HOLE_REACH`)."""
+    if axis not in spans:
+        return f"the cell's arm was measured to reach {what} along {' and '.join(spans)} only"
+    low, high = spans[axis]
+    if low - 1e-9 <= (distance := math.hypot(end[0], end[1])) <= high + 1e-9:
         return ""
-    return (f"its free end {1e3 * distance:.1f} mm from the arm's base, out of the {1e3 * low:g} to {1e3 * high:g} mm "
+    where = "its free end" if what.endswith("pin") else "its entry"
+    return (f"{where} {1e3 * distance:.1f} mm from the arm's base, out of the {1e3 * low:g} to {1e3 * high:g} mm "
             f"at which the arm was measured to reach it along {axis}")
 
 
 def _wrist_on_pin(derived: Derived, pin: PinFit, pid: str) -> str:
     """Why the arm's wrist would meet the product with part ``pid`` at its goal on ``pin``
-    along a horizontal axis ("" where it would not): :func:`tool_length`'s rule in the pin's
-    frame (z out along its axis). The part is held :data:`GRIPPER`'s grasp depth deep (at
-    most half its length) from its outer end, the wrist (:data:`WRIST_RADIUS` about the
-    tool's axis) starts the default flange beyond, and every part that may be in place (any
-    but those the geometric precedence puts after ``pid``) and the base outside the pin
-    itself (its section's half diagonal about the axis, the gripper's fingers beside it) must
-    end :data:`WRIST_CLEARANCE` short of it within that radius of the axis. Any longer flange
-    the product gets keeps this: the wrist only moves farther out along the axis."""
+    along a horizontal axis ("" where it would not): :func:`_wrist_meets` about the pin's
+    axis, the base outside the pin itself (its section's half diagonal about the axis, the
+    gripper's fingers beside it)."""
+    centre = (float(pin.section.centre[0]), float(pin.section.centre[1]))
+    return _wrist_meets(derived, pin, pid, centre, {pin.owner: math.hypot(pin.section.a, pin.section.b) / 2 + NEAR})
+
+
+def _wrist_meets(derived: Derived, fit: HoleFit | PinFit, pid: str, centre: tuple[float, float],
+                 inner: Mapping[str, float]) -> str:
+    """Why the arm's wrist would meet the product with part ``pid`` at its goal along the
+    horizontal axis of ``fit`` (a pin, a hole entered sideways) ("" where it would not):
+    :func:`tool_length`'s rule in its frame (:func:`_turn`: z out along the axis), the axis
+    through ``centre`` [m] (x, y in that frame). The part is held :data:`GRIPPER`'s grasp
+    depth deep (at most half its length) from its outer end, the wrist (:data:`WRIST_RADIUS`
+    about the tool's axis) starts the default flange beyond, and every part that may be in
+    place (any but those the geometric precedence puts after ``pid``) must end
+    :data:`WRIST_CLEARANCE` short of it within that radius of the axis, a part in ``inner``
+    only outside that radius [m] of it. Any longer flange the product gets keeps this: the
+    wrist only moves farther out along the axis."""
     graph = nx.DiGraph()
     graph.add_nodes_from(derived.parts)
     graph.add_edges_from(derived.edges)
-    turn = _turn(pin)
-    along = _along(derived.parts[pid].mesh, pin)[:, 2]
+    turn = _turn(fit)
+    along = _along(derived.parts[pid].mesh, fit)[:, 2]
     low, high = float(along.min()), float(along.max())
     grip = high - min(GRIPPER["grasp_depth"], (high - low) / 2)
-    centre = (float(pin.section.centre[0]), float(pin.section.centre[1]))
-    pin_reach = math.hypot(pin.section.a, pin.section.b) / 2 + NEAR
     for other in sorted(set(derived.parts) - nx.descendants(graph, pid) - {pid}):
         mesh = derived.parts[other].mesh.copy().apply_transform(turn)
-        top = _highest_near(mesh, centre, WRIST_RADIUS, pin_reach if other == pin.owner else 0.0)
+        top = _highest_near(mesh, centre, WRIST_RADIUS, inner.get(other, 0.0))
         if top is not None and top - grip + WRIST_CLEARANCE > GRIPPER["flange_length"] + 1e-9:
             return (f"the arm's wrist ({1e3 * WRIST_RADIUS:g} mm about the tool's axis, "
                     f"{1e3 * GRIPPER['flange_length']:g} mm out from the grip) would meet '{other}', "
                     f"{1e3 * (top - grip):.3f} mm out from the grip within {1e3 * WRIST_RADIUS:g} mm of the axis")
+    return ""
+
+
+def _sideways_refused(derived: Derived, hid: str, fit: HoleFit) -> str:
+    """Why the cell does not insert the peg of ``fit``, a hole entered sideways ("" where it
+    does): the arm not measured to reach its entry along its axis (:func:`_unreached`), or
+    its wrist meeting the product with the peg at its goal (:func:`_wrist_meets`, the base
+    counted whole: nothing of it stands out of the entry)."""
+    assert fit.part is not None
+    axis = opposite(fit.axis)
+    if why := _unreached(axis, entry_point(fit), SIDEWAYS_HOLE_REACH, "a hole entered sideways"):
+        return f"goes into hole {hid} along {axis}: {why}"
+    centre = (float(fit.hole.centre[0]), float(fit.hole.centre[1]))
+    if why := _wrist_meets(derived, fit, fit.part, centre, {}):
+        return f"goes into hole {hid} along {axis}, but {why}"
     return ""
 
 
@@ -710,7 +751,7 @@ def round_pins(derived: Derived, pid: str) -> bool:
     return derived.bores[pid].kind == "round" and all(pin.section.kind == "round" for pin in derived.pins.values())
 
 
-def _along(mesh: trimesh.Trimesh, pin: PinFit) -> np.ndarray:
+def _along(mesh: trimesh.Trimesh, pin: HoleFit | PinFit) -> np.ndarray:
     """The vertices (n, 3) [m] of ``mesh`` in the frame of ``pin`` (:func:`_turn`): z along
     its removal direction."""
     return mesh.vertices @ _turn(pin)[:3, :3].T
