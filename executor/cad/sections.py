@@ -235,7 +235,9 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     :data:`SAME_OUTLINE` of it: a wall's faces along the axis, tilted by the float). Exact, whatever
     lies between the levels slices are taken at (a taper, a groove's edge, a slanted
     facet): a point free at one level of the span and covered at another lies under a
-    face crossing the span. ``loop`` itself when the section lies within
+    face crossing the span; but for the shadows within :data:`SLIVER` of the loop's
+    outline, left out, after which a hole's section is eroded and a peg's dilated by twice
+    SLIVER (never larger, never smaller than the exact one). ``loop`` itself when the section lies within
     :data:`SAME_OUTLINE` of it, or when it is no simple polygon; no points when nothing of
     the hole is free all along."""
     outline = shapely.make_valid(shapely.Polygon(loop.points))
