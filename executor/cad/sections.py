@@ -161,10 +161,16 @@ left cracks in their shadow, and a bore's section over a span in its edge radius
 SAME_OUTLINE = 1e-8
 """A section over a span whose outline lies within this [m] of the loop sliced in it
 (Hausdorff) is that loop (the projected faces meet its edges to the float)."""
+SLIVER = 1e-12
+"""A face's shadow (:func:`shadow`) lying wholly within this [m] (1 pm) of the loop's
+outline is left out of a section over a span (:func:`over_span`): a wall's faces along the
+axis, tilted by the float, project to thousands of such slivers. The section is then made
+conservative by twice this: a hole's eroded, a peg's dilated (:func:`_conservative`)."""
 
 
 def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
-           near: tuple[float, float, float, float]) -> shapely.Geometry:
+           near: tuple[float, float, float, float], band: shapely.Geometry | None = None
+           ) -> tuple[shapely.Geometry, bool]:
     """The union of the projections across ``axis`` (in :func:`frame_of`'s axes) of the
     pieces of ``mesh``'s triangles between the levels ``low`` and ``high`` [m] (not those
     within :data:`SPAN_TOLERANCE` of an end, beyond it), of those whose projection meets the box
@@ -172,7 +178,8 @@ def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
     projection is the convex hull of its clipped corners; a wall along the axis projects
     to no area. Every point the solid covers at some level of the span, and not at a level
     inside it where it is sliced, lies under a face crossing the span: this is exactly the
-    set that sections over the span gain or lose (:func:`over_span`)."""
+    set that sections over the span gain or lose (:func:`over_span`). The projections
+    ``band`` covers are left out; with the union, whether any was."""
     axis = np.asarray(axis, dtype=float)
     triangles = mesh.triangles
     heights = triangles @ axis
@@ -185,7 +192,7 @@ def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
     heights = np.where(np.abs(heights - low) <= SPAN_TOLERANCE, low,
                        np.where(np.abs(heights - high) <= SPAN_TOLERANCE, high, heights))
     if not len(heights):
-        return shapely.Polygon()
+        return shapely.Polygon(), False
     points, valid = [flat], [(heights >= low) & (heights <= high)]
     for i, j in ((0, 1), (1, 2), (2, 0)):
         for level in (low, high):
@@ -198,7 +205,22 @@ def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
     owner = np.nonzero(mask)[0]
     hulls = shapely.convex_hull(shapely.multipoints(corners[mask], indices=owner))
     hulls = hulls[shapely.area(hulls) > 0]
-    return shapely.union_all(hulls) if len(hulls) else shapely.Polygon()
+    dropped = False
+    if band is not None and len(hulls):
+        shapely.prepare(band)
+        inside = shapely.covers(band, hulls)
+        hulls, dropped = hulls[~inside], bool(inside.any())
+    return (shapely.union_all(hulls) if len(hulls) else shapely.Polygon()), dropped
+
+
+def _conservative(section: shapely.Polygon, *, hole: bool) -> shapely.Geometry:
+    """``section`` [m] made without shadows within :data:`SLIVER` of its loop's outline
+    (:func:`shadow`'s ``band``), made no larger for a hole (eroded) and no smaller for a
+    peg (dilated) than the exact one: each point it wrongly holds (a hole's) or misses (a
+    peg's) lies within SLIVER of the loop's outline, outside the hole's section or inside
+    the peg's. By twice SLIVER: a round buffer's arcs are chords, short of the disc by
+    under a hundredth of its radius."""
+    return section.buffer(-2 * SLIVER if hole else 2 * SLIVER)
 
 
 def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float, *, hole: bool,
@@ -213,7 +235,9 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     :data:`SAME_OUTLINE` of it: a wall's faces along the axis, tilted by the float). Exact, whatever
     lies between the levels slices are taken at (a taper, a groove's edge, a slanted
     facet): a point free at one level of the span and covered at another lies under a
-    face crossing the span. ``loop`` itself when the section lies within
+    face crossing the span; but for the shadows within :data:`SLIVER` of the loop's
+    outline, left out, after which a hole's section is eroded and a peg's dilated by twice
+    SLIVER (never larger, never smaller than the exact one). ``loop`` itself when the section lies within
     :data:`SAME_OUTLINE` of it, or when it is no simple polygon; no points when nothing of
     the hole is free all along."""
     outline = shapely.make_valid(shapely.Polygon(loop.points))
@@ -223,16 +247,18 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     if not hole:
         x, y = loop.centre
         x0, y0, x1, y1 = x - reach, y - reach, x + reach, y + reach
-    cover = shadow(mesh, axis, low, high, (x0, y0, x1, y1))
-    if cover.is_empty:
+    cover, dropped = shadow(mesh, axis, low, high, (x0, y0, x1, y1), outline.exterior.buffer(SLIVER))
+    if cover.is_empty and not dropped:
         return loop
     if hole:
-        pieces = shapely.get_parts(shapely.difference(outline, cover))
+        free = shapely.difference(outline, cover)
+        pieces = shapely.get_parts(_conservative(free, hole=True) if dropped else free)
         if not len(pieces):
             return Loop(np.zeros((0, 2)))
         found = max(pieces, key=lambda piece: piece.area)
     else:
-        pieces = list(shapely.get_parts(shapely.union(outline, cover)))
+        covered = shapely.union(outline, cover)
+        pieces = list(shapely.get_parts(_conservative(covered, hole=False) if dropped else covered))
         main = max(pieces, key=lambda piece: piece.area)
         near = main.buffer(SAME_OUTLINE)
         apart = [piece for piece in pieces if piece is not main and not near.covers(piece)]

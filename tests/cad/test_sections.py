@@ -295,3 +295,39 @@ def test_a_section_is_its_loop_exactly_as_their_hausdorff_distance_decides() -> 
     expected = [bool(shapely.hausdorff_distance(a, b) <= sections.SAME_OUTLINE) for a, b in pairs]
     assert [sections._same_outline(a, b) for a, b in pairs] == expected
     assert expected[0] is False and 0 < sum(expected) < len(expected)  # both outcomes decided
+
+
+def _sliver_and_ledge(lean: float) -> tuple[Loop, trimesh.Trimesh]:
+    """A 10 mm square's loop (0 to 10 mm in x and y) and a soup of faces over the span
+    0 to 10 mm along z: its wall at x = 0 leaning by ``lean`` [m] in x from foot to top
+    (a sliver of that width in its shadow, within :data:`sections.SLIVER` of the loop),
+    and a ledge across the corner at x, y = 10 mm, 1 mm each way (the section is not the loop)."""
+    side, span, ledge = 10 * MM, 10 * MM, 1 * MM
+    vertices = np.array([[0.0, 0.0, 0.0], [0.0, side, 0.0], [lean, side, span], [lean, 0.0, span],
+                         [side - ledge, side, span / 2], [side, side - ledge, span / 2],
+                         [side + ledge, side + ledge, span / 2]])
+    mesh = trimesh.Trimesh(vertices, [[0, 1, 2], [0, 2, 3], [4, 5, 6]], process=False)
+    return Loop(np.array([[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]])), mesh
+
+
+@pytest.mark.parametrize("hole", [True, False])
+def test_a_section_over_a_span_without_its_slivers_is_conservative(hole: bool) -> None:
+    # The wall leaning by 0.5 pm into the hole (out of the peg) projects to a sliver the
+    # section over the span leaves out (SLIVER): the hole's section is eroded so it is no
+    # larger than the exact one (the loop less every face's shadow), the peg's dilated so it
+    # is no smaller (the loop with it). Without that, the hole would hold the sliver and
+    # the peg miss it, by 0.5 pm: a peg could pass a hole it overlaps.
+    lean = 0.5e-12 if hole else -0.5e-12
+    loop, mesh = _sliver_and_ledge(lean)
+    up = np.array([0.0, 0.0, 1.0])
+    found = sections.over_span(loop, mesh, up, 0.0, 10 * MM, hole=hole)
+    assert found is not loop  # the ledge's shadow: not the loop sliced
+    outline = shapely.Polygon(loop.points)
+    cover, dropped = sections.shadow(mesh, up, 0.0, 10 * MM, outline.bounds)
+    assert not dropped
+    exact = shapely.difference(outline, cover) if hole else shapely.union(outline, cover)
+    result = shapely.Polygon(found.points)
+    inner, outer = (result, exact) if hole else (exact, result)
+    assert outer.covers(inner)
+    assert inner.area < outer.area  # the ledge kept: the section changed by the tolerance only
+    assert outer.area - inner.area < 4 * sections.SLIVER * 40 * MM
