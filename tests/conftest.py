@@ -20,6 +20,10 @@ Fixtures (session-scoped but ``cli_env``, so hypothesis tests may use them too):
 - ``cli_argv(*args)`` → ``list[str]``: the argv of ``python -m assembly_constraints ARGS``, for ``Popen``;
 - ``cli_env`` → ``dict``: a fresh copy of the environment of every child process (``child_env()``).
 
+``assembled(folder, base, part, hole)`` runs the assembling cell in this process (a helper,
+not a fixture): the base, then the part into its hole or onto its pin, each asserted to fit
+(the part within 2 mm of its goal).
+
 Each runner returns the ``subprocess.CompletedProcess`` (``capture_output=True, text=True``),
 run in ``cwd`` (default: the repository root) with ``child_env()``; a run longer than
 ``timeout`` seconds raises ``subprocess.TimeoutExpired``. Tests that need a long-running
@@ -45,11 +49,16 @@ import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import pytest
 
 from asp.session.cells import CellProcess
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from executor.assembly.step import StepRecord
 from tests._schedule import (  # noqa: F401 (hooks: the order on xdist's workers)
     pytest_collection_modifyitems,
     pytest_configure,
@@ -206,3 +215,23 @@ def cells() -> Iterator[list[CellProcess]]:
     finally:
         for cell in started:
             cell.kill()
+
+
+def assembled(folder: Path | str, base: str, part: str, hole: str) -> tuple[StepRecord, np.ndarray]:
+    """The assembling cell's step of ``part`` into (or onto) ``hole`` of the taught product in
+    ``folder`` after ``base`` stood in its place, and the part's orientation then (xyzw
+    quaternion); asserts that both fit, the part within 2 mm of its goal pose."""
+    # Imported here: the tests that assemble nothing do not load PyBullet.
+    from executor.assembly.product import load_product
+    from executor.assembly.step import Assembler
+    from executor.cell_description import CellDescription
+
+    assembler = Assembler(load_product(str(folder)), description=CellDescription())
+    try:
+        assert assembler.run_step(base, None, 0).outcome == "fit"
+        step = assembler.run_step(part, hole, 0)
+        _, quat = assembler.world.pose(part)
+    finally:
+        assembler.close()
+    assert step.outcome == "fit" and step.pose_error < 0.002, step
+    return step, quat

@@ -17,16 +17,14 @@ import shapely
 import trimesh
 
 from bridge.product import load_product_description
-from executor.assembly.product import load_product
-from executor.assembly.step import Assembler
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.write import _highest_near
-from executor.cell_description import CellDescription
 from executor.skills.teach import teach_all
 from executor.trial import Cell
 from executor.world.arm import quat_to_matrix
 from executor.world.meshes import URDF_HULL_MARGIN, eroded
 from executor.world.rings import ring_pieces
+from tests.conftest import assembled
 
 PIN = 10.0
 """The pin's diameter [mm] (a 64-gon's vertex circle)."""
@@ -163,14 +161,8 @@ def test_the_ring_s_pieces_keep_its_bore_under_the_cell_s_hull_margin() -> None:
 
 @pytest.mark.slow  # teaches the ring (shared), then the block and the ring assembled in physics (about 20 s under load)
 def test_a_ring_onto_a_horizontal_pin_is_assembled_within_2_mm(taught: Path) -> None:
-    assembler = Assembler(load_product(str(taught)), description=CellDescription())
-    try:
-        assert assembler.run_step("block", None, 0).outcome == "fit"
-        step = assembler.run_step("ring", "block_pin1", 0)
-        _, quat = assembler.world.pose("ring")
-    finally:
-        assembler.close()
-    assert step.skill == "insert" and step.outcome == "fit" and step.pose_error < 0.002, step
+    step, quat = assembled(taught, "block", "ring", "block_pin1")
+    assert step.skill == "insert", step
     assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.02)  # along the pin's axis
 
 

@@ -17,16 +17,14 @@ import trimesh
 
 from bridge import BridgeError
 from bridge.product import load_product_description
-from executor.assembly.product import load_product
-from executor.assembly.step import Assembler
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.sections import frame_of
 from executor.cad.sweep import DIRECTIONS, opposite
-from executor.cell_description import CellDescription
 from executor.skills.teach import teach_all
 from executor.trial import Cell
 from executor.world.arm import ArmState, quat_to_matrix, tool_quat
 from executor.world.frames import hole_frame, hole_rotation
+from tests.conftest import assembled
 
 CORPUS = Path(__file__).parent / "corpus" / "agh_hex_horizontal"
 ENTRY = (0.56, 0.025, 0.03)
@@ -130,14 +128,7 @@ def test_a_horizontal_insertion_too_narrow_is_refused_in_physics(taught: Path, t
 
 @pytest.mark.slow  # teaches the peg (shared), then the box and the peg assembled in physics (about 40 s under load)
 def test_a_horizontal_peg_is_assembled_within_2_mm(taught: Path) -> None:
-    assembler = Assembler(load_product(str(taught)), description=CellDescription())
-    try:
-        assert assembler.run_step("box", None, 0).outcome == "fit"
-        step = assembler.run_step("hex_peg", "h1", 0)
-        _, quat = assembler.world.pose("hex_peg")
-    finally:
-        assembler.close()
-    assert step.outcome == "fit" and step.pose_error < 0.002, step
+    _, quat = assembled(taught, "box", "hex_peg", "h1")
     assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.02)  # lying along the hole's axis
 
 

@@ -32,6 +32,7 @@ from executor.world.meshes import URDF_HULL_MARGIN, read_objects
 from executor.world.outlines import boss_solids, boss_triangles, convex_parts, corners
 from executor.world.scene import hole_rims, link_frame
 from tests._outlines import splined
+from tests.conftest import assembled
 
 HOLES = {"hx": (0.00604, math.pi / 6), "hs": (0.00596, 0.0)}
 """Each hole's inradius [m] and the turn of its outline [rad]."""
@@ -202,13 +203,6 @@ def test_a_hexagon_peg_goes_into_a_hexagon_hole_with_40_um_room_and_not_into_one
     finally:
         cell.close()
     # the assembling cell picks it from the tray, turns it by 30° and stands it in hx (its fit)
-    assembler = Assembler(load_product(folder), description=CellDescription())
-    try:
-        assert assembler.run_step("bp", None, 0).outcome == "fit"
-        step = assembler.run_step("p1", "hx", 0)
-        _, quat = assembler.world.pose("p1")
-    finally:
-        assembler.close()
-    assert step.outcome == "fit" and step.pose_error < 0.002
+    _, quat = assembled(folder, "bp", "p1", "hx")
     yaw = math.degrees(2 * math.atan2(quat[2], quat[3]))
     assert abs(abs(yaw) - 30.0) < 1.0  # the hexagon's half period: the relation's turn, within the room's play
