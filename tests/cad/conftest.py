@@ -1,6 +1,7 @@
 """The shipped products exported in the assembled pose and imported, once per test
 session (a worker's): ``imported(product)`` → (what the import derived, the assembly
-folder it wrote), shared by the round trips of ``test_import`` and ``test_covers``."""
+folder it wrote), shared by the round trips of ``test_import`` and ``test_covers``; and
+``teach(folder)``, a helper: an imported product's skills taught in this process."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ import pytest
 from assembly_constraints.cli import main
 from executor.cad.cli import run_import
 from executor.cad.derive import Derived
+from executor.skills.teach import teach_all
+from executor.trial import Cell
 
 
 @pytest.fixture(scope="session")
@@ -29,3 +32,14 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], tuple[
         return done[product]
 
     return get
+
+
+def teach(folder: Path) -> Path:
+    """The skills of every part shape of the product in ``folder`` taught in its simulated
+    cell, in this process (as ``executor teach`` does); returns ``folder``."""
+    cell = Cell(str(folder))
+    try:
+        teach_all(cell)
+    finally:
+        cell.close()
+    return folder

@@ -19,11 +19,11 @@ import trimesh
 from bridge.product import load_product_description
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.write import _highest_near
-from executor.skills.teach import teach_all
 from executor.trial import Cell
 from executor.world.arm import quat_to_matrix
 from executor.world.meshes import URDF_HULL_MARGIN, eroded
 from executor.world.rings import ring_pieces
+from tests.cad.conftest import teach
 from tests.conftest import assembled
 
 PIN = 10.0
@@ -70,13 +70,7 @@ def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0,
 def taught(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The ring with a d 10.2 bore (0.1 mm of room all round) imported and taught on its pin
     (``executor teach``, in this process)."""
-    out = _import(tmp_path_factory.mktemp("horizontal"), 10.2)
-    cell = Cell(str(out))
-    try:
-        teach_all(cell)
-    finally:
-        cell.close()
-    return out
+    return teach(_import(tmp_path_factory.mktemp("horizontal"), 10.2))
 
 
 def test_a_pin_along_y_is_written_with_its_axis_and_free_end(tmp_path: Path) -> None:

@@ -14,10 +14,11 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
-from executor.skills.teach import DEMO_CLEARANCE, teach_all
+from executor.skills.teach import DEMO_CLEARANCE
 from executor.trial import Cell
 from executor.world.geometry import load_geometry
 from executor.world.scene import Scene
+from tests.cad.conftest import teach
 from tests.cad.test_import import SIZE_BOUND, _box
 
 LEVELS = {"stepped": ((0.020, 0.015), (0.030, 0.012)), "flat": ((0.020, 0.015), (0.020, 0.010))}
@@ -67,11 +68,7 @@ def test_holes_at_two_levels_get_a_geometry_the_cell_builds(imported: dict[str, 
 def taught(imported: dict[str, Path]) -> dict[str, Path]:
     """The imported products with their skills taught (each peg in its own hole)."""
     for folder in imported.values():
-        cell = Cell(str(folder))
-        try:
-            teach_all(cell)
-        finally:
-            cell.close()
+        teach(folder)
     return imported
 
 

@@ -20,10 +20,10 @@ from bridge.product import load_product_description
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.sections import frame_of
 from executor.cad.sweep import DIRECTIONS, opposite
-from executor.skills.teach import teach_all
 from executor.trial import Cell
 from executor.world.arm import ArmState, quat_to_matrix, tool_quat
 from executor.world.frames import hole_frame, hole_rotation
+from tests.cad.conftest import teach
 from tests.conftest import assembled
 
 CORPUS = Path(__file__).parent / "corpus" / "agh_hex_horizontal"
@@ -40,13 +40,7 @@ def _import(out: Path) -> Path:
 def taught(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The product imported and its peg's skill taught in its hole (``executor teach``, in
     this process)."""
-    out = _import(tmp_path_factory.mktemp("sideways") / "out")
-    cell = Cell(str(out))
-    try:
-        teach_all(cell)
-    finally:
-        cell.close()
-    return out
+    return teach(_import(tmp_path_factory.mktemp("sideways") / "out"))
 
 
 @pytest.mark.parametrize("axis", ["-z", "+x", "-x", "+y", "-y"])
