@@ -141,7 +141,7 @@ def test_a_ring_onto_a_pin_where_the_arm_was_not_seen_to_reach_it_is_placed_by_h
 def test_the_ring_s_pieces_keep_its_bore_under_the_cell_s_hull_margin() -> None:
     # What the cell collides as: each piece eroded by the hull margin, which PyBullet adds
     # back (its corners rounded). A sector of a 32-gon about the d 10.2 bore has a 1 mm face
-    # there, which that erodes away: the ring hung 4.3 mm low across the pin.
+    # there, which that erodes away: the ring hung low across the pin (docs/import.md).
     section = shapely.Point(0, 0).buffer(0.012, quad_segs=32).difference(shapely.Point(0, 0).buffer(0.0051,
                                                                                                       quad_segs=32))
     found = ring_pieces("ring", trimesh.creation.extrude_polygon(section, 0.008), 0.0, round_pins=True)
