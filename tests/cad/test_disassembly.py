@@ -333,3 +333,20 @@ def test_sweeps_in_two_processes_give_the_answers_and_queries_of_one() -> None:
                         {"housing", "shaft"}]
     assert hits[8:12] == [set(), set(), {"bearing", "housing"}, {"bearing", "housing"}] and hits[12] == {"housing"}
     assert queries == found[0][1] > 0
+
+
+def test_a_sweep_entailed_by_one_along_the_same_direction_is_not_queried_and_answers_as_queried() -> None:
+    parts = _shaft_in_bearing()
+    meshes = {p.id: p.mesh for p in parts}
+    slides = sweep.zero_clearance_fits({pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()})
+    along, up = np.array(sweep.DIRECTIONS["+x"]), np.array(sweep.DIRECTIONS["+z"])
+    # the bearing slides free along x a long way, so a short way too; lifted a little it meets both, so further too
+    first = [("bearing", along, 0.3), ("bearing", up, 3e-3)]
+    then = [("bearing", along, 3e-3), ("bearing", up, 0.3)]
+    sweeper = sweep.Sweeper(meshes, slides, workers=1)
+    assert sweeper.blocked(first) == [set(), {"housing", "shaft"}]
+    asked = sweeper.queries
+    entailed = sweeper.blocked(then)
+    assert sweeper.queries == asked  # no query: each answer entailed by the first two
+    fresh = sweep.Sweeper(meshes, slides, workers=1)
+    assert entailed == fresh.blocked(then) == [set(), {"housing", "shaft"}] and fresh.queries > 0
