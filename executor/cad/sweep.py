@@ -1018,14 +1018,33 @@ def _likely(piece: _Piece, triangles: _Triangles) -> np.ndarray:
     """The (at most :data:`LIKELY`) triangles near ``piece`` that reach farthest into it,
     deeper than :data:`TOUCH`, along the line from its centre to theirs: the piece's extent
     beyond the triangle's nearest corner along that line, what fcl's depth (libccd's portal
-    refinement from the centres' difference) approaches."""
-    found = triangles.near(piece.points.min(axis=0), piece.points.max(axis=0))
+    refinement from the centres' difference) approaches. The extent is measured only on the
+    triangles whose bound (the piece's box's extent instead, plus :data:`_SLACK`) reaches
+    the :data:`LIKELY`-th extent of the twice as many the bound ranks first: no other can
+    be among the farthest (a long sweep's piece has thousands of triangles near it)."""
+    low, high = piece.points.min(axis=0), piece.points.max(axis=0)
+    found = triangles.near(low, high)
     if not len(found):
         return found
-    corners = triangles.corners[found]
     toward = triangles.centres[found] - piece.points.mean(axis=0)
     lengths = np.linalg.norm(toward, axis=1, keepdims=True)
     toward = np.divide(toward, lengths, out=np.zeros_like(toward), where=lengths > 0)
-    reach = np.max(toward @ piece.points.T, axis=1) - np.min(np.einsum("mvc,mc->mv", corners, toward), axis=1)
+    nearest = np.min(np.einsum("mvc,mc->mv", triangles.corners[found], toward), axis=1)
+    bound = toward @ ((low + high) / 2) + np.abs(toward) @ ((high - low) / 2) - nearest + _SLACK
+    kept = np.flatnonzero(bound > TOUCH)
+    if len(kept) > 4 * LIKELY:
+        first = kept[np.argpartition(-bound[kept], 2 * LIKELY)[:2 * LIKELY]]
+        least = np.partition(-_reach(piece, toward[first], nearest[first]), LIKELY - 1)[LIKELY - 1]
+        kept = kept[bound[kept] >= -least]
+    reach = _reach(piece, toward[kept], nearest[kept])
     order = np.argsort(-reach, kind="stable")[:LIKELY]
-    return found[order[reach[order] > TOUCH]]
+    return found[kept[order[reach[order] > TOUCH]]]
+
+
+_SLACK = 1e-9
+"""Added to the bound of :func:`_likely` [m]: far above the rounding of either side."""
+
+
+def _reach(piece: _Piece, toward: np.ndarray, nearest: np.ndarray) -> np.ndarray:
+    """The extent [m] of ``piece`` along each unit vector ``toward`` beyond ``nearest`` (:func:`_likely`)."""
+    return np.max(toward @ piece.points.T, axis=1) - nearest
