@@ -43,10 +43,13 @@ twice :data:`TOUCH`.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
 part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
-moved back against A along the same path) is answered from the first. The tests asked
-together (:meth:`Sweeper.blocked`) run in :attr:`Sweeper.workers` processes forked from
-this one, each the same test on a copy of the same parts: the answers and their count
-are those of one process.
+moved back against A along the same path) is answered from the first, and so is one that
+a sweep of the same pair along the same direction entails (a longer one free frees a
+shorter, a shorter one colliding blocks a longer: the locating rule's short sweeps after
+the long ones out). The tests asked together (:meth:`Sweeper.blocked`) run in
+:attr:`Sweeper.workers` processes forked from this one, each the same test on a copy of
+the same parts (the fixed parts' BVHs made before the fork, so not once per worker): the
+answers and their count are those of one process.
 """
 
 from __future__ import annotations
@@ -755,6 +758,9 @@ class Sweeper:
         self._slid: dict[tuple[str, str, str], _Solid] = {}
         self.queries = 0
         """Narrow-phase queries made so far."""
+        self._along: dict[tuple[int, int, tuple[float, ...]], list[tuple[float, bool]]] = {}
+        """(moving solid, fixed solid (their ids), unit direction) -> (length [m], whether the
+        sweep collides) of each query made: what they entail (:meth:`_entailed`)."""
         self._answers: dict[tuple[int, int, tuple[float, ...]], bool] = {}
         """(moving solid, fixed solid (their ids), shift [m]) -> whether the sweep collides:
         A moved against B and B moved back against A are one test."""
@@ -771,7 +777,8 @@ class Sweeper:
         tested again for the next), the queries of every request's member of one rank at
         once, in :attr:`workers` processes."""
         bodies = [sorted({body} if isinstance(body, str) else set(body)) for body, _, _ in requests]
-        shifts = [np.asarray(direction, dtype=float) * length for _, direction, length in requests]
+        units = [np.asarray(direction, dtype=float) for _, direction, _ in requests]
+        shifts = [unit * length for unit, (_, _, length) in zip(units, requests)]
         hits: list[set[str]] = [set() for _ in requests]
         for rank in range(max(map(len, bodies), default=0)):
             tests: list[tuple[int, str, str]] = []  # (request, member, other)
@@ -788,30 +795,42 @@ class Sweeper:
                     if np.any(np.minimum(high, solid.bounds[1]) - np.maximum(low, solid.bounds[0]) <= TOUCH):
                         continue
                     tests.append((k, member, other))
-            answers = self._sweeps([(member, other, shifts[k]) for k, member, other in tests])
+            answers = self._sweeps([(member, other, units[k], float(requests[k][2])) for k, member, other in tests])
             for (k, _, other), collides in zip(tests, answers):
                 if collides:
                     hits[k].add(other)
         return hits
 
-    def _sweeps(self, tests: list[tuple[str, str, np.ndarray]]) -> list[bool]:
-        """Whether part ``member`` swept by ``shift`` [m] collides with part ``other``, for
-        each test (member, other, shift): one narrow-phase query each unless asked before,
+    def _sweeps(self, tests: list[tuple[str, str, np.ndarray, float]]) -> list[bool]:
+        """Whether part ``member`` moved by ``length`` [m] along the unit vector
+        ``direction`` collides with part ``other``, for each test (member, other,
+        direction, length): one narrow-phase query each unless asked before or entailed by
+        a sweep of the pair along the same direction answered before (:meth:`_entailed`),
         the new ones in :attr:`workers` processes when there are several."""
         keys = []
         pending: dict[tuple[int, int, tuple[float, ...]], tuple[str, str, np.ndarray]] = {}
         size: dict[tuple[int, int, tuple[float, ...]], int] = {}
-        for member, other, shift in tests:
+        ways: dict[tuple[int, int, tuple[float, ...]], tuple[tuple[int, int, tuple[float, ...]], float]] = {}
+        for member, other, direction, length in tests:
+            shift = direction * length
             moving, fixed, relative = self._oriented(member, other, shift)
             key = (id(moving), id(fixed), tuple(relative))
             keys.append(key)
-            if key not in self._answers and key not in pending:
-                pending[key] = (member, other, shift)
-                size[key] = len(moving.triangles) + len(fixed.triangles)
+            way = (id(moving), id(fixed), tuple(direction if relative is shift else -direction))
+            ways[key] = (way, length)
+            if key in self._answers or key in pending:
+                continue
+            entailed = self._entailed(way, length)
+            if entailed is not None:
+                self._answers[key] = entailed
+                continue
+            pending[key] = (member, other, shift)
+            size[key] = len(moving.triangles) + len(fixed.triangles)
         self.queries += len(pending)
         if self.workers > 1 and len(pending) > 1:
             pending = {key: pending[key] for key in sorted(pending, key=lambda k: -size[k])}  # the larger first
             if self._pool is None:
+                self._prepare(pending.values())
                 global _FORKED
                 _FORKED = self  # the workers' copy, forked now
                 self._pool = multiprocessing.get_context("fork").Pool(self.workers)
@@ -820,7 +839,30 @@ class Sweeper:
             self._answers.update(zip(pending, self._pool.map(_swept, pending.values(), chunksize=1)))
         else:
             self._answers.update((key, _collides(*self._oriented(*test))) for key, test in pending.items())
+        for key in pending:
+            way, length = ways[key]
+            self._along.setdefault(way, []).append((length, self._answers[key]))
         return [self._answers[key] for key in keys]
+
+    def _entailed(self, way: tuple[int, int, tuple[float, ...]], length: float) -> bool | None:
+        """The answer of the sweep ``way`` (moving solid, fixed solid (their ids), unit
+        direction) by ``length`` [m] that a sweep of the same solids along the same
+        direction answered before entails, or None: a shorter sweep's motion is part of a
+        longer one's, so a longer sweep that is free (no prism of it meets the fixed part
+        deeper than :data:`TOUCH`) frees the shorter, and a shorter one that collides
+        blocks the longer (penetration depth only grows with the moving set)."""
+        for done, collides in self._along.get(way, []):
+            if collides == (done <= length):
+                return collides
+        return None
+
+    def _prepare(self, tests: Iterable[tuple[str, str, np.ndarray]]) -> None:
+        """Make the BVHs and triangle indices of the fixed solids of ``tests`` (member,
+        other, shift) in this process, before its workers are forked: each worker then has
+        them, rather than making its own."""
+        for test in tests:
+            fixed = self._oriented(*test)[1]
+            _ = fixed.bvh, fixed.index
 
     def _oriented(self, member: str, other: str, shift: np.ndarray) -> tuple[_Solid, _Solid, np.ndarray]:
         """The moving solid, the fixed one and the shift [m] of the test whether part
@@ -976,14 +1018,33 @@ def _likely(piece: _Piece, triangles: _Triangles) -> np.ndarray:
     """The (at most :data:`LIKELY`) triangles near ``piece`` that reach farthest into it,
     deeper than :data:`TOUCH`, along the line from its centre to theirs: the piece's extent
     beyond the triangle's nearest corner along that line, what fcl's depth (libccd's portal
-    refinement from the centres' difference) approaches."""
-    found = triangles.near(piece.points.min(axis=0), piece.points.max(axis=0))
+    refinement from the centres' difference) approaches. The extent is measured only on the
+    triangles whose bound (the piece's box's extent instead, plus :data:`_SLACK`) reaches
+    the :data:`LIKELY`-th extent of the twice as many the bound ranks first: no other can
+    be among the farthest (a long sweep's piece has thousands of triangles near it)."""
+    low, high = piece.points.min(axis=0), piece.points.max(axis=0)
+    found = triangles.near(low, high)
     if not len(found):
         return found
-    corners = triangles.corners[found]
     toward = triangles.centres[found] - piece.points.mean(axis=0)
     lengths = np.linalg.norm(toward, axis=1, keepdims=True)
     toward = np.divide(toward, lengths, out=np.zeros_like(toward), where=lengths > 0)
-    reach = np.max(toward @ piece.points.T, axis=1) - np.min(np.einsum("mvc,mc->mv", corners, toward), axis=1)
+    nearest = np.min(np.einsum("mvc,mc->mv", triangles.corners[found], toward), axis=1)
+    bound = toward @ ((low + high) / 2) + np.abs(toward) @ ((high - low) / 2) - nearest + _SLACK
+    kept = np.flatnonzero(bound > TOUCH)
+    if len(kept) > 4 * LIKELY:
+        first = kept[np.argpartition(-bound[kept], 2 * LIKELY)[:2 * LIKELY]]
+        least = np.partition(-_reach(piece, toward[first], nearest[first]), LIKELY - 1)[LIKELY - 1]
+        kept = kept[bound[kept] >= -least]
+    reach = _reach(piece, toward[kept], nearest[kept])
     order = np.argsort(-reach, kind="stable")[:LIKELY]
-    return found[order[reach[order] > TOUCH]]
+    return found[kept[order[reach[order] > TOUCH]]]
+
+
+_SLACK = 1e-9
+"""Added to the bound of :func:`_likely` [m]: far above the rounding of either side."""
+
+
+def _reach(piece: _Piece, toward: np.ndarray, nearest: np.ndarray) -> np.ndarray:
+    """The extent [m] of ``piece`` along each unit vector ``toward`` beyond ``nearest`` (:func:`_likely`)."""
+    return np.max(toward @ piece.points.T, axis=1) - nearest

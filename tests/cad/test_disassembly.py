@@ -333,3 +333,41 @@ def test_sweeps_in_two_processes_give_the_answers_and_queries_of_one() -> None:
                         {"housing", "shaft"}]
     assert hits[8:12] == [set(), set(), {"bearing", "housing"}, {"bearing", "housing"}] and hits[12] == {"housing"}
     assert queries == found[0][1] > 0
+
+
+def test_a_sweep_entailed_by_one_along_the_same_direction_is_not_queried_and_answers_as_queried() -> None:
+    parts = _shaft_in_bearing()
+    meshes = {p.id: p.mesh for p in parts}
+    slides = sweep.zero_clearance_fits({pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()})
+    along, up = np.array(sweep.DIRECTIONS["+x"]), np.array(sweep.DIRECTIONS["+z"])
+    # the bearing slides free along x a long way, so a short way too; lifted a little it meets both, so further too
+    first = [("bearing", along, 0.3), ("bearing", up, 3e-3)]
+    then = [("bearing", along, 3e-3), ("bearing", up, 0.3)]
+    sweeper = sweep.Sweeper(meshes, slides, workers=1)
+    assert sweeper.blocked(first) == [set(), {"housing", "shaft"}]
+    asked = sweeper.queries
+    entailed = sweeper.blocked(then)
+    assert sweeper.queries == asked  # no query: each answer entailed by the first two
+    fresh = sweep.Sweeper(meshes, slides, workers=1)
+    assert entailed == fresh.blocked(then) == [set(), {"housing", "shaft"}] and fresh.queries > 0
+
+
+def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
+    parts = {p.id: p.mesh for p in _shaft_in_bearing((64, 360, 40))}
+    fixed = sweep._Triangles(np.array(parts["bearing"].triangles))
+    shaft = np.asarray(parts["shaft"].vertices)
+    chosen = []
+    for shift in ([0.0, 0.0, 3e-3], [0.0, 2e-3, 0.0], [5e-3, 0.0, 1e-3]):
+        piece = sweep._hull_piece(np.vstack([shaft, shaft + shift]))
+        assert piece is not None
+        found = fixed.near(piece.points.min(axis=0), piece.points.max(axis=0))
+        assert len(found) > 4 * sweep.LIKELY  # the bound prunes here
+        # the full ranking: every near triangle's reach measured
+        toward = fixed.centres[found] - piece.points.mean(axis=0)
+        toward /= np.linalg.norm(toward, axis=1, keepdims=True)
+        reach = (np.max(toward @ piece.points.T, axis=1)
+                 - np.min(np.einsum("mvc,mc->mv", fixed.corners[found], toward), axis=1))
+        order = np.argsort(-reach, kind="stable")[:sweep.LIKELY]
+        chosen.append(sweep._likely(piece, fixed))
+        assert set(chosen[-1]) == set(found[order[reach[order] > sweep.TOUCH]])
+    assert all(len(c) == sweep.LIKELY for c in chosen)
