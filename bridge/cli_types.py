@@ -223,6 +223,15 @@ def _on_sigterm(_signum: int, _frame: object) -> None:
     raise Terminated
 
 
+def worker_signals() -> None:
+    """The initializer of a worker process a command forks (a pool's): SIGTERM, which the
+    pool's ``terminate`` sends, ends it at once as by default, not through the command's
+    handler it was forked with (which would raise :class:`Terminated` in it and print its
+    traceback), and Ctrl-C is left to the command, which stops the pool."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _terminate_by_exception() -> signal.Handlers | Callable[..., Any] | int | None:
     """Make SIGTERM raise :class:`Terminated` while a command runs (Python's default ends the
     process at once, leaving its children running); returns the handler to restore, None

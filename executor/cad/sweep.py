@@ -68,6 +68,8 @@ import shapely
 import trimesh
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
+from bridge.cli_types import worker_signals
+
 TOUCH = 1e-5
 """Contacts at most this deep [m] are touching, not colliding (10 µm: below every
 clearance a cell can insert with; Cranfield's tight fit is 50 µm a side)."""
@@ -648,12 +650,12 @@ def surveys(meshes: dict[str, trimesh.Trimesh]) -> dict[str, Survey]:
         return {pid: _survey(mesh) for pid, mesh in meshes.items()}
     global _SURVEYED
     _SURVEYED = meshes  # the workers' copy, forked now
-    pool = multiprocessing.get_context("fork").Pool(min(workers, len(meshes)))
+    pool = multiprocessing.get_context("fork").Pool(min(workers, len(meshes)), initializer=worker_signals)
     _SURVEYED = None
     try:
         order = sorted(meshes, key=lambda pid: -len(meshes[pid].faces))
         found = dict(zip(order, pool.map(_surveyed, order, chunksize=1)))
-        pool.close()  # the workers end on their own (a SIGTERM would meet the command's handler in them)
+        pool.close()  # the workers end on their own once the tasks are done
     except BaseException:
         pool.terminate()
         raise
@@ -833,7 +835,7 @@ class Sweeper:
                 self._prepare(pending.values())
                 global _FORKED
                 _FORKED = self  # the workers' copy, forked now
-                self._pool = multiprocessing.get_context("fork").Pool(self.workers)
+                self._pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=worker_signals)
                 _FORKED = None
                 weakref.finalize(self, self._pool.terminate)  # the workers end (and are reaped) with the sweeper
             self._answers.update(zip(pending, self._pool.map(_swept, pending.values(), chunksize=1)))
