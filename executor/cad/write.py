@@ -459,13 +459,24 @@ REASONS = {
 """Why a pair of ``geometric_precedence.lp`` holds, as its comments say."""
 
 
-def precedence_text(derived: Derived) -> str:
-    """``geometric_precedence.lp``: its pairs with their reasons (comments), ``part/1`` and
-    the closed ``must_precede/2``."""
+def _order(derived: Derived) -> nx.DiGraph:
+    """The geometric precedence as a graph: every part a node, each derived pair an edge."""
     graph = nx.DiGraph()
     graph.add_nodes_from(derived.parts)
     graph.add_edges_from(derived.edges)
-    closure = sorted(nx.transitive_closure_dag(graph).edges)
+    return graph
+
+
+def _maybe_in_place(derived: Derived, pid: str) -> set[str]:
+    """The parts that may be in place when part ``pid`` goes to its goal: all but ``pid``
+    and those the geometric precedence puts after it."""
+    return set(derived.parts) - nx.descendants(_order(derived), pid) - {pid}
+
+
+def precedence_text(derived: Derived) -> str:
+    """``geometric_precedence.lp``: its pairs with their reasons (comments), ``part/1`` and
+    the closed ``must_precede/2``."""
+    closure = sorted(nx.transitive_closure_dag(_order(derived)).edges)
     used = [reason for reason in REASONS if reason in derived.reasons.values()]
     lines = ["% Geometric precedence by disassembly (./run.sh import), transitively closed: must_precede(A,B) when",
              *(f"% {reason}: {REASONS[reason]}" + (";" if k + 1 < len(used) else ".") for k, reason in enumerate(used)),
@@ -579,9 +590,6 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     None where :data:`GRIPPER`'s keeps it clear, with why (the part, the part below the
     wrist and how high it stands) otherwise. A part the wrist meets stops short of its goal
     (``occt_as1``: bolt_a1 4.1 mm above it, the wrist on bracket_a's wall)."""
-    graph = nx.DiGraph()
-    graph.add_nodes_from(derived.parts)
-    graph.add_edges_from(derived.edges)
     depth = GRIPPER["grasp_depth"]
     grips = {pid: (fit.position, fit.entry - fit.depth + float(_upright(derived, fit).extents[2]) - depth)
              for pid, fit in derived.hole_of.items() if fit.axis == "+z"}
@@ -592,8 +600,7 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     need, why = GRIPPER["flange_length"], ""
     clear = {derived.base} if derived.pins else set()  # the cell's wrist does not collide with a base with pins
     for pid, (xy, grip) in sorted(grips.items()):
-        later = nx.descendants(graph, pid)
-        for other in sorted(set(derived.parts) - later - clear - {pid}):
+        for other in sorted(_maybe_in_place(derived, pid) - clear):
             top = _highest_near(derived.parts[other].mesh, xy, WRIST_RADIUS)
             if top is not None and top - grip + WRIST_CLEARANCE > need + 1e-9:
                 need = top - grip + WRIST_CLEARANCE
@@ -675,14 +682,11 @@ def _wrist_meets(derived: Derived, fit: HoleFit | PinFit, pid: str, centre: tupl
     :data:`WRIST_CLEARANCE` short of it within that radius of the axis, a part in ``inner``
     only outside that radius [m] of it. Any longer flange the product gets keeps this: the
     wrist only moves farther out along the axis."""
-    graph = nx.DiGraph()
-    graph.add_nodes_from(derived.parts)
-    graph.add_edges_from(derived.edges)
     turn = _turn(fit)
     along = _along(derived.parts[pid].mesh, fit)[:, 2]
     low, high = float(along.min()), float(along.max())
     grip = high - min(GRIPPER["grasp_depth"], (high - low) / 2)
-    for other in sorted(set(derived.parts) - nx.descendants(graph, pid) - {pid}):
+    for other in sorted(_maybe_in_place(derived, pid)):
         mesh = derived.parts[other].mesh.copy().apply_transform(turn)
         top = _highest_near(mesh, centre, WRIST_RADIUS, inner.get(other, 0.0))
         if top is not None and top - grip + WRIST_CLEARANCE > GRIPPER["flange_length"] + 1e-9:
