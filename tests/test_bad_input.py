@@ -562,11 +562,18 @@ code, nothing it prints on its way out, PyBullet's banner) is checked there."""
 def _threads_children_clients() -> tuple[set[int], set[int], set[int]]:
     """This process's Python threads, child processes and connected PyBullet clients (ids):
     what a command run in this process could leave behind for the next row."""
-    children = {int(pid) for task in Path("/proc/self/task").iterdir()
-                for pid in (task / "children").read_text().split()}
+    children = {int(pid) for task in Path("/proc/self/task").iterdir() for pid in _task_children(task)}
     pybullet = sys.modules.get("pybullet")
     clients = {n for n in range(PYBULLET_CLIENTS) if pybullet.isConnected(physicsClientId=n)} if pybullet else set()
     return {thread.ident or 0 for thread in threading.enumerate()}, children, clients
+
+
+def _task_children(task: Path) -> list[str]:
+    """The child process ids one thread started; none when the thread ended since the listing."""
+    try:
+        return (task / "children").read_text().split()
+    except FileNotFoundError:
+        return []
 
 
 PYBULLET_CLIENTS = 1024  # PyBullet's own bound on the clients of one process (MAX_PHYSICS_CLIENTS)
