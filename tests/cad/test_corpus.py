@@ -102,6 +102,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
     "occt_pump",
     "occt_pulley",
     "asm4_disk_arm",
+    "gridfinity_bases",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -127,7 +128,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
                                   "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
-                                  "vitac_shapes",
+                                  "vitac_shapes", "gridfinity_bases",
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
                                       reason="its disk's d 21 bore is measured on its tessellation, d 20.951 (a "
@@ -163,6 +164,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "occt_pump",
     "occt_pulley",
     "asm4_disk_arm",
+    "gridfinity_bases",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
@@ -265,6 +267,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                              "pulley onto the hub's boss along -y: room 0), or into a hole and "
                                              "shorter than the gripper's grasp depth (the bolts, 14 mm)")),
     "vitac_shapes",
+    pytest.param("gridfinity_bases", marks=_xfail(INSERTED + " into a hole and shorter than the gripper's grasp "
+                                                  "depth (the bin bases, 4.75 mm)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
