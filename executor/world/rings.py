@@ -309,7 +309,9 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
                     f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
         corners = "/".join(map(str, sorted({len(ring.coords) - 1 for c in candidates for ring in c[k][0].interiors})))
         bore = (f"the bore a regular {corners}-gon about its inscribed circle (round pins pass it as they pass the "
-                "mesh's)" if round_pins else "exact at the bore" if k == 0 else
+                "mesh's)" if round_pins and bores == 1 else
+                f"each of its {bores} bores a regular {corners}-gon about its inscribed circle (round pins pass them "
+                "as they pass the mesh's)" if round_pins else "exact at the bore" if k == 0 else
                 f"the bore {corners}-cornered, inscribed in the mesh's, {1e6 * loss:.1f} um smaller")
         heights = ", ".join(f"{1e3 * (top - bottom):.3f}" for _, bottom, top in layers)
         return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section(s) over its {len(layers)} layer(s) of "
