@@ -1,10 +1,11 @@
 """A plate over two dowel pins of the base, each pin through its own bore: a base with two
-d 8 pins 40 mm apart and a 70 x 24 x 5 mm plate with two d 8.2 bores (0.1 mm of room per
-side) is imported with the plate one the cell puts onto both pins (down its first, held as
-the CAD turns it, its second bore over the second pin), taught and assembled in physics;
-with the second pin 1 mm off its place (the bores' spacing wrong by 1 mm) the same skill
-stops it. A plate the cell cannot put onto its pins stays placed by hand with the reason:
-too little room on one pin, or pins along a horizontal axis."""
+d 8 pins 40 mm apart on a diagonal (30 deg from x) and a 70 x 24 x 5 mm plate with two
+d 8.2 bores (0.1 mm of room per side) is imported with the plate one the cell puts onto
+both pins (down its first, held as the CAD turns it, its second bore over the second pin),
+taught and assembled in physics; with the second pin 1 mm farther from the first (the
+bores' spacing wrong by 1 mm) the same skill stops it. A plate the cell cannot put onto
+its pins stays placed by hand with the reason: too little room on one pin, or pins along a
+horizontal axis."""
 
 from __future__ import annotations
 
@@ -29,13 +30,16 @@ X_MM = 560.0
 """Where the product stands along x [mm]: within the simulated arm's reach."""
 APART = 40.0
 """The distance between the two pins [mm]."""
+TURN = 30.0
+"""How far the product of the physics tests is turned about the vertical [deg]: its pins on a diagonal."""
 
 
-def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), lying: bool = False) -> Path:
+def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), turn: float = 0.0, lying: bool = False) -> Path:
     """The base (100 x 60 x 10 mm) with two round d 8 pins (64-gons) standing 20 mm above its
     top at x 560 -/+ 20 mm, and the plate (70 x 24 x 5 mm) on that top with round ``bores``
-    [mm] (128-gons) over the pins, as STL files [mm], imported; with ``lying``, all turned a
-    quarter turn about x (the pins along +y, 30 mm up); the folder written."""
+    [mm] (128-gons) over the pins, all turned ``turn`` [deg] about the vertical through
+    (560, 0), as STL files [mm], imported; with ``lying``, all turned a quarter turn about x
+    instead (the pins along +y, 30 mm up); the folder written."""
     cad = tmp / "cad"
     cad.mkdir(parents=True)
     base = trimesh.creation.box((100.0, 60.0, 10.0))
@@ -48,10 +52,10 @@ def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), lying: bool = Fa
     plate = trimesh.creation.extrude_polygon(outline, 5.0)
     plate.apply_translation((X_MM, 0.0, 10.0))
     base = trimesh.boolean.union([base, *pins], engine="manifold")
-    if lying:
-        turn = trimesh.transformations.rotation_matrix(-np.pi / 2, (1.0, 0.0, 0.0), (X_MM, 0.0, 30.0))
-        base.apply_transform(turn)
-        plate.apply_transform(turn)
+    turned = (trimesh.transformations.rotation_matrix(-np.pi / 2, (1.0, 0.0, 0.0), (X_MM, 0.0, 30.0)) if lying else
+              trimesh.transformations.rotation_matrix(np.radians(turn), (0.0, 0.0, 1.0), (X_MM, 0.0, 0.0)))
+    base.apply_transform(turned)
+    plate.apply_transform(turned)
     base.export(cad / "base.stl")
     plate.export(cad / "plate.stl")
     (tmp / "import.toml").write_text('base = "base"\n[parts.plate]\ntray = [0.30, 0.28]\n')
@@ -61,9 +65,9 @@ def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), lying: bool = Fa
 
 @pytest.fixture(scope="module")
 def taught(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The plate with two d 8.2 bores imported and taught on its first pin (``executor
-    teach``, in this process)."""
-    return teach(_import(tmp_path_factory.mktemp("two_pins")))
+    """The plate with two d 8.2 bores over the pins on a diagonal imported and taught on its
+    first pin (``executor teach``, in this process)."""
+    return teach(_import(tmp_path_factory.mktemp("two_pins"), turn=TURN))
 
 
 def _atoms(path: Path, name: str) -> set[str]:
@@ -75,12 +79,16 @@ def _atoms(path: Path, name: str) -> set[str]:
 def test_a_plate_over_two_pins_is_one_the_cell_puts_onto_them(taught: Path) -> None:
     # both pairs are written for the learner, the truth backend and the prior; the cell has
     # the first pin as its hole (the plate's demo_hole) and no hole at the second, which the
-    # plate takes: no plan puts the plate down the second pin with its first bore
+    # plate takes: no plan puts the plate down the second pin with its first bore. Each pin
+    # is measured alone: the other, on the diagonal, lies within the square about the first
+    # that the plate reaches, but not within the circle
     product = load_product_description(taught)
     geometry = product.geometry
     assert geometry is not None and geometry.manual == {}
     assert _atoms(taught / "sizes.lp", "fits") == {"fits(plate,base_pin1)", "fits(plate,base_pin2)"}
     assert set(geometry.hole_shapes) == {"base_pin1"} and set(product.assembly.holes) == {"base_pin1", "base_pin2"}
+    pin = geometry.hole_shapes["base_pin1"]
+    assert pin.kind == "round" and pin.size == pytest.approx(0.008, abs=1e-6)
     plate = geometry.part_shapes["plate"]
     assert plate.bore and plate.demo_hole == "base_pin1"
     # its pieces: one layer, both bores regular polygons about their inscribed circles
@@ -91,23 +99,25 @@ def test_a_plate_over_two_pins_is_one_the_cell_puts_onto_them(taught: Path) -> N
 def test_a_plate_onto_two_pins_is_assembled_within_2_mm(taught: Path) -> None:
     step, quat = assembled(taught, "base", "plate", "base_pin1")
     assert step.skill == "insert", step
-    # down on the base's top, so each bore is around its pin: the yaw the CAD has, within
-    # what 0.1 mm of room per side leaves over 40 mm (0.29 deg)
+    # down on the base's top, so each bore is around its pin: turned as the CAD has it (the
+    # part frame's), within what 0.1 mm of room per side leaves over 40 mm (0.29 deg)
     assert quat_to_matrix(quat)[:, 0] == pytest.approx([1.0, 0.0, 0.0], abs=0.005)
 
 
 @pytest.mark.slow  # teaches the plate (shared), then one attempt in physics (about 5 s of CPU)
 def test_a_second_pin_off_its_place_stops_the_plate_in_physics(taught: Path, tmp_path: Path) -> None:
-    # The base (its own mesh) with its second pin 1 mm farther from the first: the plate's
-    # bores, 40 mm apart, no longer pass both pins. One attempt: the trial's second one after
+    # The base (its own mesh) with its second pin 1 mm farther from the first, along the
+    # diagonal: the plate's bores, 40 mm apart, no longer pass both pins. One attempt: the trial's second one after
     # a no-fit is tests/executor/test_executor_cell.py's.
     moved = tmp_path / "moved"
     shutil.copytree(taught, moved)
-    x, y = load_product_description(moved).assembly.holes["base_pin1"].position or (0.0, 0.0)
+    holes = load_product_description(moved).assembly.holes
+    first, second = (np.array(holes[hid].position or (0.0, 0.0)) for hid in ("base_pin1", "base_pin2"))
     mesh_file = moved / "meshes" / "base.obj"
     base = trimesh.load(mesh_file, force="mesh", process=False)
     vertices = base.vertices.copy()
-    vertices[np.hypot(vertices[:, 0] - x - APART / 1e3, vertices[:, 1] - y) < 0.0045, 0] += 0.001
+    near = np.linalg.norm(vertices[:, :2] - second, axis=1) < 0.0045  # the pin and its foot's ring
+    vertices[near, :2] += 0.001 * (second - first) / np.linalg.norm(second - first)
     base.vertices = vertices
     base.export(mesh_file)
     old = hashlib.sha256((taught / "meshes" / "base.obj").read_bytes()).hexdigest()
