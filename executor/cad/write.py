@@ -25,7 +25,9 @@
   (:func:`_cell_disagrees`; left out otherwise, and the report says why; a hole or bore
   with nominal zero-clearance fits at its nominal diameter, naming them,
   :func:`nominal_section`): pegs standing in holes entered along +z with a round, square
-  or rect section or the prism of a polygon (built by the cell from its outline), covers and heads
+  or rect section or the prism of a polygon (built by the cell from its outline), parts
+  with a bore onto pins of the base (a part on several pins down its first, the only
+  one of them written: :func:`_onto_pins`), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
   :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
   at another one with its own ``top_z`` and ``depth``, the
