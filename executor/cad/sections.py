@@ -230,8 +230,9 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     free at every level of the span, the loop less the :func:`shadow` of the faces within
     the loop's box (where that leaves several pieces, the largest). A part's: the points
     it covers at some level, the loop with the shadow of its faces within ``reach`` [m] of
-    the loop's centre across the axis, by their box (a pin's owner's other pins are not the
-    pin), its outer outline (pieces apart joined by their convex hull, but slivers within
+    the loop's centre across the axis (the faces by their box, their shadow cut to a 64-gon
+    about the circle of that radius: a pin's owner's other pins are not the pin, on a
+    diagonal too), its outer outline (pieces apart joined by their convex hull, but slivers within
     :data:`SAME_OUTLINE` of it: a wall's faces along the axis, tilted by the float). Exact, whatever
     lies between the levels slices are taken at (a taper, a groove's edge, a slanted
     facet): a point free at one level of the span and covered at another lies under a
@@ -248,6 +249,9 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
         x, y = loop.centre
         x0, y0, x1, y1 = x - reach, y - reach, x + reach, y + reach
     cover, dropped = shadow(mesh, axis, low, high, (x0, y0, x1, y1), outline.exterior.buffer(SLIVER))
+    if not hole and math.isfinite(reach):  # the box's corners reach farther: a plate's other pin on a diagonal
+        cover = shapely.intersection(cover, shapely.Point(loop.centre).buffer(reach / math.cos(math.pi / 64),
+                                                                              quad_segs=16))
     if cover.is_empty and not dropped:
         return loop
     if hole:

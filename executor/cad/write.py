@@ -25,7 +25,9 @@
   (:func:`_cell_disagrees`; left out otherwise, and the report says why; a hole or bore
   with nominal zero-clearance fits at its nominal diameter, naming them,
   :func:`nominal_section`): pegs standing in holes entered along +z with a round, square
-  or rect section or the prism of a polygon (built by the cell from its outline), covers and heads
+  or rect section or the prism of a polygon (built by the cell from its outline), parts
+  with a bore onto pins of the base (a part on several pins down its first, the only
+  one of them written: :func:`_onto_pins`), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
   :func:`cell_view`); the plate at the entry height and depth most holes share, a hole
   at another one with its own ``top_z`` and ``depth``, the
@@ -519,8 +521,9 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
                                  f"grasp depth ({1e3 * GRIPPER['grasp_depth']:g} mm)")
         else:
             kept[hid] = fit
-    pins = {pin_id: pin for pin_id, pin in derived.pins.items()
-            if pin.owner == derived.base and pin.axis != "-z" and pin.parts}  # an empty pin: no goal on it
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items()  # an empty pin: no goal on it; a further pin
+            if pin.owner == derived.base and pin.axis != "-z" and pin.parts  # of a part the cell puts onto its first:
+            and not any((pid, pin_id) in derived.further_bores and pid not in by_hand for pid in pin.parts)}  # taken
     # A hole whose part goes by hand leaves the cell, which may make the base its own mesh,
     # where the cell widens no zero-clearance fit: until no more parts go.
     while unresolved := _unresolved_in_hole(derived, replace(derived, holes=kept, pins=pins)):
@@ -617,8 +620,8 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
     the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`);
-    a part on more than one pin (a plate over two dowel pins) is placed by hand, the cell
-    aligning one bore with one pin;
+    a part on more than one pin (a plate over two dowel pins) goes onto them all at once
+    where :func:`_onto_pins` allows;
     a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
@@ -626,8 +629,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
     if pin.axis == "-z":
         return f"goes onto its pin ({pin.id}) along +z, from below"
-    if len(on := [p.id for p in derived.pins.values() if pid in p.parts]) > 1:
-        return f"goes onto {len(on)} pins ({', '.join(on)}): the cell puts a part onto one pin"
+    if len(on := [p for p in derived.pins.values() if pid in p.parts]) > 1:
+        return _onto_pins(derived, on, pid)
     lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
     if pid != lowest and pin.axis == "+z":
         return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
@@ -643,6 +646,29 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
+    """Why the cell does not put part ``pid`` onto the several pins ``on`` it is on (None: it
+    does, down its first pin, :meth:`executor.cad.derive.Derived.pin_of`, held as the CAD
+    turns it, so each further bore comes down over its own pin). :func:`_onto_pin` has
+    checked its first pin (the base's, not entered from below); the pins share the part's
+    axis, which must be +z (pins standing up), the part must be the lowest on each, with
+    room on each that the cell resolves, and a stack of prisms with one bore per pin
+    (:func:`bore_pieces`)."""
+    names = ", ".join(pin.id for pin in on)
+    if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins), the owner the base here
+        return (f"goes onto {len(on)} pins ({names}) along {opposite(on[0].axis)}: the cell puts a part onto several "
+                "pins only down onto pins standing up (+z)")
+    for pin in on:
+        lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
+        if pid != lowest:
+            return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
+        if why := _unresolved(margins(derived)[pid][pin.id]):
+            return f"goes onto a pin ({pin.id}) {why}"
+    mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
+    found = bore_pieces(derived, pid)(pid, as_written(mesh))
+    return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
 
 
 def _unreached(axis: str, end: tuple[float, float, float], spans: Mapping[str, tuple[float, float]],
@@ -724,10 +750,11 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
                                              high - low + 2 * NEAR)
     solid.apply_translation((0.0, 0.0, low - NEAR))  # the pin in its frame, turned into the part frame
     solid.apply_transform(bore_frame(derived, pid) @ _turn(pin).T)
+    bores = 1 + sum(part == pid for part, _ in derived.further_bores)  # one per pin it is on
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
-        found = ring_pieces(name, part, allowed, round_pins(derived, pid))
-        if not isinstance(found, NoStack):
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores)
+        if not isinstance(found, NoStack) or bores > 1:  # CoACD's pieces are checked about one pin
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
@@ -749,10 +776,11 @@ def bore_loss(derived: Derived, pid: str) -> float:
 
 
 def round_pins(derived: Derived, pid: str) -> bool:
-    """Whether part ``pid``'s bore is round and every pin it may go onto too (its cell's
-    bore may then be a polygon about its inscribed circle:
+    """Whether part ``pid``'s bores are round and every pin it may go onto too (its cell's
+    bores may then be polygons about their inscribed circles:
     :func:`executor.world.rings.round_bores`)."""
-    return derived.bores[pid].kind == "round" and all(pin.section.kind == "round" for pin in derived.pins.values())
+    return all(derived.bore_on(pid, pin.id).kind == "round" for pin in derived.pins.values() if pid in pin.parts) \
+        and all(pin.section.kind == "round" for pin in derived.pins.values())
 
 
 def _along(mesh: trimesh.Trimesh, pin: HoleFit | PinFit) -> np.ndarray:

@@ -125,18 +125,20 @@ _FOUND: dict[bytes, Found] = {}
 """:func:`ring_pieces` of each part and mesh asked for (an import asks for each more than once)."""
 
 
-def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pins: bool = False) -> Found:
-    """The convex pieces of part ``pid`` with a bore, its closed ``mesh`` in its part frame
-    [m] (z its axis; module docstring), each with 0.0 (no vertex dropped) and a line saying
-    how they were made; or why the part has none: no prism of its section, or a piece at
-    the bore too thin for the cell even with the bore made coarser by at most ``allowed``
-    [m] (:func:`coarser_bores`), or, when it goes onto ``round_pins`` only, circumscribing
-    the bore's inscribed circle (:func:`round_bores`)."""
-    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + bytes([round_pins])
+def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pins: bool = False,
+                bores: int = 1) -> Found:
+    """The convex pieces of part ``pid`` with ``bores`` bores (one per pin it goes onto: a
+    plate over two dowel pins has two), its closed ``mesh`` in its part frame [m] (z its
+    axis; module docstring), each with 0.0 (no vertex dropped) and a line saying how they
+    were made; or why the part has none: no prism of its sections with that many bores, or
+    a piece at a bore too thin for the cell even with the bore made coarser by at most
+    ``allowed`` [m] (:func:`coarser_bores`, one bore only), or, when it goes onto
+    ``round_pins`` only, circumscribing each bore's inscribed circle (:func:`round_bores`)."""
+    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + bytes([round_pins, bores])
                          + np.ascontiguousarray(mesh.vertices).tobytes()
                          + np.ascontiguousarray(mesh.faces).tobytes()).digest()
     if key not in _FOUND:
-        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins)
+        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins, bores)
     return _FOUND[key]
 
 
@@ -162,57 +164,77 @@ def coarser_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapel
     return found
 
 
+def _discs(section: shapely.Polygon, centres: list[np.ndarray]) -> list[float]:
+    """The radius [m] of each bore's disc: the largest circle about its centre (``centres``,
+    one per bore of ``section``) within the section's outline and at most half way to the
+    other bores' centres (the discs of two bores do not overlap)."""
+    outline = shapely.Polygon(section.exterior).exterior
+    return [min([float(shapely.distance(shapely.Point(*centre), outline)),
+                 *(float(np.linalg.norm(centre - other)) / 2 for other in centres if other is not centre)])
+            for centre in centres]
+
+
 def sector_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
-    """Convex polygons whose union is ``section``, whose one bore is a regular polygon
-    (:func:`round_bores`): for each edge of the bore, the sector between the rays from the
-    bore's centre through its ends, out to the largest circle about the centre within the
-    section's outline (a polygon inscribed in it); and the convex parts
-    (:func:`convex_parts`) of what lies beyond those circles (a gear's teeth, a handle)."""
-    ring = np.asarray(section.interiors[0].coords)[:-1]
-    centre = np.round(ring.mean(axis=0) / _GRID) * _GRID  # one disc for every bore of one section
+    """Convex polygons whose union is ``section``, whose bores are regular polygons
+    (:func:`round_bores`): for each edge of a bore, the sector between the rays from the
+    bore's centre through its ends, out to the bore's disc (:func:`_discs`: the largest
+    circle about the centre within the section's outline, half way to the other bores at
+    most; a polygon inscribed in it; of a section with several bores, the polygon of those
+    rays inscribed in it); and the convex parts (:func:`convex_parts`) of what lies beyond
+    those discs (a gear's teeth, a handle, the plate between two bores)."""
     outline = shapely.Polygon(section.exterior)
-    inner = float(shapely.distance(shapely.Point(*centre), outline.exterior))
-    disc = shapely.Point(*centre).buffer(inner, quad_segs=32)
-    far = 2 * float(np.max(np.linalg.norm(np.asarray(outline.exterior.coords) - centre, axis=1)))
-    cores = []
-    for a, b in zip(ring, np.roll(ring, -1, axis=0)):
-        wedge = shapely.Polygon([a, b, centre + far * (b - centre) / np.linalg.norm(b - centre),
-                                 centre + far * (a - centre) / np.linalg.norm(a - centre)])
-        cores.append(shapely.intersection(wedge, disc))
-    return cores + list(_beyond(outline, disc))
+    cores, discs = [], []
+    rings = [np.asarray(ring.coords)[:-1] for ring in section.interiors]
+    centres = [np.round(corners.mean(axis=0) / _GRID) * _GRID for corners in rings]  # one disc for every bore tried
+    for corners, centre, inner in zip(rings, centres, _discs(section, centres)):
+        far = 2 * float(np.max(np.linalg.norm(np.asarray(outline.exterior.coords) - centre, axis=1)))
+        if len(section.interiors) == 1:
+            disc = shapely.Point(*centre).buffer(inner, quad_segs=32)
+        else:  # what lies between the bores has straight sides, not arcs that only slivers fill
+            rays = (corners - centre) / np.linalg.norm(corners - centre, axis=1)[:, None]
+            disc = shapely.Polygon(centre + inner * rays)
+        discs.append(disc)
+        for a, b in zip(corners, np.roll(corners, -1, axis=0)):
+            wedge = shapely.Polygon([a, b, centre + far * (b - centre) / np.linalg.norm(b - centre),
+                                     centre + far * (a - centre) / np.linalg.norm(a - centre)])
+            cores.append(shapely.intersection(wedge, disc))
+    return cores + list(_beyond(outline, shapely.union_all(discs)))
 
 
 @functools.lru_cache(maxsize=16)
-def _beyond(outline: shapely.Polygon, disc: shapely.Polygon) -> tuple[shapely.Polygon, ...]:
-    """The convex parts of ``outline`` beyond ``disc`` (the same for every bore tried)."""
-    beyond = shapely.difference(outline, disc)
+def _beyond(outline: shapely.Polygon, discs: shapely.Geometry) -> tuple[shapely.Polygon, ...]:
+    """The convex parts of ``outline`` beyond ``discs`` (the same for every bore tried)."""
+    beyond = shapely.difference(outline, discs)
     return tuple(part for polygon in getattr(beyond, "geoms", [beyond]) if isinstance(polygon, shapely.Polygon)
                  and polygon.area > 0 for part in convex_parts(shapely.set_precision(polygon, _GRID)))
 
 
 def round_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapely.Polygon, float]]:
-    """``section`` with its one bore made a regular polygon of :data:`ROUND_BORE_CORNERS`
-    corners (most first) whose inscribed circle is the bore's (about its centroid); each
-    with loss 0.0 (``allowed`` is not needed): a round pin passes such a polygon exactly
-    when it passes that circle, as it passes the bore. The polygon's corners reach beyond
-    the bore, so it is for parts that go onto round pins only."""
+    """``section`` with each bore made a regular polygon of :data:`ROUND_BORE_CORNERS`
+    corners (most first) whose inscribed circle is the bore's (about its centroid), within
+    the bore's disc (:func:`_discs`); each with loss 0.0 (``allowed`` is not
+    needed): a round pin passes such a polygon exactly when it passes that circle, as it
+    passes the bore. The polygon's corners reach beyond the bore, so it is for parts that
+    go onto round pins only."""
     found: list[tuple[shapely.Polygon, float]] = []
-    bore = shapely.Polygon(section.interiors[0])
-    centre = bore.centroid
-    radius = float(shapely.distance(centre, bore.exterior))
+    centres = [np.array(shapely.Polygon(ring).centroid.coords[0]) for ring in section.interiors]
+    discs = _discs(section, centres)
+    radii = [float(shapely.distance(shapely.Point(*centre), ring)) for ring, centre in zip(section.interiors, centres)]
     for corners in ROUND_BORE_CORNERS:
         turn = np.linspace(0.0, 2 * np.pi, corners, endpoint=False)
-        reach = radius / np.cos(np.pi / corners)
-        ring = np.column_stack([centre.x + reach * np.cos(turn), centre.y + reach * np.sin(turn)])
-        if shapely.Polygon(ring).within(shapely.Polygon(section.exterior)):
-            found.append((shapely.Polygon(section.exterior.coords, [ring]), 0.0))
+        reach = [radius / np.cos(np.pi / corners) for radius in radii]
+        if any(far >= inner for far, inner in zip(reach, discs)):
+            continue
+        rings = [np.column_stack([centre[0] + far * np.cos(turn), centre[1] + far * np.sin(turn)])
+                 for far, centre in zip(reach, centres)]
+        found.append((shapely.Polygon(section.exterior.coords, rings), 0.0))
     return found
 
 
-def stack(pid: str, mesh: trimesh.Trimesh) -> list[tuple[shapely.Polygon, float, float]] | str:
-    """The layers of part ``pid`` with a bore, its closed ``mesh`` in its part frame [m]
-    (module docstring), each as (its section, its bottom, its top) [m], the section one
-    polygon with one bore; or why it has none."""
+def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely.Polygon, float, float]] | str:
+    """The layers of part ``pid`` with ``bores`` bores, its closed ``mesh`` in its part
+    frame [m] (module docstring), each as (its section, its bottom, its top) [m], the
+    section one polygon with that many bores; or why it has none."""
     low, high = (float(v) for v in mesh.bounds[:, 2])
     levels = [low]
     for z in np.sort(mesh.triangles_center[np.abs(mesh.face_normals[:, 2]) > 1 - _ACROSS, 2]):
@@ -235,18 +257,19 @@ def stack(pid: str, mesh: trimesh.Trimesh) -> list[tuple[shapely.Polygon, float,
     found = []
     for section, bottom, top in layers:
         polygons = list(getattr(section, "geoms", [section]))
-        if len(polygons) != 1 or len(polygons[0].interiors) != 1:
-            return NoStack(f"part '{pid}' has no one bore in its section from {1e3 * (bottom - low):.3f} to "
+        if len(polygons) != 1 or len(polygons[0].interiors) != bores:
+            many = "one bore" if bores == 1 else f"{bores} bores"
+            return NoStack(f"part '{pid}' has no {many} in its section from {1e3 * (bottom - low):.3f} to "
                            f"{1e3 * (top - low):.3f} mm of its height")
         found.append((polygons[0], bottom, top))
     return found
 
 
-def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -> Found:
+def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, bores: int) -> Found:
     """:func:`ring_pieces`, made."""
     if not mesh.is_volume:  # as written, a mesh can lose a sliver face to rounding
         return NoStack(f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections")
-    layers = stack(pid, mesh)
+    layers = stack(pid, mesh, bores)
     if isinstance(layers, str):
         return layers
     differ = mesh.volume
@@ -259,8 +282,8 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -
         return NoStack(f"part '{pid}' is no stack of prisms of its sections (they differ by "
                        f"{differ / mesh.volume:.1%} of its volume over {len(layers)} layer(s); the cell's exact "
                        "pieces of a part with a bore are prisms')")
-    bores = round_bores if round_pins else coarser_bores
-    candidates = [bores(section, allowed) for section, _, _ in layers]
+    made = round_bores if round_pins else coarser_bores
+    candidates = [made(section, allowed) for section, _, _ in layers]
     # the exact sections first, then the finest coarser bores that work, found by bisection
     # (a coarser bore has wider pieces at it); each one returned is checked whole
     order, low_k, high_k = [0], 1, min(len(c) for c in candidates) - 1
@@ -284,9 +307,11 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool) -
         if dropped >= THIN_TOLERANCE * mesh.volume:
             return (f"part '{pid}': the parts of its sections thinner than the cell's hull margin twice are "
                     f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
-        corners = "/".join(map(str, sorted({len(c[k][0].interiors[0].coords) - 1 for c in candidates})))
+        corners = "/".join(map(str, sorted({len(ring.coords) - 1 for c in candidates for ring in c[k][0].interiors})))
         bore = (f"the bore a regular {corners}-gon about its inscribed circle (round pins pass it as they pass the "
-                "mesh's)" if round_pins else "exact at the bore" if k == 0 else
+                "mesh's)" if round_pins and bores == 1 else
+                f"each of its {bores} bores a regular {corners}-gon about its inscribed circle (round pins pass them "
+                "as they pass the mesh's)" if round_pins else "exact at the bore" if k == 0 else
                 f"the bore {corners}-cornered, inscribed in the mesh's, {1e6 * loss:.1f} um smaller")
         heights = ", ".join(f"{1e3 * (top - bottom):.3f}" for _, bottom, top in layers)
         return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section(s) over its {len(layers)} layer(s) of "
