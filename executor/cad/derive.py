@@ -30,9 +30,10 @@ base), entry chamfer (the loop's growth just below the entry, taken as 45°). An
 loop whose section is a polygon is a hole only when it has rotational symmetry about its
 centre (:func:`receives`), else a pocket, reported but no hole. Both sections are those
 over the stretch the part passes, from its end to the entry
-(:func:`executor.cad.sections.over_span`: the hole's narrowest, the part's widest).
-Where those do not pass, the part is swept out of its hole level by level
-(:func:`swept_fits`: a taper in its own taper passes).
+(:func:`executor.cad.sections.over_span`: the hole's narrowest, the part's widest); an
+empty hole's over the stretch a part goes in, from its floor (or through) to its entry,
+so alike holes are measured alike, occupied or not. Where those do not pass, the part is
+swept out of its hole level by level (:func:`swept_fits`: a taper in its own taper passes).
 
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
@@ -995,18 +996,28 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     the hole's centre line; through it, to its lowest point around the hole, when there is
     none) and chamfer of the hole ``loop`` sliced at ``level`` [m], and the section of the
     ``occupant`` (its part, its loop there). The sections are over the stretch from the
-    occupant's end (or the hole's lowest point around it, if higher; without one, from
-    ``level``) to the entry (:func:`executor.cad.sections.over_span`); ExecutorError when
-    nothing of the hole is free all along it."""
+    occupant's end (or the hole's lowest point around it, if higher) to the entry
+    (:func:`executor.cad.sections.over_span`); without one, from the floor (the first face
+    of ``base`` down the centre line of the loop) or, with none, from the hole's lowest point
+    around it: as deep as a part goes in. Where nothing of the hole is free down to that
+    floor, it is no face across the axis (a drill point's cone) and the stretch starts at
+    ``level``. ExecutorError when nothing of the hole is free all along the stretch."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
     sliced = classify(loop, hole=True)
     radial = base.mesh.vertices @ frame.T - sliced.centre
     around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(sliced.a, sliced.b)]
     entry = float(around.max())
-    tip = level if occupant is None else float((occupant[0].mesh.vertices @ axis).min())
+    if occupant is None:  # as deep as a part can go in: to the floor down its centre line, or through
+        floor = first_hit(base.mesh, frame.T @ sliced.centre + axis * level, -axis)
+        tip = float(around.min()) if floor is None else level - floor
+    else:
+        tip = float((occupant[0].mesh.vertices @ axis).min())
     low = max(tip, float(around.min()))
     narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
+    if occupant is None and len(narrowest.points) < 3:  # a floor not across the axis (a drill point's cone)
+        low = level
+        narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
     if len(narrowest.points) < 3:
         x, y, z = 1e3 * (frame.T @ sliced.centre + axis * level)
         raise ExecutorError(f"the hole of part {base.id} at ({x:.3f}, {y:.3f}, {z:.3f}) mm is closed between "

@@ -262,6 +262,43 @@ def test_a_tenon_swept_into_its_own_taper_fits_alike_tapers_and_not_a_straight_h
     assert rooms[own] == rooms[alike] == 0.0 and rooms[straight] < -0.0004
 
 
+def _stacked(profile: list[tuple[float, float]]) -> trimesh.Trimesh:
+    """A square solid about z whose side [m] at each level [m] of ``profile`` ((z, side),
+    upwards) runs straight to the next: frustums stacked."""
+    return trimesh.boolean.union([_frustum(z0, z1, s0, s1) for (z0, s0), (z1, s1) in zip(profile, profile[1:])],
+                                 engine="manifold")
+
+
+def test_alike_chamfered_through_pockets_are_measured_alike_occupied_or_not() -> None:
+    # A 126 x 42 x 4.65 mm plate with two alike square through pockets 42 mm apart (a
+    # Gridfinity baseplate's, with sharp corners): 36.3 mm at the floor, 45 deg out to 37.7
+    # by 0.7 mm, straight up to 2.5 mm, 45 deg out to 42 at the top; a foot standing on the
+    # floor in the first (35.6 at the floor, 37.2 from 0.8 to 2.6 mm, 41.5 at its top,
+    # 4.75 mm). Each pocket's section is the narrowest a part passes on its way through it,
+    # the 36.3 mm opening at the floor, and its chamfer from that; the empty one measured
+    # only from the level sliced (2.325 mm, half the foot's depth) up would be its 37.7 mm
+    # walls, with another chamfer. The sweep admits the foot into both with 0.5 mm of room
+    # (37.2 in 37.7).
+    plate = trimesh.creation.box((0.126, 0.042, 4.65 * MM), trimesh.transformations.translation_matrix(
+        (0.021, 0.0, 2.325 * MM)))
+    pocket = [(-MM, 34.3 * MM), (0.7 * MM, 37.7 * MM), (2.5 * MM, 37.7 * MM), (5.65 * MM, 44 * MM)]
+    cuts = [_stacked(pocket), _stacked(pocket)]
+    cuts[1].apply_translation((0.042, 0.0, 0.0))
+    plate = trimesh.boolean.difference([plate, *cuts], engine="manifold")
+    foot = _stacked([(0.0, 35.6 * MM), (0.8 * MM, 37.2 * MM), (2.6 * MM, 37.2 * MM), (4.75 * MM, 41.5 * MM)])
+    derived = derive([CadPart("plate", "plate", plate, "plate.stl"), CadPart("foot", "foot", foot, "foot.stl")],
+                     "plate", {})
+    at = {round(fit.position[0], 3): fit for fit in derived.holes.values()}
+    held, empty = at[0.0], at[0.042]
+    assert held.part == "foot" and empty.part is None
+    measured = [(fit.hole.kind, fit.hole.a, fit.hole.b, fit.chamfer, fit.depth) for fit in (held, empty)]
+    assert measured[0] == pytest.approx(measured[1], abs=1e-9)
+    assert held.hole.a == pytest.approx(36.3 * MM, abs=1e-8)
+    assert held.chamfer == pytest.approx((41.96 - 36.3) / 2 * MM + 0.02 * MM, abs=1e-7)  # probed 20 um below the top
+    for fit in (held, empty):
+        assert derived.swept[("foot", fit.id)][2] == pytest.approx(0.5 * MM, abs=1e-7)
+
+
 def _rings_near(rng: np.random.Generator) -> tuple[shapely.LinearRing, shapely.LinearRing]:
     """A random convex ring [m] and its copy with a point between each two of its corners,
     pushed off their edge by :data:`sections.SAME_OUTLINE` give or take a few ulps, or the
@@ -331,3 +368,24 @@ def test_a_section_over_a_span_without_its_slivers_is_conservative(hole: bool) -
     assert outer.covers(inner)
     assert inner.area < outer.area  # the ledge kept: the section changed by the tolerance only
     assert outer.area - inner.area < 4 * sections.SLIVER * 40 * MM
+
+
+def test_an_empty_drilled_hole_is_measured_above_its_drill_point() -> None:
+    # A 60 x 30 x 10 mm plate with a d 6 mm blind hole drilled 7 mm deep, its drill point's
+    # cone (apex 7 mm down, the bore 5 mm down) the first face down its centre line, and a
+    # d 6.4 mm through bore with a d 6 mm peg in it. The empty hole is measured as deep as a
+    # part goes in, to its floor: where the floor is no face across the axis (nothing of the
+    # hole is free down to the apex), from the level sliced, its bore (48 corners).
+    box = trimesh.creation.box((0.06, 0.03, 0.01), trimesh.transformations.translation_matrix((0.015, 0.0, 0.005)))
+    drilled = _revolved([(0.0, 3 * MM), (3 * MM, 5 * MM), (3 * MM, 11 * MM), (0.0, 11 * MM)])
+    bore = _revolved([(0.0, -MM), (3.2 * MM, -MM), (3.2 * MM, 11 * MM), (0.0, 11 * MM)])
+    bore.apply_translation((0.03, 0.0, 0.0))
+    plate = trimesh.boolean.difference([box, drilled, bore], engine="manifold")
+    peg = _revolved([(0.0, 0.0), (3 * MM, 0.0), (3 * MM, 20 * MM), (0.0, 20 * MM)], sections=64)
+    peg.apply_translation((0.03, 0.0, 0.0))
+    derived = derive([CadPart("plate", "plate", plate, "plate.stl"), CadPart("peg", "peg", peg, "peg.stl")],
+                     "plate", {})
+    empty = next(fit for fit in derived.holes.values() if fit.part is None)
+    assert empty.hole.kind == "round"
+    assert empty.hole.a == pytest.approx(6 * MM * math.cos(math.pi / 48), abs=1e-8)
+    assert empty.depth == pytest.approx(7 * MM, abs=1e-8)
