@@ -71,13 +71,14 @@ _CONVEX = 1e-9
 
 def section_at(mesh: trimesh.Trimesh, z: float) -> shapely.MultiPolygon:
     """The closed mesh's section at height ``z`` [m] of its frame: its polygons, holes
-    included (each loop's inside, even-odd: a loop within one other is a hole)."""
+    included (each loop's inside, even-odd: a loop within one other is a hole). What the
+    overlay leaves of no area (a line of a few um where two loops nearly meet) is dropped."""
     cut = mesh.section(plane_origin=(0.0, 0.0, z), plane_normal=(0.0, 0.0, 1.0))
     found = shapely.MultiPolygon()
     for loop in [] if cut is None else cut.discrete:
         if len(loop) >= 4:
             found = shapely.symmetric_difference(found, shapely.Polygon(np.asarray(loop)[:, :2]))
-    return found if isinstance(found, shapely.MultiPolygon) else shapely.MultiPolygon([found])
+    return shapely.MultiPolygon([part for part in shapely.get_parts(found) if isinstance(part, shapely.Polygon)])
 
 
 def convex_parts(section: shapely.Polygon) -> list[shapely.Polygon]:

@@ -5,13 +5,15 @@ collides as; a round bore on round pins is a regular polygon about its inscribed
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import shapely
 import trimesh
 
 from executor.cad.convex import APART, CONCAVITY_REACH, _shape_key, apart, pin_pieces
-from executor.world.rings import NoStack, ring_pieces
+from executor.world.rings import NoStack, ring_pieces, section_at
 
 BORE = 5.0e-3
 """The bore's radius [m] (a 64-gon's vertex circle)."""
@@ -92,3 +94,14 @@ def test_a_pin_pieces_key_tells_apart_the_same_vertices_joined_by_other_triangle
     flipped.faces[:2] = [[rim[0], shared[0], rim[1]], [rim[1], shared[1], rim[0]]]
     assert _shape_key(square) == _shape_key(turned)
     assert _shape_key(square) != _shape_key(flipped)
+
+
+def test_a_section_whose_overlay_leaves_a_line_is_its_polygons() -> None:
+    # flynn_clutch's outer plate (a ring with 20 splines outside, a round bore) cut at
+    # 0.6 mm above its bottom: the even-odd overlay of its two loops leaves, beside the
+    # ring, a line 2.5 um long, which made the section no MultiPolygon (a traceback).
+    plate = trimesh.load(Path(__file__).parent / "corpus" / "flynn_clutch" / "meshes" / "outer_plate_a.stl")
+    plate.apply_scale(1e-3)
+    found = section_at(plate, 0.0036)
+    assert len(found.geoms) == 1 and len(found.geoms[0].interiors) == 1
+    assert found.area == pytest.approx(plate.volume / 0.0012, rel=1e-4)  # a prism 1.2 mm thick

@@ -85,6 +85,12 @@ TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 """Every product the import takes."""
+UNSIMULATED: dict[str, str] = {
+    "flynn_clutch": "no geometry.toml: the cell builds a pin of the base on a square boss no wider than the "
+                    "spacing of the base's holes (12.12 mm), and the holder's six bolt holes and its d 6 hole run "
+                    "through its 12-spline shaft (d 40), which the boss cannot hold",
+}
+"""The imported products the import writes no cell geometry for, with why."""
 
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", [
@@ -103,6 +109,7 @@ IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
     "occt_pulley",
     "asm4_disk_arm",
     "gridfinity_bases",
+    "flynn_clutch",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -129,6 +136,12 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes", "gridfinity_bases",
+                                  pytest.param("flynn_clutch", marks=pytest.mark.xfail(
+                                      strict=True, raises=AssertionError,
+                                      reason="its outer plates' d 41 bore, a 24-gon (inscribed d 40.649), is read as "
+                                             "round, its inscribed circle: 0.325 mm all round (margin 649 um), where "
+                                             "the 12-spline shaft at yaw 0 has its tips at the 24-gon's vertices, "
+                                             "0.346 mm of room (the truth's 692)")),
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
                                       reason="its disk's d 21 bore is measured on its tessellation, d 20.951 (a "
@@ -165,6 +178,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "occt_pulley",
     "asm4_disk_arm",
     "gridfinity_bases",
+    "flynn_clutch",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
@@ -228,7 +242,8 @@ def test_a_sound_product_is_imported(imported: Callable[[str], Imported], name: 
 
 
 @pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", IMPORTED)
+@pytest.mark.parametrize("name", [pytest.param(p, marks=_xfail(UNSIMULATED[p])) if p in UNSIMULATED else p
+                                  for p in IMPORTED])
 def test_every_product_is_simulated(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
     geometry = load_geometry(str(done.out))  # written, and the cell's loader takes it
@@ -269,6 +284,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
     "vitac_shapes",
     pytest.param("gridfinity_bases", marks=_xfail(INSERTED + " into a hole and shorter than the gripper's grasp "
                                                   "depth (the bin bases, 4.75 mm)")),
+    pytest.param("flynn_clutch", marks=_xfail(UNSIMULATED["flynn_clutch"])),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
