@@ -195,15 +195,16 @@ class AssemblyWorld:
         for pid in self.frames:
             self.set_pose(pid, self.tray_position(pid))
 
-    def set_peg_goal(self, part: str, hole: str) -> None:
+    def set_peg_goal(self, part: str, hole: str, stacked: float = 0.0) -> None:
         """A peg's goal: standing on the bottom of ``hole``, shifted as the polygon relation
         passes it (:func:`executor.world.geometry.fit_pose`; no shift for other sections);
         in a hole entered sideways, at its tip's depth and along the hole's axis
-        (``goal_quats``)."""
+        (``goal_quats``); a part with a bore onto a pin ``stacked`` [m] farther out along
+        its axis, on the parts already on the pin."""
         spec = self.product.geometry.holes[hole]
         x, y = np.array(spec.position) + fit_pose(self.product.pegs[part], spec)[1]
         frame = spec.frame  # a hole entered sideways: the peg lies along its axis
-        goal = np.array([x, y, spec.bottom_z])
+        goal = np.array([x, y, spec.bottom_z + stacked])
         self.goals[part] = goal if frame is None else frame.points_to_cell(goal)
         self.goal_quats[part] = _IDENTITY if frame is None else frame.quat
 

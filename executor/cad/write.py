@@ -628,11 +628,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto its pin ({pin.id}) along +z, from below"
     if len(on := [p.id for p in derived.pins.values() if pid in p.parts]) > 1:
         return f"goes onto {len(on)} pins ({', '.join(on)}): the cell puts a part onto one pin"
-    lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
-    if pid != lowest and pin.axis == "+z":
-        return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
-    if pid != lowest:
-        return f"goes onto a pin ({pin.id}) after '{lowest}': the cell puts one part onto a pin, the nearest its root"
+    if (why := _stack_refused(derived, pin, pid)) is not None:
+        return why
     if why := _unresolved(margins(derived)[pid][pin.id]):
         return f"goes onto a pin ({pin.id}) {why}"
     if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
@@ -643,6 +640,37 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+
+
+STACK_TOLERANCE = 1e-4
+"""[m] a part on top of another on a pin goes onto it in the cell when its end nearest the
+pin's root is within this of the other's far end in the CAD: the cell stacks them end to
+end (:meth:`executor.assembly.step.Assembler.stacked`), so its goal is the CAD's within this."""
+
+
+def _stack_refused(derived: Derived, pin: PinFit, pid: str) -> str | None:
+    """Why the cell does not put part ``pid`` onto ``pin`` on top of the part below it there
+    (None: it is the part nearest the pin's root, or the cell stacks it): the cell stacks
+    parts on a pin standing up (+z) only, each end to end on the one below
+    (:data:`STACK_TOLERANCE`), the one below put onto the pin by the cell too."""
+    def span(part: str) -> tuple[float, float]:
+        along = _along(derived.parts[part].mesh, pin)[:, 2]
+        return float(along.min()), float(along.max())
+
+    low = span(pid)[0]
+    below = [part for part in pin.parts if part != pid and span(part)[0] < low - _LEVEL]
+    if not below:
+        return None
+    under = max(below, key=lambda part: (span(part)[1], part))
+    if pin.axis != "+z":
+        return (f"goes onto a pin ({pin.id}) after '{under}': the cell stacks parts on a pin standing up only, "
+                "on a horizontal one it puts the part nearest the pin's root")
+    if abs(gap := low - span(under)[1]) > STACK_TOLERANCE:
+        return (f"goes onto a pin ({pin.id}) {1e3 * gap:+.3f} mm from the top of '{under}': the cell stacks the "
+                f"parts on a pin end to end (within {1e3 * STACK_TOLERANCE:g} mm)")
+    if _onto_pin(derived, pin, under) is not None:
+        return f"goes onto a pin ({pin.id}) on top of '{under}', which the cell does not put onto it"
+    return None
 
 
 def _unreached(axis: str, end: tuple[float, float, float], spans: Mapping[str, tuple[float, float]],
