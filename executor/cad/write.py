@@ -487,18 +487,20 @@ def precedence_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
-def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
+def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above or sideways
     holding, if anything, a peg going in along the hole's axis that is no polygon section,
     or the prism of its polygon (the cell builds that from its outline, exactly), longer than the gripper's
     grasp depth (the cell holds it by that much), with room in it the cell resolves or a
     nominal zero-clearance fit the cell widens (:func:`_unresolved_in_hole`); the pins of the base that
-    parts go down onto, and of the parts with a bore those it puts onto them
-    (:func:`_onto_pin`); the pegs of the other holes and the other parts going onto pins,
-    each with why the cell places it by hand (a polygon peg's room is often below what
-    convex pieces of its mesh keep)."""
+    parts go down onto, and the pins standing up on parts the cell places by hand
+    (:func:`executor.cad.covers.map_parts`) that parts go down onto, and of the parts with
+    a bore those it puts onto them (:func:`_onto_pin`); the pegs of the other holes and
+    the other parts going onto pins, each with why the cell places it by hand (a polygon
+    peg's room is often below what convex pieces of its mesh keep), those ``refused``
+    (part -> why) too."""
     kept: dict[str, HoleFit] = {}
-    by_hand: dict[str, str] = {}
+    by_hand: dict[str, str] = dict(refused or {})
     for pin in sorted(derived.pins.values(), key=lambda p: p.owner == derived.base):  # the cheap reasons first
         for pid in pin.parts:
             if pid not in by_hand and (why := _onto_pin(derived, pin, pid)) is not None:
@@ -519,15 +521,26 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
                                  f"grasp depth ({1e3 * GRIPPER['grasp_depth']:g} mm)")
         else:
             kept[hid] = fit
-    pins = {pin_id: pin for pin_id, pin in derived.pins.items()
-            if pin.owner == derived.base and pin.axis != "-z" and pin.parts}  # an empty pin: no goal on it
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items()  # an empty pin: no goal on it
+            if pin.parts and (pin.axis != "-z" if pin.owner == derived.base else pin.axis == "+z")}
     # A hole whose part goes by hand leaves the cell, which may make the base its own mesh,
     # where the cell widens no zero-clearance fit: until no more parts go.
     while unresolved := _unresolved_in_hole(derived, replace(derived, holes=kept, pins=pins)):
         by_hand |= unresolved
         kept = {hid: fit for hid, fit in kept.items() if fit.part not in unresolved}
-    return replace(derived, holes=kept, pins=pins,
-                   bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
+    view = replace(derived, holes=kept, pins=pins,
+                   bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand})
+    owned = [pin for pin in pins.values() if pin.owner != derived.base]
+    if not owned:
+        return view, by_hand
+    placed = map_parts(view, _plate_top(view), by_hand).manual  # the owners the cell leaves where they are
+    moved = {pid: f"goes onto a pin of '{pin.owner}' ({pin.id}), which the cell moves: it puts parts onto pins of "
+                  "the base and of parts placed by hand only"
+             for pin in owned if pin.owner not in placed for pid in pin.parts if pid not in by_hand}
+    if moved:
+        return cell_view(derived, by_hand | moved)
+    return replace(view, pins={pin_id: pin for pin_id, pin in pins.items()
+                               if pin.owner == derived.base or pin.owner in placed}), by_hand
 
 
 def builds_plate(cell: Derived) -> bool:
@@ -622,8 +635,9 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
-    if pin.owner != derived.base:
-        return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
+    if pin.owner != derived.base and pin.axis != "+z":
+        return (f"goes onto a pin of '{pin.owner}' ({pin.id}) along {opposite(pin.axis)}: the cell puts parts onto "
+                "pins of other parts than the base down (-z) only")
     if pin.axis == "-z":
         return f"goes onto its pin ({pin.id}) along +z, from below"
     if len(on := [p.id for p in derived.pins.values() if pid in p.parts]) > 1:
@@ -1082,6 +1096,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores])]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
+        if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
+            lines.append(f'owner = "{pin.owner}"')
         if pin.axis != "+z":  # along a horizontal axis: its free end's height, the depth along its axis
             lines += [f'axis = "{opposite(pin.axis)}"']
             top = pin_entry(derived, pin)[2]

@@ -92,6 +92,11 @@ class Scene:
                                      physicsClientId=self.client)
         if any(hole.pin for hole in geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.plate)
+        # the parts placed by hand whose pins parts go onto, there (a trial's part goes onto its pin)
+        for owner in sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None}):
+            manual = geometry.tables.manual[owner]
+            wrist_clear_of(self.client, self.robot, static_mesh(self.client, geometry.folder / manual.mesh.file,
+                                                                tuple(manual.goal)))
         if any(hole.sideways for hole in geometry.holes.values()):
             # A hole entered sideways a few cm above the floor puts the wrist below the
             # floor's level: the cell simulates no table under it (docs/cell.md).
@@ -130,14 +135,25 @@ class Scene:
 
 
 def wrist_clear_of(client: int, robot: int, base: int) -> None:
-    """Only the held part (the arm's last link) of ``robot`` collides with ``base`` (a body):
-    a pin a part with a bore goes onto reaches up past the part's top, where a real
-    gripper's fingers hold the part from its sides (the cell simulates no fingers, and its
-    wrist is no cylinder around them); the floor, under a wrist holding a part sideways
-    into a hole near it."""
+    """Only the held part (the arm's last link) of ``robot`` collides with ``base`` (a body:
+    the base, a part placed by hand with a pin): a pin a part with a bore goes onto reaches
+    up past the part's top, where a real gripper's fingers hold the part from its sides (the
+    cell simulates no fingers, and its wrist is no cylinder around them); the floor, under a
+    wrist holding a part sideways into a hole near it."""
     held = pb.getNumJoints(robot, physicsClientId=client) - 1
     for link in range(-1, held):
         pb.setCollisionFilterPair(robot, base, link, -1, 0, physicsClientId=client)
+
+
+def static_mesh(client: int, mesh: Path, position: Sequence[float] = (0.0, 0.0, 0.0)) -> int:
+    """A static body of the concave triangle mesh in file ``mesh`` [m] (a part placed by
+    hand), its frame at ``position`` [m]."""
+    col = pb.createCollisionShape(pb.GEOM_MESH, fileName=str(mesh), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+                                  physicsClientId=client)
+    vis = pb.createVisualShape(pb.GEOM_MESH, fileName=str(mesh), rgbaColor=(0.55, 0.75, 0.45, 1),
+                               physicsClientId=client)
+    return pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                              basePosition=list(position), physicsClientId=client)
 
 
 def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,
