@@ -92,16 +92,25 @@ class Scene:
                                      physicsClientId=self.client)
         if any(hole.pin for hole in geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.plate)
-        # the parts placed by hand whose pins parts go onto, there (a trial's part goes onto its pin)
-        for owner in sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None}):
-            manual = geometry.tables.manual[owner]
-            wrist_clear_of(self.client, self.robot, static_mesh(self.client, geometry.folder / manual.mesh.file,
-                                                                tuple(manual.goal)))
+        self.owners = {owner: static_mesh(self.client, geometry.folder / geometry.tables.manual[owner].mesh.file)
+                       for owner in sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None})}
+        """The parts placed by hand whose pins parts go onto (:meth:`feature`)."""
+        for body in self.owners.values():
+            wrist_clear_of(self.client, self.robot, body)
         if any(hole.sideways for hole in geometry.holes.values()):
             # A hole entered sideways a few cm above the floor puts the wrist below the
             # floor's level: the cell simulates no table under it (docs/cell.md).
             wrist_clear_of(self.client, self.robot, self.floor)
         self.held: str | None = None
+
+    def feature(self, hole: str) -> None:
+        """Make the scene the one of a trial into (or onto) ``hole``: the part placed by hand
+        whose pin it is at its goal, the other such parts parked out of the way (a trial into
+        another feature meets none of them, as when they were never placed)."""
+        owner = self.geometry.holes[hole].owner
+        for k, (pid, body) in enumerate(sorted(self.owners.items())):
+            at = self.geometry.tables.manual[pid].goal if pid == owner else (0.5 * k, _PARKED[1] - 1.0, 0.0)
+            pb.resetBasePositionAndOrientation(body, list(at), (0, 0, 0, 1), physicsClientId=self.client)
 
     def set_friction(self, coefficient: float | None) -> None:
         """Make the Coulomb friction coefficient between the held part and the plate
