@@ -1,12 +1,14 @@
 """Parts onto pins the cell puts them onto beyond one part on a pin of the base: a washer
 then a nut down one pin of the plate, the nut resting on the washer (stacked end to end),
 and an arm down the pin standing on a block placed by hand. The import leaves them to the
-cell, a sim session learns their fits in physics (the arm's bore stops on the plate's
-wider pin) and assembles the plan; what the cell does not do stays placed by hand, named."""
+cell, a sim session learns their fits in physics (the washer's and the nut's bores stop on
+the block's wider pin, the block at its goal in that trial) and assembles the plan; what
+the cell does not do stays placed by hand, named."""
 
 from __future__ import annotations
 
 import json
+import shutil
 import tomllib
 from pathlib import Path
 
@@ -15,6 +17,8 @@ import shapely
 import trimesh
 
 from assembly_constraints.cli import main
+from bridge import BridgeError
+from bridge.product import load_product_description
 from tests.conftest import Runner
 
 X_MM = 560.0
@@ -38,24 +42,24 @@ def _nut(side: float, bore: float, x: float, low: float, high: float) -> trimesh
     return _prism(_square(side, x).difference(_square(bore, x)), low, high)
 
 
-def _import(tmp_path: Path, nut_low: float = 14.0, washer_bore: float = 11.0) -> Path:
-    """The plate (100 x 60 x 10 mm) with a d 10 pin 30 mm above its top at x - 25 mm, a
-    block (24 x 24 x 10 mm) lying on it at x + 25 mm with a d 8 pin 25 mm above its top;
+def _import(tmp_path: Path, nut_low: float = 14.0, washer_bore: float = 9.0) -> Path:
+    """The plate (100 x 60 x 10 mm) with a d 8 pin 30 mm above its top at x - 25 mm, a
+    block (24 x 24 x 10 mm) lying on it at x + 25 mm with a d 10 pin 25 mm above its top;
     a washer (20 mm square, a square ``washer_bore`` [mm], 4 mm) on the plate down its pin,
-    a nut (18 mm square, an 11 mm square bore, 6 mm) on the pin from ``nut_low`` [mm] up,
-    and an arm (18 mm square, a 9 mm square bore, 4 mm) on the block down its pin;
+    a nut (18 mm square, a 9 mm square bore, 6 mm) on the pin from ``nut_low`` [mm] up,
+    and an arm (18 mm square, an 11 mm square bore, 4 mm) on the block down its pin;
     imported, the folder written."""
     cad = tmp_path / "cad"
     cad.mkdir(parents=True)
-    pin = shapely.Point(X_MM - 25, 0.0).buffer(5.0, quad_segs=32)
+    pin = shapely.Point(X_MM - 25, 0.0).buffer(4.0, quad_segs=32)
     trimesh.boolean.union([_prism(_square(100, X_MM).intersection(shapely.box(0, -30, 1000, 30)), 0, 10),
                            _prism(pin, 5, 40)], engine="manifold").export(cad / "plate.stl")
-    nipple = shapely.Point(X_MM + 25, 0.0).buffer(4.0, quad_segs=32)
+    nipple = shapely.Point(X_MM + 25, 0.0).buffer(5.0, quad_segs=32)
     trimesh.boolean.union([_prism(_square(24, X_MM + 25), 10, 20), _prism(nipple, 15, 45)],
                           engine="manifold").export(cad / "block.stl")
     _nut(20, washer_bore, X_MM - 25, 10, 14).export(cad / "washer.stl")
-    _nut(18, 11, X_MM - 25, nut_low, nut_low + 6).export(cad / "nut.stl")
-    _nut(18, 9, X_MM + 25, 20, 24).export(cad / "arm.stl")
+    _nut(18, 9, X_MM - 25, nut_low, nut_low + 6).export(cad / "nut.stl")
+    _nut(18, 11, X_MM + 25, 20, 24).export(cad / "arm.stl")
     (tmp_path / "import.toml").write_text('base = "plate"\n')
     out = tmp_path / "out"
     assert main(["-q", "import", str(cad), "--out", str(out), "--config", str(tmp_path / "import.toml")]) == 0
@@ -86,6 +90,16 @@ def test_the_import_leaves_a_part_on_top_of_another_and_one_on_a_part_placed_by_
     assert holes["plate_pin1"]["capacity"] == 2  # the washer and the nut
 
 
+@pytest.mark.slow  # the import: about 2 s
+def test_a_pin_s_owner_is_a_part_placed_by_hand(stacked: Path, tmp_path: Path) -> None:
+    folder = Path(shutil.copytree(stacked, tmp_path / "copy"))
+    geometry = folder / "geometry.toml"
+    geometry.write_text(geometry.read_text().replace('owner = "block"', 'owner = "washer"'))
+    with pytest.raises(BridgeError, match=r"\[hole_shapes.block_pin1\] owner: expected a part placed by hand "
+                                          r"\(\[manual.<id>\]\), whose pin it is, got 'washer'"):
+        load_product_description(folder)
+
+
 @pytest.mark.slow  # two imports: about 5 s
 def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_by_hand(tmp_path: Path) -> None:
     # the nut drawn 0.5 mm above the washer: the cell would rest it on the washer, not where
@@ -93,7 +107,7 @@ def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_b
     apart = _import(tmp_path / "apart", nut_low=14.5)
     assert _manual(apart)["nut"] == ("goes onto a pin (plate_pin1) +0.500 mm from the top of 'washer': the cell "
                                      "stacks the parts on a pin end to end (within 0.1 mm)")
-    tight = _manual(_import(tmp_path / "tight", washer_bore=10.02))
+    tight = _manual(_import(tmp_path / "tight", washer_bore=8.02))
     assert tight["washer"] == ("goes onto a pin (plate_pin1) with +0.0100 mm of room per side, less than the 0.025 mm "
                                "the simulated cell resolves")
     assert tight["nut"] == "goes onto a pin (plate_pin1) on top of 'washer', which the cell does not put onto it"
@@ -110,14 +124,14 @@ def test_the_stacked_and_the_owned_pins_are_learned_and_assembled_in_physics(run
     result = json.loads(done.stdout)
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     observed = {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e}
-    # tried in physics, the block at its goal for its pin: the arm's 9 mm bore stops on the
-    # plate's 10 mm pin; the parts go on their own pins, the washer on the block's too
-    assert observed["arm", "plate_pin1"] == "no_fit"
+    # tried in physics, the block at its goal in the trials onto its pin (without it a part
+    # falls to the goal through the air there: a fit): the 9 mm bores stop on the block's
+    # 10 mm pin; the parts go on their own pins, the arm on the plate's too
+    assert {pair for pair, r in observed.items() if r == "no_fit"} & {("washer", "block_pin1"), ("nut", "block_pin1")}
     assert {pair for pair, r in observed.items() if r == "fit"} >= {
         ("arm", "block_pin1"), ("washer", "plate_pin1"), ("nut", "plate_pin1")}
     assert {tuple(pair) for pair in result["fits"]} == {
-        ("arm", "block_pin1"), ("washer", "block_pin1"), ("washer", "plate_pin1"), ("nut", "block_pin1"),
-        ("nut", "plate_pin1")}
+        ("arm", "block_pin1"), ("arm", "plate_pin1"), ("washer", "plate_pin1"), ("nut", "plate_pin1")}
     steps = {step["part"]: step for step in result["assembly"]["steps"]}
     order = [step["part"] for step in result["assembly"]["steps"]]
     assert result["assembly"]["assembled"] and steps["block"]["skill"] == "manual"
