@@ -663,10 +663,10 @@ end (:meth:`executor.assembly.step.Assembler.stacked`), so its goal is the CAD's
 
 
 def _stack_refused(derived: Derived, pin: PinFit, pid: str) -> str | None:
-    """Why the cell does not put part ``pid`` onto ``pin`` on top of the part below it there
-    (None: it is the part nearest the pin's root, or the cell stacks it): the cell stacks
-    parts on a pin standing up (+z) only, each end to end on the one below
-    (:data:`STACK_TOLERANCE`), the one below put onto the pin by the cell too."""
+    """Why the cell does not put part ``pid`` onto ``pin`` after the part below it there
+    (nearer the pin's root; None: it is the part nearest the root, or the cell stacks it):
+    the cell stacks each part end to end on the one below (:data:`STACK_TOLERANCE`), the
+    one below put onto the pin by the cell too."""
     def span(part: str) -> tuple[float, float]:
         along = _along(derived.parts[part].mesh, pin)[:, 2]
         return float(along.min()), float(along.max())
@@ -676,14 +676,13 @@ def _stack_refused(derived: Derived, pin: PinFit, pid: str) -> str | None:
     if not below:
         return None
     under = max(below, key=lambda part: (span(part)[1], part))
-    if pin.axis != "+z":
-        return (f"goes onto a pin ({pin.id}) after '{under}': the cell stacks parts on a pin standing up only, "
-                "on a horizontal one it puts the part nearest the pin's root")
+    end = "top" if pin.axis == "+z" else "outer end"
     if abs(gap := low - span(under)[1]) > STACK_TOLERANCE:
-        return (f"goes onto a pin ({pin.id}) {1e3 * gap:+.3f} mm from the top of '{under}': the cell stacks the "
+        return (f"goes onto a pin ({pin.id}) {1e3 * gap:+.3f} mm from the {end} of '{under}': the cell stacks the "
                 f"parts on a pin end to end (within {1e3 * STACK_TOLERANCE:g} mm)")
     if _onto_pin(derived, pin, under) is not None:
-        return f"goes onto a pin ({pin.id}) on top of '{under}', which the cell does not put onto it"
+        return (f"goes onto a pin ({pin.id}) {'on top of' if pin.axis == '+z' else 'after'} '{under}', which the "
+                "cell does not put onto it")
     return None
 
 
