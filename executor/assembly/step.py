@@ -6,7 +6,8 @@ Per kind of part (the ``skill`` of the step's record):
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
-  a part with a bore onto a pin of the base likewise; into a hole or onto a pin entered
+  a part with a bore onto a pin of the base or of a part placed by hand likewise, resting
+  on the parts already on that pin (:meth:`Assembler.stacked`); into a hole or onto a pin entered
   sideways, all of it in the feature's frame (:attr:`executor.world.geometry.HoleSpec.frame`),
   the part carried there along its axis; once past the feature's top, a part
   with a bore is centred on its pin by contact, and so is a peg with more room than

@@ -628,8 +628,10 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
 
 
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
-    """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
-    the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`);
+    """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, onto a pin of
+    the base or down one of another part, the part colliding as its exact pieces:
+    :func:`executor.world.rings.ring_pieces`; whether that part is placed by hand is
+    :func:`cell_view`'s, and a part after another on the pin is :func:`_stack_refused`'s);
     a part on more than one pin (a plate over two dowel pins) is placed by hand, the cell
     aligning one bore with one pin;
     a part whose room on it per side (:func:`margins`) is under

@@ -240,7 +240,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
 @pytest.mark.parametrize("name", [
     pytest.param("asm4_axis_bearings", marks=_xfail(INSERTED + " onto a pin with less room than the cell resolves "
                                                     "(the bearings onto the axis's d 20 seats along x: room 0), or "
-                                                    "onto a horizontal pin after another (bearing_2 after "
+                                                    "onto a pin after a part placed by hand (bearing_2 after "
                                                     "bearing_1)")),
     "agh_hex_horizontal",
     "agh_prism_array",
