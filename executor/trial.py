@@ -182,12 +182,14 @@ class Cell:
         return self._skills[shape]
 
     def motion_for(self, part: str) -> Motion[ImpedanceController]:
-        """Put the part in the hand; the Motion driving the arm that holds it.  Each part
-        shape has its own PyBullet client, made on first use (with ``gui``, the first
-        one is the GUI); the step count carries over, so sim time only grows."""
+        """Put the part in the hand, the scene that of its demonstration's hole
+        (:meth:`executor.world.scene.Scene.feature`); the Motion driving the arm that holds
+        it.  Each part shape has its own PyBullet client, made on first use (with ``gui``,
+        the first one is the GUI); the step count carries over, so sim time only grows."""
         spec = self.geometry.parts[part]
         scene = self._scene_of(spec.shape)
         scene.hold(spec)
+        scene.feature(spec.demo_hole)  # teaching's; a trial's own hole: _attempt
         if self.logger is not None:
             self.logger.attach_arm(self._arm_of(spec.shape), part)
         motion = self._motions[spec.shape]
@@ -280,6 +282,7 @@ class Cell:
         skill = taught.in_hole(hole_spec.depth)
         wall0 = time.perf_counter()
         motion = self.motion_for(part)
+        self._scenes[spec.shape].feature(hole)
         sim0 = motion.steps
         arm = motion.controller.arm
         layer = self.layer

@@ -157,6 +157,15 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
                 raise BridgeError(f"{path}: [hole_shapes.{name}] {key}: expected the pin's "
                                   + ("top [m]" if key == "top_z" else "height above where a part rests on it [m]")
                                   + ", got nothing (a pin states both)")
+        if shape.owner is not None and shape.owner not in geo.manual:
+            raise fail(path, f"hole_shapes.{name}", "owner", "a part placed by hand ([manual.<id>]), whose pin it is",
+                       shape.owner)
+        if shape.owner is not None and shape.axis != "-z":
+            raise fail(path, f"hole_shapes.{name}", "axis", "-z for a pin of a part placed by hand (it stands up)",
+                       shape.axis)
+    for name, shape in geo.hole_shapes.items():
+        if shape.owner is not None and not shape.pin:
+            raise fail(path, f"hole_shapes.{name}", "owner", "no owner: only a pin has one", shape.owner)
     bores = {pid: shape.bore for shape in geo.part_shapes.values() for pid in shape.parts}
     for name, shape in geo.hole_shapes.items():
         for pid in shape.zero_clearance or []:

@@ -162,7 +162,9 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     where they differ from the plate's ``top_z`` and ``tile_thickness``. With ``pin`` they
     are pins of the base (in its own mesh) that parts with a bore go onto: the section is
     the pin's, ``top_z`` its top and ``depth`` from its top down to where a part going
-    onto it rests (both required). ``axis`` is the direction a part goes in along: ``-z``
+    onto it rests (both required); a pin with an ``owner`` stands up (``axis`` ``-z``) on
+    that part placed by hand (``[manual.<id>]``, in the base's place of a pin: its part is
+    put onto it with that part at its ``goal``). ``axis`` is the direction a part goes in along: ``-z``
     (down) or sideways (``+x``, ``-x``, ``+y``, ``-y``); a sideways hole is in the
     ``[base]``'s own mesh, its section, ``outline`` and ``yaw`` in its hole frame (z out of
     the hole, x and y the import's slice axes: :func:`executor.world.frames.hole_rotation`),
@@ -191,6 +193,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     zero_clearance: Ids | None = None
     near_miss: Ids | None = None
     tile: TileSize | None = None
+    owner: Id | None = None
 
 
 class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -6,7 +6,8 @@ Per kind of part (the ``skill`` of the step's record):
   put it at its goal;
 - ``insert``: a peg into a hole of the plate: hole search around the vision estimate,
   then the taught force-monitored insertion (:func:`executor.skills.insertion.insert`);
-  a part with a bore onto a pin of the base likewise; into a hole or onto a pin entered
+  a part with a bore onto a pin of the base or of a part placed by hand likewise, resting
+  on the parts already on that pin (:meth:`Assembler.stacked`); into a hole or onto a pin entered
   sideways, all of it in the feature's frame (:attr:`executor.world.geometry.HoleSpec.frame`),
   the part carried there along its axis; once past the feature's top, a part
   with a bore is centred on its pin by contact, and so is a peg with more room than
@@ -39,7 +40,7 @@ trials, (part shape, hole), a cover or head being its own shape and hole.
 from __future__ import annotations
 
 import time
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -231,7 +232,7 @@ class Assembler:
             return self._by_hand(part, wall0, sim0)
         rng = trial_rng(seed, part, hole or "none")
         if skill == "insert" and hole is not None:
-            world.set_peg_goal(part, hole)
+            world.set_peg_goal(part, hole, self.stacked(part, hole, self.hole_of))
         setup = self._draw(rng, part, hole)
         grasp = self._pick(part, setup)
         self._surface.clear()
@@ -292,10 +293,11 @@ class Assembler:
         for part, hole in placements:
             check_product_step(self.product, part, hole, placed)
             placed.append(part)
-        world = self.world
+        world, on = self.world, dict(self.hole_of)
         for part, hole in sorted(placements, key=lambda ph: ph[0] in self.product.heads):  # heads after their parts
             if part in self.product.pegs and hole is not None:
-                world.set_peg_goal(part, hole)
+                world.set_peg_goal(part, hole, self.stacked(part, hole, on))
+                on[part] = hole
             socket = part in self.product.heads  # a head's goal is the socket where its part is now
             world.set_pose(part, self._goal_tcp(part, "insert_socket") - world.frames[part].tcp if socket
                            else world.goals[part], world.goal_quats.get(part, (0.0, 0.0, 0.0, 1.0)))
@@ -309,6 +311,15 @@ class Assembler:
                 self._placed(part, hole)
         world.rest()
         return fell
+
+    def stacked(self, part: str, hole: str, on: Mapping[str, str]) -> float:
+        """How far [m] out along pin ``hole``'s axis from its foot part ``part`` rests: the
+        lengths of the parts ``on`` it (part -> its hole or pin) other than ``part``, each
+        resting on the one before, end to end (a gear on a washer); 0 on an empty pin and
+        in a hole (a peg stands on its bottom)."""
+        if not self.product.geometry.holes[hole].pin:
+            return 0.0
+        return sum(self.product.pegs[q].length for q, h in on.items() if h == hole and q != part)
 
     def why_stuck(self, part: str, hole: str | None, skill: str) -> tuple[FailureReason, tuple[str, ...]]:
         """Why ``part``, stopped short of its goal and still held, is stuck
@@ -460,12 +471,13 @@ class Assembler:
             xy = found.hole_xy
             reach = self._centring_reach(part, hole) if skill == "insert" and found.found else None
             centred = reach is not None and hole is not None
+            # the free length of the hole or pin: a pin's less the parts already on it
+            free = 0.0 if hole is None else p.geometry.holes[hole].depth - self.stacked(part, hole, self.hole_of)
             if reach is not None and hole is not None:  # in the feature's room, not touching it yet
-                xy = centre_by_contact(motion, motion.read().tip_pos, quat, reach,
-                                       p.geometry.holes[hole].depth)[:2]
+                xy = centre_by_contact(motion, motion.read().tip_pos, quat, reach, free)[:2]
             if skill == "insert" and hole is not None:  # the peg's skill, its goal at this hole's bottom
                 peg = p.pegs[part]
-                skill_obj = self._skill(peg.shape).in_hole(p.geometry.holes[hole].depth)
+                skill_obj = self._skill(peg.shape).in_hole(free)
             else:
                 skill_obj = self._skill(p.heads[part].skill)
         origin = np.array([xy[0], xy[1], goal[2] - skill_obj.end_position[2]])

@@ -21,10 +21,11 @@ from executor.assembly.product import HeadSpec, Product, rect_minus_squares
 from executor.control.controller import ImpedanceController
 from executor.control.gains import ImpedanceGains
 from executor.control.motion import Motion, StepLogger
+from executor.world import TIME_STEP
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
 from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies, tile_of
-from executor.world.scene import TIME_STEP, connect, inertial_frame, link_frame, load_plate, wrist_clear_of
+from executor.world.scene import connect, inertial_frame, link_frame, load_plate, static_mesh, wrist_clear_of
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
 _IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -158,12 +159,7 @@ class AssemblyWorld:
         """The parts placed by hand: static concave meshes, moved where they are placed."""
         c = self.client
         for mid, manual in sorted(self.product.manual.items()):
-            mesh = str(self.product.folder / manual.mesh.file)
-            col = pb.createCollisionShape(pb.GEOM_MESH, fileName=mesh, flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
-                                          physicsClientId=c)
-            vis = pb.createVisualShape(pb.GEOM_MESH, fileName=mesh, rgbaColor=(0.55, 0.75, 0.45, 1), physicsClientId=c)
-            body = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
-                                      physicsClientId=c)
+            body = static_mesh(c, self.product.folder / manual.mesh.file)
             self.frames[mid] = PartFrames(body, np.zeros(3), np.zeros(3))
             self.goals[mid] = np.array(manual.goal)
             self._tray[mid] = np.array([*manual.tray, 0.0])
@@ -187,6 +183,8 @@ class AssemblyWorld:
         pb.setCollisionFilterGroupMask(self.robot, self.tool_link, 0, 0, physicsClientId=self.client)
         if any(hole.pin for hole in self.product.geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.frames[self.product.base.id].body)
+        for owner in {hole.owner for hole in self.product.geometry.holes.values() if hole.owner is not None}:
+            wrist_clear_of(self.client, self.robot, self.frames[owner].body)  # its pin, as the base's
         if any(hole.sideways for hole in self.product.geometry.holes.values()):  # as in the trial's scene
             wrist_clear_of(self.client, self.robot, self.floor)
 
@@ -195,15 +193,16 @@ class AssemblyWorld:
         for pid in self.frames:
             self.set_pose(pid, self.tray_position(pid))
 
-    def set_peg_goal(self, part: str, hole: str) -> None:
+    def set_peg_goal(self, part: str, hole: str, stacked: float = 0.0) -> None:
         """A peg's goal: standing on the bottom of ``hole``, shifted as the polygon relation
         passes it (:func:`executor.world.geometry.fit_pose`; no shift for other sections);
         in a hole entered sideways, at its tip's depth and along the hole's axis
-        (``goal_quats``)."""
+        (``goal_quats``); a part with a bore onto a pin ``stacked`` [m] farther out along
+        its axis, on the parts already on the pin."""
         spec = self.product.geometry.holes[hole]
         x, y = np.array(spec.position) + fit_pose(self.product.pegs[part], spec)[1]
         frame = spec.frame  # a hole entered sideways: the peg lies along its axis
-        goal = np.array([x, y, spec.bottom_z])
+        goal = np.array([x, y, spec.bottom_z + stacked])
         self.goals[part] = goal if frame is None else frame.points_to_cell(goal)
         self.goal_quats[part] = _IDENTITY if frame is None else frame.quat
 

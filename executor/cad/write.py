@@ -489,18 +489,20 @@ def precedence_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
-def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
+def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above or sideways
     holding, if anything, a peg going in along the hole's axis that is no polygon section,
     or the prism of its polygon (the cell builds that from its outline, exactly), longer than the gripper's
     grasp depth (the cell holds it by that much), with room in it the cell resolves or a
     nominal zero-clearance fit the cell widens (:func:`_unresolved_in_hole`); the pins of the base that
-    parts go down onto, and of the parts with a bore those it puts onto them
-    (:func:`_onto_pin`); the pegs of the other holes and the other parts going onto pins,
-    each with why the cell places it by hand (a polygon peg's room is often below what
-    convex pieces of its mesh keep)."""
+    parts go down onto, and the pins standing up on parts the cell places by hand
+    (:func:`executor.cad.covers.map_parts`) that parts go down onto, and of the parts with
+    a bore those it puts onto them (:func:`_onto_pin`); the pegs of the other holes and
+    the other parts going onto pins, each with why the cell places it by hand (a polygon
+    peg's room is often below what convex pieces of its mesh keep), those ``refused``
+    (part -> why) too."""
     kept: dict[str, HoleFit] = {}
-    by_hand: dict[str, str] = {}
+    by_hand: dict[str, str] = dict(refused or {})
     for pin in sorted(derived.pins.values(), key=lambda p: p.owner == derived.base):  # the cheap reasons first
         for pid in pin.parts:
             if pid not in by_hand and (why := _onto_pin(derived, pin, pid)) is not None:
@@ -521,16 +523,30 @@ def cell_view(derived: Derived) -> tuple[Derived, dict[str, str]]:
                                  f"grasp depth ({1e3 * GRIPPER['grasp_depth']:g} mm)")
         else:
             kept[hid] = fit
-    pins = {pin_id: pin for pin_id, pin in derived.pins.items()  # an empty pin: no goal on it; a further pin
-            if pin.owner == derived.base and pin.axis != "-z" and pin.parts  # of a part the cell puts onto its first:
-            and not any((pid, pin_id) in derived.further_bores and pid not in by_hand for pid in pin.parts)}  # taken
+    # The pins the cell puts parts onto: none empty (no goal on it), the base's unless
+    # entered from below, another part's standing up; a further pin of a part the cell puts
+    # onto its first pin goes with that part.
+    pins = {pin_id: pin for pin_id, pin in derived.pins.items()
+            if pin.parts and (pin.axis != "-z" if pin.owner == derived.base else pin.axis == "+z")
+            and not any((pid, pin_id) in derived.further_bores and pid not in by_hand for pid in pin.parts)}
     # A hole whose part goes by hand leaves the cell, which may make the base its own mesh,
     # where the cell widens no zero-clearance fit: until no more parts go.
     while unresolved := _unresolved_in_hole(derived, replace(derived, holes=kept, pins=pins)):
         by_hand |= unresolved
         kept = {hid: fit for hid, fit in kept.items() if fit.part not in unresolved}
-    return replace(derived, holes=kept, pins=pins,
-                   bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand}), by_hand
+    view = replace(derived, holes=kept, pins=pins,
+                   bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand})
+    owned = [pin for pin in pins.values() if pin.owner != derived.base]
+    if not owned:
+        return view, by_hand
+    placed = map_parts(view, _plate_top(view), by_hand).manual  # the owners the cell leaves where they are
+    moved = {pid: f"goes onto a pin of '{pin.owner}' ({pin.id}), which the cell moves: it puts parts onto pins of "
+                  "the base and of parts placed by hand only"
+             for pin in owned if pin.owner not in placed for pid in pin.parts if pid not in by_hand}
+    if moved:
+        return cell_view(derived, by_hand | moved)
+    return replace(view, pins={pin_id: pin for pin_id, pin in pins.items()
+                               if pin.owner == derived.base or pin.owner in placed}), by_hand
 
 
 def builds_plate(cell: Derived) -> bool:
@@ -618,24 +634,24 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
 
 
 def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
-    """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, down a pin of
-    the base, the part colliding as its exact pieces: :func:`executor.world.rings.ring_pieces`);
+    """Why the cell does not put part ``pid`` onto ``pin`` (None: it does, onto a pin of
+    the base or down one of another part, the part colliding as its exact pieces:
+    :func:`executor.world.rings.ring_pieces`; whether that part is placed by hand is
+    :func:`cell_view`'s, and a part after another on the pin is :func:`_stack_refused`'s);
     a part on more than one pin (a plate over two dowel pins) goes onto them all at once
     where :func:`_onto_pins` allows;
     a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
-    if pin.owner != derived.base:
-        return f"goes onto a pin of '{pin.owner}' ({pin.id}): the cell puts parts onto pins of the base only"
+    if pin.owner != derived.base and pin.axis != "+z":
+        return (f"goes onto a pin of '{pin.owner}' ({pin.id}) along {opposite(pin.axis)}: the cell puts parts onto "
+                "pins of other parts than the base down (-z) only")
     if pin.axis == "-z":
         return f"goes onto its pin ({pin.id}) along +z, from below"
     if len(on := [p for p in derived.pins.values() if pid in p.parts]) > 1:
         return _onto_pins(derived, on, pid)
-    lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
-    if pid != lowest and pin.axis == "+z":
-        return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
-    if pid != lowest:
-        return f"goes onto a pin ({pin.id}) after '{lowest}': the cell puts one part onto a pin, the nearest its root"
+    if (why := _stack_refused(derived, pin, pid)) is not None:
+        return why
     if why := _unresolved(margins(derived)[pid][pin.id]):
         return f"goes onto a pin ({pin.id}) {why}"
     if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
@@ -652,23 +668,57 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto the several pins ``on`` it is on (None: it
     does, down its first pin, :meth:`executor.cad.derive.Derived.pin_of`, held as the CAD
     turns it, so each further bore comes down over its own pin). :func:`_onto_pin` has
-    checked its first pin (the base's, not entered from below); the pins share the part's
-    axis, which must be +z (pins standing up), the part must be the lowest on each, with
+    checked its first pin (not entered from below); the pins must be the base's and share
+    the part's axis, which must be +z (pins standing up), the part must be the lowest on each, with
     room on each that the cell resolves, and a stack of prisms with one bore per pin
     (:func:`bore_pieces`)."""
     names = ", ".join(pin.id for pin in on)
+    if others := sorted({pin.owner for pin in on} - {derived.base}):
+        return (f"goes onto {len(on)} pins ({names}), of {', '.join(repr(o) for o in others)} too: the cell puts a part "
+                "onto several pins of the base only")
     if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins), the owner the base here
         return (f"goes onto {len(on)} pins ({names}) along {opposite(on[0].axis)}: the cell puts a part onto several "
                 "pins only down onto pins standing up (+z)")
     for pin in on:
         lowest = min(pin.parts, key=lambda p: (float(_along(derived.parts[p].mesh, pin)[:, 2].min()), p))
         if pid != lowest:
-            return f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts one part onto a pin, the lowest"
+            return (f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts a part onto several pins only "
+                    "as the first on each")
         if why := _unresolved(margins(derived)[pid][pin.id]):
             return f"goes onto a pin ({pin.id}) {why}"
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
+
+
+STACK_TOLERANCE = 1e-4
+"""[m] a part on top of another on a pin goes onto it in the cell when its end nearest the
+pin's root is within this of the other's far end in the CAD: the cell stacks them end to
+end (:meth:`executor.assembly.step.Assembler.stacked`), so its goal is the CAD's within this."""
+
+
+def _stack_refused(derived: Derived, pin: PinFit, pid: str) -> str | None:
+    """Why the cell does not put part ``pid`` onto ``pin`` after the part below it there
+    (nearer the pin's root; None: it is the part nearest the root, or the cell stacks it):
+    the cell stacks each part end to end on the one below (:data:`STACK_TOLERANCE`), the
+    one below put onto the pin by the cell too."""
+    def span(part: str) -> tuple[float, float]:
+        along = _along(derived.parts[part].mesh, pin)[:, 2]
+        return float(along.min()), float(along.max())
+
+    low = span(pid)[0]
+    below = [part for part in pin.parts if part != pid and span(part)[0] < low - _LEVEL]
+    if not below:
+        return None
+    under = max(below, key=lambda part: (span(part)[1], part))
+    end = "top" if pin.axis == "+z" else "outer end"
+    if abs(gap := low - span(under)[1]) > STACK_TOLERANCE:
+        return (f"goes onto a pin ({pin.id}) {1e3 * gap:+.3f} mm from the {end} of '{under}': the cell stacks the "
+                f"parts on a pin end to end (within {1e3 * STACK_TOLERANCE:g} mm)")
+    if _onto_pin(derived, pin, under) is not None:
+        return (f"goes onto a pin ({pin.id}) {'on top of' if pin.axis == '+z' else 'after'} '{under}', which the "
+                "cell does not put onto it")
+    return None
 
 
 def _unreached(axis: str, end: tuple[float, float, float], spans: Mapping[str, tuple[float, float]],
@@ -1082,6 +1132,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores])]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
+        if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
+            lines.append(f'owner = "{pin.owner}"')
         if pin.axis != "+z":  # along a horizontal axis: its free end's height, the depth along its axis
             lines += [f'axis = "{opposite(pin.axis)}"']
             top = pin_entry(derived, pin)[2]

@@ -126,7 +126,8 @@ class HoleSpec(Section):
     """A hole of the plate at ``position`` [m], its x axis turned by ``yaw`` [rad] about z,
     its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry; a
     ``pin`` of the base a part with a bore goes onto (its section the pin's, ``top_z`` its
-    top, the bottom where a part going onto it rests); the parts stated to fit it at room 0
+    top, the bottom where a part going onto it rests), standing up on its ``owner`` where
+    that is a part placed by hand (None: the base's); the parts stated to fit it at room 0
     (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the pegs
     that miss it by less than the cell resolves (``near_miss``: :mod:`executor.world.near_miss`,
     no experiment); ``tile``
@@ -142,6 +143,7 @@ class HoleSpec(Section):
     zero_clearance: tuple[str, ...] = field(default=(), kw_only=True)
     near_miss: tuple[str, ...] = field(default=(), kw_only=True)
     tile: float | None = field(default=None, kw_only=True)
+    owner: str | None = field(default=None, kw_only=True)
 
     @property
     def bottom_z(self) -> float:
@@ -269,7 +271,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
                                   pin=hole_shape.pin, axis=hole_shape.axis,
                                   zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())),
                                   near_miss=tuple(sorted(hole_shape.near_miss or ())),
-                                  tile=hole_shape.tile)
+                                  tile=hole_shape.tile, owner=hole_shape.owner)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
     starts |= {pid: (extra.start[0], extra.start[1]) for pid, extra in geo.extra_parts.items()}
     parts: dict[str, PartSpec] = {}

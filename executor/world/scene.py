@@ -92,11 +92,25 @@ class Scene:
                                      physicsClientId=self.client)
         if any(hole.pin for hole in geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.plate)
+        self.owners = {owner: static_mesh(self.client, geometry.folder / geometry.tables.manual[owner].mesh.file)
+                       for owner in sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None})}
+        """The parts placed by hand whose pins parts go onto (:meth:`feature`)."""
+        for body in self.owners.values():
+            wrist_clear_of(self.client, self.robot, body)
         if any(hole.sideways for hole in geometry.holes.values()):
             # A hole entered sideways a few cm above the floor puts the wrist below the
             # floor's level: the cell simulates no table under it (docs/cell.md).
             wrist_clear_of(self.client, self.robot, self.floor)
         self.held: str | None = None
+
+    def feature(self, hole: str) -> None:
+        """Make the scene the one of a trial into (or onto) ``hole``: the part placed by hand
+        whose pin it is at its goal, the other such parts parked out of the way (a trial into
+        another feature meets none of them, as when they were never placed)."""
+        owner = self.geometry.holes[hole].owner
+        for k, (pid, body) in enumerate(sorted(self.owners.items())):
+            at = self.geometry.tables.manual[pid].goal if pid == owner else (0.5 * k, _PARKED[1] - 1.0, 0.0)
+            pb.resetBasePositionAndOrientation(body, list(at), (0, 0, 0, 1), physicsClientId=self.client)
 
     def set_friction(self, coefficient: float | None) -> None:
         """Make the Coulomb friction coefficient between the held part and the plate
@@ -130,14 +144,25 @@ class Scene:
 
 
 def wrist_clear_of(client: int, robot: int, base: int) -> None:
-    """Only the held part (the arm's last link) of ``robot`` collides with ``base`` (a body):
-    a pin a part with a bore goes onto reaches up past the part's top, where a real
-    gripper's fingers hold the part from its sides (the cell simulates no fingers, and its
-    wrist is no cylinder around them); the floor, under a wrist holding a part sideways
-    into a hole near it."""
+    """Only the held part (the arm's last link) of ``robot`` collides with ``base`` (a body:
+    the base, a part placed by hand with a pin): a pin a part with a bore goes onto reaches
+    up past the part's top, where a real gripper's fingers hold the part from its sides (the
+    cell simulates no fingers, and its wrist is no cylinder around them); the floor, under a
+    wrist holding a part sideways into a hole near it."""
     held = pb.getNumJoints(robot, physicsClientId=client) - 1
     for link in range(-1, held):
         pb.setCollisionFilterPair(robot, base, link, -1, 0, physicsClientId=client)
+
+
+def static_mesh(client: int, mesh: Path, position: Sequence[float] = (0.0, 0.0, 0.0)) -> int:
+    """A static body of the concave triangle mesh in file ``mesh`` [m] (a part placed by
+    hand), its frame at ``position`` [m]."""
+    col = pb.createCollisionShape(pb.GEOM_MESH, fileName=str(mesh), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+                                  physicsClientId=client)
+    vis = pb.createVisualShape(pb.GEOM_MESH, fileName=str(mesh), rgbaColor=(0.55, 0.75, 0.45, 1),
+                               physicsClientId=client)
+    return pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                              basePosition=list(position), physicsClientId=client)
 
 
 def load_plate(client: int, geometry: CellGeometry, plate_obj: Path,

@@ -2,8 +2,9 @@
 +y and a ring (d 24, 8 mm long) on it is imported with the pin's axis and free end, taught,
 and assembled in physics by the same skills as a part going down onto a pin, run in the
 pin's frame (:mod:`executor.world.frames`), as a peg goes into a hole entered sideways
-(tests/cad/test_sideways.py). A ring with less room than the cell resolves stays placed by
-hand, and a pin wider than the ring's bore stops it at the pin's end."""
+(tests/cad/test_sideways.py); a second ring goes on against the first. A ring with less
+room than the cell resolves stays placed by hand, and a pin wider than the ring's bore
+stops it at the pin's end."""
 
 from __future__ import annotations
 
@@ -17,8 +18,11 @@ import shapely
 import trimesh
 
 from bridge.product import load_product_description
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.write import _highest_near
+from executor.cell_description import CellDescription
 from executor.trial import Cell
 from executor.world.arm import quat_to_matrix
 from executor.world.meshes import URDF_HULL_MARGIN, eroded
@@ -30,12 +34,24 @@ PIN = 10.0
 """The pin's diameter [mm] (a 64-gon's vertex circle)."""
 
 
-def _cad(folder: Path, bore: float, wall: float | None = None, turn: int = 0) -> Path:
+def _ring(bore: float, outer: float, y: float) -> trimesh.Trimesh:
+    """A ring (``outer`` [mm] in radius, 8 mm long, a round ``bore`` [mm]: a 128-gon) about
+    the pin's axis, from ``y`` [mm] to ``y`` + 8 mm."""
+    section = shapely.Point(0, 0).buffer(outer, quad_segs=32).difference(shapely.Point(0, 0).buffer(bore / 2,
+                                                                                                     quad_segs=32))
+    ring = trimesh.creation.extrude_polygon(section, 8.0)
+    ring.apply_transform(trimesh.transformations.rotation_matrix(-np.pi / 2, (1.0, 0.0, 0.0)))  # its axis along y
+    ring.apply_translation((0.0, y, 30.0))
+    return ring
+
+
+def _cad(folder: Path, bore: float, wall: float | None = None, turn: int = 0, second: bool = False) -> Path:
     """The block (60 x 50 x 60 mm on the floor) with the pin from its +y face (y 25) to y 60,
     30 mm up, and the ring with a round ``bore`` [mm] (a 128-gon) against that face, as STL
     files [mm] in ``folder``, and the import settings beside it; with a ``wall`` [mm], a
     10 mm wall beside the pin (x 20 to 30 mm, as high as the block) reaches that far out of
-    the block's +y face; all turned ``turn`` quarter turns about z."""
+    the block's +y face; with ``second``, a second ring (d 22) against the first; all turned
+    ``turn`` quarter turns about z."""
     folder.mkdir(parents=True)
     block = trimesh.creation.box((60.0, 50.0, 60.0))
     block.apply_translation((0.0, 0.0, 30.0))
@@ -47,21 +63,18 @@ def _cad(folder: Path, bore: float, wall: float | None = None, turn: int = 0) ->
         side = trimesh.creation.box((10.0, wall, 60.0))
         side.apply_translation((25.0, 25.0 + wall / 2, 30.0))
         solids.append(side)
-    section = shapely.Point(0, 0).buffer(12.0, quad_segs=32).difference(shapely.Point(0, 0).buffer(bore / 2,
-                                                                                                    quad_segs=32))
-    ring = trimesh.creation.extrude_polygon(section, 8.0)
-    ring.apply_transform(trimesh.transformations.rotation_matrix(-np.pi / 2, (1.0, 0.0, 0.0)))  # its axis along y
-    ring.apply_translation((0.0, 25.0, 30.0))
     quarter = trimesh.transformations.rotation_matrix(turn * np.pi / 2, (0.0, 0.0, 1.0))
     trimesh.boolean.union(solids, engine="manifold").apply_transform(quarter).export(folder / "block.stl")
-    ring.apply_transform(quarter).export(folder / "ring.stl")
+    _ring(bore, 12.0, 25.0).apply_transform(quarter).export(folder / "ring.stl")
+    if second:
+        _ring(bore, 11.0, 33.0).apply_transform(quarter).export(folder / "ring2.stl")
     (folder.parent / "import.toml").write_text('base = "block"\n')
     return folder
 
 
 def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0,
-            place: tuple[float, float] | None = None) -> Path:
-    cad = _cad(tmp / "cad", bore, wall, turn)
+            place: tuple[float, float] | None = None, second: bool = False) -> Path:
+    cad = _cad(tmp / "cad", bore, wall, turn, second)
     run_import(cad, tmp / "out", "mm", tmp / "import.toml", ImportOptions(place=place))
     return tmp / "out"
 
@@ -186,3 +199,21 @@ def test_a_pin_wider_than_the_bore_stops_the_ring_at_its_end_in_physics(taught: 
     finally:
         cell.close()
     assert refused.outcome == "no_fit" and refused.end_error > 0.02  # stopped at the pin's end, 34 mm out
+
+
+@pytest.mark.slow  # imports, teaches two rings, assembles the block and both (about 15 s of CPU)
+def test_a_second_ring_goes_onto_the_horizontal_pin_against_the_first(tmp_path: Path) -> None:
+    # the second ring (d 22) drawn against the first along the pin: the import leaves both
+    # to the cell, which puts the second on after the first, its goal 8 mm farther out
+    out = teach(_import(tmp_path, 10.2, second=True))
+    geometry = load_product_description(out).geometry
+    assert geometry is not None and geometry.manual == {}
+    assembler = Assembler(load_product(str(out)), description=CellDescription())
+    try:
+        steps = [assembler.run_step(part, hole, 0) for part, hole in
+                 (("block", None), ("ring", "block_pin1"), ("ring2", "block_pin1"))]
+        goals = {pid: assembler.world.goals[pid] for pid in ("ring", "ring2")}
+    finally:
+        assembler.close()
+    assert all(step.outcome == "fit" and step.pose_error < 0.002 for step in steps), steps
+    assert goals["ring2"] - goals["ring"] == pytest.approx([0.0, 0.008, 0.0], abs=1e-6)  # along the pin, out of it

@@ -83,6 +83,8 @@ CASES = [
      "[hole_shapes.round_big] depth: expected more than the [plate] chamfer (0.0008 m), got 0.0005"),
     ("pin-without-a-base-mesh", 'holes = ["br"]', 'holes = ["br"]\npin = true',
      "[hole_shapes.round_big] pin: a pin needs a [base] with its own mesh (the pin is part of it), got none"),
+    ("owner-of-a-hole", 'holes = ["br"]', 'holes = ["br"]\nowner = "sh"',
+     "[hole_shapes.round_big] owner: expected no owner: only a pin has one, got 'sh'"),
     ("bore-taught-in-a-hole", "mass = 0.06", "mass = 0.06\nbore = true",
      "[part_shapes.square_peg] demo_hole: expected a pin for parts with a bore, a hole for pegs (s1 is a hole), "
      "got 's1'"),
