@@ -674,9 +674,9 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
     (:func:`bore_pieces`)."""
     names = ", ".join(pin.id for pin in on)
     if others := sorted({pin.owner for pin in on} - {derived.base}):
-        return (f"goes onto {len(on)} pins ({names}), of {', '.join(repr(o) for o in others)} too: the cell puts a part "
-                "onto several pins of the base only")
-    if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins), the owner the base here
+        return (f"goes onto {len(on)} pins ({names}), of {', '.join(repr(o) for o in others)} too: the cell puts "
+                "a part onto several pins of the base only")
+    if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins)
         return (f"goes onto {len(on)} pins ({names}) along {opposite(on[0].axis)}: the cell puts a part onto several "
                 "pins only down onto pins standing up (+z)")
     for pin in on:
