@@ -86,8 +86,8 @@ def wrist_yaw(frame: HoleFrame | None, part_kind: str, hole_kind: str, yaw: floa
     """The tool yaw [rad] in a hole's ``frame`` for the pair's aligned ``yaw``
     (:func:`executor.world.arm.aligned_yaw`): for a round part or hole entered sideways,
     whose yaw is free, the quarter turn from it that turns the hand least from pointing
-    down (along +x the frame's x is the cell's y: yaw 0 turns the hand by 120° and leaves
-    the arm's reach, -π/2 pitches it by 90°, docs/franka.md); else ``yaw``."""
+    down (along +x the frame's x is the cell's y: yaw 0 would turn the hand by 120° about
+    a skew axis, -π/2 pitches it by 90°; docs/franka.md); else ``yaw``."""
     if frame is None or "round" not in (part_kind, hole_kind):
         return yaw
     turns = [yaw + k * math.pi / 2 for k in (0, -1, 1, 2)]
