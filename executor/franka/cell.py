@@ -11,7 +11,12 @@ taught skill under the cell's execution layer
 (:func:`executor.skills.insertion.insert_in_layer`: DMP, admittance, phase stopping,
 eqs. (6)/(7), the wiggle, the goal check; ILC corrections per (part shape, hole) kept in
 memory), then the part is let go in the hole (a plan step) or carried back to its tray
-position (an experiment). What differs from the simulated cell: the grasp and the hole's
+position (an experiment). Into a hole entered sideways, as the assembling PyBullet cell enters it
+(:mod:`executor.assembly.step`): the attempt (and teaching) runs in the hole's frame
+(:attr:`executor.world.geometry.HoleSpec.frame`, ``Motion.frame``), the part carried with
+the tool turned along the hole's axis to :data:`executor.assembly.step.SIDEWAYS_OUT` out
+of the entry and in along the axis to the approach, out along the axis after. What
+differs from the simulated cell: the grasp and the hole's
 position carry the real errors, none is drawn; the hole's position is where the product's
 geometry puts it, moved by the calibrated ``offset`` of the product frame in the robot's
 base frame (axes parallel).
@@ -19,6 +24,7 @@ base frame (axes parallel).
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -26,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from executor import ExecutorError
+from executor.assembly.step import SIDEWAYS_OUT
 from executor.assembly.transfer import SAFE_Z
 from executor.cell_description import CellDescription
 from executor.control.detector import Detector
@@ -38,6 +45,7 @@ from executor.skills.insertion import InsertionResult, InsertionTask, insert_in_
 from executor.skills.search import SearchResult, hole_search
 from executor.trial import APPROACH_HEIGHT
 from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat
+from executor.world.frames import HoleFrame, hole_frame
 from executor.world.geometry import CellGeometry, PartSpec, fit_pose
 
 OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before a pick
@@ -47,13 +55,43 @@ REST_SPEED = 0.0005
 """[m/s] the arm is at rest when its tool tip moves slower than this: the hand closes on a
 part only then (closing while the arm still came down the last 2 mm of its move gripped
 the part 0.8 mm higher than ``grasp_depth`` in franky-sim, docs/franka.md)."""
-RETREAT = 0.03  # [m] the tool goes up this far after opening the hand
+RETREAT = 0.03  # [m] the tool goes back along its axis (up, or out of a sideways hole) after opening the hand
 GRIPPER_SPEED = 0.05  # [m/s] of the fingers
 HELD_FRACTION = 0.3
 """The hand holds the part when its width after closing is at least this fraction of the
 part's (closed on nothing it is about 0; franky-sim's fingers read 7.1 mm on a 10 mm peg at
 40 N, their contact soft)."""
 ABOVE_TRAY = 0.002  # [m] a part carried back is let go this far above the table
+DOWN = tool_quat(0.0)  # the tool pointing down (xyzw), the hand's fingers closing along y
+READY = (0.0, 0.0, 0.0, -1.57, 0.0, 1.57, 0.785)
+"""[rad] the joint positions the arm turns the tool's axis from (franky-sim's start pose:
+the tool pointing down, the end effector at (0.55, 0, 0.52) m): the Cartesian motions
+then start from one configuration of the redundant arm. Against franky-sim, turned from
+wherever the carry was, the wrist came to the tool along +x in another configuration, and
+a peg that fits ended 4 mm short in its hole, a false ``no_fit`` (docs/franka.md)."""
+TURN = 0.1  # [rad] a carry that turns the tool's axis by more than this turns it from READY
+
+
+def turn_between(a: np.ndarray, b: np.ndarray) -> float:
+    """[rad] the angle of the rotation between two orientations (quaternions xyzw)."""
+    return 2 * math.acos(min(1.0, abs(float(np.dot(a, b)))))
+
+
+def axis_turn(a: np.ndarray, b: np.ndarray) -> float:
+    """[rad] the angle between the tool axes (z) of two orientations (quaternions xyzw)."""
+    return math.acos(max(-1.0, min(1.0, float(quat_to_matrix(a)[:, 2] @ quat_to_matrix(b)[:, 2]))))
+
+
+def wrist_yaw(frame: HoleFrame | None, part_kind: str, hole_kind: str, yaw: float) -> float:
+    """The tool yaw [rad] in a hole's ``frame`` for the pair's aligned ``yaw``
+    (:func:`executor.world.arm.aligned_yaw`): for a round part or hole entered sideways,
+    whose yaw is free, the quarter turn from it that turns the hand least from pointing
+    down (along +x the frame's x is the cell's y: yaw 0 would turn the hand by 120° about
+    a skew axis, -π/2 pitches it by 90°; docs/franka.md); else ``yaw``."""
+    if frame is None or "round" not in (part_kind, hole_kind):
+        return yaw
+    turns = [yaw + k * math.pi / 2 for k in (0, -1, 1, 2)]
+    return min(turns, key=lambda turn: turn_between(DOWN, frame.pose_to_cell(np.zeros(3), tool_quat(turn))[1]))
 
 
 @dataclass(frozen=True)
@@ -104,6 +142,11 @@ class FrankaCell:
         self.ilc = Ilc(description.ilc, description.gains, description.admittance)
         self._skills: dict[str, Skill] = {}
         self.held: str | None = None
+        self.quat = DOWN
+        """The tool's orientation (xyzw, base frame) the moves last commanded."""
+        self.outside: np.ndarray | None = None
+        """[m] where the tip came in along the axis of a hole entered sideways (base frame),
+        None when the tool is out of such a hole."""
 
     def to_base(self, point: np.ndarray) -> np.ndarray:
         """A point [m] of the product frame in the robot's base frame."""
@@ -114,9 +157,9 @@ class FrankaCell:
             self._skills[shape] = load_product_skill(self.geometry, shape)
         return self._skills[shape]
 
-    def move_to(self, tip: np.ndarray, yaw: float | None = None) -> None:
-        """The tool tip [m] in a straight line to ``tip``, the tool pointing down turned to
-        ``yaw`` [rad] (None: as it is), by franky's own Cartesian motion (its path planned
+    def move_to(self, tip: np.ndarray, quat: np.ndarray | None = None) -> None:
+        """The tool tip [m] in a straight line to ``tip``, the tool turning to the
+        orientation ``quat`` (xyzw; None: as it is), by franky's own Cartesian motion (its path planned
         within the arm's limits scaled by the dynamics factor; the impedance tracking is
         stopped meanwhile); returns once the measured tip is within :data:`TOLERANCE`
         (franky returns when the path ends, the arm trails it). SafetyStop when the goal
@@ -125,12 +168,11 @@ class FrankaCell:
 
         self.options.workspace.check(tip)
         self.controller.stop()
-        yaw = self.motion.tool_yaw if yaw is None else yaw
-        quat = tool_quat(yaw)
+        quat = self.quat if quat is None else np.asarray(quat, dtype=float)
         ee = tip - quat_to_matrix(quat)[:, 2] * self.arm.tcp
         self.robot.move(franky.CartesianMotion(franky.Affine(ee, quat), franky.ReferenceType.Absolute,
                                                franky.RelativeDynamicsFactor(self.options.limits.dynamics)))
-        self.motion.tool_yaw = yaw
+        self.quat = quat
         deadline = time.monotonic() + ARRIVAL
         while np.linalg.norm(self.arm.read().tip_pos - tip) > TOLERANCE:
             if time.monotonic() > deadline:
@@ -148,15 +190,54 @@ class FrankaCell:
                 raise ExecutorError(f"the arm did not come to rest at {here} m")
             time.sleep(0.01)
 
-    def carry_to(self, goal: np.ndarray, yaw: float = 0.0) -> None:
-        """Up to the carrying height, across turning the tool to ``yaw`` [rad], down to
-        ``goal`` [m]."""
+    def carry_to(self, goal: np.ndarray, quat: np.ndarray = DOWN) -> None:
+        """Out of a hole entered sideways (:meth:`back_out`), up to the carrying height,
+        across turning the tool to ``quat`` (xyzw) (from :data:`READY` when its axis turns
+        by more than :data:`TURN`), down to ``goal`` [m]."""
+        self.back_out()
         here = self.arm.read().tip_pos
         high = max(SAFE_Z + self.options.offset[2], float(goal[2]), float(here[2]))
         if here[2] < high - 1e-3:
             self.move_to(np.array([here[0], here[1], high]))
-        self.move_to(np.array([goal[0], goal[1], high]), yaw)
+        if axis_turn(self.quat, quat) > TURN:
+            self.ready()
+        self.move_to(np.array([goal[0], goal[1], high]), quat)
         self.move_to(goal)
+
+    def ready(self) -> None:
+        """The arm to the joint positions :data:`READY` (franky's joint motion), at rest."""
+        import franky
+
+        self.controller.stop()
+        self.robot.move(franky.JointMotion(np.array(READY), franky.ReferenceType.Absolute,
+                                           franky.RelativeDynamicsFactor(self.options.limits.dynamics)))
+        self.settle()
+        self.quat = np.asarray(self.arm.read().tip_quat_xyzw, dtype=float)
+
+    def back_out(self) -> None:
+        """The tip back along the tool's axis to where it came into a hole entered sideways
+        (:attr:`outside`); nothing outside such a hole."""
+        if self.outside is None:
+            return
+        axis = quat_to_matrix(self.quat)[:, 2]  # into the hole
+        here = self.arm.read().tip_pos
+        self.move_to(here + axis * float(axis @ (self.outside - here)))
+        self.outside = None
+
+    def enter(self, point: np.ndarray, quat: np.ndarray) -> None:
+        """The tip to ``point`` [m], the tool at ``quat`` (xyzw), both in the motion's frame:
+        carried there (:meth:`carry_to`), or for a hole entered sideways carried to
+        :data:`SIDEWAYS_OUT` out of ``point`` along the hole's axis, the tool turned along
+        it, then in along the axis."""
+        frame = self.motion.frame
+        if frame is None:
+            self.carry_to(point, quat)
+            return
+        tip, turned = frame.pose_to_cell(point, quat)
+        outside = frame.points_to_cell(point + np.array([0.0, 0.0, SIDEWAYS_OUT]))
+        self.carry_to(outside, turned)
+        self.outside = outside
+        self.move_to(tip)
 
     def _open(self, width: float) -> None:
         if not self.gripper.move(width, GRIPPER_SPEED):
@@ -192,14 +273,15 @@ class FrankaCell:
         return spec.length - self.geometry.gripper.grasp_depth
 
     def release(self) -> None:
-        """Open the hand where it is and go up by :data:`RETREAT`."""
+        """Open the hand where it is and go back along the tool's axis by :data:`RETREAT`
+        (up, or out of a hole entered sideways)."""
         if self.held is None:
             return
         spec = self.geometry.parts[self.held]
         self._open(max(spec.sides) + OPEN_MARGIN)
         self.held = None
         self.arm.set_tcp(0.0)
-        self.move_to(self.arm.read().tip_pos + np.array([0.0, 0.0, RETREAT]))
+        self.move_to(self.arm.read().tip_pos - quat_to_matrix(self.quat)[:, 2] * RETREAT)
 
     def put_back(self) -> None:
         """Carry the held part back to its place on the table and let it go."""
@@ -211,46 +293,52 @@ class FrankaCell:
 
     def insert(self, part: str, hole: str, rng: np.random.Generator) -> tuple[InsertionResult, Detector,
                                                                                 SearchResult]:
-        """One attempt with the held part: above the hole, the search, the skill; the ILC
-        correction of (part shape, hole) updated after a success with ILC. The controller's
-        ``lowest_rate`` is that of this attempt's search and skill."""
+        """One attempt with the held part: above the hole (out of its entry along its axis,
+        for a hole entered sideways), the search, the skill, all in the hole's frame; the
+        ILC correction of (part shape, hole) updated after a success with ILC. The
+        controller's ``lowest_rate`` is that of this attempt's search and skill."""
         spec, hole_spec = self.geometry.parts[part], self.geometry.holes[hole]
-        if hole_spec.sideways:
-            raise ExecutorError(f"hole '{hole}' is entered along {hole_spec.axis}: the Franka backend inserts down "
-                                "(-z) only")
         skill = self.skill(spec.shape).in_hole(hole_spec.depth)
         turn, shift = fit_pose(spec, hole_spec)
-        est = self.to_base(np.array([*(np.array(hole_spec.position) + shift), hole_spec.top_z]))
-        yaw = aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn)
-        self.controller.watch_rate()
-        found = self.search(est, yaw, rng)
+        entry = self.to_base(np.array([*hole_spec.position, hole_spec.top_z]))
+        frame = hole_frame(hole_spec.axis, (float(entry[0]), float(entry[1]), float(entry[2])))
+        est = entry + np.array([shift[0], shift[1], 0.0])  # in the hole's frame, which shares the entry's centre
+        yaw = wrist_yaw(frame, spec.kind, hole_spec.kind, aligned_yaw(spec.kind, hole_spec.kind, hole_spec.yaw + turn))
         key = f"{spec.shape}:{hole}"
         correction = self.ilc.correction(key)[0] if self.layer.ilc else None
-        task = InsertionTask(np.array([found.hole_xy[0], found.hole_xy[1], est[2]]), self.lever(spec), yaw,
-                             needs_yaw_compliance(spec.kind, hole_spec.kind), correction)
-        detector = Detector(self.description.thresholds)
-        result = insert_in_layer(self.motion, skill, detector, task, self.layer, description=self.description)
+        self.controller.watch_rate()
+        self.motion.frame = frame
+        try:
+            found = self.search(est, tool_quat(yaw), rng)
+            task = InsertionTask(np.array([found.hole_xy[0], found.hole_xy[1], est[2]]), self.lever(spec), yaw,
+                                 needs_yaw_compliance(spec.kind, hole_spec.kind), correction)
+            detector = Detector(self.description.thresholds)
+            result = insert_in_layer(self.motion, skill, detector, task, self.layer, description=self.description)
+        finally:
+            self.motion.frame = None
         if result.reached and result.trace is not None:
             self.ilc.update(key, result.trace)
         return result, detector, found
 
-    def search(self, entry: np.ndarray, yaw: float, rng: np.random.Generator) -> SearchResult:
-        """The held part carried above the hole's calibrated entry ``entry`` [m] (its centre
-        at the top face, base frame) by :data:`executor.trial.APPROACH_HEIGHT`, the tool
-        turned to ``yaw`` [rad], held still, the wrench estimate tared, then the hole search
-        (:func:`executor.skills.search.hole_search`, its spiral drawn from ``rng``) around it:
-        where the part sinks into the hole, in the robot's reading of the tip."""
-        quat = tool_quat(yaw)
+    def search(self, entry: np.ndarray, quat: np.ndarray, rng: np.random.Generator) -> SearchResult:
+        """The held part brought to :data:`executor.trial.APPROACH_HEIGHT` above the hole's
+        calibrated entry ``entry`` [m] (its centre at the entry, in the motion's frame: the
+        hole's), the tool at ``quat`` (xyzw, the same frame) (:meth:`enter`), held still,
+        the wrench estimate tared, then the hole search
+        (:func:`executor.skills.search.hole_search`, its spiral drawn from ``rng``) around
+        it: where the part sinks into the hole, in the robot's reading of the tip."""
         approach = entry + np.array([0.0, 0.0, APPROACH_HEIGHT])
-        self.carry_to(approach, yaw=yaw)
+        self.enter(approach, quat)
         self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         self.arm.tare_sensor()
         return hole_search(self.motion, entry[:2], entry[2], approach[2], quat, rng)
 
     def lift(self) -> None:
-        """The tool straight up to the carrying height."""
+        """The tool out of a hole entered sideways (:meth:`back_out`), then straight up to
+        the carrying height."""
+        self.back_out()
         here = self.arm.read().tip_pos
-        self.move_to(np.array([here[0], here[1], SAFE_Z + self.options.offset[2]]))
+        self.move_to(np.array([here[0], here[1], max(SAFE_Z + self.options.offset[2], float(here[2]))]))
 
     def stop(self) -> None:
         """Stop the arm (the tracking motion ends, the arm comes to rest) and clear its

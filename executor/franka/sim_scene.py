@@ -13,19 +13,23 @@ What is built, in MuJoCo's world frame (= the arm's base frame, :data:`PRODUCT_I
   and rect holes exact; a hole with a floor gets the floor as one more piece; a polygon
   hole's boss is cut into convex pieces that do not overlap
   (:func:`executor.world.outlines.boss_solids`), exact to its outline and chamfer;
+- a base given as its own mesh (a concave mesh has no convex-hull form): only its holes
+  entered sideways, each its boss turned into the hole's frame (:func:`sideways_boss`):
+  the rest of the mesh is not there to collide with;
 - each peg (``[part_shapes.*]``) as a free body at its tray start, upright on the floor:
   a cylinder or box of its mass, or with a ``mesh`` its convex pieces (the ``convex``
   file as made at import, not eroded: MuJoCo adds no margin) with the mesh's inertia.
 
 Part-plate friction is the PyBullet cell's teaching friction (MuJoCo takes the larger of
 two geoms' coefficients, so the pegs and the plate both carry it; the fingers keep
-MuJoCo's 1.0 and grip with that). Not built: covers, heads, parts placed by hand, a
-base given as its own mesh (a concave mesh has no convex-hull form); each is refused or
-left out as stated in :func:`add_product`.
+MuJoCo's 1.0 and grip with that). Not built: covers, heads, parts placed by hand, the pins
+and holes entered down of a base given as its own mesh; each is refused or left out as
+stated in :func:`add_product`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import xml.etree.ElementTree as ET
 from collections.abc import Collection
@@ -179,15 +183,33 @@ def boss_pieces(hole: HoleSpec, plate: Plate, base: float) -> list[np.ndarray]:
     return pieces
 
 
+def sideways_boss(hole: HoleSpec, plate: Plate) -> list[np.ndarray]:
+    """The boss around a hole entered sideways as convex solids, vertices (n, 3) [m],
+    product frame: :func:`boss_pieces` of the same section entered down at its entry, from
+    the entry to its ``depth`` (open there: nothing stops a part in it), turned into the
+    hole's frame (:attr:`executor.world.geometry.HoleSpec.frame`)."""
+    frame = hole.frame
+    assert frame is not None  # a hole entered sideways
+    down = dataclasses.replace(hole, axis="-z")
+    return [frame.points_to_cell(piece) for piece in boss_pieces(down, plate, down.bottom_z)]
+
+
 def plate_solids(geometry: CellGeometry) -> tuple[list[StaticBox], list[ConvexPiece]]:
     """The plate as MuJoCo builds it: the box under the bosses and every boss's convex
-    pieces (:func:`boss_pieces`), in the product frame; ExecutorError naming
-    ``geometry.toml`` for a base given as its own mesh."""
+    pieces (:func:`boss_pieces`), in the product frame. A base given as its own mesh is
+    built as its holes entered sideways only (:func:`sideways_boss`, no box: MuJoCo
+    collides a mesh as its convex hull, which would close its holes); ExecutorError naming
+    ``geometry.toml`` for such a base with a pin or a hole entered down."""
     path = geometry.folder / "geometry.toml"
-    if geometry.base_mesh is not None:
-        raise ExecutorError(f"{path}: [base] mesh: the MuJoCo scene collides a mesh as its convex hull and has no "
-                            "form of a concave base; expected a plate of [plate] and [hole_shapes.*]")
     plate = geometry.plate
+    if geometry.base_mesh is not None:
+        others = sorted(hid for hid, hole in geometry.holes.items() if hole.pin or not hole.sideways)
+        if others:
+            raise ExecutorError(f"{path}: [base] mesh with pins or holes entered down ({', '.join(others)}): the "
+                                "MuJoCo scene builds a base mesh's holes entered sideways only; expected a plate of "
+                                "[plate] and [hole_shapes.*], or a base whose holes are all entered sideways")
+        return [], [ConvexPiece(f"boss_{hid}_{k}", vertices) for hid, hole in sorted(geometry.holes.items())
+                    for k, vertices in enumerate(sideways_boss(hole, plate))]
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     top = geometry.base_top
     boxes = [StaticBox("plate_base", (cx, cy, top / 2), (sx / 2, sy / 2, top / 2))]

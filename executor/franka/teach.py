@@ -2,7 +2,8 @@
 :mod:`executor.skills.teach` run by the Franka (a part picked from the table by the hand,
 its ``demo_hole`` found by the insertion's hole search, the part guided along the same
 minimum-jerk path down it, replayed to record the reference wrench from the arm's
-estimate), stored as the PyBullet cell's skills are; or,
+estimate), stored as the PyBullet cell's skills are (into a hole entered sideways all of it
+in the hole's frame, as :meth:`FrankaCell.insert`); or,
 with ``--demonstration hand``, a person's demonstration by hand-guiding
 (:mod:`executor.franka.guide`) in place of the scripted path (docs/franka.md, "Teaching")."""
 
@@ -18,16 +19,6 @@ from executor.skills.search import SearchParams
 ABOVE_START = 0.02  # [m] the part comes down onto the start from this far above
 SAME_PLACE = 0.005  # [m] a start this close (horizontally) is reached without the carrying height
 SEARCH_SEED = 0  # the hole search's spiral draws in teaching (a trial's seed draws them in an insertion)
-
-
-def tool_yaw(quat_xyzw: np.ndarray) -> float:
-    """[rad] the yaw of :func:`executor.world.arm.tool_quat`'s quaternion ``quat_xyzw``."""
-    return float(2 * np.arctan2(quat_xyzw[1], quat_xyzw[0]))
-
-
-def _down_only(motion: Motion) -> None:
-    if motion.frame is not None:
-        raise ExecutorError("a hole entered sideways: the Franka backend teaches and inserts down (-z) only")
 
 
 class FrankaTeacher:
@@ -51,9 +42,9 @@ class FrankaTeacher:
         search (:meth:`FrankaCell.search`): the entry where the part sank into the hole, in
         the robot's reading of the tip (a grasp or calibration error of 2 mm puts a part
         brought straight down onto the calibrated entry on the plate beside the hole).
-        ExecutorError when the search finds no hole."""
-        _down_only(motion)
-        found = self.cell.search(origin, tool_yaw(quat_xyzw), self.rng)
+        ExecutorError when the search finds no hole. ``origin``, ``quat_xyzw`` and the entry
+        returned are in the motion's frame (the hole's)."""
+        found = self.cell.search(origin, quat_xyzw, self.rng)
         if not found.found:
             radius = SearchParams().max_radius
             raise ExecutorError(f"the hole search found no hole within {radius * 1000:.1f} mm of "
@@ -62,18 +53,17 @@ class FrankaTeacher:
         return np.array([found.hole_xy[0], found.hole_xy[1], origin[2]])
 
     def hold_at(self, motion: Motion, tip: np.ndarray, quat_xyzw: np.ndarray) -> None:
-        """Above the start, straight down onto it, settled, the wrench tared: the
-        grasp is the one the hand made (the real one, not known to the robot)."""
+        """Above the start (in the motion's frame: out of it along a sideways hole's axis),
+        straight down onto it, settled, the wrench tared: the grasp is the one the hand
+        made (the real one, not known to the robot)."""
         cell = self.cell
-        _down_only(motion)
         above = tip + np.array([0.0, 0.0, ABOVE_START])
-        here = cell.arm.read().tip_pos
-        yaw = tool_yaw(quat_xyzw)
+        here = motion.read().tip_pos
         if np.linalg.norm(here[:2] - tip[:2]) > SAME_PLACE:
-            cell.carry_to(above, yaw=yaw)
+            cell.enter(above, quat_xyzw)
         else:
-            cell.move_to(above, yaw)
-        cell.move_to(tip)
+            cell.move_to(*motion.cell_pose(above, quat_xyzw))
+        cell.move_to(motion.cell_pose(tip, quat_xyzw)[0])
         motion.hold(tip, quat_xyzw, APPROACH_SETTLE_TIME)
         cell.arm.tare_sensor()
 

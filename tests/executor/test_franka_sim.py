@@ -61,6 +61,27 @@ def test_holes_are_open_to_their_size_and_the_boss_stands_around_them(assembly: 
                 hole.top_z - geometry.plate.chamfer / 2, abs=2e-6), hid
 
 
+def test_holes_entered_sideways_are_open_along_their_axis_and_the_boss_stands_around_them() -> None:
+    """A base mesh's holes entered sideways (the MuJoCo scene builds their bosses in each
+    hole's frame): a ray along the axis from 10 cm out passes through the hole 0.1 mm from
+    its wall, across either side, and meets the boss's face at the entry past the chamfer."""
+    geometry = load_geometry(str(ROOT / "tests" / "franka" / "data" / "side"))
+    model, data, _bodies = product_model(geometry)
+    geom = np.zeros(1, dtype=np.int32)
+    for hid, hole in geometry.holes.items():
+        frame = hole.frame
+        assert frame is not None
+        into, across = -frame.rotation[:, 2], frame.rotation[:, :2].T
+        start = to_base(np.array([*hole.position, hole.top_z])) - 0.1 * into
+        inset = hole.size / 2 * (1 / np.cos(np.pi / geometry.plate.polygon_sides) - 1)
+        for side in (*across, *-across):
+            inside = mujoco.mj_ray(model, data, start + side * (hole.size / 2 - 1e-4), into, None, 1, -1, geom)
+            assert inside < 0, (hid, side, inside)  # through: nothing along the axis
+            out = hole.size / 2 + geometry.plate.chamfer + 1e-4 + inset
+            face = mujoco.mj_ray(model, data, start + side * out, into, None, 1, -1, geom)
+            assert face == pytest.approx(0.1, abs=2e-6), (hid, side, face)
+
+
 def test_polygon_holes_are_open_to_their_outline_and_the_boss_stands_around_them(tmp_path: Path) -> None:
     """The hexagon holes of tests/executor/test_polygon_cell.py (one turned 30° in its
     outline) in the MuJoCo plate: at the middle of every edge of each outline, 0.1 mm
