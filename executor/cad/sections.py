@@ -37,7 +37,8 @@ diameter instead.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -132,9 +133,40 @@ _SECTION_SCALE = 1e6
 """The scale [1/m] a section's points are joined at (:func:`slice_loops`)."""
 
 
+_kept: dict[tuple[int, bytes, float], tuple[trimesh.Trimesh, list[Loop]]] | None = None
+"""The slices :func:`slice_loops` made within :func:`slices_kept`, by mesh (its id: the
+mesh is held, so no other takes it), axis and level, with the mesh; None outside."""
+
+
+@contextmanager
+def slices_kept() -> Iterator[None]:
+    """Within it, :func:`slice_loops` slices a mesh across an axis at a level once and
+    answers again with the same loops (the import asks for many slices twice: a part's bore
+    at its middle for its hole and for its pin). The meshes must not change within it;
+    the loops returned are shared, never to be changed."""
+    global _kept
+    outer = _kept
+    _kept = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        _kept = outer
+
+
 def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[Loop]:
-    """The closed loops of ``mesh`` cut by the plane ``dot(x, axis) = level`` [m]."""
+    """The closed loops of ``mesh`` cut by the plane ``dot(x, axis) = level`` [m] (made
+    once within :func:`slices_kept`)."""
     axis = np.asarray(axis, dtype=float)
+    if _kept is None:
+        return _sliced(mesh, axis, level)
+    key = (id(mesh), axis.tobytes(), float(level))
+    if key not in _kept:
+        _kept[key] = (mesh, _sliced(mesh, axis, level))
+    return _kept[key][1]
+
+
+def _sliced(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[Loop]:
+    """:func:`slice_loops`, made."""
     lines = trimesh.intersections.mesh_plane(mesh, plane_normal=axis, plane_origin=axis * level)
     if len(lines) == 0:
         return []

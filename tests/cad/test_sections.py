@@ -397,3 +397,18 @@ def test_a_section_over_a_span_without_its_slivers_is_conservative(hole: bool) -
     assert outer.covers(inner)
     assert inner.area < outer.area  # the ledge kept: the section changed by the tolerance only
     assert outer.area - inner.area < 4 * sections.SLIVER * 40 * MM
+
+
+def test_a_slice_asked_again_within_slices_kept_is_made_once() -> None:
+    """Within ``slices_kept`` a mesh's slice at an axis and level asked again is the one made
+    before (the same loops), outside it is made again; another level or mesh is its own."""
+    mesh, other = _plate_with_bores(), _touching_cubes()
+    up = np.array([0.0, 0.0, 1.0])
+    assert sections.slice_loops(mesh, up, 0.0) is not sections.slice_loops(mesh, up, 0.0)
+    with sections.slices_kept():
+        first = sections.slice_loops(mesh, up, 0.0)
+        assert sections.slice_loops(mesh, (0, 0, 1), 0.0) is first
+        assert sections.slice_loops(mesh, up, 1e-4) is not first
+        assert len(sections.slice_loops(other, up, 0.0)) == 2
+    again = sections.slice_loops(mesh, up, 0.0)
+    assert again is not first and all(np.array_equal(a.points, b.points) for a, b in zip(again, first, strict=True))
