@@ -51,7 +51,7 @@ from executor.cad.parts import (
     overlaps_checked,
     translated,
 )
-from executor.cad.sections import Shape2D, zero_clearance
+from executor.cad.sections import Shape2D, slices_kept, zero_clearance
 from executor.cad.step import load_step
 from executor.cad.sweep import default_workers, opposite
 from executor.cad.write import (
@@ -351,11 +351,12 @@ def _derived(parts: list[CadPart], out: Path, config: Path | None, options: Impo
     assumed.insert(0, where)
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
-    derived = derive(parts, settings.base, fixed, reach)
-    assumed += [*derived.assumptions(), *nominal_assumption(derived)]
-    near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
-    assumed += overlap_assumption(derived)
-    mapped, laid = map_product(derived, settings)
+    with slices_kept():  # the parts' meshes stay as they are until written
+        derived = derive(parts, settings.base, fixed, reach)
+        assumed += [*derived.assumptions(), *nominal_assumption(derived)]
+        near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
+        assumed += overlap_assumption(derived)
+        mapped, laid = map_product(derived, settings)
     assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:

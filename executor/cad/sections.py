@@ -37,7 +37,8 @@ diameter instead.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -46,8 +47,13 @@ import numpy as np
 import shapely
 import trimesh
 from matplotlib.path import Path as PolygonPath
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import depth_first_order
 from scipy.spatial import ConvexHull
-from trimesh.path.exchange.misc import lines_to_path
+from trimesh.constants import tol_path
+from trimesh.grouping import unique_rows
+from trimesh.path.entities import Line
+from trimesh.path.exchange.misc import edges_to_path
 from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
 from executor.cad.parts import Cylinder
@@ -127,17 +133,48 @@ _SECTION_SCALE = 1e6
 """The scale [1/m] a section's points are joined at (:func:`slice_loops`)."""
 
 
+_kept: dict[tuple[int, bytes, float], tuple[trimesh.Trimesh, list[Loop]]] | None = None
+"""The slices :func:`slice_loops` made within :func:`slices_kept`, by mesh (its id: the
+mesh is held, so no other takes it), axis and level, with the mesh; None outside."""
+
+
+@contextmanager
+def slices_kept() -> Iterator[None]:
+    """Within it, :func:`slice_loops` slices a mesh across an axis at a level once and
+    answers again with the same loops (the import asks for many slices twice: a part's bore
+    at its middle for its hole and for its pin). The meshes must not change within it;
+    the loops returned are shared, never to be changed."""
+    global _kept
+    outer = _kept
+    _kept = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        _kept = outer
+
+
 def slice_loops(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[Loop]:
-    """The closed loops of ``mesh`` cut by the plane ``dot(x, axis) = level`` [m]."""
+    """The closed loops of ``mesh`` cut by the plane ``dot(x, axis) = level`` [m] (made
+    once within :func:`slices_kept`)."""
     axis = np.asarray(axis, dtype=float)
+    if _kept is None:
+        return _sliced(mesh, axis, level)
+    key = (id(mesh), axis.tobytes(), float(level))
+    if key not in _kept:
+        _kept[key] = (mesh, _sliced(mesh, axis, level))
+    return _kept[key][1]
+
+
+def _sliced(mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[Loop]:
+    """:func:`slice_loops`, made."""
     lines = trimesh.intersections.mesh_plane(mesh, plane_normal=axis, plane_origin=axis * level)
     if len(lines) == 0:
         return []
     # trimesh joins a section's points on a grid of 1e-5 of its units (its mesh.section, in
     # metres: 10 µm, which closed a tapered mortise's corner 4 µm from the next point): the
     # points are joined in µm [m × 1e6], on a grid of 10 pm, as only those of one edge are
-    path = lines_to_path(lines * _SECTION_SCALE)
-    section = trimesh.path.Path3D(entities=path["entities"], vertices=path["vertices"] / _SECTION_SCALE)
+    entities, vertices = _lines_to_path(lines * _SECTION_SCALE)
+    section = trimesh.path.Path3D(entities=entities, vertices=vertices / _SECTION_SCALE)
     frame = frame_of(axis)
     loops = []
     # a plane section is made of straight lines, which need no scale to be discretised
@@ -484,6 +521,45 @@ def _squared(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """The squared distances [m²] of the rows of two (n, 2) arrays, as GEOS sums them (dx² + dy²)."""
     dx, dy = first[:, 0] - second[:, 0], first[:, 1] - second[:, 1]
     return dx * dx + dy * dy
+
+
+def _lines_to_path(lines: np.ndarray) -> tuple[list[Line], np.ndarray]:
+    """The entities and vertices of trimesh's ``lines_to_path`` of the segments ``lines``
+    (n, 2, 3), the same: the segments' ends joined where they agree to trimesh's digits, the
+    lines of the graph of joined points' depth-first traversals. Where that graph is
+    simple cycles (:func:`_cycles`: loops that touch nowhere, no segment shorter than the
+    joining grid), its
+    traversals are made in one search instead of trimesh's search per cycle and check of
+    every segment against the traversals (most of a fine mesh's slice's time)."""
+    points = np.asarray(lines, dtype=np.float64).reshape((-1, 3))
+    unique, inverse = unique_rows(points, digits=tol_path.merge_digits)
+    edges = inverse.reshape((-1, 2))
+    cycles = _cycles(edges)
+    if cycles is None:
+        path = edges_to_path(edges=edges, vertices=points[unique])
+        return path["entities"], path["vertices"]
+    return [Line(cycle) for cycle in cycles], points[unique]
+
+
+def _cycles(edges: np.ndarray) -> list[np.ndarray] | None:
+    """The traversals trimesh's ``edges_to_path`` makes of the graph of ``edges`` (n, 2)
+    (nodes 0 to n - 1) when it is simple cycles (each node on two edges, none twice, none
+    from a node to itself), else None: each cycle from its least node towards the lesser
+    of that node's neighbours and back to it, ordered by their least nodes, as a
+    depth-first search (scipy's, trimesh's) from each node not yet reached, in order,
+    walks them. Here one search, from a node joined to every other, walks them all."""
+    count = len(edges)
+    ordered = np.sort(edges, axis=1)
+    if (int(edges.max()) + 1 != count or np.any(ordered[:, 0] == ordered[:, 1])
+            or np.any(np.bincount(ordered.ravel(), minlength=count) != 2) or len(unique_rows(ordered)[0]) != count):
+        return None
+    rows = np.concatenate([ordered[:, 0], np.arange(count)])
+    columns = np.concatenate([ordered[:, 1], np.full(count, count)])
+    graph = csr_matrix((np.ones(len(rows), dtype=bool), (rows, columns)), shape=(count + 1, count + 1))
+    walk, before = depth_first_order(graph, count, directed=False, return_predecessors=True)
+    walk = walk[1:]
+    starts = np.flatnonzero(before[walk] == count)
+    return [np.append(cycle, cycle[0]) for cycle in np.split(walk, starts[1:])]
 
 
 def _closed_polylines(section: trimesh.path.Path3D) -> list[np.ndarray]:

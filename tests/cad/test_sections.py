@@ -10,6 +10,7 @@ import pytest
 import shapely
 import trimesh
 from shapely import affinity
+from trimesh.path.exchange.misc import lines_to_path
 from trimesh.path.traversal import discretize_path
 
 from executor.cad import sections
@@ -122,6 +123,71 @@ def test_a_fine_section_takes_its_closed_entities_as_the_graph_would() -> None:
     assert len(loops) == len(expected) == 2
     assert all(np.array_equal(a, b) for a, b in zip(loops, expected, strict=True))
 
+
+def _plate_with_bores() -> trimesh.Trimesh:
+    """A 40 x 30 x 10 mm plate [m] with a round bore and a turned square one, and a boss on
+    top, tilted (its corners at levels of their own)."""
+    plate = trimesh.creation.box((0.04, 0.03, 0.01))
+    bore = trimesh.creation.cylinder(radius=0.004, height=0.02, sections=40)
+    bore.apply_translation((-0.01, 0, 0))
+    square = trimesh.creation.box((0.006, 0.006, 0.02))
+    square.apply_transform(trimesh.transformations.rotation_matrix(0.4, (0, 0, 1)))
+    square.apply_translation((0.01, 0, 0))
+    boss = trimesh.creation.cylinder(radius=0.003, height=0.006, sections=24)
+    boss.apply_translation((0.0, 0.01, 0.007))
+    mesh = trimesh.boolean.union([trimesh.boolean.difference([plate, bore, square], engine="manifold"), boss],
+                                 engine="manifold")
+    mesh.apply_transform(trimesh.transformations.rotation_matrix(0.2, (1, 0.3, 0)))
+    return mesh
+
+
+def _touching_cubes() -> trimesh.Trimesh:
+    """Two 10 mm cubes [m] meeting along a vertical edge: their slices' squares share a corner."""
+    cubes = [trimesh.creation.box((0.01, 0.01, 0.01)) for _ in range(2)]
+    cubes[1].apply_translation((0.01, 0.01, 0.0))
+    return trimesh.util.concatenate(cubes)
+
+
+def _sliced(mesh: trimesh.Trimesh, level: float, axis: tuple[float, float, float] = (0, 0, 1)) -> np.ndarray:
+    """The segments [µm] of ``mesh``'s slice at ``level`` [m] across ``axis``, as
+    :func:`sections.slice_loops` joins them."""
+    normal = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    return trimesh.intersections.mesh_plane(mesh, plane_normal=normal, plane_origin=normal * level) * 1e6
+
+
+@pytest.mark.parametrize("case, level, loops, simple", [
+    ("the plate's outline and its two bores", 0.0, 3, True),
+    ("through a corner of the plate", 2, 1, True),
+    ("through the round bore's lowest corner, which the outline meets", 16, 2, False),
+    ("through a corner of the round bore", 17, 2, True),
+    ("through a corner, three loops", 46, 3, True),
+    ("two squares that touch", 0.0, 2, False),
+])
+def test_slice_loops_are_joined_as_trimesh_joins_them(case: str, level: float, loops: int, simple: bool) -> None:
+    """The segments of a slice are joined into the same lines, from the same point, the
+    same way round and in the same order as trimesh's ``lines_to_path`` joins them, by one
+    search where the loops are simple cycles, else by trimesh's (slices through a vertex,
+    several loops, loops that touch). An int ``level`` is the rank of a vertex's level."""
+    mesh = _touching_cubes() if case == "two squares that touch" else _plate_with_bores()
+    if isinstance(level, int):
+        level = float(np.sort(mesh.vertices[:, 2])[level])
+    lines = _sliced(mesh, level)
+    (entities, vertices), theirs = sections._lines_to_path(lines), lines_to_path(lines)
+    assert np.array_equal(vertices, theirs["vertices"]), case
+    assert [list(e.points) for e in entities] == [list(e.points) for e in theirs["entities"]], case
+    edges = trimesh.grouping.unique_rows(lines.reshape(-1, 3), digits=5)[1].reshape(-1, 2)
+    assert (sections._cycles(edges) is not None) == simple, case
+    assert len(sections.slice_loops(mesh, np.array([0.0, 0.0, 1.0]), level)) == loops, case
+
+
+def test_a_tilted_fine_slice_is_joined_as_trimesh_joins_it() -> None:
+    """A fine ring cut aslant, through none of its vertices: two loops of thousands of points, joined alike."""
+    ring = trimesh.creation.annulus(r_min=0.005, r_max=0.01, height=0.004, sections=3000)
+    lines = _sliced(ring, 1e-4, (0.1, 0.2, 1.0))
+    assert sections._cycles(trimesh.grouping.unique_rows(lines.reshape(-1, 3), digits=5)[1].reshape(-1, 2)) is not None
+    (entities, vertices), theirs = sections._lines_to_path(lines), lines_to_path(lines)
+    assert [list(e.points) for e in entities] == [list(e.points) for e in theirs["entities"]]
+    assert len(entities) == 2 and np.array_equal(vertices, theirs["vertices"])
 
 
 def _revolved(profile: list[tuple[float, float]], sections: int = 48) -> trimesh.Trimesh:
@@ -389,3 +455,18 @@ def test_an_empty_drilled_hole_is_measured_above_its_drill_point() -> None:
     assert empty.hole.kind == "round"
     assert empty.hole.a == pytest.approx(6 * MM * math.cos(math.pi / 48), abs=1e-8)
     assert empty.depth == pytest.approx(7 * MM, abs=1e-8)
+
+
+def test_a_slice_asked_again_within_slices_kept_is_made_once() -> None:
+    """Within ``slices_kept`` a mesh's slice at an axis and level asked again is the one made
+    before (the same loops), outside it is made again; another level or mesh is its own."""
+    mesh, other = _plate_with_bores(), _touching_cubes()
+    up = np.array([0.0, 0.0, 1.0])
+    assert sections.slice_loops(mesh, up, 0.0) is not sections.slice_loops(mesh, up, 0.0)
+    with sections.slices_kept():
+        first = sections.slice_loops(mesh, up, 0.0)
+        assert sections.slice_loops(mesh, (0, 0, 1), 0.0) is first
+        assert sections.slice_loops(mesh, up, 1e-4) is not first
+        assert len(sections.slice_loops(other, up, 0.0)) == 2
+    again = sections.slice_loops(mesh, up, 0.0)
+    assert again is not first and all(np.array_equal(a.points, b.points) for a, b in zip(again, first, strict=True))
