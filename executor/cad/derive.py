@@ -101,6 +101,8 @@ from executor.cad.sweep import (
     Slide,
     Sweeper,
     axis_name,
+    forked_map,
+    processes,
     surveys,
     zero_clearance_fits,
 )
@@ -321,6 +323,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
         result.located = locators(sweeper, result.bodies, reach)
     ways = {root: result.ways(root) for root in result.bodies}
     result.supports = support_pairs(sweeper, result.bodies, base)
+    sweeper.close()  # its last sweep: what follows forks its own workers
     placing, result.later = placing_pairs(result.supports, result.located, ways, result.bodies, base,
                                           set(result.reasons))
     kept, dropped = consistent(sorted(placing), set(result.reasons))
@@ -492,13 +495,18 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
     ``before`` it (a gland on a shaft: it goes onto a pin, :func:`pins`), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
     ring that stands in a housing's bore: the ring's hole, :func:`part_holes`)."""
-    cut: dict[str, tuple[float, Loop]] = {}
-    for part in parts:
+    def sliced(part: CadPart) -> tuple[float, Loop] | None:
         axis = np.array(DIRECTIONS[axes[part.id]])
         found = _part_slice(part, base, axis)
         if found is not None and not any(_bore_around(part.mesh, other.mesh, axis, found[0]) is not None
                                          for other in [base, *before.get(part.id, [])]):
-            cut[part.id] = found
+            return found
+        return None
+
+    workers = processes([base.mesh, *(part.mesh for part in parts)])
+    cut = {part.id: found for part, found in zip(parts, forked_map(sliced, parts, workers,
+                                                                   cost=lambda part: len(part.mesh.faces)))
+           if found is not None}
     by_id = {part.id: part for part in parts}
     slices: dict[tuple[str, float], list[tuple[CadPart, Loop]]] = {}
     for pid, (level, own) in cut.items():
@@ -563,30 +571,19 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
     bores: dict[str, Shape2D] = {}
     levels: dict[str, float] = {}
     for pid in sorted(derived.axis):
-        if pid in derived.hole_of:
-            continue
-        name = derived.axis[pid]
-        along = derived.parts[pid].mesh.vertices @ np.array(derived.directions[name])
-        levels[pid] = float(along.min() + along.max()) / 2
-        before = nx.ancestors(order, pid) if pid in order else set()
-        covered = {peg for peg in derived.hole_of if derived.axis[peg] == name}  # over it: a cover
-        resting = {y for y, x in derived.supports if x == pid}
-        if resting and resting <= covered:  # on those pegs alone: onto their ends, as no cover rests
-            covered -= resting
-        taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
-        for other in sorted(({derived.base} | before) - covered):
-            while (hit := _pin_of(derived, pid, name, other, taken)) is not None:
-                pin, bore, centre, level = hit
-                if any(np.linalg.norm(pin.centre - point) < _SAME_HOLE for point in taken):
-                    break  # its bore is around a pin the part is on already
-                taken.append(pin.centre)
-                if len(taken) > 1 and _within_another(derived, pid, other, name, pin.centre, levels[pid]):
-                    continue  # a washer over a sleeve over a pin: the pin is the sleeve's to go into
-                if len(taken) > 1:
-                    further[len(found)] = bore
-                else:
-                    bores[pid] = bore
-                found.append((other, name, pin, centre, pid, level))
+        if pid not in derived.hole_of:
+            along = derived.parts[pid].mesh.vertices @ np.array(derived.directions[derived.axis[pid]])
+            levels[pid] = float(along.min() + along.max()) / 2
+    onto = forked_map(lambda pid: _pins_of(derived, order, pid, levels[pid]), list(levels),
+                      processes(p.mesh for p in derived.parts.values()),
+                      cost=lambda pid: len(derived.parts[pid].mesh.faces))
+    for pid, hits in zip(levels, onto):
+        for k, (other, pin, centre, level, bore) in enumerate(hits):
+            if k:
+                further[len(found)] = bore
+            else:
+                bores[pid] = bore
+            found.append((other, derived.axis[pid], pin, centre, pid, level))
     found += [(derived.base, derived.axis[pid], pin, centre, None, math.inf) for pid in sorted(bores)
               for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str], float]] = []
@@ -612,6 +609,32 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
         result[pin_id] = PinFit(pin_id, owner, name, pin, (float(centre[0]), float(centre[1]), float(centre[2])),
                                 tuple(parts))
     return result, bores, {(str(found[k][4]), ids[into[k]]): bore for k, bore in further.items()}
+
+
+def _pins_of(derived: Derived, order: nx.DiGraph, pid: str, middle: float
+             ) -> list[tuple[str, Shape2D, np.ndarray, float, Shape2D]]:
+    """The pins part ``pid`` goes onto (:func:`pins`), in order: each one's owner, section,
+    centre [m], the level [m] it was measured at and the part's bore there; ``order`` the
+    geometric precedence, ``middle`` [m] the middle of the part's extent along its removal
+    direction."""
+    name = derived.axis[pid]
+    before = nx.ancestors(order, pid) if pid in order else set()
+    covered = {peg for peg in derived.hole_of if derived.axis[peg] == name}  # over it: a cover
+    resting = {y for y, x in derived.supports if x == pid}
+    if resting and resting <= covered:  # on those pegs alone: onto their ends, as no cover rests
+        covered -= resting
+    taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
+    hits = []
+    for other in sorted(({derived.base} | before) - covered):
+        while (hit := _pin_of(derived, pid, name, other, taken)) is not None:
+            pin, bore, centre, level = hit
+            if any(np.linalg.norm(pin.centre - point) < _SAME_HOLE for point in taken):
+                break  # its bore is around a pin the part is on already
+            taken.append(pin.centre)
+            if len(taken) > 1 and _within_another(derived, pid, other, name, pin.centre, middle):
+                continue  # a washer over a sleeve over a pin: the pin is the sleeve's to go into
+            hits.append((other, pin, centre, level, bore))
+    return hits
 
 
 def _within_another(derived: Derived, pid: str, owner: str, name: str, centre: np.ndarray, level: float) -> bool:
@@ -920,18 +943,11 @@ def part_holes(derived: Derived) -> dict[str, HoleFit]:
     geometric precedence puts before it (not the base, not of its own body) at a level both
     reach: a rod through a bracket's bore, a shaft into a bearing placed before it."""
     order = nx.DiGraph(list(derived.edges))
-    found: list[HoleFit] = []
-    for pid in sorted(derived.axis):
-        name = derived.axis[pid]
-        if pid in derived.hole_of or pid in derived.bores or name not in DIRECTIONS or pid not in order:
-            continue
-        body = next(members for members in derived.bodies.values() if pid in members)
-        for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body):
-            hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
-            if hit is not None:
-                level, loop, outer, own = hit
-                fit = _measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own))
-                found.append(replace(fit, owner=owner))
+    moving = [pid for pid in sorted(derived.axis) if pid not in derived.hole_of and pid not in derived.bores
+              and derived.axis[pid] in DIRECTIONS and pid in order]
+    found = [fit for fits in forked_map(lambda pid: _holes_of(derived, order, pid), moving,
+                                        processes(p.mesh for p in derived.parts.values()),
+                                        cost=lambda pid: len(derived.parts[pid].mesh.faces)) for fit in fits]
     found.sort(key=lambda f: (f.owner or "", round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     counts: dict[str, int] = {}
     result: dict[str, HoleFit] = {}
@@ -940,6 +956,22 @@ def part_holes(derived: Derived) -> dict[str, HoleFit]:
         counts[owner] = counts.get(owner, 0) + 1
         result[f"{owner}_hole{counts[owner]}"] = replace(fit, id=f"{owner}_hole{counts[owner]}")
     return result
+
+
+def _holes_of(derived: Derived, order: nx.DiGraph, pid: str) -> list[HoleFit]:
+    """The holes of parts before part ``pid`` in the geometric precedence ``order`` (not the
+    base, not of its body) that ``pid`` goes through (:func:`part_holes`), in order of
+    their owners' names, each with its owner."""
+    name = derived.axis[pid]
+    body = next(members for members in derived.bodies.values() if pid in members)
+    found = []
+    for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body):
+        hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
+        if hit is not None:
+            level, loop, outer, own = hit
+            fit = _measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own))
+            found.append(replace(fit, owner=owner))
+    return found
 
 
 def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float, Loop, Loop | None, Loop] | None:
