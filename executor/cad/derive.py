@@ -60,7 +60,7 @@ its free end along the axis and some bore passes over it (:func:`_standing_pins`
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 
 import networkx as nx
@@ -282,13 +282,18 @@ def _face_size(face: CylinderFace | PrismFace) -> str:
     return f"d {2000 * face.radius:.3f} mm"
 
 
-def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH) -> Derived:
+def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH,
+           beside: Callable[[], None] = lambda: None) -> Derived:
     """Axes, stages, precedence and holes of ``parts`` with ``base`` the fixture;
     ``fixed_to`` maps a part to the part it moves with; ``reach`` [m]: the locating rule's
-    (0: off). ExecutorError naming the parts that never come out with their blockers."""
+    (0: off); ``beside`` is called once the parts' surveys are made, as the sweeps begin
+    (the import starts its overlap check there: the sweeps' first work, making the fixed
+    parts' BVHs before their workers fork, runs in this process alone). ExecutorError
+    naming the parts that never come out with their blockers."""
     by_id = {p.id: p for p in parts}
     result = Derived(base, by_id, reach=reach)
     made = surveys({p.id: p.mesh for p in parts})
+    beside()
     result.slides = zero_clearance_fits({pid: survey.faces for pid, survey in made.items()})
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))

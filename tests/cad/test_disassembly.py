@@ -11,6 +11,7 @@ as a cylinder, seated on its pin, and measured over its radii without a sliver."
 from __future__ import annotations
 
 import math
+import multiprocessing
 import os
 import time
 
@@ -81,14 +82,25 @@ def test_the_overlap_check_in_its_own_process_raises_first_and_as_in_one() -> No
     bad = [*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")]
     with pytest.raises(ExecutorError) as alone:
         check_parts(bad, "m")
-    ran = []
-    with pytest.raises(ExecutorError) as forked:  # raised on leaving, over the block's own error
+    for started in (True, False):  # started by the block, in a process of its own; or not before the block failed
+        with pytest.raises(ExecutorError) as forked:  # raised on leaving, over the block's own error
+            with overlaps_checked(bad, forked=True) as start:
+                before = set(multiprocessing.active_children())
+                if started:
+                    start()
+                    assert len(set(multiprocessing.active_children()) - before) == 1
+                raise ExecutorError("the block's error")
+        assert str(forked.value) == str(alone.value)
+    with pytest.raises(ExecutorError) as late:  # not started by a block that ends well: checked on leaving
         with overlaps_checked(bad, forked=True):
+            pass
+    assert str(late.value) == str(alone.value)
+    ran = []
+    for started in (True, False):  # a sound product: nothing raised
+        with overlaps_checked(parts, forked=True) as start:
+            if started:
+                start()
             ran.append(True)
-            raise ExecutorError("the block's error")
-    assert ran and str(forked.value) == str(alone.value)
-    with overlaps_checked(parts, forked=True):  # a sound product: nothing raised
-        ran.append(True)
     assert len(ran) == 2
 
 
