@@ -948,11 +948,15 @@ def part_holes(derived: Derived) -> dict[str, HoleFit]:
     geometric precedence puts before it (not the base, not of its own body) at a level both
     reach: a rod through a bracket's bore, a shaft into a bearing placed before it."""
     order = nx.DiGraph(list(derived.edges))
-    moving = [pid for pid in sorted(derived.axis) if pid not in derived.hole_of and pid not in derived.bores
-              and derived.axis[pid] in DIRECTIONS and pid in order]
-    found = [fit for fits in forked_map(lambda pid: _holes_of(derived, order, pid), moving,
-                                        processes(p.mesh for p in derived.parts.values()),
-                                        cost=lambda pid: len(derived.parts[pid].mesh.faces)) for fit in fits]
+    pairs = []  # (part, owner): each part's, owners in order of their names
+    for pid in sorted(derived.axis):
+        if pid in derived.hole_of or pid in derived.bores or derived.axis[pid] not in DIRECTIONS or pid not in order:
+            continue
+        body = next(members for members in derived.bodies.values() if pid in members)
+        pairs += [(pid, owner) for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body)]
+    found = [fit for fit in forked_map(lambda pair: _hole_of(derived, *pair), pairs,
+                                       processes(p.mesh for p in derived.parts.values()),
+                                       cost=lambda pair: len(derived.parts[pair[1]].mesh.faces)) if fit is not None]
     found.sort(key=lambda f: (f.owner or "", round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     counts: dict[str, int] = {}
     result: dict[str, HoleFit] = {}
@@ -963,20 +967,15 @@ def part_holes(derived: Derived) -> dict[str, HoleFit]:
     return result
 
 
-def _holes_of(derived: Derived, order: nx.DiGraph, pid: str) -> list[HoleFit]:
-    """The holes of parts before part ``pid`` in the geometric precedence ``order`` (not the
-    base, not of its body) that ``pid`` goes through (:func:`part_holes`), in order of
-    their owners' names, each with its owner."""
+def _hole_of(derived: Derived, pid: str, owner: str) -> HoleFit | None:
+    """The hole of part ``owner`` that part ``pid`` goes through along its insertion axis
+    (:func:`part_holes`), with its owner; None: none."""
     name = derived.axis[pid]
-    body = next(members for members in derived.bodies.values() if pid in members)
-    found = []
-    for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body):
-        hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
-        if hit is not None:
-            level, loop, outer, own = hit
-            fit = _measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own))
-            found.append(replace(fit, owner=owner))
-    return found
+    hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
+    if hit is None:
+        return None
+    level, loop, outer, own = hit
+    return replace(_measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own)), owner=owner)
 
 
 def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float, Loop, Loop | None, Loop] | None:

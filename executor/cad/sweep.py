@@ -712,9 +712,7 @@ class _Solid:
         self._tree: _Node | None = None
         self.pieces: dict[tuple[float, ...], dict[int, _Piece | None]] = {}
         """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
-        self.hull, self.exact = (_outer_hull(np.asarray(mesh.vertices, dtype=float)) if survey is None
-                                 else (survey.hull, survey.exact))
-        """A convex superset's vertices [m] and whether it is the hull itself."""
+        self._hull = None if survey is None else (survey.hull, survey.exact)
         self.convex = survey.convex if survey is not None else _is_convex(mesh) if convex is None else convex
         self.bounds = np.array(mesh.bounds)
         """The mesh's box [m] (a copy: trimesh checks its cache by hashing the mesh on each use)."""
@@ -722,6 +720,21 @@ class _Solid:
         """(n, 3, 3): the triangles' corners [m]."""
         self._leading: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._index: _Triangles | None = None
+
+    @property
+    def hull(self) -> np.ndarray:
+        """A convex superset's vertices [m] (:func:`_outer_hull`; of a part slid at its fits,
+        made where it is first swept: in a worker, where the sweeps fork)."""
+        if self._hull is None:
+            self._hull = _outer_hull(np.asarray(self.mesh.vertices, dtype=float))
+        return self._hull[0]
+
+    @property
+    def exact(self) -> bool:
+        """Whether :attr:`hull` is the hull itself."""
+        _ = self.hull
+        assert self._hull is not None
+        return self._hull[1]
 
     @property
     def bvh(self) -> fcl.CollisionObject:
