@@ -514,10 +514,14 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
            if found is not None}
     by_id = {part.id: part for part in parts}
     slices: dict[tuple[str, float], list[tuple[CadPart, Loop]]] = {}
-    for pid, (level, own) in cut.items():
+
+    def in_another(pid: str) -> bool:
         axis = np.array(DIRECTIONS[axes[pid]])
-        if not any(other != pid and axes[other] == axes[pid] and _hole_around(by_id[other], by_id[pid], axis)
-                   for other in cut):
+        return any(other != pid and axes[other] == axes[pid] and _hole_around(by_id[other], by_id[pid], axis)
+                   for other in cut)
+
+    for (pid, (level, own)), inside in zip(cut.items(), forked_map(in_another, list(cut), workers)):
+        if not inside:
             slices.setdefault((axes[pid], round(level, 7)), []).append((by_id[pid], own))
     if not slices:
         z = base.mesh.vertices[:, 2]
@@ -539,7 +543,7 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
             if same and (occupant is None or fits[same[0]].part is not None):
                 continue
             # a hole met empty at another part's level (a shallower one beside a deeper) is its occupant's
-            fit = _measure(base, name, loop, level, around[0] if around else None, occupant)
+            fit = _measure(base, name, loop, level, around[0] if around else None, occupant, workers)
             if same:
                 fits[same[0]] = fit
             else:
@@ -1026,13 +1030,14 @@ def _fields(fit: HoleFit) -> tuple:
 
 
 def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
-             occupant: tuple[CadPart, Loop] | None) -> HoleFit:
+             occupant: tuple[CadPart, Loop] | None, workers: int = 1) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
     the hole's centre line; through it, to its lowest point around the hole, when there is
     none) and chamfer of the hole ``loop`` sliced at ``level`` [m], and the section of the
     ``occupant`` (its part, its loop there). The sections are over the stretch from the
     occupant's end (or the hole's lowest point around it, if higher; without one, from
-    ``level``) to the entry (:func:`executor.cad.sections.over_span`); ExecutorError when
+    ``level``) to the entry (:func:`executor.cad.sections.over_span`), made in ``workers``
+    processes (:func:`executor.cad.sweep.forked_map`; 1 in a forked one); ExecutorError when
     nothing of the hole is free all along it."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
@@ -1042,7 +1047,11 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     entry = float(around.max())
     tip = level if occupant is None else float((occupant[0].mesh.vertices @ axis).min())
     low = max(tip, float(around.min()))
-    narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
+    spans: list[tuple[Loop, trimesh.Trimesh, float, bool]] = [(loop, base.mesh, low, True)]
+    if occupant is not None:
+        spans.append((occupant[1], occupant[0].mesh, tip, False))
+    narrowest, *occupied = forked_map(lambda span: over_span(span[0], span[1], axis, span[2], entry, hole=span[3]),
+                                      spans, workers)
     if len(narrowest.points) < 3:
         x, y, z = 1e3 * (frame.T @ sliced.centre + axis * level)
         raise ExecutorError(f"the hole of part {base.id} at ({x:.3f}, {y:.3f}, {z:.3f}) mm is closed between "
@@ -1058,7 +1067,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
     part, section = (None, None) if occupant is None else (
-        occupant[0].id, exact_round(classify(over_span(occupant[1], occupant[0].mesh, axis, tip, entry, hole=False),
-                                             hole=False), occupant[0].cylinders, axis, level, STEP_DEFLECTION))
+        occupant[0].id, exact_round(classify(occupied[0], hole=False), occupant[0].cylinders, axis, level,
+                                    STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)
