@@ -331,17 +331,18 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     # the overlap check runs beside the derivation where the sweeps would take two cores
     with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
         found = _derived(parts, out, config, options, start)
-    removable, settings, derived, assumed, offset, mapped, near = found
-    written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
+    removable, settings, derived, cell, assumed, offset, mapped, near = found
+    written, why = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
     assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
 
 
 def _derived(parts: list[CadPart], out: Path, config: Path | None, options: ImportOptions,
-             beside: Callable[[], None]) -> tuple[set[str], Settings, Derived, list[str], tuple[float, float], Mapped,
-                                                  int]:
+             beside: Callable[[], None]) -> tuple[set[str], Settings, Derived, Derived, list[str], tuple[float, float],
+                                                  Mapped, int]:
     """What :func:`run_import` finds before it writes: the files of ``out`` it may remove,
-    the settings with every tray, the derived product, the assumptions, the offset into
+    the settings with every tray, the derived product and the product as the cell inserts
+    it (:func:`executor.cad.write.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
     known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
     reach, replace, place = options.reach, options.replace, options.place
@@ -356,14 +357,14 @@ def _derived(parts: list[CadPart], out: Path, config: Path | None, options: Impo
     assumed += [*derived.assumptions(), *nominal_assumption(derived)]
     near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
     assumed += overlap_assumption(derived)
-    mapped, laid = map_product(derived, settings)
+    mapped, laid, cell = map_product(derived, settings)
     assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "
                        f"{_mm(TRAY_GAP)} mm apart and clear of the product, in rows from "
                        f"({_mm(TRAY_START[0])}, {_mm(TRAY_START[1])}) mm (set [parts.<id>] tray)")
-    return removable, laid, derived, assumed, offset, mapped, near
+    return removable, laid, derived, cell, assumed, offset, mapped, near
 
 
 def main(argv: list[str]) -> int:
