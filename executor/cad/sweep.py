@@ -768,8 +768,8 @@ class _Solid:
 PARALLEL_TRIANGLES = 100_000
 """Parts of fewer triangles together are swept in one process (:func:`default_workers`)."""
 WORKERS: int | None = None
-"""The processes every :class:`Sweeper` runs its queries in (None: :func:`default_workers`;
-``bench import --workers`` sets it)."""
+"""The processes every :class:`Sweeper` runs its queries in, and the import's work part by
+part (:func:`processes`) (None: :func:`default_workers`; ``bench import --workers`` sets it)."""
 
 
 def processes(meshes: Iterable[trimesh.Trimesh]) -> int:
