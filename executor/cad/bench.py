@@ -8,9 +8,10 @@ covers, one lying on the first row, the other on it, each with openings for the 
 (:func:`executor.cad.cli.run_import`) ``--repeat`` times. Prints the collision queries,
 the edges found, and the median wall and CPU time of the import, each as a fraction of
 ``--target``; exit code 1 when the median wall time (what a user waits) exceeds it. The
-CPU time is the process's and its sweep workers' (:data:`executor.cad.sweep.WORKERS`,
-``--workers``), all their threads: what one core would need; on a shared machine the wall
-time also counts the waits for a core.
+CPU time is the process's and the workers it forks (the sweeps', the overlap check's, the
+work after the sweeps': :data:`executor.cad.sweep.WORKERS`, ``--workers``), all their
+threads: what one core would need; on a shared machine the wall time also counts the waits
+for a core.
 """
 
 from __future__ import annotations
@@ -131,15 +132,15 @@ def write_shafts(folder: Path, parts: int, sections: int) -> None:
 
 
 def _children_cpu() -> float:
-    """The CPU time [s] of this process's ended and reaped child processes (the sweep workers)."""
+    """The CPU time [s] of this process's ended and reaped child processes (the import's workers)."""
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     return usage.ru_utime + usage.ru_stime
 
 
 def _timed(source: Path, out: Path, config: Path | None, repeat: int) -> tuple[float, float, Imported]:
     """Median wall and CPU time [s] of ``repeat`` imports of ``source``, and the last
-    import; the CPU time this process's and its sweep workers' (ended with the import's
-    sweeper: collected before the clocks are read)."""
+    import; the CPU time this process's and its workers' (the sweeps' ended with the
+    import's sweeper: collected before the clocks are read)."""
     walls, cpus = [], []
     for k in range(repeat):
         wall, cpu = time.perf_counter(), time.process_time() + _children_cpu()
@@ -165,7 +166,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--target", type=number_in(float, 0.0, 3600.0), default=None,
                         help="the median wall time's bound [s] (default: 10 for 9 parts, 30 for 20, 10 for the plate)")
     parser.add_argument("--workers", type=int_in(1, 64), default=None,
-                        help="processes the sweeps run in (default: two where the cores allow and the parts have "
+                        help="processes the sweeps and the work after them run in (default: two where the cores "
+                             "allow and the parts have "
                              f"{sweep.PARALLEL_TRIANGLES} triangles or more, else one)")
     args = parser.parse_args(argv)
     sweep.WORKERS = args.workers

@@ -30,13 +30,13 @@ import argparse
 import math
 import time
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
-from executor.cad import sweep
 from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
@@ -53,7 +53,7 @@ from executor.cad.parts import (
 )
 from executor.cad.sections import Shape2D, slices_kept, zero_clearance
 from executor.cad.step import load_step
-from executor.cad.sweep import default_workers, opposite
+from executor.cad.sweep import opposite, processes
 from executor.cad.write import (
     MANIFEST,
     REACH,
@@ -329,20 +329,22 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     parts = load_source(source, units, options.max_triangles)
     check_solids(parts, units)
     # the overlap check runs beside the derivation where the sweeps would take two cores
-    with overlaps_checked(parts, (sweep.WORKERS or default_workers(p.mesh for p in parts)) > 1):
-        found = _derived(parts, out, config, options)
-    removable, settings, derived, assumed, offset, mapped, near = found
-    written, why = write_folder(derived, mapped, settings, source.stem, out, removable)
+    with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
+        found = _derived(parts, out, config, options, start)
+    removable, settings, derived, cell, assumed, offset, mapped, near = found
+    written, why = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
     assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
 
 
-def _derived(parts: list[CadPart], out: Path, config: Path | None, options: ImportOptions
-             ) -> tuple[set[str], Settings, Derived, list[str], tuple[float, float], Mapped, int]:
+def _derived(parts: list[CadPart], out: Path, config: Path | None, options: ImportOptions,
+             beside: Callable[[], None]) -> tuple[set[str], Settings, Derived, Derived, list[str], tuple[float, float],
+                                                  Mapped, int]:
     """What :func:`run_import` finds before it writes: the files of ``out`` it may remove,
-    the settings with every tray, the derived product, the assumptions, the offset into
+    the settings with every tray, the derived product and the product as the cell inserts
+    it (:func:`executor.cad.write.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
-    known once the meshes' pieces are written)."""
+    known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
     reach, replace, place = options.reach, options.replace, options.place
     removable = claim_folder(out, [p.id for p in parts], replace)
     settings, fixed, assumed, placed = _config(config, parts)
@@ -352,18 +354,18 @@ def _derived(parts: list[CadPart], out: Path, config: Path | None, options: Impo
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     with slices_kept():  # the parts' meshes stay as they are until written
-        derived = derive(parts, settings.base, fixed, reach)
+        derived = derive(parts, settings.base, fixed, reach, beside)
         assumed += [*derived.assumptions(), *nominal_assumption(derived)]
         near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
         assumed += overlap_assumption(derived)
-        mapped, laid = map_product(derived, settings)
+        mapped, laid, cell = map_product(derived, settings)
     assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "
                        f"{_mm(TRAY_GAP)} mm apart and clear of the product, in rows from "
                        f"({_mm(TRAY_START[0])}, {_mm(TRAY_START[1])}) mm (set [parts.<id>] tray)")
-    return removable, laid, derived, assumed, offset, mapped, near
+    return removable, laid, derived, cell, assumed, offset, mapped, near
 
 
 def main(argv: list[str]) -> int:

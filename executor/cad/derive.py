@@ -61,7 +61,7 @@ its free end along the axis and some bore passes over it (:func:`_standing_pins`
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 
 import networkx as nx
@@ -102,6 +102,8 @@ from executor.cad.sweep import (
     Slide,
     Sweeper,
     axis_name,
+    forked_map,
+    processes,
     surveys,
     zero_clearance_fits,
 )
@@ -281,13 +283,18 @@ def _face_size(face: CylinderFace | PrismFace) -> str:
     return f"d {2000 * face.radius:.3f} mm"
 
 
-def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH) -> Derived:
+def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: float = LOCATING_REACH,
+           beside: Callable[[], None] = lambda: None) -> Derived:
     """Axes, stages, precedence and holes of ``parts`` with ``base`` the fixture;
     ``fixed_to`` maps a part to the part it moves with; ``reach`` [m]: the locating rule's
-    (0: off). ExecutorError naming the parts that never come out with their blockers."""
+    (0: off); ``beside`` is called once the parts' surveys are made, as the sweeps begin
+    (the import starts its overlap check there: the sweeps' first work, making the fixed
+    parts' BVHs before their workers fork, runs in this process alone). ExecutorError
+    naming the parts that never come out with their blockers."""
     by_id = {p.id: p for p in parts}
     result = Derived(base, by_id, reach=reach)
     made = surveys({p.id: p.mesh for p in parts})
+    beside()
     result.slides = zero_clearance_fits({pid: survey.faces for pid, survey in made.items()})
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
@@ -322,6 +329,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
         result.located = locators(sweeper, result.bodies, reach)
     ways = {root: result.ways(root) for root in result.bodies}
     result.supports = support_pairs(sweeper, result.bodies, base)
+    sweeper.close()  # its last sweep: what follows forks its own workers
     placing, result.later = placing_pairs(result.supports, result.located, ways, result.bodies, base,
                                           set(result.reasons))
     kept, dropped = consistent(sorted(placing), set(result.reasons))
@@ -493,19 +501,28 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
     ``before`` it (a gland on a shaft: it goes onto a pin, :func:`pins`), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
     ring that stands in a housing's bore: the ring's hole, :func:`part_holes`)."""
-    cut: dict[str, tuple[float, Loop]] = {}
-    for part in parts:
+    def sliced(part: CadPart) -> tuple[float, Loop] | None:
         axis = np.array(DIRECTIONS[axes[part.id]])
         found = _part_slice(part, base, axis)
         if found is not None and not any(_bore_around(part.mesh, other.mesh, axis, found[0]) is not None
                                          for other in [base, *before.get(part.id, [])]):
-            cut[part.id] = found
+            return found
+        return None
+
+    workers = processes([base.mesh, *(part.mesh for part in parts)])
+    cut = {part.id: found for part, found in zip(parts, forked_map(sliced, parts, workers,
+                                                                   cost=lambda part: len(part.mesh.faces)))
+           if found is not None}
     by_id = {part.id: part for part in parts}
     slices: dict[tuple[str, float], list[tuple[CadPart, Loop]]] = {}
-    for pid, (level, own) in cut.items():
+
+    def in_another(pid: str) -> bool:
         axis = np.array(DIRECTIONS[axes[pid]])
-        if not any(other != pid and axes[other] == axes[pid] and _hole_around(by_id[other], by_id[pid], axis)
-                   for other in cut):
+        return any(other != pid and axes[other] == axes[pid] and _hole_around(by_id[other], by_id[pid], axis)
+                   for other in cut)
+
+    for (pid, (level, own)), inside in zip(cut.items(), forked_map(in_another, list(cut), workers)):
+        if not inside:
             slices.setdefault((axes[pid], round(level, 7)), []).append((by_id[pid], own))
     if not slices:
         z = base.mesh.vertices[:, 2]
@@ -527,7 +544,7 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
             if same and (occupant is None or fits[same[0]].part is not None):
                 continue
             # a hole met empty at another part's level (a shallower one beside a deeper) is its occupant's
-            fit = _measure(base, name, loop, level, around[0] if around else None, occupant)
+            fit = _measure(base, name, loop, level, around[0] if around else None, occupant, workers)
             if same:
                 fits[same[0]] = fit
             else:
@@ -564,30 +581,19 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
     bores: dict[str, Shape2D] = {}
     levels: dict[str, float] = {}
     for pid in sorted(derived.axis):
-        if pid in derived.hole_of:
-            continue
-        name = derived.axis[pid]
-        along = derived.parts[pid].mesh.vertices @ np.array(derived.directions[name])
-        levels[pid] = float(along.min() + along.max()) / 2
-        before = nx.ancestors(order, pid) if pid in order else set()
-        covered = {peg for peg in derived.hole_of if derived.axis[peg] == name}  # over it: a cover
-        resting = {y for y, x in derived.supports if x == pid}
-        if resting and resting <= covered:  # on those pegs alone: onto their ends, as no cover rests
-            covered -= resting
-        taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
-        for other in sorted(({derived.base} | before) - covered):
-            while (hit := _pin_of(derived, pid, name, other, taken)) is not None:
-                pin, bore, centre, level = hit
-                if any(np.linalg.norm(pin.centre - point) < _SAME_HOLE for point in taken):
-                    break  # its bore is around a pin the part is on already
-                taken.append(pin.centre)
-                if len(taken) > 1 and _within_another(derived, pid, other, name, pin.centre, levels[pid]):
-                    continue  # a washer over a sleeve over a pin: the pin is the sleeve's to go into
-                if len(taken) > 1:
-                    further[len(found)] = bore
-                else:
-                    bores[pid] = bore
-                found.append((other, name, pin, centre, pid, level))
+        if pid not in derived.hole_of:
+            along = derived.parts[pid].mesh.vertices @ np.array(derived.directions[derived.axis[pid]])
+            levels[pid] = float(along.min() + along.max()) / 2
+    onto = forked_map(lambda pid: _pins_of(derived, order, pid, levels[pid]), list(levels),
+                      processes(p.mesh for p in derived.parts.values()),
+                      cost=lambda pid: len(derived.parts[pid].mesh.faces))
+    for pid, hits in zip(levels, onto):
+        for k, (other, pin, centre, level, bore) in enumerate(hits):
+            if k:
+                further[len(found)] = bore
+            else:
+                bores[pid] = bore
+            found.append((other, derived.axis[pid], pin, centre, pid, level))
     found += [(derived.base, derived.axis[pid], pin, centre, None, math.inf) for pid in sorted(bores)
               for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str], float]] = []
@@ -613,6 +619,32 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
         result[pin_id] = PinFit(pin_id, owner, name, pin, (float(centre[0]), float(centre[1]), float(centre[2])),
                                 tuple(parts))
     return result, bores, {(str(found[k][4]), ids[into[k]]): bore for k, bore in further.items()}
+
+
+def _pins_of(derived: Derived, order: nx.DiGraph, pid: str, middle: float
+             ) -> list[tuple[str, Shape2D, np.ndarray, float, Shape2D]]:
+    """The pins part ``pid`` goes onto (:func:`pins`), in order: each one's owner, section,
+    centre [m], the level [m] it was measured at and the part's bore there; ``order`` the
+    geometric precedence, ``middle`` [m] the middle of the part's extent along its removal
+    direction."""
+    name = derived.axis[pid]
+    before = nx.ancestors(order, pid) if pid in order else set()
+    covered = {peg for peg in derived.hole_of if derived.axis[peg] == name}  # over it: a cover
+    resting = {y for y, x in derived.supports if x == pid}
+    if resting and resting <= covered:  # on those pegs alone: onto their ends, as no cover rests
+        covered -= resting
+    taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
+    hits = []
+    for other in sorted(({derived.base} | before) - covered):
+        while (hit := _pin_of(derived, pid, name, other, taken)) is not None:
+            pin, bore, centre, level = hit
+            if any(np.linalg.norm(pin.centre - point) < _SAME_HOLE for point in taken):
+                break  # its bore is around a pin the part is on already
+            taken.append(pin.centre)
+            if len(taken) > 1 and _within_another(derived, pid, other, name, pin.centre, middle):
+                continue  # a washer over a sleeve over a pin: the pin is the sleeve's to go into
+            hits.append((other, pin, centre, level, bore))
+    return hits
 
 
 def _within_another(derived: Derived, pid: str, owner: str, name: str, centre: np.ndarray, level: float) -> bool:
@@ -921,18 +953,15 @@ def part_holes(derived: Derived) -> dict[str, HoleFit]:
     geometric precedence puts before it (not the base, not of its own body) at a level both
     reach: a rod through a bracket's bore, a shaft into a bearing placed before it."""
     order = nx.DiGraph(list(derived.edges))
-    found: list[HoleFit] = []
+    pairs = []  # (part, owner): each part's, owners in order of their names
     for pid in sorted(derived.axis):
-        name = derived.axis[pid]
-        if pid in derived.hole_of or pid in derived.bores or name not in DIRECTIONS or pid not in order:
+        if pid in derived.hole_of or pid in derived.bores or derived.axis[pid] not in DIRECTIONS or pid not in order:
             continue
         body = next(members for members in derived.bodies.values() if pid in members)
-        for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body):
-            hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
-            if hit is not None:
-                level, loop, outer, own = hit
-                fit = _measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own))
-                found.append(replace(fit, owner=owner))
+        pairs += [(pid, owner) for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body)]
+    found = [fit for fit in forked_map(lambda pair: _hole_of(derived, *pair), pairs,
+                                       processes(p.mesh for p in derived.parts.values()),
+                                       cost=lambda pair: len(derived.parts[pair[1]].mesh.faces)) if fit is not None]
     found.sort(key=lambda f: (f.owner or "", round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     counts: dict[str, int] = {}
     result: dict[str, HoleFit] = {}
@@ -941,6 +970,17 @@ def part_holes(derived: Derived) -> dict[str, HoleFit]:
         counts[owner] = counts.get(owner, 0) + 1
         result[f"{owner}_hole{counts[owner]}"] = replace(fit, id=f"{owner}_hole{counts[owner]}")
     return result
+
+
+def _hole_of(derived: Derived, pid: str, owner: str) -> HoleFit | None:
+    """The hole of part ``owner`` that part ``pid`` goes through along its insertion axis
+    (:func:`part_holes`), with its owner; None: none."""
+    name = derived.axis[pid]
+    hit = _hole_around(derived.parts[owner], derived.parts[pid], np.array(DIRECTIONS[name]))
+    if hit is None:
+        return None
+    level, loop, outer, own = hit
+    return replace(_measure(derived.parts[owner], name, loop, level, outer, (derived.parts[pid], own)), owner=owner)
 
 
 def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float, Loop, Loop | None, Loop] | None:
@@ -991,17 +1031,19 @@ def _fields(fit: HoleFit) -> tuple:
 
 
 def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
-             occupant: tuple[CadPart, Loop] | None) -> HoleFit:
+             occupant: tuple[CadPart, Loop] | None, workers: int = 1) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
     the hole's centre line; through it, to its lowest point around the hole, when there is
     none) and chamfer of the hole ``loop`` sliced at ``level`` [m], and the section of the
     ``occupant`` (its part, its loop there). The sections are over the stretch from the
     occupant's end (or the hole's lowest point around it, if higher) to the entry
-    (:func:`executor.cad.sections.over_span`); without one, from the floor (the first face
-    of ``base`` down the centre line of the loop) or, with none, from the hole's lowest point
-    around it: as deep as a part goes in. Where nothing of the hole is free down to that
-    floor, it is no face across the axis (a drill point's cone) and the stretch starts at
-    ``level``. ExecutorError when nothing of the hole is free all along the stretch."""
+    (:func:`executor.cad.sections.over_span`, made in ``workers`` processes:
+    :func:`executor.cad.sweep.forked_map`; 1 in a forked one); without an occupant, from the
+    floor (the first face of ``base`` down the centre line of the loop) or, with none, from
+    the hole's lowest point around it: as deep as a part goes in. Where nothing of the hole
+    is free down to that floor, it is no face across the axis (a drill point's cone) and the
+    stretch starts at ``level``. ExecutorError when nothing of the hole is free all along the
+    stretch."""
     axis = np.array(DIRECTIONS[name])
     frame = frame_of(axis)
     sliced = classify(loop, hole=True)
@@ -1014,7 +1056,11 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     else:
         tip = float((occupant[0].mesh.vertices @ axis).min())
     low = max(tip, float(around.min()))
-    narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
+    spans: list[tuple[Loop, trimesh.Trimesh, float, bool]] = [(loop, base.mesh, low, True)]
+    if occupant is not None:
+        spans.append((occupant[1], occupant[0].mesh, tip, False))
+    narrowest, *occupied = forked_map(lambda span: over_span(span[0], span[1], axis, span[2], entry, hole=span[3]),
+                                      spans, workers)
     if occupant is None and len(narrowest.points) < 3:  # a floor not across the axis (a drill point's cone)
         low = level
         narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
@@ -1033,7 +1079,7 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
     part, section = (None, None) if occupant is None else (
-        occupant[0].id, exact_round(classify(over_span(occupant[1], occupant[0].mesh, axis, tip, entry, hole=False),
-                                             hole=False), occupant[0].cylinders, axis, level, STEP_DEFLECTION))
+        occupant[0].id, exact_round(classify(occupied[0], hole=False), occupant[0].cylinders, axis, level,
+                                    STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)

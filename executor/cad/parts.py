@@ -276,33 +276,51 @@ def _make_solid(part: CadPart, units: str) -> None:
 
 
 @contextlib.contextmanager
-def overlaps_checked(parts: list[CadPart], forked: bool) -> Iterator[None]:
-    """The overlap check of ``parts`` (the last of :func:`check_parts`) around the block:
-    with ``forked``, in a process forked on entry while the block runs (the two share
-    nothing: the check only reads the parts), its ExecutorError raised on leaving, before
-    any error of the block, as when it ran first; else before the block."""
+def overlaps_checked(parts: list[CadPart], forked: bool) -> Iterator[Callable[[], None]]:
+    """The overlap check of ``parts`` (the last of :func:`check_parts`) around the block,
+    which is handed the function that starts it: with ``forked``, in a process forked when
+    the block calls that function (the two share nothing: the check only reads the parts;
+    the import calls it where its own process would otherwise run alone, as the sweeps
+    begin), its ExecutorError raised on leaving, before any error of the block, as when it
+    ran first (not started by then, it runs on leaving); else before the block, the
+    function doing nothing."""
     if not forked:
         _check_overlaps(parts)
-        yield
+        yield lambda: None
         return
-    receiver, sender = multiprocessing.get_context("fork").Pipe(duplex=False)
-    child = multiprocessing.get_context("fork").Process(target=_overlaps_to, args=(parts, sender), daemon=True)
-    child.start()
-    sender.close()
+    started: list[tuple[multiprocessing.connection.Connection, multiprocessing.process.BaseProcess]] = []
+
+    def start() -> None:
+        if started:
+            return
+        receiver, sender = multiprocessing.get_context("fork").Pipe(duplex=False)
+        child = multiprocessing.get_context("fork").Process(target=_overlaps_to, args=(parts, sender), daemon=True)
+        child.start()
+        sender.close()
+        started.append((receiver, child))
+
     try:
-        yield
+        yield start
+    except Exception:
+        if not started:  # the block failed before it started the check: the check's error first
+            _check_overlaps(parts)
+        raise
     finally:
-        try:
-            found = receiver.recv()
-        except EOFError:  # it ended without an answer (killed)
-            found = None
-        child.join()
-        if found is None and child.exitcode != 0:
-            found = ("crash", f"its process ended with exit code {child.exitcode}")
-        receiver.close()
-        if found is not None:
-            kind, text = found
-            raise ExecutorError(text) if kind == "error" else RuntimeError(f"the overlap check failed:\n{text}")
+        if started:
+            receiver, child = started[0]
+            try:
+                found = receiver.recv()
+            except EOFError:  # it ended without an answer (killed)
+                found = None
+            child.join()
+            if found is None and child.exitcode != 0:
+                found = ("crash", f"its process ended with exit code {child.exitcode}")
+            receiver.close()
+            if found is not None:
+                kind, text = found
+                raise ExecutorError(text) if kind == "error" else RuntimeError(f"the overlap check failed:\n{text}")
+    if not started:
+        _check_overlaps(parts)
 
 
 def _overlaps_to(parts: list[CadPart], sender: multiprocessing.connection.Connection) -> None:

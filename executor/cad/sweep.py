@@ -58,9 +58,9 @@ import multiprocessing
 import multiprocessing.pool
 import os
 import weakref
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
-from typing import NamedTuple
+from typing import NamedTuple, TypeVar, cast
 
 import fcl
 import numpy as np
@@ -69,6 +69,7 @@ import trimesh
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
 from bridge.cli_types import worker_signals
+from executor import ExecutorError
 
 TOUCH = 1e-5
 """Contacts at most this deep [m] are touching, not colliding (10 µm: below every
@@ -642,36 +643,62 @@ def _survey(mesh: trimesh.Trimesh) -> Survey:
 
 
 def surveys(meshes: dict[str, trimesh.Trimesh]) -> dict[str, Survey]:
-    """:class:`Survey` of each closed mesh, in :data:`WORKERS` (None: :func:`default_workers`)
-    processes forked now where there are more than one, the largest parts first: each
-    part's made alone from its mesh, as one process makes it, and handed back whole."""
-    workers = WORKERS or default_workers(meshes.values())
-    if workers < 2 or len(meshes) < 2:
-        return {pid: _survey(mesh) for pid, mesh in meshes.items()}
-    global _SURVEYED
-    _SURVEYED = meshes  # the workers' copy, forked now
-    pool = multiprocessing.get_context("fork").Pool(min(workers, len(meshes)), initializer=worker_signals)
-    _SURVEYED = None
+    """:class:`Survey` of each closed mesh, in :func:`processes` of them (:func:`forked_map`),
+    the largest parts first: each part's made alone from its mesh and handed back whole."""
+    found = forked_map(lambda pid: _survey(meshes[pid]), list(meshes), processes(meshes.values()),
+                       cost=lambda pid: len(meshes[pid].faces))
+    return dict(zip(meshes, found))
+
+
+_Item = TypeVar("_Item")
+_Result = TypeVar("_Result")
+
+
+def forked_map(function: Callable[[_Item], _Result], items: Sequence[_Item], workers: int,
+               cost: Callable[[_Item], float] | None = None) -> list[_Result]:
+    """``function`` of each of ``items``, in their order: in ``workers`` processes forked now
+    (each a copy of this one: ``function``, the items and what it reads need no pickling,
+    its results do) where there are more than one and more than one item, else here. The items
+    are handed out the costliest first (``cost``; None: in order), each to the next free
+    worker. An :class:`executor.ExecutorError` of an item is raised here, that of the first
+    item in order of those that raised one, as one process raises it."""
+    if workers < 2 or len(items) < 2:
+        return [function(item) for item in items]
+    order = sorted(range(len(items)), key=lambda k: -cost(items[k])) if cost is not None else list(range(len(items)))
+    global _MAPPED
+    _MAPPED = lambda k: function(items[k])  # noqa: E731  (the workers' copy, forked now)
+    pool = multiprocessing.get_context("fork").Pool(min(workers, len(items)), initializer=worker_signals)
+    _MAPPED = None
     try:
-        order = sorted(meshes, key=lambda pid: -len(meshes[pid].faces))
-        found = dict(zip(order, pool.map(_surveyed, order, chunksize=1)))
+        answers = pool.map(_mapped, order, chunksize=1)
         pool.close()  # the workers end on their own once the tasks are done
     except BaseException:
         pool.terminate()
         raise
     finally:
         pool.join()  # reaped: their CPU is this process's children's
-    return {pid: found[pid] for pid in meshes}
+    found: list[tuple[bool, object]] = [(True, None)] * len(items)
+    for k, answer in zip(order, answers):
+        found[k] = answer
+    for done, value in found:
+        if not done:
+            raise cast(ExecutorError, value)
+    return [cast(_Result, value) for _, value in found]
 
 
-_SURVEYED: dict[str, trimesh.Trimesh] | None = None
-"""The meshes whose surveys are being forked: a worker's copy of them answers :func:`_surveyed`."""
+_MAPPED: Callable[[int], object] | None = None
+"""The function of an item's index that :func:`forked_map` is forking workers for: a
+worker's copy of it answers :func:`_mapped`."""
 
 
-def _surveyed(pid: str) -> Survey:
-    """In a worker forked by :func:`surveys`: the :class:`Survey` of part ``pid``."""
-    assert _SURVEYED is not None, "a survey worker forked without its meshes"
-    return _survey(_SURVEYED[pid])
+def _mapped(index: int) -> tuple[bool, object]:
+    """In a worker forked by :func:`forked_map`: (True, the function of item ``index``), or
+    (False, its :class:`executor.ExecutorError`), handed back to be raised in order."""
+    assert _MAPPED is not None, "a worker forked without its function"
+    try:
+        return True, _MAPPED(index)
+    except ExecutorError as error:
+        return False, error
 
 
 class _Solid:
@@ -685,9 +712,7 @@ class _Solid:
         self._tree: _Node | None = None
         self.pieces: dict[tuple[float, ...], dict[int, _Piece | None]] = {}
         """Shift -> tree node (its id; -1: the whole part) -> its swept hull, kept for the other parts' tests."""
-        self.hull, self.exact = (_outer_hull(np.asarray(mesh.vertices, dtype=float)) if survey is None
-                                 else (survey.hull, survey.exact))
-        """A convex superset's vertices [m] and whether it is the hull itself."""
+        self._hull = None if survey is None else (survey.hull, survey.exact)
         self.convex = survey.convex if survey is not None else _is_convex(mesh) if convex is None else convex
         self.bounds = np.array(mesh.bounds)
         """The mesh's box [m] (a copy: trimesh checks its cache by hashing the mesh on each use)."""
@@ -695,6 +720,21 @@ class _Solid:
         """(n, 3, 3): the triangles' corners [m]."""
         self._leading: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._index: _Triangles | None = None
+
+    @property
+    def hull(self) -> np.ndarray:
+        """A convex superset's vertices [m] (:func:`_outer_hull`; of a part slid at its fits,
+        made where it is first swept: in a worker, where the sweeps fork)."""
+        if self._hull is None:
+            self._hull = _outer_hull(np.asarray(self.mesh.vertices, dtype=float))
+        return self._hull[0]
+
+    @property
+    def exact(self) -> bool:
+        """Whether :attr:`hull` is the hull itself."""
+        _ = self.hull
+        assert self._hull is not None
+        return self._hull[1]
 
     @property
     def bvh(self) -> fcl.CollisionObject:
@@ -728,8 +768,14 @@ class _Solid:
 PARALLEL_TRIANGLES = 100_000
 """Parts of fewer triangles together are swept in one process (:func:`default_workers`)."""
 WORKERS: int | None = None
-"""The processes every :class:`Sweeper` runs its queries in (None: :func:`default_workers`;
-``bench import --workers`` sets it)."""
+"""The processes every :class:`Sweeper` runs its queries in, and the import's work part by
+part (:func:`processes`) (None: :func:`default_workers`; ``bench import --workers`` sets it)."""
+
+
+def processes(meshes: Iterable[trimesh.Trimesh]) -> int:
+    """The processes the import's work on ``meshes`` runs in: :data:`WORKERS`, else
+    :func:`default_workers`."""
+    return WORKERS or default_workers(meshes)
 
 
 def default_workers(meshes: Iterable[trimesh.Trimesh]) -> int:
@@ -751,8 +797,9 @@ class Sweeper:
         :func:`default_workers` of the meshes); ``made``: the parts' :func:`surveys`
         where made already."""
         self.meshes = meshes
-        self.workers = workers or WORKERS or default_workers(meshes.values())
+        self.workers = workers or processes(meshes.values())
         self._pool: multiprocessing.pool.Pool | None = None
+        self._ended: weakref.finalize | None = None
         self._solids = {pid: _Solid(mesh, survey=(made or {}).get(pid)) for pid, mesh in meshes.items()}
         self._slides: dict[tuple[str, str], list[Slide]] = {}
         for slide in slides:
@@ -837,7 +884,8 @@ class Sweeper:
                 _FORKED = self  # the workers' copy, forked now
                 self._pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=worker_signals)
                 _FORKED = None
-                weakref.finalize(self, self._pool.terminate)  # the workers end (and are reaped) with the sweeper
+                # the workers end (and are reaped) with the sweeper, or at close
+                self._ended = weakref.finalize(self, self._pool.terminate)
             self._answers.update(zip(pending, self._pool.map(_swept, pending.values(), chunksize=1)))
         else:
             self._answers.update((key, _collides(*self._oriented(*test))) for key, test in pending.items())
@@ -845,6 +893,13 @@ class Sweeper:
             way, length = ways[key]
             self._along.setdefault(way, []).append((length, self._answers[key]))
         return [self._answers[key] for key in keys]
+
+    def close(self) -> None:
+        """End the processes the queries ran in, if any (and reap them): what the import
+        forks next has both cores. A later query forks them anew."""
+        if self._ended is not None:
+            self._ended()
+        self._pool, self._ended = None, None
 
     def _entailed(self, way: tuple[int, int, tuple[float, ...]], length: float) -> bool | None:
         """The answer of the sweep ``way`` (moving solid, fixed solid (their ids), unit

@@ -885,13 +885,13 @@ def _polygon_refused(fit: HoleFit, derived: Derived) -> str:
     return "" if thin is None else f"part '{fit.part}': {thin}"
 
 
-def map_product(derived: Derived, settings: Settings) -> tuple[Mapped, Settings]:
+def map_product(derived: Derived, settings: Settings) -> tuple[Mapped, Settings, Derived]:
     """The covers, heads and parts placed by hand of the product as the cell inserts it
     (:func:`cell_view`: its other pegs are placed by hand), with ``why`` the cell builds
     none of it (two parts overlapping on the tray, or parts without a tray in ``settings``
     that cannot all wait within the arm's reach), its gripper's flange where the default's is
-    too short (:func:`tool_length`), and the settings with every part's tray
-    (:func:`default_trays` for those it lacks)."""
+    too short (:func:`tool_length`), the settings with every part's tray
+    (:func:`default_trays` for those it lacks), and that product (for :func:`write_folder`)."""
     cell, by_hand = cell_view(derived)
     flange, tool = tool_length(cell)
     mapped = replace(map_parts(cell, _plate_top(cell), by_hand), flange=flange, tool=tool)
@@ -902,7 +902,7 @@ def map_product(derived: Derived, settings: Settings) -> tuple[Mapped, Settings]
         None if not unreached else f"parts {', '.join(unreached)} find no tray within the arm's reach "
         f"({1000 * REACH[0]:g} to {1000 * REACH[1]:g} mm) clear of the product and the other parts "
         "(set [parts.<id>] tray in the import settings)")
-    return replace(mapped, why=why), settings
+    return replace(mapped, why=why), settings, cell
 
 
 def manual_origin(mesh: trimesh.Trimesh) -> tuple[float, float, float]:
@@ -1320,10 +1320,11 @@ def _cell_disagrees(derived: Derived, geometry: CellGeometry) -> str | None:
     return None
 
 
-def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: str, out: Path,
+def write_folder(derived: Derived, cell: Derived, mapped: Mapped, settings: Settings, title: str, out: Path,
                  removable: set[str]) -> tuple[list[Path], str | None]:
     """Write the files of the module docstring into ``out`` (removing the ``removable``
-    files, :func:`claim_folder`, that this import does not write again; the manifest last);
+    files, :func:`claim_folder`, that this import does not write again; the manifest last),
+    ``cell`` the product as the cell inserts it (:func:`cell_view`, :func:`map_product`'s);
     returns them and why there is no ``geometry.toml`` (None when there is one, checked by
     the cell's loader)."""
     make_folder(out)
@@ -1337,7 +1338,6 @@ def write_folder(derived: Derived, mapped: Mapped, settings: Settings, title: st
     geometry.unlink(missing_ok=True)  # the claim made it this import's, if there was one
     why = mapped.why
     mesh_files: list[Path] = []
-    cell = cell_view(derived)[0]
     meshes = write_meshes(cell, mapped, out, mesh_files) if why is None else None
     if isinstance(meshes, str):
         why = meshes

@@ -11,6 +11,9 @@ as a cylinder, seated on its pin, and measured over its radii without a sliver."
 from __future__ import annotations
 
 import math
+import multiprocessing
+import os
+import time
 
 import numpy as np
 import pytest
@@ -79,14 +82,25 @@ def test_the_overlap_check_in_its_own_process_raises_first_and_as_in_one() -> No
     bad = [*parts[:2], CadPart("shaft", "shaft", shaft, "shaft.stl")]
     with pytest.raises(ExecutorError) as alone:
         check_parts(bad, "m")
-    ran = []
-    with pytest.raises(ExecutorError) as forked:  # raised on leaving, over the block's own error
+    for started in (True, False):  # started by the block, in a process of its own; or not before the block failed
+        with pytest.raises(ExecutorError) as forked:  # raised on leaving, over the block's own error
+            with overlaps_checked(bad, forked=True) as start:
+                before = set(multiprocessing.active_children())
+                if started:
+                    start()
+                    assert len(set(multiprocessing.active_children()) - before) == 1
+                raise ExecutorError("the block's error")
+        assert str(forked.value) == str(alone.value)
+    with pytest.raises(ExecutorError) as late:  # not started by a block that ends well: checked on leaving
         with overlaps_checked(bad, forked=True):
+            pass
+    assert str(late.value) == str(alone.value)
+    ran = []
+    for started in (True, False):  # a sound product: nothing raised
+        with overlaps_checked(parts, forked=True) as start:
+            if started:
+                start()
             ran.append(True)
-            raise ExecutorError("the block's error")
-    assert ran and str(forked.value) == str(alone.value)
-    with overlaps_checked(parts, forked=True):  # a sound product: nothing raised
-        ran.append(True)
     assert len(ran) == 2
 
 
@@ -107,6 +121,48 @@ def test_surveys_in_two_processes_are_those_of_one(monkeypatch: pytest.MonkeyPat
                 assert (shapely.to_wkb(value) == shapely.to_wkb(other) if isinstance(value, shapely.Geometry)
                         else np.array_equal(value, other)), key
     assert [len(s.faces) for s in found[1].values()] == [2, 2, 1] and not found[1]["housing"].convex
+
+
+def _slow_error(item: tuple[float, str | None]) -> tuple[int, float]:
+    """In :func:`test_a_forked_map_answers_in_order_and_raises_the_first_error_in_order`:
+    after ``item[0]`` seconds, the process's id and the time, or the ExecutorError ``item[1]``."""
+    time.sleep(item[0])
+    if item[1] is not None:
+        raise ExecutorError(item[1])
+    return os.getpid(), time.perf_counter()
+
+
+def test_a_forked_map_answers_in_order_and_raises_the_first_error_in_order() -> None:
+    items = [(0.3, None), (0.0, None), (0.0, None)]
+    one, two = sweep.forked_map(_slow_error, items, 1), sweep.forked_map(_slow_error, items, 2, cost=lambda i: i[0])
+    assert {pid for pid, _ in one} == {os.getpid()}
+    assert len({pid for pid, _ in two}) == 2 and os.getpid() not in {pid for pid, _ in two}
+    assert two[1][1] < two[0][1]  # the costliest first, beside the others: answered in order all the same
+    # The first item's error arrives last (the second's at once), and is the one raised, as one process raises it.
+    with pytest.raises(ExecutorError, match="the first"):
+        sweep.forked_map(_slow_error, [(0.3, "the first"), (0.0, "the second")], 2)
+
+
+def _rings_on_posts() -> list[CadPart]:
+    """A plate with two posts (r 6 mm, 48-gons, 30 mm apart) and a ring on each (bore r 8
+    mm, a 40- and a 44-gon)."""
+    posts = [trimesh.creation.cylinder(radius=6 * MM, height=20 * MM, sections=48).apply_translation((x, 0, 12 * MM))
+             for x in (-15 * MM, 15 * MM)]
+    base = trimesh.boolean.union([_box((70, 40, 2), (0, 0, 1)), *posts], engine="manifold")
+    rings = [trimesh.creation.annulus(r_min=8 * MM, r_max=12 * MM, height=3 * MM, sections=n)
+             .apply_translation((x, 0, 3.5 * MM)) for x, n in ((-15 * MM, 40), (15 * MM, 44))]
+    return _parts(base=base, left=rings[0], right=rings[1])
+
+
+def test_the_holes_and_pins_in_two_processes_are_those_of_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    for parts, base in ((_shaft_in_bearing(), "housing"), (_rings_on_posts(), "base")):
+        found = []
+        for workers in (1, 2):
+            monkeypatch.setattr(sweep, "WORKERS", workers)
+            derived = derive(parts, base, {}, reach=0.0)
+            found.append(repr((derived.holes, derived.pins, derived.bores, derived.further_bores, derived.part_holes)))
+        assert found[0] == found[1]
+    assert "'base_pin1'" in found[0] and "'base_pin2'" in found[0] and "'right'" in found[0]
 
 
 def _filleted_ring(bore: float, outside: float, width: float, radius: float, sections: int) -> trimesh.Trimesh:
