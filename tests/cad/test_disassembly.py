@@ -6,7 +6,8 @@ a lid gets none, a washer on a pin under a cap nut gets exactly the forced ones)
 fixed to each other move as one; a part that never comes out is named with its blockers
 per direction; a ring passes a collar of its bore's size on its way out; a bolt at zero
 clearance beside a boss of the base is found in its hole; a bore with edge radii is fitted
-as a cylinder, seated on its pin, and measured over its radii without a sliver."""
+as a cylinder, seated on its pin, and measured over its radii without a sliver; a sliver
+in a bore is no deflection, and a ring of facets coarser than a tessellation is no cylinder."""
 
 from __future__ import annotations
 
@@ -286,6 +287,39 @@ def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fi
     derived = derive(parts, "plate", {}, reach=0.0)
     assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
     assert derived.blockers[("nut", "+z")] == set() and derived.axis["nut"] == "+z"
+
+
+def _plate_with_bore(corners: np.ndarray) -> trimesh.Trimesh:
+    """A 40 x 40 x 10 mm plate along z [m] bored through by the polygon ``corners`` [mm]."""
+    plate = shapely.Polygon(shapely.box(-20, -20, 20, 20).exterior.coords, [corners])
+    return trimesh.creation.extrude_polygon(plate, 10.0).apply_scale(MM)
+
+
+def test_a_sliver_in_a_bore_is_no_deflection_and_a_peg_with_room_in_it_is_no_fit() -> None:
+    # A d 20 bore (64-gon) with a sliver, as a CSG cut leaves where a spline's side wall
+    # meets a root arc: one vertex doubled 20 nm off, its two triangles' plane 25° from the
+    # ring's and 0.94 mm inside the circle at the axis's foot, which they do not reach
+    # (their corners are on it). A d 19.8 peg has 0.1 mm of room in it: no zero-clearance
+    # fit; a d 20 12-gon peg (chord error 0.34 mm) is one.
+    turns = np.linspace(0, 2 * math.pi, 64, endpoint=False)
+    ring = 10.0 * np.column_stack([np.cos(turns), np.sin(turns)])
+    lean = turns[0] + math.pi / 2 - math.radians(25)  # the sliver's edge, 25° off the ring's tangent
+    sliver = ring[0] + 2e-5 * np.array([math.cos(lean), math.sin(lean)])
+    plate = _plate_with_bore(np.vstack([ring[:1], sliver, ring[1:]]))
+    bore = [f for f in cylinder_faces(plate) if not f.outward]
+    chord = 10 * MM * (1 - math.cos(math.pi / 64))
+    assert len(bore) == 1 and bore[0].radius == pytest.approx(10 * MM, abs=1e-6)
+    assert chord - 1e-9 <= bore[0].deflection <= chord + 1e-8
+    for radius, sides, fits in ((9.9, 64, False), (10.0, 12, True)):
+        peg = trimesh.creation.cylinder(radius=radius * MM, height=30 * MM, sections=sides)
+        slides = sweep.zero_clearance_fits({"peg": sweep.fit_faces(peg), "plate": sweep.fit_faces(plate)})
+        assert [(s.shaft, s.bore, s.seated) for s in slides] == ([("peg", "plate", True)] if fits else [])
+    assert slides[0].tolerance == pytest.approx(10 * MM * (1 - math.cos(math.pi / 12)) + sweep.TOUCH, abs=1e-9)
+    # Chords of 55° and 5° in turn meet smoothly (turning 30°) but lie up to 11% of the
+    # radius inside the circle, beyond a 35° chord's 4.6%: a faceted peg, no cylinder.
+    turns = np.radians(np.cumsum(np.tile([55.0, 5.0], 6)))
+    faceted = shapely.Polygon(10.0 * np.column_stack([np.cos(turns), np.sin(turns)]))
+    assert cylinder_faces(trimesh.creation.extrude_polygon(faceted, 30.0).apply_scale(MM)) == []
 
 
 def test_convexity_is_decided_as_the_hull_volume_decides_it() -> None:
