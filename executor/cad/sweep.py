@@ -24,7 +24,8 @@ decided by fcl's depths of B's triangles, the likeliest deep ones first (:func:`
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
 the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth regions
-whose normals are all perpendicular to one axis and whose vertices lie on one circle; of
+whose normals are all perpendicular to one axis and whose vertices lie on one circle,
+their triangles within a 35° chord's sagitta of it: :data:`COARSEST`; of
 a smooth region that is none, as a bore joined to its ring's end faces by edge radii,
 its bands whose normals are perpendicular to the axis most of its bends turn about);
 an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
