@@ -284,6 +284,12 @@ def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fi
     bolt.apply_translation((0, 0, 5 * MM))
     parts = _parts(plate=plate, bolt=bolt, nut=nut)
     assert [(f.outward, round(f.radius / MM, 6)) for f in cylinder_faces(nut)] == [(True, 10.0), (False, 5.0)]
+    # Its deflection is the sagitta of its widest chord wherever it is (a diagonal from a
+    # bottom vertex to the top one 15° on: 42.8 µm): measured across the axis, not as its
+    # leaning planes' distance from the axis at the frame's origin (0.5 m away: 8 mm).
+    widest = 5 * MM * (1 - math.cos(math.radians(7.5)))
+    far = nut.copy().apply_translation((0, 0, 0.5))
+    assert [cylinder_faces(placed)[1].deflection for placed in (nut, far)] == pytest.approx([widest] * 2, abs=1e-9)
     derived = derive(parts, "plate", {}, reach=0.0)
     assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
     assert derived.blockers[("nut", "+z")] == set() and derived.axis["nut"] == "+z"
