@@ -7,11 +7,13 @@ fixed to each other move as one; a part that never comes out is named with its b
 per direction; a ring passes a collar of its bore's size on its way out; a bolt at zero
 clearance beside a boss of the base is found in its hole; a bore with edge radii is fitted
 as a cylinder, seated on its pin, and measured over its radii without a sliver; a sliver
-in a bore is no deflection, and a ring of facets coarser than a tessellation is no cylinder."""
+in a bore is no deflection, a ring of facets coarser than a tessellation is no cylinder,
+and flynn_clutch's spline shaft with 0.2 mm of room in its plate is no zero-clearance fit."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -286,9 +288,9 @@ def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fi
     assert [(f.outward, round(f.radius / MM, 6)) for f in cylinder_faces(nut)] == [(True, 10.0), (False, 5.0)]
     # Its deflection is the sagitta of its widest chord wherever it is (a diagonal from a
     # bottom vertex to the top one 15° on: 42.8 µm): measured across the axis, not as its
-    # leaning planes' distance from the axis at the frame's origin (0.5 m away: 8 mm).
+    # leaning planes' distance from the axis at the frame's origin (0.1 m away: 2.2 mm).
     widest = 5 * MM * (1 - math.cos(math.radians(7.5)))
-    far = nut.copy().apply_translation((0, 0, 0.5))
+    far = nut.copy().apply_translation((0, 0, 0.1))
     assert [cylinder_faces(placed)[1].deflection for placed in (nut, far)] == pytest.approx([widest] * 2, abs=1e-9)
     derived = derive(parts, "plate", {}, reach=0.0)
     assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
@@ -326,6 +328,18 @@ def test_a_sliver_in_a_bore_is_no_deflection_and_a_peg_with_room_in_it_is_no_fit
     turns = np.radians(np.cumsum(np.tile([55.0, 5.0], 6)))
     faceted = shapely.Polygon(10.0 * np.column_stack([np.cos(turns), np.sin(turns)]))
     assert cylinder_faces(trimesh.creation.extrude_polygon(faceted, 30.0).apply_scale(MM)) == []
+
+
+def test_the_clutchs_spline_shaft_in_a_plate_with_0_2_mm_of_room_is_no_zero_clearance_fit() -> None:
+    # flynn_clutch: the plate's 12-spline bore is the shaft's outline grown by 0.2 mm, its
+    # arcs between the splines ending in 20 nm slivers (the plane of each 0.98 mm inside the
+    # circle at the axis's foot). The arcs are cylinders of their 1° chords' deflection.
+    corpus = Path(__file__).parent / "corpus" / "flynn_clutch" / "meshes"
+    meshes = {pid: trimesh.load(corpus / f"{pid}.stl").apply_scale(MM) for pid in ("inner_holder", "inner_plate_a")}
+    faces = {pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()}
+    arcs = [f for f in faces["inner_plate_a"] if isinstance(f, sweep.CylinderFace) and not f.outward]
+    assert len(arcs) == 24 and max(f.deflection for f in arcs) < 1e-6
+    assert sweep.zero_clearance_fits(faces) == []
 
 
 def test_convexity_is_decided_as_the_hull_volume_decides_it() -> None:
