@@ -95,7 +95,9 @@ from executor.cad.sections import (
     zero_clearance,
 )
 from executor.cad.sweep import (
+    COARSEST,
     DIRECTIONS,
+    SMOOTH,
     TOUCH,
     CylinderFace,
     PrismFace,
@@ -236,8 +238,11 @@ class Derived:
         largest = max((s.tolerance for s in self.slides), default=0.0)
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
-                "plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, slide along their "
-                f"axis where they sit and on the way ({sum(s.seated for s in self.slides)} fit(s) and "
+                "(a face's triangles' largest distance from its circle; a face whose triangles lie farther than "
+                f"{100 * COARSEST:.1f}% of its radius from it, the sagitta of a chord of {math.degrees(SMOOTH):.0f}°, "
+                "is no cylinder) plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, "
+                "slide along their axis where they sit and on the way "
+                f"({sum(s.seated for s in self.slides)} fit(s) and "
                 f"{sum(not s.seated for s in self.slides)} passage(s) found"
                 + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
 

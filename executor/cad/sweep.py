@@ -24,7 +24,8 @@ decided by fcl's depths of B's triangles, the likeliest deep ones first (:func:`
 **Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
 one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
 the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth regions
-whose normals are all perpendicular to one axis and whose vertices lie on one circle; of
+whose normals are all perpendicular to one axis and whose vertices lie on one circle,
+their triangles within a 35° chord's sagitta of it: :data:`COARSEST`; of
 a smooth region that is none, as a bore joined to its ring's end faces by edge radii,
 its bands whose normals are perpendicular to the axis most of its bends turn about);
 an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
@@ -156,8 +157,9 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
 def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
     """The triangles ``region`` of ``mesh`` as one cylindrical face, or None: their normals
     perpendicular to one axis (within :data:`TILT`) and spanning more than a flat face's,
-    their vertices on one circle (within 1 µm plus 1e-4 of the radius) and their normals
-    all pointing away from the axis or all towards it."""
+    their vertices on one circle (within 1 µm plus 1e-4 of the radius), their normals
+    all pointing away from the axis or all towards it, and no triangle farther from the
+    circle than :data:`COARSEST` of the radius (:func:`_deflection`, the face's deflection)."""
     normals = mesh.face_normals[region]
     scatter = normals.T @ normals / len(region)
     values, vectors = np.linalg.eigh(scatter)
@@ -177,10 +179,33 @@ def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
     outwards = np.einsum("ij,ij->i", normals, (mesh.triangles_center[region] @ frame.T - centre) @ frame)
     if not (np.all(outwards > 0) or np.all(outwards < 0)):
         return None
-    reach = np.abs(np.einsum("ij,ij->i", normals, mesh.vertices[mesh.faces[region, 0]] - point))
+    deflection = _deflection(mesh.triangles[region] @ frame.T - centre, radius)
+    if deflection > COARSEST * radius:
+        return None  # coarser than a ring of smooth facets can be: no tessellated cylinder
     along = mesh.vertices[ring] @ axis
     return CylinderFace(point, axis, radius, (float(along.min()), float(along.max())),
-                        bool(outwards[0] > 0), float(np.max(radius - reach)))
+                        bool(outwards[0] > 0), deflection)
+
+
+COARSEST = 1 - np.cos(SMOOTH / 2)
+"""The largest deflection of a cylindrical face as a fraction of its radius (4.6%): the
+sagitta of a chord of :data:`SMOOTH`, the coarsest angular step a ring of facets meeting
+smoothly has (a d 20 bore: 0.46 mm; a regular ring has at least 11 facets a turn, a
+12-gon's 30° chords 3.4%)."""
+
+
+def _deflection(corners: np.ndarray, radius: float) -> float:
+    """The largest distance [m] of triangles from a circle of ``radius`` [m] about the
+    origin, their ``corners`` (n, 3, 2) [m] given across its axis: their edges' nearest
+    points to the axis inside it (a chord's sagitta), their corners beyond it. A sliver
+    whose plane passes far inside the circle (two corners a few µm apart, each within the
+    fit's µm of the circle) lies no farther from it than its corners."""
+    start = corners
+    edge = np.roll(corners, -1, axis=1) - start
+    length = np.maximum(np.einsum("ijk,ijk->ij", edge, edge), 1e-30)
+    t = np.clip(-np.einsum("ijk,ijk->ij", start, edge) / length, 0.0, 1.0)
+    nearest = np.linalg.norm(start + t[..., None] * edge, axis=2)
+    return float(max(radius - nearest.min(), np.linalg.norm(corners, axis=2).max() - radius, 0.0))
 
 
 BEND = 1e-2

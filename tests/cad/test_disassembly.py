@@ -6,7 +6,9 @@ a lid gets none, a washer on a pin under a cap nut gets exactly the forced ones)
 fixed to each other move as one; a part that never comes out is named with its blockers
 per direction; a ring passes a collar of its bore's size on its way out; a bolt at zero
 clearance beside a boss of the base is found in its hole; a bore with edge radii is fitted
-as a cylinder, seated on its pin, and measured over its radii without a sliver."""
+as a cylinder, seated on its pin, and measured over its radii without a sliver; a sliver
+in a bore is no deflection, a ring of facets coarser than a tessellation is no cylinder,
+and flynn_clutch's spline shaft with 0.2 mm of room in its plate is no zero-clearance fit."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import math
 import multiprocessing
 import os
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -339,9 +342,60 @@ def test_a_bore_whose_tessellation_rings_are_not_lined_up_is_a_zero_clearance_fi
     bolt.apply_translation((0, 0, 5 * MM))
     parts = _parts(plate=plate, bolt=bolt, nut=nut)
     assert [(f.outward, round(f.radius / MM, 6)) for f in cylinder_faces(nut)] == [(True, 10.0), (False, 5.0)]
+    # Its deflection is the sagitta of its widest chord wherever it is (a diagonal from a
+    # bottom vertex to the top one 15° on: 42.8 µm): measured across the axis, not as its
+    # leaning planes' distance from the axis at the frame's origin (0.1 m away: 2.2 mm).
+    widest = 5 * MM * (1 - math.cos(math.radians(7.5)))
+    far = nut.copy().apply_translation((0, 0, 0.1))
+    assert [cylinder_faces(placed)[1].deflection for placed in (nut, far)] == pytest.approx([widest] * 2, abs=1e-9)
     derived = derive(parts, "plate", {}, reach=0.0)
     assert {(s.shaft, s.bore) for s in derived.slides} == {("bolt", "plate"), ("bolt", "nut")}
     assert derived.blockers[("nut", "+z")] == set() and derived.axis["nut"] == "+z"
+
+
+def _plate_with_bore(corners: np.ndarray) -> trimesh.Trimesh:
+    """A 40 x 40 x 10 mm plate along z [m] bored through by the polygon ``corners`` [mm]."""
+    plate = shapely.Polygon(shapely.box(-20, -20, 20, 20).exterior.coords, [corners])
+    return trimesh.creation.extrude_polygon(plate, 10.0).apply_scale(MM)
+
+
+def test_a_sliver_in_a_bore_is_no_deflection_and_a_peg_with_room_in_it_is_no_fit() -> None:
+    # A d 20 bore (64-gon) with a sliver, as a CSG cut leaves where a spline's side wall
+    # meets a root arc: one vertex doubled 20 nm off, its two triangles' plane 25° from the
+    # ring's and 0.94 mm inside the circle at the axis's foot, which they do not reach
+    # (their corners are on it). A d 19.8 peg has 0.1 mm of room in it: no zero-clearance
+    # fit; a d 20 12-gon peg (chord error 0.34 mm) is one.
+    turns = np.linspace(0, 2 * math.pi, 64, endpoint=False)
+    ring = 10.0 * np.column_stack([np.cos(turns), np.sin(turns)])
+    lean = turns[0] + math.pi / 2 - math.radians(25)  # the sliver's edge, 25° off the ring's tangent
+    sliver = ring[0] + 2e-5 * np.array([math.cos(lean), math.sin(lean)])
+    plate = _plate_with_bore(np.vstack([ring[:1], sliver, ring[1:]]))
+    bore = [f for f in cylinder_faces(plate) if not f.outward]
+    chord = 10 * MM * (1 - math.cos(math.pi / 64))
+    assert len(bore) == 1 and bore[0].radius == pytest.approx(10 * MM, abs=1e-6)
+    assert chord - 1e-9 <= bore[0].deflection <= chord + 1e-8
+    for radius, sides, fits in ((9.9, 64, False), (10.0, 12, True)):
+        peg = trimesh.creation.cylinder(radius=radius * MM, height=30 * MM, sections=sides)
+        slides = sweep.zero_clearance_fits({"peg": sweep.fit_faces(peg), "plate": sweep.fit_faces(plate)})
+        assert [(s.shaft, s.bore, s.seated) for s in slides] == ([("peg", "plate", True)] if fits else [])
+    assert slides[0].tolerance == pytest.approx(10 * MM * (1 - math.cos(math.pi / 12)) + sweep.TOUCH, abs=1e-9)
+    # Chords of 55° and 5° in turn meet smoothly (turning 30°) but lie up to 11% of the
+    # radius inside the circle, beyond a 35° chord's 4.6%: a faceted peg, no cylinder.
+    turns = np.radians(np.cumsum(np.tile([55.0, 5.0], 6)))
+    faceted = shapely.Polygon(10.0 * np.column_stack([np.cos(turns), np.sin(turns)]))
+    assert cylinder_faces(trimesh.creation.extrude_polygon(faceted, 30.0).apply_scale(MM)) == []
+
+
+def test_the_clutchs_spline_shaft_in_a_plate_with_0_2_mm_of_room_is_no_zero_clearance_fit() -> None:
+    # flynn_clutch: the plate's 12-spline bore is the shaft's outline grown by 0.2 mm, its
+    # arcs between the splines ending in 20 nm slivers (the plane of each 0.98 mm inside the
+    # circle at the axis's foot). The arcs are cylinders of their 1° chords' deflection.
+    corpus = Path(__file__).parent / "corpus" / "flynn_clutch" / "meshes"
+    meshes = {pid: trimesh.load(corpus / f"{pid}.stl").apply_scale(MM) for pid in ("inner_holder", "inner_plate_a")}
+    faces = {pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()}
+    arcs = [f for f in faces["inner_plate_a"] if isinstance(f, sweep.CylinderFace) and not f.outward]
+    assert len(arcs) == 24 and max(f.deflection for f in arcs) < 1e-6
+    assert sweep.zero_clearance_fits(faces) == []
 
 
 def test_convexity_is_decided_as_the_hull_volume_decides_it() -> None:
