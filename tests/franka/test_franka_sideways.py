@@ -60,7 +60,7 @@ def test_a_peg_stops_at_a_too_narrow_hole_entered_sideways_and_goes_into_one_tha
         finally:
             cell.stop()
     reached, depth, _along, force = seen["h3"]
-    assert not reached and abs(depth) < 0.001 and force >= description.thresholds.f_stop, seen  # at the entry
+    assert not reached and abs(depth) < 0.001 and force >= description.thresholds.f_stop, seen  # in the entry's chamfer
     reached, depth, along, _force = seen["h2"]
     tolerance = description.thresholds.goal_tolerance
     assert reached and abs(depth - geometry.holes["h2"].depth) < tolerance and along > 0.999, seen  # in along +x
