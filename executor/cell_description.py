@@ -1,5 +1,6 @@
 """The cell's own parameters, apart from any product: the gripper, the impedance gains
-(compliant and stiff), the admittance, the detector's thresholds and the ILC.
+(compliant and stiff), the admittance, the detector's thresholds, the hole search and
+the ILC.
 
 :class:`CellDescription` holds them with the defaults the measurements in docs/results.md
 were made with; :func:`load_cell_description` reads an override file (TOML, any subset of
@@ -20,6 +21,7 @@ from executor.control.admittance import AdmittanceParams
 from executor.control.detector import Thresholds
 from executor.control.gains import POSITION_CONTROL_GAINS, ImpedanceGains
 from executor.control.ilc import IlcParams
+from executor.skills.search_params import SearchParams
 
 
 def _default_gripper() -> Gripper:
@@ -37,13 +39,15 @@ class CellDescription(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_
     """The cell: ``gripper`` (used unless the product has its own), ``gains`` (the
     compliant impedance of every motion), ``position_gains`` (the stiff tracking of the
     ``position`` layer), ``admittance`` (its bounds also bound the ILC corrections),
-    ``thresholds`` (eqs. 6 and 7, phase stopping, the goal check), ``ilc``."""
+    ``thresholds`` (eqs. 6 and 7, phase stopping, the goal check), ``search`` (the hole
+    search before every insertion: its radius covers the cell's position errors), ``ilc``."""
 
     gripper: Gripper = msgspec.field(default_factory=_default_gripper)
     gains: ImpedanceGains = msgspec.field(default_factory=ImpedanceGains)
     position_gains: ImpedanceGains = msgspec.field(default_factory=_position_gains)
     admittance: AdmittanceParams = msgspec.field(default_factory=AdmittanceParams)
     thresholds: Thresholds = msgspec.field(default_factory=Thresholds)
+    search: SearchParams = msgspec.field(default_factory=SearchParams)
     ilc: IlcParams = msgspec.field(default_factory=IlcParams)
 
 

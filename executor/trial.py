@@ -303,7 +303,7 @@ class Cell:
             motion.hold(approach, quat, APPROACH_SETTLE_TIME)
             arm.tare_sensor()
             found = hole_search(motion, est_xy, surface, approach[2], quat,
-                                np.random.default_rng(setup.search_seed))
+                                np.random.default_rng(setup.search_seed), self.description.search)
             if self.logger is not None and len(found.path):
                 self.logger.log_search_path(found.path if motion.frame is None
                                             else motion.frame.points_to_cell(found.path))

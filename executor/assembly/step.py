@@ -467,7 +467,7 @@ class Assembler:
             # The hole search around the estimate, on the plate or on the socket's part.
             surface = approach[2] - _free_approach(skill)
             found = hole_search(motion, approach[:2], surface, approach[2], quat,
-                                np.random.default_rng(setup.search_seed))
+                                np.random.default_rng(setup.search_seed), self.description.search)
             xy = found.hole_xy
             reach = self._centring_reach(part, hole) if skill == "insert" and found.found else None
             centred = reach is not None and hole is not None

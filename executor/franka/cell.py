@@ -325,13 +325,14 @@ class FrankaCell:
         calibrated entry ``entry`` [m] (its centre at the entry, in the motion's frame: the
         hole's), the tool at ``quat`` (xyzw, the same frame) (:meth:`enter`), held still,
         the wrench estimate tared, then the hole search
-        (:func:`executor.skills.search.hole_search`, its spiral drawn from ``rng``) around
+        (:func:`executor.skills.search.hole_search` with the cell description's ``search``,
+        its spiral drawn from ``rng``) around
         it: where the part sinks into the hole, in the robot's reading of the tip."""
         approach = entry + np.array([0.0, 0.0, APPROACH_HEIGHT])
         self.enter(approach, quat)
         self.motion.hold(approach, quat, APPROACH_SETTLE_TIME)
         self.arm.tare_sensor()
-        return hole_search(self.motion, entry[:2], entry[2], approach[2], quat, rng)
+        return hole_search(self.motion, entry[:2], entry[2], approach[2], quat, rng, self.description.search)
 
     def lift(self) -> None:
         """The tool out of a hole entered sideways (:meth:`back_out`), then straight up to

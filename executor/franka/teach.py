@@ -14,7 +14,6 @@ import numpy as np
 from executor import ExecutorError
 from executor.control.motion import APPROACH_SETTLE_TIME, Motion
 from executor.franka.cell import FrankaCell
-from executor.skills.search import SearchParams
 
 ABOVE_START = 0.02  # [m] the part comes down onto the start from this far above
 SAME_PLACE = 0.005  # [m] a start this close (horizontally) is reached without the carrying height
@@ -46,7 +45,7 @@ class FrankaTeacher:
         returned are in the motion's frame (the hole's)."""
         found = self.cell.search(origin, quat_xyzw, self.rng)
         if not found.found:
-            radius = SearchParams().max_radius
+            radius = self.cell.description.search.max_radius
             raise ExecutorError(f"the hole search found no hole within {radius * 1000:.1f} mm of "
                                 f"{np.round(origin, 4).tolist()} m (the held part's demo_hole); expected the plate "
                                 "where geometry.toml puts it and the part in the hand (docs/franka.md, Set-up)")

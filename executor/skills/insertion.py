@@ -18,7 +18,7 @@ from executor.control.detector import Detector
 from executor.control.ilc import ExecutionLayer, ExecutionTrace
 from executor.control.motion import Motion
 from executor.skills.dmp import PhaseClock, Skill
-from executor.skills.search import SINK_DEPTH
+from executor.skills.search_params import SINK_DEPTH
 from executor.skills.wiggle import wiggle
 from executor.world.arm import turn_quats_z, turn_z
 from executor.world.scene import TIME_STEP

@@ -24,47 +24,11 @@ import numpy as np
 
 from executor.control.admittance import Admittance, AdmittanceParams
 from executor.control.motion import Motion
+from executor.skills.search_params import SearchParams
 from executor.world.arm import ArmState
 from executor.world.scene import TIME_STEP
 
-SINK_DEPTH = 0.0005
-"""[m] below the surface: the tip is in a hole's entry chamfer."""
 _NO_SHIFT = np.zeros(2)
-
-
-@dataclass(frozen=True)
-class SearchParams:
-    """Approach speed [m/s], contact force that means "on the surface" [N], how far
-    below the surface the tip is pushed while sliding [m] (× 2000 N/m = contact force),
-    sink depth that means "in the hole's chamfer" [m], depth that means "past the
-    chamfer" [m], margin below the lowest tip of a part resting on the top face that
-    means "held below it" [m] (:func:`below_top_face`), dip that pauses the spiral
-    [m] and for how long at most [s], spiral pitch [m] (± ``pitch_jitter``),
-    sliding speed [m/s], search radius [m] (vision error ≤ 3 mm + grasp offset ≤ 1 mm
-    + half a pitch), whether the spiral comes back in from it half a pitch inside the way
-    out (the part's path then twice as dense), gain [1/s] of the slow pass's lead on the
-    part's lag behind the spiral and its bound [m], time limit [s] of the first pass,
-    speed [m/s] and time limit [s] of the slow pass out that follows a first pass that
-    found nothing (0 s: none)."""
-
-    approach_speed: float = 0.025
-    contact_force: float = 2.0
-    press_depth: float = 0.0025
-    sink_depth: float = SINK_DEPTH
-    enter_depth: float = 0.0012
-    rest_tolerance: float = 0.00025
-    dip_depth: float = 0.0001
-    dip_hold: float = 0.3
-    pitch: float = 0.0012
-    pitch_jitter: float = 0.05
-    speed: float = 0.045
-    max_radius: float = 0.0046
-    back_in: bool = True
-    track_gain: float = 30.0
-    max_lead: float = 0.004
-    max_time: float = 4.4
-    slow_speed: float = 0.015
-    slow_time: float = 6.0
 
 
 @dataclass
@@ -191,8 +155,9 @@ def _spiral(motion: Motion, est_xy: np.ndarray, contact: _Contact, quat_xyzw: np
 
 
 def hole_search(motion: Motion, est_xy: np.ndarray, surface_z: float, start_z: float, quat_xyzw: np.ndarray,
-                rng: np.random.Generator, params: SearchParams = SearchParams()) -> SearchResult:
-    """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m].
+                rng: np.random.Generator, params: SearchParams) -> SearchResult:
+    """Search for the hole near ``est_xy`` [m] on a plate whose top is at ``surface_z`` [m],
+    with the settings ``params`` (the cell description's ``search``).
 
     While sliding, a dip of the tip (``dip_depth`` below the touched surface: an edge of
     the part is over the hole) pauses the spiral for up to ``dip_hold``; meanwhile the

@@ -45,6 +45,7 @@ def test_an_override_changes_only_its_keys(tmp_path: Path) -> None:
     ("[thresholds]\npersist_steps = 2.5\n", "[thresholds] persist_steps: expected an integer in 1 .. 10000"),
     ("[gains]\nk_rot = \"60\"\n", "[gains] k_rot: expected a number in (0, 1e6], got '60'"),
     ("[ilc]\nforgetting = 1.5\n", "[ilc] forgetting: expected a number in (0, 1], got 1.5"),
+    ("[search]\nmax_radius = 0\n", "[search] max_radius: expected a number in (0, 0.05] m, got 0"),
     ("[gripper]\nflange_mass = 1.0\n", "[gripper] flange_inertia: expected a number in (0, 1] kg m^2, got nothing"),
     ("[controller]\nk = 1\n", "controller: unknown table or key; expected one of gripper, gains"),
     ("[admittance]\nbound = nan\n", "[admittance] bound: expected a number in (0, 0.5] (m or rad), got nan"),

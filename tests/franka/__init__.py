@@ -18,12 +18,14 @@ GRASP_DEPTH = 0.012
 12 mm they clear the plate."""
 
 
-def franka_cell_description(folder: Path) -> Path:
+def franka_cell_description(folder: Path, search_radius: float | None = None) -> Path:
     """A cell description of the Franka Hand on the flange (its mass [kg], inertia [kg m²],
-    length [m]) and :data:`GRASP_DEPTH`, written in ``folder``."""
+    length [m]) and :data:`GRASP_DEPTH`, with the hole search's ``search_radius`` [m] if
+    given (the default's otherwise), written in ``folder``."""
     path = folder / "franka-cell.toml"
+    search = "" if search_radius is None else f"[search]\nmax_radius = {search_radius}\n"
     path.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                    f"grasp_depth = {GRASP_DEPTH}\n")
+                    f"grasp_depth = {GRASP_DEPTH}\n{search}")
     return path
 
 

@@ -29,11 +29,17 @@ pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtur
               pytest.mark.franka_arm]
 
 PRODUCT = Path(__file__).parent / "data" / "side"
+SEARCH_RADIUS = 0.0015
+"""[m] the hole search's radius in the test's cell (its ``[search]`` table): franky-sim puts
+the product where the cell believes it, and the peg's tip came down within 0.2 mm of
+the hole's axis, so the grasp's error and half a pitch (0.6 mm) in place of the
+default's 4.6 mm for a calibrated plate: the too-narrow hole's search, which runs its
+whole spiral, takes 0.7 s of robot time in place of about 7 s."""
 
 
 def test_a_peg_stops_at_a_too_narrow_hole_entered_sideways_and_goes_into_one_that_fits(tmp_path: Path) -> None:
     folder = teach(Path(shutil.copytree(PRODUCT, tmp_path / "side")))
-    description = load_cell_description(franka_cell_description(tmp_path))
+    description = load_cell_description(franka_cell_description(tmp_path, SEARCH_RADIUS))
     geometry = load_geometry(str(folder), description)
     seen = {}
     with sim_robot(folder) as sim:
@@ -54,7 +60,7 @@ def test_a_peg_stops_at_a_too_narrow_hole_entered_sideways_and_goes_into_one_tha
         finally:
             cell.stop()
     reached, depth, _along, force = seen["h3"]
-    assert not reached and abs(depth) < 0.001 and force >= description.thresholds.f_stop, seen  # at the entry
+    assert not reached and abs(depth) < 0.001 and force >= description.thresholds.f_stop, seen  # in the entry's chamfer
     reached, depth, along, _force = seen["h2"]
     tolerance = description.thresholds.goal_tolerance
     assert reached and abs(depth - geometry.holes["h2"].depth) < tolerance and along > 0.999, seen  # in along +x
