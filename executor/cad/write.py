@@ -115,7 +115,7 @@ the free end at each point; docs/cell.md lists every point and where the arm sto
 short). Inside a box the arm is taken to reach it as at its corners; elsewhere, or along
 another axis, it is taken as out of reach."""
 SIDEWAYS_HOLE_REACH: dict[str, tuple[Region, ...]] = {
-    "+x": (((0.50, 0.65), (0.0, 0.1), (0.03, 0.12)),),
+    "+x": (((0.50, 0.65), (0.0, 0.1), (0.03, 0.03)), ((0.65, 0.65), (0.0, 0.1), (0.03, 0.12))),
     "+y": (((0.45, 0.60), (-0.1, 0.0), (0.03, 0.12)),),
     "-y": (((0.40, 0.60), (0.0, 0.1), (0.03, 0.12)),),
 }
