@@ -5,7 +5,9 @@ controller's damping (the insertion gains are lightly damped: a 0.5 m move rang 
 about a second); the gains are restored after each move.  The tool points down, turned
 about z by a yaw that a move changes with the same time law (a part aligned to a rect
 hole's estimated yaw; ``Motion.tool_yaw`` is where it stands); down a hole's frame when
-the motion has one (a hole entered sideways), :func:`reorient` turning it there and back."""
+the motion has one (a hole entered sideways), :func:`reorient` turning it there and back
+(where that turn ends the arm short, a move in joint space at the carrying height after it,
+whose tool path is not a line)."""
 
 from __future__ import annotations
 
@@ -75,8 +77,8 @@ def _stuck(motion: Motion[ImpedanceController], goal: np.ndarray, quat_xyzw: np.
     """Whether the arm rests more than :data:`VIA_TOLERANCE` [m] or :data:`TURN_TOLERANCE`
     [rad] from the pose (cell frame), or a joint within :data:`executor.world.arm.LIMIT_MARGIN`
     of its limit."""
-    state = motion.controller.arm.read()
     arm = motion.controller.arm
+    state = arm.read()
     near_limit = np.any(state.q < arm.lower + LIMIT_MARGIN) or np.any(state.q > arm.upper - LIMIT_MARGIN)
     return bool(near_limit or np.linalg.norm(state.tip_pos - goal) > VIA_TOLERANCE
                 or np.linalg.norm(rotation_error(quat_xyzw, state.tip_quat_xyzw)) > TURN_TOLERANCE)

@@ -124,8 +124,8 @@ def _closed(box: trimesh.Trimesh, peg: trimesh.Trimesh) -> tuple[trimesh.Trimesh
     plate = trimesh.creation.box((x1 - x0, 5.5, z1 - z0))
     plate.apply_translation(((x0 + x1) / 2, y0 - 2.25, (z0 + z1) / 2))
     (px0, _, pz0), (px1, py1, pz1) = peg.bounds
-    keep = trimesh.creation.box((px1 - px0 + 2, py1 - y0, pz1 - pz0 + 2))
-    keep.apply_translation(((px0 + px1) / 2, (py1 + y0 + 1) / 2 + 0.5, (pz0 + pz1) / 2))
+    keep = trimesh.creation.box((px1 - px0 + 2, py1 - y0, pz1 - pz0 + 2))  # y from y0 + 1 to beyond the peg's end
+    keep.apply_translation(((px0 + px1) / 2, (y0 + py1) / 2 + 1, (pz0 + pz1) / 2))
     return (trimesh.boolean.union([box, plate], engine="manifold"),
             trimesh.boolean.intersection([peg, keep], engine="manifold"))
 
@@ -142,13 +142,12 @@ def measure(kind: str, axis: str, x: float, y: float, height: float, tmp: Path) 
     cad, config, feature = _product(tmp / "first", kind, axis, height)
     with mock.patch.object(write, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
             mock.patch.object(write, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
-        first = run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0)))
+        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0)))
         at = load_product_description(tmp / "first" / "out").assembly.holes[feature].position
         assert at is not None and at[0] is not None and at[1] is not None
         place = (0.56 + x / 1e3 - at[0], y / 1e3 - at[1])
         out = tmp / "out"
         run_import(cad, out, "mm", config, ImportOptions(place=place))
-    del first
     geometry = load_product_description(out).geometry
     assert geometry is not None
     if (written := geometry.hole_shapes[feature].axis) != axis:
