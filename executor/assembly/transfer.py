@@ -30,7 +30,7 @@ DESCENT_SPEED = 0.15  # [m/s] mean speed of the last move of a carry, down to th
 SETTLE = 0.5  # [s] at most held at the end of a move, until the TCP is within its tolerance at rest
 TOLERANCE = 0.001  # [m] where the part is to be placed
 VIA_TOLERANCE = 0.01  # [m] at the corners of a carry
-TURN_TOLERANCE = 0.05  # [rad] of the tool's orientation where :func:`reorient` ends
+TURN_TOLERANCE = 0.15  # [rad] of the tool's orientation where :func:`reorient` ends (it lags the turn by up to 0.07)
 SEEDS = [REST_POSTURE, *(REST_POSTURE + np.array([0.0] * 6 + [roll]) for roll in (-np.pi / 2, np.pi / 2))]
 """Where :func:`reorient`'s IK starts, in turn: the arm's rest posture, the wrist rolled a quarter turn each way."""
 JOINT_SPEED = 0.8  # [rad/s] mean rate of the farthest-turning joint in a joint-space move
