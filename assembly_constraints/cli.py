@@ -36,6 +36,7 @@ BENCHMARKS: dict[str, str] = {
     "precedence-explore": "asp.bench.precedence_explore",
     "assemble": "asp.bench.assemble_plans",
     "executor": "executor.campaign.bench",
+    "reach": "executor.campaign.reach",
     "physics": "executor.campaign.physics",
     "engines": "executor.campaign.engines",
     "import": "executor.cad.bench",

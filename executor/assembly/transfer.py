@@ -5,7 +5,9 @@ controller's damping (the insertion gains are lightly damped: a 0.5 m move rang 
 about a second); the gains are restored after each move.  The tool points down, turned
 about z by a yaw that a move changes with the same time law (a part aligned to a rect
 hole's estimated yaw; ``Motion.tool_yaw`` is where it stands); down a hole's frame when
-the motion has one (a hole entered sideways), :func:`reorient` turning it there and back."""
+the motion has one (a hole entered sideways), :func:`reorient` turning it there and back
+(where that turn ends the arm short, a move in joint space at the carrying height after it,
+whose tool path is not a line)."""
 
 from __future__ import annotations
 
@@ -15,8 +17,9 @@ import msgspec
 import numpy as np
 import pybullet as pb
 
+from executor.control.controller import ImpedanceController
 from executor.control.motion import Motion
-from executor.world.arm import tool_quat
+from executor.world.arm import LIMIT_MARGIN, REST_POSTURE, rotation_error, tool_quat
 from executor.world.frames import HoleFrame
 from executor.world.scene import TIME_STEP
 
@@ -27,6 +30,10 @@ DESCENT_SPEED = 0.15  # [m/s] mean speed of the last move of a carry, down to th
 SETTLE = 0.5  # [s] at most held at the end of a move, until the TCP is within its tolerance at rest
 TOLERANCE = 0.001  # [m] where the part is to be placed
 VIA_TOLERANCE = 0.01  # [m] at the corners of a carry
+TURN_TOLERANCE = 0.15  # [rad] of the tool's orientation where :func:`reorient` ends (it lags the turn by up to 0.07)
+SEEDS = [REST_POSTURE, *(REST_POSTURE + np.array([0.0] * 6 + [roll]) for roll in (-np.pi / 2, np.pi / 2))]
+"""Where :func:`reorient`'s IK starts, in turn: the arm's rest posture, the wrist rolled a quarter turn each way."""
+JOINT_SPEED = 0.8  # [rad/s] mean rate of the farthest-turning joint in a joint-space move
 
 
 def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,
@@ -44,18 +51,59 @@ def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] |
     _damped(motion, goal, after_step, speed, settle, tolerance, turn)
 
 
-def reorient(motion: Motion, goal: np.ndarray, frame: HoleFrame | None, yaw: float,
+def reorient(motion: Motion[ImpedanceController], goal: np.ndarray, frame: HoleFrame | None, yaw: float,
              after_step: Callable[[], None] | None = None) -> None:
     """The TCP in a straight line to ``goal`` [m, cell frame] while the tool turns from
     pointing down its motion's frame to pointing down ``frame`` (None: the cell's), turned
     by ``yaw`` [rad] (spherical interpolation, the same time law); the motion then moves
-    in ``frame``. Carries a part to a hole entered sideways and back."""
+    in ``frame``. Carries a part to a hole entered sideways and back. Where that line ends
+    the arm short of the pose or near a joint's limit (:func:`_stuck`: the turn, under the
+    Cartesian controller, takes the arm through its joints' limits on a long path), the arm
+    then moves in joint space (:func:`move_joints`) to a solution of its IK for the pose
+    (:meth:`executor.world.arm.Arm.solve` from :data:`SEEDS`), from which the moves
+    in ``frame`` start."""
     start = motion.cell_pose(np.zeros(3), tool_quat(motion.tool_yaw))[1]
     end = tool_quat(yaw) if frame is None else frame.pose_to_cell(np.zeros(3), tool_quat(yaw))[1]
     motion.frame = None
     _damped(motion, goal, after_step, SPEED, SETTLE, VIA_TOLERANCE,
             lambda blend: np.array(pb.getQuaternionSlerp(list(start), list(end), blend)))
+    arm = motion.controller.arm
+    if _stuck(motion, goal, end) and (q := arm.solve(goal, end, SEEDS)) is not None:
+        move_joints(motion, q, after_step)
     motion.frame, motion.tool_yaw = frame, yaw
+
+
+def _stuck(motion: Motion[ImpedanceController], goal: np.ndarray, quat_xyzw: np.ndarray) -> bool:
+    """Whether the arm rests more than :data:`VIA_TOLERANCE` [m] or :data:`TURN_TOLERANCE`
+    [rad] from the pose (cell frame), or a joint within :data:`executor.world.arm.LIMIT_MARGIN`
+    of its limit."""
+    arm = motion.controller.arm
+    state = arm.read()
+    near_limit = np.any(state.q < arm.lower + LIMIT_MARGIN) or np.any(state.q > arm.upper - LIMIT_MARGIN)
+    return bool(near_limit or np.linalg.norm(state.tip_pos - goal) > VIA_TOLERANCE
+                or np.linalg.norm(rotation_error(quat_xyzw, state.tip_quat_xyzw)) > TURN_TOLERANCE)
+
+
+def move_joints(motion: Motion[ImpedanceController], q_goal: np.ndarray,
+                after_step: Callable[[], None] | None = None) -> None:
+    """The arm's joints from where they are to ``q_goal`` [rad] with the minimum-jerk time
+    law, the farthest turning at :data:`JOINT_SPEED` on average, under the joint servo
+    (:meth:`executor.control.controller.ImpedanceController.step_joints`); then held until
+    at rest there (each joint within 1 mrad, slower than 10 mrad/s), or :data:`SETTLE` [s]
+    has passed. For free space only: the tool's path is not a line."""
+    q0 = motion.controller.arm.read().q
+    span = q_goal - q0
+    n = max(1, int(float(np.max(np.abs(span))) / JOINT_SPEED / TIME_STEP))
+    for k in range(1, n + settle_steps(SETTLE) + 1):
+        s = min(1.0, k / n)
+        blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+        rate = (30 * s**2 - 60 * s**3 + 30 * s**4) / (n * TIME_STEP) if k < n else 0.0
+        state = motion.controller.step_joints(q0 + blend * span, rate * span)
+        motion.steps += 1
+        if after_step is not None:
+            after_step()
+        if k >= n and np.max(np.abs(state.q - q_goal)) < 1e-3 and np.max(np.abs(state.qd)) < 1e-2:
+            break
 
 
 def _damped(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None, speed: float, settle: float,

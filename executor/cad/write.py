@@ -100,29 +100,32 @@ WRIST_RADIUS = 0.06
 in the grasp (a 1 deg tilt moves its rim 1 mm down)."""
 WRIST_CLEARANCE = 0.01
 """[m] how far above the product near a part's axis the arm's wrist stays with the part at its goal."""
-SIDEWAYS_PIN_REACH = {"+x": (0.4475, 0.6575), "-y": (0.35258, 0.70128)}
+Region = tuple[tuple[float, float], tuple[float, float], tuple[float, float]]
+"""A box of the cell [m]: the spans of x, y (the arm's base at the origin) and height above the floor."""
+SIDEWAYS_PIN_REACH: dict[str, tuple[Region, ...]] = {
+    "+x": (((0.45, 0.65), (0.0, 0.1), (0.03, 0.03)), ((0.55, 0.65), (0.0, 0.1), (0.03, 0.12))),
+    "+y": (((0.45, 0.60), (-0.1, 0.0), (0.03, 0.12)),),
+    "-y": (((0.40, 0.65), (0.0, 0.1), (0.03, 0.12)),),
+}
 """Where the cell puts a part onto a pin of the base along a horizontal axis: the axes (the
-part's motion) and, on each, the span of the horizontal distance [m] of the pin's free end
-from the arm's base over which its arm was measured to reach the pin, teaching and
-assembling (the block and ring of ``tests/cad/test_horizontal_pins.py`` turned about z and
-placed along x, the free end 30 mm up: along +x its free end 447.5 to 657.5 mm out, along
--y 352.6 to 701.3 mm, all put on). Along -x (towards the arm) the arm stops 36 mm short of
-the demonstration's start with the base's centre at (560, 0) mm and 10.3 mm short of the
-goal at (420, 0) mm; along +y the assembling cell's transfer ends 17 mm short of the
-approach at (560, 0) mm; along +x with the free end 377.5 mm out, 15.4 mm short
-(docs/cell.md). Nearer or farther, or along another axis, is taken as out of reach."""
-SIDEWAYS_HOLE_REACH = {"+x": (0.4925, 0.8725), "-y": (0.25125, 0.68045)}
+part's motion) and, on each, the boxes in which the pin's free end was measured to be reached,
+taught and assembled, at each of their 8 corners (``./run.sh bench reach --kind pin``: the block
+and ring of ``tests/cad/test_horizontal_pins.py`` turned about z, raised, and placed with
+the free end at each point; docs/cell.md lists every point and where the arm stopped
+short). Inside a box the arm is taken to reach it as at its corners; elsewhere, or along
+another axis, it is taken as out of reach."""
+SIDEWAYS_HOLE_REACH: dict[str, tuple[Region, ...]] = {
+    "+x": (((0.50, 0.65), (0.0, 0.1), (0.03, 0.03)), ((0.65, 0.65), (0.0, 0.1), (0.03, 0.12))),
+    "+y": (((0.45, 0.60), (-0.1, 0.0), (0.03, 0.12)),),
+    "-y": (((0.40, 0.60), (0.0, 0.1), (0.03, 0.12)),),
+}
 """Where the cell inserts a peg into a hole of the base entered sideways: the axes (the
-peg's motion) and, on each, the span of the horizontal distance [m] of the hole's entry
-centre from the arm's base over which its arm was measured to reach it, teaching and
-assembling (``agh_hex_horizontal`` of ``tests/cad/test_sideways.py``, along +x its hole
-closed at the far end, turned about z and placed along x, the entry 30 mm up: along +x
-492.5 to 872.5 mm out, along -y 251.2 to 680.5 mm, all inserted; docs/import.md). The
-wrist is 185 mm beyond the entry, farther than on a pin: the pins' spans do not carry
-over. Along -x (towards the arm) and +y the assembling cell's transfer ends short of the
-approach wherever teaching reaches; along +x 462.5 mm out the transfer ends 5.1 mm short,
-along -y 690.5 mm out teaching 3.3 mm short. Nearer or farther, or along another axis,
-is taken as out of reach."""
+peg's motion) and, on each, the boxes in which the hole's entry centre was measured to be
+reached, taught and assembled, at each of their 8 corners (``./run.sh bench reach --kind
+hole``: ``agh_hex_horizontal`` of ``tests/cad/test_sideways.py`` turned about z, raised
+and placed; docs/cell.md). The wrist is 185 mm beyond the entry, farther than on a pin:
+the pins' boxes do not carry over. Inside a box the arm is taken to reach it as at its
+corners; elsewhere, or along another axis, it is taken as out of reach."""
 TRAY_START = (0.25, 0.40)
 """The first default tray [m] (the shipped products' trays lie 0.47 to 0.50 m from the arm's base)."""
 TRAY_PITCH = 0.05
@@ -721,20 +724,28 @@ def _stack_refused(derived: Derived, pin: PinFit, pid: str) -> str | None:
     return None
 
 
-def _unreached(axis: str, end: tuple[float, float, float], spans: Mapping[str, tuple[float, float]],
+def _unreached(axis: str, end: tuple[float, float, float], regions: Mapping[str, tuple[Region, ...]],
                what: str) -> str:
     """Why the cell's arm may not reach ``what`` (a horizontal pin, its free end at ``end``
     [m]; a hole entered sideways, its entry there) along the horizontal ``axis`` (the part's
-    motion): "" where it was measured to (``spans``: :data:`SIDEWAYS_PIN_REACH`,
-    :data:`SIDEWAYS_HOLE_REACH`)."""
-    if axis not in spans:
-        return f"the cell's arm was measured to reach {what} along {' and '.join(spans)} only"
-    low, high = spans[axis]
-    if low - 1e-9 <= (distance := math.hypot(end[0], end[1])) <= high + 1e-9:
+    motion): "" inside a box in which it was measured to (``regions``:
+    :data:`SIDEWAYS_PIN_REACH`, :data:`SIDEWAYS_HOLE_REACH`)."""
+    if axis not in regions:
+        return f"the cell's arm was measured to reach {what} along {', '.join(regions)} only"
+    if any(all(low - 1e-9 <= v <= high + 1e-9 for v, (low, high) in zip(end, box, strict=True))
+           for box in regions[axis]):
         return ""
     where = "its free end" if what.endswith("pin") else "its entry"
-    return (f"{where} {1e3 * distance:.1f} mm from the arm's base, out of the {1e3 * low:g} to {1e3 * high:g} mm "
-            f"at which the arm was measured to reach it along {axis}")
+    at = ", ".join(f"{round(1e3 * v, 1) + 0.0:.1f}" for v in end)  # + 0.0: no "-0.0"
+    boxes = "; ".join(" ".join(f"{name} {_span(low, high)}" for name, (low, high) in zip("xyz", box, strict=True))
+                      for box in regions[axis])
+    return f"{where} at ({at}) mm, out of the reach measured along {axis} ({boxes} mm)"
+
+
+def _span(low: float, high: float) -> str:
+    """A span [m] in mm: "450-650", or "30" where it is one value."""
+    low_mm, high_mm = round(1e3 * low, 1) + 0.0, round(1e3 * high, 1) + 0.0
+    return f"{low_mm:g}" if low_mm == high_mm else f"{low_mm:g}-{high_mm:g}"
 
 
 def _wrist_on_pin(derived: Derived, pin: PinFit, pid: str) -> str:

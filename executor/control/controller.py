@@ -15,6 +15,10 @@ import pybullet as pb
 from executor.control.gains import ImpedanceGains
 from executor.world.arm import REST_POSTURE, Arm, ArmState, rotation_error
 
+JOINT_BANDWIDTH = 2 * np.pi * 4.0
+"""[rad/s] the natural frequency of :meth:`ImpedanceController.step_joints`'s joint servo
+(critically damped, each joint as its own unit mass through the arm's mass matrix)."""
+
 
 class ImpedanceController:
     """Tracks a tip pose with a Cartesian spring-damper; one ``step`` per physics step."""
@@ -55,4 +59,19 @@ class ImpedanceController:
         tau += self._null_projector @ (g.k_null * (REST_POSTURE - s.q) - g.d_null * s.qd)
         self.arm.command(tau)
         pb.stepSimulation(physicsClientId=self.client)
+        return s
+
+    def step_joints(self, q_des: np.ndarray, qd_des: np.ndarray) -> ArmState:
+        """A joint-space step for moves in free space (:func:`executor.assembly.transfer.move_joints`):
+        computed torque M(q) [ω² (q_d − q) + 2ω (q̇_d − q̇)] + g(q) + C(q, q̇) q̇ toward the
+        joint angles [rad] and rates [rad/s], ω = :data:`JOINT_BANDWIDTH` (the held part,
+        a body of its own, is carried by the servo's stiffness); advances the physics one step.
+        Returns the state read before it."""
+        s = self.arm.read()
+        w = JOINT_BANDWIDTH
+        mass = np.array(pb.calculateMassMatrix(self.arm.robot, s.q.tolist(), physicsClientId=self.client))
+        tau = mass @ (w * w * (q_des - s.q) + 2 * w * (qd_des - s.qd)) + self.arm.gravity_coriolis(s.q, s.qd)
+        self.arm.command(tau)
+        pb.stepSimulation(physicsClientId=self.client)
+        self._steps = 0  # the null-space projector recomputed at the next Cartesian step
         return s

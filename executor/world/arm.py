@@ -21,6 +21,11 @@ N_JOINTS = 7
 # Comfortable posture (elbow up, tool down) for IK and the null-space term [rad].
 REST_POSTURE = np.array([0.0, 0.6, 0.0, -1.4, 0.0, 1.1, 0.0])
 TOOL_DOWN_QUAT_XYZW = np.array([1.0, 0.0, 0.0, 0.0])
+LIMIT_MARGIN = 0.1
+"""[rad] how far inside its joint limits :meth:`Arm.solve` keeps the arm: room for the
+controller's motions from there (a joint at its limit stops the tool short)."""
+SOLVED = 0.0005  # [m] how near its pose :meth:`Arm.solve` puts the tip
+SOLVED_TURN = 0.005  # [rad] and how near its orientation
 _ORIGIN = (0.0, 0.0, 0.0)
 
 
@@ -129,6 +134,11 @@ class Arm:
         # chooses for an inertia tensor with products of inertia: a polygon peg's, a mesh
         # part's) to the target orientation, not the link frame: the target is turned by it.
         self._inertial_quat = tuple(pb.getDynamicsInfo(robot, self.sensor, physicsClientId=client)[4])
+        info = [pb.getJointInfo(robot, j, physicsClientId=client) for j in self.joints]
+        self.lower = np.array([i[8] for i in info])
+        """[rad] each joint's lower limit (the URDF's, which PyBullet enforces)."""
+        self.upper = np.array([i[9] for i in info])
+        """[rad] each joint's upper limit."""
         self._zeros = [0.0] * N_JOINTS
         self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         self.tare = np.zeros(6)
@@ -152,10 +162,7 @@ class Arm:
     def inverse_kinematics(self, tip_pos: np.ndarray, tip_quat_xyzw: np.ndarray) -> np.ndarray:
         """Joint angles [rad] putting the *believed* tip at the pose (a few IK iterations;
         used only to place the arm before an attempt, never per control step)."""
-        real_pos, real_quat = pb.multiplyTransforms(list(tip_pos), list(tip_quat_xyzw),
-                                                    list(self.grasp_offset), list(self.grasp_quat_xyzw))
-        if self._inertial_quat != (0.0, 0.0, 0.0, 1.0):  # in doubles: PyBullet's product rounds to float32
-            real_quat = tuple((Rotation.from_quat(real_quat) * Rotation.from_quat(self._inertial_quat)).as_quat())
+        real_pos, real_quat = self._ik_target(tip_pos, tip_quat_xyzw)
         q = REST_POSTURE.copy()
         for _ in range(4):
             self.reset(q)
@@ -164,6 +171,49 @@ class Arm:
                 maxNumIterations=200, residualThreshold=1e-6, physicsClientId=self.client)[:N_JOINTS])
         self.reset(q)
         return q
+
+    def _ik_target(self, tip_pos: np.ndarray, tip_quat_xyzw: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """The sensor link's pose (its inertial frame's orientation) PyBullet's IK is to put
+        where the *believed* tip is at the pose."""
+        real_pos, real_quat = pb.multiplyTransforms(list(tip_pos), list(tip_quat_xyzw),
+                                                    list(self.grasp_offset), list(self.grasp_quat_xyzw))
+        if self._inertial_quat != (0.0, 0.0, 0.0, 1.0):  # in doubles: PyBullet's product rounds to float32
+            real_quat = tuple((Rotation.from_quat(real_quat) * Rotation.from_quat(self._inertial_quat)).as_quat())
+        return tuple(real_pos), tuple(real_quat)
+
+    def solve(self, tip_pos: np.ndarray, tip_quat_xyzw: np.ndarray, seeds: list[np.ndarray]) -> np.ndarray | None:
+        """Joint angles [rad] at least :data:`LIMIT_MARGIN` inside the joint limits putting
+        the *believed* tip within :data:`SOLVED` of the pose (:data:`SOLVED_TURN` of its
+        orientation): PyBullet's IK from each of ``seeds`` in turn, which also pulls to it,
+        the first such; None where none is. The arm is left as it was (its joints and their
+        rates restored; nothing steps). PyBullet's IK given the limits ends millimetres off
+        the pose: the limits are checked instead."""
+        c, r = self.client, self.robot
+        saved = [(j[0], j[1]) for j in pb.getJointStates(r, self.joints, physicsClientId=c)]
+        real_pos, real_quat = self._ik_target(tip_pos, tip_quat_xyzw)
+        try:
+            for seed in seeds:
+                q = seed
+                for _ in range(4):
+                    self._set(q)
+                    q = np.array(pb.calculateInverseKinematics(
+                        r, self.sensor, real_pos, real_quat, restPoses=list(seed), maxNumIterations=200,
+                        residualThreshold=1e-6, physicsClientId=c)[:N_JOINTS])
+                self._set(q)
+                ls = pb.getLinkState(r, self.sensor, computeForwardKinematics=1, physicsClientId=c)
+                quat = np.array(pb.multiplyTransforms(_ORIGIN, ls[5], _ORIGIN, self._inv_quat)[1])
+                within = bool(np.all(q >= self.lower + LIMIT_MARGIN) and np.all(q <= self.upper - LIMIT_MARGIN))
+                if within and self.tip_error(tip_pos) < SOLVED and np.linalg.norm(
+                        rotation_error(np.asarray(tip_quat_xyzw), quat)) < SOLVED_TURN:
+                    return q
+            return None
+        finally:
+            for j, (qj, rate) in zip(self.joints, saved):
+                pb.resetJointState(r, j, qj, rate, physicsClientId=c)
+
+    def _set(self, q: np.ndarray) -> None:
+        for j, qj in zip(self.joints, q):
+            pb.resetJointState(self.robot, j, float(qj), 0.0, physicsClientId=self.client)
 
     def tip_error(self, tip_pos: np.ndarray) -> float:
         """How far [m] the believed tip is from ``tip_pos`` now (a reach check after

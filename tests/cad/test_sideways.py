@@ -147,19 +147,20 @@ def _turned(folder: Path, wall: float | None = None) -> Path:
 
 
 def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_arm_was_not_measured_to_reach(tmp_path: Path) -> None:
-    # Along -x the assembling cell's transfer ends short of the approach (70.9 mm with the
-    # entry 375 mm out, 75.4 mm at 445 mm) and teaching does not reach farther out: never the cell's.
+    # Along -x the assembling cell's transfer ends short of the approach (68.5 mm with the
+    # entry 352.5 mm out, 75.9 mm at 452.5 mm: no IK solution within the joints' limits): never the cell's.
     turned = _turned(tmp_path / "turned")
     for place, out in (((0.56, 0.0), "default"), ((0.42, 0.0), "near")):
         imported = run_import(turned, tmp_path / out, "mm", CORPUS / "import.toml", ImportOptions(place=place))
         assert imported.derived.axis == {"hex_peg": "+x"}
         manual = load_product_description(tmp_path / out).geometry.manual  # type: ignore[union-attr]
         assert "hex_peg" in manual and "along -x: the cell's arm was measured to reach a hole entered sideways " \
-            "along +x and -y only" in manual["hex_peg"].reason, manual
-    # Along -y the entry 700.4 mm out: teaching does not reach the demonstration's start.
+            "along +x, +y, -y only" in manual["hex_peg"].reason, manual
+    # Along -y the entry 700 mm out along x: out of the box measured (docs/cell.md).
     run_import(CORPUS / "meshes", tmp_path / "far", "mm", CORPUS / "import.toml", ImportOptions(place=(0.70, 0.0)))
     manual = load_product_description(tmp_path / "far").geometry.manual  # type: ignore[union-attr]
-    assert "its entry 700.4 mm from the arm's base, out of the" in manual["hex_peg"].reason, manual
+    assert "its entry at (700.0, 25.0, 30.0) mm, out of the reach measured along -y (x 400-600 " in \
+        manual["hex_peg"].reason, manual
 
 
 @pytest.mark.parametrize(("wall", "meets"), [(60.0, True), (40.0, False)])

@@ -10,12 +10,13 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from executor.assembly.transfer import SEEDS, move_joints
 from executor.control.admittance import Admittance, AdmittanceParams
 from executor.control.detector import Detector, Thresholds
 from executor.skills.dmp import load_skill, xyzw_to_wxyz
 from executor.trial import Cell
 from executor.world import TIME_STEP
-from executor.world.arm import rotation_error, tool_quat
+from executor.world.arm import LIMIT_MARGIN, quat_to_matrix, rotation_error, tool_quat
 from executor.world.geometry import load_geometry
 from tests._tolerances import PATH_BOUND
 
@@ -126,3 +127,27 @@ def test_the_detector_keeps_the_largest_sustained_deviation() -> None:
     assert detector.max_force_dev == pytest.approx(windows.max(), abs=1e-12)
     assert fired[4:] == [bool(w >= thresholds.f_stop) for w in windows]
     assert not any(fired[:4])
+
+
+def test_the_arm_s_ik_within_its_limits_leaves_it_as_it_was_and_the_joint_move_takes_it_there(cell: Cell) -> None:
+    """:meth:`Arm.solve` for the tool pointing along +y above the plate (where the Cartesian
+    turn from pointing down ends with joints 2 and 7 at their limits, docs/cell.md): a
+    solution inside every limit by LIMIT_MARGIN, the tip on the pose, the arm's joints
+    untouched; none for a pose 2 m out; the joint servo then takes the arm there."""
+    motion = cell.motion_for("p1")
+    arm = motion.controller.arm
+    arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+    arm.inverse_kinematics(np.array([0.25, 0.4, 0.2]), tool_quat(0.0))  # above a tray
+    motion.controller.reset()
+    before = arm.read().q
+    along_y = np.array(pb.multiplyTransforms((0, 0, 0), pb.getQuaternionFromEuler((np.pi / 2, 0, 0)),
+                                             (0, 0, 0), list(tool_quat(0.0)))[1])
+    goal = np.array([0.56, -0.1, 0.2])
+    q = arm.solve(goal, along_y, SEEDS)
+    assert q is not None and np.array_equal(arm.read().q, before)
+    assert np.all(q >= arm.lower + LIMIT_MARGIN) and np.all(q <= arm.upper - LIMIT_MARGIN)
+    assert arm.solve(np.array([2.0, 0.0, 0.2]), along_y, SEEDS) is None
+    move_joints(motion, q)
+    state = arm.read()
+    assert np.max(np.abs(state.q - q)) < 0.002 and np.linalg.norm(state.tip_pos - goal) < 0.002
+    assert quat_to_matrix(state.tip_quat_xyzw)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.01)
