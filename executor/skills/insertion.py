@@ -88,7 +88,8 @@ class InsertionTask:
 def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask, admittance: Admittance | None,
            *, phase_stopping: bool = True, record: bool = False) -> InsertionResult:
     """Run the skill in the hole frame of ``task`` (:class:`InsertionTask`), starting from
-    the current tip pose, with the task's ILC correction added to the command.
+    the current tip pose, its path never above that pose's height, with the task's ILC
+    correction added to the command.
 
     The execution layer: ``admittance`` None is pure position control along the DMP;
     ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
