@@ -88,7 +88,8 @@ class InsertionTask:
 def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask, admittance: Admittance | None,
            *, phase_stopping: bool = True, record: bool = False) -> InsertionResult:
     """Run the skill in the hole frame of ``task`` (:class:`InsertionTask`), starting from
-    the current tip pose, with the task's ILC correction added to the command.
+    the current tip pose, its path never above that pose's height, with the task's ILC
+    correction added to the command.
 
     The execution layer: ``admittance`` None is pure position control along the DMP;
     ``phase_stopping`` False lets the DMP run at its own pace whatever the forces;
@@ -107,6 +108,10 @@ def insert(motion: Motion, skill: Skill, detector: Detector, task: InsertionTask
     goal = skill.demo_goal
     times, pos, quats = skill.rollout(turn_z(s.tip_pos - hole_origin, -yaw), turn_quats_z(s.tip_quat_xyzw, -yaw),
                                       goal[:3], np.roll(goal[3:], -1))
+    # Never above where the search left the part: a skill moved to a shallower hole than its
+    # teaching's (Skill.deeper keeps the forcing terms) first rises about 2.7 mm for 5 mm
+    # shallower, lifting the part out of the hole or off the pin it found, to land beside it.
+    pos[:, 2] = np.minimum(pos[:, 2], pos[0, 2])
     clock = PhaseClock(times, turn_z(pos, yaw) + hole_origin, turn_quats_z(quats, yaw), detector.thresholds.f_slow)
     d_pos, d_rot = np.zeros(3), np.zeros(3)
     wiggles, jammed, completed = 0, False, True
