@@ -23,7 +23,11 @@ passes, or for two non-convex outlines of more than :data:`SWEEP_PIECES` edge pa
 shift by zooming in on the best of a 3 x 3 grid down to :data:`FINE_SHIFT`, and the turn
 once more. The turn's search climbs a continuous score: the room where the peg is inside,
 else minus its deepest overlap (a
-peg corner outside the hole, a hole corner inside the peg). The room reported is
+peg corner outside the hole, a hole corner inside the peg; the farthest such corner of
+each peg is found through a k-d tree of points along the outline's edges, which bounds
+every corner's distance, and only the corners that may be the farthest are measured, each
+against the edges that may be nearest: the numbers ``shapely.distance`` gives against the
+whole outline, for a fraction of its pairs). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
 is one the peg can make; a pass whose window of turns the search never samples near can
@@ -44,6 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from scipy.spatial import cKDTree
 
 COARSE_TURNS = 72
 """Samples of the turn over one period of the pair's symmetry."""
@@ -126,20 +131,83 @@ def _turn(points: np.ndarray, angle: float) -> np.ndarray:
     return points @ np.array([[c, s], [-s, c]])
 
 
+_SAMPLES = 4096
+"""Points along a ring's edges that :class:`_Edges` indexes, evenly by length (and its corners)."""
+_INDEXED = 256
+"""A ring of more corners than this is indexed (:class:`_Edges`); GEOS measures a smaller one
+whole faster (the corpus's outlines: ``vitac_shapes``' 4 to 48 corners, ``flynn_clutch``'s
+splines 634 to 1192)."""
+_SLACK = 1e-12
+"""[m] added to the bounds :class:`_Edges` compares (their rounding)."""
+
+
+def _largest(values: np.ndarray, groups: np.ndarray, count: int) -> np.ndarray:
+    """The largest of ``values`` in each of ``count`` groups (``groups``: each value's); -inf without one."""
+    found = np.full(count, -np.inf)
+    np.maximum.at(found, groups, values)
+    return found
+
+
+class _Edges:
+    """A ring, and the largest distance of a group of points to it as ``shapely.distance``
+    gives each (GEOS: the least of the point's distances to every edge, brute force), for
+    far fewer pairs: a k-d tree of points along the edges at most ``step`` apart bounds each
+    point's distance (between its nearest indexed point's distance less ``step`` / 2 and
+    that distance), and only the points whose bound reaches the best lower bound of their
+    group are measured, each against the edges with an indexed point within its bound plus
+    ``step`` / 2 (which hold its nearest edges), by GEOS as it measures the whole ring: the
+    same number, which the deepest overlap of a peg needs."""
+
+    def __init__(self, ring: shapely.LinearRing) -> None:
+        self.ring = ring
+        shapely.prepare(ring)
+        corners = np.asarray(ring.coords)[:-1]
+        self.indexed = len(corners) > _INDEXED
+        if not self.indexed:
+            return
+        ends = np.roll(corners, -1, axis=0)
+        lengths = np.hypot(*(ends - corners).T)
+        self.step = float(lengths.sum()) / _SAMPLES
+        pieces = np.maximum(1, np.ceil(lengths / self.step)).astype(int)
+        self.owner = np.repeat(np.arange(len(corners)), pieces + 1)
+        starts = np.cumsum(pieces + 1) - (pieces + 1)
+        along = (np.arange(len(self.owner)) - starts[self.owner]) / pieces[self.owner]  # 0 to 1 on each edge
+        self.tree = cKDTree(corners[self.owner] + along[:, None] * (ends - corners)[self.owner])
+        self.lines = shapely.linestrings(np.stack([corners, ends], axis=1))
+
+    def largest(self, points: np.ndarray, groups: np.ndarray, count: int) -> np.ndarray:
+        """The largest distance [m] to the ring of ``points`` (k, 2) [m] in each of ``count``
+        groups (``groups``: each point's), -inf in a group without one."""
+        if not len(points):
+            return np.full(count, -np.inf)
+        if not self.indexed:
+            return _largest(shapely.distance(self.ring, shapely.points(points)), groups, count)
+        bound = self.tree.query(points)[0]
+        best = _largest(bound - self.step / 2 - _SLACK, groups, count)
+        chosen = np.flatnonzero(bound + _SLACK >= best[groups])
+        balls = self.tree.query_ball_point(points[chosen], bound[chosen] + self.step / 2 + _SLACK)
+        counts = np.fromiter(map(len, balls), int, len(balls))
+        pairs = np.unique(np.stack([np.repeat(chosen, counts), self.owner[np.concatenate(balls).astype(int)]],
+                                   axis=1), axis=0)
+        measured = np.full(len(points), np.inf)
+        np.minimum.at(measured, pairs[:, 0], shapely.distance(shapely.points(points[pairs[:, 0]]),
+                                                               self.lines[pairs[:, 1]]))
+        return _largest(measured[chosen], groups[chosen], count)
+
+
 class _Pair:
     """A peg and a hole about their centres (the peg's smallest enclosing circle's, the
     hole's largest inscribed circle's), scored at a turn [rad] and shift [m]."""
 
     def __init__(self, peg: shapely.Polygon, hole: shapely.Polygon) -> None:
         self.hole = hole
-        self.hole_edge = hole.exterior
+        self.hole_edge = _Edges(hole.exterior)
         shapely.prepare(hole)
-        shapely.prepare(self.hole_edge)
         self.peg_points = np.asarray(peg.exterior.coords)[:-1]
         self.hole_points = np.asarray(hole.exterior.coords)[:-1]
         self.peg = peg
         shapely.prepare(peg)
-        self.peg_edge = peg.exterior
+        self.peg_edge = _Edges(peg.exterior)
         hull = shapely.convex_hull(peg)
         self.peg_hull = np.asarray(hull.exterior.coords)[:-1]
         self.sweep_convex = hull.area <= peg.area * (1 + 1e-12) or \
@@ -160,27 +228,23 @@ class _Pair:
         pegs = self.pegs(angles, shifts)
         inside = shapely.contains(self.hole, pegs)
         result = np.empty(len(angles))
-        result[inside] = shapely.distance(self.hole_edge, pegs[inside])
+        result[inside] = shapely.distance(self.hole_edge.ring, pegs[inside])
         out = ~inside
         if np.any(out):
-            n = len(self.peg_points)
+            count = int(out.sum())
             corners = shapely.get_coordinates(pegs[out])
-            ends = np.cumsum([0, *[n + 1] * int(out.sum())])
-            points = shapely.points(corners)
-            outside = ~shapely.contains(self.hole, points)
-            depth = np.zeros(len(corners))
-            depth[outside] = shapely.distance(self.hole_edge, points[outside])
-            deepest = np.maximum.reduceat(depth, ends[:-1])
+            groups = np.repeat(np.arange(count), len(self.peg_points) + 1)
+            outside = ~shapely.contains(self.hole, shapely.points(corners))
+            deepest = self.hole_edge.largest(corners[outside], groups[outside], count)
             # the hole's corners, brought into each peg's frame, inside the peg
             back = self.hole_points[None, :, :] - shifts[out][:, None, :]
             c, s = np.cos(-angles[out])[:, None], np.sin(-angles[out])[:, None]
-            local = np.stack([c * back[..., 0] - s * back[..., 1], s * back[..., 0] + c * back[..., 1]], axis=2)
-            points = shapely.points(local.reshape(-1, 2))
-            within = shapely.contains(self.peg, points)
-            poke = np.zeros(len(points))
-            poke[within] = shapely.distance(self.peg_edge, points[within])
-            deepest = np.maximum(deepest, poke.reshape(len(back), -1).max(axis=1))
-            result[out] = -deepest
+            local = np.stack([c * back[..., 0] - s * back[..., 1], s * back[..., 0] + c * back[..., 1]],
+                             axis=2).reshape(-1, 2)
+            groups = np.repeat(np.arange(count), len(self.hole_points))
+            within = shapely.contains(self.peg, shapely.points(local))
+            poke = self.peg_edge.largest(local[within], groups[within], count)
+            result[out] = -np.maximum(np.maximum(deepest, poke), 0.0)  # 0: no corner out
         return result
 
     def score(self, angle: float, shift: np.ndarray) -> float:

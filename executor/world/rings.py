@@ -131,7 +131,9 @@ def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pin
     """The convex pieces of part ``pid`` with ``bores`` bores (one per pin it goes onto: a
     plate over two dowel pins has two), its closed ``mesh`` in its part frame [m] (z its
     axis; module docstring), each with 0.0 (no vertex dropped) and a line saying how they
-    were made; or why the part has none: no prism of its sections with that many bores, or
+    were made; or why the part has none: no prism of its sections with that many bores, a
+    layer no thicker than the cell's hull margin twice (a 1.2 mm clutch plate: none of its
+    pieces has an eroded form), or
     a piece at a bore too thin for the cell even with the bore made coarser by at most
     ``allowed`` [m] (:func:`coarser_bores`, one bore only), or, when it goes onto
     ``round_pins`` only, circumscribing each bore's inscribed circle (:func:`round_bores`)."""
@@ -273,6 +275,7 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
     layers = stack(pid, mesh, bores)
     if isinstance(layers, str):
         return layers
+    low = float(mesh.bounds[0][2])
     differ = mesh.volume
     for section, bottom, top in layers:
         prism = trimesh.creation.extrude_polygon(section, top - bottom)
@@ -283,6 +286,11 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
         return NoStack(f"part '{pid}' is no stack of prisms of its sections (they differ by "
                        f"{differ / mesh.volume:.1%} of its volume over {len(layers)} layer(s); the cell's exact "
                        "pieces of a part with a bore are prisms')")
+    thin = next(((bottom, top) for _, bottom, top in layers if top - bottom <= 2 * URDF_HULL_MARGIN), None)
+    if thin is not None:  # every layer has the bore, and no piece of this one an eroded form, whatever its bore
+        return (f"part '{pid}': its layer from {1e3 * (thin[0] - low):.3f} to {1e3 * (thin[1] - low):.3f} mm of its "
+                f"height, at its bore, is no thicker than the cell's hull margin twice ({2000 * URDF_HULL_MARGIN:g} "
+                "mm)")
     made = round_bores if round_pins else coarser_bores
     candidates = [made(section, allowed) for section, _, _ in layers]
     # the exact sections first, then the finest coarser bores that work, found by bisection

@@ -58,6 +58,17 @@ def test_a_part_that_is_no_stack_of_prisms_says_so() -> None:
     assert isinstance(found, NoStack) and "is no stack of prisms of its sections" in found
 
 
+def test_a_plate_thinner_than_the_hull_margin_twice_is_refused_saying_so() -> None:
+    # flynn_clutch's plates: 1.2 mm thick, no piece of them has an eroded form (its height
+    # less the margin twice is nothing), whatever its bore
+    bore = shapely.Point(0, 0).buffer(BORE, quad_segs=16)
+    plate = trimesh.creation.extrude_polygon(shapely.Point(0, 0).buffer(0.02, quad_segs=8).difference(bore), 0.0012)
+    found = ring_pieces("plate", plate, 1e-4)
+    assert isinstance(found, str) and not isinstance(found, NoStack)
+    assert found == ("part 'plate': its layer from 0.000 to 1.200 mm of its height, at its bore, is no thicker than "
+                     "the cell's hull margin twice (2 mm)")
+
+
 def test_a_large_part_whose_bore_coacd_cannot_keep_is_refused_without_decomposing() -> None:
     # asm4_disk_arm's disk: a d 240 disk with a d 21 bore and a nipple off its axis (no
     # stack of prisms), on a d 20 pin; its pieces may take 0.238 mm of the pin's room, and

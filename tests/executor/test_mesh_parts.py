@@ -22,7 +22,7 @@ from executor.assembly.world import AssemblyWorld
 from executor.cad.assembled import part_meshes
 from executor.cell_description import load_cell_description
 from executor.world.assets import sources_digest
-from executor.world.geometry import load_geometry
+from executor.world.geometry import load_geometry, plate_obj_text
 from executor.world.meshes import obj_text
 
 REST_BOUND = 3e-4
@@ -160,6 +160,29 @@ def test_the_generated_assets_follow_an_edited_mesh(product: Path) -> None:
     pieces = product / "meshes" / "peg.convex.obj"
     pieces.write_text(pieces.read_text().replace(old, new, 1))
     assert sources_digest(load_geometry(str(product))) != before
+
+
+def test_a_base_of_its_own_mesh_has_no_bosses_so_a_pin_wider_than_the_tile_loads(product: Path) -> None:
+    # A pin of the base (a 12-spline shaft d 40 in flynn_clutch) wider than the plate's
+    # tile_size (its bolt holes' spacing): the cell collides the base's own mesh, so it
+    # builds no boss about any hole or pin, none that the pin would not fit in.
+    half = 0.02  # a 40 mm hexagon across its corners, beside the square hole
+    outline = ", ".join(f"[{half * np.cos(k * np.pi / 3):.7f}, {half * np.sin(k * np.pi / 3):.7f}]" for k in range(6))
+    with (product / "assembly.toml").open("a") as file:
+        file.write(f'\n[holes.p1]\nshape = "polygon"\nposition = [{HOLE[0] - 0.025}, {HOLE[1]}]\n')
+    _edit(product, "[part_shapes.peg]", f"""[hole_shapes.p1]
+holes = ["p1"]
+pin = true
+kind = "polygon"
+size = [{2 * half}, {2 * half * np.sin(np.pi / 3):.7f}]
+outline = [{outline}]
+top_z = 0.04
+depth = 0.02
+
+[part_shapes.peg]""")
+    geometry = load_geometry(str(product))
+    assert geometry.holes["p1"].pin and geometry.base_mesh is not None
+    assert [line for line in plate_obj_text(geometry).splitlines() if not line.startswith("#")] == []
 
 
 @pytest.mark.parametrize(("old", "new", "expected"), [

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from shapely import affinity
 
 from executor.world.geometry import Section, margin, outline_polygon, section_fit
-from executor.world.polygon_fit import OutlineError, polygon, polygon_fit, round_fit
+from executor.world.polygon_fit import OutlineError, _Edges, polygon, polygon_fit, round_fit
 from tests._outlines import splined
 
 MM = 1e-3
@@ -145,3 +145,26 @@ def test_the_relation_of_two_rects_is_the_exact_rule_where_turning_gains_nothing
                   Section("h", "rect", 10.2 * MM, width=6.2 * MM, **rounded)) == pytest.approx(0.2 * MM)
     assert margin(Section("p", "rect", 10 * MM, width=6 * MM),
                   Section("h", "rect", 10.2 * MM, width=6.2 * MM, **rounded)) < 0
+
+
+def test_the_deepest_overlap_is_the_largest_distance_shapely_gives_measuring_few_pairs() -> None:
+    # The indexed ring (a 6-tooth spline and a square, cut into edges of 20 and 10 um)
+    # gives each group of points its farthest point's distance as shapely.distance measures
+    # the whole ring, number for number: the same brute-force arithmetic on the edges that
+    # may be nearest, of the points that may be farthest.
+    rng = np.random.default_rng(7)
+    for ring in (shapely.segmentize(SHAFT, 0.02 * MM).exterior,
+                 shapely.segmentize(shapely.box(-MM, -MM, MM, MM), 0.01 * MM).exterior):
+        edges = _Edges(ring)
+        assert edges.indexed
+        points = rng.normal(0.0, 3 * MM, (3000, 2))
+        points[:1000] = np.asarray(ring.coords)[rng.integers(0, len(ring.coords), 1000)]  # on a corner: 0
+        points[1000:1500] *= 1e-3  # near the centre
+        groups = rng.integers(0, 40, len(points))
+        # group 40: points 5 um beyond x = 1 mm (the square's side), 0.05 um apart at most, whose
+        # indexed points (2 um apart along the side) bound their distances less tightly than that
+        points[2500:] = np.c_[MM + 5e-6 + rng.uniform(0.0, 5e-8, 500), rng.uniform(-0.2, 0.2, 500) * MM]
+        groups[2500:] = 40
+        expected = np.full(41, -np.inf)
+        np.maximum.at(expected, groups, shapely.distance(ring, shapely.points(points)))
+        assert np.array_equal(edges.largest(points, groups, 41), expected)
