@@ -39,7 +39,7 @@ BENCHMARKS: dict[str, str] = {
     "reach": "executor.campaign.reach",
     "physics": "executor.campaign.physics",
     "engines": "executor.campaign.engines",
-    "import": "executor.cad.bench",
+    "import": "executor.campaign.import_bench",
     "corpus": "assembly_constraints.corpus_bench",
 }
 """``bench TOPIC``: topic → the module whose ``main(argv)`` runs it (each prints its figures)."""

@@ -3,7 +3,7 @@
 Modules, each importing only those before it: ``parts`` (reading mesh folders, checking
 the parts) and ``step`` (STEP assemblies), ``sweep`` (swept collision along straight
 removal paths), ``sections`` (cross-sections of slices), ``derive`` (insertion axes,
-holes, geometric precedence by disassembly), ``write`` (the assembly folder), ``cli``
-(``import``) and ``bench`` (``bench import``). ``assembled`` writes a shipped product's
+holes, geometric precedence by disassembly), ``write`` (the assembly folder) and ``cli``
+(``import``). ``assembled`` writes a shipped product's
 parts in the assembled pose (``executor export --assembled``). Units: metres inside.
 """
