@@ -41,6 +41,7 @@ from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
+from executor.cad.operations import entry_point, pin_entry
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -61,12 +62,10 @@ from executor.cad.write import (
     TRAY_START,
     Settings,
     claim_folder,
-    entry_point,
     map_product,
     mesh_pieces,
     near_miss_assumption,
     nominal_assumption,
-    pin_entry,
     section,
     write_folder,
 )
@@ -342,7 +341,7 @@ def _derived(parts: list[CadPart], out: Path, config: Path | None, options: Impo
                                                   Mapped, int]:
     """What :func:`run_import` finds before it writes: the files of ``out`` it may remove,
     the settings with every tray, the derived product and the product as the cell inserts
-    it (:func:`executor.cad.write.cell_view`), the assumptions, the offset into
+    it (:func:`executor.cad.operations.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
     known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
     reach, replace, place = options.reach, options.replace, options.place

@@ -13,7 +13,7 @@ the other side, its box's far face closed by a 5 mm plate and its peg cut 1 mm s
 each turned about z so that the part moves along the axis, raised on a
 riser of the base's own footprint to the height, and placed (``import --place``) so that
 the free end (entry) is at the point. The import's reach rule
-(:data:`executor.cad.write.SIDEWAYS_PIN_REACH`, :data:`executor.cad.write.SIDEWAYS_HOLE_REACH`)
+(:data:`executor.cad.operations.SIDEWAYS_PIN_REACH`, :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`)
 is set aside for it: the point is the cell's step wherever the import takes it as one.
 
 Prints one line a point: ``reached`` (the part assembled within 2 mm of its goal), or
@@ -37,7 +37,7 @@ import trimesh
 from bridge.cli_types import ArgumentParser
 from bridge.product import load_product_description
 from executor import ExecutorError
-from executor.cad import write
+from executor.cad import operations
 from executor.cad.cli import ImportOptions, run_import
 
 CORPUS_HOLE = Path(__file__).resolve().parents[2] / "tests" / "cad" / "corpus" / "agh_hex_horizontal"
@@ -146,8 +146,8 @@ def measure(kind: str, axis: str, x: float, y: float, height: float, tmp: Path) 
     from executor.trial import Cell
 
     cad, config, feature = _product(tmp / "first", kind, axis, height)
-    with mock.patch.object(write, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
-            mock.patch.object(write, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
+    with mock.patch.object(operations, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
+            mock.patch.object(operations, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
         run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0)))
         at = load_product_description(tmp / "first" / "out").assembly.holes[feature].position
         assert at is not None and at[0] is not None and at[1] is not None

@@ -22,8 +22,8 @@ from bridge.assembly import load_assembly
 from executor.cad.cli import run_import
 from executor.cad.convex import base_is_primitive
 from executor.cad.derive import Derived, derive
+from executor.cad.operations import WRIST_RADIUS, margins
 from executor.cad.parts import CadPart, load_meshes
-from executor.cad.write import WRIST_RADIUS, margins
 from executor.world.geometry import load_geometry
 
 SIZE_BOUND = 5e-5

@@ -21,8 +21,8 @@ import trimesh
 from assembly_constraints.cli import main
 from executor import ExecutorError
 from executor.cad.derive import _GRID, _joined, derive
+from executor.cad.operations import margins
 from executor.cad.parts import CadPart
-from executor.cad.write import margins
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 

@@ -16,14 +16,13 @@ import trimesh
 
 from executor.cad.cli import report
 from executor.cad.derive import derive
+from executor.cad.operations import cell_view, margins
 from executor.cad.parts import load_meshes
 from executor.cad.sections import Shape2D, passes, zero_clearance
 from executor.cad.write import (
     Settings,
     _section_lines,
     assembly_text,
-    cell_view,
-    margins,
     nominal_text,
     sizes_text,
 )

@@ -15,9 +15,9 @@ from trimesh.path.traversal import discretize_path
 
 from executor.cad import sections
 from executor.cad.derive import derive
+from executor.cad.operations import margins
 from executor.cad.parts import CadPart
 from executor.cad.sections import Loop, classify
-from executor.cad.write import margins
 
 MM = 1e-3
 
