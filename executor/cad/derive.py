@@ -86,6 +86,7 @@ from executor.cad.sections import (
     Slicer,
     classify,
     exact_round,
+    faceted,
     frame_of,
     over_span,
     passage,
@@ -739,8 +740,10 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[n
             beyond = _joined(beyond, pin)
         if bore is None or beyond is None:
             continue
-        union = classify(_outline(beyond), hole=False)
-        hole = classify(bore, hole=True)
+        outline = _outline(beyond)
+        union, hole = classify(outline, hole=False), classify(bore, hole=True)
+        hole = faceted(hole, bore, union, hole=True)  # a tessellated round one against no round: its polygon
+        union = faceted(union, outline, hole, hole=False)
         key = (np.round(union.outline + union.centre, 8).tobytes(), np.round(bore.points, 8).tobytes())
         if key not in rooms:
             try:
@@ -1075,6 +1078,11 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
                             f"{1e3 * (entry - low):.3f} mm below its entry and its entry along {name[1:]} "
                             "(expected an opening all the way in)")
     hole = exact_round(classify(narrowest, hole=True), base.cylinders, axis, level, STEP_DEFLECTION)
+    part, section = (None, None) if occupant is None else (
+        occupant[0].id, exact_round(classify(occupied[0], hole=False), occupant[0].cylinders, axis, level,
+                                    STEP_DEFLECTION))
+    if section is not None:  # a tessellated round section against a section that is no round: its polygon
+        hole, section = faceted(hole, narrowest, section, hole=True), faceted(section, occupied[0], hole, hole=False)
     centre = frame.T @ hole.centre + axis * level
     bottom = first_hit(base.mesh, centre, -axis)
     depth = entry - (level - bottom if bottom is not None else float(around.min()))
@@ -1083,8 +1091,5 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     if probe:
         top = classify(min(probe, key=lambda o: o.area), hole=True)
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
-    part, section = (None, None) if occupant is None else (
-        occupant[0].id, exact_round(classify(occupied[0], hole=False), occupant[0].cylinders, axis, level,
-                                    STEP_DEFLECTION))
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)

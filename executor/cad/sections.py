@@ -5,7 +5,9 @@ A loop is classified as
 
 - ``round`` when it has at least :data:`MIN_ROUND_POINTS` points, all within 2 % of one
   radius, and fills at least 98 % of that circle (a 24-gon fills 98.9 %); a splined,
-  keyed or D-shaped outline spreads its radii further and is no round;
+  keyed or D-shaped outline spreads its radii further and is no round (a tessellation
+  coarser than :data:`FACETED` is the polygon it is against a section that is no round:
+  :func:`faceted`);
 - ``rect`` (``square`` when both sides agree within :data:`SQUARE_TOLERANCE`) when it fills
   its minimum-area rectangle to :data:`RECT_FILL` and each side of that rectangle is
   covered by the loop's own edges over at least :data:`STRAIGHT_SIDES` of its length
@@ -25,11 +27,12 @@ edges do): a round peg at least as wide as a round hole's inscribed circle, whos
 circle's radius is the hole's within :data:`executor.cad.sweep.TOUCH`, is taken for the
 same nominal diameter, a nominal zero-clearance fit (:func:`zero_clearance`), as the
 disassembly's sliding cylinders are. A part's rect is
-its minimum-area rectangle (it holds the part, corners and all); a hole's is that
-rectangle inset evenly on every side until it lies inside the loop (rounded or chamfered
-corners cost the inset: 0.29 mm a side for a 1 mm radius), so a rect peg that passes the
-recorded rect passes the hole. The corner radius that explains the area the corners lack
-is kept (``corner``, reported). Where the part's
+its minimum-area rectangle (it holds the part, corners and all) with the largest corner
+radius that still holds it; a hole's is the rounded rect that lies inside the loop: that
+rectangle with the least corner radius that fits, inset evenly on every side only as far
+as no rounded rect fits without (a tessellation's side tilted by a fraction of a µm costs
+that fraction, its rounded corners nothing), so a rect peg that passes the recorded rect
+passes the hole (``corner``, reported). Where the part's
 B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
 diameter instead.
 """
@@ -651,8 +654,10 @@ def _straight(points: np.ndarray, a: float, b: float, tolerance: float) -> float
 
 
 def _rounded(a: float, b: float, radius: float, inset: float = 0.0) -> shapely.Polygon:
-    """The centred rect ``a`` x ``b`` [m] with corners of ``radius`` [m], inset by ``inset`` [m] a side."""
+    """The centred rect ``a`` x ``b`` [m] inset by ``inset`` [m] a side, with corners of
+    ``radius`` [m] (at most half its inset short side)."""
     half_a, half_b = a / 2 - inset, b / 2 - inset
+    radius = min(radius, half_b)
     core = shapely.box(radius - half_a, radius - half_b, half_a - radius, half_b - radius)
     return core.buffer(radius, quad_segs=16) if radius > 0 else core
 
@@ -672,8 +677,14 @@ def _bisect(low: float, high: float, ok_high: bool, test: Callable[[float], bool
 def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> tuple[float, float]:
     """The corner radius and inset [m] of a rect section (``points`` in its centred frame):
     a peg's the largest radius whose rounded rect still holds the loop (inset 0); a hole's
-    the least radius whose rounded rect lies inside the loop, or where none does, the
-    least even inset of the sharp rect that does (radius 0)."""
+    the least radius whose rounded rect lies inside the loop (inset 0). Where none does (a
+    notch, or a side a tessellation tilts by a fraction of a µm), the least even inset any
+    radius needs is that of radius b/2 (a rounded rect of a larger radius lies inside one
+    of a smaller): the sharp rect at its least inset where that is within
+    :data:`OUTLINE_TOUCH` of it, else the least radius whose rounded rect lies inside the
+    loop inset by OUTLINE_TOUCH beyond it, at the least inset that radius needs. A tilt
+    then costs a fraction of a µm of inset, not the corner (the sharp rect shrunk until
+    it fits: 2.3 mm of a 42 mm rounded square with 4 mm corners)."""
     loop = shapely.make_valid(shapely.Polygon(points))
     shapely.prepare(loop)
     grown = loop.buffer(1e-9)  # the loop's own points on the rect's sides stay covered
@@ -681,16 +692,23 @@ def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> 
         return _bisect(0.0, b / 2, False, lambda r: bool(_rounded(a, b, r).buffer(1e-9).covers(loop))), 0.0
     if grown.covers(_rounded(a, b, b / 2)):
         return _bisect(0.0, b / 2, True, lambda r: bool(grown.covers(_rounded(a, b, r)))), 0.0
-    return 0.0, _bisect(0.0, b / 2, True, lambda d: bool(grown.covers(_rounded(a, b, 0.0, d))))
+    least = _bisect(0.0, b / 2, True, lambda d: bool(grown.covers(_rounded(a, b, b / 2, d))))
+    allowed = min(least + OUTLINE_TOUCH, b / 2)
+    sharp = _bisect(0.0, b / 2, True, lambda d: bool(grown.covers(_rounded(a, b, 0.0, d))))
+    if sharp <= allowed:
+        return 0.0, sharp
+    radius = _bisect(0.0, b / 2, True, lambda r: bool(grown.covers(_rounded(a, b, r, allowed))))
+    return radius, _bisect(0.0, allowed, True, lambda d: bool(grown.covers(_rounded(a, b, radius, d))))
 
 
-def classify(loop: Loop, *, hole: bool) -> Shape2D:
-    """The loop's cross-section (the module docstring); ``hole`` picks the inscribed size."""
+def classify(loop: Loop, *, hole: bool, round_ok: bool = True) -> Shape2D:
+    """The loop's cross-section (the module docstring); ``hole`` picks the inscribed size;
+    without ``round_ok``, a loop is never read as round (the rect or polygon it is)."""
     points, centre = loop.points, loop.centre
     outline = points - centre
     radii = np.linalg.norm(outline, axis=1)
     outer = float(radii.max())
-    if (len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
+    if (round_ok and len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
             and loop.area >= 0.98 * math.pi * outer ** 2):
         inner = edge_distance(points, centre)
         d = 2 * (inner if hole else outer)
@@ -714,6 +732,33 @@ def classify(loop: Loop, *, hole: bool) -> Shape2D:
         return Shape2D("square" if square else "rect", a, b, round(yaw, 6), centre, outline=outline,
                        corner=round(corner, 7) if corner > ON_SIDE else 0.0)
     return Shape2D("polygon", a, b, 0.0, centre, outline=outline)
+
+
+FACETED = 0.005
+"""A round section whose loop's edges come farther in from its vertex circle than this
+fraction of its radius (a 24-gon's: 0.86 %; a 32-gon's 0.48 %, a 46-gon's 0.23 %) is a
+polygon against a section that is no round (:func:`faceted`)."""
+
+
+def faceted(shape: Shape2D, loop: Loop, other: Shape2D, *, hole: bool) -> Shape2D:
+    """``shape``, the section read from ``loop`` (``hole``: a hole's), or the polygon its
+    loop is when ``shape`` is a coarse tessellation's round reading (its ``deflection``
+    beyond :data:`FACETED` of its vertex radius; a B-rep cylinder's, :func:`exact_round`,
+    has none) and the section it meets, ``other``, is not round. A round peg's room in a
+    round hole is the same whether a tessellated one is read as its circle (a hole's
+    inscribed, a peg's vertex circle) or as its polygon, up to the deflection that a nominal
+    zero-clearance fit allows for (:func:`zero_clearance`); a straight-sided or polygonal
+    section's room depends on where its corners meet the polygon's vertices at its best
+    yaw, which the circle gives away (a 12-spline shaft d 40 in a 24-gon bore d 41: 0.325
+    mm all round read round, 0.346 mm as the polygon). A finer tessellation stays round: a
+    fine-tessellated cylinder (a d 20 pin in a 20 mm slot, nominally zero clearance) is
+    its circle, and its polygon would report the tessellation's room (12 µm) as the fit's."""
+    if shape.kind != "round" or other.kind == "round":
+        return shape
+    vertex_radius = shape.a / 2 + (shape.deflection if hole else 0.0)  # a hole's a: its inscribed circle
+    if shape.deflection <= FACETED * vertex_radius:
+        return shape
+    return classify(loop, hole=hole, round_ok=False)
 
 
 ON_AXIS = 1e-6

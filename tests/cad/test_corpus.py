@@ -132,12 +132,6 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes", "gridfinity_bases",
-                                  pytest.param("flynn_clutch", marks=pytest.mark.xfail(
-                                      strict=True, raises=AssertionError,
-                                      reason="its outer plates' d 41 bore, a 24-gon (inscribed d 40.649), is read as "
-                                             "round, its inscribed circle: 0.325 mm all round (margin 649 um), where "
-                                             "the 12-spline shaft at yaw 0 has its tips at the 24-gon's vertices, "
-                                             "0.346 mm of room (the truth's 692)")),
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
                                       reason="its disk's d 21 bore is measured on its tessellation, d 20.951 (a "

@@ -77,6 +77,30 @@ def test_a_notched_rect_hole_is_the_sharp_rect_inset_inside_it() -> None:
     assert (hole.a, hole.b) == pytest.approx((9.4 * MM, 5.4 * MM), abs=2e-7)
 
 
+def test_a_rounded_square_hole_with_a_tilted_side_keeps_its_corner_radius() -> None:
+    """gridfinity_bases' pocket 20 µm below its entry: a 41.96 mm square with corner
+    radius 3.98 mm whose tessellation runs one side from a corner's tangent point to the
+    next arc's first vertex 0.2 µm in, so no full-size rounded square lies inside it. The
+    hole is the rounded square inset by that fraction of a µm, not a sharp square shrunk
+    until it fits (39.63 mm), and it lies inside the loop."""
+    side, radius = 41.96 * MM, 3.98 * MM
+    ring = np.asarray(rounded_rect(side, side, radius, quad_segs=64).exterior.coords)[:-1]
+    tangent = np.flatnonzero(np.isclose(ring[:, 1], -side / 2, atol=1e-12) & (ring[:, 0] > 0))
+    assert len(tangent) == 1  # the bottom side's end at the right corner's arc
+    step = np.array([[math.cos(0.01), -math.sin(0.01)], [math.sin(0.01), math.cos(0.01)]])
+    first = np.array([side / 2 - radius, -side / 2 + radius]) + (ring[tangent[0]] - [side / 2 - radius,
+                                                                                      -side / 2 + radius]) @ step.T
+    points = np.insert(np.delete(ring, tangent[0], axis=0), tangent[0], first, axis=0)
+    outline = shapely.Polygon(points)
+    assert outline.is_valid and 0.1e-6 < side / 2 + first[1] < 0.3e-6  # the arc's first vertex 0.2 µm in
+    hole = classify(Loop(points), hole=True)
+    assert hole.kind == "square"
+    assert side - 2 * (0.3e-6 + sections.OUTLINE_TOUCH) <= hole.a <= side  # inset by the tilt and the allowance
+    assert hole.corner == pytest.approx(radius, abs=0.05 * MM)
+    assert outline.buffer(1e-9).covers(affinity.rotate(rounded_rect(hole.a, hole.b, hole.corner, quad_segs=64),
+                                                       hole.yaw, origin=(0, 0)))
+
+
 def test_a_chamfered_square_is_a_square() -> None:
     chamfered = shapely.box(-5 * MM, -5 * MM, 5 * MM, 5 * MM).buffer(-0.5 * MM, join_style="mitre").buffer(
         0.5 * MM, join_style="bevel")
@@ -107,6 +131,32 @@ def test_a_tessellated_cylinder_stays_round() -> None:
     hole = classify(loop_of(circle), hole=True)
     assert hole.a == pytest.approx(10 * MM * math.cos(math.pi / 24), rel=1e-9)
     assert hole.deflection == pytest.approx(5 * MM * (1 - math.cos(math.pi / 24)), rel=1e-6)
+
+
+@pytest.mark.parametrize("sides, other, kind", [
+    (24, "polygon", "polygon"),  # flynn_clutch's outer plates' 24-gon bore against the 12-spline shaft
+    (24, "round", "round"),
+    (46, "polygon", "round"),  # asm4_disk_arm's fine d 20 tessellations, a nominal fit in its slot
+    (64, "square", "round"),
+])
+def test_a_coarse_round_section_is_its_polygon_against_a_section_that_is_no_round(sides: int, other: str,
+                                                                                   kind: str) -> None:
+    """A tessellated round section deviating more than FACETED of its radius from its
+    circle is read as the polygon it is against a non-round section (its room there
+    depends on its vertices), and stays round against a round one or when finer."""
+    turns = 2 * math.pi * np.arange(sides) / sides
+    circle = shapely.Polygon(np.stack([20.5 * MM * np.cos(turns), 20.5 * MM * np.sin(turns)], axis=1))
+    counterpart = {"polygon": splined(20 * MM, 17 * MM, 12, 0.26), "round": shapely.Point(0, 0).buffer(19 * MM, 32),
+                   "square": shapely.box(-10 * MM, -10 * MM, 10 * MM, 10 * MM)}[other]
+    for hole in (True, False):
+        shape = classify(loop_of(circle), hole=hole)
+        assert shape.kind == "round"
+        against = classify(loop_of(counterpart), hole=not hole)
+        assert against.kind == other
+        found = sections.faceted(shape, loop_of(circle), against, hole=hole)
+        assert found.kind == kind
+        if kind == "polygon":
+            assert shapely.Polygon(found.outline).equals_exact(circle, 1e-12)
 
 
 def test_a_fine_section_takes_its_closed_entities_as_the_graph_would() -> None:
