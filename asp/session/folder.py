@@ -13,12 +13,16 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
+import time
 from pathlib import Path
 
 from asp import PlannerError
 from bridge.files import os_reason
 
 LOCK_NAME = ".lock"
+HOLDER_WAIT = 1.0
+"""[s] how long a refused session waits for the holder's pid to show in the lock file (the
+holder writes it just after it takes the lock)."""
 
 
 class RunLock:
@@ -47,9 +51,7 @@ def lock_run_folder(run: Path) -> RunLock:
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError as exc:
-        holder = ""
-        with contextlib.suppress(OSError, ValueError):
-            holder = f" (pid {int(os.pread(fd, 32, 0).decode())})"
+        holder = _holder(fd)
         os.close(fd)
         if isinstance(exc, BlockingIOError):
             raise PlannerError(f"{run}: in use by another session{holder}; "
@@ -59,3 +61,17 @@ def lock_run_folder(run: Path) -> RunLock:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
     return RunLock(run, fd)
+
+
+def _holder(fd: int) -> str:
+    """`` (pid N)`` of the session holding the lock file ``fd``: its whole line, read again
+    for up to :data:`HOLDER_WAIT` while the holder has taken the lock but not yet written
+    it; "" when it never shows."""
+    deadline = time.monotonic() + HOLDER_WAIT
+    while True:
+        with contextlib.suppress(OSError, ValueError):
+            if (line := os.pread(fd, 32, 0).decode()).endswith("\n"):
+                return f" (pid {int(line)})"
+        if time.monotonic() >= deadline:
+            return ""
+        time.sleep(0.005)

@@ -10,12 +10,15 @@ import os
 import shutil
 import signal
 import subprocess
+import threading
 import time
 from pathlib import Path
 
 import pytest
 
+from asp import PlannerError
 from asp.session.cells import CellProcess, start_cell
+from asp.session.folder import lock_run_folder
 from asp.session.journal import JournalEntry, JournalEvent, read_journal, read_records
 from bridge.cell_settings import ServeSettings
 from bridge.session import free_loopback_endpoint
@@ -179,3 +182,18 @@ def test_a_running_session_refuses_a_resume_and_once_killed_resumes_with_new_num
     settings = json.loads((run / "session.json").read_text())
     assert settings["starts"] == 2 and sorted(settings["abandoned"]) == sorted(in_flight)  # not the refused one
     assert len(read_journal(run / "journal.jsonl")) == result["experiments"]
+
+
+def test_a_refused_session_names_a_holder_that_writes_its_pid_late(tmp_path: Path) -> None:
+    # The holder takes the lock, then writes its pid: a session refused in between waits
+    # for the line instead of naming no one.
+    holder = os.open(tmp_path / ".lock", os.O_RDWR | os.O_CREAT, 0o666)
+    fcntl.flock(holder, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    late = threading.Timer(0.2, lambda: os.pwrite(holder, b"4242\n", 0))
+    late.start()
+    try:
+        with pytest.raises(PlannerError, match=r"in use by another session \(pid 4242\); wait"):
+            lock_run_folder(tmp_path)
+    finally:
+        late.join()
+        os.close(holder)
