@@ -40,6 +40,7 @@ from executor.skills.teach import teach_all, teach_shape
 from executor.trial import Cell
 from executor.world.assets import regenerate_assets
 from executor.world.geometry import load_geometry
+from tests.cad.conftest import learned_in_the_cell
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -286,19 +287,6 @@ def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: 
     assert manual == {}, {pid: table.reason for pid, table in manual.items()}
 
 
-def _taught_and_learned_in_the_cell(done: Imported, run_main: Runner,
-                                    run: Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Teach the imported product, run a sim session with ``--assemble`` into ``run`` (the
-    commands in this process, the session's cell a process of its own); its result and its
-    journal's entries."""
-    taught = run_main("executor", "teach", "--assembly", str(done.out))
-    assert taught.returncode == 0, taught.stderr
-    session = run_main("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json")
-    assert session.returncode == 0, session.stderr
-    journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
-    return json.loads(session.stdout), journal
-
-
 def _taught(done: Imported, parts: set[str] | None = None) -> None:
     """The skills of the imported product's part shapes taught in the simulated cell (in
     this process; ``parts``: only their shapes, default every one), as ``executor teach``
@@ -505,9 +493,9 @@ def test_a_ring_that_is_no_prism_is_learned_onto_its_pin_and_assembled_in_physic
     # over the peg and inserts it down onto it with the skill taught on that peg.
     done = imported(name)
     assert "CoACD" in (done.out / "meshes" / "round_nut.convex.obj").read_text().splitlines()[2]
-    result, journal = _taught_and_learned_in_the_cell(done, run_main, tmp_path / "run")
+    result, observed = learned_in_the_cell(run_main, done.out, tmp_path / "run")
     holes = _feature_holes(done)
-    assert {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e} == {
+    assert observed == {
         (row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
     report = result["assembly"]
     steps = {step["part"]: step for step in report["steps"]}

@@ -7,7 +7,6 @@ the cell does not do stays placed by hand, named."""
 
 from __future__ import annotations
 
-import json
 import shutil
 import tomllib
 from pathlib import Path
@@ -19,6 +18,7 @@ import trimesh
 from assembly_constraints.cli import main
 from bridge import BridgeError
 from bridge.product import load_product_description
+from tests.cad.conftest import learned_in_the_cell
 from tests.conftest import Runner
 
 X_MM = 560.0
@@ -116,14 +116,7 @@ def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_b
 @pytest.mark.slow  # teaches three parts and runs a sim session with its assembly (about 25 s of CPU)
 def test_the_stacked_and_the_owned_pins_are_learned_and_assembled_in_physics(run_main: Runner, stacked: Path,
                                                                             tmp_path: Path) -> None:
-    taught = run_main("executor", "teach", "--assembly", str(stacked))
-    assert taught.returncode == 0, taught.stderr
-    run = tmp_path / "run"
-    done = run_main("session", "--assembly", str(stacked), "--out", str(run), "--json", "--assemble")
-    assert done.returncode == 0, done.stderr
-    result = json.loads(done.stdout)
-    journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
-    observed = {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e}
+    result, observed = learned_in_the_cell(run_main, stacked, tmp_path / "run")
     # tried in physics, the block at its goal in the trials onto its pin (without it a part
     # falls to the goal through the air there: a fit): the 9 mm bores stop on the block's
     # 10 mm pin; the parts go on their own pins, the arm's 11 mm bore on the plate's too

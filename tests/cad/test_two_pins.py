@@ -9,8 +9,6 @@ horizontal axis."""
 
 from __future__ import annotations
 
-import hashlib
-import shutil
 import tomllib
 from pathlib import Path
 
@@ -21,9 +19,8 @@ import trimesh
 
 from bridge.product import load_product_description
 from executor.cad.cli import run_import
-from executor.trial import Cell
 from executor.world.arm import quat_to_matrix
-from tests.cad.conftest import teach
+from tests.cad.conftest import teach, trial_on_edited_mesh
 from tests.conftest import assembled
 
 X_MM = 560.0
@@ -109,25 +106,16 @@ def test_a_second_pin_off_its_place_stops_the_plate_in_physics(taught: Path, tmp
     # The base (its own mesh) with its second pin 1 mm farther from the first, along the
     # diagonal: the plate's bores, 40 mm apart, no longer pass both pins. One attempt: the trial's second one after
     # a no-fit is tests/executor/test_executor_cell.py's.
-    moved = tmp_path / "moved"
-    shutil.copytree(taught, moved)
-    holes = load_product_description(moved).assembly.holes
+    holes = load_product_description(taught).assembly.holes
     first, second = (np.array(holes[hid].position or (0.0, 0.0)) for hid in ("base_pin1", "base_pin2"))
-    mesh_file = moved / "meshes" / "base.obj"
-    base = trimesh.load(mesh_file, force="mesh", process=False)
-    vertices = base.vertices.copy()
-    near = np.linalg.norm(vertices[:, :2] - second, axis=1) < 0.0045  # the pin and its foot's ring
-    vertices[near, :2] += 0.001 * (second - first) / np.linalg.norm(second - first)
-    base.vertices = vertices
-    base.export(mesh_file)
-    old = hashlib.sha256((taught / "meshes" / "base.obj").read_bytes()).hexdigest()
-    text = moved / "geometry.toml"
-    text.write_text(text.read_text().replace(old, hashlib.sha256(mesh_file.read_bytes()).hexdigest()))
-    cell = Cell(str(moved))
-    try:
-        refused = cell.run_trial("plate", "base_pin1", 0, max_attempts=1)
-    finally:
-        cell.close()
+
+    def moved(base: trimesh.Trimesh) -> None:
+        vertices = base.vertices.copy()
+        near = np.linalg.norm(vertices[:, :2] - second, axis=1) < 0.0045  # the pin and its foot's ring
+        vertices[near, :2] += 0.001 * (second - first) / np.linalg.norm(second - first)
+        base.vertices = vertices
+
+    refused = trial_on_edited_mesh(taught, tmp_path / "moved", "base", moved, "plate", "base_pin1")
     assert refused.outcome == "no_fit" and refused.end_error > 0.01  # on the pins' tops, 20 mm above its goal
 
 
