@@ -1082,7 +1082,8 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         occupant[0].id, exact_round(classify(occupied[0], hole=False), occupant[0].cylinders, axis, level,
                                     STEP_DEFLECTION))
     if section is not None:  # a tessellated round section against a section that is no round: its polygon
-        hole, section = faceted(hole, narrowest, section, hole=True), faceted(section, occupied[0], hole, hole=False)
+        hole = faceted(hole, narrowest, section, hole=True)
+        section = faceted(section, occupied[0], hole, hole=False)
     centre = frame.T @ hole.centre + axis * level
     bottom = first_hit(base.mesh, centre, -axis)
     depth = entry - (level - bottom if bottom is not None else float(around.min()))
