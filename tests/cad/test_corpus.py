@@ -107,6 +107,7 @@ UNSIMULATED: dict[str, str] = {}
     "asm4_disk_arm",
     "gridfinity_bases",
     "flynn_clutch",
+    "nop_printed_box",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -133,6 +134,12 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes", "gridfinity_bases",
+                                  pytest.param("nop_printed_box", marks=pytest.mark.xfail(
+                                      strict=True, raises=AssertionError,
+                                      reason="its rounded rects' corners are read as circular arcs that hold the "
+                                             "base's polygonal arcs and lie inside the recess's (radius 8.775 for "
+                                             "the base's 8.8, 9.029 for the recess's 9.0), so the corners leave "
+                                             "0.178 mm, not 0.2: margin 355 um, the truth's 400")),
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
                                       reason="its disk's d 21 bore is measured on its tessellation, d 20.951 (a "
@@ -170,6 +177,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "asm4_disk_arm",
     "gridfinity_bases",
     "flynn_clutch",
+    "nop_printed_box",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it.
@@ -281,6 +289,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                                   "depth (the bin bases, 4.75 mm)")),
     pytest.param("flynn_clutch", marks=_xfail(INSERTED + " onto a pin and no thicker than the cell's hull margin "
                                               "twice (the plates, 1.2 mm: no convex piece of theirs at the bore)")),
+    pytest.param("nop_printed_box", marks=_xfail(INSERTED + " into a hole and shorter than the gripper's grasp "
+                                                 "depth (the base, a 2 mm plate)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
