@@ -95,6 +95,16 @@ def wrist_yaw(frame: HoleFrame | None, part_kind: str, hole_kind: str, yaw: floa
     return min(turns, key=lambda turn: turn_between(DOWN, frame.pose_to_cell(np.zeros(3), tool_quat(turn))[1]))
 
 
+def part_width(geometry: CellGeometry, spec: PartSpec) -> float:
+    """[m] how wide a part of ``geometry`` is across its axis at most: its mesh's largest
+    extent across it where it has one (a ring's outside, where its section is its bore's),
+    else its section's largest side."""
+    if spec.mesh is None:
+        return max(spec.sides)
+    (x0, y0, _), (x1, y1, _) = trimesh.load(geometry.folder / spec.mesh.file, force="mesh").bounds
+    return float(max(x1 - x0, y1 - y0))
+
+
 @dataclass(frozen=True)
 class FrankaOptions:
     """The Franka cell's settings (``--backend-option KEY=VALUE``, docs/franka.md):
@@ -276,14 +286,9 @@ class FrankaCell:
         return spec.length - spec.held_depth(self.geometry.gripper)
 
     def width(self, spec: PartSpec) -> float:
-        """[m] how wide the part is between the fingers at most: across its axis, its
-        mesh's largest extent where it has one (a ring's outside, where its section is its
-        bore's), else its section's largest side."""
-        if spec.mesh is None:
-            return max(spec.sides)
+        """[m] how wide the part is between the fingers at most (:func:`part_width`)."""
         if spec.shape not in self._widths:
-            (x0, y0, _), (x1, y1, _) = trimesh.load(self.geometry.folder / spec.mesh.file, force="mesh").bounds
-            self._widths[spec.shape] = float(max(x1 - x0, y1 - y0))
+            self._widths[spec.shape] = part_width(self.geometry, spec)
         return self._widths[spec.shape]
 
     def release(self) -> None:

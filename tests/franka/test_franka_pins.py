@@ -1,5 +1,5 @@
 """A ring onto a pin along a horizontal axis on the Franka backend against franky-sim:
-``tests/franka/data/pins`` (a ring d 24 mm, 20 mm long, its bore d 10.8 mm; pins d 10 mm
+``tests/franka/data/pins`` (a ring d 32 mm, 20 mm long, its bore d 10.8 mm; pins d 10 mm
 along -y and +x and one d 11 mm along -y, standing out of a block whose pins the MuJoCo
 scene builds in each pin's frame), the skill taught in the PyBullet cell. The ring stops at
 the free end of the pin too wide for its bore, eq. (6) on the force along the pin's axis,
