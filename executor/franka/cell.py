@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import trimesh
 
 from executor import ExecutorError
 from executor.assembly.step import SIDEWAYS_OUT
@@ -94,6 +95,16 @@ def wrist_yaw(frame: HoleFrame | None, part_kind: str, hole_kind: str, yaw: floa
     return min(turns, key=lambda turn: turn_between(DOWN, frame.pose_to_cell(np.zeros(3), tool_quat(turn))[1]))
 
 
+def part_width(geometry: CellGeometry, spec: PartSpec) -> float:
+    """[m] how wide a part of ``geometry`` is across its axis at most: its mesh's largest
+    extent across it where it has one (a ring's outside, where its section is its bore's),
+    else its section's largest side."""
+    if spec.mesh is None:
+        return max(spec.sides)
+    (x0, y0, _), (x1, y1, _) = trimesh.load(geometry.folder / spec.mesh.file, force="mesh").bounds
+    return float(max(x1 - x0, y1 - y0))
+
+
 @dataclass(frozen=True)
 class FrankaOptions:
     """The Franka cell's settings (``--backend-option KEY=VALUE``, docs/franka.md):
@@ -141,6 +152,7 @@ class FrankaCell:
         self.motion: Motion[FrankyController] = Motion(self.controller)
         self.ilc = Ilc(description.ilc, description.gains, description.admittance)
         self._skills: dict[str, Skill] = {}
+        self._widths: dict[str, float] = {}
         self.held: str | None = None
         self.quat = DOWN
         """The tool's orientation (xyzw, base frame) the moves last commanded."""
@@ -248,9 +260,9 @@ class FrankaCell:
         part; the tool tip becomes the part's tip. ExecutorError when the hand holds nothing."""
         spec = self.geometry.parts[part]
         self.arm.set_tcp(0.0)
-        width = max(spec.sides)
+        width = self.width(spec)
         self._open(width + OPEN_MARGIN)
-        grip = self.to_base(np.array([*spec.start, spec.length - self.geometry.gripper.grasp_depth]))
+        grip = self.to_base(np.array([*spec.start, self.lever(spec)]))
         self.carry_to(grip + np.array([0.0, 0.0, 0.05]))
         self.move_to(grip)
         self.settle()
@@ -269,8 +281,15 @@ class FrankaCell:
         self.arm.set_tcp(self.lever(spec))
 
     def lever(self, spec: PartSpec) -> float:
-        """[m] from the grip point to the part's tip."""
-        return spec.length - self.geometry.gripper.grasp_depth
+        """[m] from the grip point to the part's tip (a part with a bore is held at most
+        half its length deep: :meth:`executor.world.geometry.PartSpec.held_depth`)."""
+        return spec.length - spec.held_depth(self.geometry.gripper)
+
+    def width(self, spec: PartSpec) -> float:
+        """[m] how wide the part is between the fingers at most (:func:`part_width`)."""
+        if spec.shape not in self._widths:
+            self._widths[spec.shape] = part_width(self.geometry, spec)
+        return self._widths[spec.shape]
 
     def release(self) -> None:
         """Open the hand where it is and go back along the tool's axis by :data:`RETREAT`
@@ -278,7 +297,7 @@ class FrankaCell:
         if self.held is None:
             return
         spec = self.geometry.parts[self.held]
-        self._open(max(spec.sides) + OPEN_MARGIN)
+        self._open(self.width(spec) + OPEN_MARGIN)
         self.held = None
         self.arm.set_tcp(0.0)
         self.move_to(self.arm.read().tip_pos - quat_to_matrix(self.quat)[:, 2] * RETREAT)

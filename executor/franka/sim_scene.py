@@ -14,8 +14,9 @@ What is built, in MuJoCo's world frame (= the arm's base frame, :data:`PRODUCT_I
   hole's boss is cut into convex pieces that do not overlap
   (:func:`executor.world.outlines.boss_solids`), exact to its outline and chamfer;
 - a base given as its own mesh (a concave mesh has no convex-hull form): only its holes
-  entered sideways, each its boss turned into the hole's frame (:func:`sideways_boss`):
-  the rest of the mesh is not there to collide with;
+  and round pins along a horizontal axis, each hole's boss turned into the hole's frame
+  (:func:`sideways_boss`), each pin with the tile its parts rest against
+  (:func:`sideways_pin`): the rest of the mesh is not there to collide with;
 - each peg (``[part_shapes.*]``) as a free body at its tray start, upright on the floor:
   a cylinder or box of its mass, or with a ``mesh`` its convex pieces (the ``convex``
   file as made at import, not eroded: MuJoCo adds no margin) with the mesh's inertia.
@@ -23,8 +24,8 @@ What is built, in MuJoCo's world frame (= the arm's base frame, :data:`PRODUCT_I
 Part-plate friction is the PyBullet cell's teaching friction (MuJoCo takes the larger of
 two geoms' coefficients, so the pegs and the plate both carry it; the fingers keep
 MuJoCo's 1.0 and grip with that). Not built: covers, heads, parts placed by hand, the pins
-and holes entered down of a base given as its own mesh; each is refused or left out as
-stated in :func:`add_product`.
+and holes entered down and the pins not round of a base given as its own mesh; each is
+refused or left out as stated in :func:`add_product`.
 """
 
 from __future__ import annotations
@@ -194,22 +195,50 @@ def sideways_boss(hole: HoleSpec, plate: Plate) -> list[np.ndarray]:
     return [frame.points_to_cell(piece) for piece in boss_pieces(down, plate, down.bottom_z)]
 
 
+def sideways_pin(hole: HoleSpec, plate: Plate) -> list[np.ndarray]:
+    """A pin standing out along a horizontal axis as convex solids, vertices (n, 3) [m],
+    product frame: in the pin's frame (:attr:`executor.world.geometry.HoleSpec.frame`, z
+    out along the pin from its foot), the pin a prism of the plate's ``polygon_sides``
+    whose corners lie on its radius (never wider than its size), from its foot (``depth``
+    below its free end) to its free end, that end chamfered at 45° by the plate's
+    ``chamfer``; and its foot, where a part going onto it rests: the square tile of the
+    pin's boss (:func:`executor.world.geometry.tile_of`) the plate's ``tile_thickness``
+    deep behind it, turned into the cell frame."""
+    frame = hole.frame
+    assert frame is not None and hole.pin and hole.kind == "round"  # a round pin along a horizontal axis
+    centre, top = np.array([*hole.position, hole.top_z]), hole.top_z
+    foot = top - hole.depth
+    radius, chamfer = hole.size / 2, plate.chamfer
+    angles = 2 * math.pi * np.arange(plate.polygon_sides) / plate.polygon_sides
+    ring = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    pin = [np.array([*(centre[:2] + r * point), z]) for point in ring
+           for r, z in ((radius - chamfer, top), (radius, top - chamfer), (radius, foot))]
+    half = tile_of(plate, hole) / 2
+    tile = [np.array([centre[0] + a * half, centre[1] + b * half, z])
+            for a in (-1, 1) for b in (-1, 1) for z in (foot, foot - plate.tile_thickness)]
+    return [frame.points_to_cell(np.array(pin)), frame.points_to_cell(np.array(tile))]
+
+
 def plate_solids(geometry: CellGeometry) -> tuple[list[StaticBox], list[ConvexPiece]]:
     """The plate as MuJoCo builds it: the box under the bosses and every boss's convex
     pieces (:func:`boss_pieces`), in the product frame. A base given as its own mesh is
-    built as its holes entered sideways only (:func:`sideways_boss`, no box: MuJoCo
-    collides a mesh as its convex hull, which would close its holes); ExecutorError naming
-    ``geometry.toml`` for such a base with a pin or a hole entered down."""
+    built as its holes and round pins along a horizontal axis only (:func:`sideways_boss`,
+    :func:`sideways_pin`; no box: MuJoCo collides a mesh as its convex hull, which would
+    close its holes); ExecutorError naming ``geometry.toml`` for such a base with a hole or
+    pin entered down or a pin that is not round."""
     path = geometry.folder / "geometry.toml"
     plate = geometry.plate
     if geometry.base_mesh is not None:
-        others = sorted(hid for hid, hole in geometry.holes.items() if hole.pin or not hole.sideways)
+        others = sorted(hid for hid, hole in geometry.holes.items()
+                        if not hole.sideways or (hole.pin and hole.kind != "round"))
         if others:
-            raise ExecutorError(f"{path}: [base] mesh with pins or holes entered down ({', '.join(others)}): the "
-                                "MuJoCo scene builds a base mesh's holes entered sideways only; expected a plate of "
-                                "[plate] and [hole_shapes.*], or a base whose holes are all entered sideways")
-        return [], [ConvexPiece(f"boss_{hid}_{k}", vertices) for hid, hole in sorted(geometry.holes.items())
-                    for k, vertices in enumerate(sideways_boss(hole, plate))]
+            raise ExecutorError(f"{path}: [base] mesh with holes or pins entered down or pins that are not round "
+                                f"({', '.join(others)}): the MuJoCo scene builds a base mesh's holes and round pins "
+                                "along a horizontal axis only; expected a plate of [plate] and [hole_shapes.*], or a "
+                                "base whose holes and pins are all along a horizontal axis")
+        return [], [ConvexPiece(f"{'pin' if hole.pin else 'boss'}_{hid}_{k}", vertices)
+                    for hid, hole in sorted(geometry.holes.items())
+                    for k, vertices in enumerate((sideways_pin if hole.pin else sideways_boss)(hole, plate))]
     (sx, sy), (cx, cy) = plate.base_size, plate.base_center
     top = geometry.base_top
     boxes = [StaticBox("plate_base", (cx, cy, top / 2), (sx / 2, sy / 2, top / 2))]

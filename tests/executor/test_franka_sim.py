@@ -82,6 +82,25 @@ def test_holes_entered_sideways_are_open_along_their_axis_and_the_boss_stands_ar
             assert face == pytest.approx(0.1, abs=2e-6), (hid, side, face)
 
 
+def test_pins_along_a_horizontal_axis_stand_to_their_size_from_their_foot() -> None:
+    """A base mesh's pins along a horizontal axis (the MuJoCo scene builds each pin and the
+    tile at its foot in the pin's frame): a ray along the axis from 10 cm out meets the
+    pin's free end on its axis and, 0.1 mm beyond its radius on either side, passes the
+    pin to meet the tile at its foot."""
+    geometry = load_geometry(str(ROOT / "tests" / "franka" / "data" / "pins"))
+    model, data, _bodies = product_model(geometry)
+    geom = np.zeros(1, dtype=np.int32)
+    for hid, pin in geometry.holes.items():
+        frame = pin.frame
+        assert frame is not None and pin.pin
+        into, across = -frame.rotation[:, 2], frame.rotation[:, :2].T
+        start = to_base(np.array([*pin.position, pin.top_z])) - 0.1 * into
+        assert mujoco.mj_ray(model, data, start, into, None, 1, -1, geom) == pytest.approx(0.1, abs=2e-6), hid
+        for side in (*across, *-across):
+            foot = mujoco.mj_ray(model, data, start + side * (pin.size / 2 + 1e-4), into, None, 1, -1, geom)
+            assert foot == pytest.approx(0.1 + pin.depth, abs=2e-6), (hid, side, foot)
+
+
 def test_polygon_holes_are_open_to_their_outline_and_the_boss_stands_around_them(tmp_path: Path) -> None:
     """The hexagon holes of tests/executor/test_polygon_cell.py (one turned 30° in its
     outline) in the MuJoCo plate: at the middle of every edge of each outline, 0.1 mm

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
 import re
 import shutil
 from pathlib import Path
+
+from executor.control.gains import ImpedanceGains
 
 SIM_DYNAMICS = "1.0"
 """franky's relative dynamics factor of the tests' carrying moves against franky-sim (the
@@ -18,14 +21,21 @@ GRASP_DEPTH = 0.012
 12 mm they clear the plate."""
 
 
-def franka_cell_description(folder: Path, search_radius: float | None = None) -> Path:
+def franka_cell_description(folder: Path, search_radius: float | None = None, stiffness: float | None = None) -> Path:
     """A cell description of the Franka Hand on the flange (its mass [kg], inertia [kg m²],
-    length [m]) and :data:`GRASP_DEPTH`, with the hole search's ``search_radius`` [m] if
-    given (the default's otherwise), written in ``folder``."""
+    length [m]) and :data:`GRASP_DEPTH`, with the hole search's ``search_radius`` [m] and
+    the impedance's translational ``stiffness`` [N/m] if given (the defaults otherwise;
+    the damping then scaled with its square root: the same damping ratio), written in
+    ``folder``."""
     path = folder / "franka-cell.toml"
     search = "" if search_radius is None else f"[search]\nmax_radius = {search_radius}\n"
+    gains = ""
+    if stiffness is not None:
+        default = ImpedanceGains()
+        damping = default.d_trans * math.sqrt(stiffness / default.k_trans)
+        gains = f"[gains]\nk_trans = {stiffness}\nd_trans = {damping:.1f}\n"
     path.write_text("[gripper]\nflange_mass = 1.0\nflange_inertia = 0.004\nflange_length = 0.06\n"
-                    f"grasp_depth = {GRASP_DEPTH}\n{search}")
+                    f"grasp_depth = {GRASP_DEPTH}\n{search}{gains}")
     return path
 
 

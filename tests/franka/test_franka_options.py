@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.franka.backend import by_hand_reason, franka_options
+from executor.franka.cell import part_width
 from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS, SafetyStop, Workspace, capped
+from executor.world.geometry import load_geometry
 
 
 def test_options_parse_into_the_cell_settings() -> None:
@@ -54,3 +58,12 @@ def test_the_arm_places_the_pegs_and_leaves_covers_and_heads_to_an_operator() ->
         "bp", "p1", "p2", "p3", "p4", "sh"]
     assert by_hand_reason(product, "sp") == "'sp' is a cover (it goes over the pegs standing in s1, s2)"
     assert by_hand_reason(product, "ph") == "'ph' is a head (it goes into the socket of pd)"
+
+
+def test_the_hand_opens_to_a_ring_s_outside_not_its_bore() -> None:
+    # tests/franka/data/pins: the ring's section is its bore's (d 10.8 mm), its mesh 32 mm across
+    geometry = load_geometry(str(Path(__file__).parent / "data" / "pins"))
+    ring, peg = geometry.parts["r1"], load_geometry(str(Path(__file__).parent / "data" / "side")).parts["p1"]
+    assert max(ring.sides) == pytest.approx(0.0108, abs=1e-4)
+    assert part_width(geometry, ring) == pytest.approx(0.032, abs=1e-4)
+    assert part_width(geometry, peg) == pytest.approx(0.010)
