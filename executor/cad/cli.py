@@ -118,20 +118,27 @@ def drawn_up(derived: Derived) -> str | None:
     """Why the product looks drawn with another axis than z up, None when it does not: its
     base stands on its edge (:data:`STANDING` times as tall as it is thick along a
     horizontal axis, thinnest along it) and more than half of its holes and pins open
-    along that axis, one way (the direction their parts leave along)."""
+    along that axis (either way: a through hole's parts leave both ways). The way up it
+    suggests is the one the other parts stand out of the base's box farther along (both
+    where they stand out alike)."""
     base = derived.parts[derived.base].mesh
-    extents = np.ptp(base.bounds, axis=0)
-    openings = [fit.axis for fit in derived.holes.values()]
-    openings += [pin.axis for pin in derived.pins.values() if pin.owner == derived.base]
+    low, high = base.bounds
+    extents = high - low
+    openings = [fit.axis[1] for fit in derived.holes.values()]
+    openings += [pin.axis[1] for pin in derived.pins.values() if pin.owner == derived.base]
+    corners = np.vstack([part.mesh.bounds for part in derived.parts.values()])
     for k, name in enumerate("xy"):
-        if extents[k] > min(extents) or extents[2] < STANDING * extents[k]:
+        along = openings.count(name)
+        if extents[k] > min(extents) or extents[2] < STANDING * extents[k] or 2 * along <= len(openings):
             continue
-        way = max(f"+{name}", f"-{name}", key=openings.count)
-        if 2 * openings.count(way) > len(openings):
-            return (f"the base {derived.base} is thinnest along {name} ({_mm(float(extents[k]))} mm, "
-                    f"{_mm(float(extents[2]))} mm tall) and {openings.count(way)} of its {len(openings)} holes and "
-                    f"pins open along {way}: the CAD may be drawn {name} up; set up = \"{way}\" or "
-                    f"{'--up ' if way[0] == '+' else '--up='}{way} (up = \"+z\" or --up +z if z is up)")
+        above, below = corners[:, k].max() - high[k], low[k] - corners[:, k].min()
+        ways = ["+"] if above > below else ["-"] if below > above else ["+", "-"]
+        out = f", the other parts standing out of it along {ways[0]}{name}" if len(ways) == 1 else ""
+        flags = " or ".join(f"--up +{name}" if way == "+" else f"--up=-{name}" for way in ways)
+        return (f"the base {derived.base} is thinnest along {name} ({_mm(float(extents[k]))} mm, "
+                f"{_mm(float(extents[2]))} mm tall) and {along} of its {len(openings)} holes and pins open along "
+                f"{name}{out}: the CAD may be drawn {name} up; set up = "
+                + " or ".join(f'"{way}{name}"' for way in ways) + f" or {flags} (up = \"+z\" or --up +z if z is up)")
     return None
 
 
