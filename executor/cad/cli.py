@@ -134,11 +134,13 @@ def drawn_up(derived: Derived) -> str | None:
         above, below = corners[:, k].max() - high[k], low[k] - corners[:, k].min()
         ways = ["+"] if above > below else ["-"] if below > above else ["+", "-"]
         out = f", the other parts standing out of it along {ways[0]}{name}" if len(ways) == 1 else ""
+        settings = " or ".join(f'"{way}{name}"' for way in ways)
         flags = " or ".join(f"--up +{name}" if way == "+" else f"--up=-{name}" for way in ways)
         return (f"the base {derived.base} is thinnest along {name} ({_mm(float(extents[k]))} mm, "
                 f"{_mm(float(extents[2]))} mm tall) and {along} of its {len(openings)} holes and pins open along "
                 f"{name}{out}: the CAD may be drawn {name} up; set up = "
-                + " or ".join(f'"{way}{name}"' for way in ways) + f" or {flags} (up = \"+z\" or --up +z if z is up)")
+                + (f"{settings} or {flags}" if len(ways) == 1 else f"{settings} ({flags})")
+                + ' (up = "+z" or --up +z if z is up)')
     return None
 
 
