@@ -12,13 +12,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import clingo
 import numpy as np
 import pytest
 import trimesh
 
 from executor import ExecutorError
 from executor.cad.cli import Imported, ImportOptions, run_import
+from tests.cad.test_corpus import _atoms
 from tests.conftest import Runner, error_lines
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -39,13 +39,6 @@ def _drawn(product: str, up: str, folder: Path) -> Path:
         mesh.vertices = DRAWN[up](np.asarray(mesh.vertices))
         mesh.export(meshes / path.name)
     return meshes
-
-
-def _atoms(path: Path) -> set[str]:
-    control = clingo.Control(["--warn=none"])
-    control.load(str(path))
-    control.ground([("base", [])])
-    return {str(s.symbol) for s in control.symbolic_atoms}
 
 
 def _same(a: Any, b: Any, where: str = "") -> None:
