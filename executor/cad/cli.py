@@ -4,13 +4,17 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 (``--units``). ``--config FILE`` is an optional TOML file::
 
     base = "plate"            # the fixture part (default: the part of largest volume)
+    up = "+y"                 # the CAD's axis pointing up (default +z): +x, -x, +y, -y, +z or -z
     [parts.peg1]
     tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: laid out by footprints)
     name = "round peg"
     fixed_to = "lever"        # moves with that part (screwed, glued): neither blocks the other
     place = [0.56, 0.0]       # where the base's centre stands on the cell's table [m]
 
-``--place X,Y`` overrides ``place``. Without either, a product whose base's centre lies
+``--up AXIS`` overrides ``up``: every part is turned right after reading by the rotation
+taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product whose
+base looks drawn with another axis up is refused (:func:`drawn_up`). ``--place X,Y``
+overrides ``place``. Without either, a product whose base's centre lies
 outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
 says so; every part is moved right after reading, so every file written is in the cell frame.
 
@@ -34,6 +38,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
@@ -46,11 +52,14 @@ from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
     UNITS,
+    UP_AXES,
     CadPart,
     check_solids,
     load_meshes,
     overlaps_checked,
     translated,
+    turn_text,
+    turned,
 )
 from executor.cad.sections import Shape2D, slices_kept, zero_clearance
 from executor.cad.step import load_step
@@ -76,6 +85,63 @@ WORK_POSITION = (0.56, 0.0)
 cell (the arm's base at the origin); the tests' products stand at x = 0.55 to 0.63 m."""
 PLACE_BOUND = 1.0
 """``place`` coordinates lie in [-PLACE_BOUND, PLACE_BOUND] [m] (the cell's table)."""
+STANDING = 3.0
+"""A base at least this many times as tall (along z) as it is thick along a horizontal
+axis stands on its edge (:func:`drawn_up`)."""
+_UP_EXPECTED = f"one of {', '.join(UP_AXES)} (the CAD's axis pointing up)"
+
+
+def up_axis(text: str) -> str:
+    """An argparse type: one of :data:`executor.cad.parts.UP_AXES`."""
+    if text not in UP_AXES:
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected {_UP_EXPECTED}")
+    return text
+
+
+def _up_setting(path: Path | None, value: object) -> str | None:
+    """``up`` of ``--config`` (None: not set); ExecutorError naming the file otherwise."""
+    if value is None:
+        return None
+    if value not in UP_AXES:
+        raise ExecutorError(f"{path}: up: expected {_UP_EXPECTED}, got {shorten(repr(value))}")
+    return str(value)
+
+
+def _up_assumption(up: str | None) -> str:
+    """What ``import`` prints about the up axis: the turn of the ``up`` set, or the default."""
+    if up is None:
+        return "the CAD's +z is up (set up = \"+y\" or --up +y for a CAD drawn y up)"
+    return f"the CAD's {up} is up (up): every part turned {turn_text(up)}, before it is placed"
+
+
+def drawn_up(derived: Derived) -> str | None:
+    """Why the product looks drawn with another axis than z up, None when it does not: its
+    base stands on its edge (:data:`STANDING` times as tall as it is thick along a
+    horizontal axis, thinnest along it) and more than half of its holes and pins open
+    along that axis (either way: a through hole's parts leave both ways). The way up it
+    suggests is the one the other parts stand out of the base's box farther along (both
+    where they stand out alike)."""
+    base = derived.parts[derived.base].mesh
+    low, high = base.bounds
+    extents = high - low
+    openings = [fit.axis[1] for fit in derived.holes.values()]
+    openings += [pin.axis[1] for pin in derived.pins.values() if pin.owner == derived.base]
+    corners = np.vstack([part.mesh.bounds for part in derived.parts.values()])
+    for k, name in enumerate("xy"):
+        along = openings.count(name)
+        if extents[k] > min(extents) or extents[2] < STANDING * extents[k] or 2 * along <= len(openings):
+            continue
+        above, below = corners[:, k].max() - high[k], low[k] - corners[:, k].min()
+        ways = ["+"] if above > below else ["-"] if below > above else ["+", "-"]
+        out = f", the other parts standing out of it along {ways[0]}{name}" if len(ways) == 1 else ""
+        settings = " or ".join(f'"{way}{name}"' for way in ways)
+        flags = " or ".join(f"--up +{name}" if way == "+" else f"--up=-{name}" for way in ways)
+        return (f"the base {derived.base} is thinnest along {name} ({_mm(float(extents[k]))} mm, "
+                f"{_mm(float(extents[2]))} mm tall) and {along} of its {len(openings)} holes and pins open along "
+                f"{name}{out}: the CAD may be drawn {name} up; set up = "
+                + (f"{settings} or {flags}" if len(ways) == 1 else f"{settings} ({flags})")
+                + ' (up = "+z" or --up +z if z is up)')
+    return None
 
 
 def place_pair(text: str) -> tuple[float, float]:
@@ -121,18 +187,22 @@ def placement(parts: list[CadPart], base: str, place: tuple[float, float] | None
                     f"part moved by ({_mm(offset[0])}, {_mm(offset[1])}) mm from the CAD frame")
 
 
-def _config(path: Path | None, parts: list[CadPart]
+def _settings_file(path: Path | None) -> dict:
+    """The TOML of ``--config`` ({} without one); ExecutorError naming the file when it is not TOML."""
+    if path is None:
+        return {}
+    try:
+        return tomllib.loads(read_text(path, "import settings (TOML)", error=ExecutorError))
+    except tomllib.TOMLDecodeError as exc:
+        raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
+
+
+def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
             ) -> tuple[Settings, dict[str, str], list[str], tuple[float, float] | None]:
-    """The settings of ``--config`` (checked: one line naming the file and key; the trays
-    it sets only), the fixed-to map, what was assumed for lack of them, and ``place``
-    (None: not set)."""
+    """The settings of ``--config`` (``data``, read from ``path``; checked: one line
+    naming the file and key; the trays it sets only), with the ``up`` in force, the
+    fixed-to map, what was assumed for lack of them, and ``place`` (None: not set)."""
     ids = {p.id for p in parts}
-    data: dict = {}
-    if path is not None:
-        try:
-            data = tomllib.loads(read_text(path, "import settings (TOML)", error=ExecutorError))
-        except tomllib.TOMLDecodeError as exc:
-            raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
     assumed: list[str] = []
     base = data.get("base")
     if base is None:
@@ -164,7 +234,7 @@ def _config(path: Path | None, parts: list[CadPart]
                 raise ExecutorError(f"{path}: [parts.{pid}] fixed_to: expected another part than it and the base, "
                                     f"got {shorten(repr(host))}")
             fixed[pid] = host
-    return Settings(base, trays, names), fixed, assumed, _place_setting(path, data.get("place"))
+    return Settings(base, trays, names, up), fixed, assumed, _place_setting(path, data.get("place"))
 
 
 def _mm(value: float) -> str:
@@ -312,44 +382,55 @@ class ImportOptions:
     off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
     over a product another import or a person wrote (:func:`executor.cad.write.claim_folder`);
     ``place`` [m]: where the base's centre goes in the cell, over the config's
-    (:func:`placement`)."""
+    (:func:`placement`); ``up``: the CAD's axis pointing up, over the config's
+    (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""
 
     reach: float = LOCATING_REACH
     max_triangles: int = MAX_TRIANGLES
     replace: bool = False
     place: tuple[float, float] | None = None
+    up: str | None = None
 
 
 def run_import(source: Path, out: Path, units: str, config: Path | None,
                options: ImportOptions = ImportOptions()) -> Imported:
-    """Read, check, claim ``out``, move the parts into the cell, derive, map the covers and
-    heads, and write, as ``options`` say (:class:`ImportOptions`)."""
+    """Read, turn the CAD's up to +z, check, claim ``out``, move the parts into the cell,
+    derive, map the covers and heads, and write, as ``options`` say (:class:`ImportOptions`);
+    ExecutorError naming ``source`` when no up is set and the product looks drawn with
+    another (:func:`drawn_up`), before anything is written."""
     started = time.perf_counter()
-    parts = load_source(source, units, options.max_triangles)
+    data = _settings_file(config)
+    up = options.up or _up_setting(config, data.get("up"))
+    parts = turned(load_source(source, units, options.max_triangles), up or "+z")
     check_solids(parts, units)
     # the overlap check runs beside the derivation where the sweeps would take two cores
     with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
-        found = _derived(parts, out, config, options, start)
+        found = _derived(parts, out, (config, data, up), options, start)
     removable, settings, derived, cell, assumed, offset, mapped, near = found
+    doubt = None if up is not None else drawn_up(derived)
+    if doubt is not None:
+        raise ExecutorError(f"{source}: {doubt}")
     written, why = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
     assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
 
 
-def _derived(parts: list[CadPart], out: Path, config: Path | None, options: ImportOptions,
+def _derived(parts: list[CadPart], out: Path, config: tuple[Path | None, dict, str | None], options: ImportOptions,
              beside: Callable[[], None]) -> tuple[set[str], Settings, Derived, Derived, list[str], tuple[float, float],
                                                   Mapped, int]:
-    """What :func:`run_import` finds before it writes: the files of ``out`` it may remove,
+    """What :func:`run_import` finds before it writes (``config``: the settings file, its
+    TOML and the up set, None: none): the files of ``out`` it may remove,
     the settings with every tray, the derived product and the product as the cell inserts
     it (:func:`executor.cad.operations.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
     known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
     reach, replace, place = options.reach, options.replace, options.place
     removable = claim_folder(out, [p.id for p in parts], replace)
-    settings, fixed, assumed, placed = _config(config, parts)
+    path, data, up = config
+    settings, fixed, assumed, placed = _config(path, data, parts, up or "+z")
     offset, where = placement(parts, settings.base, place or placed)
     parts = translated(parts, offset)
-    assumed.insert(0, where)
+    assumed[:0] = [_up_assumption(up), where]
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
     with slices_kept():  # the parts' meshes stay as they are until written
@@ -376,7 +457,12 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--out", type=nonempty_path, required=True, metavar="DIR", help="the assembly folder to write")
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
-    parser.add_argument("--config", type=Path, metavar="FILE", help="TOML: base part, trays, names, fixed_to, place")
+    parser.add_argument("--config", type=Path, metavar="FILE",
+                        help="TOML: base part, up, trays, names, fixed_to, place")
+    parser.add_argument("--up", type=up_axis, metavar="AXIS",
+                        help=f"the CAD's axis pointing up, {', '.join(UP_AXES)} (over the config's up; default +z, "
+                             "and a product whose base looks drawn with another axis up is refused); a negative "
+                             "one as --up=-y")
     parser.add_argument("--place", type=place_pair, metavar="X,Y",
                         help="where the base's centre stands in the cell [m] (over the config's place; default: "
                              f"where the CAD has it, or ({WORK_POSITION[0]:g}, {WORK_POSITION[1]:g}) when that is "
@@ -394,7 +480,7 @@ def main(argv: list[str]) -> int:
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
     done = run_import(args.source, args.out, args.units, args.config,
-                      ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place))
+                      ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place, args.up))
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; " + "; ".join(done.assumed))

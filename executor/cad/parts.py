@@ -4,7 +4,8 @@ A source is a folder of ``*.stl``/``*.obj`` meshes (one part per file, the id is
 name's stem, units given by the caller) or a STEP assembly (one part per leaf of its
 assembly tree, the id from its name, the placement of the tree applied, units as the file
 states them: the reader converts to mm). Every part becomes a :class:`trimesh.Trimesh` in
-metres in the CAD frame; :func:`translated` moves them into the cell (``import --place``).
+metres in the CAD frame; :func:`turned` turns them so that the CAD's up is the cell's +z
+(``import --up``) and :func:`translated` moves them into the cell (``import --place``).
 
 A mesh file is read within a size bound (:data:`MAX_TRIANGLES` for the product, its
 triangles counted before the mesh is built), its coordinates must be finite (the line or
@@ -83,7 +84,7 @@ class Cylinder:
 @dataclass(frozen=True)
 class CadPart:
     """One part in the assembled pose: ``id`` (an ASP constant), the ``name`` the source
-    gives, its closed ``mesh`` [m] in the CAD frame (the cell frame once :func:`translated`),
+    gives, its closed ``mesh`` [m] in the CAD frame (the cell frame once :func:`turned` and :func:`translated`),
     ``source`` (file, or file#name), the ``cylinders`` of its B-rep and ``remesh``, its
     B-rep tessellated again to a given linear deflection [m] (a STEP part's; none for a mesh)."""
 
@@ -113,6 +114,56 @@ def translated(parts: list[CadPart], offset: tuple[float, float]) -> list[CadPar
     return [replace(part, mesh=moved_mesh(part.mesh),
                     cylinders=tuple(replace(c, point=c.point + shift) for c in part.cylinders),
                     remesh=None if part.remesh is None else moved_remesh(part.remesh)) for part in parts]
+
+
+UP_AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
+"""The CAD axes that ``import --up`` may name as the one pointing up."""
+_TURNS: dict[str, tuple[tuple[int, int, int], tuple[float, float, float], str]] = {
+    "+z": ((0, 1, 2), (1.0, 1.0, 1.0), "no turn"),
+    "-z": ((0, 1, 2), (1.0, -1.0, -1.0), "about x by 180 deg"),
+    "+y": ((0, 2, 1), (1.0, -1.0, 1.0), "about x by 90 deg"),
+    "-y": ((0, 2, 1), (1.0, 1.0, -1.0), "about x by -90 deg"),
+    "+x": ((2, 1, 0), (-1.0, 1.0, 1.0), "about y by -90 deg"),
+    "-x": ((2, 1, 0), (1.0, 1.0, -1.0), "about y by 90 deg"),
+}
+"""Each ``up`` axis -> the rotation taking it to +z as a permutation with signs (the cell's
+coordinate k is ``signs[k]`` times the CAD's coordinate ``order[k]``; a proper rotation,
+determinant +1, so a mesh keeps its outward winding) and its description."""
+
+
+def turn_text(up: str) -> str:
+    """The rotation of :func:`turned` for ``up`` in words: ``about x by 90 deg, (x, y, z) -> (x, -z, y)``."""
+    order, signs, about = _TURNS[up]
+    image = ", ".join(("-" if sign < 0 else "") + "xyz"[k] for k, sign in zip(order, signs, strict=True))
+    return f"{about}, (x, y, z) -> ({image})"
+
+
+def turn_points(points: np.ndarray, up: str) -> np.ndarray:
+    """``points`` (..., 3) in the CAD frame turned so that its axis ``up`` points along +z:
+    coordinates permuted and negated, so exactly (no rounding; -0 made 0)."""
+    order, signs, _ = _TURNS[up]
+    return points[..., list(order)] * np.array(signs) + 0.0
+
+
+def turned(parts: list[CadPart], up: str) -> list[CadPart]:
+    """The parts turned so that the CAD's axis ``up`` (one of :data:`UP_AXES`) points
+    along the cell's +z (:func:`turn_points`): their meshes, their B-rep cylinders' points
+    and directions and the meshes of ``remesh`` (the parts given are not changed)."""
+    if up == "+z":
+        return parts
+
+    def turned_mesh(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+        copy = mesh.copy()
+        copy.vertices = turn_points(np.asarray(mesh.vertices), up)
+        return copy
+
+    def turned_remesh(remesh: Callable[[float], trimesh.Trimesh]) -> Callable[[float], trimesh.Trimesh]:
+        return lambda deflection: turned_mesh(remesh(deflection))
+
+    return [replace(part, mesh=turned_mesh(part.mesh),
+                    cylinders=tuple(replace(c, point=turn_points(c.point, up), direction=turn_points(c.direction, up))
+                                    for c in part.cylinders),
+                    remesh=None if part.remesh is None else turned_remesh(part.remesh)) for part in parts]
 
 
 def part_id(name: str, source: str) -> str:

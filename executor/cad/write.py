@@ -96,6 +96,7 @@ from executor.cad.operations import (
     tool_length,
     upright,
 )
+from executor.cad.parts import turn_text
 from executor.cad.sections import Shape2D, section
 from executor.cad.sections import rounded as _q
 from executor.cad.sweep import DIRECTIONS, opposite
@@ -137,11 +138,13 @@ with (its own mesh is measured at :data:`executor.cad.parts.STEP_DEFLECTION`).""
 
 @dataclass(frozen=True)
 class Settings:
-    """What the import file states: the ``base`` part, the ``trays`` [m], part ``names``."""
+    """What the import file states: the ``base`` part, the ``trays`` [m], part ``names``,
+    the CAD's axis pointing ``up`` (:func:`executor.cad.parts.turned`)."""
 
     base: str
     trays: dict[str, tuple[float, float]]
     names: dict[str, str]
+    up: str = "+z"
 
 
 def _section_lines(shape: Shape2D) -> list[str]:
@@ -166,7 +169,9 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
     ``part``) and trays, the holes (a pin several parts go onto with their number as its
     ``capacity``)."""
     pegs = derived.hole_of
-    lines = [f"# Imported from {title} by ./run.sh import: parts in the CAD frame (the cell frame) [m].",
+    frame = "the CAD frame (the cell frame)" if settings.up == "+z" else \
+        f"the cell frame, the CAD's {settings.up} turned up ({turn_text(settings.up)})"
+    lines = [f"# Imported from {title} by ./run.sh import: parts in {frame} [m].",
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):
         role = "base" if pid == derived.base else "peg" if pid in pegs else roles.get(pid, "part")

@@ -148,12 +148,13 @@ def measure(kind: str, axis: str, x: float, y: float, height: float, tmp: Path) 
     cad, config, feature = _product(tmp / "first", kind, axis, height)
     with mock.patch.object(operations, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
             mock.patch.object(operations, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
-        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0)))
+        # built z up: a block raised on its riser stands on its edge, its feature sideways (import --up)
+        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0), up="+z"))
         at = load_product_description(tmp / "first" / "out").assembly.holes[feature].position
         assert at is not None and at[0] is not None and at[1] is not None
         place = (0.56 + x / 1e3 - at[0], y / 1e3 - at[1])
         out = tmp / "out"
-        run_import(cad, out, "mm", config, ImportOptions(place=place))
+        run_import(cad, out, "mm", config, ImportOptions(place=place, up="+z"))
     geometry = load_product_description(out).geometry
     assert geometry is not None
     if (written := geometry.hole_shapes[feature].axis) != axis:

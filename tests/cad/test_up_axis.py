@@ -1,0 +1,174 @@
+"""``import``'s up axis: a product drawn with another axis than z up (``up = "+y"``,
+``--up``) is turned by an exact signed permutation right after reading, so it gives the
+same assembly facts as drawn z up; without ``up`` a product whose base stands on its
+edge with its holes opening along that axis is refused, naming the setting."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tomllib
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import trimesh
+
+from executor import ExecutorError
+from executor.cad.cli import Imported, ImportOptions, run_import
+from tests.cad.test_corpus import _atoms
+from tests.conftest import Runner, error_lines
+
+CORPUS = Path(__file__).parent / "corpus"
+DRAWN: dict[str, Callable[[np.ndarray], np.ndarray]] = {
+    "+y": lambda v: np.column_stack([v[:, 0], v[:, 2], -v[:, 1]]),  # the cell's +z is the CAD's +y
+    "-x": lambda v: np.column_stack([-v[:, 2], v[:, 1], v[:, 0]]),  # the cell's +z is the CAD's -x
+}
+"""A z-up product's coordinates (n, 3) as drawn with another axis up: exact (permuted, negated)."""
+FACTS = ("sizes.lp", "geometric_precedence.lp", "nominal_sizes.lp")
+
+
+def _drawn(product: str, up: str, folder: Path) -> Path:
+    """The corpus ``product``'s meshes written as drawn with ``up`` up, into ``folder/meshes``."""
+    meshes = folder / "meshes"
+    meshes.mkdir(parents=True)
+    for path in sorted((CORPUS / product / "meshes").iterdir()):
+        mesh = trimesh.load(path, force="mesh", process=False)
+        mesh.vertices = DRAWN[up](np.asarray(mesh.vertices))
+        mesh.export(meshes / path.name)
+    return meshes
+
+
+def _same(a: Any, b: Any, where: str = "") -> None:
+    """``a`` and ``b`` (parsed TOML) alike: the same keys and strings, numbers within 1 nm
+    (a mesh file's digest left out: the meshes are compared by :func:`_same_meshes`)."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and a.keys() == b.keys(), where
+        for key in a.keys() - {"sha256"}:
+            _same(a[key], b[key], f"{where}.{key}")
+    elif isinstance(a, list):
+        assert isinstance(b, list) and len(a) == len(b), where
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            _same(x, y, f"{where}[{k}]")
+    elif isinstance(a, float):
+        assert b == pytest.approx(a, abs=1e-9), where
+    else:
+        assert a == b, where
+
+
+def _same_meshes(one: Path, other: Path) -> None:
+    """The meshes two imports wrote for the cell (``meshes/``) alike: the same files, their
+    vertices within 1 nm and the same triangles."""
+    names = sorted(path.name for path in (one / "meshes").glob("*.obj")) if (one / "meshes").is_dir() else []
+    assert names == (sorted(path.name for path in (other / "meshes").glob("*.obj"))
+                     if (other / "meshes").is_dir() else [])
+    for name in names:
+        a = trimesh.load(one / "meshes" / name, force="mesh", process=False)
+        b = trimesh.load(other / "meshes" / name, force="mesh", process=False)
+        assert np.array_equal(a.faces, b.faces), name
+        assert np.allclose(a.vertices, b.vertices, rtol=0.0, atol=1e-9), name
+
+
+def _same_import(first: Imported, second: Imported, one: Path, other: Path) -> None:
+    """Two imports wrote the same assembly facts: parts, holes and trays, the fits, the
+    precedence and the nominal rooms, each part's axis, the cell's geometry and meshes."""
+    _same_meshes(one, other)
+    for name in ("assembly.toml", "geometry.toml"):
+        assert (one / name).is_file() == (other / name).is_file(), name
+        if (one / name).is_file():
+            _same(tomllib.loads((one / name).read_text()), tomllib.loads((other / name).read_text()), name)
+    for name in FACTS:
+        assert _atoms(one / name) == _atoms(other / name), name
+    assert first.derived.axis == second.derived.axis
+    assert {h: (f.axis, f.part) for h, f in first.derived.holes.items()} == \
+        {h: (f.axis, f.part) for h, f in second.derived.holes.items()}
+
+
+@pytest.mark.slow  # three imports of a five-part product
+@pytest.mark.parametrize(("product", "up", "words"), [
+    ("agh_prism_array", "+y", ["the base box is thinnest along y", "4 of its 4 holes and pins open along y, the "
+                               'other parts standing out of it along +y: the CAD may be drawn y up; set up = "+y" '
+                               "or --up +y"]),
+    ("factory_rect_pegs", "-x", ["the base hole_block is thinnest along x", "4 of its 4 holes and pins open along x",
+                                 'along -x: the CAD may be drawn x up; set up = "-x" or --up=-x']),
+])
+def test_a_product_drawn_with_another_axis_up_gives_the_same_facts(tmp_path: Path, product: str, up: str,
+                                                                   words: list[str]) -> None:
+    config = CORPUS / product / "import.toml"
+    first = run_import(CORPUS / product / "meshes", tmp_path / "z_up", "mm", config)
+    meshes = _drawn(product, up, tmp_path / "drawn")
+    turned = run_import(meshes, tmp_path / "turned", "mm", config, ImportOptions(up=up))
+    _same_import(first, turned, tmp_path / "z_up", tmp_path / "turned")
+    assert f"the CAD's {up} is up (up): every part turned about" in turned.assumed[0]
+    assert f"the CAD's {up} turned up" in (tmp_path / "turned" / "assembly.toml").read_text().splitlines()[0]
+    # without up, the base stands on its edge with its holes opening sideways: refused, nothing written
+    with pytest.raises(ExecutorError) as refused:
+        run_import(meshes, tmp_path / "read_z_up", "mm", config)
+    assert all(word in str(refused.value) for word in words), str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
+
+
+@pytest.mark.slow  # two imports
+def test_up_in_the_settings_and_an_explicit_z_up(tmp_path: Path) -> None:
+    meshes = _drawn("agh_prism_array", "+y", tmp_path / "drawn")
+    (tmp_path / "up.toml").write_text('base = "box"\nup = "+y"\n')
+    turned = run_import(meshes, tmp_path / "turned", "mm", tmp_path / "up.toml")
+    assert {fit.axis for fit in turned.derived.holes.values()} == {"+z"}
+    # z stated up is the user's word: the product is imported lying on its side, holes entered along -y
+    (tmp_path / "z.toml").write_text('base = "box"\nup = "+z"\n')
+    side = run_import(meshes, tmp_path / "side", "mm", tmp_path / "z.toml")
+    assert {fit.axis for fit in side.derived.holes.values()} == {"+y"}
+    assert side.assumed[0].startswith("the CAD's +z is up (up)")
+
+
+@pytest.mark.parametrize(("argv", "setting", "words"), [
+    (["--up", "y"], None, ["argument --up", "'y': expected one of +x, -x, +y, -y, +z, -z"]),
+    (["--up", "-y"], None, ["argument --up: expected one argument"]),
+    ([], 'up = "y+"\n', ["import.toml: up: expected one of +x, -x, +y, -y, +z, -z", "got 'y+'"]),
+    ([], "up = 1\n", ["import.toml: up: expected one of", "got 1"]),
+])
+def test_a_bad_up_is_one_line(tmp_path: Path, run_main: Runner, argv: list[str], setting: str | None,
+                              words: list[str]) -> None:
+    (tmp_path / "cad").mkdir()
+    trimesh.creation.box((0.05, 0.05, 0.01)).export(tmp_path / "cad" / "plate.stl")
+    config = []
+    if setting is not None:
+        (tmp_path / "import.toml").write_text(setting)
+        config = ["--config", "import.toml"]
+    done = run_main("import", "cad", "--out", "out", "--units", "m", *config, *argv, cwd=tmp_path)
+    lines = error_lines(done.stderr)
+    assert done.returncode == 2 and len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
+    assert all(word in lines[0] for word in words), lines[0]
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.slow  # build123d in a process and two STEP imports
+def test_a_step_product_drawn_y_up_keeps_its_exact_cylinders(tmp_path: Path) -> None:
+    script = tmp_path / "make.py"
+    script.write_text(
+        "from build123d import *\n"
+        "def product(turn):\n"
+        "    plate = Box(100, 80, 12) + Pos(25, 0, 10) * Box(20, 20, 8)\n"  # a boss: the cell's base is its mesh
+        "    plate = plate - Pos(-20, 0, 2) * Cylinder(6.65, 12) - Pos(25, 0, 12) * Cylinder(4.15, 8)\n"
+        "    plate = turn * plate; plate.label = 'plate'\n"
+        "    peg = turn * (Pos(-20, 0, 11) * Cylinder(6.0, 30)); peg.label = 'peg'\n"
+        "    return Compound(label='product', children=[plate, peg])\n"
+        f"export_step(product(Rot(0, 0, 0)), {str(tmp_path / 'z' / 'p.step')!r})\n"
+        f"export_step(product(Rot(-90, 0, 0)), {str(tmp_path / 'y' / 'p.step')!r})\n")  # (x, y, z) -> (x, z, -y)
+    (tmp_path / "z").mkdir()
+    (tmp_path / "y").mkdir()
+    subprocess.run([sys.executable, str(script)], check=True)
+    first = run_import(tmp_path / "z" / "p.step", tmp_path / "z_up", "mm", None)
+    turned = run_import(tmp_path / "y" / "p.step", tmp_path / "y_up", "mm", None, ImportOptions(up="+y"))
+    _same_import(first, turned, tmp_path / "z_up", tmp_path / "y_up")
+    # the base is simulated from its B-rep tessellated again for the cell, turned too
+    assert (tmp_path / "y_up" / "meshes" / "plate.obj").is_file()
+    fit = turned.derived.hole_of["peg"]
+    assert fit.section is not None and fit.axis == "+z"
+    # the B-rep's cylinders, turned with the mesh, give the round sizes exactly
+    assert (fit.hole.a, fit.section.a) == pytest.approx((0.0133, 0.012), abs=1e-9)
+    with pytest.raises(ExecutorError, match='thinnest along y .* 1 of its 1 holes and pins open along y, the other '
+                       'parts standing out of it along \\+y: the CAD may be drawn y up; set up = "\\+y"'):
+        run_import(tmp_path / "y" / "p.step", tmp_path / "read_z_up", "mm", None)
