@@ -127,8 +127,8 @@ def section_pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2
     the bore (the pin goes into the bore); for a pair the sweep admits, those at its levels
     of least room (:func:`executor.cad.derive.swept_fits`)."""
     holes = {**derived.holes, **derived.part_holes}
-    pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in holes.items()}
-             for pid, fit in sorted(derived.in_holes.items()) if fit.section is not None}
+    pairs = {pid: {hid: (fit.occupants[pid], hole.hole) for hid, hole in holes.items()}
+             for pid, fit in sorted(derived.in_holes.items()) if pid in fit.occupants}
     for pid in sorted(derived.bores):
         pairs.setdefault(pid, {}).update({pin_id: (pin.section, derived.bore_on(pid, pin_id))
                                           for pin_id, pin in derived.pins.items()})
