@@ -38,7 +38,10 @@ swept out of its hole level by level (:func:`swept_fits`: a taper in its own tap
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
 before it when its outline across its insertion axis lies in an inner loop of that part
-(a rod through a bracket's bore), measured as a hole of the base is.
+(a rod through a bracket's bore), measured as a hole of the base is; a part onto a pin is
+so in the hole of a part the precedence does not put after it (a clutch plate's splined
+outside in the outer holder's hole as its bore goes down the shaft), the parts in one hole
+its occupants.
 
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
