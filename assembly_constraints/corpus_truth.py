@@ -69,6 +69,12 @@ def read_truth(folder: Path) -> dict[str, Any]:
         if not (isinstance(row, dict) and isinstance(row.get("part"), str) and row.get("feature") in truth["features"]
                 and isinstance(row.get("fits"), bool)):
             raise TruthError(f"{path}: fits row {number}: expected {{part, feature (one of features), fits (bool)}}")
+    for pid, part in truth["parts"].items():
+        if not isinstance(part, dict):
+            raise TruthError(f"{path}: parts.{pid}: expected a table")
+        also = part.get("also_in", [])
+        if not (isinstance(also, list) and all(fid in truth["features"] for fid in also)):
+            raise TruthError(f"{path}: parts.{pid}.also_in: expected a list of features")
     return truth
 
 
