@@ -4,7 +4,9 @@ A corpus folder holds the product's meshes in the assembled pose (``meshes/``, m
 import settings (``import.toml``) and ``truth.toml``, derived by hand from the source's
 drawing, not from the import: the features that receive parts (holes, pins) with their
 owner, kind and axis line [mm, CAD frame], and which part fits which feature
-(``fits = [{part, feature, fits, room_mm}, ...]``, closed world). The import names holes
+(``fits = [{part, feature, fits, room_mm}, ...]``, closed world), and each part's
+feature (``in``) with the further ones it goes into at once (``also_in``: a clutch plate
+onto its shaft, its splined outside into the outer holder's hole). The import names holes
 its own way (``h1``, ``table_pin1``): :func:`feature_holes` finds the imported hole of
 each truth feature by its owner, its kind and its axis, so a relation learned over the
 import's ids (``fits(P,H)``) can be compared with the truth (:func:`compare_fits`).
@@ -67,6 +69,12 @@ def read_truth(folder: Path) -> dict[str, Any]:
         if not (isinstance(row, dict) and isinstance(row.get("part"), str) and row.get("feature") in truth["features"]
                 and isinstance(row.get("fits"), bool)):
             raise TruthError(f"{path}: fits row {number}: expected {{part, feature (one of features), fits (bool)}}")
+    for pid, part in truth["parts"].items():
+        if not isinstance(part, dict):
+            raise TruthError(f"{path}: parts.{pid}: expected a table")
+        also = part.get("also_in", [])
+        if not (isinstance(also, list) and all(fid in truth["features"] for fid in also)):
+            raise TruthError(f"{path}: parts.{pid}.also_in: expected a list of features")
     return truth
 
 
@@ -77,7 +85,7 @@ def import_product(folder: Path, out: Path) -> CorpusImport:
     result = run_import(folder / "meshes", out, "mm", folder / "import.toml")
     derived = result.derived
     holes = derived.holes | derived.part_holes
-    occupants = {hid: {fit.part} for hid, fit in holes.items() if fit.part is not None}
+    occupants = {hid: set(fit.occupants) for hid, fit in holes.items() if fit.occupants}
     occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
     owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
     owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
@@ -96,6 +104,12 @@ def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tup
     return math.hypot(*across)
 
 
+def features_of(part: dict[str, Any]) -> list[str]:
+    """The truth features a part of ``truth.toml`` goes into or onto: its ``in`` (none: a
+    part in no feature), then its ``also_in``."""
+    return ([part["in"]] if "in" in part else []) + list(part.get("also_in", []))
+
+
 def feature_holes(done: CorpusImport) -> dict[str, str]:
     """Each truth feature's imported hole id (absent: none found): the one of the
     feature's owner on its axis that is a pin where the feature is one (of a hollow
@@ -104,7 +118,7 @@ def feature_holes(done: CorpusImport) -> dict[str, str]:
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
-        inside = {pid for pid, part in done.truth["parts"].items() if part.get("in") == fid}
+        inside = {pid for pid, part in done.truth["parts"].items() if fid in features_of(part)}
         near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
                 and distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
                 and (hid in done.pins) == (feature["kind"] == "pin")]

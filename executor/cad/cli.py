@@ -288,9 +288,11 @@ def report(derived: Derived) -> list[str]:
     for hid, fit in [*derived.holes.items(), *derived.part_holes.items()]:
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
         held = "empty"
-        if fit.part is not None and fit.section is not None:
-            held = (f"holds {fit.part} ({_describe(fit.section.kind, fit.section.a, fit.section.b)} mm, "
-                    f"{_clearance(fit.section, fit.hole, fit.part, hid)}{_swept(derived, fit.part, hid)})")
+        if fit.occupants:
+            held = "holds " + "; ".join(
+                f"{pid} ({_describe(section.kind, section.a, section.b)} mm, "
+                f"{_clearance(section, fit.hole, pid, hid)}{_swept(derived, pid, hid)})"
+                for pid, section in fit.occupants.items())
         owner = "" if fit.owner is None else f" of {fit.owner}"
         where = (f"at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm" if fit.axis == "+z" else
                  "entry at ({}, {}, {}) mm".format(*map(_mm, entry_point(fit))))

@@ -38,7 +38,10 @@ swept out of its hole level by level (:func:`swept_fits`: a taper in its own tap
 **Holes of moving parts** (:func:`part_holes`): a moving part in no hole of the base and
 onto no pin is in the hole of another moving part that the geometric precedence puts
 before it when its outline across its insertion axis lies in an inner loop of that part
-(a rod through a bracket's bore), measured as a hole of the base is.
+(a rod through a bracket's bore), measured as a hole of the base is; a part onto a pin is
+so in the hole of a part the precedence does not put after it (a clutch plate's splined
+outside in the outer holder's hole as its bore goes down the shaft), the parts in one hole
+its occupants.
 
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
@@ -144,11 +147,20 @@ class HoleFit:
     section: Shape2D | None = None
     owner: str | None = None
     """The moving part the hole is in (:func:`part_holes`), None for a hole of the base."""
+    more: tuple[tuple[str, Shape2D], ...] = ()
+    """The further parts in a moving part's hole with their sections, after ``part`` (the
+    deepest): plates stacked on a shaft whose outsides stand in a ring's hole."""
 
     @property
     def position(self) -> tuple[float, float]:
         """The hole's centre in the cell's x, y [m]."""
         return self.centre[0], self.centre[1]
+
+    @property
+    def occupants(self) -> dict[str, Shape2D]:
+        """Every part in the hole (``part`` first, then ``more``) -> its section there."""
+        first = {} if self.part is None or self.section is None else {self.part: self.section}
+        return first | dict(self.more)
 
 
 @dataclass(frozen=True)
@@ -277,7 +289,7 @@ class Derived:
     @property
     def in_holes(self) -> dict[str, HoleFit]:
         """Part → the hole it is in: of the base, else the first of a moving part's it passes."""
-        found = {fit.part: fit for fit in reversed(self.part_holes.values()) if fit.part is not None}
+        found = {pid: fit for fit in reversed(self.part_holes.values()) for pid in fit.occupants}
         return found | self.hole_of
 
 
@@ -383,8 +395,8 @@ def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:
     standing on the floor through a hole of the base, touching none of it, has every way in
     free whatever the order, and the base would be carried into its fixture over it)."""
     order = nx.DiGraph(list(derived.edges))
-    wanted = [(derived.base if fit.owner is None else fit.owner, fit.part)
-              for fit in [*derived.holes.values(), *derived.part_holes.values()] if fit.part is not None]
+    wanted = [(derived.base if fit.owner is None else fit.owner, part)
+              for fit in [*derived.holes.values(), *derived.part_holes.values()] for part in fit.occupants]
     wanted += [(pin.owner, part) for pin in derived.pins.values() for part in pin.parts]
     return {(owner, part): "feature" for owner, part in sorted(set(wanted))
             if not (owner in order and part in order and nx.has_path(order, owner, part))}
@@ -955,29 +967,68 @@ def _standing_pins(derived: Derived, name: str, level: float,
 
 
 def part_holes(derived: Derived) -> dict[str, HoleFit]:
-    """The holes of moving parts (``<owner>_hole1``, ... by position) and the part through
+    """The holes of moving parts (``<owner>_hole1``, ... by position) and the parts in
     each (module docstring): a moving part in no hole of the base and onto no pin, whose
     outline across its insertion axis (one of the six) lies in an inner loop of a part the
     geometric precedence puts before it (not the base, not of its own body) at a level both
-    reach: a rod through a bracket's bore, a shaft into a bearing placed before it."""
+    reach: a rod through a bracket's bore, a shaft into a bearing placed before it; and a
+    part onto a pin whose outline (its outside) lies so in an inner loop of a part the
+    precedence does not put after it: a clutch plate on its shaft, its splined outside in
+    the outer holder's splined hole. The parts in one hole (within :data:`_SAME_HOLE` of
+    each other across its axis) are its occupants, the deepest first (the hole measured
+    over its stretch)."""
     order = nx.DiGraph(list(derived.edges))
     pairs = []  # (part, owner): each part's, owners in order of their names
     for pid in sorted(derived.axis):
-        if pid in derived.hole_of or pid in derived.bores or derived.axis[pid] not in DIRECTIONS or pid not in order:
+        if pid in derived.hole_of or derived.axis[pid] not in DIRECTIONS or pid not in order:
             continue
         body = next(members for members in derived.bodies.values() if pid in members)
-        pairs += [(pid, owner) for owner in sorted(nx.ancestors(order, pid) - {derived.base} - body)]
+        if pid in derived.bores:  # onto a pin: owners around it (their box across the axis holds its box)
+            owners = {other for other in set(derived.parts) - nx.descendants(order, pid)
+                      if _around(derived.parts[other].mesh, derived.parts[pid].mesh, derived.axis[pid])}
+        else:
+            owners = nx.ancestors(order, pid)
+        pairs += [(pid, owner) for owner in sorted(owners - {derived.base} - body)]
     found = [fit for fit in forked_map(lambda pair: _hole_of(derived, *pair), pairs,
                                        processes(p.mesh for p in derived.parts.values()),
                                        cost=lambda pair: len(derived.parts[pair[1]].mesh.faces)) if fit is not None]
     found.sort(key=lambda f: (f.owner or "", round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
+    holes: list[list[HoleFit]] = []
+    for fit in found:
+        same = next((hole for hole in holes if hole[0].owner == fit.owner and hole[0].axis == fit.axis
+                     and np.linalg.norm(hole[0].hole.centre - fit.hole.centre) < _SAME_HOLE), None)
+        if same is None:
+            holes.append([fit])
+        else:
+            same.append(fit)
     counts: dict[str, int] = {}
     result: dict[str, HoleFit] = {}
-    for fit in found:
-        owner = fit.owner or ""
+    for group in holes:
+        deepest, *rest = sorted(group, key=lambda f: (_tip(derived, str(f.part), f.axis), str(f.part)))
+        owner = deepest.owner or ""
         counts[owner] = counts.get(owner, 0) + 1
-        result[f"{owner}_hole{counts[owner]}"] = replace(fit, id=f"{owner}_hole{counts[owner]}")
+        hid = f"{owner}_hole{counts[owner]}"
+        result[hid] = replace(deepest, id=hid, more=tuple((str(f.part), f.section) for f in rest
+                                                          if f.section is not None))
     return result
+
+
+def _around(owner: trimesh.Trimesh, part: trimesh.Trimesh, name: str) -> bool:
+    """Whether ``owner`` may have a hole around ``part`` across removal direction ``name``:
+    its bounding box across the direction holds the part's, and along it the two overlap by
+    more than 1 µm (as :func:`_hole_around` needs), a test of their vertices' extents alone."""
+    axis = np.array(DIRECTIONS[name])
+    frame = np.vstack([frame_of(axis), axis])
+    low, high = (owner.vertices @ frame.T).min(axis=0), (owner.vertices @ frame.T).max(axis=0)
+    inner_low, inner_high = (part.vertices @ frame.T).min(axis=0), (part.vertices @ frame.T).max(axis=0)
+    return bool(np.all(low[:2] <= inner_low[:2]) and np.all(inner_high[:2] <= high[:2])
+                and min(high[2], inner_high[2]) - max(low[2], inner_low[2]) > 1e-6)
+
+
+def _tip(derived: Derived, pid: str, name: str) -> float:
+    """How far [m] part ``pid`` reaches against removal direction ``name``: its lowest
+    level along it (the deepest part in a hole has the least)."""
+    return float((derived.parts[pid].mesh.vertices @ np.array(DIRECTIONS[name])).min())
 
 
 def _hole_of(derived: Derived, pid: str, owner: str) -> HoleFit | None:

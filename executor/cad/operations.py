@@ -43,7 +43,7 @@ from executor.cad.sections import Shape2D, section, zero_clearance
 from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
-from executor.world.geometry import margin, thin_prism
+from executor.world.geometry import Section, margin, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -127,8 +127,8 @@ def section_pairs(derived: Derived) -> dict[str, dict[str, tuple[Shape2D, Shape2
     the bore (the pin goes into the bore); for a pair the sweep admits, those at its levels
     of least room (:func:`executor.cad.derive.swept_fits`)."""
     holes = {**derived.holes, **derived.part_holes}
-    pairs = {pid: {hid: (fit.section, hole.hole) for hid, hole in holes.items()}
-             for pid, fit in sorted(derived.in_holes.items()) if fit.section is not None}
+    pairs = {pid: {hid: (fit.occupants[pid], hole.hole) for hid, hole in holes.items()}
+             for pid, fit in sorted(derived.in_holes.items()) if pid in fit.occupants}
     for pid in sorted(derived.bores):
         pairs.setdefault(pid, {}).update({pin_id: (pin.section, derived.bore_on(pid, pin_id))
                                           for pin_id, pin in derived.pins.items()})
@@ -166,11 +166,19 @@ def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
     bore -> pin -> that of the pin in the bore (:func:`executor.world.geometry.margin`;
     negative: it does not pass), or the least room of the sweep where it admits the pair
     (:func:`executor.cad.derive.swept_fits`); ExecutorError naming the part, hole, pin or
-    bore whose polygon section is no simple outline."""
+    bore whose polygon section is no simple outline. Each measured section is made the
+    cell's section once (a polygon's outline of 1500 corners, rounded, against every hole)."""
+    made: dict[tuple[int, str], Section] = {}
+
+    def cell(name: str, shape: Shape2D) -> Section:
+        if (id(shape), name) not in made:
+            made[(id(shape), name)] = section(name, shape)
+        return made[(id(shape), name)]
+
     try:
         return {pid: {hid: derived.swept[(pid, hid)][2] if (pid, hid) in derived.swept else
-                      margin(section(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
-                             section(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+                      margin(cell(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
+                             cell(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
                       for hid, (peg, hole) in holes.items()}
                 for pid, holes in section_pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself

@@ -186,7 +186,7 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         name = f"hole of {fit.part}" if fit.part else f"hole {hid}"
         x, y, _ = entry_point(fit)
         if fit.owner is not None:
-            name = f"hole of {fit.owner} ({fit.part} in it)"
+            name = f"hole of {fit.owner} ({' '.join(fit.occupants)} in it)"
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
                   f"position = [{_q(x)}, {_q(y)}]", ""]
     for pin_id, pin in derived.pins.items():
@@ -548,7 +548,7 @@ def manual_features(derived: Derived, mapped: Mapped) -> dict[str, tuple[list[st
     that carry one of them, each with the features it is in (``held_by``): a nut at its
     goal is on the bolt's end only with that bolt in its hole of the CAD."""
     def features(pid: str) -> list[str]:
-        return sorted([hid for hid, fit in (derived.holes | derived.part_holes).items() if fit.part == pid]
+        return sorted([hid for hid, fit in (derived.holes | derived.part_holes).items() if pid in fit.occupants]
                       + [pin_id for pin_id, pin in derived.pins.items() if pid in pin.parts])
 
     owner = {hid: fit.owner for hid, fit in derived.part_holes.items() if fit.owner is not None} | {

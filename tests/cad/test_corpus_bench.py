@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from assembly_constraints.corpus_truth import CorpusImport, compare_fits
+from assembly_constraints.corpus_truth import CorpusImport, TruthError, compare_fits, read_truth
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -79,3 +79,14 @@ def test_a_pair_the_session_did_not_decide_is_missing_not_a_no_fit(tmp_path: Pat
     count = compare_fits(done, {"f": "h1"}, fits={("a", "h1"), ("b", "h1")}, no_fits=set())
     assert (count.ok, count.wrong, count.missing) == (1, [("b", "h1")], ["c->f (h1)"])
     assert count.as_json()["wrong"] == ["b->h1 learned fit, the truth no_fit"]
+
+
+def test_a_truth_naming_an_unknown_further_feature_is_refused_in_one_line(tmp_path: Path) -> None:
+    # also_in: the further features a part goes into at once (flynn_clutch's plates: the
+    # shaft, and the outer holder's hole); each must be one of the truth's features.
+    text = (CORPUS / "flynn_clutch" / "truth.toml").read_text()
+    (tmp_path / "truth.toml").write_text(text)
+    assert read_truth(tmp_path)["parts"]["outer_plate_a"]["also_in"] == ["holder_splines"]
+    (tmp_path / "truth.toml").write_text(text.replace('also_in = ["holder_splines"]', 'also_in = ["holder"]', 1))
+    with pytest.raises(TruthError, match=r"truth.toml: parts.outer_plate_a.also_in: expected a list of features$"):
+        read_truth(tmp_path)

@@ -79,3 +79,32 @@ def test_a_bracket_s_bore_and_a_bolt_s_end_are_features(tmp_path: Path) -> None:
         ("bracket", "rod"): "locates", ("bolt", "nut"): "locates", ("plate", "bolt"): "base",
         ("plate", "peg"): "feature"}
     assert "blocks" not in {derived.reasons[pair] for pair in [("plate", "peg"), ("bracket", "rod")]}
+
+
+@pytest.mark.slow  # four parts swept (about 3 s)
+def test_rings_on_a_pin_are_in_the_hole_of_a_holder_around_them(tmp_path: Path) -> None:
+    # flynn_clutch's plates on its shaft, their splined outsides in the outer holder's hole,
+    # as squares: two rings (20 mm square outside, a d 10.4 bore) stacked on a d 10 pin of
+    # the plate, in the 20.6 mm square hole of a holder floating 0.1 mm above the plate.
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    parts = {
+        "plate": trimesh.boolean.union([_box((-40, -40, 0), (40, 40, 10)), _cylinder(5, 9, 20, (0, 0))],
+                                       engine="manifold"),
+        "ring_a": _less(_box((-10, -10, 10), (10, 10, 12)), _cylinder(5.2, 9, 13, (0, 0))),
+        "ring_b": _less(_box((-10, -10, 12), (10, 10, 14)), _cylinder(5.2, 11, 15, (0, 0))),
+        "holder": _less(_box((-20, -20, 10.1), (20, 20, 16)), _box((-10.3, -10.3, 9), (10.3, 10.3, 17))),
+    }
+    for name, mesh in parts.items():
+        assert mesh.is_watertight, name
+        mesh.export(folder / f"{name}.stl")
+    derived = derive(load_meshes(folder, "mm"), "plate", {})
+    (hole,) = derived.part_holes.values()
+    assert (hole.id, hole.owner, list(hole.occupants), hole.hole.kind) == (
+        "holder_hole1", "holder", ["ring_a", "ring_b"], "square")
+    assert hole.hole.a == pytest.approx(0.0206, abs=2e-6)
+    assert all(section.a == pytest.approx(0.02, abs=2e-6) for section in hole.occupants.values())
+    # each ring onto the pin through its bore, and into the holder's hole: the holder first
+    assert {pid for pin in derived.pins.values() for pid in pin.parts} >= {"ring_a", "ring_b"}
+    assert {pair: derived.reasons.get(pair) for pair in [("holder", "ring_a"), ("holder", "ring_b")]} == {
+        ("holder", "ring_a"): "feature", ("holder", "ring_b"): "feature"}
