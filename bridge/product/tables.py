@@ -164,7 +164,9 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     the pin's, ``top_z`` its top and ``depth`` from its top down to where a part going
     onto it rests (both required); a pin with an ``owner`` stands up (``axis`` ``-z``) on
     that part placed by hand (``[manual.<id>]``, in the base's place of a pin: its part is
-    put onto it with that part at its ``goal``). ``axis`` is the direction a part goes in along: ``-z``
+    put onto it with that part at its ``goal``) or on that peg of ``[part_shapes.*]`` the
+    cell inserts down into its ``demo_hole`` (its position and top with the peg at its
+    goal there; its part is put onto it where the peg ended). ``axis`` is the direction a part goes in along: ``-z``
     (down) or sideways (``+x``, ``-x``, ``+y``, ``-y``); a sideways hole is in the
     ``[base]``'s own mesh, its section, ``outline`` and ``yaw`` in its hole frame (z out of
     the hole, x and y the import's slice axes: :func:`executor.world.frames.hole_rotation`),
