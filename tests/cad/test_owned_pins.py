@@ -3,8 +3,8 @@ of the base carries an upright pin, and a ring goes onto that pin. The import
 puts the block before the ring (the geometric precedence) and leaves both to the cell; a
 sim session learns their fits in physics and assembles the plan. The ring's goal is taken
 from where the block ended (its observed pose times the pin's pose in its frame): with the
-block 1 mm off its goal, the ring still goes onto the pin. A block drawn off its pocket's
-centre leaves the ring placed by hand, named."""
+block moved 1 or 3 mm off its goal, the ring still goes onto the pin, within 2 mm of its
+goal. A block drawn off its pocket's centre leaves the ring placed by hand, named."""
 
 from __future__ import annotations
 
@@ -120,20 +120,21 @@ def _shift_locked(assembler: Assembler, part: str, shift: np.ndarray) -> None:
     pb.changeConstraint(uid, jointChildPivot=com, maxForce=1e9, physicsClientId=world.client)
 
 
-@pytest.mark.slow  # teaches two parts, the block and the ring onto its pin, the block moved 1 mm (about 10 s of CPU)
-def test_the_ring_follows_the_block_where_it_ended(owned: Path, tmp_path: Path) -> None:
+@pytest.mark.slow  # teaches two parts, the block and the ring onto its pin, the block moved (about 8 s of CPU)
+@pytest.mark.parametrize("shift_mm", [1.0, 3.0])  # 3 mm: the CAD's goal would leave the ring 3.4 mm from it
+def test_the_ring_follows_the_block_where_it_ended(owned: Path, shift_mm: float) -> None:
     teach(owned)
     assembler = Assembler(load_product(str(owned)), description=CellDescription())
     try:
         assert assembler.run_step("base", None, 0).outcome == "fit"
         assert assembler.run_step("block", "h1", 0).outcome == "fit"
-        shift, inserted = np.array([0.001, 0.0, 0.0]), assembler.world.position("block")
+        shift, inserted = np.array([shift_mm / 1e3, 0.0, 0.0]), assembler.world.position("block")
         _shift_locked(assembler, "block", shift)
         block = assembler.world.position("block")
         assert block - inserted == pytest.approx(shift, abs=1e-5)
         step = assembler.run_step("ring", "block_pin1", seed=0)
         # the goal moved with the block from the CAD's (the pin's axis on the block's top):
-        # by the 1 mm and by where the cell inserted the block off its own goal (and turned it)
+        # by the shift and by where the cell inserted the block off its own goal (and turned it)
         cad = np.array([X_MM + PIN_MM[0], PIN_MM[1], 16.0]) / 1e3
         moved = assembler.world.goals["ring"] - cad
         assert moved == pytest.approx(block - assembler.world.goals["block"], abs=1e-4)  # its tilt: 16 mm up
