@@ -199,7 +199,8 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
     grasp depth (the cell holds it by that much), with room in it the cell resolves or a
     nominal zero-clearance fit the cell widens (:func:`_unresolved_in_hole`); the pins of the base that
     parts go down onto, and the pins standing up on parts the cell places by hand
-    (:func:`executor.cad.covers.map_parts`) that parts go down onto, and of the parts with
+    (:func:`executor.cad.covers.map_parts`) or on pegs it inserts down into holes of the
+    base (:func:`_owner_refused`) that parts go down onto, and of the parts with
     a bore those it puts onto them (:func:`_onto_pin`); the pegs of the other holes and
     the other parts going onto pins, each with why the cell places it by hand (a polygon
     peg's room is often below what convex pieces of its mesh keep), those ``refused``
