@@ -170,6 +170,11 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
     for name, shape in geo.hole_shapes.items():
         if shape.owner is not None and not shape.pin:
             raise fail(path, f"hole_shapes.{name}", "owner", "no owner: only a pin has one", shape.owner)
+    for name, part_shape in geo.part_shapes.items():
+        for pid in part_shape.pins_of or []:
+            if pid not in geo.manual or not part_shape.bore:
+                raise fail(path, f"part_shapes.{name}", "pins_of", "parts placed by hand ([manual.<id>]) whose "
+                           "pins parts with a bore go onto", pid)
     bores = {pid: shape.bore for shape in geo.part_shapes.values() for pid in shape.parts}
     for name, shape in geo.hole_shapes.items():
         for pid in shape.zero_clearance or []:

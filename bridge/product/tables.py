@@ -206,7 +206,10 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     extents ``[a, b]`` along x and y (a polygon peg is simulated from its mesh); a
     square's or rect's ``corner`` radius [m]. With ``bore`` they are parts with a bore
     that go onto pins (``[hole_shapes.*]`` with ``pin``): the section is the bore's, the
-    part frame's origin the centre of the bore at the part's bottom, ``demo_hole`` a pin."""
+    part frame's origin the centre of the bore at the part's bottom, ``demo_hole`` a pin;
+    ``pins_of`` the parts placed by hand (``[manual.<id>]``) whose pins they go onto
+    besides their ``demo_hole``, each through a bore of its own (they stand at their goals
+    in the trials of these parts)."""
 
     parts: Ids
     kind: Kind
@@ -218,6 +221,7 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     demo_hole: Id
     mesh: Mesh | None = None
     bore: bool = False
+    pins_of: Ids | None = None
 
 
 MESH_FILE_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*(/[A-Za-z0-9_-][A-Za-z0-9_.-]*)*\.obj$(?!\n)"

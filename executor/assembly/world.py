@@ -183,7 +183,9 @@ class AssemblyWorld:
         pb.setCollisionFilterGroupMask(self.robot, self.tool_link, 0, 0, physicsClientId=self.client)
         if any(hole.pin for hole in self.product.geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.frames[self.product.base.id].body)
-        for owner in {hole.owner for hole in self.product.geometry.holes.values() if hole.owner is not None}:
+        tables = self.product.geometry.tables  # the owners of pins, those of the further pins of parts too
+        for owner in ({hole.owner for hole in self.product.geometry.holes.values() if hole.owner is not None}
+                      | {pid for shape in tables.part_shapes.values() for pid in shape.pins_of or ()}):
             wrist_clear_of(self.client, self.robot, self.frames[owner].body)  # its pin, as the base's
         if any(hole.sideways for hole in self.product.geometry.holes.values()):  # as in the trial's scene
             wrist_clear_of(self.client, self.robot, self.floor)

@@ -241,13 +241,19 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
     view = replace(derived, holes=kept, pins=pins,
                    bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand})
     owned = [pin for pin in pins.values() if pin.owner != derived.base]
-    if not owned:
+    several = {pid: [derived.pins[pin_id] for part, pin_id in sorted(derived.further_bores) if part == pid]
+               for pid in view.bores}
+    several = {pid: [derived.pin_of(pid), *further] for pid, further in several.items() if further}
+    if not owned and not any(pin.owner != derived.base for on in several.values() for pin in on):
         return view, by_hand
     placed = map_parts(view, plate_top(view), by_hand).manual  # the owners the cell leaves where they are
     inserted = {fit.part: fit for fit in kept.values() if fit.part is not None and fit.axis == "+z"}
     moved = {pid: f"goes onto a pin of '{pin.owner}' ({pin.id}), {why}" for pin in owned if pin.owner not in placed
              if (why := _owner_refused(derived, pin, inserted.get(pin.owner))) for pid in pin.parts
              if pid not in by_hand}
+    moved |= {pid: (f"goes onto {len(on)} pins ({', '.join(pin.id for pin in on)}), of '{pin.owner}', which the "
+                    "cell moves: it puts a part onto several pins of the base and of parts placed by hand only")
+              for pid, on in several.items() for pin in on if pin.owner not in (derived.base, *placed)}
     if moved:
         return cell_view(derived, by_hand | moved)
     return replace(view, pins={pin_id: pin for pin_id, pin in pins.items()
@@ -399,14 +405,12 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto the several pins ``on`` it is on (None: it
     does, down its first pin, :meth:`executor.cad.derive.Derived.pin_of`, held as the CAD
     turns it, so each further bore comes down over its own pin). :func:`_onto_pin` has
-    checked its first pin (not entered from below); the pins must be the base's and share
-    the part's axis, which must be +z (pins standing up), the part must be the lowest on each, with
+    checked its first pin (not entered from below); the pins must share the part's axis,
+    which must be +z (pins standing up; those of other parts than the base must be of parts
+    the cell places by hand: :func:`cell_view`'s), the part must be the lowest on each, with
     room on each that the cell resolves, and a stack of prisms with one bore per pin
     (:func:`bore_pieces`)."""
     names = ", ".join(pin.id for pin in on)
-    if others := sorted({pin.owner for pin in on} - {derived.base}):
-        return (f"goes onto {len(on)} pins ({names}), of {', '.join(repr(o) for o in others)} too: the cell puts "
-                "a part onto several pins of the base only")
     if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins)
         return (f"goes onto {len(on)} pins ({names}) along {opposite(on[0].axis)}: the cell puts a part onto several "
                 "pins only down onto pins standing up (+z)")

@@ -100,7 +100,8 @@ class Scene:
                                      physicsClientId=self.client)
         if any(hole.pin for hole in geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.plate)
-        owners = sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None})
+        owners = sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None}
+                        | {pid for shape in geometry.tables.part_shapes.values() for pid in shape.pins_of or ()})
         self.owners = {owner: self.tray_parts[owner] if owner in geometry.parts else
                        static_mesh(self.client, geometry.folder / geometry.tables.manual[owner].mesh.file)
                        for owner in owners}
@@ -116,22 +117,25 @@ class Scene:
 
     def feature(self, hole: str) -> None:
         """Make the scene the one of a trial into (or onto) ``hole``: the part whose pin it is
+        (and the parts placed by hand whose pins the held part goes onto besides: ``pins_of``)
         at its goal (a peg's in its ``demo_hole``, turned as the cell inserts it:
         :func:`executor.world.geometry.seated_pose`), the other such parts out of the way (a
         part placed by hand parked, a peg on its tray or in the hand: a trial into another
         feature meets none of them, as when they were never placed)."""
-        owner = self.geometry.holes[hole].owner
+        owners = {self.geometry.holes[hole].owner}
+        if self.held is not None:  # the owners of its other pins (a plate onto pins of several parts)
+            owners |= set(self.geometry.tables.part_shapes[self.geometry.parts[self.held].shape].pins_of or ())
         for k, (pid, body) in enumerate(sorted(self.owners.items())):
             peg = self.geometry.parts.get(pid)
             at: Sequence[float]
             turn: Sequence[float] = (0.0, 0.0, 0.0, 1.0)
-            if peg is not None and pid == owner:
+            if peg is not None and pid in owners:
                 seated, turn = seated_pose(peg, self.geometry.holes[peg.demo_hole])
                 at = seated.tolist()
             elif peg is not None:
                 at = _PARKED if pid == self.held else (*peg.start, 0.0)
             else:
-                at = self.geometry.tables.manual[pid].goal if pid == owner else (0.5 * k, _PARKED[1] - 1.0, 0.0)
+                at = self.geometry.tables.manual[pid].goal if pid in owners else (0.5 * k, _PARKED[1] - 1.0, 0.0)
             pose = pb.multiplyTransforms(list(at), list(turn), *inertial_frame(self.client, body))  # PyBullet's base
             pb.resetBasePositionAndOrientation(body, *pose, physicsClientId=self.client)
 
