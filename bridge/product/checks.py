@@ -145,7 +145,11 @@ def _check_sideways(path: Path, geo: GeometryFile) -> None:
 
 def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None:
     """Pins are in the ``[base]``'s own mesh and state their ``top_z`` and ``depth``; a part
-    with a ``bore`` is taught on a pin and fits one at zero clearance, a peg a hole."""
+    with a ``bore`` is taught on a pin and fits one at zero clearance, a peg a hole; a pin's
+    ``owner`` is a part placed by hand or a peg inserted down into its ``demo_hole``."""
+    demo_shapes = {pid: geo.hole_shapes.get(holes.get(part_shape.demo_hole, ""))
+                   for part_shape in geo.part_shapes.values() if not part_shape.bore for pid in part_shape.parts}
+    inserted = {pid for pid, demo in demo_shapes.items() if demo is not None and not demo.pin and demo.axis == "-z"}
     for name, shape in geo.hole_shapes.items():
         if not shape.pin:
             continue
@@ -157,15 +161,20 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
                 raise BridgeError(f"{path}: [hole_shapes.{name}] {key}: expected the pin's "
                                   + ("top [m]" if key == "top_z" else "height above where a part rests on it [m]")
                                   + ", got nothing (a pin states both)")
-        if shape.owner is not None and shape.owner not in geo.manual:
-            raise fail(path, f"hole_shapes.{name}", "owner", "a part placed by hand ([manual.<id>]), whose pin it is",
-                       shape.owner)
+        if shape.owner is not None and shape.owner not in geo.manual and shape.owner not in inserted:
+            raise fail(path, f"hole_shapes.{name}", "owner", "a part placed by hand ([manual.<id>]) or a peg of "
+                       "[part_shapes.*] whose demo_hole is a hole entered down, whose pin it is", shape.owner)
         if shape.owner is not None and shape.axis != "-z":
-            raise fail(path, f"hole_shapes.{name}", "axis", "-z for a pin of a part placed by hand (it stands up)",
+            raise fail(path, f"hole_shapes.{name}", "axis", "-z for a pin of another part than the base (it stands up)",
                        shape.axis)
     for name, shape in geo.hole_shapes.items():
         if shape.owner is not None and not shape.pin:
             raise fail(path, f"hole_shapes.{name}", "owner", "no owner: only a pin has one", shape.owner)
+    for name, part_shape in geo.part_shapes.items():
+        for pid in part_shape.pins_of or []:
+            if pid not in geo.manual or not part_shape.bore:
+                raise fail(path, f"part_shapes.{name}", "pins_of", "parts placed by hand ([manual.<id>]) whose "
+                           "pins parts with a bore go onto", pid)
     bores = {pid: shape.bore for shape in geo.part_shapes.values() for pid in shape.parts}
     for name, shape in geo.hole_shapes.items():
         for pid in shape.zero_clearance or []:

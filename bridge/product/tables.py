@@ -164,7 +164,9 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     the pin's, ``top_z`` its top and ``depth`` from its top down to where a part going
     onto it rests (both required); a pin with an ``owner`` stands up (``axis`` ``-z``) on
     that part placed by hand (``[manual.<id>]``, in the base's place of a pin: its part is
-    put onto it with that part at its ``goal``). ``axis`` is the direction a part goes in along: ``-z``
+    put onto it with that part at its ``goal``) or on that peg of ``[part_shapes.*]`` the
+    cell inserts down into its ``demo_hole`` (its position and top with the peg at its
+    goal there; its part is put onto it where the peg ended). ``axis`` is the direction a part goes in along: ``-z``
     (down) or sideways (``+x``, ``-x``, ``+y``, ``-y``); a sideways hole is in the
     ``[base]``'s own mesh, its section, ``outline`` and ``yaw`` in its hole frame (z out of
     the hole, x and y the import's slice axes: :func:`executor.world.frames.hole_rotation`),
@@ -204,7 +206,10 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     extents ``[a, b]`` along x and y (a polygon peg is simulated from its mesh); a
     square's or rect's ``corner`` radius [m]. With ``bore`` they are parts with a bore
     that go onto pins (``[hole_shapes.*]`` with ``pin``): the section is the bore's, the
-    part frame's origin the centre of the bore at the part's bottom, ``demo_hole`` a pin."""
+    part frame's origin the centre of the bore at the part's bottom, ``demo_hole`` a pin;
+    ``pins_of`` the parts placed by hand (``[manual.<id>]``) whose pins they go onto
+    besides their ``demo_hole``, each through a bore of its own (they stand at their goals
+    in the trials of these parts)."""
 
     parts: Ids
     kind: Kind
@@ -216,6 +221,7 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     demo_hole: Id
     mesh: Mesh | None = None
     bore: bool = False
+    pins_of: Ids | None = None
 
 
 MESH_FILE_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*(/[A-Za-z0-9_-][A-Za-z0-9_.-]*)*\.obj$(?!\n)"

@@ -294,7 +294,14 @@ class Assembler:
             check_product_step(self.product, part, hole, placed)
             placed.append(part)
         world, on = self.world, dict(self.hole_of)
-        for part, hole in sorted(placements, key=lambda ph: ph[0] in self.product.heads):  # heads after their parts
+        holes = self.product.geometry.holes
+
+        def later(placement: tuple[str, str | None]) -> tuple[bool, bool]:
+            """Heads after their parts, parts onto a pin of another part after that part."""
+            part, hole = placement
+            return part in self.product.heads, hole is not None and holes[hole].owner is not None
+
+        for part, hole in sorted(placements, key=later):
             if part in self.product.pegs and hole is not None:
                 world.set_peg_goal(part, hole, self.stacked(part, hole, on))
                 on[part] = hole
@@ -395,30 +402,33 @@ class Assembler:
 
     def search_surface(self, part: str, hole: str) -> float:
         """The height [m] where the hole search for peg ``part`` presses at ``hole`` (entered
-        down): the hole's top, or higher the highest point of a placed part other than the
-        base within the peg's section (its circumradius) plus :data:`SURFACE_MARGIN` of the
-        hole's axis (a bracket's flange over the hole, the peg going through its bore),
-        measured by rays straight down onto the world (a ray
+        down; a pin of a peg where that peg is): the hole's top, or higher the highest point
+        of a placed part other than the base within the peg's section (its circumradius)
+        plus :data:`SURFACE_MARGIN` of the hole's axis (a bracket's flange over the hole, the
+        peg going through its bore), measured by rays straight down onto the world (a ray
         that meets anything else, the arm or the held part, goes on under its bounding box)."""
         world, spec = self.world, self.product.geometry.holes[hole]
         bodies = {world.frames[q].body for q in self.placed if q not in (part, self.product.base.id)}
         reach = self.product.pegs[part].circumradius + SURFACE_MARGIN
         rings, per_ring = SURFACE_RAYS
-        xy = [np.asarray(spec.position[:2], dtype=float)]
+        entry = np.array([*spec.position, spec.top_z])
+        if spec.owner in self.product.pegs:  # a pin of a peg: where that peg is (AssemblyWorld.on_owner)
+            entry = world.on_owner(spec.owner, entry)[0]
+        xy = [entry[:2]]
         for r in np.linspace(reach / rings, reach, rings):
             xy += [xy[0] + r * np.array([np.cos(a), np.sin(a)])
                    for a in np.linspace(0.0, 2 * np.pi, per_ring, endpoint=False)]
         starts = [[x, y, SAFE_Z + 0.5] for x, y in xy]
-        top = spec.top_z
+        top = bottom = float(entry[2])
         while starts:
-            hits = pb.rayTestBatch(starts, [[x, y, spec.top_z] for x, y, _ in starts], physicsClientId=world.client)
+            hits = pb.rayTestBatch(starts, [[x, y, bottom] for x, y, _ in starts], physicsClientId=world.client)
             going_on = []
             for start, (body, link, _, position, _) in zip(starts, hits, strict=True):
                 if body in bodies:
                     top = max(top, float(position[2]))
                 elif body >= 0:  # on under what it met
                     under = float(pb.getAABB(body, link, physicsClientId=world.client)[0][2]) - 1e-4
-                    if spec.top_z < under < start[2]:
+                    if bottom < under < start[2]:
                         going_on.append([start[0], start[1], under])
             starts = going_on
         return top

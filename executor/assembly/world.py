@@ -24,7 +24,7 @@ from executor.control.motion import Motion, StepLogger
 from executor.world import TIME_STEP
 from executor.world.arm import TOOL_DOWN_QUAT_XYZW, Arm, tool_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import PartSpec, arm_urdf_text, fit_pose, product_bodies, tile_of
+from executor.world.geometry import PartSpec, arm_urdf_text, product_bodies, seat, seated_pose, tile_of
 from executor.world.scene import connect, inertial_frame, link_frame, load_plate, static_mesh, wrist_clear_of
 
 HOME = np.array([0.40, 0.0, 0.30])  # tool pose the arm starts at [m]
@@ -183,7 +183,9 @@ class AssemblyWorld:
         pb.setCollisionFilterGroupMask(self.robot, self.tool_link, 0, 0, physicsClientId=self.client)
         if any(hole.pin for hole in self.product.geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.frames[self.product.base.id].body)
-        for owner in {hole.owner for hole in self.product.geometry.holes.values() if hole.owner is not None}:
+        tables = self.product.geometry.tables  # the owners of pins, those of the further pins of parts too
+        for owner in ({hole.owner for hole in self.product.geometry.holes.values() if hole.owner is not None}
+                      | {pid for shape in tables.part_shapes.values() for pid in shape.pins_of or ()}):
             wrist_clear_of(self.client, self.robot, self.frames[owner].body)  # its pin, as the base's
         if any(hole.sideways for hole in self.product.geometry.holes.values()):  # as in the trial's scene
             wrist_clear_of(self.client, self.robot, self.floor)
@@ -195,16 +197,30 @@ class AssemblyWorld:
 
     def set_peg_goal(self, part: str, hole: str, stacked: float = 0.0) -> None:
         """A peg's goal: standing on the bottom of ``hole``, shifted as the polygon relation
-        passes it (:func:`executor.world.geometry.fit_pose`; no shift for other sections);
+        passes it (:func:`executor.world.geometry.seat`; no shift for other sections);
         in a hole entered sideways, at its tip's depth and along the hole's axis
         (``goal_quats``); a part with a bore onto a pin ``stacked`` [m] farther out along
-        its axis, on the parts already on the pin."""
+        its axis, on the parts already on the pin; onto a pin of a peg (its ``owner``), that
+        goal carried to where the owner is (:meth:`on_owner`)."""
         spec = self.product.geometry.holes[hole]
-        x, y = np.array(spec.position) + fit_pose(self.product.pegs[part], spec)[1]
         frame = spec.frame  # a hole entered sideways: the peg lies along its axis
-        goal = np.array([x, y, spec.bottom_z + stacked])
-        self.goals[part] = goal if frame is None else frame.points_to_cell(goal)
+        self.goals[part] = goal = seat(self.product.pegs[part], spec, stacked)
         self.goal_quats[part] = _IDENTITY if frame is None else frame.quat
+        if spec.owner in self.product.pegs:
+            self.goals[part], self.goal_quats[part] = self.on_owner(spec.owner, goal)
+
+    def on_owner(self, owner: str, point: np.ndarray) -> tuple[np.ndarray, tuple[float, ...]]:
+        """Where ``point`` [m] of peg ``owner``, given with the owner at its goal in its
+        ``demo_hole`` (:func:`executor.world.geometry.seated_pose`: a pin's as
+        ``geometry.toml`` has it), is with the owner where its body is now, and the owner's
+        turn (xyzw): the owner's observed pose times the point's pose in the owner's frame
+        (a real cell would measure the owner; the simulation reads it)."""
+        spec = self.product.pegs[owner]
+        seated, turn = seated_pose(spec, self.product.geometry.holes[spec.demo_hole])
+        local = pb.multiplyTransforms(*pb.invertTransform(list(seated), list(turn)), list(point), _IDENTITY)
+        pos, quat = self.pose(owner)
+        moved, moved_quat = pb.multiplyTransforms(list(pos), list(quat), *local)
+        return np.array(moved), tuple(moved_quat)
 
     def lock(self, part: str) -> None:
         """Lock a placed peg in its hole: fixed where it rests, its contacts with the plate

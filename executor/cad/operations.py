@@ -26,6 +26,7 @@ import networkx as nx
 import numpy as np
 import shapely
 import trimesh
+from scipy.spatial.transform import Rotation
 
 from executor import ExecutorError
 from executor.cad.convex import (
@@ -37,13 +38,13 @@ from executor.cad.convex import (
     peg_is_primitive,
     pin_pieces,
 )
-from executor.cad.covers import map_parts
+from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, section, zero_clearance
 from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
-from executor.world.geometry import Section, margin, thin_prism
+from executor.world.geometry import Section, margin, seated_pose, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -206,7 +207,8 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
     grasp depth (the cell holds it by that much), with room in it the cell resolves or a
     nominal zero-clearance fit the cell widens (:func:`_unresolved_in_hole`); the pins of the base that
     parts go down onto, and the pins standing up on parts the cell places by hand
-    (:func:`executor.cad.covers.map_parts`) that parts go down onto, and of the parts with
+    (:func:`executor.cad.covers.map_parts`) or on pegs it inserts down into holes of the
+    base (:func:`_owner_refused`) that parts go down onto, and of the parts with
     a bore those it puts onto them (:func:`_onto_pin`); the pegs of the other holes and
     the other parts going onto pins, each with why the cell places it by hand (a polygon
     peg's room is often below what convex pieces of its mesh keep), those ``refused``
@@ -247,16 +249,49 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
     view = replace(derived, holes=kept, pins=pins,
                    bores={pid: bore for pid, bore in derived.bores.items() if pid not in by_hand})
     owned = [pin for pin in pins.values() if pin.owner != derived.base]
-    if not owned:
+    several = {pid: [derived.pins[pin_id] for part, pin_id in sorted(derived.further_bores) if part == pid]
+               for pid in view.bores}
+    several = {pid: [derived.pin_of(pid), *further] for pid, further in several.items() if further}
+    if not owned and not any(pin.owner != derived.base for on in several.values() for pin in on):
         return view, by_hand
     placed = map_parts(view, plate_top(view), by_hand).manual  # the owners the cell leaves where they are
-    moved = {pid: f"goes onto a pin of '{pin.owner}' ({pin.id}), which the cell moves: it puts parts onto pins of "
-                  "the base and of parts placed by hand only"
-             for pin in owned if pin.owner not in placed for pid in pin.parts if pid not in by_hand}
+    inserted = {fit.part: fit for fit in kept.values() if fit.part is not None and fit.axis == "+z"}
+    moved = {pid: f"goes onto a pin of '{pin.owner}' ({pin.id}), {why}" for pin in owned if pin.owner not in placed
+             if (why := _owner_refused(derived, pin, inserted.get(pin.owner))) for pid in pin.parts
+             if pid not in by_hand}
+    moved |= {pid: (f"goes onto {len(on)} pins ({', '.join(pin.id for pin in on)}), of '{pin.owner}', which the "
+                    "cell moves: it puts a part onto several pins of the base and of parts placed by hand only")
+              for pid, on in several.items() for pin in on if pin.owner not in (derived.base, *placed)}
     if moved:
         return cell_view(derived, by_hand | moved)
     return replace(view, pins={pin_id: pin for pin_id, pin in pins.items()
-                               if pin.owner == derived.base or pin.owner in placed}), by_hand
+                               if pin.owner in (derived.base, *placed, *inserted)}), by_hand
+
+
+def _owner_refused(derived: Derived, pin: PinFit, fit: HoleFit | None) -> str:
+    """Why the cell does not put parts onto ``pin`` (standing up) of a part it moves ("" where
+    it does): its owner must be a peg it inserts down into a hole of the base (``fit``),
+    of no polygon section, so that the cell takes the pin's place from where that peg ends
+    (:meth:`executor.assembly.world.AssemblyWorld.on_owner`: its pose with the peg at its
+    goal, :func:`executor.world.geometry.seated_pose`, is the CAD's within
+    :data:`STACK_TOLERANCE`, the peg drawn on its hole's bottom, centred, turned as the cell
+    inserts it)."""
+    if fit is None:
+        return ("which the cell moves: it puts parts onto pins of the base, of parts placed by hand and of pegs it "
+                "inserts down into holes of the base only")
+    assert fit.section is not None  # a hole's part has its section
+    if "polygon" in (fit.section.kind, fit.hole.kind):
+        return (f"a peg the cell inserts into hole {fit.id}, of a polygon section: the cell takes the place of a pin "
+                "on a peg of a round, square or rect section only")
+    seated, turn = seated_pose(Section(pin.owner, fit.section.kind, fit.section.a), hole_specs(derived)[fit.id])
+    at_goal = np.eye(4)
+    at_goal[:3, :3], at_goal[:3, 3] = Rotation.from_quat(turn).as_matrix(), seated
+    mesh = derived.parts[pin.owner].mesh
+    off = at_goal @ peg_frame(fit.section, mesh) @ np.array([*pin.centre, 1.0]) - np.array([*pin.centre, 1.0])
+    if (apart := float(np.linalg.norm(off[:3]))) > STACK_TOLERANCE:
+        return (f"a peg the cell inserts into hole {fit.id}: at its goal there (centred, on the bottom) its pin is "
+                f"{1e3 * apart:.3f} mm from the CAD's (at most {1e3 * STACK_TOLERANCE:g} mm)")
+    return ""
 
 
 def builds_plate(cell: Derived) -> bool:
@@ -378,14 +413,12 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
     """Why the cell does not put part ``pid`` onto the several pins ``on`` it is on (None: it
     does, down its first pin, :meth:`executor.cad.derive.Derived.pin_of`, held as the CAD
     turns it, so each further bore comes down over its own pin). :func:`_onto_pin` has
-    checked its first pin (not entered from below); the pins must be the base's and share
-    the part's axis, which must be +z (pins standing up), the part must be the lowest on each, with
+    checked its first pin (not entered from below); the pins must share the part's axis,
+    which must be +z (pins standing up; those of other parts than the base must be of parts
+    the cell places by hand: :func:`cell_view`'s), the part must be the lowest on each, with
     room on each that the cell resolves, and a stack of prisms with one bore per pin
     (:func:`bore_pieces`)."""
     names = ", ".join(pin.id for pin in on)
-    if others := sorted({pin.owner for pin in on} - {derived.base}):
-        return (f"goes onto {len(on)} pins ({names}), of {', '.join(repr(o) for o in others)} too: the cell puts "
-                "a part onto several pins of the base only")
     if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins)
         return (f"goes onto {len(on)} pins ({names}) along {opposite(on[0].axis)}: the cell puts a part onto several "
                 "pins only down onto pins standing up (+z)")

@@ -564,12 +564,24 @@ def manual_features(derived: Derived, mapped: Mapped) -> dict[str, tuple[list[st
     return found
 
 
+def pins_of(derived: Derived) -> dict[str, list[str]]:
+    """Part with a bore -> the other parts than the base owning its further pins (parts the
+    cell places by hand where it puts the part onto them: :func:`executor.cad.operations.cell_view`),
+    for the parts that have such pins (``pins_of`` of ``[part_shapes.*]``)."""
+    owners: dict[str, set[str]] = {}
+    for pid, pin_id in derived.further_bores:
+        if derived.pins[pin_id].owner != derived.base:
+            owners.setdefault(pid, set()).add(derived.pins[pin_id].owner)
+    return {pid: sorted(found) for pid, found in owners.items()}
+
+
 def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: dict[str, Mesh],
                   features: dict[str, tuple[list[str], dict[str, list[str]]]],
-                  pieces: Mapping[str, Sequence[np.ndarray]]) -> str:
+                  pieces: Mapping[str, Sequence[np.ndarray]], further: Mapping[str, list[str]]) -> str:
     """``geometry.toml`` of a mapped product (:func:`map_product`), the parts in ``meshes``
     as their own meshes (``pieces``: the convex pieces of those that move, :func:`mesh_pieces`),
-    the features of the parts placed by hand (:func:`manual_features`)."""
+    the features of the parts placed by hand (:func:`manual_features`), the owners of the
+    further pins of parts with a bore (:func:`pins_of`)."""
     fits = list(derived.holes.values())
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
@@ -632,7 +644,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true",
                   *_section_lines(nominal_section(bore, onto)),
                   f"length = {_q(length)}", f"mass = {_q(mesh.volume * DENSITY)}",
-                  f'demo_hole = "{pin.id}"', _mesh_entry(meshes[pid]), ""]
+                  f'demo_hole = "{pin.id}"', *([f"pins_of = {json.dumps(further[pid])}"] if pid in further else []),
+                  _mesh_entry(meshes[pid]), ""]
     gripper = GRIPPER if mapped.flange is None else GRIPPER | {"flange_length": mapped.flange}
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in gripper.items()), "",
               "[base]", f'part = "{derived.base}"', f"tray = {_numbers(settings.trays[derived.base])}",
@@ -808,7 +821,7 @@ def write_folder(derived: Derived, cell: Derived, mapped: Mapped, settings: Sett
         why = meshes
     elif meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes, manual_features(derived, mapped),
-                                             mesh_pieces(out, mesh_files)))
+                                             mesh_pieces(out, mesh_files), pins_of(derived)))
         try:
             loaded = load_geometry(str(out))
             plate_obj_text(loaded)  # the cell builds its plate's bosses from it

@@ -60,6 +60,7 @@ from bridge.product import (
 from bridge.product.nominal import NOMINAL_FIT_ROOM, models_nominal_fits
 from executor import ExecutorError
 from executor.cell_description import CellDescription
+from executor.world.arm import aligned_yaw, yaw_quat
 from executor.world.frames import HoleFrame, hole_frame
 from executor.world.meshes import (
     URDF_HULL_MARGIN,
@@ -127,7 +128,9 @@ class HoleSpec(Section):
     its entry at height ``top_z`` [m] and its bottom ``depth`` [m] below the entry; a
     ``pin`` of the base a part with a bore goes onto (its section the pin's, ``top_z`` its
     top, the bottom where a part going onto it rests), standing up on its ``owner`` where
-    that is a part placed by hand (None: the base's); the parts stated to fit it at room 0
+    that is a part placed by hand or a peg the cell inserts down into its ``demo_hole``
+    (None: the base's; its position and top with the owner at its goal there:
+    :func:`seated_pose`); the parts stated to fit it at room 0
     (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the pegs
     that miss it by less than the cell resolves (``near_miss``: :mod:`executor.world.near_miss`,
     no experiment); ``tile``
@@ -436,6 +439,23 @@ def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
         yaw, (x, y) = math.radians(found.yaw), found.offset
     c, s = math.cos(hole.yaw), math.sin(hole.yaw)
     return yaw, np.array([c * x - s * y, s * x + c * y])
+
+
+def seat(peg: Section, hole: HoleSpec, stacked: float = 0.0) -> np.ndarray:
+    """Where a peg's body origin is at its goal in ``hole`` [m, cell frame]: standing on its
+    bottom, shifted as the polygon relation passes it (:func:`fit_pose`); in a hole entered
+    sideways, at its tip's depth on the hole's axis; a part with a bore onto a pin
+    ``stacked`` [m] farther out along its axis, on the parts already on the pin."""
+    x, y = np.array(hole.position) + fit_pose(peg, hole)[1]
+    goal = np.array([x, y, hole.bottom_z + stacked])
+    return goal if hole.frame is None else hole.frame.points_to_cell(goal)
+
+
+def seated_pose(peg: Section, hole: HoleSpec) -> tuple[np.ndarray, tuple[float, float, float, float]]:
+    """The body pose (position [m], quaternion xyzw) of a peg at its goal in ``hole``, a hole
+    entered down (:func:`seat`), turned as the cell inserts it without errors
+    (:func:`executor.world.arm.aligned_yaw` of the hole's yaw and the relation's turn)."""
+    return seat(peg, hole), yaw_quat(aligned_yaw(peg.kind, hole.kind, hole.yaw + fit_pose(peg, hole)[0]))
 
 
 def _key(section: Section) -> Section:

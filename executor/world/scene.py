@@ -26,7 +26,15 @@ from executor import ExecutorError
 from executor.world import TIME_STEP
 from executor.world.arm import turn_z, yaw_quat
 from executor.world.assets import current_assets
-from executor.world.geometry import CellGeometry, PartSpec, arm_urdf_text, outline_polygon, peg_files, tile_of
+from executor.world.geometry import (
+    CellGeometry,
+    PartSpec,
+    arm_urdf_text,
+    outline_polygon,
+    peg_files,
+    seated_pose,
+    tile_of,
+)
 
 PART_FRICTION = 0.5  # PyBullet's default lateral friction of a link, kept by the held part
 TEACH_FRICTION = 0.25  # part-plate friction coefficient with both at the default (0.5 × 0.5)
@@ -92,9 +100,13 @@ class Scene:
                                      physicsClientId=self.client)
         if any(hole.pin for hole in geometry.holes.values()):
             wrist_clear_of(self.client, self.robot, self.plate)
-        self.owners = {owner: static_mesh(self.client, geometry.folder / geometry.tables.manual[owner].mesh.file)
-                       for owner in sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None})}
-        """The parts placed by hand whose pins parts go onto (:meth:`feature`)."""
+        owners = sorted({hole.owner for hole in geometry.holes.values() if hole.owner is not None}
+                        | {pid for shape in geometry.tables.part_shapes.values() for pid in shape.pins_of or ()})
+        self.owners = {owner: self.tray_parts[owner] if owner in geometry.parts else
+                       static_mesh(self.client, geometry.folder / geometry.tables.manual[owner].mesh.file)
+                       for owner in owners}
+        """The parts whose pins parts go onto (:meth:`feature`): placed by hand (a static
+        mesh), or pegs the cell inserts (their tray copy)."""
         for body in self.owners.values():
             wrist_clear_of(self.client, self.robot, body)
         if any(hole.sideways for hole in geometry.holes.values()):
@@ -104,13 +116,28 @@ class Scene:
         self.held: str | None = None
 
     def feature(self, hole: str) -> None:
-        """Make the scene the one of a trial into (or onto) ``hole``: the part placed by hand
-        whose pin it is at its goal, the other such parts parked out of the way (a trial into
-        another feature meets none of them, as when they were never placed)."""
-        owner = self.geometry.holes[hole].owner
+        """Make the scene the one of a trial into (or onto) ``hole``: the part whose pin it is
+        (and the parts placed by hand whose pins the held part goes onto besides: ``pins_of``)
+        at its goal (a peg's in its ``demo_hole``, turned as the cell inserts it:
+        :func:`executor.world.geometry.seated_pose`), the other such parts out of the way (a
+        part placed by hand parked, a peg on its tray or in the hand: a trial into another
+        feature meets none of them, as when they were never placed)."""
+        owners = {self.geometry.holes[hole].owner}
+        if self.held is not None:  # the owners of its other pins (a plate onto pins of several parts)
+            owners |= set(self.geometry.tables.part_shapes[self.geometry.parts[self.held].shape].pins_of or ())
         for k, (pid, body) in enumerate(sorted(self.owners.items())):
-            at = self.geometry.tables.manual[pid].goal if pid == owner else (0.5 * k, _PARKED[1] - 1.0, 0.0)
-            pb.resetBasePositionAndOrientation(body, list(at), (0, 0, 0, 1), physicsClientId=self.client)
+            peg = self.geometry.parts.get(pid)
+            at: Sequence[float]
+            turn: Sequence[float] = (0.0, 0.0, 0.0, 1.0)
+            if peg is not None and pid in owners:
+                seated, turn = seated_pose(peg, self.geometry.holes[peg.demo_hole])
+                at = seated.tolist()
+            elif peg is not None:
+                at = _PARKED if pid == self.held else (*peg.start, 0.0)
+            else:
+                at = self.geometry.tables.manual[pid].goal if pid in owners else (0.5 * k, _PARKED[1] - 1.0, 0.0)
+            pose = pb.multiplyTransforms(list(at), list(turn), *inertial_frame(self.client, body))  # PyBullet's base
+            pb.resetBasePositionAndOrientation(body, *pose, physicsClientId=self.client)
 
     def set_friction(self, coefficient: float | None) -> None:
         """Make the Coulomb friction coefficient between the held part and the plate

@@ -96,7 +96,8 @@ def test_a_pin_s_owner_is_a_part_placed_by_hand(stacked: Path, tmp_path: Path) -
     geometry = folder / "geometry.toml"
     geometry.write_text(geometry.read_text().replace('owner = "block"', 'owner = "washer"'))
     with pytest.raises(BridgeError, match=r"\[hole_shapes.block_pin1\] owner: expected a part placed by hand "
-                                          r"\(\[manual.<id>\]\), whose pin it is, got 'washer'"):
+                                          r"\(\[manual.<id>\]\) or a peg of \[part_shapes.\*\] whose demo_hole is "
+                                          r"a hole entered down, whose pin it is, got 'washer'"):
         load_product_description(folder)
 
 
