@@ -69,7 +69,7 @@ import shapely
 import trimesh
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
-from bridge.cli_types import worker_signals
+from bridge.cli_types import forked_worker
 from executor import ExecutorError
 
 TOUCH = 1e-5
@@ -692,7 +692,7 @@ def forked_map(function: Callable[[_Item], _Result], items: Sequence[_Item], wor
     order = sorted(range(len(items)), key=lambda k: -cost(items[k])) if cost is not None else list(range(len(items)))
     global _MAPPED
     _MAPPED = lambda k: function(items[k])  # noqa: E731  (the workers' copy, forked now)
-    pool = multiprocessing.get_context("fork").Pool(min(workers, len(items)), initializer=worker_signals)
+    pool = multiprocessing.get_context("fork").Pool(min(workers, len(items)), initializer=forked_worker)
     _MAPPED = None
     try:
         answers = pool.map(_mapped, order, chunksize=1)
@@ -907,7 +907,7 @@ class Sweeper:
                 self._prepare(pending.values())
                 global _FORKED
                 _FORKED = self  # the workers' copy, forked now
-                self._pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=worker_signals)
+                self._pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=forked_worker)
                 _FORKED = None
                 # the workers end (and are reaped) with the sweeper, or at close
                 self._ended = weakref.finalize(self, self._pool.terminate)
