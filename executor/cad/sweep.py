@@ -749,7 +749,7 @@ class _Solid:
     @property
     def hull(self) -> np.ndarray:
         """A convex superset's vertices [m] (:func:`_outer_hull`; of a part slid at its fits,
-        made where it is first swept: in a worker, where the sweeps fork)."""
+        made where it is first swept, or before the sweeps' workers fork: :meth:`Sweeper._prepare`)."""
         if self._hull is None:
             self._hull = _outer_hull(np.asarray(self.mesh.vertices, dtype=float))
         return self._hull[0]
@@ -940,11 +940,13 @@ class Sweeper:
 
     def _prepare(self, tests: Iterable[tuple[str, str, np.ndarray]]) -> None:
         """Make the BVHs and triangle indices of the fixed solids of ``tests`` (member,
-        other, shift) in this process, before its workers are forked: each worker then has
-        them, rather than making its own."""
+        other, shift), and the outer hulls of the moving ones (a part slid at its fits has
+        none from the surveys), in this process, before its workers are forked: each worker
+        then has them, rather than making its own (a slid part's hull, swept in both
+        workers, was made in each)."""
         for test in tests:
-            fixed = self._oriented(*test)[1]
-            _ = fixed.bvh, fixed.index
+            moving, fixed, _ = self._oriented(*test)
+            _ = fixed.bvh, fixed.index, moving.hull
 
     def _oriented(self, member: str, other: str, shift: np.ndarray) -> tuple[_Solid, _Solid, np.ndarray]:
         """The moving solid, the fixed one and the shift [m] of the test whether part
