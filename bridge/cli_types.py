@@ -9,6 +9,7 @@ checked for finiteness and range (:func:`int_in`, :func:`non_negative_int`,
 from __future__ import annotations
 
 import argparse
+import gc
 import logging
 import math
 import os
@@ -230,6 +231,17 @@ def worker_signals() -> None:
     traceback), and Ctrl-C is left to the command, which stops the pool."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def forked_worker() -> None:
+    """The initializer of a worker process a command forks (a pool's): :func:`worker_signals`,
+    and every object it inherits frozen (:func:`gc.freeze`): the worker's garbage
+    collections then never walk them (a full collection writes to each object's header,
+    so the kernel copies every page holding one: tens of MB a worker), and what is freed
+    or collected is only what the worker made; cycles among the inherited objects are
+    left to the parent, which keeps its own copy."""
+    gc.freeze()
+    worker_signals()
 
 
 def _terminate_by_exception() -> signal.Handlers | Callable[..., Any] | int | None:

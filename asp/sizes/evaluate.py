@@ -31,7 +31,7 @@ from asp import PlannerError
 from asp.sizes.learner import LearningOptions, SizeLearner, run_learner
 from asp.sizes.policies import get_policy
 from asp.sizes.truth_oracle import NoisyOracle, TruthOracle
-from bridge.cli_types import worker_signals
+from bridge.cli_types import forked_worker
 from bridge.files import write_figure
 from bridge.progress import progress
 
@@ -189,7 +189,7 @@ def _pool_map(function, tasks: Sequence, processes: int, unit: str) -> list:
     pool = None
     iterator: Iterator[Any]
     if processes > 1 and len(tasks) > 1:
-        pool = multiprocessing.get_context("fork").Pool(processes, initializer=worker_signals)
+        pool = multiprocessing.get_context("fork").Pool(processes, initializer=forked_worker)
         chunk = max(1, min(64, len(tasks) // (processes * 8)))
         iterator = pool.imap_unordered(function, tasks, chunksize=chunk)
     else:

@@ -27,6 +27,7 @@ deflection however coarse the tessellation; :func:`executor.cad.sweep.zero_clear
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import multiprocessing
 import multiprocessing.connection
@@ -377,7 +378,9 @@ def overlaps_checked(parts: list[CadPart], forked: bool) -> Iterator[Callable[[]
 def _overlaps_to(parts: list[CadPart], sender: multiprocessing.connection.Connection) -> None:
     """In the process :func:`overlaps_checked` forks: :func:`_check_overlaps`, its answer
     sent (None: no overlap; ``("error", message)`` its ExecutorError; ``("crash",
-    traceback)`` any other exception)."""
+    traceback)`` any other exception). The objects it inherits are frozen for the garbage
+    collector, as in a pool's workers (:func:`bridge.cli_types.forked_worker`)."""
+    gc.freeze()
     try:
         _check_overlaps(parts)
         found = None

@@ -69,7 +69,7 @@ import shapely
 import trimesh
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
-from bridge.cli_types import worker_signals
+from bridge.cli_types import forked_worker
 from executor import ExecutorError
 
 TOUCH = 1e-5
@@ -692,7 +692,7 @@ def forked_map(function: Callable[[_Item], _Result], items: Sequence[_Item], wor
     order = sorted(range(len(items)), key=lambda k: -cost(items[k])) if cost is not None else list(range(len(items)))
     global _MAPPED
     _MAPPED = lambda k: function(items[k])  # noqa: E731  (the workers' copy, forked now)
-    pool = multiprocessing.get_context("fork").Pool(min(workers, len(items)), initializer=worker_signals)
+    pool = multiprocessing.get_context("fork").Pool(min(workers, len(items)), initializer=forked_worker)
     _MAPPED = None
     try:
         answers = pool.map(_mapped, order, chunksize=1)
@@ -749,7 +749,7 @@ class _Solid:
     @property
     def hull(self) -> np.ndarray:
         """A convex superset's vertices [m] (:func:`_outer_hull`; of a part slid at its fits,
-        made where it is first swept: in a worker, where the sweeps fork)."""
+        made where it is first swept, or before the sweeps' workers fork: :meth:`Sweeper._prepare`)."""
         if self._hull is None:
             self._hull = _outer_hull(np.asarray(self.mesh.vertices, dtype=float))
         return self._hull[0]
@@ -907,7 +907,7 @@ class Sweeper:
                 self._prepare(pending.values())
                 global _FORKED
                 _FORKED = self  # the workers' copy, forked now
-                self._pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=worker_signals)
+                self._pool = multiprocessing.get_context("fork").Pool(self.workers, initializer=forked_worker)
                 _FORKED = None
                 # the workers end (and are reaped) with the sweeper, or at close
                 self._ended = weakref.finalize(self, self._pool.terminate)
@@ -940,11 +940,13 @@ class Sweeper:
 
     def _prepare(self, tests: Iterable[tuple[str, str, np.ndarray]]) -> None:
         """Make the BVHs and triangle indices of the fixed solids of ``tests`` (member,
-        other, shift) in this process, before its workers are forked: each worker then has
-        them, rather than making its own."""
+        other, shift), and the outer hulls of the moving ones (a part slid at its fits has
+        none from the surveys), in this process, before its workers are forked: each worker
+        then has them, rather than making its own (a slid part's hull, swept in both
+        workers, was made in each)."""
         for test in tests:
-            fixed = self._oriented(*test)[1]
-            _ = fixed.bvh, fixed.index
+            moving, fixed, _ = self._oriented(*test)
+            _ = fixed.bvh, fixed.index, moving.hull
 
     def _oriented(self, member: str, other: str, shift: np.ndarray) -> tuple[_Solid, _Solid, np.ndarray]:
         """The moving solid, the fixed one and the shift [m] of the test whether part
