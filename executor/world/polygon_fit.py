@@ -333,18 +333,21 @@ def turned_fit(peg: shapely.Polygon, hole: shapely.Polygon, turns: list[float]) 
     pair = _Pair(shapely.affinity.translate(peg, *-peg_centre), shapely.affinity.translate(hole, *-hole_centre))
     reach = float(np.max(np.linalg.norm(pair.peg_points, axis=1)))
     sweep = pair.sweep_convex or len(pair.peg_points) * len(pair.hole_points) <= SWEEP_PIECES
-    least: tuple[float, float, np.ndarray] | None = None
+    found = []
     for angle in turns:
         free = _best_shift(pair, angle) if sweep else None
         shift = free if free is not None else \
             _refine_shift(pair, angle, np.zeros(2), reach)  # from the centroids together
-        room = pair.room(angle, shift)
-        if least is None or room < least[0]:
-            least = (room, angle, shift)
-    assert least is not None, "no turn given"
-    room, angle, shift = least
+        found.append((pair.room(angle, shift), angle, shift))
+    least = min(room for room, _, _ in found)
+    # the pose: the first turn within the float's noise (1 pm) of the least room (alike turns of symmetric outlines)
+    _, angle, shift = next(pose for pose in found if pose[0] <= least + _NOISE)
     origin = hole_centre + shift - _turn(peg_centre[None, :], angle)[0]
-    return PolygonFit(room, round(math.degrees(angle), 9) + 0.0, (float(origin[0]), float(origin[1])))
+    return PolygonFit(least, round(math.degrees(angle), 9) + 0.0, (float(origin[0]), float(origin[1])))
+
+
+_NOISE = 1e-12
+"""Rooms [m] of :func:`turned_fit`'s turns this close are alike (the float's noise)."""
 
 
 _TURNS = np.linspace(-1.0, 1.0, 9)
