@@ -844,10 +844,9 @@ def section_room(peg: Shape2D, hole: Shape2D, peg_name: str = "peg", hole_name: 
     no nominal zero-clearance fit) keeps the readings' room, a negative measure, without
     the search. OutlineError naming ``peg_name`` or ``hole_name`` when a loop is no
     simple polygon."""
-    readings = section_fit(section(peg_name, peg), section(hole_name, hole))
-    turns = aligned_turns(peg, hole)
-    if not {peg.kind, hole.kind} <= STRAIGHT or _extents_room(peg, hole, turns) < -2 * OUTLINE_TOUCH:
-        return readings
+    turns = aligned_turns(peg, hole) if {peg.kind, hole.kind} <= STRAIGHT else []
+    if not turns or _extents_room(peg, hole, turns) < -2 * OUTLINE_TOUCH:
+        return section_fit(section(peg_name, peg), section(hole_name, hole))
     try:
         return _outline_fit(peg.outline.tobytes(), hole.outline.tobytes(), tuple(turns))
     except OutlineError:  # the cached answer knows no names: name the loop that is no simple polygon
