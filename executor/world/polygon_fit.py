@@ -37,7 +37,9 @@ then given as the difference of those radii, a bound (it lacks at least that muc
 without a search. A round side has closed
 forms: a polygon peg in a round hole has the room R - (the radius of its smallest
 enclosing circle), a round peg in a polygon hole (the radius of the hole's largest
-inscribed circle) - r, at any turn.
+inscribed circle) - r, at any turn. :func:`turned_fit` measures a pair at given turns
+only, each at its best shift (two rect or square sections at the turns the skill aligns
+them by: :func:`executor.cad.sections.section_room`).
 Deterministic: the same outlines give the same answer.
 """
 
