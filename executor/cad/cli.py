@@ -61,7 +61,7 @@ from executor.cad.parts import (
     turn_text,
     turned,
 )
-from executor.cad.sections import Shape2D, slices_kept, zero_clearance
+from executor.cad.sections import Shape2D, section_room, slices_kept, zero_clearance
 from executor.cad.step import load_step
 from executor.cad.sweep import opposite, processes
 from executor.cad.write import (
@@ -75,10 +75,8 @@ from executor.cad.write import (
     mesh_pieces,
     near_miss_assumption,
     nominal_assumption,
-    section,
     write_folder,
 )
-from executor.world.geometry import section_fit
 
 WORK_POSITION = (0.56, 0.0)
 """Where a product out of the arm's reach is placed by default: its base's centre [m] in the
@@ -249,11 +247,11 @@ def _describe(kind: str, a: float, b: float) -> str:
 
 def _clearance(peg: Shape2D, hole: Shape2D, peg_name: str, hole_name: str) -> str:
     """How ``peg`` passes ``hole`` as the report says it: the clearance and room all round
-    (:func:`executor.world.geometry.section_fit`), preceded by ``no fit`` and the
+    (:func:`executor.cad.sections.section_room`), preceded by ``no fit`` and the
     clearance [µm] where it is not positive, or a nominal zero-clearance fit
     (:func:`executor.cad.sections.zero_clearance`) with the measured difference: as
     ``sizes.lp`` writes it (:func:`executor.cad.sections.passes`)."""
-    room = section_fit(section(peg_name, peg), section(hole_name, hole))
+    room = section_room(peg, hole, peg_name, hole_name)
     apart = zero_clearance(peg, hole, room.margin)
     if apart is not None:
         measured = "vertex circles" if peg.kind == hole.kind == "round" else "outlines"

@@ -94,7 +94,7 @@ from executor.cad.sections import (
     over_span,
     passage,
     passes,
-    section,
+    section_room,
     slice_loops,
     zero_clearance,
 )
@@ -113,7 +113,6 @@ from executor.cad.sweep import (
     surveys,
     zero_clearance_fits,
 )
-from executor.world.geometry import margin
 from executor.world.polygon_fit import OutlineError, polygon, symmetry
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
@@ -703,7 +702,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[n
     The part leaves over the pin's stretch from its own trailing end to the pin's free end
     (the owner's farthest vertex along the direction near the line): its bore at each level
     passes every section of the pin beyond that level. The sections kept are those of the
-    narrowest such passage (the least room, :func:`executor.world.geometry.margin`): the
+    narrowest such passage (the least room, :func:`executor.cad.sections.section_room`): the
     bore over one span and the union of the pin's outlines beyond it, over spans end to end
     split at the vertex levels of both (:func:`_intervals`), each measured over its whole
     length (:func:`executor.cad.sections.over_span`: the bore free at every level of it,
@@ -759,7 +758,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[n
         key = (np.round(union.outline + union.centre, 8).tobytes(), np.round(bore.points, 8).tobytes())
         if key not in rooms:
             try:
-                rooms[key] = margin(section("pin", union), section("bore", hole))
+                rooms[key] = section_room(union, hole, "pin", "bore").margin
             except OutlineError:
                 continue
         passages.append((rooms[key], union, hole, level))

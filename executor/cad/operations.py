@@ -40,11 +40,11 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.sections import Shape2D, section, zero_clearance
+from executor.cad.sections import Shape2D, section, section_room, zero_clearance
 from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
-from executor.world.geometry import Section, margin, seated_pose, thin_prism
+from executor.world.geometry import Section, seated_pose, thin_prism
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -153,8 +153,8 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of the peg's nominal section in the hole's, and part
     with a bore -> pin -> the room of the pin's section in the bore's
-    (:func:`executor.world.geometry.margin`, the polygon relation for
-    polygon sections; negative: it does not pass; 0 for a nominal zero-clearance fit,
+    (:func:`executor.cad.sections.section_room`: the outlines' room for straight-sided
+    pairs, the polygon relation for polygon sections; negative: it does not pass; 0 for a nominal zero-clearance fit,
     :func:`nominal_fits`); ExecutorError naming the part, hole, pin or bore whose polygon
     section is no simple outline."""
     nominal = nominal_fits(derived)
@@ -164,7 +164,7 @@ def margins(derived: Derived) -> dict[str, dict[str, float]]:
 
 def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
     """Peg -> hole -> the room [m] of its measured section in the hole's, and part with a
-    bore -> pin -> that of the pin in the bore (:func:`executor.world.geometry.margin`;
+    bore -> pin -> that of the pin in the bore (:func:`executor.cad.sections.section_room`;
     negative: it does not pass), or the least room of the sweep where it admits the pair
     (:func:`executor.cad.derive.swept_fits`); ExecutorError naming the part, hole, pin or
     bore whose polygon section is no simple outline. Each measured section is made the
@@ -178,8 +178,9 @@ def _rooms(derived: Derived) -> dict[str, dict[str, float]]:
 
     try:
         return {pid: {hid: derived.swept[(pid, hid)][2] if (pid, hid) in derived.swept else
-                      margin(cell(f"pin {hid}" if hid in derived.pins else f"part {pid}", peg),
-                             cell(f"bore of {pid}" if hid in derived.pins else f"hole {hid}", hole))
+                      section_room(peg, hole, f"pin {hid}" if hid in derived.pins else f"part {pid}",
+                                   f"bore of {pid}" if hid in derived.pins else f"hole {hid}",
+                                   make=cell).margin
                       for hid, (peg, hole) in holes.items()}
                 for pid, holes in section_pairs(derived).items()}
     except OutlineError as exc:  # a slice of a mesh that crosses itself

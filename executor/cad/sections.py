@@ -32,13 +32,15 @@ radius that still holds it; a hole's is the rounded rect that lies inside the lo
 rectangle with the least corner radius that fits, inset evenly on every side only as far
 as no rounded rect fits without (a tessellation's side tilted by a fraction of a µm costs
 that fraction, its rounded corners nothing), so a rect peg that passes the recorded rect
-passes the hole (``corner``, reported). Where the part's
+passes the hole (``corner``, reported). The room of two rect or square sections is their
+loops', not that of these readings (:func:`section_room`). Where the part's
 B-rep has a cylinder on the loop's axis (a STEP part), :func:`exact_round` takes its
 diameter instead.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -61,8 +63,8 @@ from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
 from executor.cad.parts import Cylinder
 from executor.cad.sweep import TOUCH
-from executor.world.geometry import Section, margin
-from executor.world.polygon_fit import OutlineError
+from executor.world.geometry import Section, section_fit
+from executor.world.polygon_fit import OutlineError, PolygonFit, polygon, turned_fit
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
@@ -827,12 +829,72 @@ def section(name: str, shape: Shape2D) -> Section:
                    outline=outline, corner=shape.corner)
 
 
+def section_room(peg: Shape2D, hole: Shape2D, peg_name: str = "peg", hole_name: str = "hole",
+                 make: Callable[[str, Shape2D], Section] | None = None) -> PolygonFit:
+    """How the measured ``peg`` passes the measured ``hole``: rect or square both (straight
+    sides), the room of the peg's loop in the hole's at the turns that align the peg's
+    side a with the hole's (:func:`aligned_turns`), each at its best shift, the least of
+    them (:func:`executor.world.polygon_fit.turned_fit`): the room between the outlines
+    the meshes have, corners and all, not that of the rounded rects read from them
+    (a peg's holds its loop, a hole's lies inside its loop: each a fraction of the
+    corners' tessellation conservative, which the room would add up); else
+    :func:`executor.world.geometry.section_fit` of their sections (a polygon's relation,
+    a round side's closed forms, the exact rules). A straight pair whose loops' extents
+    along the hole's sides already keep the peg out by more than twice
+    :data:`OUTLINE_TOUCH` at one of those turns (:func:`_extents_room`, a bound: no pass,
+    no nominal zero-clearance fit) keeps the readings' room, a negative measure, without
+    the search. OutlineError naming ``peg_name`` or ``hole_name`` when a loop is no
+    simple polygon. ``make`` builds the cell's section of a measured one (default
+    :func:`section`; a caller measuring one section against many holes passes a cache)."""
+    turns = aligned_turns(peg, hole) if {peg.kind, hole.kind} <= STRAIGHT else []
+    if not turns or _extents_room(peg, hole, turns) < -2 * OUTLINE_TOUCH:
+        build = make or section
+        return section_fit(build(peg_name, peg), build(hole_name, hole))
+    try:
+        return _outline_fit(peg.outline.tobytes(), hole.outline.tobytes(), tuple(turns))
+    except OutlineError:  # the cached answer knows no names: name the loop that is no simple polygon
+        polygon(peg.outline, peg_name)
+        polygon(hole.outline, hole_name)
+        raise
+
+
+def aligned_turns(peg: Shape2D, hole: Shape2D) -> list[float]:
+    """The turns [rad] of a rect or square ``peg`` that put its side a along the hole's
+    side a (a rect's long side along the long side: two turns half a turn apart; with a
+    square on either side, four a quarter turn apart); the skill turns the peg to the
+    hole's yaw by one of them."""
+    period = 90.0 if "square" in (peg.kind, hole.kind) else 180.0
+    return [math.radians(hole.yaw - peg.yaw + k * period) for k in range(round(360.0 / period))]
+
+
+def _extents_room(peg: Shape2D, hole: Shape2D, turns: list[float]) -> float:
+    """A bound [m] on the least room of ``peg``'s loop in ``hole``'s over the ``turns``
+    [rad]: at each, half the least difference of the loops' extents along the hole's
+    sides (a peg that passes fits within the hole's extent along every direction)."""
+    def extents(points: np.ndarray, angle: float) -> np.ndarray:
+        c, s = math.cos(angle), math.sin(angle)
+        turned = points @ np.array([[c, s], [-s, c]])
+        return turned.max(axis=0) - turned.min(axis=0)
+
+    frame = -math.radians(hole.yaw)
+    room = extents(hole.outline, frame)
+    return min(float(np.min(room - extents(peg.outline, turn + frame))) / 2 for turn in turns)
+
+
+@functools.lru_cache(maxsize=4096)
+def _outline_fit(peg: bytes, hole: bytes, turns: tuple[float, ...]) -> PolygonFit:
+    """:func:`turned_fit` of the outlines (their points' float64 bytes, (n, 2) [m]) at the
+    ``turns`` [rad], once for each (many pegs of one shape meet many holes of one shape)."""
+    return turned_fit(polygon(np.frombuffer(peg).reshape(-1, 2), "peg"),
+                      polygon(np.frombuffer(hole).reshape(-1, 2), "hole"), list(turns))
+
+
 def passes(peg: Shape2D, hole: Shape2D) -> bool:
     """Whether ``peg`` passes ``hole`` as ``sizes.lp`` writes it: a positive room
-    (:func:`executor.world.geometry.margin`) or a nominal zero-clearance fit
-    (:func:`zero_clearance`); False when either outline is no simple polygon."""
+    (:func:`section_room`) or a nominal zero-clearance fit (:func:`zero_clearance`);
+    False when either outline is no simple polygon."""
     try:
-        room = margin(section("peg", peg), section("hole", hole))
+        room = section_room(peg, hole).margin
     except OutlineError:
         return False
     return room > 0 or zero_clearance(peg, hole, room) is not None

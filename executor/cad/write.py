@@ -9,8 +9,8 @@
   position with the pin's section kind;
 - ``sizes.lp``: ``fits(P,H)`` for every peg and hole whose nominal sections pass, and for
   every part with a bore and pin when the pin's section passes the bore's
-  (:func:`executor.world.geometry.passes`: the exact rules of round,
-  square and rect sections, the polygon relation where one is a polygon) or when they
+  (:func:`executor.cad.sections.passes`: the exact rules of round sections, the loops'
+  room of two rect or square ones, the polygon relation where one is a polygon) or when they
   are a nominal zero-clearance fit (:func:`executor.cad.operations.nominal_fits`, named in a comment), or when
   the sweep admits them (:func:`executor.cad.derive.swept_fits`: a taper in its taper), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal

@@ -134,12 +134,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes", "gridfinity_bases", "flynn_clutch",
-                                  pytest.param("nop_printed_box", marks=pytest.mark.xfail(
-                                      strict=True, raises=AssertionError,
-                                      reason="its rounded rects' corners are read as circular arcs that hold the "
-                                             "base's polygonal arcs and lie inside the recess's (radius 8.775 for "
-                                             "the base's 8.8, 9.029 for the recess's 9.0), so the corners leave "
-                                             "0.178 mm, not 0.2: margin 355 um, the truth's 400")),
+                                  "nop_printed_box",
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
                                       reason="its disk's d 21 bore is measured on its tessellation, d 20.951 (a "

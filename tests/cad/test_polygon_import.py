@@ -6,6 +6,7 @@ backend read) give the same rooms."""
 from __future__ import annotations
 
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 import clingo
@@ -132,7 +133,7 @@ def test_a_rect_peg_a_third_of_a_micrometre_too_big_is_a_nominal_fit_and_one_two
     close, far = rect(0.009605 + 6e-7, 0.005795 + 6e-7), rect(0.009605 + 4e-6, 0.005795 + 4e-6)
     assert passes(close, hole) and zero_clearance(close, hole, -6e-7) == pytest.approx(-3e-7)
     assert not passes(far, hole) and zero_clearance(far, hole, -4e-6) is None
-    square = Shape2D("square", 0.006 + 6e-7, 0.006 + 6e-7, 0.0, np.zeros(2), outline=np.zeros((0, 2)))
+    square = replace(rect(0.006 + 6e-7, 0.006 + 6e-7), kind="square")
     assert passes(square, rect(0.006, 0.006))
 
 

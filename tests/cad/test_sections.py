@@ -101,6 +101,50 @@ def test_a_rounded_square_hole_with_a_tilted_side_keeps_its_corner_radius() -> N
                                                        hole.yaw, origin=(0, 0)))
 
 
+
+def _arcs(a: float, b: float, radius: float, per_quarter: int) -> np.ndarray:
+    """A centred a x b [m] rect with corner ``radius`` [m] whose arcs are ``per_quarter``
+    chords with their vertices on the arc (as OpenSCAD and CAD kernels tessellate)."""
+    points = []
+    for k, (sx, sy) in enumerate(((1, 1), (-1, 1), (-1, -1), (1, -1))):
+        centre = np.array([sx * (a / 2 - radius), sy * (b / 2 - radius)])
+        angles = k * math.pi / 2 + np.linspace(0, math.pi / 2, per_quarter + 1)
+        points += list(centre + radius * np.stack([np.cos(angles), np.sin(angles)], axis=1))
+    return np.array(points)
+
+
+@pytest.mark.parametrize("hole_of", ["mitred", "arcs", "one sharp corner"])
+def test_the_room_of_a_rounded_rect_in_a_rounded_rect_is_that_of_their_outlines(hole_of: str) -> None:
+    """A 20 x 12 mm peg with 2 mm corners tessellated coarsely (4 chords a quarter), in a
+    hole 0.2 mm larger all round: each edge of the peg's moved out by 0.2 mm (mitred:
+    the room is 0.2 mm exactly), or 20.4 x 12.4 mm with 2.2 mm corners tessellated alike
+    (the room is the outlines' distance, 0.2 cos(π/16) mm, measured with shapely), or the
+    mitred one with one corner sharp (no symmetry: the best shift is found). Read as
+    rounded rects each corner is conservative (the peg's arc holds its chords, the hole's
+    lies inside its own) and the errors add up (a room of 0.109 or 0.100 mm); the room is the
+    outlines' at the aligning turn, both turned 30° and apart, and the peg placed where
+    it is found is inside the hole with that room."""
+    peg = shapely.Polygon(_arcs(20 * MM, 12 * MM, 2 * MM, 4))
+    hole = shapely.Polygon(_arcs(20.4 * MM, 12.4 * MM, 2.2 * MM, 4)) if hole_of == "arcs" else \
+        peg.buffer(0.2 * MM, join_style="mitre")
+    if hole_of == "one sharp corner":  # no symmetry: its centroid moves off the best shift
+        hole = shapely.union(hole, shapely.box(7 * MM, 3 * MM, 10.2 * MM, 6.2 * MM))
+        centred = affinity.translate(peg, *np.asarray(hole.centroid.coords[0]))
+        assert shapely.distance(hole.exterior, centred) < 0.199 * MM
+    truth = shapely.distance(hole.exterior, peg)
+    # the arcs': a peg's vertex faces a hole's, whose chords are 0.2 mm out at their normal, π/16 away
+    assert truth == pytest.approx(0.2 * MM * (math.cos(math.pi / 16) if hole_of == "arcs" else 1.0), abs=1e-12)
+    turned_peg, turned_hole = (affinity.rotate(shape, 30, origin=(0, 0)) for shape in (peg, hole))
+    peg_section = classify(loop_of(turned_peg, (0.1, 0.02)), hole=False)
+    hole_section = classify(loop_of(turned_hole, (-0.3, 0.05)), hole=True)
+    assert (peg_section.kind, hole_section.kind) == ("rect", "rect")
+    found = sections.section_room(peg_section, hole_section)
+    assert truth - 1e-7 <= found.room <= truth + 1e-12  # the best shift to 0.1 µm, never more room than the truth
+    placed = affinity.translate(affinity.rotate(shapely.Polygon(peg_section.outline), found.yaw, origin=(0, 0)),
+                                *found.offset)
+    assert shapely.Polygon(hole_section.outline).contains(placed.buffer(found.room - 1e-9))
+    assert sections.passes(peg_section, hole_section)
+
 def test_a_chamfered_square_is_a_square() -> None:
     chamfered = shapely.box(-5 * MM, -5 * MM, 5 * MM, 5 * MM).buffer(-0.5 * MM, join_style="mitre").buffer(
         0.5 * MM, join_style="bevel")
