@@ -91,6 +91,7 @@ from executor.cad.sections import (
     over_span,
     passage,
     passes,
+    screwed_pairs,
     section,
     slice_loops,
     zero_clearance,
@@ -236,29 +237,45 @@ class Derived:
 
     def assumptions(self) -> list[str]:
         """The stated assumptions of the disassembly, as ``import`` prints them."""
-        largest = max((s.tolerance for s in self.slides), default=0.0)
+        fits = [s for s in self.slides if not s.pitch]
+        largest = max((s.tolerance for s in fits), default=0.0)
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
                 "(a face's triangles' largest distance from its circle; a face whose triangles lie farther than "
                 f"{100 * COARSEST:.1f}% of its radius from it, the sagitta of a chord of {math.degrees(SMOOTH):.0f}°, "
                 "is no cylinder) plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, "
                 "slide along their axis where they sit and on the way "
-                f"({sum(s.seated for s in self.slides)} fit(s) and "
-                f"{sum(not s.seated for s in self.slides)} passage(s) found"
-                + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
+                f"({sum(s.seated for s in fits)} fit(s) and "
+                f"{sum(not s.seated for s in fits)} passage(s) found"
+                + (f", tolerances up to {1e6 * largest:.1f} µm)" if fits else ")"),
+                "modelled threads: a part's outermost surface and another's innermost, each helical about one axis "
+                "of the frame (through the smaller part's box centre) with one pitch and lead within 2 %, "
+                "interlocking, are screwed: they slide along that axis against each other (the screw's thread "
+                f"taken in under the nut's minor radius; {sum(1 for s in self.slides if s.pitch)} pair(s) found)"]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""
-        lines = [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
+        lines = [f"screwed pair {s.shaft} in {s.bore} (a modelled thread): d {2000 * s.face.radius:.3f} mm in a minor "
+                 f"d {2000 * s.hole.radius:.3f} mm along {axis_name(s.direction)[1:]}, pitch {1000 * s.pitch:.3f} mm, "
+                 f"lead {1000 * abs(s.lead):.3f} mm, {'right' if s.lead > 0 else 'left'}-handed about "
+                 f"{axis_name(s.direction)}; slides along the axis against each other, the cell does not screw"
+                 for s in self.slides if s.pitch]
+        lines += [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
                   f"zero-clearance passage {s.shaft} through {s.bore} (met only on a way along the axis): ")
                  + f"{_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
-                 f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding" for s in self.slides]
+                  f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding"
+                  for s in self.slides if not s.pitch]
         lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
                   for (a, b), detail in sorted(self.detail.items())]
         lines += [f"supporting pair {y}->{x} dropped: the blocking needs {x} before {y}"
                   for y, x in sorted(self.dropped_supports)]
         return lines
+
+    def screwed(self, part: str, other: str) -> Slide | None:
+        """The screwed pair (a modelled thread) of parts ``part`` and ``other``, either in
+        the other, or None."""
+        return next((s for s in self.slides if s.pitch and {s.shaft, s.bore} == {part, other}), None)
 
     def pin_of(self, part: str) -> PinFit:
         """The first pin ``part`` (one with a bore) is on: the one its bore of :attr:`bores` is around."""
@@ -302,6 +319,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     made = surveys({p.id: p.mesh for p in parts})
     beside()
     result.slides = zero_clearance_fits({pid: survey.faces for pid, survey in made.items()})
+    result.slides += screwed_pairs({p.id: p.mesh for p in parts})
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
         result.directions.setdefault(axis_name(-slide.direction), tuple(-slide.direction))
@@ -768,7 +786,9 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
     own feature is tried the same way in every other feature of its owner along that axis
     (moved onto that feature's centre line and as deep past its entry; a pin under the bore
     as far past its tip), where the sections do not pass. A pair is admitted when its room
-    is positive or it is a nominal zero-clearance fit (:func:`executor.cad.sections.zero_clearance`)."""
+    is positive or it is a nominal zero-clearance fit (:func:`executor.cad.sections.zero_clearance`).
+    A screwed pair (a modelled thread, :meth:`Derived.screwed`) is not swept: its part fits
+    its feature by screwing, written with the feature's section for both and room 0."""
     found: dict[tuple[str, str], tuple[Shape2D, Shape2D, float]] = {}
     slicers: dict[tuple[str, str], Slicer] = {}
 
@@ -794,6 +814,9 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
     for hid, fit in holes.items():
         if fit.part is None or fit.section is None or passes(fit.section, fit.hole):
             continue
+        if derived.screwed(fit.part, fit.owner or derived.base):
+            found[(fit.part, hid)] = (fit.hole, fit.hole, 0.0)
+            continue
         out = np.array(DIRECTIONS[fit.axis])
         owner = fit.owner or derived.base
         peg, walls = slicer(fit.part, fit.axis, out), slicer(owner, fit.axis, out)
@@ -818,6 +841,9 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
         for pid in pin.parts:
             own = derived.bore_on(pid, pin_id)
             if passes(pin.section, own):
+                continue
+            if derived.screwed(pid, pin.owner):
+                found[(pid, pin_id)] = (own, own, 0.0)
                 continue
             bore = slicer(pid, name, out)
             low, entry = extent(pid, out, line, reach)

@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import networkx as nx
@@ -60,7 +60,7 @@ from trimesh.path.exchange.misc import edges_to_path
 from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
 from executor.cad.parts import Cylinder
-from executor.cad.sweep import TOUCH
+from executor.cad.sweep import TOUCH, CylinderFace, Slide
 from executor.world.geometry import Section, margin
 from executor.world.polygon_fit import OutlineError
 
@@ -836,3 +836,190 @@ def passes(peg: Shape2D, hole: Shape2D) -> bool:
     except OutlineError:
         return False
     return room > 0 or zero_clearance(peg, hole, room) is not None
+
+
+THREAD_ANGLES = 8
+"""Half-planes about a thread's axis its surface is cut with (:func:`thread_profiles`): a
+turn in eighths, so a lead of up to four pitches (four starts) shifts the profile by less than half a pitch."""
+THREAD_SAMPLES = 2048
+"""Levels along the axis each half-plane's profile is sampled at, over the part's extent."""
+THREAD_MATCH = 0.15
+"""Two profiles are one (shifted) when their mean difference is at most this fraction of
+the thread's depth (the profile's 5th to 95th percentile)."""
+
+
+@dataclass(frozen=True)
+class Thread:
+    """A helical surface measured on a part (:func:`helix`): about the axis through
+    ``point`` along the unit ``direction`` [m], its profile's period ``pitch`` [m] along the
+    axis and its ``lead`` [m] (the advance per turn, counterclockwise about ``direction``:
+    positive for a right-handed thread; a multiple of the pitch for several starts), its
+    least and largest radii ``inner`` and ``outer`` [m] over ``span`` (along ``direction``
+    from ``point``: the levels where every half-plane meets it within those radii)."""
+
+    point: np.ndarray
+    direction: np.ndarray
+    pitch: float
+    lead: float
+    inner: float
+    outer: float
+    span: tuple[float, float]
+
+
+def thread_profiles(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray,
+                    levels: np.ndarray, outermost: bool) -> np.ndarray:
+    """The radius [m] of ``mesh``'s surface about the axis through ``point`` along the unit
+    ``direction``, in each of :data:`THREAD_ANGLES` half-planes bounded by the axis (row k
+    at angle 2πk/K, counterclockwise about ``direction``, from a first one off the frame's
+    axes) at each of ``levels`` [m] along the axis: the surface crossing the half-plane's
+    line at that level nearest the axis (a nut's thread) or, ``outermost``, farthest
+    from it (a screw's); NaN where none crosses."""
+    across = np.eye(3)[int(np.argmin(np.abs(direction)))]
+    first = np.cross(direction, across)
+    first /= np.linalg.norm(first)
+    second = np.cross(direction, first)
+    found = np.full((THREAD_ANGLES, len(levels)), np.nan)
+    for k in range(THREAD_ANGLES):
+        angle = 0.1234 + 2 * np.pi * k / THREAD_ANGLES
+        out = np.cos(angle) * first + np.sin(angle) * second
+        segments = trimesh.intersections.mesh_plane(mesh, np.cross(direction, out), point)
+        if len(segments) == 0:
+            continue
+        z = (segments - point) @ direction
+        r = (segments - point) @ out
+        low, high = np.minimum(z[:, 0], z[:, 1]), np.maximum(z[:, 0], z[:, 1])
+        crossing = (levels[:, None] >= low[None]) & (levels[:, None] < high[None])
+        rise = np.where(high > low, z[:, 1] - z[:, 0], 1.0)
+        at = r[None, :, 0] + (levels[:, None] - z[None, :, 0]) / rise[None] * (r[:, 1] - r[:, 0])[None]
+        valid = crossing & (at > 0)
+        if outermost:
+            best = np.where(valid, at, -np.inf).max(axis=1)
+        else:
+            best = np.where(valid, at, np.inf).min(axis=1)
+        found[k] = np.where(np.isfinite(best), best, np.nan)
+    return found
+
+
+def _mismatch(a: np.ndarray, b: np.ndarray) -> float:
+    """The mean absolute difference of two profiles where both are measured (inf where they share under half)."""
+    both = np.isfinite(a) & np.isfinite(b)
+    return float(np.mean(np.abs(a[both] - b[both]))) if both.sum() * 2 >= min(len(a), len(b)) else math.inf
+
+
+def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[float, float] | None:
+    """(pitch, lead) [m] of :func:`thread_profiles` ``profiles`` at the evenly spaced
+    ``levels`` [m], over the levels ``within`` (along the axis), when they are one helical
+    surface: the first profile periodic along the axis (its smallest shift, above a
+    sixteenth of the stretch, under which it matches itself within :data:`THREAD_MATCH` of
+    its depth, at a local minimum of the difference: the pitch) and each half-plane's profile
+    the first one shifted by k times one shift s (within :data:`THREAD_MATCH`), s at least a
+    sixteenth of the pitch from 0 (a surface of revolution, rings or grooves, has s = 0);
+    the lead is K·s. None otherwise."""
+    inside = (levels >= within[0]) & (levels <= within[1])
+    rows = profiles[:, inside]
+    step = float(levels[1] - levels[0])
+    base = rows[0]
+    if np.isnan(base).mean() > 0.5:
+        return None
+    depth = float(np.nanpercentile(base, 95) - np.nanpercentile(base, 5))
+    if depth <= 2 * TOUCH:
+        return None
+    count = len(base)
+    shifts = np.arange(max(1, count // 16), count // 3)
+    if len(shifts) < 3:
+        return None
+    differences = np.array([_mismatch(base[s:], base[:-s]) for s in shifts])
+    minima = [i for i in range(1, len(shifts) - 1) if differences[i] <= THREAD_MATCH * depth
+              and differences[i] <= differences[i - 1] and differences[i] <= differences[i + 1]]
+    if not minima:
+        return None
+    period = int(shifts[minima[0]])
+    half = period // 2
+    options = np.arange(-half, half + 1)
+
+    def shifted(row: np.ndarray, s: int) -> float:
+        return _mismatch(row[s:], base[:-s]) if s > 0 else _mismatch(row[:s or None], base[-s:])
+
+    one = int(options[np.argmin([shifted(rows[1], int(s)) for s in options])])
+    if abs(one) * 16 < period:
+        return None
+    for k in range(1, len(rows)):
+        s = (k * one + half) % period - half
+        if shifted(rows[k], s) > THREAD_MATCH * depth:
+            return None
+    return period * step, len(rows) * one * step
+
+
+def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, overlap: tuple[float, float],
+            outermost: bool) -> Thread | None:
+    """``mesh``'s helical surface about the axis (:func:`helix`) measured over ``overlap``
+    (along the axis from ``point`` [m]), on its outermost crossings (a screw) or innermost
+    (a nut), or None; its span the levels about ``overlap`` where every half-plane meets it
+    within its radii."""
+    along = (mesh.vertices - point) @ direction
+    levels = np.linspace(float(along.min()), float(along.max()), THREAD_SAMPLES)
+    profiles = thread_profiles(mesh, point, direction, levels, outermost)
+    found = helix(profiles, levels, overlap)
+    if found is None:
+        return None
+    inside = (levels >= overlap[0]) & (levels <= overlap[1])
+    inner, outer = float(np.nanmin(profiles[:, inside])), float(np.nanmax(profiles[:, inside]))
+    on = np.all((profiles >= inner - TOUCH) & (profiles <= outer + TOUCH), axis=0)
+    middle = int(np.flatnonzero(inside)[np.sum(inside) // 2])
+    if not on[middle]:
+        return None
+    low = middle
+    while low > 0 and on[low - 1]:
+        low -= 1
+    high = middle
+    while high < len(on) - 1 and on[high + 1]:
+        high += 1
+    return Thread(point, direction, found[0], found[1], inner, outer, (float(levels[low]), float(levels[high])))
+
+
+def screwed_pairs(meshes: dict[str, trimesh.Trimesh]) -> list[Slide]:
+    """The screwed pairs among ``meshes``: a part's outermost surface (a screw's) and
+    another's innermost (a nut's, a tapped hole's), about one axis along an axis of the
+    frame through the centre of the smaller part's box across it, over the stretch where
+    both parts are, each a helical surface (:func:`helix`) of one pitch and one lead
+    (within 2 %), the screw's crest outside the nut's minor radius (they interlock).
+    Each is a :class:`executor.cad.sweep.Slide` along that axis: swept against its mate
+    only, the screw's thread is taken in to under the nut's minor radius (its vertices
+    from that radius out to twice its crest less it, on its thread's span, moved in by
+    its crest less that radius plus :data:`TOUCH`), so
+    the pair slides along the axis where nothing else (a head, a bottom) stops it."""
+    found: list[Slide] = []
+    ids = sorted(meshes)
+    for a in ids:
+        for b in ids:
+            if a == b:
+                continue
+            low = np.maximum(meshes[a].bounds[0], meshes[b].bounds[0])
+            high = np.minimum(meshes[a].bounds[1], meshes[b].bounds[1])
+            if np.any(high - low <= TOUCH):
+                continue
+            for axis in range(3):
+                slide = _screwed(meshes[a], meshes[b], axis, (float(low[axis]), float(high[axis])))
+                if slide is not None:
+                    found.append(replace(slide, shaft=a, bore=b))
+    return found
+
+
+def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: tuple[float, float]) -> Slide | None:
+    """The screwed pair (:func:`screwed_pairs`) of ``screw`` in ``nut`` along the frame's
+    ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None."""
+    direction = np.eye(3)[axis]
+    across = [i for i in range(3) if i != axis]
+    smaller = min((screw, nut), key=lambda m: float(np.prod(m.extents[across])))
+    point = smaller.bounds.mean(axis=0) * (1 - direction)
+    male = _thread(screw, point, direction, overlap, outermost=True)
+    if male is None:
+        return None
+    female = _thread(nut, point, direction, overlap, outermost=False)
+    if (female is None or abs(male.pitch - female.pitch) > 0.02 * male.pitch
+            or abs(male.lead - female.lead) > 0.02 * abs(male.lead) or male.outer <= female.inner):
+        return None
+    reach = male.outer - female.inner + TOUCH
+    face = CylinderFace(point, direction, male.outer, male.span, True, 0.0)
+    hole = CylinderFace(point, direction, female.inner, female.span, False, 0.0)
+    return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead)

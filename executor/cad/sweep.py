@@ -324,7 +324,9 @@ class Slide:
     ``thinner`` [m] there (module docstring). ``seated``: the two faces' spans along the
     axis overlap by more than the tolerance in the assembled pose (the shaft is in the
     bore); else it is a **passage**, the faces meeting only on a way along the axis (a
-    pulley's bore passing a collar of its hub on its way off the hub's end)."""
+    pulley's bore passing a collar of its hub on its way off the hub's end). A **screwed
+    pair** (:func:`executor.cad.sections.screwed_pairs`: a modelled thread, ``shaft`` the
+    screw and ``bore`` the nut) has the thread's ``pitch`` and ``lead`` [m] (0 for any other fit)."""
 
     shaft: str
     bore: str
@@ -333,6 +335,8 @@ class Slide:
     tolerance: float
     thinner: float
     seated: bool
+    pitch: float = 0.0
+    lead: float = 0.0
 
     @property
     def direction(self) -> np.ndarray:

@@ -1,0 +1,59 @@
+"""Modelled helical threads: a screw in its nut is a screwed pair (pitch and lead measured),
+slid along its axis and placed by hand; grooves of revolution are no thread."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from executor import ExecutorError
+from executor.cad.derive import derive
+from executor.cad.operations import cell_view
+from executor.cad.parts import CadPart, load_meshes
+from executor.cad.sections import screwed_pairs
+
+CORPUS = Path(__file__).parent / "corpus"
+
+
+def test_a_screw_in_its_nut_is_screwed_with_the_libraries_pitch_and_placed_by_hand() -> None:
+    # BOSL2's 1/4-20 UNC screw (pitch 1.27 mm, right-handed) in its nut: every straight way
+    # out collides with the nut's thread, so without the pair the screw never comes out.
+    parts = load_meshes(CORPUS / "bosl2_screw_nut" / "meshes", "mm")
+    derived = derive(parts, "nut", {})
+    [pair] = [s for s in derived.slides if s.pitch]
+    assert (pair.shaft, pair.bore) == ("screw", "nut")
+    assert np.allclose(np.abs(pair.direction), [0, 0, 1])
+    assert pair.pitch == pytest.approx(1.27e-3, abs=2e-5)
+    assert pair.lead * np.sign(pair.direction[2]) == pytest.approx(1.27e-3, abs=4e-5)  # right-handed about +z
+    assert derived.axis == {"screw": "+z"}  # out past its head's side only: the head stops it along -z
+    assert derived.blockers[("screw", "-z")] == {"nut"}
+    _, by_hand = cell_view(derived)
+    assert "screwed into 'nut'" in by_hand["screw"] and "modelled thread" in by_hand["screw"]
+
+
+def _grooved(outer: bool) -> trimesh.Trimesh:
+    """A rod (``outer`` False) or a ring round it (True) whose surface at the other is
+    grooved by rings 1 mm apart, 0.5 mm deep (a surface of revolution: no thread) [m]."""
+    z = np.linspace(0.0, 10.0, 41)
+    wave = 2.5 + np.abs((z % 1.0) - 0.5)  # a triangular wave, radius 2.5 to 3.0 mm
+    if outer:
+        profile = np.column_stack([np.concatenate([wave + 0.05, [6.0, 6.0, wave[0] + 0.05]]),
+                                   np.concatenate([z, [10.0, 0.0, 0.0]])])
+    else:
+        profile = np.column_stack([np.concatenate([[0.0], wave, [0.0]]), np.concatenate([[0.0], z, [10.0]])])
+    mesh = trimesh.creation.revolve(profile[::-1] if outer else profile, sections=64)
+    mesh.apply_scale(1e-3)
+    if mesh.volume < 0:
+        mesh.invert()
+    return mesh
+
+
+def test_grooves_of_revolution_are_no_thread_and_the_rod_never_comes_out() -> None:
+    rod, ring = _grooved(False), _grooved(True)
+    assert rod.is_watertight and ring.is_watertight
+    assert screwed_pairs({"rod": rod, "ring": ring}) == []
+    with pytest.raises(ExecutorError, match="rod never come out"):
+        derive([CadPart("ring", "ring", ring, "ring"), CadPart("rod", "rod", rod, "rod")], "ring", {})
