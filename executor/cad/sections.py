@@ -40,7 +40,7 @@ diameter instead.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -867,19 +867,19 @@ class Thread:
 
 
 def thread_profiles(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray,
-                    levels: np.ndarray, outermost: bool) -> np.ndarray:
+                    levels: np.ndarray, outermost: bool, rows: Iterable[int] = range(THREAD_ANGLES)) -> np.ndarray:
     """The radius [m] of ``mesh``'s surface about the axis through ``point`` along the unit
-    ``direction``, in each of :data:`THREAD_ANGLES` half-planes bounded by the axis (row k
-    at angle 2πk/K, counterclockwise about ``direction``, from a first one off the frame's
-    axes) at each of ``levels`` [m] along the axis: the surface crossing the half-plane's
-    line at that level nearest the axis (a nut's thread) or, ``outermost``, farthest
-    from it (a screw's); NaN where none crosses."""
+    ``direction``, in the half-planes ``rows`` of :data:`THREAD_ANGLES` bounded by the axis
+    (row k at angle 0.1234 + 2πk/K rad, counterclockwise about ``direction``: off the
+    frame's axes) at each of ``levels`` [m] along the axis: the surface crossing the
+    half-plane's line at that level nearest the axis (a nut's thread) or, ``outermost``,
+    farthest from it (a screw's); NaN where none crosses (and in the rows not asked)."""
     across = np.eye(3)[int(np.argmin(np.abs(direction)))]
     first = np.cross(direction, across)
     first /= np.linalg.norm(first)
     second = np.cross(direction, first)
     found = np.full((THREAD_ANGLES, len(levels)), np.nan)
-    for k in range(THREAD_ANGLES):
+    for k in rows:
         angle = 0.1234 + 2 * np.pi * k / THREAD_ANGLES
         out = np.cos(angle) * first + np.sin(angle) * second
         segments = trimesh.intersections.mesh_plane(mesh, np.cross(direction, out), point)
@@ -887,15 +887,16 @@ def thread_profiles(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndar
             continue
         z = (segments - point) @ direction
         r = (segments - point) @ out
-        low, high = np.minimum(z[:, 0], z[:, 1]), np.maximum(z[:, 0], z[:, 1])
-        crossing = (levels[:, None] >= low[None]) & (levels[:, None] < high[None])
-        rise = np.where(high > low, z[:, 1] - z[:, 0], 1.0)
-        at = r[None, :, 0] + (levels[:, None] - z[None, :, 0]) / rise[None] * (r[:, 1] - r[:, 0])[None]
-        valid = crossing & (at > 0)
-        if outermost:
-            best = np.where(valid, at, -np.inf).max(axis=1)
-        else:
-            best = np.where(valid, at, np.inf).min(axis=1)
+        order = np.argsort(levels)
+        best = np.full(len(levels), -np.inf if outermost else np.inf)
+        for (z0, z1), (r0, r1) in zip(z, r):  # each segment over the levels it spans
+            if z1 == z0:
+                continue
+            lo, hi = np.searchsorted(levels[order], [min(z0, z1), max(z0, z1)], side="left")
+            at = order[lo:hi]
+            radius = r0 + (levels[at] - z0) / (z1 - z0) * (r1 - r0)
+            radius = np.where(radius > 0, radius, -np.inf if outermost else np.inf)
+            best[at] = np.maximum(best[at], radius) if outermost else np.minimum(best[at], radius)
         found[k] = np.where(np.isfinite(best), best, np.nan)
     return found
 
@@ -906,12 +907,31 @@ def _mismatch(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.mean(np.abs(a[both] - b[both]))) if both.sum() * 2 >= min(len(a), len(b)) else math.inf
 
 
+def period(profile: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[int, float] | None:
+    """The period (in levels) and the depth [m] (5th to 95th percentile) of one
+    :func:`thread_profiles` row at the evenly spaced ``levels`` [m], over the levels
+    ``within``: its smallest shift, above a sixteenth of the stretch and under a third,
+    under which it matches itself within :data:`THREAD_MATCH` of its depth, at a local
+    minimum of the difference; None where it has none (or is measured on under half the stretch)."""
+    base = profile[(levels >= within[0]) & (levels <= within[1])]
+    if len(base) == 0 or np.isnan(base).mean() > 0.5:
+        return None
+    depth = float(np.nanpercentile(base, 95) - np.nanpercentile(base, 5))
+    if depth <= 2 * TOUCH:
+        return None
+    shifts = np.arange(max(1, len(base) // 16), len(base) // 3)
+    if len(shifts) < 3:
+        return None
+    differences = np.array([_mismatch(base[s:], base[:-s]) for s in shifts])
+    minima = [i for i in range(1, len(shifts) - 1) if differences[i] <= THREAD_MATCH * depth
+              and differences[i] <= differences[i - 1] and differences[i] <= differences[i + 1]]
+    return (int(shifts[minima[0]]), depth) if minima else None
+
+
 def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[float, float] | None:
     """(pitch, lead) [m] of :func:`thread_profiles` ``profiles`` at the evenly spaced
     ``levels`` [m], over the levels ``within`` (along the axis), when they are one helical
-    surface: the first profile periodic along the axis (its smallest shift, above a
-    sixteenth of the stretch, under which it matches itself within :data:`THREAD_MATCH` of
-    its depth, at a local minimum of the difference: the pitch) and each half-plane's profile
+    surface: the first profile periodic along the axis (:func:`period`: the pitch) and each half-plane's profile
     the first one shifted by k times one shift s (within :data:`THREAD_MATCH`), s at least a
     sixteenth of the pitch from 0 (a surface of revolution, rings or grooves, has s = 0);
     the lead is K·s. None otherwise."""
@@ -919,35 +939,24 @@ def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float])
     rows = profiles[:, inside]
     step = float(levels[1] - levels[0])
     base = rows[0]
-    if np.isnan(base).mean() > 0.5:
+    found = period(profiles[0], levels, within)
+    if found is None:
         return None
-    depth = float(np.nanpercentile(base, 95) - np.nanpercentile(base, 5))
-    if depth <= 2 * TOUCH:
-        return None
-    count = len(base)
-    shifts = np.arange(max(1, count // 16), count // 3)
-    if len(shifts) < 3:
-        return None
-    differences = np.array([_mismatch(base[s:], base[:-s]) for s in shifts])
-    minima = [i for i in range(1, len(shifts) - 1) if differences[i] <= THREAD_MATCH * depth
-              and differences[i] <= differences[i - 1] and differences[i] <= differences[i + 1]]
-    if not minima:
-        return None
-    period = int(shifts[minima[0]])
-    half = period // 2
+    cycle, depth = found
+    half = cycle // 2
     options = np.arange(-half, half + 1)
 
     def shifted(row: np.ndarray, s: int) -> float:
         return _mismatch(row[s:], base[:-s]) if s > 0 else _mismatch(row[:s or None], base[-s:])
 
     one = int(options[np.argmin([shifted(rows[1], int(s)) for s in options])])
-    if abs(one) * 16 < period:
+    if abs(one) * 16 < cycle:
         return None
     for k in range(1, len(rows)):
-        s = (k * one + half) % period - half
+        s = (k * one + half) % cycle - half
         if shifted(rows[k], s) > THREAD_MATCH * depth:
             return None
-    return period * step, len(rows) * one * step
+    return cycle * step, len(rows) * one * step
 
 
 def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, overlap: tuple[float, float],
@@ -958,6 +967,9 @@ def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, ove
     within its radii."""
     along = (mesh.vertices - point) @ direction
     levels = np.linspace(float(along.min()), float(along.max()), THREAD_SAMPLES)
+    profiles = thread_profiles(mesh, point, direction, levels, outermost, rows=[0])
+    if period(profiles[0], levels, overlap) is None:  # the cheap reject: one half-plane
+        return None
     profiles = thread_profiles(mesh, point, direction, levels, outermost)
     found = helix(profiles, levels, overlap)
     if found is None:
