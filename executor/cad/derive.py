@@ -91,7 +91,6 @@ from executor.cad.sections import (
     over_span,
     passage,
     passes,
-    screwed_pairs,
     section,
     slice_loops,
     zero_clearance,
@@ -108,6 +107,7 @@ from executor.cad.sweep import (
     axis_name,
     forked_map,
     processes,
+    screwed_pairs,
     surveys,
     zero_clearance_fits,
 )

@@ -12,8 +12,8 @@ import trimesh
 from executor import ExecutorError
 from executor.cad.derive import derive
 from executor.cad.operations import cell_view
-from executor.cad.parts import CadPart, load_meshes
-from executor.cad.sections import screwed_pairs
+from executor.cad.parts import CadPart, _check_overlaps, load_meshes
+from executor.cad.sweep import screwed_pairs
 
 CORPUS = Path(__file__).parent / "corpus"
 
@@ -57,3 +57,16 @@ def test_grooves_of_revolution_are_no_thread_and_the_rod_never_comes_out() -> No
     assert screwed_pairs({"rod": rod, "ring": ring}) == []
     with pytest.raises(ExecutorError, match="rod never come out"):
         derive([CadPart("ring", "ring", ring, "ring"), CadPart("rod", "rod", rod, "rod")], "ring", {})
+
+
+def test_a_thread_in_a_hole_drawn_at_its_tap_drill_is_named_in_the_overlap() -> None:
+    # The 1/4-20 screw through a plate under its head whose hole is drawn at the thread's tap
+    # drill (#7, d 5.105 mm) with no thread: the thread overlaps the plate; the refusal
+    # names the thread and the plate.
+    [screw] = [p for p in load_meshes(CORPUS / "bosl2_screw_nut" / "meshes", "mm") if p.id == "screw"]
+    plate = trimesh.creation.annulus(r_min=5.105e-3 / 2, r_max=15e-3, height=5e-3, sections=48)
+    plate.apply_translation([0.0, 0.0, 7.025e-3])  # z 4.525 to 9.525 mm, the head on it
+    named = (r"'plate' and 'screw' overlap .*'screw' has a modelled thread "
+             r"\(pitch 1\.27\d mm, d 6\.\d+ mm, along z\) in 'plate', which has no thread")
+    with pytest.raises(ExecutorError, match=named):
+        _check_overlaps([CadPart("plate", "plate", plate, "plate"), screw])
