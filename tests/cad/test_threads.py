@@ -70,3 +70,17 @@ def test_a_thread_in_a_hole_drawn_at_its_tap_drill_is_named_in_the_overlap() -> 
              r"\(pitch 1\.27\d mm, d 6\.\d+ mm, along z\) in 'plate', which has no thread")
     with pytest.raises(ExecutorError, match=named):
         _check_overlaps([CadPart("plate", "plate", plate, "plate"), screw])
+
+
+def test_the_screw_goes_after_the_plate_it_clamps_on_its_nut() -> None:
+    # A plate with a d 7 clearance hole between the nut's top (z 6.095) and the screw's head
+    # (z 9.525): the head closes the plate's way up, the shank its ways across, so the plate
+    # precedes the screw (blocks); the screw, slid along its thread, leaves upwards.
+    parts = load_meshes(CORPUS / "bosl2_screw_nut" / "meshes", "mm")
+    plate = trimesh.creation.annulus(r_min=3.5e-3, r_max=15e-3, height=3.43e-3, sections=48)
+    plate.apply_translation([0.0, 0.0, (6.095e-3 + 9.525e-3) / 2])
+    derived = derive([*parts, CadPart("plate", "plate", plate, "plate")], "nut", {})
+    assert derived.stages == [["screw"], ["plate"]]
+    assert derived.reasons[("plate", "screw")] == "blocks"
+    assert ("screw", "plate") not in derived.reasons
+    assert set(cell_view(derived)[1]) == {"screw"}
