@@ -8,8 +8,11 @@ pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
 every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
-along the first such direction: its **insertion axis** is the reverse. A part that no
-stage frees never comes out (an error naming it and, per direction, its blockers).
+along the first such direction: its **insertion axis** is the reverse. Where parts are
+left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`)
+between them and their blockers slide along their axes, their parts are swept again and
+the stages made anew. A part that no stage frees never comes out (an error naming it and,
+per direction, its blockers).
 
 **Geometric precedence** (:func:`forced`): A must precede B (``blocks``) when A cannot go
 in once B is there: of the directions the base leaves A free along, B blocks one, and B
@@ -319,7 +322,6 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     made = surveys({p.id: p.mesh for p in parts})
     beside()
     result.slides = zero_clearance_fits({pid: survey.faces for pid, survey in made.items()})
-    result.slides += screwed_pairs({p.id: p.mesh for p in parts})
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
         result.directions.setdefault(axis_name(-slide.direction), tuple(-slide.direction))
@@ -332,21 +334,26 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     hits = sweeper.blocked([(members, np.array(result.directions[name]), length) for members, name in requests])
     for (members, name), hit in zip(requests, hits):
         result.blockers |= {(pid, name): hit for pid in members}
-    remaining = set(by_id) - {base}
-    while remaining:
-        stage = sorted(pid for pid in remaining if any(
-            not (result.blockers[(pid, d)] & (remaining | {base})) for d in result.directions))
-        if not stage:
-            stuck = "; ".join(f"{pid} along " + ", ".join(
-                f"{d} by {' '.join(sorted(result.blockers[(pid, d)] & (remaining | {base})))}"
-                for d in result.directions) for pid in sorted(remaining))
-            raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
-                                f"blocked: {stuck} (expected a straight way out for every part but the base)")
-        for pid in stage:
-            result.axis[pid] = next(d for d in result.directions
-                                    if not (result.blockers[(pid, d)] & (remaining | {base})))
-        result.stages.append(stage)
-        remaining -= set(stage)
+    remaining = _disassembled(result)
+    if remaining:  # modelled threads: sought only where a part is left, between it and its blockers
+        screwed = screwed_pairs({p.id: p.mesh for p in parts}, {
+            (pid, other) for pid in remaining for d in result.directions for other in result.blockers[(pid, d)]})
+        if screwed:
+            result.slides += screwed
+            sweeper.add(screwed)
+            paired = {pid for s in screwed for pid in (s.shaft, s.bore)}
+            again = [(members, name) for members, name in requests if members & paired]
+            hits = sweeper.blocked([(members, np.array(result.directions[name]), length) for members, name in again])
+            for (members, name), hit in zip(again, hits):
+                result.blockers |= {(pid, name): hit for pid in members}
+            result.axis, result.stages = {}, []
+            remaining = _disassembled(result)
+    if remaining:
+        stuck = "; ".join(f"{pid} along " + ", ".join(
+            f"{d} by {' '.join(sorted(result.blockers[(pid, d)] & (remaining | {base})))}"
+            for d in result.directions) for pid in sorted(remaining))
+        raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
+                            f"blocked: {stuck} (expected a straight way out for every part but the base)")
     result.reasons = forced(result)
     result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
     if reach > 0:
@@ -375,6 +382,24 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     result.queries = sweeper.queries
     return result
+
+
+def _disassembled(result: Derived) -> set[str]:
+    """Stage by stage, every part that some direction frees from the parts still in place
+    leaves along the first such direction (``result``'s ``axis`` and ``stages`` filled in);
+    the parts no stage frees."""
+    remaining = set(result.parts) - {result.base}
+    while remaining:
+        stage = sorted(pid for pid in remaining if any(
+            not (result.blockers[(pid, d)] & (remaining | {result.base})) for d in result.directions))
+        if not stage:
+            break
+        for pid in stage:
+            result.axis[pid] = next(d for d in result.directions
+                                    if not (result.blockers[(pid, d)] & (remaining | {result.base})))
+        result.stages.append(stage)
+        remaining -= set(stage)
+    return remaining
 
 
 def receives(fit: HoleFit) -> bool:

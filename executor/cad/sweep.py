@@ -844,6 +844,15 @@ class Sweeper:
         """(moving solid, fixed solid (their ids), shift [m]) -> whether the sweep collides:
         A moved against B and B moved back against A are one test."""
 
+    def add(self, slides: Iterable[Slide]) -> None:
+        """Take ``slides`` too (screwed pairs found once the disassembly stopped): the
+        sweeps of their pairs along their axes are asked anew (their slid solids are new);
+        the workers, forked with the slides as they were, end here (a later query forks them
+        anew)."""
+        self.close()
+        for slide in slides:
+            self._slides.setdefault((slide.shaft, slide.bore), []).append(slide)
+
     def blockers(self, body: str | Iterable[str], direction: np.ndarray, length: float) -> set[str]:
         """The other parts that the part (or the parts, moved together) ``body`` collides
         with when moved by ``length`` [m] along the unit vector ``direction``, everything
@@ -1293,8 +1302,9 @@ def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, ove
     return Thread(point, direction, found[0], found[1], inner, outer, (float(levels[low]), float(levels[high])))
 
 
-def screwed_pairs(meshes: dict[str, trimesh.Trimesh]) -> list[Slide]:
-    """The screwed pairs among ``meshes``: a part's outermost surface (a screw's) and
+def screwed_pairs(meshes: dict[str, trimesh.Trimesh], pairs: Iterable[tuple[str, str]] | None = None) -> list[Slide]:
+    """The screwed pairs among ``meshes`` (of ``pairs``, either way round, where given: the
+    import asks only of parts the disassembly leaves and their blockers): a part's outermost surface (a screw's) and
     another's innermost (a nut's, a tapped hole's), about one axis along an axis of the
     frame through the centre of the smaller part's box across it, over the stretch where
     both parts are, each a helical surface (:func:`helix`) of one pitch and one lead
@@ -1306,9 +1316,10 @@ def screwed_pairs(meshes: dict[str, trimesh.Trimesh]) -> list[Slide]:
     the pair slides along the axis where nothing else (a head, a bottom) stops it."""
     found: list[Slide] = []
     ids = sorted(meshes)
+    asked = None if pairs is None else {frozenset(pair) for pair in pairs}
     for a in ids:
         for b in ids:
-            if a == b:
+            if a == b or (asked is not None and frozenset((a, b)) not in asked):
                 continue
             low = np.maximum(meshes[a].bounds[0], meshes[b].bounds[0])
             high = np.minimum(meshes[a].bounds[1], meshes[b].bounds[1])
