@@ -251,7 +251,8 @@ class Derived:
                 f"({sum(s.seated for s in fits)} fit(s) and "
                 f"{sum(not s.seated for s in fits)} passage(s) found"
                 + (f", tolerances up to {1e6 * largest:.1f} µm)" if fits else ")"),
-                "modelled threads: a part's outermost surface and another's innermost, each helical about one axis "
+                "modelled threads (sought where the disassembly leaves parts, between them and their blockers): "
+                "a part's outermost surface and another's innermost, each helical about one axis "
                 "of the frame (through the smaller part's box centre) with one pitch and lead within 2 %, "
                 "interlocking, are screwed: they slide along that axis against each other (the screw's thread "
                 f"taken in under the nut's minor radius; {sum(1 for s in self.slides if s.pitch)} pair(s) found)"]

@@ -1247,7 +1247,8 @@ def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float])
     surface: the first profile periodic along the axis (:func:`period`: the pitch) and each half-plane's profile
     the first one shifted by k times one shift s (within :data:`THREAD_MATCH`), s at least a
     sixteenth of the pitch from 0 (a surface of revolution, rings or grooves, has s = 0);
-    the lead is K·s. None otherwise."""
+    the lead is K·s, taken as the nearest whole number of pitches (the starts; K·s measured
+    within K levels of it, else None). None otherwise."""
     inside = (levels >= within[0]) & (levels <= within[1])
     rows = profiles[:, inside]
     step = float(levels[1] - levels[0])
@@ -1269,7 +1270,12 @@ def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float])
         s = (k * one + half) % cycle - half
         if shifted(rows[k], s) > THREAD_MATCH * depth:
             return None
-    return cycle * step, len(rows) * one * step
+    # one is a whole number of levels (±0.5), K·one within ±K/2 of the lead: the lead is the
+    # nearest whole number of pitches (the starts), where K·one lies within K levels of it
+    starts = round(len(rows) * abs(one) / cycle)
+    if starts < 1 or abs(len(rows) * abs(one) - starts * cycle) > len(rows):
+        return None
+    return cycle * step, float(np.sign(one)) * starts * cycle * step
 
 
 def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, overlap: tuple[float, float],

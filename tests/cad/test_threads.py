@@ -27,7 +27,7 @@ def test_a_screw_in_its_nut_is_screwed_with_the_libraries_pitch_and_placed_by_ha
     assert (pair.shaft, pair.bore) == ("screw", "nut")
     assert np.allclose(np.abs(pair.direction), [0, 0, 1])
     assert pair.pitch == pytest.approx(1.27e-3, abs=2e-5)
-    assert pair.lead * np.sign(pair.direction[2]) == pytest.approx(1.27e-3, abs=4e-5)  # right-handed about +z
+    assert pair.lead * np.sign(pair.direction[2]) == pytest.approx(pair.pitch)  # one start, right-handed about +z
     assert derived.axis == {"screw": "+z"}  # out past its head's side only: the head stops it along -z
     assert derived.blockers[("screw", "-z")] == {"nut"}
     _, by_hand = cell_view(derived)
