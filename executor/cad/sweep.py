@@ -1223,7 +1223,7 @@ def _mismatch(a: np.ndarray, b: np.ndarray) -> float:
 def period(profile: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[int, float] | None:
     """The period (in levels) and the depth [m] (5th to 95th percentile) of one
     :func:`thread_profiles` row at the evenly spaced ``levels`` [m], over the levels
-    ``within``: its smallest shift, above a sixteenth of the stretch and under a third,
+    ``within``: its smallest shift, above a sixteenth of the stretch and under a half,
     under which it matches itself within :data:`THREAD_MATCH` of its depth, at a local
     minimum of the difference; None where it has none (or is measured on under half the stretch)."""
     base = profile[(levels >= within[0]) & (levels <= within[1])]
@@ -1232,7 +1232,7 @@ def period(profile: np.ndarray, levels: np.ndarray, within: tuple[float, float])
     depth = float(np.nanpercentile(base, 95) - np.nanpercentile(base, 5))
     if depth <= 2 * TOUCH:
         return None
-    shifts = np.arange(max(1, len(base) // 16), len(base) // 3)
+    shifts = np.arange(max(1, len(base) // 16), len(base) // 2)
     if len(shifts) < 3:
         return None
     differences = np.array([_mismatch(base[s:], base[:-s]) for s in shifts])
