@@ -836,4 +836,3 @@ def passes(peg: Shape2D, hole: Shape2D) -> bool:
     except OutlineError:
         return False
     return room > 0 or zero_clearance(peg, hole, room) is not None
-
