@@ -47,7 +47,7 @@ from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
-from executor.cad.operations import entry_point, pin_entry
+from executor.cad.operations import entry_point, pin_entry, screwed_fits
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -268,6 +268,8 @@ def _swept(derived: Derived, part: str, feature: str) -> str:
     least room on the way in and that room, as ``sizes.lp`` takes it; "" elsewhere."""
     if (part, feature) not in derived.swept:
         return ""
+    if (part, feature) in screwed_fits(derived):
+        return "; screwed (a modelled thread): it fits by screwing, room 0, placed by hand"
     peg, hole, room = derived.swept[(part, feature)]
     apart = zero_clearance(peg, hole, room)
     verdict = f"room {_mm(room)} mm" if apart is None else \

@@ -8,8 +8,11 @@ pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
 every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
-along the first such direction: its **insertion axis** is the reverse. A part that no
-stage frees never comes out (an error naming it and, per direction, its blockers).
+along the first such direction: its **insertion axis** is the reverse. Where parts are
+left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`)
+between them and their blockers slide along their axes, their parts are swept again and
+the stages made anew. A part that no stage frees never comes out (an error naming it and,
+per direction, its blockers).
 
 **Geometric precedence** (:func:`forced`): A must precede B (``blocks``) when A cannot go
 in once B is there: of the directions the base leaves A free along, B blocks one, and B
@@ -110,6 +113,7 @@ from executor.cad.sweep import (
     axis_name,
     forked_map,
     processes,
+    screwed_pairs,
     surveys,
     zero_clearance_fits,
 )
@@ -247,29 +251,46 @@ class Derived:
 
     def assumptions(self) -> list[str]:
         """The stated assumptions of the disassembly, as ``import`` prints them."""
-        largest = max((s.tolerance for s in self.slides), default=0.0)
+        fits = [s for s in self.slides if not s.pitch]
+        largest = max((s.tolerance for s in fits), default=0.0)
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
                 "(a face's triangles' largest distance from its circle; a face whose triangles lie farther than "
                 f"{100 * COARSEST:.1f}% of its radius from it, the sagitta of a chord of {math.degrees(SMOOTH):.0f}°, "
                 "is no cylinder) plus 10 µm, and prisms along a cell axis whose outlines are one within 10 µm, "
                 "slide along their axis where they sit and on the way "
-                f"({sum(s.seated for s in self.slides)} fit(s) and "
-                f"{sum(not s.seated for s in self.slides)} passage(s) found"
-                + (f", tolerances up to {1e6 * largest:.1f} µm)" if self.slides else ")")]
+                f"({sum(s.seated for s in fits)} fit(s) and "
+                f"{sum(not s.seated for s in fits)} passage(s) found"
+                + (f", tolerances up to {1e6 * largest:.1f} µm)" if fits else ")"),
+                "modelled threads (sought where the disassembly leaves parts, between them and their blockers): "
+                "a part's outermost surface and another's innermost, each helical about one axis "
+                "of the frame (through the smaller part's box centre) with one pitch and lead within 2 %, "
+                "interlocking, are screwed: they slide along that axis against each other (the screw's thread "
+                f"taken in under the nut's minor radius; {sum(1 for s in self.slides if s.pitch)} pair(s) found)"]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""
-        lines = [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
+        lines = [f"screwed pair {s.shaft} in {s.bore} (a modelled thread): d {2000 * s.face.radius:.3f} mm in a minor "
+                 f"d {2000 * s.hole.radius:.3f} mm along {axis_name(s.direction)[1:]}, pitch {1000 * s.pitch:.3f} mm, "
+                 f"lead {1000 * abs(s.lead):.3f} mm, {'right' if s.lead > 0 else 'left'}-handed about "
+                 f"{axis_name(s.direction)}; slides along the axis against each other, the cell does not screw"
+                 for s in self.slides if s.pitch]
+        lines += [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
                   f"zero-clearance passage {s.shaft} through {s.bore} (met only on a way along the axis): ")
                  + f"{_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
-                 f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding" for s in self.slides]
+                  f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding"
+                  for s in self.slides if not s.pitch]
         lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
                   for (a, b), detail in sorted(self.detail.items())]
         lines += [f"supporting pair {y}->{x} dropped: the blocking needs {x} before {y}"
                   for y, x in sorted(self.dropped_supports)]
         return lines
+
+    def screwed(self, part: str, other: str) -> Slide | None:
+        """The screwed pair (a modelled thread) of parts ``part`` and ``other``, either in
+        the other, or None."""
+        return next((s for s in self.slides if s.pitch and {s.shaft, s.bore} == {part, other}), None)
 
     def pin_of(self, part: str) -> PinFit:
         """The first pin ``part`` (one with a bore) is on: the one its bore of :attr:`bores` is around."""
@@ -325,21 +346,26 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     hits = sweeper.blocked([(members, np.array(result.directions[name]), length) for members, name in requests])
     for (members, name), hit in zip(requests, hits):
         result.blockers |= {(pid, name): hit for pid in members}
-    remaining = set(by_id) - {base}
-    while remaining:
-        stage = sorted(pid for pid in remaining if any(
-            not (result.blockers[(pid, d)] & (remaining | {base})) for d in result.directions))
-        if not stage:
-            stuck = "; ".join(f"{pid} along " + ", ".join(
-                f"{d} by {' '.join(sorted(result.blockers[(pid, d)] & (remaining | {base})))}"
-                for d in result.directions) for pid in sorted(remaining))
-            raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
-                                f"blocked: {stuck} (expected a straight way out for every part but the base)")
-        for pid in stage:
-            result.axis[pid] = next(d for d in result.directions
-                                    if not (result.blockers[(pid, d)] & (remaining | {base})))
-        result.stages.append(stage)
-        remaining -= set(stage)
+    remaining = _disassembled(result)
+    if remaining:  # modelled threads: sought only where a part is left, between it and its blockers
+        screwed = screwed_pairs({p.id: p.mesh for p in parts}, {
+            (pid, other) for pid in remaining for d in result.directions for other in result.blockers[(pid, d)]})
+        if screwed:
+            result.slides += screwed
+            sweeper.add(screwed)
+            paired = {pid for s in screwed for pid in (s.shaft, s.bore)}
+            again = [(members, name) for members, name in requests if members & paired]
+            hits = sweeper.blocked([(members, np.array(result.directions[name]), length) for members, name in again])
+            for (members, name), hit in zip(again, hits):
+                result.blockers |= {(pid, name): hit for pid in members}
+            result.axis, result.stages = {}, []
+            remaining = _disassembled(result)
+    if remaining:
+        stuck = "; ".join(f"{pid} along " + ", ".join(
+            f"{d} by {' '.join(sorted(result.blockers[(pid, d)] & (remaining | {base})))}"
+            for d in result.directions) for pid in sorted(remaining))
+        raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
+                            f"blocked: {stuck} (expected a straight way out for every part but the base)")
     result.reasons = forced(result)
     result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
     if reach > 0:
@@ -368,6 +394,24 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.edges = set(result.reasons)
     result.queries = sweeper.queries
     return result
+
+
+def _disassembled(result: Derived) -> set[str]:
+    """Stage by stage, every part that some direction frees from the parts still in place
+    leaves along the first such direction (``result``'s ``axis`` and ``stages`` filled in);
+    the parts no stage frees."""
+    remaining = set(result.parts) - {result.base}
+    while remaining:
+        stage = sorted(pid for pid in remaining if any(
+            not (result.blockers[(pid, d)] & (remaining | {result.base})) for d in result.directions))
+        if not stage:
+            break
+        for pid in stage:
+            result.axis[pid] = next(d for d in result.directions
+                                    if not (result.blockers[(pid, d)] & (remaining | {result.base})))
+        result.stages.append(stage)
+        remaining -= set(stage)
+    return remaining
 
 
 def receives(fit: HoleFit) -> bool:
@@ -779,7 +823,9 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
     own feature is tried the same way in every other feature of its owner along that axis
     (moved onto that feature's centre line and as deep past its entry; a pin under the bore
     as far past its tip), where the sections do not pass. A pair is admitted when its room
-    is positive or it is a nominal zero-clearance fit (:func:`executor.cad.sections.zero_clearance`)."""
+    is positive or it is a nominal zero-clearance fit (:func:`executor.cad.sections.zero_clearance`).
+    A screwed pair (a modelled thread, :meth:`Derived.screwed`) is not swept: its part fits
+    its feature by screwing, written with the feature's section for both and room 0."""
     found: dict[tuple[str, str], tuple[Shape2D, Shape2D, float]] = {}
     slicers: dict[tuple[str, str], Slicer] = {}
 
@@ -805,6 +851,9 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
     for hid, fit in holes.items():
         if fit.part is None or fit.section is None or passes(fit.section, fit.hole):
             continue
+        if derived.screwed(fit.part, fit.owner or derived.base):
+            found[(fit.part, hid)] = (fit.hole, fit.hole, 0.0)
+            continue
         out = np.array(DIRECTIONS[fit.axis])
         owner = fit.owner or derived.base
         peg, walls = slicer(fit.part, fit.axis, out), slicer(owner, fit.axis, out)
@@ -829,6 +878,9 @@ def swept_fits(derived: Derived) -> dict[tuple[str, str], tuple[Shape2D, Shape2D
         for pid in pin.parts:
             own = derived.bore_on(pid, pin_id)
             if passes(pin.section, own):
+                continue
+            if derived.screwed(pid, pin.owner):
+                found[(pid, pin_id)] = (own, own, 0.0)
                 continue
             bore = slicer(pid, name, out)
             low, entry = extent(pid, out, line, reach)

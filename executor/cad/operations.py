@@ -143,11 +143,20 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
     """(peg, hole) -> how far apart [m] the vertex circles' radii of each nominal
     zero-clearance fit are (:func:`executor.cad.sections.zero_clearance`: a round peg at
     least as wide as a round hole's inscribed circle, their vertex circles' radii within
-    10 µm); a part with a bore and a pin too."""
+    10 µm); a part with a bore and a pin too; a screwed pair (:func:`screwed_fits`) at 0."""
     rooms = _rooms(derived)
     found = {(pid, hid): zero_clearance(peg, hole, rooms[pid][hid])
              for pid, holes in section_pairs(derived).items() for hid, (peg, hole) in holes.items()}
+    found |= {(pid, hid): 0.0 for pid, hid in screwed_fits(derived) if (pid, hid) in found}
     return {pair: apart for pair, apart in found.items() if apart is not None}
+
+
+def screwed_fits(derived: Derived) -> set[tuple[str, str]]:
+    """(part, feature) of each part in a hole or on a pin of the part it is screwed with
+    (a modelled thread): a fit at room 0, by screwing."""
+    owners = {hid: fit.owner or derived.base for hid, fit in {**derived.holes, **derived.part_holes}.items()}
+    owners |= {pin_id: pin.owner for pin_id, pin in derived.pins.items()}
+    return {(pid, hid) for pid, hid in derived.swept if hid in owners and derived.screwed(pid, owners[hid])}
 
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
@@ -201,6 +210,24 @@ def _maybe_in_place(derived: Derived, pid: str) -> set[str]:
     return set(derived.parts) - nx.descendants(order(derived), pid) - {pid}
 
 
+def screwed(derived: Derived) -> dict[str, str]:
+    """Part -> why it is placed by hand, for the parts of screwed pairs (a modelled thread,
+    :func:`executor.cad.sweep.screwed_pairs`): of each pair the part that leaves first in
+    the disassembly (both where they leave at one stage; never the base). The cell has no
+    screwing operation."""
+    stage = {pid: k for k, parts in enumerate(derived.stages) for pid in parts}
+    found: dict[str, str] = {}
+    for slide in (s for s in derived.slides if s.pitch):
+        pair = [pid for pid in (slide.shaft, slide.bore) if pid in stage]
+        first = min((stage[pid] for pid in pair), default=None)
+        for pid in (pid for pid in pair if stage[pid] == first):
+            other = slide.bore if pid == slide.shaft else slide.shaft
+            found.setdefault(pid, f"part '{pid}' is screwed {'into' if pid == slide.shaft else 'onto'} '{other}' "
+                                  f"along {opposite(derived.axis[pid])} (a modelled thread, pitch "
+                                  f"{1000 * slide.pitch:.3f} mm): the cell has no screwing operation")
+    return found
+
+
 def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tuple[Derived, dict[str, str]]:
     """The product as the cell inserts it: only the holes entered from above or sideways
     holding, if anything, a peg going in along the hole's axis that is no polygon section,
@@ -215,12 +242,15 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
     peg's room is often below what convex pieces of its mesh keep), those ``refused``
     (part -> why) too."""
     kept: dict[str, HoleFit] = {}
-    by_hand: dict[str, str] = dict(refused or {})
+    screws = screwed(derived)
+    by_hand: dict[str, str] = screws | dict(refused or {})
     for pin in sorted(derived.pins.values(), key=lambda p: p.owner == derived.base):  # the cheap reasons first
         for pid in pin.parts:
             if pid not in by_hand and (why := _onto_pin(derived, pin, pid)) is not None:
                 by_hand[pid] = why
     for hid, fit in derived.holes.items():
+        if fit.part in screws:
+            continue
         if fit.part is not None and derived.axis[fit.part] != fit.axis:
             by_hand[fit.part] = (f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, its hole {hid} "
                                  f"is entered along {opposite(fit.axis)}")

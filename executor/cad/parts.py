@@ -44,7 +44,15 @@ import trimesh
 
 from bridge.assembly import is_id
 from executor import ExecutorError
-from executor.cad.sweep import CylinderFace, PrismFace, Slide, fit_faces, near, zero_clearance_fits
+from executor.cad.sweep import (
+    CylinderFace,
+    PrismFace,
+    Slide,
+    fit_faces,
+    lone_thread,
+    near,
+    zero_clearance_fits,
+)
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
@@ -419,7 +427,7 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
                                     "that at most touch, or coaxial cylinders of one radius within their "
-                                    "tessellations' deflection)")
+                                    "tessellations' deflection)" + lone_thread({a.id: a.mesh, b.id: b.mesh}))
 
 
 def _manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:

@@ -55,6 +55,7 @@ answers and their count are those of one process.
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import multiprocessing.pool
 import os
@@ -324,7 +325,9 @@ class Slide:
     ``thinner`` [m] there (module docstring). ``seated``: the two faces' spans along the
     axis overlap by more than the tolerance in the assembled pose (the shaft is in the
     bore); else it is a **passage**, the faces meeting only on a way along the axis (a
-    pulley's bore passing a collar of its hub on its way off the hub's end)."""
+    pulley's bore passing a collar of its hub on its way off the hub's end). A **screwed
+    pair** (:func:`screwed_pairs`: a modelled thread, ``shaft`` the
+    screw and ``bore`` the nut) has the thread's ``pitch`` and ``lead`` [m] (0 for any other fit)."""
 
     shaft: str
     bore: str
@@ -333,6 +336,8 @@ class Slide:
     tolerance: float
     thinner: float
     seated: bool
+    pitch: float = 0.0
+    lead: float = 0.0
 
     @property
     def direction(self) -> np.ndarray:
@@ -839,6 +844,15 @@ class Sweeper:
         """(moving solid, fixed solid (their ids), shift [m]) -> whether the sweep collides:
         A moved against B and B moved back against A are one test."""
 
+    def add(self, slides: Iterable[Slide]) -> None:
+        """Take ``slides`` too (screwed pairs found once the disassembly stopped): the
+        sweeps of their pairs along their axes are asked anew (their slid solids are new);
+        the workers, forked with the slides as they were, end here (a later query forks them
+        anew)."""
+        self.close()
+        for slide in slides:
+            self._slides.setdefault((slide.shaft, slide.bore), []).append(slide)
+
     def blockers(self, body: str | Iterable[str], direction: np.ndarray, length: float) -> set[str]:
         """The other parts that the part (or the parts, moved together) ``body`` collides
         with when moved by ``length`` [m] along the unit vector ``direction``, everything
@@ -1132,3 +1146,238 @@ _SLACK = 1e-9
 def _reach(piece: _Piece, toward: np.ndarray, nearest: np.ndarray) -> np.ndarray:
     """The extent [m] of ``piece`` along each unit vector ``toward`` beyond ``nearest`` (:func:`_likely`)."""
     return np.max(toward @ piece.points.T, axis=1) - nearest
+
+
+THREAD_ANGLES = 8
+"""Half-planes about a thread's axis its surface is cut with (:func:`thread_profiles`): a
+turn in eighths, so a lead of up to four pitches (four starts) shifts the profile by less than half a pitch."""
+THREAD_SAMPLES = 2048
+"""Levels along the axis each half-plane's profile is sampled at, over the part's extent."""
+THREAD_MATCH = 0.15
+"""Two profiles are one (shifted) when their mean difference is at most this fraction of
+the thread's depth (the profile's 5th to 95th percentile)."""
+
+
+@dataclass(frozen=True)
+class Thread:
+    """A helical surface measured on a part (:func:`helix`): about the axis through
+    ``point`` along the unit ``direction`` [m], its profile's period ``pitch`` [m] along the
+    axis and its ``lead`` [m] (the advance per turn, counterclockwise about ``direction``:
+    positive for a right-handed thread; a multiple of the pitch for several starts), its
+    least and largest radii ``inner`` and ``outer`` [m] over ``span`` (along ``direction``
+    from ``point``: the levels where every half-plane meets it within those radii)."""
+
+    point: np.ndarray
+    direction: np.ndarray
+    pitch: float
+    lead: float
+    inner: float
+    outer: float
+    span: tuple[float, float]
+
+
+def thread_profiles(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray,
+                    levels: np.ndarray, outermost: bool, rows: Iterable[int] = range(THREAD_ANGLES)) -> np.ndarray:
+    """The radius [m] of ``mesh``'s surface about the axis through ``point`` along the unit
+    ``direction``, in the half-planes ``rows`` of :data:`THREAD_ANGLES` bounded by the axis
+    (row k at angle 0.1234 + 2πk/K rad, counterclockwise about ``direction``: off the
+    frame's axes) at each of ``levels`` [m] along the axis: the surface crossing the
+    half-plane's line at that level nearest the axis (a nut's thread) or, ``outermost``,
+    farthest from it (a screw's); NaN where none crosses (and in the rows not asked)."""
+    across = np.eye(3)[int(np.argmin(np.abs(direction)))]
+    first = np.cross(direction, across)
+    first /= np.linalg.norm(first)
+    second = np.cross(direction, first)
+    found = np.full((THREAD_ANGLES, len(levels)), np.nan)
+    for k in rows:
+        angle = 0.1234 + 2 * np.pi * k / THREAD_ANGLES
+        out = np.cos(angle) * first + np.sin(angle) * second
+        segments = trimesh.intersections.mesh_plane(mesh, np.cross(direction, out), point)
+        if len(segments) == 0:
+            continue
+        z = (segments - point) @ direction
+        r = (segments - point) @ out
+        order = np.argsort(levels)
+        best = np.full(len(levels), -np.inf if outermost else np.inf)
+        for (z0, z1), (r0, r1) in zip(z, r):  # each segment over the levels it spans
+            if z1 == z0:
+                continue
+            lo, hi = np.searchsorted(levels[order], [min(z0, z1), max(z0, z1)], side="left")
+            at = order[lo:hi]
+            radius = r0 + (levels[at] - z0) / (z1 - z0) * (r1 - r0)
+            radius = np.where(radius > 0, radius, -np.inf if outermost else np.inf)
+            best[at] = np.maximum(best[at], radius) if outermost else np.minimum(best[at], radius)
+        found[k] = np.where(np.isfinite(best), best, np.nan)
+    return found
+
+
+def _mismatch(a: np.ndarray, b: np.ndarray) -> float:
+    """The mean absolute difference of two profiles where both are measured, over the 90 %
+    of levels where they differ least (a stretch's ends may reach a head, a chamfer or a
+    run-out); inf where they share under half their levels."""
+    both = np.isfinite(a) & np.isfinite(b)
+    if both.sum() * 2 < min(len(a), len(b)):
+        return math.inf
+    differences = np.sort(np.abs(a[both] - b[both]))
+    return float(np.mean(differences[:max(1, int(0.9 * len(differences)))]))
+
+
+def period(profile: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[int, float] | None:
+    """The period (in levels) and the depth [m] (5th to 95th percentile) of one
+    :func:`thread_profiles` row at the evenly spaced ``levels`` [m], over the levels
+    ``within``: its smallest shift, above a sixteenth of the stretch and under a half,
+    under which it matches itself within :data:`THREAD_MATCH` of its depth, at a local
+    minimum of the difference; None where it has none (or is measured on under half the stretch)."""
+    base = profile[(levels >= within[0]) & (levels <= within[1])]
+    if len(base) == 0 or np.isnan(base).mean() > 0.5:
+        return None
+    depth = float(np.nanpercentile(base, 95) - np.nanpercentile(base, 5))
+    if depth <= 2 * TOUCH:
+        return None
+    shifts = np.arange(max(1, len(base) // 16), len(base) // 2)
+    if len(shifts) < 3:
+        return None
+    differences = np.array([_mismatch(base[s:], base[:-s]) for s in shifts])
+    minima = [i for i in range(1, len(shifts) - 1) if differences[i] <= THREAD_MATCH * depth
+              and differences[i] <= differences[i - 1] and differences[i] <= differences[i + 1]]
+    return (int(shifts[minima[0]]), depth) if minima else None
+
+
+def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[float, float] | None:
+    """(pitch, lead) [m] of :func:`thread_profiles` ``profiles`` at the evenly spaced
+    ``levels`` [m], over the levels ``within`` (along the axis), when they are one helical
+    surface: the first profile periodic along the axis (:func:`period`: the pitch) and each half-plane's profile
+    the first one shifted by k times one shift s (within :data:`THREAD_MATCH`), s at least a
+    sixteenth of the pitch from 0 (a surface of revolution, rings or grooves, has s = 0);
+    the lead is K·s, taken as the nearest whole number of pitches (the starts; K·s measured
+    within K levels of it, else None). None otherwise."""
+    inside = (levels >= within[0]) & (levels <= within[1])
+    rows = profiles[:, inside]
+    step = float(levels[1] - levels[0])
+    base = rows[0]
+    found = period(profiles[0], levels, within)
+    if found is None:
+        return None
+    cycle, depth = found
+    half = cycle // 2
+    options = np.arange(-half, half + 1)
+
+    def shifted(row: np.ndarray, s: int) -> float:
+        return _mismatch(row[s:], base[:-s]) if s > 0 else _mismatch(row[:s or None], base[-s:])
+
+    one = int(options[np.argmin([shifted(rows[1], int(s)) for s in options])])
+    if abs(one) * 16 < cycle:
+        return None
+    for k in range(1, len(rows)):
+        s = (k * one + half) % cycle - half
+        if shifted(rows[k], s) > THREAD_MATCH * depth:
+            return None
+    # one is a whole number of levels (±0.5), K·one within ±K/2 of the lead: the lead is the
+    # nearest whole number of pitches (the starts), where K·one lies within K levels of it
+    starts = round(len(rows) * abs(one) / cycle)
+    if starts < 1 or abs(len(rows) * abs(one) - starts * cycle) > len(rows):
+        return None
+    return cycle * step, float(np.sign(one)) * starts * cycle * step
+
+
+def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, overlap: tuple[float, float],
+            outermost: bool) -> Thread | None:
+    """``mesh``'s helical surface about the axis (:func:`helix`) measured over ``overlap``
+    (along the axis from ``point`` [m]), on its outermost crossings (a screw) or innermost
+    (a nut), or None; its span the levels about ``overlap`` where every half-plane meets it
+    within its radii."""
+    along = (mesh.vertices - point) @ direction
+    levels = np.linspace(float(along.min()), float(along.max()), THREAD_SAMPLES)
+    profiles = thread_profiles(mesh, point, direction, levels, outermost, rows=[0])
+    if period(profiles[0], levels, overlap) is None:  # the cheap reject: one half-plane
+        return None
+    profiles = thread_profiles(mesh, point, direction, levels, outermost)
+    found = helix(profiles, levels, overlap)
+    if found is None:
+        return None
+    inside = (levels >= overlap[0]) & (levels <= overlap[1])
+    inner, outer = float(np.nanmin(profiles[:, inside])), float(np.nanmax(profiles[:, inside]))
+    on = np.all((profiles >= inner - TOUCH) & (profiles <= outer + TOUCH), axis=0)
+    middle = int(np.flatnonzero(inside)[np.sum(inside) // 2])
+    if not on[middle]:
+        return None
+    low = middle
+    while low > 0 and on[low - 1]:
+        low -= 1
+    high = middle
+    while high < len(on) - 1 and on[high + 1]:
+        high += 1
+    return Thread(point, direction, found[0], found[1], inner, outer, (float(levels[low]), float(levels[high])))
+
+
+def screwed_pairs(meshes: dict[str, trimesh.Trimesh], pairs: Iterable[tuple[str, str]] | None = None) -> list[Slide]:
+    """The screwed pairs among ``meshes`` (of ``pairs``, either way round, where given: the
+    import asks only of parts the disassembly leaves and their blockers): a part's outermost surface (a screw's) and
+    another's innermost (a nut's, a tapped hole's), about one axis along an axis of the
+    frame through the centre of the smaller part's box across it, over the stretch where
+    both parts are, each a helical surface (:func:`helix`) of one pitch and one lead
+    (within 2 %), the screw's crest outside the nut's minor radius (they interlock).
+    Each is a :class:`Slide` along that axis: swept against its mate
+    only, the screw's thread is taken in to under the nut's minor radius (its vertices
+    from that radius out to twice its crest less it, on its thread's span, moved in by
+    its crest less that radius plus :data:`TOUCH`), so
+    the pair slides along the axis where nothing else (a head, a bottom) stops it."""
+    found: list[Slide] = []
+    ids = sorted(meshes)
+    asked = None if pairs is None else {frozenset(pair) for pair in pairs}
+    for a in ids:
+        for b in ids:
+            if a == b or (asked is not None and frozenset((a, b)) not in asked):
+                continue
+            low = np.maximum(meshes[a].bounds[0], meshes[b].bounds[0])
+            high = np.minimum(meshes[a].bounds[1], meshes[b].bounds[1])
+            if np.any(high - low <= TOUCH):
+                continue
+            for axis in range(3):
+                slide = _screwed(meshes[a], meshes[b], axis, (float(low[axis]), float(high[axis])))
+                if slide is not None:
+                    found.append(replace(slide, shaft=a, bore=b))
+    return found
+
+
+def lone_thread(meshes: dict[str, trimesh.Trimesh]) -> str:
+    """For two overlapping parts (``meshes``: id -> mesh [m]) that are no screwed pair, what
+    the import says of a modelled thread among them: the part whose outermost surface is a
+    helical thread (:func:`helix`) about an axis of the frame through the smaller part's box
+    centre, over the stretch both share, in the other part, whose innermost surface there is
+    none (a tapped hole drawn at its tap drill); "" where neither is such a thread."""
+    (a, one), (b, other) = sorted(meshes.items())
+    low, high = np.maximum(one.bounds[0], other.bounds[0]), np.minimum(one.bounds[1], other.bounds[1])
+    for axis in range(3):
+        direction = np.eye(3)[axis]
+        across = [i for i in range(3) if i != axis]
+        smaller = min((one, other), key=lambda m: float(np.prod(m.extents[across])))
+        point = smaller.bounds.mean(axis=0) * (1 - direction)
+        for screw, mesh, hole in ((a, one, b), (b, other, a)):
+            thread = _thread(mesh, point, direction, (float(low[axis]), float(high[axis])), outermost=True)
+            if thread is not None:
+                return (f"; '{screw}' has a modelled thread (pitch {1000 * thread.pitch:.3f} mm, d "
+                        f"{2000 * thread.outer:.3f} mm, along {axis_name(direction)[1:]}) in '{hole}', which has "
+                        "no thread there (a tapped hole drawn at its tap drill?): the import takes a modelled "
+                        "thread only screwed into another")
+    return ""
+
+
+def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: tuple[float, float]) -> Slide | None:
+    """The screwed pair (:func:`screwed_pairs`) of ``screw`` in ``nut`` along the frame's
+    ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None."""
+    direction = np.eye(3)[axis]
+    across = [i for i in range(3) if i != axis]
+    smaller = min((screw, nut), key=lambda m: float(np.prod(m.extents[across])))
+    point = smaller.bounds.mean(axis=0) * (1 - direction)
+    male = _thread(screw, point, direction, overlap, outermost=True)
+    if male is None:
+        return None
+    female = _thread(nut, point, direction, overlap, outermost=False)
+    if (female is None or abs(male.pitch - female.pitch) > 0.02 * male.pitch
+            or abs(male.lead - female.lead) > 0.02 * abs(male.lead) or male.outer <= female.inner):
+        return None
+    reach = male.outer - female.inner + TOUCH
+    face = CylinderFace(point, direction, male.outer, male.span, True, 0.0)
+    hole = CylinderFace(point, direction, female.inner, female.span, False, 0.0)
+    return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead)

@@ -108,6 +108,7 @@ UNSIMULATED: dict[str, str] = {}
     "gridfinity_bases",
     "flynn_clutch",
     "nop_printed_box",
+    "bosl2_screw_nut",
 ])
 def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name: str) -> None:
     done = imported(name)
@@ -133,7 +134,7 @@ def test_the_fit_relation_is_the_truth(imported: Callable[[str], Imported], name
                                   "factory_gears",
                                   "factory_rect_pegs",
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
-                                  "vitac_shapes", "gridfinity_bases", "flynn_clutch",
+                                  "vitac_shapes", "gridfinity_bases", "flynn_clutch", "bosl2_screw_nut",
                                   "nop_printed_box",
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
@@ -173,6 +174,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(imported: Callable[[str],
     "gridfinity_bases",
     "flynn_clutch",
     "nop_printed_box",
+    "bosl2_screw_nut",
 ])
 def test_each_part_fits_the_feature_it_is_in(imported: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it (each of a
@@ -290,6 +292,8 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                               "holder around the plates)")),
     pytest.param("nop_printed_box", marks=_xfail(INSERTED + " into a hole and shorter than the gripper's grasp "
                                                  "depth (the base, a 2 mm plate)")),
+    pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
+                                                 "cell has no screwing operation)")),
 ])
 def test_the_cell_inserts_every_part(imported: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(imported(name).out)).tables.manual
@@ -562,3 +566,16 @@ def test_the_heptagon_that_misses_the_rect_hole_by_1_4_um_is_no_experiment_but_t
     trial = run_main("executor", "trial", "--assembly", str(done.out), "--part", "convex", "--hole", h7, "--attempts",
                      "1", "--json")
     assert trial.returncode == 2 and "near miss" in trial.stderr, (trial.returncode, trial.stderr)
+
+
+@pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["bosl2_screw_nut"])
+def test_a_modelled_thread_is_a_screwed_pair_with_the_truths_pitch_placed_by_hand(
+        imported: Callable[[str], Imported], name: str) -> None:
+    done = imported(name)
+    manual = load_geometry(str(done.out)).tables.manual
+    screwed = {pid for pid, part in done.truth["parts"].items() if part.get("screwed")}
+    assert set(manual) == screwed
+    for pid in screwed:
+        thread = done.truth["features"][done.truth["parts"][pid]["in"]]
+        assert f"(a modelled thread, pitch {thread['pitch_mm']:.2f}" in manual[pid].reason, manual[pid].reason
