@@ -591,7 +591,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
-                  *_section_lines(nominal_section(_hole_section(derived, hid, fit), [pairs[pid][hid][0] for pid in listed])),
+                  *_section_lines(nominal_section(_hole_section(derived, hid, fit),
+                                                  [pairs[pid][hid][0] for pid in listed])),
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
         close = [(pid, depth) for (pid, h), depth in missed.items() if h == hid]
         if close:
