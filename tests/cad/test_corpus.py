@@ -285,8 +285,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                              "pulley onto the hub's boss along -y: room 0), or into a hole and "
                                              "shorter than the gripper's grasp depth (the bolts, 14 mm)")),
     "vitac_shapes",
-    pytest.param("gridfinity_bases", marks=_xfail(INSERTED + " into a hole and shorter than the gripper's grasp "
-                                                  "depth (the bin bases, 4.75 mm)")),
+    "gridfinity_bases",
     pytest.param("flynn_clutch", marks=_xfail(INSERTED + " onto a pin and no thicker than the cell's hull margin "
                                               "twice (the plates, 1.2 mm: no convex piece of theirs at the bore)")),
     pytest.param("nop_printed_box", marks=_xfail(INSERTED + " into a hole and shorter than the gripper's grasp "

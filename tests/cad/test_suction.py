@@ -1,0 +1,77 @@
+"""The suction cup: a part too short for the fingers whose flat top takes the cup is held by
+its top (``tool = "suction"``), learned and assembled in the cell; a top that is not flat, or
+smaller than the cup, leaves the part placed by hand with why; a part pulled off the cup
+beyond its holding force drops and is reported (docs/cell.md#the-suction-tool)."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from assembly_constraints.corpus_truth import feature_holes, import_product
+from executor.cad import operations
+from executor.cad.operations import flat_top
+from executor.trial import Cell
+from executor.world.arm import Dropped
+from executor.world.geometry import load_geometry
+from tests.cad.conftest import learned_in_the_cell
+from tests.conftest import Runner
+
+GRIDFINITY = Path(__file__).parent / "corpus" / "gridfinity_bases"
+
+
+def test_a_flat_top_is_its_face_and_a_pointed_top_has_none() -> None:
+    box = trimesh.creation.box((0.04, 0.03, 0.005))
+    assert flat_top(box).area == pytest.approx(0.04 * 0.03, rel=1e-9)
+    cone = trimesh.creation.cone(0.02, 0.01)  # its top a point: no face up there
+    assert flat_top(cone).is_empty
+
+
+@pytest.mark.slow  # imports the product (about 13 s under load)
+def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # The bin bases' top is a 41.5 mm rounded square: a 45 mm cup does not lie whole on it.
+    monkeypatch.setitem(operations.GRIPPER, "cup_diameter", 0.045)
+    done = import_product(GRIDFINITY, tmp_path / "out")
+    manual = tomllib.loads((done.out / "geometry.toml").read_text()).get("manual", {})
+    assert set(manual) == {"bin_base_a", "bin_base_b"}
+    assert "the suction cup (45 mm) does not lie whole on its flat top" in manual["bin_base_a"]["reason"]
+
+
+@pytest.mark.slow  # imports, teaches, learns 6 pairs in physics and assembles (about 90 s under load)
+@pytest.mark.timeout(900)
+def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(run_main: Runner, tmp_path: Path) -> None:
+    done = import_product(GRIDFINITY, tmp_path / "out")
+    geometry = tomllib.loads((done.out / "geometry.toml").read_text())
+    assert "manual" not in geometry
+    assert {geometry["part_shapes"][p]["tool"] for p in ("bin_base_a", "bin_base_b")} == {"suction"}
+    result, outcomes = learned_in_the_cell(run_main, done.out, tmp_path / "run")
+    holes = feature_holes(done)
+    truth = {(row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
+    assert {pair: outcomes.get(pair) for pair in truth} == truth
+    assembly = result["assembly_run"]
+    assert assembly["assembled"] is True and assembly["manual"] == []
+    assert {step["part"] for step in assembly["steps"]} == {"baseplate", "bin_base_a", "bin_base_b"}
+    assert max(assembly["final_pose_error_mm"].values()) <= 2.0
+
+
+@pytest.mark.slow  # imports the product
+def test_a_part_pulled_off_the_cup_beyond_its_holding_force_drops(tmp_path: Path) -> None:
+    # A holding force below the bin base's weight (18.5 g: 0.18 N): hanging on the cup is
+    # already too much, the cell reports the drop.
+    done = import_product(GRIDFINITY, tmp_path / "out")
+    text = done.out / "geometry.toml"
+    text.write_text(text.read_text().replace("cup_force = 20.0", "cup_force = 0.1"))
+    cell = Cell(str(done.out))
+    try:
+        motion = cell.motion_for("bin_base_a")
+        here = motion.read()
+        with pytest.raises(Dropped, match=r"more than its holding force \(0.1 N\); the part dropped"):
+            motion.hold(here.tip_pos, here.tip_quat_xyzw, 0.2)
+        assert load_geometry(str(done.out)).parts["bin_base_a"].tool == "suction"
+        assert np.isfinite(here.tip_pos).all()
+    finally:
+        cell.close()
