@@ -257,10 +257,10 @@ class Arm:
                                       physicsClientId=c)
         filtered = self._wrench_filtered
         filtered += 0.1 * ((np.array(js[N_JOINTS][2]) - self.tare) - filtered)
-        # The sensor's z (along the part, away from the flange) reads +m g with the part
-        # hanging at rest: the pull on the cup, low-passed as the contact wrench (the tare
-        # added back: weight and inertia count).
-        if self.hold_limit is not None and (pull := float(filtered[2] + self.tare[2])) > self.hold_limit:
+        # The sensor's z (along the part, away from the flange) reads -m g with the part
+        # hanging from the tool pointing down at rest: the pull on the cup is its negative,
+        # low-passed as the contact wrench (the tare added back: weight and inertia count).
+        if self.hold_limit is not None and (pull := -float(filtered[2] + self.tare[2])) > self.hold_limit:
             raise Dropped(f"the suction cup let go: {pull:.2f} N pulled the part off it along the tool's axis, "
                           f"more than its holding force ({self.hold_limit:g} N); the part dropped")
         # The contact wrench on the part is the flange's negative (weight removed by the tare).
