@@ -44,6 +44,7 @@ from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import margin, thin_prism
+from executor.world.meshes import URDF_HULL_MARGIN
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -259,8 +260,9 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
 def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
     """What holds the peg of ``fit`` and why: ``fingers`` for a part longer than
     :data:`GRIPPER`'s grasp depth (held by its sides that deep), else ``suction`` where
-    the cup (``cup_diameter``) lies whole on its flat top (:func:`flat_top`: the face
-    opposite its way in, around its axis), else "" (placed by hand) with why."""
+    it is thicker than the cell's hull margin twice and the cup (``cup_diameter``) lies
+    whole on its flat top (:func:`flat_top`: the face opposite its way in, around its
+    axis), else "" (placed by hand) with why."""
     assert fit.part is not None and fit.section is not None
     mesh = upright(derived, fit)
     length, depth = float(mesh.extents[2]), GRIPPER["grasp_depth"]
@@ -268,6 +270,9 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
         return "fingers", f"{1e3 * length:.3f} mm long, held {1e3 * depth:g} mm deep by the fingers"
     short = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's grasp depth "
              f"({1e3 * depth:g} mm)")
+    if length <= 2 * URDF_HULL_MARGIN + 1e-9:  # a physics limit: no convex piece of it keeps its shape
+        return "", (f"{short}, and no thicker than the cell's hull margin twice ({2e3 * URDF_HULL_MARGIN:g} mm): "
+                    "it has no convex pieces the cell can collide as")
     top = flat_top(mesh)
     cup = shapely.Point(*fit.section.centre).buffer(GRIPPER["cup_diameter"] / 2, 64)
     if top.is_empty:

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from assembly_constraints.cli import main
 from assembly_constraints.corpus_truth import feature_holes, import_product
 from executor.cad import operations
 from executor.cad.operations import flat_top
@@ -19,6 +20,7 @@ from executor.trial import Cell
 from executor.world.arm import Dropped, tool_quat
 from executor.world.geometry import load_geometry
 from tests.cad.conftest import learned_in_the_cell
+from tests.cad.test_covers import _pegs_and_plate
 from tests.conftest import Runner
 
 GRIDFINITY = Path(__file__).parent / "corpus" / "gridfinity_bases"
@@ -31,6 +33,17 @@ def test_a_flat_top_is_its_face_and_a_pointed_top_has_none() -> None:
     assert flat_top(cone).is_empty
 
 
+def test_a_short_peg_with_a_pointed_top_stays_by_hand(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # peg2, 18 mm long (the fingers hold 20), its 12 mm square body ends in a pyramid.
+    _pegs_and_plate(tmp_path / "cad", (560.0, 0.0))
+    corners = [(560.0 + 25 + sx * 6, sy * 6, z) for sx in (-1, 1) for sy in (-1, 1) for z in (5.0, 19.0)]
+    trimesh.convex.convex_hull([*corners, (585.0, 0.0, 23.0)]).export(tmp_path / "cad" / "peg2.stl")
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    assert ("manual peg2: the cell has no operation for it, a plan's step places it by hand (part 'peg2' is "
+            "18.000 mm long, no longer than the gripper's grasp depth (20 mm), and its top is not flat for the "
+            "suction cup)") in capsys.readouterr().out
+
+
 @pytest.mark.slow  # imports the product (about 13 s under load)
 def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # The bin bases' top is a 41.5 mm rounded square: a 45 mm cup does not lie whole on it.
@@ -39,6 +52,15 @@ def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monke
     manual = tomllib.loads((done.out / "geometry.toml").read_text()).get("manual", {})
     assert set(manual) == {"bin_base_a", "bin_base_b"}
     assert "the suction cup (45 mm) does not lie whole on its flat top" in manual["bin_base_a"]["reason"]
+
+
+@pytest.mark.slow  # imports the product (about 10 s under load)
+def test_a_plate_no_thicker_than_the_hull_margin_twice_stays_by_hand(tmp_path: Path) -> None:
+    # nop_printed_box's base: a 2 mm plate whose flat top would take the cup, but the
+    # cell's physics cannot collide it (a physics limit, not the tool's).
+    done = import_product(Path(__file__).parent / "corpus" / "nop_printed_box", tmp_path / "out")
+    manual = tomllib.loads((done.out / "geometry.toml").read_text())["manual"]
+    assert "no thicker than the cell's hull margin twice (2 mm)" in manual["smooth_box_base"]["reason"]
 
 
 @pytest.mark.slow  # imports, teaches, learns 6 pairs in physics and assembles (about 90 s under load)
@@ -52,7 +74,7 @@ def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(run_
     holes = feature_holes(done)
     truth = {(row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
     assert {pair: outcomes.get(pair) for pair in truth} == truth
-    assembly = result["assembly_run"]
+    assembly = result["assembly"]
     assert assembly["assembled"] is True and assembly["manual"] == []
     assert {step["part"] for step in assembly["steps"]} == {"baseplate", "bin_base_a", "bin_base_b"}
     assert max(assembly["final_pose_error_mm"].values()) <= 2.0
