@@ -14,8 +14,11 @@ import trimesh
 
 from assembly_constraints.cli import main
 from assembly_constraints.corpus_truth import feature_holes, import_product
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
 from executor.cad import operations
 from executor.cad.operations import flat_top
+from executor.cell_description import CellDescription
 from executor.trial import Cell
 from executor.world.arm import Dropped, tool_quat
 from executor.world.geometry import load_geometry
@@ -80,7 +83,7 @@ def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(run_
     assert max(assembly["final_pose_error_mm"].values()) <= 2.0
 
 
-@pytest.mark.slow  # imports the product
+@pytest.mark.slow  # imports the product, a trial's cell and an assembling cell (about 25 s under load)
 def test_a_part_pulled_off_the_cup_beyond_its_holding_force_drops(tmp_path: Path) -> None:
     # A holding force below the bin base's weight (18.5 g: 0.18 N): hanging on the cup is
     # already too much, the cell reports the drop.
@@ -91,6 +94,14 @@ def test_a_part_pulled_off_the_cup_beyond_its_holding_force_drops(tmp_path: Path
     text.write_text(text.read_text().replace("cup_force = 20.0", "cup_force = 0.1"))
     with pytest.raises(Dropped, match=r"more than its holding force \(0.1 N\); the part dropped"):
         _hang(done.out)
+    # The assembling cell: the base set on its fixture, then the pick of a bin base.
+    assembler = Assembler(load_product(str(done.out)), description=CellDescription())
+    try:
+        assert assembler.run_step("baseplate", None, 0).outcome == "fit"
+        with pytest.raises(Dropped, match=r"more than its holding force \(0.1 N\); the part dropped"):
+            assembler.run_step("bin_base_a", "h1", 0)
+    finally:
+        assembler.close()
 
 
 def _hang(folder: Path) -> None:
