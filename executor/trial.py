@@ -193,6 +193,7 @@ class Cell:
         if self.logger is not None:
             self.logger.attach_arm(self._arm_of(spec.shape), part)
         motion = self._motions[spec.shape]
+        motion.controller.arm.hold_limit = self.geometry.gripper.cup_force if spec.tool == "suction" else None
         if self._motion is not None and motion is not self._motion:
             motion.steps = self._motion.steps
         self._motion, self.scene = motion, scene

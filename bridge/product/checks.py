@@ -220,10 +220,11 @@ def _check_levels(path: Path, plate: Plate, shapes: Mapping[str, HoleShape]) -> 
 
 
 def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
-    """Every peg is longer than the part of it inside ``gripper``'s fingers (a part with a
-    bore is held at most half its length deep, as a head)."""
+    """Every peg the fingers hold is longer than the part of it inside ``gripper``'s fingers
+    (a part with a bore is held at most half its length deep, as a head; the suction cup
+    holds a part by its top face)."""
     for name, table in geometry.part_shapes.items():
-        if not table.bore and gripper.grasp_depth >= table.length:
+        if not table.bore and table.tool == "fingers" and gripper.grasp_depth >= table.length:
             raise fail(path, f"part_shapes.{name}", "length",
                        f"longer than [gripper] grasp_depth ({gripper.grasp_depth:g} m)", table.length)
 

@@ -145,12 +145,17 @@ class Plate(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
 
 class Gripper(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[gripper]``: flange + F/T sensor + gripper mass [kg] and inertia [kg m^2], flange
-    face to the fingertips [m], part length inside the fingers [m]."""
+    face to the fingertips [m], part length inside the fingers [m]; the suction tool the
+    same flange carries for a part whose ``[part_shapes.*]`` says ``tool = "suction"``: its
+    cup's diameter [m] (its face where the fingertips are) and holding force [N], the most
+    force pulling the part off the cup it takes (docs/cell.md#the-suction-tool)."""
 
     flange_mass: Annotated[float, Meta(gt=0.0, le=20.0, description="a number in (0, 20] kg")]
     flange_inertia: Annotated[float, Meta(gt=0.0, le=1.0, description="a number in (0, 1] kg m^2")]
     flange_length: Annotated[float, Meta(gt=0.0, le=0.5, description="a number in (0, 0.5] m")]
     grasp_depth: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")]
+    cup_diameter: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")] = 0.03
+    cup_force: Annotated[float, Meta(gt=0.0, le=1000.0, description="a number in (0, 1000] N")] = 20.0
 
 
 class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
@@ -222,6 +227,7 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     mesh: Mesh | None = None
     bore: bool = False
     pins_of: Ids | None = None
+    tool: Literal["fingers", "suction"] = "fingers"
 
 
 MESH_FILE_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*(/[A-Za-z0-9_-][A-Za-z0-9_.-]*)*\.obj$(?!\n)"

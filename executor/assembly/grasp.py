@@ -1,5 +1,7 @@
 """The grasp: a fixed constraint between the gripper tool and the part, made at pick and
-released once the part is placed (it then rests on its own contacts).
+released once the part is placed (it then rests on its own contacts). A part on the
+suction cup is held the same way while the arm's sensor watches the pull on the cup
+(:class:`executor.world.arm.Dropped` once it exceeds the cup's holding force).
 
 The constraint holds the part at its nominal grip pose composed with a random grasp
 error (≤ 1 mm lateral offset, ≤ 1° tilt, as in the single trials): the robot believes the
@@ -43,6 +45,9 @@ class Grasp:
                 parentFramePosition=parent[0], childFramePosition=child[0],
                 parentFrameOrientation=parent[1], childFrameOrientation=child[1], physicsClientId=c)
             pb.changeConstraint(self.constraint, maxForce=GRASP_FORCE, physicsClientId=c)
+        # On the suction cup the arm's sensor watches the pull on it (executor.world.arm.Dropped).
+        spec = world.product.geometry.parts.get(part)
+        world.arm.hold_limit = world.product.geometry.gripper.cup_force if spec and spec.tool == "suction" else None
         # The believed TCP in the tool frame (nominal grasp): what the controller drives.
         tcp_in_tool = pb.multiplyTransforms(body_pos, body_quat, list(frames.tcp), [0, 0, 0, 1])[0]
         world.arm.set_grasp_error(-np.array(tcp_in_tool), np.array([0.0, 0.0, 0.0, 1.0]))
@@ -61,3 +66,4 @@ class Grasp:
             pb.removeConstraint(self.constraint, physicsClientId=self.world.client)
             self.constraint = None
         self.world.arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+        self.world.arm.hold_limit = None

@@ -47,7 +47,7 @@ from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
-from executor.cad.operations import entry_point, pin_entry, screwed_fits
+from executor.cad.operations import entry_point, pin_entry, screwed_fits, tool_of
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -366,8 +366,9 @@ def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES) ->
 class Imported:
     """What :func:`run_import` found: the ``derived`` geometry, the ``mapped`` covers and
     heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
-    files ``written``, the ``seconds`` taken and the ``offset`` (x, y) [m] by which every
-    part was moved from the CAD frame into the cell (:func:`placement`)."""
+    files ``written``, the ``seconds`` taken, the ``offset`` (x, y) [m] by which every
+    part was moved from the CAD frame into the cell (:func:`placement`) and the parts the
+    cell holds on its suction cup, with why (:func:`executor.cad.operations.tool_of`)."""
 
     derived: Derived
     mapped: Mapped
@@ -376,6 +377,7 @@ class Imported:
     written: list[Path]
     seconds: float
     offset: tuple[float, float]
+    suction: dict[str, str]
 
 
 @dataclass(frozen=True)
@@ -414,7 +416,9 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
         raise ExecutorError(f"{source}: {doubt}")
     written, why = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
     assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
-    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset)
+    tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
+    suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}
+    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset, suction)
 
 
 def _derived(parts: list[CadPart], out: Path, config: tuple[Path | None, dict, str | None], options: ImportOptions,
@@ -488,6 +492,8 @@ def main(argv: list[str]) -> int:
     print(f"assumes: units {units}; " + "; ".join(done.assumed))
     for line in report(derived) + mapped_report(done.mapped):
         print(line)
+    for pid, reason in done.suction.items():
+        print(f"tool {pid}: the suction cup on its top, not the fingers ({reason})")
     meshes = sorted(p.name.removesuffix(".obj") for p in done.written
                     if p.parent.name == MESH_FOLDER and not p.name.endswith(".convex.obj"))
     print(f"wrote {args.out}: assembly.toml, sizes.lp, nominal_sizes.lp, geometric_precedence.lp"

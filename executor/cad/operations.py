@@ -45,12 +45,19 @@ from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, seated_pose, thin_prism
+from executor.world.meshes import URDF_HULL_MARGIN
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
-GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02}
-"""The simulated gripper of every imported product (Cranfield's), its flange longer where the
-arm's wrist would meet the product (:func:`tool_length`)."""
+GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02,
+           "cup_diameter": 0.03, "cup_force": 20.0}
+"""The simulated gripper of every imported product (Cranfield's, with the cell's suction
+cup: ``cup_diameter`` [m], ``cup_force`` [N]), its flange longer where the arm's wrist
+would meet the product (:func:`tool_length`)."""
+FLAT_TOLERANCE = 1e-5
+"""[m] how far from the plane of a part's top (its highest point along its way out) a
+face's vertices may lie, and still seal the cup (a face tilted by more than its size
+entails misses it)."""
 WRIST_RADIUS = 0.06
 """[m] the arm's wrist about the tool's axis: pybullet_data's ``kuka_iiwa`` ``lbr_iiwa_link_7``,
 52.1 mm in radius, its face where the gripper's flange starts, widened for the part's tilt
@@ -261,9 +268,8 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
             by_hand[fit.part] = why
         elif fit.part is not None and section_kind(fit) == "polygon" and _polygon_refused(fit, derived):
             by_hand[fit.part] = _polygon_refused(fit, derived)
-        elif fit.part is not None and (length := float(upright(derived, fit).extents[2])) <= GRIPPER["grasp_depth"]:
-            by_hand[fit.part] = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's "
-                                 f"grasp depth ({1e3 * GRIPPER['grasp_depth']:g} mm)")
+        elif fit.part is not None and tool_of(derived, fit)[0] == "":
+            by_hand[fit.part] = tool_of(derived, fit)[1]
         else:
             kept[hid] = fit
     # The pins the cell puts parts onto: none empty (no goal on it), the base's unless
@@ -325,6 +331,44 @@ def _owner_refused(derived: Derived, pin: PinFit, fit: HoleFit | None) -> str:
     return ""
 
 
+def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
+    """What holds the peg of ``fit`` and why: ``fingers`` for a part longer than
+    :data:`GRIPPER`'s grasp depth (held by its sides that deep), else ``suction`` where
+    it is thicker than the cell's hull margin twice and the cup (``cup_diameter``) lies
+    whole on its flat top (:func:`flat_top`: the face opposite its way in, around its
+    axis), else "" (placed by hand) with why."""
+    assert fit.part is not None and fit.section is not None
+    mesh = upright(derived, fit)
+    length, depth = float(mesh.extents[2]), GRIPPER["grasp_depth"]
+    if length > depth:
+        return "fingers", f"{1e3 * length:.3f} mm long, held {1e3 * depth:g} mm deep by the fingers"
+    short = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's grasp depth "
+             f"({1e3 * depth:g} mm)")
+    if length <= 2 * URDF_HULL_MARGIN + 1e-9:  # a physics limit: no convex piece of it keeps its shape
+        return "", (f"{short}, and no thicker than the cell's hull margin twice ({2e3 * URDF_HULL_MARGIN:g} mm): "
+                    "it has no convex pieces the cell can collide as")
+    top = flat_top(mesh)
+    cup = shapely.Point(*fit.section.centre).buffer(GRIPPER["cup_diameter"] / 2, 64)
+    if top.is_empty:
+        return "", f"{short}, and its top is not flat for the suction cup"
+    if not top.buffer(1e-9).contains(cup):
+        inside = top.buffer(1e-9).intersection(cup).area / cup.area
+        return "", (f"{short}, and the suction cup ({1e3 * GRIPPER['cup_diameter']:g} mm) does not lie whole on its "
+                    f"flat top ({100 * inside:.1f}% of the cup on it)")
+    return "suction", (f"{short}: its flat top ({1e6 * top.area:.1f} mm^2) holds the suction cup "
+                       f"({1e3 * GRIPPER['cup_diameter']:g} mm) about its axis")
+
+
+def flat_top(mesh: trimesh.Trimesh) -> shapely.Geometry:
+    """The flat face of ``mesh`` (axis along z) at its highest: the union, seen along z, of
+    its faces facing up whose vertices all lie within :data:`FLAT_TOLERANCE` of its top [m];
+    empty where none does."""
+    high = float(mesh.vertices[:, 2].max())
+    level = np.all(mesh.vertices[mesh.faces][:, :, 2] >= high - FLAT_TOLERANCE, axis=1) & (mesh.face_normals[:, 2] > 0)
+    triangles = [shapely.Polygon(tri[:, :2]) for tri in mesh.vertices[mesh.faces[level]]]
+    return shapely.union_all([t for t in triangles if t.area > 0]).buffer(0) if triangles else shapely.Polygon()
+
+
 def builds_plate(cell: Derived) -> bool:
     """Whether the simulated cell builds the base of the product as it inserts it
     (:func:`cell_view`) as ``[plate]`` primitives, its holes from their sections: it has
@@ -380,13 +424,15 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     may be in place (any but those the geometric precedence puts after it, and but a base with
     pins: :func:`executor.world.scene.wrist_clear_of`) within that radius
     of the axis of each part the cell inserts from above, held :data:`GRIPPER`'s grasp depth
-    deep (a part with a bore: at most half its length) at its goal (a peg standing on its
+    deep (a part with a bore: at most half its length; a part on the suction cup by its top:
+    :func:`tool_of`) at its goal (a peg standing on its
     hole's bottom, a part with a bore where the CAD has it), rounded up to the millimetre;
     None where :data:`GRIPPER`'s keeps it clear, with why (the part, the part below the
     wrist and how high it stands) otherwise. A part the wrist meets stops short of its goal
     (``occt_as1``: bolt_a1 4.1 mm above it, the wrist on bracket_a's wall)."""
     depth = GRIPPER["grasp_depth"]
-    grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2]) - depth)
+    grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2])
+                   - (0.0 if tool_of(derived, fit)[0] == "suction" else depth))  # the cup: at its top
              for pid, fit in derived.hole_of.items() if fit.axis == "+z"}
     for pin in derived.pins.values():
         for pid in (p for p in pin.parts if p in derived.bores and pin.axis == "+z"):

@@ -94,6 +94,7 @@ from executor.cad.operations import (
     section_kind,
     section_pairs,
     tool_length,
+    tool_of,
     upright,
 )
 from executor.cad.parts import turn_text
@@ -586,7 +587,9 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     base = derived.parts[derived.base].mesh
     (x0, y0, z0), (x1, y1, _) = base.bounds
     top, depth = plate_level(derived)
-    chamfer = max([MIN_CHAMFER, *(f.chamfer for f in fits)])
+    # a hole the cell states at the sweep's level of least room keeps its entry's width
+    chamfer = max([MIN_CHAMFER, *(f.chamfer - max(0.0, _hole_section(derived, hid, f).b - f.hole.b) / 2
+                                  for hid, f in derived.holes.items())])
     tile = _tile([fit for fit in fits if fit.axis == "+z"])  # the plate's bosses: none around a sideways hole
     own = _own_tiles(derived, tile, chamfer)
     lines = ["# The simulated cell's product measured from the CAD by ./run.sh import [m]: primitives, and the",
@@ -600,7 +603,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
-                  *_section_lines(nominal_section(fit.hole, [pairs[pid][hid][0] for pid in listed])),
+                  *_section_lines(nominal_section(_hole_section(derived, hid, fit),
+                                                  [pairs[pid][hid][0] for pid in listed])),
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
         close = [(pid, depth) for (pid, h), depth in missed.items() if h == hid]
         if close:
@@ -620,11 +624,12 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                 lines.append(f"depth = {_q(fit.depth)}")
         lines.append("")
     for pid, fit in sorted(derived.hole_of.items()):
-        mesh, peg = upright(derived, fit), fit.section
+        mesh, peg = upright(derived, fit), derived.swept.get((pid, fit.id), (fit.section,))[0]
         assert peg is not None
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', *_section_lines(peg),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
-                  f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []), ""]
+                  f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []),
+                  *(['tool = "suction"'] if tool_of(derived, fit)[0] == "suction" else []), ""]
     for pin_id, pin in derived.pins.items():
         top, height = pin_level(derived, pin)
         lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section),
@@ -677,6 +682,16 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   ] if held_by else []
         lines.append("")
     return "\n".join(lines)
+
+
+def _hole_section(derived: Derived, hid: str, fit: HoleFit) -> Shape2D:
+    """The section of hole ``hid`` the cell's tables state: where the sweep admits a part
+    into it (:func:`executor.cad.derive.swept_fits`, a taper in its taper), the hole's at
+    the level of least room with its own part (else with the first such part), so that
+    the cell's sections answer as ``sizes.lp`` (:func:`_cell_disagrees` checks it); else
+    its measured section."""
+    swept = sorted(((pid != fit.part, pid), hole) for (pid, h), (_, hole, _) in derived.swept.items() if h == hid)
+    return swept[0][1] if swept else fit.hole
 
 
 def _zero_clearance_line(parts: list[str]) -> list[str]:

@@ -257,8 +257,12 @@ class FrankaCell:
 
     def pick(self, part: str) -> None:
         """Open the hand, carry it to the part's grip point on the table, close it on the
-        part; the tool tip becomes the part's tip. ExecutorError when the hand holds nothing."""
+        part; the tool tip becomes the part's tip. ExecutorError when the hand holds nothing,
+        or for a part the product holds on the suction cup (the Franka's hand has none)."""
         spec = self.geometry.parts[part]
+        if spec.tool == "suction":
+            raise ExecutorError(f"part {part} is held by the suction cup (geometry.toml [part_shapes.{spec.shape}] "
+                                "tool = \"suction\"): the Franka's hand has fingers only")
         self.arm.set_tcp(0.0)
         width = self.width(spec)
         self._open(width + OPEN_MARGIN)

@@ -117,8 +117,16 @@ class ArmState:
     torque: np.ndarray
 
 
+class Dropped(ExecutorError):
+    """The part on the suction cup was pulled off it: the force pulling it away exceeded the
+    cup's holding force (:attr:`Arm.hold_limit`); it is no longer held."""
+
+
 class Arm:
-    """Reads and drives the ``kuka_iiwa`` + flange + part multibody in torque mode."""
+    """Reads and drives the ``kuka_iiwa`` + flange + part multibody in torque mode;
+    ``hold_limit`` [N], set while the suction cup holds the part: :meth:`read` raises
+    :class:`Dropped` once the sensor's force pulling the part off the cup along the tool's
+    axis (its weight, its inertia, the contacts pulling it) exceeds it."""
 
     def __init__(self, client: int, robot: int) -> None:
         self.client, self.robot = client, robot
@@ -143,6 +151,7 @@ class Arm:
         self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         self.tare = np.zeros(6)
         self._wrench_filtered = np.zeros(6)
+        self.hold_limit: float | None = None
 
     def set_grasp_error(self, offset: np.ndarray, quat_xyzw: np.ndarray) -> None:
         """Real tip = believed tip ∘ (offset [m], rotation) in the believed tip frame."""
@@ -248,8 +257,13 @@ class Arm:
                                       physicsClientId=c)
         filtered = self._wrench_filtered
         filtered += 0.1 * ((np.array(js[N_JOINTS][2]) - self.tare) - filtered)
-        # The sensor gives the wrench of the flange on the part in the part frame; the
-        # contact wrench on the part is its negative (weight removed by the tare).
+        # The sensor's z (along the part, away from the flange) reads -m g with the part
+        # hanging from the tool pointing down at rest: the pull on the cup is its negative,
+        # low-passed as the contact wrench (the tare added back: weight and inertia count).
+        if self.hold_limit is not None and (pull := -float(filtered[2] + self.tare[2])) > self.hold_limit:
+            raise Dropped(f"the suction cup let go: {pull:.2f} N pulled the part off it along the tool's axis, "
+                          f"more than its holding force ({self.hold_limit:g} N); the part dropped")
+        # The contact wrench on the part is the flange's negative (weight removed by the tare).
         force = -(rot @ filtered[:3])
         torque = -(rot @ filtered[3:]) - cross(lever, force)
         return ArmState(np.array(q_list), np.array([j[1] for j in js[:N_JOINTS]]), tip_pos, tip_quat, tip_vel,

@@ -182,10 +182,14 @@ class PartSpec(Section):
     demo_hole: str
     mesh: Mesh | None = field(default=None, kw_only=True)
     bore: bool = field(default=False, kw_only=True)
+    tool: str = field(default="fingers", kw_only=True)
 
     def held_depth(self, gripper: Gripper) -> float:
         """How deep [m] the part is in the gripper's fingers: ``grasp_depth``, a part with a
-        bore at most half its length (a ring is held by its top)."""
+        bore at most half its length (a ring is held by its top); 0 on the suction cup (its
+        face on the part's top)."""
+        if self.tool == "suction":
+            return 0.0
         return min(gripper.grasp_depth, self.length / 2) if self.bore else gripper.grasp_depth
 
 
@@ -285,7 +289,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             parts[pid] = PartSpec(
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
-                outline=_outline(part_shape), corner=part_shape.corner, bore=part_shape.bore,
+                outline=_outline(part_shape), corner=part_shape.corner, bore=part_shape.bore, tool=part_shape.tool,
             )
     if models_nominal_fits(geo):
         holes = {hid: _with_nominal_room(hole, parts) for hid, hole in holes.items()}

@@ -142,7 +142,8 @@ def test_a_peg_no_longer_than_the_grasp_is_placed_by_hand(tmp_path: Path, capsys
     assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     printed = capsys.readouterr().out
     assert ("manual peg2: the cell has no operation for it, a plan's step places it by hand (part 'peg2' is "
-            "18.000 mm long, no longer than the gripper's grasp depth (20 mm))") in printed
+            "18.000 mm long, no longer than the gripper's grasp depth (20 mm), and the suction cup (30 mm) does not "
+            "lie whole on its flat top (") in printed  # a 12 mm square top
     product = load_product(str(tmp_path / "out"))  # written, and the cell's loader takes it
     assert set(product.manual) == {"peg2"} and "peg1" in product.parts
 
