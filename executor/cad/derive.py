@@ -118,6 +118,13 @@ _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one h
 _ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
 _GRID = 1e-8  # the grid [m] the union of a pin's sections is snapped to (far below a fit's room)
 _JITTER = 5e-8  # [m] a vertex of that union this close to the line through its neighbours is dropped
+LEAVING = ("+z", "-z", "-x", "+y", "-y", "+x")
+"""The order a part's way out (its insertion axis reversed) is chosen in among those it is
+free along: up (the cell inserts from above), down, then the horizontal ones whose
+insertion the cell's arm was measured to reach sideways (+x, +y, -y:
+:data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways along x
+goes in along +x however the CAD is turned about z; a zero-clearance fit's axis that is
+none of these last, in the order found."""
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
@@ -325,8 +332,9 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
             raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
                                 f"blocked: {stuck} (expected a straight way out for every part but the base)")
         for pid in stage:
-            result.axis[pid] = next(d for d in result.directions
-                                    if not (result.blockers[(pid, d)] & (remaining | {base})))
+            result.axis[pid] = min((d for d in result.directions
+                                    if not (result.blockers[(pid, d)] & (remaining | {base}))),
+                                   key=lambda d: LEAVING.index(d) if d in LEAVING else len(LEAVING))
         result.stages.append(stage)
         remaining -= set(stage)
     result.reasons = forced(result)

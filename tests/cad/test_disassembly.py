@@ -68,7 +68,7 @@ def test_a_coarse_zero_clearance_fit_passes_the_overlap_check_and_a_collar_in_it
     parts = _shaft_in_bearing((18, 14, 12))
     check_parts(parts, "m")
     derived = derive(parts, "housing", {}, reach=0.0)
-    assert derived.free("shaft") == ["+x", "-x"] and derived.axis == {"shaft": "+x", "bearing": "+x"}
+    assert derived.free("shaft") == ["+x", "-x"] and derived.axis == {"shaft": "-x", "bearing": "-x"}
     # A collar on the shaft 1 mm into the bearing's face is no tessellation: still refused.
     collar = _along_x(trimesh.creation.cylinder(radius=12 * MM, height=5 * MM, sections=12))
     collar.apply_translation((11.5 * MM, 0, 0))
@@ -217,7 +217,8 @@ def test_a_shaft_in_a_zero_clearance_bearing_comes_out_along_its_axis() -> None:
     assert all(s.tolerance < 40e-6 for s in derived.slides)
     assert derived.free("shaft") == ["+x", "-x"]
     assert derived.blockers[("bearing", "+x")] == set() and derived.blockers[("bearing", "+z")] == {"housing", "shaft"}
-    assert derived.axis == {"shaft": "+x", "bearing": "+x"}
+    # free both ways along x, each leaves along -x: it goes in along +x, as the arm reaches sideways (LEAVING)
+    assert derived.axis == {"shaft": "-x", "bearing": "-x"}
     # Moved along y (not its axis) the shaft is blocked: the overlap counts there.
     assert derived.blockers[("shaft", "+y")] == {"bearing", "housing"}
 
