@@ -36,7 +36,10 @@ any difference but a tie.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -50,6 +53,9 @@ from typing import Any
 
 import numpy as np
 import trimesh
+
+from bridge.errors import ToolError
+from executor.cad.cli import main as import_main
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = Path(__file__).parent / "corpus"
@@ -156,18 +162,31 @@ def _toml(config: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run_import(folder: Path, units: str) -> tuple[Path, str]:
-    """``./run.sh import folder/meshes --config folder/import.toml --place PLACE``
-    into ``folder/out``: the folder and what it printed, kept in ``folder/printed.txt``
-    (ImportFailed on a non-zero exit)."""
+def run_import(folder: Path, units: str, isolated: bool = True) -> tuple[Path, str]:
+    """``import folder/meshes --config folder/import.toml --place PLACE`` into
+    ``folder/out``, in a process of its own (``isolated``: nothing cached from an import
+    before) or in this one: the folder and what it printed, kept in ``folder/printed.txt``
+    (ImportFailed on a failure)."""
     out = folder / "out"
-    done = subprocess.run([str(ROOT / "run.sh"), "import", str(folder / "meshes"), "--units", units, "--config",
-                           str(folder / "import.toml"), "--place", f"{PLACE[0]},{PLACE[1]}", "--out", str(out)],
-                          capture_output=True, text=True, cwd=ROOT, check=False)
-    if done.returncode != 0:
-        raise ImportFailed(done.stderr.strip().splitlines()[-1] if done.stderr.strip() else f"exit {done.returncode}")
-    (folder / "printed.txt").write_text(done.stdout)
-    return out, done.stdout
+    args = ["import", str(folder / "meshes"), "--units", units, "--config", str(folder / "import.toml"),
+            "--place", f"{PLACE[0]},{PLACE[1]}", "--out", str(out)]
+    if isolated:
+        done = subprocess.run([sys.executable, "-P", "-m", "assembly_constraints", *args], capture_output=True,
+                              text=True, cwd=ROOT, env=os.environ | {"PYTHONPATH": str(ROOT)}, check=False)
+        if done.returncode != 0:
+            raise ImportFailed(done.stderr.strip().splitlines()[-1] if done.stderr.strip()
+                               else f"exit {done.returncode}")
+        printed = done.stdout
+    else:
+        buffer = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(buffer):
+                import_main(args[1:])
+        except ToolError as exc:
+            raise ImportFailed(str(exc)) from None
+        printed = buffer.getvalue()
+    (folder / "printed.txt").write_text(printed)
+    return out, printed
 
 
 class ImportFailed(Exception):
@@ -349,18 +368,19 @@ def _mapped_lp(found: dict[str, Any]) -> dict[str, Any]:
     return found
 
 
-def compare(product: Path, transform: str, work: Path, base: dict[str, Any] | None = None
-            ) -> tuple[list[str], dict[str, Any]]:
+def compare(product: Path, transform: str, work: Path, base: dict[str, Any] | None = None,
+            isolated: bool = True) -> tuple[list[str], dict[str, Any]]:
     """The differences of ``product`` changed by ``transform`` from it unchanged (imported
-    in ``work``; ``base``: the unchanged import's answers, when already known), and those."""
+    in ``work``, each import ``isolated`` or not: :func:`run_import`; ``base``: the
+    unchanged import's answers, when already known), and those."""
     if base is None:
         folder = work / "same"
         write_variant(product, VARIANTS["same"], folder)
-        base = answers(*run_import(folder, "mm"))
+        base = answers(*run_import(folder, "mm", isolated))
     variant = VARIANTS[transform]
     folder = work / transform
     renamed = write_variant(product, variant, folder)
-    other = answers(*run_import(folder, variant.units))
+    other = answers(*run_import(folder, variant.units, isolated))
     frame = _Frame(variant.quarter, variant.dz, {new: old for old, new in renamed.items()})
     frame.ids |= hole_ids(base, other, frame)
     layout = not (variant.quarter or transform == "renamed")
