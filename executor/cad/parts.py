@@ -47,6 +47,10 @@ from executor.cad.sweep import CylinderFace, PrismFace, Slide, fit_faces, zero_c
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
+MERGE_DIGITS = 11
+"""A mesh's vertices are merged by their position [m] rounded to this many decimals (10⁻¹¹
+m, 10⁻⁸ mm) whatever the file's unit: merged in the file's unit, a part in metres merged
+vertices 4 nm apart that in millimetres stay two (Meta-World's ring was then refused)."""
 MESH_SUFFIXES = (".stl", ".obj")
 STEP_SUFFIXES = (".step", ".stp")
 OVERLAP_VOLUME = 1e-9
@@ -128,7 +132,7 @@ def part_id(name: str, source: str) -> str:
 
 def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
     """Every ``*.stl``/``*.obj`` of ``folder`` as a part, scaled by ``units`` to metres,
-    its vertices merged by position; ExecutorError naming the file when the files hold
+    its vertices merged by position (:data:`MERGE_DIGITS`); ExecutorError naming the file when the files hold
     more than ``max_triangles`` together or a coordinate is not finite."""
     files = sorted(p for p in folder.iterdir() if p.suffix.lower() in MESH_SUFFIXES)
     if not files:
@@ -146,8 +150,8 @@ def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) ->
         if not np.all(np.isfinite(mesh.vertices)):
             raise ExecutorError(f"{_non_finite(path, mesh)}: a coordinate that is not a finite number (expected "
                                 "finite coordinates)")
-        mesh.merge_vertices(merge_tex=True, merge_norm=True)
         mesh.apply_scale(UNITS[units])
+        mesh.merge_vertices(merge_tex=True, merge_norm=True, digits_vertex=MERGE_DIGITS)
         parts.append(CadPart(part_id(path.stem, str(path)), path.stem, mesh, str(path)))
     return parts
 

@@ -74,6 +74,8 @@ _TURN_KEYS = {"outline", "size", "yaw"}
 """A section's orientation: under a turn compared by :func:`_turn_invariant`."""
 _HEIGHT_KEYS = {"top_z", "bottom"}
 """Heights in the cell [m]: the CAD's z is the cell's."""
+_REACH = "out of the arm's reach measured in the cell"
+"""A reason of the arm's measured reach, under a turn (:meth:`_Frame.word`)."""
 _LAYOUT_KEYS = {"start", "tray"}
 """The trays the import lays out: by id order and footprint."""
 
@@ -227,6 +229,9 @@ class _Frame:
     quarter: int
     dz: float
     ids: dict[str, str] = field(default_factory=dict)
+    turned: bool = False
+    """Whether the comparison is of a turned product (either side): a reason naming the
+    arm's measured reach is its kind alone, the reach being the cell frame's."""
 
     def point(self, p: list[float]) -> list[float]:
         """A cell point [m] (x, y or x, y, z) of the variant in the unchanged product's frame."""
@@ -245,10 +250,19 @@ class _Frame:
         return ("+" if x + y > 0 else "-") + ("x" if x else "y")
 
     def word(self, text: str) -> str:
-        """``text`` with every id of the variant named as in the unchanged product, and
-        every axis turned back."""
+        """``text`` with every id of the variant named as in the unchanged product, every
+        point ``(x, y[, z]) mm`` moved back, every axis turned back (:attr:`turned`: the
+        arm's measured reach left out)."""
         text = re.sub(r"\b\w+\b", lambda m: self.ids.get(m[0], m[0]), text)
+        text = re.sub(r"\((-?\d+\.\d+), (-?\d+\.\d+)(, -?\d+\.\d+)?\) mm", self._point_mm, text)
+        if self.turned and ("measured to reach" in text or "out of the reach measured" in text):
+            text = text.split(":")[0] + ": " + _REACH
         return re.sub(r"(?<![\w.])[+-][xyz]\b", lambda m: self.axis(m[0]), text) if self.quarter else text
+
+    def _point_mm(self, match: re.Match[str]) -> str:
+        """A point ``(x, y[, z]) mm`` of the variant's cell frame moved back, to 0.1 mm."""
+        given = [float(v.strip(", ")) / 1000 for v in match.groups() if v is not None]
+        return "(" + ", ".join(f"{1000 * v:.1f}" for v in self.point(given)) + ") mm"
 
 
 def _holes(found: dict[str, Any]) -> dict[str, list[float]]:
@@ -258,17 +272,25 @@ def _holes(found: dict[str, Any]) -> dict[str, list[float]]:
 
 def hole_ids(base: dict[str, Any], other: dict[str, Any], frame: _Frame) -> dict[str, str]:
     """Each hole id of ``other`` mapped to the ``base`` hole at its position (turned back),
-    of the same name once its part ids are mapped (a name may hold the hole's own id: an
-    empty hole is "hole h2", and holes are numbered by position)."""
+    of the same name once its part ids are mapped (:func:`_name_words`), or where none is
+    there, the one hole of that name (a tied part's, :func:`_tied`, enters on the other
+    side); one matched by none (or by several) gets its id and "?", not to be taken for
+    the unchanged hole of its id."""
     mapped = {}
+    named = {bid: _name_words(hole["name"], bid) for bid, hole in base["assembly.toml"].get("holes", {}).items()}
     for hid, position in _holes(other).items():
         back = frame.point(position)
-        name = frame.word(re.sub(rf"\b{hid}\b", "#", other["assembly.toml"]["holes"][hid]["name"]))
-        near = [bid for bid, p in _holes(base).items() if math.dist(p, back) <= 1e-5
-                and re.sub(rf"\b{bid}\b", "#", base["assembly.toml"]["holes"][bid]["name"]) == name]
-        if len(near) == 1:
-            mapped[hid] = near[0]
+        name = _name_words(frame.word(other["assembly.toml"]["holes"][hid]["name"]), frame.ids.get(hid, hid))
+        alike = [bid for bid, words in named.items() if words == name]
+        near = [bid for bid in alike if math.dist(_holes(base)[bid], back) <= 1e-5] or alike
+        mapped[hid] = near[0] if len(near) == 1 else f"{hid}?"
     return mapped
+
+
+def _name_words(name: str, hid: str) -> list[str]:
+    """The words of hole ``hid``'s name, sorted (a pin's name lists its parts in id order),
+    its own id as "#" (an empty hole is "hole h2", and holes are numbered by position)."""
+    return sorted(re.findall(r"\w+|#", re.sub(rf"\b{hid}\b", "#", name)))
 
 
 def _turn_invariant(section: dict[str, Any]) -> dict[str, Any]:
@@ -300,7 +322,9 @@ def canonical(found: dict[str, Any], frame: _Frame, layout: bool) -> Any:
             items = [walk(v, key) for v in value]
             return sorted(items, key=repr) if key not in ("size", "outline", "base_size") else items
         if isinstance(value, str):
-            return frame.word(value)
+            text = frame.word(value)
+            return re.sub(r"\(([\w ]+) onto it\)", lambda m: f"({' '.join(sorted(m[1].split()))} onto it)",
+                          text) if key == "name" else text
         if key in _HEIGHT_KEYS and isinstance(value, float):
             return value - frame.dz
         return value
@@ -381,14 +405,16 @@ def compare(product: Path, transform: str, work: Path, base: dict[str, Any] | No
     folder = work / transform
     renamed = write_variant(product, variant, folder)
     other = answers(*run_import(folder, variant.units, isolated))
-    frame = _Frame(variant.quarter, variant.dz, {new: old for old, new in renamed.items()})
+    frame = _Frame(variant.quarter, variant.dz, {new: old for old, new in renamed.items()}, bool(variant.quarter))
     frame.ids |= hole_ids(base, other, frame)
     layout = not (variant.quarter or transform == "renamed")
-    mine = canonical(_mapped_lp(_deep(base)), _Frame(0, 0.0), layout)
+    mine = canonical(_mapped_lp(_deep(base)), _Frame(0, 0.0, turned=bool(variant.quarter)), layout)
     if variant.quarter:
         mine = _unturned_sections(mine)
     theirs = canonical(_mapped_lp(other), frame, layout)
     tied = _tied(mine, theirs)
+    if variant.quarter:
+        _reach_either(mine, theirs)
     return [f"tie: {pid} goes in along {mine['axes'][pid]['insertion']} unchanged, "
             f"{theirs['axes'][pid]['insertion']} changed (free both ways)" for pid in sorted(tied)
             ] + list(differences(_untied(mine, tied), _untied(theirs, tied))), base
@@ -404,6 +430,18 @@ def _tied(mine: dict[str, Any], theirs: dict[str, Any]) -> set[str]:
             and axes["insertion"] != theirs["axes"][pid]["insertion"]
             and leaves(mine["axes"], pid) == leaves(theirs["axes"], pid)
             and _opposite(theirs["axes"][pid]["insertion"]) in axes["free"]}
+
+
+def _reach_either(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
+    """Under a turn, each part placed by hand in both for a reason, one of which is the
+    arm's measured reach (the cell frame's): the other reason taken for it (the reach is
+    checked first, so where it fails turned it is the reason given)."""
+    mine_manual = mine.get("geometry.toml", {}).get("manual", {})
+    theirs_manual = theirs.get("geometry.toml", {}).get("manual", {})
+    for pid in set(mine_manual) & set(theirs_manual):
+        reasons = (mine_manual[pid].get("reason", ""), theirs_manual[pid].get("reason", ""))
+        if any(reason.endswith(_REACH) for reason in reasons):
+            mine_manual[pid]["reason"] = theirs_manual[pid]["reason"] = _REACH
 
 
 def _opposite(axis: str) -> str:
@@ -458,10 +496,16 @@ def main(argv: list[str] | None = None) -> int:
     failed = 0
     for name in products:
         work = Path(tempfile.mkdtemp(prefix=f"invariance_{name}_")) if args.keep is None else args.keep / name
-        base = None
+        write_variant(CORPUS / name, VARIANTS["same"], work / "same")
+        try:
+            base = answers(*run_import(work / "same", "mm"))
+        except ImportFailed as exc:
+            print(f"{name}: the unchanged product's import failed: {exc}", flush=True)
+            failed += 1
+            continue
         for transform in args.transform or TRANSFORMS:
             try:
-                found, base = compare(CORPUS / name, transform, work, base)
+                found, _ = compare(CORPUS / name, transform, work, base)
             except ImportFailed as exc:
                 found = [f"import failed: {exc}"]
             wrong = [line for line in found if not line.startswith("tie:")]
