@@ -1,10 +1,11 @@
 """The import's answers under changes of the CAD that cannot matter (metamorphic testing).
 
 A corpus product (``tests/cad/corpus/<name>/``, meshes in mm) is written again changed in
-one way that leaves the product the same, imported (``./run.sh import``, a process each,
-one at a time), and its written assembly folder compared, parsed, with the same product
-written unchanged (``same``: the meshes as ASCII STL of float64 coordinates, as every
-variant is written, so the comparison measures the change, not the file format):
+one way that leaves the product the same, imported (``import``, one at a time, each in a
+process of its own; the tests' in theirs: :func:`run_import`), and its written assembly
+folder compared, parsed, with the same product written unchanged (``same``: the meshes
+as ASCII STL of float64 coordinates, as every variant is written, so the comparison
+measures the change, not the file format):
 
 - ``turn90``, ``turn180``, ``turn270``: every vertex turned about z (an exact permutation
   of x and y with signs); the cell frame's points and axes turned back about ``place``;
@@ -25,7 +26,10 @@ digests (the files written are the meshes as read, in the cell frame); the trays
 out by the import (``start``, ``tray``) where ids or footprints change (``renamed`` lays
 them out in another id order, a turn turns the footprints); under a turn, a section's
 orientation (``outline``, ``size``, ``yaw``): compared by what a turn keeps (its sorted
-sides, its corners' distances from its centre).
+sides, its corners' distances from its centre), and a reason naming the arm's measured
+reach (:data:`_REACH`: the reach is the cell frame's); a part free both ways along an
+axis that goes in from the other side turned (a tie, :func:`_tied`): its axis and its
+feature's entry. docs/import.md ("Invariances") lists what the comparison found.
 
 ``python -m tests.cad.invariance [--product NAME ...] [--transform T ...]`` prints one
 line per product and transform (``same`` or the differences, each ``tie:`` too: a part
@@ -56,6 +60,7 @@ import trimesh
 
 from bridge.errors import ToolError
 from executor.cad.cli import main as import_main
+from executor.cad.sweep import opposite
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = Path(__file__).parent / "corpus"
@@ -425,11 +430,11 @@ def _tied(mine: dict[str, Any], theirs: dict[str, Any]) -> set[str]:
     imports: a tie the import breaks by its order of cell axes (the cell reaches some
     sideways, :data:`executor.cad.sweep.DIRECTIONS`), legitimate."""
     def leaves(axes: dict[str, Any], pid: str) -> set[str]:
-        return set(axes[pid]["free"]) | {_opposite(axes[pid]["insertion"])}
+        return set(axes[pid]["free"]) | {opposite(axes[pid]["insertion"])}
     return {pid for pid, axes in mine["axes"].items() if pid in theirs["axes"]
             and axes["insertion"] != theirs["axes"][pid]["insertion"]
             and leaves(mine["axes"], pid) == leaves(theirs["axes"], pid)
-            and _opposite(theirs["axes"][pid]["insertion"]) in axes["free"]}
+            and opposite(theirs["axes"][pid]["insertion"]) in axes["free"]}
 
 
 def _reach_either(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
@@ -442,11 +447,6 @@ def _reach_either(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
         reasons = (mine_manual[pid].get("reason", ""), theirs_manual[pid].get("reason", ""))
         if any(reason.endswith(_REACH) for reason in reasons):
             mine_manual[pid]["reason"] = theirs_manual[pid]["reason"] = _REACH
-
-
-def _opposite(axis: str) -> str:
-    """The opposite of a cell axis (``+x`` ↔ ``-x``)."""
-    return ("-" if axis[0] == "+" else "+") + axis[1]
 
 
 def _untied(tree: dict[str, Any], tied: set[str]) -> dict[str, Any]:
