@@ -326,8 +326,9 @@ def canonical(found: dict[str, Any], frame: _Frame, layout: bool) -> Any:
                 return frame.point(value) if key != "grip" else value
             items = [walk(v, key) for v in value]
             return sorted(items, key=repr) if key not in ("size", "outline", "base_size") else items
-        if isinstance(value, str):
-            text = frame.word(value)
+        if isinstance(value, str):  # ids listed in id order: sorted
+            text = re.sub(r"\((\w+(?:, \w+)+)\)", lambda m: f"({', '.join(sorted(m[1].split(', ')))})",
+                          frame.word(value))
             return re.sub(r"\(([\w ]+) onto it\)", lambda m: f"({' '.join(sorted(m[1].split()))} onto it)",
                           text) if key == "name" else text
         if key in _HEIGHT_KEYS and isinstance(value, float):
@@ -358,6 +359,9 @@ def differences(base: Any, other: Any, path: str = "") -> Iterator[str]:
         if not _close(float(base), float(other), path):
             yield f"{path}: {base} -> {other}"
     elif isinstance(base, str) and isinstance(other, str) and base != other:
+        if base.endswith("\u2026") or other.endswith("\u2026"):  # shortened: where ids are longer, sooner
+            base, other = base.rstrip("\u2026"), other.rstrip("\u2026")
+            base, other = base[:min(len(base), len(other))].rstrip(), other[:min(len(base), len(other))].rstrip()
         numbers = re.compile(r"-?\d+\.\d+")
         if numbers.sub("#", base) != numbers.sub("#", other) or not all(
                 abs(float(a) - float(b)) <= 2e-3 for a, b in zip(numbers.findall(base), numbers.findall(other),
