@@ -56,6 +56,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.errors import ToolError
@@ -352,6 +353,10 @@ def differences(base: Any, other: Any, path: str = "") -> Iterator[str]:
                 yield f"{path}/{key}: only changed ({_short(other[key])})"
             else:
                 yield from differences(base[key], other[key], f"{path}/{key}")
+    elif path.endswith("/outline") and isinstance(base, list) and isinstance(other, list):
+        apart = shapely.Polygon(base).hausdorff_distance(shapely.Polygon(other))
+        if apart > LENGTH_M:  # one polygon, however its corners are listed (noise adds or drops one)
+            yield f"{path}: {apart * 1e6:.3f} um apart ({_short(base)} -> {_short(other)})"
     elif isinstance(base, list) and isinstance(other, list) and len(base) == len(other):
         for k, (a, b) in enumerate(zip(base, other, strict=True)):
             yield from differences(a, b, f"{path}[{k}]")
