@@ -8,7 +8,7 @@ pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
 every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
-along the first such direction: its **insertion axis** is the reverse. Where parts are
+along the first such direction (in `LEAVING`'s order): its **insertion axis** is the reverse. Where parts are
 left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
 the stages made anew. A part that no stage frees never comes out (an error naming it and,
@@ -124,6 +124,13 @@ _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one h
 _ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
 _GRID = 1e-8  # the grid [m] the union of a pin's sections is snapped to (far below a fit's room)
 _JITTER = 5e-8  # [m] a vertex of that union this close to the line through its neighbours is dropped
+LEAVING = ("+z", "-z", "-x", "+y", "-y", "+x")
+"""The order a part's way out (its insertion axis reversed) is chosen in among those it is
+free along: up (the cell inserts from above), down, then the horizontal ones whose
+insertion the cell's arm was measured to reach sideways (+x, +y, -y:
+:data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways along x
+goes in along +x however the CAD is turned about z; a zero-clearance fit's axis that is
+none of these last, in the order found."""
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
@@ -398,7 +405,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
 
 def _disassembled(result: Derived) -> set[str]:
     """Stage by stage, every part that some direction frees from the parts still in place
-    leaves along the first such direction (``result``'s ``axis`` and ``stages`` filled in);
+    leaves along the first such direction in :data:`LEAVING`'s order (``result``'s ``axis`` and ``stages`` filled in);
     the parts no stage frees."""
     remaining = set(result.parts) - {result.base}
     while remaining:
@@ -407,8 +414,9 @@ def _disassembled(result: Derived) -> set[str]:
         if not stage:
             break
         for pid in stage:
-            result.axis[pid] = next(d for d in result.directions
-                                    if not (result.blockers[(pid, d)] & (remaining | {result.base})))
+            result.axis[pid] = min((d for d in result.directions
+                                    if not (result.blockers[(pid, d)] & (remaining | {result.base}))),
+                                   key=lambda d: LEAVING.index(d) if d in LEAVING else len(LEAVING))
         result.stages.append(stage)
         remaining -= set(stage)
     return remaining
@@ -420,13 +428,17 @@ def receives(fit: HoleFit) -> bool:
     a fraction of a turn (:func:`executor.world.polygon_fit.symmetry` of order 2 or more:
     a hexagon, a spline, a cross, a 16-gon). A polygon with no such axis is a pocket: the
     open corner beside a turned boss, a relieved corner or a slot left around a pin of the
-    base's own in its hole, the gap between two of its bodies."""
+    base's own in its hole, the gap between two of its bodies; a sliver whose mean width
+    (twice its area over its perimeter) is at most :data:`executor.cad.sweep.TOUCH` is a
+    gap between faces that touch, whatever symmetry rounding lends it (one of a Technic
+    pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z)."""
     if fit.hole.kind != "polygon":
         return True
     try:
-        return symmetry(polygon(fit.hole.outline, "hole")) >= 2
+        shape = polygon(fit.hole.outline, "hole")
     except OutlineError:  # no simple polygon: a gap of no area between faces that touch
         return False
+    return 2 * shape.area > TOUCH * shape.length and symmetry(shape) >= 2
 
 
 def owner_pairs(derived: Derived) -> dict[tuple[str, str], str]:
@@ -464,8 +476,10 @@ def bodies(parts: dict[str, CadPart], base: str, fixed_to: dict[str, str]) -> di
 def forced(derived: Derived) -> dict[tuple[str, str], str]:
     """The ``blocks`` pairs: A before B when, of the directions the base leaves A free
     along, B blocks one and B or the parts present whenever B is (its body, the base, the
-    bodies already found to precede it) block every one; repeated until no pair is added.
-    Each pair's blockers per direction in ``derived.detail``."""
+    bodies already found to precede it) block every one; repeated until no pair is added,
+    then every pair the rule gives with those, also where A already precedes B through
+    others (so the pairs do not depend on the order of the ids). Each pair's blockers per
+    direction in ``derived.detail``."""
     rep = {root: min(members) for root, members in derived.bodies.items()}
     before: dict[str, set[str]] = {root: set() for root in derived.bodies}
     pairs: dict[tuple[str, str], str] = {}
@@ -479,26 +493,37 @@ def forced(derived: Derived) -> dict[tuple[str, str], str]:
                 todo.append(prior)
         return seen
 
+    def found(a: str, b: str, known: bool) -> bool:
+        """Whether the rule puts body ``a`` before body ``b`` (recorded); ``known``: also
+        where ``a`` is already found to precede ``b``."""
+        ways, prior = list(derived.ways(rep[a])), ahead(b)
+        if b == a or (a in prior and not known) or not ways:
+            return False
+        present = derived.bodies[b].union(*(derived.bodies[p] for p in prior - {a}))
+        blocking = {d: derived.blockers[(rep[a], d)] & present for d in ways}
+        if not all(blocking.values()) or not any(hit & derived.bodies[b] for hit in blocking.values()):
+            return False
+        detail = "; ".join(f"{d} {' '.join(sorted(hit))}" for d, hit in blocking.items())
+        for x in sorted(derived.bodies[a]):
+            for y in sorted(derived.bodies[b] & set().union(*blocking.values())):
+                pairs[(x, y)] = "blocks"
+                derived.detail[(x, y)] = detail
+        return True
+
     grown = True
     while grown:
         grown = False
-        for a, a_members in derived.bodies.items():
-            ways = list(derived.ways(rep[a]))
-            for b, b_members in derived.bodies.items():
-                prior = ahead(b)
-                if b == a or a in prior or not ways:
-                    continue
-                present = b_members.union(*(derived.bodies[p] for p in prior))
-                blocking = {d: derived.blockers[(rep[a], d)] & present for d in ways}
-                if not all(blocking.values()) or not any(found & b_members for found in blocking.values()):
-                    continue
-                before[b].add(a)
-                grown = True
-                detail = "; ".join(f"{d} {' '.join(sorted(found))}" for d, found in blocking.items())
-                for x in sorted(a_members):
-                    for y in sorted(b_members & set().union(*blocking.values())):
-                        pairs[(x, y)] = "blocks"
-                        derived.detail[(x, y)] = detail
+        for a in derived.bodies:
+            for b in derived.bodies:
+                if found(a, b, known=False):
+                    before[b].add(a)
+                    grown = True
+    # every pair the rule gives once nothing is added, those already ordered through others
+    # too: which ones the loop skipped depends on the order of the ids
+    for a in derived.bodies:
+        for b in derived.bodies:
+            if a in ahead(b):
+                found(a, b, known=True)
     return pairs
 
 

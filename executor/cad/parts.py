@@ -40,6 +40,7 @@ from typing import BinaryIO
 
 import manifold3d
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.assembly import is_id
@@ -50,16 +51,19 @@ from executor.cad.sweep import (
     Slide,
     fit_faces,
     lone_thread,
-    near,
     zero_clearance_fits,
 )
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
+MERGE_DIGITS = 11
+"""A mesh's vertices are merged by their position [m] rounded to this many decimals (10⁻¹¹
+m, 10⁻⁸ mm) whatever the file's unit: merged in the file's unit, a part in metres merged
+vertices 4 nm apart that in millimetres stay two (Meta-World's ring was then refused)."""
 MESH_SUFFIXES = (".stl", ".obj")
 STEP_SUFFIXES = (".step", ".stp")
 OVERLAP_VOLUME = 1e-9
-"""Two parts overlap when their intersection, less the pieces within their zero-clearance
+"""Two parts overlap when their intersection, less what lies within their zero-clearance
 fits' tolerance of the mated faces, is larger than this [m³] (1 mm³); touching faces and
 fits with clearance have none."""
 PRODUCT_EXTENT = (0.005, 5.0)
@@ -187,7 +191,7 @@ def part_id(name: str, source: str) -> str:
 
 def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
     """Every ``*.stl``/``*.obj`` of ``folder`` as a part, scaled by ``units`` to metres,
-    its vertices merged by position; ExecutorError naming the file when the files hold
+    its vertices merged by position (:data:`MERGE_DIGITS`); ExecutorError naming the file when the files hold
     more than ``max_triangles`` together or a coordinate is not finite."""
     files = sorted(p for p in folder.iterdir() if p.suffix.lower() in MESH_SUFFIXES)
     if not files:
@@ -205,8 +209,8 @@ def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) ->
         if not np.all(np.isfinite(mesh.vertices)):
             raise ExecutorError(f"{_non_finite(path, mesh)}: a coordinate that is not a finite number (expected "
                                 "finite coordinates)")
-        mesh.merge_vertices(merge_tex=True, merge_norm=True)
         mesh.apply_scale(UNITS[units])
+        mesh.merge_vertices(merge_tex=True, merge_norm=True, digits_vertex=MERGE_DIGITS)
         parts.append(CadPart(part_id(path.stem, str(path)), path.stem, mesh, str(path)))
     return parts
 
@@ -402,8 +406,8 @@ def _overlaps_to(parts: list[CadPart], sender: multiprocessing.connection.Connec
 
 def _check_overlaps(parts: list[CadPart]) -> None:
     """ExecutorError naming the first pair whose intersection exceeds :data:`OVERLAP_VOLUME`
-    (exact booleans by manifold3d on the pairs whose bounding boxes meet), less the pieces
-    of it that lie within their zero-clearance fits' tolerance of the mated faces."""
+    (exact booleans by manifold3d on the pairs whose bounding boxes meet), less what of it
+    lies within their zero-clearance fits' tolerance of the mated faces (:func:`_beyond_fits`)."""
     faces: dict[str, list[CylinderFace | PrismFace]] = {}
     solids: dict[str, manifold3d.Manifold] = {}
     for i, a in enumerate(parts):
@@ -415,8 +419,8 @@ def _check_overlaps(parts: list[CadPart]) -> None:
             for part in (a, b):
                 if part.id not in solids:
                     solids[part.id] = _manifold(part.mesh)
-            common = _mesh((solids[a.id] ^ solids[b.id]).to_mesh())
-            volume = _volume(common)
+            common = solids[a.id] ^ solids[b.id]
+            volume = _volume(_mesh(common.to_mesh()))
             if volume > OVERLAP_VOLUME:
                 for part in (a, b):
                     if part.id not in faces:
@@ -449,16 +453,39 @@ def _volume(mesh: trimesh.Trimesh) -> float:
         return float(mesh.volume) if len(mesh.faces) else 0.0
 
 
-def _beyond_fits(common: trimesh.Trimesh, slides: list[Slide]) -> float:
-    """The volume [m³] of the pieces of the intersection ``common`` that do not lie, every
-    vertex, within a fit's tolerance of its shaft's or its bore's face (the overlap of two
-    tessellations of one nominal cylinder, as the sweeps take it: :mod:`executor.cad.sweep`)."""
-    if not slides:
-        return _volume(common)
-    outside = 0.0
-    for piece in common.split(only_watertight=False):
-        points = np.asarray(piece.vertices)
-        if not any(np.all(near(points, slide.face, slide.tolerance)[0] | near(points, slide.hole, slide.tolerance)[0])
-                   for slide in slides):
-            outside += abs(_volume(piece))
-    return outside
+def _beyond_fits(common: manifold3d.Manifold, slides: list[Slide]) -> float:
+    """The volume [m³] of the intersection ``common`` outside every fit's tolerance of its
+    shaft's and its bore's faces (:func:`_near_face`: the overlap of two tessellations of one
+    nominal cylinder, as the sweeps take it, :mod:`executor.cad.sweep`). A volume, not a
+    count of pieces: the booleans' triangulation of ``common`` differs with the order of the
+    two parts (a sheet of touching end faces joins its pieces in one order only)."""
+    for slide in slides:
+        for face in (slide.face, slide.hole):
+            common = common - _near_face(face, slide.tolerance)
+    return max(common.volume(), 0.0)
+
+
+def _near_face(face: CylinderFace | PrismFace, tolerance: float) -> manifold3d.Manifold:
+    """The solid of the points within ``tolerance`` [m] of ``face`` (of its radius or its
+    outline) and of its span (:func:`executor.cad.sweep.near`), a little wider: a circle
+    is a polygon around it, its inner one within it, of sides whose sagitta is at most a
+    tenth of ``tolerance``."""
+    across = np.linalg.svd(face.direction[None, :])[2][1:] if isinstance(face, CylinderFace) else face.frame
+    swapped = np.linalg.det(np.array([*across, face.direction])) < 0  # the solid's frame turned, not mirrored
+    across = across[::-1] if swapped else across
+    if isinstance(face, CylinderFace):
+        sides = max(8, math.ceil(math.pi / math.acos(1 - min(tolerance / 10 / (face.radius + tolerance), 1.0))))
+        centre = shapely.Point(across @ face.point)
+        outer = centre.buffer((face.radius + tolerance) / math.cos(math.pi / sides), quad_segs=math.ceil(sides / 4))
+        band = outer.difference(centre.buffer(max(face.radius - tolerance, 0.0), quad_segs=math.ceil(sides / 4)))
+    else:
+        outline = shapely.Polygon(np.asarray(face.outline.exterior.coords)[:, ::-1 if swapped else 1])
+        band = outline.buffer(tolerance).difference(outline.buffer(-tolerance))
+    contours = [np.asarray(ring.coords)[:-1] for polygon in getattr(band, "geoms", [band])
+                for ring in (shapely.geometry.polygon.orient(polygon, 1.0).exterior,
+                             *shapely.geometry.polygon.orient(polygon, 1.0).interiors)]
+    low, high = face.span
+    solid = manifold3d.Manifold.extrude(manifold3d.CrossSection(contours), high - low + 2 * tolerance)
+    turn = np.column_stack([*across, face.direction, face.direction * (float(face.point @ face.direction) + low
+                                                                       - tolerance)])
+    return solid.transform(turn)

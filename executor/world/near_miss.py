@@ -56,7 +56,9 @@ def collision_section(part: Section) -> shapely.Polygon | None:
     """The section of the cell's collision peg built from ``part``'s section [m]: a box's
     rectangle (the cell's box has sharp sides a x b whatever the section's corner) or each
     convex piece of a polygon's prism opened by the hull margin (shrunk by it, then
-    widened by it); None for a round section (a cylinder's side is its circle)."""
+    widened by it: nothing of a piece thinner than twice the margin, so a section of such
+    pieces only, a Technic axle's cross, is empty); None for a round section (a
+    cylinder's side is its circle)."""
     if part.kind == "round":
         return None
     if part.kind == "polygon":
@@ -66,8 +68,9 @@ def collision_section(part: Section) -> shapely.Polygon | None:
         pieces = [shapely.box(-a / 2, -b / 2, a / 2, b / 2)]
     opened = [shapely.buffer(shapely.buffer(piece, -URDF_HULL_MARGIN, join_style="mitre"), URDF_HULL_MARGIN,
                              quad_segs=ARC_SEGMENTS) for piece in pieces]
-    union = shapely.union_all(opened)
-    shells = union.geoms if isinstance(union, shapely.MultiPolygon) else [union]
+    union = shapely.union_all(opened)  # empty where every piece is thinner than twice the margin
+    shells = [shell for shell in getattr(union, "geoms", [union]) if isinstance(shell, shapely.Polygon)
+              and not shell.is_empty]
     return shapely.union_all([shapely.Polygon(shell.exterior) for shell in shells])  # gaps between pieces filled
 
 
@@ -79,6 +82,8 @@ def erosion(part: Section) -> float:
     if cell is None:
         return SIZE_RESOLUTION
     whole = outline_polygon(part, peg=True)
+    if cell.is_empty:  # it lacks all of it: its deepest point, the centre of its largest inscribed circle
+        return float(shapely.length(shapely.maximum_inscribed_circle(whole, 1e-7))) + SIZE_RESOLUTION
     lacking = shapely.segmentize(shapely.difference(whole, cell), URDF_HULL_MARGIN / 64)
     points = shapely.points(shapely.get_coordinates(lacking))
     deepest = float(shapely.distance(whole.exterior, points).max()) if len(points) else 0.0
@@ -107,10 +112,14 @@ def near_miss(part: Section, hole: Section, room: float) -> float | None:
     """The :func:`erosion` [m] of a peg ``part`` with ``room`` [m] (its :func:`margin`,
     negative: it does not pass) in ``hole`` when the cell cannot resolve that no-fit (the
     section eroded by it passes the hole), None when it can, or when the pair fits
-    (``room`` >= 0: the cell's smaller peg passes too)."""
+    (``room`` >= 0: the cell's smaller peg passes too); a peg whose cell's section is
+    empty (:func:`collision_section`) passes any hole in the cell: its no-fits are near misses."""
     if room >= 0:
         return None
     depth = erosion(part)
+    cell = collision_section(part)
+    if cell is not None and cell.is_empty:  # nothing of it in the cell's peg: no experiment decides the pair
+        return depth
     return depth if margin(eroded_section(part, depth), hole) > 0 else None
 
 

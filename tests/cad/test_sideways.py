@@ -18,6 +18,8 @@ import trimesh
 from bridge import BridgeError
 from bridge.product import load_product_description
 from executor.cad.cli import ImportOptions, run_import
+from executor.cad.derive import LEAVING
+from executor.cad.operations import SIDEWAYS_HOLE_REACH, SIDEWAYS_PIN_REACH
 from executor.cad.sections import frame_of
 from executor.cad.sweep import DIRECTIONS, opposite
 from executor.trial import Cell
@@ -127,8 +129,8 @@ def test_a_horizontal_peg_is_assembled_within_2_mm(taught: Path) -> None:
 
 
 def _turned(folder: Path, wall: float | None = None) -> Path:
-    """The product's CAD (turned a quarter turn about z: its hole along x, the peg going in
-    along -x, towards the arm) or, with a ``wall`` [mm], as drawn with a 10 mm wall from its
+    """The product's CAD (turned a quarter turn about z: its hole along x, the peg free both
+    ways along it) or, with a ``wall`` [mm], as drawn with a 10 mm wall from its
     box's +y face, beside the hole's entry (x 25 to 35 mm from its axis, as high as the box),
     reaching that far out, in ``folder``."""
     folder.mkdir()
@@ -147,15 +149,21 @@ def _turned(folder: Path, wall: float | None = None) -> Path:
 
 
 def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_arm_was_not_measured_to_reach(tmp_path: Path) -> None:
-    # Along -x the assembling cell's transfer ends short of the approach (68.5 mm with the
-    # entry 352.5 mm out, 75.9 mm at 452.5 mm: no IK solution within the joints' limits): never the cell's.
+    # Turned a quarter turn about z the peg is free both ways along x through its hole. Along
+    # -x the assembling cell's transfer ends short of the approach (68.5 mm with the entry
+    # 352.5 mm out, 75.9 mm at 452.5 mm: no IK solution within the joints' limits): never the
+    # cell's, so the peg goes in along +x (the import chose -x, and the turned product's peg
+    # went by hand: tests/cad/invariance.py, turn90); its entry 395 mm out is beyond the box
+    # measured along +x.
     turned = _turned(tmp_path / "turned")
-    for place, out in (((0.56, 0.0), "default"), ((0.42, 0.0), "near")):
+    for place, out, by_hand in (((0.56, 0.0), "default", False), ((0.42, 0.0), "near", True)):
         imported = run_import(turned, tmp_path / out, "mm", CORPUS / "import.toml", ImportOptions(place=place))
-        assert imported.derived.axis == {"hex_peg": "+x"}
+        assert imported.derived.axis == {"hex_peg": "-x"}
         manual = load_product_description(tmp_path / out).geometry.manual  # type: ignore[union-attr]
-        assert "hex_peg" in manual and "along -x: the cell's arm was measured to reach a hole entered sideways " \
-            "along +x, +y, -y only" in manual["hex_peg"].reason, manual
+        assert ("hex_peg" in manual) == by_hand, manual
+        if by_hand:
+            assert "goes into hole h1 along +x: its entry at (395.0, 0.0, 30.0) mm, out of the reach measured " \
+                "along +x" in manual["hex_peg"].reason, manual
     # Along -y the entry 700 mm out along x: out of the box measured (docs/cell.md).
     run_import(CORPUS / "meshes", tmp_path / "far", "mm", CORPUS / "import.toml", ImportOptions(place=(0.70, 0.0)))
     manual = load_product_description(tmp_path / "far").geometry.manual  # type: ignore[union-attr]
@@ -175,3 +183,9 @@ def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_wrist_would_meet_the_
         assert manual["hex_peg"].reason == ("goes into hole h1 along -y, but the arm's wrist (60 mm about the "
                                           "tool's axis, 60 mm out from the grip) would meet 'box', 55.000 mm out "
                                           "from the grip within 60 mm of the axis"), manual
+
+
+def test_the_ways_out_chosen_first_are_those_whose_insertion_the_arm_reaches_sideways() -> None:
+    horizontal = [d for d in LEAVING if d[1] != "z"]
+    assert {opposite(d) for d in horizontal[:len(SIDEWAYS_HOLE_REACH)]} == set(SIDEWAYS_HOLE_REACH)
+    assert set(SIDEWAYS_PIN_REACH) == set(SIDEWAYS_HOLE_REACH) and set(LEAVING) == set(DIRECTIONS)

@@ -115,3 +115,21 @@ def test_a_mesh_peg_that_misses_a_round_hole_by_less_than_its_rounded_edges_is_n
     assert depth == pytest.approx(URDF_HULL_MARGIN * (1 - math.sin(math.pi / 4)) + SIZE_RESOLUTION, abs=2e-6)
     for hole in (Section("far", "round", diagonal - 0.002), Section("fits", "round", diagonal + 0.0002)):
         assert mesh_near_miss(peg, [BOX], 0.02, hole, margin(peg, hole)) is None  # observed: a no-fit, a fit
+
+
+CROSS = ((0.0008, 0.0008), (0.0024, 0.0008), (0.0024, -0.0008), (0.0008, -0.0008), (0.0008, -0.0024),
+         (-0.0008, -0.0024), (-0.0008, -0.0008), (-0.0024, -0.0008), (-0.0024, 0.0008), (-0.0008, 0.0008),
+         (-0.0008, 0.0024), (0.0008, 0.0024))
+"""A Technic axle's cross [m]: arms 1.6 mm wide, 4.8 mm across, thinner than the hull margin twice."""
+
+
+def test_a_peg_of_pieces_thinner_than_the_margin_twice_lacks_all_of_it_and_its_no_fits_are_near_misses() -> None:
+    # ldraw_axles turned 90 deg about z set its axle against a hole it misses: the empty
+    # collision section had no exterior, and the import stopped on a traceback
+    peg = Section("axle", "polygon", 0.0048, width=0.0048, outline=CROSS)
+    cell = collision_section(peg)
+    assert cell is not None and cell.is_empty
+    deepest = math.hypot(0.0008, 0.0008)  # the centre, from the cross's inner corners
+    assert erosion(peg) == pytest.approx(deepest + SIZE_RESOLUTION, abs=1e-6)
+    assert near_miss(peg, Section("small", "round", 0.004), -0.0004) == pytest.approx(erosion(peg))
+    assert near_miss(peg, Section("wide", "round", 0.006), 0.0006) is None  # a fit
