@@ -494,7 +494,8 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
     which must be +z (pins standing up; those of other parts than the base must be of parts
     the cell places by hand: :func:`cell_view`'s), the part must be the lowest on each, with
     room on each that the cell resolves, and a stack of prisms with one bore per pin
-    (:func:`bore_pieces`)."""
+    (:func:`bore_pieces`). Pins with less room than the cell resolves are all named, with
+    the least room."""
     names = ", ".join(pin.id for pin in on)
     if on[0].axis != "+z":  # a part's pins share its axis (executor.cad.derive.pins)
         return (f"goes onto {len(on)} pins ({names}) along {opposite(on[0].axis)}: the cell puts a part onto several "
@@ -504,8 +505,10 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
         if pid != lowest:
             return (f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts a part onto several pins only "
                     "as the first on each")
-        if why := _unresolved(margins(derived)[pid][pin.id]):
-            return f"goes onto a pin ({pin.id}) {why}"
+    rooms = margins(derived)[pid]
+    if tight := sorted(pin.id for pin in on if _unresolved(rooms[pin.id])):  # all named: no pin first by its id
+        least = min(rooms[pin_id] for pin_id in tight)
+        return f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) {_unresolved(least)}"
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
