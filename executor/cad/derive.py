@@ -9,7 +9,8 @@ pairwise, so these are the blockers at every stage). The directions tried are
 every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
 along the first such direction: its **insertion axis** is the reverse. Where parts are
-left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`)
+left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`, in a nut or a
+plain hole at their tap drill; cosmetic ones, :func:`executor.cad.sweep.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
 the stages made anew. A part that no stage frees never comes out (an error naming it and,
 per direction, its blockers).
