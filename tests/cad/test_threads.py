@@ -104,9 +104,9 @@ def test_a_thread_in_a_hole_below_its_minor_diameter_is_named_in_the_overlap() -
 def _cosmetic(shank_mm: float, hole_mm: float, sunk_mm: float = 0.0) -> list[CadPart]:
     """A plate (z 5 to 10 mm) with a plain hole of d ``hole_mm`` and a plain "screw": a
     shank of d ``shank_mm`` from z -2 mm up to its head (d 1.8 times it, 3 mm high) on the
-    plate, sunk ``sunk_mm`` into it (64 sides each)."""
-    shank = trimesh.creation.cylinder(radius=shank_mm / 2e3, height=12e-3, sections=64)
-    shank.apply_translation([0.0, 0.0, 4e-3])
+    plate, sunk ``sunk_mm`` into it (negative: above it; 64 sides each)."""
+    shank = trimesh.creation.cylinder(radius=shank_mm / 2e3, height=(12.5 - sunk_mm) * 1e-3, sections=64)
+    shank.apply_translation([0.0, 0.0, (4.25 - sunk_mm / 2) * 1e-3])  # z -2 to 0.5 mm into the head
     head = trimesh.creation.cylinder(radius=shank_mm * 0.9e-3, height=3e-3, sections=64)
     head.apply_translation([0.0, 0.0, (11.5 - sunk_mm) * 1e-3])
     screw = trimesh.boolean.union([shank, head])
@@ -137,19 +137,44 @@ def test_an_interference_that_is_no_cosmetic_thread_is_refused(shank: float, hol
         _check_overlaps(_cosmetic(shank, hole, sunk))
 
 
-@pytest.mark.slow  # imports the product and runs a truth session
-def test_a_screw_in_a_tap_drill_hole_reaches_a_truth_session(run_main: Runner, tmp_path: Path) -> None:
-    cad = tmp_path / "cad"
-    cad.mkdir()
-    for part in [_plate(5.105, 4.525, 9.525), _corpus_screw()]:
+def test_a_bracket_clamped_by_a_cosmetic_screw_goes_before_it() -> None:
+    # A bracket (z 10 to 13 mm, a d 4.5 clearance hole) between the plate's tapped M4 hole
+    # and the screw's head: the head closes its way up, the shank its ways across.
+    plate, screw = _cosmetic(4.0, 3.3, sunk_mm=-3.0)
+    bracket = trimesh.creation.annulus(r_min=2.25e-3, r_max=8e-3, height=3e-3, sections=64)
+    bracket.apply_translation([0.0, 0.0, 11.5e-3])
+    parts = [plate, screw, CadPart("bracket", "bracket", bracket, "bracket")]
+    _check_overlaps(parts)
+    derived = derive(parts, "plate", {})
+    assert derived.stages == [["screw"], ["bracket"]]
+    assert derived.reasons[("bracket", "screw")] == "blocks"
+    assert set(cell_view(derived)[1]) == {"screw"}
+
+
+def _imported(run_main: Runner, parts: list[CadPart], folder: Path) -> str:
+    """``parts`` written as STL in mm under ``folder`` and imported, the plate the base,
+    into ``folder / "out"``; what the import printed."""
+    (folder / "cad").mkdir()
+    for part in parts:
         mesh = part.mesh.copy()
         mesh.apply_scale(1e3)
-        mesh.export(cad / f"{part.id}.stl")
-    (tmp_path / "import.toml").write_text('base = "plate"\n')
-    done = run_main("import", str(cad), "--config", str(tmp_path / "import.toml"), "--out", str(tmp_path / "out"))
+        mesh.export(folder / "cad" / f"{part.id}.stl")
+    (folder / "import.toml").write_text('base = "plate"\n')
+    done = run_main("import", str(folder / "cad"), "--config", str(folder / "import.toml"), "--out",
+                    str(folder / "out"))
     assert done.returncode == 0, done.stderr
-    assert "screwed pair screw in plate (a modelled thread in a plain hole at its tap drill)" in done.stdout
-    session = run_main("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(tmp_path / "out"),
+    return done.stdout
+
+
+@pytest.mark.slow  # imports the product and runs a session
+@pytest.mark.parametrize(("drawn", "backend"), [("tap drill", "truth"), ("cosmetic", "sim")])
+def test_a_screw_in_a_tap_drill_hole_reaches_a_session(run_main: Runner, tmp_path: Path, drawn: str,
+                                                         backend: str) -> None:
+    parts = [_plate(5.105, 4.525, 9.525), _corpus_screw()] if drawn == "tap drill" else _cosmetic(4.0, 3.3)
+    printed = _imported(run_main, parts, tmp_path)
+    thread = "a modelled thread in a plain hole at its tap drill" if drawn == "tap drill" else "a cosmetic thread, M4"
+    assert f"screwed pair screw in plate ({thread}" in printed
+    session = run_main("session", "--backend", backend, "--json", "--assemble", "--assembly", str(tmp_path / "out"),
                        "--out", str(tmp_path / "run"), timeout=240)
     assert session.returncode == 0, session.stderr
     result = json.loads(session.stdout)
