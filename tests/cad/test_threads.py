@@ -16,7 +16,7 @@ from executor import ExecutorError
 from executor.cad.derive import derive
 from executor.cad.operations import cell_view
 from executor.cad.parts import CadPart, _check_overlaps, load_meshes
-from executor.cad.sweep import screwed_pairs
+from executor.cad.sweep import cosmetic_thread, screwed_pairs
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -125,6 +125,18 @@ def test_a_plain_screw_in_its_tap_drill_is_drawn_with_a_cosmetic_thread() -> Non
     assert pair.pitch == pytest.approx(0.7e-3) and pair.lead == pytest.approx(0.7e-3)
     assert derived.axis == {"screw": "+z"}
     assert "(a cosmetic thread, M4: d 4 in its 3.3 mm tap drill, pitch 0.700 mm)" in cell_view(derived)[1]["screw"]
+
+
+@pytest.mark.parametrize(("shaft", "hole", "thread"), [
+    (3.0, 2.5, ("M3", 0.5)), (8.0, 6.8, ("M8", 1.25)), (8.0, 7.0, ("M8x1", 1.0)), (10.0, 8.8, ("M10x1.25", 1.25)),
+    (6.35, 5.105, ("1/4-20 UNC", 1.27)), (6.35, 5.5, ("1/4-28 UNF", 25.4 / 28)),
+    (4.826, 3.8, ("#10-24 UNC", 25.4 / 24)),
+    (16.0, 15.9, None), (17.0, 16.0, None), (4.0, 3.0, None), (4.0, 3.6, None), (3.9, 3.3, ("M4", 0.7)),
+])
+def test_the_standard_threads_tap_drills(shaft: float, hole: float, thread: tuple[str, float] | None) -> None:
+    # the shaft from D - P/4 to D, the hole from D - 1.0825 P to D - 0.85 P (10 µm slack)
+    found = cosmetic_thread(shaft * 1e-3, hole * 1e-3, 1e-5)
+    assert (found and (found[0], round(found[1] * 1e3, 4))) == (thread and (thread[0], round(thread[1], 4)))
 
 
 @pytest.mark.parametrize(("shank", "hole", "sunk"), [
