@@ -268,8 +268,8 @@ def _swept(derived: Derived, part: str, feature: str) -> str:
     least room on the way in and that room, as ``sizes.lp`` takes it; "" elsewhere."""
     if (part, feature) not in derived.swept:
         return ""
-    if (part, feature) in screwed_fits(derived):
-        return "; screwed (a modelled thread): it fits by screwing, room 0, placed by hand"
+    if (slide := screwed_fits(derived).get((part, feature))) is not None:
+        return f"; screwed ({slide.thread}): it fits by screwing, room 0, placed by hand"
     peg, hole, room = derived.swept[(part, feature)]
     apart = zero_clearance(peg, hole, room)
     verdict = f"room {_mm(room)} mm" if apart is None else \

@@ -9,7 +9,8 @@ pairwise, so these are the blockers at every stage). The directions tried are
 every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
 along the first such direction (in `LEAVING`'s order): its **insertion axis** is the reverse. Where parts are
-left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`)
+left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`, in a nut or a
+plain hole at their tap drill; cosmetic ones, :func:`executor.cad.sweep.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
 the stages made anew. A part that no stage frees never comes out (an error naming it and,
 per direction, its blockers).
@@ -111,6 +112,7 @@ from executor.cad.sweep import (
     Slide,
     Sweeper,
     axis_name,
+    cosmetic_pairs,
     forked_map,
     processes,
     screwed_pairs,
@@ -272,13 +274,16 @@ class Derived:
                 "modelled threads (sought where the disassembly leaves parts, between them and their blockers): "
                 "a part's outermost surface and another's innermost, each helical about one axis "
                 "of the frame (through the smaller part's box centre) with one pitch and lead within 2 %, "
-                "interlocking, are screwed: they slide along that axis against each other (the screw's thread "
-                f"taken in under the nut's minor radius; {sum(1 for s in self.slides if s.pitch)} pair(s) found)"]
+                "interlocking, or the screw's in a plain coaxial hole between its minor and major radii (its tap "
+                "drill), or a plain cylinder in a plain coaxial hole, their diameters a standard thread's (ISO metric, "
+                "UNC, UNF) major and tap drill (a cosmetic thread), are screwed: they slide along that axis against "
+                "each other (the screw's thread taken in under the nut's minor radius; "
+                f"{sum(1 for s in self.slides if s.pitch)} pair(s) found)"]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
         blocking pair's blockers, the supporting pairs dropped."""
-        lines = [f"screwed pair {s.shaft} in {s.bore} (a modelled thread): d {2000 * s.face.radius:.3f} mm in a minor "
+        lines = [f"screwed pair {s.shaft} in {s.bore} ({s.thread}): d {2000 * s.face.radius:.3f} mm in a minor "
                  f"d {2000 * s.hole.radius:.3f} mm along {axis_name(s.direction)[1:]}, pitch {1000 * s.pitch:.3f} mm, "
                  f"lead {1000 * abs(s.lead):.3f} mm, {'right' if s.lead > 0 else 'left'}-handed about "
                  f"{axis_name(s.direction)}; slides along the axis against each other, the cell does not screw"
@@ -295,7 +300,7 @@ class Derived:
         return lines
 
     def screwed(self, part: str, other: str) -> Slide | None:
-        """The screwed pair (a modelled thread) of parts ``part`` and ``other``, either in
+        """The screwed pair (a thread, modelled or cosmetic) of parts ``part`` and ``other``, either in
         the other, or None."""
         return next((s for s in self.slides if s.pitch and {s.shaft, s.bore} == {part, other}), None)
 
@@ -355,8 +360,12 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
         result.blockers |= {(pid, name): hit for pid in members}
     remaining = _disassembled(result)
     if remaining:  # modelled threads: sought only where a part is left, between it and its blockers
-        screwed = screwed_pairs({p.id: p.mesh for p in parts}, {
-            (pid, other) for pid in remaining for d in result.directions for other in result.blockers[(pid, d)]})
+        blocked_by = {(pid, other) for pid in remaining for d in result.directions
+                      for other in result.blockers[(pid, d)]}
+        screwed = screwed_pairs({p.id: p.mesh for p in parts}, blocked_by)
+        threaded = {frozenset((s.shaft, s.bore)) for s in screwed}
+        screwed += [s for s in cosmetic_pairs({pid: survey.faces for pid, survey in made.items()}, blocked_by)
+                    if frozenset((s.shaft, s.bore)) not in threaded]
         if screwed:
             result.slides += screwed
             sweeper.add(screwed)

@@ -41,7 +41,7 @@ from executor.cad.convex import (
 from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sections import Shape2D, section, section_room, zero_clearance
-from executor.cad.sweep import opposite
+from executor.cad.sweep import Slide, opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, seated_pose, thin_prism
@@ -158,12 +158,13 @@ def nominal_fits(derived: Derived) -> dict[tuple[str, str], float]:
     return {pair: apart for pair, apart in found.items() if apart is not None}
 
 
-def screwed_fits(derived: Derived) -> set[tuple[str, str]]:
-    """(part, feature) of each part in a hole or on a pin of the part it is screwed with
-    (a modelled thread): a fit at room 0, by screwing."""
+def screwed_fits(derived: Derived) -> dict[tuple[str, str], Slide]:
+    """(part, feature) -> the screwed pair (:meth:`Derived.screwed`) of each part in a hole
+    or on a pin of the part it is screwed with (a thread): a fit at room 0, by screwing."""
     owners = {hid: fit.owner or derived.base for hid, fit in {**derived.holes, **derived.part_holes}.items()}
     owners |= {pin_id: pin.owner for pin_id, pin in derived.pins.items()}
-    return {(pid, hid) for pid, hid in derived.swept if hid in owners and derived.screwed(pid, owners[hid])}
+    found = {(pid, hid): derived.screwed(pid, owners[hid]) for pid, hid in derived.swept if hid in owners}
+    return {pair: slide for pair, slide in found.items() if slide is not None}
 
 
 def margins(derived: Derived) -> dict[str, dict[str, float]]:
@@ -230,7 +231,7 @@ def screwed(derived: Derived) -> dict[str, str]:
         for pid in (pid for pid in pair if stage[pid] == first):
             other = slide.bore if pid == slide.shaft else slide.shaft
             found.setdefault(pid, f"part '{pid}' is screwed {'into' if pid == slide.shaft else 'onto'} '{other}' "
-                                  f"along {opposite(derived.axis[pid])} (a modelled thread, pitch "
+                                  f"along {opposite(derived.axis[pid])} ({slide.thread}, pitch "
                                   f"{1000 * slide.pitch:.3f} mm): the cell has no screwing operation")
     return found
 

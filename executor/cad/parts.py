@@ -46,11 +46,14 @@ import trimesh
 from bridge.assembly import is_id
 from executor import ExecutorError
 from executor.cad.sweep import (
+    TOUCH,
     CylinderFace,
     PrismFace,
     Slide,
+    cosmetic_pairs,
     fit_faces,
     lone_thread,
+    screwed_pairs,
     zero_clearance_fits,
 )
 
@@ -427,11 +430,46 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                         faces[part.id] = fit_faces(part.mesh)
                 seated = [s for s in zero_clearance_fits({a.id: faces[a.id], b.id: faces[b.id]}) if s.seated]
                 volume = _beyond_fits(common, seated)
+            if volume > OVERLAP_VOLUME:  # a thread drawn overlapping its hole's wall: excused in its annulus
+                threads = (screwed_pairs({a.id: a.mesh, b.id: b.mesh})
+                           or cosmetic_pairs({a.id: faces[a.id], b.id: faces[b.id]}))
+                if threads:
+                    volume = _beyond_fits(_beyond_threads(common, threads), seated)
             if volume > OVERLAP_VOLUME:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
                                     "that at most touch, or coaxial cylinders of one radius within their "
                                     "tessellations' deflection)" + lone_thread({a.id: a.mesh, b.id: b.mesh}))
+
+
+TUBE_SEGMENTS = 256
+"""Sides of the polygonal tube :func:`_beyond_threads` cuts a thread's annulus with."""
+
+
+def _beyond_threads(common: manifold3d.Manifold, threads: list[Slide]) -> manifold3d.Manifold:
+    """The intersection ``common`` of two parts less, for each screwed pair of ``threads``
+    (:func:`executor.cad.sweep.screwed_pairs`, :func:`executor.cad.sweep.cosmetic_pairs`),
+    the annulus about its axis from the hole's radius (less its deflection and
+    :data:`TOUCH`) out to the thread's major radius (plus its deflection and TOUCH, the
+    polygon's sides outside that circle) over the stretch both faces share (plus TOUCH at
+    each end): the screw's thread drawn into the hole's wall."""
+    for slide in threads:
+        face, hole = slide.face, slide.hole
+        span = hole.span if face.direction @ hole.direction > 0 else (-hole.span[1], -hole.span[0])
+        low, high = max(face.span[0], span[0]) - TOUCH, min(face.span[1], span[1]) + TOUCH
+        if high <= low:
+            continue
+        outer = (face.radius + face.deflection + TOUCH) / np.cos(np.pi / TUBE_SEGMENTS)
+        inner = max(hole.radius - hole.deflection - TOUCH, 0.0)
+        tube = (manifold3d.Manifold.cylinder(high - low, outer, outer, TUBE_SEGMENTS)
+                - manifold3d.Manifold.cylinder(high - low, inner, inner, TUBE_SEGMENTS))
+        across = np.eye(3)[int(np.argmin(np.abs(face.direction)))]
+        first = np.cross(face.direction, across)
+        first /= np.linalg.norm(first)
+        frame = np.column_stack([first, np.cross(face.direction, first), face.direction,
+                                 face.point + low * face.direction])
+        common = common - tube.transform(frame)
+    return common
 
 
 def _manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:

@@ -327,7 +327,9 @@ class Slide:
     bore); else it is a **passage**, the faces meeting only on a way along the axis (a
     pulley's bore passing a collar of its hub on its way off the hub's end). A **screwed
     pair** (:func:`screwed_pairs`: a modelled thread, ``shaft`` the
-    screw and ``bore`` the nut) has the thread's ``pitch`` and ``lead`` [m] (0 for any other fit)."""
+    screw and ``bore`` the nut, a tapped hole drawn at its tap drill or a plain hole a cosmetic
+    thread is drawn in: :func:`cosmetic_pairs`) has the thread's ``pitch`` and ``lead`` [m] (0
+    for any other fit) and ``thread``, how it is drawn (the report's words)."""
 
     shaft: str
     bore: str
@@ -338,6 +340,7 @@ class Slide:
     seated: bool
     pitch: float = 0.0
     lead: float = 0.0
+    thread: str = ""
 
     @property
     def direction(self) -> np.ndarray:
@@ -1365,7 +1368,8 @@ def lone_thread(meshes: dict[str, trimesh.Trimesh]) -> str:
 
 def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: tuple[float, float]) -> Slide | None:
     """The screwed pair (:func:`screwed_pairs`) of ``screw`` in ``nut`` along the frame's
-    ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None."""
+    ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None:
+    the nut's thread modelled, or a plain round hole at the screw's tap drill (:func:`_tap_drill`)."""
     direction = np.eye(3)[axis]
     across = [i for i in range(3) if i != axis]
     smaller = min((screw, nut), key=lambda m: float(np.prod(m.extents[across])))
@@ -1373,11 +1377,131 @@ def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: t
     male = _thread(screw, point, direction, overlap, outermost=True)
     if male is None:
         return None
+    face = CylinderFace(point, direction, male.outer, male.span, True, 0.0)
     female = _thread(nut, point, direction, overlap, outermost=False)
-    if (female is None or abs(male.pitch - female.pitch) > 0.02 * male.pitch
+    if female is None:
+        hole = _tap_drill(nut, male)
+        if hole is None:
+            return None
+        reach = male.outer - hole.radius + hole.deflection + TOUCH
+        return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead,
+                     thread="a modelled thread in a plain hole at its tap drill")
+    if (abs(male.pitch - female.pitch) > 0.02 * male.pitch
             or abs(male.lead - female.lead) > 0.02 * abs(male.lead) or male.outer <= female.inner):
         return None
     reach = male.outer - female.inner + TOUCH
-    face = CylinderFace(point, direction, male.outer, male.span, True, 0.0)
     hole = CylinderFace(point, direction, female.inner, female.span, False, 0.0)
-    return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead)
+    return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead,
+                 thread="a modelled thread")
+
+
+TAP_LEVELS = 64
+"""Levels along the stretch a modelled thread shares with a plain hole at which the hole's
+radius is sampled (:func:`_tap_drill`), in every half-plane of :data:`THREAD_ANGLES`."""
+
+
+def _tap_drill(nut: trimesh.Trimesh, male: Thread) -> CylinderFace | None:
+    """The plain round hole of ``nut`` the modelled thread ``male`` lies in, drawn at its tap
+    drill: over the stretch of the thread's span the nut covers (two pitches at least),
+    inside its ends, the nut's innermost surface in each half-plane about the thread's axis
+    (:func:`thread_profiles`, :data:`TAP_LEVELS` levels) met at every level, its radii
+    within :data:`THREAD_MATCH` of the thread's depth of each other (a round hole, coaxial:
+    an off-axis one varies by twice its offset) and between the thread's least and largest
+    radii (the minor and the major), exclusive. Its face: the least radius [m], the spread
+    as its deflection, that stretch as its span; None otherwise."""
+    along = (nut.vertices - male.point) @ male.direction
+    low, high = max(male.span[0], float(along.min())), min(male.span[1], float(along.max()))
+    if high - low < 2 * male.pitch:
+        return None
+    levels = np.linspace(low, high, TAP_LEVELS + 2)[1:-1]
+    radii = thread_profiles(nut, male.point, male.direction, levels, outermost=False)
+    if not np.all(np.isfinite(radii)):
+        return None
+    least, largest = float(radii.min()), float(radii.max())
+    if largest - least > THREAD_MATCH * (male.outer - male.inner) or not male.inner < least <= largest < male.outer:
+        return None
+    return CylinderFace(male.point, male.direction, least, (low, high), False, largest - least)
+
+
+def _metric() -> list[tuple[str, float, float]]:
+    """ISO metric threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`."""
+    coarse = {1: .25, 1.2: .25, 1.4: .3, 1.6: .35, 1.8: .35, 2: .4, 2.5: .45, 3: .5, 3.5: .6, 4: .7, 5: .8, 6: 1,
+              8: 1.25, 10: 1.5, 12: 1.75, 14: 2, 16: 2, 18: 2.5, 20: 2.5, 22: 2.5, 24: 3, 27: 3, 30: 3.5, 33: 3.5,
+              36: 4, 39: 4, 42: 4.5, 45: 4.5, 48: 5, 52: 5, 56: 5.5, 60: 5.5, 64: 6}
+    fine = {8: (1,), 10: (1.25, 1), 12: (1.5, 1.25), 14: (1.5,), 16: (1.5,), 18: (1.5,), 20: (1.5,), 22: (1.5,),
+            24: (2,), 27: (2,), 30: (2,), 33: (2,), 36: (3,), 39: (3,), 42: (3,), 45: (3,), 48: (3,), 52: (4,),
+            56: (4,), 60: (4,), 64: (4,)}
+    found = [(f"M{d:g}", d * 1e-3, p * 1e-3) for d, p in coarse.items()]
+    return found + [(f"M{d:g}x{p:g}", d * 1e-3, p * 1e-3) for d, pitches in fine.items() for p in pitches]
+
+
+def _unified() -> list[tuple[str, float, float]]:
+    """Unified inch threads, UNC and UNF (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`."""
+    sizes = [("#2", .086, 56, 64), ("#4", .112, 40, 48), ("#5", .125, 40, 44), ("#6", .138, 32, 40),
+             ("#8", .164, 32, 36), ("#10", .190, 24, 32), ("#12", .216, 24, 28), ("1/4", .25, 20, 28),
+             ("5/16", .3125, 18, 24), ("3/8", .375, 16, 24), ("7/16", .4375, 14, 20), ("1/2", .5, 13, 20),
+             ("9/16", .5625, 12, 18), ("5/8", .625, 11, 18), ("3/4", .75, 10, 16), ("7/8", .875, 9, 14),
+             ("1", 1.0, 8, 12)]
+    return [(f"{name}-{tpi} {series}", inch * 0.0254, 0.0254 / tpi)
+            for name, inch, unc, unf in sizes for tpi, series in ((unc, "UNC"), (unf, "UNF"))]
+
+
+STANDARD_THREADS = _metric() + _unified()
+"""The standard threads a cosmetic thread is taken for (name, major diameter D, pitch P)
+[m]: ISO 261's metric sizes M1 to M64 of the first and second choice, their coarse pitch
+and the common fine ones (ISO 262's M8x1 to M64x4), and the unified inch UNC and UNF
+series, #2 to 1 inch (ASME B1.1)."""
+TAP_DRILL = (1.0825, 0.85)
+"""A tapped hole drawn at its tap drill has a diameter from D - 1.0825 P (the basic minor
+diameter of the internal thread, ISO 68-1 and ASME B1.1: 5/4 of the fundamental
+triangle's height 0.866 P) to D - 0.85 P (above the common drill D - P, a drill for
+soft stock), in pitches P below the major diameter D."""
+COSMETIC_MAJOR = 0.25
+"""A screw drawn with a cosmetic thread has a diameter from D - 0.25 P to D (its major
+diameter, nominal or at its class's least), in pitches P."""
+
+
+def cosmetic_thread(shaft: float, hole: float, slack: float) -> tuple[str, float] | None:
+    """(name, pitch [m]) of the standard thread (:data:`STANDARD_THREADS`) of which a plain
+    shaft of diameter ``shaft`` [m] in a plain hole of diameter ``hole`` [m] is drawn
+    with a cosmetic thread: the shaft within :data:`COSMETIC_MAJOR` of its major diameter,
+    the hole within :data:`TAP_DRILL`, each widened by ``slack`` [m] (the faces'
+    tessellation); of several, the one whose major diameter lies nearest the shaft's."""
+    found = [(abs(shaft - d), name, p) for name, d, p in STANDARD_THREADS
+             if d - COSMETIC_MAJOR * p - slack <= shaft <= d + slack
+             and d - TAP_DRILL[0] * p - slack <= hole <= d - TAP_DRILL[1] * p + slack]
+    return (min(found)[1], min(found)[2]) if found else None
+
+
+def cosmetic_pairs(faces: dict[str, list[CylinderFace | PrismFace]],
+                   pairs: Iterable[tuple[str, str]] | None = None) -> list[Slide]:
+    """The pairs among the parts' fitted ``faces`` (of ``pairs``, either way round, where
+    given) drawn with a cosmetic thread: an outward cylinder of one part (the screw) and an
+    inward one of another (the hole), parallel (within 1e-4 rad), coaxial within their
+    larger deflection plus :data:`TOUCH`, meeting along the axis in the assembled pose,
+    their diameters a standard thread's major and tap drill (:func:`cosmetic_thread`).
+    Each is a screwed :class:`Slide` of that thread's pitch (its lead one pitch,
+    right-handed: a cosmetic thread draws neither), swept as a modelled one (the screw's
+    cylinder taken in to under the hole's radius)."""
+    found: list[Slide] = []
+    asked = None if pairs is None else {frozenset(pair) for pair in pairs}
+    for shaft, outer in faces.items():
+        for bore, inner in faces.items():
+            if bore == shaft or (asked is not None and frozenset((shaft, bore)) not in asked):
+                continue
+            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
+                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
+                    slack = max(a.deflection, b.deflection) + TOUCH
+                    offset = b.point - a.point
+                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
+                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4 or apart > slack
+                            or not _seated(a, b, TOUCH)):
+                        continue
+                    match = cosmetic_thread(2 * a.radius, 2 * b.radius, 2 * slack)
+                    if match is None:
+                        continue
+                    reach = a.radius - b.radius + b.deflection + apart + TOUCH
+                    found.append(Slide(shaft, bore, a, b, reach, reach + TOUCH, True, pitch=match[1], lead=match[1],
+                                       thread=f"a cosmetic thread, {match[0]}: d {2000 * a.radius:.4g} in its "
+                                              f"{2000 * b.radius:.4g} mm tap drill"))
+    return found

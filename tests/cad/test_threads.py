@@ -1,8 +1,11 @@
-"""Modelled helical threads: a screw in its nut is a screwed pair (pitch and lead measured),
-slid along its axis and placed by hand; grooves of revolution are no thread."""
+"""Modelled helical threads: a screw in its nut, or in a plain hole at its tap drill, is a
+screwed pair (pitch and lead measured), slid along its axis and placed by hand; a plain
+cylinder in a standard thread's tap drill is one drawn with a cosmetic thread; grooves of
+revolution and press fits are no thread."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +16,8 @@ from executor import ExecutorError
 from executor.cad.derive import derive
 from executor.cad.operations import cell_view
 from executor.cad.parts import CadPart, _check_overlaps, load_meshes
-from executor.cad.sweep import screwed_pairs
+from executor.cad.sweep import cosmetic_thread, screwed_pairs
+from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
 
@@ -59,17 +63,136 @@ def test_grooves_of_revolution_are_no_thread_and_the_rod_never_comes_out() -> No
         derive([CadPart("ring", "ring", ring, "ring"), CadPart("rod", "rod", rod, "rod")], "ring", {})
 
 
-def test_a_thread_in_a_hole_drawn_at_its_tap_drill_is_named_in_the_overlap() -> None:
-    # The 1/4-20 screw through a plate under its head whose hole is drawn at the thread's tap
-    # drill (#7, d 5.105 mm) with no thread: the thread overlaps the plate; the refusal
-    # names the thread and the plate.
+def _corpus_screw() -> CadPart:
+    """BOSL2's 1/4-20 UNC screw of the corpus (pitch 1.27 mm, its head on z 9.525 mm)."""
     [screw] = [p for p in load_meshes(CORPUS / "bosl2_screw_nut" / "meshes", "mm") if p.id == "screw"]
-    plate = trimesh.creation.annulus(r_min=5.105e-3 / 2, r_max=15e-3, height=5e-3, sections=48)
-    plate.apply_translation([0.0, 0.0, 7.025e-3])  # z 4.525 to 9.525 mm, the head on it
+    return screw
+
+
+def _plate(hole_mm: float, low_mm: float, high_mm: float) -> CadPart:
+    """A plate 30 mm across from z ``low_mm`` to ``high_mm`` with a plain round hole of
+    diameter ``hole_mm`` about the z axis (48 sides)."""
+    plate = trimesh.creation.annulus(r_min=hole_mm / 2e3, r_max=15e-3, height=(high_mm - low_mm) / 1e3, sections=48)
+    plate.apply_translation([0.0, 0.0, (low_mm + high_mm) / 2e3])
+    return CadPart("plate", "plate", plate, "plate")
+
+
+def test_a_modelled_thread_in_a_plain_hole_at_its_tap_drill_is_screwed() -> None:
+    # The 1/4-20 screw through a plate under its head whose hole is drawn at the thread's tap
+    # drill (#7, d 5.105 mm) with no thread: the thread overlaps the plate's wall (16 mm³),
+    # excused in the annulus from the hole out to the thread's crest; a screwed pair.
+    parts = [_plate(5.105, 4.525, 9.525), _corpus_screw()]
+    _check_overlaps(parts)
+    derived = derive(parts, "plate", {})
+    [pair] = derived.slides
+    assert (pair.shaft, pair.bore) == ("screw", "plate")
+    assert pair.thread == "a modelled thread in a plain hole at its tap drill"
+    assert pair.pitch == pytest.approx(1.27e-3, abs=2e-5) and pair.hole.radius == pytest.approx(2.55e-3, abs=5e-6)
+    assert derived.axis == {"screw": "+z"}  # its head stops it along -z
+    assert "screwed into 'plate' along -z (a modelled thread in a plain hole" in cell_view(derived)[1]["screw"]
+
+
+def test_a_thread_in_a_hole_below_its_minor_diameter_is_named_in_the_overlap() -> None:
+    # The hole drawn at d 4.6, inside the thread's root (d 5.0): the screw's core overlaps
+    # the plate too, no tap drill: refused, the thread and the plate named.
     named = (r"'plate' and 'screw' overlap .*'screw' has a modelled thread "
              r"\(pitch 1\.27\d mm, d 6\.\d+ mm, along z\) in 'plate', which has no thread")
     with pytest.raises(ExecutorError, match=named):
-        _check_overlaps([CadPart("plate", "plate", plate, "plate"), screw])
+        _check_overlaps([_plate(4.6, 4.525, 9.525), _corpus_screw()])
+
+
+def _cosmetic(shank_mm: float, hole_mm: float, sunk_mm: float = 0.0) -> list[CadPart]:
+    """A plate (z 5 to 10 mm) with a plain hole of d ``hole_mm`` and a plain "screw": a
+    shank of d ``shank_mm`` from z -2 mm up to its head (d 1.8 times it, 3 mm high) on the
+    plate, sunk ``sunk_mm`` into it (negative: above it; 64 sides each)."""
+    shank = trimesh.creation.cylinder(radius=shank_mm / 2e3, height=(12.5 - sunk_mm) * 1e-3, sections=64)
+    shank.apply_translation([0.0, 0.0, (4.25 - sunk_mm / 2) * 1e-3])  # z -2 to 0.5 mm into the head
+    head = trimesh.creation.cylinder(radius=shank_mm * 0.9e-3, height=3e-3, sections=64)
+    head.apply_translation([0.0, 0.0, (11.5 - sunk_mm) * 1e-3])
+    screw = trimesh.boolean.union([shank, head])
+    return [_plate(hole_mm, 5.0, 10.0), CadPart("screw", "screw", screw, "screw")]
+
+
+def test_a_plain_screw_in_its_tap_drill_is_drawn_with_a_cosmetic_thread() -> None:
+    # M4 drawn at d 4 in its tap drill d 3.3 (ISO coarse, pitch 0.7): the overlap (20 mm³)
+    # lies in the annulus d 3.3 to 4 and is excused; the pair is screwed at M4's pitch.
+    parts = _cosmetic(4.0, 3.3)
+    _check_overlaps(parts)
+    derived = derive(parts, "plate", {})
+    [pair] = derived.slides
+    assert (pair.shaft, pair.bore) == ("screw", "plate")
+    assert pair.thread == "a cosmetic thread, M4: d 4 in its 3.3 mm tap drill"
+    assert pair.pitch == pytest.approx(0.7e-3) and pair.lead == pytest.approx(0.7e-3)
+    assert derived.axis == {"screw": "+z"}
+    assert "(a cosmetic thread, M4: d 4 in its 3.3 mm tap drill, pitch 0.700 mm)" in cell_view(derived)[1]["screw"]
+
+
+@pytest.mark.parametrize(("shaft", "hole", "thread"), [
+    (3.0, 2.5, ("M3", 0.5)), (8.0, 6.8, ("M8", 1.25)), (8.0, 7.0, ("M8x1", 1.0)), (10.0, 8.8, ("M10x1.25", 1.25)),
+    (6.35, 5.105, ("1/4-20 UNC", 1.27)), (6.35, 5.5, ("1/4-28 UNF", 25.4 / 28)),
+    (4.826, 3.8, ("#10-24 UNC", 25.4 / 24)),
+    (16.0, 15.9, None), (17.0, 16.0, None), (4.0, 3.0, None), (4.0, 3.6, None), (3.9, 3.3, ("M4", 0.7)),
+])
+def test_the_standard_threads_tap_drills(shaft: float, hole: float, thread: tuple[str, float] | None) -> None:
+    # the shaft from D - P/4 to D, the hole from D - 1.0825 P to D - 0.85 P (10 µm slack)
+    found = cosmetic_thread(shaft * 1e-3, hole * 1e-3, 1e-5)
+    assert (found and (found[0], round(found[1] * 1e3, 4))) == (thread and (thread[0], round(thread[1], 4)))
+
+
+@pytest.mark.parametrize(("shank", "hole", "sunk"), [
+    (16.0, 15.9, 0.0),  # a press fit: 0.1 mm, no thread's tap drill
+    (17.0, 16.0, 0.0),  # d 17 is no standard thread of the table (M17 is ISO 261's third choice)
+    (4.0, 3.3, 0.5),  # M4 in its tap drill, its head sunk 0.5 mm into the plate: outside the annulus
+])
+def test_an_interference_that_is_no_cosmetic_thread_is_refused(shank: float, hole: float, sunk: float) -> None:
+    with pytest.raises(ExecutorError, match="'plate' and 'screw' overlap by"):
+        _check_overlaps(_cosmetic(shank, hole, sunk))
+
+
+def test_a_bracket_clamped_by_a_cosmetic_screw_goes_before_it() -> None:
+    # A bracket (z 10 to 13 mm, a d 4.5 clearance hole) between the plate's tapped M4 hole
+    # and the screw's head: the head closes its way up, the shank its ways across.
+    plate, screw = _cosmetic(4.0, 3.3, sunk_mm=-3.0)
+    bracket = trimesh.creation.annulus(r_min=2.25e-3, r_max=8e-3, height=3e-3, sections=64)
+    bracket.apply_translation([0.0, 0.0, 11.5e-3])
+    parts = [plate, screw, CadPart("bracket", "bracket", bracket, "bracket")]
+    _check_overlaps(parts)
+    derived = derive(parts, "plate", {})
+    assert derived.stages == [["screw"], ["bracket"]]
+    assert derived.reasons[("bracket", "screw")] == "blocks"
+    assert set(cell_view(derived)[1]) == {"screw"}
+
+
+def _imported(run_main: Runner, parts: list[CadPart], folder: Path) -> str:
+    """``parts`` written as STL in mm under ``folder`` and imported, the plate the base,
+    into ``folder / "out"``; what the import printed."""
+    (folder / "cad").mkdir()
+    for part in parts:
+        mesh = part.mesh.copy()
+        mesh.apply_scale(1e3)
+        mesh.export(folder / "cad" / f"{part.id}.stl")
+    (folder / "import.toml").write_text('base = "plate"\n')
+    done = run_main("import", str(folder / "cad"), "--config", str(folder / "import.toml"), "--out",
+                    str(folder / "out"))
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+@pytest.mark.slow  # imports the product and runs a session
+@pytest.mark.parametrize(("drawn", "backend"), [("tap drill", "truth"), ("cosmetic", "sim")])
+def test_a_screw_in_a_tap_drill_hole_reaches_a_session(run_main: Runner, tmp_path: Path, drawn: str,
+                                                         backend: str) -> None:
+    parts = [_plate(5.105, 4.525, 9.525), _corpus_screw()] if drawn == "tap drill" else _cosmetic(4.0, 3.3)
+    printed = _imported(run_main, parts, tmp_path)
+    thread = "a modelled thread in a plain hole at its tap drill" if drawn == "tap drill" else "a cosmetic thread, M4"
+    assert f"screwed pair screw in plate ({thread}" in printed
+    session = run_main("session", "--backend", backend, "--json", "--assemble", "--assembly", str(tmp_path / "out"),
+                       "--out", str(tmp_path / "run"), timeout=240)
+    assert session.returncode == 0, session.stderr
+    result = json.loads(session.stdout)
+    steps = {step["part"]: step for step in result["assembly"]["steps"]}
+    assert result["assembly"]["assembled"] and steps["screw"]["skill"] == "manual"
+    assert "the cell has no screwing operation" in result["assembly"]["manual_reasons"]["screw"]
 
 
 def test_the_screw_goes_after_the_plate_it_clamps_on_its_nut() -> None:
