@@ -64,7 +64,9 @@ def test_a_bracket_s_bore_and_a_bolt_s_end_are_features(tmp_path: Path) -> None:
     _write(tmp_path / "meshes")
     derived = derive(load_meshes(tmp_path / "meshes", "mm"), "plate", {})
     (hole,) = derived.part_holes.values()
-    assert (hole.id, hole.owner, hole.part, hole.axis, hole.hole.kind) == ("bracket_hole1", "bracket", "rod", "+x",
+    # The rod is free both ways along x: it leaves along -x, so it goes in along +x, which the arm reaches
+    # sideways (executor.cad.derive.LEAVING), not along -x, which it does not.
+    assert (hole.id, hole.owner, hole.part, hole.axis, hole.hole.kind) == ("bracket_hole1", "bracket", "rod", "-x",
                                                                          "round")
     assert hole.hole.a == pytest.approx(0.0085, abs=2e-5) and hole.depth == pytest.approx(0.02, abs=1e-6)
     # The bolt passes the plate only: its hole is the plate's, no part's.
