@@ -40,8 +40,9 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
+from executor.cad.fits.faces import Slide
 from executor.cad.sections import Shape2D, section, section_room, zero_clearance
-from executor.cad.sweep import Slide, opposite
+from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, seated_pose, thin_prism
