@@ -9,8 +9,8 @@ pairwise, so these are the blockers at every stage). The directions tried are
 every zero-clearance fit (:func:`executor.cad.fits.faces.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
 along the first such direction (in `LEAVING`'s order): its **insertion axis** is the reverse. Where parts are
-left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`, in a nut or a
-plain hole at their tap drill; cosmetic ones, :func:`executor.cad.sweep.cosmetic_pairs`)
+left, the screwed pairs (modelled threads, :func:`executor.cad.fits.threads.screwed_pairs`, in a nut or a
+plain hole at their tap drill; cosmetic ones, :func:`executor.cad.fits.threads.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
 the stages made anew. A part that no stage frees never comes out (an error naming it and,
 per direction, its blockers).
@@ -78,6 +78,7 @@ import trimesh
 
 from executor import ExecutorError
 from executor.cad.fits.faces import COARSEST, SMOOTH, TOUCH, CylinderFace, PrismFace, Slide, zero_clearance_fits
+from executor.cad.fits.threads import cosmetic_pairs, screwed_pairs
 from executor.cad.locating import (
     LOCATING_REACH,
     consistent,
@@ -103,16 +104,7 @@ from executor.cad.sections import (
     slice_loops,
     zero_clearance,
 )
-from executor.cad.sweep import (
-    DIRECTIONS,
-    Sweeper,
-    axis_name,
-    cosmetic_pairs,
-    forked_map,
-    processes,
-    screwed_pairs,
-    surveys,
-)
+from executor.cad.sweep import DIRECTIONS, Sweeper, axis_name, forked_map, processes, surveys
 from executor.world.polygon_fit import OutlineError, polygon, symmetry
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry

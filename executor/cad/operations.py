@@ -221,7 +221,7 @@ def _maybe_in_place(derived: Derived, pid: str) -> set[str]:
 
 def screwed(derived: Derived) -> dict[str, str]:
     """Part -> why it is placed by hand, for the parts of screwed pairs (a modelled thread,
-    :func:`executor.cad.sweep.screwed_pairs`): of each pair the part that leaves first in
+    :func:`executor.cad.fits.threads.screwed_pairs`): of each pair the part that leaves first in
     the disassembly (both where they leave at one stage; never the base). The cell has no
     screwing operation."""
     stage = {pid: k for k, parts in enumerate(derived.stages) for pid in parts}

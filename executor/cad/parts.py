@@ -46,7 +46,7 @@ import trimesh
 from bridge.assembly import is_id
 from executor import ExecutorError
 from executor.cad.fits.faces import TOUCH, CylinderFace, PrismFace, Slide, fit_faces, zero_clearance_fits
-from executor.cad.sweep import cosmetic_pairs, lone_thread, screwed_pairs
+from executor.cad.fits.threads import cosmetic_pairs, lone_thread, screwed_pairs
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
@@ -439,7 +439,7 @@ TUBE_SEGMENTS = 256
 
 def _beyond_threads(common: manifold3d.Manifold, threads: list[Slide]) -> manifold3d.Manifold:
     """The intersection ``common`` of two parts less, for each screwed pair of ``threads``
-    (:func:`executor.cad.sweep.screwed_pairs`, :func:`executor.cad.sweep.cosmetic_pairs`),
+    (:func:`executor.cad.fits.threads.screwed_pairs`, :func:`executor.cad.fits.threads.cosmetic_pairs`),
     the annulus about its axis from the hole's radius (less its deflection and
     :data:`TOUCH`) out to the thread's major radius (plus its deflection and TOUCH, the
     polygon's sides outside that circle) over the stretch both faces share (plus TOUCH at

@@ -1,4 +1,4 @@
-"""The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py) on small
+"""The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py, fits/faces.py) on small
 products of trimesh primitives: a horizontal shaft in a zero-clearance bearing comes out
 along its axis, and passes the overlap check however coarse the tessellation; a
 precedence pair only where every way in is blocked (a bar that slides out sideways under

@@ -249,9 +249,9 @@ class Slide:
     axis overlap by more than the tolerance in the assembled pose (the shaft is in the
     bore); else it is a **passage**, the faces meeting only on a way along the axis (a
     pulley's bore passing a collar of its hub on its way off the hub's end). A **screwed
-    pair** (:func:`executor.cad.sweep.screwed_pairs`: a modelled thread, ``shaft`` the
+    pair** (:func:`executor.cad.fits.threads.screwed_pairs`: a modelled thread, ``shaft`` the
     screw and ``bore`` the nut, a tapped hole drawn at its tap drill or a plain hole a cosmetic
-    thread is drawn in: :func:`executor.cad.sweep.cosmetic_pairs`) has the thread's ``pitch`` and ``lead`` [m] (0
+    thread is drawn in: :func:`executor.cad.fits.threads.cosmetic_pairs`) has the thread's ``pitch`` and ``lead`` [m] (0
     for any other fit) and ``thread``, how it is drawn (the report's words)."""
 
     shaft: str
