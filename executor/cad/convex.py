@@ -24,7 +24,7 @@ reach beyond the kept pieces' face planes. The pieces must fit where the part is
 must leave each part near it (:data:`NEAR`: a cover's pins and head, a head's cover, a
 peg's base) :data:`ROOM_KEPT` of the room its mesh leaves it, and overlap none it touches
 (measured with python-fcl in the assembled pose) but one at a stated zero-clearance fit or
-passage with it (:class:`executor.cad.sweep.Slide`: the mesh leaves it room 0, and a
+passage with it (:class:`executor.cad.fits.faces.Slide`: the mesh leaves it room 0, and a
 decomposition's hulls reach beyond the mesh by its error), which they may overlap by up to
 :data:`NOMINAL_OVERLAP`; each piece at least 2 mm thick (the
 cell's hull margin twice: :mod:`executor.world.meshes`); CoACD's
@@ -55,9 +55,10 @@ from bridge.product import CONVEX_HEADER, Mesh
 from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor.assembly.product import Box
 from executor.cad.derive import Derived, HoleFit
+from executor.cad.fits.faces import TOUCH
 from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import Shape2D, classify, exact_round, slice_loops
-from executor.cad.sweep import TOUCH, bvh, convex_object
+from executor.cad.sweep import bvh, convex_object
 from executor.world import SIZE_RESOLUTION
 from executor.world.meshes import URDF_HULL_MARGIN, eroded, obj_text
 
@@ -227,7 +228,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
     parts near it in the assembled pose, in its frame); or why no decomposition leaves
     each of them :data:`ROOM_KEPT` of the room the mesh leaves it (touching: none
-    deeper than :data:`executor.cad.sweep.TOUCH`; those in ``fits``, at a stated
+    deeper than :data:`executor.cad.fits.faces.TOUCH`; those in ``fits``, at a stated
     zero-clearance fit or passage with it: none deeper than :data:`NOMINAL_OVERLAP`)
     with every piece at least twice the cell's hull margin thick (CoACD's tree search
     making ``iterations`` per cut)."""

@@ -6,11 +6,11 @@ Disassembly: the base stays (it is the fixture); every moving body (a part with 
 size, everything else fixed, which gives its blockers per direction (blocking is
 pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
-every zero-clearance fit (:func:`executor.cad.sweep.zero_clearance_fits`).
+every zero-clearance fit (:func:`executor.cad.fits.faces.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
 along the first such direction (in `LEAVING`'s order): its **insertion axis** is the reverse. Where parts are
-left, the screwed pairs (modelled threads, :func:`executor.cad.sweep.screwed_pairs`, in a nut or a
-plain hole at their tap drill; cosmetic ones, :func:`executor.cad.sweep.cosmetic_pairs`)
+left, the screwed pairs (modelled threads, :func:`executor.cad.fits.threads.screwed_pairs`, in a nut or a
+plain hole at their tap drill; cosmetic ones, :func:`executor.cad.fits.threads.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
 the stages made anew. A part that no stage frees never comes out (an error naming it and,
 per direction, its blockers).
@@ -77,6 +77,8 @@ import shapely
 import trimesh
 
 from executor import ExecutorError
+from executor.cad.fits.faces import COARSEST, SMOOTH, TOUCH, CylinderFace, PrismFace, Slide, zero_clearance_fits
+from executor.cad.fits.threads import cosmetic_pairs, screwed_pairs
 from executor.cad.locating import (
     LOCATING_REACH,
     consistent,
@@ -102,23 +104,7 @@ from executor.cad.sections import (
     slice_loops,
     zero_clearance,
 )
-from executor.cad.sweep import (
-    COARSEST,
-    DIRECTIONS,
-    SMOOTH,
-    TOUCH,
-    CylinderFace,
-    PrismFace,
-    Slide,
-    Sweeper,
-    axis_name,
-    cosmetic_pairs,
-    forked_map,
-    processes,
-    screwed_pairs,
-    surveys,
-    zero_clearance_fits,
-)
+from executor.cad.sweep import DIRECTIONS, Sweeper, axis_name, forked_map, processes, surveys
 from executor.world.polygon_fit import OutlineError, polygon, symmetry
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
@@ -438,7 +424,7 @@ def receives(fit: HoleFit) -> bool:
     a hexagon, a spline, a cross, a 16-gon). A polygon with no such axis is a pocket: the
     open corner beside a turned boss, a relieved corner or a slot left around a pin of the
     base's own in its hole, the gap between two of its bodies; a sliver whose mean width
-    (twice its area over its perimeter) is at most :data:`executor.cad.sweep.TOUCH` is a
+    (twice its area over its perimeter) is at most :data:`executor.cad.fits.faces.TOUCH` is a
     gap between faces that touch, whatever symmetry rounding lends it (one of a Technic
     pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z)."""
     if fit.hole.kind != "polygon":
@@ -767,7 +753,7 @@ def _pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[n
     section, the bore's, the pin's centre [m] and the level [m] along the direction they
     were measured at; None when no level tried has one of ``pid``'s inner loops (its bore)
     around exactly one outline of ``owner`` lying in it (within the bore's sagitta and
-    :data:`executor.cad.sweep.TOUCH`, as a nominal zero-clearance fit lies), no bore around
+    :data:`executor.cad.fits.faces.TOUCH`, as a nominal zero-clearance fit lies), no bore around
     a point of ``taken`` (the centres [m] across the axis of pins the part is on already: it
     goes onto another pin only through another bore of its own). The pin is the owner's
     within the part's reach across the axis, short of the owner's outlines in the part's
@@ -1163,7 +1149,7 @@ def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float
 
 def _in_loop(outline: Loop, hole: Loop) -> bool:
     """Whether a part's ``outline`` lies in the ``hole`` loop of another part's slice: at
-    most the hole's sagitta (a round one's) plus :data:`executor.cad.sweep.TOUCH` beyond
+    most the hole's sagitta (a round one's) plus :data:`executor.cad.fits.faces.TOUCH` beyond
     it, as a shaft tessellated at a nominal zero-clearance fit is (its vertices on the
     circle the bore's chords cut inside); a ring around a tube is not in the tube's bore."""
     margin = classify(hole, hole=True).deflection + TOUCH

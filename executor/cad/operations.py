@@ -40,8 +40,9 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
+from executor.cad.fits.faces import Slide
 from executor.cad.sections import Shape2D, section, section_room, zero_clearance
-from executor.cad.sweep import Slide, opposite
+from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, seated_pose, thin_prism
@@ -220,7 +221,7 @@ def _maybe_in_place(derived: Derived, pid: str) -> set[str]:
 
 def screwed(derived: Derived) -> dict[str, str]:
     """Part -> why it is placed by hand, for the parts of screwed pairs (a modelled thread,
-    :func:`executor.cad.sweep.screwed_pairs`): of each pair the part that leaves first in
+    :func:`executor.cad.fits.threads.screwed_pairs`): of each pair the part that leaves first in
     the disassembly (both where they leave at one stage; never the base). The cell has no
     screwing operation."""
     stage = {pid: k for k, parts in enumerate(derived.stages) for pid in parts}

@@ -21,7 +21,7 @@ units explain (one part in mm among parts in m), a product too small or too larg
 stated units, and parts that overlap (intersection volume above :data:`OVERLAP_VOLUME`,
 leaving out what lies within a zero-clearance fit's tolerance of its two faces: coaxial
 cylinders of one nominal radius, each tessellated on its own, overlap by up to the larger
-deflection however coarse the tessellation; :func:`executor.cad.sweep.zero_clearance_fits`).
+deflection however coarse the tessellation; :func:`executor.cad.fits.faces.zero_clearance_fits`).
 """
 
 from __future__ import annotations
@@ -45,17 +45,8 @@ import trimesh
 
 from bridge.assembly import is_id
 from executor import ExecutorError
-from executor.cad.sweep import (
-    TOUCH,
-    CylinderFace,
-    PrismFace,
-    Slide,
-    cosmetic_pairs,
-    fit_faces,
-    lone_thread,
-    screwed_pairs,
-    zero_clearance_fits,
-)
+from executor.cad.fits.faces import TOUCH, CylinderFace, PrismFace, Slide, fit_faces, zero_clearance_fits
+from executor.cad.fits.threads import cosmetic_pairs, lone_thread, screwed_pairs
 
 UNITS = {"mm": 1e-3, "m": 1.0}
 """``--units``: metres per unit of a mesh file."""
@@ -448,7 +439,7 @@ TUBE_SEGMENTS = 256
 
 def _beyond_threads(common: manifold3d.Manifold, threads: list[Slide]) -> manifold3d.Manifold:
     """The intersection ``common`` of two parts less, for each screwed pair of ``threads``
-    (:func:`executor.cad.sweep.screwed_pairs`, :func:`executor.cad.sweep.cosmetic_pairs`),
+    (:func:`executor.cad.fits.threads.screwed_pairs`, :func:`executor.cad.fits.threads.cosmetic_pairs`),
     the annulus about its axis from the hole's radius (less its deflection and
     :data:`TOUCH`) out to the thread's major radius (plus its deflection and TOUCH, the
     polygon's sides outside that circle) over the stretch both faces share (plus TOUCH at
@@ -505,7 +496,7 @@ def _beyond_fits(common: manifold3d.Manifold, slides: list[Slide]) -> float:
 
 def _near_face(face: CylinderFace | PrismFace, tolerance: float) -> manifold3d.Manifold:
     """The solid of the points within ``tolerance`` [m] of ``face`` (of its radius or its
-    outline) and of its span (:func:`executor.cad.sweep.near`), a little wider: a circle
+    outline) and of its span (:func:`executor.cad.fits.faces.near`), a little wider: a circle
     is a polygon around it, its inner one within it, of sides whose sagitta is at most a
     tenth of ``tolerance``."""
     across = np.linalg.svd(face.direction[None, :])[2][1:] if isinstance(face, CylinderFace) else face.frame

@@ -24,7 +24,7 @@ the ``deflection`` kept is how far the loop's edges come in from its vertex circ
 chords' sagitta, measured). Whether a tessellation's vertices or its edges lie on the true
 cylinder the mesh does not say (a CAD kernel's vertices do, Cranfield's export's hole
 edges do): a round peg at least as wide as a round hole's inscribed circle, whose vertex
-circle's radius is the hole's within :data:`executor.cad.sweep.TOUCH`, is taken for the
+circle's radius is the hole's within :data:`executor.cad.fits.faces.TOUCH`, is taken for the
 same nominal diameter, a nominal zero-clearance fit (:func:`zero_clearance`), as the
 disassembly's sliding cylinders are. A part's rect is
 its minimum-area rectangle (it holds the part, corners and all) with the largest corner
@@ -61,8 +61,8 @@ from trimesh.path.entities import Line
 from trimesh.path.exchange.misc import edges_to_path
 from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
+from executor.cad.fits.faces import TOUCH
 from executor.cad.parts import Cylinder
-from executor.cad.sweep import TOUCH
 from executor.world.geometry import Section, section_fit
 from executor.world.polygon_fit import OutlineError, PolygonFit, polygon, turned_fit
 
@@ -324,7 +324,7 @@ SEAT = TOUCH
 """The sweep's stretch is taken this far [m] inside its ends: a peg's shoulder resting on
 the entry face, or its tip on a hole's floor, overlaps that face by the tessellations'
 touch (asap_beam's shoulders lie 27 nm below the top's face), which the disassembly takes
-for touching up to :data:`executor.cad.sweep.TOUCH` (10 µm)."""
+for touching up to :data:`executor.cad.fits.faces.TOUCH` (10 µm)."""
 _SPLIT = 1e-8
 """Vertex levels closer than this [m] are one (the sweep's levels, :func:`passage`)."""
 _INSIDE = 3e-9
@@ -805,7 +805,7 @@ def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
     fit, given the ``room`` [m] of the peg's section in the hole's
     (:func:`executor.world.geometry.margin`): both round, the peg not narrower than the
     hole's inscribed circle (else it passes with room), their vertex circles' radii within
-    :data:`executor.cad.sweep.TOUCH` (their difference); or a polygon on either side, or
+    :data:`executor.cad.fits.faces.TOUCH` (their difference); or a polygon on either side, or
     rect or square both (straight sides: no deflection), that pass only with an overlap of
     at most :data:`OUTLINE_TOUCH` all round (half the room, at most 0); None when they are
     no such pair."""

@@ -1,17 +1,19 @@
 """Swept collision along a straight removal path, exact (no sampled poses), with nominal
-zero-clearance fits sliding along their axis.
+zero-clearance fits sliding along their axis (the fits: :mod:`executor.cad.fits.faces`,
+:mod:`executor.cad.fits.threads`).
 
 **Exact sweep.** A body (one part, or parts fixed to each other) moving by ``length``
 along ``direction`` collides with a fixed part B exactly when some triangle of its
 boundary, swept along the path, meets B's interior (the sweep of a solid is bounded by
 the sweeps of its boundary triangles, and the two start apart). Each swept triangle is a
 convex prism (the triangle and its translate) tested against B's triangle BVH in
-python-fcl (GJK/EPA); a contact deeper than :data:`TOUCH` is a collision, so parts that
-only touch (a peg on its hole's bottom, a cover on its spacer) slide apart.
+python-fcl (GJK/EPA); a contact deeper than :data:`executor.cad.fits.faces.TOUCH` is a
+collision, so parts that only touch (a peg on its hole's bottom, a cover on its spacer)
+slide apart.
 
 **Conservative first.** Penetration depth only grows with the moving set, so a convex
-superset that meets B no deeper than :data:`TOUCH` clears every prism inside it: first the
-sweep of the part's convex hull (one query: the answer for a convex part), then down a
+superset that meets B no deeper than :data:`executor.cad.fits.faces.TOUCH` clears every
+prism inside it: first the sweep of the part's convex hull (one query: the answer for a convex part), then down a
 tree of the part's triangles (halves of nearby ones): a node whose swept box misses B's
 box, or meets no cell of B's grid that B's triangles' boxes meet (:meth:`_Triangles.meets`:
 no contact is found in it), or whose swept hull clears B, is done; the prisms are tested only in leaves of
@@ -20,27 +22,6 @@ holding more of the few triangles that lead the sweep into B's box (:func:`_fron
 first: where the part is blocked, they usually meet B deeply, so the search ends soon;
 the order changes no answer. Same answer as testing every prism. A piece that meets B is
 decided by fcl's depths of B's triangles, the likeliest deep ones first (:func:`_meets`).
-
-**Zero-clearance fits** (:func:`zero_clearance_fits`). Real CAD models a shaft in a bore at
-one nominal diameter, each tessellated on its own, so the two polygons overlap by up to
-the tessellation's deflection. Cylindrical faces are fitted on the mesh (smooth regions
-whose normals are all perpendicular to one axis and whose vertices lie on one circle,
-their triangles within a 35° chord's sagitta of it: :data:`COARSEST`; of
-a smooth region that is none, as a bore joined to its ring's end faces by edge radii,
-its bands whose normals are perpendicular to the axis most of its bends turn about);
-an outward face (a shaft) and an inward one (a bore) of two parts, coaxial and of equal
-radius within the pair's tolerance (the larger deflection of the two faces plus
-:data:`TOUCH`), are a fit, wherever on the way along the axis they meet: seated (their
-spans overlap in the assembled pose) or a passage (a bore passing a collar of that size
-on its way out). Swept along its axis against the bore's part, the shaft's part
-is taken thinner there (its vertices within the tolerance of that radius moved towards
-the axis by the bore's deflection, the radii's and the axes' difference and
-:data:`TOUCH`): overlap below the tolerance across the axis is not a collision, every
-other face (a shoulder, an end wall) still is. Prismatic faces along the cell's axes (a
-spline, a cross axle: :func:`prism_faces`) are a fit when the peg's outline, shrunk by
-:data:`TOUCH`, lies in the hole's and the two come within it of each other; the peg's
-part is then scaled towards the axis so that each of its sides moves in by at least
-twice :data:`TOUCH`.
 
 :attr:`Sweeper.queries` counts the narrow-phase queries (one moving part against one fixed
 part whose bounding box meets the sweep's); a test asked again (A moved against B, then B
@@ -55,27 +36,23 @@ answers and their count are those of one process.
 
 from __future__ import annotations
 
-import math
 import multiprocessing
 import multiprocessing.pool
 import os
 import weakref
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import NamedTuple, TypeVar, cast
 
 import fcl
 import numpy as np
-import shapely
 import trimesh
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
 from bridge.cli_types import forked_worker
 from executor import ExecutorError
+from executor.cad.fits.faces import TOUCH, CylinderFace, PrismFace, Slide, fit_faces, slid
 
-TOUCH = 1e-5
-"""Contacts at most this deep [m] are touching, not colliding (10 µm: below every
-clearance a cell can insert with; Cranfield's tight fit is 50 µm a side)."""
 DIRECTIONS: dict[str, tuple[float, float, float]] = {
     "+z": (0.0, 0.0, 1.0), "-z": (0.0, 0.0, -1.0), "+x": (1.0, 0.0, 0.0),
     "-x": (-1.0, 0.0, 0.0), "+y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
@@ -93,14 +70,6 @@ HULL_SAMPLE = 1000
 _FLAT = 1e-12
 """Adjacent triangles whose vertices lie at most this fraction of the mesh's size beyond
 each other's planes meet flat or convex (rounding: 1e-16)."""
-SMOOTH = np.radians(35.0)
-"""Adjacent triangles meeting at less than this angle are one smooth face (a 12-gon's is 30°)."""
-TILT = 0.05
-"""How far a cylindrical face's triangle normals may lean along its axis (the cosine: 2.9°):
-a tessellation whose rings are not lined up (a vertex of one end between two of the
-other, as Open CASCADE meshes a B-spline bore) leans them by about its chord error over
-the face's length (a 3 mm nut's bore at 0.02 mm: 1.4e-3). That the vertices lie on one
-circle is what makes the face a cylinder (a cone or a sphere fails it)."""
 _MAX_CONTACTS = 100_000
 _FEW_CONTACTS = 8
 LIKELY = 64
@@ -121,319 +90,6 @@ def axis_name(vector: np.ndarray) -> str:
     first = vector[np.flatnonzero(np.abs(vector) > 1e-9)[0]]
     unit = vector if first > 0 else -vector
     return ("+" if first > 0 else "-") + "(" + ",".join(f"{c:.4f}" for c in unit) + ")"
-
-
-@dataclass(frozen=True)
-class CylinderFace:
-    """A cylindrical face fitted on a mesh: a ``point`` on its axis and the unit axis
-    ``direction`` [m], the ``radius`` [m], the ``span`` of its vertices along the axis
-    [m] (projections on ``direction``), ``outward`` (a shaft's face; False: a bore's) and
-    the ``deflection`` [m]: the largest distance of one of its triangles from the circle."""
-
-    point: np.ndarray
-    direction: np.ndarray
-    radius: float
-    span: tuple[float, float]
-    outward: bool
-    deflection: float
-
-
-def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
-    """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
-    six triangles that are one cylinder (:func:`_cylinder`), and of every other smooth
-    region its bands lateral to its axis (:func:`_bands`) that are cylinders (a bore whose
-    edge radii join it smoothly to the ring's end faces: the bore, not the radii)."""
-    angles = mesh.face_adjacency_angles
-    smooth = mesh.face_adjacency[angles < SMOOTH]
-    faces: list[CylinderFace] = []
-    for region in trimesh.graph.connected_components(smooth, min_len=6):
-        face = _cylinder(mesh, region)
-        if face is not None:
-            faces.append(face)
-            continue
-        faces.extend(f for band in _bands(mesh, region, smooth) if (f := _cylinder(mesh, band)) is not None)
-    return faces
-
-
-def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
-    """The triangles ``region`` of ``mesh`` as one cylindrical face, or None: their normals
-    perpendicular to one axis (within :data:`TILT`) and spanning more than a flat face's,
-    their vertices on one circle (within 1 µm plus 1e-4 of the radius), their normals
-    all pointing away from the axis or all towards it, and no triangle farther from the
-    circle than :data:`COARSEST` of the radius (:func:`_deflection`, the face's deflection)."""
-    normals = mesh.face_normals[region]
-    scatter = normals.T @ normals / len(region)
-    values, vectors = np.linalg.eigh(scatter)
-    axis = vectors[:, 0]
-    if values[1] < 1e-3 or np.max(np.abs(normals @ axis)) > TILT:
-        return None  # flat, or no cylinder (a cone, a sphere)
-    ring = np.unique(mesh.faces[region].ravel())
-    frame = np.linalg.svd(axis[None, :])[2][1:]  # two unit vectors across the axis
-    flat = mesh.vertices[ring] @ frame.T
-    design = np.column_stack([2 * flat, np.ones(len(flat))])
-    solution = np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0]
-    centre = solution[:2]
-    radius = float(np.sqrt(solution[2] + centre @ centre))
-    if not np.all(np.abs(np.linalg.norm(flat - centre, axis=1) - radius) <= 1e-6 + 1e-4 * radius):
-        return None
-    point = centre @ frame
-    outwards = np.einsum("ij,ij->i", normals, (mesh.triangles_center[region] @ frame.T - centre) @ frame)
-    if not (np.all(outwards > 0) or np.all(outwards < 0)):
-        return None
-    deflection = _deflection(mesh.triangles[region] @ frame.T - centre, radius)
-    if deflection > COARSEST * radius:
-        return None  # coarser than a ring of smooth facets can be: no tessellated cylinder
-    along = mesh.vertices[ring] @ axis
-    return CylinderFace(point, axis, radius, (float(along.min()), float(along.max())),
-                        bool(outwards[0] > 0), deflection)
-
-
-COARSEST = 1 - np.cos(SMOOTH / 2)
-"""The largest deflection of a cylindrical face as a fraction of its radius (4.6%): the
-sagitta of a chord of :data:`SMOOTH`, the coarsest angular step a ring of facets meeting
-smoothly has (a d 20 bore: 0.46 mm; a regular ring has at least 11 facets a turn, a
-12-gon's 30° chords 3.4%)."""
-
-
-def _deflection(corners: np.ndarray, radius: float) -> float:
-    """The largest distance [m] of triangles from a circle of ``radius`` [m] about the
-    origin, their ``corners`` (n, 3, 2) [m] given across its axis: their edges' nearest
-    points to the axis inside it (a chord's sagitta), their corners beyond it. A sliver
-    whose plane passes far inside the circle (two corners a few µm apart, each within the
-    fit's µm of the circle) lies no farther from it than its corners."""
-    start = corners
-    edge = np.roll(corners, -1, axis=1) - start
-    length = np.maximum(np.einsum("ijk,ijk->ij", edge, edge), 1e-30)
-    t = np.clip(-np.einsum("ijk,ijk->ij", start, edge) / length, 0.0, 1.0)
-    nearest = np.linalg.norm(start + t[..., None] * edge, axis=2)
-    return float(max(radius - nearest.min(), np.linalg.norm(corners, axis=2).max() - radius, 0.0))
-
-
-BEND = 1e-2
-"""Adjacent triangles whose normals differ by more than this (the sine: 0.6°) bend about
-an axis, their normals' cross product (:func:`_bands`); flatter pairs show none."""
-CANDIDATES = 256
-"""Bends of a smooth region tried as its axis (:func:`_bands`; evenly spaced among them)."""
-
-
-def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> list[np.ndarray]:
-    """The smooth ``region`` of ``mesh`` split where it stops being a band parallel to one
-    axis. Adjacent triangles that bend (:data:`BEND`) bend about their normals' cross
-    product: on a cylinder all about its axis, on an edge radius or a sphere about
-    directions that vary. The axis is the bend shared (within :data:`TILT`) by most of the
-    region's bending pairs (tried among :data:`CANDIDATES` of them), averaged over those; the
-    bands are the connected sets of at least six of the region's triangles whose normals
-    are perpendicular to it (within :data:`TILT`), joined by the ``smooth`` adjacencies: a
-    bore's band, not its edge radii (their normals lean along the axis) nor the end faces
-    beyond them. Each band is a cylinder only if :func:`_cylinder` finds it one. One axis a
-    region: bands about another axis in the same smooth region are not looked for."""
-    inside = np.zeros(len(mesh.faces), dtype=bool)
-    inside[region] = True
-    pairs = smooth[inside[smooth].all(axis=1)]
-    bends = np.cross(mesh.face_normals[pairs[:, 0]], mesh.face_normals[pairs[:, 1]])
-    sizes = np.linalg.norm(bends, axis=1)
-    bends = bends[sizes > BEND] / sizes[sizes > BEND, None]
-    if len(bends) < 2:
-        return []
-    tried = bends[np.linspace(0, len(bends) - 1, min(CANDIDATES, len(bends))).astype(int)]
-    shared = np.abs(tried @ bends.T) >= np.sqrt(1 - TILT ** 2)
-    best = tried[np.argmax(shared.sum(axis=1))]
-    along = bends[np.abs(bends @ best) >= np.sqrt(1 - TILT ** 2)]
-    axis = np.linalg.eigh(along.T @ along)[1][:, -1]
-    lateral = np.zeros(len(mesh.faces), dtype=bool)
-    lateral[region] = np.abs(mesh.face_normals[region] @ axis) <= TILT
-    return list(trimesh.graph.connected_components(pairs[lateral[pairs].all(axis=1)], min_len=6))
-
-
-_PRISM_FRAMES = tuple((axis, np.array([np.roll(axis, 1), np.roll(axis, 2)])) for axis in np.eye(3))
-"""The cell's axes a prismatic face is looked for along, each with the two others (its section's frame)."""
-
-
-@dataclass(frozen=True)
-class PrismFace:
-    """A prismatic face fitted on a mesh along one of the cell's axes: its ``outline``
-    (the section of its triangles at mid-span, in ``frame``'s coordinates [m]), a
-    ``point`` on its axis (the outline's centroid) and the unit axis ``direction``, the
-    ``span`` of its vertices along the axis [m], ``outward`` (a peg's face; False: a
-    hole's), ``radius`` [m] the least distance of its sides' lines from the axis (a
-    thinning towards the axis by a factor 1 - t / radius moves every side in by at least
-    t) and ``deflection`` 0 (its sides are planes)."""
-
-    point: np.ndarray
-    direction: np.ndarray
-    frame: np.ndarray
-    outline: shapely.Polygon
-    span: tuple[float, float]
-    outward: bool
-    radius: float
-    deflection: float = 0.0
-
-
-def prism_faces(mesh: trimesh.Trimesh) -> list[PrismFace]:
-    """The prismatic faces of ``mesh`` along the cell's axes: connected sets of at least
-    four triangles whose normals are perpendicular to the axis (within :data:`TILT`), not
-    all meeting smoothly (those are cylinders, :func:`cylinder_faces`), whose section at
-    mid-span is one closed loop around its centroid (every side's line off it), the
-    triangles cut there all facing out of it or all into it: the face is the set's
-    triangles on that loop (within :data:`TOUCH`) facing the same way, its span theirs."""
-    faces: list[PrismFace] = []
-    smooth = mesh.face_adjacency_angles < SMOOTH
-    for axis, frame in _PRISM_FRAMES:
-        lateral = np.abs(mesh.face_normals @ axis) < TILT
-        pairs = lateral[mesh.face_adjacency].all(axis=1)
-        for region in trimesh.graph.connected_components(mesh.face_adjacency[pairs], min_len=4):
-            if np.all(smooth[pairs & np.isin(mesh.face_adjacency, region).all(axis=1)]):
-                continue
-            along = mesh.vertices[np.unique(mesh.faces[region].ravel())] @ axis
-            low, high = float(along.min()), float(along.max())
-            if high - low <= TOUCH:
-                continue
-            part = mesh.submesh([region], append=True)
-            segments = trimesh.intersections.mesh_plane(part, axis, axis * (low + high) / 2)
-            lines = shapely.union_all([shapely.LineString(s) for s in np.round(segments @ frame.T, 9)])
-            polygons = list(shapely.polygonize([lines]).geoms)  # its ends joined to 1 nm
-            if len(polygons) != 1 or polygons[0].area <= 0:
-                continue
-            outline = shapely.normalize(polygons[0])
-            centre = np.array(outline.centroid.coords[0])
-            ring = np.asarray(outline.exterior.coords)
-            sides = ring[1:] - ring[:-1]
-            normals = np.column_stack([sides[:, 1], -sides[:, 0]]) / np.linalg.norm(sides, axis=1)[:, None]
-            reach = float(np.min(np.abs(np.einsum("ij,ij->i", ring[:-1] - centre, normals))))
-            # the face is the region's triangles on the outline, facing as those cut at mid-span do
-            corners = mesh.triangles[region] @ frame.T
-            on = np.all(shapely.distance(outline.exterior, shapely.points(corners)) <= TOUCH, axis=1)
-            probe = mesh.triangles_center[region] @ frame.T + 1e-6 * (mesh.face_normals[region] @ frame.T)
-            inside = shapely.contains_xy(outline, probe[:, 0], probe[:, 1])
-            heights = mesh.triangles[region] @ axis
-            cut = (heights.min(axis=1) < (low + high) / 2) & (heights.max(axis=1) > (low + high) / 2)
-            if reach <= TOUCH or len(set(inside[cut])) != 1:
-                continue
-            kept = heights[on & (inside == inside[cut][0])]
-            if not kept.size:  # every triangle leans off the mid-span section: a taper within TILT, no prism
-                continue
-            faces.append(PrismFace(centre @ frame, axis, frame, outline, (float(kept.min()), float(kept.max())),
-                                   not bool(inside[cut][0]), reach))
-    return faces
-
-
-@dataclass(frozen=True)
-class Slide:
-    """A nominal zero-clearance fit: part ``shaft``'s outward ``face`` in part ``bore``'s
-    inward face ``hole``, coaxial and of equal radius (prisms: the peg's outline within the
-    hole's) within ``tolerance`` [m]; along the axis the shaft's part is swept (or met)
-    ``thinner`` [m] there (module docstring). ``seated``: the two faces' spans along the
-    axis overlap by more than the tolerance in the assembled pose (the shaft is in the
-    bore); else it is a **passage**, the faces meeting only on a way along the axis (a
-    pulley's bore passing a collar of its hub on its way off the hub's end). A **screwed
-    pair** (:func:`screwed_pairs`: a modelled thread, ``shaft`` the
-    screw and ``bore`` the nut, a tapped hole drawn at its tap drill or a plain hole a cosmetic
-    thread is drawn in: :func:`cosmetic_pairs`) has the thread's ``pitch`` and ``lead`` [m] (0
-    for any other fit) and ``thread``, how it is drawn (the report's words)."""
-
-    shaft: str
-    bore: str
-    face: CylinderFace | PrismFace
-    hole: CylinderFace | PrismFace
-    tolerance: float
-    thinner: float
-    seated: bool
-    pitch: float = 0.0
-    lead: float = 0.0
-    thread: str = ""
-
-    @property
-    def direction(self) -> np.ndarray:
-        return self.face.direction
-
-
-def fit_faces(mesh: trimesh.Trimesh) -> list[CylinderFace | PrismFace]:
-    """The faces of ``mesh`` a zero-clearance fit may slide on: its cylinders and prisms."""
-    return [*cylinder_faces(mesh), *prism_faces(mesh)]
-
-
-def _seated(a: CylinderFace | PrismFace, b: CylinderFace | PrismFace, tolerance: float) -> bool:
-    """Whether the spans of the parallel faces ``a`` and ``b`` along ``a``'s axis overlap
-    by more than ``tolerance`` [m]."""
-    low, high = (b.span if a.direction @ b.direction > 0 else (-b.span[1], -b.span[0]))
-    return min(a.span[1], high) - max(a.span[0], low) > tolerance
-
-
-def _prism_fit(a: PrismFace, b: PrismFace) -> Slide | None:
-    """The fit of the outward prism ``a`` in the inward ``b`` (the parts' names filled in
-    by the caller) when they share their axis, the outline of ``a`` shrunk by
-    :data:`TOUCH` lies in that of ``b`` and the two outlines come within it of each other
-    (else there is room); seated when their spans overlap by more than it."""
-    if not np.array_equal(a.direction, b.direction):
-        return None
-    if (not shapely.covers(b.outline, a.outline.buffer(-TOUCH, join_style="mitre"))
-            or shapely.distance(a.outline.exterior, b.outline.exterior) > TOUCH):
-        return None
-    return Slide("", "", a, b, TOUCH, 2 * TOUCH, _seated(a, b, TOUCH))
-
-
-def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
-    """Every pair of an outward face of one part and an inward face of another: cylinders
-    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance; prisms
-    along one of the cell's axes whose outlines are one within :data:`TOUCH`
-    (:func:`_prism_fit`). Each slides along its axis wherever the two faces meet on the
-    way, in the assembled pose (``seated``) or only on it (a passage)."""
-    found: list[Slide] = []
-    for shaft, outer in faces.items():
-        for bore, inner in faces.items():
-            if bore == shaft:
-                continue
-            for p in (f for f in outer if isinstance(f, PrismFace) and f.outward):
-                for q in (f for f in inner if isinstance(f, PrismFace) and not f.outward):
-                    if (prism := _prism_fit(p, q)) is not None:
-                        found.append(replace(prism, shaft=shaft, bore=bore))
-            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
-                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
-                    tolerance = max(a.deflection, b.deflection) + TOUCH
-                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
-                            or abs(a.radius - b.radius) > tolerance):
-                        continue
-                    offset = b.point - a.point
-                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
-                    if apart > tolerance:
-                        continue
-                    thinner = max(0.0, a.radius - b.radius) + b.deflection + apart + TOUCH
-                    found.append(Slide(shaft, bore, a, b, tolerance, thinner, _seated(a, b, tolerance)))
-    return found
-
-
-def near(points: np.ndarray, face: CylinderFace | PrismFace,
-         tolerance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Which ``points`` [m] lie within ``tolerance`` of ``face`` (of its radius or its
-    outline, within its span), their coordinates along the axis and their radial offsets from it."""
-    relative = points - face.point
-    along = relative @ face.direction
-    radial = relative - np.outer(along, face.direction)
-    if isinstance(face, PrismFace):
-        off = shapely.distance(face.outline.exterior, shapely.points(points @ face.frame.T))
-    else:
-        off = np.abs(np.linalg.norm(radial, axis=1) - face.radius)
-    near = (off <= tolerance) & (along >= face.span[0] - tolerance) & (along <= face.span[1] + tolerance)
-    return near, along, radial
-
-
-def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide]) -> trimesh.Trimesh:
-    """``mesh`` as swept along the axis of its zero-clearance fits: its vertices on each
-    of ``shafts``' faces moved ``thinner`` towards the axis (a prism's scaled towards it so
-    that every side moves in by at least that), and the triangles of those
-    faces and of ``bores``' holes (the mated surfaces) left out, whose sliding on each
-    other is the fit; what meets them meets the part's other triangles first."""
-    vertices = np.array(mesh.vertices, dtype=float)
-    mated = np.zeros(len(mesh.faces), dtype=bool)
-    for slide, face in [*((s, s.face) for s in shafts), *((s, s.hole) for s in bores)]:
-        on, along, radial = near(np.asarray(mesh.vertices), face, slide.tolerance)
-        mated |= np.all(on[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < TILT)
-        if face is slide.face:
-            distance = np.linalg.norm(radial[on], axis=1)
-            inward = slide.thinner * (distance / face.radius if isinstance(face, PrismFace) else 1.0)
-            scale = np.maximum(distance - inward, 0.0) / distance
-            vertices[on] = face.point + np.outer(along[on], face.direction) + radial[on] * scale[:, None]
-    return trimesh.Trimesh(vertices, mesh.faces[~mated], process=False)
 
 
 def bvh(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
@@ -635,7 +291,7 @@ def _outer_hull(points: np.ndarray) -> tuple[np.ndarray, bool]:
     :data:`HULL_POINTS` (tried for at most four times as many points), else of a polytope
     around it of fewer (its supporting planes along the 26 directions of a cube's faces,
     edges and corners and, around each axis of the frame, as many as keep a cylinder about
-    that axis within :data:`TOUCH` / 2), and whether it is the hull itself."""
+    that axis within :data:`executor.cad.fits.faces.TOUCH` / 2), and whether it is the hull itself."""
     hull = points
     if len(points) <= 4 * HULL_POINTS:
         hull = points[ConvexHull(points).vertices]
@@ -660,7 +316,7 @@ def _outer_hull(points: np.ndarray) -> tuple[np.ndarray, bool]:
 
 class Survey(NamedTuple):
     r"""What the sweeps and the fits need of one closed part, made once: its ``faces``
-    (:func:`fit_faces`), the vertices [m] of its ``hull`` (:func:`_outer_hull`: a convex
+    (:func:`executor.cad.fits.faces.fit_faces`), the vertices [m] of its ``hull`` (:func:`_outer_hull`: a convex
     superset), whether that is ``exact``\ ly the hull, and whether the part is ``convex``
     (:func:`_is_convex`)."""
 
@@ -948,7 +604,7 @@ class Sweeper:
         direction) by ``length`` [m] that a sweep of the same solids along the same
         direction answered before entails, or None: a shorter sweep's motion is part of a
         longer one's, so a longer sweep that is free (no prism of it meets the fixed part
-        deeper than :data:`TOUCH`) frees the shorter, and a shorter one that collides
+        deeper than :data:`executor.cad.fits.faces.TOUCH`) frees the shorter, and a shorter one that collides
         blocks the longer (penetration depth only grows with the moving set)."""
         for done, collides in self._along.get(way, []):
             if collides == (done <= length):
@@ -975,7 +631,7 @@ class Sweeper:
         return moving, fixed, shift
 
     def touching(self, a: str, b: str) -> bool:
-        """Whether parts ``a`` and ``b`` are within :data:`TOUCH` of each other: their
+        """Whether parts ``a`` and ``b`` are within :data:`executor.cad.fits.faces.TOUCH` of each other: their
         distance, unless their boxes or one's convex superset and the other are farther
         apart (no nearer than the part itself), or they meet."""
         one, other = self._solids[a], self._solids[b]
@@ -994,7 +650,7 @@ class Sweeper:
 
     def _solid(self, part: str, against: str, shift: np.ndarray) -> _Solid:
         """``part``'s solid for a sweep by ``shift`` against (or of) ``against``: at their
-        zero-clearance fits along the shift, :func:`slid`."""
+        zero-clearance fits along the shift, :func:`executor.cad.fits.faces.slid`."""
         unit = shift / np.linalg.norm(shift)
 
         def along(slides: list[Slide]) -> list[Slide]:
@@ -1022,7 +678,7 @@ def _swept(test: tuple[str, str, np.ndarray]) -> bool:
 
 
 def _collides(moving: _Solid, fixed: _Solid, shift: np.ndarray) -> bool:
-    """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`TOUCH`
+    """Whether ``moving`` swept by ``shift`` meets ``fixed`` deeper than :data:`executor.cad.fits.faces.TOUCH`
     (the module docstring: the hull, then down the triangle tree, the prisms of a leaf last)."""
     pieces = moving.pieces.setdefault(tuple(shift), {})
     if moving.convex or moving.exact:
@@ -1073,7 +729,7 @@ def _front(solid: _Solid, low: np.ndarray, high: np.ndarray, shift: np.ndarray) 
 
 
 def _meets(pieces: list[_Piece], fixed: _Solid) -> bool:
-    """Whether a piece meets ``fixed`` deeper than :data:`TOUCH` (fcl's depth of a triangle
+    """Whether a piece meets ``fixed`` deeper than :data:`executor.cad.fits.faces.TOUCH` (fcl's depth of a triangle
     of ``fixed`` it meets): a first query without contacts, then the depths of the first
     :data:`_FEW_CONTACTS` contacts; then, in a query of their own, the :data:`LIKELY`
     triangles of ``fixed`` that reach deepest into the piece along the line between their
@@ -1109,7 +765,7 @@ def _meets(pieces: list[_Piece], fixed: _Solid) -> bool:
 
 def _deeper(piece: fcl.CollisionObject, fixed: fcl.CollisionObject, most: int) -> tuple[bool, int]:
     """Whether one of the first ``most`` contacts of ``piece`` with ``fixed`` is deeper than
-    :data:`TOUCH`, and how many contacts fcl gave."""
+    :data:`executor.cad.fits.faces.TOUCH`, and how many contacts fcl gave."""
     result = fcl.CollisionResult()
     fcl.collide(piece, fixed, fcl.CollisionRequest(num_max_contacts=most, enable_contact=True), result)
     return any(contact.penetration_depth > TOUCH for contact in result.contacts), len(result.contacts)
@@ -1117,7 +773,7 @@ def _deeper(piece: fcl.CollisionObject, fixed: fcl.CollisionObject, most: int) -
 
 def _likely(piece: _Piece, triangles: _Triangles) -> np.ndarray:
     """The (at most :data:`LIKELY`) triangles near ``piece`` that reach farthest into it,
-    deeper than :data:`TOUCH`, along the line from its centre to theirs: the piece's extent
+    deeper than :data:`executor.cad.fits.faces.TOUCH`, along the line from its centre to theirs: the piece's extent
     beyond the triangle's nearest corner along that line, what fcl's depth (libccd's portal
     refinement from the centres' difference) approaches. The extent is measured only on the
     triangles whose bound (the piece's box's extent instead, plus :data:`_SLACK`) reaches
@@ -1149,359 +805,3 @@ _SLACK = 1e-9
 def _reach(piece: _Piece, toward: np.ndarray, nearest: np.ndarray) -> np.ndarray:
     """The extent [m] of ``piece`` along each unit vector ``toward`` beyond ``nearest`` (:func:`_likely`)."""
     return np.max(toward @ piece.points.T, axis=1) - nearest
-
-
-THREAD_ANGLES = 8
-"""Half-planes about a thread's axis its surface is cut with (:func:`thread_profiles`): a
-turn in eighths, so a lead of up to four pitches (four starts) shifts the profile by less than half a pitch."""
-THREAD_SAMPLES = 2048
-"""Levels along the axis each half-plane's profile is sampled at, over the part's extent."""
-THREAD_MATCH = 0.15
-"""Two profiles are one (shifted) when their mean difference is at most this fraction of
-the thread's depth (the profile's 5th to 95th percentile)."""
-
-
-@dataclass(frozen=True)
-class Thread:
-    """A helical surface measured on a part (:func:`helix`): about the axis through
-    ``point`` along the unit ``direction`` [m], its profile's period ``pitch`` [m] along the
-    axis and its ``lead`` [m] (the advance per turn, counterclockwise about ``direction``:
-    positive for a right-handed thread; a multiple of the pitch for several starts), its
-    least and largest radii ``inner`` and ``outer`` [m] over ``span`` (along ``direction``
-    from ``point``: the levels where every half-plane meets it within those radii)."""
-
-    point: np.ndarray
-    direction: np.ndarray
-    pitch: float
-    lead: float
-    inner: float
-    outer: float
-    span: tuple[float, float]
-
-
-def thread_profiles(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray,
-                    levels: np.ndarray, outermost: bool, rows: Iterable[int] = range(THREAD_ANGLES)) -> np.ndarray:
-    """The radius [m] of ``mesh``'s surface about the axis through ``point`` along the unit
-    ``direction``, in the half-planes ``rows`` of :data:`THREAD_ANGLES` bounded by the axis
-    (row k at angle 0.1234 + 2πk/K rad, counterclockwise about ``direction``: off the
-    frame's axes) at each of ``levels`` [m] along the axis: the surface crossing the
-    half-plane's line at that level nearest the axis (a nut's thread) or, ``outermost``,
-    farthest from it (a screw's); NaN where none crosses (and in the rows not asked)."""
-    across = np.eye(3)[int(np.argmin(np.abs(direction)))]
-    first = np.cross(direction, across)
-    first /= np.linalg.norm(first)
-    second = np.cross(direction, first)
-    found = np.full((THREAD_ANGLES, len(levels)), np.nan)
-    for k in rows:
-        angle = 0.1234 + 2 * np.pi * k / THREAD_ANGLES
-        out = np.cos(angle) * first + np.sin(angle) * second
-        segments = trimesh.intersections.mesh_plane(mesh, np.cross(direction, out), point)
-        if len(segments) == 0:
-            continue
-        z = (segments - point) @ direction
-        r = (segments - point) @ out
-        order = np.argsort(levels)
-        best = np.full(len(levels), -np.inf if outermost else np.inf)
-        for (z0, z1), (r0, r1) in zip(z, r):  # each segment over the levels it spans
-            if z1 == z0:
-                continue
-            lo, hi = np.searchsorted(levels[order], [min(z0, z1), max(z0, z1)], side="left")
-            at = order[lo:hi]
-            radius = r0 + (levels[at] - z0) / (z1 - z0) * (r1 - r0)
-            radius = np.where(radius > 0, radius, -np.inf if outermost else np.inf)
-            best[at] = np.maximum(best[at], radius) if outermost else np.minimum(best[at], radius)
-        found[k] = np.where(np.isfinite(best), best, np.nan)
-    return found
-
-
-def _mismatch(a: np.ndarray, b: np.ndarray) -> float:
-    """The mean absolute difference of two profiles where both are measured, over the 90 %
-    of levels where they differ least (a stretch's ends may reach a head, a chamfer or a
-    run-out); inf where they share under half their levels."""
-    both = np.isfinite(a) & np.isfinite(b)
-    if both.sum() * 2 < min(len(a), len(b)):
-        return math.inf
-    differences = np.sort(np.abs(a[both] - b[both]))
-    return float(np.mean(differences[:max(1, int(0.9 * len(differences)))]))
-
-
-def period(profile: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[int, float] | None:
-    """The period (in levels) and the depth [m] (5th to 95th percentile) of one
-    :func:`thread_profiles` row at the evenly spaced ``levels`` [m], over the levels
-    ``within``: its smallest shift, above a sixteenth of the stretch and under a half,
-    under which it matches itself within :data:`THREAD_MATCH` of its depth, at a local
-    minimum of the difference; None where it has none (or is measured on under half the stretch)."""
-    base = profile[(levels >= within[0]) & (levels <= within[1])]
-    if len(base) == 0 or np.isnan(base).mean() > 0.5:
-        return None
-    depth = float(np.nanpercentile(base, 95) - np.nanpercentile(base, 5))
-    if depth <= 2 * TOUCH:
-        return None
-    shifts = np.arange(max(1, len(base) // 16), len(base) // 2)
-    if len(shifts) < 3:
-        return None
-    differences = np.array([_mismatch(base[s:], base[:-s]) for s in shifts])
-    minima = [i for i in range(1, len(shifts) - 1) if differences[i] <= THREAD_MATCH * depth
-              and differences[i] <= differences[i - 1] and differences[i] <= differences[i + 1]]
-    return (int(shifts[minima[0]]), depth) if minima else None
-
-
-def helix(profiles: np.ndarray, levels: np.ndarray, within: tuple[float, float]) -> tuple[float, float] | None:
-    """(pitch, lead) [m] of :func:`thread_profiles` ``profiles`` at the evenly spaced
-    ``levels`` [m], over the levels ``within`` (along the axis), when they are one helical
-    surface: the first profile periodic along the axis (:func:`period`: the pitch) and each half-plane's profile
-    the first one shifted by k times one shift s (within :data:`THREAD_MATCH`), s at least a
-    sixteenth of the pitch from 0 (a surface of revolution, rings or grooves, has s = 0);
-    the lead is K·s, taken as the nearest whole number of pitches (the starts; K·s measured
-    within K levels of it, else None). None otherwise."""
-    inside = (levels >= within[0]) & (levels <= within[1])
-    rows = profiles[:, inside]
-    step = float(levels[1] - levels[0])
-    base = rows[0]
-    found = period(profiles[0], levels, within)
-    if found is None:
-        return None
-    cycle, depth = found
-    half = cycle // 2
-    options = np.arange(-half, half + 1)
-
-    def shifted(row: np.ndarray, s: int) -> float:
-        return _mismatch(row[s:], base[:-s]) if s > 0 else _mismatch(row[:s or None], base[-s:])
-
-    one = int(options[np.argmin([shifted(rows[1], int(s)) for s in options])])
-    if abs(one) * 16 < cycle:
-        return None
-    for k in range(1, len(rows)):
-        s = (k * one + half) % cycle - half
-        if shifted(rows[k], s) > THREAD_MATCH * depth:
-            return None
-    # one is a whole number of levels (±0.5), K·one within ±K/2 of the lead: the lead is the
-    # nearest whole number of pitches (the starts), where K·one lies within K levels of it
-    starts = round(len(rows) * abs(one) / cycle)
-    if starts < 1 or abs(len(rows) * abs(one) - starts * cycle) > len(rows):
-        return None
-    return cycle * step, float(np.sign(one)) * starts * cycle * step
-
-
-def _thread(mesh: trimesh.Trimesh, point: np.ndarray, direction: np.ndarray, overlap: tuple[float, float],
-            outermost: bool) -> Thread | None:
-    """``mesh``'s helical surface about the axis (:func:`helix`) measured over ``overlap``
-    (along the axis from ``point`` [m]), on its outermost crossings (a screw) or innermost
-    (a nut), or None; its span the levels about ``overlap`` where every half-plane meets it
-    within its radii."""
-    along = (mesh.vertices - point) @ direction
-    levels = np.linspace(float(along.min()), float(along.max()), THREAD_SAMPLES)
-    profiles = thread_profiles(mesh, point, direction, levels, outermost, rows=[0])
-    if period(profiles[0], levels, overlap) is None:  # the cheap reject: one half-plane
-        return None
-    profiles = thread_profiles(mesh, point, direction, levels, outermost)
-    found = helix(profiles, levels, overlap)
-    if found is None:
-        return None
-    inside = (levels >= overlap[0]) & (levels <= overlap[1])
-    inner, outer = float(np.nanmin(profiles[:, inside])), float(np.nanmax(profiles[:, inside]))
-    on = np.all((profiles >= inner - TOUCH) & (profiles <= outer + TOUCH), axis=0)
-    middle = int(np.flatnonzero(inside)[np.sum(inside) // 2])
-    if not on[middle]:
-        return None
-    low = middle
-    while low > 0 and on[low - 1]:
-        low -= 1
-    high = middle
-    while high < len(on) - 1 and on[high + 1]:
-        high += 1
-    return Thread(point, direction, found[0], found[1], inner, outer, (float(levels[low]), float(levels[high])))
-
-
-def screwed_pairs(meshes: dict[str, trimesh.Trimesh], pairs: Iterable[tuple[str, str]] | None = None) -> list[Slide]:
-    """The screwed pairs among ``meshes`` (of ``pairs``, either way round, where given: the
-    import asks only of parts the disassembly leaves and their blockers): a part's outermost surface (a screw's) and
-    another's innermost (a nut's, a tapped hole's), about one axis along an axis of the
-    frame through the centre of the smaller part's box across it, over the stretch where
-    both parts are, each a helical surface (:func:`helix`) of one pitch and one lead
-    (within 2 %), the screw's crest outside the nut's minor radius (they interlock).
-    Each is a :class:`Slide` along that axis: swept against its mate
-    only, the screw's thread is taken in to under the nut's minor radius (its vertices
-    from that radius out to twice its crest less it, on its thread's span, moved in by
-    its crest less that radius plus :data:`TOUCH`), so
-    the pair slides along the axis where nothing else (a head, a bottom) stops it."""
-    found: list[Slide] = []
-    ids = sorted(meshes)
-    asked = None if pairs is None else {frozenset(pair) for pair in pairs}
-    for a in ids:
-        for b in ids:
-            if a == b or (asked is not None and frozenset((a, b)) not in asked):
-                continue
-            low = np.maximum(meshes[a].bounds[0], meshes[b].bounds[0])
-            high = np.minimum(meshes[a].bounds[1], meshes[b].bounds[1])
-            if np.any(high - low <= TOUCH):
-                continue
-            for axis in range(3):
-                slide = _screwed(meshes[a], meshes[b], axis, (float(low[axis]), float(high[axis])))
-                if slide is not None:
-                    found.append(replace(slide, shaft=a, bore=b))
-    return found
-
-
-def lone_thread(meshes: dict[str, trimesh.Trimesh]) -> str:
-    """For two overlapping parts (``meshes``: id -> mesh [m]) that are no screwed pair, what
-    the import says of a modelled thread among them: the part whose outermost surface is a
-    helical thread (:func:`helix`) about an axis of the frame through the smaller part's box
-    centre, over the stretch both share, in the other part, whose innermost surface there is
-    none (a tapped hole drawn at its tap drill); "" where neither is such a thread."""
-    (a, one), (b, other) = sorted(meshes.items())
-    low, high = np.maximum(one.bounds[0], other.bounds[0]), np.minimum(one.bounds[1], other.bounds[1])
-    for axis in range(3):
-        direction = np.eye(3)[axis]
-        across = [i for i in range(3) if i != axis]
-        smaller = min((one, other), key=lambda m: float(np.prod(m.extents[across])))
-        point = smaller.bounds.mean(axis=0) * (1 - direction)
-        for screw, mesh, hole in ((a, one, b), (b, other, a)):
-            thread = _thread(mesh, point, direction, (float(low[axis]), float(high[axis])), outermost=True)
-            if thread is not None:
-                return (f"; '{screw}' has a modelled thread (pitch {1000 * thread.pitch:.3f} mm, d "
-                        f"{2000 * thread.outer:.3f} mm, along {axis_name(direction)[1:]}) in '{hole}', which has "
-                        "no thread there (a tapped hole drawn at its tap drill?): the import takes a modelled "
-                        "thread only screwed into another")
-    return ""
-
-
-def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: tuple[float, float]) -> Slide | None:
-    """The screwed pair (:func:`screwed_pairs`) of ``screw`` in ``nut`` along the frame's
-    ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None:
-    the nut's thread modelled, or a plain round hole at the screw's tap drill (:func:`_tap_drill`)."""
-    direction = np.eye(3)[axis]
-    across = [i for i in range(3) if i != axis]
-    smaller = min((screw, nut), key=lambda m: float(np.prod(m.extents[across])))
-    point = smaller.bounds.mean(axis=0) * (1 - direction)
-    male = _thread(screw, point, direction, overlap, outermost=True)
-    if male is None:
-        return None
-    face = CylinderFace(point, direction, male.outer, male.span, True, 0.0)
-    female = _thread(nut, point, direction, overlap, outermost=False)
-    if female is None:
-        hole = _tap_drill(nut, male)
-        if hole is None:
-            return None
-        reach = male.outer - hole.radius + hole.deflection + TOUCH
-        return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead,
-                     thread="a modelled thread in a plain hole at its tap drill")
-    if (abs(male.pitch - female.pitch) > 0.02 * male.pitch
-            or abs(male.lead - female.lead) > 0.02 * abs(male.lead) or male.outer <= female.inner):
-        return None
-    reach = male.outer - female.inner + TOUCH
-    hole = CylinderFace(point, direction, female.inner, female.span, False, 0.0)
-    return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead,
-                 thread="a modelled thread")
-
-
-TAP_LEVELS = 64
-"""Levels along the stretch a modelled thread shares with a plain hole at which the hole's
-radius is sampled (:func:`_tap_drill`), in every half-plane of :data:`THREAD_ANGLES`."""
-
-
-def _tap_drill(nut: trimesh.Trimesh, male: Thread) -> CylinderFace | None:
-    """The plain round hole of ``nut`` the modelled thread ``male`` lies in, drawn at its tap
-    drill: over the stretch of the thread's span the nut covers (two pitches at least),
-    inside its ends, the nut's innermost surface in each half-plane about the thread's axis
-    (:func:`thread_profiles`, :data:`TAP_LEVELS` levels) met at every level, its radii
-    within :data:`THREAD_MATCH` of the thread's depth of each other (a round hole, coaxial:
-    an off-axis one varies by twice its offset) and between the thread's least and largest
-    radii (the minor and the major), exclusive. Its face: the least radius [m], the spread
-    as its deflection, that stretch as its span; None otherwise."""
-    along = (nut.vertices - male.point) @ male.direction
-    low, high = max(male.span[0], float(along.min())), min(male.span[1], float(along.max()))
-    if high - low < 2 * male.pitch:
-        return None
-    levels = np.linspace(low, high, TAP_LEVELS + 2)[1:-1]
-    radii = thread_profiles(nut, male.point, male.direction, levels, outermost=False)
-    if not np.all(np.isfinite(radii)):
-        return None
-    least, largest = float(radii.min()), float(radii.max())
-    if largest - least > THREAD_MATCH * (male.outer - male.inner) or not male.inner < least <= largest < male.outer:
-        return None
-    return CylinderFace(male.point, male.direction, least, (low, high), False, largest - least)
-
-
-def _metric() -> list[tuple[str, float, float]]:
-    """ISO metric threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`."""
-    coarse = {1: .25, 1.2: .25, 1.4: .3, 1.6: .35, 1.8: .35, 2: .4, 2.5: .45, 3: .5, 3.5: .6, 4: .7, 5: .8, 6: 1,
-              8: 1.25, 10: 1.5, 12: 1.75, 14: 2, 16: 2, 18: 2.5, 20: 2.5, 22: 2.5, 24: 3, 27: 3, 30: 3.5, 33: 3.5,
-              36: 4, 39: 4, 42: 4.5, 45: 4.5, 48: 5, 52: 5, 56: 5.5, 60: 5.5, 64: 6}
-    fine = {8: (1,), 10: (1.25, 1), 12: (1.5, 1.25), 14: (1.5,), 16: (1.5,), 18: (1.5,), 20: (1.5,), 22: (1.5,),
-            24: (2,), 27: (2,), 30: (2,), 33: (2,), 36: (3,), 39: (3,), 42: (3,), 45: (3,), 48: (3,), 52: (4,),
-            56: (4,), 60: (4,), 64: (4,)}
-    found = [(f"M{d:g}", d * 1e-3, p * 1e-3) for d, p in coarse.items()]
-    return found + [(f"M{d:g}x{p:g}", d * 1e-3, p * 1e-3) for d, pitches in fine.items() for p in pitches]
-
-
-def _unified() -> list[tuple[str, float, float]]:
-    """Unified inch threads, UNC and UNF (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`."""
-    sizes = [("#2", .086, 56, 64), ("#4", .112, 40, 48), ("#5", .125, 40, 44), ("#6", .138, 32, 40),
-             ("#8", .164, 32, 36), ("#10", .190, 24, 32), ("#12", .216, 24, 28), ("1/4", .25, 20, 28),
-             ("5/16", .3125, 18, 24), ("3/8", .375, 16, 24), ("7/16", .4375, 14, 20), ("1/2", .5, 13, 20),
-             ("9/16", .5625, 12, 18), ("5/8", .625, 11, 18), ("3/4", .75, 10, 16), ("7/8", .875, 9, 14),
-             ("1", 1.0, 8, 12)]
-    return [(f"{name}-{tpi} {series}", inch * 0.0254, 0.0254 / tpi)
-            for name, inch, unc, unf in sizes for tpi, series in ((unc, "UNC"), (unf, "UNF"))]
-
-
-STANDARD_THREADS = _metric() + _unified()
-"""The standard threads a cosmetic thread is taken for (name, major diameter D, pitch P)
-[m]: ISO 261's metric sizes M1 to M64 of the first and second choice, their coarse pitch
-and the common fine ones (ISO 262's M8x1 to M64x4), and the unified inch UNC and UNF
-series, #2 to 1 inch (ASME B1.1)."""
-TAP_DRILL = (1.0825, 0.85)
-"""A tapped hole drawn at its tap drill has a diameter from D - 1.0825 P (the basic minor
-diameter of the internal thread, ISO 68-1 and ASME B1.1: 5/4 of the fundamental
-triangle's height 0.866 P) to D - 0.85 P (above the common drill D - P, a drill for
-soft stock), in pitches P below the major diameter D."""
-COSMETIC_MAJOR = 0.25
-"""A screw drawn with a cosmetic thread has a diameter from D - 0.25 P to D (its major
-diameter, nominal or at its class's least), in pitches P."""
-
-
-def cosmetic_thread(shaft: float, hole: float, slack: float) -> tuple[str, float] | None:
-    """(name, pitch [m]) of the standard thread (:data:`STANDARD_THREADS`) of which a plain
-    shaft of diameter ``shaft`` [m] in a plain hole of diameter ``hole`` [m] is drawn
-    with a cosmetic thread: the shaft within :data:`COSMETIC_MAJOR` of its major diameter,
-    the hole within :data:`TAP_DRILL`, each widened by ``slack`` [m] (the faces'
-    tessellation); of several, the one whose major diameter lies nearest the shaft's."""
-    found = [(abs(shaft - d), name, p) for name, d, p in STANDARD_THREADS
-             if d - COSMETIC_MAJOR * p - slack <= shaft <= d + slack
-             and d - TAP_DRILL[0] * p - slack <= hole <= d - TAP_DRILL[1] * p + slack]
-    return (min(found)[1], min(found)[2]) if found else None
-
-
-def cosmetic_pairs(faces: dict[str, list[CylinderFace | PrismFace]],
-                   pairs: Iterable[tuple[str, str]] | None = None) -> list[Slide]:
-    """The pairs among the parts' fitted ``faces`` (of ``pairs``, either way round, where
-    given) drawn with a cosmetic thread: an outward cylinder of one part (the screw) and an
-    inward one of another (the hole), parallel (within 1e-4 rad), coaxial within their
-    larger deflection plus :data:`TOUCH`, meeting along the axis in the assembled pose,
-    their diameters a standard thread's major and tap drill (:func:`cosmetic_thread`).
-    Each is a screwed :class:`Slide` of that thread's pitch (its lead one pitch,
-    right-handed: a cosmetic thread draws neither), swept as a modelled one (the screw's
-    cylinder taken in to under the hole's radius)."""
-    found: list[Slide] = []
-    asked = None if pairs is None else {frozenset(pair) for pair in pairs}
-    for shaft, outer in faces.items():
-        for bore, inner in faces.items():
-            if bore == shaft or (asked is not None and frozenset((shaft, bore)) not in asked):
-                continue
-            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
-                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
-                    slack = max(a.deflection, b.deflection) + TOUCH
-                    offset = b.point - a.point
-                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
-                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4 or apart > slack
-                            or not _seated(a, b, TOUCH)):
-                        continue
-                    match = cosmetic_thread(2 * a.radius, 2 * b.radius, 2 * slack)
-                    if match is None:
-                        continue
-                    reach = a.radius - b.radius + b.deflection + apart + TOUCH
-                    found.append(Slide(shaft, bore, a, b, reach, reach + TOUCH, True, pitch=match[1], lead=match[1],
-                                       thread=f"a cosmetic thread, {match[0]}: d {2000 * a.radius:.4g} in its "
-                                              f"{2000 * b.radius:.4g} mm tap drill"))
-    return found

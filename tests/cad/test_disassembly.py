@@ -1,4 +1,4 @@
-"""The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py) on small
+"""The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py, fits/faces.py) on small
 products of trimesh primitives: a horizontal shaft in a zero-clearance bearing comes out
 along its axis, and passes the overlap check however coarse the tessellation; a
 precedence pair only where every way in is blocked (a bar that slides out sideways under
@@ -26,8 +26,9 @@ import trimesh
 from executor import ExecutorError
 from executor.cad import sections, sweep
 from executor.cad.derive import derive
+from executor.cad.fits.faces import TOUCH, CylinderFace, cylinder_faces, fit_faces, zero_clearance_fits
 from executor.cad.parts import CadPart, check_parts, load_meshes, overlaps_checked
-from executor.cad.sweep import FRONT, _is_convex, cylinder_faces
+from executor.cad.sweep import FRONT, _is_convex
 
 MM = 1e-3
 CORPUS = Path(__file__).parent / "corpus"
@@ -198,8 +199,8 @@ def test_a_bore_with_edge_radii_is_found_as_a_cylinder_and_its_radii_are_not() -
     assert [(f.outward, round(f.radius / MM, 6)) for f in faces] == [(True, 18.5), (False, 10.0)]
     bore = faces[1]
     assert bore.span == pytest.approx((0.3 * MM, 8.7 * MM), abs=1e-9)  # the bore's band, not its radii
-    assert [(s.shaft, s.bore, s.seated) for s in sweep.zero_clearance_fits(
-        {"pin": sweep.fit_faces(pin), "ring": sweep.fit_faces(ring)})] == [("pin", "ring", True)]
+    assert [(s.shaft, s.bore, s.seated) for s in zero_clearance_fits(
+        {"pin": fit_faces(pin), "ring": fit_faces(ring)})] == [("pin", "ring", True)]
     check_parts(_parts(pin=pin, ring=ring), "m")  # the tessellations' overlap is the fit's
 
 
@@ -388,9 +389,9 @@ def test_a_sliver_in_a_bore_is_no_deflection_and_a_peg_with_room_in_it_is_no_fit
     assert chord - 1e-9 <= bore[0].deflection <= chord + 1e-8
     for radius, sides, fits in ((9.9, 64, False), (10.0, 12, True)):
         peg = trimesh.creation.cylinder(radius=radius * MM, height=30 * MM, sections=sides)
-        slides = sweep.zero_clearance_fits({"peg": sweep.fit_faces(peg), "plate": sweep.fit_faces(plate)})
+        slides = zero_clearance_fits({"peg": fit_faces(peg), "plate": fit_faces(plate)})
         assert [(s.shaft, s.bore, s.seated) for s in slides] == ([("peg", "plate", True)] if fits else [])
-    assert slides[0].tolerance == pytest.approx(10 * MM * (1 - math.cos(math.pi / 12)) + sweep.TOUCH, abs=1e-9)
+    assert slides[0].tolerance == pytest.approx(10 * MM * (1 - math.cos(math.pi / 12)) + TOUCH, abs=1e-9)
     # Chords of 55° and 5° in turn meet smoothly (turning 30°) but lie up to 11% of the
     # radius inside the circle, beyond a 35° chord's 4.6%: a faceted peg, no cylinder.
     turns = np.radians(np.cumsum(np.tile([55.0, 5.0], 6)))
@@ -404,10 +405,10 @@ def test_the_clutchs_spline_shaft_in_a_plate_with_0_2_mm_of_room_is_no_zero_clea
     # circle at the axis's foot). The arcs are cylinders of their 1° chords' deflection.
     corpus = Path(__file__).parent / "corpus" / "flynn_clutch" / "meshes"
     meshes = {pid: trimesh.load(corpus / f"{pid}.stl").apply_scale(MM) for pid in ("inner_holder", "inner_plate_a")}
-    faces = {pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()}
-    arcs = [f for f in faces["inner_plate_a"] if isinstance(f, sweep.CylinderFace) and not f.outward]
+    faces = {pid: fit_faces(mesh) for pid, mesh in meshes.items()}
+    arcs = [f for f in faces["inner_plate_a"] if isinstance(f, CylinderFace) and not f.outward]
     assert len(arcs) == 24 and max(f.deflection for f in arcs) < 1e-6
-    assert sweep.zero_clearance_fits(faces) == []
+    assert zero_clearance_fits(faces) == []
 
 
 def test_convexity_is_decided_as_the_hull_volume_decides_it() -> None:
@@ -441,7 +442,7 @@ def test_the_leading_triangles_change_no_answer(monkeypatch: pytest.MonkeyPatch)
 def test_sweeps_in_two_processes_give_the_answers_and_queries_of_one() -> None:
     parts = _shaft_in_bearing()
     meshes = {p.id: p.mesh for p in parts}
-    slides = sweep.zero_clearance_fits({pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()})
+    slides = zero_clearance_fits({pid: fit_faces(mesh) for pid, mesh in meshes.items()})
     requests = [(pid, np.array(vector), 0.3) for pid in ("bearing", "shaft") for vector in sweep.DIRECTIONS.values()]
     requests.append((["bearing", "shaft"], np.array(sweep.DIRECTIONS["+z"]), 3e-3))  # moved as one
     found = []
@@ -460,7 +461,7 @@ def test_sweeps_in_two_processes_give_the_answers_and_queries_of_one() -> None:
 def test_a_sweep_entailed_by_one_along_the_same_direction_is_not_queried_and_answers_as_queried() -> None:
     parts = _shaft_in_bearing()
     meshes = {p.id: p.mesh for p in parts}
-    slides = sweep.zero_clearance_fits({pid: sweep.fit_faces(mesh) for pid, mesh in meshes.items()})
+    slides = zero_clearance_fits({pid: fit_faces(mesh) for pid, mesh in meshes.items()})
     along, up = np.array(sweep.DIRECTIONS["+x"]), np.array(sweep.DIRECTIONS["+z"])
     # the bearing slides free along x a long way, so a short way too; lifted a little it meets both, so further too
     first = [("bearing", along, 0.3), ("bearing", up, 3e-3)]
@@ -491,5 +492,5 @@ def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
                  - np.min(np.einsum("mvc,mc->mv", fixed.corners[found], toward), axis=1))
         order = np.argsort(-reach, kind="stable")[:sweep.LIKELY]
         chosen.append(sweep._likely(piece, fixed))
-        assert set(chosen[-1]) == set(found[order[reach[order] > sweep.TOUCH]])
+        assert set(chosen[-1]) == set(found[order[reach[order] > TOUCH]])
     assert all(len(c) == sweep.LIKELY for c in chosen)

@@ -18,8 +18,9 @@ import trimesh
 from assembly_constraints.cli import main
 from bridge.product import CONVEX_HEADER
 from executor.cad.convex import NOMINAL_OVERLAP, PIECE_VERTICES, _beyond, _hull_planes, _planes, fitting_pieces, reduced
+from executor.cad.fits.faces import TOUCH
 from executor.cad.sections import edge_distance, slice_loops
-from executor.cad.sweep import TOUCH, bvh, convex_object
+from executor.cad.sweep import bvh, convex_object
 from executor.cad.write import CELL_DEFLECTION
 from executor.world.geometry import load_geometry
 from executor.world.meshes import read_objects

@@ -14,9 +14,9 @@ import trimesh
 
 from executor import ExecutorError
 from executor.cad.derive import derive
+from executor.cad.fits.threads import cosmetic_thread, screwed_pairs
 from executor.cad.operations import cell_view
 from executor.cad.parts import CadPart, _check_overlaps, load_meshes
-from executor.cad.sweep import cosmetic_thread, screwed_pairs
 from tests.conftest import Runner
 
 CORPUS = Path(__file__).parent / "corpus"
