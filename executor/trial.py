@@ -42,8 +42,9 @@ from executor.skills.insertion import (
 )
 from executor.skills.search import hole_search
 from executor.world import SIZE_RESOLUTION
-from executor.world.arm import Arm, aligned_yaw, tool_quat
+from executor.world.arm import Arm, tool_quat
 from executor.world.assets import current_assets
+from executor.world.frames import aligned_yaw
 from executor.world.geometry import fit_pose, load_geometry, margin
 from executor.world.perturbation import CellBias
 from executor.world.scene import TIME_STEP, Scene, hole_rims, require_display, scene_shapes

@@ -65,8 +65,8 @@ from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionTask, insert_in_layer, needs_yaw_compliance
 from executor.skills.search import hole_search
 from executor.trial import APPROACH_HEIGHT, REACH_TOLERANCE, trial_rng
-from executor.world.arm import aligned_yaw, tool_quat, turn_z, yaw_quat
-from executor.world.frames import HoleFrame
+from executor.world.arm import tool_quat, turn_z
+from executor.world.frames import HoleFrame, aligned_yaw, yaw_quat
 from executor.world.geometry import fit_pose, margin
 from executor.world.perturbation import CellBias
 from executor.world.scene import PART_FRICTION, inertial_frame

@@ -34,8 +34,8 @@ from bridge.cli_types import ArgumentParser, add_assembly_argument
 from executor import ExecutorError
 from executor.campaign.run import stdout_to_stderr
 from executor.franka.sim_scene import TIME_STEP, contact_force, product_model
-from executor.world.arm import aligned_yaw, yaw_quat
 from executor.world.assets import current_assets
+from executor.world.frames import aligned_yaw, yaw_quat
 from executor.world.geometry import CellGeometry, HoleSpec, PartSpec, load_geometry, passes
 from executor.world.scene import PART_FRICTION, TEACH_FRICTION, connect, load_plate
 

@@ -45,8 +45,8 @@ from executor.skills.dmp import Skill, load_product_skill
 from executor.skills.insertion import InsertionResult, InsertionTask, insert_in_layer, needs_yaw_compliance
 from executor.skills.search import SearchResult, hole_search
 from executor.trial import APPROACH_HEIGHT
-from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat
-from executor.world.frames import HoleFrame, hole_frame
+from executor.world.arm import quat_to_matrix, tool_quat
+from executor.world.frames import HoleFrame, aligned_yaw, hole_frame
 from executor.world.geometry import CellGeometry, PartSpec, fit_pose
 
 OPEN_MARGIN = 0.02  # [m] the fingers open this much wider than the part before a pick
@@ -85,7 +85,7 @@ def axis_turn(a: np.ndarray, b: np.ndarray) -> float:
 
 def wrist_yaw(frame: HoleFrame | None, part_kind: str, hole_kind: str, yaw: float) -> float:
     """The tool yaw [rad] in a hole's ``frame`` for the pair's aligned ``yaw``
-    (:func:`executor.world.arm.aligned_yaw`): for a round part or hole entered sideways,
+    (:func:`executor.world.frames.aligned_yaw`): for a round part or hole entered sideways,
     whose yaw is free, the quarter turn from it that turns the hand least from pointing
     down (along +x the frame's x is the cell's y: yaw 0 would turn the hand by 120° about
     a skew axis, -π/2 pitches it by 90°; docs/franka.md); else ``yaw``."""

@@ -48,8 +48,9 @@ from executor.skills.dmp import (
     save_skill,
     xyzw_to_wxyz,
 )
-from executor.world.arm import aligned_yaw, tool_quat, turn_quats_z, turn_z
+from executor.world.arm import tool_quat, turn_quats_z, turn_z
 from executor.world.assets import regenerate_assets
+from executor.world.frames import aligned_yaw
 from executor.world.geometry import CellGeometry, fit_pose
 from executor.world.scene import TIME_STEP
 

@@ -36,11 +36,6 @@ def tool_quat(yaw: float) -> np.ndarray:
     return np.array([math.cos(yaw / 2), math.sin(yaw / 2), 0.0, 0.0])
 
 
-def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
-    """The rotation by ``yaw`` [rad] about z (xyzw): a turned hole's or boss's orientation."""
-    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
-
-
 def turn_z(vectors: np.ndarray, yaw: float) -> np.ndarray:
     """Vectors (..., 3) turned by ``yaw`` [rad] about z (returned unchanged at yaw 0)."""
     if yaw == 0.0:
@@ -60,21 +55,6 @@ def turn_quats_z(quats_xyzw: np.ndarray, yaw: float) -> np.ndarray:
     s, c = math.sin(yaw / 2), math.cos(yaw / 2)
     x, y, z, w = (quats_xyzw[..., k] for k in range(4))
     return np.stack([c * x - s * y, c * y + s * x, c * z + s * w, c * w - s * z], axis=-1)
-
-
-def aligned_yaw(part_kind: str, hole_kind: str, yaw: float) -> float:
-    """The tool yaw [rad] that puts a part of ``part_kind`` along a hole of ``hole_kind``
-    whose x axis is at ``yaw`` [rad]: 0 when either is round (nothing to align), else
-    ``yaw`` reduced by the symmetry of the pair (a quarter turn when either is square,
-    a half turn for rect in rect, a whole turn with a polygon: its ``yaw`` includes the
-    turn the polygon relation found,
-    :func:`executor.world.geometry.fit_pose`) into the half period
-    around 0, the smallest turn of the wrist."""
-    if "round" in (part_kind, hole_kind):
-        return 0.0
-    kinds = (part_kind, hole_kind)
-    period = 2 * math.pi if "polygon" in kinds else math.pi / 2 if "square" in kinds else math.pi
-    return yaw - period * round(yaw / period)
 
 
 def quat_to_matrix(quat_xyzw: np.ndarray) -> np.ndarray:

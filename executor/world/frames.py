@@ -10,10 +10,14 @@ the insertion), its x and y are the axes its section was measured in
 feed-forward wrench into the cell frame and every reading (tip pose, velocities,
 Jacobian, wrench) out of it, so the same skill code runs in it unchanged; a hole entered
 down has no frame (the identity, and its trials are unchanged bit for bit).
+
+A hole's yaw about z is here too: the rotation it turns a hole or a boss by
+(:func:`yaw_quat`) and the tool yaw that aligns a part with it (:func:`aligned_yaw`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -104,3 +108,23 @@ def hole_frame(axis: str, entry: tuple[float, float, float]) -> HoleFrame | None
         return None
     rotation = hole_rotation(axis)
     return HoleFrame(rotation, np.array(entry, dtype=float), _quat_of(rotation))
+
+
+def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
+    """The rotation by ``yaw`` [rad] about z (xyzw): a turned hole's or boss's orientation."""
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
+def aligned_yaw(part_kind: str, hole_kind: str, yaw: float) -> float:
+    """The tool yaw [rad] that puts a part of ``part_kind`` along a hole of ``hole_kind``
+    whose x axis is at ``yaw`` [rad]: 0 when either is round (nothing to align), else
+    ``yaw`` reduced by the symmetry of the pair (a quarter turn when either is square,
+    a half turn for rect in rect, a whole turn with a polygon: its ``yaw`` includes the
+    turn the polygon relation found,
+    :func:`executor.world.geometry.fit_pose`) into the half period
+    around 0, the smallest turn of the wrist."""
+    if "round" in (part_kind, hole_kind):
+        return 0.0
+    kinds = (part_kind, hole_kind)
+    period = 2 * math.pi if "polygon" in kinds else math.pi / 2 if "square" in kinds else math.pi
+    return yaw - period * round(yaw / period)

@@ -60,8 +60,7 @@ from bridge.product import (
 from bridge.product.nominal import NOMINAL_FIT_ROOM, models_nominal_fits
 from executor import ExecutorError
 from executor.cell_description import CellDescription
-from executor.world.arm import aligned_yaw, yaw_quat
-from executor.world.frames import HoleFrame, hole_frame
+from executor.world.frames import HoleFrame, aligned_yaw, hole_frame, yaw_quat
 from executor.world.meshes import (
     URDF_HULL_MARGIN,
     MeshBody,
@@ -429,7 +428,7 @@ def fit_pose(part: Section, hole: HoleSpec) -> tuple[float, np.ndarray]:
     """The part's yaw [rad] in the hole's frame and its origin's offset (x, y) [m] from the
     hole's position in the cell's axes where the polygon relation passes it (:func:`section_fit`);
     (0, 0) for pairs of round, square and rect sections (the skill aligns those itself,
-    :func:`executor.world.arm.aligned_yaw`). A part with a bore onto a pin: the relation
+    :func:`executor.world.frames.aligned_yaw`). A part with a bore onto a pin: the relation
     places the pin in the bore, so the part's pose is that placement's inverse."""
     if "polygon" not in (part.kind, hole.kind):
         return 0.0, np.zeros(2)
@@ -458,7 +457,7 @@ def seat(peg: Section, hole: HoleSpec, stacked: float = 0.0) -> np.ndarray:
 def seated_pose(peg: Section, hole: HoleSpec) -> tuple[np.ndarray, tuple[float, float, float, float]]:
     """The body pose (position [m], quaternion xyzw) of a peg at its goal in ``hole``, a hole
     entered down (:func:`seat`), turned as the cell inserts it without errors
-    (:func:`executor.world.arm.aligned_yaw` of the hole's yaw and the relation's turn)."""
+    (:func:`executor.world.frames.aligned_yaw` of the hole's yaw and the relation's turn)."""
     return seat(peg, hole), yaw_quat(aligned_yaw(peg.kind, hole.kind, hole.yaw + fit_pose(peg, hole)[0]))
 
 

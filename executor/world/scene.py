@@ -24,8 +24,9 @@ import pybullet_data
 
 from executor import ExecutorError
 from executor.world import TIME_STEP
-from executor.world.arm import turn_z, yaw_quat
+from executor.world.arm import turn_z
 from executor.world.assets import current_assets
+from executor.world.frames import yaw_quat
 from executor.world.geometry import (
     CellGeometry,
     PartSpec,

@@ -12,7 +12,8 @@ import pytest
 
 from bridge.assembly import load_assembly
 from bridge.cell_settings import Magnitudes
-from executor.world.arm import aligned_yaw, quat_to_matrix, tool_quat, turn_quats_z, turn_z
+from executor.world.arm import quat_to_matrix, tool_quat, turn_quats_z, turn_z
+from executor.world.frames import aligned_yaw
 from executor.world.geometry import (
     HoleSpec,
     PartSpec,
