@@ -131,6 +131,11 @@ _PIN_LEVELS = 64
 """How many spans :func:`_pin_of` measures a part's bore and its pin over, split at the ends of the longest."""
 
 
+_CLOSED_AREA = 1e-12
+"""A hole's narrowest section over its stretch of at most this area [m², 1 µm²] is closed:
+the sliver its faces leave where they meet (a cavity's ceiling seen from below)."""
+
+
 @dataclass(frozen=True)
 class HoleFit:
     """A hole of the base (``id`` h1, h2, ... by position) entered against ``axis`` (the
@@ -505,6 +510,22 @@ def forced(derived: Derived) -> dict[tuple[str, str], str]:
 def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> float | None:
     """Distance [m] along the unit ``direction`` from ``origin`` to the first triangle of
     ``mesh`` (Möller-Trumbore over all triangles), None when the ray meets none."""
+    t, _ = _hits(mesh, origin, direction)
+    return float(t.min()) if len(t) else None
+
+
+def _roofed(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> bool:
+    """Whether the first triangle of ``mesh`` the ray from ``origin`` along the unit
+    ``direction`` meets faces it (its outward normal against the ray): the ray goes into
+    the solid there, as up a pocket cut into a base's underside to its ceiling."""
+    t, facing = _hits(mesh, origin, direction)
+    return bool(len(t)) and bool(facing[np.argmin(t)])
+
+
+def _hits(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distances [m] along the unit ``direction`` from ``origin`` at which the ray
+    meets triangles of ``mesh`` (Möller-Trumbore over all triangles), and whether each
+    triangle met faces the ray."""
     a, b, c = (mesh.triangles[:, k] for k in range(3))
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)
@@ -517,7 +538,7 @@ def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) 
     v = (q @ direction) * inv
     t = np.einsum("ij,ij->i", e2, q) * inv
     hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-9)
-    return float(t[hit].min()) if np.any(hit) else None
+    return t[hit], det[hit] > 0  # det = -direction . (e1 x e2)
 
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
@@ -604,6 +625,8 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
                 np.array(f.centre) - centre - axis * np.dot(np.array(f.centre) - centre, axis)) < _SAME_HOLE]
             if same and (occupant is None or fits[same[0]].part is not None):
                 continue
+            if occupant is None and _roofed(base.mesh, centre, axis):
+                continue  # empty and roofed along its axis: a cavity open the other way (a brick's underside)
             # a hole met empty at another part's level (a shallower one beside a deeper) is its occupant's
             fit = _measure(base, name, loop, level, around[0] if around else None, occupant, workers)
             if same:
@@ -1140,6 +1163,12 @@ def _fields(fit: HoleFit) -> tuple:
     return (fit.axis, fit.hole, fit.centre, fit.entry, fit.depth, fit.chamfer, fit.outer, fit.part, fit.section)
 
 
+def _closed(section: Loop) -> bool:
+    """Whether a hole's narrowest ``section`` over its stretch leaves nothing free: under
+    three points, or of at most :data:`_CLOSED_AREA`."""
+    return len(section.points) < 3 or section.area <= _CLOSED_AREA
+
+
 def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
              occupant: tuple[CadPart, Loop] | None, workers: int = 1) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
@@ -1171,10 +1200,10 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         spans.append((occupant[1], occupant[0].mesh, tip, False))
     narrowest, *occupied = forked_map(lambda span: over_span(span[0], span[1], axis, span[2], entry, hole=span[3]),
                                       spans, workers)
-    if occupant is None and len(narrowest.points) < 3:  # a floor not across the axis (a drill point's cone)
+    if occupant is None and _closed(narrowest):  # a floor not across the axis (a drill point's cone)
         low = level
         narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
-    if len(narrowest.points) < 3:
+    if _closed(narrowest):
         x, y, z = 1e3 * (frame.T @ sliced.centre + axis * level)
         raise ExecutorError(f"the hole of part {base.id} at ({x:.3f}, {y:.3f}, {z:.3f}) mm is closed between "
                             f"{1e3 * (entry - low):.3f} mm below its entry and its entry along {name[1:]} "

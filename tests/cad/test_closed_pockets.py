@@ -1,0 +1,41 @@
+"""A base's empty cavity that opens on its far side (a pocket cut up from its underside, a
+Lego brick's inside) is no hole along the axis it is sliced on: the import goes on without
+it, and measures the base's other empty holes as before."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import shapely
+import trimesh
+
+from executor.cad.cli import run_import
+
+
+def _write(folder: Path) -> None:
+    """A 60 x 60 x 20 mm block with a d 10 pocket 12 mm up from its underside (closed
+    above) and a d 8 hole through it, and a 20 x 20 x 5 mm plate lying on its top, as STL
+    [mm]."""
+    folder.mkdir()
+    block = trimesh.creation.box((60.0, 60.0, 20.0))
+    block.apply_translation((0.0, 0.0, 10.0))
+    pocket = trimesh.creation.extrude_polygon(shapely.Point(-15.0, 0.0).buffer(5.0, quad_segs=16), 12.0)
+    pocket.apply_translation((0.0, 0.0, -1.0))
+    through = trimesh.creation.extrude_polygon(shapely.Point(15.0, 0.0).buffer(4.0, quad_segs=16), 22.0)
+    through.apply_translation((0.0, 0.0, -1.0))
+    trimesh.boolean.difference([block, pocket, through], engine="manifold").export(folder / "block.stl")
+    plate = trimesh.creation.box((20.0, 20.0, 5.0))
+    plate.apply_translation((0.0, 20.0, 22.5))
+    plate.export(folder / "plate.stl")
+
+
+def test_pocket_open_on_the_far_side_is_no_hole(tmp_path: Path) -> None:
+    # Sliced at the block's middle along +z, the pocket's loop has nothing free up to the
+    # block's top: the import stopped on it ("the hole of part block ... is closed").
+    _write(tmp_path / "meshes")
+    derived = run_import(tmp_path / "meshes", tmp_path / "out", "mm", None).derived
+    assert derived.base == "block"
+    holes = list(derived.holes.values())
+    assert len(holes) == 1 and holes[0].part is None
+    assert holes[0].hole.kind == "round" and abs(holes[0].hole.a - 0.008) < 1e-4
+    assert derived.axis["plate"] == "+z"
