@@ -6,10 +6,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import shapely
 import trimesh
 
 from executor.cad.cli import run_import
+from executor.cad.derive import _closed
+from executor.cad.sections import Loop
 
 
 def _write(folder: Path) -> None:
@@ -39,3 +42,12 @@ def test_pocket_open_on_the_far_side_is_no_hole(tmp_path: Path) -> None:
     assert len(holes) == 1 and holes[0].part is None
     assert holes[0].hole.kind == "round" and abs(holes[0].hole.a - 0.008) < 1e-4
     assert derived.axis["plate"] == "+z"
+
+
+def test_a_sliver_of_no_area_is_a_closed_section() -> None:
+    # The narrowest section of a Lego brick's underside cavity over its stretch came out
+    # as three points on one line (two faces meeting): read as open, classify() divided
+    # by its zero width (ZeroDivisionError) instead of refusing the hole as closed.
+    sliver = Loop(np.array([[0.5537604, -0.0035801], [0.554799, -0.0044975], [0.5537604, -0.0035801]]))
+    assert _closed(sliver) and _closed(Loop(np.zeros((0, 2))))
+    assert not _closed(Loop(np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])))  # 0.5 mm²
