@@ -1363,6 +1363,39 @@ def lone_thread(meshes: dict[str, trimesh.Trimesh]) -> str:
     return ""
 
 
+def _plain_bore(male: Thread, screw: trimesh.Trimesh, nut: trimesh.Trimesh, overlap: tuple[float, float]
+                ) -> Slide | None:
+    """The thread ``male`` of ``screw`` in a plain bore of ``nut`` drawn at its crest
+    diameter (a clearance or tapped hole drawn at the screw's nominal size), or None:
+    ``nut``'s innermost surface about the thread's axis, over the thread's span within
+    ``overlap`` [m] (where both parts are, along the axis from the thread's point), a ring
+    whose crossings lie between its largest radius and that less :data:`COARSEST` of it (a
+    tessellated cylinder's chords), and the crest's vertex circle there within the two
+    tessellations' deflections (the ring's spread, the crest's vertices beyond its
+    crossings) plus :data:`TOUCH` of that largest radius. A zero-clearance fit (pitch 0),
+    no screwed pair: the screw's thread taken in to under the bore's least radius, it
+    slides along the axis out of the bore."""
+    low, high = max(male.span[0], overlap[0]) + TOUCH, min(male.span[1], overlap[1]) - TOUCH
+    if high <= low:
+        return None
+    levels = np.linspace(low, high, THREAD_SAMPLES // 8)
+    profiles = thread_profiles(nut, male.point, male.direction, levels, outermost=False)
+    if np.isnan(profiles).any():
+        return None
+    least, largest = float(profiles.min()), float(profiles.max())
+    relative = screw.vertices - male.point
+    along = relative @ male.direction
+    radii = np.linalg.norm(relative - np.outer(along, male.direction), axis=1)
+    crest = float(radii[(along >= low) & (along <= high)].max(initial=male.outer))
+    if (largest - least > COARSEST * largest
+            or abs(crest - largest) > largest - least + crest - male.outer + TOUCH):
+        return None
+    reach = crest - least + TOUCH
+    face = CylinderFace(male.point, male.direction, crest, male.span, True, 0.0)
+    hole = CylinderFace(male.point, male.direction, largest, male.span, False, 0.0)
+    return Slide("", "", face, hole, reach, reach + TOUCH, True)
+
+
 def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: tuple[float, float]) -> Slide | None:
     """The screwed pair (:func:`screwed_pairs`) of ``screw`` in ``nut`` along the frame's
     ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None."""
@@ -1374,7 +1407,9 @@ def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: t
     if male is None:
         return None
     female = _thread(nut, point, direction, overlap, outermost=False)
-    if (female is None or abs(male.pitch - female.pitch) > 0.02 * male.pitch
+    if female is None:
+        return _plain_bore(male, screw, nut, overlap)
+    if (abs(male.pitch - female.pitch) > 0.02 * male.pitch
             or abs(male.lead - female.lead) > 0.02 * abs(male.lead) or male.outer <= female.inner):
         return None
     reach = male.outer - female.inner + TOUCH
