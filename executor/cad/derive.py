@@ -131,11 +131,6 @@ _PIN_LEVELS = 64
 """How many spans :func:`_pin_of` measures a part's bore and its pin over, split at the ends of the longest."""
 
 
-_CLOSED_AREA = 1e-12
-"""A hole's narrowest section over its stretch of at most this area [m², 1 µm²] is closed:
-the sliver its faces leave where they meet (a cavity's ceiling seen from below)."""
-
-
 @dataclass(frozen=True)
 class HoleFit:
     """A hole of the base (``id`` h1, h2, ... by position) entered against ``axis`` (the
@@ -1163,12 +1158,6 @@ def _fields(fit: HoleFit) -> tuple:
     return (fit.axis, fit.hole, fit.centre, fit.entry, fit.depth, fit.chamfer, fit.outer, fit.part, fit.section)
 
 
-def _closed(section: Loop) -> bool:
-    """Whether a hole's narrowest ``section`` over its stretch leaves nothing free: under
-    three points, or of at most :data:`_CLOSED_AREA`."""
-    return len(section.points) < 3 or section.area <= _CLOSED_AREA
-
-
 def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
              occupant: tuple[CadPart, Loop] | None, workers: int = 1) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
@@ -1200,10 +1189,10 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
         spans.append((occupant[1], occupant[0].mesh, tip, False))
     narrowest, *occupied = forked_map(lambda span: over_span(span[0], span[1], axis, span[2], entry, hole=span[3]),
                                       spans, workers)
-    if occupant is None and _closed(narrowest):  # a floor not across the axis (a drill point's cone)
+    if occupant is None and len(narrowest.points) < 3:  # a floor not across the axis (a drill point's cone)
         low = level
         narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
-    if _closed(narrowest):
+    if len(narrowest.points) < 3:
         x, y, z = 1e3 * (frame.T @ sliced.centre + axis * level)
         raise ExecutorError(f"the hole of part {base.id} at ({x:.3f}, {y:.3f}, {z:.3f}) mm is closed between "
                             f"{1e3 * (entry - low):.3f} mm below its entry and its entry along {name[1:]} "

@@ -11,8 +11,7 @@ import shapely
 import trimesh
 
 from executor.cad.cli import report, run_import
-from executor.cad.derive import _closed
-from executor.cad.sections import Loop
+from executor.cad.sections import Loop, classify
 
 
 def _write(folder: Path, *, through: bool = True) -> None:
@@ -55,10 +54,10 @@ def test_a_product_with_no_hole_and_no_pin_is_named(tmp_path: Path) -> None:
     assert [line for line in report(derived) if line.startswith("no hole and no pin found: sizes.lp names no part")]
 
 
-def test_a_sliver_of_no_area_is_a_closed_section() -> None:
+def test_a_sliver_of_no_area_is_a_polygon() -> None:
     # The narrowest section of a Lego brick's underside cavity over its stretch came out
-    # as three points on one line (two faces meeting): read as open, classify() divided
-    # by its zero width (ZeroDivisionError) instead of refusing the hole as closed.
+    # as three points on one line (two faces meeting): classify() divided by its zero
+    # width (ZeroDivisionError). It is a polygon, so the empty loop is a pocket, no hole.
     sliver = Loop(np.array([[0.5537604, -0.0035801], [0.554799, -0.0044975], [0.5537604, -0.0035801]]))
-    assert _closed(sliver) and _closed(Loop(np.zeros((0, 2))))
-    assert not _closed(Loop(np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])))  # 0.5 mm²
+    shape = classify(sliver, hole=True)
+    assert shape.kind == "polygon" and shape.b == 0.0 and shape.a > 0
