@@ -3,7 +3,7 @@
 SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assembled pose
 (``--units``). ``--config FILE`` is an optional TOML file::
 
-    base = "plate"            # the fixture part (default: the part of largest volume)
+    base = "plate"            # the fixture part (default: the part of largest volume, the lowest of alike ones)
     up = "+y"                 # the CAD's axis pointing up (default +z): +x, -x, +y, -y, +z or -z
     [parts.peg1]
     tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: laid out by footprints)
@@ -195,6 +195,11 @@ def _settings_file(path: Path | None) -> dict:
         raise ExecutorError(f"{path}: not valid TOML ({exc})") from None
 
 
+ALIKE_VOLUME = 1e-6
+"""Parts whose volumes are within this fraction of the largest are alike (one part drawn
+again: stacked bricks); the default base is the lowest of them (its bottom, up being +z)."""
+
+
 def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
             ) -> tuple[Settings, dict[str, str], list[str], tuple[float, float] | None]:
     """The settings of ``--config`` (``data``, read from ``path``; checked: one line
@@ -204,8 +209,11 @@ def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
     assumed: list[str] = []
     base = data.get("base")
     if base is None:
-        base = max(parts, key=lambda p: p.mesh.volume).id
-        assumed.append(f"base {base} (the largest part; set base = \"<id>\")")
+        largest = max(p.mesh.volume for p in parts)
+        alike = [p for p in parts if p.mesh.volume >= (1 - ALIKE_VOLUME) * largest]
+        base = min(alike, key=lambda p: (float(p.mesh.bounds[0][2]), p.id)).id
+        lowest = f", the lowest of {len(alike)} alike" if len(alike) > 1 else ""
+        assumed.append(f"base {base} (the largest part{lowest}; set base = \"<id>\")")
     elif base not in ids:
         raise ExecutorError(f"{path}: base: expected a part id ({', '.join(sorted(ids))}), got {shorten(repr(base))}")
     tables = data.get("parts", {})
@@ -314,6 +322,10 @@ def report(derived: Derived) -> list[str]:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
                      f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon with no "
                      "rotational symmetry about its centre, no hole")
+    if not (derived.holes or derived.part_holes or derived.pins):
+        lines.append("no hole and no pin found: sizes.lp names no part and no hole, and `plan` and `session` "
+                     "need a part in a hole or on a pin (geometric_precedence.lp holds the order, "
+                     "for `precedence learn`)")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     for pid, by_direction in sorted(derived.located.items()):
         lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(

@@ -525,6 +525,22 @@ def forced(derived: Derived) -> dict[tuple[str, str], str]:
 def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> float | None:
     """Distance [m] along the unit ``direction`` from ``origin`` to the first triangle of
     ``mesh`` (Möller-Trumbore over all triangles), None when the ray meets none."""
+    t, _ = _hits(mesh, origin, direction)
+    return float(t.min()) if len(t) else None
+
+
+def _roofed(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> bool:
+    """Whether the first triangle of ``mesh`` the ray from ``origin`` along the unit
+    ``direction`` meets faces it (its outward normal against the ray): the ray goes into
+    the solid there, as up a pocket cut into a base's underside to its ceiling."""
+    t, facing = _hits(mesh, origin, direction)
+    return bool(len(t)) and bool(facing[np.argmin(t)])
+
+
+def _hits(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distances [m] along the unit ``direction`` from ``origin`` at which the ray
+    meets triangles of ``mesh`` (Möller-Trumbore over all triangles), and whether each
+    triangle met faces the ray."""
     a, b, c = (mesh.triangles[:, k] for k in range(3))
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)
@@ -537,7 +553,7 @@ def first_hit(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) 
     v = (q @ direction) * inv
     t = np.einsum("ij,ij->i", e2, q) * inv
     hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-9)
-    return float(t[hit].min()) if np.any(hit) else None
+    return t[hit], det[hit] > 0  # det = -direction . (e1 x e2)
 
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
@@ -624,6 +640,8 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
                 np.array(f.centre) - centre - axis * np.dot(np.array(f.centre) - centre, axis)) < _SAME_HOLE]
             if same and (occupant is None or fits[same[0]].part is not None):
                 continue
+            if occupant is None and _roofed(base.mesh, centre, axis):
+                continue  # empty and roofed along its axis: a cavity open the other way (a brick's underside)
             # a hole met empty at another part's level (a shallower one beside a deeper) is its occupant's
             fit = _measure(base, name, loop, level, around[0] if around else None, occupant, workers)
             if same:

@@ -716,6 +716,8 @@ def classify(loop: Loop, *, hole: bool, round_ok: bool = True) -> Shape2D:
         d = 2 * (inner if hole else outer)
         return Shape2D("round", d, d, 0.0, centre, outline=outline, deflection=outer - inner)
     a, b, angle = _min_rectangle(points)
+    if b <= 0:  # points on one line (two faces meeting): no rect to fit, a sliver of no area
+        return Shape2D("polygon", a, b, 0.0, centre, outline=outline)
     c, s = math.cos(angle), math.sin(angle)
     turned = points @ np.array([[c, -s], [s, c]])  # side a along the first axis
     local = turned - (turned.max(axis=0) + turned.min(axis=0)) / 2

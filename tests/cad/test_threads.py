@@ -207,3 +207,21 @@ def test_the_screw_goes_after_the_plate_it_clamps_on_its_nut() -> None:
     assert derived.reasons[("plate", "screw")] == "blocks"
     assert ("screw", "plate") not in derived.reasons
     assert set(cell_view(derived)[1]) == {"screw"}
+
+
+def test_a_thread_in_a_plain_hole_of_its_crest_diameter_slides_out() -> None:
+    # The nut replaced by a plate as thick whose hole is drawn at the thread's crest
+    # diameter (a hole drawn at the screw's nominal size, as build123d's joint tutorial
+    # draws an M6 screw's in its box): the 96-gon's chords cut into the crests, so every
+    # straight way out collided and the screw never came out. It is a zero-clearance fit,
+    # no screwed pair: the screw slides out of the plate along its axis.
+    [screw] = [p for p in load_meshes(CORPUS / "bosl2_screw_nut" / "meshes", "mm") if p.id == "screw"]
+    inside = (screw.mesh.vertices[:, 2] > 0.5e-3) & (screw.mesh.vertices[:, 2] < 5.5e-3)
+    crest = float(np.linalg.norm(screw.mesh.vertices[inside, :2], axis=1).max())  # its vertex circle
+    plate = trimesh.creation.annulus(r_min=crest, r_max=15e-3, height=6.095e-3, sections=96)
+    plate.apply_translation([0.0, 0.0, 6.095e-3 / 2])
+    derived = derive([screw, CadPart("plate", "plate", plate, "plate")], "plate", {})
+    [plain] = derived.slides
+    assert (plain.shaft, plain.bore, plain.pitch, plain.seated) == ("screw", "plate", 0.0, True)
+    assert plain.face.radius == pytest.approx(crest, abs=1e-9)
+    assert derived.axis == {"screw": "+z"}

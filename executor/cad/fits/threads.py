@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import trimesh
 
-from executor.cad.fits.faces import TOUCH, CylinderFace, PrismFace, Slide, _seated
+from executor.cad.fits.faces import COARSEST, TOUCH, CylinderFace, PrismFace, Slide, _seated
 from executor.cad.sweep import axis_name
 
 THREAD_ANGLES = 8
@@ -238,10 +238,45 @@ def lone_thread(meshes: dict[str, trimesh.Trimesh]) -> str:
     return ""
 
 
+def _plain_bore(male: Thread, screw: trimesh.Trimesh, nut: trimesh.Trimesh, overlap: tuple[float, float]
+                ) -> Slide | None:
+    """The thread ``male`` of ``screw`` in a plain bore of ``nut`` drawn at its crest
+    diameter (a clearance or tapped hole drawn at the screw's nominal size), or None:
+    ``nut``'s innermost surface about the thread's axis, over the thread's span within
+    ``overlap`` [m] (where both parts are, along the axis from the thread's point), a ring
+    whose crossings lie between its largest radius and that less :data:`COARSEST` of it (a
+    tessellated cylinder's chords), and the crest's vertex circle there within the two
+    tessellations' deflections (the ring's spread, the crest's vertices beyond its
+    crossings) plus :data:`TOUCH` of that largest radius. A zero-clearance fit (pitch 0),
+    no screwed pair: the screw's thread taken in to under the bore's least radius, it
+    slides along the axis out of the bore."""
+    low, high = max(male.span[0], overlap[0]) + TOUCH, min(male.span[1], overlap[1]) - TOUCH
+    if high <= low:
+        return None
+    levels = np.linspace(low, high, THREAD_SAMPLES // 8)
+    profiles = thread_profiles(nut, male.point, male.direction, levels, outermost=False)
+    if np.isnan(profiles).any():
+        return None
+    least, largest = float(profiles.min()), float(profiles.max())
+    relative = screw.vertices - male.point
+    along = relative @ male.direction
+    radii = np.linalg.norm(relative - np.outer(along, male.direction), axis=1)
+    crest = float(radii[(along >= low) & (along <= high)].max(initial=male.outer))
+    if (largest - least > COARSEST * largest
+            or abs(crest - largest) > largest - least + crest - male.outer + TOUCH):
+        return None
+    reach = crest - least + TOUCH
+    face = CylinderFace(male.point, male.direction, crest, male.span, True, 0.0)
+    hole = CylinderFace(male.point, male.direction, largest, male.span, False, 0.0)
+    return Slide("", "", face, hole, reach, reach + TOUCH, True)
+
+
+
 def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: tuple[float, float]) -> Slide | None:
     """The screwed pair (:func:`screwed_pairs`) of ``screw`` in ``nut`` along the frame's
     ``axis`` (0, 1, 2) over the stretch ``overlap`` [m] along it where both are, or None:
-    the nut's thread modelled, or a plain round hole at the screw's tap drill (:func:`_tap_drill`)."""
+    the nut's thread modelled, or a plain round hole at the screw's tap drill (:func:`_tap_drill`);
+    a plain bore at its crest is a zero-clearance fit (:func:`_plain_bore`)."""
     direction = np.eye(3)[axis]
     across = [i for i in range(3) if i != axis]
     smaller = min((screw, nut), key=lambda m: float(np.prod(m.extents[across])))
@@ -254,7 +289,7 @@ def _screwed(screw: trimesh.Trimesh, nut: trimesh.Trimesh, axis: int, overlap: t
     if female is None:
         hole = _tap_drill(nut, male)
         if hole is None:
-            return None
+            return _plain_bore(male, screw, nut, overlap)
         reach = male.outer - hole.radius + hole.deflection + TOUCH
         return Slide("", "", face, hole, reach, reach + TOUCH, True, pitch=male.pitch, lead=male.lead,
                      thread="a modelled thread in a plain hole at its tap drill")
