@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
+import tomllib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -52,6 +53,21 @@ def teach(folder: Path) -> Path:
     finally:
         cell.close()
     return folder
+
+
+def import_on_base(cad: Path, folder: Path, base: str) -> Path:
+    """The meshes in ``cad`` imported (``./run.sh import``, in this process) with ``base`` the
+    fixture, its settings in ``folder/import.toml``, into ``folder/out``: that folder."""
+    (folder / "import.toml").write_text(f'base = "{base}"\n')
+    out = folder / "out"
+    assert main(["-q", "import", str(cad), "--out", str(out), "--config", str(folder / "import.toml")]) == 0
+    return out
+
+
+def manual_reasons(out: Path) -> dict[str, str]:
+    """Part id -> why the import in ``out`` placed it by hand (``[manual.*]`` of its ``geometry.toml``)."""
+    return {pid: entry["reason"] for pid, entry in tomllib.loads((out / "geometry.toml").read_text())
+            .get("manual", {}).items()}
 
 
 def learned_in_the_cell(run_main: Runner, folder: Path, run: Path) -> tuple[dict[str, Any], dict[tuple[str, str], str]]:

@@ -19,13 +19,12 @@ import pytest
 import shapely
 import trimesh
 
-from assembly_constraints.cli import main
 from bridge import BridgeError
 from bridge.product import load_product_description
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cell_description import CellDescription
-from tests.cad.conftest import learned_in_the_cell, teach
+from tests.cad.conftest import import_on_base, learned_in_the_cell, manual_reasons, teach
 from tests.conftest import Runner
 
 X_MM = 560.0
@@ -65,10 +64,7 @@ def _import(tmp: Path, block_x: float = 0.0, pocket: float = 20.4) -> Path:
     washer = shapely.Point(X_MM - 30, 0.0).buffer(7.0, quad_segs=32).difference(
         shapely.Point(X_MM - 30, 0.0).buffer(3.75, quad_segs=32))
     _prism(washer, 10, 14).export(cad / "washer.stl")
-    (tmp / "import.toml").write_text('base = "base"\n')
-    out = tmp / "out"
-    assert main(["-q", "import", str(cad), "--out", str(out), "--config", str(tmp / "import.toml")]) == 0
-    return out
+    return import_on_base(cad, tmp, "base")
 
 
 @pytest.fixture(scope="module")
@@ -77,15 +73,11 @@ def owned(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return _import(tmp_path_factory.mktemp("owned"))
 
 
-def _manual(out: Path) -> dict[str, str]:
-    return {pid: entry["reason"] for pid, entry in tomllib.loads((out / "geometry.toml").read_text())
-            .get("manual", {}).items()}
-
 
 @pytest.mark.slow  # the import: about 2 s
 def test_the_import_leaves_a_ring_onto_a_pin_of_a_block_the_cell_inserts_to_the_cell(owned: Path) -> None:
     geometry = tomllib.loads((owned / "geometry.toml").read_text())
-    assert _manual(owned) == {}
+    assert manual_reasons(owned) == {}
     assert geometry["part_shapes"]["block"]["demo_hole"] == "h1"
     pin = geometry["hole_shapes"]["block_pin1"]  # the block's pin, 20 mm above where the ring rests
     assert (pin["owner"], pin["top_z"], pin["depth"]) == ("block", 0.036, 0.02)
@@ -109,7 +101,7 @@ def test_a_pin_s_owner_is_placed_by_hand_or_a_peg_inserted_down(owned: Path, tmp
 def test_a_block_drawn_off_its_pocket_s_centre_leaves_the_ring_placed_by_hand(tmp_path: Path) -> None:
     # a 22 mm pocket, the block drawn 0.5 mm from its centre: the cell puts the block at the
     # pocket's centre, its pin would be 0.5 mm from the CAD's
-    assert _manual(_import(tmp_path, block_x=0.5, pocket=22.0)) == {
+    assert manual_reasons(_import(tmp_path, block_x=0.5, pocket=22.0)) == {
         "ring": "goes onto a pin of 'block' (block_pin1), a peg the cell inserts into hole h1: at its goal there "
                 "(centred, on the bottom) its pin is 0.500 mm from the CAD's (at most 0.1 mm)"}
 

@@ -15,8 +15,7 @@ import pytest
 import shapely
 import trimesh
 
-from assembly_constraints.cli import main
-from tests.cad.conftest import learned_in_the_cell, teach, trial_on_edited_mesh
+from tests.cad.conftest import import_on_base, learned_in_the_cell, manual_reasons, teach, trial_on_edited_mesh
 from tests.conftest import Runner
 
 X_MM = 560.0
@@ -48,10 +47,7 @@ def _import(tmp: Path) -> Path:
     for x in (X_MM - 20, X_MM + 20):
         plate = plate.difference(shapely.Point(x, 0.0).buffer(4.1, quad_segs=64))
     _prism(plate, 20, 25).export(cad / "plate.stl")
-    (tmp / "import.toml").write_text('base = "base"\n')
-    out = tmp / "out"
-    assert main(["-q", "import", str(cad), "--out", str(out), "--config", str(tmp / "import.toml")]) == 0
-    return out
+    return import_on_base(cad, tmp, "base")
 
 
 @pytest.fixture(scope="module")
@@ -60,15 +56,11 @@ def taught(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return teach(_import(tmp_path_factory.mktemp("pins_of")))
 
 
-def _manual(out: Path) -> dict[str, str]:
-    return {pid: entry["reason"] for pid, entry in tomllib.loads((out / "geometry.toml").read_text())
-            .get("manual", {}).items()}
-
 
 @pytest.mark.slow  # the import and the teaching: about 3 s of CPU
 def test_a_plate_onto_pins_of_the_base_and_a_block_placed_by_hand_is_the_cell_s(taught: Path) -> None:
     geometry = tomllib.loads((taught / "geometry.toml").read_text())
-    assert set(_manual(taught)) == {"block"}  # no operation for it: it lies on the base
+    assert set(manual_reasons(taught)) == {"block"}  # no operation for it: it lies on the base
     plate = geometry["part_shapes"]["plate"]
     assert (plate["demo_hole"], plate["pins_of"]) == ("base_pin1", ["block"])
     assert "block_pin1" not in geometry["hole_shapes"]  # its further pin: no hole of the cell

@@ -18,7 +18,7 @@ import trimesh
 from assembly_constraints.cli import main
 from bridge import BridgeError
 from bridge.product import load_product_description
-from tests.cad.conftest import learned_in_the_cell
+from tests.cad.conftest import import_on_base, learned_in_the_cell, manual_reasons
 from tests.conftest import Runner
 
 X_MM = 560.0
@@ -60,10 +60,7 @@ def _import(tmp_path: Path, nut_low: float = 14.0, washer_bore: float = 9.0, nut
     _nut(20, washer_bore, X_MM - 25, 10, 14).export(cad / "washer.stl")
     _nut(18, nut_bore, X_MM - 25, nut_low, nut_low + 6).export(cad / "nut.stl")
     _nut(18, 11, X_MM + 25, 20, 24).export(cad / "arm.stl")
-    (tmp_path / "import.toml").write_text('base = "plate"\n')
-    out = tmp_path / "out"
-    assert main(["-q", "import", str(cad), "--out", str(out), "--config", str(tmp_path / "import.toml")]) == 0
-    return out
+    return import_on_base(cad, tmp_path, "plate")
 
 
 @pytest.fixture(scope="module")
@@ -72,16 +69,12 @@ def stacked(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return _import(tmp_path_factory.mktemp("stacked"))
 
 
-def _manual(out: Path) -> dict[str, str]:
-    return {pid: entry["reason"] for pid, entry in tomllib.loads((out / "geometry.toml").read_text())
-            .get("manual", {}).items()}
-
 
 @pytest.mark.slow  # the import: about 2 s
 def test_the_import_leaves_a_part_on_top_of_another_and_one_on_a_part_placed_by_hand_to_the_cell(
         stacked: Path) -> None:
     geometry = tomllib.loads((stacked / "geometry.toml").read_text())
-    assert set(_manual(stacked)) == {"block"}  # no operation for it: it lies on the plate
+    assert set(manual_reasons(stacked)) == {"block"}  # no operation for it: it lies on the plate
     assert {pid for pid, shape in geometry["part_shapes"].items() if shape.get("bore")} == {"washer", "nut", "arm"}
     pin = geometry["hole_shapes"]["block_pin1"]  # the block's pin, 25 mm above where the arm rests
     assert (pin["owner"], pin["top_z"], pin["depth"]) == ("block", 0.045, 0.025)
@@ -106,9 +99,9 @@ def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_b
     # the nut drawn 0.5 mm above the washer: the cell would rest it on the washer, not where
     # the CAD has it; a washer with 0.01 mm of room on its pin is placed by hand, and the nut on it too
     apart = _import(tmp_path / "apart", nut_low=14.5)
-    assert _manual(apart)["nut"] == ("goes onto a pin (plate_pin1) +0.500 mm from the top of 'washer': the cell "
+    assert manual_reasons(apart)["nut"] == ("goes onto a pin (plate_pin1) +0.500 mm from the top of 'washer': the cell "
                                      "stacks the parts on a pin end to end (within 0.1 mm)")
-    tight = _manual(_import(tmp_path / "tight", washer_bore=8.02))
+    tight = manual_reasons(_import(tmp_path / "tight", washer_bore=8.02))
     assert tight["washer"] == ("goes onto a pin (plate_pin1) with +0.0100 mm of room per side, less than the 0.025 mm "
                                "the simulated cell resolves")
     assert tight["nut"] == "goes onto a pin (plate_pin1) on top of 'washer', which the cell does not put onto it"
