@@ -138,7 +138,7 @@ def _shift_locked(assembler: Assembler, part: str, shift: np.ndarray) -> None:
 
 
 @pytest.mark.slow  # teaches three parts, the block and the ring onto its pin, the block moved (about 8 s of CPU)
-@pytest.mark.parametrize("shift_mm", [1.0, 3.0])  # 3 mm: the CAD's goal would leave the ring 3.4 mm from it
+@pytest.mark.parametrize("shift_mm", [3.0])  # 3 mm: the CAD's goal would leave the ring 3.4 mm from it
 def test_the_ring_follows_the_block_where_it_ended(owned: Path, shift_mm: float) -> None:
     teach(owned)
     assembler = Assembler(load_product(str(owned)), description=CellDescription())
