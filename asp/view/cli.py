@@ -119,8 +119,11 @@ def main(argv: Sequence[str]) -> int:
         from bridge.recording.sinks import Viewer, hosted_viewer, keep_serving
 
         served = Viewer(serve=True)
-        with hosted_viewer(served, [*files, blueprint]):
-            keep_serving(served)
+        try:  # Ctrl-C is how the user ends it: also while the server still loads the files
+            with hosted_viewer(served, [*files, blueprint]):
+                keep_serving(served)
+        except KeyboardInterrupt:
+            pass
         return 0
     subprocess.Popen(
         [rerun_executable(), *map(str, files), str(blueprint)],
