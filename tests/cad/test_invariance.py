@@ -44,13 +44,6 @@ def test_parts_onto_pins_of_a_part_placed_by_hand_are_imported_alike_turned_and_
     assert _compared("asm4_disk_arm", transform, tmp_path_factory) == []
 
 
-@pytest.mark.slow  # 2 imports of 5 parts, 116 s at load 8 (35 s of CPU)
-def test_empty_holes_numbered_by_position_are_matched_by_position_turned(
-        tmp_path_factory: pytest.TempPathFactory) -> None:
-    # asap_beam: h2, h3 (the empty mortises) change places turned 180 deg, as their ids follow position
-    assert _compared("asap_beam", "turn180", tmp_path_factory) == []
-
-
 @pytest.mark.slow  # 2 imports of 4 parts, 27 s at load 8
 def test_the_slits_of_a_pin_in_its_hole_stay_pockets_turned(tmp_path_factory: pytest.TempPathFactory) -> None:
     # ldraw_axles: turned 90 deg, two of the Technic pin's slits (0.816 x 0.000 mm) were
