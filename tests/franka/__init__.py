@@ -5,9 +5,18 @@ from __future__ import annotations
 import math
 import re
 import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from executor.control.gains import ImpedanceGains
+
+if TYPE_CHECKING:  # franky and mujoco are optional: the tests that need them skip without them
+    from executor.cell_description import CellDescription
+    from executor.franka.cell import FrankaCell
+    from executor.franka.sim_server import SimRobot
+    from executor.world.geometry import CellGeometry
 
 SIM_DYNAMICS = "1.0"
 """franky's relative dynamics factor of the tests' carrying moves against franky-sim (the
@@ -54,3 +63,23 @@ def parts_moved(folder: Path, to: Path, dx: float, parts: set[str] | None = None
     assert count > 0, text
     toml.write_text(text, encoding="utf-8")
     return moved
+
+
+@contextmanager
+def franka_on_sim(folder: Path, geometry: CellGeometry, description: CellDescription
+                  ) -> Iterator[tuple[FrankaCell, SimRobot]]:
+    """A Franka cell of ``geometry`` and ``description`` (the full ILC layer, not in real
+    time, :data:`SIM_DYNAMICS`) on franky-sim building the product ``folder``, and the
+    simulator; the cell stopped and the simulator ended after the block."""
+    from executor.control.ilc import layer_named
+    from executor.franka.cell import FrankaCell, FrankaOptions
+    from executor.franka.safety import Limits
+    from executor.franka.sim_server import sim_robot
+
+    with sim_robot(folder) as sim:
+        cell = FrankaCell(geometry, description, layer_named("full"),
+                          FrankaOptions(host=sim.host, realtime=False, limits=Limits(dynamics=float(SIM_DYNAMICS))))
+        try:
+            yield cell, sim
+        finally:
+            cell.stop()

@@ -18,14 +18,11 @@ pytest.importorskip("franky")
 pytest.importorskip("mujoco")
 
 from executor.cell_description import load_cell_description  # noqa: E402
-from executor.control.ilc import layer_named  # noqa: E402
-from executor.franka.cell import FrankaCell, FrankaOptions  # noqa: E402
-from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS, Limits  # noqa: E402
-from executor.franka.sim_server import sim_robot  # noqa: E402
+from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS  # noqa: E402
 from executor.world.arm import quat_to_matrix  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
 from tests.cad.conftest import teach  # noqa: E402
-from tests.franka import SIM_DYNAMICS, franka_cell_description
+from tests.franka import franka_cell_description, franka_on_sim
 from tests.franka.test_franka_sideways import SEARCH_RADIUS
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtures("one_simulated_arm"),
@@ -44,24 +41,19 @@ def test_a_ring_stops_at_a_pin_too_wide_for_its_bore_and_goes_onto_one_that_fits
     description = load_cell_description(franka_cell_description(tmp_path, SEARCH_RADIUS, STIFFNESS))
     geometry = load_geometry(str(folder), description)
     seen = {}
-    with sim_robot(folder) as sim:
-        cell = FrankaCell(geometry, description, layer_named("full"),
-                          FrankaOptions(host=sim.host, realtime=False, limits=Limits(dynamics=float(SIM_DYNAMICS))))
-        try:
-            cell.pick("r1")
-            for pin in ("q3", "q1"):  # both along -y: d 11, then d 10
-                result, detector, _found = cell.insert("r1", pin, np.random.default_rng(0))
-                frame = geometry.holes[pin].frame
-                assert frame is not None
-                tip, quat = sim.truth().poses["r1"]  # the ring's leading face, its bore's centre there; w x y z
-                along = quat_to_matrix(np.array([*quat[1:], quat[0]]))[:, 2] @ frame.rotation[:, 2]
-                seen[pin] = (result.reached, geometry.holes[pin].top_z - frame.points_in(tip)[2], along,
-                             detector.max_force_dev)
-                if not result.reached:
-                    cell.lift()  # out along the axis, up
-            held = sim.truth().held
-        finally:
-            cell.stop()
+    with franka_on_sim(folder, geometry, description) as (cell, sim):
+        cell.pick("r1")
+        for pin in ("q3", "q1"):  # both along -y: d 11, then d 10
+            result, detector, _found = cell.insert("r1", pin, np.random.default_rng(0))
+            frame = geometry.holes[pin].frame
+            assert frame is not None
+            tip, quat = sim.truth().poses["r1"]  # the ring's leading face, its bore's centre there; w x y z
+            along = quat_to_matrix(np.array([*quat[1:], quat[0]]))[:, 2] @ frame.rotation[:, 2]
+            seen[pin] = (result.reached, geometry.holes[pin].top_z - frame.points_in(tip)[2], along,
+                         detector.max_force_dev)
+            if not result.reached:
+                cell.lift()  # out along the axis, up
+        held = sim.truth().held
     reached, depth, _along, force = seen["q3"]
     assert not reached and abs(depth) < 0.001 and force >= description.thresholds.f_stop, seen  # on the chamfer
     reached, depth, along, _force = seen["q1"]

@@ -16,14 +16,10 @@ pytest.importorskip("franky")
 pytest.importorskip("mujoco")
 
 from executor.cell_description import load_cell_description  # noqa: E402
-from executor.control.ilc import layer_named  # noqa: E402
-from executor.franka.cell import FrankaCell, FrankaOptions  # noqa: E402
-from executor.franka.safety import Limits  # noqa: E402
-from executor.franka.sim_server import sim_robot  # noqa: E402
 from executor.world.arm import quat_to_matrix  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
 from tests.cad.conftest import teach  # noqa: E402
-from tests.franka import SIM_DYNAMICS, franka_cell_description
+from tests.franka import franka_cell_description, franka_on_sim
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1200), pytest.mark.usefixtures("one_simulated_arm"),
               pytest.mark.franka_arm]
@@ -42,23 +38,18 @@ def test_a_peg_stops_at_a_too_narrow_hole_entered_sideways_and_goes_into_one_tha
     description = load_cell_description(franka_cell_description(tmp_path, SEARCH_RADIUS))
     geometry = load_geometry(str(folder), description)
     seen = {}
-    with sim_robot(folder) as sim:
-        cell = FrankaCell(geometry, description, layer_named("full"),
-                          FrankaOptions(host=sim.host, realtime=False, limits=Limits(dynamics=float(SIM_DYNAMICS))))
-        try:
-            cell.pick("p1")
-            for hole in ("h3", "h2"):  # -y, then +x
-                result, detector, _found = cell.insert("p1", hole, np.random.default_rng(0))
-                frame = geometry.holes[hole].frame
-                assert frame is not None
-                tip, quat = sim.truth().poses["p1"]  # the peg's bottom face: its tip; w x y z
-                along = quat_to_matrix(np.array([*quat[1:], quat[0]]))[:, 2] @ frame.rotation[:, 2]
-                seen[hole] = (result.reached, geometry.holes[hole].top_z - frame.points_in(tip)[2], along,
-                              detector.max_force_dev)
-                if not result.reached:
-                    cell.lift()  # out along the axis, up
-        finally:
-            cell.stop()
+    with franka_on_sim(folder, geometry, description) as (cell, sim):
+        cell.pick("p1")
+        for hole in ("h3", "h2"):  # -y, then +x
+            result, detector, _found = cell.insert("p1", hole, np.random.default_rng(0))
+            frame = geometry.holes[hole].frame
+            assert frame is not None
+            tip, quat = sim.truth().poses["p1"]  # the peg's bottom face: its tip; w x y z
+            along = quat_to_matrix(np.array([*quat[1:], quat[0]]))[:, 2] @ frame.rotation[:, 2]
+            seen[hole] = (result.reached, geometry.holes[hole].top_z - frame.points_in(tip)[2], along,
+                          detector.max_force_dev)
+            if not result.reached:
+                cell.lift()  # out along the axis, up
     reached, depth, _along, force = seen["h3"]
     assert not reached and abs(depth) < 0.001 and force >= description.thresholds.f_stop, seen  # in the entry's chamfer
     reached, depth, along, _force = seen["h2"]
