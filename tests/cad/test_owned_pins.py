@@ -9,7 +9,6 @@ A block drawn off its pocket's centre leaves the ring placed by hand, named."""
 
 from __future__ import annotations
 
-import shutil
 import tomllib
 from pathlib import Path
 
@@ -19,8 +18,6 @@ import pytest
 import shapely
 import trimesh
 
-from bridge import BridgeError
-from bridge.product import load_product_description
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cell_description import CellDescription
@@ -84,17 +81,6 @@ def test_the_import_leaves_a_ring_onto_a_pin_of_a_block_the_cell_inserts_to_the_
     assert geometry["part_shapes"]["ring"]["demo_hole"] == "block_pin1"
     # the block before the ring, derived from the geometry
     assert "must_precede(block,ring)." in (owned / "geometric_precedence.lp").read_text().split()
-
-
-@pytest.mark.slow  # the import: about 2 s
-def test_a_pin_s_owner_is_placed_by_hand_or_a_peg_inserted_down(owned: Path, tmp_path: Path) -> None:
-    folder = Path(shutil.copytree(owned, tmp_path / "copy"))
-    geometry = folder / "geometry.toml"
-    geometry.write_text(geometry.read_text().replace('owner = "block"', 'owner = "washer"'))  # a part with a bore
-    with pytest.raises(BridgeError, match=r"\[hole_shapes.block_pin1\] owner: expected a part placed by hand "
-                                          r"\(\[manual.<id>\]\) or a peg of \[part_shapes.\*\] whose demo_hole is "
-                                          r"a hole entered down, whose pin it is, got 'washer'"):
-        load_product_description(folder)
 
 
 @pytest.mark.slow  # the import: about 2 s

@@ -84,10 +84,10 @@ def test_the_import_leaves_a_part_on_top_of_another_and_one_on_a_part_placed_by_
 
 
 @pytest.mark.slow  # the import: about 2 s
-def test_a_pin_s_owner_is_a_part_placed_by_hand(stacked: Path, tmp_path: Path) -> None:
+def test_a_pin_s_owner_is_placed_by_hand_or_a_peg_inserted_down(stacked: Path, tmp_path: Path) -> None:
     folder = Path(shutil.copytree(stacked, tmp_path / "copy"))
     geometry = folder / "geometry.toml"
-    geometry.write_text(geometry.read_text().replace('owner = "block"', 'owner = "washer"'))
+    geometry.write_text(geometry.read_text().replace('owner = "block"', 'owner = "washer"'))  # a part with a bore
     with pytest.raises(BridgeError, match=r"\[hole_shapes.block_pin1\] owner: expected a part placed by hand "
                                           r"\(\[manual.<id>\]\) or a peg of \[part_shapes.\*\] whose demo_hole is "
                                           r"a hole entered down, whose pin it is, got 'washer'"):
