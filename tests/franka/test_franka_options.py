@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -10,7 +12,7 @@ import pytest
 from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.franka.backend import by_hand_reason, franka_options
-from executor.franka.cell import part_width
+from executor.franka.cell import FrankaCell, part_width
 from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS, SafetyStop, Workspace, capped
 from executor.world.geometry import load_geometry
 
@@ -67,3 +69,13 @@ def test_the_hand_opens_to_a_ring_s_outside_not_its_bore() -> None:
     assert max(ring.sides) == pytest.approx(0.0108, abs=1e-4)
     assert part_width(geometry, ring) == pytest.approx(0.032, abs=1e-4)
     assert part_width(geometry, peg) == pytest.approx(0.010)
+
+
+def test_a_part_held_by_the_suction_cup_is_refused_by_the_franka_hand() -> None:
+    # The hand has fingers only: a part the product gives the suction cup is refused before
+    # the arm moves (the check is the first thing pick does; no arm is needed to reach it).
+    geometry = load_geometry(str(Path(__file__).parent / "data" / "pins"))
+    cupped = dataclasses.replace(geometry.parts["r1"], tool="suction")
+    cell = SimpleNamespace(geometry=SimpleNamespace(parts={"r1": cupped}))
+    with pytest.raises(ExecutorError, match=r"part r1 is held by the suction cup .*the Franka's hand has fingers only"):
+        FrankaCell.pick(cell, "r1")  # type: ignore[arg-type]
