@@ -103,24 +103,32 @@ class CadPart:
     remesh: Callable[[float], trimesh.Trimesh] | None = None
 
 
+def _mapped(parts: list[CadPart], point: Callable[[np.ndarray], np.ndarray],
+            direction: Callable[[np.ndarray], np.ndarray]) -> list[CadPart]:
+    """The parts with every point [m] mapped by ``point`` (their meshes' vertices, their
+    B-rep cylinders' points, the meshes ``remesh`` makes) and their cylinders' directions by
+    ``direction`` (the parts given are not changed)."""
+    def mapped_mesh(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+        copy = mesh.copy()
+        copy.vertices = point(np.asarray(mesh.vertices))
+        return copy
+
+    def mapped_remesh(remesh: Callable[[float], trimesh.Trimesh]) -> Callable[[float], trimesh.Trimesh]:
+        return lambda deflection: mapped_mesh(remesh(deflection))
+
+    return [replace(part, mesh=mapped_mesh(part.mesh),
+                    cylinders=tuple(replace(c, point=point(c.point), direction=direction(c.direction))
+                                    for c in part.cylinders),
+                    remesh=None if part.remesh is None else mapped_remesh(part.remesh)) for part in parts]
+
+
 def translated(parts: list[CadPart], offset: tuple[float, float]) -> list[CadPart]:
     """The parts moved by ``offset`` (x, y) [m] in the horizontal plane: their meshes,
     their B-rep cylinders and the meshes of ``remesh`` (the parts given are not changed)."""
     shift = np.array([offset[0], offset[1], 0.0])
     if not shift.any():
         return parts
-
-    def moved_mesh(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
-        copy = mesh.copy()
-        copy.apply_translation(shift)
-        return copy
-
-    def moved_remesh(remesh: Callable[[float], trimesh.Trimesh]) -> Callable[[float], trimesh.Trimesh]:
-        return lambda deflection: moved_mesh(remesh(deflection))
-
-    return [replace(part, mesh=moved_mesh(part.mesh),
-                    cylinders=tuple(replace(c, point=c.point + shift) for c in part.cylinders),
-                    remesh=None if part.remesh is None else moved_remesh(part.remesh)) for part in parts]
+    return _mapped(parts, lambda points: points + shift, lambda direction: direction)
 
 
 UP_AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
@@ -158,19 +166,7 @@ def turned(parts: list[CadPart], up: str) -> list[CadPart]:
     and directions and the meshes of ``remesh`` (the parts given are not changed)."""
     if up == "+z":
         return parts
-
-    def turned_mesh(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
-        copy = mesh.copy()
-        copy.vertices = turn_points(np.asarray(mesh.vertices), up)
-        return copy
-
-    def turned_remesh(remesh: Callable[[float], trimesh.Trimesh]) -> Callable[[float], trimesh.Trimesh]:
-        return lambda deflection: turned_mesh(remesh(deflection))
-
-    return [replace(part, mesh=turned_mesh(part.mesh),
-                    cylinders=tuple(replace(c, point=turn_points(c.point, up), direction=turn_points(c.direction, up))
-                                    for c in part.cylinders),
-                    remesh=None if part.remesh is None else turned_remesh(part.remesh)) for part in parts]
+    return _mapped(parts, lambda points: turn_points(points, up), lambda direction: turn_points(direction, up))
 
 
 def part_id(name: str, source: str) -> str:
@@ -414,7 +410,7 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                 if part.id not in solids:
                     solids[part.id] = _manifold(part.mesh)
             common = solids[a.id] ^ solids[b.id]
-            volume = _volume(_mesh(common.to_mesh()))
+            volume = max(common.volume(), 0.0)
             if volume > OVERLAP_VOLUME:
                 for part in (a, b):
                     if part.id not in faces:
@@ -469,17 +465,6 @@ def _manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:
     every pair the part is in."""
     return manifold3d.Manifold(manifold3d.Mesh(vert_properties=np.array(mesh.vertices, dtype=np.float32),
                                                tri_verts=np.array(mesh.faces, dtype=np.uint32)))
-
-
-def _mesh(mesh: manifold3d.Mesh) -> trimesh.Trimesh:
-    """A manifold3d result as a trimesh mesh, as trimesh's booleans return it."""
-    return trimesh.Trimesh(vertices=mesh.vert_properties, faces=mesh.tri_verts, process=False)
-
-
-def _volume(mesh: trimesh.Trimesh) -> float:
-    """The volume of a closed ``mesh`` [m³], 0 when it has no triangles."""
-    with np.errstate(divide="ignore", invalid="ignore"):  # an empty intersection has no centre
-        return float(mesh.volume) if len(mesh.faces) else 0.0
 
 
 def _beyond_fits(common: manifold3d.Manifold, slides: list[Slide]) -> float:
