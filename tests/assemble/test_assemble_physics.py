@@ -9,6 +9,7 @@ import json
 import pytest
 
 from bridge.recording.reader import column_values, read_recording
+from tests.conftest import ROOT, assembled
 
 STEP_KEYS = {"part", "hole", "skill", "outcome", "attempts", "duration_s", "max_force_dev"}
 
@@ -55,16 +56,10 @@ def test_a_blocked_hole_in_physics_is_replanned_into_the_spare_hole_with_the_cel
 
 
 @pytest.mark.slow
-def test_graded_board_thinnest_peg_blocked_from_its_hole_goes_into_the_spare_in_physics(run_main) -> None:
-    """h1 blocked: p1 (d 10 mm) is re-planned into the free d 12.8 mm hole, the loosest fit
-    of any complete assignment of the graded board, and still stands within 2 mm of its goal."""
-    done = run_main("assemble", "--assembly", "graded", "--block-hole", "h1", "--json", timeout=280)
-    assert done.returncode == 0, done.stderr
-    report = json.loads(done.stdout)
-    assert report["assembled"] is True and report["replans"]
-    assert [(s["part"], s["hole"]) for s in report["steps"] if s["outcome"] == "no_fit"] == [("p1", "h1")]
-    final = {s["part"]: s["hole"] for s in report["final_plan"]}
-    assert final["p1"] in {"h3", "h7"} and "h1" not in final.values()
-    assert [s["skill"] for s in report["steps"]].count("insert_over") == 1  # the bar
-    assert set(report["final_pose_error_mm"]) == {"bp", "p1", "p2", "p3", "p4", "p5", "p6", "bar"}
-    assert max(report["final_pose_error_mm"].values()) < 2.0, report["final_pose_error_mm"]
+def test_the_graded_boards_thinnest_peg_stands_in_the_loosest_hole_within_2_mm() -> None:
+    """p1 (d 10 mm) in h3 (d 12.8 mm), the loosest fit of any complete assignment of the
+    graded board, where the plan puts it when h1 is blocked (the re-plan: against a fake cell
+    in ``test_execute_plan.py``, in physics on the spare plate above): placed by the
+    assembling cell after the base, it stands within 2 mm of its goal."""
+    step, _quat = assembled(ROOT / "data" / "graded", "bp", "p1", "h3")
+    assert step.skill == "insert", step
