@@ -147,7 +147,6 @@ SMOKE: list[Any] = [
                  marks=pytest.mark.slow),
     pytest.param(("bench", "session", "--round-trips", "5", "--repeat", "1", "--skip-sessions", "--json"),
                  "json:overhead", marks=pytest.mark.slow),
-    pytest.param(("bench", "mesh", "--repeat", "1", "--json"), "json:rows", marks=pytest.mark.slow),
     pytest.param(("executor", "margins", "--trials", "1", "--pairs", "p1:r1"), "p1:r1", marks=pytest.mark.slow),
 ]
 """Documented commands no other test runs, each on a small input, with what its output

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import queue
 import signal
 import threading
@@ -11,6 +12,7 @@ from collections.abc import Iterator
 import pytest
 import zenoh
 
+from asp.bench.mesh import main as bench_mesh
 from asp.session.cells import CellProcess, start_cell
 from bridge.cell_settings import ServeSettings
 from bridge.client import (
@@ -349,3 +351,17 @@ def test_a_token_of_a_second_claimant_the_cells_cannot_see_makes_the_planner_wai
         assert request_insert(session, "c1", InsertRequest(id="d4", part="sh", hole="br"), 10).result == "fit"
     finally:
         hidden.close()
+
+
+@pytest.mark.slow  # three peer processes
+def test_bench_mesh_sees_two_listening_peers_meet(monkeypatch: pytest.MonkeyPatch,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """``./run.sh bench mesh`` on its row of how cells start (A and B connect to the
+    planner and listen on a port of their own): B sees A's token and B's query reaches A,
+    watched 0.5 s in place of 3. The other rows' meetings are the cells' above (started
+    together; apart, joined by a planner later)."""
+    monkeypatch.setattr("asp.bench.mesh.TOPOLOGIES", ("star+listen",))
+    monkeypatch.setattr("asp.bench.mesh.WATCH_S", 0.5)
+    assert bench_mesh(["--repeat", "1", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    assert [(row["topology"], row["token"], row["query"]) for row in rows] == [("star+listen", 1, 1)], rows
