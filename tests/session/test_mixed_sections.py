@@ -19,6 +19,7 @@ import pytest
 
 from bridge.assembly import load_assembly
 from tests.conftest import ROOT
+from tests.session import exact_cell
 
 PEGS = {"pa": ("round", 0.014), "pb": ("square", 0.013), "pc": ("round", 0.010), "pd": ("square", 0.009)}
 HOLES = {"ha": ("round", 0.0145), "hb": ("square", 0.0135), "hc": ("round", 0.0105), "hd": ("square", 0.0095)}
@@ -91,21 +92,6 @@ needed 21 to 23. The whole board through the same session is a row of the task b
 results (docs/results/assembly.md, ``./run.sh session --assembly taskboard --assemble``)."""
 
 
-EXACT_CELL = tuple(arg for name in ("grasp-offset-bias", "grasp-offset-random", "grasp-tilt-bias", "grasp-tilt-random",
-                                    "vision-bias", "vision-sigma", "vision-yaw-bias", "vision-yaw-sigma")
-                   for arg in (f"--{name}", "0"))
-"""The session's options of a cell without pose errors: the part where the hand believes it,
-the holes where the cell's vision does. The experiments then decide on the cross-sections
-alone; each ``no_fit`` still runs both attempts, its search over :data:`EXACT_SEARCH`'s
-radius (the default's 4.6 mm spirals were 6-19 s of a ``no_fit``'s wall time at a load of
-10, 2-5 s after). The cell's default uncertainty through a session is
-``tests/session/test_session_sim.py``'s, each section relation's trial under it
-``tests/executor/test_rect_trials.py``'s."""
-EXACT_SEARCH = "[search]\nmax_radius = 0.001\nslow_time = 0\n"
-"""The cell description of :data:`EXACT_CELL`'s search: 1 mm around the hole (a pitch), no
-slow pass out after a first pass that found nothing."""
-
-
 def _small_board(folder: Path) -> Path:
     """A copy of data/taskboard in ``folder`` with only the parts and holes of
     :data:`SMALL_BOARD`: the tables of the others left out of ``assembly.toml`` and
@@ -156,12 +142,10 @@ def test_the_task_board_is_learned_through_physics_and_assembled_within_2_mm(run
     square and rect, no one size line. Sim cells learn the board exactly (its sizes.lp)
     under the sections model, and the first plan is assembled in physics: the five pegs (the
     slot turned 30°) each in its own hole, every step a fit, every part within 2 mm of its goal.
-    The cells' experiments without pose errors (:data:`EXACT_CELL`)."""
+    The cells' experiments without pose errors (:func:`tests.session.exact_cell`)."""
     board = _small_board(tmp_path / "board")
-    description = tmp_path / "cell.toml"
-    description.write_text(EXACT_SEARCH)
     done = run_cli("session", "--assembly", str(board), "--cells", "2", "--assemble", "--json",
-                   "--out", str(tmp_path / "run"), "--cell-description", str(description), *EXACT_CELL, timeout=900)
+                   "--out", str(tmp_path / "run"), *exact_cell(tmp_path), timeout=900)
     assert done.returncode == 0, done.stderr[-2000:]
     result = json.loads(done.stdout)
     assert result["matches_truth"] is True and result["model"] == "sections"

@@ -20,6 +20,7 @@ from asp.session.precedence import PRECEDENCE_JOURNAL, explore_precedence
 from bridge.assembly import load_assembly
 from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
 from tests.conftest import TRUTH_SESSION, Runner
+from tests.session import exact_cell
 
 
 def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
@@ -86,17 +87,18 @@ def test_truth_cell_session_explores_cranfield_to_its_exact_relation(tmp_path: P
 @pytest.mark.timeout(400)
 def test_sim_cell_session_explores_a_small_product_in_physics_with_the_layer_it_was_given(
         tmp_path: Path, run_main: Runner) -> None:
-    """``--layer pi_phase_stop`` (no ILC) and a smaller vision error reach the cell: it
-    learns nothing across executions, so no ILC state appears in the run folder (the
-    default layer writes one at the first fit: ``tests/session/test_session_sim.py``)."""
+    """``--layer pi_phase_stop`` (no ILC) and a cell without pose errors (its sizes'
+    experiments the shorter: :func:`tests.session.exact_cell`) reach the cell: it learns
+    nothing across executions, so no ILC state appears in the run folder (the default layer
+    writes one at the first fit: ``tests/session/test_session_sim.py``)."""
     run = tmp_path / "run"
     done = run_main("session", "--json", "--assembly", "spare", "--precedence", "explore", "--layer", "pi_phase_stop",
-                   "--vision-sigma", "0.001", "--out", str(run), timeout=360)
+                    *exact_cell(tmp_path), "--out", str(run), timeout=360)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["matches_truth"] is True
     _learned_exactly_the_truth(run, "spare")
     cell = json.loads((run / "session.json").read_text())["cell"]
-    assert cell["layer"] == "pi_phase_stop" and cell["magnitudes"]["vision_sigma"] == 0.001
+    assert cell["layer"] == "pi_phase_stop" and cell["magnitudes"]["vision_sigma"] == 0.0
     assert not (run / "c1-ilc.json").exists()
     explored = json.loads((run / "session.json").read_text())["precedence_explored"]
     assert explored["experiments"] == 3 and explored["sim_s"] > 0.0  # bp<p1, bp<p2, bp<p3, each in physics
