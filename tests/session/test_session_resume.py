@@ -21,7 +21,7 @@ from asp.session.settings import (
     product_digest,
     write_session_file,
 )
-from tests.conftest import TRUTH_SESSION
+from tests.conftest import TRUTH_SESSION, Runner
 
 pytestmark = [pytest.mark.timeout(120), pytest.mark.slow]  # whole sessions, 3-8 s each
 
@@ -108,25 +108,27 @@ def as_if_killed(run: Path, keep: int) -> None:
     (run / "session.json").write_text(json.dumps({**record, "status": "running"}))
 
 
-def session(run_cli, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return run_cli("session", "--json", "--plans", "1", *args, cwd=cwd, timeout=90)
+def session(run_main: Runner, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """``session --json --plans 1 ARGS`` in this process (the session's process start: e.g.
+    ``tests/session/test_session_cells.py``), its cells processes of their own."""
+    return run_main("session", "--json", "--plans", "1", *args, cwd=cwd, timeout=90)
 
 
-def test_a_resume_from_another_folder_keeps_the_backend_and_says_what_it_resumes(tmp_path: Path, run_cli,
+def test_a_resume_from_another_folder_keeps_the_backend_and_says_what_it_resumes(tmp_path: Path, run_main: Runner,
                                                                                 root: Path) -> None:
     """A session on a product given by a path relative to its folder, resumed from another
     folder: ``session.json`` keeps the product folder as an absolute path (a shipped one by
     its name), and the resume keeps the run's backend and settings, saying so."""
     (tmp_path / "here").mkdir()
     product, run = cranfield_copy(root, tmp_path / "here" / "plate"), tmp_path / "run"
-    first = session(run_cli, "--backend", "truth", "--delay", "0.01", "--assembly", "plate", "--out", str(run),
+    first = session(run_main, "--backend", "truth", "--delay", "0.01", "--assembly", "plate", "--out", str(run),
                     cwd=tmp_path / "here")
     assert first.returncode == 0, first.stderr
     kept = json.loads((run / "session.json").read_text())
     assert (kept["backend"], kept["delay_s"]) == ("truth", 0.01) and len(kept["product"]) == 64
     assert kept["assembly"] == str(product)
     as_if_killed(run, keep=8)  # 4 experiments finished
-    resumed = session(run_cli, "--resume", str(run), "--seed", "5", cwd=tmp_path)  # no --backend: the run's
+    resumed = session(run_main, "--resume", str(run), "--seed", "5", cwd=tmp_path)  # no --backend: the run's
     assert resumed.returncode == 0, resumed.stderr
     assert f"resuming {run} (start 2): 4 experiment(s) journaled" in resumed.stderr
     assert "backend truth (delay 0.01 s)" in resumed.stderr
@@ -138,7 +140,8 @@ def test_a_resume_from_another_folder_keeps_the_backend_and_says_what_it_resumes
     assert json.loads(resumed.stdout)["matches_truth"] is True
 
 
-def test_a_resume_of_an_edited_product_is_refused_changing_nothing(tmp_path: Path, run_cli, root: Path) -> None:
+def test_a_resume_of_an_edited_product_is_refused_changing_nothing(tmp_path: Path, run_main: Runner,
+                                                                  root: Path) -> None:
     product, run = cranfield_copy(root, tmp_path / "product"), tmp_path / "run"
     run.mkdir()
     record = new_session_file(SessionSettings(assembly=str(product), backend="truth"), "r")
@@ -148,7 +151,7 @@ def test_a_resume_of_an_edited_product_is_refused_changing_nothing(tmp_path: Pat
     before = {path.name: path.read_bytes() for path in run.iterdir()}
     with (product / "sizes.lp").open("a") as sizes:
         sizes.write("% edited after the session started\n")
-    refused = session(run_cli, "--resume", str(run))
+    refused = session(run_main, "--resume", str(run))
     assert refused.returncode == 2 and refused.stdout == ""
     assert refused.stderr == (
         f"error: --resume {run}: the product {product} changed since the session started (digest "
@@ -157,25 +160,25 @@ def test_a_resume_of_an_edited_product_is_refused_changing_nothing(tmp_path: Pat
     assert {path.name: path.read_bytes() for path in run.iterdir() if path.name != ".lock"} == before
 
 
-def test_ids_of_64_characters_go_through_a_session_and_its_resume(tmp_path: Path, run_cli) -> None:
+def test_ids_of_64_characters_go_through_a_session_and_its_resume(tmp_path: Path, run_main: Runner) -> None:
     product, run = two_peg_product(tmp_path / "product"), tmp_path / "run"
-    first = session(run_cli, *TRUTH_SESSION[1:3], "--assembly", str(product), "--out", str(run))
+    first = session(run_main, *TRUTH_SESSION[1:3], "--assembly", str(product), "--out", str(run))
     assert first.returncode == 0, first.stderr
     truth = {(PEG_A, HOLE_A), (PEG_A, HOLE_B), (PEG_B, HOLE_B)}
     assert {tuple(pair) for pair in json.loads(first.stdout)["fits"]} == truth
     started = [r for r in read_records(run / "journal.jsonl") if not isinstance(r, JournalEntry)]
     assert started and all(len(r.id) > 128 for r in started)  # the run id, two 64-character ids, a number
     as_if_killed(run, keep=3)
-    resumed = session(run_cli, "--resume", str(run))
+    resumed = session(run_main, "--resume", str(run))
     assert resumed.returncode == 0, resumed.stderr
     assert {tuple(pair) for pair in json.loads(resumed.stdout)["fits"]} == truth
 
 
-def test_a_learned_product_without_an_assignment_exits_3_and_is_done(tmp_path: Path, run_cli) -> None:
+def test_a_learned_product_without_an_assignment_exits_3_and_is_done(tmp_path: Path, run_main: Runner) -> None:
     # the thick peg (13 mm) passes neither hole, though sizes.lp says it fits the larger one
     product = two_peg_product(tmp_path / "product", ("p1", "p2", "h1", "h2"), thick_peg_m=0.013)
     run = tmp_path / "run"
-    done = run_cli(*TRUTH_SESSION[:3], "--assembly", str(product), "--out", str(run), timeout=90)
+    done = run_main(*TRUTH_SESSION[:3], "--assembly", str(product), "--out", str(run), timeout=90)
     assert done.returncode == 3, done.stderr
     error = "the assembly is not solvable: part p2 fits no hole"
     assert done.stderr.endswith(f"error: {error}\n")
