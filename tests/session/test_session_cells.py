@@ -28,24 +28,11 @@ from asp.sizes.truth_oracle import TruthOracle
 from asp.solve import atoms_by_name, load_atoms
 from bridge.cell_settings import ServeSettings
 from bridge.session import free_loopback_endpoint
-from tests.conftest import ROOT, TRUTH_SESSION, Runner
+from tests.conftest import ROOT, TRUTH_SESSION
 from tests.session.test_session_batches import BEST_TWO_CELLS
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.slow]  # real processes over Zenoh, 3-11 s each
 TRUTH = TruthOracle.from_assembly("cranfield")
-
-
-@pytest.fixture
-def run_session(run_main: Runner):
-    """A truth session (``TRUTH_SESSION`` and the arguments given) in this process: its JSON
-    result, the command having exited 0."""
-    def run(*args: str, timeout: float = 60) -> dict:
-        done = run_main(*TRUTH_SESSION, *args, timeout=timeout)
-        assert done.returncode == 0, done.stderr
-        return json.loads(done.stdout)
-    return run
-
-
 
 
 def assert_learned_truth(result: dict, run: Path, truth: TruthOracle = TRUTH) -> None:
