@@ -1,10 +1,10 @@
 """Sessions with simulated (PyBullet) cells: a killed session resumes with what its cell
 had learned (ILC), and the default session learns the spare plate's exact relation with the
 cell's default uncertainty (second attempts included); the cell's options reach the
-cells in ``tests/session/test_session_explore.py``.  Real processes throughout: planner,
-``executor serve``, Zenoh on loopback. The Cranfield session in the same cells (25 pairs
-where the spare plate has 12) is ``./run.sh session`` and ``./run.sh bench session``
-(docs/results/session.md)."""
+cells in ``tests/session/test_session_explore.py``.  Real processes: the killed planner,
+``executor serve``, Zenoh on loopback; the resumed session in the test's process. The
+Cranfield session in the same cells (25 pairs where the spare plate has 12) is
+``./run.sh session`` and ``./run.sh bench session`` (docs/results/session.md)."""
 
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ def _wait_for(condition, timeout: float, what: str) -> None:
 
 @pytest.mark.slow
 def test_a_killed_sim_session_resumes_with_its_cells_ilc_and_learns_the_spare_plate_exactly(
-        tmp_path: Path, root: Path, cli_argv, cli_env: dict[str, str], run_cli) -> None:
+        tmp_path: Path, root: Path, cli_argv, cli_env: dict[str, str], run_main) -> None:
     """Default options (the full layer with ILC, the default uncertainty, two attempts per
     experiment).  The planner is SIGKILLed after two finished experiments; its cell
     follows (lifeline).  The resumed session's cell reloads ``<run>/c1-ilc.json``: every
@@ -71,7 +71,7 @@ def test_a_killed_sim_session_resumes_with_its_cells_ilc_and_learns_the_spare_pl
     finished_before = len(read_journal(run / "journal.jsonl"))
     assert sum(before.values()) >= 1
 
-    done = run_cli(*SIM_SESSION, "--resume", str(run), timeout=120)
+    done = run_main(*SIM_SESSION, "--resume", str(run), timeout=120)
     assert done.returncode == 0, done.stderr
     result = json.loads(done.stdout)
     assert_learned_truth(result, run, TruthOracle.from_assembly("spare"))  # every experiment right
