@@ -26,6 +26,10 @@ from bridge.messages import InsertRequest
 from bridge.session import free_loopback_endpoint, open_session
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(120)]
+KEPT_OUT_S = 2.0
+"""[s] how long a peer that must not get in is watched for, after the cells printed ``ready``
+(their sessions open, their tokens declared): a token reaches a connected peer within
+milliseconds (docs/decisions.md, ``bench mesh``)."""
 
 
 def _name(common_name: str) -> x509.Name:
@@ -119,7 +123,7 @@ def test_mutual_tls_serves_a_certified_planner_and_keeps_out_a_peer_without_cert
                 assert request_insert(session, "c1", InsertRequest(id="tls1", part="sh", hole="br"), 10).result == "fit"
             else:
                 with pytest.raises(CellTimeout):
-                    directory.wait_for(1, timeout=4)
+                    directory.wait_for(1, timeout=KEPT_OUT_S)
         finally:
             directory.close()
             session.close()
@@ -139,7 +143,7 @@ def _only_c1_is_served(cells: list[CellProcess], endpoint: str, planner: Path, c
         directory.wait_for(1, timeout=20)
         assert request_insert(session, "c1", InsertRequest(id=request_id, part="p1", hole="r1"), 10).result == "fit"
         with pytest.raises(CellTimeout):
-            directory.wait_for(2, timeout=4)
+            directory.wait_for(2, timeout=KEPT_OUT_S)
         assert directory.alive() == {"c1"}
     finally:
         directory.close()
