@@ -24,6 +24,7 @@ from executor.franka.sim_scene import product_model, to_base  # noqa: E402
 from executor.franka.sim_server import sim_robot  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
 from tests.executor.test_polygon_cell import HOLES, _product, hexagon  # noqa: E402
+from tests.franka import SIM_DYNAMICS  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -135,12 +136,13 @@ def _spare_with_peg_at(tmp_path: Path, part: str, start: tuple[float, float]) ->
 
 
 class _Arm:
-    """The franky client of the test: moves the TCP, tool pointing down, and waits until
-    the measured pose is there (franky's move returns when the commanded path ends)."""
+    """The franky client of the test: moves the TCP, tool pointing down, at the tests'
+    dynamics factor (:data:`tests.franka.SIM_DYNAMICS`), and waits until the measured pose
+    is there (franky's move returns when the commanded path ends)."""
 
     def __init__(self, host: str) -> None:
         self.robot = franky.Robot(host, realtime_config=franky.RealtimeConfig.Ignore)
-        self.robot.relative_dynamics_factor = franky.RelativeDynamicsFactor(0.3)
+        self.robot.relative_dynamics_factor = franky.RelativeDynamicsFactor(float(SIM_DYNAMICS))
         self.gripper = franky.Gripper(host)
         self.quat = self.robot.current_cartesian_state.pose.end_effector_pose.quaternion
 
