@@ -129,8 +129,9 @@ def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
 @pytest.mark.slow
 def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(network) -> None:
     endpoint, session, directory, cells = network
-    for cell_id in ("c1", "c2"):
-        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", connect=(endpoint,), delay_s=0.5)))
+    # c1 slow enough to be killed in an experiment; c2, which runs the rest, quicker
+    for cell_id, delay in (("c1", 0.5), ("c2", 0.2)):
+        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", connect=(endpoint,), delay_s=delay)))
     directory.wait_for(2, timeout=20)
     pairs = [(p, h) for p in ("p1", "p3", "sh") for h in ("r1", "s1", "br")]
     requests = [InsertRequest(id=f"r{i}", part=p, hole=h) for i, (p, h) in enumerate(pairs)]

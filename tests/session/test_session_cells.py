@@ -55,8 +55,9 @@ def assert_learned_truth(result: dict, run: Path, truth: TruthOracle = TRUTH) ->
 def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv,
                                              cli_env: dict[str, str]) -> None:
     endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
-    for cell_id, endpoint in zip(("c1", "c2"), endpoints):
-        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", listen=(endpoint,), delay_s=0.5)))
+    # c1 slow enough to be killed in an experiment; c2, which runs the rest, quicker
+    for cell_id, endpoint, delay in zip(("c1", "c2"), endpoints, (0.5, 0.25)):
+        cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", listen=(endpoint,), delay_s=delay)))
     run = tmp_path / "run"
     connect = [arg for ep in endpoints for arg in ("--connect", ep)]
     argv = cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run), "--policy", "best")
