@@ -199,7 +199,8 @@ def _summary(result: dict, run: Path) -> str:
         "next:",
         *(f"  {(label + ':').ljust(23)} {command}" for label, command in (
             ("view the recording", f"{_program()} view {shlex.quote(str(run.resolve()))}"),
-            (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
+            *([(f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -")]
+              if assembly.holes else []),
             *([("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5")]
               if result["plans"] else []),
         )),

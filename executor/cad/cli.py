@@ -323,9 +323,8 @@ def report(derived: Derived) -> list[str]:
                      f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon with no "
                      "rotational symmetry about its centre, no hole")
     if not (derived.holes or derived.part_holes or derived.pins):
-        lines.append("no hole and no pin found: sizes.lp names no part and no hole, and `plan` and `session` "
-                     "need a part in a hole or on a pin (geometric_precedence.lp holds the order, "
-                     "for `precedence learn`)")
+        lines.append("no hole and no pin found: sizes.lp names no part and no hole, nothing to learn; `plan` and "
+                     "`session` place every part without a hole, in the order of geometric_precedence.lp")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     for pid, by_direction in sorted(derived.located.items()):
         lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(
