@@ -27,7 +27,10 @@ a pair of theirs that the blocking contradicts is dropped and reported.
 
 **Holes** are the inner loops of the base's slices perpendicular to the axes, at the middle
 of each part's depth in the base (or, with no part reaching into it, at the base's middle
-along z). A part is in the hole whose loop holds its slice's centre. Measured: both
+along z). A part is in the hole whose loop holds its slice's centre, unless that loop is
+wider than the part by more than :data:`CAVITY_ROOM` and floored (a tray's cavity the part
+rests in: no hole for it, nor a moving part's loop); an empty floored loop so much wider
+than every part the base's holes hold is no hole (:func:`_cavity`). Measured: both
 cross-sections, their clearance, the hole's entry (the base's highest point around it
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
@@ -119,6 +122,11 @@ insertion the cell's arm was measured to reach sideways (+x, +y, -y:
 :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways along x
 goes in along +x however the CAD is turned about z; a zero-clearance fit's axis that is
 none of these last, in the order found."""
+CAVITY_ROOM = 2 * LOCATING_REACH
+"""[m] An inner loop whose narrowest width exceeds a part's widest by more than this (6 mm)
+leaves that part, wherever it lies in it, free to move the locating rule's default reach
+one way or the other across: with a floor under it, a cavity that locates nothing of that
+size (an open tray's, a case's without its lid), no hole for it (:func:`_cavity`)."""
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
@@ -624,10 +632,19 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
     if not slices:
         z = base.mesh.vertices[:, 2]
         slices[("+z", round(float(z.min() + z.max()) / 2, 7))] = []
+    sliced_at = {key: slice_loops(base.mesh, np.array(DIRECTIONS[key[0]]), key[1]) for key in slices}
+
+    def holds(loop: Loop, own: Loop, key: tuple[str, float]) -> bool:
+        """Whether ``loop`` of the slice ``key`` is a hole around the part whose outline is ``own``."""
+        return (loop.contains(own.centre) and not _outer(loop, sliced_at[key])
+                and not _cavity(base.mesh, loop, np.array(DIRECTIONS[key[0]]), key[1], own.extent[0]))
+
+    widest = max((own.extent[0] for key, members in slices.items() for _, own in members
+                  if any(holds(loop, own, key) for loop in sliced_at[key])), default=0.0)
     fits: list[HoleFit] = []
     for (name, level), members in sorted(slices.items()):
         axis = np.array(DIRECTIONS[name])
-        loops = slice_loops(base.mesh, axis, level)
+        loops = sliced_at[(name, level)]
         for loop in loops:
             around = sorted((o for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)),
                             key=lambda o: o.area)
@@ -635,7 +652,9 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
                 continue  # an outline, not a hole
             frame = frame_of(axis)
             centre = frame.T @ loop.centre + axis * level
-            occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
+            occupant = next(((p, own) for p, own in members if holds(loop, own, (name, level))), None)
+            if occupant is None and _cavity(base.mesh, loop, axis, level, widest):
+                continue  # empty, floored and wider than every part in a hole of the base needs
             same = [k for k, f in enumerate(fits) if f.axis == name and np.linalg.norm(
                 np.array(f.centre) - centre - axis * np.dot(np.array(f.centre) - centre, axis)) < _SAME_HOLE]
             if same and (occupant is None or fits[same[0]].part is not None):
@@ -650,6 +669,16 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
                 fits.append(fit)
     fits.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     return fits
+
+
+def _cavity(mesh: trimesh.Trimesh, loop: Loop, axis: np.ndarray, level: float, width: float) -> bool:
+    """Whether the inner ``loop`` of ``mesh``'s slice across the unit ``axis`` at ``level``
+    [m] along it is an open box's cavity for a part ``width`` [m] wide at its widest: the
+    loop leaves more than :data:`CAVITY_ROOM` across its narrowest, and it has a floor (the
+    ray down its centre line goes into the solid: no opening through)."""
+    if loop.extent[1] - width <= CAVITY_ROOM:
+        return False
+    return _roofed(mesh, frame_of(axis).T @ loop.centre + axis * level, -axis)
 
 
 def _outer(loop: Loop, loops: list[Loop]) -> bool:
@@ -1158,7 +1187,7 @@ def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float
         own = [o for o in cut if _outer(o, cut)]
         for loop in (o for o in loops if not _outer(o, loops)):
             inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
-            if len(inside) == 1:
+            if len(inside) == 1 and not _cavity(owner.mesh, loop, axis, level, inside[0].extent[0]):
                 around = sorted((o for o in loops if o is not loop and o.area > loop.area
                                  and o.contains(loop.centre)), key=lambda o: o.area)
                 return level, loop, around[0] if around else None, inside[0]
