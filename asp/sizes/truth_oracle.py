@@ -53,8 +53,8 @@ class TruthOracle:
     of its own; None: all parts on one line).
 
     ``parts`` and ``holes`` keep their order: it is the index order of the learner. A
-    truth naming no part and no hole (a product with no hole and no pin: nothing to learn)
-    is accepted with ``allow_empty``, else refused like one naming parts but no hole.
+    truth naming no part or no hole, and no fit (a product with no part in a hole or on a
+    pin: nothing to learn), is accepted with ``allow_empty``, else refused.
     """
 
     def __init__(
@@ -67,7 +67,7 @@ class TruthOracle:
         """The parts' sections stated by the truth's source (its product or section/2 facts)."""
         self.declared_model: str | None = None
         """The size model the truth's product declares, if any."""
-        empty = allow_empty and not (self.parts or self.holes or self.fits)
+        empty = allow_empty and not self.fits and not (self.parts and self.holes)
         if (not self.parts or not self.holes) and not empty:
             raise PlannerError(f"{source}: expected at least one part/1 and one hole/1")
         for p, h in sorted(self.fits):
@@ -107,7 +107,7 @@ class TruthOracle:
     @classmethod
     def from_assembly(cls, name_or_path: str, allow_empty: bool = False) -> TruthOracle:
         """An assembly's ``sizes.lp``, in the order of its ``assembly.toml`` (``allow_empty``:
-        one naming no part and no hole is nothing to learn, not refused)."""
+        one naming no part or no hole is nothing to learn, not refused)."""
         assembly = load_assembly(name_or_path)
         truth_parts, truth_holes, fits, _ = _read_truth(assembly.file("sizes.lp"))
         for kind, ids, known in (("part", truth_parts, assembly.part_ids),

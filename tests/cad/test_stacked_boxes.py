@@ -12,6 +12,7 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
+from tests.cad.test_closed_pockets import _write
 from tests.conftest import Runner
 
 ORDER = ["base", "lower", "upper"]
@@ -60,3 +61,21 @@ def test_stacked_boxes_are_planned_learned_and_assembled(tmp_path: Path, run_mai
     done = run_main("assemble", "--run", str(tmp_path / "run-sim"), "--backend", "truth", "--json", timeout=120)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["assembled"]
+
+
+@pytest.mark.slow
+def test_an_empty_hole_with_no_peg_leaves_nothing_to_learn(tmp_path: Path, run_main: Runner,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    # A block with an empty d 8 hole through it and a plate lying on its top: sizes.lp names
+    # the hole and no part, which the session refused ("expected at least one part/1 and one hole/1").
+    _write(tmp_path / "cad")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    assert "no part in a hole or on a pin: sizes.lp names no part, nothing to learn" in capsys.readouterr().out
+    done = run_main("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
+                    str(tmp_path / "run"), timeout=120)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert result["experiments"] == 0 and "nothing to learn" in result["assumption"]
+    assert [_order(plan) for plan in result["plans"]] == [[("block", None), ("plate", None)]]
+    assert result["assembly"]["assembled"]
