@@ -91,17 +91,22 @@ def test_a_cube_in_a_tray_on_the_base_is_in_no_hole_of_the_tray(tmp_path: Path) 
     assert {fit.part for fit in derived.holes.values()} == {"peg"}
 
 
-def test_a_wide_opening_through_the_base_stays_a_hole(tmp_path: Path) -> None:
-    # A d 30 opening through the plate beside the peg's d 10 hole: no floor, so no open box
-    # (a part may pass through it to what lies beyond), though 20 mm wider than the peg.
+def test_a_wide_opening_through_the_base_and_a_counterbored_hole_stay_holes(tmp_path: Path) -> None:
+    # A d 30 opening through the plate: no floor, so no open box (a part may pass through it
+    # to what lies beyond), though 20 mm wider than the peg. A d 20 counterbore 4 mm deep
+    # over a d 10 blind hole, sliced in the counterbore at the peg's level: its section over
+    # the stretch a part goes in is the d 10 hole's, so it is a spare hole for the peg.
     folder = tmp_path / "meshes"
     folder.mkdir()
     plate = _box((120.0, 120.0, 10.0), (0.0, 0.0, 5.0)).difference(_round(-30.0, 10.0, 9.0, 3.0))
-    plate.difference(_round(20.0, 30.0, 12.0, -1.0)).export(folder / "plate.stl")
+    plate = plate.difference(_round(20.0, 30.0, 12.0, -1.0))
+    plate = plate.difference(_round(-30.0, 20.0, 5.0, 6.0).union(_round(-30.0, 10.0, 8.0, 3.0)).apply_translation(
+        (0.0, 40.0, 0.0)))
+    plate.export(folder / "plate.stl")
     _round(-30.0, 9.8, 30.0, 3.0).export(folder / "peg.stl")
     derived = run_import(folder, tmp_path / "out", "mm", None).derived
-    assert sorted((fit.part or "", round(fit.hole.a * 1000)) for fit in derived.holes.values()) == [("", 30),
-                                                                                                   ("peg", 10)]
+    assert sorted((fit.part or "", round(fit.hole.a * 1000)) for fit in derived.holes.values()) == [
+        ("", 10), ("", 30), ("peg", 10)]
 
 
 def test_a_loop_on_one_line_is_a_polygon_of_no_width() -> None:
