@@ -178,7 +178,9 @@ def _summary(result: dict, run: Path) -> str:
     files = sorted(p.name for p in run.iterdir() if p.is_file() and not p.name.startswith("."))
     python = shlex.quote(sys.executable)
     learned = shlex.quote(str(run.resolve() / "learned.lp"))  # the "next" commands work from any folder
-    part = result["fits"][0][0] if result["fits"] else "p1"
+    part = result["fits"][0][0] if result["fits"] else None  # none when nothing fits (or nothing to learn)
+    asked = [] if part is None else [
+        (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -")]
     return "\n".join([
         f"run {result['run']}: {result['experiments']} experiments "
         f"({', '.join(f'{c}: {n}' for c, n in sorted(cells.items()))}) in {settings.wall_s:.1f} s",
@@ -199,7 +201,7 @@ def _summary(result: dict, run: Path) -> str:
         "next:",
         *(f"  {(label + ':').ljust(23)} {command}" for label, command in (
             ("view the recording", f"{_program()} view {shlex.quote(str(run.resolve()))}"),
-            (f"holes {part} fits into", f"echo '#show. #show H : fits({part},H).' | {python} -m clingo {learned} -"),
+            *asked,
             *([("five complete plans", f"{python} -m clingo {shlex.quote(str(encoding('plans.lp')))} {learned} 5")]
               if result["plans"] else []),
         )),

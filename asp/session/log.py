@@ -121,7 +121,7 @@ class PlannerLog:
         graph. One instant, so that a viewer paused where this experiment's rows start shows
         all of them."""
         matrix = np.array([[-1 if v is None else v for v in row] for row in knowledge.matrix()],
-                          dtype=np.int8)
+                          dtype=np.int8).reshape(len(knowledge.parts), len(knowledge.holes))
         dims = [f"part: {' '.join(knowledge.parts)}", f"hole: {' '.join(knowledge.holes)}"]
         nodes = [*knowledge.parts, *knowledge.holes]
         colors = [_PART_COLOR] * len(knowledge.parts) + [_HOLE_COLOR] * len(knowledge.holes)

@@ -153,9 +153,11 @@ def _holds_session(run: Path) -> bool:
 def _sizes_domain(assembly: Assembly, requested_model: str | None
                   ) -> tuple[list[str], list[str], TruthOracle | None, SizeModel]:
     """Parts and holes to learn, the truth (``sizes.lp``, if the product has one) and the
-    size model of the run (refused before any cell starts when it is unsound for the product)."""
+    size model of the run (refused before any cell starts when it is unsound for the product).
+    A ``sizes.lp`` naming no part or no hole (an imported product with no part in a hole or
+    on a pin) leaves nothing to learn: every part is planned without a hole."""
     if assembly.has_file("sizes.lp"):
-        known = TruthOracle.from_assembly(str(assembly.folder))
+        known = TruthOracle.from_assembly(str(assembly.folder), allow_empty=True)
         truth: TruthOracle | None = known
         parts, holes = list(known.parts), list(known.holes)
     else:

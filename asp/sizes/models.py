@@ -81,6 +81,8 @@ class SizeModel:
 
     def assumption(self) -> str:
         """One line saying what the model assumes, printed and written beside the results."""
+        if not self.sections:
+            return f"size model {self.name}: nothing to learn (no part goes into a hole or onto a pin)"
         if self.name == "pairs":
             return "size model pairs: no two pairs related, every pair is tried"
         groups = self.groups()

@@ -52,12 +52,14 @@ class TruthOracle:
     each section's parts (``sections``: part -> section, a part missing from it on a line
     of its own; None: all parts on one line).
 
-    ``parts`` and ``holes`` keep their order: it is the index order of the learner.
+    ``parts`` and ``holes`` keep their order: it is the index order of the learner. A
+    truth naming no part or no hole, and no fit (a product with no part in a hole or on a
+    pin: nothing to learn), is accepted with ``allow_empty``, else refused.
     """
 
     def __init__(
         self, parts: Sequence[str], holes: Sequence[str], fits: Iterable[tuple[str, str]],
-        source: str = "truth", sections: Mapping[str, str] | None = None,
+        source: str = "truth", sections: Mapping[str, str] | None = None, allow_empty: bool = False,
     ) -> None:
         self.parts, self.holes = tuple(parts), tuple(holes)
         self.fits = set(fits)
@@ -65,7 +67,8 @@ class TruthOracle:
         """The parts' sections stated by the truth's source (its product or section/2 facts)."""
         self.declared_model: str | None = None
         """The size model the truth's product declares, if any."""
-        if not self.parts or not self.holes:
+        empty = allow_empty and not self.fits and not (self.parts and self.holes)
+        if (not self.parts or not self.holes) and not empty:
             raise PlannerError(f"{source}: expected at least one part/1 and one hole/1")
         for p, h in sorted(self.fits):
             if p not in self.parts:
@@ -102,8 +105,9 @@ class TruthOracle:
         return found
 
     @classmethod
-    def from_assembly(cls, name_or_path: str) -> TruthOracle:
-        """An assembly's ``sizes.lp``, in the order of its ``assembly.toml``."""
+    def from_assembly(cls, name_or_path: str, allow_empty: bool = False) -> TruthOracle:
+        """An assembly's ``sizes.lp``, in the order of its ``assembly.toml`` (``allow_empty``:
+        one naming no part or no hole is nothing to learn, not refused)."""
         assembly = load_assembly(name_or_path)
         truth_parts, truth_holes, fits, _ = _read_truth(assembly.file("sizes.lp"))
         for kind, ids, known in (("part", truth_parts, assembly.part_ids),
@@ -118,7 +122,8 @@ class TruthOracle:
         holes = [h for h in assembly.hole_ids if h in truth_holes]
         declared = assembly.sections()
         sections = None if assembly.size_model == "line" else declared
-        found = cls(parts, holes, fits, source=str(assembly.folder / "sizes.lp"), sections=sections)
+        found = cls(parts, holes, fits, source=str(assembly.folder / "sizes.lp"), sections=sections,
+                    allow_empty=allow_empty)
         found.declared_sections, found.declared_model = declared, assembly.size_model
         return found
 

@@ -322,10 +322,12 @@ def report(derived: Derived) -> list[str]:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
                      f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon with no "
                      "rotational symmetry about its centre, no hole")
-    if not (derived.holes or derived.part_holes or derived.pins):
-        lines.append("no hole and no pin found: sizes.lp names no part and no hole, and `plan` and `session` "
-                     "need a part in a hole or on a pin (geometric_precedence.lp holds the order, "
-                     "for `precedence learn`)")
+    if not (derived.hole_of or any(fit.part for fit in derived.part_holes.values())
+            or any(pin.parts for pin in derived.pins.values())):
+        found = ("no part in a hole or on a pin: sizes.lp names no part" if derived.holes or derived.part_holes
+                 or derived.pins else "no hole and no pin found: sizes.lp names no part and no hole")
+        lines.append(f"{found}, nothing to learn; `plan` and `session` place every part without a hole, in the "
+                     "order of geometric_precedence.lp")
     lines.append("disassembly stages: " + " | ".join(" ".join(stage) for stage in derived.stages))
     for pid, by_direction in sorted(derived.located.items()):
         lines.append(f"part {pid} moved {_mm(derived.reach)} mm: " + "; ".join(

@@ -27,7 +27,10 @@ a pair of theirs that the blocking contradicts is dropped and reported.
 
 **Holes** are the inner loops of the base's slices perpendicular to the axes, at the middle
 of each part's depth in the base (or, with no part reaching into it, at the base's middle
-along z). A part is in the hole whose loop holds its slice's centre. Measured: both
+along z). A part is in the hole whose loop holds its slice's centre, unless that hole is
+floored and wider than the part by more than :data:`CAVITY_ROOM` (a tray's cavity the part
+rests in: no hole for it, nor is a moving part's loop so wide); an empty floored hole so
+much wider than every part left in a hole is none (:func:`_open_box`). Measured: both
 cross-sections, their clearance, the hole's entry (the base's highest point around it
 along the axis), depth (entry to the first face down its centre line, or through the
 base), entry chamfer (the loop's growth just below the entry, taken as 45°). An empty
@@ -119,6 +122,11 @@ insertion the cell's arm was measured to reach sideways (+x, +y, -y:
 :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways along x
 goes in along +x however the CAD is turned about z; a zero-clearance fit's axis that is
 none of these last, in the order found."""
+CAVITY_ROOM = 2 * LOCATING_REACH
+"""[m] A hole whose narrowest width exceeds a part's widest by more than this (6 mm)
+leaves that part, wherever it lies in it, free to move the locating rule's default reach
+one way or the other across: with a floor under it, a cavity that locates nothing of that
+size (an open tray's, a case's without its lid), no hole for it (:func:`_open_box`)."""
 _HOLE_LEVELS = 8
 """How many levels :func:`_hole_around` slices an owner at, and :func:`_pin_of` a part on a pin, at most,
 to find the hole or the pin."""
@@ -624,7 +632,7 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
     if not slices:
         z = base.mesh.vertices[:, 2]
         slices[("+z", round(float(z.min() + z.max()) / 2, 7))] = []
-    fits: list[HoleFit] = []
+    fits: list[tuple[HoleFit, np.ndarray, np.ndarray]] = []  # each with its centre at the level sliced, its axis
     for (name, level), members in sorted(slices.items()):
         axis = np.array(DIRECTIONS[name])
         loops = slice_loops(base.mesh, axis, level)
@@ -636,20 +644,43 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
             frame = frame_of(axis)
             centre = frame.T @ loop.centre + axis * level
             occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
-            same = [k for k, f in enumerate(fits) if f.axis == name and np.linalg.norm(
+            same = [k for k, (f, _, _) in enumerate(fits) if f.axis == name and np.linalg.norm(
                 np.array(f.centre) - centre - axis * np.dot(np.array(f.centre) - centre, axis)) < _SAME_HOLE]
-            if same and (occupant is None or fits[same[0]].part is not None):
+            if same and (occupant is None or fits[same[0]][0].part is not None):
                 continue
             if occupant is None and _roofed(base.mesh, centre, axis):
                 continue  # empty and roofed along its axis: a cavity open the other way (a brick's underside)
             # a hole met empty at another part's level (a shallower one beside a deeper) is its occupant's
-            fit = _measure(base, name, loop, level, around[0] if around else None, occupant, workers)
+            fit = (_measure(base, name, loop, level, around[0] if around else None, occupant, workers), centre, axis)
             if same:
                 fits[same[0]] = fit
             else:
                 fits.append(fit)
-    fits.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
-    return fits
+    found = _without_cavities(base.mesh, fits)
+    found.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
+    return found
+
+
+def _without_cavities(base: trimesh.Trimesh, fits: list[tuple[HoleFit, np.ndarray, np.ndarray]]) -> list[HoleFit]:
+    """The holes of ``fits`` (each with its centre at the level sliced and its axis) that
+    are no open box's cavity in ``base`` (:func:`_open_box`): a part in a cavity is in no
+    hole, and an empty cavity, or one so emptied, is no hole when it is one for the widest
+    part left in a hole (every empty floored loop wider than :data:`CAVITY_ROOM` when none is)."""
+    emptied = [(replace(fit, part=None, section=None)
+                if fit.section is not None and _open_box(fit.hole.b, fit.section.a, base, centre, axis) else fit,
+                centre, axis) for fit, centre, axis in fits]
+    widest = max((fit.section.a for fit, _, _ in emptied if fit.section is not None), default=0.0)
+    return [fit for fit, centre, axis in emptied
+            if fit.part is not None or not _open_box(fit.hole.b, widest, base, centre, axis)]
+
+
+def _open_box(narrowest: float, widest: float, mesh: trimesh.Trimesh, centre: np.ndarray, axis: np.ndarray) -> bool:
+    """Whether a loop of ``mesh`` ``narrowest`` [m] across (its section's short side) is an
+    open box's cavity for a part ``widest`` [m] at its widest (its section's long side): it
+    leaves it more than :data:`CAVITY_ROOM` of room, so it locates nothing of that size, and
+    it has a floor (the ray from its ``centre`` [m] down the unit ``axis`` goes into the
+    solid: no opening through)."""
+    return narrowest - widest > CAVITY_ROOM and _roofed(mesh, centre, -axis)
 
 
 def _outer(loop: Loop, loops: list[Loop]) -> bool:
@@ -1158,7 +1189,8 @@ def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float
         own = [o for o in cut if _outer(o, cut)]
         for loop in (o for o in loops if not _outer(o, loops)):
             inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
-            if len(inside) == 1:
+            if len(inside) == 1 and not _open_box(loop.extent[1], inside[0].extent[0], owner.mesh,
+                                                  frame.T @ loop.centre + axis * level, axis):
                 around = sorted((o for o in loops if o is not loop and o.area > loop.area
                                  and o.contains(loop.centre)), key=lambda o: o.area)
                 return level, loop, around[0] if around else None, inside[0]

@@ -54,7 +54,7 @@ import trimesh
 from matplotlib.path import Path as PolygonPath
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import depth_first_order
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, QhullError
 from trimesh.constants import tol_path
 from trimesh.grouping import unique_rows
 from trimesh.path.entities import Line
@@ -98,6 +98,12 @@ class Loop:
         if abs(signed) < 1e-18:
             return self.points.mean(axis=0)
         return np.array([np.sum((x + np.roll(x, -1)) * cross), np.sum((y + np.roll(y, -1)) * cross)]) / (6 * signed)
+
+    @cached_property
+    def extent(self) -> tuple[float, float]:
+        """The sides (a ≥ b) [m] of the minimum-area rectangle around the loop."""
+        a, b, _ = _min_rectangle(self.points)
+        return a, b
 
     def contains(self, point: np.ndarray) -> bool:
         return bool(PolygonPath(self.points).contains_point((float(point[0]), float(point[1]))))
@@ -617,8 +623,13 @@ def _closed_paths(section: trimesh.path.Path3D) -> list[list[int]]:
 
 
 def _min_rectangle(points: np.ndarray) -> tuple[float, float, float]:
-    """Sides (a ≥ b) [m] and the angle of a [rad] of the minimum-area rectangle around ``points``."""
-    hull = points[ConvexHull(points).vertices] if len(points) > 3 else points
+    """Sides (a ≥ b) [m] and the angle of a [rad] of the minimum-area rectangle around
+    ``points``; b is 0 when they lie on one line (Qhull finds no hull of them)."""
+    flat = False
+    try:
+        hull = points[ConvexHull(points).vertices] if len(points) > 3 else points
+    except QhullError:  # no area: the sliver two faces leave where they meet
+        hull, flat = points, True
     best = (math.inf, 0.0, 0.0, 0.0)
     for i in range(len(hull)):
         edge = hull[(i + 1) % len(hull)] - hull[i]
@@ -632,6 +643,8 @@ def _min_rectangle(points: np.ndarray) -> tuple[float, float, float]:
         if extent[0] * extent[1] < best[0]:
             best = (float(extent[0] * extent[1]), float(extent[0]), float(extent[1]), angle)
     _, w, h, angle = best
+    if flat:
+        w, h = max(w, h), 0.0
     return (w, h, angle) if w >= h else (h, w, angle + math.pi / 2)
 
 

@@ -1,0 +1,117 @@
+"""An open box (a tray, a case without its lid) is no hole: its cavity, floored and wider
+than what rests in it by more than ``executor.cad.derive.CAVITY_ROOM``, locates nothing of
+that size, so the part resting in it is in no hole, and an empty one is no hole for the
+pegs of the product; a hole as wide as its peg, an empty one as wide as the product's pegs
+and a wide opening through the base stay holes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import shapely
+import trimesh
+
+from executor.cad.cli import run_import
+from executor.cad.sections import Loop, classify
+
+
+def _round(x: float, d: float, height: float, bottom: float) -> trimesh.Trimesh:
+    """A cylinder of diameter ``d`` at (``x``, 0) from ``bottom`` up ``height`` [mm]."""
+    solid = trimesh.creation.extrude_polygon(shapely.Point(x, 0.0).buffer(d / 2, quad_segs=16), height)
+    solid.apply_translation((0.0, 0.0, bottom))
+    return solid
+
+
+def _box(size: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
+    box = trimesh.creation.box(size)
+    box.apply_translation(centre)
+    return box
+
+
+def _open_box(outside: tuple[float, float, float], floor: float, wall: float,
+              at: tuple[float, float, float]) -> trimesh.Trimesh:
+    """A box ``outside`` [mm] whose bottom's centre is ``at``, hollowed from its top down to a
+    ``floor`` thick bottom, its walls ``wall`` thick."""
+    x, y, z = outside
+    cavity = _box((x - 2 * wall, y - 2 * wall, z), (at[0], at[1], at[2] + floor + z / 2))
+    return _box(outside, (at[0], at[1], at[2] + z / 2)).difference(cavity)
+
+
+def _case(folder: Path, *, peg: bool, block: tuple[float, float]) -> None:
+    """A case 120 x 120 x 40 mm open at its top (floor 10 mm, walls 10 mm) as the base, a
+    30 x 30 x 10 mm block resting on its floor at ``block`` (x, y) [mm] and, with ``peg``,
+    a d 9.8 peg in a d 10 hole 7 mm deep in the floor at x -30 beside an empty d 10 hole at
+    x -30, y 30, as STL [mm]."""
+    folder.mkdir()
+    case = _open_box((120.0, 120.0, 40.0), 10.0, 10.0, (0.0, 0.0, 0.0))
+    if peg:
+        for y in (0.0, 30.0):
+            bore = _round(-30.0, 10.0, 9.0, 3.0)
+            bore.apply_translation((0.0, y, 0.0))
+            case = case.difference(bore)
+        _round(-30.0, 9.8, 30.0, 3.0).export(folder / "peg.stl")
+    case.export(folder / "case.stl")
+    _box((30.0, 30.0, 10.0), (block[0], block[1], 15.0)).export(folder / "block.stl")
+
+
+def test_a_block_resting_in_an_open_case_is_in_no_hole(tmp_path: Path) -> None:
+    # The block lies 2 mm off two walls of the case's 100 mm cavity: the import took the
+    # cavity for a square hole holding the block (35 mm all round), and the peg fitting it.
+    _case(tmp_path / "meshes", peg=True, block=(33.0, 33.0))
+    derived = run_import(tmp_path / "meshes", tmp_path / "out", "mm", None).derived
+    assert derived.base == "case"
+    assert {fit.part for fit in derived.holes.values()} == {"peg", None}  # the peg's hole and the empty one
+    assert all(fit.hole.kind == "round" and abs(fit.hole.a - 0.010) < 1e-4 for fit in derived.holes.values())
+    assert "block" not in derived.hole_of
+    sizes = (tmp_path / "out" / "sizes.lp").read_text()
+    assert "part(peg)." in sizes and "block" not in sizes and "hole(h3)" not in sizes
+
+
+def test_an_empty_open_case_is_no_hole(tmp_path: Path) -> None:
+    # Nothing stands in the case's floor: sliced at its middle, its empty cavity was a
+    # 100 mm square hole that sizes.lp named with no part to go into it.
+    _case(tmp_path / "meshes", peg=False, block=(0.0, 0.0))
+    derived = run_import(tmp_path / "meshes", tmp_path / "out", "mm", None).derived
+    assert not derived.holes and not derived.pins and not derived.part_holes
+
+
+def test_a_cube_in_a_tray_on_the_base_is_in_no_hole_of_the_tray(tmp_path: Path) -> None:
+    # A 10 mm cube 1 mm off two walls of a tray's 40 mm cavity: the import measured the
+    # cavity as a hole of the tray holding it (a traceback, then a refused section).
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    plate = _box((120.0, 120.0, 10.0), (0.0, 0.0, 5.0)).difference(_round(-30.0, 10.0, 9.0, 3.0))
+    plate.export(folder / "plate.stl")
+    _round(-30.0, 9.8, 30.0, 3.0).export(folder / "peg.stl")
+    _open_box((50.0, 50.0, 20.0), 5.0, 5.0, (25.0, 0.0, 10.0)).export(folder / "tray.stl")
+    _box((10.0, 10.0, 10.0), (39.0, 14.0, 20.0)).export(folder / "cube.stl")
+    derived = run_import(folder, tmp_path / "out", "mm", None).derived
+    assert derived.base == "plate" and not derived.part_holes
+    assert {fit.part for fit in derived.holes.values()} == {"peg"}
+
+
+def test_a_wide_opening_through_the_base_and_a_counterbored_hole_stay_holes(tmp_path: Path) -> None:
+    # A d 30 opening through the plate: no floor, so no open box (a part may pass through it
+    # to what lies beyond), though 20 mm wider than the peg. A d 20 counterbore 4 mm deep
+    # over a d 10 blind hole, sliced in the counterbore at the peg's level: its section over
+    # the stretch a part goes in is the d 10 hole's, so it is a spare hole for the peg.
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    plate = _box((120.0, 120.0, 10.0), (0.0, 0.0, 5.0)).difference(_round(-30.0, 10.0, 9.0, 3.0))
+    plate = plate.difference(_round(20.0, 30.0, 12.0, -1.0))
+    plate = plate.difference(_round(-30.0, 20.0, 5.0, 6.0).union(_round(-30.0, 10.0, 8.0, 3.0)).apply_translation(
+        (0.0, 40.0, 0.0)))
+    plate.export(folder / "plate.stl")
+    _round(-30.0, 9.8, 30.0, 3.0).export(folder / "peg.stl")
+    derived = run_import(folder, tmp_path / "out", "mm", None).derived
+    assert sorted((fit.part or "", round(fit.hole.a * 1000)) for fit in derived.holes.values()) == [
+        ("", 10), ("", 30), ("peg", 10)]
+
+
+def test_a_loop_on_one_line_is_a_polygon_of_no_width() -> None:
+    # Four points on one line (a cavity's sliver): Qhull found no hull of them (QhullError).
+    sliver = Loop(np.array([[0.565, -0.02], [0.565, 0.02], [0.565, -0.0067], [0.565, 0.01]]))
+    shape = classify(sliver, hole=True)
+    assert shape.kind == "polygon" and shape.b == 0.0 and abs(shape.a - 0.04) < 1e-9
+    assert sliver.extent == (shape.a, 0.0)

@@ -1,0 +1,81 @@
+"""A product with no hole and no pin, three boxes stacked on each other (each part rests on
+the one below): imported, it leaves nothing to learn, and ``plan``, ``session`` (truth and
+sim backends) and ``assemble`` place its parts in the order the geometry forces, the two
+boxes by hand (the cell has no operation that locates a part resting on a face)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import trimesh
+
+from assembly_constraints.cli import main
+from tests.cad.test_closed_pockets import _write
+from tests.conftest import Runner
+
+ORDER = ["base", "lower", "upper"]
+
+
+def _stack(folder: Path) -> None:
+    """A 100 x 100 x 10 mm base, a 40 x 40 x 20 mm box on it and a 30 x 30 x 15 mm box on
+    that one, as STL [mm]."""
+    folder.mkdir()
+    bottom = 0.0
+    for name, (x, y, z) in zip(ORDER, ((100.0, 100.0, 10.0), (40.0, 40.0, 20.0), (30.0, 30.0, 15.0))):
+        box = trimesh.creation.box((x, y, z))
+        box.apply_translation((0.0, 0.0, bottom + z / 2))
+        box.export(folder / f"{name}.stl")
+        bottom += z
+
+
+def _order(plan: list[dict]) -> list[tuple[str, str | None]]:
+    return [(step["part"], step["hole"]) for step in plan]
+
+
+@pytest.mark.slow
+def test_stacked_boxes_are_planned_learned_and_assembled(tmp_path: Path, run_main: Runner,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    _stack(tmp_path / "cad")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    assert "no hole and no pin found: sizes.lp names no part and no hole, nothing to learn" in capsys.readouterr().out
+    done = run_main("plan", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
+                    "--json", "-n", "0")
+    assert done.returncode == 0, done.stderr
+    assert [_order(plan) for plan in json.loads(done.stdout)["plans"]] == [[(part, None) for part in ORDER]]
+    for backend in ("truth", "sim"):
+        run = tmp_path / f"run-{backend}"
+        done = run_main("session", "--backend", backend, "--json", "--assemble", "--assembly", str(out), "--out",
+                        str(run), timeout=240)
+        assert done.returncode == 0, done.stderr
+        result = json.loads(done.stdout)
+        assert result["experiments"] == 0 and result["fits"] == []
+        assert "nothing to learn" in result["assumption"]
+        assert [_order(plan) for plan in result["plans"]] == [[(part, None) for part in ORDER]]
+        assert result["must_precede"] == [["base", "lower"], ["base", "upper"], ["lower", "upper"]]
+        report = result["assembly"]
+        assert report["assembled"] and "error" not in report, report
+        assert [step["skill"] for step in report["steps"]][1:] == ["manual", "manual"]
+    done = run_main("assemble", "--run", str(tmp_path / "run-sim"), "--backend", "truth", "--json", timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["assembled"]
+
+
+@pytest.mark.slow
+def test_an_empty_hole_with_no_peg_leaves_nothing_to_learn(tmp_path: Path, run_main: Runner,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    # A block with an empty d 8 hole through it and a plate lying on its top: sizes.lp names
+    # the hole and no part, which the session refused ("expected at least one part/1 and one hole/1").
+    _write(tmp_path / "cad")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    assert "no part in a hole or on a pin: sizes.lp names no part, nothing to learn" in capsys.readouterr().out
+    done = run_main("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
+                    str(tmp_path / "run"), timeout=120)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert result["experiments"] == 0 and "nothing to learn" in result["assumption"]
+    assert [_order(plan) for plan in result["plans"]] == [[("block", None), ("plate", None)]]
+    assert result["assembly"]["assembled"]
