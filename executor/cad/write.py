@@ -55,6 +55,7 @@ from pathlib import Path
 import clingo
 import networkx as nx
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.errors import ToolError
@@ -98,7 +99,7 @@ from executor.cad.operations import (
     upright,
 )
 from executor.cad.parts import turn_text
-from executor.cad.sections import Shape2D, section
+from executor.cad.sections import Shape2D, section, slice_loops
 from executor.cad.sections import rounded as _q
 from executor.cad.sweep import DIRECTIONS, opposite
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, plate_obj_text
@@ -207,6 +208,32 @@ def sideways_depth(derived: Derived, fit: HoleFit) -> float:
     if fit.part is None:
         return fit.depth
     return fit.entry - float(upright(derived, fit).bounds[0][2])
+
+
+STOP_PROBE = 1e-4
+"""How far [m] under a part's tip the base is cut to see whether the hole narrows there."""
+
+
+def down_depth(derived: Derived, fit: HoleFit) -> float:
+    """The ``depth`` [m] of a hole entered down: to where its part's tip is in the CAD where
+    the base's opening just under the tip does not hold the part's section at the middle of
+    its stretch in the hole (a plate on the ledge of a recess: the cell's goal, where the
+    part rests, is the CAD's, not the floor down the hole's centre line); else the measured
+    depth (to that floor, or through)."""
+    if fit.part is None:
+        return fit.depth
+    mesh = derived.parts[fit.part].mesh
+    (_, _, tip), (_, _, top) = mesh.bounds
+    if fit.entry - tip >= fit.depth - LEVEL:  # on the floor, or below the entry
+        return fit.depth
+    up = np.array([0.0, 0.0, 1.0])
+    base = derived.parts[derived.base].mesh
+    below = [shapely.Polygon(loop.points) for loop in slice_loops(base, up, tip - STOP_PROBE)
+             if loop.contains(fit.hole.centre)]
+    outline = shapely.union_all([shapely.Polygon(loop.points)
+                                 for loop in slice_loops(mesh, up, (tip + min(top, fit.entry)) / 2)])
+    passes = bool(below) and outline.within(min(below, key=lambda loop: loop.area))
+    return fit.depth if passes else fit.entry - float(tip)
 
 
 def sizes_text(derived: Derived) -> str:
@@ -620,8 +647,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         else:
             if abs(fit.entry - top) > LEVEL:
                 lines.append(f"top_z = {_q(fit.entry)}")
-            if abs(fit.depth - depth) > LEVEL:
-                lines.append(f"depth = {_q(fit.depth)}")
+            if abs(down_depth(derived, fit) - depth) > LEVEL:
+                lines.append(f"depth = {_q(down_depth(derived, fit))}")
         lines.append("")
     for pid, fit in sorted(derived.hole_of.items()):
         mesh, peg = upright(derived, fit), derived.swept.get((pid, fit.id), (fit.section,))[0]
