@@ -62,13 +62,15 @@ def test_a_2_mm_plate_goes_on_the_suction_cup_into_its_recess_at_the_ledge_it_re
     # nop_printed_box's base: a 2 mm plate, the cell's hull margin twice: it collides as
     # itself within what the cell resolves (executor/world/meshes.py), so it is inserted, not
     # placed by hand; it rests on the ledge 2.99 mm under the recess's rim, where the cell's
-    # goal is, not on the case's top 43 mm down the recess's centre line.
+    # goal is, not on the case's top 43 mm down the recess's centre line. So shallow a
+    # recess cannot tell a plate in it from one on its rim: the fit is no experiment.
     done = import_product(Path(__file__).parent / "corpus" / "nop_printed_box", tmp_path / "out")
     geometry = tomllib.loads((done.out / "geometry.toml").read_text())
     assert "manual" not in geometry
     assert geometry["part_shapes"]["smooth_box_base"]["tool"] == "suction"
     (hole,) = geometry["hole_shapes"].values()
     assert hole["depth"] == pytest.approx(0.045 - 0.0420078, abs=1e-6)
+    assert hole["near_miss"] == ["smooth_box_base"]
 
 
 @pytest.mark.slow  # imports, teaches, learns 6 pairs in physics and assembles (about 90 s under load)
