@@ -183,8 +183,9 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     or parts with a ``bore`` for a pin): the section is the nominal one, and a listed part
     whose section is not wider passes (any other part needs room above 0). ``near_miss``
     names the pegs that miss the hole by less than the simulated cell resolves with their
-    corners rounded by its hull margin (``executor.world.near_miss``): no experiment, their
-    outcome is taken from ``sizes.lp``. ``tile`` is the
+    corners rounded by its hull margin (``executor.world.near_miss``), or every peg of a
+    hole no deeper than the cell's goal tolerance (one blocked on its rim ends as near its
+    goal): no experiment, their outcome is taken from ``sizes.lp``. ``tile`` is the
     side of their square bosses [m] where it differs from the plate's ``tile_size``."""
 
     holes: Ids

@@ -26,8 +26,8 @@ peg's base) :data:`ROOM_KEPT` of the room its mesh leaves it, and overlap none i
 (measured with python-fcl in the assembled pose) but one at a stated zero-clearance fit or
 passage with it (:class:`executor.cad.fits.faces.Slide`: the mesh leaves it room 0, and a
 decomposition's hulls reach beyond the mesh by its error), which they may overlap by up to
-:data:`NOMINAL_OVERLAP`; each piece at least 2 mm thick (the
-cell's hull margin twice: :mod:`executor.world.meshes`); CoACD's
+:data:`NOMINAL_OVERLAP`; each piece at least 1.952 mm thick (the
+cell's hull margin twice less what it resolves: :mod:`executor.world.meshes`); CoACD's
 :data:`THRESHOLDS` are tried in turn with each seed until they do (the third line names the threshold, the seed
 and the least room left), and
 a part whose pieces never do is named and gets none. The decomposition is made here,
@@ -60,7 +60,7 @@ from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import Shape2D, classify, exact_round, slice_loops
 from executor.cad.sweep import bvh, convex_object
 from executor.world import SIZE_RESOLUTION
-from executor.world.meshes import URDF_HULL_MARGIN, eroded, obj_text
+from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded, obj_text
 
 PRIMITIVE_TOLERANCE = 0.01
 """A part is the primitive its sections describe when their volumes differ by less than
@@ -230,7 +230,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     each of them :data:`ROOM_KEPT` of the room the mesh leaves it (touching: none
     deeper than :data:`executor.cad.fits.faces.TOUCH`; those in ``fits``, at a stated
     zero-clearance fit or passage with it: none deeper than :data:`NOMINAL_OVERLAP`)
-    with every piece at least twice the cell's hull margin thick (CoACD's tree search
+    with every piece at least :data:`executor.world.meshes.MIN_THICKNESS` thick (CoACD's tree search
     making ``iterations`` per cut)."""
     allowed = {name: NOMINAL_OVERLAP if name in fits else TOUCH for name in neighbours}
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
@@ -266,7 +266,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
              + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else ""))
     if not short:
         return (f"part '{pid}' has no convex pieces the cell can collide as ({tried}: each gave a piece thinner than "
-                f"{2000 * URDF_HULL_MARGIN:g} mm, the cell's hull margin twice)")
+                f"{1e3 * MIN_THICKNESS:g} mm, the cell's hull margin twice less what it resolves)")
     name = min(short, key=lambda n: left[n] - ROOM_KEPT * rooms[n] + allowed[n])
     expected = (f"at a zero-clearance fit with it, expected an overlap of at most {1e3 * NOMINAL_OVERLAP:g} mm"
                 if name in fits else f"expected at least {ROOM_KEPT:.0%}")

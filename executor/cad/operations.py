@@ -46,7 +46,7 @@ from executor.cad.sweep import opposite
 from executor.world import SIZE_RESOLUTION
 from executor.world.frames import hole_rotation
 from executor.world.geometry import Section, seated_pose, thin_prism
-from executor.world.meshes import URDF_HULL_MARGIN
+from executor.world.meshes import MIN_THICKNESS
 from executor.world.polygon_fit import OutlineError
 from executor.world.rings import NoStack, ring_pieces
 
@@ -336,7 +336,7 @@ def _owner_refused(derived: Derived, pin: PinFit, fit: HoleFit | None) -> str:
 def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
     """What holds the peg of ``fit`` and why: ``fingers`` for a part longer than
     :data:`GRIPPER`'s grasp depth (held by its sides that deep), else ``suction`` where
-    it is thicker than the cell's hull margin twice and the cup (``cup_diameter``) lies
+    it is at least :data:`executor.world.meshes.MIN_THICKNESS` thick and the cup (``cup_diameter``) lies
     whole on its flat top (:func:`flat_top`: the face opposite its way in, around its
     axis), else "" (placed by hand) with why."""
     assert fit.part is not None and fit.section is not None
@@ -346,9 +346,9 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
         return "fingers", f"{1e3 * length:.3f} mm long, held {1e3 * depth:g} mm deep by the fingers"
     short = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's grasp depth "
              f"({1e3 * depth:g} mm)")
-    if length <= 2 * URDF_HULL_MARGIN + 1e-9:  # a physics limit: no convex piece of it keeps its shape
-        return "", (f"{short}, and no thicker than the cell's hull margin twice ({2e3 * URDF_HULL_MARGIN:g} mm): "
-                    "it has no convex pieces the cell can collide as")
+    if length < MIN_THICKNESS:  # a physics limit: no convex piece of it keeps its shape
+        return "", (f"{short}, and thinner than the cell's hull margin twice less what it resolves "
+                    f"({1e3 * MIN_THICKNESS:g} mm): it has no convex pieces the cell can collide as")
     top = flat_top(mesh)
     cup = shapely.Point(*fit.section.centre).buffer(GRIPPER["cup_diameter"] / 2, 64)
     if top.is_empty:

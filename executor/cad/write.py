@@ -55,6 +55,7 @@ from pathlib import Path
 import clingo
 import networkx as nx
 import numpy as np
+import shapely
 import trimesh
 
 from bridge.errors import ToolError
@@ -98,9 +99,10 @@ from executor.cad.operations import (
     upright,
 )
 from executor.cad.parts import turn_text
-from executor.cad.sections import Shape2D, section
+from executor.cad.sections import Shape2D, section, slice_loops
 from executor.cad.sections import rounded as _q
 from executor.cad.sweep import DIRECTIONS, opposite
+from executor.control.detector import Thresholds
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, plate_obj_text
 from executor.world.meshes import read_objects
 from executor.world.near_miss import mesh_near_miss, near_miss
@@ -209,6 +211,32 @@ def sideways_depth(derived: Derived, fit: HoleFit) -> float:
     return fit.entry - float(upright(derived, fit).bounds[0][2])
 
 
+STOP_PROBE = 1e-4
+"""How far [m] under a part's tip the base is cut to see whether the hole narrows there."""
+
+
+def down_depth(derived: Derived, fit: HoleFit) -> float:
+    """The ``depth`` [m] of a hole entered down: to where its part's tip is in the CAD where
+    the base's opening just under the tip does not hold the part's section at the middle of
+    its stretch in the hole (a plate on the ledge of a recess: the cell's goal, where the
+    part rests, is the CAD's, not the floor down the hole's centre line); else the measured
+    depth (to that floor, or through)."""
+    if fit.part is None:
+        return fit.depth
+    mesh = derived.parts[fit.part].mesh
+    (_, _, tip), (_, _, top) = mesh.bounds
+    if fit.entry - tip >= fit.depth - LEVEL:  # on the floor, or below the entry
+        return fit.depth
+    up = np.array([0.0, 0.0, 1.0])
+    base = derived.parts[derived.base].mesh
+    below = [shapely.Polygon(loop.points) for loop in slice_loops(base, up, tip - STOP_PROBE)
+             if loop.contains(fit.hole.centre)]
+    outline = shapely.union_all([shapely.Polygon(loop.points)
+                                 for loop in slice_loops(mesh, up, (tip + min(top, fit.entry)) / 2)])
+    passes = bool(below) and outline.within(min(below, key=lambda loop: loop.area))
+    return fit.depth if passes else fit.entry - float(tip)
+
+
 def sizes_text(derived: Derived) -> str:
     """``sizes.lp``: ``fits(P,H)`` for every peg whose nominal section passes a hole's
     (:func:`executor.cad.operations.margins`) or is a nominal zero-clearance fit in it
@@ -258,23 +286,32 @@ def zero_clearance_parts(derived: Derived) -> dict[str, list[str]]:
     return found
 
 
+RIM_PRESS = 2e-4
+"""How far [m] a part blocked on a hole's rim may end below the rim, pressed into it by the
+insertion (0.05-0.18 mm measured: docs/cell.md, "What the physics resolves")."""
+
+
 def near_misses(derived: Derived, pieces: Mapping[str, Sequence[np.ndarray]] | None = None
-                ) -> dict[tuple[str, str], float]:
-    """(peg, hole of the base) -> how deep [m] the cell's peg lacks its section, plus the
-    cell's resolution, for each no-fit the simulated cell cannot resolve: for a peg the
+                ) -> dict[tuple[str, str], str]:
+    """(peg, hole of the base) -> why the simulated cell cannot tell the pair's outcome:
+    every peg in a hole no deeper than the cell's goal tolerance plus :data:`RIM_PRESS` (a
+    part blocked on its rim ends as near its goal as one inside it), and each no-fit it
+    cannot resolve (:func:`near_miss_reason`, how deep [m] the cell's peg lacks its
+    section, plus the cell's resolution): for a peg the
     cell builds from its section (a cylinder, a box, a polygon's prism),
     :func:`executor.world.near_miss.near_miss` (its section eroded by what its collision
     shape may lack passes the hole); for a peg simulated from its mesh, whose convex
     pieces (vertices in its part frame) are in ``pieces``,
     :func:`executor.world.near_miss.mesh_near_miss` (what its pieces cover over the
     stretch that enters the hole passes it). A hole's ``near_miss`` in ``geometry.toml``."""
-    rooms, pairs, found = margins(derived), section_pairs(derived), {}
+    rooms, pairs, found, tried = margins(derived), section_pairs(derived), {}, []
     for pid, fit in sorted(derived.hole_of.items()):
         if fit.section is None:
             continue
         primitive = peg_is_primitive(fit, upright(derived, fit))
         if not primitive and (pieces is None or pid not in pieces):
             continue
+        tried.append(pid)
         tip = float((derived.parts[pid].mesh.vertices @ np.array(DIRECTIONS[fit.axis])).min())
         for hid in derived.holes:
             peg, hole = pairs[pid][hid]
@@ -282,7 +319,16 @@ def near_misses(derived: Derived, pieces: Mapping[str, Sequence[np.ndarray]] | N
             depth = (near_miss(part, cell_hole, rooms[pid][hid]) if primitive else
                      mesh_near_miss(part, (pieces or {})[pid], fit.entry - tip, cell_hole, rooms[pid][hid]))
             if depth is not None:
-                found[(pid, hid)] = depth
+                found[(pid, hid)] = near_miss_reason(pid, hid, depth)
+    tolerance = Thresholds().goal_tolerance
+    for hid, fit in derived.holes.items():
+        deep = down_depth(derived, fit) if fit.axis == "+z" else sideways_depth(derived, fit)
+        if deep <= tolerance + RIM_PRESS:
+            for pid in tried:
+                found.setdefault((pid, hid), (
+                    f"{pid} in {hid}: the hole is {1e3 * deep:.3f} mm deep, no deeper than the cell's goal tolerance "
+                    f"({1e3 * tolerance:g} mm) plus {1e3 * RIM_PRESS:g} mm: a part blocked on its rim would end as "
+                    "near its goal as one inside it, decided from the CAD"))
     return found
 
 
@@ -303,8 +349,8 @@ def near_miss_assumption(derived: Derived, pieces: Mapping[str, Sequence[np.ndar
     """The near misses the PyBullet cell does not observe (:func:`near_misses`), as
     ``import`` prints them (none without one), saying which backends try them
     (:data:`bridge.assembly.NEAR_MISS_BACKENDS`)."""
-    return [f"no experiment of the PyBullet cell (backend sim; the truth and franka backends try it): "
-            f"{near_miss_reason(pid, hid, depth)}" for (pid, hid), depth in near_misses(derived, pieces).items()]
+    return [f"no experiment of the PyBullet cell (backend sim; the truth and franka backends try it): {reason}"
+            for reason in near_misses(derived, pieces).values()]
 
 
 def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
@@ -606,10 +652,10 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_section_lines(nominal_section(_hole_section(derived, hid, fit),
                                                   [pairs[pid][hid][0] for pid in listed])),
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
-        close = [(pid, depth) for (pid, h), depth in missed.items() if h == hid]
+        close = [(pid, reason) for (pid, h), reason in missed.items() if h == hid]
         if close:
             lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
-                         + "; ".join(near_miss_reason(pid, hid, depth) for pid, depth in close))
+                         + "; ".join(reason for _, reason in close))
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         if hid in own:
@@ -620,8 +666,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         else:
             if abs(fit.entry - top) > LEVEL:
                 lines.append(f"top_z = {_q(fit.entry)}")
-            if abs(fit.depth - depth) > LEVEL:
-                lines.append(f"depth = {_q(fit.depth)}")
+            if abs(down_depth(derived, fit) - depth) > LEVEL:
+                lines.append(f"depth = {_q(down_depth(derived, fit))}")
         lines.append("")
     for pid, fit in sorted(derived.hole_of.items()):
         mesh, peg = upright(derived, fit), derived.swept.get((pid, fit.id), (fit.section,))[0]

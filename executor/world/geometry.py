@@ -62,6 +62,7 @@ from executor import ExecutorError
 from executor.cell_description import CellDescription
 from executor.world.frames import HoleFrame, aligned_yaw, hole_frame, yaw_quat
 from executor.world.meshes import (
+    MIN_THICKNESS,
     URDF_HULL_MARGIN,
     MeshBody,
     MeshFiles,
@@ -668,14 +669,14 @@ def prism(part: PartSpec) -> list[np.ndarray] | None:
 
 def thin_prism(part: Section, length: float) -> str | None:
     """Why the cell cannot collide as the prism of a polygon section over ``length`` [m]
-    (a convex piece of its outline thinner than twice the URDF hull margin, which the
-    margin would widen), None when it can."""
+    (a convex piece of its outline thinner than :data:`executor.world.meshes.MIN_THICKNESS`,
+    which the margin would widen), None when it can."""
     for k, vertices in enumerate(prism_pieces(outline_polygon(part, peg=True), length)):
         if eroded(vertices, URDF_HULL_MARGIN) is None:
             inradius = shapely.length(shapely.maximum_inscribed_circle(shapely.MultiPoint(vertices[:, :2]).convex_hull,
                                                                        1e-7))
             return (f"convex piece {k + 1} of its outline is {2e3 * inradius:.3f} mm thick, less than the cell's hull "
-                    f"margin twice ({2e3 * URDF_HULL_MARGIN:g} mm)")
+                    f"margin twice less what it resolves ({1e3 * MIN_THICKNESS:g} mm)")
     return None
 
 

@@ -9,8 +9,11 @@ inflates every hull by :data:`URDF_HULL_MARGIN` (measured: a 10 mm box rests 1.0
 the floor; ``changeDynamics(collisionMargin=...)`` does not reach a URDF link's hulls).
 So the generated asset is each piece eroded by that margin (its faces moved inwards),
 which the margin then adds back: the piece as it is, its edges rounded by 1 mm (as the
-cell's primitive shapes' edges act). A piece thinner than twice the margin has no eroded
-form and is refused. The base is a static concave triangle mesh (no margin).
+cell's primitive shapes' edges act). Across a face where the piece is thinner than twice
+the margin (a 2 mm plate), its faces are moved in to near its middle instead, so the cell's
+piece is the piece with each face at most :data:`THIN_EXCESS` farther out; a piece thinner
+than :data:`MIN_THICKNESS` has no eroded form and is refused. The base is a static concave
+triangle mesh (no margin).
 """
 
 from __future__ import annotations
@@ -26,9 +29,19 @@ from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
 from bridge.product import Mesh
 from executor import ExecutorError
+from executor.world import SIZE_RESOLUTION
 
 URDF_HULL_MARGIN = 0.001
 """How much PyBullet's URDF importer inflates each convex hull of a link [m]."""
+THIN_EXCESS = SIZE_RESOLUTION
+"""How far [m] a face of a convex piece as the cell collides as it may lie outside the
+piece's (where the piece is thinner than twice :data:`URDF_HULL_MARGIN` across it): the
+size the cell resolves."""
+THIN_CORE = 1e-6
+"""Half the thickness [m] an eroded piece keeps across a face where the piece is thinner
+than twice the margin (a flat core would have no interior for the half-space intersection)."""
+MIN_THICKNESS = 2 * (URDF_HULL_MARGIN - THIN_EXCESS + THIN_CORE)
+"""The thinnest [m] a convex piece of a moving part may be across any face (1.952 mm)."""
 
 
 def obj_text(objects: Sequence[tuple[str, np.ndarray, np.ndarray]], header: str) -> str:
@@ -71,12 +84,21 @@ def read_objects(path: Path) -> list[np.ndarray]:
 
 def eroded(vertices: np.ndarray, margin: float) -> trimesh.Trimesh | None:
     """The convex hull of ``vertices`` [m] with every face moved inwards by ``margin``
-    [m]; None when nothing is left (the hull is thinner than twice the margin)."""
+    [m]; a face whose hull is thinner than twice the margin across it moved in to
+    :data:`THIN_CORE` of its middle instead, when that leaves it at most
+    :data:`THIN_EXCESS` short of the margin (a 2 mm plate: its faces across its thickness
+    meet near its mid-plane, and the margin added back makes it 2 mm thick again); None
+    when nothing is left (the hull thinner than :data:`MIN_THICKNESS` across a face)."""
     try:
         hull = ConvexHull(vertices)
     except QhullError:
         return None  # flat or degenerate: no volume to erode
-    normals, offsets = hull.equations[:, :3], hull.equations[:, 3] + margin  # inside: n.x + d <= 0
+    normals = hull.equations[:, :3]
+    widths = (-(normals @ np.asarray(vertices, dtype=float).T + hull.equations[:, 3:])).max(axis=1)
+    moved = np.minimum(margin, widths / 2 - THIN_CORE)  # across a face: the hull's extent from its plane
+    if np.any(moved < margin - THIN_EXCESS):
+        return None
+    offsets = hull.equations[:, 3] + moved  # inside: n.x + d <= 0
     # The centre of the largest ball inside the eroded hull (Chebyshev centre): a strictly
     # interior point for the intersection, and its radius says whether anything is left.
     res = linprog(c=[0, 0, 0, -1], A_ub=np.hstack([normals, np.ones((len(normals), 1))]), b_ub=-offsets,
@@ -102,8 +124,8 @@ def eroded_text(pieces: Sequence[np.ndarray], what: str, source: str) -> str:
         piece = eroded(vertices, URDF_HULL_MARGIN)
         if piece is None:
             raise ExecutorError(f"{source}: convex piece {k + 1} of {what} is thinner than "
-                                f"{2000 * URDF_HULL_MARGIN:g} mm (the cell's hull margin twice); expected pieces "
-                                "the simulated cell can collide as")
+                                f"{1e3 * MIN_THICKNESS:g} mm (the cell's hull margin twice, less what it resolves); "
+                                "expected pieces the simulated cell can collide as")
         objects.append((f"piece{k + 1}", piece.vertices, piece.faces))
     return obj_text(objects, f"# generated from {Path(source).name}: each piece eroded by {URDF_HULL_MARGIN} m, "
                              "the URDF hull margin that PyBullet adds back")

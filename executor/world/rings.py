@@ -42,7 +42,7 @@ import numpy as np
 import shapely
 import trimesh
 
-from executor.world.meshes import URDF_HULL_MARGIN
+from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN
 
 ROUND_BORE_CORNERS = (64, 48, 32, 24, 16, 12, 8)
 """The corners of the regular polygons a round bore on round pins is tried as (:func:`round_bores`)."""
@@ -286,11 +286,11 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
         return NoStack(f"part '{pid}' is no stack of prisms of its sections (they differ by "
                        f"{differ / mesh.volume:.1%} of its volume over {len(layers)} layer(s); the cell's exact "
                        "pieces of a part with a bore are prisms')")
-    thin = next(((bottom, top) for _, bottom, top in layers if top - bottom <= 2 * URDF_HULL_MARGIN), None)
+    thin = next(((bottom, top) for _, bottom, top in layers if top - bottom < MIN_THICKNESS), None)
     if thin is not None:  # every layer has the bore, and no piece of this one an eroded form, whatever its bore
         return (f"part '{pid}': its layer from {1e3 * (thin[0] - low):.3f} to {1e3 * (thin[1] - low):.3f} mm of its "
-                f"height, at its bore, is no thicker than the cell's hull margin twice ({2000 * URDF_HULL_MARGIN:g} "
-                "mm)")
+                f"height, at its bore, is thinner than the cell's hull margin twice less what it resolves "
+                f"({1e3 * MIN_THICKNESS:g} mm)")
     made = round_bores if round_pins else coarser_bores
     candidates = [made(section, allowed) for section, _, _ in layers]
     # the exact sections first, then the finest coarser bores that work, found by bisection
@@ -339,7 +339,9 @@ def _cut(layers: list[tuple[shapely.Polygon, float, float]],
     [m], and the volume [m³] of the outline's slivers left out (parts away from the bore
     too thin for the cell); None when a part at a bore is too thin. A right prism's eroded
     form (the cell's, :func:`executor.world.meshes.eroded`) is its section's inset by the
-    margin over its height less twice the margin: it has one when both are something. A
+    margin over its height less twice the margin (near its middle when it is under twice the
+    margin but at least :data:`executor.world.meshes.MIN_THICKNESS`): it has one when both are
+    something. A
     part with a face along a bore must keep that face: its inset grown back by the margin
     (what the cell collides as, its corners rounded) still reaches the bore (a sector of a
     32-gon about a d 10.2 bore, its face 1 mm wide, ends 4.1 mm out from it: a pin across
@@ -348,7 +350,7 @@ def _cut(layers: list[tuple[shapely.Polygon, float, float]],
     for section, low, high in layers:
         bores = shapely.MultiLineString([ring.coords for ring in section.interiors])
         parts = partition(section)
-        tall = high - low > 2 * URDF_HULL_MARGIN
+        tall = high - low >= MIN_THICKNESS
         inset = [shapely.buffer(part, -URDF_HULL_MARGIN) for part in parts]
         thick = [tall and not core.is_empty for core in inset]
         if any(not ok and part.distance(bores) == 0 for ok, part in zip(thick, parts)):

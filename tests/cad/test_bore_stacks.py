@@ -65,8 +65,8 @@ def test_a_plate_thinner_than_the_hull_margin_twice_is_refused_saying_so() -> No
     plate = trimesh.creation.extrude_polygon(shapely.Point(0, 0).buffer(0.02, quad_segs=8).difference(bore), 0.0012)
     found = ring_pieces("plate", plate, 1e-4)
     assert isinstance(found, str) and not isinstance(found, NoStack)
-    assert found == ("part 'plate': its layer from 0.000 to 1.200 mm of its height, at its bore, is no thicker than "
-                     "the cell's hull margin twice (2 mm)")
+    assert found == ("part 'plate': its layer from 0.000 to 1.200 mm of its height, at its bore, is thinner than "
+                     "the cell's hull margin twice less what it resolves (1.952 mm)")
 
 
 def test_a_large_part_whose_bore_coacd_cannot_keep_is_refused_without_decomposing() -> None:

@@ -289,10 +289,7 @@ def test_every_product_is_simulated(imported: Callable[[str], Imported], name: s
                                               "twice (the plates, 1.2 mm: no convex piece of theirs at the bore), "
                                               "or onto a pin beside parts on it, resting on nothing (the outer "
                                               "holder around the plates)")),
-    pytest.param("nop_printed_box", marks=_xfail(INSERTED + " into a hole, shorter than the gripper's grasp "
-                                                 "depth and no thicker than the cell's hull margin twice (the base, a "
-                                                 "2 mm plate: its flat top takes the suction cup, but no convex piece "
-                                                 "of it keeps its shape)")),
+    "nop_printed_box",
     pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
                                                  "cell has no screwing operation)")),
 ])

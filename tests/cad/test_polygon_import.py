@@ -96,7 +96,7 @@ def test_a_splined_pair_and_a_rounded_rect_pair_are_true_fits_with_their_real_ro
     # the cell would insert the shaft as its outline's prism, but its 1 mm teeth are convex
     # pieces the 1 mm hull margin would widen: it is placed by hand, and says so
     assert cell_view(derived)[1] == {"shaft": "part 'shaft': convex piece 1 of its outline is 1.249 mm thick, less "
-                                              "than the cell's hull margin twice (2 mm)"}
+                                              "than the cell's hull margin twice less what it resolves (1.952 mm)"}
     # geometry.toml's sections, read back as the cell (and its truth backend) reads them, give the same rooms
     rooms = margins(derived)
     for pid, fit in derived.hole_of.items():

@@ -54,8 +54,14 @@ def _section(points: list[list[float]]) -> str:
     return f"size = [{max(xs) - min(xs):.9g}, {max(ys) - min(ys):.9g}]\noutline = {points}"
 
 
-def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04, peg: list[list[float]] | None = None) -> Path:
+def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04, peg: list[list[float]] | None = None,
+             plate: float | None = None) -> Path:
+    """The product of the module's docstring in ``folder``; with ``plate`` [m], the peg a
+    hexagon plate that thick and its holes' inradii 10 mm larger (16 mm, 16.04 and 15.96), held
+    by the suction cup (30 mm across), on tiles 50 mm across."""
     folder.mkdir()
+    wider = 0.0 if plate is None else 0.01
+    tile = tile if plate is None else 0.05
     assembly = ['name = "hexagon peg"', "", "[parts.bp]", 'name = "base plate"', 'role = "base"',
                 "start = [0.30, -0.40]", "", "[parts.p1]", 'name = "hexagon peg"', 'role = "peg"', 'shape = "polygon"',
                 "start = [0.30, 0.40]"]
@@ -67,9 +73,11 @@ def _product(folder: Path, chamfer: float = 0.0008, tile: float = 0.04, peg: lis
                 "polygon_sides = 24", "base_size = [0.20, 0.10]", "base_center = [0.58, 0.0]", "base_thickness = 0.02"]
     for hole, (inradius, turn) in HOLES.items():
         geometry += ["", f"[hole_shapes.{hole}]", f'holes = ["{hole}"]', 'kind = "polygon"',
-                     _section(hexagon(inradius, turn))]
+                     _section(hexagon(inradius + wider, turn))]
     geometry += ["", "[part_shapes.hexagon]", 'parts = ["p1"]', 'kind = "polygon"',
-                 _section(hexagon(PEG) if peg is None else peg), "length = 0.05", "mass = 0.05", 'demo_hole = "hx"',
+                 _section(hexagon(PEG + wider) if peg is None else peg),
+                 *(["length = 0.05", "mass = 0.05"] if plate is None else
+                   [f"length = {plate}", "mass = 0.015", 'tool = "suction"']), 'demo_hole = "hx"',
                  "", "[base]", 'part = "bp"', "tray = [0.25, -0.33]", "grip = [0.0, 0.0]", "mass = 2.0"]
     (folder / "geometry.toml").write_text("\n".join(geometry) + "\n")
     return folder
@@ -206,3 +214,19 @@ def test_a_hexagon_peg_goes_into_a_hexagon_hole_with_40_um_room_and_not_into_one
     _, quat = assembled(folder, "bp", "p1", "hx")
     yaw = math.degrees(2 * math.atan2(quat[2], quat[3]))
     assert abs(abs(yaw) - 30.0) < 1.0  # the hexagon's half period: the relation's turn, within the room's play
+
+
+@pytest.mark.slow  # teaches the plate, runs one attempt in each hole in physics (about 30 s)
+def test_a_2_mm_hexagon_plate_on_the_suction_cup_reads_40_um_of_room_and_40_um_short(tmp_path: Path, run_main) -> None:
+    # A plate thinner than the hull margin twice collides as its outline at mid-height, its
+    # faces across its thickness within what the cell resolves (executor/world/meshes.py):
+    # the room it passes is still read right on either side of 40 µm.
+    folder = str(_product(tmp_path / "plate", plate=0.002))
+    taught = run_main("executor", "teach", "--assembly", folder)
+    assert taught.returncode == 0, taught.stderr
+    cell = Cell(folder)
+    try:
+        outcomes = {hole: cell.run_trial("p1", hole, 0, max_attempts=1) for hole in ("hx", "hs")}
+    finally:
+        cell.close()
+    assert {hole: trial.outcome for hole, trial in outcomes.items()} == {"hx": "fit", "hs": "no_fit"}
