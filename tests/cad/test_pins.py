@@ -23,7 +23,7 @@ from executor import ExecutorError
 from executor.cad.derive import _GRID, _joined, derive
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
-from tests.cad.conftest import learned_in_the_cell
+from tests.cad.conftest import learned_in_the_cell, teach
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -160,7 +160,7 @@ def test_square_nuts_go_onto_the_pins_in_physics(run_main: Runner, tmp_path: Pat
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     assert "manual" not in geometry and {name: shape.get("bore") for name, shape in geometry["part_shapes"].items()} \
         == {"nut10": True, "nut8": True}
-    result, observed = learned_in_the_cell(run_main, out, tmp_path / "run")
+    result, observed = learned_in_the_cell(run_main, teach(out), tmp_path / "run")
     # every pair tried in physics: the 9 mm bore stops on the 10 mm pin, the others go on
     assert observed == {("nut10", "plate_pin1"): "fit", ("nut10", "plate_pin2"): "fit",
                         ("nut8", "plate_pin1"): "no_fit", ("nut8", "plate_pin2"): "fit"}

@@ -6,6 +6,7 @@ beyond its holding force drops and is reported (docs/cell.md#the-suction-tool)."
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,7 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
-from assembly_constraints.corpus_truth import feature_holes, import_product
+from assembly_constraints.corpus_truth import CorpusImport, feature_holes, import_product
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad import operations
@@ -22,11 +23,9 @@ from executor.cell_description import CellDescription
 from executor.trial import Cell
 from executor.world.arm import Dropped, tool_quat
 from executor.world.geometry import load_geometry
-from tests.cad.conftest import learned_in_the_cell
+from tests.cad.conftest import CORPUS, corpus_copy, learned_in_the_cell, teach
 from tests.cad.test_covers import _pegs_and_plate
 from tests.conftest import Runner
-
-GRIDFINITY = Path(__file__).parent / "corpus" / "gridfinity_bases"
 
 
 def test_a_flat_top_is_its_face_and_a_pointed_top_has_none() -> None:
@@ -51,7 +50,7 @@ def test_a_short_peg_with_a_pointed_top_stays_by_hand(tmp_path: Path, capsys: py
 def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # The bin bases' top is a 41.5 mm rounded square: a 45 mm cup does not lie whole on it.
     monkeypatch.setitem(operations.GRIPPER, "cup_diameter", 0.045)
-    done = import_product(GRIDFINITY, tmp_path / "out")
+    done = import_product(CORPUS / "gridfinity_bases", tmp_path / "out")
     manual = tomllib.loads((done.out / "geometry.toml").read_text()).get("manual", {})
     assert set(manual) == {"bin_base_a", "bin_base_b"}
     assert "the suction cup (45 mm) does not lie whole on its flat top" in manual["bin_base_a"]["reason"]
@@ -61,19 +60,20 @@ def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monke
 def test_a_plate_no_thicker_than_the_hull_margin_twice_stays_by_hand(tmp_path: Path) -> None:
     # nop_printed_box's base: a 2 mm plate whose flat top would take the cup, but the
     # cell's physics cannot collide it (a physics limit, not the tool's).
-    done = import_product(Path(__file__).parent / "corpus" / "nop_printed_box", tmp_path / "out")
+    done = import_product(CORPUS / "nop_printed_box", tmp_path / "out")
     manual = tomllib.loads((done.out / "geometry.toml").read_text())["manual"]
     assert "no thicker than the cell's hull margin twice (2 mm)" in manual["smooth_box_base"]["reason"]
 
 
-@pytest.mark.slow  # imports, teaches, learns 6 pairs in physics and assembles (about 90 s under load)
+@pytest.mark.slow  # imports (shared), teaches, learns 6 pairs in physics and assembles (about 90 s under load)
 @pytest.mark.timeout(900)
-def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(run_main: Runner, tmp_path: Path) -> None:
-    done = import_product(GRIDFINITY, tmp_path / "out")
+def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(
+        corpus_import: Callable[[str], CorpusImport], run_main: Runner, tmp_path: Path) -> None:
+    done = corpus_copy(corpus_import("gridfinity_bases"), tmp_path / "out")
     geometry = tomllib.loads((done.out / "geometry.toml").read_text())
     assert "manual" not in geometry
     assert {geometry["part_shapes"][p]["tool"] for p in ("bin_base_a", "bin_base_b")} == {"suction"}
-    result, outcomes = learned_in_the_cell(run_main, done.out, tmp_path / "run")
+    result, outcomes = learned_in_the_cell(run_main, teach(done.out), tmp_path / "run")
     holes = feature_holes(done)
     truth = {(row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
     assert {pair: outcomes.get(pair) for pair in truth} == truth
@@ -83,11 +83,12 @@ def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(run_
     assert max(assembly["final_pose_error_mm"].values()) <= 2.0
 
 
-@pytest.mark.slow  # imports the product, a trial's cell and an assembling cell (about 25 s under load)
-def test_a_part_pulled_off_the_cup_beyond_its_holding_force_drops(tmp_path: Path) -> None:
+@pytest.mark.slow  # imports the product (shared), a trial's cell and an assembling cell (about 25 s under load)
+def test_a_part_pulled_off_the_cup_beyond_its_holding_force_drops(
+        corpus_import: Callable[[str], CorpusImport], tmp_path: Path) -> None:
     # A holding force below the bin base's weight (18.5 g: 0.18 N): hanging on the cup is
     # already too much, the cell reports the drop.
-    done = import_product(GRIDFINITY, tmp_path / "out")
+    done = corpus_copy(corpus_import("gridfinity_bases"), tmp_path / "out")
     assert load_geometry(str(done.out)).parts["bin_base_a"].tool == "suction"
     _hang(done.out)  # the cell's 20 N holds it
     text = done.out / "geometry.toml"
