@@ -5,6 +5,7 @@ beyond its holding force drops and is reported (docs/cell.md#the-suction-tool)."
 
 from __future__ import annotations
 
+import shutil
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
@@ -65,21 +66,26 @@ def test_a_plate_no_thicker_than_the_hull_margin_twice_stays_by_hand(tmp_path: P
     assert "no thicker than the cell's hull margin twice (2 mm)" in manual["smooth_box_base"]["reason"]
 
 
-@pytest.mark.slow  # imports (shared), teaches, learns 6 pairs in physics and assembles (about 90 s under load)
+@pytest.mark.slow  # imports, teaches, learns 3 pairs in physics and assembles (about 60 s under load)
 @pytest.mark.timeout(900)
-def test_gridfinity_is_learned_on_the_suction_cup_and_assembled_within_2_mm(
-        corpus_import: Callable[[str], CorpusImport], run_main: Runner, tmp_path: Path) -> None:
-    done = corpus_copy(corpus_import("gridfinity_bases"), tmp_path / "out")
+def test_a_gridfinity_bin_base_is_learned_on_the_suction_cup_and_assembled_within_2_mm(
+        run_main: Runner, tmp_path: Path) -> None:
+    # gridfinity_bases with one of its two bin bases (the other the same foot, a shape of its
+    # own): its three pockets tried in physics, the bin base held by its top, and assembled.
+    folder = Path(shutil.copytree(CORPUS / "gridfinity_bases", tmp_path / "cad",
+                                  ignore=shutil.ignore_patterns("bin_base_b.stl")))
+    done = import_product(folder, tmp_path / "out")
     geometry = tomllib.loads((done.out / "geometry.toml").read_text())
     assert "manual" not in geometry
-    assert {geometry["part_shapes"][p]["tool"] for p in ("bin_base_a", "bin_base_b")} == {"suction"}
+    assert {pid: shape["tool"] for pid, shape in geometry["part_shapes"].items()} == {"bin_base_a": "suction"}
     result, outcomes = learned_in_the_cell(run_main, teach(done.out), tmp_path / "run")
     holes = feature_holes(done)
-    truth = {(row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]}
-    assert {pair: outcomes.get(pair) for pair in truth} == truth
+    truth = {(row["part"], holes[row["feature"]]): "fit" if row["fits"] else "no_fit" for row in done.truth["fits"]
+             if row["part"] == "bin_base_a"}
+    assert len(truth) == 3 and {pair: outcomes.get(pair) for pair in truth} == truth
     assembly = result["assembly"]
     assert assembly["assembled"] is True and assembly["manual"] == []
-    assert {step["part"] for step in assembly["steps"]} == {"baseplate", "bin_base_a", "bin_base_b"}
+    assert {step["part"] for step in assembly["steps"]} == {"baseplate", "bin_base_a"}
     assert max(assembly["final_pose_error_mm"].values()) <= 2.0
 
 
