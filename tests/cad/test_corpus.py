@@ -368,13 +368,13 @@ def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_planned_and_
 
 
 def _learned_from_its_cad_alone(done: Imported, run_main: Runner, run: Path) -> dict[str, Any]:
-    """Teach, run a sim session of ``done`` (every part placed by hand) and assemble its
-    plan 1 (the commands in this process); checks that nothing is taught, no experiment
-    run, every pair of ``sizes.lp`` labelled not observed with the truth's fits, and the
-    product assembled within 2 mm, every part placed by hand. The session's result."""
+    """Teach, run a sim session of ``done`` (every part placed by hand) that assembles its
+    plan 1 in its cell (the commands in this process); checks that nothing is taught, no
+    experiment run, every pair of ``sizes.lp`` labelled not observed with the truth's fits,
+    and the product assembled within 2 mm, every part placed by hand. The session's result."""
     taught = run_main("executor", "teach", "--assembly", str(done.out))
     assert taught.returncode == 0 and "no skill to teach" in taught.stdout, taught.stderr
-    session = run_main("session", "--assembly", str(done.out), "--out", str(run), "--json")
+    session = run_main("session", "--assembly", str(done.out), "--out", str(run), "--assemble", "--json")
     assert session.stdout, session.stderr
     result: dict[str, Any] = json.loads(session.stdout)
     holes = _feature_holes(done)
@@ -389,16 +389,15 @@ def _learned_from_its_cad_alone(done: Imported, run_main: Runner, run: Path) -> 
     assert _atoms(run / "learned.lp")["not_observed"] == pairs
     assert result["nominal_fits"] is None  # no pair the cell builds with room
     assert session.returncode == 0, result.get("error")
-    # the sim cell takes plan 1, each part placed by hand where the CAD has it
-    done_run = run_main("assemble", "--run", str(run), "--json")
-    report = json.loads(done_run.stdout)
-    assert done_run.returncode == 0 and report["assembled"], done_run.stderr
+    # the session's sim cell takes plan 1, each part placed by hand where the CAD has it
+    report = result["assembly"]
+    assert report["assembled"], report
     assert max(report["final_pose_error_mm"].values()) < 2.0
     assert set(report["manual"]) == set(done.truth["parts"]) - {done.truth["base"]}
     return result
 
 
-@pytest.mark.slow  # imports the product, runs a sim session of no experiment and assembles it (90 s under load)
+@pytest.mark.slow  # imports the product, a sim session of no experiment that assembles it (90 s under load)
 @pytest.mark.parametrize("name", ["ldraw_axles"])  # a unit of the workers' work with the product's other tests
 def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_session_from_its_cad_not_observed(
         corpus_import: Callable[[str], Imported], name: str, run_main: Runner, tmp_path: Path) -> None:
