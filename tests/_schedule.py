@@ -27,7 +27,7 @@ import pytest
 CACHE_KEY = "assembly-constraints/durations"
 BY_PARAMETER = ("tests/cad/test_corpus.py", "tests/test_bad_input.py")
 """Files split by their tests' parameter: the tests of a corpus product (``[name]``) share its
-import (the module fixture ``imported`` of ``test_corpus.py``), the rows of ``test_bad_input.py``
+import (the session fixture ``corpus_import`` of ``tests/cad/conftest.py``), the rows of ``test_bad_input.py``
 (a process each, about 1.3 s of CPU) share nothing."""
 EXPECTED = Path(__file__).with_name("durations.json")
 """Measured times [s] of the slowest tests, by node id (``python -m tests._schedule LOG``

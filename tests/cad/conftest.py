@@ -1,12 +1,15 @@
-"""The shipped products exported in the assembled pose and imported, once per test
-session (a worker's): ``imported(product)`` → (what the import derived, the assembly
-folder it wrote), shared by the round trips of ``test_import`` and ``test_covers``; and
-helpers: ``teach(folder)`` (an imported product's skills taught in this process),
-``learned_in_the_cell`` (taught, then a sim session with its assembly) and
-``trial_on_edited_mesh`` (one attempt in a copy whose mesh was changed)."""
+"""Imports shared once per test session (a worker's): the shipped products exported in the
+assembled pose and imported, ``imported(product)`` → (what the import derived, the assembly
+folder it wrote), shared by the round trips of ``test_import`` and ``test_covers``; each
+corpus product imported, ``corpus_import(name)`` (``test_corpus``, ``test_suction``; a test
+that writes into the folder works on a copy, :func:`corpus_copy`). And helpers:
+``teach(folder)`` (an imported product's skills taught in this process, of every part shape
+or of some parts' only), ``learned_in_the_cell`` (a sim session of a taught product with its
+assembly) and ``trial_on_edited_mesh`` (one attempt in a copy whose mesh was changed)."""
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import shutil
@@ -19,12 +22,18 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
+from assembly_constraints.corpus_truth import CorpusImport, import_product
 from executor.cad.cli import run_import
 from executor.cad.derive import Derived
 from executor.evidence import TrialResult
-from executor.skills.teach import teach_all
+from executor.skills.dmp import save_skill
+from executor.skills.teach import teach_all, teach_shape
 from executor.trial import Cell
+from executor.world.assets import regenerate_assets
 from tests.conftest import Runner
+
+CORPUS = Path(__file__).parent / "corpus"
+"""The corpus of products of real CAD (``tests/cad/corpus/README.md``)."""
 
 
 @pytest.fixture(scope="session")
@@ -44,12 +53,37 @@ def imported(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], tuple[
     return get
 
 
-def teach(folder: Path) -> Path:
-    """The skills of every part shape of the product in ``folder`` taught in its simulated
-    cell, in this process (as ``executor teach`` does); returns ``folder``."""
+@pytest.fixture(scope="session")
+def corpus_import(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], CorpusImport]:
+    """A corpus product (``tests/cad/corpus/<name>/``) imported (``import meshes/ --config
+    import.toml``) with its truth, once per product."""
+    done: dict[str, CorpusImport] = {}
+
+    def get(name: str) -> CorpusImport:
+        if name not in done:
+            done[name] = import_product(CORPUS / name, tmp_path_factory.mktemp(name) / "out")
+        return done[name]
+
+    return get
+
+
+def corpus_copy(done: CorpusImport, folder: Path) -> CorpusImport:
+    """The imported corpus product ``done`` with its assembly folder copied to ``folder``."""
+    return dataclasses.replace(done, out=Path(shutil.copytree(done.out, folder)))
+
+
+def teach(folder: Path, parts: set[str] | None = None) -> Path:
+    """The skills of the part shapes of the product in ``folder`` taught in its simulated
+    cell, in this process (as ``executor teach`` does; ``parts``: only their shapes, default
+    every one); returns ``folder``."""
     cell = Cell(str(folder))
     try:
-        teach_all(cell)
+        if parts is None:
+            teach_all(cell)
+        else:
+            regenerate_assets(cell.geometry)
+            for shape in sorted({cell.geometry.parts[pid].shape for pid in parts}):
+                save_skill(folder, teach_shape(cell, shape))
     finally:
         cell.close()
     return folder
@@ -71,11 +105,9 @@ def manual_reasons(out: Path) -> dict[str, str]:
 
 
 def learned_in_the_cell(run_main: Runner, folder: Path, run: Path) -> tuple[dict[str, Any], dict[tuple[str, str], str]]:
-    """Teach the product in ``folder``, run a sim session with ``--assemble`` into ``run``
-    (the commands in this process, the session's cell a process of its own): its result and
-    the outcome of each (part, hole) its journal records."""
-    taught = run_main("executor", "teach", "--assembly", str(folder))
-    assert taught.returncode == 0, taught.stderr
+    """A sim session of the taught product in ``folder`` (:func:`teach`) with ``--assemble``
+    into ``run`` (the command in this process, the session's cell a process of its own): its
+    result and the outcome of each (part, hole) its journal records."""
     session = run_main("session", "--assembly", str(folder), "--out", str(run), "--assemble", "--json")
     assert session.returncode == 0, session.stderr
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]

@@ -66,12 +66,12 @@ def _import(tmp: Path, block_x: float = 0.0, pocket: float = 20.4) -> Path:
 
 @pytest.fixture(scope="module")
 def owned(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The product of :func:`_import` as drawn, imported once for the module."""
-    return _import(tmp_path_factory.mktemp("owned"))
+    """The product of :func:`_import` as drawn, imported and taught once for the module."""
+    return teach(_import(tmp_path_factory.mktemp("owned")))
 
 
 
-@pytest.mark.slow  # the import: about 2 s
+@pytest.mark.slow  # the import and the teaching (shared)
 def test_the_import_leaves_a_ring_onto_a_pin_of_a_block_the_cell_inserts_to_the_cell(owned: Path) -> None:
     geometry = tomllib.loads((owned / "geometry.toml").read_text())
     assert manual_reasons(owned) == {}
@@ -92,7 +92,7 @@ def test_a_block_drawn_off_its_pocket_s_centre_leaves_the_ring_placed_by_hand(tm
                 "(centred, on the bottom) its pin is 0.500 mm from the CAD's (at most 0.1 mm)"}
 
 
-@pytest.mark.slow  # teaches three parts and runs a sim session with its assembly (about 20 s of CPU)
+@pytest.mark.slow  # three parts taught (shared), a sim session with its assembly (about 14 s of CPU)
 def test_the_ring_onto_the_block_s_pin_is_learned_and_assembled_in_physics(run_main: Runner, owned: Path,
                                                                            tmp_path: Path) -> None:
     result, observed = learned_in_the_cell(run_main, owned, tmp_path / "run")
@@ -123,10 +123,9 @@ def _shift_locked(assembler: Assembler, part: str, shift: np.ndarray) -> None:
     pb.changeConstraint(uid, jointChildPivot=com, maxForce=1e9, physicsClientId=world.client)
 
 
-@pytest.mark.slow  # teaches three parts, the block and the ring onto its pin, the block moved (about 8 s of CPU)
+@pytest.mark.slow  # three parts taught (shared), the block and the ring onto its pin, the block moved
 @pytest.mark.parametrize("shift_mm", [3.0])  # 3 mm: the CAD's goal would leave the ring 3.4 mm from it
 def test_the_ring_follows_the_block_where_it_ended(owned: Path, shift_mm: float) -> None:
-    teach(owned)
     assembler = Assembler(load_product(str(owned)), description=CellDescription())
     try:
         assert assembler.run_step("base", None, 0).outcome == "fit"

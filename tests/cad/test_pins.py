@@ -23,7 +23,7 @@ from executor import ExecutorError
 from executor.cad.derive import _GRID, _joined, derive
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
-from tests.cad.conftest import learned_in_the_cell
+from tests.cad.conftest import learned_in_the_cell, teach
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -160,7 +160,7 @@ def test_square_nuts_go_onto_the_pins_in_physics(run_main: Runner, tmp_path: Pat
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     assert "manual" not in geometry and {name: shape.get("bore") for name, shape in geometry["part_shapes"].items()} \
         == {"nut10": True, "nut8": True}
-    result, observed = learned_in_the_cell(run_main, out, tmp_path / "run")
+    result, observed = learned_in_the_cell(run_main, teach(out), tmp_path / "run")
     # every pair tried in physics: the 9 mm bore stops on the 10 mm pin, the others go on
     assert observed == {("nut10", "plate_pin1"): "fit", ("nut10", "plate_pin2"): "fit",
                         ("nut8", "plate_pin1"): "no_fit", ("nut8", "plate_pin2"): "fit"}
@@ -308,7 +308,7 @@ def test_a_dowel_pin_in_another_part_s_bore_is_no_second_pin_of_the_plate() -> N
 
 
 @pytest.mark.slow  # the import and a truth session with its assembly
-def test_a_plate_over_both_pins_is_learned_on_each_and_put_onto_its_first(run_cli: Runner, tmp_path: Path) -> None:
+def test_a_plate_over_both_pins_is_learned_on_each_and_put_onto_its_first(run_main: Runner, tmp_path: Path) -> None:
     # the plate's d 10.4 and d 8.4 bores go over the d 10 and d 8 pins: both pairs are written
     # for the learner, the truth backend and the CAD prior, each with 0.4 mm of room (its
     # d 8.4 bore does not pass the d 10 pin); the cell puts it down its first pin (the one
@@ -327,8 +327,8 @@ def test_a_plate_over_both_pins_is_learned_on_each_and_put_onto_its_first(run_cl
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     first = geometry["part_shapes"]["cover"]["demo_hole"]
     assert "manual" not in geometry and set(geometry["hole_shapes"]) == {first}
-    done = run_cli("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
-                   str(tmp_path / "truth"), timeout=240)
+    done = run_main("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
+                    str(tmp_path / "truth"))
     assert done.returncode == 0, done.stderr
     result = json.loads(done.stdout)
     assert {tuple(pair) for pair in result["fits"]} == {("cover", "plate_pin1"), ("cover", "plate_pin2")}

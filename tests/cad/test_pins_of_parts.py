@@ -67,7 +67,7 @@ def test_a_plate_onto_pins_of_the_base_and_a_block_placed_by_hand_is_the_cell_s(
     assert "must_precede(block,plate)." in (taught / "geometric_precedence.lp").read_text().split()
 
 
-@pytest.mark.slow  # teaches the plate (shared) and runs a sim session with its assembly (about 10 s of CPU)
+@pytest.mark.slow  # the plate taught (shared), a sim session with its assembly
 def test_the_plate_is_learned_and_assembled_in_physics(run_main: Runner, taught: Path, tmp_path: Path) -> None:
     result, observed = learned_in_the_cell(run_main, taught, tmp_path / "run")
     assert observed == {("plate", "base_pin1"): "fit"}

@@ -15,10 +15,9 @@ import pytest
 import shapely
 import trimesh
 
-from assembly_constraints.cli import main
 from bridge import BridgeError
 from bridge.product import load_product_description
-from tests.cad.conftest import import_on_base, learned_in_the_cell, manual_reasons
+from tests.cad.conftest import import_on_base, learned_in_the_cell, manual_reasons, teach
 from tests.conftest import Runner
 
 X_MM = 560.0
@@ -110,7 +109,7 @@ def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_b
 @pytest.mark.slow  # teaches three parts and runs a sim session with its assembly (about 25 s of CPU)
 def test_the_stacked_and_the_owned_pins_are_learned_and_assembled_in_physics(run_main: Runner, stacked: Path,
                                                                             tmp_path: Path) -> None:
-    result, observed = learned_in_the_cell(run_main, stacked, tmp_path / "run")
+    result, observed = learned_in_the_cell(run_main, teach(stacked), tmp_path / "run")
     # tried in physics, the block at its goal in the trials onto its pin (without it a part
     # falls to the goal through the air there: a fit): the 9 mm bores stop on the block's
     # 10 mm pin; the parts go on their own pins, the arm's 11 mm bore on the plate's too
@@ -127,7 +126,7 @@ def test_the_stacked_and_the_owned_pins_are_learned_and_assembled_in_physics(run
     assert all(steps[pid]["pose_error_mm"] <= 2.0 for pid in ("washer", "nut", "arm")), steps
 
 
-@pytest.mark.slow  # the import, the teaching and one trial: about 8 s of CPU
+@pytest.mark.slow  # the import, the nut's teaching and one trial
 def test_a_skill_taught_on_a_deeper_pin_does_not_lift_the_part_off_a_shallower_one(tmp_path: Path) -> None:
     # an 11 mm nut, taught on the plate's pin (30 mm), onto the block's (25 mm), 0.5 mm of
     # room all round: moved 5 mm shallower, the skill's path first rose 2.7 mm, lifting the
@@ -135,8 +134,7 @@ def test_a_skill_taught_on_a_deeper_pin_does_not_lift_the_part_off_a_shallower_o
     # attempts of this trial, cell seed 0: the seed one session drew)
     from executor.trial import Cell
 
-    out = _import(tmp_path, nut_bore=11.0)
-    assert main(["-q", "executor", "teach", "--assembly", str(out)]) == 0
+    out = teach(_import(tmp_path, nut_bore=11.0), {"nut"})  # the nut's skill alone: the trial's
     cell = Cell(str(out))
     try:
         trial = cell.run_trial("nut", "block_pin1", seed=2715702753)
