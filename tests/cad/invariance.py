@@ -460,11 +460,15 @@ def _reach_either(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
 
 def _untied(tree: dict[str, Any], tied: set[str]) -> dict[str, Any]:
     """``tree`` without what follows from the insertion axis of each ``tied`` part: the
-    axis itself, and its feature's entry (position, axis, entry height, depth)."""
+    axis itself, its feature's entry (position, axis, entry height, depth), and the sense
+    of the axes its reason for going by hand names (``along -y`` as ``along y``)."""
     tree = _deep(tree)
     geometry = tree.get("geometry.toml", {})
     for pid in tied:
         del tree["axes"][pid]
+        manual = geometry.get("manual", {}).get(pid, {})
+        if "reason" in manual:
+            manual["reason"] = re.sub(r"(?<![\w.])[+-]([xyz])\b", r"\1", manual["reason"])
         features = [geometry.get("part_shapes", {}).get(pid, {}).get("demo_hole"),
                     *geometry.get("manual", {}).get(pid, {}).get("on", [])]
         for hid in filter(None, features):
