@@ -115,11 +115,11 @@ _GRID = 1e-8  # the grid [m] the union of a pin's sections is snapped to (far be
 _JITTER = 5e-8  # [m] a vertex of that union this close to the line through its neighbours is dropped
 PREFERRED = (("+z",), ("-z",), ("-x", "+y", "-y"), ("+x",))
 """The classes a part's way out (its insertion axis reversed) is chosen by among those it
-is free along, in order: up (the cell inserts from above), down, then the horizontal ones
-whose insertion the cell's arm was measured to reach sideways (+x, +y, -y:
-:data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways along x
-goes in along +x however the CAD is turned about z, then +x; a zero-clearance fit's axis
-that is none of these last. Within a class the product's geometry chooses
+is free along, in order: up (the cell inserts from above), down, the horizontal ones whose
+insertion the cell's arm was measured to reach sideways (-x, +y, -y: the insertions +x,
+-y, +y of :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways
+along x goes in along +x however the CAD is turned about z, then +x; a zero-clearance
+fit's axis that is none of these, last. Within a class the product's geometry chooses
 (:func:`_way_out`)."""
 LEAVING = tuple(d for kind in PREFERRED for d in kind)
 """The six axes in :data:`PREFERRED`'s order: the last rule between ways out the geometry
@@ -441,8 +441,10 @@ def _way_out(result: Derived, pid: str, free: list[str], present: set[str]) -> s
        of the vector from the body's centre of mass to theirs (uniform density);
     3. :data:`LEAVING`'s order (a fit's axis after the six, in the order found).
 
-    Ways within :data:`TIED` of the best are tied for a rule; only a product alike seen
-    from either way ties through rule 2, and then the two answers are mirror images."""
+    Ways within :data:`TIED` of the best are tied for a rule. Rule 3 is the cell frame's:
+    a part that reaches it (equal travels, the present parts' mass centred across the ways,
+    as in a product alike seen from either way) may go in from its other end with the
+    product turned 180° about z."""
     def kind(d: str) -> int:
         return next((k for k, ways in enumerate(PREFERRED) if d in ways), len(PREFERRED))
     best = min(kind(d) for d in free)
@@ -663,7 +665,7 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
     ring that stands in a housing's bore: the ring's hole, :func:`part_holes`), in along
     the same way or, that part ``before`` it, the other way (the shaft sent in from the
     ring's far end, through the housing's other opening: still in the ring, not in the
-    housing's bore, where it would be a peg standing in a hole of the base and the glands
+    housing's bore, where it would be a peg standing in a hole of the base, and the glands
     going in after it along its axis covers over it, on no pin)."""
     def sliced(part: CadPart) -> tuple[float, Loop] | None:
         axis = np.array(DIRECTIONS[axes[part.id]])
