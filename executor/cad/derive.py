@@ -8,7 +8,8 @@ pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
 every zero-clearance fit (:func:`executor.cad.fits.faces.zero_clearance_fits`).
 Stage by stage, every part that some direction frees from the parts still in place leaves
-along the first such direction (in `LEAVING`'s order): its **insertion axis** is the reverse. Where parts are
+along one such direction (:func:`_way_out`: up, down, the ways the arm reaches sideways, then
+the product's geometry): its **insertion axis** is the reverse. Where parts are
 left, the screwed pairs (modelled threads, :func:`executor.cad.fits.threads.screwed_pairs`, in a nut or a
 plain hole at their tap drill; cosmetic ones, :func:`executor.cad.fits.threads.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
@@ -107,7 +108,7 @@ from executor.cad.sections import (
     slice_loops,
     zero_clearance,
 )
-from executor.cad.sweep import DIRECTIONS, Sweeper, axis_name, forked_map, processes, surveys
+from executor.cad.sweep import DIRECTIONS, Sweeper, axis_name, forked_map, opposite, processes, surveys
 from executor.world.polygon_fit import OutlineError, polygon, symmetry
 
 _ENTRY_PROBE = 2e-5  # the chamfer is measured this far [m] below the entry
@@ -115,13 +116,20 @@ _SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one h
 _ON_PIN = 1e-6  # a vertex of the base this close [m] to a pin's outline is on it
 _GRID = 1e-8  # the grid [m] the union of a pin's sections is snapped to (far below a fit's room)
 _JITTER = 5e-8  # [m] a vertex of that union this close to the line through its neighbours is dropped
-LEAVING = ("+z", "-z", "-x", "+y", "-y", "+x")
-"""The order a part's way out (its insertion axis reversed) is chosen in among those it is
-free along: up (the cell inserts from above), down, then the horizontal ones whose
-insertion the cell's arm was measured to reach sideways (+x, +y, -y:
-:data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways along x
-goes in along +x however the CAD is turned about z; a zero-clearance fit's axis that is
-none of these last, in the order found."""
+PREFERRED = (("+z",), ("-z",), ("-x", "+y", "-y"), ("+x",))
+"""The classes a part's way out (its insertion axis reversed) is chosen by among those it
+is free along, in order: up (the cell inserts from above), down, the horizontal ones whose
+insertion the cell's arm was measured to reach sideways (-x, +y, -y: the insertions +x,
+-y, +y of :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways
+along x goes in along +x however the CAD is turned about z, then +x; a zero-clearance
+fit's axis that is none of these, last. Within a class the product's geometry chooses
+(:func:`_way_out`)."""
+LEAVING = tuple(d for kind in PREFERRED for d in kind)
+"""The six axes in :data:`PREFERRED`'s order: the last rule between ways out the geometry
+leaves tied (:func:`_way_out`)."""
+TIED = 1e-6
+"""Two ways out whose travels (or mass balances) differ by at most this [m] are tied for
+that rule of :func:`_way_out` (a turn about z changes them by rounding alone)."""
 CAVITY_ROOM = 2 * LOCATING_REACH
 """[m] A hole whose narrowest width exceeds a part's widest by more than this (6 mm)
 leaves that part, wherever it lies in it, free to move the locating rule's default reach
@@ -408,8 +416,8 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
 
 def _disassembled(result: Derived) -> set[str]:
     """Stage by stage, every part that some direction frees from the parts still in place
-    leaves along the first such direction in :data:`LEAVING`'s order (``result``'s ``axis`` and ``stages`` filled in);
-    the parts no stage frees."""
+    leaves along the one :func:`_way_out` chooses of them (``result``'s ``axis`` and ``stages``
+    filled in); the parts no stage frees."""
     remaining = set(result.parts) - {result.base}
     while remaining:
         stage = sorted(pid for pid in remaining if any(
@@ -417,12 +425,69 @@ def _disassembled(result: Derived) -> set[str]:
         if not stage:
             break
         for pid in stage:
-            result.axis[pid] = min((d for d in result.directions
-                                    if not (result.blockers[(pid, d)] & (remaining | {result.base}))),
-                                   key=lambda d: LEAVING.index(d) if d in LEAVING else len(LEAVING))
+            result.axis[pid] = _way_out(result, pid, [d for d in result.directions if not (
+                result.blockers[(pid, d)] & (remaining | {result.base}))], remaining | {result.base})
         result.stages.append(stage)
         remaining -= set(stage)
     return remaining
+
+
+def _way_out(result: Derived, pid: str, free: list[str], present: set[str]) -> str:
+    """The way out part ``pid`` leaves along, of the directions ``free`` of the parts
+    ``present`` (the base and the parts still in place): the first class of
+    :data:`PREFERRED` holding one of them (a zero-clearance fit's axis of none of them,
+    last), then within it by the product's geometry, each rule in the product's own terms,
+    so that a turn about z chooses the same way:
+
+    1. the shortest travel: the least distance [m] the part's body (it and the parts fixed
+       to it) moves along the direction until it is past every triangle of the present
+       parts in line with it (whose extent across the direction overlaps the body's by
+       more than :data:`executor.cad.fits.faces.TOUCH`): a shaft free both ways goes in
+       from the end nearer the product's face it passes, a wall beside that face, out of
+       its line, not counted;
+    2. the way away from the present parts' mass: the least component along the direction
+       of the vector from the body's centre of mass to theirs (uniform density);
+    3. :data:`LEAVING`'s order (a fit's axis after the six, in the order found).
+
+    Ways within :data:`TIED` of the best are tied for a rule. Rule 3 is the cell frame's:
+    a part that reaches it (equal travels, the present parts' mass centred across the ways,
+    as in a product alike seen from either way) may go in from its other end with the
+    product turned 180° about z."""
+    def kind(d: str) -> int:
+        return next((k for k, ways in enumerate(PREFERRED) if d in ways), len(PREFERRED))
+    best = min(kind(d) for d in free)
+    ways = [d for d in free if kind(d) == best]
+    if len(ways) == 1:
+        return ways[0]
+    body = next(members for members in result.bodies.values() if pid in members)
+    others = sorted(present - body)
+    moving = np.vstack([result.parts[p].mesh.vertices for p in sorted(body)])
+    fixed = np.vstack([result.parts[p].mesh.triangles for p in others])
+
+    def travel(d: str) -> float:
+        vector = np.array(result.directions[d])
+        across = frame_of(vector)  # the cell's axes for the six: a quarter turn maps the boxes onto each other
+        own = moving @ across.T
+        theirs = fixed @ across.T
+        inline = np.all((theirs.min(axis=1) < own.max(axis=0) - TOUCH)
+                        & (theirs.max(axis=1) > own.min(axis=0) + TOUCH), axis=1)
+        ahead = float((fixed[inline] @ vector).max()) if inline.any() else -math.inf
+        return max(0.0, ahead - float((moving @ vector).min()))
+
+    def mass_centre(ids: Iterable[str]) -> np.ndarray:
+        meshes = [result.parts[p].mesh for p in ids]
+        volumes = np.array([abs(m.volume) for m in meshes])
+        return np.sum([v * m.center_mass for v, m in zip(volumes, meshes)], axis=0) / volumes.sum()
+
+    apart = mass_centre(others) - mass_centre(sorted(body))
+    for rule in (travel, lambda d: float(np.dot(apart, result.directions[d]))):
+        values = {d: rule(d) for d in ways}
+        least = min(values.values())
+        ways = [d for d in ways if values[d] <= least + TIED]
+        if len(ways) == 1:
+            return ways[0]
+    order = list(LEAVING) + [d for d in result.directions if d not in LEAVING]
+    return min(ways, key=order.index)
 
 
 def receives(fit: HoleFit) -> bool:
@@ -605,7 +670,11 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
     none when, at its level, its bore holds an outline of the base or of one of the parts
     ``before`` it (a gland on a shaft: it goes onto a pin, :func:`pins`), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
-    ring that stands in a housing's bore: the ring's hole, :func:`part_holes`)."""
+    ring that stands in a housing's bore: the ring's hole, :func:`part_holes`), in along
+    the same way or, that part ``before`` it, the other way (the shaft sent in from the
+    ring's far end, through the housing's other opening: still in the ring, not in the
+    housing's bore, where it would be a peg standing in a hole of the base, and the glands
+    going in after it along its axis covers over it, on no pin)."""
     def sliced(part: CadPart) -> tuple[float, Loop] | None:
         axis = np.array(DIRECTIONS[axes[part.id]])
         found = _part_slice(part, base, axis)
@@ -623,8 +692,10 @@ def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: di
 
     def in_another(pid: str) -> bool:
         axis = np.array(DIRECTIONS[axes[pid]])
-        return any(other != pid and axes[other] == axes[pid] and _hole_around(by_id[other], by_id[pid], axis)
-                   for other in cut)
+        earlier = {part.id for part in before.get(pid, [])}
+        return any(other != pid and (axes[other] == axes[pid] or (axes[other] == opposite(axes[pid])
+                                                                   and other in earlier))
+                   and _hole_around(by_id[other], by_id[pid], axis) for other in cut)
 
     for (pid, (level, own)), inside in zip(cut.items(), forked_map(in_another, list(cut), workers)):
         if not inside:

@@ -31,7 +31,9 @@ whole outline, for a fraction of its pairs). The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
 is one the peg can make; a pass whose window of turns the search never samples near can
-be missed (a no-pass is the search's finding, not a proof). A peg whose largest
+be missed (a no-pass is the search's finding, not a proof; it is searched in four frames
+a quarter turn apart, so that it, and the lack it reports, do not follow how the product
+is turned about its axis by quarter turns). A peg whose largest
 inscribed circle is wider than the hole's does not pass whatever its turn: its room is
 then given as the difference of those radii, a bound (it lacks at least that much),
 without a search. A round side has closed
@@ -276,10 +278,42 @@ class _Pair:
 
 def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     """The best turn and shift of ``peg`` in ``hole`` and the room there (the module
-    docstring); both simple polygons in their own frames [m] (:func:`polygon`)."""
+    docstring); both simple polygons in their own frames [m] (:func:`polygon`). Where the
+    search finds no pass, it searches the pair again turned together by one, two and
+    three quarter turns (exactly: a permutation of the coordinates with signs) and keeps
+    the most room (the first frame's on a tie), its offset turned back: the search's start
+    (the hole's largest inscribed circle's centre, which slides where that circle is not
+    unique) and its steps (a grid along the frame's axes) follow the frame, so one frame's
+    least lack, a local best, changed with a quarter turn of the product (``vitac_shapes``'
+    hourglass peg in the convex hole: 1.773, 1.681, 1.773, 2.104 mm lacking per side); the
+    four frames searched are the same four however the product is turned by quarter turns."""
+    bound = _room_bound(peg, hole)
+    found = _searched(peg, hole, bound)
+    if found.room >= 0 or bound < 0:
+        return found
+    for quarter in (1, 2, 3):
+        turned_peg, turned_hole = (shapely.transform(shape, lambda xy, k=quarter: _quarters(xy, k))
+                                   for shape in (peg, hole))
+        fit = _searched(turned_peg, turned_hole, bound)
+        if fit.room > found.room:
+            x, y = _quarters(np.array([fit.offset]), -quarter)[0]
+            found = PolygonFit(fit.room, fit.yaw, (float(x), float(y)))
+    return found
+
+
+def _quarters(points: np.ndarray, quarter: int) -> np.ndarray:
+    """``points`` (n, 2) turned by ``quarter`` × 90° about the origin (negative: clockwise),
+    exactly (the coordinates swapped and negated)."""
+    for _ in range(quarter % 4):
+        points = np.column_stack([-points[:, 1], points[:, 0]])
+    return points
+
+
+def _searched(peg: shapely.Polygon, hole: shapely.Polygon, bound: float) -> PolygonFit:
+    """:func:`polygon_fit`'s search in the frame the polygons are given in; ``bound`` [m]
+    the room's (:func:`_room_bound`: negative, the answer without a search)."""
     peg_centre = np.asarray(shapely.minimum_bounding_circle(peg).centroid.coords[0])
     hole_centre = np.asarray(shapely.maximum_inscribed_circle(hole, FINE_SHIFT).coords[0])
-    bound = _room_bound(peg, hole)
     if bound < 0:
         return PolygonFit(bound, 0.0, (float(hole_centre[0] - peg_centre[0]), float(hole_centre[1] - peg_centre[1])))
     pair = _Pair(shapely.affinity.translate(peg, *-peg_centre), shapely.affinity.translate(hole, *-hole_centre))

@@ -28,8 +28,9 @@ them out in another id order, a turn turns the footprints); under a turn, a sect
 orientation (``outline``, ``size``, ``yaw``): compared by what a turn keeps (its sorted
 sides, its corners' distances from its centre), and a reason naming the arm's measured
 reach (:data:`_REACH`: the reach is the cell frame's); a part free both ways along an
-axis that goes in from the other side turned (a tie, :func:`_tied`): its axis and its
-feature's entry. docs/import.md ("Invariances") lists what the comparison found.
+axis that goes in from the other side turned (a tie, :func:`_tied`): its axis, its
+feature's entry and the sense of the axes its reason for going by hand names.
+docs/import.md ("Invariances") lists what the comparison found.
 
 ``python -m tests.cad.invariance [--product NAME ...] [--transform T ...]`` prints one
 line per product and transform (``same`` or the differences, each ``tie:`` too: a part
@@ -436,8 +437,11 @@ def compare(product: Path, transform: str, work: Path, base: dict[str, Any] | No
 
 def _tied(mine: dict[str, Any], theirs: dict[str, Any]) -> set[str]:
     """The parts of a turned product that go in along another axis, both free in both
-    imports: a tie the import breaks by its order of cell axes (the cell reaches some
-    sideways, :data:`executor.cad.sweep.DIRECTIONS`), legitimate."""
+    imports: a tie the import breaks in the cell's terms, legitimate: the arm reaches some
+    insertions sideways and not others (:data:`executor.cad.derive.PREFERRED`), and a
+    product alike seen from either way goes by the order of the cell's axes
+    (:data:`executor.cad.derive.LEAVING`); otherwise the product's geometry chooses, the
+    same however it is turned (:func:`executor.cad.derive._way_out`)."""
     def leaves(axes: dict[str, Any], pid: str) -> set[str]:
         return set(axes[pid]["free"]) | {opposite(axes[pid]["insertion"])}
     return {pid for pid, axes in mine["axes"].items() if pid in theirs["axes"]
@@ -460,11 +464,15 @@ def _reach_either(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
 
 def _untied(tree: dict[str, Any], tied: set[str]) -> dict[str, Any]:
     """``tree`` without what follows from the insertion axis of each ``tied`` part: the
-    axis itself, and its feature's entry (position, axis, entry height, depth)."""
+    axis itself, its feature's entry (position, axis, entry height, depth), and the sense
+    of the axes its reason for going by hand names (``along -y`` as ``along y``)."""
     tree = _deep(tree)
     geometry = tree.get("geometry.toml", {})
     for pid in tied:
         del tree["axes"][pid]
+        manual = geometry.get("manual", {}).get(pid, {})
+        if "reason" in manual:
+            manual["reason"] = re.sub(r"(?<![\w.])[+-]([xyz])\b", r"\1", manual["reason"])
         features = [geometry.get("part_shapes", {}).get(pid, {}).get("demo_hole"),
                     *geometry.get("manual", {}).get(pid, {}).get("on", [])]
         for hid in filter(None, features):

@@ -24,6 +24,7 @@ import shapely
 import trimesh
 
 from executor import ExecutorError
+from executor.cad import derive as derive_module
 from executor.cad import sections, sweep
 from executor.cad.derive import derive
 from executor.cad.fits.faces import TOUCH, CylinderFace, cylinder_faces, fit_faces, zero_clearance_fits
@@ -247,6 +248,49 @@ def _ring_past_a_collar(collar: float) -> list[CadPart]:
     ring = trimesh.creation.annulus(r_min=8 * MM, r_max=14 * MM, height=3 * MM, sections=40)
     ring.apply_translation((0, 0, 3.5 * MM))
     return _parts(base=base, ring=ring)
+
+
+@pytest.mark.parametrize("quarter", [0, 1, 2, 3])
+def test_a_shaft_free_both_ways_goes_in_from_the_nearer_end_however_the_product_is_turned(quarter: int) -> None:
+    # A housing bored through along y (r 6 mm, y -15 to 15) and a shaft in it (r 4 mm, y
+    # -20 to 60): free both ways, it comes out 35 mm along +y, 75 mm along -y. Turned 180
+    # deg it went out along +y too (the first of the cell's axes), from the product's other
+    # end. Turned 90 or 270 deg its axis is x: of +x and -x the arm reaches the insertion
+    # along +x alone, so it leaves along -x whichever end that is.
+    bore = trimesh.creation.cylinder(radius=6 * MM, height=32 * MM, sections=48)
+    bore.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (1, 0, 0)))
+    bore.apply_translation((0, 0, 30 * MM))
+    housing = trimesh.boolean.difference([_box((40, 30, 40), (0, 0, 30)), bore], engine="manifold")
+    shaft = trimesh.creation.cylinder(radius=4 * MM, height=80 * MM, sections=24)
+    shaft.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (1, 0, 0)))
+    shaft.apply_translation((0, 20 * MM, 30 * MM))
+    turn = trimesh.transformations.rotation_matrix(quarter * math.pi / 2, (0, 0, 1))
+    derived = derive(_parts(housing=housing.apply_transform(turn), shaft=shaft.apply_transform(turn)), "housing", {},
+                     reach=0.0)
+    assert sorted(derived.free("shaft")) == sorted({0: ["+y", "-y"], 2: ["+y", "-y"]}.get(quarter, ["+x", "-x"]))
+    assert derived.axis["shaft"] == ("+y", "-x", "-y", "-x")[quarter]
+
+
+@pytest.mark.slow  # occt_pump's six parts swept and sliced (10 s at load 4)
+@pytest.mark.parametrize("shaft_out", ["+y", "-y"])
+def test_the_pumps_glands_go_onto_the_shaft_whichever_end_the_shaft_goes_in_from(
+        shaft_out: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    # The shaft, free both ways along y, leaves along +y (its nearer end). Sent in from
+    # the impeller's end instead (as turned 180 deg it was, of two ways tied), along the
+    # glands' axis, it was a peg in the housing's bore entered through its cone (a hole of
+    # the base, chamfer 11.4 mm, which the cell refused): the glands and the impeller
+    # going in after it along its axis were covers over it, on no pin, and every fit of
+    # theirs was lost. It is in the bearing ring's bore, placed before it, either way.
+    chosen = derive_module._way_out
+    monkeypatch.setattr(derive_module, "_way_out", lambda result, pid, free, present: shaft_out if pid == "shaft"
+                        else chosen(result, pid, free, present))
+    derived = derive(load_meshes(CORPUS / "occt_pump" / "meshes", "mm"), "housing", {})
+    assert derived.axis["shaft"] == shaft_out
+    assert {pin.id: (pin.owner, sorted(pin.parts)) for pin in derived.pins.values()} == {
+        "shaft_pin1": ("shaft", ["gland_2", "gland_3", "impeller"])}
+    assert {(hole.owner, hole.part, hole.axis) for hole in derived.part_holes.values()} == {
+        ("bearing_ring", "shaft", shaft_out)}
+    assert {fit.part for fit in derived.holes.values()} == {"bearing_ring"}
 
 
 def test_a_ring_passes_a_collar_of_its_bore_size_on_its_way_out_but_not_a_larger_one() -> None:

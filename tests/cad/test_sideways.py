@@ -128,18 +128,19 @@ def test_a_horizontal_peg_is_assembled_within_2_mm(taught: Path) -> None:
     assert quat_to_matrix(quat)[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=0.02)  # lying along the hole's axis
 
 
-def _turned(folder: Path, wall: float | None = None) -> Path:
+def _turned(folder: Path, wall: float | None = None, faces: tuple[int, ...] = (1, -1)) -> Path:
     """The product's CAD (turned a quarter turn about z: its hole along x, the peg free both
-    ways along it) or, with a ``wall`` [mm], as drawn with a 10 mm wall from its
-    box's +y face, beside the hole's entry (x 25 to 35 mm from its axis, as high as the box),
-    reaching that far out, in ``folder``."""
+    ways along it) or, with a ``wall`` [mm], as drawn with a 10 mm wall from each of its
+    box's ``faces`` (+y: 1, -y: -1) the hole passes, beside the hole's entry there (x 25 to
+    35 mm from its axis, as high as the box), reaching that far out, in ``folder``."""
     folder.mkdir()
     box = trimesh.load(CORPUS / "meshes" / "box.stl", force="mesh")
     peg = trimesh.load(CORPUS / "meshes" / "hex_peg.stl", force="mesh")
     if wall is not None:
-        side = trimesh.creation.box((10.0, wall, 60.0))
-        side.apply_translation((30.0, 25.0 + wall / 2, 30.0))
-        box = trimesh.boolean.union([box, side], engine="manifold")
+        for face in faces:
+            side = trimesh.creation.box((10.0, wall, 60.0))
+            side.apply_translation((30.0, face * (25.0 + wall / 2), 30.0))
+            box = trimesh.boolean.union([box, side], engine="manifold")
     else:
         for mesh in (box, peg):
             mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (0.0, 0.0, 1.0)))
@@ -175,7 +176,8 @@ def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_arm_was_not_measured_
 def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_wrist_would_meet_the_base(
         tmp_path: Path, wall: float, meets: bool) -> None:
     # The peg sticks 25 mm out of the entry, held 20 mm deep: the wrist starts 65 mm out,
-    # a wall beside the entry must end 10 mm short of it.
+    # a wall beside the entry must end 10 mm short of it. A wall beside both entries: the
+    # product alike from either, the peg goes in along -y, the first the cell reaches.
     run_import(_turned(tmp_path / "cad", wall), tmp_path / "out", "mm", CORPUS / "import.toml")
     manual = load_product_description(tmp_path / "out").geometry.manual  # type: ignore[union-attr]
     assert ("hex_peg" in manual) == meets, manual
@@ -183,6 +185,23 @@ def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_wrist_would_meet_the_
         assert manual["hex_peg"].reason == ("goes into hole h1 along -y, but the arm's wrist (60 mm about the "
                                           "tool's axis, 60 mm out from the grip) would meet 'box', 55.000 mm out "
                                           "from the grip within 60 mm of the axis"), manual
+
+
+def test_a_peg_free_both_ways_alike_goes_in_from_the_side_away_from_a_wall(tmp_path: Path) -> None:
+    # The peg sticks 25 mm out of either face: it leaves 75 mm either way. With a wall
+    # beside the +y entry alone it went in along -y (the first axis the cell reaches),
+    # past the wall, and by hand (its wrist would meet the wall); it goes in along +y, away
+    # from the product's mass, and turned 180 deg from the same side.
+    for turned, out in ((False, "-y"), (True, "+y")):
+        cad = _turned(tmp_path / f"cad{turned}", 60.0, (1,))
+        if turned:
+            for stl in cad.iterdir():
+                mesh = trimesh.load(stl, force="mesh")
+                mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi, (0.0, 0.0, 1.0)))
+                mesh.export(stl)
+        imported = run_import(cad, tmp_path / f"out{turned}", "mm", CORPUS / "import.toml")
+        assert imported.derived.axis == {"hex_peg": out}
+        assert not load_product_description(tmp_path / f"out{turned}").geometry.manual  # type: ignore[union-attr]
 
 
 def test_the_ways_out_chosen_first_are_those_whose_insertion_the_arm_reaches_sideways() -> None:

@@ -51,6 +51,28 @@ def test_a_splined_shaft_too_wide_for_its_hub_does_not_pass() -> None:
     assert found.room == pytest.approx(-GAP, abs=TESSELLATION)
 
 
+def test_a_peg_that_does_not_pass_lacks_the_same_however_the_pair_is_turned_by_quarter_turns() -> None:
+    """vitac_shapes' hourglass peg and its convex hole (tests/cad/corpus/vitac_shapes/truth.toml,
+    mm): the peg's waist does not let it pass. The search started from the hole's largest
+    inscribed circle's centre, which slides along the hole's parallel sides (32 mm apart)
+    as the pair turns, and stepped along the frame's axes: it reported from 1.681 to 2.103
+    mm lacking per side as the pair turned by quarter turns (1.773, 1.681, 1.773, 2.103
+    turned exactly; here by cos and sin, their rounding)."""
+    peg = np.array([(-17.5, -15), (17.5, -15), (11.7265, -5), (11.7265, 5), (17.5, 15), (-17.5, 15),
+                    (-11.7265, 5), (-11.7265, -5)]) * MM
+    hole = np.array([(-23.0644, -5.2232), (-15.5207, -16), (15.618, -16), (26.2892, 5.3424), (10.3028, 16),
+                     (-10.4142, 16), (-20.9212, 5.493)]) * MM
+    found = []
+    for quarter in range(4):
+        turned = [np.column_stack([np.cos(quarter * math.pi / 2) * xy[:, 0] - np.sin(quarter * math.pi / 2) * xy[:, 1],
+                                   np.sin(quarter * math.pi / 2) * xy[:, 0] + np.cos(quarter * math.pi / 2) * xy[:, 1]])
+                  for xy in (peg, hole)]
+        found.append(polygon_fit(polygon(turned[0], "peg"), polygon(turned[1], "hole")))
+    assert all(fit.room < -1.5 * MM for fit in found)
+    assert max(fit.room for fit in found) - min(fit.room for fit in found) <= TESSELLATION
+    assert {round(fit.yaw, 3) for fit in found} == {round(found[0].yaw, 3)}  # the turn relative to the hole's
+
+
 def test_a_d_shaft_passes_a_round_hole_by_its_circle_not_its_centroid() -> None:
     """A 9.8 mm D-shaft (flat 4 mm from its axis) in a 10 mm bore: 0.1 mm all round, its
     arc's centre on the bore's, whichever way the flat faces."""
