@@ -477,7 +477,7 @@ def test_a_sweep_entailed_by_one_along_the_same_direction_is_not_queried_and_ans
 
 def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
     parts = {p.id: p.mesh for p in _shaft_in_bearing((64, 360, 40))}
-    fixed = sweep._Triangles(np.array(parts["bearing"].triangles))
+    fixed = sweep._Solid(parts["bearing"]).index
     shaft = np.asarray(parts["shaft"].vertices)
     chosen = []
     for shift in ([0.0, 0.0, 3e-3], [0.0, 2e-3, 0.0], [5e-3, 0.0, 1e-3]):
