@@ -629,9 +629,9 @@ class Sweeper:
         moving ones (a part slid at its fits has none from the surveys), in this process,
         before its workers are forked: each worker then has them, rather than making its
         own (a slid part's hull, swept in both workers, was made in each). A convex moving
-        solid is tested whole first (:func:`_collides`), which needs no index and mostly
-        clears it (a slid shaft along its bores): the index is made where that test does
-        not, in the worker."""
+        solid is tested whole first (:func:`_collides`), which mostly decides without an
+        index (a slid shaft along its bores): the index is made where it is needed, in the
+        worker."""
         for test in tests:
             moving, fixed, _ = self._oriented(*test)
             _ = fixed.bvh, moving.hull
