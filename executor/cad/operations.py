@@ -367,8 +367,10 @@ def flat_top(mesh: trimesh.Trimesh) -> shapely.Geometry:
     empty where none does."""
     high = float(mesh.vertices[:, 2].max())
     level = np.all(mesh.vertices[mesh.faces][:, :, 2] >= high - FLAT_TOLERANCE, axis=1) & (mesh.face_normals[:, 2] > 0)
-    triangles = [shapely.Polygon(tri[:, :2]) for tri in mesh.vertices[mesh.faces[level]]]
-    return shapely.union_all([t for t in triangles if t.area > 0]).buffer(0) if triangles else shapely.Polygon()
+    if not level.any():
+        return shapely.Polygon()
+    triangles = shapely.polygons(mesh.vertices[mesh.faces[level]][:, :, :2])
+    return shapely.union_all(triangles[shapely.area(triangles) > 0]).buffer(0)
 
 
 def builds_plate(cell: Derived) -> bool:

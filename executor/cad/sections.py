@@ -250,8 +250,12 @@ def shadow(mesh: trimesh.Trimesh, axis: np.ndarray, low: float, high: float,
             points.append((flat[:, i] + t[:, None] * (flat[:, j] - flat[:, i]))[:, None])
             valid.append(crossing[:, None])
     corners, mask = np.concatenate(points, axis=1), np.concatenate(valid, axis=1)
+    spanning = mask.sum(axis=1) >= 3  # fewer corners span no area
+    corners, mask = corners[spanning], mask[spanning]
     owner = np.nonzero(mask)[0]
-    hulls = shapely.convex_hull(shapely.multipoints(corners[mask], indices=owner))
+    # a line string through the corners: GEOS hulls its coordinates in their order, as a
+    # multipoint's (the same hull), without making a point of each
+    hulls = shapely.convex_hull(shapely.linestrings(corners[mask], indices=owner))
     hulls = hulls[shapely.area(hulls) > 0]
     dropped = False
     if band is not None and len(hulls):

@@ -167,11 +167,11 @@ class _Triangles:
     boxes, to find those near a piece (:func:`_likely`), and a grid of the cells their
     boxes meet, to find that none is near a box (:func:`_collides`)."""
 
-    def __init__(self, corners: np.ndarray) -> None:
+    def __init__(self, corners: np.ndarray, low: np.ndarray, high: np.ndarray, centres: np.ndarray) -> None:
+        """``low``, ``high``, ``centres``: the triangles' lowest and highest corners and
+        their centres [m] (:attr:`_Solid.extents`)."""
         self.corners = corners
-        self.low, self.high = corners.min(axis=1), corners.max(axis=1)
-        self.centres = corners.mean(axis=1)
-        centres = self.centres
+        self.low, self.high, self.centres = low, high, centres
         cells = ((centres - centres.min(axis=0)) / max(float(np.ptp(centres)), 1e-12) * 1023).astype(np.int64)
         code = np.zeros(len(corners), dtype=np.int64)
         for bit in range(10):
@@ -407,6 +407,7 @@ class _Solid:
         """The mesh's box [m] (a copy: trimesh checks its cache by hashing the mesh on each use)."""
         self.triangles = np.array(mesh.triangles)
         """(n, 3, 3): the triangles' corners [m]."""
+        self._extents: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._leading: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._index: _Triangles | None = None
 
@@ -435,15 +436,26 @@ class _Solid:
     def index(self) -> _Triangles:
         """The triangles, to find those near a piece (:func:`_likely`)."""
         if self._index is None:
-            self._index = _Triangles(self.triangles)
+            self._index = _Triangles(self.triangles, *self.extents)
         return self._index
+
+    @property
+    def extents(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The triangles' lowest and highest corners and their centres [m], made once for
+        :attr:`leading` and :attr:`index` (the least and most of three corners compared
+        pairwise: a reduction over an axis of three is several times slower)."""
+        if self._extents is None:
+            first, second, third = self.triangles[:, 0], self.triangles[:, 1], self.triangles[:, 2]
+            self._extents = (np.minimum(np.minimum(first, second), third), np.maximum(np.maximum(first, second), third),
+                             self.triangles.mean(axis=1))
+        return self._extents
 
     @property
     def leading(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The triangles' lowest and highest corners, normals and centres [m] (:func:`_front`)."""
         if self._leading is None:
-            self._leading = (self.triangles.min(axis=1), self.triangles.max(axis=1), np.array(self.mesh.face_normals),
-                             self.triangles.mean(axis=1))
+            low, high, centres = self.extents
+            self._leading = (low, high, np.array(self.mesh.face_normals), centres)
         return self._leading
 
     @property
@@ -612,14 +624,19 @@ class Sweeper:
         return None
 
     def _prepare(self, tests: Iterable[tuple[str, str, np.ndarray]]) -> None:
-        """Make the BVHs and triangle indices of the fixed solids of ``tests`` (member,
-        other, shift), and the outer hulls of the moving ones (a part slid at its fits has
-        none from the surveys), in this process, before its workers are forked: each worker
-        then has them, rather than making its own (a slid part's hull, swept in both
-        workers, was made in each)."""
+        """Make the BVHs of the fixed solids of ``tests`` (member, other, shift), their
+        triangle indices where the moving solid is not convex, and the outer hulls of the
+        moving ones (a part slid at its fits has none from the surveys), in this process,
+        before its workers are forked: each worker then has them, rather than making its
+        own (a slid part's hull, swept in both workers, was made in each). A convex moving
+        solid is tested whole first (:func:`_collides`), which mostly decides without an
+        index (a slid shaft along its bores): the index is made where it is needed, in the
+        worker."""
         for test in tests:
             moving, fixed, _ = self._oriented(*test)
-            _ = fixed.bvh, fixed.index, moving.hull
+            _ = fixed.bvh, moving.hull
+            if not moving.convex:
+                _ = fixed.index
 
     def _oriented(self, member: str, other: str, shift: np.ndarray) -> tuple[_Solid, _Solid, np.ndarray]:
         """The moving solid, the fixed one and the shift [m] of the test whether part

@@ -502,6 +502,27 @@ def test_sweeps_in_two_processes_give_the_answers_and_queries_of_one() -> None:
     assert queries == found[0][1] > 0
 
 
+def test_the_sweeps_workers_are_forked_with_the_indices_of_what_a_part_not_convex_sweeps_against() -> None:
+    parts = _shaft_in_bearing()
+    meshes = {p.id: p.mesh for p in parts}
+    slides = zero_clearance_fits({pid: fit_faces(mesh) for pid, mesh in meshes.items()})
+    sweeper = sweep.Sweeper(meshes, slides, workers=2)
+    # the convex shaft slides out along x through the bearing and the housing; the bearing
+    # (an annulus) lifted meets the housing and the shaft
+    requests = [("shaft", np.array(sweep.DIRECTIONS[name]), 0.3) for name in ("+x", "-x")]
+    hits = sweeper.blocked([*requests, ("bearing", np.array(sweep.DIRECTIONS["+z"]), 3e-3)])
+    assert hits == [set(), set(), {"housing", "shaft"}]
+    assert sweeper._pool is not None  # forked: prepared before
+    # made before the fork: the index of the fixed one of the bearing and the housing (the
+    # one of fewer triangles moves), none of those only the convex shaft moves against (its
+    # whole sweep tested first needs none)
+    _, fixed, _ = sweeper._oriented("bearing", "housing", np.array(sweep.DIRECTIONS["+z"]) * 3e-3)
+    assert fixed._index is not None
+    against_shaft = [solid for (part, other, _), solid in sweeper._slid.items() if other == "shaft"]
+    assert against_shaft and all(solid._index is None for solid in against_shaft)
+    sweeper.close()
+
+
 def test_a_sweep_entailed_by_one_along_the_same_direction_is_not_queried_and_answers_as_queried() -> None:
     parts = _shaft_in_bearing()
     meshes = {p.id: p.mesh for p in parts}
@@ -521,7 +542,7 @@ def test_a_sweep_entailed_by_one_along_the_same_direction_is_not_queried_and_ans
 
 def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
     parts = {p.id: p.mesh for p in _shaft_in_bearing((64, 360, 40))}
-    fixed = sweep._Triangles(np.array(parts["bearing"].triangles))
+    fixed = sweep._Solid(parts["bearing"]).index
     shaft = np.asarray(parts["shaft"].vertices)
     chosen = []
     for shift in ([0.0, 0.0, 3e-3], [0.0, 2e-3, 0.0], [5e-3, 0.0, 1e-3]):
