@@ -390,6 +390,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.dropped = {pair for pair in dropped if placing[pair] == "locates"}
     result.dropped_supports = {pair for pair in dropped if placing[pair] == "supports"}
     result.edges = set(result.reasons)
+    _ways_in(result)
     order = nx.DiGraph(list(result.edges))
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis) if result.axis[pid] in DIRECTIONS],
                    result.axis, {pid: [by_id[p] for p in sorted(nx.ancestors(order, pid)) if p != base]
@@ -419,10 +420,42 @@ def _disassembled(result: Derived) -> set[str]:
         for pid in stage:
             result.axis[pid] = min((d for d in result.directions
                                     if not (result.blockers[(pid, d)] & (remaining | {result.base}))),
-                                   key=lambda d: LEAVING.index(d) if d in LEAVING else len(LEAVING))
+                                   key=_leaving_rank)
         result.stages.append(stage)
         remaining -= set(stage)
     return remaining
+
+
+def _ways_in(result: Derived) -> None:
+    """Each part's insertion axis judged as the cell meets the part (``result.axis`` set
+    anew): of the directions free of the parts present then, the first in :data:`LEAVING`'s
+    order. Present are the base, the parts still in place at the part's disassembly stage and
+    the parts ``result.edges`` put before its body; absent, the parts they put after it (the
+    parts it supports, those its ``blocks``, ``supports`` and ``locates`` pairs put later),
+    even where the disassembly took them out after it (a box slid out sideways from under the
+    box resting on it goes in from above, before that one). Where the parts put before it and
+    not in place at its stage leave it no way, the stage's own, less the parts after it."""
+    order = nx.DiGraph(list(result.edges))
+    root = {pid: r for r, members in result.bodies.items() for pid in members}
+
+    def related(pid: str, find: Callable[[nx.DiGraph, str], set[str]]) -> set[str]:
+        return set().union(*(find(order, m) for m in result.bodies[root[pid]] if m in order))
+
+    def free(pid: str, present: set[str]) -> list[str]:
+        return [d for d in result.directions if not result.blockers[(pid, d)] & present]
+
+    for k, stage in enumerate(result.stages):
+        in_place = set().union(*result.stages[k:]) | {result.base}
+        for pid in stage:
+            later = related(pid, nx.descendants)
+            # the second is never empty: the stage's own way out is free of every part in place
+            ways = free(pid, (in_place | related(pid, nx.ancestors)) - later) or free(pid, in_place - later)
+            result.axis[pid] = min(ways, key=_leaving_rank)
+
+
+def _leaving_rank(direction: str) -> int:
+    """Where ``direction`` stands in :data:`LEAVING`'s order (a fit's own axis: after them all)."""
+    return LEAVING.index(direction) if direction in LEAVING else len(LEAVING)
 
 
 def receives(fit: HoleFit) -> bool:

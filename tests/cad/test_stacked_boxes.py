@@ -12,6 +12,8 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
+from executor.cad.cli import run_import
+from tests.cad.conftest import manual_reasons
 from tests.cad.test_closed_pockets import _write
 from tests.conftest import Runner
 
@@ -32,6 +34,19 @@ def _stack(folder: Path) -> None:
 
 def _order(plan: list[dict]) -> list[tuple[str, str | None]]:
     return [(step["part"], step["hole"]) for step in plan]
+
+
+def test_a_box_under_another_goes_in_from_above(tmp_path: Path) -> None:
+    # Assembled, the lower box is free only sideways (the upper one sits on it), but it
+    # supports the upper one, which every plan places after it: its way in is judged
+    # with the upper box out, from above, and the pairs stay the base's and the support's.
+    _stack(tmp_path / "cad")
+    derived = run_import(tmp_path / "cad", tmp_path / "out", "mm", None).derived
+    assert derived.stages == [["lower", "upper"]]
+    assert derived.axis == {"lower": "+z", "upper": "+z"}
+    assert derived.reasons == {("base", "lower"): "base", ("lower", "upper"): "supports"}
+    reasons = manual_reasons(tmp_path / "out")
+    assert set(reasons) == {"lower", "upper"} and not any("not from above" in why for why in reasons.values())
 
 
 @pytest.mark.slow
