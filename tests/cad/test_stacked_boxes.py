@@ -6,6 +6,8 @@ boxes by hand (the cell has no operation that locates a part resting on a face).
 from __future__ import annotations
 
 import json
+import math
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -47,6 +49,24 @@ def test_a_box_under_another_goes_in_from_above(tmp_path: Path) -> None:
     assert derived.reasons == {("base", "lower"): "base", ("lower", "upper"): "supports"}
     reasons = manual_reasons(tmp_path / "out")
     assert set(reasons) == {"lower", "upper"} and not any("not from above" in why for why in reasons.values())
+
+
+def test_a_product_with_no_hole_is_planned_by_least_travel(tmp_path: Path, run_main: Runner) -> None:
+    # With no hole there is no centre of the holes: each part is carried to the base's
+    # centre in the cell (base_center of [plate]), the one order's cost its straight legs
+    # from home (the cell origin) to each start, on to that centre, and back, whole mm each.
+    _stack(tmp_path / "cad")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    done = run_main("plan", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
+                    "--optimal", "--json")
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert [_order(plan) for plan in result["plans"]] == [[(part, None) for part in ORDER]]
+    starts = {pid: part["start"] for pid, part in tomllib.loads((out / "assembly.toml").read_text())["parts"].items()}
+    centre = tomllib.loads((out / "geometry.toml").read_text())["plate"]["base_center"]
+    stops = [[0.0, 0.0]] + [point for pid in ORDER for point in (starts[pid], centre)] + [[0.0, 0.0]]
+    assert result["cost"] == sum(round(1000 * math.dist(a, b)) for a, b in zip(stops, stops[1:]))
 
 
 @pytest.mark.slow
