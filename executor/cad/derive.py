@@ -7,8 +7,10 @@ size, everything else fixed, which gives its blockers per direction (blocking is
 pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
 every zero-clearance fit (:func:`executor.cad.fits.faces.zero_clearance_fits`).
-Stage by stage, every part that some direction frees from the parts still in place leaves
-along the first such direction (in `LEAVING`'s order): its **insertion axis** is the reverse. Where parts are
+Stage by stage, every part that some direction frees from the parts still in place leaves.
+Its **insertion axis** is the reverse of the first direction (in `LEAVING`'s order) free of
+the parts present as the cell meets it: those in place at its stage and those the
+precedence puts before it, less those it puts after it (:func:`_ways_in`). Where parts are
 left, the screwed pairs (modelled threads, :func:`executor.cad.fits.threads.screwed_pairs`, in a nut or a
 plain hole at their tap drill; cosmetic ones, :func:`executor.cad.fits.threads.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
@@ -431,9 +433,9 @@ def _ways_in(result: Derived) -> None:
     anew): of the directions free of the parts present then, the first in :data:`LEAVING`'s
     order. Present are the base, the parts still in place at the part's disassembly stage and
     the parts ``result.edges`` put before its body; absent, the parts they put after it (the
-    parts it supports, those its ``blocks``, ``supports`` and ``locates`` pairs put later),
-    even where the disassembly took them out after it (a box slid out sideways from under the
-    box resting on it goes in from above, before that one). Where the parts put before it and
+    parts it supports, those its ``blocks`` and ``locates`` pairs put later), in place at its
+    stage or not (a box the box resting on it leaves free only sideways goes in from above,
+    before that one). Where the parts put before it and
     not in place at its stage leave it no way, the stage's own, less the parts after it."""
     order = nx.DiGraph(list(result.edges))
     root = {pid: r for r, members in result.bodies.items() for pid in members}
