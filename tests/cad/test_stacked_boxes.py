@@ -38,16 +38,19 @@ def _order(plan: list[dict]) -> list[tuple[str, str | None]]:
     return [(step["part"], step["hole"]) for step in plan]
 
 
-def test_a_box_under_another_goes_in_from_above(tmp_path: Path) -> None:
+def test_a_box_under_another_goes_in_from_above(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     # Assembled, the lower box is free only sideways (the upper one sits on it), but it
     # supports the upper one, which every plan places after it: its way in is judged
     # with the upper box out, from above, and the pairs stay the base's and the support's.
     _stack(tmp_path / "cad")
-    derived = run_import(tmp_path / "cad", tmp_path / "out", "mm", None).derived
+    assert main(["import", str(tmp_path / "cad"), "--units", "mm", "--out", str(tmp_path / "out")]) == 0
+    assert ("part lower: insertion axis -z (leaves along +z with upper out, placed after it); free in the "
+            "assembled product along +x, -x, +y, -y") in capsys.readouterr().out
+    derived = run_import(tmp_path / "cad", tmp_path / "again", "mm", None).derived
     assert derived.stages == [["lower", "upper"]]
     assert derived.axis == {"lower": "+z", "upper": "+z"}
     assert derived.reasons == {("base", "lower"): "base", ("lower", "upper"): "supports"}
-    reasons = manual_reasons(tmp_path / "out")
+    reasons = manual_reasons(tmp_path / "again")
     assert set(reasons) == {"lower", "upper"} and not any("not from above" in why for why in reasons.values())
 
 
