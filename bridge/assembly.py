@@ -120,6 +120,9 @@ class Assembly:
     """The (part, hole) pairs ``geometry.toml`` states the PyBullet cell cannot tell from a
     fit (``near_miss``: the part misses the hole by less than the cell's peg lacks at its
     corners); a near miss only with a backend of :data:`NEAR_MISS_BACKENDS`."""
+    base_center: tuple[float, float] | None = None
+    """Where the cell's fixture holds the base's centre [m] (``base_center`` of ``[plate]`` in
+    ``geometry.toml``), None without a ``geometry.toml``."""
     nominal_modelled: bool = False
     """Whether the simulated cell builds those fits with
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
@@ -220,6 +223,8 @@ def assembly_of(product: ProductDescription) -> Assembly:
                     near_misses=frozenset() if geometry is None else frozenset(
                         (pid, hid) for shape in geometry.hole_shapes.values() for hid in shape.holes
                         for pid in shape.near_miss or ()),
+                    base_center=None if geometry is None else (geometry.plate.base_center[0],
+                                                               geometry.plate.base_center[1]),
                     nominal_modelled=geometry is not None and models_nominal_fits(geometry))
 
 

@@ -6,7 +6,8 @@ part that needs a hole in a distinct hole it fits (``plan_step/3``), and the che
 - :func:`travel_facts`: the ``travel/3`` facts of the cost, from an assembly's geometry.
   The tool starts at ``home`` ([x, y] [m], default the cell origin where the arm
   stands), and for every step goes to the part's ``start``, carries it to its hole (or,
-  for a part without a hole, to the assembly ``site``: the centre of the holes) and,
+  for a part without a hole, to the assembly ``site``: the centre of the holes; with no
+  hole, the base's centre in the cell, ``base_center`` of ``[plate]``) and,
   after the last step, returns home. Legs are straight lines, in whole millimetres.
 - :func:`check_plan`, :func:`check_assignment`: the error atoms the checker
   (``check_plan.lp``) derives; an empty list means valid.
@@ -156,13 +157,18 @@ def _locations(
     starts = {part.id: part.start for part in assembly.parts if part.start is not None}
     positions = {hole.id: hole.position for hole in assembly.holes if hole.position is not None}
     missing = [p for p in facts.parts if p not in starts] + [h for h in facts.holes if h not in positions]
-    if missing or not positions:
+    if positions:
+        xs, ys = zip(*positions.values())
+        site = (sum(xs) / len(xs), sum(ys) / len(ys))
+    elif assembly.base_center is not None:  # no hole: the parts are placed on the base, held at its centre
+        site = assembly.base_center
+    else:
+        missing = missing or ["all holes (with none: base_center of [plate] in geometry.toml)"]
+    if missing:
         raise PlannerError(
             f"assembly '{assembly.name}': optimal plans need a start [x, y] for every part "
-            f"and a position for every hole; missing for: {' '.join(missing) or 'all holes'}"
+            f"and a position for every hole; missing for: {' '.join(missing)}"
         )
-    xs, ys = zip(*positions.values())
-    site = (sum(xs) / len(xs), sum(ys) / len(ys))
     locations = {clingo.Function("home"): home, clingo.Function("site"): site}
     for part in facts.parts:
         locations[clingo.Function("start", [clingo.Function(part)])] = starts[part]

@@ -290,9 +290,11 @@ def report(derived: Derived) -> list[str]:
     """The lines ``import`` prints about what it derived."""
     lines = []
     for pid in sorted(derived.axis):
-        lines.append(f"part {pid}: insertion axis {opposite(derived.axis[pid])} (leaves along "
-                     f"{derived.axis[pid]}); free in the assembled product along "
-                     f"{', '.join(derived.free(pid)) or 'none'}")
+        way = derived.axis[pid]
+        later = "" if way in derived.free(pid) else (
+            f" with {' '.join(sorted(derived.blockers[(pid, way)]))} out, placed after it")
+        lines.append(f"part {pid}: insertion axis {opposite(way)} (leaves along {way}{later}); free in the "
+                     f"assembled product along {', '.join(derived.free(pid)) or 'none'}")
     for hid, fit in [*derived.holes.items(), *derived.part_holes.items()]:
         yaw = f", yaw {fit.hole.yaw:g} deg" if fit.hole.yaw else ""
         held = "empty"

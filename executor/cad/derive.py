@@ -7,9 +7,11 @@ size, everything else fixed, which gives its blockers per direction (blocking is
 pairwise, so these are the blockers at every stage). The directions tried are
 :data:`executor.cad.sweep.DIRECTIONS` and both senses of the axis of
 every zero-clearance fit (:func:`executor.cad.fits.faces.zero_clearance_fits`).
-Stage by stage, every part that some direction frees from the parts still in place leaves
-along one such direction (:func:`_way_out`: up, down, the ways the arm reaches sideways, then
-the product's geometry): its **insertion axis** is the reverse. Where parts are
+Stage by stage, every part that some direction frees from the parts still in place leaves.
+Its **insertion axis** is the reverse of the way out :func:`_way_out` chooses (up, down, the
+ways the arm reaches sideways, then the product's geometry) among the directions free of the
+parts present as the cell meets it: those in place at its stage and those the precedence
+puts before it, less those it puts after it (:func:`_ways_in`). Where parts are
 left, the screwed pairs (modelled threads, :func:`executor.cad.fits.threads.screwed_pairs`, in a nut or a
 plain hole at their tap drill; cosmetic ones, :func:`executor.cad.fits.threads.cosmetic_pairs`)
 between them and their blockers slide along their axes, their parts are swept again and
@@ -398,6 +400,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result.dropped = {pair for pair in dropped if placing[pair] == "locates"}
     result.dropped_supports = {pair for pair in dropped if placing[pair] == "supports"}
     result.edges = set(result.reasons)
+    _ways_in(result)
     order = nx.DiGraph(list(result.edges))
     found = _holes(by_id[base], [by_id[pid] for pid in sorted(result.axis) if result.axis[pid] in DIRECTIONS],
                    result.axis, {pid: [by_id[p] for p in sorted(nx.ancestors(order, pid)) if p != base]
@@ -488,6 +491,35 @@ def _way_out(result: Derived, pid: str, free: list[str], present: set[str]) -> s
             return ways[0]
     order = list(LEAVING) + [d for d in result.directions if d not in LEAVING]
     return min(ways, key=order.index)
+
+
+def _ways_in(result: Derived) -> None:
+    """Each part's insertion axis judged as the cell meets the part (``result.axis`` set
+    anew): of the directions free of the parts present then, the one :func:`_way_out`
+    chooses. Present are the base, the parts still in place at the part's disassembly stage and
+    the parts ``result.edges`` put before its body; absent, the parts they put after it (the
+    parts it supports, those its ``blocks`` and ``locates`` pairs put later), in place at its
+    stage or not (a box the box resting on it leaves free only sideways goes in from above,
+    before that one). Where the parts put before it and
+    not in place at its stage leave it no way, the stage's own, less the parts after it."""
+    order = nx.DiGraph(list(result.edges))
+    root = {pid: r for r, members in result.bodies.items() for pid in members}
+
+    def related(pid: str, find: Callable[[nx.DiGraph, str], set[str]]) -> set[str]:
+        return set().union(*(find(order, m) for m in result.bodies[root[pid]] if m in order))
+
+    def free(pid: str, present: set[str]) -> list[str]:
+        return [d for d in result.directions if not result.blockers[(pid, d)] & present]
+
+    for k, stage in enumerate(result.stages):
+        in_place = set().union(*result.stages[k:]) | {result.base}
+        for pid in stage:
+            later = related(pid, nx.descendants)
+            present = (in_place | related(pid, nx.ancestors)) - later
+            if not free(pid, present):  # the stage's own way out is free of every part in place
+                present = in_place - later
+            result.axis[pid] = _way_out(result, pid, free(pid, present), present)
+
 
 
 def receives(fit: HoleFit) -> bool:

@@ -6,12 +6,16 @@ boxes by hand (the cell has no operation that locates a part resting on a face).
 from __future__ import annotations
 
 import json
+import math
+import tomllib
 from pathlib import Path
 
 import pytest
 import trimesh
 
 from assembly_constraints.cli import main
+from executor.cad.cli import run_import
+from tests.cad.conftest import manual_reasons
 from tests.cad.test_closed_pockets import _write
 from tests.conftest import Runner
 
@@ -32,6 +36,40 @@ def _stack(folder: Path) -> None:
 
 def _order(plan: list[dict]) -> list[tuple[str, str | None]]:
     return [(step["part"], step["hole"]) for step in plan]
+
+
+def test_a_box_under_another_goes_in_from_above(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # Assembled, the lower box is free only sideways (the upper one sits on it), but it
+    # supports the upper one, which every plan places after it: its way in is judged
+    # with the upper box out, from above, and the pairs stay the base's and the support's.
+    _stack(tmp_path / "cad")
+    assert main(["import", str(tmp_path / "cad"), "--units", "mm", "--out", str(tmp_path / "out")]) == 0
+    assert ("part lower: insertion axis -z (leaves along +z with upper out, placed after it); free in the "
+            "assembled product along +x, -x, +y, -y") in capsys.readouterr().out
+    derived = run_import(tmp_path / "cad", tmp_path / "again", "mm", None).derived
+    assert derived.stages == [["lower", "upper"]]
+    assert derived.axis == {"lower": "+z", "upper": "+z"}
+    assert derived.reasons == {("base", "lower"): "base", ("lower", "upper"): "supports"}
+    reasons = manual_reasons(tmp_path / "again")
+    assert set(reasons) == {"lower", "upper"} and not any("not from above" in why for why in reasons.values())
+
+
+def test_a_product_with_no_hole_is_planned_by_least_travel(tmp_path: Path, run_main: Runner) -> None:
+    # With no hole there is no centre of the holes: each part is carried to the base's
+    # centre in the cell (base_center of [plate]), the one order's cost its straight legs
+    # from home (the cell origin) to each start, on to that centre, and back, whole mm each.
+    _stack(tmp_path / "cad")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    done = run_main("plan", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
+                    "--optimal", "--json")
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    assert [_order(plan) for plan in result["plans"]] == [[(part, None) for part in ORDER]]
+    starts = {pid: part["start"] for pid, part in tomllib.loads((out / "assembly.toml").read_text())["parts"].items()}
+    centre = tomllib.loads((out / "geometry.toml").read_text())["plate"]["base_center"]
+    stops = [[0.0, 0.0]] + [point for pid in ORDER for point in (starts[pid], centre)] + [[0.0, 0.0]]
+    assert result["cost"] == sum(round(1000 * math.dist(a, b)) for a, b in zip(stops, stops[1:]))
 
 
 @pytest.mark.slow
