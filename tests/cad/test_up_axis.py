@@ -175,9 +175,9 @@ def test_a_step_product_drawn_y_up_keeps_its_exact_cylinders(tmp_path: Path) -> 
         run_import(tmp_path / "y" / "p.step", tmp_path / "read_z_up", "mm", None)
 
 
-def _block_and_peg(folder: Path, peg_low: float) -> Path:
+def _block_and_peg(folder: Path, peg_low: float, length: float = 100.0) -> Path:
     """A y-up block (60 x 50 x 60 mm: 50 mm tall along y) with a 29 mm square hole through
-    it along y, and a 28.3 mm square peg 100 mm long in it from ``peg_low`` [mm] along y,
+    it along y, and a 28.3 mm square peg ``length`` [mm] long in it from ``peg_low`` [mm] along y,
     written as STL into ``folder``: read z up, the block lies on a side only 1.2 times as
     tall as it is thick."""
     folder.mkdir()
@@ -186,8 +186,8 @@ def _block_and_peg(folder: Path, peg_low: float) -> Path:
     block = block.difference(trimesh.creation.box((29.0, 80.0, 29.0), trimesh.transformations.translation_matrix(
         (0.0, 25.0, 0.0))))
     block.export(folder / "block.stl")
-    trimesh.creation.box((28.3, 100.0, 28.3), trimesh.transformations.translation_matrix(
-        (0.0, peg_low + 50.0, 0.0))).export(folder / "peg.stl")
+    trimesh.creation.box((28.3, length, 28.3), trimesh.transformations.translation_matrix(
+        (0.0, peg_low + length / 2, 0.0))).export(folder / "peg.stl")
     return folder
 
 
@@ -212,3 +212,12 @@ def test_a_horizontal_unit_whose_parts_stand_out_both_ways_is_imported_as_drawn(
     imported = run_import(cad, tmp_path / "out", "mm", None)
     assert {fit.axis[1] for fit in imported.derived.holes.values()} == {"y"}
     assert imported.assumed[0].startswith("the CAD's +z is up (set up")
+
+
+def test_a_base_lying_on_its_side_with_the_parts_within_its_box_is_refused(tmp_path: Path) -> None:
+    # the peg flush with the block's faces: nothing stands out, the one hole is left one way
+    cad = _block_and_peg(tmp_path / "cad", 0.0, 50.0)
+    with pytest.raises(ExecutorError, match="1 of its 1 holes and pins open along y, all of them left along "
+                       "[+-]y and the other parts within 0.000 mm of its box: the CAD may be drawn y up"):
+        run_import(cad, tmp_path / "read_z_up", "mm", None)
+    assert not (tmp_path / "read_z_up").exists()
