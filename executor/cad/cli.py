@@ -13,7 +13,7 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 
 ``--up AXIS`` overrides ``up``: every part is turned right after reading by the rotation
 taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product whose
-base looks drawn with another axis up is refused (:func:`drawn_up`). ``--place X,Y``
+base looks drawn with another axis up (lying on its side) is refused (:func:`drawn_up`). ``--place X,Y``
 overrides ``place``. Without either, a product whose base's centre lies
 outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
 says so; every part is moved right after reading, so every file written is in the cell frame.
@@ -86,6 +86,11 @@ PLACE_BOUND = 1.0
 STANDING = 3.0
 """A base at least this many times as tall (along z) as it is thick along a horizontal
 axis stands on its edge (:func:`drawn_up`)."""
+ONE_SIDED = 0.25
+"""The other parts stand out of the base's box along one way only when along each of the
+five other ways (the opposite one, the four across) they stand out of it by at most this
+fraction of that way's, and lie within its box when they stand out of it by at most this
+fraction of its thickness (:func:`drawn_up`): parts set on the base's top face."""
 _UP_EXPECTED = f"one of {', '.join(UP_AXES)} (the CAD's axis pointing up)"
 
 
@@ -114,29 +119,48 @@ def _up_assumption(up: str | None) -> str:
 
 def drawn_up(derived: Derived) -> str | None:
     """Why the product looks drawn with another axis than z up, None when it does not: its
-    base stands on its edge (:data:`STANDING` times as tall as it is thick along a
-    horizontal axis, thinnest along it) and more than half of its holes and pins open
-    along that axis (either way: a through hole's parts leave both ways). The way up it
-    suggests is the one the other parts stand out of the base's box farther along (both
-    where they stand out alike)."""
+    base is thinnest along a horizontal axis, more than half of its holes and pins open
+    along that axis (either way: a through hole's parts leave both ways), and the base
+    stands on its edge (:data:`STANDING` times as tall as it is thick along that axis), or
+    the other parts stand out of the base's box along one way of that axis only, or they
+    lie within :data:`ONE_SIDED` of the base's thickness of its box and every hole and pin
+    along that axis is left one way (:data:`ONE_SIDED`: parts set on what would be its top
+    face). The way up it suggests is the one the other parts stand out of the base's box
+    farther along (both where they stand out alike), else the way they leave its holes and
+    pins."""
     base = derived.parts[derived.base].mesh
     low, high = base.bounds
     extents = high - low
-    openings = [fit.axis[1] for fit in derived.holes.values()]
-    openings += [pin.axis[1] for pin in derived.pins.values() if pin.owner == derived.base]
+    removals = [fit.axis for fit in derived.holes.values()]
+    removals += [pin.axis for pin in derived.pins.values() if pin.owner == derived.base]
+    openings = [axis[1] for axis in removals]
     corners = np.vstack([part.mesh.bounds for part in derived.parts.values()])
+    out = np.array([[corners[:, j].max() - high[j], low[j] - corners[:, j].min()] for j in range(3)])
     for k, name in enumerate("xy"):
         along = openings.count(name)
-        if extents[k] > min(extents) or extents[2] < STANDING * extents[k] or 2 * along <= len(openings):
+        if extents[k] > min(extents) or 2 * along <= len(openings):
             continue
-        above, below = corners[:, k].max() - high[k], low[k] - corners[:, k].min()
+        above, below = out[k]
         ways = ["+"] if above > below else ["-"] if below > above else ["+", "-"]
-        out = f", the other parts standing out of it along {ways[0]}{name}" if len(ways) == 1 else ""
+        farthest = float(max(above, below))
+        others = float(np.delete(out.ravel(), 2 * k + (ways[0] == "-")).max())
+        leave = sorted({axis[0] for axis in removals if axis[1] == name})
+        if extents[2] >= STANDING * extents[k]:
+            why = f", the other parts standing out of it along {ways[0]}{name}" if len(ways) == 1 else ""
+        elif farthest > 0 and others <= ONE_SIDED * farthest:
+            why = (f", the other parts standing out of it along {ways[0]}{name} only ({_mm(farthest)} mm; at most "
+                   f"{_mm(others)} mm along every other way)")
+        elif len(leave) == 1 and float(out.max()) <= ONE_SIDED * extents[k]:
+            ways = leave
+            why = (f", all of them left along {leave[0]}{name} and the other parts within {_mm(float(out.max()))} mm "
+                   "of its box")
+        else:
+            continue
         settings = " or ".join(f'"{way}{name}"' for way in ways)
         flags = " or ".join(f"--up +{name}" if way == "+" else f"--up=-{name}" for way in ways)
         return (f"the base {derived.base} is thinnest along {name} ({_mm(float(extents[k]))} mm, "
                 f"{_mm(float(extents[2]))} mm tall) and {along} of its {len(openings)} holes and pins open along "
-                f"{name}{out}: the CAD may be drawn {name} up; set up = "
+                f"{name}{why}: the CAD may be drawn {name} up; set up = "
                 + (f"{settings} or {flags}" if len(ways) == 1 else f"{settings} ({flags})")
                 + ' (up = "+z" or --up +z if z is up)')
     return None

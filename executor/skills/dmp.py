@@ -265,7 +265,8 @@ def load_skill(folder: Path, shape: str) -> Skill:
     path = skill_path(folder, shape)
     if not path.is_file():
         raise ExecutorError(
-            f"part shape '{shape}': no demonstration at {path} (expected one; run ./run.sh executor teach)")
+            f"part shape '{shape}': no demonstration at {path} (expected one; run ./run.sh executor teach "
+            f"--assembly {folder})")
     text = read_text(path, "taught skill (JSON)", error=ExecutorError)
     try:
         skill = Skill.from_json(json.loads(text))

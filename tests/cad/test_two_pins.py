@@ -36,7 +36,7 @@ def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), turn: float = 0.
     top at x 560 -/+ 20 mm, and the plate (70 x 24 x 5 mm) on that top with round ``bores``
     [mm] (128-gons) over the pins, all turned ``turn`` [deg] about the vertical through
     (560, 0), as STL files [mm], imported; with ``lying``, all turned a quarter turn about x
-    instead (the pins along +y, 30 mm up); the folder written."""
+    instead (the pins along +y, 30 mm up, ``up = "+z"`` stated); the folder written."""
     cad = tmp / "cad"
     cad.mkdir(parents=True)
     base = trimesh.creation.box((100.0, 60.0, 10.0))
@@ -55,7 +55,9 @@ def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), turn: float = 0.
     plate.apply_transform(turned)
     base.export(cad / "base.stl")
     plate.export(cad / "plate.stl")
-    (tmp / "import.toml").write_text('base = "base"\n[parts.plate]\ntray = [0.30, 0.28]\n')
+    # lying, it is a product drawn z up on its side (the import would take it for one drawn y up): stated
+    up = 'up = "+z"\n' if lying else ""
+    (tmp / "import.toml").write_text(f'base = "base"\n{up}[parts.plate]\ntray = [0.30, 0.28]\n')
     run_import(cad, tmp / "out", "mm", tmp / "import.toml")
     return tmp / "out"
 

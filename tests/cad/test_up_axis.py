@@ -1,7 +1,8 @@
 """``import``'s up axis: a product drawn with another axis than z up (``up = "+y"``,
 ``--up``) is turned by an exact signed permutation right after reading, so it gives the
-same assembly facts as drawn z up; without ``up`` a product whose base stands on its
-edge with its holes opening along that axis is refused, naming the setting."""
+same assembly facts as drawn z up; without ``up`` a product whose base lies on its side
+with its holes opening sideways (standing on its edge, or the other parts set on one face)
+is refused, naming the setting."""
 
 from __future__ import annotations
 
@@ -172,3 +173,51 @@ def test_a_step_product_drawn_y_up_keeps_its_exact_cylinders(tmp_path: Path) -> 
     with pytest.raises(ExecutorError, match='thinnest along y .* 1 of its 1 holes and pins open along y, the other '
                        'parts standing out of it along \\+y: the CAD may be drawn y up; set up = "\\+y"'):
         run_import(tmp_path / "y" / "p.step", tmp_path / "read_z_up", "mm", None)
+
+
+def _block_and_peg(folder: Path, peg_low: float, length: float = 100.0) -> Path:
+    """A y-up block (60 x 50 x 60 mm: 50 mm tall along y) with a 29 mm square hole through
+    it along y, and a 28.3 mm square peg ``length`` [mm] long in it from ``peg_low`` [mm] along y,
+    written as STL into ``folder``: read z up, the block lies on a side only 1.2 times as
+    tall as it is thick."""
+    folder.mkdir()
+    block = trimesh.creation.box((60.0, 50.0, 60.0))
+    block.apply_translation((0.0, 25.0, 0.0))
+    block = block.difference(trimesh.creation.box((29.0, 80.0, 29.0), trimesh.transformations.translation_matrix(
+        (0.0, 25.0, 0.0))))
+    block.export(folder / "block.stl")
+    trimesh.creation.box((28.3, length, 28.3), trimesh.transformations.translation_matrix(
+        (0.0, peg_low + length / 2, 0.0))).export(folder / "peg.stl")
+    return folder
+
+
+def test_a_base_lying_on_its_side_with_the_parts_set_on_one_face_is_refused(tmp_path: Path) -> None:
+    cad = _block_and_peg(tmp_path / "cad", 0.0)  # the peg on the table through the block: out along +y only
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", None)
+    assert ("the base block is thinnest along y (50.000 mm, 60.000 mm tall) and 1 of its 1 holes and pins open "
+            "along y, the other parts standing out of it along +y only (50.000 mm; at most 0.000 mm along every "
+            'other way): the CAD may be drawn y up; set up = "+y" or --up +y') in str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
+    turned = run_import(cad, tmp_path / "turned", "mm", None, ImportOptions(up="+y"))
+    assert {fit.axis for fit in turned.derived.holes.values()} == {"+z"}
+    # a stated +z is never doubted: the block is imported on its side, its hole entered sideways
+    side = run_import(cad, tmp_path / "side", "mm", None, ImportOptions(up="+z"))
+    assert {fit.axis[1] for fit in side.derived.holes.values()} == {"y"}
+
+
+def test_a_horizontal_unit_whose_parts_stand_out_both_ways_is_imported_as_drawn(tmp_path: Path) -> None:
+    # the peg through the block, 25 mm out of each face: a shaft through its housing, z up as drawn
+    cad = _block_and_peg(tmp_path / "cad", -25.0)
+    imported = run_import(cad, tmp_path / "out", "mm", None)
+    assert {fit.axis[1] for fit in imported.derived.holes.values()} == {"y"}
+    assert imported.assumed[0].startswith("the CAD's +z is up (set up")
+
+
+def test_a_base_lying_on_its_side_with_the_parts_within_its_box_is_refused(tmp_path: Path) -> None:
+    # the peg flush with the block's faces: nothing stands out, the one hole is left one way
+    cad = _block_and_peg(tmp_path / "cad", 0.0, 50.0)
+    with pytest.raises(ExecutorError, match="1 of its 1 holes and pins open along y, all of them left along "
+                       "[+-]y and the other parts within 0.000 mm of its box: the CAD may be drawn y up"):
+        run_import(cad, tmp_path / "read_z_up", "mm", None)
+    assert not (tmp_path / "read_z_up").exists()

@@ -48,6 +48,13 @@ def test_every_shipped_skill_records_a_teaching_in_its_demonstration_hole() -> N
             assert (taught.part_kind, taught.part_sides) == (taught_part.kind, taught_part.sides)
 
 
+def test_a_skill_never_taught_names_the_command_that_teaches_this_product(spare: Path) -> None:
+    skill_path(spare, "square_peg").unlink()
+    with pytest.raises(ExecutorError, match=f"part shape 'square_peg': no demonstration at .* run ./run.sh executor "
+                       f"teach --assembly {spare}\\)$"):
+        load_skill(spare, "square_peg")
+
+
 def test_a_skill_file_without_its_record_is_refused(spare: Path) -> None:
     path = _edit_record(spare, None)
     with pytest.raises(ExecutorError, match="no record of its teaching") as refused:
