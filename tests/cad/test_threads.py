@@ -129,9 +129,17 @@ def test_a_plain_screw_in_its_tap_drill_is_drawn_with_a_cosmetic_thread() -> Non
 
 @pytest.mark.parametrize(("shaft", "hole", "thread"), [
     (3.0, 2.5, ("M3", 0.5)), (8.0, 6.8, ("M8", 1.25)), (8.0, 7.0, ("M8x1", 1.0)), (10.0, 8.8, ("M10x1.25", 1.25)),
-    (6.35, 5.105, ("1/4-20 UNC", 1.27)), (6.35, 5.5, ("1/4-28 UNF", 25.4 / 28)),
+    (6.35, 5.105, ("1/4-20 UNC", 1.27)), (6.35, 5.41, ("1/4-28 UNF", 25.4 / 28)),
     (4.826, 3.8, ("#10-24 UNC", 25.4 / 24)),
-    (16.0, 15.9, None), (17.0, 16.0, None), (4.0, 3.0, None), (4.0, 3.6, None), (3.9, 3.3, ("M4", 0.7)),
+    (16.0, 15.9, None), (17.0, 15.0, None), (4.0, 3.0, None), (4.0, 3.6, None), (3.9, 3.3, ("M4", 0.7)),
+    # ISO 261's third choice and the UNEF series
+    (15.0, 14.0, ("M15x1", 1.0)), (17.0, 16.0, ("M17x1", 1.0)), (11.0, 9.5, ("M11", 1.5)),
+    (6.35, 5.65, ("1/4-32 UNEF", 25.4 / 32)), (19.05, 17.8, ("3/4-20 UNEF", 1.27)),
+    # nearest major diameter first: 1-8 UNC's ranges hold d 25 in d 23 too
+    (25.0, 23.0, ("M25x2", 2.0)),
+    # one major diameter, two pitches: the common tap drill D - P nearest the hole
+    (6.35, 5.556, ("1/4-32 UNEF", 25.4 / 32)), (6.35, 5.49, ("1/4-28 UNF", 25.4 / 28)),
+    (12.0, 10.7, ("M12x1.25", 1.25)),
 ])
 def test_the_standard_threads_tap_drills(shaft: float, hole: float, thread: tuple[str, float] | None) -> None:
     # the shaft from D - P/4 to D, the hole from D - 1.0825 P to D - 0.85 P (10 µm slack)
@@ -141,12 +149,26 @@ def test_the_standard_threads_tap_drills(shaft: float, hole: float, thread: tupl
 
 @pytest.mark.parametrize(("shank", "hole", "sunk"), [
     (16.0, 15.9, 0.0),  # a press fit: 0.1 mm, no thread's tap drill
-    (17.0, 16.0, 0.0),  # d 17 is no standard thread of the table (M17 is ISO 261's third choice)
+    (17.0, 15.0, 0.0),  # d 15 is no tap drill of M17 (M17x1.5: 15.376 mm up) nor of a thread nearer
     (4.0, 3.3, 0.5),  # M4 in its tap drill, its head sunk 0.5 mm into the plate: outside the annulus
 ])
 def test_an_interference_that_is_no_cosmetic_thread_is_refused(shank: float, hole: float, sunk: float) -> None:
     with pytest.raises(ExecutorError, match="'plate' and 'screw' overlap by"):
         _check_overlaps(_cosmetic(shank, hole, sunk))
+
+
+@pytest.mark.parametrize(("shank", "hole", "name", "pitch"), [
+    (15.0, 14.0, "M15x1", 1.0),  # ISO 261's third choice, fine pitch only
+    (6.35, 5.65, "1/4-32 UNEF", 25.4 / 32),
+])
+def test_a_third_choice_or_unef_screw_in_its_tap_drill_is_a_cosmetic_thread(shank: float, hole: float, name: str,
+                                                                          pitch: float) -> None:
+    parts = _cosmetic(shank, hole)
+    _check_overlaps(parts)
+    [pair] = derive(parts, "plate", {}).slides
+    assert (pair.shaft, pair.bore, pair.thread) == ("screw", "plate", f"a cosmetic thread, {name}: d {shank:g} in "
+                                                                      f"its {hole:g} mm tap drill")
+    assert pair.pitch == pytest.approx(pitch * 1e-3)
 
 
 def test_a_bracket_clamped_by_a_cosmetic_screw_goes_before_it() -> None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from fractions import Fraction
 
 import numpy as np
 import trimesh
@@ -331,33 +332,48 @@ def _tap_drill(nut: trimesh.Trimesh, male: Thread) -> CylinderFace | None:
 
 
 def _metric() -> list[tuple[str, float, float]]:
-    """ISO metric threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`."""
+    """ISO metric threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`:
+    the first and second choice with their coarse and common fine pitches (ISO 262), and
+    the third choice with every pitch ISO 261:1998 (Table 1) gives it, coarse (M9, M11
+    only) and fine."""
     coarse = {1: .25, 1.2: .25, 1.4: .3, 1.6: .35, 1.8: .35, 2: .4, 2.5: .45, 3: .5, 3.5: .6, 4: .7, 5: .8, 6: 1,
               8: 1.25, 10: 1.5, 12: 1.75, 14: 2, 16: 2, 18: 2.5, 20: 2.5, 22: 2.5, 24: 3, 27: 3, 30: 3.5, 33: 3.5,
               36: 4, 39: 4, 42: 4.5, 45: 4.5, 48: 5, 52: 5, 56: 5.5, 60: 5.5, 64: 6}
     fine = {8: (1,), 10: (1.25, 1), 12: (1.5, 1.25), 14: (1.5,), 16: (1.5,), 18: (1.5,), 20: (1.5,), 22: (1.5,),
             24: (2,), 27: (2,), 30: (2,), 33: (2,), 36: (3,), 39: (3,), 42: (3,), 45: (3,), 48: (3,), 52: (4,),
             56: (4,), 60: (4,), 64: (4,)}
-    found = [(f"M{d:g}", d * 1e-3, p * 1e-3) for d, p in coarse.items()]
-    return found + [(f"M{d:g}x{p:g}", d * 1e-3, p * 1e-3) for d, pitches in fine.items() for p in pitches]
+    third_coarse = {9: 1.25, 11: 1.5}
+    third_fine = {5.5: (.5,), 9: (1, .75), 11: (1, .75), 15: (1.5, 1), 17: (1.5, 1), 25: (2, 1.5, 1), 26: (1.5,),
+                  28: (2, 1.5, 1), 32: (2, 1.5), 35: (1.5,), 38: (1.5,), 40: (3, 2, 1.5), 50: (3, 2, 1.5),
+                  55: (4, 3, 2, 1.5), 58: (4, 3, 2, 1.5), 62: (4, 3, 2, 1.5)}
+    found = [(f"M{d:g}", d * 1e-3, p * 1e-3) for d, p in (coarse | third_coarse).items()]
+    return found + [(f"M{d:g}x{p:g}", d * 1e-3, p * 1e-3)
+                    for table in (fine, third_fine) for d, pitches in table.items() for p in pitches]
 
 
 def _unified() -> list[tuple[str, float, float]]:
-    """Unified inch threads, UNC and UNF (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`."""
+    """Unified inch threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`
+    (ASME B1.1): UNC and UNF #2 to 1 inch, UNEF #12 to 1 11/16 inch."""
     sizes = [("#2", .086, 56, 64), ("#4", .112, 40, 48), ("#5", .125, 40, 44), ("#6", .138, 32, 40),
              ("#8", .164, 32, 36), ("#10", .190, 24, 32), ("#12", .216, 24, 28), ("1/4", .25, 20, 28),
              ("5/16", .3125, 18, 24), ("3/8", .375, 16, 24), ("7/16", .4375, 14, 20), ("1/2", .5, 13, 20),
              ("9/16", .5625, 12, 18), ("5/8", .625, 11, 18), ("3/4", .75, 10, 16), ("7/8", .875, 9, 14),
              ("1", 1.0, 8, 12)]
-    return [(f"{name}-{tpi} {series}", inch * 0.0254, 0.0254 / tpi)
-            for name, inch, unc, unf in sizes for tpi, series in ((unc, "UNC"), (unf, "UNF"))]
+    extra_fine = [("#12", .216, 32), ("1/4", .25, 32), ("5/16", .3125, 32), ("3/8", .375, 32), ("7/16", .4375, 28),
+                  ("1/2", .5, 28), ("9/16", .5625, 24), ("5/8", .625, 24), ("11/16", .6875, 24), ("3/4", .75, 20),
+                  ("13/16", .8125, 20), ("7/8", .875, 20), ("15/16", .9375, 20), ("1", 1.0, 20)]
+    extra_fine += [(f"1 {Fraction(n, 16)}", 1 + n / 16, 18) for n in range(1, 12)]
+    found = [(f"{name}-{tpi} {series}", inch * 0.0254, 0.0254 / tpi)
+             for name, inch, unc, unf in sizes for tpi, series in ((unc, "UNC"), (unf, "UNF"))]
+    return found + [(f"{name}-{tpi} UNEF", inch * 0.0254, 0.0254 / tpi) for name, inch, tpi in extra_fine]
 
 
 STANDARD_THREADS = _metric() + _unified()
 """The standard threads a cosmetic thread is taken for (name, major diameter D, pitch P)
 [m]: ISO 261's metric sizes M1 to M64 of the first and second choice, their coarse pitch
-and the common fine ones (ISO 262's M8x1 to M64x4), and the unified inch UNC and UNF
-series, #2 to 1 inch (ASME B1.1)."""
+and the common fine ones (ISO 262's M8x1 to M64x4), its third-choice sizes M5.5 to M62
+with their pitches (M9 and M11 coarse; M15x1.5, M17x1, ...), and the unified inch UNC
+and UNF series, #2 to 1 inch, and UNEF, #12-32 to 1 11/16-18 (ASME B1.1)."""
 TAP_DRILL = (1.0825, 0.85)
 """A tapped hole drawn at its tap drill has a diameter from D - 1.0825 P (the basic minor
 diameter of the internal thread, ISO 68-1 and ASME B1.1: 5/4 of the fundamental
@@ -373,11 +389,13 @@ def cosmetic_thread(shaft: float, hole: float, slack: float) -> tuple[str, float
     shaft of diameter ``shaft`` [m] in a plain hole of diameter ``hole`` [m] is drawn
     with a cosmetic thread: the shaft within :data:`COSMETIC_MAJOR` of its major diameter,
     the hole within :data:`TAP_DRILL`, each widened by ``slack`` [m] (the faces'
-    tessellation); of several, the one whose major diameter lies nearest the shaft's."""
-    found = [(abs(shaft - d), name, p) for name, d, p in STANDARD_THREADS
+    tessellation); of several, the one whose major diameter lies nearest the shaft's and, of
+    those of one major diameter (pitches whose ranges overlap: M12x1.5 and M12x1.25,
+    1/4-28 UNF and 1/4-32 UNEF), the one whose common tap drill D - P lies nearest the hole's."""
+    found = [(abs(shaft - d), abs(hole - (d - p)), name, p) for name, d, p in STANDARD_THREADS
              if d - COSMETIC_MAJOR * p - slack <= shaft <= d + slack
              and d - TAP_DRILL[0] * p - slack <= hole <= d - TAP_DRILL[1] * p + slack]
-    return (min(found)[1], min(found)[2]) if found else None
+    return (min(found)[2], min(found)[3]) if found else None
 
 
 def cosmetic_pairs(faces: dict[str, list[CylinderFace | PrismFace]],
