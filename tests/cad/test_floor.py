@@ -11,7 +11,9 @@ import pytest
 import trimesh
 
 from assembly_constraints.cli import main
+from executor import ExecutorError
 from executor.cad.cli import FLOOR_TOLERANCE, ImportOptions, run_import
+from tests.cad.conftest import teach
 
 HEIGHT_MM = 50.0
 """The box's height [mm]: its top stands this high in the cell when its bottom is on the floor."""
@@ -71,3 +73,14 @@ def test_a_rounding_below_the_floor_moves_nothing(tmp_path: Path) -> None:
     assert done.offset[2] == 0.0
     beyond = _boxed_peg(tmp_path / "beyond", -FLOOR_TOLERANCE * 1000 * 2)
     assert run_import(beyond, tmp_path / "out2", "mm", None).offset[2] == pytest.approx(2 * FLOOR_TOLERANCE, rel=1e-6)
+
+
+def test_the_peg_of_a_product_drawn_centred_on_the_origin_is_taught(tmp_path: Path) -> None:
+    # Cut by the floor (its lowest point kept at z = -25 mm, as drawn), the floor stops the
+    # peg 4.5 mm short of the hole's bottom; on the floor the teaching reaches it.
+    cad = _boxed_peg(tmp_path / "cad", -HEIGHT_MM / 2)
+    run_import(cad, tmp_path / "drawn", "mm", None, ImportOptions(place=(0.56, 0.0, -HEIGHT_MM / 2000)))
+    with pytest.raises(ExecutorError, match="does not reach the bottom of its demo_hole"):
+        teach(tmp_path / "drawn")
+    run_import(cad, tmp_path / "stood", "mm", None)
+    assert (teach(tmp_path / "stood") / "demonstrations" / "peg.json").is_file()
