@@ -38,7 +38,7 @@ class TruthError(ToolError):
 class CorpusImport:
     """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
     moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
-    ``offset`` (x, y) [m] the import moved it by from its CAD frame (its truth's) into the
+    ``offset`` (x, y, z) [m] the import moved it by from its CAD frame (its truth's) into the
     cell, each imported hole's or pin's ``occupants`` (the parts in it or onto it) and
     ``owners`` (the part it is a feature of), the ids that are ``pins``, the product's
     ``parts`` (the base included) and the import's wall time ``seconds``."""
@@ -46,7 +46,7 @@ class CorpusImport:
     truth: dict[str, Any]
     out: Path
     axes: dict[str, str]
-    offset: tuple[float, float]
+    offset: tuple[float, float, float]
     occupants: dict[str, set[str]]
     owners: dict[str, str]
     pins: frozenset[str] = frozenset()
@@ -93,11 +93,11 @@ def import_product(folder: Path, out: Path) -> CorpusImport:
                         result.offset, occupants, owners, frozenset(derived.pins), len(derived.parts), result.seconds)
 
 
-def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float]) -> float:
+def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float, float]) -> float:
     """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, moved by
     ``offset`` [m] from the CAD frame) lies from a truth feature's axis line [mm]; with x, y
     only, from the line's projection on the xy plane."""
-    point = [1000.0 * (v - (offset[k] if k < 2 else 0.0)) for k, v in enumerate(position)]
+    point = [1000.0 * (v - offset[k]) for k, v in enumerate(position)]
     origin = feature["axis_point"][:len(point)]
     direction = {"x": 0, "y": 1, "z": 2}[feature["axis"][1]]
     across = [point[k] - origin[k] for k in range(len(point)) if k != direction]

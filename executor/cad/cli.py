@@ -9,14 +9,16 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
     tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: laid out by footprints)
     name = "round peg"
     fixed_to = "lever"        # moves with that part (screwed, glued): neither blocks the other
-    place = [0.56, 0.0]       # where the base's centre stands on the cell's table [m]
+    place = [0.56, 0.0]       # where the base's centre stands on the cell's table [m]; a third value:
+                              # the height of the product's lowest point (default 0, the cell's floor)
 
 ``--up AXIS`` overrides ``up``: every part is turned right after reading by the rotation
 taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product whose
-base looks drawn with another axis up (lying on its side) is refused (:func:`drawn_up`). ``--place X,Y``
+base looks drawn with another axis up (lying on its side) is refused (:func:`drawn_up`). ``--place X,Y[,Z]``
 overrides ``place``. Without either, a product whose base's centre lies
 outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
-says so; every part is moved right after reading, so every file written is in the cell frame.
+says so; without a z, the product's lowest point (of all its parts) goes to the cell's floor,
+z = 0 (:func:`placement`); every part is moved right after reading, so every file written is in the cell frame.
 
 It prints what it assumes, each part's insertion axis and free directions, each hole
 with both cross-sections and the clearance, the disassembly stages, the geometric
@@ -35,7 +37,7 @@ import math
 import time
 import tomllib
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -166,47 +168,67 @@ def drawn_up(derived: Derived) -> str | None:
     return None
 
 
-def place_pair(text: str) -> tuple[float, float]:
-    """An argparse type: ``"X,Y"`` [m], both finite in [-PLACE_BOUND, PLACE_BOUND]."""
+Place = tuple[float, ...]
+"""Where the product goes in the cell [m]: the base's centre (x, y), and (z) the height of its lowest point."""
+
+
+def place_pair(text: str) -> Place:
+    """An argparse type: ``"X,Y"`` or ``"X,Y,Z"`` [m], each finite in [-PLACE_BOUND, PLACE_BOUND]."""
     parse = finite_float(-PLACE_BOUND, PLACE_BOUND)
     values = text.split(",")
-    if len(values) != 2:
-        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected X,Y in m, each a finite number in "
+    if len(values) not in (2, 3):
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected X,Y or X,Y,Z in m, each a finite number in "
                                          f"[{-PLACE_BOUND:g}, {PLACE_BOUND:g}]")
-    return parse(values[0].strip()), parse(values[1].strip())
+    return tuple(parse(value.strip()) for value in values)
 
 
-def _place_setting(path: Path | None, value: object) -> tuple[float, float] | None:
+def _place_setting(path: Path | None, value: object) -> Place | None:
     """``place`` of ``--config`` (None: not set); ExecutorError naming the file otherwise."""
     if value is None:
         return None
-    if not (isinstance(value, list) and len(value) == 2 and all(
+    if not (isinstance(value, list) and len(value) in (2, 3) and all(
             isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
             and abs(v) <= PLACE_BOUND for v in value)):
-        raise ExecutorError(f"{path}: place: expected [x, y] in m, each in [{-PLACE_BOUND:g}, {PLACE_BOUND:g}], got "
-                            f"{shorten(repr(value))}")
-    return float(value[0]), float(value[1])
+        raise ExecutorError(f"{path}: place: expected [x, y] or [x, y, z] in m, each in [{-PLACE_BOUND:g}, "
+                            f"{PLACE_BOUND:g}], got {shorten(repr(value))}")
+    return tuple(float(v) for v in value)
 
 
-def placement(parts: list[CadPart], base: str, place: tuple[float, float] | None) -> tuple[tuple[float, float], str]:
-    """The horizontal offset [m] that puts the centre of ``base``'s box at ``place`` (None:
-    at :data:`WORK_POSITION` when it lies out of :data:`REACH`, else no offset), and the
-    assumption to print."""
+FLOOR_TOLERANCE = 1e-6
+"""A product whose lowest point lies within this [m] of the height it goes to (the cell's
+floor, z = 0, unless ``place`` gives z) is not moved along z: a CAD's rounding moves nothing."""
+
+
+def placement(parts: list[CadPart], base: str, place: Place | None) -> tuple[tuple[float, float, float], str]:
+    """The offset [m] that puts the centre of ``base``'s box at ``place``'s x, y (None: at
+    :data:`WORK_POSITION` when it lies out of :data:`REACH`, else no horizontal offset) and
+    the lowest point of all the parts at ``place``'s z (default 0, the cell's floor; within
+    :data:`FLOOR_TOLERANCE`: not moved), and the assumption to print."""
     bounds = next(p.mesh.bounds for p in parts if p.id == base)
     centre = (float(bounds[0][0] + bounds[1][0]) / 2, float(bounds[0][1] + bounds[1][1]) / 2)
     distance = math.hypot(*centre)
-    if place is None:
-        if REACH[0] <= distance <= REACH[1]:
-            return (0.0, 0.0), (f"the CAD frame is the cell frame (the base's centre {_mm(distance)} mm from the "
-                                "arm's base, within reach; set place = [x, y] to move it)")
-        place = WORK_POSITION
-        why = (f"the base's centre {_mm(distance)} mm from the arm's base is out of its reach "
-               f"({_mm(REACH[0])} to {_mm(REACH[1])} mm); set place = [x, y] or --place X,Y")
+    if place is None and REACH[0] <= distance <= REACH[1]:
+        horizontal = (0.0, 0.0)
+        where = (f"the base's centre where the CAD has it ({_mm(distance)} mm from the arm's base, within reach; "
+                 "set place = [x, y] to move it)")
     else:
-        why = "place"
-    offset = (place[0] - centre[0], place[1] - centre[1])
-    return offset, (f"the base's centre placed at ({_mm(place[0])}, {_mm(place[1])}) mm in the cell ({why}): every "
-                    f"part moved by ({_mm(offset[0])}, {_mm(offset[1])}) mm from the CAD frame")
+        target, why = ((place[0], place[1]), "place") if place is not None else (WORK_POSITION, (
+            f"the base's centre {_mm(distance)} mm from the arm's base is out of its reach "
+            f"({_mm(REACH[0])} to {_mm(REACH[1])} mm); set place = [x, y] or --place X,Y"))
+        horizontal = (target[0] - centre[0], target[1] - centre[1])
+        where = f"the base's centre placed at ({_mm(target[0])}, {_mm(target[1])}) mm in the cell ({why})"
+    lowest = min(float(p.mesh.bounds[0][2]) for p in parts)
+    height, given = (place[2], True) if place is not None and len(place) == 3 else (0.0, False)
+    rise = height - lowest if abs(height - lowest) > FLOOR_TOLERANCE else 0.0
+    floor = (f"the product's lowest point (of all its parts) at z = {_mm(height)} mm (place)" if given else
+             "the product's lowest point (of all its parts) on the cell's floor, z = 0 (set place = [x, y, z] "
+             "or --place X,Y,Z for another height)")
+    if rise:
+        floor += f", from z = {_mm(lowest)} mm in the CAD"
+    offset = (horizontal[0], horizontal[1], rise)
+    moved = (f": every part moved by ({_mm(offset[0])}, {_mm(offset[1])}, {_mm(offset[2])}) mm from the CAD frame"
+             if any(offset) else ": the CAD frame is the cell frame")
+    return offset, f"{where}; {floor}{moved}"
 
 
 def _settings_file(path: Path | None) -> dict:
@@ -225,7 +247,7 @@ again: stacked bricks); the default base is the lowest of them (its bottom, up b
 
 
 def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
-            ) -> tuple[Settings, dict[str, str], list[str], tuple[float, float] | None]:
+            ) -> tuple[Settings, dict[str, str], list[str], Place | None]:
     """The settings of ``--config`` (``data``, read from ``path``; checked: one line
     naming the file and key; the trays it sets only), with the ``up`` in force, the
     fixed-to map, what was assumed for lack of them, and ``place`` (None: not set)."""
@@ -406,7 +428,7 @@ def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES) ->
 class Imported:
     """What :func:`run_import` found: the ``derived`` geometry, the ``mapped`` covers and
     heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
-    files ``written``, the ``seconds`` taken, the ``offset`` (x, y) [m] by which every
+    files ``written``, the ``seconds`` taken, the ``offset`` (x, y, z) [m] by which every
     part was moved from the CAD frame into the cell (:func:`placement`) and the parts the
     cell holds on its suction cup, with why (:func:`executor.cad.operations.tool_of`)."""
 
@@ -416,7 +438,7 @@ class Imported:
     why: str | None
     written: list[Path]
     seconds: float
-    offset: tuple[float, float]
+    offset: tuple[float, float, float]
     suction: dict[str, str]
 
 
@@ -425,14 +447,14 @@ class ImportOptions:
     """The command line's choices of an import: ``reach`` [m], the locating rule's (0:
     off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
     over a product another import or a person wrote (:func:`executor.cad.write.claim_folder`);
-    ``place`` [m]: where the base's centre goes in the cell, over the config's
+    ``place`` [m]: where the base's centre goes in the cell (and the product's lowest point's height), over the config's
     (:func:`placement`); ``up``: the CAD's axis pointing up, over the config's
     (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""
 
     reach: float = LOCATING_REACH
     max_triangles: int = MAX_TRIANGLES
     replace: bool = False
-    place: tuple[float, float] | None = None
+    place: Place | None = None
     up: str | None = None
 
 
@@ -462,20 +484,21 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
 
 
 def _derived(parts: list[CadPart], out: Path, config: tuple[Path | None, dict, str | None], options: ImportOptions,
-             beside: Callable[[], None]) -> tuple[set[str], Settings, Derived, Derived, list[str], tuple[float, float],
-                                                  Mapped, int]:
+             beside: Callable[[], None]) -> tuple[set[str], Settings, Derived, Derived, list[str],
+                                                  tuple[float, float, float], Mapped, int]:
     """What :func:`run_import` finds before it writes (``config``: the settings file, its
     TOML and the up set, None: none): the files of ``out`` it may remove,
     the settings with every tray, the derived product and the product as the cell inserts
     it (:func:`executor.cad.operations.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
     known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
-    reach, replace, place = options.reach, options.replace, options.place
-    removable = claim_folder(out, [p.id for p in parts], replace)
+    reach, place = options.reach, options.place
+    removable = claim_folder(out, [p.id for p in parts], options.replace)
     path, data, up = config
     settings, fixed, assumed, placed = _config(path, data, parts, up or "+z")
     offset, where = placement(parts, settings.base, place or placed)
     parts = translated(parts, offset)
+    settings = replace(settings, moved=offset)
     assumed[:0] = [_up_assumption(up), where]
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
@@ -509,10 +532,11 @@ def main(argv: list[str]) -> int:
                         help=f"the CAD's axis pointing up, {', '.join(UP_AXES)} (over the config's up; default +z, "
                              "and a product whose base looks drawn with another axis up is refused); a negative "
                              "one as --up=-y")
-    parser.add_argument("--place", type=place_pair, metavar="X,Y",
+    parser.add_argument("--place", type=place_pair, metavar="X,Y[,Z]",
                         help="where the base's centre stands in the cell [m] (over the config's place; default: "
                              f"where the CAD has it, or ({WORK_POSITION[0]:g}, {WORK_POSITION[1]:g}) when that is "
-                             "out of the arm's reach)")
+                             "out of the arm's reach); Z: the height of the product's lowest point (default 0, "
+                             "the cell's floor)")
     parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")

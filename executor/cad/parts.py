@@ -122,10 +122,10 @@ def _mapped(parts: list[CadPart], point: Callable[[np.ndarray], np.ndarray],
                     remesh=None if part.remesh is None else mapped_remesh(part.remesh)) for part in parts]
 
 
-def translated(parts: list[CadPart], offset: tuple[float, float]) -> list[CadPart]:
-    """The parts moved by ``offset`` (x, y) [m] in the horizontal plane: their meshes,
-    their B-rep cylinders and the meshes of ``remesh`` (the parts given are not changed)."""
-    shift = np.array([offset[0], offset[1], 0.0])
+def translated(parts: list[CadPart], offset: tuple[float, float, float]) -> list[CadPart]:
+    """The parts moved by ``offset`` (x, y, z) [m]: their meshes, their B-rep cylinders
+    and the meshes of ``remesh`` (the parts given are not changed)."""
+    shift = np.array(offset, dtype=float)
     if not shift.any():
         return parts
     return _mapped(parts, lambda points: points + shift, lambda direction: direction)

@@ -142,12 +142,14 @@ with (its own mesh is measured at :data:`executor.cad.parts.STEP_DEFLECTION`).""
 @dataclass(frozen=True)
 class Settings:
     """What the import file states: the ``base`` part, the ``trays`` [m], part ``names``,
-    the CAD's axis pointing ``up`` (:func:`executor.cad.parts.turned`)."""
+    the CAD's axis pointing ``up`` (:func:`executor.cad.parts.turned`) and the offset (x, y, z)
+    [m] every part was ``moved`` by from the CAD frame into the cell (:func:`executor.cad.cli.placement`)."""
 
     base: str
     trays: dict[str, tuple[float, float]]
     names: dict[str, str]
     up: str = "+z"
+    moved: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 def _section_lines(shape: Shape2D) -> list[str]:
@@ -172,8 +174,12 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
     ``part``) and trays, the holes (a pin several parts go onto with their number as its
     ``capacity``)."""
     pegs = derived.hole_of
-    frame = "the CAD frame (the cell frame)" if settings.up == "+z" else \
-        f"the cell frame, the CAD's {settings.up} turned up ({turn_text(settings.up)})"
+    frame = "the CAD frame (the cell frame)" if settings.up == "+z" and not any(settings.moved) else "the cell frame"
+    if settings.up != "+z":
+        frame += f", the CAD's {settings.up} turned up ({turn_text(settings.up)})"
+    if any(settings.moved):
+        frame += (", moved by ({}, {}, {}) mm from the CAD frame (the base's centre to place, the product's lowest "
+                  "point to the floor, z = 0, or place's z)").format(*(f"{1000 * v:.3f}" for v in settings.moved))
     lines = [f"# Imported from {title} by ./run.sh import: parts in {frame} [m].",
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):

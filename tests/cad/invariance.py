@@ -9,8 +9,8 @@ measures the change, not the file format):
 
 - ``turn90``, ``turn180``, ``turn270``: every vertex turned about z (an exact permutation
   of x and y with signs); the cell frame's points and axes turned back about ``place``;
-- ``shift``: every vertex moved by :data:`SHIFT` [mm] (x and y taken off by the import's
-  placement; z kept by it: the cell frame's heights moved back by hand);
+- ``shift``: every vertex moved by :data:`SHIFT` [mm] (taken off by the import's
+  placement: x and y by ``place``, z by standing the product on the cell's floor);
 - ``metres``: coordinates × 0.001, imported with ``--units m``;
 - ``renamed``: each file's stem prefixed so that the ids sort in the reverse order;
 - ``shuffled``: the triangles in another order, each triangle's corners turned cyclically
@@ -79,7 +79,6 @@ MASS_REL = 1e-5
 TRANSFORMS = ("turn90", "turn180", "turn270", "shift", "metres", "renamed", "shuffled")
 _TURN_KEYS = {"outline", "size", "yaw"}
 """A section's orientation: under a turn compared by :func:`_turn_invariant`."""
-_HEIGHT_KEYS = {"top_z", "bottom"}
 """Heights in the cell [m]: the CAD's z is the cell's."""
 _REACH = "out of the arm's reach measured in the cell"
 """A reason of the arm's measured reach, under a turn (:meth:`_Frame.word`)."""
@@ -91,14 +90,12 @@ _LAYOUT_KEYS = {"start", "tray"}
 class Variant:
     """One change of a product's CAD: the ``points`` map on vertices [mm] into the file's
     unit, the import's ``units``, each file stem's new ``name``, ``quarter`` turns about z
-    (+90° each), the height ``dz`` [m] the cell frame moves by and whether triangles are
-    ``shuffled``."""
+    (+90° each) and whether triangles are ``shuffled``."""
 
     points: Callable[[np.ndarray], np.ndarray] = lambda v: v
     units: str = "mm"
     name: Callable[[str, list[str]], str] = lambda stem, stems: stem
     quarter: int = 0
-    dz: float = 0.0
     shuffled: bool = False
 
 
@@ -122,7 +119,7 @@ VARIANTS: dict[str, Variant] = {
     "turn90": Variant(points=_turn(1), quarter=1),
     "turn180": Variant(points=_turn(2), quarter=2),
     "turn270": Variant(points=_turn(3), quarter=3),
-    "shift": Variant(points=lambda v: v + np.array(SHIFT), dz=SHIFT[2] / 1000),
+    "shift": Variant(points=lambda v: v + np.array(SHIFT)),
     "metres": Variant(points=lambda v: v * 0.001, units="m"),
     "renamed": Variant(name=_reverse_prefix),
     "shuffled": Variant(shuffled=True),
@@ -234,7 +231,6 @@ class _Frame:
     """How a variant's cell frame maps back onto the unchanged one's."""
 
     quarter: int
-    dz: float
     ids: dict[str, str] = field(default_factory=dict)
     turned: bool = False
     """Whether the comparison is of a turned product (either side): a reason naming the
@@ -245,7 +241,7 @@ class _Frame:
         x, y = p[0] - PLACE[0], p[1] - PLACE[1]
         for _ in range(self.quarter):  # turned back: -90° each
             x, y = y, -x
-        return [x + PLACE[0], y + PLACE[1], *([p[2] - self.dz] if len(p) > 2 else [])]
+        return [x + PLACE[0], y + PLACE[1], *p[2:]]
 
     def axis(self, a: str) -> str:
         """A cell axis (``+x``, ``-z``) of the variant in the unchanged product's frame."""
@@ -333,8 +329,6 @@ def canonical(found: dict[str, Any], frame: _Frame, layout: bool) -> Any:
                           frame.word(value))
             return re.sub(r"\(([\w ]+) onto it\)", lambda m: f"({' '.join(sorted(m[1].split()))} onto it)",
                           text) if key == "name" else text
-        if key in _HEIGHT_KEYS and isinstance(value, float):
-            return value - frame.dz
         return value
     tree = walk(found, "")
     if frame.quarter % 2:
@@ -420,10 +414,10 @@ def compare(product: Path, transform: str, work: Path, base: dict[str, Any] | No
     folder = work / transform
     renamed = write_variant(product, variant, folder)
     other = answers(*run_import(folder, variant.units, isolated))
-    frame = _Frame(variant.quarter, variant.dz, {new: old for old, new in renamed.items()}, bool(variant.quarter))
+    frame = _Frame(variant.quarter, {new: old for old, new in renamed.items()}, bool(variant.quarter))
     frame.ids |= hole_ids(base, other, frame)
     layout = not (variant.quarter or transform == "renamed")
-    mine = canonical(_mapped_lp(_deep(base)), _Frame(0, 0.0, turned=bool(variant.quarter)), layout)
+    mine = canonical(_mapped_lp(_deep(base)), _Frame(0, turned=bool(variant.quarter)), layout)
     if variant.quarter:
         mine = _unturned_sections(mine)
     theirs = canonical(_mapped_lp(other), frame, layout)

@@ -290,7 +290,7 @@ def test_a_product_drawn_at_the_origin_is_decided_and_assembled_within_2_mm_wher
     # two pairs nearest the truth's edge, in physics in the cell where the import placed the
     # product: peg8 refused by the hexagon (0.343 mm short), peg12 into it (0.167 mm to spare).
     done = corpus_import(name)  # drawn around x = 0, out of the arm's reach: placed
-    assert done.offset == pytest.approx((0.56, 0.0), abs=1e-9)
+    assert done.offset == pytest.approx((0.56, 0.0, 0.0), abs=1e-9)  # drawn on the floor: not moved along z
     teach(done.out)
     holes = _feature_holes(done)
     cell = Cell(str(done.out))

@@ -86,11 +86,11 @@ def test_a_product_drawn_at_the_origin_is_placed_where_the_arm_reaches(
 
 
 @pytest.mark.parametrize(("setting", "expected"), [
-    (["--place", "0.56"], "argument --place: '0.56': expected X,Y in m, each a finite number in [-1, 1]"),
+    (["--place", "0.56"], "argument --place: '0.56': expected X,Y or X,Y,Z in m, each a finite number in [-1, 1]"),
     (["--place", "0.56,nan"], "argument --place: 'nan': expected a finite number in [-1, 1]"),
     (["--place", "2,0"], "argument --place: '2': expected a finite number in [-1, 1]"),
-    ("place = [0.56]", "import.toml: place: expected [x, y] in m, each in [-1, 1], got [0.56]"),
-    ('place = [0.56, "0"]', "import.toml: place: expected [x, y] in m, each in [-1, 1]"),
+    ("place = [0.56]", "import.toml: place: expected [x, y] or [x, y, z] in m, each in [-1, 1], got [0.56]"),
+    ('place = [0.56, "0"]', "import.toml: place: expected [x, y] or [x, y, z] in m, each in [-1, 1]"),
 ])
 def test_a_bad_place_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str], setting: list[str] | str,
                                  expected: str) -> None:
@@ -123,7 +123,9 @@ def test_a_part_on_pin_tops_is_written_to_be_placed_by_hand(tmp_path: Path,
     assert "manual lid: the cell has no operation for it, a plan's step places it by hand (part 'lid' is no peg" \
         in printed and ", geometry.toml;" in printed
     # drawn where the arm reaches: kept as it is drawn
-    assert "the CAD frame is the cell frame (the base's centre 560.000 mm from the arm's base" in printed
+    assert "the base's centre where the CAD has it (560.000 mm from the arm's base" in printed
+    assert "on the cell's floor, z = 0 (set place = [x, y, z] or --place X,Y,Z for another height): the CAD frame is " \
+        "the cell frame" in printed
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     manual = geometry["manual"]["lid"]
     assert "no pin passes through it" in manual["reason"]
