@@ -663,9 +663,12 @@ def _hits(mesh: trimesh.Trimesh, origin: np.ndarray, direction: np.ndarray) -> t
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
     """The level [m] (to 0.1 µm) in the middle of the part's depth inside the base along ``axis`` (the
-    base's extent there taken over its vertices within the part's box across the axis
-    grown by the box's larger side on each side: a pin of the base standing farther off is
-    not around it) and the part's one outline there (a ring's, its bore inside); None when
+    base's extent there taken over its vertices within the part's box across the axis, where
+    at that level the base has an inner loop around the part: a switch's body in the slot of
+    a hollow case's top, sliced in the top, not in the cavity under it; else over its
+    vertices within that box grown by the box's larger side on each side: the walls of a
+    hole with room around the part, while a pin of the base standing farther off is not
+    around it) and the part's one outline there (a ring's, its bore inside); None when
     the part does not reach into the base or its slice there is not one outline. Where the
     base's slice at that level has no inner loop around the part (a boss of the base beside
     it stretches the base's extent: a bolt in a hub's disc next to its boss, sliced at the
@@ -673,8 +676,29 @@ def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, 
     if any."""
     across = np.abs(axis) < 0.5
     lower, upper = part.mesh.bounds[0][across], part.mesh.bounds[1][across]
+    tight = _level_within(part, base, axis, lower, upper)
+    if tight is not None and _holds(base, axis, *tight):
+        return tight
     grown = float(np.max(upper - lower))
-    lower, upper = lower - grown, upper + grown
+    found = _level_within(part, base, axis, lower - grown, upper + grown)
+    if found is None:
+        return None
+    level, own = found
+    if not _holds(base, axis, level, own):
+        hit = _hole_around(base, part, axis)
+        if hit is not None:
+            return round(hit[0], 7), hit[3]
+    return level, own
+
+
+def _level_within(part: CadPart, base: CadPart, axis: np.ndarray, lower: np.ndarray, upper: np.ndarray
+                  ) -> tuple[float, Loop] | None:
+    """The level [m] (to 0.1 µm) in the middle of the part's depth inside the base along
+    ``axis``, the base's extent taken over its vertices between ``lower`` and ``upper``
+    across the axis [m], and the part's one outline there; None when no vertex of the base
+    lies there, the part does not reach into that extent or its slice there is not one
+    outline."""
+    across = np.abs(axis) < 0.5
     inside = np.all((base.mesh.vertices[:, across] >= lower) & (base.mesh.vertices[:, across] <= upper), axis=1)
     if not np.any(inside):
         return None
@@ -685,14 +709,14 @@ def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, 
     level = round(float(low + high) / 2, 7)
     cut = slice_loops(part.mesh, axis, level)
     own = [loop for loop in cut if _outer(loop, cut)]
-    if len(own) != 1:
-        return None
+    return (level, own[0]) if len(own) == 1 else None
+
+
+def _holds(base: CadPart, axis: np.ndarray, level: float, own: Loop) -> bool:
+    """Whether the base's slice at ``level`` [m] across ``axis`` has an inner loop around
+    the centre of the part's outline ``own``."""
     loops = slice_loops(base.mesh, axis, level)
-    if not any(loop.contains(own[0].centre) and not _outer(loop, loops) for loop in loops):
-        hit = _hole_around(base, part, axis)
-        if hit is not None:
-            return round(hit[0], 7), hit[3]
-    return level, own[0]
+    return any(loop.contains(own.centre) and not _outer(loop, loops) for loop in loops)
 
 
 def _holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dict[str, list[CadPart]]
