@@ -15,7 +15,7 @@ import trimesh
 
 from executor.world import SIZE_RESOLUTION
 from executor.world.geometry import Section, margin, outline_polygon
-from executor.world.meshes import URDF_HULL_MARGIN, eroded_text
+from executor.world.meshes import URDF_HULL_MARGIN
 from executor.world.near_miss import (
     collision_section,
     eroded_section,
@@ -24,6 +24,7 @@ from executor.world.near_miss import (
     near_miss,
     pieces_section,
 )
+from tests.executor import load_piece
 
 SQUARE = (( -0.005, -0.005), (0.005, -0.005), (0.005, 0.005), (-0.005, 0.005))
 L_SHAPE = ((-0.01, -0.01), (0.01, -0.01), (0.01, -0.004), (-0.004, -0.004), (-0.004, 0.01), (-0.01, 0.01))
@@ -90,14 +91,9 @@ def test_a_mesh_pegs_pieces_lack_their_edges_in_pybullet_as_the_rule_takes_them(
     # and loads it (a URDF link), probed at mid-height: its faces where the CAD has them,
     # its vertical edges r (sqrt 2 - 1) = 0.414 mm inside the CAD's corners along the
     # diagonal; what the rule takes it to cover reaches as far, never farther.
-    (tmp_path / "piece.obj").write_text(eroded_text([BOX], "peg", "peg.convex.obj"))
-    (tmp_path / "peg.urdf").write_text(
-        '<?xml version="1.0"?><robot name="peg"><link name="part"><inertial><mass value="0.05"/>'
-        '<inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial><collision><geometry>'
-        f'<mesh filename="{tmp_path / "piece.obj"}"/></geometry></collision></link></robot>')
     client = p.connect(p.DIRECT)
     try:
-        peg = p.loadURDF(str(tmp_path / "peg.urdf"), useFixedBase=True)
+        peg = load_piece(tmp_path, BOX, "peg", 0.05)
         face, corner = _outline_along(peg, (1, 0), 0.015), _outline_along(peg, (1, 1), 0.015)
     finally:
         p.disconnect(client)

@@ -14,6 +14,7 @@ import shapely
 
 from executor import ExecutorError
 from executor.world.meshes import MIN_THICKNESS, THIN_EXCESS, URDF_HULL_MARGIN, eroded, eroded_text
+from tests.executor import load_piece
 
 
 def plate(thickness: float) -> np.ndarray:
@@ -45,14 +46,9 @@ def test_a_2_mm_plate_collides_in_pybullet_as_its_cad_within_what_the_cell_resol
     # The plate as the cell writes a mesh part's collision asset and loads it (a URDF
     # link): at mid-height its sides and rounded corners where the CAD has them, its top
     # and bottom faces at most THIN_EXCESS beyond the CAD's.
-    (tmp_path / "piece.obj").write_text(eroded_text([plate(0.002)], "plate", "plate.convex.obj"))
-    (tmp_path / "plate.urdf").write_text(
-        '<?xml version="1.0"?><robot name="plate"><link name="part"><inertial><mass value="0.02"/>'
-        '<inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial><collision><geometry>'
-        f'<mesh filename="{tmp_path / "piece.obj"}"/></geometry></collision></link></robot>')
     client = p.connect(p.DIRECT)
     try:
-        body = p.loadURDF(str(tmp_path / "plate.urdf"), useFixedBase=True)
+        body = load_piece(tmp_path, plate(0.002), "plate", 0.02)
         middle = np.array([0.0, 0.0, 0.001])
         side, end = _reach(body, middle, np.array([0.0, 1.0, 0.0])), _reach(body, middle, np.array([1.0, 0.0, 0.0]))
         corner = _reach(body, np.array([0.015, 0.007, 0.001]), np.array([1.0, 1.0, 0.0]))
