@@ -241,9 +241,15 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     convex = hull.volume < (1 + CONVEX_TOLERANCE) * mesh.volume
     left: dict[str, float] = {}
     short: list[str] = []
+    thin: set[int] = set()  # the seeds whose pieces were too thin at a threshold
+    tries = 0
     for seed, threshold in [(0, 0.0)] if convex else [(s, t) for s in SEEDS for t in thresholds]:
+        if seed in thin:
+            continue  # a finer threshold cuts more, smaller pieces: it mends no piece too thin
+        tries += 1
         kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed, iterations))]
         if any(eroded(piece.vertices, URDF_HULL_MARGIN) is None for piece, _ in kept):
+            thin.add(seed)
             continue  # a piece the cell cannot collide as
         objects = [convex_object(piece) for piece, _ in kept]
         left = {name: _room(objects, other) for name, other in others.items()}
@@ -263,7 +269,9 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             return kept, (f"{kind}; they leave {name} {1e3 * left[name]:.3f} of {1e3 * rooms[name]:.3f} mm"
                           + (touching if len(apart) < len(rooms) else ""))
     tried = (f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
-             + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else ""))
+             + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else "")
+             + (f"; {tries} tried: seed(s) {', '.join(map(str, sorted(thin)))} no finer after a piece too thin"
+                if thin else ""))
     if not short:
         return (f"part '{pid}' has no convex pieces the cell can collide as ({tried}: each gave a piece thinner than "
                 f"{1e3 * MIN_THICKNESS:g} mm, the cell's hull margin twice less what it resolves)")
