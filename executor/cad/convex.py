@@ -29,9 +29,10 @@ decomposition's hulls reach beyond the mesh by its error), which they may overla
 :data:`NOMINAL_OVERLAP`; each piece at least 1.952 mm thick (the
 cell's hull margin twice less what it resolves: :mod:`executor.world.meshes`); CoACD's
 :data:`THRESHOLDS` are tried in turn with each seed until they do (the third line names the threshold, the seed
-and the least room left), and
-a part whose pieces never do is named and gets none. The decomposition is made here,
-never when a cell starts.
+and the least room left), a seed's finer thresholds not after a piece too thin (a finer
+threshold cuts more, smaller pieces: it is for pieces that took too much room), and
+a part whose pieces never do is named and gets none (:func:`executor.cad.write.write_folder`
+places it by hand with why). The decomposition is made here, never when a cell starts.
 """
 
 from __future__ import annotations
@@ -69,7 +70,10 @@ CONVEX_TOLERANCE = 1e-3
 """A part is convex (one piece, its hull) when its hull is larger by less than this fraction."""
 THRESHOLDS = (0.05, 0.03, 0.02, 0.01)
 """CoACD's concavity thresholds (the largest concavity left in a piece, relative to the
-part's size) tried in turn, its default first, until the pieces fit (:data:`ROOM_KEPT`)."""
+part's size) tried in turn, its default first, until the pieces fit (:data:`ROOM_KEPT`);
+after a piece thinner than the cell's hull margin twice, none finer with that seed (the
+rocker switch of nop_rocker_switches, 0.5 mm spade terminals: 23, 57 and 103 thin pieces
+at 0.05, 0.03 and 0.02, 15, 24 and 38 s of CPU)."""
 ITERATIONS = 150
 """CoACD's tree-search iterations per cut (its default)."""
 SEEDS = (0, 1)
