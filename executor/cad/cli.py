@@ -476,7 +476,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     doubt = None if up is not None else drawn_up(derived)
     if doubt is not None:
         raise ExecutorError(f"{source}: {doubt}")
-    written, why = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
+    written, why, mapped, cell = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
     assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
     tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
     suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}

@@ -258,7 +258,7 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
             if pid not in by_hand and (why := _onto_pin(derived, pin, pid)) is not None:
                 by_hand[pid] = why
     for hid, fit in derived.holes.items():
-        if fit.part in screws:
+        if fit.part in screws or fit.part in (refused or {}):
             continue
         if fit.part is not None and derived.axis[fit.part] != fit.axis:
             by_hand[fit.part] = (f"part '{fit.part}' goes in along {opposite(derived.axis[fit.part])}, its hole {hid} "

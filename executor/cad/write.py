@@ -425,14 +425,16 @@ def precedence_text(derived: Derived) -> str:
     return "\n".join(lines) + "\n"
 
 
-def map_product(derived: Derived, settings: Settings) -> tuple[Mapped, Settings, Derived]:
+def map_product(derived: Derived, settings: Settings, refused: Mapping[str, str] | None = None
+                ) -> tuple[Mapped, Settings, Derived]:
     """The covers, heads and parts placed by hand of the product as the cell inserts it
-    (:func:`executor.cad.operations.cell_view`: its other pegs are placed by hand), with ``why`` the cell builds
+    (:func:`executor.cad.operations.cell_view`: its other pegs, and those ``refused``
+    (part -> why), are placed by hand), with ``why`` the cell builds
     none of it (two parts overlapping on the tray, or parts without a tray in ``settings``
     that cannot all wait within the arm's reach), its gripper's flange where the default's is
     too short (:func:`executor.cad.operations.tool_length`), the settings with every part's tray
     (:func:`default_trays` for those it lacks), and that product (for :func:`write_folder`)."""
-    cell, by_hand = cell_view(derived)
+    cell, by_hand = cell_view(derived, refused)
     flange, tool = tool_length(cell)
     mapped = replace(map_parts(cell, plate_top(cell), by_hand), flange=flange, tool=tool)
     boxes = _footprints(cell, mapped)
@@ -557,13 +559,15 @@ def _mesh_entry(mesh: Mesh) -> str:
     return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
 
 
-def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path]) -> dict[str, Mesh] | str:
+def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path]
+                 ) -> tuple[dict[str, Mesh], dict[str, str]]:
     """The meshes of the parts of a mapped product that are no primitive, written into
     ``out`` (the base in the cell frame, the others in their part frames, the moving ones
     with their convex pieces; each file written is appended to ``written``); returns their
-    ``mesh`` entries by part, or why a part has no pieces that fit
-    (:func:`executor.cad.convex.fitting_pieces`)."""
+    ``mesh`` entries by part, and the moving parts that have no pieces that fit, each with
+    why (:func:`executor.cad.convex.fitting_pieces`)."""
     meshes: dict[str, Mesh] = {}
+    refused: dict[str, str] = {}
     if not builds_plate(derived):
         done = write_mesh(out, derived.base, *cell_base(derived), None, "the cell frame")
         assert not isinstance(done, str)  # the base has no pieces
@@ -589,10 +593,11 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                           fits=frozenset(fitted(derived, pid)))
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
-            return done
+            refused[pid] = done
+            continue
         meshes[pid], files = done
         written += files
-    return meshes
+    return meshes, refused
 
 
 def manual_features(derived: Derived, mapped: Mapped) -> dict[str, tuple[list[str], dict[str, list[str]]]]:
@@ -866,27 +871,36 @@ def _cell_disagrees(derived: Derived, geometry: CellGeometry) -> str | None:
 
 
 def write_folder(derived: Derived, cell: Derived, mapped: Mapped, settings: Settings, title: str, out: Path,
-                 removable: set[str]) -> tuple[list[Path], str | None]:
+                 removable: set[str]) -> tuple[list[Path], str | None, Mapped, Derived]:
     """Write the files of the module docstring into ``out`` (removing the ``removable``
     files, :func:`claim_folder`, that this import does not write again; the manifest last),
     ``cell`` the product as the cell inserts it (:func:`executor.cad.operations.cell_view`, :func:`map_product`'s);
-    returns them and why there is no ``geometry.toml`` (None when there is one, checked by
-    the cell's loader)."""
+    a moving part with no convex pieces that fit (:func:`write_meshes`) is placed by hand
+    with why, the product mapped again without it; returns the files, why there is no
+    ``geometry.toml`` (None when there is one, checked by the cell's loader), and the
+    mapped product and its cell's view as written."""
     make_folder(out)
+    geometry = out / "geometry.toml"
+    geometry.unlink(missing_ok=True)  # the claim made it this import's, if there was one
+    why = mapped.why
+    mesh_files: list[Path] = []
+    stale: list[Path] = []  # the meshes written before a part was refused
+    meshes: dict[str, Mesh] | None = None
+    refused: dict[str, str] = {}
+    while why is None and meshes is None:
+        meshes, more = write_meshes(cell, mapped, out, mesh_files)
+        if more:
+            refused |= more
+            mapped, settings, cell = map_product(derived, settings, refused)
+            why, meshes = mapped.why, None
+            stale, mesh_files = stale + mesh_files, []
     roles = ({pid: "cover" for pid in mapped.covers} | {pid: "head" for pid in mapped.heads}
              | {pid: "manual" for pid in mapped.manual})
     written = [write_atomic(out / "assembly.toml", assembly_text(derived, settings, title, roles)),
                write_atomic(out / "sizes.lp", sizes_text(derived)),
                write_atomic(out / "nominal_sizes.lp", nominal_text(derived)),
                write_atomic(out / "geometric_precedence.lp", precedence_text(derived))]
-    geometry = out / "geometry.toml"
-    geometry.unlink(missing_ok=True)  # the claim made it this import's, if there was one
-    why = mapped.why
-    mesh_files: list[Path] = []
-    meshes = write_meshes(cell, mapped, out, mesh_files) if why is None else None
-    if isinstance(meshes, str):
-        why = meshes
-    elif meshes is not None:
+    if meshes is not None:
         write_atomic(geometry, geometry_text(cell, mapped, settings, meshes, manual_features(derived, mapped),
                                              mesh_pieces(out, mesh_files), pins_of(derived)))
         try:
@@ -901,8 +915,8 @@ def write_folder(derived: Derived, cell: Derived, mapped: Mapped, settings: Sett
             geometry.unlink()
     kept = {path.relative_to(out).as_posix(): _digest(path) for path in written}
     # an earlier import's files not written again, and this one's meshes of a geometry not kept
-    for name in sorted((removable | {path.relative_to(out).as_posix() for path in mesh_files}) - set(kept)):
+    for name in sorted((removable | {path.relative_to(out).as_posix() for path in stale + mesh_files}) - set(kept)):
         (out / name).unlink(missing_ok=True)
     write_atomic(out / MANIFEST, json.dumps({"written_by": "./run.sh import", "title": title, "files": kept},
                                             indent=1) + "\n")
-    return written, why
+    return written, why, mapped, cell

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import fcl
@@ -17,6 +18,7 @@ import trimesh
 
 from assembly_constraints.cli import main
 from bridge.product import CONVEX_HEADER
+from executor.cad import convex
 from executor.cad.convex import NOMINAL_OVERLAP, PIECE_VERTICES, _beyond, _hull_planes, _planes, fitting_pieces, reduced
 from executor.cad.fits.faces import TOUCH
 from executor.cad.sections import edge_distance, slice_loops
@@ -191,3 +193,35 @@ def test_a_pieces_vertices_are_kept_on_the_face_planes_of_trimeshs_hull_of_them(
     kept, reach = reduced(piece)
     assert len(kept.vertices) == PIECE_VERTICES and reach == pytest.approx(max(0.0, float(np.max(
         _beyond(_planes(kept), np.asarray(piece.vertices))))), abs=0.0)
+
+
+def _finned_peg() -> trimesh.Trimesh:
+    """A 10 x 10 x 30 mm peg with a fin 0.5 mm thick, 8 wide and 6 high on its top [mm]:
+    thinner than the cell's hull margin twice, so no convex pieces of it hold."""
+    return trimesh.boolean.union([_box((10, 10, 30), (0, 0, 10)), _box((0.5, 8, 6), (0, 0, 27.5))], engine="manifold")
+
+
+def test_a_part_whose_pieces_are_too_thin_is_sought_once_a_seed(monkeypatch: pytest.MonkeyPatch) -> None:
+    # A finer threshold cuts more, smaller pieces: after a piece too thin, the seed's next thresholds are not tried.
+    calls: list[tuple[float, int]] = []
+    decomposed = convex._decomposed
+
+    def counted(mesh: trimesh.Trimesh, threshold: float, seed: int, iterations: int) -> list[trimesh.Trimesh]:
+        calls.append((threshold, seed))
+        return decomposed(mesh, threshold, seed, iterations)
+
+    monkeypatch.setattr(convex, "_decomposed", counted)
+    found = fitting_pieces("peg", _finned_peg().apply_scale(1e-3), {})
+    assert isinstance(found, str) and "thinner than 1.952 mm" in found, found
+    assert calls == [(convex.THRESHOLDS[0], seed) for seed in convex.SEEDS]
+    assert f"{len(convex.SEEDS)} tried" in found
+
+
+def test_a_part_without_pieces_is_placed_by_hand_and_the_rest_simulated(tmp_path: Path) -> None:
+    _plate(tmp_path / "cad", _finned_peg())
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    geometry = load_geometry(str(tmp_path / "out"))  # written: the product is simulated
+    assert "peg" not in geometry.parts
+    manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["manual"]["peg"]
+    assert "no convex pieces the cell can collide as" in manual["reason"] and manual["mesh"]["file"] == "meshes/peg.obj"
+    assert not (tmp_path / "out" / "meshes" / "peg.convex.obj").exists()
