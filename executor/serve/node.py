@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import queue
 import signal
+import sys
 import threading
 import time
 import traceback
@@ -56,6 +57,18 @@ CACHE_SIZE = 100_000
 QUEUE_SIZE = 16
 """Requests that may wait for the cell; more are refused with ``busy``."""
 
+
+
+_SAID = threading.Lock()
+
+
+def say(line: str) -> None:
+    """Print ``line`` whole on stdout, flushed: the zenoh callbacks' refusals and the worker's
+    start and done lines come from different threads, and ``print`` writes a line's text and
+    its newline apart, so two lines could be glued (the planner reads them by their start)."""
+    with _SAID:
+        sys.stdout.write(line + "\n")
+        sys.stdout.flush()
 
 @dataclass(frozen=True)
 class _Work:
@@ -107,7 +120,7 @@ class CellNode:
 
     def _refuse(self, query: zenoh.Query, code: ErrorCode, text: str,
                 request_id: str | None = None) -> None:
-        print(f"refused {code}: {text}", flush=True)
+        say(f"refused {code}: {text}")
         reply = ErrorReply(cell=self.cell_id, code=code, error=text[:MAX_ERROR_CHARS], id=request_id)
         query.reply(query.key_expr, encode(reply))
 
@@ -199,7 +212,7 @@ class CellNode:
     def _run(self, query: zenoh.Query, request: Request) -> bytes | None:
         number = (request.experiment if isinstance(request, InsertRequest) else
                   f"step {request.step}" if isinstance(request, StepRequest) else "experiment")
-        print(f"start {request.id} {_what(request)} {number}", flush=True)
+        say(f"start {request.id} {_what(request)} {number}")
         started = time.perf_counter()
         try:
             message = self._answer(request, started)
@@ -220,7 +233,7 @@ class CellNode:
             self._replies[request.id] = (request, reply)
             while len(self._replies) > CACHE_SIZE:
                 self._replies.popitem(last=False)
-        print(f"done {request.id} {result}", flush=True)
+        say(f"done {request.id} {result}")
         return reply
 
 
@@ -270,8 +283,7 @@ def serve(settings: ServeSettings) -> int:
                      session.liveliness().declare_token(alive_key(cell_id, claim.instance)))
         if settings.lifeline:
             threading.Thread(target=_stop_when_stdin_closes, args=(node,), daemon=True).start()
-        print(f"ready cell {cell_id} backend {settings.backend} "
-              f"listen {listen} connect {connect}", flush=True)
+        say(f"ready cell {cell_id} backend {settings.backend} listen {listen} connect {connect}")
         node.serve()
     except SystemExit:
         pass  # SIGTERM/SIGINT: close below
