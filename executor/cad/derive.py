@@ -810,6 +810,16 @@ def _open_box(narrowest: float, widest: float, mesh: trimesh.Trimesh, centre: np
     return narrowest - widest > CAVITY_ROOM and _roofed(mesh, centre, -axis)
 
 
+def _roomy(hole: Loop, part: Loop) -> bool:
+    """Whether the ``hole`` loop may leave the ``part``'s loop in it more than
+    :data:`CAVITY_ROOM` across (:func:`_open_box`), by bounds that need no minimum-area
+    rectangle (whose sides cost a turn per hull edge, a second on a fine round loop): the
+    hole's short side is at most the square root of its axis-aligned box's area, the
+    part's long side at least the square root of its own area. False: it does not."""
+    box = np.ptp(hole.points, axis=0)
+    return math.sqrt(float(box[0] * box[1])) - math.sqrt(part.area) > CAVITY_ROOM
+
+
 def _outer(loop: Loop, loops: list[Loop]) -> bool:
     """Whether ``loop`` is an outline of its slice (inside an even number of the others)."""
     return sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0
@@ -1316,8 +1326,8 @@ def _hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float
         own = [o for o in cut if _outer(o, cut)]
         for loop in (o for o in loops if not _outer(o, loops)):
             inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
-            if len(inside) == 1 and not _open_box(loop.extent[1], inside[0].extent[0], owner.mesh,
-                                                  frame.T @ loop.centre + axis * level, axis):
+            if len(inside) == 1 and not (_roomy(loop, inside[0]) and _open_box(
+                    loop.extent[1], inside[0].extent[0], owner.mesh, frame.T @ loop.centre + axis * level, axis)):
                 around = sorted((o for o in loops if o is not loop and o.area > loop.area
                                  and o.contains(loop.centre)), key=lambda o: o.area)
                 return level, loop, around[0] if around else None, inside[0]

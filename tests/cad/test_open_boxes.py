@@ -13,6 +13,7 @@ import shapely
 import trimesh
 
 from executor.cad.cli import run_import
+from executor.cad.derive import CAVITY_ROOM, _roomy
 from executor.cad.sections import Loop, classify
 
 
@@ -115,3 +116,21 @@ def test_a_loop_on_one_line_is_a_polygon_of_no_width() -> None:
     shape = classify(sliver, hole=True)
     assert shape.kind == "polygon" and shape.b == 0.0 and abs(shape.a - 0.04) < 1e-9
     assert sliver.extent == (shape.a, 0.0)
+
+
+def test_the_bound_that_skips_a_cavitys_rectangles_never_skips_a_cavity() -> None:
+    # _roomy bounds the hole's short side and the part's long side without their
+    # minimum-area rectangles: wherever the rectangles leave more than CAVITY_ROOM across,
+    # the bound says so; a shaft in its bore at zero clearance is skipped.
+    rng = np.random.default_rng(3)
+    turn = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    for _ in range(300):
+        hole = Loop(np.c_[rng.uniform(0.01, 0.12) * np.cos(turn), rng.uniform(0.01, 0.12) * np.sin(turn)]
+                    @ np.array([[np.cos(a := rng.uniform(0, np.pi)), -np.sin(a)], [np.sin(a), np.cos(a)]]))
+        part = Loop(np.array([[0, 0], [rng.uniform(0.002, 0.05), 0], [0, rng.uniform(0.002, 0.05)]]))
+        if hole.extent[1] - part.extent[0] > CAVITY_ROOM:
+            assert _roomy(hole, part)
+    shaft = Loop(np.c_[0.02 * np.cos(turn), 0.02 * np.sin(turn)])
+    assert not _roomy(Loop(shaft.points * 1.0001), shaft)
+    assert _roomy(Loop(np.array([[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]])),
+                  Loop(np.array([[0, 0], [0.03, 0], [0.03, 0.03], [0, 0.03]])))
