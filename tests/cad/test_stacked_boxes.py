@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import math
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -34,6 +35,14 @@ def _stack(folder: Path) -> None:
         bottom += z
 
 
+def _imported(tmp_path: Path, write: Callable[[Path], None]) -> Path:
+    """The product ``write`` draws in ``tmp_path/cad``, imported quietly into ``tmp_path/out``."""
+    write(tmp_path / "cad")
+    out = tmp_path / "out"
+    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    return out
+
+
 def _order(plan: list[dict]) -> list[tuple[str, str | None]]:
     return [(step["part"], step["hole"]) for step in plan]
 
@@ -58,9 +67,7 @@ def test_a_product_with_no_hole_is_planned_by_least_travel(tmp_path: Path, run_m
     # With no hole there is no centre of the holes: each part is carried to the base's
     # centre in the cell (base_center of [plate]), the one order's cost its straight legs
     # from home (the cell origin) to each start, on to that centre, and back, whole mm each.
-    _stack(tmp_path / "cad")
-    out = tmp_path / "out"
-    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    out = _imported(tmp_path, _stack)
     done = run_main("plan", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
                     "--optimal", "--json")
     assert done.returncode == 0, done.stderr
@@ -75,9 +82,7 @@ def test_a_product_with_no_hole_is_planned_by_least_travel(tmp_path: Path, run_m
 @pytest.mark.slow
 def test_stacked_boxes_are_planned_learned_and_assembled(tmp_path: Path, run_main: Runner,
                                                         capsys: pytest.CaptureFixture[str]) -> None:
-    _stack(tmp_path / "cad")
-    out = tmp_path / "out"
-    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    out = _imported(tmp_path, _stack)
     assert "no hole and no pin found: sizes.lp names no part and no hole, nothing to learn" in capsys.readouterr().out
     done = run_main("plan", str(out / "sizes.lp"), str(out / "geometric_precedence.lp"), "--assembly", str(out),
                     "--json", "-n", "0")
@@ -106,9 +111,7 @@ def test_an_empty_hole_with_no_peg_leaves_nothing_to_learn(tmp_path: Path, run_m
                                                           capsys: pytest.CaptureFixture[str]) -> None:
     # A block with an empty d 8 hole through it and a plate lying on its top: sizes.lp names
     # the hole and no part, which the session refused ("expected at least one part/1 and one hole/1").
-    _write(tmp_path / "cad")
-    out = tmp_path / "out"
-    assert main(["-q", "import", str(tmp_path / "cad"), "--units", "mm", "--out", str(out)]) == 0
+    out = _imported(tmp_path, _write)
     assert "no part in a hole or on a pin: sizes.lp names no part, nothing to learn" in capsys.readouterr().out
     done = run_main("session", "--backend", "truth", "--json", "--assemble", "--assembly", str(out), "--out",
                     str(tmp_path / "run"), timeout=120)
