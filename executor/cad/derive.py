@@ -521,7 +521,6 @@ def _ways_in(result: Derived) -> None:
             result.axis[pid] = _way_out(result, pid, free(pid, present), present)
 
 
-
 def receives(fit: HoleFit) -> bool:
     """Whether the empty hole ``fit`` is one a part goes into along its axis: its section is
     round, square or rect, or a simple polygon that turns onto itself about its centre by

@@ -677,8 +677,9 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         else:
             if abs(fit.entry - top) > LEVEL:
                 lines.append(f"top_z = {_q(fit.entry)}")
-            if abs(down_depth(derived, fit) - depth) > LEVEL:
-                lines.append(f"depth = {_q(down_depth(derived, fit))}")
+            deep = down_depth(derived, fit)  # slices the base and the part: once
+            if abs(deep - depth) > LEVEL:
+                lines.append(f"depth = {_q(deep)}")
         lines.append("")
     for pid, fit in sorted(derived.hole_of.items()):
         mesh, peg = upright(derived, fit), derived.swept.get((pid, fit.id), (fit.section,))[0]
