@@ -140,6 +140,10 @@ def test_a_plain_screw_in_its_tap_drill_is_drawn_with_a_cosmetic_thread() -> Non
     # one major diameter, two pitches: the common tap drill D - P nearest the hole
     (6.35, 5.556, ("1/4-32 UNEF", 25.4 / 32)), (6.35, 5.49, ("1/4-28 UNF", 25.4 / 28)),
     (12.0, 10.7, ("M12x1.25", 1.25)),
+    # every pitch of ISO 261's first and second choice, and the 8-UN, large UNC and small UNF sizes
+    (12.0, 11.0, ("M12x1", 1.0)), (16.0, 15.0, ("M16x1", 1.0)), (7.0, 6.0, ("M7", 1.0)), (2.2, 1.75, ("M2.2", 0.45)),
+    (38.1, 34.925, ("1 1/2-8 UN", 3.175)), (50.8, 45.2, ("2-4.5 UNC", 25.4 / 4.5)),
+    (1.524, 1.191, ("#0-80 UNF", 0.3175)),
 ])
 def test_the_standard_threads_tap_drills(shaft: float, hole: float, thread: tuple[str, float] | None) -> None:
     # the shaft from D - P/4 to D, the hole from D - 1.0825 P to D - 0.85 P (10 µm slack)

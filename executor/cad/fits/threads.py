@@ -333,47 +333,64 @@ def _tap_drill(nut: trimesh.Trimesh, male: Thread) -> CylinderFace | None:
 
 def _metric() -> list[tuple[str, float, float]]:
     """ISO metric threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`:
-    the first and second choice with their coarse and common fine pitches (ISO 262), and
-    the third choice with every pitch ISO 261:1998 (Table 1) gives it, coarse (M9, M11
-    only) and fine."""
-    coarse = {1: .25, 1.2: .25, 1.4: .3, 1.6: .35, 1.8: .35, 2: .4, 2.5: .45, 3: .5, 3.5: .6, 4: .7, 5: .8, 6: 1,
-              8: 1.25, 10: 1.5, 12: 1.75, 14: 2, 16: 2, 18: 2.5, 20: 2.5, 22: 2.5, 24: 3, 27: 3, 30: 3.5, 33: 3.5,
-              36: 4, 39: 4, 42: 4.5, 45: 4.5, 48: 5, 52: 5, 56: 5.5, 60: 5.5, 64: 6}
-    fine = {8: (1,), 10: (1.25, 1), 12: (1.5, 1.25), 14: (1.5,), 16: (1.5,), 18: (1.5,), 20: (1.5,), 22: (1.5,),
-            24: (2,), 27: (2,), 30: (2,), 33: (2,), 36: (3,), 39: (3,), 42: (3,), 45: (3,), 48: (3,), 52: (4,),
-            56: (4,), 60: (4,), 64: (4,)}
-    third_coarse = {9: 1.25, 11: 1.5}
-    third_fine = {5.5: (.5,), 9: (1, .75), 11: (1, .75), 15: (1.5, 1), 17: (1.5, 1), 25: (2, 1.5, 1), 26: (1.5,),
-                  28: (2, 1.5, 1), 32: (2, 1.5), 35: (1.5,), 38: (1.5,), 40: (3, 2, 1.5), 50: (3, 2, 1.5),
-                  55: (4, 3, 2, 1.5), 58: (4, 3, 2, 1.5), 62: (4, 3, 2, 1.5)}
-    found = [(f"M{d:g}", d * 1e-3, p * 1e-3) for d, p in (coarse | third_coarse).items()]
+    every size of ISO 261:1998 (Table 1) from M1 to M64 with every pitch the table gives
+    it, the first and second choice (M1.1, M2.2, M4.5 and M7 among them) and the third
+    (coarse only for M9 and M11)."""
+    coarse = {1: .25, 1.1: .25, 1.2: .25, 1.4: .3, 1.6: .35, 1.8: .35, 2: .4, 2.2: .45, 2.5: .45, 3: .5, 3.5: .6,
+              4: .7, 4.5: .75, 5: .8, 6: 1, 7: 1, 8: 1.25, 10: 1.5, 12: 1.75, 14: 2, 16: 2, 18: 2.5, 20: 2.5,
+              22: 2.5, 24: 3, 27: 3, 30: 3.5, 33: 3.5, 36: 4, 39: 4, 42: 4.5, 45: 4.5, 48: 5, 52: 5, 56: 5.5,
+              60: 5.5, 64: 6, 9: 1.25, 11: 1.5}
+    fine = {1: (.2,), 1.1: (.2,), 1.2: (.2,), 1.4: (.2,), 1.6: (.2,), 1.8: (.2,), 2: (.25,), 2.2: (.25,),
+            2.5: (.35,), 3: (.35,), 3.5: (.35,), 4: (.5,), 4.5: (.5,), 5: (.5,), 6: (.75,), 7: (.75,),
+            8: (1, .75), 10: (1.25, 1, .75), 12: (1.5, 1.25, 1), 14: (1.5, 1.25, 1), 16: (1.5, 1),
+            18: (2, 1.5, 1), 20: (2, 1.5, 1), 22: (2, 1.5, 1), 24: (2, 1.5, 1), 27: (2, 1.5, 1),
+            30: (3, 2, 1.5, 1), 33: (3, 2, 1.5), 36: (3, 2, 1.5), 39: (3, 2, 1.5)}
+    fine |= {d: (4, 3, 2, 1.5) for d in (42, 45, 48, 52, 56, 60, 64)}
+    third = {5.5: (.5,), 9: (1, .75), 11: (1, .75), 15: (1.5, 1), 17: (1.5, 1), 25: (2, 1.5, 1), 26: (1.5,),
+             28: (2, 1.5, 1), 32: (2, 1.5), 35: (1.5,), 38: (1.5,), 40: (3, 2, 1.5), 50: (3, 2, 1.5),
+             55: (4, 3, 2, 1.5), 58: (4, 3, 2, 1.5), 62: (4, 3, 2, 1.5)}
+    found = [(f"M{d:g}", d * 1e-3, p * 1e-3) for d, p in coarse.items()]
     return found + [(f"M{d:g}x{p:g}", d * 1e-3, p * 1e-3)
-                    for table in (fine, third_fine) for d, pitches in table.items() for p in pitches]
+                    for table in (fine, third) for d, pitches in table.items() for p in pitches]
 
 
 def _unified() -> list[tuple[str, float, float]]:
     """Unified inch threads (name, major diameter, pitch) [m] of :data:`STANDARD_THREADS`
-    (ASME B1.1): UNC and UNF #2 to 1 inch, UNEF #12 to 1 11/16 inch."""
-    sizes = [("#2", .086, 56, 64), ("#4", .112, 40, 48), ("#5", .125, 40, 44), ("#6", .138, 32, 40),
-             ("#8", .164, 32, 36), ("#10", .190, 24, 32), ("#12", .216, 24, 28), ("1/4", .25, 20, 28),
-             ("5/16", .3125, 18, 24), ("3/8", .375, 16, 24), ("7/16", .4375, 14, 20), ("1/2", .5, 13, 20),
-             ("9/16", .5625, 12, 18), ("5/8", .625, 11, 18), ("3/4", .75, 10, 16), ("7/8", .875, 9, 14),
-             ("1", 1.0, 8, 12)]
+    (ASME B1.1): UNC #1 to 4 inch, UNF #0 to 1 1/2 inch, UNEF #12 to 1 11/16 inch and the
+    8-thread series (8-UN) 1 1/8 to 6 inch."""
+    sizes = [("#1", .073, 64, 72), ("#2", .086, 56, 64), ("#3", .099, 48, 56), ("#4", .112, 40, 48),
+             ("#5", .125, 40, 44), ("#6", .138, 32, 40), ("#8", .164, 32, 36), ("#10", .190, 24, 32),
+             ("#12", .216, 24, 28), ("1/4", .25, 20, 28), ("5/16", .3125, 18, 24), ("3/8", .375, 16, 24),
+             ("7/16", .4375, 14, 20), ("1/2", .5, 13, 20), ("9/16", .5625, 12, 18), ("5/8", .625, 11, 18),
+             ("3/4", .75, 10, 16), ("7/8", .875, 9, 14), ("1", 1.0, 8, 12), ("1 1/8", 1.125, 7, 12),
+             ("1 1/4", 1.25, 7, 12), ("1 3/8", 1.375, 6, 12), ("1 1/2", 1.5, 6, 12)]
+    series: list[tuple[str, float, float, str]] = [("#0", .06, 80, "UNF")]
+    series += [(name, inch, tpi, kind) for name, inch, unc, unf in sizes for tpi, kind in ((unc, "UNC"), (unf, "UNF"))]
+    series += [(_inches(inch), inch, tpi, "UNC") for inch, tpi in
+               ((1.75, 5.0), (2.0, 4.5), (2.25, 4.5), (2.5, 4.0), (2.75, 4.0), (3.0, 4.0), (3.25, 4.0), (3.5, 4.0),
+                (3.75, 4.0), (4.0, 4.0))]
     extra_fine = [("#12", .216, 32), ("1/4", .25, 32), ("5/16", .3125, 32), ("3/8", .375, 32), ("7/16", .4375, 28),
                   ("1/2", .5, 28), ("9/16", .5625, 24), ("5/8", .625, 24), ("11/16", .6875, 24), ("3/4", .75, 20),
                   ("13/16", .8125, 20), ("7/8", .875, 20), ("15/16", .9375, 20), ("1", 1.0, 20)]
-    extra_fine += [(f"1 {Fraction(n, 16)}", 1 + n / 16, 18) for n in range(1, 12)]
-    found = [(f"{name}-{tpi} {series}", inch * 0.0254, 0.0254 / tpi)
-             for name, inch, unc, unf in sizes for tpi, series in ((unc, "UNC"), (unf, "UNF"))]
-    return found + [(f"{name}-{tpi} UNEF", inch * 0.0254, 0.0254 / tpi) for name, inch, tpi in extra_fine]
+    series += [(name, inch, tpi, "UNEF") for name, inch, tpi in extra_fine]
+    series += [(_inches(1 + n / 16), 1 + n / 16, 18, "UNEF") for n in range(1, 12)]
+    series += [(_inches(1 + n / 8), 1 + n / 8, 8, "UN") for n in range(1, 8)]
+    series += [(_inches(2 + n / 4), 2 + n / 4, 8, "UN") for n in range(17)]
+    return [(f"{name}-{tpi:g} {kind}", inch * 0.0254, 0.0254 / tpi) for name, inch, tpi, kind in series]
+
+
+def _inches(inch: float) -> str:
+    """A unified thread's size ``inch`` [inch] as its name: 1 1/16, 2, 3 3/4."""
+    whole, part = int(inch), Fraction(inch - int(inch)).limit_denominator(64)
+    return f"{whole} {part}" if part else f"{whole}"
 
 
 STANDARD_THREADS = _metric() + _unified()
 """The standard threads a cosmetic thread is taken for (name, major diameter D, pitch P)
-[m]: ISO 261's metric sizes M1 to M64 of the first and second choice, their coarse pitch
-and the common fine ones (ISO 262's M8x1 to M64x4), its third-choice sizes M5.5 to M62
-with their pitches (M9 and M11 coarse; M15x1.5, M17x1, ...), and the unified inch UNC
-and UNF series, #2 to 1 inch, and UNEF, #12-32 to 1 11/16-18 (ASME B1.1)."""
+[m]: ISO 261's metric sizes M1 to M64, first, second and third choice, with every coarse
+and fine pitch its table gives them (M12x1.5, M12x1.25, M12x1, ...), and the unified inch
+series (ASME B1.1): UNC #1-64 to 4-4, UNF #0-80 to 1 1/2-12, UNEF #12-32 to 1 11/16-18
+and 8-UN 1 1/8-8 to 6-8."""
 TAP_DRILL = (1.0825, 0.85)
 """A tapped hole drawn at its tap drill has a diameter from D - 1.0825 P (the basic minor
 diameter of the internal thread, ISO 68-1 and ASME B1.1: 5/4 of the fundamental
