@@ -57,7 +57,7 @@ SEARCH_RADIUS = 0.003
 the plate where the cell believes it, so the grasp's error (:data:`GRASP_ERROR`), half a
 pitch (0.6 mm) and 0.4 mm more, in place of the default's 4.6 mm for a calibrated plate:
 the ``no_fit``'s two searches run their whole spirals, whose path grows with the radius
-squared; the session took about 36.5 s of robot time at the default, 28.3 s at 3 mm
+squared; the session took 36.2-36.9 s of robot time at the default, 28.3-30.7 s at 3 mm
 (docs/development.md)."""
 PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 BACK = 0.002
