@@ -53,3 +53,15 @@ def test_the_franka_arm_tests_follow_the_suite_only_without_a_selection(args: tu
     done = subprocess.run(["bash", "-c", function[0] + 'selects_tests "$@"', "bash", *args], cwd=ROOT,
                           capture_output=True, text=True, timeout=30)
     assert done.returncode == (0 if selects else 1), (args, done.stderr)
+
+
+def test_every_franka_arm_test_is_in_the_folder_its_serial_run_collects() -> None:
+    """run.sh collects only ``ARM_TESTS`` for the franka_arm tests' serial run: a test module
+    elsewhere marked ``franka_arm`` would run in neither of its pytest runs (the suite's
+    addopts leave the marker out)."""
+    found = re.search(r'^ARM_TESTS="([^"]+)"$', RUN_SH.read_text(encoding="utf-8"), re.M)
+    assert found is not None
+    folder = ROOT / found[1]
+    marked = {path for path in (ROOT / "tests").rglob("*.py")
+              if re.search(r"mark\.franka_arm\b", path.read_text(encoding="utf-8"))}
+    assert marked and all(folder in path.parents for path in marked), sorted(map(str, marked))

@@ -23,6 +23,7 @@ with a weld, as the PyBullet cell's grasp constraint does."""
 from __future__ import annotations
 
 import json
+import logging
 import shutil
 import subprocess
 from collections.abc import Iterator
@@ -51,10 +52,19 @@ DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2")}
 GRASP_ERROR = 0.002
 """[m] along x, where the fingers' pads do not centre a part: how far each peg waits from
 its ``start`` in the simulated world."""
+SEARCH_RADIUS = 0.003
+"""[m] the hole search's radius in the test's cell (its ``[search]`` table): franky-sim puts
+the plate where the cell believes it, so the grasp's error (:data:`GRASP_ERROR`), half a
+pitch (0.6 mm) and 0.4 mm more, in place of the default's 4.6 mm for a calibrated plate:
+the ``no_fit``'s two searches run their whole spirals, whose path grows with the radius
+squared; the session took 36.2-36.9 s of robot time at the default, 28.3-30.7 s at 3 mm
+(docs/development.md)."""
 PLACED = 0.002  # [m] a placed peg's distance from its goal, at most
 BACK = 0.002
 """[m] a peg carried back lies this close to where it waited, at most (0.2 mm measured with
 the grasp weld; 12.9 mm without it, the peg sliding along franky-sim's pads)."""
+
+LOG = logging.getLogger(__name__)  # the figures of the run (pytest --log-cli-level=INFO shows them)
 
 pytestmark = [pytest.mark.slow, pytest.mark.franka_arm]
 
@@ -78,7 +88,7 @@ def taught(tmp_path_factory: pytest.TempPathFactory, run_executor) -> Iterator[T
     skills, then ``executor teach --backend franka``; the arm's lock held for the module."""
     tmp = tmp_path_factory.mktemp("duo")
     folder = Path(shutil.copytree(DUO, tmp / "duo", ignore=shutil.ignore_patterns("assets", "demonstrations")))
-    description = franka_cell_description(tmp)
+    description = franka_cell_description(tmp, SEARCH_RADIUS)
     with simulated_arm_lock(), sim_robot(parts_moved(folder, tmp / "world", GRASP_ERROR)) as sim:
         options = {"host": sim.host, "realtime": "ignore", "dynamics": SIM_DYNAMICS}
         arm = (*(arg for key, value in options.items() for arg in ("--backend-option", f"{key}={value}")),
@@ -90,6 +100,7 @@ def taught(tmp_path_factory: pytest.TempPathFactory, run_executor) -> Iterator[T
         except ExecutorError as exc:
             refused = str(exc)
         teach = run_executor("teach", "--assembly", str(folder), "--backend", "franka", *arm, timeout=1500)
+        LOG.info("the teaching: %.1f s of robot time", sim.truth().time)
         yield Taught(folder, sim, ("--backend", "franka", *arm), refused, teach)
 
 
@@ -114,6 +125,7 @@ def test_a_session_on_the_taught_skills_learns_the_fits_and_assemble_places_ever
     done = run_cli("session", "--assembly", str(folder), "--cells", "1", *taught.arm,
                          "--timeout", "1500", "--json", "--out", str(run), timeout=1700)
     assert done.returncode == 0, (done.stderr, done.stdout)
+    LOG.info("teaching and session: %.1f s of robot time", sim.truth().time)
     result = json.loads(done.stdout)
     assert sorted(map(tuple, result["fits"])) == sorted(truth) and result["matches_truth"] is True
     answers = [json.loads(line) for line in (run / "journal.jsonl").read_text(encoding="utf-8").splitlines()]
@@ -131,6 +143,7 @@ def test_a_session_on_the_taught_skills_learns_the_fits_and_assemble_places_ever
     assert done.returncode == 0, (done.stderr, done.stdout)  # stdout: the steps' goal errors, if it got there
     report = json.loads(done.stdout)
     world = sim.truth()
+    LOG.info("teaching, session and assembly: %.1f s of robot time", world.time)
     assert report["assembled"] and report["manual"] == [], report
     inserted = [step for step in report["steps"] if step["hole"] is not None]
     assert len(inserted) == len(DEMOS) and all(step["outcome"] == "fit" for step in inserted), report["steps"]
