@@ -590,7 +590,7 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
                           exact=bore_pieces(derived, pid) if pid in derived.bores else None,
-                          fits=frozenset(fitted(derived, pid)))
+                          fits=frozenset(fitted(derived, pid)), prisms=pid in derived.hole_of)
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             refused[pid] = done
