@@ -391,8 +391,8 @@ leaves their overlap out)."""
 @dataclasses.dataclass(frozen=True)
 class Prisms:
     """The convex ``pieces`` of a part with no bore made from its sections (each with 0.0: no
-    vertex dropped), a line on how (``made``), and the volume [m³] of its parts thinner than
-    the cell collides as, left out (``dropped``)."""
+    vertex dropped), a line on how (``made``), and the volume [m³] its parts thinner than the
+    cell collides as change, filled or left out (``dropped``)."""
 
     pieces: list[tuple[trimesh.Trimesh, float]]
     made: str
@@ -418,6 +418,16 @@ def _swept(polygon: shapely.Polygon, low: float, high: float) -> trimesh.Trimesh
     return trimesh.convex.convex_hull(np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (low, high)]))
 
 
+def _layer_pieces(polygons: list[shapely.Polygon], bottom: float, top: float, inside: trimesh.Trimesh | None
+                  ) -> list[trimesh.Trimesh]:
+    """A layer's convex pieces from ``bottom`` to ``top`` [m]: the prisms of its ``polygons``'
+    convex parts (:func:`convex_parts`), or, for a layer that is no prism (``inside``: the
+    mesh between its levels), the convex hull of each body of that (none flatter than :data:`LEVEL`)."""
+    if inside is not None:
+        return [body.convex_hull for body in inside.split(only_watertight=True) if min(body.extents) > LEVEL]
+    return [_swept(part, bottom, top) for polygon in polygons for part in convex_parts(polygon)]
+
+
 def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     """The convex pieces of part ``pid`` with no bore (a peg), its closed ``mesh`` in its part
     frame [m] (z its axis), made from its sections (:func:`layers_of`): a layer whose prism
@@ -426,38 +436,57 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     (:func:`convex_parts`, each polygon's holes that its other polygons fill filled), so its
     faces are the mesh's own: the section a fit was measured on goes through its hole as it
     is; any other layer is the convex hull of each body of the mesh between its levels, these
-    hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A piece with no
-    eroded form (:func:`executor.world.meshes.eroded`: thinner than
-    :data:`executor.world.meshes.MIN_THICKNESS` across a face, a 0.5 mm spade terminal) is left
-    out, up to :data:`THIN_TOLERANCE` of the part's volume. Returns them, or why there are none."""
+    hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A layer with a
+    piece that has no eroded form (:func:`executor.world.meshes.eroded`: thinner than
+    :data:`executor.world.meshes.MIN_THICKNESS` across a face) whose section lies within the
+    section of the prism layer next to it (above first) is filled to that section (a switch's
+    0.5 mm spade terminals under its body, inside its outline: the body's prism goes down to
+    their ends, so the part's end, where the cell believes its tip, is where it collides, and
+    it passes wherever the body does); any other such piece is left out, up to
+    :data:`THIN_TOLERANCE` of the part's volume. Returns them, or why there are none."""
     if not mesh.is_volume:
         return f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections"
     centre, size = mesh.bounds.mean(axis=0), 2 * mesh.extents
-    pieces: list[tuple[trimesh.Trimesh, float]] = []
-    differ = excess = dropped = 0.0
-    prisms = hulls = 0
+    layers: list[tuple[list[shapely.Polygon], float, float, trimesh.Trimesh | None, float]] = []
+    differ = 0.0
     for section, bottom, top in layers_of(mesh):
         slab = trimesh.creation.box((size[0], size[1], top - bottom))
         slab.apply_translation((centre[0], centre[1], (bottom + top) / 2))
         inside = trimesh.boolean.intersection([mesh, slab], engine="manifold")
         volume = float(inside.volume) if len(inside.faces) else 0.0
         polygons = _filled(section)
-        area = sum(polygon.area for polygon in polygons)
         common = 0.0
         for polygon in polygons:
             prism = trimesh.creation.extrude_polygon(polygon, top - bottom)
             prism.apply_translation((0.0, 0.0, bottom))
             both = trimesh.boolean.intersection([mesh, prism], engine="manifold")
             common += float(both.volume) if len(both.faces) else 0.0
-        here = area * (top - bottom) + volume - 2 * common
-        if differ + here < PRISM_TOLERANCE * mesh.volume:
-            differ += here
-            prisms += 1
-            layer = [_swept(part, bottom, top) for polygon in polygons for part in convex_parts(polygon)]
-        else:
-            hulls += 1
-            layer = [body.convex_hull for body in inside.split(only_watertight=True) if min(body.extents) > LEVEL]
-            excess += sum(hull.volume for hull in layer) - volume
+        here = sum(polygon.area for polygon in polygons) * (top - bottom) + volume - 2 * common
+        flat = differ + here < PRISM_TOLERANCE * mesh.volume
+        differ += here if flat else 0.0
+        layers.append((polygons, bottom, top, None if flat else inside, volume))
+    filled = 0.0
+    k = 0
+    while k < len(layers):
+        polygons, bottom, top, inside, volume = layers[k]
+        thin = any(eroded(piece.vertices, URDF_HULL_MARGIN) is None
+                   for piece in _layer_pieces(polygons, bottom, top, inside))
+        outline = shapely.union_all(polygons)
+        into = next((j for j in (k + 1, k - 1) if thin and 0 <= j < len(layers) and layers[j][3] is None
+                     and shapely.union_all(layers[j][0]).buffer(LEVEL).contains(outline)), None)
+        if into is None:
+            k += 1
+            continue
+        other, low, high, _, more = layers[into]
+        filled += sum(polygon.area for polygon in other) * (top - bottom) - volume
+        layers[into] = (other, min(low, bottom), max(high, top), None, more + volume)
+        del layers[k]
+        k = min(k, into)
+    pieces: list[tuple[trimesh.Trimesh, float]] = []
+    excess = dropped = 0.0
+    for polygons, bottom, top, inside, volume in layers:
+        layer = _layer_pieces(polygons, bottom, top, inside)
+        excess += 0.0 if inside is None else sum(hull.volume for hull in layer) - volume
         for piece in layer:
             if eroded(piece.vertices, URDF_HULL_MARGIN) is None:
                 dropped += piece.volume
@@ -469,8 +498,10 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     if dropped >= THIN_TOLERANCE * mesh.volume or not pieces:
         return (f"part '{pid}': the parts of its layers thinner than the cell's hull margin twice are "
                 f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
-    made = (f"{len(pieces)} convex prism(s) and hull(s) of its sections over {prisms} prism layer(s) "
-            f"({differ / mesh.volume:.2%} of its volume apart from the mesh) and {hulls} other layer(s) (their hulls "
-            f"{excess / mesh.volume:.2%} of its volume beyond it); its parts thinner than the cell's hull margin "
-            f"twice, {dropped / mesh.volume:.2%} of its volume, left out")
-    return Prisms(pieces, made, dropped)
+    heights = ", ".join(f"{1e3 * (top - bottom):.3f}{'' if inside is None else ' (hulls)'}"
+                        for _, bottom, top, inside, _ in layers)
+    made = (f"{len(pieces)} convex piece(s) over its {len(layers)} layer(s) of {heights} mm, the prisms "
+            f"{differ / mesh.volume:.2%} of its volume apart from the mesh, the hulls {excess / mesh.volume:.2%} "
+            f"beyond it; its parts thinner than the cell's hull margin twice filled to the section next to them, "
+            f"{filled / mesh.volume:.2%} of its volume added, or left out, {dropped / mesh.volume:.2%}")
+    return Prisms(pieces, made, filled + dropped)
