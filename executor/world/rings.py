@@ -439,7 +439,7 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A layer with a
     piece that has no eroded form (:func:`executor.world.meshes.eroded`: thinner than
     :data:`executor.world.meshes.MIN_THICKNESS` across a face) whose section lies within the
-    section of the prism layer next to it (above first) is filled to that section (a switch's
+    thick pieces of the prism layer next to it (above first) is filled to that layer's section (a switch's
     0.5 mm spade terminals under its body, inside its outline: the body's prism goes down to
     their ends, so the part's end, where the cell believes its tip, is where it collides, and
     it passes wherever the body does); any other such piece is left out, up to
@@ -465,15 +465,22 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
         flat = differ + here < PRISM_TOLERANCE * mesh.volume
         differ += here if flat else 0.0
         layers.append((polygons, bottom, top, None if flat else inside, volume))
+    def thick(layer: tuple[list[shapely.Polygon], float, float, trimesh.Trimesh | None, float]) -> list[bool]:
+        return [eroded(piece.vertices, URDF_HULL_MARGIN) is not None for piece in _layer_pieces(*layer[:4])]
+
+    def covers(layer: tuple[list[shapely.Polygon], float, float, trimesh.Trimesh | None, float],
+               outline: shapely.Geometry) -> bool:  # a prism layer's thick pieces cover the outline
+        parts = [part for polygon in layer[0] for part in convex_parts(polygon)]
+        kept = [part for part, ok in zip(parts, thick(layer)) if ok]
+        return layer[3] is None and shapely.union_all(kept).buffer(LEVEL).contains(outline)
+
     filled = 0.0
     k = 0
     while k < len(layers):
         polygons, bottom, top, inside, volume = layers[k]
-        thin = any(eroded(piece.vertices, URDF_HULL_MARGIN) is None
-                   for piece in _layer_pieces(polygons, bottom, top, inside))
         outline = shapely.union_all(polygons)
-        into = next((j for j in (k + 1, k - 1) if thin and 0 <= j < len(layers) and layers[j][3] is None
-                     and shapely.union_all(layers[j][0]).buffer(LEVEL).contains(outline)), None)
+        into = next((j for j in (k + 1, k - 1) if 0 <= j < len(layers) and covers(layers[j], outline)),
+                    None) if not all(thick(layers[k])) else None
         if into is None:
             k += 1
             continue
