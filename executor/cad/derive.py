@@ -1349,12 +1349,11 @@ def _fields(fit: HoleFit) -> tuple:
 def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | None,
              occupant: tuple[CadPart, Loop] | None, workers: int = 1) -> HoleFit:
     """Section, entry, depth (to the first face of ``base``, the part the hole is in, down
-    the hole's centre line; through it, to the ``occupant``'s end (a switch hanging by its
-    flange in a slot of a case's top: its goal where the CAD has it) or, empty, to its
-    lowest point around the hole, when there is none) and chamfer of the hole ``loop``
-    sliced at ``level`` [m], and the section of the ``occupant`` (its part, its loop there).
-    The sections are over the stretch from the occupant's end (or the hole's lowest point
-    around it, if higher) to the entry (:func:`executor.cad.sections.over_span`, made in ``workers`` processes:
+    the hole's centre line; through it, to its lowest point around the hole, when there is
+    none) and chamfer of the hole ``loop`` sliced at ``level`` [m], and the section of the
+    ``occupant`` (its part, its loop there). The sections are over the stretch from the
+    occupant's end (or the hole's lowest point around it, if higher) to the entry
+    (:func:`executor.cad.sections.over_span`, made in ``workers`` processes:
     :func:`executor.cad.sweep.forked_map`; 1 in a forked one); without an occupant, from the
     floor (the first face of ``base`` down the centre line of the loop) or, with none, from
     the hole's lowest point around it: as deep as a part goes in. Where nothing of the hole
@@ -1396,8 +1395,6 @@ def _measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | N
     centre = frame.T @ hole.centre + axis * level
     bottom = first_hit(base.mesh, centre, -axis)
     depth = entry - (level - bottom if bottom is not None else float(around.min()))
-    if bottom is None and occupant is not None:  # through: to its occupant's end, where the CAD has the part
-        depth = entry - tip
     probe = [o for o in slice_loops(base.mesh, axis, entry - _ENTRY_PROBE) if o.contains(hole.centre)]
     chamfer = 0.0
     if probe:

@@ -39,6 +39,7 @@ from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad.cli import load_source
 from executor.cad.derive import derive
+from executor.cad.write import down_depth
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.trial import Cell
@@ -570,9 +571,9 @@ def test_each_switch_hanging_through_a_slot_of_the_case_top_is_found_in_that_slo
             for pid, part in truth["parts"].items()}
     assert set(found) == set(want), found
     assert all(math.dist(found[pid], want[pid]) < 1e-4 for pid in want), found
-    # Through the top (nothing under the slots): each hole as deep as its switch goes in the
-    # CAD, its goal where the CAD has it (the slots' depths read 2 and 42 mm).
-    tips = {fit.part: fit.entry - fit.depth for fit in derived.holes.values() if fit.part is not None}
+    # Each hanging by its flange on its slot's entry: the cell's hole as deep as its switch
+    # goes in the CAD, its goal where the CAD has it (measured through the top: 2 and 42 mm).
+    tips = {fit.part: fit.entry - down_depth(derived, fit) for fit in derived.holes.values() if fit.part is not None}
     assert all(abs(tips[pid] - float(derived.parts[pid].mesh.bounds[0][2])) < 1e-9 for pid in want), tips
 
 
