@@ -16,7 +16,9 @@ head in its (the centre of its section at its bottom, the cell's axes), the base
 cell frame. A moving part also gets its convex pieces
 (``meshes/<id>.convex.obj``, one OBJ object each, the first line naming the mesh and its
 SHA-256): its convex hull when the hull's volume is within :data:`CONVEX_TOLERANCE` of
-the mesh's, else a convex decomposition by CoACD (seeds :data:`SEEDS`, so an import is repeatable),
+the mesh's, else (for a peg whose sections have parts thinner than the cell collides as, the
+prisms of its sections first: :func:`executor.world.rings.prism_pieces`) a convex
+decomposition by CoACD (seeds :data:`SEEDS`, so an import is repeatable),
 each piece cut down to at most :data:`PIECE_VERTICES` of its vertices (the cell's contact
 cost grows with them: a 900-vertex piece ran 40 steps/s, a 32-vertex one 270), each next
 one the farthest beyond the hull of those kept; the file's second line states how far the dropped vertices
