@@ -16,8 +16,8 @@ head in its (the centre of its section at its bottom, the cell's axes), the base
 cell frame. A moving part also gets its convex pieces
 (``meshes/<id>.convex.obj``, one OBJ object each, the first line naming the mesh and its
 SHA-256): its convex hull when the hull's volume is within :data:`CONVEX_TOLERANCE` of
-the mesh's, else (for a peg whose sections have parts thinner than the cell collides as, the
-prisms of its sections first: :func:`executor.world.rings.prism_pieces`) a convex
+the mesh's, else (for a peg with a layer thinner than the cell collides as within the
+section next to it, the prisms of its sections first: :func:`executor.world.rings.prism_pieces`) a convex
 decomposition by CoACD (seeds :data:`SEEDS`, so an import is repeatable),
 each piece cut down to at most :data:`PIECE_VERTICES` of its vertices (the cell's contact
 cost grows with them: a 900-vertex piece ran 40 steps/s, a 32-vertex one 270), each next
@@ -239,10 +239,10 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     deeper than :data:`executor.cad.fits.faces.TOUCH`; those in ``fits``, at a stated
     zero-clearance fit or passage with it: none deeper than :data:`NOMINAL_OVERLAP`)
     with every piece at least :data:`executor.world.meshes.MIN_THICKNESS` thick (CoACD's tree search
-    making ``iterations`` per cut). For a peg (``prisms``) whose sections have parts thinner
-    than that (:func:`executor.world.rings.prism_pieces` leaves some out: a switch's 0.5 mm
-    spade terminals, which CoACD's pieces follow), the prisms of its sections are tried
-    first, under the same checks."""
+    making ``iterations`` per cut). For a peg (``prisms``) with a layer of parts thinner
+    than that within the section next to it, which :func:`executor.world.rings.prism_pieces`
+    fills to that section (a switch's 0.5 mm spade terminals under its body, which CoACD's
+    pieces follow), the prisms of its sections are tried first, under the same checks."""
     allowed = {name: NOMINAL_OVERLAP if name in fits else TOUCH for name in neighbours}
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
     own = bvh(mesh)
@@ -255,7 +255,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     thin: set[int] = set()  # the seeds whose pieces were too thin at a threshold
     tries = 0
     stacked = prism_pieces(pid, mesh) if prisms and not convex else None
-    stacked = stacked if isinstance(stacked, Prisms) and stacked.dropped > 0 else None
+    stacked = stacked if isinstance(stacked, Prisms) and stacked.filled > 0 else None
     first = [] if stacked is None else [(-1, 0.0)]  # seed -1: the prisms
     for seed, threshold in [(0, 0.0)] if convex else first + [(s, t) for s in SEEDS for t in thresholds]:
         if seed in thin:

@@ -218,13 +218,15 @@ def sideways_depth(derived: Derived, fit: HoleFit) -> float:
 
 
 STOP_PROBE = 1e-4
-"""How far [m] under a part's tip the base is cut to see whether the hole narrows there."""
+"""How far [m] under a part's tip the base is cut to see whether the hole narrows there (and
+above and under a hole's entry, and how far beyond the hole a part resting on it reaches)."""
 
 
 def down_depth(derived: Derived, fit: HoleFit) -> float:
     """The ``depth`` [m] of a hole entered down: to where its part's tip is in the CAD where
-    the part rests on the hole's entry (its outline just above the entry is not within the
-    base's loop around the hole just under it: a switch hanging by its flange through a slot
+    the part rests on the hole's entry (its outline just above the entry reaches more than
+    :data:`STOP_PROBE` beyond the base's loop around the hole just under it, so not at a
+    nominal zero-clearance fit: a switch hanging by its flange through a slot
     of a case's 2 mm top, its tip 19.4 mm down where the measured depth says 2 mm, through
     the top, or 42 mm, to the case's rim) or where the base's opening just under the tip
     does not hold the part's section at the middle of its stretch in the hole (a plate on
@@ -241,7 +243,7 @@ def down_depth(derived: Derived, fit: HoleFit) -> float:
                if loop.contains(fit.hole.centre)]
         above = shapely.union_all([shapely.Polygon(loop.points)
                                    for loop in slice_loops(mesh, up, fit.entry + STOP_PROBE)])
-        if rim and not above.is_empty and not above.within(min(rim, key=lambda loop: loop.area)):
+        if rim and not above.is_empty and not above.within(min(rim, key=lambda loop: loop.area).buffer(STOP_PROBE)):
             return fit.entry - float(tip)
     if fit.entry - tip >= fit.depth - LEVEL:  # on the floor, or below the entry
         return fit.depth

@@ -391,12 +391,12 @@ leaves their overlap out)."""
 @dataclasses.dataclass(frozen=True)
 class Prisms:
     """The convex ``pieces`` of a part with no bore made from its sections (each with 0.0: no
-    vertex dropped), a line on how (``made``), and the volume [m³] its parts thinner than the
-    cell collides as change, filled or left out (``dropped``)."""
+    vertex dropped), a line on how (``made``), and the volume [m³] added where its layers
+    thinner than the cell collides as are filled to the section next to them (``filled``)."""
 
     pieces: list[tuple[trimesh.Trimesh, float]]
     made: str
-    dropped: float
+    filled: float
 
 
 def _filled(section: shapely.Geometry) -> list[shapely.Polygon]:
@@ -436,13 +436,14 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     (:func:`convex_parts`, each polygon's holes that its other polygons fill filled), so its
     faces are the mesh's own: the section a fit was measured on goes through its hole as it
     is; any other layer is the convex hull of each body of the mesh between its levels, these
-    hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A layer with a
-    piece that has no eroded form (:func:`executor.world.meshes.eroded`: thinner than
-    :data:`executor.world.meshes.MIN_THICKNESS` across a face) whose section lies within the
-    thick pieces of the prism layer next to it (above first) is filled to that layer's section (a switch's
-    0.5 mm spade terminals under its body, inside its outline: the body's prism goes down to
-    their ends, so the part's end, where the cell believes its tip, is where it collides, and
-    it passes wherever the body does); any other such piece is left out, up to
+    hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A layer at
+    least :data:`executor.world.meshes.MIN_THICKNESS` tall with a piece that has no eroded form
+    (:func:`executor.world.meshes.eroded`: thinner than that across a face) whose section lies
+    within the thick pieces of the prism layer next to it (above first) is filled to that
+    layer's section (a switch's 0.5 mm spade terminals under its body, inside its outline:
+    the body's prism goes down to their ends, so the part's end, where the cell believes its
+    tip, is where it collides, and it passes wherever the body does; not a chamfer, thin only
+    along the axis); any other such piece is left out, up to
     :data:`THIN_TOLERANCE` of the part's volume. Returns them, or why there are none."""
     if not mesh.is_volume:
         return f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections"
@@ -479,8 +480,9 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     while k < len(layers):
         polygons, bottom, top, inside, volume = layers[k]
         outline = shapely.union_all(polygons)
+        tall = top - bottom >= MIN_THICKNESS  # thin across its section, not only along the axis (a chamfer)
         into = next((j for j in (k + 1, k - 1) if 0 <= j < len(layers) and covers(layers[j], outline)),
-                    None) if not all(thick(layers[k])) else None
+                    None) if tall and not all(thick(layers[k])) else None
         if into is None:
             k += 1
             continue
@@ -511,4 +513,4 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
             f"{differ / mesh.volume:.2%} of its volume apart from the mesh, the hulls {excess / mesh.volume:.2%} "
             f"beyond it; its parts thinner than the cell's hull margin twice filled to the section next to them, "
             f"{filled / mesh.volume:.2%} of its volume added, or left out, {dropped / mesh.volume:.2%}")
-    return Prisms(pieces, made, filled + dropped)
+    return Prisms(pieces, made, filled)
