@@ -437,7 +437,7 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
     faces are the mesh's own: the section a fit was measured on goes through its hole as it
     is; any other layer is the convex hull of each body of the mesh between its levels, these
     hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A layer at
-    least :data:`executor.world.meshes.MIN_THICKNESS` tall with a piece that has no eroded form
+    least :data:`executor.world.meshes.MIN_THICKNESS` tall whose pieces have no eroded form
     (:func:`executor.world.meshes.eroded`: thinner than that across a face) whose section lies
     within the thick pieces of the prism layer next to it (above first) is filled to that
     layer's section (a switch's 0.5 mm spade terminals under its body, inside its outline:
@@ -482,7 +482,7 @@ def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
         outline = shapely.union_all(polygons)
         tall = top - bottom >= MIN_THICKNESS  # thin across its section, not only along the axis (a chamfer)
         into = next((j for j in (k + 1, k - 1) if 0 <= j < len(layers) and covers(layers[j], outline)),
-                    None) if tall and not all(thick(layers[k])) else None
+                    None) if tall and not any(thick(layers[k])) else None
         if into is None:
             k += 1
             continue
