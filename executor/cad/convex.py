@@ -16,7 +16,9 @@ head in its (the centre of its section at its bottom, the cell's axes), the base
 cell frame. A moving part also gets its convex pieces
 (``meshes/<id>.convex.obj``, one OBJ object each, the first line naming the mesh and its
 SHA-256): its convex hull when the hull's volume is within :data:`CONVEX_TOLERANCE` of
-the mesh's, else a convex decomposition by CoACD (seeds :data:`SEEDS`, so an import is repeatable),
+the mesh's, else (for a peg with a layer thinner than the cell collides as within the
+section next to it, the prisms of its sections first: :func:`executor.world.rings.prism_pieces`) a convex
+decomposition by CoACD (seeds :data:`SEEDS`, so an import is repeatable),
 each piece cut down to at most :data:`PIECE_VERTICES` of its vertices (the cell's contact
 cost grows with them: a 900-vertex piece ran 40 steps/s, a 32-vertex one 270), each next
 one the farthest beyond the hull of those kept; the file's second line states how far the dropped vertices
@@ -62,6 +64,7 @@ from executor.cad.sections import Shape2D, classify, exact_round, slice_loops
 from executor.cad.sweep import bvh, convex_object
 from executor.world import SIZE_RESOLUTION
 from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded, obj_text
+from executor.world.rings import Prisms, prism_pieces
 
 PRIMITIVE_TOLERANCE = 0.01
 """A part is the primitive its sections describe when their volumes differ by less than
@@ -227,7 +230,8 @@ def overlap_assumption(derived: Derived) -> list[str]:
 
 def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimesh.Trimesh],
                    fits: frozenset[str] = frozenset(), thresholds: Sequence[float] = THRESHOLDS,
-                   iterations: int = ITERATIONS) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
+                   iterations: int = ITERATIONS, prisms: bool = False
+                   ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
     """The convex pieces of part ``pid``'s closed mesh (module docstring; each with how far
     its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
     parts near it in the assembled pose, in its frame); or why no decomposition leaves
@@ -235,7 +239,10 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     deeper than :data:`executor.cad.fits.faces.TOUCH`; those in ``fits``, at a stated
     zero-clearance fit or passage with it: none deeper than :data:`NOMINAL_OVERLAP`)
     with every piece at least :data:`executor.world.meshes.MIN_THICKNESS` thick (CoACD's tree search
-    making ``iterations`` per cut)."""
+    making ``iterations`` per cut). For a peg (``prisms``) with a layer of parts thinner
+    than that within the section next to it, which :func:`executor.world.rings.prism_pieces`
+    fills to that section (a switch's 0.5 mm spade terminals under its body, which CoACD's
+    pieces follow), the prisms of its sections are tried first, under the same checks."""
     allowed = {name: NOMINAL_OVERLAP if name in fits else TOUCH for name in neighbours}
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
     own = bvh(mesh)
@@ -247,11 +254,17 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     short: list[str] = []
     thin: set[int] = set()  # the seeds whose pieces were too thin at a threshold
     tries = 0
-    for seed, threshold in [(0, 0.0)] if convex else [(s, t) for s in SEEDS for t in thresholds]:
+    stacked = prism_pieces(pid, mesh) if prisms and not convex else None
+    stacked = stacked if isinstance(stacked, Prisms) and stacked.filled > 0 else None
+    first = [] if stacked is None else [(-1, 0.0)]  # seed -1: the prisms
+    for seed, threshold in [(0, 0.0)] if convex else first + [(s, t) for s in SEEDS for t in thresholds]:
         if seed in thin:
             continue  # a finer threshold cuts more, smaller pieces: it mends no piece too thin
         tries += 1
-        kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed, iterations))]
+        if stacked is not None and seed < 0:
+            kept = [reduced(piece) for piece, _ in stacked.pieces]
+        else:
+            kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed, iterations))]
         if any(eroded(piece.vertices, URDF_HULL_MARGIN) is None for piece, _ in kept):
             thin.add(seed)
             continue  # a piece the cell cannot collide as
@@ -259,7 +272,9 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
         left = {name: _room(objects, other) for name, other in others.items()}
         short = [name for name in others if left[name] < ROOM_KEPT * rooms[name] - allowed[name]]
         if not short:
-            kind = "its hull" if convex else (f"CoACD at threshold {threshold:g}" + (f", seed {seed}" if seed else "")
+            kind = "its hull" if convex else f"the prisms of its sections: {stacked.made}" if (
+                stacked is not None and seed < 0) else (
+                f"CoACD at threshold {threshold:g}" + (f", seed {seed}" if seed else "")
                                               + (f", {iterations} tree-search iterations" if iterations != ITERATIONS
                                                  else ""))
             apart = [name for name in rooms if rooms[name] > TOUCH]
@@ -272,7 +287,8 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             name = min(apart, key=lambda n: left[n] / rooms[n])
             return kept, (f"{kind}; they leave {name} {1e3 * left[name]:.3f} of {1e3 * rooms[name]:.3f} mm"
                           + (touching if len(apart) < len(rooms) else ""))
-    tried = (f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
+    tried = (("the prisms of its sections, " if first else "")
+             + f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
              + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else "")
              + (f"; {tries} tried: seed(s) {', '.join(map(str, sorted(thin)))} no finer after a piece too thin"
                 if thin else ""))
@@ -465,13 +481,15 @@ def as_written(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
                neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame",
-               exact: Pieces | None = None, fits: frozenset[str] = frozenset()) -> tuple[Mesh, list[Path]] | str:
+               exact: Pieces | None = None, fits: frozenset[str] = frozenset(), prisms: bool = False
+               ) -> tuple[Mesh, list[Path]] | str:
     """Write ``mesh`` (already in ``frame`` [m]; ``made``: how, for its header) as
     ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
     (``neighbours``: the parts near it, in its frame; None for a static one: the base, a
     part placed by hand), its convex pieces (:func:`fitting_pieces`, or ``exact``'s:
     :func:`executor.world.rings.ring_pieces`; ``fits``: the neighbours at a stated
-    zero-clearance fit or passage with it); returns the ``mesh`` entry of
+    zero-clearance fit or passage with it; ``prisms``: a peg's, whose prisms of its sections
+    may serve); returns the ``mesh`` entry of
     ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
@@ -484,7 +502,8 @@ def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
     # The pieces of the mesh as written (0.1 µm), so that they are pieces of that file.
     written_mesh = trimesh.load(folder / name, force="mesh")
     assert isinstance(written_mesh, trimesh.Trimesh)  # the closed mesh just written
-    found = fitting_pieces(pid, written_mesh, neighbours, fits) if exact is None else exact(pid, written_mesh)
+    found = (fitting_pieces(pid, written_mesh, neighbours, fits, prisms=prisms) if exact is None
+             else exact(pid, written_mesh))
     if isinstance(found, str):
         return found
     kept, made = found

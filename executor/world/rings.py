@@ -34,6 +34,7 @@ round pin passes it exactly when it passes the bore.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 from collections.abc import Callable
@@ -42,7 +43,7 @@ import numpy as np
 import shapely
 import trimesh
 
-from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN
+from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded
 
 ROUND_BORE_CORNERS = (64, 48, 32, 24, 16, 12, 8)
 """The corners of the regular polygons a round bore on round pins is tried as (:func:`round_bores`)."""
@@ -234,10 +235,11 @@ def round_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapely.
     return found
 
 
-def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely.Polygon, float, float]] | str:
-    """The layers of part ``pid`` with ``bores`` bores, its closed ``mesh`` in its part
-    frame [m] (module docstring), each as (its section, its bottom, its top) [m], the
-    section one polygon with that many bores; or why it has none."""
+def layers_of(mesh: trimesh.Trimesh) -> list[tuple[shapely.Geometry, float, float]]:
+    """The layers of a closed ``mesh`` in its part frame [m] (module docstring), each as (its
+    section, its bottom, its top) [m], the section the union of its sections near its ends
+    and at its middle (polygons, holes included), adjacent layers joined while that adds
+    less than :data:`PRISM_TOLERANCE` of the part's volume."""
     low, high = (float(v) for v in mesh.bounds[:, 2])
     levels = [low]
     for z in np.sort(mesh.triangles_center[np.abs(mesh.face_normals[:, 2]) > 1 - _ACROSS, 2]):
@@ -257,8 +259,16 @@ def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely
                 layers[-1] = (union, start, top)
                 continue
         layers.append((section, bottom, top))
+    return layers
+
+
+def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely.Polygon, float, float]] | str:
+    """The layers of part ``pid`` with ``bores`` bores, its closed ``mesh`` in its part
+    frame [m] (:func:`layers_of`), each as (its section, its bottom, its top) [m], the
+    section one polygon with that many bores; or why it has none."""
+    low = float(mesh.bounds[0][2])
     found = []
-    for section, bottom, top in layers:
+    for section, bottom, top in layers_of(mesh):
         polygons = list(getattr(section, "geoms", [section]))
         if len(polygons) != 1 or len(polygons[0].interiors) != bores:
             many = "one bore" if bores == 1 else f"{bores} bores"
@@ -365,3 +375,142 @@ def _cut(layers: list[tuple[shapely.Polygon, float, float]],
                                                                   for z in (low, high)])), 0.0))
         dropped += (high - low) * sum(part.area for ok, part in zip(thick, parts) if not ok)
     return pieces, dropped
+
+
+HULL_TOLERANCE = 0.05
+"""The layers of a part with no bore that are no prisms of their sections (a rocker
+switch's tilted rocker) are taken as the convex hulls of the mesh between their levels
+(:func:`prism_pieces`) when these hulls exceed the mesh by less than this fraction of the
+part's volume (the rocker's: 2.3 %)."""
+_FILLED = 0.99
+"""A hole of a section's polygon is filled when the section's other polygons cover this
+share of it (a lens in its flange: the mesh's two shells overlap, and the even-odd section
+leaves their overlap out)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Prisms:
+    """The convex ``pieces`` of a part with no bore made from its sections (each with 0.0: no
+    vertex dropped), a line on how (``made``), and the volume [m³] added where its layers
+    thinner than the cell collides as are filled to the section next to them (``filled``)."""
+
+    pieces: list[tuple[trimesh.Trimesh, float]]
+    made: str
+    filled: float
+
+
+def _filled(section: shapely.Geometry) -> list[shapely.Polygon]:
+    """The polygons of ``section``, each hole the others cover (:data:`_FILLED`) filled, joined."""
+    polygons = [p for p in getattr(section, "geoms", [section]) if isinstance(p, shapely.Polygon) and p.area > 0]
+    kept = []
+    for k, polygon in enumerate(polygons):
+        others = shapely.union_all(polygons[:k] + polygons[k + 1:])
+        holes = [ring for ring in polygon.interiors
+                 if shapely.intersection(shapely.Polygon(ring), others).area < _FILLED * shapely.Polygon(ring).area]
+        kept.append(shapely.Polygon(polygon.exterior, holes))
+    joined = shapely.set_precision(shapely.union_all(kept), _GRID)
+    return [p for p in getattr(joined, "geoms", [joined]) if isinstance(p, shapely.Polygon) and p.area > 0]
+
+
+def _swept(polygon: shapely.Polygon, low: float, high: float) -> trimesh.Trimesh:
+    """The convex prism of a convex ``polygon`` from ``low`` to ``high`` [m]."""
+    ring = np.asarray(polygon.exterior.coords)[:-1]
+    return trimesh.convex.convex_hull(np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (low, high)]))
+
+
+def _layer_pieces(polygons: list[shapely.Polygon], bottom: float, top: float, inside: trimesh.Trimesh | None
+                  ) -> list[trimesh.Trimesh]:
+    """A layer's convex pieces from ``bottom`` to ``top`` [m]: the prisms of its ``polygons``'
+    convex parts (:func:`convex_parts`), or, for a layer that is no prism (``inside``: the
+    mesh between its levels), the convex hull of each body of that (none flatter than :data:`LEVEL`)."""
+    if inside is not None:
+        return [body.convex_hull for body in inside.split(only_watertight=True) if min(body.extents) > LEVEL]
+    return [_swept(part, bottom, top) for polygon in polygons for part in convex_parts(polygon)]
+
+
+def prism_pieces(pid: str, mesh: trimesh.Trimesh) -> Prisms | str:
+    """The convex pieces of part ``pid`` with no bore (a peg), its closed ``mesh`` in its part
+    frame [m] (z its axis), made from its sections (:func:`layers_of`): a layer whose prism
+    and the mesh between its levels differ by little (these differences summed, less than
+    :data:`PRISM_TOLERANCE` of the part's volume) is the prisms of its section's convex parts
+    (:func:`convex_parts`, each polygon's holes that its other polygons fill filled), so its
+    faces are the mesh's own: the section a fit was measured on goes through its hole as it
+    is; any other layer is the convex hull of each body of the mesh between its levels, these
+    hulls exceeding the mesh by less than :data:`HULL_TOLERANCE` of its volume. A layer at
+    least :data:`executor.world.meshes.MIN_THICKNESS` tall whose pieces have no eroded form
+    (:func:`executor.world.meshes.eroded`: thinner than that across a face) whose section lies
+    within the thick pieces of the prism layer next to it (above first) is filled to that
+    layer's section (a switch's 0.5 mm spade terminals under its body, inside its outline:
+    the body's prism goes down to their ends, so the part's end, where the cell believes its
+    tip, is where it collides, and it passes wherever the body does; not a chamfer, thin only
+    along the axis); any other such piece is left out, up to
+    :data:`THIN_TOLERANCE` of the part's volume. Returns them, or why there are none."""
+    if not mesh.is_volume:
+        return f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections"
+    centre, size = mesh.bounds.mean(axis=0), 2 * mesh.extents
+    layers: list[tuple[list[shapely.Polygon], float, float, trimesh.Trimesh | None, float]] = []
+    differ = 0.0
+    for section, bottom, top in layers_of(mesh):
+        slab = trimesh.creation.box((size[0], size[1], top - bottom))
+        slab.apply_translation((centre[0], centre[1], (bottom + top) / 2))
+        inside = trimesh.boolean.intersection([mesh, slab], engine="manifold")
+        volume = float(inside.volume) if len(inside.faces) else 0.0
+        polygons = _filled(section)
+        common = 0.0
+        for polygon in polygons:
+            prism = trimesh.creation.extrude_polygon(polygon, top - bottom)
+            prism.apply_translation((0.0, 0.0, bottom))
+            both = trimesh.boolean.intersection([mesh, prism], engine="manifold")
+            common += float(both.volume) if len(both.faces) else 0.0
+        here = sum(polygon.area for polygon in polygons) * (top - bottom) + volume - 2 * common
+        flat = differ + here < PRISM_TOLERANCE * mesh.volume
+        differ += here if flat else 0.0
+        layers.append((polygons, bottom, top, None if flat else inside, volume))
+    def thick(layer: tuple[list[shapely.Polygon], float, float, trimesh.Trimesh | None, float]) -> list[bool]:
+        return [eroded(piece.vertices, URDF_HULL_MARGIN) is not None for piece in _layer_pieces(*layer[:4])]
+
+    def covers(layer: tuple[list[shapely.Polygon], float, float, trimesh.Trimesh | None, float],
+               outline: shapely.Geometry) -> bool:  # a prism layer's thick pieces cover the outline
+        parts = [part for polygon in layer[0] for part in convex_parts(polygon)]
+        kept = [part for part, ok in zip(parts, thick(layer)) if ok]
+        return layer[3] is None and shapely.union_all(kept).buffer(LEVEL).contains(outline)
+
+    filled = 0.0
+    k = 0
+    while k < len(layers):
+        polygons, bottom, top, inside, volume = layers[k]
+        outline = shapely.union_all(polygons)
+        tall = top - bottom >= MIN_THICKNESS  # thin across its section, not only along the axis (a chamfer)
+        into = next((j for j in (k + 1, k - 1) if 0 <= j < len(layers) and covers(layers[j], outline)),
+                    None) if tall and not any(thick(layers[k])) else None
+        if into is None:
+            k += 1
+            continue
+        other, low, high, _, more = layers[into]
+        filled += sum(polygon.area for polygon in other) * (top - bottom) - volume
+        layers[into] = (other, min(low, bottom), max(high, top), None, more + volume)
+        del layers[k]
+        k = min(k, into)
+    pieces: list[tuple[trimesh.Trimesh, float]] = []
+    excess = dropped = 0.0
+    for polygons, bottom, top, inside, volume in layers:
+        layer = _layer_pieces(polygons, bottom, top, inside)
+        excess += 0.0 if inside is None else sum(hull.volume for hull in layer) - volume
+        for piece in layer:
+            if eroded(piece.vertices, URDF_HULL_MARGIN) is None:
+                dropped += piece.volume
+            else:
+                pieces.append((piece, 0.0))
+    if excess >= HULL_TOLERANCE * mesh.volume:
+        return (f"part '{pid}': the convex hulls of its layers that are no prisms of their sections exceed its mesh "
+                f"by {excess / mesh.volume:.1%} of its volume (at most {HULL_TOLERANCE:.0%})")
+    if dropped >= THIN_TOLERANCE * mesh.volume or not pieces:
+        return (f"part '{pid}': the parts of its layers thinner than the cell's hull margin twice are "
+                f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
+    heights = ", ".join(f"{1e3 * (top - bottom):.3f}{'' if inside is None else ' (hulls)'}"
+                        for _, bottom, top, inside, _ in layers)
+    made = (f"{len(pieces)} convex piece(s) over its {len(layers)} layer(s) of {heights} mm, the prisms "
+            f"{differ / mesh.volume:.2%} of its volume apart from the mesh, the hulls {excess / mesh.volume:.2%} "
+            f"beyond it; its parts thinner than the cell's hull margin twice filled to the section next to them, "
+            f"{filled / mesh.volume:.2%} of its volume added, or left out, {dropped / mesh.volume:.2%}")
+    return Prisms(pieces, made, filled)

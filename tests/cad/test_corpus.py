@@ -23,7 +23,10 @@ from pathlib import Path
 from typing import Any
 
 import clingo
+import numpy as np
 import pytest
+import shapely
+import trimesh
 
 from assembly_constraints.corpus_truth import CorpusImport as Imported
 from assembly_constraints.corpus_truth import feature_holes as _feature_holes
@@ -36,10 +39,13 @@ from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad.cli import load_source
 from executor.cad.derive import derive
+from executor.cad.write import down_depth
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.trial import Cell
 from executor.world.geometry import load_geometry
+from executor.world.meshes import read_objects
+from executor.world.rings import section_at
 from tests.cad.conftest import CORPUS, learned_in_the_cell, teach
 from tests.conftest import Runner
 
@@ -276,9 +282,7 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
                                               "or onto a pin beside parts on it, resting on nothing (the outer "
                                               "holder around the plates)")),
     "nop_printed_box",
-    pytest.param("nop_rocker_switches", marks=_xfail(INSERTED + " into a slot with spade terminals thinner than "
-                                                     "the cell's hull margin twice (the switches', 0.5 mm: no "
-                                                     "convex pieces of theirs)")),
+    "nop_rocker_switches",
     pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
                                                  "cell has no screwing operation)")),
 ])
@@ -567,3 +571,25 @@ def test_each_switch_hanging_through_a_slot_of_the_case_top_is_found_in_that_slo
             for pid, part in truth["parts"].items()}
     assert set(found) == set(want), found
     assert all(math.dist(found[pid], want[pid]) < 1e-4 for pid in want), found
+    # Each hanging by its flange on its slot's entry: the cell's hole as deep as its switch
+    # goes in the CAD, its goal where the CAD has it (measured through the top: 2 and 42 mm).
+    tips = {fit.part: fit.entry - down_depth(derived, fit) for fit in derived.holes.values() if fit.part is not None}
+    assert all(abs(tips[pid] - float(derived.parts[pid].mesh.bounds[0][2])) < 1e-9 for pid in want), tips
+
+
+@pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["nop_rocker_switches"])
+def test_a_switch_collides_as_the_prism_of_the_section_its_fit_was_measured_on(
+        corpus_import: Callable[[str], Imported], name: str) -> None:
+    # Each switch's piece through its slot is its body's section as the mesh has it (the
+    # room the truth states, 0.0757 mm per side), down to the ends of its spade terminals
+    # (0.5 mm: thinner than the cell collides as, within the body's outline, filled to it),
+    # so the cell's belief of its tip is where it collides.
+    out = corpus_import(name).out
+    for pid in ("small_rocker", "neon_indicator"):
+        mesh = trimesh.load(out / "meshes" / f"{pid}.obj", force="mesh")
+        body = max(read_objects(out / "meshes" / f"{pid}.convex.obj"), key=lambda v: float(np.ptp(v[:, 2])))
+        assert float(body[:, 2].min()) == pytest.approx(float(mesh.bounds[0][2]), abs=1e-7)
+        measured = shapely.union_all(section_at(mesh, float(body[:, 2].max()) - 0.001))  # in the slot at its goal
+        footprint = shapely.MultiPoint(body[:, :2]).convex_hull
+        assert shapely.symmetric_difference(footprint, measured).area < 1e-4 * measured.area, pid

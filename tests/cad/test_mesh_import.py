@@ -195,10 +195,23 @@ def test_a_pieces_vertices_are_kept_on_the_face_planes_of_trimeshs_hull_of_them(
         _beyond(_planes(kept), np.asarray(piece.vertices))))), abs=0.0)
 
 
-def _finned_peg() -> trimesh.Trimesh:
-    """A 10 x 10 x 30 mm peg with a fin 0.5 mm thick, 8 wide and 6 high on its top [mm]:
+def _finned_peg(wide: float = 8.0, high: float = 6.0) -> trimesh.Trimesh:
+    """A 10 x 10 x 30 mm peg with a fin 0.5 mm thick, ``wide`` and ``high`` on its top [mm]:
     thinner than the cell's hull margin twice, so no convex pieces of it hold."""
-    return trimesh.boolean.union([_box((10, 10, 30), (0, 0, 10)), _box((0.5, 8, 6), (0, 0, 27.5))], engine="manifold")
+    return trimesh.boolean.union([_box((10, 10, 30), (0, 0, 10)), _box((0.5, wide, high), (0, 0, 24.5 + high / 2))],
+                                 engine="manifold")
+
+
+def test_a_peg_with_a_fin_too_thin_collides_as_the_prisms_of_its_sections(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Its sections are prisms: its body's piece is its 10 x 10 mm section, over its 30 mm
+    # and the fin's 5.5 above them (the fin, 0.5 mm thick, is within that section: filled
+    # to it), and CoACD is not run.
+    monkeypatch.setattr(convex, "_decomposed", lambda *_: pytest.fail("CoACD was run"))
+    found = fitting_pieces("peg", _finned_peg().apply_scale(1e-3), {}, prisms=True)
+    assert not isinstance(found, str), found
+    pieces, made = found
+    assert made.startswith("the prisms of its sections"), made
+    assert len(pieces) == 1 and pieces[0][0].extents == pytest.approx((0.01, 0.01, 0.0355), abs=1e-9)
 
 
 def test_a_part_whose_pieces_are_too_thin_is_sought_once_a_seed(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -218,7 +231,9 @@ def test_a_part_whose_pieces_are_too_thin_is_sought_once_a_seed(monkeypatch: pyt
 
 
 def test_a_part_without_pieces_is_placed_by_hand_and_the_rest_simulated(tmp_path: Path) -> None:
-    _plate(tmp_path / "cad", _finned_peg())
+    # The fin, 0.5 x 40 x 40 mm, reaches beyond the peg's section and is over a fifth of its
+    # volume: no prisms of its sections leave it out.
+    _plate(tmp_path / "cad", _finned_peg(40.0, 40.0))
     assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     geometry = load_geometry(str(tmp_path / "out"))  # written: the product is simulated
     assert "peg" not in geometry.parts
