@@ -154,7 +154,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
             hits = sweeper.blocked([(members, np.array(result.directions[name]), length) for members, name in again])
             for (members, name), hit in zip(again, hits):
                 result.blockers |= {(pid, name): hit for pid in members}
-            result.axis, result.stages = {}, []
+            result.stages = []
             remaining = disassembled(result)
     if remaining:
         stuck = "; ".join(f"{pid} along " + ", ".join(
@@ -163,7 +163,7 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
         raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
                             f"blocked: {stuck} (expected a straight way out for every part but the base)")
     result.reasons = forced(result)
-    result.reasons |= {(base, pid): "base" for pid in result.axis if sweeper.touching(base, pid)}
+    result.reasons |= {(base, pid): "base" for stage in result.stages for pid in stage if sweeper.touching(base, pid)}
     if reach > 0:
         result.located = locators(sweeper, result.bodies, reach)
     ways = {root: result.ways(root) for root in result.bodies}

@@ -34,17 +34,14 @@ that rule of :func:`_way_out` (a turn about z changes them by rounding alone).""
 
 def disassembled(result: Derived) -> set[str]:
     """Stage by stage, every part that some direction frees from the parts still in place
-    leaves along the one :func:`_way_out` chooses of them (``result``'s ``axis`` and ``stages``
-    filled in); the parts no stage frees."""
+    leaves (``result.stages`` filled in; which way each goes, :func:`ways_in` chooses once
+    the precedence is known); the parts no stage frees."""
     remaining = set(result.parts) - {result.base}
     while remaining:
         stage = sorted(pid for pid in remaining if any(
             not (result.blockers[(pid, d)] & (remaining | {result.base})) for d in result.directions))
         if not stage:
             break
-        for pid in stage:
-            result.axis[pid] = _way_out(result, pid, [d for d in result.directions if not (
-                result.blockers[(pid, d)] & (remaining | {result.base}))], remaining | {result.base})
         result.stages.append(stage)
         remaining -= set(stage)
     return remaining
@@ -109,8 +106,8 @@ def _way_out(result: Derived, pid: str, free: list[str], present: set[str]) -> s
 
 
 def ways_in(result: Derived) -> None:
-    """Each part's insertion axis judged as the cell meets the part (``result.axis`` set
-    anew): of the directions free of the parts present then, the one :func:`_way_out`
+    """Each part's insertion axis judged as the cell meets the part (``result.axis`` filled
+    in): of the directions free of the parts present then, the one :func:`_way_out`
     chooses. Present are the base, the parts still in place at the part's disassembly stage and
     the parts ``result.edges`` put before its body; absent, the parts they put after it (the
     parts it supports, those its ``blocks`` and ``locates`` pairs put later), in place at its
