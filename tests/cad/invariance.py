@@ -435,7 +435,7 @@ def _tied(mine: dict[str, Any], theirs: dict[str, Any]) -> set[str]:
     insertions sideways and not others (:data:`executor.cad.derive.PREFERRED`), and a
     product alike seen from either way goes by the order of the cell's axes
     (:data:`executor.cad.derive.LEAVING`); otherwise the product's geometry chooses, the
-    same however it is turned (:func:`executor.cad.derive._way_out`)."""
+    same however it is turned (:func:`executor.cad.derive.ways._way_out`)."""
     def leaves(axes: dict[str, Any], pid: str) -> set[str]:
         return set(axes[pid]["free"]) | {opposite(axes[pid]["insertion"])}
     return {pid for pid, axes in mine["axes"].items() if pid in theirs["axes"]

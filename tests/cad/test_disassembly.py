@@ -1,4 +1,4 @@
-"""The disassembly analysis of ``import`` (executor/cad/derive.py, sweep.py, fits/faces.py) on small
+"""The disassembly analysis of ``import`` (executor/cad/derive/, sweep.py, fits/faces.py) on small
 products of trimesh primitives: a horizontal shaft in a zero-clearance bearing comes out
 along its axis, and passes the overlap check however coarse the tessellation; a
 precedence pair only where every way in is blocked (a bar that slides out sideways under
@@ -24,9 +24,8 @@ import shapely
 import trimesh
 
 from executor import ExecutorError
-from executor.cad import derive as derive_module
 from executor.cad import sections, sweep
-from executor.cad.derive import derive
+from executor.cad.derive import derive, ways
 from executor.cad.fits.faces import TOUCH, CylinderFace, cylinder_faces, fit_faces, zero_clearance_fits
 from executor.cad.parts import CadPart, check_parts, load_meshes, overlaps_checked
 from executor.cad.sweep import FRONT, _is_convex
@@ -281,8 +280,8 @@ def test_the_pumps_glands_go_onto_the_shaft_whichever_end_the_shaft_goes_in_from
     # the base, chamfer 11.4 mm, which the cell refused): the glands and the impeller
     # going in after it along its axis were covers over it, on no pin, and every fit of
     # theirs was lost. It is in the bearing ring's bore, placed before it, either way.
-    chosen = derive_module._way_out
-    monkeypatch.setattr(derive_module, "_way_out", lambda result, pid, free, present: shaft_out if pid == "shaft"
+    chosen = ways._way_out
+    monkeypatch.setattr(ways, "_way_out", lambda result, pid, free, present: shaft_out if pid == "shaft"
                         else chosen(result, pid, free, present))
     derived = derive(load_meshes(CORPUS / "occt_pump" / "meshes", "mm"), "housing", {})
     assert derived.axis["shaft"] == shaft_out

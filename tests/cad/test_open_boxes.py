@@ -13,7 +13,8 @@ import shapely
 import trimesh
 
 from executor.cad.cli import run_import
-from executor.cad.derive import CAVITY_ROOM, _roomy
+from executor.cad.derive import CAVITY_ROOM
+from executor.cad.derive.cavities import roomy
 from executor.cad.sections import Loop, classify
 
 
@@ -119,7 +120,7 @@ def test_a_loop_on_one_line_is_a_polygon_of_no_width() -> None:
 
 
 def test_the_bound_that_skips_a_cavitys_rectangles_never_skips_a_cavity() -> None:
-    # _roomy bounds the hole's short side and the part's long side without their
+    # roomy bounds the hole's short side and the part's long side without their
     # minimum-area rectangles: wherever the rectangles leave more than CAVITY_ROOM across,
     # the bound says so; a shaft in its bore at zero clearance is skipped.
     rng = np.random.default_rng(3)
@@ -129,8 +130,8 @@ def test_the_bound_that_skips_a_cavitys_rectangles_never_skips_a_cavity() -> Non
                     @ np.array([[np.cos(a := rng.uniform(0, np.pi)), -np.sin(a)], [np.sin(a), np.cos(a)]]))
         part = Loop(np.array([[0, 0], [rng.uniform(0.002, 0.05), 0], [0, rng.uniform(0.002, 0.05)]]))
         if hole.extent[1] - part.extent[0] > CAVITY_ROOM:
-            assert _roomy(hole, part)
+            assert roomy(hole, part)
     shaft = Loop(np.c_[0.02 * np.cos(turn), 0.02 * np.sin(turn)])
-    assert not _roomy(Loop(shaft.points * 1.0001), shaft)
-    assert _roomy(Loop(np.array([[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]])),
+    assert not roomy(Loop(shaft.points * 1.0001), shaft)
+    assert roomy(Loop(np.array([[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]])),
                   Loop(np.array([[0, 0], [0.03, 0], [0.03, 0.03], [0, 0.03]])))

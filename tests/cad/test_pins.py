@@ -20,7 +20,8 @@ import trimesh
 
 from assembly_constraints.cli import main
 from executor import ExecutorError
-from executor.cad.derive import _GRID, _joined, derive
+from executor.cad.derive import derive
+from executor.cad.derive.bore_on_pin import _GRID, _joined
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
 from tests.cad.conftest import learned_in_the_cell, teach

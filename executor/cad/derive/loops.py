@@ -1,0 +1,110 @@
+"""The loops of parts' slices, as the finders of holes and pins read them: which are
+outlines (:func:`outer`), the levels a slice changes between (:func:`spans`), where one
+part has a hole around another (:func:`hole_around`) and where a part's bore holds
+another part's outline (:func:`bore_around`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+
+import numpy as np
+import shapely
+import trimesh
+
+from executor.cad.derive.cavities import open_box, roomy
+from executor.cad.fits.faces import TOUCH
+from executor.cad.parts import CadPart
+from executor.cad.sections import Loop, classify, frame_of, slice_loops
+
+SAME_HOLE = 1e-4  # hole centres closer than this [m] across the axis are one hole
+HOLE_LEVELS = 8
+"""How many levels :func:`hole_around` slices an owner at, and
+:func:`executor.cad.derive.bore_on_pin.pin_of` a part on a pin, at most, to find the hole
+or the pin."""
+
+
+def outer(loop: Loop, loops: list[Loop]) -> bool:
+    """Whether ``loop`` is an outline of its slice (inside an even number of the others)."""
+    return sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0
+
+
+def _in_loop(outline: Loop, hole: Loop) -> bool:
+    """Whether a part's ``outline`` lies in the ``hole`` loop of another part's slice: at
+    most the hole's sagitta (a round one's) plus :data:`executor.cad.fits.faces.TOUCH` beyond
+    it, as a shaft tessellated at a nominal zero-clearance fit is (its vertices on the
+    circle the bore's chords cut inside); a ring around a tube is not in the tube's bore."""
+    margin = classify(hole, hole=True).deflection + TOUCH
+    return bool(shapely.Polygon(hole.points).buffer(margin).covers(shapely.Polygon(outline.points)))
+
+
+def spans(levels: np.ndarray, low: float, high: float) -> list[float]:
+    """The middles [m] of the spans between the distinct ``levels`` [m] clipped to
+    [``low``, ``high``], longest first, spans of 1 µm or less left out: a slice changes only
+    at its mesh's vertex levels."""
+    bounds = np.unique(np.concatenate([[low, high], np.unique(np.round(np.clip(levels, low, high), 9))]))
+    spans = sorted(zip(bounds[:-1], bounds[1:], strict=True), key=lambda span: span[0] - span[1])
+    return [float(a + b) / 2 for a, b in spans if b - a > 1e-6]
+
+
+def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float, Loop, Loop | None, Loop] | None:
+    """Where ``owner`` has a hole around ``part`` across ``axis``: the level [m], the
+    hole's loop, the loop around it (None: none) and the part's loop in it; None when no
+    level tried has one. The levels tried are the middles of the spans between the owner's
+    vertices near the part's centre line (within twice the part's reach across it) along
+    the axis, where both reach, :data:`HOLE_LEVELS` longest first: an owner's slice changes
+    only at its vertices' levels."""
+    along, owner_along = part.mesh.vertices @ axis, owner.mesh.vertices @ axis
+    low, high = max(along.min(), owner_along.min()), min(along.max(), owner_along.max())
+    if high - low <= 1e-6:
+        return None
+    frame = frame_of(axis)
+    middle = slice_loops(part.mesh, axis, float(along.min() + along.max()) / 2)
+    outlines = [loop for loop in middle if outer(loop, middle)]
+    if len(outlines) != 1:
+        return None
+    line = outlines[0].centre
+    reach = 2 * float(np.linalg.norm(part.mesh.vertices @ frame.T - line, axis=1).max())
+    near = np.linalg.norm(owner.mesh.vertices @ frame.T - line, axis=1) <= reach
+    if not near.any():  # nothing of the owner around the part: no slice needed
+        return None
+    for level in spans(owner_along[near], low, high)[:HOLE_LEVELS]:
+        loops = slice_loops(owner.mesh, axis, level)
+        cut = slice_loops(part.mesh, axis, level)
+        own = [o for o in cut if outer(o, cut)]
+        for loop in (o for o in loops if not outer(o, loops)):
+            inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
+            if len(inside) == 1 and not (roomy(loop, inside[0]) and open_box(
+                    loop.extent[1], inside[0].extent[0], owner.mesh, frame.T @ loop.centre + axis * level, axis)):
+                around = sorted((o for o in loops if o is not loop and o.area > loop.area
+                                 and o.contains(loop.centre)), key=lambda o: o.area)
+                return level, loop, around[0] if around else None, inside[0]
+    return None
+
+
+def bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float,
+                taken: Iterable[np.ndarray] = ()) -> tuple[np.ndarray, float] | None:
+    """The centre (2,) [m] of the one outline of ``other`` that lies in an inner loop (a
+    bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`_in_loop`),
+    of the bores around none of the points ``taken`` (2,) [m], and how far [m] from it the
+    nearest outline of ``other`` in another inner loop of ``part`` lies (a plate's other
+    dowel pin: inf when there is none); None when no bore holds exactly one."""
+    own = slice_loops(part, axis, level)
+    bores = [o for o in own if not outer(o, own) and not any(o.contains(point) for point in taken)]
+    if not bores:
+        return None
+    across = other.vertices @ frame_of(axis).T
+    if not any(np.all((across >= bore.points.min(axis=0)) & (across <= bore.points.max(axis=0)), axis=1).any()
+               for bore in bores):
+        return None  # nothing of the other part in a bore's box across the axis, at any level: no slice needed
+    theirs = slice_loops(other, axis, level)
+    outlines = [o for o in theirs if outer(o, theirs)]
+    for bore in bores:
+        inside = [o for o in outlines if bore.contains(o.centre) and _in_loop(o, bore)]
+        if len(inside) == 1:
+            centre = inside[0].centre
+            apart = [float(np.linalg.norm(o.points - centre, axis=1).min()) for o in outlines
+                     if o is not inside[0] and any(h is not bore and h.contains(o.centre) for h in own
+                                                   if not outer(h, own))]
+            return centre, min(apart, default=math.inf)
+    return None
