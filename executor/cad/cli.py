@@ -133,11 +133,12 @@ def drawn_up(derived: Derived) -> str | None:
     edge (:data:`STANDING` times as tall as it is thick along that axis) or the other
     parts are set on one face of it along that axis (:func:`_one_face`). Drawn upside down
     (z down): more than half of those holes and pins open along z and the other parts are
-    set on the base's bottom face (:func:`_one_face` along -z), or every one along z is
-    left downwards and the other parts stand out of the base's box above it by at most
-    :data:`ONE_SIDED` of what they do below it. The way up it suggests is the one the other
-    parts stand out of the base's box farther along, else the way they leave its holes and
-    pins (both where neither tells)."""
+    set on the base's bottom face (:func:`_one_face` along -z), or the other parts stand
+    out of the base's box above it by at most :data:`ONE_SIDED` of what they do below it
+    and every hole and pin along z is left downwards, or they do stand out below it and
+    more of them leave the product downwards than upwards (their removal directions). The
+    way up it suggests is the one the other parts stand out of the base's box farther
+    along, else the way they leave its holes and pins (both where neither tells)."""
     low, high = derived.parts[derived.base].mesh.bounds
     extents = high - low
     removals = [fit.axis for fit in derived.holes.values()]
@@ -160,8 +161,14 @@ def drawn_up(derived: Derived) -> str | None:
         face = _one_face(out, k, leave, float(extents[k]))
         if name == "z":
             above, below = (float(v) for v in out[2])
-            if (face is None or face[0] != ["-"]) and leave == ["-"] and above <= ONE_SIDED * below:
-                face = ["-"], f", all of them left along -z and the other parts at most {_mm(above)} mm above it"
+            ways = list(derived.axis.values())
+            down, up = ways.count("-z"), ways.count("+z")
+            if (face is None or face[0] != ["-"]) and above <= ONE_SIDED * below:
+                if leave == ["-"]:
+                    face = ["-"], f", all of them left along -z and the other parts at most {_mm(above)} mm above it"
+                elif down > up and below > 0:
+                    face = ["-"], (f", {down} of the other parts left along -z ({up} along +z) and standing out of "
+                                   f"it {_mm(below)} mm below it, {_mm(above)} mm above it")
             if face is None or face[0] != ["-"]:
                 continue
             return (f"the base {derived.base} is {_mm(float(extents[2]))} mm tall{features}{face[1]}: the CAD "

@@ -248,7 +248,7 @@ def _upside_down(folder: Path, below: float) -> Path:
 @pytest.mark.parametrize(("below", "why"), [
     (30.0, "the other parts standing out of it along -z (30.000 mm; at most 0.000 mm the other way and 0.000 mm "
            "across)"),
-    (0.0, "all of them left along -z and the other parts within 0.000 mm of its box"),  # the peg flush with its bottom
+    (0.0, "all of them left along -z and the other parts within 0.000 mm of its box"),  # flush with its bottom
 ])
 def test_a_product_drawn_upside_down_is_refused_and_imported_with_up_minus_z(tmp_path: Path, below: float,
                                                                              why: str) -> None:
@@ -262,6 +262,20 @@ def test_a_product_drawn_upside_down_is_refused_and_imported_with_up_minus_z(tmp
     turned = run_import(cad, tmp_path / "turned", "mm", None, ImportOptions(up="-z"))
     assert {fit.axis for fit in turned.derived.holes.values()} == {"+z"}
     assert turned.derived.hole_of["peg"].depth == pytest.approx(0.02, abs=1e-9)
+    assert turned.derived.axis["peg"] == "+z"
+
+
+@pytest.mark.slow  # an import of a seven-part product with a spline shaft
+def test_a_product_drawn_upside_down_with_its_parts_beyond_the_base_across_is_refused(tmp_path: Path) -> None:
+    # flynn_clutch z down: its plates 5.5 mm beyond the holder across, 0.6 mm under it; its seven bolt
+    # holes, empty, are left upwards, but four of its five other parts leave it downwards
+    meshes = _drawn("flynn_clutch", "-z", tmp_path / "drawn")
+    with pytest.raises(ExecutorError) as refused:
+        run_import(meshes, tmp_path / "read_z_up", "mm", CORPUS / "flynn_clutch" / "import.toml")
+    assert ("the base inner_holder is 9.300 mm tall and 9 of its 9 holes and pins open along z, 4 of the other parts "
+            "left along -z (1 along +z) and standing out of it 0.600 mm below it, 0.000 mm above it: the CAD may be "
+            'drawn upside down (z down); set up = "-z" or --up=-z') in str(refused.value), str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
 
 
 def test_a_part_hanging_beyond_the_base_across_is_still_set_on_one_face(tmp_path: Path) -> None:
