@@ -96,7 +96,10 @@ fraction of that way's, and lie within its box when they stand out of it by at m
 fraction of its thickness (:func:`drawn_up`): parts set on one face of the base."""
 TILT = 1.0
 """The base's largest flat faces are tilted when their normal lies more than this [deg]
-from the z axis and from the horizontal plane (:func:`drawn_up`): no quarter turn sets them square."""
+from the z axis and from the horizontal plane (:func:`drawn_tilted`): no quarter turn sets them square."""
+TILTED_SHARE = 0.15
+"""...and they make at least this fraction of its surface (:func:`drawn_tilted`): not one
+strip of a coarsely tessellated rod (a 24-gon's pair of opposite facets: 8 %)."""
 _UP_EXPECTED = f"one of {', '.join(UP_AXES)} (the CAD's axis pointing up)"
 
 
@@ -215,14 +218,15 @@ def drawn_tilted(mesh: trimesh.Trimesh, base: str) -> str | None:
     """Why the product whose base ``base`` has ``mesh`` looks drawn tilted, None when it
     does not: the normal that the largest area of the base's faces shares (its largest flat
     faces, normals alike to 0.001, a face and its opposite as one: the normal taken with z
-    >= 0) lies more than :data:`TILT` from the z axis and from the horizontal plane."""
+    >= 0) lies more than :data:`TILT` from the z axis and from the horizontal plane, and
+    they make :data:`TILTED_SHARE` of its surface or more."""
     normals = mesh.face_normals * np.where(mesh.face_normals[:, 2:] < 0, -1.0, 1.0)  # a face's plane: z >= 0
     keys, index = np.unique(np.round(normals, 3) + 0.0, axis=0, return_inverse=True)
     areas = np.bincount(index.ravel(), mesh.area_faces)
     largest = int(np.argmax(areas))
     normal = keys[largest] / np.linalg.norm(keys[largest])
     from_z = math.degrees(math.acos(min(1.0, float(normal[2]))))
-    if min(from_z, 90.0 - from_z) <= TILT:
+    if min(from_z, 90.0 - from_z) <= TILT or areas[largest] < TILTED_SHARE * mesh.area:
         return None
     facing = ", ".join(f"{v:.3f}" for v in normal + 0.0)
     return (f"the base {base}'s largest flat faces ({100 * areas[largest] / mesh.area:.0f} % of its surface) face "
