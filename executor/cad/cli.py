@@ -122,7 +122,8 @@ def _up_setting(path: Path | None, value: object) -> str | None:
 def _up_assumption(up: str | None) -> str:
     """What ``import`` prints about the up axis: the turn of the ``up`` set, or the default."""
     if up is None:
-        return "the CAD's +z is up (set up = \"+y\" or --up +y for a CAD drawn y up)"
+        return ("the CAD's +z is up (set up = \"+y\" or --up +y for a CAD drawn y up, up = \"-z\" or --up=-z "
+                "for one drawn upside down)")
     return f"the CAD's {up} is up (up): every part turned {turn_text(up)}, before it is placed"
 
 
