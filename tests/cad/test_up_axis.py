@@ -1,8 +1,9 @@
 """``import``'s up axis: a product drawn with another axis than z up (``up = "+y"``,
 ``--up``) is turned by an exact signed permutation right after reading, so it gives the
 same assembly facts as drawn z up; without ``up`` a product whose base lies on its side
-with its holes opening sideways (standing on its edge, or the other parts set on one face)
-is refused, naming the setting."""
+with its holes opening sideways (standing on its edge, or the other parts set on one face),
+is upside down (the other parts set on its bottom face, or left downwards), or is tilted
+by another angle than quarter turns, is refused, naming the setting."""
 
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ CORPUS = Path(__file__).parent / "corpus"
 DRAWN: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "+y": lambda v: np.column_stack([v[:, 0], v[:, 2], -v[:, 1]]),  # the cell's +z is the CAD's +y
     "-x": lambda v: np.column_stack([-v[:, 2], v[:, 1], v[:, 0]]),  # the cell's +z is the CAD's -x
+    "-z": lambda v: np.column_stack([v[:, 0], -v[:, 1], -v[:, 2]]),  # upside down: the cell's +z is the CAD's -z
 }
 """A z-up product's coordinates (n, 3) as drawn with another axis up: exact (permuted, negated)."""
 FACTS = ("sizes.lp", "geometric_precedence.lp", "nominal_sizes.lp")
@@ -94,6 +96,11 @@ def _same_import(first: Imported, second: Imported, one: Path, other: Path) -> N
                                "or --up +y"]),
     ("factory_rect_pegs", "-x", ["the base hole_block is thinnest along x", "4 of its 4 holes and pins open along x",
                                  'along -x: the CAD may be drawn x up; set up = "-x" or --up=-x']),
+    # upside down: the pegs hang 41 mm under the block through its holes
+    ("factory_rect_pegs", "-z", ["the base hole_block is 8.992 mm tall and 4 of its 4 holes and pins open along z, "
+                                 "the other parts standing out of it along -z (41.008 mm; at most 0.000 mm the other "
+                                 'way and 0.000 mm across): the CAD may be drawn upside down (z down); set up = "-z" '
+                                 "or --up=-z"]),
 ])
 def test_a_product_drawn_with_another_axis_up_gives_the_same_facts(tmp_path: Path, product: str, up: str,
                                                                    words: list[str]) -> None:
@@ -196,8 +203,8 @@ def test_a_base_lying_on_its_side_with_the_parts_set_on_one_face_is_refused(tmp_
     with pytest.raises(ExecutorError) as refused:
         run_import(cad, tmp_path / "read_z_up", "mm", None)
     assert ("the base block is thinnest along y (50.000 mm, 60.000 mm tall) and 1 of its 1 holes and pins open "
-            "along y, the other parts standing out of it along +y only (50.000 mm; at most 0.000 mm along every "
-            'other way): the CAD may be drawn y up; set up = "+y" or --up +y') in str(refused.value)
+            "along y, the other parts standing out of it along +y (50.000 mm; at most 0.000 mm the other way and "
+            '0.000 mm across): the CAD may be drawn y up; set up = "+y" or --up +y') in str(refused.value)
     assert not (tmp_path / "read_z_up").exists()
     turned = run_import(cad, tmp_path / "turned", "mm", None, ImportOptions(up="+y"))
     assert {fit.axis for fit in turned.derived.holes.values()} == {"+z"}
@@ -221,3 +228,121 @@ def test_a_base_lying_on_its_side_with_the_parts_within_its_box_is_refused(tmp_p
                        "[+-]y and the other parts within 0.000 mm of its box: the CAD may be drawn y up"):
         run_import(cad, tmp_path / "read_z_up", "mm", None)
     assert not (tmp_path / "read_z_up").exists()
+
+
+def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
+    return trimesh.creation.box(extents, trimesh.transformations.translation_matrix(centre))
+
+
+def _upside_down(folder: Path, below: float) -> Path:
+    """A 60 x 60 x 30 mm block with a 29 mm square hole 20 mm deep into its bottom and a
+    28.3 mm square peg up in it, standing ``below`` [mm] out of the block's bottom, as STL
+    in ``folder``: a product drawn z down (its parts go up into the base from below)."""
+    folder.mkdir()
+    _box((60.0, 60.0, 30.0), (0.0, 0.0, 15.0)).difference(_box((29.0, 29.0, 40.0), (0.0, 0.0, 0.0))).export(
+        folder / "block.stl")
+    _box((28.3, 28.3, 20.0 + below), (0.0, 0.0, (20.0 - below) / 2)).export(folder / "peg.stl")
+    return folder
+
+
+@pytest.mark.parametrize(("below", "why"), [
+    (30.0, "the other parts standing out of it along -z (30.000 mm; at most 0.000 mm the other way and 0.000 mm "
+           "across)"),
+    (0.0, "all of them left along -z and the other parts within 0.000 mm of its box"),  # flush with its bottom
+])
+def test_a_product_drawn_upside_down_is_refused_and_imported_with_up_minus_z(tmp_path: Path, below: float,
+                                                                             why: str) -> None:
+    cad = _upside_down(tmp_path / "cad", below)
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", None)
+    assert (f"the base block is 30.000 mm tall and 1 of its 1 holes and pins open along z, {why}: the CAD may be "
+            'drawn upside down (z down); set up = "-z" or --up=-z (up = "+z" or --up +z if z is up)') \
+        in str(refused.value), str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
+    turned = run_import(cad, tmp_path / "turned", "mm", None, ImportOptions(up="-z"))
+    assert {fit.axis for fit in turned.derived.holes.values()} == {"+z"}
+    assert turned.derived.hole_of["peg"].depth == pytest.approx(0.02, abs=1e-9)
+    assert turned.derived.axis["peg"] == "+z"
+
+
+@pytest.mark.slow  # an import of a seven-part product with a spline shaft
+def test_a_product_drawn_upside_down_with_its_parts_beyond_the_base_across_is_refused(tmp_path: Path) -> None:
+    # flynn_clutch z down: its plates 5.5 mm beyond the holder across, 0.6 mm under it; its seven bolt
+    # holes, empty, are left upwards, but four of its five other parts leave it downwards
+    meshes = _drawn("flynn_clutch", "-z", tmp_path / "drawn")
+    with pytest.raises(ExecutorError) as refused:
+        run_import(meshes, tmp_path / "read_z_up", "mm", CORPUS / "flynn_clutch" / "import.toml")
+    assert ("the base inner_holder is 9.300 mm tall and 9 of its 9 holes and pins open along z, 4 of the other parts "
+            "left along -z (1 along +z) and standing out of it 0.600 mm below it, 0.000 mm above it: the CAD may be "
+            'drawn upside down (z down); set up = "-z" or --up=-z') in str(refused.value), str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
+
+
+def test_a_part_hanging_beyond_the_base_across_is_still_set_on_one_face(tmp_path: Path) -> None:
+    # drawn y up: the peg's flange (100 x 30 x 80 mm) on the block's top face, 20 mm beyond it along x
+    # and 10 mm along z: across, less far than it stands out along +y (30 mm)
+    cad = _block_and_peg(tmp_path / "cad", 0.0, 50.0)
+    trimesh.boolean.union([trimesh.load(cad / "peg.stl"), _box((100.0, 30.0, 80.0), (0.0, 65.0, 0.0))],
+                          engine="manifold").export(cad / "peg.stl")
+    (tmp_path / "import.toml").write_text('base = "block"\n')
+    with pytest.raises(ExecutorError, match=r"1 of its 1 holes and pins open along y, the other parts standing out "
+                       r"of it along \+y \(30.000 mm; at most 0.000 mm the other way and 20.000 mm across\): the CAD "
+                       r'may be drawn y up; set up = "\+y" or --up \+y'):
+        run_import(cad, tmp_path / "read_z_up", "mm", tmp_path / "import.toml")
+    turned = run_import(cad, tmp_path / "turned", "mm", tmp_path / "import.toml", ImportOptions(up="+y"))
+    assert {fit.axis for fit in turned.derived.holes.values()} == {"+z"}
+
+
+def test_a_base_with_no_holes_or_pins_is_judged_by_the_products(tmp_path: Path) -> None:
+    # drawn y up: a plate (2.5 times as tall as thick read z up), a bracket on it, a peg in the bracket's blind hole
+    cad = tmp_path / "cad"
+    cad.mkdir()
+    _box((100.0, 20.0, 50.0), (0.0, 10.0, 0.0)).export(cad / "plate.stl")
+    _box((40.0, 40.0, 40.0), (0.0, 40.0, 0.0)).difference(_box((20.5, 30.0, 20.5), (0.0, 50.0, 0.0))).export(
+        cad / "bracket.stl")
+    _box((20.0, 45.0, 20.0), (0.0, 57.5, 0.0)).export(cad / "peg.stl")
+    with pytest.raises(ExecutorError, match=r"the base plate is thinnest along y \(20.000 mm, 50.000 mm tall\), has "
+                       r"no holes or pins, and 1 of the product's 1 holes and pins open along y, the other parts "
+                       r"standing out of it along \+y .*: the CAD may be drawn y up; set up = \"\+y\""):
+        run_import(cad, tmp_path / "read_z_up", "mm", None)
+    turned = run_import(cad, tmp_path / "turned", "mm", None, ImportOptions(up="+y"))
+    assert {(fit.axis, fit.owner) for fit in turned.derived.part_holes.values()} == {("+z", "bracket")}
+
+
+def _tilted(source: Path, folder: Path, degrees: float, about: tuple[float, float, float]) -> Path:
+    """The meshes of ``source`` turned by ``degrees`` about the axis ``about`` (through the
+    origin), written into ``folder``."""
+    folder.mkdir()
+    turn = trimesh.transformations.rotation_matrix(np.radians(degrees), about)
+    for path in sorted(source.iterdir()):
+        trimesh.load(path, force="mesh", process=False).apply_transform(turn).export(folder / path.name)
+    return folder
+
+
+@pytest.mark.parametrize(("degrees", "about", "facing"), [
+    (30.0, (1.0, 0.0, 0.0), "(0.000, -0.500, 0.866), 30.0 deg"),
+    (-12.5, (1.0, 1.0, 0.0), "(-0.153, 0.153, 0.976), 12.5 deg"),
+    (60.0, (0.0, 1.0, 0.0), "(0.866, 0.000, 0.500), 60.0 deg"),
+])
+def test_a_product_tilted_by_another_angle_than_quarter_turns_is_refused_before_deriving(
+        tmp_path: Path, degrees: float, about: tuple[float, float, float], facing: str) -> None:
+    cad = _tilted(CORPUS / "factory_rect_pegs" / "meshes", tmp_path / "cad", degrees, about)
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", CORPUS / "factory_rect_pegs" / "import.toml")
+    assert (f"cad: the base hole_block's largest flat faces (55 % of its surface) face {facing} from the z axis: the "
+            "CAD may be drawn tilted; turn it in the CAD so that one of its axes points up (up turns by quarter turns "
+            'only), or set up = "+z" or --up +z to import it as drawn') in str(refused.value), str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
+
+
+def test_a_product_turned_about_z_is_not_taken_for_tilted(tmp_path: Path) -> None:
+    # a wall 20 mm thick, 80 mm tall, with a square peg down its top, yawed by 30 deg: its largest
+    # faces, its sides, face the horizontal plane
+    (tmp_path / "wall").mkdir()
+    _box((20.0, 60.0, 80.0), (0.0, 0.0, 40.0)).difference(_box((10.5, 10.5, 40.0), (0.0, 0.0, 80.0))).export(
+        tmp_path / "wall" / "wall.stl")
+    _box((10.0, 10.0, 40.0), (0.0, 0.0, 80.0)).export(tmp_path / "wall" / "peg.stl")
+    cad = _tilted(tmp_path / "wall", tmp_path / "cad", 30.0, (0.0, 0.0, 1.0))
+    imported = run_import(cad, tmp_path / "out", "mm", None)
+    assert {fit.axis for fit in imported.derived.holes.values()} == {"+z"}
+    assert imported.assumed[0].startswith("the CAD's +z is up (set up")
