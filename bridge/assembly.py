@@ -124,9 +124,10 @@ class Assembly:
     """Where the cell's fixture holds the base's centre [m] (``base_center`` of ``[plate]`` in
     ``geometry.toml``), None without a ``geometry.toml``."""
     nominal_modelled: bool = False
-    """Whether the simulated cell builds those fits with
+    """Whether the simulated cell builds those fits in holes with
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
-    it cannot resolve them and they are no experiment."""
+    it cannot resolve them and they are no experiment. Those on pins it always builds so
+    (the part's bore widened)."""
 
     def tried_by_hand(self, part: str, hole: str, backend: str) -> bool:
         """Whether no cell of ``backend`` (``sim``, ``truth``, ``franka`` or a plugin's
@@ -139,7 +140,7 @@ class Assembly:
         tell from a fit (:attr:`near_misses`)."""
         return (part in self.manual or self.cell_cannot_insert(part, hole)
                 or (backend in NEAR_MISS_BACKENDS and (part, hole) in self.near_misses)
-                or ((part, hole) in self.nominal_fits and not self.nominal_modelled))
+                or ((part, hole) in self.nominal_fits and not (self.nominal_modelled or hole in self.pins)))
 
     def cell_cannot_insert(self, part: str, hole: str) -> bool:
         """Whether the simulated cell refuses to put ``part`` into ``hole`` even were the

@@ -8,9 +8,14 @@ fit is a sliding fit in practice, so the simulated cell builds it with
 :data:`NOMINAL_FIT_ROOM` per side where it builds the hole itself from its section (a base
 of ``[plate]`` primitives: the hole is widened by that room all round, and the cell's loader
 refuses the product when that changes the answer of any other pair). Where the hole is
-part of the base's own mesh (a ``[base]`` with ``mesh``: holes entered sideways, pins) the
+part of the base's own mesh (a ``[base]`` with ``mesh``: holes entered sideways) the
 cell cannot widen it: those pairs are no experiment, the planner takes them from the CAD
-(``sizes.lp``), not observed. Both sides read the rule here, so they agree on which pairs
+(``sizes.lp``), not observed. On a pin (always in the base's own mesh) it widens the part
+instead: a part with a bore that a pin states such a fit with has its bore wider by
+:data:`NOMINAL_FIT_ROOM` per side (its ``[part_shapes.*]`` section as the cell reads it, and
+the convex pieces the import writes for it: regular polygons about its round bore's inscribed
+circle grown by that room), and the cell's loader refuses the product when that changes the
+part's answer on any other pin. Both sides read the rule here, so they agree on which pairs
 the cell tries (docs/decisions.md, "Nominal zero-clearance fits in the simulated cell").
 """
 

@@ -28,6 +28,7 @@ import shapely
 import trimesh
 from scipy.spatial.transform import Rotation
 
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.cad.convex import (
     NEAR,
@@ -478,7 +479,7 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return _onto_pins(derived, on, pid)
     if (why := _stack_refused(derived, pin, pid)) is not None:
         return why
-    if why := _unresolved(margins(derived)[pid][pin.id]):
+    if why := _bore_unresolved(derived, pid, pin.id):
         return f"goes onto a pin ({pin.id}) {why}"
     if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
                                                "a horizontal pin")):
@@ -510,9 +511,10 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
             return (f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts a part onto several pins only "
                     "as the first on each")
     rooms = margins(derived)[pid]
-    if tight := sorted(pin.id for pin in on if _unresolved(rooms[pin.id])):  # all named: no pin first by its id
-        least = min(rooms[pin_id] for pin_id in tight)
-        return f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) {_unresolved(least)}"
+    if tight := sorted(pin.id for pin in on if _bore_unresolved(derived, pid, pin.id)):  # all named: no pin first
+        least = min(tight, key=lambda pin_id: (rooms[pin_id], pin_id))
+        return (f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) "
+                f"{_bore_unresolved(derived, pid, least)}")
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
@@ -637,13 +639,45 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     solid.apply_transform(bore_frame(derived, pid) @ feature_turn(pin).T)
     bores = 1 + sum(part == pid for part, _ in derived.further_bores)  # one per pin it is on
 
+    widen = NOMINAL_FIT_ROOM if widens_bore(derived, pid) else 0.0
+
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
-        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores)
-        if not isinstance(found, NoStack) or bores > 1:  # CoACD's pieces are checked about one pin
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores, widen)
+        if not isinstance(found, NoStack) or bores > 1 or widen:  # CoACD's pieces: about one pin, not widened
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
     return pieces
+
+
+def widens_bore(derived: Derived, pid: str) -> bool:
+    """Whether the cell widens part ``pid``'s bores by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side: it has a nominal zero-clearance
+    fit on a pin (:func:`nominal_fits`), and its bores and every pin are round
+    (:func:`round_pins`: its pieces' bores are regular polygons about their inscribed
+    circles, grown by that room, :func:`executor.world.rings.round_bores`)."""
+    nominal = nominal_fits(derived)
+    return any((pid, pin_id) in nominal for pin_id in derived.pins) and round_pins(derived, pid)
+
+
+def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
+    """Why the cell cannot tell part ``pid``'s room on pin ``pin_id`` from its sign (:func:`_unresolved`; ""
+    where it can): a nominal zero-clearance fit it widens (:func:`widens_bore`) it can, unless
+    that room would turn the part's no-fit on another pin into a fit or a room it cannot
+    tell (a negative room within twice :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` and
+    :data:`executor.world.SIZE_RESOLUTION` of 0)."""
+    rooms = margins(derived)[pid]
+    why = _unresolved(rooms[pin_id])
+    if not why or (pid, pin_id) not in nominal_fits(derived):
+        return why
+    if not widens_bore(derived, pid):
+        return f"{why}; a zero-clearance fit the cell widens only for a round bore, every pin round"
+    nominal = nominal_fits(derived)
+    if turned := sorted(other for other in derived.pins if (pid, other) not in nominal
+                        and -2 * (NOMINAL_FIT_ROOM + SIZE_RESOLUTION) < rooms[other] <= 0):
+        return (f"{why}; widened by the {1e3 * NOMINAL_FIT_ROOM:g} mm per side the cell gives a zero-clearance fit, "
+                f"its bore would pass pin {turned[0]} ({rooms[turned[0]] * 500:+.4f} mm per side), which it does not")
+    return ""
 
 
 BORE_LOSS = 0.25

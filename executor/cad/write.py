@@ -63,6 +63,7 @@ from bridge.files import make_folder, os_reason, write_atomic
 from bridge.inputs import read_text, shorten
 from bridge.product import Mesh
 from bridge.product.checks import overlapping_bosses
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
@@ -97,6 +98,7 @@ from executor.cad.operations import (
     tool_length,
     tool_of,
     upright,
+    widens_bore,
 )
 from executor.cad.parts import turn_text
 from executor.cad.sections import Shape2D, section, slice_loops
@@ -273,6 +275,19 @@ def nominal_assumption(derived: Derived) -> list[str]:
     nominal = nominal_fits(derived)
     return [f"nominal zero-clearance fits: {RULE.format(um='µm')} ({len(nominal)} pairs, vertex circles up to "
             f"{1e6 * max(map(abs, nominal.values())):.1f} µm apart)"] if nominal else []
+
+
+def widened_bores_assumption(cell: Derived) -> list[str]:
+    """What the simulated cell assumes of the nominal zero-clearance fits on pins of the
+    product as it inserts it (``cell``: :func:`executor.cad.operations.cell_view`), as
+    ``import`` prints it: it builds each with the part's round bore wider
+    (:func:`executor.cad.operations.widens_bore`); none without one."""
+    pairs = sorted((pid, pin_id) for pid, pin_id in nominal_fits(cell)
+                   if pin_id in cell.pins and pid in cell.bores and widens_bore(cell, pid))
+    return [f"nominal zero-clearance fits on pins: the simulated cell builds each with the part's bore "
+            f"{1e3 * NOMINAL_FIT_ROOM:g} mm wider per side (its pieces' bores regular polygons about the bore's "
+            f"inscribed circle grown by that), so they are observed in that model, not at room 0: "
+            + " ".join(f"{pid}->{pin_id}" for pid, pin_id in pairs)] if pairs else []
 
 
 def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:

@@ -293,13 +293,18 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             )
     if models_nominal_fits(geo):
         holes = {hid: _with_nominal_room(hole, parts) for hid, hole in holes.items()}
+    parts = {pid: _with_nominal_bore(part, holes) for pid, part in parts.items()}
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
 
-def widened(hole: HoleSpec, room: float) -> HoleSpec:
-    """``hole`` with ``room`` [m] more all round: a round, square or rect section ``2 room``
-    wider on each side's extent (a corner radius grown by ``room``, a sharp corner kept
-    sharp), a polygon's outline offset outwards by ``room`` (mitred corners)."""
+_Widened = TypeVar("_Widened", bound=Section)
+
+
+def widened(hole: _Widened, room: float) -> _Widened:
+    """``hole`` (a hole's section, a part's bore) with ``room`` [m] more all round: a round,
+    square or rect section ``2 room`` wider on each side's extent (a corner radius grown by
+    ``room``, a sharp corner kept sharp), a polygon's outline offset outwards by ``room``
+    (mitred corners)."""
     if hole.kind == "polygon":
         grown = shapely.Polygon(hole.outline).buffer(room, join_style="mitre")
         outline = tuple((float(x), float(y)) for x, y in np.asarray(grown.exterior.coords)[:-1])
@@ -326,6 +331,25 @@ def _with_nominal_room(hole: HoleSpec, parts: dict[str, PartSpec]) -> HoleSpec:
                 f"part '{pid}' ({margin(part, hole) * 500:+.4f} mm per side) would then "
                 f"{'fit' if feature_passes(part, built) else 'not fit'}: expected every other pair's answer "
                 "unchanged (docs/cell.md#nominal-zero-clearance-fits)")
+    return built
+
+
+def _with_nominal_bore(part: PartSpec, holes: dict[str, HoleSpec]) -> PartSpec:
+    """The part as the simulated cell builds it: a part with a bore that a pin states a
+    nominal zero-clearance fit with (``zero_clearance``) has its bore :func:`widened` by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its pieces are made so:
+    :func:`executor.world.rings.round_bores`); ExecutorError naming the first pin on which
+    that room would change its answer (:func:`feature_passes`)."""
+    if not part.bore or not any(part.id in hole.zero_clearance for hole in holes.values() if hole.pin):
+        return part
+    built = widened(part, NOMINAL_FIT_ROOM)
+    for hid, hole in sorted(holes.items()):
+        if hole.pin and feature_passes(part, hole) != feature_passes(built, hole):
+            raise ExecutorError(
+                f"part '{part.id}': the simulated cell builds its nominal zero-clearance fits on pins with its bore "
+                f"{NOMINAL_FIT_ROOM * 1e3:g} mm wider per side, and on pin '{hid}' ({margin(hole, part) * 500:+.4f} mm "
+                f"per side) it would then {'fit' if feature_passes(built, hole) else 'not fit'}: expected every "
+                "other pair's answer unchanged (docs/cell.md#nominal-zero-clearance-fits)")
     return built
 
 
