@@ -675,8 +675,8 @@ def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
     nominal = nominal_fits(derived)
     if turned := sorted(other for other in derived.pins if (pid, other) not in nominal
                         and -2 * (NOMINAL_FIT_ROOM + SIZE_RESOLUTION) < rooms[other] <= 0):
-        return (f"{why}; widened by the {1e3 * NOMINAL_FIT_ROOM:g} mm per side the cell gives a zero-clearance fit, "
-                f"its bore would pass pin {turned[0]} ({rooms[turned[0]] * 500:+.4f} mm per side), which it does not")
+        return f"{why}; its bore {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side would pass pin {turned[0]} " \
+               f"({rooms[turned[0]] * 500:+.4f} mm)"
     return ""
 
 

@@ -7,7 +7,9 @@ gear's 2 mm teeth)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import re
 import tomllib
 from pathlib import Path
 
@@ -23,6 +25,7 @@ from executor import ExecutorError
 from executor.cad.derive import _GRID, _joined, derive
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
+from executor.world.geometry import HoleSpec, PartSpec, _with_nominal_bore
 from tests.cad.conftest import learned_in_the_cell, teach
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
@@ -334,3 +337,34 @@ def test_a_plate_over_both_pins_is_learned_on_each_and_put_onto_its_first(run_ma
     assert {tuple(pair) for pair in result["fits"]} == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
     assert result["assembly"]["assembled"] and [(s["part"], s["hole"]) for s in result["assembly"]["steps"]] == [
         ("plate", None), ("cover", first)], result["assembly"]["steps"]
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_a_zero_clearance_bore_the_widening_would_pass_over_another_pin_is_placed_by_hand(tmp_path: Path) -> None:
+    # The washer's d 10 bore on the d 10 pin: a nominal zero-clearance fit, which the cell
+    # builds with the bore 0.15 mm per side wider; a d 10.1 pin beside it (a collar with a
+    # d 10.5 bore on it) the washer does not pass (-0.05 mm per side), and would, widened:
+    # so the washer is placed by hand, naming that pin; the collar is the cell's.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.0, X_MM - 25)
+    collar = _with_bore(shapely.Point(0.0, 0.0).buffer(9.0, quad_segs=32), 10.5, X_MM)
+    out = _import(tmp_path, {"washer": washer, "collar": collar}, (_pin(5.05, X_MM),))
+    holes = tomllib.loads((out / "assembly.toml").read_text())["holes"]
+    beside = next(hid for hid, hole in holes.items() if round(1000 * hole["position"][0]) == X_MM)
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    assert set(geometry["manual"]) == {"washer"}, geometry["manual"]
+    reason = geometry["manual"]["washer"]["reason"]
+    assert re.fullmatch(r"goes onto a pin \(plate_pin1\) with \+0\.0000 mm of room per side, less than the "
+                        r"0\.025 mm the simulated cell resolves; its bore 0\.15 mm wider per side would pass pin "
+                        f"{beside} " r"\(-0\.05[0-9]{2} mm\)", reason), reason
+
+
+def test_the_cell_reads_a_zero_clearance_bore_widened_and_refuses_one_that_would_then_pass_another_pin() -> None:
+    washer = PartSpec("washer", "round", 0.010, shape="washer", length=0.004, mass=0.01, start=(0.3, 0.3),
+                      demo_hole="p1", bore=True)
+    pin = HoleSpec("p1", "round", 0.010, (0.5, 0.0), top_z=0.04, depth=0.03, pin=True, zero_clearance=("washer",))
+    other = HoleSpec("p2", "round", 0.0105, (0.55, 0.0), top_z=0.04, depth=0.03, pin=True)
+    assert _with_nominal_bore(washer, {"p1": pin, "p2": other}).size == pytest.approx(0.0103)
+    assert _with_nominal_bore(washer, {"p2": other}) == washer  # no zero-clearance fit stated: as read
+    tight = dataclasses.replace(other, size=0.0101)  # -0.05 mm per side; +0.1 widened
+    with pytest.raises(ExecutorError, match="on pin 'p2' \\(-0.0500 mm per side\\) it would then fit"):
+        _with_nominal_bore(washer, {"p1": pin, "p2": tight})
