@@ -650,13 +650,14 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     return pieces
 
 
-def widens_bore(derived: Derived, pid: str) -> bool:
+def widens_bore(derived: Derived, pid: str, nominal: Mapping[tuple[str, str], float] | None = None) -> bool:
     """Whether the cell widens part ``pid``'s bores by
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side: it has a nominal zero-clearance
     fit on a pin (:func:`nominal_fits`), and its bores and every pin are round
     (:func:`round_pins`: its pieces' bores are regular polygons about their inscribed
-    circles, grown by that room, :func:`executor.world.rings.round_bores`)."""
-    nominal = nominal_fits(derived)
+    circles, grown by that room, :func:`executor.world.rings.round_bores`); ``nominal``: the
+    product's :func:`nominal_fits`, where known."""
+    nominal = nominal_fits(derived) if nominal is None else nominal
     return any((pid, pin_id) in nominal for pin_id in derived.pins) and round_pins(derived, pid)
 
 
@@ -668,11 +669,10 @@ def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
     :data:`executor.world.SIZE_RESOLUTION` of 0)."""
     rooms = margins(derived)[pid]
     why = _unresolved(rooms[pin_id])
-    if not why or (pid, pin_id) not in nominal_fits(derived):
+    if not why or (pid, pin_id) not in (nominal := nominal_fits(derived)):
         return why
-    if not widens_bore(derived, pid):
+    if not widens_bore(derived, pid, nominal):
         return f"{why}; a zero-clearance fit the cell widens only for a round bore, every pin round"
-    nominal = nominal_fits(derived)
     if turned := sorted(other for other in derived.pins if (pid, other) not in nominal
                         and -2 * (NOMINAL_FIT_ROOM + SIZE_RESOLUTION) < rooms[other] <= 0):
         return f"{why}; its bore {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side would pass pin {turned[0]} " \
