@@ -663,14 +663,19 @@ def widens_bore(derived: Derived, pid: str, nominal: Mapping[tuple[str, str], fl
 
 def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
     """Why the cell cannot tell part ``pid``'s room on pin ``pin_id`` from its sign (:func:`_unresolved`; ""
-    where it can): a nominal zero-clearance fit it widens (:func:`widens_bore`) it can, unless
-    that room would turn the part's no-fit on another pin into a fit or a room it cannot
-    tell (a negative room within twice :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` and
-    :data:`executor.world.SIZE_RESOLUTION` of 0)."""
-    rooms = margins(derived)[pid]
+    where it can). A part with a nominal zero-clearance fit on any pin the cell tries at
+    the room it builds such a fit with, its bore widened (:func:`widens_bore`): it does not
+    where it cannot widen that bore, or where that room would turn the part's no-fit on
+    another pin into a fit or a room it cannot tell (a negative room within twice
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` and :data:`executor.world.SIZE_RESOLUTION`
+    of 0)."""
+    rooms, nominal = margins(derived)[pid], nominal_fits(derived)
     why = _unresolved(rooms[pin_id])
-    if not why or (pid, pin_id) not in (nominal := nominal_fits(derived)):
+    if why and (pid, pin_id) not in nominal:
         return why
+    if not (stated := sorted(other for other in derived.pins if (pid, other) in nominal)):
+        return why
+    why = why or f"with its bore a nominal zero-clearance fit on pin {stated[0]}"
     if not widens_bore(derived, pid, nominal):
         return f"{why}; a zero-clearance fit the cell widens only for a round bore, every pin round"
     if turned := sorted(other for other in derived.pins if (pid, other) not in nominal

@@ -368,3 +368,22 @@ def test_the_cell_reads_a_zero_clearance_bore_widened_and_refuses_one_that_would
     tight = dataclasses.replace(other, size=0.0101)  # -0.05 mm per side; +0.1 widened
     with pytest.raises(ExecutorError, match="on pin 'p2' \\(-0.0500 mm per side\\) it would then fit"):
         _with_nominal_bore(washer, {"p1": pin, "p2": tight})
+
+
+@pytest.mark.slow  # the import: about 4 s
+def test_a_part_with_a_zero_clearance_fit_on_another_pin_the_cell_cannot_widen_is_placed_by_hand(
+        tmp_path: Path) -> None:
+    # The washer's d 10.5 bore has room on its own d 10 pin and is a nominal zero-clearance
+    # fit on a d 10.5 pin beside it, which the cell would try at the room it gives such a
+    # fit, its bore widened; with a square pin in the product (a square nut on it) it widens
+    # no bore, so the washer is placed by hand rather than tried there at room 0.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM - 25)
+    nut = trimesh.creation.extrude_polygon(shapely.box(-8.0, -8.0, 8.0, 8.0).difference(shapely.box(-3.3, -3.3, 3.3,
+                                                                                                       3.3)), 4.0)
+    nut.apply_translation((X_MM, 18.0, 10.0))
+    out = _import(tmp_path, {"washer": washer, "nut": nut}, (_pin(5.25, X_MM), _box((6, 6, 30), (X_MM, 18, 25))))
+    manual = tomllib.loads((out / "geometry.toml").read_text()).get("manual", {})
+    assert set(manual) == {"washer"}, manual
+    assert re.fullmatch(r"goes onto a pin \(plate_pin\d\) with its bore a nominal zero-clearance fit on pin "
+                        r"plate_pin\d; a zero-clearance fit the cell widens only for a round bore, every pin round",
+                        manual["washer"]["reason"]), manual["washer"]["reason"]
