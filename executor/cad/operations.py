@@ -7,7 +7,8 @@ and, for every other moving part, the reason it is placed by hand (``[manual.<id
 the rules it applies: the reach measured along horizontal axes (:data:`SIDEWAYS_PIN_REACH`,
 :data:`SIDEWAYS_HOLE_REACH`), the arm's wrist clear of the product (:data:`WRIST_RADIUS`,
 :data:`WRIST_CLEARANCE`, :func:`tool_length`), parts stacked on a pin
-(:data:`STACK_TOLERANCE`), a bore's room the cell resolves (:data:`BORE_LOSS`), a polygon
+(:data:`STACK_TOLERANCE`), a bore's room the cell resolves (:data:`BORE_LOSS`), a round
+bore's nominal zero-clearance fit on a pin it widens (:func:`widens_bore`), a polygon
 peg's prism. Also the figures both this and the product's files need: each peg's room in
 each hole and each bore's on each pin (:func:`margins`, nominal zero-clearance fits:
 :func:`nominal_fits`), the frames of holes, pins and bores, the plate's level

@@ -29,7 +29,9 @@ in it, so the cell's bore is smaller by a ``loss`` (the largest distance of the 
 it), never larger; the finest that works within the ``allowed`` loss is taken and the
 loss reported. A round bore of a part that goes onto round pins only is made a regular
 polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_parts`): a
-round pin passes it exactly when it passes the bore.
+round pin passes it exactly when it passes the bore; for a nominal zero-clearance fit, about
+that circle grown by the room the cell gives such a fit (``widen``), so a round pin passes
+it as it passes the bore widened by that room.
 """
 
 from __future__ import annotations
