@@ -77,6 +77,7 @@ from executor.cad.write import (
     mesh_pieces,
     near_miss_assumption,
     nominal_assumption,
+    widened_assumption,
     write_folder,
 )
 
@@ -509,6 +510,7 @@ def _derived(parts: list[CadPart], out: Path, config: tuple[Path | None, dict, s
         assumed += overlap_assumption(derived)
         mapped, laid, cell = map_product(derived, settings)
     assumed += [mapped.tool] if mapped.tool else []
+    assumed += widened_assumption(cell)
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "

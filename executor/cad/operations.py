@@ -28,6 +28,7 @@ import shapely
 import trimesh
 from scipy.spatial.transform import Rotation
 
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.cad.convex import (
     NEAR,
@@ -478,7 +479,7 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return _onto_pins(derived, on, pid)
     if (why := _stack_refused(derived, pin, pid)) is not None:
         return why
-    if why := _unresolved(margins(derived)[pid][pin.id]):
+    if why := _bore_unresolved(derived, pid, pin.id):
         return f"goes onto a pin ({pin.id}) {why}"
     if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
                                                "a horizontal pin")):
@@ -510,9 +511,10 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
             return (f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts a part onto several pins only "
                     "as the first on each")
     rooms = margins(derived)[pid]
-    if tight := sorted(pin.id for pin in on if _unresolved(rooms[pin.id])):  # all named: no pin first by its id
-        least = min(rooms[pin_id] for pin_id in tight)
-        return f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) {_unresolved(least)}"
+    if tight := sorted(pin.id for pin in on if _bore_unresolved(derived, pid, pin.id)):  # all named: no pin first
+        least = min(tight, key=lambda pin_id: (rooms[pin_id], pin_id))
+        return (f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) "
+                f"{_bore_unresolved(derived, pid, least)}")
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
@@ -636,14 +638,49 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     solid.apply_translation((0.0, 0.0, low - NEAR))  # the pin in its frame, turned into the part frame
     solid.apply_transform(bore_frame(derived, pid) @ feature_turn(pin).T)
     bores = 1 + sum(part == pid for part, _ in derived.further_bores)  # one per pin it is on
+    widen = NOMINAL_FIT_ROOM if widens_bore(derived, pid) else 0.0
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
-        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores)
-        if not isinstance(found, NoStack) or bores > 1:  # CoACD's pieces are checked about one pin
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores, widen)
+        if not isinstance(found, NoStack) or bores > 1 or widen:  # CoACD's pieces: about one pin, not widened
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
     return pieces
+
+
+def widens_bore(derived: Derived, pid: str) -> bool:
+    """Whether the cell widens part ``pid``'s bores by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side: on some pin it has room the
+    CAD makes a fit but the cell does not resolve (a positive room in :func:`margins` under
+    :func:`_unresolved`'s: Factory's gears' 0.012 mm per side on their shafts), it goes onto
+    one pin (the cell's view of a part on several keeps its first pin only), and its bore
+    and every pin are round (:func:`round_pins`: its pieces' bore is a regular polygon
+    about its inscribed circle, grown by that room, :func:`executor.world.rings.round_bores`).
+    The fit's answer is the CAD's; the cell observes it with that room, not the CAD's."""
+    rooms = margins(derived).get(pid, {})
+    return (round_pins(derived, pid) and not any(part == pid for part, _ in derived.further_bores)
+            and any(room > 0 and _unresolved(room) for hid, room in rooms.items() if hid in derived.pins))
+
+
+def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
+    """Why the cell cannot tell part ``pid``'s room on pin ``pin_id`` from its sign
+    (:func:`_unresolved`; "" where it can): a fit it widens (:func:`widens_bore`) it can,
+    unless that room would turn the part's no-fit on another pin into a fit or into a room
+    it does not resolve (a negative room of at most twice
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` plus what it resolves)."""
+    rooms = margins(derived)[pid]
+    why = _unresolved(rooms[pin_id])
+    if not why or rooms[pin_id] <= 0:
+        return why
+    if not widens_bore(derived, pid):
+        return f"{why}; the cell widens such a fit only for a part on one pin, its bore and every pin round"
+    reach = 2 * (NOMINAL_FIT_ROOM + SIZE_RESOLUTION)
+    if turned := sorted(other for other in derived.pins if other in rooms and -reach < rooms[other] < 0):
+        return (f"{why}; widened by the {1e3 * NOMINAL_FIT_ROOM:g} mm per side the cell gives a fit it does not "
+                f"resolve, its bore would pass pin {turned[0]} ({rooms[turned[0]] * 500:+.4f} mm per side), "
+                "which it does not")
+    return ""
 
 
 BORE_LOSS = 0.25

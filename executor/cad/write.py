@@ -63,6 +63,7 @@ from bridge.files import make_folder, os_reason, write_atomic
 from bridge.inputs import read_text, shorten
 from bridge.product import Mesh
 from bridge.product.checks import overlapping_bosses
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
@@ -97,12 +98,14 @@ from executor.cad.operations import (
     tool_length,
     tool_of,
     upright,
+    widens_bore,
 )
 from executor.cad.parts import turn_text
 from executor.cad.sections import Shape2D, section, slice_loops
 from executor.cad.sections import rounded as _q
 from executor.cad.sweep import DIRECTIONS, opposite
 from executor.control.detector import Thresholds
+from executor.world import SIZE_RESOLUTION
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, plate_obj_text
 from executor.world.meshes import read_objects
 from executor.world.near_miss import mesh_near_miss, near_miss
@@ -370,6 +373,28 @@ def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
         return inward
     size = max(inward.a + 2 * inward.deflection, *widths)
     return replace(inward, a=size, b=size, deflection=0.0)
+
+
+def widened_bore(derived: Derived, pid: str, bore: Shape2D) -> Shape2D:
+    """Part ``pid``'s ``bore`` section as the cell builds it: grown by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side where the cell widens it
+    (:func:`executor.cad.operations.widens_bore`, as its pieces' bores are), else as given."""
+    if not widens_bore(derived, pid):
+        return bore
+    grown = bore.a + 2 * NOMINAL_FIT_ROOM
+    return replace(bore, a=grown, b=grown)
+
+
+def widened_assumption(cell: Derived) -> list[str]:
+    """The assumption of the bores the cell widens (:func:`widened_bore`) of the parts it puts
+    onto pins (``cell``: :func:`executor.cad.operations.cell_view`), as ``import`` prints it
+    (none without one)."""
+    widened = sorted(pid for pid in cell.bores if widens_bore(cell, pid))
+    if not widened:
+        return []
+    return [f"the bores of {', '.join(widened)} widened by {1e3 * NOMINAL_FIT_ROOM:g} mm per side in the simulated "
+            f"cell: their room on a pin is a fit the CAD gives, less than the {1e3 * SIZE_RESOLUTION:g} mm per side "
+            "the cell resolves; the cell observes those fits with its room, not the CAD's"]
 
 
 def nominal_text(derived: Derived) -> str:
@@ -705,7 +730,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         onto = [pins[0] for pin_id, pins in pairs[pid].items() if pid in nominal.get(pin_id, [])]
         length = float(np.ptp(along_axis(mesh, pin)[:, 2]))
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true",
-                  *_section_lines(nominal_section(bore, onto)),
+                  *_section_lines(widened_bore(derived, pid, nominal_section(bore, onto))),
                   f"length = {_q(length)}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{pin.id}"', *([f"pins_of = {json.dumps(further[pid])}"] if pid in further else []),
                   _mesh_entry(meshes[pid]), ""]

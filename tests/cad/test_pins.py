@@ -136,6 +136,24 @@ def test_an_empty_pin_of_the_base_is_a_feature_when_a_bore_passes_over_it(tmp_pa
     assert set(tomllib.loads((out / "geometry.toml").read_text())["hole_shapes"]) == {"plate_pin1"}
 
 
+@pytest.mark.slow  # the import: about 3 s
+def test_a_round_bore_with_less_room_than_the_cell_resolves_is_widened_for_it(tmp_path: Path) -> None:
+    # A d 10.03 bore (a 128-gon, inradius 5.0135 mm) on the d 10 pin (a 64-gon of vertex
+    # radius 5): 0.0135 mm of room per side, a fit the cell does not resolve. The cell puts
+    # the washer onto it with its bore widened by 0.15 mm per side (its pieces and its
+    # section), as it fits the 8 mm pin too: no answer changes.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.03, X_MM - 25)
+    out = _import(tmp_path, {"washer": washer})
+    rooms = {(p, h): int(m) for p, h, m in _atoms(out / "nominal_sizes.lp", "nominal_margin")}
+    assert 0 < rooms[("washer", "plate_pin1")] < 50  # [um] diametral: under 0.025 mm per side
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    assert "manual" not in geometry
+    pin, bore = geometry["hole_shapes"]["plate_pin1"]["size"], geometry["part_shapes"]["washer"]["size"]
+    assert bore - pin == pytest.approx(1e-6 * rooms[("washer", "plate_pin1")] + 3e-4, abs=2e-6)
+    assert "about its inscribed circle grown by 0.15 mm" in \
+        (out / "meshes" / "washer.convex.obj").read_text().splitlines()[2]
+
+
 @pytest.mark.slow
 def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_main: Runner, washer_and_gear: Path,
                                                                tmp_path: Path) -> None:
