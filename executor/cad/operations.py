@@ -674,12 +674,11 @@ def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
     if not why or rooms[pin_id] <= 0:
         return why
     if not widens_bore(derived, pid):
-        return f"{why}; the cell widens such a fit only for a part on one pin, its bore and every pin round"
+        return f"{why}; the cell widens it only for a part on one pin, its bore and pins round"
     reach = 2 * (NOMINAL_FIT_ROOM + SIZE_RESOLUTION)
     if turned := sorted(other for other in derived.pins if other in rooms and -reach < rooms[other] < 0):
-        return (f"{why}; widened by the {1e3 * NOMINAL_FIT_ROOM:g} mm per side the cell gives a fit it does not "
-                f"resolve, its bore would pass pin {turned[0]} ({rooms[turned[0]] * 500:+.4f} mm per side), "
-                "which it does not")
+        return (f"{why}; widened {1e3 * NOMINAL_FIT_ROOM:g} mm per side it would pass pin {turned[0]} "
+                f"({rooms[turned[0]] * 500:+.4f} mm per side)")
     return ""
 
 

@@ -8,6 +8,7 @@ gear's 2 mm teeth)."""
 from __future__ import annotations
 
 import json
+import re
 import tomllib
 from pathlib import Path
 
@@ -23,7 +24,7 @@ from executor import ExecutorError
 from executor.cad.derive import _GRID, _joined, derive
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
-from tests.cad.conftest import learned_in_the_cell, teach
+from tests.cad.conftest import learned_in_the_cell, manual_reasons, teach
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -152,6 +153,18 @@ def test_a_round_bore_with_less_room_than_the_cell_resolves_is_widened_for_it(tm
     assert bore - pin == pytest.approx(1e-6 * rooms[("washer", "plate_pin1")] + 3e-4, abs=2e-6)
     assert "about its inscribed circle grown by 0.15 mm" in \
         (out / "meshes" / "washer.convex.obj").read_text().splitlines()[2]
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_a_bore_widened_would_pass_a_pin_it_does_not_so_it_is_placed_by_hand(tmp_path: Path) -> None:
+    # The same d 10.03 bore, and a d 10.1 pin (a ring with a d 10.5 bore on it) that it does
+    # not pass by 0.037 mm per side: widened by 0.15 mm it would, so the cell does not widen it.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.03, X_MM - 25)
+    ring = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM)
+    reason = manual_reasons(_import(tmp_path, {"washer": washer, "ring": ring}, (_pin(5.05, X_MM),)))["washer"]
+    assert re.fullmatch(r"goes onto a pin \(plate_pin1\) with \+0\.01\d\d mm of room per side, less than the 0\.025 mm "
+                        r"the simulated cell resolves; widened 0\.15 mm per side it would pass pin plate_pin2 "
+                        r"\(-0\.03\d\d mm per side\)", reason)
 
 
 @pytest.mark.slow

@@ -103,8 +103,8 @@ def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_b
                                      "stacks the parts on a pin end to end (within 0.1 mm)")
     tight = manual_reasons(_import(tmp_path / "tight", washer_bore=8.02))
     assert tight["washer"] == ("goes onto a pin (plate_pin1) with +0.0100 mm of room per side, less than the 0.025 mm "
-                               "the simulated cell resolves; the cell widens such a fit only for a part on one pin, "
-                               "its bore and every pin round")
+                               "the simulated cell resolves; the cell widens it only for a part on one pin, its bore "
+                               "and pins round")
     assert tight["nut"] == "goes onto a pin (plate_pin1) on top of 'washer', which the cell does not put onto it"
 
 
