@@ -731,6 +731,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         length = float(np.ptp(along_axis(mesh, pin)[:, 2]))
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', "bore = true",
                   *_section_lines(widened_bore(derived, pid, nominal_section(bore, onto))),
+                  *([f"# the bore {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side than the CAD's: its room on a pin "
+                     "is a fit the cell does not resolve"] if widens_bore(derived, pid) else []),
                   f"length = {_q(length)}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{pin.id}"', *([f"pins_of = {json.dumps(further[pid])}"] if pid in further else []),
                   _mesh_entry(meshes[pid]), ""]
