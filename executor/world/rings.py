@@ -29,9 +29,9 @@ in it, so the cell's bore is smaller by a ``loss`` (the largest distance of the 
 it), never larger; the finest that works within the ``allowed`` loss is taken and the
 loss reported. A round bore of a part that goes onto round pins only is made a regular
 polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_parts`): a
-round pin passes it exactly when it passes the bore; for a nominal zero-clearance fit, about
-that circle grown by the room the cell gives such a fit (``widen``), so a round pin passes
-it as it passes the bore widened by that room.
+round pin passes it exactly when it passes the bore; for a fit whose room the cell does not
+resolve, about that circle grown by the room the cell gives such a fit (``widen``), so a
+round pin passes it as it passes the bore widened by that room.
 """
 
 from __future__ import annotations
@@ -139,7 +139,7 @@ def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pin
     a piece at a bore too thin for the cell even with the bore made coarser by at most
     ``allowed`` [m] (:func:`coarser_bores`, one bore only), or, when it goes onto
     ``round_pins`` only, circumscribing each bore's inscribed circle grown by ``widen`` [m]
-    (:func:`round_bores`: the cell's room of a nominal zero-clearance fit; 0 elsewhere)."""
+    (:func:`round_bores`: the cell's room of a fit it does not resolve; 0 elsewhere)."""
     assert round_pins or not widen  # a bore is widened about its inscribed circle only
     key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.float64(widen).tobytes()
                          + bytes([round_pins, bores]) + np.ascontiguousarray(mesh.vertices).tobytes()
@@ -322,8 +322,8 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
             return (f"part '{pid}': the parts of its sections thinner than the cell's hull margin twice are "
                     f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
         corners = "/".join(map(str, sorted({len(ring.coords) - 1 for c in candidates for ring in c[k][0].interiors})))
-        grown = (f" grown by {1e3 * widen:g} mm (a nominal zero-clearance fit: round pins pass it as they pass the "
-                 "mesh's widened by that per side)" if widen else "")
+        grown = (f" grown by {1e3 * widen:g} mm (a fit whose room the cell does not resolve: round pins pass it as "
+                 "they pass the mesh's widened by that per side)" if widen else "")
         bore = (f"the bore a regular {corners}-gon about its inscribed circle" + (grown or " (round pins pass it as "
                 "they pass the mesh's)") if round_pins and bores == 1 else
                 f"each of its {bores} bores a regular {corners}-gon about its inscribed circle" + (grown or
