@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from asp.session.cells import ROOT, STOP_S
+from asp.session.settings import fit_text
 from asp.solve import atoms_by_name, load_atoms
 from assembly_constraints.corpus_truth import (
     CorpusImport,
@@ -77,7 +78,8 @@ class Learned:
     each compared pair was learned (``sources``): ``observed`` (an experiment in physics),
     ``entailed`` (by the size model from other answers), ``CAD`` (taken from ``sizes.lp``:
     no cell can try it) or ``demonstrated``; the pairs observed with the room the sim cell
-    gives a nominal zero-clearance fit (``widened``), not at the CAD's room 0."""
+    gives a fit whose room it does not resolve (``widened``, the CAD's room per side where
+    above 0), not at the CAD's room."""
 
     fits: FitCount
     experiments: int
@@ -241,7 +243,8 @@ def _learned(done: CorpusImport, holes: dict[str, str], result: dict, atoms: lis
     sources = {pair: "observed" if pair in tried else "CAD" if pair in stated else
                "demonstrated" if pair in shown else "entailed" for pair in count.pairs}
     nominal = result.get("nominal_fits") or {}
-    return Learned(count, result["experiments"], sources, [f"{p}->{h}" for p, h in nominal.get("pairs", [])])
+    return Learned(count, result["experiments"], sources,
+                   [fit_text(nominal.get("cad_room_m", {}), p, h) for p, h in nominal.get("pairs", [])])
 
 
 def bench_product(folder: Path, out: Path, truth_only: bool, seed: int, timeout: float) -> Row:
@@ -312,7 +315,8 @@ def _details(row: Row) -> list[str]:
     lines = [] if row.failed is None else [f"failed at {row.failed.step}: {row.failed.error}"]
     lines += [f"WRONG {w}" for w in row.wrong] + row.short_of_exact
     if row.sim is not None and row.sim.widened:
-        lines.append(f"observed with the sim cell's room, not at the CAD's room 0: {' '.join(row.sim.widened)}")
+        lines.append(f"observed with the sim cell's room, not at the CAD's room (0 unless given): "
+                     f"{' '.join(row.sim.widened)}")
     if row.assembly is not None:
         placed = row.assembly.placed
         lines.append("final pose error: " + ", ".join(

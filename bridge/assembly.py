@@ -42,7 +42,7 @@ from bridge.product import (
     part_kinds,
     section_label,
 )
-from bridge.product.nominal import models_nominal_fits, stated_nominal_fits
+from bridge.product.nominal import models_nominal_fits, stated_nominal_fits, widened_bores
 
 __all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "NEAR_MISS_BACKENDS", "SHAPES", "SIZE_MODELS", "Assembly",
            "Hole", "Item", "Part", "is_id", "load_assembly", "resolve_assembly_folder"]
@@ -124,9 +124,14 @@ class Assembly:
     """Where the cell's fixture holds the base's centre [m] (``base_center`` of ``[plate]`` in
     ``geometry.toml``), None without a ``geometry.toml``."""
     nominal_modelled: bool = False
-    """Whether the simulated cell builds those fits with
+    """Whether the simulated cell builds those fits in holes with
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
-    it cannot resolve them and they are no experiment."""
+    it cannot resolve them and they are no experiment. Those on pins it builds so where it
+    widens the part's bore (:attr:`widened`)."""
+    widened: dict[tuple[str, str], float] = field(default_factory=dict)
+    """The (part, pin) pairs whose room the simulated cell does not resolve, room 0 or
+    positive, built with the part's round bore wider by that room per side (``widened`` of a
+    pin: :func:`bridge.product.nominal.widened_bores`): pair -> the CAD's room per side [m]."""
 
     def tried_by_hand(self, part: str, hole: str, backend: str) -> bool:
         """Whether no cell of ``backend`` (``sim``, ``truth``, ``franka`` or a plugin's
@@ -139,7 +144,8 @@ class Assembly:
         tell from a fit (:attr:`near_misses`)."""
         return (part in self.manual or self.cell_cannot_insert(part, hole)
                 or (backend in NEAR_MISS_BACKENDS and (part, hole) in self.near_misses)
-                or ((part, hole) in self.nominal_fits and not self.nominal_modelled))
+                or ((part, hole) in self.nominal_fits
+                    and not ((self.nominal_modelled and hole not in self.pins) or (part, hole) in self.widened)))
 
     def cell_cannot_insert(self, part: str, hole: str) -> bool:
         """Whether the simulated cell refuses to put ``part`` into ``hole`` even were the
@@ -225,7 +231,8 @@ def assembly_of(product: ProductDescription) -> Assembly:
                         for pid in shape.near_miss or ()),
                     base_center=None if geometry is None else (geometry.plate.base_center[0],
                                                                geometry.plate.base_center[1]),
-                    nominal_modelled=geometry is not None and models_nominal_fits(geometry))
+                    nominal_modelled=geometry is not None and models_nominal_fits(geometry),
+                    widened={} if geometry is None else widened_bores(geometry))
 
 
 def load_assembly(name_or_path: str) -> Assembly:

@@ -23,6 +23,7 @@ from asp.session.settings import (
     MAX_WAIT_S,
     PRECEDENCE_MODES,
     SessionSettings,
+    fit_text,
     prior_statement,
     read_session_file,
 )
@@ -150,8 +151,8 @@ def _explored_lines(explored: dict | UnsetType) -> list[str]:
 
 def _stated_lines(result: dict) -> list[str]:
     """The summary's lines on what was not observed as the CAD states it: the pairs taken
-    from ``sizes.lp`` (no cell can try them), the nominal zero-clearance fits the sim cell
-    built with room."""
+    from ``sizes.lp`` (no cell can try them), the fits with room under what the sim cell
+    resolves that it built with room."""
     lines = []
     if result["not_observed"]:
         fits = [f"{p}->{h}" for p, h, outcome in result["not_observed"] if outcome == "fit"]
@@ -159,8 +160,10 @@ def _stated_lines(result: dict) -> list[str]:
                      f"pairs, {len(fits)} fit" + (f": {' '.join(fits)}" if fits else ""))
     nominal = result["nominal_fits"]
     if nominal:
-        lines.append(f"observed with {nominal['room_m'] * 1e3:.3f} mm of room per side, not at the CAD's room 0 "
-                     f"(nominal zero-clearance fits): {' '.join(f'{p}->{h}' for p, h in nominal['pairs'])}")
+        rooms = nominal.get("cad_room_m", {})
+        lines.append(f"observed with {nominal['room_m'] * 1e3:.3f} mm of room per side, not at the CAD's room "
+                     "(under what the sim cell resolves; room 0 unless given): "
+                     + " ".join(fit_text(rooms, p, h) for p, h in nominal["pairs"]))
     return lines
 
 

@@ -67,6 +67,7 @@ from asp.session.settings import (
     SessionFile,
     SessionSettings,
     checked,
+    fit_text,
     new_session_file,
     prior_statement,
     product_digest,
@@ -207,21 +208,27 @@ def _near_miss_statement(assembly: Assembly, backend: str, by_hand: list[tuple[P
 
 
 def _nominal_fits(assembly: Assembly, backend: str, parts: list[str], holes: list[str]) -> NominalFits | None:
-    """The nominal zero-clearance fits the simulated cell (``backend`` sim) tries with the
-    room it builds them with (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`); None with
-    another backend or without such a pair among ``parts`` x ``holes``."""
-    pairs = sorted(pair for pair in assembly.nominal_fits
+    """The fits with room under what the simulated cell (``backend`` sim) resolves that it
+    tries with the room it builds them with (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`):
+    the nominal zero-clearance fits and the bores on pins it widens
+    (:attr:`bridge.assembly.Assembly.widened`, with their CAD room); None with another
+    backend or without such a pair among ``parts`` x ``holes``."""
+    pairs = sorted(pair for pair in assembly.nominal_fits | set(assembly.widened)
                    if pair[0] in parts and pair[1] in holes and not assembly.tried_by_hand(*pair, backend))
-    return NominalFits(room_m=NOMINAL_FIT_ROOM, pairs=pairs) if backend == "sim" and pairs else None
+    rooms = {f"{p}->{h}": assembly.widened[p, h] for p, h in pairs
+             if (p, h) in assembly.widened and (p, h) not in assembly.nominal_fits}
+    return NominalFits(room_m=NOMINAL_FIT_ROOM, pairs=pairs, cad_room_m=rooms) if backend == "sim" and pairs else None
 
 
 def _nominal_statement(nominal: NominalFits) -> str:
-    """The line a run prints (and ``learned.lp`` keeps) for the nominal zero-clearance fits
-    its simulated cell builds with room."""
-    shown = " ".join(f"{part}->{hole}" for part, hole in nominal.pairs[:8]) + (" ..." if len(nominal.pairs) > 8 else "")
-    return (f"{len(nominal.pairs)} nominal zero-clearance fits stated by the CAD at room 0 ({shown}) are built in "
-            f"the simulated cell with {nominal.room_m * 1e3:.3f} mm of room per side (room 0 is below what its physics "
-            "resolves): their outcomes are observed in that model, not at room 0")
+    """The line a run prints (and ``learned.lp`` keeps) for the fits its simulated cell
+    builds with room (:func:`_nominal_fits`)."""
+    shown = " ".join(fit_text(nominal.cad_room_m, part, hole) for part, hole in nominal.pairs[:8]) + (
+        " ..." if len(nominal.pairs) > 8 else "")
+    return (f"{len(nominal.pairs)} fits stated by the CAD with room under what the simulated cell's physics resolves "
+            f"({shown}; room 0 unless given) are built in that cell with {nominal.room_m * 1e3:.3f} mm of room per "
+            "side: their outcomes are observed in that model, not at the CAD's room")
+
 
 
 def _endpoints(settings: SessionSettings) -> tuple[list[str], list[str]]:

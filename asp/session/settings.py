@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -155,12 +156,23 @@ class DecidedPrior(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fie
 
 
 class NominalFits(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """The nominal zero-clearance fits (room 0 in the CAD) a sim session's cell tries, built
-    with ``room_m`` [m] per side (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`): the
-    ``pairs`` [part, hole] whose outcomes are observed in that model, not at room 0."""
+    """The fits whose room in the CAD is under what a sim session's cell resolves (nominal
+    zero-clearance fits, room 0; bores on pins with a positive room under it) that the cell
+    tries, built with ``room_m`` [m] per side (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`):
+    the ``pairs`` [part, hole] whose outcomes are observed in that model, not at the CAD's
+    room; ``cad_room_m``: "part->hole" -> the CAD's room per side [m] of those with room
+    above 0 (the others room 0)."""
 
     room_m: Annotated[float, Meta(gt=0)]
     pairs: list[tuple[str, str]]
+    cad_room_m: dict[str, float] = msgspec.field(default_factory=dict)
+
+
+def fit_text(cad_room_m: Mapping[str, float], part: str, hole: str) -> str:
+    """``part->hole``, with the CAD's room per side [mm] where ``cad_room_m``
+    (:attr:`asp.session.settings.NominalFits.cad_room_m`) gives one."""
+    room = cad_room_m.get(f"{part}->{hole}")
+    return f"{part}->{hole}" + ("" if room is None else f" ({room * 1e3:+.4f} mm)")
 
 
 class SessionFile(msgspec.Struct, kw_only=True, forbid_unknown_fields=True):

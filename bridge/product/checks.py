@@ -176,11 +176,16 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
                 raise fail(path, f"part_shapes.{name}", "pins_of", "parts placed by hand ([manual.<id>]) whose "
                            "pins parts with a bore go onto", pid)
     bores = {pid: shape.bore for shape in geo.part_shapes.values() for pid in shape.parts}
+    round_bores = {pid: shape.kind == "round" for shape in geo.part_shapes.values() for pid in shape.parts}
     for name, shape in geo.hole_shapes.items():
         for pid in shape.zero_clearance or []:
             if bores.get(pid) != shape.pin:
                 raise fail(path, f"hole_shapes.{name}", "zero_clearance", "parts with a bore of [part_shapes.*] "
                            "for a pin, pegs of [part_shapes.*] for a hole", pid)
+        for pid in shape.widened or []:
+            if not (shape.pin and bores.get(pid) and shape.kind == "round" and round_bores.get(pid)):
+                raise fail(path, f"hole_shapes.{name}", "widened", "parts with a round bore of [part_shapes.*] "
+                           "on a round pin", pid)
         for pid in shape.near_miss or []:
             if bores.get(pid) is not False or shape.pin:
                 raise fail(path, f"hole_shapes.{name}", "near_miss", "pegs of [part_shapes.*] in a hole", pid)

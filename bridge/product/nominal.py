@@ -8,9 +8,15 @@ fit is a sliding fit in practice, so the simulated cell builds it with
 :data:`NOMINAL_FIT_ROOM` per side where it builds the hole itself from its section (a base
 of ``[plate]`` primitives: the hole is widened by that room all round, and the cell's loader
 refuses the product when that changes the answer of any other pair). Where the hole is
-part of the base's own mesh (a ``[base]`` with ``mesh``: holes entered sideways, pins) the
+part of the base's own mesh (a ``[base]`` with ``mesh``: holes entered sideways) the
 cell cannot widen it: those pairs are no experiment, the planner takes them from the CAD
-(``sizes.lp``), not observed. Both sides read the rule here, so they agree on which pairs
+(``sizes.lp``), not observed. On a pin (always in the base's own mesh) it widens the part
+instead, for such a fit and for a positive room under what it resolves alike: a part a pin
+names in ``widened`` has its round bore wider by :data:`NOMINAL_FIT_ROOM` per side (its
+``[part_shapes.*]`` section as the cell reads it, and the convex pieces the import writes
+for it: regular polygons about its bore's inscribed circle grown by that room), and the
+cell's loader refuses the product when that changes the part's answer on any other pin
+(:func:`widened_bores`). Both sides read the rule here, so they agree on which pairs
 the cell tries (docs/decisions.md, "Nominal zero-clearance fits in the simulated cell").
 """
 
@@ -33,6 +39,21 @@ def models_nominal_fits(geometry: GeometryFile) -> bool:
     ``[plate]`` primitives), so that it can widen a hole by :data:`NOMINAL_FIT_ROOM` for the
     parts it states a nominal zero-clearance fit with; False for a base with its own mesh."""
     return geometry.base is None or geometry.base.mesh is None
+
+
+def widened_bores(geometry: GeometryFile) -> dict[tuple[str, str], float]:
+    """The (part, pin) pairs, sorted, whose round bore the simulated cell builds
+    :data:`NOMINAL_FIT_ROOM` wider per side (a pin's ``widened``: the room on it, room 0 or
+    positive, is under what the cell resolves), each with the room per side [m] its
+    sections state (the CAD's; both round, diameters)."""
+    bores = {pid: shape.size for shape in geometry.part_shapes.values() for pid in shape.parts}
+    found: dict[tuple[str, str], float] = {}
+    for shape in geometry.hole_shapes.values():
+        for pid in shape.widened or () if shape.pin else ():
+            bore, pin = bores[pid], shape.size
+            assert not isinstance(bore, list) and not isinstance(pin, list)  # round: checked as the file is read
+            found |= {(pid, hid): (bore - pin) / 2 for hid in shape.holes}
+    return dict(sorted(found.items()))
 
 
 def stated_nominal_fits(geometry: GeometryFile) -> list[tuple[str, str]]:

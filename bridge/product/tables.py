@@ -181,7 +181,11 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     is its free end, its ``depth`` along the axis to its part's nearest end. ``zero_clearance`` names
     the parts stated to fit at room 0, a nominal zero-clearance fit (pegs of ``part_shapes``,
     or parts with a ``bore`` for a pin): the section is the nominal one, and a listed part
-    whose section is not wider passes (any other part needs room above 0). ``near_miss``
+    whose section is not wider passes (any other part needs room above 0). A pin's
+    ``widened`` names the parts whose round bore's room on it (room 0 or positive) is under
+    what the simulated cell resolves: that cell builds their bores wider
+    (``bridge.product.nominal.NOMINAL_FIT_ROOM`` per side), and the pair is observed with
+    that room, not the CAD's. ``near_miss``
     names the pegs that miss the hole by less than the simulated cell resolves with their
     corners rounded by its hull margin (``executor.world.near_miss``), or every peg of a
     hole no deeper than the cell's goal tolerance (one blocked on its rim ends as near its
@@ -199,6 +203,7 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     pin: bool = False
     axis: InsertionAxis = "-z"
     zero_clearance: Ids | None = None
+    widened: Ids | None = None
     near_miss: Ids | None = None
     tile: TileSize | None = None
     owner: Id | None = None

@@ -7,7 +7,8 @@ and, for every other moving part, the reason it is placed by hand (``[manual.<id
 the rules it applies: the reach measured along horizontal axes (:data:`SIDEWAYS_PIN_REACH`,
 :data:`SIDEWAYS_HOLE_REACH`), the arm's wrist clear of the product (:data:`WRIST_RADIUS`,
 :data:`WRIST_CLEARANCE`, :func:`tool_length`), parts stacked on a pin
-(:data:`STACK_TOLERANCE`), a bore's room the cell resolves (:data:`BORE_LOSS`), a polygon
+(:data:`STACK_TOLERANCE`), a bore's room the cell resolves (:data:`BORE_LOSS`), a round
+bore whose room on a pin it does not resolve widened (:func:`widens_bore`), a polygon
 peg's prism. Also the figures both this and the product's files need: each peg's room in
 each hole and each bore's on each pin (:func:`margins`, nominal zero-clearance fits:
 :func:`nominal_fits`), the frames of holes, pins and bores, the plate's level
@@ -28,6 +29,7 @@ import shapely
 import trimesh
 from scipy.spatial.transform import Rotation
 
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.cad.convex import (
     NEAR,
@@ -478,7 +480,7 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return _onto_pins(derived, on, pid)
     if (why := _stack_refused(derived, pin, pid)) is not None:
         return why
-    if why := _unresolved(margins(derived)[pid][pin.id]):
+    if why := _bore_unresolved(derived, pid, pin.id):
         return f"goes onto a pin ({pin.id}) {why}"
     if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
                                                "a horizontal pin")):
@@ -510,9 +512,11 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
             return (f"goes onto a pin ({pin.id}) on top of '{lowest}': the cell puts a part onto several pins only "
                     "as the first on each")
     rooms = margins(derived)[pid]
-    if tight := sorted(pin.id for pin in on if _unresolved(rooms[pin.id])):  # all named: no pin first by its id
-        least = min(rooms[pin_id] for pin_id in tight)
-        return f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) {_unresolved(least)}"
+    if tight := sorted(pin.id for pin in on if _bore_unresolved(derived, pid, pin.id)):  # all named: no pin first
+        tight = [pin_id for pin_id in tight if _unresolved(rooms[pin_id])] or tight  # those of the room, if any
+        least = min(tight, key=lambda pin_id: (rooms[pin_id], pin_id))
+        return (f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) "
+                f"{_bore_unresolved(derived, pid, least)}")
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
@@ -636,14 +640,62 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     solid.apply_translation((0.0, 0.0, low - NEAR))  # the pin in its frame, turned into the part frame
     solid.apply_transform(bore_frame(derived, pid) @ feature_turn(pin).T)
     bores = 1 + sum(part == pid for part, _ in derived.further_bores)  # one per pin it is on
+    widen = NOMINAL_FIT_ROOM if widens_bore(derived, pid) else 0.0
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
-        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores)
-        if not isinstance(found, NoStack) or bores > 1:  # CoACD's pieces are checked about one pin
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores, widen)
+        if not isinstance(found, NoStack) or bores > 1 or widen:  # CoACD's pieces: about one pin, not widened
             return found
         other = pin_pieces(name, part, solid, allowed)
         return other if not isinstance(other, str) else f"{found}; nor do CoACD's pieces fit: {other}"
     return pieces
+
+
+def fine_pins(derived: Derived, pid: str, nominal: Mapping[tuple[str, str], float] | None = None) -> list[str]:
+    """The pins, sorted, on which part ``pid``'s bore is a fit in the CAD whose room the cell
+    does not resolve: a nominal zero-clearance fit (:func:`nominal_fits`, room 0) or a
+    positive room under :func:`_unresolved`'s (Factory's gears' 0.012 mm per side on their
+    shafts); ``nominal``: the product's :func:`nominal_fits`, where known."""
+    nominal = nominal_fits(derived) if nominal is None else nominal
+    rooms = margins(derived).get(pid, {})
+    return sorted(pin_id for pin_id in derived.pins if pin_id in rooms and (
+        (pid, pin_id) in nominal or (rooms[pin_id] > 0 and _unresolved(rooms[pin_id]))))
+
+
+def widens_bore(derived: Derived, pid: str, nominal: Mapping[tuple[str, str], float] | None = None) -> bool:
+    """Whether the cell widens part ``pid``'s bore by
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side: it is a fit on some pin whose
+    room the cell does not resolve (:func:`fine_pins`), the part goes onto one pin (the
+    cell's view of a part on several keeps its first pin only), and its bore and every pin
+    are round (:func:`round_pins`: its pieces' bore is a regular polygon about its
+    inscribed circle, grown by that room, :func:`executor.world.rings.round_bores`). The
+    fit's answer is the CAD's; the cell observes it with that room, not the CAD's."""
+    return (round_pins(derived, pid) and not any(part == pid for part, _ in derived.further_bores)
+            and bool(fine_pins(derived, pid, nominal)))
+
+
+def _bore_unresolved(derived: Derived, pid: str, pin_id: str) -> str:
+    """Why the cell cannot tell part ``pid``'s room on pin ``pin_id`` from its sign (:func:`_unresolved`; ""
+    where it can). A part whose bore is a fit on a pin with room the cell does not resolve
+    (:func:`fine_pins`) the cell tries with its bore widened (:func:`widens_bore`), on every
+    pin: it cannot where it does not widen that bore, or where the wider bore would turn the
+    part's no-fit on another pin into a fit or a room it cannot tell (a room of at most 0,
+    less than twice :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` and
+    :data:`executor.world.SIZE_RESOLUTION` below it)."""
+    rooms, nominal = margins(derived)[pid], nominal_fits(derived)
+    fine, why = fine_pins(derived, pid, nominal), _unresolved(rooms[pin_id])
+    if (why and pin_id not in fine) or not fine:
+        return why
+    why = why or f"with its bore a fit on pin {fine[0]} " + (
+        "at nominal zero clearance" if (pid, fine[0]) in nominal else _unresolved(rooms[fine[0]]))
+    if not widens_bore(derived, pid, nominal):
+        return f"{why}; the cell widens a bore only for a part on one pin, its bore and every pin round"
+    reach = 2 * (NOMINAL_FIT_ROOM + SIZE_RESOLUTION)
+    if turned := sorted(other for other in derived.pins if other in rooms and other not in fine
+                        and -reach < rooms[other] <= 0):
+        return (f"{why}; its bore {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side would pass pin {turned[0]} "
+                f"({rooms[turned[0]] * 500:+.4f} mm per side)")
+    return ""
 
 
 BORE_LOSS = 0.25

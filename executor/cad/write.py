@@ -63,6 +63,7 @@ from bridge.files import make_folder, os_reason, write_atomic
 from bridge.inputs import read_text, shorten
 from bridge.product import Mesh
 from bridge.product.checks import overlapping_bosses
+from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor import ExecutorError
 from executor.cad.convex import (
     MESH_FOLDER,
@@ -85,6 +86,7 @@ from executor.cad.operations import (
     cell_view,
     entry_point,
     feature_turn,
+    fine_pins,
     margins,
     nominal_fits,
     order,
@@ -97,12 +99,14 @@ from executor.cad.operations import (
     tool_length,
     tool_of,
     upright,
+    widens_bore,
 )
 from executor.cad.parts import turn_text
 from executor.cad.sections import Shape2D, section, slice_loops
 from executor.cad.sections import rounded as _q
 from executor.cad.sweep import DIRECTIONS, opposite
 from executor.control.detector import Thresholds
+from executor.world import SIZE_RESOLUTION
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, plate_obj_text
 from executor.world.meshes import read_objects
 from executor.world.near_miss import mesh_near_miss, near_miss
@@ -285,6 +289,31 @@ def nominal_assumption(derived: Derived) -> list[str]:
     nominal = nominal_fits(derived)
     return [f"nominal zero-clearance fits: {RULE.format(um='µm')} ({len(nominal)} pairs, vertex circles up to "
             f"{1e6 * max(map(abs, nominal.values())):.1f} µm apart)"] if nominal else []
+
+
+def widened_bores(cell: Derived) -> dict[tuple[str, str], float]:
+    """The fits on pins of the product as the cell inserts it (``cell``:
+    :func:`executor.cad.operations.cell_view`) whose part's round bore the simulated cell
+    builds :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` wider per side
+    (:func:`executor.cad.operations.widens_bore`), sorted: (part, pin) to the CAD's room
+    per side [m] (0.0 for a nominal zero-clearance fit); a pin's ``widened`` in
+    ``geometry.toml``."""
+    rooms, nominal = margins(cell), nominal_fits(cell)
+    return {(pid, pin_id): 0.0 if (pid, pin_id) in nominal else rooms[pid][pin_id] / 2
+            for pid in sorted(cell.bores) if widens_bore(cell, pid, nominal)
+            for pin_id in fine_pins(cell, pid, nominal)}
+
+
+def widened_bores_assumption(cell: Derived) -> list[str]:
+    """What the simulated cell assumes of the fits on pins whose room it does not resolve
+    (:func:`widened_bores`), as ``import`` prints it; none without one."""
+    pairs = widened_bores(cell)
+    return [f"fits on pins with room under the {1e3 * SIZE_RESOLUTION:g} mm per side the simulated cell resolves: "
+            f"it builds each with the part's round bore {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side (its pieces' "
+            "bores regular polygons about the bore's inscribed circle grown by that), so they are observed in that "
+            "model, not at the CAD's room: "
+            + " ".join(f"{pid}->{pin_id} ({'room 0' if not room else f'{1e3 * room:+.4f} mm'})"
+                       for (pid, pin_id), room in pairs.items())] if pairs else []
 
 
 def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
@@ -669,6 +698,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
     nominal, pairs, missed = zero_clearance_parts(derived), section_pairs(derived), near_misses(derived, pieces)
+    widened = widened_bores(derived)
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
@@ -703,7 +733,8 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
     for pin_id, pin in derived.pins.items():
         top, height = pin_level(derived, pin)
         lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section),
-                  *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores])]
+                  *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores]),
+                  *_widened_line([pid for pid, on in widened if on == pin_id])]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
         if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
@@ -762,6 +793,12 @@ def _hole_section(derived: Derived, hid: str, fit: HoleFit) -> Shape2D:
     its measured section."""
     swept = sorted(((pid != fit.part, pid), hole) for (pid, h), (_, hole, _) in derived.swept.items() if h == hid)
     return swept[0][1] if swept else fit.hole
+
+
+def _widened_line(parts: list[str]) -> list[str]:
+    """A pin's ``widened`` line naming ``parts`` (:func:`widened_bores`; none without one)."""
+    return [f"widened = {json.dumps(parts)}  # bores the cell builds {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side: "
+            "room under what it resolves"] if parts else []
 
 
 def _zero_clearance_line(parts: list[str]) -> list[str]:

@@ -131,7 +131,9 @@ class HoleSpec(Section):
     that is a part placed by hand or a peg the cell inserts down into its ``demo_hole``
     (None: the base's; its position and top with the owner at its goal there:
     :func:`seated_pose`); the parts stated to fit it at room 0
-    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the pegs
+    (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the parts
+    with a bore whose room on it is under what the cell resolves, whose bore it builds wider
+    (``widened``: :func:`_with_widened_bore`); the pegs
     that miss it by less than the cell resolves (``near_miss``: :mod:`executor.world.near_miss`,
     no experiment); ``tile``
     the side of its square boss [m] where it differs from the plate's ``tile_size``
@@ -144,6 +146,7 @@ class HoleSpec(Section):
     pin: bool = field(default=False, kw_only=True)
     axis: str = field(default="-z", kw_only=True)
     zero_clearance: tuple[str, ...] = field(default=(), kw_only=True)
+    widened: tuple[str, ...] = field(default=(), kw_only=True)
     near_miss: tuple[str, ...] = field(default=(), kw_only=True)
     tile: float | None = field(default=None, kw_only=True)
     owner: str | None = field(default=None, kw_only=True)
@@ -277,6 +280,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
                                   top_z=top, depth=depth, outline=_outline(hole_shape), corner=hole_shape.corner,
                                   pin=hole_shape.pin, axis=hole_shape.axis,
                                   zero_clearance=tuple(sorted(hole_shape.zero_clearance or ())),
+                                  widened=tuple(sorted(hole_shape.widened or ())),
                                   near_miss=tuple(sorted(hole_shape.near_miss or ())),
                                   tile=hole_shape.tile, owner=hole_shape.owner)
     starts = {part.id: part.start for part in layout.parts if part.start is not None}
@@ -293,13 +297,18 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             )
     if models_nominal_fits(geo):
         holes = {hid: _with_nominal_room(hole, parts) for hid, hole in holes.items()}
+    parts = {pid: _with_widened_bore(part, holes) for pid, part in parts.items()}
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
 
-def widened(hole: HoleSpec, room: float) -> HoleSpec:
-    """``hole`` with ``room`` [m] more all round: a round, square or rect section ``2 room``
-    wider on each side's extent (a corner radius grown by ``room``, a sharp corner kept
-    sharp), a polygon's outline offset outwards by ``room`` (mitred corners)."""
+_Widened = TypeVar("_Widened", bound=Section)
+
+
+def widened(hole: _Widened, room: float) -> _Widened:
+    """``hole`` (a hole's section, a part's bore) with ``room`` [m] more all round: a round,
+    square or rect section ``2 room`` wider on each side's extent (a corner radius grown by
+    ``room``, a sharp corner kept sharp), a polygon's outline offset outwards by ``room``
+    (mitred corners)."""
     if hole.kind == "polygon":
         grown = shapely.Polygon(hole.outline).buffer(room, join_style="mitre")
         outline = tuple((float(x), float(y)) for x, y in np.asarray(grown.exterior.coords)[:-1])
@@ -326,6 +335,26 @@ def _with_nominal_room(hole: HoleSpec, parts: dict[str, PartSpec]) -> HoleSpec:
                 f"part '{pid}' ({margin(part, hole) * 500:+.4f} mm per side) would then "
                 f"{'fit' if feature_passes(part, built) else 'not fit'}: expected every other pair's answer "
                 "unchanged (docs/cell.md#nominal-zero-clearance-fits)")
+    return built
+
+
+def _with_widened_bore(part: PartSpec, holes: dict[str, HoleSpec]) -> PartSpec:
+    """The part as the simulated cell builds it: a part with a bore that a pin names in
+    ``widened`` (its room on that pin, room 0 or positive, is under what the cell resolves)
+    has its bore :func:`widened` by :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per
+    side (its pieces are made so: :func:`executor.world.rings.round_bores`); ExecutorError
+    naming the first pin on which that room would change its answer (:func:`feature_passes`)."""
+    if not part.bore or not any(part.id in hole.widened for hole in holes.values() if hole.pin):
+        return part
+    built = widened(part, NOMINAL_FIT_ROOM)
+    for hid, hole in sorted(holes.items()):
+        if hole.pin and feature_passes(part, hole) != feature_passes(built, hole):
+            raise ExecutorError(
+                f"part '{part.id}': the simulated cell builds its fits on pins whose room it does not resolve "
+                f"(widened) with its bore {NOMINAL_FIT_ROOM * 1e3:g} mm wider per side, and on pin '{hid}' "
+                f"({margin(hole, part) * 500:+.4f} mm per side) it would then "
+                f"{'fit' if feature_passes(built, hole) else 'not fit'}: expected every other pair's answer unchanged"
+                " (docs/cell.md#nominal-zero-clearance-fits)")
     return built
 
 

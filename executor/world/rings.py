@@ -29,7 +29,9 @@ in it, so the cell's bore is smaller by a ``loss`` (the largest distance of the 
 it), never larger; the finest that works within the ``allowed`` loss is taken and the
 loss reported. A round bore of a part that goes onto round pins only is made a regular
 polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_parts`): a
-round pin passes it exactly when it passes the bore.
+round pin passes it exactly when it passes the bore; for a fit whose room the cell does not
+resolve, about that circle grown by the room the cell gives such a fit (``widen``), so a
+round pin passes it as it passes the bore widened by that room.
 """
 
 from __future__ import annotations
@@ -128,7 +130,7 @@ _FOUND: dict[bytes, Found] = {}
 
 
 def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pins: bool = False,
-                bores: int = 1) -> Found:
+                bores: int = 1, widen: float = 0.0) -> Found:
     """The convex pieces of part ``pid`` with ``bores`` bores (one per pin it goes onto: a
     plate over two dowel pins has two), its closed ``mesh`` in its part frame [m] (z its
     axis; module docstring), each with 0.0 (no vertex dropped) and a line saying how they
@@ -137,12 +139,14 @@ def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pin
     pieces has an eroded form), or
     a piece at a bore too thin for the cell even with the bore made coarser by at most
     ``allowed`` [m] (:func:`coarser_bores`, one bore only), or, when it goes onto
-    ``round_pins`` only, circumscribing each bore's inscribed circle (:func:`round_bores`)."""
-    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + bytes([round_pins, bores])
-                         + np.ascontiguousarray(mesh.vertices).tobytes()
+    ``round_pins`` only, circumscribing each bore's inscribed circle grown by ``widen`` [m]
+    (:func:`round_bores`: the cell's room of a fit it does not resolve; 0 elsewhere)."""
+    assert round_pins or not widen  # a bore is widened about its inscribed circle only
+    key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.float64(widen).tobytes()
+                         + bytes([round_pins, bores]) + np.ascontiguousarray(mesh.vertices).tobytes()
                          + np.ascontiguousarray(mesh.faces).tobytes()).digest()
     if key not in _FOUND:
-        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins, bores)
+        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins, bores, widen)
     return _FOUND[key]
 
 
@@ -213,17 +217,18 @@ def _beyond(outline: shapely.Polygon, discs: shapely.Geometry) -> tuple[shapely.
                  and polygon.area > 0 for part in convex_parts(shapely.set_precision(polygon, _GRID)))
 
 
-def round_bores(section: shapely.Polygon, allowed: float) -> list[tuple[shapely.Polygon, float]]:
+def round_bores(section: shapely.Polygon, allowed: float, widen: float = 0.0) -> list[tuple[shapely.Polygon, float]]:
     """``section`` with each bore made a regular polygon of :data:`ROUND_BORE_CORNERS`
-    corners (most first) whose inscribed circle is the bore's (about its centroid), within
-    the bore's disc (:func:`_discs`); each with loss 0.0 (``allowed`` is not
-    needed): a round pin passes such a polygon exactly when it passes that circle, as it
-    passes the bore. The polygon's corners reach beyond the bore, so it is for parts that
-    go onto round pins only."""
+    corners (most first) whose inscribed circle is the bore's (about its centroid) grown by
+    ``widen`` [m] (0: the bore's own), within the bore's disc (:func:`_discs`); each with
+    loss 0.0 (``allowed`` is not needed): a round pin passes such a polygon exactly when it
+    passes that circle, as it passes the bore (``widen`` 0). The polygon's corners reach
+    beyond the bore, so it is for parts that go onto round pins only."""
     found: list[tuple[shapely.Polygon, float]] = []
     centres = [np.array(shapely.Polygon(ring).centroid.coords[0]) for ring in section.interiors]
     discs = _discs(section, centres)
-    radii = [float(shapely.distance(shapely.Point(*centre), ring)) for ring, centre in zip(section.interiors, centres)]
+    radii = [float(shapely.distance(shapely.Point(*centre), ring)) + widen
+             for ring, centre in zip(section.interiors, centres)]
     for corners in ROUND_BORE_CORNERS:
         turn = np.linspace(0.0, 2 * np.pi, corners, endpoint=False)
         reach = [radius / np.cos(np.pi / corners) for radius in radii]
@@ -278,7 +283,7 @@ def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely
     return found
 
 
-def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, bores: int) -> Found:
+def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, bores: int, widen: float) -> Found:
     """:func:`ring_pieces`, made."""
     if not mesh.is_volume:  # as written, a mesh can lose a sliver face to rounding
         return NoStack(f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections")
@@ -301,8 +306,8 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
         return (f"part '{pid}': its layer from {1e3 * (thin[0] - low):.3f} to {1e3 * (thin[1] - low):.3f} mm of its "
                 f"height, at its bore, is thinner than the cell's hull margin twice less what it resolves "
                 f"({1e3 * MIN_THICKNESS:g} mm)")
-    made = round_bores if round_pins else coarser_bores
-    candidates = [made(section, allowed) for section, _, _ in layers]
+    candidates = [round_bores(section, allowed, widen) if round_pins else coarser_bores(section, allowed)
+                  for section, _, _ in layers]
     # the exact sections first, then the finest coarser bores that work, found by bisection
     # (a coarser bore has wider pieces at it); each one returned is checked whole
     order, low_k, high_k = [0], 1, min(len(c) for c in candidates) - 1
@@ -327,10 +332,12 @@ def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, b
             return (f"part '{pid}': the parts of its sections thinner than the cell's hull margin twice are "
                     f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
         corners = "/".join(map(str, sorted({len(ring.coords) - 1 for c in candidates for ring in c[k][0].interiors})))
-        bore = (f"the bore a regular {corners}-gon about its inscribed circle (round pins pass it as they pass the "
-                "mesh's)" if round_pins and bores == 1 else
-                f"each of its {bores} bores a regular {corners}-gon about its inscribed circle (round pins pass them "
-                "as they pass the mesh's)" if round_pins else "exact at the bore" if k == 0 else
+        grown = (f" grown by {1e3 * widen:g} mm (a fit whose room the cell does not resolve: round pins pass it as "
+                 "they pass the mesh's widened by that per side)" if widen else "")
+        bore = (f"the bore a regular {corners}-gon about its inscribed circle" + (grown or " (round pins pass it as "
+                "they pass the mesh's)") if round_pins and bores == 1 else
+                f"each of its {bores} bores a regular {corners}-gon about its inscribed circle" + (grown or
+                " (round pins pass them as they pass the mesh's)") if round_pins else "exact at the bore" if k == 0 else
                 f"the bore {corners}-cornered, inscribed in the mesh's, {1e6 * loss:.1f} um smaller")
         heights = ", ".join(f"{1e3 * (top - bottom):.3f}" for _, bottom, top in layers)
         return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section(s) over its {len(layers)} layer(s) of "

@@ -7,7 +7,9 @@ gear's 2 mm teeth)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import re
 import tomllib
 from pathlib import Path
 
@@ -24,7 +26,8 @@ from executor.cad.derive import derive
 from executor.cad.derive.bore_on_pin import _GRID, _joined
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
-from tests.cad.conftest import learned_in_the_cell, teach
+from executor.world.geometry import HoleSpec, PartSpec, _with_widened_bore, load_geometry
+from tests.cad.conftest import learned_in_the_cell, manual_reasons, teach
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -135,6 +138,40 @@ def test_an_empty_pin_of_the_base_is_a_feature_when_a_bore_passes_over_it(tmp_pa
     assert _atoms(out / "sizes.lp", "fits") == {("washer", "plate_pin1"), ("washer", "plate_pin2")}
     # the cell has no goal on a pin no part of the CAD is on: the session takes its pairs from sizes.lp
     assert set(tomllib.loads((out / "geometry.toml").read_text())["hole_shapes"]) == {"plate_pin1"}
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_a_round_bore_with_less_room_than_the_cell_resolves_is_widened_for_it(tmp_path: Path) -> None:
+    # A d 10.03 bore (a 128-gon, inradius 5.0135 mm) on the d 10 pin (a 64-gon of vertex
+    # radius 5): 0.0135 mm of room per side, a fit the cell does not resolve. The cell puts
+    # the washer onto it with its bore widened by 0.15 mm per side (its pieces and its
+    # section as the cell reads it; geometry.toml keeps the CAD's, the pin names the washer
+    # in its `widened`), as it fits the 8 mm pin too: no answer changes.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.03, X_MM - 25)
+    out = _import(tmp_path, {"washer": washer})
+    rooms = {(p, h): int(m) for p, h, m in _atoms(out / "nominal_sizes.lp", "nominal_margin")}
+    assert 0 < rooms[("washer", "plate_pin1")] < 50  # [um] diametral: under 0.025 mm per side
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    assert "manual" not in geometry
+    pin, bore = geometry["hole_shapes"]["plate_pin1"], geometry["part_shapes"]["washer"]["size"]
+    assert pin["widened"] == ["washer"]
+    assert bore - pin["size"] == pytest.approx(1e-6 * rooms[("washer", "plate_pin1")], abs=2e-6)
+    assert load_geometry(str(out)).parts["washer"].size - pin["size"] == pytest.approx(
+        1e-6 * rooms[("washer", "plate_pin1")] + 3e-4, abs=2e-6)
+    assert "about its inscribed circle grown by 0.15 mm" in \
+        (out / "meshes" / "washer.convex.obj").read_text().splitlines()[2]
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_a_bore_widened_would_pass_a_pin_it_does_not_so_it_is_placed_by_hand(tmp_path: Path) -> None:
+    # The same d 10.03 bore, and a d 10.1 pin (a ring with a d 10.5 bore on it) that it does
+    # not pass by 0.037 mm per side: widened by 0.15 mm it would, so the cell does not widen it.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.03, X_MM - 25)
+    ring = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM)
+    reason = manual_reasons(_import(tmp_path, {"washer": washer, "ring": ring}, (_pin(5.05, X_MM),)))["washer"]
+    assert re.fullmatch(r"goes onto a pin \(plate_pin1\) with \+0\.01\d\d mm of room per side, less than the 0\.025 mm "
+                        r"the simulated cell resolves; its bore 0\.15 mm wider per side would pass pin plate_pin2 "
+                        r"\(-0\.03\d\d mm per side\)", reason)
 
 
 @pytest.mark.slow
@@ -335,3 +372,54 @@ def test_a_plate_over_both_pins_is_learned_on_each_and_put_onto_its_first(run_ma
     assert {tuple(pair) for pair in result["fits"]} == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
     assert result["assembly"]["assembled"] and [(s["part"], s["hole"]) for s in result["assembly"]["steps"]] == [
         ("plate", None), ("cover", first)], result["assembly"]["steps"]
+
+
+@pytest.mark.slow  # the import: about 3 s
+def test_a_zero_clearance_bore_the_widening_would_pass_over_another_pin_is_placed_by_hand(tmp_path: Path) -> None:
+    # The washer's d 10 bore on the d 10 pin: a nominal zero-clearance fit, which the cell
+    # builds with the bore 0.15 mm per side wider; a d 10.1 pin beside it (a collar with a
+    # d 10.5 bore on it) the washer does not pass (-0.05 mm per side), and would, widened:
+    # so the washer is placed by hand, naming that pin; the collar is the cell's.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.0, X_MM - 25)
+    collar = _with_bore(shapely.Point(0.0, 0.0).buffer(9.0, quad_segs=32), 10.5, X_MM)
+    out = _import(tmp_path, {"washer": washer, "collar": collar}, (_pin(5.05, X_MM),))
+    holes = tomllib.loads((out / "assembly.toml").read_text())["holes"]
+    beside = next(hid for hid, hole in holes.items() if round(1000 * hole["position"][0]) == X_MM)
+    geometry = tomllib.loads((out / "geometry.toml").read_text())
+    assert set(geometry["manual"]) == {"washer"}, geometry["manual"]
+    reason = geometry["manual"]["washer"]["reason"]
+    assert re.fullmatch(r"goes onto a pin \(plate_pin1\) with \+0\.0000 mm of room per side, less than the "
+                        r"0\.025 mm the simulated cell resolves; its bore 0\.15 mm wider per side would pass pin "
+                        f"{beside} " r"\(-0\.05[0-9]{2} mm per side\)", reason), reason
+
+
+def test_the_cell_reads_a_zero_clearance_bore_widened_and_refuses_one_that_would_then_pass_another_pin() -> None:
+    washer = PartSpec("washer", "round", 0.010, shape="washer", length=0.004, mass=0.01, start=(0.3, 0.3),
+                      demo_hole="p1", bore=True)
+    pin = HoleSpec("p1", "round", 0.010, (0.5, 0.0), top_z=0.04, depth=0.03, pin=True, zero_clearance=("washer",),
+                   widened=("washer",))
+    other = HoleSpec("p2", "round", 0.0105, (0.55, 0.0), top_z=0.04, depth=0.03, pin=True)
+    assert _with_widened_bore(washer, {"p1": pin, "p2": other}).size == pytest.approx(0.0103)
+    assert _with_widened_bore(washer, {"p2": other}) == washer  # no widened bore stated: as read
+    tight = dataclasses.replace(other, size=0.0101)  # -0.05 mm per side; +0.1 widened
+    with pytest.raises(ExecutorError, match="on pin 'p2' \\(-0.0500 mm per side\\) it would then fit"):
+        _with_widened_bore(washer, {"p1": pin, "p2": tight})
+
+
+@pytest.mark.slow  # the import: about 4 s
+def test_a_part_with_a_zero_clearance_fit_on_another_pin_the_cell_cannot_widen_is_placed_by_hand(
+        tmp_path: Path) -> None:
+    # The washer's d 10.5 bore has room on its own d 10 pin and is a nominal zero-clearance
+    # fit on a d 10.5 pin beside it, which the cell would try at the room it gives such a
+    # fit, its bore widened; with a square pin in the product (a square nut on it) it widens
+    # no bore, so the washer is placed by hand rather than tried there at room 0.
+    washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM - 25)
+    nut = trimesh.creation.extrude_polygon(shapely.box(-8.0, -8.0, 8.0, 8.0).difference(shapely.box(-3.3, -3.3, 3.3,
+                                                                                                       3.3)), 4.0)
+    nut.apply_translation((X_MM, 18.0, 10.0))
+    out = _import(tmp_path, {"washer": washer, "nut": nut}, (_pin(5.25, X_MM), _box((6, 6, 30), (X_MM, 18, 25))))
+    manual = tomllib.loads((out / "geometry.toml").read_text()).get("manual", {})
+    assert set(manual) == {"washer"}, manual
+    assert re.fullmatch(r"goes onto a pin \(plate_pin\d\) with its bore a fit on pin plate_pin\d at nominal zero "
+                        r"clearance; the cell widens a bore only for a part on one pin, its bore and every pin round",
+                        manual["washer"]["reason"]), manual["washer"]["reason"]

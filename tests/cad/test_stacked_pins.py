@@ -96,13 +96,15 @@ def test_a_pin_s_owner_is_placed_by_hand_or_a_peg_inserted_down(stacked: Path, t
 @pytest.mark.slow  # two imports: about 5 s
 def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_by_hand(tmp_path: Path) -> None:
     # the nut drawn 0.5 mm above the washer: the cell would rest it on the washer, not where
-    # the CAD has it; a washer with 0.01 mm of room on its pin is placed by hand, and the nut on it too
+    # the CAD has it; a washer with 0.01 mm of room on its pin is placed by hand (its square
+    # bore the cell does not widen), and the nut on it too
     apart = _import(tmp_path / "apart", nut_low=14.5)
     assert manual_reasons(apart)["nut"] == ("goes onto a pin (plate_pin1) +0.500 mm from the top of 'washer': the cell "
                                      "stacks the parts on a pin end to end (within 0.1 mm)")
     tight = manual_reasons(_import(tmp_path / "tight", washer_bore=8.02))
     assert tight["washer"] == ("goes onto a pin (plate_pin1) with +0.0100 mm of room per side, less than the 0.025 mm "
-                               "the simulated cell resolves")
+                               "the simulated cell resolves; the cell widens a bore only for a part on one pin, its "
+                               "bore and every pin round")
     assert tight["nut"] == "goes onto a pin (plate_pin1) on top of 'washer', which the cell does not put onto it"
 
 

@@ -125,7 +125,8 @@ def test_a_plate_the_cell_cannot_put_onto_its_two_pins_is_placed_by_hand(tmp_pat
     tight = tomllib.loads((_import(tmp_path / "tight", (8.2, 8.04)) / "geometry.toml").read_text())
     # the d 8.04 bore, a 128-gon, over the d 8 pin's 64-gon (its vertex circle)
     assert tight["manual"]["plate"]["reason"] == ("goes onto a pin (base_pin2) with +0.0187 mm of room per side, less "
-                                                  "than the 0.025 mm the simulated cell resolves")
+                                                  "than the 0.025 mm the simulated cell resolves; the cell widens a "
+                                                  "bore only for a part on one pin, its bore and every pin round")
     assert tight["manual"]["plate"]["on"] == ["base_pin1", "base_pin2"]
     lying = tomllib.loads((_import(tmp_path / "lying", lying=True) / "geometry.toml").read_text())
     assert lying["manual"]["plate"]["reason"] == (
