@@ -22,7 +22,7 @@ import trimesh
 
 from assembly_constraints.cli import main
 from executor import ExecutorError
-from executor.cad.derive import derive
+from executor.cad.derive import Derived, derive
 from executor.cad.derive.bore_on_pin import _GRID, _joined
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
@@ -423,3 +423,44 @@ def test_a_part_with_a_zero_clearance_fit_on_another_pin_the_cell_cannot_widen_i
     assert re.fullmatch(r"goes onto a pin \(plate_pin\d\) with its bore a fit on pin plate_pin\d at nominal zero "
                         r"clearance; the cell widens a bore only for a part on one pin, its bore and every pin round",
                         manual["washer"]["reason"]), manual["washer"]["reason"]
+
+
+def _stepped() -> Derived:
+    """A base with a stepped pin (a pot's thread d 8, z 10 to 20 mm, under its shaft: d 6.1,
+    z 20 to 25, then a D of that circle cut flat 1.5 mm from its axis, z 25 to 35), a nut
+    (bore d 8.2, z 12 to 16) on the thread and a knob (z 22 to 38) on the shaft: a round
+    bore d 6.4 up to z 26 (0.3 mm of room over the d 6.1, the least), then a D bore (d 7,
+    flat 2.2 mm from the axis); derived (lengths in metres)."""
+    mm = 1e-3
+    flat = shapely.box(-10 * mm, 1.5 * mm, 10 * mm, 10 * mm)
+    base = trimesh.boolean.union([
+        _prism(shapely.box(-15 * mm, -15 * mm, 15 * mm, 15 * mm), 0.0, 10 * mm), _round(0.0, 4 * mm, 5 * mm, 20 * mm),
+        _round(0.0, 3.05 * mm, 19 * mm, 25 * mm),
+        _prism(shapely.Point(0.0, 0.0).buffer(3 * mm, quad_segs=16).difference(flat), 24 * mm, 35 * mm)],
+        engine="manifold")
+    nut = trimesh.boolean.difference([_prism(shapely.box(-6 * mm, -6 * mm, 6 * mm, 6 * mm), 12 * mm, 16 * mm),
+                                      _round(0.0, 4.1 * mm, 11 * mm, 17 * mm)], engine="manifold")
+    d_bore = shapely.Point(0.0, 0.0).buffer(3.5 * mm, quad_segs=16).difference(
+        shapely.box(-10 * mm, 2.2 * mm, 10 * mm, 10 * mm))
+    knob = trimesh.boolean.difference([_round(0.0, 8 * mm, 22 * mm, 38 * mm),
+                                       _round(0.0, 3.2 * mm, 21 * mm, 26 * mm),
+                                       _prism(d_bore, 25.5 * mm, 36 * mm)], engine="manifold")
+    return derive([CadPart(pid, pid, mesh, "test") for pid, mesh in (("base", base), ("nut", nut), ("knob", knob))],
+                  "base", {})
+
+
+def test_a_knob_on_a_pins_narrower_step_is_on_a_pin_of_its_own_not_the_nuts_below_it() -> None:
+    # nop_pot_knob: a pot's knob goes onto its shaft (d 6, a D at its end), the nut onto the
+    # d 7 thread below it, coaxial. The two were one pin measured over the nut's longer
+    # stretch, the thread, so the knob's bore was judged against the thread (no fit), and
+    # the D-shaft, whose centroid lies off the axis, was a second, empty pin of its own.
+    mm = 1e-3
+    derived = _stepped()
+    assert sorted((pin.parts, round(pin.section.a / mm, 2)) for pin in derived.pins.values()) == [
+        (("knob",), 6.1), (("nut",), 8.0)]
+    rooms = margins(derived)
+    knob_pin = derived.pin_of("knob").id
+    assert abs(rooms["knob"][knob_pin] - 0.3 * mm) < 0.02 * mm, rooms
+    assert rooms["knob"][derived.pin_of("nut").id] < 0 < rooms["nut"][knob_pin], rooms
+    assert set(derived.edges) == {("base", "knob"), ("base", "nut"), ("nut", "knob")}  # the knob over the nut
+

@@ -59,15 +59,32 @@ def pins(derived: Derived) -> tuple[dict[str, PinFit], dict[str, Shape2D], dict[
     found += [(derived.base, derived.axis[pid], pin, centre, None, math.inf) for pid in sorted(bores)
               for pin, centre in _standing_pins(derived, derived.axis[pid], levels[pid], bores.values())]
     merged: list[tuple[str, str, Shape2D, np.ndarray, list[str], float]] = []
+    held: list[list[tuple[Shape2D, Shape2D]]] = []  # index in merged -> each part's own pin section and bore
     into: list[int] = []  # index in found -> index in merged
-    for owner, name, pin, centre, on, level in found:
+    for k, (owner, name, pin, centre, on, level) in enumerate(found):
         axis = np.array(derived.directions[name])
-        same = next((k for k, m in enumerate(merged) if m[0] == owner and m[1] == name and np.linalg.norm(
-            (m[3] - centre) - axis * np.dot(m[3] - centre, axis)) < SAME_HOLE), None)
+        mine = [] if on is None else [(pin, further[k] if k in further else bores[on])]
+        same = None
+        for k_merged, m in enumerate(merged):
+            # coaxial, and the section kept passes every bore on it that passes its own: a
+            # pin's wider step farther from its end (a pot's thread under its shaft) is a pin
+            # of its own, not the section of the knob on the shaft; a standing pin whose
+            # outline holds the pin's centre is that pin (a D-shaft's centroid lies off its axis)
+            across = float(np.linalg.norm((m[3] - centre) - axis * np.dot(m[3] - centre, axis)))
+            kept = pin if level < m[5] else m[2]
+            if m[:2] == (owner, name) and (
+                    across < SAME_HOLE and all(passes(kept, bore) or not passes(own, bore)
+                                               for own, bore in held[k_merged] + mine)
+                    if on is not None else across < SAME_HOLE or shapely.Polygon(pin.outline + pin.centre)
+                    .contains(shapely.Point(frame_of(axis) @ m[3]))):
+                same = k_merged
+                break
         into.append(len(merged) if same is None else same)
         if same is None:
             merged.append((owner, name, pin, centre, [] if on is None else [on], level))
+            held.append(mine)
             continue
+        held[same] += mine
         parts = merged[same][4] + ([] if on is None else [on])
         merged[same] = (owner, name, pin, centre, parts, level) if level < merged[same][5] else (
             *merged[same][:4], parts, merged[same][5])
