@@ -7,6 +7,7 @@ by another angle than quarter turns, is refused, naming the setting."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import tomllib
@@ -346,3 +347,57 @@ def test_a_product_turned_about_z_is_not_taken_for_tilted(tmp_path: Path) -> Non
     imported = run_import(cad, tmp_path / "out", "mm", None)
     assert {fit.axis for fit in imported.derived.holes.values()} == {"+z"}
     assert imported.assumed[0].startswith("the CAD's +z is up (set up")
+
+
+def _one_peg_from_below(folder: Path) -> Path:
+    """A 100 x 60 x 30 mm block at x = 560 mm with a 20.5 mm square hole 15 mm deep into its
+    top (h1) and one into its bottom (h2), a 20 mm square peg 40 mm long down in h1 (25 mm
+    out of the top) and a 15 mm one up in h2 (flush with the bottom), as STL in ``folder``:
+    drawn z up, one part going into the base from below."""
+    folder.mkdir()
+    _box((100.0, 60.0, 30.0), (560.0, 0.0, 15.0)).difference(_box((20.5, 20.5, 30.0), (535.0, 0.0, 30.0))).difference(
+        _box((20.5, 20.5, 30.0), (585.0, 0.0, 0.0))).export(folder / "block.stl")
+    _box((20.0, 20.0, 40.0), (535.0, 0.0, 35.0)).export(folder / "down.stl")
+    _box((20.0, 20.0, 15.0), (585.0, 0.0, 7.5)).export(folder / "up.stl")
+    return folder
+
+
+def test_a_part_going_into_the_base_from_below_is_placed_by_hand(tmp_path: Path, run_main: Runner) -> None:
+    # the peg going up into h2 is no sign of a CAD drawn upside down (the other stands out above):
+    # imported as drawn, that peg written to be placed by hand, its hole's entry on the floor
+    _one_peg_from_below(tmp_path / "cad")
+    done = run_main("import", "cad", "--out", "out", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert ("manual up: the cell has no operation for it, a plan's step places it by hand (goes into hole h2 along "
+            "+z, from below)") in done.stdout, done.stdout
+    assert "hole h2 entry at (585.000, 0.000, 0.000) mm, entered along +z" in done.stdout
+    assert "no experiment of the PyBullet cell" not in done.stdout  # h2 is 15 mm deep, not taken for 0 mm
+    holes = tomllib.loads((tmp_path / "out" / "assembly.toml").read_text())["holes"]
+    assert holes["h2"]["position"] == pytest.approx([0.585, 0.0], abs=1e-9)
+    manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["manual"]
+    assert set(manual) == {"up"} and manual["up"]["on"] == ["h2"]
+    assert manual["up"]["goal"] == pytest.approx([0.585, 0.0, 0.0], abs=1e-6)  # where the CAD has it
+
+
+def test_a_product_drawn_upside_down_imported_as_drawn_places_its_parts_by_hand(tmp_path: Path) -> None:
+    # up = "+z" stated over the refusal: the peg goes up into the block's hole, which the cell
+    # has no operation for; the product is still written (not a KeyError of the hole frame)
+    cad = _upside_down(tmp_path / "cad", 30.0)
+    imported = run_import(cad, tmp_path / "out", "mm", None, ImportOptions(up="+z"))
+    assert imported.derived.axis["peg"] == "-z"
+    assert imported.mapped.manual == {"peg": "goes into hole h1 along +z, from below"}
+    assert (tmp_path / "out" / "geometry.toml").is_file()
+
+
+@pytest.mark.slow  # teaches the peg going down, assembles the product in physics
+def test_the_sim_cell_assembles_a_product_with_a_part_going_in_from_below(tmp_path: Path, run_main: Runner) -> None:
+    _one_peg_from_below(tmp_path / "cad")
+    assert run_main("import", "cad", "--out", "out", cwd=tmp_path).returncode == 0
+    assert run_main("-q", "executor", "teach", "--assembly", "out", cwd=tmp_path).returncode == 0
+    done = run_main("assemble", "out/sizes.lp", "out/geometric_precedence.lp", "--assembly", "out", "--json",
+                    cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    steps = {step["part"]: step for step in report["steps"]}
+    assert report["assembled"] and (steps["down"]["skill"], steps["up"]["skill"]) == ("insert", "manual")
+    assert report["manual_reasons"] == {"up": "goes into hole h2 along +z, from below"}
