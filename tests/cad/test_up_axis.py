@@ -17,10 +17,11 @@ from typing import Any
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from executor import ExecutorError
-from executor.cad.cli import Imported, ImportOptions, run_import
+from executor.cad.cli import Imported, ImportOptions, drawn_tilted, run_import
 from tests.cad.test_corpus import _atoms
 from tests.conftest import Runner, error_lines
 
@@ -401,3 +402,51 @@ def test_the_sim_cell_assembles_a_product_with_a_part_going_in_from_below(tmp_pa
     steps = {step["part"]: step for step in report["steps"]}
     assert report["assembled"] and (steps["down"]["skill"], steps["up"]["skill"]) == ("insert", "manual")
     assert report["manual_reasons"] == {"up": "goes into hole h2 along +z, from below"}
+
+
+def _bar(folder: Path, sides: int, roll: float) -> Path:
+    """A regular ``sides``-gon bar 40 mm across its flats and 120 mm long along x, lying on
+    a flat face turned by ``roll`` [deg] about its axis (on its lowest point at z = 0), a
+    10.5 mm square hole down through it and a 10 mm square peg 50 mm long in it from the
+    floor, as STL in ``folder``."""
+    folder.mkdir()
+    radius = 20.0 / np.cos(np.pi / sides)
+    corners = [(radius * np.cos(np.pi / sides * (2 * k + 1)), radius * np.sin(np.pi / sides * (2 * k + 1)))
+               for k in range(sides)]  # a flat face across +x, which the turn below sets down
+    bar = trimesh.creation.extrude_polygon(shapely.Polygon(corners), 120.0)
+    bar.apply_transform(trimesh.transformations.rotation_matrix(np.radians(roll), (1.0, 0.0, 0.0))
+                        @ trimesh.transformations.rotation_matrix(np.pi / 2, (0.0, 1.0, 0.0)))
+    low, high = bar.bounds
+    bar.apply_translation((560.0 - (low[0] + high[0]) / 2, -(low[1] + high[1]) / 2, -low[2]))
+    bar.difference(_box((10.5, 10.5, 100.0), (560.0, 0.0, 20.0))).export(folder / "bar.stl")
+    _box((10.0, 10.0, 50.0), (560.0, 0.0, 25.0)).export(folder / "peg.stl")
+    return folder
+
+
+@pytest.mark.parametrize("sides", [6, 8])
+def test_a_coarse_prism_lying_on_a_face_is_not_taken_for_tilted(tmp_path: Path, sides: int) -> None:
+    # its largest flat faces, a pair at 60 or 45 deg (as large as its horizontal pair, less
+    # the hole's), are tilted; it stands on its bottom face: imported as drawn
+    imported = run_import(_bar(tmp_path / "cad", sides, 0.0), tmp_path / "out", "mm", None)
+    assert {fit.axis for fit in imported.derived.holes.values()} == {"+z"}
+    assert imported.derived.hole_of["peg"].id == "h1"
+
+
+def test_a_coarse_prism_on_its_edge_is_tilted(tmp_path: Path) -> None:
+    # the hexagonal bar turned 30 deg about its axis: on an edge, no face horizontal
+    with pytest.raises(ExecutorError, match=r"the base bar's largest flat faces \(\d+ % of its surface\) face "
+                       r"\(0.000, -?0.500, 0.866\), 30.0 deg from the z axis: the CAD may be drawn tilted"):
+        run_import(_bar(tmp_path / "cad", 6, 30.0), tmp_path / "read_z_up", "mm", None)
+    assert not (tmp_path / "read_z_up").exists()
+
+
+@pytest.mark.parametrize(("turn", "tilted"), [(0.0, False), (180.0, True)])
+def test_a_base_stands_on_horizontal_faces_only_from_its_lowest_point(turn: float, tilted: bool) -> None:
+    # a wedge 20 mm wide along y, 27.5 mm high to its edge, 100 mm long: its flat face as large
+    # as two thirds of each slanted face (20 deg from vertical), so its horizontal faces count;
+    # lying on that face it stands on it, turned over about x onto its edge it is tilted
+    wedge = trimesh.creation.extrude_polygon(shapely.Polygon([(0.0, -0.01), (0.0, 0.01), (-0.0275, 0.0)]), 0.1)
+    wedge.apply_transform(trimesh.transformations.rotation_matrix(np.radians(turn), (1.0, 0.0, 0.0))
+                          @ trimesh.transformations.rotation_matrix(np.pi / 2, (0.0, 1.0, 0.0)))
+    why = drawn_tilted(wedge, "wedge")
+    assert (why is not None) == tilted, why
