@@ -104,8 +104,9 @@ STANDING_SHARE = 0.5
 """...unless its horizontal faces (within :data:`TILT`) make at least this fraction of the
 area of those largest faces, one of them at its lowest point, facing down (:func:`drawn_tilted`):
 a coarse prism lying on a face (a hexagonal or octagonal bar: its horizontal pair as large
-as each tilted pair, less its holes) stands on it as drawn, where a tilted product's
-horizontal faces are chamfers or facets, if any."""
+as each tilted pair, less its holes) stands on it as drawn, where a product tilted by
+another angle than quarter turns rests on an edge or a corner, unless a face of its base
+lies at that angle."""
 FLOOR = 1e-6
 """[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
 _UP_EXPECTED = f"one of {', '.join(UP_AXES)} (the CAD's axis pointing up)"
