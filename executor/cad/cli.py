@@ -101,6 +101,15 @@ from the z axis and from the horizontal plane (:func:`drawn_tilted`): no quarter
 TILTED_SHARE = 0.15
 """...and they make at least this fraction of its surface (:func:`drawn_tilted`): not one
 strip of a coarsely tessellated rod (a 24-gon's pair of opposite facets: 8 %)."""
+STANDING_SHARE = 0.5
+"""...unless its horizontal faces (within :data:`TILT`) make at least this fraction of the
+area of those largest faces, one of them at its lowest point, facing down (:func:`drawn_tilted`):
+a coarse prism lying on a face (a hexagonal or octagonal bar: its horizontal pair as large
+as each tilted pair, less its holes) stands on it as drawn, where a product tilted by
+another angle than quarter turns rests on an edge or a corner, unless a face of its base
+lies at that angle."""
+FLOOR = 1e-6
+"""[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
 _UP_EXPECTED = f"one of {', '.join(UP_AXES)} (the CAD's axis pointing up)"
 
 
@@ -220,21 +229,34 @@ def drawn_tilted(mesh: trimesh.Trimesh, base: str) -> str | None:
     """Why the product whose base ``base`` has ``mesh`` looks drawn tilted, None when it
     does not: the normal that the largest area of the base's faces shares (its largest flat
     faces, normals alike to 0.001, a face and its opposite as one: the normal taken with z
-    >= 0) lies more than :data:`TILT` from the z axis and from the horizontal plane, and
-    they make :data:`TILTED_SHARE` of its surface or more."""
+    >= 0) lies more than :data:`TILT` from the z axis and from the horizontal plane, they
+    make :data:`TILTED_SHARE` of its surface or more, and the base does not stand on
+    horizontal faces (:func:`_standing`)."""
     normals = mesh.face_normals * np.where(mesh.face_normals[:, 2:] < 0, -1.0, 1.0)  # a face's plane: z >= 0
     keys, index = np.unique(np.round(normals, 3) + 0.0, axis=0, return_inverse=True)
     areas = np.bincount(index.ravel(), mesh.area_faces)
     largest = int(np.argmax(areas))
     normal = keys[largest] / np.linalg.norm(keys[largest])
     from_z = math.degrees(math.acos(min(1.0, float(normal[2]))))
-    if min(from_z, 90.0 - from_z) <= TILT or areas[largest] < TILTED_SHARE * mesh.area:
+    if min(from_z, 90.0 - from_z) <= TILT or areas[largest] < TILTED_SHARE * mesh.area \
+            or _standing(mesh, float(areas[largest])):
         return None
     facing = ", ".join(f"{v:.3f}" for v in normal + 0.0)
     return (f"the base {base}'s largest flat faces ({100 * areas[largest] / mesh.area:.0f} % of its surface) face "
             f"({facing}), {from_z:.1f} deg from the z axis: the CAD may be drawn tilted; turn it in the CAD so that "
             'one of its axes points up (up turns by quarter turns only), or set up = "+z" or --up +z to import it as '
             "drawn")
+
+
+def _standing(mesh: trimesh.Trimesh, largest: float) -> bool:
+    """Whether the base ``mesh`` stands on horizontal faces as drawn: its faces within
+    :data:`TILT` of horizontal make :data:`STANDING_SHARE` of ``largest`` [m²] (the area of
+    its largest flat faces) or more, and one of them faces down from its lowest point
+    (within :data:`FLOOR`)."""
+    up = mesh.face_normals[:, 2]
+    flat = np.abs(up) >= math.cos(math.radians(TILT))
+    low = mesh.vertices[mesh.faces][:, :, 2].min(axis=1) <= mesh.bounds[0][2] + FLOOR
+    return float(mesh.area_faces[flat].sum()) >= STANDING_SHARE * largest and bool(np.any(flat & low & (up < 0)))
 
 
 Place = tuple[float, ...]

@@ -125,9 +125,11 @@ def upright(derived: Derived, fit: HoleFit) -> trimesh.Trimesh:
 
 
 def entry_point(fit: HoleFit) -> tuple[float, float, float]:
-    """The centre of a hole's entry in the cell frame [m] (x, y its position, z its ``top_z``)."""
-    if fit.axis == "+z":
-        return fit.centre
+    """The centre of a hole's entry in the cell frame [m] (x, y its position, z its ``top_z``;
+    ``entry`` is measured along the removal direction: a hole entered from below, removal
+    -z, has its entry at z = -``entry``)."""
+    if fit.axis in ("+z", "-z"):  # the slice's axes are the cell's x and y (sections.frame_of)
+        return fit.centre[0], fit.centre[1], fit.entry if fit.axis == "+z" else -fit.entry
     x, y, z = hole_rotation(opposite(fit.axis)) @ np.array([*fit.hole.centre, fit.entry])
     return float(x), float(y), float(z)
 
@@ -267,7 +269,7 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
                                  f"is entered along {opposite(fit.axis)}")
         elif fit.axis == "-z":
             if fit.part is not None:
-                by_hand[fit.part] = f"hole {hid} is entered from below"
+                by_hand[fit.part] = f"goes into hole {hid} along +z, from below"
         elif fit.part is not None and fit.axis != "+z" and (why := _sideways_refused(derived, hid, fit)):
             by_hand[fit.part] = why
         elif fit.part is not None and section_kind(fit) == "polygon" and _polygon_refused(fit, derived):

@@ -213,12 +213,12 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
 
 
 def sideways_depth(derived: Derived, fit: HoleFit) -> float:
-    """The ``depth`` [m] of a hole entered sideways: from its entry along its axis to where
-    its part's tip is in the CAD (the taught goal: nothing stops a part in a through hole),
-    or the measured depth of an empty one."""
+    """The ``depth`` [m] of a hole entered sideways (or from below): from its entry along
+    its axis to where its part's tip is in the CAD (the taught goal: nothing stops a part
+    in a through hole), or the measured depth of an empty one."""
     if fit.part is None:
         return fit.depth
-    return fit.entry - float(upright(derived, fit).bounds[0][2])
+    return fit.entry - float((derived.parts[fit.part].mesh.vertices @ np.array(DIRECTIONS[fit.axis])).min())
 
 
 STOP_PROBE = 1e-4

@@ -7,6 +7,7 @@ by another angle than quarter turns, is refused, naming the setting."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import tomllib
@@ -16,10 +17,11 @@ from typing import Any
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from executor import ExecutorError
-from executor.cad.cli import Imported, ImportOptions, run_import
+from executor.cad.cli import Imported, ImportOptions, drawn_tilted, run_import
 from tests.cad.test_corpus import _atoms
 from tests.conftest import Runner, error_lines
 
@@ -346,3 +348,105 @@ def test_a_product_turned_about_z_is_not_taken_for_tilted(tmp_path: Path) -> Non
     imported = run_import(cad, tmp_path / "out", "mm", None)
     assert {fit.axis for fit in imported.derived.holes.values()} == {"+z"}
     assert imported.assumed[0].startswith("the CAD's +z is up (set up")
+
+
+def _one_peg_from_below(folder: Path) -> Path:
+    """A 100 x 60 x 30 mm block at x = 560 mm with a 20.5 mm square hole 15 mm deep into its
+    top (h1) and one into its bottom (h2), a 20 mm square peg 40 mm long down in h1 (25 mm
+    out of the top) and a 15 mm one up in h2 (flush with the bottom), as STL in ``folder``:
+    drawn z up, one part going into the base from below."""
+    folder.mkdir()
+    _box((100.0, 60.0, 30.0), (560.0, 0.0, 15.0)).difference(_box((20.5, 20.5, 30.0), (535.0, 0.0, 30.0))).difference(
+        _box((20.5, 20.5, 30.0), (585.0, 0.0, 0.0))).export(folder / "block.stl")
+    _box((20.0, 20.0, 40.0), (535.0, 0.0, 35.0)).export(folder / "down.stl")
+    _box((20.0, 20.0, 15.0), (585.0, 0.0, 7.5)).export(folder / "up.stl")
+    return folder
+
+
+def test_a_part_going_into_the_base_from_below_is_placed_by_hand(tmp_path: Path, run_main: Runner) -> None:
+    # the peg going up into h2 is no sign of a CAD drawn upside down (the other stands out above):
+    # imported as drawn, that peg written to be placed by hand, its hole's entry on the floor
+    _one_peg_from_below(tmp_path / "cad")
+    done = run_main("import", "cad", "--out", "out", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert ("manual up: the cell has no operation for it, a plan's step places it by hand (goes into hole h2 along "
+            "+z, from below)") in done.stdout, done.stdout
+    assert "hole h2 entry at (585.000, 0.000, 0.000) mm, entered along +z" in done.stdout
+    assert "no experiment of the PyBullet cell" not in done.stdout  # h2 is 15 mm deep, not taken for 0 mm
+    holes = tomllib.loads((tmp_path / "out" / "assembly.toml").read_text())["holes"]
+    assert holes["h2"]["position"] == pytest.approx([0.585, 0.0], abs=1e-9)
+    manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["manual"]
+    assert set(manual) == {"up"} and manual["up"]["on"] == ["h2"]
+    assert manual["up"]["goal"] == pytest.approx([0.585, 0.0, 0.0], abs=1e-6)  # where the CAD has it
+
+
+def test_a_product_drawn_upside_down_imported_as_drawn_places_its_parts_by_hand(tmp_path: Path) -> None:
+    # up = "+z" stated over the refusal: the peg goes up into the block's hole, which the cell
+    # has no operation for; the product is still written (not a KeyError of the hole frame)
+    cad = _upside_down(tmp_path / "cad", 30.0)
+    imported = run_import(cad, tmp_path / "out", "mm", None, ImportOptions(up="+z"))
+    assert imported.derived.axis["peg"] == "-z"
+    assert imported.mapped.manual == {"peg": "goes into hole h1 along +z, from below"}
+    assert (tmp_path / "out" / "geometry.toml").is_file()
+
+
+@pytest.mark.slow  # teaches the peg going down, assembles the product in physics
+def test_the_sim_cell_assembles_a_product_with_a_part_going_in_from_below(tmp_path: Path, run_main: Runner) -> None:
+    _one_peg_from_below(tmp_path / "cad")
+    assert run_main("import", "cad", "--out", "out", cwd=tmp_path).returncode == 0
+    assert run_main("-q", "executor", "teach", "--assembly", "out", cwd=tmp_path).returncode == 0
+    done = run_main("assemble", "out/sizes.lp", "out/geometric_precedence.lp", "--assembly", "out", "--json",
+                    cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    steps = {step["part"]: step for step in report["steps"]}
+    assert report["assembled"] and (steps["down"]["skill"], steps["up"]["skill"]) == ("insert", "manual")
+    assert report["manual_reasons"] == {"up": "goes into hole h2 along +z, from below"}
+
+
+def _bar(folder: Path, sides: int, roll: float) -> Path:
+    """A regular ``sides``-gon bar 40 mm across its flats and 120 mm long along x, lying on
+    a flat face turned by ``roll`` [deg] about its axis (on its lowest point at z = 0), a
+    10.5 mm square hole down through it and a 10 mm square peg 50 mm long in it from the
+    floor, as STL in ``folder``."""
+    folder.mkdir()
+    radius = 20.0 / np.cos(np.pi / sides)
+    corners = [(radius * np.cos(np.pi / sides * (2 * k + 1)), radius * np.sin(np.pi / sides * (2 * k + 1)))
+               for k in range(sides)]  # a flat face across +x, which the turn below sets down
+    bar = trimesh.creation.extrude_polygon(shapely.Polygon(corners), 120.0)
+    bar.apply_transform(trimesh.transformations.rotation_matrix(np.radians(roll), (1.0, 0.0, 0.0))
+                        @ trimesh.transformations.rotation_matrix(np.pi / 2, (0.0, 1.0, 0.0)))
+    low, high = bar.bounds
+    bar.apply_translation((560.0 - (low[0] + high[0]) / 2, -(low[1] + high[1]) / 2, -low[2]))
+    bar.difference(_box((10.5, 10.5, 100.0), (560.0, 0.0, 20.0))).export(folder / "bar.stl")
+    _box((10.0, 10.0, 50.0), (560.0, 0.0, 25.0)).export(folder / "peg.stl")
+    return folder
+
+
+@pytest.mark.parametrize("sides", [6, 8])
+def test_a_coarse_prism_lying_on_a_face_is_not_taken_for_tilted(tmp_path: Path, sides: int) -> None:
+    # its largest flat faces, a pair at 60 or 45 deg (as large as its horizontal pair, less
+    # the hole's), are tilted; it stands on its bottom face: imported as drawn
+    imported = run_import(_bar(tmp_path / "cad", sides, 0.0), tmp_path / "out", "mm", None)
+    assert {fit.axis for fit in imported.derived.holes.values()} == {"+z"}
+    assert imported.derived.hole_of["peg"].id == "h1"
+
+
+def test_a_coarse_prism_on_its_edge_is_tilted(tmp_path: Path) -> None:
+    # the hexagonal bar turned 30 deg about its axis: on an edge, no face horizontal
+    with pytest.raises(ExecutorError, match=r"the base bar's largest flat faces \(\d+ % of its surface\) face "
+                       r"\(0.000, -?0.500, 0.866\), 30.0 deg from the z axis: the CAD may be drawn tilted"):
+        run_import(_bar(tmp_path / "cad", 6, 30.0), tmp_path / "read_z_up", "mm", None)
+    assert not (tmp_path / "read_z_up").exists()
+
+
+@pytest.mark.parametrize(("turn", "tilted"), [(0.0, False), (180.0, True)])
+def test_a_base_stands_on_horizontal_faces_only_from_its_lowest_point(turn: float, tilted: bool) -> None:
+    # a wedge 20 mm wide along y, 27.5 mm high to its edge, 100 mm long: its flat face as large
+    # as two thirds of each slanted face (20 deg from vertical), so its horizontal faces count;
+    # lying on that face it stands on it, turned over about x onto its edge it is tilted
+    wedge = trimesh.creation.extrude_polygon(shapely.Polygon([(0.0, -0.01), (0.0, 0.01), (-0.0275, 0.0)]), 0.1)
+    wedge.apply_transform(trimesh.transformations.rotation_matrix(np.radians(turn), (1.0, 0.0, 0.0))
+                          @ trimesh.transformations.rotation_matrix(np.pi / 2, (0.0, 1.0, 0.0)))
+    why = drawn_tilted(wedge, "wedge")
+    assert (why is not None) == tilted, why
