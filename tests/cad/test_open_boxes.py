@@ -14,7 +14,7 @@ import trimesh
 
 from executor.cad.cli import run_import
 from executor.cad.derive import CAVITY_ROOM
-from executor.cad.derive.cavities import roomy
+from executor.cad.derive.cavities import room_at, roomy
 from executor.cad.sections import Loop, classify
 
 
@@ -169,3 +169,24 @@ def test_a_block_in_the_roomy_leg_of_an_l_pocket_is_in_no_hole(tmp_path: Path) -
     assert derived.base == "plate"
     assert {fit.part for fit in derived.holes.values()} == {"peg"}
     assert "block" not in derived.hole_of
+
+
+def test_the_room_in_a_rectangle_is_its_short_side_less_the_part_wherever_the_part_lies() -> None:
+    # In a rectangle (turned any way) the room is the short side less the part's widest,
+    # as the rule by the rectangle's sides had it, at every place the part may lie; in an L
+    # it is the leg's where the part lies, and an empty L is roomy only if every leg is.
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        a, b, turn = rng.uniform(0.02, 0.1), rng.uniform(0.02, 0.1), rng.uniform(0, np.pi)
+        widest = rng.uniform(0.0, min(a, b))
+        rotation = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+        corners = np.array([[-a, -b], [a, -b], [a, b], [-a, b]]) / 2 @ rotation.T
+        at = rng.uniform(-0.5, 0.5, 2) * (np.array([a, b]) - widest) @ rotation.T
+        room = min(a, b) - widest
+        if abs(room - CAVITY_ROOM) > 1e-6:
+            assert room_at(corners, widest, at) == room_at(corners, widest, None) == (room > CAVITY_ROOM)
+    leg = np.array(shapely.union(shapely.box(-0.050, -0.040, -0.020, -0.022),
+                                 shapely.box(-0.020, -0.040, 0.030, 0.040)).exterior.coords)[:-1]
+    assert not room_at(leg, 0.014, np.array([-0.040, -0.031]))
+    assert room_at(leg, 0.014, np.array([0.010, 0.020]))
+    assert not room_at(leg, 0.014, None) and room_at(leg, 0.011, None)
