@@ -19,10 +19,11 @@ from executor.cad.locating import LOCATING_REACH
 from executor.cad.sections import Loop
 
 CAVITY_ROOM = 2 * LOCATING_REACH
-"""[m] A hole whose narrowest width exceeds a part's widest by more than this (6 mm)
-leaves that part, wherever it lies in it, free to move the locating rule's default reach
-one way or the other across: with a floor under it, a cavity that locates nothing of that
-size (an open tray's, a case's without its lid), no hole for it (:func:`open_box`)."""
+"""[m] A hole that leaves the part in it more than this (6 mm) of room every way where it
+lies (:func:`room_at`: a convex hole, as its narrowest width exceeds the part's widest)
+leaves it free to move the locating rule's default reach one way or the other across:
+with a floor under it, a cavity that locates nothing of that size (an open tray's, a
+case's without its lid), no hole for it (:func:`open_box`)."""
 
 
 def without_cavities(base: trimesh.Trimesh, fits: list[tuple[HoleFit, np.ndarray, np.ndarray]]) -> list[HoleFit]:
