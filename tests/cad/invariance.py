@@ -8,7 +8,9 @@ as ASCII STL of float64 coordinates, as every variant is written, so the compari
 measures the change, not the file format):
 
 - ``turn90``, ``turn180``, ``turn270``: every vertex turned about z (an exact permutation
-  of x and y with signs); the cell frame's points and axes turned back about ``place``;
+  of x and y with signs), and the trays the settings set turned as a whole with the parts
+  on them (:func:`_turn_trays`); the cell frame's points and axes turned back about
+  ``place``;
 - ``shift``: every vertex moved by :data:`SHIFT` [mm] (taken off by the import's
   placement: x and y by ``place``, z by standing the product on the cell's floor);
 - ``metres``: coordinates × 0.001, imported with ``--units m``;
@@ -154,8 +156,25 @@ def write_variant(product: Path, variant: Variant, out: Path, seed: int = 1) -> 
     config = tomllib.loads((product / "import.toml").read_text())
     config["base"] = renamed[config["base"]]
     config["parts"] = {renamed[pid]: table for pid, table in config.get("parts", {}).items()}
+    _turn_trays(config["parts"], variant.points if variant.quarter else None)
     (out / "import.toml").write_text(_toml(config))
     return renamed
+
+
+def _turn_trays(parts: dict[str, dict[str, Any]], turn: Callable[[np.ndarray], np.ndarray] | None) -> None:
+    """The trays the settings set (positions in the cell [m], each part waiting on its tray
+    as the CAD has it turned) turned by ``turn`` (None: as they are) about the centre of
+    their box, in place: the parts turned with the product keep the room they had between
+    them on their trays, as they would not on the trays set for the product unturned (the
+    200 mm rod turned across them lies over another part's tray)."""
+    set_trays = {pid: table["tray"] for pid, table in parts.items() if "tray" in table}
+    if turn is None or not set_trays:
+        return
+    trays = np.array(list(set_trays.values()), dtype=float)
+    centre = (trays.min(axis=0) + trays.max(axis=0)) / 2
+    turned = turn(np.column_stack([trays - centre, np.zeros(len(trays))]))[:, :2] + centre
+    for pid, tray in zip(set_trays, turned.tolist(), strict=True):
+        parts[pid]["tray"] = tray
 
 
 def _toml(config: dict[str, Any]) -> str:

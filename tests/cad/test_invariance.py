@@ -5,13 +5,15 @@ marked. The whole run: ``.venv/bin/python -m tests.cad.invariance``."""
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from executor.cad.parts import check_solids, load_meshes
-from tests.cad.invariance import CORPUS, VARIANTS, compare, differences, write_variant
+from tests.cad.invariance import CORPUS, VARIANTS, _turn_trays, compare, differences, write_variant
 
 _BASES: dict[str, dict[str, Any]] = {}
 """Each product's unchanged import, once per session."""
@@ -42,6 +44,31 @@ def test_parts_onto_pins_of_a_part_placed_by_hand_are_imported_alike_turned_and_
         transform: str, tmp_path_factory: pytest.TempPathFactory) -> None:
     # asm4_disk_arm: pins of the base and of the disk, two parts placed by hand with reasons naming them
     assert _compared("asm4_disk_arm", transform, tmp_path_factory) == []
+
+
+@pytest.mark.parametrize("transform", ["turn90", "turn180", "turn270"])
+def test_the_trays_the_settings_set_turn_with_the_product(transform: str) -> None:
+    # occt_as1 sets every tray for the product as drawn; turned with the trays unturned, its
+    # 200 mm rod lay along y over nut_a1's tray and the import wrote no geometry.toml.
+    parts = tomllib.loads((CORPUS / "occt_as1" / "import.toml").read_text())["parts"]
+    before = {pid: np.array(table["tray"]) for pid, table in parts.items()}
+    _turn_trays(parts, VARIANTS[transform].points)
+    turn = VARIANTS[transform].points
+    for pid, table in parts.items():
+        offset = np.append(before[pid] - before["rod"], 0.0)[None, :]
+        assert np.allclose(np.array(table["tray"]) - parts["rod"]["tray"], turn(offset)[0, :2], atol=1e-12)
+    same = tomllib.loads((CORPUS / "occt_as1" / "import.toml").read_text())["parts"]
+    _turn_trays(same, None)
+    assert all(same[pid]["tray"] == list(before[pid]) for pid in same)
+
+
+@pytest.mark.slow  # 2 imports of 18 parts, 38 s of CPU (290 s wall at load 9)
+def test_a_product_whose_settings_set_its_trays_is_imported_alike_turned(
+        tmp_path_factory: pytest.TempPathFactory) -> None:
+    # occt_as1 turned 90 deg got no geometry.toml (the rod over nut_a1's tray); its rod,
+    # free both ways along x, is a tie turned 90 deg
+    assert _compared("occt_as1", "turn90", tmp_path_factory) == [
+        "tie: rod goes in along +x unchanged, -x changed (free both ways)"]
 
 
 @pytest.mark.slow  # 2 imports of 4 parts, 27 s at load 8

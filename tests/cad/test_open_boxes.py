@@ -14,7 +14,7 @@ import trimesh
 
 from executor.cad.cli import run_import
 from executor.cad.derive import CAVITY_ROOM
-from executor.cad.derive.cavities import roomy
+from executor.cad.derive.cavities import room_at, roomy
 from executor.cad.sections import Loop, classify
 
 
@@ -135,3 +135,58 @@ def test_the_bound_that_skips_a_cavitys_rectangles_never_skips_a_cavity() -> Non
     assert not roomy(Loop(shaft.points * 1.0001), shaft)
     assert roomy(Loop(np.array([[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]])),
                   Loop(np.array([[0, 0], [0.03, 0], [0.03, 0.03], [0, 0.03]])))
+
+
+def _l_pocket(folder: Path, block: tuple[float, float]) -> None:
+    """A plate 120 x 120 x 20 mm as the base with an L-shaped pocket 10 mm deep (a leg 18 mm
+    wide, x -50 to -20, y -40 to -22, joining one 50 x 80 mm: its minimum-area rectangle
+    80 x 80 mm), a d 9.8 peg in a d 10 hole at (-40, 30) and a 14 x 14 x 10 mm block
+    resting on the pocket's floor at ``block`` (x, y) [mm], as STL [mm]."""
+    folder.mkdir()
+    pocket = trimesh.creation.extrude_polygon(shapely.union(shapely.box(-50.0, -40.0, -20.0, -22.0),
+                                                            shapely.box(-20.0, -40.0, 30.0, 40.0)), 11.0)
+    plate = _box((120.0, 120.0, 20.0), (0.0, 0.0, 10.0)).difference(pocket.apply_translation((0.0, 0.0, 10.0)))
+    plate.difference(_round(-40.0, 10.0, 9.0, 12.0).apply_translation((0.0, 30.0, 0.0))).export(folder / "plate.stl")
+    _round(-40.0, 9.8, 30.0, 12.0).apply_translation((0.0, 30.0, 0.0)).export(folder / "peg.stl")
+    _box((14.0, 14.0, 10.0), (block[0], block[1], 15.0)).export(folder / "block.stl")
+
+
+def test_a_block_held_in_the_narrow_leg_of_an_l_pocket_is_in_a_hole(tmp_path: Path) -> None:
+    # In the 18 mm leg the 14 mm block has 4 mm across: the pocket locates it. Its width was
+    # its minimum-area rectangle's short side (80 mm), so the block lay in an open box.
+    _l_pocket(tmp_path / "meshes", block=(-40.0, -31.0))
+    derived = run_import(tmp_path / "meshes", tmp_path / "out", "mm", None).derived
+    assert derived.base == "plate"
+    assert {fit.part for fit in derived.holes.values()} == {"peg", "block"}
+    assert "block" in derived.hole_of
+
+
+def test_a_block_in_the_roomy_leg_of_an_l_pocket_is_in_no_hole(tmp_path: Path) -> None:
+    # In the 50 mm leg the same block has 36 mm across every way: an open box, however
+    # narrow the other leg.
+    _l_pocket(tmp_path / "meshes", block=(10.0, 20.0))
+    derived = run_import(tmp_path / "meshes", tmp_path / "out", "mm", None).derived
+    assert derived.base == "plate"
+    assert {fit.part for fit in derived.holes.values()} == {"peg"}
+    assert "block" not in derived.hole_of
+
+
+def test_the_room_in_a_rectangle_is_its_short_side_less_the_part_wherever_the_part_lies() -> None:
+    # In a rectangle (turned any way) the room is the short side less the part's widest,
+    # as the rule by the rectangle's sides had it, at every place the part may lie; in an L
+    # it is the leg's where the part lies, and an empty L is roomy only if every leg is.
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        a, b, turn = rng.uniform(0.02, 0.1), rng.uniform(0.02, 0.1), rng.uniform(0, np.pi)
+        widest = rng.uniform(0.0, min(a, b))
+        rotation = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+        corners = np.array([[-a, -b], [a, -b], [a, b], [-a, b]]) / 2 @ rotation.T
+        at = rng.uniform(-0.5, 0.5, 2) * (np.array([a, b]) - widest) @ rotation.T
+        room = min(a, b) - widest
+        if abs(room - CAVITY_ROOM) > 1e-6:
+            assert room_at(corners, widest, at) == room_at(corners, widest, None) == (room > CAVITY_ROOM)
+    leg = np.array(shapely.union(shapely.box(-0.050, -0.040, -0.020, -0.022),
+                                 shapely.box(-0.020, -0.040, 0.030, 0.040)).exterior.coords)[:-1]
+    assert not room_at(leg, 0.014, np.array([-0.040, -0.031]))
+    assert room_at(leg, 0.014, np.array([0.010, 0.020]))
+    assert not room_at(leg, 0.014, None) and room_at(leg, 0.011, None)

@@ -32,9 +32,10 @@ a pair of theirs that the blocking contradicts is dropped and reported.
 **Holes** are the inner loops of the base's slices perpendicular to the axes, at the
 middle of each part's depth in the base (or, with no part reaching into it, at the base's
 middle along z). A part is in the hole whose loop holds its slice's centre, unless that
-hole is floored and wider than the part by more than :data:`CAVITY_ROOM` (a tray's cavity
-the part rests in: no hole for it, nor is a moving part's loop so wide); an empty floored
-hole so much wider than every part left in a hole is none
+hole is floored and leaves the part more than :data:`CAVITY_ROOM` of room every way where
+it lies (a tray's cavity the part rests in: no hole for it, nor is a moving part's loop so
+roomy); an empty floored hole so roomy wherever the widest part left in a hole lies in it
+is none
 (:func:`executor.cad.derive.cavities.open_box`). Measured: both cross-sections, their
 clearance, the hole's entry (the base's highest point around it along the axis), depth
 (entry to the first face down its centre line, or through the base), entry chamfer (the

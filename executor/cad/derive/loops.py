@@ -75,7 +75,8 @@ def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float,
         for loop in (o for o in loops if not outer(o, loops)):
             inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
             if len(inside) == 1 and not (roomy(loop, inside[0]) and open_box(
-                    loop.extent[1], inside[0].extent[0], owner.mesh, frame.T @ loop.centre + axis * level, axis)):
+                    loop.points, loop.extent[1], inside[0].extent[0], inside[0].centre, owner.mesh,
+                    frame.T @ loop.centre + axis * level, axis)):
                 around = sorted((o for o in loops if o is not loop and o.area > loop.area
                                  and o.contains(loop.centre)), key=lambda o: o.area)
                 return level, loop, around[0] if around else None, inside[0]
