@@ -62,15 +62,6 @@ def test_the_trays_the_settings_set_turn_with_the_product(transform: str) -> Non
     assert all(same[pid]["tray"] == list(before[pid]) for pid in same)
 
 
-@pytest.mark.slow  # 2 imports of 18 parts, 38 s of CPU (290 s wall at load 9)
-def test_a_product_whose_settings_set_its_trays_is_imported_alike_turned(
-        tmp_path_factory: pytest.TempPathFactory) -> None:
-    # occt_as1 turned 90 deg got no geometry.toml (the rod over nut_a1's tray); its rod,
-    # free both ways along x, is a tie turned 90 deg
-    assert _compared("occt_as1", "turn90", tmp_path_factory) == [
-        "tie: rod goes in along +x unchanged, -x changed (free both ways)"]
-
-
 @pytest.mark.slow  # 2 imports of 4 parts, 27 s at load 8
 def test_the_slits_of_a_pin_in_its_hole_stay_pockets_turned(tmp_path_factory: pytest.TempPathFactory) -> None:
     # ldraw_axles: turned 90 deg, two of the Technic pin's slits (0.816 x 0.000 mm) were
