@@ -267,16 +267,28 @@ def test_a_product_drawn_upside_down_is_refused_and_imported_with_up_minus_z(tmp
     assert turned.derived.axis["peg"] == "+z"
 
 
-@pytest.mark.slow  # an import of a seven-part product with a spline shaft
-def test_a_product_drawn_upside_down_with_its_parts_beyond_the_base_across_is_refused(tmp_path: Path) -> None:
-    # flynn_clutch z down: its plates 5.5 mm beyond the holder across, 0.6 mm under it; its seven bolt
-    # holes, empty, are left upwards, but four of its five other parts leave it downwards
-    meshes = _drawn("flynn_clutch", "-z", tmp_path / "drawn")
+def test_a_product_drawn_upside_down_with_more_parts_going_up_than_down_is_refused(tmp_path: Path) -> None:
+    # Two pegs go up into holes in the block's bottom, standing 0.6 mm out of it below, one with
+    # a flange 6 mm beyond the block across, and one down into a hole in its top, flush with it
+    # (flynn_clutch drawn z down: four of its parts leave downwards, its plates 0.6 mm under the
+    # holder and 5.5 mm beyond it across, one upwards)
+    cad = tmp_path / "cad"
+    cad.mkdir()
+    block = _box((150.0, 60.0, 30.0), (0.0, 0.0, 15.0))
+    for x, z in ((-45.0, 0.0), (0.0, 0.0), (45.0, 30.0)):
+        block = block.difference(_box((29.0, 29.0, 40.0), (x, 0.0, z)))
+    block.export(cad / "block.stl")
+    for name, x, low, high in (("a", -45.0, -0.6, 20.0), ("b", 0.0, -0.6, 20.0), ("c", 45.0, 10.0, 30.0)):
+        peg = _box((28.3, 28.3, high - low), (x, 0.0, (low + high) / 2))
+        if name == "a":
+            peg = trimesh.boolean.union([peg, _box((28.3, 72.0, 0.6), (x, 0.0, -0.3))], engine="manifold")
+        peg.export(cad / f"{name}.stl")
+    (tmp_path / "import.toml").write_text('base = "block"\n')
     with pytest.raises(ExecutorError) as refused:
-        run_import(meshes, tmp_path / "read_z_up", "mm", CORPUS / "flynn_clutch" / "import.toml")
-    assert ("the base inner_holder is 9.300 mm tall and 9 of its 9 holes and pins open along z, 4 of the other parts "
-            "left along -z (1 along +z) and standing out of it 0.600 mm below it, 0.000 mm above it: the CAD may be "
-            'drawn upside down (z down); set up = "-z" or --up=-z') in str(refused.value), str(refused.value)
+        run_import(cad, tmp_path / "read_z_up", "mm", tmp_path / "import.toml")
+    assert ("2 of the other parts left along -z (1 along +z) and standing out of it 0.600 mm below it, 0.000 mm above "
+            'it: the CAD may be drawn upside down (z down); set up = "-z" or --up=-z') in str(refused.value), \
+        str(refused.value)
     assert not (tmp_path / "read_z_up").exists()
 
 
