@@ -55,6 +55,16 @@ GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "
 """The simulated gripper of every imported product (Cranfield's, with the cell's suction
 cup: ``cup_diameter`` [m], ``cup_force`` [N]), its flange longer where the arm's wrist
 would meet the product (:func:`tool_length`)."""
+FINGER_THICKNESS = 0.01
+"""[m] the finger model: the fingers lie in the band this wide around the part's footprint
+(its outline seen along its axis, convex hull), from its top down as deep as they hold it;
+an assumption of about a parallel gripper's fingertip (docs/cell.md#the-fingers-grip)."""
+GRIP_CLEARANCE = 0.001
+"""[m] how far above everything else of the product in the finger band the fingertips stay
+with the part at its goal."""
+MIN_GRIP = 0.005
+"""[m] the least length of a part the fingers hold it over (docs/cell.md#the-fingers-grip):
+below it the pads' give tilts the part beyond the cell's grasp error model (≤ 1 deg)."""
 FLAT_TOLERANCE = 1e-5
 """[m] how far from the plane of a part's top (its highest point along its way out) a
 face's vertices may lie, and still seal the cup (a face tilted by more than its size
@@ -335,17 +345,22 @@ def _owner_refused(derived: Derived, pin: PinFit, fit: HoleFit | None) -> str:
 
 def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
     """What holds the peg of ``fit`` and why: ``fingers`` for a part longer than
-    :data:`GRIPPER`'s grasp depth (held by its sides that deep), else ``suction`` where
-    it is at least :data:`executor.world.meshes.MIN_THICKNESS` thick and the cup (``cup_diameter``) lies
+    :data:`GRIPPER`'s grasp depth that stands out of the product at its goal far enough
+    for them (:func:`finger_grip`), else ``suction`` where it is at least
+    :data:`executor.world.meshes.MIN_THICKNESS` thick and the cup (``cup_diameter``) lies
     whole on its flat top (:func:`flat_top`: the face opposite its way in, around its
     axis), else "" (placed by hand) with why."""
     assert fit.part is not None and fit.section is not None
     mesh = upright(derived, fit)
     length, depth = float(mesh.extents[2]), GRIPPER["grasp_depth"]
     if length > depth:
-        return "fingers", f"{1e3 * length:.3f} mm long, held {1e3 * depth:g} mm deep by the fingers"
-    short = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's grasp depth "
-             f"({1e3 * depth:g} mm)")
+        grip, why = finger_grip(derived, fit)
+        if grip > 0:
+            return "fingers", f"{1e3 * length:.3f} mm long, held {1e3 * grip:g} mm deep by the fingers{why}"
+        short = f"part '{fit.part}' {why}"
+    else:
+        short = (f"part '{fit.part}' is {1e3 * length:.3f} mm long, no longer than the gripper's grasp depth "
+                 f"({1e3 * depth:g} mm)")
     if length < MIN_THICKNESS:  # a physics limit: no convex piece of it keeps its shape
         return "", (f"{short}, and thinner than the cell's hull margin twice less what it resolves "
                     f"({1e3 * MIN_THICKNESS:g} mm): it has no convex pieces the cell can collide as")
@@ -359,6 +374,82 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
                     f"flat top ({100 * inside:.1f}% of the cup on it)")
     return "suction", (f"{short}: its flat top ({1e6 * top.area:.1f} mm^2) holds the suction cup "
                        f"({1e3 * GRIPPER['cup_diameter']:g} mm) about its axis")
+
+
+def finger_assumption() -> str:
+    """The finger model, as the import states it among its assumptions."""
+    return (f"the fingers hold a peg over its top {1e3 * GRIPPER['grasp_depth']:g} mm, less where it stands out of "
+            f"the product less at its goal (its top above every part that may be in place within "
+            f"{1e3 * FINGER_THICKNESS:g} mm of its outline) less {1e3 * GRIP_CLEARANCE:g} mm, over "
+            f"{1e3 * MIN_GRIP:g} mm at least; a peg standing out less goes on the suction cup or by hand")
+
+
+def finger_grip(derived: Derived, fit: HoleFit) -> tuple[float, str]:
+    """How deep [m] the fingers hold the peg of ``fit`` (longer than :data:`GRIPPER`'s
+    grasp depth) and why where not that deep: the grasp depth, or what the peg stands out
+    of the product at its goal (:func:`standing_out`) less :data:`GRIP_CLEARANCE` where
+    that is less, rounded down to 0.1 mm; 0 where that is under :data:`MIN_GRIP` (the
+    fingers would meet the product before the peg reaches its goal)."""
+    assert fit.part is not None
+    out, under = standing_out(derived, fit.part, fit)
+    depth, need = GRIPPER["grasp_depth"], MIN_GRIP + GRIP_CLEARANCE
+    if out - GRIP_CLEARANCE >= depth:
+        return depth, ""
+    where = f"stands out of the product by {1e3 * out:.3f} mm at its goal" + (
+        f" ('{under}' within {1e3 * FINGER_THICKNESS:g} mm of its outline)" if under else "")
+    if out < need - 1e-9:
+        return 0.0, f"{where}, less than the {1e3 * need:g} mm the fingers need"
+    return math.floor(round((out - GRIP_CLEARANCE) * 1e4, 6)) / 1e4, f": it {where}, less {1e3 * GRIP_CLEARANCE:g} mm"
+
+
+def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit) -> tuple[float, str]:
+    """How far [m] part ``pid``'s top stands out, at its goal (where the CAD has it) along
+    the removal direction of ``fit`` (its hole or pin), of every other part that may be in
+    place then (:func:`_maybe_in_place`) within the finger band: :data:`FINGER_THICKNESS`
+    around its footprint (the convex hull of its outline seen along that direction); and
+    the part it stands out of ("" where none reaches into the band above the part's
+    bottom: its length)."""
+    turn = feature_turn(fit)[:3, :3].T
+    own = derived.parts[pid].mesh.vertices @ turn
+    low, high = float(own[:, 2].min()), float(own[:, 2].max())
+    hull = shapely.MultiPoint(own[:, :2]).convex_hull
+    band = hull.buffer(FINGER_THICKNESS, 16).difference(hull)
+    under, other_top = "", low
+    for other in sorted(_maybe_in_place(derived, pid)):
+        mesh = derived.parts[other].mesh
+        top = _highest_in(mesh.vertices[mesh.faces] @ turn, band, other_top)
+        if top is not None:
+            under, other_top = other, top
+    return high - other_top, under
+
+
+def _highest_in(triangles: np.ndarray, region: shapely.Geometry, above: float) -> float | None:
+    """The highest point [m] of the ``triangles`` (n, 3, 3) [m] within the vertical prism
+    over ``region`` (x, y [m]), where above ``above`` [m]; None where none is. A triangle's
+    height is linear over it: its highest over the region is at a corner of their
+    intersection (a vertical triangle is the edge of its neighbours)."""
+    x0, y0, x1, y1 = region.bounds
+    xy = triangles[:, :, :2]
+    near = ((xy[:, :, 0].max(axis=1) >= x0) & (xy[:, :, 0].min(axis=1) <= x1)
+            & (xy[:, :, 1].max(axis=1) >= y0) & (xy[:, :, 1].min(axis=1) <= y1)
+            & (triangles[:, :, 2].max(axis=1) > above))
+    triangles = triangles[near]
+    edges = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    triangles, normals = triangles[np.abs(edges[:, 2]) > 1e-12], edges[np.abs(edges[:, 2]) > 1e-12]
+    best: float | None = None
+    for k in np.argsort(-triangles[:, :, 2].max(axis=1)):
+        corner, normal = triangles[k], normals[k]
+        if float(corner[:, 2].max()) <= (above if best is None else best):
+            break
+        cut = shapely.Polygon(corner[:, :2]).intersection(region)
+        if cut.is_empty:
+            continue
+        points = shapely.get_coordinates(cut)
+        heights = corner[0, 2] - ((points - corner[0, :2]) @ normal[:2]) / normal[2]
+        top = float(min(heights.max(), corner[:, 2].max()))
+        if top > (above if best is None else best):
+            best = top
+    return best
 
 
 def flat_top(mesh: trimesh.Trimesh) -> shapely.Geometry:
@@ -428,15 +519,15 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     may be in place (any but those the geometric precedence puts after it, and but a base with
     pins: :func:`executor.world.scene.wrist_clear_of`) within that radius
     of the axis of each part the cell inserts from above, held :data:`GRIPPER`'s grasp depth
-    deep (a part with a bore: at most half its length; a part on the suction cup by its top:
-    :func:`tool_of`) at its goal (a peg standing on its
+    deep (a part with a bore: at most half its length; a peg standing out less: :func:`finger_grip`;
+    a part on the suction cup by its top: :func:`tool_of`) at its goal (a peg standing on its
     hole's bottom, a part with a bore where the CAD has it), rounded up to the millimetre;
     None where :data:`GRIPPER`'s keeps it clear, with why (the part, the part below the
     wrist and how high it stands) otherwise. A part the wrist meets stops short of its goal
     (``occt_as1``: bolt_a1 4.1 mm above it, the wrist on bracket_a's wall)."""
     depth = GRIPPER["grasp_depth"]
     grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2])
-                   - (0.0 if tool_of(derived, fit)[0] == "suction" else depth))  # the cup: at its top
+                   - (0.0 if tool_of(derived, fit)[0] == "suction" else finger_grip(derived, fit)[0]))  # cup: top
              for pid, fit in derived.hole_of.items() if fit.axis == "+z"}
     for pin in derived.pins.values():
         for pid in (p for p in pin.parts if p in derived.bores and pin.axis == "+z"):
