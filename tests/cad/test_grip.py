@@ -45,7 +45,6 @@ def test_a_peg_is_held_over_what_stands_out_of_the_product(tmp_path: Path, capsy
     _plate_and_pegs(tmp_path / "cad")
     assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     printed = capsys.readouterr().out
-    assert operations.finger_assumption() in printed
     assert ("manual peg3: the cell has no operation for it, a plan's step places it by hand (part 'peg3' stands out "
             "of the product by 5.500 mm at its goal ('plate' within 10 mm of its outline), less than the 6 mm the "
             "fingers need, and its top is not flat for the suction cup)") in printed
@@ -53,6 +52,7 @@ def test_a_peg_is_held_over_what_stands_out_of_the_product(tmp_path: Path, capsy
     assert set(shapes) == {"peg1", "peg2"}
     assert "grasp_depth" not in shapes["peg1"] and "tool" not in shapes["peg1"]  # 30 mm out: the fingers' 20
     assert shapes["peg2"]["grasp_depth"] == pytest.approx(0.007, abs=1e-9)  # 8 mm out, 1 mm clear
+    assert "assumes: " in printed and "the fingers hold a peg over its top 20 mm, less where it stands out" in printed
     geometry = load_geometry(str(tmp_path / "out"))
     gripper = geometry.gripper
     assert geometry.parts["peg1"].held_depth(gripper) == pytest.approx(0.02)
@@ -68,11 +68,10 @@ def test_a_peg_is_held_over_what_stands_out_of_the_product(tmp_path: Path, capsy
 
 @pytest.mark.slow  # imports the product (about 6 s under load)
 def test_a_peg_standing_out_less_with_a_flat_top_goes_on_the_suction_cup(tmp_path: Path) -> None:
-    # peg3 with a flat top: 5 mm out, less than the fingers need; the cup lies on its 12 mm
-    # square top with a 10 mm cup.
+    # peg3 20.5 mm long with a flat top: 5.5 mm out, less than the fingers need; a 10 mm cup
+    # lies on its 12 mm square top.
     _plate_and_pegs(tmp_path / "cad")
-    _box((12, 12, 20), (X + 35, 0, 15)).export(tmp_path / "cad" / "peg3.stl")
-    (tmp_path / "import.toml").write_text("")
+    _box((12, 12, 20.5), (X + 35, 0, 15.25)).export(tmp_path / "cad" / "peg3.stl")
     with pytest.MonkeyPatch.context() as patch:
         patch.setitem(operations.GRIPPER, "cup_diameter", 0.01)
         assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
