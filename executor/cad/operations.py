@@ -56,9 +56,16 @@ GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "
 cup: ``cup_diameter`` [m], ``cup_force`` [N]), its flange longer where the arm's wrist
 would meet the product (:func:`tool_length`)."""
 FINGER_THICKNESS = 0.01
-"""[m] the finger model: the fingers lie in the band this wide around the part's footprint
-(its outline seen along its axis, convex hull), from its top down as deep as they hold it;
-an assumption of about a parallel gripper's fingertip (docs/cell.md#the-fingers-grip)."""
+"""[m] the finger model: a parallel gripper's two fingers, each this thick along the way they
+close and :data:`FINGER_WIDTH` across it, centred on the part's axis, beside the part's
+footprint (its outline seen along its axis) from its top down as deep as they hold it; the
+gripper turned about that axis where the part stands out most (every
+:data:`FINGER_YAW_STEP`). An assumption of about a parallel gripper's fingertips
+(docs/cell.md#the-fingers-grip)."""
+FINGER_WIDTH = 0.02
+"""[m] each finger across the way the fingers close (:data:`FINGER_THICKNESS`)."""
+FINGER_YAW_STEP = 15.0
+"""[deg] the turns about the part's axis the fingers are tried at, over half a turn."""
 GRIP_CLEARANCE = 0.001
 """[m] how far above everything else of the product in the finger band the fingertips stay
 with the part at its goal."""
@@ -379,8 +386,9 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
 def finger_assumption() -> str:
     """The finger model, as the import states it among its assumptions."""
     return (f"the fingers hold a peg over its top {1e3 * GRIPPER['grasp_depth']:g} mm, less where it stands out of "
-            f"the product less at its goal (its top above every part that may be in place within "
-            f"{1e3 * FINGER_THICKNESS:g} mm of its outline) less {1e3 * GRIP_CLEARANCE:g} mm, over "
+            f"the product less at its goal (its top above every part that may be in place where the fingers are: "
+            f"two {1e3 * FINGER_THICKNESS:g} x {1e3 * FINGER_WIDTH:g} mm beside its outline, turned about its axis "
+            f"where it stands out most) less {1e3 * GRIP_CLEARANCE:g} mm, over "
             f"{1e3 * MIN_GRIP:g} mm at least; a peg standing out less goes on the suction cup or by hand")
 
 
@@ -396,7 +404,7 @@ def finger_grip(derived: Derived, fit: HoleFit) -> tuple[float, str]:
     if out - GRIP_CLEARANCE >= depth:
         return depth, ""
     where = f"stands out of the product by {1e3 * out:.3f} mm at its goal" + (
-        f" ('{under}' within {1e3 * FINGER_THICKNESS:g} mm of its outline)" if under else "")
+        f" ('{under}' where the fingers are)" if under else "")
     if out < need - 1e-9:
         return 0.0, f"{where}, less than the {1e3 * need:g} mm the fingers need"
     return math.floor(round((out - GRIP_CLEARANCE) * 1e4, 6)) / 1e4, f": it {where}, less {1e3 * GRIP_CLEARANCE:g} mm"
@@ -405,51 +413,79 @@ def finger_grip(derived: Derived, fit: HoleFit) -> tuple[float, str]:
 def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit) -> tuple[float, str]:
     """How far [m] part ``pid``'s top stands out, at its goal (where the CAD has it) along
     the removal direction of ``fit`` (its hole or pin), of every other part that may be in
-    place then (:func:`_maybe_in_place`) within the finger band: :data:`FINGER_THICKNESS`
-    around its footprint (the convex hull of its outline seen along that direction); and
-    the part it stands out of ("" where none reaches into the band above the part's
-    bottom: its length)."""
+    place then (:func:`_maybe_in_place`) where the fingers are (:data:`FINGER_THICKNESS`,
+    turned about the axis where it stands out most), below its top (what overhangs the top
+    is the wrist's: :func:`tool_length`); and the part it stands out of there ("" where none
+    reaches the fingers above the part's bottom: its length)."""
     turn = feature_turn(fit)[:3, :3].T
     own = derived.parts[pid].mesh.vertices @ turn
     low, high = float(own[:, 2].min()), float(own[:, 2].max())
-    hull = shapely.MultiPoint(own[:, :2]).convex_hull
-    band = hull.buffer(FINGER_THICKNESS, 16).difference(hull)
-    under, other_top = "", low
+    triangles = {}  # of the others, below the part's top (above it: the wrist's, tool_length)
     for other in sorted(_maybe_in_place(derived, pid)):
-        mesh = derived.parts[other].mesh
-        top = _highest_in(mesh.vertices[mesh.faces] @ turn, band, other_top)
-        if top is not None:
-            under, other_top = other, top
-    return high - other_top, under
+        below = trimesh.Trimesh(derived.parts[other].mesh.vertices @ turn, derived.parts[other].mesh.faces,
+                                process=False)
+        below = trimesh.intersections.slice_mesh_plane(below, (0.0, 0.0, -1.0), (0.0, 0.0, high))
+        if len(below.faces):
+            triangles[other] = below.vertices[below.faces]
+    centre = np.asarray(shapely.MultiPoint(own[:, :2]).convex_hull.centroid.coords[0])
+    best = (-math.inf, "")
+    for yaw in np.radians(np.arange(0.0, 180.0, FINGER_YAW_STEP)):
+        across, along = np.array([math.cos(yaw), math.sin(yaw)]), np.array([-math.sin(yaw), math.cos(yaw)])
+        reach = (own[:, :2] - centre) @ across
+        pads = [shapely.Polygon([centre + s * across + w * along
+                                 for s, w in ((start, -FINGER_WIDTH / 2), (start + FINGER_THICKNESS, -FINGER_WIDTH / 2),
+                                              (start + FINGER_THICKNESS, FINGER_WIDTH / 2),
+                                              (start, FINGER_WIDTH / 2))])
+                for start in (float(reach.max()), float(reach.min()) - FINGER_THICKNESS)]
+        fingers = shapely.union_all(pads)
+        under, other_top = "", low
+        for other, corners in triangles.items():
+            top = _highest_in(corners, fingers, other_top)
+            if top is not None:
+                under, other_top = other, top
+        if high - other_top > best[0]:
+            best = (high - other_top, under)
+    return best
 
 
 def _highest_in(triangles: np.ndarray, region: shapely.Geometry, above: float) -> float | None:
     """The highest point [m] of the ``triangles`` (n, 3, 3) [m] within the vertical prism
     over ``region`` (x, y [m]), where above ``above`` [m]; None where none is. A triangle's
     height is linear over it: its highest over the region is at a corner of their
-    intersection (a vertical triangle is the edge of its neighbours)."""
+    intersection; a vertical one's on its edges."""
     x0, y0, x1, y1 = region.bounds
     xy = triangles[:, :, :2]
     near = ((xy[:, :, 0].max(axis=1) >= x0) & (xy[:, :, 0].min(axis=1) <= x1)
             & (xy[:, :, 1].max(axis=1) >= y0) & (xy[:, :, 1].min(axis=1) <= y1)
             & (triangles[:, :, 2].max(axis=1) > above))
     triangles = triangles[near]
-    edges = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    triangles, normals = triangles[np.abs(edges[:, 2]) > 1e-12], edges[np.abs(edges[:, 2]) > 1e-12]
-    best: float | None = None
+    normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    best = above
     for k in np.argsort(-triangles[:, :, 2].max(axis=1)):
         corner, normal = triangles[k], normals[k]
-        if float(corner[:, 2].max()) <= (above if best is None else best):
+        if float(corner[:, 2].max()) <= best:
             break
-        cut = shapely.Polygon(corner[:, :2]).intersection(region)
-        if cut.is_empty:
-            continue
-        points = shapely.get_coordinates(cut)
-        heights = corner[0, 2] - ((points - corner[0, :2]) @ normal[:2]) / normal[2]
-        top = float(min(heights.max(), corner[:, 2].max()))
-        if top > (above if best is None else best):
+        if abs(normal[2]) > 1e-12:
+            points = shapely.get_coordinates(shapely.Polygon(corner[:, :2]).intersection(region))
+            heights = corner[0, 2] - ((points - corner[0, :2]) @ normal[:2]) / normal[2]
+        else:  # vertical: along its edges
+            heights = np.array([_edge_height(corner[j], corner[(j + 1) % 3], region) for j in range(3)])
+        if len(heights) and (top := float(min(np.nanmax(heights, initial=-np.inf), corner[:, 2].max()))) > best:
             best = top
-    return best
+    return None if best == above else best
+
+
+def _edge_height(start: np.ndarray, end: np.ndarray, region: shapely.Geometry) -> float:
+    """The highest point [m] of the segment from ``start`` to ``end`` (x, y, z [m]) over
+    ``region``; NaN where it does not pass over it."""
+    run = float(np.hypot(*(end[:2] - start[:2])))
+    if run < 1e-12:  # upright: its top where it stands in the region
+        return float(max(start[2], end[2])) if region.intersects(shapely.Point(start[:2])) else math.nan
+    points = shapely.get_coordinates(shapely.LineString([start[:2], end[:2]]).intersection(region))
+    if not len(points):
+        return math.nan
+    along = np.hypot(*(points - start[:2]).T) / run
+    return float((start[2] + along * (end[2] - start[2])).max())
 
 
 def flat_top(mesh: trimesh.Trimesh) -> shapely.Geometry:

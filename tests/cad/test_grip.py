@@ -26,14 +26,18 @@ X = 560.0
 """[mm] where the plate's centre stands: where the simulated arm reaches."""
 
 
-def _plate_and_pegs(folder: Path) -> None:
+def _plate_and_pegs(folder: Path, rib: bool = False) -> None:
     """A 120 x 80 x 20 mm plate (top at z 20) with three 13 mm square holes 15 mm deep, 35 mm
     apart along x; in them 12 mm square pegs standing on the bottoms: peg1 45 mm long (30 mm
     out), peg2 23 mm (8 mm out), peg3 a 19 mm body under a 1.5 mm pyramid (5.5 mm out, its
-    top pointed)."""
+    top pointed); with ``rib``, the plate has a rib 4 x 20 mm and 40 mm high 6 mm beside peg1
+    (its side along y): in the fingers' way closing along x, not along y."""
     folder.mkdir()
     holes = [_box((13, 13, 15.001), (X + dx, 0, 12.5)) for dx in (-35, 0, 35)]
-    _solid(_box((120, 80, 20), (X, 0, 10)), *holes).export(folder / "plate.stl")
+    plate = _solid(_box((120, 80, 20), (X, 0, 10)), *holes)
+    if rib:
+        plate = trimesh.boolean.union([plate, _box((4, 20, 40.01), (X - 35 + 14, 0, 39.995))], engine="manifold")
+    plate.export(folder / "plate.stl")
     _box((12, 12, 45), (X - 35, 0, 27.5)).export(folder / "peg1.stl")
     _box((12, 12, 23), (X, 0, 16.5)).export(folder / "peg2.stl")
     corners = [(X + 35 + sx * 6, sy * 6, z) for sx in (-1, 1) for sy in (-1, 1) for z in (5.0, 24.0)]
@@ -42,15 +46,16 @@ def _plate_and_pegs(folder: Path) -> None:
 
 @pytest.mark.slow  # imports the product and builds its assembling cell (about 10 s under load)
 def test_a_peg_is_held_over_what_stands_out_of_the_product(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    _plate_and_pegs(tmp_path / "cad")
+    _plate_and_pegs(tmp_path / "cad", rib=True)
     assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     printed = capsys.readouterr().out
     assert ("manual peg3: the cell has no operation for it, a plan's step places it by hand (part 'peg3' stands out "
-            "of the product by 5.500 mm at its goal ('plate' within 10 mm of its outline), less than the 6 mm the "
+            "of the product by 5.500 mm at its goal ('plate' where the fingers are), less than the 6 mm the "
             "fingers need, and its top is not flat for the suction cup)") in printed
     shapes = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["part_shapes"]
     assert set(shapes) == {"peg1", "peg2"}
-    assert "grasp_depth" not in shapes["peg1"] and "tool" not in shapes["peg1"]  # 30 mm out: the fingers' 20
+    # 30 mm out, the fingers closing along y clear of the rib: the fingers' 20
+    assert "grasp_depth" not in shapes["peg1"] and "tool" not in shapes["peg1"]
     assert shapes["peg2"]["grasp_depth"] == pytest.approx(0.007, abs=1e-9)  # 8 mm out, 1 mm clear
     assert "assumes: " in printed and "the fingers hold a peg over its top 20 mm, less where it stands out" in printed
     geometry = load_geometry(str(tmp_path / "out"))
@@ -79,17 +84,20 @@ def test_a_peg_standing_out_less_with_a_flat_top_goes_on_the_suction_cup(tmp_pat
     assert shapes["peg3"]["tool"] == "suction" and "grasp_depth" not in shapes["peg3"]
 
 
-def test_the_finger_band_meets_a_neighbour_reaching_into_it() -> None:
-    # The ring 10 mm wide around a 12 mm square; a 10 mm block up to 15 mm whose side is 1 mm
-    # into the ring, a wedge rising outwards from inside it, and a block 2 mm beyond it.
-    band = shapely.box(-0.016, -0.016, 0.016, 0.016).difference(shapely.box(-0.006, -0.006, 0.006, 0.006))
+def test_the_fingers_meet_a_neighbour_reaching_under_the_top_and_turn_away_from_it() -> None:
+    # Pads 10 x 20 mm on either side of a 12 mm square: a 10 mm block whose side is 1 mm
+    # into them (whole, and its walls only, cut at 10 mm), a wedge rising outwards from inside
+    # them, a block 2 mm beyond them.
+    pads = shapely.union_all([shapely.box(0.006, -0.01, 0.016, 0.01), shapely.box(-0.016, -0.01, -0.006, 0.01)])
     block = trimesh.creation.box((0.01, 0.01, 0.03))
     block.apply_translation((0.02, 0.0, 0.0))
-    assert operations._highest_in(block.vertices[block.faces], band, -1.0) == pytest.approx(0.015)
-    assert operations._highest_in(block.vertices[block.faces], band, 0.02) is None  # none above 20 mm
+    assert operations._highest_in(block.vertices[block.faces], pads, -1.0) == pytest.approx(0.015)
+    assert operations._highest_in(block.vertices[block.faces], pads, 0.02) is None  # none above 20 mm
     wedge = trimesh.convex.convex_hull([(x, y, z) for x in (0.0, 0.03) for y in (-0.005, 0.005)
                                         for z in (0.0, 0.001 + x)])  # its top 1 mm at x 0, 31 mm at x 30
-    wedge.apply_translation((0.013, 0.0, 0.0))  # from x 13, 4 mm high where the ring ends (x 16)
-    assert operations._highest_in(wedge.vertices[wedge.faces], band, -1.0) == pytest.approx(0.004)
+    wedge.apply_translation((0.013, 0.0, 0.0))  # from x 13, 4 mm high where the pad ends (x 16)
+    assert operations._highest_in(wedge.vertices[wedge.faces], pads, -1.0) == pytest.approx(0.004)
+    walls = trimesh.intersections.slice_mesh_plane(block, (0.0, 0.0, -1.0), (0.0, 0.0, 0.01))  # open at 10 mm
+    assert operations._highest_in(walls.vertices[walls.faces], pads, -1.0) == pytest.approx(0.01)
     beyond = block.copy().apply_translation((0.003, 0.0, 0.0))
-    assert operations._highest_in(beyond.vertices[beyond.faces], band, -1.0) is None
+    assert operations._highest_in(beyond.vertices[beyond.faces], pads, -1.0) is None
