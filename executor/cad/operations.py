@@ -64,6 +64,8 @@ gripper turned about that axis where the part stands out most (every
 (docs/cell.md#the-fingers-grip)."""
 FINGER_WIDTH = 0.02
 """[m] each finger across the way the fingers close (:data:`FINGER_THICKNESS`)."""
+FINGER_TOUCH = 1e-6
+"""[m] how far into the fingers a part must reach to be in their way (less: it touches them)."""
 FINGER_YAW_STEP = 15.0
 """[deg] the turns about the part's axis the fingers are tried at, over half a turn."""
 GRIP_CLEARANCE = 0.001
@@ -437,7 +439,7 @@ def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit) -> tuple[flo
                                               (start + FINGER_THICKNESS, FINGER_WIDTH / 2),
                                               (start, FINGER_WIDTH / 2))])
                 for start in (float(reach.max()), float(reach.min()) - FINGER_THICKNESS)]
-        fingers = shapely.union_all(pads)
+        fingers = shapely.union_all(pads).buffer(-FINGER_TOUCH)  # a face they touch is not in their way
         under, other_top = "", low
         for other, corners in triangles.items():
             top = _highest_in(corners, fingers, other_top)

@@ -30,13 +30,13 @@ def _plate_and_pegs(folder: Path, rib: bool = False) -> None:
     """A 120 x 80 x 20 mm plate (top at z 20) with three 13 mm square holes 15 mm deep, 35 mm
     apart along x; in them 12 mm square pegs standing on the bottoms: peg1 45 mm long (30 mm
     out), peg2 23 mm (8 mm out), peg3 a 19 mm body under a 1.5 mm pyramid (5.5 mm out, its
-    top pointed); with ``rib``, the plate has a rib 4 x 20 mm and 40 mm high 6 mm beside peg1
+    top pointed); with ``rib``, the plate has a rib 4 x 20 mm and 80 mm high 6 mm beside peg1
     (its side along y): in the fingers' way closing along x, not along y."""
     folder.mkdir()
     holes = [_box((13, 13, 15.001), (X + dx, 0, 12.5)) for dx in (-35, 0, 35)]
     plate = _solid(_box((120, 80, 20), (X, 0, 10)), *holes)
     if rib:
-        plate = trimesh.boolean.union([plate, _box((4, 20, 40.01), (X - 35 + 14, 0, 39.995))], engine="manifold")
+        plate = trimesh.boolean.union([plate, _box((4, 20, 80), (X - 35 + 14, 0, 59.99))], engine="manifold")
     plate.export(folder / "plate.stl")
     _box((12, 12, 45), (X - 35, 0, 27.5)).export(folder / "peg1.stl")
     _box((12, 12, 23), (X, 0, 16.5)).export(folder / "peg2.stl")
@@ -60,6 +60,9 @@ def test_a_peg_is_held_over_what_stands_out_of_the_product(tmp_path: Path, capsy
     assert "assumes: " in printed and "the fingers hold a peg over its top 20 mm, less where it stands out" in printed
     geometry = load_geometry(str(tmp_path / "out"))
     gripper = geometry.gripper
+    # The wrist clear of the rib's top (99.99 mm) with peg2 at its goal held 7 mm under its top
+    # (28 mm): a flange of 99.99 - 21 + 10 mm, rounded up (held 20 mm deep it would be 102 mm).
+    assert gripper.flange_length == pytest.approx(0.089)
     assert geometry.parts["peg1"].held_depth(gripper) == pytest.approx(0.02)
     assert geometry.parts["peg2"].held_depth(gripper) == pytest.approx(0.007)
     # The assembling cell holds each that deep: the tool at its grip point, that far under its top.
