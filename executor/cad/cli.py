@@ -49,7 +49,14 @@ from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
-from executor.cad.operations import entry_point, finger_assumption, pin_entry, screwed_fits, tool_of
+from executor.cad.operations import (
+    entry_point,
+    finger_assumption,
+    finger_orders,
+    pin_entry,
+    screwed_fits,
+    tool_of,
+)
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -508,7 +515,7 @@ def _derived(parts: list[CadPart], out: Path, config: tuple[Path | None, dict, s
         near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
         assumed += overlap_assumption(derived)
         mapped, laid, cell = map_product(derived, settings)
-    assumed += [finger_assumption(), *([mapped.tool] if mapped.tool else [])]
+    assumed += [finger_assumption(), *finger_orders(cell), *([mapped.tool] if mapped.tool else [])]
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "

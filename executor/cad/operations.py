@@ -397,11 +397,17 @@ def finger_assumption() -> str:
 def finger_grip(derived: Derived, fit: HoleFit) -> tuple[float, str]:
     """How deep [m] the fingers hold the peg of ``fit`` (longer than :data:`GRIPPER`'s
     grasp depth) and why where not that deep: the grasp depth, or what the peg stands out
-    of the product at its goal (:func:`standing_out`) less :data:`GRIP_CLEARANCE` where
+    at its goal of the parts in place whenever it goes there (:func:`standing_out`, the
+    base and those the geometric precedence puts before it; others the precedence admits
+    before it: :func:`finger_orders`) less :data:`GRIP_CLEARANCE` where
     that is less, rounded down to 0.1 mm; 0 where that is under :data:`MIN_GRIP` (the
     fingers would meet the product before the peg reaches its goal)."""
     assert fit.part is not None
-    out, under = standing_out(derived, fit.part, fit)
+    return _grip(*standing_out(derived, fit.part, fit, _in_place_before(derived, fit.part)))
+
+
+def _grip(out: float, under: str) -> tuple[float, str]:
+    """:func:`finger_grip`'s rule for a part standing ``out`` [m] of ``under`` ("": of nothing)."""
     depth, need = GRIPPER["grasp_depth"], MIN_GRIP + GRIP_CLEARANCE
     if out - GRIP_CLEARANCE >= depth:
         return depth, ""
@@ -412,10 +418,35 @@ def finger_grip(derived: Derived, fit: HoleFit) -> tuple[float, str]:
     return math.floor(round((out - GRIP_CLEARANCE) * 1e4, 6)) / 1e4, f": it {where}, less {1e3 * GRIP_CLEARANCE:g} mm"
 
 
-def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit) -> tuple[float, str]:
+def _in_place_before(derived: Derived, pid: str) -> set[str]:
+    """The parts in place whenever part ``pid`` goes to its goal: the base and those the
+    geometric precedence puts before it."""
+    return (nx.ancestors(order(derived), pid) | {derived.base}) - {pid}
+
+
+def finger_orders(cell: Derived) -> list[str]:
+    """The orders the fingers' grip (:func:`finger_grip`) assumes, as the import states
+    them: each peg the cell inserts with the fingers that a part the geometric precedence
+    lets be in place before it (:func:`_maybe_in_place`), not only those it puts before it,
+    would leave standing out less (Cranfield's pegs: 5 mm out of the front plate, 25 mm
+    out of the base plate); the plan must put it before that part (a demonstrated or
+    learned precedence), which the import does not enforce."""
+    found = []
+    for pid, fit in sorted(cell.hole_of.items()):
+        if fit.axis == "-z" or tool_of(cell, fit)[0] != "fingers":
+            continue
+        grip = finger_grip(cell, fit)[0]
+        out, under = standing_out(cell, pid, fit, _maybe_in_place(cell, pid))
+        if _grip(out, under)[0] < grip:
+            found.append(f"'{pid}' goes in before '{under}' (the fingers hold it {1e3 * grip:g} mm deep; with "
+                         f"'{under}' in place it would stand out {1e3 * out:.3f} mm)")
+    return found
+
+
+def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit, others: set[str]) -> tuple[float, str]:
     """How far [m] part ``pid``'s top stands out, at its goal (where the CAD has it) along
-    the removal direction of ``fit`` (its hole or pin), of every other part that may be in
-    place then (:func:`_maybe_in_place`) where the fingers are (:data:`FINGER_THICKNESS`,
+    the removal direction of ``fit`` (its hole or pin), of the ``others`` (in place then)
+    where the fingers are (:data:`FINGER_THICKNESS`,
     turned about the axis where it stands out most), below its top (what overhangs the top
     is the wrist's: :func:`tool_length`); and the part it stands out of there ("" where none
     reaches the fingers above the part's bottom: its length)."""
@@ -423,7 +454,7 @@ def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit) -> tuple[flo
     own = derived.parts[pid].mesh.vertices @ turn
     low, high = float(own[:, 2].min()), float(own[:, 2].max())
     triangles = {}  # of the others, below the part's top (above it: the wrist's, tool_length)
-    for other in sorted(_maybe_in_place(derived, pid)):
+    for other in sorted(others):
         below = trimesh.Trimesh(derived.parts[other].mesh.vertices @ turn, derived.parts[other].mesh.faces,
                                 process=False)
         below = trimesh.intersections.slice_mesh_plane(below, (0.0, 0.0, -1.0), (0.0, 0.0, high))
