@@ -69,8 +69,8 @@ FINGER_TOUCH = 1e-6
 FINGER_YAW_STEP = 15.0
 """[deg] the turns about the part's axis the fingers are tried at, over half a turn."""
 GRIP_CLEARANCE = 0.001
-"""[m] how far above everything else of the product in the finger band the fingertips stay
-with the part at its goal."""
+"""[m] how far above everything else of the product where the fingers are the fingertips
+stay with the part at its goal."""
 MIN_GRIP = 0.005
 """[m] the least length of a part the fingers hold it over (docs/cell.md#the-fingers-grip):
 below it the pads' give tilts the part beyond the cell's grasp error model (≤ 1 deg)."""
@@ -388,7 +388,8 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
 def finger_assumption() -> str:
     """The finger model, as the import states it among its assumptions."""
     return (f"the fingers hold a peg over its top {1e3 * GRIPPER['grasp_depth']:g} mm, less where it stands out of "
-            f"the product less at its goal (its top above every part that may be in place where the fingers are: "
+            f"the product less at its goal (its top above the base and every part the geometric precedence puts "
+            f"before it, where the fingers are: "
             f"two {1e3 * FINGER_THICKNESS:g} x {1e3 * FINGER_WIDTH:g} mm beside its outline, turned about its axis "
             f"where it stands out most) less {1e3 * GRIP_CLEARANCE:g} mm, over "
             f"{1e3 * MIN_GRIP:g} mm at least; a peg standing out less goes on the suction cup or by hand")
@@ -593,7 +594,7 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     hole's bottom, a part with a bore where the CAD has it), rounded up to the millimetre;
     None where :data:`GRIPPER`'s keeps it clear, with why (the part, the part below the
     wrist and how high it stands) otherwise. A part the wrist meets stops short of its goal
-    (``occt_as1``: bolt_a1 4.1 mm above it, the wrist on bracket_a's wall)."""
+    (a bolt beside a bracket's 80 mm wall stopped 4.1 mm above it)."""
     depth = GRIPPER["grasp_depth"]
     grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2])
                    - (0.0 if tool_of(derived, fit)[0] == "suction" else finger_grip(derived, fit)[0]))  # cup: top
