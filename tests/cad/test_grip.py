@@ -15,10 +15,13 @@ import trimesh
 
 from assembly_constraints.cli import main
 from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
 from executor.assembly.world import AssemblyWorld
 from executor.cad import operations
-from executor.cell_description import load_cell_description
+from executor.cell_description import CellDescription, load_cell_description
+from executor.trial import Cell
 from executor.world.geometry import load_geometry
+from tests.cad.conftest import teach
 from tests.cad.test_covers import _solid
 from tests.cad.test_mesh_import import _box
 
@@ -104,3 +107,28 @@ def test_the_fingers_meet_a_neighbour_reaching_under_the_top_and_turn_away_from_
     assert operations._highest_in(walls.vertices[walls.faces], pads, -1.0) == pytest.approx(0.01)
     beyond = block.copy().apply_translation((0.003, 0.0, 0.0))
     assert operations._highest_in(beyond.vertices[beyond.faces], pads, -1.0) is None
+
+
+@pytest.mark.slow  # imports, teaches peg2's skill, one trial and one assembly step in physics (about 60 s under load)
+@pytest.mark.timeout(900)
+def test_a_peg_held_shallower_is_taught_inserted_and_assembled(tmp_path: Path) -> None:
+    # peg2 stands 8 mm out of the plate: held 7 mm deep, its skill taught so held, one trial
+    # into its hole fits and the assembling cell puts it within 2 mm of its goal.
+    _plate_and_pegs(tmp_path / "cad")
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    out = teach(tmp_path / "out", {"peg2"})
+    geometry = load_geometry(str(out))
+    assert geometry.parts["peg2"].held_depth(geometry.gripper) == pytest.approx(0.007)
+    hole = geometry.parts["peg2"].demo_hole
+    cell = Cell(str(out))
+    try:
+        assert cell.run_trial("peg2", hole, 0, max_attempts=1).outcome == "fit"
+    finally:
+        cell.close()
+    assembler = Assembler(load_product(str(out)), description=CellDescription())
+    try:
+        placed = [assembler.run_step(pid, where, 0) for pid, where in (("plate", None), ("peg2", hole))]
+    finally:
+        assembler.close()
+    assert (placed[1].skill, placed[1].outcome) == ("insert", "fit")
+    assert placed[1].pose_error < 0.002, placed[1].pose_error
