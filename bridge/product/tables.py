@@ -220,7 +220,9 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     part frame's origin the centre of the bore at the part's bottom, ``demo_hole`` a pin;
     ``pins_of`` the parts placed by hand (``[manual.<id>]``) whose pins they go onto
     besides their ``demo_hole``, each through a bore of its own (they stand at their goals
-    in the trials of these parts)."""
+    in the trials of these parts). ``grasp_depth`` [m]: how deep the fingers hold them where
+    less than the ``[gripper]``'s (a peg that stands out of the product at its goal by
+    less, docs/cell.md#the-fingers-grip)."""
 
     parts: Ids
     kind: Kind
@@ -234,6 +236,7 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     bore: bool = False
     pins_of: Ids | None = None
     tool: Literal["fingers", "suction"] = "fingers"
+    grasp_depth: Annotated[float, Meta(gt=0.0, le=0.2, description="a number in (0, 0.2] m")] | None = None
 
 
 MESH_FILE_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*(/[A-Za-z0-9_-][A-Za-z0-9_.-]*)*\.obj$(?!\n)"

@@ -50,7 +50,14 @@ from executor.cad.convex import MESH_FOLDER, overlap_assumption
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
-from executor.cad.operations import entry_point, pin_entry, screwed_fits, tool_of
+from executor.cad.operations import (
+    entry_point,
+    finger_assumption,
+    finger_orders,
+    pin_entry,
+    screwed_fits,
+    tool_of,
+)
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -607,7 +614,7 @@ def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path 
         assumed += overlap_assumption(derived)
         mapped, laid, cell = map_product(derived, settings)
         assumed += widened_bores_assumption(cell)
-    assumed += [mapped.tool] if mapped.tool else []
+    assumed += [finger_assumption(), *finger_orders(cell), *([mapped.tool] if mapped.tool else [])]
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "

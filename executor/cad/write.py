@@ -87,6 +87,7 @@ from executor.cad.operations import (
     entry_point,
     feature_turn,
     fine_pins,
+    finger_grip,
     margins,
     nominal_fits,
     order,
@@ -595,6 +596,17 @@ def _tray_overlap(boxes: dict[str, Box], trays: dict[str, tuple[float, float]]) 
     return None
 
 
+def _tool_lines(derived: Derived, fit: HoleFit) -> list[str]:
+    """A peg's ``[part_shapes.*]`` lines of what holds it (:func:`executor.cad.operations.tool_of`):
+    ``tool = "suction"``, or the fingers' ``grasp_depth`` where they hold it less deep than
+    :data:`executor.cad.operations.GRIPPER`'s (:func:`executor.cad.operations.finger_grip`); none otherwise."""
+    tool, why = tool_of(derived, fit)
+    if tool == "suction":
+        return ['tool = "suction"']
+    grip = finger_grip(derived, fit)[0]
+    return [f"grasp_depth = {_q(grip)}  # {why}"] if 0 < grip < GRIPPER["grasp_depth"] else []
+
+
 def _mesh_entry(mesh: Mesh) -> str:
     convex = "" if mesh.convex is None else f', convex = "{mesh.convex}"'
     return f'mesh = {{ file = "{mesh.file}", sha256 = "{mesh.sha256}"{convex} }}'
@@ -729,7 +741,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         lines += [f"[part_shapes.{pid}]", f'parts = ["{pid}"]', *_section_lines(peg),
                   f"length = {_q(float(mesh.extents[2]))}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{fit.id}"', *([_mesh_entry(meshes[pid])] if pid in meshes else []),
-                  *(['tool = "suction"'] if tool_of(derived, fit)[0] == "suction" else []), ""]
+                  *_tool_lines(derived, fit), ""]
     for pin_id, pin in derived.pins.items():
         top, height = pin_level(derived, pin)
         lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section),

@@ -186,14 +186,17 @@ class PartSpec(Section):
     mesh: Mesh | None = field(default=None, kw_only=True)
     bore: bool = field(default=False, kw_only=True)
     tool: str = field(default="fingers", kw_only=True)
+    grasp_depth: float | None = field(default=None, kw_only=True)
 
     def held_depth(self, gripper: Gripper) -> float:
-        """How deep [m] the part is in the gripper's fingers: ``grasp_depth``, a part with a
-        bore at most half its length (a ring is held by its top); 0 on the suction cup (its
-        face on the part's top)."""
+        """How deep [m] the part is in the gripper's fingers: the gripper's ``grasp_depth``,
+        or the part's own where less (a peg standing out of the product by less at its goal),
+        a part with a bore at most half its length (a ring is held by its top); 0 on the
+        suction cup (its face on the part's top)."""
         if self.tool == "suction":
             return 0.0
-        return min(gripper.grasp_depth, self.length / 2) if self.bore else gripper.grasp_depth
+        depth = gripper.grasp_depth if self.grasp_depth is None else min(self.grasp_depth, gripper.grasp_depth)
+        return min(depth, self.length / 2) if self.bore else depth
 
 
 @dataclass(frozen=True)
@@ -294,6 +297,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
                 pid, kind, size, shape=name, length=float(part_shape.length), mass=float(part_shape.mass),
                 start=(float(x), float(y)), demo_hole=part_shape.demo_hole, width=width, mesh=part_shape.mesh,
                 outline=_outline(part_shape), corner=part_shape.corner, bore=part_shape.bore, tool=part_shape.tool,
+                grasp_depth=part_shape.grasp_depth,
             )
     if models_nominal_fits(geo):
         holes = {hid: _with_nominal_room(hole, parts) for hid, hole in holes.items()}

@@ -30,13 +30,14 @@ import trimesh
 
 from assembly_constraints.corpus_truth import CorpusImport as Imported
 from assembly_constraints.corpus_truth import feature_holes as _feature_holes
-from assembly_constraints.corpus_truth import features_of
+from assembly_constraints.corpus_truth import features_of, import_product
 from bridge.assembly import load_assembly
 from bridge.cell_settings import ServeSettings
 from bridge.messages import InsertRequest
 from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
+from executor.cad import operations
 from executor.cad.cli import load_source
 from executor.cad.derive import derive
 from executor.cad.operations import margins
@@ -270,7 +271,9 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
     "metaworld_assembly",
     pytest.param("occt_as1", marks=_xfail(INSERTED + " onto a bolt's end from below, onto a pin of a part other "
                                           "than the base along a horizontal axis (the nuts onto the rod's ends), "
-                                          "or a rod through two brackets")),
+                                          "a rod through two brackets, or into a hole standing out of the product "
+                                          "at its goal by less than the fingers need (the bolts' heads, 3 mm out of "
+                                          "the brackets' feet)")),
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into a hole of a part that is not the base (the "
                                            "shaft into the bearing ring), into a hole of the base's own mesh with less "
@@ -288,7 +291,9 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
                                               "or onto a pin beside parts on it, resting on nothing (the outer "
                                               "holder around the plates)")),
     "nop_printed_box",
-    "nop_rocker_switches",
+    pytest.param("nop_rocker_switches", marks=_xfail(INSERTED + " into a hole standing out of the product at its "
+                                                     "goal by less than the fingers need, its top no face for the "
+                                                     "suction cup (the switches, 5.82 and 2.30 mm out of the case)")),
     pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
                                                  "cell has no screwing operation)")),
 ])
@@ -328,57 +333,39 @@ def test_a_product_drawn_at_the_origin_is_decided_and_assembled_within_2_mm_wher
     assert max(s.pose_error for s in steps) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in steps}
 
 
-@pytest.mark.slow  # imports, teaches, two bolts inserted through their brackets' flanges in physics (about 150 s)
+@pytest.mark.slow  # imports the product and runs its plan with the truth backend (about 40 s under load)
 @pytest.mark.timeout(900)
 @pytest.mark.parametrize("name", ["occt_as1"])  # a unit of the workers' work with the product's other tests
-def test_the_bolts_go_through_the_brackets_and_the_whole_product_is_planned_and_assembled(
+def test_the_bolts_stand_out_too_little_for_the_fingers_and_the_whole_product_is_planned_and_placed(
         corpus_import: Callable[[str], Imported], name: str, run_main: Runner) -> None:
-    # occt_as1: the cell inserts the six bolts, each down through its bracket's flange into
-    # the plate; the brackets, the rod and the eight nuts are placed by hand. bolt_a1's axis
-    # is 10 mm from bracket_a's wall, whose top stands 80 mm high: with the default 60 mm
-    # flange the arm's wrist came down on the wall top and the bolt stopped 4.1 mm above its
-    # goal (no_fit); the import makes the flange long enough that the wrist stays above the
-    # wall. bolt_b2 goes through bracket_b's 10 mm flange over the plate: with the search
-    # pressing at the plate's top, 10 mm under the flange's, it was pushed onto the flange,
-    # dragged behind the spiral and missed the opening in both attempts (no_fit).
-    # The whole product's 18 steps in physics: `./run.sh bench corpus --product occt_as1`
-    # (docs/results/corpus.md); here its plan run by the truth backend and those two bolts.
+    # occt_as1: each bolt's head stands 3 mm out of its bracket's foot at its goal, less than
+    # the 6 mm the fingers need (5 mm of grip, 1 mm clear of the product), and its 15 mm top
+    # does not take the 30 mm suction cup: the cell places every bolt by hand (held 20 mm
+    # deep, as before that rule, a real hand's fingers would reach 17 mm into the feet), and
+    # with them every moving part; no flange longer than the default is needed.
     done = corpus_import(name)
-    gripper = load_geometry(str(done.out)).tables.gripper
-    assert gripper is not None and gripper.flange_length > 0.06
-    # The facts a sim session learns here: its experiments observe the bolts in the plate's
-    # holes to fit (all 36 pairs), the other pairs it takes from sizes.lp, and its precedence
-    # is the import's geometric prior (no demonstration refines it).
+    tables = load_geometry(str(done.out)).tables
+    bolts = {pid for pid in done.truth["parts"] if pid.startswith("bolt")}
+    assert set(tables.manual) == set(done.truth["parts"])
+    for pid in bolts:
+        assert (f"part '{pid}' stands out of the product by 3.000 mm at its goal ('bracket_"
+                in tables.manual[pid].reason and "less than the 6 mm the fingers need" in tables.manual[pid].reason)
+    assert tables.gripper is None or tables.gripper.flange_length == pytest.approx(0.06)
+    # Its plan run by the truth backend: each step names where its part is, a bolt the hole
+    # the CAD has it in, so that each nut placed at its pose in the CAD is on the end of the
+    # bolt its step names.
     facts = [str(done.out / "sizes.lp"), str(done.out / "geometric_precedence.lp")]
     assembled = run_main("assemble", *facts, "--assembly", str(done.out), "--backend", "truth", "--seed", "1",
                          "--json")
     assert assembled.returncode == 0, assembled.stderr
     report = json.loads(assembled.stdout)
-    bolts = {pid for pid in done.truth["parts"] if pid.startswith("bolt")}
     assert {s["part"]: (s["skill"], s["outcome"]) for s in report["steps"]} == {
-        done.truth["base"]: ("truth", "fit"),
-        **{pid: ("truth" if pid in bolts else "manual", "fit") for pid in done.truth["parts"]}}
+        done.truth["base"]: ("truth", "fit"), **{pid: ("manual", "fit") for pid in done.truth["parts"]}}
     assert report["assembled"] and report["replans"] == []
-    assert set(report["manual"]) == set(report["manual_reasons"]) == set(done.truth["parts"]) - bolts
-    # each step names where the part is: a bolt in the hole the CAD has it in, so that each
-    # nut placed by hand at its pose in the CAD is on the end of the bolt its step names
     holes = tomllib.loads((done.out / "assembly.toml").read_text())["holes"]
     named = {s["part"]: s["hole"] for s in report["steps"]}
     assert all(holes[named[pid]]["name"] == f"hole of {pid}" for pid in bolts), named
     assert all(named[pid] == f"bolt_{pid[4:]}_pin1" for pid in named if pid.startswith("nut_")), named
-    # in physics: the base on its fixture, the brackets placed by hand, bolt_a1 beside
-    # bracket_a's wall and bolt_b2 through bracket_b's flange, each into its hole (each bolt
-    # is a shape of its own: those two taught)
-    teach(done.out, {"bolt_a1", "bolt_b2"})
-    assembler = Assembler(load_product(str(done.out)), description=CellDescription())
-    try:
-        placed = [assembler.run_step(pid, named[pid], 0)
-                  for pid in (done.truth["base"], "bracket_a", "bracket_b", "bolt_a1", "bolt_b2")]
-    finally:
-        assembler.close()
-    assert {s.part: (s.skill, s.outcome) for s in placed[3:]} == {"bolt_a1": ("insert", "fit"),
-                                                                   "bolt_b2": ("insert", "fit")}
-    assert max(s.pose_error for s in placed) < 0.002, {s.part: round(s.pose_error * 1000, 2) for s in placed}
 
 
 def _learned_from_its_cad_alone(done: Imported, run_main: Runner, run: Path) -> dict[str, Any]:
@@ -581,15 +568,17 @@ def test_each_switch_hanging_through_a_slot_of_the_case_top_is_found_in_that_slo
     assert all(abs(tips[pid] - float(derived.parts[pid].mesh.bounds[0][2])) < 1e-9 for pid in want), tips
 
 
-@pytest.mark.slow  # the first test of a product imports it
-@pytest.mark.parametrize("name", ["nop_rocker_switches"])
+@pytest.mark.slow  # imports the product (about 6 s under load)
 def test_a_switch_collides_as_the_prism_of_the_section_its_fit_was_measured_on(
-        corpus_import: Callable[[str], Imported], name: str) -> None:
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # Each switch's piece through its slot is its body's section as the mesh has it (the
     # room the truth states, 0.0757 mm per side), down to the ends of its spade terminals
     # (0.5 mm: thinner than the cell collides as, within the body's outline, filled to it),
-    # so the cell's belief of its tip is where it collides.
-    out = corpus_import(name).out
+    # so the cell's belief of its tip is where it collides. The switches stand out of the
+    # case by less than the fingers need (the cell places them by hand); a hand that holds
+    # 1 mm has the cell insert them, from these pieces.
+    monkeypatch.setattr(operations, "MIN_GRIP", 0.001)
+    out = import_product(CORPUS / "nop_rocker_switches", tmp_path / "out").out
     for pid in ("small_rocker", "neon_indicator"):
         mesh = trimesh.load(out / "meshes" / f"{pid}.obj", force="mesh")
         body = max(read_objects(out / "meshes" / f"{pid}.convex.obj"), key=lambda v: float(np.ptp(v[:, 2])))

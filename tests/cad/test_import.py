@@ -22,7 +22,7 @@ from bridge.assembly import load_assembly
 from executor.cad.cli import run_import
 from executor.cad.convex import base_is_primitive
 from executor.cad.derive import Derived, derive
-from executor.cad.operations import WRIST_RADIUS, margins
+from executor.cad.operations import WRIST_RADIUS, finger_orders, margins
 from executor.cad.parts import CadPart, load_meshes
 from executor.world.geometry import load_geometry
 
@@ -86,6 +86,10 @@ def test_cranfield_geometric_precedence_against_the_physics(
     # pendulum from sliding along x). Without it the geometry lacks that one edge.
     assert {pair for pair, reason in derived.reasons.items() if reason == "locates"} == {("sh", "pd")}
     assert "% sh->pd: locates" in (out / "geometric_precedence.lp").read_text()
+    # The pegs stand 25 mm out of the base plate, 5 mm out of the front plate: the fingers'
+    # 20 mm grip assumes each goes in before it, which the prior does not enforce.
+    assert [order.split(" (")[0] for order in finger_orders(derived)] == [
+        f"'{pid}' goes in before 'fp'" for pid in ("p1", "p2", "p3", "p4")]
     parts = load_meshes(out.parent / "meshes", "m")
     blocking = derive(parts, "bp", {"ph": "pd"}, reach=0.0).edges
     assert blocking == derived.edges - {("sh", "pd")}

@@ -1,0 +1,134 @@
+"""The fingers' grip: a peg is held over at most what stands out of the product at its goal
+less the clearance, at least the minimum grip; a peg standing out less goes on the suction
+cup or by hand with why; one standing out well is held the gripper's grasp depth
+(docs/cell.md#the-fingers-grip)."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+import trimesh
+
+from assembly_constraints.cli import main
+from executor.assembly.product import load_product
+from executor.assembly.step import Assembler
+from executor.assembly.world import AssemblyWorld
+from executor.cad import operations
+from executor.cell_description import CellDescription, load_cell_description
+from executor.trial import Cell
+from executor.world.geometry import load_geometry
+from tests.cad.conftest import teach
+from tests.cad.test_covers import _solid
+from tests.cad.test_mesh_import import _box
+
+X = 560.0
+"""[mm] where the plate's centre stands: where the simulated arm reaches."""
+
+
+def _plate_and_pegs(folder: Path, rib: bool = False) -> None:
+    """A 120 x 80 x 20 mm plate (top at z 20) with three 13 mm square holes 15 mm deep, 35 mm
+    apart along x; in them 12 mm square pegs standing on the bottoms: peg1 45 mm long (30 mm
+    out), peg2 23 mm (8 mm out), peg3 a 19 mm body under a 1.5 mm pyramid (5.5 mm out, its
+    top pointed); with ``rib``, the plate has a rib 4 x 20 mm and 80 mm high 6 mm beside peg1
+    (its side along y): in the fingers' way closing along x, not along y."""
+    folder.mkdir()
+    holes = [_box((13, 13, 15.001), (X + dx, 0, 12.5)) for dx in (-35, 0, 35)]
+    plate = _solid(_box((120, 80, 20), (X, 0, 10)), *holes)
+    if rib:
+        plate = trimesh.boolean.union([plate, _box((4, 20, 80), (X - 35 + 14, 0, 59.99))], engine="manifold")
+    plate.export(folder / "plate.stl")
+    _box((12, 12, 45), (X - 35, 0, 27.5)).export(folder / "peg1.stl")
+    _box((12, 12, 23), (X, 0, 16.5)).export(folder / "peg2.stl")
+    corners = [(X + 35 + sx * 6, sy * 6, z) for sx in (-1, 1) for sy in (-1, 1) for z in (5.0, 24.0)]
+    trimesh.convex.convex_hull([*corners, (X + 35, 0.0, 25.5)]).export(folder / "peg3.stl")
+
+
+@pytest.mark.slow  # imports the product and builds its assembling cell (about 10 s under load)
+def test_a_peg_is_held_over_what_stands_out_of_the_product(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _plate_and_pegs(tmp_path / "cad", rib=True)
+    assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    printed = capsys.readouterr().out
+    assert ("manual peg3: the cell has no operation for it, a plan's step places it by hand (part 'peg3' stands out "
+            "of the product by 5.500 mm at its goal ('plate' where the fingers are), less than the 6 mm the "
+            "fingers need, and its top is not flat for the suction cup)") in printed
+    shapes = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["part_shapes"]
+    assert set(shapes) == {"peg1", "peg2"}
+    # 30 mm out, the fingers closing along y clear of the rib: the fingers' 20
+    assert "grasp_depth" not in shapes["peg1"] and "tool" not in shapes["peg1"]
+    assert shapes["peg2"]["grasp_depth"] == pytest.approx(0.007, abs=1e-9)  # 8 mm out, 1 mm clear
+    assert "assumes: " in printed and "the fingers hold a peg over its top 20 mm, less where it stands out" in printed
+    geometry = load_geometry(str(tmp_path / "out"))
+    gripper = geometry.gripper
+    # The wrist clear of the rib's top (99.99 mm) with peg2 at its goal held 7 mm under its top
+    # (28 mm): a flange of 99.99 - 21 + 10 mm, rounded up (held 20 mm deep it would be 102 mm).
+    assert gripper.flange_length == pytest.approx(0.089)
+    assert geometry.parts["peg1"].held_depth(gripper) == pytest.approx(0.02)
+    assert geometry.parts["peg2"].held_depth(gripper) == pytest.approx(0.007)
+    # The assembling cell holds each that deep: the tool at its grip point, that far under its top.
+    world = AssemblyWorld(load_product(str(tmp_path / "out")), gains=load_cell_description(None).gains)
+    try:
+        for pid, held in (("peg1", 0.02), ("peg2", 0.007)):
+            assert np.allclose(world.frames[pid].grip, [0.0, 0.0, geometry.parts[pid].length - held])
+    finally:
+        world.close()
+
+
+@pytest.mark.slow  # imports the product (about 6 s under load)
+def test_a_peg_standing_out_less_with_a_flat_top_goes_on_the_suction_cup(tmp_path: Path) -> None:
+    # peg3 20.5 mm long with a flat top: 5.5 mm out, less than the fingers need; a 10 mm cup
+    # lies on its 12 mm square top.
+    _plate_and_pegs(tmp_path / "cad")
+    _box((12, 12, 20.5), (X + 35, 0, 15.25)).export(tmp_path / "cad" / "peg3.stl")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setitem(operations.GRIPPER, "cup_diameter", 0.01)
+        assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    shapes = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["part_shapes"]
+    assert shapes["peg3"]["tool"] == "suction" and "grasp_depth" not in shapes["peg3"]
+
+
+def test_the_fingers_meet_a_neighbour_reaching_under_the_top_and_turn_away_from_it() -> None:
+    # Pads 10 x 20 mm on either side of a 12 mm square: a 10 mm block whose side is 1 mm
+    # into them (whole, and its walls only, cut at 10 mm), a wedge rising outwards from inside
+    # them, a block 2 mm beyond them.
+    pads = shapely.union_all([shapely.box(0.006, -0.01, 0.016, 0.01), shapely.box(-0.016, -0.01, -0.006, 0.01)])
+    block = trimesh.creation.box((0.01, 0.01, 0.03))
+    block.apply_translation((0.02, 0.0, 0.0))
+    assert operations._highest_in(block.vertices[block.faces], pads, -1.0) == pytest.approx(0.015)
+    assert operations._highest_in(block.vertices[block.faces], pads, 0.02) is None  # none above 20 mm
+    wedge = trimesh.convex.convex_hull([(x, y, z) for x in (0.0, 0.03) for y in (-0.005, 0.005)
+                                        for z in (0.0, 0.001 + x)])  # its top 1 mm at x 0, 31 mm at x 30
+    wedge.apply_translation((0.013, 0.0, 0.0))  # from x 13, 4 mm high where the pad ends (x 16)
+    assert operations._highest_in(wedge.vertices[wedge.faces], pads, -1.0) == pytest.approx(0.004)
+    walls = trimesh.intersections.slice_mesh_plane(block, (0.0, 0.0, -1.0), (0.0, 0.0, 0.01))  # open at 10 mm
+    assert operations._highest_in(walls.vertices[walls.faces], pads, -1.0) == pytest.approx(0.01)
+    beyond = block.copy().apply_translation((0.003, 0.0, 0.0))
+    assert operations._highest_in(beyond.vertices[beyond.faces], pads, -1.0) is None
+
+
+@pytest.mark.slow  # imports, teaches peg2's skill, one trial and one assembly step in physics (about 60 s under load)
+@pytest.mark.timeout(900)
+def test_a_peg_held_shallower_is_taught_inserted_and_assembled(tmp_path: Path) -> None:
+    # peg2 stands 8 mm out of the plate: held 7 mm deep, its skill taught so held, one trial
+    # into its hole fits and the assembling cell puts it within 2 mm of its goal.
+    _plate_and_pegs(tmp_path / "cad")
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    out = teach(tmp_path / "out", {"peg2"})
+    geometry = load_geometry(str(out))
+    assert geometry.parts["peg2"].held_depth(geometry.gripper) == pytest.approx(0.007)
+    hole = geometry.parts["peg2"].demo_hole
+    cell = Cell(str(out))
+    try:
+        assert cell.run_trial("peg2", hole, 0, max_attempts=1).outcome == "fit"
+    finally:
+        cell.close()
+    assembler = Assembler(load_product(str(out)), description=CellDescription())
+    try:
+        placed = [assembler.run_step(pid, where, 0) for pid, where in (("plate", None), ("peg2", hole))]
+    finally:
+        assembler.close()
+    assert (placed[1].skill, placed[1].outcome) == ("insert", "fit")
+    assert placed[1].pose_error < 0.002, placed[1].pose_error
