@@ -70,20 +70,22 @@ def sources_digest(geometry: CellGeometry) -> str:
 def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
     """A hole's fields, its entry height and depth only where they are not the plate's,
     ``pin`` only for a pin, ``axis`` only for a hole entered sideways, ``tile`` only for a
-    boss of its own and ``owner`` only for a pin of another part than the base (so a product whose
-    holes are all at the plate's level keeps its digest);
+    boss of its own, ``owner`` only for a pin of another part than the base and ``widened``
+    only where it names a part (so a product whose holes are all at the plate's level keeps its digest);
     not ``near_miss``, which names pairs no cell tries and shapes no asset."""
     fields = {key: value for key, value in dataclasses.asdict(hole).items() if key != "near_miss"}
     for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False), ("axis", "-z"),
-                         ("tile", None), ("owner", None)):
+                         ("tile", None), ("owner", None), ("widened", ())):
         if fields[key] == default:
             del fields[key]
     return fields
 
 
 def _part_fields(part: PartSpec) -> dict[str, object]:
+    """A part's fields, ``bore`` only for a part with a bore and ``grasp_depth`` only where
+    it is set (so a peg held as deep as the gripper holds keeps its digest)."""
     fields = {key: value for key, value in dataclasses.asdict(part).items()
-              if key != "mesh" and (key != "bore" or value)}  # a peg's digest as before parts had bores
+              if key != "mesh" and (key != "bore" or value) and (key != "grasp_depth" or value is not None)}
     return fields if part.mesh is None else fields | {"mesh": msgspec.structs.asdict(part.mesh)}
 
 
