@@ -63,7 +63,7 @@ from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import Shape2D, classify, exact_round, slice_loops
 from executor.cad.sweep import bvh, convex_object
 from executor.world import SIZE_RESOLUTION
-from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded, obj_text
+from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded, narrowed, obj_text
 from executor.world.rings import Prisms, prism_pieces
 
 PRIMITIVE_TOLERANCE = 0.01
@@ -481,16 +481,17 @@ def as_written(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
                neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame",
-               exact: Pieces | None = None, fits: frozenset[str] = frozenset(), prisms: bool = False
-               ) -> tuple[Mesh, list[Path]] | str:
+               exact: Pieces | None = None, fits: frozenset[str] = frozenset(), prisms: bool = False,
+               narrow: float = 0.0) -> tuple[Mesh, list[Path]] | str:
     """Write ``mesh`` (already in ``frame`` [m]; ``made``: how, for its header) as
     ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
     (``neighbours``: the parts near it, in its frame; None for a static one: the base, a
     part placed by hand), its convex pieces (:func:`fitting_pieces`, or ``exact``'s:
     :func:`executor.world.rings.ring_pieces`; ``fits``: the neighbours at a stated
     zero-clearance fit or passage with it; ``prisms``: a peg's, whose prisms of its sections
-    may serve); returns the ``mesh`` entry of
-    ``geometry.toml`` and the paths written, or why no pieces fit."""
+    may serve; ``narrow`` [m]: a peg the cell narrows, each piece :func:`narrowed` by that
+    about its axis, z); returns the ``mesh`` entry of ``geometry.toml`` and the paths
+    written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
     text = obj_text([(pid, apart(mesh.vertices), mesh.faces)],
@@ -507,6 +508,15 @@ def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
     if isinstance(found, str):
         return found
     kept, made = found
+    if narrow:
+        shrunk = [narrowed(piece.vertices, narrow) for piece, _ in kept]
+        if thin := [k + 1 for k, piece in enumerate(shrunk)
+                    if piece is None or eroded(piece.vertices, URDF_HULL_MARGIN) is None]:
+            return (f"piece {thin[0]} of part '{pid}' narrowed by {1e3 * narrow:g} mm per side (a fit whose room the "
+                    f"cell does not resolve) is thinner than {1e3 * MIN_THICKNESS:g} mm, the cell's hull margin twice "
+                    "less what it resolves")
+        kept = [(piece, reach) for piece, (_, reach) in zip(shrunk, kept, strict=True) if piece is not None]
+        made += f"; each narrowed by {1e3 * narrow:g} mm about its axis (a fit whose room the cell does not resolve)"
     convex = f"{MESH_FOLDER}/{pid}.convex.obj"
     pieces = [(f"{pid}_{k + 1}", piece.vertices, piece.faces) for k, (piece, _) in enumerate(kept)]
     header = (CONVEX_HEADER.format(file=name, sha256=digest) + f"\n# {len(kept)} piece(s) of at most {PIECE_VERTICES} "
