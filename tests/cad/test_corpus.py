@@ -268,9 +268,9 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
     "robosuite_nuts",
     pytest.param("occt_pump", marks=_xfail(INSERTED + " along y into a hole of a part that is not the base (the "
                                            "shaft into the bearing ring), into a hole of the base's own mesh with less "
-                                           "room than the cell resolves (the ring, room 0), or onto a pin of a part "
-                                           "other than the base along a horizontal axis (the glands and the impeller "
-                                           "onto the shaft's end)")),
+                                           "room than the cell resolves (the ring, room 0: no stack of prisms to "
+                                           "narrow), or onto a pin of a part other than the base along a horizontal "
+                                           "axis (the glands and the impeller onto the shaft's end)")),
     pytest.param("occt_pulley", marks=_xfail(INSERTED + " onto a pin being no stack of prisms with one bore (the "
                                              "pulley: rings about its axis apart from its bore, bolt holes beside "
                                              "it; its room 0 on the hub's boss the cell widens), or into a hole where "
@@ -436,15 +436,16 @@ def test_parts_with_less_room_than_the_cell_resolves_are_placed_by_hand_saying_s
 
 
 @pytest.mark.slow  # the first test of a product imports it
-def test_the_pump_bearing_ring_narrowed_for_its_room_has_no_pieces_the_cell_collides_as(
+def test_the_pump_bearing_ring_narrowed_for_its_room_is_no_stack_of_prisms(
         corpus_import: Callable[[str], Imported]) -> None:
     # occt_pump: the bearing ring is a nominal zero-clearance fit (d 27 in d 27) in the
     # housing's bore, a hole of the housing's own mesh: the cell would narrow the ring by
-    # 0.15 mm per side (tests/cad/test_narrowed_pegs.py), but the ring's 3 mm wall with its
-    # two ball grooves inside is no stack of prisms, and CoACD's pieces of it are thinner
-    # than the cell collides as: it is placed by hand for its pieces, not for its room.
+    # 0.15 mm per side (tests/cad/test_narrowed_pegs.py), but a narrowed peg's pieces are
+    # its hull or the prisms of its sections, and the ring's 3 mm wall with its two ball
+    # grooves inside is no stack of prisms: placed by hand for its pieces, not its room.
     manual = load_geometry(str(corpus_import("occt_pump").out)).tables.manual
-    assert "has no convex pieces the cell can collide as" in manual["bearing_ring"].reason
+    assert manual["bearing_ring"].reason.endswith(
+        "the cell narrows a peg whose pieces are its hull or the prisms of its sections only")
     assert not any("the simulated cell resolves" in table.reason for table in manual.values())
 
 
