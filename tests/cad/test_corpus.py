@@ -444,8 +444,9 @@ def test_the_pump_bearing_ring_narrowed_for_its_room_is_no_stack_of_prisms(
     # its hull or the prisms of its sections, and the ring's 3 mm wall with its two ball
     # grooves inside is no stack of prisms: placed by hand for its pieces, not its room.
     manual = load_geometry(str(corpus_import("occt_pump").out)).tables.manual
-    assert manual["bearing_ring"].reason.endswith(
-        "the cell narrows a peg whose pieces are its hull or the prisms of its sections only")
+    reason = manual["bearing_ring"].reason
+    assert reason.startswith("part 'bearing_ring': the convex hulls of its layers that are no prisms of their sections "
+                             "exceed its mesh by ") and "; the cell narrows a peg whose pieces are its hull" in reason
     assert not any("the simulated cell resolves" in table.reason for table in manual.values())
 
 
