@@ -417,8 +417,8 @@ def _peg_unresolved(derived: Derived, cell: Derived, pid: str, hid: str) -> str:
     mesh (``cell``: the product as the cell inserts it, so far) from its sign
     (:func:`_unresolved`; "" where it can): a peg that is a fit there whose room the cell
     does not resolve it tries narrowed (:func:`narrows_peg`), in every hole where it is
-    such a fit; it cannot where it does not narrow the peg (``occt_pump``'s bearing ring at
-    room 0 in its housing's bore, were it square), or where the narrower peg would turn its
+    such a fit; it cannot where it does not narrow the peg (``asap_beam``'s tapered rect
+    tenons at room 0 in the top's mortises), or where the narrower peg would turn its
     no-fit in another hole into a fit or a room it cannot tell (:func:`_turned`)."""
     rooms, nominal = margins(derived)[pid], nominal_fits(derived)
     holes = [*derived.holes, *derived.part_holes]
@@ -426,7 +426,7 @@ def _peg_unresolved(derived: Derived, cell: Derived, pid: str, hid: str) -> str:
     if hid not in fine:
         return why
     if not narrows_peg(cell, pid, nominal):
-        return (f"{why}" + ("; a zero-clearance fit" if (pid, hid) in nominal else "")
+        return (why + ("; a zero-clearance fit" if (pid, hid) in nominal else "")
                 + "; the cell narrows a peg in a base that is its own mesh only where it and its hole are round")
     turned = _turned(rooms, fine, holes, "section", "hole")
     return f"{why}; {turned}" if turned else ""
@@ -716,8 +716,9 @@ def narrows_peg(cell: Derived, pid: str, nominal: Mapping[tuple[str, str], float
 
 def _turned(rooms: Mapping[str, float], fine: list[str], features: Iterable[str], what: str, noun: str) -> str:
     """Where giving a part :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` more room per side
-    (``what``: its bore wider, its section narrower) would turn its no-fit in another of
-    ``features`` (not in ``fine``; ``noun``: pin or hole; ``rooms``: its room in each [m])
+    (``what``: its bore, wider on a pin, or its section, narrower in a hole) would turn its
+    no-fit in another of ``features`` (not in ``fine``; ``noun``: pin or hole; ``rooms``:
+    its room in each [m])
     into a fit or a room the cell cannot tell (a room of at most 0, less than twice that
     room and :data:`executor.world.SIZE_RESOLUTION` below it): why, naming the first; ""
     where none."""
