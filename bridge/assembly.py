@@ -42,7 +42,7 @@ from bridge.product import (
     part_kinds,
     section_label,
 )
-from bridge.product.nominal import models_nominal_fits, stated_nominal_fits, widened_bores
+from bridge.product.nominal import models_nominal_fits, stated_nominal_fits, widened_fits
 
 __all__ = ["DATA_DIR", "ID_PATTERN", "MAX_COORDINATE", "NEAR_MISS_BACKENDS", "SHAPES", "SIZE_MODELS", "Assembly",
            "Hole", "Item", "Part", "is_id", "load_assembly", "resolve_assembly_folder"]
@@ -127,11 +127,14 @@ class Assembly:
     """Whether the simulated cell builds those fits in holes with
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per side (its holes are primitives); else
     it cannot resolve them and they are no experiment. Those on pins it builds so where it
-    widens the part's bore (:attr:`widened`)."""
+    widens the part's bore, and in holes of a base with its own mesh where it narrows the peg
+    (:attr:`widened`)."""
     widened: dict[tuple[str, str], float] = field(default_factory=dict)
-    """The (part, pin) pairs whose room the simulated cell does not resolve, room 0 or
-    positive, built with the part's round bore wider by that room per side (``widened`` of a
-    pin: :func:`bridge.product.nominal.widened_bores`): pair -> the CAD's room per side [m]."""
+    """The (part, feature) pairs whose room the simulated cell does not resolve, room 0 or
+    positive, built with :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` more room per side
+    (the part's round bore wider on a pin, the round peg narrower in a hole of a base with
+    its own mesh; ``widened`` of the feature: :func:`bridge.product.nominal.widened_fits`):
+    pair -> the CAD's room per side [m]."""
 
     def tried_by_hand(self, part: str, hole: str, backend: str) -> bool:
         """Whether no cell of ``backend`` (``sim``, ``truth``, ``franka`` or a plugin's
@@ -232,7 +235,7 @@ def assembly_of(product: ProductDescription) -> Assembly:
                     base_center=None if geometry is None else (geometry.plate.base_center[0],
                                                                geometry.plate.base_center[1]),
                     nominal_modelled=geometry is not None and models_nominal_fits(geometry),
-                    widened={} if geometry is None else widened_bores(geometry))
+                    widened={} if geometry is None else widened_fits(geometry))
 
 
 def load_assembly(name_or_path: str) -> Assembly:

@@ -210,8 +210,9 @@ def _near_miss_statement(assembly: Assembly, backend: str, by_hand: list[tuple[P
 def _nominal_fits(assembly: Assembly, backend: str, parts: list[str], holes: list[str]) -> NominalFits | None:
     """The fits with room under what the simulated cell (``backend`` sim) resolves that it
     tries with the room it builds them with (:data:`bridge.product.nominal.NOMINAL_FIT_ROOM`):
-    the nominal zero-clearance fits and the bores on pins it widens
-    (:attr:`bridge.assembly.Assembly.widened`, with their CAD room); None with another
+    the nominal zero-clearance fits and the fits it widens, bores on pins and pegs in holes
+    of a base with its own mesh (:attr:`bridge.assembly.Assembly.widened`, with their CAD
+    room); None with another
     backend or without such a pair among ``parts`` x ``holes``."""
     pairs = sorted(pair for pair in assembly.nominal_fits | set(assembly.widened)
                    if pair[0] in parts and pair[1] in holes and not assembly.tried_by_hand(*pair, backend))

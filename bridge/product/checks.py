@@ -18,6 +18,7 @@ import shapely
 from bridge import BridgeError
 from bridge.inputs import read_bytes, shorten
 from bridge.product.kinds import section_label
+from bridge.product.nominal import models_nominal_fits
 from bridge.product.tables import (
     CONVEX_HEADER,
     TOUCH_TOLERANCE,
@@ -183,9 +184,10 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
                 raise fail(path, f"hole_shapes.{name}", "zero_clearance", "parts with a bore of [part_shapes.*] "
                            "for a pin, pegs of [part_shapes.*] for a hole", pid)
         for pid in shape.widened or []:
-            if not (shape.pin and bores.get(pid) and shape.kind == "round" and round_bores.get(pid)):
+            if not (shape.pin == bores.get(pid) and shape.kind == "round" and round_bores.get(pid)
+                    and (shape.pin or not models_nominal_fits(geo))):
                 raise fail(path, f"hole_shapes.{name}", "widened", "parts with a round bore of [part_shapes.*] "
-                           "on a round pin", pid)
+                           "on a round pin, round pegs in a round hole of a [base] with its own mesh", pid)
         for pid in shape.near_miss or []:
             if bores.get(pid) is not False or shape.pin:
                 raise fail(path, f"hole_shapes.{name}", "near_miss", "pegs of [part_shapes.*] in a hole", pid)

@@ -10,14 +10,18 @@ of ``[plate]`` primitives: the hole is widened by that room all round, and the c
 refuses the product when that changes the answer of any other pair). Where the hole is
 part of the base's own mesh (a ``[base]`` with ``mesh``: holes entered sideways) the
 cell cannot widen it: those pairs are no experiment, the planner takes them from the CAD
-(``sizes.lp``), not observed. On a pin (always in the base's own mesh) it widens the part
-instead, for such a fit and for a positive room under what it resolves alike: a part a pin
-names in ``widened`` has its round bore wider by :data:`NOMINAL_FIT_ROOM` per side (its
-``[part_shapes.*]`` section as the cell reads it, and the convex pieces the import writes
-for it: regular polygons about its bore's inscribed circle grown by that room), and the
-cell's loader refuses the product when that changes the part's answer on any other pin
-(:func:`widened_bores`). Both sides read the rule here, so they agree on which pairs
-the cell tries (docs/decisions.md, "Nominal zero-clearance fits in the simulated cell").
+(``sizes.lp``), not observed, unless the cell narrows the peg (below). On a pin (always in
+the base's own mesh) it widens the part instead, for such a fit and for a positive room
+under what it resolves alike: a part a pin names in ``widened`` has its round bore wider by
+:data:`NOMINAL_FIT_ROOM` per side (its ``[part_shapes.*]`` section as the cell reads it,
+and the convex pieces the import writes for it: regular polygons about its bore's
+inscribed circle grown by that room), and the cell's loader refuses the product when that
+changes the part's answer on any other pin. In a round hole of a base with its own mesh it
+narrows the round peg the hole names in ``widened`` by that room per side alike (its
+section as read, its pieces as written: narrowed about its axis), and the loader refuses
+the product when that changes the peg's answer in any other hole (:func:`widened_fits`).
+Both sides read the rule here, so they agree on which pairs the cell tries
+(docs/decisions.md, "Nominal zero-clearance fits in the simulated cell").
 """
 
 from __future__ import annotations
@@ -41,18 +45,20 @@ def models_nominal_fits(geometry: GeometryFile) -> bool:
     return geometry.base is None or geometry.base.mesh is None
 
 
-def widened_bores(geometry: GeometryFile) -> dict[tuple[str, str], float]:
-    """The (part, pin) pairs, sorted, whose round bore the simulated cell builds
-    :data:`NOMINAL_FIT_ROOM` wider per side (a pin's ``widened``: the room on it, room 0 or
-    positive, is under what the cell resolves), each with the room per side [m] its
-    sections state (the CAD's; both round, diameters)."""
-    bores = {pid: shape.size for shape in geometry.part_shapes.values() for pid in shape.parts}
+def widened_fits(geometry: GeometryFile) -> dict[tuple[str, str], float]:
+    """The (part, feature) pairs, sorted, whose room the simulated cell builds
+    :data:`NOMINAL_FIT_ROOM` wider per side (a feature's ``widened``: the room, room 0 or
+    positive, is under what the cell resolves): on a pin with the part's round bore that
+    much wider, in a hole of a base that is its own mesh with the round peg that much
+    narrower; each with the room per side [m] its sections state (the CAD's; both round,
+    diameters)."""
+    sizes = {pid: shape.size for shape in geometry.part_shapes.values() for pid in shape.parts}
     found: dict[tuple[str, str], float] = {}
     for shape in geometry.hole_shapes.values():
-        for pid in shape.widened or () if shape.pin else ():
-            bore, pin = bores[pid], shape.size
-            assert not isinstance(bore, list) and not isinstance(pin, list)  # round: checked as the file is read
-            found |= {(pid, hid): (bore - pin) / 2 for hid in shape.holes}
+        for pid in shape.widened or ():
+            part, feature = sizes[pid], shape.size
+            assert not isinstance(part, list) and not isinstance(feature, list)  # round: checked as the file is read
+            found |= {(pid, hid): (part - feature if shape.pin else feature - part) / 2 for hid in shape.holes}
     return dict(sorted(found.items()))
 
 

@@ -185,7 +185,8 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     ``widened`` names the parts whose round bore's room on it (room 0 or positive) is under
     what the simulated cell resolves: that cell builds their bores wider
     (``bridge.product.nominal.NOMINAL_FIT_ROOM`` per side), and the pair is observed with
-    that room, not the CAD's. ``near_miss``
+    that room, not the CAD's; a round hole's of a base with its own mesh names such round
+    pegs, which that cell builds that much narrower. ``near_miss``
     names the pegs that miss the hole by less than the simulated cell resolves with their
     corners rounded by its hull margin (``executor.world.near_miss``), or every peg of a
     hole no deeper than the cell's goal tolerance (one blocked on its rim ends as near its

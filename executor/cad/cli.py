@@ -85,7 +85,7 @@ from executor.cad.write import (
     mesh_pieces,
     near_miss_assumption,
     nominal_assumption,
-    widened_bores_assumption,
+    widened_fits_assumption,
     write_folder,
 )
 
@@ -613,7 +613,7 @@ def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path 
         near = len(assumed)  # the near misses' place: they are known once the pieces of the meshes are
         assumed += overlap_assumption(derived)
         mapped, laid, cell = map_product(derived, settings)
-        assumed += widened_bores_assumption(cell)
+        assumed += widened_fits_assumption(cell)
     assumed += [finger_assumption(), *finger_orders(cell), *([mapped.tool] if mapped.tool else [])]
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:

@@ -63,7 +63,7 @@ from executor.cad.parts import STEP_DEFLECTION, CadPart
 from executor.cad.sections import Shape2D, classify, exact_round, slice_loops
 from executor.cad.sweep import bvh, convex_object
 from executor.world import SIZE_RESOLUTION
-from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded, obj_text
+from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded, narrowed, obj_text
 from executor.world.rings import Prisms, prism_pieces
 
 PRIMITIVE_TOLERANCE = 0.01
@@ -230,7 +230,7 @@ def overlap_assumption(derived: Derived) -> list[str]:
 
 def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimesh.Trimesh],
                    fits: frozenset[str] = frozenset(), thresholds: Sequence[float] = THRESHOLDS,
-                   iterations: int = ITERATIONS, prisms: bool = False
+                   iterations: int = ITERATIONS, prisms: bool = False, only_prisms: bool = False
                    ) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
     """The convex pieces of part ``pid``'s closed mesh (module docstring; each with how far
     its dropped vertices reach) and a line on what they leave its ``neighbours`` (the
@@ -242,7 +242,9 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     making ``iterations`` per cut). For a peg (``prisms``) with a layer of parts thinner
     than that within the section next to it, which :func:`executor.world.rings.prism_pieces`
     fills to that section (a switch's 0.5 mm spade terminals under its body, which CoACD's
-    pieces follow), the prisms of its sections are tried first, under the same checks."""
+    pieces follow), the prisms of its sections are tried first, under the same checks;
+    ``only_prisms``: its hull or those prisms alone, filled or not (a peg the cell narrows
+    about its axis: :func:`write_mesh`)."""
     allowed = {name: NOMINAL_OVERLAP if name in fits else TOUCH for name in neighbours}
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
     own = bvh(mesh)
@@ -254,10 +256,13 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     short: list[str] = []
     thin: set[int] = set()  # the seeds whose pieces were too thin at a threshold
     tries = 0
-    stacked = prism_pieces(pid, mesh) if prisms and not convex else None
-    stacked = stacked if isinstance(stacked, Prisms) and stacked.filled > 0 else None
+    found = prism_pieces(pid, mesh) if (prisms or only_prisms) and not convex else None
+    if only_prisms and isinstance(found, str):
+        return f"{found}; the cell narrows a peg whose pieces are its hull or the prisms of its sections only"
+    stacked = found if isinstance(found, Prisms) and (found.filled > 0 or only_prisms) else None
     first = [] if stacked is None else [(-1, 0.0)]  # seed -1: the prisms
-    for seed, threshold in [(0, 0.0)] if convex else first + [(s, t) for s in SEEDS for t in thresholds]:
+    coacd = [] if only_prisms else [(s, t) for s in SEEDS for t in thresholds]
+    for seed, threshold in [(0, 0.0)] if convex else first + coacd:
         if seed in thin:
             continue  # a finer threshold cuts more, smaller pieces: it mends no piece too thin
         tries += 1
@@ -287,11 +292,12 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
             name = min(apart, key=lambda n: left[n] / rooms[n])
             return kept, (f"{kind}; they leave {name} {1e3 * left[name]:.3f} of {1e3 * rooms[name]:.3f} mm"
                           + (touching if len(apart) < len(rooms) else ""))
-    tried = (("the prisms of its sections, " if first else "")
-             + f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
-             + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else "")
-             + (f"; {tries} tried: seed(s) {', '.join(map(str, sorted(thin)))} no finer after a piece too thin"
-                if thin else ""))
+    tried = "the prisms of its sections" if only_prisms else (
+        ("the prisms of its sections, " if first else "")
+        + f"CoACD's thresholds {', '.join(f'{t:g}' for t in thresholds)}, seeds {', '.join(map(str, SEEDS))}"
+        + (f", {iterations} tree-search iterations" if iterations != ITERATIONS else "")
+        + (f"; {tries} tried: seed(s) {', '.join(map(str, sorted(thin)))} no finer after a piece too thin"
+           if thin else ""))
     if not short:
         return (f"part '{pid}' has no convex pieces the cell can collide as ({tried}: each gave a piece thinner than "
                 f"{1e3 * MIN_THICKNESS:g} mm, the cell's hull margin twice less what it resolves)")
@@ -481,16 +487,17 @@ def as_written(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
 
 def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
                neighbours: dict[str, trimesh.Trimesh] | None, frame: str = "its part frame",
-               exact: Pieces | None = None, fits: frozenset[str] = frozenset(), prisms: bool = False
-               ) -> tuple[Mesh, list[Path]] | str:
+               exact: Pieces | None = None, fits: frozenset[str] = frozenset(), prisms: bool = False,
+               narrow: float = 0.0) -> tuple[Mesh, list[Path]] | str:
     """Write ``mesh`` (already in ``frame`` [m]; ``made``: how, for its header) as
     ``meshes/<pid>.obj`` in the assembly ``folder`` and, for a moving part
     (``neighbours``: the parts near it, in its frame; None for a static one: the base, a
     part placed by hand), its convex pieces (:func:`fitting_pieces`, or ``exact``'s:
     :func:`executor.world.rings.ring_pieces`; ``fits``: the neighbours at a stated
     zero-clearance fit or passage with it; ``prisms``: a peg's, whose prisms of its sections
-    may serve); returns the ``mesh`` entry of
-    ``geometry.toml`` and the paths written, or why no pieces fit."""
+    may serve; ``narrow`` [m]: a peg the cell narrows, its hull or the prisms of its sections
+    alone, each piece :func:`narrowed` by that about its axis, z); returns the ``mesh``
+    entry of ``geometry.toml`` and the paths written, or why no pieces fit."""
     make_folder(folder / MESH_FOLDER)
     name = f"{MESH_FOLDER}/{pid}.obj"
     text = obj_text([(pid, apart(mesh.vertices), mesh.faces)],
@@ -502,11 +509,20 @@ def write_mesh(folder: Path, pid: str, mesh: trimesh.Trimesh, made: str,
     # The pieces of the mesh as written (0.1 µm), so that they are pieces of that file.
     written_mesh = trimesh.load(folder / name, force="mesh")
     assert isinstance(written_mesh, trimesh.Trimesh)  # the closed mesh just written
-    found = (fitting_pieces(pid, written_mesh, neighbours, fits, prisms=prisms) if exact is None
-             else exact(pid, written_mesh))
+    found = (fitting_pieces(pid, written_mesh, neighbours, fits, prisms=prisms, only_prisms=narrow > 0)
+             if exact is None else exact(pid, written_mesh))
     if isinstance(found, str):
         return found
     kept, made = found
+    if narrow:
+        shrunk = [narrowed(piece.vertices, narrow) for piece, _ in kept]
+        if thin := [k + 1 for k, piece in enumerate(shrunk)
+                    if piece is None or eroded(piece.vertices, URDF_HULL_MARGIN) is None]:
+            return (f"piece {thin[0]} of part '{pid}' narrowed by {1e3 * narrow:g} mm per side (a fit whose room the "
+                    f"cell does not resolve) is thinner than {1e3 * MIN_THICKNESS:g} mm, the cell's hull margin twice "
+                    "less what it resolves")
+        kept = [(piece, reach) for piece, (_, reach) in zip(shrunk, kept, strict=True) if piece is not None]
+        made += f"; each narrowed by {1e3 * narrow:g} mm about its axis (a fit whose room the cell does not resolve)"
     convex = f"{MESH_FOLDER}/{pid}.convex.obj"
     pieces = [(f"{pid}_{k + 1}", piece.vertices, piece.faces) for k, (piece, _) in enumerate(kept)]
     header = (CONVEX_HEADER.format(file=name, sha256=digest) + f"\n# {len(kept)} piece(s) of at most {PIECE_VERTICES} "

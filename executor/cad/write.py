@@ -86,9 +86,10 @@ from executor.cad.operations import (
     cell_view,
     entry_point,
     feature_turn,
-    fine_pins,
+    fine_fits,
     finger_grip,
     margins,
+    narrows_peg,
     nominal_fits,
     order,
     pin_entry,
@@ -292,29 +293,34 @@ def nominal_assumption(derived: Derived) -> list[str]:
             f"{1e6 * max(map(abs, nominal.values())):.1f} µm apart)"] if nominal else []
 
 
-def widened_bores(cell: Derived) -> dict[tuple[str, str], float]:
-    """The fits on pins of the product as the cell inserts it (``cell``:
-    :func:`executor.cad.operations.cell_view`) whose part's round bore the simulated cell
-    builds :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` wider per side
-    (:func:`executor.cad.operations.widens_bore`), sorted: (part, pin) to the CAD's room
-    per side [m] (0.0 for a nominal zero-clearance fit); a pin's ``widened`` in
-    ``geometry.toml``."""
+def widened_fits(cell: Derived) -> dict[tuple[str, str], float]:
+    """The fits of the product as the cell inserts it (``cell``:
+    :func:`executor.cad.operations.cell_view`) whose room the simulated cell builds
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` wider per side, sorted: on a pin with
+    the part's round bore wider (:func:`executor.cad.operations.widens_bore`), in a hole of
+    a base that is its own mesh with the round peg narrower
+    (:func:`executor.cad.operations.narrows_peg`); (part, feature) to the CAD's room per
+    side [m] (0.0 for a nominal zero-clearance fit); a feature's ``widened`` in ``geometry.toml``."""
     rooms, nominal = margins(cell), nominal_fits(cell)
-    return {(pid, pin_id): 0.0 if (pid, pin_id) in nominal else rooms[pid][pin_id] / 2
-            for pid in sorted(cell.bores) if widens_bore(cell, pid, nominal)
-            for pin_id in fine_pins(cell, pid, nominal)}
+    resized: list[tuple[str, list[str]]] = [
+        *((pid, list(cell.pins)) for pid in cell.bores if widens_bore(cell, pid, nominal)),
+        *((pid, list(cell.holes)) for pid in cell.hole_of if narrows_peg(cell, pid, nominal))]
+    found = {(pid, fid): 0.0 if (pid, fid) in nominal else rooms[pid][fid] / 2
+             for pid, features in resized for fid in fine_fits(cell, pid, features, nominal)}
+    return dict(sorted(found.items()))
 
 
-def widened_bores_assumption(cell: Derived) -> list[str]:
-    """What the simulated cell assumes of the fits on pins whose room it does not resolve
-    (:func:`widened_bores`), as ``import`` prints it; none without one."""
-    pairs = widened_bores(cell)
-    return [f"fits on pins with room under the {1e3 * SIZE_RESOLUTION:g} mm per side the simulated cell resolves: "
-            f"it builds each with the part's round bore {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side (its pieces' "
-            "bores regular polygons about the bore's inscribed circle grown by that), so they are observed in that "
-            "model, not at the CAD's room: "
-            + " ".join(f"{pid}->{pin_id} ({'room 0' if not room else f'{1e3 * room:+.4f} mm'})"
-                       for (pid, pin_id), room in pairs.items())] if pairs else []
+def widened_fits_assumption(cell: Derived) -> list[str]:
+    """What the simulated cell assumes of the fits whose room it does not resolve
+    (:func:`widened_fits`), as ``import`` prints it; none without one."""
+    pairs = widened_fits(cell)
+    return [f"fits with room under the {1e3 * SIZE_RESOLUTION:g} mm per side the simulated cell resolves: it builds "
+            f"each with {1e3 * NOMINAL_FIT_ROOM:g} mm more room per side, on a pin with the part's round bore that "
+            "much wider (its pieces' bores regular polygons about the bore's inscribed circle grown by that), in a "
+            "hole of a base that is its own mesh with the round peg that much narrower (its pieces narrowed about its "
+            "axis), so they are observed in that model, not at the CAD's room: "
+            + " ".join(f"{pid}->{fid} ({'room 0' if not room else f'{1e3 * room:+.4f} mm'})"
+                       for (pid, fid), room in pairs.items())] if pairs else []
 
 
 def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
@@ -643,7 +649,8 @@ def write_meshes(derived: Derived, mapped: Mapped, out: Path, written: list[Path
                                            - np.maximum(mesh.bounds[0], part.mesh.bounds[0]) > -NEAR)}
         done = write_mesh(out, pid, mesh.copy().apply_transform(frames[pid]), "as measured", near,
                           exact=bore_pieces(derived, pid) if pid in derived.bores else None,
-                          fits=frozenset(fitted(derived, pid)), prisms=pid in derived.hole_of)
+                          fits=frozenset(fitted(derived, pid)), prisms=pid in derived.hole_of,
+                          narrow=NOMINAL_FIT_ROOM if narrows_peg(derived, pid) else 0.0)
         if isinstance(done, str):
             written.append(out / MESH_FOLDER / f"{pid}.obj")  # written before its pieces were sought
             refused[pid] = done
@@ -710,13 +717,14 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
     nominal, pairs, missed = zero_clearance_parts(derived), section_pairs(derived), near_misses(derived, pieces)
-    widened = widened_bores(derived)
+    widened = widened_fits(derived)
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
         lines += [f"[hole_shapes.{hid}]", f'holes = ["{hid}"]',
                   *_section_lines(nominal_section(_hole_section(derived, hid, fit),
                                                   [pairs[pid][hid][0] for pid in listed])),
-                  *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of])]
+                  *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of]),
+                  *_widened_line([pid for pid, on in widened if on == hid], "pegs", "narrower")]
         close = [(pid, reason) for (pid, h), reason in missed.items() if h == hid]
         if close:
             lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
@@ -746,7 +754,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         top, height = pin_level(derived, pin)
         lines += [f"[hole_shapes.{pin_id}]", f'holes = ["{pin_id}"]', "pin = true", *_section_lines(pin.section),
                   *_zero_clearance_line([pid for pid in nominal.get(pin_id, []) if pid in derived.bores]),
-                  *_widened_line([pid for pid, on in widened if on == pin_id])]
+                  *_widened_line([pid for pid, on in widened if on == pin_id], "bores", "wider")]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
         if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
@@ -807,9 +815,10 @@ def _hole_section(derived: Derived, hid: str, fit: HoleFit) -> Shape2D:
     return swept[0][1] if swept else fit.hole
 
 
-def _widened_line(parts: list[str]) -> list[str]:
-    """A pin's ``widened`` line naming ``parts`` (:func:`widened_bores`; none without one)."""
-    return [f"widened = {json.dumps(parts)}  # bores the cell builds {1e3 * NOMINAL_FIT_ROOM:g} mm wider per side: "
+def _widened_line(parts: list[str], what: str, how: str) -> list[str]:
+    """A feature's ``widened`` line naming ``parts`` (:func:`widened_fits`; none without
+    one): ``what`` the cell builds (bores, pegs) ``how`` (wider, narrower)."""
+    return [f"widened = {json.dumps(parts)}  # {what} the cell builds {1e3 * NOMINAL_FIT_ROOM:g} mm {how} per side: "
             "room under what it resolves"] if parts else []
 
 

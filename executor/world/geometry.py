@@ -133,7 +133,7 @@ class HoleSpec(Section):
     :func:`seated_pose`); the parts stated to fit it at room 0
     (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the parts
     with a bore whose room on it is under what the cell resolves, whose bore it builds wider
-    (``widened``: :func:`_with_widened_bore`); the pegs
+    (``widened``: :func:`_with_widened_fits`; a hole's: the pegs it builds narrower); the pegs
     that miss it by less than the cell resolves (``near_miss``: :mod:`executor.world.near_miss`,
     no experiment); ``tile``
     the side of its square boss [m] where it differs from the plate's ``tile_size``
@@ -301,7 +301,7 @@ def _geometry(folder: Path, layout: Assembly, geo: GeometryFile, gripper: Grippe
             )
     if models_nominal_fits(geo):
         holes = {hid: _with_nominal_room(hole, parts) for hid, hole in holes.items()}
-    parts = {pid: _with_widened_bore(part, holes) for pid, part in parts.items()}
+    parts = {pid: _with_widened_fits(part, holes) for pid, part in parts.items()}
     return CellGeometry(folder, geo.plate, gripper, holes, parts, geo, layout)
 
 
@@ -342,21 +342,26 @@ def _with_nominal_room(hole: HoleSpec, parts: dict[str, PartSpec]) -> HoleSpec:
     return built
 
 
-def _with_widened_bore(part: PartSpec, holes: dict[str, HoleSpec]) -> PartSpec:
-    """The part as the simulated cell builds it: a part with a bore that a pin names in
-    ``widened`` (its room on that pin, room 0 or positive, is under what the cell resolves)
-    has its bore :func:`widened` by :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` per
-    side (its pieces are made so: :func:`executor.world.rings.round_bores`); ExecutorError
-    naming the first pin on which that room would change its answer (:func:`feature_passes`)."""
-    if not part.bore or not any(part.id in hole.widened for hole in holes.values() if hole.pin):
+def _with_widened_fits(part: PartSpec, holes: dict[str, HoleSpec]) -> PartSpec:
+    """The part as the simulated cell builds it: a part that a feature names in ``widened``
+    (its room there, room 0 or positive, is under what the cell resolves) has
+    :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` more room per side, its bore
+    :func:`widened` by that on a pin, its section narrowed by that in a hole of a base
+    with its own mesh (its pieces are made so: :func:`executor.world.rings.round_bores`,
+    :func:`executor.world.meshes.narrowed`); ExecutorError naming the first feature of its
+    kind (pins for a bore, holes for a peg) in which that room would change its answer
+    (:func:`feature_passes`)."""
+    if not any(part.id in hole.widened for hole in holes.values() if hole.pin == part.bore):
         return part
-    built = widened(part, NOMINAL_FIT_ROOM)
+    built = widened(part, NOMINAL_FIT_ROOM if part.bore else -NOMINAL_FIT_ROOM)
     for hid, hole in sorted(holes.items()):
-        if hole.pin and feature_passes(part, hole) != feature_passes(built, hole):
+        if hole.pin == part.bore and feature_passes(part, hole) != feature_passes(built, hole):
+            room, what = (margin(hole, part), "bore {:g} mm wider") if part.bore else (
+                margin(part, hole), "section {:g} mm narrower")
             raise ExecutorError(
-                f"part '{part.id}': the simulated cell builds its fits on pins whose room it does not resolve "
-                f"(widened) with its bore {NOMINAL_FIT_ROOM * 1e3:g} mm wider per side, and on pin '{hid}' "
-                f"({margin(hole, part) * 500:+.4f} mm per side) it would then "
+                f"part '{part.id}': the simulated cell builds its fits whose room it does not resolve (widened) with "
+                f"its {what.format(NOMINAL_FIT_ROOM * 1e3)} per side, and "
+                f"{'on pin' if hole.pin else 'in hole'} '{hid}' ({room * 500:+.4f} mm per side) it would then "
                 f"{'fit' if feature_passes(built, hole) else 'not fit'}: expected every other pair's answer unchanged"
                 " (docs/cell.md#nominal-zero-clearance-fits)")
     return built

@@ -98,8 +98,26 @@ def eroded(vertices: np.ndarray, margin: float) -> trimesh.Trimesh | None:
     moved = np.minimum(margin, widths / 2 - THIN_CORE)  # across a face: the hull's extent from its plane
     if np.any(moved < margin - THIN_EXCESS):
         return None
-    offsets = hull.equations[:, 3] + moved  # inside: n.x + d <= 0
-    # The centre of the largest ball inside the eroded hull (Chebyshev centre): a strictly
+    return _moved_in(normals, hull.equations[:, 3] + moved)
+
+
+def narrowed(vertices: np.ndarray, room: float) -> trimesh.Trimesh | None:
+    """The convex hull of ``vertices`` [m] less ``room`` [m] all round the z axis: every
+    face moved inwards by ``room`` times its normal's part across z (the hull eroded by a
+    disc of radius ``room`` across z), so a prism along z has its section ``room`` narrower
+    per side and its ends where they were; None when nothing is left."""
+    try:
+        hull = ConvexHull(vertices)
+    except QhullError:
+        return None
+    normals = hull.equations[:, :3]
+    return _moved_in(normals, hull.equations[:, 3] + room * np.hypot(normals[:, 0], normals[:, 1]))
+
+
+def _moved_in(normals: np.ndarray, offsets: np.ndarray) -> trimesh.Trimesh | None:
+    """The convex solid of the half-spaces ``normals @ x + offsets <= 0`` [m], None when it
+    is empty or thinner than 0.2 µm."""
+    # The centre of the largest ball inside the solid (Chebyshev centre): a strictly
     # interior point for the intersection, and its radius says whether anything is left.
     res = linprog(c=[0, 0, 0, -1], A_ub=np.hstack([normals, np.ones((len(normals), 1))]), b_ub=-offsets,
                   bounds=[(None, None)] * 3 + [(0, None)])

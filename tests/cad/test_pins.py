@@ -26,7 +26,7 @@ from executor.cad.derive import Derived, derive
 from executor.cad.derive.bore_on_pin import _GRID, _joined
 from executor.cad.operations import margins
 from executor.cad.parts import CadPart
-from executor.world.geometry import HoleSpec, PartSpec, _with_widened_bore, load_geometry
+from executor.world.geometry import HoleSpec, PartSpec, _with_widened_fits, load_geometry
 from tests.cad.conftest import learned_in_the_cell, manual_reasons, teach
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
@@ -399,11 +399,11 @@ def test_the_cell_reads_a_zero_clearance_bore_widened_and_refuses_one_that_would
     pin = HoleSpec("p1", "round", 0.010, (0.5, 0.0), top_z=0.04, depth=0.03, pin=True, zero_clearance=("washer",),
                    widened=("washer",))
     other = HoleSpec("p2", "round", 0.0105, (0.55, 0.0), top_z=0.04, depth=0.03, pin=True)
-    assert _with_widened_bore(washer, {"p1": pin, "p2": other}).size == pytest.approx(0.0103)
-    assert _with_widened_bore(washer, {"p2": other}) == washer  # no widened bore stated: as read
+    assert _with_widened_fits(washer, {"p1": pin, "p2": other}).size == pytest.approx(0.0103)
+    assert _with_widened_fits(washer, {"p2": other}) == washer  # no widened bore stated: as read
     tight = dataclasses.replace(other, size=0.0101)  # -0.05 mm per side; +0.1 widened
     with pytest.raises(ExecutorError, match="on pin 'p2' \\(-0.0500 mm per side\\) it would then fit"):
-        _with_widened_bore(washer, {"p1": pin, "p2": tight})
+        _with_widened_fits(washer, {"p1": pin, "p2": tight})
 
 
 @pytest.mark.slow  # the import: about 4 s

@@ -96,8 +96,12 @@ CASES = [
     ("zero-clearance-unknown-part", 'holes = ["br"]', 'holes = ["br"]\nzero_clearance = ["zz"]',
      "[hole_shapes.round_big] zero_clearance: expected parts with a bore of [part_shapes.*] for a pin, pegs of "
      "[part_shapes.*] for a hole, got 'zz'"),
-    ("widened-in-a-hole", 'holes = ["br"]', 'holes = ["br"]\nwidened = ["zz"]',
-     "[hole_shapes.round_big] widened: expected parts with a round bore of [part_shapes.*] on a round pin, got 'zz'"),
+    ("widened-unknown-part", 'holes = ["br"]', 'holes = ["br"]\nwidened = ["zz"]',
+     "[hole_shapes.round_big] widened: expected parts with a round bore of [part_shapes.*] on a round pin, round "
+     "pegs in a round hole of a [base] with its own mesh, got 'zz'"),
+    ("widened-peg-in-a-plate", 'holes = ["br"]', 'holes = ["br"]\nwidened = ["p1"]',  # the plate widens its holes
+     "[hole_shapes.round_big] widened: expected parts with a round bore of [part_shapes.*] on a round pin, round "
+     "pegs in a round hole of a [base] with its own mesh, got 'p1'"),
     ("near-miss-unknown-part", 'holes = ["br"]', 'holes = ["br"]\nnear_miss = ["zz"]',
      "[hole_shapes.round_big] near_miss: expected pegs of [part_shapes.*] in a hole, got 'zz'"),
     ("hole-bottom-under-the-floor", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.1',
