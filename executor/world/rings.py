@@ -32,6 +32,15 @@ polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_p
 round pin passes it exactly when it passes the bore; for a fit whose room the cell does not
 resolve, about that circle grown by the room the cell gives such a fit (``widen``), so a
 round pin passes it as it passes the bore widened by that room.
+
+A part on pins not all round that is no such stack (a knob on a D shaft: its top a wall
+across the bore, its recess tapering to the bore in a layer thinner than the cell
+collides as, its outside tapered) may be a stack of layers of which some have no bore,
+thin ones joined to the next (:func:`_joined`), and those that are no prisms the hulls of
+the mesh within their section's convex parts (:func:`_cut`); and its bore, where no
+coarser one gives pieces (faces narrower than the hull margin twice), its round part a
+regular polygon cut by its flats that leaves each pin the room the bore does
+(:func:`flat_bores`).
 """
 
 from __future__ import annotations
