@@ -5,6 +5,7 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 
     base = "plate"            # the fixture part (default: the part of largest volume, the lowest of alike ones)
     up = "+y"                 # the CAD's axis pointing up (default +z): +x, -x, +y, -y, +z or -z
+    pieces_cpu_s = 60         # CoACD's CPU time per part's convex pieces [s] (default 60): then placed by hand
     [parts.peg1]
     tray = [0.25, 0.40]       # where the part waits in the cell [m] (default: laid out by footprints)
     name = "round peg"
@@ -46,7 +47,7 @@ import trimesh
 from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
-from executor.cad.convex import MESH_FOLDER, overlap_assumption
+from executor.cad.convex import MESH_FOLDER, PIECES_CPU, budget_assumption, overlap_assumption, pieces_budget
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
@@ -134,6 +135,17 @@ def _up_setting(path: Path | None, value: object) -> str | None:
     if value not in UP_AXES:
         raise ExecutorError(f"{path}: up: expected {_UP_EXPECTED}, got {shorten(repr(value))}")
     return str(value)
+
+
+def _budget_setting(path: Path | None, value: object) -> float:
+    """``pieces_cpu_s`` of ``--config``, the CPU time [s] CoACD may spend on one part's
+    pieces (:data:`executor.cad.convex.PIECES_CPU` when not set); ExecutorError naming the
+    file when it is no positive number."""
+    if value is None:
+        return PIECES_CPU
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ExecutorError(f"{path}: pieces_cpu_s: expected a positive number of seconds, got {shorten(repr(value))}")
+    return float(value)
 
 
 def _up_assumption(up: str | None) -> str:
@@ -565,16 +577,19 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     started = time.perf_counter()
     data = _settings_file(config)
     up = options.up or _up_setting(config, data.get("up"))
+    seconds = _budget_setting(config, data.get("pieces_cpu_s"))
     parts = turned(load_source(source, units, options.max_triangles), up or "+z")
     check_solids(parts, units)
-    # the overlap check runs beside the derivation where the sweeps would take two cores
-    with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
-        found = _derived(parts, (source, out), (config, data, up), options, start)
-    removable, settings, derived, cell, assumed, offset, mapped, near = found
-    doubt = None if up is not None else drawn_up(derived)
-    if doubt is not None:
-        raise ExecutorError(f"{source}: {doubt}")
-    written, why, mapped, cell = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
+    with pieces_budget(seconds):
+        # the overlap check runs beside the derivation where the sweeps would take two cores
+        with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
+            found = _derived(parts, (source, out), (config, data, up), options, start)
+        removable, settings, derived, cell, assumed, offset, mapped, near = found
+        doubt = None if up is not None else drawn_up(derived)
+        if doubt is not None:
+            raise ExecutorError(f"{source}: {doubt}")
+        written, why, mapped, cell = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
+    assumed.append(budget_assumption(seconds))
     assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
     tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
     suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}

@@ -39,14 +39,18 @@ places it by hand with why). The decomposition is made here, never when a cell s
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import hashlib
 import io
 import math
-from collections.abc import Callable, Sequence
+import resource
+import signal
+import subprocess
+import sys
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
-import clingo  # noqa: F401  (before CoACD: loaded after it, clingo cannot print a symbol, std::bad_cast)
-import coacd
 import fcl
 import numpy as np
 import scipy.spatial
@@ -192,13 +196,92 @@ def peg_frame(section: Shape2D, mesh: trimesh.Trimesh) -> np.ndarray:
     return turn @ shift
 
 
-def _decomposed(mesh: trimesh.Trimesh, threshold: float, seed: int, iterations: int) -> list[trimesh.Trimesh]:
-    """CoACD's convex pieces of a closed mesh at a concavity ``threshold``, a random
-    ``seed`` and ``iterations`` of its tree search per cut."""
-    coacd.set_log_level("error")
-    pieces = coacd.run_coacd(coacd.Mesh(mesh.vertices, mesh.faces), threshold=threshold, seed=seed,
-                             mcts_iterations=iterations)
-    return [trimesh.convex.convex_hull(vertices) for vertices, _ in pieces]
+PIECES_CPU = 60.0
+"""The most CPU time [s] CoACD may spend on one part's pieces in an import, over all its
+thresholds, seeds and tree searches (import.toml's ``pieces_cpu_s``): then the part gets
+none, and is placed by hand with why. The corpus's longest search of pieces that fit took
+17.5 s (a ring, two runs); a knob of 2414 triangles ran for minutes."""
+_CHILD = """
+import io, resource, sys
+import numpy as np
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_CPU, (limit, limit + 1))
+import coacd
+coacd.set_log_level("error")
+given = np.load(io.BytesIO(sys.stdin.buffer.read()))
+found = coacd.run_coacd(coacd.Mesh(given["vertices"], given["faces"]), threshold=float(sys.argv[2]),
+                        seed=int(sys.argv[3]), mcts_iterations=int(sys.argv[4]))
+out = io.BytesIO()
+np.savez(out, *[np.asarray(vertices, dtype=float) for vertices, _ in found])
+sys.stdout.buffer.write(out.getvalue())
+"""
+"""The program a CoACD run is made by, in a process of its own under a CPU limit [s] (its first argument)."""
+
+
+class Budget:
+    """The CPU time [s] CoACD may spend on each part's pieces (``seconds``) and what it has
+    spent on each (by part id) in one import."""
+
+    def __init__(self, seconds: float) -> None:
+        self.seconds = seconds
+        self.spent: dict[str, float] = {}
+
+    def left(self, pid: str) -> float:
+        """The CPU time [s] CoACD may still spend on part ``pid``."""
+        return self.seconds - self.spent.get(pid, 0.0)
+
+
+_BUDGET: contextvars.ContextVar[Budget | None] = contextvars.ContextVar("pieces_budget", default=None)
+"""The budget of the import under way (None: each search of pieces gets :data:`PIECES_CPU` of its own)."""
+
+
+@contextlib.contextmanager
+def pieces_budget(seconds: float) -> Iterator[Budget]:
+    """Within it, CoACD spends at most ``seconds`` of CPU on each part's pieces, over all its searches."""
+    budget = Budget(seconds)
+    token = _BUDGET.set(budget)
+    try:
+        yield budget
+    finally:
+        _BUDGET.reset(token)
+
+
+def budget_assumption(seconds: float) -> str:
+    """What ``import`` prints of the CPU time CoACD may spend on a part's pieces."""
+    return (f"CoACD spends at most {seconds:g} s of CPU on one part's convex pieces (pieces_cpu_s; a part whose "
+            "pieces are not found within it is placed by hand)")
+
+
+class OverBudget(str):
+    """Why a part has no convex pieces: CoACD's CPU time for it ran out."""
+
+
+def _decomposed(pid: str, mesh: trimesh.Trimesh, threshold: float, seed: int, iterations: int, budget: Budget
+                ) -> list[trimesh.Trimesh] | OverBudget:
+    """CoACD's convex pieces of part ``pid``'s closed mesh at a concavity ``threshold``, a
+    random ``seed`` and ``iterations`` of its tree search per cut, made in a process of its
+    own (:data:`_CHILD`) under the CPU time part ``pid`` has left in ``budget``, which it
+    is charged; or why not, when that runs out."""
+    over = OverBudget(f"part '{pid}' has no convex pieces within {budget.seconds:g} s of CoACD's CPU time "
+                      "(pieces_cpu_s in import.toml)")
+    left = budget.left(pid)
+    if left <= 0:
+        return over
+    given = io.BytesIO()
+    np.savez(given, vertices=np.asarray(mesh.vertices, dtype=float), faces=np.asarray(mesh.faces, dtype=np.int64))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    done = subprocess.run([sys.executable, "-c", _CHILD, str(math.ceil(left)), repr(threshold), str(seed),
+                           str(iterations)], input=given.getvalue(), capture_output=True, check=False)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    budget.spent[pid] = budget.spent.get(pid, 0.0) + (after.ru_utime - before.ru_utime) + (
+        after.ru_stime - before.ru_stime)
+    if done.returncode in (-signal.SIGXCPU, -signal.SIGKILL) or budget.left(pid) < 0:  # its soft limit, hard one
+        return over
+    if done.returncode != 0:
+        raise RuntimeError(f"CoACD failed on part '{pid}' (exit {done.returncode}): "
+                           f"{done.stderr.decode(errors='replace')[-500:]}")
+    found = np.load(io.BytesIO(done.stdout))
+    return [trimesh.convex.convex_hull(found[name]) for name in found.files]
 
 
 def _room(pieces: list[fcl.CollisionObject], other: fcl.CollisionObject) -> float:
@@ -244,7 +327,9 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     fills to that section (a switch's 0.5 mm spade terminals under its body, which CoACD's
     pieces follow), the prisms of its sections are tried first, under the same checks;
     ``only_prisms``: its hull or those prisms alone, filled or not (a peg the cell narrows
-    about its axis: :func:`write_mesh`)."""
+    about its axis: :func:`write_mesh`). CoACD spends at most the import's
+    :func:`pieces_budget` on the part (:data:`PIECES_CPU` outside an import):
+    :class:`OverBudget` when it runs out."""
     allowed = {name: NOMINAL_OVERLAP if name in fits else TOUCH for name in neighbours}
     others = {name: bvh(other) for name, other in sorted(neighbours.items())}
     own = bvh(mesh)
@@ -256,6 +341,7 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
     short: list[str] = []
     thin: set[int] = set()  # the seeds whose pieces were too thin at a threshold
     tries = 0
+    budget = _BUDGET.get() or Budget(PIECES_CPU)
     found = prism_pieces(pid, mesh) if (prisms or only_prisms) and not convex else None
     if only_prisms and isinstance(found, str):
         return f"{found}; the cell narrows a peg whose pieces are its hull or the prisms of its sections only"
@@ -269,7 +355,10 @@ def fitting_pieces(pid: str, mesh: trimesh.Trimesh, neighbours: dict[str, trimes
         if stacked is not None and seed < 0:
             kept = [reduced(piece) for piece, _ in stacked.pieces]
         else:
-            kept = [reduced(piece) for piece in ([hull] if convex else _decomposed(mesh, threshold, seed, iterations))]
+            made = [hull] if convex else _decomposed(pid, mesh, threshold, seed, iterations, budget)
+            if isinstance(made, OverBudget):
+                return OverBudget(f"{made}, {tries - 1} CoACD run(s) done")
+            kept = [reduced(piece) for piece in made]
         if any(eroded(piece.vertices, URDF_HULL_MARGIN) is None for piece, _ in kept):
             thin.add(seed)
             continue  # a piece the cell cannot collide as
@@ -315,9 +404,12 @@ def pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: f
     part's frame, where the part rests on it) as its neighbour, which they may leave at most
     ``allowed`` [m] less room than the mesh leaves it (the cell's bore smaller by at most
     that, as :func:`executor.world.rings.coarser_bores`), CoACD's :data:`PIN_THRESHOLDS` tried
-    in turn, each with :data:`PIN_ITERATIONS` in turn; or why they do not. Made once for
-    a mesh and the file written of it (alike within the 0.1 µm the file keeps)."""
+    in turn, each with :data:`PIN_ITERATIONS` in turn, within the part's CPU time
+    (:func:`pieces_budget`); or why they do not. Made once for a mesh and the file written
+    of it (alike within the 0.1 µm the file keeps) and a budget."""
+    budget = _BUDGET.get()
     key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.round(pin.vertices, 7).tobytes()
+                         + np.float64(PIECES_CPU if budget is None else budget.seconds).tobytes()
                          + _shape_key(mesh)).digest()
     if key not in _PIN_PIECES:
         _PIN_PIECES[key] = _pin_pieces(pid, mesh, pin, allowed)
@@ -357,6 +449,8 @@ def _pin_pieces(pid: str, mesh: trimesh.Trimesh, pin: trimesh.Trimesh, allowed: 
     why = ""
     for threshold, iterations in [(t, n) for t in thresholds for n in PIN_ITERATIONS]:
         found = fitting_pieces(pid, mesh, {"its pin": pin}, thresholds=(threshold,), iterations=iterations)
+        if isinstance(found, OverBudget):
+            return found
         if isinstance(found, str):
             why = found
             continue

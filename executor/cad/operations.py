@@ -815,7 +815,9 @@ def _sideways_refused(derived: Derived, hid: str, fit: HoleFit) -> str:
 
 def bore_pieces(derived: Derived, pid: str) -> Pieces:
     """How the pieces of part ``pid`` with a bore are made from its mesh in its part frame:
-    a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`), or, for
+    a stack of prisms of its sections (:func:`executor.world.rings.ring_pieces`, with the
+    sections of the pins along its pin's axis placed on that axis, which a bore made of its
+    round part and flats must leave the room the bore does), or, for
     a part that is no such stack, CoACD's pieces that keep its bore within :func:`bore_loss`
     of its pin's room (the part has room on its pin: :func:`_onto_pin`)
     (:func:`executor.cad.convex.pin_pieces`)."""
@@ -828,9 +830,15 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     solid.apply_transform(bore_frame(derived, pid) @ feature_turn(pin).T)
     bores = 1 + sum(part == pid for part, _ in derived.further_bores)  # one per pin it is on
     widen = NOMINAL_FIT_ROOM if widens_bore(derived, pid) else 0.0
+    frame = bore_frame(derived, pid) @ feature_turn(pin).T
+    parallel = [pin, *(other for _, other in sorted(derived.pins.items())
+                       if other is not pin and other.axis == pin.axis)]
+    pins = tuple(shapely.Polygon(trimesh.transform_points(np.column_stack([
+        other.section.outline + pin.section.centre, np.zeros(len(other.section.outline))]), frame)[:, :2])
+        for other in parallel)  # each pin's section with its axis on the part's pin's, in the part frame
 
     def pieces(name: str, part: trimesh.Trimesh) -> tuple[list[tuple[trimesh.Trimesh, float]], str] | str:
-        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores, widen)
+        found = ring_pieces(name, part, allowed, round_pins(derived, pid), bores, widen, pins)
         if not isinstance(found, NoStack) or bores > 1 or widen:  # CoACD's pieces: about one pin, not widened
             return found
         other = pin_pieces(name, part, solid, allowed)

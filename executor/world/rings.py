@@ -32,6 +32,15 @@ polygon about its inscribed circle instead (:func:`round_bores`, :func:`sector_p
 round pin passes it exactly when it passes the bore; for a fit whose room the cell does not
 resolve, about that circle grown by the room the cell gives such a fit (``widen``), so a
 round pin passes it as it passes the bore widened by that room.
+
+A part on pins not all round that is no such stack (a knob on a D shaft: its top a wall
+across the bore, its recess tapering to the bore in a layer thinner than the cell
+collides as, its outside tapered) may be a stack of layers of which some have no bore,
+thin ones joined to the next (:func:`_joined`), and those that are no prisms the hulls of
+the mesh within their section's convex parts (:func:`_cut`); and its bore, where no
+coarser one gives pieces (faces narrower than the hull margin twice), its round part a
+regular polygon cut by its flats that leaves each pin the room the bore does
+(:func:`flat_bores`).
 """
 
 from __future__ import annotations
@@ -45,6 +54,7 @@ import numpy as np
 import shapely
 import trimesh
 
+from executor.world import SIZE_RESOLUTION
 from executor.world.meshes import MIN_THICKNESS, URDF_HULL_MARGIN, eroded
 
 ROUND_BORE_CORNERS = (64, 48, 32, 24, 16, 12, 8)
@@ -130,7 +140,7 @@ _FOUND: dict[bytes, Found] = {}
 
 
 def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pins: bool = False,
-                bores: int = 1, widen: float = 0.0) -> Found:
+                bores: int = 1, widen: float = 0.0, pins: tuple[shapely.Polygon, ...] = ()) -> Found:
     """The convex pieces of part ``pid`` with ``bores`` bores (one per pin it goes onto: a
     plate over two dowel pins has two), its closed ``mesh`` in its part frame [m] (z its
     axis; module docstring), each with 0.0 (no vertex dropped) and a line saying how they
@@ -140,13 +150,17 @@ def ring_pieces(pid: str, mesh: trimesh.Trimesh, allowed: float = 0.0, round_pin
     a piece at a bore too thin for the cell even with the bore made coarser by at most
     ``allowed`` [m] (:func:`coarser_bores`, one bore only), or, when it goes onto
     ``round_pins`` only, circumscribing each bore's inscribed circle grown by ``widen`` [m]
-    (:func:`round_bores`: the cell's room of a fit it does not resolve; 0 elsewhere)."""
+    (:func:`round_bores`: the cell's room of a fit it does not resolve; 0 elsewhere), or,
+    where no coarser bore within ``allowed`` keeps it, with its round part a regular polygon
+    cut by its flats that leaves each of ``pins`` (their sections in the part frame, axes
+    together with the bore) the room the bore does (:func:`flat_bores`)."""
     assert round_pins or not widen  # a bore is widened about its inscribed circle only
     key = hashlib.sha256(pid.encode() + np.float64(allowed).tobytes() + np.float64(widen).tobytes()
                          + bytes([round_pins, bores]) + np.ascontiguousarray(mesh.vertices).tobytes()
+                         + b"".join(shapely.to_wkb(pin) for pin in pins)
                          + np.ascontiguousarray(mesh.faces).tobytes()).digest()
     if key not in _FOUND:
-        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins, bores, widen)
+        _FOUND[key] = _pieces(pid, mesh, allowed, round_pins, bores, widen, pins)
     return _FOUND[key]
 
 
@@ -182,18 +196,20 @@ def _discs(section: shapely.Polygon, centres: list[np.ndarray]) -> list[float]:
             for centre in centres]
 
 
-def sector_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
+def sector_parts(section: shapely.Polygon, centres: list[np.ndarray] | None = None) -> list[shapely.Polygon]:
     """Convex polygons whose union is ``section``, whose bores are regular polygons
     (:func:`round_bores`): for each edge of a bore, the sector between the rays from the
     bore's centre through its ends, out to the bore's disc (:func:`_discs`: the largest
     circle about the centre within the section's outline, half way to the other bores at
     most; a polygon inscribed in it; of a section with several bores, the polygon of those
     rays inscribed in it); and the convex parts (:func:`convex_parts`) of what lies beyond
-    those discs (a gear's teeth, a handle, the plate between two bores)."""
+    those discs (a gear's teeth, a handle, the plate between two bores). Each bore's centre
+    is the mean of its corners, or as given (``centres``: a bore cut by a flat, about its
+    round part's, :func:`flat_bores`)."""
     outline = shapely.Polygon(section.exterior)
     cores, discs = [], []
     rings = [np.asarray(ring.coords)[:-1] for ring in section.interiors]
-    centres = [np.round(corners.mean(axis=0) / _GRID) * _GRID for corners in rings]  # one disc for every bore tried
+    centres = centres or [np.round(corners.mean(axis=0) / _GRID) * _GRID for corners in rings]  # one disc a bore
     for corners, centre, inner in zip(rings, centres, _discs(section, centres)):
         far = 2 * float(np.max(np.linalg.norm(np.asarray(outline.exterior.coords) - centre, axis=1)))
         if len(section.interiors) == 1:
@@ -240,6 +256,136 @@ def round_bores(section: shapely.Polygon, allowed: float, widen: float = 0.0) ->
     return found
 
 
+FLAT = 4 * URDF_HULL_MARGIN
+"""[m] an edge of a bore at least this long is a flat of it (a D bore's), which the cell's
+pieces keep (:func:`flat_bores`): a face that long keeps its middle under the hull margin."""
+ROOM_KEPT = SIZE_RESOLUTION / 5
+"""[m] the cell's bore of :func:`flat_bores` leaves each pin the room the bore does within
+this, a fifth of what the cell resolves (a tessellated round pin's room in a polygon
+changes by a few um with the polygon's corners: a 60-gon of d 6 in an 8-gon about d 6.4,
+0.201 mm, in the 13-gon it replaces 0.200)."""
+
+
+def room_in(pin: shapely.Polygon, bore: shapely.Polygon) -> float:
+    """The room [m] of a ``pin``'s section in a ``bore``'s, axes as placed (no shift or turn):
+    the distance from the pin to the bore's outline where the pin lies within it, else minus
+    the farthest its corners reach outside it."""
+    if bore.contains(pin):
+        return float(shapely.distance(bore.exterior, pin))
+    return -max(float(shapely.distance(shapely.Point(corner), bore)) for corner in pin.exterior.coords)
+
+
+def flat_bores(section: shapely.Polygon, pins: tuple[shapely.Polygon, ...], widen: float = 0.0
+               ) -> list[tuple[shapely.Polygon, float]]:
+    """``section`` with its one bore made a regular polygon of :data:`ROUND_BORE_CORNERS`
+    corners (most first) about the largest circle within its edges shorter than
+    :data:`FLAT` (its round part: a knob's 13-gon), grown by ``widen`` [m], cut by its
+    flats (edges at least that long: a D's), within the bore's disc (:func:`_discs`); each
+    with loss 0.0, kept only where every pin of ``pins`` (their sections in the part frame,
+    axes together with the bore) has the room in it that it has in the bore
+    (:func:`room_in`, within :data:`ROOM_KEPT`, grown by ``widen``): the fits and no-fits and
+    the rooms the cell sees are the mesh's. For a bore whose faces are narrower than the
+    cell's hull margin twice (a 13-gon of 1.6 mm faces), which no convex pieces keep."""
+    if len(section.interiors) != 1 or not pins:
+        return []
+    bore = shapely.simplify(shapely.Polygon(section.interiors[0]), _GRID)
+    corners = np.asarray(bore.exterior.coords)[:-1]
+    edges = list(zip(corners, np.roll(corners, -1, axis=0)))
+    flats = [_side(bore, a, b) for a, b in edges if np.linalg.norm(b - a) >= FLAT]
+    rounds = [(a, b) for a, b in edges if np.linalg.norm(b - a) < FLAT]
+    if not rounds:
+        return []
+    centre, radius = _inscribed(bore, rounds)
+    radius += widen
+    disc = _discs(section, [centre])[0]
+    found = []
+    for count in ROUND_BORE_CORNERS:
+        turn = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+        reach = radius / np.cos(np.pi / count)
+        if reach >= disc:
+            continue
+        made = shapely.Polygon(centre + reach * np.column_stack([np.cos(turn), np.sin(turn)]))
+        made = shapely.intersection_all([made, *flats])
+        if not isinstance(made, shapely.Polygon) or made.is_empty:
+            continue
+        made = shapely.set_precision(_whole_edges(made, 2 * reach * np.sin(np.pi / count)), _GRID)
+        if not isinstance(made, shapely.Polygon) or any(
+                abs(room_in(pin, made) - room_in(pin, bore) - (widen if room_in(pin, bore) >= 0 else 0.0)) > ROOM_KEPT
+                for pin in pins):
+            continue
+        found.append((shapely.Polygon(section.exterior.coords, [made.exterior.coords]), 0.0))
+    return found
+
+
+def _side(bore: shapely.Polygon, a: np.ndarray, b: np.ndarray) -> shapely.Polygon:
+    """The bore's side of its edge ``a`` -> ``b`` [m], a half-plane as far as matters (a
+    polygon four times the bore's size beyond it)."""
+    far = 4 * float(np.max(np.ptp(np.asarray(bore.exterior.coords), axis=0)))
+    along = (b - a) / np.linalg.norm(b - a)
+    into = np.array([-along[1], along[0]]) * (1.0 if bore.exterior.is_ccw else -1.0)
+    return shapely.Polygon([a - far * along, b + far * along, b + far * along + far * into,
+                            a - far * along + far * into])
+
+
+def _inscribed(bore: shapely.Polygon, edges: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, float]:
+    """The centre and radius [m] of the largest circle on the bore's side of each of its ``edges``."""
+    circle = shapely.maximum_inscribed_circle(shapely.intersection_all([_side(bore, a, b) for a, b in edges]), _GRID)
+    return np.round(np.array(circle.coords[0]) / _GRID) * _GRID, float(circle.length)
+
+
+def _centre_of(section: shapely.Polygon) -> np.ndarray:
+    """The centre [m] of the regular polygon the bore of ``section`` was made of by
+    :func:`flat_bores`: the point as far from each of its whole edges (the shortest: its
+    flats and the edges extended to them are longer) along their normals through their
+    middles (least squares)."""
+    bore = shapely.orient_polygons(shapely.Polygon(section.interiors[0]))
+    corners = np.asarray(bore.exterior.coords)[:-1]
+    ends = np.roll(corners, -1, axis=0)
+    lengths = np.linalg.norm(ends - corners, axis=1)
+    whole = lengths <= np.min(lengths) * (1 + 1e-6)
+    along = (ends - corners)[whole] / lengths[whole][:, None]
+    inward = np.column_stack([-along[:, 1], along[:, 0]])  # counter-clockwise: the bore to the left
+    middles = ((corners + ends) / 2)[whole]
+    # centre - r * inward = middle: two equations an edge, in (x, y, r)
+    rows = np.vstack([np.column_stack([np.ones(len(middles)), np.zeros(len(middles)), -inward[:, 0]]),
+                      np.column_stack([np.zeros(len(middles)), np.ones(len(middles)), -inward[:, 1]])])
+    solved = np.linalg.lstsq(rows, np.concatenate([middles[:, 0], middles[:, 1]]), rcond=None)[0]
+    return np.round(solved[:2] / _GRID) * _GRID
+
+
+def _flat_parts(section: shapely.Polygon) -> list[shapely.Polygon]:
+    """:func:`sector_parts` of a section whose bore :func:`flat_bores` made, about its
+    regular polygon's centre (:func:`_centre_of`); of a section with no bore, its convex parts."""
+    return sector_parts(section, [_centre_of(section)]) if section.interiors else convex_parts(section)
+
+
+def _whole_edges(polygon: shapely.Polygon, edge: float) -> shapely.Polygon:
+    """The convex ``polygon`` with each edge shorter than ``edge`` [m] (a regular polygon's
+    edge cut short by a flat) taken out by extending the edges on either side of it to
+    where they meet (the polygon grows there), while they meet beyond it and more than
+    three corners are left: a convex piece of a bore holds one edge, which must be wide
+    enough for the cell's hull margin."""
+    corners = [np.asarray(c) for c in np.asarray(shapely.orient_polygons(polygon).exterior.coords)[:-1]]
+    k = 0
+    while k < len(corners) and len(corners) > 3:
+        n = len(corners)
+        a, b = corners[k], corners[(k + 1) % n]
+        if float(np.linalg.norm(b - a)) >= (1 - 1e-6) * edge:
+            k += 1
+            continue
+        before, after = corners[k - 1], corners[(k + 2) % n]
+        u, v = a - before, after - b
+        cross = u[0] * v[1] - u[1] * v[0]
+        if cross <= 0:  # the edges on either side do not meet beyond it
+            k += 1
+            continue
+        t = ((b - before)[0] * v[1] - (b - before)[1] * v[0]) / cross
+        corners[k] = before + t * u
+        del corners[(k + 1) % n]
+        k = 0
+    return shapely.Polygon(corners)
+
+
 def layers_of(mesh: trimesh.Trimesh) -> list[tuple[shapely.Geometry, float, float]]:
     """The layers of a closed ``mesh`` in its part frame [m] (module docstring), each as (its
     section, its bottom, its top) [m], the section the union of its sections near its ends
@@ -267,15 +413,17 @@ def layers_of(mesh: trimesh.Trimesh) -> list[tuple[shapely.Geometry, float, floa
     return layers
 
 
-def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely.Polygon, float, float]] | str:
+def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1, caps: bool = False
+          ) -> list[tuple[shapely.Polygon, float, float]] | str:
     """The layers of part ``pid`` with ``bores`` bores, its closed ``mesh`` in its part
     frame [m] (:func:`layers_of`), each as (its section, its bottom, its top) [m], the
-    section one polygon with that many bores; or why it has none."""
+    section one polygon with that many bores, or, with ``caps``, with none (a wall across
+    them: a knob's top over the shaft's end); or why it has none."""
     low = float(mesh.bounds[0][2])
     found = []
     for section, bottom, top in layers_of(mesh):
         polygons = list(getattr(section, "geoms", [section]))
-        if len(polygons) != 1 or len(polygons[0].interiors) != bores:
+        if len(polygons) != 1 or len(polygons[0].interiors) not in ((0, bores) if caps else (bores,)):
             many = "one bore" if bores == 1 else f"{bores} bores"
             return NoStack(f"part '{pid}' has no {many} in its section from {1e3 * (bottom - low):.3f} to "
                            f"{1e3 * (top - low):.3f} mm of its height")
@@ -283,105 +431,218 @@ def stack(pid: str, mesh: trimesh.Trimesh, bores: int = 1) -> list[tuple[shapely
     return found
 
 
-def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, bores: int, widen: float) -> Found:
-    """:func:`ring_pieces`, made."""
+def _pieces(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, bores: int, widen: float,
+            pins: tuple[shapely.Polygon, ...]) -> Found:
+    """:func:`ring_pieces`, made: a stack of prisms; where it has none and its pins are not
+    all round (``pins``), the stack with the further layers and bores of :func:`_stacked`
+    (its reason when that has none either)."""
+    found = _stacked(pid, mesh, allowed, round_pins, bores, widen, ())
+    if not isinstance(found, str) or round_pins or not pins:
+        return found
+    other = _stacked(pid, mesh, allowed, round_pins, bores, widen, pins)
+    return found if isinstance(other, str) else other
+
+
+def _stacked(pid: str, mesh: trimesh.Trimesh, allowed: float, round_pins: bool, bores: int, widen: float,
+             pins: tuple[shapely.Polygon, ...]) -> Found:
+    """The pieces of :func:`ring_pieces` as a stack of prisms of its sections; with ``pins``
+    (their sections, for :func:`flat_bores`) also a stack whose layers may have no bore
+    (a wall across it, at an end), whose layers at a bore thinner than the cell's hull
+    margin twice are joined to the next (:func:`_joined`), whose layers that are no prisms
+    are hulls within their section's parts (:func:`_cut`), and whose bores may be made of
+    their round part and flats (:func:`flat_bores`); or why there is none."""
     if not mesh.is_volume:  # as written, a mesh can lose a sliver face to rounding
         return NoStack(f"part '{pid}': its mesh as written is no closed volume to compare with prisms of its sections")
-    layers = stack(pid, mesh, bores)
+    layers = stack(pid, mesh, bores, caps=bool(pins))
     if isinstance(layers, str):
         return layers
     low = float(mesh.bounds[0][2])
-    differ = mesh.volume
+    if not any(section.interiors for section, _, _ in layers):
+        return NoStack(f"part '{pid}' has no bore in its sections")
+    layers, joined = _joined(layers, bores) if pins else (layers, set())
+    centre, size = mesh.bounds.mean(axis=0), 2 * mesh.extents
+    differ = excess = 0.0
+    insides: list[trimesh.Trimesh | None] = []
     for section, bottom, top in layers:
         prism = trimesh.creation.extrude_polygon(section, top - bottom)
         prism.apply_translation((0.0, 0.0, bottom))
         common = trimesh.boolean.intersection([mesh, prism], engine="manifold")
-        differ += prism.volume - 2 * (float(common.volume) if len(common.faces) else 0.0)
+        slab = trimesh.creation.box((size[0], size[1], top - bottom))
+        slab.apply_translation((centre[0], centre[1], (bottom + top) / 2))
+        inside = trimesh.boolean.intersection([mesh, slab], engine="manifold")
+        volume = float(inside.volume) if len(inside.faces) else 0.0
+        here = prism.volume + volume - 2 * (float(common.volume) if len(common.faces) else 0.0)
+        flat = not pins or ((bottom, top) not in joined and differ + here < PRISM_TOLERANCE * mesh.volume)
+        differ += here if flat else 0.0
+        insides.append(None if flat else inside)
     if differ >= PRISM_TOLERANCE * mesh.volume:
         return NoStack(f"part '{pid}' is no stack of prisms of its sections (they differ by "
                        f"{differ / mesh.volume:.1%} of its volume over {len(layers)} layer(s); the cell's exact "
                        "pieces of a part with a bore are prisms')")
-    thin = next(((bottom, top) for _, bottom, top in layers if top - bottom < MIN_THICKNESS), None)
-    if thin is not None:  # every layer has the bore, and no piece of this one an eroded form, whatever its bore
+    thin = next(((bottom, top) for section, bottom, top in layers
+                 if top - bottom < MIN_THICKNESS and section.interiors), None)
+    if thin is not None:  # no piece of this layer at its bore has an eroded form, whatever its bore
         return (f"part '{pid}': its layer from {1e3 * (thin[0] - low):.3f} to {1e3 * (thin[1] - low):.3f} mm of its "
                 f"height, at its bore, is thinner than the cell's hull margin twice less what it resolves "
                 f"({1e3 * MIN_THICKNESS:g} mm)")
-    candidates = [round_bores(section, allowed, widen) if round_pins else coarser_bores(section, allowed)
-                  for section, _, _ in layers]
     # the exact sections first, then the finest coarser bores that work, found by bisection
-    # (a coarser bore has wider pieces at it); each one returned is checked whole
-    order, low_k, high_k = [0], 1, min(len(c) for c in candidates) - 1
-    if high_k < 0:
-        return f"part '{pid}': no regular polygon about its bore lies within its outline"
-    tried: dict[int, tuple[list[tuple[trimesh.Trimesh, float]], float] | None] = {}
-    while order:
-        k = order.pop()
-        tried[k] = _cut([(c[k][0], bottom, top) for c, (_, bottom, top) in zip(candidates, layers)],
-                        sector_parts if round_pins else convex_parts)
-        if k == 0 and tried[0] is None and low_k <= high_k:
-            order.append((low_k + high_k) // 2)
-        elif k > 0:
-            low_k, high_k = (low_k, k - 1) if tried[k] is not None else (k + 1, high_k)
-            if low_k <= high_k:
+    # (a coarser bore has wider pieces at it); each one returned is checked whole; then, for
+    # a bore that none keeps, its round part a regular polygon cut by its flats
+    searches: list[tuple[Callable[[shapely.Polygon], list[tuple[shapely.Polygon, float]]],
+                         Callable[[shapely.Polygon], list[shapely.Polygon]]]] = (
+        [(lambda section: round_bores(section, allowed, widen), sector_parts)] if round_pins
+        else [(lambda section: coarser_bores(section, allowed), convex_parts)]
+        + ([(lambda section: flat_bores(section, pins), _flat_parts)] if pins else []))
+    tried: dict[int, tuple[list[tuple[trimesh.Trimesh, float]], float, float] | None] = {}
+    for search, (make, partition) in enumerate(searches):
+        made = {k: make(section) for k, (section, _, _) in enumerate(layers) if section.interiors}
+        padded = max(len(c) for c in made.values())  # a layer with no bore is the same whatever its bore (none)
+        candidates = [made.get(k, [(section, 0.0)] * padded) for k, (section, _, _) in enumerate(layers)]
+        order, low_k, high_k = [0], 1, min(len(c) for c in candidates) - 1
+        if high_k < 0:
+            if search:  # no polygon of the round part within the outline: the coarser bores' why
+                break
+            return f"part '{pid}': no regular polygon about its bore lies within its outline"
+        tried = {}
+        while order:
+            k = order.pop()
+            tried[k] = _cut([(c[k][0], bottom, top) for c, (_, bottom, top) in zip(candidates, layers)],
+                            partition, insides)
+            if k == 0 and tried[0] is None and low_k <= high_k:
                 order.append((low_k + high_k) // 2)
+            elif k > 0:
+                low_k, high_k = (low_k, k - 1) if tried[k] is not None else (k + 1, high_k)
+                if low_k <= high_k:
+                    order.append((low_k + high_k) // 2)
+        if any(found is not None for found in tried.values()):
+            break
     working = {k: found for k, found in tried.items() if found is not None}
     if working:
         k = min(working)
-        (pieces, dropped), loss = working[k], max(c[k][1] for c in candidates)
+        (pieces, dropped, excess), loss = working[k], max(c[k][1] for c in candidates)
         if dropped >= THIN_TOLERANCE * mesh.volume:
             return (f"part '{pid}': the parts of its sections thinner than the cell's hull margin twice are "
                     f"{dropped / mesh.volume:.1%} of its volume (at most {THIN_TOLERANCE:.0%} are left out)")
+        if excess >= HULL_TOLERANCE * mesh.volume:
+            return NoStack(f"part '{pid}' is no stack of prisms of its sections, nor of hulls within them (its layers "
+                           f"that are no prisms differ from their hulls by {excess / mesh.volume:.1%} of its volume, "
+                           f"at most {HULL_TOLERANCE:.0%})")
         corners = "/".join(map(str, sorted({len(ring.coords) - 1 for c in candidates for ring in c[k][0].interiors})))
         grown = (f" grown by {1e3 * widen:g} mm (a fit whose room the cell does not resolve: round pins pass it as "
                  "they pass the mesh's widened by that per side)" if widen else "")
         bore = (f"the bore a regular {corners}-gon about its inscribed circle" + (grown or " (round pins pass it as "
                 "they pass the mesh's)") if round_pins and bores == 1 else
                 f"each of its {bores} bores a regular {corners}-gon about its inscribed circle" + (grown or
-                " (round pins pass them as they pass the mesh's)") if round_pins else "exact at the bore" if k == 0 else
+                " (round pins pass them as they pass the mesh's)") if round_pins else
+                f"the bore's round part a regular polygon about its inscribed circle, cut by its flats, {corners} "
+                f"corners (each pin's room in it the bore's within {1e3 * ROOM_KEPT:g} mm)" if search else
+                "exact at the bore" if k == 0 else
                 f"the bore {corners}-cornered, inscribed in the mesh's, {1e6 * loss:.1f} um smaller")
-        heights = ", ".join(f"{1e3 * (top - bottom):.3f}" for _, bottom, top in layers)
+        heights = ", ".join(f"{1e3 * (top - bottom):.3f}{'' if inside is None else ' (hulls)'}"
+                            for (_, bottom, top), inside in zip(layers, insides))
+        hulls = "" if all(inside is None for inside in insides) else (
+            f", the hulls within them {excess / mesh.volume:.2%} beyond it")
         return pieces, (f"{bore}: {len(pieces)} convex prism(s) of its section(s) over its {len(layers)} layer(s) of "
-                        f"{heights} mm, {differ / mesh.volume:.2%} of its volume apart from the mesh; the parts of "
-                        f"its outline thinner than the cell's hull margin twice (a gear's teeth), "
+                        f"{heights} mm, {differ / mesh.volume:.2%} of its volume apart from the mesh{hulls}; "
+                        f"the parts of its outline thinner than the cell's hull margin twice (a gear's teeth), "
                         f"{dropped / mesh.volume:.2%} of its volume, left out")
     return (f"part '{pid}': a convex piece of its section at its bore is thinner than {2000 * URDF_HULL_MARGIN:g} mm "
             f"(the cell's hull margin twice; a coarser bore would lose more than {1e6 * allowed:.1f} um)")
 
 
+def _joined(layers: list[tuple[shapely.Polygon, float, float]], bores: int
+            ) -> tuple[list[tuple[shapely.Polygon, float, float]], set[tuple[float, float]]]:
+    """``layers`` with each layer at a bore thinner than
+    :data:`executor.world.meshes.MIN_THICKNESS` (a knob's recess tapering to its bore, a
+    washer under a nut) joined to the layer above it (the one below at the top), the
+    section their union within that layer's outline (what of the thin layer lies beyond it,
+    a washer's rim, is left out: :func:`_cut`), while that union is one polygon with
+    ``bores`` bores; and the spans (bottom, top) [m] of the joined layers, which are taken
+    as hulls within their section's parts (:func:`_cut`)."""
+    layers, joined = list(layers), set()
+    k = 0
+    while k < len(layers) and len(layers) > 1:
+        section, bottom, top = layers[k]
+        if top - bottom >= MIN_THICKNESS or not section.interiors:
+            k += 1
+            continue
+        other = k + 1 if k + 1 < len(layers) else k - 1
+        within = shapely.intersection(section, shapely.Polygon(layers[other][0].exterior))
+        union = shapely.set_precision(shapely.union(within, layers[other][0]), _GRID)
+        if not isinstance(union, shapely.Polygon) or len(union.interiors) != bores:
+            k += 1
+            continue
+        span = (min(bottom, layers[other][1]), max(top, layers[other][2]))
+        layers[min(k, other)] = (union, *span)
+        del layers[max(k, other)]
+        joined.add(span)
+        k = min(k, other)
+    return layers, joined
+
+
 def _cut(layers: list[tuple[shapely.Polygon, float, float]],
-         partition: Callable[[shapely.Polygon], list[shapely.Polygon]]
-         ) -> tuple[list[tuple[trimesh.Trimesh, float]], float] | None:
+         partition: Callable[[shapely.Polygon], list[shapely.Polygon]],
+         insides: list[trimesh.Trimesh | None]
+         ) -> tuple[list[tuple[trimesh.Trimesh, float]], float, float] | None:
     """The convex prisms of each layer's section's convex parts (``partition``: :func:`convex_parts`,
-    or :func:`sector_parts` about a regular bore), from its bottom to its top
-    [m], and the volume [m³] of the outline's slivers left out (parts away from the bore
-    too thin for the cell); None when a part at a bore is too thin. A right prism's eroded
+    or :func:`sector_parts` about a regular bore), from its bottom to its top [m]; of a
+    layer that is no prism of its section (``insides``: the mesh between its levels, None
+    for a prism layer; a knob's tapered outside), the convex hull of the mesh within each
+    part's prism instead (within the prism: it reaches no farther into the bore); the
+    volume [m³] of the outline's slivers left out (parts away from the bore too thin for
+    the cell, a wall across the bore thinner than that); and the volume [m³] by which the
+    hulls exceed the mesh. None when a part at a bore is too thin. A right prism's eroded
     form (the cell's, :func:`executor.world.meshes.eroded`) is its section's inset by the
     margin over its height less twice the margin (near its middle when it is under twice the
     margin but at least :data:`executor.world.meshes.MIN_THICKNESS`): it has one when both are
-    something. A
+    something; a hull has one when :func:`executor.world.meshes.eroded` finds it. A
     part with a face along a bore must keep that face: its inset grown back by the margin
     (what the cell collides as, its corners rounded) still reaches the bore (a sector of a
     32-gon about a d 10.2 bore, its face 1 mm wide, ends 4.1 mm out from it: a pin across
     it hung the part that low)."""
-    pieces, dropped = [], 0.0
-    for section, low, high in layers:
+    pieces, dropped, excess = [], 0.0, 0.0
+    for (section, low, high), inside in zip(layers, insides):
         bores = shapely.MultiLineString([ring.coords for ring in section.interiors])
-        parts = partition(section)
+        parts = [part for part in partition(section) if isinstance(part, shapely.Polygon) and part.area > 0]
+        if abs(sum(part.area for part in parts) - section.area) > _CONVEX * 1e3 * section.area:
+            return None  # the parts are no partition of the section (one over its bore)
         tall = high - low >= MIN_THICKNESS
         inset = [shapely.buffer(part, -URDF_HULL_MARGIN) for part in parts]
-        thick = [tall and not core.is_empty for core in inset]
-        if any(not ok and part.distance(bores) == 0 for ok, part in zip(thick, parts)):
+        within = [(_swept(part, low, high), 0.0) if inside is None else _hull_within(inside, part, low, high)
+                  for part in parts]
+        made = [piece for piece, _ in within]
+        thick = [piece is not None and (eroded(piece.vertices, URDF_HULL_MARGIN) is not None if inside is not None
+                                        else tall and not core.is_empty) for piece, core in zip(made, inset)]
+        if any(not ok and section.interiors and part.distance(bores) == 0 for ok, part in zip(thick, parts)):
             return None
         faces = [shapely.intersection(part.exterior, bores).length > _KEPT for part in parts]  # along the bore
         if any(face and shapely.buffer(core, URDF_HULL_MARGIN).distance(bores) > _KEPT
                for face, core in zip(faces, inset)):
             return None
-        for part in (part for ok, part in zip(thick, parts) if ok):
-            ring = np.asarray(part.exterior.coords)[:-1]
-            pieces.append((trimesh.convex.convex_hull(np.vstack([np.column_stack([ring, np.full(len(ring), z)])
-                                                                  for z in (low, high)])), 0.0))
-        dropped += (high - low) * sum(part.area for ok, part in zip(thick, parts) if not ok)
-    return pieces, dropped
+        for ok, part, piece in zip(thick, parts, made):
+            if ok and piece is not None:
+                pieces.append((piece, 0.0))
+            else:
+                dropped += (high - low) * part.area if piece is None or inside is None else float(piece.volume)
+        if inside is not None:  # the hulls beyond the mesh; the mesh beyond the section's parts left out
+            excess += sum(float(piece.volume) - common for piece, common in within if piece is not None)
+            dropped += float(inside.volume) - sum(common for _, common in within)
+    return pieces, dropped, excess
+
+
+def _hull_within(inside: trimesh.Trimesh, part: shapely.Polygon, low: float, high: float
+                 ) -> tuple[trimesh.Trimesh | None, float]:
+    """The convex hull of the mesh ``inside`` (a layer's, from ``low`` to ``high`` [m])
+    within the prism of the convex polygon ``part`` (None where it has none there), and the
+    volume [m³] of the mesh there."""
+    prism = trimesh.creation.extrude_polygon(shapely.set_precision(part, _GRID), high - low + 2 * LEVEL)
+    prism.apply_translation((0.0, 0.0, low - LEVEL))
+    if not prism.is_volume:  # a sliver the grid leaves no volume of
+        return None, 0.0
+    common = trimesh.boolean.intersection([inside, prism], engine="manifold")
+    if not len(common.faces) or common.volume <= 0:
+        return None, 0.0
+    return common.convex_hull, float(common.volume)
 
 
 HULL_TOLERANCE = 0.05

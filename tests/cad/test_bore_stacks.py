@@ -13,7 +13,7 @@ import shapely
 import trimesh
 
 from executor.cad.convex import APART, CONCAVITY_REACH, _shape_key, apart, pin_pieces
-from executor.world.rings import NoStack, ring_pieces, section_at
+from executor.world.rings import NoStack, ring_pieces, room_in, section_at
 
 BORE = 5.0e-3
 """The bore's radius [m] (a 64-gon's vertex circle)."""
@@ -116,3 +116,39 @@ def test_a_section_whose_overlay_leaves_a_line_is_its_polygons() -> None:
     found = section_at(plate, 0.0036)
     assert len(found.geoms) == 1 and len(found.geoms[0].interiors) == 1
     assert found.area == pytest.approx(plate.volume / 0.0012, rel=1e-4)  # a prism 1.2 mm thick
+
+
+def _knob() -> tuple[trimesh.Trimesh, shapely.Polygon, shapely.Polygon]:
+    """A knob [m]: a d 16 cylinder 14 mm tall, a D bore 12 mm deep from its bottom (a
+    13-gon whose flats are 3.2 mm from the axis, its faces 1.6 mm wide, cut flat 1.76 mm
+    from it) under a 2 mm top; and the D shaft (d 6, a 60-gon, flat 1.5 mm from the axis)
+    and the d 7 thread it may be tried on, in its frame."""
+    turn = np.linspace(0.0, 2 * np.pi, 13, endpoint=False)
+    gon = shapely.Polygon(3.2e-3 / np.cos(np.pi / 13) * np.column_stack([np.cos(turn), np.sin(turn)]))
+    bore = gon.intersection(shapely.box(-0.01, -0.01, 0.01, 1.76e-3))
+    body = trimesh.creation.cylinder(radius=0.008, height=0.014, sections=64)
+    body.apply_translation((0.0, 0.0, 0.007))
+    hole = trimesh.creation.extrude_polygon(bore, 0.013)
+    hole.apply_translation((0.0, 0.0, -0.001))
+    shaft = shapely.Point(0, 0).buffer(3e-3, quad_segs=15).intersection(shapely.box(-0.01, -0.01, 0.01, 1.5e-3))
+    return trimesh.boolean.difference([body, hole], engine="manifold"), shaft, shapely.Point(0, 0).buffer(3.5e-3, 15)
+
+
+@pytest.mark.slow  # about 3 s on a loaded machine
+def test_a_d_bore_of_faces_narrower_than_the_hull_margin_twice_keeps_each_pins_room() -> None:
+    mesh, shaft, thread = _knob()
+    # no convex piece keeps a 1.6 mm face under the cell's 1 mm hull margin, nor does a
+    # coarser bore within 0.1 mm
+    assert isinstance(ring_pieces("knob", mesh, 1e-4), str)
+    found = ring_pieces("knob", mesh, 1e-4, pins=(shaft, thread))
+    assert not isinstance(found, str), found
+    pieces, made = [piece for piece, _ in found[0]], found[1]
+    assert "the bore's round part a regular polygon about its inscribed circle, cut by its flats" in made, made
+    # the cell's bore, half way up: the shaft's room the mesh's 0.2 mm (within 0.005), the thread none
+    cut = shapely.union_all([shapely.MultiPoint(p.vertices[:, :2]).convex_hull for p in pieces
+                             if p.bounds[0][2] < 0.006 < p.bounds[1][2]])
+    holes = [shapely.Polygon(ring) for ring in cut.interiors]
+    assert len(holes) == 1
+    assert abs(room_in(shaft, holes[0]) - 2e-4) <= 5e-6 and room_in(thread, holes[0]) < 0
+    assert any(p.bounds[0][2] >= 0.012 - 1e-9 and shapely.MultiPoint(p.vertices[:, :2]).convex_hull.contains(
+        shapely.Point(0, 0)) for p in pieces)  # its top, over the bore

@@ -77,11 +77,7 @@ PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file
 
 REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
-TOO_SLOW: dict[str, str] = {
-    "nop_pot_knob": "its knob, a body of revolution with a skirt and a rounded top (no stack of prisms), goes onto "
-                    "the shaft with 0.2 mm of room the cell resolves: the import seeks CoACD's pieces that keep it "
-                    "(minutes of CPU); its pins, fits and precedence are derived alone below",
-}
+TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
 IMPORTED = [p for p in PRODUCTS if p not in REFUSED and p not in TOO_SLOW]
 """Every product the import takes."""
@@ -108,6 +104,7 @@ UNSIMULATED: dict[str, str] = {}
     "flynn_clutch",
     "nop_printed_box",
     "bosl2_screw_nut",
+    "nop_pot_knob",
 ])
 def test_the_fit_relation_is_the_truth(corpus_import: Callable[[str], Imported], name: str) -> None:
     done = corpus_import(name)
@@ -294,6 +291,9 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
     pytest.param("nop_rocker_switches", marks=_xfail(INSERTED + " into a hole standing out of the product at its "
                                                      "goal by less than the fingers need, its top no face for the "
                                                      "suction cup (the switches, 5.82 and 2.30 mm out of the case)")),
+    pytest.param("nop_pot_knob", marks=_xfail(INSERTED + " onto a pin and with a layer at its bore no thicker than "
+                                              "the cell's hull margin twice (the nut's washer, 0.4 mm, under its "
+                                              "hex, which is narrower than it)")),
     pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
                                                  "cell has no screwing operation)")),
 ])

@@ -219,9 +219,10 @@ def test_a_part_whose_pieces_are_too_thin_is_sought_once_a_seed(monkeypatch: pyt
     calls: list[tuple[float, int]] = []
     decomposed = convex._decomposed
 
-    def counted(mesh: trimesh.Trimesh, threshold: float, seed: int, iterations: int) -> list[trimesh.Trimesh]:
+    def counted(pid: str, mesh: trimesh.Trimesh, threshold: float, seed: int, iterations: int,
+                budget: convex.Budget) -> list[trimesh.Trimesh] | convex.OverBudget:
         calls.append((threshold, seed))
-        return decomposed(mesh, threshold, seed, iterations)
+        return decomposed(pid, mesh, threshold, seed, iterations, budget)
 
     monkeypatch.setattr(convex, "_decomposed", counted)
     found = fitting_pieces("peg", _finned_peg().apply_scale(1e-3), {})
@@ -240,3 +241,31 @@ def test_a_part_without_pieces_is_placed_by_hand_and_the_rest_simulated(tmp_path
     manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["manual"]["peg"]
     assert "no convex pieces the cell can collide as" in manual["reason"] and manual["mesh"]["file"] == "meshes/peg.obj"
     assert not (tmp_path / "out" / "meshes" / "peg.convex.obj").exists()
+
+
+@pytest.mark.slow
+def test_a_part_whose_pieces_take_more_cpu_than_the_bound_is_placed_by_hand(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # The flanged peg's CoACD pieces fit (test above), but any CoACD run takes more than
+    # the 1 ms of CPU set: the search stops there, the peg is placed by hand with why, and
+    # the rest is written; the bound is printed.
+    flanged = trimesh.boolean.union([_box((10, 10, 30), (0, 0, 10)), _box((16, 16, 4), (0, 0, 23))], engine="manifold")
+    _plate(tmp_path / "cad", flanged)
+    (tmp_path / "import.toml").write_text("pieces_cpu_s = 0.001\n")
+    assert main(["import", str(tmp_path / "cad"), "--out", str(tmp_path / "out"),
+                 "--config", str(tmp_path / "import.toml")]) == 0
+    assert "CoACD spends at most 0.001 s of CPU on one part's convex pieces (pieces_cpu_s" in capsys.readouterr().out
+    manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["manual"]["peg"]
+    assert "part 'peg' has no convex pieces within 0.001 s of CoACD's CPU time" in manual["reason"], manual
+    assert (tmp_path / "out" / "meshes" / "peg.obj").exists()
+
+
+@pytest.mark.parametrize("value", ["0", "-1", '"60"', "nan", "true"])
+def test_a_bad_pieces_cpu_setting_is_one_line_naming_the_file(tmp_path: Path, value: str,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    _plate(tmp_path / "cad", _box((10, 10, 30), (0, 0, 10)))
+    (tmp_path / "import.toml").write_text(f"pieces_cpu_s = {value}\n")
+    code = main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out"),
+                 "--config", str(tmp_path / "import.toml")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and err.count("\n") == 0 and "import.toml: pieces_cpu_s: expected a positive number" in err, err
