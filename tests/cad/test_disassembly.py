@@ -204,6 +204,19 @@ def test_a_bore_with_edge_radii_is_found_as_a_cylinder_and_its_radii_are_not() -
     check_parts(_parts(pin=pin, ring=ring), "m")  # the tessellations' overlap is the fit's
 
 
+def test_a_bearings_outside_whose_coarse_edge_radii_join_its_band_is_found_as_a_cylinder() -> None:
+    # bd_warehouse's 608 tessellated by Open CASCADE at 0.8 rad: the outer race's first
+    # triangles of each 0.3 mm edge radius run from the d 22 rim to a point 23 µm inside
+    # it, tilted under TILT, so its band takes them in; without them it is the cylinder
+    # (a 608 drawn at zero clearance in a d 22 seat was refused, blocked in every way).
+    bearing = load_meshes(CORPUS / "bdw_pillow_block" / "meshes", "mm")[0]
+    assert bearing.id == "bearing"
+    found = sorted((f.outward, round(f.radius / MM, 3)) for f in cylinder_faces(bearing.mesh))
+    assert found == [(False, 4.0), (False, 8.8), (True, 6.05), (True, 11.0)]
+    outside = next(f for f in cylinder_faces(bearing.mesh) if f.outward and f.radius > 10 * MM)
+    assert outside.span == pytest.approx((3.3 * MM, 9.7 * MM), abs=1e-9)  # the band, not its radii
+
+
 def test_a_bore_section_over_a_span_in_its_edge_radius_has_the_polygons_sagitta() -> None:
     # The spans between the ring's vertex levels, their ends rounded to 1 nm as the pin's
     # stretch is split: a corner a fraction of a nm beyond an end is at that end, or the

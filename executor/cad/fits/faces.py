@@ -65,7 +65,8 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
     """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
     six triangles that are one cylinder (:func:`_cylinder`), and of every other smooth
     region its bands lateral to its axis (:func:`_bands`) that are cylinders (a bore whose
-    edge radii join it smoothly to the ring's end faces: the bore, not the radii)."""
+    edge radii join it smoothly to the ring's end faces: the bore, not the radii), a band
+    that is none without the edge radii's triangles it took in (:func:`_off_rim`)."""
     angles = mesh.face_adjacency_angles
     smooth = mesh.face_adjacency[angles < SMOOTH]
     faces: list[CylinderFace] = []
@@ -74,8 +75,40 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
         if face is not None:
             faces.append(face)
             continue
-        faces.extend(f for band in _bands(mesh, region, smooth) if (f := _cylinder(mesh, band)) is not None)
+        axis, bands = _bands(mesh, region, smooth)
+        for band in bands:
+            face = _cylinder(mesh, band)
+            if face is None and len(rim := _off_rim(mesh, band, axis)) >= 6:
+                face = _cylinder(mesh, rim)
+            if face is not None:
+                faces.append(face)
     return faces
+
+
+def _off_rim(mesh: trimesh.Trimesh, band: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """The triangles of ``band`` with no corner off its cylinder: a band can take in the
+    first triangles of an edge radius tessellated coarsely (Open CASCADE's, from the
+    cylinder's rim to a point of the radius a few tens of µm inside it, its normal within
+    :data:`TILT` of the band's), whose corners the cylinder's circle does not hold. The
+    circle is about the band's ``axis`` (:func:`_bands`: its bends', which those triangles
+    do not tilt as they tilt its normals), through the centre fitted to its corners, and
+    of their farthest distance from it for an outward band (an edge radius bends inwards
+    from a shaft's face), their nearest for an inward one (outwards from a bore's); a
+    corner is on it within 1 µm plus 1e-4 of it."""
+    normals = mesh.face_normals[band]
+    frame = np.linalg.svd(axis[None, :])[2][1:]
+    ring = np.unique(mesh.faces[band].ravel())
+    flat = mesh.vertices[ring] @ frame.T
+    solution = np.linalg.lstsq(np.column_stack([2 * flat, np.ones(len(flat))]), np.sum(flat ** 2, axis=1),
+                               rcond=None)[0]
+    centre = solution[:2]
+    distance = np.zeros(len(mesh.vertices))
+    distance[ring] = np.linalg.norm(flat - centre, axis=1)
+    across = mesh.triangles_center[band] @ frame.T - centre
+    outward = float(np.mean(np.einsum("ij,ij->i", normals @ frame.T, across))) > 0
+    radius = distance[ring].max() if outward else distance[ring].min()
+    on = np.abs(distance - radius) <= 1e-6 + 1e-4 * radius
+    return band[on[mesh.faces[band]].all(axis=1)]
 
 
 def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
@@ -139,7 +172,7 @@ CANDIDATES = 256
 """Bends of a smooth region tried as its axis (:func:`_bands`; evenly spaced among them)."""
 
 
-def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> list[np.ndarray]:
+def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
     """The smooth ``region`` of ``mesh`` split where it stops being a band parallel to one
     axis. Adjacent triangles that bend (:data:`BEND`) bend about their normals' cross
     product: on a cylinder all about its axis, on an edge radius or a sphere about
@@ -149,7 +182,8 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     are perpendicular to it (within :data:`TILT`), joined by the ``smooth`` adjacencies: a
     bore's band, not its edge radii (their normals lean along the axis) nor the end faces
     beyond them. Each band is a cylinder only if :func:`_cylinder` finds it one. One axis a
-    region: bands about another axis in the same smooth region are not looked for."""
+    region: bands about another axis in the same smooth region are not looked for. The
+    axis (a unit vector; any, with no band) and the bands."""
     inside = np.zeros(len(mesh.faces), dtype=bool)
     inside[region] = True
     pairs = smooth[inside[smooth].all(axis=1)]
@@ -157,7 +191,7 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     sizes = np.linalg.norm(bends, axis=1)
     bends = bends[sizes > BEND] / sizes[sizes > BEND, None]
     if len(bends) < 2:
-        return []
+        return np.eye(3)[2], []
     tried = bends[np.linspace(0, len(bends) - 1, min(CANDIDATES, len(bends))).astype(int)]
     shared = np.abs(tried @ bends.T) >= np.sqrt(1 - TILT ** 2)
     best = tried[np.argmax(shared.sum(axis=1))]
@@ -165,7 +199,7 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     axis = np.linalg.eigh(along.T @ along)[1][:, -1]
     lateral = np.zeros(len(mesh.faces), dtype=bool)
     lateral[region] = np.abs(mesh.face_normals[region] @ axis) <= TILT
-    return list(trimesh.graph.connected_components(pairs[lateral[pairs].all(axis=1)], min_len=6))
+    return axis, list(trimesh.graph.connected_components(pairs[lateral[pairs].all(axis=1)], min_len=6))
 
 
 _PRISM_FRAMES = tuple((axis, np.array([np.roll(axis, 1), np.roll(axis, 2)])) for axis in np.eye(3))
