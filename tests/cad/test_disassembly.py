@@ -571,3 +571,25 @@ def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
         chosen.append(sweep._likely(piece, fixed))
         assert set(chosen[-1]) == set(found[order[reach[order] > TOUCH]])
     assert all(len(c) == sweep.LIKELY for c in chosen)
+
+
+def _pressed_ring(outside: float) -> list[CadPart]:
+    """A 50 x 30 x 10 mm block with a d 21.95 mm seat 7 mm deep and a ring (d 8.8 to
+    ``outside`` [mm], 7 mm tall) in it, as 40-gons: their deflections (34 µm at the seat)
+    above a press fit's 0.025 mm per side."""
+    seat = trimesh.creation.cylinder(radius=10.975 * MM, height=8 * MM, sections=40)
+    seat.apply_translation((0, 0, 7 * MM))
+    block = trimesh.boolean.difference([_box((50, 30, 10), (0, 0, 5)), seat], engine="manifold")
+    ring = trimesh.creation.annulus(r_min=4.4 * MM, r_max=outside / 2 * MM, height=7 * MM, sections=40)
+    ring.apply_translation((0, 0, 6.5 * MM))
+    return _parts(block=block, ring=ring)
+
+
+def test_a_ring_pressed_into_its_seat_is_refused_as_a_press_fit_not_taken_for_a_zero_clearance_fit() -> None:
+    # bd_warehouse's 608 in its PressFitHole (0.025 mm of interference): the overlap lies
+    # within the faces' tolerance (deflection plus 10 µm), and was excused as a seated fit.
+    with pytest.raises(ExecutorError, match=r"'ring' is pressed into 'block': its d 22\.000 mm cylinder in a "
+                                            r"d 21\.950 mm bore \(0\.025 mm per side\), a press fit"):
+        check_parts(_pressed_ring(22.0), "m")
+    check_parts(_pressed_ring(21.95), "m")  # drawn at the seat's diameter: a zero-clearance fit
+    assert zero_clearance_fits({p.id: fit_faces(p.mesh) for p in _pressed_ring(22.0)}) == []

@@ -86,12 +86,16 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
 
 
 def _off_rim(mesh: trimesh.Trimesh, band: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    """The triangles of ``band`` with no corner off its cylinder: a band can take in the
+    """The triangles of ``band`` with no corner off its cylinder, none when their corners
+    leave a wider angle about its axis uncovered than the band's (and than :data:`SMOOTH`:
+    a rounded rect's four corners each touch the circle through their farthest points in a
+    few triangles, 60 deg and more apart). A band can take in the
     first triangles of an edge radius tessellated coarsely (Open CASCADE's, from the
     cylinder's rim to a point of the radius a few tens of µm inside it, its normal within
     :data:`TILT` of the band's), whose corners the cylinder's circle does not hold. The
     circle is about the band's ``axis`` (:func:`_bands`: its bends', which those triangles
-    do not tilt as they tilt its normals), through the centre fitted to its corners, and
+    do not tilt as they tilt its normals), through the centre fitted to its corners (then to
+    the outer half of them, twice, for an outward band, the inner for an inward one), and
     of their farthest distance from it for an outward band (an edge radius bends inwards
     from a shaft's face), their nearest for an inward one (outwards from a bore's); a
     corner is on it within 1 µm plus 1e-4 of it."""
@@ -99,16 +103,36 @@ def _off_rim(mesh: trimesh.Trimesh, band: np.ndarray, axis: np.ndarray) -> np.nd
     frame = np.linalg.svd(axis[None, :])[2][1:]
     ring = np.unique(mesh.faces[band].ravel())
     flat = mesh.vertices[ring] @ frame.T
-    solution = np.linalg.lstsq(np.column_stack([2 * flat, np.ones(len(flat))]), np.sum(flat ** 2, axis=1),
-                               rcond=None)[0]
-    centre = solution[:2]
-    distance = np.zeros(len(mesh.vertices))
-    distance[ring] = np.linalg.norm(flat - centre, axis=1)
+    centre = _centre(flat)
     across = mesh.triangles_center[band] @ frame.T - centre
     outward = float(np.mean(np.einsum("ij,ij->i", normals @ frame.T, across))) > 0
+    for _ in range(2):  # refitted on the outer (inner) half of the corners: the radii's pull it off
+        apart = np.linalg.norm(flat - centre, axis=1)
+        middle = (apart.max() + apart.min()) / 2
+        centre = _centre(flat[apart >= middle if outward else apart <= middle])
+    distance = np.zeros(len(mesh.vertices))
+    distance[ring] = np.linalg.norm(flat - centre, axis=1)
     radius = distance[ring].max() if outward else distance[ring].min()
     on = np.abs(distance - radius) <= 1e-6 + 1e-4 * radius
-    return band[on[mesh.faces[band]].all(axis=1)]
+    rim = band[on[mesh.faces[band]].all(axis=1)]
+    covered = _widest_gap(mesh, rim, frame, centre) <= max(_widest_gap(mesh, band, frame, centre), SMOOTH)
+    return rim if covered else rim[:0]
+
+
+def _centre(flat: np.ndarray) -> np.ndarray:
+    """The centre of the circle fitted to the points ``flat`` (n, 2) [m] (least squares)."""
+    design = np.column_stack([2 * flat, np.ones(len(flat))])
+    return np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0][:2]
+
+
+def _widest_gap(mesh: trimesh.Trimesh, triangles: np.ndarray, frame: np.ndarray, centre: np.ndarray) -> float:
+    """The widest angle [rad] about ``centre`` (across the axis, in ``frame``) between the
+    corners of ``triangles`` (2 pi when they have none)."""
+    if len(triangles) == 0:
+        return 2 * np.pi
+    flat = mesh.vertices[np.unique(mesh.faces[triangles].ravel())] @ frame.T - centre
+    angles = np.sort(np.arctan2(flat[:, 1], flat[:, 0]))
+    return float(np.max(np.diff(np.append(angles, angles[0] + 2 * np.pi))))
 
 
 def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
@@ -329,9 +353,42 @@ def _prism_fit(a: PrismFace, b: PrismFace) -> Slide | None:
     return Slide("", "", a, b, TOUCH, 2 * TOUCH, _seated(a, b, TOUCH))
 
 
+PRESS_FIT = 0.01
+"""The most a shaft's cylinder may be wider than a coaxial bore's, relative to its radius,
+to be named a press fit (:func:`press_fits`; ISO 286's interference fits are some
+thousandths of the diameter): a wider one is no fit of the two."""
+
+
+def press_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
+    """Every pair of an outward cylinder of one part and an inward one of another, parallel
+    (within 1e-4 rad), coaxial within their tolerance (the larger deflection plus
+    :data:`TOUCH`) and seated, the shaft's circle wider than the bore's by more than TOUCH
+    and by at most :data:`PRESS_FIT` of its radius: a part drawn pressed into its bore.
+    The circles are those of the faces' corners, which both tessellations put on the
+    drawn circles: they tell a press fit of 0.025 mm per side from a zero-clearance fit
+    however coarse the tessellations (the faces' own overlap, up to the larger deflection,
+    is no interference)."""
+    found: list[Slide] = []
+    for shaft, outer in faces.items():
+        for bore, inner in faces.items():
+            if bore == shaft:
+                continue
+            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
+                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
+                    tolerance = max(a.deflection, b.deflection) + TOUCH
+                    offset = b.point - a.point
+                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
+                    if (np.linalg.norm(np.cross(a.direction, b.direction)) <= 1e-4 and apart <= tolerance
+                            and TOUCH < a.radius - b.radius <= PRESS_FIT * a.radius and _seated(a, b, tolerance)):
+                        found.append(Slide(shaft, bore, a, b, tolerance, 0.0, True))
+    return found
+
+
 def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
     """Every pair of an outward face of one part and an inward face of another: cylinders
-    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance; prisms
+    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance (the
+    shaft's circle no wider than the bore's by more than :data:`TOUCH`: wider, it is
+    pressed in, :func:`press_fits`); prisms
     along one of the cell's axes whose outlines are one within :data:`TOUCH`
     (:func:`_prism_fit`). Each slides along its axis wherever the two faces meet on the
     way, in the assembled pose (``seated``) or only on it (a passage)."""
@@ -348,7 +405,7 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> lis
                 for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
                     tolerance = max(a.deflection, b.deflection) + TOUCH
                     if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
-                            or abs(a.radius - b.radius) > tolerance):
+                            or abs(a.radius - b.radius) > tolerance or a.radius - b.radius > TOUCH):
                         continue
                     offset = b.point - a.point
                     apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
