@@ -593,3 +593,12 @@ def test_a_ring_pressed_into_its_seat_is_refused_as_a_press_fit_not_taken_for_a_
         check_parts(_pressed_ring(22.0), "m")
     check_parts(_pressed_ring(21.95), "m")  # drawn at the seat's diameter: a zero-clearance fit
     assert zero_clearance_fits({p.id: fit_faces(p.mesh) for p in _pressed_ring(22.0)}) == []
+
+
+def test_a_rounded_rects_four_corners_are_no_cylinder_through_their_farthest_points() -> None:
+    # Build123d's RectangleRounded(50, 30, 2) extruded 10 mm, its corners finely tessellated:
+    # one smooth band around it, whose triangles at the four corners' farthest points lie on
+    # one circle (d 56.8), 60 deg and more apart: no face.
+    outline = shapely.box(-23 * MM, -13 * MM, 23 * MM, 13 * MM).buffer(2 * MM, quad_segs=64)
+    block = trimesh.creation.extrude_polygon(outline, 10 * MM)
+    assert [(f.outward, round(f.radius / MM, 1)) for f in cylinder_faces(block)] == []
