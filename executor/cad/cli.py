@@ -169,7 +169,11 @@ def drawn_up(derived: Derived) -> str | None:
     set on the base's bottom face (:func:`_one_face` along -z), or the other parts stand
     out of the base's box above it by at most :data:`ONE_SIDED` of what they do below it
     and every hole and pin along z is left downwards, or they do stand out below it and
-    more of them leave the product downwards than upwards (their removal directions). The
+    more of them leave the product downwards than upwards (their removal directions); not
+    when every hole and pin along z is left upwards and so is every part along z, the base
+    keeping each from going down (screws through the base from above, their heads on it,
+    their shanks standing out under it into a part not drawn; a peg through a through hole
+    can leave either way). The
     way up it suggests is the one the other parts stand out of the base's box farther
     along, else the way they leave its holes and pins (both where neither tells)."""
     low, high = derived.parts[derived.base].mesh.bounds
@@ -202,8 +206,10 @@ def drawn_up(derived: Derived) -> str | None:
                 elif down > up and below > 0:
                     face = ["-"], (f", {down} of the other parts left along -z ({up} along +z) and standing out of "
                                    f"it {_mm(below)} mm below it, {_mm(above)} mm above it")
-            if face is None or face[0] != ["-"]:
-                continue
+            held = all(derived.base in derived.blockers.get((pid, "-z"), set())
+                       for pid, way in derived.axis.items() if way == "+z")
+            if face is None or face[0] != ["-"] or (leave == ["+"] and up > 0 and down == 0 and held):
+                continue  # parts through it from above standing out under it (screws into what is not drawn)
             return (f"the base {derived.base} is {_mm(float(extents[2]))} mm tall{features}{face[1]}: the CAD "
                     'may be drawn upside down (z down); set up = "-z" or --up=-z (up = "+z" or --up +z if z is up)')
         if extents[2] >= STANDING * extents[k]:

@@ -21,7 +21,8 @@ units explain (one part in mm among parts in m), a product too small or too larg
 stated units, and parts that overlap (intersection volume above :data:`OVERLAP_VOLUME`,
 leaving out what lies within a zero-clearance fit's tolerance of its two faces: coaxial
 cylinders of one nominal radius, each tessellated on its own, overlap by up to the larger
-deflection however coarse the tessellation; :func:`executor.cad.fits.faces.zero_clearance_fits`).
+deflection however coarse the tessellation; :func:`executor.cad.fits.faces.zero_clearance_fits`;
+the refusal names a press fit among them: :func:`executor.cad.fits.faces.press_fits`).
 """
 
 from __future__ import annotations
@@ -45,7 +46,15 @@ import trimesh
 
 from bridge.assembly import is_id
 from executor import ExecutorError
-from executor.cad.fits.faces import TOUCH, CylinderFace, PrismFace, Slide, fit_faces, zero_clearance_fits
+from executor.cad.fits.faces import (
+    TOUCH,
+    CylinderFace,
+    PrismFace,
+    Slide,
+    fit_faces,
+    press_fits,
+    zero_clearance_fits,
+)
 from executor.cad.fits.threads import cosmetic_pairs, lone_thread, screwed_pairs
 
 UNITS = {"mm": 1e-3, "m": 1.0}
@@ -426,7 +435,17 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
                                     "that at most touch, or coaxial cylinders of one radius within their "
-                                    "tessellations' deflection)" + lone_thread({a.id: a.mesh, b.id: b.mesh}))
+                                    "tessellations' deflection)" + lone_thread({a.id: a.mesh, b.id: b.mesh})
+                                    + _pressed(press_fits({a.id: faces[a.id], b.id: faces[b.id]})))
+
+
+def _pressed(pairs: list[Slide]) -> str:
+    """The refusal's words on the press fits among ``pairs`` (:func:`executor.cad.fits.faces.press_fits`),
+    "" when there is none."""
+    return "".join(f"; '{s.shaft}' is pressed into '{s.bore}': its d {2000 * s.face.radius:.3f} mm cylinder in a "
+                   f"d {2000 * s.hole.radius:.3f} mm bore ({1000 * (s.face.radius - s.hole.radius):.3f} mm per "
+                   "side), a press fit, which the import does not take (drawn at the bore's diameter, it is a "
+                   "zero-clearance fit)" for s in pairs)
 
 
 TUBE_SEGMENTS = 256

@@ -7,7 +7,9 @@ tessellate it again more coarsely (``CadPart.remesh``: the simulated cell's base
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
 converts to metres. A leaf without a name is named after its parent and position; leaves
-of one name (a sub-assembly placed twice) are told apart by their assemblies' names.
+of one name (a sub-assembly placed twice) are told apart by their assemblies' names, and
+leaves of one name in one assembly (a bearing's balls) are numbered. The triangles a
+face's degenerate edge leaves (a sphere's poles) are dropped: the mesh stays closed.
 
 A file whose reading Open CASCADE reports a failure for (a syntax error, a reference to a
 missing record, a record with the wrong parameters: its reader goes on without the
@@ -158,7 +160,16 @@ def _name(label: Any) -> str:
 def _unique_names(paths: list[tuple[str, ...]]) -> list[str]:
     """Each leaf's name from its ``paths`` (the names from the root down to it): its own,
     and where several leaves share it (a sub-assembly placed twice), joined with ``_``
-    to those of as many of its assemblies as tell them apart (``l-bracket-assembly_1_bolt_1``)."""
+    to those of as many of its assemblies as tell them apart (``l-bracket-assembly_1_bolt_1``);
+    leaves of one name in one assembly (a bearing's balls) numbered in the file's order
+    (``ball_1``, ``ball_2``)."""
+    paths = list(paths)
+    repeated = {path for path in paths if paths.count(path) > 1}
+    seen: dict[tuple[str, ...], int] = {}
+    for k, path in enumerate(paths):
+        if path in repeated:
+            seen[path] = seen.get(path, 0) + 1
+            paths[k] = (*path[:-1], f"{path[-1]}_{seen[path]}")
     depth = [1] * len(paths)
     while True:
         names = ["_".join(path[-d:]) for path, d in zip(paths, depth, strict=True)]
@@ -231,7 +242,8 @@ def _mesh(shape: Any, source: str, deflection: float = STEP_DEFLECTION, angle: f
 
 
 def _tessellation(shape: Any, source: str) -> trimesh.Trimesh:
-    """The shape's tessellation (:func:`_tessellate`) as one mesh [m], vertices merged."""
+    """The shape's tessellation (:func:`_tessellate`) as one mesh [m], vertices merged,
+    the triangles with two corners at one vertex left out."""
     from OCP.BRep import BRep_Tool
     from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
     from OCP.TopExp import TopExp_Explorer
@@ -265,6 +277,13 @@ def _tessellation(shape: Any, source: str) -> trimesh.Trimesh:
         raise ExecutorError(f"{source}: the part has no faces to tessellate")
     mesh = trimesh.Trimesh(np.vstack(vertices), np.vstack(faces), process=True)
     mesh.merge_vertices(digits_vertex=9)
+    corners = mesh.faces
+    # A face's degenerate edge (a sphere's or a cone's pole) is tessellated as nodes of
+    # one point: the triangles on it have two corners one vertex once merged, no area,
+    # and would leave the pole's edges unpaired (an open mesh).
+    mesh.update_faces((corners[:, 0] != corners[:, 1]) & (corners[:, 1] != corners[:, 2])
+                      & (corners[:, 0] != corners[:, 2]))
+    mesh.remove_unreferenced_vertices()
     return mesh
 
 

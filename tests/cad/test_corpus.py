@@ -75,7 +75,11 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-REFUSED: dict[str, str] = {}
+REFUSED: dict[str, str] = {
+    "bdw_pillow_block": "a press fit: the bearing's d 22 outer race drawn in its d 21.95 seat (0.025 mm of "
+                        "interference all round), refused as parts that overlap, named a press fit the import "
+                        "does not take",
+}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""

@@ -204,6 +204,19 @@ def test_a_bore_with_edge_radii_is_found_as_a_cylinder_and_its_radii_are_not() -
     check_parts(_parts(pin=pin, ring=ring), "m")  # the tessellations' overlap is the fit's
 
 
+def test_a_bearings_outside_whose_coarse_edge_radii_join_its_band_is_found_as_a_cylinder() -> None:
+    # bd_warehouse's 608 tessellated by Open CASCADE at 0.8 rad: the outer race's first
+    # triangles of each 0.3 mm edge radius run from the d 22 rim to a point 23 µm inside
+    # it, tilted under TILT, so its band takes them in; without them it is the cylinder
+    # (a 608 drawn at zero clearance in a d 22 seat was refused, blocked in every way).
+    bearing = load_meshes(CORPUS / "bdw_pillow_block" / "meshes", "mm")[0]
+    assert bearing.id == "bearing"
+    found = sorted((f.outward, round(f.radius / MM, 3)) for f in cylinder_faces(bearing.mesh))
+    assert found == [(False, 4.0), (False, 8.8), (True, 6.05), (True, 11.0)]
+    outside = next(f for f in cylinder_faces(bearing.mesh) if f.outward and f.radius > 10 * MM)
+    assert outside.span == pytest.approx((3.3 * MM, 9.7 * MM), abs=1e-9)  # the band, not its radii
+
+
 def test_a_bore_section_over_a_span_in_its_edge_radius_has_the_polygons_sagitta() -> None:
     # The spans between the ring's vertex levels, their ends rounded to 1 nm as the pin's
     # stretch is split: a corner a fraction of a nm beyond an end is at that end, or the
@@ -558,3 +571,34 @@ def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
         chosen.append(sweep._likely(piece, fixed))
         assert set(chosen[-1]) == set(found[order[reach[order] > TOUCH]])
     assert all(len(c) == sweep.LIKELY for c in chosen)
+
+
+def _pressed_ring(outside: float) -> list[CadPart]:
+    """A 50 x 30 x 10 mm block with a d 21.95 mm seat 7 mm deep and a ring (d 8.8 to
+    ``outside`` [mm], 7 mm tall) in it, as 40-gons: their deflections (34 µm at the seat)
+    above a press fit's 0.025 mm per side."""
+    seat = trimesh.creation.cylinder(radius=10.975 * MM, height=8 * MM, sections=40)
+    seat.apply_translation((0, 0, 7 * MM))
+    block = trimesh.boolean.difference([_box((50, 30, 10), (0, 0, 5)), seat], engine="manifold")
+    ring = trimesh.creation.annulus(r_min=4.4 * MM, r_max=outside / 2 * MM, height=7 * MM, sections=40)
+    ring.apply_translation((0, 0, 6.5 * MM))
+    return _parts(block=block, ring=ring)
+
+
+def test_a_ring_pressed_into_its_seat_is_refused_as_a_press_fit_not_taken_for_a_zero_clearance_fit() -> None:
+    # bd_warehouse's 608 in its PressFitHole (0.025 mm of interference): the overlap lies
+    # within the faces' tolerance (deflection plus 10 µm), and was excused as a seated fit.
+    with pytest.raises(ExecutorError, match=r"'ring' is pressed into 'block': its d 22\.000 mm cylinder in a "
+                                            r"d 21\.950 mm bore \(0\.025 mm per side\), a press fit"):
+        check_parts(_pressed_ring(22.0), "m")
+    check_parts(_pressed_ring(21.95), "m")  # drawn at the seat's diameter: a zero-clearance fit
+    assert zero_clearance_fits({p.id: fit_faces(p.mesh) for p in _pressed_ring(22.0)}) == []
+
+
+def test_a_rounded_rects_four_corners_are_no_cylinder_through_their_farthest_points() -> None:
+    # Build123d's RectangleRounded(50, 30, 2) extruded 10 mm, its corners finely tessellated:
+    # one smooth band around it, whose triangles at the four corners' farthest points lie on
+    # one circle (d 56.8), 60 deg and more apart: no face.
+    outline = shapely.box(-23 * MM, -13 * MM, 23 * MM, 13 * MM).buffer(2 * MM, quad_segs=64)
+    block = trimesh.creation.extrude_polygon(outline, 10 * MM)
+    assert [(f.outward, round(f.radius / MM, 1)) for f in cylinder_faces(block)] == []

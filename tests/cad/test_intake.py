@@ -221,9 +221,10 @@ def test_a_source_mesh_in_the_out_folder_is_never_overwritten(tmp_path: Path) ->
 
 @pytest.fixture(scope="module")
 def step_files(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The folder of two STEP files written by build123d (one process): ``p.step``, a plate
+    """The folder of three STEP files written by build123d (one process): ``p.step``, a plate
     and a round peg placed 10 mm up in it; ``u.step``, a bracket assembly placed twice (as
-    AS1 of the STEP test suite places its l-brackets), each copy's bolt named 'bolt'."""
+    AS1 of the STEP test suite places its l-brackets), each copy's bolt named 'bolt';
+    ``b.step``, the plate and two balls named 'ball' in one sub-assembly, resting on it."""
     folder = tmp_path_factory.mktemp("step")
     script = folder / "make.py"
     script.write_text(
@@ -236,7 +237,12 @@ def step_files(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "    bolt = Pos(x, 0, 20) * Cylinder(5, 20); bolt.label = 'bolt'\n"
         "    return Compound(label=label, children=[bolt])\n"
         f"export_step(Compound(label='unit', children=[plate, side(-30, 'left'), side(30, 'right')]), "
-        f"{str(folder / 'u.step')!r})\n")
+        f"{str(folder / 'u.step')!r})\n"
+        "def ball(x):\n"
+        "    ball = Pos(x, 0, 25) * Sphere(5); ball.label = 'ball'\n"
+        "    return ball\n"
+        "bearing = Compound(label='bearing', children=[ball(-20), ball(20)])\n"
+        f"export_step(Compound(label='balls', children=[plate, bearing]), {str(folder / 'b.step')!r})\n")
     subprocess.run([sys.executable, str(script)], check=True)
     return folder
 
@@ -295,3 +301,14 @@ def test_parts_of_one_name_in_two_sub_assemblies_are_told_apart_by_them(step_fil
     parts = {part.id: part for part in load_step(step_files / "u.step")}
     assert sorted(parts) == ["left_bolt", "plate", "right_bolt"]
     assert parts["left_bolt"].mesh.centroid[0] == pytest.approx(-0.03, abs=1e-6)
+
+
+@pytest.mark.slow  # build123d writes the STEP files (shared, about 5 s)
+def test_balls_of_one_name_in_one_assembly_are_numbered_and_closed(step_files: Path) -> None:
+    # A bearing's balls: one name in one sub-assembly, each a sphere whose poles Open
+    # CASCADE tessellates as degenerate edges (triangles with two corners at one point).
+    parts = {part.id: part for part in load_step(step_files / "b.step")}
+    assert sorted(parts) == ["ball_1", "ball_2", "plate"]
+    assert parts["ball_1"].mesh.centroid[0] == pytest.approx(-0.02, abs=1e-6)
+    assert all(part.mesh.is_watertight for part in parts.values())
+    check_parts(list(parts.values()), "mm")

@@ -267,6 +267,23 @@ def test_a_product_drawn_upside_down_is_refused_and_imported_with_up_minus_z(tmp
     assert turned.derived.axis["peg"] == "+z"
 
 
+def test_a_screw_through_the_base_standing_out_under_it_is_no_product_drawn_upside_down(tmp_path: Path) -> None:
+    # bd_warehouse's pillow block: its screws' heads in counterbores flush with the block's
+    # top, their shanks 8 mm under it (into a part the example does not draw); they leave
+    # along +z only
+    cad = tmp_path / "cad"
+    cad.mkdir()
+    hole = trimesh.boolean.union([_box((10.0, 10.0, 40.0), (0.0, 0.0, 15.0)),
+                                  _box((16.0, 16.0, 10.0), (0.0, 0.0, 30.0))],
+                                 engine="manifold")
+    _box((60.0, 60.0, 30.0), (0.0, 0.0, 15.0)).difference(hole).export(cad / "block.stl")
+    trimesh.boolean.union([_box((9.6, 9.6, 33.0), (0.0, 0.0, 8.5)), _box((15.6, 15.6, 5.0), (0.0, 0.0, 27.5))],
+                          engine="manifold").export(cad / "screw.stl")
+    (tmp_path / "import.toml").write_text('base = "block"\n')
+    done = run_import(cad, tmp_path / "read_z_up", "mm", tmp_path / "import.toml")
+    assert done.derived.axis["screw"] == "+z"  # its removal: up out of the counterbore
+
+
 def test_a_product_drawn_upside_down_with_more_parts_going_up_than_down_is_refused(tmp_path: Path) -> None:
     # Two pegs go up into holes in the block's bottom, standing 0.6 mm out of it below, one with
     # a flange 6 mm beyond the block across, and one down into a hole in its top, flush with it

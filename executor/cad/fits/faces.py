@@ -65,7 +65,8 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
     """The cylindrical faces of ``mesh`` (the module docstring): smooth regions of at least
     six triangles that are one cylinder (:func:`_cylinder`), and of every other smooth
     region its bands lateral to its axis (:func:`_bands`) that are cylinders (a bore whose
-    edge radii join it smoothly to the ring's end faces: the bore, not the radii)."""
+    edge radii join it smoothly to the ring's end faces: the bore, not the radii), a band
+    that is none without the edge radii's triangles it took in (:func:`_off_rim`)."""
     angles = mesh.face_adjacency_angles
     smooth = mesh.face_adjacency[angles < SMOOTH]
     faces: list[CylinderFace] = []
@@ -74,8 +75,64 @@ def cylinder_faces(mesh: trimesh.Trimesh) -> list[CylinderFace]:
         if face is not None:
             faces.append(face)
             continue
-        faces.extend(f for band in _bands(mesh, region, smooth) if (f := _cylinder(mesh, band)) is not None)
+        axis, bands = _bands(mesh, region, smooth)
+        for band in bands:
+            face = _cylinder(mesh, band)
+            if face is None and len(rim := _off_rim(mesh, band, axis)) >= 6:
+                face = _cylinder(mesh, rim)
+            if face is not None:
+                faces.append(face)
     return faces
+
+
+def _off_rim(mesh: trimesh.Trimesh, band: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """The triangles of ``band`` with no corner off its cylinder, none when their corners
+    leave a wider angle about its axis uncovered than the band's (and than :data:`SMOOTH`:
+    a rounded rect's four corners each touch the circle through their farthest points in a
+    few triangles, 60 deg and more apart). A band can take in the
+    first triangles of an edge radius tessellated coarsely (Open CASCADE's, from the
+    cylinder's rim to a point of the radius a few tens of µm inside it, its normal within
+    :data:`TILT` of the band's), whose corners the cylinder's circle does not hold. The
+    circle is about the band's ``axis`` (:func:`_bands`: its bends', which those triangles
+    do not tilt as they tilt its normals), through the centre fitted to its corners (then to
+    the outer half of them, twice, for an outward band, the inner for an inward one), and
+    of their farthest distance from it for an outward band (an edge radius bends inwards
+    from a shaft's face), their nearest for an inward one (outwards from a bore's); a
+    corner is on it within 1 µm plus 1e-4 of it."""
+    normals = mesh.face_normals[band]
+    frame = np.linalg.svd(axis[None, :])[2][1:]
+    ring = np.unique(mesh.faces[band].ravel())
+    flat = mesh.vertices[ring] @ frame.T
+    centre = _centre(flat)
+    across = mesh.triangles_center[band] @ frame.T - centre
+    outward = float(np.mean(np.einsum("ij,ij->i", normals @ frame.T, across))) > 0
+    for _ in range(2):  # refitted on the outer (inner) half of the corners: the radii's pull it off
+        apart = np.linalg.norm(flat - centre, axis=1)
+        middle = (apart.max() + apart.min()) / 2
+        centre = _centre(flat[apart >= middle if outward else apart <= middle])
+    distance = np.zeros(len(mesh.vertices))
+    distance[ring] = np.linalg.norm(flat - centre, axis=1)
+    radius = distance[ring].max() if outward else distance[ring].min()
+    on = np.abs(distance - radius) <= 1e-6 + 1e-4 * radius
+    rim = band[on[mesh.faces[band]].all(axis=1)]
+    covered = _widest_gap(mesh, rim, frame, centre) <= max(_widest_gap(mesh, band, frame, centre), SMOOTH)
+    return rim if covered else rim[:0]
+
+
+def _centre(flat: np.ndarray) -> np.ndarray:
+    """The centre of the circle fitted to the points ``flat`` (n, 2) [m] (least squares)."""
+    design = np.column_stack([2 * flat, np.ones(len(flat))])
+    return np.linalg.lstsq(design, np.sum(flat ** 2, axis=1), rcond=None)[0][:2]
+
+
+def _widest_gap(mesh: trimesh.Trimesh, triangles: np.ndarray, frame: np.ndarray, centre: np.ndarray) -> float:
+    """The widest angle [rad] about ``centre`` (across the axis, in ``frame``) between the
+    corners of ``triangles`` (2 pi when they have none)."""
+    if len(triangles) == 0:
+        return 2 * np.pi
+    flat = mesh.vertices[np.unique(mesh.faces[triangles].ravel())] @ frame.T - centre
+    angles = np.sort(np.arctan2(flat[:, 1], flat[:, 0]))
+    return float(np.max(np.diff(np.append(angles, angles[0] + 2 * np.pi))))
 
 
 def _cylinder(mesh: trimesh.Trimesh, region: np.ndarray) -> CylinderFace | None:
@@ -139,7 +196,7 @@ CANDIDATES = 256
 """Bends of a smooth region tried as its axis (:func:`_bands`; evenly spaced among them)."""
 
 
-def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> list[np.ndarray]:
+def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
     """The smooth ``region`` of ``mesh`` split where it stops being a band parallel to one
     axis. Adjacent triangles that bend (:data:`BEND`) bend about their normals' cross
     product: on a cylinder all about its axis, on an edge radius or a sphere about
@@ -149,7 +206,8 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     are perpendicular to it (within :data:`TILT`), joined by the ``smooth`` adjacencies: a
     bore's band, not its edge radii (their normals lean along the axis) nor the end faces
     beyond them. Each band is a cylinder only if :func:`_cylinder` finds it one. One axis a
-    region: bands about another axis in the same smooth region are not looked for."""
+    region: bands about another axis in the same smooth region are not looked for. The
+    axis (a unit vector; any, with no band) and the bands."""
     inside = np.zeros(len(mesh.faces), dtype=bool)
     inside[region] = True
     pairs = smooth[inside[smooth].all(axis=1)]
@@ -157,7 +215,7 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     sizes = np.linalg.norm(bends, axis=1)
     bends = bends[sizes > BEND] / sizes[sizes > BEND, None]
     if len(bends) < 2:
-        return []
+        return np.eye(3)[2], []
     tried = bends[np.linspace(0, len(bends) - 1, min(CANDIDATES, len(bends))).astype(int)]
     shared = np.abs(tried @ bends.T) >= np.sqrt(1 - TILT ** 2)
     best = tried[np.argmax(shared.sum(axis=1))]
@@ -165,7 +223,7 @@ def _bands(mesh: trimesh.Trimesh, region: np.ndarray, smooth: np.ndarray) -> lis
     axis = np.linalg.eigh(along.T @ along)[1][:, -1]
     lateral = np.zeros(len(mesh.faces), dtype=bool)
     lateral[region] = np.abs(mesh.face_normals[region] @ axis) <= TILT
-    return list(trimesh.graph.connected_components(pairs[lateral[pairs].all(axis=1)], min_len=6))
+    return axis, list(trimesh.graph.connected_components(pairs[lateral[pairs].all(axis=1)], min_len=6))
 
 
 _PRISM_FRAMES = tuple((axis, np.array([np.roll(axis, 1), np.roll(axis, 2)])) for axis in np.eye(3))
@@ -295,9 +353,42 @@ def _prism_fit(a: PrismFace, b: PrismFace) -> Slide | None:
     return Slide("", "", a, b, TOUCH, 2 * TOUCH, _seated(a, b, TOUCH))
 
 
+PRESS_FIT = 0.01
+"""The most a shaft's cylinder may be wider than a coaxial bore's, relative to its radius,
+to be named a press fit (:func:`press_fits`; ISO 286's interference fits are some
+thousandths of the diameter): a wider one is no fit of the two."""
+
+
+def press_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
+    """Every pair of an outward cylinder of one part and an inward one of another, parallel
+    (within 1e-4 rad), coaxial within their tolerance (the larger deflection plus
+    :data:`TOUCH`) and seated, the shaft's circle wider than the bore's by more than TOUCH
+    and by at most :data:`PRESS_FIT` of its radius: a part drawn pressed into its bore.
+    The circles are those of the faces' corners, which both tessellations put on the
+    drawn circles: they tell a press fit of 0.025 mm per side from a zero-clearance fit
+    however coarse the tessellations (the faces' own overlap, up to the larger deflection,
+    is no interference)."""
+    found: list[Slide] = []
+    for shaft, outer in faces.items():
+        for bore, inner in faces.items():
+            if bore == shaft:
+                continue
+            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
+                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
+                    tolerance = max(a.deflection, b.deflection) + TOUCH
+                    offset = b.point - a.point
+                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
+                    if (np.linalg.norm(np.cross(a.direction, b.direction)) <= 1e-4 and apart <= tolerance
+                            and TOUCH < a.radius - b.radius <= PRESS_FIT * a.radius and _seated(a, b, tolerance)):
+                        found.append(Slide(shaft, bore, a, b, tolerance, 0.0, True))
+    return found
+
+
 def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
     """Every pair of an outward face of one part and an inward face of another: cylinders
-    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance; prisms
+    parallel (within 1e-4 rad), coaxial and of equal radius within their tolerance (the
+    shaft's circle no wider than the bore's by more than :data:`TOUCH`: wider, it is
+    pressed in, :func:`press_fits`); prisms
     along one of the cell's axes whose outlines are one within :data:`TOUCH`
     (:func:`_prism_fit`). Each slides along its axis wherever the two faces meet on the
     way, in the assembled pose (``seated``) or only on it (a passage)."""
@@ -314,7 +405,7 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> lis
                 for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
                     tolerance = max(a.deflection, b.deflection) + TOUCH
                     if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
-                            or abs(a.radius - b.radius) > tolerance):
+                            or abs(a.radius - b.radius) > tolerance or a.radius - b.radius > TOUCH):
                         continue
                     offset = b.point - a.point
                     apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
