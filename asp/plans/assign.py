@@ -83,6 +83,11 @@ class LearnedFacts:
     cell_before: frozenset[tuple[str, str]] = frozenset()
     """(peg, part) pairs the cell's fingers need in this order (``cell_before/2``, not precedence)."""
 
+    @property
+    def plan_order(self) -> frozenset[tuple[str, str]]:
+        """The orders every plan keeps: the precedence and the cell's own orders."""
+        return self.must_precede | self.cell_before
+
     def holes_of(self, part: str) -> list[str]:
         """The holes ``part`` fits and the cell can put it in, sorted."""
         return [hole for hole in self.holes if (part, hole) in self.fits and (part, hole) not in self.out_of_reach]
