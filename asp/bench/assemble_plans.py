@@ -72,10 +72,11 @@ TOLERANCE_MM = 2.0
 
 def draw_plans(facts: LearnedFacts, n: int, seed: int) -> list[Plan]:
     """``n`` plans: each a sequence drawn uniformly among those ``facts.must_precede``
-    admits, with a feasible hole assignment drawn uniformly; all from ``random.Random(seed)``.
+    and the cell's own orders admit (:attr:`asp.plans.assign.LearnedFacts.plan_order`),
+    with a feasible hole assignment drawn uniformly; all from ``random.Random(seed)``.
     PlannerError when one fails the checker (it cannot: the checker guards the sampler)."""
     rng = random.Random(seed)
-    sampler = UniformSampler(Relation.from_pairs(facts.parts, facts.must_precede))
+    sampler = UniformSampler(Relation.from_pairs(facts.parts, facts.plan_order))
     assignments = all_assignments(facts, ASSIGNMENT_LIMIT)
     drawn = []
     for _ in range(n):

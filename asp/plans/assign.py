@@ -80,6 +80,13 @@ class LearnedFacts:
     """(part, hole) pairs the cell cannot put in or the CAD holds elsewhere (``out_of_reach/2``)."""
     cad_holes: frozenset[tuple[str, str]] = frozenset()
     """(part, hole) pairs of a part held where the CAD has it (``cad_hole/2``)."""
+    cell_before: frozenset[tuple[str, str]] = frozenset()
+    """(peg, part) pairs the cell's fingers need in this order (``cell_before/2``, not precedence)."""
+
+    @property
+    def plan_order(self) -> frozenset[tuple[str, str]]:
+        """The orders every plan keeps: the precedence and the cell's own orders."""
+        return self.must_precede | self.cell_before
 
     def holes_of(self, part: str) -> list[str]:
         """The holes ``part`` fits and the cell can put it in, sorted."""
@@ -95,8 +102,12 @@ class LearnedFacts:
 
 
 LEARNED_SIGNATURES = {"part": 1, "hole": 1, "fits": 2, "no_fit": 2, "needs_hole": 1,
-                      "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2, "cad_hole": 2}
+                      "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2, "cad_hole": 2,
+                      "cell_before": 2}
 """The predicates of learned facts the planner reads, with their arities (ids only)."""
+
+CELL_ORDER = "cell_order.lp"
+"""The product's file of the cell's own orders (``cell_before/2``, written by ``./run.sh import``)."""
 
 RESERVED_IDS = frozenset({"none", "home", "site"})
 """Constants of plan_step/3 (``none``) and of the travel cost (``home``, ``site``)."""
@@ -117,6 +128,10 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
                     f"{sources}: {name}({part},{hole}): expected a part/1 and a hole/1 "
                     f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
                 )
+    for first, then in sorted(facts.cell_before):
+        if first not in known_parts or then not in known_parts:
+            raise PlannerError(f"{sources}: cell_before({first},{then}): expected two part/1 "
+                               f"(parts: {' '.join(facts.parts)})")
     both = sorted(facts.fits & set(pairs_by_name(facts.atoms, "no_fit")))
     if both:
         part, hole = both[0]
@@ -145,10 +160,14 @@ def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     """What the product says about its holes beyond sizes: ``capacity(H,C)`` for a hole
     taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not the base,
     not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`),
-    ``cad_hole(P,H)`` for a part held where the CAD has it (:attr:`bridge.assembly.Assembly.cad_holes`)."""
+    ``cad_hole(P,H)`` for a part held where the CAD has it (:attr:`bridge.assembly.Assembly.cad_holes`),
+    and the cell's own orders ``cell_before(P,Q)`` of the product's ``cell_order.lp``
+    (:data:`CELL_ORDER`: the fingers' grip of peg P needs it in before part Q)."""
     atoms = [fact("capacity", hole.id, hole.capacity) for hole in assembly.holes if hole.capacity > 1]
     atoms += [fact("cad_hole", part, hole) for part, holes in sorted(assembly.cad_holes.items())
               for hole in sorted(holes)]
+    if assembly.has_file(CELL_ORDER):
+        atoms += [atom for atom in load_atoms([assembly.file(CELL_ORDER)]) if atom.match("cell_before", 2)]
     inserted = [part.id for part in assembly.parts if part.role != "base" and part.id not in assembly.manual]
     return atoms + [fact("out_of_reach", part, hole) for part in inserted
                     for hole in assembly.hole_ids if assembly.cell_cannot_insert(part, hole)]
@@ -183,6 +202,7 @@ def load_learned_facts(paths: Sequence[Path | str], product: Sequence[clingo.Sym
         capacity=_capacities(atoms, {h for (h,) in atoms_by_name(atoms, "hole", 1)}, sources),
         out_of_reach=frozenset(pairs_by_name(atoms, "out_of_reach")),
         cad_holes=frozenset(pairs_by_name(atoms, "cad_hole")),
+        cell_before=frozenset(pairs_by_name(atoms, "cell_before")),
     )
     _check_ids(facts, sources)
     return facts

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import clingo
 
 from asp import PlannerError
-from asp.plans.assign import LearnedFacts, feasible_assignment
+from asp.plans.assign import LearnedFacts, UnsolvableAssembly, feasible_assignment
 from asp.solve import fact, solve
 from bridge.assembly import Assembly
 
@@ -76,8 +76,10 @@ def plans(
 
     With ``optimal=True`` every plan returned has the least cost and clingo has proven
     it; PlannerError when that takes longer than ``time_limit_s`` [s] (None: no limit).
-    UnsolvableAssembly names the part without a hole; PlannerError when no order
-    respects ``must_precede`` (a cycle).
+    Every plan keeps the cell's own orders (``cell_before/2``, ``plans/cell_order.lp``).
+    UnsolvableAssembly names the part without a hole, or the parts on a cycle of the
+    cell's orders and the precedence; PlannerError when no order respects
+    ``must_precede`` (a cycle).
     """
     if optimal and not travel:
         raise PlannerError("optimal plans need the travel/3 facts of an assembly's geometry")
@@ -98,6 +100,11 @@ def plans(
           time_limit_s)
     if not found:
         feasible_assignment(facts)  # raises UnsolvableAssembly when no assignment exists
+        crossed = _parts_on_cycles(facts.must_precede | facts.cell_before)
+        if crossed and facts.cell_before:
+            raise UnsolvableAssembly(crossed, "the assembly is not solvable: the cell's own orders (cell_before/2, "
+                                     "the fingers' grip: cell_order.lp) and the precedence have a cycle through "
+                                     + " ".join(crossed))
         raise PlannerError(
             "no plan: no order of the parts respects must_precede, it has a cycle through "
             + " ".join(_parts_on_cycles(facts.must_precede))

@@ -57,6 +57,9 @@ MAX_DELAY_S = 3600.0
 PRODUCT_FILES = ("assembly.toml", "geometry.toml", "sizes.lp", "precedence.lp", "demos.txt", "nominal_sizes.lp")
 """The files of a product folder its digest covers (the meshes ``geometry.toml`` names are
 pinned by the SHA-256 it states for each)."""
+PRESENT_PRODUCT_FILES = ("cell_order.lp",)
+"""Files the digest covers where present (an absent one leaves the digest of the others as
+it was): the cell's own orders an import writes for the fingers' grip."""
 
 RecordingId = Annotated[str, Meta(pattern=rf"^[A-Za-z0-9_-]{{1,{MAX_RECORDING_ID}}}$")]
 Digest = Annotated[str, Meta(pattern=r"^[0-9a-f]{64}$")]
@@ -279,9 +282,10 @@ def resumed_settings(settings: SessionSettings, record: SessionFile) -> tuple[Se
 
 def product_digest(folder: Path) -> str:
     """The SHA-256 (hex) of the product folder's files :data:`PRODUCT_FILES` (each one's
-    name and bytes; an absent one counts as absent): equal digests, the same product."""
+    name and bytes; an absent one counts as absent), and :data:`PRESENT_PRODUCT_FILES` where
+    present: equal digests, the same product."""
     digest = hashlib.sha256()
-    for name in PRODUCT_FILES:
+    for name in (*PRODUCT_FILES, *(name for name in PRESENT_PRODUCT_FILES if (folder / name).exists())):
         path = folder / name
         data = read_bytes(path, f"product file {name}", error=PlannerError) if path.exists() else None
         digest.update(f"{name} {-1 if data is None else len(data)}\n".encode())

@@ -54,6 +54,7 @@ from executor.cad.locating import LOCATING_REACH, MAX_REACH
 from executor.cad.operations import (
     entry_point,
     finger_assumption,
+    finger_order_text,
     finger_orders,
     pin_entry,
     screwed_fits,
@@ -635,7 +636,8 @@ def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path 
         assumed += overlap_assumption(derived)
         mapped, laid, cell = map_product(derived, settings)
         assumed += widened_fits_assumption(cell)
-    assumed += [finger_assumption(), *finger_orders(cell), *([mapped.tool] if mapped.tool else [])]
+    assumed += [finger_assumption(), *map(finger_order_text, finger_orders(cell))]
+    assumed += [mapped.tool] if mapped.tool else []
     missing = sorted(set(laid.trays) - set(settings.trays))
     if missing:
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "

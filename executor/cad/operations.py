@@ -431,23 +431,39 @@ def _in_place_before(derived: Derived, pid: str) -> set[str]:
     return (nx.ancestors(order(derived), pid) | {derived.base}) - {pid}
 
 
-def finger_orders(cell: Derived) -> list[str]:
-    """The orders the fingers' grip (:func:`finger_grip`) assumes, as the import states
-    them: each peg the cell inserts with the fingers that a part the geometric precedence
-    lets be in place before it (:func:`_maybe_in_place`), not only those it puts before it,
-    would leave standing out less (Cranfield's pegs: 5 mm out of the front plate, 25 mm
-    out of the base plate); the plan must put it before that part (a demonstrated or
-    learned precedence), which the import does not enforce."""
+def finger_orders(cell: Derived) -> list[tuple[str, str, float, float]]:
+    """The orders the fingers' grip (:func:`finger_grip`) needs, as (peg, part, grip [m],
+    out [m]): each peg the cell inserts with the fingers goes in before each part the
+    geometric precedence merely lets be in place before it (:func:`_maybe_in_place`, not
+    the base nor those it puts before it) that would leave it standing out ``out``, too
+    little for its ``grip`` (Cranfield's pegs: 5 mm out of the front plate, 25 mm out of
+    the base plate). The parts are taken in id order, each one left free to be in place
+    only while the peg, with it and those left free before it, keeps its grip; so every
+    part left free, all together in place, leaves the grip as it is. The plans honour
+    these orders (``cell_order.lp``, :func:`executor.cad.write.cell_order_text`)."""
     found = []
     for pid, fit in sorted(cell.hole_of.items()):
         if fit.axis == "-z" or tool_of(cell, fit)[0] != "fingers":
             continue
         grip = finger_grip(cell, fit)[0]
-        out, under = standing_out(cell, pid, fit, _maybe_in_place(cell, pid))
-        if _grip(out, under)[0] < grip:
-            found.append(f"'{pid}' goes in before '{under}' (the fingers hold it {1e3 * grip:g} mm deep; with "
-                         f"'{under}' in place it would stand out {1e3 * out:.3f} mm)")
+        free = _in_place_before(cell, pid)
+        if _grip(*standing_out(cell, pid, fit, _maybe_in_place(cell, pid)))[0] >= grip:
+            continue
+        for other in sorted(_maybe_in_place(cell, pid) - free):
+            out, _ = standing_out(cell, pid, fit, free | {other})
+            if _grip(out, other)[0] < grip:
+                found.append((pid, other, grip, out))
+            else:
+                free.add(other)
     return found
+
+
+def finger_order_text(order: tuple[str, str, float, float]) -> str:
+    """One order of :func:`finger_orders` as the import states it."""
+    pid, other, grip, out = order
+    return (f"'{pid}' goes in before '{other}' (the fingers hold it {1e3 * grip:g} mm deep; with "
+            f"'{other}' in place it would stand out {1e3 * out:.3f} mm): the cell's own order, "
+            "every plan honours it (cell_order.lp)")
 
 
 def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit, others: set[str]) -> tuple[float, str]:

@@ -35,6 +35,9 @@
   meshes with convex pieces (``meshes/``, :mod:`executor.cad.convex`;
   a STEP base tessellated again to :data:`CELL_DEFLECTION` for the cell), a part placed by
   hand as its own mesh (static, no pieces), a base without such holes as its own mesh.
+- ``cell_order.lp``: with ``geometry.toml``, ``cell_before(P,Q)`` where the fingers' grip
+  of peg P needs it in before part Q (:func:`cell_order_text`), the cell's own orders
+  every plan of the product honours;
 - ``.import-manifest.json`` (:data:`MANIFEST`): the files this import wrote with their
   SHA-256. A later import into the folder replaces or removes only those of them that
   are still as written (:func:`claim_folder`), and refuses a folder holding any other file
@@ -88,6 +91,8 @@ from executor.cad.operations import (
     feature_turn,
     fine_fits,
     finger_grip,
+    finger_order_text,
+    finger_orders,
     margins,
     narrows_peg,
     nominal_fits,
@@ -136,8 +141,10 @@ MAX_REASON = 200
 MANIFEST = ".import-manifest.json"
 """The files the last import into a folder wrote: ``{"written_by": "./run.sh import",
 "title": the product's name, "files": {path relative to the folder: SHA-256 of its content}}``."""
-PRODUCT_FILES = ("assembly.toml", "sizes.lp", "nominal_sizes.lp", "geometric_precedence.lp", "geometry.toml")
-"""The product's files an import writes (``geometry.toml`` only where the cell builds the product)."""
+PRODUCT_FILES = ("assembly.toml", "sizes.lp", "nominal_sizes.lp", "geometric_precedence.lp", "geometry.toml",
+                 "cell_order.lp")
+"""The product's files an import writes (``geometry.toml`` only where the cell builds the product,
+``cell_order.lp`` only where it does and its fingers' grip orders parts)."""
 _MESH_NAME = re.compile(rf"{MESH_FOLDER}/[a-z][a-z0-9_]*(\.convex)?\.obj")
 """The name of a mesh file an import writes, relative to the folder (a part id is an ASP constant)."""
 CELL_DEFLECTION = 1e-5
@@ -470,6 +477,22 @@ def precedence_text(derived: Derived) -> str:
              _symbols([clingo.Function("part", [clingo.Function(p)]) for p in sorted(derived.parts)])]
     lines += [_symbols([clingo.Function("must_precede", [clingo.Function(a), clingo.Function(b)])])
               for a, b in closure]
+    return "\n".join(lines) + "\n"
+
+
+def cell_order_text(cell: Derived) -> str | None:
+    """``cell_order.lp``: ``cell_before(P,Q)`` for each order the fingers' grip needs
+    (:func:`executor.cad.operations.finger_orders`), each with its reason in a comment;
+    None where there is none. The cell's own constraint, not the product's precedence."""
+    orders = finger_orders(cell)
+    if not orders:
+        return None
+    lines = ["% The cell's own orders (./run.sh import): cell_before(P,Q) when the fingers hold peg P so deep",
+             "% that part Q, in place before it, would meet them (P must go in before Q). Not the product's",
+             "% precedence: the plans of this product honour them (plan --assembly, session, assemble).",
+             *(f"% {finger_order_text(order)}" for order in orders)]
+    lines += [_symbols([clingo.Function("cell_before", [clingo.Function(p), clingo.Function(q)])])
+              for p, q, _, _ in orders]
     return "\n".join(lines) + "\n"
 
 
@@ -982,6 +1005,8 @@ def write_folder(derived: Derived, cell: Derived, mapped: Mapped, settings: Sett
             why = f"the cell refuses its geometry ({exc})"
         if why is None:
             written += [*mesh_files, geometry]
+            orders = cell_order_text(cell)
+            written += [write_atomic(out / "cell_order.lp", orders)] if orders is not None else []
         else:
             geometry.unlink()
     kept = {path.relative_to(out).as_posix(): _digest(path) for path in written}

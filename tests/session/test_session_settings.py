@@ -104,3 +104,6 @@ def test_the_product_digest_follows_every_product_file(tmp_path: Path, root: Pat
     digests.add(product_digest(tmp_path))
     (tmp_path / "notes.txt").write_text("not a product file")
     assert product_digest(tmp_path) in digests and len(digests) == 3
+    (tmp_path / "cell_order.lp").write_text("cell_before(p1,fp).\n")  # the cell's own orders
+    digests.add(product_digest(tmp_path))
+    assert len(digests) == 4
