@@ -249,5 +249,5 @@ def test_a_thread_in_a_plain_hole_of_its_crest_diameter_slides_out() -> None:
     derived = derive([screw, CadPart("plate", "plate", plate, "plate")], "plate", {})
     [plain] = derived.slides
     assert (plain.shaft, plain.bore, plain.pitch, plain.seated) == ("screw", "plate", 0.0, True)
-    assert plain.face.radius == pytest.approx(crest, abs=1e-9)
+    assert plain.face.radius == pytest.approx(crest, abs=1e-8)  # the vertex circle: its chords' sag is 1.65 µm
     assert derived.axis == {"screw": "+z"}
