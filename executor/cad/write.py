@@ -74,7 +74,7 @@ from executor.cad.convex import (
     write_mesh,
 )
 from executor.cad.covers import Mapped, map_parts
-from executor.cad.derive import Derived, HoleFit
+from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.operations import (
     GRIPPER,
     LEVEL,
@@ -386,6 +386,53 @@ def near_misses(derived: Derived, pieces: Mapping[str, Sequence[np.ndarray]] | N
     return found
 
 
+def pin_near_misses(derived: Derived) -> dict[tuple[str, str], str]:
+    """(part with a bore, pin) -> why the simulated cell cannot tell the pair's outcome: the
+    part does not pass the pin (its room below 0) and would stop on the pin's end no farther
+    than the cell's goal tolerance plus :data:`RIM_PRESS` from its goal there (the cell
+    compares the part's origin, the centre of its bore at its end nearest the pin's root,
+    with the pin's written bottom, where the first of the pin's parts rests in the CAD:
+    :func:`executor.world.geometry.seat`, nothing stacked on it), so a part blocked on it
+    ends as near its goal as one on it: a pin's ``near_miss`` in ``geometry.toml``. Where it
+    stops (:func:`_pin_stop`) is a lower bound: the pair is listed whenever it may be that close."""
+    rooms, found = margins(derived), {}
+    tolerance = Thresholds().goal_tolerance
+    for pin_id, pin in derived.pins.items():
+        top, height = pin_level(derived, pin)
+        for pid in sorted(derived.bores):
+            if rooms[pid][pin_id] >= 0:
+                continue
+            travel = _pin_stop(derived, pid, pin) - (top - height)
+            if travel <= tolerance + RIM_PRESS:
+                found[(pid, pin_id)] = (
+                    f"{pid} on {pin_id}: it does not pass the pin and would stop on its end {1e3 * travel:.3f} mm from "
+                    f"its goal there, no farther than the cell's goal tolerance ({1e3 * tolerance:g} mm) plus "
+                    f"{1e3 * RIM_PRESS:g} mm: a part blocked on it would end as near its goal as one on it, "
+                    "decided from the CAD")
+    return found
+
+
+def _pin_stop(derived: Derived, pid: str, pin: PinFit) -> float:
+    """The lowest level [m, along ``pin``'s axis, its frame] the end of part ``pid`` nearest
+    the pin's root reaches going down the pin's axis, its bore centred on it: the pin's top
+    (the highest vertex of its owner within its section's reach at least as far from its
+    axis as the circle its section holds) less the height above that end of the part's lowest
+    vertex inside that circle (the part's material the pin cannot pass). Vertices only: the
+    part may be stopped higher (on material between its vertices, on a wider step above),
+    never lower, so the travel from here to its goal is at most the cell's."""
+    outline = shapely.Polygon(pin.section.outline)
+    inner = float(outline.exterior.distance(shapely.Point(0.0, 0.0)))
+    reach = math.hypot(pin.section.a, pin.section.b) / 2
+    owner = along_axis(derived.parts[pin.owner].mesh, pin)
+    off = np.linalg.norm(owner[:, :2] - pin.section.centre, axis=1)
+    wide = (off >= inner - LEVEL) & (off <= reach + LEVEL)
+    part = trimesh.transform_points(derived.parts[pid].mesh.vertices, bore_frame(derived, pid))
+    inside = part[np.linalg.norm(part[:, :2], axis=1) < inner - LEVEL]
+    if not wide.any() or not len(inside):
+        return -math.inf
+    return float(owner[wide, 2].max()) - float(inside[:, 2].min())
+
+
 def mesh_pieces(out: Path, written: Iterable[Path]) -> dict[str, list[np.ndarray]]:
     """Part -> the vertices [m] of each convex piece of its ``convex`` file among the files
     ``written`` into the assembly folder ``out`` (a part simulated from its mesh)."""
@@ -404,7 +451,7 @@ def near_miss_assumption(derived: Derived, pieces: Mapping[str, Sequence[np.ndar
     ``import`` prints them (none without one), saying which backends try them
     (:data:`bridge.assembly.NEAR_MISS_BACKENDS`)."""
     return [f"no experiment of the PyBullet cell (backend sim; the truth and franka backends try it): {reason}"
-            for reason in near_misses(derived, pieces).values()]
+            for reason in (near_misses(derived, pieces) | pin_near_misses(derived)).values()]
 
 
 def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
@@ -717,6 +764,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
     nominal, pairs, missed = zero_clearance_parts(derived), section_pairs(derived), near_misses(derived, pieces)
+    missed |= pin_near_misses(derived)
     widened = widened_fits(derived)
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
@@ -757,6 +805,9 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_widened_line([pid for pid, on in widened if on == pin_id], "bores", "wider")]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
+        if close := [(pid, reason) for (pid, h), reason in missed.items() if h == pin_id]:
+            lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
+                         + "; ".join(reason for _, reason in close))
         if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
             lines.append(f'owner = "{pin.owner}"')
         if pin.axis != "+z":  # along a horizontal axis: its free end's height, the depth along its axis
