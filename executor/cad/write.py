@@ -398,6 +398,8 @@ def pin_near_misses(derived: Derived) -> dict[tuple[str, str], str]:
     rooms, found = margins(derived), {}
     tolerance = Thresholds().goal_tolerance
     for pin_id, pin in derived.pins.items():
+        if not pin.parts:  # an empty pin: the cell has no goal on it (geometry_text leaves it out)
+            continue
         top, height = pin_level(derived, pin)
         for pid in sorted(derived.bores):
             if rooms[pid][pin_id] >= 0:
