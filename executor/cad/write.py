@@ -414,25 +414,56 @@ def pin_near_misses(derived: Derived) -> dict[tuple[str, str], str]:
     return found
 
 
+STOP_RINGS = (0.0, 0.3, 0.6, 0.8, 0.9, 0.97, 0.995)
+"""The radii, as fractions of the circle a pin's section holds, of the rings of points at
+which :func:`_pin_stop` finds a part's material over that circle (72 points a ring)."""
+
+
 def _pin_stop(derived: Derived, pid: str, pin: PinFit) -> float:
     """The lowest level [m, along ``pin``'s axis, its frame] the end of part ``pid`` nearest
     the pin's root reaches going down the pin's axis, its bore centred on it: the pin's top
     (the highest vertex of its owner within its section's reach at least as far from its
-    axis as the circle its section holds) less the height above that end of the part's lowest
-    vertex inside that circle (the part's material the pin cannot pass). Vertices only: the
-    part may be stopped higher (on material between its vertices, on a wider step above),
-    never lower, so the travel from here to its goal is at most the cell's."""
+    axis as the circle its section holds) less the height above that end of the part's
+    lowest material over that circle (its lowest vertex in it, or the lowest of its faces
+    over the points of :data:`STOP_RINGS`: the part's material the pin cannot pass). The part
+    may be stopped higher (on material between those points, on a wider step above), never
+    lower, so the travel from here to its goal is at most the cell's; without material over
+    the circle (the pin's corners stop it), -inf: a near miss whatever its goal."""
     outline = shapely.Polygon(pin.section.outline)
     inner = float(outline.exterior.distance(shapely.Point(0.0, 0.0)))
     reach = math.hypot(pin.section.a, pin.section.b) / 2
     owner = along_axis(derived.parts[pin.owner].mesh, pin)
     off = np.linalg.norm(owner[:, :2] - pin.section.centre, axis=1)
     wide = (off >= inner - LEVEL) & (off <= reach + LEVEL)
-    part = trimesh.transform_points(derived.parts[pid].mesh.vertices, bore_frame(derived, pid))
-    inside = part[np.linalg.norm(part[:, :2], axis=1) < inner - LEVEL]
-    if not wide.any() or not len(inside):
+    mesh = derived.parts[pid].mesh
+    frame = bore_frame(derived, pid)
+    part = trimesh.transform_points(mesh.vertices, frame)
+    inside = part[np.linalg.norm(part[:, :2], axis=1) < inner - LEVEL, 2]
+    turns = np.linspace(0.0, 2 * math.pi, 72, endpoint=False)
+    points = np.array([(r * inner * math.cos(t), r * inner * math.sin(t)) for r in STOP_RINGS for t in turns])
+    over = _lowest_over(points, part[mesh.faces])
+    low = min([*inside, over])
+    if not wide.any() or not math.isfinite(low):
         return -math.inf
-    return float(owner[wide, 2].max()) - float(inside[:, 2].min())
+    return float(owner[wide, 2].max()) - low
+
+
+def _lowest_over(points: np.ndarray, triangles: np.ndarray) -> float:
+    """The lowest z [m] of the ``triangles`` (n, 3, 3) over any of ``points`` (k, 2) [m] (the
+    first face a ray up from below each point meets), inf over none."""
+    (ax, ay, az), (bx, by, bz), (cx, cy, cz) = (triangles[:, k, :].T for k in range(3))
+    det = (by - cy) * (ax - cx) + (cx - bx) * (ay - cy)
+    flat = np.abs(det) > 1e-18  # faces seen from below; walls along the axis hide nothing
+    ax, ay, az, bx, by, bz, cx, cy, cz, det = (v[flat] for v in (ax, ay, az, bx, by, bz, cx, cy, cz, det))
+    lowest = math.inf
+    for chunk in np.array_split(points, max(1, len(points) // 32)):
+        px, py = chunk[:, :1], chunk[:, 1:]
+        u = ((by - cy) * (px - cx) + (cx - bx) * (py - cy)) / det
+        v = ((cy - ay) * (px - cx) + (ax - cx) * (py - cy)) / det
+        hit = (u >= 0) & (v >= 0) & (u + v <= 1)
+        if hit.any():
+            lowest = min(lowest, float(np.where(hit, u * az + v * bz + (1 - u - v) * cz, np.inf).min()))
+    return lowest
 
 
 def mesh_pieces(out: Path, written: Iterable[Path]) -> dict[str, list[np.ndarray]]:
