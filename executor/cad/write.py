@@ -423,7 +423,7 @@ def _pin_stop(derived: Derived, pid: str, pin: PinFit) -> float:
     """The lowest level [m, along ``pin``'s axis, its frame] the end of part ``pid`` nearest
     the pin's root reaches going down the pin's axis, its bore centred on it: the pin's top
     (the highest vertex of its owner within its section's reach at least as far from its
-    axis as the circle its section holds) less the height above that end of the part's
+    axis as the circle its section holds, assumed to hold that circle up to there) less the height above that end of the part's
     lowest material over that circle (its lowest vertex in it, or the lowest of its faces
     over the points of :data:`STOP_RINGS`: the part's material the pin cannot pass). The part
     may be stopped higher (on material between those points, on a wider step above), never
