@@ -423,12 +423,13 @@ def _pin_stop(derived: Derived, pid: str, pin: PinFit) -> float:
     """The lowest level [m, along ``pin``'s axis, its frame] the end of part ``pid`` nearest
     the pin's root reaches going down the pin's axis, its bore centred on it: the pin's top
     (the highest vertex of its owner within its section's reach at least as far from its
-    axis as the circle its section holds, assumed to hold that circle up to there) less the height above that end of the part's
-    lowest material over that circle (its lowest vertex in it, or the lowest of its faces
-    over the points of :data:`STOP_RINGS`: the part's material the pin cannot pass). The part
-    may be stopped higher (on material between those points, on a wider step above), never
-    lower, so the travel from here to its goal is at most the cell's; without material over
-    the circle (the pin's corners stop it), -inf: a near miss whatever its goal."""
+    axis as the circle its section holds, assumed to hold that circle up to there) less the
+    height above that end of the part's lowest material over that circle (its lowest vertex
+    in it, or the lowest of its faces over the points of :data:`STOP_RINGS`: the part's
+    material the pin cannot pass). The part may be stopped higher (on material between
+    those points, on a wider step above), never lower, so the travel from here to its goal
+    is at most the cell's; without material over the circle (the pin's corners stop it),
+    -inf: a near miss whatever its goal."""
     outline = shapely.Polygon(pin.section.outline)
     inner = float(outline.exterior.distance(shapely.Point(0.0, 0.0)))
     reach = math.hypot(pin.section.a, pin.section.b) / 2
