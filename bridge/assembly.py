@@ -119,7 +119,8 @@ class Assembly:
     near_misses: frozenset[tuple[str, str]] = frozenset()
     """The (part, hole) pairs ``geometry.toml`` states the PyBullet cell cannot tell from a
     fit (``near_miss``: the part misses the hole by less than the cell's peg lacks at its
-    corners); a near miss only with a backend of :data:`NEAR_MISS_BACKENDS`."""
+    corners, or stops on it as near its goal as in or on it); a near miss only with a
+    backend of :data:`NEAR_MISS_BACKENDS`."""
     base_center: tuple[float, float] | None = None
     """Where the cell's fixture holds the base's centre [m] (``base_center`` of ``[plate]`` in
     ``geometry.toml``), None without a ``geometry.toml``."""

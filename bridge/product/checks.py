@@ -189,8 +189,9 @@ def _check_pins(path: Path, geo: GeometryFile, holes: Mapping[str, str]) -> None
                 raise fail(path, f"hole_shapes.{name}", "widened", "parts with a round bore of [part_shapes.*] "
                            "on a round pin, round pegs in a round hole of a [base] with its own mesh", pid)
         for pid in shape.near_miss or []:
-            if bores.get(pid) is not False or shape.pin:
-                raise fail(path, f"hole_shapes.{name}", "near_miss", "pegs of [part_shapes.*] in a hole", pid)
+            if bores.get(pid) != shape.pin:
+                raise fail(path, f"hole_shapes.{name}", "near_miss", "parts with a bore of [part_shapes.*] "
+                           "for a pin, pegs of [part_shapes.*] for a hole", pid)
     for name, part_shape in geo.part_shapes.items():
         demo = geo.hole_shapes.get(holes.get(part_shape.demo_hole, ""))
         if demo is not None and demo.pin != part_shape.bore:

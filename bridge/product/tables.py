@@ -190,7 +190,9 @@ class HoleShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     names the pegs that miss the hole by less than the simulated cell resolves with their
     corners rounded by its hull margin (``executor.world.near_miss``), or every peg of a
     hole no deeper than the cell's goal tolerance (one blocked on its rim ends as near its
-    goal): no experiment, their outcome is taken from ``sizes.lp``. ``tile`` is the
+    goal), and on a pin the parts with a bore that do not pass it and would stop on its end
+    within that tolerance of their goal on it: no experiment, their outcome is taken from
+    ``sizes.lp``. ``tile`` is the
     side of their square bosses [m] where it differs from the plate's ``tile_size``."""
 
     holes: Ids

@@ -77,7 +77,7 @@ from executor.cad.convex import (
     write_mesh,
 )
 from executor.cad.covers import Mapped, map_parts
-from executor.cad.derive import Derived, HoleFit
+from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.operations import (
     GRIPPER,
     LEVEL,
@@ -393,6 +393,87 @@ def near_misses(derived: Derived, pieces: Mapping[str, Sequence[np.ndarray]] | N
     return found
 
 
+def pin_near_misses(derived: Derived) -> dict[tuple[str, str], str]:
+    """(part with a bore, pin) -> why the simulated cell cannot tell the pair's outcome: the
+    part does not pass the pin (its room below 0) and would stop on the pin's end no farther
+    than the cell's goal tolerance plus :data:`RIM_PRESS` from its goal there (the cell
+    compares the part's origin, the centre of its bore at its end nearest the pin's root,
+    with the pin's written bottom, where the first of the pin's parts rests in the CAD:
+    :func:`executor.world.geometry.seat`, nothing stacked on it), so a part blocked on it
+    ends as near its goal as one on it: a pin's ``near_miss`` in ``geometry.toml``. Where it
+    stops (:func:`_pin_stop`) is a lower bound: the pair is listed whenever it may be that close."""
+    rooms, found = margins(derived), {}
+    tolerance = Thresholds().goal_tolerance
+    for pin_id, pin in derived.pins.items():
+        if not pin.parts:  # an empty pin: the cell has no goal on it (geometry_text leaves it out)
+            continue
+        top, height = pin_level(derived, pin)
+        for pid in sorted(derived.bores):
+            if rooms[pid][pin_id] >= 0:
+                continue
+            travel = _pin_stop(derived, pid, pin) - (top - height)
+            if travel <= tolerance + RIM_PRESS:
+                found[(pid, pin_id)] = (
+                    f"{pid} on {pin_id}: it does not pass the pin and would stop on its end {1e3 * travel:.3f} mm from "
+                    f"its goal there, no farther than the cell's goal tolerance ({1e3 * tolerance:g} mm) plus "
+                    f"{1e3 * RIM_PRESS:g} mm: a part blocked on it would end as near its goal as one on it, "
+                    "decided from the CAD")
+    return found
+
+
+STOP_RINGS = (0.0, 0.3, 0.6, 0.8, 0.9, 0.97, 0.995)
+"""The radii, as fractions of the circle a pin's section holds, of the rings of points at
+which :func:`_pin_stop` finds a part's material over that circle (72 points a ring)."""
+
+
+def _pin_stop(derived: Derived, pid: str, pin: PinFit) -> float:
+    """The lowest level [m, along ``pin``'s axis, its frame] the end of part ``pid`` nearest
+    the pin's root reaches going down the pin's axis, its bore centred on it: the pin's top
+    (the highest vertex of its owner within its section's reach at least as far from its
+    axis as the circle its section holds, assumed to hold that circle up to there) less the
+    height above that end of the part's lowest material over that circle (its lowest vertex
+    in it, or the lowest of its faces over the points of :data:`STOP_RINGS`: the part's
+    material the pin cannot pass). The part may be stopped higher (on material between
+    those points, on a wider step above), never lower, so the travel from here to its goal
+    is at most the cell's; without material over the circle (the pin's corners stop it),
+    -inf: a near miss whatever its goal."""
+    outline = shapely.Polygon(pin.section.outline)
+    inner = float(outline.exterior.distance(shapely.Point(0.0, 0.0)))
+    reach = math.hypot(pin.section.a, pin.section.b) / 2
+    owner = along_axis(derived.parts[pin.owner].mesh, pin)
+    off = np.linalg.norm(owner[:, :2] - pin.section.centre, axis=1)
+    wide = (off >= inner - LEVEL) & (off <= reach + LEVEL)
+    mesh = derived.parts[pid].mesh
+    frame = bore_frame(derived, pid)
+    part = trimesh.transform_points(mesh.vertices, frame)
+    inside = part[np.linalg.norm(part[:, :2], axis=1) < inner - LEVEL, 2]
+    turns = np.linspace(0.0, 2 * math.pi, 72, endpoint=False)
+    points = np.array([(r * inner * math.cos(t), r * inner * math.sin(t)) for r in STOP_RINGS for t in turns])
+    over = _lowest_over(points, part[mesh.faces])
+    low = min([*inside, over])
+    if not wide.any() or not math.isfinite(low):
+        return -math.inf
+    return float(owner[wide, 2].max()) - low
+
+
+def _lowest_over(points: np.ndarray, triangles: np.ndarray) -> float:
+    """The lowest z [m] of the ``triangles`` (n, 3, 3) over any of ``points`` (k, 2) [m] (the
+    first face a ray up from below each point meets), inf over none."""
+    (ax, ay, az), (bx, by, bz), (cx, cy, cz) = (triangles[:, k, :].T for k in range(3))
+    det = (by - cy) * (ax - cx) + (cx - bx) * (ay - cy)
+    flat = np.abs(det) > 1e-18  # faces seen from below; walls along the axis hide nothing
+    ax, ay, az, bx, by, bz, cx, cy, cz, det = (v[flat] for v in (ax, ay, az, bx, by, bz, cx, cy, cz, det))
+    lowest = math.inf
+    for chunk in np.array_split(points, max(1, len(points) // 32)):
+        px, py = chunk[:, :1], chunk[:, 1:]
+        u = ((by - cy) * (px - cx) + (cx - bx) * (py - cy)) / det
+        v = ((cy - ay) * (px - cx) + (ax - cx) * (py - cy)) / det
+        hit = (u >= 0) & (v >= 0) & (u + v <= 1)
+        if hit.any():
+            lowest = min(lowest, float(np.where(hit, u * az + v * bz + (1 - u - v) * cz, np.inf).min()))
+    return lowest
+
+
 def mesh_pieces(out: Path, written: Iterable[Path]) -> dict[str, list[np.ndarray]]:
     """Part -> the vertices [m] of each convex piece of its ``convex`` file among the files
     ``written`` into the assembly folder ``out`` (a part simulated from its mesh)."""
@@ -411,7 +492,7 @@ def near_miss_assumption(derived: Derived, pieces: Mapping[str, Sequence[np.ndar
     ``import`` prints them (none without one), saying which backends try them
     (:data:`bridge.assembly.NEAR_MISS_BACKENDS`)."""
     return [f"no experiment of the PyBullet cell (backend sim; the truth and franka backends try it): {reason}"
-            for reason in near_misses(derived, pieces).values()]
+            for reason in (near_misses(derived, pieces) | pin_near_misses(derived)).values()]
 
 
 def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
@@ -740,6 +821,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
              f"base_size = [{_q(x1 - x0)}, {_q(y1 - y0)}]", f"base_center = [{_q((x0 + x1) / 2)}, {_q((y0 + y1) / 2)}]",
              f"base_thickness = {_q(min(max(top - depth - z0, 1e-3), MAX_PLATE_DEPTH))}", ""]
     nominal, pairs, missed = zero_clearance_parts(derived), section_pairs(derived), near_misses(derived, pieces)
+    missed |= pin_near_misses(derived)
     widened = widened_fits(derived)
     for hid, fit in derived.holes.items():
         listed = nominal.get(hid, [])
@@ -780,6 +862,9 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_widened_line([pid for pid, on in widened if on == pin_id], "bores", "wider")]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
+        if close := [(pid, reason) for (pid, h), reason in missed.items() if h == pin_id]:
+            lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
+                         + "; ".join(reason for _, reason in close))
         if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
             lines.append(f'owner = "{pin.owner}"')
         if pin.axis != "+z":  # along a horizontal axis: its free end's height, the depth along its axis

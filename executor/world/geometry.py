@@ -134,8 +134,9 @@ class HoleSpec(Section):
     (``zero_clearance``, a nominal zero-clearance fit: :func:`feature_passes`); the parts
     with a bore whose room on it is under what the cell resolves, whose bore it builds wider
     (``widened``: :func:`_with_widened_fits`; a hole's: the pegs it builds narrower); the pegs
-    that miss it by less than the cell resolves (``near_miss``: :mod:`executor.world.near_miss`,
-    no experiment); ``tile``
+    that miss it by less than the cell resolves, or, on a pin, the parts that would stop on
+    its end as near their goal as one on it (``near_miss``: :mod:`executor.world.near_miss`,
+    :func:`executor.cad.write.pin_near_misses`; no experiment); ``tile``
     the side of its square boss [m] where it differs from the plate's ``tile_size``
     (:func:`tile_of`)."""
 

@@ -42,7 +42,7 @@ from executor.cad.cli import load_source
 from executor.cad.derive import derive
 from executor.cad.operations import margins
 from executor.cad.sweep import opposite
-from executor.cad.write import down_depth
+from executor.cad.write import down_depth, pin_near_misses
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.trial import Cell
@@ -623,3 +623,8 @@ def test_a_knob_on_a_d_shaft_and_the_nut_on_the_thread_under_it_are_each_on_a_pi
     assert {pair for pair in derived.edges if truth["base"] not in pair} == {tuple(p) for p in truth["precedence"]}
     assert {pid: opposite(axis) for pid, axis in derived.axis.items()} == {
         pid: part["axes"][0] for pid, part in truth["parts"].items()}
+    # the knob, its D bore from 3.5 mm above its foot, stops on the thread's top (z 4): its
+    # foot 0.5 mm above the washer's (z 0), its goal on the thread, within the goal tolerance
+    missed = pin_near_misses(derived)
+    assert set(missed) == {("knob", pin_of["thread"])} and " 0.500 mm from its goal" in missed[
+        ("knob", pin_of["thread"])], missed

@@ -103,7 +103,8 @@ CASES = [
      "[hole_shapes.round_big] widened: expected parts with a round bore of [part_shapes.*] on a round pin, round "
      "pegs in a round hole of a [base] with its own mesh, got 'p1'"),
     ("near-miss-unknown-part", 'holes = ["br"]', 'holes = ["br"]\nnear_miss = ["zz"]',
-     "[hole_shapes.round_big] near_miss: expected pegs of [part_shapes.*] in a hole, got 'zz'"),
+     "[hole_shapes.round_big] near_miss: expected parts with a bore of [part_shapes.*] for a pin, pegs of "
+     "[part_shapes.*] for a hole, got 'zz'"),
     ("hole-bottom-under-the-floor", 'holes = ["br"]', 'holes = ["br"]\ndepth = 0.1',
      "[hole_shapes.round_big] depth: expected less than the entry height (0.1 m: the bottom above the floor), "
      "got 0.1"),
