@@ -248,14 +248,21 @@ def screwed(derived: Derived) -> dict[str, str]:
     """Part -> why it is placed by hand, for the parts of screwed pairs (a modelled thread,
     :func:`executor.cad.fits.threads.screwed_pairs`): of each pair the part that leaves first in
     the disassembly (both where they leave at one stage; never the base). The cell has no
-    screwing operation."""
+    screwing operation; nor a pressing one: the parts of press fits
+    (:func:`executor.cad.fits.faces.press_fits`) are placed by hand alike."""
     stage = {pid: k for k, parts in enumerate(derived.stages) for pid in parts}
     found: dict[str, str] = {}
-    for slide in (s for s in derived.slides if s.pitch):
+    for slide in (s for s in derived.slides if s.pitch or s.interference):
         pair = [pid for pid in (slide.shaft, slide.bore) if pid in stage]
         first = min((stage[pid] for pid in pair), default=None)
         for pid in (pid for pid in pair if stage[pid] == first):
             other = slide.bore if pid == slide.shaft else slide.shaft
+            if slide.interference:
+                found.setdefault(pid, f"part '{pid}' is pressed {'into' if pid == slide.shaft else 'onto'} "
+                                      f"'{other}' along {opposite(derived.axis[pid])} (a press fit, "
+                                      f"{1000 * slide.interference:.3f} mm per side): the cell has no pressing "
+                                      "operation")
+                continue
             found.setdefault(pid, f"part '{pid}' is screwed {'into' if pid == slide.shaft else 'onto'} '{other}' "
                                   f"along {opposite(derived.axis[pid])} ({slide.thread}, pitch "
                                   f"{1000 * slide.pitch:.3f} mm): the cell has no screwing operation")
