@@ -75,11 +75,7 @@ INSERTED = "fits of any part on any part: the cell has no operation for a part g
 
 PRODUCTS = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.toml").is_file())
 
-REFUSED: dict[str, str] = {
-    "bdw_pillow_block": "a press fit: the bearing's d 22 outer race drawn in its d 21.95 seat (0.025 mm of "
-                        "interference all round), refused as parts that overlap, named a press fit the import "
-                        "does not take",
-}
+REFUSED: dict[str, str] = {}
 """The products the import refuses though they are sound, with why."""
 TOO_SLOW: dict[str, str] = {}
 """The products whose import is too slow for the suite (their closed-world test still runs), with why."""
@@ -109,6 +105,9 @@ UNSIMULATED: dict[str, str] = {}
     "nop_printed_box",
     "bosl2_screw_nut",
     "nop_pot_knob",
+    pytest.param("bdw_pillow_block", marks=_xfail("the bearing, pressed into its seat, gets no hole: its slice is "
+                                                  "its races and balls, no one outline, wider than the seat's loop; "
+                                                  "sizes.lp leaves it out")),
 ])
 def test_the_fit_relation_is_the_truth(corpus_import: Callable[[str], Imported], name: str) -> None:
     done = corpus_import(name)
@@ -300,6 +299,9 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
                                               "hex, which is narrower than it)")),
     pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
                                                  "cell has no screwing operation)")),
+    pytest.param("bdw_pillow_block", marks=_xfail(INSERTED + " pressed (the bearing into its seat: the cell has no "
+                                                  "pressing operation), or with a polygon section it is no prism of "
+                                                  "(the screws)")),
 ])
 def test_the_cell_inserts_every_part(corpus_import: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(corpus_import(name).out)).tables.manual
