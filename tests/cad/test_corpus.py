@@ -105,9 +105,7 @@ UNSIMULATED: dict[str, str] = {}
     "nop_printed_box",
     "bosl2_screw_nut",
     "nop_pot_knob",
-    pytest.param("bdw_pillow_block", marks=_xfail("the bearing, pressed into its seat, gets no hole: its slice is "
-                                                  "its races and balls, no one outline, wider than the seat's loop; "
-                                                  "sizes.lp leaves it out")),
+    "bdw_pillow_block",
 ])
 def test_the_fit_relation_is_the_truth(corpus_import: Callable[[str], Imported], name: str) -> None:
     done = corpus_import(name)
