@@ -28,6 +28,8 @@ import pytest
 import shapely
 import trimesh
 
+from asp.plans.assign import load_learned_facts, product_facts
+from asp.plans.plans import plans
 from assembly_constraints.corpus_truth import CorpusImport as Imported
 from assembly_constraints.corpus_truth import feature_holes as _feature_holes
 from assembly_constraints.corpus_truth import features_of, import_product
@@ -558,6 +560,22 @@ def test_a_modelled_thread_is_a_screwed_pair_with_the_truths_pitch_placed_by_han
     for pid in screwed:
         thread = done.truth["features"][done.truth["parts"][pid]["in"]]
         assert f"(a modelled thread, pitch {thread['pitch_mm']:.2f}" in manual[pid].reason, manual[pid].reason
+
+
+@pytest.mark.slow  # the first test of a product imports it
+def test_the_pressed_bearing_is_pressed_in_by_hand_and_every_plan_leaves_its_seat_to_it(
+        corpus_import: Callable[[str], Imported]) -> None:
+    # bdw_pillow_block: the bearing fits no hole (the truth's room -0.025 in its seat); placed
+    # by hand as pressed into that seat, it needs no hole, and no screw goes into the seat.
+    done = corpus_import("bdw_pillow_block")
+    bearing = load_geometry(str(done.out)).tables.manual["bearing"]
+    seat = _feature_holes(done)["seat"]
+    assert bearing.pressed and bearing.on == [seat] and "the cell has no pressing operation" in bearing.reason
+    facts = load_learned_facts([done.out / "sizes.lp", done.out / "geometric_precedence.lp"],
+                               product_facts(load_assembly(done.out)))
+    found = plans(facts, 0)
+    assert found and all({s.part: s.hole for s in plan.steps}["bearing"] is None
+                         and seat not in {s.hole for s in plan.steps} for plan in found)
 
 
 @pytest.mark.slow  # derives the product (6 s of wall time under load)
