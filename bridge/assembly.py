@@ -107,6 +107,9 @@ class Assembly:
     put it there: a part placed by hand goes to its goal in the CAD (``on`` of its
     ``[manual.<id>]``), and a part the cell places that carries its feature must be where
     the CAD has it (``held_by``)."""
+    pressed: frozenset[str] = frozenset()
+    """Of the parts placed by hand, those pressed into where the CAD has them (``pressed``
+    of their ``[manual.<id>]``): no fit as the cell slides parts, they need no hole."""
     cell_holes: frozenset[str] | None = None
     """The holes the simulated cell models (``[hole_shapes.*]`` of ``geometry.toml``), None
     without a ``geometry.toml``."""
@@ -229,6 +232,8 @@ def assembly_of(product: ProductDescription) -> Assembly:
     return Assembly(folder=product.folder, name=layout.name or product.folder.name, parts=parts, holes=holes,
                     size_model=None if layout.sizes is None else layout.sizes.model, manual=manual,
                     cad_holes=cad_holes, cell_holes=cell_holes, pins=pins, bores=bores,
+                    pressed=frozenset() if geometry is None else frozenset(
+                        mid for mid, m in geometry.manual.items() if m.pressed),
                     nominal_fits=frozenset() if geometry is None else frozenset(stated_nominal_fits(geometry)),
                     near_misses=frozenset() if geometry is None else frozenset(
                         (pid, hid) for shape in geometry.hole_shapes.values() for hid in shape.holes

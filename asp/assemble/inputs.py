@@ -82,7 +82,8 @@ def read_plan_json(path: Path, k: int) -> Plan:
 def check_facts_product(assembly: Assembly, facts: LearnedFacts, sources: str) -> None:
     """PlannerError naming ``sources`` when the facts are not of the product ``assembly``:
     other parts than those of its ``assembly.toml``, a hole it does not have, or a peg
-    about whose holes the facts say nothing (it would be placed without a hole)."""
+    about whose holes the facts say nothing (it would be placed without a hole; a peg
+    pressed in by hand is: ``plans/needs_hole.lp``)."""
     toml = assembly.file("assembly.toml")
     parts, known = set(facts.parts), set(assembly.part_ids)
     if parts != known:
@@ -96,7 +97,7 @@ def check_facts_product(assembly: Assembly, facts: LearnedFacts, sources: str) -
         raise PlannerError(f"{sources}: hole({unknown[0]}) is not a hole of the product in {toml} "
                            f"(holes: {' '.join(assembly.hole_ids) or '-'})")
     for part in assembly.parts:
-        if part.role == "peg" and part.id not in facts.needs_hole:
+        if part.role == "peg" and part.id not in facts.needs_hole and part.id not in assembly.pressed:
             raise PlannerError(f"{sources}: peg {part.id} of {toml} has no fits/2, no_fit/2 or needs_hole/1 "
                                "fact; expected the holes it fits")
 

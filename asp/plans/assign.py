@@ -103,7 +103,7 @@ class LearnedFacts:
 
 LEARNED_SIGNATURES = {"part": 1, "hole": 1, "fits": 2, "no_fit": 2, "needs_hole": 1,
                       "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2, "cad_hole": 2,
-                      "cell_before": 2}
+                      "cell_before": 2, "pressed": 1}
 """The predicates of learned facts the planner reads, with their arities (ids only)."""
 
 CELL_ORDER = "cell_order.lp"
@@ -160,10 +160,12 @@ def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     """What the product says about its holes beyond sizes: ``capacity(H,C)`` for a hole
     taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not the base,
     not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`),
+    ``pressed(P)`` for a part pressed in by hand (:attr:`bridge.assembly.Assembly.pressed`: it needs no hole),
     ``cad_hole(P,H)`` for a part held where the CAD has it (:attr:`bridge.assembly.Assembly.cad_holes`),
     and the cell's own orders ``cell_before(P,Q)`` of the product's ``cell_order.lp``
     (:data:`CELL_ORDER`: the fingers' grip of peg P needs it in before part Q)."""
     atoms = [fact("capacity", hole.id, hole.capacity) for hole in assembly.holes if hole.capacity > 1]
+    atoms += [fact("pressed", part) for part in sorted(assembly.pressed)]
     atoms += [fact("cad_hole", part, hole) for part, holes in sorted(assembly.cad_holes.items())
               for hole in sorted(holes)]
     if assembly.has_file(CELL_ORDER):

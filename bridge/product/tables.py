@@ -337,7 +337,9 @@ class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     ``on``: the holes and pins of ``assembly.toml`` it is in or on where the CAD has it
     (its goal), the plan gives it one of them; ``held_by``: the parts the cell places
     that carry one of those (a nut on a bolt's end), each with the holes it is in where
-    the CAD has it, the plan puts it into one of them (else the part would not be on it)."""
+    the CAD has it, the plan puts it into one of them (else the part would not be on it).
+    ``pressed``: it is pressed into what it is ``on`` (a press fit: no fit as the cell
+    slides parts), so a plan gives it no hole; the hand presses it to its goal."""
 
     reason: Text
     goal: Annotated[list[Coordinate], Meta(min_length=3, max_length=3,
@@ -348,6 +350,7 @@ class Manual(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     name: Text | None = None
     on: Ids | None = None
     held_by: dict[Id, Ids] = {}
+    pressed: bool = False
 
 
 class GeometryFile(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

@@ -244,22 +244,37 @@ def _maybe_in_place(derived: Derived, pid: str) -> set[str]:
     return set(derived.parts) - nx.descendants(order(derived), pid) - {pid}
 
 
-def screwed(derived: Derived) -> dict[str, str]:
-    """Part -> why it is placed by hand, for the parts of screwed pairs (a modelled thread,
-    :func:`executor.cad.fits.threads.screwed_pairs`): of each pair the part that leaves first in
-    the disassembly (both where they leave at one stage; never the base). The cell has no
-    screwing operation."""
+def _leaving_first(derived: Derived) -> dict[str, Slide]:
+    """Part -> the screwed pair (a thread, :func:`executor.cad.fits.threads.screwed_pairs`) or
+    press fit (:func:`executor.cad.fits.faces.press_fits`) of which it is the part that
+    leaves first in the disassembly (both where they leave at one stage; never the base)."""
     stage = {pid: k for k, parts in enumerate(derived.stages) for pid in parts}
-    found: dict[str, str] = {}
-    for slide in (s for s in derived.slides if s.pitch):
+    found: dict[str, Slide] = {}
+    for slide in (s for s in derived.slides if s.pitch or s.interference):
         pair = [pid for pid in (slide.shaft, slide.bore) if pid in stage]
         first = min((stage[pid] for pid in pair), default=None)
         for pid in (pid for pid in pair if stage[pid] == first):
-            other = slide.bore if pid == slide.shaft else slide.shaft
-            found.setdefault(pid, f"part '{pid}' is screwed {'into' if pid == slide.shaft else 'onto'} '{other}' "
-                                  f"along {opposite(derived.axis[pid])} ({slide.thread}, pitch "
-                                  f"{1000 * slide.pitch:.3f} mm): the cell has no screwing operation")
+            found.setdefault(pid, slide)
     return found
+
+
+def screwed(derived: Derived) -> dict[str, str]:
+    """Part -> why it is placed by hand, for the parts of screwed pairs and press fits that
+    leave first (:func:`_leaving_first`): the cell has no screwing operation, nor a pressing one."""
+    found: dict[str, str] = {}
+    for pid, slide in _leaving_first(derived).items():
+        other = slide.bore if pid == slide.shaft else slide.shaft
+        way = f"{'into' if pid == slide.shaft else 'onto'} '{other}' along {opposite(derived.axis[pid])}"
+        found[pid] = (f"part '{pid}' is pressed {way} (a press fit, {1000 * slide.interference:.3f} mm per side): "
+                      "the cell has no pressing operation" if slide.interference else
+                      f"part '{pid}' is screwed {way} ({slide.thread}, pitch {1000 * slide.pitch:.3f} mm): "
+                      "the cell has no screwing operation")
+    return found
+
+
+def pressed(derived: Derived) -> set[str]:
+    """The parts placed by hand for a press fit (:func:`screwed`): pressed in, no fit as the cell slides parts."""
+    return {pid for pid, slide in _leaving_first(derived).items() if slide.interference}
 
 
 def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tuple[Derived, dict[str, str]]:

@@ -22,7 +22,9 @@ stated units, and parts that overlap (intersection volume above :data:`OVERLAP_V
 leaving out what lies within a zero-clearance fit's tolerance of its two faces: coaxial
 cylinders of one nominal radius, each tessellated on its own, overlap by up to the larger
 deflection however coarse the tessellation; :func:`executor.cad.fits.faces.zero_clearance_fits`;
-the refusal names a press fit among them: :func:`executor.cad.fits.faces.press_fits`).
+and the annulus a thread or a pressed shaft is drawn into its hole's wall by, over the
+stretch the two share: :func:`executor.cad.fits.threads.screwed_pairs`,
+:func:`executor.cad.fits.threads.cosmetic_pairs`, :func:`executor.cad.fits.faces.press_fits`).
 """
 
 from __future__ import annotations
@@ -426,40 +428,32 @@ def _check_overlaps(parts: list[CadPart]) -> None:
                         faces[part.id] = fit_faces(part.mesh)
                 seated = [s for s in zero_clearance_fits({a.id: faces[a.id], b.id: faces[b.id]}) if s.seated]
                 volume = _beyond_fits(common, seated)
-            if volume > OVERLAP_VOLUME:  # a thread drawn overlapping its hole's wall: excused in its annulus
-                threads = (screwed_pairs({a.id: a.mesh, b.id: b.mesh})
-                           or cosmetic_pairs({a.id: faces[a.id], b.id: faces[b.id]}))
-                if threads:
-                    volume = _beyond_fits(_beyond_threads(common, threads), seated)
+            if volume > OVERLAP_VOLUME:  # a thread or a pressed shaft in its hole's wall: excused in its annulus
+                annuli = (screwed_pairs({a.id: a.mesh, b.id: b.mesh})
+                          or cosmetic_pairs({a.id: faces[a.id], b.id: faces[b.id]}))
+                annuli += press_fits({a.id: faces[a.id], b.id: faces[b.id]})
+                if annuli:
+                    volume = _beyond_fits(_beyond_annuli(common, annuli), seated)
             if volume > OVERLAP_VOLUME:
                 raise ExecutorError(f"{b.source}: parts '{a.id}' and '{b.id}' overlap by "
                                     f"{volume * 1e9:.4g} mm³ in the assembled pose (expected solids "
                                     "that at most touch, or coaxial cylinders of one radius within their "
-                                    "tessellations' deflection)" + lone_thread({a.id: a.mesh, b.id: b.mesh})
-                                    + _pressed(press_fits({a.id: faces[a.id], b.id: faces[b.id]})))
-
-
-def _pressed(pairs: list[Slide]) -> str:
-    """The refusal's words on the press fits among ``pairs`` (:func:`executor.cad.fits.faces.press_fits`),
-    "" when there is none."""
-    return "".join(f"; '{s.shaft}' is pressed into '{s.bore}': its d {2000 * s.face.radius:.3f} mm cylinder in a "
-                   f"d {2000 * s.hole.radius:.3f} mm bore ({1000 * (s.face.radius - s.hole.radius):.3f} mm per "
-                   "side), a press fit, which the import does not take (drawn at the bore's diameter, it is a "
-                   "zero-clearance fit)" for s in pairs)
+                                    "tessellations' deflection)" + lone_thread({a.id: a.mesh, b.id: b.mesh}))
 
 
 TUBE_SEGMENTS = 256
-"""Sides of the polygonal tube :func:`_beyond_threads` cuts a thread's annulus with."""
+"""Sides of the polygonal tube :func:`_beyond_annuli` cuts an annulus with."""
 
 
-def _beyond_threads(common: manifold3d.Manifold, threads: list[Slide]) -> manifold3d.Manifold:
-    """The intersection ``common`` of two parts less, for each screwed pair of ``threads``
-    (:func:`executor.cad.fits.threads.screwed_pairs`, :func:`executor.cad.fits.threads.cosmetic_pairs`),
-    the annulus about its axis from the hole's radius (less its deflection and
-    :data:`TOUCH`) out to the thread's major radius (plus its deflection and TOUCH, the
-    polygon's sides outside that circle) over the stretch both faces share (plus TOUCH at
-    each end): the screw's thread drawn into the hole's wall."""
-    for slide in threads:
+def _beyond_annuli(common: manifold3d.Manifold, pairs: list[Slide]) -> manifold3d.Manifold:
+    """The intersection ``common`` of two parts less, for each screwed pair or press fit of ``pairs``
+    (:func:`executor.cad.fits.threads.screwed_pairs`, :func:`executor.cad.fits.threads.cosmetic_pairs`,
+    :func:`executor.cad.fits.faces.press_fits`), the annulus about its axis from the hole's
+    radius (less its deflection and :data:`TOUCH`) out to the shaft's radius (a thread's
+    major; plus its deflection and TOUCH, the polygon's sides outside that circle) over the
+    stretch both faces share (plus TOUCH at each end): the screw's thread, or the pressed
+    shaft, drawn into the hole's wall."""
+    for slide in pairs:
         face, hole = slide.face, slide.hole
         span = hole.span if face.direction @ hole.direction > 0 else (-hole.span[1], -hole.span[0])
         low, high = max(face.span[0], span[0]) - TOUCH, min(face.span[1], span[1]) + TOUCH

@@ -101,6 +101,7 @@ from executor.cad.operations import (
     pin_level,
     plate_level,
     plate_top,
+    pressed,
     section_kind,
     section_pairs,
     tool_length,
@@ -899,6 +900,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   f'into = "{head.into}"', f'kind = "{head.section.kind}"', f"size = {_q(head.section.a)}",
                   f"length = {_q(head.length)}", f"mass = {_q(derived.parts[hid].mesh.volume * DENSITY)}",
                   f'skill = "{head.skill}"', *([_mesh_entry(meshes[hid])] if hid in meshes else []), ""]
+    pressed_in = pressed(derived)
     for mid, reason in sorted(mapped.manual.items()):
         lines += [f"[manual.{mid}]", f"name = {json.dumps(settings.names.get(mid, derived.parts[mid].name))}",
                   f"reason = {json.dumps(shorten(reason, MAX_REASON))}",
@@ -909,6 +911,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
         lines += [f"on = {json.dumps(on)}"] if on else []
         lines += [f"held_by = {{ {', '.join(f'{pid} = {json.dumps(holes)}' for pid, holes in held_by.items())} }}",
                   ] if held_by else []
+        lines += ["pressed = true"] if mid in pressed_in else []
         lines.append("")
     return "\n".join(lines)
 

@@ -27,6 +27,7 @@ from executor import ExecutorError
 from executor.cad import sections, sweep
 from executor.cad.derive import derive, ways
 from executor.cad.fits.faces import TOUCH, CylinderFace, cylinder_faces, fit_faces, zero_clearance_fits
+from executor.cad.operations import cell_view
 from executor.cad.parts import CadPart, check_parts, load_meshes, overlaps_checked
 from executor.cad.sweep import FRONT, _is_convex
 
@@ -573,26 +574,38 @@ def test_the_likeliest_deep_triangles_are_those_of_the_full_ranking() -> None:
     assert all(len(c) == sweep.LIKELY for c in chosen)
 
 
-def _pressed_ring(outside: float) -> list[CadPart]:
+def _pressed_ring(outside: float, sunk: float = 0.0) -> list[CadPart]:
     """A 50 x 30 x 10 mm block with a d 21.95 mm seat 7 mm deep and a ring (d 8.8 to
-    ``outside`` [mm], 7 mm tall) in it, as 40-gons: their deflections (34 µm at the seat)
-    above a press fit's 0.025 mm per side."""
+    ``outside`` [mm], 7 mm tall) in it, ``sunk`` [mm] into the seat's floor, as 40-gons:
+    their deflections (34 µm at the seat) above a press fit's 0.025 mm per side."""
     seat = trimesh.creation.cylinder(radius=10.975 * MM, height=8 * MM, sections=40)
     seat.apply_translation((0, 0, 7 * MM))
     block = trimesh.boolean.difference([_box((50, 30, 10), (0, 0, 5)), seat], engine="manifold")
     ring = trimesh.creation.annulus(r_min=4.4 * MM, r_max=outside / 2 * MM, height=7 * MM, sections=40)
-    ring.apply_translation((0, 0, 6.5 * MM))
+    ring.apply_translation((0, 0, (6.5 - sunk) * MM))
     return _parts(block=block, ring=ring)
 
 
-def test_a_ring_pressed_into_its_seat_is_refused_as_a_press_fit_not_taken_for_a_zero_clearance_fit() -> None:
-    # bd_warehouse's 608 in its PressFitHole (0.025 mm of interference): the overlap lies
-    # within the faces' tolerance (deflection plus 10 µm), and was excused as a seated fit.
-    with pytest.raises(ExecutorError, match=r"'ring' is pressed into 'block': its d 22\.000 mm cylinder in a "
-                                            r"d 21\.950 mm bore \(0\.025 mm per side\), a press fit"):
-        check_parts(_pressed_ring(22.0), "m")
+def test_a_ring_pressed_into_its_seat_is_imported_and_placed_by_hand() -> None:
+    # bd_warehouse's 608 in its PressFitHole (0.025 mm of interference): the overlap in the
+    # annulus between the two circles is excused, the pair is a press fit (no zero-clearance
+    # fit), the ring slides out along z and the cell places it by hand.
+    parts = _pressed_ring(22.0)
+    check_parts(parts, "m")
+    assert zero_clearance_fits({p.id: fit_faces(p.mesh) for p in parts}) == []
+    derived = derive(parts, "block", {})
+    [pair] = derived.slides
+    assert (pair.shaft, pair.bore, pair.interference * 1e3) == ("ring", "block", pytest.approx(0.025, abs=1e-4))
+    assert derived.axis == {"ring": "+z"}
+    assert cell_view(derived)[1]["ring"] == ("part 'ring' is pressed into 'block' along -z (a press fit, 0.025 mm "
+                                             "per side): the cell has no pressing operation")
+
+
+def test_a_pressed_ring_that_overlaps_beyond_its_annulus_is_refused() -> None:
+    # sunk 0.5 mm into the seat's floor: that overlap lies outside the press fit's annulus
+    with pytest.raises(ExecutorError, match=r"parts 'block' and 'ring' overlap by"):
+        check_parts(_pressed_ring(22.0, sunk=0.5), "m")
     check_parts(_pressed_ring(21.95), "m")  # drawn at the seat's diameter: a zero-clearance fit
-    assert zero_clearance_fits({p.id: fit_faces(p.mesh) for p in _pressed_ring(22.0)}) == []
 
 
 def test_a_rounded_rects_four_corners_are_no_cylinder_through_their_farthest_points() -> None:

@@ -14,7 +14,8 @@ import trimesh
 
 from executor import ExecutorError
 from executor.cad.derive import derive
-from executor.cad.fits.threads import cosmetic_thread, screwed_pairs
+from executor.cad.fits.faces import fit_faces, press_fits
+from executor.cad.fits.threads import cosmetic_pairs, cosmetic_thread, screwed_pairs
 from executor.cad.operations import cell_view
 from executor.cad.parts import CadPart, _check_overlaps, load_meshes
 from tests.conftest import Runner
@@ -152,13 +153,22 @@ def test_the_standard_threads_tap_drills(shaft: float, hole: float, thread: tupl
 
 
 @pytest.mark.parametrize(("shank", "hole", "sunk"), [
-    (16.0, 15.9, 0.0),  # a press fit: 0.1 mm, no thread's tap drill
     (17.0, 15.0, 0.0),  # d 15 is no tap drill of M17 (M17x1.5: 15.376 mm up) nor of a thread nearer
     (4.0, 3.3, 0.5),  # M4 in its tap drill, its head sunk 0.5 mm into the plate: outside the annulus
 ])
 def test_an_interference_that_is_no_cosmetic_thread_is_refused(shank: float, hole: float, sunk: float) -> None:
     with pytest.raises(ExecutorError, match="'plate' and 'screw' overlap by"):
         _check_overlaps(_cosmetic(shank, hole, sunk))
+
+
+def test_a_shank_wider_than_its_hole_by_no_tap_drill_is_a_press_fit_not_a_cosmetic_thread() -> None:
+    # d 16 in d 15.9: no thread's tap drill, 0.05 mm per side: pressed, its annulus excused
+    parts = _cosmetic(16.0, 15.9)
+    _check_overlaps(parts)
+    faces = {p.id: fit_faces(p.mesh) for p in parts}
+    assert cosmetic_pairs(faces) == []
+    [pressed] = press_fits(faces)
+    assert (pressed.shaft, pressed.bore, round(pressed.interference * 1e3, 3)) == ("screw", "plate", 0.05)
 
 
 @pytest.mark.parametrize(("shank", "hole", "name", "pitch"), [

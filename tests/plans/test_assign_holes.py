@@ -45,6 +45,11 @@ ASSIGN_CASES = [
     ("spare hole", "part(a). hole(h1;h2). fits(a,h2). no_fit(a,h1).", [{"assigned(a,h2)"}]),
     ("part fitting nothing is unsat", "part(a). hole(h). no_fit(a,h).", []),
     ("declared needs_hole without sizes is unsat", "part(a). hole(h). needs_hole(a).", []),
+    ("a part pressed in by hand needs no hole",
+     "part(a;b). hole(h1;h2). fits(a,h1). no_fit(a,h2). no_fit(b,h1). no_fit(b,h2). cad_hole(b,h2). pressed(b).",
+     [{"assigned(a,h1)"}]),
+    ("a part not pressed into a CAD hole it fits none of is unsat",
+     "part(a;b). hole(h1;h2). fits(a,h1). no_fit(a,h2). no_fit(b,h1). no_fit(b,h2). cad_hole(b,h2).", []),
     ("two parts one hole is unsat",
      "part(a;b). hole(h1;h2). fits(a,h1). fits(b,h1). no_fit(a,h2). no_fit(b,h2).", []),
 ]

@@ -102,7 +102,7 @@ from executor.cad.derive.precedence import bodies, forced, owner_pairs
 from executor.cad.derive.rays import first_hit
 from executor.cad.derive.swept import swept_fits
 from executor.cad.derive.ways import LEAVING, PREFERRED, disassembled, ways_in
-from executor.cad.fits.faces import zero_clearance_fits
+from executor.cad.fits.faces import press_fits, zero_clearance_fits
 from executor.cad.fits.threads import cosmetic_pairs, screwed_pairs
 from executor.cad.locating import LOCATING_REACH, consistent, locators, placing_pairs, support_pairs
 from executor.cad.parts import CadPart
@@ -126,7 +126,8 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
     result = Derived(base, by_id, reach=reach)
     made = surveys({p.id: p.mesh for p in parts})
     beside()
-    result.slides = zero_clearance_fits({pid: survey.faces for pid, survey in made.items()})
+    faces = {pid: survey.faces for pid, survey in made.items()}
+    result.slides = zero_clearance_fits(faces) + press_fits(faces)
     for slide in result.slides:
         result.directions.setdefault(axis_name(slide.direction), tuple(slide.direction))
         result.directions.setdefault(axis_name(-slide.direction), tuple(-slide.direction))

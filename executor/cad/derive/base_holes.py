@@ -121,9 +121,10 @@ def _level_within(part: CadPart, base: CadPart, axis: np.ndarray, lower: np.ndar
                   ) -> tuple[float, Loop] | None:
     """The level [m] (to 0.1 µm) in the middle of the part's depth inside the base along
     ``axis``, the base's extent taken over its vertices between ``lower`` and ``upper``
-    across the axis [m], and the part's one outline there; None when no vertex of the base
-    lies there, the part does not reach into that extent or its slice there is not one
-    outline."""
+    across the axis [m], and the part's one outline there (of several, the one around the
+    others: a bearing's outer race around its balls and inner race); None when no vertex of
+    the base lies there, the part does not reach into that extent or its slice there is no
+    outline around the others."""
     across = np.abs(axis) < 0.5
     inside = np.all((base.mesh.vertices[:, across] >= lower) & (base.mesh.vertices[:, across] <= upper), axis=1)
     if not np.any(inside):
@@ -135,7 +136,8 @@ def _level_within(part: CadPart, base: CadPart, axis: np.ndarray, lower: np.ndar
     level = round(float(low + high) / 2, 7)
     cut = slice_loops(part.mesh, axis, level)
     own = [loop for loop in cut if outer(loop, cut)]
-    return (level, own[0]) if len(own) == 1 else None
+    around = [loop for loop in own if all(o is loop or loop.contains(o.centre) for o in own)]
+    return (level, around[0]) if len(around) == 1 else None
 
 
 def _holds(base: CadPart, axis: np.ndarray, level: float, own: Loop) -> bool:

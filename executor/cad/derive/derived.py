@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from executor.cad.fits.faces import COARSEST, SMOOTH, CylinderFace, PrismFace, Slide
+from executor.cad.fits.faces import COARSEST, PRESS_FIT, SMOOTH, CylinderFace, PrismFace, Slide
 from executor.cad.parts import CadPart
 from executor.cad.sections import Shape2D
 from executor.cad.sweep import DIRECTIONS, axis_name
@@ -134,7 +134,7 @@ class Derived:
 
     def assumptions(self) -> list[str]:
         """The stated assumptions of the disassembly, as ``import`` prints them."""
-        fits = [s for s in self.slides if not s.pitch]
+        fits = [s for s in self.slides if not s.pitch and not s.interference]
         largest = max((s.tolerance for s in fits), default=0.0)
         return ["the support rule: a part resting on parts other than the base goes after them",
                 "zero-clearance fits: coaxial cylinders of one radius within the larger tessellation deflection "
@@ -152,7 +152,11 @@ class Derived:
                 "drill), or a plain cylinder in a plain coaxial hole, their diameters a standard thread's (ISO metric, "
                 "UNC, UNF) major and tap drill (a cosmetic thread), are screwed: they slide along that axis against "
                 "each other (the screw's thread taken in under the nut's minor radius; "
-                f"{sum(1 for s in self.slides if s.pitch)} pair(s) found)"]
+                f"{sum(1 for s in self.slides if s.pitch)} pair(s) found)",
+                "press fits: a shaft's cylinder coaxial with another part's bore and seated in it, its circle wider "
+                f"than the bore's by more than 10 µm and at most {100 * PRESS_FIT:g} % of its radius, slides along its "
+                "axis against it (the shaft's part taken in by the interference; placed by hand: the cell does not "
+                f"press; {sum(1 for s in self.slides if s.interference)} pair(s) found)"]
 
     def notes(self) -> list[str]:
         """What the report says beyond the axes and holes: the zero-clearance fits, each
@@ -162,11 +166,14 @@ class Derived:
                  f"lead {1000 * abs(s.lead):.3f} mm, {'right' if s.lead > 0 else 'left'}-handed about "
                  f"{axis_name(s.direction)}; slides along the axis against each other, the cell does not screw"
                  for s in self.slides if s.pitch]
+        lines += [f"press fit {s.shaft} in {s.bore}: {_face_size(s.face)} in {_face_size(s.hole)} along "
+                  f"{axis_name(s.direction)[1:]} ({1000 * s.interference:.3f} mm per side); slides along the axis "
+                  "against each other, the cell does not press" for s in self.slides if s.interference]
         lines += [(f"zero-clearance fit {s.shaft} in {s.bore}: " if s.seated else
                   f"zero-clearance passage {s.shaft} through {s.bore} (met only on a way along the axis): ")
                  + f"{_face_size(s.face)} along {axis_name(s.direction)[1:]}, "
                   f"overlap up to {1e6 * s.tolerance:.1f} µm across it taken as sliding"
-                  for s in self.slides if not s.pitch]
+                  for s in self.slides if not s.pitch and not s.interference]
         lines += [f"{a}->{b} blocks: of {a}'s ways out the base leaves, blocked by {detail}"
                   for (a, b), detail in sorted(self.detail.items())]
         lines += [f"supporting pair {y}->{x} dropped: the blocking needs {x} before {y}"

@@ -322,6 +322,7 @@ class Slide:
     pitch: float = 0.0
     lead: float = 0.0
     thread: str = ""
+    interference: float = 0.0
 
     @property
     def direction(self) -> np.ndarray:
@@ -367,7 +368,9 @@ def press_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
     The circles are those of the faces' corners, which both tessellations put on the
     drawn circles: they tell a press fit of 0.025 mm per side from a zero-clearance fit
     however coarse the tessellations (the faces' own overlap, up to the larger deflection,
-    is no interference)."""
+    is no interference). Each is a seated :class:`Slide` of that ``interference``, swept as
+    a zero-clearance fit: the shaft's cylinder taken in to under the bore's radius
+    (``thinner``: the interference, the bore's deflection, the axes' offset and :data:`TOUCH`)."""
     found: list[Slide] = []
     for shaft, outer in faces.items():
         for bore, inner in faces.items():
@@ -380,7 +383,9 @@ def press_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
                     apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
                     if (np.linalg.norm(np.cross(a.direction, b.direction)) <= 1e-4 and apart <= tolerance
                             and TOUCH < a.radius - b.radius <= PRESS_FIT * a.radius and _seated(a, b, tolerance)):
-                        found.append(Slide(shaft, bore, a, b, tolerance, 0.0, True))
+                        thinner = a.radius - b.radius + b.deflection + apart + TOUCH
+                        found.append(Slide(shaft, bore, a, b, tolerance, thinner, True,
+                                           interference=a.radius - b.radius))
     return found
 
 
@@ -431,6 +436,21 @@ def near(points: np.ndarray, face: CylinderFace | PrismFace,
     return near, along, radial
 
 
+def _pressed_band(along: np.ndarray, radial: np.ndarray, slide: Slide) -> np.ndarray:
+    """Which vertices of a press fit's shaft part (``along`` its axis and ``radial`` off
+    it [m], :func:`near`) its sweep takes in: those between the bore's inner circle (its
+    radius less its deflection and :data:`TOUCH`) and the shaft's outer one (its radius
+    plus its tolerance), over the stretch of the two faces together: the shaft's face and
+    the edge radii or chamfers that leave it wider than the bore, which would catch on the
+    bore's rim."""
+    face, hole = slide.face, slide.hole
+    span = hole.span if face.direction @ hole.direction > 0 else (-hole.span[1], -hole.span[0])
+    low, high = min(face.span[0], span[0]) - slide.tolerance, max(face.span[1], span[1]) + slide.tolerance
+    distance = np.linalg.norm(radial, axis=1)
+    return ((distance >= hole.radius - hole.deflection - TOUCH) & (distance <= face.radius + slide.tolerance)
+            & (along >= low) & (along <= high))
+
+
 def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide]) -> trimesh.Trimesh:
     """``mesh`` as swept along the axis of its zero-clearance fits: its vertices on each
     of ``shafts``' faces moved ``thinner`` towards the axis (a prism's scaled towards it so
@@ -441,6 +461,8 @@ def slid(mesh: trimesh.Trimesh, shafts: Iterable[Slide], bores: Iterable[Slide])
     mated = np.zeros(len(mesh.faces), dtype=bool)
     for slide, face in [*((s, s.face) for s in shafts), *((s, s.hole) for s in bores)]:
         on, along, radial = near(np.asarray(mesh.vertices), face, slide.tolerance)
+        if slide.interference and face is slide.face:
+            on = _pressed_band(along, radial, slide)
         mated |= np.all(on[mesh.faces], axis=1) & (np.abs(mesh.face_normals @ face.direction) < TILT)
         if face is slide.face:
             distance = np.linalg.norm(radial[on], axis=1)
