@@ -608,11 +608,14 @@ def _cut(layers: list[tuple[shapely.Polygon, float, float]],
             return None  # the parts are no partition of the section (one over its bore)
         tall = high - low >= MIN_THICKNESS
         inset = [shapely.buffer(part, -URDF_HULL_MARGIN) for part in parts]
-        within = [(_swept(part, low, high), 0.0) if inside is None else _hull_within(inside, part, low, high)
-                  for part in parts]
-        made = [piece for piece, _ in within]
-        thick = [piece is not None and (eroded(piece.vertices, URDF_HULL_MARGIN) is not None if inside is not None
-                                        else tall and not core.is_empty) for piece, core in zip(made, inset)]
+        if inside is None:  # a prism is swept only where it is thick enough to be kept (a gear's teeth are not)
+            thick = [tall and not core.is_empty for core in inset]
+            made = [_swept(part, low, high) if ok else None for ok, part in zip(thick, parts)]
+            within: list[tuple[trimesh.Trimesh | None, float]] = []
+        else:
+            within = [_hull_within(inside, part, low, high) for part in parts]
+            made = [piece for piece, _ in within]
+            thick = [piece is not None and eroded(piece.vertices, URDF_HULL_MARGIN) is not None for piece in made]
         if any(not ok and section.interiors and part.distance(bores) == 0 for ok, part in zip(thick, parts)):
             return None
         faces = [shapely.intersection(part.exterior, bores).length > _KEPT for part in parts]  # along the bore
