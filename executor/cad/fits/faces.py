@@ -26,7 +26,7 @@ twice :data:`TOUCH`.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -360,6 +360,23 @@ to be named a press fit (:func:`press_fits`; ISO 286's interference fits are som
 thousandths of the diameter): a wider one is no fit of the two."""
 
 
+def coaxial(outer: list[CylinderFace | PrismFace], inner: list[CylinderFace | PrismFace]
+            ) -> Iterator[tuple[CylinderFace, CylinderFace, float, float]]:
+    """Every outward cylinder ``a`` of ``outer`` and inward one ``b`` of ``inner`` (one
+    part's faces and another's), parallel (within 1e-4 rad) and coaxial within their
+    tolerance (the larger deflection plus :data:`TOUCH`): (a, b, that tolerance [m], their
+    axes' offset [m])."""
+    for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
+        for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
+            tolerance = max(a.deflection, b.deflection) + TOUCH
+            if np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4:
+                continue
+            offset = b.point - a.point
+            apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
+            if apart <= tolerance:
+                yield a, b, tolerance, apart
+
+
 def press_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
     """Every pair of an outward cylinder of one part and an inward one of another, parallel
     (within 1e-4 rad), coaxial within their tolerance (the larger deflection plus
@@ -376,16 +393,10 @@ def press_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> list[Slide]:
         for bore, inner in faces.items():
             if bore == shaft:
                 continue
-            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
-                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
-                    tolerance = max(a.deflection, b.deflection) + TOUCH
-                    offset = b.point - a.point
-                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
-                    if (np.linalg.norm(np.cross(a.direction, b.direction)) <= 1e-4 and apart <= tolerance
-                            and TOUCH < a.radius - b.radius <= PRESS_FIT * a.radius and _seated(a, b, tolerance)):
-                        thinner = a.radius - b.radius + b.deflection + apart + TOUCH
-                        found.append(Slide(shaft, bore, a, b, tolerance, thinner, True,
-                                           interference=a.radius - b.radius))
+            for a, b, tolerance, apart in coaxial(outer, inner):
+                if TOUCH < a.radius - b.radius <= PRESS_FIT * a.radius and _seated(a, b, tolerance):
+                    thinner = a.radius - b.radius + b.deflection + apart + TOUCH
+                    found.append(Slide(shaft, bore, a, b, tolerance, thinner, True, interference=a.radius - b.radius))
     return found
 
 
@@ -406,16 +417,8 @@ def zero_clearance_fits(faces: dict[str, list[CylinderFace | PrismFace]]) -> lis
                 for q in (f for f in inner if isinstance(f, PrismFace) and not f.outward):
                     if (prism := _prism_fit(p, q)) is not None:
                         found.append(replace(prism, shaft=shaft, bore=bore))
-            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
-                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
-                    tolerance = max(a.deflection, b.deflection) + TOUCH
-                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4
-                            or abs(a.radius - b.radius) > tolerance or a.radius - b.radius > TOUCH):
-                        continue
-                    offset = b.point - a.point
-                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
-                    if apart > tolerance:
-                        continue
+            for a, b, tolerance, apart in coaxial(outer, inner):
+                if abs(a.radius - b.radius) <= tolerance and a.radius - b.radius <= TOUCH:
                     thinner = max(0.0, a.radius - b.radius) + b.deflection + apart + TOUCH
                     found.append(Slide(shaft, bore, a, b, tolerance, thinner, _seated(a, b, tolerance)))
     return found

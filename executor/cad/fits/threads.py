@@ -21,7 +21,7 @@ from fractions import Fraction
 import numpy as np
 import trimesh
 
-from executor.cad.fits.faces import COARSEST, TOUCH, CylinderFace, PrismFace, Slide, _seated
+from executor.cad.fits.faces import COARSEST, TOUCH, CylinderFace, PrismFace, Slide, _seated, coaxial
 from executor.cad.sweep import axis_name
 
 THREAD_ANGLES = 8
@@ -431,19 +431,14 @@ def cosmetic_pairs(faces: dict[str, list[CylinderFace | PrismFace]],
         for bore, inner in faces.items():
             if bore == shaft or (asked is not None and frozenset((shaft, bore)) not in asked):
                 continue
-            for a in (f for f in outer if isinstance(f, CylinderFace) and f.outward):
-                for b in (f for f in inner if isinstance(f, CylinderFace) and not f.outward):
-                    slack = max(a.deflection, b.deflection) + TOUCH
-                    offset = b.point - a.point
-                    apart = float(np.linalg.norm(offset - a.direction * (offset @ a.direction)))
-                    if (np.linalg.norm(np.cross(a.direction, b.direction)) > 1e-4 or apart > slack
-                            or not _seated(a, b, TOUCH)):
-                        continue
-                    match = cosmetic_thread(2 * a.radius, 2 * b.radius, 2 * slack)
-                    if match is None:
-                        continue
-                    reach = a.radius - b.radius + b.deflection + apart + TOUCH
-                    found.append(Slide(shaft, bore, a, b, reach, reach + TOUCH, True, pitch=match[1], lead=match[1],
-                                       thread=f"a cosmetic thread, {match[0]}: d {2000 * a.radius:.4g} in its "
-                                              f"{2000 * b.radius:.4g} mm tap drill"))
+            for a, b, slack, apart in coaxial(outer, inner):
+                if not _seated(a, b, TOUCH):
+                    continue
+                match = cosmetic_thread(2 * a.radius, 2 * b.radius, 2 * slack)
+                if match is None:
+                    continue
+                reach = a.radius - b.radius + b.deflection + apart + TOUCH
+                found.append(Slide(shaft, bore, a, b, reach, reach + TOUCH, True, pitch=match[1], lead=match[1],
+                                   thread=f"a cosmetic thread, {match[0]}: d {2000 * a.radius:.4g} in its "
+                                          f"{2000 * b.radius:.4g} mm tap drill"))
     return found
