@@ -41,7 +41,7 @@ import msgspec
 import zenoh
 
 from asp import PlannerError
-from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts, product_facts
+from asp.plans.assign import UnsolvableAssembly, cell_orders, feasible_assignment, load_learned_facts, product_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import Demonstrations, demo_facts
 from asp.precedence.explore.learner import SUPPORTS
@@ -371,10 +371,10 @@ def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: 
 
 
 def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Demonstrations, prior: Path | None,
-             record: SessionFile, timeout_s: float) -> ExploredPrecedence:
+             record: SessionFile, timeout_s: float, cell_before: tuple[Pair, ...]) -> ExploredPrecedence:
     """``session --precedence explore``: precedence from ``demos``, the geometric ``prior``
-    (None: no CAD) and experiments at the first of ``cells``, its pegs in the holes of an
-    assignment of the sizes just learned (``learned``)."""
+    (None: no CAD) and experiments at the first of ``cells`` keeping its own orders
+    ``cell_before``, its pegs in the holes of an assignment of the sizes just learned (``learned``)."""
     if not cells:
         raise PlannerError("--precedence explore needs a cell (none is alive)")
     try:
@@ -384,7 +384,7 @@ def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Dem
                            f"with: {exc}") from None
     oracle = CellOracle(session, cells[0], assignment, seed=record.seed, timeout_s=timeout_s)
     explored = explore_precedence(demos, prior, oracle, run_id=f"{record.recording_id}.p",
-                                  journal=learned.parent / PRECEDENCE_JOURNAL)
+                                  journal=learned.parent / PRECEDENCE_JOURNAL, cell_before=cell_before)
     LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)",
              len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})", len(explored.trials),
              cells[0], explored.sim_s)
@@ -588,7 +588,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         if record.precedence == "explore":
             started_explore = time.perf_counter()
             explored = _explore(session, cell_ids or sorted(set(directory.alive()) & set(allowed or directory.alive())),
-                                learned, demos, prior, record, settings.timeout_s)
+                                learned, demos, prior, record, settings.timeout_s, cell_orders(assembly))
             relation = explored.learned.relation
             timings["precedence_s"] = time.perf_counter() - started_explore
             record.precedence_explored = explored.summary()
