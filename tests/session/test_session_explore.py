@@ -20,7 +20,9 @@ from asp.session.precedence import PRECEDENCE_JOURNAL, explore_precedence
 from bridge.assembly import load_assembly
 from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
 from tests.conftest import TRUTH_SESSION, Runner
+from tests.precedence.test_precedence_cell_order import CRANFIELD_ORDERS, breaks
 from tests.session import exact_cell
+from tests.session.test_session_resume import cranfield_copy
 
 
 def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
@@ -103,3 +105,28 @@ def test_sim_cell_session_explores_a_small_product_in_physics_with_the_layer_it_
     explored = json.loads((run / "session.json").read_text())["precedence_explored"]
     assert explored["experiments"] == 3 and explored["sim_s"] > 0.0  # bp<p1, bp<p2, bp<p3, each in physics
     assert (run / "experiments.lp").read_text().count(",1,unsupported).") == 3  # each peg fell: no plate
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(180)
+def test_truth_cell_session_keeps_the_cells_own_orders_and_reports_what_they_leave_undecided(
+        tmp_path: Path, root: Path, run_main: Runner) -> None:
+    """Cranfield with the six orders its import writes (the pegs before the front plate and
+    the square ones before the spacer, all true precedence) and p2 before p1 (free in the
+    product): no experiment breaks one, every true pair is learned, and p2<p1, which the cell
+    can show only by p1 going in without p2 (never p2 after it), is reported undecidable by
+    the cell and kept, not taken for a process constraint."""
+    orders = (*CRANFIELD_ORDERS, ("p2", "p1"))
+    product, run = cranfield_copy(root, tmp_path / "product"), tmp_path / "run"
+    (product / "cell_order.lp").write_text("".join(f"cell_before({p},{q}).\n" for p, q in orders))
+    done = run_main(*TRUTH_SESSION, "--precedence", "explore", "--assembly", str(product), "--out", str(run),
+                    timeout=150)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["matches_truth"] is True  # every true pair learned, the sizes equal
+    trials = load_trials(run / "experiments.lp", true_relation(load_assembly(str(product))).parts)
+    assert trials and not [t.experiment.id for t in trials if breaks([s.part for s in t.experiment.sequence], orders)]
+    explored = json.loads((run / "session.json").read_text())["precedence_explored"]
+    assert explored["process"] == [["p3", "p4"]]
+    assert any(line.startswith("undecidable by this cell: p2<p1: p1 went in without p2")
+               for line in explored["rests_on"])
+    assert ("p2", "p1") in load_learned_facts([run / "learned.lp"]).must_precede
