@@ -183,6 +183,32 @@ def _placed_by_hand(assembly: Assembly, backend: str, truth: TruthOracle | None,
             if assembly.tried_by_hand(part, hole, backend) and (part, hole) not in known]
 
 
+def _against_cell_orders(assembly: Assembly, pairs: list[Pair], truth: TruthOracle | None,
+                         decided: list[tuple[Pair, Result]]) -> tuple[list[tuple[Pair, Result]], str | None]:
+    """The pairs (of ``pairs``, the sizes' domain) whose trial would break one of the cell's
+    own orders (``cell_order.lp``: the part tried goes in after a part standing in the
+    trial's scene that the cell puts in after it, :meth:`bridge.assembly.Assembly.in_trial`),
+    except those ``decided`` already,
+    with their outcomes from the product's ``sizes.lp`` and the line a run prints for them
+    (None without such a pair); PlannerError when there is such a pair and no ``sizes.lp``."""
+    orders = set(cell_orders(assembly))
+    known = {pair for pair, _ in decided}
+    against = {(part, hole): sorted(q for q in assembly.in_trial(part, hole) if (part, q) in orders)
+               for part, hole in pairs if (part, hole) not in known}
+    against = {pair: stand for pair, stand in against.items() if stand}
+    if not against:
+        return [], None
+    shown = " ".join(f"{p}->{h} ({' '.join(stand)} in place)" for (p, h), stand in sorted(against.items())[:8])
+    if truth is None:
+        raise PlannerError(f"{assembly.folder / 'cell_order.lp'}: the trials {shown} would break the cell's own "
+                           "orders, and there is no sizes.lp to take their outcomes from")
+    taken: list[tuple[Pair, Result]] = [(pair, "fit" if pair in truth.fits else "no_fit") for pair in sorted(against)]
+    fits = sum(result == "fit" for _, result in taken)
+    return taken, (f"{len(taken)} pairs whose trial would stand a part the cell puts in after the one tried (the "
+                   f"cell's own orders, cell_order.lp: {shown}{' ...' if len(taken) > 8 else ''}) are taken from "
+                   f"{assembly.folder / 'sizes.lp'} (the nominal sections, {fits} fit), not observed")
+
+
 def _by_hand_statement(assembly: Assembly, backend: str, by_hand: list[tuple[Pair, Result]]) -> str:
     """The line a run prints (and ``learned.lp`` keeps) for the pairs it takes from
     ``sizes.lp`` because no cell of ``backend`` can try them."""
@@ -495,13 +521,16 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         kind=record.size_prior, tolerance_m=record.tolerance_m, pairs=len(parts) * len(holes),
         decided=[(p, h, result) for (p, h), result in decided])
     by_hand = _placed_by_hand(assembly, settings.backend, truth, decided)
-    decided = [*decided, *by_hand]
-    record.not_observed = [(part, hole, result) for (part, hole), result in by_hand]
-    not_observed = [pair for pair, _ in by_hand]
+    against_orders, orders_statement = _against_cell_orders(
+        assembly, [(part, hole) for part in parts for hole in holes], truth, [*decided, *by_hand])
+    decided = [*decided, *by_hand, *against_orders]
+    record.not_observed = [(part, hole, result) for (part, hole), result in (*by_hand, *against_orders)]
+    not_observed = [pair for pair, _ in (*by_hand, *against_orders)]
     record.nominal_fits = _nominal_fits(assembly, settings.backend, parts, holes)
     stated_prior = "; ".join(statement for statement in (
         None if record.prior is None else prior_statement(record.prior),
         None if not by_hand else _by_hand_statement(assembly, settings.backend, by_hand),
+        orders_statement,
         _near_miss_statement(assembly, settings.backend, by_hand),
         None if record.nominal_fits is None else _nominal_statement(record.nominal_fits))
         if statement is not None) or None

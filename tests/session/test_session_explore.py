@@ -6,6 +6,7 @@ exploration runs no journaled experiment again."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -17,6 +18,8 @@ from asp.precedence.explore.oracle import TruthOracle
 from asp.precedence.explore.trials import load_trials
 from asp.precedence.relation import Relation, true_relation
 from asp.session.precedence import PRECEDENCE_JOURNAL, explore_precedence
+from asp.session.run import _against_cell_orders
+from asp.sizes.truth_oracle import TruthOracle as SizesTruth
 from bridge.assembly import load_assembly
 from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
 from tests.conftest import TRUTH_SESSION, Runner
@@ -130,3 +133,20 @@ def test_truth_cell_session_keeps_the_cells_own_orders_and_reports_what_they_lea
     assert any(line.startswith("undecidable by this cell: p2<p1: p1 went in without p2")
                for line in explored["rests_on"])
     assert ("p2", "p1") in load_learned_facts([run / "learned.lp"]).must_precede
+
+
+def test_a_size_trial_that_would_break_a_cells_order_is_taken_from_sizes_lp(tmp_path: Path, root: Path) -> None:
+    """A trial stands the owner of the pin it tries at its goal (``Scene.feature``): were s1
+    a pin of the spacer, p3's trial onto it would put p3 in after sp, against the order
+    p3 before sp; that pair is no experiment, its outcome the CAD's, stated."""
+    product = cranfield_copy(root, tmp_path / "product")
+    (product / "cell_order.lp").write_text("cell_before(p3,sp).\n")
+    assembly = replace(load_assembly(str(product)), hole_owners={"s1": "sp"})
+    truth = SizesTruth.from_assembly(str(product))
+    pairs = [(p, h) for p in truth.parts for h in truth.holes]
+    taken, statement = _against_cell_orders(assembly, pairs, truth, [])
+    assert taken == [(("p3", "s1"), "fit")]
+    assert statement is not None and "1 pairs whose trial would stand a part the cell puts in after the one tried" \
+        in statement and "p3->s1 (sp in place)" in statement
+    assert _against_cell_orders(assembly, pairs, truth, [(("p3", "s1"), "fit")]) == ([], None)  # decided already
+    assert _against_cell_orders(replace(assembly, hole_owners={}), pairs, truth, []) == ([], None)
