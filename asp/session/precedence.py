@@ -131,9 +131,11 @@ class ExploredPrecedence:
 
     def summary(self) -> dict[str, Any]:
         """What ``session.json`` keeps: ``experiments``, ``sim_s`` and ``wall_s`` [s], ``rests_on``
-        (the learner's summary lines: the pairs by support), ``process`` (pairs)."""
+        (the learner's summary lines: the pairs by support), ``process`` (pairs), ``undecidable``
+        (``[a, b, why]``: the pairs the cell's own orders leave undecidable)."""
         return {"experiments": len(self.trials), "sim_s": round(self.sim_s, 3), "wall_s": round(self.wall_s, 3),
-                "rests_on": self.learned.summary().splitlines(), "process": [list(p) for p in self.learned.process]}
+                "rests_on": self.learned.summary().splitlines(), "process": [list(p) for p in self.learned.process],
+                "undecidable": [[a, b, why] for (a, b), why in self.learned.cell_undecided]}
 
 
 def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOracle,

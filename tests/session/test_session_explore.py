@@ -130,6 +130,7 @@ def test_truth_cell_session_keeps_the_cells_own_orders_and_reports_what_they_lea
     assert trials and not [t.experiment.id for t in trials if breaks([s.part for s in t.experiment.sequence], orders)]
     explored = json.loads((run / "session.json").read_text())["precedence_explored"]
     assert explored["process"] == [["p3", "p4"]]
+    assert [pair[:2] for pair in explored["undecidable"]] == [["bp", "p1"], ["p2", "fp"], ["p2", "p1"]]
     assert any(line.startswith("undecidable by this cell: p2<p1: p1 went in without p2")
                for line in explored["rests_on"])
     assert ("p2", "p1") in load_learned_facts([run / "learned.lp"]).must_precede
