@@ -140,6 +140,18 @@ class Assembly:
     its own mesh; ``widened`` of the feature: :func:`bridge.product.nominal.widened_fits`):
     pair -> the CAD's room per side [m]."""
 
+    hole_owners: dict[str, str] = field(default_factory=dict)
+    """Hole -> the part whose pin it is (``owner`` of its ``[hole_shapes.*]``): a pin not on the base."""
+    pins_of: dict[str, frozenset[str]] = field(default_factory=dict)
+    """Part -> the parts placed by hand whose pins it goes onto besides (``pins_of`` of its ``[part_shapes.*]``)."""
+
+    def in_trial(self, part: str, hole: str) -> frozenset[str]:
+        """The parts other than the base that stand at their goals in the scene of a trial of
+        ``part`` into ``hole`` (:meth:`executor.world.scene.Scene.feature`): the hole's owner
+        and the parts whose pins ``part`` goes onto besides; the cell puts ``part`` in after them."""
+        owner = self.hole_owners.get(hole)
+        return self.pins_of.get(part, frozenset()) | (frozenset() if owner is None else frozenset({owner}))
+
     def tried_by_hand(self, part: str, hole: str, backend: str) -> bool:
         """Whether no cell of ``backend`` (``sim``, ``truth``, ``franka`` or a plugin's
         ``MODULE:CLASS``) can try ``part`` in ``hole``: the part is placed by hand, the
@@ -241,7 +253,13 @@ def assembly_of(product: ProductDescription) -> Assembly:
                     base_center=None if geometry is None else (geometry.plate.base_center[0],
                                                                geometry.plate.base_center[1]),
                     nominal_modelled=geometry is not None and models_nominal_fits(geometry),
-                    widened={} if geometry is None else widened_fits(geometry))
+                    widened={} if geometry is None else widened_fits(geometry),
+                    hole_owners={} if geometry is None else {
+                        hid: shape.owner for shape in geometry.hole_shapes.values() if shape.owner is not None
+                        for hid in shape.holes},
+                    pins_of={} if geometry is None else {
+                        pid: frozenset(shape.pins_of) for shape in geometry.part_shapes.values() if shape.pins_of
+                        for pid in shape.parts})
 
 
 def load_assembly(name_or_path: str) -> Assembly:

@@ -40,7 +40,7 @@ from pathlib import Path
 import clingo
 
 from asp import MAX_IDS, PlannerError
-from asp.precedence.relation import closed_precedence
+from asp.precedence.relation import Pair, closed_precedence
 from asp.solve import atoms_by_name, check_facts, fact, load_atoms, pairs_by_name, solve
 from bridge.assembly import Assembly
 from bridge.inputs import shorten
@@ -156,6 +156,22 @@ def _capacities(atoms: Sequence[clingo.Symbol], holes: set[str], sources: str) -
     return capacity
 
 
+def cell_orders(assembly: Assembly) -> tuple[Pair, ...]:
+    """The cell's own orders ``cell_before(P,Q)`` of the product's :data:`CELL_ORDER` (the
+    fingers' grip of peg P needs it in before part Q), sorted; () without the file.
+    PlannerError naming the file for an order of an id that is no part of the assembly."""
+    if not assembly.has_file(CELL_ORDER):
+        return ()
+    path = assembly.file(CELL_ORDER)
+    orders = pairs_by_name(load_atoms([path]), "cell_before")
+    parts = set(assembly.part_ids)
+    for first, then in orders:
+        if first not in parts or then not in parts:
+            raise PlannerError(f"{path}: cell_before({first},{then}): expected two parts of the assembly "
+                               f"({' '.join(assembly.part_ids)})")
+    return tuple(orders)
+
+
 def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     """What the product says about its holes beyond sizes: ``capacity(H,C)`` for a hole
     taking C > 1 parts, ``out_of_reach(P,H)`` for a part the cell inserts (not the base,
@@ -168,8 +184,7 @@ def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     atoms += [fact("pressed", part) for part in sorted(assembly.pressed)]
     atoms += [fact("cad_hole", part, hole) for part, holes in sorted(assembly.cad_holes.items())
               for hole in sorted(holes)]
-    if assembly.has_file(CELL_ORDER):
-        atoms += [atom for atom in load_atoms([assembly.file(CELL_ORDER)]) if atom.match("cell_before", 2)]
+    atoms += [fact("cell_before", first, then) for first, then in cell_orders(assembly)]
     inserted = [part.id for part in assembly.parts if part.role != "base" and part.id not in assembly.manual]
     return atoms + [fact("out_of_reach", part, hole) for part in inserted
                     for hole in assembly.hole_ids if assembly.cell_cannot_insert(part, hole)]

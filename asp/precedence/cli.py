@@ -54,7 +54,8 @@ def _parser() -> argparse.ArgumentParser:
     learn = commands.add_parser("learn", help="learn the must-precede relation from demonstrations (Algorithm 1)")
     learn.add_argument("demos", nargs="?",
                        help="demonstrations file (text, or demo/3 facts *.lp); default: the assembly's demos.txt")
-    add_assembly_argument(learn, None, purpose="gives the parts and the default demonstrations")
+    add_assembly_argument(learn, None, purpose="gives the parts, the default demonstrations and, with "
+                          "--experiments, the cell's own orders (cell_order.lp)")
     learn.add_argument("--out", type=nonempty_path,
                        help="write part/1, must_precede/2, precedence_edge/2 facts to this .lp file")
     learn.add_argument("--dot", type=nonempty_path, help="write the transitive-reduction graph as Graphviz DOT")
@@ -108,7 +109,8 @@ def _parser() -> argparse.ArgumentParser:
                                                   "experiments chosen by ASP (answered from the assembly's "
                                                   "precedence.lp)")
     explore.add_argument("demos", nargs="?", help="demonstrations file; default: the assembly's demos.txt")
-    add_assembly_argument(explore, None, required=True, purpose="gives the parts and the truth oracle's relation")
+    add_assembly_argument(explore, None, required=True, purpose="gives the parts, the truth oracle's relation "
+                          "and the cell's own orders (cell_order.lp)")
     explore.add_argument("--prior", metavar="FILE", help="the geometric precedence (geometric_precedence.lp)")
     explore.add_argument("--policy", choices=("informative", "first"), default="informative",
                          help="informative: the experiment deciding the most pairs whatever its outcome (default); "
@@ -200,9 +202,10 @@ def _learn(args: argparse.Namespace) -> None:
 
 
 def _evidence(demos: Demonstrations, prior: Relation | None, prior_file: str | None,
-              experiments: str | None = None) -> Evidence:
+              experiments: str | None = None, assembly: str | None = None) -> Evidence:
     """The three sources: demonstrations, the geometric prior (and its file) and the
-    experiments file, if any."""
+    experiments file, if any; with the cell's own orders of ``assembly`` (its ``cell_order.lp``)."""
+    from asp.plans.assign import cell_orders
     from asp.precedence.explore.knowledge import Evidence
     from asp.precedence.explore.learner import geometric_reasons
     from asp.precedence.explore.trials import load_trials
@@ -210,7 +213,7 @@ def _evidence(demos: Demonstrations, prior: Relation | None, prior_file: str | N
     geometry = tuple(prior.pairs()) if prior is not None else ()
     trials = load_trials(experiments, demos.parts) if experiments else ()
     return Evidence(demos, geometry, prior_file or "the geometric precedence", geometric_reasons(prior_file),
-                    trials)
+                    trials, () if assembly is None else cell_orders(load_assembly(assembly)))
 
 
 def _report(learned: Learned, out: Path | None) -> None:
@@ -227,7 +230,7 @@ def _learn_sources(args: argparse.Namespace, demos: Demonstrations, prior: Relat
 
     if args.json or args.dot or args.png or args.evidence or args.min_support != 1:
         raise PlannerError("--experiments: expected none of --json, --dot, --png, --evidence, --min-support")
-    _report(learn_sources(_evidence(demos, prior, args.prior, args.experiments)), args.out)
+    _report(learn_sources(_evidence(demos, prior, args.prior, args.experiments, args.assembly)), args.out)
 
 
 def _explore(args: argparse.Namespace) -> None:
@@ -243,7 +246,7 @@ def _explore(args: argparse.Namespace) -> None:
     assembly = load_assembly(args.assembly)
     prior = load_relation([args.prior], data=True) if args.prior else None
     demos = load_demos(args.demos or assembly.file("demos.txt"), assembly.part_ids, assembly.hole_ids)
-    evidence = _evidence(demos, prior, args.prior)
+    evidence = _evidence(demos, prior, args.prior, assembly=args.assembly)
     oracle = TruthOracle(true_relation(assembly))
     for _knowledge, trial in explore(evidence, oracle, args.policy, limit=args.limit):
         evidence = evidence.with_trial(trial)

@@ -36,7 +36,7 @@ from asp.precedence.explore.knowledge import Evidence, Trial
 from asp.precedence.explore.learner import Learned, geometric_reasons, learn_sources
 from asp.precedence.explore.select import explore
 from asp.precedence.explore.trials import load_trials, write_trials
-from asp.precedence.relation import Relation, load_relation
+from asp.precedence.relation import Pair, Relation, load_relation
 from bridge import BridgeError
 from bridge.client import CellRefused, CellTimeout, request_experiment
 from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment, PrecedenceOutcome
@@ -131,24 +131,28 @@ class ExploredPrecedence:
 
     def summary(self) -> dict[str, Any]:
         """What ``session.json`` keeps: ``experiments``, ``sim_s`` and ``wall_s`` [s], ``rests_on``
-        (the learner's summary lines: the pairs by support), ``process`` (pairs)."""
+        (the learner's summary lines: the pairs by support), ``process`` (pairs), ``undecidable``
+        (``[a, b, why]``: the pairs the cell's own orders leave undecidable)."""
         return {"experiments": len(self.trials), "sim_s": round(self.sim_s, 3), "wall_s": round(self.wall_s, 3),
-                "rests_on": self.learned.summary().splitlines(), "process": [list(p) for p in self.learned.process]}
+                "rests_on": self.learned.summary().splitlines(), "process": [list(p) for p in self.learned.process],
+                "undecidable": [[a, b, why] for (a, b), why in self.learned.cell_undecided]}
 
 
 def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOracle,
                        policy: str = "informative", run_id: str = "explore",
-                       journal: Path | None = None) -> ExploredPrecedence:
+                       journal: Path | None = None, cell_before: tuple[Pair, ...] = ()) -> ExploredPrecedence:
     """Learn the must-precede relation from ``demos``, the geometric precedence in ``prior``
     (None: no CAD) and the experiments the ASP ``policy`` chooses, run by ``oracle``
-    (:func:`asp.precedence.explore.select.explore`) until no pair is open; PlannerError when
-    one is left open, PrecedenceConflict where the sources disagree. ``journal`` (a
+    (:func:`asp.precedence.explore.select.explore`), every one keeping the cell's own orders
+    ``cell_before`` (the product's ``cell_order.lp``), until no pair is open but those these
+    orders leave undecidable (reported, :attr:`asp.precedence.explore.learner.Learned.cell_undecided`);
+    PlannerError when another is left open, PrecedenceConflict where the sources disagree. ``journal`` (a
     :data:`PRECEDENCE_JOURNAL`): the experiments it holds are evidence and never run again
     (a resumed session), and every new one is written there before it is learned from;
     ``sim_s`` and ``wall_s`` count this call's experiments only."""
     geometry = () if prior is None else tuple(load_relation([prior], data=True).pairs())
     evidence = Evidence(demos, geometry, str(prior or "the geometric precedence"),
-                        geometric_reasons(None if prior is None else str(prior)))
+                        geometric_reasons(None if prior is None else str(prior)), cell_before=cell_before)
     if journal is not None and journal.is_file():
         for trial in load_trials(journal, demos.parts):
             evidence = evidence.with_trial(trial)
@@ -160,7 +164,8 @@ def explore_precedence(demos: Demonstrations, prior: Path | None, oracle: CellOr
             write_trials(journal, (*evidence.trials, trial))
         evidence = evidence.with_trial(trial)
     learned = learn_sources(evidence)
-    if learned.knowledge.open:
-        raise PlannerError(f"precedence exploration ended with {len(learned.knowledge.open)} pair(s) open: "
-                           f"{' '.join(f'{a}<{b}' for a, b in sorted(learned.knowledge.open))}")
+    left = learned.knowledge.open - {pair for pair, _ in learned.cell_undecided}
+    if left:
+        raise PlannerError(f"precedence exploration ended with {len(left)} pair(s) open: "
+                           f"{' '.join(f'{a}<{b}' for a, b in sorted(left))}")
     return ExploredPrecedence(learned, evidence.trials, oracle.sim_s, oracle.wall_s)

@@ -41,7 +41,7 @@ import msgspec
 import zenoh
 
 from asp import PlannerError
-from asp.plans.assign import UnsolvableAssembly, feasible_assignment, load_learned_facts, product_facts
+from asp.plans.assign import UnsolvableAssembly, cell_orders, feasible_assignment, load_learned_facts, product_facts
 from asp.plans.plans import Plan, check_plan, plans
 from asp.precedence.demos import Demonstrations, demo_facts
 from asp.precedence.explore.learner import SUPPORTS
@@ -181,6 +181,32 @@ def _placed_by_hand(assembly: Assembly, backend: str, truth: TruthOracle | None,
     return [((part, hole), "fit" if (part, hole) in truth.fits else "no_fit")
             for part in truth.parts for hole in truth.holes
             if assembly.tried_by_hand(part, hole, backend) and (part, hole) not in known]
+
+
+def _against_cell_orders(assembly: Assembly, pairs: list[Pair], truth: TruthOracle | None,
+                         decided: list[tuple[Pair, Result]]) -> tuple[list[tuple[Pair, Result]], str | None]:
+    """The pairs (of ``pairs``, the sizes' domain) whose trial would break one of the cell's
+    own orders (``cell_order.lp``: the part tried goes in after a part standing in the
+    trial's scene that the cell puts in after it, :meth:`bridge.assembly.Assembly.in_trial`),
+    except those ``decided`` already,
+    with their outcomes from the product's ``sizes.lp`` and the line a run prints for them
+    (None without such a pair); PlannerError when there is such a pair and no ``sizes.lp``."""
+    orders = set(cell_orders(assembly))
+    known = {pair for pair, _ in decided}
+    against = {(part, hole): sorted(q for q in assembly.in_trial(part, hole) if (part, q) in orders)
+               for part, hole in pairs if (part, hole) not in known}
+    against = {pair: stand for pair, stand in against.items() if stand}
+    if not against:
+        return [], None
+    shown = " ".join(f"{p}->{h} ({' '.join(stand)} in place)" for (p, h), stand in sorted(against.items())[:8])
+    if truth is None:
+        raise PlannerError(f"{assembly.folder / 'cell_order.lp'}: the trials {shown} would break the cell's own "
+                           "orders, and there is no sizes.lp to take their outcomes from")
+    taken: list[tuple[Pair, Result]] = [(pair, "fit" if pair in truth.fits else "no_fit") for pair in sorted(against)]
+    fits = sum(result == "fit" for _, result in taken)
+    return taken, (f"{len(taken)} pairs whose trial would stand a part the cell puts in after the one tried (the "
+                   f"cell's own orders, cell_order.lp: {shown}{' ...' if len(taken) > 8 else ''}) are taken from "
+                   f"{assembly.folder / 'sizes.lp'} (the nominal sections, {fits} fit), not observed")
 
 
 def _by_hand_statement(assembly: Assembly, backend: str, by_hand: list[tuple[Pair, Result]]) -> str:
@@ -371,10 +397,10 @@ def _assemble(session: zenoh.Session, cell_ids: list[str], learned: Path, plan: 
 
 
 def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Demonstrations, prior: Path | None,
-             record: SessionFile, timeout_s: float) -> ExploredPrecedence:
+             record: SessionFile, timeout_s: float, cell_before: tuple[Pair, ...]) -> ExploredPrecedence:
     """``session --precedence explore``: precedence from ``demos``, the geometric ``prior``
-    (None: no CAD) and experiments at the first of ``cells``, its pegs in the holes of an
-    assignment of the sizes just learned (``learned``)."""
+    (None: no CAD) and experiments at the first of ``cells`` keeping its own orders
+    ``cell_before``, its pegs in the holes of an assignment of the sizes just learned (``learned``)."""
     if not cells:
         raise PlannerError("--precedence explore needs a cell (none is alive)")
     try:
@@ -384,7 +410,7 @@ def _explore(session: zenoh.Session, cells: list[str], learned: Path, demos: Dem
                            f"with: {exc}") from None
     oracle = CellOracle(session, cells[0], assignment, seed=record.seed, timeout_s=timeout_s)
     explored = explore_precedence(demos, prior, oracle, run_id=f"{record.recording_id}.p",
-                                  journal=learned.parent / PRECEDENCE_JOURNAL)
+                                  journal=learned.parent / PRECEDENCE_JOURNAL, cell_before=cell_before)
     LOG.info("precedence by exploration: %d demonstration(s), %s, %d experiment(s) at %s (%.1f s simulated)",
              len(demos.sequences), "no CAD" if prior is None else f"the CAD ({prior})", len(explored.trials),
              cells[0], explored.sim_s)
@@ -495,13 +521,16 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         kind=record.size_prior, tolerance_m=record.tolerance_m, pairs=len(parts) * len(holes),
         decided=[(p, h, result) for (p, h), result in decided])
     by_hand = _placed_by_hand(assembly, settings.backend, truth, decided)
-    decided = [*decided, *by_hand]
-    record.not_observed = [(part, hole, result) for (part, hole), result in by_hand]
-    not_observed = [pair for pair, _ in by_hand]
+    against_orders, orders_statement = _against_cell_orders(
+        assembly, [(part, hole) for part in parts for hole in holes], truth, [*decided, *by_hand])
+    decided = [*decided, *by_hand, *against_orders]
+    record.not_observed = [(part, hole, result) for (part, hole), result in (*by_hand, *against_orders)]
+    not_observed = [pair for pair, _ in (*by_hand, *against_orders)]
     record.nominal_fits = _nominal_fits(assembly, settings.backend, parts, holes)
     stated_prior = "; ".join(statement for statement in (
         None if record.prior is None else prior_statement(record.prior),
         None if not by_hand else _by_hand_statement(assembly, settings.backend, by_hand),
+        orders_statement,
         _near_miss_statement(assembly, settings.backend, by_hand),
         None if record.nominal_fits is None else _nominal_statement(record.nominal_fits))
         if statement is not None) or None
@@ -588,7 +617,7 @@ def _run_locked(settings: SessionSettings, run: Path, record: SessionFile, start
         if record.precedence == "explore":
             started_explore = time.perf_counter()
             explored = _explore(session, cell_ids or sorted(set(directory.alive()) & set(allowed or directory.alive())),
-                                learned, demos, prior, record, settings.timeout_s)
+                                learned, demos, prior, record, settings.timeout_s, cell_orders(assembly))
             relation = explored.learned.relation
             timings["precedence_s"] = time.perf_counter() - started_explore
             record.precedence_explored = explored.summary()

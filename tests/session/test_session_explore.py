@@ -6,6 +6,7 @@ exploration runs no journaled experiment again."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -17,10 +18,14 @@ from asp.precedence.explore.oracle import TruthOracle
 from asp.precedence.explore.trials import load_trials
 from asp.precedence.relation import Relation, true_relation
 from asp.session.precedence import PRECEDENCE_JOURNAL, explore_precedence
+from asp.session.run import _against_cell_orders
+from asp.sizes.truth_oracle import TruthOracle as SizesTruth
 from bridge.assembly import load_assembly
 from bridge.precedence.experiment import PrecedenceExperiment, PrecedenceOutcome
 from tests.conftest import TRUTH_SESSION, Runner
+from tests.precedence.test_precedence_cell_order import CRANFIELD_ORDERS, breaks
 from tests.session import exact_cell
+from tests.session.test_session_resume import cranfield_copy
 
 
 def _learned_exactly_the_truth(run: Path, assembly: str) -> None:
@@ -103,3 +108,46 @@ def test_sim_cell_session_explores_a_small_product_in_physics_with_the_layer_it_
     explored = json.loads((run / "session.json").read_text())["precedence_explored"]
     assert explored["experiments"] == 3 and explored["sim_s"] > 0.0  # bp<p1, bp<p2, bp<p3, each in physics
     assert (run / "experiments.lp").read_text().count(",1,unsupported).") == 3  # each peg fell: no plate
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(180)
+def test_truth_cell_session_keeps_the_cells_own_orders_and_reports_what_they_leave_undecided(
+        tmp_path: Path, root: Path, run_main: Runner) -> None:
+    """Cranfield with the six orders its import writes (the pegs before the front plate and
+    the square ones before the spacer, all true precedence) and p2 before p1 (free in the
+    product): no experiment breaks one, every true pair is learned, and p2<p1, which the cell
+    can show only by p1 going in without p2 (never p2 after it), is reported undecidable by
+    the cell and kept, not taken for a process constraint."""
+    orders = (*CRANFIELD_ORDERS, ("p2", "p1"))
+    product, run = cranfield_copy(root, tmp_path / "product"), tmp_path / "run"
+    (product / "cell_order.lp").write_text("".join(f"cell_before({p},{q}).\n" for p, q in orders))
+    done = run_main(*TRUTH_SESSION, "--precedence", "explore", "--assembly", str(product), "--out", str(run),
+                    timeout=150)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["matches_truth"] is True  # every true pair learned, the sizes equal
+    trials = load_trials(run / "experiments.lp", true_relation(load_assembly(str(product))).parts)
+    assert trials and not [t.experiment.id for t in trials if breaks([s.part for s in t.experiment.sequence], orders)]
+    explored = json.loads((run / "session.json").read_text())["precedence_explored"]
+    assert explored["process"] == [["p3", "p4"]]
+    assert [pair[:2] for pair in explored["undecidable"]] == [["bp", "p1"], ["p2", "fp"], ["p2", "p1"]]
+    assert any(line.startswith("undecidable by this cell: p2<p1: p1 went in without p2")
+               for line in explored["rests_on"])
+    assert ("p2", "p1") in load_learned_facts([run / "learned.lp"]).must_precede
+
+
+def test_a_size_trial_that_would_break_a_cells_order_is_taken_from_sizes_lp(tmp_path: Path, root: Path) -> None:
+    """A trial stands the owner of the pin it tries at its goal (``Scene.feature``): were s1
+    a pin of the spacer, p3's trial onto it would put p3 in after sp, against the order
+    p3 before sp; that pair is no experiment, its outcome the CAD's, stated."""
+    product = cranfield_copy(root, tmp_path / "product")
+    (product / "cell_order.lp").write_text("cell_before(p3,sp).\n")
+    assembly = replace(load_assembly(str(product)), hole_owners={"s1": "sp"})
+    truth = SizesTruth.from_assembly(str(product))
+    pairs = [(p, h) for p in truth.parts for h in truth.holes]
+    taken, statement = _against_cell_orders(assembly, pairs, truth, [])
+    assert taken == [(("p3", "s1"), "fit")]
+    assert statement is not None and "1 pairs whose trial would stand a part the cell puts in after the one tried" \
+        in statement and "p3->s1 (sp in place)" in statement
+    assert _against_cell_orders(assembly, pairs, truth, [(("p3", "s1"), "fit")]) == ([], None)  # decided already
+    assert _against_cell_orders(replace(assembly, hole_owners={}), pairs, truth, []) == ([], None)

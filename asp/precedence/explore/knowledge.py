@@ -11,14 +11,20 @@ failed there for another cause it decides nothing. A failure still undecided at 
 fixpoint is kept and reported, never read as a confirmation. A failure before the tested step (the known
 state was not reached) and every conflict between sources are errors naming their
 evidence (:class:`PrecedenceConflict`).
+
+The cell's own orders (``cell_before(P,Q)``, :attr:`Evidence.cell_before`: the fingers
+holding P would meet Q in place) are kept by every experiment chosen; a failure of a step
+placing P after such a Q (from a file) is the cell's and confirms nothing, and a pair
+(P,Q) of them is confirmed only by Q failing without P, never shown free by the cell
+(:attr:`Knowledge.cell_tried`, ``precedence/experiment_candidates.lp``).
 """
 
 from __future__ import annotations
 
 import re
 from collections import deque
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass, field, replace
 
 import clingo
 
@@ -67,14 +73,15 @@ class Evidence:
     geometry_source: str = "the geometric precedence"
     geometry_reasons: dict[Pair, str] = field(default_factory=dict)
     trials: tuple[Trial, ...] = ()
+    cell_before: tuple[Pair, ...] = ()
+    """The cell's own orders (P, Q): the cell puts P in before Q (the product's ``cell_order.lp``)."""
 
     @property
     def parts(self) -> tuple[str, ...]:
         return self.demos.parts
 
     def with_trial(self, trial: Trial) -> Evidence:
-        return Evidence(self.demos, self.geometry, self.geometry_source, self.geometry_reasons,
-                        (*self.trials, trial))
+        return replace(self, trials=(*self.trials, trial))
 
     def source_name(self, source: str) -> str:
         """The evidence a source (``demo(D)``, ``experiment(E)``, ``geometry``) stands for."""
@@ -86,10 +93,11 @@ class Evidence:
         return self.geometry_source
 
     def facts(self) -> list[clingo.Symbol]:
-        """``part/1``, ``part_index/2``, ``demo/3``, ``forced/3`` (geometry) and the experiments'
-        ``experiment/3``, ``experiment_step/3``, ``experiment_success/1``, ``experiment_failed/3``,
-        ``experiment_blocker/2`` (E: 1-based)."""
+        """``part/1``, ``part_index/2``, ``demo/3``, ``forced/3`` (geometry), ``cell_before/2`` and
+        the experiments' ``experiment/3``, ``experiment_step/3``, ``experiment_success/1``,
+        ``experiment_failed/3``, ``experiment_blocker/2`` (E: 1-based)."""
         atoms = [fact("part", p) for p in self.parts]
+        atoms += [fact("cell_before", p, q) for p, q in self.cell_before]
         atoms += [fact("part_index", p, i) for i, p in enumerate(self.parts, 1)]
         atoms += [fact("demo", d, i, p) for d, sequence in enumerate(self.demos.sequences, 1)
                   for i, p in enumerate(sequence, 1)]
@@ -110,8 +118,12 @@ class Evidence:
 class Knowledge:
     """The knowledge state: ``known`` (closed), ``excluded``, ``open`` pairs; ``candidates``
     (experiments whose outcome decides their pair) with the parts each ``requires`` before its
-    second part; ``confirmed`` (pairs of failed experiments, by trial index); ``undecided``
-    (failed experiments that confirm nothing yet); ``facts`` (the solver's input); the pair
+    second part (every open pair no part lies between), ``alone`` those placing their second part
+    without the first after it (the cell's orders); ``confirmed`` (pairs of failed
+    experiments, by trial index); ``undecided`` (failed experiments that confirm nothing
+    yet); ``cell_blocked`` and ``cell_tried``: the open pairs no part lies between that the
+    cell's orders leave untested (their experiment would break one; their second part went
+    in alone, the first never tried after it); ``facts`` (the solver's input); the pair
     ``selected`` by ``policy`` (None: no policy asked, or nothing open)."""
 
     evidence: Evidence
@@ -123,6 +135,9 @@ class Knowledge:
     confirmed: dict[int, Pair]
     undecided: tuple[Trial, ...]
     facts: tuple[clingo.Symbol, ...]
+    alone: frozenset[Pair] = frozenset()
+    cell_blocked: frozenset[Pair] = frozenset()
+    cell_tried: frozenset[Pair] = frozenset()
     policy: str | None = None
     selected: Pair | None = None
 
@@ -208,15 +223,28 @@ def _check_tested_step(trial: Trial) -> None:
             f"{tested}, in an order the evidence showed feasible; expected the known state to be reached")
 
 
-def decisive(trial: Trial, excluded: frozenset[Pair], parts: Sequence[str]) -> bool:
+def broken_order(sequence: Sequence[str], cell_before: Collection[Pair]) -> Pair | None:
+    """The first of the cell's orders (P, Q) that placing ``sequence`` in turn breaks (Q
+    placed before P), None when it keeps them all."""
+    for i, part in enumerate(sequence):
+        for placed in sequence[:i]:
+            if (part, placed) in cell_before:
+                return part, placed
+    return None
+
+
+def decisive(trial: Trial, excluded: frozenset[Pair], parts: Sequence[str],
+             cell_before: Collection[Pair] = ()) -> bool:
     """Whether a failure at the tested step (placing the pair's second part) confirms the
-    pair: every absent part but its first is excluded from preceding its second. (A failure
-    of the first part's step in "B then A" is read by ``precedence/evidence.lp``.)"""
+    pair: every absent part but its first is excluded from preceding its second, and the
+    step breaks none of the cell's orders ``cell_before`` (the fingers meeting a part in
+    place explain such a failure). (A failure of the first part's step in "B then A" is
+    read by ``precedence/evidence.lp``.)"""
     a, b = trial.experiment.pair
     tested = tested_step(trial.experiment)
-    before = {step.part for step in trial.experiment.sequence[:tested - 1]}
-    return trial.outcome.failed_step == tested and all(
-        (x, b) in excluded for x in parts if x not in before and x not in (a, b))
+    placed = [step.part for step in trial.experiment.sequence[:tested]]
+    return (trial.outcome.failed_step == tested and not any((b, q) in cell_before for q in placed[:-1])
+            and all((x, b) in excluded for x in parts if x not in placed and x != a))
 
 
 def know(evidence: Evidence, policy: str | None = None, confirmed: dict[int, Pair] | None = None) -> Knowledge:
@@ -244,7 +272,8 @@ def know(evidence: Evidence, policy: str | None = None, confirmed: dict[int, Pai
         excluded = _pairs(atoms, "excluded")
         grown = dict(confirmed)
         grown.update({e: trial.experiment.pair for e, trial in enumerate(evidence.trials, 1)
-                      if e not in confirmed and decisive(trial, excluded, evidence.parts)})
+                      if e not in confirmed
+                      and decisive(trial, excluded, evidence.parts, evidence.cell_before)})
         if grown == confirmed:
             break
         confirmed = grown
@@ -256,5 +285,6 @@ def know(evidence: Evidence, policy: str | None = None, confirmed: dict[int, Pai
                       if t.outcome.outcome == "failed" and e not in confirmed)
     selected = sorted(_pairs(atoms, "select"))
     return Knowledge(evidence, _pairs(atoms, "known"), excluded, _pairs(atoms, "open"), tuple(candidates),
-                     {pair: tuple(requires.get(pair, ())) for pair in candidates}, confirmed, undecided,
-                     tuple(facts), policy, selected[0] if selected else None)
+                     {pair: tuple(requires.get(pair, ())) for pair in _pairs(atoms, "covering")}, confirmed, undecided,
+                     tuple(facts), _pairs(atoms, "alone"), _pairs(atoms, "cell_blocked"), _pairs(atoms, "cell_tried"),
+                     policy, selected[0] if selected else None)

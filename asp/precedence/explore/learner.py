@@ -13,6 +13,12 @@ alone (as a prior alone). Pairs that every demonstration keeps but an experiment
 are *process constraints*: not physics, perhaps the user's process; reported, to confirm
 with the user, never silently dropped. Conflicts between the sources are errors
 (:class:`asp.precedence.explore.knowledge.PrecedenceConflict`).
+
+The cell's own orders (``cell_before(P,Q)``, the fingers' grip) leave some pairs open: the
+cell never places P after Q, so it cannot show P<Q free, and an experiment that would
+break one is never run. Such pairs are *undecidable by this cell*
+(:attr:`Learned.cell_undecided`, each with its reason): kept in the relation as the
+demonstrations have them (the cell's plans put P first anyway), never guessed.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ from pathlib import Path
 
 import clingo
 
-from asp.precedence.explore.knowledge import Evidence, Knowledge, Trial, know
+from asp.precedence.explore.knowledge import Evidence, Knowledge, Trial, broken_order, know
 from asp.precedence.learn import learn_must_precede
 from asp.precedence.relation import Pair, Relation, close, precedence_facts
 from asp.solve import fact
@@ -44,14 +50,16 @@ def geometric_reasons(path: str | None) -> dict[Pair, str]:
 
 @dataclass(frozen=True)
 class Learned:
-    """The learned relation, the support of each of its pairs, the process constraints and
-    the failed experiments that confirmed nothing (another absent part may be the cause)."""
+    """The learned relation, the support of each of its pairs, the process constraints, the
+    failed experiments that confirmed nothing (another absent part, or the cell's order, may
+    be the cause) and the open pairs the cell's own orders leave undecidable, each with why."""
 
     knowledge: Knowledge
     relation: Relation
     support: dict[Pair, str]
     process: tuple[Pair, ...]
     undecided: tuple[Trial, ...]
+    cell_undecided: tuple[tuple[Pair, str], ...] = ()
 
     def facts(self) -> list[clingo.Symbol]:
         """``part/1``, ``must_precede/2``, ``precedence_edge/2``, ``support(A,B,S)`` and
@@ -73,13 +81,27 @@ class Learned:
         if self.process:
             lines.append("process constraints to confirm with the user (every demonstration keeps the order, "
                          "experiments show it free): " + " ".join(f"{a}<{b}" for a, b in self.process))
+        cell_before = self.knowledge.evidence.cell_before
         for trial in self.undecided:
             a, b = trial.experiment.pair
-            cause = (f"{a} was not seen blocked by {b} alone: another part, or none seen, may be the cause"
+            failed = [step.part for step in trial.experiment.sequence[:trial.outcome.failed_step]]
+            broken = broken_order(failed, cell_before)
+            cause = (f"the cell's own order explains it: the fingers holding {broken[0]} meet {broken[1]} in place"
+                     if broken is not None and broken[0] == failed[-1] else
+                     f"{a} was not seen blocked by {b} alone: another part, or none seen, may be the cause"
                      if trial.outcome.failed_step == len(trial.experiment.sequence) and trial.experiment.then_first
                      else "another absent part may be the cause")
             lines.append(f"undecided: {trial.describe()}: {cause}")
-        lines.append(f"open pairs left: {len(self.knowledge.open)}")
+        for (a, b), why in self.cell_undecided:
+            lines.append(f"undecidable by this cell: {a}<{b}: {why}")
+        lines.append(f"open pairs left: {len(self.knowledge.open)}"
+                     + (f" ({len(self.cell_undecided)} undecidable by this cell, kept as the demonstrations "
+                        "have them)" if self.cell_undecided else ""))
+        if cell_before:
+            lines.append("assumes: the cell's own orders (cell_order.lp: "
+                         + " ".join(f"{p}<{q}" for p, q in cell_before) + ") hold in every experiment: "
+                         "a pair of them is confirmed only by its second part failing without its first, "
+                         "never shown free (the cell never places the first after the second)")
         return "\n".join(lines)
 
 
@@ -103,4 +125,54 @@ def learn_sources(evidence: Evidence) -> Learned:
             support[pair] = "assumed"
     demonstrated = learn_must_precede(evidence.demos).pairs() if has_demos else []
     process = tuple(sorted(p for p in demonstrated if p in knowledge.excluded))
-    return Learned(knowledge, relation, support, process, knowledge.undecided)
+    return Learned(knowledge, relation, support, process, knowledge.undecided, cell_undecided(knowledge))
+
+
+def _tried_alone(knowledge: Knowledge, pair: Pair) -> str:
+    a, b = pair
+    trial = next(t for t in reversed(knowledge.evidence.trials) if t.experiment.pair == pair
+                 and t.outcome.outcome == "success" and not t.experiment.then_first)
+    placed = [step.part for step in trial.experiment.sequence]
+    orders = " ".join(f"{a}<{q}" for q in placed if (a, q) in knowledge.evidence.cell_before)
+    return (f"{b} went in without {a} ({trial.describe()}), and the cell never places {a} after it "
+            f"(its own order {orders}): whether {a} can go in after {b} is not observed")
+
+
+def _blocked(knowledge: Knowledge, pair: Pair) -> str:
+    a, b = pair
+    set_up = knowledge.requires.get(pair, ())
+    orders = [(p, q) for p, q in knowledge.evidence.cell_before
+              if (p == b and q in set_up) or (p in set_up and q in set_up)]
+    return (f"its experiment ({b} without {a}, after {' '.join(set_up)}) would break the cell's own order "
+            + " ".join(f"{p}<{q}" for p, q in orders))
+
+
+def cell_undecided(knowledge: Knowledge) -> tuple[tuple[Pair, str], ...]:
+    """The open pairs the cell's own orders leave undecidable, each with why: its second part
+    went in alone and the cell never places its first after it, its experiment would break
+    one of the orders, or it lies over such pairs (no experiment separates the two parts);
+    () without those orders or while a candidate is left."""
+    if not knowledge.evidence.cell_before or knowledge.candidates:
+        return ()
+    upper = knowledge.known | knowledge.open
+    after: dict[str, set[str]] = {p: {p} for p in knowledge.evidence.parts}
+    for start, reached in after.items():  # the parts at or after each in the upper bound
+        frontier = [start]
+        while frontier:
+            part = frontier.pop()
+            for a, b in upper:
+                if a == part and b not in reached:
+                    reached.add(b)
+                    frontier.append(b)
+    untested = knowledge.cell_tried | knowledge.cell_blocked
+    reasons = []
+    for a, b in sorted(knowledge.open):
+        if (a, b) in knowledge.cell_tried:
+            reasons.append(((a, b), _tried_alone(knowledge, (a, b))))
+        elif (a, b) in knowledge.cell_blocked:
+            reasons.append(((a, b), _blocked(knowledge, (a, b))))
+        else:
+            over = [f"{x}<{y}" for x, y in sorted(untested) if x in after[a] and b in after[y]]
+            reasons.append(((a, b), "a part may lie between them, over " + " ".join(over)
+                            + ", which this cell cannot decide: no experiment of it separates the two"))
+    return tuple(reasons)

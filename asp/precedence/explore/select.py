@@ -4,17 +4,19 @@ Policies (one encoding each): ``informative`` (``select_precedence_informative.l
 candidate deciding the most open pairs whatever its outcome) and ``first``
 (``select_precedence_first.lp``: the first candidate in part order, a systematic
 baseline). The experiment on (a, b) places every part that precedes b in the upper bound
-except a, in the order of the first demonstration (a linear extension of the upper
-bound), then b, then a ("B then A": a precedence the physics shows only at a's step,
-once b is in, is seen too).
+except a, in an order of the upper bound and of the cell's own orders together (the first
+demonstration's where they allow), then b, then a ("B then A": a precedence the physics
+shows only at a's step, once b is in, is seen too), or b alone where the cell's orders
+keep a from going in after the parts then in place (:attr:`Knowledge.alone`). No
+experiment breaks one of the cell's orders.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 
 from asp import PlannerError
-from asp.precedence.explore.knowledge import POLICIES, Evidence, Knowledge, Trial, decisive, know
+from asp.precedence.explore.knowledge import POLICIES, Evidence, Knowledge, Trial, broken_order, decisive, know
 from asp.precedence.explore.oracle import Oracle
 from asp.precedence.relation import Pair
 from bridge.precedence.experiment import ExperimentStep, PrecedenceExperiment
@@ -36,11 +38,33 @@ def select_pair(knowledge: Knowledge, policy: str = "informative") -> Pair | Non
     return knowledge.selected
 
 
+def _set_up_order(knowledge: Knowledge, parts: Sequence[str]) -> list[str]:
+    """``parts`` (a down-set of the upper bound but the tested pair's first part) in an order
+    of the upper bound (known and open pairs) and of the cell's own orders among them, the
+    first demonstration's where both leave it free (the candidates' encoding has checked that
+    such an order exists)."""
+    rank = knowledge.evidence.demos.sequences[0].index
+    among = set(parts)
+    edges = [(a, b) for a, b in (*knowledge.known, *knowledge.open, *knowledge.evidence.cell_before)
+             if a in among and b in among]
+    order: list[str] = []
+    while among:
+        ready = [p for p in among if not any(a in among and b == p for a, b in edges)]
+        order.append(min(ready, key=rank))
+        among.remove(order[-1])
+    return order
+
+
 def experiment_for(knowledge: Knowledge, pair: Pair, request_id: str) -> PrecedenceExperiment:
-    """The experiment testing ``pair`` (a candidate of ``knowledge``)."""
-    first_demo = knowledge.evidence.demos.sequences[0]
-    before = sorted(knowledge.requires[pair], key=first_demo.index)
-    steps = tuple(ExperimentStep(p) for p in (*before, pair[1], pair[0]))
+    """The experiment testing ``pair`` (a candidate of ``knowledge``): its set-up, then the
+    pair's second part, then its first unless :attr:`Knowledge.alone`."""
+    a, b = pair
+    then = () if pair in knowledge.alone else (a,)
+    steps = tuple(ExperimentStep(p) for p in (*_set_up_order(knowledge, knowledge.requires[pair]), b, *then))
+    broken = broken_order([step.part for step in steps], knowledge.evidence.cell_before)
+    if broken is not None:
+        raise AssertionError(f"the experiment on {a}<{b} would place {broken[0]} after {broken[1]}, against the "
+                             "cell's own order")
     return PrecedenceExperiment(id=request_id, pair=pair, sequence=steps)
 
 
@@ -67,6 +91,6 @@ def explore(evidence: Evidence, oracle: Oracle, policy: str = "informative", run
         yield knowledge, trial
         evidence = evidence.with_trial(trial)
         confirmed = dict(knowledge.confirmed)
-        if decisive(trial, knowledge.excluded, evidence.parts):
+        if decisive(trial, knowledge.excluded, evidence.parts, evidence.cell_before):
             confirmed[len(evidence.trials)] = pair
         knowledge = know(evidence, policy, confirmed)
