@@ -51,15 +51,10 @@ from executor.cad.convex import MESH_FOLDER, PIECES_CPU, budget_assumption, over
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
-from executor.cad.operations import (
-    entry_point,
-    finger_assumption,
-    finger_order_text,
-    finger_orders,
-    pin_entry,
-    screwed_fits,
-    tool_of,
-)
+from executor.cad.operations.fingers import finger_assumption
+from executor.cad.operations.frames import entry_point, pin_entry
+from executor.cad.operations.screwed import screwed_fits
+from executor.cad.operations.tools import finger_order_text, finger_orders, tool_of
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -547,7 +542,7 @@ class Imported:
     heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
     files ``written``, the ``seconds`` taken, the ``offset`` (x, y, z) [m] by which every
     part was moved from the CAD frame into the cell (:func:`placement`) and the parts the
-    cell holds on its suction cup, with why (:func:`executor.cad.operations.tool_of`)."""
+    cell holds on its suction cup, with why (:func:`executor.cad.operations.tools.tool_of`)."""
 
     derived: Derived
     mapped: Mapped
@@ -611,7 +606,7 @@ def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path 
     the source where no up is set and the base looks drawn tilted, :func:`drawn_tilted`):
     the files of ``out`` it may remove,
     the settings with every tray, the derived product and the product as the cell inserts
-    it (:func:`executor.cad.operations.cell_view`), the assumptions, the offset into
+    it (:func:`executor.cad.operations.view.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
     known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
     reach, place = options.reach, options.place

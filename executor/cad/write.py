@@ -11,7 +11,7 @@
   every part with a bore and pin when the pin's section passes the bore's
   (:func:`executor.cad.sections.passes`: the exact rules of round sections, the loops'
   room of two rect or square ones, the polygon relation where one is a polygon) or when they
-  are a nominal zero-clearance fit (:func:`executor.cad.operations.nominal_fits`, named in a comment), or when
+  are a nominal zero-clearance fit (:func:`executor.cad.operations.rooms.nominal_fits`, named in a comment), or when
   the sweep admits them (:func:`executor.cad.derive.swept_fits`: a taper in its taper), closed world;
 - ``nominal_sizes.lp``: ``nominal_margin(P,H,M)``, the room M [µm] of each peg's nominal
   section in each hole's (0: a nominal zero-clearance fit), the input of ``sizes learn --prior cad``;
@@ -27,9 +27,9 @@
   :func:`nominal_section`): pegs standing in holes entered along +z with a round, square
   or rect section or the prism of a polygon (built by the cell from its outline), parts
   with a bore onto pins of the base (a part on several pins down its first, the only
-  one of them written: :func:`executor.cad.operations._onto_pins`), covers and heads
+  one of them written: :func:`executor.cad.operations.pins._onto_pins`), covers and heads
   (:mod:`executor.cad.covers`), every other part placed by hand (``[manual.<id>]``,
-  :func:`executor.cad.operations.cell_view`); the plate at the entry height and depth most holes share, a hole
+  :func:`executor.cad.operations.view.cell_view`); the plate at the entry height and depth most holes share, a hole
   at another one with its own ``top_z`` and ``depth``, the
   plate, pegs, covers and heads as primitives where they are ones, else as their own
   meshes with convex pieces (``meshes/``, :mod:`executor.cad.convex`;
@@ -78,37 +78,25 @@ from executor.cad.convex import (
 )
 from executor.cad.covers import Mapped, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations import (
-    GRIPPER,
-    LEVEL,
-    MAX_PLATE_DEPTH,
+from executor.cad.operations.arm import tool_length
+from executor.cad.operations.fingers import GRIPPER, finger_grip
+from executor.cad.operations.frames import (
     along_axis,
     bore_frame,
-    bore_pieces,
-    builds_plate,
-    cell_view,
     entry_point,
     feature_turn,
-    fine_fits,
-    finger_grip,
-    finger_order_text,
-    finger_orders,
-    margins,
-    narrows_peg,
-    nominal_fits,
-    order,
     pin_entry,
     pin_level,
-    plate_level,
-    plate_top,
-    pressed,
-    section_kind,
-    section_pairs,
-    tool_length,
-    tool_of,
     upright,
-    widens_bore,
 )
+from executor.cad.operations.pins import bore_pieces
+from executor.cad.operations.plate import LEVEL, MAX_PLATE_DEPTH, builds_plate, plate_level, plate_top
+from executor.cad.operations.precedence import order
+from executor.cad.operations.resolution import fine_fits, narrows_peg, widens_bore
+from executor.cad.operations.rooms import margins, nominal_fits, section_pairs
+from executor.cad.operations.screwed import pressed
+from executor.cad.operations.tools import finger_order_text, finger_orders, tool_of
+from executor.cad.operations.view import cell_view, section_kind
 from executor.cad.parts import turn_text
 from executor.cad.sections import Shape2D, section, slice_loops
 from executor.cad.sections import rounded as _q
@@ -271,8 +259,8 @@ def down_depth(derived: Derived, fit: HoleFit) -> float:
 
 def sizes_text(derived: Derived) -> str:
     """``sizes.lp``: ``fits(P,H)`` for every peg whose nominal section passes a hole's
-    (:func:`executor.cad.operations.margins`) or is a nominal zero-clearance fit in it
-    (:func:`executor.cad.operations.nominal_fits`, named in a comment as the assumption it is)."""
+    (:func:`executor.cad.operations.rooms.margins`) or is a nominal zero-clearance fit in it
+    (:func:`executor.cad.operations.rooms.nominal_fits`, named in a comment as the assumption it is)."""
     rooms, nominal = margins(derived), nominal_fits(derived)
     lines = ["% Which part fits which hole from the nominal cross-sections (closed world), by ./run.sh import.",
              *_nominal_comments(nominal),
@@ -303,11 +291,11 @@ def nominal_assumption(derived: Derived) -> list[str]:
 
 def widened_fits(cell: Derived) -> dict[tuple[str, str], float]:
     """The fits of the product as the cell inserts it (``cell``:
-    :func:`executor.cad.operations.cell_view`) whose room the simulated cell builds
+    :func:`executor.cad.operations.view.cell_view`) whose room the simulated cell builds
     :data:`bridge.product.nominal.NOMINAL_FIT_ROOM` wider per side, sorted: on a pin with
-    the part's round bore wider (:func:`executor.cad.operations.widens_bore`), in a hole of
+    the part's round bore wider (:func:`executor.cad.operations.resolution.widens_bore`), in a hole of
     a base that is its own mesh with the round peg narrower
-    (:func:`executor.cad.operations.narrows_peg`); (part, feature) to the CAD's room per
+    (:func:`executor.cad.operations.resolution.narrows_peg`); (part, feature) to the CAD's room per
     side [m] (0.0 for a nominal zero-clearance fit); a feature's ``widened`` in ``geometry.toml``."""
     rooms, nominal = margins(cell), nominal_fits(cell)
     resized: list[tuple[str, list[str]]] = [
@@ -341,7 +329,8 @@ def _nominal_comments(nominal: dict[tuple[str, str], float]) -> list[str]:
 
 def zero_clearance_parts(derived: Derived) -> dict[str, list[str]]:
     """Feature (a hole or a pin) -> the parts that are a nominal zero-clearance fit in or on
-    it (:func:`executor.cad.operations.nominal_fits`), sorted: a hole's ``zero_clearance`` in ``geometry.toml``."""
+    it (:func:`executor.cad.operations.rooms.nominal_fits`), sorted: a hole's ``zero_clearance``
+    in ``geometry.toml``."""
     found: dict[str, list[str]] = {}
     for pid, hid in sorted(nominal_fits(derived)):
         found.setdefault(hid, []).append(pid)
@@ -511,7 +500,7 @@ def nominal_section(inward: Shape2D, outward: Iterable[Shape2D]) -> Shape2D:
 
 def nominal_text(derived: Derived) -> str:
     """``nominal_margin(P,H,M)``: the room [µm, rounded] of each peg in each hole
-    (:func:`executor.cad.operations.margins`)."""
+    (:func:`executor.cad.operations.rooms.margins`)."""
     lines = ["% The nominal room of every peg in every hole [um] (negative: it does not pass), by ./run.sh import;",
              "% the input of sizes learn --prior cad.", *_nominal_comments(nominal_fits(derived))]
     for pid, rooms in margins(derived).items():
@@ -564,7 +553,7 @@ def precedence_text(derived: Derived) -> str:
 
 def cell_order_text(cell: Derived) -> str | None:
     """``cell_order.lp``: ``cell_before(P,Q)`` for each order the fingers' grip needs
-    (:func:`executor.cad.operations.finger_orders`), each with its reason in a comment;
+    (:func:`executor.cad.operations.tools.finger_orders`), each with its reason in a comment;
     None where there is none. The cell's own constraint, not the product's precedence."""
     orders = finger_orders(cell)
     if not orders:
@@ -581,11 +570,11 @@ def cell_order_text(cell: Derived) -> str | None:
 def map_product(derived: Derived, settings: Settings, refused: Mapping[str, str] | None = None
                 ) -> tuple[Mapped, Settings, Derived]:
     """The covers, heads and parts placed by hand of the product as the cell inserts it
-    (:func:`executor.cad.operations.cell_view`: its other pegs, and those ``refused``
+    (:func:`executor.cad.operations.view.cell_view`: its other pegs, and those ``refused``
     (part -> why), are placed by hand), with ``why`` the cell builds
     none of it (two parts overlapping on the tray, or parts without a tray in ``settings``
     that cannot all wait within the arm's reach), its gripper's flange where the default's is
-    too short (:func:`executor.cad.operations.tool_length`), the settings with every part's tray
+    too short (:func:`executor.cad.operations.arm.tool_length`), the settings with every part's tray
     (:func:`default_trays` for those it lacks), and that product (for :func:`write_folder`)."""
     cell, by_hand = cell_view(derived, refused)
     flange, tool = tool_length(cell)
@@ -708,9 +697,10 @@ def _tray_overlap(boxes: dict[str, Box], trays: dict[str, tuple[float, float]]) 
 
 
 def _tool_lines(derived: Derived, fit: HoleFit) -> list[str]:
-    """A peg's ``[part_shapes.*]`` lines of what holds it (:func:`executor.cad.operations.tool_of`):
+    """A peg's ``[part_shapes.*]`` lines of what holds it (:func:`executor.cad.operations.tools.tool_of`):
     ``tool = "suction"``, or the fingers' ``grasp_depth`` where they hold it less deep than
-    :data:`executor.cad.operations.GRIPPER`'s (:func:`executor.cad.operations.finger_grip`); none otherwise."""
+    :data:`executor.cad.operations.fingers.GRIPPER`'s
+    (:func:`executor.cad.operations.fingers.finger_grip`); none otherwise."""
     tool, why = tool_of(derived, fit)
     if tool == "suction":
         return ['tool = "suction"']
@@ -789,7 +779,7 @@ def manual_features(derived: Derived, mapped: Mapped) -> dict[str, tuple[list[st
 
 def pins_of(derived: Derived) -> dict[str, list[str]]:
     """Part with a bore -> the other parts than the base owning its further pins (parts the
-    cell places by hand where it puts the part onto them: :func:`executor.cad.operations.cell_view`),
+    cell places by hand where it puts the part onto them: :func:`executor.cad.operations.view.cell_view`),
     for the parts that have such pins (``pins_of`` of ``[part_shapes.*]``)."""
     owners: dict[str, set[str]] = {}
     for pid, pin_id in derived.further_bores:
@@ -1039,7 +1029,7 @@ def claim_folder(out: Path, ids: Iterable[str], replace: bool) -> set[str]:
 def _cell_disagrees(derived: Derived, geometry: CellGeometry) -> str | None:
     """Why the cell's ``geometry`` would answer a pair otherwise than ``sizes.lp``
     (:func:`executor.world.geometry.feature_passes` on its sections against
-    :func:`executor.cad.operations.margins` and :func:`executor.cad.operations.nominal_fits`), naming
+    :func:`executor.cad.operations.rooms.margins` and :func:`executor.cad.operations.rooms.nominal_fits`), naming
     the first such pair; None when it answers every pair alike."""
     rooms, nominal = margins(derived), nominal_fits(derived)
     for pid, part in sorted(geometry.parts.items()):
@@ -1056,7 +1046,7 @@ def write_folder(derived: Derived, cell: Derived, mapped: Mapped, settings: Sett
                  removable: set[str]) -> tuple[list[Path], str | None, Mapped, Derived]:
     """Write the files of the module docstring into ``out`` (removing the ``removable``
     files, :func:`claim_folder`, that this import does not write again; the manifest last),
-    ``cell`` the product as the cell inserts it (:func:`executor.cad.operations.cell_view`, :func:`map_product`'s);
+    ``cell`` the product as the cell inserts it (:func:`executor.cad.operations.view.cell_view`, :func:`map_product`'s);
     a moving part with no convex pieces that fit (:func:`write_meshes`) is placed by hand
     with why, the product mapped again without it; returns the files, why there is no
     ``geometry.toml`` (None when there is one, checked by the cell's loader), and the

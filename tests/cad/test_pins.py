@@ -24,7 +24,7 @@ from assembly_constraints.cli import main
 from executor import ExecutorError
 from executor.cad.derive import Derived, derive
 from executor.cad.derive.bore_on_pin import _GRID, _joined
-from executor.cad.operations import margins
+from executor.cad.operations.rooms import margins
 from executor.cad.parts import CadPart
 from executor.cad.write import near_miss_assumption, pin_near_misses
 from executor.world.geometry import HoleSpec, PartSpec, _with_widened_fits, load_geometry

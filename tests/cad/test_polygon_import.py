@@ -17,7 +17,8 @@ import trimesh
 
 from executor.cad.cli import report
 from executor.cad.derive import derive
-from executor.cad.operations import cell_view, margins
+from executor.cad.operations.rooms import margins
+from executor.cad.operations.view import cell_view
 from executor.cad.parts import load_meshes
 from executor.cad.sections import Shape2D, passes, zero_clearance
 from executor.cad.write import (
