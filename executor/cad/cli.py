@@ -28,7 +28,7 @@ precedence with each pair's reason (``--locating-reach R``: the locating rule's 
 CAD or a bad file: one line, exit code 2. ``--max-triangles N`` bounds the parts'
 triangles together; the folder's ``.import-manifest.json`` lists the files an import
 wrote, the only ones a later import replaces or removes (``--replace``: also a product it
-did not write, :func:`executor.cad.write.claim_folder`).
+did not write, :func:`executor.cad.write.manifest.claim_folder`).
 """
 
 from __future__ import annotations
@@ -71,20 +71,14 @@ from executor.cad.parts import (
 from executor.cad.sections import Shape2D, section_room, slices_kept, zero_clearance
 from executor.cad.step import load_step
 from executor.cad.sweep import opposite, processes
-from executor.cad.write import (
-    MANIFEST,
-    REACH,
-    TRAY_GAP,
-    TRAY_START,
-    Settings,
-    claim_folder,
-    map_product,
-    mesh_pieces,
-    near_miss_assumption,
-    nominal_assumption,
-    widened_fits_assumption,
-    write_folder,
-)
+from executor.cad.write.assembly import Settings
+from executor.cad.write.facts import nominal_assumption
+from executor.cad.write.folder import map_product, write_folder
+from executor.cad.write.manifest import MANIFEST, claim_folder
+from executor.cad.write.meshes import mesh_pieces
+from executor.cad.write.near_misses import near_miss_assumption
+from executor.cad.write.trays import REACH, TRAY_GAP, TRAY_START
+from executor.cad.write.widened import widened_fits_assumption
 
 WORK_POSITION = (0.56, 0.0)
 """Where a product out of the arm's reach is placed by default: its base's centre [m] in the
@@ -558,7 +552,7 @@ class Imported:
 class ImportOptions:
     """The command line's choices of an import: ``reach`` [m], the locating rule's (0:
     off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
-    over a product another import or a person wrote (:func:`executor.cad.write.claim_folder`);
+    over a product another import or a person wrote (:func:`executor.cad.write.manifest.claim_folder`);
     ``place`` [m]: where the base's centre goes in the cell (and the product's lowest point's height), over the config's
     (:func:`placement`); ``up``: the CAD's axis pointing up, over the config's
     (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""

@@ -44,7 +44,8 @@ from executor.cad.derive import derive
 from executor.cad.operations import fingers
 from executor.cad.operations.rooms import margins
 from executor.cad.sweep import opposite
-from executor.cad.write import down_depth, pin_near_misses
+from executor.cad.write.depths import down_depth
+from executor.cad.write.near_misses import pin_near_misses
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.trial import Cell

@@ -70,7 +70,7 @@ def finger_orders(cell: Derived) -> list[tuple[str, str, float, float]]:
     the base plate). The parts are taken in id order, each one left free to be in place
     only while the peg, with it and those left free before it, keeps its grip; so every
     part left free, all together in place, leaves the grip as it is. The plans honour
-    these orders (``cell_order.lp``, :func:`executor.cad.write.cell_order_text`)."""
+    these orders (``cell_order.lp``, :func:`executor.cad.write.facts.cell_order_text`)."""
     found = []
     for pid, fit in sorted(cell.hole_of.items()):
         if fit.axis == "-z" or tool_of(cell, fit)[0] != "fingers":
