@@ -58,9 +58,7 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) {why}"
     if why := sideways_pin_refused(derived, pin, pid):
         return why
-    mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
-    found = bore_pieces(derived, pid)(pid, as_written(mesh))
-    return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+    return f"goes onto a pin ({pin.id}), but {why}" if (why := _no_pieces(derived, pid)) else None
 
 
 def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
@@ -88,9 +86,15 @@ def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
         least = min(tight, key=lambda pin_id: (rooms[pin_id], pin_id))
         return (f"goes onto {'a pin' if len(tight) == 1 else 'pins'} ({', '.join(tight)}) "
                 f"{bore_unresolved(derived, pid, least)}")
+    return f"goes onto {len(on)} pins ({names}), but {why}" if (why := _no_pieces(derived, pid)) else None
+
+
+def _no_pieces(derived: Derived, pid: str) -> str:
+    """Why part ``pid`` with a bore has no pieces the cell collides it as
+    (:func:`bore_pieces` of its mesh in its part frame); "" where it has."""
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
-    return f"goes onto {len(on)} pins ({names}), but {found}" if isinstance(found, str) else None
+    return found if isinstance(found, str) else ""
 
 
 STACK_TOLERANCE = 1e-4
@@ -136,11 +140,11 @@ def bore_pieces(derived: Derived, pid: str) -> Pieces:
     low, high = float(along.min()), float(along.max())
     solid = trimesh.creation.extrude_polygon(shapely.Polygon(pin.section.outline + pin.section.centre),
                                              high - low + 2 * NEAR)
+    frame = bore_frame(derived, pid) @ feature_turn(pin).T
     solid.apply_translation((0.0, 0.0, low - NEAR))  # the pin in its frame, turned into the part frame
-    solid.apply_transform(bore_frame(derived, pid) @ feature_turn(pin).T)
+    solid.apply_transform(frame)
     bores = 1 + sum(part == pid for part, _ in derived.further_bores)  # one per pin it is on
     widen = NOMINAL_FIT_ROOM if widens_bore(derived, pid) else 0.0
-    frame = bore_frame(derived, pid) @ feature_turn(pin).T
     parallel = [pin, *(other for _, other in sorted(derived.pins.items())
                        if other is not pin and other.axis == pin.axis)]
     pins = tuple(shapely.Polygon(trimesh.transform_points(np.column_stack([

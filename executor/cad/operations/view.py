@@ -75,10 +75,10 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
                 by_hand[fit.part] = f"goes into hole {hid} along +z, from below"
         elif fit.part is not None and fit.axis != "+z" and (why := sideways_refused(derived, hid, fit)):
             by_hand[fit.part] = why
-        elif fit.part is not None and section_kind(fit) == "polygon" and _polygon_refused(fit, derived):
-            by_hand[fit.part] = _polygon_refused(fit, derived)
-        elif fit.part is not None and tool_of(derived, fit)[0] == "":
-            by_hand[fit.part] = tool_of(derived, fit)[1]
+        elif fit.part is not None and section_kind(fit) == "polygon" and (why := _polygon_refused(fit, derived)):
+            by_hand[fit.part] = why
+        elif fit.part is not None and (tool := tool_of(derived, fit))[0] == "":
+            by_hand[fit.part] = tool[1]
         else:
             kept[hid] = fit
     # The pins the cell puts parts onto: none empty (no goal on it), the base's unless

@@ -154,10 +154,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                                                   [pairs[pid][hid][0] for pid in listed])),
                   *_zero_clearance_line([pid for pid in listed if pid in derived.hole_of]),
                   *_widened_line([pid for pid, on in widened if on == hid], "pegs", "narrower")]
-        close = [(pid, reason) for (pid, h), reason in missed.items() if h == hid]
-        if close:
-            lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
-                         + "; ".join(reason for _, reason in close))
+        lines += _near_miss_line(missed, hid)
         if fit.hole.yaw:
             lines.append(f"yaw = {fit.hole.yaw:.6g}")
         if hid in own:
@@ -186,9 +183,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_widened_line([pid for pid, on in widened if on == pin_id], "bores", "wider")]
         if pin.section.yaw and pin.section.kind != "round":
             lines.append(f"yaw = {pin.section.yaw:.6g}")
-        if close := [(pid, reason) for (pid, h), reason in missed.items() if h == pin_id]:
-            lines.append(f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
-                         + "; ".join(reason for _, reason in close))
+        lines += _near_miss_line(missed, pin_id)
         if pin.owner != derived.base:  # standing up on a part placed by hand (cell_view)
             lines.append(f'owner = "{pin.owner}"')
         if pin.axis != "+z":  # along a horizontal axis: its free end's height, the depth along its axis
@@ -254,6 +249,15 @@ def _widened_line(parts: list[str], what: str, how: str) -> list[str]:
     one): ``what`` the cell builds (bores, pegs) ``how`` (wider, narrower)."""
     return [f"widened = {json.dumps(parts)}  # {what} the cell builds {1e3 * NOMINAL_FIT_ROOM:g} mm {how} per side: "
             "room under what it resolves"] if parts else []
+
+
+def _near_miss_line(missed: Mapping[tuple[str, str], str], fid: str) -> list[str]:
+    """A feature's ``near_miss`` line naming the parts of the pairs of ``missed`` on or in
+    feature ``fid`` (:func:`executor.cad.write.near_misses.near_misses`,
+    :func:`executor.cad.write.near_misses.pin_near_misses`) with their reasons; none without one."""
+    close = [(pid, reason) for (pid, f), reason in missed.items() if f == fid]
+    return [f"near_miss = {json.dumps([pid for pid, _ in close])}  # no experiment: "
+            + "; ".join(reason for _, reason in close)] if close else []
 
 
 def _zero_clearance_line(parts: list[str]) -> list[str]:
