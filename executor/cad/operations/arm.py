@@ -14,21 +14,10 @@ from collections.abc import Mapping
 import numpy as np
 import trimesh
 
-from executor.cad.convex import (
-    NEAR,
-)
+from executor.cad.convex import NEAR
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations.fingers import (
-    GRIPPER,
-    finger_grip,
-)
-from executor.cad.operations.frames import (
-    along_axis,
-    entry_point,
-    feature_turn,
-    pin_entry,
-    upright,
-)
+from executor.cad.operations.fingers import GRIPPER, finger_grip
+from executor.cad.operations.frames import along_axis, entry_point, feature_turn, pin_entry, upright
 from executor.cad.operations.precedence import maybe_in_place
 from executor.cad.operations.tools import tool_of
 from executor.cad.sweep import opposite

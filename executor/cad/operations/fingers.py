@@ -13,9 +13,7 @@ import shapely
 import trimesh
 
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations.frames import (
-    feature_turn,
-)
+from executor.cad.operations.frames import feature_turn
 from executor.cad.operations.precedence import in_place_before
 
 GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02,

@@ -11,9 +11,7 @@ import math
 import numpy as np
 import trimesh
 
-from executor.cad.convex import (
-    peg_frame,
-)
+from executor.cad.convex import peg_frame
 from executor.cad.derive import Derived, HoleFit, PinFit
 from executor.cad.sweep import opposite
 from executor.world.frames import hole_rotation

@@ -10,26 +10,12 @@ import shapely
 import trimesh
 
 from bridge.product.nominal import NOMINAL_FIT_ROOM
-from executor.cad.convex import (
-    NEAR,
-    Pieces,
-    as_written,
-    pin_pieces,
-)
+from executor.cad.convex import NEAR, Pieces, as_written, pin_pieces
 from executor.cad.derive import Derived, PinFit
 from executor.cad.operations.arm import sideways_pin_refused
-from executor.cad.operations.frames import (
-    along_axis,
-    bore_frame,
-    feature_turn,
-)
+from executor.cad.operations.frames import along_axis, bore_frame, feature_turn
 from executor.cad.operations.plate import LEVEL
-from executor.cad.operations.resolution import (
-    bore_unresolved,
-    round_pins,
-    unresolved,
-    widens_bore,
-)
+from executor.cad.operations.resolution import bore_unresolved, round_pins, unresolved, widens_bore
 from executor.cad.operations.rooms import margins
 from executor.cad.sweep import opposite
 from executor.world.rings import NoStack, ring_pieces

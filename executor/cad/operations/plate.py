@@ -5,9 +5,7 @@ Lengths in metres."""
 
 from __future__ import annotations
 
-from executor.cad.convex import (
-    base_is_primitive,
-)
+from executor.cad.convex import base_is_primitive
 from executor.cad.derive import Derived
 
 LEVEL = 1e-5

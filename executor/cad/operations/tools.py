@@ -10,15 +10,8 @@ import shapely
 import trimesh
 
 from executor.cad.derive import Derived, HoleFit
-from executor.cad.operations.fingers import (
-    GRIPPER,
-    finger_grip,
-    grip_for,
-    standing_out,
-)
-from executor.cad.operations.frames import (
-    upright,
-)
+from executor.cad.operations.fingers import GRIPPER, finger_grip, grip_for, standing_out
+from executor.cad.operations.frames import upright
 from executor.cad.operations.precedence import in_place_before, maybe_in_place
 from executor.world.meshes import MIN_THICKNESS
 

@@ -13,26 +13,14 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from executor.cad.convex import (
-    peg_frame,
-    peg_is_primitive,
-)
+from executor.cad.convex import peg_frame, peg_is_primitive
 from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations.arm import (
-    sideways_refused,
-)
-from executor.cad.operations.frames import (
-    upright,
-)
-from executor.cad.operations.pins import (
-    STACK_TOLERANCE,
-    onto_pin,
-)
+from executor.cad.operations.arm import sideways_refused
+from executor.cad.operations.frames import upright
+from executor.cad.operations.pins import STACK_TOLERANCE, onto_pin
 from executor.cad.operations.plate import plate_top
-from executor.cad.operations.resolution import (
-    unresolved_in_hole,
-)
+from executor.cad.operations.resolution import unresolved_in_hole
 from executor.cad.operations.screwed import screwed
 from executor.cad.operations.tools import tool_of
 from executor.cad.sections import section
@@ -41,6 +29,7 @@ from executor.world.geometry import Section, seated_pose, thin_prism
 
 
 def section_kind(fit: HoleFit | None) -> str | None:
+    """The kind of the section of the peg in ``fit`` (None: no hole, or no peg in it)."""
     return None if fit is None or fit.section is None else fit.section.kind
 
 

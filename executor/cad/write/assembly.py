@@ -12,10 +12,7 @@ import json
 from dataclasses import dataclass
 
 from executor.cad.derive import Derived
-from executor.cad.operations.frames import (
-    entry_point,
-    pin_entry,
-)
+from executor.cad.operations.frames import entry_point, pin_entry
 from executor.cad.operations.view import section_kind
 from executor.cad.parts import turn_text
 from executor.cad.sections import rounded as _q

@@ -21,26 +21,11 @@ from executor.cad.operations.plate import plate_top
 from executor.cad.operations.rooms import margins, nominal_fits
 from executor.cad.operations.view import cell_view
 from executor.cad.write.assembly import Settings, assembly_text
-from executor.cad.write.facts import (
-    cell_order_text,
-    nominal_text,
-    precedence_text,
-    sizes_text,
-)
-from executor.cad.write.geometry import (
-    geometry_text,
-    manual_features,
-    pins_of,
-)
+from executor.cad.write.facts import cell_order_text, nominal_text, precedence_text, sizes_text
+from executor.cad.write.geometry import geometry_text, manual_features, pins_of
 from executor.cad.write.manifest import MANIFEST, file_digest
 from executor.cad.write.meshes import mesh_pieces, write_meshes
-from executor.cad.write.trays import (
-    REACH,
-    default_trays,
-    footprints,
-    product_box,
-    tray_overlap,
-)
+from executor.cad.write.trays import REACH, default_trays, footprints, product_box, tray_overlap
 from executor.world.geometry import CellGeometry, feature_passes, load_geometry, plate_obj_text
 
 

@@ -24,13 +24,7 @@ from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, HoleFit
 from executor.cad.operations.fingers import GRIPPER, finger_grip
-from executor.cad.operations.frames import (
-    along_axis,
-    entry_point,
-    pin_entry,
-    pin_level,
-    upright,
-)
+from executor.cad.operations.frames import along_axis, entry_point, pin_entry, pin_level, upright
 from executor.cad.operations.plate import LEVEL, MAX_PLATE_DEPTH, plate_level
 from executor.cad.operations.rooms import section_pairs
 from executor.cad.operations.screwed import pressed
@@ -42,10 +36,7 @@ from executor.cad.write.assembly import Settings
 from executor.cad.write.bosses import own_tiles, plate_tile
 from executor.cad.write.depths import down_depth, sideways_depth
 from executor.cad.write.meshes import manual_origin
-from executor.cad.write.near_misses import (
-    near_misses,
-    pin_near_misses,
-)
+from executor.cad.write.near_misses import near_misses, pin_near_misses
 from executor.cad.write.widened import nominal_section, widened_fits, zero_clearance_parts
 
 DENSITY = 2700.0

@@ -15,9 +15,7 @@ from pathlib import Path
 from bridge.files import os_reason
 from bridge.inputs import read_text, shorten
 from executor import ExecutorError
-from executor.cad.convex import (
-    MESH_FOLDER,
-)
+from executor.cad.convex import MESH_FOLDER
 
 MANIFEST = ".import-manifest.json"
 """The files the last import into a folder wrote: ``{"written_by": "./run.sh import",

@@ -14,21 +14,10 @@ import trimesh
 
 from bridge.product import Mesh
 from bridge.product.nominal import NOMINAL_FIT_ROOM
-from executor.cad.convex import (
-    MESH_FOLDER,
-    NEAR,
-    fitted,
-    peg_frame,
-    peg_is_primitive,
-    write_mesh,
-)
+from executor.cad.convex import MESH_FOLDER, NEAR, fitted, peg_frame, peg_is_primitive, write_mesh
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived
-from executor.cad.operations.frames import (
-    bore_frame,
-    feature_turn,
-    upright,
-)
+from executor.cad.operations.frames import bore_frame, feature_turn, upright
 from executor.cad.operations.pins import bore_pieces
 from executor.cad.operations.plate import builds_plate
 from executor.cad.operations.resolution import narrows_peg

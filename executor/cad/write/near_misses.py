@@ -13,16 +13,9 @@ import numpy as np
 import shapely
 import trimesh
 
-from executor.cad.convex import (
-    peg_is_primitive,
-)
+from executor.cad.convex import peg_is_primitive
 from executor.cad.derive import Derived, PinFit
-from executor.cad.operations.frames import (
-    along_axis,
-    bore_frame,
-    pin_level,
-    upright,
-)
+from executor.cad.operations.frames import along_axis, bore_frame, pin_level, upright
 from executor.cad.operations.plate import LEVEL
 from executor.cad.operations.rooms import margins, section_pairs
 from executor.cad.sections import section
