@@ -28,7 +28,7 @@ precedence with each pair's reason (``--locating-reach R``: the locating rule's 
 CAD or a bad file: one line, exit code 2. ``--max-triangles N`` bounds the parts'
 triangles together; the folder's ``.import-manifest.json`` lists the files an import
 wrote, the only ones a later import replaces or removes (``--replace``: also a product it
-did not write, :func:`executor.cad.write.claim_folder`).
+did not write, :func:`executor.cad.write.manifest.claim_folder`).
 """
 
 from __future__ import annotations
@@ -51,15 +51,10 @@ from executor.cad.convex import MESH_FOLDER, PIECES_CPU, budget_assumption, over
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
-from executor.cad.operations import (
-    entry_point,
-    finger_assumption,
-    finger_order_text,
-    finger_orders,
-    pin_entry,
-    screwed_fits,
-    tool_of,
-)
+from executor.cad.operations.fingers import finger_assumption
+from executor.cad.operations.frames import entry_point, pin_entry
+from executor.cad.operations.screwed import screwed_fits
+from executor.cad.operations.tools import finger_order_text, finger_orders, tool_of
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -76,20 +71,14 @@ from executor.cad.parts import (
 from executor.cad.sections import Shape2D, section_room, slices_kept, zero_clearance
 from executor.cad.step import load_step
 from executor.cad.sweep import opposite, processes
-from executor.cad.write import (
-    MANIFEST,
-    REACH,
-    TRAY_GAP,
-    TRAY_START,
-    Settings,
-    claim_folder,
-    map_product,
-    mesh_pieces,
-    near_miss_assumption,
-    nominal_assumption,
-    widened_fits_assumption,
-    write_folder,
-)
+from executor.cad.write.assembly import Settings
+from executor.cad.write.facts import nominal_assumption
+from executor.cad.write.folder import map_product, write_folder
+from executor.cad.write.manifest import MANIFEST, claim_folder
+from executor.cad.write.meshes import mesh_pieces
+from executor.cad.write.near_misses import near_miss_assumption
+from executor.cad.write.trays import REACH, TRAY_GAP, TRAY_START
+from executor.cad.write.widened import widened_fits_assumption
 
 WORK_POSITION = (0.56, 0.0)
 """Where a product out of the arm's reach is placed by default: its base's centre [m] in the
@@ -547,7 +536,7 @@ class Imported:
     heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
     files ``written``, the ``seconds`` taken, the ``offset`` (x, y, z) [m] by which every
     part was moved from the CAD frame into the cell (:func:`placement`) and the parts the
-    cell holds on its suction cup, with why (:func:`executor.cad.operations.tool_of`)."""
+    cell holds on its suction cup, with why (:func:`executor.cad.operations.tools.tool_of`)."""
 
     derived: Derived
     mapped: Mapped
@@ -563,7 +552,7 @@ class Imported:
 class ImportOptions:
     """The command line's choices of an import: ``reach`` [m], the locating rule's (0:
     off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
-    over a product another import or a person wrote (:func:`executor.cad.write.claim_folder`);
+    over a product another import or a person wrote (:func:`executor.cad.write.manifest.claim_folder`);
     ``place`` [m]: where the base's centre goes in the cell (and the product's lowest point's height), over the config's
     (:func:`placement`); ``up``: the CAD's axis pointing up, over the config's
     (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""
@@ -611,7 +600,7 @@ def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path 
     the source where no up is set and the base looks drawn tilted, :func:`drawn_tilted`):
     the files of ``out`` it may remove,
     the settings with every tray, the derived product and the product as the cell inserts
-    it (:func:`executor.cad.operations.cell_view`), the assumptions, the offset into
+    it (:func:`executor.cad.operations.view.cell_view`), the assumptions, the offset into
     the cell, the mapped product and where in the assumptions the near misses go (they are
     known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
     reach, place = options.reach, options.place

@@ -33,7 +33,7 @@ cell's hull margin twice less what it resolves: :mod:`executor.world.meshes`); C
 :data:`THRESHOLDS` are tried in turn with each seed until they do (the third line names the threshold, the seed
 and the least room left), a seed's finer thresholds not after a piece too thin (a finer
 threshold cuts more, smaller pieces: it is for pieces that took too much room), and
-a part whose pieces never do is named and gets none (:func:`executor.cad.write.write_folder`
+a part whose pieces never do is named and gets none (:func:`executor.cad.write.folder.write_folder`
 places it by hand with why). The decomposition is made here, never when a cell starts.
 """
 

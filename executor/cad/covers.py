@@ -99,7 +99,7 @@ class Mapped:
     """The covers and heads of a product, the parts the cell places by hand (``manual``:
     why it has no operation for each), or ``why`` the cell builds none of it; ``flange``
     the length [m] of its gripper's flange where the default's would not keep the arm's
-    wrist clear of the product (:func:`executor.cad.operations.tool_length`; None: the default),
+    wrist clear of the product (:func:`executor.cad.operations.arm.tool_length`; None: the default),
     and why (``tool``)."""
 
     covers: dict[str, CoverFit]

@@ -13,7 +13,7 @@ the other side, its box's far face closed by a 5 mm plate and its peg cut 1 mm s
 each turned about z so that the part moves along the axis, raised on a
 riser of the base's own footprint to the height, and placed (``import --place``) so that
 the free end (entry) is at the point. The import's reach rule
-(:data:`executor.cad.operations.SIDEWAYS_PIN_REACH`, :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`)
+(:data:`executor.cad.operations.arm.SIDEWAYS_PIN_REACH`, :data:`executor.cad.operations.arm.SIDEWAYS_HOLE_REACH`)
 is set aside for it: the point is the cell's step wherever the import takes it as one.
 
 Prints one line a point: ``reached`` (the part assembled within 2 mm of its goal), or
@@ -37,8 +37,8 @@ import trimesh
 from bridge.cli_types import ArgumentParser
 from bridge.product import load_product_description
 from executor import ExecutorError
-from executor.cad import operations
 from executor.cad.cli import ImportOptions, run_import
+from executor.cad.operations import arm
 
 CORPUS_HOLE = Path(__file__).resolve().parents[2] / "tests" / "cad" / "corpus" / "agh_hex_horizontal"
 """The hole's product: real CAD, a peg going along -y into a box's hole 30 mm up."""
@@ -146,8 +146,8 @@ def measure(kind: str, axis: str, x: float, y: float, height: float, tmp: Path) 
     from executor.trial import Cell
 
     cad, config, feature = _product(tmp / "first", kind, axis, height)
-    with mock.patch.object(operations, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
-            mock.patch.object(operations, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
+    with mock.patch.object(arm, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
+            mock.patch.object(arm, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
         # built z up: a block raised on its riser stands on its edge, its feature sideways (import --up)
         run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0), up="+z"))
         at = load_product_description(tmp / "first" / "out").assembly.holes[feature].position

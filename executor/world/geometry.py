@@ -136,7 +136,7 @@ class HoleSpec(Section):
     (``widened``: :func:`_with_widened_fits`; a hole's: the pegs it builds narrower); the pegs
     that miss it by less than the cell resolves, or, on a pin, the parts that would stop on
     its end as near their goal as one on it (``near_miss``: :mod:`executor.world.near_miss`,
-    :func:`executor.cad.write.pin_near_misses`; no experiment); ``tile``
+    :func:`executor.cad.write.near_misses.pin_near_misses`; no experiment); ``tile``
     the side of its square boss [m] where it differs from the plate's ``tile_size``
     (:func:`tile_of`)."""
 

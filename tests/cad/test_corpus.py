@@ -39,12 +39,13 @@ from bridge.messages import InsertRequest
 from executor import ExecutorError
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad import operations
 from executor.cad.cli import load_source
 from executor.cad.derive import derive
-from executor.cad.operations import margins
+from executor.cad.operations import fingers
+from executor.cad.operations.rooms import margins
 from executor.cad.sweep import opposite
-from executor.cad.write import down_depth, pin_near_misses
+from executor.cad.write.depths import down_depth
+from executor.cad.write.near_misses import pin_near_misses
 from executor.cell_description import CellDescription
 from executor.serve.truth import TruthBackend
 from executor.trial import Cell
@@ -609,7 +610,7 @@ def test_a_switch_collides_as_the_prism_of_the_section_its_fit_was_measured_on(
     # so the cell's belief of its tip is where it collides. The switches stand out of the
     # case by less than the fingers need (the cell places them by hand); a hand that holds
     # 1 mm has the cell insert them, from these pieces.
-    monkeypatch.setattr(operations, "MIN_GRIP", 0.001)
+    monkeypatch.setattr(fingers, "MIN_GRIP", 0.001)
     out = import_product(CORPUS / "nop_rocker_switches", tmp_path / "out").out
     for pid in ("small_rocker", "neon_indicator"):
         mesh = trimesh.load(out / "meshes" / f"{pid}.obj", force="mesh")

@@ -23,7 +23,7 @@ from executor.assembly.product import MAX_COVER_BOXES, load_product
 from executor.assembly.world import AssemblyWorld
 from executor.cad.covers import GRIP_MARGIN
 from executor.cad.derive import Derived
-from executor.cad.write import DENSITY
+from executor.cad.write.geometry import DENSITY
 from executor.cell_description import load_cell_description
 from executor.world.meshes import read_objects
 from tests.cad.test_import import _fits

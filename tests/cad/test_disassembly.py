@@ -27,7 +27,7 @@ from executor import ExecutorError
 from executor.cad import sections, sweep
 from executor.cad.derive import derive, ways
 from executor.cad.fits.faces import TOUCH, CylinderFace, cylinder_faces, fit_faces, zero_clearance_fits
-from executor.cad.operations import cell_view
+from executor.cad.operations.view import cell_view
 from executor.cad.parts import CadPart, check_parts, load_meshes, overlaps_checked
 from executor.cad.sweep import FRONT, _is_convex
 

@@ -18,7 +18,7 @@ from assembly_constraints.cli import main
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.assembly.world import AssemblyWorld
-from executor.cad import operations
+from executor.cad.operations import fingers
 from executor.cell_description import CellDescription, load_cell_description
 from executor.trial import Cell
 from executor.world.geometry import load_geometry
@@ -85,7 +85,7 @@ def test_a_peg_standing_out_less_with_a_flat_top_goes_on_the_suction_cup(tmp_pat
     _plate_and_pegs(tmp_path / "cad")
     _box((12, 12, 20.5), (X + 35, 0, 15.25)).export(tmp_path / "cad" / "peg3.stl")
     with pytest.MonkeyPatch.context() as patch:
-        patch.setitem(operations.GRIPPER, "cup_diameter", 0.01)
+        patch.setitem(fingers.GRIPPER, "cup_diameter", 0.01)
         assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
     shapes = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text())["part_shapes"]
     assert shapes["peg3"]["tool"] == "suction" and "grasp_depth" not in shapes["peg3"]
@@ -98,16 +98,16 @@ def test_the_fingers_meet_a_neighbour_reaching_under_the_top_and_turn_away_from_
     pads = shapely.union_all([shapely.box(0.006, -0.01, 0.016, 0.01), shapely.box(-0.016, -0.01, -0.006, 0.01)])
     block = trimesh.creation.box((0.01, 0.01, 0.03))
     block.apply_translation((0.02, 0.0, 0.0))
-    assert operations._highest_in(block.vertices[block.faces], pads, -1.0) == pytest.approx(0.015)
-    assert operations._highest_in(block.vertices[block.faces], pads, 0.02) is None  # none above 20 mm
+    assert fingers._highest_in(block.vertices[block.faces], pads, -1.0) == pytest.approx(0.015)
+    assert fingers._highest_in(block.vertices[block.faces], pads, 0.02) is None  # none above 20 mm
     wedge = trimesh.convex.convex_hull([(x, y, z) for x in (0.0, 0.03) for y in (-0.005, 0.005)
                                         for z in (0.0, 0.001 + x)])  # its top 1 mm at x 0, 31 mm at x 30
     wedge.apply_translation((0.013, 0.0, 0.0))  # from x 13, 4 mm high where the pad ends (x 16)
-    assert operations._highest_in(wedge.vertices[wedge.faces], pads, -1.0) == pytest.approx(0.004)
+    assert fingers._highest_in(wedge.vertices[wedge.faces], pads, -1.0) == pytest.approx(0.004)
     walls = trimesh.intersections.slice_mesh_plane(block, (0.0, 0.0, -1.0), (0.0, 0.0, 0.01))  # open at 10 mm
-    assert operations._highest_in(walls.vertices[walls.faces], pads, -1.0) == pytest.approx(0.01)
+    assert fingers._highest_in(walls.vertices[walls.faces], pads, -1.0) == pytest.approx(0.01)
     beyond = block.copy().apply_translation((0.003, 0.0, 0.0))
-    assert operations._highest_in(beyond.vertices[beyond.faces], pads, -1.0) is None
+    assert fingers._highest_in(beyond.vertices[beyond.faces], pads, -1.0) is None
 
 
 @pytest.mark.slow  # imports, teaches peg2's skill, one trial and one assembly step in physics (about 60 s under load)

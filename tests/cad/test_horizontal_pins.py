@@ -19,7 +19,7 @@ from bridge.product import load_product_description
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.cad.cli import ImportOptions, run_import
-from executor.cad.operations import _highest_near
+from executor.cad.operations.arm import _highest_near
 from executor.campaign.reach import pin_cad, pin_ring
 from executor.cell_description import CellDescription
 from executor.world.arm import quat_to_matrix

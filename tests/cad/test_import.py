@@ -22,7 +22,9 @@ from bridge.assembly import load_assembly
 from executor.cad.cli import run_import
 from executor.cad.convex import base_is_primitive
 from executor.cad.derive import Derived, derive
-from executor.cad.operations import WRIST_RADIUS, finger_orders, margins
+from executor.cad.operations.arm import WRIST_RADIUS
+from executor.cad.operations.rooms import margins
+from executor.cad.operations.tools import finger_orders
 from executor.cad.parts import CadPart, load_meshes
 from executor.world.geometry import load_geometry
 

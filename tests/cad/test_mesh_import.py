@@ -23,7 +23,7 @@ from executor.cad.convex import NOMINAL_OVERLAP, PIECE_VERTICES, _beyond, _hull_
 from executor.cad.fits.faces import TOUCH
 from executor.cad.sections import edge_distance, slice_loops
 from executor.cad.sweep import bvh, convex_object
-from executor.cad.write import CELL_DEFLECTION
+from executor.cad.write.meshes import CELL_DEFLECTION
 from executor.world.geometry import load_geometry
 from executor.world.meshes import read_objects
 

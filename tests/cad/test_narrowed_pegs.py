@@ -1,7 +1,7 @@
 """A round peg at a room the cell does not resolve (here room 0) in a round hole of a base
 that is its own mesh (a block with a bore along y, entered sideways): the cell cannot widen
 the hole, so it narrows the peg by ``NOMINAL_FIT_ROOM`` per side, the peg's section as it
-reads it and the convex pieces the import writes (``executor.cad.operations.narrows_peg``,
+reads it and the convex pieces the import writes (``executor.cad.operations.resolution.narrows_peg``,
 ``executor.world.meshes.narrowed``), and only where no other hole's answer would change."""
 
 from __future__ import annotations

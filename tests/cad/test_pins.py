@@ -24,9 +24,9 @@ from assembly_constraints.cli import main
 from executor import ExecutorError
 from executor.cad.derive import Derived, derive
 from executor.cad.derive.bore_on_pin import _GRID, _joined
-from executor.cad.operations import margins
+from executor.cad.operations.rooms import margins
 from executor.cad.parts import CadPart
-from executor.cad.write import near_miss_assumption, pin_near_misses
+from executor.cad.write.near_misses import near_miss_assumption, pin_near_misses
 from executor.world.geometry import HoleSpec, PartSpec, _with_widened_fits, load_geometry
 from tests.cad.conftest import learned_in_the_cell, manual_reasons, teach
 from tests.cad.test_mesh_import import _box

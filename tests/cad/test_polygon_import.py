@@ -17,16 +17,13 @@ import trimesh
 
 from executor.cad.cli import report
 from executor.cad.derive import derive
-from executor.cad.operations import cell_view, margins
+from executor.cad.operations.rooms import margins
+from executor.cad.operations.view import cell_view
 from executor.cad.parts import load_meshes
 from executor.cad.sections import Shape2D, passes, zero_clearance
-from executor.cad.write import (
-    Settings,
-    _section_lines,
-    assembly_text,
-    nominal_text,
-    sizes_text,
-)
+from executor.cad.write.assembly import Settings, assembly_text
+from executor.cad.write.facts import nominal_text, sizes_text
+from executor.cad.write.geometry import _section_lines
 from executor.world.geometry import Section, margin
 from tests._outlines import splined
 

@@ -15,7 +15,7 @@ from trimesh.path.traversal import discretize_path
 
 from executor.cad import sections
 from executor.cad.derive import derive
-from executor.cad.operations import margins
+from executor.cad.operations.rooms import margins
 from executor.cad.parts import CadPart
 from executor.cad.sections import Loop, classify
 

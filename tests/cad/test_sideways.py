@@ -19,7 +19,7 @@ from bridge import BridgeError
 from bridge.product import load_product_description
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.derive import LEAVING
-from executor.cad.operations import SIDEWAYS_HOLE_REACH, SIDEWAYS_PIN_REACH
+from executor.cad.operations.arm import SIDEWAYS_HOLE_REACH, SIDEWAYS_PIN_REACH
 from executor.cad.sections import frame_of
 from executor.cad.sweep import DIRECTIONS, opposite
 from executor.trial import Cell

@@ -18,8 +18,8 @@ from assembly_constraints.cli import main
 from assembly_constraints.corpus_truth import CorpusImport, feature_holes, import_product
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad import operations
-from executor.cad.operations import flat_top
+from executor.cad.operations import fingers
+from executor.cad.operations.tools import flat_top
 from executor.cell_description import CellDescription
 from executor.trial import Cell
 from executor.world.arm import Dropped, tool_quat
@@ -50,7 +50,7 @@ def test_a_short_peg_with_a_pointed_top_stays_by_hand(tmp_path: Path, capsys: py
 @pytest.mark.slow  # imports the product (about 13 s under load)
 def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # The bin bases' top is a 41.5 mm rounded square: a 45 mm cup does not lie whole on it.
-    monkeypatch.setitem(operations.GRIPPER, "cup_diameter", 0.045)
+    monkeypatch.setitem(fingers.GRIPPER, "cup_diameter", 0.045)
     done = import_product(CORPUS / "gridfinity_bases", tmp_path / "out")
     manual = tomllib.loads((done.out / "geometry.toml").read_text()).get("manual", {})
     assert set(manual) == {"bin_base_a", "bin_base_b"}

@@ -16,7 +16,7 @@ from executor import ExecutorError
 from executor.cad.derive import derive
 from executor.cad.fits.faces import fit_faces, press_fits
 from executor.cad.fits.threads import cosmetic_pairs, cosmetic_thread, screwed_pairs
-from executor.cad.operations import cell_view
+from executor.cad.operations.view import cell_view
 from executor.cad.parts import CadPart, _check_overlaps, load_meshes
 from tests.conftest import Runner
 

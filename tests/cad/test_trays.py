@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from assembly_constraints.cli import main
-from executor.cad.write import REACH, TRAY_GAP, default_trays
+from executor.cad.write.trays import REACH, TRAY_GAP, default_trays
 from tests.cad.test_covers import _pegs_and_plate
 from tests.cad.test_mesh_import import _box
 

@@ -20,7 +20,7 @@ PREFERRED = (("+z",), ("-z",), ("-x", "+y", "-y"), ("+x",))
 """The classes a part's way out (its insertion axis reversed) is chosen by among those it
 is free along, in order: up (the cell inserts from above), down, the horizontal ones whose
 insertion the cell's arm was measured to reach sideways (-x, +y, -y: the insertions +x,
--y, +y of :data:`executor.cad.operations.SIDEWAYS_HOLE_REACH`), so a part free both ways
+-y, +y of :data:`executor.cad.operations.arm.SIDEWAYS_HOLE_REACH`), so a part free both ways
 along x goes in along +x however the CAD is turned about z, then +x; a zero-clearance
 fit's axis that is none of these, last. Within a class the product's geometry chooses
 (:func:`_way_out`)."""
