@@ -199,7 +199,7 @@ def test_square_nuts_go_onto_the_pins_in_physics(run_main: Runner, tmp_path: Pat
     geometry = tomllib.loads((out / "geometry.toml").read_text())
     assert "manual" not in geometry and {name: shape.get("bore") for name, shape in geometry["part_shapes"].items()} \
         == {"nut10": True, "nut8": True}
-    result, observed = learned_in_the_cell(run_main, teach(out), tmp_path / "run")
+    result, observed = learned_in_the_cell(run_main, teach(out), tmp_path / "run", exact=True)
     # every pair tried in physics: the 9 mm bore stops on the 10 mm pin, the others go on
     assert observed == {("nut10", "plate_pin1"): "fit", ("nut10", "plate_pin2"): "fit",
                         ("nut8", "plate_pin1"): "no_fit", ("nut8", "plate_pin2"): "fit"}
