@@ -1,8 +1,9 @@
 """Parts onto pins the cell puts them onto beyond one part on a pin of the base: a washer
 then a nut down one pin of the plate, the nut resting on the washer (stacked end to end),
 and an arm down the pin standing on a block placed by hand. The import leaves them to the
-cell, a sim session learns their fits in physics (the washer's and the nut's bores stop
-on the block's wider pin, the block at its goal in those trials) and assembles the plan; what
+cell, a sim session learns their fits in physics (square bores onto round pins: the
+washer's and the nut's stop on the block's wider pin, the block at its goal in those
+trials, the arm's goes onto either pin) and assembles the plan; what
 the cell does not do stays placed by hand, named."""
 
 from __future__ import annotations
