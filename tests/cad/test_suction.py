@@ -57,15 +57,15 @@ def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monke
     assert "the suction cup (45 mm) does not lie whole on its flat top" in manual["bin_base_a"]["reason"]
 
 
-@pytest.mark.slow  # imports the product (about 10 s under load)
-def test_a_2_mm_plate_goes_on_the_suction_cup_into_its_recess_at_the_ledge_it_rests_on(tmp_path: Path) -> None:
+@pytest.mark.slow  # imports the product (shared with test_corpus.py's on a worker: about 10 s under load)
+def test_a_2_mm_plate_goes_on_the_suction_cup_into_its_recess_at_the_ledge_it_rests_on(
+        corpus_import: Callable[[str], CorpusImport]) -> None:
     # nop_printed_box's base: a 2 mm plate, the cell's hull margin twice: it collides as
     # itself within what the cell resolves (executor/world/meshes.py), so it is inserted, not
     # placed by hand; it rests on the ledge 2.99 mm under the recess's rim, where the cell's
     # goal is, not on the case's top 43 mm down the recess's centre line. So shallow a
     # recess cannot tell a plate in it from one on its rim: the fit is no experiment.
-    done = import_product(CORPUS / "nop_printed_box", tmp_path / "out")
-    geometry = tomllib.loads((done.out / "geometry.toml").read_text())
+    geometry = tomllib.loads((corpus_import("nop_printed_box").out / "geometry.toml").read_text())
     assert "manual" not in geometry
     assert geometry["part_shapes"]["smooth_box_base"]["tool"] == "suction"
     (hole,) = geometry["hole_shapes"].values()
