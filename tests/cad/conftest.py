@@ -107,17 +107,18 @@ def manual_reasons(out: Path) -> dict[str, str]:
             .get("manual", {}).items()}
 
 
-def learned_in_the_cell(run_main: Runner, folder: Path, run: Path,
-                        exact: bool = False) -> tuple[dict[str, Any], dict[tuple[str, str], str]]:
-    """A sim session of the taught product in ``folder`` (:func:`teach`) with ``--assemble``
-    into ``run`` (the command in this process, the session's cell a process of its own): its
-    result and the outcome of each (part, hole) its journal records. With ``exact``, its cell
+def learned_in_the_cell(run_main: Runner, folder: Path, run: Path, exact: bool = False,
+                        assemble: bool = True) -> tuple[dict[str, Any], dict[tuple[str, str], str]]:
+    """A sim session of the taught product in ``folder`` (:func:`teach`), with ``--assemble``
+    if ``assemble``, into ``run`` (the command in this process, the session's cell a process
+    of its own): its result and the outcome of each (part, hole) its journal records. With ``exact``, its cell
     without pose errors and its search 1 mm wide (:func:`tests.session.exact_cell`, written
     beside ``run``): the experiments decide on the geometry alone, a ``no_fit`` without the
     default search's spirals (the cell's default uncertainty through a session:
     ``tests/session/test_session_sim.py``)."""
     cell = exact_cell(run.parent) if exact else ()
-    session = run_main("session", "--assembly", str(folder), "--out", str(run), "--assemble", "--json", *cell)
+    session = run_main("session", "--assembly", str(folder), "--out", str(run), "--json",
+                       *(("--assemble",) if assemble else ()), *cell)
     assert session.returncode == 0, session.stderr
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     return json.loads(session.stdout), {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e}
