@@ -18,7 +18,6 @@ from assembly_constraints.cli import main
 from assembly_constraints.corpus_truth import CorpusImport, feature_holes, import_product
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
-from executor.cad import operations
 from executor.cad.operations import flat_top
 from executor.cell_description import CellDescription
 from executor.trial import Cell
@@ -26,6 +25,7 @@ from executor.world.arm import Dropped, tool_quat
 from executor.world.geometry import load_geometry
 from tests.cad.conftest import CORPUS, corpus_copy, learned_in_the_cell, teach
 from tests.cad.test_covers import _pegs_and_plate
+from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
 
@@ -47,14 +47,15 @@ def test_a_short_peg_with_a_pointed_top_stays_by_hand(tmp_path: Path, capsys: py
             "suction cup)") in capsys.readouterr().out
 
 
-@pytest.mark.slow  # imports the product (about 13 s under load)
-def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    # The bin bases' top is a 41.5 mm rounded square: a 45 mm cup does not lie whole on it.
-    monkeypatch.setitem(operations.GRIPPER, "cup_diameter", 0.045)
-    done = import_product(CORPUS / "gridfinity_bases", tmp_path / "out")
-    manual = tomllib.loads((done.out / "geometry.toml").read_text()).get("manual", {})
-    assert set(manual) == {"bin_base_a", "bin_base_b"}
-    assert "the suction cup (45 mm) does not lie whole on its flat top" in manual["bin_base_a"]["reason"]
+def test_a_cup_larger_than_the_top_leaves_the_part_by_hand(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # peg2, 18 mm long (the fingers hold 20), its flat top a 12 mm square: the 30 mm cup
+    # does not lie whole on it (a 12 mm square is 20.4 % of the cup's disc).
+    _pegs_and_plate(tmp_path / "cad", (560.0, 0.0))
+    _box((12, 12, 18), (585.0, 0.0, 14.0)).export(tmp_path / "cad" / "peg2.stl")
+    assert main(["-q", "import", str(tmp_path / "cad"), "--out", str(tmp_path / "out")]) == 0
+    assert ("manual peg2: the cell has no operation for it, a plan's step places it by hand (part 'peg2' is "
+            "18.000 mm long, no longer than the gripper's grasp depth (20 mm), and the suction cup (30 mm) does not "
+            "lie whole on its flat top (20.4% of the cup on it))") in capsys.readouterr().out
 
 
 @pytest.mark.slow  # imports the product (shared with test_corpus.py's on a worker: about 10 s under load)
