@@ -5,7 +5,8 @@ corpus product imported, ``corpus_import(name)`` (``test_corpus``, ``test_suctio
 that writes into the folder works on a copy, :func:`corpus_copy`). And helpers:
 ``teach(folder)`` (an imported product's skills taught in this process, of every part shape
 or of some parts' only), ``learned_in_the_cell`` (a sim session of a taught product with its
-assembly) and ``trial_on_edited_mesh`` (one attempt in a copy whose mesh was changed)."""
+assembly), ``trial_on_edited_mesh`` (one attempt in a copy whose mesh was changed) and
+``exact_setup`` (the cell without pose errors both of these can run on)."""
 
 from __future__ import annotations
 
