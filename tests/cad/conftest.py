@@ -5,7 +5,8 @@ corpus product imported, ``corpus_import(name)`` (``test_corpus``, ``test_suctio
 that writes into the folder works on a copy, :func:`corpus_copy`). And helpers:
 ``teach(folder)`` (an imported product's skills taught in this process, of every part shape
 or of some parts' only), ``learned_in_the_cell`` (a sim session of a taught product with its
-assembly) and ``trial_on_edited_mesh`` (one attempt in a copy whose mesh was changed)."""
+assembly), ``trial_on_edited_mesh`` (one attempt in a copy whose mesh was changed) and
+``exact_setup`` (the cell without pose errors both of these can run on)."""
 
 from __future__ import annotations
 
@@ -23,14 +24,17 @@ import trimesh
 
 from assembly_constraints.cli import main
 from assembly_constraints.corpus_truth import CorpusImport, import_product
+from bridge.cell_settings import Magnitudes
 from executor.cad.cli import run_import
 from executor.cad.derive import Derived
+from executor.cell_description import load_cell_description
 from executor.evidence import TrialResult
 from executor.skills.dmp import save_skill
 from executor.skills.teach import teach_all, teach_shape
-from executor.trial import Cell
+from executor.trial import Cell, CellSetup
 from executor.world.assets import regenerate_assets
 from tests.conftest import Runner
+from tests.session import exact_cell
 
 CORPUS = Path(__file__).parent / "corpus"
 """The corpus of products of real CAD (``tests/cad/corpus/README.md``)."""
@@ -104,21 +108,39 @@ def manual_reasons(out: Path) -> dict[str, str]:
             .get("manual", {}).items()}
 
 
-def learned_in_the_cell(run_main: Runner, folder: Path, run: Path) -> tuple[dict[str, Any], dict[tuple[str, str], str]]:
-    """A sim session of the taught product in ``folder`` (:func:`teach`) with ``--assemble``
-    into ``run`` (the command in this process, the session's cell a process of its own): its
-    result and the outcome of each (part, hole) its journal records."""
-    session = run_main("session", "--assembly", str(folder), "--out", str(run), "--assemble", "--json")
+def learned_in_the_cell(run_main: Runner, folder: Path, run: Path, exact: bool = False,
+                        assemble: bool = True) -> tuple[dict[str, Any], dict[tuple[str, str], str]]:
+    """A sim session of the taught product in ``folder`` (:func:`teach`), with ``--assemble``
+    if ``assemble``, into ``run`` (the command in this process, the session's cell a process
+    of its own): its result and the outcome of each (part, hole) its journal records. With ``exact``, its cell
+    without pose errors and its search 1 mm wide (:func:`tests.session.exact_cell`, written
+    beside ``run``): the experiments decide on the geometry alone, a ``no_fit`` without the
+    default search's spirals (the cell's default uncertainty through a session:
+    ``tests/session/test_session_sim.py``)."""
+    cell = exact_cell(run.parent) if exact else ()
+    session = run_main("session", "--assembly", str(folder), "--out", str(run), "--json",
+                       *(("--assemble",) if assemble else ()), *cell)
     assert session.returncode == 0, session.stderr
     journal = [json.loads(line) for line in (run / "journal.jsonl").read_text().splitlines()]
     return json.loads(session.stdout), {(e["part"], e["hole"]): e["result"] for e in journal if "result" in e}
+
+
+def exact_setup(folder: Path) -> CellSetup:
+    """A simulated cell without pose errors, its search 1 mm wide: :func:`tests.session.exact_cell`
+    (its cell description written in ``folder``) as a :class:`CellSetup`."""
+    argv = exact_cell(folder)  # --option value pairs
+    options = dict(zip(argv[::2], argv[1::2]))
+    description = load_cell_description(Path(options.pop("--cell-description")))
+    return CellSetup(magnitudes=Magnitudes(**{name[2:].replace("-", "_"): float(value)
+                                               for name, value in options.items()}), description=description)
 
 
 def trial_on_edited_mesh(taught: Path, copy: Path, mesh: str, edit: Callable[[trimesh.Trimesh], None],
                          part: str, hole: str) -> TrialResult:
     """One attempt of ``part`` into ``hole`` (seed 0) in a cell of ``taught`` copied to
     ``copy`` with ``meshes/<mesh>.obj`` changed by ``edit`` (its digest in ``geometry.toml``
-    with it): the cell collides with the edited mesh."""
+    with it): the cell collides with the edited mesh. The cell is :func:`exact_setup`'s: the
+    attempt decides on the edited geometry alone, without the default search's spirals."""
     shutil.copytree(taught, copy)
     mesh_file = copy / "meshes" / f"{mesh}.obj"
     loaded = trimesh.load(mesh_file, force="mesh", process=False)
@@ -127,7 +149,7 @@ def trial_on_edited_mesh(taught: Path, copy: Path, mesh: str, edit: Callable[[tr
     old = hashlib.sha256((taught / "meshes" / f"{mesh}.obj").read_bytes()).hexdigest()
     text = copy / "geometry.toml"
     text.write_text(text.read_text().replace(old, hashlib.sha256(mesh_file.read_bytes()).hexdigest()))
-    cell = Cell(str(copy))
+    cell = Cell(str(copy), setup=exact_setup(copy.parent))
     try:
         return cell.run_trial(part, hole, 0, max_attempts=1)
     finally:

@@ -37,6 +37,8 @@ POSE_BOUND_MM = 2.0
 SECTIONS = 24
 """The sides of the own-mesh cover's openings and socket and of the head's cylinders (CoACD
 cuts the cover at its first threshold, 0.05; a 48-gon's cover it cuts twice, 2.5 times the CPU)."""
+STEP_KEYS = {"part", "hole", "skill", "outcome", "attempts", "duration_s", "max_force_dev"}
+"""What ``assemble --json`` reports of each step."""
 REST_BOUND = 5e-4
 """A cover of convex pieces let go at its goal rests within this of it [m] (the hull margin,
 1 mm, is what an uneroded piece would add)."""
@@ -103,6 +105,8 @@ def test_the_imported_cranfield_is_learned_and_assembled_in_the_cell(
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["assembled"] and set(report["final_pose_error_mm"]) == set(derived.parts)
+    assert len(report["steps"]) == 10 and all(STEP_KEYS <= set(step) for step in report["steps"])
+    assert [step["outcome"] for step in report["steps"]] == ["fit"] * 10
     assert "truth" not in {step["skill"] for step in report["steps"]}  # the sim cell's skills, not the truth's
     assert max(report["final_pose_error_mm"].values()) <= POSE_BOUND_MM, report["final_pose_error_mm"]
 

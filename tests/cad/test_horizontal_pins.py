@@ -2,9 +2,9 @@
 +y and a ring (d 24, 8 mm long) on it is imported with the pin's axis and free end, taught,
 and assembled in physics by the same skills as a part going down onto a pin, run in the
 pin's frame (:mod:`executor.world.frames`), as a peg goes into a hole entered sideways
-(tests/cad/test_sideways.py); a second ring goes on against the first. A ring at nominal
-zero clearance goes on with its bore widened by the room the cell gives such a fit, and a
-pin wider than the ring's bore stops it at the pin's end."""
+(tests/cad/test_sideways.py); a second ring, at nominal zero clearance, goes on against
+the first with its bore widened by the room the cell gives such a fit, and a pin wider
+than the ring's bore stops it at the pin's end."""
 
 from __future__ import annotations
 
@@ -34,20 +34,22 @@ PIN = 10.0
 
 
 def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0,
-            place: tuple[float, float] | None = None, second: bool = False) -> Path:
-    """:func:`pin_cad`'s product imported; with ``second``, a second ring (d 22) against the first."""
+            place: tuple[float, float] | None = None, second: float | None = None) -> Path:
+    """:func:`pin_cad`'s product imported; with a ``second`` bore [mm], a second ring (d 22)
+    with that bore against the first."""
     cad = pin_cad(tmp / "cad", bore, wall, turn)
-    if second:
-        pin_ring(bore, 11.0, 33.0, turn).export(cad / "ring2.stl")
+    if second is not None:
+        pin_ring(second, 11.0, 33.0, turn).export(cad / "ring2.stl")
     run_import(cad, tmp / "out", "mm", tmp / "import.toml", ImportOptions(place=place))
     return tmp / "out"
 
 
 @pytest.fixture(scope="module")
 def taught(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The ring with a d 10.2 bore (0.1 mm of room all round) and a second ring against it,
-    imported and taught on their pin (``executor teach``, in this process)."""
-    return teach(_import(tmp_path_factory.mktemp("horizontal"), 10.2, second=True))
+    """The ring with a d 10.2 bore (0.1 mm of room all round) and a second ring against it
+    with a d 10 bore (a nominal zero-clearance fit), imported and taught on their pin
+    (``executor teach``, in this process)."""
+    return teach(_import(tmp_path_factory.mktemp("horizontal"), 10.2, second=PIN))
 
 
 def test_a_pin_along_y_is_written_with_its_axis_and_free_end(tmp_path: Path) -> None:
@@ -66,20 +68,18 @@ def test_a_pin_along_y_is_written_with_its_axis_and_free_end(tmp_path: Path) -> 
     assert written.bounds == pytest.approx(np.array([[-0.012, -0.012, 0.0], [0.012, 0.012, 0.008]]), abs=1e-6)
 
 
-@pytest.mark.slow  # imports, teaches the ring, then the block and the ring assembled in physics (about 10 s of CPU)
-def test_a_ring_at_zero_clearance_goes_onto_the_horizontal_pin_with_its_bore_widened_within_2_mm(
-        tmp_path: Path) -> None:
-    # The ring's d 10 bore on the d 10 pin: a nominal zero-clearance fit, room 0, under the
-    # 0.025 mm per side the physics resolves. The cell builds it 0.15 mm per side wider
-    # (the ring's pieces about a d 10.3 circle, its bore section as the cell reads it) and
-    # puts it on as the bearings of real CAD go onto their seats.
-    out = _import(tmp_path, PIN)
-    geometry = load_product_description(out).geometry
+@pytest.mark.slow  # imports and teaches the rings (shared)
+def test_a_ring_at_zero_clearance_is_built_with_its_bore_widened(taught: Path) -> None:
+    # The second ring's d 10 bore on the d 10 pin: a nominal zero-clearance fit, room 0,
+    # under the 0.025 mm per side the physics resolves. The cell builds it 0.15 mm per side
+    # wider (the ring's pieces about a d 10.3 circle, its bore section as the cell reads it)
+    # and puts it on as the bearings of real CAD go onto their seats (in physics: the two
+    # rings' assembly below).
+    geometry = load_product_description(taught).geometry
     assert geometry is not None and geometry.manual == {}
-    assert geometry.hole_shapes["block_pin1"].zero_clearance == ["ring"]
-    assert load_geometry(str(out)).parts["ring"].size == pytest.approx(0.0103, abs=1e-6)
-    assert "grown by 0.15 mm" in (out / "meshes" / "ring.convex.obj").read_text().splitlines()[2]
-    assembled(teach(out), "block", "ring", "block_pin1")
+    assert geometry.hole_shapes["block_pin1"].zero_clearance == ["ring2"]
+    assert load_geometry(str(taught)).parts["ring2"].size == pytest.approx(0.0103, abs=1e-6)
+    assert "grown by 0.15 mm" in (taught / "meshes" / "ring2.convex.obj").read_text().splitlines()[2]
 
 
 def test_a_ring_whose_wrist_would_meet_a_wall_of_the_base_is_placed_by_hand(tmp_path: Path) -> None:
@@ -159,9 +159,10 @@ def test_a_pin_wider_than_the_bore_stops_the_ring_at_its_end_in_physics(taught: 
 
 @pytest.mark.slow  # teaches two rings (shared), assembles the block and both in physics (about 10 s of CPU)
 def test_a_ring_then_a_second_ring_go_onto_the_horizontal_pin_within_2_mm(taught: Path) -> None:
-    # the ring goes on along the pin's axis by the skill's insertion; the second ring (d 22)
-    # drawn against the first along the pin: the import leaves both to the cell, which puts
-    # the second on after the first, its goal 8 mm farther out
+    # the ring goes on along the pin's axis by the skill's insertion; the second ring (d 22,
+    # its zero-clearance bore widened) drawn against the first along the pin: the import
+    # leaves both to the cell, which puts the second on after the first, its goal 8 mm
+    # farther out
     geometry = load_product_description(taught).geometry
     assert geometry is not None and geometry.manual == {}
     assembler = Assembler(load_product(str(taught)), description=CellDescription())

@@ -2,9 +2,10 @@
 of the base carries an upright pin, and a ring goes onto that pin (a washer onto a pin of
 the base beside it, its bore too small for the block's pin). The import puts the block
 before the ring (the geometric precedence) and leaves all three to the cell; a sim session
-learns their fits in physics and assembles the plan. The ring's goal is taken from where
+learns their fits in physics, and the cell inserts the block and puts the ring onto its
+pin (the washer onto the base's pin is a plain step). The ring's goal is taken from where
 the block ended (its observed pose times the pin's pose in its frame): with the block
-moved 1 or 3 mm off its goal, the ring still goes onto the pin, within 2 mm of its goal.
+moved 3 mm off its goal, the ring still goes onto the pin, within 2 mm of its goal.
 A block drawn off its pocket's centre leaves the ring placed by hand, named."""
 
 from __future__ import annotations
@@ -92,10 +93,10 @@ def test_a_block_drawn_off_its_pocket_s_centre_leaves_the_ring_placed_by_hand(tm
                 "(centred, on the bottom) its pin is 0.500 mm from the CAD's (at most 0.1 mm)"}
 
 
-@pytest.mark.slow  # three parts taught (shared), a sim session with its assembly (about 14 s of CPU)
-def test_the_ring_onto_the_block_s_pin_is_learned_and_assembled_in_physics(run_main: Runner, owned: Path,
-                                                                           tmp_path: Path) -> None:
-    result, observed = learned_in_the_cell(run_main, owned, tmp_path / "run")
+@pytest.mark.slow  # three parts taught (shared), a sim session (about 10 s of CPU)
+def test_the_ring_onto_the_block_s_pin_is_learned_in_physics(run_main: Runner, owned: Path, tmp_path: Path) -> None:
+    # the plan's assembly: the block and the ring onto its pin below, the block moved
+    result, observed = learned_in_the_cell(run_main, owned, tmp_path / "run", exact=True, assemble=False)
     # tried in physics, the block at its goal in the trials onto its pin (without it a part
     # falls to the pin's goal through the air: a fit): the washer's 7.5 mm bore stops on the
     # block's d 8 pin, the ring's 9 mm bore goes onto it
@@ -103,11 +104,8 @@ def test_the_ring_onto_the_block_s_pin_is_learned_and_assembled_in_physics(run_m
     cad = {atom for atom in (owned / "sizes.lp").read_text().replace(".", " ").split() if atom.startswith("fits(")}
     assert {f"fits({part},{hole})" for part, hole in result["fits"]} == cad == {
         "fits(block,h1)", "fits(ring,block_pin1)", "fits(ring,base_pin1)", "fits(washer,base_pin1)"}
-    steps = {step["part"]: step for step in result["assembly"]["steps"]}
-    assert result["assembly"]["assembled"]
-    assert {pid: (steps[pid]["hole"], steps[pid]["skill"]) for pid in ("block", "ring", "washer")} == {
-        "block": ("h1", "insert"), "ring": ("block_pin1", "insert"), "washer": ("base_pin1", "insert")}
-    assert all(steps[pid]["pose_error_mm"] <= 2.0 for pid in ("block", "ring", "washer")), steps
+    order = [step["part"] for step in result["plans"][0]]
+    assert order.index("block") < order.index("ring")  # the geometric precedence kept
 
 
 def _shift_locked(assembler: Assembler, part: str, shift: np.ndarray) -> None:
@@ -129,7 +127,8 @@ def test_the_ring_follows_the_block_where_it_ended(owned: Path, shift_mm: float)
     assembler = Assembler(load_product(str(owned)), description=CellDescription())
     try:
         assert assembler.run_step("base", None, 0).outcome == "fit"
-        assert assembler.run_step("block", "h1", 0).outcome == "fit"
+        block_step = assembler.run_step("block", "h1", 0)
+        assert block_step.outcome == "fit" and block_step.pose_error <= 0.002, block_step
         shift, inserted = np.array([shift_mm / 1e3, 0.0, 0.0]), assembler.world.position("block")
         _shift_locked(assembler, "block", shift)
         block = assembler.world.position("block")

@@ -1,9 +1,9 @@
 """Parts that go onto pins: a washer and a gear whose bores go over the pins of a plate are
 fits of each part onto a pin (the pin's section inside the bore's), written like pegs in
-holes; the cell puts a part onto a pin where its convex pieces keep the bore (two square
-nuts: learned and assembled in physics; the washer with its round bore made coarser by a
-loss within its room), and places by hand a part whose pieces are too thin for it (the
-gear's 2 mm teeth)."""
+holes; the cell puts a part onto a pin where its convex pieces keep the bore (the washer
+with its round bore made coarser by a loss within its room; square bores onto round pins
+learned and assembled in physics: ``test_stacked_pins.py``), and places by hand a part
+whose pieces are too thin for it (the gear's 2 mm teeth)."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ from executor.cad.operations.rooms import margins
 from executor.cad.parts import CadPart
 from executor.cad.write.near_misses import near_miss_assumption, pin_near_misses
 from executor.world.geometry import HoleSpec, PartSpec, _with_widened_fits, load_geometry
-from tests.cad.conftest import learned_in_the_cell, manual_reasons, teach
+from tests.cad.conftest import manual_reasons
 from tests.cad.test_mesh_import import _box
 from tests.conftest import Runner
 
@@ -43,11 +43,10 @@ def _pin(radius: float, x: float) -> trimesh.Trimesh:
     return pin
 
 
-def _with_bore(outline: shapely.Polygon, bore: float | shapely.Polygon, x: float) -> trimesh.Trimesh:
-    """``outline`` [mm] less a bore (a round one of diameter ``bore`` [mm], or that
-    polygon), 4 mm thick, on the plate top (z 10) at ``x`` [mm]."""
-    hole = bore if isinstance(bore, shapely.Polygon) else shapely.Point(0.0, 0.0).buffer(bore / 2, quad_segs=32)
-    ring = outline.difference(hole)
+def _with_bore(outline: shapely.Polygon, bore: float, x: float) -> trimesh.Trimesh:
+    """``outline`` [mm] less a round bore of diameter ``bore`` [mm], 4 mm thick, on the
+    plate top (z 10) at ``x`` [mm]."""
+    ring = outline.difference(shapely.Point(0.0, 0.0).buffer(bore / 2, quad_segs=32))
     part = trimesh.creation.extrude_polygon(ring, 4.0)
     part.apply_translation((x, 0.0, 10.0))
     return part
@@ -186,27 +185,6 @@ def test_a_truth_session_learns_which_part_goes_onto_which_pin(run_main: Runner,
     assert {tuple(pair) for pair in result["fits"]} == FITS
     steps = {step["part"]: step for step in result["assembly"]["steps"]}
     assert result["assembly"]["assembled"] and steps["gear"]["skill"] == "manual" != steps["washer"]["skill"]
-
-
-@pytest.mark.slow  # imports, teaches two parts and runs a sim session with its assembly (about 90 s)
-def test_square_nuts_go_onto_the_pins_in_physics(run_main: Runner, tmp_path: Path) -> None:
-    square = shapely.box(-1.0, -1.0, 1.0, 1.0)
-    nuts = {"nut10": _with_bore(shapely.affinity.scale(square, 10.0, 10.0), shapely.affinity.scale(square, 5.5, 5.5),
-                                X_MM - 25),  # a 20 mm square with an 11 mm square bore on the 10 mm pin
-            "nut8": _with_bore(shapely.affinity.scale(square, 9.0, 9.0), shapely.affinity.scale(square, 4.5, 4.5),
-                               X_MM + 25)}  # an 18 mm square with a 9 mm square bore on the 8 mm pin
-    out = _import(tmp_path, nuts)
-    geometry = tomllib.loads((out / "geometry.toml").read_text())
-    assert "manual" not in geometry and {name: shape.get("bore") for name, shape in geometry["part_shapes"].items()} \
-        == {"nut10": True, "nut8": True}
-    result, observed = learned_in_the_cell(run_main, teach(out), tmp_path / "run")
-    # every pair tried in physics: the 9 mm bore stops on the 10 mm pin, the others go on
-    assert observed == {("nut10", "plate_pin1"): "fit", ("nut10", "plate_pin2"): "fit",
-                        ("nut8", "plate_pin1"): "no_fit", ("nut8", "plate_pin2"): "fit"}
-    assert {tuple(pair) for pair in result["fits"]} == {pair for pair, r in observed.items() if r == "fit"}
-    steps = {step["part"]: step for step in result["assembly"]["steps"]}
-    assert result["assembly"]["assembled"]
-    assert all(steps[p]["skill"] == "insert" and steps[p]["pose_error_mm"] <= 2.0 for p in nuts)
 
 
 def test_the_union_of_a_straight_pin_s_noisy_sections_keeps_a_section_s_size_and_lies_within_the_grid() -> None:

@@ -69,7 +69,7 @@ def test_a_plate_onto_pins_of_the_base_and_a_block_placed_by_hand_is_the_cell_s(
 
 @pytest.mark.slow  # the plate taught (shared), a sim session with its assembly
 def test_the_plate_is_learned_and_assembled_in_physics(run_main: Runner, taught: Path, tmp_path: Path) -> None:
-    result, observed = learned_in_the_cell(run_main, taught, tmp_path / "run")
+    result, observed = learned_in_the_cell(run_main, taught, tmp_path / "run", exact=True)
     assert observed == {("plate", "base_pin1"): "fit"}
     cad = {atom for atom in (taught / "sizes.lp").read_text().replace(".", " ").split() if atom.startswith("fits(")}
     assert {f"fits({part},{hole})" for part, hole in result["fits"]} == cad == {

@@ -16,6 +16,7 @@ import pytest
 
 from tests.cad.test_import import _fits
 from tests.conftest import ROOT, Runner
+from tests.session import exact_cell
 
 ASSEMBLY_BOUND_MM = 2.0
 """The largest final pose error of an assembled part [mm]."""
@@ -30,8 +31,7 @@ def _session(run: Runner, backend: str, *argv: str) -> dict:
 
 
 @pytest.mark.slow
-def test_a_build123d_step_product_is_learned_in_physics_and_assembled(run_cli: Runner, run_main: Runner,
-                                                                      tmp_path: Path) -> None:
+def test_a_build123d_step_product_is_learned_in_physics_and_assembled(run_main: Runner, tmp_path: Path) -> None:
     step, product = tmp_path / "pegs.step", tmp_path / "pegs"
     subprocess.run([sys.executable, str(ROOT / "examples" / "step_pegs.py"), str(step)], check=True, timeout=120)
     for argv in (("import", str(step), "--out", str(product)), ("executor", "teach", "--assembly", str(product))):
@@ -44,11 +44,13 @@ def test_a_build123d_step_product_is_learned_in_physics_and_assembled(run_cli: R
     assert {tuple(pair) for pair in plain["fits"]} == truth and plain["prior"] is None
 
     # the prior decides every pair but the rect peg's 0.3 mm room in its slot: that one
-    # observed in physics, then the plan assembled by the sim cell (the console command as a
-    # process, its cell another)
+    # observed in physics, then the plan assembled by the sim cell (the command in this
+    # process, its cell another; a sim session's command as a process:
+    # tests/session/test_mixed_sections.py), the cell without pose errors (exact_cell: the
+    # cell's default uncertainty through a session is tests/session/test_session_sim.py's)
     run = tmp_path / "prior"
-    prior = _session(run_cli, "sim", "--assembly", str(product), "--prior", "cad", "--tolerance", TOLERANCE_M,
-                     "--assemble", "--out", str(run))
+    prior = _session(run_main, "sim", "--assembly", str(product), "--prior", "cad", "--tolerance", TOLERANCE_M,
+                     "--assemble", "--out", str(run), *exact_cell(tmp_path))
     assert {tuple(pair) for pair in prior["fits"]} == truth
     assert prior["experiments"] < plain["experiments"]
     decided = {(p, h): r for p, h, r in prior["prior"]["decided"]}
