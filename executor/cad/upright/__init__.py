@@ -1,0 +1,144 @@
+"""Whether a product read with the CAD's +z up looks drawn with another axis up
+(docs/import.md, "The up axis"): tilted (:func:`drawn_tilted`, before deriving), lying on its
+side or upside down, or unable to rest on the floor as read (:func:`drawn_up`, after
+deriving), and the up to set."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import trimesh
+
+from executor.cad.derive import Derived
+from executor.cad.parts import UP_AXES
+from executor.cad.upright.gravity import base_unheld, falls_over, tipping, turned_facts
+from executor.cad.upright.sides import lying
+
+TILT = 1.0
+"""The base's largest flat faces are tilted when their normal lies more than this [deg]
+from the z axis and from the horizontal plane (:func:`drawn_tilted`): no quarter turn sets them square."""
+TILTED_SHARE = 0.15
+"""...and they make at least this fraction of its surface (:func:`drawn_tilted`): not one
+strip of a coarsely tessellated rod (a 24-gon's pair of opposite facets: 8 %)."""
+STANDING_SHARE = 0.5
+"""...unless its horizontal faces (within :data:`TILT`) make at least this fraction of the
+area of those largest faces, one of them at its lowest point, facing down (:func:`drawn_tilted`):
+a coarse prism lying on a face (a hexagonal or octagonal bar: its horizontal pair as large
+as each tilted pair, less its holes) stands on it as drawn, where a product tilted by
+another angle than quarter turns rests on an edge or a corner, unless a face of its base
+lies at that angle."""
+FLOOR = 1e-6
+"""[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
+TIE = 1.0
+"""[deg] ups whose readings stand within this of the steadiest one's tipping angle are named
+together (:func:`drawn_up`)."""
+
+
+def drawn_up(derived: Derived) -> str | None:
+    """Why the product looks drawn with another axis than z up, and the up to set; None
+    when it does not. Doubted (:func:`_doubt`): its base's features and the parts' boxes
+    say it lies on its side or upside down (:func:`executor.cad.upright.sides.lying`), or
+    read as drawn it would fall over (:func:`executor.cad.upright.gravity.falls_over`) or
+    its base would slide down the parts under it
+    (:func:`executor.cad.upright.gravity.base_unheld`). The ups named are those the rule
+    suggests whose readings (:func:`executor.cad.upright.gravity.turned_facts`) are not
+    doubted; where none is, the ups whose readings are not and stand steadiest (their
+    tipping angles, :func:`executor.cad.upright.gravity.tipping`, within :data:`TIE` of
+    the steadiest), of those the ones that lay the base's largest flat faces horizontal
+    where some do (:func:`largest_faces`), in the order of
+    :data:`executor.cad.parts.UP_AXES`; where none is either, the rule's."""
+    found = _doubt(derived)
+    if found is None:
+        return None
+    why, suggested = found
+    readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
+    refused = {up: _doubt(readings[up]) for up in suggested}
+    ups = [up for up in suggested if refused[up] is None]
+    if not ups:
+        steady = {up: tipping(reading)[0] for up, reading in readings.items() if _doubt(reading) is None}
+        best = max(steady.values(), default=0.0)
+        ups = [up for up, angle in steady.items() if angle >= best - TIE]
+        lying_flat = [up for up in ups if _flat(readings[up])]
+        ups = lying_flat or ups
+    rejected = [up for up in suggested if up not in ups]
+    if rejected:
+        first = refused[rejected[0]]
+        why += (f"; read with up = \"{rejected[0]}\" it would be doubted too ({first[0]})" if first is not None
+                else "")
+    return f"{why}: the CAD may be drawn {_described(ups or suggested)}; set up = {_settings(ups or suggested)}" \
+        ' (up = "+z" or --up +z if z is up)'
+
+
+def _flat(derived: Derived) -> bool:
+    """Whether the base's largest flat faces (:func:`largest_faces`) lie horizontal, within :data:`TILT`."""
+    normal, _ = largest_faces(derived.parts[derived.base].mesh)
+    return float(normal[2]) >= math.cos(math.radians(TILT))
+
+
+def _doubt(derived: Derived) -> tuple[str, list[str]] | None:
+    """Why the product read as ``derived`` is doubted and the ups the reason suggests
+    (none: the gravity rules suggest none themselves), None when it is not (:func:`drawn_up`)."""
+    found = lying(derived)
+    if found is not None:
+        return found
+    for rule in (falls_over, base_unheld):
+        why = rule(derived)
+        if why is not None:
+            return why, []
+    return None
+
+
+def _described(ups: list[str]) -> str:
+    """How the CAD may be drawn, by the ``ups`` named: ``y up``, ``upside down (z down)``."""
+    if ups == ["-z"]:
+        return "upside down (z down)"
+    axes = {up[1] for up in ups}
+    return f"{axes.pop()} up" if len(axes) == 1 else "with another axis up"
+
+
+def _settings(ups: list[str]) -> str:
+    """The settings naming ``ups``: ``"+y" or --up +y``, ``"+y" or "-y" (--up +y or --up=-y)``."""
+    settings = " or ".join(f'"{up}"' for up in ups)
+    flags = " or ".join(f"--up {up}" if up[0] == "+" else f"--up={up}" for up in ups)
+    return f"{settings} or {flags}" if len(ups) == 1 else f"{settings} ({flags})"
+
+
+def drawn_tilted(mesh: trimesh.Trimesh, base: str) -> str | None:
+    """Why the product whose base ``base`` has ``mesh`` looks drawn tilted, None when it
+    does not: the normal that the largest area of the base's faces shares (its largest flat
+    faces, normals alike to 0.001, a face and its opposite as one: the normal taken with z
+    >= 0) lies more than :data:`TILT` from the z axis and from the horizontal plane, they
+    make :data:`TILTED_SHARE` of its surface or more, and the base does not stand on
+    horizontal faces (:func:`_standing`)."""
+    normal, area = largest_faces(mesh)
+    from_z = math.degrees(math.acos(min(1.0, float(normal[2]))))
+    if min(from_z, 90.0 - from_z) <= TILT or area < TILTED_SHARE * mesh.area or _standing(mesh, area):
+        return None
+    facing = ", ".join(f"{v:.3f}" for v in normal + 0.0)
+    return (f"the base {base}'s largest flat faces ({100 * area / mesh.area:.0f} % of its surface) face "
+            f"({facing}), {from_z:.1f} deg from the z axis: the CAD may be drawn tilted; turn it in the CAD so that "
+            'one of its axes points up (up turns by quarter turns only), or set up = "+z" or --up +z to import it as '
+            "drawn")
+
+
+def largest_faces(mesh: trimesh.Trimesh) -> tuple[np.ndarray, float]:
+    """The unit normal that the largest area of ``mesh``'s faces shares (normals alike to
+    0.001, a face and its opposite as one: the normal taken with z >= 0) and that area [m²]."""
+    normals = mesh.face_normals * np.where(mesh.face_normals[:, 2:] < 0, -1.0, 1.0)  # a face's plane: z >= 0
+    keys, index = np.unique(np.round(normals, 3) + 0.0, axis=0, return_inverse=True)
+    areas = np.bincount(index.ravel(), mesh.area_faces)
+    largest = int(np.argmax(areas))
+    return keys[largest] / np.linalg.norm(keys[largest]), float(areas[largest])
+
+
+def _standing(mesh: trimesh.Trimesh, largest: float) -> bool:
+    """Whether the base ``mesh`` stands on horizontal faces as drawn: its faces within
+    :data:`TILT` of horizontal make :data:`STANDING_SHARE` of ``largest`` [m²] (the area of
+    its largest flat faces) or more, and one of them faces down from its lowest point
+    (within :data:`FLOOR`)."""
+    up = mesh.face_normals[:, 2]
+    flat = np.abs(up) >= math.cos(math.radians(TILT))
+    low = mesh.vertices[mesh.faces][:, :, 2].min(axis=1) <= mesh.bounds[0][2] + FLOOR
+    return float(mesh.area_faces[flat].sum()) >= STANDING_SHARE * largest and bool(np.any(flat & low & (up < 0)))
+
