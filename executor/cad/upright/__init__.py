@@ -12,8 +12,8 @@ import trimesh
 
 from executor.cad.derive import Derived
 from executor.cad.parts import UP_AXES
-from executor.cad.upright.gravity import base_unheld, falls_over, tipping, turned_facts
-from executor.cad.upright.sides import lying
+from executor.cad.upright.gravity import base_unheld, falls_over, resting, tipping, turned_facts
+from executor.cad.upright.sides import from_below, lying
 
 TILT = 1.0
 """The base's largest flat faces are tilted when their normal lies more than this [deg]
@@ -41,33 +41,55 @@ def drawn_up(derived: Derived) -> str | None:
     say it lies on its side or upside down (:func:`executor.cad.upright.sides.lying`), or
     read as drawn it would fall over (:func:`executor.cad.upright.gravity.falls_over`) or
     its base would slide down the parts under it
-    (:func:`executor.cad.upright.gravity.base_unheld`). The ups named are those the rule
-    suggests whose readings (:func:`executor.cad.upright.gravity.turned_facts`) are not
-    doubted; where none is, the ups whose readings are not and stand steadiest (their
-    tipping angles, :func:`executor.cad.upright.gravity.tipping`, within :data:`TIE` of
-    the steadiest), of those the ones that lay the base's largest flat faces horizontal
-    where some do (:func:`largest_faces`), in the order of
-    :data:`executor.cad.parts.UP_AXES`; where none is either, the rule's."""
+    (:func:`executor.cad.upright.gravity.base_unheld`). The ups named are those whose
+    readings (:func:`executor.cad.upright.gravity.turned_facts`) are not doubted, narrowed
+    in turn, where that leaves some and drops some, to those that rest the base on the
+    floor (:func:`executor.cad.upright.gravity.resting`), lay its largest flat faces level
+    (:func:`largest_faces`), stand steadiest (their tipping angles,
+    :func:`executor.cad.upright.gravity.tipping`, within :data:`TIE` of the steadiest's)
+    and that the rule suggests; the rule's first, then in the order of
+    :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's."""
     found = _doubt(derived)
     if found is None:
         return None
     why, suggested = found
     readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
-    refused = {up: _doubt(readings[up]) for up in suggested}
-    ups = [up for up in suggested if refused[up] is None]
-    if not ups:
-        steady = {up: tipping(reading)[0] for up, reading in readings.items() if _doubt(reading) is None}
-        best = max(steady.values(), default=0.0)
-        ups = [up for up, angle in steady.items() if angle >= best - TIE]
-        lying_flat = [up for up in ups if _flat(readings[up])]
-        ups = lying_flat or ups
-    rejected = [up for up in suggested if up not in ups]
-    if rejected:
-        first = refused[rejected[0]]
-        why += (f"; read with up = \"{rejected[0]}\" it would be doubted too ({first[0]})" if first is not None
-                else "")
+    refused = {up: _doubt(reading) for up, reading in readings.items()}
+    ups, chosen = _narrowed([up for up in UP_AXES if up in readings and refused[up] is None], readings, suggested)
+    ups = sorted(ups, key=lambda up: up not in suggested)
+    for up in suggested:
+        if refused[up] is not None:
+            why += f"; read with up = \"{up}\" it would be doubted too ({refused[up][0]})"  # type: ignore[index]
+            break
+    if ups and ups != suggested and chosen:
+        why += f"; read with {_listed(ups)} {chosen}"
     return f"{why}: the CAD may be drawn {_described(ups or suggested)}; set up = {_settings(ups or suggested)}" \
         ' (up = "+z" or --up +z if z is up)'
+
+
+def _narrowed(ups: list[str], readings: dict[str, Derived], suggested: list[str]) -> tuple[list[str], str]:
+    """The ``ups`` whose ``readings`` are not doubted narrowed by the preferences of
+    :func:`drawn_up` (each where it leaves some and drops some), and the words of the last
+    that narrowed them ("": none did)."""
+    chosen = ""
+
+    def narrow(kept: list[str], words: str) -> None:
+        nonlocal ups, chosen
+        if kept and len(kept) < len(ups):
+            ups, chosen = kept, words
+
+    narrow([up for up in ups if resting(readings[up])], "its base resting on the floor")
+    narrow([up for up in ups if _flat(readings[up])], "its base's largest flat faces level")
+    steady = {up: tipping(readings[up])[0] for up in ups}
+    best = max(steady.values(), default=0.0)
+    narrow([up for up in ups if steady[up] >= best - TIE], f"standing steadiest ({best:.1f} deg from tipping over)")
+    narrow([up for up in ups if up in suggested], "as the rule suggests")
+    return ups, chosen
+
+
+def _listed(ups: list[str]) -> str:
+    """``up = "+y"`` or ``up = "+y" or "-y"``."""
+    return "up = " + " or ".join(f'"{up}"' for up in ups)
 
 
 def _flat(derived: Derived) -> bool:
@@ -79,9 +101,10 @@ def _flat(derived: Derived) -> bool:
 def _doubt(derived: Derived) -> tuple[str, list[str]] | None:
     """Why the product read as ``derived`` is doubted and the ups the reason suggests
     (none: the gravity rules suggest none themselves), None when it is not (:func:`drawn_up`)."""
-    found = lying(derived)
-    if found is not None:
-        return found
+    for features in (lying, from_below):
+        found = features(derived)
+        if found is not None:
+            return found
     for rule in (falls_over, base_unheld):
         why = rule(derived)
         if why is not None:

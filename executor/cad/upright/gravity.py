@@ -24,7 +24,7 @@ from executor.cad.sweep import DIRECTIONS
 CONTACT = 1e-3
 """[m] how far above the product's lowest point a point touches the floor: the parts' points
 within it make what the product stands on."""
-TIPPED = 1.0
+TIPPED = 2.0
 """[deg] a product whose centre of mass lies outside what it stands on by more than this
 angle, seen from the floor (:func:`tipping`), falls over: read with that up, it could not
 stand as drawn."""
@@ -90,7 +90,13 @@ def falls_over(derived: Derived) -> str | None:
     if angle >= -TIPPED:
         return None
     return (f"the product's centre of mass lies {mm(outside)} mm outside what it stands on ({-angle:.1f} deg "
-            "from its edge): it would fall over")
+            "past its edge): it would fall over")
+
+
+def resting(derived: Derived) -> bool:
+    """Whether the base's lowest point lies within :data:`CONTACT` of the product's: it rests on the floor."""
+    lowest = min(float(part.mesh.bounds[0][2]) for part in derived.parts.values())
+    return float(derived.parts[derived.base].mesh.bounds[0][2]) <= lowest + CONTACT
 
 
 def base_unheld(derived: Derived) -> str | None:

@@ -108,3 +108,16 @@ def _one_face(out: np.ndarray, k: int, leave: list[str], thickness: float) -> tu
     return None
 
 
+
+
+def from_below(derived: Derived) -> tuple[str, list[str]] | None:
+    """Why the product looks drawn upside down by how its parts go in, and the up that
+    suggests (``["-z"]``); None when it does not: every other part goes in from below,
+    leaving the product along -z only (its way up blocked). Assumed: a product drawn with
+    its up has a part at least that goes in from above or sideways (one assembled wholly
+    from below, a table's legs screwed into its top from under it, is refused: state ``up``)."""
+    others = [pid for pid in derived.parts if pid != derived.base]
+    if not others or any(derived.axis.get(pid) != "-z" or not derived.blockers.get((pid, "+z")) for pid in others):
+        return None
+    return (f"every one of the {len(others)} other parts goes in from below (leaves the product along -z only)",
+            ["-z"])

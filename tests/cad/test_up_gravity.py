@@ -1,0 +1,90 @@
+"""``import``'s up axis read by gravity: without ``up``, a product that as read could not
+rest on the floor as assembled (its centre of mass outside what it stands on, its base
+free to slide down the parts under it) is refused, and the up a refusal names is one whose
+reading is not refused itself (docs/import.md, "The up axis")."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from executor import ExecutorError
+from executor.cad.cli import ImportOptions, run_import
+from executor.campaign.import_bench import write_shafts
+
+
+def _box(extents: tuple[float, float, float], centre: tuple[float, float, float]) -> trimesh.Trimesh:
+    return trimesh.creation.box(extents, trimesh.transformations.translation_matrix(centre))
+
+
+def _y_up(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """A z-up part as drawn y up: (x, y, z) -> (x, z, -y), exact."""
+    v = np.asarray(mesh.vertices)
+    mesh.vertices = np.column_stack([v[:, 0], v[:, 2], -v[:, 1]])
+    return mesh
+
+
+def _write(folder: Path, parts: dict[str, trimesh.Trimesh], base: str) -> Path:
+    """``parts`` (z up, mm) written drawn y up as STL into ``folder``, with ``base`` the
+    fixture in ``folder/import.toml``."""
+    folder.mkdir()
+    for name, mesh in parts.items():
+        _y_up(mesh).export(folder / f"{name}.stl")
+    (folder / "import.toml").write_text(f'base = "{base}"\n')
+    return folder
+
+
+def test_a_shaft_through_its_housing_drawn_y_up_is_refused_naming_y(tmp_path: Path) -> None:
+    # z up: an 80 x 50 x 60 mm housing with a 29 mm square bore along y, a 28.3 mm shaft
+    # through it 25 mm out of each face. Drawn y up and read z up, the shaft stands
+    # upright through the housing, which nothing keeps from sliding down it to the floor
+    housing = _box((80.0, 50.0, 60.0), (0.0, 0.0, 30.0)).difference(_box((29.0, 80.0, 29.0), (0.0, 0.0, 30.0)))
+    cad = _write(tmp_path / "cad", {"housing": housing, "shaft": _box((28.3, 100.0, 28.3), (0.0, 0.0, 30.0))},
+                 "housing")
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", cad / "import.toml")
+    assert ("the base housing stands 25.000 mm above the product's lowest point and no part keeps it from going "
+            'down: it would slide down shaft; read with up = "+y" or "-y" standing steadiest (39.8 deg from tipping '
+            'over): the CAD may be drawn y up; set up = "+y" or "-y" (--up +y or --up=-y)') in str(refused.value), \
+        str(refused.value)
+    assert not (tmp_path / "read_z_up").exists()
+    turned = run_import(cad, tmp_path / "turned", "mm", cad / "import.toml", ImportOptions(up="+y"))
+    assert {fit.axis[1] for fit in turned.derived.holes.values()} == {"y"}
+
+
+def test_a_product_whose_arm_stands_beside_its_base_drawn_y_up_is_refused_as_falling_over(tmp_path: Path) -> None:
+    # z up: a 200 x 40 x 20 mm bar, an arm 150 mm long lying on it across, reaching 130 mm
+    # beyond it, held by a peg through it into the bar. Drawn y up and read z up, the arm
+    # hangs 130 mm under the bar, the product on the arm's end, its centre of mass beside it
+    bar = _box((200.0, 40.0, 20.0), (0.0, 0.0, 10.0)).difference(_box((10.6, 10.6, 20.0), (80.0, 0.0, 20.0)))
+    arm = _box((30.0, 150.0, 10.0), (80.0, 55.0, 25.0)).difference(_box((10.6, 10.6, 20.0), (80.0, 0.0, 25.0)))
+    cad = _write(tmp_path / "cad", {"bar": bar, "arm": arm, "peg": _box((10.0, 10.0, 30.0), (80.0, 0.0, 25.0))},
+                 "bar")
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", cad / "import.toml")
+    assert ("the product's centre of mass lies 47.671 mm outside what it stands on (22.0 deg past its edge): it "
+            'would fall over; read with up = "+y" standing steadiest (30.8 deg from tipping over): the CAD may be '
+            'drawn y up; set up = "+y" or --up +y') in str(refused.value), str(refused.value)
+    imported = run_import(cad, tmp_path / "turned", "mm", cad / "import.toml", ImportOptions(up="+y"))
+    assert imported.derived.axis["peg"] == "+z"
+
+
+@pytest.mark.slow  # a 20-part import
+def test_the_shaft_unit_drawn_y_up_is_refused_naming_y_not_the_axis_of_its_bores(tmp_path: Path) -> None:
+    # the bench's 20-part unit (two shafts along x through housings on a floor plate 200 mm
+    # long) drawn y up stands read z up on the plate's 60 x 65 mm end, 200 mm tall, its bores
+    # along x; read with x up its shafts would stand upright under the housings, the base
+    # 35 mm above the floor
+    z_up = tmp_path / "z_up"
+    z_up.mkdir()
+    write_shafts(z_up, 20, 13)
+    parts = {path.stem: trimesh.load(path, force="mesh", process=False) for path in sorted(z_up.glob("*.stl"))}
+    cad = _write(tmp_path / "cad", parts, "base")
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", cad / "import.toml")
+    assert "the base base is thinnest along x" in str(refused.value)
+    assert ('the other parts standing out of it along -x; read with up = "+y" its base resting on the floor: the CAD '
+            'may be drawn y up; set up = "+y" or --up +y') in str(refused.value), str(refused.value)
