@@ -88,3 +88,24 @@ def test_the_shaft_unit_drawn_y_up_is_refused_naming_y_not_the_axis_of_its_bores
     assert "the base base is thinnest along x" in str(refused.value)
     assert ('the other parts standing out of it along -x; read with up = "+y" its base resting on the floor: the CAD '
             'may be drawn y up; set up = "+y" or --up +y') in str(refused.value), str(refused.value)
+
+
+def test_a_product_assembled_wholly_from_below_is_refused_as_upside_down(tmp_path: Path) -> None:
+    # z up: a screw through a 60 x 60 x 30 mm block from above, its head in a counterbore
+    # flush with the top, its shank 8 mm under the block (bd_warehouse's pillow block).
+    # Drawn z down, the screw goes in from below, its shank 8 mm above the block
+    cad = tmp_path / "cad"
+    cad.mkdir()
+    hole = trimesh.boolean.union([_box((10.0, 10.0, 40.0), (0.0, 0.0, 15.0)),
+                                  _box((16.0, 16.0, 10.0), (0.0, 0.0, 30.0))], engine="manifold")
+    upside_down = np.diag([1.0, -1.0, -1.0, 1.0])  # about x by 180 deg, exact
+    _box((60.0, 60.0, 30.0), (0.0, 0.0, 15.0)).difference(hole).apply_transform(upside_down).export(cad / "block.stl")
+    trimesh.boolean.union([_box((9.6, 9.6, 33.0), (0.0, 0.0, 8.5)), _box((15.6, 15.6, 5.0), (0.0, 0.0, 27.5))],
+                          engine="manifold").apply_transform(upside_down).export(cad / "screw.stl")
+    (tmp_path / "import.toml").write_text('base = "block"\n')
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", tmp_path / "import.toml")
+    assert ("every one of the 1 other parts goes in from below (leaves the product along -z only): the CAD may be "
+            'drawn upside down (z down); set up = "-z" or --up=-z') in str(refused.value), str(refused.value)
+    turned = run_import(cad, tmp_path / "turned", "mm", tmp_path / "import.toml", ImportOptions(up="-z"))
+    assert turned.derived.axis["screw"] == "+z"
