@@ -109,3 +109,20 @@ def test_a_product_assembled_wholly_from_below_is_refused_as_upside_down(tmp_pat
             'drawn upside down (z down); set up = "-z" or --up=-z') in str(refused.value), str(refused.value)
     turned = run_import(cad, tmp_path / "turned", "mm", tmp_path / "import.toml", ImportOptions(up="-z"))
     assert turned.derived.axis["screw"] == "+z"
+
+
+def test_a_base_held_off_the_floor_where_another_up_rests_it_steadier_is_refused(tmp_path: Path) -> None:
+    # z up: the housing and shaft above, with a collar on the shaft against each face of the
+    # housing. Drawn y up and read z up, the lower collar holds the housing 25 mm up on the
+    # upright shaft; read y up the housing rests on the floor, steadier
+    housing = _box((80.0, 50.0, 60.0), (0.0, 0.0, 30.0)).difference(_box((29.0, 80.0, 29.0), (0.0, 0.0, 30.0)))
+    parts = {"housing": housing, "shaft": _box((28.3, 100.0, 28.3), (0.0, 0.0, 30.0))}
+    for name, y in (("collar_a", 30.0), ("collar_b", -30.0)):
+        parts[name] = _box((50.0, 10.0, 50.0), (0.0, y, 30.0)).difference(_box((29.0, 20.0, 29.0), (0.0, y, 30.0)))
+    cad = _write(tmp_path / "cad", parts, "housing")
+    with pytest.raises(ExecutorError) as refused:
+        run_import(cad, tmp_path / "read_z_up", "mm", cad / "import.toml")
+    assert ("the base housing stands 25.000 mm above the product's lowest point on the parts under it, the "
+            "product 15.8 deg from tipping over, where 4 other up(s) would rest the base on the floor steadier (up to "
+            '39.8 deg); read with up = "+y" or "-y" standing steadiest (39.8 deg from tipping over): the CAD may be '
+            'drawn y up; set up = "+y" or "-y" (--up +y or --up=-y)') in str(refused.value), str(refused.value)

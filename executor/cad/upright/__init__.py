@@ -12,7 +12,7 @@ import trimesh
 
 from executor.cad.derive import Derived
 from executor.cad.parts import UP_AXES
-from executor.cad.upright.gravity import base_unheld, falls_over, resting, tipping, turned_facts
+from executor.cad.upright.gravity import base_unheld, falls_over, mm, raised, resting, tipping, turned_facts
 from executor.cad.upright.sides import from_below, lying
 
 TILT = 1.0
@@ -41,7 +41,8 @@ def drawn_up(derived: Derived) -> str | None:
     say it lies on its side or upside down (:func:`executor.cad.upright.sides.lying`), or
     read as drawn it would fall over (:func:`executor.cad.upright.gravity.falls_over`) or
     its base would slide down the parts under it
-    (:func:`executor.cad.upright.gravity.base_unheld`). The ups named are those whose
+    (:func:`executor.cad.upright.gravity.base_unheld`), or its base stands off the floor
+    where another up would rest it there steadier (:func:`_perched`). The ups named are those whose
     readings (:func:`executor.cad.upright.gravity.turned_facts`) are not doubted, narrowed
     in turn, where that leaves some and drops some, to those that rest the base on the
     floor (:func:`executor.cad.upright.gravity.resting`), lay its largest flat faces level
@@ -50,10 +51,13 @@ def drawn_up(derived: Derived) -> str | None:
     and that the rule suggests; the rule's first, then in the order of
     :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's."""
     found = _doubt(derived)
+    if found is None and resting(derived):
+        return None
+    readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
+    found = found or _perched(derived, readings)
     if found is None:
         return None
     why, suggested = found
-    readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
     refused = {up: _doubt(reading) for up, reading in readings.items()}
     ups, chosen = _narrowed([up for up in UP_AXES if up in readings and refused[up] is None], readings, suggested)
     ups = sorted(ups, key=lambda up: up not in suggested)
@@ -96,6 +100,24 @@ def _flat(derived: Derived) -> bool:
     """Whether the base's largest flat faces (:func:`largest_faces`) lie horizontal, within :data:`TILT`."""
     normal, _ = largest_faces(derived.parts[derived.base].mesh)
     return float(normal[2]) >= math.cos(math.radians(TILT))
+
+
+def _perched(derived: Derived, readings: dict[str, Derived]) -> tuple[str, list[str]] | None:
+    """Why the product read as ``derived``, its base held off the floor by the parts under
+    it, looks drawn with another up, and the ups that rest the base on the floor (their
+    ``readings`` doubted by no rule, :func:`_doubt`) standing steadier than it does by more
+    than :data:`TIE` (:func:`executor.cad.upright.gravity.tipping`), steadiest first; None
+    where none does. Assumed: a product drawn with its up rests its base on the floor
+    where another up would rest it there undoubted and steadier."""
+    angle = tipping(derived)[0]
+    steadier = {up: tipping(reading)[0] for up, reading in readings.items()
+                if resting(reading) and _doubt(reading) is None}
+    ups = sorted((up for up, steady in steadier.items() if steady > angle + TIE), key=lambda up: -steadier[up])
+    if not ups:
+        return None
+    return (f"the base {derived.base} stands {mm(raised(derived))} mm above the product's lowest point on the parts "
+            f"under it, the product {angle:.1f} deg from tipping over, where {len(ups)} other up(s) would rest the "
+            f"base on the floor steadier (up to {steadier[ups[0]]:.1f} deg)", ups)
 
 
 def _doubt(derived: Derived) -> tuple[str, list[str]] | None:

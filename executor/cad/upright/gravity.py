@@ -93,10 +93,15 @@ def falls_over(derived: Derived) -> str | None:
             "past its edge): it would fall over")
 
 
-def resting(derived: Derived) -> bool:
-    """Whether the base's lowest point lies within :data:`CONTACT` of the product's: it rests on the floor."""
+def raised(derived: Derived) -> float:
+    """How far [m] the base's lowest point lies above the product's."""
     lowest = min(float(part.mesh.bounds[0][2]) for part in derived.parts.values())
-    return float(derived.parts[derived.base].mesh.bounds[0][2]) <= lowest + CONTACT
+    return float(derived.parts[derived.base].mesh.bounds[0][2]) - lowest
+
+
+def resting(derived: Derived) -> bool:
+    """Whether the base rests on the floor: its lowest point within :data:`CONTACT` of the product's."""
+    return raised(derived) <= CONTACT
 
 
 def base_unheld(derived: Derived) -> str | None:
