@@ -32,7 +32,8 @@ FLOOR = 1e-6
 """[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
 TIE = 1.0
 """[deg] ups whose readings stand within this of the steadiest one's tipping angle are named
-together (:func:`drawn_up`)."""
+together (:func:`drawn_up`); a base off the floor is doubted where another up rests it there
+more than this steadier (:func:`_perched`)."""
 
 
 def drawn_up(derived: Derived) -> str | None:
@@ -49,21 +50,26 @@ def drawn_up(derived: Derived) -> str | None:
     (:func:`largest_faces`), stand steadiest (their tipping angles,
     :func:`executor.cad.upright.gravity.tipping`, within :data:`TIE` of the steadiest's)
     and that the rule suggests; the rule's first, then in the order of
-    :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's."""
+    :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's (a
+    gravity rule, which suggests none, then refuses nothing)."""
     found = _doubt(derived)
     if found is None and resting(derived):
         return None
     readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
-    found = found or _perched(derived, readings)
+    refused = {up: _doubt(reading) for up, reading in readings.items()}
+    undoubted = [up for up in UP_AXES if up in readings and refused[up] is None]
+    found = found or _perched(derived, {up: readings[up] for up in undoubted})
     if found is None:
         return None
     why, suggested = found
-    refused = {up: _doubt(reading) for up, reading in readings.items()}
-    ups, chosen = _narrowed([up for up in UP_AXES if up in readings and refused[up] is None], readings, suggested)
+    if not suggested and not undoubted:
+        return None  # a gravity rule names no up of its own: it refuses only where another up reads it undoubted
+    ups, chosen = _narrowed(undoubted, readings, suggested)
     ups = sorted(ups, key=lambda up: up not in suggested)
     for up in suggested:
-        if refused[up] is not None:
-            why += f"; read with up = \"{up}\" it would be doubted too ({refused[up][0]})"  # type: ignore[index]
+        doubt = refused[up]
+        if doubt is not None:
+            why += f"; read with up = \"{up}\" it would be doubted too ({doubt[0]})"
             break
     if ups and ups != suggested and chosen:
         why += f"; read with {_listed(ups)} {chosen}"
@@ -102,16 +108,15 @@ def _flat(derived: Derived) -> bool:
     return float(normal[2]) >= math.cos(math.radians(TILT))
 
 
-def _perched(derived: Derived, readings: dict[str, Derived]) -> tuple[str, list[str]] | None:
+def _perched(derived: Derived, undoubted: dict[str, Derived]) -> tuple[str, list[str]] | None:
     """Why the product read as ``derived``, its base held off the floor by the parts under
-    it, looks drawn with another up, and the ups that rest the base on the floor (their
-    ``readings`` doubted by no rule, :func:`_doubt`) standing steadier than it does by more
-    than :data:`TIE` (:func:`executor.cad.upright.gravity.tipping`), steadiest first; None
-    where none does. Assumed: a product drawn with its up rests its base on the floor
-    where another up would rest it there undoubted and steadier."""
+    it, looks drawn with another up, and the ups whose readings (``undoubted``: those no
+    rule doubts, :func:`_doubt`) rest the base on the floor standing steadier than it does
+    by more than :data:`TIE` (:func:`executor.cad.upright.gravity.tipping`), steadiest
+    first; None where none does. Assumed: a product drawn with its up rests its base on
+    the floor where another up would rest it there undoubted and steadier."""
     angle = tipping(derived)[0]
-    steadier = {up: tipping(reading)[0] for up, reading in readings.items()
-                if resting(reading) and _doubt(reading) is None}
+    steadier = {up: tipping(reading)[0] for up, reading in undoubted.items() if resting(reading)}
     ups = sorted((up for up, steady in steadier.items() if steady > angle + TIE), key=lambda up: -steadier[up])
     if not ups:
         return None
