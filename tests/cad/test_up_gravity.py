@@ -13,6 +13,7 @@ import trimesh
 
 from executor import ExecutorError
 from executor.cad.cli import ImportOptions, run_import
+from executor.cad.upright.gravity import turned_facts
 from executor.campaign.import_bench import write_shafts
 
 
@@ -126,3 +127,23 @@ def test_a_base_held_off_the_floor_where_another_up_rests_it_steadier_is_refused
             "product 15.8 deg from tipping over, where 4 other up(s) would rest the base on the floor steadier (up to "
             '39.8 deg); read with up = "+y" or "-y" standing steadiest (39.8 deg from tipping over): the CAD may be '
             'drawn y up; set up = "+y" or "-y" (--up +y or --up=-y)') in str(refused.value), str(refused.value)
+
+
+def test_facts_turned_as_an_up_turns_them_are_those_an_import_with_that_up_derives(tmp_path: Path) -> None:
+    # what the up check reads other ups by (and tests.cad.up_readings evaluates it by); the
+    # shaft's flange against the housing's face: it leaves one way only (a part free both
+    # ways keeps the way its import chose, where an import with the other up picks the cell's)
+    housing = _box((80.0, 50.0, 60.0), (0.0, 0.0, 30.0)).difference(_box((29.0, 80.0, 29.0), (0.0, 0.0, 30.0)))
+    shaft = trimesh.boolean.union([_box((28.3, 60.0, 28.3), (0.0, 5.0, 30.0)),
+                                   _box((50.0, 10.0, 50.0), (0.0, 40.0, 30.0))], engine="manifold")
+    cad = _write(tmp_path / "cad", {"housing": housing, "shaft": shaft}, "housing")
+    as_drawn = run_import(cad, tmp_path / "z", "mm", cad / "import.toml", ImportOptions(up="+z"))
+    turned = turned_facts(as_drawn.derived, "+y")
+    imported = run_import(cad, tmp_path / "y", "mm", cad / "import.toml", ImportOptions(up="+y"))
+    assert turned.axis == imported.derived.axis == {"shaft": "+y"}
+    assert {h: f.axis for h, f in turned.holes.items()} == {h: f.axis for h, f in imported.derived.holes.items()}
+    assert turned.blockers == imported.derived.blockers
+    corner = {name: d.parts["housing"].mesh.bounds[0] for name, d in (("turned", turned), ("y", imported.derived))}
+    for pid, part in imported.derived.parts.items():  # the same up to where each import placed it
+        assert np.allclose(turned.parts[pid].mesh.bounds - corner["turned"], part.mesh.bounds - corner["y"],
+                           rtol=0.0, atol=1e-9), pid

@@ -8,10 +8,11 @@ tessellated with 64-gons, not the bench's 250000 triangles: the check reads boxe
 axes, not the fineness). Its derived facts are then turned as the product would be read
 drawn with each other up (the meshes turned by the inverse of that up's turn,
 :func:`executor.cad.parts.turn_points`, and every removal direction with them: the parts'
-axes, their blockers, the holes' and pins' axes), and the check run on each reading
-(:func:`executor.cad.upright.drawn_up`). A product refused in its own orientation is a
-false refusal; one read turned and refused is named right when the up its line names
-first is the one it was drawn with.
+axes, their blockers, the holes' and pins' axes: a part free both ways along an axis keeps
+the way the import as drawn chose, where an import of the turned CAD picks the cell's
+preferred way), and the check run on each reading (:func:`executor.cad.upright.drawn_up`).
+A product refused in its own orientation is a false refusal; one read turned and refused
+is named right when the up its line names first is the one it was drawn with.
 
 ``python -m tests.cad.up_readings [--product NAME ...] [--cache DIR]`` prints one line per
 product and reading, then the counts; ``--cache`` keeps each product's facts (pickled) so
