@@ -14,9 +14,10 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
                               # the height of the product's lowest point (default 0, the cell's floor)
 
 ``--up AXIS`` overrides ``up``: every part is turned right after reading by the rotation
-taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product whose
-base looks drawn with another axis up (lying on its side) is refused (:func:`drawn_up`). ``--place X,Y[,Z]``
-overrides ``place``. Without either, a product whose base's centre lies
+taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product that
+looks drawn with another axis up (lying on its side, upside down, or unable to rest on the
+floor as read) is refused (:func:`drawn_up`). ``--place X,Y[,Z]`` overrides ``place``.
+Without either, a product whose base's centre lies
 outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
 says so; without a z, the product's lowest point (of all its parts) goes to the cell's floor,
 z = 0 (:func:`placement`); every part is moved right after reading, so every file written is in the cell frame.
@@ -40,9 +41,6 @@ import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-
-import numpy as np
-import trimesh
 
 from bridge.cli_types import ArgumentParser, finite_float, int_in, nonempty_path, number_in
 from bridge.inputs import read_text, shorten
@@ -71,6 +69,8 @@ from executor.cad.parts import (
 from executor.cad.sections import Shape2D, section_room, slices_kept, zero_clearance
 from executor.cad.step import load_step
 from executor.cad.sweep import opposite, processes
+from executor.cad.upright import drawn_tilted, drawn_up
+from executor.cad.upright.gravity import mm as _mm
 from executor.cad.write.assembly import Settings
 from executor.cad.write.facts import nominal_assumption
 from executor.cad.write.folder import map_product, write_folder
@@ -85,29 +85,6 @@ WORK_POSITION = (0.56, 0.0)
 cell (the arm's base at the origin); the tests' products stand at x = 0.55 to 0.63 m."""
 PLACE_BOUND = 1.0
 """``place`` coordinates lie in [-PLACE_BOUND, PLACE_BOUND] [m] (the cell's table)."""
-STANDING = 3.0
-"""A base at least this many times as tall (along z) as it is thick along a horizontal
-axis stands on its edge (:func:`drawn_up`)."""
-ONE_SIDED = 0.25
-"""The other parts stand out of the base's box along one way only when along each of the
-five other ways (the opposite one, the four across) they stand out of it by at most this
-fraction of that way's, and lie within its box when they stand out of it by at most this
-fraction of its thickness (:func:`drawn_up`): parts set on one face of the base."""
-TILT = 1.0
-"""The base's largest flat faces are tilted when their normal lies more than this [deg]
-from the z axis and from the horizontal plane (:func:`drawn_tilted`): no quarter turn sets them square."""
-TILTED_SHARE = 0.15
-"""...and they make at least this fraction of its surface (:func:`drawn_tilted`): not one
-strip of a coarsely tessellated rod (a 24-gon's pair of opposite facets: 8 %)."""
-STANDING_SHARE = 0.5
-"""...unless its horizontal faces (within :data:`TILT`) make at least this fraction of the
-area of those largest faces, one of them at its lowest point, facing down (:func:`drawn_tilted`):
-a coarse prism lying on a face (a hexagonal or octagonal bar: its horizontal pair as large
-as each tilted pair, less its holes) stands on it as drawn, where a product tilted by
-another angle than quarter turns rests on an edge or a corner, unless a face of its base
-lies at that angle."""
-FLOOR = 1e-6
-"""[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
 _UP_EXPECTED = f"one of {', '.join(UP_AXES)} (the CAD's axis pointing up)"
 
 
@@ -144,134 +121,6 @@ def _up_assumption(up: str | None) -> str:
         return ("the CAD's +z is up (set up = \"+y\" or --up +y for a CAD drawn y up, up = \"-z\" or --up=-z "
                 "for one drawn upside down)")
     return f"the CAD's {up} is up (up): every part turned {turn_text(up)}, before it is placed"
-
-
-def drawn_up(derived: Derived) -> str | None:
-    """Why the product looks drawn with another axis than z up, None when it does not.
-
-    Drawn with x or y up (a tilt is found before deriving, :func:`drawn_tilted`): the
-    base is thinnest along that axis, more than half of its holes and pins open along it
-    (either way: a through hole's parts leave both ways; where the base has none, the
-    product's: the holes of the other parts and their pins), and the base stands on its
-    edge (:data:`STANDING` times as tall as it is thick along that axis) or the other
-    parts are set on one face of it along that axis (:func:`_one_face`). Drawn upside down
-    (z down): more than half of those holes and pins open along z and the other parts are
-    set on the base's bottom face (:func:`_one_face` along -z), or the other parts stand
-    out of the base's box above it by at most :data:`ONE_SIDED` of what they do below it
-    and every hole and pin along z is left downwards, or they do stand out below it and
-    more of them leave the product downwards than upwards (their removal directions); not
-    when every hole and pin along z is left upwards and so is every part along z, the base
-    keeping each from going down (screws through the base from above, their heads on it,
-    their shanks standing out under it into a part not drawn; a peg through a through hole
-    can leave either way). The
-    way up it suggests is the one the other parts stand out of the base's box farther
-    along, else the way they leave its holes and pins (both where neither tells)."""
-    low, high = derived.parts[derived.base].mesh.bounds
-    extents = high - low
-    removals = [fit.axis for fit in derived.holes.values()]
-    removals += [pin.axis for pin in derived.pins.values() if pin.owner == derived.base]
-    whose = "its"
-    if not removals:
-        removals = [fit.axis for fit in derived.part_holes.values()] + [pin.axis for pin in derived.pins.values()]
-        whose = "the product's"
-    openings = [axis[1] for axis in removals]
-    corners = np.vstack([part.mesh.bounds for part in derived.parts.values()])
-    out = np.array([[corners[:, j].max() - high[j], low[j] - corners[:, j].min()] for j in range(3)])
-    for k, name in enumerate("xyz"):
-        along = openings.count(name)
-        if 2 * along <= len(openings) or (name != "z" and extents[k] > min(extents)):
-            continue
-        features = f" and {along} of {whose} {len(openings)} holes and pins open along {name}"
-        if whose != "its":
-            features = f", has no holes or pins,{features}"
-        leave = sorted({axis[0] for axis in removals if axis[1] == name})
-        face = _one_face(out, k, leave, float(extents[k]))
-        if name == "z":
-            above, below = (float(v) for v in out[2])
-            ways = list(derived.axis.values())
-            down, up = ways.count("-z"), ways.count("+z")
-            if (face is None or face[0] != ["-"]) and above <= ONE_SIDED * below:
-                if leave == ["-"]:
-                    face = ["-"], f", all of them left along -z and the other parts at most {_mm(above)} mm above it"
-                elif down > up and below > 0:
-                    face = ["-"], (f", {down} of the other parts left along -z ({up} along +z) and standing out of "
-                                   f"it {_mm(below)} mm below it, {_mm(above)} mm above it")
-            held = all(derived.base in derived.blockers.get((pid, "-z"), set())
-                       for pid, way in derived.axis.items() if way == "+z")
-            if face is None or face[0] != ["-"] or (leave == ["+"] and up > 0 and down == 0 and held):
-                continue  # parts through it from above standing out under it (screws into what is not drawn)
-            return (f"the base {derived.base} is {_mm(float(extents[2]))} mm tall{features}{face[1]}: the CAD "
-                    'may be drawn upside down (z down); set up = "-z" or --up=-z (up = "+z" or --up +z if z is up)')
-        if extents[2] >= STANDING * extents[k]:
-            above, below = out[k]
-            ways = ["+"] if above > below else ["-"] if below > above else leave if len(leave) == 1 else ["+", "-"]
-            why = "" if len(ways) > 1 else f", the other parts standing out of it along {ways[0]}{name}" \
-                if above != below else f", all of them left along {ways[0]}{name}"
-        elif face is not None:
-            ways, why = face
-        else:
-            continue
-        settings = " or ".join(f'"{way}{name}"' for way in ways)
-        flags = " or ".join(f"--up +{name}" if way == "+" else f"--up=-{name}" for way in ways)
-        return (f"the base {derived.base} is thinnest along {name} ({_mm(float(extents[k]))} mm, "
-                f"{_mm(float(extents[2]))} mm tall){features}{why}: the CAD may be drawn {name} up; set up = "
-                + (f"{settings} or {flags}" if len(ways) == 1 else f"{settings} ({flags})")
-                + ' (up = "+z" or --up +z if z is up)')
-    return None
-
-
-def _one_face(out: np.ndarray, k: int, leave: list[str], thickness: float) -> tuple[list[str], str] | None:
-    """The way (``["+"]`` or ``["-"]``) of axis ``k`` the other parts are set on the base
-    from, and the words saying why, or None. ``out`` [m], (3, 2): how far they stand out of
-    the base's box along +x, -x, +y, ...; they stand out of it along one way of ``k``, along
-    the opposite way by at most :data:`ONE_SIDED` of that and across by at most that, or
-    they lie within :data:`ONE_SIDED` of its ``thickness`` [m] along ``k`` of its box and
-    every hole and pin along ``k`` is left the same way (``leave``: the ways they are left)."""
-    name = "xyz"[k]
-    above, below = (float(v) for v in out[k])
-    way, farthest, opposite = ("+", above, below) if above >= below else ("-", below, above)
-    across = float(np.delete(out, k, axis=0).max())
-    if farthest > 0 and opposite <= ONE_SIDED * farthest and across <= farthest:
-        return [way], (f", the other parts standing out of it along {way}{name} ({_mm(farthest)} mm; at most "
-                       f"{_mm(opposite)} mm the other way and {_mm(across)} mm across)")
-    if len(leave) == 1 and float(out.max()) <= ONE_SIDED * thickness:
-        return leave, (f", all of them left along {leave[0]}{name} and the other parts within "
-                       f"{_mm(float(out.max()))} mm of its box")
-    return None
-
-
-def drawn_tilted(mesh: trimesh.Trimesh, base: str) -> str | None:
-    """Why the product whose base ``base`` has ``mesh`` looks drawn tilted, None when it
-    does not: the normal that the largest area of the base's faces shares (its largest flat
-    faces, normals alike to 0.001, a face and its opposite as one: the normal taken with z
-    >= 0) lies more than :data:`TILT` from the z axis and from the horizontal plane, they
-    make :data:`TILTED_SHARE` of its surface or more, and the base does not stand on
-    horizontal faces (:func:`_standing`)."""
-    normals = mesh.face_normals * np.where(mesh.face_normals[:, 2:] < 0, -1.0, 1.0)  # a face's plane: z >= 0
-    keys, index = np.unique(np.round(normals, 3) + 0.0, axis=0, return_inverse=True)
-    areas = np.bincount(index.ravel(), mesh.area_faces)
-    largest = int(np.argmax(areas))
-    normal = keys[largest] / np.linalg.norm(keys[largest])
-    from_z = math.degrees(math.acos(min(1.0, float(normal[2]))))
-    if min(from_z, 90.0 - from_z) <= TILT or areas[largest] < TILTED_SHARE * mesh.area \
-            or _standing(mesh, float(areas[largest])):
-        return None
-    facing = ", ".join(f"{v:.3f}" for v in normal + 0.0)
-    return (f"the base {base}'s largest flat faces ({100 * areas[largest] / mesh.area:.0f} % of its surface) face "
-            f"({facing}), {from_z:.1f} deg from the z axis: the CAD may be drawn tilted; turn it in the CAD so that "
-            'one of its axes points up (up turns by quarter turns only), or set up = "+z" or --up +z to import it as '
-            "drawn")
-
-
-def _standing(mesh: trimesh.Trimesh, largest: float) -> bool:
-    """Whether the base ``mesh`` stands on horizontal faces as drawn: its faces within
-    :data:`TILT` of horizontal make :data:`STANDING_SHARE` of ``largest`` [m²] (the area of
-    its largest flat faces) or more, and one of them faces down from its lowest point
-    (within :data:`FLOOR`)."""
-    up = mesh.face_normals[:, 2]
-    flat = np.abs(up) >= math.cos(math.radians(TILT))
-    low = mesh.vertices[mesh.faces][:, :, 2].min(axis=1) <= mesh.bounds[0][2] + FLOOR
-    return float(mesh.area_faces[flat].sum()) >= STANDING_SHARE * largest and bool(np.any(flat & low & (up < 0)))
 
 
 Place = tuple[float, ...]
@@ -395,10 +244,6 @@ def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
     return Settings(base, trays, names, up), fixed, assumed, _place_setting(path, data.get("place"))
 
 
-def _mm(value: float) -> str:
-    """Metres as millimetres with 3 decimals (no "-0.000")."""
-    millimetres = 1000 * value
-    return f"{millimetres if abs(millimetres) >= 5e-4 else 0.0:.3f}"
 
 
 def _describe(kind: str, a: float, b: float) -> str:

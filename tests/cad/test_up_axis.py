@@ -21,7 +21,8 @@ import shapely
 import trimesh
 
 from executor import ExecutorError
-from executor.cad.cli import Imported, ImportOptions, drawn_tilted, run_import
+from executor.cad.cli import Imported, ImportOptions, run_import
+from executor.cad.upright import drawn_tilted
 from tests.cad.test_corpus import _atoms
 from tests.conftest import Runner, error_lines
 
