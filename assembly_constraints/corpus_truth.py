@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,6 +24,7 @@ from typing import Any
 from bridge.errors import ToolError
 from bridge.inputs import read_text
 from executor.cad.cli import run_import
+from executor.cad.derive import HoleFit
 from executor.cad.sweep import opposite
 
 FEATURE_REACH_MM = 2.0
@@ -41,7 +42,8 @@ class CorpusImport:
     ``offset`` (x, y, z) [m] the import moved it by from its CAD frame (its truth's) into the
     cell, each imported hole's or pin's ``occupants`` (the parts in it or onto it) and
     ``owners`` (the part it is a feature of), the ids that are ``pins``, the product's
-    ``parts`` (the base included) and the import's wall time ``seconds``."""
+    ``parts`` (the base included), the import's wall time ``seconds`` and the base's
+    ``holes`` as the import measured them (their sections, chamfers and depths [m])."""
 
     truth: dict[str, Any]
     out: Path
@@ -52,6 +54,7 @@ class CorpusImport:
     pins: frozenset[str] = frozenset()
     parts: int = 0
     seconds: float = 0.0
+    holes: Mapping[str, HoleFit] = field(default_factory=dict)
 
 
 def read_truth(folder: Path) -> dict[str, Any]:
@@ -90,7 +93,8 @@ def import_product(folder: Path, out: Path) -> CorpusImport:
     owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
     owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
     return CorpusImport(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
-                        result.offset, occupants, owners, frozenset(derived.pins), len(derived.parts), result.seconds)
+                        result.offset, occupants, owners, frozenset(derived.pins), len(derived.parts), result.seconds,
+                        derived.holes)
 
 
 def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float, float]) -> float:

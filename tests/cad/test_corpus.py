@@ -187,6 +187,29 @@ def test_each_part_fits_the_feature_it_is_in(corpus_import: Callable[[str], Impo
     assert pairs and [pair for pair in pairs if pair not in fits] == []
 
 
+ALIKE_HOLES = {"gridfinity_bases": 3, "asap_beam": 4}
+"""Products whose truth calls all their base's holes one shape, some holding a part and some
+empty: gridfinity_bases' three rounded-square through pockets (two holding a bin's base),
+asap_beam's four tapered through mortises (two holding an upright); how many each has."""
+
+
+@pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", sorted(ALIKE_HOLES))
+def test_alike_holes_occupied_or_empty_are_measured_alike(corpus_import: Callable[[str], Imported], name: str) -> None:
+    # Each hole's section is the narrowest over the stretch a part goes in: through the
+    # base, for an empty hole as for one whose part stands on the floor the base stands
+    # on (gridfinity_bases: the 36.3 mm bottom opening; asap_beam: the mortise's narrow
+    # end, 9.120 x 5.310 mm). Measured only from the level it is sliced at up, an empty
+    # pocket was its 37.7 mm walls, an empty mortise 9.605 x 5.795 mm.
+    holes = corpus_import(name).holes
+    assert len(holes) == ALIKE_HOLES[name] and 0 < sum(fit.part is None for fit in holes.values()) < len(holes)
+    first, *others = holes.values()
+    for fit in others:
+        assert fit.hole.kind == first.hole.kind
+        assert (fit.hole.a, fit.hole.b, fit.hole.corner, fit.chamfer, fit.depth) == pytest.approx(
+            (first.hole.a, first.hole.b, first.hole.corner, first.chamfer, first.depth), abs=1e-7)
+
+
 @pytest.mark.slow  # the first test of a product imports it
 @pytest.mark.parametrize("name", IMPORTED)
 def test_insertion_axes_are_ones_the_geometry_allows(corpus_import: Callable[[str], Imported], name: str) -> None:
@@ -421,29 +444,31 @@ def test_a_product_whose_every_part_is_placed_by_hand_is_learned_by_a_sim_sessio
 
 
 @pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["asap_beam"])  # a unit of the workers' work with the product's other tests
 def test_parts_with_less_room_than_the_cell_resolves_are_placed_by_hand_saying_so(
-        corpus_import: Callable[[str], Imported]) -> None:
+        corpus_import: Callable[[str], Imported], name: str) -> None:
     # asap_beam: the uprights' tapered tenons are nominal zero-clearance fits in the top's
     # tapered mortises, which make the top its own mesh (a plate's holes are straight), and
     # are no round pegs the cell narrows; its feet go onto the uprights' tenons, nominal
     # zero-clearance fits too. Each is placed by hand with that reason; a sim session of such
     # a product takes every pair from sizes.lp as not observed (ldraw_axles' test above;
     # end to end: `./run.sh bench corpus`).
-    manual = load_geometry(str(corpus_import("asap_beam").out)).tables.manual
+    manual = load_geometry(str(corpus_import(name).out)).tables.manual
     assert {pid for pid, table in manual.items()
             if "mm of room per side, less than the 0.025 mm the simulated cell resolves" in table.reason} == {
         "upright_a", "upright_b", "foot_a", "foot_b"}
 
 
 @pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["occt_pump"])  # a unit of the workers' work with the product's other tests
 def test_the_pump_bearing_ring_is_placed_by_hand_for_the_fingers_not_its_room(
-        corpus_import: Callable[[str], Imported]) -> None:
+        corpus_import: Callable[[str], Imported], name: str) -> None:
     # occt_pump: the bearing ring is a nominal zero-clearance fit (d 27 in d 27) in the
     # housing's bore, a hole of the housing's own mesh: the cell would narrow the ring by
     # 0.15 mm per side (tests/cad/test_narrowed_pegs.py), but the ring sits flush in the
     # housing (0.047 mm out), too little for the fingers, and its top is no face for the
     # suction cup: placed by hand for the grip, not its room.
-    manual = load_geometry(str(corpus_import("occt_pump").out)).tables.manual
+    manual = load_geometry(str(corpus_import(name).out)).tables.manual
     reason = manual["bearing_ring"].reason
     assert reason.startswith("part 'bearing_ring' stands out of the product by 0.047 mm at its goal ('housing' where "
                              "the fingers are), less than the 6 mm the fingers need"), reason
@@ -564,11 +589,12 @@ def test_a_modelled_thread_is_a_screwed_pair_with_the_truths_pitch_placed_by_han
 
 
 @pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["bdw_pillow_block"])  # a unit of the workers' work with the product's other tests
 def test_the_pressed_bearing_is_pressed_in_by_hand_and_every_plan_leaves_its_seat_to_it(
-        corpus_import: Callable[[str], Imported]) -> None:
+        corpus_import: Callable[[str], Imported], name: str) -> None:
     # bdw_pillow_block: the bearing fits no hole (the truth's room -0.025 in its seat); placed
     # by hand as pressed into that seat, it needs no hole, and no screw goes into the seat.
-    done = corpus_import("bdw_pillow_block")
+    done = corpus_import(name)
     bearing = load_geometry(str(done.out)).tables.manual["bearing"]
     seat = _feature_holes(done)["seat"]
     assert bearing.pressed and bearing.on == [seat] and "the cell has no pressing operation" in bearing.reason

@@ -92,7 +92,22 @@ def _same_import(first: Imported, second: Imported, one: Path, other: Path) -> N
         {h: (f.axis, f.part) for h, f in second.derived.holes.items()}
 
 
-@pytest.mark.slow  # three imports of a five-part product
+@pytest.fixture(scope="module")
+def as_drawn(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], tuple[Imported, Path]]:
+    """A corpus product imported z up as drawn, with its ``import.toml``: what the import
+    derived and the folder it wrote, once per product for the module's tests."""
+    done: dict[str, tuple[Imported, Path]] = {}
+
+    def get(product: str) -> tuple[Imported, Path]:
+        if product not in done:
+            out = tmp_path_factory.mktemp(product) / "z_up"
+            done[product] = run_import(CORPUS / product / "meshes", out, "mm", CORPUS / product / "import.toml"), out
+        return done[product]
+
+    return get
+
+
+@pytest.mark.slow  # two imports of a five-part product (three for its first test)
 @pytest.mark.parametrize(("product", "up", "words"), [
     ("agh_prism_array", "+y", ["the base box is thinnest along y", "4 of its 4 holes and pins open along y, the "
                                'other parts standing out of it along +y: the CAD may be drawn y up; set up = "+y" '
@@ -105,13 +120,14 @@ def _same_import(first: Imported, second: Imported, one: Path, other: Path) -> N
                                  'way and 0.000 mm across): the CAD may be drawn upside down (z down); set up = "-z" '
                                  "or --up=-z"]),
 ])
-def test_a_product_drawn_with_another_axis_up_gives_the_same_facts(tmp_path: Path, product: str, up: str,
-                                                                   words: list[str]) -> None:
+def test_a_product_drawn_with_another_axis_up_gives_the_same_facts(
+        as_drawn: Callable[[str], tuple[Imported, Path]], tmp_path: Path, product: str, up: str,
+        words: list[str]) -> None:
     config = CORPUS / product / "import.toml"
-    first = run_import(CORPUS / product / "meshes", tmp_path / "z_up", "mm", config)
+    first, z_up = as_drawn(product)
     meshes = _drawn(product, up, tmp_path / "drawn")
     turned = run_import(meshes, tmp_path / "turned", "mm", config, ImportOptions(up=up))
-    _same_import(first, turned, tmp_path / "z_up", tmp_path / "turned")
+    _same_import(first, turned, z_up, tmp_path / "turned")
     assert f"the CAD's {up} is up (up): every part turned about" in turned.assumed[0]
     assert f"the CAD's {up} turned up" in (tmp_path / "turned" / "assembly.toml").read_text().splitlines()[0]
     # without up, the base stands on its edge with its holes opening sideways: refused, nothing written

@@ -102,8 +102,8 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
     description = load_cell_description(str(description_file))
     geometry = load_geometry(str(folder), description)
     hole = geometry.holes["h1"]
-    descent = 4.0  # [s] of the hand's path from 5 mm above the entrance to the bottom
-    path = [Waypoint((hole.position[0], hole.position[1], hole.top_z + 0.005), 1.5),
+    descent = 3.0  # [s] of the hand's path from 5 mm above the entrance to the bottom
+    path = [Waypoint((hole.position[0], hole.position[1], hole.top_z + 0.005), 1.0),
             Waypoint((hole.position[0], hole.position[1], hole.bottom_z - 0.001), descent)]
     lines: list[str] = []
     with sim_robot(folder) as sim:
@@ -125,8 +125,8 @@ def test_a_peg_guided_into_its_hole_by_a_hand_is_taught(tmp_path: Path) -> None:
              hands[0].peak if hands else 0.0)
     assert len(lines) == 2 and lines[1].startswith("recorded"), lines
     assert hands and hands[0].done and hands[0].peak > 1.0, hands
-    # The hand's: it crosses the start depth 7 mm into its 4 s descent of 31 mm (minimum jerk,
-    # at 1.3 s) and the part stops on the bottom (30 mm, at 3.4 s); the scripted one lasts 0.8 s.
+    # The hand's: it crosses the start depth 7 mm into its 3 s descent of 31 mm (minimum jerk,
+    # at 1.0 s) and the part stops on the bottom (30 mm, at 2.6 s); the scripted one lasts 0.8 s.
     assert 1.2 < skill.execution_time < descent, skill.execution_time
     assert abs(skill.demo_start[2] - DEMO_START_HEIGHT) < 0.001, skill.demo_start
     assert abs(skill.demo_goal[2] + hole.depth) < 0.001, skill.demo_goal  # at the hole's bottom

@@ -1,7 +1,8 @@
 """A ring onto a pin along a horizontal axis on the Franka backend against franky-sim:
 ``tests/franka/data/pins`` (a ring d 32 mm, 20 mm long, its bore d 10.8 mm; pins d 10 mm
 along -y and +x and one d 11 mm along -y, standing out of a block whose pins the MuJoCo
-scene builds in each pin's frame), the skill taught in the PyBullet cell. The ring stops at
+scene builds in each pin's frame), the skill taught in the PyBullet cell and shipped with it
+(``demonstrations/``, as ``test_franka_sideways.py``'s). The ring stops at
 the free end of the pin too wide for its bore, eq. (6) on the force along the pin's axis,
 backs out and goes onto the d 10 mm pin along -y to its foot; the tool turned along -y once.
 The cell's impedance is the arm's stiffest (:data:`STIFFNESS`)."""
@@ -21,7 +22,6 @@ from executor.cell_description import load_cell_description  # noqa: E402
 from executor.franka.safety import MAX_TRANSLATIONAL_STIFFNESS  # noqa: E402
 from executor.world.arm import quat_to_matrix  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
-from tests.cad.conftest import teach  # noqa: E402
 from tests.franka import franka_cell_description, franka_on_sim
 from tests.franka.test_franka_sideways import SEARCH_RADIUS
 
@@ -37,7 +37,7 @@ the stiffness; at the default 2000 N/m the ring ended 2.5 mm from its goal on th
 
 
 def test_a_ring_stops_at_a_pin_too_wide_for_its_bore_and_goes_onto_one_that_fits(tmp_path: Path) -> None:
-    folder = teach(Path(shutil.copytree(PRODUCT, tmp_path / "pins")))
+    folder = Path(shutil.copytree(PRODUCT, tmp_path / "pins"))
     description = load_cell_description(franka_cell_description(tmp_path, SEARCH_RADIUS, STIFFNESS))
     geometry = load_geometry(str(folder), description)
     seen = {}
