@@ -196,8 +196,8 @@ class Derived:
 
     @property
     def hole_of(self) -> dict[str, HoleFit]:
-        """Part → the hole of the base it stands in."""
-        return {fit.part: fit for fit in self.holes.values() if fit.part is not None}
+        """Part → the hole of the base it stands in (each of a stack in one hole)."""
+        return {pid: fit for fit in self.holes.values() for pid in fit.occupants}
 
     @property
     def in_holes(self) -> dict[str, HoleFit]:
