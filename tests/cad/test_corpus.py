@@ -108,6 +108,10 @@ UNSIMULATED: dict[str, str] = {}
     "bosl2_screw_nut",
     "nop_pot_knob",
     "bdw_pillow_block",
+    pytest.param("cubefactory_cutting_unit", marks=_xfail(
+        "a hollow pin: the clamping flange's bore (d 30) round the coupling's d 29 outside, the coupling on the "
+        "shaft's end, is taken for a bore on the shaft's pin inside both (room 2.5), so the coupling's outside is "
+        "no feature")),
 ])
 def test_the_fit_relation_is_the_truth(corpus_import: Callable[[str], Imported], name: str) -> None:
     done = corpus_import(name)
@@ -174,6 +178,7 @@ def test_the_cad_prior_margin_is_twice_the_truths_room(corpus_import: Callable[[
     "flynn_clutch",
     "nop_printed_box",
     "bosl2_screw_nut",
+    "cubefactory_cutting_unit",
 ])
 def test_each_part_fits_the_feature_it_is_in(corpus_import: Callable[[str], Imported], name: str) -> None:
     # On the features the import finds: the part the CAD has in each fits it (each of a
@@ -302,6 +307,10 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
     pytest.param("bdw_pillow_block", marks=_xfail(INSERTED + " pressed (the bearing into its seat: the cell has no "
                                                   "pressing operation), or with a polygon section it is no prism of "
                                                   "(the screws)")),
+    pytest.param("cubefactory_cutting_unit", marks=_xfail(INSERTED + " along a horizontal axis (every part of it: the "
+                                                          "bearings, the spacer and the cover into the housing's bore "
+                                                          "along -y, the shaft through them along +y, the coupling "
+                                                          "and the flange onto its end along -y)")),
 ])
 def test_the_cell_inserts_every_part(corpus_import: Callable[[str], Imported], name: str) -> None:
     manual = load_geometry(str(corpus_import(name).out)).tables.manual
