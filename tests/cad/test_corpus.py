@@ -587,6 +587,24 @@ def test_the_pressed_bearing_is_pressed_in_by_hand_and_every_plan_leaves_its_sea
                          and seat not in {s.hole for s in plan.steps} for plan in found)
 
 
+@pytest.mark.slow  # the first test of a product imports it
+def test_the_bearings_spacer_and_cover_are_planned_into_the_one_bore_of_the_housing_in_their_order(
+        corpus_import: Callable[[str], Imported]) -> None:
+    # cubefactory_cutting_unit: bearing_b, the spacer, bearing_a and the cover's spigot stand
+    # in the housing's d 47 bore along y, one hole holding the four (its capacity); the
+    # planner puts each into it after the ones the precedence puts before it. Written once
+    # per part's level, the bore was four holes, each bolt hole beside it four too.
+    done = corpus_import("cubefactory_cutting_unit")
+    bore = _feature_holes(done)["bore"]
+    assert done.occupants[bore] == {"bearing_b", "spacer", "bearing_a", "cover"}
+    assert tomllib.loads((done.out / "assembly.toml").read_text())["holes"][bore]["capacity"] == 4
+    facts = load_learned_facts([done.out / "sizes.lp", done.out / "geometric_precedence.lp"],
+                               product_facts(load_assembly(done.out)))
+    found = plans(facts, 0)
+    assert found and all([s.part for s in plan.steps if s.hole == bore] == ["bearing_b", "spacer", "bearing_a", "cover"]
+                         for plan in found)
+
+
 @pytest.mark.slow  # derives the product (6 s of wall time under load)
 def test_each_switch_hanging_through_a_slot_of_the_case_top_is_found_in_that_slot() -> None:
     # nop_rocker_switches: a rocker switch and a neon indicator
