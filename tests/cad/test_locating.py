@@ -118,6 +118,7 @@ def test_a_part_is_located_by_what_it_meets_first_not_by_what_lies_beyond() -> N
     parts = [_part("plate", plate), _part("peg", _box((10, 10, 40), (0, 0, 15))), _part("sleeve", sleeve),
              _part("flange", flange)]
     derived = derive(parts, "plate", {})
-    assert derived.located["sleeve"]["+x"] == {"peg"} and derived.located["flange"]["+x"] == {"sleeve"}
+    assert derived.located["sleeve"]["+x"] == {"peg", "flange"} and derived.located["flange"]["+x"] == {"sleeve", "peg"}
+    assert derived.nearer["sleeve"]["+x"][0] == {"peg"} and derived.nearer["flange"]["+x"][0] == {"sleeve"}
     assert {pair: why for pair, why in derived.reasons.items() if why == "locates"} == {
         ("peg", "sleeve"): "locates", ("sleeve", "flange"): "locates"}

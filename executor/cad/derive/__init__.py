@@ -177,11 +177,11 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
             result.reasons = seeded
     result.reasons |= {(base, pid): "base" for stage in result.stages for pid in stage if sweeper.touching(base, pid)}
     if reach > 0:
-        result.located = locators(sweeper, result.bodies, reach)
+        result.located, result.nearer = locators(sweeper, result.bodies, reach)
     ways = {root: result.ways(root) for root in result.bodies}
     sweeper.close()  # its last sweep: what follows forks its own workers
     placing, result.later = placing_pairs(result.supports, result.located, ways, result.bodies, base,
-                                          set(result.reasons))
+                                          set(result.reasons), result.nearer)
     kept, dropped = consistent(sorted(placing), set(result.reasons))
     result.reasons |= {pair: placing[pair] for pair in kept if pair not in result.reasons}
     result.dropped = {pair for pair in dropped if placing[pair] == "locates"}

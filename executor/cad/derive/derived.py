@@ -95,6 +95,9 @@ class Derived:
     edges: set[tuple[str, str]] = field(default_factory=set)
     reasons: dict[tuple[str, str], str] = field(default_factory=dict)
     located: dict[str, dict[str, set[str]]] = field(default_factory=dict)
+    nearer: dict[str, dict[str, list[set[str]]]] = field(default_factory=dict)
+    """Where a body meets several parts along a direction: those met within shorter
+    reaches, the nearest first (:func:`executor.cad.locating.locators`)."""
     later: dict[str, set[str]] = field(default_factory=dict)
     """Each moving body's parts that the placing pairs put after it (not counted among its locators)."""
     dropped: set[tuple[str, str]] = field(default_factory=set)
