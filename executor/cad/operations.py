@@ -298,6 +298,9 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
             if pid not in by_hand and (why := _onto_pin(derived, pin, pid)) is not None:
                 by_hand[pid] = why
     for hid, fit in derived.holes.items():
+        for pid in dict(fit.more):  # the further parts of a stack: the hole is measured for the deepest
+            by_hand.setdefault(pid, f"stands in hole {hid} with '{fit.part}' deeper in it: the cell inserts one "
+                                    "part into a hole of the base")
         if fit.part in screws or fit.part in (refused or {}):
             continue
         if fit.part is not None and derived.axis[fit.part] != fit.axis:
@@ -657,7 +660,7 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     depth = GRIPPER["grasp_depth"]
     grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2])
                    - (0.0 if tool_of(derived, fit)[0] == "suction" else finger_grip(derived, fit)[0]))  # cup: top
-             for pid, fit in derived.hole_of.items() if fit.axis == "+z"}
+             for pid, fit in derived.hole_of.items() if fit.axis == "+z" and fit.part == pid}
     for pin in derived.pins.values():
         for pid in (p for p in pin.parts if p in derived.bores and pin.axis == "+z"):
             low, high = (float(v) for v in derived.parts[pid].mesh.bounds[:, 2])
