@@ -214,7 +214,7 @@ def _largest_peg(derived: Derived, holes: tuple[str, ...]) -> str:
 
 def _nearest_peg(derived: Derived, section: Shape2D) -> str:
     """The peg whose section is nearest ``section`` (same kind first, then size, then id)."""
-    pegs = [(pid, fit.section) for pid, fit in derived.hole_of.items() if fit.section is not None]
+    pegs = [(pid, fit.occupants[pid]) for pid, fit in derived.hole_of.items() if pid in fit.occupants]
     return min(pegs, key=lambda item: (item[1].kind != section.kind, abs(item[1].a - section.a), item[0]))[0]
 
 

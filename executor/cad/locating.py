@@ -8,9 +8,13 @@ Blocking cannot decide this (a lid lifted off its spacer has a free way in whate
 order); it is gravity's order, and like the locating rule it only removes sequences.
 
 **Model.** In the assembled product, a part X is *located* along a direction by the parts
-it meets when moved :data:`LOCATING_REACH` that way (swept, everything else fixed, as the
-blocking is found: :class:`executor.cad.sweep.Sweeper`). X may go in along any of its
-*ways*: the directions the base leaves it free along (those the blocking rule tries).
+it meets first when moved :data:`LOCATING_REACH` that way (swept, everything else fixed, as
+the blocking is found: :class:`executor.cad.sweep.Sweeper`; of several met, those present
+when X goes in met within a quarter of the way, a quarter of that, ...: a coupling on a shaft's
+end at zero clearance with a flange 0.5 mm round it is located by the shaft, not by the
+flange, and the flange by the coupling, not by the shaft it would reach through the
+coupling). X may go in along any of its *ways*: the directions the base leaves it free
+along (those the blocking rule tries).
 Gone in along a way, X is located along every direction but the way out: across it, and
 along the insertion itself by what stops it there. When, whichever way X goes in, one
 part Y other than the base is the only one that locates X along some such direction, Y
@@ -43,6 +47,12 @@ LOCATING_REACH = 3e-3
 """How far a part is moved sideways to find what locates it [m]: more than the play of
 the openings a cell places a part over (Cranfield's widest, the front plate over its
 pins, 2.15 mm a side), less than the distance to unrelated neighbours."""
+NEARER = 0.25
+"""Of several parts a body meets within a reach, those met within this fraction of it are
+met first (:func:`locators`)."""
+NEARER_STEPS = 3
+"""How many times :func:`locators` shortens the reach by :data:`NEARER` (to 1/64 of it:
+47 µm of the 3 mm reach, within a zero-clearance fit's tolerance of contact)."""
 MAX_REACH = 0.1
 """The largest reach ``import --locating-reach`` takes [m]."""
 
@@ -54,15 +64,34 @@ def beside(way: tuple[float, float, float]) -> list[str]:
     return [name for name, vector in DIRECTIONS.items() if float(np.dot(vector, way)) < 1 - 1e-9]
 
 
-def locators(sweeper: Sweeper, bodies: dict[str, set[str]], reach: float) -> dict[str, dict[str, set[str]]]:
+def locators(sweeper: Sweeper, bodies: dict[str, set[str]], reach: float
+             ) -> tuple[dict[str, dict[str, set[str]]], dict[str, dict[str, list[set[str]]]]]:
     """Body -> direction -> the other parts that stop the body (its members moved
-    together) within ``reach`` [m] along each direction of :data:`DIRECTIONS`."""
+    together) within ``reach`` [m] along each direction of :data:`DIRECTIONS`; and, where
+    that is several, those met within :data:`NEARER` of the reach, of that, ... (at most
+    :data:`NEARER_STEPS` times, while several are met), the nearest first (module docstring)."""
     requests = [(root, name) for root in bodies for name in DIRECTIONS]
     hits = sweeper.blocked([(bodies[root], np.array(DIRECTIONS[name]), reach) for root, name in requests])
     located: dict[str, dict[str, set[str]]] = {root: {} for root in bodies}
     for (root, name), hit in zip(requests, hits):
         located[root][name] = hit
-    return located
+    nearer: dict[str, dict[str, list[set[str]]]] = {root: {} for root in bodies}
+    crowded = [(root, name) for root, name in requests if len(located[root][name]) > 1]
+    for step in range(1, NEARER_STEPS + 1):
+        if not crowded:
+            break
+        found = sweeper.blocked([(bodies[root], np.array(DIRECTIONS[name]), reach * NEARER ** step)
+                                 for root, name in crowded])
+        for (root, name), hit in zip(crowded, found):
+            nearer[root].setdefault(name, []).insert(0, hit)
+        crowded = [(root, name) for (root, name), hit in zip(crowded, found) if len(hit) > 1]
+    return located, nearer
+
+
+def first_met(met: list[set[str]], absent: set[str]) -> set[str]:
+    """Of the sets of parts ``met`` within ever longer reaches, the first that holds a part
+    not ``absent`` (those going in later), less them; empty: none."""
+    return next((hit - absent for hit in met if hit - absent), set())
 
 
 def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> set[tuple[str, str]]:
@@ -76,19 +105,22 @@ def support_pairs(sweeper: Sweeper, bodies: dict[str, set[str]], base: str) -> s
 
 
 def locating_candidates(located: dict[str, dict[str, set[str]]], ways: dict[str, dict[str, tuple[float, float, float]]],
-                        base: str, later: dict[str, set[str]] | None = None) -> set[tuple[str, str]]:
-    """The locating pairs (Y, X) of ``located`` (body -> direction -> its locators) and
-    ``ways`` (body -> its ways in, named removal directions -> unit vectors): along every
-    way, Y (not the base) is the one locator of X along some direction :func:`beside` it,
-    the parts ``later`` puts after X (body -> parts that must follow it) not counted: they
+                        base: str, later: dict[str, set[str]] | None = None,
+                        nearer: dict[str, dict[str, list[set[str]]]] | None = None) -> set[tuple[str, str]]:
+    """The locating pairs (Y, X) of ``located`` (body -> direction -> its locators),
+    ``nearer`` (those met within shorter reaches, :func:`locators`) and ``ways`` (body ->
+    its ways in, named removal directions -> unit vectors): along every way, Y (not the
+    base) is the one locator X meets first along some direction :func:`beside` it, the
+    parts ``later`` puts after X (body -> parts that must follow it) not counted: they
     are not there when X goes in."""
     pairs: set[tuple[str, str]] = set()
     for part, by_direction in located.items():
         after = (later or {}).get(part, set())
+        closer = (nearer or {}).get(part, {})
         alone: set[str] | None = None
         for axis in ways[part].values():
-            here = {next(iter(by_direction[name] - after)) for name in beside(axis)
-                    if len(by_direction[name] - after) == 1 and base not in by_direction[name]}
+            met = {name: first_met([*closer.get(name, []), by_direction[name]], after) for name in beside(axis)}
+            here = {next(iter(met[name])) for name in met if len(met[name]) == 1 and base not in by_direction[name]}
             alone = here if alone is None else alone & here
         pairs |= {(locator, part) for locator in alone or ()}
     return pairs
@@ -96,7 +128,8 @@ def locating_candidates(located: dict[str, dict[str, set[str]]], ways: dict[str,
 
 def placing_pairs(supports: set[tuple[str, str]], located: dict[str, dict[str, set[str]]],
                   ways: dict[str, dict[str, tuple[float, float, float]]], bodies: dict[str, set[str]], base: str,
-                  edges: set[tuple[str, str]]) -> tuple[dict[tuple[str, str], str], dict[str, set[str]]]:
+                  edges: set[tuple[str, str]], nearer: dict[str, dict[str, list[set[str]]]] | None = None
+                  ) -> tuple[dict[tuple[str, str], str], dict[str, set[str]]]:
     """The supporting and locating pairs with their reasons (``supports``, ``locates``) and
     each body's parts that must follow it by the blocking ``edges`` and the pairs of these
     that :func:`consistent` keeps. A part that must follow X does not locate
@@ -109,7 +142,7 @@ def placing_pairs(supports: set[tuple[str, str]], located: dict[str, dict[str, s
     while True:
         # every round's pairs are kept: a later round only adds pairs, or loses ones the
         # pairs kept contradict (a locator after its part), which stay to be reported dropped
-        placing |= {pair: "locates" for pair in locating_candidates(located, ways, base, later)
+        placing |= {pair: "locates" for pair in locating_candidates(located, ways, base, later, nearer)
                     if pair not in placing}
         kept, _ = consistent(sorted(placing), edges)
         graph = nx.DiGraph(edges | kept)

@@ -100,3 +100,25 @@ def test_a_ring_that_slides_on_along_its_shaft_is_located_by_the_shaft_alone() -
     assert derived.located["spacer"]["+x"] == {"bearing"} and derived.located["spacer"]["-x"] == {"pulley"}
     assert {pair for pair, reason in derived.reasons.items() if reason == "locates"} == {
         ("shaft", "spacer"), ("shaft", "pulley"), ("spacer", "pulley")}
+
+
+def test_a_part_is_located_by_what_it_meets_first_not_by_what_lies_beyond() -> None:
+    # A 10 mm square peg in the plate (0.25 mm of play a side), a sleeve on it at zero
+    # clearance (13 mm square) and a flange round the sleeve with 0.5 mm of play a side,
+    # both lying on the plate. Moved 3 mm sideways the sleeve meets the peg at once and the
+    # flange after 0.5 mm; the flange meets the sleeve after 0.5 mm and the peg 2 mm on,
+    # through the sleeve. Each is located by the one it meets first (cubefactory_cutting_unit's
+    # coupling on the shaft's end and its clamping flange).
+    plate = trimesh.boolean.difference([_box((100, 100, 20), (0, 0, 0)), _box((10.5, 10.5, 16), (0, 0, 3))],
+                                       engine="manifold")
+    sleeve = trimesh.boolean.difference([_box((13, 13, 10), (0, 0, 15)), _box((10, 10, 12), (0, 0, 15))],
+                                        engine="manifold")
+    flange = trimesh.boolean.difference([_box((30, 30, 4), (0, 0, 12)), _box((14, 14, 6), (0, 0, 12))],
+                                        engine="manifold")
+    parts = [_part("plate", plate), _part("peg", _box((10, 10, 40), (0, 0, 15))), _part("sleeve", sleeve),
+             _part("flange", flange)]
+    derived = derive(parts, "plate", {})
+    assert derived.located["sleeve"]["+x"] == {"peg", "flange"} and derived.located["flange"]["+x"] == {"sleeve", "peg"}
+    assert derived.nearer["sleeve"]["+x"][0] == {"peg"} and derived.nearer["flange"]["+x"][0] == {"sleeve"}
+    assert {pair: why for pair, why in derived.reasons.items() if why == "locates"} == {
+        ("peg", "sleeve"): "locates", ("sleeve", "flange"): "locates"}

@@ -21,9 +21,10 @@ per direction, its blockers).
 
 **Geometric precedence** (:func:`forced`): A must precede B (``blocks``) when A cannot go
 in once B is there: of the directions the base leaves A free along, B blocks one, and B
-or parts present whenever B is (its body, the base, parts already found to precede B)
-block every one. The base precedes every part touching it (``base``), the owner of a
-feature every part going into or onto it (``feature``, :func:`owner_pairs`). Two stated rules
+or parts present whenever B is (its body, the base, parts already found to precede B, by
+this rule or by the support rule where the blocking allows it) block every one. The base
+precedes every part touching it (``base``), the owner of a feature every part going into
+or onto it (``feature``, :func:`owner_pairs`). Two stated rules
 of placing (:mod:`executor.cad.locating`) add ``supports`` (a part
 resting on parts other than the base goes after them) and ``locates`` (whichever way a part
 goes in, one other part alone locates it across that way; off with reach 0);
@@ -164,15 +165,23 @@ def derive(parts: list[CadPart], base: str, fixed_to: dict[str, str], reach: flo
             for d in result.directions) for pid in sorted(remaining))
         raise ExecutorError(f"part(s) {', '.join(sorted(remaining))} never come out of the assembled product, "
                             f"blocked: {stuck} (expected a straight way out for every part but the base)")
+    result.supports = support_pairs(sweeper, result.bodies, base)
     result.reasons = forced(result)
+    # the support rule's pairs the blocking allows are parts present whenever their part is:
+    # a ring between a bearing and a shaft's shoulder cannot go in once the shaft, which
+    # rests on the bearing, is there (kept unless that closes a cycle)
+    held, _ = consistent(sorted(result.supports), set(result.reasons))
+    if held:
+        seeded = forced(result, held)
+        if nx.is_directed_acyclic_graph(nx.DiGraph(list(seeded | dict.fromkeys(held, "supports")))):
+            result.reasons = seeded
     result.reasons |= {(base, pid): "base" for stage in result.stages for pid in stage if sweeper.touching(base, pid)}
     if reach > 0:
-        result.located = locators(sweeper, result.bodies, reach)
+        result.located, result.nearer = locators(sweeper, result.bodies, reach)
     ways = {root: result.ways(root) for root in result.bodies}
-    result.supports = support_pairs(sweeper, result.bodies, base)
     sweeper.close()  # its last sweep: what follows forks its own workers
     placing, result.later = placing_pairs(result.supports, result.located, ways, result.bodies, base,
-                                          set(result.reasons))
+                                          set(result.reasons), result.nearer)
     kept, dropped = consistent(sorted(placing), set(result.reasons))
     result.reasons |= {pair: placing[pair] for pair in kept if pair not in result.reasons}
     result.dropped = {pair for pair in dropped if placing[pair] == "locates"}

@@ -4,6 +4,8 @@ part goes into (:func:`receives`), the others pockets."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from executor.cad.derive.cavities import without_cavities
@@ -70,9 +72,19 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
             frame = frame_of(axis)
             centre = frame.T @ loop.centre + axis * level
             occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
-            same = [k for k, (f, _, _) in enumerate(fits) if f.axis == name and np.linalg.norm(
-                np.array(f.centre) - centre - axis * np.dot(np.array(f.centre) - centre, axis)) < SAME_HOLE]
-            if same and (occupant is None or fits[same[0]][0].part is not None):
+            # across the axis, by the loops' centres: a fit's ``centre`` keeps the cell's x, y and
+            # the entry (a horizontal hole's height across its axis is not in it)
+            same = [k for k, (f, c, _) in enumerate(fits) if f.axis == name and np.linalg.norm(
+                c - centre - axis * np.dot(c - centre, axis)) < SAME_HOLE]
+            if same and occupant is None:
+                continue
+            if same and fits[same[0]][0].part is not None:
+                # a further part in the hole (a bearing, a spacer and another bearing in one
+                # housing bore): levels come deepest first, the hole is measured for the deepest
+                first, at, along = fits[same[0]]
+                more = measure(base, name, loop, level, around[0] if around else None, occupant, workers)
+                if more.section is not None:
+                    fits[same[0]] = (replace(first, more=(*first.more, (str(more.part), more.section))), at, along)
                 continue
             if occupant is None and roofed(base.mesh, centre, axis):
                 continue  # empty and roofed along its axis: a cavity open the other way (a brick's underside)

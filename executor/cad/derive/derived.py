@@ -95,6 +95,9 @@ class Derived:
     edges: set[tuple[str, str]] = field(default_factory=set)
     reasons: dict[tuple[str, str], str] = field(default_factory=dict)
     located: dict[str, dict[str, set[str]]] = field(default_factory=dict)
+    nearer: dict[str, dict[str, list[set[str]]]] = field(default_factory=dict)
+    """Where a body meets several parts along a direction: those met within shorter
+    reaches, the nearest first (:func:`executor.cad.locating.locators`)."""
     later: dict[str, set[str]] = field(default_factory=dict)
     """Each moving body's parts that the placing pairs put after it (not counted among its locators)."""
     dropped: set[tuple[str, str]] = field(default_factory=set)
@@ -196,8 +199,8 @@ class Derived:
 
     @property
     def hole_of(self) -> dict[str, HoleFit]:
-        """Part → the hole of the base it stands in."""
-        return {fit.part: fit for fit in self.holes.values() if fit.part is not None}
+        """Part → the hole of the base it stands in (each of a stack in one hole)."""
+        return {pid: fit for fit in self.holes.values() for pid in fit.occupants}
 
     @property
     def in_holes(self) -> dict[str, HoleFit]:

@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import networkx as nx
 
 from executor.cad.derive.derived import Derived
@@ -26,15 +28,20 @@ def bodies(parts: dict[str, CadPart], base: str, fixed_to: dict[str, str]) -> di
     return found
 
 
-def forced(derived: Derived) -> dict[tuple[str, str], str]:
+def forced(derived: Derived, seeds: Iterable[tuple[str, str]] = ()) -> dict[tuple[str, str], str]:
     """The ``blocks`` pairs: A before B when, of the directions the base leaves A free
     along, B blocks one and B or the parts present whenever B is (its body, the base, the
-    bodies already found to precede it) block every one; repeated until no pair is added,
+    bodies already found to precede it, or put before it by ``seeds``: (part, part) pairs
+    of the support rule) block every one; repeated until no pair is added,
     then every pair the rule gives with those, also where A already precedes B through
     others (so the pairs do not depend on the order of the ids). Each pair's blockers per
     direction in ``derived.detail``."""
     rep = {root: min(members) for root, members in derived.bodies.items()}
     before: dict[str, set[str]] = {root: set() for root in derived.bodies}
+    root_of = {pid: root for root, members in derived.bodies.items() for pid in members}
+    for first, then in seeds:
+        if first in root_of and then in root_of and root_of[first] != root_of[then]:
+            before[root_of[then]].add(root_of[first])
     pairs: dict[tuple[str, str], str] = {}
 
     def ahead(root: str) -> set[str]:

@@ -87,7 +87,7 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     depth = GRIPPER["grasp_depth"]
     grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2])
                    - (0.0 if tool_of(derived, fit)[0] == "suction" else finger_grip(derived, fit)[0]))  # cup: top
-             for pid, fit in derived.hole_of.items() if fit.axis == "+z"}
+             for pid, fit in derived.hole_of.items() if fit.axis == "+z" and fit.part == pid}
     for pin in derived.pins.values():
         for pid in (p for p in pin.parts if p in derived.bores and pin.axis == "+z"):
             low, high = (float(v) for v in derived.parts[pid].mesh.bounds[:, 2])

@@ -54,6 +54,9 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
             if pid not in by_hand and (why := onto_pin(derived, pin, pid)) is not None:
                 by_hand[pid] = why
     for hid, fit in derived.holes.items():
+        for pid in dict(fit.more):  # the further parts of a stack: the hole is measured for the deepest
+            by_hand.setdefault(pid, f"stands in hole {hid} with '{fit.part}' deeper in it: the cell inserts one "
+                                    "part into a hole of the base")
         if fit.part in screws or fit.part in (refused or {}):
             continue
         if fit.part is not None and derived.axis[fit.part] != fit.axis:

@@ -33,8 +33,8 @@ class Settings:
 
 def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[str, str]) -> str:
     """``assembly.toml``: the parts with their ``roles`` (base, peg, else the given one or
-    ``part``) and trays, the holes (a pin several parts go onto with their number as its
-    ``capacity``)."""
+    ``part``) and trays, the holes (a pin several parts go onto, or a hole of the base
+    several parts stand in, with their number as its ``capacity``)."""
     pegs = derived.hole_of
     frame = "the CAD frame (the cell frame)" if settings.up == "+z" and not any(settings.moved) else "the cell frame"
     if settings.up != "+z":
@@ -59,7 +59,10 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         if fit.owner is not None:
             name = f"hole of {fit.owner} ({' '.join(fit.occupants)} in it)"
         lines += [f"[holes.{hid}]", f'name = "{name}"', f'shape = "{fit.hole.kind}"',
-                  f"position = [{_q(x)}, {_q(y)}]", ""]
+                  f"position = [{_q(x)}, {_q(y)}]"]
+        # a stack in a hole of the base (bearings and a spacer in a housing's bore)
+        lines += [f"capacity = {len(fit.occupants)}"] if fit.owner is None and len(fit.occupants) > 1 else []
+        lines.append("")
     for pin_id, pin in derived.pins.items():
         onto = f" ({' '.join(pin.parts)} onto it)" if pin.parts else ""
         x, y, _ = pin_entry(derived, pin)
