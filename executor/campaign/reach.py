@@ -149,12 +149,12 @@ def measure(kind: str, axis: str, x: float, y: float, height: float, tmp: Path) 
     with mock.patch.object(arm, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
             mock.patch.object(arm, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
         # built z up: a block raised on its riser stands on its edge, its feature sideways (import --up)
-        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0), up="+z"))
+        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0), up="+z", turn=0))
         at = load_product_description(tmp / "first" / "out").assembly.holes[feature].position
         assert at is not None and at[0] is not None and at[1] is not None
         place = (0.56 + x / 1e3 - at[0], y / 1e3 - at[1])
         out = tmp / "out"
-        run_import(cad, out, "mm", config, ImportOptions(place=place, up="+z"))
+        run_import(cad, out, "mm", config, ImportOptions(place=place, up="+z", turn=0))
     geometry = load_product_description(out).geometry
     assert geometry is not None
     if (written := geometry.hole_shapes[feature].axis) != axis:

@@ -1,0 +1,96 @@
+"""The product's pose on the table chosen for the arm's reach: :func:`executor.campaign.reach.pin_cad`'s
+block drawn with its pin standing out along +x (its ring goes on along -x, along which no
+reach was measured: placed by hand as drawn) is turned a quarter turn about z by the
+import, so the cell puts the ring on; the answers (fits, precedence) are those of the
+product as drawn, and a turn or place the user sets is kept."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pytest
+
+from bridge.product import load_product_description
+from executor import ExecutorError
+from executor.cad.cli import ImportOptions, run_import, turn_degrees
+from executor.cad.operations.arm import Reach, best_pose
+from executor.campaign.reach import pin_cad
+from tests.conftest import assembled
+
+from .conftest import teach
+
+
+def _facts(out: Path, name: str) -> list[str]:
+    """The facts of ``out/name`` (its comment lines left out), sorted."""
+    return sorted(line for line in (out / name).read_text().splitlines() if line and not line.startswith("%"))
+
+
+def _imported(tmp: Path, options: ImportOptions, settings: str = 'base = "block"\n') -> tuple[Path, int, list[str]]:
+    """The ring on its pin along -x (the CAD turned three quarter turns) imported with
+    ``options`` and ``settings``: its folder, the turn the import gave it and its assumptions."""
+    cad = pin_cad(tmp / "cad", 10.2, turn=3)
+    (tmp / "import.toml").write_text(settings)
+    done = run_import(cad, tmp / "out", "mm", tmp / "import.toml", options)
+    return tmp / "out", done.turn, done.assumed
+
+
+def test_a_ring_on_a_pin_along_minus_x_goes_on_in_the_cell_once_the_product_is_turned(tmp_path: Path) -> None:
+    drawn, turn, _ = _imported(tmp_path / "drawn", ImportOptions(turn=0))
+    geometry = load_product_description(drawn).geometry
+    assert geometry is not None and turn == 0 and geometry.hole_shapes["block_pin1"].axis == "-x"
+    assert "measured to reach a horizontal pin along +x, +y, -y only" in geometry.manual["ring"].reason
+    chosen, turn, assumed = _imported(tmp_path / "chosen", ImportOptions())
+    geometry = load_product_description(chosen).geometry
+    assert geometry is not None and geometry.manual == {}
+    # one quarter turn (fewer than 180's two): the ring goes on along -y (90) or +y (270)
+    assert (turn, geometry.hole_shapes["block_pin1"].axis) in ((90, "-y"), (270, "+y"))
+    said = next(line for line in assumed if line.startswith(f"the product turned {turn} deg about z"))
+    assert "so the arm reaches 1 more insertion(s) (ring; the cell inserts 1 of 1 moving parts)" in said
+    assert said.endswith("set turn = 0 and place = [0.56, 0] to keep it as drawn")
+    assert f"turned {turn} deg about z" in (chosen / "assembly.toml").read_text().splitlines()[0]
+    for name in ("sizes.lp", "geometric_precedence.lp"):  # the answers do not turn with the product
+        assert _facts(chosen, name) == _facts(drawn, name)
+
+
+def test_a_turn_or_place_the_user_sets_is_kept(tmp_path: Path) -> None:
+    out, turn, _ = _imported(tmp_path / "config", ImportOptions(), 'base = "block"\nturn = 0\n')
+    geometry = load_product_description(out).geometry
+    assert geometry is not None and turn == 0 and "ring" in geometry.manual
+    out, turn, _ = _imported(tmp_path / "half", ImportOptions(turn=180))  # along +x, moved into its box
+    geometry = load_product_description(out).geometry
+    assert geometry is not None and turn == 180 and geometry.hole_shapes["block_pin1"].axis == "+x"
+    assert geometry.manual == {}
+    # placed where no turn brings the pin's end (60 mm out of the base's centre) into a box: as drawn
+    out, turn, _ = _imported(tmp_path / "near", ImportOptions(place=(0.36, 0.0)))
+    geometry = load_product_description(out).geometry
+    assert geometry is not None and turn == 0 and "ring" in geometry.manual
+
+
+def test_a_bad_turn_is_refused_naming_the_setting(tmp_path: Path) -> None:
+    with pytest.raises(argparse.ArgumentTypeError, match="expected one of 0, 90, 180, 270"):
+        turn_degrees("45")
+    with pytest.raises(ExecutorError, match=r"import.toml: turn: expected one of 0, 90, 180, 270 \(deg about z\), "
+                                            "got 45"):
+        _imported(tmp_path, ImportOptions(), 'base = "block"\nturn = 45\n')
+
+
+def test_the_pose_ties_go_to_the_product_as_it_stands_then_the_fewest_quarter_turns() -> None:
+    # A pin's free end 50 mm before the base's centre along x, 30 mm up, its part going on
+    # along -x: turned 90 or 270 it goes on along -y or +y, within their boxes once moved.
+    reach = Reach("ring", "-x", (0.51, 0.0, 0.03), True)
+    def anywhere(xy: tuple[float, float]) -> bool:
+        return True
+    pose = best_pose([reach], {"ring"}, (0.56, 0.0), (None, None), anywhere)
+    assert pose.turn in (90, 270) and pose.steps == 1
+    assert best_pose([reach], {"ring"}, (0.56, 0.0), (0, None), anywhere).steps == 0  # turn set: nothing reaches
+    assert best_pose([], {"ring"}, (0.56, 0.0), (None, None), anywhere) == best_pose(
+        [], {"ring"}, (0.56, 0.0), (0, (0.56, 0.0)), anywhere)  # nothing to reach: as it stands
+
+
+@pytest.mark.slow  # a truth session of the turned product, then the ring taught and put on in physics (~15 s)
+def test_the_turned_product_is_learned_and_assembled_by_the_cell(tmp_path: Path, run_session) -> None:
+    chosen, _, _ = _imported(tmp_path, ImportOptions())
+    result = run_session("--assembly", str(chosen), "--out", str(tmp_path / "run"), "--assemble", timeout=120)
+    assert result["assembly"]["manual"] == [] and result["assembly"]["assembled"]
+    assembled(teach(chosen), "block", "ring", "block_pin1")
