@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from assembly_constraints.corpus_truth import distance_to_axis
 from bridge.product import load_product_description
 from executor import ExecutorError
 from executor.cad.cli import ImportOptions, run_import, turn_degrees
@@ -94,3 +95,11 @@ def test_the_turned_product_is_learned_and_assembled_by_the_cell(tmp_path: Path,
     result = run_session("--assembly", str(chosen), "--out", str(tmp_path / "run"), "--assemble", timeout=120)
     assert result["assembly"]["manual"] == [] and result["assembly"]["assembled"]
     assembled(teach(chosen), "block", "ring", "block_pin1")
+
+
+def test_a_turned_import_is_set_against_its_truth_in_the_cad_frame() -> None:
+    # A point on a truth feature's axis (along x through (100, 20, 30) mm in the CAD),
+    # turned 90 deg about z and moved by (500, 100, 0) mm: on the axis again.
+    feature = {"axis": "+x", "axis_point": [100.0, 20.0, 30.0]}
+    assert distance_to_axis([0.48, 0.25, 0.03], feature, (0.5, 0.1, 0.0), 90) == pytest.approx(0.0, abs=1e-9)
+    assert distance_to_axis([0.48, 0.25, 0.03], feature, (0.5, 0.1, 0.0)) > 100
