@@ -6,15 +6,13 @@ product as drawn, and a turn or place the user sets is kept."""
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import pytest
 
 from assembly_constraints.corpus_truth import distance_to_axis
 from bridge.product import load_product_description
-from executor import ExecutorError
-from executor.cad.cli import ImportOptions, run_import, turn_degrees
+from executor.cad.cli import ImportOptions, run_import
 from executor.cad.operations.arm import Reach, best_pose
 from executor.campaign.reach import pin_cad
 from tests.conftest import assembled
@@ -66,14 +64,6 @@ def test_a_turn_or_place_the_user_sets_is_kept(tmp_path: Path) -> None:
     out, turn, _ = _imported(tmp_path / "near", ImportOptions(place=(0.36, 0.0)))
     geometry = load_product_description(out).geometry
     assert geometry is not None and turn == 0 and "ring" in geometry.manual
-
-
-def test_a_bad_turn_is_refused_naming_the_setting(tmp_path: Path) -> None:
-    with pytest.raises(argparse.ArgumentTypeError, match="expected one of 0, 90, 180, 270"):
-        turn_degrees("45")
-    with pytest.raises(ExecutorError, match=r"import.toml: turn: expected one of 0, 90, 180, 270 \(deg about z\), "
-                                            "got 45"):
-        _imported(tmp_path, ImportOptions(), 'base = "block"\nturn = 45\n')
 
 
 def test_the_pose_ties_go_to_the_product_as_it_stands_then_the_fewest_quarter_turns() -> None:
