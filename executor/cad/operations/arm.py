@@ -141,11 +141,11 @@ def best_pose(reaches: list[Reach], inserted: set[str], centre: tuple[float, flo
     """The pose (:class:`Pose`) under which the cell inserts the most of the parts
     ``inserted`` (those it inserts where the arm reaches everything), each one counted
     where it reaches every one of its ``reaches`` (:func:`reached`), the base's centre
-    now at ``centre`` [m]: a turn of :data:`QUARTERS` and a place where ``allowed``; ties
-    go to the product as it stands (turn 0, at ``centre``), then the fewest quarter turns,
-    then the smallest move. ``fixed`` holds the turn and the place the user set (None:
-    free). A place that brings a feature into a box keeps it :data:`POSE_MARGIN` inside,
-    rounded to 0.1 mm."""
+    now at ``centre`` [m]: a turn of :data:`QUARTERS` and a place where ``allowed`` (the
+    user's place wherever it is); ties go to the product as it stands (turn 0, at
+    ``centre``), then the fewest quarter turns, then the smallest move. ``fixed`` holds
+    the turn and the place the user set (None: free). A place that brings a feature into
+    a box keeps it :data:`POSE_MARGIN` inside, rounded to 0.1 mm."""
     turn_set, place_set = fixed
     by_part: dict[str, list[Reach]] = {}
     for reach in reaches:
@@ -156,15 +156,17 @@ def best_pose(reaches: list[Reach], inserted: set[str], centre: tuple[float, flo
 
     poses = [Pose(turn_set or 0, place_set or centre, steps(turn_set or 0, place_set or centre))]
     for turn in QUARTERS if turn_set is None else (turn_set,):
-        xs, ys = {(place_set or centre)[0]}, {(place_set or centre)[1]}
-        for reach in reaches if place_set is None else ():
+        xs, ys = {centre[0]}, {centre[1]}
+        for reach in reaches:
             x, y = turned_xy(reach.point[0] - centre[0], reach.point[1] - centre[1], turn)
             regions = SIDEWAYS_PIN_REACH if reach.pin else SIDEWAYS_HOLE_REACH
             for (x0, x1), (y0, y1), _ in regions.get(turned_axis(reach.axis, turn), ()):
                 xs |= {x0 + POSE_MARGIN - x, x1 - POSE_MARGIN - x}
                 ys |= {y0 + POSE_MARGIN - y, y1 - POSE_MARGIN - y}
-        poses += [Pose(turn, place, steps(turn, place)) for place in
-                  ((round(x, 4) + 0.0, round(y, 4) + 0.0) for x in sorted(xs) for y in sorted(ys)) if allowed(place)]
+        places = [place_set] if place_set is not None else [
+            place for place in ((round(x, 4) + 0.0, round(y, 4) + 0.0) for x in sorted(xs) for y in sorted(ys))
+            if allowed(place)]
+        poses += [Pose(turn, place, steps(turn, place)) for place in places]
     return min(poses, key=lambda pose: (-pose.steps, min(pose.turn, 360 - pose.turn),
                                         math.dist(pose.place, place_set or centre), pose.turn, pose.place))
 
