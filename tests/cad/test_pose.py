@@ -79,11 +79,16 @@ def test_the_pose_ties_go_to_the_product_as_it_stands_then_the_fewest_quarter_tu
         [], {"ring"}, (0.56, 0.0), (0, (0.56, 0.0)), anywhere)  # nothing to reach: as it stands
 
 
-@pytest.mark.slow  # a truth session of the turned product, then the ring taught and put on in physics (~15 s)
-def test_the_turned_product_is_learned_and_assembled_by_the_cell(tmp_path: Path, run_session) -> None:
+@pytest.mark.slow  # a truth session of the turned product with --assemble (~10 s)
+def test_the_turned_product_is_learned_and_assembled_with_no_part_by_hand(tmp_path: Path, run_session) -> None:
     chosen, _, _ = _imported(tmp_path, ImportOptions())
     result = run_session("--assembly", str(chosen), "--out", str(tmp_path / "run"), "--assemble", timeout=120)
     assert result["assembly"]["manual"] == [] and result["assembly"]["assembled"]
+
+
+@pytest.mark.slow  # the ring taught, then the block and the ring assembled in physics (~10 s)
+def test_the_cell_puts_the_ring_on_the_turned_product_in_physics(tmp_path: Path) -> None:
+    chosen, _, _ = _imported(tmp_path, ImportOptions())
     assembled(teach(chosen), "block", "ring", "block_pin1")
 
 
