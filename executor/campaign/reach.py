@@ -11,8 +11,9 @@ with a d 10 pin and the ring with a d 10.2 bore (0.1 mm of room all round) of
 hexagonal peg (for +x and +y, where the import would enter its hole through the box from
 the other side, its box's far face closed by a 5 mm plate and its peg cut 1 mm short of it);
 each turned about z so that the part moves along the axis, raised on a
-riser of the base's own footprint to the height, and placed (``import --place``) so that
-the free end (entry) is at the point. The import's reach rule
+riser of the base's own footprint to the height, and placed (``import --place``, with
+``--turn 0``: the import chooses no pose of its own) so that the free end (entry) is at
+the point. The import's reach rule
 (:data:`executor.cad.operations.arm.SIDEWAYS_PIN_REACH`, :data:`executor.cad.operations.arm.SIDEWAYS_HOLE_REACH`)
 is set aside for it: the point is the cell's step wherever the import takes it as one.
 
