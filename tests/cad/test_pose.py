@@ -52,6 +52,20 @@ def test_a_ring_on_a_pin_along_minus_x_goes_on_in_the_cell_once_the_product_is_t
         assert _facts(chosen, name) == _facts(drawn, name)
 
 
+@pytest.mark.slow  # four imports (about 4 s of CPU, more beside other work)
+def test_however_the_cad_is_turned_the_cell_puts_the_ring_on_and_the_answers_hold(tmp_path: Path) -> None:
+    answers = []
+    for quarter in range(4):  # the pin drawn along +y, -x, -y, +x
+        cad = pin_cad(tmp_path / f"cad{quarter}", 10.2, turn=quarter)
+        (tmp_path / f"import{quarter}.toml").write_text('base = "block"\n')
+        out = tmp_path / f"out{quarter}"
+        run_import(cad, out, "mm", tmp_path / f"import{quarter}.toml")
+        geometry = load_product_description(out).geometry
+        assert geometry is not None and geometry.manual == {}, quarter
+        answers.append([_facts(out, name) for name in ("sizes.lp", "geometric_precedence.lp")])
+    assert all(found == answers[0] for found in answers)
+
+
 def test_a_turn_or_place_the_user_sets_is_kept(tmp_path: Path) -> None:
     out, turn, _ = _imported(tmp_path / "config", ImportOptions(), 'base = "block"\nturn = 0\n')
     geometry = load_product_description(out).geometry
