@@ -665,15 +665,16 @@ def _chosen_pose(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[P
     now = (turn or 0) + pose.turn
     where = place if place is not None else pose.place
     again = _derived(parts, paths, config, options, lambda: None, (now, where, "chosen for the arm's reach: below"))
-    more = sorted(set(found.mapped.manual) - set(again.mapped.manual))
-    if len(again.mapped.manual) >= len(found.mapped.manual):
+    more, gained = sorted(set(found.mapped.manual) - set(again.mapped.manual)), len(found.mapped.manual) - len(
+        again.mapped.manual)
+    if gained <= 0:
         return found
     drawn = ", ".join(f"{v:g}" for v in (place or (round(centre[0], 4), round(centre[1], 4))))
     keep = " and ".join(([] if turn is not None else ["turn = 0"])
                         + ([] if place is not None else [f"place = [{drawn}]"]))
     again.assumed.insert(2, (f"the product turned {now} deg about z" if now else "the product as drawn")
                          + f" and its base's centre placed at ({_mm(pose.place[0])}, {_mm(pose.place[1])}) mm so the "
-                         f"arm reaches {len(more)} more insertion(s) ({' '.join(more)}; the cell inserts "
+                         f"arm reaches {gained} more insertion(s) ({' '.join(more)}; the cell inserts "
                          f"{len(derived.parts) - 1 - len(again.mapped.manual)} of {len(derived.parts) - 1} moving "
                          f"parts); set {keep} to keep it as drawn")
     return replace(again, near=again.near + 1)
