@@ -104,16 +104,18 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
 
 
 def reaches_asked(derived: Derived) -> tuple[set[str], list[Reach]]:
-    """The moving parts the cell inserts where its arm reaches every horizontal insertion
-    (:func:`cell_view` with :func:`executor.cad.operations.arm.reaches_recorded`), and the
+    """The moving parts the cell places where its arm reaches every horizontal insertion
+    (:func:`cell_view` with :func:`executor.cad.operations.arm.reaches_recorded`, then
+    :func:`executor.cad.covers.map_parts`), and the
     reaches its decisions rest on: what the product's pose on the table decides (none,
     and no view made, where no part goes into or onto a feature along a horizontal axis)."""
     sideways = [fit.part for fit in derived.holes.values() if fit.axis not in ("+z", "-z")]
     if not any(sideways) and not any(pin.parts for pin in derived.pins.values() if pin.axis not in ("+z", "-z")):
         return set(), []
     with reaches_recorded() as found:
-        _, by_hand = cell_view(derived)
-    return set(derived.parts) - {derived.base} - set(by_hand), found
+        cell, by_hand = cell_view(derived)
+        manual = map_parts(cell, plate_top(cell), by_hand).manual  # covers and heads the cell places too
+    return set(derived.parts) - {derived.base} - set(manual), found
 
 
 def _owner_refused(derived: Derived, pin: PinFit, fit: HoleFit | None) -> str:
