@@ -70,7 +70,7 @@ def test_a_turn_or_place_the_user_sets_is_kept(tmp_path: Path) -> None:
     out, turn, _ = _imported(tmp_path / "config", ImportOptions(), 'base = "block"\nturn = 0\n')
     geometry = load_product_description(out).geometry
     assert geometry is not None and turn == 0 and "ring" in geometry.manual
-    out, turn, _ = _imported(tmp_path / "half", ImportOptions(turn=180))  # along +x, moved into its box
+    out, turn, _ = _imported(tmp_path / "half", ImportOptions(turn=180))  # along +x: its end in the box 30 mm up
     geometry = load_product_description(out).geometry
     assert geometry is not None and turn == 180 and geometry.hole_shapes["block_pin1"].axis == "+x"
     assert geometry.manual == {}
@@ -82,7 +82,8 @@ def test_a_turn_or_place_the_user_sets_is_kept(tmp_path: Path) -> None:
 
 def test_the_pose_ties_go_to_the_product_as_it_stands_then_the_fewest_quarter_turns() -> None:
     # A pin's free end 50 mm before the base's centre along x, 30 mm up, its part going on
-    # along -x: turned 90 or 270 it goes on along -y or +y, within their boxes once moved.
+    # along -x: turned 180 it goes on along +x in its box where it stands, turned 90 or 270
+    # along -y or +y in theirs once moved 51 mm: one quarter turn before two.
     reach = Reach("ring", "-x", (0.51, 0.0, 0.03), True)
     def anywhere(xy: tuple[float, float]) -> bool:
         return True
