@@ -25,6 +25,7 @@ from bridge.errors import ToolError
 from bridge.inputs import read_text
 from executor.cad.cli import run_import
 from executor.cad.derive import HoleFit
+from executor.cad.operations.arm import turned_axis, turned_xy
 from executor.cad.sweep import opposite
 
 FEATURE_REACH_MM = 2.0
@@ -38,12 +39,13 @@ class TruthError(ToolError):
 @dataclass(frozen=True)
 class CorpusImport:
     """A corpus product as ``import`` wrote it: its ``truth``, the ``out`` folder, each
-    moving part's insertion ``axes`` (the reverse of the direction it leaves along), the
-    ``offset`` (x, y, z) [m] the import moved it by from its CAD frame (its truth's) into the
-    cell, each imported hole's or pin's ``occupants`` (the parts in it or onto it) and
-    ``owners`` (the part it is a feature of), the ids that are ``pins``, the product's
-    ``parts`` (the base included), the import's wall time ``seconds`` and the base's
-    ``holes`` as the import measured them (their sections, chamfers and depths [m])."""
+    moving part's insertion ``axes`` (the reverse of the direction it leaves along) in the
+    CAD frame (its truth's), the ``offset`` (x, y, z) [m] the import moved it by into the
+    cell after turning it ``turn`` [deg] about z, each imported hole's or pin's
+    ``occupants`` (the parts in it or onto it) and ``owners`` (the part it is a feature
+    of), the ids that are ``pins``, the product's ``parts`` (the base included), the
+    import's wall time ``seconds`` and the base's ``holes`` as the import measured them
+    (their sections, chamfers and depths [m], in the cell frame)."""
 
     truth: dict[str, Any]
     out: Path
@@ -55,6 +57,7 @@ class CorpusImport:
     parts: int = 0
     seconds: float = 0.0
     holes: Mapping[str, HoleFit] = field(default_factory=dict)
+    turn: int = 0
 
 
 def read_truth(folder: Path) -> dict[str, Any]:
@@ -92,16 +95,19 @@ def import_product(folder: Path, out: Path) -> CorpusImport:
     occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
     owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
     owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
-    return CorpusImport(truth, out, {pid: opposite(leaves) for pid, leaves in derived.axis.items()},
+    return CorpusImport(truth, out, {pid: turned_axis(opposite(leaves), -derived.holes, result.turn)
+                                     for pid, leaves in derived.axis.items()},
                         result.offset, occupants, owners, frozenset(derived.pins), len(derived.parts), result.seconds,
-                        derived.holes)
+                        derived.holes, result.turn)
 
 
-def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float, float]) -> float:
-    """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, moved by
-    ``offset`` [m] from the CAD frame) lies from a truth feature's axis line [mm]; with x, y
-    only, from the line's projection on the xy plane."""
+def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float, float],
+                     turn: int = 0) -> float:
+    """How far an imported hole's ``position`` [m] (x, y, or x, y, z, in the cell, turned
+    ``turn`` [deg] about z from the CAD frame, then moved by ``offset`` [m]) lies from a
+    truth feature's axis line [mm]; with x, y only, from the line's projection on the xy plane."""
     point = [1000.0 * (v - offset[k]) for k, v in enumerate(position)]
+    point[:2] = turned_xy(point[0], point[1], -turn % 360)
     origin = feature["axis_point"][:len(point)]
     direction = {"x": 0, "y": 1, "z": 2}[feature["axis"][1]]
     across = [point[k] - origin[k] for k in range(len(point)) if k != direction]
@@ -124,7 +130,7 @@ def feature_holes(done: CorpusImport) -> dict[str, str]:
     for fid, feature in done.truth["features"].items():
         inside = {pid for pid, part in done.truth["parts"].items() if fid in features_of(part)}
         near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
-                and distance_to_axis(hole["position"], feature, done.offset) <= FEATURE_REACH_MM
+                and distance_to_axis(hole["position"], feature, done.offset, done.turn) <= FEATURE_REACH_MM
                 and (hid in done.pins) == (feature["kind"] == "pin")]
         if len(near) > 1:
             near = [hid for hid in near if not done.occupants.get(hid) or done.occupants[hid] & inside]

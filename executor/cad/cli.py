@@ -12,15 +12,19 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
     fixed_to = "lever"        # moves with that part (screwed, glued): neither blocks the other
     place = [0.56, 0.0]       # where the base's centre stands on the cell's table [m]; a third value:
                               # the height of the product's lowest point (default 0, the cell's floor)
+    turn = 90                 # the product turned about z on the table [deg]: 0, 90, 180 or 270
 
 ``--up AXIS`` overrides ``up``: every part is turned right after reading by the rotation
 taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product that
 looks drawn with another axis up (lying on its side, upside down, or unable to rest on the
-floor as read) is refused (:func:`drawn_up`). ``--place X,Y[,Z]`` overrides ``place``.
+floor as read) is refused (:func:`drawn_up`). ``--place X,Y[,Z]`` overrides ``place``,
+``--turn DEG`` ``turn``.
 Without either, a product whose base's centre lies
 outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
 says so; without a z, the product's lowest point (of all its parts) goes to the cell's floor,
-z = 0 (:func:`placement`); every part is moved right after reading, so every file written is in the cell frame.
+z = 0 (:func:`placement`). Where the user sets no turn or no place, the import chooses
+them so that the arm reaches the most horizontal insertions (:func:`_chosen_pose`); every
+part is turned and moved right after reading, so every file written is in the cell frame.
 
 It prints what it assumes, each part's insertion axis and free directions, each hole
 with both cross-sections and the clearance, the disassembly stages, the geometric
@@ -49,10 +53,12 @@ from executor.cad.convex import MESH_FOLDER, PIECES_CPU, budget_assumption, over
 from executor.cad.covers import Mapped
 from executor.cad.derive import Derived, derive
 from executor.cad.locating import LOCATING_REACH, MAX_REACH
+from executor.cad.operations.arm import QUARTERS, best_pose
 from executor.cad.operations.fingers import finger_assumption
 from executor.cad.operations.frames import entry_point, pin_entry
 from executor.cad.operations.screwed import screwed_fits
 from executor.cad.operations.tools import finger_order_text, finger_orders, tool_of
+from executor.cad.operations.view import reaches_asked
 from executor.cad.parts import (
     MAX_TRIANGLES,
     STEP_SUFFIXES,
@@ -62,6 +68,7 @@ from executor.cad.parts import (
     check_solids,
     load_meshes,
     overlaps_checked,
+    quarter_turned,
     translated,
     turn_text,
     turned,
@@ -149,16 +156,35 @@ def _place_setting(path: Path | None, value: object) -> Place | None:
     return tuple(float(v) for v in value)
 
 
+def turn_degrees(text: str) -> int:
+    """An argparse type: a turn about z [deg], one of :data:`QUARTERS`."""
+    if text.strip() not in {str(q) for q in QUARTERS}:
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected one of {', '.join(map(str, QUARTERS))} (deg)")
+    return int(text)
+
+
+def _turn_setting(path: Path | None, value: object) -> int | None:
+    """``turn`` of ``--config`` (None: not set); ExecutorError naming the file otherwise."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or value not in QUARTERS:
+        raise ExecutorError(f"{path}: turn: expected one of {', '.join(map(str, QUARTERS))} (deg about z), "
+                            f"got {shorten(repr(value))}")
+    return int(value)
+
+
 FLOOR_TOLERANCE = 1e-6
 """A product whose lowest point lies within this [m] of the height it goes to (the cell's
 floor, z = 0, unless ``place`` gives z) is not moved along z: a CAD's rounding moves nothing."""
 
 
-def placement(parts: list[CadPart], base: str, place: Place | None) -> tuple[tuple[float, float, float], str]:
+def placement(parts: list[CadPart], base: str, place: Place | None, chosen: str = "place"
+              ) -> tuple[tuple[float, float, float], str]:
     """The offset [m] that puts the centre of ``base``'s box at ``place``'s x, y (None: at
     :data:`WORK_POSITION` when it lies out of :data:`REACH`, else no horizontal offset) and
     the lowest point of all the parts at ``place``'s z (default 0, the cell's floor; within
-    :data:`FLOOR_TOLERANCE`: not moved), and the assumption to print."""
+    :data:`FLOOR_TOLERANCE`: not moved), and the assumption to print (``chosen``: why the
+    place is where it is)."""
     bounds = next(p.mesh.bounds for p in parts if p.id == base)
     centre = (float(bounds[0][0] + bounds[1][0]) / 2, float(bounds[0][1] + bounds[1][1]) / 2)
     distance = math.hypot(*centre)
@@ -167,7 +193,7 @@ def placement(parts: list[CadPart], base: str, place: Place | None) -> tuple[tup
         where = (f"the base's centre where the CAD has it ({_mm(distance)} mm from the arm's base, within reach; "
                  "set place = [x, y] to move it)")
     else:
-        target, why = ((place[0], place[1]), "place") if place is not None else (WORK_POSITION, (
+        target, why = ((place[0], place[1]), chosen) if place is not None else (WORK_POSITION, (
             f"the base's centre {_mm(distance)} mm from the arm's base is out of its reach "
             f"({_mm(REACH[0])} to {_mm(REACH[1])} mm); set place = [x, y] or --place X,Y"))
         horizontal = (target[0] - centre[0], target[1] - centre[1])
@@ -202,10 +228,10 @@ again: stacked bricks); the default base is the lowest of them (its bottom, up b
 
 
 def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
-            ) -> tuple[Settings, dict[str, str], list[str], Place | None]:
+            ) -> tuple[Settings, dict[str, str], list[str]]:
     """The settings of ``--config`` (``data``, read from ``path``; checked: one line
     naming the file and key; the trays it sets only), with the ``up`` in force, the
-    fixed-to map, what was assumed for lack of them, and ``place`` (None: not set)."""
+    fixed-to map and what was assumed for lack of them."""
     ids = {p.id for p in parts}
     assumed: list[str] = []
     base = data.get("base")
@@ -241,7 +267,7 @@ def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
                 raise ExecutorError(f"{path}: [parts.{pid}] fixed_to: expected another part than it and the base, "
                                     f"got {shorten(repr(host))}")
             fixed[pid] = host
-    return Settings(base, trays, names, up), fixed, assumed, _place_setting(path, data.get("place"))
+    return Settings(base, trays, names, up), fixed, assumed
 
 
 
@@ -380,8 +406,10 @@ class Imported:
     """What :func:`run_import` found: the ``derived`` geometry, the ``mapped`` covers and
     heads, what was ``assumed``, ``why`` there is no geometry.toml (None: there is), the
     files ``written``, the ``seconds`` taken, the ``offset`` (x, y, z) [m] by which every
-    part was moved from the CAD frame into the cell (:func:`placement`) and the parts the
-    cell holds on its suction cup, with why (:func:`executor.cad.operations.tools.tool_of`)."""
+    part was moved into the cell (:func:`placement`) after it was turned ``turn`` [deg] about z
+    (:func:`executor.cad.parts.quarter_turned`; a point p of the CAD, its up turned up, is at
+    turn(p) + offset in the cell), and the parts the cell holds on its suction cup, with why
+    (:func:`executor.cad.operations.tools.tool_of`)."""
 
     derived: Derived
     mapped: Mapped
@@ -391,6 +419,7 @@ class Imported:
     seconds: float
     offset: tuple[float, float, float]
     suction: dict[str, str]
+    turn: int = 0
 
 
 @dataclass(frozen=True)
@@ -399,7 +428,8 @@ class ImportOptions:
     off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
     over a product another import or a person wrote (:func:`executor.cad.write.manifest.claim_folder`);
     ``place`` [m]: where the base's centre goes in the cell (and the product's lowest point's height), over the config's
-    (:func:`placement`); ``up``: the CAD's axis pointing up, over the config's
+    (:func:`placement`); ``turn`` [deg]: the product's turn about z, over the config's (None:
+    the config's, else chosen, :func:`_chosen_pose`); ``up``: the CAD's axis pointing up, over the config's
     (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""
 
     reach: float = LOCATING_REACH
@@ -407,59 +437,120 @@ class ImportOptions:
     replace: bool = False
     place: Place | None = None
     up: str | None = None
+    turn: int | None = None
 
 
 def run_import(source: Path, out: Path, units: str, config: Path | None,
                options: ImportOptions = ImportOptions()) -> Imported:
-    """Read, turn the CAD's up to +z, check, claim ``out``, move the parts into the cell,
-    derive, map the covers and heads, and write, as ``options`` say (:class:`ImportOptions`);
+    """Read, turn the CAD's up to +z, check, claim ``out``, turn and move the parts into
+    the cell (the pose :func:`_chosen_pose` chooses where the user sets none), derive, map
+    the covers and heads, and write, as ``options`` say (:class:`ImportOptions`);
     ExecutorError naming ``source`` when no up is set and the product looks drawn with
     another (:func:`drawn_up`), before anything is written."""
     started = time.perf_counter()
     data = _settings_file(config)
     up = options.up or _up_setting(config, data.get("up"))
     seconds = _budget_setting(config, data.get("pieces_cpu_s"))
+    place = options.place or _place_setting(config, data.get("place"))
+    turn = options.turn if options.turn is not None else _turn_setting(config, data.get("turn"))
     parts = turned(load_source(source, units, options.max_triangles), up or "+z")
     check_solids(parts, units)
     with pieces_budget(seconds):
         # the overlap check runs beside the derivation where the sweeps would take two cores
         with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
-            found = _derived(parts, (source, out), (config, data, up), options, start)
-        removable, settings, derived, cell, assumed, offset, mapped, near = found
-        doubt = None if up is not None else drawn_up(derived)
+            found = _derived(parts, (source, out), (config, data, up), options, start, (turn or 0, place, "place"))
+            found = _chosen_pose(parts, (source, out), (config, data, up), options, found, (turn, place))
+        doubt = None if up is not None else drawn_up(found.derived)
         if doubt is not None:
             raise ExecutorError(f"{source}: {doubt}")
-        written, why, mapped, cell = write_folder(derived, cell, mapped, settings, source.stem, out, removable)
+        written, why, mapped, cell = write_folder(found.derived, found.cell, found.mapped, found.settings, source.stem,
+                                                  out, found.removable)
+    assumed, derived = found.assumed, found.derived
     assumed.append(budget_assumption(seconds))
-    assumed[near:near] = near_miss_assumption(derived, mesh_pieces(out, written))
+    assumed[found.near:found.near] = near_miss_assumption(derived, mesh_pieces(out, written))
     tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
     suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}
-    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, offset, suction)
+    return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, found.settings.moved,
+                    suction, found.settings.turn)
+
+
+@dataclass(frozen=True)
+class _Found:
+    """What :func:`run_import` finds before it writes (:func:`_derived`)."""
+
+    removable: set[str]
+    settings: Settings
+    derived: Derived
+    cell: Derived
+    assumed: list[str]
+    mapped: Mapped
+    near: int
+
+
+def _chosen_pose(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path | None, dict, str | None],
+                 options: ImportOptions, found: _Found, given: tuple[int | None, Place | None]) -> _Found:
+    """``found`` (the product as drawn, or in the turn and place the user ``given``) or,
+    where the user leaves the turn or the place free, the product in the pose that makes
+    the cell insert more parts: :func:`executor.cad.operations.arm.best_pose` over the
+    reaches the cell's decisions rest on (:func:`reaches_asked`, evaluated for each pose
+    on the features turned and moved: the derivation is not run again for each), the
+    base's centre within :data:`REACH` of the arm's base; the product is derived again in
+    that pose alone and taken where the cell places fewer parts by hand there, with the
+    assumption that says so (the parts it now inserts, the settings that keep it as drawn)."""
+    turn, place = given
+    if turn is not None and place is not None:
+        return found
+    derived = found.derived
+    bounds = derived.parts[derived.base].mesh.bounds
+    centre = (float(bounds[0][0] + bounds[1][0]) / 2, float(bounds[0][1] + bounds[1][1]) / 2)
+    inserted, reaches = reaches_asked(derived)
+    pose = best_pose(reaches, inserted, centre, (None if turn is None else 0, None if place is None else centre),
+                     lambda xy: REACH[0] <= math.hypot(*xy) <= REACH[1] and max(map(abs, xy)) <= PLACE_BOUND)
+    if pose.turn == 0 and pose.place == centre:
+        return found
+    now = (turn or 0) + pose.turn
+    where = place if place is not None else pose.place
+    again = _derived(parts, paths, config, options, lambda: None, (now, where, "chosen for the arm's reach: below"))
+    more, gained = sorted(set(found.mapped.manual) - set(again.mapped.manual)), len(found.mapped.manual) - len(
+        again.mapped.manual)
+    if gained <= 0:
+        return found
+    drawn = ", ".join(f"{v:g}" for v in (place or (round(centre[0], 4), round(centre[1], 4))))
+    keep = " and ".join(([] if turn is not None else ["turn = 0"])
+                        + ([] if place is not None else [f"place = [{drawn}]"]))
+    again.assumed.insert(2, (f"the product turned {now} deg about z" if now else "the product as drawn")
+                         + f" and its base's centre placed at ({_mm(pose.place[0])}, {_mm(pose.place[1])}) mm so the "
+                         f"arm reaches {gained} more insertion(s) ({' '.join(more)}; the cell inserts "
+                         f"{len(derived.parts) - 1 - len(again.mapped.manual)} of {len(derived.parts) - 1} moving "
+                         f"parts); set {keep} to keep it as drawn")
+    return replace(again, near=again.near + 1)
 
 
 def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path | None, dict, str | None],
-             options: ImportOptions, beside: Callable[[], None]
-             ) -> tuple[set[str], Settings, Derived, Derived, list[str], tuple[float, float, float], Mapped, int]:
+             options: ImportOptions, beside: Callable[[], None], pose: tuple[int, Place | None, str]) -> _Found:
     """What :func:`run_import` finds before it writes (``paths``: the source and ``out``;
-    ``config``: the settings file, its TOML and the up set, None: none; ExecutorError naming
-    the source where no up is set and the base looks drawn tilted, :func:`drawn_tilted`):
-    the files of ``out`` it may remove,
-    the settings with every tray, the derived product and the product as the cell inserts
-    it (:func:`executor.cad.operations.view.cell_view`), the assumptions, the offset into
-    the cell, the mapped product and where in the assumptions the near misses go (they are
-    known once the meshes' pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
-    reach, place = options.reach, options.place
+    ``config``: the settings file, its TOML and the up set, None: none; ``pose``: the turn
+    [deg] about z, the place (None: :func:`placement`'s default) and why it is there;
+    ExecutorError naming the source where no up is set and the base looks drawn tilted,
+    :func:`drawn_tilted`): the files of ``out`` it may remove,
+    the settings with every tray, the offset into the cell and the turn, the derived
+    product and the product as the cell inserts
+    it (:func:`executor.cad.operations.view.cell_view`), the assumptions, the mapped product
+    and where in the assumptions the near misses go (they are known once the meshes'
+    pieces are written); ``beside``: :func:`executor.cad.derive.derive`'s."""
+    reach, (turn, place, chosen) = options.reach, pose
     source, out = paths
     removable = claim_folder(out, [p.id for p in parts], options.replace)
     path, data, up = config
-    settings, fixed, assumed, placed = _config(path, data, parts, up or "+z")
+    settings, fixed, assumed = _config(path, data, parts, up or "+z")
     base = next(p.mesh for p in parts if p.id == settings.base)
     tilt = None if up is not None else drawn_tilted(base, settings.base)
     if tilt is not None:
         raise ExecutorError(f"{source}: {tilt}")
-    offset, where = placement(parts, settings.base, place or placed)
+    parts = quarter_turned(parts, turn)
+    offset, where = placement(parts, settings.base, place, chosen)
     parts = translated(parts, offset)
-    settings = replace(settings, moved=offset)
+    settings = replace(settings, moved=offset, turn=turn)
     assumed[:0] = [_up_assumption(up), where]
     assumed.append(f"the locating rule: a part that one other part alone keeps from moving {_mm(reach)} mm sideways "
                    "goes after it (--locating-reach 0: off)" if reach > 0 else "no locating rule")
@@ -477,7 +568,7 @@ def _derived(parts: list[CadPart], paths: tuple[Path, Path], config: tuple[Path 
         assumed.append(f"trays of {', '.join(missing)} laid out by their footprints, "
                        f"{_mm(TRAY_GAP)} mm apart and clear of the product, in rows from "
                        f"({_mm(TRAY_START[0])}, {_mm(TRAY_START[1])}) mm (set [parts.<id>] tray)")
-    return removable, laid, derived, cell, assumed, offset, mapped, near
+    return _Found(removable, laid, derived, cell, assumed, mapped, near)
 
 
 def main(argv: list[str]) -> int:
@@ -490,7 +581,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
     parser.add_argument("--config", type=Path, metavar="FILE",
-                        help="TOML: base part, up, trays, names, fixed_to, place")
+                        help="TOML: base part, up, trays, names, fixed_to, place, turn")
     parser.add_argument("--up", type=up_axis, metavar="AXIS",
                         help=f"the CAD's axis pointing up, {', '.join(UP_AXES)} (over the config's up; default +z, "
                              "and a product whose base looks drawn with another axis up is refused); a negative "
@@ -500,6 +591,9 @@ def main(argv: list[str]) -> int:
                              f"where the CAD has it, or ({WORK_POSITION[0]:g}, {WORK_POSITION[1]:g}) when that is "
                              "out of the arm's reach); Z: the height of the product's lowest point (default 0, "
                              "the cell's floor)")
+    parser.add_argument("--turn", type=turn_degrees, metavar="DEG",
+                        help="the product turned about z on the table, 0, 90, 180 or 270 [deg] (over the config's "
+                             "turn; default: as drawn, or a turn and place where the arm reaches more insertions)")
     parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
@@ -513,7 +607,8 @@ def main(argv: list[str]) -> int:
     if not args.source.exists():
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
     done = run_import(args.source, args.out, args.units, args.config,
-                      ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place, args.up))
+                      ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place, args.up,
+                                    args.turn))
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; " + "; ".join(done.assumed))

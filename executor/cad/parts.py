@@ -180,6 +180,23 @@ def turned(parts: list[CadPart], up: str) -> list[CadPart]:
     return _mapped(parts, lambda points: turn_points(points, up), lambda direction: turn_points(direction, up))
 
 
+def quarter_turned(parts: list[CadPart], turn: int) -> list[CadPart]:
+    """The parts turned by ``turn`` [deg, a multiple of 90] about the z axis, counterclockwise
+    seen from above: x and y permuted and negated, so exactly (their meshes, their B-rep
+    cylinders' points and directions and the meshes of ``remesh``; the parts given are not
+    changed)."""
+    quarters = turn // 90 % 4
+    if not quarters:
+        return parts
+
+    def turn_xy(points: np.ndarray) -> np.ndarray:
+        for _ in range(quarters):
+            points = np.stack([-points[..., 1], points[..., 0], points[..., 2]], axis=-1)
+        return points + 0.0
+
+    return _mapped(parts, turn_xy, turn_xy)
+
+
 def part_id(name: str, source: str) -> str:
     """An ASP constant from a file stem or a STEP name (lower case, ``_`` for other
     characters); ExecutorError naming ``source`` when none can be made."""

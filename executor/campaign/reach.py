@@ -11,8 +11,9 @@ with a d 10 pin and the ring with a d 10.2 bore (0.1 mm of room all round) of
 hexagonal peg (for +x and +y, where the import would enter its hole through the box from
 the other side, its box's far face closed by a 5 mm plate and its peg cut 1 mm short of it);
 each turned about z so that the part moves along the axis, raised on a
-riser of the base's own footprint to the height, and placed (``import --place``) so that
-the free end (entry) is at the point. The import's reach rule
+riser of the base's own footprint to the height, and placed (``import --place``, with
+``--turn 0``: the import chooses no pose of its own) so that the free end (entry) is at
+the point. The import's reach rule
 (:data:`executor.cad.operations.arm.SIDEWAYS_PIN_REACH`, :data:`executor.cad.operations.arm.SIDEWAYS_HOLE_REACH`)
 is set aside for it: the point is the cell's step wherever the import takes it as one.
 
@@ -149,12 +150,12 @@ def measure(kind: str, axis: str, x: float, y: float, height: float, tmp: Path) 
     with mock.patch.object(arm, "SIDEWAYS_PIN_REACH", EVERYWHERE), \
             mock.patch.object(arm, "SIDEWAYS_HOLE_REACH", EVERYWHERE):
         # built z up: a block raised on its riser stands on its edge, its feature sideways (import --up)
-        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0), up="+z"))
+        run_import(cad, tmp / "first" / "out", "mm", config, ImportOptions(place=(0.56, 0.0), up="+z", turn=0))
         at = load_product_description(tmp / "first" / "out").assembly.holes[feature].position
         assert at is not None and at[0] is not None and at[1] is not None
         place = (0.56 + x / 1e3 - at[0], y / 1e3 - at[1])
         out = tmp / "out"
-        run_import(cad, out, "mm", config, ImportOptions(place=place, up="+z"))
+        run_import(cad, out, "mm", config, ImportOptions(place=place, up="+z", turn=0))
     geometry = load_product_description(out).geometry
     assert geometry is not None
     if (written := geometry.hole_shapes[feature].axis) != axis:

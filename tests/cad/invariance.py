@@ -18,8 +18,9 @@ measures the change, not the file format):
 - ``shuffled``: the triangles in another order, each triangle's corners turned cyclically
   (the same surface, the same winding).
 
-Every import has ``--place`` :data:`PLACE` (the default placement depends on where the
-CAD has the base). What is compared (:func:`answers`): ``sizes.lp``, ``nominal_sizes.lp``
+Every import has ``--place`` :data:`PLACE` and ``--turn 0`` (the default placement
+depends on where the CAD has the base, and the import would choose a turn and a place
+where its arm reaches more). What is compared (:func:`answers`): ``sizes.lp``, ``nominal_sizes.lp``
 (margins within :data:`MARGIN_UM`), ``geometric_precedence.lp`` (pairs and each pair's
 reason), the insertion axes and free directions printed, ``assembly.toml`` and
 ``geometry.toml`` (lengths within :data:`LENGTH_M`, masses relative :data:`MASS_REL`),
@@ -194,7 +195,7 @@ def run_import(folder: Path, units: str, isolated: bool = True) -> tuple[Path, s
     (ImportFailed on a failure)."""
     out = folder / "out"
     args = ["import", str(folder / "meshes"), "--units", units, "--config", str(folder / "import.toml"),
-            "--place", f"{PLACE[0]},{PLACE[1]}", "--out", str(out)]
+            "--place", f"{PLACE[0]},{PLACE[1]}", "--turn", "0", "--out", str(out)]
     if isolated:
         done = subprocess.run([sys.executable, "-P", "-m", "assembly_constraints", *args], capture_output=True,
                               text=True, cwd=ROOT, env=os.environ | {"PYTHONPATH": str(ROOT)}, check=False)

@@ -34,13 +34,13 @@ PIN = 10.0
 
 
 def _import(tmp: Path, bore: float, wall: float | None = None, turn: int = 0,
-            place: tuple[float, float] | None = None, second: float | None = None) -> Path:
+            place: tuple[float, float] | None = None, second: float | None = None, as_drawn: bool = False) -> Path:
     """:func:`pin_cad`'s product imported; with a ``second`` bore [mm], a second ring (d 22)
-    with that bore against the first."""
+    with that bore against the first; ``as_drawn``: not turned on the table (``turn = 0``)."""
     cad = pin_cad(tmp / "cad", bore, wall, turn)
     if second is not None:
         pin_ring(second, 11.0, 33.0, turn).export(cad / "ring2.stl")
-    run_import(cad, tmp / "out", "mm", tmp / "import.toml", ImportOptions(place=place))
+    run_import(cad, tmp / "out", "mm", tmp / "import.toml", ImportOptions(place=place, turn=0 if as_drawn else None))
     return tmp / "out"
 
 
@@ -119,7 +119,7 @@ def test_a_ring_onto_a_pin_where_the_arm_was_not_seen_to_reach_it_is_placed_by_h
         tmp_path: Path, turn: int, place: tuple[float, float] | None, axis: str, why: str | None) -> None:
     # Turned a quarter turn (1), the pin stands out of the block's -x face: the ring goes on along +x;
     # turned three (3), along -x, where the arm stops short (docs/cell.md).
-    geometry = load_product_description(_import(tmp_path, 10.2, turn=turn, place=place)).geometry
+    geometry = load_product_description(_import(tmp_path, 10.2, turn=turn, place=place, as_drawn=True)).geometry
     assert geometry is not None and geometry.hole_shapes["block_pin1"].axis == axis
     reason = geometry.manual["ring"].reason if "ring" in geometry.manual else None
     assert reason == (None if why is None else f"goes onto a pin (block_pin1) along {axis}: {why}")

@@ -91,6 +91,9 @@ def test_a_product_drawn_at_the_origin_is_placed_where_the_arm_reaches(
     (["--place", "2,0"], "argument --place: '2': expected a finite number in [-1, 1]"),
     ("place = [0.56]", "import.toml: place: expected [x, y] or [x, y, z] in m, each in [-1, 1], got [0.56]"),
     ('place = [0.56, "0"]', "import.toml: place: expected [x, y] or [x, y, z] in m, each in [-1, 1]"),
+    (["--turn", "45"], "argument --turn: '45': expected one of 0, 90, 180, 270 (deg)"),
+    ("turn = 90.5", "import.toml: turn: expected one of 0, 90, 180, 270 (deg about z), got 90.5"),
+    ("turn = true", "import.toml: turn: expected one of 0, 90, 180, 270 (deg about z), got True"),
 ])
 def test_a_bad_place_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str], setting: list[str] | str,
                                  expected: str) -> None:

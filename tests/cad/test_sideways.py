@@ -158,7 +158,7 @@ def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_arm_was_not_measured_
     # measured along +x.
     turned = _turned(tmp_path / "turned")
     for place, out, by_hand in (((0.56, 0.0), "default", False), ((0.42, 0.0), "near", True)):
-        imported = run_import(turned, tmp_path / out, "mm", CORPUS / "import.toml", ImportOptions(place=place))
+        imported = run_import(turned, tmp_path / out, "mm", CORPUS / "import.toml", ImportOptions(place=place, turn=0))
         assert imported.derived.axis == {"hex_peg": "-x"}
         manual = load_product_description(tmp_path / out).geometry.manual  # type: ignore[union-attr]
         assert ("hex_peg" in manual) == by_hand, manual
@@ -166,7 +166,8 @@ def test_a_peg_into_a_sideways_hole_goes_by_hand_where_the_arm_was_not_measured_
             assert "goes into hole h1 along +x: its entry at (395.0, 0.0, 30.0) mm, out of the reach measured " \
                 "along +x" in manual["hex_peg"].reason, manual
     # Along -y the entry 700 mm out along x: out of the box measured (docs/cell.md).
-    run_import(CORPUS / "meshes", tmp_path / "far", "mm", CORPUS / "import.toml", ImportOptions(place=(0.70, 0.0)))
+    run_import(CORPUS / "meshes", tmp_path / "far", "mm", CORPUS / "import.toml",
+               ImportOptions(place=(0.70, 0.0), turn=0))
     manual = load_product_description(tmp_path / "far").geometry.manual  # type: ignore[union-attr]
     assert "its entry at (700.0, 25.0, 30.0) mm, out of the reach measured along -y (x 400-600 " in \
         manual["hex_peg"].reason, manual

@@ -4,12 +4,16 @@ flange long enough that the wrist (:data:`WRIST_RADIUS` about the tool's axis) s
 (:func:`tool_length`); a hole entered sideways (:func:`sideways_refused`) or a pin along a
 horizontal axis (:func:`sideways_pin_refused`) the cell takes only inside the boxes where its
 arm was measured to reach them (:data:`SIDEWAYS_HOLE_REACH`, :data:`SIDEWAYS_PIN_REACH`) and
-where that wrist would not meet the product. Lengths in metres."""
+where that wrist would not meet the product; the pose of the product on the table that
+makes the most of those reaches (:func:`best_pose`). Lengths in metres."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 
 import numpy as np
 import trimesh
@@ -54,6 +58,117 @@ hole``: ``agh_hex_horizontal`` of ``tests/cad/test_sideways.py`` turned about z,
 and placed; docs/cell.md). The wrist is 185 mm beyond the entry, farther than on a pin:
 the pins' boxes do not carry over. Inside a box the arm is taken to reach it as at its
 corners; elsewhere, or along another axis, it is taken as out of reach."""
+
+
+QUARTERS = (0, 90, 180, 270)
+"""The turns about z [deg] a product may be given on the table: the only ones that keep
+every axis-aligned feature axis-aligned."""
+POSE_MARGIN = 1e-3
+"""[m] how far inside a measured reach box :func:`best_pose` keeps each feature it brings
+into reach (the boxes' corners are where the reach was measured)."""
+
+
+@dataclass(frozen=True)
+class Reach:
+    """One reach the cell's decision about ``part`` rests on: its motion along the
+    horizontal ``axis`` to the ``point`` [m] (a pin's free end where ``pin``, else a hole's
+    entry) in the cell frame."""
+
+    part: str
+    axis: str
+    point: tuple[float, float, float]
+    pin: bool
+
+
+_RECORDED: ContextVar[list[Reach] | None] = ContextVar("_RECORDED", default=None)
+
+
+@contextmanager
+def reaches_recorded() -> Iterator[list[Reach]]:
+    """Within the block the arm is taken to reach every horizontal insertion, and each one
+    asked for is appended to the list yielded (:func:`sideways_pin_refused`,
+    :func:`sideways_refused`): what the product's pose decides."""
+    found: list[Reach] = []
+    token = _RECORDED.set(found)
+    try:
+        yield found
+    finally:
+        _RECORDED.reset(token)
+
+
+def turned_axis(axis: str, turn: int) -> str:
+    """The name of ``axis`` (``+x``, ``-y``, ...) turned by ``turn`` [deg, a multiple of 90] about z."""
+    names = ["+x", "+y", "-x", "-y"]
+    return names[(names.index(axis) + turn // 90) % 4] if axis in names else axis
+
+
+def turned_xy(x: float, y: float, turn: int) -> tuple[float, float]:
+    """The point (x, y) turned by ``turn`` [deg, a multiple of 90] about the origin,
+    exactly (a permutation with signs)."""
+    for _ in range(turn // 90 % 4):
+        x, y = -y, x
+    return x + 0.0, y + 0.0
+
+
+def reached(reach: Reach, turn: int, centre: tuple[float, float], place: tuple[float, float]) -> bool:
+    """Whether the arm reaches ``reach`` with the product turned by ``turn`` [deg] about
+    the vertical line through ``centre`` [m] (its base's centre) and that centre moved to
+    ``place`` [m] (the boxes of :data:`SIDEWAYS_PIN_REACH`, :data:`SIDEWAYS_HOLE_REACH`)."""
+    x, y = turned_xy(reach.point[0] - centre[0], reach.point[1] - centre[1], turn)
+    regions = SIDEWAYS_PIN_REACH if reach.pin else SIDEWAYS_HOLE_REACH
+    return not _box_missed(turned_axis(reach.axis, turn), (x + place[0], y + place[1], reach.point[2]), regions)
+
+
+def _box_missed(axis: str, point: tuple[float, float, float], regions: Mapping[str, tuple[Region, ...]]) -> bool:
+    """Whether ``point`` [m] lies in none of the boxes of ``regions`` along ``axis``."""
+    return not any(all(low - 1e-9 <= v <= high + 1e-9 for v, (low, high) in zip(point, box, strict=True))
+                   for box in regions.get(axis, ()))
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A product's pose on the table: turned ``turn`` [deg] about z about its base's
+    centre, that centre at ``place`` [m]; ``steps``: the parts the cell inserts so."""
+
+    turn: int
+    place: tuple[float, float]
+    steps: int
+
+
+def best_pose(reaches: list[Reach], inserted: set[str], centre: tuple[float, float],
+              fixed: tuple[int | None, tuple[float, float] | None], allowed: Callable[[tuple[float, float]], bool]
+              ) -> Pose:
+    """The pose (:class:`Pose`) under which the cell inserts the most of the parts
+    ``inserted`` (those it inserts where the arm reaches everything), each one counted
+    where it reaches every one of its ``reaches`` (:func:`reached`), the base's centre
+    now at ``centre`` [m]: a turn of :data:`QUARTERS` and a place where ``allowed`` (the
+    user's place wherever it is); ties go to the product as it stands (turn 0, at
+    ``centre``), then the fewest quarter turns, then the smallest move. ``fixed`` holds
+    the turn and the place the user set (None: free). A place that brings a feature into
+    a box keeps it :data:`POSE_MARGIN` inside, rounded to 0.1 mm."""
+    turn_set, place_set = fixed
+    by_part: dict[str, list[Reach]] = {}
+    for reach in reaches:
+        by_part.setdefault(reach.part, []).append(reach)
+
+    def steps(turn: int, place: tuple[float, float]) -> int:
+        return sum(all(reached(r, turn, centre, place) for r in by_part.get(pid, [])) for pid in inserted)
+
+    poses = [Pose(turn_set or 0, place_set or centre, steps(turn_set or 0, place_set or centre))]
+    for turn in QUARTERS if turn_set is None else (turn_set,):
+        xs, ys = {centre[0]}, {centre[1]}
+        for reach in reaches:
+            x, y = turned_xy(reach.point[0] - centre[0], reach.point[1] - centre[1], turn)
+            regions = SIDEWAYS_PIN_REACH if reach.pin else SIDEWAYS_HOLE_REACH
+            for (x0, x1), (y0, y1), _ in regions.get(turned_axis(reach.axis, turn), ()):
+                xs |= {x0 + POSE_MARGIN - x, x1 - POSE_MARGIN - x}
+                ys |= {y0 + POSE_MARGIN - y, y1 - POSE_MARGIN - y}
+        places = [place_set] if place_set is not None else [
+            place for place in ((round(x, 4) + 0.0, round(y, 4) + 0.0) for x in sorted(xs) for y in sorted(ys))
+            if allowed(place)]
+        poses += [Pose(turn, place, steps(turn, place)) for place in places]
+    return min(poses, key=lambda pose: (-pose.steps, min(pose.turn, 360 - pose.turn),
+                                        math.dist(pose.place, place_set or centre), pose.turn, pose.place))
 
 
 def _highest_near(mesh: trimesh.Trimesh, xy: tuple[float, float], radius: float, inner: float = 0.0) -> float | None:
@@ -110,15 +225,18 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
 
 
 def _unreached(axis: str, end: tuple[float, float, float], regions: Mapping[str, tuple[Region, ...]],
-               what: str) -> str:
+               what: str, part: str) -> str:
     """Why the cell's arm may not reach ``what`` (a horizontal pin, its free end at ``end``
     [m]; a hole entered sideways, its entry there) along the horizontal ``axis`` (the part's
-    motion): "" inside a box in which it was measured to (``regions``:
-    :data:`SIDEWAYS_PIN_REACH`, :data:`SIDEWAYS_HOLE_REACH`)."""
+    motion, ``part``'s): "" inside a box in which it was measured to (``regions``:
+    :data:`SIDEWAYS_PIN_REACH`, :data:`SIDEWAYS_HOLE_REACH`), and anywhere while the
+    reaches are recorded (:func:`reaches_recorded`)."""
+    if (recorded := _RECORDED.get()) is not None:
+        recorded.append(Reach(part, axis, end, what.endswith("pin")))
+        return ""
     if axis not in regions:
         return f"the cell's arm was measured to reach {what} along {', '.join(regions)} only"
-    if any(all(low - 1e-9 <= v <= high + 1e-9 for v, (low, high) in zip(end, box, strict=True))
-           for box in regions[axis]):
+    if not _box_missed(axis, end, regions):
         return ""
     where = "its free end" if what.endswith("pin") else "its entry"
     at = ", ".join(f"{round(1e3 * v, 1) + 0.0:.1f}" for v in end)  # + 0.0: no "-0.0"
@@ -139,7 +257,7 @@ def sideways_pin_refused(derived: Derived, pin: PinFit, pid: str) -> str:
     its axis (:func:`_unreached`, :data:`SIDEWAYS_PIN_REACH`), or its wrist meeting the
     product with the part at its goal (:func:`_wrist_on_pin`)."""
     if pin.axis != "+z" and (why := _unreached(opposite(pin.axis), pin_entry(derived, pin), SIDEWAYS_PIN_REACH,
-                                               "a horizontal pin")):
+                                               "a horizontal pin", pid)):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: {why}"
     if pin.axis != "+z" and (why := _wrist_on_pin(derived, pin, pid)):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}, but {why}"
@@ -188,7 +306,8 @@ def sideways_refused(derived: Derived, hid: str, fit: HoleFit) -> str:
     counted whole: nothing of it stands out of the entry)."""
     assert fit.part is not None
     axis = opposite(fit.axis)
-    if why := _unreached(axis, entry_point(fit), SIDEWAYS_HOLE_REACH, "a hole entered sideways"):
+    if why := _unreached(axis, entry_point(fit), SIDEWAYS_HOLE_REACH, "a hole entered sideways",
+                          fit.part):
         return f"goes into hole {hid} along {axis}: {why}"
     centre = (float(fit.hole.centre[0]), float(fit.hole.centre[1]))
     if why := _wrist_meets(derived, fit, fit.part, centre, {}):

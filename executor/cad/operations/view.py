@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 from executor.cad.convex import peg_frame, peg_is_primitive
 from executor.cad.covers import hole_specs, map_parts
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations.arm import sideways_refused
+from executor.cad.operations.arm import Reach, reaches_recorded, sideways_refused
 from executor.cad.operations.frames import upright
 from executor.cad.operations.pins import STACK_TOLERANCE, onto_pin
 from executor.cad.operations.plate import plate_top
@@ -104,6 +104,21 @@ def cell_view(derived: Derived, refused: Mapping[str, str] | None = None) -> tup
         return cell_view(derived, by_hand | moved)
     return replace(view, pins={pin_id: pin for pin_id, pin in pins.items()
                                if pin.owner in (derived.base, *placed, *inserted)}), by_hand
+
+
+def reaches_asked(derived: Derived) -> tuple[set[str], list[Reach]]:
+    """The moving parts the cell places where its arm reaches every horizontal insertion
+    (:func:`cell_view` with :func:`executor.cad.operations.arm.reaches_recorded`, then
+    :func:`executor.cad.covers.map_parts`), and the
+    reaches its decisions rest on: what the product's pose on the table decides (none,
+    and no view made, where no part goes into or onto a feature along a horizontal axis)."""
+    sideways = [fit.part for fit in derived.holes.values() if fit.axis not in ("+z", "-z")]
+    if not any(sideways) and not any(pin.parts for pin in derived.pins.values() if pin.axis not in ("+z", "-z")):
+        return set(), []
+    with reaches_recorded() as found:
+        cell, by_hand = cell_view(derived)
+        manual = map_parts(cell, plate_top(cell), by_hand).manual  # covers and heads the cell places too
+    return set(derived.parts) - {derived.base} - set(manual), found
 
 
 def _owner_refused(derived: Derived, pin: PinFit, fit: HoleFit | None) -> str:

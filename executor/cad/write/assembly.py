@@ -21,14 +21,16 @@ from executor.cad.sections import rounded as _q
 @dataclass(frozen=True)
 class Settings:
     """What the import file states: the ``base`` part, the ``trays`` [m], part ``names``,
-    the CAD's axis pointing ``up`` (:func:`executor.cad.parts.turned`) and the offset (x, y, z)
-    [m] every part was ``moved`` by from the CAD frame into the cell (:func:`executor.cad.cli.placement`)."""
+    the CAD's axis pointing ``up`` (:func:`executor.cad.parts.turned`), the ``turn`` [deg]
+    about z the product was then given (:func:`executor.cad.parts.quarter_turned`) and the
+    offset (x, y, z) [m] every part was then ``moved`` by into the cell (:func:`executor.cad.cli.placement`)."""
 
     base: str
     trays: dict[str, tuple[float, float]]
     names: dict[str, str]
     up: str = "+z"
     moved: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    turn: int = 0
 
 
 def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[str, str]) -> str:
@@ -36,12 +38,16 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
     ``part``) and trays, the holes (a pin several parts go onto, or a hole of the base
     several parts stand in, with their number as its ``capacity``)."""
     pegs = derived.hole_of
-    frame = "the CAD frame (the cell frame)" if settings.up == "+z" and not any(settings.moved) else "the cell frame"
+    frame = ("the CAD frame (the cell frame)" if settings.up == "+z" and not any(settings.moved) and not settings.turn
+             else "the cell frame")
     if settings.up != "+z":
         frame += f", the CAD's {settings.up} turned up ({turn_text(settings.up)})"
+    if settings.turn:
+        frame += f", turned {settings.turn} deg about z"
     if any(settings.moved):
-        frame += (", moved by ({}, {}, {}) mm from the CAD frame (the base's centre to place, the product's lowest "
-                  "point to the floor, z = 0, or place's z)").format(*(f"{1000 * v:.3f}" for v in settings.moved))
+        frame += (", moved by ({}, {}, {}) mm from {} (the base's centre to place, the product's lowest "
+                  "point to the floor, z = 0, or place's z)").format(*(f"{1000 * v:.3f}" for v in settings.moved),
+                                                                   "there" if settings.turn else "the CAD frame")
     lines = [f"# Imported from {title} by ./run.sh import: parts in {frame} [m].",
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):
