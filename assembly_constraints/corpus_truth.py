@@ -95,7 +95,7 @@ def import_product(folder: Path, out: Path) -> CorpusImport:
     occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
     owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
     owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
-    return CorpusImport(truth, out, {pid: turned_axis(opposite(leaves), -derived.holes, result.turn)
+    return CorpusImport(truth, out, {pid: turned_axis(opposite(leaves), -result.turn)
                                      for pid, leaves in derived.axis.items()},
                         result.offset, occupants, owners, frozenset(derived.pins), len(derived.parts), result.seconds,
                         derived.holes, result.turn)
