@@ -3,9 +3,10 @@
 (:func:`tipping`), its base held up (:func:`base_unheld`); and the facts of a product
 turned as another up reads them (:func:`turned_facts`), to check the up a refusal names.
 
-Assumed: a product drawn with its up stands on the floor by itself as assembled, its parts
-of one density; its base rests on the floor or on parts that keep it from going down,
-save on parts hanging from it (screws through it into a fixture not drawn)."""
+Assumed: a product drawn with its up stands on the floor by itself as assembled, or rests
+its base on the floor, where the cell holds it; its parts of one density; its base rests
+on the floor or on parts that keep it from going down, save on parts hanging from it
+(screws through it into a fixture not drawn)."""
 
 from __future__ import annotations
 
@@ -85,9 +86,13 @@ def tipping(derived: Derived) -> tuple[float, float]:
 
 def falls_over(derived: Derived) -> str | None:
     """Why the product as read would fall over (:func:`tipping`: its centre of mass outside
-    what it stands on by more than :data:`TIPPED`), None when it stands."""
+    what it stands on by more than :data:`TIPPED`), None when it stands, or when its base
+    rests on the floor (:func:`resting`): the cell holds the base on its table, so a base
+    on the floor need not balance, nor the parts reaching out from it (a sub-assembly
+    drawn without the frame it is bolted to: a housing plate on a narrow foot, its shaft
+    and coupling beyond it)."""
     angle, outside = tipping(derived)
-    if angle >= -TIPPED:
+    if angle >= -TIPPED or resting(derived):
         return None
     return (f"the product's centre of mass lies {mm(outside)} mm outside what it stands on ({-angle:.1f} deg "
             "past its edge): it would fall over")
