@@ -686,7 +686,8 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     :func:`cell_view`'s, and a part after another on the pin is :func:`_stack_refused`'s);
     a part on more than one pin (a plate over two dowel pins) goes onto them all at once
     where :func:`_onto_pins` allows;
-    a part whose room on it per side (:func:`margins`) is under
+    a part that stands out of the product at its goal less than the fingers need
+    (:func:`_grip`) is placed by hand; a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
     if pin.owner != derived.base and pin.axis != "+z":
@@ -705,6 +706,9 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: {why}"
     if pin.axis != "+z" and (why := _wrist_on_pin(derived, pin, pid)):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}, but {why}"
+    grip, why = _grip(*standing_out(derived, pid, pin, _in_place_before(derived, pid)))
+    if grip == 0.0:  # sunk at its goal (a ring over an island of a pocket, flush with its top)
+        return f"goes onto a pin ({pin.id}), but part '{pid}' {why}"
     mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
     found = bore_pieces(derived, pid)(pid, as_written(mesh))
     return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
