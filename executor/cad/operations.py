@@ -706,12 +706,14 @@ def _onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}: {why}"
     if pin.axis != "+z" and (why := _wrist_on_pin(derived, pin, pid)):
         return f"goes onto a pin ({pin.id}) along {opposite(pin.axis)}, but {why}"
+    mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
+    found = bore_pieces(derived, pid)(pid, as_written(mesh))
+    if isinstance(found, str):
+        return f"goes onto a pin ({pin.id}), but {found}"
     grip, why = _grip(*standing_out(derived, pid, pin, _in_place_before(derived, pid)))
     if grip == 0.0:  # sunk at its goal (a ring over an island of a pocket, flush with its top)
         return f"goes onto a pin ({pin.id}), but part '{pid}' {why}"
-    mesh = derived.parts[pid].mesh.copy().apply_transform(bore_frame(derived, pid))
-    found = bore_pieces(derived, pid)(pid, as_written(mesh))
-    return f"goes onto a pin ({pin.id}), but {found}" if isinstance(found, str) else None
+    return None
 
 
 def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
