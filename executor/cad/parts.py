@@ -10,7 +10,9 @@ metres in the CAD frame; :func:`turned` turns them so that the CAD's up is the c
 A mesh file is read within a size bound (:data:`MAX_TRIANGLES` for the product, its
 triangles counted before the mesh is built), its coordinates must be finite (the line or
 triangle of the first that is not is named) and its vertices are merged by position (an
-OBJ that repeats a vertex once per normal or texture coordinate is one surface).
+OBJ that repeats a vertex once per normal or texture coordinate is one surface). An OBJ
+whose objects are each closed but together no manifold (boxes that touch or overlap) is
+their union (:func:`_united_objects`).
 
 Checks (:func:`check_parts`; the last, the overlaps, can run in a process of its own
 while the import goes on: :func:`overlaps_checked`), each an :class:`executor.ExecutorError` naming the part:
@@ -31,6 +33,8 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import io
+import itertools
 import math
 import multiprocessing
 import multiprocessing.connection
@@ -229,8 +233,42 @@ def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) ->
                                 "finite coordinates)")
         mesh.apply_scale(UNITS[units])
         mesh.merge_vertices(merge_tex=True, merge_norm=True, digits_vertex=MERGE_DIGITS)
+        if not mesh.is_watertight and path.suffix.lower() == ".obj":
+            mesh = _united_objects(path, UNITS[units]) or mesh
         parts.append(CadPart(part_id(path.stem, str(path)), path.stem, mesh, str(path)))
     return parts
+
+
+def _united_objects(path: Path, scale: float) -> trimesh.Trimesh | None:
+    """The union of an OBJ's objects (its ``o`` records) as one closed mesh [m], each
+    object scaled by ``scale`` and taken as a solid of its own (its triangles wound
+    consistently and outwards); None when the file has fewer than two objects or one of
+    them is not closed (the part's crack is then located as for any open mesh); objects
+    are told apart by their records, not their names. A part modelled as boxes that touch
+    or overlap, each closed (Blender's objects, a MuJoCo model's convex pieces joined in
+    one file), is one mesh with edges of four faces and T-junctions, not a manifold: the
+    union (exact booleans, manifold3d in double precision) is the solid the objects fill."""
+    count = itertools.count()  # each record its own object: Blender names repeat in files joined together
+    text = re.sub(rb"(?m)^o\b[^\r\n]*", lambda _: b"o object_%d" % next(count), path.read_bytes())
+    scene = trimesh.load(io.BytesIO(text), file_type="obj", split_objects=True, group_material=False, process=False)
+    objects = list(scene.geometry.values()) if isinstance(scene, trimesh.Scene) else []
+    if len(objects) < 2:
+        return None
+    solids = []
+    for shell in objects:
+        shell.apply_scale(scale)
+        shell.merge_vertices(merge_tex=True, merge_norm=True, digits_vertex=MERGE_DIGITS)
+        if not shell.is_watertight:
+            return None
+        if not shell.is_winding_consistent:
+            trimesh.repair.fix_winding(shell)
+        if shell.volume < 0:
+            shell.invert()
+        solids.append(manifold3d.Manifold(manifold3d.Mesh64(
+            vert_properties=np.asarray(shell.vertices, dtype=np.float64),
+            tri_verts=np.asarray(shell.faces, dtype=np.uint32))))
+    union = manifold3d.Manifold.batch_boolean(solids, manifold3d.OpType.Add).to_mesh64()
+    return trimesh.Trimesh(np.asarray(union.vert_properties)[:, :3], np.asarray(union.tri_verts), process=False)
 
 
 def count_triangles(source: str, count: int, total: int, bound: int) -> int:

@@ -270,3 +270,27 @@ def test_a_bad_manual_table_is_one_line_naming_it(tmp_path: Path, capsys: pytest
     assert main(["executor", "sizes", "--assembly", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and expected in err, err
+
+
+def test_a_ring_sunk_flush_over_an_island_of_a_pocket_is_placed_by_hand(tmp_path: Path) -> None:
+    # PEARL's digit 0 (corpus pearl_peg_board) fills its pocket, flush with the board's top,
+    # over the island the pocket keeps: the import took the island for a pin and let the cell
+    # put the ring onto it, where the fingers have no room beside it (the sim cell failed it
+    # twice, and the assembly with it); a peg standing as little out of a hole was placed by hand.
+    folder = tmp_path / "cad"
+    folder.mkdir()
+    pocket = trimesh.creation.cylinder(radius=15.0, height=22.0, sections=64)
+    pocket.apply_translation((X_MM, 0.0, 20.0))
+    island = trimesh.creation.cylinder(radius=3.0, height=20.0, sections=64)
+    island.apply_translation((X_MM, 0.0, 20.0))
+    block = trimesh.boolean.difference([_box((80, 80, 30), (X_MM, 0, 15)), pocket], engine="manifold")
+    trimesh.boolean.union([block, island], engine="manifold").export(folder / "block.stl")
+    ring = trimesh.boolean.difference([trimesh.creation.cylinder(radius=14.0, height=20.0, sections=64),
+                                       trimesh.creation.cylinder(radius=4.5, height=22.0, sections=64)],
+                                      engine="manifold")
+    ring.apply_translation((X_MM, 0.0, 20.0))
+    ring.export(folder / "ring.stl")
+    assert main(["-q", "import", str(folder), "--out", str(tmp_path / "out")]) == 0
+    manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text()).get("manual", {})
+    assert "ring" in manual, manual
+    assert "stands out of the product by 0.000 mm" in manual["ring"]["reason"]

@@ -13,8 +13,10 @@ from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor.cad.convex import NEAR, Pieces, as_written, pin_pieces
 from executor.cad.derive import Derived, PinFit
 from executor.cad.operations.arm import sideways_pin_refused
+from executor.cad.operations.fingers import grip_for, standing_out
 from executor.cad.operations.frames import along_axis, bore_frame, feature_turn
 from executor.cad.operations.plate import LEVEL
+from executor.cad.operations.precedence import in_place_before
 from executor.cad.operations.resolution import bore_unresolved, round_pins, unresolved, widens_bore
 from executor.cad.operations.rooms import margins
 from executor.cad.sweep import opposite
@@ -28,7 +30,8 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     :func:`cell_view`'s, and a part after another on the pin is :func:`_stack_refused`'s);
     a part on more than one pin (a plate over two dowel pins) goes onto them all at once
     where :func:`_onto_pins` allows;
-    a part whose room on it per side (:func:`margins`) is under
+    a part that stands out of the product at its goal less than the fingers need
+    (:func:`executor.cad.operations.fingers.grip_for`) is placed by hand; a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
     if pin.owner != derived.base and pin.axis != "+z":
@@ -44,7 +47,12 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return f"goes onto a pin ({pin.id}) {why}"
     if why := sideways_pin_refused(derived, pin, pid):
         return why
-    return f"goes onto a pin ({pin.id}), but {why}" if (why := _no_pieces(derived, pid)) else None
+    if why := _no_pieces(derived, pid):
+        return f"goes onto a pin ({pin.id}), but {why}"
+    grip, why = grip_for(*standing_out(derived, pid, pin, in_place_before(derived, pid)))
+    if grip == 0.0:  # sunk at its goal (a ring over an island of a pocket, flush with its top)
+        return f"goes onto a pin ({pin.id}), but part '{pid}' {why}"
+    return None
 
 
 def _onto_pins(derived: Derived, on: list[PinFit], pid: str) -> str | None:
