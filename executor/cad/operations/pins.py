@@ -31,7 +31,8 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     a part on more than one pin (a plate over two dowel pins) goes onto them all at once
     where :func:`_onto_pins` allows;
     a part that stands out of the product at its goal less than the fingers need
-    (:func:`executor.cad.operations.fingers.grip_for`) is placed by hand; a part whose room on it per side (:func:`margins`) is under
+    (:func:`executor.cad.operations.fingers.grip_for`) is placed by hand; a part whose room
+    on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
     if pin.owner != derived.base and pin.axis != "+z":
