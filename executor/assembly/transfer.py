@@ -27,6 +27,9 @@ DAMPING_FACTOR = 2.0
 SAFE_Z = 0.20  # [m] TCP height for carrying: above every part standing on the plate or the tray
 SPEED = 0.5  # [m/s] mean speed of a move
 DESCENT_SPEED = 0.15  # [m/s] mean speed of the last move of a carry, down to the goal
+DESCENT_CLEARANCE = 0.03
+"""[m] a carry goes down at :data:`SPEED` to this far above its goal, only the rest at
+:data:`DESCENT_SPEED` (nothing stands between the carrying height and there)."""
 SETTLE = 0.5  # [s] at most held at the end of a move, until the TCP is within its tolerance at rest
 TOLERANCE = 0.001  # [m] where the part is to be placed
 VIA_TOLERANCE = 0.01  # [m] at the corners of a carry
@@ -144,10 +147,13 @@ def settle_steps(duration: float) -> int:
 def carry(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,
           safe_z: float = SAFE_Z, tolerance: float = TOLERANCE, yaw: float = 0.0) -> None:
     """Lift to ``safe_z``, move across above ``goal`` turning the tool to ``yaw`` [rad], go
-    down to it [m] (slowly, until within ``tolerance`` [m])."""
+    down to :data:`DESCENT_CLEARANCE` above it, then down to it [m] (slowly, until within
+    ``tolerance`` [m])."""
     here = motion.read().tip_pos
     high = max(safe_z, float(goal[2]), float(here[2]))
     if here[2] < high - 1e-3:
         move_line(motion, np.array([here[0], here[1], high]), after_step, tolerance=VIA_TOLERANCE)
     move_line(motion, np.array([goal[0], goal[1], high]), after_step, tolerance=VIA_TOLERANCE, yaw=yaw)
+    if high - goal[2] > DESCENT_CLEARANCE + 1e-3:
+        move_line(motion, goal + np.array([0.0, 0.0, DESCENT_CLEARANCE]), after_step, tolerance=VIA_TOLERANCE)
     move_line(motion, goal, after_step, speed=DESCENT_SPEED, tolerance=tolerance)

@@ -30,13 +30,17 @@ def test_drawn_plans_pass_the_checker_and_the_seed_reproduces_them() -> None:
 
 def test_the_summary_counts_a_part_beyond_2_mm_as_a_failure() -> None:
     def report(assembled: bool, worst: float, wall: float) -> dict:
+        steps = [{"skill": "insert", "sim_time_s": wall / 10, "duration_s": wall / 20},
+                 {"skill": "manual", "sim_time_s": 0.0, "duration_s": 0.0}]
         return {"assembled": assembled, "final_pose_error_mm": {"bp": 0.0, "sp": worst}, "replans": [],
-                "wall_s": wall}
+                "wall_s": wall, "steps": steps}
 
     figures = summary([report(True, 1.5, 30.0), report(True, 2.4, 40.0), report(False, 0.5, 50.0)])
     assert figures["assembled"] == 2 and figures["within_tolerance"] == 1
     assert figures["worst_pose_error_mm"] == 2.4 and figures["worst_part"] == "sp" and figures["worst_plan"] == 2
     assert figures["median_wall_s"] == 40.0
+    # the steps the arm carried out (not those placed by hand): their median simulated and cell time
+    assert figures["steps"] == 3 and figures["median_step_sim_s"] == 4.0 and figures["median_step_cell_s"] == 2.0
 
 
 def test_bad_input_is_one_line_and_exit_2(run_main, tmp_path) -> None:

@@ -1,0 +1,36 @@
+"""A carry in free space: fast (:data:`executor.assembly.transfer.SPEED`) down from the
+carrying height to :data:`executor.assembly.transfer.DESCENT_CLEARANCE` above its goal,
+slowly (:data:`executor.assembly.transfer.DESCENT_SPEED`) only the rest of the way, and
+at its goal at rest. From 10 mm under the carrying height to 5 mm above the clearance
+(0.13 m, down to a peg's grip point on the tray) it takes 0.20 s of simulated time; all
+the way at the slow speed it would take 0.50 s."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from executor.assembly.product import load_product
+from executor.assembly.transfer import DESCENT_CLEARANCE, DESCENT_SPEED, SAFE_Z, carry
+from executor.assembly.world import AssemblyWorld
+from executor.cell_description import CellDescription
+from executor.world.scene import TIME_STEP
+
+
+def test_a_carry_goes_down_fast_to_its_clearance_and_slowly_the_rest() -> None:
+    description = CellDescription()
+    world = AssemblyWorld(load_product("spare", description), gains=description.gains)
+    try:
+        goal = world.tray_position("p1") + world.frames["p1"].grip  # the empty tool to a peg's grip point
+        tips: list[np.ndarray] = []
+        carry(world.motion, goal, lambda: tips.append(world.arm.read().tip_pos), tolerance=0.002)
+        z = np.array([tip[2] for tip in tips])
+        assert np.linalg.norm(tips[-1] - goal) < 0.002
+        left = int(np.argmax(z < SAFE_Z - 0.01))  # leaves the carrying height
+        near = int(np.argmax(z < goal[2] + DESCENT_CLEARANCE + 0.005))  # 5 mm above the clearance
+        assert 0 < left < near
+        assert (near - left) * TIME_STEP < 0.3, f"{(near - left) * TIME_STEP:.3f} s down to the clearance"
+        below = np.flatnonzero(z < goal[2] + DESCENT_CLEARANCE - 0.005)
+        down = -np.diff(z)[below[0]:] / TIME_STEP  # [m/s] in the last 25 mm
+        assert down.max() < 2 * DESCENT_SPEED, f"{down.max():.3f} m/s in the last {DESCENT_CLEARANCE} m"
+    finally:
+        world.close()
