@@ -115,18 +115,6 @@ def test_a_repeated_id_returns_the_cached_reply_without_rerunning(served) -> Non
 
 
 @pytest.mark.slow
-def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
-    gone: queue.SimpleQueue[str] = queue.SimpleQueue()
-    directory.listen(lambda cell, alive: None if alive else gone.put(cell))
-    cells[0].popen.send_signal(signal.SIGTERM)
-    assert cells[0].popen.wait(10) == 0
-    assert gone.get(timeout=10) == "c1"
-
-
-@pytest.mark.slow
 def test_a_cell_killed_mid_experiment_loses_no_request_and_counts_none_twice(network) -> None:
     endpoint, session, directory, cells = network
     # c1 slow enough to be killed in an experiment; c2, which runs the rest, quicker
@@ -211,7 +199,8 @@ def raw_ping(session: zenoh.Session, key: str, payload: bytes) -> bytes:
 
 
 @pytest.mark.slow
-def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(network) -> None:
+def test_a_full_queue_answers_busy_a_request_past_its_timeout_expires_and_sigterm_closes_the_cell(network) -> None:
+    """Then SIGTERM closes the cell (exit code 0) and its token disappears."""
     endpoint, session, directory, cells = network
     cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,), delay_s=0.3)))
     directory.wait_for(1, timeout=20)
@@ -228,6 +217,11 @@ def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(networ
     assert 1 <= len(answered) <= 4, codes
     cells[0].wait_for_line("start q", timeout=10, count=len(answered))  # its stdout is read by a thread
     assert sum(line.startswith("start q") for line in cells[0].lines) == len(answered)
+    gone: queue.SimpleQueue[str] = queue.SimpleQueue()
+    directory.listen(lambda cell, alive: None if alive else gone.put(cell))
+    cells[0].popen.send_signal(signal.SIGTERM)
+    assert cells[0].popen.wait(10) == 0
+    assert gone.get(timeout=10) == "c1"
 
 
 @pytest.mark.slow
