@@ -1,7 +1,8 @@
 """Precedence experiments and plan steps at a cell, over a real Zenoh session to ``executor
 serve`` in its own process: the truth cell answers experiments from the product's
 precedence, a bad or impossible experiment gets an error reply and the cell keeps serving;
-the sim cell observes why a step fails (the physics, not a rule). Plan steps of two runs: a
+the sim cell inserts a fitting peg and records it, and observes why a step fails (the
+physics, not a rule). Plan steps of two runs: a
 cell builds one product at a time, and a refused step changes nothing (another run's step
 is ``run_active``, a step the product does not allow is ``invalid_step`` or ``unknown_id``).
 One cell of each backend for both."""
@@ -11,6 +12,7 @@ from __future__ import annotations
 import queue
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 
 import pytest
 import zenoh
@@ -21,8 +23,8 @@ from asp.session.cells import start_cell
 from asp.session.precedence import CellOracle
 from bridge.assembly import load_assembly
 from bridge.cell_settings import ServeSettings
-from bridge.client import CellDirectory, CellRefused, request_experiment, request_step
-from bridge.messages import ErrorReply, StepReply, StepRequest
+from bridge.client import CellDirectory, CellRefused, request_experiment, request_insert, request_step
+from bridge.messages import ErrorReply, InsertRequest, StepReply, StepRequest
 from bridge.precedence.experiment import (
     ExperimentStep,
     PrecedenceExperiment,
@@ -34,11 +36,13 @@ HOLES = {"p1": "r1", "p2": "r2", "p3": "s1", "p4": "s2", "sh": "br"}
 
 
 @contextmanager
-def one_cell(backend: str, stop_s: float = 30.0) -> Iterator[zenoh.Session]:
-    """A cell ``c1`` of Cranfield with ``backend``, and a planner's session connected to it;
-    the cell must stop cleanly within ``stop_s`` [s] afterwards."""
+def one_cell(backend: str, stop_s: float = 30.0, rrd: Path | None = None) -> Iterator[zenoh.Session]:
+    """A cell ``c1`` of Cranfield with ``backend`` (recording to ``rrd`` if given, recording id
+    ``sim-test``), and a planner's session connected to it; the cell must stop cleanly within
+    ``stop_s`` [s] afterwards (a cell flushes its recording as it stops)."""
     endpoint = free_loopback_endpoint()
-    cell = start_cell(ServeSettings(cell_id="c1", backend=backend, listen=(endpoint,)))
+    recording = {} if rrd is None else {"rrd": str(rrd), "recording_id": "sim-test"}
+    cell = start_cell(ServeSettings(cell_id="c1", backend=backend, listen=(endpoint,), **recording))
     session = open_session(connect=(endpoint,))
     try:
         CellDirectory(session).wait_for(1, timeout=30)
@@ -132,8 +136,17 @@ def test_truth_cell_answers_experiments_from_the_precedence_and_builds_one_produ
 
 @pytest.mark.slow
 @pytest.mark.timeout(900)
-def test_sim_cell_observes_why_a_step_fails_and_keeps_its_world_when_another_run_is_refused() -> None:
-    with one_cell("sim", stop_s=120.0) as session:
+def test_sim_cell_logs_an_insertion_observes_why_a_step_fails_and_keeps_its_world_when_another_run_is_refused(
+        tmp_path: Path) -> None:
+    from bridge.recording.reader import column_values, read_recording
+
+    rrd = tmp_path / "c1.rrd"
+    with one_cell("sim", stop_s=120.0, rrd=rrd) as session:
+        # one simulated insertion, logged
+        reply = request_insert(session, "c1", InsertRequest(id="i1", part="p1", hole="br", seed=3, experiment=7), 60)
+        assert reply.result == "fit"
+        assert reply.evidence is not None and reply.evidence.attempts >= 1
+        assert reply.evidence.end_error < 0.01 and reply.evidence.duration_s > 0
         # a peg before the back plate: it reaches its goal height in air, and falls once let go
         fell = request_experiment(session, "c1", experiment("s1", ("bp", "p1"), "p1", seed=1), 300)
         assert (fell.outcome, fell.failed_step, fell.reason) == ("failed", 1, "unsupported")
@@ -156,3 +169,7 @@ def test_sim_cell_observes_why_a_step_fails_and_keeps_its_world_when_another_run
         assert refusal_code(session, "a", 2, "p3", None) == "invalid_step"
         reply = step(session, "a", 2, "p3", "s1")
         assert reply.result == "fit" and dict(reply.pose_errors_mm).keys() == {"bp", "p3"}
+    summary = read_recording([rrd])
+    assert set(summary.recording_ids) == {"sim-test"}
+    assert any(path.startswith("/executor/c1/wrench") for path in summary.entities)
+    assert set(column_values([rrd], "/executor/c1/outcome", "experiment")) == {7}
