@@ -53,8 +53,8 @@ def assert_learned_truth(result: dict, run: Path, truth: TruthOracle = TRUTH) ->
     assert len(atoms_by_name(learned, "tried", 4)) == len(journal)
 
 
-def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellProcess], root: Path, cli_argv,
-                                             cli_env: dict[str, str]) -> None:
+def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellProcess], run_session) -> None:
+    """The session in the test's process; c1, a process of its own, SIGKILLed by a thread."""
     endpoints = [free_loopback_endpoint(), free_loopback_endpoint()]
     # c1 slow enough to be killed in an experiment (its third, when about 9 of Cranfield's
     # 19 are done); c2, which runs the rest, quicker
@@ -62,16 +62,17 @@ def test_two_cells_one_killed_mid_experiment(tmp_path: Path, cells: list[CellPro
         cells.append(start_cell(ServeSettings(cell_id=cell_id, backend="truth", listen=(endpoint,), delay_s=delay)))
     run = tmp_path / "run"
     connect = [arg for ep in endpoints for arg in ("--connect", ep)]
-    argv = cli_argv(*TRUTH_SESSION, "--cells", "0", *connect, "--out", str(run), "--policy", "best")
-    planner = subprocess.Popen(argv, cwd=root, env=cli_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
+
+    def kill_c1_in_its_third_experiment() -> None:
         cells[0].wait_for_line("start", timeout=30, count=3)
         cells[0].kill()
-        out, err = planner.communicate(timeout=60)
+
+    killer = threading.Thread(target=kill_c1_in_its_third_experiment)
+    killer.start()
+    try:
+        result = run_session("--cells", "0", *connect, "--out", str(run), "--policy", "best")
     finally:
-        planner.kill()
-    assert planner.returncode == 0, err
-    result = json.loads(out)
+        killer.join(30)
     assert_learned_truth(result, run)
     journal = read_journal(run / "journal.jsonl")
     by_id = {e.id: e for e in journal}
