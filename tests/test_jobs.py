@@ -25,13 +25,16 @@ def _results(value: Any) -> Any:
 @pytest.mark.slow
 def test_two_drawn_plans_in_two_truth_cells_at_once_give_the_json_of_one_cell(run_main) -> None:
     """``bench assemble --jobs 2``: two plans in two truth cells at once, each assembled, the
-    report that of ``--jobs 1``. (The campaign's workers, one against two, are compared in
-    ``tests/executor/test_campaign_cell.py``, where ``--jobs`` reaches ``run_campaign``.)"""
+    report that of ``--jobs 1``; on a stderr that is no terminal, no progress bar (on a
+    terminal: ``tests/bridge/test_progress.py``). (The campaign's workers, one against two,
+    are compared in ``tests/executor/test_campaign_cell.py``, where ``--jobs`` reaches
+    ``run_campaign``.)"""
     reports = []
     for jobs in ("1", "2"):
         done = run_main("bench", "assemble", "--plans", "2", "--seed", "5", "--backend", "truth", "--jobs", jobs,
                         "--json", timeout=300)
         assert done.returncode == 0, done.stderr
+        assert "100%" not in done.stderr and "100%" not in done.stdout
         reports.append(json.loads(done.stdout))
     assert _results(reports[0]) == _results(reports[1])
     assert [r["seed"] for r in reports[1]["plans"]] == [6, 7]

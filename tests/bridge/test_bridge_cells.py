@@ -28,7 +28,9 @@ from bridge.client import (
 )
 from bridge.keys import alive_key
 from bridge.messages import (
+    MAX_COUNT,
     MAX_MESSAGE_BYTES,
+    MAX_REQUEST_ID,
     ErrorReply,
     InsertReply,
     InsertRequest,
@@ -60,14 +62,16 @@ def network() -> Iterator[tuple[str, zenoh.Session, CellDirectory, list[CellProc
 
 
 @pytest.fixture(scope="module")
-def served() -> Iterator[tuple[str, zenoh.Session, CellDirectory, CellProcess]]:
+def served(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[str, zenoh.Session, CellDirectory,
+                                                                      CellProcess]]:
     """A planner-side session listening on a free loopback port and one truth cell c1 on it,
-    shared by the tests that leave c1 serving (one cell start for them all; each uses
-    request ids of its own, as the cell caches replies by id)."""
+    recording to Rerun, shared by the tests that leave c1 serving (one cell start for them
+    all; each uses request ids of its own, as the cell caches replies by id)."""
     endpoint = free_loopback_endpoint()
     session = open_session(listen=(endpoint,))
     directory = CellDirectory(session)
-    cell = start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,)))
+    cell = start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,),
+                                    rrd=str(tmp_path_factory.mktemp("served") / "c1.rrd"), recording_id="served"))
     try:
         directory.wait_for(1, timeout=20)
         yield endpoint, session, directory, cell
@@ -104,6 +108,24 @@ def test_bad_requests_get_error_replies_and_the_cell_keeps_serving(served) -> No
 
 
 @pytest.mark.slow
+def test_a_cell_recording_to_rerun_refuses_a_huge_experiment_number_and_keeps_serving(served) -> None:
+    """The bounds of ``tests/bridge/test_message_bounds.py`` at a real cell: a request at
+    them is answered, one past them (an experiment number of 2**63 or 10**30) refused with
+    an error reply."""
+    endpoint, session, directory, cell = served
+    for number in (2**63, 10**30, -1):
+        payload = b'{"kind":"insert","id":"n%d","part":"sh","hole":"br","experiment":%d}' % (abs(number), number)
+        reply = raw_query(session, "cell/c1/insert", payload)
+        assert isinstance(reply, ErrorReply) and reply.code == "malformed", reply
+        assert "at `$.experiment`" in reply.error
+    at_bounds = InsertRequest(id="x" * MAX_REQUEST_ID, part="sh", hole="br", experiment=MAX_COUNT, seed=2**32 - 1)
+    answer = request_insert(session, "c1", at_bounds, timeout=10)
+    assert isinstance(answer, InsertReply) and answer.result == "fit"
+    assert request_insert(session, "c1", InsertRequest(id="after", part="sh", hole="r1"), 10).result == "no_fit"
+    assert cell.popen.poll() is None
+
+
+@pytest.mark.slow
 def test_a_repeated_id_returns_the_cached_reply_without_rerunning(served) -> None:
     endpoint, session, directory, cell = served
     request = InsertRequest(id="same", part="p3", hole="s1")
@@ -112,18 +134,6 @@ def test_a_repeated_id_returns_the_cached_reply_without_rerunning(served) -> Non
     assert first == again  # same wall_s: the experiment was not run again
     cell.wait_for_line("done same", timeout=5)
     assert sum(line.startswith("start same") for line in cell.lines) == 1
-
-
-@pytest.mark.slow
-def test_sigterm_closes_the_cell_and_its_token_disappears(network) -> None:
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,))))
-    directory.wait_for(1, timeout=20)
-    gone: queue.SimpleQueue[str] = queue.SimpleQueue()
-    directory.listen(lambda cell, alive: None if alive else gone.put(cell))
-    cells[0].popen.send_signal(signal.SIGTERM)
-    assert cells[0].popen.wait(10) == 0
-    assert gone.get(timeout=10) == "c1"
 
 
 @pytest.mark.slow
@@ -211,7 +221,8 @@ def raw_ping(session: zenoh.Session, key: str, payload: bytes) -> bytes:
 
 
 @pytest.mark.slow
-def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(network) -> None:
+def test_a_full_queue_answers_busy_a_request_past_its_timeout_expires_and_sigterm_closes_the_cell(network) -> None:
+    """Then SIGTERM closes the cell (exit code 0) and its token disappears."""
     endpoint, session, directory, cells = network
     cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,), delay_s=0.3)))
     directory.wait_for(1, timeout=20)
@@ -228,6 +239,11 @@ def test_a_full_queue_answers_busy_and_a_request_past_its_timeout_expires(networ
     assert 1 <= len(answered) <= 4, codes
     cells[0].wait_for_line("start q", timeout=10, count=len(answered))  # its stdout is read by a thread
     assert sum(line.startswith("start q") for line in cells[0].lines) == len(answered)
+    gone: queue.SimpleQueue[str] = queue.SimpleQueue()
+    directory.listen(lambda cell, alive: None if alive else gone.put(cell))
+    cells[0].popen.send_signal(signal.SIGTERM)
+    assert cells[0].popen.wait(10) == 0
+    assert gone.get(timeout=10) == "c1"
 
 
 @pytest.mark.slow

@@ -1,25 +1,68 @@
-"""Precedence experiments at a cell, over a real Zenoh session to ``executor serve`` in its
-own process: the truth cell answers from the product's precedence, a bad or impossible
-experiment gets an error reply and the cell keeps serving; the sim cell observes why a step
-fails (the physics, not a rule)."""
+"""Precedence experiments and plan steps at a cell, over a real Zenoh session to ``executor
+serve`` in its own process: the truth cell answers experiments from the product's
+precedence, a bad or impossible experiment gets an error reply and the cell keeps serving;
+the sim cell inserts a fitting peg and records it, and observes why a step fails (the
+physics, not a rule). Plan steps of two runs: a
+cell builds one product at a time, and a refused step changes nothing (another run's step
+is ``run_active``, a step the product does not allow is ``invalid_step`` or ``unknown_id``).
+One cell of each backend for both."""
 
 from __future__ import annotations
 
 import queue
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
 
 import pytest
+import zenoh
 
+from asp.assemble.cli import truth_facts
+from asp.plans.plans import plans
+from asp.session.cells import start_cell
 from asp.session.precedence import CellOracle
-from bridge.client import CellRefused, request_experiment
-from bridge.messages import ErrorReply
+from bridge.assembly import load_assembly
+from bridge.cell_settings import ServeSettings
+from bridge.client import CellDirectory, CellRefused, request_experiment, request_insert, request_step
+from bridge.messages import ErrorReply, InsertRequest, StepReply, StepRequest
 from bridge.precedence.experiment import (
     ExperimentStep,
     PrecedenceExperiment,
     decode_outcome_reply,
 )
-from tests.bridge.test_bridge_step_runs import one_cell
+from bridge.session import free_loopback_endpoint, open_session
 
 HOLES = {"p1": "r1", "p2": "r2", "p3": "s1", "p4": "s2", "sh": "br"}
+
+
+@contextmanager
+def one_cell(backend: str, stop_s: float = 30.0, rrd: Path | None = None) -> Iterator[zenoh.Session]:
+    """A cell ``c1`` of Cranfield with ``backend`` (recording to ``rrd`` if given, recording id
+    ``sim-test``), and a planner's session connected to it; the cell must stop cleanly within
+    ``stop_s`` [s] afterwards (a cell flushes its recording as it stops)."""
+    endpoint = free_loopback_endpoint()
+    recording = {} if rrd is None else {"rrd": str(rrd), "recording_id": "sim-test"}
+    cell = start_cell(ServeSettings(cell_id="c1", backend=backend, listen=(endpoint,), **recording))
+    session = open_session(connect=(endpoint,))
+    try:
+        CellDirectory(session).wait_for(1, timeout=30)
+        yield session
+    finally:
+        session.close()
+        assert cell.stop(timeout=stop_s) == 0
+
+
+def step(session: zenoh.Session, run: str, number: int, part: str, hole: str | None) -> StepReply:
+    request = StepRequest(id=f"{run}-{number}-{part}-{hole}", assembly=run, step=number, part=part, hole=hole,
+                          seed=1)
+    return request_step(session, "c1", request, timeout=120)
+
+
+def refusal_code(session: zenoh.Session, run: str, number: int, part: str, hole: str | None) -> str:
+    """The code of the refusal of this step."""
+    with pytest.raises(CellRefused) as refusal:
+        step(session, run, number, part, hole)
+    return refusal.value.reply.code
 
 
 def experiment(name: str, pair: tuple[str, str], sequence: str, placed: str = "",
@@ -32,8 +75,8 @@ def experiment(name: str, pair: tuple[str, str], sequence: str, placed: str = ""
 
 
 @pytest.mark.slow
-@pytest.mark.timeout(120)
-def test_truth_cell_answers_experiments_from_the_precedence_and_refuses_bad_ones() -> None:
+@pytest.mark.timeout(180)
+def test_truth_cell_answers_experiments_from_the_precedence_and_builds_one_product_at_a_time() -> None:
     with one_cell("truth") as session:
         done = request_experiment(session, "c1", experiment("e1", ("p1", "sp"), "p3 p4 sp", placed="bp"), 30)
         assert (done.outcome, done.failed_step, done.pair) == ("success", None, ("p1", "sp"))
@@ -72,12 +115,38 @@ def test_truth_cell_answers_experiments_from_the_precedence_and_refuses_bad_ones
         outcome = oracle.run(then_a)
         assert (outcome.outcome, outcome.failed_step, outcome.reason, outcome.blocked_by) == (
             "failed", 3, "precedence", ())
+        # plan steps: one product at a time, refusals change nothing
+        plan = plans(truth_facts(load_assembly("cranfield")))[0].steps
+        assert step(session, "a", 1, "bp", None).result == "fit"
+        assert refusal_code(session, "b", 1, "bp", None) == "run_active"
+        assert refusal_code(session, "a", 2, "zz", None) == "unknown_id"
+        assert refusal_code(session, "a", 2, "none", None) == "unknown_id"
+        assert refusal_code(session, "a", 2, "p1", None) == "invalid_step"  # a peg needs a hole
+        assert refusal_code(session, "a", 2, "sp", "r1") == "invalid_step"  # a spacer goes without one
+        assert refusal_code(session, "a", 2, "bp", None) == "invalid_step"  # already placed
+        reply = step(session, "a", 2, "p3", "s1")
+        assert reply.result == "fit" and dict(reply.pose_errors_mm).keys() == {"bp", "p3"}
+        placed = {"bp", "p3"}
+        for number, planned in enumerate((s for s in plan if s.part not in placed), start=3):
+            assert step(session, "a", number, planned.part, planned.hole).result == "fit"
+        # the product is complete: the next run starts a fresh world
+        reply = step(session, "b", 1, "bp", None)
+        assert reply.result == "fit" and dict(reply.pose_errors_mm).keys() == {"bp"}
 
 
 @pytest.mark.slow
 @pytest.mark.timeout(900)
-def test_sim_cell_observes_why_a_step_fails() -> None:
-    with one_cell("sim", stop_s=120.0) as session:
+def test_sim_cell_logs_an_insertion_observes_why_a_step_fails_and_keeps_its_world_when_another_run_is_refused(
+        tmp_path: Path) -> None:
+    from bridge.recording.reader import column_values, read_recording
+
+    rrd = tmp_path / "c1.rrd"
+    with one_cell("sim", stop_s=120.0, rrd=rrd) as session:
+        # one simulated insertion, logged
+        reply = request_insert(session, "c1", InsertRequest(id="i1", part="p1", hole="br", seed=3, experiment=7), 60)
+        assert reply.result == "fit"
+        assert reply.evidence is not None and reply.evidence.attempts >= 1
+        assert reply.evidence.end_error < 0.01 and reply.evidence.duration_s > 0
         # a peg before the back plate: it reaches its goal height in air, and falls once let go
         fell = request_experiment(session, "c1", experiment("s1", ("bp", "p1"), "p1", seed=1), 300)
         assert (fell.outcome, fell.failed_step, fell.reason) == ("failed", 1, "unsupported")
@@ -94,3 +163,13 @@ def test_sim_cell_observes_why_a_step_fails() -> None:
         outcome = oracle.run(before_fp)
         assert (outcome.outcome, outcome.failed_step, outcome.reason) == ("failed", 10, "blocked")
         assert outcome.blocked_by == ("fp",), outcome
+        # a plan step's run keeps its world when another run's step is refused
+        assert step(session, "a", 1, "bp", None).result == "fit"
+        assert refusal_code(session, "b", 1, "p1", "r1") == "run_active"
+        assert refusal_code(session, "a", 2, "p3", None) == "invalid_step"
+        reply = step(session, "a", 2, "p3", "s1")
+        assert reply.result == "fit" and dict(reply.pose_errors_mm).keys() == {"bp", "p3"}
+    summary = read_recording([rrd])
+    assert set(summary.recording_ids) == {"sim-test"}
+    assert any(path.startswith("/executor/c1/wrench") for path in summary.entities)
+    assert set(column_values([rrd], "/executor/c1/outcome", "experiment")) == {7}

@@ -1,24 +1,17 @@
 """Every integer, string and array of every message is bounded by the published schema,
-and the bounds are what the cell and the planner enforce: a cell recording to Rerun
-answers a request at the bounds and refuses one past them (an experiment number of 2**63
-or 10**30) with an error reply, and keeps serving (a real cell process over Zenoh)."""
+and the bounds are what the cell and the planner enforce (the real cell process's answers at
+and past the bounds: ``tests/bridge/test_bridge_cells.py``)."""
 
 from __future__ import annotations
 
 import re
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
-from asp.session.cells import start_cell
-from bridge.cell_settings import ServeSettings
-from bridge.client import request_insert
 from bridge.messages import (
     MAX_COUNT,
     MAX_REQUEST_ID,
-    ErrorReply,
-    InsertReply,
     InsertRequest,
     MessageError,
     decode_reply,
@@ -26,7 +19,6 @@ from bridge.messages import (
     encode,
 )
 from bridge.protocol_schema import MESSAGES, schema
-from tests.bridge.test_bridge_cells import network, raw_query  # noqa: F401  (the fixture)
 
 BOUNDED_PATTERN = re.compile(r"^\^[^*+]*\{\d+,\d+\}[^*+]*\$")
 """A pattern that bounds the length of what it matches: one counted repetition, no * or +."""
@@ -72,21 +64,3 @@ def test_the_planner_refuses_a_reply_past_the_bounds() -> None:
     assert decode_reply(reply % MAX_COUNT).evidence.attempts == MAX_COUNT  # type: ignore[union-attr]
     with pytest.raises(MessageError, match=r"Expected `int` <= 2147483647 - at `\$.evidence.attempts`"):
         decode_reply(reply % 2**63)
-
-
-@pytest.mark.slow
-def test_a_cell_refuses_a_huge_experiment_number_and_keeps_serving(network, tmp_path: Path) -> None:  # noqa: F811
-    endpoint, session, directory, cells = network
-    cells.append(start_cell(ServeSettings(cell_id="c1", backend="truth", connect=(endpoint,),
-                                          rrd=str(tmp_path / "c1.rrd"), recording_id="bounds")))
-    directory.wait_for(1, timeout=20)
-    for number in (2**63, 10**30, -1):
-        payload = b'{"kind":"insert","id":"n%d","part":"sh","hole":"br","experiment":%d}' % (abs(number), number)
-        reply = raw_query(session, "cell/c1/insert", payload)
-        assert isinstance(reply, ErrorReply) and reply.code == "malformed", reply
-        assert "at `$.experiment`" in reply.error
-    at_bounds = InsertRequest(id="x" * MAX_REQUEST_ID, part="sh", hole="br", experiment=MAX_COUNT, seed=2**32 - 1)
-    answer = request_insert(session, "c1", at_bounds, timeout=10)
-    assert isinstance(answer, InsertReply) and answer.result == "fit"
-    assert request_insert(session, "c1", InsertRequest(id="after", part="sh", hole="r1"), 10).result == "no_fit"
-    assert cells[0].popen.poll() is None

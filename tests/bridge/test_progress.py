@@ -37,12 +37,8 @@ def test_a_bar_only_on_a_terminal_that_wants_info(tty: bool, level: int, drawn: 
     assert drawn or stream.getvalue() == ""
 
 
-def run_with_stderr(argv: list[str], tty: bool, cwd: Path, env: dict[str, str]) -> tuple[str, str]:
-    """Run ``argv`` with stdout a pipe and stderr a pseudo-terminal (``tty``) or a pipe;
-    (stdout, stderr) as text."""
-    if not tty:
-        done = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
-        return done.stdout, done.stderr
+def run_with_terminal_stderr(argv: list[str], cwd: Path, env: dict[str, str]) -> tuple[str, str]:
+    """Run ``argv`` with stdout a pipe and stderr a pseudo-terminal; (stdout, stderr) as text."""
     leader, follower = pty.openpty()
     # a terminal 120 columns wide (a new pseudo-terminal has none: a bar of no width)
     fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 120, 0, 0))
@@ -63,15 +59,16 @@ def run_with_stderr(argv: list[str], tty: bool, cwd: Path, env: dict[str, str]) 
     return out, b"".join(chunks).decode(errors="replace")
 
 
-@pytest.mark.slow  # two truth-cell assemblies, ~10 s
+@pytest.mark.slow  # a truth-cell assembly of two plans
 @pytest.mark.timeout(180)
-@pytest.mark.parametrize("tty", [True, False])
 def test_bench_assemble_draws_a_bar_on_a_terminal_stderr_only_and_never_in_its_json(
-        tty: bool, root: Path, cli_argv, cli_env: dict[str, str]) -> None:
-    out, err = run_with_stderr(cli_argv("bench", "assemble", "--backend", "truth", "--plans", "2", "--jobs", "2",
-                                        "--json"), tty, root, cli_env)
+        root: Path, cli_argv, cli_env: dict[str, str]) -> None:
+    """The command as a process, its stderr a terminal; with stderr not a terminal it draws
+    none (the same command in ``tests/test_jobs.py``, in the test's process)."""
+    out, err = run_with_terminal_stderr(cli_argv("bench", "assemble", "--backend", "truth", "--plans", "2",
+                                                 "--jobs", "2", "--json"), root, cli_env)
     assert out, err
     report = json.loads(out)
     assert len(report["plans"]) == 2
-    assert ("plans: 100%" in err) is tty
+    assert "plans: 100%" in err
     assert "100%" not in out

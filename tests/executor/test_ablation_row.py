@@ -40,10 +40,10 @@ def test_force_past_stop_is_the_share_of_attempts_on_fitting_pairs_that_reached_
 
 
 @pytest.mark.slow
-def test_the_documented_ablation_command_prints_its_json_on_a_reduced_run(run_cli):
+def test_the_documented_ablation_command_prints_its_json_on_a_reduced_run(run_main):
     """``bench executor --ablation --json`` through to its output, on one fitting pair and one
     execution per variant (six real trials): the JSON holds every layer and the magnitudes."""
-    done = run_cli("bench", "executor", "--ablation", "--trials", "1", "--executions", "1", "--seed", "7311",
+    done = run_main("bench", "executor", "--ablation", "--trials", "1", "--executions", "1", "--seed", "7311",
                    "--pairs", "p1:r1", "--json", "--jobs", "1")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)

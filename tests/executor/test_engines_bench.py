@@ -10,8 +10,8 @@ pytest.importorskip("mujoco")
 
 
 @pytest.mark.slow
-def test_bench_engines_inserts_where_the_part_fits_and_stops_where_not_in_both(run_cli) -> None:
-    done = run_cli("bench", "engines", "--assembly", "spare", "--pair", "p3:r1", "--pair", "p3:s1", "--json")
+def test_bench_engines_inserts_where_the_part_fits_and_stops_where_not_in_both(run_main) -> None:
+    done = run_main("bench", "engines", "--assembly", "spare", "--pair", "p3:r1", "--pair", "p3:s1", "--json")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     rows = {(row["part"], row["hole"]): row for row in report["rows"]}
@@ -28,8 +28,8 @@ def test_bench_engines_inserts_where_the_part_fits_and_stops_where_not_in_both(r
 
 
 @pytest.mark.slow
-def test_bench_engines_refuses_an_unknown_pair(run_cli) -> None:
-    done = run_cli("bench", "engines", "--assembly", "spare", "--pair", "p3:zz")
+def test_bench_engines_refuses_an_unknown_pair(run_main) -> None:
+    done = run_main("bench", "engines", "--assembly", "spare", "--pair", "p3:zz")
     assert done.returncode == 2 and "--pair p3:zz: expected a part of" in done.stderr
     assert "Traceback" not in done.stderr
 

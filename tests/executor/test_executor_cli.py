@@ -33,9 +33,9 @@ def test_part_without_demonstration_exits_2(tmp_path, root, run_main):
 
 
 @pytest.mark.slow
-def test_trial_json_contract_and_rerun_file(tmp_path, run_executor):
+def test_trial_json_contract_and_rerun_file(tmp_path, run_main):
     rrd = tmp_path / "trial.rrd"
-    proc = run_executor("trial", "--part", "p4", "--hole", "s2", "--seed", "4", "--json", "--rrd", str(rrd))
+    proc = run_main("executor", "trial", "--part", "p4", "--hole", "s2", "--seed", "4", "--json", "--rrd", str(rrd))
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     trial = out["trials"][0]

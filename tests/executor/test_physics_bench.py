@@ -8,8 +8,8 @@ import pytest
 
 
 @pytest.mark.slow
-def test_bench_physics_measures_bare_contact_and_trial_steps(run_cli) -> None:
-    done = run_cli("bench", "physics", "--repeats", "1", "--steps", "500", "--baseline", "1e8", "--json")
+def test_bench_physics_measures_bare_contact_and_trial_steps(run_main) -> None:
+    done = run_main("bench", "physics", "--repeats", "1", "--steps", "500", "--baseline", "1e8", "--json")
     assert done.returncode == 1, done.stderr  # nothing steps 1e8 times per second: a regression
     report = json.loads(done.stdout)
     assert report["contact_points"] > 0  # figure b is really the part in contact with the hole

@@ -55,12 +55,12 @@ def wait_for_journal(run: Path, lines: int, planner: subprocess.Popen, timeout: 
 
 @pytest.fixture
 def planner_of(tmp_path: Path, root: Path, cli_argv, cli_env: dict[str, str]) -> Iterator:
-    """Start a truth session (``--out tmp/run``) with more arguments; killed at the end,
-    with any cell it left."""
+    """Start a truth session (``--out tmp/run``, experiments of 0.15 s: the test kills a
+    cell while many are left) with more arguments; killed at the end, with any cell it left."""
     started: list[subprocess.Popen] = []
 
     def start(*args: str) -> subprocess.Popen:
-        argv = cli_argv(*TRUTH_SESSION, "--delay", "0.3", "--out", str(tmp_path / "run"), *args)
+        argv = cli_argv(*TRUTH_SESSION, "--delay", "0.15", "--out", str(tmp_path / "run"), *args)
         started.append(subprocess.Popen(argv, cwd=root, env=cli_env, stdout=subprocess.PIPE,
                                         stderr=subprocess.PIPE, text=True))
         return started[-1]

@@ -117,15 +117,15 @@ def test_out_under_a_regular_file_is_one_line(tmp_path: Path, run_main, parent: 
 
 
 @pytest.mark.slow
-def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, run_cli, run_main) -> None:
+def test_a_failed_start_leaves_no_run_folder_and_blocks_nothing(tmp_path: Path, run_main) -> None:
     run = tmp_path / "run"
     argv = (*TRUTH_SESSION, "--cells", "1", "--listen", "tcp/127.0.0.1:99999", "--out", str(run))
-    failed = run_cli(*argv, timeout=30)
+    failed = run_main(*argv, timeout=30)
     assert failed.returncode == 2 and failed.stderr.startswith("error: cannot open a Zenoh session")
     assert failed.stderr.count("\n") == 1
     assert not run.exists()  # the folder this start made is gone
     run.mkdir()  # a folder the user made stays, and a failed start there blocks nothing
-    again = run_main(*argv, timeout=30)  # in process: the first start was the real process
+    again = run_main(*argv, timeout=30)
     assert again.returncode == 2 and again.stderr == failed.stderr
     assert run.is_dir() and lock_is_free(run)
 

@@ -42,8 +42,8 @@ def client(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def fleet(hosts: Hosts, client: Path) -> Iterator[list[LineProcess]]:
-    """The router and cells c1, c2 (truth, 0.3 s per experiment), each in its namespace."""
-    started = hosts.start_fleet(client, delay_s=0.3)
+    """The router and cells c1, c2 (truth, 0.1 s per experiment), each in its namespace."""
+    started = hosts.start_fleet(client, delay_s=0.1)
     yield started
     for process in started:
         process.kill()
@@ -54,7 +54,7 @@ def test_a_cell_whose_link_is_cut_is_dropped_and_the_session_finishes(
     run = tmp_path / "run"
     argv = cli_argv(*TRUTH_SESSION, "--cells", "0", "--zenoh-config", str(client),
                     "--connect", hosts.router_endpoints()[0],
-                    "--allow-cells", "c1,c2", "--timeout", "3", "--out", str(run), "--policy", "best")
+                    "--allow-cells", "c1,c2", "--timeout", "2", "--out", str(run), "--policy", "best")
     planner = subprocess.Popen(hosts.argv(hosts.router, argv), cwd=root, env=cli_env,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:

@@ -179,12 +179,12 @@ def test_a_journal_of_other_ids_is_refused_naming_the_line(tmp_path: Path) -> No
     LINE.format(id="b", part="zz", hole="br", result="fit", extra=""),  # not a part of the assembly
 ])
 @pytest.mark.slow
-def test_a_refused_resume_starts_no_cell_and_changes_nothing(tmp_path: Path, run_cli, second: str) -> None:
+def test_a_refused_resume_starts_no_cell_and_changes_nothing(tmp_path: Path, run_main, second: str) -> None:
     run = tmp_path / "run"
     run.mkdir()
     (run / "session.json").write_text('{"assembly": "cranfield", "policy": "best", "seed": 0, "recording_id": "r"}')
     (run / "journal.jsonl").write_text(LINE.format(id="a", part="p1", hole="br", result="fit", extra="") + second)
     before = {path.name: path.read_bytes() for path in run.iterdir()}
-    done = run_cli("session", "--resume", str(run), "--backend", "truth", timeout=60)
+    done = run_main("session", "--resume", str(run), "--backend", "truth", timeout=60)
     assert done.returncode == 2 and f"{run / 'journal.jsonl'}:2: " in done.stderr
     assert {path.name: path.read_bytes() for path in run.iterdir() if path.name != ".lock"} == before

@@ -1,4 +1,5 @@
-"""A session reports each finished experiment (INFO log lines) with the unknown pairs left."""
+"""A session reports each finished experiment (INFO log lines) with the unknown pairs left, then
+its files and the next commands."""
 
 from __future__ import annotations
 
@@ -17,10 +18,13 @@ LINE = re.compile(r"experiment (\d+) on (c\d): (\w+) -> (\w+) (fit|no_fit) \(.*s
 
 @pytest.mark.slow
 @pytest.mark.timeout(90)
-def test_one_progress_line_per_experiment_down_to_no_unknown_pair(
+def test_one_progress_line_per_experiment_down_to_no_unknown_pair_and_a_summary_whose_commands_work(
         tmp_path: Path, caplog: pytest.LogCaptureFixture, capsys: pytest.CaptureFixture[str]) -> None:
+    """A session of two cells: its INFO lines, one per experiment, and its printed summary:
+    the files it wrote and the next commands, which work."""
+    run = tmp_path / "run"
     caplog.set_level(logging.INFO, logger="asp.session.run")
-    assert session_main(["--backend", "truth", "--cells", "2", "--out", str(tmp_path / "run")]) == 0
+    assert session_main(["--backend", "truth", "--cells", "2", "--out", str(run)]) == 0
     lines = [LINE.fullmatch(r.getMessage()) for r in caplog.records if r.getMessage().startswith("experiment")]
     assert lines and all(lines)
     numbers = sorted(int(m.group(1)) for m in lines if m)
@@ -28,16 +32,8 @@ def test_one_progress_line_per_experiment_down_to_no_unknown_pair(
     unknown = [int(m.group(6)) for m in lines if m]
     assert unknown[-1] == 0 and unknown == sorted(unknown, reverse=True)
     assert {m.group(2) for m in lines if m} <= {"c1", "c2"}
-    assert f"{len(numbers)} experiments" in capsys.readouterr().out
-
-
-@pytest.mark.slow
-@pytest.mark.timeout(90)
-def test_the_summary_lists_the_files_and_next_commands_that_work(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    run = tmp_path / "run"
-    assert session_main(["--backend", "truth", "--out", str(run)]) == 0
     out = capsys.readouterr().out
+    assert f"{len(numbers)} experiments" in out
     files = next(line for line in out.splitlines() if line.startswith("files written in"))
     assert files.split(": ")[1].split() == sorted(p.name for p in run.iterdir() if not p.name.startswith("."))
     commands = {line.split(":", 1)[0].strip(): line.split(":", 1)[1].strip()

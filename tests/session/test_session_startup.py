@@ -21,12 +21,12 @@ def short_peg(product: Path) -> None:
 
 
 @pytest.mark.slow
-def test_a_cell_dying_at_start_up_fails_the_session_at_once(tmp_path: Path, root: Path, run_cli) -> None:
+def test_a_cell_dying_at_start_up_fails_the_session_at_once(tmp_path: Path, root: Path, run_main) -> None:
     assembly = tmp_path / "short_peg"
     shutil.copytree(root / "data" / "cranfield", assembly)
     short_peg(assembly)
     start = time.monotonic()
-    done = run_cli("session", "--assembly", str(assembly), "--cells", "1", "--out", str(tmp_path / "run"), timeout=50)
+    done = run_main("session", "--assembly", str(assembly), "--cells", "1", "--out", str(tmp_path / "run"), timeout=50)
     assert done.returncode == 2
     assert "exited (code 2) before printing line 'ready" in done.stderr
     # the cell's own message is passed on
