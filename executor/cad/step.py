@@ -54,6 +54,9 @@ COARSE_DEFLECTIONS = (1e-5, SIZE_RESOLUTION)
 cone (spheres, tori, B-splines: a bearing's balls, fillets, engravings) when the product's
 tessellation within :data:`STEP_DEFLECTION` passes its bound of triangles [m]; the last is
 the least room the cell tells apart."""
+_OCCURRENCE_ID = re.compile(r"NAUO\d+")
+"""The id of a STEP file's ``NEXT_ASSEMBLY_USAGE_OCCURRENCE`` record as SolidWorks writes
+it, the name Open CASCADE gives a component whose own is blank."""
 _NAMED = 6
 """The parts named in :func:`coarse_assumption` (the others counted)."""
 
@@ -209,6 +212,20 @@ def _name(label: Any) -> str:
     return ""
 
 
+def _component_name(label: Any) -> str:
+    """A component's name: its own, or where that is its record's id, its part's (the
+    definition it refers to; "" when none). Open CASCADE names a component whose name is
+    blank by its record's id, as SolidWorks writes them (``NAUO12``, :data:`_OCCURRENCE_ID`)."""
+    from OCP.TDF import TDF_Label
+    from OCP.XCAFDoc import XCAFDoc_ShapeTool
+
+    own = _name(label)
+    if not _OCCURRENCE_ID.fullmatch(own):
+        return own
+    referred = TDF_Label()
+    return _name(referred) if XCAFDoc_ShapeTool.GetReferredShape_s(label, referred) else ""
+
+
 def _unique_names(paths: list[tuple[str, ...]]) -> list[str]:
     """Each leaf's name from its ``paths`` (the names from the root down to it): its own,
     and where several leaves share it (a sub-assembly placed twice), joined with ``_``
@@ -252,7 +269,8 @@ def _collect(tool: object, label: Any, location: Any, path: tuple[str, ...],
         for k in range(1, children.Length() + 1):
             child = children.Value(k)
             placement = here.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(child))
-            _collect(tool, child, placement, (*path, _name(child) or _name(definition) or f"{path[-1]}_{k}"), leaves)
+            name = _component_name(child) or _name(definition) or f"{path[-1]}_{k}"
+            _collect(tool, child, placement, (*path, name), leaves)
         return
     shape = XCAFDoc_ShapeTool.GetShape_s(definition)
     leaves.append((path, shape.Located(here.Multiplied(shape.Location()))))

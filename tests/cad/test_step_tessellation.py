@@ -1,10 +1,13 @@
 """A STEP product whose 1 µm tessellation passes its bound of triangles: its faces that are
 no plane, cylinder or cone (a ball knob's sphere) are tessellated more coarsely, its planes
 and cylinders as finely as before (a bored hole's diameter exact from the B-rep), the mesh
-closed, and the import says so; where even the coarsest passes the bound, it is refused."""
+closed, and the import says so; where even the coarsest passes the bound, it is refused.
+Components SolidWorks leaves unnamed (Open CASCADE names them by their records' ids,
+``NAUO5``) are named after their parts."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -77,3 +80,12 @@ def test_the_import_of_a_coarser_step_product_keeps_its_hole_exact_and_says_so(b
     assert fit.hole.kind == "round" and fit.hole.a == pytest.approx(0.010, abs=1e-9)
     assert ("STEP faces that are no plane, cylinder or cone (1 face of block) tessellated within 0.01 mm, the "
             f"finest of 0.001, 0.01, 0.025 mm within {total - 1} triangles") in "; ".join(done.assumed)
+
+
+def test_components_named_by_their_record_ids_are_named_after_their_parts(ball_step: Path, tmp_path: Path) -> None:
+    # as SolidWorks writes them: the name blank, the id NAUO<n>
+    text = re.sub(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\s*\(\s*'(\d+)'\s*,\s*'(block|pin)'\s*,\s*''",
+                  r"NEXT_ASSEMBLY_USAGE_OCCURRENCE('NAUO\1',' ',' '", ball_step.read_text())
+    assert text.count("'NAUO") == 2
+    (tmp_path / "nauo.step").write_text(text)
+    assert [part.id for part in load_step(tmp_path / "nauo.step")] == ["block", "pin"]
