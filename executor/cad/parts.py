@@ -188,8 +188,10 @@ def turned(parts: list[CadPart], up: str) -> list[CadPart]:
 
 def part_id(name: str, source: str) -> str:
     """An ASP constant from a file stem or a STEP name (lower case, ``_`` for other
-    characters); ExecutorError naming ``source`` when none can be made."""
+    characters, ``part_`` before a leading digit: a part number, ``01_02_01-block``);
+    ExecutorError naming ``source`` when none can be made."""
     candidate = re.sub(r"[^a-z0-9_]", "_", name.strip().lower())
+    candidate = f"part_{candidate}" if candidate[:1].isdigit() else candidate
     if not is_id(candidate):
         raise ExecutorError(f"{source}: part name {name!r} gives no part id (expected a letter first, "
                             "then letters, digits or _)")

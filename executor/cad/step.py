@@ -6,7 +6,8 @@ cylindrical faces of its B-rep (axis and radius, exact where the tessellation is
 tessellate it again more coarsely (``CadPart.remesh``: the simulated cell's base).
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
-converts to metres. A leaf without a name is named after its parent and position; leaves
+converts to metres. A leaf without a name is named after its parent and position (one named
+by its record's id, SolidWorks's ``NAUO12`` for a blank name, after its part); leaves
 of one name (a sub-assembly placed twice) are told apart by their assemblies' names, and
 leaves of one name in one assembly (a bearing's balls) are numbered. The triangles a
 face's degenerate edge leaves (a sphere's poles) are dropped: the mesh stays closed.

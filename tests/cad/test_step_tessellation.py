@@ -15,7 +15,7 @@ import pytest
 
 from executor import ExecutorError
 from executor.cad.cli import ImportOptions, run_import
-from executor.cad.parts import STEP_DEFLECTION
+from executor.cad.parts import STEP_DEFLECTION, part_id
 from executor.cad.step import COARSE_DEFLECTIONS, load_step
 
 HOLE = np.array([-0.015, 0.0])
@@ -89,3 +89,9 @@ def test_components_named_by_their_record_ids_are_named_after_their_parts(ball_s
     assert text.count("'NAUO") == 2
     (tmp_path / "nauo.step").write_text(text)
     assert [part.id for part in load_step(tmp_path / "nauo.step")] == ["block", "pin"]
+
+
+def test_a_part_number_gives_a_part_id() -> None:
+    assert part_id("01_02_01-block_Standard", "cutting_unit.step") == "part_01_02_01_block_standard"
+    with pytest.raises(ExecutorError, match="gives no part id"):
+        part_id("_block", "cutting_unit.step")
