@@ -74,7 +74,7 @@ from executor.cad.parts import (
     turned,
 )
 from executor.cad.sections import Shape2D, section_room, slices_kept, zero_clearance
-from executor.cad.step import load_step
+from executor.cad.step import coarse_assumption, load_step
 from executor.cad.sweep import opposite, processes
 from executor.cad.upright import drawn_tilted, drawn_up
 from executor.cad.upright.gravity import mm as _mm
@@ -468,6 +468,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed, derived = found.assumed, found.derived
     assumed.append(budget_assumption(seconds))
     assumed[found.near:found.near] = near_miss_assumption(derived, mesh_pieces(out, written))
+    assumed[2:2] = coarse_assumption(parts, options.max_triangles)  # after the up and the placement
     tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
     suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, found.settings.moved,

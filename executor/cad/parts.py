@@ -82,7 +82,9 @@ UNIT_RATIO = 300.0
 """A part larger than the median part by this factor (or smaller) is taken as a unit
 mismatch (mm vs m is 1000)."""
 STEP_DEFLECTION = 1e-6
-"""Tessellation of STEP faces: largest distance of a triangle from its surface [m]."""
+"""Tessellation of STEP faces: largest distance of a triangle from its surface [m] (the
+planes, cylinders and cones always; the other faces too where the product stays within its
+bound of triangles, else :data:`executor.cad.step.COARSE_DEFLECTIONS`)."""
 MAX_TRIANGLES = 1_000_000
 """The most triangles of a product's parts together (``import --max-triangles`` sets
 another bound): the import's peak memory grows by about 1.9 kB per triangle (a plate and
@@ -108,7 +110,9 @@ class CadPart:
     """One part in the assembled pose: ``id`` (an ASP constant), the ``name`` the source
     gives, its closed ``mesh`` [m] in the CAD frame (the cell frame once :func:`turned` and :func:`translated`),
     ``source`` (file, or file#name), the ``cylinders`` of its B-rep and ``remesh``, its
-    B-rep tessellated again to a given linear deflection [m] (a STEP part's; none for a mesh)."""
+    B-rep tessellated again to a given linear deflection [m] (a STEP part's; none for a mesh);
+    ``coarse_faces``, how many faces of its B-rep (no plane, cylinder or cone) its mesh
+    holds within ``coarse_deflection`` [m] instead of :data:`STEP_DEFLECTION`."""
 
     id: str
     name: str
@@ -116,6 +120,8 @@ class CadPart:
     source: str
     cylinders: tuple[Cylinder, ...] = ()
     remesh: Callable[[float], trimesh.Trimesh] | None = None
+    coarse_faces: int = 0
+    coarse_deflection: float = STEP_DEFLECTION
 
 
 def _mapped(parts: list[CadPart], point: Callable[[np.ndarray], np.ndarray],
@@ -203,8 +209,10 @@ def quarter_turned(parts: list[CadPart], turn: int) -> list[CadPart]:
 
 def part_id(name: str, source: str) -> str:
     """An ASP constant from a file stem or a STEP name (lower case, ``_`` for other
-    characters); ExecutorError naming ``source`` when none can be made."""
+    characters, ``part_`` before a leading digit: a part number, ``01_02_01-block``);
+    ExecutorError naming ``source`` when none can be made."""
     candidate = re.sub(r"[^a-z0-9_]", "_", name.strip().lower())
+    candidate = f"part_{candidate}" if candidate[:1].isdigit() else candidate
     if not is_id(candidate):
         raise ExecutorError(f"{source}: part name {name!r} gives no part id (expected a letter first, "
                             "then letters, digits or _)")

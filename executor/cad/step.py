@@ -6,7 +6,8 @@ cylindrical faces of its B-rep (axis and radius, exact where the tessellation is
 tessellate it again more coarsely (``CadPart.remesh``: the simulated cell's base).
 
 Open CASCADE reads a STEP file's own length unit and gives millimetres; this module
-converts to metres. A leaf without a name is named after its parent and position; leaves
+converts to metres. A leaf without a name is named after its parent and position (one named
+by its record's id, SolidWorks's ``NAUO12`` for a blank name, after its part); leaves
 of one name (a sub-assembly placed twice) are told apart by their assemblies' names, and
 leaves of one name in one assembly (a bearing's balls) are numbered. The triangles a
 face's degenerate edge leaves (a sphere's poles) are dropped: the mesh stays closed.
@@ -40,13 +41,25 @@ from executor.cad.parts import (
     count_triangles,
     part_id,
 )
+from executor.world import SIZE_RESOLUTION
 
 _MM = 1e-3
 FINE_ANGLE = 0.1
 """The angular deflection of the tessellation the import measures on [rad]."""
 COARSE_ANGLE = 0.5
 """The angular deflection of a part tessellated again for the cell [rad]: loose enough
-that the linear deflection decides how many sides a round hole gets."""
+that the linear deflection decides how many sides a round hole gets; and of the faces
+tessellated within :data:`COARSE_DEFLECTIONS`."""
+COARSE_DEFLECTIONS = (1e-5, SIZE_RESOLUTION)
+"""The linear deflections tried, finest first, for the faces that are no plane, cylinder or
+cone (spheres, tori, B-splines: a bearing's balls, fillets, engravings) when the product's
+tessellation within :data:`STEP_DEFLECTION` passes its bound of triangles [m]; the last is
+the least room the cell tells apart."""
+_OCCURRENCE_ID = re.compile(r"NAUO\d+")
+"""The id of a STEP file's ``NEXT_ASSEMBLY_USAGE_OCCURRENCE`` record as SolidWorks writes
+it, the name Open CASCADE gives a component whose own is blank."""
+_NAMED = 6
+"""The parts named in :func:`coarse_assumption` (the others counted)."""
 
 
 def load_step(path: Path, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
@@ -80,15 +93,58 @@ def load_step(path: Path, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
         _collect(tool, roots.Value(k), None, (_name(roots.Value(k)) or path.stem,), leaves)
     if not leaves:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
+    names = _unique_names([names for names, _ in leaves])
+    shapes = [(f"{path}#{name}", shape) for name, (_, shape) in zip(names, leaves, strict=True)]
+    coarse = _tessellate_within(shapes, max_triangles)
     parts: list[CadPart] = []
-    total = 0
-    for name, (_, shape) in zip(_unique_names([names for names, _ in leaves]), leaves, strict=True):
-        source = f"{path}#{name}"
-        _tessellate(shape)
-        total = count_triangles(source, _triangles(shape), total, max_triangles)
+    for name, (source, shape) in zip(names, shapes, strict=True):
+        rough = 0 if coarse is None else len(_faces(shape, exact=False))
         parts.append(CadPart(part_id(name, source), name, _tessellation(shape, source), source, _cylinders(shape),
-                             functools.partial(_mesh, shape, source, angle=COARSE_ANGLE)))
+                             functools.partial(_mesh, shape, source, angle=COARSE_ANGLE), rough,
+                             STEP_DEFLECTION if coarse is None or not rough else coarse))
     return parts
+
+
+def _tessellate_within(shapes: list[tuple[str, Any]], max_triangles: int) -> float | None:
+    """Tessellate the ``(source, shape)`` pairs within :data:`STEP_DEFLECTION`, or, where
+    their triangles together pass ``max_triangles``, their faces that are no plane,
+    cylinder or cone within the finest of :data:`COARSE_DEFLECTIONS` that keeps them
+    within it: that deflection [m] (None: all within :data:`STEP_DEFLECTION`); ExecutorError
+    naming the part at which the coarsest passes the bound."""
+    for coarse in (None, *COARSE_DEFLECTIONS):
+        total = 0
+        for source, shape in shapes:
+            _tessellate(shape, coarse=coarse)
+            if coarse == COARSE_DEFLECTIONS[-1]:
+                try:
+                    total = count_triangles(source, _triangles(shape), total, max_triangles)
+                except ExecutorError as error:
+                    raise ExecutorError(f"{error}; its faces that are no plane, cylinder or cone tessellated within "
+                                        f"{coarse / _MM:g} mm, the coarsest tried") from None
+                continue
+            total += _triangles(shape)
+            if total > max_triangles:
+                break
+        else:
+            return coarse
+    raise AssertionError("the coarsest tessellation returns or raises")
+
+
+def coarse_assumption(parts: list[CadPart], max_triangles: int) -> list[str]:
+    """The assumption of the parts' tessellation when faces of theirs were tessellated
+    coarser than :data:`STEP_DEFLECTION` (:func:`load_step`; none else)."""
+    rough = [part for part in parts if part.coarse_faces]
+    if not rough:
+        return []
+    named = ", ".join(part.id for part in rough[:_NAMED])
+    more = f" and {len(rough) - _NAMED} more" if len(rough) > _NAMED else ""
+    deflection = max(part.coarse_deflection for part in rough)
+    faces = sum(part.coarse_faces for part in rough)
+    return [f"STEP faces that are no plane, cylinder or cone ({faces} face{'s' if faces > 1 else ''} of "
+            f"{named}{more}) tessellated within {deflection / _MM:g} mm, the finest of "
+            f"{', '.join(f'{d / _MM:g}' for d in (STEP_DEFLECTION, *COARSE_DEFLECTIONS))} mm within "
+            f"{max_triangles} triangles (--max-triangles); planes, cylinders and cones within "
+            f"{STEP_DEFLECTION / _MM:g} mm"]
 
 
 @contextlib.contextmanager
@@ -157,6 +213,20 @@ def _name(label: Any) -> str:
     return ""
 
 
+def _component_name(label: Any) -> str:
+    """A component's name: its own, or where that is its record's id, its part's (the
+    definition it refers to; "" when none). Open CASCADE names a component whose name is
+    blank by its record's id, as SolidWorks writes them (``NAUO12``, :data:`_OCCURRENCE_ID`)."""
+    from OCP.TDF import TDF_Label
+    from OCP.XCAFDoc import XCAFDoc_ShapeTool
+
+    own = _name(label)
+    if not _OCCURRENCE_ID.fullmatch(own):
+        return own
+    referred = TDF_Label()
+    return _name(referred) if XCAFDoc_ShapeTool.GetReferredShape_s(label, referred) else ""
+
+
 def _unique_names(paths: list[tuple[str, ...]]) -> list[str]:
     """Each leaf's name from its ``paths`` (the names from the root down to it): its own,
     and where several leaves share it (a sub-assembly placed twice), joined with ``_``
@@ -200,20 +270,59 @@ def _collect(tool: object, label: Any, location: Any, path: tuple[str, ...],
         for k in range(1, children.Length() + 1):
             child = children.Value(k)
             placement = here.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(child))
-            _collect(tool, child, placement, (*path, _name(child) or _name(definition) or f"{path[-1]}_{k}"), leaves)
+            name = _component_name(child) or _name(definition) or f"{path[-1]}_{k}"
+            _collect(tool, child, placement, (*path, name), leaves)
         return
     shape = XCAFDoc_ShapeTool.GetShape_s(definition)
     leaves.append((path, shape.Located(here.Multiplied(shape.Location()))))
 
 
-def _tessellate(shape: Any, deflection: float = STEP_DEFLECTION, angle: float = FINE_ANGLE) -> None:
+def _tessellate(shape: Any, deflection: float = STEP_DEFLECTION, angle: float = FINE_ANGLE,
+                coarse: float | None = None) -> None:
     """Tessellate the shape's faces (:func:`_mesh`), replacing an earlier tessellation (a
-    coarser one would only refine it)."""
+    coarser one would only refine it); with ``coarse`` [m], its faces that are no plane,
+    cylinder or cone within that and :data:`COARSE_ANGLE`: the others first, then the
+    whole shape, whose edges already tessellated finer are kept and shared (a closed mesh)."""
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
     from OCP.BRepTools import BRepTools
 
     BRepTools.Clean_s(shape)
-    BRepMesh_IncrementalMesh(shape, deflection / _MM, False, angle, True)
+    if coarse is None:
+        BRepMesh_IncrementalMesh(shape, deflection / _MM, False, angle, True)
+        return
+    BRepMesh_IncrementalMesh(_compound(_faces(shape, exact=True)), deflection / _MM, False, angle, True)
+    BRepMesh_IncrementalMesh(shape, coarse / _MM, False, COARSE_ANGLE, True)
+
+
+def _faces(shape: Any, exact: bool) -> list[Any]:
+    """The shape's faces that are planes, cylinders or cones (``exact``), or the others."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.GeomAbs import GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Plane
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    found = []
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        face = TopoDS.Face(explorer.Current())
+        explorer.Next()
+        if (BRepAdaptor_Surface(face).GetType() in (GeomAbs_Plane, GeomAbs_Cylinder, GeomAbs_Cone)) == exact:
+            found.append(face)
+    return found
+
+
+def _compound(faces: list[Any]) -> Any:
+    """The faces as one compound shape."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Compound
+
+    compound = TopoDS_Compound()
+    builder = BRep_Builder()
+    builder.MakeCompound(compound)
+    for face in faces:
+        builder.Add(compound, face)
+    return compound
 
 
 def _triangles(shape: Any) -> int:

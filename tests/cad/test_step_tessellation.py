@@ -1,0 +1,97 @@
+"""A STEP product whose 1 µm tessellation passes its bound of triangles: its faces that are
+no plane, cylinder or cone (a ball knob's sphere) are tessellated more coarsely, its planes
+and cylinders as finely as before (a bored hole's diameter exact from the B-rep), the mesh
+closed, and the import says so; where even the coarsest passes the bound, it is refused.
+Components SolidWorks leaves unnamed (Open CASCADE names them by their records' ids,
+``NAUO5``) are named after their parts."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from executor import ExecutorError
+from executor.cad.cli import ImportOptions, run_import
+from executor.cad.parts import STEP_DEFLECTION, part_id
+from executor.cad.step import COARSE_DEFLECTIONS, load_step
+
+HOLE = np.array([-0.015, 0.0])
+"""The bored hole's axis (vertical) in the block [m]: radius 5 mm."""
+BALL = np.array([0.015, 0.0, 0.010])
+"""The centre of the ball knob on the block's top face [m]: radius 6 mm."""
+
+
+@pytest.fixture(scope="module")
+def ball_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A 60 x 40 x 20 mm block with a d 10 bored hole and a d 12 ball knob half out of its top,
+    and a d 10 pin in the hole (build123d)."""
+    from build123d import Box, Compound, Cylinder, Pos, Sphere, export_step
+
+    block = Box(60, 40, 20) - Pos(-15, 0, 0) * Cylinder(5, 20) + Pos(15, 0, 10) * Sphere(6)
+    block.label = "block"
+    pin = Pos(-15, 0, 10) * Cylinder(5, 30)
+    pin.label = "pin"
+    path = tmp_path_factory.mktemp("step") / "ball.step"
+    export_step(Compound(label="ballblock", children=[block, pin]), str(path))
+    return path
+
+
+def _on_hole(vertices: np.ndarray) -> int:
+    """The vertices [m] on the bored hole's cylinder."""
+    return int(np.sum(np.abs(np.linalg.norm(vertices[:, :2] - HOLE, axis=1) - 0.005) < 1e-9))
+
+
+def _ball_gap(mesh: object) -> float:
+    """The largest distance [m] of a triangle's centroid inside the ball knob from its sphere."""
+    vertices = np.asarray(mesh.vertices)  # type: ignore[attr-defined]
+    corners = vertices[np.asarray(mesh.faces)]  # type: ignore[attr-defined]
+    on_ball = np.all(np.abs(np.linalg.norm(corners - BALL, axis=2) - 0.006) < 1e-9, axis=1)
+    return float(0.006 - np.linalg.norm(corners[on_ball].mean(axis=1) - BALL, axis=1).min())
+
+
+@pytest.mark.slow
+def test_a_step_product_past_its_bound_is_tessellated_coarser_off_its_fits(ball_step: Path) -> None:
+    fine = {part.id: part for part in load_step(ball_step)}
+    total = sum(len(part.mesh.faces) for part in fine.values())
+    assert [part.coarse_faces for part in fine.values()] == [0, 0]
+    assert _ball_gap(fine["block"].mesh) <= STEP_DEFLECTION * 1.01
+    coarse = {part.id: part for part in load_step(ball_step, total - 1)}
+    block = coarse["block"]
+    assert (block.coarse_faces, coarse["pin"].coarse_faces) == (1, 0)  # the sphere alone
+    assert block.coarse_deflection == COARSE_DEFLECTIONS[0]
+    assert sum(len(part.mesh.faces) for part in coarse.values()) < total / 4
+    assert block.mesh.is_watertight
+    assert STEP_DEFLECTION * 1.01 < _ball_gap(block.mesh) <= COARSE_DEFLECTIONS[0] * 1.01
+    # the bored hole's cylinder tessellated as before
+    assert _on_hole(np.asarray(block.mesh.vertices)) == _on_hole(np.asarray(fine["block"].mesh.vertices)) > 100
+    with pytest.raises(ExecutorError, match=r"block: \d+ triangles, beyond the bound of 1000 .* within 0.025 mm"):
+        load_step(ball_step, 1000)
+
+
+@pytest.mark.slow
+def test_the_import_of_a_coarser_step_product_keeps_its_hole_exact_and_says_so(ball_step: Path,
+                                                                               tmp_path: Path) -> None:
+    total = sum(len(part.mesh.faces) for part in load_step(ball_step))
+    done = run_import(ball_step, tmp_path / "out", "mm", None, ImportOptions(max_triangles=total - 1))
+    fit = done.derived.hole_of["pin"]
+    assert fit.hole.kind == "round" and fit.hole.a == pytest.approx(0.010, abs=1e-9)
+    assert ("STEP faces that are no plane, cylinder or cone (1 face of block) tessellated within 0.01 mm, the "
+            f"finest of 0.001, 0.01, 0.025 mm within {total - 1} triangles") in "; ".join(done.assumed)
+
+
+def test_components_named_by_their_record_ids_are_named_after_their_parts(ball_step: Path, tmp_path: Path) -> None:
+    # as SolidWorks writes them: the name blank, the id NAUO<n>
+    text = re.sub(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\s*\(\s*'(\d+)'\s*,\s*'(block|pin)'\s*,\s*''",
+                  r"NEXT_ASSEMBLY_USAGE_OCCURRENCE('NAUO\1',' ',' '", ball_step.read_text())
+    assert text.count("'NAUO") == 2
+    (tmp_path / "nauo.step").write_text(text)
+    assert [part.id for part in load_step(tmp_path / "nauo.step")] == ["block", "pin"]
+
+
+def test_a_part_number_gives_a_part_id() -> None:
+    assert part_id("01_02_01-block_Standard", "cutting_unit.step") == "part_01_02_01_block_standard"
+    with pytest.raises(ExecutorError, match="gives no part id"):
+        part_id("_block", "cutting_unit.step")
