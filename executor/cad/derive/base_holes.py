@@ -22,7 +22,9 @@ from executor.world.polygon_fit import OutlineError, polygon, symmetry
 def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dict[str, list[CadPart]]
           ) -> list[HoleFit]:
     """Every inner loop of the base's slices (at the levels of the parts in it, or at its
-    middle along +z), with the part in it where one is, in order of position. A part is in
+    middle along +z), with the part in it where one is, in order of position; a loop no
+    wider than faces that touch (:func:`executor.cad.derive.loops.touching_gap`: the crack
+    two closed objects of one part keep where their faces meet not quite flat) is none. A part is in
     none when, at its level, its bore holds an outline of the base or of one of the parts
     ``before`` it (a gland on a shaft: it goes onto a pin, :func:`executor.cad.derive.pins`), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
