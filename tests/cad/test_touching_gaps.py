@@ -51,6 +51,7 @@ def _as_the_source_has_it(text: str, keep: tuple[float, float] = (-1e9, 1e9)) ->
     return "\n".join(out) + "\n"
 
 
+@pytest.mark.slow
 def test_the_crack_between_two_boxes_of_pearls_digit_2_block_is_no_hole(tmp_path: Path) -> None:
     # Two of the digit 2's block's objects meet along a slanted face, not quite flat in the
     # source's 6 decimals: their union keeps a crack of no width beside the pocket, a loop of
