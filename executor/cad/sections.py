@@ -90,6 +90,11 @@ class Loop:
         return abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2
 
     @cached_property
+    def length(self) -> float:
+        """The perimeter [m]."""
+        return float(np.sum(np.linalg.norm(self.points - np.roll(self.points, 1, axis=0), axis=1)))
+
+    @cached_property
     def centre(self) -> np.ndarray:
         """The area centroid [m] (a mean of the points would lean towards denser edges)."""
         x, y = self.points[:, 0], self.points[:, 1]

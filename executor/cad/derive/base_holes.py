@@ -10,10 +10,9 @@ import numpy as np
 
 from executor.cad.derive.cavities import without_cavities
 from executor.cad.derive.derived import HoleFit
-from executor.cad.derive.loops import SAME_HOLE, bore_around, hole_around, outer
+from executor.cad.derive.loops import SAME_HOLE, bore_around, hole_around, outer, touching_gap
 from executor.cad.derive.measure_hole import measure
 from executor.cad.derive.rays import roofed
-from executor.cad.fits.faces import TOUCH
 from executor.cad.parts import CadPart
 from executor.cad.sections import Loop, frame_of, slice_loops
 from executor.cad.sweep import DIRECTIONS, forked_map, opposite, processes
@@ -23,7 +22,9 @@ from executor.world.polygon_fit import OutlineError, polygon, symmetry
 def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dict[str, list[CadPart]]
           ) -> list[HoleFit]:
     """Every inner loop of the base's slices (at the levels of the parts in it, or at its
-    middle along +z), with the part in it where one is, in order of position. A part is in
+    middle along +z), with the part in it where one is, in order of position; a loop no
+    wider than faces that touch (:func:`executor.cad.derive.loops.touching_gap`: the crack
+    two closed objects of one part keep where their faces meet not quite flat) is none. A part is in
     none when, at its level, its bore holds an outline of the base or of one of the parts
     ``before`` it (a gland on a shaft: it goes onto a pin, :func:`executor.cad.derive.pins`), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
@@ -69,6 +70,8 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
                             key=lambda o: o.area)
             if len(around) % 2 == 0:
                 continue  # an outline, not a hole
+            if touching_gap(loop.area, loop.length):
+                continue  # a crack between faces that touch: no part goes in
             frame = frame_of(axis)
             centre = frame.T @ loop.centre + axis * level
             occupant = next(((p, own) for p, own in members if loop.contains(own.centre)), None)
@@ -175,4 +178,4 @@ def receives(fit: HoleFit) -> bool:
         shape = polygon(fit.hole.outline, "hole")
     except OutlineError:  # no simple polygon: a gap of no area between faces that touch
         return False
-    return 2 * shape.area > TOUCH * shape.length and symmetry(shape) >= 2
+    return not touching_gap(shape.area, shape.length) and symmetry(shape) >= 2

@@ -29,6 +29,14 @@ def outer(loop: Loop, loops: list[Loop]) -> bool:
     return sum(1 for o in loops if o is not loop and o.area > loop.area and o.contains(loop.centre)) % 2 == 0
 
 
+def touching_gap(area: float, length: float) -> bool:
+    """Whether a loop of ``area`` [m²] and perimeter ``length`` [m] is a gap between faces
+    that touch: its mean width (twice its area over its perimeter) at most
+    :data:`executor.cad.fits.faces.TOUCH`, too narrow for any part (the crack two boxes of one
+    part leave where their faces meet not quite flat, a Technic pin's slit)."""
+    return 2 * area <= TOUCH * length
+
+
 def _in_loop(outline: Loop, hole: Loop) -> bool:
     """Whether a part's ``outline`` lies in the ``hole`` loop of another part's slice: at
     most the hole's sagitta (a round one's) plus :data:`executor.cad.fits.faces.TOUCH` beyond
