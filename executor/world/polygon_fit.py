@@ -15,7 +15,7 @@ centre on the hole's largest inscribed circle's, and the area centroids together
 :data:`CANDIDATES` best are refined by zooming in on the best of 9 turns until the peg's
 farthest corner moves less than :data:`FINE_SHIFT`, then (unless both outlines share a
 rotational symmetry, which keeps their centres together) the shift. Where a shift passes
-at that turn, the best shift at a turn is exact (:func:`_best_shift`: the centre of the
+at that turn, the best shift at a turn is exact (:func:`_free_shift`: the centre of the
 largest circle in the shifts that pass, the regions ∂hole ⊕ (−peg) leaves, to
 :data:`FINE_SHIFT`), and the turn is climbed once more with each turn at its best shift
 (one coarse step either side), then at the shift found down to the resolution. Where none
@@ -42,11 +42,15 @@ enclosing circle), a round peg in a polygon hole (the radius of the hole's large
 inscribed circle) - r, at any turn. :func:`turned_fit` measures a pair at given turns
 only, each at its best shift (two rect or square sections at the turns the skill aligns
 them by: :func:`executor.cad.sections.section_room`).
-Deterministic: the same outlines give the same answer.
+Deterministic: the same outlines give the same answer, so :func:`polygon_fit` searches
+a pair of outlines once (the pair's exact WKB bytes its key: the same peg and hole
+polygons of sections that differ elsewhere meet many times in an import), and a polygon's
+largest inscribed circle, a peg's best shift at a turn, are found once for each.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -216,7 +220,9 @@ class _Pair:
         self.peg_hull = np.asarray(hull.exterior.coords)[:-1]
         self.sweep_convex = hull.area <= peg.area * (1 + 1e-12) or \
             shapely.convex_hull(hole).area <= hole.area * (1 + 1e-12)
-        """Whether :func:`_best_shift` sweeps the peg's convex hull (either outline convex)."""
+        """Whether :func:`_free_shift` sweeps the peg's convex hull (either outline convex)."""
+        self.best_shifts: dict[str, np.ndarray | None] = {}
+        """:func:`_best_shift`'s answers, by the turn's float in hex."""
 
     def pegs(self, angles: np.ndarray, shifts: np.ndarray) -> np.ndarray:
         """The peg polygons turned by ``angles`` (k,) and shifted by ``shifts`` (k, 2)."""
@@ -286,7 +292,15 @@ def polygon_fit(peg: shapely.Polygon, hole: shapely.Polygon) -> PolygonFit:
     unique) and its steps (a grid along the frame's axes) follow the frame, so one frame's
     least lack, a local best, changed with a quarter turn of the product (``vitac_shapes``'
     hourglass peg in the convex hole: 1.773, 1.681, 1.773, 2.104 mm lacking per side); the
-    four frames searched are the same four however the product is turned by quarter turns."""
+    four frames searched are the same four however the product is turned by quarter turns.
+    Once for each pair of outlines (their WKB bytes, which hold the coordinates exactly)."""
+    return _polygon_fit(shapely.to_wkb(peg), shapely.to_wkb(hole))
+
+
+@functools.lru_cache(maxsize=4096)
+def _polygon_fit(peg_wkb: bytes, hole_wkb: bytes) -> PolygonFit:
+    """:func:`polygon_fit` of the polygons of these WKB bytes."""
+    peg, hole = shapely.from_wkb(peg_wkb), shapely.from_wkb(hole_wkb)
     bound = _room_bound(peg, hole)
     found = _searched(peg, hole, bound)
     if found.room >= 0 or bound < 0:
@@ -313,7 +327,7 @@ def _searched(peg: shapely.Polygon, hole: shapely.Polygon, bound: float) -> Poly
     """:func:`polygon_fit`'s search in the frame the polygons are given in; ``bound`` [m]
     the room's (:func:`_room_bound`: negative, the answer without a search)."""
     peg_centre = np.asarray(shapely.minimum_bounding_circle(peg).centroid.coords[0])
-    hole_centre = np.asarray(shapely.maximum_inscribed_circle(hole, FINE_SHIFT).coords[0])
+    hole_centre = np.asarray(inscribed(hole).coords[0])
     if bound < 0:
         return PolygonFit(bound, 0.0, (float(hole_centre[0] - peg_centre[0]), float(hole_centre[1] - peg_centre[1])))
     pair = _Pair(shapely.affinity.translate(peg, *-peg_centre), shapely.affinity.translate(hole, *-hole_centre))
@@ -399,8 +413,18 @@ _SHIFTED_ZOOM = 64
 def _room_bound(peg: shapely.Polygon, hole: shapely.Polygon) -> float:
     """A bound [m] the room cannot exceed: the peg offset by r has a largest inscribed
     circle r wider (narrower for r < 0), which must fit the hole's."""
-    return float(shapely.length(shapely.maximum_inscribed_circle(hole, FINE_SHIFT))
-                 - shapely.length(shapely.maximum_inscribed_circle(peg, FINE_SHIFT))) + FINE_SHIFT
+    return float(shapely.length(inscribed(hole)) - shapely.length(inscribed(peg))) + FINE_SHIFT
+
+
+def inscribed(shape: shapely.Polygon) -> shapely.LineString:
+    """The largest inscribed circle of ``shape`` to :data:`FINE_SHIFT` as shapely gives it
+    (its centre, then the nearest boundary point [m]), once for each polygon (its WKB bytes)."""
+    return _inscribed(shapely.to_wkb(shape))
+
+
+@functools.lru_cache(maxsize=4096)
+def _inscribed(wkb: bytes) -> shapely.LineString:
+    return shapely.maximum_inscribed_circle(shapely.from_wkb(wkb), FINE_SHIFT)
 
 
 def _refine_turn(pair: _Pair, angle: float, shift: np.ndarray, step: float, fine: float) -> tuple[float, np.ndarray]:
@@ -429,7 +453,7 @@ def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: flo
             break
         tried = angle + step * _TURNS
         shifts = [shift if (free := _best_shift(pair, float(turn))) is None else free for turn in tried]
-        scores = [pair.score(float(turn), moved) for turn, moved in zip(tried, shifts, strict=True)]
+        scores = pair.scores(tried, np.array(shifts))
         k = int(np.argmax(scores))
         angle, shift = float(tried[k]), shifts[k]
         if 0 < k < len(tried) - 1:
@@ -438,6 +462,16 @@ def _refine_turn_shifted(pair: _Pair, angle: float, shift: np.ndarray, step: flo
 
 
 def _best_shift(pair: _Pair, angle: float) -> np.ndarray | None:
+    """:func:`_free_shift` of the pair at the turn ``angle`` [rad], once for each turn (the
+    float exactly: -0.0 is not 0.0; a refinement tries the best turn of a round again)."""
+    key = float(angle).hex()
+    if key not in pair.best_shifts:
+        pair.best_shifts[key] = _free_shift(pair, angle)
+    found = pair.best_shifts[key]
+    return None if found is None else found.copy()
+
+
+def _free_shift(pair: _Pair, angle: float) -> np.ndarray | None:
     """The shift [m] with the most room at the turn ``angle`` [rad], from the free shifts:
     the peg at shift t meets the hole's boundary where t lies in ∂hole ⊕ (−peg), and its
     room there is t's distance to that set (the distance from peg + t to ∂hole). With a
@@ -466,10 +500,13 @@ def _best_shift(pair: _Pair, angle: float) -> np.ndarray | None:
     low, high = pair.hole_points.min(axis=0) - 2 * reach, pair.hole_points.max(axis=0) + 2 * reach
     free = shapely.get_parts(shapely.difference(shapely.box(*low, *high), touching))
     free = free[shapely.get_type_id(free) == shapely.GeometryType.POLYGON]
-    inside = [region for region in free if pair.score(angle, np.asarray(region.representative_point().coords[0])) > 0]
-    if not inside:
+    if not len(free):
         return None
-    circles = shapely.maximum_inscribed_circle(np.array(inside), FINE_SHIFT)
+    points = shapely.get_coordinates(shapely.point_on_surface(free))  # a point of each region, scored at once
+    inside = free[pair.scores(np.full(len(free), angle), points) > 0]
+    if not len(inside):
+        return None
+    circles = shapely.maximum_inscribed_circle(inside, FINE_SHIFT)
     return np.asarray(circles[int(np.argmax(shapely.length(circles)))].coords[0])
 
 
@@ -501,7 +538,6 @@ def round_fit(peg: shapely.Polygon | None, hole: shapely.Polygon | None, peg_dia
         centre = np.asarray(mbc.centroid.coords[0])
         reach = float(np.max(np.linalg.norm(np.asarray(peg.exterior.coords) - centre, axis=1)))
         return PolygonFit(hole_diameter / 2 - reach, 0.0, (float(-centre[0]), float(-centre[1])))
-    mic = shapely.maximum_inscribed_circle(hole, 1e-7)
-    centre = np.asarray(mic.coords[0])
+    centre = np.asarray(inscribed(hole).coords[0])
     inner = float(shapely.distance(hole.exterior, shapely.Point(centre)))
     return PolygonFit(inner - peg_diameter / 2, 0.0, (float(centre[0]), float(centre[1])))
