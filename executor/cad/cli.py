@@ -459,10 +459,13 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
         # the overlap check runs beside the derivation where the sweeps would take two cores
         with overlaps_checked(parts, processes(p.mesh for p in parts) > 1) as start:
             found = _derived(parts, (source, out), (config, data, up), options, start, (turn or 0, place, "place"))
+            # the up checked on the CAD's own axes (or as the user turned it), before any pose is chosen
+            doubt = None if up is not None else drawn_up(found.derived)
+            if doubt is not None:
+                turned_by = f" (read turned {turn} deg about z as set: the axes named are the turned ones)" \
+                    if turn else ""
+                raise ExecutorError(f"{source}: {doubt}{turned_by}")
             found = _chosen_pose(parts, (source, out), (config, data, up), options, found, (turn, place))
-        doubt = None if up is not None else drawn_up(found.derived)
-        if doubt is not None:
-            raise ExecutorError(f"{source}: {doubt}")
         written, why, mapped, cell = write_folder(found.derived, found.cell, found.mapped, found.settings, source.stem,
                                                   out, found.removable)
     assumed, derived = found.assumed, found.derived
