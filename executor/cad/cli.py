@@ -156,7 +156,7 @@ class LeaveOut:
         if not ids:
             return []
         count = f"{len(ids)} part{'s' if len(ids) > 1 else ''}"
-        return [f"parts left out as set ({self.setting}): {', '.join(ids)} ({count}; read, then dropped before any "
+        return [f"parts left out as set ({self.setting}): {', '.join(ids)} ({count}; dropped as read, before any "
                 "check: their triangles, overlaps and fits do not count)"]
 
 
