@@ -39,6 +39,7 @@ did not write, :func:`executor.cad.write.manifest.claim_folder`).
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import time
 import tomllib
@@ -145,18 +146,29 @@ def _leave_out_setting(path: Path | None, value: object) -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class LeaveOut:
-    """The parts to leave out: part ids or ``fnmatch`` patterns (:func:`executor.cad.parts.left_out`)
-    and the ``setting`` that names them (``--leave-out``, or the file's ``leave_out``)."""
+    """The parts to leave out: part ids or ``fnmatch`` patterns (:func:`executor.cad.parts.left_out`),
+    the ``setting`` that names them as errors name it (``--leave-out``, or ``<file>: leave_out``),
+    as the assumption names it (``label``) and the ``base`` set (None: none), which none may leave out."""
 
     names: tuple[str, ...] = ()
     setting: str = "--leave-out"
+    label: str = "--leave-out"
+    base: object = None
+
+    def kept(self, ids: list[str], dropped: list[str]) -> set[str]:
+        """Of ``ids``, those kept; those left out added to ``dropped`` (sorted); ExecutorError
+        naming the setting when a name matches none or the base is left out."""
+        dropped.extend(sorted(left_out(ids, self.names, self.setting)))
+        if self.base in dropped:
+            raise ExecutorError(f"{self.setting}: the base {self.base!r} cannot be left out (set another base)")
+        return set(ids) - set(dropped)
 
     def assumption(self, ids: list[str]) -> list[str]:
         """The assumption of the parts ``ids`` left out (none without one)."""
         if not ids:
             return []
         count = f"{len(ids)} part{'s' if len(ids) > 1 else ''}"
-        return [f"parts left out as set ({self.setting}): {', '.join(ids)} ({count}; dropped as read, before any "
+        return [f"parts left out as set ({self.label}): {', '.join(ids)} ({count}; dropped as read, before any "
                 "check: their triangles, overlaps and fits do not count)"]
 
 
@@ -435,12 +447,7 @@ def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES,
     most ``max_triangles`` together, but those ``leave`` leaves out, and the ids of these
     (sorted; ExecutorError naming its setting when a name matches none)."""
     dropped: list[str] = []
-
-    def kept(ids: list[str]) -> set[str]:
-        dropped.extend(sorted(left_out(ids, leave.names, leave.setting)))
-        return set(ids) - set(dropped)
-
-    keep = kept if leave.names else None
+    keep = functools.partial(leave.kept, dropped=dropped) if leave.names else None
     if source.is_dir():
         return load_meshes(source, units, max_triangles, keep), dropped
     if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
@@ -502,11 +509,10 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     seconds = _budget_setting(config, data.get("pieces_cpu_s"))
     place = options.place or _place_setting(config, data.get("place"))
     turn = options.turn if options.turn is not None else _turn_setting(config, data.get("turn"))
-    leave = (LeaveOut(options.leave_out) if options.leave_out is not None
-             else LeaveOut(_leave_out_setting(config, data.get("leave_out")), f"leave_out in {config}"))
+    leave = (LeaveOut(options.leave_out, base=data.get("base")) if options.leave_out is not None
+             else LeaveOut(_leave_out_setting(config, data.get("leave_out")), f"{config}: leave_out",
+                           f"leave_out in {config}", data.get("base")))
     read, dropped = load_source(source, units, options.max_triangles, leave)
-    if data.get("base") in dropped:
-        raise ExecutorError(f"{leave.setting}: the base {data['base']!r} cannot be left out (set another base)")
     parts = turned(read, up or "+z")
     check_solids(parts, units)
     with pieces_budget(seconds):
@@ -517,7 +523,7 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
         doubt = None if up is not None else drawn_up(found.derived)
         if doubt is not None:
             raise ExecutorError(f"{source}: {doubt}")
-        settings = replace(found.settings, left_out=(leave.setting, tuple(dropped)))
+        settings = replace(found.settings, left_out=(leave.label, tuple(dropped)))
         written, why, mapped, cell = write_folder(found.derived, found.cell, found.mapped, settings, source.stem,
                                                   out, found.removable)
     assumed, derived = found.assumed, found.derived

@@ -81,9 +81,9 @@ def test_the_bound_of_triangles_counts_the_parts_kept(tmp_path: Path, run_main: 
 
 BAD = [
     ('leave_out = ["funnel", "hopper"]\n',
-     ["import.toml", "leave_out", "'funnel' matches no part", "hopper, peg, plate"]),
-    ('base = "plate"\nleave_out = ["pl*"]\n', ["import.toml", "leave_out", "the base 'plate' cannot be left out"]),
-    ('leave_out = ["*"]\n', ["import.toml", "leave_out", "every part left out"]),
+     ["import.toml: leave_out: ", "'funnel' matches no part", "hopper, peg, plate"]),
+    ('base = "plate"\nleave_out = ["pl*"]\n', ["import.toml: leave_out: ", "the base 'plate' cannot be left out"]),
+    ('leave_out = ["*"]\n', ["import.toml: leave_out: ", "every part left out"]),
     ('leave_out = "hopper"\n', ["import.toml", "leave_out: expected a list of part ids or patterns"]),
 ]
 
