@@ -39,6 +39,7 @@ did not write, :func:`executor.cad.write.manifest.claim_folder`).
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import time
 import tomllib
@@ -66,6 +67,7 @@ from executor.cad.parts import (
     UP_AXES,
     CadPart,
     check_solids,
+    left_out,
     load_meshes,
     overlaps_checked,
     quarter_turned,
@@ -120,6 +122,54 @@ def _budget_setting(path: Path | None, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
         raise ExecutorError(f"{path}: pieces_cpu_s: expected a positive number of seconds, got {shorten(repr(value))}")
     return float(value)
+
+
+def part_names(text: str) -> tuple[str, ...]:
+    """An argparse type: part ids or ``fnmatch`` patterns on ids, separated by commas."""
+    names = tuple(name.strip() for name in text.split(","))
+    if not all(names):
+        raise argparse.ArgumentTypeError(f"{shorten(text)!r}: expected part ids or patterns separated by commas "
+                                         "(hopper,screw_*)")
+    return names
+
+
+def _leave_out_setting(path: Path | None, value: object) -> tuple[str, ...]:
+    """``leave_out`` of ``--config``, the part ids or patterns to leave out (none when not
+    set); ExecutorError naming the file when it is no list of non-empty strings."""
+    if value is None:
+        return ()
+    if not (isinstance(value, list) and all(isinstance(v, str) and v.strip() for v in value)):
+        raise ExecutorError(f"{path}: leave_out: expected a list of part ids or patterns "
+                            f"([\"hopper\", \"screw_*\"]), got {shorten(repr(value))}")
+    return tuple(value)
+
+
+@dataclass(frozen=True)
+class LeaveOut:
+    """The parts to leave out: part ids or ``fnmatch`` patterns (:func:`executor.cad.parts.left_out`),
+    the ``setting`` that names them as errors name it (``--leave-out``, or ``<file>: leave_out``),
+    as the assumption names it (``label``) and the ``base`` set (None: none), which none may leave out."""
+
+    names: tuple[str, ...] = ()
+    setting: str = "--leave-out"
+    label: str = "--leave-out"
+    base: object = None
+
+    def kept(self, ids: list[str], dropped: list[str]) -> set[str]:
+        """Of ``ids``, those kept; those left out added to ``dropped`` (sorted); ExecutorError
+        naming the setting when a name matches none or the base is left out."""
+        dropped.extend(sorted(left_out(ids, self.names, self.setting)))
+        if self.base in dropped:
+            raise ExecutorError(f"{self.setting}: the base {self.base!r} cannot be left out (set another base)")
+        return set(ids) - set(dropped)
+
+    def assumption(self, ids: list[str]) -> list[str]:
+        """The assumption of the parts ``ids`` left out (none without one)."""
+        if not ids:
+            return []
+        count = f"{len(ids)} part{'s' if len(ids) > 1 else ''}"
+        return [f"parts left out as set ({self.label}): {', '.join(ids)} ({count}; dropped as read, before any "
+                "check: their triangles, overlaps and fits do not count)"]
 
 
 def _up_assumption(up: str | None) -> str:
@@ -391,13 +441,17 @@ def mapped_report(mapped: Mapped) -> list[str]:
 
 
 
-def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
+def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES,
+                leave: LeaveOut = LeaveOut()) -> tuple[list[CadPart], list[str]]:
     """The parts of a mesh folder or a STEP file (``units`` applies to meshes only), of at
-    most ``max_triangles`` together."""
+    most ``max_triangles`` together, but those ``leave`` leaves out, and the ids of these
+    (sorted; ExecutorError naming its setting when a name matches none)."""
+    dropped: list[str] = []
+    keep = functools.partial(leave.kept, dropped=dropped) if leave.names else None
     if source.is_dir():
-        return load_meshes(source, units, max_triangles)
+        return load_meshes(source, units, max_triangles, keep), dropped
     if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
-        return load_step(source, max_triangles)
+        return load_step(source, max_triangles, keep), dropped
     raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
 
 
@@ -428,7 +482,8 @@ class ImportOptions:
     off); ``max_triangles``, the bound on the product's triangles; ``replace``: also write
     over a product another import or a person wrote (:func:`executor.cad.write.manifest.claim_folder`);
     ``place`` [m]: where the base's centre goes in the cell (and the product's lowest point's height), over the config's
-    (:func:`placement`); ``turn`` [deg]: the product's turn about z, over the config's (None:
+    (:func:`placement`); ``leave_out``: the parts to leave out, over the config's (None: the config's);
+    ``turn`` [deg]: the product's turn about z, over the config's (None:
     the config's, else chosen, :func:`_chosen_pose`); ``up``: the CAD's axis pointing up, over the config's
     (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""
 
@@ -438,6 +493,7 @@ class ImportOptions:
     place: Place | None = None
     up: str | None = None
     turn: int | None = None
+    leave_out: tuple[str, ...] | None = None
 
 
 def run_import(source: Path, out: Path, units: str, config: Path | None,
@@ -453,7 +509,11 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     seconds = _budget_setting(config, data.get("pieces_cpu_s"))
     place = options.place or _place_setting(config, data.get("place"))
     turn = options.turn if options.turn is not None else _turn_setting(config, data.get("turn"))
-    parts = turned(load_source(source, units, options.max_triangles), up or "+z")
+    leave = (LeaveOut(options.leave_out, base=data.get("base")) if options.leave_out is not None
+             else LeaveOut(_leave_out_setting(config, data.get("leave_out")), f"{config}: leave_out",
+                           f"leave_out in {config}", data.get("base")))
+    read, dropped = load_source(source, units, options.max_triangles, leave)
+    parts = turned(read, up or "+z")
     check_solids(parts, units)
     with pieces_budget(seconds):
         # the overlap check runs beside the derivation where the sweeps would take two cores
@@ -466,12 +526,14 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
                     if turn else ""
                 raise ExecutorError(f"{source}: {doubt}{turned_by}")
             found = _chosen_pose(parts, (source, out), (config, data, up), options, found, (turn, place))
-        written, why, mapped, cell = write_folder(found.derived, found.cell, found.mapped, found.settings, source.stem,
+        settings = replace(found.settings, left_out=(leave.label, tuple(dropped)))
+        written, why, mapped, cell = write_folder(found.derived, found.cell, found.mapped, settings, source.stem,
                                                   out, found.removable)
     assumed, derived = found.assumed, found.derived
     assumed.append(budget_assumption(seconds))
     assumed[found.near:found.near] = near_miss_assumption(derived, mesh_pieces(out, written))
-    assumed[2:2] = coarse_assumption(parts, options.max_triangles)  # after the up and the placement
+    # after the up and the placement
+    assumed[2:2] = [*leave.assumption(dropped), *coarse_assumption(parts, options.max_triangles)]
     tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
     suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, found.settings.moved,
@@ -585,7 +647,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
     parser.add_argument("--config", type=Path, metavar="FILE",
-                        help="TOML: base part, up, trays, names, fixed_to, place, turn")
+                        help="TOML: base part, up, trays, names, fixed_to, place, turn, leave_out")
     parser.add_argument("--up", type=up_axis, metavar="AXIS",
                         help=f"the CAD's axis pointing up, {', '.join(UP_AXES)} (over the config's up; default +z, "
                              "and a product whose base looks drawn with another axis up is refused); a negative "
@@ -598,6 +660,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--turn", type=turn_degrees, metavar="DEG",
                         help="the product turned about z on the table, 0, 90, 180 or 270 [deg] (over the config's "
                              "turn; default: as drawn, or a turn and place where the arm reaches more insertions)")
+    parser.add_argument("--leave-out", type=part_names, metavar="NAME[,NAME...]",
+                        help="parts of the CAD to leave out, by id or fnmatch pattern on ids (screw_*), over the "
+                             "config's leave_out; dropped as read, before the triangle bound and every check")
     parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
@@ -612,7 +677,7 @@ def main(argv: list[str]) -> int:
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
     done = run_import(args.source, args.out, args.units, args.config,
                       ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place, args.up,
-                                    args.turn))
+                                    args.turn, args.leave_out))
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; " + "; ".join(done.assumed))

@@ -32,6 +32,7 @@ stretch the two share: :func:`executor.cad.fits.threads.screwed_pairs`,
 from __future__ import annotations
 
 import contextlib
+import fnmatch
 import gc
 import io
 import itertools
@@ -40,7 +41,7 @@ import multiprocessing
 import multiprocessing.connection
 import re
 import traceback
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import BinaryIO
@@ -219,13 +220,43 @@ def part_id(name: str, source: str) -> str:
     return candidate
 
 
-def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
+_LISTED = 8
+"""The part ids an unmatched ``leave_out`` name lists (the others counted)."""
+
+Kept = Callable[[list[str]], set[str]]
+"""Of a product's part ids, as read and before any is tessellated or counted, those to keep."""
+
+
+def left_out(ids: Sequence[str], names: Sequence[str], setting: str) -> set[str]:
+    """The ``ids`` one of ``names`` matches (a part id or an ``fnmatch`` pattern on ids,
+    ``screw_*``; compared in lower case, as ids are made: :func:`part_id`); ExecutorError
+    naming ``setting`` when a name matches no id (listing a few) or every id matches."""
+    matched: set[str] = set()
+    for name in names:
+        hits = fnmatch.filter(ids, name.strip().lower())
+        if not hits:
+            listed = ", ".join(sorted(set(ids))[:_LISTED])
+            more = f" and {len(set(ids)) - _LISTED} more" if len(set(ids)) > _LISTED else ""
+            raise ExecutorError(f"{setting}: {name!r} matches no part (expected a part id or a pattern such as "
+                                f"'screw_*' on the ids: {listed}{more})")
+        matched.update(hits)
+    if matched == set(ids):
+        raise ExecutorError(f"{setting}: every part left out (expected some part kept)")
+    return matched
+
+
+def load_meshes(folder: Path, units: str, max_triangles: int = MAX_TRIANGLES,
+                kept: Kept | None = None) -> list[CadPart]:
     """Every ``*.stl``/``*.obj`` of ``folder`` as a part, scaled by ``units`` to metres,
     its vertices merged by position (:data:`MERGE_DIGITS`); ExecutorError naming the file when the files hold
-    more than ``max_triangles`` together or a coordinate is not finite."""
+    more than ``max_triangles`` together or a coordinate is not finite; only the files whose
+    ids ``kept`` keeps are counted and read (None: all)."""
     files = sorted(p for p in folder.iterdir() if p.suffix.lower() in MESH_SUFFIXES)
     if not files:
         raise ExecutorError(f"{folder}: no mesh files (expected *.stl or *.obj, one per part)")
+    if kept is not None:
+        keep = kept([part_id(path.stem, str(path)) for path in files])
+        files = [path for path in files if part_id(path.stem, str(path)) in keep]
     parts: list[CadPart] = []
     total = 0
     for path in files:

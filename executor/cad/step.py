@@ -38,6 +38,7 @@ from executor.cad.parts import (
     STEP_DEFLECTION,
     CadPart,
     Cylinder,
+    Kept,
     count_triangles,
     part_id,
 )
@@ -62,10 +63,11 @@ _NAMED = 6
 """The parts named in :func:`coarse_assumption` (the others counted)."""
 
 
-def load_step(path: Path, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
+def load_step(path: Path, max_triangles: int = MAX_TRIANGLES, kept: Kept | None = None) -> list[CadPart]:
     """The leaves of the STEP assembly at ``path`` as parts; ExecutorError naming the file
     when it is not a readable STEP file, a record of it failed (:func:`_failure`), it
-    holds no solid or its parts' tessellations hold more than ``max_triangles`` together."""
+    holds no solid or its parts' tessellations hold more than ``max_triangles`` together;
+    only the leaves whose ids ``kept`` keeps are tessellated and counted (None: all)."""
     from OCP.collections import Sequence_TDF_Label
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPCAFControl import STEPCAFControl_Reader
@@ -95,6 +97,11 @@ def load_step(path: Path, max_triangles: int = MAX_TRIANGLES) -> list[CadPart]:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
     names = _unique_names([names for names, _ in leaves])
     shapes = [(f"{path}#{name}", shape) for name, (_, shape) in zip(names, leaves, strict=True)]
+    if kept is not None:
+        keep = kept([part_id(name, source) for name, (source, _) in zip(names, shapes, strict=True)])
+        chosen = [k for k, (name, (source, _)) in enumerate(zip(names, shapes, strict=True))
+                  if part_id(name, source) in keep]
+        names, shapes = [names[k] for k in chosen], [shapes[k] for k in chosen]
     coarse = _tessellate_within(shapes, max_triangles)
     parts: list[CadPart] = []
     for name, (source, shape) in zip(names, shapes, strict=True):

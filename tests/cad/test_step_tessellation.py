@@ -95,3 +95,17 @@ def test_a_part_number_gives_a_part_id() -> None:
     assert part_id("01_02_01-block_Standard", "cutting_unit.step") == "part_01_02_01_block_standard"
     with pytest.raises(ExecutorError, match="gives no part id"):
         part_id("_block", "cutting_unit.step")
+
+
+def test_a_step_leaf_left_out_is_neither_tessellated_nor_counted(ball_step: Path) -> None:
+    pin = {part.id: part for part in load_step(ball_step)}["pin"]
+    bound = len(pin.mesh.faces)  # the block alone passes it at its coarsest: above
+    seen: list[list[str]] = []
+
+    def kept(ids: list[str]) -> set[str]:
+        seen.append(ids)
+        return {"pin"}
+
+    parts = load_step(ball_step, bound, kept)
+    assert seen == [["block", "pin"]] and [part.id for part in parts] == ["pin"]
+    assert len(parts[0].mesh.faces) == bound and parts[0].coarse_faces == 0

@@ -23,7 +23,8 @@ class Settings:
     """What the import file states: the ``base`` part, the ``trays`` [m], part ``names``,
     the CAD's axis pointing ``up`` (:func:`executor.cad.parts.turned`), the ``turn`` [deg]
     about z the product was then given (:func:`executor.cad.parts.quarter_turned`) and the
-    offset (x, y, z) [m] every part was then ``moved`` by into the cell (:func:`executor.cad.cli.placement`)."""
+    offset (x, y, z) [m] every part was then ``moved`` by into the cell (:func:`executor.cad.cli.placement`);
+    ``left_out``: the setting that left parts of the CAD out and their ids (none: no part left out)."""
 
     base: str
     trays: dict[str, tuple[float, float]]
@@ -31,6 +32,7 @@ class Settings:
     up: str = "+z"
     moved: tuple[float, float, float] = (0.0, 0.0, 0.0)
     turn: int = 0
+    left_out: tuple[str, tuple[str, ...]] = ("", ())
 
 
 def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[str, str]) -> str:
@@ -48,7 +50,9 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
         frame += (", moved by ({}, {}, {}) mm from {} (the base's centre to place, the product's lowest "
                   "point to the floor, z = 0, or place's z)").format(*(f"{1000 * v:.3f}" for v in settings.moved),
                                                                    "there" if settings.turn else "the CAD frame")
+    setting, dropped = settings.left_out
     lines = [f"# Imported from {title} by ./run.sh import: parts in {frame} [m].",
+             *([f"# Parts of {title} left out as set ({setting}): {', '.join(dropped)}."] if dropped else []),
              f"name = {json.dumps(title)}", ""]
     for pid in sorted(derived.parts):
         role = "base" if pid == derived.base else "peg" if pid in pegs else roles.get(pid, "part")
