@@ -656,7 +656,7 @@ def test_each_switch_hanging_through_a_slot_of_the_case_top_is_found_in_that_slo
     # indicator was put in the small rocker's slot and the small rocker in none.
     folder = CORPUS / "nop_rocker_switches"
     truth = tomllib.loads((folder / "truth.toml").read_text())
-    derived = derive(load_source(folder / "meshes", "mm"), truth["base"], {})
+    derived = derive(load_source(folder / "meshes", "mm")[0], truth["base"], {})
     found = {fit.part: fit.position for fit in derived.holes.values() if fit.part is not None}
     want = {pid: tuple(v / 1000 for v in truth["features"][part["in"]]["axis_point"][:2])
             for pid, part in truth["parts"].items()}
@@ -696,7 +696,7 @@ def test_a_knob_on_a_d_shaft_and_the_nut_on_the_thread_under_it_are_each_on_a_pi
     # and the D, whose centroid lies 0.513 mm off the axis, an empty pin of its own.
     folder = CORPUS / "nop_pot_knob"
     truth = tomllib.loads((folder / "truth.toml").read_text())
-    derived = derive(load_source(folder / "meshes", "mm"), truth["base"], {})
+    derived = derive(load_source(folder / "meshes", "mm")[0], truth["base"], {})
     on = {pid: pin.id for pin in derived.pins.values() for pid in pin.parts}
     assert set(on) == set(truth["parts"]) and len(set(on.values())) == len(on) == len(derived.pins), derived.pins
     axes = {pid: truth["features"][part["in"]]["axis_point"][:2] for pid, part in truth["parts"].items()}  # mm
