@@ -629,13 +629,14 @@ def test_the_pressed_bearing_is_pressed_in_by_hand_and_every_plan_leaves_its_sea
 
 
 @pytest.mark.slow  # the first test of a product imports it
+@pytest.mark.parametrize("name", ["cubefactory_cutting_unit"])  # one unit of work with its other tests
 def test_the_bearings_spacer_and_cover_are_planned_into_the_one_bore_of_the_housing_in_their_order(
-        corpus_import: Callable[[str], Imported]) -> None:
+        corpus_import: Callable[[str], Imported], name: str) -> None:
     # cubefactory_cutting_unit: bearing_b, the spacer, bearing_a and the cover's spigot stand
     # in the housing's d 47 bore along y, one hole holding the four (its capacity); the
     # planner puts each into it after the ones the precedence puts before it. Written once
     # per part's level, the bore was four holes, each bolt hole beside it four too.
-    done = corpus_import("cubefactory_cutting_unit")
+    done = corpus_import(name)
     bore = _feature_holes(done)["bore"]
     assert done.occupants[bore] == {"bearing_b", "spacer", "bearing_a", "cover"}
     assert tomllib.loads((done.out / "assembly.toml").read_text())["holes"][bore]["capacity"] == 4
