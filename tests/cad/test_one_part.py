@@ -110,3 +110,12 @@ def test_one_part_on_a_mesh_folder_is_one_line_naming_it(tmp_path: Path, run_mai
     trimesh.creation.box((100, 100, 20)).export(tmp_path / "cad" / "plate.stl")
     line = _one_line(run_main("import", "cad", "--out", "out", "--one-part", "bearing", cwd=tmp_path))
     assert "--one-part: cad is a folder of meshes, each file one part already" in line
+
+
+@pytest.mark.slow  # build123d writes the STEP file (about 5 s)
+def test_the_flag_is_over_the_setting_and_named_in_its_errors(bearing_step: Path, tmp_path: Path,
+                                                              run_main: Runner) -> None:
+    (tmp_path / "import.toml").write_text('one_part = ["bearing"]\n')
+    line = _one_line(run_main("import", str(bearing_step), "--out", "out", "--config", "import.toml",
+                              "--one-part", "bearing,motor*", cwd=tmp_path))
+    assert "--one-part: 'motor*' matches no sub-assembly" in line
