@@ -69,6 +69,7 @@ from executor.cad.parts import (
     check_solids,
     left_out,
     load_meshes,
+    matching,
     overlaps_checked,
     quarter_turned,
     translated,
@@ -133,14 +134,15 @@ def part_names(text: str) -> tuple[str, ...]:
     return names
 
 
-def _leave_out_setting(path: Path | None, value: object) -> tuple[str, ...]:
-    """``leave_out`` of ``--config``, the part ids or patterns to leave out (none when not
-    set); ExecutorError naming the file when it is no list of non-empty strings."""
+def _names_setting(path: Path | None, key: str, value: object, example: str = "part ids or patterns "
+                   "([\"hopper\", \"screw_*\"])") -> tuple[str, ...]:
+    """``key`` of ``--config``, ids or patterns (``leave_out``, ``one_part``; none when not
+    set); ExecutorError naming the file and ``key`` when it is no list of non-empty strings
+    (``example``: what is expected)."""
     if value is None:
         return ()
     if not (isinstance(value, list) and all(isinstance(v, str) and v.strip() for v in value)):
-        raise ExecutorError(f"{path}: leave_out: expected a list of part ids or patterns "
-                            f"([\"hopper\", \"screw_*\"]), got {shorten(repr(value))}")
+        raise ExecutorError(f"{path}: {key}: expected a list of {example}, got {shorten(repr(value))}")
     return tuple(value)
 
 
@@ -170,6 +172,35 @@ class LeaveOut:
         count = f"{len(ids)} part{'s' if len(ids) > 1 else ''}"
         return [f"parts left out as set ({self.label}): {', '.join(ids)} ({count}; dropped as read, before any "
                 "check: their triangles, overlaps and fits do not count)"]
+
+
+@dataclass(frozen=True)
+class OnePart:
+    """The STEP sub-assemblies each imported as one part (:func:`executor.cad.step.load_step`):
+    their ids or ``fnmatch`` patterns on them (:func:`executor.cad.parts.matching`), the
+    ``setting`` that names them as errors name it (``--one-part``, or ``<file>: one_part``)
+    and as the assumption names it (``label``)."""
+
+    names: tuple[str, ...] = ()
+    setting: str = "--one-part"
+    label: str = "--one-part"
+
+    def chosen(self, solids: dict[str, int], joined: dict[str, int]) -> set[str]:
+        """Of the sub-assemblies' ids (each with its solids), those the names match, these
+        added to ``joined``; ExecutorError naming the setting when a name matches none."""
+        hits = matching(sorted(solids), self.names, self.setting, "sub-assembly")
+        joined.update({ident: solids[ident] for ident in sorted(hits)})
+        return hits
+
+    def assumption(self, joined: dict[str, int], ids: set[str]) -> list[str]:
+        """The assumption of the sub-assemblies ``joined`` that are parts of ``ids`` (not
+        within another joined, nor left out; none without one)."""
+        listed = [f"{ident} ({count} solid{'s' if count > 1 else ''})" for ident, count in joined.items()
+                  if ident in ids]
+        if not listed:
+            return []
+        return [f"STEP sub-assemblies imported as one part as set ({self.label}): {', '.join(listed)} (each its "
+                "solids' meshes joined into one, their cylinders kept)"]
 
 
 def _up_assumption(up: str | None) -> str:
@@ -441,17 +472,23 @@ def mapped_report(mapped: Mapped) -> list[str]:
 
 
 
-def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES,
-                leave: LeaveOut = LeaveOut()) -> tuple[list[CadPart], list[str]]:
+def load_source(source: Path, units: str, max_triangles: int = MAX_TRIANGLES, leave: LeaveOut = LeaveOut(),
+                one: OnePart = OnePart(), joined: dict[str, int] | None = None) -> tuple[list[CadPart], list[str]]:
     """The parts of a mesh folder or a STEP file (``units`` applies to meshes only), of at
-    most ``max_triangles`` together, but those ``leave`` leaves out, and the ids of these
-    (sorted; ExecutorError naming its setting when a name matches none)."""
+    most ``max_triangles`` together, the STEP sub-assemblies ``one`` names each one part
+    (their ids and solids added to ``joined``), but those ``leave`` leaves out, and the ids
+    of these (sorted; ExecutorError naming its setting when a name matches none, or when
+    ``one`` names any for a mesh folder)."""
     dropped: list[str] = []
     keep = functools.partial(leave.kept, dropped=dropped) if leave.names else None
+    whole = functools.partial(one.chosen, joined={} if joined is None else joined) if one.names else None
     if source.is_dir():
+        if whole is not None:
+            raise ExecutorError(f"{one.setting}: {source} is a folder of meshes, each file one part already "
+                                "(expected a STEP file, whose sub-assemblies it names)")
         return load_meshes(source, units, max_triangles, keep), dropped
     if source.suffix.lower() in STEP_SUFFIXES and source.is_file():
-        return load_step(source, max_triangles, keep), dropped
+        return load_step(source, max_triangles, keep, whole), dropped
     raise ExecutorError(f"{source}: expected a folder of *.stl/*.obj meshes or a STEP file (*.step, *.stp)")
 
 
@@ -483,6 +520,7 @@ class ImportOptions:
     over a product another import or a person wrote (:func:`executor.cad.write.manifest.claim_folder`);
     ``place`` [m]: where the base's centre goes in the cell (and the product's lowest point's height), over the config's
     (:func:`placement`); ``leave_out``: the parts to leave out, over the config's (None: the config's);
+    ``one_part``: the STEP sub-assemblies each imported as one part, over the config's (None: the config's);
     ``turn`` [deg]: the product's turn about z, over the config's (None:
     the config's, else chosen, :func:`_chosen_pose`); ``up``: the CAD's axis pointing up, over the config's
     (:func:`executor.cad.parts.turned`; None: the config's, else +z and :func:`drawn_up` checked)."""
@@ -494,6 +532,7 @@ class ImportOptions:
     up: str | None = None
     turn: int | None = None
     leave_out: tuple[str, ...] | None = None
+    one_part: tuple[str, ...] | None = None
 
 
 def run_import(source: Path, out: Path, units: str, config: Path | None,
@@ -510,9 +549,14 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     place = options.place or _place_setting(config, data.get("place"))
     turn = options.turn if options.turn is not None else _turn_setting(config, data.get("turn"))
     leave = (LeaveOut(options.leave_out, base=data.get("base")) if options.leave_out is not None
-             else LeaveOut(_leave_out_setting(config, data.get("leave_out")), f"{config}: leave_out",
+             else LeaveOut(_names_setting(config, "leave_out", data.get("leave_out")), f"{config}: leave_out",
                            f"leave_out in {config}", data.get("base")))
-    read, dropped = load_source(source, units, options.max_triangles, leave)
+    one = (OnePart(options.one_part) if options.one_part is not None
+           else OnePart(_names_setting(config, "one_part", data.get("one_part"),
+                                       "sub-assembly ids or patterns ([\"deep_groove_ball_bearing*\"])"),
+                        f"{config}: one_part", f"one_part in {config}"))
+    joined: dict[str, int] = {}
+    read, dropped = load_source(source, units, options.max_triangles, leave, one, joined)
     parts = turned(read, up or "+z")
     check_solids(parts, units)
     with pieces_budget(seconds):
@@ -533,7 +577,8 @@ def run_import(source: Path, out: Path, units: str, config: Path | None,
     assumed.append(budget_assumption(seconds))
     assumed[found.near:found.near] = near_miss_assumption(derived, mesh_pieces(out, written))
     # after the up and the placement
-    assumed[2:2] = [*leave.assumption(dropped), *coarse_assumption(parts, options.max_triangles)]
+    assumed[2:2] = [*one.assumption(joined, {part.id for part in read}), *leave.assumption(dropped),
+                    *coarse_assumption(parts, options.max_triangles)]
     tools = {pid: tool_of(cell, fit) for pid, fit in sorted(cell.hole_of.items())}
     suction = {pid: reason for pid, (tool, reason) in tools.items() if tool == "suction"}
     return Imported(derived, mapped, assumed, why, written, time.perf_counter() - started, found.settings.moved,
@@ -647,7 +692,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--units", choices=list(UNITS), default="mm",
                         help="length unit of mesh files (default mm; a STEP file states its own)")
     parser.add_argument("--config", type=Path, metavar="FILE",
-                        help="TOML: base part, up, trays, names, fixed_to, place, turn, leave_out")
+                        help="TOML: base part, up, trays, names, fixed_to, place, turn, leave_out, one_part")
     parser.add_argument("--up", type=up_axis, metavar="AXIS",
                         help=f"the CAD's axis pointing up, {', '.join(UP_AXES)} (over the config's up; default +z, "
                              "and a product whose base looks drawn with another axis up is refused); a negative "
@@ -663,6 +708,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--leave-out", type=part_names, metavar="NAME[,NAME...]",
                         help="parts of the CAD to leave out, by id or fnmatch pattern on ids (screw_*), over the "
                              "config's leave_out; dropped as read, before the triangle bound and every check")
+    parser.add_argument("--one-part", type=part_names, metavar="NAME[,NAME...]",
+                        help="STEP sub-assemblies each imported as one part (a bearing, a motor), by id or fnmatch "
+                             "pattern on ids, over the config's one_part; its solids' meshes joined into one")
     parser.add_argument("--locating-reach", type=number_in(float, 0.0, MAX_REACH), default=LOCATING_REACH,
                         metavar="R", help="the locating rule: a part that one other part alone keeps from moving "
                                           f"R [m] sideways goes after it (default {LOCATING_REACH:g}; 0: off)")
@@ -677,7 +725,7 @@ def main(argv: list[str]) -> int:
         raise ExecutorError(f"{args.source}: no such file or folder (expected a STEP file or a mesh folder)")
     done = run_import(args.source, args.out, args.units, args.config,
                       ImportOptions(args.locating_reach, args.max_triangles, args.replace, args.place, args.up,
-                                    args.turn, args.leave_out))
+                                    args.turn, args.leave_out, args.one_part))
     derived, why = done.derived, done.why
     units = "the STEP file's" if args.source.is_file() else args.units
     print(f"assumes: units {units}; " + "; ".join(done.assumed))

@@ -221,25 +221,32 @@ def part_id(name: str, source: str) -> str:
 
 
 _LISTED = 8
-"""The part ids an unmatched ``leave_out`` name lists (the others counted)."""
+"""The ids an unmatched ``leave_out`` or ``one_part`` name lists (the others counted)."""
 
 Kept = Callable[[list[str]], set[str]]
 """Of a product's part ids, as read and before any is tessellated or counted, those to keep."""
 
 
-def left_out(ids: Sequence[str], names: Sequence[str], setting: str) -> set[str]:
-    """The ``ids`` one of ``names`` matches (a part id or an ``fnmatch`` pattern on ids,
+def matching(ids: Sequence[str], names: Sequence[str], setting: str, what: str = "part") -> set[str]:
+    """The ``ids`` one of ``names`` matches (an id or an ``fnmatch`` pattern on ids,
     ``screw_*``; compared in lower case, as ids are made: :func:`part_id`); ExecutorError
-    naming ``setting`` when a name matches no id (listing a few) or every id matches."""
+    naming ``setting`` when a name matches no id (listing a few, each one ``what``)."""
     matched: set[str] = set()
     for name in names:
         hits = fnmatch.filter(ids, name.strip().lower())
         if not hits:
-            listed = ", ".join(sorted(set(ids))[:_LISTED])
+            listed = ", ".join(sorted(set(ids))[:_LISTED]) or "none"
             more = f" and {len(set(ids)) - _LISTED} more" if len(set(ids)) > _LISTED else ""
-            raise ExecutorError(f"{setting}: {name!r} matches no part (expected a part id or a pattern such as "
+            raise ExecutorError(f"{setting}: {name!r} matches no {what} (expected a {what} id or a pattern such as "
                                 f"'screw_*' on the ids: {listed}{more})")
         matched.update(hits)
+    return matched
+
+
+def left_out(ids: Sequence[str], names: Sequence[str], setting: str) -> set[str]:
+    """The ``ids`` one of ``names`` matches (:func:`matching`); ExecutorError naming
+    ``setting`` when a name matches no id or every id matches."""
+    matched = matching(ids, names, setting)
     if matched == set(ids):
         raise ExecutorError(f"{setting}: every part left out (expected some part kept)")
     return matched

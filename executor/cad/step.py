@@ -12,6 +12,11 @@ of one name (a sub-assembly placed twice) are told apart by their assemblies' na
 leaves of one name in one assembly (a bearing's balls) are numbered. The triangles a
 face's degenerate edge leaves (a sphere's poles) are dropped: the mesh stays closed.
 
+A sub-assembly the user names (``one_part``: a bought part, a bearing of rings, balls and
+shields) is one part instead of its leaves: their shapes as one compound, so its mesh is
+the union of their closed meshes and its cylinders theirs, named as a leaf in its place
+would be (its path's names, told apart among the sub-assemblies as leaves are).
+
 A file whose reading Open CASCADE reports a failure for (a syntax error, a reference to a
 missing record, a record with the wrong parameters: its reader goes on without the
 record, which can rename a part or drop its placement) is refused, naming the record
@@ -24,7 +29,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -62,12 +67,21 @@ it, the name Open CASCADE gives a component whose own is blank."""
 _NAMED = 6
 """The parts named in :func:`coarse_assumption` (the others counted)."""
 
+Whole = Callable[[dict[str, int]], set[str]]
+"""Of a STEP file's sub-assemblies' ids, each with the solids (leaves) it holds, those each
+imported as one part."""
+Node = tuple[tuple[str, ...], int, int]
+"""A sub-assembly as :func:`_collect` finds it: the names from the root down to it, and the
+range of its leaves among all (first, past the last)."""
 
-def load_step(path: Path, max_triangles: int = MAX_TRIANGLES, kept: Kept | None = None) -> list[CadPart]:
-    """The leaves of the STEP assembly at ``path`` as parts; ExecutorError naming the file
+
+def load_step(path: Path, max_triangles: int = MAX_TRIANGLES, kept: Kept | None = None,
+              whole: Whole | None = None) -> list[CadPart]:
+    """The leaves of the STEP assembly at ``path`` as parts, each sub-assembly ``whole``
+    chooses as one part (:func:`_joined`; None: none); ExecutorError naming the file
     when it is not a readable STEP file, a record of it failed (:func:`_failure`), it
     holds no solid or its parts' tessellations hold more than ``max_triangles`` together;
-    only the leaves whose ids ``kept`` keeps are tessellated and counted (None: all)."""
+    only the parts whose ids ``kept`` keeps are tessellated and counted (None: all)."""
     from OCP.collections import Sequence_TDF_Label
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.STEPCAFControl import STEPCAFControl_Reader
@@ -91,12 +105,15 @@ def load_step(path: Path, max_triangles: int = MAX_TRIANGLES, kept: Kept | None 
     roots = Sequence_TDF_Label()
     tool.GetFreeShapes(roots)
     leaves: list[tuple[tuple[str, ...], Any]] = []
+    nodes: list[Node] = []
     for k in range(1, roots.Length() + 1):
-        _collect(tool, roots.Value(k), None, (_name(roots.Value(k)) or path.stem,), leaves)
+        _collect(roots.Value(k), None, (_name(roots.Value(k)) or path.stem,), leaves, nodes)
     if not leaves:
         raise ExecutorError(f"{path}: no solid parts in the STEP file")
     names = _unique_names([names for names, _ in leaves])
     shapes = [(f"{path}#{name}", shape) for name, (_, shape) in zip(names, leaves, strict=True)]
+    if whole is not None:
+        names, shapes = _joined(path, (names, shapes), nodes, whole)
     if kept is not None:
         keep = kept([part_id(name, source) for name, (source, _) in zip(names, shapes, strict=True)])
         chosen = [k for k, (name, (source, _)) in enumerate(zip(names, shapes, strict=True))
@@ -110,6 +127,32 @@ def load_step(path: Path, max_triangles: int = MAX_TRIANGLES, kept: Kept | None 
                              functools.partial(_mesh, shape, source, angle=COARSE_ANGLE), rough,
                              STEP_DEFLECTION if coarse is None or not rough else coarse))
     return parts
+
+
+def _joined(path: Path, parts: tuple[list[str], list[tuple[str, Any]]], nodes: list[Node],
+            whole: Whole) -> tuple[list[str], list[tuple[str, Any]]]:
+    """The ``parts`` (the leaves' names and ``(source, shape)`` pairs), the leaves of each
+    sub-assembly of ``nodes`` that ``whole`` chooses replaced by one part in their place:
+    their shapes as one compound, named after the sub-assembly (:func:`_unique_names` among
+    the sub-assemblies); one chosen within another chosen is part of that one."""
+    names, shapes = parts
+    ordered = sorted(nodes, key=lambda node: (node[1], -node[2]))  # each before those within it
+    titles = _unique_names([route for route, _, _ in ordered])
+    ids = [part_id(title, f"{path}#{title}") for title in titles]
+    chosen = whole({ident: end - start for ident, (_, start, end) in zip(ids, ordered, strict=True)})
+    joined_names: list[str] = []
+    joined_shapes: list[tuple[str, Any]] = []
+    done = 0  # the leaves before it placed
+    for ident, title, (_, start, end) in zip(ids, titles, ordered, strict=True):
+        if ident not in chosen or start < done:
+            continue
+        compound = _compound([shape for _, shape in shapes[start:end]])
+        joined_names += [*names[done:start], title]
+        joined_shapes += [*shapes[done:start], (f"{path}#{title}", compound)]
+        done = end
+    joined_names += names[done:]
+    joined_shapes += shapes[done:]
+    return joined_names, joined_shapes
 
 
 def _tessellate_within(shapes: list[tuple[str, Any]], max_triangles: int) -> float | None:
@@ -258,11 +301,12 @@ def _unique_names(paths: list[tuple[str, ...]]) -> list[str]:
             depth[k] += 1
 
 
-def _collect(tool: object, label: Any, location: Any, path: tuple[str, ...],
-             leaves: list[tuple[tuple[str, ...], Any]]) -> None:
+def _collect(label: Any, location: Any, path: tuple[str, ...], leaves: list[tuple[tuple[str, ...], Any]],
+             nodes: list[Node]) -> None:
     """Append ``(names from the root, located shape)`` for every leaf under ``label``
-    (``path``: the names down to it); ``location`` is the placement of ``label`` in the
-    product (None at a root)."""
+    (``path``: the names down to it) to ``leaves``, and each sub-assembly under it holding
+    a leaf, ``label`` too when it is one but no root, to ``nodes``; ``location`` is the
+    placement of ``label`` in the product (None at a root)."""
     from OCP.collections import Sequence_TDF_Label
     from OCP.TDF import TDF_Label
     from OCP.TopLoc import TopLoc_Location
@@ -272,13 +316,16 @@ def _collect(tool: object, label: Any, location: Any, path: tuple[str, ...],
     referred = TDF_Label()
     definition = referred if XCAFDoc_ShapeTool.GetReferredShape_s(label, referred) else label
     if XCAFDoc_ShapeTool.IsAssembly_s(definition):
+        first = len(leaves)
         children = Sequence_TDF_Label()
         XCAFDoc_ShapeTool.GetComponents_s(definition, children, False)
         for k in range(1, children.Length() + 1):
             child = children.Value(k)
             placement = here.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(child))
             name = _component_name(child) or _name(definition) or f"{path[-1]}_{k}"
-            _collect(tool, child, placement, (*path, name), leaves)
+            _collect(child, placement, (*path, name), leaves, nodes)
+        if location is not None and len(leaves) > first:
+            nodes.append((path, first, len(leaves)))
         return
     shape = XCAFDoc_ShapeTool.GetShape_s(definition)
     leaves.append((path, shape.Located(here.Multiplied(shape.Location()))))
@@ -319,16 +366,16 @@ def _faces(shape: Any, exact: bool) -> list[Any]:
     return found
 
 
-def _compound(faces: list[Any]) -> Any:
-    """The faces as one compound shape."""
+def _compound(shapes: list[Any]) -> Any:
+    """The shapes (faces, solids) as one compound shape."""
     from OCP.BRep import BRep_Builder
     from OCP.TopoDS import TopoDS_Compound
 
     compound = TopoDS_Compound()
     builder = BRep_Builder()
     builder.MakeCompound(compound)
-    for face in faces:
-        builder.Add(compound, face)
+    for shape in shapes:
+        builder.Add(compound, shape)
     return compound
 
 

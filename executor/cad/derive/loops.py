@@ -61,7 +61,7 @@ def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float,
     level tried has one. The levels tried are the middles of the spans between the owner's
     vertices near the part's centre line (within twice the part's reach across it) along
     the axis, where both reach, :data:`HOLE_LEVELS` longest first: an owner's slice changes
-    only at its vertices' levels."""
+    only at its vertices' levels. Of the owner's holes holding the part, the smallest."""
     along, owner_along = part.mesh.vertices @ axis, owner.mesh.vertices @ axis
     low, high = max(along.min(), owner_along.min()), min(along.max(), owner_along.max())
     if high - low <= 1e-6:
@@ -80,7 +80,9 @@ def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float,
         loops = slice_loops(owner.mesh, axis, level)
         cut = slice_loops(part.mesh, axis, level)
         own = [o for o in cut if outer(o, cut)]
-        for loop in (o for o in loops if not outer(o, loops)):
+        # smallest first: of a part of several shells (a bearing's rings and balls) the
+        # innermost hole around the part (the inner ring's bore, not the outer ring's inside)
+        for loop in sorted((o for o in loops if not outer(o, loops)), key=lambda o: o.area):
             inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
             if len(inside) == 1 and not (roomy(loop, inside[0]) and open_box(
                     loop.points, loop.extent[1], inside[0].extent[0], inside[0].centre, owner.mesh,
