@@ -34,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import fnmatch
 import gc
+import hashlib
 import io
 import itertools
 import math
@@ -208,12 +209,22 @@ def quarter_turned(parts: list[CadPart], turn: int) -> list[CadPart]:
     return _mapped(parts, turn_xy, turn_xy)
 
 
+PART_ID_CHARS = 48
+"""The longest part id the import makes from a name: the ids of a part's features add to
+it (``_hole12``, ``_pin3``) within the 64 characters of an id."""
+
+
 def part_id(name: str, source: str) -> str:
     """An ASP constant from a file stem or a STEP name (lower case, ``_`` for other
-    characters, ``part_`` before a leading digit: a part number, ``01_02_01-block``);
-    ExecutorError naming ``source`` when none can be made."""
+    characters, ``part_`` before a leading digit: a part number, ``01_02_01-block``; one
+    longer than :data:`PART_ID_CHARS` cut to its first 39 characters and 8 hex digits of
+    its SHA-1, so that names alike to their end stay apart); ExecutorError naming
+    ``source`` when none can be made."""
     candidate = re.sub(r"[^a-z0-9_]", "_", name.strip().lower())
     candidate = f"part_{candidate}" if candidate[:1].isdigit() else candidate
+    if len(candidate) > PART_ID_CHARS:
+        digest = hashlib.sha1(candidate.encode()).hexdigest()[:8]
+        candidate = f"{candidate[:PART_ID_CHARS - 9]}_{digest}"
     if not is_id(candidate):
         raise ExecutorError(f"{source}: part name {name!r} gives no part id (expected a letter first, "
                             "then letters, digits or _)")

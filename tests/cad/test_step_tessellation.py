@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bridge.product.tables import is_id
 from executor import ExecutorError
 from executor.cad.cli import ImportOptions, run_import
 from executor.cad.parts import STEP_DEFLECTION, part_id
@@ -95,6 +96,15 @@ def test_a_part_number_gives_a_part_id() -> None:
     assert part_id("01_02_01-block_Standard", "cutting_unit.step") == "part_01_02_01_block_standard"
     with pytest.raises(ExecutorError, match="gives no part id"):
         part_id("_block", "cutting_unit.step")
+
+
+def test_a_long_name_gives_a_part_id_its_features_ids_fit_after() -> None:
+    # SolidWorks' names: 62 characters made a bearing's hole id (`..._hole1`) too long for an id
+    long = "01_02_05-deep_groove_ball_bearing_fag_6005_2z_standard_skf_iso"
+    first, second = part_id(long + "_1", "unit.step"), part_id(long + "_2", "unit.step")
+    assert first.startswith("part_01_02_05_deep_groove_ball_bearing") and len(first) == 48
+    assert first != second and first == part_id(long + "_1", "other.step")
+    assert is_id(f"{first}_hole12") and not is_id(f"part_{long.replace('-', '_')}_1_hole12")
 
 
 def test_a_step_leaf_left_out_is_neither_tessellated_nor_counted(ball_step: Path) -> None:
