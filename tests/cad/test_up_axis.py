@@ -326,6 +326,7 @@ def test_a_product_drawn_upside_down_with_more_parts_going_up_than_down_is_refus
     assert not (tmp_path / "read_z_up").exists()
 
 
+@pytest.mark.slow  # two imports, one read with every other up (6 s)
 def test_a_part_hanging_beyond_the_base_across_is_still_set_on_one_face(tmp_path: Path) -> None:
     # drawn y up: the peg's flange (100 x 30 x 80 mm) on the block's top face, 20 mm beyond it along x
     # and 10 mm along z: across, less far than it stands out along +y (30 mm)
