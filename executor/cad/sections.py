@@ -26,7 +26,9 @@ cylinder the mesh does not say (a CAD kernel's vertices do, Cranfield's export's
 edges do): a round peg at least as wide as a round hole's inscribed circle, whose vertex
 circle's radius is the hole's within :data:`executor.cad.fits.faces.TOUCH`, is taken for the
 same nominal diameter, a nominal zero-clearance fit (:func:`zero_clearance`), as the
-disassembly's sliding cylinders are. A part's rect is
+disassembly's sliding cylinders are; so is a round section against a polygon whose
+vertices lie on its vertex circle where they meet, each edge between them a short chord of
+it (a hinge pin in a printed teardrop hole tangent to it). A part's rect is
 its minimum-area rectangle (it holds the part, corners and all) with the largest corner
 radius that still holds it; a hole's is the rounded rect that lies inside the loop: that
 rectangle with the least corner radius that fits, inset evenly on every side only as far
@@ -61,10 +63,10 @@ from trimesh.path.entities import Line
 from trimesh.path.exchange.misc import edges_to_path
 from trimesh.path.traversal import discretize_path, vertex_to_entity_path
 
-from executor.cad.fits.faces import TOUCH
+from executor.cad.fits.faces import SMOOTH, TOUCH
 from executor.cad.parts import Cylinder
 from executor.world.geometry import Section, section_fit
-from executor.world.polygon_fit import OutlineError, PolygonFit, polygon, turned_fit
+from executor.world.polygon_fit import OutlineError, PolygonFit, inscribed, polygon, round_fit, turned_fit
 
 MIN_ROUND_POINTS = 12
 SQUARE_TOLERANCE = 1e-5
@@ -829,16 +831,50 @@ def zero_clearance(peg: Shape2D, hole: Shape2D, room: float) -> float | None:
     fit, given the ``room`` [m] of the peg's section in the hole's
     (:func:`executor.world.geometry.margin`): both round, the peg not narrower than the
     hole's inscribed circle (else it passes with room), their vertex circles' radii within
-    :data:`executor.cad.fits.faces.TOUCH` (their difference); or a polygon on either side, or
-    rect or square both (straight sides: no deflection), that pass only with an overlap of
-    at most :data:`OUTLINE_TOUCH` all round (half the room, at most 0); None when they are
-    no such pair."""
+    :data:`executor.cad.fits.faces.TOUCH` (their difference); a round section and a polygon
+    that do not pass, the round side's vertex circle on the polygon's vertices where they
+    meet (:func:`_round_and_polygon`); or a polygon on either side, or rect or square both
+    (straight sides: no deflection), that pass only with an overlap of at most
+    :data:`OUTLINE_TOUCH` all round (half the room, at most 0); None when they are no such
+    pair."""
     if "polygon" in (peg.kind, hole.kind) or {peg.kind, hole.kind} <= STRAIGHT:
-        return room / 2 if -2 * OUTLINE_TOUCH <= room <= 0 else None
+        if -2 * OUTLINE_TOUCH <= room <= 0:
+            return room / 2
+        return _round_and_polygon(peg, hole) if {peg.kind, hole.kind} == {"round", "polygon"} and room < 0 else None
     if peg.kind != "round" or hole.kind != "round" or peg.a < hole.a:
         return None
     apart = hole.a / 2 + hole.deflection - peg.a / 2
     return apart if abs(apart) < TOUCH else None
+
+
+def _round_and_polygon(peg: Shape2D, hole: Shape2D) -> float | None:
+    """How far apart [m] a round section's vertex circle (a tessellated cylinder's own
+    circle) and a polygon are when they are a nominal zero-clearance fit, as two coaxial
+    cylinders of one radius are (:func:`zero_clearance`): a polygon peg whose corners reach
+    a round hole's vertex circle within :data:`executor.cad.fits.faces.TOUCH`; a round peg
+    in a polygon hole, on the centre of the hole's largest inscribed circle, each edge of
+    the hole that its circle crosses a chord of that circle (both its ends on it within
+    TOUCH, spanning at most :data:`executor.cad.fits.faces.SMOOTH` about its centre): the
+    tessellation of a wall the peg touches (NopSCADlib's hinge pin, d 4, in a teardrop
+    hole whose two arcs are tangent to its circle; the chords beside the tangent vertices
+    cut 2.5 µm into it), not a straight side it goes into; the nearest vertex's distance
+    from the circle, None when they are no such pair."""
+    if hole.kind == "round":
+        reach = -round_fit(polygon(peg.outline, "peg"), None).room
+        apart = hole.a / 2 + hole.deflection - reach
+        return apart if abs(apart) < TOUCH else None
+    outline = polygon(hole.outline, "hole")
+    centre = np.asarray(inscribed(outline).coords[0])
+    ends = np.asarray(outline.exterior.coords) - centre
+    radius = peg.a / 2
+    distances = np.linalg.norm(ends, axis=1)
+    for k in range(len(ends) - 1):
+        if shapely.distance(shapely.LineString(ends[k:k + 2]), shapely.Point(0.0, 0.0)) >= radius:
+            continue
+        cosine = float(ends[k] @ ends[k + 1]) / (distances[k] * distances[k + 1])
+        if np.any(np.abs(distances[k:k + 2] - radius) > TOUCH) or cosine < math.cos(SMOOTH):
+            return None
+    return float(distances.min() - radius)
 
 
 def rounded(value: float) -> float:

@@ -564,3 +564,57 @@ def test_a_slice_asked_again_within_slices_kept_is_made_once() -> None:
         assert len(sections.slice_loops(other, up, 0.0)) == 2
     again = sections.slice_loops(mesh, up, 0.0)
     assert again is not first and all(np.array_equal(a.points, b.points) for a, b in zip(again, first, strict=True))
+
+
+def _ngon(radius: float, sides: int, start: float = 0.0, centre: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """(sides, 2) [m]: the vertices of a regular ``sides``-gon on a circle of ``radius``
+    about ``centre``, the first at ``start`` [rad]."""
+    turns = start + 2 * math.pi * np.arange(sides) / sides
+    return np.stack([centre[0] + radius * np.cos(turns), centre[1] + radius * np.sin(turns)], axis=1)
+
+
+def teardrop_plus(radius: float) -> shapely.Polygon:
+    """NopSCADlib's ``teardrop_plus(r)`` as OpenSCAD draws it (layer height 0.25 mm): each
+    side an arc of a 56-gon of r + 0.117 mm about a centre 0.117 mm across the axis from the
+    far side, so the arcs are tangent inside to the circle of r at (±r, 0), the top a
+    truncated point; a hinge pin's hole."""
+    elongation = (0.125 - 1 / 128) * MM
+    right = _ngon(radius + elongation, 56, centre=(-elongation, 0.0))
+    right = right[right[:, 0] >= -1e-12]
+    top = 1.2 * radius
+    points = np.vstack([right, right * [-1.0, 1.0], [[0.3 * radius, top], [-0.3 * radius, top]]])
+    return shapely.MultiPoint(points).convex_hull
+
+
+@pytest.mark.parametrize("hole_of, peg_radius, zero", [
+    ("teardrop", 2.0, True),  # nop_flat_hinge: its pin, a 51-gon d 4, in the male's teardrop_plus(r = 2)
+    ("teardrop", 2.02, False),  # a pin 40 µm wider: an interference
+    ("hexagon", 2.003, False),  # a pin 3 µm into a hexagon's flats: straight sides, no chords of its circle
+])
+def test_a_round_peg_whose_circle_the_polygon_holes_vertices_lie_on_is_a_zero_clearance_fit(
+        hole_of: str, peg_radius: float, zero: bool) -> None:
+    # The hole's edges that the peg's circle crosses are short chords of that circle (their
+    # ends on it within TOUCH): the tessellation of a wall it touches, as two coaxial
+    # cylinders of one radius are, whose measured overlap (2.5 µm here) is no interference.
+    hole_outline = {"teardrop": teardrop_plus(2 * MM),
+                    "hexagon": shapely.Polygon(_ngon(2 * MM / math.cos(math.pi / 6), 6))}[hole_of]
+    hole = classify(loop_of(hole_outline), hole=True)
+    peg = classify(Loop(_ngon(peg_radius * MM, 51, start=-math.pi / 2) + (0.1, -0.05)), hole=False)
+    assert (hole.kind, peg.kind) == ("polygon", "round")
+    margin = sections.section_room(peg, hole).margin
+    assert margin < -2 * sections.OUTLINE_TOUCH  # more than a straight-sided pair's touch: no fit before
+    assert (sections.zero_clearance(peg, hole, margin) is not None) == zero
+    assert sections.passes(peg, hole) == zero
+
+
+@pytest.mark.parametrize("reach, zero", [(1.0, True), (1.02, False)])
+def test_a_polygon_peg_whose_corners_lie_on_a_round_holes_vertex_circle_is_a_zero_clearance_fit(
+        reach: float, zero: bool) -> None:
+    # A hexagonal peg whose corners touch a 48-gon bore's vertex circle (d 4): its inscribed
+    # circle, the hole's measure, is 8.6 µm narrower than the corners reach.
+    hole = classify(Loop(_ngon(2 * MM, 48) + (0.1, -0.05)), hole=True)
+    peg = classify(loop_of(shapely.Polygon(_ngon(2 * reach * MM, 6, start=0.1))), hole=False)
+    assert (hole.kind, peg.kind) == ("round", "polygon")
+    margin = sections.section_room(peg, hole).margin
+    assert margin < -2 * sections.OUTLINE_TOUCH
+    assert (sections.zero_clearance(peg, hole, margin) is not None) == zero

@@ -51,7 +51,8 @@ def sizes_text(derived: Derived) -> str:
 
 RULE = ("a round peg at least as wide as a round hole's inscribed circle, their vertex circles' radii within 10 {um}, "
         "or a peg and hole of a polygon section (or both rect or square) that pass with an overlap of at most "
-        "0.5 {um} all round, "
+        "0.5 {um} all round, or a round section and a polygon whose edges its vertex circle crosses are chords of "
+        "it (their ends on it within 10 {um}, at most 35 deg apart), "
         "is taken for one nominal section: a fit, room 0")
 """The stated assumption of nominal zero-clearance fits ({um}: the micrometre's symbol)."""
 
