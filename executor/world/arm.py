@@ -127,6 +127,9 @@ class Arm:
         """[rad] each joint's lower limit (the URDF's, which PyBullet enforces)."""
         self.upper = np.array([i[9] for i in info])
         """[rad] each joint's upper limit."""
+        self.rate_limit = np.array([i[11] for i in info])
+        """[rad/s] each joint's speed limit (the URDF's ``velocity``:
+        :data:`executor.world.geometry.JOINT_RATE_LIMITS`), which PyBullet does not enforce."""
         self._zeros = [0.0] * N_JOINTS
         self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         self.tare = np.zeros(6)
