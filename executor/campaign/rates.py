@@ -31,7 +31,7 @@ import pybullet as pb
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
 from executor.assembly import transfer
 from executor.assembly.product import load_product
-from executor.assembly.step import Assembler, StepRecord
+from executor.assembly.step import Assembler, StepRecord, check_product_step
 from executor.campaign.run import stdout_to_stderr
 from executor.cell_description import CellDescription
 from executor.control.motion import Motion
@@ -116,9 +116,13 @@ def _plan(text: str) -> list[tuple[str, str | None]]:
 
 
 def measure(assembly: str, plan: list[tuple[str, str | None]], seed: int) -> tuple[Recorder, list[StepRecord]]:
-    """The plan's steps run in one assembling cell of ``assembly``, their moves recorded."""
+    """The plan's steps run in one assembling cell of ``assembly``, their moves recorded
+    (a step the product does not allow is refused before anything moves)."""
     description = CellDescription()
-    assembler = Assembler(load_product(assembly, description), description=description)
+    product = load_product(assembly, description)
+    for k, (part, hole) in enumerate(plan):
+        check_product_step(product, part, hole, [p for p, _ in plan[:k]])
+    assembler = Assembler(product, description=description)
     try:
         recorder = Recorder(assembler.world.arm)
         with recorder.installed():
