@@ -1,6 +1,8 @@
 """Collision-free motions of the tool between tray and product: up to a safe height, across,
-and down, each a straight line with a minimum-jerk time law, tracked by the impedance
-controller (the arm and the held part are simulated all along).  Moves use twice the
+and down, each a straight line with a minimum-jerk time law at a tip speed, made longer
+where that would turn a joint faster than :data:`RATE_MARGIN` of its speed limit
+(:func:`rate_steps`), tracked by the impedance controller (the arm and the held part are
+simulated all along).  Moves use twice the
 controller's damping (the insertion gains are lightly damped: a 0.5 m move rang for
 about a second); the gains are restored after each move.  The tool points down, turned
 about z by a yaw that a move changes with the same time law (a part aligned to a rect

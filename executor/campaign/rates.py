@@ -35,7 +35,7 @@ from executor.assembly.step import Assembler, StepRecord, check_product_step
 from executor.campaign.run import stdout_to_stderr
 from executor.cell_description import CellDescription
 from executor.control.motion import Motion
-from executor.world.arm import Arm
+from executor.world.arm import N_JOINTS, Arm
 from executor.world.scene import TIME_STEP
 
 KINDS = ("up", "across", "down", "slow", "joint")
@@ -47,7 +47,7 @@ class Rates:
 
     moves: int = 0
     seconds: float = 0.0
-    peak: np.ndarray = field(default_factory=lambda: np.zeros(7))
+    peak: np.ndarray = field(default_factory=lambda: np.zeros(N_JOINTS))
 
 
 class Recorder:
@@ -69,7 +69,7 @@ class Recorder:
     def _move(self, run: Callable[[Callable[[], None]], None], after_step: Callable[[], None] | None,
               kind: Callable[[np.ndarray], str]) -> None:
         """Run a move (``run`` given the per-step callback), then count it under ``kind(displacement [m])``."""
-        peak, start, steps = np.zeros(7), self._tip(), 0
+        peak, start, steps = np.zeros(N_JOINTS), self._tip(), 0
 
         def step() -> None:
             nonlocal peak, steps
