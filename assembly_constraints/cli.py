@@ -37,6 +37,7 @@ BENCHMARKS: dict[str, str] = {
     "assemble": "asp.bench.assemble_plans",
     "executor": "executor.campaign.bench",
     "reach": "executor.campaign.reach",
+    "rates": "executor.campaign.rates",
     "physics": "executor.campaign.physics",
     "engines": "executor.campaign.engines",
     "import": "executor.campaign.import_bench",

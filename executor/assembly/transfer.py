@@ -1,6 +1,8 @@
 """Collision-free motions of the tool between tray and product: up to a safe height, across,
-and down, each a straight line with a minimum-jerk time law, tracked by the impedance
-controller (the arm and the held part are simulated all along).  Moves use twice the
+and down, each a straight line with a minimum-jerk time law at a tip speed, made longer
+where that would turn a joint faster than :data:`RATE_MARGIN` of its speed limit
+(:func:`rate_steps`), tracked by the impedance controller (the arm and the held part are
+simulated all along).  Moves use twice the
 controller's damping (the insertion gains are lightly damped: a 0.5 m move rang for
 about a second); the gains are restored after each move.  The tool points down, turned
 about z by a yaw that a move changes with the same time law (a part aligned to a rect
@@ -11,7 +13,9 @@ whose tool path is not a line)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from typing import TypeVar
 
 import msgspec
 import numpy as np
@@ -19,7 +23,7 @@ import pybullet as pb
 
 from executor.control.controller import ImpedanceController
 from executor.control.motion import Motion
-from executor.world.arm import LIMIT_MARGIN, REST_POSTURE, rotation_error, tool_quat
+from executor.world.arm import LIMIT_MARGIN, REST_POSTURE, Arm, rotation_error, tool_quat
 from executor.world.frames import HoleFrame
 from executor.world.scene import TIME_STEP
 
@@ -37,6 +41,13 @@ TURN_TOLERANCE = 0.15  # [rad] of the tool's orientation where :func:`reorient` 
 SEEDS = [REST_POSTURE, *(REST_POSTURE + np.array([0.0] * 6 + [roll]) for roll in (-np.pi / 2, np.pi / 2))]
 """Where :func:`reorient`'s IK starts, in turn: the arm's rest posture, the wrist rolled a quarter turn each way."""
 JOINT_SPEED = 0.8  # [rad/s] mean rate of the farthest-turning joint in a joint-space move
+RATE_MARGIN = 0.85
+"""A move's planned joint rates stay within this fraction of each joint's speed limit
+(:attr:`executor.world.arm.Arm.rate_limit`): room for the controller's tracking, which
+the plan does not model."""
+RATE_SAMPLES = 8  # stretches of a Cartesian move over which its joint rates are planned
+PEAK_RATE = 1.875  # the minimum-jerk law's peak rate, in units of the move's mean (at its middle)
+T = TypeVar("T", float, np.ndarray)
 
 
 def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None = None,
@@ -46,12 +57,8 @@ def move_line(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] |
     [rad] (None: keeping its yaw); then held until it is within ``tolerance`` [m] at rest
     (speed below ``tolerance`` per 0.1 s), or ``settle`` [s] has passed."""
     yaw0, yaw1 = motion.tool_yaw, motion.tool_yaw if yaw is None else yaw
-
-    def turn(blend: float) -> np.ndarray:
-        motion.tool_yaw = yaw0 + blend * (yaw1 - yaw0)
-        return tool_quat(motion.tool_yaw)
-
-    _damped(motion, goal, after_step, speed, settle, tolerance, turn)
+    _damped(motion, goal, after_step, speed, settle, tolerance, lambda blend: tool_quat(yaw0 + blend * (yaw1 - yaw0)))
+    motion.tool_yaw = yaw1
 
 
 def reorient(motion: Motion[ImpedanceController], goal: np.ndarray, frame: HoleFrame | None, yaw: float,
@@ -94,14 +101,14 @@ def move_joints(motion: Motion[ImpedanceController], q_goal: np.ndarray,
     (:meth:`executor.control.controller.ImpedanceController.step_joints`); then held until
     at rest there (each joint within 1 mrad, slower than 10 mrad/s), or :data:`SETTLE` [s]
     has passed. For free space only: the tool's path is not a line."""
-    q0 = motion.controller.arm.read().q
+    arm = motion.controller.arm
+    q0 = arm.read().q
     span = q_goal - q0
-    n = max(1, int(float(np.max(np.abs(span))) / JOINT_SPEED / TIME_STEP))
+    n = max(1, int(float(np.max(np.abs(span))) / JOINT_SPEED / TIME_STEP),
+            math.ceil(float(np.max(PEAK_RATE * np.abs(span) / (RATE_MARGIN * arm.rate_limit))) / TIME_STEP))
     for k in range(1, n + settle_steps(SETTLE) + 1):
-        s = min(1.0, k / n)
-        blend = 10 * s**3 - 15 * s**4 + 6 * s**5
-        rate = (30 * s**2 - 60 * s**3 + 30 * s**4) / (n * TIME_STEP) if k < n else 0.0
-        state = motion.controller.step_joints(q0 + blend * span, rate * span)
+        blend, rate = minimum_jerk(min(1.0, k / n))
+        state = motion.controller.step_joints(q0 + blend * span, (rate / (n * TIME_STEP) if k < n else 0.0) * span)
         motion.steps += 1
         if after_step is not None:
             after_step()
@@ -125,19 +132,48 @@ def _damped(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | N
 def _track(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None, speed: float, settle: float,
            tolerance: float, turn: Callable[[float], np.ndarray]) -> None:
     """The TCP from where it is to ``goal`` [m] along a line, the tool at ``turn(blend)``
-    (a quaternion xyzw) as the minimum-jerk blend goes from 0 to 1, then held (:func:`move_line`)."""
+    (a quaternion xyzw) as the minimum-jerk blend goes from 0 to 1, then held (:func:`move_line`).
+    The move takes its distance at the mean ``speed`` [m/s], or longer where the joint rates
+    that asks would go beyond :data:`RATE_MARGIN` of their limits (:func:`rate_steps`)."""
     start = motion.read().tip_pos
     distance = float(np.linalg.norm(goal - start))
-    n = max(1, int(distance / speed / TIME_STEP))
+
+    def line(blends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        poses = [motion.cell_pose(start + blend * (goal - start), turn(blend)) for blend in blends]
+        return np.array([p[0] for p in poses]), np.array([p[1] for p in poses])
+
+    n = max(1, int(distance / speed / TIME_STEP), rate_steps(motion.controller.arm, line))
     for k in range(1, n + settle_steps(settle) + 1):
-        s = min(1.0, k / n)
-        blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+        blend = minimum_jerk(min(1.0, k / n))[0]
         state = motion.step(start + blend * (goal - start), turn(blend))
         if after_step is not None:
             after_step()
         at_rest = np.linalg.norm(state.tip_vel) < 10 * tolerance
         if k >= n and at_rest and np.linalg.norm(state.tip_pos - goal) < tolerance:
             break
+
+
+def rate_steps(arm: Arm, line: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> int:
+    """The fewest control steps in which a minimum-jerk move along ``line`` (the tip's
+    positions [m] and orientations (xyzw) at an array of blends, cell frame) asks every
+    joint at most :data:`RATE_MARGIN` of its limit: the arm's postures along it
+    (:meth:`executor.world.arm.Arm.posture_path`) at :data:`RATE_SAMPLES` + 1 evenly spaced
+    blends; each joint's change between two of them, per unit of blend, times the law's
+    fastest blend rate between them (:data:`PEAK_RATE` where they straddle the middle).
+    Every rate scales as the inverse of the move's duration."""
+    blends = np.linspace(0.0, 1.0, RATE_SAMPLES + 1)
+    path = arm.posture_path(*line(blends))
+    law, law_rate = minimum_jerk(np.linspace(0.0, 1.0, 1001))
+    fastest = np.array([law_rate[np.searchsorted(law, min(max(0.5, a), b))] for a, b in zip(blends, blends[1:])])
+    per_blend = np.abs(np.diff(path, axis=0)) * RATE_SAMPLES
+    peak = float(np.max(per_blend * fastest[:, None] / arm.rate_limit))  # the move in 1 s
+    return math.ceil(peak / RATE_MARGIN / TIME_STEP)
+
+
+def minimum_jerk(s: T) -> tuple[T, T]:
+    """The minimum-jerk law at ``s``, the fraction of the move's duration gone (0 to 1; a
+    number or an array): the blend (0 to 1) and its rate per unit of ``s``."""
+    return 10 * s**3 - 15 * s**4 + 6 * s**5, 30 * s**2 * (1 - s) ** 2
 
 
 def settle_steps(duration: float) -> int:

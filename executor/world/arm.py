@@ -26,6 +26,9 @@ LIMIT_MARGIN = 0.1
 controller's motions from there (a joint at its limit stops the tool short)."""
 SOLVED = 0.0005  # [m] how near its pose :meth:`Arm.solve` puts the tip
 SOLVED_TURN = 0.005  # [rad] and how near its orientation
+RELAXED = 0.001
+"""[rad] :meth:`Arm.posture_path` repeats a pose's IK from its answer until no joint moves more than this"""
+RELAX_CALLS = 4  # or this many times
 _ORIGIN = (0.0, 0.0, 0.0)
 
 
@@ -127,6 +130,9 @@ class Arm:
         """[rad] each joint's lower limit (the URDF's, which PyBullet enforces)."""
         self.upper = np.array([i[9] for i in info])
         """[rad] each joint's upper limit."""
+        self.rate_limit = np.array([i[11] for i in info])
+        """[rad/s] each joint's speed limit (the URDF's ``velocity``:
+        :data:`executor.world.geometry.JOINT_RATE_LIMITS`), which PyBullet does not enforce."""
         self._zeros = [0.0] * N_JOINTS
         self.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         self.tare = np.zeros(6)
@@ -196,6 +202,37 @@ class Arm:
                         rotation_error(np.asarray(tip_quat_xyzw), quat)) < SOLVED_TURN:
                     return q
             return None
+        finally:
+            for j, (qj, rate) in zip(self.joints, saved):
+                pb.resetJointState(r, j, qj, rate, physicsClientId=c)
+
+    def posture_path(self, tip_pos: np.ndarray, tip_quats_xyzw: np.ndarray) -> np.ndarray:
+        """Joint angles [rad] (n × 7) putting the *believed* tip at each of the poses in turn
+        (n × 3 [m], n × 4 xyzw; cell frame): PyBullet's IK within the joint limits, toward
+        :data:`REST_POSTURE`, from the angles before (the first from the arm's now), repeated
+        from its own answer until the pull toward that posture has come to rest
+        (:data:`RELAXED`, :data:`RELAX_CALLS`). The postures the arm passes through where the
+        Cartesian impedance controller carries its tip along the poses: its null-space
+        spring pulls to that posture, the limits stop the joints. The arm is left as it was
+        (its joints and their rates restored; nothing steps)."""
+        c, r = self.client, self.robot
+        saved = [(j[0], j[1]) for j in pb.getJointStates(r, self.joints, physicsClientId=c)]
+        limits = {"lowerLimits": self.lower.tolist(), "upperLimits": self.upper.tolist(),
+                  "jointRanges": (self.upper - self.lower).tolist(), "restPoses": REST_POSTURE.tolist()}
+        path = np.full((len(tip_pos), N_JOINTS), np.inf)
+        try:
+            for k, (pos, quat) in enumerate(zip(tip_pos, tip_quats_xyzw)):
+                real_pos, real_quat = self._ik_target(pos, quat)
+                for _ in range(RELAX_CALLS):
+                    q = np.array(pb.calculateInverseKinematics(r, self.sensor, real_pos, real_quat,
+                                                               maxNumIterations=50, residualThreshold=1e-5,
+                                                               physicsClientId=c, **limits)[:N_JOINTS])
+                    self._set(q)
+                    moved = float(np.max(np.abs(q - path[k])))
+                    path[k] = q
+                    if moved < RELAXED:
+                        break
+            return path
         finally:
             for j, (qj, rate) in zip(self.joints, saved):
                 pb.resetJointState(r, j, qj, rate, physicsClientId=c)

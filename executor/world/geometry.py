@@ -33,6 +33,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -791,10 +792,31 @@ def part_urdf_text(part: PartSpec, files: MeshFiles | None = None) -> str:
 
 # The flange link is attached 45 mm beyond joint 7 (the iiwa's flange face).
 _FLANGE_OFFSET = 0.045
+JOINT_RATE_LIMITS = (85.0, 85.0, 100.0, 75.0, 130.0, 135.0, 135.0)
+"""[°/s] the axis speeds A1–A7 of the KUKA LBR iiwa 14 R820 (KUKA, "LBR iiwa 7 R800, LBR iiwa
+14 R820 Specification", axis data), the arm whose geometry pybullet_data's ``kuka_iiwa`` has
+(0.36 m from its base to A2, 0.42 m on to A4, 0.40 m to A6, 0.126 m to the flange face);
+that URDF's ``velocity`` is 10 rad/s on every joint, no arm's: :func:`arm_urdf_text` writes
+these (in rad/s) in its place. PyBullet does not enforce them (the arm is torque driven):
+the cell's moves keep within them (:mod:`executor.assembly.transfer`)."""
+_JOINT_LIMIT = re.compile(r'(<joint name="lbr_iiwa_joint_(\d)".*?<limit [^>]*?velocity=")[^"]*(")', re.S)
+
+
+def _rate_limits(text: str, source: Path) -> str:
+    """The iiwa URDF ``text`` with each joint's ``velocity`` set to :data:`JOINT_RATE_LIMITS`."""
+    def limit(match: re.Match[str]) -> str:
+        return f"{match[1]}{math.radians(JOINT_RATE_LIMITS[int(match[2]) - 1]):.6f}{match[3]}"
+
+    text, count = _JOINT_LIMIT.subn(limit, text)
+    if count != len(JOINT_RATE_LIMITS):
+        raise ExecutorError(f"{source}: {count} joints lbr_iiwa_joint_N with a velocity limit, expected "
+                            f"{len(JOINT_RATE_LIMITS)} (the arm's URDF of pybullet_data)")
+    return text
 
 
 def arm_urdf_text(part: PartSpec, gripper: Gripper, files: MeshFiles | None = None) -> str:
-    """The pybullet_data ``kuka_iiwa`` with a flange (realistic inertia) and the held part.
+    """The pybullet_data ``kuka_iiwa``, its joints' speed limits the real arm's
+    (:data:`JOINT_RATE_LIMITS`), with a flange (realistic inertia) and the held part.
 
     Links appended after ``lbr_iiwa_link_7``: ``flange`` (fixed) and ``part`` (fixed joint
     ``ft_sensor``: the wrist force/torque sensor).  The ``part`` link frame is at the
@@ -803,7 +825,7 @@ def arm_urdf_text(part: PartSpec, gripper: Gripper, files: MeshFiles | None = No
     a mesh part needs its ``files`` with absolute paths (:func:`mesh_files`).
     """
     source = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
-    text = source.read_text().replace('filename="meshes/', f'filename="{source.parent}/meshes/')
+    text = _rate_limits(source.read_text(), source).replace('filename="meshes/', f'filename="{source.parent}/meshes/')
     flange_len = gripper.flange_length
     tip = flange_len + part.length - part.held_depth(gripper)
     tool = (
