@@ -73,6 +73,39 @@ def test_a_peg_that_does_not_pass_lacks_the_same_however_the_pair_is_turned_by_q
     assert {round(fit.yaw, 3) for fit in found} == {round(found[0].yaw, 3)}  # the turn relative to the hole's
 
 
+def _square(side: float, x: float = 0.0, y: float = 0.0) -> tuple[tuple[float, float], ...]:
+    """A square's corners [m] of ``side`` [mm] about (``x``, ``y``) [mm]."""
+    h = side / 2
+    return tuple(((x + dx) * MM, (y + dy) * MM) for dx, dy in ((-h, -h), (h, -h), (h, h), (-h, h)))
+
+
+def test_a_ring_passes_a_pocket_around_an_island_and_a_peg_of_its_outline_does_not() -> None:
+    """A 30 mm square pocket around a 10 mm island standing in it (PEARL's digit 0 over its
+    counter): a ring of 28 mm with a 12 mm bore goes in around the island, 1 mm all round;
+    the same outline without its bore would meet the island; a 4 x 26 mm bar passes beside
+    it (2 mm of room, along the pocket), not at its centre."""
+    pocket = Section("h", "polygon", 30 * MM, width=30 * MM, outline=_square(30), inner=(_square(10),))
+    ring = Section("r", "polygon", 28 * MM, width=28 * MM, outline=_square(28), inner=(_square(12),))
+    assert section_fit(ring, pocket).room == pytest.approx(1 * MM, abs=TESSELLATION)
+    assert margin(Section("p", "polygon", 28 * MM, width=28 * MM, outline=_square(28)), pocket) < 0
+    assert margin(Section("n", "polygon", 28 * MM, width=28 * MM, outline=_square(28), inner=(_square(9),)),
+                  pocket) < 0  # its bore narrower than the island
+    bar = Section("b", "polygon", 4 * MM, width=26 * MM, outline=((-2 * MM, -13 * MM), (2 * MM, -13 * MM),
+                                                                  (2 * MM, 13 * MM), (-2 * MM, 13 * MM)))
+    found = section_fit(bar, pocket)
+    assert found.room == pytest.approx(2 * MM, abs=TESSELLATION)
+    assert math.hypot(*found.offset) > 9 * MM  # beside the island
+    # without the island it turns on the diagonal at the centre, with more room
+    assert section_fit(bar, Section("h", "polygon", 30 * MM, width=30 * MM, outline=_square(30))).room > 3 * MM
+
+
+def test_a_bore_meets_nothing_of_a_hole_without_islands() -> None:
+    # a ring's room in a plain pocket is its outline's: the bore leaves the relation as it was
+    ring = Section("r", "polygon", 28 * MM, width=28 * MM, outline=_square(28), inner=(_square(12),))
+    plain = Section("h", "polygon", 30 * MM, width=30 * MM, outline=_square(30))
+    assert section_fit(ring, plain).room == pytest.approx(1 * MM, abs=TESSELLATION)
+
+
 def test_a_d_shaft_passes_a_round_hole_by_its_circle_not_its_centroid() -> None:
     """A 9.8 mm D-shaft (flat 4 mm from its axis) in a 10 mm bore: 0.1 mm all round, its
     arc's centre on the bore's, whichever way the flat faces."""
@@ -177,7 +210,7 @@ def test_the_deepest_overlap_is_the_largest_distance_shapely_gives_measuring_few
     rng = np.random.default_rng(7)
     for ring in (shapely.segmentize(SHAFT, 0.02 * MM).exterior,
                  shapely.segmentize(shapely.box(-MM, -MM, MM, MM), 0.01 * MM).exterior):
-        edges = _Edges(ring)
+        edges = _Edges(shapely.Polygon(ring))
         assert edges.indexed
         points = rng.normal(0.0, 3 * MM, (3000, 2))
         points[:1000] = np.asarray(ring.coords)[rng.integers(0, len(ring.coords), 1000)]  # on a corner: 0

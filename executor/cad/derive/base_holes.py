@@ -10,7 +10,7 @@ import numpy as np
 
 from executor.cad.derive.cavities import without_cavities
 from executor.cad.derive.derived import HoleFit
-from executor.cad.derive.loops import SAME_HOLE, bore_around, hole_around, outer, touching_gap
+from executor.cad.derive.loops import SAME_HOLE, bore_around, hole_around, in_loop, outer, touching_gap
 from executor.cad.derive.measure_hole import measure
 from executor.cad.derive.rays import roofed
 from executor.cad.parts import CadPart
@@ -37,7 +37,8 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
         axis = np.array(DIRECTIONS[axes[part.id]])
         found = _part_slice(part, base, axis)
         if found is not None and not any(bore_around(part.mesh, other.mesh, axis, found[0]) is not None
-                                         for other in [base, *before.get(part.id, [])]):
+                                         for other in [*([] if _sunk(base, axis, *found) else [base]),
+                                                       *before.get(part.id, [])]):
             return found
         return None
 
@@ -70,6 +71,7 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
                             key=lambda o: o.area)
             if len(around) % 2 == 0:
                 continue  # an outline, not a hole
+            loop = Loop(loop.points, _islands(loop, loops))
             if touching_gap(loop.area, loop.length):
                 continue  # a crack between faces that touch: no part goes in
             frame = frame_of(axis)
@@ -100,6 +102,23 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
     found = without_cavities(base.mesh, fits)
     found.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     return found
+
+
+def _islands(loop: Loop, loops: list[Loop]) -> tuple[np.ndarray, ...]:
+    """The points (k, 2) [m] of each outline among ``loops`` (a slice's) that stands in the
+    hole ``loop`` with no other loop between them: the base's islands in it (a pocket's
+    standing core)."""
+    inside = [o for o in loops if o is not loop and o.area < loop.area and loop.contains(o.centre)]
+    return tuple(o.points for o in inside
+                 if not any(other is not o and other.area > o.area and other.contains(o.centre) for other in inside))
+
+
+def _sunk(base: CadPart, axis: np.ndarray, level: float, own: Loop) -> bool:
+    """Whether the part's outline ``own`` at ``level`` [m] across ``axis`` lies in a hole of
+    the base's slice there that has islands (:func:`_islands`): the part stands in that
+    pocket around them, not on them as on pins (a ring sunk over a pocket's core)."""
+    loops = slice_loops(base.mesh, axis, level)
+    return any(not outer(loop, loops) and _islands(loop, loops) and in_loop(own, loop) for loop in loops)
 
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
@@ -174,6 +193,8 @@ def receives(fit: HoleFit) -> bool:
     pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z)."""
     if fit.hole.kind != "polygon":
         return True
+    if len(fit.hole.inner):  # around islands: no part is known to go in (a groove round a pin)
+        return False
     try:
         shape = polygon(fit.hole.outline, "hole")
     except OutlineError:  # no simple polygon: a gap of no area between faces that touch
