@@ -24,9 +24,13 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
     """Every inner loop of the base's slices (at the levels of the parts in it, or at its
     middle along +z), with the part in it where one is, in order of position; a loop no
     wider than faces that touch (:func:`executor.cad.derive.loops.touching_gap`: the crack
-    two closed objects of one part keep where their faces meet not quite flat) is none. A part is in
+    two closed objects of one part keep where their faces meet not quite flat) is none. A
+    loop keeps the base's outlines standing in it as its islands (:func:`_islands`: the
+    hole's opening has a hole, a pocket around a standing core). A part is in
     none when, at its level, its bore holds an outline of the base or of one of the parts
-    ``before`` it (a gland on a shaft: it goes onto a pin, :func:`executor.cad.derive.pins`), or when it lies
+    ``before`` it (a gland on a shaft: it goes onto a pin, :func:`executor.cad.derive.pins`),
+    but for the base's islands of a hole its outline lies in (:func:`_sunk`: a ring sunk in
+    the pocket around them goes into it), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
     ring that stands in a housing's bore: the ring's hole, :func:`executor.cad.derive.part_holes`), in along
     the same way or, that part ``before`` it, the other way (the shaft sent in from the
@@ -190,7 +194,9 @@ def receives(fit: HoleFit) -> bool:
     base's own in its hole, the gap between two of its bodies; a sliver whose mean width
     (twice its area over its perimeter) is at most :data:`executor.cad.fits.faces.TOUCH` is a
     gap between faces that touch, whatever symmetry rounding lends it (one of a Technic
-    pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z)."""
+    pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z).
+    An empty hole with islands is a pocket: no part is known to go in around them (a groove
+    round a pin of the base's own)."""
     if fit.hole.kind != "polygon":
         return True
     if len(fit.hole.inner):  # around islands: no part is known to go in (a groove round a pin)
