@@ -53,7 +53,7 @@ def measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | No
             spans += [(bore, occupant[0].mesh, tip, True) for bore in bores]
     narrowest, *occupied = forked_map(lambda span: over_span(span[0], span[1], axis, span[2], entry, hole=span[3]),
                                       spans, workers)
-    if occupied[1:]:  # a bore with something of the part inside it all along is left solid (no smaller a part)
+    if occupied[1:]:  # a bore with something of the part in it (at the level or along) is left solid
         kept = tuple(bore.points for bore in occupied[1:] if len(bore.points) >= 3 and not bore.inner)
         occupied = [Loop(occupied[0].points, kept)]
     if occupant is None and len(narrowest.points) < 3:  # a floor not across the axis (a drill point's cone)
@@ -97,8 +97,18 @@ def _free_point(loop: Loop, centre: np.ndarray) -> np.ndarray:
 
 def _bores(mesh: trimesh.Trimesh, axis: np.ndarray, level: float, own: Loop) -> list[Loop]:
     """The inner loops of the part ``mesh``'s slice at ``level`` [m] across ``axis`` that lie
-    in its outline ``own`` with no other loop between them (its bores there)."""
+    in its outline ``own`` with no other loop between them (its bores there), each with the
+    part's outlines that stand in it as its inner rings (a bearing's balls and inner race in
+    its outer race's bore: what the section must keep solid)."""
     loops = slice_loops(mesh, axis, level)
     inside = [o for o in loops if o.area < own.area and own.contains(o.centre)]
-    return [o for o in inside
-            if not any(other is not o and other.area > o.area and other.contains(o.centre) for other in inside)]
+
+    def direct(loop: Loop, among: list[Loop]) -> bool:
+        return not any(other is not loop and other.area > loop.area and other.contains(loop.centre)
+                       for other in among)
+
+    bores = [o for o in inside if direct(o, inside)]
+    return [Loop(bore.points, tuple(o.points for o in inside if o is not bore and o.area < bore.area
+                                    and bore.contains(o.centre)
+                                    and direct(o, [i for i in inside if i is not bore and bore.contains(i.centre)])))
+            for bore in bores]
