@@ -353,6 +353,11 @@ def _config(path: Path | None, data: dict, parts: list[CadPart], up: str
 
 
 
+def _around(islands: int) -> str:
+    """A hole's islands as the report names them ("" for none)."""
+    return "" if not islands else f" around {islands} island{'s' if islands > 1 else ''}"
+
+
 def _describe(kind: str, a: float, b: float) -> str:
     return f"round d {_mm(a)}" if kind == "round" else f"{kind} {_mm(a)} x {_mm(b)}"
 
@@ -411,7 +416,8 @@ def report(derived: Derived) -> list[str]:
         where = (f"at ({_mm(fit.position[0])}, {_mm(fit.position[1])}) mm" if fit.axis == "+z" else
                  "entry at ({}, {}, {}) mm".format(*map(_mm, entry_point(fit))))
         lines.append(f"hole {hid}{owner} {where}, entered along "
-                     f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}, depth "
+                     f"{opposite(fit.axis)}: {_describe(fit.hole.kind, fit.hole.a, fit.hole.b)} mm{yaw}"
+                     f"{_around(len(fit.hole.inner))}, depth "
                      f"{_mm(fit.depth)} mm, chamfer {_mm(fit.chamfer)} mm; {held}")
     for pin_id, pin in derived.pins.items():
         onto = []
@@ -426,8 +432,10 @@ def report(derived: Derived) -> list[str]:
                      f" mm; {'; '.join(onto) or 'empty'}")
     for pocket in derived.pockets:
         lines.append(f"pocket at ({_mm(pocket.position[0])}, {_mm(pocket.position[1])}) mm, "
-                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm, depth {_mm(pocket.depth)} mm: a polygon with no "
-                     "rotational symmetry about its centre, no hole")
+                     f"{_mm(pocket.hole.a)} x {_mm(pocket.hole.b)} mm{_around(len(pocket.hole.inner))}, depth "
+                     f"{_mm(pocket.depth)} mm: " + ("empty around its islands" if len(pocket.hole.inner) else
+                                                    "a polygon with no rotational symmetry about its centre")
+                     + ", no hole")
     if not (derived.hole_of or any(fit.part for fit in derived.part_holes.values())
             or any(pin.parts for pin in derived.pins.values())):
         found = ("no part in a hole or on a pin: sizes.lp names no part" if derived.holes or derived.part_holes

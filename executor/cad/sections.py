@@ -82,9 +82,12 @@ rectangle lies on it (a flat face's slice is straight to the float)."""
 
 @dataclass(frozen=True)
 class Loop:
-    """A closed loop of a slice: its ``points`` (n, 2) [m] in the slice's frame."""
+    """A closed loop of a slice: its ``points`` (n, 2) [m] in the slice's frame, and the
+    loops cut out of what it bounds, ``inner`` (each (k, 2) [m]: a hole's islands, a
+    part's bores; its measures are its outline's)."""
 
     points: np.ndarray
+    inner: tuple[np.ndarray, ...] = ()
 
     @cached_property
     def area(self) -> float:
@@ -125,7 +128,8 @@ class Shape2D:
     ``yaw`` [°] of side a in (-90, 90] (square: (-45, 45]; a polygon: 0, its outline
     holds its turn), ``centre`` (2,) [m] in the slice's frame, ``outline`` (n, 2) [m] the
     loop's points about the centre, ``corner`` [m] the corner radius a rect's missing
-    area gives (0: sharp)."""
+    area gives (0: sharp), ``inner`` the loop's inner rings about the centre (a hole's
+    islands, a part's bores)."""
 
     kind: str
     a: float
@@ -135,6 +139,7 @@ class Shape2D:
     outline: np.ndarray = field(repr=False, kw_only=True)
     corner: float = field(default=0.0, kw_only=True)
     deflection: float = field(default=0.0, kw_only=True)
+    inner: tuple[np.ndarray, ...] = field(default=(), kw_only=True, repr=False)
 
 
 def frame_of(axis: np.ndarray) -> np.ndarray:
@@ -297,17 +302,21 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
     facet): a point free at one level of the span and covered at another lies under a
     face crossing the span; but for the shadows within :data:`SLIVER` of the loop's
     outline, left out, after which a hole's section is eroded and a peg's dilated by twice
-    SLIVER (never larger, never smaller than the exact one). ``loop`` itself when the section lies within
+    SLIVER (never larger, never smaller than the exact one). A hole's loop's ``inner`` rings
+    (islands) are cut out of it first, and what the shadow cuts out inside it is kept as
+    inner rings of the section (not filled: a stub standing on a pocket's floor into the
+    span). ``loop`` itself when the section lies within
     :data:`SAME_OUTLINE` of it, or when it is no simple polygon; no points when nothing of
     the hole is free all along."""
-    outline = shapely.make_valid(shapely.Polygon(loop.points))
+    outline = shapely.make_valid(shapely.Polygon(loop.points, loop.inner if hole else ()))
     if not isinstance(outline, shapely.Polygon):
         return loop  # no simple polygon (faces that touch): the fit relation refuses it as sliced
     x0, y0, x1, y1 = outline.bounds
     if not hole:
         x, y = loop.centre
         x0, y0, x1, y1 = x - reach, y - reach, x + reach, y + reach
-    cover, dropped = shadow(mesh, axis, low, high, (x0, y0, x1, y1), outline.exterior.buffer(SLIVER))
+    cover, dropped = shadow(mesh, axis, low, high, (x0, y0, x1, y1),
+                            (outline.boundary if hole and loop.inner else outline.exterior).buffer(SLIVER))
     if not hole and math.isfinite(reach):  # the box's corners reach farther: a plate's other pin on a diagonal
         cover = shapely.intersection(cover, shapely.Point(loop.centre).buffer(reach / math.cos(math.pi / 64),
                                                                               quad_segs=16))
@@ -326,9 +335,12 @@ def over_span(loop: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, low: float, h
         near = main.buffer(SAME_OUTLINE)
         apart = [piece for piece in pieces if piece is not main and not near.covers(piece)]
         found = shapely.Polygon((shapely.union_all([main, *apart]).convex_hull if apart else main).exterior)
-    if _same_outline(outline.exterior, found.exterior):
+    islands = tuple(np.asarray(ring.coords)[:-1] for ring in found.interiors) if hole else ()
+    if _same_outline(outline.exterior, found.exterior) and len(islands) == len(loop.inner) and all(
+            _same_outline(shapely.LinearRing(mine), shapely.LinearRing(kept))
+            for mine, kept in zip(loop.inner, islands, strict=True)):
         return loop
-    return Loop(np.asarray(found.exterior.coords)[:-1])
+    return Loop(np.asarray(found.exterior.coords)[:-1], islands)
 
 
 SPIKE = 5e-8
@@ -729,9 +741,13 @@ def _corner_and_inset(points: np.ndarray, a: float, b: float, *, hole: bool) -> 
 
 def classify(loop: Loop, *, hole: bool, round_ok: bool = True) -> Shape2D:
     """The loop's cross-section (the module docstring); ``hole`` picks the inscribed size;
-    without ``round_ok``, a loop is never read as round (the rect or polygon it is)."""
+    without ``round_ok``, a loop is never read as round (the rect or polygon it is). A loop
+    with inner rings (a hole's islands, a part's bores) is a polygon that keeps them."""
     points, centre = loop.points, loop.centre
     outline = points - centre
+    if loop.inner:
+        a, b, _ = _min_rectangle(points)
+        return Shape2D("polygon", a, b, 0.0, centre, outline=outline, inner=tuple(ring - centre for ring in loop.inner))
     radii = np.linalg.norm(outline, axis=1)
     outer = float(radii.max())
     if (round_ok and len(points) >= MIN_ROUND_POINTS and (outer - radii.min()) <= 0.02 * outer
@@ -884,9 +900,11 @@ def rounded(value: float) -> float:
 
 def section(name: str, shape: Shape2D) -> Section:
     """The cell's section of a measured one (a polygon's outline about its centre, in the cell's axes)."""
-    outline = tuple((rounded(x), rounded(y)) for x, y in shape.outline) if shape.kind == "polygon" else ()
+    polygonal = shape.kind == "polygon"
+    outline = tuple((rounded(x), rounded(y)) for x, y in shape.outline) if polygonal else ()
+    inner = tuple(tuple((rounded(x), rounded(y)) for x, y in ring) for ring in shape.inner) if polygonal else ()
     return Section(name, shape.kind, shape.a, width=shape.b if shape.kind in ("rect", "polygon") else 0.0,
-                   outline=outline, corner=shape.corner)
+                   outline=outline, corner=shape.corner, inner=inner)
 
 
 def section_room(peg: Shape2D, hole: Shape2D, peg_name: str = "peg", hole_name: str = "hole",

@@ -97,7 +97,8 @@ class Section:
     "square" (``size`` = side [m]), "rect" (``size`` = long side a along x [m],
     ``width`` = short side b along y [m]; 0 means ``size``: round and square) or
     "polygon" (``outline`` its points (x, y) [m] in its own frame, ``size`` and ``width``
-    its extents along x and y); a square's or rect's ``corner`` radius [m] (0: sharp)."""
+    its extents along x and y, ``inner`` the rings cut out of it: a hole's islands, a
+    part's bores, in that frame); a square's or rect's ``corner`` radius [m] (0: sharp)."""
 
     id: str
     kind: str
@@ -105,6 +106,7 @@ class Section:
     width: float = field(default=0.0, kw_only=True)
     outline: tuple[tuple[float, float], ...] = field(default=(), kw_only=True)
     corner: float = field(default=0.0, kw_only=True)
+    inner: tuple[tuple[tuple[float, float], ...], ...] = field(default=(), kw_only=True)
 
     @property
     def sides(self) -> tuple[float, float]:
@@ -435,12 +437,14 @@ def feature_passes(part: PartSpec, hole: HoleSpec) -> bool:
 
 
 def outline_polygon(section: Section, *, peg: bool) -> shapely.Polygon:
-    """The section as a polygon in its own frame [m]: a polygon's outline, a square's or
+    """The section as a polygon in its own frame [m]: a polygon's outline less its
+    ``inner`` rings, a square's or
     rect's exact rectangle (its corner arcs 256-gons as a circle's), a round one's 256-gon
     around the circle for a ``peg`` (it holds the part), inside it for a hole.
     OutlineError naming the section when its outline is no simple polygon."""
     if section.kind == "polygon":
-        return polygon(np.array(section.outline), f"the section of {section.id}")
+        return polygon(np.array(section.outline), f"the section of {section.id}",
+                       [np.array(ring) for ring in section.inner])
     if section.kind == "round":
         return circle(section.size / 2, outside=peg)
     a, b = section.sides
@@ -505,7 +509,7 @@ def seated_pose(peg: Section, hole: HoleSpec) -> tuple[np.ndarray, tuple[float, 
 def _key(section: Section) -> Section:
     """The section without its id (pairs of equal sections share one answer)."""
     return Section("", section.kind, section.size, width=section.width, outline=section.outline,
-                   corner=section.corner)
+                   corner=section.corner, inner=section.inner)
 
 
 @functools.lru_cache(maxsize=4096)

@@ -118,10 +118,7 @@ UNSIMULATED: dict[str, str] = {}
         "a hollow pin: the clamping flange's bore (d 30) round the coupling's d 29 outside, the coupling on the "
         "shaft's end, is taken for a bore on the shaft's pin inside both (room 2.5), so the coupling's outside is "
         "no feature")),
-    pytest.param("pearl_peg_board", marks=_xfail(
-        "a pocket of the base with an island in it (PEARL's digits 0 and 4 over their counters): the import "
-        "reads the islands as pins and the pegs onto them, not the pockets around them as holes (h0, h4); the "
-        "digit 0 then fits the digit 4's island, though not its pocket")),
+    "pearl_peg_board",
 ])
 def test_the_fit_relation_is_the_truth(corpus_import: Callable[[str], Imported], name: str) -> None:
     done = corpus_import(name)
@@ -149,10 +146,7 @@ def test_the_fit_relation_is_the_truth(corpus_import: Callable[[str], Imported],
                                   "metaworld_assembly", "robosuite_nuts", "occt_pulley",
                                   "vitac_shapes", "gridfinity_bases", "flynn_clutch", "bosl2_screw_nut",
                                   "nop_printed_box", "nop_flat_hinge",
-                                  pytest.param("pearl_peg_board", marks=pytest.mark.xfail(
-                                      strict=True, raises=AssertionError,
-                                      reason="the digit 2 in its pocket: 0.665 mm all round at yaw 0.389 deg "
-                                             "(margin 1330 um), the truth's 0.6664 at yaw 0.375 (1332.9 um)")),
+                                  "pearl_peg_board",
                                   pytest.param("asm4_disk_arm", marks=pytest.mark.xfail(
                                       strict=True, raises=AssertionError,
                                       reason="its disk's d 21 bore is measured on its tessellation, d 20.951 (a "
@@ -344,10 +338,9 @@ def test_every_product_is_simulated(corpus_import: Callable[[str], Imported], na
     pytest.param("bosl2_screw_nut", marks=_xfail(INSERTED + " screwed (the screw into the nut's modelled thread: the "
                                                  "cell has no screwing operation)")),
     pytest.param("pearl_peg_board", marks=_xfail(INSERTED + " into a blind pocket it fills flush with the top (no "
-                                                 "grip for the fingers, too narrow for the suction cup; the 0 over "
-                                                 "the pocket's island too), with a polygon section it is no prism "
-                                                 "of (the 3), or onto a pin with a layer at its bore thinner than "
-                                                 "the cell's hull margin (the 4)")),
+                                                 "grip for the fingers, too narrow for the suction cup), with a "
+                                                 "polygon section it is no prism of (the 3; the 0 and the 4, rings "
+                                                 "over their pockets' islands, no prisms of their outlines)")),
     pytest.param("bdw_pillow_block", marks=_xfail(INSERTED + " pressed (the bearing into its seat: the cell has no "
                                                   "pressing operation), or with a polygon section it is no prism of "
                                                   "(the screws)")),

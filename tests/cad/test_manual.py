@@ -272,11 +272,12 @@ def test_a_bad_manual_table_is_one_line_naming_it(tmp_path: Path, capsys: pytest
     assert len(err.splitlines()) == 1 and expected in err, err
 
 
-def test_a_ring_sunk_flush_over_an_island_of_a_pocket_is_placed_by_hand(tmp_path: Path) -> None:
+def test_a_ring_sunk_flush_around_an_island_of_a_pocket_is_placed_by_hand(tmp_path: Path) -> None:
     # PEARL's digit 0 (corpus pearl_peg_board) fills its pocket, flush with the board's top,
-    # over the island the pocket keeps: the import took the island for a pin and let the cell
-    # put the ring onto it, where the fingers have no room beside it (the sim cell failed it
-    # twice, and the assembly with it); a peg standing as little out of a hole was placed by hand.
+    # around the island the pocket keeps: the import took the island for a pin and let the
+    # cell put the ring onto it, where the fingers have no room beside it (the sim cell failed
+    # it twice, and the assembly with it). The pocket is a hole whose opening has a hole, the
+    # ring a peg in it with its bore, which the cell's prism of its outline would not keep.
     folder = tmp_path / "cad"
     folder.mkdir()
     pocket = trimesh.creation.cylinder(radius=15.0, height=22.0, sections=64)
@@ -293,4 +294,5 @@ def test_a_ring_sunk_flush_over_an_island_of_a_pocket_is_placed_by_hand(tmp_path
     assert main(["-q", "import", str(folder), "--out", str(tmp_path / "out")]) == 0
     manual = tomllib.loads((tmp_path / "out" / "geometry.toml").read_text()).get("manual", {})
     assert "ring" in manual, manual
-    assert "stands out of the product by 0.000 mm" in manual["ring"]["reason"]
+    assert "no prism of it" in manual["ring"]["reason"]
+    assert "fits(ring,h1)." in (tmp_path / "out" / "sizes.lp").read_text()

@@ -10,7 +10,7 @@ import numpy as np
 
 from executor.cad.derive.cavities import without_cavities
 from executor.cad.derive.derived import HoleFit
-from executor.cad.derive.loops import SAME_HOLE, bore_around, hole_around, outer, touching_gap
+from executor.cad.derive.loops import SAME_HOLE, bore_around, hole_around, in_loop, outer, touching_gap
 from executor.cad.derive.measure_hole import measure
 from executor.cad.derive.rays import roofed
 from executor.cad.parts import CadPart
@@ -24,9 +24,13 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
     """Every inner loop of the base's slices (at the levels of the parts in it, or at its
     middle along +z), with the part in it where one is, in order of position; a loop no
     wider than faces that touch (:func:`executor.cad.derive.loops.touching_gap`: the crack
-    two closed objects of one part keep where their faces meet not quite flat) is none. A part is in
+    two closed objects of one part keep where their faces meet not quite flat) is none. A
+    loop keeps the base's outlines standing in it as its islands (:func:`_islands`: the
+    hole's opening has a hole, a pocket around a standing core). A part is in
     none when, at its level, its bore holds an outline of the base or of one of the parts
-    ``before`` it (a gland on a shaft: it goes onto a pin, :func:`executor.cad.derive.pins`), or when it lies
+    ``before`` it (a gland on a shaft: it goes onto a pin, :func:`executor.cad.derive.pins`),
+    but for the base's islands of a hole its outline lies in (:func:`_sunk`: a ring sunk in
+    the pocket around them goes into it), or when it lies
     in the bore of another part standing in the base along its axis (a shaft in a bearing
     ring that stands in a housing's bore: the ring's hole, :func:`executor.cad.derive.part_holes`), in along
     the same way or, that part ``before`` it, the other way (the shaft sent in from the
@@ -37,7 +41,8 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
         axis = np.array(DIRECTIONS[axes[part.id]])
         found = _part_slice(part, base, axis)
         if found is not None and not any(bore_around(part.mesh, other.mesh, axis, found[0]) is not None
-                                         for other in [base, *before.get(part.id, [])]):
+                                         for other in [*([] if _sunk(base, axis, *found) else [base]),
+                                                       *before.get(part.id, [])]):
             return found
         return None
 
@@ -70,6 +75,7 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
                             key=lambda o: o.area)
             if len(around) % 2 == 0:
                 continue  # an outline, not a hole
+            loop = Loop(loop.points, _islands(loop, loops))
             if touching_gap(loop.area, loop.length):
                 continue  # a crack between faces that touch: no part goes in
             frame = frame_of(axis)
@@ -100,6 +106,23 @@ def holes(base: CadPart, parts: list[CadPart], axes: dict[str, str], before: dic
     found = without_cavities(base.mesh, fits)
     found.sort(key=lambda f: (round(f.centre[0], 6), round(f.centre[1], 6), round(f.centre[2], 6)))
     return found
+
+
+def _islands(loop: Loop, loops: list[Loop]) -> tuple[np.ndarray, ...]:
+    """The points (k, 2) [m] of each outline among ``loops`` (a slice's) that stands in the
+    hole ``loop`` with no other loop between them: the base's islands in it (a pocket's
+    standing core)."""
+    inside = [o for o in loops if o is not loop and o.area < loop.area and loop.contains(o.centre)]
+    return tuple(o.points for o in inside
+                 if not any(other is not o and other.area > o.area and other.contains(o.centre) for other in inside))
+
+
+def _sunk(base: CadPart, axis: np.ndarray, level: float, own: Loop) -> bool:
+    """Whether the part's outline ``own`` at ``level`` [m] across ``axis`` lies in a hole of
+    the base's slice there that has islands (:func:`_islands`): the part stands in that
+    pocket around them, not on them as on pins (a ring sunk over a pocket's core)."""
+    loops = slice_loops(base.mesh, axis, level)
+    return any(not outer(loop, loops) and _islands(loop, loops) and in_loop(own, loop) for loop in loops)
 
 
 def _part_slice(part: CadPart, base: CadPart, axis: np.ndarray) -> tuple[float, Loop] | None:
@@ -171,9 +194,13 @@ def receives(fit: HoleFit) -> bool:
     base's own in its hole, the gap between two of its bodies; a sliver whose mean width
     (twice its area over its perimeter) is at most :data:`executor.cad.fits.faces.TOUCH` is a
     gap between faces that touch, whatever symmetry rounding lends it (one of a Technic
-    pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z)."""
+    pin's slits, 0.816 x 0.000 mm, was a hole with ``ldraw_axles`` turned 90 deg about z).
+    An empty hole with islands is a pocket: no part is known to go in around them (a groove
+    round a pin of the base's own)."""
     if fit.hole.kind != "polygon":
         return True
+    if len(fit.hole.inner):  # around islands: no part is known to go in (a groove round a pin)
+        return False
     try:
         shape = polygon(fit.hole.outline, "hole")
     except OutlineError:  # no simple polygon: a gap of no area between faces that touch

@@ -37,7 +37,7 @@ def touching_gap(area: float, length: float) -> bool:
     return 2 * area <= TOUCH * length
 
 
-def _in_loop(outline: Loop, hole: Loop) -> bool:
+def in_loop(outline: Loop, hole: Loop) -> bool:
     """Whether a part's ``outline`` lies in the ``hole`` loop of another part's slice: at
     most the hole's sagitta (a round one's) plus :data:`executor.cad.fits.faces.TOUCH` beyond
     it, as a shaft tessellated at a nominal zero-clearance fit is (its vertices on the
@@ -83,7 +83,7 @@ def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float,
         # smallest first: of a part of several shells (a bearing's rings and balls) the
         # innermost hole around the part (the inner ring's bore, not the outer ring's inside)
         for loop in sorted((o for o in loops if not outer(o, loops)), key=lambda o: o.area):
-            inside = [o for o in own if loop.contains(o.centre) and _in_loop(o, loop)]
+            inside = [o for o in own if loop.contains(o.centre) and in_loop(o, loop)]
             if len(inside) == 1 and not (roomy(loop, inside[0]) and open_box(
                     loop.points, loop.extent[1], inside[0].extent[0], inside[0].centre, owner.mesh,
                     frame.T @ loop.centre + axis * level, axis)):
@@ -96,7 +96,7 @@ def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float,
 def bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float,
                 taken: Iterable[np.ndarray] = ()) -> tuple[np.ndarray, float] | None:
     """The centre (2,) [m] of the one outline of ``other`` that lies in an inner loop (a
-    bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`_in_loop`),
+    bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`in_loop`),
     of the bores around none of the points ``taken`` (2,) [m], and how far [m] from it the
     nearest outline of ``other`` in another inner loop of ``part`` lies (a plate's other
     dowel pin: inf when there is none); None when no bore holds exactly one."""
@@ -111,7 +111,7 @@ def bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray,
     theirs = slice_loops(other, axis, level)
     outlines = [o for o in theirs if outer(o, theirs)]
     for bore in bores:
-        inside = [o for o in outlines if bore.contains(o.centre) and _in_loop(o, bore)]
+        inside = [o for o in outlines if bore.contains(o.centre) and in_loop(o, bore)]
         if len(inside) == 1:
             centre = inside[0].centre
             apart = [float(np.linalg.norm(o.points - centre, axis=1).min()) for o in outlines

@@ -4,6 +4,7 @@ occupant's over the stretch the part passes, entry, depth and entry chamfer."""
 from __future__ import annotations
 
 import numpy as np
+import shapely
 import trimesh
 
 from executor import ExecutorError
@@ -36,17 +37,25 @@ def measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | No
     radial = base.mesh.vertices @ frame.T - sliced.centre
     around = (base.mesh.vertices @ axis)[np.linalg.norm(radial, axis=1) <= max(sliced.a, sliced.b)]
     entry = float(around.max())
+    line = _free_point(loop, sliced.centre)
     if occupant is None:  # as deep as a part can go in: to the floor down its centre line, or through
-        floor = first_hit(base.mesh, frame.T @ sliced.centre + axis * level, -axis)
+        floor = first_hit(base.mesh, frame.T @ line + axis * level, -axis)
         tip = float(around.min()) if floor is None else level - floor
     else:
         tip = float((occupant[0].mesh.vertices @ axis).min())
     low = max(tip, float(around.min()))
     spans: list[tuple[Loop, trimesh.Trimesh, float, bool]] = [(loop, base.mesh, low, True)]
+    bores: list[Loop] = []
     if occupant is not None:
         spans.append((occupant[1], occupant[0].mesh, tip, False))
+        if loop.inner:  # around islands: the occupant's bores over them, each free all along as a hole is
+            bores = _bores(occupant[0].mesh, axis, level, occupant[1])
+            spans += [(bore, occupant[0].mesh, tip, True) for bore in bores]
     narrowest, *occupied = forked_map(lambda span: over_span(span[0], span[1], axis, span[2], entry, hole=span[3]),
                                       spans, workers)
+    if occupied[1:]:  # a bore with something of the part in it (at the level or along) is left solid
+        kept = tuple(bore.points for bore in occupied[1:] if len(bore.points) >= 3 and not bore.inner)
+        occupied = [Loop(occupied[0].points, kept)]
     if occupant is None and len(narrowest.points) < 3:  # a floor not across the axis (a drill point's cone)
         low = level
         narrowest = over_span(loop, base.mesh, axis, low, entry, hole=True)
@@ -63,7 +72,7 @@ def measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | No
         hole = faceted(hole, narrowest, section, hole=True)
         section = faceted(section, occupied[0], hole, hole=False)
     centre = frame.T @ hole.centre + axis * level
-    bottom = first_hit(base.mesh, centre, -axis)
+    bottom = first_hit(base.mesh, frame.T @ _free_point(narrowest, hole.centre) + axis * level, -axis)
     depth = entry - (level - bottom if bottom is not None else float(around.min()))
     probe = [o for o in slice_loops(base.mesh, axis, entry - _ENTRY_PROBE) if o.contains(hole.centre)]
     chamfer = 0.0
@@ -72,3 +81,34 @@ def measure(base: CadPart, name: str, loop: Loop, level: float, outer: Loop | No
         chamfer = max(0.0, (top.b - hole.b) / 2 + _ENTRY_PROBE) if top.b > hole.b + 1e-7 else 0.0
     return HoleFit("", name, hole, (float(centre[0]), float(centre[1]), float(entry)), entry, depth, chamfer,
                    None if outer is None else classify(outer, hole=False), part, section)
+
+
+def _free_point(loop: Loop, centre: np.ndarray) -> np.ndarray:
+    """Where (2,) [m] a ray down the hole ``loop`` finds its floor: its ``centre``, or where
+    that lies on an island (:attr:`executor.cad.sections.Loop.inner`), a point of the
+    opening around it."""
+    if not loop.inner:
+        return centre
+    opening = shapely.Polygon(loop.points, loop.inner)
+    if opening.is_valid and opening.contains(shapely.Point(centre)):
+        return centre
+    return np.asarray(shapely.point_on_surface(shapely.make_valid(opening)).coords[0])
+
+
+def _bores(mesh: trimesh.Trimesh, axis: np.ndarray, level: float, own: Loop) -> list[Loop]:
+    """The inner loops of the part ``mesh``'s slice at ``level`` [m] across ``axis`` that lie
+    in its outline ``own`` with no other loop between them (its bores there), each with the
+    part's outlines that stand in it as its inner rings (a bearing's balls and inner race in
+    its outer race's bore: what the section must keep solid)."""
+    loops = slice_loops(mesh, axis, level)
+    inside = [o for o in loops if o.area < own.area and own.contains(o.centre)]
+
+    def direct(loop: Loop, among: list[Loop]) -> bool:
+        return not any(other is not loop and other.area > loop.area and other.contains(loop.centre)
+                       for other in among)
+
+    bores = [o for o in inside if direct(o, inside)]
+    return [Loop(bore.points, tuple(o.points for o in inside if o is not bore and o.area < bore.area
+                                    and bore.contains(o.centre)
+                                    and direct(o, [i for i in inside if i is not bore and bore.contains(i.centre)])))
+            for bore in bores]

@@ -52,7 +52,7 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     if why := _no_pieces(derived, pid):
         return f"goes onto a pin ({pin.id}), but {why}"
     out, under = standing_out(derived, pid, pin, in_place_before(derived, pid))
-    if out <= GRIP_CLEARANCE:  # sunk at its goal (a ring over an island of a pocket, flush with its top)
+    if out <= GRIP_CLEARANCE:  # sunk at its goal, or flush with what stands beside it
         return f"goes onto a pin ({pin.id}), but part '{pid}' {grip_for(out, under)[1]}: nothing to hold it by"
     return None
 
