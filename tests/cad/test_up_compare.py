@@ -66,3 +66,21 @@ def test_a_product_falling_over_on_its_held_base_where_another_up_stands_it_is_r
     why = drawn_up(lying)
     assert why is not None and "it would fall over but for its base held on the floor, where 1 other up(s) would " \
         'stand it by itself: the CAD may be drawn x up; set up = "+x" or --up +x' in why, why
+
+
+def test_the_up_the_rule_suggests_is_named_before_those_laying_the_base_flat_or_steadier() -> None:
+    # z up: a 120 x 30 x 50 mm block, two pegs sunk flush in blind holes from its top
+    # (pearl_peg_board). Drawn z down and read z up, the pegs are left downwards out of the
+    # block's bottom: upside down. Read y up the block lies on its 120 x 50 mm face, its
+    # largest, steadier (59 deg from tipping over, 31 as drawn), its holes opening sideways
+    block = _box((120.0, 30.0, 50.0), (0.0, 0.0, 25.0))
+    parts = {}
+    for k, x in enumerate((-30.0, 30.0)):
+        block = block.difference(_box((10.6, 10.6, 30.0), (x, 0.0, 40.0)))
+        parts[f"peg{k}"] = _box((10.0, 10.0, 24.8), (x, 0.0, 37.6))
+    derived = _derived({"block": block} | parts, "block")
+    assert drawn_up(derived) is None
+    why = drawn_up(turned_facts(derived, "-z"))
+    assert why is not None and why.endswith(
+        'all of them left along -z and the other parts within 0.000 mm of its box: the CAD may be drawn upside down '
+        '(z down); set up = "-z" or --up=-z (up = "+z" or --up +z if z is up)'), why

@@ -46,10 +46,10 @@ def drawn_up(derived: Derived) -> str | None:
     are not doubted and hold as well as the others (no other doubts them by
     :func:`executor.cad.upright.compare.compared`; where each is doubted so, all those not
     doubted), narrowed in turn, where that leaves some and drops some, to those that rest
-    the base on the floor (:func:`executor.cad.upright.gravity.resting`), lay its largest
-    flat faces level (:func:`largest_faces`), stand steadiest (their tipping angles,
-    :func:`executor.cad.upright.gravity.tipping`, within :data:`TIE` of the steadiest's)
-    and that the rule suggests; the rule's first, then in the order of
+    the base on the floor (:func:`executor.cad.upright.gravity.resting`), that the rule
+    suggests, that lay its largest flat faces level (:func:`largest_faces`) and that stand
+    steadiest (their tipping angles, :func:`executor.cad.upright.gravity.tipping`, within
+    :data:`TIE` of the steadiest's); the rule's first, then in the order of
     :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's (a
     gravity rule, which suggests none, then refuses nothing)."""
     found = _doubt(derived)
@@ -94,11 +94,11 @@ def _narrowed(ups: list[str], readings: dict[str, Derived], stances: dict[str, S
             ups, chosen = kept, words
 
     narrow([up for up in ups if stances[up].resting], "its base resting on the floor")
+    narrow([up for up in ups if up in suggested], "as the rule suggests")
     narrow([up for up in ups if _flat(readings[up])], "its base's largest flat faces level")
     best = max((stances[up].angle for up in ups), default=0.0)
     narrow([up for up in ups if stances[up].angle >= best - TIE],
            f"standing steadiest ({best:.1f} deg from tipping over)")
-    narrow([up for up in ups if up in suggested], "as the rule suggests")
     return ups, chosen
 
 
