@@ -46,7 +46,7 @@ def test_a_part_free_to_drop_where_another_up_holds_every_part_is_refused() -> N
     why = drawn_up(on_end)
     assert why is not None and why.startswith(
         "bearing_a would drop: free to go down and above the floor, no part under it keeping it up, where 4 other "
-        'up(s) would hold every part: the CAD may be drawn with another axis up; set up = "+x" or "-x" or "+y" or '
+        'up(s) would hold every part: the CAD may be drawn with another axis up; set up = "+y" or "+x" or "-x" or '
         '"-y"'), why
 
 

@@ -11,7 +11,6 @@ import numpy as np
 import trimesh
 
 from executor.cad.derive import Derived
-from executor.cad.parts import UP_AXES
 from executor.cad.upright.compare import TIE, compared
 from executor.cad.upright.gravity import Stance, base_unheld, falls_over, stance, turned_facts
 from executor.cad.upright.sides import from_below, lying
@@ -29,6 +28,13 @@ a coarse prism lying on a face (a hexagonal or octagonal bar: its horizontal pai
 as each tilted pair, less its holes) stands on it as drawn, where a product tilted by
 another angle than quarter turns rests on an edge or a corner, unless a face of its base
 lies at that angle."""
+NAMING = ("+y", "+x", "-x", "-y", "-z")
+"""The order the ups named are listed in where the preferences of :func:`drawn_up` leave
+several (after the rule's suggestion): +y first, the up of SolidWorks, Fusion 360,
+Inventor and glTF, the commonest other than z; then those of
+:data:`executor.cad.parts.UP_AXES`. A prior on how CAD is drawn, not a measure: the ups
+left are those whose readings no rule tells apart (a horizontal unit turned about its
+shaft)."""
 FLOOR = 1e-6
 """[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
 def drawn_up(derived: Derived) -> str | None:
@@ -49,16 +55,16 @@ def drawn_up(derived: Derived) -> str | None:
     the base on the floor (:func:`executor.cad.upright.gravity.resting`), that the rule
     suggests, that lay its largest flat faces level (:func:`largest_faces`) and that stand
     steadiest (their tipping angles, :func:`executor.cad.upright.gravity.tipping`, within
-    :data:`TIE` of the steadiest's); the rule's first, then in the order of
-    :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's (a
+    :data:`TIE` of the steadiest's); the rule's first, then in the order of :data:`NAMING`;
+    where no reading is undoubted, the rule's (a
     gravity rule, which suggests none, then refuses nothing)."""
     found = _doubt(derived)
     own = stance(derived)
     if found is None and own.resting and own.stands and not own.drops:
         return None
-    readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
+    readings = {up: turned_facts(derived, up) for up in NAMING}
     refused = {up: _doubt(reading) for up, reading in readings.items()}
-    undoubted = [up for up in UP_AXES if up in readings and refused[up] is None]
+    undoubted = [up for up in NAMING if refused[up] is None]
     stances = {up: stance(readings[up]) for up in undoubted}
     found = found or compared(derived, own, stances)
     if found is None:
