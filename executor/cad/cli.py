@@ -16,9 +16,9 @@ SOURCE is a STEP assembly or a folder of ``*.stl``/``*.obj`` meshes in the assem
 
 ``--up AXIS`` overrides ``up``: every part is turned right after reading by the rotation
 taking that axis to +z (:func:`executor.cad.parts.turned`). Without either, a product that
-looks drawn with another axis up (lying on its side, upside down, or unable to rest on the
-floor as read) is refused (:func:`drawn_up`). ``--place X,Y[,Z]`` overrides ``place``,
-``--turn DEG`` ``turn``.
+looks drawn with another axis up (lying on its side, upside down, unable to rest on the
+floor as read, or holding its parts less well than another up) is refused
+(:func:`drawn_up`). ``--place X,Y[,Z]`` overrides ``place``, ``--turn DEG`` ``turn``.
 Without either, a product whose base's centre lies
 outside the arm's reach (:data:`REACH`) is placed at :data:`WORK_POSITION`, and the import
 says so; without a z, the product's lowest point (of all its parts) goes to the cell's floor,

@@ -78,7 +78,7 @@ def test_the_shaft_unit_drawn_y_up_is_refused_naming_y_not_the_axis_of_its_bores
     # the bench's 20-part unit (two shafts along x through housings on a floor plate 200 mm
     # long) drawn y up stands read z up on the plate's 60 x 65 mm end, 200 mm tall, its bores
     # along x; read with x up its shafts would stand upright under the housings, the base
-    # 35 mm above the floor
+    # 35 mm above the floor, its lids and pulleys free to drop; read -y up the base would stand 5 mm up on its lids
     z_up = tmp_path / "z_up"
     z_up.mkdir()
     write_shafts(z_up, 20, 13)
@@ -87,8 +87,8 @@ def test_the_shaft_unit_drawn_y_up_is_refused_naming_y_not_the_axis_of_its_bores
     with pytest.raises(ExecutorError) as refused:
         run_import(cad, tmp_path / "read_z_up", "mm", cad / "import.toml")
     assert "the base base is thinnest along x" in str(refused.value)
-    assert ('the other parts standing out of it along -x; read with up = "+y" its base resting on the floor: the CAD '
-            'may be drawn y up; set up = "+y" or --up +y') in str(refused.value), str(refused.value)
+    assert ('the other parts standing out of it along -x: the CAD may be drawn y up; set up = "+y" or --up +y '
+            '(up = "+z"') in str(refused.value), str(refused.value)
 
 
 def test_a_product_assembled_wholly_from_below_is_refused_as_upside_down(tmp_path: Path) -> None:
@@ -113,14 +113,16 @@ def test_a_product_assembled_wholly_from_below_is_refused_as_upside_down(tmp_pat
 
 
 def test_a_base_held_off_the_floor_where_another_up_rests_it_steadier_is_refused(tmp_path: Path) -> None:
-    # z up: the housing and shaft above, with a collar on the shaft against each face of the
-    # housing. Drawn y up and read z up, the lower collar holds the housing 25 mm up on the
-    # upright shaft; read y up the housing rests on the floor, steadier
+    # z up: the housing and shaft above, the shaft's shoulder against the housing's +y face
+    # and a collar on the shaft against its -y face. Drawn y up and read z up, the shoulder
+    # holds the housing 25 mm up on the upright shaft (nothing would drop: the shaft stands
+    # on the floor, the collar on the housing); read y up the housing rests on the floor,
+    # steadier
     housing = _box((80.0, 50.0, 60.0), (0.0, 0.0, 30.0)).difference(_box((29.0, 80.0, 29.0), (0.0, 0.0, 30.0)))
-    parts = {"housing": housing, "shaft": _box((28.3, 100.0, 28.3), (0.0, 0.0, 30.0))}
-    for name, y in (("collar_a", 30.0), ("collar_b", -30.0)):
-        parts[name] = _box((50.0, 10.0, 50.0), (0.0, y, 30.0)).difference(_box((29.0, 20.0, 29.0), (0.0, y, 30.0)))
-    cad = _write(tmp_path / "cad", parts, "housing")
+    shaft = trimesh.boolean.union([_box((28.3, 100.0, 28.3), (0.0, 0.0, 30.0)),
+                                   _box((50.0, 10.0, 50.0), (0.0, 30.0, 30.0))], engine="manifold")
+    collar = _box((50.0, 10.0, 50.0), (0.0, -30.0, 30.0)).difference(_box((29.0, 20.0, 29.0), (0.0, -30.0, 30.0)))
+    cad = _write(tmp_path / "cad", {"housing": housing, "shaft": shaft, "collar": collar}, "housing")
     with pytest.raises(ExecutorError) as refused:
         run_import(cad, tmp_path / "read_z_up", "mm", cad / "import.toml")
     assert ("the base housing stands 25.000 mm above the product's lowest point on the parts under it, the "

@@ -11,8 +11,8 @@ import numpy as np
 import trimesh
 
 from executor.cad.derive import Derived
-from executor.cad.parts import UP_AXES
-from executor.cad.upright.gravity import base_unheld, falls_over, mm, raised, resting, tipping, turned_facts
+from executor.cad.upright.compare import TIE, compared
+from executor.cad.upright.gravity import Stance, base_unheld, falls_over, stance, turned_facts
 from executor.cad.upright.sides import from_below, lying
 
 TILT = 1.0
@@ -28,43 +28,53 @@ a coarse prism lying on a face (a hexagonal or octagonal bar: its horizontal pai
 as each tilted pair, less its holes) stands on it as drawn, where a product tilted by
 another angle than quarter turns rests on an edge or a corner, unless a face of its base
 lies at that angle."""
+NAMING = ("+y", "+x", "-x", "-y", "-z")
+"""The order the ups named are listed in where the preferences of :func:`drawn_up` leave
+several (after the rule's suggestion): +y first, the up of SolidWorks, Fusion 360,
+Inventor and glTF, the commonest other than z; then those of
+:data:`executor.cad.parts.UP_AXES`. A prior on how CAD is drawn, not a measure: the ups
+left are those whose readings no rule tells apart (a horizontal unit turned about its
+shaft)."""
 FLOOR = 1e-6
 """[m] how far above the base's lowest point a face it stands on may start (:func:`drawn_tilted`)."""
-TIE = 1.0
-"""[deg] ups whose readings stand within this of the steadiest one's tipping angle are named
-together (:func:`drawn_up`); a base off the floor is doubted where another up rests it there
-more than this steadier (:func:`_perched`)."""
-
-
 def drawn_up(derived: Derived) -> str | None:
     """Why the product looks drawn with another axis than z up, and the up to set; None
     when it does not. Doubted (:func:`_doubt`): its base's features and the parts' boxes
     say it lies on its side or upside down (:func:`executor.cad.upright.sides.lying`), or
+    it is assembled wholly from below (:func:`executor.cad.upright.sides.from_below`), or
     read as drawn it would fall over (:func:`executor.cad.upright.gravity.falls_over`) or
     its base would slide down the parts under it
-    (:func:`executor.cad.upright.gravity.base_unheld`), or its base stands off the floor
-    where another up would rest it there steadier (:func:`_perched`). The ups named are those whose
-    readings (:func:`executor.cad.upright.gravity.turned_facts`) are not doubted, narrowed
-    in turn, where that leaves some and drops some, to those that rest the base on the
-    floor (:func:`executor.cad.upright.gravity.resting`), lay its largest flat faces level
-    (:func:`largest_faces`), stand steadiest (their tipping angles,
-    :func:`executor.cad.upright.gravity.tipping`, within :data:`TIE` of the steadiest's)
-    and that the rule suggests; the rule's first, then in the order of
-    :data:`executor.cad.parts.UP_AXES`; where no reading is undoubted, the rule's (a
+    (:func:`executor.cad.upright.gravity.base_unheld`); or, compared with its readings with
+    the other ups that are not doubted
+    (:func:`executor.cad.upright.gravity.turned_facts`), one of them holds its parts, stands
+    it or rests its base on the floor where it does not
+    (:func:`executor.cad.upright.compare.compared`). The ups named are those whose readings
+    are not doubted and hold as well as the others (no other doubts them by
+    :func:`executor.cad.upright.compare.compared`; where each is doubted so, all those not
+    doubted), narrowed in turn, where that leaves some and drops some, to those that rest
+    the base on the floor (:func:`executor.cad.upright.gravity.resting`), that the rule
+    suggests, that lay its largest flat faces level (:func:`largest_faces`) and that stand
+    steadiest (their tipping angles, :func:`executor.cad.upright.gravity.tipping`, within
+    :data:`TIE` of the steadiest's); the rule's first, then in the order of :data:`NAMING`;
+    where no reading is undoubted, the rule's (a
     gravity rule, which suggests none, then refuses nothing)."""
     found = _doubt(derived)
-    if found is None and resting(derived):
+    own = stance(derived)
+    if found is None and own.resting and own.stands and not own.drops:
         return None
-    readings = {up: turned_facts(derived, up) for up in UP_AXES if up != "+z"}
+    readings = {up: turned_facts(derived, up) for up in NAMING}
     refused = {up: _doubt(reading) for up, reading in readings.items()}
-    undoubted = [up for up in UP_AXES if up in readings and refused[up] is None]
-    found = found or _perched(derived, {up: readings[up] for up in undoubted})
+    undoubted = [up for up in NAMING if refused[up] is None]
+    stances = {up: stance(readings[up]) for up in undoubted}
+    found = found or compared(derived, own, stances)
     if found is None:
         return None
     why, suggested = found
     if not suggested and not undoubted:
         return None  # a gravity rule names no up of its own: it refuses only where another up reads it undoubted
-    ups, chosen = _narrowed(undoubted, readings, suggested)
+    holding = [up for up in undoubted
+               if compared(readings[up], stances[up], {o: s for o, s in stances.items() if o != up}) is None]
+    ups, chosen = _narrowed(holding or undoubted, readings, stances, suggested)
     ups = sorted(ups, key=lambda up: up not in suggested)
     for up in suggested:
         doubt = refused[up]
@@ -77,10 +87,11 @@ def drawn_up(derived: Derived) -> str | None:
         ' (up = "+z" or --up +z if z is up)'
 
 
-def _narrowed(ups: list[str], readings: dict[str, Derived], suggested: list[str]) -> tuple[list[str], str]:
-    """The ``ups`` whose ``readings`` are not doubted narrowed by the preferences of
-    :func:`drawn_up` (each where it leaves some and drops some), and the words of the last
-    that narrowed them ("": none did)."""
+def _narrowed(ups: list[str], readings: dict[str, Derived], stances: dict[str, Stance],
+              suggested: list[str]) -> tuple[list[str], str]:
+    """The ``ups`` whose ``readings`` (their ``stances``) are not doubted narrowed by the
+    preferences of :func:`drawn_up` (each where it leaves some and drops some), and the
+    words of the last that narrowed them ("": none did)."""
     chosen = ""
 
     def narrow(kept: list[str], words: str) -> None:
@@ -88,12 +99,12 @@ def _narrowed(ups: list[str], readings: dict[str, Derived], suggested: list[str]
         if kept and len(kept) < len(ups):
             ups, chosen = kept, words
 
-    narrow([up for up in ups if resting(readings[up])], "its base resting on the floor")
-    narrow([up for up in ups if _flat(readings[up])], "its base's largest flat faces level")
-    steady = {up: tipping(readings[up])[0] for up in ups}
-    best = max(steady.values(), default=0.0)
-    narrow([up for up in ups if steady[up] >= best - TIE], f"standing steadiest ({best:.1f} deg from tipping over)")
+    narrow([up for up in ups if stances[up].resting], "its base resting on the floor")
     narrow([up for up in ups if up in suggested], "as the rule suggests")
+    narrow([up for up in ups if _flat(readings[up])], "its base's largest flat faces level")
+    best = max((stances[up].angle for up in ups), default=0.0)
+    narrow([up for up in ups if stances[up].angle >= best - TIE],
+           f"standing steadiest ({best:.1f} deg from tipping over)")
     return ups, chosen
 
 
@@ -106,23 +117,6 @@ def _flat(derived: Derived) -> bool:
     """Whether the base's largest flat faces (:func:`largest_faces`) lie horizontal, within :data:`TILT`."""
     normal, _ = largest_faces(derived.parts[derived.base].mesh)
     return float(normal[2]) >= math.cos(math.radians(TILT))
-
-
-def _perched(derived: Derived, undoubted: dict[str, Derived]) -> tuple[str, list[str]] | None:
-    """Why the product read as ``derived``, its base held off the floor by the parts under
-    it, looks drawn with another up, and the ups whose readings (``undoubted``: those no
-    rule doubts, :func:`_doubt`) rest the base on the floor standing steadier than it does
-    by more than :data:`TIE` (:func:`executor.cad.upright.gravity.tipping`), steadiest
-    first; None where none does. Assumed: a product drawn with its up rests its base on
-    the floor where another up would rest it there undoubted and steadier."""
-    angle = tipping(derived)[0]
-    steadier = {up: tipping(reading)[0] for up, reading in undoubted.items() if resting(reading)}
-    ups = sorted((up for up, steady in steadier.items() if steady > angle + TIE), key=lambda up: -steadier[up])
-    if not ups:
-        return None
-    return (f"the base {derived.base} stands {mm(raised(derived))} mm above the product's lowest point on the parts "
-            f"under it, the product {angle:.1f} deg from tipping over, where {len(ups)} other up(s) would rest the "
-            f"base on the floor steadier (up to {steadier[ups[0]]:.1f} deg)", ups)
 
 
 def _doubt(derived: Derived) -> tuple[str, list[str]] | None:

@@ -1,6 +1,7 @@
 """Whether a product read with a given up could rest on the floor as assembled
 (docs/import.md, "The up axis"): its centre of mass over what it stands on
-(:func:`tipping`), its base held up (:func:`base_unheld`); and the facts of a product
+(:func:`tipping`), its base held up (:func:`base_unheld`), its parts held where they are
+drawn (:func:`dropping`), those three as one :class:`Stance`; and the facts of a product
 turned as another up reads them (:func:`turned_facts`), to check the up a refusal names.
 
 Assumed: a product drawn with its up stands on the floor by itself as assembled, or rests
@@ -126,6 +127,48 @@ def base_unheld(derived: Derived) -> str | None:
         return None
     return (f"the base {base} stands {mm(above)} mm above the product's lowest point and no part keeps it from "
             f"going down: it would slide down {', '.join(loose)}")
+
+
+def dropping(derived: Derived) -> list[str]:
+    """The parts that as read would drop (their moving bodies', :attr:`Derived.bodies`):
+    free to go down (nothing blocks the body along -z: it leaves the product that way),
+    its lowest point more than :data:`CONTACT` above the product's (not on the floor), and
+    no part of it in a screwed pair or a press fit with a part outside it (held by its
+    thread or its interference, where the model lets it slide)."""
+    lowest = min(float(part.mesh.bounds[0][2]) for part in derived.parts.values())
+    pairs = [{slide.shaft, slide.bore} for slide in derived.slides if slide.pitch or slide.interference]
+    found: list[str] = []
+    for root, members in derived.bodies.items():
+        bottom = min(float(derived.parts[pid].mesh.bounds[0][2]) for pid in members)
+        held = any(pair & members and pair - members for pair in pairs)
+        if derived.blockers.get((root, "-z")) or bottom <= lowest + CONTACT or held:
+            continue
+        found += sorted(members)
+    return sorted(found)
+
+
+@dataclasses.dataclass(frozen=True)
+class Stance:
+    """How a product as read rests on the floor: its base on it (:func:`resting`), how far
+    it stands from tipping over (:func:`tipping`: the angle [deg], negative past its edge,
+    and how far [m] its centre of mass lies outside), and its parts that would drop
+    (:func:`dropping`)."""
+
+    resting: bool
+    angle: float
+    outside: float
+    drops: tuple[str, ...]
+
+    @property
+    def stands(self) -> bool:
+        """Whether it stands by itself: its centre of mass outside what it stands on by at most :data:`TIPPED`."""
+        return self.angle >= -TIPPED
+
+
+def stance(derived: Derived) -> Stance:
+    """The :class:`Stance` of the product read as ``derived``."""
+    angle, outside = tipping(derived)
+    return Stance(resting(derived), angle, outside, tuple(dropping(derived)))
 
 
 def mm(value: float) -> str:
