@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 import shapely
 import trimesh
 
@@ -151,6 +152,7 @@ def _l_pocket(folder: Path, block: tuple[float, float]) -> None:
     _box((14.0, 14.0, 10.0), (block[0], block[1], 15.0)).export(folder / "block.stl")
 
 
+@pytest.mark.slow  # an import (3 s); the narrow leg's room: the quick test of room_at below
 def test_a_block_held_in_the_narrow_leg_of_an_l_pocket_is_in_a_hole(tmp_path: Path) -> None:
     # In the 18 mm leg the 14 mm block has 4 mm across: the pocket locates it. Its width was
     # its minimum-area rectangle's short side (80 mm), so the block lay in an open box.
