@@ -58,6 +58,7 @@ def _case(folder: Path, *, peg: bool, block: tuple[float, float]) -> None:
     _box((30.0, 30.0, 10.0), (block[0], block[1], 15.0)).export(folder / "block.stl")
 
 
+@pytest.mark.slow  # an import (2 s); a block in an open box in no hole: the L pocket's roomy leg (quick)
 def test_a_block_resting_in_an_open_case_is_in_no_hole(tmp_path: Path) -> None:
     # The block lies 2 mm off two walls of the case's 100 mm cavity: the import took the
     # cavity for a square hole holding the block (35 mm all round), and the peg fitting it.

@@ -307,6 +307,7 @@ def test_a_plate_whose_bore_is_too_small_for_its_dowel_pin_is_refused() -> None:
         derive([CadPart("base", "base", base, "test"), CadPart("plate", "plate", plate, "test")], "base", {})
 
 
+@pytest.mark.slow  # three parts derived (1.4 s); a plate's second bore: the quick tests of the dowels and the disk arm
 def test_a_dowel_pin_in_another_part_s_bore_is_no_second_pin_of_the_plate() -> None:
     # the plate's second bore (d 12.4) goes over a sleeve (d 12, its d 8.2 bore on the d 8
     # pin), not onto the pin: the plate is on the d 6 pin alone, the sleeve on the d 8, and
