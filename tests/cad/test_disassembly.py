@@ -170,6 +170,7 @@ def _rings_on_posts() -> list[CadPart]:
     return _parts(base=base, left=rings[0], right=rings[1])
 
 
+@pytest.mark.slow  # four derivations (2 s); the sweeps and surveys in two processes: quick tests of their own
 def test_the_holes_and_pins_in_two_processes_are_those_of_one(monkeypatch: pytest.MonkeyPatch) -> None:
     for parts, base in ((_shaft_in_bearing(), "housing"), (_rings_on_posts(), "base")):
         found = []

@@ -75,6 +75,7 @@ def test_a_rounding_below_the_floor_moves_nothing(tmp_path: Path) -> None:
     assert run_import(beyond, tmp_path / "out2", "mm", None).offset[2] == pytest.approx(2 * FLOOR_TOLERANCE, rel=1e-6)
 
 
+@pytest.mark.slow  # two imports and two teachings (2 s); the import on the floor: the quick tests above
 def test_the_peg_of_a_product_drawn_centred_on_the_origin_is_taught(tmp_path: Path) -> None:
     # Cut by the floor (its lowest point kept at z = -25 mm, as drawn), the floor stops the
     # peg 4.5 mm short of the hole's bottom; on the floor the teaching reaches it.

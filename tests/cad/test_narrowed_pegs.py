@@ -73,6 +73,7 @@ def test_a_zero_clearance_peg_in_a_mesh_base_is_narrowed_by_the_cell(imported: P
     assert not assembly.tried_by_hand("peg1", "h1", "sim")
 
 
+@pytest.mark.slow  # an import (2 s); the cell's refusal of that peg: the quick test after it
 def test_a_peg_the_narrowing_would_let_into_another_hole_is_placed_by_hand(tmp_path: Path) -> None:
     # peg1 d 20 at room 0 in its d 20 bore; beside it a d 19.8 bore (with its d 19.6 peg):
     # peg1 misses it by 0.1 mm per side, and 0.15 mm narrower would pass it.

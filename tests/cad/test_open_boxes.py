@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 import shapely
 import trimesh
 
@@ -57,6 +58,7 @@ def _case(folder: Path, *, peg: bool, block: tuple[float, float]) -> None:
     _box((30.0, 30.0, 10.0), (block[0], block[1], 15.0)).export(folder / "block.stl")
 
 
+@pytest.mark.slow  # an import (2 s); a block in an open box in no hole: the L pocket's roomy leg (quick)
 def test_a_block_resting_in_an_open_case_is_in_no_hole(tmp_path: Path) -> None:
     # The block lies 2 mm off two walls of the case's 100 mm cavity: the import took the
     # cavity for a square hole holding the block (35 mm all round), and the peg fitting it.
@@ -151,6 +153,7 @@ def _l_pocket(folder: Path, block: tuple[float, float]) -> None:
     _box((14.0, 14.0, 10.0), (block[0], block[1], 15.0)).export(folder / "block.stl")
 
 
+@pytest.mark.slow  # an import (3 s); the narrow leg's room: the quick test of room_at below
 def test_a_block_held_in_the_narrow_leg_of_an_l_pocket_is_in_a_hole(tmp_path: Path) -> None:
     # In the 18 mm leg the 14 mm block has 4 mm across: the pocket locates it. Its width was
     # its minimum-area rectangle's short side (80 mm), so the block lay in an open box.

@@ -8,6 +8,7 @@ whose pieces are too thin for it (the gear's 2 mm teeth)."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import re
 import tomllib
@@ -306,6 +307,7 @@ def test_a_plate_whose_bore_is_too_small_for_its_dowel_pin_is_refused() -> None:
         derive([CadPart("base", "base", base, "test"), CadPart("plate", "plate", plate, "test")], "base", {})
 
 
+@pytest.mark.slow  # three parts derived (1.4 s); a plate's second bore: the quick tests of the dowels and the disk arm
 def test_a_dowel_pin_in_another_part_s_bore_is_no_second_pin_of_the_plate() -> None:
     # the plate's second bore (d 12.4) goes over a sleeve (d 12, its d 8.2 bore on the d 8
     # pin), not onto the pin: the plate is on the d 6 pin alone, the sleeve on the d 8, and
@@ -404,7 +406,12 @@ def test_a_part_with_a_zero_clearance_fit_on_another_pin_the_cell_cannot_widen_i
                         manual["washer"]["reason"]), manual["washer"]["reason"]
 
 
-def _stepped(nut_z: tuple[float, float] = (12.0, 16.0)) -> Derived:
+LOW_NUT = (12.0, 16.0)
+"""[mm] the nut's bottom and top in :func:`_stepped` with the knob's foot 8 mm above it."""
+
+
+@functools.cache  # each product derived once a process: the knob's test and a near miss's share LOW_NUT
+def _stepped(nut_z: tuple[float, float]) -> Derived:
     """A base with a stepped pin (a pot's thread d 8, z 10 to 20 mm, under its shaft: d 6.1,
     z 20 to 25, then a D of that circle cut flat 1.5 mm from its axis, z 25 to 35), a nut
     (bore d 8.2, from ``nut_z`` [0] to [1] [mm]) on the thread and a knob (z 22 to 38) on the shaft: a round
@@ -435,7 +442,7 @@ def test_a_knob_on_a_pins_narrower_step_is_on_a_pin_of_its_own_not_the_nuts_belo
     # stretch, the thread, so the knob's bore was judged against the thread (no fit), and
     # the D-shaft, whose centroid lies off the axis, was a second, empty pin of its own.
     mm = 1e-3
-    derived = _stepped()
+    derived = _stepped(LOW_NUT)
     assert sorted((pin.parts, round(pin.section.a / mm, 2)) for pin in derived.pins.values()) == [
         (("knob",), 6.1), (("nut",), 8.0)]
     rooms = margins(derived)
@@ -446,7 +453,7 @@ def test_a_knob_on_a_pins_narrower_step_is_on_a_pin_of_its_own_not_the_nuts_belo
 
 
 
-@pytest.mark.parametrize(("nut_z", "near"), [((17.5, 19.5), True), ((12.0, 16.0), False)])
+@pytest.mark.parametrize(("nut_z", "near"), [((17.5, 19.5), True), (LOW_NUT, False)])
 def test_a_part_stopped_on_a_pins_wider_step_within_the_goal_tolerance_is_a_near_miss_of_it(
         nut_z: tuple[float, float], near: bool) -> None:
     # nop_pot_knob: the knob, whose bore does not pass the thread below its shaft, stops on

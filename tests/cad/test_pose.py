@@ -66,6 +66,7 @@ def test_however_the_cad_is_turned_the_cell_puts_the_ring_on_and_the_answers_hol
     assert all(found == answers[0] for found in answers)
 
 
+@pytest.mark.slow  # three imports (2 s); a turn set kept: the first test's turn = 0, best_pose's below
 def test_a_turn_or_place_the_user_sets_is_kept(tmp_path: Path) -> None:
     out, turn, _ = _imported(tmp_path / "config", ImportOptions(), 'base = "block"\nturn = 0\n')
     geometry = load_product_description(out).geometry

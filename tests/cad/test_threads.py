@@ -231,6 +231,7 @@ def test_a_screw_in_a_tap_drill_hole_reaches_a_session(run_main: Runner, tmp_pat
     assert "the cell has no screwing operation" in result["assembly"]["manual_reasons"]["screw"]
 
 
+@pytest.mark.slow  # the corpus screw and nut derived (1.5 s); a clamped part before its screw: the bracket's test
 def test_the_screw_goes_after_the_plate_it_clamps_on_its_nut() -> None:
     # A plate with a d 7 clearance hole between the nut's top (z 6.095) and the screw's head
     # (z 9.525): the head closes the plate's way up, the shank its ways across, so the plate

@@ -69,14 +69,14 @@ def test_missed_cycles_are_filled_in_on_the_1_ms_grid() -> None:
     assert np.allclose(np.abs(q[:, 0]), 1.0) and np.all(q[:, 0] * q[0, 0] > 0)  # the sign flip undone
 
 
-def test_hand_guiding_needs_the_franka_backend(run_executor) -> None:
-    done = run_executor("teach", "--assembly", str(TRIO), "--demonstration", "hand")
+def test_hand_guiding_needs_the_franka_backend(run_main) -> None:
+    done = run_main("executor", "teach", "--assembly", str(TRIO), "--demonstration", "hand")
     assert done.returncode == 2 and "--backend franka" in done.stderr and "Traceback" not in done.stderr, done.stderr
 
 
-def test_teaching_on_the_arm_refuses_an_offset_it_would_not_apply(run_executor) -> None:
-    done = run_executor("teach", "--assembly", str(TRIO), "--backend", "franka", "--backend-option", "host=127.0.0.9",
-                        "--backend-option", "offset=0.01,0,0")
+def test_teaching_on_the_arm_refuses_an_offset_it_would_not_apply(run_main) -> None:
+    done = run_main("executor", "teach", "--assembly", str(TRIO), "--backend", "franka",
+                    "--backend-option", "host=127.0.0.9", "--backend-option", "offset=0.01,0,0")
     assert done.returncode == 2 and "offset=0,0,0" in done.stderr and "Traceback" not in done.stderr, done.stderr
 
 

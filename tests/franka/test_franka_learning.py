@@ -118,12 +118,12 @@ def test_skills_taught_on_the_arm_are_stored(taught: Taught) -> None:
 
 @pytest.mark.timeout(2400)
 def test_a_session_on_the_taught_skills_learns_the_fits_and_assemble_places_every_peg(
-        taught: Taught, run_cli, tmp_path: Path) -> None:
+        taught: Taught, run_main, tmp_path: Path) -> None:
     assert taught.teach.returncode == 0, taught.teach.stderr
     folder, sim, run = taught.folder, taught.sim, tmp_path / "run"
     _, _, truth = sizes_truth(folder / "sizes.lp")
-    done = run_cli("session", "--assembly", str(folder), "--cells", "1", *taught.arm,
-                         "--timeout", "1500", "--json", "--out", str(run), timeout=1700)
+    done = run_main("session", "--assembly", str(folder), "--cells", "1", *taught.arm,
+                    "--timeout", "1500", "--json", "--out", str(run))
     assert done.returncode == 0, (done.stderr, done.stdout)
     LOG.info("teaching and session: %.1f s of robot time", sim.truth().time)
     result = json.loads(done.stdout)
@@ -138,8 +138,7 @@ def test_a_session_on_the_taught_skills_learns_the_fits_and_assemble_places_ever
         waited = np.array(geometry.parts[part].start) + np.array([GRASP_ERROR, 0.0])
         assert np.linalg.norm(position[:2] - waited) < BACK and abs(position[2]) < 0.001, (part, position)
         assert abs(quat[0]) > np.cos(np.radians(5) / 2), (part, quat)
-    done = run_cli("assemble", "--run", str(run), *taught.arm, "--timeout", "600", "--json",
-                         timeout=1400)
+    done = run_main("assemble", "--run", str(run), *taught.arm, "--timeout", "600", "--json")
     assert done.returncode == 0, (done.stderr, done.stdout)  # stdout: the steps' goal errors, if it got there
     report = json.loads(done.stdout)
     world = sim.truth()
