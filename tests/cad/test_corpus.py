@@ -109,10 +109,7 @@ UNSIMULATED: dict[str, str] = {}
     "bosl2_screw_nut",
     "nop_pot_knob",
     "bdw_pillow_block",
-    pytest.param("cubefactory_cutting_unit", marks=_xfail(
-        "a hollow pin: the clamping flange's bore (d 30) round the coupling's d 29 outside, the coupling on the "
-        "shaft's end, is taken for a bore on the shaft's pin inside both (room 2.5), so the coupling's outside is "
-        "no feature")),
+    "cubefactory_cutting_unit",
     pytest.param("pearl_peg_board", marks=_xfail(
         "a pocket of the base with an island in it (PEARL's digits 0 and 4 over their counters): the import "
         "reads the islands as pins and the pegs onto them, not the pockets around them as holes (h0, h4); the "
