@@ -146,13 +146,16 @@ def _pin_in(bore: Loop, other: trimesh.Trimesh, axis: np.ndarray, level: float, 
             ) -> list[Loop] | None:
     """The outlines of ``other`` (its slice's ``outlines`` at ``level`` [m] along removal
     direction ``axis``) that lie in ``bore`` when they are one pin: one outline, or several
-    that one outline of ``other`` holds beyond the level along the axis, towards the pin's
-    free end, which a part going off passes (a sleeve slit into halves at one end and whole
-    at its other, :data:`HOLE_LEVELS` levels tried, longest spans first); None otherwise
-    (two dowel pins in one slot, a bearing's rings and balls: no one pin)."""
+    side by side that one outline of ``other`` holds beyond the level along the axis,
+    towards the pin's free end, which a part going off passes (a sleeve slit into halves at
+    one end and whole at its other, :data:`HOLE_LEVELS` levels tried, longest spans first);
+    None otherwise (two dowel pins in one slot; a bearing's rings and balls, one inside
+    another: which of them the bore holds is not measured)."""
     inside = [o for o in outlines if bore.contains(o.centre) and _in_loop(o, bore)]
     if len(inside) <= 1:
         return inside or None
+    if any(o is not i and o.contains(i.centre) for o in inside for i in inside):
+        return None
     along = other.vertices @ axis
     for beyond in spans(along, level, float(along.max()))[:HOLE_LEVELS]:
         loops = slice_loops(other, axis, beyond)
