@@ -2,15 +2,18 @@
 that is on a shaft goes onto the sleeve (a pin of the sleeve, measured on its outside),
 not onto the shaft inside both, whichever of them sorts first; a sleeve slit into halves
 where the collar is and whole towards its free end is one pin (cubefactory_cutting_unit's
-clamping flange round its coupling); two pins in one slot are none."""
+clamping flange round its coupling); two pins in one slot are none, nor two outlines of one
+part one inside the other (a bearing's rings)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import shapely
 import trimesh
 
 from executor.cad.derive import derive
+from executor.cad.derive.loops import bore_around
 from executor.cad.operations.rooms import margins
 from executor.cad.parts import CadPart
 
@@ -72,3 +75,14 @@ def test_two_pins_in_one_slot_are_no_pin() -> None:
     plate = _prism(shapely.box(-20, -10, 20, 10).difference(slot), 10, 14)
     derived = derive([CadPart("base", "base", base, "test"), CadPart("plate", "plate", plate, "test")], "base", {})
     assert derived.pins == {}
+
+
+def test_outlines_of_one_part_one_inside_another_are_no_pin() -> None:
+    # a bearing-like part (an outer ring d 20, an inner ring d 12 inside it, joined by a cap
+    # beyond): a collar's bore round both holds two outlines, one inside the other; which
+    # of them it is on is not measured, so it is on no pin there
+    rings = trimesh.boolean.union([_prism(_disc(10.0).difference(_disc(8.0)), 0, 10),
+                                   _prism(_disc(6.0).difference(_disc(4.0)), 0, 10), _prism(_disc(10.0), 10, 12)],
+                                  engine="manifold")
+    collar = _prism(_disc(14.0).difference(_disc(10.3)), 2, 8)
+    assert bore_around(collar, rings, np.array([0.0, 0.0, 1.0]), 5 * MM) is None
