@@ -60,8 +60,10 @@ its occupants.
 
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)
-around a solid loop of another part there (the base's pin, another part's shaft), that
-part the base or one the geometric precedence puts before it, goes onto that pin (onto
+around a solid loop of another part there (the base's pin, another part's shaft; or the
+pieces of one loop, whole beyond them towards the pin's free end: a slit sleeve's halves),
+that part the base or one the geometric precedence puts before it, and no other such
+part round it in the bore (a collar round a sleeve on a shaft: the sleeve's), goes onto that pin (onto
 every pin of such parts in a bore of its own: a plate on two dowel pins of the base, an
 arm on the base's pivot pin through its bore and on a disk's nipple through its slot); a peg
 standing in a hole of the base is a pin only of a part going in along another axis (a

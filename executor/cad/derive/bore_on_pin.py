@@ -30,15 +30,17 @@ _PIN_LEVELS = 64
 """How many spans :func:`pin_of` measures a part's bore and its pin over, split at the ends of the longest."""
 
 
-def pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[np.ndarray] = ()
-           ) -> tuple[Shape2D, Shape2D, np.ndarray, float] | None:
+def pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[np.ndarray] = (),
+           around: Iterable[str] = ()) -> tuple[Shape2D, Shape2D, np.ndarray, float] | None:
     """Part ``pid`` on a pin of ``owner`` along removal direction ``name``: the pin's
     section, the bore's, the pin's centre [m] and the level [m] along the direction they
     were measured at; None when no level tried has one of ``pid``'s inner loops (its bore)
     around exactly one outline of ``owner`` lying in it (within the bore's sagitta and
-    :data:`executor.cad.fits.faces.TOUCH`, as a nominal zero-clearance fit lies), no bore around
-    a point of ``taken`` (the centres [m] across the axis of pins the part is on already: it
-    goes onto another pin only through another bore of its own). The pin is the owner's
+    :data:`executor.cad.fits.faces.TOUCH`, as a nominal zero-clearance fit lies; or the
+    pieces of one, :func:`executor.cad.derive.loops.bore_around`), no bore around a point of
+    ``taken`` (the centres [m] across the axis of pins the part is on already: it goes onto
+    another pin only through another bore of its own), nor one where a part of ``around``
+    (the other parts ``pid`` may go onto) lies round the pin in the bore. The pin is the owner's
     within the part's reach across the axis, short of the owner's outlines in the part's
     other bores by twice :data:`SAME_HOLE` (a plate's other dowel pin is not this one). The levels
     tried: the middle of the part's extent along the direction, then
@@ -68,9 +70,10 @@ def pin_of(derived: Derived, pid: str, name: str, owner: str, taken: Iterable[np
     if high - low <= 1e-6:
         return None
     middle = float(along.min() + along.max()) / 2
+    meshes = [derived.parts[q].mesh for q in around if q not in (pid, owner)]
     hit = next((found for level in ([middle] if low < middle < high else [])
                 + spans(other_along, low, high)[:HOLE_LEVELS]
-                if (found := bore_around(part, other, axis, level, taken)) is not None), None)
+                if (found := bore_around(part, other, axis, level, taken, meshes)) is not None), None)
     if hit is None:
         return None
     line, apart = hit

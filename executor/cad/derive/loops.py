@@ -6,7 +6,7 @@ another part's outline (:func:`bore_around`)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 import shapely
@@ -94,28 +94,76 @@ def hole_around(owner: CadPart, part: CadPart, axis: np.ndarray) -> tuple[float,
 
 
 def bore_around(part: trimesh.Trimesh, other: trimesh.Trimesh, axis: np.ndarray, level: float,
-                taken: Iterable[np.ndarray] = ()) -> tuple[np.ndarray, float] | None:
-    """The centre (2,) [m] of the one outline of ``other`` that lies in an inner loop (a
-    bore) of ``part`` on their slices at ``level`` [m] along ``axis`` (:func:`in_loop`),
-    of the bores around none of the points ``taken`` (2,) [m], and how far [m] from it the
-    nearest outline of ``other`` in another inner loop of ``part`` lies (a plate's other
-    dowel pin: inf when there is none); None when no bore holds exactly one."""
+                taken: Iterable[np.ndarray] = (), around: Sequence[trimesh.Trimesh] = ()
+                ) -> tuple[np.ndarray, float] | None:
+    """The centre line (2,) [m] of the pin of ``other`` that lies in an inner loop (a bore)
+    of ``part`` on their slices at ``level`` [m] along removal direction ``axis``
+    (:func:`_pin_in`: one outline of ``other``, or the pieces of one, a slit sleeve's
+    halves), of the bores around none of the points ``taken`` (2,) [m], and how far [m]
+    from it the nearest outline of ``other`` in another inner loop of ``part`` lies (a
+    plate's other dowel pin: inf when there is none); None when no bore holds such a pin.
+    A bore where a part of ``around`` (the other parts it may go onto) lies round that pin
+    is not on it (a collar round a sleeve on a shaft is on the sleeve, not on the shaft):
+    the outlines of that part in the bore, taken together (their convex hull), cover it."""
     own = slice_loops(part, axis, level)
     bores = [o for o in own if not outer(o, own) and not any(o.contains(point) for point in taken)]
-    if not bores:
-        return None
-    across = other.vertices @ frame_of(axis).T
-    if not any(np.all((across >= bore.points.min(axis=0)) & (across <= bore.points.max(axis=0)), axis=1).any()
-               for bore in bores):
+    frame = frame_of(axis)
+    if not any(_in_box(other, frame, bore) for bore in bores):
         return None  # nothing of the other part in a bore's box across the axis, at any level: no slice needed
     theirs = slice_loops(other, axis, level)
     outlines = [o for o in theirs if outer(o, theirs)]
     for bore in bores:
-        inside = [o for o in outlines if bore.contains(o.centre) and in_loop(o, bore)]
-        if len(inside) == 1:
-            centre = inside[0].centre
-            apart = [float(np.linalg.norm(o.points - centre, axis=1).min()) for o in outlines
-                     if o is not inside[0] and any(h is not bore and h.contains(o.centre) for h in own
-                                                   if not outer(h, own))]
-            return centre, min(apart, default=math.inf)
+        inside = _pin_in(bore, other, axis, level, outlines)
+        if inside is None:
+            continue
+        pin = _hull(inside)
+        if any(_hull(loops).buffer(TOUCH).covers(pin) for mesh in around if _in_box(mesh, frame, bore)
+               and (loops := _outlines_in(bore, mesh, axis, level))):
+            continue
+        centre = inside[0].centre if len(inside) == 1 else np.array(pin.centroid.coords[0])
+        apart = [float(np.linalg.norm(o.points - centre, axis=1).min()) for o in outlines
+                 if all(o is not i for i in inside) and any(h is not bore and h.contains(o.centre) for h in own
+                                                             if not outer(h, own))]
+        return centre, min(apart, default=math.inf)
     return None
+
+
+def _in_box(mesh: trimesh.Trimesh, frame: np.ndarray, bore: Loop) -> bool:
+    """Whether a vertex of ``mesh`` lies in the box of ``bore`` across the axis of
+    ``frame`` (:func:`executor.cad.sections.frame_of`) at any level: else no outline of
+    the mesh lies in the bore."""
+    across = mesh.vertices @ frame.T
+    return bool(np.all((across >= bore.points.min(axis=0)) & (across <= bore.points.max(axis=0)), axis=1).any())
+
+
+def _outlines_in(bore: Loop, mesh: trimesh.Trimesh, axis: np.ndarray, level: float) -> list[Loop]:
+    """The outlines of ``mesh``'s slice at ``level`` [m] along ``axis`` that lie in ``bore``."""
+    loops = slice_loops(mesh, axis, level)
+    return [o for o in loops if outer(o, loops) and bore.contains(o.centre) and in_loop(o, bore)]
+
+
+def _pin_in(bore: Loop, other: trimesh.Trimesh, axis: np.ndarray, level: float, outlines: list[Loop]
+            ) -> list[Loop] | None:
+    """The outlines of ``other`` (its slice's ``outlines`` at ``level`` [m] along removal
+    direction ``axis``) that lie in ``bore`` when they are one pin: one outline, or several
+    side by side that one outline of ``other`` holds beyond the level along the axis,
+    towards the pin's free end, which a part going off passes (a sleeve slit into halves at
+    one end and whole at its other, :data:`HOLE_LEVELS` levels tried, longest spans first);
+    None otherwise (two dowel pins in one slot; a bearing's rings and balls, one inside
+    another: which of them the bore holds is not measured)."""
+    inside = [o for o in outlines if bore.contains(o.centre) and in_loop(o, bore)]
+    if len(inside) <= 1:
+        return inside or None
+    if any(o is not i and o.contains(i.centre) for o in inside for i in inside):
+        return None
+    along = other.vertices @ axis
+    for beyond in spans(along, level, float(along.max()))[:HOLE_LEVELS]:
+        loops = slice_loops(other, axis, beyond)
+        if any(outer(whole, loops) and all(in_loop(piece, whole) for piece in inside) for whole in loops):
+            return inside
+    return None
+
+
+def _hull(loops: list[Loop]) -> shapely.Polygon:
+    """The convex hull of ``loops`` across the axis: what a convex bore must hold to pass them all."""
+    return shapely.MultiPoint(np.concatenate([loop.points for loop in loops])).convex_hull

@@ -114,8 +114,9 @@ def _pins_of(derived: Derived, order: nx.DiGraph, pid: str, middle: float
         covered -= resting
     taken: list[np.ndarray] = []  # the centres of the pins the part is on so far, across the axis
     hits = []
-    for other in sorted(({derived.base} | before) - covered):
-        while (hit := pin_of(derived, pid, name, other, taken)) is not None:
+    owners = sorted(({derived.base} | before) - covered)
+    for other in owners:
+        while (hit := pin_of(derived, pid, name, other, taken, owners)) is not None:
             pin, bore, centre, level = hit
             if any(np.linalg.norm(pin.centre - point) < SAME_HOLE for point in taken):
                 break  # its bore is around a pin the part is on already
