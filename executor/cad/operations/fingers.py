@@ -115,12 +115,12 @@ def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit, others: set[
                                               (start + FINGER_THICKNESS, FINGER_WIDTH / 2),
                                               (start, FINGER_WIDTH / 2))])
                 for start in (float(reach.max()), float(reach.min()) - FINGER_THICKNESS)]
-        fingers = shapely.union_all(pads).buffer(-FINGER_TOUCH)  # a face they touch is not in their way
         under, other_top = "", low
         for other, corners in triangles.items():
-            top = _highest_in(corners, fingers, other_top)
-            if top is not None:
-                under, other_top = other, top
+            for pad in pads:  # one at a time: each one's bounds keep the triangles near it alone
+                top = _highest_in(corners, pad.buffer(-FINGER_TOUCH), other_top)  # a face it touches: not in its way
+                if top is not None:
+                    under, other_top = other, top
         if high - other_top > best[0]:
             best = (high - other_top, under)
     return best
