@@ -235,9 +235,9 @@ def check_grasp(path: Path, geometry: GeometryFile, gripper: Gripper) -> None:
         if not table.bore and table.tool == "fingers" and gripper.grasp_depth >= table.length:
             raise fail(path, f"part_shapes.{name}", "length",
                        f"longer than [gripper] grasp_depth ({gripper.grasp_depth:g} m)", table.length)
-        if table.grasp_depth is not None and (table.bore or table.tool != "fingers"):
-            raise fail(path, f"part_shapes.{name}", "grasp_depth", "none: a part with a bore or on the suction cup "
-                       "is not held by the fingers' depth", table.grasp_depth)
+        if table.grasp_depth is not None and table.tool != "fingers":
+            raise fail(path, f"part_shapes.{name}", "grasp_depth", "none: a part on the suction cup is not held by "
+                       "the fingers' depth", table.grasp_depth)
 
 
 def check_geometry(path: Path, geo: GeometryFile, layout: AssemblyFile) -> None:

@@ -224,8 +224,9 @@ class PartShape(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     ``pins_of`` the parts placed by hand (``[manual.<id>]``) whose pins they go onto
     besides their ``demo_hole``, each through a bore of its own (they stand at their goals
     in the trials of these parts). ``grasp_depth`` [m]: how deep the fingers hold them where
-    less than the ``[gripper]``'s (a peg that stands out of the product at its goal by
-    less, docs/cell.md#the-fingers-grip)."""
+    less than the ``[gripper]``'s (a part that stands out of the product at its goal by
+    less; a part with a bore is held at most half its length deep besides,
+    docs/cell.md#the-fingers-grip)."""
 
     parts: Ids
     kind: Kind

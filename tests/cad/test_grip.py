@@ -1,6 +1,7 @@
 """The fingers' grip: a peg is held over at most what stands out of the product at its goal
 less the clearance, at least the minimum grip; a peg standing out less goes on the suction
-cup or by hand with why; one standing out well is held the gripper's grasp depth
+cup or by hand with why; one standing out well is held the gripper's grasp depth; a part
+with a bore onto a pin by the same rule, by hand where it stands out less
 (docs/cell.md#the-fingers-grip)."""
 
 from __future__ import annotations
@@ -18,13 +19,18 @@ from assembly_constraints.cli import main
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler
 from executor.assembly.world import AssemblyWorld
+from executor.cad.derive import Derived, derive
 from executor.cad.operations import fingers
+from executor.cad.operations.pins import onto_pin
+from executor.cad.parts import CadPart
+from executor.cad.write.geometry import _bore_grip_lines
 from executor.cell_description import CellDescription, load_cell_description
 from executor.trial import Cell
 from executor.world.geometry import load_geometry
 from tests.cad.conftest import teach
 from tests.cad.test_covers import _solid
 from tests.cad.test_mesh_import import _box
+from tests.cad.test_pins import _prism, _round
 
 X = 560.0
 """[mm] where the plate's centre stands: where the simulated arm reaches."""
@@ -108,6 +114,50 @@ def test_the_fingers_meet_a_neighbour_reaching_under_the_top_and_turn_away_from_
     assert fingers._highest_in(walls.vertices[walls.faces], pads, -1.0) == pytest.approx(0.01)
     beyond = block.copy().apply_translation((0.003, 0.0, 0.0))
     assert fingers._highest_in(beyond.vertices[beyond.faces], pads, -1.0) is None
+
+
+def _washer_on_a_pin(thick: float, wall: float) -> Derived:
+    """A 60 x 60 x 10 mm base with a d 10 pin 30 mm above its top, and a washer (d 24, a
+    d 10.5 bore, ``thick`` [mm]) on that top down the pin; where ``wall`` [mm] is positive,
+    a ring wall of the base (d 34 to 50) that high around the washer, where the fingers
+    are, slit through along a diagonal (a closed ring would make a pocket around the pin, its
+    island); derived (lengths in metres)."""
+    mm = 1e-3
+    slit = shapely.affinity.rotate(shapely.box(-30 * mm, -1 * mm, 30 * mm, 1 * mm), 45.0, origin=(0.0, 0.0))
+    around = shapely.Point(0.0, 0.0).buffer(25 * mm, quad_segs=16).difference(
+        shapely.Point(0.0, 0.0).buffer(17 * mm, quad_segs=16)).difference(slit)
+    base = trimesh.boolean.union([_prism(shapely.box(-30 * mm, -30 * mm, 30 * mm, 30 * mm), 0.0, 10 * mm),
+                                  _round(0.0, 5 * mm, 5 * mm, 40 * mm),
+                                  *([_prism(half, 5 * mm, (10 + wall) * mm) for half in around.geoms] if wall > 0 else [])],
+                                 engine="manifold")
+    washer = _prism(shapely.Point(0.0, 0.0).buffer(12 * mm, quad_segs=32).difference(
+        shapely.Point(0.0, 0.0).buffer(5.25 * mm, quad_segs=32)), 10 * mm, (10 + thick) * mm)
+    return derive([CadPart("base", "base", base, "test"), CadPart("washer", "washer", washer, "test")], "base", {})
+
+
+@pytest.mark.parametrize(("thick", "wall", "reason", "held"), [
+    (4.0, 0.0, "stands out of the product by 4.000 mm at its goal, less than the 6 mm the fingers need", None),
+    (12.0, 8.0, "stands out of the product by 4.000 mm at its goal ('base' where the fingers are), less than the "
+                "6 mm the fingers need", None),
+    (8.0, 0.0, None, 4.0), (12.0, 4.0, None, 6.0), (20.0, 12.0, None, 7.0)])
+def test_a_part_onto_a_pin_is_the_fingers_only_where_it_stands_out_of_the_product_enough_for_them(
+        thick: float, wall: float, reason: str | None, held: float | None) -> None:
+    # The fingers hold a washer on a pin by its outside, as they hold a peg: a 4 mm washer on
+    # the base's top, or a 12 mm one within a wall 8 mm high, stands out 4 mm, less than
+    # their 5 mm grip and 1 mm clear of the product: placed by hand (the cell put it on, held
+    # 2 mm deep, where a real hand's fingers would meet the base). An 8 mm washer, or a
+    # 12 mm one within a wall 4 mm high, stands out 8 mm: the cell puts it on, held half its
+    # length deep at most (4 and 6 mm); a 20 mm one within a 12 mm wall no deeper than the
+    # fingers' 7 mm, which geometry.toml states as its grasp_depth.
+    derived = _washer_on_a_pin(thick, wall)
+    pin = derived.pin_of("washer")
+    why = onto_pin(derived, pin, "washer")
+    assert why == (None if reason is None else f"goes onto a pin ({pin.id}), but part 'washer' {reason}"), why
+    if held is not None:
+        assert fingers.bore_grip(derived, "washer", pin) == pytest.approx(held * 1e-3)
+        lines = _bore_grip_lines(derived, "washer", thick * 1e-3)  # none where half its length is less
+        stated = f"grasp_depth = {held * 1e-3:g}  # held {held:g} mm deep by the fingers: it stands out of the product"
+        assert (lines[0].startswith(stated) if held < thick / 2 else lines == []), lines
 
 
 @pytest.mark.slow  # imports, teaches peg2's skill, one trial and one assembly step in physics (about 60 s under load)

@@ -42,9 +42,9 @@ def _import(tmp: Path, block_x: float = 0.0, pocket: float = 20.4) -> Path:
     """The base (100 x 60 x 10 mm) with a square ``pocket`` [mm] 6 mm deep at x 560 mm and
     a d 7 pin 20 mm above its top at x 530 mm; the block (20 x 20 x 12 mm) on the pocket's
     bottom, ``block_x`` [mm] from its centre along x, with a d 8 pin standing 20 mm above
-    its top at :data:`PIN_MM` from its axis; a ring (d 16, a d 9 bore, 5 mm) on the block's
-    top down its pin, a washer (d 14, a d 7.5 bore, 4 mm) on the base down its pin; as STL
-    files [mm], imported."""
+    its top at :data:`PIN_MM` from its axis; a ring (d 16, a d 9 bore, 8 mm) on the block's
+    top down its pin, a washer (d 14, a d 7.5 bore, 8 mm) on the base down its pin (each
+    standing out more than the 6 mm the fingers need); as STL files [mm], imported."""
     cad = tmp / "cad"
     cad.mkdir(parents=True)
     hole = shapely.box(X_MM - pocket / 2, -pocket / 2, X_MM + pocket / 2, pocket / 2)
@@ -56,12 +56,12 @@ def _import(tmp: Path, block_x: float = 0.0, pocket: float = 20.4) -> Path:
     trimesh.boolean.union([_prism(block, 4, 16), _prism(shapely.Point(x, y).buffer(4.0, quad_segs=32), 15, 36)],
                           engine="manifold").export(cad / "block.stl")
     ring = shapely.Point(x, y).buffer(8.0, quad_segs=32).difference(shapely.Point(x, y).buffer(4.5, quad_segs=32))
-    _prism(ring, 16, 21).export(cad / "ring.stl")
+    _prism(ring, 16, 24).export(cad / "ring.stl")
     trimesh.boolean.union([base, _prism(shapely.Point(X_MM - 30, 0.0).buffer(3.5, quad_segs=32), 5, 30)],
                           engine="manifold").export(cad / "base.stl")
     washer = shapely.Point(X_MM - 30, 0.0).buffer(7.0, quad_segs=32).difference(
         shapely.Point(X_MM - 30, 0.0).buffer(3.75, quad_segs=32))
-    _prism(washer, 10, 14).export(cad / "washer.stl")
+    _prism(washer, 10, 18).export(cad / "washer.stl")
     return import_on_base(cad, tmp, "base")
 
 

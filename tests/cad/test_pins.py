@@ -45,10 +45,10 @@ def _pin(radius: float, x: float) -> trimesh.Trimesh:
 
 
 def _with_bore(outline: shapely.Polygon, bore: float, x: float) -> trimesh.Trimesh:
-    """``outline`` [mm] less a round bore of diameter ``bore`` [mm], 4 mm thick, on the
-    plate top (z 10) at ``x`` [mm]."""
+    """``outline`` [mm] less a round bore of diameter ``bore`` [mm], 8 mm thick (out of the
+    plate by more than the 6 mm the fingers need), on the plate top (z 10) at ``x`` [mm]."""
     ring = outline.difference(shapely.Point(0.0, 0.0).buffer(bore / 2, quad_segs=32))
-    part = trimesh.creation.extrude_polygon(ring, 4.0)
+    part = trimesh.creation.extrude_polygon(ring, 8.0)
     part.apply_translation((x, 0.0, 10.0))
     return part
 
@@ -336,7 +336,7 @@ def test_a_plate_over_both_pins_is_learned_on_each_and_put_onto_its_first(run_ma
     # part onto the second, which the plate takes) and the truth session assembles it there.
     outline = shapely.box(-40.0, -10.0, 40.0, 10.0).difference(shapely.Point(-25.0, 0.0).buffer(5.2, quad_segs=32))
     outline = outline.difference(shapely.Point(25.0, 0.0).buffer(4.2, quad_segs=32))
-    plate = trimesh.creation.extrude_polygon(outline, 4.0)
+    plate = trimesh.creation.extrude_polygon(outline, 8.0)
     plate.apply_translation((X_MM, 0.0, 10.0))
     out = _import(tmp_path, {"cover": plate})
     assert _atoms(out / "sizes.lp", "fits") == {("cover", "plate_pin1"), ("cover", "plate_pin2")}
@@ -396,7 +396,7 @@ def test_a_part_with_a_zero_clearance_fit_on_another_pin_the_cell_cannot_widen_i
     # no bore, so the washer is placed by hand rather than tried there at room 0.
     washer = _with_bore(shapely.Point(0.0, 0.0).buffer(12.0, quad_segs=32), 10.5, X_MM - 25)
     nut = trimesh.creation.extrude_polygon(shapely.box(-8.0, -8.0, 8.0, 8.0).difference(shapely.box(-3.3, -3.3, 3.3,
-                                                                                                       3.3)), 4.0)
+                                                                                                       3.3)), 8.0)
     nut.apply_translation((X_MM, 18.0, 10.0))
     out = _import(tmp_path, {"washer": washer, "nut": nut}, (_pin(5.25, X_MM), _box((6, 6, 30), (X_MM, 18, 25))))
     manual = tomllib.loads((out / "geometry.toml").read_text()).get("manual", {})

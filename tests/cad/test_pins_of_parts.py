@@ -32,8 +32,9 @@ def _prism(outline: shapely.Polygon, low: float, high: float) -> trimesh.Trimesh
 def _import(tmp: Path) -> Path:
     """The base (100 x 60 x 10 mm) with a 24 x 24 mm pad 10 mm high at x 540 mm and a d 8
     pin 20 mm above the pad; a block (24 x 24 x 10 mm) lying on the base at x 580 mm with a
-    d 8 pin 20 mm above its top; a plate (70 x 24 x 5 mm) on the pad and the block with two
-    d 8.2 bores over the pins; as STL files [mm], imported."""
+    d 8 pin 20 mm above its top; a plate (70 x 24 x 8 mm: out of the product by more than the
+    6 mm the fingers need) on the pad and the block with two d 8.2 bores over the pins; as
+    STL files [mm], imported."""
     cad = tmp / "cad"
     cad.mkdir(parents=True)
     trimesh.boolean.union([_prism(shapely.box(X_MM - 50, -30, X_MM + 50, 30), 0, 10),
@@ -46,7 +47,7 @@ def _import(tmp: Path) -> Path:
     plate = shapely.box(X_MM - 35, -12, X_MM + 35, 12)
     for x in (X_MM - 20, X_MM + 20):
         plate = plate.difference(shapely.Point(x, 0.0).buffer(4.1, quad_segs=64))
-    _prism(plate, 20, 25).export(cad / "plate.stl")
+    _prism(plate, 20, 28).export(cad / "plate.stl")
     return import_on_base(cad, tmp, "base")
 
 

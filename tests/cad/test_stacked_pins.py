@@ -42,12 +42,13 @@ def _nut(side: float, bore: float, x: float, low: float, high: float) -> trimesh
     return _prism(_square(side, x).difference(_square(bore, x)), low, high)
 
 
-def _import(tmp_path: Path, nut_low: float = 14.0, washer_bore: float = 9.0, nut_bore: float = 9.0) -> Path:
+def _import(tmp_path: Path, nut_low: float = 18.0, washer_bore: float = 9.0, nut_bore: float = 9.0) -> Path:
     """The plate (100 x 60 x 10 mm) with a d 8 pin 30 mm above its top at x - 25 mm, a
     block (24 x 24 x 10 mm) lying on it at x + 25 mm with a d 10 pin 25 mm above its top;
-    a washer (20 mm square, a square ``washer_bore`` [mm], 4 mm) on the plate down its pin,
+    a washer (20 mm square, a square ``washer_bore`` [mm], 8 mm) on the plate down its pin,
     a nut (18 mm square, a square ``nut_bore`` [mm], 6 mm) on the pin from ``nut_low`` [mm] up,
-    and an arm (18 mm square, an 11 mm square bore, 4 mm) on the block down its pin;
+    and an arm (18 mm square, an 11 mm square bore, 8 mm) on the block down its pin (each
+    standing out more than the 6 mm the fingers need);
     imported, the folder written."""
     cad = tmp_path / "cad"
     cad.mkdir(parents=True)
@@ -57,9 +58,9 @@ def _import(tmp_path: Path, nut_low: float = 14.0, washer_bore: float = 9.0, nut
     nipple = shapely.Point(X_MM + 25, 0.0).buffer(5.0, quad_segs=32)
     trimesh.boolean.union([_prism(_square(24, X_MM + 25), 10, 20), _prism(nipple, 15, 45)],
                           engine="manifold").export(cad / "block.stl")
-    _nut(20, washer_bore, X_MM - 25, 10, 14).export(cad / "washer.stl")
+    _nut(20, washer_bore, X_MM - 25, 10, 18).export(cad / "washer.stl")
     _nut(18, nut_bore, X_MM - 25, nut_low, nut_low + 6).export(cad / "nut.stl")
-    _nut(18, 11, X_MM + 25, 20, 24).export(cad / "arm.stl")
+    _nut(18, 11, X_MM + 25, 20, 28).export(cad / "arm.stl")
     return import_on_base(cad, tmp_path, "plate")
 
 
@@ -99,7 +100,7 @@ def test_a_part_apart_from_the_one_below_or_on_one_placed_by_hand_stays_placed_b
     # the nut drawn 0.5 mm above the washer: the cell would rest it on the washer, not where
     # the CAD has it; a washer with 0.01 mm of room on its pin is placed by hand (its square
     # bore the cell does not widen), and the nut on it too
-    apart = _import(tmp_path / "apart", nut_low=14.5)
+    apart = _import(tmp_path / "apart", nut_low=18.5)
     assert manual_reasons(apart)["nut"] == ("goes onto a pin (plate_pin1) +0.500 mm from the top of 'washer': the cell "
                                      "stacks the parts on a pin end to end (within 0.1 mm)")
     tight = manual_reasons(_import(tmp_path / "tight", washer_bore=8.02))

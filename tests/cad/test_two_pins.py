@@ -1,5 +1,5 @@
 """A plate over two dowel pins of the base, each pin through its own bore: a base with two
-d 8 pins 40 mm apart on a diagonal (30 deg from x) and a 70 x 24 x 5 mm plate with two
+d 8 pins 40 mm apart on a diagonal (30 deg from x) and a 70 x 24 x 8 mm plate with two
 d 8.2 bores (0.1 mm of room per side) is imported with the plate one the cell puts onto
 both pins (down its first, held as the CAD turns it, its second bore over the second pin),
 taught and assembled in physics; with the second pin 1 mm farther from the first (the
@@ -33,7 +33,7 @@ TURN = 30.0
 
 def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), turn: float = 0.0, lying: bool = False) -> Path:
     """The base (100 x 60 x 10 mm) with two round d 8 pins (64-gons) standing 20 mm above its
-    top at x 560 -/+ 20 mm, and the plate (70 x 24 x 5 mm) on that top with round ``bores``
+    top at x 560 -/+ 20 mm, and the plate (70 x 24 x 8 mm) on that top with round ``bores``
     [mm] (128-gons) over the pins, all turned ``turn`` [deg] about the vertical through
     (560, 0), as STL files [mm], imported; with ``lying``, all turned a quarter turn about x
     instead (the pins along +y, 30 mm up, ``up = "+z"`` stated); the folder written."""
@@ -46,7 +46,7 @@ def _import(tmp: Path, bores: tuple[float, float] = (8.2, 8.2), turn: float = 0.
     for pin, bore, x in zip(pins, bores, (-APART / 2, APART / 2)):
         pin.apply_translation((X_MM + x, 0.0, 17.5))
         outline = outline.difference(shapely.Point(x, 0.0).buffer(bore / 2, quad_segs=32))
-    plate = trimesh.creation.extrude_polygon(outline, 5.0)
+    plate = trimesh.creation.extrude_polygon(outline, 8.0)
     plate.apply_translation((X_MM, 0.0, 10.0))
     base = trimesh.boolean.union([base, *pins], engine="manifold")
     turned = (trimesh.transformations.rotation_matrix(-np.pi / 2, (1.0, 0.0, 0.0), (X_MM, 0.0, 30.0)) if lying else

@@ -56,8 +56,8 @@ CASES = [
     ("grasp-deeper-than-the-part", "grasp_depth = 0.02", "grasp_depth = 0.06",
      "[part_shapes.round_peg] length: expected longer than [gripper] grasp_depth (0.06 m), got 0.05"),
     ("own-grasp-depth-on-the-suction-cup", 'demo_hole = "r1"      # where', 'tool = "suction"\ngrasp_depth = 0.01\n'
-     'demo_hole = "r1"      # where', "[part_shapes.round_peg] grasp_depth: expected none: a part with a bore or on "
-     "the suction cup is not held by the fingers' depth, got 0.01"),
+     'demo_hole = "r1"      # where', "[part_shapes.round_peg] grasp_depth: expected none: a part on the suction "
+     "cup is not held by the fingers' depth, got 0.01"),
     ("own-grasp-depth-zero", 'demo_hole = "r1"      # where', 'grasp_depth = 0.0\ndemo_hole = "r1"      # where',
      "[part_shapes.round_peg] grasp_depth: expected a number in (0, 0.2] m"),
     ("flange-mass-zero", "flange_mass = 1.0", "flange_mass = 0.0",

@@ -20,7 +20,7 @@ import trimesh
 
 from executor.cad.convex import NEAR
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations.fingers import GRIPPER, finger_grip
+from executor.cad.operations.fingers import GRIPPER, bore_grip, finger_grip
 from executor.cad.operations.frames import along_axis, entry_point, feature_turn, pin_entry, upright
 from executor.cad.operations.precedence import maybe_in_place
 from executor.cad.operations.tools import tool_of
@@ -193,20 +193,18 @@ def tool_length(derived: Derived) -> tuple[float | None, str]:
     may be in place (any but those the geometric precedence puts after it, and but a base with
     pins: :func:`executor.world.scene.wrist_clear_of`) within that radius
     of the axis of each part the cell inserts from above, held :data:`GRIPPER`'s grasp depth
-    deep (a part with a bore: at most half its length; a peg standing out less: :func:`finger_grip`;
+    deep (a part with a bore: :func:`bore_grip`; a peg standing out less: :func:`finger_grip`;
     a part on the suction cup by its top: :func:`tool_of`) at its goal (a peg standing on its
     hole's bottom, a part with a bore where the CAD has it), rounded up to the millimetre;
     None where :data:`GRIPPER`'s keeps it clear, with why (the part, the part below the
     wrist and how high it stands) otherwise. A part the wrist meets stops short of its goal
     (a bolt beside a bracket's 80 mm wall stopped 4.1 mm above it)."""
-    depth = GRIPPER["grasp_depth"]
     grips = {pid: (fit.position, fit.entry - fit.depth + float(upright(derived, fit).extents[2])
-                   - (0.0 if tool_of(derived, fit)[0] == "suction" else finger_grip(derived, fit)[0]))  # cup: top
+                   - (0.0 if tool_of(derived, fit)[0] == "suction" else finger_grip(derived, pid, fit)[0]))  # cup: top
              for pid, fit in derived.hole_of.items() if fit.axis == "+z" and fit.part == pid}
     for pin in derived.pins.values():
         for pid in (p for p in pin.parts if p in derived.bores and pin.axis == "+z"):
-            low, high = (float(v) for v in derived.parts[pid].mesh.bounds[:, 2])
-            grips[pid] = (pin.position, high - min(depth, (high - low) / 2))
+            grips[pid] = (pin.position, float(derived.parts[pid].mesh.bounds[1, 2]) - bore_grip(derived, pid, pin))
     need, why = GRIPPER["flange_length"], ""
     clear = {derived.base} if derived.pins else set()  # the cell's wrist does not collide with a base with pins
     for pid, (xy, grip) in sorted(grips.items()):
@@ -270,16 +268,17 @@ def _wrist_on_pin(derived: Derived, pin: PinFit, pid: str) -> str:
     axis, the base outside the pin itself (its section's half diagonal about the axis, the
     gripper's fingers beside it)."""
     centre = (float(pin.section.centre[0]), float(pin.section.centre[1]))
-    return _wrist_meets(derived, pin, pid, centre, {pin.owner: math.hypot(pin.section.a, pin.section.b) / 2 + NEAR})
+    return _wrist_meets(derived, pin, pid, centre, {pin.owner: math.hypot(pin.section.a, pin.section.b) / 2 + NEAR},
+                        bore_grip(derived, pid, pin))
 
 
 def _wrist_meets(derived: Derived, fit: HoleFit | PinFit, pid: str, centre: tuple[float, float],
-                 inner: Mapping[str, float]) -> str:
+                 inner: Mapping[str, float], held: float | None = None) -> str:
     """Why the arm's wrist would meet the product with part ``pid`` at its goal along the
     horizontal axis of ``fit`` (a pin, a hole entered sideways) ("" where it would not):
     :func:`tool_length`'s rule in its frame (:func:`feature_turn`: z out along the axis), the axis
-    through ``centre`` [m] (x, y in that frame). The part is held :data:`GRIPPER`'s grasp
-    depth deep (at most half its length) from its outer end, the wrist (:data:`WRIST_RADIUS`
+    through ``centre`` [m] (x, y in that frame). The part is held ``held`` [m] deep from its
+    outer end (None: :data:`GRIPPER`'s grasp depth, at most half its length), the wrist (:data:`WRIST_RADIUS`
     about the tool's axis) starts the default flange beyond, and every part that may be in
     place (any but those the geometric precedence puts after ``pid``) must end
     :data:`WRIST_CLEARANCE` short of it within that radius of the axis, a part in ``inner``
@@ -288,7 +287,7 @@ def _wrist_meets(derived: Derived, fit: HoleFit | PinFit, pid: str, centre: tupl
     turn = feature_turn(fit)
     along = along_axis(derived.parts[pid].mesh, fit)[:, 2]
     low, high = float(along.min()), float(along.max())
-    grip = high - min(GRIPPER["grasp_depth"], (high - low) / 2)
+    grip = high - (min(GRIPPER["grasp_depth"], (high - low) / 2) if held is None else held)
     for other in sorted(maybe_in_place(derived, pid)):
         mesh = derived.parts[other].mesh.copy().apply_transform(turn)
         top = _highest_near(mesh, centre, WRIST_RADIUS, inner.get(other, 0.0))

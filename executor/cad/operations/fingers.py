@@ -1,8 +1,9 @@
-"""The simulated gripper (:data:`GRIPPER`) and the fingers' grip of a peg: how deep the
-fingers hold it (:func:`finger_grip`), from how far it stands out at its goal of the parts in
-place where the fingers are (:func:`standing_out`, the finger model :data:`FINGER_THICKNESS`,
-:data:`FINGER_WIDTH`), at least :data:`MIN_GRIP`; the model as the import states it
-(:func:`finger_assumption`). Lengths in metres (docs/cell.md#the-fingers-grip)."""
+"""The simulated gripper (:data:`GRIPPER`) and the fingers' grip of a peg or of a part with a
+bore going onto its pin: how deep the fingers hold it (:func:`finger_grip`, :func:`bore_grip`),
+from how far it stands out at its goal of the parts in place where the fingers are
+(:func:`standing_out`, the finger model :data:`FINGER_THICKNESS`, :data:`FINGER_WIDTH`), at
+least :data:`MIN_GRIP`; the model as the import states it (:func:`finger_assumption`).
+Lengths in metres (docs/cell.md#the-fingers-grip)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import shapely
 import trimesh
 
 from executor.cad.derive import Derived, HoleFit, PinFit
-from executor.cad.operations.frames import feature_turn
+from executor.cad.operations.frames import along_axis, feature_turn
 from executor.cad.operations.precedence import in_place_before
 
 GRIPPER = {"flange_mass": 1.0, "flange_inertia": 0.004, "flange_length": 0.06, "grasp_depth": 0.02,
@@ -49,19 +50,30 @@ def finger_assumption() -> str:
             f"before it, where the fingers are: "
             f"two {1e3 * FINGER_THICKNESS:g} x {1e3 * FINGER_WIDTH:g} mm beside its outline, turned about its axis "
             f"where it stands out most) less {1e3 * GRIP_CLEARANCE:g} mm, over "
-            f"{1e3 * MIN_GRIP:g} mm at least; a peg standing out less goes on the suction cup or by hand")
+            f"{1e3 * MIN_GRIP:g} mm at least, and a part with a bore so by its outside (at most half its length); "
+            f"a peg standing out less goes on the suction cup or by hand, a part with a bore by hand")
 
 
-def finger_grip(derived: Derived, fit: HoleFit) -> tuple[float, str]:
-    """How deep [m] the fingers hold the peg of ``fit`` (longer than :data:`GRIPPER`'s
-    grasp depth) and why where not that deep: the grasp depth, or what the peg stands out
-    at its goal of the parts in place whenever it goes there (:func:`standing_out`, the
-    base and those the geometric precedence puts before it; others the precedence admits
-    before it: :func:`finger_orders`) less :data:`GRIP_CLEARANCE` where
+def finger_grip(derived: Derived, pid: str, fit: HoleFit | PinFit) -> tuple[float, str]:
+    """How deep [m] the fingers hold part ``pid``, the peg of hole ``fit`` (longer than
+    :data:`GRIPPER`'s grasp depth) or a part with a bore on pin ``fit`` (the cell holds it
+    at most half its length deep besides: :func:`bore_grip`), by its outside, and why where
+    not that deep: the grasp depth, or what the part stands out at its goal of the parts in
+    place whenever it goes there (:func:`standing_out`, the base, the pin's owner and those
+    the geometric precedence puts before it; others the precedence admits before it:
+    :func:`executor.cad.operations.tools.finger_orders`) less :data:`GRIP_CLEARANCE` where
     that is less, rounded down to 0.1 mm; 0 where that is under :data:`MIN_GRIP` (the
-    fingers would meet the product before the peg reaches its goal)."""
-    assert fit.part is not None
-    return grip_for(*standing_out(derived, fit.part, fit, in_place_before(derived, fit.part)))
+    fingers would meet the product before the part reaches its goal: placed by hand, or
+    a peg on the suction cup)."""
+    return grip_for(*standing_out(derived, pid, fit, in_place_before(derived, pid)))
+
+
+def bore_grip(derived: Derived, pid: str, pin: PinFit) -> float:
+    """How deep [m] the cell holds part ``pid`` with a bore on ``pin``: by its top, at most
+    half its length along the pin (:meth:`executor.world.geometry.PartSpec.held_depth`) and
+    no deeper than the fingers' grip (:func:`finger_grip`)."""
+    along = along_axis(derived.parts[pid].mesh, pin)[:, 2]
+    return min(finger_grip(derived, pid, pin)[0], float(np.ptp(along)) / 2)
 
 
 def grip_for(out: float, under: str) -> tuple[float, str]:
@@ -103,12 +115,12 @@ def standing_out(derived: Derived, pid: str, fit: HoleFit | PinFit, others: set[
                                               (start + FINGER_THICKNESS, FINGER_WIDTH / 2),
                                               (start, FINGER_WIDTH / 2))])
                 for start in (float(reach.max()), float(reach.min()) - FINGER_THICKNESS)]
-        fingers = shapely.union_all(pads).buffer(-FINGER_TOUCH)  # a face they touch is not in their way
         under, other_top = "", low
         for other, corners in triangles.items():
-            top = _highest_in(corners, fingers, other_top)
-            if top is not None:
-                under, other_top = other, top
+            for pad in pads:  # one at a time: each one's bounds keep the triangles near it alone
+                top = _highest_in(corners, pad.buffer(-FINGER_TOUCH), other_top)  # a face it touches: not in its way
+                if top is not None:
+                    under, other_top = other, top
         if high - other_top > best[0]:
             best = (high - other_top, under)
     return best

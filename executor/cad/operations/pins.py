@@ -13,10 +13,9 @@ from bridge.product.nominal import NOMINAL_FIT_ROOM
 from executor.cad.convex import NEAR, Pieces, as_written, pin_pieces
 from executor.cad.derive import Derived, PinFit
 from executor.cad.operations.arm import sideways_pin_refused
-from executor.cad.operations.fingers import GRIP_CLEARANCE, grip_for, standing_out
+from executor.cad.operations.fingers import finger_grip
 from executor.cad.operations.frames import along_axis, bore_frame, feature_turn
 from executor.cad.operations.plate import LEVEL
-from executor.cad.operations.precedence import in_place_before
 from executor.cad.operations.resolution import bore_unresolved, round_pins, unresolved, widens_bore
 from executor.cad.operations.rooms import margins
 from executor.cad.sweep import opposite
@@ -30,10 +29,9 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
     :func:`cell_view`'s, and a part after another on the pin is :func:`_stack_refused`'s);
     a part on more than one pin (a plate over two dowel pins) goes onto them all at once
     where :func:`_onto_pins` allows;
-    a part that stands out of the product at its goal no more than the fingertips stay above
-    it (:data:`executor.cad.operations.fingers.GRIP_CLEARANCE`: sunk or flush, nothing to
-    hold it by) is placed by hand (a part standing out more is held as the peg model says
-    nothing of: a limit, docs/cell.md); a part whose room on it per side (:func:`margins`) is under
+    a part the fingers do not hold at its goal, gripping its outside
+    (:func:`executor.cad.operations.fingers.finger_grip`: it stands out of the product there
+    less than they need), is placed by hand; a part whose room on it per side (:func:`margins`) is under
     :data:`executor.world.scene.SIZE_RESOLUTION` (a nominal zero-clearance fit too) is no
     experiment of the cell: it would jam there, and its pairs are taken from ``sizes.lp``."""
     if pin.owner != derived.base and pin.axis != "+z":
@@ -51,9 +49,8 @@ def onto_pin(derived: Derived, pin: PinFit, pid: str) -> str | None:
         return why
     if why := _no_pieces(derived, pid):
         return f"goes onto a pin ({pin.id}), but {why}"
-    out, under = standing_out(derived, pid, pin, in_place_before(derived, pid))
-    if out <= GRIP_CLEARANCE:  # sunk at its goal, or flush with what stands beside it
-        return f"goes onto a pin ({pin.id}), but part '{pid}' {grip_for(out, under)[1]}: nothing to hold it by"
+    if not (grip := finger_grip(derived, pid, pin))[0]:  # a washer on a plate, a ring sunk flush over a pin
+        return f"goes onto a pin ({pin.id}), but part '{pid}' {grip[1]}"
     return None
 
 

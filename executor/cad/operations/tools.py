@@ -9,8 +9,8 @@ import numpy as np
 import shapely
 import trimesh
 
-from executor.cad.derive import Derived, HoleFit
-from executor.cad.operations.fingers import GRIPPER, finger_grip, grip_for, standing_out
+from executor.cad.derive import Derived, HoleFit, PinFit
+from executor.cad.operations.fingers import GRIPPER, bore_grip, finger_grip, grip_for, standing_out
 from executor.cad.operations.frames import upright
 from executor.cad.operations.precedence import in_place_before, maybe_in_place
 from executor.world.meshes import MIN_THICKNESS
@@ -32,7 +32,7 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
     mesh = upright(derived, fit)
     length, depth = float(mesh.extents[2]), GRIPPER["grasp_depth"]
     if length > depth:
-        grip, why = finger_grip(derived, fit)
+        grip, why = finger_grip(derived, fit.part, fit)
         if grip > 0:
             return "fingers", f"{1e3 * length:.3f} mm long, held {1e3 * grip:g} mm deep by the fingers{why}"
         short = f"part '{fit.part}' {why}"
@@ -56,7 +56,8 @@ def tool_of(derived: Derived, fit: HoleFit) -> tuple[str, str]:
 
 def finger_orders(cell: Derived) -> list[tuple[str, str, float, float]]:
     """The orders the fingers' grip (:func:`finger_grip`) needs, as (peg, part, grip [m],
-    out [m]): each peg the cell inserts with the fingers goes in before each part the
+    out [m]): each peg the cell inserts with the fingers, and each part with a bore it puts
+    onto its pin (held :func:`bore_grip` deep), goes in before each part the
     geometric precedence merely lets be in place before it (:func:`maybe_in_place`, not
     the base nor those it puts before it) that would leave it standing out ``out``, too
     little for its ``grip`` (Cranfield's pegs: 5 mm out of the front plate, 25 mm out of
@@ -64,11 +65,12 @@ def finger_orders(cell: Derived) -> list[tuple[str, str, float, float]]:
     only while the peg, with it and those left free before it, keeps its grip; so every
     part left free, all together in place, leaves the grip as it is. The plans honour
     these orders (``cell_order.lp``, :func:`executor.cad.write.facts.cell_order_text`)."""
+    held: list[tuple[str, HoleFit | PinFit, float]] = [
+        (pid, fit, finger_grip(cell, pid, fit)[0]) for pid, fit in sorted(cell.hole_of.items())
+        if fit.axis != "-z" and tool_of(cell, fit)[0] == "fingers"]
+    held += [(pid, cell.pin_of(pid), bore_grip(cell, pid, cell.pin_of(pid))) for pid in sorted(cell.bores)]
     found = []
-    for pid, fit in sorted(cell.hole_of.items()):
-        if fit.axis == "-z" or tool_of(cell, fit)[0] != "fingers":
-            continue
-        grip = finger_grip(cell, fit)[0]
+    for pid, fit, grip in held:
         free = in_place_before(cell, pid)
         if grip_for(*standing_out(cell, pid, fit, maybe_in_place(cell, pid)))[0] >= grip:
             continue

@@ -67,11 +67,22 @@ def _tool_lines(derived: Derived, fit: HoleFit) -> list[str]:
     ``tool = "suction"``, or the fingers' ``grasp_depth`` where they hold it less deep than
     :data:`executor.cad.operations.fingers.GRIPPER`'s
     (:func:`executor.cad.operations.fingers.finger_grip`); none otherwise."""
+    assert fit.part is not None
     tool, why = tool_of(derived, fit)
     if tool == "suction":
         return ['tool = "suction"']
-    grip = finger_grip(derived, fit)[0]
+    grip = finger_grip(derived, fit.part, fit)[0]
     return [f"grasp_depth = {_q(grip)}  # {why}"] if 0 < grip < GRIPPER["grasp_depth"] else []
+
+
+def _bore_grip_lines(derived: Derived, pid: str, length: float) -> list[str]:
+    """A part with a bore's ``[part_shapes.*]`` line of the fingers' ``grasp_depth`` where
+    they hold it less deep (:func:`executor.cad.operations.fingers.finger_grip`) than the cell
+    holds it (:data:`executor.cad.operations.fingers.GRIPPER`'s grasp depth, at most half
+    its ``length`` [m]); none otherwise."""
+    grip, why = finger_grip(derived, pid, derived.pin_of(pid))
+    return [f"grasp_depth = {_q(grip)}  # held {1e3 * grip:g} mm deep by the fingers{why}"] if grip < min(
+        GRIPPER["grasp_depth"], length / 2) else []
 
 
 def _mesh_entry(mesh: Mesh) -> str:
@@ -189,7 +200,7 @@ def geometry_text(derived: Derived, mapped: Mapped, settings: Settings, meshes: 
                   *_section_lines(nominal_section(bore, onto)),
                   f"length = {_q(length)}", f"mass = {_q(mesh.volume * DENSITY)}",
                   f'demo_hole = "{pin.id}"', *([f"pins_of = {json.dumps(further[pid])}"] if pid in further else []),
-                  _mesh_entry(meshes[pid]), ""]
+                  *_bore_grip_lines(derived, pid, length), _mesh_entry(meshes[pid]), ""]
     gripper = GRIPPER if mapped.flange is None else GRIPPER | {"flange_length": mapped.flange}
     lines += ["[gripper]", *(f"{key} = {value}" for key, value in gripper.items()), "",
               "[base]", f'part = "{derived.base}"', f"tray = {_numbers(settings.trays[derived.base])}",
