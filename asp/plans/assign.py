@@ -270,12 +270,17 @@ def _no_hole_message(facts: LearnedFacts, part: str, fitting: list[str], taken_b
 
 def _reach_note(facts: LearnedFacts, parts: Sequence[str]) -> str:
     """`` the cell can use`` when the cell cannot reach a hole one of ``parts`` fits,
-    `` the CAD leaves it`` when the CAD holds one of them or such a hole elsewhere."""
+    `` the CAD leaves it`` when the CAD holds one of them or such a hole elsewhere, else
+    `` (with every hole on its line ...)`` when a hole one of them fits is no place for it
+    (on another's line, or a hole on its line it does not fit: :attr:`LearnedFacts.on_line`)."""
     ruled_out = [pair for pair in facts.out_of_reach & facts.fits if pair[0] in parts]
     held = {part for part, _ in facts.cad_holes} | {hole for _, hole in facts.cad_holes}
     if any(part in held or hole in held for part, hole in ruled_out):
         return " the CAD leaves it (cad_hole/2)"
-    return " the cell can use" if ruled_out else ""
+    if ruled_out:
+        return " the cell can use"
+    off_line = [(part, hole) for part, hole in facts.fits if part in parts and hole not in facts.holes_of(part)]
+    return " (with every hole on its line: on_line/3)" if off_line else ""
 
 
 def maximum_matching(facts: LearnedFacts) -> Assignment:

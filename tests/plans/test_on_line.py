@@ -65,7 +65,7 @@ def test_a_part_fits_the_place_only_if_it_fits_every_hole_on_its_line() -> None:
     assert feasible_assignment(facts) == {"bolt_a": "h2", "bolt_b": "h1"}
     assert check_assignment(facts, {"bolt_a": "h1", "bolt_b": "h2"}) == ["not_fitting(bolt_a,bracket_hole1)"]
     alone = _facts(FACTS.replace("fits(bolt_a,bracket_hole1).", "").replace("fits(bolt_a,h2).", ""), LINE)
-    with pytest.raises(UnsolvableAssembly):
+    with pytest.raises(UnsolvableAssembly, match=r"bolt_a fits no hole \(with every hole on its line: on_line/3\)"):
         feasible_assignment(alone)
 
 
