@@ -44,8 +44,9 @@ class CorpusImport:
     cell after turning it ``turn`` [deg] about z, each imported hole's or pin's
     ``occupants`` (the parts in it or onto it) and ``owners`` (the part it is a feature
     of), the ids that are ``pins``, the product's ``parts`` (the base included), the
-    import's wall time ``seconds`` and the base's ``holes`` as the import measured them
-    (their sections, chamfers and depths [m], in the cell frame)."""
+    import's wall time ``seconds``, the base's ``holes`` as the import measured them
+    (their sections, chamfers and depths [m], in the cell frame) and each hole's or pin's
+    axis ``lines``."""
 
     truth: dict[str, Any]
     out: Path
@@ -58,6 +59,8 @@ class CorpusImport:
     seconds: float = 0.0
     holes: Mapping[str, HoleFit] = field(default_factory=dict)
     turn: int = 0
+    lines: Mapping[str, str] = field(default_factory=dict)
+    """Each imported hole's or pin's axis in the CAD frame, its letter (``x``, ``y``, ``z``)."""
 
 
 def read_truth(folder: Path) -> dict[str, Any]:
@@ -95,10 +98,12 @@ def import_product(folder: Path, out: Path) -> CorpusImport:
     occupants |= {pid: set(pin.parts) for pid, pin in derived.pins.items()}
     owners = {hid: fit.owner or derived.base for hid, fit in holes.items()}
     owners |= {pid: pin.owner for pid, pin in derived.pins.items()}
+    axes = {hid: fit.axis for hid, fit in holes.items()} | {pid: pin.axis for pid, pin in derived.pins.items()}
+    lines = {hid: turned_axis(axis, -result.turn)[1] for hid, axis in axes.items()}
     return CorpusImport(truth, out, {pid: turned_axis(opposite(leaves), -result.turn)
                                      for pid, leaves in derived.axis.items()},
                         result.offset, occupants, owners, frozenset(derived.pins), len(derived.parts), result.seconds,
-                        derived.holes, result.turn)
+                        derived.holes, result.turn, lines)
 
 
 def distance_to_axis(position: list[float], feature: dict[str, Any], offset: tuple[float, float, float],
@@ -122,15 +127,17 @@ def features_of(part: dict[str, Any]) -> list[str]:
 
 def feature_holes(done: CorpusImport) -> dict[str, str]:
     """Each truth feature's imported hole id (absent: none found): the one of the
-    feature's owner on its axis that is a pin where the feature is one (of a hollow
-    shaft's bore and the shaft, the shaft); of several (the two ends of one rod), the one
-    that is empty or holds a part the truth puts in that feature."""
+    feature's owner on its axis (along it: a bracket's flange hole under its horizontal
+    bore, on the bore's line as seen from above, is not it) that is a pin where the
+    feature is one (of a hollow shaft's bore and the shaft, the shaft); of several (the
+    two ends of one rod), the one that is empty or holds a part the truth puts in that feature."""
     holes = tomllib.loads((done.out / "assembly.toml").read_text()).get("holes", {})
     found = {}
     for fid, feature in done.truth["features"].items():
         inside = {pid for pid, part in done.truth["parts"].items() if fid in features_of(part)}
         near = [hid for hid, hole in holes.items() if done.owners.get(hid) == feature["owner"]
                 and distance_to_axis(hole["position"], feature, done.offset, done.turn) <= FEATURE_REACH_MM
+                and done.lines.get(hid, feature["axis"][1]) == feature["axis"][1]
                 and (hid in done.pins) == (feature["kind"] == "pin")]
         if len(near) > 1:
             near = [hid for hid in near if not done.occupants.get(hid) or done.occupants[hid] & inside]

@@ -9,7 +9,9 @@ An assembly is a folder (a name under ``data/`` or a path) holding:
   cross-section; default the shape for round and square, the part's own id for rect);
   ``[holes.<id>]`` with ``name``, ``shape`` (default the kind ``geometry.toml`` gives it,
   else round), ``position`` ``[x, y]`` [m] on the base plate and ``capacity`` (the number
-  of parts stacked in it or onto it along its axis, default 1); an optional ``[sizes]``
+  of parts stacked in it or onto it along its axis, default 1), and for a hole of a part
+  that parts go through into another hole (on its line), ``on_line`` (that hole) and
+  ``owner`` (the part); an optional ``[sizes]``
   table with ``model`` (the size model the product declares: ``line``, ``sections`` or
   ``pairs``, docs/sizes.md);
 - ``precedence.lp`` (optional): the true precedence constraints (``part/1``,
@@ -83,11 +85,13 @@ class Part(Item):
 @dataclass(frozen=True)
 class Hole(Item):
     """One hole of the base plate; ``position`` [m] or None; ``capacity``: how many parts
-    go in it or onto it, one above the other."""
+    go in it or onto it, one above the other; ``line``: (the hole whose line it lies on, the
+    part it is in) for a hole parts go through into that one (``on_line``, ``owner``), else None."""
 
     shape: str = "round"
     position: tuple[float, float] | None = None
     capacity: int = 1
+    line: tuple[str, str] | None = None
 
 
 @dataclass(frozen=True)
@@ -227,7 +231,8 @@ def assembly_of(product: ProductDescription) -> Assembly:
              kinds.get(pid), None if pid not in kinds else section_label(pid, kinds[pid], part.section))
         for pid, part in layout.parts.items())
     holes = tuple(Hole(hid, hole.name or hid, hole_kind[hid],
-                       None if hole.position is None else (hole.position[0], hole.position[1]), hole.capacity)
+                       None if hole.position is None else (hole.position[0], hole.position[1]), hole.capacity,
+                       None if hole.on_line is None or hole.owner is None else (hole.on_line, hole.owner))
                   for hid, hole in layout.holes.items())
     geometry = product.geometry
     manual = {} if geometry is None else {mid: m.reason for mid, m in geometry.manual.items()}

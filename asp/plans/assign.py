@@ -82,6 +82,9 @@ class LearnedFacts:
     """(part, hole) pairs of a part held where the CAD has it (``cad_hole/2``)."""
     cell_before: frozenset[tuple[str, str]] = frozenset()
     """(peg, part) pairs the cell's fingers need in this order (``cell_before/2``, not precedence)."""
+    on_line: frozenset[tuple[str, str, str]] = frozenset()
+    """(G, H, O): hole G of part O lies on hole H's line (``on_line/3``): a part goes through G
+    into H, never into G alone, and only if it fits both (``asp/encodings/plans/on_line.lp``)."""
 
     @property
     def plan_order(self) -> frozenset[tuple[str, str]]:
@@ -89,8 +92,11 @@ class LearnedFacts:
         return self.must_precede | self.cell_before
 
     def holes_of(self, part: str) -> list[str]:
-        """The holes ``part`` fits and the cell can put it in, sorted."""
-        return [hole for hole in self.holes if (part, hole) in self.fits and (part, hole) not in self.out_of_reach]
+        """The holes ``part`` fits and the cell can put it in, sorted: places (on no other
+        hole's line) whose every hole on their line it fits too (:attr:`on_line`)."""
+        passed = {g for g, _, _ in self.on_line}
+        return [hole for hole in self.holes if (part, hole) in self.fits and (part, hole) not in self.out_of_reach
+                and hole not in passed and all((part, g) in self.fits for g, h, _ in self.on_line if h == hole)]
 
     def room(self, hole: str) -> int:
         """How many parts ``hole`` takes."""
@@ -103,7 +109,7 @@ class LearnedFacts:
 
 LEARNED_SIGNATURES = {"part": 1, "hole": 1, "fits": 2, "no_fit": 2, "needs_hole": 1,
                       "must_precede": 2, "precedence_edge": 2, "out_of_reach": 2, "cad_hole": 2,
-                      "cell_before": 2, "pressed": 1}
+                      "cell_before": 2, "pressed": 1, "on_line": 3}
 """The predicates of learned facts the planner reads, with their arities (ids only)."""
 
 CELL_ORDER = "cell_order.lp"
@@ -128,6 +134,10 @@ def _check_ids(facts: LearnedFacts, sources: str) -> None:
                     f"{sources}: {name}({part},{hole}): expected a part/1 and a hole/1 "
                     f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})"
                 )
+    for passed, hole, owner in sorted(facts.on_line):
+        if passed not in known_holes or hole not in known_holes or owner not in known_parts or passed == hole:
+            raise PlannerError(f"{sources}: on_line({passed},{hole},{owner}): expected two holes/1 and a part/1 "
+                               f"(parts: {' '.join(facts.parts)}; holes: {' '.join(facts.holes) or '-'})")
     for first, then in sorted(facts.cell_before):
         if first not in known_parts or then not in known_parts:
             raise PlannerError(f"{sources}: cell_before({first},{then}): expected two part/1 "
@@ -178,6 +188,7 @@ def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     not placed by hand) and a hole the cell cannot put it in (:meth:`bridge.assembly.Assembly.cell_cannot_insert`),
     ``pressed(P)`` for a part pressed in by hand (:attr:`bridge.assembly.Assembly.pressed`: it needs no hole),
     ``cad_hole(P,H)`` for a part held where the CAD has it (:attr:`bridge.assembly.Assembly.cad_holes`),
+    ``on_line(G,H,O)`` for a hole G of part O on hole H's line (:attr:`bridge.assembly.Hole.line`),
     and the cell's own orders ``cell_before(P,Q)`` of the product's ``cell_order.lp``
     (:data:`CELL_ORDER`: the fingers' grip of peg P needs it in before part Q)."""
     atoms = [fact("capacity", hole.id, hole.capacity) for hole in assembly.holes if hole.capacity > 1]
@@ -185,6 +196,7 @@ def product_facts(assembly: Assembly) -> list[clingo.Symbol]:
     atoms += [fact("cad_hole", part, hole) for part, holes in sorted(assembly.cad_holes.items())
               for hole in sorted(holes)]
     atoms += [fact("cell_before", first, then) for first, then in cell_orders(assembly)]
+    atoms += [fact("on_line", hole.id, *hole.line) for hole in assembly.holes if hole.line is not None]
     inserted = [part.id for part in assembly.parts if part.role != "base" and part.id not in assembly.manual]
     return atoms + [fact("out_of_reach", part, hole) for part in inserted
                     for hole in assembly.hole_ids if assembly.cell_cannot_insert(part, hole)]
@@ -220,6 +232,7 @@ def load_learned_facts(paths: Sequence[Path | str], product: Sequence[clingo.Sym
         out_of_reach=frozenset(pairs_by_name(atoms, "out_of_reach")),
         cad_holes=frozenset(pairs_by_name(atoms, "cad_hole")),
         cell_before=frozenset(pairs_by_name(atoms, "cell_before")),
+        on_line=frozenset((g, h, o) for g, h, o in atoms_by_name(atoms, "on_line", 3)),
     )
     _check_ids(facts, sources)
     return facts
@@ -257,12 +270,17 @@ def _no_hole_message(facts: LearnedFacts, part: str, fitting: list[str], taken_b
 
 def _reach_note(facts: LearnedFacts, parts: Sequence[str]) -> str:
     """`` the cell can use`` when the cell cannot reach a hole one of ``parts`` fits,
-    `` the CAD leaves it`` when the CAD holds one of them or such a hole elsewhere."""
+    `` the CAD leaves it`` when the CAD holds one of them or such a hole elsewhere, else
+    `` (with every hole on its line ...)`` when a hole one of them fits is no place for it
+    (on another's line, or a hole on its line it does not fit: :attr:`LearnedFacts.on_line`)."""
     ruled_out = [pair for pair in facts.out_of_reach & facts.fits if pair[0] in parts]
     held = {part for part, _ in facts.cad_holes} | {hole for _, hole in facts.cad_holes}
     if any(part in held or hole in held for part, hole in ruled_out):
         return " the CAD leaves it (cad_hole/2)"
-    return " the cell can use" if ruled_out else ""
+    if ruled_out:
+        return " the cell can use"
+    off_line = [(part, hole) for part, hole in facts.fits if part in parts and hole not in facts.holes_of(part)]
+    return " (with every hole on its line: on_line/3)" if off_line else ""
 
 
 def maximum_matching(facts: LearnedFacts) -> Assignment:

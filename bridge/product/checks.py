@@ -53,7 +53,8 @@ def _sides(size: float | list[float]) -> tuple[float, float]:
 
 def check_assembly(path: Path, layout: AssemblyFile, kinds: Mapping[str, str]) -> None:
     """A ``section`` only for a rect part (``kinds``: part id -> kind, from every statement
-    of the product, :func:`bridge.product.kinds.part_kinds`); no id both a part and a hole."""
+    of the product, :func:`bridge.product.kinds.part_kinds`); no id both a part and a hole;
+    a hole's ``on_line`` (a hole on no other's line) and ``owner`` (a part) given together."""
     for pid, part in layout.parts.items():
         kind = kinds.get(pid)
         if part.section is not None and kind != "rect":
@@ -62,6 +63,15 @@ def check_assembly(path: Path, layout: AssemblyFile, kinds: Mapping[str, str]) -
     clash = set(layout.parts) & set(layout.holes)
     if clash:
         raise BridgeError(f"{path}: ids used for both a part and a hole: {sorted(clash)}")
+    for hid, hole in layout.holes.items():
+        if (hole.on_line is None) != (hole.owner is None):
+            key = "owner" if hole.owner is None else "on_line"
+            raise fail(path, f"holes.{hid}", key, f"{key} beside {'on_line' if key == 'owner' else 'owner'} "
+                       "(a hole on another's line and the part it is in, or neither)", None)
+        if hole.on_line is not None and (hole.on_line not in layout.holes or layout.holes[hole.on_line].on_line):
+            raise fail(path, f"holes.{hid}", "on_line", "a hole of [holes.*] on no other's line", hole.on_line)
+        if hole.owner is not None and hole.owner not in layout.parts:
+            raise fail(path, f"holes.{hid}", "owner", "a part of [parts.*]", hole.owner)
 
 
 def _members(path: Path, group: str, tables: Mapping[str, HoleShape] | Mapping[str, PartShape]) -> dict[str, str]:

@@ -94,12 +94,17 @@ class HoleEntry(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """``[holes.<id>]``: a readable ``name``, its cross-section kind (default: the kind of
     its ``[hole_shapes.*]`` in ``geometry.toml``, else round), its ``position`` [m] on the
     base plate, its ``capacity``: how many parts the product stacks in it or onto it (a
-    pin several parts go onto, one above the other)."""
+    pin several parts go onto, one above the other); for a hole of part ``owner`` on the
+    line of another hole (``on_line``: a bracket's flange hole over the plate's hole a bolt
+    goes through it into), both: a part goes through it into that hole, never into it
+    alone (the planner's ``on_line/3``, docs/plans.md)."""
 
     name: Text | None = None
     shape: Kind | None = None
     position: XY | None = None
     capacity: Annotated[int, Meta(ge=1, le=64, description="an integer in 1 .. 64")] = 1
+    on_line: Id | None = None
+    owner: Id | None = None
 
 
 class SizesTable(Table, frozen=True, kw_only=True, forbid_unknown_fields=True):

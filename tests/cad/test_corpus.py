@@ -109,11 +109,7 @@ UNSIMULATED: dict[str, str] = {}
     "bosl2_screw_nut",
     "nop_pot_knob",
     "bdw_pillow_block",
-    pytest.param("nop_flat_hinge", marks=_xfail(
-        "a pin in a hole of the base that goes through a moving part's hole too: the hinge pin, in the male "
-        "leaf's knuckles, through the female leaf's (female_knuckles), which is no feature (a moving part's "
-        "holes are sought for parts in no hole of the base: sought on a base hole's line too, occt_as1's bolts "
-        "are planned into its brackets' flange holes, which the planner takes for places apart from the plate's)")),
+    "nop_flat_hinge",
     "cubefactory_cutting_unit",
     "pearl_peg_board",
 ])

@@ -128,7 +128,7 @@ def _washer_on_a_pin(thick: float, wall: float) -> Derived:
         shapely.Point(0.0, 0.0).buffer(17 * mm, quad_segs=16)).difference(slit)
     base = trimesh.boolean.union([_prism(shapely.box(-30 * mm, -30 * mm, 30 * mm, 30 * mm), 0.0, 10 * mm),
                                   _round(0.0, 5 * mm, 5 * mm, 40 * mm),
-                                  *([_prism(half, 5 * mm, (10 + wall) * mm) for half in around.geoms] if wall > 0 else [])],
+                                  *[_prism(half, 5 * mm, (10 + wall) * mm) for half in around.geoms if wall > 0]],
                                  engine="manifold")
     washer = _prism(shapely.Point(0.0, 0.0).buffer(12 * mm, quad_segs=32).difference(
         shapely.Point(0.0, 0.0).buffer(5.25 * mm, quad_segs=32)), 10 * mm, (10 + thick) * mm)

@@ -110,3 +110,33 @@ def test_rings_on_a_pin_are_in_the_hole_of_a_holder_around_them(tmp_path: Path) 
     assert {pid for pin in derived.pins.values() for pid in pin.parts} >= {"ring_a", "ring_b"}
     assert {pair: derived.reasons.get(pair) for pair in [("holder", "ring_a"), ("holder", "ring_b")]} == {
         ("holder", "ring_a"): "feature", ("holder", "ring_b"): "feature"}
+
+
+@pytest.mark.slow  # four parts swept (about 3 s)
+def test_a_bolt_through_a_bracket_into_the_plate_is_in_the_bracket_s_hole_on_the_plate_hole_s_line(
+        tmp_path: Path) -> None:
+    # A plate with two d 10.2 holes at x -20 and 20, a bracket on it over the first with a
+    # d 10.6 flange hole on its line, a bolt (a d 10 shank, its head on the bracket) through
+    # both, and a bolt in the second hole alone: the flange hole is a feature holding the
+    # first bolt (0.3 mm all round), on h1's line (the planner's one place with h1), after
+    # the bracket; the second bolt passes no hole of a part.
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    parts = {
+        "plate": _less(_box((-40, -20, 0), (40, 20, 10)), _cylinder(5.1, -1, 11, (-20, 0)),
+                       _cylinder(5.1, -1, 11, (20, 0))),
+        "bracket": _less(_box((-35, -15, 10), (-5, 15, 20)), _cylinder(5.3, 9, 21, (-20, 0))),
+        "bolt_a": trimesh.boolean.union([_cylinder(5, 0, 20.5, (-20, 0)), _cylinder(8, 20, 23, (-20, 0))],
+                                        engine="manifold"),
+        "bolt_b": trimesh.boolean.union([_cylinder(5, 0, 10.5, (20, 0)), _cylinder(8, 10, 13, (20, 0))],
+                                        engine="manifold"),
+    }
+    for name, mesh in parts.items():
+        assert mesh.is_watertight, name
+        mesh.export(folder / f"{name}.stl")
+    derived = derive(load_meshes(folder, "mm"), "plate", {})
+    assert {pid: fit.id for pid, fit in derived.hole_of.items()} == {"bolt_a": "h1", "bolt_b": "h2"}
+    (hole,) = derived.part_holes.values()
+    assert (hole.id, hole.owner, list(hole.occupants), hole.line) == ("bracket_hole1", "bracket", ["bolt_a"], "h1")
+    assert hole.hole.a - hole.occupants["bolt_a"].a == pytest.approx(0.0006, abs=2e-5)
+    assert ("bracket", "bolt_a") in derived.reasons and derived.in_holes["bolt_a"].id == "h1"

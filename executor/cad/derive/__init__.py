@@ -56,7 +56,9 @@ before it when its outline across its insertion axis lies in an inner loop of th
 (a rod through a bracket's bore), measured as a hole of the base is; a part onto a pin is
 so in the hole of a part the precedence does not put after it (a clutch plate's splined
 outside in the outer holder's hole as its bore goes down the shaft), the parts in one hole
-its occupants.
+its occupants; a part standing in a hole of the base is in the hole of a part before it that
+it passes on that hole's line too (a bolt through a bracket's flange into the plate), a hole
+the planner takes for one place with the base's.
 
 **Pins** (:func:`pins`): a moving part whose slice across its insertion axis, at the middle
 of its extent along it, has an inner loop (a **bore**: a nut's, a washer's, a gear's)

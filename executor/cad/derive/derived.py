@@ -35,6 +35,11 @@ class HoleFit:
     more: tuple[tuple[str, Shape2D], ...] = ()
     """The further parts in a moving part's hole with their sections, after ``part`` (the
     deepest): plates stacked on a shaft whose outsides stand in a ring's hole."""
+    line: str | None = None
+    """The hole of the base on whose line this hole of a moving part lies, its occupants
+    standing in that one (a bolt through a bracket's flange into the plate, a hinge's pin
+    through the female leaf's knuckles into the male's): the cell inserts them through it
+    into that hole, so it is no place of its own; None: a place (every other hole)."""
 
     @property
     def position(self) -> tuple[float, float]:

@@ -2,7 +2,8 @@
 and its section's kind as ``shape``, ``cover``, ``head``, any other ``part``) with its tray
 ``start``, every hole (``h1``, ``h2``, ... by position, empty ones too) with its kind and
 position, every hole of a moving part a part passes (``<owner>_hole1``, ...
-:func:`executor.cad.derive.part_holes`), and every pin a part goes onto or no part is on
+:func:`executor.cad.derive.part_holes`; one on the line of a hole of the base its parts
+stand in, with ``on_line``, that hole, and ``owner``), and every pin a part goes onto or no part is on
 (``<owner>_pin1``, ... :func:`executor.cad.derive.pins`) as a hole at the pin's position with
 the pin's section kind; and the import's :class:`Settings`. Lengths in metres."""
 
@@ -72,6 +73,8 @@ def assembly_text(derived: Derived, settings: Settings, title: str, roles: dict[
                   f"position = [{_q(x)}, {_q(y)}]"]
         # a stack in a hole of the base (bearings and a spacer in a housing's bore)
         lines += [f"capacity = {len(fit.occupants)}"] if fit.owner is None and len(fit.occupants) > 1 else []
+        # passed on the way into a hole of the base: one place with it (HoleEntry.on_line)
+        lines += [f'on_line = "{fit.line}"', f'owner = "{fit.owner}"'] if fit.line is not None else []
         lines.append("")
     for pin_id, pin in derived.pins.items():
         onto = f" ({' '.join(pin.parts)} onto it)" if pin.parts else ""
