@@ -70,22 +70,24 @@ def sources_digest(geometry: CellGeometry) -> str:
 def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
     """A hole's fields, its entry height and depth only where they are not the plate's,
     ``pin`` only for a pin, ``axis`` only for a hole entered sideways, ``tile`` only for a
-    boss of its own, ``owner`` only for a pin of another part than the base and ``widened``
-    only where it names a part (so a product whose holes are all at the plate's level keeps its digest);
+    boss of its own, ``owner`` only for a pin of another part than the base, ``widened``
+    only where it names a part and ``inner`` only for a hole around islands (so a product whose holes are all at the plate's level keeps its digest);
     not ``near_miss``, which names pairs no cell tries and shapes no asset."""
     fields = {key: value for key, value in dataclasses.asdict(hole).items() if key != "near_miss"}
     for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False), ("axis", "-z"),
-                         ("tile", None), ("owner", None), ("widened", ())):
+                         ("tile", None), ("owner", None), ("widened", ()), ("inner", ())):
         if fields[key] == default:
             del fields[key]
     return fields
 
 
 def _part_fields(part: PartSpec) -> dict[str, object]:
-    """A part's fields, ``bore`` only for a part with a bore and ``grasp_depth`` only where
-    it is set (so a peg held as deep as the gripper holds keeps its digest)."""
+    """A part's fields, ``bore`` only for a part with a bore, ``grasp_depth`` only where
+    it is set and ``inner`` only where its section has rings cut out (so a peg held as deep
+    as the gripper holds keeps its digest)."""
     fields = {key: value for key, value in dataclasses.asdict(part).items()
-              if key != "mesh" and (key != "bore" or value) and (key != "grasp_depth" or value is not None)}
+              if key != "mesh" and (key not in ("bore", "inner") or value)
+              and (key != "grasp_depth" or value is not None)}
     return fields if part.mesh is None else fields | {"mesh": msgspec.structs.asdict(part.mesh)}
 
 
