@@ -71,7 +71,8 @@ def _hole_fields(hole: HoleSpec, plate: Plate) -> dict[str, object]:
     """A hole's fields, its entry height and depth only where they are not the plate's,
     ``pin`` only for a pin, ``axis`` only for a hole entered sideways, ``tile`` only for a
     boss of its own, ``owner`` only for a pin of another part than the base, ``widened``
-    only where it names a part and ``inner`` only for a hole around islands (so a product whose holes are all at the plate's level keeps its digest);
+    only where it names a part and ``inner`` only for a hole around islands (so a product
+    whose holes are all at the plate's level keeps its digest);
     not ``near_miss``, which names pairs no cell tries and shapes no asset."""
     fields = {key: value for key, value in dataclasses.asdict(hole).items() if key != "near_miss"}
     for key, default in (("top_z", plate.top_z), ("depth", plate.tile_thickness), ("pin", False), ("axis", "-z"),
