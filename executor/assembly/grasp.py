@@ -6,8 +6,8 @@ suction cup is held the same way while the arm's sensor watches the pull on the 
 The constraint holds the part at its nominal grip pose composed with a random grasp
 error (≤ 1 mm lateral offset, ≤ 1° tilt, as in the single trials): the robot believes the
 nominal pose, so the skills meet a real, unknown error. The tool may hold the part turned
-about the grip point's vertical by a yaw (the grasp's, :attr:`Grasp.yaw`): the part keeps
-that pose in the tool, so the tool is turned by it wherever the part is placed.  The back plate is a static
+about the grip point's vertical (:attr:`Grasp.yaw`): the part keeps that pose in the tool,
+so the tool is turned by it wherever the part is placed. The back plate is a static
 (fixed-base) body: while held it is moved kinematically with the tool instead.
 """
 
@@ -31,7 +31,8 @@ class Grasp:
                  yaw: float = 0.0) -> None:
         self.world, self.part = world, part
         self.yaw = yaw
-        """[rad] the tool's turn about the part's z axis (the part's x axis at ``-yaw`` in the tool's)"""
+        """[rad] the tool's turn about the part's z axis: the tool in the part's frame is
+        :func:`executor.world.arm.tool_quat` of it, at the grip point"""
         frames = world.frames[part]
         c = world.client
         # Part body in the tool frame: tool at the grip point, pointing down, turned by the yaw; the grasp error on top.
