@@ -5,7 +5,9 @@ suction cup is held the same way while the arm's sensor watches the pull on the 
 
 The constraint holds the part at its nominal grip pose composed with a random grasp
 error (≤ 1 mm lateral offset, ≤ 1° tilt, as in the single trials): the robot believes the
-nominal pose, so the skills meet a real, unknown error.  The back plate is a static
+nominal pose, so the skills meet a real, unknown error. The tool may hold the part turned
+about the grip point's vertical (:attr:`Grasp.yaw`): the part keeps that pose in the tool,
+so the tool is turned by it wherever the part is placed. The back plate is a static
 (fixed-base) body: while held it is moved kinematically with the tool instead.
 """
 
@@ -16,7 +18,7 @@ import pybullet as pb
 
 from executor.assembly.world import AssemblyWorld
 from executor.skills.insertion import rotvec_quat_xyzw
-from executor.world.arm import TOOL_DOWN_QUAT_XYZW
+from executor.world.arm import tool_quat
 from executor.world.scene import inertial_frame
 
 GRASP_FORCE = 500.0  # [N] the constraint's maximum force
@@ -25,12 +27,16 @@ GRASP_FORCE = 500.0  # [N] the constraint's maximum force
 class Grasp:
     """A part in the gripper; :meth:`follow` moves a kinematic (base) part with the tool."""
 
-    def __init__(self, world: AssemblyWorld, part: str, offset: np.ndarray, tilt: np.ndarray) -> None:
+    def __init__(self, world: AssemblyWorld, part: str, offset: np.ndarray, tilt: np.ndarray,
+                 yaw: float = 0.0) -> None:
         self.world, self.part = world, part
+        self.yaw = yaw
+        """[rad] the tool's turn about the part's z axis: the tool in the part's frame is
+        :func:`executor.world.arm.tool_quat` of it, at the grip point"""
         frames = world.frames[part]
         c = world.client
-        # Part body in the tool frame: tool at the grip point, pointing down; the grasp error on top.
-        tool_in_part = (list(frames.grip), list(TOOL_DOWN_QUAT_XYZW))
+        # Part body in the tool frame: tool at the grip point, pointing down, turned by the yaw; the grasp error on top.
+        tool_in_part = (list(frames.grip), list(tool_quat(yaw)))
         body_pos, body_quat = pb.invertTransform(*tool_in_part)
         self.body_in_tool = pb.multiplyTransforms(list(offset), list(rotvec_quat_xyzw(tilt)), body_pos, body_quat)
         self.kinematic = part == world.product.base.id

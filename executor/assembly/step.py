@@ -52,7 +52,7 @@ from executor import ExecutorError
 from executor.assembly.failure import carried_by, targets_of, why_stuck
 from executor.assembly.grasp import Grasp
 from executor.assembly.product import Product
-from executor.assembly.transfer import DESCENT_SPEED, SAFE_Z, VIA_TOLERANCE, carry, move_line, reorient
+from executor.assembly.transfer import DESCENT_SPEED, SAFE_Z, VIA_TOLERANCE, carry, freest_yaw, move_line, reorient
 from executor.assembly.world import AssemblyWorld
 from executor.backend_plugin import check_step
 from executor.cell_description import CellDescription
@@ -94,6 +94,14 @@ SETTLE_S = 0.5
 """How long parts set at their goals by hand are left to the physics before the check that they stayed [s]."""
 DEFAULT_LAYER = LAYERS["pi_phase_stop"]
 """The insertion of a plan step unless the cell gives its layer: admittance PI, phase stopping, no ILC."""
+GRASP_YAWS = (0.0, np.pi, -np.pi)
+"""[rad] the tool yaws, about the part's z axis, at which the cell may pick the back plate
+(the fixture's part): a two-finger gripper holds it by the same two sides turned by a half
+turn (its fingers swapped), reached by the wrist turning either way. The plate keeps that
+turn in the tool, and the tool keeps it at the fixture, so the plate reaches its goal pose
+whatever its own symmetry; of these, the one whose postures on the way to the pick and on
+to the fixture keep the joints farthest from their limits
+(:func:`executor.assembly.transfer.freest_yaw`)."""
 FLAT_GRASP_OFFSET = 0.3  # a cover's grasp offset, as a fraction of a peg's (no tilt)
 SURFACE_RAYS = (8, 24)
 """The rays that measure where a peg's hole search presses (:meth:`Assembler.search_surface`):
@@ -240,7 +248,7 @@ class Assembler:
             self._surface[hole] = self.search_surface(part, hole)  # the arm at the tray, clear of the product
         stuck: tuple[FailureReason | None, tuple[str, ...]] = (None, ())
         if skill == "fixture":
-            carry(motion, world.frames[part].grip, grasp.follow)
+            carry(motion, world.frames[part].grip, grasp.follow, yaw=grasp.yaw)
             world.set_pose(part, world.goals[part])  # the fixture's locating pins
             outcomes = [(True, 0.0, 0.0)]
         else:
@@ -372,10 +380,13 @@ class Assembler:
         world.arm.set_grasp_error(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
         pos, quat = world.pose(part)
         grip = np.array(pb.multiplyTransforms(list(pos), list(quat), list(world.frames[part].grip), [0, 0, 0, 1])[0])
-        carry(world.motion, grip, tolerance=GRIP_TOLERANCE, yaw=0.0)  # the parts lie on the tray unturned
+        yaw = 0.0  # the parts lie on the tray unturned
+        if self.skill_of(part) == "fixture":  # placed at its grip point's goal, turned as it is held
+            yaw = freest_yaw(world.motion, np.array([grip, world.frames[part].grip]), GRASP_YAWS)
+        carry(world.motion, grip, tolerance=GRIP_TOLERANCE, yaw=yaw)
         if part in self.product.covers:  # a flat part lies against the palm, centred by the fingers
             return Grasp(world, part, FLAT_GRASP_OFFSET * setup.grasp_offset, np.zeros(3))
-        return Grasp(world, part, setup.grasp_offset, setup.grasp_tilt)
+        return Grasp(world, part, setup.grasp_offset, setup.grasp_tilt, yaw)
 
     def _goal_tcp(self, part: str, skill: str) -> np.ndarray:
         """Where the TCP is when the part is placed [m] (a head: in its part's socket now)."""

@@ -14,7 +14,7 @@ whose tool path is not a line)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TypeVar
 
 import msgspec
@@ -168,6 +168,30 @@ def rate_steps(arm: Arm, line: Callable[[np.ndarray], tuple[np.ndarray, np.ndarr
     per_blend = np.abs(np.diff(path, axis=0)) * RATE_SAMPLES
     peak = float(np.max(per_blend * fastest[:, None] / arm.rate_limit))  # the move in 1 s
     return math.ceil(peak / RATE_MARGIN / TIME_STEP)
+
+
+def freest_yaw(motion: Motion, points: np.ndarray, yaws: Sequence[float]) -> float:
+    """The tool yaw [rad] among ``yaws`` (cell frame, the tool pointing down) with which the
+    arm, going from where it is through ``points`` (n × 3 [m], cell frame) in straight lines,
+    its tool turning from :attr:`Motion.tool_yaw` to that yaw over the first and keeping it
+    after, keeps its joints farthest inside their limits: its postures
+    (:meth:`executor.world.arm.Arm.posture_path`) at :data:`RATE_SAMPLES` + 1 evenly spaced
+    points of each line, the largest smallest room of a joint from its nearer limit over
+    them, then the next smallest (rooms to 1 mrad; the first of ``yaws`` on a tie). A yaw
+    and that yaw plus a whole turn are the same pose reached by opposite turns of the wrist."""
+    arm = motion.controller.arm
+    legs = [motion.read().tip_pos, *points]
+    blends = np.linspace(0.0, 1.0, RATE_SAMPLES + 1)
+    tips = np.concatenate([a + blends[:, None] * (b - a) for a, b in zip(legs, legs[1:])])
+
+    def rooms(yaw: float) -> tuple[float, ...]:
+        turn = motion.tool_yaw + np.concatenate([blends * (yaw - motion.tool_yaw), np.full(len(tips) - len(blends), yaw
+                                                                                             - motion.tool_yaw)])
+        path = arm.posture_path(tips, np.array([tool_quat(t) for t in turn]))
+        room = np.min(np.minimum(path - arm.lower, arm.upper - path), axis=0)
+        return tuple(np.round(np.sort(room), 3))
+
+    return max(yaws, key=rooms)
 
 
 def minimum_jerk(s: T) -> tuple[T, T]:

@@ -8,13 +8,19 @@ their speed limits."""
 
 from __future__ import annotations
 
+from typing import Any
+from unittest import mock
+
 import numpy as np
 
+from executor.assembly import step
+from executor.assembly.grasp import Grasp
 from executor.assembly.product import load_product
 from executor.assembly.transfer import DESCENT_CLEARANCE, DESCENT_SPEED, SAFE_Z, carry
 from executor.assembly.world import AssemblyWorld
 from executor.campaign.rates import measure
 from executor.cell_description import CellDescription
+from executor.world.arm import LIMIT_MARGIN
 from executor.world.geometry import JOINT_RATE_LIMITS
 from executor.world.scene import TIME_STEP
 
@@ -43,12 +49,26 @@ def test_the_plate_carried_across_keeps_every_joint_within_its_speed_limit() -> 
     """The plate's step on ``spare`` (seed 0): at the tip speed alone its move from the tray
     to the fixture turned A1 at 2.7 rad/s, its limit 1.48 rad/s; stretched where the arm's
     postures along the line ask more, no move of the step turns a joint faster than its
-    limit, read from the simulated arm's joint rates after every control step."""
-    recorder, records = measure("spare", [("bp", None)], 0)
-    assert records[0].outcome == "fit"
+    limit, read from the simulated arm's joint rates after every control step. The plate
+    picked with the tool unturned had A7 against its limit (the move to it took 3.1 s, the
+    step 8.6 s of simulated time); picked turned by a half turn, A7 has room at the pick and
+    the step takes 5.8 s, the plate at its goal."""
+    picked: list[np.ndarray] = []
+
+    def grasp(world: AssemblyWorld, part: str, *args: Any, **kwargs: Any) -> Grasp:
+        picked.append(world.arm.read().q)
+        return Grasp(world, part, *args, **kwargs)
+
+    with mock.patch.object(step, "Grasp", grasp):
+        recorder, records = measure("spare", [("bp", None)], 0)
+    assert records[0].outcome == "fit" and records[0].pose_error < 1e-4
     limit = recorder.arm.rate_limit
     assert np.allclose(limit, np.radians(JOINT_RATE_LIMITS))  # the real arm's, from the URDF the cell loaded
     across = recorder.kinds["across"]
     assert across.moves == 2 and across.peak[0] > 0.7 * limit[0], across.peak  # A1 carries the plate across
     for kind, rates in recorder.kinds.items():
         assert np.all(rates.peak <= limit), f"{kind}: {np.round(rates.peak / limit, 2)} of the limits"
+    arm = recorder.arm
+    room = np.minimum(picked[0] - arm.lower, arm.upper - picked[0])
+    assert room[6] > LIMIT_MARGIN, f"A7 {room[6]:.3f} rad from its limit at the pick"
+    assert records[0].sim_time_s < 7.0, f"{records[0].sim_time_s:.2f} s simulated"
