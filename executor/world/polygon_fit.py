@@ -33,7 +33,10 @@ peg corner outside the hole, a hole corner inside the peg; the farthest such cor
 each peg is found through a k-d tree of points along the outline's edges, which bounds
 every corner's distance, and only the corners that may be the farthest are measured, each
 against the edges that may be nearest: the numbers ``shapely.distance`` gives against the
-whole outline, for a fraction of its pairs). The room reported is
+whole outline, for a fraction of its pairs); the room of a peg inside the hole, and a
+corner's distance to an outline (the symmetry's test), are measured by GEOS on the runs
+of edges whose boxes may hold the nearest pair (:meth:`_Pair.clearances`,
+:meth:`_Edges.distances`; outlines without inner rings): the same numbers again. The room reported is
 measured at the turn and shift found (inside: the peg's distance to the hole's boundary,
 exact; outside: a bisection on the buffer to :data:`FINE_SHIFT`), so a pass it reports
 is one the peg can make; a pass whose window of turns the search never samples near can
@@ -51,7 +54,7 @@ them by: :func:`executor.cad.sections.section_room`).
 Deterministic: the same outlines give the same answer, so :func:`polygon_fit` searches
 a pair of outlines once (the pair's exact WKB bytes its key: the same peg and hole
 polygons of sections that differ elsewhere meet many times in an import), and a polygon's
-largest inscribed circle, a peg's best shift at a turn, are found once for each.
+largest inscribed circle and its symmetry, a peg's best shift at a turn, are found once for each.
 """
 
 from __future__ import annotations
@@ -142,17 +145,22 @@ def circle(radius: float, *, outside: bool) -> shapely.Polygon:
 def symmetry(shape: shapely.Polygon) -> int:
     """The largest n <= :data:`MAX_ORDER` such that turning ``shape`` by 2π/n about the
     origin puts each of its corners (its inner rings' too) on its boundary within :data:`SYMMETRY_TOLERANCE`
-    (eight spread corners tried for every n at once, then all for the likely ones)."""
+    (eight spread corners tried for every n at once, then all for the likely ones), once
+    for each polygon (its WKB bytes)."""
+    return _symmetry(shapely.to_wkb(shape))
+
+
+@functools.lru_cache(maxsize=4096)
+def _symmetry(wkb: bytes) -> int:
+    shape = shapely.from_wkb(wkb)
+    edge = _Edges(shape)
     corners = _edges_of(shape)[:, 0]
-    edge = _boundary(shape)
-    shapely.prepare(edge)
     few = corners[:: max(1, len(corners) // 8)]
     orders = np.arange(MAX_ORDER, 1, -1)
     turned = np.concatenate([_turn(few, 2 * math.pi / order) for order in orders])
-    off = shapely.distance(edge, shapely.points(turned)).reshape(len(orders), len(few)).max(axis=1)
+    off = edge.distances(turned).reshape(len(orders), len(few)).max(axis=1)
     for order in orders[off <= SYMMETRY_TOLERANCE]:
-        if float(np.max(shapely.distance(edge, shapely.points(_turn(corners, 2 * math.pi / order))))) \
-                <= SYMMETRY_TOLERANCE:
+        if float(np.max(edge.distances(_turn(corners, 2 * math.pi / order)))) <= SYMMETRY_TOLERANCE:
             return int(order)
     return 1
 
@@ -170,6 +178,24 @@ whole faster (the corpus's outlines: ``vitac_shapes``' 4 to 48 corners, ``flynn_
 splines 634 to 1192)."""
 _SLACK = 1e-12
 """[m] added to the bounds :class:`_Edges` compares (their rounding)."""
+_CHUNK = 32
+"""Edges of a ring's runs whose boxes :meth:`_Pair.clearances` compares."""
+
+
+def _runs(rings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closed rings (k, n + 1, 2) [m] cut into runs of :data:`_CHUNK` edges in a row (the
+    last shorter): their line strings (k, runs), each the ring's corners in its order, and
+    their boxes' lowest and highest corners (k, runs, 2) [m]."""
+    count, ends = rings.shape[0], rings.shape[1] - 1
+    starts = np.arange(0, ends, _CHUNK)
+    sizes = np.minimum(starts + _CHUNK, ends) - starts + 1
+    index = np.repeat(starts - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
+    corners = rings[:, index]
+    lines = shapely.linestrings(corners.reshape(-1, 2), indices=np.repeat(np.arange(count * len(starts)),
+                                                                          np.tile(sizes, count)))
+    first = np.cumsum(sizes) - sizes
+    return (lines.reshape(count, len(starts)), np.minimum.reduceat(corners, first, axis=1),
+            np.maximum.reduceat(corners, first, axis=1))
 
 
 def _largest(values: np.ndarray, groups: np.ndarray, count: int) -> np.ndarray:
@@ -187,7 +213,13 @@ class _Edges:
     that distance), and only the points whose bound reaches the best lower bound of their
     group are measured, each against the edges with an indexed point within its bound plus
     ``step`` / 2 (which hold its nearest edges), by GEOS as it measures the whole ring: the
-    same number, which the deepest overlap of a peg needs."""
+    same number, which the deepest overlap of a peg needs. An outline without inner rings
+    has runs of :data:`_CHUNK` edges (:func:`_runs`) that answer each point's own distance
+    (:meth:`distances`)."""
+
+    runs: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    """An indexed outline's runs of edges without inner rings (:func:`_runs`): line strings,
+    boxes' lowest and highest corners; None otherwise."""
 
     def __init__(self, shape: shapely.Polygon) -> None:
         self.ring = _boundary(shape)
@@ -197,6 +229,10 @@ class _Edges:
         if not self.indexed:
             return
         corners, ends = edges[:, 0], edges[:, 1]
+        if not shape.interiors:
+            self.runs = _runs(np.asarray(shape.exterior.coords)[None])
+            self.run_starts = corners[::_CHUNK]
+            """Each run's first corner [m]."""
         lengths = np.hypot(*(ends - corners).T)
         self.step = float(lengths.sum()) / _SAMPLES
         pieces = np.maximum(1, np.ceil(lengths / self.step)).astype(int)
@@ -205,6 +241,22 @@ class _Edges:
         along = (np.arange(len(self.owner)) - starts[self.owner]) / pieces[self.owner]  # 0 to 1 on each edge
         self.tree = cKDTree(corners[self.owner] + along[:, None] * (ends - corners)[self.owner])
         self.lines = shapely.linestrings(np.stack([corners, ends], axis=1))
+
+    def distances(self, points: np.ndarray) -> np.ndarray:
+        """The distance [m] of each of ``points`` (k, 2) [m] to the rings as
+        ``shapely.distance`` gives it (the least of its distances to every edge): for an
+        outline with runs, measured against only the runs of edges whose boxes lie within its
+        distance to the nearest run's first corner, each as GEOS measures the whole ring."""
+        if self.runs is None:
+            return shapely.distance(self.ring, shapely.points(points))
+        lines, low, high = (run[0] for run in self.runs)
+        offset = points[:, None] - low[None]  # (k, runs, 2): from each box's lowest corner
+        gap = np.maximum(np.maximum(-offset, points[:, None] - high[None]), 0.0)
+        bound = np.min(np.hypot(*(points[:, None] - self.run_starts[None]).transpose(2, 0, 1)), axis=1)
+        point, run = np.nonzero(np.hypot(gap[..., 0], gap[..., 1]) <= bound[:, None] + _SLACK)
+        found = np.full(len(points), np.inf)
+        np.minimum.at(found, point, shapely.distance(lines[run], shapely.points(points[point])))
+        return found
 
     def largest(self, points: np.ndarray, groups: np.ndarray, count: int) -> np.ndarray:
         """The largest distance [m] to the ring of ``points`` (k, 2) [m] in each of ``count``
@@ -218,11 +270,10 @@ class _Edges:
         chosen = np.flatnonzero(bound + _SLACK >= best[groups])
         balls = self.tree.query_ball_point(points[chosen], bound[chosen] + self.step / 2 + _SLACK)
         counts = np.fromiter(map(len, balls), int, len(balls))
-        pairs = np.unique(np.stack([np.repeat(chosen, counts), self.owner[np.concatenate(balls).astype(int)]],
-                                   axis=1), axis=0)
+        point, edge = np.divmod(np.unique(np.repeat(chosen, counts) * len(self.lines)
+                                          + self.owner[np.concatenate(balls).astype(int)]), len(self.lines))
         measured = np.full(len(points), np.inf)
-        np.minimum.at(measured, pairs[:, 0], shapely.distance(shapely.points(points[pairs[:, 0]]),
-                                                               self.lines[pairs[:, 1]]))
+        np.minimum.at(measured, point, shapely.distance(shapely.points(points[point]), self.lines[edge]))
         return _largest(measured[chosen], groups[chosen], count)
 
 
@@ -272,13 +323,14 @@ class _Pair:
         pegs = self.pegs(angles, shifts)
         inside = shapely.contains(self.hole, pegs)
         result = np.empty(len(angles))
-        result[inside] = shapely.distance(self.hole_edge.ring, pegs[inside])
+        if np.any(inside):
+            result[inside] = self.clearances(pegs[inside])
         out = ~inside
         if np.any(out):
             count = int(out.sum())
             corners = shapely.get_coordinates(pegs[out])
             groups = np.repeat(np.arange(count), len(self.peg_edges) + len(self.peg_rings))
-            outside = ~shapely.contains(self.hole, shapely.points(corners))
+            outside = ~shapely.contains_xy(self.hole, corners[:, 0], corners[:, 1])
             deepest = self.hole_edge.largest(corners[outside], groups[outside], count)
             # the hole's corners, brought into each peg's frame, inside the peg
             back = self.hole_edges[None, :, 0, :] - shifts[out][:, None, :]
@@ -286,10 +338,33 @@ class _Pair:
             local = np.stack([c * back[..., 0] - s * back[..., 1], s * back[..., 0] + c * back[..., 1]],
                              axis=2).reshape(-1, 2)
             groups = np.repeat(np.arange(count), len(self.hole_edges))
-            within = shapely.contains(self.peg, shapely.points(local))
+            within = shapely.contains_xy(self.peg, local[:, 0], local[:, 1])
             poke = self.peg_edge.largest(local[within], groups[within], count)
             result[out] = -np.maximum(np.maximum(deepest, poke), 0.0)  # 0: no corner out
         return result
+
+    def clearances(self, pegs: np.ndarray) -> np.ndarray:
+        """The distance [m] from the hole's boundary to each of ``pegs`` (inside the hole)
+        as ``shapely.distance`` gives it: GEOS takes the least of every pair of edges' (the
+        hole's, the peg's) distances. For two outlines of more than :data:`_INDEXED` corners
+        and no inner rings, GEOS measures only the runs of edges (:func:`_runs`) whose boxes
+        lie within a bound of that least (the least distance of a few of the peg's corners
+        to the hole), each pair of runs as the whole outlines' pairs of edges are measured:
+        the same number."""
+        hole_runs = self.hole_edge.runs
+        if len(self.peg_points) <= _INDEXED or hole_runs is None or len(self.peg_rings) > 1:
+            return shapely.distance(self.hole_edge.ring, pegs)
+        count = len(pegs)
+        placed = shapely.get_coordinates(pegs).reshape(count, -1, 2)  # each ring closed
+        few = placed[:, :: max(1, len(self.peg_points) // 8)]
+        bound = self.hole_edge.distances(few.reshape(-1, 2)).reshape(count, -1).min(axis=1)
+        lines, low, high = _runs(placed)
+        hole_lines, hole_low, hole_high = hole_runs
+        gap = np.maximum(np.maximum(low[:, :, None] - hole_high[:, None], hole_low[:, None] - high[:, :, None]), 0.0)
+        peg, run, hole_run = np.nonzero(np.hypot(gap[..., 0], gap[..., 1]) <= bound[:, None, None] + _SLACK)
+        found = np.full(count, np.inf)
+        np.minimum.at(found, peg, shapely.distance(hole_lines[0, hole_run], lines[peg, run]))
+        return found
 
     def score(self, angle: float, shift: np.ndarray) -> float:
         return float(self.scores(np.array([angle]), shift[None, :])[0])

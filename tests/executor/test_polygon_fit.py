@@ -19,7 +19,7 @@ from shapely import affinity
 from executor.cad.cli import load_source
 from executor.cad.sections import classify, section, slice_loops
 from executor.world.geometry import Section, margin, outline_polygon, section_fit
-from executor.world.polygon_fit import OutlineError, _Edges, polygon, polygon_fit, round_fit
+from executor.world.polygon_fit import OutlineError, _Edges, _Pair, polygon, polygon_fit, round_fit
 from tests._outlines import splined
 
 MM = 1e-3
@@ -228,6 +228,7 @@ def test_the_deepest_overlap_is_the_largest_distance_shapely_gives_measuring_few
         expected = np.full(41, -np.inf)
         np.maximum.at(expected, groups, shapely.distance(ring, shapely.points(points)))
         assert np.array_equal(edges.largest(points, groups, 41), expected)
+        assert np.array_equal(edges.distances(points), shapely.distance(ring, shapely.points(points)))
 
 
 def test_the_yaw_at_its_best_shift_is_found_to_the_room_the_truth_has(tmp_path: Path) -> None:
@@ -245,3 +246,33 @@ def test_the_yaw_at_its_best_shift_is_found_to_the_room_the_truth_has(tmp_path: 
     assert len(peg) == 1
     found = section_fit(section("peg2", classify(peg[0], hole=False)), section("h2", classify(pocket, hole=True)))
     assert found.room == pytest.approx(0.66643 * MM, abs=0.25e-6)
+
+
+def test_the_room_of_a_peg_inside_is_the_distance_shapely_gives_measuring_few_pairs() -> None:
+    # Both outlines of more than 256 corners (a 6-tooth spline in its outline grown by 0.2
+    # mm, edges of 20 um; a 400-gon touching a 600-gon with one corner): each peg inside
+    # the hole, turned and shifted, gets the distance shapely.distance measures between
+    # the hole's ring and the whole peg, number for number, from the runs of edges near it,
+    # 0 where GEOS finds a corner's edges crossing the hole's though its distance is not 0.
+    rng = np.random.default_rng(11)
+    pair = _Pair(shapely.segmentize(SHAFT, 0.02 * MM), shapely.segmentize(SHAFT.buffer(0.2 * MM), 0.02 * MM))
+    angles = np.concatenate([rng.normal(0.0, 0.02, 200), rng.normal(0.0, 1e-4, 100)])
+    shifts = np.concatenate([rng.normal(0.0, 0.07 * MM, (200, 2)), rng.normal(0.0, 1e-3 * MM, (100, 2))])
+    pegs = pair.pegs(angles, shifts)
+    inside = shapely.contains(pair.hole, pegs)
+    assert inside.sum() > 200
+    assert np.array_equal(pair.clearances(pegs[inside]), shapely.distance(pair.hole.exterior, pegs[inside]))
+    hole = shapely.Polygon(5 * MM * np.c_[np.cos(np.arange(600) * np.pi / 300), np.sin(np.arange(600) * np.pi / 300)])
+    corners = np.asarray(hole.exterior.coords)
+    found, expected = [], []
+    for k in rng.integers(0, 600, 40):
+        touch = (corners[k] + corners[k + 1]) / 2  # on the hole's edge, to the float
+        turns = np.arange(400) * np.pi / 200 + math.atan2(touch[1], touch[0])
+        ring = 3 * MM * np.c_[np.cos(turns), np.sin(turns)]
+        ring[0] = touch
+        pair = _Pair(shapely.Polygon(ring), hole)
+        peg = pair.pegs(np.zeros(1), np.zeros((1, 2)))
+        if shapely.contains(hole, peg[0]):
+            found.append(float(pair.clearances(peg)[0]))
+            expected.append(float(shapely.distance(hole.exterior, peg[0])))
+    assert found == expected and expected.count(0.0) >= 5
