@@ -25,6 +25,7 @@ from bridge.cli_types import (
     ArgumentParser,
     add_assembly_argument,
     backend_option,
+    comma_list,
     int_in,
     nonempty_path,
     png_path,
@@ -48,11 +49,14 @@ MAX_ATTEMPTS = 10
 def _teach(args: argparse.Namespace) -> int:
     from executor import ExecutorError
     from executor.cell_description import load_cell_description
-    from executor.skills.teach import Demonstrator, TeachingCell, scripted_demonstration, teach_all
+    from executor.skills.teach import Demonstrator, TeachingCell, chosen_shapes, scripted_demonstration, teach_all
+    from executor.world.geometry import load_geometry
 
     if args.demonstration == "hand" and args.backend != "franka":
         raise ExecutorError("--demonstration hand: a person guides the part on a real arm; expected --backend franka")
     description = load_cell_description(args.cell_description)
+    geometry = load_geometry(args.assembly, description)
+    chosen_shapes(geometry, args.shapes)  # an unknown name is refused before a cell starts
     cell: TeachingCell
     demonstrate: Demonstrator = scripted_demonstration
     if args.backend == "franka":
@@ -60,7 +64,6 @@ def _teach(args: argparse.Namespace) -> int:
         from executor.franka.backend import franka_options
         from executor.franka.cell import FrankaCell
         from executor.franka.teach import FrankaTeacher
-        from executor.world.geometry import load_geometry
 
         options = franka_options(dict(args.backend_option))
         if any(options.offset):
@@ -68,7 +71,7 @@ def _teach(args: argparse.Namespace) -> int:
             raise ExecutorError("--backend-option offset: teaching on the arm does not move its poses by the "
                                 "offset; expected offset=0,0,0 (the plate where geometry.toml puts it in the "
                                 "robot's base frame)")
-        arm = FrankaCell(load_geometry(args.assembly, description), description, layer_named("full"), options)
+        arm = FrankaCell(geometry, description, layer_named("full"), options)
         cell = FrankaTeacher(arm)
         close = arm.stop
         if args.demonstration == "hand":
@@ -83,7 +86,7 @@ def _teach(args: argparse.Namespace) -> int:
         sim = Cell(args.assembly, setup=CellSetup(description=description))
         cell, close = sim, sim.close
     try:
-        written = teach_all(cell, demonstrate)
+        written = teach_all(cell, demonstrate, args.shapes)
     finally:
         close()
     for path in written:
@@ -218,6 +221,9 @@ def build_parser() -> argparse.ArgumentParser:
     teach.add_argument("--demonstration", choices=("scripted", "hand"), default="scripted",
                        help="scripted: the cell guides the part down its hole; hand: a person guides it on the arm, "
                             "compliant (--backend franka only; docs/franka.md, Teaching) (default scripted)")
+    teach.add_argument("--shapes", type=comma_list(str, "part shapes such as peg_d10,peg_d11"), metavar="SHAPE,...",
+                       help="teach only these part shapes (of geometry.toml's [part_shapes]); the stored skills of "
+                            "the others are kept (default: every shape)")
     add_cell_description_argument(teach)
     teach.set_defaults(func=_teach)
 

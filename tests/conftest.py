@@ -13,6 +13,8 @@ Fixtures (session-scoped but ``cli_env``, so hypothesis tests may use them too):
   the imports of clingo, PyBullet, Rerun: about 1 s of CPU each), ``timeout`` unused; the
   working directory, stdin, the root logger's handlers and level, the environment and the
   handlers of :data:`HANDLED_SIGNALS` are this process's again after it;
+- ``main_in_process(*args, cwd=None, input=None)`` (a function, not a fixture): the same as
+  ``run_main`` for a module's or session's fixture, its output captured without ``capsys``;
 - ``run_python(module, *args, cwd=None, input=None, timeout=120)``: ``python -m MODULE ARGS``
   (e.g. ``clingo``);
 - ``run_session(*args, timeout=60)`` → ``dict``: ``session --backend truth --json ARGS`` (the
@@ -154,34 +156,61 @@ def run_executor() -> Runner:
     return functools.partial(python_module, CLI_MODULE, "executor")
 
 
-@pytest.fixture
-def run_main(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> Runner:
+@contextlib.contextmanager
+def _as_a_process(cwd: Path | str | None, input: str | None) -> Iterator[None]:
+    """The block runs a command as its own process would: in ``cwd`` (default: the
+    repository root), ``input`` on stdin, no root log handler (the command's is made on the
+    block's stderr, as a child's on its own); the working directory, stdin, the root
+    logger's handlers and level, the environment and the handlers of
+    :data:`HANDLED_SIGNALS` are this process's again after it."""
+    root_logger = logging.getLogger()
+    level = root_logger.level
+    environ = dict(os.environ)
+    handlers = {number: signal.getsignal(number) for number in HANDLED_SIGNALS}
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(ROOT if cwd is None else cwd)
+        patch.setattr(sys, "stdin", io.StringIO(input or ""))
+        patch.setattr(root_logger, "handlers", [])
+        try:
+            yield
+        finally:
+            # what a command sets for its process (RUST_LOG, its signal handlers) ends with it
+            root_logger.setLevel(level)
+            os.environ.clear()
+            os.environ.update(environ)
+            for number, handler in handlers.items():
+                if handler is not None:
+                    signal.signal(number, handler)
+
+
+def _exit_code(args: tuple[str, ...]) -> int:
+    """``assembly_constraints.cli.main(ARGS)``'s exit code (argparse's errors: its SystemExit's)."""
     from assembly_constraints.cli import main
 
+    try:
+        return main(list(args))
+    except SystemExit as exit_:
+        return exit_.code if isinstance(exit_.code, int) else 1
+
+
+def main_in_process(*args: str, cwd: Path | str | None = None, input: str | None = None,
+                    timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]:
+    """``run_main`` for a module's or session's fixture, which cannot take a test's
+    ``capsys``: the command's stdout and stderr are captured by redirecting
+    ``sys.stdout`` and ``sys.stderr`` for its run; ``timeout`` unused."""
+    out, err = io.StringIO(), io.StringIO()
+    with _as_a_process(cwd, input), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = _exit_code(args)
+    return subprocess.CompletedProcess([CLI_MODULE, *args], code, out.getvalue(), err.getvalue())
+
+
+@pytest.fixture
+def run_main(capsys: pytest.CaptureFixture[str]) -> Runner:
     def run(*args: str, cwd: Path | str | None = None, input: str | None = None,
             timeout: float = DEFAULT_TIMEOUT) -> subprocess.CompletedProcess[str]:
         capsys.readouterr()
-        root_logger = logging.getLogger()
-        level = root_logger.level
-        environ = dict(os.environ)
-        handlers = {number: signal.getsignal(number) for number in HANDLED_SIGNALS}
-        with monkeypatch.context() as patch:
-            patch.chdir(ROOT if cwd is None else cwd)
-            patch.setattr(sys, "stdin", io.StringIO(input or ""))
-            # the command's log handler is made on this test's stderr, as a child's is on its own
-            patch.setattr(root_logger, "handlers", [])
-            try:
-                code = main(list(args))
-            except SystemExit as exit_:  # argparse's errors
-                code = exit_.code if isinstance(exit_.code, int) else 1
-            finally:
-                # what a command sets for its process (RUST_LOG, its signal handlers) ends with it
-                root_logger.setLevel(level)
-                os.environ.clear()
-                os.environ.update(environ)
-                for number, handler in handlers.items():
-                    if handler is not None:
-                        signal.signal(number, handler)
+        with _as_a_process(cwd, input):
+            code = _exit_code(args)
         out, err = capsys.readouterr()
         return subprocess.CompletedProcess([CLI_MODULE, *args], code, out, err)
     return run

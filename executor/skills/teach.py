@@ -24,12 +24,13 @@ yaw), so the skill runs in a hole of any yaw and at any height; in a hole of ano
 its goal moves with the bottom, by the depth its record gives
 (:meth:`executor.skills.dmp.Skill.in_hole`).
 ``./run.sh executor teach`` rebuilds ``data/<assembly>/demonstrations/<shape>.json``: every
-shape is taught first, and the files are written only when all were taught.
+shape (or those of ``--shapes``, the other shapes' files kept) is taught first, and the
+files are written only when all were taught.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -203,11 +204,28 @@ def teach_shape(cell: TeachingCell, shape: str, demonstrate: Demonstrator = scri
     return skill
 
 
-def teach_all(cell: TeachingCell, demonstrate: Demonstrator = scripted_demonstration) -> list[Path]:
-    """Regenerate the assets of the cell's product and teach every part shape, each
-    demonstrated by ``demonstrate``, then write the skills (none when one teaching fails:
-    ExecutorError, :func:`teach_shape`); returns the written files."""
+def chosen_shapes(geometry: CellGeometry, names: Sequence[str] | None) -> list[str]:
+    """The part shapes to teach, sorted: ``names`` (``executor teach --shapes``), or every
+    shape of the product when None; ExecutorError naming geometry.toml, the unknown names
+    and the product's shapes when one is not a part shape of it."""
+    shapes = sorted({p.shape for p in geometry.parts.values()})
+    if names is None:
+        return shapes
+    unknown = sorted(set(names) - set(shapes))
+    if unknown:
+        raise ExecutorError(f"--shapes: no part shape {', '.join(unknown)} in {geometry.folder / 'geometry.toml'} "
+                            f"(its shapes: {', '.join(shapes) or 'none'})")
+    return sorted(set(names))
+
+
+def teach_all(cell: TeachingCell, demonstrate: Demonstrator = scripted_demonstration,
+              shapes: Sequence[str] | None = None) -> list[Path]:
+    """Regenerate the assets of the cell's product and teach its part shapes (``shapes``,
+    checked by :func:`chosen_shapes`; every shape when None), each demonstrated by
+    ``demonstrate``, then write their skills (none when one teaching fails: ExecutorError,
+    :func:`teach_shape`); the stored skills of the other shapes are kept. Returns the
+    written files."""
+    chosen = chosen_shapes(cell.geometry, shapes)
     written = regenerate_assets(cell.geometry)
-    skills = [teach_shape(cell, shape, demonstrate)
-              for shape in sorted({p.shape for p in cell.geometry.parts.values()})]
+    skills = [teach_shape(cell, shape, demonstrate) for shape in chosen]
     return written + [save_skill(cell.geometry.folder, skill) for skill in skills]

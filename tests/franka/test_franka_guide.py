@@ -80,6 +80,16 @@ def test_teaching_on_the_arm_refuses_an_offset_it_would_not_apply(run_main) -> N
     assert done.returncode == 2 and "offset=0,0,0" in done.stderr and "Traceback" not in done.stderr, done.stderr
 
 
+def test_teaching_refuses_a_shape_the_product_has_not_before_it_reaches_the_arm(run_main) -> None:
+    """``--shapes`` names a shape of the product and one it has not: one line naming the
+    unknown one and geometry.toml, exit 2, before a connection to the (absent) arm."""
+    done = run_main("executor", "teach", "--assembly", str(TRIO), "--backend", "franka",
+                    "--backend-option", "host=127.0.0.9", "--shapes", "peg_d10,peg_d9")
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert done.returncode == 2 and len(lines) == 1, done.stderr
+    assert "peg_d9" in lines[0] and "geometry.toml" in lines[0] and "127.0.0.9" not in lines[0], lines
+
+
 @pytest.mark.slow
 @pytest.mark.timeout(1200)
 @pytest.mark.usefixtures("one_simulated_arm")

@@ -1,22 +1,25 @@
 """Teaching, learning and assembling on the arm, one after the other on one franky-sim, as
-docs/franka.md shows them: ``executor teach --backend franka`` records the skill of every
-part shape of a product that has none (the scripted demonstration, the reference wrench
-from the harness's wrist sensor) and stores it as the PyBullet cell's skills are; on those
-skills ``./run.sh session --backend franka --backend-option host=...`` learns the
-product's fits exactly, each ``no_fit`` stopped by eq. (6) and its peg carried back where
-it waited, standing; then ``./run.sh assemble --run RUN --backend franka`` (the same
-options) places every peg, each ``fit`` and within 2 mm of its goal in the simulated world
-(its truth, not the robot's own reading), no step left to an operator.
+docs/franka.md shows them: ``executor teach --backend franka --shapes peg_d11`` records the
+skill of the part shape that has none (the scripted demonstration, the reference wrench from
+the harness's wrist sensor) and stores it as the PyBullet cell's skills are, keeping the
+other shape's stored skill; on those skills ``./run.sh session --backend franka
+--backend-option host=...`` learns the product's fits exactly, each ``no_fit`` stopped by
+eq. (6) and its peg carried back where it waited, standing; then ``./run.sh assemble --run
+RUN --backend franka`` (the same options) places every peg, each ``fit`` and within 2 mm of
+its goal in the simulated world (its truth, not the robot's own reading), no step left to an
+operator.
 
 The product is ``tests/franka/data/duo``, the graded board's first two pegs (d 10, 11 mm)
-and holes (d 10.8, 11.8 mm), without skills: two shapes to teach, one fit and one no-fit
-to learn by experiment (the session's two experiments), two pegs to place. Its pegs wait
-in the simulated world 2 mm (along x) from where the cell believes them, so the hand holds
-each 2 mm off (along its pads, which do not centre it): the teaching finds each hole with
-the hole search before the descent (brought straight down, a part lands on the plate beside
-it), and so do the experiments and the plan steps.
+and holes (d 10.8, 11.8 mm), with the skill of ``peg_d10`` taught in the PyBullet cell
+(``demonstrations/``; ``test_franka_guide.py`` teaches that shape on the arm, by hand) and
+none for ``peg_d11``: one shape to teach on the arm, one fit and one no-fit to learn by
+experiment (the session's two experiments), two pegs to place. Its pegs wait in the
+simulated world 2 mm (along x) from where the cell believes them, so the hand holds each 2
+mm off (along its pads, which do not centre it): the teaching finds each hole with the hole
+search before the descent (brought straight down, a part lands on the plate beside it), and
+so do the experiments and the plan steps.
 
-Long (each shape picked, guided down its hole, replayed and put back; two experiments; two
+Long (one shape picked, guided down its hole, replayed and put back; two experiments; two
 plan steps): several minutes on the shared 2-core machine; the harness holds a grasped part
 with a weld, as the PyBullet cell's grasp constraint does."""
 
@@ -43,12 +46,14 @@ from executor.franka.backend import franka_starter  # noqa: E402
 from executor.franka.sim_server import SimRobot, sim_robot  # noqa: E402
 from executor.serve.truth import sizes_truth  # noqa: E402
 from executor.world.geometry import load_geometry  # noqa: E402
-from tests.conftest import simulated_arm_lock
+from tests.conftest import main_in_process, simulated_arm_lock
 from tests.franka import SIM_DYNAMICS, franka_cell_description, parts_moved
 
 DUO = Path(__file__).parent / "data" / "duo"
 DEMOS = {"peg_d10": ("p1", "h1"), "peg_d11": ("p2", "h2")}
 """Each shape's part and the hole it is taught in (``demo_hole``)."""
+TAUGHT = "peg_d11"
+"""The shape the test teaches on the arm (``--shapes``); the other's skill is shipped."""
 GRASP_ERROR = 0.002
 """[m] along x, where the fingers' pads do not centre a part: how far each peg waits from
 its ``start`` in the simulated world."""
@@ -72,22 +77,25 @@ pytestmark = [pytest.mark.slow, pytest.mark.franka_arm]
 @dataclass(frozen=True)
 class Taught:
     """The product's copy (``folder``), the simulator and the arm's command-line options, what
-    a franka cell said before the teaching (``refused``, None: it started) and the teaching's
-    run (``teach``)."""
+    a franka cell said before the teaching (``refused``, None: it started), the teaching's
+    run (``teach``) and the shipped skill files' bytes before it (``shipped``, by shape)."""
 
     folder: Path
     sim: SimRobot
     arm: tuple[str, ...]
     refused: str | None
     teach: subprocess.CompletedProcess[str]
+    shipped: dict[str, bytes]
 
 
 @pytest.fixture(scope="module")
-def taught(tmp_path_factory: pytest.TempPathFactory, run_executor) -> Iterator[Taught]:
+def taught(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Taught]:
     """franky-sim with the two pegs 2 mm off, a franka cell's start on the product without
-    skills, then ``executor teach --backend franka``; the arm's lock held for the module."""
+    :data:`TAUGHT`'s skill, then ``executor teach --backend franka --shapes TAUGHT`` in this
+    process; the arm's lock held for the module."""
     tmp = tmp_path_factory.mktemp("duo")
-    folder = Path(shutil.copytree(DUO, tmp / "duo", ignore=shutil.ignore_patterns("assets", "demonstrations")))
+    folder = Path(shutil.copytree(DUO, tmp / "duo", ignore=shutil.ignore_patterns("assets")))
+    shipped = {path.stem: path.read_bytes() for path in (folder / "demonstrations").glob("*.json")}
     description = franka_cell_description(tmp, SEARCH_RADIUS)
     with simulated_arm_lock(), sim_robot(parts_moved(folder, tmp / "world", GRASP_ERROR)) as sim:
         options = {"host": sim.host, "realtime": "ignore", "dynamics": SIM_DYNAMICS}
@@ -99,17 +107,22 @@ def taught(tmp_path_factory: pytest.TempPathFactory, run_executor) -> Iterator[T
             refused = None
         except ExecutorError as exc:
             refused = str(exc)
-        teach = run_executor("teach", "--assembly", str(folder), "--backend", "franka", *arm, timeout=1500)
+        teach = main_in_process("executor", "teach", "--assembly", str(folder), "--backend", "franka", *arm,
+                                "--shapes", TAUGHT)
         LOG.info("the teaching: %.1f s of robot time", sim.truth().time)
-        yield Taught(folder, sim, ("--backend", "franka", *arm), refused, teach)
+        yield Taught(folder, sim, ("--backend", "franka", *arm), refused, teach, shipped)
 
 
 @pytest.mark.timeout(1800)
 def test_skills_taught_on_the_arm_are_stored(taught: Taught) -> None:
-    assert taught.refused is not None and "peg_d10" in taught.refused, taught.refused  # no skills: refused
+    assert set(taught.shipped) == set(DEMOS) - {TAUGHT}, taught.shipped
+    assert taught.refused is not None and TAUGHT in taught.refused, taught.refused  # a skill missing: refused
     assert taught.teach.returncode == 0, taught.teach.stderr
     for shape, (part, hole) in DEMOS.items():
         path = taught.folder / "demonstrations" / f"{shape}.json"
+        if shape != TAUGHT:  # not taught (--shapes), its file kept as it was
+            assert f"wrote {path}" not in taught.teach.stdout and path.read_bytes() == taught.shipped[shape]
+            continue
         assert f"wrote {path}" in taught.teach.stdout, taught.teach.stdout
         record = json.loads(path.read_text(encoding="utf-8"))["taught"]
         assert (record["part"], record["hole"]) == (part, hole), record
