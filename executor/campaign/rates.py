@@ -28,7 +28,7 @@ from unittest import mock
 import numpy as np
 import pybullet as pb
 
-from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, int_in
+from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
 from executor.assembly import transfer
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler, StepRecord, check_product_step
@@ -107,12 +107,12 @@ class Recorder:
             yield
 
 
-def _plan(text: str) -> list[tuple[str, str | None]]:
-    steps = []
-    for item in text.split(","):
-        part, _, hole = item.strip().partition(":")
-        steps.append((part, hole or None))
-    return steps
+def _step(text: str) -> tuple[str, str | None]:
+    """A plan step: ``"bp"`` → ``("bp", None)``, ``"p1:r1"`` → ``("p1", "r1")`` (ValueError otherwise)."""
+    part, sep, hole = text.partition(":")
+    if not part or (sep and not hole) or ":" in hole:
+        raise ValueError(text)
+    return part, hole or None
 
 
 def measure(assembly: str, plan: list[tuple[str, str | None]], seed: int) -> tuple[Recorder, list[StepRecord]]:
@@ -136,7 +136,8 @@ def main(argv: list[str]) -> int:
     parser = ArgumentParser(prog="bench rates", description="The joint rates the assembling cell's moves in free "
                             "space ask of the arm, against its joints' speed limits (docs/cell.md).")
     add_assembly_argument(parser, "spare")
-    parser.add_argument("--plan", required=True, type=_plan, metavar="PART[:HOLE],...",
+    parser.add_argument("--plan", required=True, type=comma_list(_step, "steps PART or PART:HOLE"),
+                        metavar="PART[:HOLE],...",
                         help="the steps in order, e.g. bp,p1:r1,p2:r2,p3:s1")
     parser.add_argument("--seed", type=int_in(0, MAX_SEED), default=0, help="each step's seed (default 0)")
     parser.add_argument("--json", action="store_true", help="print JSON")
