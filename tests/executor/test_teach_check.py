@@ -1,7 +1,8 @@
 """Teaching checks its own result: a demonstration that does not reach its goal is
 refused (one line naming the part, the hole and the end error; no skill written), and a
 skill file is loaded only with the record of a teaching that reached its goal, so no
-trial reports a fit from a skill that did not fit."""
+trial reports a fit from a skill that did not fit. ``--shapes`` teaches only the named
+shapes and keeps the other stored skills byte for byte."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from executor import ExecutorError
 from executor.skills.dmp import load_skill, skill_path
 from executor.trial import Cell
 from executor.world.geometry import load_geometry
+from tests.conftest import error_lines
 
 
 @pytest.fixture
@@ -146,3 +148,34 @@ def test_a_skill_on_the_product_it_was_taught_on_is_used(spare: Path) -> None:
         assert cell.check_pair("p3", "s1").taught == load_skill(spare, "square_peg").taught
     finally:
         cell.close()
+
+
+def test_teaching_the_named_shapes_keeps_the_other_stored_skills(spare: Path, run_main) -> None:
+    """``executor teach --shapes round_peg`` on the sim backend writes the round peg's skill
+    (its file removed first, so it must be written) and leaves the square peg's file byte for
+    byte as it was (stored compact here, so a teaching of it would rewrite it indented)."""
+    taught, kept = skill_path(spare, "round_peg"), skill_path(spare, "square_peg")
+    taught.unlink()
+    kept.write_text(json.dumps(json.loads(kept.read_text())))
+    before = kept.read_bytes()
+    done = run_main("executor", "teach", "--assembly", str(spare), "--shapes", "round_peg")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"wrote {taught}" in done.stdout.splitlines(), done.stdout
+    assert f"wrote {kept}" not in done.stdout.splitlines(), done.stdout
+    assert kept.read_bytes() == before
+    record = load_skill(spare, "round_peg").taught
+    assert record is not None and record.reached
+
+
+@pytest.mark.parametrize(("shapes", "word"), [("round_peg,,square_peg", "expected comma-separated part shapes"),
+                                              ("round_peg,hex_peg", "no part shape hex_peg in")])
+def test_teaching_refuses_an_empty_or_unknown_shape_and_writes_nothing(spare: Path, run_main, shapes: str,
+                                                                       word: str) -> None:
+    """An empty item or a name not among geometry.toml's part shapes: one line, exit 2, no file written."""
+    before = {path: path.read_bytes() for path in spare.rglob("*") if path.is_file()}
+    done = run_main("executor", "teach", "--assembly", str(spare), "--shapes", shapes)
+    lines = error_lines(done.stderr)
+    assert done.returncode == 2 and len(lines) == 1 and word in lines[0] and not done.stdout, done.stdout + done.stderr
+    if "no part shape" in word:
+        assert str(spare / "geometry.toml") in lines[0]
+    assert {path: path.read_bytes() for path in spare.rglob("*") if path.is_file()} == before
