@@ -106,14 +106,21 @@ def move_joints(motion: Motion[ImpedanceController], q_goal: np.ndarray,
     span = q_goal - q0
     n = max(1, int(float(np.max(np.abs(span))) / JOINT_SPEED / TIME_STEP),
             math.ceil(float(np.max(PEAK_RATE * np.abs(span) / (RATE_MARGIN * arm.rate_limit))) / TIME_STEP))
+    observer = motion.observer
+    if observer is not None:
+        observer.begin("joint")
     for k in range(1, n + settle_steps(SETTLE) + 1):
         blend, rate = minimum_jerk(min(1.0, k / n))
         state = motion.controller.step_joints(q0 + blend * span, (rate / (n * TIME_STEP) if k < n else 0.0) * span)
         motion.steps += 1
         if after_step is not None:
             after_step()
+        if observer is not None:
+            observer.step()
         if k >= n and np.max(np.abs(state.q - q_goal)) < 1e-3 and np.max(np.abs(state.qd)) < 1e-2:
             break
+    if observer is not None:
+        observer.end()
 
 
 def _damped(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None, speed: float, settle: float,
@@ -143,14 +150,21 @@ def _track(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | No
         return np.array([p[0] for p in poses]), np.array([p[1] for p in poses])
 
     n = max(1, int(distance / speed / TIME_STEP), rate_steps(motion.controller.arm, line))
+    observer = motion.observer
+    if observer is not None:
+        observer.begin("descent" if speed == DESCENT_SPEED else "line")
     for k in range(1, n + settle_steps(settle) + 1):
         blend = minimum_jerk(min(1.0, k / n))[0]
         state = motion.step(start + blend * (goal - start), turn(blend))
         if after_step is not None:
             after_step()
+        if observer is not None:
+            observer.step()
         at_rest = np.linalg.norm(state.tip_vel) < 10 * tolerance
         if k >= n and at_rest and np.linalg.norm(state.tip_pos - goal) < tolerance:
             break
+    if observer is not None:
+        observer.end()
 
 
 def rate_steps(arm: Arm, line: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> int:

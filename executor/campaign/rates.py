@@ -6,7 +6,9 @@
 Runs the plan's steps (``PART`` or ``PART:HOLE``, in order) in one assembling cell, each
 with step seed S, and reads the simulated arm's joint rates after every control step of
 every move (:func:`executor.assembly.transfer.move_line`, :func:`~executor.assembly.transfer.reorient`
-and :func:`~executor.assembly.transfer.move_joints`; the insertions are not counted). A
+and :func:`~executor.assembly.transfer.move_joints`; the insertions are not counted), a
+:class:`Recorder` told of them as the cell's motion's observer
+(:class:`executor.control.motion.MoveObserver`). A
 move's kind is how its tool tip went (its real tip, in the cell frame): ``slow`` the last
 part of a descent (:data:`executor.assembly.transfer.DESCENT_SPEED`), else ``across``
 where it went farther sideways than up or down, else ``down`` or ``up``; ``joint`` a move
@@ -18,23 +20,19 @@ code 1 when a joint went faster than its limit, or a step did not fit.
 
 from __future__ import annotations
 
-import contextlib
 import json
-from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
-from unittest import mock
 
 import numpy as np
 import pybullet as pb
 
 from bridge.cli_types import MAX_SEED, ArgumentParser, add_assembly_argument, comma_list, int_in
-from executor.assembly import transfer
 from executor.assembly.product import load_product
 from executor.assembly.step import Assembler, StepRecord, check_product_step
 from executor.campaign.run import stdout_to_stderr
 from executor.cell_description import CellDescription
-from executor.control.motion import Motion
+from executor.control.motion import MoveKind
 from executor.world.arm import N_JOINTS, Arm
 from executor.world.scene import TIME_STEP
 
@@ -51,11 +49,16 @@ class Rates:
 
 
 class Recorder:
-    """Reads the joint rates of every move while installed (:meth:`installed`), by kind."""
+    """Reads the joint rates of every move an arm's motion makes (a
+    :class:`executor.control.motion.MoveObserver`: set it as the motion's ``observer``), by kind."""
 
     def __init__(self, arm: Arm) -> None:
         self.arm = arm
         self.kinds = {kind: Rates() for kind in KINDS}
+        self._kind: MoveKind = "line"
+        self._start = np.zeros(3)  # [m] the real tip where the move began
+        self._peak = np.zeros(N_JOINTS)  # [rad/s] each joint's peak rate in the move so far
+        self._steps = 0
 
     def _rates(self) -> np.ndarray:
         """The joints' rates now [rad/s] (not :meth:`Arm.read`, whose wrench filter a read advances)."""
@@ -63,48 +66,35 @@ class Recorder:
                                                        physicsClientId=self.arm.client)])
 
     def _tip(self) -> np.ndarray:
+        """The real tool tip now [m, cell frame]."""
         return np.array(pb.getLinkState(self.arm.robot, self.arm.sensor, computeForwardKinematics=1,
                                         physicsClientId=self.arm.client)[4])
 
-    def _move(self, run: Callable[[Callable[[], None]], None], after_step: Callable[[], None] | None,
-              kind: Callable[[np.ndarray], str]) -> None:
-        """Run a move (``run`` given the per-step callback), then count it under ``kind(displacement [m])``."""
-        peak, start, steps = np.zeros(N_JOINTS), self._tip(), 0
+    def begin(self, kind: MoveKind) -> None:
+        """A move of ``kind`` starts: its tip and its peaks from here."""
+        self._kind, self._start, self._peak, self._steps = kind, self._tip(), np.zeros(N_JOINTS), 0
 
-        def step() -> None:
-            nonlocal peak, steps
-            if after_step is not None:
-                after_step()
-            peak = np.maximum(peak, self._rates())
-            steps += 1
+    def step(self) -> None:
+        """After a control step of the move: the joints' rates now into its peaks."""
+        self._peak = np.maximum(self._peak, self._rates())
+        self._steps += 1
 
-        run(step)
-        rates = self.kinds[kind(self._tip() - start)]
+    def end(self) -> None:
+        """Count the move under its kind: ``joint``, ``slow`` (a ``descent``), else by its tip's travel."""
+        rates = self.kinds[self._bench_kind(self._tip() - self._start)]
         rates.moves += 1
-        rates.seconds += steps * TIME_STEP
-        rates.peak = np.maximum(rates.peak, peak)
+        rates.seconds += self._steps * TIME_STEP
+        rates.peak = np.maximum(rates.peak, self._peak)
 
-    @contextlib.contextmanager
-    def installed(self) -> Iterator[None]:
-        """Within it, :mod:`executor.assembly.transfer`'s Cartesian and joint moves are recorded."""
-        damped, joints = transfer._damped, transfer.move_joints
-
-        def recorded_damped(motion: Motion, goal: np.ndarray, after_step: Callable[[], None] | None, speed: float,
-                            settle: float, tolerance: float, turn: Callable[[float], np.ndarray]) -> None:
-            def kind(moved: np.ndarray) -> str:
-                if speed == transfer.DESCENT_SPEED:
-                    return "slow"
-                if np.linalg.norm(moved[:2]) > abs(moved[2]):
-                    return "across"
-                return "down" if moved[2] < 0 else "up"
-
-            self._move(lambda step: damped(motion, goal, step, speed, settle, tolerance, turn), after_step, kind)
-
-        def recorded_joints(motion: Motion, q_goal: np.ndarray, after_step: Callable[[], None] | None = None) -> None:
-            self._move(lambda step: joints(motion, q_goal, step), after_step, lambda _: "joint")
-
-        with mock.patch.multiple(transfer, _damped=recorded_damped, move_joints=recorded_joints):
-            yield
+    def _bench_kind(self, moved: np.ndarray) -> str:
+        """The kind of the move just ended, its real tip having moved by ``moved`` [m]."""
+        if self._kind == "joint":
+            return "joint"
+        if self._kind == "descent":
+            return "slow"
+        if np.linalg.norm(moved[:2]) > abs(moved[2]):
+            return "across"
+        return "down" if moved[2] < 0 else "up"
 
 
 def _step(text: str) -> tuple[str, str | None]:
@@ -125,8 +115,8 @@ def measure(assembly: str, plan: list[tuple[str, str | None]], seed: int) -> tup
     assembler = Assembler(product, description=description)
     try:
         recorder = Recorder(assembler.world.arm)
-        with recorder.installed():
-            records = [assembler.run_step(part, hole, seed) for part, hole in plan]
+        assembler.world.motion.observer = recorder
+        records = [assembler.run_step(part, hole, seed) for part, hole in plan]
     finally:
         assembler.close()
     return recorder, records

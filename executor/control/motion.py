@@ -7,7 +7,7 @@ robot's 1 kHz clock)."""
 
 from __future__ import annotations
 
-from typing import Generic, Protocol, TypeVar
+from typing import Generic, Literal, Protocol, TypeVar
 
 import numpy as np
 
@@ -28,6 +28,27 @@ class StepLogger(Protocol):
 
     def log_step(self, sim_time: float, phase: float, tool_pos: np.ndarray, force_mes: np.ndarray,
                  force_des: np.ndarray, torque_mes: np.ndarray, torque_des: np.ndarray) -> None: ...
+
+
+MoveKind = Literal["line", "descent", "joint"]
+"""How a move in free space (:mod:`executor.assembly.transfer`) goes: ``line`` the tip in a
+straight line (:func:`~executor.assembly.transfer.move_line`,
+:func:`~executor.assembly.transfer.reorient`), ``descent`` such a line at
+:data:`~executor.assembly.transfer.DESCENT_SPEED` (the slow end of a descent), ``joint``
+the joints to a posture (:func:`~executor.assembly.transfer.move_joints`)."""
+
+
+class MoveObserver(Protocol):
+    """What watches the moves in free space a :class:`Motion` makes (the bench of their joint
+    rates, :mod:`executor.campaign.rates`, is one): :meth:`begin` before a move's first
+    control step, :meth:`step` after each of its steps (after the move's own per-step
+    callback), :meth:`end` after its last (not called when the move raised)."""
+
+    def begin(self, kind: MoveKind) -> None: ...
+
+    def step(self) -> None: ...
+
+    def end(self) -> None: ...
 
 
 class ArmReader(Protocol):
@@ -76,6 +97,8 @@ class Motion(Generic[C]):
         """[rad] the yaw of the pointing-down tool the transfers last commanded
         (:mod:`executor.assembly.transfer`): where their next move turns it from."""
         self.frame: HoleFrame | None = None
+        self.observer: MoveObserver | None = None
+        """Told of every move in free space the transfers make through this motion (None: none is)."""
 
     def read(self) -> ArmState:
         """The arm's state now (in the ``frame``, if any)."""
