@@ -873,7 +873,7 @@ def _round_and_polygon(peg: Shape2D, hole: Shape2D) -> float | None:
     TOUCH, spanning at most :data:`executor.cad.fits.faces.SMOOTH` about its centre): the
     tessellation of a wall the peg touches (NopSCADlib's hinge pin, d 4, in a teardrop
     hole whose two arcs are tangent to its circle; the chords beside the tangent vertices
-    cut 2.5 µm into it), not a straight side it goes into; the nearest vertex's distance
+    cut 3.2 µm into it on its meshes), not a straight side it goes into; the nearest vertex's distance
     from the circle, None when they are no such pair."""
     if hole.kind == "round":
         reach = -round_fit(polygon(peg.outline, "peg"), None).room
